@@ -1,0 +1,60 @@
+"""Validation of user input at the public boundary.
+
+Public functions convert array_like input once, here, to float64 and check shape and
+finiteness; internal functions trust validated arrays.
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+
+from .exceptions import NonFiniteError, ShapeError
+
+
+def finite(name: str, x: NDArray[np.float64]) -> None:
+    """Raise :class:`NonFiniteError` naming ``name`` and the first bad index."""
+    if not np.all(np.isfinite(x)):
+        bad = np.argwhere(~np.isfinite(x))[0]
+        idx = tuple(int(i) for i in bad)
+        raise NonFiniteError(
+            f"{name} must be finite; got {x[idx]} at index {idx if len(idx) > 1 else idx[0]}"
+        )
+
+
+def as_array(name: str, x: ArrayLike, *, allow_nonfinite: bool = False) -> NDArray[np.float64]:
+    """Convert to a float64 array (a copy when needed) and check finiteness."""
+    try:
+        a = np.asarray(x, dtype=np.float64)
+    except (TypeError, ValueError) as exc:
+        raise ShapeError(f"{name} must be numeric array_like; got {type(x).__name__}") from exc
+    if not allow_nonfinite:
+        finite(name, a)
+    return a
+
+
+def as_batch(name: str, x: ArrayLike, tail: tuple[int, ...], **kw: Any) -> NDArray[np.float64]:
+    """Convert ``x`` and check that its trailing axes equal ``tail`` (leading axes are batch)."""
+    a = as_array(name, x, **kw)
+    k = len(tail)
+    if a.ndim < k or a.shape[a.ndim - k :] != tail:
+        want = ", ".join(["..."] + [str(t) for t in tail])
+        raise ShapeError(f"{name} must have shape ({want}); got {a.shape}")
+    return a
+
+
+def as_exact(name: str, x: ArrayLike, shape: tuple[int, ...], **kw: Any) -> NDArray[np.float64]:
+    """Convert ``x`` and check that its shape equals ``shape`` exactly."""
+    a = as_array(name, x, **kw)
+    if a.shape != shape:
+        raise ShapeError(f"{name} must have shape {shape}; got {a.shape}")
+    return a
+
+
+def frozen(a: NDArray[Any]) -> NDArray[Any]:
+    """Return a read-only copy of ``a``."""
+    b = np.array(a, copy=True)
+    b.setflags(write=False)
+    return b

@@ -1,0 +1,142 @@
+"""Terms of the joint-space equation of motion, batched.
+
+.. math:: M(q) \\ddot q + c(q, \\dot q) + g(q) = \\tau, \\qquad c = S(q, \\dot q) \\dot q
+
+``M`` [kg m^2] is built column by column from RNEA with unit accelerations and gravity off;
+``g`` [N m] is RNEA at rest; ``c`` [N m] is RNEA with zero acceleration and gravity off.
+``S`` is the Coriolis matrix from the Christoffel symbols of the first kind, for which
+:math:`\\dot M - 2 S` is skew-symmetric; its symbols are read exactly off the quadratic
+form ``c(q, v)`` by polarization.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+
+from .. import _checks
+from ..model.robot import Robot
+from .rnea import _prepare, _rnea
+
+__all__ = ["mass_matrix", "gravity_torques", "coriolis", "coriolis_matrix", "forward_dynamics"]
+
+_ZERO_G = np.zeros(3)
+
+
+def _mass_matrix(robot: Robot, q2: NDArray[np.float64]) -> NDArray[np.float64]:
+    """(B, n, n) mass matrices for validated (B, n) positions."""
+    B, n = q2.shape
+    qs = np.repeat(q2, n, axis=0)  # sample-major: row b*n + k
+    E = np.tile(np.eye(n), (B, 1))
+    cols = _rnea(robot, robot.phi, qs, np.zeros_like(qs), E, _ZERO_G)  # (B*n, n): column k
+    M = np.swapaxes(cols.reshape(B, n, n), 1, 2)
+    return 0.5 * (M + np.swapaxes(M, 1, 2))
+
+
+def mass_matrix(robot: Robot, q: ArrayLike) -> NDArray[np.float64]:
+    """Joint-space inertia matrix M(q).
+
+    Parameters
+    ----------
+    q : array_like, shape (..., n)
+        Joint positions [rad].
+
+    Returns
+    -------
+    M : ndarray, shape (..., n, n)
+        Symmetric positive definite [kg m^2] (kg for prismatic rows/columns).
+
+    Raises
+    ------
+    ShapeError, NonFiniteError
+    """
+    q = _checks.as_batch("q", q, (robot.n,))
+    return _mass_matrix(robot, q.reshape(-1, robot.n)).reshape(q.shape + (robot.n,))
+
+
+def gravity_torques(robot: Robot, q: ArrayLike) -> NDArray[np.float64]:
+    """Gravity torques g(q) = rnea(q, 0, 0) [N m], shape (..., n), for ``robot.gravity``."""
+    q = _checks.as_batch("q", q, (robot.n,))
+    q2 = q.reshape(-1, robot.n)
+    z = np.zeros_like(q2)
+    return _rnea(robot, robot.phi, q2, z, z, robot.gravity).reshape(q.shape)
+
+
+def coriolis(robot: Robot, q: ArrayLike, dq: ArrayLike) -> NDArray[np.float64]:
+    """Coriolis and centrifugal torques c(q, dq) = rnea(q, dq, 0) without gravity [N m].
+
+    Parameters
+    ----------
+    q, dq : array_like, shape (..., n)
+        Positions [rad] and velocities [rad/s]; batch shapes broadcast.
+
+    Returns
+    -------
+    c : ndarray, shape (..., n)
+    """
+    shape, (q2, dq2, _) = _prepare(robot, q, dq, np.zeros(robot.n))
+    return _rnea(robot, robot.phi, q2, dq2, np.zeros_like(q2), _ZERO_G).reshape(shape)
+
+
+def christoffel(robot: Robot, q: ArrayLike) -> NDArray[np.float64]:
+    """Christoffel symbols of the first kind ``G[..., i, j, k]`` [kg m^2], symmetric in j, k.
+
+    .. math:: \\Gamma_{ijk} = \\tfrac12 (\\partial_k M_{ij} + \\partial_j M_{ik} - \\partial_i M_{jk}),
+              \\qquad c_i = \\sum_{jk} \\Gamma_{ijk} \\dot q_j \\dot q_k
+    """
+    q = _checks.as_batch("q", q, (robot.n,))
+    n = robot.n
+    q2 = q.reshape(-1, n)
+    B = q2.shape[0]
+    pairs = [(j, k) for j in range(n) for k in range(j, n)]
+    V = np.zeros((len(pairs), n))
+    for r, (j, k) in enumerate(pairs):
+        V[r, j] = V[r, k] = 1.0
+    qs = np.repeat(q2, len(pairs), axis=0)
+    vs = np.tile(V, (B, 1))
+    cv = _rnea(robot, robot.phi, qs, vs, np.zeros_like(qs), _ZERO_G).reshape(B, len(pairs), n)
+    G = np.empty((B, n, n, n))
+    diag = {j: r for r, (j, k) in enumerate(pairs) if j == k}
+    for r, (j, k) in enumerate(pairs):
+        if j == k:
+            G[:, :, j, j] = cv[:, r]
+        else:  # c(e_j + e_k) = G_jj + G_kk + 2 G_jk
+            G[:, :, j, k] = G[:, :, k, j] = 0.5 * (cv[:, r] - cv[:, diag[j]] - cv[:, diag[k]])
+    return G.reshape(q.shape[:-1] + (n, n, n))
+
+
+def coriolis_matrix(robot: Robot, q: ArrayLike, dq: ArrayLike) -> NDArray[np.float64]:
+    """Coriolis matrix S(q, dq) from the Christoffel symbols, ``S dq = c``.
+
+    .. math:: S_{ij} = \\sum_k \\Gamma_{ijk}(q) \\dot q_k
+
+    With this choice :math:`\\dot M - 2S` is skew-symmetric.
+
+    Returns
+    -------
+    S : ndarray, shape (..., n, n)
+    """
+    q = _checks.as_batch("q", q, (robot.n,))
+    dq = _checks.as_batch("dq", dq, (robot.n,))
+    G = christoffel(robot, q)
+    return np.einsum("...ijk,...k->...ij", G, dq)
+
+
+def forward_dynamics(
+    robot: Robot, q: ArrayLike, dq: ArrayLike, tau: ArrayLike
+) -> NDArray[np.float64]:
+    """Joint accelerations from torques, ``ddq = M^{-1} (tau - c - g)`` (solved, not inverted).
+
+    Parameters
+    ----------
+    q, dq, tau : array_like, shape (..., n)
+        Positions [rad], velocities [rad/s], torques [N m] (friction not included).
+
+    Returns
+    -------
+    ddq : ndarray, shape (..., n) [rad/s^2]
+    """
+    shape, (q2, dq2, tau2) = _prepare(robot, q, dq, tau)
+    bias = _rnea(robot, robot.phi, q2, dq2, np.zeros_like(q2), robot.gravity)
+    M = _mass_matrix(robot, q2)
+    return np.linalg.solve(M, (tau2 - bias)[..., None])[..., 0].reshape(shape)

@@ -1,0 +1,54 @@
+"""Exceptions and warnings raised by dynid.
+
+Every error derives from :class:`DynidError`; each subclass also inherits the matching
+builtin (``ValueError``, ``KeyError``, ...) so generic handlers keep working.
+"""
+
+from __future__ import annotations
+
+
+class DynidError(Exception):
+    """Base class of every error raised by dynid."""
+
+
+class ShapeError(DynidError, ValueError):
+    """An array has the wrong shape."""
+
+
+class NonFiniteError(DynidError, ValueError):
+    """An array holds NaN or infinite values."""
+
+
+class UnknownNameError(DynidError, KeyError):
+    """A frame, joint, link or column name is not known."""
+
+    def __str__(self) -> str:  # KeyError quotes its message; keep it readable
+        return str(self.args[0]) if self.args else ""
+
+
+class ModelError(DynidError, ValueError):
+    """A robot description is malformed or cannot be modelled."""
+
+
+class DataError(DynidError, ValueError):
+    """A data set or log file is malformed."""
+
+
+class LimitError(DynidError, ValueError):
+    """A value lies outside the robot's limits where that matters."""
+
+
+class RankDeficientError(DynidError, ValueError):
+    """A regressor does not have the rank needed to identify the parameters."""
+
+
+class InfeasibleError(DynidError, ValueError):
+    """A specification of physical parameters cannot be met."""
+
+
+class ConvergenceError(DynidError, RuntimeError):
+    """An iterative method did not converge."""
+
+
+class DynidWarning(UserWarning):
+    """A recoverable problem: ill-conditioning, inconsistent inertials, dropped data."""

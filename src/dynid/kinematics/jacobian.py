@@ -1,0 +1,95 @@
+"""Geometric Jacobians, batched.
+
+``J`` has shape ``(..., 6, n)`` with rows ``[v; w]`` (linear velocity of the frame's
+origin, then angular velocity), both expressed in the base frame: ``[v; w] = J(q) dq``.
+Linear rows are in [m/rad] (revolute) or [m/m] (prismatic), angular rows in [rad/rad].
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+
+from .. import _checks
+from ..exceptions import ShapeError
+from ..model.robot import Robot
+from .forward import _link_poses, check_q, frame_pose_in_link
+
+__all__ = ["jacobian", "jacobian_to_tool"]
+
+
+def jacobian(
+    robot: Robot, q: ArrayLike, frame: str = "flange", tool: ArrayLike | None = None
+) -> NDArray[np.float64]:
+    """Geometric Jacobian of a frame's origin (or of a tool fixed to it), in the base frame.
+
+    Column ``i`` is ``[z_i x (p - o_i); z_i]`` for a revolute joint and ``[z_i; 0]`` for a
+    prismatic one, ``z_i`` the joint axis and ``o_i`` the origin of link i in the base
+    frame, ``p`` the frame's origin; joints after the frame's link give zero columns.
+
+    Parameters
+    ----------
+    q : array_like, shape (..., n)
+    frame : str
+        Name of the frame.
+    tool : array_like, shape (4, 4), optional
+        Pose of a tool in ``frame`` [m]; the Jacobian is then the tool origin's.
+
+    Returns
+    -------
+    J_base : ndarray, shape (..., 6, n)
+        Rows ``vx, vy, vz, wx, wy, wz``; reference point: the frame's (tool's) origin.
+
+    Raises
+    ------
+    ShapeError, NonFiniteError, UnknownNameError
+    """
+    link, T_link_frame = frame_pose_in_link(robot, frame, tool)
+    q = check_q(robot, q)
+    T = _link_poses(robot, q.reshape(-1, robot.n))
+    p = (T[:, link] @ T_link_frame)[:, :3, 3]  # (B, 3)
+    z = (T[:, 1:, :3, :3] @ robot.axes[:, :, None])[..., 0]  # (B, n, 3)
+    o = T[:, 1:, :3, 3]
+    J = np.zeros((q.reshape(-1, robot.n).shape[0], 6, robot.n))
+    rev = ~robot.prismatic
+    lin = np.where(rev[:, None], np.cross(z, p[:, None, :] - o), z)
+    ang = np.where(rev[:, None], z, 0.0)
+    active = np.arange(1, robot.n + 1) <= link
+    J[:, :3, :] = np.swapaxes(lin, 1, 2) * active
+    J[:, 3:, :] = np.swapaxes(ang, 1, 2) * active
+    return J.reshape(q.shape[:-1] + (6, robot.n))
+
+
+def jacobian_to_tool(
+    J_base_frame: ArrayLike, T_base_frame: ArrayLike, T_frame_tool: ArrayLike
+) -> NDArray[np.float64]:
+    """Carry a geometric Jacobian from a frame to a tool rigidly attached to it.
+
+    With ``r = R_base_frame p_frame_tool`` the tool offset in the base frame,
+
+    .. math:: J_{tool} = \\begin{bmatrix} E & -[r]_\\times \\\\ 0 & E \\end{bmatrix} J_{frame}
+
+    Parameters
+    ----------
+    J_base_frame : array_like, shape (..., 6, n)
+        Jacobian of the frame's origin, rows ``[v; w]`` in the base frame.
+    T_base_frame : array_like, shape (..., 4, 4)
+        Pose of the frame in the base frame [m].
+    T_frame_tool : array_like, shape (4, 4) or (..., 4, 4)
+        Pose of the tool in the frame [m].
+
+    Returns
+    -------
+    J_base_tool : ndarray, shape (..., 6, n)
+        Jacobian of the tool origin, in the base frame.
+    """
+    J = _checks.as_array("J_base_frame", J_base_frame)
+    if J.ndim < 2 or J.shape[-2] != 6:
+        raise ShapeError(f"J_base_frame must have shape (..., 6, n); got {J.shape}")
+    T = _checks.as_batch("T_base_frame", T_base_frame, (4, 4))
+    Tt = _checks.as_batch("T_frame_tool", T_frame_tool, (4, 4))
+    r = np.einsum("...ij,...j->...i", T[..., :3, :3], Tt[..., :3, 3])
+    w = J[..., 3:, :]
+    out = np.array(np.broadcast_to(J, np.broadcast_shapes(J.shape, r.shape[:-1] + J.shape[-2:])))
+    out[..., :3, :] = J[..., :3, :] + np.cross(w, r[..., :, None], axis=-2)
+    return out

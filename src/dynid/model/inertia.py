@@ -1,0 +1,120 @@
+"""Inertial parameters of a rigid link and the standard parameter vector.
+
+Layout of the standard parameters of one link (Gaz et al. 2019, eqs. 3-4), 10 entries::
+
+    phi_i = [m, m*cx, m*cy, m*cz, Jxx, Jxy, Jxz, Jyy, Jyz, Jzz]
+
+with the centre of mass ``c`` [m] in the link frame and ``J`` [kg m^2] the inertia tensor
+**about the link-frame origin**, in link-frame axes. The barycentric inertia ``I`` (about the
+CoM, link-frame axes) follows from the parallel-axis theorem (Gaz et al. eq. 26):
+
+.. math:: J = I + m (c^T c \\, E - c c^T)
+
+The robot's vector ``phi`` concatenates the links in joint order: shape ``(n * 10,)``;
+:func:`param_labels` names every entry (``m3``, ``mc3x``, ``J3xx``, ...).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+
+from .. import _checks
+
+__all__ = [
+    "PARAMS_PER_LINK",
+    "INERTIA_ORDER",
+    "param_labels",
+    "matrix_from_inertia6",
+    "inertia6_from_matrix",
+    "phi_from_inertial",
+    "inertial_from_phi",
+    "parallel_axis",
+]
+
+PARAMS_PER_LINK = 10
+INERTIA_ORDER = ("xx", "xy", "xz", "yy", "yz", "zz")
+_I6 = ((0, 0), (0, 1), (0, 2), (1, 1), (1, 2), (2, 2))
+
+
+def param_labels(n: int) -> tuple[str, ...]:
+    """Labels of the ``10 n`` standard parameters, links numbered from 1.
+
+    ``m<i>`` [kg], ``mc<i>x`` ... [kg m], ``J<i>xx`` ... [kg m^2] (about the link origin).
+    """
+    out: list[str] = []
+    for i in range(1, n + 1):
+        out += [f"m{i}", f"mc{i}x", f"mc{i}y", f"mc{i}z"]
+        out += [f"J{i}{ax}" for ax in INERTIA_ORDER]
+    return tuple(out)
+
+
+def matrix_from_inertia6(i6: ArrayLike) -> NDArray[np.float64]:
+    """Symmetric 3x3 tensor from ``(xx, xy, xz, yy, yz, zz)``; (..., 6) -> (..., 3, 3)."""
+    a = _checks.as_batch("inertia", i6, (6,))
+    xx, xy, xz, yy, yz, zz = np.moveaxis(a, -1, 0)
+    return np.stack(
+        [np.stack([xx, xy, xz], -1), np.stack([xy, yy, yz], -1), np.stack([xz, yz, zz], -1)], -2
+    )
+
+
+def inertia6_from_matrix(I: ArrayLike) -> NDArray[np.float64]:
+    """``(xx, xy, xz, yy, yz, zz)`` of a 3x3 tensor (its upper triangle); (..., 3, 3) -> (..., 6)."""
+    a = _checks.as_batch("inertia", I, (3, 3))
+    return np.stack([a[..., i, j] for i, j in _I6], axis=-1)
+
+
+def parallel_axis(mass: ArrayLike, com: ArrayLike) -> NDArray[np.float64]:
+    """The term ``m (c^T c E - c c^T)`` [kg m^2] that moves an inertia from the CoM to the origin."""
+    m = np.asarray(mass, dtype=np.float64)
+    c = np.asarray(com, dtype=np.float64)
+    cc = np.einsum("...i,...i->...", c, c)
+    return m[..., None, None] * (cc[..., None, None] * np.eye(3) - c[..., :, None] * c[..., None, :])
+
+
+def phi_from_inertial(mass: ArrayLike, com: ArrayLike, inertia: ArrayLike) -> NDArray[np.float64]:
+    """Standard parameters from mass, CoM and inertia about the CoM.
+
+    Parameters
+    ----------
+    mass : array_like, shape (...)
+        Link masses [kg].
+    com : array_like, shape (..., 3)
+        Centres of mass in the link frame [m].
+    inertia : array_like, shape (..., 3, 3) or (..., 6)
+        Inertia about the CoM, link-frame axes [kg m^2]; 6-vectors in ``INERTIA_ORDER``.
+
+    Returns
+    -------
+    phi : ndarray, shape (..., 10)
+    """
+    m = _checks.as_array("mass", mass)
+    c = _checks.as_batch("com", com, (3,))
+    I = _checks.as_array("inertia", inertia)
+    if I.shape[-1:] == (6,):
+        I = matrix_from_inertia6(I)
+    I = _checks.as_batch("inertia", I, (3, 3))
+    J = I + parallel_axis(m, c)
+    shape = np.broadcast_shapes(m.shape, c.shape[:-1], J.shape[:-2])
+    out = np.empty(shape + (10,))
+    out[..., 0] = m
+    out[..., 1:4] = m[..., None] * c
+    out[..., 4:] = inertia6_from_matrix(J)
+    return out
+
+
+def inertial_from_phi(
+    phi: ArrayLike,
+) -> tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.float64]]:
+    """Mass [kg], CoM [m] and inertia about the CoM [kg m^2, (..., 3, 3)] from ``(..., 10)``.
+
+    A link of zero mass has its CoM set to the origin (its first moment must then be zero
+    for the result to describe the same body; this is not checked here, see
+    ``feasibility.validate``).
+    """
+    p = _checks.as_batch("phi", phi, (10,))
+    m = p[..., 0]
+    safe = np.where(m != 0.0, m, 1.0)
+    c = np.where((m != 0.0)[..., None], p[..., 1:4] / safe[..., None], 0.0)
+    J = matrix_from_inertia6(p[..., 4:])
+    return m.copy(), c, J - parallel_axis(m, c)

@@ -1,0 +1,95 @@
+"""The built-in Franka Emika Panda (FER).
+
+Kinematics: modified DH table of Gaz et al. 2019 (Fig. 1) and Franka's documentation; the
+flange (frame 8) is 0.107 m along z7. Link frames ``link0..link7`` coincide with the
+``panda_link0..7`` frames of Franka's URDF.
+
+Inertial parameters: the feasible set p_hat of Gaz et al., "Dynamic Identification of the
+Franka Emika Panda Robot With Retrieval of Feasible Parameters Using Penalty-Based
+Optimization", IEEE RA-L 4(4):4147-4154, 2019 (supplementary material, Tables VIII and IX;
+identical to ``DynPars2VREP.m`` of marcocognetti/FrankaEmikaPandaDynModel). Mass [kg],
+CoM in the MDH link frame [m], inertia about the CoM in link axes [kg m^2], order
+``xx, xy, xz, yy, yz, zz``. The CoM z of link 1 is not identifiable and is stored as 0.
+
+Friction: the sigmoid model of the same paper (supplementary Table I),
+``tau_f = phi1 / (1 + exp(-phi2 (dq + phi3))) - phi1 / (1 + exp(-phi2 phi3))``.
+
+Limits: Franka's "Limits for Panda" (frankaemika/docs, control_parameters).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from .robot import Robot
+
+__all__ = ["panda", "PANDA_NEUTRAL_Q"]
+
+_A = [0.0, 0.0, 0.0, 0.0825, -0.0825, 0.0, 0.088]
+_D = [0.333, 0.0, 0.316, 0.0, 0.384, 0.0, 0.0]
+_ALPHA = [0.0, -np.pi / 2, np.pi / 2, np.pi / 2, -np.pi / 2, np.pi / 2, np.pi / 2]
+_FLANGE = (0.0, 0.107, 0.0, 0.0)
+
+_MASS = [4.970684, 0.646926, 3.228604, 3.587895, 1.225946, 1.666555, 0.735522]
+_COM = [
+    [0.003875, 0.002081, 0.0],
+    [-0.003141, -0.02872, 0.003495],
+    [0.027518, 0.039252, -0.066502],
+    [-0.05317, 0.104419, 0.027454],
+    [-0.011953, 0.041065, -0.038437],
+    [0.060149, -0.014117, -0.010517],
+    [0.010517, -0.004252, 0.061597],
+]
+_INERTIA = [  # xx, xy, xz, yy, yz, zz about the CoM
+    [0.70337, -0.000139, 0.006772, 0.70661, 0.019169, 0.009117],
+    [0.007962, -0.003925, 0.010254, 0.02811, 0.000704, 0.025995],
+    [0.037242, -0.004761, -0.011396, 0.036155, -0.012805, 0.01083],
+    [0.025853, 0.007796, -0.001332, 0.019552, 0.008641, 0.028323],
+    [0.035549, -0.002117, -0.004037, 0.029474, 0.000229, 0.008627],
+    [0.001964, 0.000109, -0.001158, 0.004354, 0.000341, 0.005433],
+    [0.012516, -0.000428, -0.001196, 0.010027, -0.000741, 0.004815],
+]
+_FRICTION = np.array(
+    [
+        [0.54615, 0.87224, 0.64068, 1.2794, 0.83904, 0.30301, 0.56489],  # phi1 [N m]
+        [5.1181, 9.0657, 10.136, 5.5903, 8.3469, 17.133, 10.336],  # phi2 [s/rad]
+        [0.039533, 0.025882, -0.04607, 0.036194, 0.026226, -0.021047, 0.0035526],  # phi3 [rad/s]
+    ]
+).T
+
+_Q_MAX = [2.8973, 1.7628, 2.8973, -0.0698, 2.8973, 3.7525, 2.8973]
+_Q_MIN = [-2.8973, -1.7628, -2.8973, -3.0718, -2.8973, -0.0175, -2.8973]
+_DQ_MAX = [2.175, 2.175, 2.175, 2.175, 2.61, 2.61, 2.61]
+_DDQ_MAX = [15.0, 7.5, 10.0, 12.5, 15.0, 20.0, 20.0]
+_TAU_MAX = [87.0, 87.0, 87.0, 87.0, 12.0, 12.0, 12.0]
+
+#: Neutral pose [rad] (franka_ros' "ready" pose), used as the default start for IK and demos.
+PANDA_NEUTRAL_Q = np.array([0.0, -np.pi / 4, 0.0, -3 * np.pi / 4, 0.0, np.pi / 2, np.pi / 4])
+PANDA_NEUTRAL_Q.setflags(write=False)
+
+
+def panda() -> Robot:
+    """The Franka Emika Panda with the published feasible parameters and friction.
+
+    Returns
+    -------
+    Robot
+        7 revolute joints ``joint1..joint7``, links ``link0..link7``, frame ``flange``
+        0.107 m along z7; gravity 9.80665 m/s^2 along -z of ``link0``.
+    """
+    return Robot.from_mdh(
+        _A,
+        _D,
+        _ALPHA,
+        flange=_FLANGE,
+        mass=_MASS,
+        com=_COM,
+        inertia=np.asarray(_INERTIA),
+        q_min=_Q_MIN,
+        q_max=_Q_MAX,
+        dq_max=_DQ_MAX,
+        ddq_max=_DDQ_MAX,
+        tau_max=_TAU_MAX,
+        friction=_FRICTION,
+        name="panda",
+    )

@@ -1,0 +1,76 @@
+"""Shared fixtures: the built-in Panda, a planar 2R arm with closed forms, seeded states."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+import dynid
+
+
+@pytest.fixture(scope="session")
+def panda() -> dynid.Robot:
+    return dynid.panda()
+
+
+@pytest.fixture
+def rng() -> np.random.Generator:
+    return np.random.default_rng(12345)
+
+
+def random_states(robot: dynid.Robot, n: int, seed: int):
+    """``n`` seeded random (q, dq, ddq) with q inside the limits."""
+    rng = np.random.default_rng(seed)
+    lo = np.where(np.isfinite(robot.q_min), robot.q_min, -np.pi)
+    hi = np.where(np.isfinite(robot.q_max), robot.q_max, np.pi)
+    q = rng.uniform(lo, hi, (n, robot.n))
+    dq = rng.uniform(-2.0, 2.0, (n, robot.n))
+    ddq = rng.uniform(-5.0, 5.0, (n, robot.n))
+    return q, dq, ddq
+
+
+def planar_2r(l1: float = 0.7, l2: float = 0.5, m1: float = 2.0, m2: float = 1.5,
+              I1: float = 0.05, I2: float = 0.03, g: float = 9.81) -> dynid.Robot:
+    """Planar 2R arm moving in the vertical x-y plane (gravity along -y), CoM at mid-link.
+
+    Joints rotate about z; link i has length l_i along its x axis (MDH a), point CoM
+    inertia I_i about z at the CoM.
+    """
+    inertia = np.zeros((2, 3, 3))
+    inertia[0] = np.diag([I1, I1, I1])
+    inertia[1] = np.diag([I2, I2, I2])
+    r = dynid.Robot.from_mdh(
+        [0.0, l1], [0.0, 0.0], [0.0, 0.0], flange=(l2, 0.0, 0.0, 0.0),
+        mass=[m1, m2], com=[[l1 / 2, 0, 0], [l2 / 2, 0, 0]], inertia=inertia,
+        gravity=(0.0, -g, 0.0), name="planar2r",
+    )
+    return r
+
+
+@pytest.fixture
+def planar2r() -> dynid.Robot:
+    return planar_2r()
+
+
+def pinocchio_panda_urdf() -> str:
+    """Path of example-robot-data's Panda URDF (skips the test when not installed)."""
+    return robot_data_urdf("panda_description/urdf/panda.urdf")
+
+
+def robot_data_urdf(rel: str) -> str:
+    import importlib.util
+    from pathlib import Path
+
+    spec = importlib.util.find_spec("example_robot_data")
+    roots = []
+    if spec is not None and spec.submodule_search_locations:
+        roots += [Path(p) for p in spec.submodule_search_locations]
+    import sys
+
+    for p in sys.path:
+        roots.append(Path(p) / "cmeel.prefix" / "share" / "example-robot-data" / "robots")
+    for root in roots:
+        for cand in (root / rel, root / "robots" / rel):
+            if cand.exists():
+                return str(cand)
+    pytest.skip(f"example-robot-data file {rel} not found")
