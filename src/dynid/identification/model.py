@@ -1,0 +1,80 @@
+"""The identified Lagrangian model: base parameters ``beta`` valid for a robot's kinematics.
+
+.. math:: \\hat\\tau(q, \\dot q, \\ddot q) = Y_b(q, \\dot q, \\ddot q) \\hat\\beta
+          \\quad \\text{(Gaz et al. 2019, eq. 23)}
+
+The model is evaluated through an *equivalent robot*: standard parameters equal to
+``beta`` at the independent columns and 0 elsewhere map to ``beta`` by the base
+projection, so RNEA, ``M``, ``g`` and ``c`` of that (generally non-physical) parameter set
+are exactly those of the identified model.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+
+from ..dynamics.rnea import rnea
+from ..dynamics.terms import coriolis, gravity_torques, mass_matrix
+from ..model.robot import Robot
+from ..regressors.base import BaseParameters
+from .least_squares import LeastSquaresFit
+
+__all__ = ["IdentifiedModel"]
+
+
+@dataclass(frozen=True, slots=True, eq=False)
+class IdentifiedModel:
+    """Identified base parameters with the kinematics they are valid for.
+
+    Attributes
+    ----------
+    robot : Robot
+        Kinematics (and gravity) the coefficients belong to; its inertial parameters
+        are not used.
+    base : BaseParameters
+        Labels, expressions and the map from standard parameters.
+    fit : LeastSquaresFit
+        Estimates ``fit.beta`` and statistics.
+    friction : ndarray, shape (n, 3), optional
+        Linear friction ``fv [N m s/rad], fc [N m], fo [N m]`` per joint, identified with
+        the classical route; None otherwise.
+    metadata : dict
+        Route, data source, row counts, dropped rows, seed.
+    """
+
+    robot: Robot
+    base: BaseParameters
+    fit: LeastSquaresFit
+    friction: NDArray[np.float64] | None = None
+    metadata: dict[str, Any] = field(default_factory=dict)
+    equivalent_robot: Robot = field(init=False)
+
+    def __post_init__(self) -> None:
+        phi = np.zeros(self.base.n_std)
+        phi[self.base.independent] = self.fit.beta
+        object.__setattr__(self, "equivalent_robot", self.robot.with_params(phi))
+
+    @property
+    def beta(self) -> NDArray[np.float64]:
+        """Identified base parameters (r,)."""
+        return self.fit.beta
+
+    def mass_matrix(self, q: ArrayLike) -> NDArray[np.float64]:
+        """Identified ``M(q)``: (..., n) -> (..., n, n) [kg m^2]."""
+        return mass_matrix(self.equivalent_robot, q)
+
+    def gravity_torques(self, q: ArrayLike) -> NDArray[np.float64]:
+        """Identified ``g(q)`` [N m]: (..., n) -> (..., n)."""
+        return gravity_torques(self.equivalent_robot, q)
+
+    def coriolis(self, q: ArrayLike, dq: ArrayLike) -> NDArray[np.float64]:
+        """Identified ``c(q, dq)`` [N m]: (..., n) -> (..., n)."""
+        return coriolis(self.equivalent_robot, q, dq)
+
+    def torques(self, q: ArrayLike, dq: ArrayLike, ddq: ArrayLike) -> NDArray[np.float64]:
+        """Identified ``M ddq + c + g`` [N m], friction not included: (..., n)."""
+        return rnea(self.equivalent_robot, q, dq, ddq)
