@@ -1,0 +1,89 @@
+"""Architecture: each module imports only from its own layer or an earlier one."""
+
+from __future__ import annotations
+
+import ast
+from pathlib import Path
+
+SRC = Path(__file__).resolve().parents[1] / "src" / "dynid"
+
+#: Layers in data-flow order (STYLE.md section 1).
+LAYERS = [
+    {"exceptions", "_checks", "spatial", "signals"},
+    {"model"},
+    {"kinematics"},
+    {"dynamics"},
+    {"regressors"},
+    {"identification"},
+    {"friction"},
+    {"simulation"},
+    {"feasibility"},
+    {"io"},
+    {"plots"},
+    {"cli"},
+]
+
+
+def _layer(part: str) -> int | None:
+    for k, names in enumerate(LAYERS):
+        if part in names:
+            return k
+    return None
+
+
+def _module_layer(path: Path) -> int | None:
+    rel = path.relative_to(SRC).with_suffix("")
+    return _layer(rel.parts[0])
+
+
+def _imported_parts(path: Path) -> list[str]:
+    tree = ast.parse(path.read_text())
+    rel = path.relative_to(SRC)
+    pkg = list(rel.parts[:-1])
+    out = []
+    for node in ast.walk(tree):
+        if isinstance(node, ast.ImportFrom):
+            if node.level:
+                base = pkg[: len(pkg) - (node.level - 1)]
+                target = base + (node.module.split(".") if node.module else [])
+                if not target:  # "from . import x" at the package root
+                    target = [a.name for a in node.names]
+                    out += target
+                    continue
+                out.append(target[0])
+            elif node.module and node.module.startswith("dynid."):
+                out.append(node.module.split(".")[1])
+        elif isinstance(node, ast.Import):
+            out += [a.name.split(".")[1] for a in node.names if a.name.startswith("dynid.")]
+    return out
+
+
+def test_modules_import_only_from_earlier_or_same_layers():
+    """No module imports from a later layer of the data flow."""
+    bad = []
+    for path in SRC.rglob("*.py"):
+        own = _module_layer(path)
+        if own is None:
+            continue
+        for part in _imported_parts(path):
+            dep = _layer(part)
+            if dep is not None and dep > own:
+                bad.append(f"{path.relative_to(SRC)} imports {part}")
+    assert not bad, "layering violations:\n" + "\n".join(bad)
+
+
+def test_every_package_is_assigned_a_layer():
+    """Every subpackage and top-level module of dynid belongs to a layer."""
+    names = {p.stem for p in SRC.glob("*.py")} | {p.name for p in SRC.iterdir() if p.is_dir()}
+    names -= {"__init__", "__pycache__", "py.typed"}
+    assert {n for n in names if _layer(n) is None} == set()
+
+
+def test_import_dynid_does_not_load_matplotlib():
+    """Importing the library keeps matplotlib unloaded (figures import it lazily)."""
+    import subprocess
+    import sys
+
+    code = "import sys, dynid; print('matplotlib' in sys.modules)"
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
+    assert out.stdout.strip() == "False"
