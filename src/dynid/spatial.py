@@ -74,16 +74,15 @@ def matrix_from_rpy(rpy: ArrayLike) -> NDArray[np.float64]:
 def rpy_from_matrix(R: ArrayLike) -> NDArray[np.float64]:
     """URDF roll-pitch-yaw [rad] of a rotation matrix (inverse of :func:`matrix_from_rpy`).
 
-    At pitch = ±pi/2 (gimbal lock) roll is set to 0 and yaw takes the whole rotation.
+    Roll is read first, then pitch and yaw from ``R Rx(-roll) = Rz(yaw) Ry(pitch)``, whose
+    entries stay O(1) near gimbal lock (pitch = ±pi/2), so ``matrix_from_rpy`` of the result
+    reproduces ``R`` to rounding error everywhere; (..., 3, 3) -> (..., 3).
     """
     R = _checks.as_batch("R", R, (3, 3))
-    pitch = np.arctan2(-R[..., 2, 0], np.hypot(R[..., 0, 0], R[..., 1, 0]))
     roll = np.arctan2(R[..., 2, 1], R[..., 2, 2])
-    yaw = np.arctan2(R[..., 1, 0], R[..., 0, 0])
-    lock = np.hypot(R[..., 0, 0], R[..., 1, 0]) < 1e-12
-    if np.any(lock):
-        roll = np.where(lock, 0.0, roll)
-        yaw = np.where(lock, np.arctan2(-R[..., 0, 1], R[..., 1, 1]), yaw)
+    Rr = R @ rot_x(-roll)
+    pitch = np.arctan2(-Rr[..., 2, 0], Rr[..., 2, 2])
+    yaw = np.arctan2(-Rr[..., 0, 1], Rr[..., 1, 1])
     return np.stack([roll, pitch, yaw], axis=-1)
 
 

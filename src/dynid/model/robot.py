@@ -153,8 +153,12 @@ class Robot:
                 f"{self.q_min[j]} >= {self.q_max[j]}"
             )
         for k in ("dq_max", "ddq_max", "tau_max"):
-            if np.any(getattr(self, k) <= 0):
-                raise ModelError(f"{k} must be positive")
+            bad = np.flatnonzero(getattr(self, k) <= 0)
+            if bad.size:
+                j = int(bad[0])
+                raise ModelError(
+                    f"{k} must be positive; joint {self.joint_names[j]}: {getattr(self, k)[j]}"
+                )
         put("gravity", _checks.frozen(_checks.as_exact("gravity", self.gravity, (3,))))
         frames = {name: Frame(i, np.eye(4)) for i, name in enumerate(self.link_names)}
         frames.update(self.frames)
@@ -247,7 +251,7 @@ class Robot:
         T_flange_tool: ArrayLike,
         mass: float = 0.0,
         com: ArrayLike = (0.0, 0.0, 0.0),
-        inertia: ArrayLike = np.zeros((3, 3)),
+        inertia: ArrayLike | None = None,
         *,
         parent: str = "flange",
         name: str = "tool",
@@ -269,9 +273,13 @@ class Robot:
             Tool inertia about its CoM, tool-frame axes [kg m^2].
         """
         robot = self.with_frame(name, T_flange_tool, parent)
+        if inertia is None:
+            inertia = np.zeros((3, 3))
         if mass == 0.0 and not np.any(np.asarray(inertia)):
             return robot
         f = robot.frame(name)
+        if f.link == 0:
+            raise ModelError("a tool with inertia cannot be fixed to the base")
         R, p = f.T_link_frame[:3, :3], f.T_link_frame[:3, 3]
         I = _checks.as_array("inertia", inertia)
         if I.shape == (6,):
@@ -282,8 +290,6 @@ class Robot:
         phi_tool = phi_from_inertial(mass, c_link, R @ I @ R.T)
         phi = np.array(robot.phi)
         phi[f.link - 1] += phi_tool
-        if f.link == 0:
-            raise ModelError("a tool with inertia cannot be fixed to the base")
         return robot.replace(phi=phi)
 
     # ------------------------------------------------------------------ constructors
@@ -342,7 +348,7 @@ class Robot:
             )
         th = np.zeros(n) if theta is None else _checks.as_exact("theta", theta, (n,))
         types = joint_types * n if isinstance(joint_types, str) and len(joint_types) == 1 else joint_types
-        if len(types) != n or any(t.upper() not in "RP" for t in types):
+        if len(types) != n or any(str(t).upper() not in ("R", "P") for t in types):
             raise ModelError(f"joint_types must be 'R' or 'P' for each of the {n} joints; got {joint_types!r}")
         pri = np.array([t.upper() == "P" for t in types])
         T = np.stack([mdh_transform(a_[i], d_[i], al[i], th[i]) for i in range(n)])
@@ -400,7 +406,7 @@ class Robot:
 
         text = toml_from_robot(self)
         if path is not None:
-            Path(path).write_text(text)
+            Path(path).write_text(text, encoding="utf-8")
         return text
 
     def __repr__(self) -> str:

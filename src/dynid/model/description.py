@@ -1,0 +1,449 @@
+"""dynid's own TOML robot description, read and written.
+
+:func:`robot_from_toml` (or :func:`robot_from_toml_string`) reads a description,
+:func:`toml_from_robot` writes one. The description holds everything a
+:class:`~dynid.model.robot.Robot` holds: kinematics, inertial parameters, limits,
+friction, gravity and named frames. Units are SI throughout (m, rad, kg, kg m^2, s);
+angles are never in degrees. Writing and reading a robot gives the same robot to about
+1e-15 (floats are written with ``repr``).
+
+Schema
+------
+Top-level keys::
+
+    format_version = 1                    # optional; the only version
+    name = "panda"                        # optional, default "robot"
+    gravity = [0.0, 0.0, -9.80665]        # optional; base frame [m/s^2], default standard gravity
+
+One ``[[joints]]`` table per joint, listed from the base to the tip::
+
+    [[joints]]
+    name = "joint1"                       # required, unique
+    type = "revolute"                     # required: "revolute" or "prismatic"
+    parent = "link0"                      # required: the base link for the first joint,
+                                          #   the previous joint's child afterwards
+    child = "link1"                       # required, unique; names the link the joint moves
+    origin = { xyz = [0.0, 0.0, 0.333], rpy = [0.0, 0.0, 0.0] }
+                                          # pose of the joint frame (= child link frame at
+                                          #   q = 0) in the parent link [m, rad]; URDF rpy
+                                          #   Rz(yaw) Ry(pitch) Rx(roll); xyz, rpy default 0
+    # mdh = { a = 0.0, d = 0.333, alpha = 0.0, theta = 0.0 }
+                                          # alternative to origin: Craig's modified DH,
+                                          #   RotX(alpha) TransX(a) RotZ(theta) TransZ(d);
+                                          #   a, d, alpha required, theta default 0
+    axis = [0.0, 0.0, 1.0]                # optional, child-link coordinates, normalised;
+                                          #   default z
+    limits = { lower = -2.8973, upper = 2.8973, velocity = 2.175, acceleration = 15.0,
+               effort = 87.0 }            # optional, each key optional; omitted = unbounded
+                                          #   [rad or m, rad/s or m/s, rad/s^2 or m/s^2,
+                                          #   N m or N] (write inline tables on one line)
+    friction = [0.5, 5.0, 0.04]           # optional sigmoid friction phi1 [N m], phi2 [s/rad],
+                                          #   phi3 [rad/s] (Gaz et al. 2019 eq. 25);
+                                          #   give it for every joint or for none
+
+    [joints.inertial]                     # optional; omitted = massless link
+    mass = 4.970684                       # [kg]
+    com = [0.003875, 0.002081, 0.0]       # centre of mass in the child link frame [m]
+    inertia = [0.70337, -0.000139, 0.006772, 0.70661, 0.019169, 0.009117]
+                                          # xx, xy, xz, yy, yz, zz about the CoM, in
+                                          #   child-link axes [kg m^2]
+
+Extra named frames, optional (every link name is a frame already; ``flange`` defaults to
+the last link's frame)::
+
+    [[frames]]
+    name = "flange"                       # required, unique
+    parent = "link7"                      # required: a link name or a frame listed earlier
+    xyz = [0.0, 0.0, 0.107]               # pose in the parent frame [m, rad], default 0
+    rpy = [0.0, 0.0, 0.0]
+    # mdh = { a = 0.0, d = 0.107, alpha = 0.0, theta = 0.0 }   # alternative to xyz/rpy
+
+Unknown keys are rejected, so that a misspelt key does not silently fall back to a
+default. Every error names the joint or frame and the key.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+import tomllib
+from collections.abc import Mapping, Sequence
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+from numpy.typing import NDArray
+
+from .. import spatial
+from ..exceptions import DynidError, ModelError
+from .inertia import inertia6_from_matrix, phi_from_inertial
+from .robot import STANDARD_GRAVITY, Frame, Robot, mdh_transform
+
+__all__ = ["FORMAT_VERSION", "robot_from_toml", "robot_from_toml_string", "toml_from_robot"]
+
+#: Version of the schema written by :func:`toml_from_robot`.
+FORMAT_VERSION = 1
+
+_TOP_KEYS = {"format_version", "name", "gravity", "joints", "frames"}
+_JOINT_KEYS = {
+    "name",
+    "type",
+    "parent",
+    "child",
+    "origin",
+    "mdh",
+    "axis",
+    "limits",
+    "friction",
+    "inertial",
+}
+_ORIGIN_KEYS = {"xyz", "rpy"}
+_MDH_KEYS = {"a", "d", "alpha", "theta"}
+_LIMIT_KEYS = ("lower", "upper", "velocity", "acceleration", "effort")
+_INERTIAL_KEYS = {"mass", "com", "inertia"}
+_FRAME_KEYS = {"name", "parent", "xyz", "rpy", "mdh"}
+_TYPES = {"revolute": False, "prismatic": True}
+
+
+# ---------------------------------------------------------------------- reading helpers
+def _check_keys(table: Mapping[str, Any], allowed: set[str], where: str) -> None:
+    unknown = sorted(set(table) - allowed)
+    if unknown:
+        raise ModelError(f"{where}: unknown key {unknown[0]!r}; allowed: {sorted(allowed)}")
+
+
+def _table(value: Any, where: str) -> Mapping[str, Any]:
+    if not isinstance(value, Mapping):
+        raise ModelError(f"{where} must be a table; got {type(value).__name__}")
+    return value
+
+
+def _require(table: Mapping[str, Any], key: str, where: str) -> Any:
+    if key not in table:
+        raise ModelError(f"{where}: missing key {key!r}")
+    return table[key]
+
+
+def _string(table: Mapping[str, Any], key: str, where: str) -> str:
+    value = _require(table, key, where)
+    if not isinstance(value, str) or not value:
+        raise ModelError(f"{where}: key {key!r} must be a non-empty string; got {value!r}")
+    return value
+
+
+def _number(value: Any, where: str, key: str, *, finite: bool = True) -> float:
+    if isinstance(value, bool) or not isinstance(value, int | float):
+        raise ModelError(f"{where}: key {key!r} must be a number; got {value!r}")
+    x = float(value)
+    if math.isnan(x) or (finite and not math.isfinite(x)):
+        raise ModelError(f"{where}: key {key!r} must be finite; got {value!r}")
+    return x
+
+
+def _vector(value: Any, size: int, where: str, key: str) -> NDArray[np.float64]:
+    if not isinstance(value, list) or len(value) != size:
+        got = f"{len(value)} entries" if isinstance(value, list) else repr(value)
+        raise ModelError(f"{where}: key {key!r} must be a list of {size} numbers; got {got}")
+    return np.array([_number(v, where, key) for v in value])
+
+
+def _pose(table: Mapping[str, Any], where: str, *, nested: bool) -> NDArray[np.float64]:
+    """Pose (4, 4) from ``xyz``/``rpy`` (in ``origin = {...}`` when ``nested``) or ``mdh``."""
+    origin_keys = ("origin",) if nested else ("xyz", "rpy")
+    if "mdh" in table:
+        if any(k in table for k in origin_keys):
+            what = " and ".join(repr(k) for k in origin_keys if k in table)
+            raise ModelError(f"{where}: give either {what} or 'mdh', not both")
+        mdh = _table(table["mdh"], f"{where}: key 'mdh'")
+        _check_keys(mdh, _MDH_KEYS, f"{where}: mdh")
+        a, d, alpha = (
+            _number(_require(mdh, k, f"{where}: mdh"), where, f"mdh.{k}")
+            for k in ("a", "d", "alpha")
+        )
+        theta = _number(mdh.get("theta", 0.0), where, "mdh.theta")
+        return mdh_transform(a, d, alpha, theta)
+    origin, prefix = table, ""
+    if nested:
+        origin, prefix = _table(table.get("origin", {}), f"{where}: key 'origin'"), "origin."
+        _check_keys(origin, _ORIGIN_KEYS, f"{where}: origin")
+    xyz = _vector(origin.get("xyz", [0.0, 0.0, 0.0]), 3, where, f"{prefix}xyz")
+    rpy = _vector(origin.get("rpy", [0.0, 0.0, 0.0]), 3, where, f"{prefix}rpy")
+    return spatial.transform_from_xyz_rpy(xyz, rpy)
+
+
+def robot_from_toml_string(text: str, *, source: str = "TOML text") -> Robot:
+    """Robot from the text of a dynid TOML description (schema: see the module docstring).
+
+    Parameters
+    ----------
+    text : str
+        The TOML document.
+    source : str
+        Name of the document used in error messages (a file path, say).
+
+    Returns
+    -------
+    Robot
+
+    Raises
+    ------
+    ModelError
+        The text is not valid TOML, or a key is missing, unknown, of the wrong type or
+        length, a joint's parent is not the previous joint's child, a frame's parent is
+        unknown, names repeat, or the robot is otherwise invalid (limits, axes); the
+        message names the joint or frame and the key.
+    """
+    try:
+        doc = tomllib.loads(text)
+    except tomllib.TOMLDecodeError as exc:
+        raise ModelError(f"{source} is not valid TOML: {exc}") from exc
+    _check_keys(doc, _TOP_KEYS, source)
+    version = doc.get("format_version", FORMAT_VERSION)
+    if version != FORMAT_VERSION:
+        raise ModelError(
+            f"{source}: key 'format_version' must be {FORMAT_VERSION}; got {version!r}"
+        )
+    name = doc.get("name", "robot")
+    if not isinstance(name, str):
+        raise ModelError(f"{source}: key 'name' must be a string; got {name!r}")
+    gravity = _vector(doc.get("gravity", [0.0, 0.0, -STANDARD_GRAVITY]), 3, source, "gravity")
+    joints = _require(doc, "joints", source)
+    if not isinstance(joints, list) or not joints:
+        raise ModelError(f"{source}: 'joints' must be a non-empty array of tables ([[joints]])")
+
+    n = len(joints)
+    joint_names: list[str] = []
+    link_names: list[str] = []
+    T_fix = np.empty((n, 4, 4))
+    axes = np.empty((n, 3))
+    prismatic = np.empty(n, dtype=bool)
+    lim = {k: np.full(n, np.inf) for k in _LIMIT_KEYS}
+    lim["lower"][:] = -np.inf
+    mass, com, inertia = np.zeros(n), np.zeros((n, 3)), np.zeros((n, 6))
+    friction: list[NDArray[np.float64] | None] = []
+    for i, raw in enumerate(joints):
+        where = f"joints[{i}]"
+        jt = _table(raw, where)
+        jname = _string(jt, "name", where)
+        where = f"joints[{i}] ({jname!r})"
+        _check_keys(jt, _JOINT_KEYS, where)
+        kind = _string(jt, "type", where)
+        if kind not in _TYPES:
+            raise ModelError(f"{where}: key 'type' must be one of {sorted(_TYPES)}; got {kind!r}")
+        parent, child = _string(jt, "parent", where), _string(jt, "child", where)
+        if i == 0:
+            link_names.append(parent)
+        elif parent != link_names[-1]:
+            raise ModelError(
+                f"{where}: unknown parent {parent!r}; joints must form a chain, so the parent "
+                f"must be the previous joint's child {link_names[-1]!r}"
+            )
+        joint_names.append(jname)
+        link_names.append(child)
+        T_fix[i] = _pose(jt, where, nested=True)
+        axes[i] = _vector(jt.get("axis", [0.0, 0.0, 1.0]), 3, where, "axis")
+        if np.linalg.norm(axes[i]) < 1e-12:
+            raise ModelError(f"{where}: key 'axis' must not be zero")
+        prismatic[i] = _TYPES[kind]
+        limits = _table(jt.get("limits", {}), f"{where}: key 'limits'")
+        _check_keys(limits, set(_LIMIT_KEYS), f"{where}: limits")
+        for k, v in limits.items():
+            lim[k][i] = _number(v, where, f"limits.{k}", finite=False)
+            if k not in ("lower", "upper") and not lim[k][i] > 0.0:
+                raise ModelError(f"{where}: key 'limits.{k}' must be positive; got {v!r}")
+        if not lim["lower"][i] < lim["upper"][i]:
+            raise ModelError(
+                f"{where}: key 'limits.lower' must be below 'limits.upper'; "
+                f"got {lim['lower'][i]!r} >= {lim['upper'][i]!r}"
+            )
+        if "inertial" in jt:
+            inertial = _table(jt["inertial"], f"{where}: key 'inertial'")
+            _check_keys(inertial, _INERTIAL_KEYS, f"{where}: inertial")
+            mass[i] = _number(
+                _require(inertial, "mass", f"{where}: inertial"), where, "inertial.mass"
+            )
+            com[i] = _vector(
+                _require(inertial, "com", f"{where}: inertial"), 3, where, "inertial.com"
+            )
+            inertia[i] = _vector(
+                _require(inertial, "inertia", f"{where}: inertial"), 6, where, "inertial.inertia"
+            )
+        friction.append(_vector(jt["friction"], 3, where, "friction") if "friction" in jt else None)
+    given = [f is not None for f in friction]
+    if any(given) and not all(given):
+        missing = joint_names[given.index(False)]
+        raise ModelError(
+            f"{source}: key 'friction' is given for some joints but not for joint {missing!r}; "
+            "give it for every joint or for none"
+        )
+
+    frames: dict[str, Frame] = {}
+    raw_frames = doc.get("frames", [])
+    if not isinstance(raw_frames, list):
+        raise ModelError(f"{source}: 'frames' must be an array of tables ([[frames]])")
+    for i, raw in enumerate(raw_frames):
+        where = f"frames[{i}]"
+        ft = _table(raw, where)
+        fname = _string(ft, "name", where)
+        where = f"frames[{i}] ({fname!r})"
+        _check_keys(ft, _FRAME_KEYS, where)
+        if fname in frames:
+            raise ModelError(f"{where}: duplicate frame name {fname!r}")
+        parent = _string(ft, "parent", where)
+        if parent in link_names:
+            link, T_link_parent = link_names.index(parent), np.eye(4)
+        elif parent in frames:
+            link, T_link_parent = frames[parent].link, frames[parent].T_link_frame
+        else:
+            raise ModelError(
+                f"{where}: unknown parent {parent!r}; available: links {link_names} "
+                f"and earlier frames {list(frames)}"
+            )
+        frames[fname] = Frame(link, T_link_parent @ _pose(ft, where, nested=False))
+
+    try:
+        return Robot(
+            name=name,
+            joint_names=tuple(joint_names),
+            link_names=tuple(link_names),
+            T_parent_joint=T_fix,
+            axes=axes,
+            prismatic=prismatic,
+            phi=phi_from_inertial(mass, com, inertia),
+            q_min=lim["lower"],
+            q_max=lim["upper"],
+            dq_max=lim["velocity"],
+            ddq_max=lim["acceleration"],
+            tau_max=lim["effort"],
+            gravity=gravity,
+            frames=frames,
+            friction=np.stack(friction) if all(given) else None,
+        )
+    except DynidError as exc:
+        raise ModelError(f"{source}: {exc}") from exc
+
+
+def robot_from_toml(path: str | Path) -> Robot:
+    """Robot from a dynid TOML description file (schema: see the module docstring).
+
+    Parameters
+    ----------
+    path : str or Path
+        The ``.toml`` file (UTF-8).
+
+    Returns
+    -------
+    Robot
+
+    Raises
+    ------
+    ModelError
+        The file does not exist or cannot be read, is not valid TOML, or does not follow
+        the schema (the message names the joint or frame and the key).
+    """
+    p = Path(path)
+    try:
+        text = p.read_text(encoding="utf-8")
+    except FileNotFoundError as exc:
+        raise ModelError(f"TOML description not found: {str(p)!r}") from exc
+    except (OSError, UnicodeDecodeError) as exc:
+        raise ModelError(f"cannot read TOML description {str(p)!r}: {exc}") from exc
+    return robot_from_toml_string(text, source=f"TOML file {str(p)!r}")
+
+
+# ---------------------------------------------------------------------- writing
+def _f(x: float) -> str:
+    """A float as a TOML literal that reads back to the same float (-0.0 written as 0.0)."""
+    x = float(x) + 0.0
+    if math.isnan(x):
+        return "nan"
+    if math.isinf(x):
+        return "inf" if x > 0 else "-inf"
+    return repr(x)
+
+
+def _arr(v: Sequence[float] | NDArray[np.float64]) -> str:
+    return "[" + ", ".join(_f(x) for x in v) + "]"
+
+
+def _s(text: str) -> str:
+    """A TOML basic string (JSON escapes are valid TOML escapes)."""
+    return json.dumps(text, ensure_ascii=False)
+
+
+def _xyz_rpy(T: NDArray[np.float64]) -> tuple[str, str]:
+    return _arr(T[:3, 3]), _arr(spatial.rpy_from_matrix(T[:3, :3]))
+
+
+def toml_from_robot(robot: Robot) -> str:
+    """The dynid TOML description of a robot (schema: see the module docstring).
+
+    Joint origins are written as ``origin = {xyz, rpy}``, inertials as mass, CoM and
+    inertia about the CoM, finite limits only, friction when the robot has a friction
+    model, and every frame except the links' own frames (``flange`` always). Floats are
+    written with ``repr``, so :func:`robot_from_toml_string` gives back the same robot to
+    about 1e-15 (the inertia about the CoM and the rpy angles are recomputed).
+
+    Parameters
+    ----------
+    robot : Robot
+
+    Returns
+    -------
+    text : str
+        The TOML document.
+    """
+    out = [
+        "# dynid robot description; schema: dynid.model.description",
+        "# units: m, rad, kg, kg m^2, s; inertia about the CoM, in link axes",
+        f"format_version = {FORMAT_VERSION}",
+        f"name = {_s(robot.name)}",
+        f"gravity = {_arr(robot.gravity)}",
+    ]
+    mass, com, inertia = robot.mass, robot.com, robot.inertia
+    for i in range(robot.n):
+        xyz, rpy = _xyz_rpy(robot.T_parent_joint[i])
+        limits = {
+            "lower": robot.q_min[i],
+            "upper": robot.q_max[i],
+            "velocity": robot.dq_max[i],
+            "acceleration": robot.ddq_max[i],
+            "effort": robot.tau_max[i],
+        }
+        finite = [f"{k} = {_f(v)}" for k, v in limits.items() if math.isfinite(v)]
+        out += [
+            "",
+            "[[joints]]",
+            f"name = {_s(robot.joint_names[i])}",
+            f"type = {_s('prismatic' if robot.prismatic[i] else 'revolute')}",
+            f"parent = {_s(robot.link_names[i])}",
+            f"child = {_s(robot.link_names[i + 1])}",
+            f"origin = {{ xyz = {xyz}, rpy = {rpy} }}",
+            f"axis = {_arr(robot.axes[i])}",
+        ]
+        if finite:
+            out.append("limits = { " + ", ".join(finite) + " }")
+        if robot.friction is not None:
+            out.append(f"friction = {_arr(robot.friction[i])}")
+        out += [
+            "",
+            "[joints.inertial]",
+            f"mass = {_f(mass[i])}",
+            f"com = {_arr(com[i])}",
+            f"inertia = {_arr(inertia6_from_matrix(inertia[i]))}",
+        ]
+    for name, frame in robot.frames.items():
+        T = frame.T_link_frame
+        own = name in robot.link_names and robot.link_names.index(name) == frame.link
+        if own and name != "flange" and np.array_equal(T, np.eye(4)):
+            continue
+        xyz, rpy = _xyz_rpy(T)
+        out += [
+            "",
+            "[[frames]]",
+            f"name = {_s(name)}",
+            f"parent = {_s(robot.link_names[frame.link])}",
+            f"xyz = {xyz}",
+            f"rpy = {rpy}",
+        ]
+    return "\n".join(out) + "\n"

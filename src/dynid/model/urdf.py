@@ -1,0 +1,529 @@
+"""Serial chains read from URDF robot descriptions.
+
+:func:`robot_from_urdf` extracts the serial chain between a base link and a tip link of a
+URDF file and returns a :class:`~dynid.model.robot.Robot`; :func:`robot_from_urdf_string`
+does the same for URDF text. Only the standard library's ``xml.etree.ElementTree`` is used.
+
+Conventions
+-----------
+* The base frame (link 0) is the frame of ``base_link``. Gravity is ``(0, 0, -9.80665)``
+  m/s^2 in that frame (URDF holds no gravity); change it with ``Robot.with_gravity``.
+* Every ``revolute``, ``continuous`` or ``prismatic`` joint on the chain becomes a joint of
+  the robot, with the URDF joint and child-link names. A joint origin ``xyz`` [m] / ``rpy``
+  [rad] is the pose of the child link in the parent link at ``q = 0``; ``rpy`` is URDF's
+  ``Rz(yaw) Ry(pitch) Rx(roll)`` (:func:`dynid.spatial.matrix_from_rpy`). The axis is given
+  in the child-link frame and normalised (URDF default ``(1, 0, 0)``).
+* ``fixed`` joints are merged. Fixed joints before the first moving joint fold into
+  ``T_parent_joint[0]``; a fixed joint after a moving joint makes its child part of the
+  rigid body of the preceding moving link. Every URDF link on the chain, and every link
+  hanging off a chain link through fixed joints only (a hand, a tool-centre-point link),
+  becomes a named frame ``Frame(link index, T_link_frame)``; ``flange`` is the frame of
+  the tip link.
+* The inertia of a link rigidly fixed to moving link ``k`` (on or off the chain) is added
+  to link ``k``: its CoM and its inertia about the CoM are carried into link-``k``
+  coordinates (``c_k = R c + p``, ``I_k = R I R^T``) before the standard parameters are
+  summed. Inertials of links fixed to the base do not enter the dynamics and are dropped.
+  An ``<inertial>`` origin rotates the principal frame: the inertia about the CoM in link
+  axes is ``R_o I R_o^T``. A link without ``<inertial>`` has zero mass.
+* Limits: ``lower``/``upper`` [rad or m] (a ``continuous`` joint, or a missing
+  attribute, gives ``-inf``/``inf``), ``velocity`` [rad/s or m/s] and ``effort``
+  [N m or N] (missing or non-positive: ``inf``); URDF holds no acceleration limit, so
+  ``ddq_max`` is ``inf``.
+* Ignored: what is off the chain (other branches through moving joints, mimic joints off
+  the chain, transmissions, gazebo tags), visual and collision geometry, ``<dynamics>``,
+  ``<safety_controller>``.
+"""
+
+from __future__ import annotations
+
+import warnings
+import xml.etree.ElementTree as ET
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+from numpy.typing import NDArray
+
+from .. import spatial
+from ..exceptions import DynidWarning, ModelError, UnknownNameError
+from .inertia import phi_from_inertial
+from .robot import Frame, Robot
+
+__all__ = ["robot_from_urdf", "robot_from_urdf_string"]
+
+_MOVING = {"revolute": False, "continuous": False, "prismatic": True}  # type -> prismatic
+_UNSUPPORTED = ("floating", "planar")
+_INERTIA_ATTRS = ("ixx", "ixy", "ixz", "iyy", "iyz", "izz")
+
+
+@dataclass(frozen=True, slots=True)
+class _Joint:
+    """One ``<joint>`` element: its name, type, parent and child link, and the element."""
+
+    name: str
+    type: str
+    parent: str
+    child: str
+    elem: ET.Element
+
+
+def _tag(elem: ET.Element) -> str:
+    """Element tag without an XML namespace."""
+    return elem.tag.rsplit("}", 1)[-1]
+
+
+def _children(elem: ET.Element, tag: str) -> list[ET.Element]:
+    return [c for c in elem if _tag(c) == tag]
+
+
+def _child(elem: ET.Element, tag: str) -> ET.Element | None:
+    found = _children(elem, tag)
+    return found[0] if found else None
+
+
+def _floats(
+    text: str | None, count: int, what: str, default: tuple[float, ...]
+) -> NDArray[np.float64]:
+    """Parse ``count`` whitespace-separated floats; ``default`` when the attribute is absent."""
+    if text is None:
+        return np.array(default, dtype=np.float64)
+    parts = text.split()
+    try:
+        values = np.array([float(x) for x in parts], dtype=np.float64)
+    except ValueError:
+        raise ModelError(f"{what} must hold {count} numbers; got {text!r}") from None
+    if values.shape != (count,):
+        raise ModelError(f"{what} must hold {count} numbers; got {len(parts)} in {text!r}")
+    if not np.all(np.isfinite(values)):
+        raise ModelError(f"{what} must be finite; got {text!r}")
+    return values
+
+
+def _float(elem: ET.Element, attr: str, what: str) -> float | None:
+    """A float attribute, or None when absent."""
+    text = elem.get(attr)
+    if text is None:
+        return None
+    try:
+        value = float(text)
+    except ValueError:
+        raise ModelError(f"{what} attribute {attr!r} must be a number; got {text!r}") from None
+    if np.isnan(value):
+        raise ModelError(f"{what} attribute {attr!r} is NaN")
+    return value
+
+
+def _origin(elem: ET.Element, what: str) -> NDArray[np.float64]:
+    """Pose given by the ``<origin xyz rpy>`` child of ``elem`` (identity when absent), (4, 4)."""
+    o = _child(elem, "origin")
+    if o is None:
+        return np.eye(4)
+    xyz = _floats(o.get("xyz"), 3, f"{what} origin xyz", (0.0, 0.0, 0.0))
+    rpy = _floats(o.get("rpy"), 3, f"{what} origin rpy", (0.0, 0.0, 0.0))
+    return spatial.transform_from_xyz_rpy(xyz, rpy)
+
+
+def _parse_tree(
+    root: ET.Element,
+) -> tuple[str, dict[str, ET.Element], dict[str, _Joint], dict[str, list[_Joint]]]:
+    """Robot name, links by name, the joint whose child is each link, child joints per link."""
+    if _tag(root) != "robot":
+        raise ModelError(f"the root element of a URDF must be <robot>; got <{_tag(root)}>")
+    links: dict[str, ET.Element] = {}
+    for el in _children(root, "link"):
+        name = el.get("name")
+        if not name:
+            raise ModelError("a <link> has no name attribute")
+        if name in links:
+            raise ModelError(f"duplicate link name {name!r}")
+        links[name] = el
+    if not links:
+        raise ModelError("the URDF holds no <link>")
+    parent_joint: dict[str, _Joint] = {}
+    child_joints: dict[str, list[_Joint]] = {name: [] for name in links}
+    joint_names: set[str] = set()
+    for el in _children(root, "joint"):
+        name = el.get("name")
+        if not name:
+            raise ModelError("a <joint> has no name attribute")
+        if name in joint_names:
+            raise ModelError(f"duplicate joint name {name!r}")
+        joint_names.add(name)
+        jtype = el.get("type")
+        if not jtype:
+            raise ModelError(f"joint {name!r} has no type attribute")
+        ends = []
+        for tag in ("parent", "child"):
+            sub = _child(el, tag)
+            link = None if sub is None else sub.get("link")
+            if not link:
+                raise ModelError(f"joint {name!r} has no <{tag} link=...>")
+            if link not in links:
+                raise ModelError(f"joint {name!r} refers to unknown {tag} link {link!r}")
+            ends.append(link)
+        joint = _Joint(name, jtype, ends[0], ends[1], el)
+        if joint.child in parent_joint:
+            raise ModelError(
+                f"link {joint.child!r} is the child of two joints "
+                f"({parent_joint[joint.child].name!r} and {name!r}); a URDF must be a tree"
+            )
+        parent_joint[joint.child] = joint
+        child_joints[joint.parent].append(joint)
+    return root.get("name") or "robot", links, parent_joint, child_joints
+
+
+def _subtree_leaves(base: str, child_joints: dict[str, list[_Joint]]) -> list[str]:
+    """Links below ``base`` (``base`` included) that have no child joint, in document order."""
+    leaves, stack, seen = [], [base], set()
+    while stack:
+        link = stack.pop()
+        if link in seen:
+            raise ModelError(f"the joints below link {base!r} form a cycle through {link!r}")
+        seen.add(link)
+        kids = child_joints[link]
+        if not kids:
+            leaves.append(link)
+        stack.extend(j.child for j in reversed(kids))
+    return leaves
+
+
+def _chain(base: str, tip: str, parent_joint: dict[str, _Joint]) -> list[_Joint]:
+    """Joints from ``base`` down to ``tip``, in order."""
+    path: list[_Joint] = []
+    link, seen = tip, {tip}
+    while link != base:
+        joint = parent_joint.get(link)
+        if joint is None:
+            raise ModelError(f"tip link {tip!r} is not below base link {base!r}")
+        path.append(joint)
+        link = joint.parent
+        if link in seen:
+            raise ModelError(f"the joints above link {tip!r} form a cycle through {link!r}")
+        seen.add(link)
+    return path[::-1]
+
+
+def _inertial(
+    link: str, el: ET.Element
+) -> tuple[float, NDArray[np.float64], NDArray[np.float64]] | None:
+    """Mass [kg], CoM [m] and inertia about the CoM [kg m^2] in link axes, or None if absent.
+
+    Warns (:class:`DynidWarning`) when the values are physically inconsistent.
+    """
+    inertial = _child(el, "inertial")
+    if inertial is None:
+        return None
+    what = f"link {link!r} <inertial>"
+    T_link_o = _origin(inertial, what)
+    mass_el = _child(inertial, "mass")
+    mass = None if mass_el is None else _float(mass_el, "value", f"{what} <mass>")
+    if mass is None or not np.isfinite(mass):
+        raise ModelError(f"{what} needs a finite <mass value=...>")
+    I6 = np.zeros(6)
+    inertia_el = _child(inertial, "inertia")
+    if inertia_el is not None:
+        for k, attr in enumerate(_INERTIA_ATTRS):
+            v = _float(inertia_el, attr, f"{what} <inertia>")
+            if v is not None and not np.isfinite(v):
+                raise ModelError(f"{what} <inertia> attribute {attr!r} must be finite")
+            I6[k] = 0.0 if v is None else v
+    xx, xy, xz, yy, yz, zz = I6
+    I_o = np.array([[xx, xy, xz], [xy, yy, yz], [xz, yz, zz]])
+    _warn_if_inconsistent(link, mass, I_o)
+    R = T_link_o[:3, :3]
+    return mass, T_link_o[:3, 3].copy(), R @ I_o @ R.T
+
+
+def _warn_if_inconsistent(link: str, mass: float, I: NDArray[np.float64]) -> None:
+    """Warn when mass < 0, I is not positive semi-definite or violates the triangle inequality."""
+    problems = []
+    if mass < 0.0:
+        problems.append(f"negative mass {mass}")
+    lam = np.linalg.eigvalsh(I)
+    tol = 1e-9 * max(float(np.sum(np.abs(lam))), 1e-300)
+    if lam[0] < -tol:
+        problems.append(f"inertia not positive semi-definite (eigenvalues {lam.tolist()})")
+    elif lam[0] + lam[1] < lam[2] - tol:
+        problems.append(
+            f"principal moments {lam.tolist()} violate the triangle inequality (a + b >= c)"
+        )
+    if problems:
+        warnings.warn(
+            f"link {link!r} has a physically inconsistent inertial: {'; '.join(problems)}; "
+            "kept as given",
+            DynidWarning,
+            stacklevel=5,
+        )
+
+
+def _limits(joint: _Joint) -> tuple[float, float, float, float]:
+    """Lower, upper, velocity and effort limits of a moving joint (inf where none)."""
+    lim = _child(joint.elem, "limit")
+    what = f"joint {joint.name!r} <limit>"
+    get = (lambda a: None) if lim is None else (lambda a: _float(lim, a, what))
+    lower, upper = get("lower"), get("upper")
+    if joint.type == "continuous":
+        lower = upper = None
+    lo = -np.inf if lower is None else lower
+    hi = np.inf if upper is None else upper
+    if not lo < hi:
+        raise ModelError(
+            f"joint {joint.name!r}: lower limit must be below the upper one; got {lo} >= {hi}"
+        )
+    out = []
+    for attr in ("velocity", "effort"):
+        v = get(attr)
+        if v is not None and v <= 0.0:
+            warnings.warn(
+                f"joint {joint.name!r} has {attr} limit {v}; treated as unbounded",
+                DynidWarning,
+                stacklevel=4,
+            )
+            v = None
+        out.append(np.inf if v is None else v)
+    return lo, hi, out[0], out[1]
+
+
+def robot_from_urdf_string(
+    text: str | bytes,
+    base_link: str | None = None,
+    tip_link: str | None = None,
+    *,
+    source: str = "URDF text",
+) -> Robot:
+    """Serial chain between ``base_link`` and ``tip_link`` of a URDF document.
+
+    Parameters
+    ----------
+    text : str or bytes
+        The URDF XML document.
+    base_link : str, optional
+        Link whose frame is the base frame (link 0). Default: the root link of the tree.
+    tip_link : str, optional
+        Last link of the chain; its frame is ``flange``. Default: the unique leaf link
+        below ``base_link``.
+    source : str
+        Name of the document used in error messages (a file path, say).
+
+    Returns
+    -------
+    Robot
+        ``n`` = number of revolute, continuous and prismatic joints between base and tip.
+        ``T_parent_joint`` (n, 4, 4) [m], ``axes`` (n, 3) unit vectors in link
+        coordinates, ``phi`` (n, 10) standard parameters about the link origins [SI],
+        limits (n,), gravity ``(0, 0, -9.80665)`` m/s^2 in the base frame, frames for every
+        URDF link on the chain and fixed to it, ``flange`` at the tip link. See the module
+        docstring for the merging of fixed joints.
+
+    Raises
+    ------
+    ModelError
+        Malformed XML or URDF (missing names, unknown link references, duplicates, a link
+        with two parents, cycles, unparsable numbers); several root links and no
+        ``base_link``; several leaves below the base and no ``tip_link``; tip not below
+        base; a ``floating``, ``planar``, unknown-type or mimic joint on the chain; no
+        moving joint between base and tip; a lower limit not below the upper one.
+    UnknownNameError
+        ``base_link`` or ``tip_link`` is not a link of the URDF (the message lists them).
+
+    Warns
+    -----
+    DynidWarning
+        The inertial of a link that enters the model is physically inconsistent
+        (negative mass, inertia not positive semi-definite, triangle inequality violated):
+        it is kept as given. A velocity or
+        effort limit is not positive: it is treated as unbounded. A URDF link named
+        ``flange`` is not the tip link (the frame ``flange`` is the tip's).
+    """
+    return _robot_from_text(text, base_link, tip_link, source)
+
+
+def _robot_from_text(
+    text: str | bytes, base_link: str | None, tip_link: str | None, source: str
+) -> Robot:
+    """Body of the two public readers (called directly by both, so warnings point at the caller)."""
+    try:
+        root = ET.fromstring(text)
+    except ET.ParseError as exc:
+        raise ModelError(f"{source} is not well-formed XML: {exc}") from exc
+    name, links, parent_joint, child_joints = _parse_tree(root)
+
+    for role, given in (("base", base_link), ("tip", tip_link)):
+        if given is not None and given not in links:
+            raise UnknownNameError(f"Unknown {role} link {given!r}; available: {sorted(links)}")
+    if base_link is None:
+        roots = [link for link in links if link not in parent_joint]
+        if len(roots) != 1:
+            raise ModelError(
+                f"{source} has {len(roots)} root links {roots}; pass base_link= to choose one"
+            )
+        base_link = roots[0]
+    if tip_link is None:
+        leaves = _subtree_leaves(base_link, child_joints)
+        if len(leaves) != 1:
+            raise ModelError(
+                f"several leaf links below base link {base_link!r}: {leaves}; "
+                "pass tip_link= to choose the end of the chain"
+            )
+        tip_link = leaves[0]
+    path = _chain(base_link, tip_link, parent_joint)
+    for joint in path:
+        if joint.type in _UNSUPPORTED:
+            raise ModelError(
+                f"joint {joint.name!r} of type {joint.type!r} on the chain cannot be modelled; "
+                "a serial chain holds revolute, continuous, prismatic and fixed joints only"
+            )
+        if joint.type not in _MOVING and joint.type != "fixed":
+            raise ModelError(f"joint {joint.name!r} has unknown type {joint.type!r}")
+        if joint.type in _MOVING and _child(joint.elem, "mimic") is not None:
+            raise ModelError(
+                f"joint {joint.name!r} on the chain mimics another joint; coupled joints "
+                "cannot be modelled, choose a tip link before it"
+            )
+    if not any(j.type in _MOVING for j in path):
+        raise ModelError(
+            f"no revolute, continuous or prismatic joint between base link {base_link!r} "
+            f"and tip link {tip_link!r}"
+        )
+
+    # Walk the chain: body index k (0 = base) and pose of the current URDF link in link k.
+    on_chain = {j.name for j in path}
+    link_names = [base_link]
+    joint_names: list[str] = []
+    T_fix: list[NDArray[np.float64]] = []
+    axes: list[NDArray[np.float64]] = []
+    prismatic: list[bool] = []
+    limits: list[tuple[float, float, float, float]] = []
+    placed: dict[str, tuple[int, NDArray[np.float64]]] = {base_link: (0, np.eye(4))}
+    order = [base_link]  # URDF links in the order they are placed
+    k, T_k_cur = 0, np.eye(4)
+    for joint in path:
+        T = T_k_cur @ _origin(joint.elem, f"joint {joint.name!r}")
+        if joint.type == "fixed":
+            T_k_cur = T
+        else:
+            axis_el = _child(joint.elem, "axis")
+            axis = _floats(
+                None if axis_el is None else axis_el.get("xyz"),
+                3,
+                f"joint {joint.name!r} axis",
+                (1.0, 0.0, 0.0),
+            )
+            norm = float(np.linalg.norm(axis))
+            if norm < 1e-12:
+                raise ModelError(f"joint {joint.name!r} has a zero axis")
+            joint_names.append(joint.name)
+            T_fix.append(T)
+            axes.append(axis / norm)
+            prismatic.append(_MOVING[joint.type])
+            limits.append(_limits(joint))
+            link_names.append(joint.child)
+            k, T_k_cur = k + 1, np.eye(4)
+        placed[joint.child] = (k, T_k_cur)
+        order.append(joint.child)
+
+    # Links hanging off chain links through fixed joints only (hands, TCP frames).
+    stack = list(reversed(order))
+    while stack:
+        link = stack.pop()
+        kl, T_k_link = placed[link]
+        for joint in child_joints[link]:
+            if joint.name in on_chain or joint.type != "fixed":
+                continue
+            if joint.child in placed:
+                raise ModelError(f"the joints form a cycle through link {joint.child!r}")
+            placed[joint.child] = (kl, T_k_link @ _origin(joint.elem, f"joint {joint.name!r}"))
+            order.append(joint.child)
+            stack.append(joint.child)
+
+    n = len(joint_names)
+    phi = np.zeros((n, 10))
+    for link in order:
+        kl, T_k_link = placed[link]
+        if kl == 0:
+            continue
+        inertial = _inertial(link, links[link])
+        if inertial is None:
+            continue
+        mass, c_link, I_link = inertial
+        R, p = T_k_link[:3, :3], T_k_link[:3, 3]
+        phi[kl - 1] += phi_from_inertial(mass, R @ c_link + p, R @ I_link @ R.T)
+
+    moving_links = set(link_names)
+    frames = {link: Frame(kl, T) for link, (kl, T) in placed.items() if link not in moving_links}
+    if "flange" in placed and tip_link != "flange":
+        warnings.warn(
+            f"URDF link 'flange' is not the tip link {tip_link!r}; the frame 'flange' is the "
+            "tip link's",
+            DynidWarning,
+            stacklevel=3,
+        )
+    k_tip, T_tip = placed[tip_link]
+    frames["flange"] = Frame(k_tip, T_tip)
+
+    lim = np.array(limits)
+    return Robot(
+        name=name,
+        joint_names=tuple(joint_names),
+        link_names=tuple(link_names),
+        T_parent_joint=np.stack(T_fix),
+        axes=np.stack(axes),
+        prismatic=np.array(prismatic),
+        phi=phi,
+        q_min=lim[:, 0],
+        q_max=lim[:, 1],
+        dq_max=lim[:, 2],
+        ddq_max=np.full(n, np.inf),
+        tau_max=lim[:, 3],
+        frames=frames,
+    )
+
+
+def robot_from_urdf(
+    path: str | Path, base_link: str | None = None, tip_link: str | None = None
+) -> Robot:
+    """Serial chain between ``base_link`` and ``tip_link`` of a URDF file.
+
+    Parameters
+    ----------
+    path : str or Path
+        URDF file. Mesh references are not read.
+    base_link : str, optional
+        Link whose frame is the base frame (link 0). Default: the root link.
+    tip_link : str, optional
+        Last link of the chain; its frame is ``flange``. Default: the unique leaf link
+        below ``base_link``.
+
+    Returns
+    -------
+    Robot
+        See :func:`robot_from_urdf_string` and the module docstring.
+
+    Raises
+    ------
+    ModelError
+        The file does not exist or cannot be read, or its content cannot be modelled
+        (see :func:`robot_from_urdf_string`).
+    UnknownNameError
+        ``base_link`` or ``tip_link`` is not a link of the URDF.
+
+    Warns
+    -----
+    DynidWarning
+        Physically inconsistent inertials (kept as given); non-positive velocity or effort
+        limits (treated as unbounded).
+
+    Examples
+    --------
+    >>> robot = robot_from_urdf("panda.urdf", "panda_link0", "panda_hand")  # doctest: +SKIP
+    >>> robot.joint_names[0]  # doctest: +SKIP
+    'panda_joint1'
+    """
+    p = Path(path)
+    try:
+        data = p.read_bytes()
+    except FileNotFoundError as exc:
+        raise ModelError(f"URDF file not found: {str(p)!r}") from exc
+    except OSError as exc:
+        raise ModelError(f"cannot read URDF file {str(p)!r}: {exc.strerror or exc}") from exc
+    return _robot_from_text(data, base_link, tip_link, f"URDF file {str(p)!r}")
