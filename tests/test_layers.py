@@ -20,7 +20,7 @@ LAYERS = [
     {"feasibility"},
     {"io"},
     {"plots"},
-    {"cli"},
+    {"cli", "__main__"},
 ]
 
 

@@ -17,8 +17,9 @@ from .exceptions import NonFiniteError, ShapeError
 def finite(name: str, x: NDArray[np.float64]) -> None:
     """Raise :class:`NonFiniteError` naming ``name`` and the first bad index."""
     if not np.all(np.isfinite(x)):
-        bad = np.argwhere(~np.isfinite(x))[0]
-        idx = tuple(int(i) for i in bad)
+        if x.ndim == 0:
+            raise NonFiniteError(f"{name} must be finite; got {x.item()}")
+        idx = tuple(int(i) for i in np.argwhere(~np.isfinite(x))[0])
         raise NonFiniteError(
             f"{name} must be finite; got {x[idx]} at index {idx if len(idx) > 1 else idx[0]}"
         )

@@ -103,7 +103,7 @@ def angle_axis_from_matrix(R: ArrayLike) -> NDArray[np.float64]:
     """Rotation vector ``theta * u`` [rad] of a rotation matrix, ``theta`` in [0, pi].
 
     Robust over the whole range: near 0 it uses the first-order series of the log map,
-    near pi it reads the axis from the symmetric part ``(R + R^T)/2 = I + (1 - cos) u u^T``
+    near pi it reads the axis from the symmetric part ``(R + R^T)/2 = cos I + (1 - cos) u u^T``
     with the sign fixed by the skew part.
 
     Parameters
@@ -133,7 +133,8 @@ def angle_axis_from_matrix(R: ArrayLike) -> NDArray[np.float64]:
         Rp = R[near_pi]
         S = 0.5 * (Rp + np.swapaxes(Rp, -1, -2))
         one_minus_cos = (1.0 - cos[near_pi])[..., None, None]
-        uu = (S - np.eye(3)) / one_minus_cos  # u u^T
+        cos_p = cos[near_pi][..., None, None]
+        uu = (S - cos_p * np.eye(3)) / one_minus_cos  # u u^T
         k = np.argmax(np.diagonal(uu, axis1=-2, axis2=-1), axis=-1)
         rows = np.take_along_axis(uu, k[:, None, None], axis=-2)[:, 0, :]
         u = rows / np.sqrt(np.take_along_axis(rows, k[:, None], axis=-1))

@@ -10,6 +10,7 @@ from typing import Any
 
 import numpy as np
 
+from .. import _checks, spatial
 from ..exceptions import DynidError, ShapeError
 from ..model.panda import panda
 from ..model.robot import Robot
@@ -63,3 +64,45 @@ def _jsonable(x: Any) -> Any:
 def format_matrix(A: np.ndarray, fmt: str = "{:+.6f}") -> str:
     """A readable fixed-width table of a 2-D array."""
     return "\n".join("  ".join(fmt.format(v) for v in row) for row in np.atleast_2d(A))
+
+
+# ---------------------------------------------------------------------- kinematics options
+def add_frame_tool_options(p: argparse.ArgumentParser) -> None:
+    """``--frame NAME`` (default flange) and ``--tool x,y,z[,roll,pitch,yaw]``."""
+    p.add_argument("--frame", default="flange", help="a frame of the robot (default: flange)")
+    p.add_argument(
+        "--tool",
+        default=None,
+        metavar="X,Y,Z[,R,P,Y]",
+        help="a tool fixed to --frame: offset [m] and URDF roll, pitch, yaw [rad] in that frame",
+    )
+
+
+def parse_tool(text: str | None) -> np.ndarray | None:
+    """``T_frame_tool`` (4, 4) from ``x,y,z[,roll,pitch,yaw]`` [m, rad], or None."""
+    if text is None:
+        return None
+    v = parse_vector(text, "--tool")
+    if v.size not in (3, 6):
+        raise ShapeError(
+            f"--tool must have 3 values (x,y,z) or 6 (x,y,z,roll,pitch,yaw); got {v.size}"
+        )
+    _checks.finite("--tool", v)
+    return spatial.transform_from_xyz_rpy(v[:3], v[3:] if v.size == 6 else (0.0, 0.0, 0.0))
+
+
+def parse_q(text: str, robot: Robot, name: str = "--q") -> np.ndarray:
+    """Joint positions (n,) [rad or m] from comma-separated values, checked for count and NaN."""
+    v = parse_vector(text, name, robot.n)
+    _checks.finite(name, v)
+    return v
+
+
+def format_joint_table(robot: Robot, q: np.ndarray) -> str:
+    """One line per joint: name, value [rad] and value [deg] (revolute joints)."""
+    width = max(len(s) for s in robot.joint_names)
+    lines = []
+    for name, v, pri in zip(robot.joint_names, q, robot.prismatic, strict=True):
+        unit = f"{v:+.6f} m" if pri else f"{v:+.6f} rad  ({np.degrees(v):+9.3f} deg)"
+        lines.append(f"  {name:<{width}}  {unit}")
+    return "\n".join(lines)

@@ -77,7 +77,7 @@ def panda() -> Robot:
         7 revolute joints ``joint1..joint7``, links ``link0..link7``, frame ``flange``
         0.107 m along z7; gravity 9.80665 m/s^2 along -z of ``link0``.
     """
-    return Robot.from_mdh(
+    robot = Robot.from_mdh(
         _A,
         _D,
         _ALPHA,
@@ -93,3 +93,4 @@ def panda() -> Robot:
         friction=_FRICTION,
         name="panda",
     )
+    return robot.replace(q_neutral=PANDA_NEUTRAL_Q)

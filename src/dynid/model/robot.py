@@ -94,6 +94,8 @@ class Robot:
     friction : ndarray, shape (n, 3), or None
         Sigmoid friction parameters ``phi1 [N m], phi2 [s/rad], phi3 [rad/s]`` per joint
         (Gaz et al. 2019 eq. 25), or None for no friction model.
+    q_neutral : ndarray, shape (n,), or None
+        A documented neutral pose (start of IK, demos); None: the middle of the limits.
     """
 
     name: str
@@ -113,6 +115,7 @@ class Robot:
     )
     frames: Mapping[str, Frame] = field(default_factory=dict)
     friction: NDArray[np.float64] | None = None
+    q_neutral: NDArray[np.float64] | None = None
 
     def __post_init__(self) -> None:
         n = len(self.joint_names)
@@ -169,6 +172,11 @@ class Robot:
         put("frames", _fixed_frames(frames))
         if self.friction is not None:
             put("friction", _checks.frozen(_checks.as_exact("friction", self.friction, (n, 3))))
+        if self.q_neutral is not None:
+            qn = _checks.as_exact("q_neutral", self.q_neutral, (n,))
+            if np.any((qn < self.q_min) | (qn > self.q_max)):
+                raise ModelError("q_neutral must lie within the position limits")
+            put("q_neutral", _checks.frozen(qn))
 
     # ------------------------------------------------------------------ properties
     @property

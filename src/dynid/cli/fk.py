@@ -1,0 +1,81 @@
+"""Forward kinematics: the pose of a frame (or of a tool fixed to it) in the base frame.
+
+Prints T_base_frame (4x4, translation in m), its position [m] and its URDF roll, pitch,
+yaw [rad]. --q defaults to the documented start pose (the Panda's neutral pose
+PANDA_NEUTRAL_Q, else the middle of the joint limits). Write a first negative value as
+--q=-0.1,... so that it is not read as an option.
+
+--json prints one object: {"T": [[...], [...], [...], [...]]} (row-major, base frame, m).
+
+Example:
+  dynid fk --robot panda --q=0,-0.785,0,-2.356,0,1.571,0.785 --tool 0,0,0.1 --json
+"""
+
+from __future__ import annotations
+
+import argparse
+
+import numpy as np
+
+from ..kinematics.forward import fk
+from ..kinematics.ik import default_q0
+from ..spatial import rpy_from_matrix
+from .common import (
+    add_frame_tool_options,
+    add_robot_options,
+    format_joint_table,
+    format_matrix,
+    load_robot,
+    parse_q,
+    parse_tool,
+    print_json,
+)
+
+NAME = "fk"
+
+
+def register(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParser:
+    """Add the ``fk`` subcommand."""
+    p = subparsers.add_parser(
+        NAME,
+        help="pose of a frame or tool in the base frame",
+        description=__doc__,
+        formatter_class=argparse.RawDescriptionHelpFormatter,
+    )
+    add_robot_options(p)
+    add_q_option(p)
+    add_frame_tool_options(p)
+    p.add_argument("--json", action="store_true", help="print one JSON object")
+    return p
+
+
+def add_q_option(p: argparse.ArgumentParser) -> None:
+    """``--q`` joint positions, defaulting to the documented start pose."""
+    p.add_argument(
+        "--q",
+        default=None,
+        metavar="Q1,...,QN",
+        help="joint positions [rad or m], comma-separated (default: the neutral pose)",
+    )
+
+
+def joint_positions(args: argparse.Namespace, robot) -> np.ndarray:
+    """``--q`` parsed, or the documented start pose."""
+    return default_q0(robot) if args.q is None else parse_q(args.q, robot)
+
+
+def run(args: argparse.Namespace) -> int:
+    """Print the pose (table or JSON)."""
+    robot = load_robot(args)
+    q = joint_positions(args, robot)
+    T = fk(robot, q, args.frame, parse_tool(args.tool))
+    if args.json:
+        print_json({"T": T})
+        return 0
+    what = f"tool on frame {args.frame!r}" if args.tool else f"frame {args.frame!r}"
+    print(f"{robot.name}: pose of the {what} in the base frame")
+    print(f"q:\n{format_joint_table(robot, q)}")
+    print(f"T_base_{'tool' if args.tool else args.frame} [m]:\n{format_matrix(T)}")
+    print(f"position x, y, z [m]:        {format_matrix(T[:3, 3])}")
+    print(f"URDF roll, pitch, yaw [rad]: {format_matrix(rpy_from_matrix(T[:3, :3]))}")
+    return 0

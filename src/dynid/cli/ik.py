@@ -1,0 +1,148 @@
+"""Inverse kinematics: joint positions that put a frame (or a tool) at a goal pose.
+
+The goal is the pose of the frame (of the tool with --tool) in the base frame, either
+  --goal     16 comma-separated numbers, a row-major 4x4 transform [m], or
+  --goal-xyz x,y,z [m] with --goal-rpy roll,pitch,yaw [rad] (URDF convention); without
+             --goal-rpy the frame keeps its orientation at --q0.
+The solver simulates the joint motion of a resolved-rate controller (damped least
+squares, joint position and velocity limits, restarts when it stalls; see
+dynid.kinematics.ik) from --q0, by default the documented start pose: the Panda's
+neutral pose PANDA_NEUTRAL_Q, else the middle of the joint limits. Write a first
+negative value as --goal=-0.1,... so that it is not read as an option.
+
+--json prints one object: {"q": [...], "converged": bool, "iterations": k,
+"position_error": m, "orientation_error": rad}. The exit status is 1 when the goal was
+not reached (the best configuration found is still printed), 2 on bad input.
+
+Example:
+  dynid ik --robot panda --tool 0,0,0.1 --goal-xyz 0.4,0.1,0.4 --goal-rpy 3.1416,0,0 --json
+"""
+
+from __future__ import annotations
+
+import argparse
+
+import numpy as np
+
+from ..exceptions import DynidError
+from ..kinematics.forward import fk
+from ..kinematics.ik import IKOptions, default_q0, ik
+from ..spatial import matrix_from_rpy, transform
+from .common import (
+    add_frame_tool_options,
+    add_robot_options,
+    format_joint_table,
+    format_matrix,
+    load_robot,
+    parse_q,
+    parse_tool,
+    parse_vector,
+    print_json,
+)
+
+NAME = "ik"
+
+
+def register(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParser:
+    """Add the ``ik`` subcommand."""
+    p = subparsers.add_parser(
+        NAME,
+        help="joint positions for a goal pose (inverse kinematics)",
+        description=__doc__,
+        formatter_class=argparse.RawDescriptionHelpFormatter,
+    )
+    add_robot_options(p)
+    add_frame_tool_options(p)
+    p.add_argument(
+        "--goal",
+        default=None,
+        metavar="T11,...,T44",
+        help="goal pose: 16 numbers, row-major 4x4 in the base frame [m]",
+    )
+    p.add_argument("--goal-xyz", default=None, metavar="X,Y,Z", help="goal position [m]")
+    p.add_argument(
+        "--goal-rpy",
+        default=None,
+        metavar="R,P,Y",
+        help="goal roll, pitch, yaw [rad] (default: the orientation at --q0)",
+    )
+    p.add_argument(
+        "--q0",
+        default=None,
+        metavar="Q1,...,QN",
+        help="start [rad or m] (default: the neutral pose)",
+    )
+    defaults = IKOptions()
+    p.add_argument(
+        "--position-tolerance",
+        type=float,
+        default=defaults.position_tolerance,
+        help=f"[m] (default {defaults.position_tolerance:g})",
+    )
+    p.add_argument(
+        "--orientation-tolerance",
+        type=float,
+        default=defaults.orientation_tolerance,
+        help=f"[rad] (default {defaults.orientation_tolerance:g})",
+    )
+    p.add_argument(
+        "--max-iterations",
+        type=int,
+        default=defaults.max_iterations,
+        help=f"simulation steps, restarts included (default {defaults.max_iterations})",
+    )
+    p.add_argument(
+        "--seed", type=int, default=0, help="seed of the restart configurations (default 0)"
+    )
+    p.add_argument("--json", action="store_true", help="print one JSON object")
+    return p
+
+
+def goal_pose(args: argparse.Namespace, robot, q0: np.ndarray, tool) -> np.ndarray:
+    """``T_base_goal`` (4, 4) from ``--goal`` or ``--goal-xyz``/``--goal-rpy``."""
+    if (args.goal is None) == (args.goal_xyz is None):
+        raise DynidError("give the goal as either --goal (16 numbers) or --goal-xyz [--goal-rpy]")
+    if args.goal is not None:
+        if args.goal_rpy is not None:
+            raise DynidError("--goal-rpy goes with --goal-xyz, not with --goal")
+        return parse_vector(args.goal, "--goal", 16).reshape(4, 4)
+    xyz = parse_vector(args.goal_xyz, "--goal-xyz", 3)
+    if args.goal_rpy is None:
+        R = fk(robot, q0, args.frame, tool)[:3, :3]
+    else:
+        R = matrix_from_rpy(parse_vector(args.goal_rpy, "--goal-rpy", 3))
+    return transform(R, xyz)
+
+
+def run(args: argparse.Namespace) -> int:
+    """Solve and print (table or JSON); exit status 1 when not converged."""
+    robot = load_robot(args)
+    tool = parse_tool(args.tool)
+    q0 = default_q0(robot) if args.q0 is None else parse_q(args.q0, robot, "--q0")
+    T_goal = goal_pose(args, robot, q0, tool)
+    options = IKOptions(
+        position_tolerance=args.position_tolerance,
+        orientation_tolerance=args.orientation_tolerance,
+        max_iterations=args.max_iterations,
+    )
+    res = ik(robot, T_goal, q0, args.frame, tool, options, rng=np.random.default_rng(args.seed))
+    if args.json:
+        print_json(
+            {
+                "q": res.q,
+                "converged": res.converged,
+                "iterations": res.iterations,
+                "position_error": res.position_error,
+                "orientation_error": res.orientation_error,
+            }
+        )
+        return 0 if res.converged else 1
+    what = f"tool on frame {args.frame!r}" if args.tool else f"frame {args.frame!r}"
+    print(f"{robot.name}: inverse kinematics of the {what}")
+    print(f"goal T_base_{'tool' if args.tool else args.frame} [m]:\n{format_matrix(T_goal)}")
+    status = "converged" if res.converged else "NOT converged (best configuration found)"
+    print(f"{status} after {res.iterations} iterations, {res.restarts} restarts")
+    print(f"position error:    {res.position_error:.3e} m")
+    print(f"orientation error: {res.orientation_error:.3e} rad")
+    print(f"q:\n{format_joint_table(robot, res.q)}")
+    return 0 if res.converged else 1

@@ -1,0 +1,66 @@
+"""Geometric Jacobian of a frame (or of a tool fixed to it), expressed in the base frame.
+
+Rows vx, vy, vz [m/rad] (linear velocity of the frame's origin) and wx, wy, wz [rad/rad]
+(angular velocity), one column per joint: [v; w] = J(q) dq. --q defaults to the
+documented start pose (the Panda's neutral pose PANDA_NEUTRAL_Q, else the middle of the
+joint limits). Write a first negative value as --q=-0.1,... so that it is not read as an
+option.
+
+--json prints one object: {"J": [[...] x 6], "rows": ["vx","vy","vz","wx","wy","wz"]}.
+
+Example:
+  dynid jacobian --robot panda --frame flange --tool 0,0,0.1 --json
+"""
+
+from __future__ import annotations
+
+import argparse
+
+from ..kinematics.jacobian import jacobian
+from .common import (
+    add_frame_tool_options,
+    add_robot_options,
+    format_joint_table,
+    load_robot,
+    parse_tool,
+    print_json,
+)
+from .fk import add_q_option, joint_positions
+
+NAME = "jacobian"
+
+#: Row labels of the geometric Jacobian (linear, then angular velocity; base frame).
+ROWS = ("vx", "vy", "vz", "wx", "wy", "wz")
+
+
+def register(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParser:
+    """Add the ``jacobian`` subcommand."""
+    p = subparsers.add_parser(
+        NAME,
+        help="geometric Jacobian of a frame or tool (base frame)",
+        description=__doc__,
+        formatter_class=argparse.RawDescriptionHelpFormatter,
+    )
+    add_robot_options(p)
+    add_q_option(p)
+    add_frame_tool_options(p)
+    p.add_argument("--json", action="store_true", help="print one JSON object")
+    return p
+
+
+def run(args: argparse.Namespace) -> int:
+    """Print the Jacobian (table or JSON)."""
+    robot = load_robot(args)
+    q = joint_positions(args, robot)
+    J = jacobian(robot, q, args.frame, parse_tool(args.tool))
+    if args.json:
+        print_json({"J": J, "rows": list(ROWS)})
+        return 0
+    what = f"tool on frame {args.frame!r}" if args.tool else f"frame {args.frame!r}"
+    print(f"{robot.name}: geometric Jacobian of the {what}, base frame")
+    print(f"q:\n{format_joint_table(robot, q)}")
+    width = max(10, *(len(s) + 1 for s in robot.joint_names))
+    print("    " + "".join(f"{s:>{width}}" for s in robot.joint_names))
+    for label, row in zip(ROWS, J, strict=True):
+        print(f"{label:<4}" + "".join(f"{v:>+{width}.6f}" for v in row))
+    return 0

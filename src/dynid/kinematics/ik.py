@@ -1,0 +1,939 @@
+"""Inverse kinematics by kinematic simulation (closed-loop inverse kinematics).
+
+The solver simulates the joint motion that a resolved-rate controller would command
+(Siciliano, "A closed-loop inverse kinematic scheme for on-line joint-based robot
+control", Robotica 8(3), 1990; Siciliano et al., *Robotics*, 2009, sec. 3.7):
+
+.. math::
+
+    e_k = \\begin{bmatrix} p_{goal} - p(q_k) \\\\
+          \\log(R_{goal} R(q_k)^T) \\end{bmatrix}, \\qquad
+    \\dot q_k = J^{\\#}(q_k)\\, K\\, e_k, \\qquad
+    q_{k+1} = \\mathrm{clip}(q_k + \\Delta t\\, \\dot q_k,\\; q_{min},\\; q_{max})
+
+Conventions:
+
+* ``e`` is the pose error in the **base frame**: the position error [m] of the frame's
+  origin, then the orientation error as an angle-axis vector [rad] (``log`` as in
+  :func:`dynid.spatial.angle_axis_from_matrix`, angle in ``[0, pi]``). ``J`` is the
+  geometric Jacobian of the same origin, rows ``[v; w]`` in the base frame
+  (:func:`dynid.kinematics.jacobian.jacobian`), so both halves of ``e`` match its rows.
+* ``J^#`` is the damped least-squares inverse (Nakamura and Hanafusa 1986; Wampler 1986)
+  with the damping schedule of Maciejewski and Klein 1988 and Chiaverini 1997: with
+  ``s_i`` the singular values of ``J``,
+  ``J^# = sum_i s_i / (s_i^2 + lambda^2) v_i u_i^T`` and
+  ``lambda^2 = (1 - (s_min / eps)^2) lambda_max^2`` when ``s_min < eps``, else 0. Away
+  from singularities it is the exact pseudo-inverse. Damping is needed only while the
+  steps are large, so ``lambda^2`` is further scaled by ``min(1, |e| / damping_error)``
+  (as Sugihara, "Solvability-unconcerned inverse kinematics by the Levenberg-Marquardt
+  method", IEEE T-RO 27(5), 2011, lets the damping fall with the error): a goal at a
+  near-singular configuration is still reached to the tolerances instead of creeping
+  towards it.
+* Joint position limits: ``q`` is clipped into ``[q_min, q_max]`` after every step, and a
+  joint resting on a limit whose step would push it further out is removed from ``J`` for
+  that step (an active set), so that the other joints take over the task. Every row of
+  the returned path lies within the limits.
+* Joint velocity limits (``IKOptions.velocity_limits``): each step is scaled uniformly so
+  that ``|dq_i| <= dq_max_i``, which keeps the simulated motion feasible.
+* The error fed to the controller is clamped to ``max_position_step`` and
+  ``max_orientation_step`` (Buss 2004, "Introduction to inverse kinematics with Jacobian
+  transpose, pseudoinverse and damped least squares methods", sec. 6), so a distant goal
+  is approached along a line instead of through one large linearised step.
+* ``dt * gain = 1`` (the default) is a full Gauss-Newton step; the discrete loop contracts
+  the error when ``0 < dt * gain < 2``.
+* Restarts: a local method can stall in a local minimum of the error (a joint limit
+  blocks the way, or a singular configuration). When the error has not fallen by 0.1 %
+  for ``stall_iterations`` steps, the simulation moves the arm at the velocity limits,
+  along a straight line in joint space, to a random configuration within the limits
+  (drawn from ``rng``) and resumes from there, at most ``max_restarts`` times. With
+  velocity limits the path stays a continuous, velocity-limited motion (without them the
+  transfer is one step). ``max_restarts=0`` gives the plain local simulation.
+
+One goal per call: iteration counts differ between goals, so :func:`ik` does not batch
+(loop over goals; with the compiled kernel a Panda solve typically takes 0.1-0.3 ms).
+
+Implementation: the loop runs in a compiled kernel (``_solve_kernel``) when numba is
+installed (compiled on first use, cached on disk; importing dynid does not import numba)
+and in a numpy loop (``_solve_numpy``) otherwise or when the environment variable
+``DYNID_NO_NUMBA=1`` is set before the first call. Both take the same steps, and the
+tests check that their paths agree. Both compute the forward kinematics and the Jacobian
+of one sample directly (scalar code in the kernel, ``_Chain`` in the numpy loop), checked
+against
+:func:`dynid.kinematics.forward.fk` and :func:`dynid.kinematics.jacobian.jacobian`.
+Restart configurations are drawn from ``rng`` only when a stall asks for them.
+"""
+
+from __future__ import annotations
+
+import math
+import os
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+from scipy.linalg import lapack
+
+from .. import _checks
+from ..exceptions import DataError, LimitError
+from ..model.robot import Robot
+from .forward import frame_pose_in_link
+
+__all__ = ["IKOptions", "IKResult", "check_pose", "default_q0", "ik"]
+
+#: Largest deviation ``max |R^T R - I|`` accepted for the rotation block of a goal pose.
+ORTHONORMALITY_TOLERANCE = 1e-5
+
+#: Relative decrease of the error norm that counts as progress (see ``stall_iterations``).
+_PROGRESS = 1e-3
+
+
+@dataclass(frozen=True, slots=True)
+class IKOptions:
+    """Settings of :func:`ik`.
+
+    Attributes
+    ----------
+    dt : float
+        Time step of the kinematic simulation [s].
+    gain : float
+        Task-space gain ``K`` [1/s]; ``dt * gain`` must lie in ``(0, 2)`` (1: a full
+        Gauss-Newton step).
+    damping : float
+        Largest damping ``lambda_max`` of the least-squares inverse, reached at a singular
+        configuration [units of ``J``]; 0 gives the plain pseudo-inverse.
+    singular_threshold : float
+        Smallest singular value ``eps`` of ``J`` below which damping starts.
+    damping_error : float
+        Error norm ``|[e_p; e_o]|`` below which the damping fades (linearly in
+        ``lambda^2``) to 0, so that a goal at a near-singular configuration is still
+        reached to the tolerances [m and rad].
+    position_tolerance : float
+        Convergence threshold on ``|p_goal - p|`` [m].
+    orientation_tolerance : float
+        Convergence threshold on the angle of ``R_goal R^T`` [rad].
+    max_iterations : int
+        Largest number of simulation steps, restarts included.
+    max_position_step : float
+        Clamp on the norm of the position error fed to the controller [m].
+    max_orientation_step : float
+        Clamp on the norm of the orientation error fed to the controller [rad].
+    velocity_limits : bool
+        Scale each step so that ``|dq_i| <= robot.dq_max[i]`` (joints without a finite
+        limit are not constrained).
+    stall_iterations : int
+        Steps without a 0.1 % decrease of the error norm after which the simulation
+        restarts (or stops, once ``max_restarts`` are used).
+    max_restarts : int
+        Largest number of restarts from random configurations (0: none).
+    """
+
+    dt: float = 0.1
+    gain: float = 10.0
+    damping: float = 0.1
+    singular_threshold: float = 0.05
+    damping_error: float = 0.1
+    position_tolerance: float = 1e-6
+    orientation_tolerance: float = 1e-6
+    max_iterations: int = 2000
+    max_position_step: float = 0.2
+    max_orientation_step: float = 0.5
+    velocity_limits: bool = True
+    stall_iterations: int = 30
+    max_restarts: int = 20
+
+    def __post_init__(self) -> None:
+        for name in (
+            "dt",
+            "gain",
+            "singular_threshold",
+            "damping_error",
+            "position_tolerance",
+            "orientation_tolerance",
+            "max_position_step",
+            "max_orientation_step",
+        ):
+            v = getattr(self, name)
+            if not (isinstance(v, (int, float)) and math.isfinite(v) and v > 0):
+                raise DataError(f"IKOptions.{name} must be a positive finite number; got {v!r}")
+        if not (
+            isinstance(self.damping, (int, float))
+            and math.isfinite(self.damping)
+            and self.damping >= 0
+        ):
+            raise DataError(f"IKOptions.damping must be a finite number >= 0; got {self.damping!r}")
+        if not 0 < self.dt * self.gain < 2:
+            raise DataError(
+                "IKOptions.dt * gain must lie in (0, 2) for the discrete loop to converge; "
+                f"got {self.dt * self.gain!r}"
+            )
+        for name, low in (("max_iterations", 1), ("stall_iterations", 1), ("max_restarts", 0)):
+            v = getattr(self, name)
+            if isinstance(v, bool) or not isinstance(v, (int, np.integer)) or v < low:
+                raise DataError(f"IKOptions.{name} must be an integer >= {low}; got {v!r}")
+
+
+@dataclass(frozen=True, slots=True, eq=False)
+class IKResult:
+    """Outcome of :func:`ik`.
+
+    Attributes
+    ----------
+    q : ndarray, shape (n,)
+        Joint positions [rad or m] of the best point of the path (the last one when
+        converged), within the limits.
+    converged : bool
+        Both errors at ``q`` are within their tolerances.
+    iterations : int
+        Number of simulation steps taken.
+    position_error : float
+        ``|p_goal - p(q)|`` at ``q`` [m], base frame.
+    orientation_error : float
+        Angle of ``R_goal R(q)^T`` at ``q`` [rad].
+    path : ndarray, shape (iterations + 1, n)
+        The simulated joint motion from ``q0``; row ``k`` is the state after ``k`` steps
+        (time ``k * dt``).
+    restarts : int
+        Number of restarts used.
+    """
+
+    q: NDArray[np.float64]
+    converged: bool
+    iterations: int
+    position_error: float
+    orientation_error: float
+    path: NDArray[np.float64]
+    restarts: int = 0
+
+
+def default_q0(robot: Robot) -> NDArray[np.float64]:
+    """The documented default start of :func:`ik`, shape (n,) [rad or m].
+
+    ``robot.q_neutral`` when the robot has one (the Panda: :data:`dynid.PANDA_NEUTRAL_Q`);
+    otherwise the middle of the joint limits, with 0 for a joint whose range is unbounded
+    on either side.
+    """
+    if robot.q_neutral is not None:
+        return np.array(robot.q_neutral)
+    bounded = np.isfinite(robot.q_min) & np.isfinite(robot.q_max)
+    mid = 0.5 * (np.where(bounded, robot.q_min, 0.0) + np.where(bounded, robot.q_max, 0.0))
+    return np.where(bounded, mid, 0.0)
+
+
+def check_pose(name: str, T: ArrayLike) -> NDArray[np.float64]:
+    """Validate a rigid transform (4, 4): finite, last row ``[0, 0, 0, 1]``, rotation block.
+
+    Returns a new array whose rotation block is re-orthonormalised (the nearest rotation,
+    by SVD) when it deviates by more than 1e-13, so that a goal written with 6 decimals
+    can still be reached to 1e-6.
+
+    Raises
+    ------
+    ShapeError, NonFiniteError
+        ``T`` is not a finite (4, 4) array.
+    DataError
+        The last row is not ``[0, 0, 0, 1]`` or the rotation block is not a rotation
+        (``max |R^T R - I| > 1e-5`` or ``det R <= 0``).
+    """
+    T = np.array(_checks.as_exact(name, T, (4, 4)))
+    rows = T.tolist()
+    last = max(abs(x - y) for x, y in zip(rows[3], (0.0, 0.0, 0.0, 1.0), strict=True))
+    if last > ORTHONORMALITY_TOLERANCE:
+        raise DataError(f"{name} must have last row [0, 0, 0, 1]; got {rows[3]}")
+    (a, b, c, _), (d, e, f, _), (g, h, i, _) = rows[:3]
+    cols = ((a, d, g), (b, e, h), (c, f, i))
+    dev = max(
+        abs(sum(x * y for x, y in zip(cols[j], cols[k], strict=True)) - float(j == k))
+        for j in range(3)
+        for k in range(j, 3)
+    )
+    det = a * (e * i - f * h) - b * (d * i - f * g) + c * (d * h - e * g)
+    if dev > ORTHONORMALITY_TOLERANCE or det <= 0:
+        raise DataError(
+            f"{name} rotation block must be orthonormal with det +1 (max |R^T R - I| <= "
+            f"{ORTHONORMALITY_TOLERANCE:g}); got deviation {dev:.3g}, det {det:.3g}"
+        )
+    if dev > 1e-13:
+        U, _, Vt = np.linalg.svd(T[:3, :3])
+        T[:3, :3] = U @ Vt
+    T[3] = (0.0, 0.0, 0.0, 1.0)
+    return T
+
+
+# ---------------------------------------------------------------------- single sample
+class _Chain:
+    """Single-sample forward kinematics and Jacobian of one frame, with small arrays.
+
+    The motion of revolute joint ``i`` is ``T_fix (I + sin q K + (1 - cos q) K^2)`` with
+    ``K = [a]x``, of a prismatic one ``T_fix (I + q [0 a; 0 0])``. Both are affine in
+    ``(1, sin q, cos q, q)``: ``A[0] + sin q A[1] + cos q A[2] + q A[3]``, so the
+    coefficients ``A`` (4, m, 4, 4) are formed once and a call costs a few broadcast
+    operations. Only the ``m`` joints up to the frame's link move it.
+    """
+
+    __slots__ = ("m", "A", "axes", "rev", "T_link_frame")
+
+    def __init__(self, robot: Robot, link: int, T_link_frame: NDArray[np.float64]) -> None:
+        m = link
+        a = robot.axes[:m]
+        rev = ~robot.prismatic[:m]
+        K = np.zeros((m, 3, 3))  # [a]x, zero for prismatic joints
+        K[:, 0, 1], K[:, 0, 2], K[:, 1, 2] = -a[:, 2], a[:, 1], -a[:, 0]
+        K[:, 1, 0], K[:, 2, 0], K[:, 2, 1] = a[:, 2], -a[:, 1], a[:, 0]
+        K *= rev[:, None, None]
+        KK = K @ K
+        Rf = robot.T_parent_joint[:m, :3, :3]
+        A = np.zeros((4, m, 4, 4))
+        A[0, :, :3, :3] = Rf + Rf @ KK
+        A[0, :, :3, 3] = robot.T_parent_joint[:m, :3, 3]
+        A[0, :, 3, 3] = 1.0
+        A[1, :, :3, :3] = Rf @ K
+        A[2, :, :3, :3] = -(Rf @ KK)
+        A[3, :, :3, 3] = (Rf @ (a * ~rev[:, None])[:, :, None])[:, :, 0]
+        self.m = m
+        self.A = A
+        self.axes = np.array(a)
+        self.rev = np.array(rev)
+        self.T_link_frame = np.array(T_link_frame)
+
+    def pose_jacobian(self, q: NDArray[np.float64]) -> tuple[NDArray, NDArray]:
+        """``T_base_frame`` (4, 4) and the Jacobian (6, m) of the first ``m`` joints."""
+        m = self.m
+        if m == 0:
+            return self.T_link_frame.copy(), np.zeros((6, 0))
+        qm = q[:m]
+        A = self.A
+        T = A[0] + np.sin(qm)[:, None, None] * A[1] + np.cos(qm)[:, None, None] * A[2]
+        if not self.rev.all():
+            T += qm[:, None, None] * A[3]
+        d = 1
+        while d < m:  # prefix products T_base_link_i (Hillis-Steele scan)
+            T[d:] = T[:-d] @ T[d:]
+            d *= 2
+        Te = T[m - 1] @ self.T_link_frame
+        z = (T[:, :3, :3] @ self.axes[:, :, None])[:, :, 0]  # joint axes in the base frame
+        r = Te[:3, 3] - T[:, :3, 3]  # joint origins to the frame origin
+        J = np.empty((6, m))
+        J[0] = z[:, 1] * r[:, 2] - z[:, 2] * r[:, 1]
+        J[1] = z[:, 2] * r[:, 0] - z[:, 0] * r[:, 2]
+        J[2] = z[:, 0] * r[:, 1] - z[:, 1] * r[:, 0]
+        J[3:] = z.T
+        if not self.rev.all():
+            J[:3, ~self.rev] = z[~self.rev].T
+            J[3:, ~self.rev] = 0.0
+        return Te, J
+
+
+def _rotvec(R: NDArray[np.float64]) -> tuple[float, float, float, float]:
+    """Angle-axis vector (x, y, z) [rad] and angle in [0, pi] of one rotation matrix.
+
+    Scalar form of :func:`dynid.spatial.angle_axis_from_matrix`: the skew part is
+    ``sin(theta) u``; near pi the axis comes from the symmetric part
+    ``(R + R^T) / 2 = cos(theta) I + (1 - cos(theta)) u u^T``, signed by the skew part.
+    """
+    (r00, r01, r02), (r10, r11, r12), (r20, r21, r22) = R.tolist()
+    vx, vy, vz = 0.5 * (r21 - r12), 0.5 * (r02 - r20), 0.5 * (r10 - r01)
+    c = min(1.0, max(-1.0, 0.5 * (r00 + r11 + r22 - 1.0)))
+    s = math.sqrt(vx * vx + vy * vy + vz * vz)
+    theta = math.atan2(s, c)
+    if c > -0.9:
+        f = theta / s if s > 1e-12 else 1.0 + theta * theta / 6.0
+        return f * vx, f * vy, f * vz, theta
+    w = 1.0 / (1.0 - c)  # u u^T = (S - c I) / (1 - c); read the row of the largest diagonal
+    dx, dy, dz = (r00 - c) * w, (r11 - c) * w, (r22 - c) * w
+    sxy, sxz, syz = 0.5 * (r01 + r10) * w, 0.5 * (r02 + r20) * w, 0.5 * (r12 + r21) * w
+    if dx >= dy and dx >= dz:
+        ux, uy, uz = dx, sxy, sxz
+    elif dy >= dz:
+        ux, uy, uz = sxy, dy, syz
+    else:
+        ux, uy, uz = sxz, syz, dz
+    norm = math.sqrt(ux * ux + uy * uy + uz * uz)
+    if ux * vx + uy * vy + uz * vz < 0.0:
+        norm = -norm
+    return theta * ux / norm, theta * uy / norm, theta * uz / norm, theta
+
+
+def _dls(J: NDArray[np.float64], e: NDArray[np.float64], lam_max: float, eps: float) -> NDArray:
+    """Damped least-squares solution ``J^# e`` with singular-value dependent damping."""
+    U, s, Vt, info = lapack.dgesdd(J, full_matrices=0)
+    if info != 0:  # LAPACK did not converge: numpy's driver raises a clear error
+        U, s, Vt = np.linalg.svd(J, full_matrices=False)
+    s_min = s[-1]
+    lam2 = (1.0 - (s_min / eps) ** 2) * lam_max**2 if s_min < eps else 0.0
+    keep = s > 1e-12 * s[0]
+    inv = np.where(keep, s / np.where(keep, s * s + lam2, 1.0), 0.0)
+    return Vt.T @ (inv * (U.T @ e))
+
+
+# ---------------------------------------------------------------------- numpy loop
+def _solve_numpy(
+    chain: _Chain,
+    q_min: NDArray,
+    q_max: NDArray,
+    inv_vmax: NDArray,
+    q_restart: NDArray,
+    p_goal: NDArray,
+    R_goal: NDArray,
+    fpar: NDArray,
+    ipar: NDArray,
+    path: NDArray,
+) -> tuple[int, int, float, float, bool, int, bool]:
+    """The simulation loop with numpy; same steps and outputs as :func:`_solve_kernel`."""
+    dt, K, lam, eps, tol_p, tol_o, step_p, step_o, e_damp = (float(x) for x in fpar)
+    max_iter, stall, max_restarts = int(ipar[0]), int(ipar[1]), int(ipar[2])
+    m = chain.m
+    use_vmax = bool(np.any(inv_vmax > 0))
+    q = path[0].copy()
+    e = np.empty(6)
+    k = best_k = 0
+    best_err = best_p = best_o = math.inf
+    ref, k_ref, restarts, converged = math.inf, 0, 0, False
+    target: NDArray | None = None
+    while True:
+        if target is not None:  # transfer to a restart configuration at the velocity limits
+            dq = (target - q[:m]) / dt
+            ratio = float(np.max(np.abs(dq) * inv_vmax)) if use_vmax else 0.0
+            if ratio <= 1.0:
+                q[:m] = target
+                target, ref, k_ref = None, math.inf, k + 1
+            else:
+                q[:m] = np.minimum(np.maximum(q[:m] + (dt / ratio) * dq, q_min), q_max)
+            k += 1
+            path[k] = q
+            if k >= max_iter:
+                break
+            continue
+        T, J = chain.pose_jacobian(q)
+        e[:3] = p_goal - T[:3, 3]
+        ox, oy, oz, err_o = _rotvec(R_goal @ T[:3, :3].T)
+        e[3], e[4], e[5] = ox, oy, oz
+        err_p = math.sqrt(e[0] * e[0] + e[1] * e[1] + e[2] * e[2])
+        err = math.sqrt(err_p * err_p + err_o * err_o)
+        if (err_p <= tol_p and err_o <= tol_o) or err < best_err:
+            best_k, best_err, best_p, best_o = k, err, err_p, err_o
+        if err_p <= tol_p and err_o <= tol_o:
+            converged = True
+            break
+        if err < ref * (1.0 - _PROGRESS):
+            ref, k_ref = err, k
+        if k >= max_iter or m == 0:
+            break
+        if k - k_ref >= stall:
+            if restarts == max_restarts:
+                break
+            if restarts == q_restart.shape[0]:  # ask the caller for restart configurations
+                return k, best_k, best_p, best_o, converged, restarts, True
+            target = q_restart[restarts]
+            restarts += 1
+            continue
+        if err_p > step_p:
+            e[:3] *= step_p / err_p
+        if err_o > step_o:
+            e[3:] *= step_o / err_o
+        qm = q[:m]
+        at_lo, at_hi = qm <= q_min, qm >= q_max
+        free = np.ones(m, dtype=bool)
+        lam_e = lam * math.sqrt(min(1.0, err / e_damp))
+        dq = _dls(J, e, lam_e, eps)
+        for _ in range(m):  # active set: joints pushed beyond a limit they rest on stay put
+            push = free & ((at_lo & (dq < 0.0)) | (at_hi & (dq > 0.0)))
+            if not push.any():
+                break
+            free &= ~push
+            dq = np.zeros(m)
+            if free.any():
+                dq[free] = _dls(J[:, free], e, lam_e, eps)
+        dq *= K
+        if use_vmax:
+            ratio = float(np.max(np.abs(dq) * inv_vmax))
+            if ratio > 1.0:
+                dq /= ratio
+        q[:m] = np.minimum(np.maximum(qm + dt * dq, q_min), q_max)
+        k += 1
+        path[k] = q
+    return k, best_k, best_p, best_o, converged, restarts, False
+
+
+# ---------------------------------------------------------------------- compiled loop
+def _solve_kernel(
+    Tf, axes, rev, T_lf, q_min, q_max, inv_vmax, q_restart, p_goal, R_goal, fpar, ipar, path
+):  # pragma: no cover (compiled by numba)
+    """The simulation loop in scalar form, compiled with numba; see :func:`_solve_numpy`.
+
+    ``Tf`` (m, 4, 4), ``axes`` (m, 3) and ``rev`` (m,) are the robot's ``T_parent_joint``,
+    ``axes`` and ``~prismatic`` of the ``m`` joints that move the frame, ``T_lf`` the
+    frame's pose in link m. ``path`` (max_iterations + 1, n) holds ``q0`` in row 0 and
+    receives the motion. ``ipar`` is ``(max_iterations, stall_iterations, max_restarts)``.
+    Returns ``(iterations, best row, position error, orientation error, converged,
+    restarts, need_restarts)``; ``need_restarts`` asks the caller to run again with the
+    ``max_restarts`` configurations in ``q_restart`` (drawn only when needed).
+
+    The damped least-squares step is formed from the eigen-decomposition (cyclic Jacobi
+    rotations) of the smaller Gram matrix, ``J J^T`` (then ``J^# e = J^T V (W + lambda^2)^-1
+    V^T e``) or ``J^T J`` (then ``V (W + lambda^2)^-1 V^T J^T e``), with ``W = diag(s^2)``:
+    the same step as the SVD form of :func:`_dls`, several times faster than a LAPACK call
+    on a 6 x 7 matrix.
+    """
+    dt, K, lam, eps = fpar[0], fpar[1], fpar[2], fpar[3]
+    tol_p, tol_o, step_p, step_o, e_damp = fpar[4], fpar[5], fpar[6], fpar[7], fpar[8]
+    max_iter, stall, max_restarts = ipar[0], ipar[1], ipar[2]
+    n, m, n_restart = path.shape[1], axes.shape[0], q_restart.shape[0]
+    use_vmax = False
+    for j in range(m):
+        if inv_vmax[j] > 0.0:
+            use_vmax = True
+    q = path[0].copy()
+    Tc = np.empty((m, 3, 4))
+    rel = np.empty((3, 4))
+    Rq = np.empty((3, 3))
+    Te = np.empty((3, 4))
+    J = np.empty((6, m))
+    e = np.empty(6)
+    M = np.empty((3, 3))
+    dq = np.zeros(m)
+    free = np.empty(m, dtype=np.bool_)
+    target = np.empty(m)
+    Jf = np.empty((6, m))
+    G = np.empty((6, 6))
+    V = np.empty((6, 6))
+    bvec = np.empty(6)
+    y = np.empty(6)
+    k = 0
+    best_k = 0
+    best_err = np.inf
+    best_p = np.inf
+    best_o = np.inf
+    ref = np.inf
+    k_ref = 0
+    restarts = 0
+    converged = False
+    transfer = False
+    while True:
+        if transfer:
+            ratio = 0.0
+            for j in range(m):
+                dq[j] = (target[j] - q[j]) / dt
+                if use_vmax:
+                    ratio = max(ratio, abs(dq[j]) * inv_vmax[j])
+            if ratio <= 1.0:
+                for j in range(m):
+                    q[j] = target[j]
+                transfer = False
+                ref = np.inf
+                k_ref = k + 1
+            else:
+                for j in range(m):
+                    q[j] = min(max(q[j] + (dt / ratio) * dq[j], q_min[j]), q_max[j])
+            k += 1
+            for j in range(n):
+                path[k, j] = q[j]
+            if k >= max_iter:
+                break
+            continue
+        # forward kinematics: T_base_link_i (3 x 4) and the frame pose Te
+        for i in range(m):
+            ax, ay, az, qi = axes[i, 0], axes[i, 1], axes[i, 2], q[i]
+            if rev[i]:  # Rodrigues: Rq = c I + s [a]x + (1 - c) a a^T
+                s, c = math.sin(qi), math.cos(qi)
+                v = 1.0 - c
+                Rq[0, 0] = c + v * ax * ax
+                Rq[1, 1] = c + v * ay * ay
+                Rq[2, 2] = c + v * az * az
+                Rq[0, 1], Rq[1, 0] = v * ax * ay - s * az, v * ax * ay + s * az
+                Rq[0, 2], Rq[2, 0] = v * ax * az + s * ay, v * ax * az - s * ay
+                Rq[1, 2], Rq[2, 1] = v * ay * az - s * ax, v * ay * az + s * ax
+                for r in range(3):
+                    for col in range(3):
+                        rel[r, col] = (
+                            Tf[i, r, 0] * Rq[0, col]
+                            + Tf[i, r, 1] * Rq[1, col]
+                            + Tf[i, r, 2] * Rq[2, col]
+                        )
+                    rel[r, 3] = Tf[i, r, 3]
+            else:
+                for r in range(3):
+                    for col in range(3):
+                        rel[r, col] = Tf[i, r, col]
+                    rel[r, 3] = Tf[i, r, 3] + qi * (
+                        Tf[i, r, 0] * ax + Tf[i, r, 1] * ay + Tf[i, r, 2] * az
+                    )
+            if i == 0:
+                for r in range(3):
+                    for col in range(4):
+                        Tc[0, r, col] = rel[r, col]
+            else:
+                for r in range(3):
+                    for col in range(4):
+                        v = (
+                            Tc[i - 1, r, 0] * rel[0, col]
+                            + Tc[i - 1, r, 1] * rel[1, col]
+                            + Tc[i - 1, r, 2] * rel[2, col]
+                        )
+                        if col == 3:
+                            v += Tc[i - 1, r, 3]
+                        Tc[i, r, col] = v
+        for r in range(3):
+            for col in range(4):
+                v = (
+                    Tc[m - 1, r, 0] * T_lf[0, col]
+                    + Tc[m - 1, r, 1] * T_lf[1, col]
+                    + Tc[m - 1, r, 2] * T_lf[2, col]
+                )
+                if col == 3:
+                    v += Tc[m - 1, r, 3]
+                Te[r, col] = v
+        # geometric Jacobian of the frame origin, base frame
+        for i in range(m):
+            zx = Tc[i, 0, 0] * axes[i, 0] + Tc[i, 0, 1] * axes[i, 1] + Tc[i, 0, 2] * axes[i, 2]
+            zy = Tc[i, 1, 0] * axes[i, 0] + Tc[i, 1, 1] * axes[i, 1] + Tc[i, 1, 2] * axes[i, 2]
+            zz = Tc[i, 2, 0] * axes[i, 0] + Tc[i, 2, 1] * axes[i, 1] + Tc[i, 2, 2] * axes[i, 2]
+            if rev[i]:
+                rx, ry, rz = Te[0, 3] - Tc[i, 0, 3], Te[1, 3] - Tc[i, 1, 3], Te[2, 3] - Tc[i, 2, 3]
+                J[0, i], J[1, i], J[2, i] = zy * rz - zz * ry, zz * rx - zx * rz, zx * ry - zy * rx
+                J[3, i], J[4, i], J[5, i] = zx, zy, zz
+            else:
+                J[0, i], J[1, i], J[2, i] = zx, zy, zz
+                J[3, i], J[4, i], J[5, i] = 0.0, 0.0, 0.0
+        # pose error in the base frame: position, then angle-axis of R_goal Te^T
+        for r in range(3):
+            e[r] = p_goal[r] - Te[r, 3]
+        for r in range(3):
+            for col in range(3):
+                M[r, col] = (
+                    R_goal[r, 0] * Te[col, 0]
+                    + R_goal[r, 1] * Te[col, 1]
+                    + R_goal[r, 2] * Te[col, 2]
+                )
+        vx, vy, vz = 0.5 * (M[2, 1] - M[1, 2]), 0.5 * (M[0, 2] - M[2, 0]), 0.5 * (M[1, 0] - M[0, 1])
+        cs = min(1.0, max(-1.0, 0.5 * (M[0, 0] + M[1, 1] + M[2, 2] - 1.0)))
+        sn = math.sqrt(vx * vx + vy * vy + vz * vz)
+        theta = math.atan2(sn, cs)
+        if cs > -0.9:
+            f = theta / sn if sn > 1e-12 else 1.0 + theta * theta / 6.0
+            e[3], e[4], e[5] = f * vx, f * vy, f * vz
+        else:
+            w = 1.0 / (1.0 - cs)
+            dx, dy, dz = (M[0, 0] - cs) * w, (M[1, 1] - cs) * w, (M[2, 2] - cs) * w
+            sxy, sxz = 0.5 * (M[0, 1] + M[1, 0]) * w, 0.5 * (M[0, 2] + M[2, 0]) * w
+            syz = 0.5 * (M[1, 2] + M[2, 1]) * w
+            if dx >= dy and dx >= dz:
+                ux, uy, uz = dx, sxy, sxz
+            elif dy >= dz:
+                ux, uy, uz = sxy, dy, syz
+            else:
+                ux, uy, uz = sxz, syz, dz
+            norm = math.sqrt(ux * ux + uy * uy + uz * uz)
+            if ux * vx + uy * vy + uz * vz < 0.0:
+                norm = -norm
+            e[3], e[4], e[5] = theta * ux / norm, theta * uy / norm, theta * uz / norm
+        err_o = theta
+        err_p = math.sqrt(e[0] * e[0] + e[1] * e[1] + e[2] * e[2])
+        err = math.sqrt(err_p * err_p + err_o * err_o)
+        done = err_p <= tol_p and err_o <= tol_o
+        if done or err < best_err:
+            best_k, best_err, best_p, best_o = k, err, err_p, err_o
+        if done:
+            converged = True
+            break
+        if err < ref * (1.0 - 1e-3):  # _PROGRESS
+            ref = err
+            k_ref = k
+        if k >= max_iter or m == 0:
+            break
+        if k - k_ref >= stall:
+            if restarts == max_restarts:
+                break
+            if restarts == n_restart:  # ask the caller for restart configurations
+                return k, best_k, best_p, best_o, converged, restarts, True
+            for j in range(m):
+                target[j] = q_restart[restarts, j]
+            restarts += 1
+            transfer = True
+            continue
+        if err_p > step_p:
+            for r in range(3):
+                e[r] *= step_p / err_p
+        if err_o > step_o:
+            for r in range(3, 6):
+                e[r] *= step_o / err_o
+        # damped least squares with the active set of the joint limits
+        for j in range(m):
+            free[j] = True
+        for _ in range(m + 1):
+            nf = 0
+            for j in range(m):
+                if free[j]:
+                    nf += 1
+            for j in range(m):
+                dq[j] = 0.0
+            if nf > 0:
+                # J^# e from the eigen-decomposition G = V diag(w) V^T of the smaller Gram
+                # matrix (J J^T if nf >= 6, else J^T J; w = s^2), by cyclic Jacobi rotations
+                col = 0
+                for j in range(m):
+                    if free[j]:
+                        for r in range(6):
+                            Jf[r, col] = J[r, j]
+                        col += 1
+                d = 6 if nf >= 6 else nf
+                tot = 0.0
+                for a in range(d):
+                    for b in range(d):
+                        acc = 0.0
+                        if nf >= 6:
+                            for t in range(nf):
+                                acc += Jf[a, t] * Jf[b, t]
+                        else:
+                            for t in range(6):
+                                acc += Jf[t, a] * Jf[t, b]
+                        G[a, b] = acc
+                        V[a, b] = 1.0 if a == b else 0.0
+                        tot += acc * acc
+                for _sweep in range(50):
+                    off = 0.0
+                    for a in range(d - 1):
+                        for b in range(a + 1, d):
+                            off += G[a, b] * G[a, b]
+                    if off <= 1e-30 * tot:
+                        break
+                    for a in range(d - 1):
+                        for b in range(a + 1, d):
+                            gab = G[a, b]
+                            if gab == 0.0:
+                                continue
+                            th = (G[b, b] - G[a, a]) / (2.0 * gab)
+                            t = 1.0 / (abs(th) + math.sqrt(th * th + 1.0))
+                            if th < 0.0:
+                                t = -t
+                            c = 1.0 / math.sqrt(t * t + 1.0)
+                            sn = t * c
+                            for r in range(d):
+                                g1, g2 = G[r, a], G[r, b]
+                                G[r, a], G[r, b] = c * g1 - sn * g2, sn * g1 + c * g2
+                            for r in range(d):
+                                g1, g2 = G[a, r], G[b, r]
+                                G[a, r], G[b, r] = c * g1 - sn * g2, sn * g1 + c * g2
+                            for r in range(d):
+                                g1, g2 = V[r, a], V[r, b]
+                                V[r, a], V[r, b] = c * g1 - sn * g2, sn * g1 + c * g2
+                w_max, w_min = 0.0, np.inf
+                for a in range(d):
+                    w_max = max(w_max, G[a, a])
+                    w_min = min(w_min, G[a, a])
+                s_min = math.sqrt(max(w_min, 0.0))
+                lam2 = (1.0 - (s_min / eps) ** 2) * lam * lam if s_min < eps else 0.0
+                if err < e_damp:
+                    lam2 *= err / e_damp
+                cut = 1e-24 * w_max
+                for a in range(d):  # b = e (nf >= 6) or J^T e (nf < 6)
+                    acc = 0.0
+                    if nf >= 6:
+                        acc = e[a]
+                    else:
+                        for r in range(6):
+                            acc += Jf[r, a] * e[r]
+                    bvec[a] = acc
+                for a in range(d):  # y = diag(1 / (w + lam^2)) V^T b, zero where w <= cut
+                    acc = 0.0
+                    for r in range(d):
+                        acc += V[r, a] * bvec[r]
+                    y[a] = acc / (G[a, a] + lam2) if G[a, a] > cut else 0.0
+                col = 0
+                for j in range(m):
+                    if free[j]:
+                        acc = 0.0
+                        if nf >= 6:  # dq = J^T V y
+                            for r in range(6):
+                                vy = 0.0
+                                for a in range(d):
+                                    vy += V[r, a] * y[a]
+                                acc += Jf[r, col] * vy
+                        else:  # dq = V y
+                            for a in range(d):
+                                acc += V[col, a] * y[a]
+                        dq[j] = acc
+                        col += 1
+            pushed = False
+            for j in range(m):
+                if free[j] and (
+                    (q[j] <= q_min[j] and dq[j] < 0.0) or (q[j] >= q_max[j] and dq[j] > 0.0)
+                ):
+                    free[j] = False
+                    pushed = True
+            if not pushed:
+                break
+        ratio = 0.0
+        for j in range(m):
+            dq[j] *= K
+            if use_vmax:
+                ratio = max(ratio, abs(dq[j]) * inv_vmax[j])
+        scale = dt / ratio if ratio > 1.0 else dt
+        for j in range(m):
+            q[j] = min(max(q[j] + scale * dq[j], q_min[j]), q_max[j])
+        k += 1
+        for j in range(n):
+            path[k, j] = q[j]
+    return k, best_k, best_p, best_o, converged, restarts, False
+
+
+_COMPILED: dict[str, Any] = {}
+_DEFAULT_OPTIONS = IKOptions()
+
+
+def _compiled_kernel() -> Any:
+    """The numba-compiled :func:`_solve_kernel`, or None for the numpy loop.
+
+    None when numba is not installed or the environment variable ``DYNID_NO_NUMBA`` is set
+    to anything but ``""`` or ``"0"`` (read on the first call, as :mod:`dynid.dynamics`
+    does).
+    """
+    if "kernel" not in _COMPILED:
+        try:
+            if os.environ.get("DYNID_NO_NUMBA", "") not in ("", "0"):
+                raise ImportError("DYNID_NO_NUMBA is set")
+            import numba
+        except ImportError:
+            _COMPILED["kernel"] = None
+        else:
+            try:
+                _COMPILED["kernel"] = numba.njit(cache=True)(_solve_kernel)
+            except RuntimeError:  # no writable cache folder: compile in memory only
+                _COMPILED["kernel"] = numba.njit(_solve_kernel)
+    return _COMPILED["kernel"]
+
+
+# ---------------------------------------------------------------------- solver
+def ik(
+    robot: Robot,
+    T_goal: ArrayLike,
+    q0: ArrayLike | None = None,
+    frame: str = "flange",
+    tool: ArrayLike | None = None,
+    options: IKOptions | None = None,
+    *,
+    rng: np.random.Generator | None = None,
+) -> IKResult:
+    """Joint positions that put a frame (or a tool fixed to it) at a goal pose.
+
+    Simulates ``q <- clip(q + dt J^#(q) K e(q))`` from ``q0`` until the position and the
+    orientation errors are within their tolerances (see the module docstring for the
+    damping, the limits and the restarts).
+
+    Parameters
+    ----------
+    robot : Robot
+    T_goal : array_like, shape (4, 4)
+        Goal pose of the frame (of the tool when given) in the base frame [m]. The
+        rotation block must be orthonormal to 1e-5; it is re-orthonormalised.
+    q0 : array_like, shape (n,), optional
+        Start [rad or m], within the position limits. Default :func:`default_q0`: the
+        Panda's neutral pose :data:`~dynid.model.panda.PANDA_NEUTRAL_Q`, else the middle
+        of the limits.
+    frame : str
+        A frame of ``robot.frames``.
+    tool : array_like, shape (4, 4), optional
+        Pose of a tool in ``frame`` [m]; the goal is then the tool's.
+    options : IKOptions, optional
+        Step, gain, damping, tolerances, iteration and restart limits.
+    rng : numpy.random.Generator, optional
+        Source of the restart configurations; default ``np.random.default_rng(0)``, made
+        anew on each call so results are reproducible.
+
+    Returns
+    -------
+    IKResult
+        ``converged=False`` (no exception) when the goal is not reached: ``q`` is then
+        the point of the path with the smallest ``|[e_p; e_o]|``, with its errors.
+
+    Raises
+    ------
+    ShapeError
+        ``T_goal`` or ``tool`` is not (4, 4), or ``q0`` is not (n,).
+    NonFiniteError
+        ``T_goal``, ``tool`` or ``q0`` holds NaN or inf.
+    DataError
+        ``T_goal`` is not a rigid transform.
+    UnknownNameError
+        ``frame`` is not a frame of the robot.
+    LimitError
+        ``q0`` lies outside the joint position limits.
+
+    Examples
+    --------
+    >>> import dynid
+    >>> from dynid.kinematics import ik
+    >>> robot = dynid.panda()
+    >>> T = dynid.fk(robot, [0.1, -0.5, 0.2, -2.0, 0.1, 1.8, 0.5])
+    >>> ik(robot, T).converged
+    True
+    """
+    opts = _DEFAULT_OPTIONS if options is None else options
+    if not isinstance(opts, IKOptions):
+        raise TypeError(f"options must be an IKOptions; got {type(opts).__name__}")
+    link, T_link_frame = frame_pose_in_link(robot, frame, tool)
+    T_goal = check_pose("T_goal", T_goal)
+    n = robot.n
+    q = default_q0(robot) if q0 is None else _checks.as_exact("q0", q0, (n,))
+    outside = np.flatnonzero((q < robot.q_min) | (q > robot.q_max))
+    if outside.size:
+        j = int(outside[0])
+        raise LimitError(
+            f"q0 must lie within the joint limits; {robot.joint_names[j]} = {q[j]:.6g} is "
+            f"outside [{robot.q_min[j]:.6g}, {robot.q_max[j]:.6g}]"
+        )
+
+    m = link  # joints 1..m move the frame
+    q_min, q_max = np.array(robot.q_min[:m]), np.array(robot.q_max[:m])
+    inv_vmax = np.zeros(m)
+    if opts.velocity_limits:
+        dq_max = robot.dq_max[:m]
+        inv_vmax = np.where(np.isfinite(dq_max), 1.0 / dq_max, 0.0)
+    fpar = np.array(
+        [
+            opts.dt,
+            opts.gain,
+            opts.damping,
+            opts.singular_threshold,
+            opts.position_tolerance,
+            opts.orientation_tolerance,
+            opts.max_position_step,
+            opts.max_orientation_step,
+            opts.damping_error,
+        ]
+    )
+    ipar = np.array([opts.max_iterations, opts.stall_iterations, opts.max_restarts], np.int64)
+    path = np.empty((opts.max_iterations + 1, n))
+    path[0] = q
+    p_goal, R_goal = np.array(T_goal[:3, 3]), np.array(T_goal[:3, :3])
+    kernel = _compiled_kernel() if m > 0 else None
+    if kernel is not None:
+        args = (
+            np.array(robot.T_parent_joint[:m]),
+            np.array(robot.axes[:m]),
+            ~robot.prismatic[:m],
+            np.array(T_link_frame),
+        )
+    else:
+        kernel, args = _solve_numpy, (_Chain(robot, link, T_link_frame),)
+    q_restart = np.empty((0, m))
+    while True:  # a second pass only when the first one asks for restart configurations
+        k, best_k, err_p, err_o, converged, restarts, more = kernel(
+            *args, q_min, q_max, inv_vmax, q_restart, p_goal, R_goal, fpar, ipar, path
+        )
+        if not more:
+            break
+        lo = np.where(np.isfinite(q_min), q_min, np.minimum(q[:m], q_max) - np.pi)
+        hi = np.where(np.isfinite(q_max), q_max, np.maximum(q[:m], q_min) + np.pi)
+        rng = np.random.default_rng(0) if rng is None else rng
+        q_restart = lo + (hi - lo) * rng.random((opts.max_restarts, m))
+    path = _checks.frozen(path[: k + 1])
+    return IKResult(
+        q=_checks.frozen(path[best_k]),
+        converged=bool(converged),
+        iterations=int(k),
+        position_error=float(err_p),
+        orientation_error=float(err_o),
+        path=path,
+        restarts=int(restarts),
+    )

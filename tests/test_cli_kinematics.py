@@ -1,0 +1,195 @@
+"""The fk, jacobian, ik and demo subcommands: JSON equals the library, errors are one line."""
+
+from __future__ import annotations
+
+import json
+
+import numpy as np
+import pytest
+
+import dynid
+from dynid import spatial
+from dynid.cli.__main__ import main
+from dynid.kinematics import IKOptions, ik
+
+
+def _csv(x) -> str:
+    return ",".join(repr(float(v)) for v in np.ravel(x))
+
+
+def _run_json(capsys, argv):
+    """Run the CLI, check exit status 0 and that stdout is exactly one JSON object."""
+    code = main(argv)
+    out, err = capsys.readouterr()
+    assert code == 0, err
+    assert err == ""
+    assert out.count("\n") == 1
+    return json.loads(out)
+
+
+def test_fk_json_equals_library(capsys):
+    """fk --json prints {"T": 4x4} equal to dynid.fk with the same frame and tool."""
+    rng = np.random.default_rng(41)
+    robot = dynid.panda()
+    q = rng.uniform(robot.q_min, robot.q_max)
+    tool = [0.01, -0.02, 0.1, 0.1, -0.2, 0.3]
+    argv = ["fk", f"--q={_csv(q)}", "--frame", "link6", "--tool", _csv(tool), "--json"]
+    obj = _run_json(capsys, argv)
+    assert set(obj) == {"T"}
+    T_ref = dynid.fk(robot, q, "link6", spatial.transform_from_xyz_rpy(tool[:3], tool[3:]))
+    np.testing.assert_array_equal(np.array(obj["T"]), T_ref)
+
+
+def test_fk_default_q_is_the_neutral_pose(capsys):
+    """Without --q, fk uses the documented neutral pose PANDA_NEUTRAL_Q."""
+    obj = _run_json(capsys, ["fk", "--json"])
+    T_ref = dynid.fk(dynid.panda(), dynid.PANDA_NEUTRAL_Q)
+    np.testing.assert_array_equal(np.array(obj["T"]), T_ref)
+
+
+def test_jacobian_json_equals_library(capsys):
+    """jacobian --json prints {"J": 6xn, "rows": [...]} equal to dynid.jacobian."""
+    rng = np.random.default_rng(42)
+    robot = dynid.panda()
+    q = rng.uniform(robot.q_min, robot.q_max)
+    obj = _run_json(capsys, ["jacobian", f"--q={_csv(q)}", "--tool", "0,0,0.1", "--json"])
+    assert obj["rows"] == ["vx", "vy", "vz", "wx", "wy", "wz"]
+    J_ref = dynid.jacobian(robot, q, tool=spatial.transform_from_xyz_rpy([0, 0, 0.1]))
+    np.testing.assert_array_equal(np.array(obj["J"]), J_ref)
+
+
+def test_ik_json_with_goal_matrix_equals_library_and_reaches_the_goal(capsys):
+    """ik --goal (16 numbers) --json equals dynid.kinematics.ik and fk(q) is the goal."""
+    rng = np.random.default_rng(43)
+    robot = dynid.panda()
+    tool = spatial.transform_from_xyz_rpy([0, 0, 0.1])
+    T_goal = dynid.fk(robot, rng.uniform(robot.q_min, robot.q_max), tool=tool)
+    obj = _run_json(capsys, ["ik", f"--goal={_csv(T_goal)}", "--tool", "0,0,0.1", "--json"])
+    assert set(obj) == {"q", "converged", "iterations", "position_error", "orientation_error"}
+    ref = ik(robot, T_goal, tool=tool, rng=np.random.default_rng(0))
+    assert obj["converged"] is True and obj["iterations"] == ref.iterations
+    np.testing.assert_array_equal(obj["q"], ref.q)
+    assert obj["position_error"] == ref.position_error <= 1e-6
+    assert obj["orientation_error"] == ref.orientation_error <= 1e-6
+    np.testing.assert_allclose(dynid.fk(robot, obj["q"], tool=tool), T_goal, atol=2e-6)
+
+
+def test_ik_json_with_xyz_rpy_and_q0_equals_library(capsys):
+    """ik --goal-xyz/--goal-rpy/--q0/tolerances equal the library call with the same values."""
+    robot = dynid.panda()
+    q0 = np.array([0.2, -0.5, -0.1, -2.2, 0.1, 1.7, 0.5])
+    xyz, rpy = [0.45, -0.1, 0.35], [np.pi, 0.1, -0.3]
+    obj = _run_json(
+        capsys,
+        [
+            "ik",
+            "--goal-xyz",
+            _csv(xyz),
+            "--goal-rpy",
+            _csv(rpy),
+            "--q0",
+            _csv(q0),
+            "--position-tolerance",
+            "1e-8",
+            "--orientation-tolerance",
+            "1e-8",
+            "--json",
+        ],
+    )
+    opts = IKOptions(position_tolerance=1e-8, orientation_tolerance=1e-8)
+    ref = ik(
+        robot,
+        spatial.transform_from_xyz_rpy(xyz, rpy),
+        q0,
+        options=opts,
+        rng=np.random.default_rng(0),
+    )
+    assert obj["converged"] and obj["position_error"] <= 1e-8
+    np.testing.assert_array_equal(obj["q"], ref.q)
+
+
+def test_ik_goal_xyz_without_rpy_keeps_the_start_orientation(capsys):
+    """Without --goal-rpy the goal orientation is the frame's orientation at --q0."""
+    robot = dynid.panda()
+    obj = _run_json(capsys, ["ik", "--goal-xyz", "0.35,0.1,0.45", "--json"])
+    T = dynid.fk(robot, obj["q"])
+    np.testing.assert_allclose(T[:3, 3], [0.35, 0.1, 0.45], atol=1e-6)
+    np.testing.assert_allclose(T[:3, :3], dynid.fk(robot, dynid.PANDA_NEUTRAL_Q)[:3, :3], atol=1e-6)
+
+
+def test_ik_unreachable_goal_exits_1_with_best_result(capsys):
+    """An unreachable goal prints converged false and exits with status 1."""
+    code = main(["ik", "--goal-xyz", "2,0,0.3", "--max-iterations", "300", "--json"])
+    out, err = capsys.readouterr()
+    assert code == 1 and err == ""
+    obj = json.loads(out)
+    assert obj["converged"] is False and obj["position_error"] > 1.0
+
+
+@pytest.mark.parametrize("command", ["fk", "jacobian", "ik"])
+def test_text_output_is_a_readable_table(capsys, command):
+    """Without --json, the joint names and the key quantities are printed."""
+    extra = ["--goal-xyz", "0.4,0,0.4"] if command == "ik" else []
+    assert main([command, *extra]) == 0
+    out = capsys.readouterr().out
+    assert "joint7" in out
+    word = {"fk": "T_base_flange", "jacobian": "wz", "ik": "converged after"}[command]
+    assert word in out
+
+
+@pytest.mark.parametrize(
+    ("argv", "message"),
+    [
+        (["fk", "--q", "1,2"], "--q must have 7 values; got 2"),
+        (["fk", "--q=nan,0,0,-1,0,1,0"], "--q must be finite"),
+        (["fk", "--frame", "gripper"], "Unknown frame 'gripper'"),
+        (["jacobian", "--tool", "0,0"], "--tool must have 3 values"),
+        (["jacobian", "--robot", "robot.xml"], "--robot must be 'panda'"),
+        (["ik"], "give the goal as either --goal"),
+        (["ik", "--goal", "1,0,0,0"], "--goal must have 16 values"),
+        (["ik", "--goal", "1,0,0,0,0,2,0,0,0,0,1,0,0,0,0,1"], "rotation block must be orthonormal"),
+        (["ik", "--goal-xyz", "0.4,0,0.4", "--q0", "0,0,0,0,0,0,0"], "q0 must lie within"),
+        (["ik", "--goal-xyz", "0.4,0,0.4", "--goal", "1"], "either --goal"),
+        (["ik", "--goal-xyz", "a,b,c"], "--goal-xyz must be comma-separated numbers"),
+    ],
+)
+def test_bad_input_exits_nonzero_with_one_stderr_line(capsys, argv, message):
+    """Bad input returns a non-zero status and one 'dynid CMD: error: ...' line on stderr."""
+    code = main(argv)
+    out, err = capsys.readouterr()
+    assert code != 0
+    assert out == ""
+    lines = err.splitlines()
+    assert len(lines) == 1, err
+    assert lines[0].startswith(f"dynid {argv[0]}: error: ")
+    assert message in lines[0]
+
+
+def test_demo_stage_1_runs_headless_and_writes_a_png(capsys, tmp_path):
+    """demo --out DIR writes a non-empty PNG of the IK joint motion and reports convergence."""
+    out_dir = tmp_path / "demo"
+    assert main(["demo", "--out", str(out_dir), "--seed", "3"]) == 0
+    text = capsys.readouterr().out
+    png = out_dir / "ik_joint_motion.png"
+    assert png.stat().st_size > 1000
+    assert png.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+    assert "IK converged" in text and "flange Jacobian" in text
+
+
+def test_plot_ik_path_draws_one_line_per_joint_into_given_axes():
+    """plot_ik_path returns the Figure of the given axes with n lines and a time axis."""
+    from matplotlib.figure import Figure
+
+    from dynid.plots.kinematics import plot_ik_path
+
+    rng = np.random.default_rng(44)
+    path = np.cumsum(rng.normal(size=(30, 7)) * 0.01, axis=0)
+    fig = plot_ik_path(path, dt=0.1)
+    assert isinstance(fig, Figure)
+    assert len(fig.axes[0].lines) == 7 and fig.axes[0].get_xlabel() == "time [s]"
+    fig2 = Figure()
+    ax = fig2.add_subplot()
+    assert plot_ik_path(path, ax=ax, q_min=-np.ones(7), q_max=np.ones(7)) is fig2
+    assert len(ax.lines) == 7 + 14
+    with pytest.raises(dynid.ShapeError, match="path must have shape"):
+        plot_ik_path(np.zeros(7))
