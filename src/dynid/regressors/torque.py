@@ -71,23 +71,50 @@ def _torque_regressor(
     ddq: NDArray[np.float64],
     gravity: NDArray[np.float64],
 ) -> NDArray[np.float64]:
-    """(B, n, 10 n) regressor for validated (B, n) inputs; gravity (3,) or (B, 3)."""
+    """(B, n, 10 n) regressor for validated (B, n) inputs; gravity (3,) or (B, 3).
+
+    Every link's wrench regressor is carried to the base frame (moment about the base
+    origin), then projected on every joint at once: for a revolute joint i with axis z_i
+    through o_i, ``tau_i = z_i . N + (o_i x z_i) . F``; for a prismatic one ``z_i . F``;
+    links before joint i do not act on it.
+    """
     B, n = q.shape
     mot = link_motion(robot, q, dq, ddq, gravity)
-    Y = np.zeros((B, n, 10 * n))
-    U = np.zeros((B, 6, 0))  # wrench regressor of links > i, columns of those links
-    for i in range(n - 1, -1, -1):
-        K = link_wrench_regressor(mot.w[:, i], mot.dw[:, i], mot.a[:, i])
-        if i < n - 1:
-            R, p = mot.R[:, i + 1], mot.p[:, i + 1]
-            RF = R @ U[:, :3]
-            RN = R @ U[:, 3:] + _skew(p) @ RF
-            U = np.concatenate([K, np.concatenate([RF, RN], axis=1)], axis=2)
-        else:
-            U = K
-        rows = U[:, :3] if robot.prismatic[i] else U[:, 3:]
-        Y[:, i, 10 * i :] = np.einsum("k,bkp->bp", robot.axes[i], rows)
+    K = link_wrench_regressor(
+        mot.w.reshape(-1, 3), mot.dw.reshape(-1, 3), mot.a.reshape(-1, 3)
+    ).reshape(B, n, 6, 10)
+    R0 = np.empty((B, n, 3, 3))
+    p0 = np.empty((B, n, 3))
+    Rc = np.broadcast_to(np.eye(3), (B, 3, 3))
+    pc = np.zeros((B, 3))
+    for i in range(n):
+        pc = pc + (Rc @ mot.p[:, i, :, None])[..., 0]
+        Rc = Rc @ mot.R[:, i]
+        R0[:, i], p0[:, i] = Rc, pc
+    W = np.empty((B, n, 6, 10))
+    W[:, :, :3] = R0 @ K[:, :, :3]
+    W[:, :, 3:] = R0 @ K[:, :, 3:] + _skew(p0) @ W[:, :, :3]
+    z = (R0 @ robot.axes[:, :, None])[..., 0]  # (B, n, 3)
+    A = np.empty((B, n, 6))
+    pri = robot.prismatic
+    A[:, :, :3] = np.where(pri[:, None], z, np.cross(p0, z))
+    A[:, :, 3:] = np.where(pri[:, None], 0.0, z)
+    Y = A @ W.transpose(0, 2, 1, 3).reshape(B, 6, 10 * n)
+    Y *= _ACTS[n]
     return Y
+
+
+class _ActsOn(dict):
+    """Masks (n, 10 n): link j's columns act on joint i only when j >= i."""
+
+    def __missing__(self, n: int) -> NDArray[np.float64]:
+        mask = np.repeat(np.triu(np.ones((n, n))), 10, axis=1)
+        mask.setflags(write=False)
+        self[n] = mask
+        return mask
+
+
+_ACTS = _ActsOn()
 
 
 def torque_regressor(
