@@ -1,0 +1,199 @@
+"""Joint friction models: the sigmoid of Gaz et al. 2019 and the classical linear model.
+
+Sign convention: ``tau_f`` is the part of the measured joint torque spent on friction,
+
+.. math:: \\tau = M(q)\\ddot q + c(q, \\dot q) + g(q) + \\tau_f(\\dot q)
+
+so ``tau_f`` has the sign of the velocity for a dissipative joint.
+
+* **Sigmoid** (Gaz et al. 2019, eq. 25), per joint, zero at rest:
+
+  .. math:: \\tau_f(\\dot q) = \\frac{\\varphi_1}{1 + e^{-\\varphi_2 (\\dot q + \\varphi_3)}}
+            - \\frac{\\varphi_1}{1 + e^{-\\varphi_2 \\varphi_3}}
+
+  ``phi1`` [N m] is the span between the two saturation levels, ``phi2`` [s/rad] the
+  steepness, ``phi3`` [rad/s] the velocity offset of the transition.
+
+* **Classical** (Gaz et al. 2019, eq. 24): viscous, Coulomb and offset terms, linear in
+  the parameters,
+
+  .. math:: \\tau_f(\\dot q) = f_v \\dot q + f_c \\, \\mathrm{sign}(\\dot q) + f_o
+
+  with ``sign(0) = 0``; ``fv`` [N m s/rad], ``fc`` [N m], ``fo`` [N m].
+
+Both evaluate on velocities of shape ``(..., n)`` and return torques of the same shape.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import ClassVar
+
+import numpy as np
+import scipy.special
+from numpy.typing import ArrayLike, NDArray
+
+from .. import _checks
+from ..exceptions import ShapeError
+
+__all__ = [
+    "ClassicalFriction",
+    "FrictionModel",
+    "SigmoidFriction",
+    "classical_friction",
+    "sigmoid_friction",
+]
+
+
+def sigmoid_friction(
+    dq: ArrayLike, phi1: ArrayLike, phi2: ArrayLike, phi3: ArrayLike
+) -> NDArray[np.float64]:
+    """Sigmoid friction torques (Gaz et al. 2019, eq. 25).
+
+    Parameters
+    ----------
+    dq : array_like, shape (..., n)
+        Joint velocities [rad/s].
+    phi1, phi2, phi3 : array_like, shape (n,)
+        Span [N m], steepness [s/rad] and velocity offset [rad/s] per joint (broadcast
+        against ``dq``).
+
+    Returns
+    -------
+    tau_f : ndarray, shape (..., n)
+        Friction torques [N m], zero at ``dq = 0``.
+    """
+    dq = _checks.as_array("dq", dq)
+    phi1, phi2, phi3 = (np.asarray(p, dtype=np.float64) for p in (phi1, phi2, phi3))
+    return phi1 * (scipy.special.expit(phi2 * (dq + phi3)) - scipy.special.expit(phi2 * phi3))
+
+
+def classical_friction(
+    dq: ArrayLike, fv: ArrayLike, fc: ArrayLike, fo: ArrayLike
+) -> NDArray[np.float64]:
+    """Viscous + Coulomb + offset friction torques (Gaz et al. 2019, eq. 24).
+
+    Parameters
+    ----------
+    dq : array_like, shape (..., n)
+        Joint velocities [rad/s].
+    fv, fc, fo : array_like, shape (n,)
+        Viscous [N m s/rad], Coulomb [N m] and offset [N m] coefficients.
+
+    Returns
+    -------
+    tau_f : ndarray, shape (..., n)
+        ``fv dq + fc sign(dq) + fo`` [N m].
+    """
+    dq = _checks.as_array("dq", dq)
+    fv, fc, fo = (np.asarray(p, dtype=np.float64) for p in (fv, fc, fo))
+    return fv * dq + fc * np.sign(dq) + fo
+
+
+def _params(cls_name: str, names: tuple[str, ...], obj: object) -> int:
+    first = _checks.as_array(names[0], getattr(obj, names[0]))
+    if first.ndim != 1:
+        raise ShapeError(f"{cls_name}.{names[0]} must have shape (n,); got {first.shape}")
+    n = first.shape[0]
+    for k in names:
+        object.__setattr__(obj, k, _checks.frozen(_checks.as_exact(k, getattr(obj, k), (n,))))
+    return n
+
+
+@dataclass(frozen=True, slots=True, eq=False)
+class SigmoidFriction:
+    """Sigmoid friction parameters per joint (Gaz et al. 2019, eq. 25); arrays read-only.
+
+    Attributes
+    ----------
+    phi1 : ndarray, shape (n,)
+        Span [N m].
+    phi2 : ndarray, shape (n,)
+        Steepness [s/rad].
+    phi3 : ndarray, shape (n,)
+        Velocity offset [rad/s].
+    """
+
+    phi1: NDArray[np.float64]
+    phi2: NDArray[np.float64]
+    phi3: NDArray[np.float64]
+
+    kind: ClassVar[str] = "sigmoid"
+    names: ClassVar[tuple[str, ...]] = ("phi1", "phi2", "phi3")
+
+    def __post_init__(self) -> None:
+        _params("SigmoidFriction", self.names, self)
+
+    @classmethod
+    def from_array(cls, params: ArrayLike) -> SigmoidFriction:
+        """From an (n, 3) array with columns ``phi1, phi2, phi3`` (as ``Robot.friction``)."""
+        p = _checks.as_array("params", params)
+        if p.ndim != 2 or p.shape[1] != 3:
+            raise ShapeError(f"params must have shape (n, 3); got {p.shape}")
+        return cls(p[:, 0], p[:, 1], p[:, 2])
+
+    def as_array(self) -> NDArray[np.float64]:
+        """The parameters as an (n, 3) array, columns ``phi1, phi2, phi3``."""
+        return np.stack([self.phi1, self.phi2, self.phi3], axis=1)
+
+    @property
+    def n(self) -> int:
+        """Number of joints."""
+        return self.phi1.shape[0]
+
+    def torques(self, dq: ArrayLike) -> NDArray[np.float64]:
+        """Friction torques [N m] (..., n) at velocities ``dq`` [rad/s] (..., n)."""
+        dq = _checks.as_batch("dq", dq, (self.n,))
+        return sigmoid_friction(dq, self.phi1, self.phi2, self.phi3)
+
+
+@dataclass(frozen=True, slots=True, eq=False)
+class ClassicalFriction:
+    """Viscous, Coulomb and offset friction per joint (Gaz et al. 2019, eq. 24).
+
+    Attributes
+    ----------
+    fv : ndarray, shape (n,)
+        Viscous coefficients [N m s/rad].
+    fc : ndarray, shape (n,)
+        Coulomb coefficients [N m].
+    fo : ndarray, shape (n,)
+        Offsets [N m].
+    """
+
+    fv: NDArray[np.float64]
+    fc: NDArray[np.float64]
+    fo: NDArray[np.float64]
+
+    kind: ClassVar[str] = "classical"
+    names: ClassVar[tuple[str, ...]] = ("fv", "fc", "fo")
+
+    def __post_init__(self) -> None:
+        _params("ClassicalFriction", self.names, self)
+
+    @classmethod
+    def from_array(cls, params: ArrayLike) -> ClassicalFriction:
+        """From an (n, 3) array with columns ``fv, fc, fo`` (as ``IdentifiedModel.friction``)."""
+        p = _checks.as_array("params", params)
+        if p.ndim != 2 or p.shape[1] != 3:
+            raise ShapeError(f"params must have shape (n, 3); got {p.shape}")
+        return cls(p[:, 0], p[:, 1], p[:, 2])
+
+    def as_array(self) -> NDArray[np.float64]:
+        """The parameters as an (n, 3) array, columns ``fv, fc, fo``."""
+        return np.stack([self.fv, self.fc, self.fo], axis=1)
+
+    @property
+    def n(self) -> int:
+        """Number of joints."""
+        return self.fv.shape[0]
+
+    def torques(self, dq: ArrayLike) -> NDArray[np.float64]:
+        """Friction torques [N m] (..., n) at velocities ``dq`` [rad/s] (..., n)."""
+        dq = _checks.as_batch("dq", dq, (self.n,))
+        return classical_friction(dq, self.fv, self.fc, self.fo)
+
+
+#: Either friction model; both have ``kind``, ``names``, ``n``, ``torques(dq)`` and
+#: ``as_array()``.
+FrictionModel = SigmoidFriction | ClassicalFriction

@@ -1,0 +1,194 @@
+"""Classical identification from the torque log of an exciting trajectory (Gaz et al. 2019).
+
+Sec. IV-B of the paper:
+
+.. math:: \\tau_k = Y_b(q_k, \\dot q_k, \\ddot q_k)\\, \\beta + F(\\dot q_k)\\, f,
+          \\qquad f_j = (f_{v,j}, f_{c,j}, f_{o,j})
+
+stacked over samples ``k`` and solved by ordinary least squares
+(:func:`~dynid.identification.least_squares.fit_least_squares`, the same estimator and
+statistics as the static route). ``Y_b`` is the torque regressor reduced to the base
+parameters of ``base_parameters(robot, kind="torque")``; ``F`` holds the classical
+friction of each joint (eq. 24), ``fv dq_j + fc sign(dq_j) + fo`` in the row of joint
+``j`` only. Columns are ordered ``beta1 .. beta_r`` then ``fv1, fc1, fo1, fv2, ...``;
+rows sample-major (row ``k n + j`` is sample ``k``, joint ``j``).
+
+Pipeline: :func:`~dynid.identification.log.prepare_log` (resample if needed, zero-phase
+low-pass of ``q``, ``dq``, ``tau``, ``ddq`` from the filtered ``dq``, trim the edges), then
+**decimation**: after the low-pass at ``cutoff_hz`` the signals hold nothing above a few
+times the cutoff, so keeping every ``k``-th sample with ``fs / k >= 10 cutoff_hz`` loses no
+information and divides the cost of the regressor and of the least squares by ``k``
+(the "parallel filtering and decimation" of Gautier, Khalil and coworkers). The
+statistics then also assume less correlated residuals. ``decimate=1`` keeps every sample.
+Gaz et al. report a condition number of 122 and a relative error of 1.4 % for this route
+on the real Panda.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+from typing import Any
+
+import numpy as np
+from numpy.typing import NDArray
+
+from ..exceptions import ShapeError
+from ..model.robot import Robot
+from ..regressors.base import BaseParameters, base_parameters
+from ..regressors.torque import _torque_regressor
+from .least_squares import LeastSquaresFit, fit_with_pruning
+from .log import DEFAULT_CUTOFF_HZ, TorqueLog, prepare_log
+from .model import IdentifiedModel
+
+__all__ = ["friction_labels", "friction_regressor", "identify_from_log", "auto_decimation"]
+
+
+def friction_labels(n: int) -> tuple[str, ...]:
+    """``fv1, fc1, fo1, fv2, ...`` for ``n`` joints."""
+    return tuple(f"{k}{j + 1}" for j in range(n) for k in ("fv", "fc", "fo"))
+
+
+def friction_regressor(dq: NDArray[np.float64]) -> NDArray[np.float64]:
+    """Regressor ``F`` (..., n, 3 n) of the classical friction, columns :func:`friction_labels`.
+
+    ``F[..., j, 3 j : 3 j + 3] = (dq_j, sign(dq_j), 1)``; zero elsewhere.
+    """
+    n = dq.shape[-1]
+    F = np.zeros(dq.shape + (3 * n,))
+    j = np.arange(n)
+    F[..., j, 3 * j] = dq
+    F[..., j, 3 * j + 1] = np.sign(dq)
+    F[..., j, 3 * j + 2] = 1.0
+    return F
+
+
+def auto_decimation(fs: float, cutoff_hz: float | None) -> int:
+    """Largest ``k`` with ``fs / k >= 10 cutoff_hz`` (1 without filtering)."""
+    if cutoff_hz is None:
+        return 1
+    return max(1, int(np.floor(fs / (10.0 * cutoff_hz))))
+
+
+def _split_fit(fit: LeastSquaresFit, r: int) -> LeastSquaresFit:
+    """The fit restricted to its first ``r`` coefficients; global statistics kept."""
+    return dataclasses.replace(
+        fit,
+        beta=fit.beta[:r],
+        std=fit.std[:r],
+        std_percent=fit.std_percent[:r],
+        kept=fit.kept[:r],
+    )
+
+
+def identify_from_log(
+    robot: Robot,
+    log: TorqueLog,
+    *,
+    cutoff_hz: float | None = DEFAULT_CUTOFF_HZ,
+    trim_s: float | None = None,
+    decimate: int | None = None,
+    max_std_percent: float | None = None,
+    friction: bool = True,
+    base: BaseParameters | None = None,
+    rtol: float = 1e-10,
+) -> IdentifiedModel:
+    """Identify base parameters (and linear friction) from a torque log.
+
+    Parameters
+    ----------
+    robot : Robot
+        Kinematics and gravity; its inertial parameters are not used.
+    log : TorqueLog
+        Measured ``t``, ``q``, ``dq``, ``tau`` (``ddq`` optional) of an exciting trajectory.
+    cutoff_hz : float or None
+        Zero-phase low-pass cutoff [Hz] (:func:`~dynid.identification.log.prepare_log`);
+        None for noise-free data (then ``ddq`` of the log is used if present, else
+        differentiated).
+    trim_s : float, optional
+        Seconds dropped at each end after filtering (default ``2 / cutoff_hz``).
+    decimate : int, optional
+        Keep every ``decimate``-th sample after filtering; default
+        :func:`auto_decimation`.
+    max_std_percent : float, optional
+        Remove coefficients with a larger relative standard deviation and re-fit (the
+        paper used 30 %).
+    friction : bool
+        Identify ``fv, fc, fo`` per joint together with the base parameters.
+    base : BaseParameters, optional
+        Base parameters to use; default ``base_parameters(robot, kind="torque")``.
+    rtol : float
+        Relative rank tolerance of the least squares.
+
+    Returns
+    -------
+    IdentifiedModel
+        ``fit`` holds the ``r`` base parameters (with the statistics of the whole fit:
+        condition number, relative error, sigma); ``friction`` (n, 3) columns
+        ``fv, fc, fo`` or None; ``metadata`` the route, filter settings, sample counts,
+        the friction labels and their standard deviations.
+
+    Raises
+    ------
+    ShapeError
+        ``log.n != robot.n`` or ``decimate < 1``.
+    DataError
+        From the preparation of the log (gaps, too short, bad cutoff).
+    RankDeficientError
+        The trajectory does not excite every base parameter (and friction column).
+    """
+    n = robot.n
+    if log.n != n:
+        raise ShapeError(f"log has {log.n} joints; robot {robot.name!r} has {n}")
+    fs = log.sample_rate
+    prepared = prepare_log(log, cutoff_hz=cutoff_hz, trim_s=trim_s)
+    k = auto_decimation(fs, cutoff_hz) if decimate is None else int(decimate)
+    if k < 1:
+        raise ShapeError(f"decimate must be >= 1; got {decimate}")
+    sl = slice(None, None, k)
+    q, dq, ddq, tau = prepared.q[sl], prepared.dq[sl], prepared.ddq[sl], prepared.tau[sl]
+    bp = base_parameters(robot, kind="torque") if base is None else base
+    N = q.shape[0]
+    Y = _torque_regressor(robot, q, dq, ddq, robot.gravity)
+    Yb = Y[..., bp.independent]  # reduce columns before stacking
+    if friction:
+        Yb = np.concatenate([Yb, friction_regressor(dq)], axis=-1)
+    W = Yb.reshape(N * n, -1)
+    y = tau.reshape(-1)
+    fit = fit_with_pruning(W, y, max_std_percent=max_std_percent, rtol=rtol, covariance="classical")
+    r = bp.rank
+    labels = bp.labels + (friction_labels(n) if friction else ())
+    fr = None
+    meta: dict[str, Any] = {
+        "route": "classical",
+        "reference": "Gaz et al. 2019, Sec. IV-B, eq. 24 (classical friction)",
+        "pruned": [labels[j] for j in np.flatnonzero(~np.asarray(fit.kept))],
+        "max_std_percent": max_std_percent,
+        "std_estimator": "classical",
+        "dropped_rows": [],
+        "cutoff_hz": cutoff_hz,
+        "trim_s": float(prepared.t[0] - log.t[0]),
+        "decimate": k,
+        "sample_rate_hz": fs,
+        "n_samples_log": log.n_samples,
+        "n_samples_used": int(N),
+        "n_rows": int(N * n),
+        "duration_s": log.duration,
+        "n_nan_rows": log.cleaning.n_nan_rows,
+        "n_duplicates": log.cleaning.n_duplicates,
+        "n_gaps": len(log.cleaning.gaps),
+        "condition_number": fit.condition_number,
+        "relative_error_percent": fit.relative_error_percent,
+    }
+    if friction:
+        fb = np.asarray(fit.beta[r:]).reshape(n, 3)
+        fr = fb
+        meta["friction_labels"] = list(friction_labels(n))
+        meta["friction_std"] = [float(x) for x in fit.std[r:]]
+        meta["friction_kept"] = [bool(x) for x in fit.kept[r:]]
+    return IdentifiedModel(
+        robot=robot,
+        base=bp,
+        fit=_split_fit(fit, r) if friction else fit,
+        friction=fr,
+        metadata=meta,
+    )

@@ -1,0 +1,111 @@
+"""Error metrics of predicted joint torques against measured ones.
+
+For measured ``tau`` and predicted ``tau_hat`` (N, n) [N m], with ``e = tau - tau_hat``:
+
+* ``rms_j = sqrt(mean_k e_kj^2)`` [N m] and ``mse_j = rms_j^2`` [N^2 m^2] per joint;
+* ``relative_error_percent = 100 ||e||_F / ||tau||_F`` over all joints and samples (the
+  relative error of Gaz et al. 2019, eq. 22 and Sec. VI);
+* ``relative_error_percent_per_joint = 100 ||e_j|| / ||tau_j||``.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+
+from .. import _checks
+from ..exceptions import ShapeError
+
+__all__ = ["TorqueErrors", "torque_errors", "rms", "mse", "relative_error_percent"]
+
+
+def _pair(tau: ArrayLike, tau_hat: ArrayLike) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+    a = _checks.as_array("tau", tau)
+    b = _checks.as_array("tau_hat", tau_hat)
+    if a.ndim != 2 or a.shape != b.shape or a.shape[0] < 1:
+        raise ShapeError(
+            f"tau and tau_hat must both have shape (N, n); got {a.shape} and {b.shape}"
+        )
+    return a, b
+
+
+def rms(tau: ArrayLike, tau_hat: ArrayLike) -> NDArray[np.float64]:
+    """Root-mean-square error per joint [N m]: (N, n), (N, n) -> (n,)."""
+    a, b = _pair(tau, tau_hat)
+    return np.sqrt(np.mean((a - b) ** 2, axis=0))
+
+
+def mse(tau: ArrayLike, tau_hat: ArrayLike) -> NDArray[np.float64]:
+    """Mean squared error per joint [N^2 m^2]: (N, n), (N, n) -> (n,)."""
+    a, b = _pair(tau, tau_hat)
+    return np.mean((a - b) ** 2, axis=0)
+
+
+def relative_error_percent(tau: ArrayLike, tau_hat: ArrayLike) -> float:
+    """``100 ||tau - tau_hat||_F / ||tau||_F`` [%] over all joints and samples."""
+    a, b = _pair(tau, tau_hat)
+    na = float(np.linalg.norm(a))
+    return 100.0 * float(np.linalg.norm(a - b)) / na if na > 0 else float("inf")
+
+
+@dataclass(frozen=True, slots=True, eq=False)
+class TorqueErrors:
+    """Per-joint torque errors of a prediction.
+
+    Attributes
+    ----------
+    rms : ndarray, shape (n,)
+        [N m].
+    mse : ndarray, shape (n,)
+        [N^2 m^2].
+    relative_error_percent : float
+        Over all joints and samples [%].
+    relative_error_percent_per_joint : ndarray, shape (n,)
+        [%].
+    n_samples : int
+    """
+
+    rms: NDArray[np.float64]
+    mse: NDArray[np.float64]
+    relative_error_percent: float
+    relative_error_percent_per_joint: NDArray[np.float64]
+    n_samples: int
+
+    def as_dict(self) -> dict[str, object]:
+        """JSON-ready dictionary (lists of floats)."""
+        return {
+            "rms": [float(x) for x in self.rms],
+            "mse": [float(x) for x in self.mse],
+            "relative_error_percent": float(self.relative_error_percent),
+            "relative_error_percent_per_joint": [
+                float(x) for x in self.relative_error_percent_per_joint
+            ],
+            "n_samples": int(self.n_samples),
+        }
+
+
+def torque_errors(tau: ArrayLike, tau_hat: ArrayLike) -> TorqueErrors:
+    """All metrics of ``tau_hat`` against ``tau``, both (N, n) [N m].
+
+    Raises
+    ------
+    ShapeError
+        Shapes differ or are not (N, n).
+    NonFiniteError
+        NaN or inf in an input.
+    """
+    a, b = _pair(tau, tau_hat)
+    e2 = (a - b) ** 2
+    m = e2.mean(axis=0)
+    na = np.sqrt((a**2).sum(axis=0))
+    with np.errstate(divide="ignore", invalid="ignore"):
+        per = np.where(na > 0, 100.0 * np.sqrt(e2.sum(axis=0)) / na, np.inf)
+    return TorqueErrors(
+        rms=_checks.frozen(np.sqrt(m)),
+        mse=_checks.frozen(m),
+        relative_error_percent=relative_error_percent(a, b),
+        relative_error_percent_per_joint=_checks.frozen(per),
+        n_samples=a.shape[0],
+    )

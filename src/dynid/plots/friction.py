@@ -1,0 +1,118 @@
+"""Figures of friction fits: torque residual against joint velocity (Gaz et al. 2019, Fig. 4).
+
+matplotlib is imported inside the functions; they return a Figure and never show it.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from typing import TYPE_CHECKING
+
+import numpy as np
+
+from ..friction.fit import FrictionFit, FrictionResidual
+from ..friction.model import FrictionModel
+
+if TYPE_CHECKING:  # pragma: no cover
+    from matplotlib.figure import Figure
+
+__all__ = ["plot_friction_fit"]
+
+
+def plot_friction_fit(
+    residual: FrictionResidual,
+    fit: FrictionFit,
+    *,
+    reference: FrictionModel | None = None,
+    reference_label: str = "reference",
+    joint_names: Sequence[str] | None = None,
+    max_points: int = 4000,
+    ncols: int = 4,
+    title: str | None = None,
+    fig: Figure | None = None,
+) -> Figure:
+    """Per joint: residual torque against velocity, with the fitted friction curve.
+
+    Parameters
+    ----------
+    residual : FrictionResidual
+        From :func:`dynid.friction.fit.friction_residual` (the data the fit used).
+    fit : FrictionFit
+        The fitted model, drawn over the visited velocity range.
+    reference : FrictionModel, optional
+        A second curve (e.g. the ground truth or the published parameters).
+    reference_label : str
+    joint_names : sequence of str, optional
+    max_points : int
+        Residual samples drawn per joint (evenly strided).
+    ncols : int
+        Panels per row.
+    title : str, optional
+    fig : Figure, optional
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+        One panel per joint: velocity [rad/s] on x, torque [N m] on y; the title of each
+        panel gives the RMS before and after compensation.
+    """
+    import matplotlib.pyplot as plt
+
+    dq, r = residual.dq, residual.residual
+    n = dq.shape[1]
+    names = list(joint_names) if joint_names is not None else [f"joint {j + 1}" for j in range(n)]
+    ncols = max(1, min(ncols, n))
+    nrows = int(np.ceil(n / ncols))
+    if fig is None:
+        fig = plt.figure(figsize=(3.4 * ncols, 2.9 * nrows + 0.6))
+    else:
+        fig.clear()
+    axes = fig.subplots(nrows, ncols, squeeze=False)
+    step = max(1, int(np.ceil(dq.shape[0] / max_points)))
+    for j in range(n):
+        ax = axes[j // ncols, j % ncols]
+        ax.plot(
+            dq[::step, j],
+            r[::step, j],
+            ".",
+            ms=1.5,
+            color="0.55",
+            alpha=0.5,
+            rasterized=True,
+            label="residual (measured - model)",
+        )
+        lo, hi = float(dq[:, j].min()), float(dq[:, j].max())
+        v = np.linspace(lo, hi, 400)
+        V = np.zeros((v.size, n))
+        V[:, j] = v
+        ax.plot(
+            v, fit.friction.torques(V)[:, j], color="tab:red", lw=1.8, label=f"fitted {fit.kind}"
+        )
+        if reference is not None:
+            ax.plot(
+                v, reference.torques(V)[:, j], color="k", lw=1.0, ls="--", label=reference_label
+            )
+        ax.axhline(0.0, color="0.7", lw=0.5)
+        ax.axvline(0.0, color="0.7", lw=0.5)
+        ax.set_title(
+            f"{names[j]}: RMS {fit.rms_before[j]:.3f} -> {fit.rms_after[j]:.3f} N m", fontsize=9
+        )
+        ax.set_xlabel("velocity [rad/s]", fontsize=8)
+        ax.set_ylabel("torque [N m]", fontsize=8)
+        ax.tick_params(labelsize=7)
+        ax.grid(alpha=0.3)
+    for k in range(n, nrows * ncols):
+        axes[k // ncols, k % ncols].set_axis_off()
+    handles, labels = axes[0, 0].get_legend_handles_labels()
+    if n < nrows * ncols:
+        spare = axes[-1, -1]
+        spare.legend(handles, labels, loc="center", fontsize=9, markerscale=6, frameon=False)
+        fig.tight_layout(rect=(0, 0, 1, 0.97 if title else 1.0))
+    else:
+        fig.legend(
+            handles, labels, loc="lower center", ncol=len(labels), markerscale=6, frameon=False
+        )
+        fig.tight_layout(rect=(0, 0.05, 1, 0.97 if title else 1.0))
+    if title:
+        fig.suptitle(title, fontsize=11)
+    return fig

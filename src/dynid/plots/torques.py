@@ -1,0 +1,157 @@
+"""Figures of measured against predicted joint torques (Gaz et al. 2019, Fig. 3).
+
+matplotlib is imported inside the functions (never by ``import dynid``); the functions
+return a Figure and never show it. Use the ``Agg`` backend for files.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping, Sequence
+from typing import TYPE_CHECKING
+
+import numpy as np
+from numpy.typing import ArrayLike
+
+from ..friction.validation import Validation
+
+if TYPE_CHECKING:  # pragma: no cover
+    from matplotlib.axes import Axes
+    from matplotlib.figure import Figure
+
+__all__ = ["plot_torque_validation", "plot_rms_comparison"]
+
+_MEASURED = dict(color="0.35", lw=0.6, label="measured")
+_NO_FRICTION = dict(color="tab:orange", lw=1.1, label="model, no friction")
+_FRICTION = dict(color="tab:blue", lw=1.1, ls="--", label="model + friction")
+
+
+def _stride(N: int, max_points: int) -> slice:
+    return slice(None, None, max(1, int(np.ceil(N / max_points))))
+
+
+def plot_torque_validation(
+    validation: Validation,
+    *,
+    joint_names: Sequence[str] | None = None,
+    max_points: int = 5000,
+    title: str | None = None,
+    fig: Figure | None = None,
+) -> Figure:
+    """Per joint: measured and predicted torques (left) and prediction errors (right).
+
+    Parameters
+    ----------
+    validation : Validation
+        From :func:`dynid.friction.validation.validate`.
+    joint_names : sequence of str, optional
+        Row labels (default ``joint 1 .. n``).
+    max_points : int
+        Samples drawn per line (evenly strided; metrics use every sample).
+    title : str, optional
+    fig : Figure, optional
+        Drawn into (cleared first); a new figure by default.
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+        ``n`` rows of two axes; time [s] on x, torque [N m] on y. Each error panel gives
+        the RMS of each prediction.
+    """
+    import matplotlib.pyplot as plt
+
+    log = validation.log
+    n = log.n
+    names = list(joint_names) if joint_names is not None else [f"joint {j + 1}" for j in range(n)]
+    if fig is None:
+        fig = plt.figure(figsize=(13, 1.9 * n + 0.8))
+    else:
+        fig.clear()
+    axes = fig.subplots(n, 2, sharex=True, squeeze=False, gridspec_kw={"width_ratios": [3, 2]})
+    s = _stride(log.n_samples, max_points)
+    t = log.t[s] - log.t[0]
+    e0 = log.tau - validation.tau_model
+    e1 = None if validation.tau_friction is None else e0 - validation.tau_friction
+    for j in range(n):
+        ax, axe = axes[j]
+        ax.plot(t, log.tau[s, j], **_MEASURED)
+        ax.plot(t, validation.tau_model[s, j], **_NO_FRICTION)
+        if e1 is not None:
+            ax.plot(t, validation.tau_hat[s, j], **_FRICTION)
+        ax.set_ylabel(f"{names[j]}\n[N m]")
+        ax.grid(alpha=0.3)
+        r0 = validation.without_friction.rms[j]
+        axe.plot(
+            t, e0[s, j], color=_NO_FRICTION["color"], lw=0.8, label=f"no friction, RMS {r0:.3f}"
+        )
+        if e1 is not None and validation.with_friction is not None:
+            r1 = validation.with_friction.rms[j]
+            axe.plot(
+                t,
+                e1[s, j],
+                color=_FRICTION["color"],
+                lw=0.6,
+                alpha=0.8,
+                label=f"+ friction, RMS {r1:.3f}",
+            )
+        axe.axhline(0.0, color="0.5", lw=0.6)
+        axe.grid(alpha=0.3)
+        axe.legend(loc="upper right", fontsize=7, framealpha=0.8)
+    axes[0, 0].set_title("joint torques [N m]", fontsize=10)
+    axes[0, 1].set_title("error: measured - model [N m]", fontsize=10)
+    axes[0, 0].legend(loc="upper left", ncol=3, fontsize=7, framealpha=0.8)
+    axes[-1, 0].set_xlabel("time [s]")
+    axes[-1, 1].set_xlabel("time [s]")
+    if title:
+        fig.suptitle(title, fontsize=11)
+    fig.tight_layout()
+    return fig
+
+
+def plot_rms_comparison(
+    rms: Mapping[str, ArrayLike],
+    *,
+    joint_names: Sequence[str] | None = None,
+    noise_std: float | None = None,
+    title: str | None = None,
+    ax: Axes | None = None,
+) -> Figure:
+    """Grouped bars of per-joint torque RMS [N m] for several predictions.
+
+    Parameters
+    ----------
+    rms : mapping of str to array_like, shape (n,)
+        Label -> per-joint RMS [N m] (e.g. without and with friction).
+    joint_names : sequence of str, optional
+    noise_std : float, optional
+        Torque sensor noise [N m], drawn as a horizontal line.
+    title : str, optional
+    ax : Axes, optional
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+    """
+    import matplotlib.pyplot as plt
+
+    if ax is None:
+        fig, ax = plt.subplots(figsize=(8, 3.6))
+    else:
+        fig = ax.figure
+    vals = [np.asarray(v, dtype=float) for v in rms.values()]
+    n = vals[0].shape[0]
+    names = list(joint_names) if joint_names is not None else [f"{j + 1}" for j in range(n)]
+    width = 0.8 / len(vals)
+    x = np.arange(n)
+    for k, (label, v) in enumerate(zip(rms, vals, strict=True)):
+        ax.bar(x + (k - (len(vals) - 1) / 2) * width, v, width, label=label)
+    if noise_std is not None:
+        ax.axhline(noise_std, color="k", ls=":", lw=1.0, label=f"sensor noise {noise_std:g} N m")
+    ax.set_xticks(x, names)
+    ax.set_xlabel("joint")
+    ax.set_ylabel("torque RMS error [N m]")
+    ax.grid(axis="y", alpha=0.3)
+    ax.legend(fontsize=8)
+    if title:
+        ax.set_title(title)
+    fig.tight_layout()
+    return fig

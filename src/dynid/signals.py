@@ -1,0 +1,281 @@
+"""Signal conditioning of measured time series: resampling, zero-phase filtering, derivatives.
+
+Time series are ``t`` (N,) [s] and signals (N, ...) with time along axis 0.
+
+Pipeline used for torque logs (Gaz et al. 2019, Sec. VI; Swevers et al. 1997):
+
+1. :func:`resample_uniform`: a log with jittered or missing timestamps is interpolated
+   (linearly, per column) onto a uniform grid ``t0 + k / fs``. Digital filters assume
+   uniform sampling; at 1 kHz the interpolation error of a signal band-limited to a few
+   Hz is far below sensor noise. The recorded timestamps are taken as the true sample
+   times.
+2. :func:`lowpass`: a Butterworth low-pass applied forward and backward
+   (``scipy.signal.sosfiltfilt``). The designed ``order`` (default 4, as in the paper)
+   is applied twice, so the magnitude response is the square of the order-4 response:
+   effectively order 8, -6 dB (not -3 dB) at the cutoff, zero phase (no lag).
+3. :func:`derivative`: second-order accurate central differences
+   (``numpy.gradient(..., edge_order=2)``), valid on non-uniform grids, e.g. the
+   acceleration from the filtered velocity.
+4. :func:`trim_edges`: the first and last samples carry the filter's start-up
+   transient and one-sided differences. :func:`lowpass` pads each end with an odd
+   extension one cutoff period long, which shrinks the transient about 25-fold;
+   :func:`edge_seconds` gives the default amount trimmed, ``2 / cutoff_hz`` seconds at
+   each end (two periods of the cutoff frequency; the impulse response of the order-4
+   Butterworth has then decayed to about 2 % of its peak, and the edge error of a smooth
+   signal is about 1e-4 of its amplitude).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import scipy.signal
+from numpy.typing import ArrayLike, NDArray
+
+from . import _checks
+from .exceptions import DataError, ShapeError
+
+__all__ = [
+    "BUTTERWORTH_ORDER",
+    "derivative",
+    "edge_seconds",
+    "is_uniform",
+    "lowpass",
+    "resample_uniform",
+    "sample_rate",
+    "trim_edges",
+]
+
+#: Designed order of the Butterworth low-pass (Gaz et al. 2019); applied forward and
+#: backward, so the effective order is twice this.
+BUTTERWORTH_ORDER = 4
+
+
+def _time(t: ArrayLike, name: str = "t") -> NDArray[np.float64]:
+    t = _checks.as_array(name, t)
+    if t.ndim != 1 or t.shape[0] < 2:
+        raise ShapeError(f"{name} must have shape (N,) with N >= 2; got {t.shape}")
+    dt = np.diff(t)
+    bad = np.flatnonzero(dt <= 0)
+    if bad.size:
+        k = int(bad[0])
+        raise DataError(
+            f"{name} must be strictly increasing; got {name}[{k}] = {float(t[k])!r} and "
+            f"{name}[{k + 1}] = {float(t[k + 1])!r}; hint: clean the log (TorqueLog.from_raw)"
+        )
+    return t
+
+
+def sample_rate(t: ArrayLike) -> float:
+    """Nominal sample rate [Hz] of timestamps ``t`` (N,) [s], robust to jitter and gaps.
+
+    Each step is counted as ``m_i = round(dt_i / h0)`` nominal periods, with ``h0`` the
+    median step (a gap of dropped samples counts as several periods); the period is the
+    least-squares slope of ``t`` against the cumulative count, whose error falls as
+    ``N^-1.5``. When some step lies far from a whole number of periods (``|dt_i / h0 -
+    m_i| > 0.4``: jitter too large to count periods), the period is the median of the steps
+    within ``(0.5, 1.5) h0`` instead. For uniform ``t`` both give ``1 / dt``.
+    """
+    t = _time(t)
+    dt = np.diff(t)
+    h0 = float(np.median(dt))
+    m = dt / h0
+    whole = np.round(m)
+    if np.all(np.abs(m - whole) <= 0.4) and np.all(whole >= 1):
+        k = np.concatenate([[0.0], np.cumsum(whole)])
+        kc = k - k.mean()
+        h = float(kc @ (t - t.mean()) / (kc @ kc))
+    else:
+        h = float(np.median(dt[(dt > 0.5 * h0) & (dt < 1.5 * h0)]))
+    return 1.0 / h
+
+
+def is_uniform(t: ArrayLike, *, rtol: float = 1e-6) -> bool:
+    """True when every step of ``t`` (N,) equals the median step within ``rtol``."""
+    t = _time(t)
+    dt = np.diff(t)
+    h = np.median(dt)
+    return bool(np.all(np.abs(dt - h) <= rtol * h))
+
+
+def resample_uniform(
+    t: ArrayLike, x: ArrayLike, fs: float | None = None
+) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+    """Linear interpolation of a signal onto a uniform time grid.
+
+    Parameters
+    ----------
+    t : array_like, shape (N,)
+        Strictly increasing sample times [s] (jittered, possibly with gaps).
+    x : array_like, shape (N, ...)
+        Signal values at ``t``; each column is interpolated independently.
+    fs : float, optional
+        Sample rate of the new grid [Hz]; default :func:`sample_rate` of ``t``.
+
+    Returns
+    -------
+    t_uniform : ndarray, shape (M,)
+        ``t[0] + k / fs`` for ``k = 0 .. M-1``, the last one not after ``t[-1]``.
+    x_uniform : ndarray, shape (M, ...)
+
+    Raises
+    ------
+    ShapeError
+        ``t`` not 1-D, or ``x`` does not have ``N`` rows.
+    DataError
+        ``t`` not strictly increasing.
+    NonFiniteError
+        NaN or inf in ``t`` or ``x``.
+
+    Notes
+    -----
+    Linear interpolation attenuates a sinusoid of frequency ``f`` by at most
+    ``(pi f / fs)^2 / 2`` (relative): 5e-5 at 3 Hz and 1 kHz. Gaps (dropped samples) are
+    bridged by straight lines; callers bound the gap length (``max_gap_s`` of
+    :func:`dynid.identification.log.prepare_log`).
+    """
+    t = _time(t)
+    x = _checks.as_array("x", x)
+    if x.ndim < 1 or x.shape[0] != t.shape[0]:
+        raise ShapeError(f"x must have shape ({t.shape[0]}, ...) like t; got {x.shape}")
+    fs = sample_rate(t) if fs is None else float(fs)
+    if not fs > 0:
+        raise DataError(f"fs must be positive; got {fs}")
+    m = int(np.floor((t[-1] - t[0]) * fs * (1.0 + 1e-12))) + 1
+    tu = t[0] + np.arange(m) / fs
+    flat = x.reshape(x.shape[0], -1)
+    out = np.empty((m, flat.shape[1]))
+    for k in range(flat.shape[1]):
+        out[:, k] = np.interp(tu, t, flat[:, k])
+    return tu, out.reshape((m,) + x.shape[1:])
+
+
+def lowpass(
+    x: ArrayLike,
+    fs: float,
+    cutoff_hz: float,
+    *,
+    order: int = BUTTERWORTH_ORDER,
+    axis: int = 0,
+) -> NDArray[np.float64]:
+    """Zero-phase Butterworth low-pass filter (forward-backward).
+
+    .. math:: |H_{zp}(f)| = |H_B(f)|^2 = \\frac{1}{1 + (f / f_c)^{2 \\cdot order}}
+
+    Parameters
+    ----------
+    x : array_like, shape (N, ...)
+        Uniformly sampled signal (time along ``axis``).
+    fs : float
+        Sample rate [Hz].
+    cutoff_hz : float
+        Cutoff frequency of the designed filter [Hz], ``0 < cutoff_hz < fs / 2``; the
+        zero-phase response is -6 dB there. Gaz et al. 2019 used 1 Hz.
+    order : int
+        Designed Butterworth order (applied twice: effective order ``2 order``).
+    axis : int
+        Time axis.
+
+    Returns
+    -------
+    y : ndarray, same shape as ``x``
+        Filtered signal, no phase lag; a new array.
+
+    Raises
+    ------
+    DataError
+        Cutoff not in ``(0, fs / 2)``, or not more samples than the minimum padding
+        ``3 (2 ceil(order / 2) + 1)``.
+    NonFiniteError
+        NaN or inf in ``x``.
+
+    Notes
+    -----
+    Each end is padded with an odd extension of ``min(N - 1, max(minimum,
+    ceil(fs / cutoff_hz)))`` samples (one period of the cutoff), which keeps the
+    value and slope continuous and reduces the start-up transient.
+    """
+    x = _checks.as_array("x", x)
+    fs, cutoff_hz = float(fs), float(cutoff_hz)
+    if not (fs > 0 and 0 < cutoff_hz < fs / 2):
+        raise DataError(
+            f"cutoff_hz must lie in (0, fs/2) = (0, {fs / 2:g}) Hz; got {cutoff_hz:g} Hz"
+        )
+    if order < 1:
+        raise DataError(f"order must be >= 1; got {order}")
+    sos = scipy.signal.butter(order, cutoff_hz, btype="low", fs=fs, output="sos")
+    minimum = 3 * (2 * len(sos) + 1)
+    N = x.shape[axis]
+    if N <= minimum:
+        raise DataError(f"lowpass needs more than {minimum} samples along axis {axis}; got {N}")
+    padlen = min(N - 1, max(minimum, int(np.ceil(fs / cutoff_hz))))
+    return scipy.signal.sosfiltfilt(sos, x, axis=axis, padtype="odd", padlen=padlen)
+
+
+def derivative(t: ArrayLike, x: ArrayLike) -> NDArray[np.float64]:
+    """Time derivative of a sampled signal by second-order finite differences.
+
+    Central differences inside, one-sided second-order differences at both ends
+    (``numpy.gradient(x, t, axis=0, edge_order=2)``); exact for quadratics on any grid.
+
+    Parameters
+    ----------
+    t : array_like, shape (N,)
+        Strictly increasing sample times [s], uniform or not; N >= 3.
+    x : array_like, shape (N, ...)
+        Signal (e.g. filtered joint velocities [rad/s]).
+
+    Returns
+    -------
+    dx : ndarray, shape (N, ...)
+        Derivative [unit of x per s].
+
+    Raises
+    ------
+    ShapeError
+        ``t`` not 1-D with N >= 3, or ``x`` without N rows.
+    DataError
+        ``t`` not strictly increasing.
+    """
+    t = _time(t)
+    x = _checks.as_array("x", x)
+    if t.shape[0] < 3 or x.ndim < 1 or x.shape[0] != t.shape[0]:
+        raise ShapeError(
+            f"derivative needs t (N,) with N >= 3 and x (N, ...); got {t.shape} and {x.shape}"
+        )
+    return np.gradient(x, t, axis=0, edge_order=2)
+
+
+def edge_seconds(cutoff_hz: float) -> float:
+    """Default time trimmed at each end after filtering [s]: ``2 / cutoff_hz``."""
+    return 2.0 / float(cutoff_hz)
+
+
+def trim_edges(t: ArrayLike, seconds: float) -> NDArray[np.bool_]:
+    """Mask of the samples more than ``seconds`` away from both ends of ``t``.
+
+    Parameters
+    ----------
+    t : array_like, shape (N,)
+        Sample times [s].
+    seconds : float
+        Time dropped at each end [s] (``>= 0``).
+
+    Returns
+    -------
+    keep : ndarray of bool, shape (N,)
+
+    Raises
+    ------
+    DataError
+        Nothing would be left.
+    """
+    t = _checks.as_array("t", t)
+    if seconds < 0:
+        raise DataError(f"seconds must be >= 0; got {seconds}")
+    keep = (t >= t[0] + seconds) & (t <= t[-1] - seconds)
+    if not keep.any():
+        raise DataError(
+            f"trimming {seconds:g} s at each end leaves no sample of a {t[-1] - t[0]:g} s "
+            "series; hint: record longer or trim less"
+        )
+    return keep

@@ -1,0 +1,157 @@
+"""Zero-phase filtering, differentiation, resampling and trimming of sampled signals."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from dynid import signals
+from dynid.exceptions import DataError, NonFiniteError, ShapeError
+
+FS = 1000.0
+
+
+def _amplitude_phase(t, x, f):
+    """Amplitude and phase of the component of frequency f (least squares on sin/cos)."""
+    A = np.stack([np.sin(2 * np.pi * f * t), np.cos(2 * np.pi * f * t)], axis=1)
+    a, b = np.linalg.lstsq(A, x, rcond=None)[0]
+    return np.hypot(a, b), np.arctan2(b, a)
+
+
+def test_lowpass_passes_a_slow_sinusoid_without_lag_or_attenuation():
+    """A 0.5 Hz sinusoid through the 5 Hz zero-phase filter keeps amplitude and phase."""
+    t = np.arange(20000) / FS
+    x = 1.3 * np.sin(2 * np.pi * 0.5 * t + 0.4)
+    y = signals.lowpass(x, FS, 5.0)
+    keep = signals.trim_edges(t, signals.edge_seconds(5.0))
+    a, ph = _amplitude_phase(t[keep], y[keep], 0.5)
+    a0, ph0 = _amplitude_phase(t[keep], x[keep], 0.5)
+    # |H_B(0.1 fc)|^2 = 1 / (1 + 0.1^8): attenuation 1e-8
+    assert a == pytest.approx(a0, rel=1e-6)
+    assert abs(ph - ph0) < 1e-6
+    np.testing.assert_allclose(y[keep], x[keep], atol=1e-4 * 1.3)  # edge residue, see signals
+
+
+def test_lowpass_gain_is_the_squared_butterworth_response():
+    """Forward-backward doubles the order: gain 1/2 (-6 dB) at the cutoff, 1/(1+2^8) at 2 fc."""
+    t = np.arange(30000) / FS
+    fc = 4.0
+    keep = signals.trim_edges(t, signals.edge_seconds(fc))
+    for f, gain in ((fc, 0.5), (2 * fc, 1.0 / (1.0 + 2.0**8)), (0.5 * fc, 1.0 / (1.0 + 0.5**8))):
+        x = np.sin(2 * np.pi * f * t)
+        y = signals.lowpass(x, FS, fc)
+        a, ph = _amplitude_phase(t[keep], y[keep], f)
+        assert a == pytest.approx(gain, rel=2e-3)
+        assert abs(ph) < 1e-4  # zero phase
+
+
+def test_lowpass_filters_columns_independently_and_keeps_shape():
+    """A (N, 3) signal filtered at once equals each column filtered alone."""
+    rng = np.random.default_rng(1)
+    x = rng.normal(size=(3000, 3))
+    y = signals.lowpass(x, FS, 10.0)
+    assert y.shape == x.shape
+    for k in range(3):
+        np.testing.assert_allclose(y[:, k], signals.lowpass(x[:, k], FS, 10.0), atol=1e-14)
+
+
+def test_lowpass_edges_are_small_after_trimming():
+    """After trimming 2 / fc seconds the edge error of a smooth signal is about 1e-4."""
+    t = np.arange(20000) / FS
+    x = np.sin(2 * np.pi * 0.3 * t + 0.7) + 0.025 * t
+    y = signals.lowpass(x, FS, 1.0)
+    keep = signals.trim_edges(t, signals.edge_seconds(1.0))
+    assert np.max(np.abs(y[keep] - x[keep])) < 5e-4
+    assert np.max(np.abs(y - x)) > 1e-3  # the untrimmed edges are worse
+
+
+def test_lowpass_rejects_bad_cutoff_short_signal_and_nan():
+    """Cutoff at or above Nyquist, too few samples and NaN raise clear errors."""
+    x = np.zeros(100)
+    with pytest.raises(DataError, match="cutoff_hz must lie in"):
+        signals.lowpass(x, FS, 500.0)
+    with pytest.raises(DataError, match="cutoff_hz must lie in"):
+        signals.lowpass(x, FS, 0.0)
+    with pytest.raises(DataError, match="needs more than"):
+        signals.lowpass(np.zeros(10), FS, 5.0)
+    x[5] = np.nan
+    with pytest.raises(NonFiniteError, match="x must be finite"):
+        signals.lowpass(x, FS, 5.0)
+
+
+def test_derivative_of_a_sinusoid_on_a_uniform_grid():
+    """Second-order differences match the analytic derivative to O(h^2)."""
+    t = np.arange(5000) / FS
+    w = 2 * np.pi * 1.5
+    x = np.stack([np.sin(w * t), np.cos(w * t)], axis=1)
+    dx = signals.derivative(t, x)
+    ref = np.stack([w * np.cos(w * t), -w * np.sin(w * t)], axis=1)
+    # central difference error w^3 h^2 / 6, one-sided ends w^3 h^2 / 3
+    assert np.max(np.abs(dx - ref)) < w**3 / FS**2 / 2
+
+
+def test_derivative_on_non_uniform_timestamps():
+    """On jittered timestamps the derivative is exact for quadratics and accurate for sines."""
+    rng = np.random.default_rng(2)
+    t = np.arange(4000) / FS + rng.uniform(-3e-4, 3e-4, 4000)
+    t.sort()
+    quad = 3.0 * t**2 - 2.0 * t + 1.0
+    np.testing.assert_allclose(signals.derivative(t, quad), 6.0 * t - 2.0, atol=1e-8)
+    w = 2 * np.pi * 2.0
+    err = signals.derivative(t, np.sin(w * t)) - w * np.cos(w * t)
+    assert np.max(np.abs(err)) < 5e-3 * w
+
+
+def test_resample_uniform_on_jittered_timestamps():
+    """Linear interpolation of a smooth signal onto k / fs is accurate to (pi f / fs)^2 / 2."""
+    rng = np.random.default_rng(3)
+    n = 5000
+    t = np.arange(n) / FS + np.clip(rng.normal(0, 2e-4, n), -4e-4, 4e-4)
+    t[0] = 0.0
+    f = 2.0
+    x = np.stack([np.sin(2 * np.pi * f * t), np.cos(2 * np.pi * f * t)], axis=1)
+    tu, xu = signals.resample_uniform(t, x, FS)
+    np.testing.assert_allclose(np.diff(tu), 1.0 / FS, rtol=1e-9)
+    assert tu[0] == t[0] and tu[-1] <= t[-1]
+    ref = np.stack([np.sin(2 * np.pi * f * tu), np.cos(2 * np.pi * f * tu)], axis=1)
+    # linear interpolation error <= h^2 max|x''| / 8 with h <= 1.8 ms
+    assert np.max(np.abs(xu - ref)) < (1.8e-3) ** 2 * (2 * np.pi * f) ** 2 / 8
+
+
+def test_sample_rate_and_uniformity():
+    """The nominal rate of a uniform grid is 1 / dt; jitter makes a grid non-uniform."""
+    t = np.arange(100) / 500.0
+    assert signals.sample_rate(t) == pytest.approx(500.0, rel=1e-12)
+    assert signals.is_uniform(t)
+    t2 = t.copy()
+    t2[10] += 1e-4
+    assert not signals.is_uniform(t2)
+
+
+def test_sample_rate_with_jitter_and_dropped_samples():
+    """Jitter and gaps do not bias the nominal rate (counted periods, or windowed median)."""
+    rng = np.random.default_rng(6)
+    k = np.sort(rng.choice(20000, 19000, replace=False))  # 5 % dropped
+    small = k / FS + rng.normal(0, 3e-5, k.size)  # periods countable: least squares
+    assert signals.sample_rate(small) == pytest.approx(FS, rel=1e-6)
+    large = k / FS + np.clip(rng.normal(0, 2e-4, k.size), -4e-4, 4e-4)  # windowed median
+    assert signals.sample_rate(large) == pytest.approx(FS, rel=1e-2)
+
+
+def test_time_checks_raise_on_non_increasing_timestamps():
+    """Repeated or decreasing timestamps are rejected with the offending index."""
+    with pytest.raises(DataError, match=r"t\[2\]"):
+        signals.derivative([0.0, 0.1, 0.2, 0.2, 0.3], np.zeros(5))
+    with pytest.raises(ShapeError, match="N >= 3"):
+        signals.derivative([0.0, 0.1], np.zeros(2))
+    with pytest.raises(ShapeError, match="x must have shape"):
+        signals.resample_uniform([0.0, 0.1, 0.2], np.zeros(4))
+
+
+def test_trim_edges_mask_and_error():
+    """Trimming keeps the samples at least `seconds` from both ends; too much raises."""
+    t = np.arange(11) * 0.1
+    keep = signals.trim_edges(t, 0.25)
+    np.testing.assert_array_equal(np.flatnonzero(keep), np.arange(3, 8))
+    with pytest.raises(DataError, match="leaves no sample"):
+        signals.trim_edges(t, 0.6)

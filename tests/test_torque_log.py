@@ -1,0 +1,178 @@
+"""Torque logs: validation, cleaning, preparation, and CSV/NPZ files."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from dynid.exceptions import DataError, NonFiniteError, ShapeError
+from dynid.identification.log import TorqueLog, prepare_log
+from dynid.io.torque_log import read_torque_log, torque_log_columns, write_torque_log
+from dynid.kinematics.trajectories import sinusoid_trajectory
+from dynid.simulation.measurement import SensorNoise, sample_times, simulate_measurement
+
+
+def _log(rng, N=50, n=3, ddq=False):
+    t = np.arange(N) * 1e-3
+    a = [rng.normal(size=(N, n)) for _ in range(4)]
+    return TorqueLog(t, a[0], a[1], a[2], a[3] if ddq else None)
+
+
+@pytest.mark.parametrize("suffix", [".csv", ".npz"])
+@pytest.mark.parametrize("with_ddq", [False, True])
+def test_round_trip_is_exact(tmp_path, suffix, with_ddq):
+    """Writing then reading a log gives back the same arrays, bit for bit."""
+    log = _log(np.random.default_rng(41), ddq=with_ddq)
+    back = read_torque_log(write_torque_log(tmp_path / f"log{suffix}", log))
+    for k in ("t", "q", "dq", "tau"):
+        np.testing.assert_array_equal(getattr(back, k), getattr(log, k))
+    if with_ddq:
+        np.testing.assert_array_equal(back.ddq, log.ddq)
+    else:
+        assert back.ddq is None
+    assert back.cleaning.n_nan_rows == 0 and back.cleaning.n_duplicates == 0
+
+
+def test_csv_header_names_columns_and_units(tmp_path):
+    """The CSV starts with a units comment and the t, q1..qn, dq1..dqn, tau1..taun header."""
+    path = write_torque_log(tmp_path / "log.csv", _log(np.random.default_rng(42), n=2))
+    lines = path.read_text().splitlines()
+    assert lines[0].startswith("#") and "tau [N m]" in lines[0]
+    assert lines[1] == "t,q1,q2,dq1,dq2,tau1,tau2"
+    assert torque_log_columns(2, with_ddq=True)[-2:] == ["ddq1", "ddq2"]
+
+
+def test_strict_log_rejects_duplicates_nan_and_shapes():
+    """TorqueLog itself rejects repeated timestamps, NaN and inconsistent shapes."""
+    z = np.zeros((4, 2))
+    with pytest.raises(DataError, match=r"row 2 \(t = 0.1\) repeats row 1"):
+        TorqueLog(np.array([0.0, 0.1, 0.1, 0.2]), z, z, z)
+    bad = z.copy()
+    bad[2, 1] = np.nan
+    with pytest.raises(NonFiniteError, match=r"tau must be finite; got nan at index \(2, 1\)"):
+        TorqueLog(np.arange(4.0), z, z, bad)
+    with pytest.raises(ShapeError, match="dq must have shape"):
+        TorqueLog(np.arange(4.0), z, np.zeros((4, 3)), z)
+
+
+def test_from_raw_drops_nan_rows_and_duplicates_and_reports_gaps():
+    """Cleaning drops and counts NaN rows and duplicate stamps, and lists gaps."""
+    t = np.array([0.0, 0.001, 0.002, 0.002, 0.003, 0.004, 0.008, 0.009, 0.010])
+    q = np.arange(9.0)[:, None] * np.ones((1, 2))
+    q[4, 0] = np.nan
+    log = TorqueLog.from_raw(t, q, q, q)
+    c = log.cleaning
+    assert (c.n_input_rows, c.n_nan_rows, c.n_duplicates) == (9, 1, 1)
+    np.testing.assert_array_equal(log.t, [0.0, 0.001, 0.002, 0.004, 0.008, 0.009, 0.010])
+    np.testing.assert_array_equal(log.q[:, 0], [0, 1, 2, 5, 6, 7, 8])  # first duplicate kept
+    assert c.gaps == ((0.002, 0.004), (0.004, 0.008))
+    assert c.dt_median == pytest.approx(0.001)
+
+
+def test_select_keeps_rows_and_cleaning():
+    """select() picks rows of every array (ddq included) and keeps the cleaning record."""
+    t = np.array([0.0, 0.001, 0.001, 0.002, 0.003])
+    a = np.arange(10.0).reshape(5, 2)
+    log = TorqueLog.from_raw(t, a, a + 1, a + 2, a + 3)
+    sub = log.select(np.array([0, 2]))
+    np.testing.assert_array_equal(sub.t, [0.0, 0.002])
+    np.testing.assert_array_equal(sub.ddq, [[3.0, 4.0], [9.0, 10.0]])
+    assert sub.cleaning.n_duplicates == 1
+
+
+def test_from_raw_rejects_time_running_backwards():
+    """A timestamp below its predecessor is rejected with the row number."""
+    t = np.array([0.0, 0.1, 0.2, 0.15, 0.3])
+    z = np.zeros((5, 1))
+    with pytest.raises(DataError, match="timestamps run backwards at row 3"):
+        TorqueLog.from_raw(t, z, z, z)
+
+
+def test_csv_with_empty_and_nan_cells_is_cleaned(tmp_path):
+    """Empty or 'nan' cells make a row invalid: it is dropped and counted."""
+    path = write_torque_log(tmp_path / "log.csv", _log(np.random.default_rng(43), N=20, n=2))
+    lines = path.read_text().splitlines()
+    cells = lines[5].split(",")
+    cells[3] = ""
+    lines[5] = ",".join(cells)
+    cells = lines[9].split(",")
+    cells[6] = "nan"
+    lines[9] = ",".join(cells)
+    path.write_text("\n".join(lines) + "\n")
+    log = read_torque_log(path)
+    assert log.n_samples == 18 and log.cleaning.n_nan_rows == 2
+
+
+def test_csv_errors_name_the_line_and_column(tmp_path):
+    """Non-numeric cells, short rows and missing columns raise DataError with the place."""
+    path = write_torque_log(tmp_path / "log.csv", _log(np.random.default_rng(44), N=10, n=2))
+    lines = path.read_text().splitlines()
+    bad = lines.copy()
+    cells = bad[4].split(",")
+    cells[5] = "abc"
+    bad[4] = ",".join(cells)
+    (tmp_path / "a.csv").write_text("\n".join(bad))
+    with pytest.raises(DataError, match=r"a.csv, line 5, column 'tau1': not a number: 'abc'"):
+        read_torque_log(tmp_path / "a.csv")
+    bad = lines.copy()
+    bad[6] = ",".join(bad[6].split(",")[:-1])
+    (tmp_path / "b.csv").write_text("\n".join(bad))
+    with pytest.raises(DataError, match="b.csv, line 7: expected 7 fields"):
+        read_torque_log(tmp_path / "b.csv")
+    bad = lines.copy()
+    bad[1] = bad[1].replace("tau2", "torque2")
+    (tmp_path / "c.csv").write_text("\n".join(bad))
+    with pytest.raises(DataError, match=r"missing column\(s\) \['tau2'\]"):
+        read_torque_log(tmp_path / "c.csv")
+    with pytest.raises(DataError, match="must be a .csv or .npz"):
+        read_torque_log(tmp_path / "log.txt")
+
+
+def test_npz_errors(tmp_path):
+    """A missing array or an object array in an NPZ raises DataError."""
+    np.savez(tmp_path / "a.npz", t=np.arange(3.0), q=np.zeros((3, 1)), dq=np.zeros((3, 1)))
+    with pytest.raises(DataError, match=r"missing array\(s\) \['tau'\]"):
+        read_torque_log(tmp_path / "a.npz")
+    np.savez(
+        tmp_path / "b.npz",
+        t=np.arange(3.0),
+        q=np.zeros((3, 1)),
+        dq=np.zeros((3, 1)),
+        tau=np.array([[{}], [{}], [{}]], dtype=object),
+    )
+    with pytest.raises(DataError, match="b.npz"):
+        read_torque_log(tmp_path / "b.npz")
+
+
+def test_prepare_log_resamples_jittered_and_dropped_samples(panda):
+    """Jittered timestamps and 2 % dropped samples: the prepared log is uniform and its
+    filtered states and accelerations match the true trajectory."""
+    rng = np.random.default_rng(45)
+    t = sample_times(10.0, 1000.0, jitter_std=5e-5, rng=rng)
+    q0 = np.array([0.0, -0.3, 0.0, -2.0, 0.0, 1.6, 0.0])
+    A = np.array([0.5, -0.4, 0.6, 0.5, -0.7, 0.6, 0.8])
+    T = np.array([4.0, 3.0, 5.0, 2.5, 3.5, 4.5, 2.0])
+    log = simulate_measurement(
+        panda,
+        sinusoid_trajectory(t, q0, A, T),
+        rng=rng,
+        noise=SensorNoise(tau_std=0.05, q_std=0.0, dq_std=1e-3),
+        drop_fraction=0.02,
+    )
+    raw = TorqueLog.from_raw(log.t, log.q, log.dq, log.tau)
+    assert len(raw.cleaning.gaps) > 50 and raw.cleaning.dt_jitter > 0.05
+    p = prepare_log(raw, cutoff_hz=10.0)
+    np.testing.assert_allclose(np.diff(p.t), 1e-3, rtol=1e-6)
+    ref = sinusoid_trajectory(p.t, q0, A, T)
+    assert np.max(np.abs(p.q - ref.q)) < 1e-5
+    assert np.max(np.abs(p.dq - ref.dq)) < 2e-3
+    assert np.max(np.abs(p.ddq - ref.ddq)) < 0.05
+    assert p.t[0] == pytest.approx(0.2, abs=1e-3)  # 2 / cutoff trimmed
+
+
+def test_prepare_log_rejects_long_gaps():
+    """A gap longer than max_gap_s is a DataError naming where it is."""
+    t = np.concatenate([np.arange(100), np.arange(150, 250)]) * 1e-3
+    z = np.zeros((200, 2))
+    with pytest.raises(DataError, match=r"gap of 0.051 s .* t = 0.099 s"):
+        prepare_log(TorqueLog(t, z, z, z), cutoff_hz=None)
