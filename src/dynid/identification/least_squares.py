@@ -8,7 +8,19 @@ solved by a column-scaled QR factorisation (never a normal-equation inverse). St
   Panda data and 122 for the exciting trajectory);
 * ``relative_error_percent`` ``= 100 ||y - W beta|| / ||y||``;
 * ``sigma^2 = ||y - W beta||^2 / (m - r)`` and ``cov(beta) = sigma^2 (W^T W)^{-1}``
-  (from ``R^{-1}``), ``std`` its root diagonal and ``std_percent = 100 std / |beta|``.
+  (from ``R^{-1}``), ``std`` its root diagonal and ``std_percent = 100 std / |beta|``
+  (``covariance="classical"``, the paper's formula, which assumes errors of equal
+  variance in every row);
+* or, with ``covariance="robust"``, the heteroscedasticity-consistent covariance (White
+  1980, HC1) ``m / (m - r) (W^T W)^{-1} W^T diag(e^2) W (W^T W)^{-1}``, valid when the
+  rows' errors differ in size: the static data stack kg m^2 and N m, and a relative error
+  scales with each entry.
+
+For a tall ``W`` (more than four rows per column) ``R`` is obtained in two stages: the
+triangular factor of ``[W y]`` by Householder QR without pivoting, then the pivoted QR of
+its leading square block. Both stages are orthogonal, so the pivoted ``R``, the rank
+decision and ``Q^T y`` are those of a pivoted QR of ``W`` itself, without forming the
+``m x r`` matrix ``Q``.
 
 Coefficients whose ``std_percent`` exceeds a threshold (the paper used 30 %) can be
 removed and the rest re-fitted (:func:`fit_with_pruning`).
@@ -73,6 +85,7 @@ def fit_least_squares(
     *,
     kept: ArrayLike | None = None,
     rtol: float = 1e-10,
+    covariance: str = "classical",
 ) -> LeastSquaresFit:
     """Least-squares estimate of ``beta`` in ``W beta = y`` with its statistics.
 
@@ -86,6 +99,9 @@ def fit_least_squares(
         Columns to use (others are fixed to 0).
     rtol : float
         Relative rank tolerance on the diagonal of R of the column-scaled ``W``.
+    covariance : {"classical", "robust"}
+        ``"classical"``: ``sigma^2 (W^T W)^{-1}`` (Gaz et al. 2019); ``"robust"``: the
+        heteroscedasticity-consistent (HC1) estimate, for rows of unequal error variance.
 
     Raises
     ------
@@ -101,22 +117,36 @@ def fit_least_squares(
     y = _checks.as_array("y", y)
     if W.ndim != 2 or y.shape != (W.shape[0],):
         raise ShapeError(f"W must be (m, r) and y (m,); got {W.shape} and {y.shape}")
+    if covariance not in ("classical", "robust"):
+        raise ValueError(f"covariance must be 'classical' or 'robust'; got {covariance!r}")
     m, r = W.shape
     keep = np.ones(r, bool) if kept is None else np.asarray(kept, dtype=bool)
     if keep.shape != (r,):
         raise ShapeError(f"kept must have shape ({r},); got {keep.shape}")
-    Wk = W[:, keep]
+    Wk = W if keep.all() else W[:, keep]
     rk = Wk.shape[1]
-    norms = np.linalg.norm(Wk, axis=0)
-    if m < rk:
-        raise RankDeficientError(
-            f"Regressor has {m} rows < {rk} coefficients; add configurations"
-        )
+    norms = np.sqrt(np.einsum("ij,ij->j", Wk, Wk))
     scale = np.where(norms > 0, norms, 1.0)
-    Ws = Wk / scale
-    Q, R, piv = scipy.linalg.qr(Ws, mode="economic", pivoting=True)
+    if m > 4 * (rk + 1):
+        # stage 1: R of [Ws y] by unpivoted Householder QR (LAPACK geqrf, column-major, in
+        # place); its last column holds Q0^T y
+        Ay = np.empty((m, rk + 1), order="F")
+        np.divide(Wk, scale, out=Ay[:, :rk])
+        Ay[:, rk] = y
+        qr0, _, _, info = scipy.linalg.lapack.dgeqrf(Ay, overwrite_a=True)
+        if info != 0:  # pragma: no cover - LAPACK argument error
+            raise RuntimeError(f"LAPACK dgeqrf failed with info={info}")
+        R0 = np.triu(qr0[: rk + 1])
+        A, b = R0[:rk, :rk], R0[:rk, rk]
+    else:
+        A, b = Wk / scale, y
+    Q, R, piv = scipy.linalg.qr(A, mode="economic", pivoting=True)
     d = np.abs(np.diag(R))
     rank = int(np.sum(d > rtol * d[0])) if d.size and d[0] > 0 else 0
+    if m < rk:
+        raise RankDeficientError(
+            f"Regressor rank {rank} < {rk}: {m} rows for {rk} coefficients; add configurations"
+        )
     sv = np.linalg.svd(R, compute_uv=False)
     cond = float(sv[0] / sv[-1]) if sv[-1] > 0 else float("inf")
     if rank < rk:
@@ -124,7 +154,7 @@ def fit_least_squares(
             f"Regressor rank {rank} < {rk} at rtol={rtol:g} (cond {cond:.3g}); add configurations "
             "or excite the trajectory more, or drop unidentifiable parameters"
         )
-    z = scipy.linalg.solve_triangular(R, Q.T @ y)
+    z = scipy.linalg.solve_triangular(R, Q.T @ b)
     bs = np.empty(rk)
     bs[piv] = z
     bk = bs / scale
@@ -133,8 +163,15 @@ def fit_least_squares(
     dof = max(m - rk, 1)
     sigma = np.sqrt(ss / dof)
     Rinv = scipy.linalg.solve_triangular(R, np.eye(rk))
+    if covariance == "classical":
+        var_p = np.sum(Rinv**2, axis=1) * sigma**2
+    else:  # HC1: (R^T R)^{-1} Ws^T diag(e^2) Ws (R^T R)^{-1}, in pivoted order
+        We = Wk * e[:, None]
+        meat = (We.T @ We) / np.outer(scale, scale)
+        G = Rinv @ Rinv.T
+        var_p = np.einsum("ij,jk,ik->i", G, meat[np.ix_(piv, piv)], G) * (m / dof)
     var_s = np.empty(rk)
-    var_s[piv] = np.sum(Rinv**2, axis=1) * sigma**2
+    var_s[piv] = var_p
     sk = np.sqrt(var_s) / scale
     beta = np.zeros(r)
     std = np.zeros(r)
@@ -159,17 +196,22 @@ def fit_least_squares(
 
 
 def fit_with_pruning(
-    W: ArrayLike, y: ArrayLike, *, max_std_percent: float | None = None, rtol: float = 1e-10
+    W: ArrayLike,
+    y: ArrayLike,
+    *,
+    max_std_percent: float | None = None,
+    rtol: float = 1e-10,
+    covariance: str = "classical",
 ) -> LeastSquaresFit:
     """Fit, then (optionally) remove coefficients with ``std_percent > max_std_percent`` and re-fit.
 
     Gaz et al. 2019 discard coefficients whose relative standard deviation exceeds 30 %.
-    One removal pass, as in the paper.
+    One removal pass, as in the paper. ``covariance`` as in :func:`fit_least_squares`.
     """
-    fit = fit_least_squares(W, y, rtol=rtol)
+    fit = fit_least_squares(W, y, rtol=rtol, covariance=covariance)
     if max_std_percent is None:
         return fit
     keep = ~(fit.std_percent > max_std_percent)
     if keep.all():
         return fit
-    return fit_least_squares(W, y, kept=keep, rtol=rtol)
+    return fit_least_squares(W, y, kept=keep, rtol=rtol, covariance=covariance)

@@ -148,12 +148,15 @@ def base_parameters_from_regressor(
     null = norms <= 1e-12 * np.max(norms, initial=0.0)
     scale = np.where(null, 1.0, norms)
     Ws = np.where(null, 0.0, W / scale)
-    _, R, piv = scipy.linalg.qr(Ws, mode="economic", pivoting=True)
+    R, piv = scipy.linalg.qr(Ws, mode="r", pivoting=True)  # Q is not needed
+    R = R[: min(m, p)]
     d = np.abs(np.diag(R))
     r = int(np.sum(d > rtol * d[0])) if d.size and d[0] > 0 else 0
     ind, dep = np.sort(piv[:r]), np.sort(piv[r:])
-    # K_d from the scaled problem, on the sorted independent set
-    Ks = np.linalg.lstsq(Ws[:, ind], Ws[:, dep], rcond=None)[0]
+    # K_d from the scaled problem: Ws_b K = Ws_d  <=>  R11 K = R12 (pivot order); then rows
+    # and columns in sorted column order
+    Kp = scipy.linalg.solve_triangular(R[:r, :r], R[:r, r:]) if r else np.zeros((0, p - r))
+    Ks = Kp[np.argsort(piv[:r])][:, np.argsort(piv[r:])]
     K_d = (Ks / scale[ind][:, None]) * scale[dep][None, :]
     if clean_digits:
         K_d = _clean(K_d, clean_digits, float(np.max(np.abs(K_d), initial=0.0)))

@@ -1,0 +1,305 @@
+"""Fit joint friction to the torque residual of a dynamic model on a measured log.
+
+The residual tau_measured - (M ddq + c + g) of the model (an identification.json, or a
+robot's own link parameters with --robot) is fitted per joint by the sigmoid of Gaz et
+al. 2019 (eq. 25, Nelder-Mead; default) or the classical viscous + Coulomb + offset model
+(eq. 24, least squares). The states are low-pass filtered with zero phase (--cutoff) and
+the accelerations differentiated from the filtered velocities.
+
+Writes OUT/friction.json (parameters, RMS of the residual before and after) and
+OUT/friction.png (residual against velocity with the fitted curve, per joint).
+
+Example:
+  dynid friction --model out/identification.json --data traj.csv --out out/friction
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from ..exceptions import DynidError
+from ..friction.fit import (
+    FrictionFit,
+    FrictionResidual,
+    fit_classical,
+    fit_sigmoid,
+    friction_residual,
+)
+from ..friction.model import SigmoidFriction
+from ..friction.validation import Validation, validate
+from ..identification.log import DEFAULT_CUTOFF_HZ
+from ..identification.model import IdentifiedModel
+from ..io.friction_json import write_friction_json
+from ..io.torque_log import read_torque_log
+from ..kinematics.trajectories import (
+    centered_start,
+    check_limits,
+    scale_into_limits,
+    sinusoid_trajectory,
+)
+from ..model.robot import Robot
+from ..simulation.measurement import SensorNoise, sample_times, simulate_measurement
+from .common import load_robot
+
+NAME = "friction"
+
+
+def register(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParser:
+    """Add the ``friction`` subcommand."""
+    p = subparsers.add_parser(
+        NAME,
+        help="fit joint friction (sigmoid or classical) to a model's torque residual",
+        description=__doc__,
+        formatter_class=argparse.RawDescriptionHelpFormatter,
+    )
+    src = p.add_mutually_exclusive_group(required=True)
+    src.add_argument("--model", type=Path, help="identification.json of an identified model")
+    src.add_argument("--robot", help="'panda', a .urdf or a .toml: the robot's own link parameters")
+    p.add_argument("--base", default=None, help="URDF base link (with --robot)")
+    p.add_argument("--tip", default=None, help="URDF tip link (with --robot)")
+    p.add_argument("--data", type=Path, required=True, help="torque log (.csv or .npz)")
+    p.add_argument("--out", type=Path, required=True, help="output directory")
+    p.add_argument("--friction-model", choices=("sigmoid", "classical"), default="sigmoid")
+    p.add_argument(
+        "--cutoff",
+        type=float,
+        default=DEFAULT_CUTOFF_HZ,
+        help=f"low-pass cutoff of the states [Hz] (default {DEFAULT_CUTOFF_HZ:g})",
+    )
+    p.add_argument("--no-figures", action="store_true", help="skip the PNG figures")
+    return p
+
+
+def load_torque_model(args: argparse.Namespace) -> IdentifiedModel | Robot:
+    """The rigid-body model named by ``--model`` (identification.json) or ``--robot``."""
+    if getattr(args, "model", None) is not None:
+        from ..io.model_json import load_model_json
+
+        return load_model_json(args.model)
+    if getattr(args, "robot", None) is not None:
+        return load_robot(args)
+    raise DynidError("give --model identification.json or --robot ROBOT")
+
+
+def _joint_names(model: IdentifiedModel | Robot) -> list[str]:
+    robot = model.robot if isinstance(model, IdentifiedModel) else model
+    return list(robot.joint_names)
+
+
+def save_friction_figure(
+    path: Path, residual: FrictionResidual, fit: FrictionFit, *, names: list[str], **kw: Any
+) -> Path:
+    """Write the residual-vs-velocity figure (Fig. 4) to ``path``."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    from ..plots.friction import plot_friction_fit
+
+    fig = plot_friction_fit(residual, fit, joint_names=names, **kw)
+    fig.savefig(path, dpi=110)
+    plt.close(fig)
+    return path
+
+
+def save_validation_figures(
+    out: Path,
+    validation: Validation,
+    *,
+    names: list[str],
+    prefix: str = "validation",
+    noise_std: float | None = None,
+    title: str | None = None,
+) -> list[Path]:
+    """Write ``<prefix>_torques.png`` (Fig. 3) and ``<prefix>_rms.png`` under ``out``."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    from ..plots.torques import plot_rms_comparison, plot_torque_validation
+
+    paths = []
+    fig = plot_torque_validation(validation, joint_names=names, title=title)
+    paths.append(out / f"{prefix}_torques.png")
+    fig.savefig(paths[-1], dpi=100)
+    plt.close(fig)
+    rms = {"without friction": validation.without_friction.rms}
+    if validation.with_friction is not None:
+        rms["with friction"] = validation.with_friction.rms
+    fig = plot_rms_comparison(rms, noise_std=noise_std, title=title)
+    paths.append(out / f"{prefix}_rms.png")
+    fig.savefig(paths[-1], dpi=110)
+    plt.close(fig)
+    return paths
+
+
+def format_rms_table(names: list[str], columns: dict[str, np.ndarray]) -> str:
+    """A per-joint table of RMS values [N m]."""
+    head = f"{'joint':<10}" + "".join(f"{k:>22}" for k in columns)
+    rows = [head]
+    for j, name in enumerate(names):
+        rows.append(f"{name:<10}" + "".join(f"{float(v[j]):>22.4f}" for v in columns.values()))
+    return "\n".join(rows)
+
+
+def run(args: argparse.Namespace) -> int:
+    """Fit friction, write friction.json and the figure, print the RMS table (unless -q)."""
+    say = (lambda *a: None) if getattr(args, "quiet", False) else print
+    model = load_torque_model(args)
+    log = read_torque_log(args.data)
+    res = friction_residual(model, log, cutoff_hz=args.cutoff)
+    fit = (
+        fit_sigmoid(res.dq, res.residual)
+        if args.friction_model == "sigmoid"
+        else fit_classical(res.dq, res.residual)
+    )
+    args.out.mkdir(parents=True, exist_ok=True)
+    meta = {
+        "data": str(args.data.name),
+        "model": str(args.model.name) if args.model is not None else args.robot,
+        "cutoff_hz": args.cutoff,
+        "n_samples": fit.n_samples,
+        "converged": [bool(x) for x in fit.converged],
+    }
+    write_friction_json(args.out / "friction.json", fit, metadata=meta)
+    names = _joint_names(model)
+    if not args.no_figures:
+        save_friction_figure(
+            args.out / "friction.png",
+            res,
+            fit,
+            names=names,
+            title=f"{fit.kind} friction fitted to the torque residual ({args.data.name})",
+        )
+    print(
+        format_rms_table(
+            names, {"RMS before [N m]": fit.rms_before, "RMS after [N m]": fit.rms_after}
+        )
+    )
+    say(f"wrote {args.out / 'friction.json'}")
+    return 0
+
+
+def demo_stages(
+    out_dir: Path, model: IdentifiedModel, seed: int, *, truth: Robot | None = None
+) -> dict[str, Any]:
+    """Friction and validation stages of the demo, from a static identified model.
+
+    1. Simulate two 20 s logs at 1 kHz of the velocity-mode sinusoids (Gaz et al. 2019,
+       eq. 31, Table I; started centred in the joint ranges and scaled in amplitude into
+       the limits) on the true robot, with independent sensor noise (0.05 N m): one to
+       fit the friction, one to validate.
+    2. Validate the model without friction; fit the sigmoid friction on the first log's
+       residual; validate with friction on the second log.
+    3. Write ``friction.json``, ``validation.json`` and the figures under ``out_dir``, print
+       the per-joint RMS before/after table.
+
+    Parameters
+    ----------
+    out_dir : Path
+    model : IdentifiedModel
+        The rigid-body model to validate (e.g. from the static route).
+    seed : int
+    truth : Robot, optional
+        The robot that plays the real one (its link parameters and sigmoid friction);
+        default ``model.robot`` (for the built-in Panda: the published values).
+
+    Returns
+    -------
+    dict
+        ``rms_without_friction``, ``rms_with_friction``, ``rms_friction_fit_before`` /
+        ``_after`` (n lists, N m), ``relative_error_percent_without`` / ``_with``,
+        ``friction`` (n, 3) fitted sigmoid parameters, ``friction_curve_rms`` (RMS of the
+        fitted minus true friction over the visited velocities, or None), ``scale``,
+        ``files``.
+    """
+    truth = model.robot if truth is None else truth
+    if not np.any(truth.phi):
+        raise DynidError(
+            "the model's robot has no link parameters to simulate with (read from JSON?); "
+            "pass truth=<Robot>"
+        )
+    out_dir = Path(out_dir)
+    out_dir.mkdir(parents=True, exist_ok=True)
+    rng = np.random.default_rng(seed)
+    t = sample_times(20.0, 1000.0)
+    traj = sinusoid_trajectory(t, centered_start(truth))
+    report = check_limits(truth, traj)
+    traj, scale = scale_into_limits(truth, traj, method="amplitude")
+    noise = SensorNoise()
+    fit_log = simulate_measurement(truth, traj, rng=rng, noise=noise)
+    val_log = simulate_measurement(truth, traj, rng=rng, noise=noise)
+    names = list(truth.joint_names)
+    res = friction_residual(model, fit_log)
+    fit = fit_sigmoid(res.dq, res.residual)
+    val = validate(model, val_log, friction=fit.friction)
+    write_friction_json(
+        out_dir / "friction.json", fit, metadata={"seed": seed, "source": "demo, sinusoids"}
+    )
+    doc = val.as_dict()
+    doc["seed"] = seed
+    doc["units"] = {"rms": "N m", "mse": "N^2 m^2", "relative_error_percent": "%"}
+    (out_dir / "validation.json").write_text(json.dumps(doc, indent=2) + "\n")
+    files = [out_dir / "friction.json", out_dir / "validation.json"]
+    files.append(
+        save_friction_figure(
+            out_dir / "friction.png",
+            res,
+            fit,
+            names=names,
+            reference=SigmoidFriction.from_array(truth.friction)
+            if truth.friction is not None
+            else None,
+            reference_label="true (published) friction",
+            title="sigmoid friction fitted to the residual of the identified model",
+        )
+    )
+    files += save_validation_figures(
+        out_dir,
+        val,
+        names=names,
+        noise_std=float(noise.tau_std),
+        title="validation on the sinusoids of Gaz et al. 2019 (eq. 31)",
+    )
+    curve = None
+    if truth.friction is not None:
+        v = np.linspace(-1.0, 1.0, 801)[:, None] * np.max(np.abs(traj.dq), axis=0)
+        true_f = SigmoidFriction.from_array(truth.friction)
+        curve = np.sqrt(np.mean((fit.friction.torques(v) - true_f.torques(v)) ** 2, axis=0))
+    assert val.with_friction is not None
+    if not report.ok:
+        print(
+            f"sinusoids of Table I exceed the limits; amplitudes scaled by {scale:.4f}:\n{report}"
+        )
+    print(
+        format_rms_table(
+            names,
+            {
+                "RMS no friction [N m]": val.without_friction.rms,
+                "RMS + friction [N m]": val.with_friction.rms,
+            },
+        )
+    )
+    print(
+        f"relative error: {val.without_friction.relative_error_percent:.2f} % without friction, "
+        f"{val.with_friction.relative_error_percent:.2f} % with (sensor noise {noise.tau_std} N m)"
+    )
+    return {
+        "rms_without_friction": val.without_friction.rms.tolist(),
+        "rms_with_friction": val.with_friction.rms.tolist(),
+        "rms_friction_fit_before": fit.rms_before.tolist(),
+        "rms_friction_fit_after": fit.rms_after.tolist(),
+        "relative_error_percent_without": val.without_friction.relative_error_percent,
+        "relative_error_percent_with": val.with_friction.relative_error_percent,
+        "friction": fit.friction.as_array().tolist(),
+        "friction_curve_rms": None if curve is None else curve.tolist(),
+        "scale": scale,
+        "files": [str(f) for f in files],
+    }

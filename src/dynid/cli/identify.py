@@ -1,0 +1,202 @@
+"""Identify the dynamic coefficients (base parameters) from a data file.
+
+Static data (a CSV or NPZ of q, M(q), g(q) at rest, as written by `dynid acquire-static`):
+the stacked static regressor [tril M; g] (Gaz et al. 2019, Sec. IV-A, eq. 20) is solved by
+least squares; rows without information (g1 of the Panda) are dropped and reported.
+With --max-std-percent, coefficients above that relative standard deviation are removed
+and the rest re-fitted (the paper used 30).
+
+Torque logs (a CSV with a `t` column, or an NPZ with `t` and `tau`) go to the classical
+route.
+
+Writes DIR/identification.json (coefficients, expressions, std, metrics, kinematics) and
+prints a summary table.
+
+example:
+  dynid identify --robot panda --data static.csv --out result --max-std-percent 30
+"""
+
+from __future__ import annotations
+
+import argparse
+import logging
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from ..exceptions import DataError, DynidError
+from ..identification.model import IdentifiedModel
+from ..identification.static import identify_static
+from ..io.model_json import save_model_json
+from ..io.static_data import load_static_data, save_static_data
+from ..model.panda import panda
+from ..model.robot import Robot
+from ..simulation.controller import SimulatedController, acquire_static
+from .acquire_static import streams
+from .common import add_robot_options, load_robot
+
+NAME = "identify"
+
+#: Relative noise of the simulated controller in :func:`demo_stage`.
+DEMO_RELATIVE_NOISE = 1e-4
+
+_log = logging.getLogger(__name__)
+
+
+def register(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParser:
+    """Add the ``identify`` subcommand."""
+    p = subparsers.add_parser(
+        NAME,
+        help="identify the base parameters from static data (or a torque log)",
+        description=__doc__,
+        formatter_class=argparse.RawDescriptionHelpFormatter,
+    )
+    add_robot_options(p)
+    p.add_argument("--data", type=Path, required=True, help="data file: .csv or .npz")
+    p.add_argument("--out", type=Path, required=True, help="output folder")
+    p.add_argument(
+        "--max-std-percent",
+        type=float,
+        default=None,
+        metavar="PCT",
+        help="remove coefficients above this relative std [%%] and re-fit (paper: 30)",
+    )
+    p.add_argument(
+        "--drop-invalid",
+        action="store_true",
+        help="drop rows with NaN, non-numbers or a non-symmetric M instead of failing",
+    )
+    p.add_argument(
+        "--std",
+        choices=("robust", "classical"),
+        default="robust",
+        help="standard deviations: heteroscedasticity-consistent (default) or sigma^2 (W^T W)^-1",
+    )
+    p.add_argument("--rtol", type=float, default=1e-10, help="relative rank tolerance")
+    return p
+
+
+def data_kind(path: Path) -> str:
+    """``"static"`` or ``"torque_log"``: a CSV with a ``t`` column or an NPZ with ``t``/``tau``
+    is a torque log."""
+    suffix = path.suffix.lower()
+    if suffix == ".csv":
+        with path.open(encoding="utf-8", errors="replace") as fh:
+            for line in fh:
+                s = line.strip()
+                if s and not s.startswith("#"):
+                    cols = [c.strip() for c in s.split(",")]
+                    return "torque_log" if "t" in cols else "static"
+        raise DataError(f"{path.name}: no header line")
+    if suffix == ".npz":
+        try:
+            with np.load(path, allow_pickle=False) as z:
+                keys = set(z.files)
+        except ValueError as exc:
+            raise DataError(f"{path.name}: not a readable NPZ file ({exc})") from exc
+        return "torque_log" if "t" in keys or "tau" in keys else "static"
+    raise DataError(f"--data must be a .csv or .npz file; got {path.name!r}")
+
+
+# ---------------------------------------------------------------------------------------
+# Classical route (torque logs). To be connected to identification.identify_from_log once
+# it exists; this is the only place to change.
+def identify_torque_log(robot: Robot, path: Path, args: argparse.Namespace) -> IdentifiedModel:
+    """Classical identification from a torque log (not available yet)."""
+    raise DynidError(
+        f"{path.name} is a torque log (column 't'); torque logs: classical route not available "
+        "in this version; hint: identify from static data (dynid acquire-static)"
+    )
+
+
+# ---------------------------------------------------------------------------------------
+
+
+def identify_static_file(robot: Robot, path: Path, args: argparse.Namespace) -> IdentifiedModel:
+    """Static route: load (checked), identify."""
+    data, n_dropped = load_static_data(path, robot, drop_invalid=args.drop_invalid)
+    if n_dropped:
+        _log.warning("%s: %d invalid row(s) dropped", path.name, n_dropped)
+    return identify_static(
+        robot, data, max_std_percent=args.max_std_percent, rtol=args.rtol, std_estimator=args.std
+    )
+
+
+def run(args: argparse.Namespace) -> int:
+    """Identify, write DIR/identification.json and print the summary; returns the exit code."""
+    robot = load_robot(args)
+    if data_kind(args.data) == "torque_log":
+        model = identify_torque_log(robot, args.data, args)
+    else:
+        model = identify_static_file(robot, args.data, args)
+    args.out.mkdir(parents=True, exist_ok=True)
+    path = save_model_json(args.out / "identification.json", model)
+    if not args.quiet:
+        print(format_summary(model))
+        print(f"wrote {path}")
+    return 0
+
+
+def format_summary(model: IdentifiedModel, *, width: int = 60) -> str:
+    """A readable summary: metrics, then one line per coefficient (expressions shortened)."""
+    fit, meta = model.fit, model.metadata
+    head = [
+        f"{meta.get('route', '?')} identification of {model.robot.name}: "
+        f"{meta.get('n_configurations', '?')} configurations, {fit.n_rows} rows"
+        + (f", dropped rows {', '.join(meta['dropped_rows'])}" if meta.get("dropped_rows") else ""),
+        f"rank {fit.rank}, condition number {fit.condition_number:.4g}, relative error "
+        f"{fit.relative_error_percent:.4g} %, std {meta.get('std_estimator', '?')}"
+        + (
+            f", pruned {len(meta['pruned'])} above {meta['max_std_percent']:g} %"
+            if meta.get("pruned")
+            else ""
+        ),
+        f"{'#':>3}  {'name':<7} {'value':>13} {'std %':>9}  kept  expression",
+    ]
+    rows = []
+    for k in range(model.base.rank):
+        e = model.base.expressions[k]
+        e = e if len(e) <= width else e[: width - 3] + "..."
+        pct = fit.std_percent[k]
+        rows.append(
+            f"{k + 1:>3}  {model.base.labels[k]:<7} {fit.beta[k]:>+13.6g} "
+            f"{'-' if not np.isfinite(pct) else f'{pct:.3g}':>9}  "
+            f"{'yes' if fit.kept[k] else 'no':<4}  {e}"
+        )
+    return "\n".join(head + rows)
+
+
+def demo_stage(out_dir: Path, seed: int) -> dict[str, Any]:
+    """Static identification of the simulated Panda, for ``dynid demo``.
+
+    Acquires 1010 configurations from the simulated controller with relative noise
+    :data:`DEMO_RELATIVE_NOISE`, identifies, writes ``out_dir/static.csv`` and
+    ``out_dir/identification.json``, prints the summary and returns the key numbers:
+    ``rank``, ``condition_number``, ``relative_error_percent``, ``n_configurations``,
+    ``dropped_rows``, ``max_abs_error`` (largest |beta - beta_true|, SI) and
+    ``max_error_in_std`` (largest |beta - beta_true| / std), plus the two paths.
+    """
+    out_dir = Path(out_dir)
+    out_dir.mkdir(parents=True, exist_ok=True)
+    robot = panda()
+    rng_q, rng_noise = streams(seed)
+    controller = SimulatedController(robot, DEMO_RELATIVE_NOISE, rng=rng_noise)
+    data = acquire_static(controller, 1010, rng_q).with_metadata(seed=seed)
+    data_path = save_static_data(out_dir / "static.csv", data)
+    model = identify_static(robot, data)
+    model_path = save_model_json(out_dir / "identification.json", model, seed=seed)
+    print(format_summary(model))
+    err = np.abs(model.beta - model.base.beta_from_phi(robot.phi))
+    return {
+        "n_configurations": data.n_configurations,
+        "rank": model.fit.rank,
+        "condition_number": model.fit.condition_number,
+        "relative_error_percent": model.fit.relative_error_percent,
+        "dropped_rows": list(model.metadata["dropped_rows"]),
+        "max_abs_error": float(err.max()),
+        "max_error_in_std": float(np.max(err / model.fit.std)),
+        "relative_noise": DEMO_RELATIVE_NOISE,
+        "data": str(data_path),
+        "model": str(model_path),
+    }

@@ -1,0 +1,149 @@
+"""Simulate a torque log: the robot follows a trajectory, torque sensors read with noise.
+
+Trajectories:
+  sinusoid  velocity-mode sinusoids dq_i = A_i sin(2 pi t / T_i) (Gaz et al. 2019, eq. 31;
+            default A, T of their Table I for 7 joints), started so that each sweep is
+            centred in its joint range
+  fourier   a seeded random finite Fourier series (Swevers et al. 1997) inside the limits
+
+The measured torques are M ddq + c + g + friction(dq) + noise, with the robot's own
+friction (the published sigmoid for the built-in Panda) unless --no-friction. Limits are
+checked; by default a trajectory that exceeds them is scaled down in amplitude
+(--scale amplitude), or slowed down (--scale time), or kept (--scale none).
+
+Example:
+  dynid simulate --robot panda --trajectory sinusoid --duration 20 --seed 1 --out traj.csv
+"""
+
+from __future__ import annotations
+
+import argparse
+import logging
+from pathlib import Path
+
+import numpy as np
+
+from ..exceptions import DynidError
+from ..io.torque_log import write_torque_log
+from ..kinematics.trajectories import (
+    GAZ2019_SINUSOID_AMPLITUDES,
+    GAZ2019_SINUSOID_PERIODS,
+    centered_start,
+    check_limits,
+    random_fourier,
+    scale_into_limits,
+    sinusoid_trajectory,
+)
+from ..simulation.measurement import SensorNoise, sample_times, simulate_measurement
+from .common import add_robot_options, load_robot, parse_vector
+
+NAME = "simulate"
+log = logging.getLogger(__name__)
+
+
+def register(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParser:
+    """Add the ``simulate`` subcommand."""
+    p = subparsers.add_parser(
+        NAME,
+        help="simulate a torque log of a trajectory (sinusoids or Fourier series)",
+        description=__doc__,
+        formatter_class=argparse.RawDescriptionHelpFormatter,
+    )
+    add_robot_options(p)
+    p.add_argument("--trajectory", choices=("sinusoid", "fourier"), default="sinusoid")
+    p.add_argument("--duration", type=float, default=20.0, help="seconds (default 20)")
+    p.add_argument("--rate", type=float, default=1000.0, help="sample rate [Hz] (default 1000)")
+    p.add_argument(
+        "--noise", type=float, default=0.05, help="torque sensor noise std [N m] (default 0.05)"
+    )
+    p.add_argument("--q-noise", type=float, default=1e-4, help="position noise std [rad]")
+    p.add_argument("--dq-noise", type=float, default=1e-3, help="velocity noise std [rad/s]")
+    p.add_argument("--jitter", type=float, default=0.0, help="timestamp jitter std [s] (default 0)")
+    p.add_argument(
+        "--drop", type=float, default=0.0, help="fraction of samples dropped at random (default 0)"
+    )
+    p.add_argument("--no-friction", action="store_true", help="simulate without joint friction")
+    p.add_argument(
+        "--scale",
+        choices=("amplitude", "time", "none"),
+        default="amplitude",
+        help="how to bring the trajectory into the limits (default amplitude)",
+    )
+    p.add_argument(
+        "--amplitudes",
+        default=None,
+        help="sinusoid amplitudes A_i [rad/s], comma-separated (default: Table I)",
+    )
+    p.add_argument(
+        "--periods",
+        default=None,
+        help="sinusoid periods T_i [s], comma-separated (default: Table I)",
+    )
+    p.add_argument("--q0", default=None, help="start (sinusoid) or offset (fourier) [rad]")
+    p.add_argument("--harmonics", type=int, default=5, help="Fourier harmonics L (default 5)")
+    p.add_argument(
+        "--base-freq", type=float, default=0.1, help="Fourier base frequency [Hz] (default 0.1)"
+    )
+    p.add_argument("--with-ddq", action="store_true", help="also write the true accelerations")
+    p.add_argument("--seed", type=int, default=0, help="random seed (default 0)")
+    p.add_argument("--out", required=True, type=Path, help="output .csv or .npz")
+    return p
+
+
+def run(args: argparse.Namespace) -> int:
+    """Simulate and write the log; prints the limit report and a summary (unless -q)."""
+    say = (lambda *a: None) if getattr(args, "quiet", False) else print
+    robot = load_robot(args)
+    n = robot.n
+    rng = np.random.default_rng(args.seed)
+    t = sample_times(args.duration, args.rate, jitter_std=args.jitter, rng=rng)
+    q0 = None if args.q0 is None else parse_vector(args.q0, "--q0", n)
+    if args.trajectory == "sinusoid":
+        if n != len(GAZ2019_SINUSOID_AMPLITUDES) and (
+            args.amplitudes is None or args.periods is None
+        ):
+            raise DynidError(
+                f"the default sinusoids are for 7 joints; robot {robot.name!r} has {n}: "
+                "give --amplitudes and --periods"
+            )
+        A = (
+            GAZ2019_SINUSOID_AMPLITUDES
+            if args.amplitudes is None
+            else parse_vector(args.amplitudes, "--amplitudes", n)
+        )
+        T = (
+            GAZ2019_SINUSOID_PERIODS
+            if args.periods is None
+            else parse_vector(args.periods, "--periods", n)
+        )
+        start = centered_start(robot, A, T) if q0 is None else q0
+        traj = sinusoid_trajectory(t, start, A, T)
+    else:
+        series = random_fourier(
+            robot, rng, n_harmonics=args.harmonics, w_f=2 * np.pi * args.base_freq, q0=q0
+        )
+        traj = series(t)
+    report = check_limits(robot, traj)
+    if not report.ok:
+        say(f"limits exceeded by the {args.trajectory} trajectory:\n{report}")
+        if args.scale != "none":
+            traj, factor = scale_into_limits(robot, traj, method=args.scale)
+            what = "amplitude scaled by" if args.scale == "amplitude" else "time stretched by"
+            say(f"{what} {factor:.4f}; now: {check_limits(robot, traj)}")
+    noise = SensorNoise(tau_std=args.noise, q_std=args.q_noise, dq_std=args.dq_noise)
+    measured = simulate_measurement(
+        robot,
+        traj,
+        rng=rng,
+        noise=noise,
+        friction=None if args.no_friction else "robot",
+        drop_fraction=args.drop,
+        with_ddq=args.with_ddq,
+    )
+    args.out.parent.mkdir(parents=True, exist_ok=True)
+    write_torque_log(args.out, measured)
+    say(
+        f"wrote {args.out}: {measured.n_samples} samples, {measured.duration:.2f} s, "
+        f"{n} joints, torque noise {args.noise:g} N m, seed {args.seed}"
+    )
+    return 0

@@ -1,0 +1,120 @@
+"""Validate a dynamic model against a measured torque log (Gaz et al. 2019, Sec. VI).
+
+The model's torques M ddq + c + g, without and with friction, are compared with the
+measured ones, per joint (RMS, MSE) and overall (relative error). Model sources:
+
+  --model identification.json   an identified model (its classical friction, if it has
+                                one, is used unless --friction or --no-friction)
+  --robot ROBOT                 a robot's own link parameters and friction ('panda': the
+                                published feasible parameters and sigmoid friction)
+
+--friction friction.json replaces the model's own friction. The states are low-pass
+filtered with zero phase (--cutoff), the accelerations differentiated from the filtered
+velocities; the measured torques are compared unfiltered.
+
+Writes OUT/validation.json {"rms": [...], "mse": [...], "relative_error_percent": x, ...}
+(for the full model, plus a "without_friction" block) and the figures
+OUT/validation_torques.png and OUT/validation_rms.png.
+
+Example:
+  dynid validate --robot panda --data traj.csv --out out/validation
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+from pathlib import Path
+
+from ..exceptions import DynidError
+from ..friction.validation import own_friction, validate
+from ..identification.log import DEFAULT_CUTOFF_HZ
+from ..identification.model import IdentifiedModel
+from ..io.friction_json import read_friction_json
+from ..io.torque_log import read_torque_log
+from ..model.robot import Robot
+from .common import load_robot
+from .friction import format_rms_table, save_validation_figures
+
+NAME = "validate"
+
+
+def register(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParser:
+    """Add the ``validate`` subcommand."""
+    p = subparsers.add_parser(
+        NAME,
+        help="compare a model's torques (without and with friction) with a measured log",
+        description=__doc__,
+        formatter_class=argparse.RawDescriptionHelpFormatter,
+    )
+    src = p.add_mutually_exclusive_group(required=True)
+    src.add_argument("--model", type=Path, help="identification.json of an identified model")
+    src.add_argument("--robot", help="'panda', a .urdf or a .toml: the robot's own parameters")
+    # A third source, --params feasible.json (feasible standard parameters), is added to
+    # this group here, with a branch in load_model_source below.
+    p.add_argument("--base", default=None, help="URDF base link (with --robot)")
+    p.add_argument("--tip", default=None, help="URDF tip link (with --robot)")
+    fr = p.add_mutually_exclusive_group()
+    fr.add_argument("--friction", type=Path, help="friction.json to add to the model")
+    fr.add_argument("--no-friction", action="store_true", help="ignore the model's own friction")
+    p.add_argument("--data", type=Path, required=True, help="torque log (.csv or .npz)")
+    p.add_argument("--out", type=Path, required=True, help="output directory")
+    p.add_argument(
+        "--cutoff",
+        type=float,
+        default=DEFAULT_CUTOFF_HZ,
+        help=f"low-pass cutoff of the states [Hz] (default {DEFAULT_CUTOFF_HZ:g})",
+    )
+    p.add_argument("--no-figures", action="store_true", help="skip the PNG figures")
+    return p
+
+
+def load_model_source(args: argparse.Namespace) -> tuple[IdentifiedModel | Robot, str]:
+    """The rigid-body model and a label, from --model or --robot (or --params later)."""
+    if args.model is not None:
+        from ..io.model_json import load_model_json
+
+        return load_model_json(args.model), str(args.model.name)
+    if args.robot is not None:
+        return load_robot(args), f"robot {args.robot}"
+    # --params feasible.json: a Robot with the feasible standard parameters goes here.
+    raise DynidError("give one model source: --model identification.json or --robot ROBOT")
+
+
+def run(args: argparse.Namespace) -> int:
+    """Validate, write validation.json and the figures, print the RMS table (unless -q)."""
+    say = (lambda *a: None) if getattr(args, "quiet", False) else print
+    model, label = load_model_source(args)
+    log = read_torque_log(args.data)
+    if args.friction is not None:
+        friction = read_friction_json(args.friction)
+    elif args.no_friction:
+        friction = None
+    else:
+        friction = own_friction(model)
+    val = validate(model, log, friction=friction, cutoff_hz=args.cutoff)
+    args.out.mkdir(parents=True, exist_ok=True)
+    doc = val.as_dict()
+    doc["model"] = label
+    doc["friction_source"] = (
+        str(args.friction.name)
+        if args.friction is not None
+        else ("model" if friction is not None else None)
+    )
+    doc["data"] = str(args.data.name)
+    doc["cutoff_hz"] = args.cutoff
+    doc["units"] = {"rms": "N m", "mse": "N^2 m^2", "relative_error_percent": "%"}
+    (args.out / "validation.json").write_text(json.dumps(doc, indent=2) + "\n")
+    robot = model.robot if isinstance(model, IdentifiedModel) else model
+    names = list(robot.joint_names)
+    if not args.no_figures:
+        save_validation_figures(args.out, val, names=names, title=f"{label} on {args.data.name}")
+    cols = {"RMS no friction [N m]": val.without_friction.rms}
+    if val.with_friction is not None:
+        cols["RMS + friction [N m]"] = val.with_friction.rms
+    say(format_rms_table(names, cols))
+    say(
+        f"relative error {val.errors.relative_error_percent:.3f} %; "
+        f"wrote {args.out / 'validation.json'}"
+    )
+    return 0

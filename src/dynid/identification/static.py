@@ -1,0 +1,302 @@
+"""Identification of the dynamic coefficients from ``M(q)`` and ``g(q)`` at static configurations.
+
+Gaz et al. 2019, Sec. IV-A ("reverse engineering" of the controller's model library): at
+each of ``N`` configurations the inertia matrix and the gravity torques are linear in the
+base parameters ``beta``,
+
+.. math:: s(q_s) = \\begin{bmatrix} \\mathrm{tril}\\, M(q_s) \\\\ g(q_s) \\end{bmatrix}
+          = Y_b(q_s) \\, \\beta \\quad \\text{(eqs. 17-19)}
+
+and stacking the configurations gives the overdetermined system of eq. 20,
+``W beta = y``, solved by least squares (eq. 21; :mod:`dynid.identification.least_squares`).
+The rows of ``s(q)`` are ordered as :func:`dynid.regressors.static.static_labels` (``tril
+M`` by ``np.tril_indices``, then ``g``). Internally the stack is held row-major over (row of
+``s``, configuration) so that ``W`` is column-major for LAPACK without a copy; the order of
+the rows does not change a least-squares solution or its statistics.
+
+Rows that carry no information about ``beta`` for this robot are found numerically over
+the data set and dropped: a row whose (column-scaled) regressor vanishes at every
+configuration, such as the gravity torque of joint 1 when gravity is along the joint-1
+axis (``g1`` of the Panda). Keeping them would add equations ``0 = 0`` that lower the
+residual variance estimate. Their labels are recorded in the model's metadata.
+
+Standard deviations are by default the heteroscedasticity-consistent ones
+(``std_estimator="robust"``): the stacked vector mixes kg m^2 and N m and a controller's
+errors scale with each entry, so the paper's single-variance formula
+(``std_estimator="classical"``) misstates them (see :func:`identify_static`).
+
+:func:`basis_transform` and :func:`coefficients_in_basis` express identified coefficients
+in another basis defined on the standard parameters, e.g. the 43 expressions printed by
+Gaz et al. (supplementary Table III).
+"""
+
+from __future__ import annotations
+
+import logging
+import warnings
+from typing import Any
+
+import numpy as np
+import scipy.linalg
+from numpy.typing import ArrayLike, NDArray
+
+from .. import _checks
+from ..exceptions import DynidWarning, RankDeficientError, ShapeError
+from ..model.robot import Robot
+from ..regressors.base import BaseParameters, base_parameters
+from ..regressors.static import _static_regressor_samples_last, static_labels
+from .data import StaticDataset
+from .least_squares import fit_with_pruning
+from .model import IdentifiedModel
+
+__all__ = ["identify_static", "informative_static_rows", "basis_transform", "coefficients_in_basis"]
+
+_log = logging.getLogger(__name__)
+
+#: A dropped row whose data exceed this fraction of the largest |entry| triggers a warning:
+#: the robot says the row is identically zero, the data say otherwise.
+_DROPPED_ROW_DATA_RTOL = 1e-6
+
+
+def informative_static_rows(Y_b: ArrayLike, *, rtol: float = 1e-10) -> NDArray[np.bool_]:
+    """Which rows of the static vector carry information about the base parameters.
+
+    Parameters
+    ----------
+    Y_b : array_like, shape (N, s, r)
+        Base regressor at ``N`` configurations, ``s = n (n + 1) / 2 + n`` rows each.
+    rtol : float
+        A row is uninformative when the norm of its block (over configurations and
+        column-scaled coefficients) is at most ``rtol`` times the largest block norm.
+
+    Returns
+    -------
+    informative : ndarray of bool, shape (s,)
+    """
+    Y = _checks.as_array("Y_b", Y_b)
+    if Y.ndim != 3:
+        raise ShapeError(f"Y_b must have shape (N, s, r); got {Y.shape}")
+    return _informative(np.einsum("bkj,bkj->jk", Y, Y), rtol)
+
+
+def _informative(ss: NDArray[np.float64], rtol: float) -> NDArray[np.bool_]:
+    """Rows with information from the sums of squares ``ss[j, k]`` of coefficient j, row k."""
+    col = ss.sum(axis=1)
+    block = np.sqrt(np.sum(ss / np.where(col > 0, col, 1.0)[:, None], axis=0))
+    return block > rtol * float(np.max(block, initial=0.0))
+
+
+def identify_static(
+    robot: Robot,
+    data: StaticDataset,
+    *,
+    max_std_percent: float | None = None,
+    rtol: float = 1e-10,
+    base: BaseParameters | None = None,
+    std_estimator: str = "robust",
+) -> IdentifiedModel:
+    """Identify the base parameters from inertia matrices and gravity torques at rest.
+
+    .. math:: \\hat\\beta = \\arg\\min_\\beta \\|W \\beta - y\\|^2, \\quad
+              W = \\begin{bmatrix} Y_b(q_1) \\\\ \\vdots \\\\ Y_b(q_N) \\end{bmatrix},\\;
+              y = \\begin{bmatrix} s(q_1) \\\\ \\vdots \\\\ s(q_N) \\end{bmatrix}
+              \\quad \\text{(Gaz et al. 2019, eqs. 20-21)}
+
+    Parameters
+    ----------
+    robot : Robot
+        Kinematics and gravity vector the data were recorded with; its inertial
+        parameters are not used.
+    data : StaticDataset
+        ``q`` (N, n) [rad], ``M`` (N, n, n) [kg m^2], ``g`` (N, n) [N m].
+    max_std_percent : float, optional
+        Remove the coefficients whose relative standard deviation exceeds this (the paper
+        used 30 %) and re-fit the rest (one pass); removed coefficients are 0.
+    rtol : float
+        Relative rank tolerance (column-scaled R diagonal) of the base parameters and of
+        the fit, and threshold for uninformative rows (:func:`informative_static_rows`).
+    base : BaseParameters, optional
+        The base parameters to identify; default ``base_parameters(robot, rtol=rtol)``
+        (the structural ones, from random configurations).
+    std_estimator : {"robust", "classical"}
+        Standard deviations from the heteroscedasticity-consistent covariance (White 1980,
+        HC1; default) or from ``sigma^2 (W^T W)^{-1}`` (the paper's formula, valid when
+        every row has the same error variance).
+
+    Returns
+    -------
+    IdentifiedModel
+        ``fit`` holds ``beta`` (r,) with std, std %, rank, condition number and relative
+        error (%); ``metadata`` holds ``route="static"``, ``n_configurations``,
+        ``n_rows``, ``dropped_rows`` (labels such as ``"g1"``), ``pruned`` (labels of
+        removed coefficients), ``max_std_percent``, ``std_estimator``, ``rtol`` and the
+        data set's own metadata under ``"data"``.
+
+    Raises
+    ------
+    DataError
+        The data set's joint count differs from the robot's.
+    ShapeError
+        ``base`` was built for a different number of standard parameters.
+    RankDeficientError
+        The stacked regressor has rank below the number of base parameters (too few or
+        too similar configurations); the message gives the rank found and the rank needed.
+    ValueError
+        ``max_std_percent`` not positive, or an unknown ``std_estimator``.
+
+    Warns
+    -----
+    DynidWarning
+        A dropped (identically zero) row holds non-zero data: the gravity vector or the
+        kinematics probably differ from the controller's.
+
+    Notes
+    -----
+    With the Panda, 1010 configurations and noise-free data the fit recovers the
+    coefficients of the generating parameters to round-off; rank 43 after ``g1`` is dropped.
+    """
+    data.check_robot(robot)
+    if max_std_percent is not None and not max_std_percent > 0:
+        raise ValueError(f"max_std_percent must be positive or None; got {max_std_percent}")
+    if std_estimator not in ("robust", "classical"):
+        raise ValueError(f"std_estimator must be 'robust' or 'classical'; got {std_estimator!r}")
+    if base is None:
+        base = base_parameters(robot, kind="static", rtol=rtol)
+    elif base.n_std != 10 * robot.n:
+        raise ShapeError(
+            f"base was built for {base.n_std} standard parameters; robot {robot.name!r} has "
+            f"{10 * robot.n}"
+        )
+    N, n, r = data.n_configurations, robot.n, base.rank
+    labels = static_labels(n)
+    # base regressor with the configurations last: Yb[c, k, b] = coefficient c, row k of
+    # s(q), configuration b (a contiguous gather of the independent columns)
+    Yb = _static_regressor_samples_last(robot, data.q).transpose(1, 0, 2)[base.independent]
+    i, j = np.tril_indices(n)
+    S = np.concatenate([data.M[:, i, j], data.g], axis=1).T  # (s, N), rows as static_labels
+    info = _informative(np.einsum("jkb,jkb->jk", Yb, Yb), rtol)
+    dropped = [labels[k] for k in np.flatnonzero(~info)]
+    if dropped:
+        big = np.max(np.abs(S[~info]))
+        if big > _DROPPED_ROW_DATA_RTOL * np.max(np.abs(S)):
+            warnings.warn(
+                f"rows {dropped} carry no information for robot {robot.name!r} (its regressor "
+                f"is zero there) but the data reach |{big:.3g}|; hint: check the gravity "
+                "vector and the kinematics against the source of the data",
+                DynidWarning,
+                stacklevel=2,
+            )
+        _log.info("dropping rows without information: %s", ", ".join(dropped))
+        Yb = Yb[:, info]
+    # W (m, r) in column-major memory; row k N + b is row k of s at configuration b (the
+    # order of the rows does not change a least-squares fit)
+    W = Yb.reshape(r, -1).T
+    y = S[info].reshape(-1)
+    _log.info("static identification: %d configurations, %d rows, %d base parameters", N, y.size, r)
+    try:
+        fit = fit_with_pruning(
+            W, y, max_std_percent=max_std_percent, rtol=rtol, covariance=std_estimator
+        )
+    except RankDeficientError as exc:
+        rank = _rank(W, rtol)
+        raise RankDeficientError(
+            f"static regressor of {N} configuration(s) ({y.size} rows) has rank {rank} < {r} "
+            f"needed for the base parameters (rtol={rtol:g}); add configurations spread over "
+            "the joint ranges (Gaz et al. 2019 used 1010)"
+        ) from exc
+    pruned = [base.labels[k] for k in np.flatnonzero(~fit.kept)]
+    if pruned:
+        _log.info(
+            "pruned %d coefficient(s) above %g %% std: %s", len(pruned), max_std_percent, pruned
+        )
+    meta: dict[str, Any] = {
+        "route": "static",
+        "reference": "Gaz et al. 2019, Sec. IV-A, eqs. 17-21",
+        "n_configurations": N,
+        "n_rows": int(y.size),
+        "rows_per_configuration": int(info.sum()),
+        "dropped_rows": dropped,
+        "pruned": pruned,
+        "max_std_percent": max_std_percent,
+        "std_estimator": std_estimator,
+        "rtol": rtol,
+        "data": dict(data.metadata),
+    }
+    return IdentifiedModel(robot=robot, base=base, fit=fit, metadata=meta)
+
+
+def _rank(W: NDArray[np.float64], rtol: float) -> int:
+    """Numerical rank of the column-scaled ``W`` (pivoted QR, as the fit decides it)."""
+    norms = np.linalg.norm(W, axis=0)
+    Ws = W / np.where(norms > 0, norms, 1.0)
+    R = scipy.linalg.qr(Ws, mode="r", pivoting=True)[0]
+    d = np.abs(np.diag(R))
+    return int(np.sum(d > rtol * d[0])) if d.size and d[0] > 0 else 0
+
+
+def basis_transform(
+    base: BaseParameters,
+    A: ArrayLike,
+    *,
+    labels: tuple[str, ...] | None = None,
+    rtol: float = 1e-8,
+) -> NDArray[np.float64]:
+    """The matrix ``T`` (k, r) with ``A phi = T beta`` for every standard parameter vector.
+
+    ``A`` defines ``k`` coefficients as linear combinations of the standard parameters
+    (e.g. the 43 expressions of Gaz et al. 2019). They are functions of the base
+    parameters exactly when every row of ``A`` lies in the row space of the base
+    projection ``P`` (``beta = P phi``); then ``T = A P^+``.
+
+    Parameters
+    ----------
+    base : BaseParameters
+    A : array_like, shape (k, p)
+        Coefficients on the standard parameters, columns as ``base.std_labels``.
+    labels : tuple of str, length k, optional
+        Names of the coefficients, used in error messages.
+    rtol : float
+        Tolerance of the row-space test, relative to each row's norm.
+
+    Returns
+    -------
+    T : ndarray, shape (k, r)
+
+    Raises
+    ------
+    ShapeError
+        ``A`` not (k, p).
+    RankDeficientError
+        A row of ``A`` is not a combination of the base parameters (it cannot be
+        identified); the message names the first such row and its residual.
+    """
+    A = _checks.as_array("A", A)
+    p = base.n_std
+    if A.ndim != 2 or A.shape[1] != p:
+        raise ShapeError(f"A must have shape (k, {p}); got {A.shape}")
+    P = base.projection
+    T = np.linalg.lstsq(P.T, A.T, rcond=None)[0].T
+    res = np.linalg.norm(T @ P - A, axis=1)
+    scale = np.linalg.norm(A, axis=1)
+    bad = np.flatnonzero(res > rtol * np.maximum(scale, np.finfo(float).tiny))
+    if bad.size:
+        k = int(bad[0])
+        name = f" ({labels[k]!r})" if labels is not None else ""
+        raise RankDeficientError(
+            f"row {k}{name} of A is not a combination of the base parameters (residual "
+            f"{res[k] / scale[k]:.3g} relative, tolerance {rtol:g}); {bad.size} row(s) in all "
+            "cannot be identified; hint: check the labels' order and the kinematic constants"
+        )
+    return T
+
+
+def coefficients_in_basis(
+    base: BaseParameters, beta: ArrayLike, A: ArrayLike, *, rtol: float = 1e-8
+) -> NDArray[np.float64]:
+    """Values of the coefficients ``A phi`` from base parameters ``beta``: (..., r) -> (..., k).
+
+    See :func:`basis_transform` (which raises when ``A`` is not identifiable).
+    """
+    b = _checks.as_batch("beta", beta, (base.rank,))
+    T = basis_transform(base, A, rtol=rtol)
+    return b @ T.T

@@ -1,0 +1,248 @@
+"""An identified model to and from JSON, with the kinematics it is valid for.
+
+Layout of the file (top-level keys)::
+
+    schema, dynid_version, route, seed,
+    rank, condition_number, relative_error_percent, residual_rms, sigma, n_rows, rtol,
+    dropped_rows, pruned, std_estimator,
+    coefficients: [{"name", "expression", "value", "std", "std_percent", "kept"}, ...],
+    base: {"std_labels", "independent", "dependent", "K_d", "rank", "rtol"},
+    friction: null or (n, 3) linear friction [fv N m s/rad, fc N m, fo N m],
+    robot: the kinematics (:mod:`dynid.io.robot_json`),
+    metadata: everything else the identification recorded,
+    units, conventions
+
+``rank`` is the rank of the fit (the kept coefficients; all of them without pruning),
+``base.rank`` the number of base parameters. ``value`` is the identified base parameter
+``beta_k`` in SI units (the unit of its expression: kg, kg m or kg m^2); ``std`` its
+standard deviation, ``std_percent`` ``100 std / |value|`` (``null`` when undefined:
+removed coefficients); ``kept`` is false for coefficients removed by pruning (their value
+is 0). ``expression`` writes the coefficient in the standard parameters (``m<i>`` kg,
+``mc<i>x`` kg m, ``J<i>xx`` kg m^2 about the link origin, link axes).
+
+Floats are written with Python's shortest round-trip representation, so
+:func:`load_model_json` rebuilds a model whose predictions are bit-identical.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+from collections.abc import Mapping
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from .. import __version__, _checks
+from ..exceptions import DataError
+from ..identification.least_squares import LeastSquaresFit
+from ..identification.model import IdentifiedModel
+from ..regressors.base import BaseParameters
+from .robot_json import robot_from_dict, robot_to_dict
+
+__all__ = ["MODEL_SCHEMA", "model_to_dict", "model_from_dict", "save_model_json", "load_model_json"]
+
+MODEL_SCHEMA = "dynid-identified-model/1"
+
+_FIT_SCALARS = (
+    "rank",
+    "condition_number",
+    "relative_error_percent",
+    "residual_rms",
+    "sigma",
+    "n_rows",
+    "rtol",
+)
+
+
+def _num(x: float) -> float | None:
+    """A JSON number, or None for NaN/inf (JSON has neither)."""
+    x = float(x)
+    return x if math.isfinite(x) else None
+
+
+def _jsonable(x: Any) -> Any:
+    if isinstance(x, Mapping):
+        return {str(k): _jsonable(v) for k, v in x.items()}
+    if isinstance(x, (list, tuple)):
+        return [_jsonable(v) for v in x]
+    if isinstance(x, np.ndarray):
+        return _jsonable(x.tolist())
+    if isinstance(x, (bool, np.bool_)):
+        return bool(x)
+    if isinstance(x, (int, np.integer)):
+        return int(x)
+    if isinstance(x, (float, np.floating)):
+        return _num(x)
+    if x is None or isinstance(x, str):
+        return x
+    return str(x)
+
+
+def model_to_dict(model: IdentifiedModel, *, seed: int | None = None) -> dict[str, Any]:
+    """The JSON-ready dictionary of an identified model (layout in the module docstring).
+
+    ``seed`` defaults to ``model.metadata["seed"]`` or the data set's recorded seed.
+    """
+    fit, base, meta = model.fit, model.base, dict(model.metadata)
+    if seed is None:
+        seed = meta.get("seed", dict(meta.get("data", {})).get("seed"))
+    coefficients = [
+        {
+            "name": base.labels[k],
+            "expression": base.expressions[k],
+            "value": float(fit.beta[k]),
+            "std": float(fit.std[k]),
+            "std_percent": _num(fit.std_percent[k]),
+            "kept": bool(fit.kept[k]),
+        }
+        for k in range(base.rank)
+    ]
+    out: dict[str, Any] = {
+        "schema": MODEL_SCHEMA,
+        "dynid_version": __version__,
+        "route": meta.get("route"),
+        "seed": seed,
+    }
+    out.update({k: _jsonable(getattr(fit, k)) for k in _FIT_SCALARS})
+    out["dropped_rows"] = list(meta.get("dropped_rows", []))
+    out["pruned"] = list(meta.get("pruned", []))
+    out["std_estimator"] = meta.get("std_estimator")
+    out["coefficients"] = coefficients
+    out["base"] = {
+        "std_labels": list(base.std_labels),
+        "independent": base.independent.tolist(),
+        "dependent": base.dependent.tolist(),
+        "K_d": base.K_d.tolist(),
+        "rank": base.rank,
+        "rtol": base.rtol,
+    }
+    out["friction"] = None if model.friction is None else model.friction.tolist()
+    out["robot"] = robot_to_dict(model.robot)
+    out["metadata"] = _jsonable(meta)
+    out["units"] = {
+        "value": "SI of each expression: m kg, mc kg m, J kg m^2",
+        "std": "as value",
+        "std_percent": "%",
+        "relative_error_percent": "%",
+        "friction": "fv N m s/rad, fc N m, fo N m",
+    }
+    out["conventions"] = {
+        "standard_parameters": "per link m, mcx, mcy, mcz, Jxx, Jxy, Jxz, Jyy, Jyz, Jzz; J about "
+        "the link origin, link axes",
+        "beta": "beta = phi_b + K_d phi_d (base.independent, base.dependent)",
+        "reference": "Gaz et al. 2019, IEEE RA-L 4(4):4147-4154",
+    }
+    return out
+
+
+def model_from_dict(d: Mapping[str, Any]) -> IdentifiedModel:
+    """Rebuild an :class:`IdentifiedModel` from :func:`model_to_dict` output.
+
+    Raises
+    ------
+    DataError
+        Wrong schema, or a field missing or inconsistent (named in the message).
+    """
+    if d.get("schema") != MODEL_SCHEMA:
+        raise DataError(
+            f"identified model: schema must be {MODEL_SCHEMA!r}; got {d.get('schema')!r}"
+        )
+    try:
+        robot = robot_from_dict(d["robot"])
+        b = d["base"]
+        coefs = d["coefficients"]
+        r = int(b["rank"])
+        if len(coefs) != r:
+            raise DataError(f"identified model: {len(coefs)} coefficients for base rank {r}")
+        K_d = np.asarray(b["K_d"], dtype=np.float64).reshape(r, -1)
+        base = BaseParameters(
+            std_labels=tuple(b["std_labels"]),
+            independent=_frozen(np.asarray(b["independent"], dtype=np.intp)),
+            dependent=_frozen(np.asarray(b["dependent"], dtype=np.intp)),
+            K_d=_frozen(K_d),
+            rank=r,
+            rtol=float(b["rtol"]),
+            labels=tuple(c["name"] for c in coefs),
+            expressions=tuple(c["expression"] for c in coefs),
+        )
+        kept = np.array([bool(c["kept"]) for c in coefs])
+        pct = np.array(
+            [
+                float(c["std_percent"])
+                if c["std_percent"] is not None
+                else (np.inf if c["kept"] else np.nan)
+                for c in coefs
+            ]
+        )
+        fit = LeastSquaresFit(
+            beta=_frozen(np.array([float(c["value"]) for c in coefs])),
+            std=_frozen(np.array([float(c["std"]) for c in coefs])),
+            std_percent=_frozen(pct),
+            kept=_frozen(kept),
+            rank=int(d["rank"]),
+            condition_number=_float(d["condition_number"]),
+            relative_error_percent=_float(d["relative_error_percent"]),
+            residual_rms=_float(d["residual_rms"]),
+            sigma=_float(d["sigma"]),
+            n_rows=int(d["n_rows"]),
+            rtol=float(d["rtol"]),
+        )
+        friction = d.get("friction")
+        metadata = dict(d.get("metadata") or {})
+    except KeyError as exc:
+        raise DataError(f"identified model: missing field {exc.args[0]!r}") from None
+    except (TypeError, ValueError) as exc:
+        if isinstance(exc, DataError):
+            raise
+        raise DataError(f"identified model: malformed field ({exc})") from exc
+    if base.n_std != 10 * robot.n:
+        raise DataError(
+            f"identified model: base has {base.n_std} standard parameters; the robot has "
+            f"{robot.n} joints ({10 * robot.n} parameters)"
+        )
+    return IdentifiedModel(
+        robot=robot,
+        base=base,
+        fit=fit,
+        friction=None if friction is None else _frozen(np.asarray(friction, dtype=np.float64)),
+        metadata=metadata,
+    )
+
+
+def save_model_json(path: str | Path, model: IdentifiedModel, *, seed: int | None = None) -> Path:
+    """Write an identified model as JSON (indented, UTF-8); returns the path."""
+    path = Path(path)
+    text = json.dumps(model_to_dict(model, seed=seed), indent=1, allow_nan=False)
+    path.write_text(text + "\n", encoding="utf-8")
+    return path
+
+
+def load_model_json(path: str | Path) -> IdentifiedModel:
+    """Read an identified model written by :func:`save_model_json`.
+
+    Raises
+    ------
+    DataError
+        Not JSON, or not an identified model (see :func:`model_from_dict`).
+    """
+    path = Path(path)
+    try:
+        d = json.loads(path.read_text(encoding="utf-8"))
+    except (json.JSONDecodeError, UnicodeDecodeError) as exc:
+        raise DataError(f"{path.name}: not a JSON file ({exc})") from exc
+    if not isinstance(d, dict):
+        raise DataError(f"{path.name}: expected a JSON object")
+    try:
+        return model_from_dict(d)
+    except DataError as exc:
+        raise DataError(f"{path.name}: {exc}") from exc
+
+
+def _float(x: Any) -> float:
+    return float("nan") if x is None else float(x)
+
+
+def _frozen(a: np.ndarray) -> np.ndarray:
+    return _checks.frozen(a)

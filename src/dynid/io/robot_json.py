@@ -1,0 +1,100 @@
+"""A robot's kinematic description to and from a JSON-ready dictionary.
+
+Written next to identified coefficients, which are valid only for the kinematics and the
+gravity vector they were identified with. Fields (see :class:`dynid.Robot`): ``name``,
+``joint_names``, ``link_names`` (base first), ``T_parent_joint`` (n, 4, 4) [m],
+``axes`` (n, 3) (unit, link coordinates), ``prismatic`` (n,), ``limits`` (``q_min``,
+``q_max`` [rad or m], ``dq_max`` [rad/s], ``ddq_max`` [rad/s^2], ``tau_max`` [N m]; ``null``
+where there is no limit), ``gravity`` (3,) [m/s^2] in the base frame, and ``frames``
+(name -> ``{"link": index, "T_link_frame": 4x4}``).
+
+Inertial parameters and friction are not written: a robot read back has zero standard
+parameters and no friction model. Floats are written with Python's shortest round-trip
+representation, so the kinematics read back are bit-identical.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping
+from typing import Any
+
+import numpy as np
+
+from ..exceptions import DataError, ModelError, ShapeError
+from ..model.robot import Frame, Robot
+
+__all__ = ["robot_to_dict", "robot_from_dict", "ROBOT_SCHEMA"]
+
+ROBOT_SCHEMA = "dynid-robot-kinematics/1"
+_LIMITS = ("q_min", "q_max", "dq_max", "ddq_max", "tau_max")
+
+
+def _finite_or_none(v: np.ndarray) -> list[float | None]:
+    return [float(x) if np.isfinite(x) else None for x in v]
+
+
+def robot_to_dict(robot: Robot) -> dict[str, Any]:
+    """The kinematic fields of a robot as a JSON-ready dictionary (no inertial parameters)."""
+    return {
+        "schema": ROBOT_SCHEMA,
+        "name": robot.name,
+        "joint_names": list(robot.joint_names),
+        "link_names": list(robot.link_names),
+        "T_parent_joint": robot.T_parent_joint.tolist(),
+        "axes": robot.axes.tolist(),
+        "prismatic": [bool(p) for p in robot.prismatic],
+        "limits": {k: _finite_or_none(getattr(robot, k)) for k in _LIMITS},
+        "gravity": robot.gravity.tolist(),
+        "frames": {
+            name: {"link": int(f.link), "T_link_frame": f.T_link_frame.tolist()}
+            for name, f in robot.frames.items()
+        },
+        "units": {
+            "T_parent_joint": "m",
+            "q_min/q_max": "rad (m if prismatic)",
+            "dq_max": "rad/s",
+            "ddq_max": "rad/s^2",
+            "tau_max": "N m",
+            "gravity": "m/s^2, base frame",
+        },
+    }
+
+
+def robot_from_dict(d: Mapping[str, Any]) -> Robot:
+    """A robot (zero inertial parameters, no friction) from :func:`robot_to_dict` output.
+
+    Raises
+    ------
+    DataError
+        A field is missing or malformed (named in the message).
+    """
+    try:
+        n = len(d["joint_names"])
+        limits = d["limits"]
+        sign = {"q_min": -1.0}
+        lim = {
+            k: np.array([sign.get(k, 1.0) * np.inf if v is None else float(v) for v in limits[k]])
+            for k in _LIMITS
+        }
+        frames = {
+            str(name): Frame(int(f["link"]), np.asarray(f["T_link_frame"], dtype=np.float64))
+            for name, f in d["frames"].items()
+        }
+        return Robot(
+            name=str(d["name"]),
+            joint_names=tuple(d["joint_names"]),
+            link_names=tuple(d["link_names"]),
+            T_parent_joint=np.asarray(d["T_parent_joint"], dtype=np.float64),
+            axes=np.asarray(d["axes"], dtype=np.float64),
+            prismatic=np.asarray(d["prismatic"], dtype=bool),
+            phi=np.zeros((n, 10)),
+            gravity=np.asarray(d["gravity"], dtype=np.float64),
+            frames=frames,
+            **lim,
+        )
+    except KeyError as exc:
+        raise DataError(f"robot description: missing field {exc.args[0]!r}") from None
+    except (TypeError, ValueError, AttributeError) as exc:
+        if isinstance(exc, (ModelError, ShapeError)):
+            raise DataError(f"robot description: {exc}") from exc
+        raise DataError(f"robot description: malformed field ({exc})") from exc

@@ -1,0 +1,357 @@
+"""Static data sets (``q``, ``M(q)``, ``g(q)`` at rest) to and from CSV and NPZ files.
+
+CSV: one row per configuration. Leading lines starting with ``#`` are comments; the first
+states the units, an optional ``# metadata: {...}`` line holds the data set's metadata as
+JSON. Then a header and the rows. Columns (any order when read):
+
+* ``q1 .. qn``: joint positions [rad] (m for a prismatic joint);
+* ``M<i>_<j>`` for ``i >= j`` (1-based): the lower triangle of the inertia matrix
+  [kg m^2] (kg m or kg in prismatic rows and columns), written in ``np.tril_indices``
+  order (``M1_1, M2_1, M2_2, M3_1, ...``); the upper triangle follows by symmetry;
+* ``g1 .. gn``: gravity torques [N m] (N).
+
+NPZ: arrays ``q`` (N, n), ``M`` (N, n, n), ``g`` (N, n) and optionally ``metadata`` (a
+JSON string); read with ``allow_pickle=False``.
+
+Loading checks everything and raises :class:`~dynid.exceptions.DataError` naming the
+column, key, line or row: missing or extra columns (keys), duplicated columns, cells that
+are not numbers, NaN or inf, a non-symmetric ``M`` (NPZ), a joint count different from the
+robot's. With ``drop_invalid=True`` rows with bad values are dropped instead, logged with
+their count, and the count is returned (structural problems still raise).
+"""
+
+from __future__ import annotations
+
+import json
+import logging
+import re
+import zipfile
+from collections.abc import Mapping
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+from numpy.typing import NDArray
+
+from ..exceptions import DataError
+from ..identification.data import DEFAULT_SYMMETRY_RTOL, StaticDataset
+from ..model.robot import Robot
+from ..regressors.static import static_labels
+
+__all__ = [
+    "static_columns",
+    "save_static_data",
+    "load_static_data",
+    "save_static_csv",
+    "load_static_csv",
+    "save_static_npz",
+    "load_static_npz",
+]
+
+_log = logging.getLogger(__name__)
+
+UNITS_LINE = (
+    "# dynid static data set, one row per configuration: q<i> [rad] (m if prismatic), "
+    "M<i>_<j> lower triangle (i >= j, 1-based) of M [kg m^2], g<i> [N m]"
+)
+_META_PREFIX = "# metadata:"
+_NPZ_KEYS = ("q", "M", "g")
+
+
+def static_columns(n: int) -> tuple[str, ...]:
+    """Column names for ``n`` joints: ``q1..qn``, ``M1_1, M2_1, M2_2, ...``, ``g1..gn``."""
+    return tuple(f"q{k}" for k in range(1, n + 1)) + static_labels(n)
+
+
+# ---------------------------------------------------------------------------- dispatch
+def save_static_data(path: str | Path, data: StaticDataset) -> Path:
+    """Write a data set to ``.csv`` or ``.npz`` (by the extension); returns the path."""
+    path = Path(path)
+    suffix = path.suffix.lower()
+    if suffix == ".csv":
+        return save_static_csv(path, data)
+    if suffix == ".npz":
+        return save_static_npz(path, data)
+    raise DataError(f"static data file must end in .csv or .npz; got {path.name!r}")
+
+
+def load_static_data(
+    path: str | Path, robot: Robot | None = None, *, drop_invalid: bool = False
+) -> tuple[StaticDataset, int]:
+    """Read a ``.csv`` or ``.npz`` static data set; see :func:`load_static_csv`."""
+    path = Path(path)
+    suffix = path.suffix.lower()
+    if suffix == ".csv":
+        return load_static_csv(path, robot, drop_invalid=drop_invalid)
+    if suffix == ".npz":
+        return load_static_npz(path, robot, drop_invalid=drop_invalid)
+    raise DataError(f"static data file must end in .csv or .npz; got {path.name!r}")
+
+
+# ---------------------------------------------------------------------------- CSV
+def save_static_csv(path: str | Path, data: StaticDataset) -> Path:
+    """Write a data set as CSV (full float64 precision, ``%.17g``); returns the path."""
+    path = Path(path)
+    n = data.n
+    i, j = np.tril_indices(n)
+    table = np.concatenate([data.q, data.M[:, i, j], data.g], axis=1)
+    header = ",".join(static_columns(n))
+    lines = [UNITS_LINE]
+    if data.metadata:
+        lines.append(f"{_META_PREFIX} {json.dumps(dict(data.metadata), default=_jsonable)}")
+    with path.open("w", encoding="utf-8", newline="\n") as fh:
+        fh.write("\n".join(lines) + "\n" + header + "\n")
+        np.savetxt(fh, table, fmt="%.17g", delimiter=",")
+    return path
+
+
+def load_static_csv(
+    path: str | Path, robot: Robot | None = None, *, drop_invalid: bool = False
+) -> tuple[StaticDataset, int]:
+    """Read a static data set from CSV.
+
+    Parameters
+    ----------
+    path : str or Path
+    robot : Robot, optional
+        When given, the file must have ``robot.n`` joints.
+    drop_invalid : bool
+        Drop rows with a wrong cell count, a cell that is not a number, NaN or inf
+        (logged, counted) instead of raising.
+
+    Returns
+    -------
+    data : StaticDataset
+        ``q`` (N, n) [rad], ``M`` (N, n, n) [kg m^2] (symmetric), ``g`` (N, n) [N m];
+        metadata from the file plus ``file`` (its name) and ``dropped_invalid_rows``.
+    n_dropped : int
+        Rows dropped (0 unless ``drop_invalid``).
+
+    Raises
+    ------
+    DataError
+        No header, duplicated, missing or extra columns (named), a joint count different
+        from the robot's, a bad row (its line number and column) unless ``drop_invalid``,
+        or no valid row at all.
+    """
+    path = Path(path)
+    try:
+        text = path.read_text(encoding="utf-8")
+    except UnicodeDecodeError as exc:
+        raise DataError(f"{path.name}: not a UTF-8 text file ({exc.reason})") from exc
+    meta: dict[str, Any] = {}
+    header: list[str] | None = None
+    header_line = 0
+    rows: list[tuple[int, list[str]]] = []
+    for lineno, raw in enumerate(text.splitlines(), start=1):
+        line = raw.strip()
+        if not line:
+            continue
+        if line.startswith("#"):
+            if header is None and line.startswith(_META_PREFIX):
+                meta = _parse_meta(path, f"line {lineno}", line[len(_META_PREFIX) :])
+            continue
+        cells = [c.strip() for c in line.split(",")]
+        if header is None:
+            header, header_line = cells, lineno
+        else:
+            rows.append((lineno, cells))
+    if header is None:
+        raise DataError(f"{path.name}: no header line; expected columns {_expected_hint(robot)}")
+    n = _check_columns(path, header, header_line, robot)
+    cols = static_columns(n)
+    where = {name: header.index(name) for name in cols}
+    order = np.array([where[c] for c in cols])
+    good: list[list[float]] = []
+    bad: list[str] = []
+    for lineno, cells in rows:
+        reason = None
+        if len(cells) != len(header):
+            reason = f"has {len(cells)} cells, the header {len(header)}"
+            values = None
+        else:
+            values = []
+            for k in order:
+                try:
+                    v = float(cells[k])
+                except ValueError:
+                    reason = f"column {header[k]!r}: {cells[k]!r} is not a number"
+                    break
+                if not np.isfinite(v):
+                    reason = f"column {header[k]!r} holds {cells[k]}"
+                    break
+                values.append(v)
+        if reason is not None:
+            msg = f"line {lineno} (row {len(good) + len(bad)}) {reason}"
+            if not drop_invalid:
+                raise DataError(
+                    f"{path.name}: {msg}; hint: fix the file or load with drop_invalid=True"
+                )
+            bad.append(msg)
+            continue
+        assert values is not None
+        good.append(values)
+    table = np.array(good, dtype=np.float64).reshape(len(good), len(cols))
+    return _finish(path, table, n, meta, bad)
+
+
+def _check_columns(path: Path, header: list[str], line: int, robot: Robot | None) -> int:
+    """Validate the header; return the joint count."""
+    dup = sorted({c for c in header if header.count(c) > 1})
+    if dup:
+        raise DataError(f"{path.name}: line {line}: duplicated columns {dup}")
+    qcols = [c for c in header if re.fullmatch(r"q[1-9]\d*", c)]
+    if not qcols:
+        raise DataError(
+            f"{path.name}: line {line}: no joint position columns q1..qn; got columns "
+            f"{header[:8]}{' ...' if len(header) > 8 else ''}"
+        )
+    n_file = max(int(c[1:]) for c in qcols)
+    n = robot.n if robot is not None else n_file
+    if robot is not None and n_file != robot.n:
+        raise DataError(
+            f"{path.name}: data for {n_file} joints (columns q1..q{n_file}); robot "
+            f"{robot.name!r} has {robot.n}; hint: pass the robot the data were recorded with"
+        )
+    expected = static_columns(n)
+    missing = [c for c in expected if c not in header]
+    extra = [c for c in header if c not in expected]
+    if missing:
+        raise DataError(
+            f"{path.name}: line {line}: missing columns {missing}; expected q1..q{n}, "
+            f"M<i>_<j> (i >= j) and g1..g{n}"
+        )
+    if extra:
+        raise DataError(
+            f"{path.name}: line {line}: unexpected columns {extra}; expected q1..q{n}, "
+            f"M<i>_<j> (i >= j) and g1..g{n} only"
+        )
+    return n
+
+
+def _parse_meta(path: Path, where: str, text: str) -> dict[str, Any]:
+    try:
+        meta = json.loads(text)
+    except json.JSONDecodeError as exc:
+        raise DataError(f"{path.name}: {where}: metadata is not valid JSON ({exc.msg})") from exc
+    if not isinstance(meta, dict):
+        raise DataError(f"{path.name}: {where}: metadata must be a JSON object")
+    return meta
+
+
+def _expected_hint(robot: Robot | None) -> str:
+    n = "n" if robot is None else str(robot.n)
+    return f"q1..q{n}, M<i>_<j> (i >= j), g1..g{n}"
+
+
+# ---------------------------------------------------------------------------- NPZ
+def save_static_npz(path: str | Path, data: StaticDataset) -> Path:
+    """Write a data set as NPZ (``q``, ``M``, ``g``, ``metadata`` as JSON); returns the path."""
+    path = Path(path)
+    meta = json.dumps(dict(data.metadata), default=_jsonable)
+    with path.open("wb") as fh:
+        np.savez(fh, q=data.q, M=data.M, g=data.g, metadata=np.array(meta))
+    return path
+
+
+def load_static_npz(
+    path: str | Path, robot: Robot | None = None, *, drop_invalid: bool = False
+) -> tuple[StaticDataset, int]:
+    """Read a static data set from NPZ (``allow_pickle=False``).
+
+    Same parameters, returns and errors as :func:`load_static_csv`; rows with NaN or inf
+    or a non-symmetric ``M`` are the droppable ones. Missing or extra keys, or arrays of
+    the wrong shape, raise :class:`DataError` naming the key.
+    """
+    path = Path(path)
+    try:
+        with np.load(path, allow_pickle=False) as z:
+            keys = set(z.files)
+            missing = [k for k in _NPZ_KEYS if k not in keys]
+            extra = sorted(keys - set(_NPZ_KEYS) - {"metadata"})
+            if missing:
+                raise DataError(f"{path.name}: missing arrays {missing}; expected q, M, g")
+            if extra:
+                raise DataError(
+                    f"{path.name}: unexpected arrays {extra}; expected q, M, g (and metadata)"
+                )
+            arrays = {k: np.asarray(z[k]) for k in _NPZ_KEYS}
+            meta_text = str(z["metadata"]) if "metadata" in keys else "{}"
+    except (zipfile.BadZipFile, OSError, ValueError) as exc:
+        if isinstance(exc, DataError):
+            raise
+        raise DataError(f"{path.name}: not a readable NPZ file of arrays ({exc})") from exc
+    for k, a in arrays.items():
+        if not np.issubdtype(a.dtype, np.number):
+            raise DataError(f"{path.name}: array {k!r} must be numeric; got dtype {a.dtype}")
+    q, M, g = (arrays[k].astype(np.float64) for k in _NPZ_KEYS)
+    if q.ndim != 2 or q.shape[0] < 1:
+        raise DataError(f"{path.name}: array 'q' must have shape (N, n); got {q.shape}")
+    N, n = q.shape
+    if robot is not None and n != robot.n:
+        raise DataError(
+            f"{path.name}: data for {n} joints (q of shape {q.shape}); robot {robot.name!r} "
+            f"has {robot.n}; hint: pass the robot the data were recorded with"
+        )
+    if M.shape != (N, n, n):
+        raise DataError(f"{path.name}: array 'M' must have shape {(N, n, n)}; got {M.shape}")
+    if g.shape != (N, n):
+        raise DataError(f"{path.name}: array 'g' must have shape {(N, n)}; got {g.shape}")
+    meta = _parse_meta(path, "array 'metadata'", meta_text)
+    i, j = np.tril_indices(n)
+    bad: list[str] = []
+    ok = np.ones(N, bool)
+    for name, a in (("q", q), ("M", M), ("g", g)):
+        fin = np.isfinite(a.reshape(N, -1)).all(axis=1)
+        for s in np.flatnonzero(ok & ~fin):
+            bad.append(f"row {s}: {name} holds NaN or inf")
+        ok &= fin
+    Mf = np.where(np.isfinite(M), M, 0.0)
+    asym = np.max(np.abs(Mf - np.swapaxes(Mf, 1, 2)), axis=(1, 2))
+    sym = asym <= DEFAULT_SYMMETRY_RTOL * np.max(np.abs(Mf), axis=(1, 2))
+    for s in np.flatnonzero(ok & ~sym):
+        bad.append(f"row {s}: M is not symmetric (max |M - M^T| = {asym[s]:.3g})")
+    ok &= sym
+    if bad and not drop_invalid:
+        first = min(bad, key=lambda b: int(b.split(":")[0].split()[1]))
+        raise DataError(
+            f"{path.name}: {first} ({len(bad)} bad row(s) in all); hint: fix the file or load "
+            "with drop_invalid=True"
+        )
+    table = np.concatenate([q, M[:, i, j], g], axis=1)[ok]
+    return _finish(path, table, n, meta, bad)
+
+
+# ---------------------------------------------------------------------------- common
+def _finish(
+    path: Path, table: NDArray[np.float64], n: int, meta: Mapping[str, Any], bad: list[str]
+) -> tuple[StaticDataset, int]:
+    """Data set from the valid rows ``[q, tril M, g]`` of a file."""
+    if bad:
+        _log.warning(
+            "%s: dropped %d invalid row(s) of %d; first: %s",
+            path.name,
+            len(bad),
+            len(bad) + len(table),
+            bad[0],
+        )
+    if len(table) == 0:
+        raise DataError(f"{path.name}: no valid configuration ({len(bad)} invalid row(s))")
+    i, j = np.tril_indices(n)
+    q = table[:, :n]
+    M = np.zeros((len(table), n, n))
+    M[:, i, j] = table[:, n : n + i.size]
+    M[:, j, i] = table[:, n : n + i.size]
+    g = table[:, n + i.size :]
+    info = dict(meta)
+    info["file"] = path.name
+    info["dropped_invalid_rows"] = len(bad)
+    return StaticDataset(q, M, g, info), len(bad)
+
+
+def _jsonable(x: Any) -> Any:
+    if isinstance(x, np.ndarray):
+        return x.tolist()
+    if isinstance(x, np.generic):
+        return x.item()
+    raise TypeError(f"not JSON serialisable: {type(x).__name__}")

@@ -1,0 +1,250 @@
+"""The simulate -> friction -> validate command-line route and the demo's friction stages."""
+
+from __future__ import annotations
+
+import json
+
+import matplotlib
+import numpy as np
+import pytest
+
+from dynid.cli.__main__ import main
+from dynid.identification.classical import identify_from_log
+from dynid.io.torque_log import read_torque_log
+
+matplotlib.use("Agg")
+
+PNG = b"\x89PNG\r\n\x1a\n"
+
+
+def _png(path):
+    data = path.read_bytes()
+    return data[:8] == PNG and len(data) > 10_000
+
+
+@pytest.fixture(scope="module")
+def workdir(tmp_path_factory, panda):
+    """A Fourier log identified in-process to identification.json, and a sinusoid log."""
+    from dynid.io.model_json import save_model_json
+
+    d = tmp_path_factory.mktemp("cli")
+    assert (
+        main(
+            [
+                "simulate",
+                "--trajectory",
+                "fourier",
+                "--duration",
+                "15",
+                "--seed",
+                "1",
+                "--out",
+                str(d / "fourier.npz"),
+                "-q",
+            ]
+        )
+        == 0
+    )
+    model = identify_from_log(panda, read_torque_log(d / "fourier.npz"))
+    save_model_json(d / "identification.json", model, seed=1)
+    assert (
+        main(
+            [
+                "simulate",
+                "--trajectory",
+                "sinusoid",
+                "--duration",
+                "12",
+                "--seed",
+                "2",
+                "--out",
+                str(d / "sin.csv"),
+                "-q",
+            ]
+        )
+        == 0
+    )
+    return d
+
+
+def test_simulate_writes_a_readable_log(workdir, capsys):
+    """simulate writes 1 kHz logs of the requested duration and reports the scaling."""
+    log = read_torque_log(workdir / "sin.csv")
+    assert log.n == 7 and log.n_samples == 12001
+    assert log.sample_rate == pytest.approx(1000.0)
+    assert (
+        main(
+            [
+                "simulate",
+                "--duration",
+                "2",
+                "--seed",
+                "3",
+                "--jitter",
+                "3e-5",
+                "--drop",
+                "0.01",
+                "--out",
+                str(workdir / "short.npz"),
+            ]
+        )
+        == 0
+    )
+    out = capsys.readouterr().out
+    assert "velocity limit of joint1 exceeded" in out and "amplitude scaled by 0.935" in out
+    short = read_torque_log(workdir / "short.npz")
+    assert short.n_samples == 2001 - 20 and len(short.cleaning.gaps) > 0
+
+
+def test_friction_then_validate_write_json_and_figures(workdir, capsys):
+    """friction writes friction.json and its figure; validate uses it and writes its own."""
+    fr = workdir / "fr"
+    assert (
+        main(
+            [
+                "friction",
+                "--model",
+                str(workdir / "identification.json"),
+                "--data",
+                str(workdir / "sin.csv"),
+                "--out",
+                str(fr),
+            ]
+        )
+        == 0
+    )
+    doc = json.loads((fr / "friction.json").read_text())
+    assert doc["model"] == "sigmoid" and len(doc["joints"]) == 7
+    j = doc["joints"][3]
+    assert set(j) == {"phi1", "phi2", "phi3", "rms_before", "rms_after"}
+    assert j["rms_after"] < j["rms_before"]
+    assert _png(fr / "friction.png")
+    assert "RMS after" in capsys.readouterr().out
+
+    val = workdir / "val"
+    assert (
+        main(
+            [
+                "validate",
+                "--model",
+                str(workdir / "identification.json"),
+                "--friction",
+                str(fr / "friction.json"),
+                "--data",
+                str(workdir / "sin.csv"),
+                "--out",
+                str(val),
+            ]
+        )
+        == 0
+    )
+    v = json.loads((val / "validation.json").read_text())
+    assert len(v["rms"]) == 7 and len(v["mse"]) == 7
+    np.testing.assert_allclose(np.square(v["rms"]), v["mse"], rtol=1e-12)
+    assert v["relative_error_percent"] < v["without_friction"]["relative_error_percent"]
+    assert v["friction_model"] == "sigmoid"
+    assert _png(val / "validation_torques.png") and _png(val / "validation_rms.png")
+
+
+def test_validate_with_the_robots_own_parameters(workdir):
+    """--robot panda uses the published parameters and friction: RMS at the 0.05 N m noise."""
+    out = workdir / "val_robot"
+    assert (
+        main(
+            [
+                "validate",
+                "--robot",
+                "panda",
+                "--data",
+                str(workdir / "sin.csv"),
+                "--out",
+                str(out),
+                "--no-figures",
+                "-q",
+            ]
+        )
+        == 0
+    )
+    v = json.loads((out / "validation.json").read_text())
+    np.testing.assert_allclose(v["rms"], 0.05, rtol=0.05)
+    assert v["friction_source"] == "model"
+
+
+def test_classical_friction_model_option(workdir):
+    """--friction-model classical writes fv, fc, fo per joint."""
+    out = workdir / "fr_classical"
+    assert (
+        main(
+            [
+                "friction",
+                "--robot",
+                "panda",
+                "--data",
+                str(workdir / "sin.csv"),
+                "--out",
+                str(out),
+                "--friction-model",
+                "classical",
+                "--no-figures",
+            ]
+        )
+        == 0
+    )
+    doc = json.loads((out / "friction.json").read_text())
+    assert doc["model"] == "classical"
+    assert set(doc["joints"][0]) == {"fv", "fc", "fo", "rms_before", "rms_after"}
+
+
+def test_cli_errors_are_one_line_with_exit_code_2(workdir, capsys):
+    """A missing file or a malformed log gives exit code 2 and a one-line message."""
+    code = main(
+        [
+            "validate",
+            "--robot",
+            "panda",
+            "--data",
+            str(workdir / "nope.csv"),
+            "--out",
+            str(workdir / "x"),
+        ]
+    )
+    assert code == 2
+    err = capsys.readouterr().err.strip()
+    assert err.startswith("dynid validate: error:") and "\n" not in err
+    (workdir / "bad.csv").write_text("t,q1,dq1\n0,1,2\n")
+    assert (
+        main(
+            [
+                "friction",
+                "--robot",
+                "panda",
+                "--data",
+                str(workdir / "bad.csv"),
+                "--out",
+                str(workdir / "y"),
+            ]
+        )
+        == 2
+    )
+    assert "missing column" in capsys.readouterr().err
+
+
+def test_demo_stages_fit_friction_and_validate(tmp_path, panda, capsys):
+    """demo_stages returns per-joint RMS before/after and writes its files."""
+    from dynid.cli.friction import demo_stages
+    from dynid.kinematics.trajectories import random_fourier
+    from dynid.simulation.measurement import sample_times, simulate_measurement
+
+    series = random_fourier(panda, np.random.default_rng(51))
+    log = simulate_measurement(
+        panda, series(sample_times(15.0)), rng=np.random.default_rng(52), friction=None
+    )
+    model = identify_from_log(panda, log, friction=False)
+    out = demo_stages(tmp_path / "demo", model, seed=3)
+    assert np.all(np.array(out["rms_with_friction"]) < 0.06)
+    assert np.all(np.array(out["rms_without_friction"]) > 0.1)
+    assert np.all(np.array(out["friction_curve_rms"]) < 0.01)
+    assert out["scale"] == pytest.approx(0.95 * 2.175 / 2.21, rel=1e-4)
+    for f in out["files"]:
+        assert (tmp_path / "demo" / f.split("/")[-1]).stat().st_size > 0
+    assert "RMS + friction" in capsys.readouterr().out
