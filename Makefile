@@ -6,6 +6,11 @@ STAMP := $(VENV)/.installed
 
 .PHONY: demo test bench lint clean
 
+# The problems here are tall and thin (e.g. 34,000 x 44): threaded BLAS only adds overhead
+# on a small machine. Override with OPENBLAS_NUM_THREADS=N make ...
+export OPENBLAS_NUM_THREADS ?= 1
+export OMP_NUM_THREADS ?= 1
+
 $(STAMP): pyproject.toml
 	test -x $(PY) || $(PYTHON) -m venv $(VENV)
 	$(PY) -m pip install -q --upgrade pip

@@ -248,3 +248,19 @@ def test_demo_stages_fit_friction_and_validate(tmp_path, panda, capsys):
     for f in out["files"]:
         assert (tmp_path / "demo" / f.split("/")[-1]).stat().st_size > 0
     assert "RMS + friction" in capsys.readouterr().out
+
+
+def test_identify_routes_a_torque_log_to_the_classical_identification(tmp_path):
+    """`dynid identify` on a simulated Fourier log writes the classical result with friction terms."""
+    log = tmp_path / "fourier.npz"
+    assert main(["simulate", "--trajectory", "fourier", "--duration", "10", "--seed", "3",
+                 "--out", str(log), "-q"]) == 0
+    assert main(["identify", "--data", str(log), "--out", str(tmp_path / "cls"), "-q"]) == 0
+    d = json.loads((tmp_path / "cls" / "identification.json").read_text())
+    for key in ("rank", "condition_number", "relative_error_percent", "dropped_rows", "coefficients"):
+        assert key in d
+    names = [c["name"] for c in d["coefficients"]]
+    assert len([n for n in names if n.startswith("beta")]) == 43
+    text = json.dumps(d)
+    assert "fv1" in text and "fc7" in text and "fo3" in text
+    assert d["relative_error_percent"] < 5.0

@@ -6,8 +6,10 @@ least squares; rows without information (g1 of the Panda) are dropped and report
 With --max-std-percent, coefficients above that relative standard deviation are removed
 and the rest re-fitted (the paper used 30).
 
-Torque logs (a CSV with a `t` column, or an NPZ with `t` and `tau`) go to the classical
-route.
+Torque logs (a CSV with a `t` column, or an NPZ with `t` and `tau`, as written by
+`dynid simulate`) go to the classical route: zero-phase filtering, accelerations by
+differentiation, the torque regressor in the base parameters plus viscous, Coulomb and
+offset friction columns per joint, and the same least squares and statistics.
 
 Writes DIR/identification.json (coefficients, expressions, std, metrics, kinematics) and
 prints a summary table.
@@ -74,6 +76,13 @@ def register(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParser:
         help="standard deviations: heteroscedasticity-consistent (default) or sigma^2 (W^T W)^-1",
     )
     p.add_argument("--rtol", type=float, default=1e-10, help="relative rank tolerance")
+    p.add_argument(
+        "--cutoff",
+        type=float,
+        default=None,
+        metavar="HZ",
+        help="torque logs: zero-phase low-pass cutoff [Hz] (default: the library's)",
+    )
     return p
 
 
@@ -99,14 +108,15 @@ def data_kind(path: Path) -> str:
     raise DataError(f"--data must be a .csv or .npz file; got {path.name!r}")
 
 
-# ---------------------------------------------------------------------------------------
-# Classical route (torque logs). To be connected to identification.identify_from_log once
-# it exists; this is the only place to change.
 def identify_torque_log(robot: Robot, path: Path, args: argparse.Namespace) -> IdentifiedModel:
-    """Classical identification from a torque log (not available yet)."""
-    raise DynidError(
-        f"{path.name} is a torque log (column 't'); torque logs: classical route not available "
-        "in this version; hint: identify from static data (dynid acquire-static)"
+    """Classical route: read the log (checked), filter, identify base parameters and friction."""
+    from ..identification.classical import identify_from_log
+    from ..io.torque_log import read_torque_log
+
+    log = read_torque_log(path)
+    kw = {} if args.cutoff is None else {"cutoff_hz": args.cutoff}
+    return identify_from_log(
+        robot, log, max_std_percent=args.max_std_percent, rtol=args.rtol, **kw
     )
 
 
@@ -143,7 +153,12 @@ def format_summary(model: IdentifiedModel, *, width: int = 60) -> str:
     fit, meta = model.fit, model.metadata
     head = [
         f"{meta.get('route', '?')} identification of {model.robot.name}: "
-        f"{meta.get('n_configurations', '?')} configurations, {fit.n_rows} rows"
+        + (
+            f"{meta['n_configurations']} configurations"
+            if "n_configurations" in meta
+            else f"{meta.get('n_samples_used', '?')} samples of {meta.get('n_samples_log', '?')}"
+        )
+        + f", {fit.n_rows} rows"
         + (f", dropped rows {', '.join(meta['dropped_rows'])}" if meta.get("dropped_rows") else ""),
         f"rank {fit.rank}, condition number {fit.condition_number:.4g}, relative error "
         f"{fit.relative_error_percent:.4g} %, std {meta.get('std_estimator', '?')}"
