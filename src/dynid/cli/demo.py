@@ -6,6 +6,13 @@ Stages (each prints what it does and lists the files it writes):
                  of the flange, to a goal drawn from --seed near the neutral pose; a plot
                  of the simulated joint motion (ik_joint_motion.png).
 
+  2. identification  1010 static configurations from the simulated controller (M(q), g(q)
+                 with relative noise), the 43 base parameters by least squares, summary
+                 table (identification/).
+  3. friction    validation of the identified model on the paper's sinusoids, sigmoid
+                 friction fit per joint, validation with friction; per-joint RMS before and
+                 after, figures (friction/).
+
 Runs headless (figures are rendered with Agg); the first run also compiles the numba
 kernels (cached on disk for later runs).
 
@@ -104,8 +111,40 @@ def stage_kinematics(ctx: DemoContext) -> None:
     ctx.results["ik"] = res
 
 
-#: The stages in order; later stages are appended here.
-STAGES: list[Callable[[DemoContext], None]] = [stage_kinematics]
+def stage_identification(ctx: DemoContext) -> None:
+    """Stage 2: static acquisition (1010 configurations) and identification of the 43 coefficients."""
+    from ..io.model_json import load_model_json
+    from .identify import demo_stage
+
+    _header(2, "identification from the controller's M(q) and g(q) (Gaz et al. 2019, Sec. IV-A)")
+    res = demo_stage(ctx.out / "identification", ctx.seed)
+    ctx.files += [Path(res["data"]), Path(res["model"])]
+    print(
+        f"  rank {res['rank']}, condition number {res['condition_number']:.3g}, "
+        f"relative error {res['relative_error_percent']:.3g} %, dropped rows "
+        f"{res['dropped_rows']}; largest coefficient error {res['max_abs_error']:.2e} "
+        f"({res['max_error_in_std']:.2f} std)"
+    )
+    ctx.results["identification"] = res
+    ctx.results["model"] = load_model_json(res["model"])
+
+
+def stage_friction(ctx: DemoContext) -> None:
+    """Stage 3: sinusoidal validation, sigmoid friction fit, validation with friction."""
+    from .friction import demo_stages
+
+    _header(3, "validation on sinusoids and joint friction (Gaz et al. 2019, Sec. IV-B, VI)")
+    res = demo_stages(ctx.out / "friction", ctx.results["model"], ctx.seed, truth=ctx.robot)
+    ctx.files += [Path(f) for f in res.get("files", [])]
+    ctx.results["friction"] = res
+
+
+#: The stages in order.
+STAGES: list[Callable[[DemoContext], None]] = [
+    stage_kinematics,
+    stage_identification,
+    stage_friction,
+]
 
 
 def register(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParser:
