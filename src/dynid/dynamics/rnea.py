@@ -6,11 +6,23 @@ Quantities are propagated in link coordinates. The base's linear acceleration is
 about the link-frame origin using the standard parameters (``m``, ``m c``, ``J`` about the
 origin), which makes the torques linear in ``phi`` (the basis of the regressors).
 
-Samples are vectorised; the loop runs over the joints.
+Two implementations compute the same torques (to rounding, about 1e-15 relative):
+
+* the compiled kernels of :mod:`dynid.dynamics._kernels` (numba), used when numba is
+  installed: a loop over samples and joints, compiled on the first call and cached on
+  disk; importing dynid does not import numba;
+* the numpy reference path (:func:`rnea_numpy`): samples vectorised, a loop over joints.
+
+The public functions of :mod:`dynid.dynamics` use the kernels when :func:`kernels` finds
+them and the numpy path otherwise. Set the environment variable ``DYNID_NO_NUMBA=1``
+before the first dynamics call to force the numpy path; :func:`rnea_numpy` always takes
+it.
 """
 
 from __future__ import annotations
 
+import os
+from types import ModuleType
 from typing import NamedTuple
 
 import numpy as np
@@ -22,7 +34,44 @@ from ..kinematics.forward import _joint_rotations_translations
 from ..model.inertia import matrix_from_inertia6
 from ..model.robot import Robot
 
-__all__ = ["rnea", "LinkMotion", "link_motion"]
+__all__ = ["rnea", "rnea_numpy", "kernels", "LinkMotion", "link_motion"]
+
+_KERNELS: ModuleType | None = None
+_LOADED = False
+
+
+def kernels() -> ModuleType | None:
+    """The compiled kernels module, or None when numba is missing or ``DYNID_NO_NUMBA`` is set.
+
+    Imported once, on the first call; ``DYNID_NO_NUMBA`` is read then. Any value other
+    than ``""`` and ``"0"`` selects the numpy reference path.
+    """
+    global _KERNELS, _LOADED
+    if not _LOADED:
+        mod: ModuleType | None = None
+        if os.environ.get("DYNID_NO_NUMBA", "") in ("", "0"):
+            try:
+                from . import _kernels as mod
+            except ImportError:  # numba is not installed
+                mod = None
+        _KERNELS, _LOADED = mod, True
+    return _KERNELS
+
+
+def _flat(x: NDArray[np.float64]) -> NDArray[np.float64]:
+    """``x`` as a flat C-contiguous, aligned, writeable array (a view when it can be).
+
+    The kernels then see a single argument type, so they are compiled once.
+    """
+    if x.ndim != 1:
+        x = x.reshape(-1)
+    return x if x.flags.carray else np.array(x)
+
+
+def _readonly(x: NDArray[np.float64]) -> NDArray[np.float64]:
+    """``x`` as a read-only C array, as the robot's constants are (one kernel type)."""
+    f = x.flags
+    return x if f.c_contiguous and f.aligned and not f.writeable else _checks.frozen(x)
 
 
 def cross(a: NDArray[np.float64], b: NDArray[np.float64]) -> NDArray[np.float64]:
@@ -143,13 +192,93 @@ def rnea(
         An input does not end in ``n`` or the batch shapes do not broadcast.
     NonFiniteError
         An input holds NaN or inf.
+
+    Notes
+    -----
+    Uses the compiled kernel when available (see :func:`kernels`), else :func:`rnea_numpy`.
     """
+    K = _KERNELS if _LOADED else kernels()
+    if K is not None and gravity is None:
+        # lean path for the common call: same shapes, float64-convertible; the kernel
+        # checks finiteness and any failure falls through to the full validation below
+        try:
+            qa = np.asarray(q, dtype=np.float64)
+            va = np.asarray(dq, dtype=np.float64)
+            aa = np.asarray(ddq, dtype=np.float64)
+        except (TypeError, ValueError):
+            pass
+        else:
+            shape = qa.shape
+            if shape == va.shape == aa.shape and shape and shape[-1] == len(robot.joint_names):
+                tau = np.empty(shape)
+                if K.rnea(
+                    robot.T_parent_joint,
+                    robot.axes,
+                    robot.prismatic,
+                    robot.phi,
+                    robot.gravity,
+                    _flat(qa),
+                    _flat(va),
+                    _flat(aa),
+                    tau if len(shape) == 1 else tau.reshape(-1),
+                ):
+                    return tau
     shape, (q2, dq2, ddq2) = _prepare(robot, q, dq, ddq)
     g = robot.gravity if gravity is None else _checks.as_exact("gravity", gravity, (3,))
     return _rnea(robot, robot.phi, q2, dq2, ddq2, g).reshape(shape)
 
 
+def rnea_numpy(
+    robot: Robot,
+    q: ArrayLike,
+    dq: ArrayLike,
+    ddq: ArrayLike,
+    *,
+    gravity: ArrayLike | None = None,
+) -> NDArray[np.float64]:
+    """:func:`rnea` by the numpy reference path, never the compiled kernel.
+
+    Same parameters, result, shapes and errors as :func:`rnea`.
+    """
+    shape, (q2, dq2, ddq2) = _prepare(robot, q, dq, ddq)
+    g = robot.gravity if gravity is None else _checks.as_exact("gravity", gravity, (3,))
+    return _rnea_numpy(robot, robot.phi, q2, dq2, ddq2, g).reshape(shape)
+
+
 def _rnea(
+    robot: Robot,
+    phi: NDArray[np.float64],
+    q: NDArray[np.float64],
+    dq: NDArray[np.float64],
+    ddq: NDArray[np.float64],
+    gravity: NDArray[np.float64],
+) -> NDArray[np.float64]:
+    """RNEA on validated (B, n) arrays with standard parameters ``phi`` (n, 10).
+
+    The compiled kernel when available, else :func:`_rnea_numpy`. ``dq`` and ``ddq`` may
+    also be (1, n), one row for every sample.
+    """
+    K = _KERNELS if _LOADED else kernels()
+    if K is not None:
+        B, n = q.shape
+        if dq.shape[0] in (1, B) and ddq.shape[0] in (1, B):
+            tau = np.empty((B, n))
+            if K.rnea(
+                robot.T_parent_joint,
+                robot.axes,
+                robot.prismatic,
+                robot.phi if phi is robot.phi else _readonly(np.asarray(phi, dtype=np.float64)),
+                robot.gravity if gravity is robot.gravity else _readonly(gravity),
+                _flat(q),
+                _flat(dq),
+                _flat(ddq),
+                tau.reshape(-1),
+            ):
+                return tau
+    return _rnea_numpy(robot, phi, q, dq, ddq, gravity)
+
+
+def _rnea_numpy(
     robot: Robot,
     phi: NDArray[np.float64],
     q: NDArray[np.float64],

@@ -7,6 +7,12 @@
 ``S`` is the Coriolis matrix from the Christoffel symbols of the first kind, for which
 :math:`\\dot M - 2 S` is skew-symmetric; its symbols are read exactly off the quadratic
 form ``c(q, v)`` by polarization.
+
+With numba installed (see :func:`dynid.dynamics.rnea.kernels`), ``M`` comes from the
+composite-rigid-body algorithm and ``g`` and the RNEA calls from the compiled kernels of
+:mod:`dynid.dynamics._kernels`; :func:`mass_matrix_numpy` and
+:func:`gravity_torques_numpy` are the numpy reference path (``DYNID_NO_NUMBA=1`` selects
+it everywhere). Both agree to rounding.
 """
 
 from __future__ import annotations
@@ -16,19 +22,54 @@ from numpy.typing import ArrayLike, NDArray
 
 from .. import _checks
 from ..model.robot import Robot
-from .rnea import _prepare, _rnea
+from .rnea import _flat, _prepare, _rnea, _rnea_numpy, kernels
 
-__all__ = ["mass_matrix", "gravity_torques", "coriolis", "coriolis_matrix", "forward_dynamics"]
+__all__ = [
+    "mass_matrix",
+    "mass_matrix_numpy",
+    "gravity_torques",
+    "gravity_torques_numpy",
+    "coriolis",
+    "coriolis_matrix",
+    "forward_dynamics",
+]
 
-_ZERO_G = np.zeros(3)
+_ZERO_G = _checks.frozen(np.zeros(3))
+
+
+def _lean_q(robot: Robot, q: ArrayLike) -> NDArray[np.float64] | None:
+    """``q`` as a float64 array when it is plainly (..., n), else None (full validation).
+
+    No finiteness check here: the kernels do it.
+    """
+    try:
+        qa = np.asarray(q, dtype=np.float64)
+    except (TypeError, ValueError):
+        return None
+    if qa.ndim == 0 or qa.shape[-1] != len(robot.joint_names):
+        return None
+    return qa
 
 
 def _mass_matrix(robot: Robot, q2: NDArray[np.float64]) -> NDArray[np.float64]:
-    """(B, n, n) mass matrices for validated (B, n) positions."""
+    """(B, n, n) mass matrices for validated (B, n) positions (kernel when available)."""
+    K = kernels()
+    if K is not None:
+        B, n = q2.shape
+        M = np.empty((B, n, n))
+        if K.mass_matrix(
+            robot.T_parent_joint, robot.axes, robot.prismatic, robot.phi, _flat(q2), M.reshape(-1)
+        ):
+            return M
+    return _mass_matrix_numpy(robot, q2)
+
+
+def _mass_matrix_numpy(robot: Robot, q2: NDArray[np.float64]) -> NDArray[np.float64]:
+    """(B, n, n) mass matrices for validated (B, n) positions, numpy path: RNEA columns."""
     B, n = q2.shape
     qs = np.repeat(q2, n, axis=0)  # sample-major: row b*n + k
     E = np.tile(np.eye(n), (B, 1))
-    cols = _rnea(robot, robot.phi, qs, np.zeros_like(qs), E, _ZERO_G)  # (B*n, n): column k
+    cols = _rnea_numpy(robot, robot.phi, qs, np.zeros_like(qs), E, _ZERO_G)  # (B*n, n): column k
     M = np.swapaxes(cols.reshape(B, n, n), 1, 2)
     return 0.5 * (M + np.swapaxes(M, 1, 2))
 
@@ -49,17 +90,70 @@ def mass_matrix(robot: Robot, q: ArrayLike) -> NDArray[np.float64]:
     Raises
     ------
     ShapeError, NonFiniteError
+
+    Notes
+    -----
+    Composite-rigid-body algorithm in the compiled kernel when available; otherwise
+    :func:`mass_matrix_numpy`.
     """
+    K = kernels()
+    if K is not None:
+        qa = _lean_q(robot, q)
+        if qa is not None:
+            M = np.empty(qa.shape + qa.shape[-1:])
+            if K.mass_matrix(
+                robot.T_parent_joint,
+                robot.axes,
+                robot.prismatic,
+                robot.phi,
+                _flat(qa),
+                M.reshape(-1),
+            ):
+                return M
     q = _checks.as_batch("q", q, (robot.n,))
     return _mass_matrix(robot, q.reshape(-1, robot.n)).reshape(q.shape + (robot.n,))
 
 
+def mass_matrix_numpy(robot: Robot, q: ArrayLike) -> NDArray[np.float64]:
+    """:func:`mass_matrix` by the numpy reference path (columns of RNEA), never the kernel."""
+    q = _checks.as_batch("q", q, (robot.n,))
+    return _mass_matrix_numpy(robot, q.reshape(-1, robot.n)).reshape(q.shape + (robot.n,))
+
+
 def gravity_torques(robot: Robot, q: ArrayLike) -> NDArray[np.float64]:
-    """Gravity torques g(q) = rnea(q, 0, 0) [N m], shape (..., n), for ``robot.gravity``."""
+    """Gravity torques g(q) = rnea(q, 0, 0) [N m], shape (..., n), for ``robot.gravity``.
+
+    Raises
+    ------
+    ShapeError, NonFiniteError
+    """
+    K = kernels()
+    if K is not None:
+        qa = _lean_q(robot, q)
+        if qa is not None:
+            tau = np.empty(qa.shape)
+            if K.gravity_torques(
+                robot.T_parent_joint,
+                robot.axes,
+                robot.prismatic,
+                robot.phi,
+                robot.gravity,
+                _flat(qa),
+                tau if tau.ndim == 1 else tau.reshape(-1),
+            ):
+                return tau
+    q = _checks.as_batch("q", q, (robot.n,))
+    q2 = q.reshape(-1, robot.n)
+    z = np.zeros((1, robot.n))
+    return _rnea(robot, robot.phi, q2, z, z, robot.gravity).reshape(q.shape)
+
+
+def gravity_torques_numpy(robot: Robot, q: ArrayLike) -> NDArray[np.float64]:
+    """:func:`gravity_torques` by the numpy reference path, never the kernel."""
     q = _checks.as_batch("q", q, (robot.n,))
     q2 = q.reshape(-1, robot.n)
     z = np.zeros_like(q2)
-    return _rnea(robot, robot.phi, q2, z, z, robot.gravity).reshape(q.shape)
+    return _rnea_numpy(robot, robot.phi, q2, z, z, robot.gravity).reshape(q.shape)
 
 
 def coriolis(robot: Robot, q: ArrayLike, dq: ArrayLike) -> NDArray[np.float64]:
@@ -75,7 +169,7 @@ def coriolis(robot: Robot, q: ArrayLike, dq: ArrayLike) -> NDArray[np.float64]:
     c : ndarray, shape (..., n)
     """
     shape, (q2, dq2, _) = _prepare(robot, q, dq, np.zeros(robot.n))
-    return _rnea(robot, robot.phi, q2, dq2, np.zeros_like(q2), _ZERO_G).reshape(shape)
+    return _rnea(robot, robot.phi, q2, dq2, np.zeros((1, robot.n)), _ZERO_G).reshape(shape)
 
 
 def christoffel(robot: Robot, q: ArrayLike) -> NDArray[np.float64]:
