@@ -28,7 +28,6 @@ Pipeline used for torque logs (Gaz et al. 2019, Sec. VI; Swevers et al. 1997):
 from __future__ import annotations
 
 import numpy as np
-import scipy.signal
 from numpy.typing import ArrayLike, NDArray
 
 from . import _checks
@@ -202,6 +201,8 @@ def lowpass(
         )
     if order < 1:
         raise DataError(f"order must be >= 1; got {order}")
+    import scipy.signal  # imported here: it costs most of ``import dynid`` otherwise
+
     sos = scipy.signal.butter(order, cutoff_hz, btype="low", fs=fs, output="sos")
     minimum = 3 * (2 * len(sos) + 1)
     N = x.shape[axis]

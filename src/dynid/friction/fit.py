@@ -32,7 +32,6 @@ from dataclasses import dataclass
 
 import numpy as np
 import scipy.linalg
-import scipy.optimize
 import scipy.special
 from numpy.typing import NDArray
 
@@ -195,8 +194,10 @@ def _fit_sigmoid_joint(
         e = rs - z[0] * s1 * _sigmoid_basis(dq, s2 * np.exp(z[1]), z[2] * s3)
         return float(np.mean(e**2))
 
+    from scipy.optimize import minimize  # imported here: slow to import, rarely needed
+
     z0 = np.array([1.0, 0.0, p30 / s3])
-    res = scipy.optimize.minimize(
+    res = minimize(
         cost, z0, method="Nelder-Mead", options={"xatol": 1e-7, "fatol": 1e-12, "maxiter": maxiter}
     )
     z = res.x
