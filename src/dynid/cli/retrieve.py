@@ -1,0 +1,404 @@
+"""Retrieve physically feasible link parameters from identified coefficients.
+
+Gaz et al. 2019, Sec. V, Algorithm 1: Q independent runs (--runs) of K stages (--stages)
+of simulated annealing and local refinement on the coefficients' error plus penalties
+on the violated constraints (positive mass, positive-definite inertia, triangle
+inequality, total-mass band), inside a box per parameter (--bounds; default: the
+Panda's bounds of Gaz et al. for the Panda's kinematics, else bounds derived from the
+link lengths). The runs are spread over --workers processes; --seed makes the result
+reproducible whatever the number of workers.
+
+Input: --model DIR/identification.json (from `dynid identify`; pruned coefficients are
+ignored), or --static FILE (static data, single-step variant: the objective is taken
+directly on [tril M; g], no identification step) with --robot.
+
+--total-mass MIN,MAX sets the band on the total mass [kg] (--no-total-mass drops the
+default one); --friction friction.json (sigmoid) puts a friction model on the exported
+robot.
+
+Writes DIR2/feasible.json (mass, CoM, inertia about the CoM per link, with the
+kinematics), DIR2/robot.urdf, DIR2/robot.toml, DIR2/report.json (relative residual,
+every constraint margin, stage costs, run time, seed) and DIR2/retrieval.png; prints
+the progress on stderr and a summary on stdout. Exit code 1 when no feasible parameter
+set was found (the least-violating one is written and reported).
+
+example:
+  dynid retrieve --model result/identification.json --runs 10 --seed 0 --out feasible
+"""
+
+from __future__ import annotations
+
+import argparse
+import os
+import sys
+import time
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from ..exceptions import DynidError
+from ..feasibility.constraints import default_bounds, principal_moments
+from ..feasibility.retrieve import (
+    RetrievalOptions,
+    RetrievalProgress,
+    RetrievalResult,
+    retrieve,
+    retrieve_from_static,
+)
+from ..feasibility.validate import NewtonEulerValidation, validate_newton_euler
+from ..identification.model import IdentifiedModel
+from ..io.feasible import load_bounds, save_feasible_json, save_report_json
+from ..io.urdf_export import save_urdf
+from ..model.robot import Robot
+from .common import add_robot_options, load_robot, parse_vector
+
+NAME = "retrieve"
+
+#: Processes used by :func:`demo_stage` at most.
+DEMO_WORKERS = 2
+
+
+def register(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParser:
+    """Add the ``retrieve`` subcommand."""
+    p = subparsers.add_parser(
+        NAME,
+        help="retrieve feasible link parameters from identified coefficients",
+        description=__doc__,
+        formatter_class=argparse.RawDescriptionHelpFormatter,
+    )
+    src = p.add_mutually_exclusive_group(required=True)
+    src.add_argument("--model", type=Path, help="identification.json of an identified model")
+    src.add_argument(
+        "--static", type=Path, help="static data (.csv/.npz) for the single-step variant"
+    )
+    add_robot_options(p)
+    p.add_argument("--bounds", type=Path, default=None, help="bounds file (.json or .toml)")
+    p.add_argument(
+        "--total-mass", default=None, metavar="MIN,MAX", help="band on the total mass [kg]"
+    )
+    p.add_argument("--no-total-mass", action="store_true", help="drop the default total-mass band")
+    d = RetrievalOptions()
+    p.add_argument(
+        "--runs", type=int, default=d.runs, help=f"independent runs Q (default {d.runs})"
+    )
+    p.add_argument(
+        "--stages", type=int, default=d.stages, help=f"stages K per run (default {d.stages})"
+    )
+    p.add_argument(
+        "--workers", type=int, default=None, help="processes (default: min(runs, cores))"
+    )
+    p.add_argument("--seed", type=int, default=0, help="random seed (default 0)")
+    p.add_argument(
+        "--friction", type=Path, default=None, help="friction.json (sigmoid) to put on the robot"
+    )
+    p.add_argument("--out", type=Path, required=True, help="output folder")
+    p.add_argument("--no-figures", action="store_true", help="skip retrieval.png")
+    return p
+
+
+def _band(args: argparse.Namespace) -> tuple[float, float] | None:
+    if args.total_mass is None:
+        return None
+    v = parse_vector(args.total_mass, "--total-mass", 2)
+    return float(v[0]), float(v[1])
+
+
+def progress_printer(stream: Any = None) -> Any:
+    """A ``progress`` callback that prints one line per finished run on ``stream`` (stderr)."""
+
+    def show(p: RetrievalProgress) -> None:
+        out = sys.stderr if stream is None else stream
+        state = "feasible" if p.feasible else "INFEASIBLE"
+        out.write(
+            f"  run {p.done:>2}/{p.total} (#{p.run}): cost {p.cost:.3e}, relative residual "
+            f"{p.relative_residual:.2e}, {state}  [{p.elapsed:6.1f} s]\n"
+        )
+        out.flush()
+
+    return show
+
+
+def _band_margin(r: RetrievalResult) -> float:
+    return min(r.report.min_margin("total_mass_min"), r.report.min_margin("total_mass_max"))
+
+
+def format_summary(result: RetrievalResult) -> str:
+    """Readable summary: per link mass, CoM, principal moments and triangle margin; totals."""
+    r = result
+    lam = principal_moments(r.inertia)
+    tri = {c.link: c.margin for c in r.report.select("triangle_inequality")}
+    names = r.robot.link_names[1:]
+    w = max(len(s) for s in names)
+    lines = [
+        f"{'link':<{w}}  {'mass [kg]':>9}  {'CoM [m]':^26}  "
+        f"{'principal moments [kg m^2]':^30}  {'triangle':>9}",
+    ]
+    for i, name in enumerate(names):
+        c = " ".join(f"{x:+.4f}" for x in r.com[i])
+        m = " ".join(f"{x:.3e}" for x in lam[i])
+        lines.append(f"{name:<{w}}  {r.mass[i]:>9.4f}  {c:^26}  {m:^30}  {tri[i + 1]:>9.2e}")
+    status = "FEASIBLE" if r.feasible else "INFEASIBLE (least-violating solution)"
+    lines += [
+        f"total mass {float(np.sum(r.mass)):.4f} kg"
+        + ("" if r.total_mass is None else f" (band {r.total_mass[0]:g}..{r.total_mass[1]:g} kg)"),
+        f"{status}: relative residual {r.relative_residual:.3e} ({r.kind}); "
+        f"{r.n_feasible_runs}/{len(r.runs)} runs feasible; kept run {r.best_run}",
+        "min margins: "
+        + ", ".join(
+            f"{n} {r.report.min_margin(n):.3g}"
+            for n in (
+                "mass_positive",
+                "inertia_positive_definite",
+                "triangle_inequality",
+                "com_in_box",
+            )
+            if r.report.select(n)
+        )
+        + (f", total mass {_band_margin(r):.3g} kg" if r.report.select("total_mass_min") else ""),
+        f"stage costs {', '.join(f'{x:.3g}' for x in r.stage_costs)}; "
+        f"{r.run_time:.1f} s on {r.workers} worker(s), seed {r.seed}",
+    ]
+    if not r.feasible:
+        lines.append(str(r.report))
+    return "\n".join(lines)
+
+
+def write_outputs(
+    out: Path, result: RetrievalResult, *, figures: bool = True, **report_extra: Any
+) -> list[Path]:
+    """Write feasible.json, robot.urdf, robot.toml, report.json (and retrieval.png)."""
+    out.mkdir(parents=True, exist_ok=True)
+    files = [
+        save_feasible_json(out / "feasible.json", result),
+        save_urdf(out / "robot.urdf", result.robot),
+    ]
+    result.robot.to_toml(out / "robot.toml")
+    files.append(out / "robot.toml")
+    files.append(save_report_json(out / "report.json", result, **report_extra))
+    if figures:
+        from ..plots.feasible import plot_retrieval
+
+        fig = plot_retrieval(result)
+        fig.savefig(out / "retrieval.png", dpi=110)
+        files.append(out / "retrieval.png")
+        import matplotlib.pyplot as plt
+
+        plt.close(fig)
+    return files
+
+
+def _friction_robot(robot: Robot, path: Path | None) -> Robot:
+    if path is None:
+        return robot
+    from ..friction.model import SigmoidFriction
+    from ..io.friction_json import read_friction_json
+
+    fr = read_friction_json(path)
+    if not isinstance(fr, SigmoidFriction):
+        raise DynidError(f"{path.name}: a robot holds sigmoid friction; got a {fr.kind} model")
+    return robot.with_friction(fr.as_array())
+
+
+def run(args: argparse.Namespace) -> int:
+    """Retrieve, write the outputs, print the summary; 0 if feasible, 1 if not."""
+    quiet = bool(getattr(args, "quiet", False))
+    try:
+        options = RetrievalOptions(runs=args.runs, stages=args.stages)
+    except ValueError as exc:
+        raise DynidError(f"--runs/--stages: {exc}") from None
+    band = _band(args)
+    if band is not None and not 0.0 <= band[0] <= band[1]:
+        raise DynidError(f"--total-mass must be MIN,MAX, 0 <= MIN <= MAX; got {args.total_mass}")
+    if args.workers is not None and args.workers < 1:
+        raise DynidError(f"--workers must be >= 1; got {args.workers}")
+    common: dict[str, Any] = dict(
+        options=options,
+        workers=args.workers,
+        seed=args.seed,
+        progress=None if quiet else progress_printer(),
+    )
+    if args.model is not None:
+        from ..io.model_json import load_model_json
+
+        model = load_model_json(args.model)
+        robot = _friction_robot(model.robot, args.friction)
+        if robot is not model.robot:
+            model = IdentifiedModel(
+                robot, model.base, model.fit, model.friction, dict(model.metadata)
+            )
+        bounds = load_bounds(args.bounds, robot) if args.bounds else default_bounds(robot)
+        if args.no_total_mass:
+            bounds = bounds.with_total_mass(None)
+        source = str(args.model)
+        if not quiet:
+            print(
+                f"retrieving feasible parameters of {robot.name} from {args.model} ...",
+                file=sys.stderr,
+            )
+        result = retrieve(model, bounds=bounds, total_mass=band, **common)
+    else:
+        from ..io.static_data import load_static_data
+
+        robot = _friction_robot(load_robot(args), args.friction)
+        data, _ = load_static_data(args.static, robot)
+        bounds = load_bounds(args.bounds, robot) if args.bounds else default_bounds(robot)
+        if args.no_total_mass:
+            bounds = bounds.with_total_mass(None)
+        source = str(args.static)
+        if not quiet:
+            print(
+                f"retrieving feasible parameters of {robot.name} from {args.static} ...",
+                file=sys.stderr,
+            )
+        result = retrieve_from_static(robot, data, bounds=bounds, total_mass=band, **common)
+    files = write_outputs(args.out, result, figures=not args.no_figures, source=source)
+    if not quiet:
+        print(format_summary(result))
+        print("wrote " + ", ".join(str(f) for f in files))
+    return 0 if result.feasible else 1
+
+
+# ------------------------------------------------------------------------------ demo
+def _validation_log(robot: Robot, seed: int) -> Any:
+    """A 10 s random Fourier trajectory at 1 kHz, simulated with sensor noise on ``robot``."""
+    from ..kinematics.trajectories import random_fourier
+    from ..simulation.measurement import SensorNoise, sample_times, simulate_measurement
+
+    rng = np.random.default_rng(np.random.SeedSequence([seed, 5]))
+    series = random_fourier(robot, rng, n_harmonics=5)
+    traj = series(sample_times(10.0, 1000.0))
+    return simulate_measurement(robot, traj, rng=rng, noise=SensorNoise())
+
+
+def demo_stage(
+    out_dir: Path,
+    model: IdentifiedModel,
+    validation_log: Any = None,
+    friction: Any = None,
+    seed: int = 0,
+    *,
+    truth: Robot | None = None,
+) -> dict[str, Any]:
+    """Feasible-parameter retrieval and its Newton-Euler validation, for ``dynid demo``.
+
+    1. Retrieve feasible parameters from the static ``model`` with the default options
+       and bounds (on ``min(2, cores)`` workers, seeded).
+    2. Write ``feasible.json``, ``robot.urdf``, ``robot.toml``, ``report.json`` and
+       ``retrieval.png`` under ``out_dir``.
+    3. Newton-Euler validation: RNEA with the feasible parameters plus ``friction``
+       against the measured torques of ``validation_log`` (a trajectory the friction was
+       not fitted on), and the identified model's torques for comparison; figure
+       ``feasible_validation.png``, ``feasible_validation.json``.
+    4. Print a short table and return the numbers.
+
+    Parameters
+    ----------
+    out_dir : Path
+    model : IdentifiedModel
+        Identified static coefficients (e.g. from ``cli.identify.demo_stage``).
+    validation_log : TorqueLog, optional
+        Measured validation trajectory, used as it is when it has ``ddq``, else prepared
+        with :func:`dynid.identification.log.prepare_log` (zero-phase filtered states,
+        ``ddq`` differentiated, torques kept unfiltered). Default: a 10 s random Fourier
+        trajectory simulated on ``truth`` with sensor noise.
+    friction : SigmoidFriction, ClassicalFriction, array_like (n, 3) or None
+        Friction added to the Newton-Euler torques (e.g. the fitted sigmoid of the
+        friction stage); None: none.
+    seed : int
+    truth : Robot, optional
+        Robot that plays the real one for the default validation log (default
+        ``model.robot``; it must have link parameters).
+
+    Returns
+    -------
+    dict
+        ``feasible``, ``relative_residual``, ``min_margin`` (per constraint name),
+        ``run_time_s``, ``workers``, ``stage_costs``, ``total_mass``, ``rms_newton_euler``
+        and ``rms_identified`` (per joint [N m]), ``relative_error_percent_newton_euler`` /
+        ``_identified``, ``max_torque_difference`` (largest |NE - identified| over the
+        validation samples, friction excluded [N m]), ``files``.
+    """
+    from ..identification.log import prepare_log
+
+    out_dir = Path(out_dir)
+    out_dir.mkdir(parents=True, exist_ok=True)
+    workers = max(1, min(DEMO_WORKERS, os.cpu_count() or 1))
+    t0 = time.perf_counter()
+    result = retrieve(model, seed=seed, workers=workers, progress=progress_printer(sys.stdout))
+    files = write_outputs(out_dir, result, seed=seed)
+    if validation_log is None:
+        truth = model.robot if truth is None else truth
+        if not np.any(truth.phi):
+            raise DynidError(
+                "no validation log given and the model's robot has no link parameters to "
+                "simulate with; pass truth="
+            )
+        validation_log = _validation_log(truth, seed)
+    log = (
+        validation_log
+        if validation_log.ddq is not None
+        else prepare_log(validation_log, filter_tau=False)
+    )
+    val = validate_newton_euler(
+        result.robot, log.t, log.q, log.dq, log.ddq, log.tau, friction=friction, reference=model
+    )
+    from ..plots.feasible import plot_newton_euler_validation
+
+    fig = plot_newton_euler_validation(
+        val, title="Newton-Euler with the retrieved feasible parameters (validation trajectory)"
+    )
+    fig.savefig(out_dir / "feasible_validation.png", dpi=110)
+    import matplotlib.pyplot as plt
+
+    plt.close(fig)
+    files.append(out_dir / "feasible_validation.png")
+    import json
+
+    doc = val.as_dict() | {"seed": seed}
+    (out_dir / "feasible_validation.json").write_text(json.dumps(doc, indent=1) + "\n")
+    files.append(out_dir / "feasible_validation.json")
+    diff = float(np.max(np.abs(val.tau_rigid - model.torques(log.q, log.dq, log.ddq))))
+    print(format_summary(result))
+    print(_rms_table(val))
+    print(f"max |NE(feasible) - identified model| on the validation states: {diff:.3g} N m")
+    print(
+        f"retrieval stage: {time.perf_counter() - t0:.1f} s; wrote {len(files)} files in {out_dir}"
+    )
+    rep = result.report
+    return {
+        "feasible": bool(result.feasible),
+        "relative_residual": float(result.relative_residual),
+        "min_margin": {n: rep.min_margin(n) for n in rep.names},
+        "run_time_s": float(result.run_time),
+        "workers": int(result.workers),
+        "stage_costs": result.stage_costs.tolist(),
+        "total_mass": float(np.sum(result.mass)),
+        "rms_newton_euler": val.errors.rms.tolist(),
+        "rms_identified": None
+        if val.errors_reference is None
+        else val.errors_reference.rms.tolist(),
+        "relative_error_percent_newton_euler": float(val.errors.relative_error_percent),
+        "relative_error_percent_identified": None
+        if val.errors_reference is None
+        else float(val.errors_reference.relative_error_percent),
+        "max_torque_difference": diff,
+        "files": [str(f) for f in files],
+    }
+
+
+def _rms_table(val: NewtonEulerValidation) -> str:
+    names = val.joint_names
+    w = max(len(s) for s in names)
+    head = f"{'joint':<{w}}  {'RMS NE [N m]':>12}" + (
+        "  {:>18}".format("RMS identified [N m]") if val.errors_reference is not None else ""
+    )
+    rows = [head]
+    for j, name in enumerate(names):
+        row = f"{name:<{w}}  {val.errors.rms[j]:>12.4f}"
+        if val.errors_reference is not None:
+            row += f"  {val.errors_reference.rms[j]:>20.4f}"
+        rows.append(row)
+    fr = "with " + val.friction_kind + " friction" if val.friction_kind else "without friction"
+    rows.append(f"(torques {fr}; relative error NE {val.errors.relative_error_percent:.2f} %)")
+    return "\n".join(rows)

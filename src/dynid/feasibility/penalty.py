@@ -1,0 +1,591 @@
+"""The penalised objective of the feasible-parameter retrieval (Gaz et al. 2019, Sec. V).
+
+Decision variables: ``p = (m_i, c_i, I_i)`` per link (:data:`~dynid.feasibility.
+constraints.DECISION_FIELDS`, inertia about the CoM), inside the box of
+:class:`~dynid.feasibility.constraints.Bounds`. The optimisers work on normalised
+variables ``z`` in ``[0, 1]^{10 n}``, ``p = lo + z (hi - lo)``.
+
+**Data term.** The standard parameters follow from ``p`` by the parallel-axis theorem,
+``phi(p) = [m, m c, I + m (c^T c E - c c^T)]`` (:func:`~dynid.model.inertia.
+phi_from_inertial`), and every data term is linear in ``phi``: a matrix ``A`` and a
+vector ``b`` precomputed once,
+
+.. math:: f_0(p) = \\| A \\phi(p) - b \\|^2 + f_{off}
+
+* Two-step (:func:`coefficient_problem`, eq. 29):
+  ``A = S^{-1} P_kept``, ``b = S^{-1} \\hat\\pi_kept`` with the base projection ``P``
+  (``beta = P phi``) restricted to the kept coefficients and ``S`` diagonal with
+
+  .. math:: s_k = \\max(|\\hat\\pi_k|, \\sigma_k, \\epsilon_{u(k)})
+
+  so that every coefficient counts by its relative error whether it is in kg, kg m or
+  kg m^2; ``sigma_k`` is its standard deviation (a coefficient known to 20 % need not be
+  met to 1 %) and the floor ``epsilon_u = scale_floor * max |pi_hat_j|`` over the kept
+  coefficients ``j`` of the same unit ``u`` (stops a coefficient that is zero up to noise
+  from dominating).
+* Single-step (:func:`static_problem`, supplementary material): the static data
+  ``||Y_s phi - s||^2`` directly. Each row type of ``s`` (``M_ij`` in kg m^2, ``g_j`` in
+  N m) is divided by its RMS over the configurations, and the stack is compressed by a
+  QR factorisation of the weighted base regressor, ``W_w = Q R``: ``A = R P``,
+  ``b = Q^T y_w``, ``f_off = ||y_w||^2 - ||Q^T y_w||^2``; the term is finally scaled by
+  ``r / ||y_w||^2`` (r coefficients), so that it is ``r`` at ``phi = 0`` as the two-step
+  term is.
+
+**Constraints** ``h_j(p) >= delta_j``, each divided by a scale ``s_j``:
+
+* per link, the triangle inequality ``tr(I)/2 - lambda_max(I)`` and positive
+  definiteness ``lambda_min(I)`` [kg m^2], scale ``s_I`` = the link's largest bound of a
+  principal moment (:meth:`~dynid.feasibility.constraints.Bounds.inertia_scale`),
+  target margin ``delta = margin * s_I``;
+* the total-mass band, ``M - M_min`` and ``M_max - M`` [kg], scale ``M_max``, target
+  ``margin * M_max``;
+* user constraints, whose violation ``v(p) >= 0`` enters as it is.
+
+The violation distance (eq. 32) is ``g_j = max(0, delta_j - h_j) / s_j`` (``v`` for a
+user constraint). Masses, CoMs and inertia entries are kept inside their box by the
+optimisers themselves: the box is shrunk by ``margin`` times its width so that every
+bound holds with a margin too.
+
+**Stage objective** (eq. 29, stage ``k`` with penalty weight ``xi_k``):
+
+.. math:: F_k(p) = f_0(p) + \\xi_k \\sum_j g_j(p)^2
+
+(:meth:`PenaltyProblem.stage_cost`). Departure from the paper, on purpose: Gaz et al.
+add ``xi_k sum_j g_j`` (the distances themselves). The squared distances have the same
+zero set, so the same minimisers wherever the constraints can be met, but make ``F_k``
+differentiable and a sum of squares: the annealing and the local refinement (a
+Levenberg-Marquardt method on the residual vector ``[A phi - b; sqrt(xi_k) g]``,
+:meth:`PenaltyProblem.lsq_residual`, :meth:`PenaltyProblem.lsq_jacobian`) then minimise
+the same function. With the distances, the annealing traded real data fit for
+round-off-sized violations that the refinement then undid. The target margins
+``delta_j`` keep the result strictly feasible although a quadratic penalty leaves
+violations of order ``1 / xi`` of the targets.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+import scipy.linalg
+from numpy.typing import ArrayLike, NDArray
+
+from .. import _checks
+from ..exceptions import DataError, ShapeError
+from ..model.robot import Robot
+from ..regressors.base import BaseParameters, base_parameters
+from ..regressors.static import static_regressor, static_vector
+from .constraints import Bounds, UserConstraint, default_bounds, user_constraints
+
+__all__ = [
+    "DEFAULT_MARGIN",
+    "DEFAULT_SCALE_FLOOR",
+    "PenaltyProblem",
+    "coefficient_problem",
+    "coefficient_scales",
+    "static_problem",
+    "phi_from_params",
+]
+
+#: Relative target margin of the constraints and relative shrink of the box.
+DEFAULT_MARGIN = 1e-6
+#: Floor of the coefficient scales, relative to the largest kept coefficient of a unit.
+DEFAULT_SCALE_FLOOR = 1e-3
+
+_IU = np.array([0, 1, 2, 1, 3, 4, 2, 4, 5])  # (6,) -> 3x3 symmetric, row-major
+
+
+def phi_from_params(p: NDArray[np.float64]) -> NDArray[np.float64]:
+    """Standard parameters (n, 10) from decision parameters (n, 10) (validated input)."""
+    m, c = p[:, 0], p[:, 1:4]
+    mc = m[:, None] * c
+    phi = np.empty_like(p)
+    phi[:, 0] = m
+    phi[:, 1:4] = mc
+    phi[:, 4:] = p[:, 4:]
+    phi[:, 4] += mc[:, 1] * c[:, 1] + mc[:, 2] * c[:, 2]
+    phi[:, 5] -= mc[:, 0] * c[:, 1]
+    phi[:, 6] -= mc[:, 0] * c[:, 2]
+    phi[:, 7] += mc[:, 0] * c[:, 0] + mc[:, 2] * c[:, 2]
+    phi[:, 8] -= mc[:, 1] * c[:, 2]
+    phi[:, 9] += mc[:, 0] * c[:, 0] + mc[:, 1] * c[:, 1]
+    return phi
+
+
+def _phi_jacobian(p: NDArray[np.float64]) -> NDArray[np.float64]:
+    """d phi_i / d p_i per link, shape (n, 10, 10)."""
+    n = p.shape[0]
+    m, cx, cy, cz = p[:, 0], p[:, 1], p[:, 2], p[:, 3]
+    J = np.zeros((n, 10, 10))
+    J[:, 0, 0] = 1.0
+    for a in range(3):
+        J[:, 1 + a, 0] = p[:, 1 + a]
+        J[:, 1 + a, 1 + a] = m
+    J[:, 4, 0] = cy * cy + cz * cz
+    J[:, 5, 0] = -cx * cy
+    J[:, 6, 0] = -cx * cz
+    J[:, 7, 0] = cx * cx + cz * cz
+    J[:, 8, 0] = -cy * cz
+    J[:, 9, 0] = cx * cx + cy * cy
+    J[:, 4, 2], J[:, 4, 3] = 2 * m * cy, 2 * m * cz
+    J[:, 5, 1], J[:, 5, 2] = -m * cy, -m * cx
+    J[:, 6, 1], J[:, 6, 3] = -m * cz, -m * cx
+    J[:, 7, 1], J[:, 7, 3] = 2 * m * cx, 2 * m * cz
+    J[:, 8, 2], J[:, 8, 3] = -m * cz, -m * cy
+    J[:, 9, 1], J[:, 9, 2] = 2 * m * cx, 2 * m * cy
+    idx = np.arange(4, 10)
+    J[:, idx, idx] = 1.0
+    return J
+
+
+@dataclass(frozen=True, slots=True, eq=False)
+class PenaltyProblem:
+    """The precomputed data term, box and constraints of one retrieval.
+
+    Attributes
+    ----------
+    n : int
+        Number of links.
+    A : ndarray, shape (m, 10 n)
+        Scaled linear map of the standard parameters (``robot.param_labels`` order).
+    b : ndarray, shape (m,)
+    offset : float
+        Constant part of the data term (0 for the two-step objective).
+    lower, upper : ndarray, shape (10 n,)
+        The (shrunk) box of the decision parameters, decision layout.
+    inertia_scale : ndarray, shape (n,)
+        ``s_I`` per link [kg m^2].
+    total_mass : (float, float) or None
+        Total-mass band [kg].
+    extra : tuple of UserConstraint
+    margin : float
+        Relative target margin ``delta / s``.
+    report_A, report_b, report_offset, report_norm
+        Unscaled data term for the relative residual:
+        ``sqrt(||report_A phi - report_b||^2 + report_offset) / report_norm``.
+    kind : str
+        ``"coefficients"`` or ``"static"``.
+    """
+
+    n: int
+    A: NDArray[np.float64]
+    b: NDArray[np.float64]
+    offset: float
+    lower: NDArray[np.float64]
+    upper: NDArray[np.float64]
+    inertia_scale: NDArray[np.float64]
+    total_mass: tuple[float, float] | None
+    extra: tuple[UserConstraint, ...]
+    margin: float
+    report_A: NDArray[np.float64]
+    report_b: NDArray[np.float64]
+    report_offset: float
+    report_norm: float
+    kind: str
+
+    # ------------------------------------------------------------------ variables
+    @property
+    def dim(self) -> int:
+        """Number of decision variables, ``10 n``."""
+        return 10 * self.n
+
+    @property
+    def width(self) -> NDArray[np.float64]:
+        """``upper - lower`` (10 n,)."""
+        return self.upper - self.lower
+
+    def p_from_z(self, z: NDArray[np.float64]) -> NDArray[np.float64]:
+        """Decision parameters (n, 10) from normalised variables (10 n,)."""
+        return (self.lower + np.asarray(z) * (self.upper - self.lower)).reshape(self.n, 10)
+
+    def z_from_p(self, p: ArrayLike) -> NDArray[np.float64]:
+        """Normalised variables (10 n,) of decision parameters (n, 10), clipped to [0, 1]."""
+        w = self.upper - self.lower
+        safe = np.where(w > 0, w, 1.0)
+        z = (np.asarray(p, dtype=np.float64).reshape(-1) - self.lower) / safe
+        return np.clip(np.where(w > 0, z, 0.5), 0.0, 1.0)
+
+    # ------------------------------------------------------------------ data term
+    def residual(self, z: NDArray[np.float64]) -> NDArray[np.float64]:
+        """Scaled data residual ``A phi(p) - b`` (m,)."""
+        return self.A @ phi_from_params(self.p_from_z(z)).reshape(-1) - self.b
+
+    def residual_jacobian(self, z: NDArray[np.float64]) -> NDArray[np.float64]:
+        """d residual / d z, shape (m, 10 n)."""
+        p = self.p_from_z(z)
+        An = self.A.reshape(self.A.shape[0], self.n, 10)
+        J = np.einsum("rik,ikl->ril", An, _phi_jacobian(p)).reshape(self.A.shape[0], -1)
+        return J * self.width
+
+    def data_cost(self, z: NDArray[np.float64]) -> float:
+        """``f_0 = ||A phi - b||^2 + offset``."""
+        r = self.residual(z)
+        return float(r @ r) + self.offset
+
+    def relative_residual(self, p: ArrayLike) -> float:
+        """Unscaled relative residual of the data term at decision parameters (n, 10).
+
+        Two-step: ``||pi(p) - pi_hat|| / ||pi_hat||`` over the kept coefficients;
+        single-step: ``||Y_s phi(p) - s|| / ||s||`` over the static data.
+        """
+        phi = phi_from_params(np.asarray(p, dtype=np.float64).reshape(self.n, 10)).reshape(-1)
+        e = self.report_A @ phi - self.report_b
+        ss = max(float(e @ e) + self.report_offset, 0.0)
+        return float(np.sqrt(ss) / self.report_norm) if self.report_norm > 0 else float(np.sqrt(ss))
+
+    # ------------------------------------------------------------------ constraints
+    @property
+    def n_constraints(self) -> int:
+        """Number of penalised constraints: 2 per link, 2 for a mass band, the user's."""
+        return 2 * self.n + (2 if self.total_mass is not None else 0) + len(self.extra)
+
+    def constraint_names(self) -> tuple[str, ...]:
+        """Names of the penalised constraints, in the order of :meth:`violations`."""
+        names = [f"triangle_inequality[{i + 1}]" for i in range(self.n)]
+        names += [f"inertia_positive_definite[{i + 1}]" for i in range(self.n)]
+        if self.total_mass is not None:
+            names += ["total_mass_min", "total_mass_max"]
+        names += [uc.name for uc in self.extra]
+        return tuple(names)
+
+    def _eig(self, p: NDArray[np.float64], vectors: bool):
+        I = p[:, 4:][:, _IU].reshape(self.n, 3, 3)
+        return np.linalg.eigh(I) if vectors else np.linalg.eigvalsh(I)
+
+    def slacks(self, z: NDArray[np.float64]) -> NDArray[np.float64]:
+        """Scaled signed violations ``(delta_j - h_j) / s_j`` (positive when violated;
+        user constraints: their violation ``v >= 0``), :meth:`constraint_names` order."""
+        p = self.p_from_z(z)
+        lam = self._eig(p, False)
+        sI = self.inertia_scale
+        d = self.margin
+        out = [d - 0.5 * (lam[:, 0] + lam[:, 1] - lam[:, 2]) / sI, d - lam[:, 0] / sI]
+        if self.total_mass is not None:
+            lo, hi = self.total_mass
+            M = float(p[:, 0].sum())
+            out.append(np.array([d - (M - lo) / hi, d - (hi - M) / hi]))
+        if self.extra:
+            out.append(np.array([max(0.0, float(uc.violation(p.copy()))) for uc in self.extra]))
+        return np.concatenate(out)
+
+    def violations(self, z: NDArray[np.float64]) -> NDArray[np.float64]:
+        """Scaled violation distances ``g_j = max(0, slack_j) >= 0`` (eq. 32)."""
+        return np.maximum(self.slacks(z), 0.0)
+
+    def violation_jacobian(self, z: NDArray[np.float64], band: float = 0.0) -> NDArray[np.float64]:
+        """Jacobian of the violations w.r.t. ``z``, shape (n_constraints, 10 n).
+
+        Rows of constraints with ``slack_j > -band`` (violated, or within ``band`` of
+        their target) hold ``d slack_j / d z``; the others are zero. ``band > 0`` gives the
+        refinement a sticky active set: a constraint at its target is held there
+        instead of being released and violated again by the next step. Eigenvalue
+        derivatives ``d lambda = v^T dI v`` (simple eigenvalues); user constraints by
+        forward differences (only when violated).
+        """
+        z = np.asarray(z, dtype=np.float64)
+        sl = self.slacks(z)
+        n, w = self.n, self.width
+        p = self.p_from_z(z)
+        lam, V = self._eig(p, True)
+        K = np.zeros((self.n_constraints, 10 * n))
+        sI = self.inertia_scale
+        act = sl > -band
+
+        def d_lam(v: NDArray[np.float64]) -> NDArray[np.float64]:
+            # derivative of v^T I v w.r.t. (xx, xy, xz, yy, yz, zz), (n, 6)
+            x, y, zz = v[:, 0], v[:, 1], v[:, 2]
+            return np.stack([x * x, 2 * x * y, 2 * x * zz, y * y, 2 * y * zz, zz * zz], axis=1)
+
+        half_tr = np.tile([0.5, 0.0, 0.0, 0.5, 0.0, 0.5], (n, 1))
+        dT = half_tr - d_lam(V[:, :, 2])  # d(tr/2 - lambda_max)
+        dP = d_lam(V[:, :, 0])  # d lambda_min
+        for i in range(n):
+            cols = slice(10 * i + 4, 10 * i + 10)
+            if act[i]:
+                K[i, cols] = -dT[i] / sI[i]
+            if act[n + i]:
+                K[n + i, cols] = -dP[i] / sI[i]
+        k = 2 * n
+        if self.total_mass is not None:
+            hi = self.total_mass[1]
+            mcols = np.arange(n) * 10
+            if act[k]:
+                K[k, mcols] = -1.0 / hi
+            if act[k + 1]:
+                K[k + 1, mcols] = 1.0 / hi
+            k += 2
+        K *= w  # analytic rows: d/dp -> d/dz
+        for uc in self.extra:
+            if sl[k] > 0:  # forward differences in z
+                h = 1e-7
+                for j in range(10 * n):
+                    zj = z.copy()
+                    step = h if zj[j] + h <= 1.0 else -h
+                    zj[j] += step
+                    gj = max(0.0, float(uc.violation(self.p_from_z(zj))))
+                    K[k, j] = (gj - sl[k]) / step
+            k += 1
+        return K
+
+    # ------------------------------------------------------------------ objectives
+    def stage_cost(self, z: NDArray[np.float64], xi: float = 0.0) -> float:
+        """Stage objective ``F = f_0 + xi * sum_j g_j^2`` (eq. 29; squared eq. 32 distances)."""
+        f = self.data_cost(z)
+        if xi > 0.0:
+            g = self.violations(z)
+            f += xi * float(g @ g)
+        return f
+
+    def lsq_residual(self, z: NDArray[np.float64], xi: float) -> NDArray[np.float64]:
+        """Residual ``[A phi - b; sqrt(xi) g]``: ``||.||^2 + offset`` is :meth:`stage_cost`."""
+        r = self.residual(z)
+        if xi <= 0.0:
+            return r
+        return np.concatenate([r, np.sqrt(xi) * self.violations(z)])
+
+    def lsq_jacobian(
+        self, z: NDArray[np.float64], xi: float, band: float = 0.0
+    ) -> NDArray[np.float64]:
+        """Jacobian of :meth:`lsq_residual` w.r.t. ``z`` (``band``: see
+        :meth:`violation_jacobian`)."""
+        J = self.residual_jacobian(z)
+        if xi <= 0.0:
+            return J
+        return np.vstack([J, np.sqrt(xi) * self.violation_jacobian(z, band)])
+
+
+# ------------------------------------------------------------------------ builders
+def _box(bounds: Bounds, margin: float) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+    lo, hi = bounds.lower.reshape(-1), bounds.upper.reshape(-1)
+    shrink = margin * (hi - lo)
+    return lo + shrink, hi - shrink
+
+
+def _unit_class(base: BaseParameters) -> NDArray[np.intp]:
+    """0 for coefficients led by a mass (kg), 1 by a first moment (kg m), 2 by an inertia."""
+    k = np.asarray(base.independent) % 10
+    return np.where(k == 0, 0, np.where(k < 4, 1, 2))
+
+
+def coefficient_scales(
+    base: BaseParameters,
+    beta: NDArray[np.float64],
+    std: NDArray[np.float64] | None,
+    kept: NDArray[np.bool_],
+    scale_floor: float = DEFAULT_SCALE_FLOOR,
+) -> NDArray[np.float64]:
+    """Scales ``s_k = max(|pi_hat_k|, sigma_k, floor_u(k))`` of the coefficients (r,).
+
+    ``floor_u = scale_floor * max |pi_hat_j|`` over kept ``j`` of the same unit class
+    (kg, kg m, kg m^2), or over all kept coefficients when the class has none nonzero.
+    """
+    u = _unit_class(base)
+    a = np.abs(beta)
+    top = float(np.max(a[kept], initial=0.0)) or 1.0
+    floors = np.array([float(np.max(a[kept & (u == c)], initial=0.0)) or top for c in range(3)])
+    s = np.maximum(a, scale_floor * floors[u])
+    if std is not None:
+        s = np.maximum(s, np.abs(std))
+    return s
+
+
+def _common(
+    robot: Robot,
+    bounds: Bounds | None,
+    total_mass: tuple[float, float] | None,
+    extra: Sequence[Any],
+    margin: float,
+) -> tuple[Bounds, tuple[float, float] | None, tuple[UserConstraint, ...]]:
+    if not 0.0 <= margin < 0.5:
+        raise ValueError(f"margin must be in [0, 0.5); got {margin}")
+    b = default_bounds(robot) if bounds is None else bounds
+    if b.n != robot.n:
+        raise ShapeError(f"bounds are for {b.n} links; robot {robot.name!r} has {robot.n}")
+    band = total_mass if total_mass is not None else b.total_mass
+    if band is not None:
+        lo, hi = (float(x) for x in band)
+        if not (0 <= lo <= hi):
+            raise ValueError(f"total_mass must be (min, max) with 0 <= min <= max; got {band}")
+        band = (lo, hi)
+    return b, band, user_constraints(extra)
+
+
+def coefficient_problem(
+    robot: Robot,
+    base: BaseParameters,
+    beta: ArrayLike,
+    *,
+    std: ArrayLike | None = None,
+    kept: ArrayLike | None = None,
+    bounds: Bounds | None = None,
+    total_mass: tuple[float, float] | None = None,
+    extra: Sequence[Any] = (),
+    margin: float = DEFAULT_MARGIN,
+    scale_floor: float = DEFAULT_SCALE_FLOOR,
+) -> PenaltyProblem:
+    """The two-step objective: match identified coefficients (Gaz et al. 2019, eq. 29).
+
+    .. math:: f_0(p) = \\sum_{k\\ kept} \\left(\\frac{(P \\phi(p))_k - \\hat\\pi_k}{s_k}\\right)^2
+
+    Parameters
+    ----------
+    robot : Robot
+        Kinematics (its inertial parameters are not used).
+    base : BaseParameters
+        The coefficients' definition, ``pi = P phi``.
+    beta : array_like, shape (r,)
+        Identified coefficients ``pi_hat`` [kg, kg m or kg m^2 each].
+    std : array_like, shape (r,), optional
+        Their standard deviations (same units).
+    kept : array_like of bool, shape (r,), optional
+        Coefficients to use (pruned ones are ignored); default all.
+    bounds : Bounds, optional
+        Default :func:`~dynid.feasibility.constraints.default_bounds`.
+    total_mass : (float, float), optional
+        Overrides ``bounds.total_mass`` [kg].
+    extra : sequence
+        User constraints (:func:`~dynid.feasibility.constraints.user_constraints`).
+    margin, scale_floor : float
+        See the module docstring.
+
+    Returns
+    -------
+    PenaltyProblem
+
+    Raises
+    ------
+    ShapeError
+        Sizes of ``beta``, ``std``, ``kept``, ``base`` and ``bounds`` disagree with the robot.
+    DataError
+        No kept coefficient.
+    """
+    if base.n_std != 10 * robot.n:
+        raise ShapeError(
+            f"base parameters are for {base.n_std} standard parameters; robot has {10 * robot.n}"
+        )
+    r = base.rank
+    beta = _checks.as_exact("beta", beta, (r,))
+    sd = None if std is None else np.abs(_checks.as_exact("std", std, (r,)))
+    keep = np.ones(r, bool) if kept is None else np.asarray(kept, dtype=bool)
+    if keep.shape != (r,):
+        raise ShapeError(f"kept must have shape ({r},); got {keep.shape}")
+    if not keep.any():
+        raise DataError("no kept coefficient to match")
+    b, band, ucs = _common(robot, bounds, total_mass, extra, margin)
+    s = coefficient_scales(base, beta, sd, keep, scale_floor)
+    P = base.projection[keep]
+    lo, hi = _box(b, margin)
+    return PenaltyProblem(
+        n=robot.n,
+        A=_checks.frozen(P / s[keep][:, None]),
+        b=_checks.frozen(beta[keep] / s[keep]),
+        offset=0.0,
+        lower=_checks.frozen(lo),
+        upper=_checks.frozen(hi),
+        inertia_scale=_checks.frozen(b.inertia_scale()),
+        total_mass=band,
+        extra=ucs,
+        margin=float(margin),
+        report_A=_checks.frozen(P),
+        report_b=_checks.frozen(beta[keep]),
+        report_offset=0.0,
+        report_norm=float(np.linalg.norm(beta[keep])),
+        kind="coefficients",
+    )
+
+
+def static_problem(
+    robot: Robot,
+    q: ArrayLike,
+    M: ArrayLike,
+    g: ArrayLike,
+    *,
+    base: BaseParameters | None = None,
+    bounds: Bounds | None = None,
+    total_mass: tuple[float, float] | None = None,
+    extra: Sequence[Any] = (),
+    margin: float = DEFAULT_MARGIN,
+) -> PenaltyProblem:
+    """The single-step objective on static data (Gaz et al. 2019, supplementary material).
+
+    .. math:: f_0(p) = \\frac{r}{\\|y_w\\|^2} \\| D (Y_s \\phi(p) - s) \\|^2
+
+    with ``s = [tril M; g]`` stacked over the configurations and ``D`` the row weights
+    (1 / RMS of each row type); see the module docstring for the QR compression.
+
+    Parameters
+    ----------
+    robot : Robot
+        Kinematics and gravity the data were recorded with.
+    q : array_like, shape (N, n)
+        Configurations [rad].
+    M : array_like, shape (N, n, n)
+        Inertia matrices [kg m^2].
+    g : array_like, shape (N, n)
+        Gravity torques [N m].
+    base : BaseParameters, optional
+        Default ``base_parameters(robot)``.
+    bounds, total_mass, extra, margin
+        As for :func:`coefficient_problem`.
+
+    Returns
+    -------
+    PenaltyProblem
+
+    Raises
+    ------
+    ShapeError
+        Inconsistent shapes.
+    DataError
+        Fewer stacked rows than coefficients.
+    """
+    n = robot.n
+    q = _checks.as_array("q", q)
+    if q.ndim != 2 or q.shape[1] != n:
+        raise ShapeError(f"q must have shape (N, {n}); got {q.shape}")
+    N = q.shape[0]
+    M = _checks.as_exact("M", M, (N, n, n))
+    g = _checks.as_exact("g", g, (N, n))
+    base = base_parameters(robot) if base is None else base
+    y = static_vector(M, g)  # (N, rows)
+    Yb = base.reduce(static_regressor(robot, q))  # (N, rows, r)
+    rms = np.sqrt(np.mean(y**2, axis=0))
+    rms_reg = np.sqrt(np.mean(np.sum(Yb**2, axis=2), axis=0))
+    informative = rms_reg > 1e-12 * max(float(rms_reg.max(initial=0.0)), 1e-300)
+    floor = 1e-6 * float(rms.max(initial=0.0)) or 1.0
+    w = np.where(informative, 1.0 / np.maximum(rms, floor), 0.0)
+    W = (Yb * w[None, :, None]).reshape(-1, base.rank)
+    yw = (y * w[None, :]).reshape(-1)
+    if W.shape[0] < base.rank:
+        raise DataError(f"{W.shape[0]} stacked rows < {base.rank} coefficients; add configurations")
+    P = base.projection
+    Q, R = scipy.linalg.qr(W, mode="economic")
+    qy = Q.T @ yw
+    ny2 = float(yw @ yw)
+    k = np.sqrt(base.rank / ny2) if ny2 > 0 else 1.0
+    # unweighted copy for the reported residual
+    Wu = Yb.reshape(-1, base.rank)
+    yu = y.reshape(-1)
+    Qu, Ru = scipy.linalg.qr(Wu, mode="economic")
+    qyu = Qu.T @ yu
+    b, band, ucs = _common(robot, bounds, total_mass, extra, margin)
+    lo, hi = _box(b, margin)
+    return PenaltyProblem(
+        n=n,
+        A=_checks.frozen(k * (R @ P)),
+        b=_checks.frozen(k * qy),
+        offset=max(k * k * (ny2 - float(qy @ qy)), 0.0),
+        lower=_checks.frozen(lo),
+        upper=_checks.frozen(hi),
+        inertia_scale=_checks.frozen(b.inertia_scale()),
+        total_mass=band,
+        extra=ucs,
+        margin=float(margin),
+        report_A=_checks.frozen(Ru @ P),
+        report_b=_checks.frozen(qyu),
+        report_offset=max(float(yu @ yu) - float(qyu @ qyu), 0.0),
+        report_norm=float(np.linalg.norm(yu)),
+        kind="static",
+    )

@@ -1,0 +1,148 @@
+"""Export a robot (e.g. with retrieved feasible parameters) as URDF for simulators.
+
+:func:`urdf_from_robot` writes one ``<link>`` per link of the robot and one ``<joint>``
+per joint, keeping the robot's link and joint names:
+
+* link ``i`` (1..n) carries an ``<inertial>``: ``<origin xyz="c_i" rpy="0 0 0"/>`` (the
+  CoM in the link frame [m]), ``<mass value="m_i"/>`` [kg] and ``<inertia ixx ixy ixz iyy
+  iyz izz/>`` [kg m^2], the tensor **about the CoM** in link axes (URDF's convention:
+  the entries of the matrix, products of inertia included with their sign). The base
+  link (link 0) has no inertial (it does not enter a fixed-base model).
+* joint ``i``: ``<origin xyz rpy>`` = ``T_parent_joint[i]`` (URDF roll-pitch-yaw
+  ``Rz(yaw) Ry(pitch) Rx(roll)``, :func:`dynid.spatial.rpy_from_matrix`),
+  ``<axis xyz>`` in the child link, ``revolute`` (``continuous`` when it has no position
+  limits) or ``prismatic``, ``<limit lower upper effort velocity>``. URDF (urdfdom)
+  requires finite ``effort`` and ``velocity`` and a prismatic joint's ``lower``/``upper``:
+  a missing (infinite) limit is written as the largest float, ``1.7976931348623157e+308``.
+* the ``flange`` frame becomes a ``fixed`` joint ``<last link>_flange_joint`` to a
+  massless link ``flange`` (unless a link is already named so), so that the file's
+  only leaf is the flange and ``Robot.from_urdf(path)`` needs no ``tip_link``. With
+  ``all_frames=True`` every other named frame is written the same way (then load with
+  ``tip_link="flange"``).
+
+Gravity and friction are not part of URDF and are not written. Numbers use Python's
+shortest round-trip representation, so the parameters read back exactly.
+"""
+
+from __future__ import annotations
+
+import sys
+from pathlib import Path
+from xml.sax.saxutils import quoteattr
+
+import numpy as np
+
+from .. import __version__, spatial
+from ..model.inertia import inertia6_from_matrix
+from ..model.robot import Robot
+
+__all__ = ["urdf_from_robot", "save_urdf"]
+
+_BIG = sys.float_info.max
+
+
+def _f(x: float) -> str:
+    x = float(x)
+    if x == 0.0:
+        return "0"
+    return repr(x)
+
+
+def _v(v: np.ndarray) -> str:
+    return " ".join(_f(x) for x in v)
+
+
+def _fixed(name: str, parent: str, T: np.ndarray) -> list[str]:
+    """A fixed joint ``<name>_joint`` from ``parent`` to a massless link ``name``."""
+    rpy = spatial.rpy_from_matrix(T[:3, :3])
+    return [
+        f'  <joint name={quoteattr(name + "_joint")} type="fixed">',
+        f"    <parent link={quoteattr(parent)}/>",
+        f"    <child link={quoteattr(name)}/>",
+        f'    <origin xyz="{_v(T[:3, 3])}" rpy="{_v(rpy)}"/>',
+        "  </joint>",
+        f"  <link name={quoteattr(name)}/>",
+    ]
+
+
+def urdf_from_robot(robot: Robot, *, all_frames: bool = False, comment: str | None = None) -> str:
+    """The URDF document of a robot: kinematics, limits and link inertials.
+
+    Parameters
+    ----------
+    robot : Robot
+    all_frames : bool
+        Also write every named frame other than the links and ``flange`` as a fixed,
+        massless link (see the module docstring).
+    comment : str, optional
+        Text of an XML comment at the top (default: the writer and the conventions).
+
+    Returns
+    -------
+    str
+        The URDF XML text.
+    """
+    n = robot.n
+    I6 = inertia6_from_matrix(robot.inertia)
+    mass, com = robot.mass, robot.com
+    text = comment or (
+        f"written by dynid {__version__}: inertials about the CoM in link axes [kg, m, kg m^2]; "
+        "gravity and friction are not part of URDF"
+    )
+    lines = [
+        '<?xml version="1.0"?>',
+        f"<!-- {text.replace('--', '- -')} -->",
+        f"<robot name={quoteattr(robot.name)}>",
+    ]
+    lines.append(f"  <link name={quoteattr(robot.link_names[0])}/>")
+    for i in range(n):
+        T = robot.T_parent_joint[i]
+        rpy = spatial.rpy_from_matrix(T[:3, :3])
+        lo, hi = robot.q_min[i], robot.q_max[i]
+        if robot.prismatic[i]:
+            jtype = "prismatic"
+        elif np.isfinite(lo) and np.isfinite(hi):
+            jtype = "revolute"
+        else:
+            jtype = "continuous"
+        eff = robot.tau_max[i] if np.isfinite(robot.tau_max[i]) else _BIG
+        vel = robot.dq_max[i] if np.isfinite(robot.dq_max[i]) else _BIG
+        limit = f'effort="{_f(eff)}" velocity="{_f(vel)}"'
+        if jtype != "continuous":
+            lo_s = lo if np.isfinite(lo) else -_BIG
+            hi_s = hi if np.isfinite(hi) else _BIG
+            limit = f'lower="{_f(lo_s)}" upper="{_f(hi_s)}" ' + limit
+        child = robot.link_names[i + 1]
+        lines += [
+            f'  <joint name={quoteattr(robot.joint_names[i])} type="{jtype}">',
+            f"    <parent link={quoteattr(robot.link_names[i])}/>",
+            f"    <child link={quoteattr(child)}/>",
+            f'    <origin xyz="{_v(T[:3, 3])}" rpy="{_v(rpy)}"/>',
+            f'    <axis xyz="{_v(robot.axes[i])}"/>',
+            f"    <limit {limit}/>",
+            "  </joint>",
+            f"  <link name={quoteattr(child)}>",
+            "    <inertial>",
+            f'      <origin xyz="{_v(com[i])}" rpy="0 0 0"/>',
+            f'      <mass value="{_f(mass[i])}"/>',
+            '      <inertia ixx="{}" ixy="{}" ixz="{}" iyy="{}" iyz="{}" izz="{}"/>'.format(
+                *(_f(x) for x in I6[i])
+            ),
+            "    </inertial>",
+            "  </link>",
+        ]
+    names = set(robot.link_names)
+    frames = [("flange", robot.frame("flange"))] if "flange" not in names else []
+    if all_frames:
+        frames += [(k, f) for k, f in robot.frames.items() if k not in names and k != "flange"]
+    for name, f in frames:
+        lines += _fixed(name, robot.link_names[f.link], f.T_link_frame)
+    lines.append("</robot>")
+    return "\n".join(lines) + "\n"
+
+
+def save_urdf(path: str | Path, robot: Robot, *, all_frames: bool = False) -> Path:
+    """Write :func:`urdf_from_robot` to ``path``; returns the path."""
+    path = Path(path)
+    path.write_text(urdf_from_robot(robot, all_frames=all_frames), encoding="utf-8")
+    return path

@@ -1,0 +1,195 @@
+"""The ``dynid retrieve`` subcommand and the demo stage of the feasible-parameter retrieval.
+
+References: the files are read back with the library's readers (feasible.json, URDF,
+report.json) and compared with the identified model's torques.
+"""
+
+from __future__ import annotations
+
+import json
+
+import numpy as np
+import pytest
+
+import dynid
+from dynid.cli.__main__ import main
+from dynid.feasibility.constraints import panda_bounds
+from dynid.identification.data import StaticDataset
+from dynid.identification.least_squares import LeastSquaresFit
+from dynid.identification.log import TorqueLog
+from dynid.identification.model import IdentifiedModel
+from dynid.io.feasible import load_feasible_json, save_bounds
+from dynid.io.model_json import save_model_json
+from dynid.io.static_data import save_static_data
+from dynid.regressors.base import base_parameters
+
+from conftest import random_states
+
+
+def _model() -> IdentifiedModel:
+    panda = dynid.panda()
+    base = base_parameters(panda)
+    r = base.rank
+    fit = LeastSquaresFit(
+        base.beta_from_phi(panda.phi),
+        np.zeros(r),
+        np.zeros(r),
+        np.ones(r, bool),
+        r,
+        1.0,
+        0.0,
+        0.0,
+        0.0,
+        0,
+        1e-10,
+    )
+    return IdentifiedModel(panda, base, fit)
+
+
+@pytest.fixture(scope="module")
+def model_file(tmp_path_factory):
+    path = tmp_path_factory.mktemp("ident") / "identification.json"
+    save_model_json(path, _model())
+    return path
+
+
+def test_retrieve_writes_feasible_parameters_urdf_toml_and_report(model_file, tmp_path, capsys):
+    """dynid retrieve writes the four files, reports progress on stderr and a summary on stdout."""
+    out = tmp_path / "feasible"
+    rc = main(
+        [
+            "retrieve",
+            "--model",
+            str(model_file),
+            "--runs",
+            "3",
+            "--workers",
+            "1",
+            "--seed",
+            "0",
+            "--out",
+            str(out),
+        ]
+    )
+    cap = capsys.readouterr()
+    assert rc == 0
+    assert "run  3/3" in cap.err and "FEASIBLE" in cap.out
+    for name in ("feasible.json", "robot.urdf", "robot.toml", "report.json", "retrieval.png"):
+        assert (out / name).is_file(), name
+    rep = json.loads((out / "report.json").read_text())
+    assert rep["feasible"] and rep["relative_residual"] <= 1e-4 and rep["seed"] == 0
+    robot = load_feasible_json(out / "feasible.json")
+    model = _model()
+    q, dq, ddq = random_states(robot, 200, 21)
+    tau = model.torques(q, dq, ddq)
+    np.testing.assert_allclose(dynid.rnea(robot, q, dq, ddq), tau, atol=1e-6 * np.abs(tau).max())
+    for loaded in (
+        dynid.Robot.from_urdf(out / "robot.urdf"),
+        dynid.Robot.from_toml(out / "robot.toml"),
+    ):
+        np.testing.assert_allclose(loaded.phi, robot.phi, atol=1e-14)
+
+
+def test_retrieve_reports_a_contradictory_total_mass_band(model_file, tmp_path, capsys):
+    """A total-mass band the coefficients rule out gives exit code 1 and feasible false."""
+    out = tmp_path / "bad"
+    rc = main(
+        [
+            "retrieve",
+            "--model",
+            str(model_file),
+            "--runs",
+            "2",
+            "--stages",
+            "4",
+            "--workers",
+            "1",
+            "--total-mass",
+            "1,3",
+            "--no-figures",
+            "--out",
+            str(out),
+        ]
+    )
+    cap = capsys.readouterr()
+    assert rc == 1 and "INFEASIBLE" in cap.out
+    rep = json.loads((out / "report.json").read_text())
+    assert rep["feasible"] is False and rep["total_mass"] == [1.0, 3.0]
+    assert not json.loads((out / "feasible.json").read_text())["feasible"]
+
+
+def test_retrieve_single_step_from_static_data_with_a_bounds_file(tmp_path, capsys):
+    """--static with --bounds: the single-step variant on a static data file."""
+    panda = dynid.panda()
+    q = random_states(panda, 40, 22)[0]
+    data = StaticDataset(q, dynid.mass_matrix(panda, q), dynid.gravity_torques(panda, q))
+    static = save_static_data(tmp_path / "static.csv", data)
+    bounds = save_bounds(tmp_path / "bounds.json", panda_bounds())
+    out = tmp_path / "single"
+    rc = main(
+        [
+            "retrieve",
+            "--static",
+            str(static),
+            "--robot",
+            "panda",
+            "--bounds",
+            str(bounds),
+            "--runs",
+            "3",
+            "--workers",
+            "1",
+            "--no-figures",
+            "-q",
+            "--out",
+            str(out),
+        ]
+    )
+    assert rc == 0 and capsys.readouterr().out == ""
+    rep = json.loads((out / "report.json").read_text())
+    assert rep["kind"] == "static" and rep["feasible"] and rep["relative_residual"] <= 1e-4
+
+
+@pytest.mark.parametrize(
+    "extra, match",
+    [
+        ([], "not a JSON file"),
+        (["--runs", "0"], "--runs"),
+        (["--total-mass", "5,1"], "--total-mass"),
+    ],
+)
+def test_retrieve_error_is_one_line_with_exit_code_2(model_file, tmp_path, capsys, extra, match):
+    """A malformed model file or bad options give a one-line error and exit code 2."""
+    path = model_file
+    if not extra:
+        path = tmp_path / "identification.json"
+        path.write_text("{not json")
+    rc = main(["retrieve", "--model", str(path), "--out", str(tmp_path / "o")] + extra)
+    err = capsys.readouterr().err
+    assert rc == 2 and err.startswith("dynid retrieve: error:") and match in err
+    assert len(err.strip().splitlines()) == 1
+
+
+def test_demo_stage_retrieves_exports_and_validates(tmp_path, capsys):
+    """demo_stage: feasible parameters, files, Newton-Euler validation against a log."""
+    from dynid.cli.retrieve import demo_stage
+    from dynid.friction.model import SigmoidFriction
+
+    panda = dynid.panda()
+    rng = np.random.default_rng(23)
+    t = np.arange(400) * 1e-3
+    q, dq, ddq = random_states(panda, 1, 23)
+    q = q + 0.2 * np.sin(2 * np.pi * t)[:, None]
+    dq = np.broadcast_to(0.2 * 2 * np.pi * np.cos(2 * np.pi * t)[:, None], q.shape).copy()
+    ddq = np.broadcast_to(-0.2 * (2 * np.pi) ** 2 * np.sin(2 * np.pi * t)[:, None], q.shape).copy()
+    fr = SigmoidFriction.from_array(panda.friction)
+    tau = dynid.rnea(panda, q, dq, ddq) + fr.torques(dq) + rng.normal(0, 0.01, q.shape)
+    log = TorqueLog(t, q, dq, tau, ddq)
+    out = demo_stage(tmp_path / "demo", _model(), log, fr, seed=0)
+    text = capsys.readouterr().out
+    assert out["feasible"] and out["relative_residual"] <= 1e-4
+    assert out["max_torque_difference"] < 1e-6
+    assert np.all(np.array(out["rms_newton_euler"]) < 0.05)
+    assert "RMS NE" in text
+    for f in out["files"]:
+        assert (tmp_path / "demo" / f.split("/")[-1]).is_file()
