@@ -12,6 +12,10 @@ Stages (each prints what it does and lists the files it writes):
   3. friction    validation of the identified model on the paper's sinusoids, sigmoid
                  friction fit per joint, validation with friction; per-joint RMS before and
                  after, figures (friction/).
+  4. feasible    feasible link parameters from the coefficients (penalty-based global
+                 optimisation), URDF/TOML/JSON export, Newton-Euler validation (feasible/).
+
+Finally report.md gathers the tables and figures.
 
 Runs headless (figures are rendered with Agg); the first run also compiles the numba
 kernels (cached on disk for later runs).
@@ -23,6 +27,7 @@ Example:
 from __future__ import annotations
 
 import argparse
+import time
 from collections.abc import Callable
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -139,11 +144,96 @@ def stage_friction(ctx: DemoContext) -> None:
     ctx.results["friction"] = res
 
 
+def stage_feasible(ctx: DemoContext) -> None:
+    """Stage 4: feasible link parameters (Algorithm 1), export, Newton-Euler validation."""
+    from ..friction.model import SigmoidFriction
+    from .retrieve import demo_stage
+
+    _header(4, "feasible link parameters and Newton-Euler validation (Gaz et al. 2019, Sec. V)")
+    fitted = ctx.results["friction"]["friction"]
+    res = demo_stage(
+        ctx.out / "feasible",
+        ctx.results["model"],
+        friction=SigmoidFriction.from_array(np.asarray(fitted)),
+        seed=ctx.seed,
+        truth=ctx.robot,
+    )
+    ctx.files += [Path(f) for f in res.get("files", [])]
+    ctx.results["feasible"] = res
+
+
+def _table(header: list[str], rows: list[list[str]]) -> str:
+    lines = ["| " + " | ".join(header) + " |", "|" + "---|" * len(header)]
+    return "\n".join(lines + ["| " + " | ".join(r) + " |" for r in rows])
+
+
+def write_report(ctx: DemoContext) -> Path:
+    """``out/report.md``: the tables and figures of every stage, with links to the files."""
+    from .. import __version__
+
+    r, names = ctx.results, ctx.robot.joint_names
+    parts = [
+        "# dynid demo: the paper on the simulated Panda",
+        f"dynid {__version__}, seed {ctx.seed}. Gaz et al., IEEE RA-L 4(4), 2019.",
+        "## 1. Kinematics",
+        f"IK with a tool 0.1 m along the flange z: converged {r['ik'].converged} in "
+        f"{r['ik'].iterations} steps, position error {r['ik'].position_error:.2e} m, "
+        f"orientation error {r['ik'].orientation_error:.2e} rad.",
+        "![IK joint motion](ik_joint_motion.png)",
+    ]
+    if "identification" in r:
+        i = r["identification"]
+        parts += [
+            "## 2. Identification from M(q) and g(q) at static configurations",
+            _table(
+                ["configurations", "rank", "condition number", "relative error [%]",
+                 "dropped rows", "largest error / std"],
+                [[str(i["n_configurations"]), str(i["rank"]), f"{i['condition_number']:.3g}",
+                  f"{i['relative_error_percent']:.3g}", ", ".join(i["dropped_rows"]),
+                  f"{i['max_error_in_std']:.2f}"]],
+            ),
+            "Coefficients, expressions and standard deviations: "
+            "[identification/identification.json](identification/identification.json).",
+        ]
+    if "friction" in r:
+        f = r["friction"]
+        rows = [[n, f"{a:.4f}", f"{b:.4f}"] for n, a, b in
+                zip(names, f["rms_without_friction"], f["rms_with_friction"], strict=True)]
+        parts += [
+            "## 3. Validation on sinusoids and joint friction",
+            _table(["joint", "RMS without friction [N m]", "RMS with friction [N m]"], rows),
+            f"Relative error {f['relative_error_percent_without']:.3g} % without friction, "
+            f"{f['relative_error_percent_with']:.3g} % with.",
+            "![torques](friction/validation_torques.png)",
+            "![friction](friction/friction.png)",
+        ]
+    if "feasible" in r:
+        e = r["feasible"]
+        rows = [[n, f"{a:.4f}"] for n, a in zip(names, e["rms_newton_euler"], strict=True)]
+        parts += [
+            "## 4. Feasible link parameters and Newton-Euler validation",
+            f"Feasible: {e['feasible']}; relative residual on the coefficients "
+            f"{e['relative_residual']:.2e}; total mass {e['total_mass']:.3f} kg; "
+            f"{e['run_time_s']:.1f} s on {e['workers']} worker(s). Smallest margins: "
+            + ", ".join(f"{k} {v:.2e}" for k, v in e["min_margin"].items()) + ".",
+            _table(["joint", "RMS Newton-Euler + friction [N m]"], rows),
+            "Files: [feasible.json](feasible/feasible.json), [robot.urdf](feasible/robot.urdf), "
+            "[robot.toml](feasible/robot.toml), [report.json](feasible/report.json).",
+        ]
+        parts += [f"![{p.stem}](feasible/{p.name})" for p in
+                  sorted((ctx.out / "feasible").glob("*.png"))]
+    path = ctx.out / "report.md"
+    path.write_text("\n\n".join(parts) + "\n", encoding="utf-8")
+    ctx.files.append(path)
+    return path
+
+
 #: The stages in order.
 STAGES: list[Callable[[DemoContext], None]] = [
     stage_kinematics,
     stage_identification,
     stage_friction,
+    stage_feasible,
 ]
 
 
@@ -167,7 +257,10 @@ def run(args: argparse.Namespace) -> int:
         robot=panda(), out=args.out, rng=np.random.default_rng(args.seed), seed=args.seed
     )
     print(f"dynid demo: {ctx.robot!r}, seed {args.seed}, output in {args.out}")
+    t0 = time.perf_counter()
     for stage in STAGES:
         stage(ctx)
+    report = write_report(ctx)
+    print(f"\nreport: {report} ({time.perf_counter() - t0:.0f} s)")
     print(f"\ndone: {len(ctx.files)} files in {args.out}")
     return 0

@@ -7,6 +7,9 @@ measured ones, per joint (RMS, MSE) and overall (relative error). Model sources:
                                 one, is used unless --friction or --no-friction)
   --robot ROBOT                 a robot's own link parameters and friction ('panda': the
                                 published feasible parameters and sigmoid friction)
+  --params feasible.json        retrieved feasible link parameters (dynid retrieve), with
+                                the sigmoid friction stored beside them: Newton-Euler
+                                torques (RNEA) with those parameters (the paper's Fig. 5)
 
 --friction friction.json replaces the model's own friction. The states are low-pass
 filtered with zero phase (--cutoff), the accelerations differentiated from the filtered
@@ -50,8 +53,9 @@ def register(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParser:
     src = p.add_mutually_exclusive_group(required=True)
     src.add_argument("--model", type=Path, help="identification.json of an identified model")
     src.add_argument("--robot", help="'panda', a .urdf or a .toml: the robot's own parameters")
-    # A third source, --params feasible.json (feasible standard parameters), is added to
-    # this group here, with a branch in load_model_source below.
+    src.add_argument(
+        "--params", type=Path, help="feasible.json of retrieved link parameters (RNEA)"
+    )
     p.add_argument("--base", default=None, help="URDF base link (with --robot)")
     p.add_argument("--tip", default=None, help="URDF tip link (with --robot)")
     fr = p.add_mutually_exclusive_group()
@@ -70,15 +74,20 @@ def register(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParser:
 
 
 def load_model_source(args: argparse.Namespace) -> tuple[IdentifiedModel | Robot, str]:
-    """The rigid-body model and a label, from --model or --robot (or --params later)."""
+    """The rigid-body model and a label, from --model, --robot or --params."""
     if args.model is not None:
         from ..io.model_json import load_model_json
 
         return load_model_json(args.model), str(args.model.name)
     if args.robot is not None:
         return load_robot(args), f"robot {args.robot}"
-    # --params feasible.json: a Robot with the feasible standard parameters goes here.
-    raise DynidError("give one model source: --model identification.json or --robot ROBOT")
+    if args.params is not None:
+        from ..io.feasible import load_feasible_json
+
+        return load_feasible_json(args.params), str(args.params.name)
+    raise DynidError(
+        "give one model source: --model identification.json, --robot ROBOT or --params feasible.json"
+    )
 
 
 def run(args: argparse.Namespace) -> int:
