@@ -20,7 +20,13 @@ rigid = robot.with_friction(None)  # the rigid-body model only
 fit = dynid.fit_friction(rigid, log)
 print(f"amplitudes scaled by {scale:.3f} into the limits")
 true = robot.friction
-print("joint  phi1 [N m]  phi2 [s/rad]  phi3 [rad/s]   RMS before -> after [N m]   (true phi1, phi2, phi3)")
+print(
+    "joint  phi1 [N m]  phi2 [s/rad]  phi3 [rad/s]   RMS before -> after [N m]"
+    "   (true phi1, phi2, phi3)"
+)
 for j, (p1, p2, p3) in enumerate(fit.friction.as_array()):
-    print(f"{j + 1:>5}  {p1:10.4f}  {p2:12.3f}  {p3:+12.5f}   {fit.rms_before[j]:.3f} -> {fit.rms_after[j]:.3f}"
-          f"   ({true[j, 0]:.4f}, {true[j, 1]:.3f}, {true[j, 2]:+.5f})")
+    print(
+        f"{j + 1:>5}  {p1:10.4f}  {p2:12.3f}  {p3:+12.5f}   "
+        f"{fit.rms_before[j]:.3f} -> {fit.rms_after[j]:.3f}"
+        f"   ({true[j, 0]:.4f}, {true[j, 1]:.3f}, {true[j, 2]:+.5f})"
+    )

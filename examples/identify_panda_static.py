@@ -16,8 +16,11 @@ data = dynid.acquire_static(controller, 1010, np.random.default_rng(2))
 model = dynid.identify_static(robot, data)
 
 fit = model.fit
-print(f"rank {fit.rank}, condition number {fit.condition_number:.3g}, "
-      f"relative error {fit.relative_error_percent:.3g} %, dropped rows {model.metadata['dropped_rows']}")
+print(
+    f"rank {fit.rank}, condition number {fit.condition_number:.3g}, "
+    f"relative error {fit.relative_error_percent:.3g} %, "
+    f"dropped rows {model.metadata['dropped_rows']}"
+)
 truth = model.base.beta_from_phi(robot.phi)
 k = int(np.argmax(np.abs(model.beta - truth) / fit.std))
 print(f"worst coefficient {model.base.labels[k]} = {model.base.expressions[k]}:")

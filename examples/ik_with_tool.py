@@ -18,6 +18,9 @@ J_tool = dynid.jacobian(robot, q0, "flange", tool=T_flange_tool)  # (6, 7), base
 
 result = dynid.ik(robot, T_goal, q0, tool=T_flange_tool)
 print(f"converged: {result.converged} after {result.iterations} steps")
-print(f"position error {result.position_error:.2e} m, orientation error {result.orientation_error:.2e} rad")
+print(
+    f"position error {result.position_error:.2e} m, "
+    f"orientation error {result.orientation_error:.2e} rad"
+)
 print("q [rad]:", np.array2string(result.q, precision=4))
 print("joint path:", result.path.shape, "(steps + 1, joints)")

@@ -29,8 +29,15 @@ def random_states(robot: dynid.Robot, n: int, seed: int):
     return q, dq, ddq
 
 
-def planar_2r(l1: float = 0.7, l2: float = 0.5, m1: float = 2.0, m2: float = 1.5,
-              I1: float = 0.05, I2: float = 0.03, g: float = 9.81) -> dynid.Robot:
+def planar_2r(
+    l1: float = 0.7,
+    l2: float = 0.5,
+    m1: float = 2.0,
+    m2: float = 1.5,
+    I1: float = 0.05,
+    I2: float = 0.03,
+    g: float = 9.81,
+) -> dynid.Robot:
     """Planar 2R arm moving in the vertical x-y plane (gravity along -y), CoM at mid-link.
 
     Joints rotate about z; link i has length l_i along its x axis (MDH a), point CoM
@@ -40,9 +47,15 @@ def planar_2r(l1: float = 0.7, l2: float = 0.5, m1: float = 2.0, m2: float = 1.5
     inertia[0] = np.diag([I1, I1, I1])
     inertia[1] = np.diag([I2, I2, I2])
     r = dynid.Robot.from_mdh(
-        [0.0, l1], [0.0, 0.0], [0.0, 0.0], flange=(l2, 0.0, 0.0, 0.0),
-        mass=[m1, m2], com=[[l1 / 2, 0, 0], [l2 / 2, 0, 0]], inertia=inertia,
-        gravity=(0.0, -g, 0.0), name="planar2r",
+        [0.0, l1],
+        [0.0, 0.0],
+        [0.0, 0.0],
+        flange=(l2, 0.0, 0.0, 0.0),
+        mass=[m1, m2],
+        com=[[l1 / 2, 0, 0], [l2 / 2, 0, 0]],
+        inertia=inertia,
+        gravity=(0.0, -g, 0.0),
+        name="planar2r",
     )
     return r
 

@@ -251,13 +251,34 @@ def test_demo_stages_fit_friction_and_validate(tmp_path, panda, capsys):
 
 
 def test_identify_routes_a_torque_log_to_the_classical_identification(tmp_path):
-    """`dynid identify` on a simulated Fourier log writes the classical result with friction terms."""
+    """`dynid identify` on a simulated Fourier log writes the classical result with friction."""
     log = tmp_path / "fourier.npz"
-    assert main(["simulate", "--trajectory", "fourier", "--duration", "10", "--seed", "3",
-                 "--out", str(log), "-q"]) == 0
+    assert (
+        main(
+            [
+                "simulate",
+                "--trajectory",
+                "fourier",
+                "--duration",
+                "10",
+                "--seed",
+                "3",
+                "--out",
+                str(log),
+                "-q",
+            ]
+        )
+        == 0
+    )
     assert main(["identify", "--data", str(log), "--out", str(tmp_path / "cls"), "-q"]) == 0
     d = json.loads((tmp_path / "cls" / "identification.json").read_text())
-    for key in ("rank", "condition_number", "relative_error_percent", "dropped_rows", "coefficients"):
+    for key in (
+        "rank",
+        "condition_number",
+        "relative_error_percent",
+        "dropped_rows",
+        "coefficients",
+    ):
         assert key in d
     names = [c["name"] for c in d["coefficients"]]
     assert len([n for n in names if n.startswith("beta")]) == 43

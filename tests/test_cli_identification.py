@@ -143,7 +143,7 @@ def test_npz_route_and_pruning_option(tmp_path, capsys):
 
 
 def test_bad_inputs_exit_non_zero_with_one_stderr_line(tmp_path, identified, capsys):
-    """Missing file, malformed torque logs, bad vector, --ddq without --dq, bad extension: exit 2, one line."""
+    """Missing file, malformed logs, bad vector, --ddq without --dq, bad suffix: exit 2."""
     model = str(identified / "res" / "identification.json")
     capsys.readouterr()
     assert main(["identify", "--data", str(tmp_path / "nope.csv"), "--out", str(tmp_path)]) == 2

@@ -14,11 +14,11 @@ import pytest
 import dynid
 from dynid.cli.__main__ import main
 from dynid.feasibility.constraints import panda_bounds
+from dynid.friction.model import SigmoidFriction
 from dynid.identification.data import StaticDataset
 from dynid.identification.least_squares import LeastSquaresFit
 from dynid.identification.log import TorqueLog
 from dynid.identification.model import IdentifiedModel
-from dynid.friction.model import SigmoidFriction
 from dynid.io.feasible import load_feasible_json, save_bounds
 from dynid.io.friction_json import write_friction_json
 from dynid.io.model_json import save_model_json
@@ -200,21 +200,81 @@ def test_demo_stage_retrieves_exports_and_validates(tmp_path, capsys):
 def test_validate_with_retrieved_parameters_uses_rnea(model_file, tmp_path):
     """dynid validate --params feasible.json validates RNEA with the retrieved parameters."""
     out = tmp_path / "feasible"
-    assert main(["retrieve", "--model", str(model_file), "--runs", "2", "--workers", "1",
-                 "--out", str(out), "-q"]) == 0
+    assert (
+        main(
+            [
+                "retrieve",
+                "--model",
+                str(model_file),
+                "--runs",
+                "2",
+                "--workers",
+                "1",
+                "--out",
+                str(out),
+                "-q",
+            ]
+        )
+        == 0
+    )
     log = tmp_path / "log.npz"
-    assert main(["simulate", "--trajectory", "fourier", "--duration", "6", "--seed", "4",
-                 "--out", str(log), "-q"]) == 0
+    assert (
+        main(
+            [
+                "simulate",
+                "--trajectory",
+                "fourier",
+                "--duration",
+                "6",
+                "--seed",
+                "4",
+                "--out",
+                str(log),
+                "-q",
+            ]
+        )
+        == 0
+    )
     val = tmp_path / "val"
-    assert main(["validate", "--params", str(out / "feasible.json"), "--data", str(log),
-                 "--out", str(val), "--no-figures", "-q"]) == 0
+    assert (
+        main(
+            [
+                "validate",
+                "--params",
+                str(out / "feasible.json"),
+                "--data",
+                str(log),
+                "--out",
+                str(val),
+                "--no-figures",
+                "-q",
+            ]
+        )
+        == 0
+    )
     d = json.loads((val / "validation.json").read_text())
     assert len(d["rms"]) == 7 and len(d["mse"]) == 7
     assert max(d["rms"]) > 0.1  # the log carries friction that this model lacks
     # with the published sigmoid friction the residual falls to the sensor noise (0.05 N m)
     fr = tmp_path / "friction.json"
     write_friction_json(fr, SigmoidFriction.from_array(dynid.panda().friction))
-    assert main(["validate", "--params", str(out / "feasible.json"), "--friction", str(fr),
-                 "--data", str(log), "--out", str(val), "--no-figures", "-q"]) == 0
+    assert (
+        main(
+            [
+                "validate",
+                "--params",
+                str(out / "feasible.json"),
+                "--friction",
+                str(fr),
+                "--data",
+                str(log),
+                "--out",
+                str(val),
+                "--no-figures",
+                "-q",
+            ]
+        )
+        == 0
+    )
     d = json.loads((val / "validation.json").read_text())
     assert max(d["rms"]) < 0.1

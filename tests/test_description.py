@@ -4,10 +4,11 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
-from conftest import random_states, robot_data_urdf
 
 import dynid
 from dynid.model.description import robot_from_toml, robot_from_toml_string, toml_from_robot
+
+from conftest import random_states, robot_data_urdf
 
 
 def assert_same_robot(a: dynid.Robot, b: dynid.Robot, seed: int) -> None:

@@ -6,6 +6,7 @@ import numpy as np
 import pytest
 
 import dynid
+
 from conftest import random_states
 
 
@@ -30,7 +31,9 @@ def test_coriolis_matrix_times_dq_is_c_and_mdot_minus_2s_is_skew(panda):
     """S dq = c and dM/dt - 2S is skew-symmetric (dM/dt by central differences)."""
     q, dq, _ = random_states(panda, 10, seed=4)
     S = dynid.coriolis_matrix(panda, q, dq)
-    np.testing.assert_allclose(np.einsum("bij,bj->bi", S, dq), dynid.coriolis(panda, q, dq), atol=1e-10)
+    np.testing.assert_allclose(
+        np.einsum("bij,bj->bi", S, dq), dynid.coriolis(panda, q, dq), atol=1e-10
+    )
     h = 1e-6
     Mdot = (dynid.mass_matrix(panda, q + h * dq) - dynid.mass_matrix(panda, q - h * dq)) / (2 * h)
     K = Mdot - 2 * S
@@ -56,9 +59,15 @@ def test_planar_2r_matches_closed_form(planar2r):
         d22 = m2 * lc2**2 + I2
         hh = -m2 * l1 * lc2 * np.sin(q[1])
         c = np.array([2 * hh * dq[0] * dq[1] + hh * dq[1] ** 2, -hh * dq[0] ** 2])
-        g = np.array([(m1 * lc1 + m2 * l1) * g0 * np.cos(q[0]) + m2 * lc2 * g0 * np.cos(q[0] + q[1]),
-                      m2 * lc2 * g0 * np.cos(q[0] + q[1])])
-        np.testing.assert_allclose(dynid.mass_matrix(planar2r, q), [[d11, d12], [d12, d22]], atol=1e-12)
+        g = np.array(
+            [
+                (m1 * lc1 + m2 * l1) * g0 * np.cos(q[0]) + m2 * lc2 * g0 * np.cos(q[0] + q[1]),
+                m2 * lc2 * g0 * np.cos(q[0] + q[1]),
+            ]
+        )
+        np.testing.assert_allclose(
+            dynid.mass_matrix(planar2r, q), [[d11, d12], [d12, d22]], atol=1e-12
+        )
         np.testing.assert_allclose(dynid.coriolis(planar2r, q, dq), c, atol=1e-12)
         np.testing.assert_allclose(dynid.gravity_torques(planar2r, q), g, atol=1e-12)
 

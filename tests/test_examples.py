@@ -17,7 +17,11 @@ def test_example_runs(path, tmp_path):
     """The example exits 0 and prints something (run in a scratch folder, Agg backend)."""
     env = dict(os.environ, MPLBACKEND="Agg")
     out = subprocess.run(
-        [sys.executable, str(path)], cwd=tmp_path, env=env, capture_output=True, text=True,
+        [sys.executable, str(path)],
+        cwd=tmp_path,
+        env=env,
+        capture_output=True,
+        text=True,
         timeout=300,
     )
     assert out.returncode == 0, out.stderr[-2000:]

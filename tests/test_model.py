@@ -12,7 +12,7 @@ from dynid.spatial import rot_x, rot_z, transform, translation
 
 
 def test_panda_matches_published_tables(panda):
-    """Built-in Panda: 7 joints, total mass 16.062132 kg (Gaz et al. p_hat), flange 0.107 m on z7."""
+    """Built-in Panda: 7 joints, total mass 16.062132 kg (Gaz et al. p_hat), flange 0.107 m."""
     assert panda.n == 7
     np.testing.assert_allclose(panda.mass.sum(), 16.062132, rtol=1e-12)
     np.testing.assert_allclose(panda.frame("flange").T_link_frame[:3, 3], [0, 0, 0.107])

@@ -6,6 +6,7 @@ import numpy as np
 import pytest
 
 import dynid
+
 from conftest import pinocchio_panda_urdf, random_states
 
 pin = pytest.importorskip("pinocchio")
@@ -49,4 +50,6 @@ def test_fk_jacobian_dynamics_match_pinocchio_on_random_states(pin_panda):
         np.testing.assert_allclose(M[s], Mp, atol=1e-10)
         gp = pin.computeGeneralizedGravity(model, data, q[s])
         np.testing.assert_allclose(g[s], gp, atol=1e-10)
-        np.testing.assert_allclose(c[s], pin.nonLinearEffects(model, data, q[s], dq[s]) - gp, atol=1e-10)
+        np.testing.assert_allclose(
+            c[s], pin.nonLinearEffects(model, data, q[s], dq[s]) - gp, atol=1e-10
+        )

@@ -6,10 +6,11 @@ import warnings
 
 import numpy as np
 import pytest
-from conftest import random_states, robot_data_urdf
 
 import dynid
 from dynid.model.urdf import robot_from_urdf, robot_from_urdf_string
+
+from conftest import random_states, robot_data_urdf
 
 pin = pytest.importorskip("pinocchio")
 

@@ -21,7 +21,13 @@ base by default; standard parameters are 10 per link (m, m c, J about the link o
 """
 
 from .dynamics.rnea import rnea
-from .dynamics.terms import coriolis, coriolis_matrix, forward_dynamics, gravity_torques, mass_matrix
+from .dynamics.terms import (
+    coriolis,
+    coriolis_matrix,
+    forward_dynamics,
+    gravity_torques,
+    mass_matrix,
+)
 from .exceptions import (
     ConvergenceError,
     DataError,

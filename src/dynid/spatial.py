@@ -66,7 +66,7 @@ def rot_z(angle: ArrayLike) -> NDArray[np.float64]:
 
 
 def matrix_from_rpy(rpy: ArrayLike) -> NDArray[np.float64]:
-    """Rotation matrix from URDF roll-pitch-yaw [rad]: ``Rz(y) Ry(p) Rx(r)``; (..., 3) -> (..., 3, 3)."""
+    """Rotation from URDF roll-pitch-yaw [rad], ``Rz(y) Ry(p) Rx(r)``; (..., 3) -> (..., 3, 3)."""
     rpy = _checks.as_batch("rpy", rpy, (3,))
     return rot_z(rpy[..., 2]) @ rot_y(rpy[..., 1]) @ rot_x(rpy[..., 0])
 
@@ -87,7 +87,7 @@ def rpy_from_matrix(R: ArrayLike) -> NDArray[np.float64]:
 
 
 def matrix_from_angle_axis(rotvec: ArrayLike) -> NDArray[np.float64]:
-    """Rotation matrix from a rotation vector ``theta * u`` [rad] (Rodrigues); (..., 3) -> (..., 3, 3)."""
+    """Rotation from a rotation vector ``theta * u`` [rad] (Rodrigues); (..., 3) -> (..., 3, 3)."""
     w = _checks.as_batch("rotvec", rotvec, (3,))
     theta = np.linalg.norm(w, axis=-1)
     small = theta < 1e-8

@@ -18,9 +18,13 @@ from ..model.robot import Robot
 
 def add_robot_options(p: argparse.ArgumentParser) -> None:
     """``--robot panda|FILE.urdf|FILE.toml`` with ``--base``/``--tip`` for URDF chains."""
-    p.add_argument("--robot", default="panda", help="'panda', a .urdf or a .toml file (default: panda)")
+    p.add_argument(
+        "--robot", default="panda", help="'panda', a .urdf or a .toml file (default: panda)"
+    )
     p.add_argument("--base", default=None, help="URDF base link of the chain (default: the root)")
-    p.add_argument("--tip", default=None, help="URDF tip link of the chain (default: the only leaf)")
+    p.add_argument(
+        "--tip", default=None, help="URDF tip link of the chain (default: the only leaf)"
+    )
 
 
 def load_robot(args: argparse.Namespace) -> Robot:

@@ -117,7 +117,7 @@ def stage_kinematics(ctx: DemoContext) -> None:
 
 
 def stage_identification(ctx: DemoContext) -> None:
-    """Stage 2: static acquisition (1010 configurations) and identification of the 43 coefficients."""
+    """Stage 2: static acquisition (1010 configurations), identification of the coefficients."""
     from ..io.model_json import load_model_json
     from .identify import demo_stage
 
@@ -186,19 +186,36 @@ def write_report(ctx: DemoContext) -> Path:
         parts += [
             "## 2. Identification from M(q) and g(q) at static configurations",
             _table(
-                ["configurations", "rank", "condition number", "relative error [%]",
-                 "dropped rows", "largest error / std"],
-                [[str(i["n_configurations"]), str(i["rank"]), f"{i['condition_number']:.3g}",
-                  f"{i['relative_error_percent']:.3g}", ", ".join(i["dropped_rows"]),
-                  f"{i['max_error_in_std']:.2f}"]],
+                [
+                    "configurations",
+                    "rank",
+                    "condition number",
+                    "relative error [%]",
+                    "dropped rows",
+                    "largest error / std",
+                ],
+                [
+                    [
+                        str(i["n_configurations"]),
+                        str(i["rank"]),
+                        f"{i['condition_number']:.3g}",
+                        f"{i['relative_error_percent']:.3g}",
+                        ", ".join(i["dropped_rows"]),
+                        f"{i['max_error_in_std']:.2f}",
+                    ]
+                ],
             ),
             "Coefficients, expressions and standard deviations: "
             "[identification/identification.json](identification/identification.json).",
         ]
     if "friction" in r:
         f = r["friction"]
-        rows = [[n, f"{a:.4f}", f"{b:.4f}"] for n, a, b in
-                zip(names, f["rms_without_friction"], f["rms_with_friction"], strict=True)]
+        rows = [
+            [n, f"{a:.4f}", f"{b:.4f}"]
+            for n, a, b in zip(
+                names, f["rms_without_friction"], f["rms_with_friction"], strict=True
+            )
+        ]
         parts += [
             "## 3. Validation on sinusoids and joint friction",
             _table(["joint", "RMS without friction [N m]", "RMS with friction [N m]"], rows),
@@ -215,13 +232,15 @@ def write_report(ctx: DemoContext) -> Path:
             f"Feasible: {e['feasible']}; relative residual on the coefficients "
             f"{e['relative_residual']:.2e}; total mass {e['total_mass']:.3f} kg; "
             f"{e['run_time_s']:.1f} s on {e['workers']} worker(s). Smallest margins: "
-            + ", ".join(f"{k} {v:.2e}" for k, v in e["min_margin"].items()) + ".",
+            + ", ".join(f"{k} {v:.2e}" for k, v in e["min_margin"].items())
+            + ".",
             _table(["joint", "RMS Newton-Euler + friction [N m]"], rows),
             "Files: [feasible.json](feasible/feasible.json), [robot.urdf](feasible/robot.urdf), "
             "[robot.toml](feasible/robot.toml), [report.json](feasible/report.json).",
         ]
-        parts += [f"![{p.stem}](feasible/{p.name})" for p in
-                  sorted((ctx.out / "feasible").glob("*.png"))]
+        parts += [
+            f"![{p.stem}](feasible/{p.name})" for p in sorted((ctx.out / "feasible").glob("*.png"))
+        ]
     path = ctx.out / "report.md"
     path.write_text("\n\n".join(parts) + "\n", encoding="utf-8")
     ctx.files.append(path)

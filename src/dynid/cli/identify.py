@@ -27,7 +27,7 @@ from typing import Any
 
 import numpy as np
 
-from ..exceptions import DataError, DynidError
+from ..exceptions import DataError
 from ..identification.model import IdentifiedModel
 from ..identification.static import identify_static
 from ..io.model_json import save_model_json
@@ -115,9 +115,7 @@ def identify_torque_log(robot: Robot, path: Path, args: argparse.Namespace) -> I
 
     log = read_torque_log(path)
     kw = {} if args.cutoff is None else {"cutoff_hz": args.cutoff}
-    return identify_from_log(
-        robot, log, max_std_percent=args.max_std_percent, rtol=args.rtol, **kw
-    )
+    return identify_from_log(robot, log, max_std_percent=args.max_std_percent, rtol=args.rtol, **kw)
 
 
 # ---------------------------------------------------------------------------------------

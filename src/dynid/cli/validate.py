@@ -86,7 +86,8 @@ def load_model_source(args: argparse.Namespace) -> tuple[IdentifiedModel | Robot
 
         return load_feasible_json(args.params), str(args.params.name)
     raise DynidError(
-        "give one model source: --model identification.json, --robot ROBOT or --params feasible.json"
+        "give one model source: --model identification.json, --robot ROBOT "
+        "or --params feasible.json"
     )
 
 

@@ -175,7 +175,8 @@ def coriolis(robot: Robot, q: ArrayLike, dq: ArrayLike) -> NDArray[np.float64]:
 def christoffel(robot: Robot, q: ArrayLike) -> NDArray[np.float64]:
     """Christoffel symbols of the first kind ``G[..., i, j, k]`` [kg m^2], symmetric in j, k.
 
-    .. math:: \\Gamma_{ijk} = \\tfrac12 (\\partial_k M_{ij} + \\partial_j M_{ik} - \\partial_i M_{jk}),
+    .. math:: \\Gamma_{ijk} = \\tfrac12 (\\partial_k M_{ij} + \\partial_j M_{ik}
+              - \\partial_i M_{jk}),
               \\qquad c_i = \\sum_{jk} \\Gamma_{ijk} \\dot q_j \\dot q_k
     """
     q = _checks.as_batch("q", q, (robot.n,))

@@ -59,17 +59,19 @@ def matrix_from_inertia6(i6: ArrayLike) -> NDArray[np.float64]:
 
 
 def inertia6_from_matrix(I: ArrayLike) -> NDArray[np.float64]:
-    """``(xx, xy, xz, yy, yz, zz)`` of a 3x3 tensor (its upper triangle); (..., 3, 3) -> (..., 6)."""
+    """``(xx, xy, xz, yy, yz, zz)`` of a 3x3 tensor (upper triangle); (..., 3, 3) -> (..., 6)."""
     a = _checks.as_batch("inertia", I, (3, 3))
     return np.stack([a[..., i, j] for i, j in _I6], axis=-1)
 
 
 def parallel_axis(mass: ArrayLike, com: ArrayLike) -> NDArray[np.float64]:
-    """The term ``m (c^T c E - c c^T)`` [kg m^2] that moves an inertia from the CoM to the origin."""
+    """The term ``m (c^T c E - c c^T)`` [kg m^2] moving an inertia from the CoM to the origin."""
     m = np.asarray(mass, dtype=np.float64)
     c = np.asarray(com, dtype=np.float64)
     cc = np.einsum("...i,...i->...", c, c)
-    return m[..., None, None] * (cc[..., None, None] * np.eye(3) - c[..., :, None] * c[..., None, :])
+    return m[..., None, None] * (
+        cc[..., None, None] * np.eye(3) - c[..., :, None] * c[..., None, :]
+    )
 
 
 def phi_from_inertial(mass: ArrayLike, com: ArrayLike, inertia: ArrayLike) -> NDArray[np.float64]:

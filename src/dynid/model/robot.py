@@ -29,7 +29,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from .. import _checks, spatial
+from .. import _checks
 from ..exceptions import ModelError, ShapeError, UnknownNameError
 from .inertia import inertial_from_phi, param_labels, phi_from_inertial
 
@@ -124,7 +124,8 @@ class Robot:
             raise ModelError("a robot needs at least one joint")
         if len(self.link_names) != n + 1:
             raise ModelError(
-                f"link_names must have n + 1 = {n + 1} entries (base first); got {len(self.link_names)}"
+                f"link_names must have n + 1 = {n + 1} entries (base first); "
+                f"got {len(self.link_names)}"
             )
         for kind, names in (("joint", self.joint_names), ("link", self.link_names)):
             dup = sorted({x for x in names if list(names).count(x) > 1})
@@ -132,7 +133,10 @@ class Robot:
                 raise ModelError(f"duplicate {kind} names: {dup}")
         put("joint_names", tuple(str(x) for x in self.joint_names))
         put("link_names", tuple(str(x) for x in self.link_names))
-        put("T_parent_joint", _checks.frozen(_checks.as_exact("T_parent_joint", self.T_parent_joint, (n, 4, 4))))
+        put(
+            "T_parent_joint",
+            _checks.frozen(_checks.as_exact("T_parent_joint", self.T_parent_joint, (n, 4, 4))),
+        )
         axes = _checks.as_exact("axes", self.axes, (n, 3))
         norm = np.linalg.norm(axes, axis=1)
         if np.any(norm < 1e-9):
@@ -235,7 +239,7 @@ class Robot:
         return self.replace(phi=p)
 
     def with_inertials(self, mass: ArrayLike, com: ArrayLike, inertia: ArrayLike) -> Robot:
-        """A copy with link masses [kg] (n,), CoMs [m] (n, 3) and CoM inertias (n, 3, 3) or (n, 6)."""
+        """A copy with masses [kg] (n,), CoMs [m] (n, 3), CoM inertias (n, 3, 3) or (n, 6)."""
         return self.replace(phi=phi_from_inertial(mass, com, inertia))
 
     def with_friction(self, friction: ArrayLike | None) -> Robot:
@@ -247,7 +251,7 @@ class Robot:
         return self.replace(gravity=gravity)
 
     def with_frame(self, name: str, T_parent_frame: ArrayLike, parent: str = "flange") -> Robot:
-        """A copy with a new named frame fixed at ``T_parent_frame`` relative to frame ``parent``."""
+        """A copy with a new frame ``name`` fixed at ``T_parent_frame`` in frame ``parent``."""
         T = _checks.as_exact("T_parent_frame", T_parent_frame, (4, 4))
         f = self.frame(parent)
         frames = dict(self.frames)
@@ -352,12 +356,19 @@ class Robot:
         n = a_.shape[0]
         if not (a_.shape == d_.shape == al.shape == (n,)):
             raise ShapeError(
-                f"a, d and alpha must have the same shape (n,); got {a_.shape}, {d_.shape}, {al.shape}"
+                f"a, d and alpha must have the same shape (n,); "
+                f"got {a_.shape}, {d_.shape}, {al.shape}"
             )
         th = np.zeros(n) if theta is None else _checks.as_exact("theta", theta, (n,))
-        types = joint_types * n if isinstance(joint_types, str) and len(joint_types) == 1 else joint_types
+        types = (
+            joint_types * n
+            if isinstance(joint_types, str) and len(joint_types) == 1
+            else joint_types
+        )
         if len(types) != n or any(str(t).upper() not in ("R", "P") for t in types):
-            raise ModelError(f"joint_types must be 'R' or 'P' for each of the {n} joints; got {joint_types!r}")
+            raise ModelError(
+                f"joint_types must be 'R' or 'P' for each of the {n} joints; got {joint_types!r}"
+            )
         pri = np.array([t.upper() == "P" for t in types])
         T = np.stack([mdh_transform(a_[i], d_[i], al[i], th[i]) for i in range(n)])
         frames = {}

@@ -148,5 +148,3 @@ def torque_regressor(
     g = robot.gravity if gravity is None else _checks.as_exact("gravity", gravity, (3,))
     Y = _torque_regressor(robot, q2, dq2, ddq2, g)
     return Y.reshape(shape + (10 * robot.n,))
-
-
