@@ -311,3 +311,12 @@ def test_description_without_joints_or_bad_toml_raises_model_error(tmp_path):
         robot_from_toml(tmp_path / "none.toml")
     with pytest.raises(dynid.ModelError, match="TOML description not found"):
         dynid.Robot.from_toml(tmp_path / "none.toml")
+
+
+def test_neutral_pose_round_trips_and_is_checked():
+    """q_neutral survives the TOML round trip; a wrong length raises ModelError naming the key."""
+    panda = dynid.panda()
+    text = panda.to_toml()
+    np.testing.assert_array_equal(robot_from_toml_string(text).q_neutral, panda.q_neutral)
+    with pytest.raises(dynid.ModelError, match="'q_neutral' must be a list of 7 numbers"):
+        robot_from_toml_string(text.replace("q_neutral = [", "q_neutral = [1.0, "))

@@ -14,6 +14,7 @@ Top-level keys::
     format_version = 1                    # optional; the only version
     name = "panda"                        # optional, default "robot"
     gravity = [0.0, 0.0, -9.80665]        # optional; base frame [m/s^2], default standard gravity
+    q_neutral = [0.0, -0.785, ...]        # optional; a neutral pose [rad or m] (IK start, demos)
 
 One ``[[joints]]`` table per joint, listed from the base to the tip::
 
@@ -84,7 +85,7 @@ __all__ = ["FORMAT_VERSION", "robot_from_toml", "robot_from_toml_string", "toml_
 #: Version of the schema written by :func:`toml_from_robot`.
 FORMAT_VERSION = 1
 
-_TOP_KEYS = {"format_version", "name", "gravity", "joints", "frames"}
+_TOP_KEYS = {"format_version", "name", "gravity", "q_neutral", "joints", "frames"}
 _JOINT_KEYS = {
     "name",
     "type",
@@ -207,6 +208,11 @@ def robot_from_toml_string(text: str, *, source: str = "TOML text") -> Robot:
     if not isinstance(name, str):
         raise ModelError(f"{source}: key 'name' must be a string; got {name!r}")
     gravity = _vector(doc.get("gravity", [0.0, 0.0, -STANDARD_GRAVITY]), 3, source, "gravity")
+    q_neutral = (
+        _vector(doc["q_neutral"], len(doc.get("joints", [])), source, "q_neutral")
+        if "q_neutral" in doc
+        else None
+    )
     joints = _require(doc, "joints", source)
     if not isinstance(joints, list) or not joints:
         raise ModelError(f"{source}: 'joints' must be a non-empty array of tables ([[joints]])")
@@ -318,6 +324,7 @@ def robot_from_toml_string(text: str, *, source: str = "TOML text") -> Robot:
             gravity=gravity,
             frames=frames,
             friction=np.stack(friction) if all(given) else None,
+            q_neutral=q_neutral,
         )
     except DynidError as exc:
         raise ModelError(f"{source}: {exc}") from exc
@@ -400,6 +407,8 @@ def toml_from_robot(robot: Robot) -> str:
         f"name = {_s(robot.name)}",
         f"gravity = {_arr(robot.gravity)}",
     ]
+    if robot.q_neutral is not None:
+        out.append(f"q_neutral = {_arr(robot.q_neutral)}")
     mass, com, inertia = robot.mass, robot.com, robot.inertia
     for i in range(robot.n):
         xyz, rpy = _xyz_rpy(robot.T_parent_joint[i])
