@@ -14,8 +14,9 @@ and the inertials and gravity of ``dynid.panda()``):
   (``LOCAL_WORLD_ALIGNED``).
 
 Every case checks that both give the same answer before timing it. The header also gives
-the time of dynid's first dynamics calls in this process (numba compilation, or loading
-its disk cache) and, in a fresh process with an empty numba cache, the compile time.
+the time of dynid's first dynamics and kinematics calls in this process (numba
+compilation, or loading its disk cache) and, in a fresh process with an empty numba cache,
+the compile time.
 
 Run ``python benchmarks/bench_dynamics.py [--json out.json] [--batch N]``.
 """
@@ -52,7 +53,9 @@ q = np.zeros(robot.n)
 out = {}
 for name, f in (("rnea", lambda: dynid.rnea(robot, q, q, q)),
                 ("mass_matrix", lambda: dynid.mass_matrix(robot, q)),
-                ("gravity_torques", lambda: dynid.gravity_torques(robot, q))):
+                ("gravity_torques", lambda: dynid.gravity_torques(robot, q)),
+                ("fk", lambda: dynid.fk(robot, q)),
+                ("jacobian", lambda: dynid.jacobian(robot, q))):
     t = time.perf_counter()
     f()
     out[name] = time.perf_counter() - t
@@ -61,7 +64,7 @@ print(json.dumps(out))
 
 
 def first_calls_in_process() -> dict[str, float]:
-    """Seconds of the first rnea, mass_matrix and gravity_torques calls of this process."""
+    """Seconds of the first rnea, mass_matrix, gravity_torques, fk and jacobian calls."""
     import dynid
 
     robot = dynid.panda()
@@ -71,6 +74,8 @@ def first_calls_in_process() -> dict[str, float]:
         ("rnea", lambda: dynid.rnea(robot, q, q, q)),
         ("mass_matrix", lambda: dynid.mass_matrix(robot, q)),
         ("gravity_torques", lambda: dynid.gravity_torques(robot, q)),
+        ("fk", lambda: dynid.fk(robot, q)),
+        ("jacobian", lambda: dynid.jacobian(robot, q)),
     ):
         t = time.perf_counter()
         f()

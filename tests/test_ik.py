@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import importlib
+import os
 
 import numpy as np
 import pytest
@@ -161,6 +162,8 @@ def test_ik_unbounded_limits_default_start_is_zero(planar2r):
 def test_ik_compiled_kernel_and_numpy_loop_agree(panda, monkeypatch):
     """The numba kernel and the numpy loop give the same path (with restarts and a tool)."""
     pytest.importorskip("numba")
+    if os.environ.get("DYNID_NO_NUMBA"):
+        pytest.skip("DYNID_NO_NUMBA is set: only the numpy loop runs")
     q_true, _, _ = random_states(panda, 25, seed=27)
     goals = [(dynid.fk(panda, qt, tool=TOOL), TOOL) for qt in q_true[:15]]
     goals += [(dynid.fk(panda, qt), None) for qt in q_true[15:]]

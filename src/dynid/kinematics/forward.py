@@ -2,9 +2,24 @@
 
 ``q`` has shape ``(..., n)`` [rad for revolute, m for prismatic joints]; every result keeps
 the batch shape ``...``. Poses are ``T_base_x``: frame x in the base frame (link 0) [m].
+
+Two implementations compute the same poses (to rounding, about 1e-16 relative):
+
+* the compiled kernels of :mod:`dynid.kinematics._kernels` (numba), used when numba is
+  installed: a loop over samples and joints, compiled on the first call and cached on
+  disk; importing dynid does not import numba;
+* the numpy reference path (:func:`link_poses_numpy`, :func:`fk_numpy`): samples
+  vectorised, a loop over joints.
+
+:func:`link_poses` and :func:`fk` (and :func:`dynid.kinematics.jacobian.jacobian`) use the
+kernels when :func:`kernels` finds them and the numpy path otherwise. Set the environment
+variable ``DYNID_NO_NUMBA=1`` before the first kinematics call to force the numpy path.
 """
 
 from __future__ import annotations
+
+import os
+from types import ModuleType
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -12,7 +27,66 @@ from numpy.typing import ArrayLike, NDArray
 from .. import _checks
 from ..model.robot import Robot
 
-__all__ = ["joint_transforms", "link_poses", "fk", "frame_pose_in_link"]
+__all__ = [
+    "joint_transforms",
+    "link_poses",
+    "link_poses_numpy",
+    "fk",
+    "fk_numpy",
+    "frame_pose_in_link",
+    "kernels",
+]
+
+_KERNELS: ModuleType | None = None
+_LOADED = False
+
+
+def kernels() -> ModuleType | None:
+    """The compiled kernels module, or None when numba is missing or ``DYNID_NO_NUMBA`` is set.
+
+    Imported once, on the first call; ``DYNID_NO_NUMBA`` is read then. Any value other
+    than ``""`` and ``"0"`` selects the numpy reference path.
+    """
+    global _KERNELS, _LOADED
+    if not _LOADED:
+        mod: ModuleType | None = None
+        if os.environ.get("DYNID_NO_NUMBA", "") in ("", "0"):
+            try:
+                from . import _kernels as mod
+            except ImportError:  # numba is not installed
+                mod = None
+        _KERNELS, _LOADED = mod, True
+    return _KERNELS
+
+
+def _flat(x: NDArray[np.float64]) -> NDArray[np.float64]:
+    """``x`` as a flat C-contiguous, aligned, writeable array (a view when it can be).
+
+    The kernels then see a single argument type, so they are compiled once.
+    """
+    if x.ndim != 1:
+        x = x.reshape(-1)
+    return x if x.flags.carray else np.array(x)
+
+
+def _readonly(x: NDArray[np.float64]) -> NDArray[np.float64]:
+    """``x`` as a read-only C array, as the robot's constants are (one kernel type)."""
+    f = x.flags
+    return x if f.c_contiguous and f.aligned and not f.writeable else _checks.frozen(x)
+
+
+def _as_q(robot: Robot, q: ArrayLike) -> NDArray[np.float64] | None:
+    """``q`` as float64 when that is cheap and its shape is ``(..., n)``, else None.
+
+    The lean path of the public functions: finiteness is left to the kernels, and None
+    sends the call to the full validation, which raises the documented errors.
+    """
+    try:
+        qa = np.asarray(q, dtype=np.float64)
+    except (TypeError, ValueError):
+        return None
+    shape = qa.shape
+    return qa if shape and shape[-1] == len(robot.joint_names) and shape[-1] else None
 
 
 def check_q(robot: Robot, q: ArrayLike, name: str = "q") -> NDArray[np.float64]:
@@ -101,6 +175,23 @@ def link_poses(robot: Robot, q: ArrayLike) -> NDArray[np.float64]:
     T_base_link : ndarray, shape (..., n + 1, 4, 4)
         Index 0 is the base (identity), index i is link i; translations in [m].
     """
+    K = _KERNELS if _LOADED else kernels()
+    if K is not None:
+        qa = _as_q(robot, q)
+        if qa is not None:
+            T = np.empty(qa.shape[:-1] + (qa.shape[-1] + 1, 4, 4))
+            if K.link_poses(
+                robot.T_parent_joint, robot.axes, robot.prismatic, _flat(qa), T.reshape(-1)
+            ):
+                return T
+    return link_poses_numpy(robot, q)
+
+
+def link_poses_numpy(robot: Robot, q: ArrayLike) -> NDArray[np.float64]:
+    """:func:`link_poses` by the numpy reference path, never the compiled kernel.
+
+    Same parameters, result, shapes and errors as :func:`link_poses`.
+    """
     q = check_q(robot, q)
     T = _link_poses(robot, q.reshape(-1, robot.n))
     return T.reshape(q.shape[:-1] + (robot.n + 1, 4, 4))
@@ -146,8 +237,45 @@ def fk(
         ``q`` holds NaN or inf.
     UnknownNameError
         ``frame`` is not a frame of the robot.
+
+    Notes
+    -----
+    Uses the compiled kernel when available (see :func:`kernels`), else :func:`fk_numpy`.
     """
     link, T_link_frame = frame_pose_in_link(robot, frame, tool)
+    K = _KERNELS if _LOADED else kernels()
+    if K is not None:
+        qa = _as_q(robot, q)
+        if qa is not None:
+            T = np.empty(qa.shape[:-1] + (4, 4))
+            if K.frame_pose(
+                robot.T_parent_joint,
+                robot.axes,
+                robot.prismatic,
+                link,
+                T_link_frame if tool is None else _readonly(T_link_frame),
+                _flat(qa),
+                T.reshape(-1),
+            ):
+                return T
+    return _fk_numpy(robot, q, link, T_link_frame)
+
+
+def fk_numpy(
+    robot: Robot, q: ArrayLike, frame: str = "flange", tool: ArrayLike | None = None
+) -> NDArray[np.float64]:
+    """:func:`fk` by the numpy reference path, never the compiled kernel.
+
+    Same parameters, result, shapes and errors as :func:`fk`.
+    """
+    link, T_link_frame = frame_pose_in_link(robot, frame, tool)
+    return _fk_numpy(robot, q, link, T_link_frame)
+
+
+def _fk_numpy(
+    robot: Robot, q: ArrayLike, link: int, T_link_frame: NDArray[np.float64]
+) -> NDArray[np.float64]:
+    """The numpy path of :func:`fk` once the frame is resolved: validates ``q``."""
     q = check_q(robot, q)
     T = _link_poses(robot, q.reshape(-1, robot.n))[:, link] @ T_link_frame
     return T.reshape(q.shape[:-1] + (4, 4))

@@ -3,6 +3,10 @@
 ``J`` has shape ``(..., 6, n)`` with rows ``[v; w]`` (linear velocity of the frame's
 origin, then angular velocity), both expressed in the base frame: ``[v; w] = J(q) dq``.
 Linear rows are in [m/rad] (revolute) or [m/m] (prismatic), angular rows in [rad/rad].
+
+:func:`jacobian` uses the compiled kernel of :mod:`dynid.kinematics._kernels` when numba
+is installed and the numpy reference path (:func:`jacobian_numpy`) otherwise or with
+``DYNID_NO_NUMBA=1``, as :mod:`dynid.kinematics.forward` does; both agree to rounding.
 """
 
 from __future__ import annotations
@@ -13,9 +17,10 @@ from numpy.typing import ArrayLike, NDArray
 from .. import _checks
 from ..exceptions import ShapeError
 from ..model.robot import Robot
-from .forward import _link_poses, check_q, frame_pose_in_link
+from . import forward as _forward
+from .forward import _as_q, _flat, _link_poses, _readonly, check_q, frame_pose_in_link
 
-__all__ = ["jacobian", "jacobian_to_tool"]
+__all__ = ["jacobian", "jacobian_numpy", "jacobian_to_tool"]
 
 
 def jacobian(
@@ -43,8 +48,47 @@ def jacobian(
     Raises
     ------
     ShapeError, NonFiniteError, UnknownNameError
+
+    Notes
+    -----
+    Uses the compiled kernel when available (see :func:`dynid.kinematics.forward.kernels`),
+    else :func:`jacobian_numpy`.
     """
     link, T_link_frame = frame_pose_in_link(robot, frame, tool)
+    K = _forward._KERNELS if _forward._LOADED else _forward.kernels()
+    if K is not None:
+        qa = _as_q(robot, q)
+        if qa is not None:
+            n = qa.shape[-1]
+            J = np.empty(qa.shape[:-1] + (6, n))
+            if K.jacobian(
+                robot.T_parent_joint,
+                robot.axes,
+                robot.prismatic,
+                link,
+                T_link_frame if tool is None else _readonly(T_link_frame),
+                _flat(qa),
+                J.reshape(-1),
+            ):
+                return J
+    return _jacobian_numpy(robot, q, link, T_link_frame)
+
+
+def jacobian_numpy(
+    robot: Robot, q: ArrayLike, frame: str = "flange", tool: ArrayLike | None = None
+) -> NDArray[np.float64]:
+    """:func:`jacobian` by the numpy reference path, never the compiled kernel.
+
+    Same parameters, result, shapes and errors as :func:`jacobian`.
+    """
+    link, T_link_frame = frame_pose_in_link(robot, frame, tool)
+    return _jacobian_numpy(robot, q, link, T_link_frame)
+
+
+def _jacobian_numpy(
+    robot: Robot, q: ArrayLike, link: int, T_link_frame: NDArray[np.float64]
+) -> NDArray[np.float64]:
+    """The numpy path of :func:`jacobian` once the frame is resolved: validates ``q``."""
     q = check_q(robot, q)
     T = _link_poses(robot, q.reshape(-1, robot.n))
     p = (T[:, link] @ T_link_frame)[:, :3, 3]  # (B, 3)
