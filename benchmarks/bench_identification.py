@@ -7,15 +7,17 @@ and gravity off for the n columns of M, then at rest with gravity for g, n + 1 c
 
 * ``identify, end to end``: ``identify_static`` on ``--n`` configurations (1010, as in
   Gaz et al. 2019): static regressor, base parameters computed from the robot's
-  structure, reduction to them, check of the rows, least squares, standard deviations
-  and metrics;
+  structure (in every call: nothing is cached between calls), reduction to them, check of
+  the rows, least squares, standard deviations and metrics;
 * ``identify, base given``: the same with the base parameters computed beforehand (once
   per robot);
 * ``static regressor, batch``: ``static_regressor`` on the same configurations;
 * ``static regressor, 1 configuration``.
 
 Before timing, the regressors are checked to agree (after Pinocchio's inertia-order
-permutation) and the identified coefficients to equal those of the true parameters.
+permutation) and the identified coefficients to equal those of the true parameters. The
+warm-up calls compile dynid's numba kernels (or load them from numba's disk cache), so
+compilation is not timed.
 
 Run ``python benchmarks/bench_identification.py [--json [PATH]] [--n 1010]``.
 """

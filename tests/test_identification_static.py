@@ -419,3 +419,141 @@ def test_gravity_mismatch_between_data_and_robot_warns():
     data = acquire_static(SimulatedController(tilted), 100, np.random.default_rng(115))
     with pytest.warns(DynidWarning, match=r"rows \['g1'\] carry no information"):
         identify_static(robot, data)
+
+
+# ------------------------------------------------------------------ least-squares routes
+def _spy_qr(monkeypatch):
+    """Count the calls of the QR route of fit_least_squares."""
+    from dynid.identification import least_squares as ls
+
+    calls = []
+    real = ls._solve_qr
+
+    def spy(*args, **kwargs):
+        calls.append(args[0].shape)
+        return real(*args, **kwargs)
+
+    monkeypatch.setattr(ls, "_solve_qr", spy)
+    return calls
+
+
+def _tall_problem(seed, m=3000, r=12, cond=10.0):
+    """Tall W with columns of very different scales, scaled condition about ``cond``.
+
+    The coefficients times the column scales are of one size, so that each coefficient
+    is determined to the same relative accuracy.
+    """
+    rng = np.random.default_rng(seed)
+    U = np.linalg.qr(rng.normal(size=(m, r)))[0]
+    V = np.linalg.qr(rng.normal(size=(r, r)))[0]
+    scale = np.logspace(-3, 3, r)
+    W = (U * np.logspace(0, -np.log10(cond), r)) @ V.T * scale
+    beta = rng.uniform(1.0, 2.0, r) * rng.choice([-1.0, 1.0], r) / scale
+    y = W @ beta + 1e-3 * np.std(W @ beta) * rng.normal(size=m) * rng.uniform(0.1, 2.0, m)
+    return W, y
+
+
+@pytest.mark.parametrize("covariance", ["classical", "robust"])
+def test_semi_normal_route_equals_the_qr_route_on_a_well_conditioned_problem(
+    monkeypatch, covariance
+):
+    """Issue 3: CSNE (tall, cond <= 100) and pivoted QR give the same fit to 1e-10."""
+    from dynid.identification import least_squares as ls
+
+    W, y = _tall_problem(120)
+    calls = _spy_qr(monkeypatch)
+    fast = fit_least_squares(W, y, covariance=covariance)
+    assert calls == []  # the semi-normal route was taken
+    monkeypatch.setattr(ls, "_CSNE_MAX_COND", 0.0)  # force the QR route
+    qr = fit_least_squares(W, y, covariance=covariance)
+    assert len(calls) == 1
+    assert fast.rank == qr.rank == 12 and fast.n_rows == qr.n_rows == 3000
+    np.testing.assert_allclose(fast.beta, qr.beta, rtol=1e-10)
+    np.testing.assert_allclose(fast.std, qr.std, rtol=1e-10)
+    np.testing.assert_allclose(fast.std_percent, qr.std_percent, rtol=1e-10)
+    for name in ("condition_number", "relative_error_percent", "residual_rms", "sigma"):
+        assert getattr(fast, name) == pytest.approx(getattr(qr, name), rel=1e-10)
+    # independent reference: numpy's SVD least squares and the condition number of W D^-1
+    np.testing.assert_allclose(fast.beta, np.linalg.lstsq(W, y, rcond=None)[0], rtol=1e-10)
+    assert fast.condition_number == pytest.approx(np.linalg.cond(W / np.linalg.norm(W, axis=0)))
+
+
+def test_ill_conditioned_or_rank_deficient_regressor_takes_the_qr_route(monkeypatch):
+    """Above the guard the fit is the QR route's; a rank-deficient W raises as before."""
+    calls = _spy_qr(monkeypatch)
+    W, y = _tall_problem(121, cond=1e6)
+    fit = fit_least_squares(W, y, covariance="robust")
+    assert len(calls) == 1 and fit.rank == 12 and fit.condition_number > 1e5
+    # a duplicated column: rank 3 of 4, the QR route's message
+    rng = np.random.default_rng(122)
+    A = rng.normal(size=(2000, 3))
+    Wd = np.column_stack([A, 2.0 * A[:, 1]])
+    with pytest.raises(RankDeficientError, match=r"Regressor rank 3 < 4 at rtol=1e-10"):
+        fit_least_squares(Wd, A @ [1.0, 2.0, 3.0])
+    assert len(calls) == 2
+
+
+def test_rank_guard_leaves_a_large_rtol_to_the_qr_rank_decision(monkeypatch):
+    """With cond * rtol >= 0.1 the QR route decides the rank (here: rank deficient)."""
+    calls = _spy_qr(monkeypatch)
+    W, y = _tall_problem(123, cond=50.0)
+    assert fit_least_squares(W, y, rtol=1e-3).rank == 12
+    assert len(calls) == 0
+    with pytest.raises(RankDeficientError, match=r"Regressor rank \d+ < 12 at rtol=0.5"):
+        fit_least_squares(W, y, rtol=0.5)
+    assert len(calls) == 1
+
+
+def test_non_finite_tall_regressor_raises_non_finite_error():
+    """NaN or inf in a tall W is reported as before (found through its Gram matrix)."""
+    W, y = _tall_problem(124)
+    W[1234, 5] = np.nan
+    with pytest.raises(NonFiniteError, match=r"W must be finite; got nan at index \(1234, 5\)"):
+        fit_least_squares(W, y)
+    W[1234, 5] = np.inf
+    with pytest.raises(NonFiniteError, match=r"W must be finite; got inf"):
+        fit_least_squares(W, y, covariance="robust")
+
+
+@pytest.mark.parametrize("covariance", ["classical", "robust"])
+def test_fit_on_row_blocks_equals_the_fit_on_the_stacked_rows(covariance):
+    """Row blocks (rows used, leading zero columns skipped) give the fit of those rows."""
+    from dynid.identification.least_squares import _fit
+
+    W, y = _tall_problem(125, m=4000, r=8)
+    blocks = np.array([[0, 1000, 0], [1500, 2500, 3], [2500, 3000, 3], [3200, 4000, 6]])
+    for a, b, c in blocks:
+        W[a:b, :c] = 0.0  # the structure the blocks declare
+    rows = np.concatenate([np.arange(a, b) for a, b, _ in blocks])
+    ref = fit_least_squares(W[rows], y[rows], covariance=covariance)
+    got = _fit(W, y, rtol=1e-10, covariance=covariance, blocks=blocks)
+    G = W[rows].T @ W[rows]
+    with_gram = _fit(W, y, rtol=1e-10, covariance=covariance, blocks=blocks, gram=G)
+    keep = np.arange(8) != 4
+    pruned = _fit(W, y, kept=keep, rtol=1e-10, covariance=covariance, blocks=blocks, gram=G)
+    ref_pruned = fit_least_squares(W[rows], y[rows], kept=keep, covariance=covariance)
+    for fit, want in ((got, ref), (with_gram, ref), (pruned, ref_pruned)):
+        assert fit.n_rows == want.n_rows == rows.size
+        np.testing.assert_allclose(fit.beta, want.beta, rtol=1e-12)
+        np.testing.assert_allclose(fit.std, want.std, rtol=1e-12)
+        assert fit.sigma == pytest.approx(want.sigma, rel=1e-12)
+        assert fit.relative_error_percent == pytest.approx(want.relative_error_percent, rel=1e-12)
+
+
+def test_identify_static_is_the_same_with_the_numpy_regressor(monkeypatch, noise_free):
+    """The compiled static-regressor kernel and the numpy path give the same fit (1e-12)."""
+    from dynid.regressors import static as static_module
+
+    robot, _, _ = noise_free
+    data = acquire_static(
+        SimulatedController(robot, 1e-3, rng=np.random.default_rng(126)),
+        300,
+        np.random.default_rng(127),
+    )
+    base = base_parameters(robot)
+    compiled = identify_static(robot, data, base=base)
+    monkeypatch.setattr(static_module, "_kernel", lambda: None)
+    numpy_path = identify_static(robot, data, base=base)
+    assert compiled.metadata["dropped_rows"] == numpy_path.metadata["dropped_rows"] == ["g1"]
+    np.testing.assert_allclose(compiled.beta, numpy_path.beta, rtol=1e-12, atol=1e-15)
+    np.testing.assert_allclose(compiled.fit.std, numpy_path.fit.std, rtol=1e-10)

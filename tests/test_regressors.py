@@ -2,14 +2,34 @@
 
 from __future__ import annotations
 
+import json
+import os
+import subprocess
+import sys
+
 import numpy as np
 import pytest
+import scipy.linalg
 
 import dynid
-from conftest import pinocchio_panda_urdf, planar_2r, random_states
-from dynid.regressors.base import base_parameters, base_parameters_from_regressor
-from dynid.regressors.static import static_labels, static_regressor, static_vector
+from dynid.regressors import static as static_module
+from dynid.regressors.base import (
+    _clean,
+    _qr_r_pivoted,
+    base_parameters,
+    base_parameters_from_regressor,
+)
+from dynid.regressors.static import (
+    _static_first_columns,
+    _static_regressor_columns,
+    static_labels,
+    static_regressor,
+    static_regressor_numpy,
+    static_vector,
+)
 from dynid.regressors.torque import torque_regressor
+
+from conftest import pinocchio_panda_urdf, planar_2r, random_states, robot_data_urdf
 
 #: dynid order (m, mcx, mcy, mcz, Jxx, Jxy, Jxz, Jyy, Jyz, Jzz) from Pinocchio's
 #: (m, mcx, mcy, mcz, Ixx, Ixy, Iyy, Ixz, Iyz, Izz)
@@ -75,7 +95,10 @@ def test_base_expressions_use_exact_kinematic_constants(panda):
 
 
 def test_planar_2r_base_parameters_match_closed_form():
-    """Planar 2R in a vertical plane: 6 base parameters (Khalil and Dombre, ZZ1R, MX1R, MY1, ZZ2, MX2, MY2)."""
+    """Planar 2R in a vertical plane: 6 base parameters (Khalil and Dombre).
+
+    ZZ1R, MX1R, MY1, ZZ2, MX2, MY2.
+    """
     r = planar_2r()
     bp = base_parameters(r)
     W = static_regressor(r, np.random.default_rng(15).uniform(-3, 3, (50, 2))).reshape(-1, 20)
@@ -91,3 +114,148 @@ def test_rank_of_rank_deficient_regressor_is_reported():
     bp = base_parameters_from_regressor(W, ("a", "b", "c", "d", "e"))
     assert bp.rank == 3
     np.testing.assert_allclose(W @ np.arange(5.0), bp.reduce(W) @ bp.beta_from_phi(np.arange(5.0)))
+
+
+# ------------------------------------------------------------------ compiled static regressor
+def _rpr():
+    """An RPR arm with tilted gravity (a prismatic joint in the middle)."""
+    return dynid.Robot.from_mdh(
+        [0.0, 0.1, 0.2],
+        [0.3, 0.0, 0.1],
+        [0.0, np.pi / 2, -np.pi / 2],
+        joint_types="RPR",
+        gravity=(0.3, -1.0, -9.8),
+    )
+
+
+def _kernel_in_use():
+    if static_module._kernel() is None:
+        pytest.skip("compiled kernels disabled (DYNID_NO_NUMBA) or numba missing")
+
+
+@pytest.mark.parametrize("B", [1, 127, 128, 300])
+def test_static_regressor_kernel_matches_the_numpy_path(B):
+    """The numba kernel equals the numpy path to rounding, for partial and full blocks."""
+    _kernel_in_use()
+    for robot in (dynid.panda(), _rpr(), planar_2r()):
+        q, _, _ = random_states(robot, B, seed=200 + B)
+        Y = static_regressor(robot, q)
+        ref = static_regressor_numpy(robot, q)
+        assert Y.shape == ref.shape == (B, robot.n * (robot.n + 1) // 2 + robot.n, 10 * robot.n)
+        np.testing.assert_allclose(Y, ref, rtol=0, atol=1e-13 * np.abs(ref).max())
+        # a subset of the columns, in any order, as written by the kernel directly
+        cols = np.random.default_rng(B).permutation(10 * robot.n)[: 4 * robot.n]
+        sub = _static_regressor_columns(robot, q, cols)
+        np.testing.assert_allclose(
+            sub, ref.transpose(2, 1, 0)[cols], rtol=0, atol=1e-13 * np.abs(ref).max()
+        )
+    # one configuration keeps its shape; a batch of shape (2, 3) too
+    robot = dynid.panda()
+    q, _, _ = random_states(robot, 6, seed=210)
+    assert static_regressor(robot, q[0]).shape == (35, 70)
+    np.testing.assert_allclose(
+        static_regressor(robot, q.reshape(2, 3, 7)).reshape(6, 35, 70),
+        static_regressor_numpy(robot, q),
+        atol=1e-12,
+    )
+
+
+def test_static_regressor_kernel_times_phi_equals_tril_m_and_g_with_a_prismatic_joint():
+    """Independent of the numpy path: Y_s phi == [tril M; g] from the dynamics (RPR arm)."""
+    _kernel_in_use()
+    robot = _rpr()
+    rng = np.random.default_rng(211)
+    q = rng.uniform(-2.0, 2.0, (50, 3))
+    Y = static_regressor(robot, q)
+    for _ in range(3):
+        other = robot.with_params(rng.normal(size=30))
+        want = static_vector(dynid.mass_matrix(other, q), dynid.gravity_torques(other, q))
+        np.testing.assert_allclose(Y @ other.phi.reshape(-1), want, atol=1e-12 * np.abs(want).max())
+
+
+def test_static_regressor_rows_are_exactly_zero_before_their_first_column():
+    """Rows (i, j) and g_i do not act on links before i: exact zeros, both paths."""
+    robots = [dynid.panda(), _rpr(), planar_2r()]
+    try:
+        robots.append(
+            dynid.Robot.from_urdf(
+                robot_data_urdf("ur_description/urdf/ur5_robot.urdf"), tip_link="tool0"
+            )
+        )
+    except pytest.skip.Exception:
+        pass
+    for robot in robots:
+        q, _, _ = random_states(robot, 40, seed=212)
+        bp = base_parameters(robot)
+        for cols in (np.arange(10 * robot.n), bp.independent):
+            first = _static_first_columns(robot.n, cols)
+            for numpy_path in (False, True):
+                Y = _static_regressor_columns(robot, q, cols, numpy_path=numpy_path)
+                for k, c in enumerate(first):
+                    assert np.all(Y[:c, k] == 0.0)
+    # the Panda's g7 and M7_j rows start at link 7's mass (column 60); M1_1 at column 0
+    first = _static_first_columns(7, np.arange(70))
+    assert first[0] == 0 and first[21:28].tolist() == [60] * 7 and first[-1] == 60
+    # no structure is claimed for columns out of order
+    assert np.all(_static_first_columns(7, np.array([30, 10, 50])) == 0)
+
+
+def test_no_numba_environment_variable_selects_the_numpy_static_regressor():
+    """DYNID_NO_NUMBA=1: numpy path, numba not imported; same regressor and base parameters."""
+    code = (
+        "import json, sys, numpy as np, dynid\n"
+        "from dynid.regressors.static import _kernel\n"
+        "r = dynid.panda(); q = np.linspace(-1, 1, 14).reshape(2, 7)\n"
+        "Y = dynid.static_regressor(r, q); bp = dynid.base_parameters(r)\n"
+        "assert _kernel() is None and 'numba' not in sys.modules\n"
+        "print(json.dumps([Y.tolist(), list(bp.expressions)]))\n"
+    )
+    env = dict(os.environ, DYNID_NO_NUMBA="1")
+    out = subprocess.run(
+        [sys.executable, "-c", code], env=env, capture_output=True, text=True, check=True
+    )
+    Y, expressions = json.loads(out.stdout)
+    robot = dynid.panda()
+    q = np.linspace(-1, 1, 14).reshape(2, 7)
+    np.testing.assert_allclose(Y, static_regressor(robot, q), rtol=0, atol=1e-12)
+    assert tuple(expressions) == base_parameters(robot).expressions
+
+
+def test_pivoted_r_is_that_of_scipy_qr_exactly():
+    """base_parameters' direct LAPACK call gives scipy.linalg.qr's R and pivots bit for bit."""
+    rng = np.random.default_rng(213)
+    A = rng.normal(size=(500, 12)) * np.logspace(-2, 2, 12)
+    A[:, 5] = A[:, 2] - 3.0 * A[:, 7]  # rank deficient
+    A[:, 9] = 0.0
+    R_ref, piv_ref = scipy.linalg.qr(A, mode="r", pivoting=True)
+    R, piv = _qr_r_pivoted(np.asfortranarray(A))
+    np.testing.assert_array_equal(piv, piv_ref)
+    np.testing.assert_array_equal(R, R_ref[:12])
+
+
+def test_compiled_scaling_of_the_base_parameter_regressor_is_numpys_bit_for_bit():
+    """Column norms and the scaled column-major matrix equal numpy's exactly (same pivots)."""
+    _kernel_in_use()
+    from dynid.regressors import _kernels
+
+    robot = dynid.panda()
+    q = np.random.default_rng(214).uniform(robot.q_min, robot.q_max, (200, 7))
+    Yt = static_module._static_regressor_numpy(robot, q)  # (s, p, B)
+    W = Yt.transpose(2, 0, 1).reshape(-1, 70)
+    norms = np.linalg.norm(W, axis=0)
+    ss = np.empty(70)
+    _kernels.sum_squares_sample_major(Yt, ss)
+    np.testing.assert_array_equal(np.sqrt(ss), norms)
+    null = norms <= 1e-12 * norms.max()
+    scale = np.where(null, 1.0, norms)
+    Ws = np.empty(W.shape, order="F")
+    _kernels.scale_sample_major(Yt, scale, null, Ws)
+    np.testing.assert_array_equal(Ws, np.where(null, 0.0, W / scale))
+
+
+def test_clean_rounds_to_significant_digits_and_zeroes_round_off():
+    """K_d cleaning: 10 significant digits; entries below 1e-11 of the largest become +0."""
+    x = np.array([[0.09985600000000012, -1e-17, 0.0], [-0.0, 0.632 + 4e-16, -2.5]])
+    out = _clean(x, 10, 2.5)
+    np.testing.assert_array_equal(out, [[0.099856, 0.0, 0.0], [0.0, 0.632, -2.5]])
+    assert not np.signbit(out[1, 0]) and not np.signbit(out[0, 1])

@@ -11,8 +11,14 @@ and stacking the configurations gives the overdetermined system of eq. 20,
 ``W beta = y``, solved by least squares (eq. 21; :mod:`dynid.identification.least_squares`).
 The rows of ``s(q)`` are ordered as :func:`dynid.regressors.static.static_labels` (``tril
 M`` by ``np.tril_indices``, then ``g``). Internally the stack is held row-major over (row of
-``s``, configuration) so that ``W`` is column-major for LAPACK without a copy; the order of
-the rows does not change a least-squares solution or its statistics.
+``s``, configuration) so that ``W`` is column-major for LAPACK and BLAS without a copy; the
+order of the rows does not change a least-squares solution or its statistics. Only the
+columns of the base parameters are computed. Row ``(i, j)`` of ``tril M`` and row ``g_i``
+do not depend on the parameters of the links before link ``i``, so each row of ``s`` is a
+block of ``N`` rows of ``W`` that is exactly zero in those columns (with the base columns
+in increasing order, a leading block of them): the products over the rows of ``W`` (Gram
+matrix, ``W^T y``, residuals, robust covariance) skip them, and the Gram matrix of each
+block gives the sums of squares of the row check below.
 
 Rows that carry no information about ``beta`` for this robot are found numerically over
 the data set and dropped: a row whose (column-scaled) regressor vanishes at every
@@ -44,9 +50,13 @@ from .. import _checks
 from ..exceptions import DynidWarning, RankDeficientError, ShapeError
 from ..model.robot import Robot
 from ..regressors.base import BaseParameters, base_parameters
-from ..regressors.static import _static_regressor_samples_last, static_labels
+from ..regressors.static import (
+    _static_first_columns,
+    _static_regressor_columns,
+    static_labels,
+)
 from .data import StaticDataset
-from .least_squares import fit_with_pruning
+from .least_squares import _block_grams, _fit_with_pruning
 from .model import IdentifiedModel
 
 __all__ = ["identify_static", "informative_static_rows", "basis_transform", "coefficients_in_basis"]
@@ -170,11 +180,20 @@ def identify_static(
     N, n, r = data.n_configurations, robot.n, base.rank
     labels = static_labels(n)
     # base regressor with the configurations last: Yb[c, k, b] = coefficient c, row k of
-    # s(q), configuration b (a contiguous gather of the independent columns)
-    Yb = _static_regressor_samples_last(robot, data.q).transpose(1, 0, 2)[base.independent]
+    # s(q), configuration b (only the independent columns are computed). Its transpose W
+    # (s N, r) is column-major for LAPACK and BLAS without a copy; row k N + b is row k of
+    # s at configuration b (the order of the rows does not change a least-squares fit)
+    Yb = _static_regressor_columns(robot, data.q, base.independent)
+    W = Yb.reshape(r, -1).T
     i, j = np.tril_indices(n)
     S = np.concatenate([data.M[:, i, j], data.g], axis=1).T  # (s, N), rows as static_labels
-    info = _informative(np.einsum("jkb,jkb->jk", Yb, Yb), rtol)
+    # one block of N rows per row k of s, exactly zero before column first[k] (the links
+    # before the row's first link do not act on it); the Gram matrix of each block gives
+    # the sums of squares of the row check, and their sum over the rows kept that of W
+    ks = np.arange(len(labels))
+    rows = np.column_stack([ks * N, (ks + 1) * N, _static_first_columns(n, base.independent)])
+    grams = _block_grams(W, rows)
+    info = _informative(np.einsum("kjj->jk", grams), rtol)
     dropped = [labels[k] for k in np.flatnonzero(~info)]
     if dropped:
         big = np.max(np.abs(S[~info]))
@@ -187,20 +206,23 @@ def identify_static(
                 stacklevel=2,
             )
         _log.info("dropping rows without information: %s", ", ".join(dropped))
-        Yb = Yb[:, info]
-    # W (m, r) in column-major memory; row k N + b is row k of s at configuration b (the
-    # order of the rows does not change a least-squares fit)
-    W = Yb.reshape(r, -1).T
-    y = S[info].reshape(-1)
-    _log.info("static identification: %d configurations, %d rows, %d base parameters", N, y.size, r)
+    y = S.reshape(-1)
+    m = int(info.sum()) * N
+    _log.info("static identification: %d configurations, %d rows, %d base parameters", N, m, r)
     try:
-        fit = fit_with_pruning(
-            W, y, max_std_percent=max_std_percent, rtol=rtol, covariance=std_estimator
+        fit = _fit_with_pruning(
+            W,
+            y,
+            max_std_percent=max_std_percent,
+            rtol=rtol,
+            covariance=std_estimator,
+            blocks=rows[info],
+            gram=grams[info].sum(axis=0),
         )
     except RankDeficientError as exc:
-        rank = _rank(W, rtol)
+        rank = _rank(Yb[:, info].reshape(r, -1).T, rtol)
         raise RankDeficientError(
-            f"static regressor of {N} configuration(s) ({y.size} rows) has rank {rank} < {r} "
+            f"static regressor of {N} configuration(s) ({m} rows) has rank {rank} < {r} "
             f"needed for the base parameters (rtol={rtol:g}); add configurations spread over "
             "the joint ranges (Gaz et al. 2019 used 1010)"
         ) from exc
@@ -213,7 +235,7 @@ def identify_static(
         "route": "static",
         "reference": "Gaz et al. 2019, Sec. IV-A, eqs. 17-21",
         "n_configurations": N,
-        "n_rows": int(y.size),
+        "n_rows": m,
         "rows_per_configuration": int(info.sum()),
         "dropped_rows": dropped,
         "pruned": pruned,

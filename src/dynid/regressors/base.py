@@ -16,6 +16,16 @@ significant digits (``clean_digits``).
 
 Columns are scaled to unit norm before the rank decision (parameters mix kg, kg m and
 kg m^2); the rank threshold is ``rtol * |R_00|`` on the scaled problem and is returned.
+
+Which standard parameters are independent is decided by the pivot order. After scaling
+every column has norm 1, so the first pivot, and later ones where residual norms tie
+exactly, are decided by rounding: another factorisation of the same matrix (QR of a QR
+factor, other rows, other BLAS kernels) can choose other independent parameters, the same
+space and rank with other expressions. :func:`base_parameters` therefore computes its
+regressor always by the numpy path of :mod:`dynid.regressors.static` (never the compiled
+kernel; compiled helpers only scale it and lay it out for LAPACK, bit for bit as numpy
+does) and factors it with the same LAPACK call as ``scipy.linalg.qr(..., pivoting=True)``,
+so that its expressions do not depend on whether numba is installed.
 """
 
 from __future__ import annotations
@@ -29,7 +39,7 @@ from numpy.typing import ArrayLike, NDArray
 from .. import _checks
 from ..exceptions import ShapeError
 from ..model.robot import Robot
-from .static import _static_regressor
+from .static import _kernel, _static_regressor_numpy
 from .torque import _torque_regressor
 
 __all__ = ["BaseParameters", "base_parameters", "base_parameters_from_regressor"]
@@ -98,8 +108,10 @@ class BaseParameters:
 
 
 def _clean(x: NDArray[np.float64], digits: int, scale: float) -> NDArray[np.float64]:
-    out = np.array([float(f"{v:.{digits}g}") for v in x.ravel()]).reshape(x.shape)
-    out[np.abs(x) < 1e-11 * max(scale, 1.0)] = 0.0
+    """``x`` rounded to ``digits`` significant digits; 0 below ``1e-11 max(scale, 1)``."""
+    out = np.zeros(x.shape)
+    keep = ~(np.abs(x) < 1e-11 * max(scale, 1.0))  # only these are formatted
+    out[keep] = [float(f"{v:.{digits}g}") for v in x[keep]]
     return out
 
 
@@ -110,6 +122,22 @@ def _term(coef: float, label: str) -> str:
         return f"- {label}"
     sign = "-" if coef < 0 else "+"
     return f"{sign} {abs(coef):.10g}*{label}"
+
+
+def _qr_r_pivoted(A: NDArray[np.float64]) -> tuple[NDArray[np.float64], NDArray[np.intp]]:
+    """``R`` (min(m, p), p) and pivots of the QR with column pivoting of ``A`` (m, p).
+
+    LAPACK ``geqp3`` in place on the column-major ``A`` with the optimal workspace, as
+    ``scipy.linalg.qr(A, mode="r", pivoting=True)`` calls it (the same ``R`` and pivots),
+    without its finiteness check, copies and the triangle of all ``m`` rows.
+    """
+    m, p = A.shape
+    geqp3 = scipy.linalg.lapack.dgeqp3
+    work = geqp3(A, lwork=-1, overwrite_a=True)[3]  # workspace query: A is not touched
+    qr, jpvt, _, _, info = geqp3(A, lwork=int(work[0].real), overwrite_a=True)
+    if info != 0:  # pragma: no cover - LAPACK argument error
+        raise RuntimeError(f"LAPACK dgeqp3 failed with info={info}")
+    return np.triu(qr[: min(m, p)]), (jpvt - 1).astype(np.intp)
 
 
 def base_parameters_from_regressor(
@@ -143,13 +171,36 @@ def base_parameters_from_regressor(
     if len(labels) != p:
         raise ShapeError(f"std_labels must have {p} entries; got {len(labels)}")
     norms = np.linalg.norm(W, axis=0)
+    null, scale = _null_and_scale(norms)
+    Ws = np.empty((m, p), order="F")  # column-major, as LAPACK takes it (no further copy)
+    np.divide(W, scale, out=Ws)
+    Ws[:, null] = 0.0
+    return _from_scaled(Ws, scale, labels, rtol, clean_digits)
+
+
+def _null_and_scale(
+    norms: NDArray[np.float64],
+) -> tuple[NDArray[np.bool_], NDArray[np.float64]]:
+    """Columns at round-off level, and the column scales (1 for those)."""
     # columns at round-off level relative to the largest act on nothing: zero them, since
     # scaling them to unit norm would turn round-off into a spurious direction
     null = norms <= 1e-12 * np.max(norms, initial=0.0)
-    scale = np.where(null, 1.0, norms)
-    Ws = np.where(null, 0.0, W / scale)
-    R, piv = scipy.linalg.qr(Ws, mode="r", pivoting=True)  # Q is not needed
-    R = R[: min(m, p)]
+    return null, np.where(null, 1.0, norms)
+
+
+def _from_scaled(
+    Ws: NDArray[np.float64],
+    scale: NDArray[np.float64],
+    labels: tuple[str, ...],
+    rtol: float,
+    clean_digits: int,
+) -> BaseParameters:
+    """Base parameters from the column-scaled regressor ``Ws`` (m, p), column-major.
+
+    ``Ws`` is overwritten by its QR factorisation.
+    """
+    m, p = Ws.shape
+    R, piv = _qr_r_pivoted(Ws)
     d = np.abs(np.diag(R))
     r = int(np.sum(d > rtol * d[0])) if d.size and d[0] > 0 else 0
     ind, dep = np.sort(piv[:r]), np.sort(piv[r:])
@@ -205,7 +256,19 @@ def base_parameters(
     hi = np.where(np.isfinite(robot.q_max), robot.q_max, np.pi)
     q = rng.uniform(lo, hi, (n_samples, robot.n))
     if kind == "static":
-        W = _static_regressor(robot, q).reshape(-1, 10 * robot.n)
+        Yt = _static_regressor_numpy(robot, q)  # (s, 10 n, B): samples last
+        K = _kernel()
+        if K is None:
+            W = Yt.transpose(2, 0, 1).reshape(-1, 10 * robot.n)  # sample-major rows
+            return base_parameters_from_regressor(W, robot.param_labels, rtol=rtol)
+        # the same scaled matrix and norms, bit for bit, without the sample-major copy
+        s, p, B = Yt.shape
+        ss = np.empty(p)
+        K.sum_squares_sample_major(Yt, ss)
+        null, scale = _null_and_scale(np.sqrt(ss))
+        Ws = np.empty((B * s, p), order="F")
+        K.scale_sample_major(Yt, scale, null, Ws)
+        return _from_scaled(Ws, scale, robot.param_labels, rtol, clean_digits=10)
     elif kind == "torque":
         dq = rng.uniform(-2, 2, q.shape)
         ddq = rng.uniform(-5, 5, q.shape)

@@ -18,18 +18,49 @@ its angular velocity for a unit rate of joint ``k`` (link-``l`` coordinates; zer
 and its potential energy ``-g_0 \\cdot (m_l p_l + R_l h_l)`` gives
 :math:`g_k = \\sum_l -m_l\\, g_l \\cdot v_k + h_l \\cdot (w_k \\times g_l)`, ``g_l`` the gravity
 vector in link ``l`` coordinates.
+
+Two implementations compute the same rows (to rounding): the compiled kernel of
+:mod:`dynid.regressors._kernels` (numba; one pass over the samples, writing only the
+columns asked for), used when :func:`dynid.dynamics.rnea.kernels` finds the compiled
+kernels, and the numpy path (samples vectorised, a loop over links), used otherwise or
+with ``DYNID_NO_NUMBA=1`` (:func:`static_regressor_numpy` always takes it).
 """
 
 from __future__ import annotations
+
+from types import ModuleType
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from .. import _checks
+from ..dynamics.rnea import _flat, kernels
 from ..kinematics.forward import _link_poses
 from ..model.robot import Robot
 
-__all__ = ["static_regressor", "static_labels", "static_vector", "static_rows"]
+__all__ = [
+    "static_regressor",
+    "static_regressor_numpy",
+    "static_labels",
+    "static_vector",
+    "static_rows",
+]
+
+_KERNEL: ModuleType | None = None
+
+
+def _kernel() -> ModuleType | None:
+    """The compiled static-regressor kernel module, or None (numpy path).
+
+    Follows :func:`dynid.dynamics.rnea.kernels`: None when numba is missing or
+    ``DYNID_NO_NUMBA`` is set. Imported on the first call.
+    """
+    global _KERNEL
+    if _KERNEL is None and kernels() is not None:
+        from . import _kernels
+
+        _KERNEL = _kernels
+    return _KERNEL
 
 
 def static_rows(n: int) -> int:
@@ -54,16 +85,64 @@ def static_vector(M: ArrayLike, g: ArrayLike) -> NDArray[np.float64]:
     return np.concatenate([M[..., i, j], np.broadcast_to(g, M.shape[:-2] + (n,))], axis=-1)
 
 
+def _static_first_columns(n: int, columns: NDArray[np.intp]) -> NDArray[np.intp]:
+    """For each row of ``s``, the first of ``columns`` where its regressor can be non-zero.
+
+    Row ``(i, j)`` of ``tril M`` and row ``g_i`` depend only on the parameters of links
+    ``i .. n - 1`` (0-based: ``v_k = w_k = 0`` for a joint ``k`` after link ``l``), and the
+    regressor holds exact zeros elsewhere. With ``columns`` (standard-parameter indices,
+    ``robot.param_labels`` order) increasing, the row's entries in the columns before the
+    returned index are therefore exactly zero. Zeros (no structure) when ``columns`` does
+    not increase. Returns shape (n (n + 1) / 2 + n,).
+    """
+    ii, _ = np.tril_indices(n)
+    first_link = np.concatenate([ii, np.arange(n)])
+    cols = np.asarray(columns, dtype=np.intp)
+    if np.any(np.diff(cols) <= 0):
+        return np.zeros(first_link.size, dtype=np.intp)
+    return np.searchsorted(cols // 10, first_link, side="left").astype(np.intp)
+
+
 def _static_regressor(robot: Robot, q2: NDArray[np.float64]) -> NDArray[np.float64]:
     """(B, n (n + 1) / 2 + n, 10 n) static regressor for validated (B, n) positions.
 
-    A transposed view of :func:`_static_regressor_samples_last` (not C-contiguous).
+    A transposed view of :func:`_static_regressor_columns` (not C-contiguous).
     """
-    return _static_regressor_samples_last(robot, q2).transpose(2, 0, 1)
+    return _static_regressor_columns(robot, q2).transpose(2, 1, 0)
 
 
-def _static_regressor_samples_last(robot: Robot, q2: NDArray[np.float64]) -> NDArray[np.float64]:
-    """The static regressor with the samples on the last axis: (n (n + 1) / 2 + n, 10 n, B)."""
+def _static_regressor_columns(
+    robot: Robot,
+    q2: NDArray[np.float64],
+    columns: NDArray[np.intp] | None = None,
+    *,
+    numpy_path: bool = False,
+) -> NDArray[np.float64]:
+    """Columns of the static regressor, samples last: (c, n (n + 1) / 2 + n, B), C order.
+
+    ``Y[c, k, b]`` is standard parameter ``columns[c]`` (all ``10 n`` in order when None),
+    row ``k`` of ``s``, sample ``b`` of the validated (B, n) positions ``q2``; a column of
+    the stacked regressor (rows, then samples) is contiguous. The compiled kernel writes
+    only these columns; the numpy path (``numpy_path=True`` or no kernel) gathers them.
+    """
+    B, n = q2.shape
+    p = 10 * n
+    idx = np.arange(p) if columns is None else np.asarray(columns, dtype=np.intp)
+    K = None if numpy_path else _kernel()
+    if K is not None and np.unique(idx).size == idx.size:  # (a repeated column: gather)
+        cols = np.full(p, -1, dtype=np.int64)  # output column of each standard parameter
+        cols[idx] = np.arange(idx.size)
+        Y = np.zeros((idx.size, static_rows(n), B))  # the kernel writes the non-zeros
+        if K.static_regressor(
+            robot.T_parent_joint, robot.axes, robot.prismatic, robot.gravity, _flat(q2), cols, Y
+        ):
+            return Y
+    Yt = _static_regressor_numpy(robot, q2).transpose(1, 0, 2)  # (10 n, s, B) view
+    return np.ascontiguousarray(Yt if columns is None else Yt[idx])
+
+
+def _static_regressor_numpy(robot: Robot, q2: NDArray[np.float64]) -> NDArray[np.float64]:
+    """Numpy path: the static regressor with the samples on the last axis (s, 10 n, B)."""
     B, n = q2.shape
     T = _link_poses(robot, q2)
     # samples on the last axis: the arithmetic below runs on contiguous (.., B) rows
@@ -130,4 +209,11 @@ def static_regressor(robot: Robot, q: ArrayLike) -> NDArray[np.float64]:
     """
     q = _checks.as_batch("q", q, (robot.n,))
     Y = _static_regressor(robot, q.reshape(-1, robot.n))
+    return Y.reshape(q.shape[:-1] + Y.shape[1:])
+
+
+def static_regressor_numpy(robot: Robot, q: ArrayLike) -> NDArray[np.float64]:
+    """:func:`static_regressor` by the numpy path, never the compiled kernel."""
+    q = _checks.as_batch("q", q, (robot.n,))
+    Y = _static_regressor_numpy(robot, q.reshape(-1, robot.n)).transpose(2, 0, 1)
     return Y.reshape(q.shape[:-1] + Y.shape[1:])
