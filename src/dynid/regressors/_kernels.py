@@ -21,26 +21,17 @@ regressor is written without forming the full one. ``Y`` must hold zeros on entr
 (``np.zeros``, whose pages the system zeroes only when they are first touched): the kernel
 writes only the entries that can be non-zero, which leaves untouched the rows of the links
 after the row's joint (about half of the entries).
-
-:func:`sum_squares_sample_major` and :func:`scale_sample_major` prepare the stacked
-regressor of :func:`dynid.regressors.base.base_parameters` (column norms, then the scaled
-column-major matrix) from the numpy path's ``(s, p, B)`` array without the sample-major
-copy. They are compiled without fast-math flags (no fused multiply-add) and add in the
-order of the rows, so that they reproduce numpy's results bit for bit: the choice of the
-base parameters depends on the rounding of these numbers (see
-:mod:`dynid.regressors.base`).
 """
 
 from __future__ import annotations
 
 import math
 
-import numba
 import numpy as np
 
 from ..dynamics._kernels import _SINCOS_MAX, _jit, _sincos
 
-__all__ = ["BLOCK", "static_regressor", "sum_squares_sample_major", "scale_sample_major"]
+__all__ = ["BLOCK", "static_regressor"]
 
 #: Samples per block (the length of the inner loops and of the runs written into ``Y``).
 BLOCK = 128
@@ -215,52 +206,6 @@ def _static_regressor(T, axes, prismatic, g, q, cols, Y):
                             out[kk] = w[k, a1, kk] * gl[a2, kk] - w[k, a2, kk] * gl[a1, kk]
     return True
 
-
-def _sum_squares_sample_major(Y, out):
-    """``out[j]`` = sum of ``Y[k, j, b]^2`` over the rows ``b s + k`` in order.
-
-    ``Y`` (s, p, B); the rows are those of ``Y.transpose(2, 0, 1).reshape(-1, p)``, and the
-    sum is sequential, as numpy's ``add.reduce`` along axis 0 of that C-ordered array.
-    """
-    s, p, B = Y.shape
-    for j in range(p):
-        out[j] = 0.0
-    for b in range(B):
-        for k in range(s):
-            for j in range(p):
-                x = Y[k, j, b]
-                out[j] += x * x
-
-
-def _scale_sample_major(Y, scale, null, Ws):
-    """``Ws[b s + k, j] = Y[k, j, b] / scale[j]``, 0 in the columns where ``null[j]``.
-
-    ``Y`` (s, p, B), ``Ws`` (B s, p) column-major.
-    """
-    s, p, B = Y.shape
-    for j in range(p):
-        if null[j]:
-            for i in range(B * s):
-                Ws[i, j] = 0.0
-            continue
-        d = scale[j]
-        for b in range(B):
-            for k in range(s):
-                Ws[b * s + k, j] = Y[k, j, b] / d
-
-
-def _jit_exact(fn):
-    """``numba.njit(cache=True)`` without fast-math flags: IEEE operations in program order."""
-    try:
-        return numba.njit(cache=True)(fn)
-    except RuntimeError:  # no writable cache location
-        return numba.njit(fn)
-
-
-#: ``sum_squares_sample_major(Y, out)``
-sum_squares_sample_major = _jit_exact(_sum_squares_sample_major)
-#: ``scale_sample_major(Y, scale, null, Ws)``
-scale_sample_major = _jit_exact(_scale_sample_major)
 
 #: ``static_regressor(T, axes, prismatic, g, q, cols, Y) -> ok``
 static_regressor = _jit(_static_regressor)

@@ -15,17 +15,14 @@ of dependent ones, printed as ``J3yy + J2zz + 0.099856*m3 + ...``. The coefficie
 significant digits (``clean_digits``).
 
 Columns are scaled to unit norm before the rank decision (parameters mix kg, kg m and
-kg m^2); the rank threshold is ``rtol * |R_00|`` on the scaled problem and is returned.
+kg m^2); the rank threshold is ``rtol`` times the largest scaled column norm, returned.
 
 Which standard parameters are independent is decided by the pivot order. After scaling
-every column has norm 1, so the first pivot, and later ones where residual norms tie
-exactly, are decided by rounding: another factorisation of the same matrix (QR of a QR
-factor, other rows, other BLAS kernels) can choose other independent parameters, the same
-space and rank with other expressions. :func:`base_parameters` therefore computes its
-regressor always by the numpy path of :mod:`dynid.regressors.static` (never the compiled
-kernel; compiled helpers only scale it and lay it out for LAPACK, bit for bit as numpy
-does) and factors it with the same LAPACK call as ``scipy.linalg.qr(..., pivoting=True)``,
-so that its expressions do not depend on whether numba is installed.
+every column has norm 1, so pivoting on the largest norm (LAPACK's ``geqp3``) would choose
+by rounding noise and by the samples, and the expressions would change from one data set
+or machine to the next. Here the first column in parameter order that is independent of
+the columns chosen before it is taken, as Gauss-Jordan elimination does: the base
+parameters depend on the robot's structure only (see :func:`_pivoted_r`).
 """
 
 from __future__ import annotations
@@ -39,7 +36,7 @@ from numpy.typing import ArrayLike, NDArray
 from .. import _checks
 from ..exceptions import ShapeError
 from ..model.robot import Robot
-from .static import _kernel, _static_regressor_numpy
+from .static import static_regressor
 from .torque import _torque_regressor
 
 __all__ = ["BaseParameters", "base_parameters", "base_parameters_from_regressor"]
@@ -124,20 +121,52 @@ def _term(coef: float, label: str) -> str:
     return f"{sign} {abs(coef):.10g}*{label}"
 
 
-def _qr_r_pivoted(A: NDArray[np.float64]) -> tuple[NDArray[np.float64], NDArray[np.intp]]:
-    """``R`` (min(m, p), p) and pivots of the QR with column pivoting of ``A`` (m, p).
+#: A column whose part not explained by the columns already chosen keeps at least this
+#: fraction of its (unit) norm counts as independent of them; the first such column in
+#: parameter order is chosen, as Gauss-Jordan elimination does (Gaz et al. 2019).
+INDEPENDENCE_THRESHOLD = 1e-6
 
-    LAPACK ``geqp3`` in place on the column-major ``A`` with the optimal workspace, as
-    ``scipy.linalg.qr(A, mode="r", pivoting=True)`` calls it (the same ``R`` and pivots),
-    without its finiteness check, copies and the triangle of all ``m`` rows.
+
+def _pivoted_r(
+    A: NDArray[np.float64], rtol: float
+) -> tuple[NDArray[np.float64], NDArray[np.intp], int]:
+    """``R`` (min(m, p), p), pivots and rank of a QR with column pivoting of ``A`` (m, p).
+
+    First the triangular factor ``R0`` of ``A`` without pivoting: an orthogonal
+    transformation keeps every column norm and the pivoted factorisation. Then Householder
+    steps on the small ``R0``: at each step the first column (in parameter order) whose
+    remaining norm is at least ``INDEPENDENCE_THRESHOLD`` is chosen; if none is, the
+    column of largest remaining norm while it exceeds ``rtol`` times the first step's
+    largest norm; the rank is the number of steps taken. The choice then depends on the
+    structure of the regressor, not on rounding or on the particular samples.
     """
     m, p = A.shape
-    geqp3 = scipy.linalg.lapack.dgeqp3
-    work = geqp3(A, lwork=-1, overwrite_a=True)[3]  # workspace query: A is not touched
-    qr, jpvt, _, _, info = geqp3(A, lwork=int(work[0].real), overwrite_a=True)
-    if info != 0:  # pragma: no cover - LAPACK argument error
-        raise RuntimeError(f"LAPACK dgeqp3 failed with info={info}")
-    return np.triu(qr[: min(m, p)]), (jpvt - 1).astype(np.intp)
+    R0 = scipy.linalg.qr(A, mode="r", overwrite_a=True, check_finite=False)[0]
+    R = np.array(R0[: min(m, p)], dtype=np.float64)
+    piv = np.arange(p)
+    first = None
+    rank = 0
+    for k in range(R.shape[0]):
+        norms = np.sqrt(np.einsum("ij,ij->j", R[k:, k:], R[k:, k:]))
+        top = norms.max(initial=0.0)
+        first = top if first is None else first
+        if top == 0.0 or top <= rtol * first:
+            break
+        ok = np.flatnonzero(norms >= INDEPENDENCE_THRESHOLD)
+        j = k + (int(ok[np.argmin(piv[k + ok])]) if ok.size else int(np.argmax(norms)))
+        if j != k:
+            R[:, [k, j]] = R[:, [j, k]]
+            piv[[k, j]] = piv[[j, k]]
+        x = R[k:, k]
+        alpha = -np.copysign(np.linalg.norm(x), x[0])
+        v = x.copy()
+        v[0] -= alpha
+        vv = float(v @ v)
+        if vv > 0.0:
+            R[k:, k:] -= np.outer(v, (2.0 / vv) * (v @ R[k:, k:]))
+        R[k + 1 :, k] = 0.0
+        rank = k + 1
+    return np.triu(R), piv, rank
 
 
 def base_parameters_from_regressor(
@@ -200,9 +229,7 @@ def _from_scaled(
     ``Ws`` is overwritten by its QR factorisation.
     """
     m, p = Ws.shape
-    R, piv = _qr_r_pivoted(Ws)
-    d = np.abs(np.diag(R))
-    r = int(np.sum(d > rtol * d[0])) if d.size and d[0] > 0 else 0
+    R, piv, r = _pivoted_r(Ws, rtol)
     ind, dep = np.sort(piv[:r]), np.sort(piv[r:])
     # K_d from the scaled problem: Ws_b K = Ws_d  <=>  R11 K = R12 (pivot order); then rows
     # and columns in sorted column order
@@ -256,19 +283,7 @@ def base_parameters(
     hi = np.where(np.isfinite(robot.q_max), robot.q_max, np.pi)
     q = rng.uniform(lo, hi, (n_samples, robot.n))
     if kind == "static":
-        Yt = _static_regressor_numpy(robot, q)  # (s, 10 n, B): samples last
-        K = _kernel()
-        if K is None:
-            W = Yt.transpose(2, 0, 1).reshape(-1, 10 * robot.n)  # sample-major rows
-            return base_parameters_from_regressor(W, robot.param_labels, rtol=rtol)
-        # the same scaled matrix and norms, bit for bit, without the sample-major copy
-        s, p, B = Yt.shape
-        ss = np.empty(p)
-        K.sum_squares_sample_major(Yt, ss)
-        null, scale = _null_and_scale(np.sqrt(ss))
-        Ws = np.empty((B * s, p), order="F")
-        K.scale_sample_major(Yt, scale, null, Ws)
-        return _from_scaled(Ws, scale, robot.param_labels, rtol, clean_digits=10)
+        W = static_regressor(robot, q).reshape(-1, 10 * robot.n)
     elif kind == "torque":
         dq = rng.uniform(-2, 2, q.shape)
         ddq = rng.uniform(-5, 5, q.shape)
