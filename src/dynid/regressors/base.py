@@ -260,7 +260,7 @@ def base_parameters(
     robot: Robot,
     *,
     kind: str = "static",
-    n_samples: int = 200,
+    n_samples: int = 64,
     rng: np.random.Generator | None = None,
     rtol: float = 1e-10,
 ) -> BaseParameters:
