@@ -21,14 +21,15 @@ it.
 
 from __future__ import annotations
 
-import os
 from types import ModuleType
 from typing import NamedTuple
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from .. import _checks
+from .. import _checks, _compiled
+from .._compiled import flat as _flat
+from .._compiled import readonly as _readonly
 from ..exceptions import ShapeError
 from ..kinematics.forward import _joint_rotations_translations
 from ..model.inertia import matrix_from_inertia6
@@ -48,30 +49,8 @@ def kernels() -> ModuleType | None:
     """
     global _KERNELS, _LOADED
     if not _LOADED:
-        mod: ModuleType | None = None
-        if os.environ.get("DYNID_NO_NUMBA", "") in ("", "0"):
-            try:
-                from . import _kernels as mod
-            except ImportError:  # numba is not installed
-                mod = None
-        _KERNELS, _LOADED = mod, True
+        _KERNELS, _LOADED = _compiled.optional(f"{__package__}._kernels"), True
     return _KERNELS
-
-
-def _flat(x: NDArray[np.float64]) -> NDArray[np.float64]:
-    """``x`` as a flat C-contiguous, aligned, writeable array (a view when it can be).
-
-    The kernels then see a single argument type, so they are compiled once.
-    """
-    if x.ndim != 1:
-        x = x.reshape(-1)
-    return x if x.flags.carray else np.array(x)
-
-
-def _readonly(x: NDArray[np.float64]) -> NDArray[np.float64]:
-    """``x`` as a read-only C array, as the robot's constants are (one kernel type)."""
-    f = x.flags
-    return x if f.c_contiguous and f.aligned and not f.writeable else _checks.frozen(x)
 
 
 def cross(a: NDArray[np.float64], b: NDArray[np.float64]) -> NDArray[np.float64]:
