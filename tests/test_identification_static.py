@@ -208,6 +208,16 @@ def test_classical_and_robust_std_match_their_formulas():
     np.testing.assert_allclose(a.beta, beta, rtol=1e-10)
     np.testing.assert_allclose(a.std, classical, rtol=1e-10)
     np.testing.assert_allclose(b.std, robust, rtol=1e-10)
+    # the full covariance is kept (semi-normal path here; the QR path below)
+    np.testing.assert_allclose(a.covariance, G * (e @ e) / (m - r), rtol=1e-9, atol=1e-14)
+    np.testing.assert_allclose(
+        b.covariance, G @ (W.T * e**2) @ W @ G * m / (m - r), rtol=1e-9, atol=1e-14
+    )
+    short = slice(0, 3 * r)  # too few rows for the semi-normal path: QR with pivoting
+    Gs = np.linalg.inv(W[short].T @ W[short])
+    es = y[short] - W[short] @ (Gs @ W[short].T @ y[short])
+    c = fit_least_squares(W[short], y[short])
+    np.testing.assert_allclose(c.covariance, Gs * (es @ es) / (2 * r), rtol=1e-8, atol=1e-14)
 
 
 def test_pruning_removes_uncertain_coefficients_and_refits_the_rest(panda_base):

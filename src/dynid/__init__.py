@@ -39,6 +39,7 @@ from .exceptions import (
     NonFiniteError,
     RankDeficientError,
     ShapeError,
+    SolverError,
     UnknownNameError,
 )
 from .friction.fit import FrictionFit, fit_friction
@@ -94,6 +95,7 @@ __all__ = [
     "Robot",
     "SensorNoise",
     "ShapeError",
+    "SolverError",
     "SigmoidFriction",
     "SimulatedController",
     "StaticDataset",

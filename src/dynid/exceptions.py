@@ -52,3 +52,7 @@ class ConvergenceError(DynidError, RuntimeError):
 
 class DynidWarning(UserWarning):
     """A recoverable problem: ill-conditioning, inconsistent inertials, dropped data."""
+
+
+class SolverError(DynidError, RuntimeError):
+    """A numerical solver failed (its status is named in the message)."""

@@ -77,6 +77,7 @@ def _split_fit(fit: LeastSquaresFit, r: int) -> LeastSquaresFit:
         std=fit.std[:r],
         std_percent=fit.std_percent[:r],
         kept=fit.kept[:r],
+        covariance=None if fit.covariance is None else fit.covariance[:r, :r],
     )
 
 

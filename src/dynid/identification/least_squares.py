@@ -104,6 +104,10 @@ class LeastSquaresFit:
         Residual standard deviation ``sqrt(||e||^2 / (m - r))``.
     n_rows : int
     rtol : float
+    covariance : ndarray, shape (r, r), optional
+        Full covariance of ``beta`` (same estimator as ``std``; zero rows and columns for
+        removed coefficients), so that ``std = sqrt(diag(covariance))``. None when not
+        known (files written before it was kept).
     """
 
     beta: NDArray[np.float64]
@@ -117,6 +121,7 @@ class LeastSquaresFit:
     sigma: float
     n_rows: int
     rtol: float
+    covariance: NDArray[np.float64] | None = None
 
 
 def fit_least_squares(
@@ -224,13 +229,17 @@ def _fit(
         Wu = Wk if used is None else Wk[used]
         _checks.finite("W", W if used is None else Wu)
         solved = _solve_qr(Wu, yu, rtol, covariance)
-    rank, cond, bk, e, var_s, scale = solved
+    rank, cond, bk, e, cov_s, scale = solved
     ss = float(e @ e)
     sigma = np.sqrt(ss / max(m - rk, 1))
-    sk = np.sqrt(var_s) / scale
+    cov_k = cov_s / np.outer(scale, scale)
+    cov_k = 0.5 * (cov_k + cov_k.T)
+    sk = np.sqrt(np.maximum(np.diag(cov_k), 0.0))
     beta = np.zeros(r)
     std = np.zeros(r)
+    cov = np.zeros((r, r))
     beta[keep], std[keep] = bk, sk
+    cov[np.ix_(keep, keep)] = cov_k
     with np.errstate(divide="ignore", invalid="ignore"):
         pct = np.where(keep, 100.0 * std / np.abs(beta), np.nan)
     pct = np.where(keep & (std == 0.0), 0.0, pct)
@@ -247,6 +256,7 @@ def _fit(
         sigma=float(sigma),
         n_rows=m,
         rtol=rtol,
+        covariance=_checks.frozen(cov),
     )
 
 
@@ -352,7 +362,7 @@ def _solve_semi_normal(
     """Corrected semi-normal equations, or None when the QR path must decide.
 
     ``y`` holds the rows used (in block order), ``G`` is ``W^T W`` or None. Returns
-    ``(rank, cond, beta, e, var_s, scale)`` as :func:`_solve_qr`; None when the Gram
+    ``(rank, cond, beta, e, cov_s, scale)`` as :func:`_solve_qr`; None when the Gram
     matrix is not finite or out of range, its Cholesky factorisation fails or the
     condition number exceeds the guard (see the module docstring).
     """
@@ -384,13 +394,13 @@ def _solve_semi_normal(
     e, meat = _residual(Wk, blk, y, bk, "meat" if covariance == "robust" else "rmatvec")
     dof = max(m - rk, 1)
     Rinv = scipy.linalg.solve_triangular(R, np.eye(rk), check_finite=False)
+    Gi = Rinv @ Rinv.T
     if covariance == "classical":
-        var_s = np.sum(Rinv**2, axis=1) * (float(e @ e) / dof)
+        cov_s = Gi * (float(e @ e) / dof)
     else:  # HC1: (R^T R)^{-1} D^{-1} W^T diag(e^2) W D^{-1} (R^T R)^{-1}
         meat = meat / scale[:, None] / scale[None, :]
-        Gi = Rinv @ Rinv.T
-        var_s = np.einsum("ij,jk,ik->i", Gi, meat, Gi) * (m / dof)
-    return rk, cond, bk, e, var_s, scale
+        cov_s = Gi @ meat @ Gi * (m / dof)
+    return rk, cond, bk, e, cov_s, scale
 
 
 def _solve_qr(
@@ -398,9 +408,9 @@ def _solve_qr(
 ) -> _Solved:
     """Column-scaled Householder QR with column pivoting (two stages when ``W`` is tall).
 
-    Returns ``(rank, cond, beta, e, var_s, scale)``: the rank at ``rtol``, the condition
-    number of the scaled ``W``, the estimates, the residual ``y - W beta``, the variances
-    of the scaled coefficients (the column norms ``scale`` divide their roots).
+    Returns ``(rank, cond, beta, e, cov_s, scale)``: the rank at ``rtol``, the condition
+    number of the scaled ``W``, the estimates, the residual ``y - W beta``, the covariance
+    of the scaled coefficients (divide by ``outer(scale, scale)`` for ``beta``'s).
 
     Raises
     ------
@@ -446,16 +456,16 @@ def _solve_qr(
     dof = max(m - rk, 1)
     sigma = np.sqrt(ss / dof)
     Rinv = scipy.linalg.solve_triangular(R, np.eye(rk))
+    G = Rinv @ Rinv.T
     if covariance == "classical":
-        var_p = np.sum(Rinv**2, axis=1) * sigma**2
+        cov_p = G * sigma**2
     else:  # HC1: (R^T R)^{-1} Ws^T diag(e^2) Ws (R^T R)^{-1}, in pivoted order
         We = Wk * e[:, None]
         meat = (We.T @ We) / np.outer(scale, scale)
-        G = Rinv @ Rinv.T
-        var_p = np.einsum("ij,jk,ik->i", G, meat[np.ix_(piv, piv)], G) * (m / dof)
-    var_s = np.empty(rk)
-    var_s[piv] = var_p
-    return rank, cond, bk, e, var_s, scale
+        cov_p = G @ meat[np.ix_(piv, piv)] @ G * (m / dof)
+    cov_s = np.empty((rk, rk))
+    cov_s[np.ix_(piv, piv)] = cov_p
+    return rank, cond, bk, e, cov_s, scale
 
 
 def fit_with_pruning(

@@ -6,6 +6,7 @@ Layout of the file (top-level keys)::
     rank, condition_number, relative_error_percent, residual_rms, sigma, n_rows, rtol,
     dropped_rows, pruned, std_estimator,
     coefficients: [{"name", "expression", "value", "std", "std_percent", "kept"}, ...],
+    covariance: (r x r) covariance of the values, or null,
     base: {"std_labels", "independent", "dependent", "K_d", "rank", "rtol"},
     friction: null or (n, 3) linear friction [fv N m s/rad, fc N m, fo N m],
     robot: the kinematics (:mod:`dynid.io.robot_json`),
@@ -33,6 +34,7 @@ from pathlib import Path
 from typing import Any
 
 import numpy as np
+from numpy.typing import NDArray
 
 from .. import __version__, _checks
 from ..exceptions import DataError
@@ -110,6 +112,7 @@ def model_to_dict(model: IdentifiedModel, *, seed: int | None = None) -> dict[st
     out["pruned"] = list(meta.get("pruned", []))
     out["std_estimator"] = meta.get("std_estimator")
     out["coefficients"] = coefficients
+    out["covariance"] = None if fit.covariance is None else np.asarray(fit.covariance).tolist()
     out["base"] = {
         "std_labels": list(base.std_labels),
         "independent": base.independent.tolist(),
@@ -135,6 +138,16 @@ def model_to_dict(model: IdentifiedModel, *, seed: int | None = None) -> dict[st
         "reference": "Gaz et al. 2019, IEEE RA-L 4(4):4147-4154",
     }
     return out
+
+
+def _covariance(c: Any, r: int) -> NDArray[np.float64] | None:
+    """The (r, r) covariance of a file, or None when the file has none (older files)."""
+    if c is None:
+        return None
+    a = np.asarray(c, dtype=np.float64)
+    if a.shape != (r, r) or not np.all(np.isfinite(a)):
+        raise DataError(f"identified model: covariance must be a finite {r}x{r} matrix")
+    return _frozen(0.5 * (a + a.T))
 
 
 def model_from_dict(d: Mapping[str, Any]) -> IdentifiedModel:
@@ -188,6 +201,7 @@ def model_from_dict(d: Mapping[str, Any]) -> IdentifiedModel:
             sigma=_float(d["sigma"]),
             n_rows=int(d["n_rows"]),
             rtol=float(d["rtol"]),
+            covariance=_covariance(d.get("covariance"), r),
         )
         friction = d.get("friction")
         metadata = dict(d.get("metadata") or {})
