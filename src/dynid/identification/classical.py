@@ -192,4 +192,5 @@ def identify_from_log(
         fit=_split_fit(fit, r) if friction else fit,
         friction=fr,
         metadata=meta,
+        joint_fit=fit if friction else None,
     )

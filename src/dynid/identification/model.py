@@ -44,6 +44,10 @@ class IdentifiedModel:
         the classical route; None otherwise.
     metadata : dict
         Route, data source, row counts, dropped rows, seed.
+    joint_fit : LeastSquaresFit, optional
+        Classical route with friction: the fit of every column (the ``r`` base parameters,
+        then ``fv, fc, fo`` per joint), whose covariance couples both (consistent
+        identification uses it); not saved to files.
     """
 
     robot: Robot
@@ -51,6 +55,7 @@ class IdentifiedModel:
     fit: LeastSquaresFit
     friction: NDArray[np.float64] | None = None
     metadata: dict[str, Any] = field(default_factory=dict)
+    joint_fit: LeastSquaresFit | None = None
     equivalent_robot: Robot = field(init=False)
 
     def __post_init__(self) -> None:

@@ -1,0 +1,213 @@
+"""Prior link parameters for consistent identification: checked, repaired, or made up.
+
+A prior is a complete set of standard parameters (10 per link, :mod:`dynid.model.inertia`)
+that the convex retrieval (:mod:`dynid.feasibility.sdp`) is pulled towards in the
+directions the data cannot see. It comes from
+
+* a robot description with inertials (:func:`prior_from_robot`): the built-in Panda, a
+  URDF from CAD, a TOML file, a feasible set retrieved earlier; or
+* the kinematics alone (:func:`generic_prior`): each link a solid cylinder of radius
+  :data:`GENERIC_RADIUS_FRACTION` of its length (at least :data:`GENERIC_RADIUS_MIN`)
+  along the segment that bounds it (from the parent's origin or its own to the next
+  joint's origin, or to the frames fixed to the last link); masses in proportion to
+  ``GENERIC_LINK_MASS_BASE + GENERIC_LINK_MASS_PER_M * length``, scaled to the middle of
+  the total-mass band when one is given.
+
+Every prior is checked before use: a link whose pseudo-inertia is not positive definite
+with the margin ``lambda_min(J) >= margin tr(J)`` (a CAD inertia violating the triangle
+inequality, a massless link) is repaired by flooring the eigenvalues of ``J``
+(:func:`~dynid.feasibility.lmi.repair_pseudo_inertia`; a massless link gets the generic
+cylinder), and a total mass outside the band is reported. Nothing is repaired silently:
+:attr:`Prior.notes` says what was done, one line each.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+from numpy.typing import NDArray
+
+from ..exceptions import ModelError
+from ..model.inertia import phi_from_inertial
+from ..model.robot import Robot
+from .lmi import pseudo_inertia, pseudo_inertia_margin, repair_pseudo_inertia
+
+__all__ = [
+    "DEFAULT_PRIOR_MARGIN",
+    "Prior",
+    "generic_prior",
+    "prior_from_robot",
+]
+
+#: A prior's links are repaired up to ``lambda_min(J) >= DEFAULT_PRIOR_MARGIN tr(J)``
+#: (the published Panda's links lie between 2e-4 and 2e-3).
+DEFAULT_PRIOR_MARGIN = 2e-4
+#: Generic cylinder: radius as a fraction of the link's length, and its floor [m].
+GENERIC_RADIUS_FRACTION = 0.2
+GENERIC_RADIUS_MIN = 0.04
+#: Generic masses (before scaling to a band): a drive plus a structure [kg, kg/m].
+GENERIC_LINK_MASS_BASE = 1.0
+GENERIC_LINK_MASS_PER_M = 10.0
+#: Shortest generic cylinder [m] (links whose frames coincide with the next joint's).
+GENERIC_LENGTH_MIN = 0.05
+
+
+@dataclass(frozen=True, slots=True, eq=False)
+class Prior:
+    """Prior standard parameters of every link, checked.
+
+    Attributes
+    ----------
+    phi : ndarray, shape (n, 10)
+        Standard parameters (m, m c, J about the link origin), every link strictly
+        consistent with the margin.
+    source : str
+        Where it came from (``"panda"``, a file name, ``"generic"``).
+    repaired : tuple of int
+        Links (1-based) whose parameters were repaired.
+    notes : tuple of str
+        One line per repair or warning (also the total mass against the band).
+    """
+
+    phi: NDArray[np.float64]
+    source: str
+    repaired: tuple[int, ...] = ()
+    notes: tuple[str, ...] = ()
+
+    @property
+    def n(self) -> int:
+        """Number of links."""
+        return int(self.phi.shape[0])
+
+    @property
+    def pseudo_inertia(self) -> NDArray[np.float64]:
+        """``J0`` of every link, (n, 4, 4)."""
+        return pseudo_inertia(self.phi)
+
+    @property
+    def mass(self) -> NDArray[np.float64]:
+        """Prior link masses [kg], (n,)."""
+        return self.phi[:, 0].copy()
+
+
+def _segment(robot: Robot, i: int) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+    """End points [m] in link ``i``'s frame (0-based) of the segment that bounds it."""
+    T = robot.T_parent_joint[i]
+    pts = [np.zeros(3), -T[:3, :3].T @ T[:3, 3]]  # own origin, parent's origin
+    if i + 1 < robot.n:
+        pts.append(robot.T_parent_joint[i + 1][:3, 3])
+    pts += [f.T_link_frame[:3, 3] for f in robot.frames.values() if f.link == i + 1]
+    P = np.asarray(pts)
+    d = np.linalg.norm(P[:, None] - P[None], axis=-1)
+    a, b = np.unravel_index(int(np.argmax(d)), d.shape)
+    return P[a], P[b]
+
+
+def _cylinder(mass: float, a: NDArray[np.float64], b: NDArray[np.float64]) -> NDArray[np.float64]:
+    """Standard parameters of a solid cylinder of ``mass`` along a..b (link frame)."""
+    axis = b - a
+    L = float(np.linalg.norm(axis))
+    if L < GENERIC_LENGTH_MIN:
+        mid = 0.5 * (a + b)
+        axis = np.array([0.0, 0.0, 1.0])
+        L = GENERIC_LENGTH_MIN
+        a, b = mid - 0.5 * L * axis, mid + 0.5 * L * axis
+    u = (b - a) / np.linalg.norm(b - a)
+    r = max(GENERIC_RADIUS_MIN, GENERIC_RADIUS_FRACTION * L)
+    ax, tr = 0.5 * mass * r**2, mass * (3 * r**2 + L**2) / 12.0
+    Ic = tr * np.eye(3) + (ax - tr) * np.outer(u, u)
+    return phi_from_inertial(mass, 0.5 * (a + b), Ic)
+
+
+def _lengths(robot: Robot) -> NDArray[np.float64]:
+    return np.array(
+        [float(np.linalg.norm(np.subtract(*_segment(robot, i)))) for i in range(robot.n)]
+    )
+
+
+def generic_prior(robot: Robot, total_mass: tuple[float, float] | None = None) -> Prior:
+    """A prior from the kinematics alone: one solid cylinder per link (module docstring).
+
+    Parameters
+    ----------
+    robot : Robot
+    total_mass : (float, float), optional
+        Band on the total mass [kg]: the masses are scaled to its middle.
+    """
+    L = np.maximum(_lengths(robot), GENERIC_LENGTH_MIN)
+    m = GENERIC_LINK_MASS_BASE + GENERIC_LINK_MASS_PER_M * L
+    notes = [
+        f"generic prior: solid cylinders along the links, masses {GENERIC_LINK_MASS_BASE:g} kg "
+        f"+ {GENERIC_LINK_MASS_PER_M:g} kg/m"
+    ]
+    if total_mass is not None:
+        mid = 0.5 * (float(total_mass[0]) + float(total_mass[1]))
+        if mid > 0:
+            m = m * (mid / m.sum())
+            notes[0] += f", scaled to {mid:g} kg in all"
+    phi = np.stack([_cylinder(float(m[i]), *_segment(robot, i)) for i in range(robot.n)])
+    return Prior(phi=phi, source="generic", notes=tuple(notes))
+
+
+def prior_from_robot(
+    robot: Robot,
+    *,
+    source: str | None = None,
+    margin: float = DEFAULT_PRIOR_MARGIN,
+    total_mass: tuple[float, float] | None = None,
+) -> Prior:
+    """The link parameters of ``robot`` as a prior, checked and repaired where needed.
+
+    Parameters
+    ----------
+    robot : Robot
+        A robot with link inertials (``robot.phi``).
+    source : str, optional
+        Name in reports (default ``robot.name``).
+    margin : float
+        Links with ``lambda_min(J) < margin tr(J)`` are repaired (module docstring).
+    total_mass : (float, float), optional
+        Band [kg]; a prior whose total mass lies outside is reported in ``notes``.
+
+    Raises
+    ------
+    ModelError
+        ``robot`` has no link inertials at all (every parameter zero).
+    """
+    phi = np.array(robot.phi, dtype=np.float64).reshape(robot.n, 10)
+    name = robot.name if source is None else source
+    if not np.any(phi):
+        raise ModelError(
+            f"prior {name!r} has no link inertials (every mass and inertia is zero); give a "
+            "description with <inertial> elements, or no prior for the generic one"
+        )
+    notes: list[str] = []
+    repaired: list[int] = []
+    massless = phi[:, 0] <= 0
+    if np.any(massless):
+        cyl = generic_prior(robot).phi
+        for i in np.flatnonzero(massless):
+            notes.append(
+                f"prior {name}: link {i + 1} ({robot.link_names[i + 1]}) has mass "
+                f"{phi[i, 0]:g} kg; replaced by the generic cylinder of {cyl[i, 0]:.3g} kg"
+            )
+            phi[i] = cyl[i]
+            repaired.append(i + 1)
+    before = pseudo_inertia_margin(phi)
+    phi, changed = repair_pseudo_inertia(phi, margin)
+    for i in np.flatnonzero(changed):
+        notes.append(
+            f"prior {name}: link {i + 1} ({robot.link_names[i + 1]}) is not physically "
+            f"consistent with margin {margin:g} (lambda_min(J)/tr(J) = {before[i]:.3g}); "
+            "its pseudo-inertia eigenvalues were floored"
+        )
+        repaired.append(int(i) + 1)
+    if total_mass is not None:
+        M = float(phi[:, 0].sum())
+        lo, hi = (float(x) for x in total_mass)
+        if not lo <= M <= hi:
+            notes.append(
+                f"prior {name}: total mass {M:.3f} kg lies outside the band {lo:g}..{hi:g} kg"
+            )
+    return Prior(phi=phi, source=name, repaired=tuple(sorted(set(repaired))), notes=tuple(notes))

@@ -1,0 +1,831 @@
+"""Physically consistent parameters by convex optimisation (LMI, semidefinite programming).
+
+Every link's pseudo-inertia ``J_i(phi)`` (:mod:`dynid.feasibility.lmi`) is kept positive
+definite with a margin, and the parameters are pulled towards a prior ``J0_i``
+(:mod:`dynid.feasibility.prior`) in the directions the data cannot see:
+
+.. math:: \\min_{\\phi, f} \\; w \\sum_i d(J_i(\\phi), J_{0,i})
+          + \\tfrac12 \\| A (x - \\hat x) \\|^2, \\quad x = [P \\phi;\\, f]
+
+subject to ``J_i >= epsilon tr(J_i) 1`` (every link), ``m_min <= m_i <= m_max``, the CoM box
+``m_i c_min <= h_i <= m_i c_max`` and ``M_min <= sum m_i <= M_max``
+
+(Wensing, Kim, Slotine, RA-L 2018; Lee, Wensing, Park, T-RO 2020). ``P`` maps the standard
+parameters to the base parameters, ``x_hat`` is the least-squares estimate and ``A^T A`` the
+inverse of its covariance, so the data term is the increase of the identification's
+residual sum of squares in units of its noise variance (``Delta chi^2``).
+
+* **Two-step** (:func:`retrieve_sdp`, the paper's setting): ``x = beta``, the identified
+  coefficients with their full covariance. When the coefficients are exact (a residual below
+  1e-9 relative), the data term becomes the equality ``P phi = beta`` and the result is
+  polished by a minimum-norm correction so that it holds to round-off.
+* **One-step** (:func:`identify_consistent`): the same problem on data, with the classical
+  friction ``f = (fv, fc, fo)`` per joint as extra unknowns, ``fv, fc >= 0`` (torque logs),
+  or on static ``[tril M; g]`` data. The data term is then exactly
+  ``||W x - y||^2 / sigma^2`` up to a constant, ``W`` the stacked regressor.
+
+**The prior's weight** ``w``: by default the largest weight (over a logarithmic search)
+whose fit keeps the identification's residual RMS within ``residual_increase`` (1 %) of the
+unconstrained least squares, ``Delta chi^2 <= ((1 + 0.01)^2 - 1) dof``: the prior decides
+only what the data leave open. A larger weight trusts the prior more.
+
+**Margin** ``epsilon`` (default 1e-4): ``lambda_min(J) >= epsilon tr(J)`` for every link;
+the published Panda's links lie between 2e-4 and 2e-3 of their trace.
+
+**Objectives**: ``"logdet"`` (the Bregman divergence above, default) or ``"euclidean"``,
+``sum_i ||S0_i^{-1} J_i S0_i^{-T} - 1||_F^2`` (the prior's own metric).
+
+**Solver**: cvxpy with Clarabel, in whitened variables ``X_i = S0_i^{-1} J_i S0_i^{-T}``
+(``J0_i = S0_i S0_i^T``); when the interior-point method stalls it is retried with
+``max_iter=500`` and static regularisation ``1e-7``, then with SCS; a failure raises
+:class:`~dynid.exceptions.SolverError` with the solver's status. An equality that no
+consistent set meets is reported (``feasible = False``, status ``"infeasible"``) with the
+closest consistent set (least relative coefficient error) and how far it is.
+"""
+
+from __future__ import annotations
+
+import math
+import time
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+from numpy.typing import NDArray
+
+from ..exceptions import InfeasibleError, ModelError, ShapeError, SolverError
+from ..identification.least_squares import LeastSquaresFit
+from ..identification.model import IdentifiedModel
+from ..model.inertia import inertial_from_phi
+from ..model.robot import Robot
+from .constraints import (
+    Bounds,
+    Constraint,
+    FeasibilityReport,
+    default_bounds,
+    feasibility_report,
+    params_from_inertial,
+)
+from .lmi import log_det_divergence, pseudo_inertia, pseudo_inertia_margin
+from .prior import Prior, generic_prior, prior_from_robot
+
+__all__ = [
+    "DEFAULT_SDP_MARGIN",
+    "ConsistentResult",
+    "DataTerm",
+    "SDPOptions",
+    "coefficient_term",
+    "retrieve_sdp",
+    "solve_consistent",
+]
+
+#: Default margin ``epsilon``: ``lambda_min(J_i) >= epsilon tr(J_i)``.
+DEFAULT_SDP_MARGIN = 1e-4
+#: Relative residual below which identified coefficients count as exact.
+EXACT_RTOL = 1e-9
+#: Range of the automatic weight search and its number of bisection steps.
+WEIGHT_RANGE = (1e-4, 1e6)
+WEIGHT_BISECTIONS = 6
+
+_OBJECTIVES = ("logdet", "euclidean")
+_FITS = ("auto", "equality", "weighted")
+#: T (10, 16): phi of a link from vec(J) (row-major 4x4): m, h, J_o = tr(S) 1 - S.
+_T = np.zeros((10, 16))
+_T[0, 15] = 1.0
+_T[1, 3] = _T[2, 7] = _T[3, 11] = 1.0
+for _k, (_i, _j) in enumerate(((0, 0), (0, 1), (0, 2), (1, 1), (1, 2), (2, 2))):
+    if _i == _j:
+        for _d in range(3):
+            if _d != _i:
+                _T[4 + _k, 5 * _d] = 1.0
+    else:
+        _T[4 + _k, 4 * _i + _j] = -1.0
+
+
+@dataclass(frozen=True, slots=True)
+class SDPOptions:
+    """Settings of the convex retrieval (module docstring).
+
+    Attributes
+    ----------
+    objective : {"logdet", "euclidean"}
+        Distance to the prior.
+    prior_weight : float or None
+        ``w``; None chooses it automatically (``residual_increase``).
+    residual_increase : float
+        Automatic weight: largest increase of the residual RMS allowed (0.01 = 1 %).
+    margin : float
+        ``epsilon`` of ``lambda_min(J) >= epsilon tr(J)`` (dimensionless, >= 0).
+    fit : {"auto", "equality", "weighted"}
+        ``"equality"``: ``P phi = beta``; ``"weighted"``: the covariance-weighted data
+        term; ``"auto"``: equality for exact coefficients, weighted otherwise.
+    mass_factor : float or None
+        Masses within ``[m0 / f, f m0]`` of the prior's (intersected with the bounds);
+        None: the bounds alone.
+    residual_tol : float
+        Two-step: the report's ``data_fit`` holds when the relative residual on the
+        coefficients is below this (weighted fit) or below 1e-6 (equality).
+    tol : float
+        Relative tolerance of the feasibility report.
+    """
+
+    objective: str = "logdet"
+    prior_weight: float | None = None
+    residual_increase: float = 0.01
+    margin: float = DEFAULT_SDP_MARGIN
+    fit: str = "auto"
+    mass_factor: float | None = 3.0
+    residual_tol: float = 0.05
+    tol: float = 1e-9
+
+    def __post_init__(self) -> None:
+        if self.objective not in _OBJECTIVES:
+            raise ModelError(f"objective must be one of {_OBJECTIVES}; got {self.objective!r}")
+        if self.fit not in _FITS:
+            raise ModelError(f"fit must be one of {_FITS}; got {self.fit!r}")
+        if self.prior_weight is not None and not (
+            math.isfinite(self.prior_weight) and self.prior_weight > 0
+        ):
+            raise ModelError(f"prior weight must be finite and > 0; got {self.prior_weight}")
+        if not (math.isfinite(self.margin) and 0.0 <= self.margin < 0.25):
+            raise ModelError(f"margin must be in [0, 0.25); got {self.margin}")
+        if not self.residual_increase > 0:
+            raise ModelError(f"residual_increase must be > 0; got {self.residual_increase}")
+        if self.mass_factor is not None and not self.mass_factor > 1:
+            raise ModelError(f"mass_factor must be > 1 or None; got {self.mass_factor}")
+
+
+@dataclass(frozen=True, slots=True, eq=False)
+class DataTerm:
+    """The data term ``1/2 ||A (x - x_hat)||^2`` over ``x = [P phi; f]``.
+
+    Attributes
+    ----------
+    P : ndarray, shape (r, 10 n)
+        Standard to base parameters (kept coefficients only).
+    x_hat : ndarray, shape (r + k,)
+        Least-squares estimate (base parameters, then ``k`` friction coefficients).
+    A : ndarray, shape (s, r + k)
+        Whitening: ``A^T A`` is the inverse covariance of ``x_hat``.
+    dof : int
+        Degrees of freedom of the fit's residual (rows minus coefficients).
+    exact : bool
+        The estimate is exact (noise-free): the equality ``P phi = beta`` applies.
+    n_friction : int
+        ``k``: 0, or ``3 n`` classical friction coefficients (``fv, fc, fo`` per joint).
+    labels : tuple of str
+        Names of the entries of ``x``.
+    """
+
+    P: NDArray[np.float64]
+    x_hat: NDArray[np.float64]
+    A: NDArray[np.float64]
+    dof: int
+    exact: bool
+    n_friction: int = 0
+    labels: tuple[str, ...] = ()
+
+    @property
+    def r(self) -> int:
+        """Number of base parameters in ``x``."""
+        return int(self.P.shape[0])
+
+    def chi2(self, x: NDArray[np.float64]) -> float:
+        """``||A (x - x_hat)||^2``: the increase of the residual sum of squares / sigma^2."""
+        return float(np.sum((self.A @ (x - self.x_hat)) ** 2))
+
+
+def _whitening(cov: NDArray[np.float64]) -> NDArray[np.float64]:
+    """``A`` with ``A^T A = cov^+`` (directions of zero variance dropped)."""
+    cov = 0.5 * (cov + cov.T)
+    s, U = np.linalg.eigh(cov)
+    keep = s > 1e-14 * max(float(s.max()), 0.0)
+    return (U[:, keep] / np.sqrt(s[keep])).T
+
+
+def coefficient_term(model: IdentifiedModel, *, with_friction: bool = False) -> DataTerm:
+    """The data term of identified coefficients (and their friction) with their covariance.
+
+    Uses ``model.fit.covariance`` (or ``model.joint_fit``'s with friction); without a
+    covariance (a file written before it was kept) the standard deviations, uncorrelated.
+    Pruned coefficients are left out.
+    """
+    fit: LeastSquaresFit = model.fit
+    r_all = model.base.rank
+    k = 0
+    if with_friction:
+        if model.joint_fit is None:
+            raise ModelError("the model holds no friction identified with the coefficients")
+        fit = model.joint_fit
+        k = fit.beta.shape[0] - r_all
+    kept = np.asarray(fit.kept, dtype=bool)
+    kept_b = kept[:r_all]
+    P = model.base.projection[kept_b]
+    x_hat = np.asarray(fit.beta, dtype=np.float64)[kept]
+    cov = (
+        np.diag(np.asarray(fit.std, dtype=np.float64) ** 2)
+        if fit.covariance is None
+        else np.asarray(fit.covariance, dtype=np.float64)
+    )[np.ix_(kept, kept)]
+    rel = fit.relative_error_percent / 100.0
+    exact = bool(fit.sigma == 0.0 or rel < EXACT_RTOL or not np.any(cov))
+    labels = tuple(
+        lab
+        for lab, kk in zip(
+            model.base.labels + tuple(model.metadata.get("friction_labels", ()))[:k],
+            kept,
+            strict=False,
+        )
+        if kk
+    )
+    return DataTerm(
+        P=P,
+        x_hat=x_hat,
+        A=np.zeros((0, x_hat.size)) if exact else _whitening(cov),
+        dof=max(int(fit.n_rows) - int(fit.rank), 1),
+        exact=exact,
+        n_friction=int(kept[r_all:].sum()) if k else 0,
+        labels=labels,
+    )
+
+
+@dataclass(frozen=True, slots=True, eq=False)
+class ConsistentResult:
+    """Physically consistent parameters from the convex retrieval or identification.
+
+    Attributes
+    ----------
+    robot : Robot
+        The input robot with the consistent link parameters (and its friction, if any).
+    phi : ndarray, shape (n, 10)
+        Standard parameters (m, m c, J about the link origin).
+    friction : ndarray, shape (n, 3) or None
+        One-step on a torque log: classical friction ``fv, fc, fo`` per joint identified
+        with the links (``fv, fc >= 0``) [N m s/rad, N m, N m].
+    relative_residual : float
+        ``||P phi - beta|| / ||beta||`` over the kept coefficients.
+    residual_ratio : float
+        Residual RMS of the identification's data with these parameters over that of the
+        unconstrained least squares (1 for exact data met exactly): ``sqrt(1 + chi2/dof)``.
+    feasible : bool
+        Every constraint of ``report`` holds.
+    report : FeasibilityReport
+        Physical constraints, bounds, total mass, ``pseudo_inertia`` (margin
+        ``lambda_min(J)/tr(J)``, dimensionless) and ``data_fit``.
+    pseudo_inertia_margin : ndarray, shape (n,)
+        ``lambda_min(J_i) / tr(J_i)``.
+    prior : Prior
+    prior_weight : float
+        The weight used (the automatic choice, or the one given).
+    weight_search : tuple of (float, float)
+        ``(w, residual_ratio)`` of every weight tried by the automatic choice.
+    divergence : ndarray, shape (n,)
+        Log-det divergence of each link from the prior.
+    fit : str
+        ``"equality"`` or ``"weighted"``.
+    status : str
+        Solver status (``"optimal"``, ``"optimal_inaccurate"``, ``"infeasible"`` when the
+        equality has no consistent solution and the closest set is returned).
+    solver : str
+    kind : str
+        ``"coefficients"`` (two-step), ``"log"`` or ``"static"`` (one-step).
+    run_time : float
+        Wall time [s].
+    bounds : Bounds
+        The bounds used (masses narrowed by the prior).
+    total_mass : (float, float) or None
+    options : SDPOptions
+    notes : tuple of str
+        What the user should know: the prior's repairs, the weight's choice.
+    method : str
+        ``"sdp"``.
+    """
+
+    robot: Robot
+    phi: NDArray[np.float64]
+    friction: NDArray[np.float64] | None
+    relative_residual: float
+    residual_ratio: float
+    feasible: bool
+    report: FeasibilityReport
+    pseudo_inertia_margin: NDArray[np.float64]
+    prior: Prior
+    prior_weight: float
+    weight_search: tuple[tuple[float, float], ...]
+    divergence: NDArray[np.float64]
+    fit: str
+    status: str
+    solver: str
+    kind: str
+    run_time: float
+    bounds: Bounds
+    total_mass: tuple[float, float] | None
+    options: SDPOptions
+    notes: tuple[str, ...] = ()
+    method: str = "sdp"
+    seed: int | None = field(default=None)
+
+    @property
+    def mass(self) -> NDArray[np.float64]:
+        """Link masses [kg], (n,)."""
+        return self.robot.mass
+
+    @property
+    def com(self) -> NDArray[np.float64]:
+        """CoMs in the link frames [m], (n, 3)."""
+        return self.robot.com
+
+    @property
+    def inertia(self) -> NDArray[np.float64]:
+        """Inertias about the CoMs, link axes [kg m^2], (n, 3, 3)."""
+        return self.robot.inertia
+
+    @property
+    def p(self) -> NDArray[np.float64]:
+        """Decision layout (n, 10): ``m, c, I`` about the CoM (as the penalty method's)."""
+        return params_from_inertial(self.mass, self.com, self.inertia)
+
+
+# ------------------------------------------------------------------------- the problem
+def _mass_bounds(
+    prior: Prior, bounds: Bounds, factor: float | None
+) -> tuple[NDArray[np.float64], NDArray[np.float64], list[str]]:
+    lo = np.array(bounds.mass_min, dtype=float)
+    hi = np.array(bounds.mass_max, dtype=float)
+    notes: list[str] = []
+    if factor is None:
+        return lo, hi, notes
+    m0 = prior.mass
+    plo, phi_ = m0 / factor, m0 * factor
+    nlo, nhi = np.maximum(lo, plo), np.minimum(hi, phi_)
+    empty = nlo > nhi
+    for i in np.flatnonzero(empty):
+        notes.append(
+            f"link {i + 1}: the prior's mass range {plo[i]:.3g}..{phi_[i]:.3g} kg lies outside "
+            f"the bounds {lo[i]:g}..{hi[i]:g} kg; the bounds alone are used"
+        )
+    return np.where(empty, lo, nlo), np.where(empty, hi, nhi), notes
+
+
+def _check_band(lo: NDArray[np.float64], hi: NDArray[np.float64], band: Any) -> None:
+    if band is None:
+        return
+    a, b = (float(x) for x in band)
+    if not (math.isfinite(a) and math.isfinite(b)) or a < 0 or a > b:
+        raise InfeasibleError(f"total-mass band must be MIN,MAX with 0 <= MIN <= MAX; got {band}")
+    if lo.sum() > b or hi.sum() < a:
+        raise InfeasibleError(
+            f"total-mass band {a:g}..{b:g} kg cannot be met: the link mass bounds allow "
+            f"{lo.sum():.4g}..{hi.sum():.4g} kg in all"
+        )
+
+
+class _Problem:
+    """The cvxpy problem, built once; the weight is a parameter (re-solved cheaply)."""
+
+    def __init__(
+        self,
+        term: DataTerm,
+        prior: Prior,
+        mass_lo: NDArray[np.float64],
+        mass_hi: NDArray[np.float64],
+        bounds: Bounds,
+        band: tuple[float, float] | None,
+        options: SDPOptions,
+        equality: bool,
+        closest: bool,
+        friction_nonneg: bool,
+        constraints: Sequence[Callable[..., Any]],
+    ) -> None:
+        import cvxpy as cp
+
+        n = prior.n
+        J0 = prior.pseudo_inertia
+        self.S0 = np.linalg.cholesky(J0)
+        self.X = [cp.Variable((4, 4), symmetric=True, name=f"X{i + 1}") for i in range(n)]
+        self.J = [self.S0[i] @ self.X[i] @ self.S0[i].T for i in range(n)]
+        B = np.stack([_T @ np.kron(self.S0[i], self.S0[i]) for i in range(n)])  # (n, 10, 16)
+        self.B = B
+        phis = [B[i] @ cp.vec(self.X[i], order="C") for i in range(n)]
+        phi = cp.hstack(phis)
+        self.phi_links = phis
+        self.w = cp.Parameter(nonneg=True, value=1.0, name="w")
+        eps = options.margin
+        cons: list[Any] = []
+        for i in range(n):
+            C = self.S0[i].T @ self.S0[i]
+            Ci = np.linalg.inv(C)
+            Ci = 0.5 * (Ci + Ci.T)
+            cons.append(self.X[i] - eps * cp.trace(C @ self.X[i]) * Ci >> 0)
+            m, h = phis[i][0], phis[i][1:4]
+            cons += [m >= mass_lo[i], m <= mass_hi[i]]
+            cons += [h >= m * bounds.com_min[i], h <= m * bounds.com_max[i]]
+        if band is not None:
+            M = sum(p[0] for p in phis)
+            cons += [M >= band[0], M <= band[1]]
+        if options.objective == "logdet":
+            div = sum(-cp.log_det(X) + cp.trace(X) - 4.0 for X in self.X)
+        else:
+            div = sum(cp.sum_squares(X - np.eye(4)) for X in self.X)
+        k = term.n_friction
+        self.f = cp.Variable(k, name="f") if k else None
+        x = term.P @ phi
+        if self.f is not None:
+            x = cp.hstack([x, self.f])
+            if friction_nonneg:  # fv, fc >= 0 (every joint's fo is free)
+                sel = np.zeros((2 * (k // 3), k))
+                for j in range(k // 3):
+                    sel[2 * j, 3 * j] = sel[2 * j + 1, 3 * j + 1] = 1.0
+                cons.append(sel @ self.f >= 0)
+        for make in constraints:
+            cons += list(make(phis, self.J))
+        if equality:
+            s = np.maximum(np.abs(term.x_hat), 1e-6 * max(float(np.abs(term.x_hat).max()), 1e-12))
+            cons.append(cp.multiply(1.0 / s, x - term.x_hat) == 0)
+            obj = div
+        elif closest:
+            s = np.maximum(np.abs(term.x_hat), 1e-3 * max(float(np.abs(term.x_hat).max()), 1e-12))
+            obj = 1e-6 * div + 0.5 * cp.sum_squares(cp.multiply(1.0 / s, x - term.x_hat))
+        else:
+            obj = self.w * div + 0.5 * cp.sum_squares(term.A @ x - term.A @ term.x_hat)
+        self.problem = cp.Problem(cp.Minimize(obj), cons)
+        self.term = term
+
+    def solve(self, w: float) -> str:
+        """Solve at weight ``w``; the status (retries as in the module docstring)."""
+        import cvxpy as cp
+
+        self.w.value = float(w)
+        attempts: list[tuple[str, dict[str, Any]]] = [
+            ("CLARABEL", {}),
+            ("CLARABEL", {"max_iter": 500, "static_regularization_constant": 1e-7}),
+            ("SCS", {"eps": 1e-9, "max_iters": 200_000}),
+        ]
+        status = "not solved"
+        for solver, kw in attempts:
+            try:
+                self.problem.solve(solver=solver, **kw)
+            except (cp.error.SolverError, ArithmeticError, ValueError) as exc:
+                status = f"{solver} failed ({exc})"
+                continue
+            status = str(self.problem.status)
+            if status in ("optimal", "infeasible", "infeasible_inaccurate"):
+                return status
+            if status == "optimal_inaccurate" and solver == attempts[-1][0]:
+                return status
+        if status == "optimal_inaccurate":
+            return status
+        raise SolverError(f"convex retrieval: the solver did not converge (status {status})")
+
+    def values(self) -> tuple[NDArray[np.float64], NDArray[np.float64] | None]:
+        """``phi`` (n, 10) and the friction (k,) at the solution."""
+        phi = np.stack([self.B[i] @ np.asarray(X.value).reshape(-1) for i, X in enumerate(self.X)])
+        f = None if self.f is None else np.asarray(self.f.value, dtype=float)
+        return phi, f
+
+
+def _polish(phi: NDArray[np.float64], term: DataTerm, prior: Prior) -> NDArray[np.float64]:
+    """Minimum-norm correction (in the prior's scales) so that ``P phi = beta`` to round-off."""
+    p0 = prior.phi
+    L = np.sqrt(np.maximum(np.abs(p0[:, 4:]).max(axis=1), 1e-12) / np.maximum(p0[:, 0], 1e-9))
+    scale = np.concatenate(
+        [
+            p0[:, :1],
+            (p0[:, :1] * L[:, None]).repeat(3, 1),
+            np.abs(p0[:, 4:]).max(axis=1, keepdims=True).repeat(6, 1),
+        ],
+        axis=1,
+    ).reshape(-1)
+    scale = np.maximum(scale, 1e-12)
+    x = phi.reshape(-1)
+    for _ in range(2):
+        e = term.x_hat[: term.r] - term.P @ x
+        PD = term.P * scale
+        x = x + scale * np.linalg.lstsq(PD, e, rcond=None)[0]
+    return x.reshape(phi.shape)
+
+
+def _finish(
+    robot: Robot,
+    phi: NDArray[np.float64],
+    f: NDArray[np.float64] | None,
+    term: DataTerm,
+    prior: Prior,
+    weight: float,
+    search: list[tuple[float, float]],
+    bounds: Bounds,
+    band: tuple[float, float] | None,
+    options: SDPOptions,
+    fit: str,
+    status: str,
+    kind: str,
+    t0: float,
+    notes: list[str],
+) -> ConsistentResult:
+    m, c, I = inertial_from_phi(phi)
+    out = robot.with_params(phi)
+    x = term.P @ phi.reshape(-1)
+    if f is not None:
+        x = np.concatenate([x, f])
+    beta = term.x_hat[: term.r]
+    nb = float(np.linalg.norm(beta))
+    rel = float(np.linalg.norm(x[: term.r] - beta) / nb) if nb > 0 else 0.0
+    ratio = 1.0 if term.exact else math.sqrt(1.0 + term.chi2(x) / term.dof)
+    rep = feasibility_report((m, c, I), bounds, band, tol=options.tol)
+    marg = pseudo_inertia_margin(phi)
+    extra = [
+        Constraint("pseudo_inertia", i + 1, float(marg[i]), "1", bool(marg[i] > 0))
+        for i in range(robot.n)
+    ]
+    if kind == "coefficients":
+        tol = 1e-6 if fit == "equality" else options.residual_tol
+        extra.append(Constraint("data_fit", None, tol - rel, "1", bool(rel <= tol)))
+    report = FeasibilityReport(
+        tuple(c for c in rep.constraints if c.name != "inertia_in_bounds") + tuple(extra), rep.tol
+    )
+    div = log_det_divergence(pseudo_inertia(phi), prior.pseudo_inertia)
+    return ConsistentResult(
+        robot=out,
+        phi=phi,
+        friction=None if f is None else f.reshape(-1, 3),
+        relative_residual=rel,
+        residual_ratio=ratio,
+        feasible=bool(report.ok) and status != "infeasible",
+        report=report,
+        pseudo_inertia_margin=marg,
+        prior=prior,
+        prior_weight=float(weight),
+        weight_search=tuple(search),
+        divergence=np.asarray(div, dtype=float),
+        fit=fit,
+        status=status,
+        solver="CLARABEL",
+        kind=kind,
+        run_time=time.perf_counter() - t0,
+        bounds=bounds,
+        total_mass=band,
+        options=options,
+        notes=tuple(prior.notes) + tuple(notes),
+    )
+
+
+def solve_consistent(
+    robot: Robot,
+    term: DataTerm,
+    *,
+    prior: Prior | Robot | None = None,
+    bounds: Bounds | None = None,
+    total_mass: tuple[float, float] | None = None,
+    options: SDPOptions | None = None,
+    constraints: Sequence[Callable[..., Any]] = (),
+    kind: str = "coefficients",
+    friction_nonneg: bool = True,
+) -> ConsistentResult:
+    """Solve the convex problem of the module docstring for a data term.
+
+    Parameters
+    ----------
+    robot : Robot
+        Kinematics, gravity and friction of the result (its inertials are not used).
+    term : DataTerm
+        From :func:`coefficient_term` (or built by the one-step routes).
+    prior : Prior or Robot, optional
+        A :class:`~dynid.feasibility.prior.Prior`, a robot with link inertials (checked
+        and repaired by :func:`~dynid.feasibility.prior.prior_from_robot`), or None for
+        :func:`~dynid.feasibility.prior.generic_prior`.
+    bounds : Bounds, optional
+        Mass and CoM boxes and the total-mass band; default
+        :func:`~dynid.feasibility.constraints.default_bounds`. The inertia-entry bounds of
+        the penalty method are not used (the pseudo-inertia LMI replaces them).
+    total_mass : (float, float), optional
+        Overrides ``bounds.total_mass`` [kg].
+    options : SDPOptions, optional
+    constraints : sequence of callables
+        Convex constraints of the user's: ``make(phi, J) -> list of cvxpy constraints``,
+        ``phi`` the list of the links' (10,) cvxpy expressions (m, h, J_o) and ``J`` their
+        4x4 pseudo-inertias; e.g. ``lambda phi, J: [cp.norm(phi[6][1:3]) <= 0.02 * phi[6][0]]``
+        keeps link 7's CoM within 2 cm of its z axis.
+    kind : str
+        Recorded in the result (``"coefficients"``, ``"log"``, ``"static"``).
+    friction_nonneg : bool
+        ``fv, fc >= 0`` for the friction unknowns of the data term.
+
+    Raises
+    ------
+    InfeasibleError
+        The bounds themselves contradict each other (a total-mass band outside what the
+        link mass bounds allow).
+    SolverError
+        The solver failed; its status is named.
+    ShapeError
+        The prior or the bounds are for another number of links.
+    """
+    t0 = time.perf_counter()
+    opts = SDPOptions() if options is None else options
+    n = robot.n
+    if term.P.shape[1] != 10 * n:
+        raise ShapeError(f"data term is for {term.P.shape[1] // 10} links; robot has {n}")
+    b = default_bounds(robot) if bounds is None else bounds
+    if b.n != n:
+        raise ShapeError(f"bounds are for {b.n} links; robot {robot.name!r} has {n}")
+    band = total_mass if total_mass is not None else b.total_mass
+    if band is not None:
+        band = (float(band[0]), float(band[1]))
+    if prior is None:
+        pr = generic_prior(robot, band)
+    elif isinstance(prior, Prior):
+        pr = prior
+    else:
+        pr = prior_from_robot(prior, total_mass=band)
+    if pr.n != n:
+        raise ShapeError(f"prior {pr.source!r} has {pr.n} links; robot {robot.name!r} has {n}")
+    lo, hi, notes = _mass_bounds(pr, b, opts.mass_factor)
+    _check_band(lo, hi, band)
+    nb = Bounds(lo, hi, b.com_min, b.com_max, b.inertia_min, b.inertia_max, band, b.link_names)
+    equality = opts.fit == "equality" or (opts.fit == "auto" and term.exact)
+    if equality and term.n_friction:
+        raise ModelError("an exact fit with friction unknowns is not supported; use fit='weighted'")
+    if not equality and term.A.shape[0] == 0:
+        raise ModelError("the data term has no covariance; use fit='equality'")
+    common = (term, pr, lo, hi, nb, band, opts)
+    search: list[tuple[float, float]] = []
+    if equality:
+        prob = _Problem(*common, True, False, friction_nonneg, constraints)
+        status = prob.solve(1.0)
+        if status.startswith("infeasible"):
+            notes.append(
+                "no consistent parameter set reproduces the coefficients exactly within the "
+                "bounds; the closest one (least relative coefficient error) is returned"
+            )
+            prob = _Problem(*common, False, True, friction_nonneg, constraints)
+            st = prob.solve(1.0)
+            if st.startswith("infeasible"):
+                raise InfeasibleError("the bounds and constraints admit no consistent parameters")
+            phi, f = prob.values()
+            return _finish(
+                robot,
+                phi,
+                f,
+                term,
+                pr,
+                1.0,
+                search,
+                nb,
+                band,
+                opts,
+                "equality",
+                "infeasible",
+                kind,
+                t0,
+                notes,
+            )
+        phi, f = prob.values()
+        phi = _polish(phi, term, pr)
+        return _finish(
+            robot,
+            phi,
+            f,
+            term,
+            pr,
+            1.0,
+            search,
+            nb,
+            band,
+            opts,
+            "equality",
+            status,
+            kind,
+            t0,
+            notes,
+        )
+    prob = _Problem(*common, False, False, friction_nonneg, constraints)
+    if opts.prior_weight is not None:
+        status = prob.solve(opts.prior_weight)
+        if status.startswith("infeasible"):
+            raise InfeasibleError("the bounds and constraints admit no consistent parameters")
+        phi, f = prob.values()
+        return _finish(
+            robot,
+            phi,
+            f,
+            term,
+            pr,
+            opts.prior_weight,
+            search,
+            nb,
+            band,
+            opts,
+            "weighted",
+            status,
+            kind,
+            t0,
+            notes,
+        )
+    w, status, phi, f, search = _auto_weight(prob, term, opts)
+    limit = 1.0 + opts.residual_increase
+    if search and min(r for _, r in search) > limit:
+        notes.append(
+            f"even the smallest prior weight ({WEIGHT_RANGE[0]:g}) raises the residual RMS by "
+            f"{100 * (min(r for _, r in search) - 1):.2f} % "
+            f"(> {100 * opts.residual_increase:g} %): "
+            "the data are not consistent with a rigid-body model within that margin"
+        )
+    notes.append(
+        f"prior weight {w:.3g}: the largest keeping the residual RMS within "
+        f"{100 * opts.residual_increase:g} % of the unconstrained fit"
+    )
+    return _finish(
+        robot, phi, f, term, pr, w, search, nb, band, opts, "weighted", status, kind, t0, notes
+    )
+
+
+def _auto_weight(
+    prob: _Problem, term: DataTerm, opts: SDPOptions
+) -> tuple[float, str, NDArray[np.float64], NDArray[np.float64] | None, list[tuple[float, float]]]:
+    """Largest weight in :data:`WEIGHT_RANGE` with ``residual_ratio <= 1 + increase``."""
+    limit = 1.0 + opts.residual_increase
+    search: list[tuple[float, float]] = []
+    cache: dict[float, tuple[str, NDArray[np.float64], NDArray[np.float64] | None]] = {}
+
+    def ratio(w: float) -> float:
+        status = prob.solve(w)
+        if status.startswith("infeasible"):
+            raise InfeasibleError("the bounds and constraints admit no consistent parameters")
+        phi, f = prob.values()
+        x = term.P @ phi.reshape(-1)
+        if f is not None:
+            x = np.concatenate([x, f])
+        rr = math.sqrt(1.0 + term.chi2(x) / term.dof)
+        search.append((w, rr))
+        cache[w] = (status, phi, f)
+        return rr
+
+    lo_e, hi_e = (math.log10(x) for x in WEIGHT_RANGE)
+    # coarse pass upwards by decades from the bottom, then bisect the crossing
+    good, bad = None, None
+    e = lo_e
+    while e <= hi_e + 1e-9:
+        if ratio(10**e) <= limit:
+            good = e
+            e += 2.0
+        else:
+            bad = e
+            break
+    if good is None:
+        w = 10**lo_e
+    else:
+        if bad is None:
+            bad = min(good + 2.0, hi_e)
+            if bad == good:
+                w = 10**good
+                status, phi, f = cache[w]
+                return w, status, phi, f, search
+            if ratio(10**bad) <= limit:
+                w = 10**bad
+                status, phi, f = cache[w]
+                return w, status, phi, f, search
+        for _ in range(WEIGHT_BISECTIONS):
+            mid = 0.5 * (good + bad)
+            if ratio(10**mid) <= limit:
+                good = mid
+            else:
+                bad = mid
+        w = 10**good
+    status, phi, f = cache[w]
+    return w, status, phi, f, search
+
+
+def retrieve_sdp(
+    model: IdentifiedModel,
+    *,
+    prior: Prior | Robot | None = None,
+    bounds: Bounds | None = None,
+    total_mass: tuple[float, float] | None = None,
+    options: SDPOptions | None = None,
+    constraints: Sequence[Callable[..., Any]] = (),
+) -> ConsistentResult:
+    """Consistent link parameters from identified coefficients (two-step, convex).
+
+    The coefficients' full covariance weighs the data term (``model.fit.covariance``);
+    exact coefficients are met exactly. Parameters as in :func:`solve_consistent`; the
+    result's robot carries ``model.robot``'s kinematics and friction.
+
+    Examples
+    --------
+    >>> import dynid
+    >>> from dynid.feasibility.sdp import retrieve_sdp
+    >>> robot = dynid.panda()
+    >>> data = dynid.acquire_static(dynid.SimulatedController(robot), 100, np.random.default_rng(0))
+    >>> res = retrieve_sdp(dynid.identify_static(robot, data), prior=robot)  # doctest: +SKIP
+    """
+    return solve_consistent(
+        model.robot,
+        coefficient_term(model),
+        prior=prior,
+        bounds=bounds,
+        total_mass=total_mass,
+        options=options,
+        constraints=constraints,
+        kind="coefficients",
+    )
