@@ -47,8 +47,9 @@ from __future__ import annotations
 
 import math
 import time
+import warnings
 from collections.abc import Callable, Sequence
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
@@ -67,7 +68,12 @@ from .constraints import (
     feasibility_report,
     params_from_inertial,
 )
-from .lmi import log_det_divergence, pseudo_inertia, pseudo_inertia_margin
+from .lmi import (
+    log_det_divergence,
+    pseudo_inertia,
+    pseudo_inertia_margin,
+    repair_pseudo_inertia,
+)
 from .prior import Prior, generic_prior, prior_from_robot
 
 __all__ = [
@@ -88,6 +94,9 @@ EXACT_RTOL = 1e-9
 WEIGHT_RANGE = (1e-4, 1e6)
 WEIGHT_BISECTIONS = 6
 
+#: Boxes and the band are shrunk by this fraction of their width inside the solver, so
+#: that its tolerance (about 1e-8) cannot put the solution outside them.
+_SHRINK = 1e-6
 _OBJECTIVES = ("logdet", "euclidean")
 _FITS = ("auto", "equality", "weighted")
 #: T (10, 16): phi of a link from vec(J) (row-major 4x4): m, h, J_o = tr(S) 1 - S.
@@ -300,6 +309,10 @@ class ConsistentResult:
         What the user should know: the prior's repairs, the weight's choice.
     method : str
         ``"sdp"``.
+    seed : int or None
+        Recorded for files (the convex problem uses no randomness).
+    identified : IdentifiedModel or None
+        One-step: the unconstrained least-squares identification of the same data.
     """
 
     robot: Robot
@@ -324,7 +337,8 @@ class ConsistentResult:
     options: SDPOptions
     notes: tuple[str, ...] = ()
     method: str = "sdp"
-    seed: int | None = field(default=None)
+    seed: int | None = None
+    identified: IdentifiedModel | None = None
 
     @property
     def mass(self) -> NDArray[np.float64]:
@@ -411,7 +425,7 @@ class _Problem:
         phi = cp.hstack(phis)
         self.phi_links = phis
         self.w = cp.Parameter(nonneg=True, value=1.0, name="w")
-        eps = options.margin
+        eps = self.margin = options.margin
         cons: list[Any] = []
         for i in range(n):
             C = self.S0[i].T @ self.S0[i]
@@ -419,11 +433,14 @@ class _Problem:
             Ci = 0.5 * (Ci + Ci.T)
             cons.append(self.X[i] - eps * cp.trace(C @ self.X[i]) * Ci >> 0)
             m, h = phis[i][0], phis[i][1:4]
-            cons += [m >= mass_lo[i], m <= mass_hi[i]]
-            cons += [h >= m * bounds.com_min[i], h <= m * bounds.com_max[i]]
+            dm = _SHRINK * (mass_hi[i] - mass_lo[i])
+            dc = _SHRINK * (bounds.com_max[i] - bounds.com_min[i])
+            cons += [m >= mass_lo[i] + dm, m <= mass_hi[i] - dm]
+            cons += [h >= m * (bounds.com_min[i] + dc), h <= m * (bounds.com_max[i] - dc)]
         if band is not None:
             M = sum(p[0] for p in phis)
-            cons += [M >= band[0], M <= band[1]]
+            db = _SHRINK * (band[1] - band[0])
+            cons += [M >= band[0] + db, M <= band[1] - db]
         if options.objective == "logdet":
             div = sum(-cp.log_det(X) + cp.trace(X) - 4.0 for X in self.X)
         else:
@@ -465,7 +482,9 @@ class _Problem:
         status = "not solved"
         for solver, kw in attempts:
             try:
-                self.problem.solve(solver=solver, **kw)
+                with warnings.catch_warnings():  # the status says it; retried below
+                    warnings.simplefilter("ignore", UserWarning)
+                    self.problem.solve(solver=solver, **kw)
             except (cp.error.SolverError, ArithmeticError, ValueError) as exc:
                 status = f"{solver} failed ({exc})"
                 continue
@@ -479,10 +498,20 @@ class _Problem:
         raise SolverError(f"convex retrieval: the solver did not converge (status {status})")
 
     def values(self) -> tuple[NDArray[np.float64], NDArray[np.float64] | None]:
-        """``phi`` (n, 10) and the friction (k,) at the solution."""
+        """``phi`` (n, 10) and the friction (k,) at the solution (margins enforced)."""
         phi = np.stack([self.B[i] @ np.asarray(X.value).reshape(-1) for i, X in enumerate(self.X)])
         f = None if self.f is None else np.asarray(self.f.value, dtype=float)
-        return phi, f
+        return _with_margin(phi, self.margin), f
+
+
+def _with_margin(phi: NDArray[np.float64], margin: float) -> NDArray[np.float64]:
+    """Links the solver left a little below the margin (its tolerance) floored onto it."""
+    low = pseudo_inertia_margin(phi) < margin
+    if not np.any(low):
+        return phi
+    out = phi.copy()
+    out[low] = repair_pseudo_inertia(phi[low], margin)[0]
+    return out
 
 
 def _polish(phi: NDArray[np.float64], term: DataTerm, prior: Prior) -> NDArray[np.float64]:
@@ -500,7 +529,7 @@ def _polish(phi: NDArray[np.float64], term: DataTerm, prior: Prior) -> NDArray[n
     scale = np.maximum(scale, 1e-12)
     x = phi.reshape(-1)
     for _ in range(2):
-        e = term.x_hat[: term.r] - term.P @ x
+        e = term.x_hat[: term.r] - term.P @ x  # the base part; friction is met exactly
         PD = term.P * scale
         x = x + scale * np.linalg.lstsq(PD, e, rcond=None)[0]
     return x.reshape(phi.shape)
@@ -644,8 +673,6 @@ def solve_consistent(
     _check_band(lo, hi, band)
     nb = Bounds(lo, hi, b.com_min, b.com_max, b.inertia_min, b.inertia_max, band, b.link_names)
     equality = opts.fit == "equality" or (opts.fit == "auto" and term.exact)
-    if equality and term.n_friction:
-        raise ModelError("an exact fit with friction unknowns is not supported; use fit='weighted'")
     if not equality and term.A.shape[0] == 0:
         raise ModelError("the data term has no covariance; use fit='equality'")
     common = (term, pr, lo, hi, nb, band, opts)
@@ -682,6 +709,8 @@ def solve_consistent(
             )
         phi, f = prob.values()
         phi = _polish(phi, term, pr)
+        if f is not None:
+            f = term.x_hat[term.r :].copy()
         return _finish(
             robot,
             phi,
@@ -722,19 +751,19 @@ def solve_consistent(
             t0,
             notes,
         )
-    w, status, phi, f, search = _auto_weight(prob, term, opts)
-    limit = 1.0 + opts.residual_increase
-    if search and min(r for _, r in search) > limit:
+    w, limit, status, phi, f, search = _auto_weight(prob, term, opts)
+    if limit > 1.0 + opts.residual_increase:
         notes.append(
-            f"even the smallest prior weight ({WEIGHT_RANGE[0]:g}) raises the residual RMS by "
-            f"{100 * (min(r for _, r in search) - 1):.2f} % "
-            f"(> {100 * opts.residual_increase:g} %): "
-            "the data are not consistent with a rigid-body model within that margin"
+            f"the data are not consistent with a rigid body within {100 * opts.residual_increase:g}"
+            f" %: the closest consistent fit raises the residual RMS by "
+            f"{100 * (search[0][1] - 1):.2f} %; the prior weight {w:.3g} keeps it within "
+            f"{100 * opts.residual_increase:g} % of that fit"
         )
-    notes.append(
-        f"prior weight {w:.3g}: the largest keeping the residual RMS within "
-        f"{100 * opts.residual_increase:g} % of the unconstrained fit"
-    )
+    else:
+        notes.append(
+            f"prior weight {w:.3g}: the largest keeping the residual RMS within "
+            f"{100 * opts.residual_increase:g} % of the unconstrained fit"
+        )
     return _finish(
         robot, phi, f, term, pr, w, search, nb, band, opts, "weighted", status, kind, t0, notes
     )
@@ -742,13 +771,22 @@ def solve_consistent(
 
 def _auto_weight(
     prob: _Problem, term: DataTerm, opts: SDPOptions
-) -> tuple[float, str, NDArray[np.float64], NDArray[np.float64] | None, list[tuple[float, float]]]:
-    """Largest weight in :data:`WEIGHT_RANGE` with ``residual_ratio <= 1 + increase``."""
-    limit = 1.0 + opts.residual_increase
+) -> tuple[
+    float, float, str, NDArray[np.float64], NDArray[np.float64] | None, list[tuple[float, float]]
+]:
+    """Largest weight in :data:`WEIGHT_RANGE` whose residual ratio stays within the limit.
+
+    The limit is ``1 + residual_increase``, or, when the consistent fit at the smallest
+    weight already exceeds it (data that no rigid body fits within the allowance),
+    ``(1 + residual_increase)`` times that fit's ratio. Decades upwards from the smallest
+    weight, then :data:`WEIGHT_BISECTIONS` bisections of the logarithm. Returns the weight,
+    the limit used, the status, ``phi``, the friction and every ``(w, ratio)`` tried.
+    """
     search: list[tuple[float, float]] = []
     cache: dict[float, tuple[str, NDArray[np.float64], NDArray[np.float64] | None]] = {}
 
-    def ratio(w: float) -> float:
+    def ratio(e: float) -> float:
+        w = 10.0**e
         status = prob.solve(w)
         if status.startswith("infeasible"):
             raise InfeasibleError("the bounds and constraints admit no consistent parameters")
@@ -758,42 +796,31 @@ def _auto_weight(
             x = np.concatenate([x, f])
         rr = math.sqrt(1.0 + term.chi2(x) / term.dof)
         search.append((w, rr))
-        cache[w] = (status, phi, f)
+        cache[e] = (status, phi, f)
         return rr
 
     lo_e, hi_e = (math.log10(x) for x in WEIGHT_RANGE)
-    # coarse pass upwards by decades from the bottom, then bisect the crossing
-    good, bad = None, None
-    e = lo_e
+    r0 = ratio(lo_e)
+    allowed = 1.0 + opts.residual_increase
+    limit = allowed if r0 <= allowed else r0 * allowed
+    good, bad = lo_e, None
+    e = lo_e + 2.0
     while e <= hi_e + 1e-9:
-        if ratio(10**e) <= limit:
+        if ratio(e) <= limit:
             good = e
             e += 2.0
         else:
             bad = e
             break
-    if good is None:
-        w = 10**lo_e
-    else:
-        if bad is None:
-            bad = min(good + 2.0, hi_e)
-            if bad == good:
-                w = 10**good
-                status, phi, f = cache[w]
-                return w, status, phi, f, search
-            if ratio(10**bad) <= limit:
-                w = 10**bad
-                status, phi, f = cache[w]
-                return w, status, phi, f, search
+    if bad is not None:
         for _ in range(WEIGHT_BISECTIONS):
             mid = 0.5 * (good + bad)
-            if ratio(10**mid) <= limit:
+            if ratio(mid) <= limit:
                 good = mid
             else:
                 bad = mid
-        w = 10**good
-    status, phi, f = cache[w]
-    return w, status, phi, f, search
+    status, phi, f = cache[good]
+    return 10.0**good, limit, status, phi, f, search
 
 
 def retrieve_sdp(

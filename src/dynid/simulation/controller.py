@@ -37,6 +37,7 @@ from ..exceptions import LimitError
 from ..identification.data import StaticDataset
 from ..model.panda import panda
 from ..model.robot import Robot
+from .unmodelled import UnmodelledEffects
 
 __all__ = ["SimulatedController", "sample_configurations", "acquire_static", "DEFAULT_MARGIN"]
 
@@ -60,6 +61,9 @@ class SimulatedController:
         readings); see the module docstring.
     rng : numpy.random.Generator, optional
         Source of the noise; default ``np.random.default_rng(0)`` (reproducible).
+    effects : UnmodelledEffects, optional
+        Rotor inertia added to ``M`` and a tilted gravity in ``g`` (effects outside the
+        rigid-body model, :mod:`dynid.simulation.unmodelled`); None: a rigid body.
 
     Raises
     ------
@@ -70,8 +74,11 @@ class SimulatedController:
     robot: Robot = field(default_factory=panda)
     relative_noise: float = 0.0
     rng: np.random.Generator | None = None
+    effects: UnmodelledEffects | None = None
 
     def __post_init__(self) -> None:
+        if self.effects is not None:
+            self.effects.check(self.robot)
         eps = float(self.relative_noise)
         if not np.isfinite(eps) or eps < 0:
             raise ValueError(f"relative_noise must be finite and >= 0; got {self.relative_noise}")
@@ -87,6 +94,8 @@ class SimulatedController:
     def mass_matrix(self, q: ArrayLike) -> NDArray[np.float64]:
         """Reading of ``M(q)``: (..., n) -> (..., n, n) [kg m^2], symmetric."""
         M = mass_matrix(self.robot, q)
+        if self.effects is not None:
+            M = M + self.effects.mass_matrix_term()
         if self.relative_noise == 0.0:
             return M
         assert self.rng is not None  # set in __post_init__
@@ -96,7 +105,8 @@ class SimulatedController:
 
     def gravity_torques(self, q: ArrayLike) -> NDArray[np.float64]:
         """Reading of ``g(q)``: (..., n) -> (..., n) [N m]."""
-        g = gravity_torques(self.robot, q)
+        truth = self.robot if self.effects is None else self.effects.true_robot(self.robot)
+        g = gravity_torques(truth, q)
         if self.relative_noise == 0.0:
             return g
         assert self.rng is not None

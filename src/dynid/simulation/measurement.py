@@ -33,6 +33,7 @@ from ..friction.model import FrictionModel, SigmoidFriction
 from ..identification.log import TorqueLog
 from ..kinematics.trajectories import Trajectory
 from ..model.robot import Robot
+from .unmodelled import UnmodelledEffects
 
 __all__ = ["SensorNoise", "sample_times", "simulate_measurement"]
 
@@ -121,6 +122,7 @@ def simulate_measurement(
     friction: FrictionModel | None | str = "robot",
     drop_fraction: float = 0.0,
     with_ddq: bool = False,
+    effects: UnmodelledEffects | None = None,
 ) -> TorqueLog:
     """Simulated torque log of ``robot`` following ``traj``.
 
@@ -143,6 +145,9 @@ def simulate_measurement(
     with_ddq : bool
         Store the true (noise-free) accelerations in the log (for tests of the
         identification without differentiation).
+    effects : UnmodelledEffects, optional
+        Rotor inertia, torque offsets and a gravity tilt added to the torques
+        (:mod:`dynid.simulation.unmodelled`); None: a rigid body.
 
     Returns
     -------
@@ -168,7 +173,11 @@ def simulate_measurement(
         friction = None if robot.friction is None else SigmoidFriction.from_array(robot.friction)
     if friction is not None and friction.n != n:
         raise ShapeError(f"friction model has {friction.n} joints; robot has {n}")
-    tau = rnea(robot, traj.q, traj.dq, traj.ddq)
+    if effects is not None:
+        effects.check(robot)
+        tau = rnea(effects.true_robot(robot), traj.q, traj.dq, traj.ddq) + effects.torques(traj.ddq)
+    else:
+        tau = rnea(robot, traj.q, traj.dq, traj.ddq)
     if friction is not None:
         tau = tau + friction.torques(traj.dq)
     N = len(traj)

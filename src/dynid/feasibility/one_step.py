@@ -1,0 +1,99 @@
+"""Consistent identification straight from data (one step): torque logs or static data.
+
+The data's least-squares problem is the convex problem of :mod:`dynid.feasibility.sdp`
+with the data term taken on the data themselves: for ordinary least squares,
+
+.. math:: \\|W x - y\\|^2 = \\|W \\hat x - y\\|^2 + (x - \\hat x)^T W^T W (x - \\hat x),
+
+so the classical covariance ``sigma^2 (W^T W)^{-1}`` of the unconstrained fit ``x_hat`` gives
+the data term exactly (up to the constant ``RSS / sigma^2``). Torque logs go through the
+classical route (:func:`~dynid.identification.classical.identify_from_log`: filtering,
+decimation, base regressor plus viscous, Coulomb and offset friction per joint), with
+``fv, fc >= 0`` in the consistent problem; static data through
+:func:`~dynid.identification.static.identify_static` (``[tril M; g]``). The unconstrained
+fit is returned with the result (``result.identified``) for comparison.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable, Sequence
+from dataclasses import replace
+from typing import Any
+
+from ..exceptions import ShapeError
+from ..identification.classical import identify_from_log
+from ..identification.data import StaticDataset
+from ..identification.log import DEFAULT_CUTOFF_HZ, TorqueLog
+from ..identification.static import identify_static
+from ..model.robot import Robot
+from .constraints import Bounds
+from .prior import Prior
+from .sdp import ConsistentResult, SDPOptions, coefficient_term, solve_consistent
+
+__all__ = ["identify_consistent"]
+
+
+def identify_consistent(
+    robot: Robot,
+    data: TorqueLog | StaticDataset,
+    *,
+    prior: Prior | Robot | None = None,
+    bounds: Bounds | None = None,
+    total_mass: tuple[float, float] | None = None,
+    options: SDPOptions | None = None,
+    constraints: Sequence[Callable[..., Any]] = (),
+    cutoff_hz: float | None = DEFAULT_CUTOFF_HZ,
+    decimate: int | None = None,
+    rtol: float = 1e-10,
+) -> ConsistentResult:
+    """Physically consistent link parameters (and friction) identified from data.
+
+    Parameters
+    ----------
+    robot : Robot
+        Kinematics and gravity of the data.
+    data : TorqueLog or StaticDataset
+        A torque log of an exciting trajectory, or static ``q, M, g`` data.
+    prior, bounds, total_mass, options, constraints
+        As in :func:`~dynid.feasibility.sdp.solve_consistent`.
+    cutoff_hz, decimate
+        Torque logs: the classical route's filtering and decimation.
+    rtol : float
+        Rank tolerance of the unconstrained fit.
+
+    Returns
+    -------
+    ConsistentResult
+        ``kind`` ``"log"`` (with ``friction`` (n, 3) ``fv, fc, fo``) or ``"static"``;
+        ``identified`` the unconstrained identification.
+
+    Raises
+    ------
+    RankDeficientError
+        The data do not excite every base parameter (from the unconstrained fit).
+    ShapeError
+        ``data`` is neither a torque log nor static data.
+    """
+    if isinstance(data, TorqueLog):
+        model = identify_from_log(
+            robot, data, cutoff_hz=cutoff_hz, decimate=decimate, friction=True, rtol=rtol
+        )
+        term = coefficient_term(model, with_friction=True)
+        kind = "log"
+    elif isinstance(data, StaticDataset):
+        model = identify_static(robot, data, rtol=rtol, std_estimator="classical")
+        term = coefficient_term(model)
+        kind = "static"
+    else:
+        raise ShapeError(f"data must be a TorqueLog or a StaticDataset; got {type(data).__name__}")
+    res = solve_consistent(
+        robot,
+        term,
+        prior=prior,
+        bounds=bounds,
+        total_mass=total_mass,
+        options=options,
+        constraints=constraints,
+        kind=kind,
+    )
+    return replace(res, identified=model)
