@@ -131,7 +131,7 @@ class SDPOptions:
         term; ``"auto"``: equality for exact coefficients, weighted otherwise.
     mass_factor : float or None
         Masses within ``[m0 / f, f m0]`` of the prior's (intersected with the bounds);
-        None: the bounds alone.
+        None: the bounds alone. Not applied with the generic prior (a guess).
     residual_tol : float
         Two-step: the report's ``data_fit`` holds when the relative residual on the
         coefficients is below this (weighted fit) or below 1e-6 (equality).
@@ -368,7 +368,7 @@ def _mass_bounds(
     lo = np.array(bounds.mass_min, dtype=float)
     hi = np.array(bounds.mass_max, dtype=float)
     notes: list[str] = []
-    if factor is None:
+    if factor is None or prior.source == "generic":  # a guess does not bound the masses
         return lo, hi, notes
     m0 = prior.mass
     plo, phi_ = m0 / factor, m0 * factor

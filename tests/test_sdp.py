@@ -1,0 +1,221 @@
+"""Convex retrieval and one-step consistent identification.
+
+References: the coefficients of known (perturbed, consistent) Panda parameter sets, held-out
+torques of a simulated robot with effects outside the rigid-body model, the pseudo-inertia
+margin computed independently of the solver, and the unconstrained least squares.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+import dynid
+from dynid.exceptions import InfeasibleError, ModelError, ShapeError
+from dynid.feasibility.constraints import panda_bounds
+from dynid.feasibility.lmi import pseudo_inertia_margin, repair_pseudo_inertia
+from dynid.feasibility.one_step import identify_consistent
+from dynid.feasibility.prior import generic_prior, prior_from_robot
+from dynid.feasibility.sdp import SDPOptions, retrieve_sdp
+from dynid.identification.least_squares import LeastSquaresFit
+from dynid.identification.log import prepare_log
+from dynid.identification.model import IdentifiedModel
+from dynid.kinematics.trajectories import random_fourier
+from dynid.regressors.base import base_parameters
+from dynid.simulation.measurement import SensorNoise, sample_times, simulate_measurement
+from dynid.simulation.unmodelled import UnmodelledEffects
+
+from conftest import robot_data_urdf
+
+
+def _perturbed(robot: dynid.Robot, rng: np.random.Generator, spread: float = 0.2) -> dynid.Robot:
+    """Every mass, CoM coordinate and inertia entry scaled by up to +-spread, kept consistent."""
+    m, c, I = dynid.inertial_from_phi(robot.phi.reshape(robot.n, 10))
+    n = robot.n
+    I2 = I * (1 + rng.uniform(-spread, spread, (n, 3, 3)))
+    phi = dynid.phi_from_inertial(
+        m * (1 + rng.uniform(-spread, spread, n)),
+        c * (1 + rng.uniform(-spread, spread, (n, 3))),
+        0.5 * (I2 + np.swapaxes(I2, 1, 2)),
+    )
+    return robot.with_params(repair_pseudo_inertia(phi, 2e-4)[0])
+
+
+def _exact_model(robot: dynid.Robot, truth: dynid.Robot) -> IdentifiedModel:
+    base = base_parameters(robot, kind="static")
+    r = base.rank
+    fit = LeastSquaresFit(
+        beta=base.beta_from_phi(truth.phi),
+        std=np.zeros(r),
+        std_percent=np.zeros(r),
+        kept=np.ones(r, bool),
+        rank=r,
+        condition_number=1.0,
+        relative_error_percent=0.0,
+        residual_rms=0.0,
+        sigma=0.0,
+        n_rows=0,
+        rtol=1e-10,
+    )
+    return IdentifiedModel(robot=robot, base=base, fit=fit)
+
+
+def test_exact_coefficients_of_perturbed_pandas_are_met_with_plausible_masses():
+    """beta to 1e-9, margins >= 1e-4, masses >= 0.3 kg, median mass error <= 0.7 of the prior's."""
+    robot = dynid.panda()
+    ours, prior_err = [], []
+    for seed in range(8):
+        truth = _perturbed(robot, np.random.default_rng(seed))
+        model = _exact_model(robot, truth)
+        res = retrieve_sdp(model, prior=robot)
+        beta = model.beta
+        P = model.base.projection
+        assert np.linalg.norm(P @ res.phi.reshape(-1) - beta) <= 1e-9 * np.linalg.norm(beta)
+        assert res.fit == "equality" and res.feasible
+        assert pseudo_inertia_margin(res.phi).min() >= 1e-4 * (1 - 1e-9)
+        assert res.mass.min() >= 0.3
+        # the retrieved robot reproduces the truth's M and g (the coefficients fix them)
+        q = np.random.default_rng(100 + seed).uniform(robot.q_min, robot.q_max, (20, 7))
+        np.testing.assert_allclose(
+            dynid.mass_matrix(res.robot, q), dynid.mass_matrix(truth, q), atol=1e-9
+        )
+        mt = truth.mass
+        ours.append(np.median(np.abs(res.mass - mt)[1:] / mt[1:]))
+        prior_err.append(np.median(np.abs(robot.mass - mt)[1:] / mt[1:]))
+    assert np.median(ours) <= 0.7 * np.median(prior_err)
+
+
+def test_noisy_static_coefficients_with_model_error_give_a_strictly_consistent_set():
+    """Rotor inertia and a gravity tilt make beta inconsistent; the result is still consistent
+    and says how far the data are from a rigid body."""
+    robot = dynid.panda()
+    eff = UnmodelledEffects.typical(7, np.random.default_rng(3))
+    ctl = dynid.SimulatedController(
+        robot, relative_noise=1e-4, rng=np.random.default_rng(1), effects=eff
+    )
+    data = dynid.acquire_static(ctl, 300, np.random.default_rng(2))
+    with pytest.warns(dynid.DynidWarning, match="g1"):
+        model = dynid.identify_static(robot, data)
+    # the unconstrained coefficients admit no consistent set (the equality is infeasible)
+    exact = retrieve_sdp(model, prior=robot, options=SDPOptions(fit="equality"))
+    assert exact.status == "infeasible" and not exact.feasible
+    assert exact.relative_residual > 1e-6
+    res = retrieve_sdp(model, prior=robot)
+    assert res.fit == "weighted" and res.feasible
+    assert pseudo_inertia_margin(res.phi).min() >= 1e-4 * (1 - 1e-9)
+    assert res.residual_ratio > 1.0 and res.relative_residual < 0.05
+    assert any("not consistent with a rigid body" in s or "prior weight" in s for s in res.notes)
+
+
+@pytest.mark.slow
+def test_one_step_on_a_log_with_model_error_predicts_held_out_torques_like_least_squares():
+    """Held-out torque RMS within 10 % of the unconstrained classical identification's."""
+    robot = dynid.panda()
+    eff = UnmodelledEffects.typical(7, np.random.default_rng(4))
+
+    def log(seed: int, duration: float) -> dynid.TorqueLog:
+        rng = np.random.default_rng(seed)
+        traj = random_fourier(robot, rng, n_harmonics=5)(sample_times(duration, 1000.0))
+        return simulate_measurement(robot, traj, rng=rng, noise=SensorNoise(), effects=eff)
+
+    res = identify_consistent(robot, log(5, 20.0), prior=robot)
+    assert res.kind == "log" and res.feasible and res.friction is not None
+    assert np.all(res.friction[:, :2] >= -1e-9)
+    assert pseudo_inertia_margin(res.phi).min() >= 1e-4 * (1 - 1e-9)
+    p = prepare_log(log(15, 10.0), filter_tau=False)
+    ols = res.identified
+    assert ols is not None and ols.friction is not None
+    tau_ols = ols.torques(p.q, p.dq, p.ddq) + dynid.ClassicalFriction.from_array(
+        ols.friction
+    ).torques(p.dq)
+    tau_c = dynid.rnea(res.robot, p.q, p.dq, p.ddq) + dynid.ClassicalFriction.from_array(
+        res.friction
+    ).torques(p.dq)
+    rms_ols = np.sqrt(np.mean((tau_ols - p.tau) ** 2))
+    rms_c = np.sqrt(np.mean((tau_c - p.tau) ** 2))
+    assert rms_c <= 1.1 * rms_ols
+
+
+def test_one_step_on_static_data_without_model_error_reproduces_m_and_g():
+    """Static one-step with noise: M and g of the result within the noise of the truth's."""
+    robot = dynid.panda()
+    ctl = dynid.SimulatedController(robot, relative_noise=1e-4, rng=np.random.default_rng(7))
+    data = dynid.acquire_static(ctl, 200, np.random.default_rng(8))
+    res = identify_consistent(robot, data, prior=robot)
+    assert res.kind == "static" and res.feasible and res.residual_ratio <= 1.01 + 1e-9
+    q = np.random.default_rng(9).uniform(robot.q_min, robot.q_max, (50, 7))
+    g_true = dynid.gravity_torques(robot, q)
+    g = dynid.gravity_torques(res.robot, q)
+    assert np.max(np.abs(g - g_true)) < 1e-2 * np.max(np.abs(g_true))
+
+
+def test_generic_prior_of_a_ur5_is_consistent_and_retrieval_runs_without_a_prior():
+    """UR5 from its URDF: the cylinders are strictly consistent; exact coefficients are met."""
+    ur5 = dynid.Robot.from_urdf(
+        robot_data_urdf("ur_description/urdf/ur5_robot.urdf"),
+        base_link="base_link",
+        tip_link="tool0",
+    )
+    pr = generic_prior(ur5, total_mass=(15.0, 25.0))
+    assert pseudo_inertia_margin(pr.phi).min() > 2e-4
+    assert pr.mass.sum() == pytest.approx(20.0)
+    model = _exact_model(ur5, ur5)
+    res = retrieve_sdp(model)  # generic prior from the kinematics
+    assert res.feasible and res.prior.source == "generic"
+    assert res.relative_residual < 1e-9
+
+
+def test_a_cad_prior_violating_the_triangle_inequality_is_repaired_and_reported():
+    """The impossible link is floored onto the margin, and a note names it."""
+    robot = dynid.panda()
+    m, c, I = robot.mass.copy(), robot.com.copy(), robot.inertia.copy()
+    I[3] = np.diag([0.01, 0.01, 0.05])  # Izz > Ixx + Iyy
+    bad = robot.with_inertials(m, c, I)
+    pr = prior_from_robot(bad, source="cad.urdf", total_mass=(30.0, 40.0))
+    assert 4 in pr.repaired
+    assert any("link 4" in s and "floored" in s for s in pr.notes)
+    assert any("outside the band" in s for s in pr.notes)
+    assert pseudo_inertia_margin(pr.phi).min() >= 2e-4 * (1 - 1e-9)
+
+
+def test_bad_inputs_raise_one_clear_error():
+    """Contradictory band, prior of another robot, bad options, a prior without inertials."""
+    robot = dynid.panda()
+    model = _exact_model(robot, robot)
+    with pytest.raises(InfeasibleError, match="cannot be met"):
+        retrieve_sdp(model, prior=robot, total_mass=(100.0, 120.0))
+    ur5 = dynid.Robot.from_urdf(
+        robot_data_urdf("ur_description/urdf/ur5_robot.urdf"),
+        base_link="base_link",
+        tip_link="tool0",
+    )
+    with pytest.raises(ShapeError, match="6 links"):
+        retrieve_sdp(model, prior=ur5)
+    with pytest.raises(ModelError, match="objective"):
+        SDPOptions(objective="l1")
+    with pytest.raises(ModelError, match="prior weight"):
+        SDPOptions(prior_weight=-1.0)
+    with pytest.raises(ModelError, match="no link inertials"):
+        prior_from_robot(robot.with_params(np.zeros(70)))
+
+
+def test_a_user_constraint_and_the_euclidean_objective_are_honoured():
+    """Link 7's CoM kept within 1 cm of its axis (second-order cone), Euclidean pull."""
+    import cvxpy as cp
+
+    robot = dynid.panda()
+    truth = _perturbed(robot, np.random.default_rng(11))
+    model = _exact_model(robot, truth)
+
+    def com7_near_axis(phi, J):
+        return [cp.norm(phi[6][1:3]) <= 0.01 * phi[6][0]]
+
+    res = retrieve_sdp(
+        model,
+        prior=robot,
+        bounds=panda_bounds(),
+        options=SDPOptions(objective="euclidean"),
+        constraints=[com7_near_axis],
+    )
+    assert res.feasible
+    assert np.linalg.norm(res.com[6, :2]) <= 0.01 + 1e-7
