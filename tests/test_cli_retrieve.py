@@ -61,6 +61,8 @@ def test_retrieve_writes_feasible_parameters_urdf_toml_and_report(model_file, tm
     rc = main(
         [
             "retrieve",
+            "--method",
+            "penalty",
             "--model",
             str(model_file),
             "--runs",
@@ -98,6 +100,8 @@ def test_retrieve_reports_a_contradictory_total_mass_band(model_file, tmp_path, 
     rc = main(
         [
             "retrieve",
+            "--method",
+            "penalty",
             "--model",
             str(model_file),
             "--runs",
@@ -131,6 +135,8 @@ def test_retrieve_single_step_from_static_data_with_a_bounds_file(tmp_path, caps
     rc = main(
         [
             "retrieve",
+            "--method",
+            "penalty",
             "--static",
             str(static),
             "--robot",
@@ -156,7 +162,9 @@ def test_retrieve_single_step_from_static_data_with_a_bounds_file(tmp_path, caps
     "extra, match",
     [
         ([], "not a JSON file"),
-        (["--runs", "0"], "--runs"),
+        (["--method", "penalty", "--runs", "0"], "--runs"),
+        (["--prior", "missing.urdf"], "does not exist"),
+        (["--prior-weight", "-2"], "prior weight"),
         (["--total-mass", "5,1"], "--total-mass"),
     ],
 )
@@ -204,6 +212,10 @@ def test_validate_with_retrieved_parameters_uses_rnea(model_file, tmp_path):
         main(
             [
                 "retrieve",
+                "--method",
+                "penalty",
+                "--method",
+                "penalty",
                 "--model",
                 str(model_file),
                 "--runs",
@@ -278,3 +290,69 @@ def test_validate_with_retrieved_parameters_uses_rnea(model_file, tmp_path):
     )
     d = json.loads((val / "validation.json").read_text())
     assert max(d["rms"]) < 0.1
+
+
+def test_retrieve_sdp_default_with_a_prior_writes_consistent_files(model_file, tmp_path, capsys):
+    """--method sdp (default) with --prior panda: exact coefficients met, margins in report.json."""
+    out = tmp_path / "sdp"
+    rc = main(["retrieve", "--model", str(model_file), "--prior", "panda", "--out", str(out)])
+    cap = capsys.readouterr()
+    assert rc == 0 and "CONSISTENT" in cap.out
+    rep = json.loads((out / "report.json").read_text())
+    assert rep["method"] == "sdp" and rep["fit"] == "equality" and rep["feasible"]
+    assert rep["relative_residual"] <= 1e-9
+    assert min(rep["pseudo_inertia_margin"]) >= 1e-4 * (1 - 1e-9)
+    assert rep["prior"]["source"] == "panda" and rep["status"] == "optimal"
+    robot = load_feasible_json(out / "feasible.json")
+    q, dq, ddq = random_states(robot, 100, 23)
+    tau = _model().torques(q, dq, ddq)
+    np.testing.assert_allclose(dynid.rnea(robot, q, dq, ddq), tau, atol=1e-8 * np.abs(tau).max())
+    assert dynid.Robot.from_urdf(out / "robot.urdf").n == 7
+
+
+def test_identify_consistent_on_a_log_writes_both_models_and_validate_uses_its_friction(
+    tmp_path, capsys
+):
+    """identify --consistent: identification.json + feasible.json with linear friction (fv, fc
+    >= 0), which validate --params uses."""
+    from dynid.io.feasible import load_feasible_linear_friction
+    from dynid.io.torque_log import write_torque_log
+    from dynid.kinematics.trajectories import random_fourier
+    from dynid.simulation.measurement import sample_times, simulate_measurement
+
+    panda = dynid.panda()
+    rng = np.random.default_rng(31)
+    traj = random_fourier(panda, rng, n_harmonics=5)(sample_times(12.0, 500.0))
+    log = simulate_measurement(panda, traj, rng=rng)
+    path = write_torque_log(tmp_path / "log.csv", log)
+    out = tmp_path / "c"
+    rc = main(
+        ["identify", "--data", str(path), "--consistent", "--prior", "panda", "--out", str(out)]
+    )
+    cap = capsys.readouterr()
+    assert rc == 0, cap.err
+    for name in ("identification.json", "feasible.json", "robot.urdf", "report.json"):
+        assert (out / name).is_file(), name
+    fr = load_feasible_linear_friction(out / "feasible.json")
+    assert fr is not None and np.all(fr.fv >= -1e-9) and np.all(fr.fc >= -1e-9)
+    rep = json.loads((out / "report.json").read_text())
+    assert rep["kind"] == "log" and rep["feasible"] and rep["friction"] is not None
+    rc = main(
+        [
+            "validate",
+            "--params",
+            str(out / "feasible.json"),
+            "--data",
+            str(path),
+            "--no-figures",
+            "--out",
+            str(tmp_path / "v"),
+        ]
+    )
+    assert rc == 0
+    val = json.loads((tmp_path / "v" / "validation.json").read_text())
+    assert val["friction_source"] == "model"
+    assert (
+        val["with_friction"]["relative_error_percent"]
+        < val["without_friction"]["relative_error_percent"]
+    )

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import argparse
 import json
+import logging
 import sys
 from pathlib import Path
 from typing import Any
@@ -14,6 +15,8 @@ from .. import _checks, spatial
 from ..exceptions import DynidError, ShapeError
 from ..model.panda import panda
 from ..model.robot import Robot
+
+_log = logging.getLogger(__name__)
 
 
 def add_robot_options(p: argparse.ArgumentParser) -> None:
@@ -38,6 +41,95 @@ def load_robot(args: argparse.Namespace) -> Robot:
     if path.suffix.lower() == ".toml":
         return Robot.from_toml(path)
     raise DynidError(f"--robot must be 'panda', a .urdf or a .toml file; got {spec!r}")
+
+
+def add_consistency_options(p: argparse.ArgumentParser) -> None:
+    """Options of the convex (SDP) route: prior, its weight, objective, margin, mass band."""
+    g = p.add_argument_group("physically consistent parameters (convex, LMI)")
+    g.add_argument(
+        "--prior",
+        default=None,
+        metavar="panda|FILE",
+        help="prior link parameters: 'panda', a .urdf (with --prior-base/--prior-tip), a "
+        ".toml or a feasible.json; default: a solid cylinder per link from the kinematics",
+    )
+    g.add_argument("--prior-base", default=None, help="URDF base link of the prior's chain")
+    g.add_argument("--prior-tip", default=None, help="URDF tip link of the prior's chain")
+    g.add_argument(
+        "--prior-weight",
+        type=float,
+        default=None,
+        metavar="W",
+        help="weight of the distance to the prior (default: the largest that keeps the data "
+        "residual RMS within 1 %% of the unconstrained fit; printed)",
+    )
+    g.add_argument(
+        "--objective",
+        choices=("logdet", "euclidean"),
+        default="logdet",
+        help="distance to the prior: log-det (Bregman) divergence (default) or Euclidean",
+    )
+    g.add_argument(
+        "--margin",
+        type=float,
+        default=None,
+        metavar="EPS",
+        help="every link's lambda_min(J) >= EPS tr(J) (pseudo-inertia J; default 1e-4)",
+    )
+
+
+def load_prior(args: argparse.Namespace, robot: Robot) -> Robot | None:
+    """The prior robot named by ``--prior`` (None: the generic prior), checked against ``robot``."""
+    spec = getattr(args, "prior", None)
+    if spec is None:
+        return None
+    if spec == "panda":
+        prior = panda()
+    else:
+        path = Path(spec)
+        suffix = path.suffix.lower()
+        if not path.exists():
+            raise DynidError(f"--prior: {spec} does not exist")
+        if suffix == ".urdf":
+            base = args.prior_base or robot.link_names[0]
+            tip = args.prior_tip or robot.link_names[-1]
+            try:
+                prior = Robot.from_urdf(path, base_link=base, tip_link=tip)
+            except DynidError as exc:
+                raise DynidError(
+                    f"--prior {path.name}: {exc} (name the chain with --prior-base/--prior-tip)"
+                ) from None
+        elif suffix == ".toml":
+            prior = Robot.from_toml(path)
+        elif suffix == ".json":
+            from ..io.feasible import load_feasible_json
+
+            prior = load_feasible_json(path)
+        else:
+            raise DynidError(f"--prior must be 'panda', a .urdf, .toml or .json file; got {spec!r}")
+    kinds = ("".join("P" if x else "R" for x in r.prismatic) for r in (prior, robot))
+    pk, rk = kinds
+    if pk != rk:
+        raise DynidError(f"--prior {spec}: joints {pk}; the robot's are {rk}")
+    if not np.allclose(prior.T_parent_joint, robot.T_parent_joint, atol=1e-3):
+        _log.warning(
+            "--prior %s: its joint frames differ from the robot's by up to %.3g m; its link "
+            "parameters are used in the robot's link frames as they are",
+            spec,
+            float(np.max(np.abs(prior.T_parent_joint - robot.T_parent_joint))),
+        )
+    return prior
+
+
+def sdp_options(args: argparse.Namespace) -> Any:
+    """:class:`~dynid.feasibility.sdp.SDPOptions` from the consistency options."""
+    from ..feasibility.sdp import DEFAULT_SDP_MARGIN, SDPOptions
+
+    return SDPOptions(
+        objective=args.objective,
+        prior_weight=args.prior_weight,
+        margin=DEFAULT_SDP_MARGIN if args.margin is None else args.margin,
+    )
 
 
 def parse_vector(text: str, name: str, size: int | None = None) -> np.ndarray:

@@ -14,8 +14,17 @@ offset friction columns per joint, and the same least squares and statistics.
 Writes DIR/identification.json (coefficients, expressions, std, metrics, kinematics) and
 prints a summary table.
 
+With --consistent, the link parameters are identified physically consistent in one step
+(convex, every link's pseudo-inertia positive definite, pulled towards --prior; see
+`dynid retrieve --help`): from a torque log with the classical friction (fv, fc >= 0), or
+from static data. Writes next to identification.json (the unconstrained fit) the files of
+`dynid retrieve`: feasible.json (links, and the friction identified with them), robot.urdf,
+robot.toml, report.json, retrieval.png. Exit code 1 when no consistent set satisfies the
+constraints (the closest one is written and reported).
+
 example:
   dynid identify --robot panda --data static.csv --out result --max-std-percent 30
+  dynid identify --robot panda --data log.csv --consistent --prior panda --out result
 """
 
 from __future__ import annotations
@@ -36,7 +45,14 @@ from ..model.panda import panda
 from ..model.robot import Robot
 from ..simulation.controller import SimulatedController, acquire_static
 from .acquire_static import streams
-from .common import add_robot_options, load_robot
+from .common import (
+    add_consistency_options,
+    add_robot_options,
+    load_prior,
+    load_robot,
+    parse_vector,
+    sdp_options,
+)
 
 NAME = "identify"
 
@@ -76,6 +92,19 @@ def register(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParser:
         help="standard deviations: heteroscedasticity-consistent (default) or sigma^2 (W^T W)^-1",
     )
     p.add_argument("--rtol", type=float, default=1e-10, help="relative rank tolerance")
+    p.add_argument(
+        "--consistent",
+        action="store_true",
+        help="identify physically consistent link parameters in one step (convex, with a prior)",
+    )
+    add_consistency_options(p)
+    p.add_argument(
+        "--total-mass",
+        default=None,
+        metavar="MIN,MAX",
+        help="--consistent: band on the total mass [kg]",
+    )
+    p.add_argument("--no-figures", action="store_true", help="--consistent: skip retrieval.png")
     p.add_argument(
         "--cutoff",
         type=float,
@@ -134,6 +163,8 @@ def identify_static_file(robot: Robot, path: Path, args: argparse.Namespace) -> 
 def run(args: argparse.Namespace) -> int:
     """Identify, write DIR/identification.json and print the summary; returns the exit code."""
     robot = load_robot(args)
+    if args.consistent:
+        return run_consistent(robot, args)
     if data_kind(args.data) == "torque_log":
         model = identify_torque_log(robot, args.data, args)
     else:
@@ -144,6 +175,50 @@ def run(args: argparse.Namespace) -> int:
         print(format_summary(model))
         print(f"wrote {path}")
     return 0
+
+
+def run_consistent(robot: Robot, args: argparse.Namespace) -> int:
+    """One-step consistent identification: identification.json plus the retrieve files."""
+    from ..feasibility.one_step import identify_consistent
+    from .retrieve import format_consistent_summary, write_outputs
+
+    if args.max_std_percent is not None:
+        raise DataError("--max-std-percent does not apply to --consistent (nothing is pruned)")
+    if data_kind(args.data) == "torque_log":
+        from ..io.torque_log import read_torque_log
+
+        data: Any = read_torque_log(args.data)
+    else:
+        data, n_dropped = load_static_data(args.data, robot, drop_invalid=args.drop_invalid)
+        if n_dropped:
+            _log.warning("%s: %d invalid row(s) dropped", args.data.name, n_dropped)
+    band = None
+    if args.total_mass is not None:
+        v = parse_vector(args.total_mass, "--total-mass", 2)
+        if not 0.0 <= v[0] <= v[1]:
+            raise DataError(f"--total-mass must be MIN,MAX, 0 <= MIN <= MAX; got {args.total_mass}")
+        band = (float(v[0]), float(v[1]))
+    kw = {} if args.cutoff is None else {"cutoff_hz": args.cutoff}
+    result = identify_consistent(
+        robot,
+        data,
+        prior=load_prior(args, robot),
+        total_mass=band,
+        options=sdp_options(args),
+        rtol=args.rtol,
+        **kw,
+    )
+    if result.identified is None:  # pragma: no cover - identify_consistent always sets it
+        raise DataError("the one-step identification returned no unconstrained fit")
+    args.out.mkdir(parents=True, exist_ok=True)
+    files = [save_model_json(args.out / "identification.json", result.identified)]
+    files += write_outputs(args.out, result, figures=not args.no_figures, source=str(args.data))
+    if not args.quiet:
+        print(format_summary(result.identified))
+        print()
+        print(format_consistent_summary(result))
+        print("wrote " + ", ".join(str(f) for f in files))
+    return 0 if result.feasible else 1
 
 
 def format_summary(model: IdentifiedModel, *, width: int = 60) -> str:

@@ -102,6 +102,10 @@ def run(args: argparse.Namespace) -> int:
         friction = None
     else:
         friction = own_friction(model)
+        if args.params is not None:
+            from ..io.feasible import load_feasible_linear_friction
+
+            friction = load_feasible_linear_friction(args.params) or friction
     val = validate(model, log, friction=friction, cutoff_hz=args.cutoff)
     args.out.mkdir(parents=True, exist_ok=True)
     doc = val.as_dict()

@@ -198,9 +198,8 @@ def prior_from_robot(
     phi, changed = repair_pseudo_inertia(phi, margin)
     for i in np.flatnonzero(changed):
         notes.append(
-            f"prior {name}: link {i + 1} ({robot.link_names[i + 1]}) is not physically "
-            f"consistent with margin {margin:g} (lambda_min(J)/tr(J) = {before[i]:.3g}); "
-            "its pseudo-inertia eigenvalues were floored"
+            f"prior {name}: link {i + 1} ({robot.link_names[i + 1]}) has lambda_min(J)/tr(J) "
+            f"= {before[i]:.3g} < {margin:g}; its pseudo-inertia eigenvalues were floored"
         )
         repaired.append(int(i) + 1)
     if total_mass is not None:

@@ -49,7 +49,9 @@ from .. import __version__
 from ..exceptions import DataError, ModelError, ShapeError
 from ..feasibility.constraints import Bounds, FeasibilityReport, default_bounds
 from ..feasibility.retrieve import RetrievalResult
-from ..model.inertia import INERTIA_ORDER, inertia6_from_matrix
+from ..feasibility.sdp import ConsistentResult
+from ..friction.model import ClassicalFriction
+from ..model.inertia import INERTIA_ORDER, inertia6_from_matrix, inertial_from_phi
 from ..model.robot import Robot
 from .robot_json import robot_from_dict, robot_to_dict
 
@@ -61,7 +63,9 @@ __all__ = [
     "bounds_to_dict",
     "feasible_to_dict",
     "load_bounds",
+    "consistent_report_to_dict",
     "load_feasible_json",
+    "load_feasible_linear_friction",
     "report_to_dict",
     "robot_from_feasible_dict",
     "save_bounds",
@@ -107,17 +111,19 @@ def _read_json(path: str | Path) -> dict[str, Any]:
 
 
 # ------------------------------------------------------------------ feasible parameters
-def feasible_to_dict(source: RetrievalResult | Robot, *, seed: int | None = None) -> dict[str, Any]:
+def feasible_to_dict(source: Any, *, seed: int | None = None) -> dict[str, Any]:
     """The link parameters (and kinematics, friction) of a retrieval result or a robot.
 
     Parameters
     ----------
-    source : RetrievalResult or Robot
-        A result also records ``feasible``, ``relative_residual`` and its seed.
+    source : RetrievalResult, ConsistentResult or Robot
+        A result also records ``method``, ``feasible``, ``relative_residual`` and its seed;
+        a consistent identification from a torque log its classical friction
+        (``linear_friction``: ``fv, fc >= 0`` identified with the links).
     seed : int, optional
         Recorded when ``source`` is a Robot.
     """
-    robot = source.robot if isinstance(source, RetrievalResult) else source
+    robot = source if isinstance(source, Robot) else source.robot
     I6 = inertia6_from_matrix(robot.inertia)
     links = [
         {
@@ -133,17 +139,23 @@ def feasible_to_dict(source: RetrievalResult | Robot, *, seed: int | None = None
         fr = {"model": "sigmoid"} | {
             f"phi{k + 1}": [float(x) for x in robot.friction[:, k]] for k in range(3)
         }
+    lin = getattr(source, "friction", None) if not isinstance(source, Robot) else None
     d: dict[str, Any] = {
         "schema": FEASIBLE_SCHEMA,
         "dynid_version": __version__,
         "name": robot.name,
         "links": links,
         "friction": fr,
+        "linear_friction": None
+        if lin is None
+        else {"model": "classical"}
+        | {k: [float(x) for x in np.asarray(lin)[:, j]] for j, k in enumerate(("fv", "fc", "fo"))},
         "kinematics": robot_to_dict(robot),
         "units": _UNITS,
         "conventions": _CONVENTIONS,
     }
-    if isinstance(source, RetrievalResult):
+    if not isinstance(source, Robot):
+        d["method"] = getattr(source, "method", "penalty")
         d["feasible"] = bool(source.feasible)
         d["relative_residual"] = _num(source.relative_residual)
         d["seed"] = source.seed
@@ -152,7 +164,7 @@ def feasible_to_dict(source: RetrievalResult | Robot, *, seed: int | None = None
     return d
 
 
-def save_feasible_json(path: str | Path, source: RetrievalResult | Robot) -> Path:
+def save_feasible_json(path: str | Path, source: Any) -> Path:
     """Write ``feasible.json`` (see :func:`feasible_to_dict`); returns the path."""
     return _write_json(path, feasible_to_dict(source))
 
@@ -257,6 +269,26 @@ def load_feasible_json(path: str | Path, robot: Robot | None = None) -> Robot:
         raise DataError(f"{name}: {exc}") from exc
 
 
+def load_feasible_linear_friction(path: str | Path) -> ClassicalFriction | None:
+    """The classical friction (``fv, fc, fo`` per joint) held by ``feasible.json``, or None.
+
+    Written by a consistent identification from a torque log; ``dynid validate --params``
+    uses it unless another friction is given.
+    """
+    d = _read_json(path)
+    lin = d.get("linear_friction")
+    if lin is None:
+        return None
+    name = Path(path).name
+    try:
+        n = len(d["links"])
+        return ClassicalFriction(
+            *(_vec(lin[k], n, f"{name}: linear_friction {k}") for k in ("fv", "fc", "fo"))
+        )
+    except (KeyError, TypeError):
+        raise DataError(f"{name}: linear_friction needs fv, fc, fo per joint") from None
+
+
 # ------------------------------------------------------------------------ the report
 def _report_constraints(report: FeasibilityReport) -> list[dict[str, Any]]:
     return [
@@ -334,9 +366,88 @@ def report_to_dict(result: RetrievalResult) -> dict[str, Any]:
     }
 
 
-def save_report_json(path: str | Path, result: RetrievalResult, **extra: Any) -> Path:
-    """Write ``report.json`` (:func:`report_to_dict`, plus ``extra`` entries)."""
-    d = report_to_dict(result)
+def consistent_report_to_dict(result: ConsistentResult) -> dict[str, Any]:
+    """Everything a convex retrieval or consistent identification reports, JSON-ready.
+
+    Keys: ``method`` ("sdp"), ``kind``, ``fit`` ("equality" or "weighted"), ``prior``
+    (source, repaired links, notes), ``prior_weight`` and the automatic ``weight_search``
+    (``[w, residual_ratio]``), ``relative_residual`` (on the coefficients),
+    ``residual_ratio`` (data residual RMS over the unconstrained fit's), ``feasible``,
+    ``min_margin`` and ``constraints`` (every margin, with ``pseudo_inertia`` as
+    ``lambda_min(J)/tr(J)``), ``pseudo_inertia_margin`` and ``divergence`` per link,
+    ``distance_to_prior`` (mass [kg], CoM [m] per link), ``friction`` (classical, when
+    identified), ``solver``, ``status``, ``run_time_s``, ``notes``, ``options``,
+    ``total_mass``, ``bounds``.
+    """
+    rep = result.report
+    o = result.options
+    pm, pc, _ = inertial_from_phi(result.prior.phi)
+    return {
+        "schema": REPORT_SCHEMA,
+        "dynid_version": __version__,
+        "method": result.method,
+        "kind": result.kind,
+        "fit": result.fit,
+        "robot": result.robot.name,
+        "link_names": list(result.robot.link_names[1:]),
+        "prior": {
+            "source": result.prior.source,
+            "repaired_links": list(result.prior.repaired),
+            "mass": [float(x) for x in pm],
+        },
+        "prior_weight": _num(result.prior_weight),
+        "weight_search": [[_num(w), _num(r)] for w, r in result.weight_search],
+        "relative_residual": _num(result.relative_residual),
+        "residual_ratio": _num(result.residual_ratio),
+        "feasible": bool(result.feasible),
+        "min_margin": {name: _num(rep.min_margin(name)) for name in rep.names},
+        "constraints": _report_constraints(rep),
+        "pseudo_inertia_margin": [_num(x) for x in result.pseudo_inertia_margin],
+        "divergence": [_num(x) for x in result.divergence],
+        "distance_to_prior": {
+            "mass": [float(x) for x in np.abs(result.mass - pm)],
+            "com": [float(x) for x in np.linalg.norm(result.com - pc, axis=1)],
+        },
+        "friction": None
+        if result.friction is None
+        else {
+            k: [float(x) for x in result.friction[:, j]] for j, k in enumerate(("fv", "fc", "fo"))
+        },
+        "solver": result.solver,
+        "status": result.status,
+        "run_time_s": float(result.run_time),
+        "seed": result.seed,
+        "notes": list(result.notes),
+        "options": {
+            "objective": o.objective,
+            "prior_weight": o.prior_weight,
+            "residual_increase": o.residual_increase,
+            "margin": o.margin,
+            "fit": o.fit,
+            "mass_factor": o.mass_factor,
+            "residual_tol": o.residual_tol,
+            "tol": o.tol,
+        },
+        "total_mass": None if result.total_mass is None else list(result.total_mass),
+        "bounds": bounds_to_dict(result.bounds),
+        "units": {
+            "relative_residual": "1",
+            "residual_ratio": "1",
+            "margin": "per constraint (see unit)",
+            "pseudo_inertia_margin": "1",
+            "run_time_s": "s",
+        },
+    }
+
+
+def save_report_json(path: str | Path, result: Any, **extra: Any) -> Path:
+    """Write ``report.json`` (:func:`report_to_dict` or :func:`consistent_report_to_dict`,
+    plus ``extra`` entries)."""
+    d = (
+        consistent_report_to_dict(result)
+        if isinstance(result, ConsistentResult)
+        else report_to_dict(result)
+    )
     d.update(extra)
     return _write_json(path, d)
 

@@ -13,7 +13,7 @@ return a Figure and never show it. Use the ``Agg`` backend for files.
 from __future__ import annotations
 
 from collections.abc import Sequence
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
@@ -23,7 +23,7 @@ from ..feasibility.validate import NewtonEulerValidation
 if TYPE_CHECKING:  # pragma: no cover
     from matplotlib.figure import Figure
 
-__all__ = ["plot_newton_euler_validation", "plot_retrieval"]
+__all__ = ["plot_consistent", "plot_newton_euler_validation", "plot_retrieval"]
 
 
 def _stride(N: int, max_points: int) -> slice:
@@ -201,5 +201,70 @@ def plot_retrieval(
     ax2.legend(fontsize=7)
     ax2.grid(True, axis="y", lw=0.3)
     fig.suptitle(title or "Feasible-parameter retrieval", fontsize=10)
+    fig.tight_layout()
+    return fig
+
+
+def plot_consistent(
+    results: Sequence[Any],
+    *,
+    labels: Sequence[str] | None = None,
+    truth: Any = None,
+    fig: Figure | None = None,
+) -> Figure:
+    """Masses and pseudo-inertia margins per link of one or more parameter sets.
+
+    Left: link masses [kg] of each result (bars), the prior's (of the first result that has
+    one, open markers) and ``truth``'s (a Robot, crosses) when given. Right: the margin
+    ``lambda_min(J)/tr(J)`` of each link's pseudo-inertia (log scale; non-positive margins
+    drawn at the bottom, red), with the convex method's margin as a dashed line.
+
+    Parameters
+    ----------
+    results : sequence
+        :class:`~dynid.feasibility.sdp.ConsistentResult` or
+        :class:`~dynid.feasibility.retrieve.RetrievalResult` (anything with ``robot``).
+    labels : sequence of str, optional
+        Legend entries (default the results' ``method``).
+    truth : Robot, optional
+    """
+    import matplotlib.pyplot as plt
+
+    from ..feasibility.lmi import pseudo_inertia_margin
+
+    if fig is None:
+        fig = plt.figure(figsize=(11, 4))
+    ax1, ax2 = fig.subplots(1, 2)
+    names = labels or [getattr(r, "method", "penalty") for r in results]
+    n = results[0].robot.n
+    x = np.arange(1, n + 1)
+    w = 0.8 / len(results)
+    floor = 1e-7
+    for k, (res, name) in enumerate(zip(results, names, strict=True)):
+        off = (k - (len(results) - 1) / 2) * w
+        ax1.bar(x + off, res.robot.mass, width=w, label=name)
+        mg = pseudo_inertia_margin(res.robot.phi.reshape(n, 10))
+        ok = mg > 0
+        ax2.bar(x[ok] + off, mg[ok], width=w, label=name)
+        ax2.bar(x[~ok] + off, np.full((~ok).sum(), floor), width=w, color="tab:red")
+    prior = next((r.prior for r in results if getattr(r, "prior", None) is not None), None)
+    if prior is not None:
+        ax1.plot(x, prior.mass, "o", mfc="none", mec="k", label=f"prior ({prior.source})")
+    if truth is not None:
+        ax1.plot(x, truth.mass, "kx", ms=8, label="truth")
+    eps = next((r.options.margin for r in results if hasattr(r.options, "margin")), None)
+    if eps is not None:
+        ax2.axhline(eps, ls="--", color="k", lw=0.8, label=f"margin {eps:g}")
+    ax1.set_xlabel("link")
+    ax1.set_ylabel("mass [kg]")
+    ax1.set_xticks(x)
+    ax1.legend(fontsize=8)
+    ax2.set_yscale("log")
+    ax2.set_ylim(bottom=floor / 2)
+    ax2.set_xlabel("link")
+    ax2.set_ylabel("lambda_min(J) / tr(J)")
+    ax2.set_xticks(x)
+    ax2.legend(fontsize=8)
+    ax2.set_title("pseudo-inertia margin (red: not physically consistent)", fontsize=9)
     fig.tight_layout()
     return fig
