@@ -6,6 +6,10 @@ import numpy as np
 import pytest
 
 import dynid
+from dynid.feasibility.lmi import repair_pseudo_inertia
+from dynid.identification.least_squares import LeastSquaresFit
+from dynid.identification.model import IdentifiedModel
+from dynid.regressors.base import base_parameters
 
 
 @pytest.fixture(scope="session")
@@ -87,3 +91,38 @@ def robot_data_urdf(rel: str) -> str:
             if cand.exists():
                 return str(cand)
     pytest.skip(f"example-robot-data file {rel} not found")
+
+
+def perturbed_robot(
+    robot: dynid.Robot, rng: np.random.Generator, spread: float = 0.2
+) -> dynid.Robot:
+    """Every mass, CoM coordinate and inertia entry scaled by up to +-spread, kept consistent."""
+    m, c, I = dynid.inertial_from_phi(robot.phi.reshape(robot.n, 10))
+    n = robot.n
+    I2 = I * (1 + rng.uniform(-spread, spread, (n, 3, 3)))
+    phi = dynid.phi_from_inertial(
+        m * (1 + rng.uniform(-spread, spread, n)),
+        c * (1 + rng.uniform(-spread, spread, (n, 3))),
+        0.5 * (I2 + np.swapaxes(I2, 1, 2)),
+    )
+    return robot.with_params(repair_pseudo_inertia(phi, 2e-4)[0])
+
+
+def exact_model(robot: dynid.Robot, truth: dynid.Robot) -> IdentifiedModel:
+    """An identified model holding the exact static coefficients of ``truth``."""
+    base = base_parameters(robot, kind="static")
+    r = base.rank
+    fit = LeastSquaresFit(
+        beta=base.beta_from_phi(truth.phi),
+        std=np.zeros(r),
+        std_percent=np.zeros(r),
+        kept=np.ones(r, bool),
+        rank=r,
+        condition_number=1.0,
+        relative_error_percent=0.0,
+        residual_rms=0.0,
+        sigma=0.0,
+        n_rows=0,
+        rtol=1e-10,
+    )
+    return IdentifiedModel(robot=robot, base=base, fit=fit)

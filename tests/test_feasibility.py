@@ -41,7 +41,7 @@ from dynid.identification.least_squares import LeastSquaresFit
 from dynid.identification.model import IdentifiedModel
 from dynid.regressors.base import base_parameters
 
-from conftest import random_states, robot_data_urdf
+from conftest import exact_model, perturbed_robot, random_states, robot_data_urdf
 
 EXAMPLES = Path(__file__).resolve().parents[1] / "examples"
 PHYSICAL = ("mass_positive", "inertia_positive_definite", "triangle_inequality")
@@ -472,3 +472,17 @@ def test_feasible_figures_render(panda_retrieval):
     assert len([a for a in f1.axes if a.get_visible()]) >= panda.n and len(f2.axes) == 2
     plt.close(f1)
     plt.close(f2)
+
+
+def test_penalty_method_with_a_prior_lands_near_the_truth_and_still_meets_the_coefficients():
+    """Prior term (weight 1e-6): coefficients to 1e-5, masses far closer to a perturbed truth."""
+    robot = dynid.panda()
+    truth = perturbed_robot(robot, np.random.default_rng(2))
+    model = exact_model(robot, truth)
+    opts = RetrievalOptions(runs=2, stages=4)
+    plain = retrieve(model, options=opts, workers=1, seed=0)
+    pulled = retrieve(model, options=opts, workers=1, seed=0, prior=robot)
+    assert pulled.feasible and pulled.relative_residual < 1e-5
+    err = lambda r: np.median(np.abs(r.mass - truth.mass)[1:] / truth.mass[1:])  # noqa: E731
+    assert err(pulled) < 0.5 * err(plain)
+    assert pulled.mass.min() > 0.3

@@ -13,51 +13,16 @@ import pytest
 import dynid
 from dynid.exceptions import InfeasibleError, ModelError, ShapeError
 from dynid.feasibility.constraints import panda_bounds
-from dynid.feasibility.lmi import pseudo_inertia_margin, repair_pseudo_inertia
+from dynid.feasibility.lmi import pseudo_inertia_margin
 from dynid.feasibility.one_step import identify_consistent
 from dynid.feasibility.prior import generic_prior, prior_from_robot
 from dynid.feasibility.sdp import SDPOptions, retrieve_sdp
-from dynid.identification.least_squares import LeastSquaresFit
 from dynid.identification.log import prepare_log
-from dynid.identification.model import IdentifiedModel
 from dynid.kinematics.trajectories import random_fourier
-from dynid.regressors.base import base_parameters
 from dynid.simulation.measurement import SensorNoise, sample_times, simulate_measurement
 from dynid.simulation.unmodelled import UnmodelledEffects
 
-from conftest import robot_data_urdf
-
-
-def _perturbed(robot: dynid.Robot, rng: np.random.Generator, spread: float = 0.2) -> dynid.Robot:
-    """Every mass, CoM coordinate and inertia entry scaled by up to +-spread, kept consistent."""
-    m, c, I = dynid.inertial_from_phi(robot.phi.reshape(robot.n, 10))
-    n = robot.n
-    I2 = I * (1 + rng.uniform(-spread, spread, (n, 3, 3)))
-    phi = dynid.phi_from_inertial(
-        m * (1 + rng.uniform(-spread, spread, n)),
-        c * (1 + rng.uniform(-spread, spread, (n, 3))),
-        0.5 * (I2 + np.swapaxes(I2, 1, 2)),
-    )
-    return robot.with_params(repair_pseudo_inertia(phi, 2e-4)[0])
-
-
-def _exact_model(robot: dynid.Robot, truth: dynid.Robot) -> IdentifiedModel:
-    base = base_parameters(robot, kind="static")
-    r = base.rank
-    fit = LeastSquaresFit(
-        beta=base.beta_from_phi(truth.phi),
-        std=np.zeros(r),
-        std_percent=np.zeros(r),
-        kept=np.ones(r, bool),
-        rank=r,
-        condition_number=1.0,
-        relative_error_percent=0.0,
-        residual_rms=0.0,
-        sigma=0.0,
-        n_rows=0,
-        rtol=1e-10,
-    )
-    return IdentifiedModel(robot=robot, base=base, fit=fit)
+from conftest import exact_model, perturbed_robot, robot_data_urdf
 
 
 def test_exact_coefficients_of_perturbed_pandas_are_met_with_plausible_masses():
@@ -65,8 +30,8 @@ def test_exact_coefficients_of_perturbed_pandas_are_met_with_plausible_masses():
     robot = dynid.panda()
     ours, prior_err = [], []
     for seed in range(8):
-        truth = _perturbed(robot, np.random.default_rng(seed))
-        model = _exact_model(robot, truth)
+        truth = perturbed_robot(robot, np.random.default_rng(seed))
+        model = exact_model(robot, truth)
         res = retrieve_sdp(model, prior=robot)
         beta = model.beta
         P = model.base.projection
@@ -159,7 +124,7 @@ def test_generic_prior_of_a_ur5_is_consistent_and_retrieval_runs_without_a_prior
     pr = generic_prior(ur5, total_mass=(15.0, 25.0))
     assert pseudo_inertia_margin(pr.phi).min() > 2e-4
     assert pr.mass.sum() == pytest.approx(20.0)
-    model = _exact_model(ur5, ur5)
+    model = exact_model(ur5, ur5)
     res = retrieve_sdp(model)  # generic prior from the kinematics
     assert res.feasible and res.prior.source == "generic"
     assert res.relative_residual < 1e-9
@@ -181,7 +146,7 @@ def test_a_cad_prior_violating_the_triangle_inequality_is_repaired_and_reported(
 def test_bad_inputs_raise_one_clear_error():
     """Contradictory band, prior of another robot, bad options, a prior without inertials."""
     robot = dynid.panda()
-    model = _exact_model(robot, robot)
+    model = exact_model(robot, robot)
     with pytest.raises(InfeasibleError, match="cannot be met"):
         retrieve_sdp(model, prior=robot, total_mass=(100.0, 120.0))
     ur5 = dynid.Robot.from_urdf(
@@ -204,8 +169,8 @@ def test_a_user_constraint_and_the_euclidean_objective_are_honoured():
     import cvxpy as cp
 
     robot = dynid.panda()
-    truth = _perturbed(robot, np.random.default_rng(11))
-    model = _exact_model(robot, truth)
+    truth = perturbed_robot(robot, np.random.default_rng(11))
+    model = exact_model(robot, truth)
 
     def com7_near_axis(phi, J):
         return [cp.norm(phi[6][1:3]) <= 0.01 * phi[6][0]]

@@ -285,9 +285,10 @@ def run(args: argparse.Namespace) -> int:
         return run_sdp(args)
     quiet = bool(getattr(args, "quiet", False))
     try:
-        options = RetrievalOptions(runs=args.runs, stages=args.stages)
+        extra_opts = {} if args.prior_weight is None else {"prior_weight": args.prior_weight}
+        options = RetrievalOptions(runs=args.runs, stages=args.stages, **extra_opts)
     except ValueError as exc:
-        raise DynidError(f"--runs/--stages: {exc}") from None
+        raise DynidError(f"--runs/--stages/--prior-weight: {exc}") from None
     band = _band(args)
     if args.workers is not None and args.workers < 1:
         raise DynidError(f"--workers must be >= 1; got {args.workers}")
@@ -315,7 +316,9 @@ def run(args: argparse.Namespace) -> int:
                 f"retrieving feasible parameters of {robot.name} from {args.model} ...",
                 file=sys.stderr,
             )
-        result = retrieve(model, bounds=bounds, total_mass=band, **common)
+        result = retrieve(
+            model, bounds=bounds, total_mass=band, prior=load_prior(args, robot), **common
+        )
     else:
         from ..io.static_data import load_static_data
 
@@ -330,7 +333,9 @@ def run(args: argparse.Namespace) -> int:
                 f"retrieving feasible parameters of {robot.name} from {args.static} ...",
                 file=sys.stderr,
             )
-        result = retrieve_from_static(robot, data, bounds=bounds, total_mass=band, **common)
+        result = retrieve_from_static(
+            robot, data, bounds=bounds, total_mass=band, prior=load_prior(args, robot), **common
+        )
     files = write_outputs(args.out, result, figures=not args.no_figures, source=source)
     if not quiet:
         print(format_summary(result))

@@ -64,6 +64,7 @@ violations of order ``1 / xi`` of the targets.
 
 from __future__ import annotations
 
+import dataclasses
 from collections.abc import Sequence
 from dataclasses import dataclass
 from typing import Any
@@ -78,6 +79,7 @@ from ..model.robot import Robot
 from ..regressors.base import BaseParameters, base_parameters
 from ..regressors.static import static_regressor, static_vector
 from .constraints import Bounds, UserConstraint, default_bounds, user_constraints
+from .prior import prior_scales
 
 __all__ = [
     "DEFAULT_MARGIN",
@@ -87,6 +89,7 @@ __all__ = [
     "coefficient_scales",
     "static_problem",
     "phi_from_params",
+    "with_prior",
 ]
 
 #: Relative target margin of the constraints and relative shrink of the box.
@@ -410,6 +413,23 @@ def _common(
             raise ValueError(f"total_mass must be (min, max) with 0 <= min <= max; got {band}")
         band = (lo, hi)
     return b, band, user_constraints(extra)
+
+
+def with_prior(problem: PenaltyProblem, phi0: ArrayLike, weight: float) -> PenaltyProblem:
+    """``problem`` with a pull towards prior standard parameters ``phi0`` (n, 10) added to
+    its data term: ``weight * sum_j ((phi_j - phi0_j) / s_j)^2``, ``s`` the prior's scales
+    (:func:`~dynid.feasibility.prior.prior_scales`). It is linear in ``phi``, so it enters
+    as extra rows of ``A`` and ``b``; the reported relative residual is unchanged."""
+    if not (np.isfinite(weight) and weight >= 0):
+        raise DataError(f"prior weight must be finite and >= 0; got {weight}")
+    p0 = _checks.as_exact("phi0", phi0, (problem.n, 10)).reshape(-1)
+    if weight == 0:
+        return problem
+    s = prior_scales(p0)
+    k = np.sqrt(weight)
+    A = np.vstack([problem.A, np.diag(k / s)])
+    b = np.concatenate([problem.b, k * p0 / s])
+    return dataclasses.replace(problem, A=_checks.frozen(A), b=_checks.frozen(b))
 
 
 def coefficient_problem(

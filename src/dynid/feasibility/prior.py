@@ -38,6 +38,7 @@ __all__ = [
     "Prior",
     "generic_prior",
     "prior_from_robot",
+    "prior_scales",
 ]
 
 #: A prior's links are repaired up to ``lambda_min(J) >= DEFAULT_PRIOR_MARGIN tr(J)``
@@ -89,6 +90,20 @@ class Prior:
     def mass(self) -> NDArray[np.float64]:
         """Prior link masses [kg], (n,)."""
         return self.phi[:, 0].copy()
+
+
+def prior_scales(phi0: NDArray[np.float64]) -> NDArray[np.float64]:
+    """Size of every standard parameter of a prior (10 n,): ``m0``, ``m0 L`` for the first
+    moments and ``m0 L^2`` for the inertia entries, ``L = sqrt(max |J_o| / m0)`` the link's
+    radius of gyration about its origin [kg, kg m, kg m^2]; 1e-12 at least."""
+    p0 = np.asarray(phi0, dtype=np.float64).reshape(-1, 10)
+    m0 = np.maximum(p0[:, 0], 1e-9)
+    j0 = np.maximum(np.abs(p0[:, 4:]).max(axis=1), 1e-12)
+    L = np.sqrt(j0 / m0)
+    s = np.concatenate(
+        [m0[:, None], np.repeat((m0 * L)[:, None], 3, 1), np.repeat(j0[:, None], 6, 1)], axis=1
+    )
+    return np.maximum(s, 1e-12).reshape(-1)
 
 
 def _segment(robot: Robot, i: int) -> tuple[NDArray[np.float64], NDArray[np.float64]]:

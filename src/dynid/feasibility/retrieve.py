@@ -55,7 +55,7 @@ import scipy.linalg
 from numpy.typing import ArrayLike, NDArray
 from scipy.optimize import dual_annealing
 
-from ..exceptions import InfeasibleError
+from ..exceptions import InfeasibleError, ShapeError
 from ..identification.model import IdentifiedModel
 from ..model.inertia import matrix_from_inertia6
 from ..model.robot import Robot
@@ -74,6 +74,7 @@ from .penalty import (
     PenaltyProblem,
     coefficient_problem,
     static_problem,
+    with_prior,
 )
 
 __all__ = [
@@ -132,6 +133,13 @@ class RetrievalOptions:
         infeasible even when the penalties gave in to it. None leaves it out. 5 % by
         default: noise-free or well-identified coefficients are met to round-off, the
         single-step residual is about the noise level of the static data.
+    prior_weight : float
+        Weight of the pull towards a prior, when one is given
+        (:func:`~dynid.feasibility.penalty.with_prior`): each relative deviation of a
+        standard parameter from the prior's counts ``prior_weight`` times a relative
+        coefficient error. Small by default (1e-6: the coefficients are still met to
+        about 1e-6 relative): among parameter sets that fit equally, the one closest to the
+        prior wins.
     """
 
     runs: int = 10
@@ -146,10 +154,13 @@ class RetrievalOptions:
     scale_floor: float = DEFAULT_SCALE_FLOOR
     tol: float = 1e-9
     residual_tol: float | None = 0.05
+    prior_weight: float = 1e-6
 
     def __post_init__(self) -> None:
         if self.residual_tol is not None and not self.residual_tol > 0:
             raise ValueError(f"residual_tol must be positive or None; got {self.residual_tol}")
+        if not (math.isfinite(self.prior_weight) and self.prior_weight >= 0):
+            raise ValueError(f"prior_weight must be finite and >= 0; got {self.prior_weight}")
         if self.runs < 1 or self.stages < 1:
             raise ValueError(f"runs and stages must be >= 1; got {self.runs}, {self.stages}")
         if self.anneal_maxiter < 0 or self.local_maxiter < 0:
@@ -606,6 +617,22 @@ def _solve(
     )
 
 
+def _prior_problem(
+    problem: PenaltyProblem, robot: Robot, prior: Any, weight: float
+) -> PenaltyProblem:
+    """``problem`` pulled towards ``prior`` (a Prior, a Robot with inertials, or None)."""
+    if prior is None:
+        return problem
+    from .prior import Prior, prior_from_robot
+
+    pr = prior if isinstance(prior, Prior) else prior_from_robot(prior)
+    if pr.n != robot.n:
+        raise ShapeError(
+            f"prior {pr.source!r} has {pr.n} links; robot {robot.name!r} has {robot.n}"
+        )
+    return with_prior(problem, pr.phi, weight)
+
+
 def retrieve_from_coefficients(
     robot: Robot,
     base: BaseParameters,
@@ -621,6 +648,7 @@ def retrieve_from_coefficients(
     seed: int | None = 0,
     progress: Callable[[RetrievalProgress], None] | None = None,
     require_feasible: bool = False,
+    prior: Any = None,
 ) -> RetrievalResult:
     """Feasible link parameters that reproduce given dynamic coefficients (two-step).
 
@@ -658,6 +686,10 @@ def retrieve_from_coefficients(
     require_feasible : bool
         Raise :class:`~dynid.exceptions.InfeasibleError` when no run is feasible
         (default: return the least-violating solution with ``feasible = False``).
+    prior : Prior or Robot, optional
+        Prior link parameters to pull towards (weight ``options.prior_weight``; see
+        :func:`~dynid.feasibility.penalty.with_prior`), checked and repaired as in
+        :func:`~dynid.feasibility.prior.prior_from_robot`. None: the paper's method.
 
     Returns
     -------
@@ -686,6 +718,7 @@ def retrieve_from_coefficients(
         margin=options.margin,
         scale_floor=options.scale_floor,
     )
+    problem = _prior_problem(problem, robot, prior, options.prior_weight)
     return _solve(
         problem,
         robot,
@@ -710,6 +743,7 @@ def retrieve(
     progress: Callable[[RetrievalProgress], None] | None = None,
     require_feasible: bool = False,
     use_std: bool = True,
+    prior: Any = None,
 ) -> RetrievalResult:
     """Feasible link parameters from an identified model (Gaz et al. 2019, Algorithm 1).
 
@@ -744,6 +778,7 @@ def retrieve(
         seed=seed,
         progress=progress,
         require_feasible=require_feasible,
+        prior=prior,
     )
 
 
@@ -760,6 +795,7 @@ def retrieve_from_static(
     seed: int | None = 0,
     progress: Callable[[RetrievalProgress], None] | None = None,
     require_feasible: bool = False,
+    prior: Any = None,
 ) -> RetrievalResult:
     """Feasible link parameters directly from static data (single-step variant).
 
@@ -803,6 +839,7 @@ def retrieve_from_static(
         extra=extra,
         margin=options.margin,
     )
+    problem = _prior_problem(problem, robot, prior, options.prior_weight)
     return _solve(
         problem,
         robot,

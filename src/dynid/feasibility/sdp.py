@@ -74,7 +74,7 @@ from .lmi import (
     pseudo_inertia_margin,
     repair_pseudo_inertia,
 )
-from .prior import Prior, generic_prior, prior_from_robot
+from .prior import Prior, generic_prior, prior_from_robot, prior_scales
 
 __all__ = [
     "DEFAULT_SDP_MARGIN",
@@ -516,17 +516,7 @@ def _with_margin(phi: NDArray[np.float64], margin: float) -> NDArray[np.float64]
 
 def _polish(phi: NDArray[np.float64], term: DataTerm, prior: Prior) -> NDArray[np.float64]:
     """Minimum-norm correction (in the prior's scales) so that ``P phi = beta`` to round-off."""
-    p0 = prior.phi
-    L = np.sqrt(np.maximum(np.abs(p0[:, 4:]).max(axis=1), 1e-12) / np.maximum(p0[:, 0], 1e-9))
-    scale = np.concatenate(
-        [
-            p0[:, :1],
-            (p0[:, :1] * L[:, None]).repeat(3, 1),
-            np.abs(p0[:, 4:]).max(axis=1, keepdims=True).repeat(6, 1),
-        ],
-        axis=1,
-    ).reshape(-1)
-    scale = np.maximum(scale, 1e-12)
+    scale = prior_scales(prior.phi)
     x = phi.reshape(-1)
     for _ in range(2):
         e = term.x_hat[: term.r] - term.P @ x  # the base part; friction is met exactly
