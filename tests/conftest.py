@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 import dynid
-from dynid.feasibility.lmi import repair_pseudo_inertia
+from dynid.feasibility.compare import perturbed_robot  # noqa: F401 (shared with the tests)
 from dynid.identification.least_squares import LeastSquaresFit
 from dynid.identification.model import IdentifiedModel
 from dynid.regressors.base import base_parameters
@@ -91,21 +91,6 @@ def robot_data_urdf(rel: str) -> str:
             if cand.exists():
                 return str(cand)
     pytest.skip(f"example-robot-data file {rel} not found")
-
-
-def perturbed_robot(
-    robot: dynid.Robot, rng: np.random.Generator, spread: float = 0.2
-) -> dynid.Robot:
-    """Every mass, CoM coordinate and inertia entry scaled by up to +-spread, kept consistent."""
-    m, c, I = dynid.inertial_from_phi(robot.phi.reshape(robot.n, 10))
-    n = robot.n
-    I2 = I * (1 + rng.uniform(-spread, spread, (n, 3, 3)))
-    phi = dynid.phi_from_inertial(
-        m * (1 + rng.uniform(-spread, spread, n)),
-        c * (1 + rng.uniform(-spread, spread, (n, 3))),
-        0.5 * (I2 + np.swapaxes(I2, 1, 2)),
-    )
-    return robot.with_params(repair_pseudo_inertia(phi, 2e-4)[0])
 
 
 def exact_model(robot: dynid.Robot, truth: dynid.Robot) -> IdentifiedModel:
