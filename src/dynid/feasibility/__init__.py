@@ -1,0 +1,46 @@
+"""Physically consistent link parameters: the convex (LMI) methods and the paper's penalty method.
+
+* :func:`retrieve_sdp` (two-step) and :func:`identify_consistent` (one-step, from torque
+  logs or static data): every link's pseudo-inertia kept positive definite, pulled towards
+  a :class:`Prior` (:mod:`.sdp`, :mod:`.one_step`, :mod:`.lmi`, :mod:`.prior`).
+* :func:`retrieve`: Gaz et al. 2019, Algorithm 1 (:mod:`.retrieve`, :mod:`.penalty`).
+* :func:`compare_methods`: both on the same coefficients (:mod:`.compare`).
+* :func:`feasibility_report`, :class:`Bounds`: constraints and their margins
+  (:mod:`.constraints`); :func:`validate_newton_euler` (:mod:`.validate`).
+"""
+
+from .compare import MethodSummary, compare_methods, perturbed_robot
+from .constraints import Bounds, default_bounds, feasibility_report, kinematic_bounds, panda_bounds
+from .lmi import log_det_divergence, pseudo_inertia, pseudo_inertia_margin
+from .one_step import identify_consistent
+from .prior import Prior, generic_prior, prior_from_robot
+from .retrieve import RetrievalOptions, RetrievalResult, retrieve, retrieve_from_static
+from .sdp import ConsistentResult, SDPOptions, retrieve_sdp, solve_consistent
+from .validate import validate_newton_euler
+
+__all__ = [
+    "Bounds",
+    "ConsistentResult",
+    "MethodSummary",
+    "Prior",
+    "RetrievalOptions",
+    "RetrievalResult",
+    "SDPOptions",
+    "compare_methods",
+    "default_bounds",
+    "feasibility_report",
+    "generic_prior",
+    "identify_consistent",
+    "kinematic_bounds",
+    "log_det_divergence",
+    "panda_bounds",
+    "perturbed_robot",
+    "prior_from_robot",
+    "pseudo_inertia",
+    "pseudo_inertia_margin",
+    "retrieve",
+    "retrieve_from_static",
+    "retrieve_sdp",
+    "solve_consistent",
+    "validate_newton_euler",
+]
