@@ -67,6 +67,7 @@ __all__ = [
     "panda_bounds",
     "params_from_inertial",
     "principal_moments",
+    "segment_points",
     "user_constraints",
     "validate",
 ]
@@ -351,12 +352,20 @@ GENERIC_MASS_BASE = 5.0
 GENERIC_MASS_PER_M = 40.0
 
 
-def _segment_points(robot: Robot, i: int) -> NDArray[np.float64]:
+def segment_points(robot: Robot, i: int) -> NDArray[np.float64]:
     """Points that bound link ``i`` (0-based joint index) in its own frame [m], (k, 3):
-    its origin, the parent link's origin, the next joint's origin (or, for the last link,
-    the frames fixed to it, e.g. ``flange``)."""
+    its origin, the parent link's origin (for a prismatic joint, at both ends of its finite
+    travel: the link slides along its z axis), the next joint's origin (or, for the last
+    link, the frames fixed to it, e.g. ``flange``)."""
     T = robot.T_parent_joint[i]
-    pts = [np.zeros(3), -T[:3, :3].T @ T[:3, 3]]  # own origin, parent origin in link i
+    parent = -T[:3, :3].T @ T[:3, 3]
+    pts = [np.zeros(3), parent]  # own origin, parent origin in link i (at q = 0)
+    if robot.prismatic[i]:
+        pts += [
+            parent - q * np.array([0.0, 0.0, 1.0])
+            for q in (robot.q_min[i], robot.q_max[i])
+            if np.isfinite(q)
+        ]
     if i + 1 < robot.n:
         pts.append(robot.T_parent_joint[i + 1][:3, 3])
     pts += [f.T_link_frame[:3, 3] for f in robot.frames.values() if f.link == i + 1]
@@ -402,7 +411,7 @@ def kinematic_bounds(
     Bounds
     """
     n = robot.n
-    pts = [_segment_points(robot, i) for i in range(n)]
+    pts = [segment_points(robot, i) for i in range(n)]
     ext = np.array([float(np.max(np.ptp(P, axis=0))) if len(P) > 1 else 0.0 for P in pts])
     seg = np.array([float(np.max(np.linalg.norm(P, axis=1))) for P in pts])
     L = np.maximum(ext, seg)

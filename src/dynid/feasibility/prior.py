@@ -31,6 +31,7 @@ from numpy.typing import NDArray
 from ..exceptions import ModelError
 from ..model.inertia import phi_from_inertial
 from ..model.robot import Robot
+from .constraints import segment_points
 from .lmi import pseudo_inertia, pseudo_inertia_margin, repair_pseudo_inertia
 
 __all__ = [
@@ -107,13 +108,9 @@ def prior_scales(phi0: NDArray[np.float64]) -> NDArray[np.float64]:
 
 
 def _segment(robot: Robot, i: int) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
-    """End points [m] in link ``i``'s frame (0-based) of the segment that bounds it."""
-    T = robot.T_parent_joint[i]
-    pts = [np.zeros(3), -T[:3, :3].T @ T[:3, 3]]  # own origin, parent's origin
-    if i + 1 < robot.n:
-        pts.append(robot.T_parent_joint[i + 1][:3, 3])
-    pts += [f.T_link_frame[:3, 3] for f in robot.frames.values() if f.link == i + 1]
-    P = np.asarray(pts)
+    """End points [m] in link ``i``'s frame (0-based): the two farthest apart of the points
+    that bound it (:func:`~dynid.feasibility.constraints.segment_points`)."""
+    P = segment_points(robot, i)
     d = np.linalg.norm(P[:, None] - P[None], axis=-1)
     a, b = np.unravel_index(int(np.argmax(d)), d.shape)
     return P[a], P[b]

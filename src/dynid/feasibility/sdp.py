@@ -426,6 +426,8 @@ class _Problem:
         self.phi_links = phis
         self.w = cp.Parameter(nonneg=True, value=1.0, name="w")
         eps = self.margin = options.margin
+        self.scale = 1.0 if equality or closest else float(max(term.dof, 1))
+        self.equality = equality
         cons: list[Any] = []
         for i in range(n):
             C = self.S0[i].T @ self.S0[i]
@@ -465,42 +467,62 @@ class _Problem:
             s = np.maximum(np.abs(term.x_hat), 1e-3 * max(float(np.abs(term.x_hat).max()), 1e-12))
             obj = 1e-6 * div + 0.5 * cp.sum_squares(cp.multiply(1.0 / s, x - term.x_hat))
         else:
-            obj = self.w * div + 0.5 * cp.sum_squares(term.A @ x - term.A @ term.x_hat)
+            # divided by dof (the data term's size at a good fit): same minimiser, better scaled
+            k = 1.0 / math.sqrt(self.scale)
+            obj = self.w * div + 0.5 * cp.sum_squares((k * term.A) @ x - (k * term.A) @ term.x_hat)
         self.problem = cp.Problem(cp.Minimize(obj), cons)
         self.term = term
 
     def solve(self, w: float) -> str:
-        """Solve at weight ``w``; the status (retries as in the module docstring)."""
+        """Solve at weight ``w``; the status (retries as in the module docstring).
+
+        The first ``optimal`` attempt is kept; otherwise an ``optimal_inaccurate`` one;
+        ``infeasible`` only when every attempt says so (an interior-point method can
+        misreport a badly scaled feasible problem).
+        """
         import cvxpy as cp
 
-        self.w.value = float(w)
+        self.w.value = float(w) / self.scale
         attempts: list[tuple[str, dict[str, Any]]] = [
             ("CLARABEL", {}),
             ("CLARABEL", {"max_iter": 500, "static_regularization_constant": 1e-7}),
             ("SCS", {"eps": 1e-9, "max_iters": 200_000}),
         ]
-        status = "not solved"
+        seen: list[str] = []
+        inaccurate = None
         for solver, kw in attempts:
             try:
                 with warnings.catch_warnings():  # the status says it; retried below
                     warnings.simplefilter("ignore", UserWarning)
                     self.problem.solve(solver=solver, **kw)
             except (cp.error.SolverError, ArithmeticError, ValueError) as exc:
-                status = f"{solver} failed ({exc})"
+                seen.append(f"{solver}: {exc}")
                 continue
             status = str(self.problem.status)
-            if status in ("optimal", "infeasible", "infeasible_inaccurate"):
+            seen.append(f"{solver}: {status}")
+            if status == "optimal":
+                self._snapshot = self._read()
                 return status
-            if status == "optimal_inaccurate" and solver == attempts[-1][0]:
-                return status
-        if status == "optimal_inaccurate":
-            return status
-        raise SolverError(f"convex retrieval: the solver did not converge (status {status})")
+            if status == "optimal_inaccurate" and inaccurate is None:
+                inaccurate = self._read()
+            if status.startswith("infeasible") and self.equality:
+                return status  # an exact fit with no consistent solution: a real answer
+        if inaccurate is not None:
+            self._snapshot = inaccurate
+            return "optimal_inaccurate"
+        if all(": infeasible" in x for x in seen):
+            return "infeasible"
+        raise SolverError("convex retrieval: the solver did not converge (" + "; ".join(seen) + ")")
+
+    def _read(self) -> tuple[list[NDArray[np.float64]], NDArray[np.float64] | None]:
+        Xs = [np.array(X.value, dtype=float) for X in self.X]
+        f = None if self.f is None else np.array(self.f.value, dtype=float)
+        return Xs, f
 
     def values(self) -> tuple[NDArray[np.float64], NDArray[np.float64] | None]:
         """``phi`` (n, 10) and the friction (k,) at the solution (margins enforced)."""
-        phi = np.stack([self.B[i] @ np.asarray(X.value).reshape(-1) for i, X in enumerate(self.X)])
-        f = None if self.f is None else np.asarray(self.f.value, dtype=float)
+        Xs, f = self._snapshot
+        phi = np.stack([self.B[i] @ X.reshape(-1) for i, X in enumerate(Xs)])
         return _with_margin(phi, self.margin), f
 
 
