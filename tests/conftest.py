@@ -93,16 +93,20 @@ def robot_data_urdf(rel: str) -> str:
     pytest.skip(f"example-robot-data file {rel} not found")
 
 
-def exact_model(robot: dynid.Robot, truth: dynid.Robot) -> IdentifiedModel:
-    """An identified model holding the exact static coefficients of ``truth``."""
+def exact_model(
+    robot: dynid.Robot, truth: dynid.Robot, kept: np.ndarray | None = None
+) -> IdentifiedModel:
+    """An identified model holding the exact static coefficients of ``truth`` (``kept``:
+    the coefficients not pruned; the others are 0)."""
     base = base_parameters(robot, kind="static")
     r = base.rank
+    keep = np.ones(r, bool) if kept is None else np.asarray(kept, dtype=bool)
     fit = LeastSquaresFit(
-        beta=base.beta_from_phi(truth.phi),
+        beta=np.where(keep, base.beta_from_phi(truth.phi), 0.0),
         std=np.zeros(r),
         std_percent=np.zeros(r),
-        kept=np.ones(r, bool),
-        rank=r,
+        kept=keep,
+        rank=int(keep.sum()),
         condition_number=1.0,
         relative_error_percent=0.0,
         residual_rms=0.0,

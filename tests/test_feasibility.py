@@ -37,7 +37,6 @@ from dynid.feasibility.retrieve import (
 )
 from dynid.feasibility.validate import validate_newton_euler
 from dynid.friction.model import SigmoidFriction
-from dynid.identification.least_squares import LeastSquaresFit
 from dynid.identification.model import IdentifiedModel
 from dynid.regressors.base import base_parameters
 
@@ -60,24 +59,7 @@ def _one_link(m: float, I: np.ndarray, c=(0.0, 0.0, 0.0)):
 
 def _noise_free_model(robot: dynid.Robot, kept: np.ndarray | None = None) -> IdentifiedModel:
     """An IdentifiedModel holding the exact coefficients of ``robot``'s own parameters."""
-    base = base_parameters(robot)
-    beta = base.beta_from_phi(robot.phi)
-    r = base.rank
-    keep = np.ones(r, bool) if kept is None else kept
-    fit = LeastSquaresFit(
-        beta=np.where(keep, beta, 0.0),
-        std=np.zeros(r),
-        std_percent=np.zeros(r),
-        kept=keep,
-        rank=int(keep.sum()),
-        condition_number=1.0,
-        relative_error_percent=0.0,
-        residual_rms=0.0,
-        sigma=0.0,
-        n_rows=0,
-        rtol=1e-10,
-    )
-    return IdentifiedModel(robot=robot, base=base, fit=fit)
+    return exact_model(robot, robot, kept=kept)
 
 
 def _torque_rel_error(a: dynid.Robot, model: IdentifiedModel, seed: int) -> float:

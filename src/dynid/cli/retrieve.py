@@ -267,6 +267,17 @@ def write_outputs(
     return files
 
 
+def _load_model(args: argparse.Namespace) -> tuple[IdentifiedModel, Robot]:
+    """The identified model of --model, its robot carrying the friction of --friction."""
+    from ..io.model_json import load_model_json
+
+    model = load_model_json(args.model)
+    robot = _friction_robot(model.robot, args.friction)
+    if robot is not model.robot:
+        model = IdentifiedModel(robot, model.base, model.fit, model.friction, dict(model.metadata))
+    return model, robot
+
+
 def _friction_robot(robot: Robot, path: Path | None) -> Robot:
     if path is None:
         return robot
@@ -299,17 +310,8 @@ def run(args: argparse.Namespace) -> int:
         progress=None if quiet else progress_printer(),
     )
     if args.model is not None:
-        from ..io.model_json import load_model_json
-
-        model = load_model_json(args.model)
-        robot = _friction_robot(model.robot, args.friction)
-        if robot is not model.robot:
-            model = IdentifiedModel(
-                robot, model.base, model.fit, model.friction, dict(model.metadata)
-            )
-        bounds = load_bounds(args.bounds, robot) if args.bounds else default_bounds(robot)
-        if args.no_total_mass:
-            bounds = bounds.with_total_mass(None)
+        model, robot = _load_model(args)
+        bounds = _bounds(args, robot)
         source = str(args.model)
         if not quiet:
             print(
@@ -324,9 +326,7 @@ def run(args: argparse.Namespace) -> int:
 
         robot = _friction_robot(load_robot(args), args.friction)
         data, _ = load_static_data(args.static, robot)
-        bounds = load_bounds(args.bounds, robot) if args.bounds else default_bounds(robot)
-        if args.no_total_mass:
-            bounds = bounds.with_total_mass(None)
+        bounds = _bounds(args, robot)
         source = str(args.static)
         if not quiet:
             print(
@@ -355,14 +355,8 @@ def run_sdp(args: argparse.Namespace) -> int:
     options = sdp_options(args)
     if args.model is not None:
         from ..feasibility.sdp import retrieve_sdp
-        from ..io.model_json import load_model_json
 
-        model = load_model_json(args.model)
-        robot = _friction_robot(model.robot, args.friction)
-        if robot is not model.robot:
-            model = IdentifiedModel(
-                robot, model.base, model.fit, model.friction, dict(model.metadata)
-            )
+        model, robot = _load_model(args)
         prior = load_prior(args, robot)
         source = str(args.model)
         result = retrieve_sdp(

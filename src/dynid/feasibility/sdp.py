@@ -689,6 +689,14 @@ def solve_consistent(
         raise ModelError("the data term has no covariance; use fit='equality'")
     common = (term, pr, lo, hi, nb, band, opts)
     search: list[tuple[float, float]] = []
+
+    def finish(
+        phi: NDArray[np.float64], f: NDArray[np.float64] | None, w: float, fit: str, status: str
+    ) -> ConsistentResult:
+        return _finish(
+            robot, phi, f, term, pr, w, search, nb, band, opts, fit, status, kind, t0, notes
+        )
+
     if equality:
         prob = _Problem(*common, True, False, friction_nonneg, constraints)
         status = prob.solve(1.0)
@@ -698,72 +706,21 @@ def solve_consistent(
                 "bounds; the closest one (least relative coefficient error) is returned"
             )
             prob = _Problem(*common, False, True, friction_nonneg, constraints)
-            st = prob.solve(1.0)
-            if st.startswith("infeasible"):
+            if prob.solve(1.0).startswith("infeasible"):
                 raise InfeasibleError("the bounds and constraints admit no consistent parameters")
-            phi, f = prob.values()
-            return _finish(
-                robot,
-                phi,
-                f,
-                term,
-                pr,
-                1.0,
-                search,
-                nb,
-                band,
-                opts,
-                "equality",
-                "infeasible",
-                kind,
-                t0,
-                notes,
-            )
+            return finish(*prob.values(), 1.0, "equality", "infeasible")
         phi, f = prob.values()
         phi = _polish(phi, term, pr)
         if f is not None:
             f = term.x_hat[term.r :].copy()
-        return _finish(
-            robot,
-            phi,
-            f,
-            term,
-            pr,
-            1.0,
-            search,
-            nb,
-            band,
-            opts,
-            "equality",
-            status,
-            kind,
-            t0,
-            notes,
-        )
+        return finish(phi, f, 1.0, "equality", status)
     prob = _Problem(*common, False, False, friction_nonneg, constraints)
     if opts.prior_weight is not None:
         status = prob.solve(opts.prior_weight)
         if status.startswith("infeasible"):
             raise InfeasibleError("the bounds and constraints admit no consistent parameters")
-        phi, f = prob.values()
-        return _finish(
-            robot,
-            phi,
-            f,
-            term,
-            pr,
-            opts.prior_weight,
-            search,
-            nb,
-            band,
-            opts,
-            "weighted",
-            status,
-            kind,
-            t0,
-            notes,
-        )
-    w, limit, status, phi, f, search = _auto_weight(prob, term, opts)
+        return finish(*prob.values(), opts.prior_weight, "weighted", status)
+    w, limit, status, phi, f, search[:] = _auto_weight(prob, term, opts)
     if limit > 1.0 + opts.residual_increase:
         notes.append(
             f"the data are not consistent with a rigid body within {100 * opts.residual_increase:g}"
@@ -776,9 +733,7 @@ def solve_consistent(
             f"prior weight {w:.3g}: the largest keeping the residual RMS within "
             f"{100 * opts.residual_increase:g} % of the unconstrained fit"
         )
-    return _finish(
-        robot, phi, f, term, pr, w, search, nb, band, opts, "weighted", status, kind, t0, notes
-    )
+    return finish(phi, f, w, "weighted", status)
 
 
 def _auto_weight(
