@@ -356,3 +356,37 @@ def test_identify_consistent_on_a_log_writes_both_models_and_validate_uses_its_f
         val["with_friction"]["relative_error_percent"]
         < val["without_friction"]["relative_error_percent"]
     )
+
+
+def test_consistent_routes_fail_in_one_line_and_write_nothing(tmp_path, capsys):
+    """Rank-deficient static data, a contradictory mass band, a prior of another arm: exit 2,
+    one line, no output folder."""
+    panda = dynid.panda()
+    q = random_states(panda, 1, 24)[0]
+    few = save_static_data(
+        tmp_path / "few.csv",
+        StaticDataset(q, dynid.mass_matrix(panda, q), dynid.gravity_torques(panda, q)),
+    )
+    q = random_states(panda, 60, 25)[0]
+    ok = save_static_data(
+        tmp_path / "ok.csv",
+        StaticDataset(q, dynid.mass_matrix(panda, q), dynid.gravity_torques(panda, q)),
+    )
+    cases = [
+        (["identify", "--data", str(few), "--consistent"], "rank"),
+        (
+            ["identify", "--data", str(ok), "--consistent", "--total-mass", "100,120"],
+            "cannot be met",
+        ),
+        (["retrieve", "--static", str(ok), "--total-mass", "100,120"], "cannot be met"),
+        (
+            ["identify", "--data", str(ok), "--consistent", "--prior", "missing.toml"],
+            "does not exist",
+        ),
+    ]
+    for k, (argv, match) in enumerate(cases):
+        out = tmp_path / f"out{k}"
+        rc = main(argv + ["--out", str(out)])
+        err = capsys.readouterr().err
+        assert rc == 2 and match in err and len(err.strip().splitlines()) == 1, (argv, err)
+        assert not out.exists(), argv
