@@ -125,13 +125,14 @@ def test_urdf_export_without_limits_and_with_a_prismatic_joint(tmp_path):
 
 
 def test_urdf_export_of_a_urdf_robot_with_all_frames(tmp_path):
-    """UR5 from URDF, exported with all its frames, reloads with tip 'flange', same frames."""
+    """UR5 from URDF, exported with all its frames, reloads with its own tip name, same frames."""
     ur5 = dynid.Robot.from_urdf(
         robot_data_urdf("ur_description/urdf/ur5_robot.urdf"), "base_link", "tool0"
     )
     path = save_urdf(tmp_path / "ur5.urdf", ur5, all_frames=True)
-    back = dynid.Robot.from_urdf(path, tip_link="flange")
+    back = dynid.Robot.from_urdf(path, tip_link="tool0")
     np.testing.assert_allclose(back.phi, ur5.phi, atol=1e-15)
+    assert back.link_names == ur5.link_names and back.joint_names == ur5.joint_names
     for name, f in ur5.frames.items():
         g = back.frame(name)
         assert g.link == f.link

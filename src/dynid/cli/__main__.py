@@ -26,6 +26,7 @@ SUBCOMMANDS = (
     "friction",
     "validate",
     "retrieve",
+    "export",
     "demo",
 )
 

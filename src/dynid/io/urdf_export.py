@@ -14,11 +14,15 @@ per joint, keeping the robot's link and joint names:
   limits) or ``prismatic``, ``<limit lower upper effort velocity>``. URDF (urdfdom)
   requires finite ``effort`` and ``velocity`` and a prismatic joint's ``lower``/``upper``:
   a missing (infinite) limit is written as the largest float, ``1.7976931348623157e+308``.
-* the ``flange`` frame becomes a ``fixed`` joint ``<last link>_flange_joint`` to a
-  massless link ``flange`` (unless a link is already named so), so that the file's
-  only leaf is the flange and ``Robot.from_urdf(path)`` needs no ``tip_link``. With
-  ``all_frames=True`` every other named frame is written the same way (then load with
-  ``tip_link="flange"``).
+* the ``flange`` frame (the tip) keeps the source robot's name for it: when the robot
+  was read from a URDF whose tip link is fixed to the last moving link (``panda_link8``),
+  that link is written as a ``fixed`` joint ``<tip>_joint`` to a massless link ``<tip>``;
+  when the tip is the last moving link itself nothing is added; otherwise (an MDH robot)
+  a massless link ``flange`` is added. The file's only leaf is the tip, so
+  ``Robot.from_urdf(path)`` needs no ``tip_link``. With ``all_frames=True`` every other
+  named frame is written the same way (then load with ``tip_link=`` the tip's name).
+* with ``template=`` the original URDF is written back with only the chain's
+  ``<inertial>`` elements replaced (:func:`dynid.io.urdf_patch.patch_urdf_inertials`).
 
 Gravity and friction are not part of URDF and are not written. Numbers use Python's
 shortest round-trip representation, so the parameters read back exactly.
@@ -33,10 +37,12 @@ from xml.sax.saxutils import quoteattr
 import numpy as np
 
 from .. import __version__, spatial
+from ..exceptions import ModelError
 from ..model.inertia import inertia6_from_matrix
 from ..model.robot import Robot
+from .urdf_patch import patch_urdf_inertials
 
-__all__ = ["urdf_from_robot", "save_urdf"]
+__all__ = ["save_urdf", "tip_name", "urdf_from_robot"]
 
 _BIG = sys.float_info.max
 
@@ -63,6 +69,22 @@ def _fixed(name: str, parent: str, T: np.ndarray) -> list[str]:
         "  </joint>",
         f"  <link name={quoteattr(name)}/>",
     ]
+
+
+def tip_name(robot: Robot) -> str | None:
+    """Name of the source link at the ``flange`` frame, None when it is a moving link.
+
+    ``"flange"`` when no other named frame sits there (a robot built from MDH).
+    """
+    f = robot.frame("flange")
+    if f.link == robot.n and np.array_equal(f.T_link_frame, np.eye(4)):
+        return None
+    for name, g in robot.frames.items():
+        if name in ("flange",) or name in robot.link_names:
+            continue
+        if g.link == f.link and np.allclose(g.T_link_frame, f.T_link_frame, atol=1e-12):
+            return name
+    return "flange"
 
 
 def urdf_from_robot(robot: Robot, *, all_frames: bool = False, comment: str | None = None) -> str:
@@ -132,17 +154,62 @@ def urdf_from_robot(robot: Robot, *, all_frames: bool = False, comment: str | No
             "  </link>",
         ]
     names = set(robot.link_names)
-    frames = [("flange", robot.frame("flange"))] if "flange" not in names else []
+    tip = tip_name(robot)
+    frames = [] if tip is None else [(tip, robot.frame("flange"))]
     if all_frames:
-        frames += [(k, f) for k, f in robot.frames.items() if k not in names and k != "flange"]
+        frames += [
+            (k, f) for k, f in robot.frames.items() if k not in names and k not in ("flange", tip)
+        ]
     for name, f in frames:
         lines += _fixed(name, robot.link_names[f.link], f.T_link_frame)
     lines.append("</robot>")
     return "\n".join(lines) + "\n"
 
 
-def save_urdf(path: str | Path, robot: Robot, *, all_frames: bool = False) -> Path:
-    """Write :func:`urdf_from_robot` to ``path``; returns the path."""
+def save_urdf(
+    path: str | Path,
+    robot: Robot,
+    *,
+    all_frames: bool = False,
+    template: str | Path | None = None,
+    base: str | None = None,
+    tip: str | None = None,
+    merged: str = "subtract",
+) -> Path:
+    """Write the robot as URDF to ``path``; returns the path.
+
+    Parameters
+    ----------
+    path : str or Path
+    robot : Robot
+    all_frames : bool
+        Chain export only: also write every named frame (:func:`urdf_from_robot`).
+    template : str or Path, optional
+        The original URDF file: written back with only the chain's ``<inertial>``
+        elements replaced (:func:`dynid.io.urdf_patch.patch_urdf_inertials`, with
+        ``base``, ``tip`` and ``merged``).
+
+    Raises
+    ------
+    ModelError
+        The template cannot be read or its chain does not match the robot's.
+    """
     path = Path(path)
-    path.write_text(urdf_from_robot(robot, all_frames=all_frames), encoding="utf-8")
+    if template is None:
+        text = urdf_from_robot(robot, all_frames=all_frames)
+    else:
+        tpath = Path(template)
+        try:
+            original = tpath.read_text(encoding="utf-8")
+        except OSError as exc:
+            raise ModelError(f"cannot read URDF template {str(tpath)!r}: {exc}") from exc
+        text = patch_urdf_inertials(
+            original,
+            robot,
+            base=base,
+            tip=tip,
+            merged=merged,
+            source=f"URDF template {tpath.name!r}",
+        )
+    path.write_text(text, encoding="utf-8")
     return path

@@ -1,0 +1,99 @@
+"""Write a robot with its (identified, feasible) parameters as URDF, MJCF or TOML.
+
+--params takes feasible.json (from `dynid retrieve`), a robot .toml or 'panda'. The format
+comes from --format or the suffix of --out (.urdf, .xml/.mjcf, .toml).
+
+URDF without a template: the chain with the source robot's link and joint names. With
+--urdf-template ORIGINAL.urdf (and --base/--tip for its chain): the original file written
+back with only the chain's <inertial> elements replaced; names, meshes, other links, the
+gripper and <dynamics> are kept. Links fixed to a moving link (a hand) keep their inertials
+and the moving link gets the rest (--merged subtract, default), or the moving link gets the
+whole body and the fixed links lose their inertials (--merged move).
+
+MJCF (MuJoCo): bodies, hinge/slide joints with ranges, full inertials, gravity, motors, and
+the sigmoid friction approximated as frictionloss + damping (its odd part fitted over the
+velocity range; --no-friction for frictionless joints).
+
+examples:
+  dynid export --params feasible/feasible.json --out panda.xml
+  dynid export --params feasible/feasible.json --out panda.urdf \\
+      --urdf-template panda_original.urdf --base panda_link0 --tip panda_hand
+"""
+
+from __future__ import annotations
+
+import argparse
+from pathlib import Path
+
+from ..exceptions import DynidError
+from ..friction.mujoco import coulomb_viscous_from_sigmoid
+from ..io.export import EXPORT_FORMATS, save_robot
+from ..io.feasible import load_feasible_json
+from ..io.urdf_patch import MERGED_POLICIES
+from ..model.panda import panda
+from ..model.robot import Robot
+
+NAME = "export"
+
+
+def register(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParser:
+    """Add the ``export`` subcommand."""
+    p = subparsers.add_parser(
+        NAME,
+        help="write a robot as URDF (optionally patching the original), MJCF or TOML",
+        description=__doc__,
+        formatter_class=argparse.RawDescriptionHelpFormatter,
+    )
+    p.add_argument("--params", required=True, help="feasible.json, a robot .toml, or 'panda'")
+    p.add_argument("--format", choices=EXPORT_FORMATS, default=None, help="default: by suffix")
+    p.add_argument("--out", type=Path, required=True, help="output file")
+    p.add_argument("--urdf-template", type=Path, default=None, help="the original URDF file")
+    p.add_argument("--base", default=None, help="base link of the template's chain")
+    p.add_argument("--tip", default=None, help="tip link of the template's chain")
+    p.add_argument("--merged", choices=MERGED_POLICIES, default="subtract")
+    p.add_argument("--no-friction", action="store_true", help="MJCF: frictionless joints")
+    p.add_argument("--all-frames", action="store_true", help="URDF chain: every named frame")
+    return p
+
+
+def load_params(spec: str) -> Robot:
+    """The robot of ``--params``: feasible.json, a robot .toml, or ``panda``."""
+    if spec == "panda":
+        return panda()
+    path = Path(spec)
+    suffix = path.suffix.lower()
+    if suffix == ".json":
+        return load_feasible_json(path)
+    if suffix == ".toml":
+        return Robot.from_toml(path)
+    raise DynidError(f"--params must be feasible.json, a robot .toml or 'panda'; got {spec!r}")
+
+
+def run(args: argparse.Namespace) -> int:
+    """Load, write, print a summary; returns the exit code."""
+    robot = load_params(args.params)
+    if args.urdf_template is None and (args.base or args.tip):
+        raise DynidError("--base/--tip choose the chain of --urdf-template; give the template")
+    path = save_robot(
+        args.out,
+        robot,
+        format=args.format,
+        template=args.urdf_template,
+        base=args.base,
+        tip=args.tip,
+        merged=args.merged,
+        friction=not args.no_friction,
+        all_frames=args.all_frames,
+    )
+    print(f"wrote {path}")
+    mjcf = args.format == "mjcf" or path.suffix.lower() in (".xml", ".mjcf")
+    if mjcf and not args.no_friction and robot.friction is not None:
+        approx = coulomb_viscous_from_sigmoid(robot.friction, robot.dq_max)
+        print("friction as MuJoCo holds it (odd part of the sigmoid, fitted up to dq_max):")
+        for j, name in enumerate(robot.joint_names):
+            print(
+                f"  {name}: frictionloss {approx.coulomb[j]:.4g} N m, damping "
+                f"{approx.viscous[j]:.4g} N m s/rad, dropped offset {approx.offset[j]:+.3g} "
+                f"N m, fit RMS {approx.rms_error[j]:.3g} N m"
+            )
+    return 0

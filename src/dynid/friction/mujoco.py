@@ -1,0 +1,102 @@
+"""The sigmoid friction approximated by what MuJoCo's joints hold: Coulomb and viscous.
+
+MuJoCo joints carry a symmetric dry friction ``frictionloss`` [N m] (a constraint, so
+the friction torque lies in ``[-f_c, f_c]`` at rest) and a viscous ``damping``
+[N m s/rad]. The sigmoid of Gaz et al. 2019 (eq. 25, :mod:`dynid.friction.model`) is
+neither: it saturates at ``phi1 (1 - s0)`` for large positive velocities and at
+``-phi1 s0`` for large negative ones, ``s0 = 1 / (1 + exp(-phi2 phi3))``. The
+approximation keeps its odd part,
+
+.. math:: \\tau_{odd}(\\dot q) = (\\tau_f(\\dot q) - \\tau_f(-\\dot q)) / 2
+          \\approx f_c \\, \\mathrm{sign}(\\dot q) + f_v \\dot q,
+
+fitted by non-negative least squares on ``n_points`` velocities spread evenly over
+``(0, dq_max]``. The even part (the offset ``phi1 (1/2 - s0)`` at large speeds and the
+sigmoid's curvature) has no MuJoCo counterpart and is returned as ``offset`` (the
+velocity-independent torque [N m] dropped at large speeds) so that callers can report it.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+import scipy.optimize
+from numpy.typing import ArrayLike, NDArray
+
+from .. import _checks
+from ..exceptions import ShapeError
+from .model import sigmoid_friction
+
+__all__ = ["CoulombViscous", "coulomb_viscous_from_sigmoid"]
+
+
+@dataclass(frozen=True, slots=True)
+class CoulombViscous:
+    """Per-joint Coulomb and viscous friction fitted to a sigmoid.
+
+    Attributes
+    ----------
+    coulomb : ndarray, shape (n,)
+        Dry friction ``f_c`` [N m] (MuJoCo ``frictionloss``).
+    viscous : ndarray, shape (n,)
+        Viscous coefficient ``f_v`` [N m s/rad] (MuJoCo ``damping``).
+    offset : ndarray, shape (n,)
+        Even part of the sigmoid at ``dq_max``, ``(tau_f(dq_max) + tau_f(-dq_max)) / 2``
+        [N m]: what the approximation drops.
+    rms_error : ndarray, shape (n,)
+        RMS difference between the odd part of the sigmoid and the fit over the grid [N m].
+    dq_max : ndarray, shape (n,)
+        Upper end of the velocity grid [rad/s].
+    """
+
+    coulomb: NDArray[np.float64]
+    viscous: NDArray[np.float64]
+    offset: NDArray[np.float64]
+    rms_error: NDArray[np.float64]
+    dq_max: NDArray[np.float64]
+
+
+def coulomb_viscous_from_sigmoid(
+    friction: ArrayLike, dq_max: ArrayLike, *, n_points: int = 200
+) -> CoulombViscous:
+    """Fit ``f_c sign(dq) + f_v dq`` to the odd part of sigmoid friction, per joint.
+
+    Parameters
+    ----------
+    friction : array_like, shape (n, 3)
+        Sigmoid parameters ``phi1 [N m], phi2 [s/rad], phi3 [rad/s]`` per joint.
+    dq_max : array_like, shape (n,)
+        Velocity range of the fit [rad/s] per joint; non-finite entries use 2 rad/s.
+    n_points : int
+        Grid points per joint in ``(0, dq_max]``.
+
+    Returns
+    -------
+    CoulombViscous
+        ``coulomb >= 0`` and ``viscous >= 0`` (non-negative least squares).
+
+    Raises
+    ------
+    ShapeError
+        ``friction`` is not (n, 3) or ``dq_max`` not (n,).
+    """
+    f = _checks.as_array("friction", friction)
+    if f.ndim != 2 or f.shape[1] != 3:
+        raise ShapeError(f"friction must have shape (n, 3); got {f.shape}")
+    n = f.shape[0]
+    vmax = _checks.as_exact("dq_max", dq_max, (n,), allow_nonfinite=True)
+    vmax = np.where(np.isfinite(vmax) & (vmax > 0), vmax, 2.0)
+    coulomb, viscous, offset, rms = (np.zeros(n) for _ in range(4))
+    for j in range(n):
+        v = np.linspace(vmax[j] / n_points, vmax[j], n_points)
+        p1, p2, p3 = f[j]
+        up = sigmoid_friction(v, p1, p2, p3)
+        down = sigmoid_friction(-v, p1, p2, p3)
+        odd = (up - down) / 2.0
+        A = np.stack([np.ones_like(v), v], axis=1)
+        x, _ = scipy.optimize.nnls(A, odd)
+        coulomb[j], viscous[j] = x
+        offset[j] = (up[-1] + down[-1]) / 2.0
+        rms[j] = float(np.sqrt(np.mean((A @ x - odd) ** 2)))
+    return CoulombViscous(coulomb, viscous, offset, rms, vmax)

@@ -1,0 +1,94 @@
+"""One entry point for writing a robot description: URDF, MJCF or dynid TOML.
+
+:func:`save_robot` picks the writer by ``format`` (or the file suffix: ``.urdf``;
+``.xml``/``.mjcf``; ``.toml``) and passes its options on:
+
+* URDF: :func:`dynid.io.urdf_export.save_urdf` (chain export, or ``template=`` the
+  original URDF patched with the new inertials);
+* MJCF: :func:`dynid.io.mjcf_export.save_mjcf` (``friction`` as ``frictionloss`` and
+  ``damping``);
+* TOML: :meth:`dynid.Robot.to_toml` (kinematics, inertials, limits, sigmoid friction).
+
+``dynid export``, ``dynid retrieve`` and ``identify --consistent`` write through it.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+from ..exceptions import DataError
+from ..model.robot import Robot
+from .mjcf_export import save_mjcf
+from .urdf_export import save_urdf
+
+__all__ = ["EXPORT_FORMATS", "export_format", "save_mjcf", "save_robot", "save_urdf"]
+
+EXPORT_FORMATS = ("urdf", "mjcf", "toml")
+_BY_SUFFIX = {".urdf": "urdf", ".xml": "mjcf", ".mjcf": "mjcf", ".toml": "toml"}
+
+
+def export_format(path: str | Path, format: str | None = None) -> str:
+    """The export format: ``format`` when given, else from the suffix of ``path``.
+
+    Raises
+    ------
+    DataError
+        Unknown format, or a suffix that names none.
+    """
+    if format is not None:
+        if format not in EXPORT_FORMATS:
+            raise DataError(f"format must be one of {EXPORT_FORMATS}; got {format!r}")
+        return format
+    suffix = Path(path).suffix.lower()
+    if suffix not in _BY_SUFFIX:
+        raise DataError(
+            f"cannot tell the format of {Path(path).name!r} from its suffix; "
+            f"use .urdf, .xml/.mjcf or .toml, or give the format ({EXPORT_FORMATS})"
+        )
+    return _BY_SUFFIX[suffix]
+
+
+def save_robot(
+    path: str | Path,
+    robot: Robot,
+    *,
+    format: str | None = None,
+    template: str | Path | None = None,
+    base: str | None = None,
+    tip: str | None = None,
+    merged: str = "subtract",
+    friction: bool = True,
+    all_frames: bool = False,
+) -> Path:
+    """Write ``robot`` as URDF, MJCF or TOML; returns the path.
+
+    Parameters
+    ----------
+    path : str or Path
+    robot : Robot
+    format : {"urdf", "mjcf", "toml"}, optional
+        Default: from the suffix of ``path``.
+    template, base, tip, merged, all_frames
+        URDF only (:func:`dynid.io.urdf_export.save_urdf`).
+    friction : bool
+        MJCF only: write the robot's friction (:func:`dynid.io.mjcf_export.save_mjcf`).
+
+    Raises
+    ------
+    DataError
+        Unknown format; a URDF template given for another format.
+    ModelError
+        The template's chain does not match the robot.
+    """
+    fmt = export_format(path, format)
+    if template is not None and fmt != "urdf":
+        raise DataError(f"a URDF template applies to the urdf format only; got format {fmt!r}")
+    if fmt == "urdf":
+        return save_urdf(
+            path, robot, all_frames=all_frames, template=template, base=base, tip=tip, merged=merged
+        )
+    if fmt == "mjcf":
+        return save_mjcf(path, robot, friction=friction)
+    path = Path(path)
+    robot.to_toml(path)
+    return path

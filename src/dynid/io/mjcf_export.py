@@ -1,0 +1,145 @@
+"""Export a robot as MJCF, MuJoCo's model format.
+
+:func:`mjcf_from_robot` writes one nested ``<body>`` per link under ``<worldbody>``,
+keeping the robot's link and joint names:
+
+* the base link is a body fixed to the world at the origin (the base frame is MuJoCo's
+  world frame); body ``i`` sits at ``T_parent_joint[i]`` in its parent (``pos`` [m],
+  ``quat`` ``w x y z``) and holds joint ``i``: ``hinge`` (revolute) or ``slide``
+  (prismatic) about/along ``axis`` in the body frame, with ``range`` [rad or m] when both
+  position limits are finite (``<compiler angle="radian" autolimits="true"/>``);
+* ``<inertial pos="c" mass="m" fullinertia="xx yy zz xy xz yz"/>``: CoM [m] in the link
+  frame and the inertia about the CoM in link axes [kg m^2] (MuJoCo's ``fullinertia``
+  order);
+* every named frame that is not a link (``flange``, tools) becomes a ``<site>``;
+* ``<option gravity>`` is the robot's gravity [m/s^2]; one ``<motor>`` per joint with
+  ``ctrlrange`` = the torque limit when it is finite (gear 1, so ``ctrl`` is the joint
+  torque [N m]);
+* friction (``friction=True`` and a sigmoid on the robot): the sigmoid's odd part fitted
+  as ``frictionloss`` [N m] + ``damping`` [N m s/rad]
+  (:func:`dynid.friction.mujoco.coulomb_viscous_from_sigmoid`; an approximation: MuJoCo
+  cannot hold the sigmoid's offset and curvature). With ``friction=False`` the joints are
+  frictionless, and ``mj_inverse`` equals :func:`dynid.rnea`.
+
+Numbers use Python's shortest round-trip representation.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+from xml.sax.saxutils import quoteattr
+
+import numpy as np
+from scipy.spatial.transform import Rotation
+
+from .. import __version__
+from ..friction.mujoco import CoulombViscous, coulomb_viscous_from_sigmoid
+from ..model.inertia import inertia6_from_matrix
+from ..model.robot import Robot
+
+__all__ = ["mjcf_from_robot", "save_mjcf"]
+
+
+def _f(x: float) -> str:
+    x = float(x)
+    return "0" if x == 0.0 else repr(x)
+
+
+def _v(v: np.ndarray) -> str:
+    return " ".join(_f(x) for x in v)
+
+
+def _pose(T: np.ndarray) -> str:
+    """``pos`` and ``quat`` (w x y z) attributes of a pose (4, 4)."""
+    x, y, z, w = Rotation.from_matrix(T[:3, :3]).as_quat()
+    return f'pos="{_v(T[:3, 3])}" quat="{_v(np.array([w, x, y, z]))}"'
+
+
+def mjcf_from_robot(
+    robot: Robot, *, friction: bool = True, comment: str | None = None
+) -> tuple[str, CoulombViscous | None]:
+    """The MJCF document of a robot, and the friction approximation it holds.
+
+    Parameters
+    ----------
+    robot : Robot
+    friction : bool
+        Write the robot's sigmoid friction (if any) as ``frictionloss`` and ``damping``.
+    comment : str, optional
+        Text of an XML comment at the top (default: the writer and the conventions).
+
+    Returns
+    -------
+    text : str
+        The MJCF XML text.
+    approximation : CoulombViscous or None
+        The fitted friction written to the joints, or None when none was written.
+    """
+    n = robot.n
+    approx = None
+    if friction and robot.friction is not None:
+        approx = coulomb_viscous_from_sigmoid(robot.friction, robot.dq_max)
+    I6 = inertia6_from_matrix(robot.inertia)[:, [0, 3, 5, 1, 2, 4]]  # xx yy zz xy xz yz
+    mass, com = robot.mass, robot.com
+    text = comment or (
+        f"written by dynid {__version__}: inertials about the CoM in link axes [kg, m, kg m^2]"
+        + (
+            "; friction: odd part of the sigmoid as frictionloss + damping (approximation)"
+            if approx is not None
+            else "; frictionless joints"
+        )
+    )
+    sites: dict[int, list[str]] = {}
+    links = set(robot.link_names)
+    for name, fr in robot.frames.items():
+        if name in links:
+            continue
+        sites.setdefault(fr.link, []).append(
+            f'<site name={quoteattr(name)} {_pose(fr.T_link_frame)} size="0.005"/>'
+        )
+    lines = [
+        '<?xml version="1.0"?>',
+        f"<!-- {text.replace('--', '- -')} -->",
+        f"<mujoco model={quoteattr(robot.name)}>",
+        '  <compiler angle="radian" autolimits="true"/>',
+        f'  <option gravity="{_v(robot.gravity)}"/>',
+        "  <worldbody>",
+        f'    <body name={quoteattr(robot.link_names[0])} pos="0 0 0">',
+    ]
+    lines += ["      " + s for s in sites.get(0, [])]
+    for i in range(n):
+        ind = "    " + "  " * (i + 2)
+        kind = "slide" if robot.prismatic[i] else "hinge"
+        attrs = f'name={quoteattr(robot.joint_names[i])} type="{kind}" axis="{_v(robot.axes[i])}"'
+        lo, hi = robot.q_min[i], robot.q_max[i]
+        if np.isfinite(lo) and np.isfinite(hi):
+            attrs += f' range="{_f(lo)} {_f(hi)}"'
+        if approx is not None:
+            attrs += f' frictionloss="{_f(approx.coulomb[i])}" damping="{_f(approx.viscous[i])}"'
+        lines += [
+            f"{ind[:-2]}<body name={quoteattr(robot.link_names[i + 1])} "
+            f"{_pose(robot.T_parent_joint[i])}>",
+            f"{ind}<joint {attrs}/>",
+            f'{ind}<inertial pos="{_v(com[i])}" mass="{_f(mass[i])}" fullinertia="{_v(I6[i])}"/>',
+        ]
+        lines += [ind + s for s in sites.get(i + 1, [])]
+    for i in reversed(range(n)):
+        lines.append("    " + "  " * (i + 1) + "</body>")
+    lines += ["    </body>", "  </worldbody>", "  <actuator>"]
+    for i in range(n):
+        t = robot.tau_max[i]
+        rng = f' ctrlrange="{_f(-t)} {_f(t)}"' if np.isfinite(t) else ""
+        lines.append(
+            f"    <motor name={quoteattr(robot.joint_names[i] + '_motor')} "
+            f'joint={quoteattr(robot.joint_names[i])} gear="1"{rng}/>'
+        )
+    lines += ["  </actuator>", "</mujoco>"]
+    return "\n".join(lines) + "\n", approx
+
+
+def save_mjcf(path: str | Path, robot: Robot, *, friction: bool = True) -> Path:
+    """Write :func:`mjcf_from_robot` to ``path``; returns the path."""
+    path = Path(path)
+    text, _ = mjcf_from_robot(robot, friction=friction)
+    path.write_text(text, encoding="utf-8")
+    return path

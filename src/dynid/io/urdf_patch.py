@@ -1,0 +1,254 @@
+"""Write a robot's link inertials back into the URDF it came from (a template).
+
+:func:`patch_urdf_inertials` takes the original URDF text and replaces only the
+``<inertial>`` elements of the chain's moving links between ``base`` and ``tip``; every
+other byte is kept (names, meshes, other links, a gripper, ``<dynamics>``, comments,
+formatting). The robot's link ``k`` must be the chain's moving link ``k``: the same
+number of joints and the same joint frames and axes (checked to 1e-9 m/rad).
+
+Merged fixed links. dynid lumps links fixed to moving link ``k`` (``panda_link8``, a
+hand) into body ``k`` (:mod:`dynid.model.urdf`). Two ways to write body ``k`` back:
+
+* ``merged="subtract"`` (default): the fixed links keep their inertials and the moving
+  link gets the rest, ``phi_k - sum(phi_fixed)`` (a :class:`DynidWarning` when that rest
+  is not physically consistent: the identified body is lighter than the template's
+  fixed links);
+* ``merged="move"``: the moving link gets all of ``phi_k`` and the ``<inertial>`` of each
+  fixed link merged into body ``k`` is removed.
+
+Either way the template read back between the same ``base`` and ``tip`` gives exactly the
+robot's ``phi`` (checked before returning). Links fixed to the base, and links reached
+through joints off the chain (fingers), are left as they are.
+
+Inertials are written as ``<origin xyz="c" rpy="0 0 0"/>`` (CoM in the link frame [m]),
+``<mass>`` [kg] and ``<inertia>`` about the CoM in link axes [kg m^2].
+"""
+
+from __future__ import annotations
+
+import re
+import warnings
+import xml.etree.ElementTree as ET
+
+import numpy as np
+from numpy.typing import NDArray
+
+from .. import spatial
+from ..exceptions import DynidWarning, ModelError
+from ..model.inertia import inertia6_from_matrix, inertial_from_phi, phi_from_inertial
+from ..model.robot import Robot
+from ..model.urdf import robot_from_urdf_string
+
+__all__ = ["MERGED_POLICIES", "patch_urdf_inertials"]
+
+MERGED_POLICIES = ("subtract", "move")
+
+_LINK = re.compile(r"<link\b[^>]*?\bname\s*=\s*([\"'])(.*?)\1[^>]*?(/?)>", re.S)
+_INERTIAL = re.compile(r"<inertial\b[^>]*?/>|<inertial\b.*?</inertial>", re.S)
+_COMMENT = re.compile(r"<!--.*?-->", re.S)
+_ATTRS = ("ixx", "ixy", "ixz", "iyy", "iyz", "izz")
+
+
+def _f(x: float) -> str:
+    x = float(x)
+    return "0" if x == 0.0 else repr(x)
+
+
+def _v(v: NDArray[np.float64]) -> str:
+    return " ".join(_f(x) for x in v)
+
+
+def _own_phi(elem: ET.Element) -> NDArray[np.float64]:
+    """Standard parameters (10,) of a link's own ``<inertial>`` in the link frame (0 if none)."""
+    inertial = elem.find("inertial")
+    if inertial is None:
+        return np.zeros(10)
+    o = inertial.find("origin")
+    get = (lambda a: None) if o is None else o.get
+    xyz = [float(x) for x in (get("xyz") or "0 0 0").split()]
+    rpy = [float(x) for x in (get("rpy") or "0 0 0").split()]
+    R = spatial.matrix_from_rpy(rpy)
+    m_el = inertial.find("mass")
+    m = float(m_el.get("value", "0")) if m_el is not None else 0.0
+    i_el = inertial.find("inertia")
+    I6 = [float(i_el.get(a, "0")) if i_el is not None else 0.0 for a in _ATTRS]
+    xx, xy, xz, yy, yz, zz = I6
+    I = np.array([[xx, xy, xz], [xy, yy, yz], [xz, yz, zz]])
+    return phi_from_inertial(m, np.asarray(xyz, dtype=float), R @ I @ R.T)
+
+
+def _inertial_xml(phi: NDArray[np.float64], indent: str, step: str) -> str:
+    m, c, I = inertial_from_phi(phi)
+    i6 = inertia6_from_matrix(I)
+    inner = indent + step
+    attrs = " ".join(f'{a}="{_f(x)}"' for a, x in zip(_ATTRS, i6, strict=True))
+    return (
+        f'<inertial>\n{inner}<origin xyz="{_v(c)}" rpy="0 0 0"/>\n'
+        f'{inner}<mass value="{_f(m)}"/>\n{inner}<inertia {attrs}/>\n{indent}</inertial>'
+    )
+
+
+def _line_indent(text: str, pos: int) -> str:
+    start = text.rfind("\n", 0, pos) + 1
+    lead = text[start:pos]
+    return lead if lead.strip() == "" else ""
+
+
+def _link_spans(text: str) -> dict[str, tuple[int, int, int, bool]]:
+    """Link name -> (start, end of opening tag, end of element, self-closing), comments masked."""
+    masked = _COMMENT.sub(lambda m: " " * len(m.group(0)), text)
+    spans = {}
+    for m in _LINK.finditer(masked):
+        if m.group(3) == "/":
+            spans[m.group(2)] = (m.start(), m.end(), m.end(), True)
+        else:
+            end = masked.find("</link>", m.end())
+            if end < 0:
+                raise ModelError(f"link {m.group(2)!r} has no closing </link>")
+            spans[m.group(2)] = (m.start(), m.end(), end, False)
+    return spans
+
+
+def _check_same_chain(robot: Robot, chain: Robot, source: str) -> None:
+    if robot.n != chain.n:
+        raise ModelError(
+            f"{source}: the chain has {chain.n} moving joints, the robot {robot.n}; "
+            "choose --base/--tip so that the chains match"
+        )
+    for i in range(robot.n):
+        same = np.allclose(robot.T_parent_joint[i], chain.T_parent_joint[i], atol=1e-9) and (
+            np.allclose(robot.axes[i], chain.axes[i], atol=1e-9)
+            and bool(robot.prismatic[i]) == bool(chain.prismatic[i])
+        )
+        if not same:
+            raise ModelError(
+                f"{source}: joint {chain.joint_names[i]!r} has another frame, axis or type "
+                f"than the robot's joint {robot.joint_names[i]!r}; the inertials would be in "
+                "different link frames"
+            )
+
+
+def patch_urdf_inertials(
+    template: str,
+    robot: Robot,
+    *,
+    base: str | None = None,
+    tip: str | None = None,
+    merged: str = "subtract",
+    source: str = "URDF template",
+) -> str:
+    """The template URDF with the chain's link inertials replaced by the robot's.
+
+    Parameters
+    ----------
+    template : str
+        The original URDF text.
+    robot : Robot
+        The robot whose ``phi`` (n, 10) is written; its chain must match the template's.
+    base, tip : str, optional
+        Chain of the template (defaults as in :func:`dynid.model.urdf.robot_from_urdf`).
+    merged : {"subtract", "move"}
+        How body ``k`` is split over the moving link and the fixed links merged into it
+        (module docstring).
+    source : str
+        Name of the template in messages.
+
+    Returns
+    -------
+    str
+        The patched URDF text.
+
+    Raises
+    ------
+    ModelError
+        Malformed template, chains that do not match, an unknown ``merged`` policy.
+    UnknownNameError
+        ``base`` or ``tip`` is not a link of the template.
+
+    Warns
+    -----
+    DynidWarning
+        ``merged="subtract"`` leaves a moving link with an inconsistent inertial.
+    """
+    if merged not in MERGED_POLICIES:
+        raise ModelError(f"merged must be one of {MERGED_POLICIES}; got {merged!r}")
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", DynidWarning)  # the template's own inertials
+        chain = robot_from_urdf_string(template, base, tip, source=source)
+    _check_same_chain(robot, chain, source)
+    root = ET.fromstring(template)
+    elems = {el.get("name"): el for el in root if el.tag.rsplit("}", 1)[-1] == "link"}
+    spans = _link_spans(template)
+    moving = set(chain.link_names[1:])
+    new_xml: dict[str, str | None] = {}  # link -> inertial text, None: remove it
+    for k in range(1, robot.n + 1):
+        link = chain.link_names[k]
+        own = _own_phi(elems[link])
+        if merged == "subtract":
+            phi = robot.phi[k - 1] - (chain.phi[k - 1] - own)
+            _warn_if_inconsistent(link, phi)
+        else:
+            phi = np.array(robot.phi[k - 1])
+            for name, fr in chain.frames.items():
+                if fr.link == k and name in elems and name not in moving:
+                    if elems[name].find("inertial") is not None:
+                        new_xml[name] = None
+        new_xml[link] = phi  # type: ignore[assignment]
+    edits: list[tuple[int, int, str]] = []
+    for link, phi in new_xml.items():
+        start, open_end, end, closed = spans[link]
+        body = template[open_end:end]
+        masked = _COMMENT.sub(lambda m: " " * len(m.group(0)), body)
+        found = _INERTIAL.search(masked)
+        if phi is None:
+            if found is not None:
+                a, b = open_end + found.start(), open_end + found.end()
+                line_start = template.rfind("\n", 0, a)
+                if _line_indent(template, a) and line_start >= 0:
+                    a = line_start
+                edits.append((a, b, ""))
+            continue
+        link_indent = _line_indent(template, start)
+        if found is not None:
+            a = open_end + found.start()
+            indent = _line_indent(template, a) or link_indent + "  "
+            step = _indent_step(indent, link_indent)
+            edits.append((a, open_end + found.end(), _inertial_xml(phi, indent, step)))
+        elif closed:
+            indent = link_indent + "  "
+            tag = template[start:open_end]
+            opening = tag[:-2].rstrip() + ">"
+            xml = _inertial_xml(phi, indent, "  ")
+            edits.append((start, open_end, f"{opening}\n{indent}{xml}\n{link_indent}</link>"))
+        else:
+            indent = link_indent + "  "
+            xml = _inertial_xml(phi, indent, "  ")
+            edits.append((open_end, open_end, f"\n{indent}{xml}"))
+    out = template
+    for a, b, s in sorted(edits, reverse=True):
+        out = out[:a] + s + out[b:]
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", DynidWarning)
+        back = robot_from_urdf_string(out, base, tip, source=source)
+    scale = max(float(np.max(np.abs(robot.phi))), 1e-300)
+    if not np.allclose(back.phi, robot.phi, rtol=1e-9, atol=1e-12 * scale):
+        raise ModelError(f"{source}: the patched inertials do not read back as the robot's")
+    return out
+
+
+def _indent_step(indent: str, link_indent: str) -> str:
+    step = indent[len(link_indent) :] if indent.startswith(link_indent) else ""
+    return step or "  "
+
+
+def _warn_if_inconsistent(link: str, phi: NDArray[np.float64]) -> None:
+    m, _, I = inertial_from_phi(phi)
+    lam = np.linalg.eigvalsh(I)
+    if m <= 0 or lam[0] < 0 or lam[0] + lam[1] < lam[2]:
+        warnings.warn(
+            f"link {link!r}: the identified body minus the template's fixed links is not "
+            f"physically consistent (mass {float(m):.6g} kg, principal moments {lam.tolist()}); "
+            "use merged='move' to put the whole body on the moving link",
+            DynidWarning,
+            stacklevel=3,
+        )

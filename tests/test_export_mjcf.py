@@ -1,0 +1,140 @@
+"""MJCF export: MuJoCo loads it and its inverse dynamics equal dynid's RNEA; friction fit.
+
+References: MuJoCo's ``mj_inverse`` (an independent implementation of rigid-body inverse
+dynamics) on the exported file; the closed form of a step-like sigmoid's odd part.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+import dynid
+from dynid.exceptions import DataError, ShapeError
+from dynid.friction.mujoco import coulomb_viscous_from_sigmoid
+from dynid.io.export import export_format, save_robot
+from dynid.io.mjcf_export import mjcf_from_robot, save_mjcf
+
+from conftest import planar_2r, random_states
+
+mujoco = pytest.importorskip("mujoco")
+
+
+def _mj_inverse(model, q, dq, ddq):
+    data = mujoco.MjData(model)
+    out = np.empty_like(q)
+    for s in range(q.shape[0]):
+        data.qpos[:], data.qvel[:], data.qacc[:] = q[s], dq[s], ddq[s]
+        mujoco.mj_inverse(model, data)
+        out[s] = data.qfrc_inverse
+    return out
+
+
+def _rpp_robot() -> dynid.Robot:
+    """A 3-joint arm with two prismatic joints, tilted gravity and off-axis inertials."""
+    rng = np.random.default_rng(7)
+    mass = np.array([2.0, 1.5, 0.7])
+    sides = rng.uniform(0.05, 0.3, (3, 3))  # solid boxes [m], rotated at random
+    box = mass[:, None] / 12 * (np.sum(sides**2, axis=1, keepdims=True) - sides**2)
+    R = np.linalg.qr(rng.normal(size=(3, 3, 3)))[0]
+    inertia = R @ (box[:, :, None] * np.eye(3)) @ np.swapaxes(R, 1, 2)
+    return dynid.Robot.from_mdh(
+        [0.0, 0.2, 0.1],
+        [0.3, 0.1, 0.05],
+        [0.0, -np.pi / 2, np.pi / 2],
+        [0.1, 0.2, -0.3],
+        joint_types="RPP",
+        flange=(0.0, 0.1, 0.0, 0.0),
+        mass=mass,
+        com=rng.normal(scale=0.05, size=(3, 3)),
+        inertia=inertia,
+        q_min=[-2.0, -0.2, -0.1],
+        q_max=[2.0, 0.3, 0.2],
+        gravity=(0.5, -1.0, -9.7),
+        name="rpp",
+    )
+
+
+@pytest.mark.parametrize("make", [dynid.panda, planar_2r, _rpp_robot])
+def test_mj_inverse_equals_rnea_at_random_states(make, tmp_path):
+    """MuJoCo's mj_inverse on the frictionless export equals dynid rnea to 1e-9 relative."""
+    robot = make()
+    path = save_mjcf(tmp_path / "robot.xml", robot, friction=False)
+    model = mujoco.MjModel.from_xml_path(str(path))
+    assert model.nv == robot.n
+    np.testing.assert_allclose(model.opt.gravity, robot.gravity, rtol=0, atol=0)
+    q, dq, ddq = random_states(robot, 100, seed=3)
+    tau_mj = _mj_inverse(model, q, dq, ddq)
+    tau = dynid.rnea(robot, q, dq, ddq)
+    scale = np.max(np.abs(tau), axis=1, keepdims=True)
+    assert np.max(np.abs(tau_mj - tau) / scale) < 1e-9
+
+
+def test_mjcf_keeps_names_limits_and_flange_site(tmp_path):
+    """Bodies and joints carry the robot's names; ranges are the limits; flange is a site."""
+    robot = dynid.panda()
+    model = mujoco.MjModel.from_xml_path(str(save_mjcf(tmp_path / "p.xml", robot)))
+    for i, name in enumerate(robot.joint_names):
+        j = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_JOINT, name)
+        assert j == i
+        np.testing.assert_allclose(model.jnt_range[j], [robot.q_min[i], robot.q_max[i]])
+        assert model.jnt_limited[j]
+    for name in robot.link_names:
+        assert mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_BODY, name) >= 0
+    data = mujoco.MjData(model)
+    q = dynid.PANDA_NEUTRAL_Q
+    data.qpos[:] = q
+    mujoco.mj_kinematics(model, data)
+    site = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_SITE, "flange")
+    np.testing.assert_allclose(data.site_xpos[site], dynid.fk(robot, q)[:3, 3], atol=1e-12)
+    np.testing.assert_allclose(model.actuator_ctrlrange[:, 1], robot.tau_max)
+
+
+def test_mjcf_friction_is_the_fitted_approximation(tmp_path):
+    """Joint frictionloss and damping in MuJoCo are the Coulomb/viscous fit of the sigmoid."""
+    robot = dynid.panda()
+    text, approx = mjcf_from_robot(robot)
+    model = mujoco.MjModel.from_xml_string(text)
+    np.testing.assert_allclose(model.dof_frictionloss, approx.coulomb, rtol=1e-15)
+    np.testing.assert_allclose(model.dof_damping, approx.viscous, rtol=1e-15)
+    assert np.all(approx.coulomb > 0)
+    _, none = mjcf_from_robot(robot, friction=False)
+    assert none is None
+
+
+def test_sigmoid_fit_of_a_step_is_coulomb():
+    """A steep sigmoid centred at zero velocity has odd part phi1/2 sign(dq): f_c = phi1/2."""
+    friction = np.array([[2.0, 1e6, 0.0], [0.6, 1e6, 0.0]])
+    fit = coulomb_viscous_from_sigmoid(friction, [2.0, np.inf])
+    np.testing.assert_allclose(fit.coulomb, [1.0, 0.3], rtol=1e-9)
+    np.testing.assert_allclose(fit.viscous, 0.0, atol=1e-9)
+    np.testing.assert_allclose(fit.offset, 0.0, atol=1e-9)
+    np.testing.assert_allclose(fit.dq_max, [2.0, 2.0])
+
+
+def test_sigmoid_fit_offset_is_the_even_part():
+    """A shifted sigmoid saturates at phi1(1-s0) and -phi1 s0: the dropped offset is their mean."""
+    p1, p2, p3 = 1.5, 1e3, 0.2
+    s0 = 1.0 / (1.0 + np.exp(-p2 * p3))
+    fit = coulomb_viscous_from_sigmoid([[p1, p2, p3]], [2.0])
+    np.testing.assert_allclose(fit.offset, [p1 * (0.5 - s0)], rtol=1e-9)
+
+
+def test_sigmoid_fit_rejects_bad_shapes():
+    """friction must be (n, 3)."""
+    with pytest.raises(ShapeError, match="friction must have shape"):
+        coulomb_viscous_from_sigmoid(np.zeros((2, 2)), [1.0, 1.0])
+
+
+def test_export_format_by_suffix_and_errors(tmp_path):
+    """The format follows the suffix; an unknown suffix or a template for MJCF is refused."""
+    assert export_format("a.urdf") == "urdf" and export_format("a.xml") == "mjcf"
+    assert export_format("a.toml") == "toml" and export_format("a.txt", "mjcf") == "mjcf"
+    with pytest.raises(DataError, match="cannot tell the format"):
+        export_format("robot.txt")
+    with pytest.raises(DataError, match="format must be one of"):
+        export_format("robot.txt", "sdf")
+    with pytest.raises(DataError, match="URDF template applies"):
+        save_robot(tmp_path / "a.xml", dynid.panda(), template=tmp_path / "t.urdf")
+    path = save_robot(tmp_path / "a.toml", dynid.panda())
+    np.testing.assert_allclose(dynid.Robot.from_toml(path).phi, dynid.panda().phi, rtol=1e-15)

@@ -1,0 +1,191 @@
+"""URDF export that fits the user's files: template patching and the chain export's names.
+
+Reference: Pinocchio (``buildModelFromUrdf``, CRBA, generalized gravity) on the patched
+template and on the chain export; the template's own text for what must be kept.
+"""
+
+from __future__ import annotations
+
+import re
+import warnings
+
+import numpy as np
+import pytest
+
+import dynid
+from dynid.cli.__main__ import main
+from dynid.exceptions import DynidWarning, ModelError
+from dynid.io.urdf_export import save_urdf, urdf_from_robot
+from dynid.io.urdf_patch import patch_urdf_inertials
+from dynid.model.urdf import robot_from_urdf_string
+
+from conftest import pinocchio_panda_urdf, random_states, robot_data_urdf
+
+_INERTIAL = re.compile(r"<inertial\b.*?</inertial>", re.S)
+_FINGERS = ("panda_finger_joint1", "panda_finger_joint2")
+
+
+def _template_chain():
+    path = pinocchio_panda_urdf()
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", DynidWarning)
+        chain = dynid.Robot.from_urdf(path, "panda_link0", "panda_hand")
+    return path, chain
+
+
+def _identified(chain, seed):
+    """The template's chain with every body scaled by a factor in [1, 1.3] (stays consistent)."""
+    rng = np.random.default_rng(seed)
+    return chain.with_params(chain.phi * rng.uniform(1.0, 1.3, (chain.n, 1)))
+
+
+def _pin_M_g(path, q, lock=()):
+    pin = pytest.importorskip("pinocchio")
+    model = pin.buildModelFromUrdf(str(path))
+    if lock:
+        ids = [model.getJointId(name) for name in lock]
+        model = pin.buildReducedModel(model, ids, pin.neutral(model))
+    model.gravity.linear = np.array([0.0, 0.0, -9.80665])  # dynid's default
+    data = model.createData()
+    M = np.stack([pin.crba(model, data, qv) for qv in q])
+    M = np.triu(M) + np.swapaxes(np.triu(M, 1), -1, -2)
+    g = np.stack([pin.computeGeneralizedGravity(model, data, qv) for qv in q])
+    return M, g
+
+
+def test_patched_template_keeps_every_link_joint_and_mesh(tmp_path):
+    """Only the chain's <inertial> elements change; links, joints, meshes, dynamics stay."""
+    path, chain = _template_chain()
+    text = open(path).read()
+    new = _identified(chain, seed=1)
+    out = save_urdf(tmp_path / "p.urdf", new, template=path, base="panda_link0", tip="panda_hand")
+    patched = out.read_text()
+    assert _INERTIAL.sub("", patched) == _INERTIAL.sub("", text)
+    for pattern in (r'<link name="([^"]+)"', r'<joint name="([^"]+)"', r'filename="([^"]+)"'):
+        assert re.findall(pattern, patched) == re.findall(pattern, text)
+    assert patched.count("<dynamics") == text.count("<dynamics") > 0
+    changed = [
+        a != b for a, b in zip(_INERTIAL.findall(text), _INERTIAL.findall(patched), strict=True)
+    ]
+    assert sum(changed) == 7  # panda_link1..7; hand, link8, fingers untouched
+
+
+def test_patched_template_gives_pinocchio_the_chain_exports_dynamics(tmp_path):
+    """Pinocchio: M, g change from the template to the patch exactly as between chain exports."""
+    path, chain = _template_chain()
+    new = _identified(chain, seed=2)
+    patched = save_urdf(
+        tmp_path / "p.urdf", new, template=path, base="panda_link0", tip="panda_hand"
+    )
+    q, _, _ = random_states(chain, 50, seed=4)
+    M_t, g_t = _pin_M_g(path, q, lock=_FINGERS)  # fingers locked at 0
+    M_p, g_p = _pin_M_g(patched, q, lock=_FINGERS)
+    M_new, g_new = _pin_M_g(save_urdf(tmp_path / "new.urdf", new), q)
+    M_old, g_old = _pin_M_g(save_urdf(tmp_path / "old.urdf", chain), q)
+    # M and g are linear in the inertials: the fingers (off the chain) cancel in the difference.
+    np.testing.assert_allclose(M_p - M_t, M_new - M_old, atol=1e-10)
+    np.testing.assert_allclose(g_p - g_t, g_new - g_old, atol=1e-10)
+    np.testing.assert_allclose(M_new, dynid.mass_matrix(new, q), atol=1e-10)
+
+
+def test_patched_template_without_other_branches_equals_chain_export(tmp_path):
+    """A template whose only branch is the chain: Pinocchio's M and g equal the chain export's."""
+    path = robot_data_urdf("ur_description/urdf/ur5_robot.urdf")
+    chain = dynid.Robot.from_urdf(path, "base_link", "tool0")
+    new = _identified(chain, seed=3)
+    patched = save_urdf(tmp_path / "p.urdf", new, template=path, base="base_link", tip="tool0")
+    exported = save_urdf(tmp_path / "c.urdf", new)
+    q, _, _ = random_states(chain, 30, seed=5)
+    M_p, g_p = _pin_M_g(patched, q)
+    M_c, g_c = _pin_M_g(exported, q)
+    np.testing.assert_allclose(M_p, M_c, atol=1e-10)
+    np.testing.assert_allclose(g_p, g_c, atol=1e-10)
+    np.testing.assert_allclose(g_c, dynid.gravity_torques(new, q), atol=1e-10)
+
+
+def test_merged_move_puts_the_body_on_the_moving_link():
+    """merged='move': the hand loses its inertial, link7 carries the whole body, phi reads back."""
+    path, chain = _template_chain()
+    new = _identified(chain, seed=6)
+    text = patch_urdf_inertials(
+        open(path).read(), new, base="panda_link0", tip="panda_hand", merged="move"
+    )
+    hand = re.search(r'<link name="panda_hand">.*?</link>', text, re.S).group(0)
+    assert "<inertial" not in hand and "<visual" in hand
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", DynidWarning)
+        back = robot_from_urdf_string(text, "panda_link0", "panda_hand")
+    np.testing.assert_allclose(back.phi, new.phi, rtol=1e-12, atol=1e-15)
+    m7 = re.search(r'<link name="panda_link7">.*?<mass value="([^"]+)"', text, re.S).group(1)
+    np.testing.assert_allclose(float(m7), new.phi[6, 0], rtol=1e-15)
+
+
+def test_subtract_warns_when_the_rest_is_inconsistent():
+    """The published link 7 (0.74 kg) minus the template's 0.73 kg hand is not a rigid body."""
+    path, _ = _template_chain()
+    with pytest.warns(DynidWarning, match="panda_link7.*merged='move'"):
+        patch_urdf_inertials(open(path).read(), dynid.panda(), base="panda_link0", tip="panda_hand")
+
+
+def test_template_with_another_chain_is_refused():
+    """The UR5 template cannot carry the Panda's inertials."""
+    text = open(robot_data_urdf("ur_description/urdf/ur5_robot.urdf")).read()
+    with pytest.raises(ModelError, match="moving joints"):
+        patch_urdf_inertials(text, dynid.panda(), base="base_link", tip="tool0")
+    two = dynid.Robot.from_mdh([0, 1.0], [0, 0], [0, 0])
+    other = dynid.Robot.from_mdh([0, 2.0], [0, 0], [0, 0])
+    with pytest.raises(ModelError, match="another frame"):
+        patch_urdf_inertials(urdf_from_robot(two), other)
+    with pytest.raises(ModelError, match="merged must be one of"):
+        patch_urdf_inertials(urdf_from_robot(two), two, merged="drop")
+
+
+def test_links_without_inertial_get_one():
+    """A self-closing link and a link without <inertial> receive the robot's inertial."""
+    text = """<robot name="r">
+  <link name="base"/>
+  <joint name="j1" type="revolute"><parent link="base"/><child link="a"/>
+    <axis xyz="0 0 1"/><limit lower="-1" upper="1" effort="1" velocity="1"/></joint>
+  <link name="a"/>
+  <joint name="j2" type="continuous"><parent link="a"/><child link="b"/>
+    <origin xyz="0.5 0 0"/><axis xyz="0 1 0"/></joint>
+  <link name="b"><!-- <inertial> in a comment --><visual/></link>
+</robot>
+"""
+    chain = robot_from_urdf_string(text)
+    new = chain.with_inertials(
+        [1.0, 2.0], [[0.1, 0, 0], [0, 0.2, 0]], np.tile([0.1, 0, 0, 0.2, 0, 0.3], (2, 1))
+    )
+    out = patch_urdf_inertials(text, new)
+    back = robot_from_urdf_string(out)
+    np.testing.assert_allclose(back.phi, new.phi, rtol=1e-15, atol=1e-17)
+    assert "<!-- <inertial> in a comment -->" in out and '<link name="base"/>' in out
+
+
+def test_chain_export_keeps_the_source_tip_name():
+    """A Panda read to panda_link8 is exported with panda_link8 as its tip, not 'flange'."""
+    path = pinocchio_panda_urdf()
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", DynidWarning)
+        chain = dynid.Robot.from_urdf(path, "panda_link0", "panda_link8")
+    text = urdf_from_robot(chain)
+    assert '<link name="panda_link8"/>' in text and "flange" not in text
+    assert re.findall(r'<joint name="(panda_joint\d)"', text) == list(chain.joint_names)
+    assert '<link name="flange"/>' in urdf_from_robot(dynid.panda())
+
+
+def test_cli_export_urdf_template_and_mjcf(tmp_path, capsys):
+    """dynid export writes a patched URDF and an MJCF; a bad chain exits 2 with one line."""
+    pytest.importorskip("mujoco")
+    path, chain = _template_chain()
+    params = tmp_path / "robot.toml"
+    _identified(chain, seed=8).to_toml(params)
+    out = tmp_path / "patched.urdf"
+    argv = ["export", "--params", str(params), "--out", str(out), "--urdf-template", path]
+    assert main(argv + ["--base", "panda_link0", "--tip", "panda_hand"]) == 0
+    assert out.read_text().count("<mesh") == open(path).read().count("<mesh")
+    assert main(["export", "--params", "panda", "--out", str(tmp_path / "p.xml")]) == 0
+    assert "frictionloss" in capsys.readouterr().out
+    assert main(argv + ["--tip", "panda_link3"]) == 2
+    err = capsys.readouterr().err.strip()
+    assert err.startswith("dynid export: error:") and "\n" not in err
