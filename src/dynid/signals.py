@@ -37,6 +37,7 @@ __all__ = [
     "BUTTERWORTH_ORDER",
     "derivative",
     "edge_seconds",
+    "filtered_derivative",
     "is_uniform",
     "lowpass",
     "resample_uniform",
@@ -244,6 +245,41 @@ def derivative(t: ArrayLike, x: ArrayLike) -> NDArray[np.float64]:
             f"derivative needs t (N,) with N >= 3 and x (N, ...); got {t.shape} and {x.shape}"
         )
     return np.gradient(x, t, axis=0, edge_order=2)
+
+
+def filtered_derivative(
+    t: ArrayLike, x: ArrayLike, cutoff_hz: float, *, order: int = BUTTERWORTH_ORDER
+) -> NDArray[np.float64]:
+    """Derivative of a signal after a zero-phase low-pass: :func:`lowpass`, then :func:`derivative`.
+
+    Used for velocities from positions when a log has positions only. The filter assumes
+    uniform sampling at the median rate of ``t`` (resample jittered logs first with
+    :func:`resample_uniform`); the first and last ``edge_seconds(cutoff_hz)`` carry the
+    filter's transient (:func:`trim_edges`).
+
+    Parameters
+    ----------
+    t : array_like, shape (N,)
+        Strictly increasing sample times [s].
+    x : array_like, shape (N, ...)
+        Signal, e.g. joint positions [rad].
+    cutoff_hz : float
+        Cutoff of the low-pass [Hz], ``0 < cutoff_hz < fs / 2``.
+    order : int
+        Designed Butterworth order.
+
+    Returns
+    -------
+    dx : ndarray, shape (N, ...)
+        Derivative of the filtered signal [unit of x per s].
+
+    Raises
+    ------
+    DataError
+        Cutoff not below the Nyquist frequency, too few samples, ``t`` not increasing.
+    """
+    t = _time(t)
+    return derivative(t, lowpass(x, sample_rate(t), cutoff_hz, order=order))
 
 
 def edge_seconds(cutoff_hz: float) -> float:

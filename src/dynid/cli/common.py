@@ -202,3 +202,54 @@ def format_joint_table(robot: Robot, q: np.ndarray) -> str:
         unit = f"{v:+.6f} m" if pri else f"{v:+.6f} rad  ({np.degrees(v):+9.3f} deg)"
         lines.append(f"  {name:<{width}}  {unit}")
     return "\n".join(lines)
+
+
+# ---------------------------------------------------------------------- data files
+def add_column_options(p: argparse.ArgumentParser) -> None:
+    """``--columns`` (text or a .toml file) and ``--units`` for files of other tools."""
+    p.add_argument(
+        "--columns",
+        default=None,
+        metavar="MAP|FILE.toml",
+        help="column names of --data: 'q=position_{i0},tau=effort_{i0}' ({i} from 1, {i0} "
+        "from 0) or a TOML file with [columns] and [units]; positions only: velocities "
+        "from the zero-phase filtered derivative",
+    )
+    p.add_argument(
+        "--units",
+        default=None,
+        metavar="MAP",
+        help="units of --data: 'q=deg,tau=mNm,t=ms' (converted to SI)",
+    )
+
+
+def column_map(args: argparse.Namespace) -> Any:
+    """The :class:`~dynid.io.columns.ColumnMap` of ``--columns``/``--units``, or None."""
+    from ..io.columns import load_column_map, parse_column_map
+
+    spec, units = getattr(args, "columns", None), getattr(args, "units", None)
+    if spec is None and units is None:
+        return None
+    kw = {} if getattr(args, "cutoff", None) is None else {"velocity_cutoff_hz": args.cutoff}
+    if spec is not None and spec.lower().endswith(".toml"):
+        cmap = load_column_map(spec, **kw)
+        if units is not None:
+            extra = parse_column_map(None, units)
+            cmap = type(cmap)(cmap.columns, {**cmap.factors, **extra.factors}, **kw)
+        return cmap
+    return parse_column_map(spec, units, **kw)
+
+
+def read_log(args: argparse.Namespace, path: Path, n: int | None = None) -> Any:
+    """The torque log ``path``, through ``--columns``/``--units`` when given (notes logged)."""
+    from ..io.torque_log import read_torque_log
+
+    cmap = column_map(args)
+    if cmap is None:
+        return read_torque_log(path)
+    from ..io.columns import read_mapped_torque_log
+
+    mapped = read_mapped_torque_log(path, cmap, n=n)
+    for note in mapped.notes:
+        _log.warning("%s: %s", path.name, note)
+    return mapped.log

@@ -35,7 +35,6 @@ from ..friction.validation import Validation, validate
 from ..identification.log import DEFAULT_CUTOFF_HZ
 from ..identification.model import IdentifiedModel
 from ..io.friction_json import write_friction_json
-from ..io.torque_log import read_torque_log
 from ..kinematics.trajectories import (
     centered_start,
     check_limits,
@@ -44,7 +43,7 @@ from ..kinematics.trajectories import (
 )
 from ..model.robot import Robot
 from ..simulation.measurement import SensorNoise, sample_times, simulate_measurement
-from .common import load_robot
+from .common import add_column_options, load_robot, read_log
 
 NAME = "friction"
 
@@ -63,6 +62,7 @@ def register(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParser:
     p.add_argument("--base", default=None, help="URDF base link (with --robot)")
     p.add_argument("--tip", default=None, help="URDF tip link (with --robot)")
     p.add_argument("--data", type=Path, required=True, help="torque log (.csv or .npz)")
+    add_column_options(p)
     p.add_argument("--out", type=Path, required=True, help="output directory")
     p.add_argument("--friction-model", choices=("sigmoid", "classical"), default="sigmoid")
     p.add_argument(
@@ -153,7 +153,7 @@ def run(args: argparse.Namespace) -> int:
     """Fit friction, write friction.json and the figure, print the RMS table (unless -q)."""
     say = (lambda *a: None) if getattr(args, "quiet", False) else print
     model = load_torque_model(args)
-    log = read_torque_log(args.data)
+    log = read_log(args, args.data)
     res = friction_residual(model, log, cutoff_hz=args.cutoff)
     fit = (
         fit_sigmoid(res.dq, res.residual)

@@ -37,6 +37,7 @@ from typing import Any
 import numpy as np
 
 from ..exceptions import DataError
+from ..identification.data import StaticDataset
 from ..identification.model import IdentifiedModel
 from ..identification.static import identify_static
 from ..io.model_json import save_model_json
@@ -46,11 +47,14 @@ from ..model.robot import Robot
 from ..simulation.controller import SimulatedController, acquire_static
 from .acquire_static import streams
 from .common import (
+    add_column_options,
     add_consistency_options,
     add_robot_options,
+    column_map,
     load_prior,
     load_robot,
     parse_vector,
+    read_log,
     sdp_options,
 )
 
@@ -72,6 +76,7 @@ def register(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParser:
     )
     add_robot_options(p)
     p.add_argument("--data", type=Path, required=True, help="data file: .csv or .npz")
+    add_column_options(p)
     p.add_argument("--out", type=Path, required=True, help="output folder")
     p.add_argument(
         "--max-std-percent",
@@ -115,9 +120,15 @@ def register(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParser:
     return p
 
 
-def data_kind(path: Path) -> str:
+def data_kind(path: Path, columns: Any = None) -> str:
     """``"static"`` or ``"torque_log"``: a CSV with a ``t`` column or an NPZ with ``t``/``tau``
-    is a torque log."""
+    is a torque log; with a column map, mapping ``t``, ``dq`` or ``tau`` makes a torque log
+    and mapping ``M`` or ``g`` static data."""
+    if columns is not None:
+        if any(columns.mapped(k) for k in ("t", "dq", "tau", "ddq")):
+            return "torque_log"
+        if any(columns.mapped(k) for k in ("M", "g")):
+            return "static"
     suffix = path.suffix.lower()
     if suffix == ".csv":
         with path.open(encoding="utf-8", errors="replace") as fh:
@@ -140,9 +151,8 @@ def data_kind(path: Path) -> str:
 def identify_torque_log(robot: Robot, path: Path, args: argparse.Namespace) -> IdentifiedModel:
     """Classical route: read the log (checked), filter, identify base parameters and friction."""
     from ..identification.classical import identify_from_log
-    from ..io.torque_log import read_torque_log
 
-    log = read_torque_log(path)
+    log = read_log(args, path, robot.n)
     kw = {} if args.cutoff is None else {"cutoff_hz": args.cutoff}
     return identify_from_log(robot, log, max_std_percent=args.max_std_percent, rtol=args.rtol, **kw)
 
@@ -150,11 +160,25 @@ def identify_torque_log(robot: Robot, path: Path, args: argparse.Namespace) -> I
 # ---------------------------------------------------------------------------------------
 
 
-def identify_static_file(robot: Robot, path: Path, args: argparse.Namespace) -> IdentifiedModel:
-    """Static route: load (checked), identify."""
+def read_static_file(robot: Robot, path: Path, args: argparse.Namespace) -> StaticDataset:
+    """Static data (checked), through ``--columns``/``--units`` when given; notes logged."""
+    cmap = column_map(args)
+    if cmap is not None:
+        from ..io.columns import read_mapped_static_data
+
+        mapped = read_mapped_static_data(path, cmap, robot)
+        for note in mapped.notes:
+            _log.warning("%s: %s", path.name, note)
+        return mapped.data
     data, n_dropped = load_static_data(path, robot, drop_invalid=args.drop_invalid)
     if n_dropped:
         _log.warning("%s: %d invalid row(s) dropped", path.name, n_dropped)
+    return data
+
+
+def identify_static_file(robot: Robot, path: Path, args: argparse.Namespace) -> IdentifiedModel:
+    """Static route: load (checked), identify."""
+    data = read_static_file(robot, path, args)
     return identify_static(
         robot, data, max_std_percent=args.max_std_percent, rtol=args.rtol, std_estimator=args.std
     )
@@ -165,7 +189,7 @@ def run(args: argparse.Namespace) -> int:
     robot = load_robot(args)
     if args.consistent:
         return run_consistent(robot, args)
-    if data_kind(args.data) == "torque_log":
+    if data_kind(args.data, column_map(args)) == "torque_log":
         model = identify_torque_log(robot, args.data, args)
     else:
         model = identify_static_file(robot, args.data, args)
@@ -184,14 +208,11 @@ def run_consistent(robot: Robot, args: argparse.Namespace) -> int:
 
     if args.max_std_percent is not None:
         raise DataError("--max-std-percent does not apply to --consistent (nothing is pruned)")
-    if data_kind(args.data) == "torque_log":
-        from ..io.torque_log import read_torque_log
-
-        data: Any = read_torque_log(args.data)
+    data: Any
+    if data_kind(args.data, column_map(args)) == "torque_log":
+        data = read_log(args, args.data, robot.n)
     else:
-        data, n_dropped = load_static_data(args.data, robot, drop_invalid=args.drop_invalid)
-        if n_dropped:
-            _log.warning("%s: %d invalid row(s) dropped", args.data.name, n_dropped)
+        data = read_static_file(robot, args.data, args)
     band = None
     if args.total_mass is not None:
         v = parse_vector(args.total_mass, "--total-mass", 2)

@@ -34,9 +34,8 @@ from ..friction.validation import own_friction, validate
 from ..identification.log import DEFAULT_CUTOFF_HZ
 from ..identification.model import IdentifiedModel
 from ..io.friction_json import read_friction_json
-from ..io.torque_log import read_torque_log
 from ..model.robot import Robot
-from .common import load_robot
+from .common import add_column_options, load_robot, read_log
 from .friction import format_rms_table, save_validation_figures
 
 NAME = "validate"
@@ -62,6 +61,7 @@ def register(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParser:
     fr.add_argument("--friction", type=Path, help="friction.json to add to the model")
     fr.add_argument("--no-friction", action="store_true", help="ignore the model's own friction")
     p.add_argument("--data", type=Path, required=True, help="torque log (.csv or .npz)")
+    add_column_options(p)
     p.add_argument("--out", type=Path, required=True, help="output directory")
     p.add_argument(
         "--cutoff",
@@ -95,7 +95,7 @@ def run(args: argparse.Namespace) -> int:
     """Validate, write validation.json and the figures, print the RMS table (unless -q)."""
     say = (lambda *a: None) if getattr(args, "quiet", False) else print
     model, label = load_model_source(args)
-    log = read_torque_log(args.data)
+    log = read_log(args, args.data)
     if args.friction is not None:
         friction = read_friction_json(args.friction)
     elif args.no_friction:

@@ -1,0 +1,420 @@
+"""Column mapping and unit scaling for torque logs and static data of other tools.
+
+A :class:`ColumnMap` names, per quantity, the column template of a file and its unit:
+
+* quantities: torque logs ``t, q, dq, tau, ddq``; static data ``q, M, g``;
+* templates: ``{i}`` is the joint number from 1, ``{i0}`` from 0 (``position_{i0}``
+  reads ``position_0 .. position_{n-1}``); ``M`` needs a row and a column index,
+  ``{i}``/``{j}`` or ``{i0}``/``{j0}`` (either triangle, or both: a full matrix is
+  checked for symmetry by the data set). A quantity not mapped keeps dynid's name
+  (``q{i}``, ``tau{i}``, ``M{i}_{j}``, ...). In an NPZ file a template names an array;
+* units (converted to SI on reading): ``t`` in ``s, ms, us, ns``; ``q`` in ``rad, deg``
+  (``m, mm`` for prismatic arms); ``dq`` in ``rad/s, deg/s``; ``ddq`` in ``rad/s^2,
+  deg/s^2``; ``tau`` and ``g`` in ``Nm, N m, mNm, mN m``; ``M`` in ``kg m^2, g m^2``; or
+  a number, the factor to SI.
+
+Written on the command line as ``--columns 'q=position_{i0},tau=effort_{i0}'`` and
+``--units 'q=deg,tau=mNm'``, or as a TOML file with tables ``[columns]`` and ``[units]``.
+
+A torque log without velocities (``dq`` neither mapped nor present) gets them from the
+zero-phase filtered derivative of the positions (:func:`dynid.signals.filtered_derivative`,
+cutoff ``velocity_cutoff_hz``), after cleaning; the returned notes say so.
+"""
+
+from __future__ import annotations
+
+import io
+import math
+import tomllib
+from collections.abc import Mapping
+from dataclasses import dataclass, field
+from pathlib import Path
+from types import MappingProxyType
+from typing import Any
+
+import numpy as np
+from numpy.typing import NDArray
+
+from .. import signals
+from ..exceptions import DataError
+from ..identification.data import StaticDataset
+from ..identification.log import DEFAULT_CUTOFF_HZ, TorqueLog
+from ..model.robot import Robot
+
+__all__ = [
+    "ColumnMap",
+    "MappedLog",
+    "MappedStatic",
+    "load_column_map",
+    "parse_column_map",
+    "read_mapped_static_data",
+    "read_mapped_torque_log",
+]
+
+_DEFAULT = {
+    "t": "t",
+    "q": "q{i}",
+    "dq": "dq{i}",
+    "tau": "tau{i}",
+    "ddq": "ddq{i}",
+    "M": "M{i}_{j}",
+    "g": "g{i}",
+}
+_TIME = {"s": 1.0, "ms": 1e-3, "us": 1e-6, "ns": 1e-9}
+_ANGLE = {"rad": 1.0, "deg": math.pi / 180, "m": 1.0, "mm": 1e-3}
+_TORQUE = {"Nm": 1.0, "N m": 1.0, "N": 1.0, "mNm": 1e-3, "mN m": 1e-3}
+_UNITS: dict[str, dict[str, float]] = {
+    "t": _TIME,
+    "q": _ANGLE,
+    "dq": {k + "/s": v for k, v in _ANGLE.items()},
+    "ddq": {k + "/s^2": v for k, v in _ANGLE.items()},
+    "tau": _TORQUE,
+    "g": _TORQUE,
+    "M": {"kg m^2": 1.0, "g m^2": 1e-3},
+}
+
+
+def _to_factor(quantity: str, unit: Any) -> float:
+    if isinstance(unit, int | float) and not isinstance(unit, bool):
+        f = float(unit)
+    else:
+        table = _UNITS[quantity]
+        key = str(unit).strip()
+        try:
+            return _to_factor(quantity, float(key))
+        except ValueError:
+            pass
+        if key not in table:
+            raise DataError(
+                f"unknown unit {unit!r} for {quantity!r}; use one of {sorted(table)} "
+                "or a number (the factor to SI)"
+            )
+        f = table[key]
+    if not (math.isfinite(f) and f != 0.0):
+        raise DataError(f"unit factor of {quantity!r} must be finite and non-zero; got {unit!r}")
+    return f
+
+
+@dataclass(frozen=True, slots=True)
+class ColumnMap:
+    """Column templates and unit factors per quantity (module docstring).
+
+    Attributes
+    ----------
+    columns : mapping of str to str
+        Quantity -> template (``position_{i0}``); missing quantities keep dynid's names.
+    factors : mapping of str to float
+        Quantity -> factor to SI (degrees: ``pi / 180``); missing: 1.
+    velocity_cutoff_hz : float
+        Cutoff [Hz] of the low-pass before differentiating positions into velocities.
+    """
+
+    columns: Mapping[str, str] = field(default_factory=dict)
+    factors: Mapping[str, float] = field(default_factory=dict)
+    velocity_cutoff_hz: float = DEFAULT_CUTOFF_HZ
+
+    def __post_init__(self) -> None:
+        for key in list(self.columns) + list(self.factors):
+            if key not in _DEFAULT:
+                raise DataError(f"unknown quantity {key!r}; expected one of {list(_DEFAULT)}")
+        object.__setattr__(self, "columns", MappingProxyType(dict(self.columns)))
+        object.__setattr__(self, "factors", MappingProxyType(dict(self.factors)))
+
+    @classmethod
+    def from_units(
+        cls, columns: Mapping[str, str], units: Mapping[str, Any], **kw: Any
+    ) -> ColumnMap:
+        """Map from templates and unit names (``{"q": "deg", "tau": "mNm"}``)."""
+        for key in units:
+            if key not in _DEFAULT:
+                raise DataError(f"unknown quantity {key!r}; expected one of {list(_DEFAULT)}")
+        return cls(dict(columns), {k: _to_factor(k, u) for k, u in units.items()}, **kw)
+
+    def template(self, quantity: str) -> str:
+        """The column template of a quantity."""
+        return self.columns.get(quantity, _DEFAULT[quantity])
+
+    def factor(self, quantity: str) -> float:
+        """The factor to SI of a quantity."""
+        return float(self.factors.get(quantity, 1.0))
+
+    def mapped(self, quantity: str) -> bool:
+        """Whether the quantity was given a template."""
+        return quantity in self.columns
+
+
+def _pairs(text: str, what: str) -> dict[str, str]:
+    out = {}
+    for part in text.split(","):
+        part = part.strip()
+        if not part:
+            continue
+        key, sep, value = part.partition("=")
+        if not sep or not key.strip() or not value.strip():
+            raise DataError(f"{what} must read 'quantity=value,...'; got {part!r} in {text!r}")
+        out[key.strip()] = value.strip()
+    return out
+
+
+def parse_column_map(columns: str | None = None, units: str | None = None, **kw: Any) -> ColumnMap:
+    """Map from ``'q=position_{i0},tau=effort_{i0}'`` and ``'q=deg,tau=mNm'``.
+
+    Raises
+    ------
+    DataError
+        Malformed text, an unknown quantity or unit.
+    """
+    cols = _pairs(columns or "", "--columns")
+    unit = _pairs(units or "", "--units")
+    return ColumnMap.from_units(cols, unit, **kw)
+
+
+def load_column_map(path: str | Path, **kw: Any) -> ColumnMap:
+    """Map from a TOML file with tables ``[columns]`` and ``[units]``.
+
+    Raises
+    ------
+    DataError
+        Not TOML, other tables or keys, an unknown quantity or unit.
+    """
+    path = Path(path)
+    try:
+        d = tomllib.loads(path.read_text(encoding="utf-8"))
+    except tomllib.TOMLDecodeError as exc:
+        raise DataError(f"{path.name}: not valid TOML ({exc})") from exc
+    extra = sorted(set(d) - {"columns", "units", "velocity_cutoff_hz"})
+    if extra:
+        raise DataError(f"{path.name}: unknown key(s) {extra}; expected [columns], [units]")
+    if "velocity_cutoff_hz" in d:
+        kw.setdefault("velocity_cutoff_hz", float(d["velocity_cutoff_hz"]))
+    try:
+        return ColumnMap.from_units(
+            {k: str(v) for k, v in d.get("columns", {}).items()}, d.get("units", {}), **kw
+        )
+    except DataError as exc:
+        raise DataError(f"{path.name}: {exc}") from exc
+
+
+# ------------------------------------------------------------------------------ tables
+def _fill(template: str, i: int, j: int | None = None) -> str:
+    d = {"i": i + 1, "i0": i}
+    if j is not None:
+        d.update(j=j + 1, j0=j)
+    try:
+        return template.format(**d)
+    except (KeyError, IndexError, ValueError) as exc:
+        raise DataError(
+            f"column template {template!r}: use {{i}} (from 1) or {{i0}} (from 0)"
+            + (" and {j}/{j0}" if j is not None else "")
+        ) from exc
+
+
+@dataclass(frozen=True, slots=True)
+class _Table:
+    name: str
+    columns: dict[str, NDArray[np.float64]]  # CSV column or NPZ array by name
+
+
+def _read_table(path: Path) -> _Table:
+    suffix = path.suffix.lower()
+    if suffix == ".npz":
+        try:
+            with np.load(path, allow_pickle=False) as npz:
+                arrays = {k: np.asarray(npz[k], dtype=np.float64) for k in npz.files}
+        except ValueError as exc:
+            raise DataError(f"{path.name}: not a numeric NPZ file without pickles ({exc})") from exc
+        return _Table(path.name, arrays)
+    if suffix != ".csv":
+        raise DataError(f"{path.name}: expected a .csv or .npz file")
+    lines = path.read_text(encoding="utf-8").splitlines()
+    h = next((k for k, s in enumerate(lines) if s.strip() and not s.lstrip().startswith("#")), None)
+    if h is None:
+        raise DataError(f"{path.name}: no header line")
+    names = [c.strip() for c in lines[h].split(",")]
+    dup = sorted({c for c in names if names.count(c) > 1})
+    if dup:
+        raise DataError(f"{path.name}: duplicate column(s) {dup}")
+    body = "\n".join(lines[h + 1 :])
+    try:
+        data = np.genfromtxt(
+            io.StringIO(body),
+            delimiter=",",
+            comments="#",
+            dtype=np.float64,
+            ndmin=2,
+            invalid_raise=True,
+        )
+    except ValueError as exc:
+        raise DataError(f"{path.name}: a row does not match the header ({exc})") from exc
+    if data.size == 0:
+        raise DataError(f"{path.name}: no data rows after the header")
+    if data.shape[1] != len(names):
+        raise DataError(f"{path.name}: rows have {data.shape[1]} fields, the header {len(names)}")
+    return _Table(path.name, {c: data[:, k] for k, c in enumerate(names)})
+
+
+def _vector(table: _Table, cmap: ColumnMap, quantity: str, n: int | None) -> NDArray | None:
+    """(N, n) array of a joint quantity in SI, or None when its columns are absent."""
+    tpl = cmap.template(quantity)
+    if "{" not in tpl:  # an NPZ array, or one CSV column per quantity is not a vector
+        if tpl not in table.columns:
+            return None
+        a = table.columns[tpl]
+        a = a[:, None] if a.ndim == 1 else a
+        if n is not None and a.shape[1] != n:
+            raise DataError(f"{table.name}: {tpl!r} has {a.shape[1]} joints; expected {n}")
+        return a * cmap.factor(quantity)
+    if n is None:
+        n = 0
+        while _fill(tpl, n) in table.columns:
+            n += 1
+        if n == 0:
+            return None
+    names = [_fill(tpl, i) for i in range(n)]
+    missing = [c for c in names if c not in table.columns]
+    if len(missing) == n:
+        return None
+    if missing:
+        raise DataError(f"{table.name}: missing column(s) {missing} for {quantity!r} ({tpl!r})")
+    return np.stack([table.columns[c] for c in names], axis=1) * cmap.factor(quantity)
+
+
+def _need(table: _Table, cmap: ColumnMap, quantity: str, n: int | None) -> NDArray:
+    a = _vector(table, cmap, quantity, n)
+    if a is None:
+        tpl = cmap.template(quantity)
+        first = _fill(tpl, 0) if "{" in tpl else tpl
+        have = list(table.columns)[:12]
+        raise DataError(
+            f"{table.name}: no column {first!r} for {quantity!r} (template {tpl!r}); "
+            f"the file has {have}{'...' if len(table.columns) > 12 else ''}; "
+            "hint: map it with --columns"
+        )
+    return a
+
+
+@dataclass(frozen=True, slots=True)
+class MappedLog:
+    """A torque log read through a column map, and what was done to it.
+
+    Attributes
+    ----------
+    log : TorqueLog
+    notes : tuple of str
+        Human-readable notes (velocities derived, units converted).
+    """
+
+    log: TorqueLog
+    notes: tuple[str, ...] = ()
+
+
+def read_mapped_torque_log(
+    path: str | Path, columns: ColumnMap, *, n: int | None = None, gap_factor: float = 1.5
+) -> MappedLog:
+    """Read a torque log (CSV or NPZ) through a column map; SI out.
+
+    Parameters
+    ----------
+    path : str or Path
+    columns : ColumnMap
+    n : int, optional
+        Expected joint count (default: the number of position columns).
+    gap_factor : float
+        See :meth:`TorqueLog.from_raw`.
+
+    Returns
+    -------
+    MappedLog
+        The cleaned log; velocities from the filtered derivative of the positions when the
+        file has none (said in ``notes``).
+
+    Raises
+    ------
+    DataError
+        Missing columns (named with the template), a malformed file, a joint count
+        other than ``n``, time running backwards.
+    """
+    path = Path(path)
+    table = _read_table(path)
+    t = table.columns.get(columns.template("t"))
+    if t is None:
+        raise DataError(
+            f"{path.name}: no time column {columns.template('t')!r}; "
+            f"the file has {list(table.columns)[:12]}; hint: map it with --columns t=NAME"
+        )
+    t = t * columns.factor("t")
+    q = _need(table, columns, "q", n)
+    n = q.shape[1]
+    tau = _need(table, columns, "tau", n)
+    dq = _vector(table, columns, "dq", n)
+    ddq = _vector(table, columns, "ddq", n)
+    notes = [
+        f"{k} scaled by {columns.factor(k):.17g} to SI" for k in columns.factors if k in _DEFAULT
+    ]
+    try:
+        if dq is not None:
+            return MappedLog(
+                TorqueLog.from_raw(t, q, dq, tau, ddq, gap_factor=gap_factor), tuple(notes)
+            )
+        raw = TorqueLog.from_raw(t, q, np.zeros_like(q), tau, ddq, gap_factor=gap_factor)
+    except DataError as exc:
+        raise DataError(f"{path.name}: {exc}") from exc
+    dq = signals.filtered_derivative(raw.t, raw.q, columns.velocity_cutoff_hz)
+    notes.append(
+        "velocities derived from positions: zero-phase low-pass at "
+        f"{columns.velocity_cutoff_hz:g} Hz, then central differences"
+    )
+    log = TorqueLog(raw.t, raw.q, dq, raw.tau, raw.ddq, raw.cleaning)
+    return MappedLog(log, tuple(notes))
+
+
+@dataclass(frozen=True, slots=True)
+class MappedStatic:
+    """Static data read through a column map: the data set and notes."""
+
+    data: StaticDataset
+    notes: tuple[str, ...] = ()
+
+
+def read_mapped_static_data(
+    path: str | Path, columns: ColumnMap, robot: Robot | None = None
+) -> MappedStatic:
+    """Read static data ``q, M, g`` (CSV or NPZ) through a column map; SI out.
+
+    ``M`` is read from the lower triangle ``i >= j`` (a column named by ``(i, j)`` or, when
+    absent, by ``(j, i)``) and mirrored; NPZ arrays are taken whole.
+
+    Raises
+    ------
+    DataError
+        Missing columns (named), a joint count other than the robot's, NaN rows.
+    """
+    path = Path(path)
+    table = _read_table(path)
+    n = robot.n if robot is not None else None
+    q = _need(table, columns, "q", n)
+    n = q.shape[1]
+    g = _need(table, columns, "g", n)
+    tpl = columns.template("M")
+    if "{" not in tpl:
+        if tpl not in table.columns:
+            raise DataError(f"{path.name}: no array {tpl!r} for 'M'")
+        M = table.columns[tpl] * columns.factor("M")
+    else:
+        M = np.zeros((q.shape[0], n, n))
+        for i in range(n):
+            for j in range(i + 1):
+                name = _fill(tpl, i, j)
+                if name not in table.columns:
+                    name = _fill(tpl, j, i)
+                if name not in table.columns:
+                    raise DataError(
+                        f"{path.name}: no column {_fill(tpl, i, j)!r} for M (template {tpl!r})"
+                    )
+                M[:, i, j] = M[:, j, i] = table.columns[name] * columns.factor("M")
+    bad = ~(np.all(np.isfinite(q), 1) & np.all(np.isfinite(g), 1))
+    bad |= ~np.all(np.isfinite(M.reshape(len(M), -1)), 1)
+    if bad.any():
+        raise DataError(f"{path.name}: row {int(np.argmax(bad))} holds NaN or inf")
+    notes = tuple(f"{k} scaled by {columns.factor(k):.17g} to SI" for k in columns.factors)
+    return MappedStatic(StaticDataset(q, M, g, {"file": path.name}), notes)
