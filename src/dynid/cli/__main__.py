@@ -19,6 +19,7 @@ SUBCOMMANDS = (
     "fk",
     "jacobian",
     "ik",
+    "import_bag",
     "acquire_static",
     "identify",
     "predict",

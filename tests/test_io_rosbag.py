@@ -1,0 +1,218 @@
+"""ROS bags in: JointState from ROS 1 and ROS 2 (sqlite3, MCAP) bags to torque logs.
+
+Reference: bags written with rosbags' own writers from a torque log CSV; the import must
+give that CSV's log back (times to 1e-9 s, values exactly), and count what it dropped.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+import dynid
+from dynid.cli.__main__ import main
+from dynid.exceptions import DataError
+from dynid.identification.log import TorqueLog
+from dynid.io.rosbag import match_joints, read_joint_state_bag
+from dynid.io.torque_log import read_torque_log, write_torque_log
+
+rosbags = pytest.importorskip("rosbags")
+from rosbags.rosbag1 import Writer as Writer1  # noqa: E402
+from rosbags.rosbag2 import StoragePlugin  # noqa: E402
+from rosbags.rosbag2 import Writer as Writer2  # noqa: E402
+from rosbags.typesys import Stores, get_typestore  # noqa: E402
+
+JS = "sensor_msgs/msg/JointState"
+T0_NS = 1_700_000_000_123_456_789  # an epoch stamp: float64 seconds would lose the ns
+
+
+def _bag_names(robot):
+    return [f"panda_{name}" for name in robot.joint_names]
+
+
+def _message(ts, ros1, k, stamp_ns, names, q, dq, tau):
+    types = ts.types
+    stamp = types["builtin_interfaces/msg/Time"](
+        sec=stamp_ns // 1_000_000_000, nanosec=stamp_ns % 1_000_000_000
+    )
+    Header = types["std_msgs/msg/Header"]
+    header = Header(seq=k, stamp=stamp, frame_id="") if ros1 else Header(stamp=stamp, frame_id="")
+    return types[JS](
+        header=header,
+        name=list(names),
+        position=np.asarray(q, float),
+        velocity=np.asarray(dq, float),
+        effort=np.asarray(tau, float),
+    )
+
+
+def write_bag(path, kind, messages, *, extra_topic=0):
+    """Write ``messages`` (receive_ns, stamp_ns, names, q, dq, tau) to a bag of ``kind``."""
+    ros1 = kind == "ros1"
+    ts = get_typestore(Stores.ROS1_NOETIC if ros1 else Stores.ROS2_HUMBLE)
+    if ros1:
+        writer = Writer1(path)
+    else:
+        plugin = StoragePlugin.MCAP if kind == "mcap" else StoragePlugin.SQLITE3
+        writer = Writer2(path, version=9, storage_plugin=plugin)
+    ser = ts.serialize_ros1 if ros1 else ts.serialize_cdr
+    with writer as w:
+        conn = w.add_connection("/joint_states", JS, typestore=ts)
+        other = w.add_connection("/chatter", "std_msgs/msg/String", typestore=ts)
+        for k, (recv, stamp, names, q, dq, tau) in enumerate(messages):
+            w.write(conn, recv, ser(_message(ts, ros1, k, stamp, names, q, dq, tau), JS))
+        String = ts.types["std_msgs/msg/String"]
+        for k in range(extra_topic):
+            w.write(other, T0_NS + k, ser(String(data="hello"), "std_msgs/msg/String"))
+    return path
+
+
+def _shuffled(log, robot, seed, t0=T0_NS):
+    """Messages of a log with the joint names in a new random order in every message."""
+    rng = np.random.default_rng(seed)
+    names = np.array(_bag_names(robot))
+    out = []
+    for k in range(log.n_samples):
+        p = rng.permutation(robot.n)
+        stamp = t0 + int(round(log.t[k] * 1e9))
+        out.append((stamp + 1000, stamp, names[p], log.q[k, p], log.dq[k, p], log.tau[k, p]))
+    return out
+
+
+@pytest.fixture(scope="module")
+def csv_log(tmp_path_factory):
+    """A 20 s, 1 kHz Panda log written to CSV and read back (the reference)."""
+    rng = np.random.default_rng(11)
+    N, n = 20_000, 7
+    t = np.arange(N) * 1e-3
+    log = TorqueLog(t, rng.normal(size=(N, n)), rng.normal(size=(N, n)), rng.normal(size=(N, n)))
+    path = write_torque_log(tmp_path_factory.mktemp("csv") / "log.csv", log)
+    return read_torque_log(path)
+
+
+@pytest.mark.parametrize("kind", ["mcap", "sqlite3", "ros1"])
+def test_bag_with_shuffled_names_imports_to_the_csv_log(kind, csv_log, tmp_path):
+    """20 s at 1 kHz, names shuffled per message: t to 1e-9 s, q, dq, tau exactly."""
+    robot = dynid.panda()
+    path = tmp_path / ("log.bag" if kind == "ros1" else "bag")
+    write_bag(path, kind, _shuffled(csv_log, robot, seed=1), extra_topic=5)
+    res = read_joint_state_bag(path, robot.joint_names)
+    assert res.joints == tuple(_bag_names(robot)) and res.time_source == "header"
+    assert res.t0_ns == T0_NS and res.n_messages == 20_000 and res.n_other_topics == 5
+    np.testing.assert_allclose(res.log.t, csv_log.t, rtol=0, atol=1e-9)
+    for k in ("q", "dq", "tau"):
+        np.testing.assert_array_equal(getattr(res.log, k), getattr(csv_log, k))
+    assert not res.velocity_derived and res.n_missing == res.n_duplicate_stamps == 0
+
+
+def _small(robot, N=50, seed=3):
+    rng = np.random.default_rng(seed)
+    t = np.arange(N) * 1e-2
+    return TorqueLog(
+        t,
+        rng.normal(size=(N, robot.n)),
+        rng.normal(size=(N, robot.n)),
+        rng.normal(size=(N, robot.n)),
+    )
+
+
+def test_bad_messages_are_dropped_and_counted(tmp_path):
+    """Missing joint, short effort, NaN, repeated and out-of-order stamps, other topics."""
+    robot = dynid.panda()
+    log = _small(robot)
+    msgs = _shuffled(log, robot, seed=2)
+    recv, stamp, names, q, dq, tau = msgs[5]
+    msgs[5] = (recv, stamp, names[:-1], q[:-1], dq[:-1], tau[:-1])  # a joint missing
+    recv, stamp, names, q, dq, tau = msgs[6]
+    msgs[6] = (recv, stamp, names, q, dq, tau[:3])  # effort too short
+    recv, stamp, names, q, dq, tau = msgs[7]
+    msgs[7] = (recv, stamp, names, np.where(np.arange(7) == 2, np.nan, q), dq, tau)
+    msgs.insert(10, msgs[9])  # a repeated stamp
+    a, b = msgs[20], msgs[21]  # stamps out of order, received in order
+    msgs[20], msgs[21] = (a[0], *b[1:]), (b[0], *a[1:])
+    write_bag(tmp_path / "b", "mcap", msgs, extra_topic=3)
+    res = read_joint_state_bag(tmp_path / "b", robot.joint_names)
+    assert (res.n_missing, res.n_nonfinite, res.n_duplicate_stamps) == (2, 1, 1)
+    assert res.n_out_of_order == 1 and res.n_other_topics == 3
+    keep = np.setdiff1d(np.arange(log.n_samples), [5, 6, 7])
+    np.testing.assert_array_equal(res.log.q, log.q[keep])
+    np.testing.assert_allclose(res.log.t, log.t[keep] - log.t[keep][0], atol=1e-9)
+    assert any("repeated stamp" in s for s in res.notes)
+
+
+def test_unset_stamps_fall_back_to_receive_time(tmp_path):
+    """Zero header stamps: receive times are used, and the notes say so."""
+    robot = dynid.panda()
+    log = _small(robot)
+    msgs = [(T0_NS + 10**7 * k, 0, *m[2:]) for k, m in enumerate(_shuffled(log, robot, 4))]
+    write_bag(tmp_path / "b.bag", "ros1", msgs)
+    res = read_joint_state_bag(tmp_path / "b.bag", robot.joint_names)
+    assert res.time_source == "receive" and any("receive times" in s for s in res.notes)
+    np.testing.assert_allclose(res.log.t, log.t, atol=1e-9)
+
+
+def test_positions_only_bag_derives_velocities(tmp_path):
+    """No velocity field: dq from the filtered derivative of q matches the analytic one."""
+    robot = dynid.panda()
+    t = np.arange(6000) * 1e-3
+    f = np.linspace(0.2, 0.8, robot.n)
+    q = np.sin(2 * np.pi * f * t[:, None])
+    names = _bag_names(robot)
+    msgs = [(T0_NS + int(t[k] * 1e9),) * 2 + (names, q[k], [], np.zeros(7)) for k in range(len(t))]
+    write_bag(tmp_path / "b", "sqlite3", msgs)
+    res = read_joint_state_bag(tmp_path / "b", robot.joint_names)
+    assert res.velocity_derived and any("derived from positions" in s for s in res.notes)
+    dq = 2 * np.pi * f * np.cos(2 * np.pi * f * t[:, None])
+    inner = slice(1000, -1000)
+    assert np.max(np.abs(res.log.dq[inner] - dq[inner])) < 1e-4 * np.max(np.abs(dq))
+
+
+def test_match_joints_rule_and_override():
+    """Exact names first, then the '_' prefix rule; ambiguity and absence need --joints."""
+    robot = ("joint1", "joint2")
+    assert match_joints(robot, ["panda_joint2", "panda_joint1"]) == ["panda_joint1", "panda_joint2"]
+    assert match_joints(robot, ["joint2", "joint1", "x_joint1"]) == ["joint1", "joint2"]
+    with pytest.raises(DataError, match="several .* robot joint 'joint1'.*--joints"):
+        match_joints(robot, ["a_joint1", "b_joint1", "joint2"])
+    with pytest.raises(DataError, match="no bag joint"):
+        match_joints(robot, ["joint10", "joint2"])
+    assert match_joints(robot, ["A", "B"], joints=["B", "A"]) == ["B", "A"]
+    with pytest.raises(DataError, match="not in the bag"):
+        match_joints(robot, ["A", "B"], joints=["B", "C"])
+    with pytest.raises(DataError, match="must name 2 joints"):
+        match_joints(robot, ["A", "B"], joints=["B"])
+
+
+def test_bag_errors(tmp_path):
+    """Missing bag, wrong topic, no effort: DataError naming the bag and what is wrong."""
+    robot = dynid.panda()
+    with pytest.raises(DataError, match="bag not found"):
+        read_joint_state_bag(tmp_path / "none.bag", robot.joint_names)
+    log = _small(robot)
+    write_bag(tmp_path / "b", "mcap", _shuffled(log, robot, 5), extra_topic=1)
+    with pytest.raises(
+        DataError, match=r"no topic '/js'; the bag has \['/chatter', '/joint_states'\]"
+    ):
+        read_joint_state_bag(tmp_path / "b", robot.joint_names, topic="/js")
+    with pytest.raises(DataError, match="holds std_msgs/msg/String, not JointState"):
+        read_joint_state_bag(tmp_path / "b", robot.joint_names, topic="/chatter")
+    msgs = [(*m[:5], []) for m in _shuffled(log, robot, 6)]
+    write_bag(tmp_path / "c", "mcap", msgs)
+    with pytest.raises(DataError, match="holds effort"):
+        read_joint_state_bag(tmp_path / "c", robot.joint_names)
+
+
+def test_cli_import_writes_a_log_every_command_reads(tmp_path, capsys):
+    """dynid import writes CSV/NPZ logs equal to the bag's; errors exit 2 with one line."""
+    robot = dynid.panda()
+    log = _small(robot, N=200)
+    write_bag(tmp_path / "b.bag", "ros1", _shuffled(log, robot, 7))
+    for out in ("log.csv", "log.npz"):
+        assert main(["import", str(tmp_path / "b.bag"), "--out", str(tmp_path / out)]) == 0
+        back = read_torque_log(tmp_path / out)
+        np.testing.assert_array_equal(back.tau, log.tau)
+    assert "joint1 <- panda_joint1" in capsys.readouterr().out
+    argv = ["import", str(tmp_path / "b.bag"), "--out", str(tmp_path / "x.csv")]
+    assert main(argv + ["--topic", "/nope"]) == 2
+    err = capsys.readouterr().err
+    assert err.startswith("dynid import: error:") and err.count("\n") == 1
