@@ -78,7 +78,14 @@ def test_retrieve_writes_feasible_parameters_urdf_toml_and_report(model_file, tm
     cap = capsys.readouterr()
     assert rc == 0
     assert "run  3/3" in cap.err and "FEASIBLE" in cap.out
-    for name in ("feasible.json", "robot.urdf", "robot.toml", "report.json", "retrieval.png"):
+    for name in (
+        "feasible.json",
+        "robot.urdf",
+        "robot.xml",
+        "robot.toml",
+        "report.json",
+        "retrieval.png",
+    ):
         assert (out / name).is_file(), name
     rep = json.loads((out / "report.json").read_text())
     assert rep["feasible"] and rep["relative_residual"] <= 1e-4 and rep["seed"] == 0
@@ -92,6 +99,9 @@ def test_retrieve_writes_feasible_parameters_urdf_toml_and_report(model_file, tm
         dynid.Robot.from_toml(out / "robot.toml"),
     ):
         np.testing.assert_allclose(loaded.phi, robot.phi, atol=1e-14)
+    mujoco = pytest.importorskip("mujoco")
+    mj = mujoco.MjModel.from_xml_path(str(out / "robot.xml"))  # feasible: MuJoCo compiles it
+    np.testing.assert_allclose(mj.body_mass[2:], robot.mass, rtol=1e-12)
 
 
 def test_retrieve_reports_a_contradictory_total_mass_band(model_file, tmp_path, capsys):

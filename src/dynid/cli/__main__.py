@@ -27,6 +27,7 @@ SUBCOMMANDS = (
     "friction",
     "validate",
     "retrieve",
+    "payload",
     "export",
     "demo",
 )

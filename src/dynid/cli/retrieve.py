@@ -27,7 +27,8 @@ default one); --friction friction.json (sigmoid) puts a friction model on the ex
 robot.
 
 Writes DIR2/feasible.json (mass, CoM, inertia about the CoM per link, with the
-kinematics), DIR2/robot.urdf, DIR2/robot.toml, DIR2/report.json (relative residual,
+kinematics), DIR2/robot.urdf, DIR2/robot.xml (MJCF), DIR2/robot.toml (all written by the
+code of `dynid export`), DIR2/report.json (relative residual,
 every constraint margin, stage costs, run time, seed) and DIR2/retrieval.png; prints
 the progress on stderr and a summary on stdout. Exit code 1 when no feasible parameter
 set was found (the least-violating one is written and reported).
@@ -66,8 +67,8 @@ from ..feasibility.retrieve import (
 from ..feasibility.sdp import ConsistentResult
 from ..feasibility.validate import NewtonEulerValidation, validate_newton_euler
 from ..identification.model import IdentifiedModel
+from ..io.export import save_robot
 from ..io.feasible import load_bounds, save_feasible_json, save_report_json
-from ..io.urdf_export import save_urdf
 from ..model.robot import Robot
 from .common import (
     add_consistency_options,
@@ -242,14 +243,10 @@ def write_outputs(
     figures: bool = True,
     **report_extra: Any,
 ) -> list[Path]:
-    """Write feasible.json, robot.urdf, robot.toml, report.json (and retrieval.png)."""
+    """Write feasible.json, robot.urdf, robot.xml, robot.toml, report.json (and retrieval.png)."""
     out.mkdir(parents=True, exist_ok=True)
-    files = [
-        save_feasible_json(out / "feasible.json", result),
-        save_urdf(out / "robot.urdf", result.robot),
-    ]
-    result.robot.to_toml(out / "robot.toml")
-    files.append(out / "robot.toml")
+    files = [save_feasible_json(out / "feasible.json", result)]
+    files += [save_robot(out / f"robot.{ext}", result.robot) for ext in ("urdf", "xml", "toml")]
     files.append(save_report_json(out / "report.json", result, **report_extra))
     if figures:
         from ..plots.feasible import plot_consistent, plot_retrieval

@@ -377,12 +377,14 @@ class MappedStatic:
 
 
 def read_mapped_static_data(
-    path: str | Path, columns: ColumnMap, robot: Robot | None = None
+    path: str | Path, columns: ColumnMap, robot: Robot | None = None, *, require_M: bool = True
 ) -> MappedStatic:
     """Read static data ``q, M, g`` (CSV or NPZ) through a column map; SI out.
 
     ``M`` is read from the lower triangle ``i >= j`` (a column named by ``(i, j)`` or, when
-    absent, by ``(j, i)``) and mirrored; NPZ arrays are taken whole.
+    absent, by ``(j, i)``) and mirrored; NPZ arrays are taken whole. With
+    ``require_M=False`` a file without ``M`` (gravity torques only) is read with ``M`` set
+    to zero, said in the notes.
 
     Raises
     ------
@@ -396,7 +398,12 @@ def read_mapped_static_data(
     n = q.shape[1]
     g = _need(table, columns, "g", n)
     tpl = columns.template("M")
-    if "{" not in tpl:
+    extra: tuple[str, ...] = ()
+    has_M = (tpl in table.columns) if "{" not in tpl else (_fill(tpl, 0, 0) in table.columns)
+    if not require_M and not has_M:
+        M = np.zeros((q.shape[0], n, n))
+        extra = ("no M columns: M set to zero (gravity torques only)",)
+    elif "{" not in tpl:
         if tpl not in table.columns:
             raise DataError(f"{path.name}: no array {tpl!r} for 'M'")
         M = table.columns[tpl] * columns.factor("M")
@@ -416,5 +423,5 @@ def read_mapped_static_data(
     bad |= ~np.all(np.isfinite(M.reshape(len(M), -1)), 1)
     if bad.any():
         raise DataError(f"{path.name}: row {int(np.argmax(bad))} holds NaN or inf")
-    notes = tuple(f"{k} scaled by {columns.factor(k):.17g} to SI" for k in columns.factors)
+    notes = extra + tuple(f"{k} scaled by {columns.factor(k):.17g} to SI" for k in columns.factors)
     return MappedStatic(StaticDataset(q, M, g, {"file": path.name}), notes)

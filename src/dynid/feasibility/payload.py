@@ -1,0 +1,357 @@
+"""Payload identification: mass, centre of mass and inertia of a load on a known arm.
+
+A load rigidly fixed to frame ``F`` (default ``flange``, on link ``k``) adds its standard
+parameters, carried into link ``k`` coordinates, to link ``k``. With ``T = T_link_F`` the
+pseudo-inertia transforms as ``J_link = T J_F T^T`` (:mod:`dynid.feasibility.lmi`), a
+linear map ``phi_link = A phi_F``, so the measured quantities minus the arm's own are
+linear in the load's parameters ``phi_F = [m, m c, J_F]`` (about ``F``'s origin, ``F`` axes):
+
+.. math:: y - y_{arm}(q) = Y_k(q) \\, A \\, \\phi_F \\; (+ F(\\dot q) f)
+
+* **static M and g** (:func:`identify_payload` with a
+  :class:`~dynid.identification.data.StaticDataset`): ``y = [tril M; g]`` and ``Y`` the
+  static regressor (Gaz et al. 2019, eq. 20); all 10 parameters;
+* **static g only** (``gravity_only=True``): ``g`` depends on ``m`` and ``m c`` only, so
+  the mass and the CoM are estimated and the inertia is not (``inertia_identified`` False);
+* **a torque log** (:class:`~dynid.identification.log.TorqueLog`): zero-phase filtered and
+  differentiated (:func:`~dynid.identification.log.prepare_log`), ``Y`` the torque
+  regressor, and the classical friction ``fv, fc, fo`` per joint estimated alongside;
+* **difference method** (``unloaded=`` data of the same kind recorded without the load):
+  the arm is first identified from the unloaded data (base parameters,
+  :func:`~dynid.identification.static.identify_static` or
+  :func:`~dynid.identification.classical.identify_from_log`) and its identified model is
+  the arm; model errors common to both recordings cancel.
+
+Physical consistency: the least-squares estimate is kept when its pseudo-inertia is
+positive definite with ``lambda_min(J) >= margin tr(J)``; otherwise the estimate closest to
+it in the metric of the data, ``||R (phi - phi_ls)||`` (``W = Q R``), subject to that LMI
+(Wensing, Kim, Slotine, RA-L 2018), is solved for with cvxpy and Clarabel. For ``g`` only
+the constraint is ``m > 0``.
+
+Standard deviations: the heteroscedasticity-consistent (HC1) covariance of the least
+squares (relative, multiplicative sensor noise gives rows of unequal variance), carried to
+mass, CoM and inertia about the CoM through the Jacobian of that map (central differences).
+When the LMI is active they describe the unconstrained estimate.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+from numpy.typing import NDArray
+
+from ..dynamics.rnea import rnea
+from ..dynamics.terms import gravity_torques, mass_matrix
+from ..exceptions import DataError, ModelError, ShapeError, SolverError
+from ..identification.classical import friction_regressor, identify_from_log
+from ..identification.data import StaticDataset
+from ..identification.least_squares import fit_least_squares
+from ..identification.log import DEFAULT_CUTOFF_HZ, TorqueLog, prepare_log
+from ..identification.model import IdentifiedModel
+from ..identification.static import identify_static
+from ..model.inertia import inertia6_from_matrix, inertial_from_phi
+from ..model.robot import Robot
+from ..regressors.static import static_regressor, static_vector
+from ..regressors.torque import torque_regressor
+from .lmi import phi_from_pseudo_inertia, pseudo_inertia, pseudo_inertia_margin
+
+__all__ = ["PayloadEstimate", "identify_payload", "link_params_from_frame", "robot_with_payload"]
+
+
+@dataclass(frozen=True, slots=True, eq=False)
+class PayloadEstimate:
+    """A load's inertial parameters in its frame, with standard deviations.
+
+    Attributes
+    ----------
+    frame : str
+        The frame ``F`` the load is fixed to.
+    link : int
+        The link carrying ``F``.
+    phi : ndarray, shape (10,)
+        Standard parameters in ``F``: ``m, m c, J`` about ``F``'s origin, ``F`` axes [SI].
+    mass : float
+        [kg].
+    com : ndarray, shape (3,)
+        CoM in ``F`` [m].
+    inertia : ndarray, shape (3, 3)
+        Inertia about the CoM in ``F`` axes [kg m^2] (zeros when not identified).
+    std_mass : float
+    std_com : ndarray, shape (3,)
+    std_inertia : ndarray, shape (6,)
+        Standard deviations of ``xx xy xz yy yz zz`` (NaN when not identified).
+    covariance : ndarray, shape (p, p)
+        Covariance of the estimated entries of ``phi`` (``p`` = 10, or 4 for ``g`` only).
+    route : str
+        ``"static M and g"``, ``"static g"`` or ``"torque log"`` (``", difference"`` appended
+        for the difference method).
+    inertia_identified : bool
+    constraint_active : bool
+        The LMI changed the least-squares estimate.
+    margin : float
+        ``lambda_min(J) / tr(J)`` of the result (``nan`` for ``g`` only).
+    rank : int
+    condition_number : float
+    residual_rms : float
+        RMS of the fit's residual [SI of the rows].
+    n_rows : int
+    friction : ndarray, shape (n, 3), or None
+        ``fv, fc, fo`` per joint estimated alongside (torque logs).
+    notes : tuple of str
+    """
+
+    frame: str
+    link: int
+    phi: NDArray[np.float64]
+    mass: float
+    com: NDArray[np.float64]
+    inertia: NDArray[np.float64]
+    std_mass: float
+    std_com: NDArray[np.float64]
+    std_inertia: NDArray[np.float64]
+    covariance: NDArray[np.float64]
+    route: str
+    inertia_identified: bool
+    constraint_active: bool
+    margin: float
+    rank: int
+    condition_number: float
+    residual_rms: float
+    n_rows: int
+    friction: NDArray[np.float64] | None
+    notes: tuple[str, ...]
+
+
+def link_params_from_frame(T_link_frame: NDArray[np.float64]) -> NDArray[np.float64]:
+    """The 10x10 matrix ``A`` with ``phi_link = A phi_F`` for a body fixed at ``T_link_F``.
+
+    From the pseudo-inertia's transformation ``J_link = T J_F T^T``.
+    """
+    T = np.asarray(T_link_frame, dtype=np.float64)
+    E = np.eye(10)
+    return np.stack([phi_from_pseudo_inertia(T @ pseudo_inertia(E[i]) @ T.T) for i in range(10)], 1)
+
+
+def _arm(arm: Robot | IdentifiedModel) -> Robot:
+    return arm.equivalent_robot if isinstance(arm, IdentifiedModel) else arm
+
+
+def _kinematics(arm: Robot | IdentifiedModel) -> Robot:
+    return arm.robot if isinstance(arm, IdentifiedModel) else arm
+
+
+def _summary(phi: NDArray[np.float64], cov: NDArray[np.float64], full: bool):
+    """Mass, CoM, inertia (about CoM) and their standard deviations from phi and its cov."""
+
+    def f(p: NDArray[np.float64]) -> NDArray[np.float64]:
+        m, c, I = inertial_from_phi(p)
+        return np.concatenate([[m], c, inertia6_from_matrix(I)])
+
+    p = phi.copy()
+    k = cov.shape[0]
+    scale = np.maximum(np.abs(p[:k]), 1e-6 * max(float(np.max(np.abs(p[:k]))), 1e-12))
+    Jac = np.empty((10, k))
+    for i in range(k):
+        h = 1e-6 * scale[i]
+        a, b = p.copy(), p.copy()
+        a[i] += h
+        b[i] -= h
+        Jac[:, i] = (f(a) - f(b)) / (2 * h)
+    C = Jac @ cov @ Jac.T
+    std = np.sqrt(np.maximum(np.diag(C), 0.0))
+    m, c, I = inertial_from_phi(p)
+    if not full:
+        std[4:] = np.nan
+        I = np.zeros((3, 3))
+    return float(m), c, I, float(std[0]), std[1:4], std[4:]
+
+
+def _consistent(
+    phi_ls: NDArray[np.float64], R: NDArray[np.float64], margin: float
+) -> tuple[NDArray[np.float64], bool]:
+    """The LMI-constrained estimate closest to ``phi_ls`` in ``||R (phi - phi_ls)||``."""
+    if pseudo_inertia_margin(phi_ls) >= margin:
+        return phi_ls, False
+    import cvxpy as cp
+
+    s = np.maximum(np.abs(phi_ls), 1e-9 * max(float(np.max(np.abs(phi_ls))), 1e-12))
+    x = cp.Variable(10)  # phi = s * x, so the variables are of order one
+    phi = cp.multiply(s, x)
+    J = _pseudo_inertia_expr(phi)
+    Rs = R * s[None, :]
+    obj = cp.sum_squares(Rs @ x - R @ phi_ls)
+    cons = [J - margin * cp.trace(J) * np.eye(4) >> 0]
+    prob = cp.Problem(cp.Minimize(obj), cons)
+    try:
+        prob.solve(solver="CLARABEL")
+    except (cp.error.SolverError, ArithmeticError, ValueError) as exc:
+        raise SolverError(f"payload: the consistent estimate was not found ({exc})") from exc
+    if prob.status not in ("optimal", "optimal_inaccurate") or x.value is None:
+        raise SolverError(f"payload: the consistent estimate was not found (status {prob.status})")
+    return s * np.asarray(x.value), True
+
+
+def _pseudo_inertia_expr(phi):  # noqa: ANN001, ANN202 (cvxpy expressions)
+    """cvxpy expression of :func:`~dynid.feasibility.lmi.pseudo_inertia` (linear in phi)."""
+    E = np.eye(10)
+    return sum(phi[i] * pseudo_inertia(E[i]) for i in range(10))
+
+
+def identify_payload(
+    arm: Robot | IdentifiedModel,
+    data: StaticDataset | TorqueLog,
+    *,
+    frame: str = "flange",
+    gravity_only: bool = False,
+    unloaded: StaticDataset | TorqueLog | None = None,
+    margin: float = 1e-6,
+    cutoff_hz: float | None = DEFAULT_CUTOFF_HZ,
+    rtol: float = 1e-10,
+) -> PayloadEstimate:
+    """Estimate the load fixed to ``frame`` from data recorded with it on a known arm.
+
+    Parameters
+    ----------
+    arm : Robot or IdentifiedModel
+        The arm without the load: a robot with its parameters (built-in, feasible), or an
+        identified model (its equivalent robot). Ignored for its parameters when
+        ``unloaded`` is given (then only its kinematics and gravity are used).
+    data : StaticDataset or TorqueLog
+        Recorded with the load: ``q`` (N, n) [rad], ``M`` [kg m^2], ``g`` [N m]; or a log.
+    frame : str
+        The frame the load is fixed to; its CoM and inertia are given in it.
+    gravity_only : bool
+        Static data: use ``g`` only (mass and CoM; the inertia is not identified).
+    unloaded : StaticDataset or TorqueLog, optional
+        The same kind of data without the load (difference method).
+    margin : float
+        LMI margin: ``lambda_min(J) >= margin tr(J)``.
+    cutoff_hz : float or None
+        Torque logs: zero-phase low-pass cutoff [Hz] (None: no filtering).
+    rtol : float
+        Relative rank tolerance of the least squares.
+
+    Returns
+    -------
+    PayloadEstimate
+
+    Raises
+    ------
+    UnknownNameError
+        ``frame`` is not a frame of the robot.
+    ModelError
+        The frame is on the base (a load there does not move).
+    ShapeError
+        Data of another joint count; ``unloaded`` of another kind than ``data``.
+    RankDeficientError
+        The configurations do not excite the load's parameters.
+    DataError
+        ``g`` only and the estimated mass is not positive.
+    SolverError
+        The constrained problem failed.
+    """
+    kin = _kinematics(arm)
+    f = kin.frame(frame)
+    if f.link == 0:
+        raise ModelError(f"frame {frame!r} is on the base; a load there does not move")
+    n, k = kin.n, f.link
+    if data.q.shape[-1] != n:
+        raise ShapeError(f"data have {data.q.shape[-1]} joints; robot {kin.name!r} has {n}")
+    notes: list[str] = []
+    static = isinstance(data, StaticDataset)
+    if unloaded is not None:
+        if isinstance(unloaded, StaticDataset) != static:
+            raise ShapeError("unloaded must be the same kind of data as data (static or log)")
+        if static:
+            model = identify_static(kin, unloaded, rtol=rtol)  # type: ignore[arg-type]
+        else:
+            model = identify_from_log(kin, unloaded, cutoff_hz=cutoff_hz, rtol=rtol)  # type: ignore[arg-type]
+        robot = model.equivalent_robot
+        notes.append(
+            f"difference method: arm identified from the unloaded data "
+            f"({model.base.rank} base parameters); the standard deviations leave out "
+            "the uncertainty of that fit"
+        )
+    else:
+        robot = _arm(arm)
+    A = link_params_from_frame(f.T_link_frame)
+    cols = slice(10 * (k - 1), 10 * k)
+    friction = None
+    if static:
+        q = data.q
+        Y = static_regressor(robot, q)[..., cols] @ A
+        y = static_vector(data.M, data.g) - static_vector(
+            mass_matrix(robot, q), gravity_torques(robot, q)
+        )
+        route = "static M and g"
+        if gravity_only:
+            rows = n * (n + 1) // 2
+            Y, y = Y[:, rows:, :4], y[:, rows:]
+            route = "static g"
+            notes.append("g only: mass and CoM identified, the inertia is not")
+        W, yv = Y.reshape(-1, Y.shape[-1]), y.reshape(-1)
+    else:
+        log = prepare_log(data, cutoff_hz=cutoff_hz)
+        Y = torque_regressor(robot, log.q, log.dq, log.ddq)[..., cols] @ A
+        y = log.tau - rnea(robot, log.q, log.dq, log.ddq)
+        Y = np.concatenate([Y, friction_regressor(log.dq)], axis=-1)
+        W, yv = Y.reshape(-1, Y.shape[-1]), y.reshape(-1)
+        route = "torque log"
+        notes.append("classical friction fv, fc, fo per joint estimated alongside")
+    if unloaded is not None:
+        route += ", difference"
+    fit = fit_least_squares(W, yv, rtol=rtol, covariance="robust")
+    p = 4 if (static and gravity_only) else 10
+    est = np.asarray(fit.beta)
+    cov = np.asarray(fit.covariance)[:p, :p]
+    phi_ls = np.zeros(10)
+    phi_ls[:p] = est[:p]
+    if not static:
+        friction = est[10:].reshape(n, 3)
+    if p == 4:
+        if phi_ls[0] <= 0:
+            raise DataError(
+                f"the estimated load mass is {phi_ls[0]:.6g} kg (not positive); "
+                "is a load mounted, and is the arm's model right?"
+            )
+        phi, active, marg = phi_ls, False, float("nan")
+    else:
+        import scipy.linalg
+
+        R = scipy.linalg.qr(W[:, :10], mode="r")[0][:10]
+        phi, active = _consistent(phi_ls, R, margin)
+        marg = float(pseudo_inertia_margin(phi))
+        if active:
+            notes.append(
+                "the least-squares estimate was not physically consistent; the LMI "
+                f"(margin {margin:g}) moved it; standard deviations are the unconstrained ones"
+            )
+    m, c, I, sm, sc, si = _summary(phi, cov, p == 10)
+    return PayloadEstimate(
+        frame=frame,
+        link=k,
+        phi=phi,
+        mass=m,
+        com=c,
+        inertia=I,
+        std_mass=sm,
+        std_com=sc,
+        std_inertia=si,
+        covariance=cov,
+        route=route,
+        inertia_identified=p == 10,
+        constraint_active=active,
+        margin=marg,
+        rank=fit.rank,
+        condition_number=fit.condition_number,
+        residual_rms=fit.residual_rms,
+        n_rows=fit.n_rows,
+        friction=friction,
+        notes=tuple(notes),
+    )
+
+
+def robot_with_payload(robot: Robot, est: PayloadEstimate, *, name: str = "payload") -> Robot:
+    """The robot carrying the load: :meth:`Robot.with_tool` at the estimate's frame."""
+    return robot.with_tool(np.eye(4), est.mass, est.com, est.inertia, parent=est.frame, name=name)

@@ -1,0 +1,109 @@
+"""payload.json: an identified load, also in libfranka's ``setLoad`` convention.
+
+:func:`payload_to_dict` / :func:`save_payload_json` write::
+
+    {"schema": "dynid-payload/1", "dynid_version": ..., "robot": ..., "frame": "flange",
+     "route": "static M and g", "mass": 0.8, "com": [x, y, z],
+     "inertia": [xx, xy, xz, yy, yz, zz] | null,
+     "std": {"mass": ..., "com": [...], "inertia": [...] | null},
+     "load_mass": ..., "F_x_Cload": [...], "load_inertia": [9 numbers, column-major],
+     "with_tool": "robot_with_payload.toml", "inertia_identified": true,
+     "constraint_active": false, "pseudo_inertia_margin": ..., "rank": 10,
+     "condition_number": ..., "residual_rms": ..., "n_rows": ..., "notes": [...],
+     "units": {...}, "conventions": {...}}
+
+``mass`` [kg]; ``com`` [m] in the given frame; ``inertia`` about the CoM in the frame's axes
+[kg m^2]. ``load_mass``, ``F_x_Cload`` (CoM in the flange frame [m]) and ``load_inertia``
+(inertia about the CoM in flange axes, 3x3 column-major) are libfranka's
+``Robot::setLoad`` arguments: the load carried into the flange frame when the frame is on
+the flange's link; null otherwise (and ``load_inertia`` null when the inertia was not
+identified). Floats use Python's shortest round-trip representation.
+"""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from .. import __version__, spatial
+from ..feasibility.payload import PayloadEstimate
+from ..model.inertia import INERTIA_ORDER, inertia6_from_matrix
+from ..model.robot import Robot
+
+__all__ = ["PAYLOAD_SCHEMA", "payload_to_dict", "save_payload_json"]
+
+PAYLOAD_SCHEMA = "dynid-payload/1"
+
+
+def _num(x: float) -> float | None:
+    x = float(x)
+    return x if np.isfinite(x) else None
+
+
+def _list(a: Any) -> list[float | None]:
+    return [_num(x) for x in np.asarray(a, dtype=float).reshape(-1)]
+
+
+def payload_to_dict(
+    est: PayloadEstimate, robot: Robot, *, with_tool: str | None = None
+) -> dict[str, Any]:
+    """The payload.json document of an estimate on ``robot`` (module docstring)."""
+    d: dict[str, Any] = {
+        "schema": PAYLOAD_SCHEMA,
+        "dynid_version": __version__,
+        "robot": robot.name,
+        "frame": est.frame,
+        "route": est.route,
+        "mass": _num(est.mass),
+        "com": _list(est.com),
+        "inertia": _list(inertia6_from_matrix(est.inertia)) if est.inertia_identified else None,
+        "std": {
+            "mass": _num(est.std_mass),
+            "com": _list(est.std_com),
+            "inertia": _list(est.std_inertia) if est.inertia_identified else None,
+        },
+    }
+    fl, fr = robot.frame("flange"), robot.frame(est.frame)
+    if fl.link == fr.link:
+        T_flange_frame = spatial.inverse_transform(fl.T_link_frame) @ fr.T_link_frame
+        R, p = T_flange_frame[:3, :3], T_flange_frame[:3, 3]
+        I_fl = R @ est.inertia @ R.T
+        d["load_mass"] = _num(est.mass)
+        d["F_x_Cload"] = _list(R @ est.com + p)
+        d["load_inertia"] = _list(I_fl.T) if est.inertia_identified else None
+    else:
+        d["load_mass"] = d["F_x_Cload"] = d["load_inertia"] = None
+    d.update(
+        {
+            "with_tool": with_tool,
+            "inertia_identified": est.inertia_identified,
+            "constraint_active": est.constraint_active,
+            "pseudo_inertia_margin": _num(est.margin),
+            "rank": int(est.rank),
+            "condition_number": _num(est.condition_number),
+            "residual_rms": _num(est.residual_rms),
+            "n_rows": int(est.n_rows),
+            "notes": list(est.notes),
+            "units": {"mass": "kg", "com": "m", "inertia": "kg m^2"},
+            "conventions": {
+                "com": f"centre of mass in frame {est.frame!r}",
+                "inertia": "about the CoM, frame axes, order " + " ".join(INERTIA_ORDER),
+                "load_inertia": "libfranka setLoad: about the CoM, flange axes, column-major",
+                "F_x_Cload": "libfranka setLoad: CoM in the flange frame",
+            },
+        }
+    )
+    return d
+
+
+def save_payload_json(
+    path: str | Path, est: PayloadEstimate, robot: Robot, *, with_tool: str | None = None
+) -> Path:
+    """Write :func:`payload_to_dict` to ``path``; returns the path."""
+    path = Path(path)
+    text = json.dumps(payload_to_dict(est, robot, with_tool=with_tool), indent=1, allow_nan=False)
+    path.write_text(text + "\n", encoding="utf-8")
+    return path
