@@ -24,6 +24,7 @@ from pathlib import Path
 from ..exceptions import DynidError
 from ..feasibility.payload import identify_payload, robot_with_payload
 from ..identification.log import DEFAULT_CUTOFF_HZ
+from ..identification.model import IdentifiedModel
 from ..io.columns import ColumnMap, read_mapped_static_data
 from ..io.payload_json import save_payload_json
 from .common import add_column_options, column_map, read_log
@@ -70,7 +71,7 @@ def _read(args: argparse.Namespace, path: Path, robot, kind: str):  # noqa: ANN0
 def run(args: argparse.Namespace) -> int:
     """Identify, write payload.json and the robot with the load, print a summary."""
     arm, label = load_model_source(args)
-    kin = arm.robot if hasattr(arm, "equivalent_robot") else arm
+    kin = arm.robot if isinstance(arm, IdentifiedModel) else arm
     kind = data_kind(args.data, column_map(args))
     if args.gravity_only and kind != "static":
         raise DynidError("--gravity-only applies to static data (q, g), not to a torque log")
@@ -85,7 +86,7 @@ def run(args: argparse.Namespace) -> int:
         cutoff_hz=args.cutoff if kind == "torque_log" else None,
     )
     args.out.mkdir(parents=True, exist_ok=True)
-    base = arm.equivalent_robot if hasattr(arm, "equivalent_robot") else arm
+    base = arm.equivalent_robot if isinstance(arm, IdentifiedModel) else arm
     tool = robot_with_payload(base, est)
     tool.to_toml(args.out / "robot_with_payload.toml")
     path = save_payload_json(

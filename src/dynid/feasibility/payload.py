@@ -278,7 +278,7 @@ def identify_payload(
     A = link_params_from_frame(f.T_link_frame)
     cols = slice(10 * (k - 1), 10 * k)
     friction = None
-    if static:
+    if isinstance(data, StaticDataset):
         q = data.q
         Y = static_regressor(robot, q)[..., cols] @ A
         y = static_vector(data.M, data.g) - static_vector(
@@ -293,8 +293,10 @@ def identify_payload(
         W, yv = Y.reshape(-1, Y.shape[-1]), y.reshape(-1)
     else:
         log = prepare_log(data, cutoff_hz=cutoff_hz)
-        Y = torque_regressor(robot, log.q, log.dq, log.ddq)[..., cols] @ A
-        y = log.tau - rnea(robot, log.q, log.dq, log.ddq)
+        ddq = log.ddq
+        assert ddq is not None  # prepare_log always differentiates
+        Y = torque_regressor(robot, log.q, log.dq, ddq)[..., cols] @ A
+        y = np.asarray(log.tau) - rnea(robot, log.q, log.dq, ddq)
         Y = np.concatenate([Y, friction_regressor(log.dq)], axis=-1)
         W, yv = Y.reshape(-1, Y.shape[-1]), y.reshape(-1)
         route = "torque log"

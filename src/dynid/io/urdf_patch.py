@@ -84,7 +84,7 @@ def _inertial_xml(phi: NDArray[np.float64], indent: str, step: str) -> str:
     attrs = " ".join(f'{a}="{_f(x)}"' for a, x in zip(_ATTRS, i6, strict=True))
     return (
         f'<inertial>\n{inner}<origin xyz="{_v(c)}" rpy="0 0 0"/>\n'
-        f'{inner}<mass value="{_f(m)}"/>\n{inner}<inertia {attrs}/>\n{indent}</inertial>'
+        f'{inner}<mass value="{_f(float(m))}"/>\n{inner}<inertia {attrs}/>\n{indent}</inertial>'
     )
 
 
@@ -180,7 +180,7 @@ def patch_urdf_inertials(
     elems = {el.get("name"): el for el in root if el.tag.rsplit("}", 1)[-1] == "link"}
     spans = _link_spans(template)
     moving = set(chain.link_names[1:])
-    new_xml: dict[str, str | None] = {}  # link -> inertial text, None: remove it
+    new_xml: dict[str, NDArray[np.float64] | None] = {}  # link -> phi, None: remove
     for k in range(1, robot.n + 1):
         link = chain.link_names[k]
         own = _own_phi(elems[link])
@@ -193,7 +193,7 @@ def patch_urdf_inertials(
                 if fr.link == k and name in elems and name not in moving:
                     if elems[name].find("inertial") is not None:
                         new_xml[name] = None
-        new_xml[link] = phi  # type: ignore[assignment]
+        new_xml[link] = phi
     edits: list[tuple[int, int, str]] = []
     for link, phi in new_xml.items():
         start, open_end, end, closed = spans[link]
