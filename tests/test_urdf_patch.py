@@ -172,6 +172,8 @@ def test_chain_export_keeps_the_source_tip_name():
     assert '<link name="panda_link8"/>' in text and "flange" not in text
     assert re.findall(r'<joint name="(panda_joint\d)"', text) == list(chain.joint_names)
     assert '<link name="flange"/>' in urdf_from_robot(dynid.panda())
+    tooled = dynid.panda().with_tool(np.eye(4), 0.5, (0, 0, 0.05), name="gripper")
+    assert '<link name="flange"/>' in urdf_from_robot(tooled)  # a later frame is not the tip
 
 
 def test_cli_export_urdf_template_and_mjcf(tmp_path, capsys):

@@ -74,14 +74,18 @@ def _fixed(name: str, parent: str, T: np.ndarray) -> list[str]:
 def tip_name(robot: Robot) -> str | None:
     """Name of the source link at the ``flange`` frame, None when it is a moving link.
 
-    ``"flange"`` when no other named frame sits there (a robot built from MDH).
+    The first named frame (in the robot's order) at the flange's pose: a URDF tip link
+    fixed to the last moving link (``panda_link8``) precedes ``flange``, while frames added
+    later (``with_tool`` at the flange) follow it. ``"flange"`` when no source name precedes.
     """
     f = robot.frame("flange")
     if f.link == robot.n and np.array_equal(f.T_link_frame, np.eye(4)):
         return None
     for name, g in robot.frames.items():
-        if name in ("flange",) or name in robot.link_names:
+        if name in robot.link_names:
             continue
+        if name == "flange":
+            return "flange"
         if g.link == f.link and np.allclose(g.T_link_frame, f.T_link_frame, atol=1e-12):
             return name
     return "flange"
