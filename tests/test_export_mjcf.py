@@ -138,3 +138,16 @@ def test_export_format_by_suffix_and_errors(tmp_path):
         save_robot(tmp_path / "a.xml", dynid.panda(), template=tmp_path / "t.urdf")
     path = save_robot(tmp_path / "a.toml", dynid.panda())
     np.testing.assert_allclose(dynid.Robot.from_toml(path).phi, dynid.panda().phi, rtol=1e-15)
+
+
+def test_identified_classical_friction_is_written_as_it_is():
+    """Classical fv, fc go to damping and frictionloss exactly; the offset fo is reported."""
+    robot = dynid.panda()
+    fr = dynid.ClassicalFriction(np.linspace(0.1, 0.7, 7), np.linspace(0.2, 0.8, 7), np.ones(7))
+    text, approx = mjcf_from_robot(robot, friction=fr)
+    model = mujoco.MjModel.from_xml_string(text)
+    np.testing.assert_array_equal(model.dof_damping, fr.fv)
+    np.testing.assert_array_equal(model.dof_frictionloss, fr.fc)
+    np.testing.assert_array_equal(approx.offset, fr.fo)
+    with pytest.raises(ShapeError, match="friction has 2 joints"):
+        mjcf_from_robot(robot, friction=dynid.ClassicalFriction(np.ones(2), np.ones(2), np.ones(2)))

@@ -66,6 +66,7 @@ from ..feasibility.retrieve import (
 )
 from ..feasibility.sdp import ConsistentResult
 from ..feasibility.validate import NewtonEulerValidation, validate_newton_euler
+from ..friction.model import ClassicalFriction
 from ..identification.model import IdentifiedModel
 from ..io.export import save_robot
 from ..io.feasible import load_bounds, save_feasible_json, save_report_json
@@ -246,7 +247,12 @@ def write_outputs(
     """Write feasible.json, robot.urdf, robot.xml, robot.toml, report.json (and retrieval.png)."""
     out.mkdir(parents=True, exist_ok=True)
     files = [save_feasible_json(out / "feasible.json", result)]
-    files += [save_robot(out / f"robot.{ext}", result.robot) for ext in ("urdf", "xml", "toml")]
+    fr = getattr(result, "friction", None)  # one-step on a log: classical fv, fc, fo
+    mj = ClassicalFriction.from_array(fr) if fr is not None else True
+    files += [
+        save_robot(out / f"robot.{ext}", result.robot, friction=mj)
+        for ext in ("urdf", "xml", "toml")
+    ]
     files.append(save_report_json(out / "report.json", result, **report_extra))
     if figures:
         from ..plots.feasible import plot_consistent, plot_retrieval

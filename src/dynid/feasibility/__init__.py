@@ -5,6 +5,8 @@
   a :class:`Prior` (:mod:`.sdp`, :mod:`.one_step`, :mod:`.lmi`, :mod:`.prior`).
 * :func:`retrieve`: Gaz et al. 2019, Algorithm 1 (:mod:`.retrieve`, :mod:`.penalty`).
 * :func:`compare_methods`: both on the same coefficients (:mod:`.compare`).
+* :func:`identify_payload`: a load's mass, CoM and inertia on a known arm, with the same
+  LMI (:mod:`.payload`).
 * :func:`feasibility_report`, :class:`Bounds`: constraints and their margins
   (:mod:`.constraints`); :func:`validate_newton_euler` (:mod:`.validate`).
 """
@@ -13,6 +15,7 @@ from .compare import MethodSummary, compare_methods, perturbed_robot
 from .constraints import Bounds, default_bounds, feasibility_report, kinematic_bounds, panda_bounds
 from .lmi import log_det_divergence, pseudo_inertia, pseudo_inertia_margin
 from .one_step import identify_consistent
+from .payload import PayloadEstimate, identify_payload, robot_with_payload
 from .prior import Prior, generic_prior, prior_from_robot
 from .retrieve import RetrievalOptions, RetrievalResult, retrieve, retrieve_from_static
 from .sdp import ConsistentResult, SDPOptions, retrieve_sdp, solve_consistent
@@ -22,6 +25,7 @@ __all__ = [
     "Bounds",
     "ConsistentResult",
     "MethodSummary",
+    "PayloadEstimate",
     "Prior",
     "RetrievalOptions",
     "RetrievalResult",
@@ -31,6 +35,7 @@ __all__ = [
     "feasibility_report",
     "generic_prior",
     "identify_consistent",
+    "identify_payload",
     "kinematic_bounds",
     "log_det_divergence",
     "panda_bounds",
@@ -41,6 +46,7 @@ __all__ = [
     "retrieve",
     "retrieve_from_static",
     "retrieve_sdp",
+    "robot_with_payload",
     "solve_consistent",
     "validate_newton_euler",
 ]

@@ -17,6 +17,7 @@ from __future__ import annotations
 from pathlib import Path
 
 from ..exceptions import DataError
+from ..friction.model import ClassicalFriction
 from ..model.robot import Robot
 from .mjcf_export import save_mjcf
 from .urdf_export import save_urdf
@@ -57,7 +58,7 @@ def save_robot(
     base: str | None = None,
     tip: str | None = None,
     merged: str = "subtract",
-    friction: bool = True,
+    friction: bool | ClassicalFriction = True,
     all_frames: bool = False,
 ) -> Path:
     """Write ``robot`` as URDF, MJCF or TOML; returns the path.
@@ -70,8 +71,9 @@ def save_robot(
         Default: from the suffix of ``path``.
     template, base, tip, merged, all_frames
         URDF only (:func:`dynid.io.urdf_export.save_urdf`).
-    friction : bool
-        MJCF only: write the robot's friction (:func:`dynid.io.mjcf_export.save_mjcf`).
+    friction : bool or ClassicalFriction
+        MJCF only: the robot's friction, identified classical friction, or none
+        (:func:`dynid.io.mjcf_export.save_mjcf`).
 
     Raises
     ------

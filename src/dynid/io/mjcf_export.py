@@ -18,8 +18,11 @@ keeping the robot's link and joint names:
 * friction (``friction=True`` and a sigmoid on the robot): the sigmoid's odd part fitted
   as ``frictionloss`` [N m] + ``damping`` [N m s/rad]
   (:func:`dynid.friction.mujoco.coulomb_viscous_from_sigmoid`; an approximation: MuJoCo
-  cannot hold the sigmoid's offset and curvature). With ``friction=False`` the joints are
-  frictionless, and ``mj_inverse`` equals :func:`dynid.rnea`.
+  cannot hold the sigmoid's offset and curvature). ``friction=`` a
+  :class:`~dynid.friction.model.ClassicalFriction` (identified ``fv, fc, fo``) is written
+  as it is, ``frictionloss = fc``, ``damping = fv``; only the offset ``fo`` is dropped.
+  With ``friction=False`` the joints are frictionless, and ``mj_inverse`` equals
+  :func:`dynid.rnea`.
 
 Numbers use Python's shortest round-trip representation.
 """
@@ -33,6 +36,8 @@ import numpy as np
 from scipy.spatial.transform import Rotation
 
 from .. import __version__
+from ..exceptions import ShapeError
+from ..friction.model import ClassicalFriction
 from ..friction.mujoco import CoulombViscous, coulomb_viscous_from_sigmoid
 from ..model.inertia import inertia6_from_matrix
 from ..model.robot import Robot
@@ -56,15 +61,16 @@ def _pose(T: np.ndarray) -> str:
 
 
 def mjcf_from_robot(
-    robot: Robot, *, friction: bool = True, comment: str | None = None
+    robot: Robot, *, friction: bool | ClassicalFriction = True, comment: str | None = None
 ) -> tuple[str, CoulombViscous | None]:
     """The MJCF document of a robot, and the friction approximation it holds.
 
     Parameters
     ----------
     robot : Robot
-    friction : bool
-        Write the robot's sigmoid friction (if any) as ``frictionloss`` and ``damping``.
+    friction : bool or ClassicalFriction
+        True: the robot's sigmoid friction (if any) as ``frictionloss`` and ``damping``;
+        a classical model: its ``fc`` and ``fv``; False: none.
     comment : str, optional
         Text of an XML comment at the top (default: the writer and the conventions).
 
@@ -77,14 +83,22 @@ def mjcf_from_robot(
     """
     n = robot.n
     approx = None
-    if friction and robot.friction is not None:
+    if isinstance(friction, ClassicalFriction):
+        if friction.n != n:
+            raise ShapeError(f"friction has {friction.n} joints; robot {robot.name!r} has {n}")
+        z = np.zeros(n)
+        approx = CoulombViscous(
+            np.asarray(friction.fc), np.asarray(friction.fv), np.asarray(friction.fo), z, z
+        )
+    elif friction and robot.friction is not None:
         approx = coulomb_viscous_from_sigmoid(robot.friction, robot.dq_max)
     I6 = inertia6_from_matrix(robot.inertia)[:, [0, 3, 5, 1, 2, 4]]  # xx yy zz xy xz yz
     mass, com = robot.mass, robot.com
     text = comment or (
         f"written by dynid {__version__}: inertials about the CoM in link axes [kg, m, kg m^2]"
         + (
-            "; friction: odd part of the sigmoid as frictionloss + damping (approximation)"
+            "; friction: Coulomb as frictionloss, viscous as damping"
+            + ("" if isinstance(friction, ClassicalFriction) else " (fit of the sigmoid)")
             if approx is not None
             else "; frictionless joints"
         )
@@ -137,7 +151,7 @@ def mjcf_from_robot(
     return "\n".join(lines) + "\n", approx
 
 
-def save_mjcf(path: str | Path, robot: Robot, *, friction: bool = True) -> Path:
+def save_mjcf(path: str | Path, robot: Robot, *, friction: bool | ClassicalFriction = True) -> Path:
     """Write :func:`mjcf_from_robot` to ``path``; returns the path."""
     path = Path(path)
     text, _ = mjcf_from_robot(robot, friction=friction)
