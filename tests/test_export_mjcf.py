@@ -15,7 +15,7 @@ from dynid.friction.mujoco import coulomb_viscous_from_sigmoid
 from dynid.io.export import export_format, save_robot
 from dynid.io.mjcf_export import mjcf_from_robot, save_mjcf
 
-from conftest import planar_2r, random_states
+from conftest import planar_2r, random_states, robot_data_urdf
 
 mujoco = pytest.importorskip("mujoco")
 
@@ -55,7 +55,13 @@ def _rpp_robot() -> dynid.Robot:
     )
 
 
-@pytest.mark.parametrize("make", [dynid.panda, planar_2r, _rpp_robot])
+def _ur5_from_urdf() -> dynid.Robot:
+    """UR5 of example-robot-data: URDF joint frames with rpy, fixed links as sites."""
+    path = robot_data_urdf("ur_description/urdf/ur5_robot.urdf")
+    return dynid.Robot.from_urdf(path, "base_link", "tool0")
+
+
+@pytest.mark.parametrize("make", [dynid.panda, planar_2r, _rpp_robot, _ur5_from_urdf])
 def test_mj_inverse_equals_rnea_at_random_states(make, tmp_path):
     """MuJoCo's mj_inverse on the frictionless export equals dynid rnea to 1e-9 relative."""
     robot = make()
@@ -151,3 +157,21 @@ def test_identified_classical_friction_is_written_as_it_is():
     np.testing.assert_array_equal(approx.offset, fr.fo)
     with pytest.raises(ShapeError, match="friction has 2 joints"):
         mjcf_from_robot(robot, friction=dynid.ClassicalFriction(np.ones(2), np.ones(2), np.ones(2)))
+
+
+def test_massless_link_compiles_with_negligible_bound(tmp_path):
+    """A massless moving link compiles (bounded to 1e-10 kg) and mj_inverse still equals rnea."""
+    inertia = np.stack([np.zeros((3, 3)), np.diag([0.01, 0.02, 0.025])])
+    robot = dynid.Robot.from_mdh(
+        [0.0, 1.0],
+        [0.0, 0.0],
+        [0.0, np.pi / 2],
+        mass=[0.0, 1.0],
+        com=[[0, 0, 0], [0.5, 0, 0.1]],
+        inertia=inertia,
+    )
+    model = mujoco.MjModel.from_xml_path(str(save_mjcf(tmp_path / "r.xml", robot)))
+    np.testing.assert_allclose(model.body_mass[2:], [1e-10, 1.0])
+    q, dq, ddq = random_states(robot, 50, seed=9)
+    tau = dynid.rnea(robot, q, dq, ddq)
+    assert np.max(np.abs(_mj_inverse(model, q, dq, ddq) - tau)) < 1e-9 * np.max(np.abs(tau))

@@ -10,7 +10,11 @@ keeping the robot's link and joint names:
   position limits are finite (``<compiler angle="radian" autolimits="true"/>``);
 * ``<inertial pos="c" mass="m" fullinertia="xx yy zz xy xz yz"/>``: CoM [m] in the link
   frame and the inertia about the CoM in link axes [kg m^2] (MuJoCo's ``fullinertia``
-  order);
+  order); omitted for a link whose parameters are all zero (MuJoCo refuses a zero
+  ``fullinertia``). MuJoCo also refuses moving bodies without mass, so the compiler
+  bounds every body's mass to at least 1e-10 kg and its principal moments to 1e-14 kg m^2
+  (``boundmass``, ``boundinertia``): massless links weigh 1e-10 kg, real links are
+  unchanged;
 * every named frame that is not a link (``flange``, tools) becomes a ``<site>``;
 * ``<option gravity>`` is the robot's gravity [m/s^2]; one ``<motor>`` per joint with
   ``ctrlrange`` = the torque limit when it is finite (gear 1, so ``ctrl`` is the joint
@@ -115,7 +119,7 @@ def mjcf_from_robot(
         '<?xml version="1.0"?>',
         f"<!-- {text.replace('--', '- -')} -->",
         f"<mujoco model={quoteattr(robot.name)}>",
-        '  <compiler angle="radian" autolimits="true"/>',
+        '  <compiler angle="radian" autolimits="true" boundmass="1e-10" boundinertia="1e-14"/>',
         f'  <option gravity="{_v(robot.gravity)}"/>',
         "  <worldbody>",
         f'    <body name={quoteattr(robot.link_names[0])} pos="0 0 0">',
@@ -134,8 +138,12 @@ def mjcf_from_robot(
             f"{ind[:-2]}<body name={quoteattr(robot.link_names[i + 1])} "
             f"{_pose(robot.T_parent_joint[i])}>",
             f"{ind}<joint {attrs}/>",
-            f'{ind}<inertial pos="{_v(com[i])}" mass="{_f(mass[i])}" fullinertia="{_v(I6[i])}"/>',
         ]
+        if np.any(robot.phi[i] != 0.0):  # MuJoCo refuses a zero fullinertia; omit it
+            lines.append(
+                f'{ind}<inertial pos="{_v(com[i])}" mass="{_f(mass[i])}" '
+                f'fullinertia="{_v(I6[i])}"/>'
+            )
         lines += [ind + s for s in sites.get(i + 1, [])]
     for i in reversed(range(n)):
         lines.append("    " + "  " * (i + 1) + "</body>")
