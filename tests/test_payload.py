@@ -257,3 +257,20 @@ def test_cli_payload_writes_payload_json_and_the_robot(tmp_path, capsys):
     assert "g only" in capsys.readouterr().out
     assert main(argv[:-2] + ["--frame", "nope", "--out", str(tmp_path / "x")]) == 2
     assert capsys.readouterr().err.startswith("dynid payload: error: Unknown frame")
+
+
+def test_cli_payload_on_an_identified_arm(tmp_path):
+    """--model identification.json (the arm identified without the load) as the known arm."""
+    arm = dynid.panda()
+    save_static_csv(tmp_path / "arm.csv", _static(arm, 300, 0.0, 14))
+    loaded = arm.with_tool(np.eye(4), MASS, COM, _inertia(), name="load")
+    save_static_csv(tmp_path / "loaded.csv", _static(loaded, 300, 0.0, 15))
+    assert (
+        main(["identify", "--data", str(tmp_path / "arm.csv"), "--out", str(tmp_path / "id"), "-q"])
+        == 0
+    )
+    model = tmp_path / "id" / "identification.json"
+    argv = ["payload", "--model", str(model), "--data", str(tmp_path / "loaded.csv")]
+    assert main(argv + ["--out", str(tmp_path / "p"), "-q"]) == 0
+    d = json.loads((tmp_path / "p" / "payload.json").read_text())
+    assert abs(d["mass"] - MASS) < 1e-8 and np.max(np.abs(np.subtract(d["com"], COM))) < 1e-8

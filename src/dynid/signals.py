@@ -252,10 +252,10 @@ def filtered_derivative(
 ) -> NDArray[np.float64]:
     """Derivative of a signal after a zero-phase low-pass: :func:`lowpass`, then :func:`derivative`.
 
-    Used for velocities from positions when a log has positions only. The filter assumes
-    uniform sampling at the median rate of ``t`` (resample jittered logs first with
-    :func:`resample_uniform`); the first and last ``edge_seconds(cutoff_hz)`` carry the
-    filter's transient (:func:`trim_edges`).
+    Used for velocities from positions when a log has positions only. A jittered ``t``
+    (or one with gaps) is resampled onto a uniform grid first (:func:`resample_uniform`)
+    and the derivative interpolated back onto ``t``; the first and last
+    ``edge_seconds(cutoff_hz)`` carry the filter's transient (:func:`trim_edges`).
 
     Parameters
     ----------
@@ -279,7 +279,14 @@ def filtered_derivative(
         Cutoff not below the Nyquist frequency, too few samples, ``t`` not increasing.
     """
     t = _time(t)
-    return derivative(t, lowpass(x, sample_rate(t), cutoff_hz, order=order))
+    if is_uniform(t):
+        return derivative(t, lowpass(x, sample_rate(t), cutoff_hz, order=order))
+    x = _checks.as_array("x", x)
+    tu, xu = resample_uniform(t, x)
+    du = derivative(tu, lowpass(xu, sample_rate(tu), cutoff_hz, order=order))
+    flat = du.reshape(du.shape[0], -1)
+    out = np.stack([np.interp(t, tu, flat[:, k]) for k in range(flat.shape[1])], axis=1)
+    return out.reshape((t.shape[0],) + x.shape[1:])
 
 
 def edge_seconds(cutoff_hz: float) -> float:
