@@ -14,8 +14,10 @@ linear in the load's parameters ``phi_F = [m, m c, J_F]`` (about ``F``'s origin,
 * **static g only** (``gravity_only=True``): ``g`` depends on ``m`` and ``m c`` only, so
   the mass and the CoM are estimated and the inertia is not (``inertia_identified`` False);
 * **a torque log** (:class:`~dynid.identification.log.TorqueLog`): zero-phase filtered and
-  differentiated (:func:`~dynid.identification.log.prepare_log`), ``Y`` the torque
-  regressor, and the classical friction ``fv, fc, fo`` per joint estimated alongside;
+  differentiated (:func:`~dynid.identification.log.prepare_log`), decimated to about ten
+  samples per cutoff period (as :func:`~dynid.identification.classical.identify_from_log`),
+  ``Y`` the torque regressor, and the classical friction ``fv, fc, fo`` per joint
+  estimated alongside;
 * **difference method** (``unloaded=`` data of the same kind recorded without the load):
   the arm is first identified from the unloaded data (base parameters,
   :func:`~dynid.identification.static.identify_static` or
@@ -44,7 +46,7 @@ from numpy.typing import NDArray
 from ..dynamics.rnea import rnea
 from ..dynamics.terms import gravity_torques, mass_matrix
 from ..exceptions import DataError, ModelError, ShapeError, SolverError
-from ..identification.classical import friction_regressor, identify_from_log
+from ..identification.classical import auto_decimation, friction_regressor, identify_from_log
 from ..identification.data import StaticDataset
 from ..identification.least_squares import fit_least_squares
 from ..identification.log import DEFAULT_CUTOFF_HZ, TorqueLog, prepare_log
@@ -295,9 +297,11 @@ def identify_payload(
         log = prepare_log(data, cutoff_hz=cutoff_hz)
         ddq = log.ddq
         assert ddq is not None  # prepare_log always differentiates
-        Y = torque_regressor(robot, log.q, log.dq, ddq)[..., cols] @ A
-        y = np.asarray(log.tau) - rnea(robot, log.q, log.dq, ddq)
-        Y = np.concatenate([Y, friction_regressor(log.dq)], axis=-1)
+        sl = slice(None, None, auto_decimation(data.sample_rate, cutoff_hz))
+        q_, dq_, ddq_ = log.q[sl], log.dq[sl], ddq[sl]
+        Y = torque_regressor(robot, q_, dq_, ddq_)[..., cols] @ A
+        y = np.asarray(log.tau[sl]) - rnea(robot, q_, dq_, ddq_)
+        Y = np.concatenate([Y, friction_regressor(dq_)], axis=-1)
         W, yv = Y.reshape(-1, Y.shape[-1]), y.reshape(-1)
         route = "torque log"
         notes.append("classical friction fv, fc, fo per joint estimated alongside")
