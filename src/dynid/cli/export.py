@@ -50,7 +50,13 @@ def register(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParser:
     p.add_argument("--urdf-template", type=Path, default=None, help="the original URDF file")
     p.add_argument("--base", default=None, help="base link of the template's chain")
     p.add_argument("--tip", default=None, help="tip link of the template's chain")
-    p.add_argument("--merged", choices=MERGED_POLICIES, default="subtract")
+    p.add_argument(
+        "--merged",
+        choices=MERGED_POLICIES,
+        default="subtract",
+        help="template: links fixed to a moving link keep their inertials (subtract, default) "
+        "or give them to it (move)",
+    )
     p.add_argument("--no-friction", action="store_true", help="MJCF: frictionless joints")
     p.add_argument("--all-frames", action="store_true", help="URDF chain: every named frame")
     return p
