@@ -205,7 +205,7 @@ def prior_from_robot(
                 f"{phi[i, 0]:g} kg; replaced by the generic cylinder of {cyl[i, 0]:.3g} kg"
             )
             phi[i] = cyl[i]
-            repaired.append(i + 1)
+            repaired.append(int(i) + 1)
     before = pseudo_inertia_margin(phi)
     phi, changed = repair_pseudo_inertia(phi, margin)
     for i in np.flatnonzero(changed):

@@ -468,8 +468,10 @@ class _Problem:
             obj = 1e-6 * div + 0.5 * cp.sum_squares(cp.multiply(1.0 / s, x - term.x_hat))
         else:
             # divided by dof (the data term's size at a good fit): same minimiser, better scaled
-            k = 1.0 / math.sqrt(self.scale)
-            obj = self.w * div + 0.5 * cp.sum_squares((k * term.A) @ x - (k * term.A) @ term.x_hat)
+            ks = 1.0 / math.sqrt(self.scale)
+            obj = self.w * div + 0.5 * cp.sum_squares(
+                (ks * term.A) @ x - (ks * term.A) @ term.x_hat
+            )
         self.problem = cp.Problem(cp.Minimize(obj), cons)
         self.term = term
 

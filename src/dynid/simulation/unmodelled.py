@@ -97,7 +97,7 @@ class UnmodelledEffects:
         """``robot`` with the tilted gravity ``R g``."""
         if self.gravity_tilt == 0.0:
             return robot
-        k, t = self.tilt_axis, self.gravity_tilt
+        k, t = np.asarray(self.tilt_axis, dtype=np.float64), self.gravity_tilt
         K = np.array([[0.0, -k[2], k[1]], [k[2], 0.0, -k[0]], [-k[1], k[0], 0.0]])
         R = np.eye(3) + math.sin(t) * K + (1.0 - math.cos(t)) * K @ K
         return robot.with_gravity(R @ robot.gravity)
