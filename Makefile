@@ -1,34 +1,49 @@
-# Each target creates the virtual environment when it is missing and installs what it needs.
+# Each target creates the virtual environment when it is missing and installs what it needs:
+# `make demo` the runtime and the figures, the other targets the test extras too.
 PYTHON ?= python3
 VENV ?= .venv
 PY := $(VENV)/bin/python
-STAMP := $(VENV)/.installed
+RUNTIME := $(VENV)/.installed-runtime
+TESTS := $(VENV)/.installed-tests
 
-.PHONY: demo test bench lint clean
+.PHONY: demo test test-fast bench lint types clean
 
 # The problems here are tall and thin (e.g. 34,000 x 44): threaded BLAS only adds overhead
 # on a small machine. Override with OPENBLAS_NUM_THREADS=N make ...
 export OPENBLAS_NUM_THREADS ?= 1
 export OMP_NUM_THREADS ?= 1
 
-$(STAMP): pyproject.toml
+$(RUNTIME): pyproject.toml
 	test -x $(PY) || $(PYTHON) -m venv $(VENV)
 	$(PY) -m pip install -q --upgrade pip
-	$(PY) -m pip install -q -e ".[test,plots]"
-	touch $(STAMP)
+	$(PY) -m pip install -q -e ".[plots]"
+	touch $(RUNTIME)
 
-demo: $(STAMP)
+$(TESTS): $(RUNTIME)
+	$(PY) -m pip install -q -e ".[test,plots]"
+	touch $(TESTS)
+
+demo: $(RUNTIME)
 	$(VENV)/bin/dynid demo --out out
 
-test: $(STAMP)
+test: $(TESTS)
 	MPLBACKEND=Agg $(PY) -m pytest -q
 
-bench: $(STAMP)
+# everything but the tests marked slow (over about 10 s each)
+test-fast: $(TESTS)
+	MPLBACKEND=Agg $(PY) -m pytest -q -m "not slow"
+
+bench: $(TESTS)
 	$(PY) benchmarks/run_all.py
 
-lint: $(STAMP)
+lint: $(TESTS)
 	$(PY) -m pip install -q ruff
 	$(PY) -m ruff check src tests benchmarks examples
+	$(PY) -m ruff format --check src tests benchmarks examples
+
+types: $(TESTS)
+	$(PY) -m pip install -q mypy
+	$(PY) -m mypy src/dynid
 
 clean:
 	rm -rf $(VENV) out build src/*.egg-info

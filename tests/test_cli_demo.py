@@ -15,7 +15,7 @@ def test_demo_runs_every_stage_and_writes_the_report(tmp_path, capsys):
     out = tmp_path / "out"
     assert main(["demo", "--out", str(out), "--seed", "1"]) == 0
     text = capsys.readouterr().out
-    for stage in ("stage 1", "stage 2", "stage 3", "stage 4"):
+    for stage in ("stage 1", "stage 2", "stage 3", "stage 4", "stage 5"):
         assert stage in text
     for rel in (
         "ik_joint_motion.png",
@@ -28,6 +28,9 @@ def test_demo_runs_every_stage_and_writes_the_report(tmp_path, capsys):
         "feasible/robot.urdf",
         "feasible/robot.toml",
         "feasible/report.json",
+        "consistent/comparison.json",
+        "consistent/comparison.png",
+        "consistent/feasible.json",
         "report.md",
     ):
         assert (out / rel).stat().st_size > 0, rel
@@ -39,3 +42,15 @@ def test_demo_runs_every_stage_and_writes_the_report(tmp_path, capsys):
     assert rep["feasible"] and rep["relative_residual"] < 1e-4
     md = (out / "report.md").read_text()
     assert "## 4. Feasible link parameters" in md and "](friction/friction.png)" in md
+    # stage 5: the convex method is consistent with margin and plausible on data with model
+    # error; both methods reproduce the coefficients
+    cmp = {
+        m["method"]: m
+        for m in json.loads((out / "consistent" / "comparison.json").read_text())["methods"]
+    }
+    assert set(cmp) == {"sdp", "penalty", "penalty + prior"}
+    sdp = cmp["sdp"]
+    assert sdp["feasible"] and sdp["min_margin"]["pseudo_inertia"] >= 1e-4 * (1 - 1e-9)
+    assert sdp["lightest_link_kg"] >= 0.3 and sdp["relative_residual"] < 0.05
+    assert cmp["penalty"]["relative_residual"] < 1e-4
+    assert "## 5. Physically consistent parameters" in md
