@@ -26,6 +26,14 @@ class UnknownNameError(DynidError, KeyError):
         return str(self.args[0]) if self.args else ""
 
 
+class OptionError(DynidError, ValueError):
+    """An option or argument has a value outside its range (the message names it)."""
+
+
+class WrongTypeError(DynidError, TypeError):
+    """An argument has the wrong type (the message names it)."""
+
+
 class ModelError(DynidError, ValueError):
     """A robot description is malformed or cannot be modelled."""
 

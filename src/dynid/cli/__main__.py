@@ -1,17 +1,27 @@
 """dynid: kinematics, dynamics and dynamic identification of robot manipulators.
 
 Run ``dynid <command> --help`` for the options of one command.
+
+Exit status: 0 success; 1 a command's documented negative result (retrieve: no feasible
+set); 2 an error (one line on stderr; --debug shows the traceback); 130 interrupted
+(Ctrl-C); 143 terminated (SIGTERM). A failed or interrupted command leaves no file or
+folder of its own behind, and no file is ever half written.
 """
 
 from __future__ import annotations
 
 import argparse
+import contextlib
 import importlib
 import logging
+import re
+import signal
 import sys
-from collections.abc import Sequence
+import warnings
+from collections.abc import Iterator, Sequence
 
 from ..exceptions import DynidError
+from ..io._files import output_transaction
 
 #: Subcommands in pipeline order; each is the module ``dynid.cli.<module>`` with
 #: ``NAME``, ``register(subparsers)`` and ``run(args) -> int``.
@@ -42,9 +52,16 @@ def _modules():
                 raise
 
 
+class _Parser(argparse.ArgumentParser):
+    """An argument parser whose errors are one line (usage only with --help)."""
+
+    def error(self, message: str) -> None:  # type: ignore[override]
+        self.exit(2, f"{self.prog}: error: {message} (see {self.prog} --help)\n")
+
+
 def build_parser() -> argparse.ArgumentParser:
     """The argument parser with every subcommand."""
-    parser = argparse.ArgumentParser(
+    parser = _Parser(
         prog="dynid", description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter
     )
     from .. import __version__
@@ -60,8 +77,60 @@ def build_parser() -> argparse.ArgumentParser:
     return parser
 
 
+#: A value that starts like a negative number (``-0.1,0.2``, ``-.5``, ``-1e-3``), which
+#: argparse would take for an option when it holds a comma.
+_NEGATIVE = re.compile(r"-(\d|\.\d)")
+
+
+def join_negative_values(argv: Sequence[str]) -> list[str]:
+    """``--opt -0.1,0.2`` -> ``--opt=-0.1,0.2``, so that negative lists parse as values."""
+    out: list[str] = []
+    it = iter(range(len(argv)))
+    for i in it:
+        a = argv[i]
+        if (
+            a.startswith("--")
+            and "=" not in a
+            and i + 1 < len(argv)
+            and _NEGATIVE.match(argv[i + 1])
+        ):
+            out.append(f"{a}={argv[i + 1]}")
+            next(it, None)
+        else:
+            out.append(a)
+    return out
+
+
+class Terminated(BaseException):
+    """Raised in the main thread when a termination signal (SIGTERM) arrives."""
+
+
+def _terminate(signum: int, frame: object) -> None:
+    raise Terminated(signum)
+
+
+@contextlib.contextmanager
+def _signals_and_warnings(command: str) -> Iterator[None]:
+    """SIGTERM raises :class:`Terminated`; warnings print as one line (no source line)."""
+    old = None
+    with contextlib.suppress(ValueError):  # not the main thread: leave signals alone
+        old = signal.signal(signal.SIGTERM, _terminate)
+
+    def show(message, category, filename, lineno, file=None, line=None):  # noqa: ANN001
+        print(f"dynid {command}: warning: {message}", file=sys.stderr)
+
+    try:
+        with warnings.catch_warnings():
+            warnings.showwarning = show
+            yield
+    finally:
+        if old is not None:
+            signal.signal(signal.SIGTERM, old)
+
+
 def main(argv: Sequence[str] | None = None) -> int:
     """Entry point of the ``dynid`` console script; returns the exit code."""
+    argv = join_negative_values(sys.argv[1:] if argv is None else list(argv))
     parser = build_parser()
     args = parser.parse_args(argv)
     level = (
@@ -72,12 +141,33 @@ def main(argv: Sequence[str] | None = None) -> int:
         )
     )
     logging.basicConfig(level=level, format="%(levelname)s %(name)s: %(message)s")
+    say = f"dynid {args.command}"
     try:
-        return int(args._run(args) or 0)
+        with _signals_and_warnings(args.command), output_transaction():
+            return int(args._run(args) or 0)
+    except KeyboardInterrupt:
+        if args.debug:
+            raise
+        print(f"{say}: interrupted; no partial output left", file=sys.stderr)
+        return 130
+    except Terminated:
+        if args.debug:
+            raise
+        print(f"{say}: terminated (SIGTERM); no partial output left", file=sys.stderr)
+        return 143
     except (DynidError, OSError) as exc:
         if args.debug:
             raise
-        print(f"dynid {args.command}: error: {exc}", file=sys.stderr)
+        print(f"{say}: error: {exc}", file=sys.stderr)
+        return 2
+    except Exception as exc:  # anything unexpected: one line, never a traceback
+        if args.debug:
+            raise
+        print(
+            f"{say}: error: unexpected {type(exc).__name__}: {exc} (run with --debug for "
+            "the traceback)",
+            file=sys.stderr,
+        )
         return 2
 
 

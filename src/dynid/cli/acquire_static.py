@@ -22,7 +22,7 @@ import numpy as np
 
 from ..io.static_data import save_static_data
 from ..simulation.controller import DEFAULT_MARGIN, SimulatedController, acquire_static
-from .common import add_robot_options, load_robot
+from .common import add_robot_options, add_seed_option, count_type, load_robot, nonnegative_type
 
 NAME = "acquire-static"
 
@@ -36,18 +36,20 @@ def register(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParser:
         formatter_class=argparse.RawDescriptionHelpFormatter,
     )
     add_robot_options(p)
-    p.add_argument("--n", type=int, default=1010, help="number of configurations (default: 1010)")
+    p.add_argument(
+        "--n", type=count_type, default=1010, help="number of configurations (default: 1010)"
+    )
     p.add_argument(
         "--noise",
-        type=float,
+        type=nonnegative_type,
         default=0.0,
         metavar="REL",
         help="relative standard deviation of the multiplicative noise (default: 0)",
     )
-    p.add_argument("--seed", type=int, default=0, help="random seed (default: 0)")
+    add_seed_option(p)
     p.add_argument(
         "--margin",
-        type=float,
+        type=nonnegative_type,
         default=DEFAULT_MARGIN,
         help=f"distance kept from the joint limits [rad] (default: {DEFAULT_MARGIN})",
     )

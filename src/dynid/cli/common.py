@@ -1,11 +1,14 @@
-"""Options and helpers shared by the subcommands: robot selection, vectors, JSON output."""
+"""Options and helpers shared by the subcommands: robot selection, vectors, JSON output,
+argparse types for checked option values, figures that are skipped without matplotlib."""
 
 from __future__ import annotations
 
 import argparse
 import json
 import logging
+import math
 import sys
+from collections.abc import Callable
 from pathlib import Path
 from typing import Any
 
@@ -13,10 +16,68 @@ import numpy as np
 
 from .. import _checks, spatial
 from ..exceptions import DynidError, ShapeError
+from ..io._files import open_atomic
+from ..io._json import dumps
 from ..model.panda import panda
 from ..model.robot import Robot
 
 _log = logging.getLogger(__name__)
+
+
+# ---------------------------------------------------------------------- option value types
+def number(
+    kind: type = float,
+    *,
+    min: float | None = None,
+    max: float | None = None,
+    min_open: bool = False,
+    max_open: bool = False,
+) -> Callable[[str], Any]:
+    """An argparse ``type``: a finite ``int`` or ``float`` in a range, else a one-line error.
+
+    ``number(int, min=0)`` is a seed, ``number(float, min=0, min_open=True)`` a positive
+    float; NaN and infinities are always refused.
+    """
+    lo = "" if min is None else f"{'>' if min_open else '>='} {min:g}"
+    hi = "" if max is None else f"{'<' if max_open else '<='} {max:g}"
+    want = " and ".join(x for x in (lo, hi) if x)
+    label = "an integer" if kind is int else "a finite number"
+
+    def parse(text: str) -> Any:
+        try:
+            v = kind(text)
+        except ValueError:
+            raise argparse.ArgumentTypeError(
+                f"must be {label}{' ' + want if want else ''}; got {text!r}"
+            ) from None
+        bad = not math.isfinite(v)
+        if min is not None:
+            bad |= v <= min if min_open else v < min
+        if max is not None:
+            bad |= v >= max if max_open else v > max
+        if bad:
+            raise argparse.ArgumentTypeError(
+                f"must be {label}{' ' + want if want else ''}; got {text!r}"
+            )
+        return v
+
+    parse.__name__ = kind.__name__  # argparse names the type in some messages
+    return parse
+
+
+#: ``--seed``: a non-negative integer (numpy's SeedSequence refuses negative ones).
+seed_type = number(int, min=0)
+#: Counts such as ``--n``, ``--runs``: positive integers.
+count_type = number(int, min=1)
+#: Positive finite floats (rates, durations, cutoffs, tolerances).
+positive_type = number(float, min=0, min_open=True)
+#: Non-negative finite floats (noise levels, margins).
+nonnegative_type = number(float, min=0)
+
+
+def add_seed_option(p: argparse.ArgumentParser, help: str = "random seed (default: 0)") -> None:
+    """``--seed N`` (N >= 0)."""
+    p.add_argument("--seed", type=seed_type, default=0, metavar="N", help=help)
 
 
 def add_robot_options(p: argparse.ArgumentParser) -> None:
@@ -57,7 +118,7 @@ def add_consistency_options(p: argparse.ArgumentParser) -> None:
     g.add_argument("--prior-tip", default=None, help="URDF tip link of the prior's chain")
     g.add_argument(
         "--prior-weight",
-        type=float,
+        type=nonnegative_type,
         default=None,
         metavar="W",
         help="weight of the distance to the prior (default: the largest that keeps the data "
@@ -71,7 +132,7 @@ def add_consistency_options(p: argparse.ArgumentParser) -> None:
     )
     g.add_argument(
         "--margin",
-        type=float,
+        type=number(float, min=0, max=0.25, max_open=True),
         default=None,
         metavar="EPS",
         help="every link's lambda_min(J) >= EPS tr(J) (pseudo-inertia J; default 1e-4)",
@@ -132,29 +193,49 @@ def sdp_options(args: argparse.Namespace) -> Any:
     )
 
 
-def parse_vector(text: str, name: str, size: int | None = None) -> np.ndarray:
-    """Comma-separated floats; ``size`` checks the count."""
+def parse_vector(
+    text: str, name: str, size: int | None = None, *, finite: bool = True
+) -> np.ndarray:
+    """Comma-separated floats (negative values welcome: ``--q -0.1,0.2``); ``size`` checks
+    the count, ``finite`` refuses NaN and infinities."""
     try:
         v = np.array([float(x) for x in text.replace(" ", "").split(",") if x != ""])
     except ValueError:
         raise ShapeError(f"{name} must be comma-separated numbers; got {text!r}") from None
     if size is not None and v.shape != (size,):
         raise ShapeError(f"{name} must have {size} values; got {v.size}")
+    if finite:
+        _checks.finite(name, v)
     return v
 
 
 def print_json(obj: Any) -> None:
-    """One JSON object on stdout."""
-    json.dump(obj, sys.stdout, default=_jsonable)
-    sys.stdout.write("\n")
+    """One strict JSON object on stdout (a NaN or infinity is an error, not ``NaN``)."""
+    sys.stdout.write(dumps(obj, indent=None) + "\n")
 
 
-def _jsonable(x: Any) -> Any:
-    if isinstance(x, np.ndarray):
-        return x.tolist()
-    if isinstance(x, np.generic):
-        return x.item()
-    raise TypeError(f"not JSON serialisable: {type(x).__name__}")
+def save_figure(fig_factory: Callable[[], Any], path: Path, *, dpi: int = 110) -> Path | None:
+    """Render ``fig_factory()`` to ``path`` (atomically); without matplotlib, skip it with a
+    one-line note on stderr and return None.
+
+    The plots extra is optional: every data file is written before the figures, and a
+    missing matplotlib never fails a command.
+    """
+    try:
+        import matplotlib
+
+        matplotlib.use("Agg")
+        import matplotlib.pyplot as plt
+    except ImportError:
+        print(f"note: matplotlib is not installed; skipped the figure {path.name}", file=sys.stderr)
+        return None
+    fig = fig_factory()
+    try:
+        with open_atomic(path, "wb") as fh:
+            fig.savefig(fh, format=path.suffix.lstrip(".") or "png", dpi=dpi)
+    finally:
+        plt.close(fig)
+    return path
 
 
 def format_matrix(A: np.ndarray, fmt: str = "{:+.6f}") -> str:
@@ -189,9 +270,7 @@ def parse_tool(text: str | None) -> np.ndarray | None:
 
 def parse_q(text: str, robot: Robot, name: str = "--q") -> np.ndarray:
     """Joint positions (n,) [rad or m] from comma-separated values, checked for count and NaN."""
-    v = parse_vector(text, name, robot.n)
-    _checks.finite(name, v)
-    return v
+    return parse_vector(text, name, robot.n)
 
 
 def format_joint_table(robot: Robot, q: np.ndarray) -> str:

@@ -48,7 +48,7 @@ from ..kinematics.jacobian import jacobian
 from ..model.panda import PANDA_NEUTRAL_Q, panda
 from ..model.robot import Robot
 from ..spatial import rpy_from_matrix, transform_from_xyz_rpy
-from .common import format_joint_table, format_matrix
+from .common import add_seed_option, format_joint_table, format_matrix
 
 NAME = "demo"
 
@@ -389,7 +389,7 @@ def register(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParser:
         formatter_class=argparse.RawDescriptionHelpFormatter,
     )
     p.add_argument("--out", type=Path, default=Path("out"), help="output folder (default: out)")
-    p.add_argument("--seed", type=int, default=0, help="random seed (default 0)")
+    add_seed_option(p)
     return p
 
 

@@ -43,7 +43,7 @@ from ..kinematics.trajectories import (
 )
 from ..model.robot import Robot
 from ..simulation.measurement import SensorNoise, sample_times, simulate_measurement
-from .common import add_column_options, load_robot, read_log
+from .common import add_column_options, load_robot, positive_type, read_log
 
 NAME = "friction"
 
@@ -67,7 +67,7 @@ def register(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParser:
     p.add_argument("--friction-model", choices=("sigmoid", "classical"), default="sigmoid")
     p.add_argument(
         "--cutoff",
-        type=float,
+        type=positive_type,
         default=DEFAULT_CUTOFF_HZ,
         help=f"low-pass cutoff of the states [Hz] (default {DEFAULT_CUTOFF_HZ:g})",
     )

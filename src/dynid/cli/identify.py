@@ -53,7 +53,9 @@ from .common import (
     column_map,
     load_prior,
     load_robot,
+    number,
     parse_vector,
+    positive_type,
     read_log,
     sdp_options,
 )
@@ -80,7 +82,7 @@ def register(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParser:
     p.add_argument("--out", type=Path, required=True, help="output folder")
     p.add_argument(
         "--max-std-percent",
-        type=float,
+        type=positive_type,
         default=None,
         metavar="PCT",
         help="remove coefficients above this relative std [%%] and re-fit (paper: 30)",
@@ -96,7 +98,12 @@ def register(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParser:
         default="robust",
         help="standard deviations: heteroscedasticity-consistent (default) or sigma^2 (W^T W)^-1",
     )
-    p.add_argument("--rtol", type=float, default=1e-10, help="relative rank tolerance")
+    p.add_argument(
+        "--rtol",
+        type=number(float, min=0, max=1, min_open=True, max_open=True),
+        default=1e-10,
+        help="relative rank tolerance, 0 < RTOL < 1 (default 1e-10)",
+    )
     p.add_argument(
         "--consistent",
         action="store_true",
@@ -112,7 +119,7 @@ def register(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParser:
     p.add_argument("--no-figures", action="store_true", help="--consistent: skip retrieval.png")
     p.add_argument(
         "--cutoff",
-        type=float,
+        type=positive_type,
         default=None,
         metavar="HZ",
         help="torque logs: zero-phase low-pass cutoff [Hz] (default: the library's)",

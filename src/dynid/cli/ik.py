@@ -31,13 +31,16 @@ from ..spatial import matrix_from_rpy, transform
 from .common import (
     add_frame_tool_options,
     add_robot_options,
+    count_type,
     format_joint_table,
     format_matrix,
     load_robot,
     parse_q,
     parse_tool,
     parse_vector,
+    positive_type,
     print_json,
+    seed_type,
 )
 
 NAME = "ik"
@@ -75,24 +78,27 @@ def register(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParser:
     defaults = IKOptions()
     p.add_argument(
         "--position-tolerance",
-        type=float,
+        type=positive_type,
         default=defaults.position_tolerance,
         help=f"[m] (default {defaults.position_tolerance:g})",
     )
     p.add_argument(
         "--orientation-tolerance",
-        type=float,
+        type=positive_type,
         default=defaults.orientation_tolerance,
         help=f"[rad] (default {defaults.orientation_tolerance:g})",
     )
     p.add_argument(
         "--max-iterations",
-        type=int,
+        type=count_type,
         default=defaults.max_iterations,
         help=f"simulation steps, restarts included (default {defaults.max_iterations})",
     )
     p.add_argument(
-        "--seed", type=int, default=0, help="seed of the restart configurations (default 0)"
+        "--seed",
+        type=seed_type,
+        default=0,
+        help="seed of the restart configurations (default 0)",
     )
     p.add_argument("--json", action="store_true", help="print one JSON object")
     return p

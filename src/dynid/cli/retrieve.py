@@ -74,6 +74,8 @@ from ..model.robot import Robot
 from .common import (
     add_consistency_options,
     add_robot_options,
+    add_seed_option,
+    count_type,
     load_prior,
     load_robot,
     parse_vector,
@@ -114,15 +116,15 @@ def register(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParser:
     p.add_argument("--no-total-mass", action="store_true", help="drop the default total-mass band")
     d = RetrievalOptions()
     p.add_argument(
-        "--runs", type=int, default=d.runs, help=f"independent runs Q (default {d.runs})"
+        "--runs", type=count_type, default=d.runs, help=f"independent runs Q (default {d.runs})"
     )
     p.add_argument(
-        "--stages", type=int, default=d.stages, help=f"stages K per run (default {d.stages})"
+        "--stages", type=count_type, default=d.stages, help=f"stages K per run (default {d.stages})"
     )
     p.add_argument(
-        "--workers", type=int, default=None, help="processes (default: min(runs, cores))"
+        "--workers", type=count_type, default=None, help="processes (default: min(runs, cores))"
     )
-    p.add_argument("--seed", type=int, default=0, help="random seed (default 0)")
+    add_seed_option(p)
     p.add_argument(
         "--friction", type=Path, default=None, help="friction.json (sigmoid) to put on the robot"
     )

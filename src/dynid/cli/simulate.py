@@ -35,7 +35,16 @@ from ..kinematics.trajectories import (
     sinusoid_trajectory,
 )
 from ..simulation.measurement import SensorNoise, sample_times, simulate_measurement
-from .common import add_robot_options, load_robot, parse_vector
+from .common import (
+    add_robot_options,
+    add_seed_option,
+    count_type,
+    load_robot,
+    nonnegative_type,
+    number,
+    parse_vector,
+    positive_type,
+)
 
 NAME = "simulate"
 log = logging.getLogger(__name__)
@@ -51,16 +60,30 @@ def register(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParser:
     )
     add_robot_options(p)
     p.add_argument("--trajectory", choices=("sinusoid", "fourier"), default="sinusoid")
-    p.add_argument("--duration", type=float, default=20.0, help="seconds (default 20)")
-    p.add_argument("--rate", type=float, default=1000.0, help="sample rate [Hz] (default 1000)")
+    p.add_argument("--duration", type=positive_type, default=20.0, help="seconds (default 20)")
     p.add_argument(
-        "--noise", type=float, default=0.05, help="torque sensor noise std [N m] (default 0.05)"
+        "--rate", type=positive_type, default=1000.0, help="sample rate [Hz] (default 1000)"
     )
-    p.add_argument("--q-noise", type=float, default=1e-4, help="position noise std [rad]")
-    p.add_argument("--dq-noise", type=float, default=1e-3, help="velocity noise std [rad/s]")
-    p.add_argument("--jitter", type=float, default=0.0, help="timestamp jitter std [s] (default 0)")
     p.add_argument(
-        "--drop", type=float, default=0.0, help="fraction of samples dropped at random (default 0)"
+        "--noise",
+        type=nonnegative_type,
+        default=0.05,
+        help="torque sensor noise std [N m] (default 0.05)",
+    )
+    p.add_argument(
+        "--q-noise", type=nonnegative_type, default=1e-4, help="position noise std [rad]"
+    )
+    p.add_argument(
+        "--dq-noise", type=nonnegative_type, default=1e-3, help="velocity noise std [rad/s]"
+    )
+    p.add_argument(
+        "--jitter", type=nonnegative_type, default=0.0, help="timestamp jitter std [s] (default 0)"
+    )
+    p.add_argument(
+        "--drop",
+        type=number(float, min=0, max=1, max_open=True),
+        default=0.0,
+        help="fraction of samples dropped at random (default 0)",
     )
     p.add_argument("--no-friction", action="store_true", help="simulate without joint friction")
     p.add_argument(
@@ -80,12 +103,17 @@ def register(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParser:
         help="sinusoid periods T_i [s], comma-separated (default: Table I)",
     )
     p.add_argument("--q0", default=None, help="start (sinusoid) or offset (fourier) [rad]")
-    p.add_argument("--harmonics", type=int, default=5, help="Fourier harmonics L (default 5)")
     p.add_argument(
-        "--base-freq", type=float, default=0.1, help="Fourier base frequency [Hz] (default 0.1)"
+        "--harmonics", type=count_type, default=5, help="Fourier harmonics L (default 5)"
+    )
+    p.add_argument(
+        "--base-freq",
+        type=positive_type,
+        default=0.1,
+        help="Fourier base frequency [Hz] (default 0.1)",
     )
     p.add_argument("--with-ddq", action="store_true", help="also write the true accelerations")
-    p.add_argument("--seed", type=int, default=0, help="random seed (default 0)")
+    add_seed_option(p)
     p.add_argument("--out", required=True, type=Path, help="output .csv or .npz")
     return p
 

@@ -35,7 +35,7 @@ from ..identification.log import DEFAULT_CUTOFF_HZ
 from ..identification.model import IdentifiedModel
 from ..io.friction_json import read_friction_json
 from ..model.robot import Robot
-from .common import add_column_options, load_robot, read_log
+from .common import add_column_options, load_robot, positive_type, read_log
 from .friction import format_rms_table, save_validation_figures
 
 NAME = "validate"
@@ -65,7 +65,7 @@ def register(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParser:
     p.add_argument("--out", type=Path, required=True, help="output directory")
     p.add_argument(
         "--cutoff",
-        type=float,
+        type=positive_type,
         default=DEFAULT_CUTOFF_HZ,
         help=f"low-pass cutoff of the states [Hz] (default {DEFAULT_CUTOFF_HZ:g})",
     )

@@ -43,7 +43,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from .. import _checks
-from ..exceptions import ShapeError
+from ..exceptions import OptionError, ShapeError, WrongTypeError
 from ..model.inertia import (
     INERTIA_ORDER,
     inertia6_from_matrix,
@@ -210,16 +210,16 @@ class Bounds:
             bad = np.argwhere(getattr(self, lo) > getattr(self, hi))
             if bad.size:
                 idx = tuple(int(i) for i in bad[0])
-                raise ValueError(
+                raise OptionError(
                     f"{lo} must not exceed {hi}; at index {idx}: "
                     f"{getattr(self, lo)[idx]} > {getattr(self, hi)[idx]}"
                 )
         if np.any(self.mass_min < 0):
-            raise ValueError(f"mass_min must be >= 0; got {self.mass_min.tolist()}")
+            raise OptionError(f"mass_min must be >= 0; got {self.mass_min.tolist()}")
         if self.total_mass is not None:
             lo, hi = (float(x) for x in self.total_mass)
             if not (math.isfinite(lo) and math.isfinite(hi)) or lo < 0 or lo > hi:
-                raise ValueError(
+                raise OptionError(
                     f"total_mass must be (min, max) with 0 <= min <= max; got {self.total_mass}"
                 )
             put("total_mass", (lo, hi))
@@ -421,7 +421,7 @@ def kinematic_bounds(
         else float(radius)
     )
     if r <= 0:
-        raise ValueError(f"radius must be positive; got {r}")
+        raise OptionError(f"radius must be positive; got {r}")
     lo = np.array([P.min(axis=0) for P in pts]) - r
     hi = np.array([P.max(axis=0) for P in pts]) + r
     if mass_max is None:
@@ -517,7 +517,7 @@ def user_constraints(extra: Sequence[Any]) -> tuple[UserConstraint, ...]:
             name = getattr(e, "__name__", None) or type(e).__name__
             out.append(UserConstraint(str(name) if name != "<lambda>" else f"user{k + 1}", e))
         else:
-            raise TypeError(
+            raise WrongTypeError(
                 f"extra[{k}] must be a UserConstraint, a callable p -> violation or a "
                 f"(name, callable) pair; got {type(e).__name__}"
             )

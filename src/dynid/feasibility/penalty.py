@@ -74,7 +74,7 @@ import scipy.linalg
 from numpy.typing import ArrayLike, NDArray
 
 from .. import _checks
-from ..exceptions import DataError, ShapeError
+from ..exceptions import DataError, OptionError, ShapeError
 from ..model.robot import Robot
 from ..regressors.base import BaseParameters, base_parameters
 from ..regressors.static import static_regressor, static_vector
@@ -402,7 +402,7 @@ def _common(
     margin: float,
 ) -> tuple[Bounds, tuple[float, float] | None, tuple[UserConstraint, ...]]:
     if not 0.0 <= margin < 0.5:
-        raise ValueError(f"margin must be in [0, 0.5); got {margin}")
+        raise OptionError(f"margin must be in [0, 0.5); got {margin}")
     b = default_bounds(robot) if bounds is None else bounds
     if b.n != robot.n:
         raise ShapeError(f"bounds are for {b.n} links; robot {robot.name!r} has {robot.n}")
@@ -410,7 +410,7 @@ def _common(
     if band is not None:
         lo, hi = (float(x) for x in band)
         if not (0 <= lo <= hi):
-            raise ValueError(f"total_mass must be (min, max) with 0 <= min <= max; got {band}")
+            raise OptionError(f"total_mass must be (min, max) with 0 <= min <= max; got {band}")
         band = (lo, hi)
     return b, band, user_constraints(extra)
 

@@ -46,7 +46,7 @@ import math
 import os
 import time
 from collections.abc import Callable, Sequence
-from concurrent.futures import ProcessPoolExecutor, as_completed
+from concurrent.futures import as_completed
 from dataclasses import dataclass
 from typing import Any
 
@@ -55,7 +55,8 @@ import scipy.linalg
 from numpy.typing import ArrayLike, NDArray
 from scipy.optimize import dual_annealing
 
-from ..exceptions import InfeasibleError, ShapeError
+from .._parallel import process_pool
+from ..exceptions import InfeasibleError, OptionError, ShapeError
 from ..identification.model import IdentifiedModel
 from ..model.inertia import matrix_from_inertia6
 from ..model.robot import Robot
@@ -158,21 +159,21 @@ class RetrievalOptions:
 
     def __post_init__(self) -> None:
         if self.residual_tol is not None and not self.residual_tol > 0:
-            raise ValueError(f"residual_tol must be positive or None; got {self.residual_tol}")
+            raise OptionError(f"residual_tol must be positive or None; got {self.residual_tol}")
         if not (math.isfinite(self.prior_weight) and self.prior_weight >= 0):
-            raise ValueError(f"prior_weight must be finite and >= 0; got {self.prior_weight}")
+            raise OptionError(f"prior_weight must be finite and >= 0; got {self.prior_weight}")
         if self.runs < 1 or self.stages < 1:
-            raise ValueError(f"runs and stages must be >= 1; got {self.runs}, {self.stages}")
+            raise OptionError(f"runs and stages must be >= 1; got {self.runs}, {self.stages}")
         if self.anneal_maxiter < 0 or self.local_maxiter < 0:
-            raise ValueError("anneal_maxiter and local_maxiter must be >= 0")
+            raise OptionError("anneal_maxiter and local_maxiter must be >= 0")
         if self.xi is not None:
             xi = tuple(float(x) for x in self.xi)
             if len(xi) != self.stages:
-                raise ValueError(
+                raise OptionError(
                     f"xi must have one weight per stage ({self.stages}); got {len(xi)}"
                 )
             if any(x < 0 or not math.isfinite(x) for x in xi):
-                raise ValueError(f"xi must be finite and >= 0; got {xi}")
+                raise OptionError(f"xi must be finite and >= 0; got {xi}")
             object.__setattr__(self, "xi", xi)
 
     def schedule(self) -> tuple[float, ...]:
@@ -344,7 +345,7 @@ class RetrievalResult:
         anything :func:`~dynid.feasibility.constraints.link_params` accepts)."""
         q = link_params(reference)
         if q.shape != self.p.shape:
-            raise ValueError(f"reference has {q.shape[0]} links; the result has {self.p.shape[0]}")
+            raise OptionError(f"reference has {q.shape[0]} links; the result has {self.p.shape[0]}")
         d_I = matrix_from_inertia6(self.p[:, 4:]) - matrix_from_inertia6(q[:, 4:])
         return ParameterDistance(
             mass=np.abs(self.p[:, 0] - q[:, 0]),
@@ -497,7 +498,7 @@ def _run_all(
             runs[i] = _one_run(problem, s, options, i)
             on_done(runs[i])
     else:
-        with ProcessPoolExecutor(max_workers=workers) as ex:
+        with process_pool(workers) as ex:
             futs = {ex.submit(_one_run, problem, s, options, i): i for i, s in enumerate(seqs)}
             for fut in as_completed(futs):
                 run = fut.result()
@@ -520,7 +521,7 @@ def _solve(
     t0 = time.perf_counter()
     w = min(options.runs, os.cpu_count() or 1) if workers is None else int(workers)
     if w < 1:
-        raise ValueError(f"workers must be >= 1; got {workers}")
+        raise OptionError(f"workers must be >= 1; got {workers}")
     xis = options.schedule()
     _log.info(
         "retrieval (%s): %d runs x %d stages (xi %s), %d workers, seed %s",

@@ -30,7 +30,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from .. import _checks
 from ..dynamics.rnea import rnea
-from ..exceptions import ShapeError
+from ..exceptions import OptionError, ShapeError
 from ..friction.model import ClassicalFriction, SigmoidFriction
 from ..identification.metrics import TorqueErrors, torque_errors
 from ..identification.model import IdentifiedModel
@@ -105,7 +105,7 @@ class NewtonEulerValidation:
 def _friction_model(robot: Robot, friction: Any) -> SigmoidFriction | ClassicalFriction | None:
     if isinstance(friction, str):
         if friction != "robot":
-            raise ValueError(
+            raise OptionError(
                 "friction must be 'robot', None, a friction model or an (n, 3) array; "
                 f"got {friction!r}"
             )

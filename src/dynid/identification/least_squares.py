@@ -75,7 +75,7 @@ import scipy.linalg
 from numpy.typing import ArrayLike, NDArray
 
 from .. import _checks
-from ..exceptions import RankDeficientError, ShapeError
+from ..exceptions import OptionError, RankDeficientError, ShapeError
 
 __all__ = ["LeastSquaresFit", "fit_least_squares", "fit_with_pruning"]
 
@@ -175,7 +175,7 @@ def _validated(
     if W.ndim != 2 or y.shape != (W.shape[0],):
         raise ShapeError(f"W must be (m, r) and y (m,); got {W.shape} and {y.shape}")
     if covariance not in ("classical", "robust"):
-        raise ValueError(f"covariance must be 'classical' or 'robust'; got {covariance!r}")
+        raise OptionError(f"covariance must be 'classical' or 'robust'; got {covariance!r}")
     return W, y
 
 
@@ -428,7 +428,7 @@ def _solve_qr(
         Ay[:, rk] = y
         qr0, _, _, info = scipy.linalg.lapack.dgeqrf(Ay, overwrite_a=True)
         if info != 0:  # pragma: no cover - LAPACK argument error
-            raise RuntimeError(f"LAPACK dgeqrf failed with info={info}")
+            raise RankDeficientError(f"LAPACK dgeqrf failed with info={info}")
         R0 = np.triu(qr0[: rk + 1])
         A, b = R0[:rk, :rk], R0[:rk, rk]
     else:

@@ -47,7 +47,7 @@ import scipy.linalg
 from numpy.typing import ArrayLike, NDArray
 
 from .. import _checks
-from ..exceptions import DynidWarning, RankDeficientError, ShapeError
+from ..exceptions import DynidWarning, OptionError, RankDeficientError, ShapeError
 from ..model.robot import Robot
 from ..regressors.base import BaseParameters, base_parameters
 from ..regressors.static import (
@@ -167,9 +167,9 @@ def identify_static(
     """
     data.check_robot(robot)
     if max_std_percent is not None and not max_std_percent > 0:
-        raise ValueError(f"max_std_percent must be positive or None; got {max_std_percent}")
+        raise OptionError(f"max_std_percent must be positive or None; got {max_std_percent}")
     if std_estimator not in ("robust", "classical"):
-        raise ValueError(f"std_estimator must be 'robust' or 'classical'; got {std_estimator!r}")
+        raise OptionError(f"std_estimator must be 'robust' or 'classical'; got {std_estimator!r}")
     if base is None:
         base = base_parameters(robot, kind="static", rtol=rtol)
     elif base.n_std != 10 * robot.n:

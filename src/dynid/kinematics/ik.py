@@ -75,7 +75,7 @@ from numpy.typing import ArrayLike, NDArray
 from scipy.linalg import lapack
 
 from .. import _checks
-from ..exceptions import DataError, LimitError
+from ..exceptions import DataError, LimitError, WrongTypeError
 from ..model.robot import Robot
 from .forward import frame_pose_in_link
 
@@ -870,7 +870,7 @@ def ik(
     """
     opts = _DEFAULT_OPTIONS if options is None else options
     if not isinstance(opts, IKOptions):
-        raise TypeError(f"options must be an IKOptions; got {type(opts).__name__}")
+        raise WrongTypeError(f"options must be an IKOptions; got {type(opts).__name__}")
     link, T_link_frame = frame_pose_in_link(robot, frame, tool)
     T_goal = check_pose("T_goal", T_goal)
     n = robot.n

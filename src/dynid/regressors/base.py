@@ -34,7 +34,7 @@ import scipy.linalg
 from numpy.typing import ArrayLike, NDArray
 
 from .. import _checks
-from ..exceptions import ShapeError
+from ..exceptions import OptionError, ShapeError
 from ..model.robot import Robot
 from .static import static_regressor
 from .torque import _torque_regressor
@@ -289,5 +289,5 @@ def base_parameters(
         ddq = rng.uniform(-5, 5, q.shape)
         W = _torque_regressor(robot, q, dq, ddq, robot.gravity).reshape(-1, 10 * robot.n)
     else:
-        raise ValueError(f"kind must be 'static' or 'torque'; got {kind!r}")
+        raise OptionError(f"kind must be 'static' or 'torque'; got {kind!r}")
     return base_parameters_from_regressor(W, robot.param_labels, rtol=rtol)

@@ -33,7 +33,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from ..dynamics.terms import gravity_torques, mass_matrix
-from ..exceptions import LimitError
+from ..exceptions import LimitError, OptionError
 from ..identification.data import StaticDataset
 from ..model.panda import panda
 from ..model.robot import Robot
@@ -81,7 +81,7 @@ class SimulatedController:
             self.effects.check(self.robot)
         eps = float(self.relative_noise)
         if not np.isfinite(eps) or eps < 0:
-            raise ValueError(f"relative_noise must be finite and >= 0; got {self.relative_noise}")
+            raise OptionError(f"relative_noise must be finite and >= 0; got {self.relative_noise}")
         object.__setattr__(self, "relative_noise", eps)
         if self.rng is None:
             object.__setattr__(self, "rng", np.random.default_rng(0))
@@ -150,9 +150,9 @@ def sample_configurations(
         A joint's range is not wider than ``2 margin``.
     """
     if int(n) != n or n < 1:
-        raise ValueError(f"n must be a positive integer; got {n}")
+        raise OptionError(f"n must be a positive integer; got {n}")
     if not np.isfinite(margin) or margin < 0:
-        raise ValueError(f"margin must be finite and >= 0; got {margin}")
+        raise OptionError(f"margin must be finite and >= 0; got {margin}")
     rng = np.random.default_rng(0) if rng is None else rng
     lo = np.where(np.isfinite(robot.q_min), robot.q_min + margin, -np.pi)
     hi = np.where(np.isfinite(robot.q_max), robot.q_max - margin, np.pi)

@@ -1,0 +1,141 @@
+"""Atomic file output: a file appears complete under its name, or not at all.
+
+Every writer of dynid goes through this module:
+
+* :func:`atomic_path` yields a temporary path in the destination's folder (same file
+  system, so the rename is atomic); when the block ends normally the file is flushed to
+  disk and renamed over the destination with :func:`os.replace`; when it ends with any
+  exception (``KeyboardInterrupt`` and termination included) the temporary file is
+  deleted and the destination is left as it was.
+* :func:`open_atomic`, :func:`write_text` and :func:`write_bytes` are the same for a file
+  object, a string and bytes.
+* The destination folder is created only when a file is written into it.
+* :func:`output_transaction` groups the files of one command: on failure, the files and
+  folders it created are removed again (files it replaced keep their new content, since
+  each was complete when renamed).
+
+Temporary files are named ``.<name>.<random>.tmp<suffix>`` (hidden, the destination's
+suffix kept for writers that dispatch on it).
+"""
+
+from __future__ import annotations
+
+import contextlib
+import os
+import tempfile
+from collections.abc import Iterator
+from pathlib import Path
+from typing import IO, Any
+
+__all__ = ["atomic_path", "open_atomic", "output_transaction", "write_bytes", "write_text"]
+
+#: Stack of active transactions; each records (created files, created folders).
+_TRANSACTIONS: list[tuple[list[Path], list[Path]]] = []
+
+
+def _make_parents(folder: Path) -> None:
+    """Create ``folder`` and missing parents, recording new ones in the transactions."""
+    missing = []
+    p = folder
+    while not p.exists():
+        missing.append(p)
+        if p.parent == p:
+            break
+        p = p.parent
+    folder.mkdir(parents=True, exist_ok=True)
+    for t in _TRANSACTIONS:
+        t[1].extend(reversed(missing))
+
+
+def _mode() -> int:
+    """Permissions of a new file under the current umask (mkstemp makes 0600)."""
+    mask = os.umask(0)
+    os.umask(mask)
+    return 0o666 & ~mask
+
+
+@contextlib.contextmanager
+def atomic_path(path: str | Path) -> Iterator[Path]:
+    """Yield a temporary path next to ``path``; rename it to ``path`` when the block succeeds.
+
+    The writer inside the block must create the file at the yielded path (it exists,
+    empty, when the block starts).
+    """
+    path = Path(path)
+    _make_parents(path.parent)
+    existed = path.exists()
+    fd, name = tempfile.mkstemp(
+        dir=path.parent, prefix=f".{path.name}.", suffix=f".tmp{path.suffix}"
+    )
+    os.close(fd)
+    tmp = Path(name)
+    try:
+        yield tmp
+        with open(tmp, "rb+") as fh:
+            os.fsync(fh.fileno())
+        os.chmod(tmp, _mode())
+        os.replace(tmp, path)
+    except BaseException:
+        with contextlib.suppress(OSError):
+            tmp.unlink()
+        raise
+    if not existed:
+        for t in _TRANSACTIONS:
+            t[0].append(path)
+
+
+@contextlib.contextmanager
+def open_atomic(
+    path: str | Path, mode: str = "w", *, encoding: str | None = "utf-8", newline: str | None = "\n"
+) -> Iterator[IO[Any]]:
+    """Open a temporary file next to ``path`` for writing; renamed to ``path`` on success.
+
+    ``mode`` is ``"w"`` (text, ``encoding`` and ``newline`` apply) or ``"wb"``.
+    """
+    if mode not in ("w", "wb"):
+        raise ValueError(f"mode must be 'w' or 'wb'; got {mode!r}")  # internal misuse
+    with atomic_path(path) as tmp:
+        if mode == "wb":
+            with open(tmp, "wb") as fh:
+                yield fh
+        else:
+            with open(tmp, "w", encoding=encoding, newline=newline) as fh:
+                yield fh
+
+
+def write_text(path: str | Path, text: str) -> Path:
+    """Write ``text`` (UTF-8, ``\\n`` line ends) atomically; returns the path."""
+    with open_atomic(path, "w") as fh:
+        fh.write(text)
+    return Path(path)
+
+
+def write_bytes(path: str | Path, data: bytes) -> Path:
+    """Write ``data`` atomically; returns the path."""
+    with open_atomic(path, "wb") as fh:
+        fh.write(data)
+    return Path(path)
+
+
+@contextlib.contextmanager
+def output_transaction() -> Iterator[None]:
+    """Remove the files and folders created inside the block if it raises.
+
+    Used by the command line around each command, so that a failing or interrupted
+    command leaves no output of its own behind.
+    """
+    record: tuple[list[Path], list[Path]] = ([], [])
+    _TRANSACTIONS.append(record)
+    try:
+        yield
+    except BaseException:
+        files, folders = record
+        for f in reversed(files):
+            with contextlib.suppress(OSError):
+                f.unlink()
+        for d in reversed(folders):
+            with contextlib.suppress(OSError):
+                d.rmdir()  # only when empty: never removes what others put there
+        raise
+    finally:
+        _TRANSACTIONS.remove(record)

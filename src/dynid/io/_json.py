@@ -1,0 +1,155 @@
+"""Strict JSON: the one reader and writer of dynid's JSON files.
+
+Writing (:func:`dumps`, :func:`save_json`): numpy arrays and scalars become lists and
+numbers; a NaN or infinite number raises :class:`~dynid.exceptions.NonFiniteError` naming
+its key path (``rms[3]``) instead of writing ``NaN``/``Infinity``, which strict parsers
+reject (write ``None`` for "undefined" on purpose). Files are written atomically
+(:mod:`dynid.io._files`), indented, UTF-8, with a ``schema`` key first.
+
+Reading (:func:`load_json`): UTF-8 with or without a byte-order mark; ``NaN``,
+``Infinity``, numbers that overflow a float, duplicated keys and a top level other than
+an object are rejected with a :class:`~dynid.exceptions.DataError` naming the file; the
+``schema`` key must be one of the accepted ones.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+from collections.abc import Iterable, Mapping
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from ..exceptions import DataError, NonFiniteError
+from ._files import write_text
+
+__all__ = ["dumps", "jsonable", "load_json", "loads", "save_json"]
+
+
+def jsonable(x: Any, where: str = "") -> Any:
+    """``x`` with numpy types converted; raises :class:`NonFiniteError` on NaN/inf."""
+    if isinstance(x, Mapping):
+        return {str(k): jsonable(v, f"{where}.{k}" if where else str(k)) for k, v in x.items()}
+    if isinstance(x, np.ndarray):
+        return jsonable(x.tolist(), where)
+    if isinstance(x, (list, tuple)):
+        return [jsonable(v, f"{where}[{i}]") for i, v in enumerate(x)]
+    if isinstance(x, (bool, np.bool_)):
+        return bool(x)
+    if isinstance(x, (int, np.integer)):
+        return int(x)
+    if isinstance(x, (float, np.floating)):
+        v = float(x)
+        if not math.isfinite(v):
+            raise NonFiniteError(f"{where or 'value'} is {v}; JSON has no NaN or infinity")
+        return v
+    if x is None or isinstance(x, str):
+        return x
+    if isinstance(x, Path):
+        return str(x)
+    raise DataError(f"{where or 'value'}: cannot write a {type(x).__name__} as JSON")
+
+
+def dumps(obj: Any, *, indent: int | None = 1) -> str:
+    """Strict JSON text of ``obj`` (see the module docstring)."""
+    return json.dumps(jsonable(obj), indent=indent, allow_nan=False)
+
+
+def save_json(path: str | Path, obj: Mapping[str, Any], *, schema: str | None = None) -> Path:
+    """Write ``obj`` as strict JSON, atomically; ``schema`` is put first when given.
+
+    Raises
+    ------
+    NonFiniteError
+        A NaN or infinite number (the message names the file and the key path).
+    """
+    path = Path(path)
+    doc = (
+        dict(obj)
+        if schema is None
+        else {"schema": schema, **{k: v for k, v in obj.items() if k != "schema"}}
+    )
+    try:
+        text = dumps(doc)
+    except DataError as exc:
+        raise type(exc)(f"{path.name}: {exc}") from None
+    return write_text(path, text + "\n")
+
+
+def _no_constant(name: str) -> Any:
+    raise ValueError(f"{name} is not a JSON number")
+
+
+def _finite_float(text: str) -> float:
+    v = float(text)
+    if not math.isfinite(v):
+        raise ValueError(f"number {text} overflows a float")
+    return v
+
+
+def _unique_keys(pairs: list[tuple[str, Any]]) -> dict[str, Any]:
+    d: dict[str, Any] = {}
+    for k, v in pairs:
+        if k in d:
+            raise ValueError(f"duplicated key {k!r}")
+        d[k] = v
+    return d
+
+
+def loads(text: str) -> Any:
+    """Parse strict JSON text (no NaN/Infinity, no overflow, no duplicated key)."""
+    return json.loads(
+        text,
+        parse_constant=_no_constant,
+        parse_float=_finite_float,
+        object_pairs_hook=_unique_keys,
+    )
+
+
+def load_json(
+    path: str | Path, *, schema: str | Iterable[str] | None = None, what: str = "JSON file"
+) -> dict[str, Any]:
+    """Read a strict JSON object from ``path`` and check its ``schema`` key.
+
+    Parameters
+    ----------
+    path : str or Path
+    schema : str or iterable of str, optional
+        Accepted values of the top-level ``schema`` key; None accepts any (or none).
+    what : str
+        What the file should be, for messages ("identified model").
+
+    Raises
+    ------
+    DataError
+        Not UTF-8, not strict JSON (the line and column), not an object, wrong schema.
+    OSError
+        The file cannot be read.
+    """
+    path = Path(path)
+    raw = path.read_bytes()
+    try:
+        text = raw.decode("utf-8-sig")
+    except UnicodeDecodeError as exc:
+        raise DataError(f"{path.name}: not a UTF-8 text file ({exc.reason})") from None
+    try:
+        d = loads(text)
+    except json.JSONDecodeError as exc:
+        raise DataError(
+            f"{path.name}: not valid JSON ({exc.msg} at line {exc.lineno}, column {exc.colno})"
+        ) from None
+    except (ValueError, RecursionError) as exc:
+        raise DataError(f"{path.name}: not strict JSON ({exc})") from None
+    if not isinstance(d, dict):
+        raise DataError(f"{path.name}: expected a JSON object ({what}); got {type(d).__name__}")
+    if schema is not None:
+        ok = (schema,) if isinstance(schema, str) else tuple(schema)
+        got = d.get("schema")
+        if got not in ok:
+            raise DataError(
+                f"{path.name}: not a {what}: 'schema' must be {' or '.join(map(repr, ok))}; "
+                f"got {got!r}"
+            )
+    return d
