@@ -38,7 +38,8 @@ def test_csv_header_names_columns_and_units(tmp_path):
     path = write_torque_log(tmp_path / "log.csv", _log(np.random.default_rng(42), n=2))
     lines = path.read_text().splitlines()
     assert lines[0].startswith("#") and "tau [N m]" in lines[0]
-    assert lines[1] == "t,q1,q2,dq1,dq2,tau1,tau2"
+    assert lines[1] == "# rows: 50"
+    assert lines[2] == "t,q1,q2,dq1,dq2,tau1,tau2"
     assert torque_log_columns(2, with_ddq=True)[-2:] == ["ddq1", "ddq2"]
 
 
@@ -88,8 +89,9 @@ def test_from_raw_rejects_time_running_backwards():
         TorqueLog.from_raw(t, z, z, z)
 
 
-def test_csv_with_empty_and_nan_cells_is_cleaned(tmp_path):
-    """Empty or 'nan' cells make a row invalid: it is dropped and counted."""
+def test_csv_with_empty_and_nan_cells_is_refused_or_dropped_on_request(tmp_path, caplog):
+    """Empty or 'nan' cells make a row invalid: refused by default (issue 12), dropped and
+    counted with drop_invalid, with a warning that says how many and where."""
     path = write_torque_log(tmp_path / "log.csv", _log(np.random.default_rng(43), N=20, n=2))
     lines = path.read_text().splitlines()
     cells = lines[5].split(",")
@@ -99,8 +101,11 @@ def test_csv_with_empty_and_nan_cells_is_cleaned(tmp_path):
     cells[6] = "nan"
     lines[9] = ",".join(cells)
     path.write_text("\n".join(lines) + "\n")
-    log = read_torque_log(path)
+    with pytest.raises(DataError, match=r"2 row\(s\) hold NaN.*first row 2 \(line 6\) in 'dq1'"):
+        read_torque_log(path)
+    log = read_torque_log(path, drop_invalid=True)
     assert log.n_samples == 18 and log.cleaning.n_nan_rows == 2
+    assert "dropped 2 row(s) of 20" in caplog.text and "row 6 (line 10)" in caplog.text
 
 
 def test_csv_errors_name_the_line_and_column(tmp_path):
@@ -120,7 +125,7 @@ def test_csv_errors_name_the_line_and_column(tmp_path):
     with pytest.raises(DataError, match="b.csv, line 7: expected 7 fields"):
         read_torque_log(tmp_path / "b.csv")
     bad = lines.copy()
-    bad[1] = bad[1].replace("tau2", "torque2")
+    bad[2] = bad[2].replace("tau2", "torque2")
     (tmp_path / "c.csv").write_text("\n".join(bad))
     with pytest.raises(DataError, match=r"missing column\(s\) \['tau2'\]"):
         read_torque_log(tmp_path / "c.csv")

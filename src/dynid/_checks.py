@@ -54,8 +54,23 @@ def as_exact(name: str, x: ArrayLike, shape: tuple[int, ...], **kw: Any) -> NDAr
     return a
 
 
+def _read_only_throughout(a: Any) -> bool:
+    """True for a read-only array whose data belong to read-only numpy arrays only (a
+    view of such an array cannot be made writable: nobody can change it)."""
+    while isinstance(a, np.ndarray):
+        if a.flags.writeable:
+            return False
+        if a.base is None:
+            return True
+        a = a.base
+    return False
+
+
 def frozen(a: NDArray[Any]) -> NDArray[Any]:
-    """Return a read-only copy of ``a``."""
+    """Return a read-only copy of ``a``, or ``a`` itself when it is read-only throughout
+    (nobody can write into it, and a large log is not copied again)."""
+    if _read_only_throughout(a):
+        return a
     b = np.array(a, copy=True)
     b.setflags(write=False)
     return b

@@ -210,7 +210,15 @@ def lowpass(
     if N <= minimum:
         raise DataError(f"lowpass needs more than {minimum} samples along axis {axis}; got {N}")
     padlen = min(N - 1, max(minimum, int(np.ceil(fs / cutoff_hz))))
-    return scipy.signal.sosfiltfilt(sos, x, axis=axis, padtype="odd", padlen=padlen)
+    if x.ndim < 2:
+        return scipy.signal.sosfiltfilt(sos, x, axis=axis, padtype="odd", padlen=padlen)
+    # one signal at a time: the filter's padded temporaries stay the size of one column
+    # (a 2-million-sample log would otherwise need several copies of every signal)
+    y = np.empty(x.shape)
+    xt, yt = np.moveaxis(x, axis, -1), np.moveaxis(y, axis, -1)
+    for idx in np.ndindex(*xt.shape[:-1]):
+        yt[idx] = scipy.signal.sosfiltfilt(sos, xt[idx], padtype="odd", padlen=padlen)
+    return y
 
 
 def derivative(t: ArrayLike, x: ArrayLike) -> NDArray[np.float64]:

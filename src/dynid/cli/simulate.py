@@ -81,7 +81,7 @@ def register(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParser:
     )
     p.add_argument(
         "--drop",
-        type=number(float, min=0, max=1, max_open=True),
+        type=number(float, min=0, max=0.5, max_open=True),
         default=0.0,
         help="fraction of samples dropped at random (default 0)",
     )

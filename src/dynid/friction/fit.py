@@ -62,7 +62,29 @@ TorqueModel = IdentifiedModel | Robot | Callable[..., NDArray[np.float64]]
 def rigid_body_torques(
     model: TorqueModel, q: NDArray[np.float64], dq: NDArray[np.float64], ddq: NDArray[np.float64]
 ) -> NDArray[np.float64]:
-    """``M ddq + c + g`` [N m] (N, n) of a :data:`TorqueModel`, friction not included."""
+    """``M ddq + c + g`` [N m] (N, n) of a :data:`TorqueModel`, friction not included.
+
+    Long logs are evaluated in blocks of :data:`BLOCK_SAMPLES` samples, so the memory of
+    the intermediate kinematics (and of an identified model's regressor, ~2.4 kB per
+    sample for the Panda) stays bounded whatever the log's length.
+    """
+    N = q.shape[0] if q.ndim == 2 else 0
+    if N > BLOCK_SAMPLES:
+        out = np.empty(q.shape)
+        for a in range(0, N, BLOCK_SAMPLES):
+            b = slice(a, a + BLOCK_SAMPLES)
+            out[b] = _rigid_body_torques(model, q[b], dq[b], ddq[b])
+        return out
+    return _rigid_body_torques(model, q, dq, ddq)
+
+
+#: Samples per block in :func:`rigid_body_torques`.
+BLOCK_SAMPLES = 50_000
+
+
+def _rigid_body_torques(
+    model: TorqueModel, q: NDArray[np.float64], dq: NDArray[np.float64], ddq: NDArray[np.float64]
+) -> NDArray[np.float64]:
     if isinstance(model, IdentifiedModel):
         tau = model.torques(q, dq, ddq)
     elif isinstance(model, Robot):

@@ -254,12 +254,16 @@ class TorqueLog:
             dt_median=h,
             dt_jitter=jitter,
         )
+        if rows.size == N:  # nothing dropped: no copy of a large log
+            tt, pick = t, (lambda a: a)
+        else:
+            pick = lambda a: a[rows]  # noqa: E731
         return cls(
             t=tt,
-            q=arrays["q"][rows],
-            dq=arrays["dq"][rows],
-            tau=arrays["tau"][rows],
-            ddq=arrays["ddq"][rows] if "ddq" in arrays else None,
+            q=pick(arrays["q"]),
+            dq=pick(arrays["dq"]),
+            tau=pick(arrays["tau"]),
+            ddq=pick(arrays["ddq"]) if "ddq" in arrays else None,
             cleaning=cleaning,
         )
 
@@ -338,10 +342,8 @@ def prepare_log(
         parts = np.split(res, len(data), axis=1)
         data = dict(zip(data, parts, strict=True))
     if cutoff_hz is not None:
-        names = [k for k in data if filter_tau or k != "tau"]
-        stacked = np.concatenate([data[k] for k in names], axis=1)
-        filt = signals.lowpass(stacked, rate, cutoff_hz)
-        data.update(zip(names, np.split(filt, len(names), axis=1), strict=True))
+        for k in [k for k in data if filter_tau or k != "tau"]:
+            data[k] = signals.lowpass(data[k], rate, cutoff_hz)
     if "ddq" not in data:
         data["ddq"] = signals.derivative(t, data["dq"])
     if trim_s is None:
@@ -349,11 +351,19 @@ def prepare_log(
     keep = signals.trim_edges(t, trim_s)
     if keep.sum() < 2:
         raise DataError(f"fewer than 2 samples left after trimming {trim_s:g} s at each end")
+
+    k = np.flatnonzero(keep)
+    rows = slice(int(k[0]), int(k[-1]) + 1)  # trimming keeps one contiguous block
+
+    def pick(a: NDArray[np.float64]) -> NDArray[np.float64]:
+        a.setflags(write=False)  # so that TorqueLog keeps a view, not a copy, of big logs
+        return a[rows]
+
     return TorqueLog(
-        t=t[keep],
-        q=data["q"][keep],
-        dq=data["dq"][keep],
-        tau=data["tau"][keep],
-        ddq=data["ddq"][keep],
+        t=pick(t),
+        q=pick(data["q"]),
+        dq=pick(data["dq"]),
+        tau=pick(data["tau"]),
+        ddq=pick(data["ddq"]),
         cleaning=log.cleaning,
     )

@@ -138,7 +138,7 @@ def load_json(
         d = loads(text)
     except json.JSONDecodeError as exc:
         raise DataError(
-            f"{path.name}: not valid JSON ({exc.msg} at line {exc.lineno}, column {exc.colno})"
+            f"{path.name}: not a JSON file ({exc.msg} at line {exc.lineno}, column {exc.colno})"
         ) from None
     except (ValueError, RecursionError) as exc:
         raise DataError(f"{path.name}: not strict JSON ({exc})") from None

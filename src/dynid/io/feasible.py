@@ -53,6 +53,8 @@ from ..feasibility.sdp import ConsistentResult
 from ..friction.model import ClassicalFriction
 from ..model.inertia import INERTIA_ORDER, inertia6_from_matrix, inertial_from_phi
 from ..model.robot import Robot
+from ._files import write_text
+from ._json import load_json, save_json
 from .robot_json import robot_from_dict, robot_to_dict
 
 __all__ = [
@@ -94,20 +96,11 @@ def _num(x: float) -> float | None:
 
 
 def _write_json(path: str | Path, d: Mapping[str, Any]) -> Path:
-    path = Path(path)
-    path.write_text(json.dumps(d, indent=1, allow_nan=False) + "\n", encoding="utf-8")
-    return path
+    return save_json(path, d)
 
 
 def _read_json(path: str | Path) -> dict[str, Any]:
-    path = Path(path)
-    try:
-        d = json.loads(path.read_text(encoding="utf-8"))
-    except (json.JSONDecodeError, UnicodeDecodeError) as exc:
-        raise DataError(f"{path.name}: not a JSON file ({exc})") from exc
-    if not isinstance(d, dict):
-        raise DataError(f"{path.name}: expected a JSON object")
-    return d
+    return load_json(path)
 
 
 # ------------------------------------------------------------------ feasible parameters
@@ -546,7 +539,7 @@ def load_bounds(path: str | Path, robot: Robot) -> Bounds:
         d = _read_json(path)
     elif suffix == ".toml":
         try:
-            d = tomllib.loads(path.read_text(encoding="utf-8"))
+            d = tomllib.loads(path.read_text(encoding="utf-8-sig"))
         except (tomllib.TOMLDecodeError, UnicodeDecodeError) as exc:
             raise DataError(f"{path.name}: not a TOML file ({exc})") from exc
     else:
@@ -571,8 +564,7 @@ def save_bounds(path: str | Path, bounds: Bounds) -> Path:
         lines = [f"schema = {_toml_value(d['schema'])}", f"total_mass = {_toml_value(band)}"]
         for link in d["links"]:
             lines += ["", "[[links]]"] + [f"{k} = {_toml_value(v)}" for k, v in link.items()]
-        path.write_text("\n".join(lines) + "\n", encoding="utf-8")
-        return path
+        return write_text(path, "\n".join(lines) + "\n")
     if path.suffix.lower() != ".json":
         raise DataError(f"{path.name}: bounds files are .json or .toml; got {path.suffix!r}")
     return _write_json(path, d)

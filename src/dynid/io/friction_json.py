@@ -2,7 +2,7 @@
 
 ::
 
-    {"format": "dynid-friction/1", "dynid_version": "...",
+    {"schema": "dynid-friction/1", "dynid_version": "...",
      "model": "sigmoid",
      "convention": "tau = M ddq + c + g + tau_f(dq); tau_f = ...",
      "units": {"phi1": "N m", "phi2": "s/rad", "phi3": "rad/s", "rms_before": "N m", ...},
@@ -16,7 +16,6 @@ when a :class:`~dynid.friction.fit.FrictionFit` is saved and are optional on rea
 
 from __future__ import annotations
 
-import json
 from pathlib import Path
 from typing import Any
 
@@ -25,6 +24,7 @@ import numpy as np
 from ..exceptions import DataError
 from ..friction.fit import FrictionFit
 from ..friction.model import ClassicalFriction, FrictionModel, SigmoidFriction
+from ._json import load_json, save_json
 
 __all__ = ["FORMAT", "read_friction_json", "write_friction_json"]
 
@@ -75,7 +75,7 @@ def write_friction_json(
     if fit is not None:
         units.update(rms_before="N m", rms_after="N m")
     doc = {
-        "format": FORMAT,
+        "schema": FORMAT,
         "dynid_version": __version__,
         "model": model.kind,
         "convention": _CONVENTION[model.kind],
@@ -83,8 +83,7 @@ def write_friction_json(
         "joints": joints,
         "metadata": metadata or {},
     }
-    path.write_text(json.dumps(doc, indent=2) + "\n")
-    return path
+    return save_json(path, doc)
 
 
 def read_friction_json(path: str | Path) -> FrictionModel:
@@ -99,12 +98,12 @@ def read_friction_json(path: str | Path) -> FrictionModel:
         The file cannot be read.
     """
     path = Path(path)
-    try:
-        doc = json.loads(path.read_text())
-    except json.JSONDecodeError as exc:
-        raise DataError(f"{path.name}: not valid JSON ({exc})") from exc
-    if not isinstance(doc, dict):
-        raise DataError(f"{path.name}: expected a JSON object with 'model' and 'joints'")
+    doc = load_json(path, what="friction file (dynid friction)")
+    tag = doc.get("schema", doc.get("format"))  # "format": files of dynid 0.1
+    if tag != FORMAT:
+        raise DataError(
+            f"{path.name}: not a friction file: 'schema' must be {FORMAT!r}; got {tag!r}"
+        )
     kind = doc.get("model")
     if kind not in _CLASSES:
         raise DataError(f"{path.name}: 'model' must be 'sigmoid' or 'classical'; got {kind!r}")

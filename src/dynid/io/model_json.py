@@ -27,7 +27,6 @@ Floats are written with Python's shortest round-trip representation, so
 
 from __future__ import annotations
 
-import json
 import math
 from collections.abc import Mapping
 from pathlib import Path
@@ -41,6 +40,7 @@ from ..exceptions import DataError
 from ..identification.least_squares import LeastSquaresFit
 from ..identification.model import IdentifiedModel
 from ..regressors.base import BaseParameters
+from ._json import load_json, save_json
 from .robot_json import robot_from_dict, robot_to_dict
 
 __all__ = ["MODEL_SCHEMA", "model_to_dict", "model_from_dict", "save_model_json", "load_model_json"]
@@ -226,11 +226,8 @@ def model_from_dict(d: Mapping[str, Any]) -> IdentifiedModel:
 
 
 def save_model_json(path: str | Path, model: IdentifiedModel, *, seed: int | None = None) -> Path:
-    """Write an identified model as JSON (indented, UTF-8); returns the path."""
-    path = Path(path)
-    text = json.dumps(model_to_dict(model, seed=seed), indent=1, allow_nan=False)
-    path.write_text(text + "\n", encoding="utf-8")
-    return path
+    """Write an identified model as strict JSON (indented, UTF-8, atomic); returns the path."""
+    return save_json(path, model_to_dict(model, seed=seed))
 
 
 def load_model_json(path: str | Path) -> IdentifiedModel:
@@ -242,12 +239,7 @@ def load_model_json(path: str | Path) -> IdentifiedModel:
         Not JSON, or not an identified model (see :func:`model_from_dict`).
     """
     path = Path(path)
-    try:
-        d = json.loads(path.read_text(encoding="utf-8"))
-    except (json.JSONDecodeError, UnicodeDecodeError) as exc:
-        raise DataError(f"{path.name}: not a JSON file ({exc})") from exc
-    if not isinstance(d, dict):
-        raise DataError(f"{path.name}: expected a JSON object")
+    d = load_json(path, schema=MODEL_SCHEMA, what="identified model (dynid identify)")
     try:
         return model_from_dict(d)
     except DataError as exc:

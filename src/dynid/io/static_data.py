@@ -1,8 +1,9 @@
 """Static data sets (``q``, ``M(q)``, ``g(q)`` at rest) to and from CSV and NPZ files.
 
 CSV: one row per configuration. Leading lines starting with ``#`` are comments; the first
-states the units, an optional ``# metadata: {...}`` line holds the data set's metadata as
-JSON. Then a header and the rows. Columns (any order when read):
+states the units, ``# rows: N`` the number of rows written, an optional
+``# metadata: {...}`` line holds the data set's metadata as JSON. Then a header and the
+rows. A UTF-8 byte-order mark (spreadsheet exports) is accepted. Columns (any order when read):
 
 * ``q1 .. qn``: joint positions [rad] (m for a prismatic joint);
 * ``M<i>_<j>`` for ``i >= j`` (1-based): the lower triangle of the inertia matrix
@@ -10,19 +11,23 @@ JSON. Then a header and the rows. Columns (any order when read):
   order (``M1_1, M2_1, M2_2, M3_1, ...``); the upper triangle follows by symmetry;
 * ``g1 .. gn``: gravity torques [N m] (N).
 
-NPZ: arrays ``q`` (N, n), ``M`` (N, n, n), ``g`` (N, n) and optionally ``metadata`` (a
-JSON string); read with ``allow_pickle=False``.
+NPZ: arrays ``q`` (N, n), ``M`` (N, n, n), ``g`` (N, n) and optionally ``n_rows`` (N)
+and ``metadata`` (a JSON string); read with ``allow_pickle=False``.
+
+Files are written atomically (:mod:`dynid.io._files`) and record their row count; when
+a file states one, loading checks it, so a file cut short (a copy interrupted, a disk
+full) is refused rather than read as a smaller data set.
 
 Loading checks everything and raises :class:`~dynid.exceptions.DataError` naming the
 column, key, line or row: missing or extra columns (keys), duplicated columns, cells that
 are not numbers, NaN or inf, a non-symmetric ``M`` (NPZ), a joint count different from the
-robot's. With ``drop_invalid=True`` rows with bad values are dropped instead, logged with
-their count, and the count is returned (structural problems still raise).
+robot's, a row count different from the recorded one. With ``drop_invalid=True`` rows
+with bad values are dropped instead, logged as a warning with their count and where they
+are, and the count is returned (structural problems still raise).
 """
 
 from __future__ import annotations
 
-import json
 import logging
 import re
 import zipfile
@@ -37,6 +42,8 @@ from ..exceptions import DataError
 from ..identification.data import DEFAULT_SYMMETRY_RTOL, StaticDataset
 from ..model.robot import Robot
 from ..regressors.static import static_labels
+from ._files import open_atomic
+from ._json import dumps, loads
 
 __all__ = [
     "static_columns",
@@ -55,6 +62,7 @@ UNITS_LINE = (
     "M<i>_<j> lower triangle (i >= j, 1-based) of M [kg m^2], g<i> [N m]"
 )
 _META_PREFIX = "# metadata:"
+_ROWS_PREFIX = "# rows:"
 _NPZ_KEYS = ("q", "M", "g")
 
 
@@ -96,10 +104,10 @@ def save_static_csv(path: str | Path, data: StaticDataset) -> Path:
     i, j = np.tril_indices(n)
     table = np.concatenate([data.q, data.M[:, i, j], data.g], axis=1)
     header = ",".join(static_columns(n))
-    lines = [UNITS_LINE]
+    lines = [UNITS_LINE, f"{_ROWS_PREFIX} {len(table)}"]
     if data.metadata:
-        lines.append(f"{_META_PREFIX} {json.dumps(dict(data.metadata), default=_jsonable)}")
-    with path.open("w", encoding="utf-8", newline="\n") as fh:
+        lines.append(f"{_META_PREFIX} {dumps(dict(data.metadata), indent=None)}")
+    with open_atomic(path, "w") as fh:
         fh.write("\n".join(lines) + "\n" + header + "\n")
         np.savetxt(fh, table, fmt="%.17g", delimiter=",")
     return path
@@ -136,10 +144,11 @@ def load_static_csv(
     """
     path = Path(path)
     try:
-        text = path.read_text(encoding="utf-8")
+        text = path.read_text(encoding="utf-8-sig")
     except UnicodeDecodeError as exc:
         raise DataError(f"{path.name}: not a UTF-8 text file ({exc.reason})") from exc
     meta: dict[str, Any] = {}
+    n_recorded: int | None = None
     header: list[str] | None = None
     header_line = 0
     rows: list[tuple[int, list[str]]] = []
@@ -150,6 +159,8 @@ def load_static_csv(
         if line.startswith("#"):
             if header is None and line.startswith(_META_PREFIX):
                 meta = _parse_meta(path, f"line {lineno}", line[len(_META_PREFIX) :])
+            elif header is None and line.startswith(_ROWS_PREFIX):
+                n_recorded = _parse_rows(path, lineno, line[len(_ROWS_PREFIX) :])
             continue
         cells = [c.strip() for c in line.split(",")]
         if header is None:
@@ -158,6 +169,7 @@ def load_static_csv(
             rows.append((lineno, cells))
     if header is None:
         raise DataError(f"{path.name}: no header line; expected columns {_expected_hint(robot)}")
+    check_row_count(path, n_recorded, len(rows))
     n = _check_columns(path, header, header_line, robot)
     cols = static_columns(n)
     where = {name: header.index(name) for name in cols}
@@ -229,11 +241,30 @@ def _check_columns(path: Path, header: list[str], line: int, robot: Robot | None
     return n
 
 
+def _parse_rows(path: Path, lineno: int, text: str) -> int:
+    try:
+        n = int(text.strip())
+    except ValueError:
+        raise DataError(f"{path.name}: line {lineno}: '# rows:' must give an integer") from None
+    if n < 0:
+        raise DataError(f"{path.name}: line {lineno}: '# rows:' must be >= 0; got {n}")
+    return n
+
+
+def check_row_count(path: Path, recorded: int | None, found: int) -> None:
+    """Raise :class:`DataError` when a file holds fewer or more rows than it recorded."""
+    if recorded is not None and recorded != found:
+        raise DataError(
+            f"{path.name}: the file records {recorded} rows but holds {found}; it is "
+            "incomplete or was edited (a write or copy cut short?); regenerate it"
+        )
+
+
 def _parse_meta(path: Path, where: str, text: str) -> dict[str, Any]:
     try:
-        meta = json.loads(text)
-    except json.JSONDecodeError as exc:
-        raise DataError(f"{path.name}: {where}: metadata is not valid JSON ({exc.msg})") from exc
+        meta = loads(text)
+    except ValueError as exc:
+        raise DataError(f"{path.name}: {where}: metadata is not strict JSON ({exc})") from exc
     if not isinstance(meta, dict):
         raise DataError(f"{path.name}: {where}: metadata must be a JSON object")
     return meta
@@ -248,9 +279,16 @@ def _expected_hint(robot: Robot | None) -> str:
 def save_static_npz(path: str | Path, data: StaticDataset) -> Path:
     """Write a data set as NPZ (``q``, ``M``, ``g``, ``metadata`` as JSON); returns the path."""
     path = Path(path)
-    meta = json.dumps(dict(data.metadata), default=_jsonable)
-    with path.open("wb") as fh:
-        np.savez(fh, q=data.q, M=data.M, g=data.g, metadata=np.array(meta))
+    meta = dumps(dict(data.metadata), indent=None)
+    with open_atomic(path, "wb") as fh:
+        np.savez(
+            fh,
+            q=data.q,
+            M=data.M,
+            g=data.g,
+            n_rows=np.array(data.q.shape[0]),
+            metadata=np.array(meta),
+        )
     return path
 
 
@@ -268,7 +306,7 @@ def load_static_npz(
         with np.load(path, allow_pickle=False) as z:
             keys = set(z.files)
             missing = [k for k in _NPZ_KEYS if k not in keys]
-            extra = sorted(keys - set(_NPZ_KEYS) - {"metadata"})
+            extra = sorted(keys - set(_NPZ_KEYS) - {"metadata", "n_rows"})
             if missing:
                 raise DataError(f"{path.name}: missing arrays {missing}; expected q, M, g")
             if extra:
@@ -277,7 +315,8 @@ def load_static_npz(
                 )
             arrays = {k: np.asarray(z[k]) for k in _NPZ_KEYS}
             meta_text = str(z["metadata"]) if "metadata" in keys else "{}"
-    except (zipfile.BadZipFile, OSError, ValueError) as exc:
+            n_recorded = _npz_rows(path, z) if "n_rows" in keys else None
+    except (zipfile.BadZipFile, OSError, ValueError, EOFError, KeyError) as exc:
         if isinstance(exc, DataError):
             raise
         raise DataError(f"{path.name}: not a readable NPZ file of arrays ({exc})") from exc
@@ -288,6 +327,7 @@ def load_static_npz(
     if q.ndim != 2 or q.shape[0] < 1:
         raise DataError(f"{path.name}: array 'q' must have shape (N, n); got {q.shape}")
     N, n = q.shape
+    check_row_count(path, n_recorded, N)
     if robot is not None and n != robot.n:
         raise DataError(
             f"{path.name}: data for {n} joints (q of shape {q.shape}); robot {robot.name!r} "
@@ -329,11 +369,12 @@ def _finish(
     """Data set from the valid rows ``[q, tril M, g]`` of a file."""
     if bad:
         _log.warning(
-            "%s: dropped %d invalid row(s) of %d; first: %s",
+            "%s: dropped %d invalid row(s) of %d: %s%s",
             path.name,
             len(bad),
             len(bad) + len(table),
-            bad[0],
+            "; ".join(bad[:5]),
+            "; ..." if len(bad) > 5 else "",
         )
     if len(table) == 0:
         raise DataError(f"{path.name}: no valid configuration ({len(bad)} invalid row(s))")
@@ -349,9 +390,8 @@ def _finish(
     return StaticDataset(q, M, g, info), len(bad)
 
 
-def _jsonable(x: Any) -> Any:
-    if isinstance(x, np.ndarray):
-        return x.tolist()
-    if isinstance(x, np.generic):
-        return x.item()
-    raise TypeError(f"not JSON serialisable: {type(x).__name__}")
+def _npz_rows(path: Path, z: Any) -> int:
+    a = np.asarray(z["n_rows"])
+    if a.shape != () or not np.issubdtype(a.dtype, np.integer) or int(a) < 0:
+        raise DataError(f"{path.name}: array 'n_rows' must be one integer >= 0; got {a!r}")
+    return int(a)

@@ -1,36 +1,57 @@
 """Reading and writing torque logs as CSV or NPZ.
 
-CSV: an optional comment line (``#``) with the units, then a header naming the columns,
-then one row per sample::
+CSV: comment lines (``#``) with the units and the row count, then a header naming the
+columns, then one row per sample::
 
     # dynid torque log; units: t [s], q [rad], dq [rad/s], tau [N m], ddq [rad/s^2]
+    # rows: N
     t,q1,...,qn,dq1,...,dqn,tau1,...,taun[,ddq1,...,ddqn]
 
-Columns are found by name (any order; other columns are ignored); ``n`` is the number of
-``q`` columns. Empty cells and ``nan`` read as NaN. NPZ: arrays ``t`` (N,), ``q``, ``dq``,
-``tau`` and optionally ``ddq`` (N, n), loaded with ``allow_pickle=False``.
+Columns are found by name, in any order; ``n`` is the number of ``q`` columns
+(``q1..qn``, no gap). A duplicated column, a column of no known name, or an incomplete
+``ddq1..ddqn`` set is an error (a wrong column silently used or ignored is a wrong
+answer). Empty cells and ``nan`` read as NaN. A UTF-8 byte-order mark is accepted. NPZ:
+arrays ``t`` (N,), ``q``, ``dq``, ``tau``, optionally ``ddq`` (N, n) and ``n_rows``, loaded
+with ``allow_pickle=False``; other arrays are an error.
 
-Reading cleans the log with :meth:`~dynid.identification.log.TorqueLog.from_raw`: rows
-with NaN are dropped and counted, duplicate timestamps removed and counted, gaps
-recorded (``log.cleaning``); timestamps running backwards are rejected. Malformed files
-raise :class:`~dynid.exceptions.DataError` naming the file, the column and the line.
-Writing uses 17 significant digits, so a round trip is exact.
+Strict by default: a row holding NaN or inf, or repeating the previous timestamp, raises
+:class:`~dynid.exceptions.DataError` naming the first such row and the count. With
+``drop_invalid=True`` such rows are dropped, and a warning says how many and where
+(``log.cleaning`` counts them). Timestamps running backwards are always rejected. When
+the file records its row count (``# rows:``, ``n_rows``), a different count is an error
+(a file cut short). Malformed files raise :class:`~dynid.exceptions.DataError` naming
+the file, the column and the line.
+
+Writing is atomic (:mod:`dynid.io._files`) with 17 significant digits, so a round trip is
+exact. The CSV reader parses the body in one pass with numpy's C reader straight from the
+file (no copy of the text), so a 2-million-row log needs about the memory of its arrays.
 """
 
 from __future__ import annotations
 
 import io
+import logging
+import re
+import warnings
+import zipfile
 from pathlib import Path
+from typing import IO
 
 import numpy as np
 from numpy.typing import NDArray
 
 from ..exceptions import DataError
 from ..identification.log import TorqueLog
+from ._files import open_atomic
+from .static_data import check_row_count
 
 __all__ = ["read_torque_log", "write_torque_log", "torque_log_columns"]
 
+_log = logging.getLogger(__name__)
+
 _UNITS = "# dynid torque log; units: t [s], q [rad], dq [rad/s], tau [N m], ddq [rad/s^2]"
+_ROWS_PREFIX = "# rows:"
+_SIGNALS = ("q", "dq", "tau", "ddq")
 
 
 def torque_log_columns(n: int, *, with_ddq: bool = False) -> list[str]:
@@ -55,154 +76,371 @@ def write_torque_log(path: str | Path, log: TorqueLog) -> Path:
         arrays = {"t": log.t, "q": log.q, "dq": log.dq, "tau": log.tau}
         if log.ddq is not None:
             arrays["ddq"] = log.ddq
-        with open(path, "wb") as f:
-            np.savez(f, **arrays)
+        with open_atomic(path, "wb") as f:
+            np.savez(f, n_rows=np.array(log.n_samples), **arrays)
         return path
     if suffix != ".csv":
         raise DataError(f"torque log must be a .csv or .npz file; got {path.name!r}")
     parts = [log.t[:, None], log.q, log.dq, log.tau]
     if log.ddq is not None:
         parts.append(log.ddq)
-    data = np.concatenate(parts, axis=1)
-    header = _UNITS + "\n" + ",".join(torque_log_columns(log.n, with_ddq=log.ddq is not None))
-    np.savetxt(path, data, delimiter=",", fmt="%.17g", header=header, comments="")
+    header = "\n".join(
+        [
+            _UNITS,
+            f"{_ROWS_PREFIX} {log.n_samples}",
+            ",".join(torque_log_columns(log.n, with_ddq=log.ddq is not None)),
+        ]
+    )
+    with open_atomic(path, "w") as fh:
+        fh.write(header + "\n")
+        step = 100_000  # bounded memory: format the table in blocks of rows
+        for a in range(0, log.n_samples, step):
+            block = np.concatenate([x[a : a + step] for x in parts], axis=1)
+            np.savetxt(fh, block, delimiter=",", fmt="%.17g")
     return path
 
 
-def read_torque_log(path: str | Path, *, gap_factor: float = 1.5) -> TorqueLog:
-    """Read a torque log from a ``.csv`` or ``.npz`` file and clean it.
+def read_torque_log(
+    path: str | Path, *, gap_factor: float = 1.5, drop_invalid: bool = False
+) -> TorqueLog:
+    """Read a torque log from a ``.csv`` or ``.npz`` file, strictly.
 
     Parameters
     ----------
     path : str or Path
     gap_factor : float
         Steps longer than this times the median step are recorded as gaps.
+    drop_invalid : bool
+        Drop rows holding NaN or inf and rows repeating the previous timestamp (a warning
+        gives the count and the first rows) instead of raising.
 
     Returns
     -------
     TorqueLog
-        Cleaned (``log.cleaning`` says what was dropped).
+        ``log.cleaning`` counts what was dropped and lists the gaps.
 
     Raises
     ------
     DataError
-        Unknown suffix, missing column or array, a non-numeric cell, a row with the wrong
-        number of fields, timestamps running backwards.
+        Unknown suffix; a missing, duplicated or unknown column or array; an incomplete
+        ``ddq`` set; a non-numeric cell, a row with the wrong number of fields (the line);
+        a row count other than the recorded one; NaN/inf or repeated timestamps unless
+        ``drop_invalid``; timestamps running backwards.
     OSError
         The file cannot be read.
     """
     path = Path(path)
     suffix = path.suffix.lower()
     if suffix == ".npz":
-        return _read_npz(path, gap_factor)
-    if suffix == ".csv":
-        return _read_csv(path, gap_factor)
-    raise DataError(f"torque log must be a .csv or .npz file; got {path.name!r}")
+        arrays, lines = _read_npz(path), None
+    elif suffix == ".csv":
+        arrays, lines = _read_csv(path)
+    else:
+        raise DataError(f"torque log must be a .csv or .npz file; got {path.name!r}")
+    _check_rows(path, arrays, lines, drop_invalid)
+    try:
+        return TorqueLog.from_raw(**arrays, gap_factor=gap_factor)
+    except DataError as exc:
+        raise DataError(f"{path.name}: {exc}") from exc
 
 
-def _read_npz(path: Path, gap_factor: float) -> TorqueLog:
+def _where(rows: NDArray[np.intp], lines: tuple[int, int] | None) -> str:
+    """``row 12 (line 15), row 40 (line 43), ...`` for the first few rows."""
+
+    def one(r: int) -> str:
+        return f"row {r} (line {lines[0] + r})" if lines is not None else f"row {r}"
+
+    shown = ", ".join(one(int(r)) for r in rows[:5])
+    return shown + (", ..." if rows.size > 5 else "")
+
+
+def _check_rows(
+    path: Path,
+    arrays: dict[str, NDArray[np.float64]],
+    lines: tuple[int, int] | None,
+    drop_invalid: bool,
+) -> None:
+    """NaN/inf rows and repeated timestamps: raise, or (``drop_invalid``) report them.
+
+    ``lines`` is (line number of data row 0, rows) when rows map to lines one to one.
+    """
+    t = arrays["t"]
+    ok = np.isfinite(t)
+    for k in _SIGNALS:
+        if k in arrays:
+            ok &= np.isfinite(arrays[k]).all(axis=1)
+    bad = np.flatnonzero(~ok)
+    good = np.flatnonzero(ok)
+    tg = t[good]
+    dup = good[1:][tg[1:] == tg[:-1]]
+    hint = "fix the file or pass --drop-invalid (drop_invalid=True) to drop such rows"
+    if bad.size and not drop_invalid:
+        r = int(bad[0])
+        col = "t"
+        for k in (k for k in _SIGNALS if k in arrays and np.isfinite(t[r])):
+            j = np.flatnonzero(~np.isfinite(arrays[k][r]))
+            if j.size:
+                col = f"{k}{int(j[0]) + 1}"
+                break
+        raise DataError(
+            f"{path.name}: {bad.size} row(s) hold NaN, inf or an empty cell; first "
+            f"{_where(bad[:1], lines)} in {col!r}; hint: {hint}"
+        )
+    if dup.size and not drop_invalid:
+        raise DataError(
+            f"{path.name}: {dup.size} row(s) repeat the previous timestamp; first "
+            f"{_where(dup[:1], lines)} (t = {float(t[dup[0]])!r}); hint: {hint}"
+        )
+    if bad.size:
+        _log.warning(
+            "%s: dropped %d row(s) of %d holding NaN, inf or an empty cell: %s",
+            path.name,
+            bad.size,
+            t.size,
+            _where(bad, lines),
+        )
+    if dup.size:
+        _log.warning(
+            "%s: dropped %d row(s) of %d repeating the previous timestamp: %s",
+            path.name,
+            dup.size,
+            t.size,
+            _where(dup, lines),
+        )
+
+
+def _read_npz(path: Path) -> dict[str, NDArray[np.float64]]:
     try:
         npz = np.load(path, allow_pickle=False)
-    except ValueError as exc:
+    except (ValueError, OSError, EOFError, zipfile.BadZipFile) as exc:
         raise DataError(f"{path.name}: not a readable NPZ file without pickles ({exc})") from exc
-    with npz:
-        missing = [k for k in ("t", "q", "dq", "tau") if k not in npz.files]
-        if missing:
-            raise DataError(
-                f"{path.name}: missing array(s) {missing}; expected t, q, dq, tau (optional ddq); "
-                f"found {sorted(npz.files)}"
-            )
-        arrays = {}
-        for k in ("t", "q", "dq", "tau", "ddq"):
-            if k not in npz.files:
-                continue
-            try:
-                arrays[k] = np.asarray(npz[k])
-            except ValueError as exc:  # object arrays need pickles, which are refused
-                raise DataError(f"{path.name}: array {k!r} cannot be read ({exc})") from exc
-    for k, a in arrays.items():
-        if not np.issubdtype(a.dtype, np.number):
-            raise DataError(f"{path.name}: array {k!r} must be numeric; got dtype {a.dtype}")
+    if not hasattr(npz, "files"):
+        raise DataError(f"{path.name}: a single .npy array, not an NPZ archive of arrays")
+    arrays = {}
     try:
-        return TorqueLog.from_raw(**arrays, gap_factor=gap_factor)
-    except DataError as exc:
-        raise DataError(f"{path.name}: {exc}") from exc
-
-
-def _header(path: Path, lines: list[str]) -> tuple[int, list[str]]:
-    for i, line in enumerate(lines):
-        s = line.strip()
-        if s and not s.startswith("#"):
-            return i, [c.strip() for c in s.split(",")]
-    raise DataError(f"{path.name}: no header line (t,q1,...,dq1,...,tau1,...) found")
-
-
-def _slow_parse(path: Path, lines: list[str], first: int, width: int, names: list[str]) -> NDArray:
-    rows = []
-    for i in range(first, len(lines)):
-        s = lines[i].strip()
-        if not s or s.startswith("#"):
-            continue
-        cells = s.split(",")
-        if len(cells) != width:
-            raise DataError(
-                f"{path.name}, line {i + 1}: expected {width} fields like the header; "
-                f"got {len(cells)}"
-            )
-        row = []
-        for c, name in zip(cells, names, strict=True):
-            c = c.strip()
-            if c == "":
-                row.append(np.nan)
-                continue
-            try:
-                row.append(float(c))
-            except ValueError:
+        with npz:
+            missing = [k for k in ("t", "q", "dq", "tau") if k not in npz.files]
+            if missing:
                 raise DataError(
-                    f"{path.name}, line {i + 1}, column {name!r}: not a number: {c!r}"
-                ) from None
-        rows.append(row)
-    return np.array(rows, dtype=np.float64).reshape(-1, width)
+                    f"{path.name}: missing array(s) {missing}; expected t, q, dq, tau "
+                    f"(optional ddq); found {sorted(npz.files)}"
+                )
+            extra = sorted(set(npz.files) - {"t", "n_rows", *_SIGNALS})
+            if extra:
+                raise DataError(
+                    f"{path.name}: unknown array(s) {extra}; expected t, q, dq, tau "
+                    "(optional ddq, n_rows)"
+                )
+            n_rows = None
+            for k in ("t", "n_rows", *_SIGNALS):
+                if k not in npz.files:
+                    continue
+                try:
+                    a = np.asarray(npz[k])
+                except ValueError as exc:  # object arrays need pickles, which are refused
+                    raise DataError(f"{path.name}: array {k!r} cannot be read ({exc})") from exc
+                if k == "n_rows":
+                    if a.shape != () or not np.issubdtype(a.dtype, np.integer):
+                        raise DataError(f"{path.name}: array 'n_rows' must be one integer")
+                    n_rows = int(a)
+                    continue
+                if not np.issubdtype(a.dtype, np.number) or np.iscomplexobj(a):
+                    raise DataError(
+                        f"{path.name}: array {k!r} must be real numbers; got dtype {a.dtype}"
+                    )
+                arrays[k] = a.astype(np.float64, copy=False)
+    except (zipfile.BadZipFile, EOFError, OSError) as exc:
+        raise DataError(f"{path.name}: not a readable NPZ file ({exc})") from exc
+    t = arrays["t"]
+    if t.ndim != 1:
+        raise DataError(f"{path.name}: array 't' must have shape (N,); got {t.shape}")
+    check_row_count(path, n_rows, t.shape[0])
+    for k in _SIGNALS:
+        if k in arrays and (arrays[k].ndim != 2 or arrays[k].shape[0] != t.shape[0]):
+            raise DataError(
+                f"{path.name}: array {k!r} must have shape ({t.shape[0]}, n) like t; "
+                f"got {arrays[k].shape}"
+            )
+    return arrays
 
 
-def _read_csv(path: Path, gap_factor: float) -> TorqueLog:
-    text = path.read_text()
-    lines = text.splitlines()
-    h, names = _header(path, lines)
-    index = {c: k for k, c in enumerate(names)}
-    n = 0
-    while f"q{n + 1}" in index:
-        n += 1
-    if "t" not in index or n == 0:
+def _columns(path: Path, names: list[str], line: int) -> tuple[int, bool]:
+    """Check the header; return the joint count n and whether ddq columns are present."""
+    where = f"{path.name}, line {line}"
+    dup = sorted({c for c in names if names.count(c) > 1})
+    if dup:
+        raise DataError(f"{where}: duplicated column(s) {dup}; each column must appear once")
+    qs = sorted(int(c[1:]) for c in names if re.fullmatch(r"q[1-9]\d*", c))
+    n = len(qs)
+    if "t" not in names or n == 0:
         raise DataError(
-            f"{path.name}: header must name columns t, q1..qn, dq1..dqn, tau1..taun; "
-            f"got {names[:8]}..."
+            f"{where}: header must name columns t, q1..qn, dq1..dqn, tau1..taun; "
+            f"got {names[:8]}{' ...' if len(names) > 8 else ''}"
         )
+    if qs != list(range(1, n + 1)):
+        gap = sorted(set(range(1, max(qs) + 1)) - set(qs))
+        raise DataError(f"{where}: joint position columns must be q1..qn; missing q{gap[0]}")
     need = torque_log_columns(n)
-    missing = [c for c in need if c not in index]
+    missing = [c for c in need if c not in names]
     if missing:
         raise DataError(f"{path.name}: missing column(s) {missing} (n = {n} from q1..q{n})")
-    with_ddq = all(f"ddq{j}" in index for j in range(1, n + 1))
-    body = "\n".join(lines[h + 1 :])
-    try:
-        data = np.loadtxt(io.StringIO(body), delimiter=",", ndmin=2, comments="#")
-        if data.size and data.shape[1] != len(names):
-            raise ValueError("width")
-    except ValueError:
-        data = _slow_parse(path, lines, h + 1, len(names), names)
-    if data.shape[0] == 0:
+    ddq = [f"ddq{j}" for j in range(1, n + 1)]
+    have = [c for c in ddq if c in names]
+    if have and len(have) != n:
+        raise DataError(
+            f"{where}: accelerations must be all of ddq1..ddq{n} or none; got only {have}"
+        )
+    unknown = [c for c in names if c not in set(need) | set(ddq)]
+    if unknown:
+        raise DataError(
+            f"{where}: unknown column(s) {unknown}; a torque log has t, q1..q{n}, "
+            f"dq1..dq{n}, tau1..tau{n} and optionally ddq1..ddq{n}"
+        )
+    return n, bool(have)
+
+
+def _read_csv(path: Path) -> tuple[dict[str, NDArray[np.float64]], tuple[int, int] | None]:
+    """The arrays of a CSV log, and (line of the first data row, rows) for messages."""
+    with open(path, "rb") as fb:
+        recorded = None
+        lineno = 0
+        names: list[str] | None = None
+        while raw := fb.readline():
+            lineno += 1
+            try:
+                s = raw.decode("utf-8-sig" if lineno == 1 else "utf-8").strip()
+            except UnicodeDecodeError as exc:
+                raise DataError(
+                    f"{path.name}, line {lineno}: not UTF-8 text ({exc.reason})"
+                ) from None
+            if not s:
+                continue
+            if s.startswith("#"):
+                if s.startswith(_ROWS_PREFIX):
+                    recorded = _rows(path, lineno, s[len(_ROWS_PREFIX) :])
+                continue
+            names = [c.strip() for c in s.split(",")]
+            break
+        if names is None:
+            raise DataError(f"{path.name}: no header line (t,q1,...,dq1,...,tau1,...) found")
+        n, with_ddq = _columns(path, names, lineno)
+        first = lineno + 1
+        index = {c: k for k, c in enumerate(names)}
+        layout = {"t": [index["t"]]}
+        for k in _SIGNALS if with_ddq else _SIGNALS[:3]:
+            layout[k] = [index[f"{k}{j}"] for j in range(1, n + 1)]
+        start = fb.tell()
+        arrays = _fast_parse(fb, len(names), layout, recorded)
+        if arrays is None:  # the fast reader refused the text: find and name the problem
+            fb.seek(start)
+            table = _slow_parse(path, io.TextIOWrapper(fb, encoding="utf-8"), first, names)
+            arrays = {k: table[:, cols] for k, cols in layout.items()}
+    N = arrays["t"].shape[0]
+    if N == 0:
         raise DataError(f"{path.name}: no data rows after the header")
-    col = lambda k: data[:, [index[c] for c in k]]  # noqa: E731
-    qs = [f"q{j}" for j in range(1, n + 1)]
-    arrays = {
-        "t": data[:, index["t"]],
-        "q": col(qs),
-        "dq": col(["d" + c for c in qs]),
-        "tau": col([f"tau{j}" for j in range(1, n + 1)]),
-    }
-    if with_ddq:
-        arrays["ddq"] = col(["dd" + c for c in qs])
+    check_row_count(path, recorded, N)
+    arrays["t"] = arrays["t"].reshape(N)
+    for a in arrays.values():
+        a.setflags(write=False)  # fresh and owned: TorqueLog keeps them without a copy
+    return arrays, (first, N)
+
+
+#: Bytes of CSV text parsed at a time (bounded memory whatever the file size).
+_CHUNK_BYTES = 32 << 20
+
+
+def _fast_parse(
+    fb: IO[bytes], width: int, layout: dict[str, list[int]], n_rows: int | None
+) -> dict[str, NDArray[np.float64]] | None:
+    """Parse the data rows in blocks with numpy's C number reader, straight into the
+    per-signal arrays; None when a block is not a clean table of numbers (a short row, an
+    empty cell, a word, a blank or comment line), for :func:`_slow_parse` to explain."""
+    blocks: dict[str, list[NDArray[np.float64]]] = {k: [] for k in layout}
+    out: dict[str, NDArray[np.float64]] | None = None
+    if n_rows is not None and n_rows > 0:
+        out = {k: np.empty((n_rows, len(c))) for k, c in layout.items()}
+    row = 0
+    tail = b""
+    while True:
+        chunk = fb.read(_CHUNK_BYTES)
+        last = not chunk
+        buf = tail + chunk
+        if last:
+            buf = buf.rstrip()
+            if not buf:
+                break
+            buf += b"\n"
+            tail = b""
+        else:
+            cut = buf.rfind(b"\n") + 1
+            buf, tail = buf[:cut], buf[cut:]
+            if not buf:
+                continue
+        rows = buf.count(b"\n")
+        if b"\n\n" in buf or b"#" in buf or b",," in buf:
+            return None
+        with warnings.catch_warnings():
+            warnings.simplefilter("error")
+            try:
+                flat = np.fromstring(buf.replace(b"\n", b","), dtype=np.float64, sep=",")
+            except (ValueError, DeprecationWarning):
+                return None
+        del buf
+        if flat.size != rows * width:
+            return None
+        table = flat.reshape(rows, width)
+        if out is not None and row + rows <= n_rows:
+            for k, cols in layout.items():
+                out[k][row : row + rows] = table[:, cols]
+        else:
+            if out is not None:  # more rows than recorded: keep going, report later
+                for k in layout:
+                    blocks[k].append(out[k][:row])
+                out = None
+            for k, cols in layout.items():
+                blocks[k].append(table[:, cols])
+        row += rows
+        if last:
+            break
+    if out is not None:
+        return {k: a[:row] if row < a.shape[0] else a for k, a in out.items()}
+    return {k: np.concatenate(b) if b else np.empty((0, len(layout[k]))) for k, b in blocks.items()}
+
+
+def _rows(path: Path, lineno: int, text: str) -> int:
     try:
-        return TorqueLog.from_raw(**arrays, gap_factor=gap_factor)
-    except DataError as exc:
-        raise DataError(f"{path.name}: {exc}") from exc
+        return int(text.strip())
+    except ValueError:
+        raise DataError(f"{path.name}, line {lineno}: '# rows:' must give an integer") from None
+
+
+def _slow_parse(path: Path, fh: IO[str], first: int, names: list[str]) -> NDArray[np.float64]:
+    width = len(names)
+    rows: list[list[float]] = []
+    try:
+        for i, line in enumerate(fh, start=first):
+            s = line.strip()
+            if not s or s.startswith("#"):
+                continue
+            cells = s.split(",")
+            if len(cells) != width:
+                raise DataError(
+                    f"{path.name}, line {i}: expected {width} fields like the header; "
+                    f"got {len(cells)}"
+                )
+            row = []
+            for c, name in zip(cells, names, strict=True):
+                c = c.strip()
+                if c == "":
+                    row.append(np.nan)
+                    continue
+                try:
+                    row.append(float(c))
+                except ValueError:
+                    raise DataError(
+                        f"{path.name}, line {i}, column {name!r}: not a number: {c!r}"
+                    ) from None
+            rows.append(row)
+    except UnicodeDecodeError as exc:
+        raise DataError(f"{path.name}: not a UTF-8 text file ({exc.reason})") from None
+    return np.array(rows, dtype=np.float64).reshape(-1, width)

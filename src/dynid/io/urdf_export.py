@@ -41,6 +41,7 @@ from ..exceptions import ModelError
 from ..model.inertia import inertia6_from_matrix
 from ..model.robot import Robot
 from .urdf_patch import patch_urdf_inertials
+from ._files import write_text
 
 __all__ = ["save_urdf", "tip_name", "urdf_from_robot"]
 
@@ -215,5 +216,5 @@ def save_urdf(
             merged=merged,
             source=f"URDF template {tpath.name!r}",
         )
-    path.write_text(text, encoding="utf-8")
+    write_text(path, text)
     return path
