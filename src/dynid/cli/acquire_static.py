@@ -20,6 +20,7 @@ from pathlib import Path
 
 import numpy as np
 
+from ..identification.consistency import kinematics_record
 from ..io.static_data import save_static_data
 from ..simulation.controller import DEFAULT_MARGIN, SimulatedController, acquire_static
 from .common import add_robot_options, add_seed_option, count_type, load_robot, nonnegative_type
@@ -69,8 +70,7 @@ def run(args: argparse.Namespace) -> int:
     rng_q, rng_noise = streams(args.seed)
     controller = SimulatedController(robot, args.noise, rng=rng_noise)
     data = acquire_static(controller, args.n, rng_q, margin=args.margin)
-    data = data.with_metadata(seed=args.seed)
-    args.out.parent.mkdir(parents=True, exist_ok=True)
+    data = data.with_metadata(seed=args.seed, kinematics=kinematics_record(robot))
     path = save_static_data(args.out, data)
     if not args.quiet:
         print(

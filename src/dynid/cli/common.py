@@ -4,18 +4,18 @@ argparse types for checked option values, figures that are skipped without matpl
 from __future__ import annotations
 
 import argparse
-import json
+import contextlib
 import logging
 import math
 import sys
-from collections.abc import Callable
+from collections.abc import Callable, Iterator
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 
 from .. import _checks, spatial
-from ..exceptions import DynidError, ShapeError
+from ..exceptions import DataError, DynidError, ShapeError
 from ..io._files import open_atomic
 from ..io._json import dumps
 from ..model.panda import panda
@@ -78,6 +78,42 @@ nonnegative_type = number(float, min=0)
 def add_seed_option(p: argparse.ArgumentParser, help: str = "random seed (default: 0)") -> None:
     """``--seed N`` (N >= 0)."""
     p.add_argument("--seed", type=seed_type, default=0, metavar="N", help=help)
+
+
+def add_log_options(p: argparse.ArgumentParser, *, drop_invalid: bool = True) -> None:
+    """``--max-gap SECONDS`` and ``--drop-invalid`` for commands that read a torque log."""
+    p.add_argument(
+        "--max-gap",
+        type=positive_type,
+        default=None,
+        metavar="SECONDS",
+        help="longest gap in the log bridged by interpolation [s] (default: 2.5 median "
+        "steps, at least 0.02 s; a log at any rate from 10 Hz up passes)",
+    )
+    if drop_invalid:
+        p.add_argument(
+            "--drop-invalid",
+            action="store_true",
+            help="drop rows with NaN, inf, empty cells or a repeated timestamp (reported: "
+            "how many and where) instead of failing",
+        )
+
+
+@contextlib.contextmanager
+def about(path: Path) -> Iterator[None]:
+    """Prefix the file's name to a :class:`DataError` raised inside, if it lacks it."""
+    try:
+        yield
+    except DataError as exc:
+        if str(exc).startswith(path.name):
+            raise
+        raise type(exc)(f"{path.name}: {exc}") from exc
+
+
+def warn(args: argparse.Namespace, message: str) -> None:
+    """One warning line on stderr (``dynid CMD: warning: ...``), unless ``-q``."""
+    if not getattr(args, "quiet", False):
+        print(f"dynid {args.command}: warning: {message}", file=sys.stderr)
 
 
 def add_robot_options(p: argparse.ArgumentParser) -> None:
@@ -320,15 +356,33 @@ def column_map(args: argparse.Namespace) -> Any:
 
 
 def read_log(args: argparse.Namespace, path: Path, n: int | None = None) -> Any:
-    """The torque log ``path``, through ``--columns``/``--units`` when given (notes logged)."""
+    """The torque log ``path``, read strictly (``--drop-invalid`` relaxes it), through
+    ``--columns``/``--units`` when given (notes logged).
+
+    A mapped log is cleaned by :meth:`~dynid.identification.log.TorqueLog.from_raw`: rows
+    it dropped (NaN/inf, repeated timestamps) are an error here unless ``--drop-invalid``,
+    as for a log read directly.
+    """
     from ..io.torque_log import read_torque_log
 
+    drop = bool(getattr(args, "drop_invalid", False))
     cmap = column_map(args)
     if cmap is None:
-        return read_torque_log(path)
+        return read_torque_log(path, drop_invalid=drop)
     from ..io.columns import read_mapped_torque_log
 
     mapped = read_mapped_torque_log(path, cmap, n=n)
     for note in mapped.notes:
         _log.warning("%s: %s", path.name, note)
+    c = mapped.log.cleaning
+    if c.n_nan_rows or c.n_duplicates:
+        what = (
+            f"{c.n_nan_rows} row(s) of {c.n_input_rows} hold NaN or inf and {c.n_duplicates} "
+            "repeat the previous timestamp"
+        )
+        if not drop:
+            raise DataError(
+                f"{path.name}: {what}; hint: fix the file or pass --drop-invalid to drop them"
+            )
+        _log.warning("%s: dropped: %s", path.name, what)
     return mapped.log

@@ -42,13 +42,14 @@ from typing import Any
 
 import numpy as np
 
+from ..io._files import write_text
 from ..kinematics.forward import fk
 from ..kinematics.ik import IKOptions, ik
 from ..kinematics.jacobian import jacobian
 from ..model.panda import PANDA_NEUTRAL_Q, panda
 from ..model.robot import Robot
 from ..spatial import rpy_from_matrix, transform_from_xyz_rpy
-from .common import add_seed_option, format_joint_table, format_matrix
+from .common import add_seed_option, format_joint_table, format_matrix, save_figure
 
 NAME = "demo"
 
@@ -70,12 +71,12 @@ class DemoContext:
     results: dict[str, Any] = field(default_factory=dict)
     files: list[Path] = field(default_factory=list)
 
-    def save_figure(self, fig: Any, name: str) -> Path:
-        """Write a figure as PNG under ``out`` and record it."""
-        path = self.out / name
-        fig.savefig(path, dpi=120)
-        self.files.append(path)
-        print(f"  wrote {path}")
+    def save_figure(self, make_fig: Callable[[], Any], name: str) -> Path | None:
+        """Write a figure as PNG under ``out`` and record it (skipped without matplotlib)."""
+        path = save_figure(make_fig, self.out / name, dpi=120)
+        if path is not None:
+            self.files.append(path)
+            print(f"  wrote {path}")
         return path
 
 
@@ -113,13 +114,15 @@ def stage_kinematics(ctx: DemoContext) -> None:
         f"orientation error {res.orientation_error:.2e} rad"
     )
     print(f"solution q:\n{format_joint_table(robot, res.q)}")
-    fig = plot_ik_path(
-        res.path,
-        joint_names=robot.joint_names,
-        dt=options.dt,
-        title="Inverse kinematics: simulated joint motion (tool 0.1 m along flange z)",
+    ctx.save_figure(
+        lambda: plot_ik_path(
+            res.path,
+            joint_names=robot.joint_names,
+            dt=options.dt,
+            title="Inverse kinematics: simulated joint motion (tool 0.1 m along flange z)",
+        ),
+        "ik_joint_motion.png",
     )
-    ctx.save_figure(fig, "ik_joint_motion.png")
     ctx.results["ik"] = res
 
 
@@ -365,7 +368,7 @@ def write_report(ctx: DemoContext) -> Path:
             "![comparison](consistent/comparison.png)",
         ]
     path = ctx.out / "report.md"
-    path.write_text("\n\n".join(parts) + "\n", encoding="utf-8")
+    write_text(path, "\n\n".join(parts) + "\n")
     ctx.files.append(path)
     return path
 
@@ -395,7 +398,6 @@ def register(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParser:
 
 def run(args: argparse.Namespace) -> int:
     """Run every stage in order."""
-    args.out.mkdir(parents=True, exist_ok=True)
     ctx = DemoContext(
         robot=panda(), out=args.out, rng=np.random.default_rng(args.seed), seed=args.seed
     )

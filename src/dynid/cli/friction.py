@@ -7,7 +7,9 @@ al. 2019 (eq. 25, Nelder-Mead; default) or the classical viscous + Coulomb + off
 the accelerations differentiated from the filtered velocities.
 
 Writes OUT/friction.json (parameters, RMS of the residual before and after) and
-OUT/friction.png (residual against velocity with the fitted curve, per joint).
+OUT/friction.png (residual against velocity with the fitted curve, per joint; skipped,
+with a note, without matplotlib). The log is read strictly: rows with NaN/inf or a
+repeated timestamp are an error unless --drop-invalid; gaps up to --max-gap are bridged.
 
 Example:
   dynid friction --model out/identification.json --data traj.csv --out out/friction
@@ -16,13 +18,12 @@ Example:
 from __future__ import annotations
 
 import argparse
-import json
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 
-from ..exceptions import DynidError
+from ..exceptions import DataError, DynidError
 from ..friction.fit import (
     FrictionFit,
     FrictionResidual,
@@ -34,6 +35,7 @@ from ..friction.model import SigmoidFriction
 from ..friction.validation import Validation, validate
 from ..identification.log import DEFAULT_CUTOFF_HZ
 from ..identification.model import IdentifiedModel
+from ..io._json import save_json
 from ..io.friction_json import write_friction_json
 from ..kinematics.trajectories import (
     centered_start,
@@ -43,9 +45,20 @@ from ..kinematics.trajectories import (
 )
 from ..model.robot import Robot
 from ..simulation.measurement import SensorNoise, sample_times, simulate_measurement
-from .common import add_column_options, load_robot, positive_type, read_log
+from .common import (
+    about,
+    add_column_options,
+    add_log_options,
+    load_robot,
+    positive_type,
+    read_log,
+    save_figure,
+)
 
 NAME = "friction"
+
+#: ``schema`` of validation.json (written by ``validate`` and by the demo).
+VALIDATION_SCHEMA = "dynid-validation/1"
 
 
 def register(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParser:
@@ -71,6 +84,7 @@ def register(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParser:
         default=DEFAULT_CUTOFF_HZ,
         help=f"low-pass cutoff of the states [Hz] (default {DEFAULT_CUTOFF_HZ:g})",
     )
+    add_log_options(p)
     p.add_argument("--no-figures", action="store_true", help="skip the PNG figures")
     return p
 
@@ -86,6 +100,10 @@ def load_torque_model(args: argparse.Namespace) -> IdentifiedModel | Robot:
     raise DynidError("give --model identification.json or --robot ROBOT")
 
 
+def _joint_count(model: IdentifiedModel | Robot) -> int:
+    return (model.robot if isinstance(model, IdentifiedModel) else model).n
+
+
 def _joint_names(model: IdentifiedModel | Robot) -> list[str]:
     robot = model.robot if isinstance(model, IdentifiedModel) else model
     return list(robot.joint_names)
@@ -93,19 +111,11 @@ def _joint_names(model: IdentifiedModel | Robot) -> list[str]:
 
 def save_friction_figure(
     path: Path, residual: FrictionResidual, fit: FrictionFit, *, names: list[str], **kw: Any
-) -> Path:
-    """Write the residual-vs-velocity figure (Fig. 4) to ``path``."""
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
+) -> Path | None:
+    """Write the residual-vs-velocity figure (Fig. 4) to ``path`` (None: no matplotlib)."""
     from ..plots.friction import plot_friction_fit
 
-    fig = plot_friction_fit(residual, fit, joint_names=names, **kw)
-    fig.savefig(path, dpi=110)
-    plt.close(fig)
-    return path
+    return save_figure(lambda: plot_friction_fit(residual, fit, joint_names=names, **kw), path)
 
 
 def save_validation_figures(
@@ -117,27 +127,25 @@ def save_validation_figures(
     noise_std: float | None = None,
     title: str | None = None,
 ) -> list[Path]:
-    """Write ``<prefix>_torques.png`` (Fig. 3) and ``<prefix>_rms.png`` under ``out``."""
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
+    """Write ``<prefix>_torques.png`` (Fig. 3) and ``<prefix>_rms.png`` under ``out``
+    (none without matplotlib)."""
     from ..plots.torques import plot_rms_comparison, plot_torque_validation
 
-    paths = []
-    fig = plot_torque_validation(validation, joint_names=names, title=title)
-    paths.append(out / f"{prefix}_torques.png")
-    fig.savefig(paths[-1], dpi=100)
-    plt.close(fig)
     rms = {"without friction": validation.without_friction.rms}
     if validation.with_friction is not None:
         rms["with friction"] = validation.with_friction.rms
-    fig = plot_rms_comparison(rms, noise_std=noise_std, title=title)
-    paths.append(out / f"{prefix}_rms.png")
-    fig.savefig(paths[-1], dpi=110)
-    plt.close(fig)
-    return paths
+    paths = [
+        save_figure(
+            lambda: plot_torque_validation(validation, joint_names=names, title=title),
+            out / f"{prefix}_torques.png",
+            dpi=100,
+        ),
+        save_figure(
+            lambda: plot_rms_comparison(rms, noise_std=noise_std, title=title),
+            out / f"{prefix}_rms.png",
+        ),
+    ]
+    return [p for p in paths if p is not None]
 
 
 def format_rms_table(names: list[str], columns: dict[str, np.ndarray]) -> str:
@@ -153,14 +161,17 @@ def run(args: argparse.Namespace) -> int:
     """Fit friction, write friction.json and the figure, print the RMS table (unless -q)."""
     say = (lambda *a: None) if getattr(args, "quiet", False) else print
     model = load_torque_model(args)
-    log = read_log(args, args.data)
-    res = friction_residual(model, log, cutoff_hz=args.cutoff)
-    fit = (
-        fit_sigmoid(res.dq, res.residual)
-        if args.friction_model == "sigmoid"
-        else fit_classical(res.dq, res.residual)
-    )
-    args.out.mkdir(parents=True, exist_ok=True)
+    n = _joint_count(model)
+    log = read_log(args, args.data, n)
+    if log.n != n:
+        raise DataError(f"{args.data.name}: the log has {log.n} joints; the model has {n}")
+    with about(args.data):
+        res = friction_residual(model, log, cutoff_hz=args.cutoff, max_gap_s=args.max_gap)
+        fit = (
+            fit_sigmoid(res.dq, res.residual)
+            if args.friction_model == "sigmoid"
+            else fit_classical(res.dq, res.residual)
+        )
     meta = {
         "data": str(args.data.name),
         "model": str(args.model.name) if args.model is not None else args.robot,
@@ -227,7 +238,6 @@ def demo_stages(
             "pass truth=<Robot>"
         )
     out_dir = Path(out_dir)
-    out_dir.mkdir(parents=True, exist_ok=True)
     rng = np.random.default_rng(seed)
     t = sample_times(20.0, 1000.0)
     traj = sinusoid_trajectory(t, centered_start(truth))
@@ -246,8 +256,8 @@ def demo_stages(
     doc = val.as_dict()
     doc["seed"] = seed
     doc["units"] = {"rms": "N m", "mse": "N^2 m^2", "relative_error_percent": "%"}
-    (out_dir / "validation.json").write_text(json.dumps(doc, indent=2) + "\n")
-    files = [out_dir / "friction.json", out_dir / "validation.json"]
+    save_json(out_dir / "validation.json", doc, schema=VALIDATION_SCHEMA)
+    files: list[Path | None] = [out_dir / "friction.json", out_dir / "validation.json"]
     files.append(
         save_friction_figure(
             out_dir / "friction.png",
@@ -301,5 +311,5 @@ def demo_stages(
         "friction": fit.friction.as_array().tolist(),
         "friction_curve_rms": None if curve is None else curve.tolist(),
         "scale": scale,
-        "files": [str(f) for f in files],
+        "files": [str(f) for f in files if f is not None],
     }

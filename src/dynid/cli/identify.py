@@ -11,6 +11,15 @@ Torque logs (a CSV with a `t` column, or an NPZ with `t` and `tau`, as written b
 differentiation, the torque regressor in the base parameters plus viscous, Coulomb and
 offset friction columns per joint, and the same least squares and statistics.
 
+Checks that the data belong to --robot: a static data file that records another robot
+(name, joint count or kinematics) is an error; configurations outside the joint limits,
+and a relative error far above the recorded noise level (noise-free data must fit to
+rounding), are reported as one-line warnings with the numbers. On exact data the
+residual and the standard deviations are 0 (said in the summary), never NaN.
+
+Torque logs are read strictly: rows with NaN/inf or a repeated timestamp are an error
+unless --drop-invalid; gaps up to --max-gap are bridged.
+
 Writes DIR/identification.json (coefficients, expressions, std, metrics, kinematics) and
 prints a summary table.
 
@@ -31,12 +40,14 @@ from __future__ import annotations
 
 import argparse
 import logging
+import zipfile
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 
 from ..exceptions import DataError
+from ..identification.consistency import fit_mismatch, limit_violations, recorded_robot_mismatch
 from ..identification.data import StaticDataset
 from ..identification.model import IdentifiedModel
 from ..identification.static import identify_static
@@ -47,8 +58,10 @@ from ..model.robot import Robot
 from ..simulation.controller import SimulatedController, acquire_static
 from .acquire_static import streams
 from .common import (
+    about,
     add_column_options,
     add_consistency_options,
+    add_log_options,
     add_robot_options,
     column_map,
     load_prior,
@@ -58,6 +71,7 @@ from .common import (
     positive_type,
     read_log,
     sdp_options,
+    warn,
 )
 
 NAME = "identify"
@@ -90,8 +104,11 @@ def register(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParser:
     p.add_argument(
         "--drop-invalid",
         action="store_true",
-        help="drop rows with NaN, non-numbers or a non-symmetric M instead of failing",
+        help="drop rows with NaN, non-numbers or a non-symmetric M (static data), or with "
+        "NaN/inf or a repeated timestamp (torque logs), instead of failing; says how many "
+        "and where",
     )
+    add_log_options(p, drop_invalid=False)
     p.add_argument(
         "--std",
         choices=("robust", "classical"),
@@ -138,7 +155,7 @@ def data_kind(path: Path, columns: Any = None) -> str:
             return "static"
     suffix = path.suffix.lower()
     if suffix == ".csv":
-        with path.open(encoding="utf-8", errors="replace") as fh:
+        with path.open(encoding="utf-8-sig", errors="replace") as fh:
             for line in fh:
                 s = line.strip()
                 if s and not s.startswith("#"):
@@ -149,8 +166,10 @@ def data_kind(path: Path, columns: Any = None) -> str:
         try:
             with np.load(path, allow_pickle=False) as z:
                 keys = set(z.files)
-        except ValueError as exc:
+        except (ValueError, EOFError, zipfile.BadZipFile) as exc:
             raise DataError(f"{path.name}: not a readable NPZ file ({exc})") from exc
+        except AttributeError:  # a single .npy array: np.load gives an array
+            raise DataError(f"{path.name}: a single array, not an NPZ archive") from None
         return "torque_log" if "t" in keys or "tau" in keys else "static"
     raise DataError(f"--data must be a .csv or .npz file; got {path.name!r}")
 
@@ -160,8 +179,21 @@ def identify_torque_log(robot: Robot, path: Path, args: argparse.Namespace) -> I
     from ..identification.classical import identify_from_log
 
     log = read_log(args, path, robot.n)
+    if log.n != robot.n:
+        raise DataError(
+            f"{path.name}: the log has {log.n} joints; robot {robot.name!r} has {robot.n}; "
+            "hint: pass the robot the log was recorded with"
+        )
     kw = {} if args.cutoff is None else {"cutoff_hz": args.cutoff}
-    return identify_from_log(robot, log, max_std_percent=args.max_std_percent, rtol=args.rtol, **kw)
+    with about(path):
+        return identify_from_log(
+            robot,
+            log,
+            max_std_percent=args.max_std_percent,
+            rtol=args.rtol,
+            max_gap_s=args.max_gap,
+            **kw,
+        )
 
 
 # ---------------------------------------------------------------------------------------
@@ -178,17 +210,27 @@ def read_static_file(robot: Robot, path: Path, args: argparse.Namespace) -> Stat
             _log.warning("%s: %s", path.name, note)
         return mapped.data
     data, n_dropped = load_static_data(path, robot, drop_invalid=args.drop_invalid)
-    if n_dropped:
-        _log.warning("%s: %d invalid row(s) dropped", path.name, n_dropped)
     return data
 
 
 def identify_static_file(robot: Robot, path: Path, args: argparse.Namespace) -> IdentifiedModel:
-    """Static route: load (checked), identify."""
+    """Static route: load (checked), check it belongs to the robot, identify."""
     data = read_static_file(robot, path, args)
-    return identify_static(
+    mismatch = recorded_robot_mismatch(robot, data.metadata)
+    if mismatch is not None:
+        raise DataError(
+            f"{path.name}: {mismatch}; hint: pass --robot for the arm that recorded the data"
+        )
+    outside = limit_violations(robot, data.q)
+    if outside is not None:
+        warn(args, f"{path.name}: {outside}")
+    model = identify_static(
         robot, data, max_std_percent=args.max_std_percent, rtol=args.rtol, std_estimator=args.std
     )
+    misfit = fit_mismatch(model.fit.relative_error_percent, data.metadata)
+    if misfit is not None:
+        warn(args, f"{path.name}: {misfit}")
+    return model
 
 
 def run(args: argparse.Namespace) -> int:
@@ -200,7 +242,6 @@ def run(args: argparse.Namespace) -> int:
         model = identify_torque_log(robot, args.data, args)
     else:
         model = identify_static_file(robot, args.data, args)
-    args.out.mkdir(parents=True, exist_ok=True)
     path = save_model_json(args.out / "identification.json", model)
     if not args.quiet:
         print(format_summary(model))
@@ -270,6 +311,8 @@ def format_summary(model: IdentifiedModel, *, width: int = 60) -> str:
         ),
         f"{'#':>3}  {'name':<7} {'value':>13} {'std %':>9}  kept  expression",
     ]
+    if fit.residual_rms == 0.0 or not np.any(fit.std[fit.kept]):
+        head.append("the residual is zero to rounding (exact data): standard deviations are 0")
     rows = []
     for k in range(model.base.rank):
         e = model.base.expressions[k]
@@ -294,7 +337,6 @@ def demo_stage(out_dir: Path, seed: int) -> dict[str, Any]:
     ``max_error_in_std`` (largest |beta - beta_true| / std), plus the two paths.
     """
     out_dir = Path(out_dir)
-    out_dir.mkdir(parents=True, exist_ok=True)
     robot = panda()
     rng_q, rng_noise = streams(seed)
     controller = SimulatedController(robot, DEMO_RELATIVE_NOISE, rng=rng_noise)

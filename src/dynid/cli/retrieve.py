@@ -68,6 +68,7 @@ from ..feasibility.sdp import ConsistentResult
 from ..feasibility.validate import NewtonEulerValidation, validate_newton_euler
 from ..friction.model import ClassicalFriction
 from ..identification.model import IdentifiedModel
+from ..io._json import save_json
 from ..io.export import save_robot
 from ..io.feasible import load_bounds, save_feasible_json, save_report_json
 from ..model.robot import Robot
@@ -79,6 +80,7 @@ from .common import (
     load_prior,
     load_robot,
     parse_vector,
+    save_figure,
     sdp_options,
 )
 
@@ -247,7 +249,6 @@ def write_outputs(
     **report_extra: Any,
 ) -> list[Path]:
     """Write feasible.json, robot.urdf, robot.xml, robot.toml, report.json (and retrieval.png)."""
-    out.mkdir(parents=True, exist_ok=True)
     files = [save_feasible_json(out / "feasible.json", result)]
     fr = getattr(result, "friction", None)  # one-step on a log: classical fv, fc, fo
     mj = ClassicalFriction.from_array(fr) if fr is not None else True
@@ -259,16 +260,15 @@ def write_outputs(
     if figures:
         from ..plots.feasible import plot_consistent, plot_retrieval
 
-        fig = (
-            plot_consistent([result])
-            if isinstance(result, ConsistentResult)
-            else plot_retrieval(result)
+        fig = save_figure(
+            lambda: (
+                plot_consistent([result])
+                if isinstance(result, ConsistentResult)
+                else plot_retrieval(result)
+            ),
+            out / "retrieval.png",
         )
-        fig.savefig(out / "retrieval.png", dpi=110)
-        files.append(out / "retrieval.png")
-        import matplotlib.pyplot as plt
-
-        plt.close(fig)
+        files += [fig] if fig is not None else []
     return files
 
 
@@ -452,7 +452,6 @@ def demo_stage(
     from ..identification.log import prepare_log
 
     out_dir = Path(out_dir)
-    out_dir.mkdir(parents=True, exist_ok=True)
     workers = max(1, min(DEMO_WORKERS, os.cpu_count() or 1))
     t0 = time.perf_counter()
     result = retrieve(model, seed=seed, workers=workers, progress=progress_printer(sys.stdout))
@@ -475,19 +474,16 @@ def demo_stage(
     )
     from ..plots.feasible import plot_newton_euler_validation
 
-    fig = plot_newton_euler_validation(
-        val, title="Newton-Euler with the retrieved feasible parameters (validation trajectory)"
-    )
-    fig.savefig(out_dir / "feasible_validation.png", dpi=110)
-    import matplotlib.pyplot as plt
-
-    plt.close(fig)
-    files.append(out_dir / "feasible_validation.png")
-    import json
-
     doc = val.as_dict() | {"seed": seed}
-    (out_dir / "feasible_validation.json").write_text(json.dumps(doc, indent=1) + "\n")
-    files.append(out_dir / "feasible_validation.json")
+    files.append(save_json(out_dir / "feasible_validation.json", doc))
+    fig = save_figure(
+        lambda: plot_newton_euler_validation(
+            val,
+            title="Newton-Euler with the retrieved feasible parameters (validation trajectory)",
+        ),
+        out_dir / "feasible_validation.png",
+    )
+    files += [fig] if fig is not None else []
     diff = float(np.max(np.abs(val.tau_rigid - model.torques(log.q, log.dq, log.ddq))))
     print(format_summary(result))
     print(_rms_table(val))

@@ -168,7 +168,6 @@ def run(args: argparse.Namespace) -> int:
         drop_fraction=args.drop,
         with_ddq=args.with_ddq,
     )
-    args.out.parent.mkdir(parents=True, exist_ok=True)
     write_torque_log(args.out, measured)
     say(
         f"wrote {args.out}: {measured.n_samples} samples, {measured.duration:.2f} s, "

@@ -17,7 +17,9 @@ velocities; the measured torques are compared unfiltered.
 
 Writes OUT/validation.json {"rms": [...], "mse": [...], "relative_error_percent": x, ...}
 (for the full model, plus a "without_friction" block) and the figures
-OUT/validation_torques.png and OUT/validation_rms.png.
+OUT/validation_torques.png and OUT/validation_rms.png (skipped, with a note, without
+matplotlib). The log is read strictly: rows with NaN/inf or a repeated timestamp are an
+error unless --drop-invalid; gaps up to --max-gap are bridged.
 
 Example:
   dynid validate --robot panda --data traj.csv --out out/validation
@@ -26,17 +28,19 @@ Example:
 from __future__ import annotations
 
 import argparse
-import json
 from pathlib import Path
 
-from ..exceptions import DynidError
+import numpy as np
+
+from ..exceptions import DataError, DynidError
 from ..friction.validation import own_friction, validate
 from ..identification.log import DEFAULT_CUTOFF_HZ
 from ..identification.model import IdentifiedModel
+from ..io._json import save_json
 from ..io.friction_json import read_friction_json
 from ..model.robot import Robot
-from .common import add_column_options, load_robot, positive_type, read_log
-from .friction import format_rms_table, save_validation_figures
+from .common import about, add_column_options, add_log_options, load_robot, positive_type, read_log
+from .friction import VALIDATION_SCHEMA, format_rms_table, save_validation_figures
 
 NAME = "validate"
 
@@ -69,6 +73,7 @@ def register(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParser:
         default=DEFAULT_CUTOFF_HZ,
         help=f"low-pass cutoff of the states [Hz] (default {DEFAULT_CUTOFF_HZ:g})",
     )
+    add_log_options(p)
     p.add_argument("--no-figures", action="store_true", help="skip the PNG figures")
     return p
 
@@ -95,7 +100,12 @@ def run(args: argparse.Namespace) -> int:
     """Validate, write validation.json and the figures, print the RMS table (unless -q)."""
     say = (lambda *a: None) if getattr(args, "quiet", False) else print
     model, label = load_model_source(args)
-    log = read_log(args, args.data)
+    robot = model.robot if isinstance(model, IdentifiedModel) else model
+    log = read_log(args, args.data, robot.n)
+    if log.n != robot.n:
+        raise DataError(
+            f"{args.data.name}: the log has {log.n} joints; the model ({label}) has {robot.n}"
+        )
     if args.friction is not None:
         friction = read_friction_json(args.friction)
     elif args.no_friction:
@@ -106,8 +116,15 @@ def run(args: argparse.Namespace) -> int:
             from ..io.feasible import load_feasible_linear_friction
 
             friction = load_feasible_linear_friction(args.params) or friction
-    val = validate(model, log, friction=friction, cutoff_hz=args.cutoff)
-    args.out.mkdir(parents=True, exist_ok=True)
+    with about(args.data):
+        val = validate(model, log, friction=friction, cutoff_hz=args.cutoff, max_gap_s=args.max_gap)
+    errors = val.errors
+    if not np.isfinite(errors.relative_error_percent) or not np.all(np.isfinite(errors.rms)):
+        raise DataError(
+            f"{args.data.name}: the torque errors overflow (relative error "
+            f"{errors.relative_error_percent}); the log holds values far outside a robot's "
+            f"range (largest |tau| {float(np.max(np.abs(log.tau))):.3g} N m)"
+        )
     doc = val.as_dict()
     doc["model"] = label
     doc["friction_source"] = (
@@ -118,8 +135,7 @@ def run(args: argparse.Namespace) -> int:
     doc["data"] = str(args.data.name)
     doc["cutoff_hz"] = args.cutoff
     doc["units"] = {"rms": "N m", "mse": "N^2 m^2", "relative_error_percent": "%"}
-    (args.out / "validation.json").write_text(json.dumps(doc, indent=2) + "\n")
-    robot = model.robot if isinstance(model, IdentifiedModel) else model
+    save_json(args.out / "validation.json", doc, schema=VALIDATION_SCHEMA)
     names = list(robot.joint_names)
     if not args.no_figures:
         save_validation_figures(args.out, val, names=names, title=f"{label} on {args.data.name}")

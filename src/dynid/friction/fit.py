@@ -130,6 +130,7 @@ def friction_residual(
     *,
     cutoff_hz: float | None = DEFAULT_CUTOFF_HZ,
     trim_s: float | None = None,
+    max_gap_s: float | None = None,
     filter_tau: bool = False,
 ) -> FrictionResidual:
     """Prepare ``log`` and compute the torque residual of ``model``.
@@ -138,7 +139,7 @@ def friction_residual(
     ----------
     model : TorqueModel
     log : TorqueLog
-    cutoff_hz, trim_s, filter_tau
+    cutoff_hz, trim_s, filter_tau, max_gap_s
         Passed to :func:`~dynid.identification.log.prepare_log` (``cutoff_hz=None``: no
         filtering).
 
@@ -146,7 +147,9 @@ def friction_residual(
     -------
     FrictionResidual
     """
-    p = prepare_log(log, cutoff_hz=cutoff_hz, trim_s=trim_s, filter_tau=filter_tau)
+    p = prepare_log(
+        log, cutoff_hz=cutoff_hz, trim_s=trim_s, filter_tau=filter_tau, max_gap_s=max_gap_s
+    )
     tau_m = rigid_body_torques(model, p.q, p.dq, p.ddq)
     return FrictionResidual(log=p, tau_model=tau_m, residual=p.tau - tau_m)
 

@@ -96,6 +96,7 @@ def validate(
     cutoff_hz: float | None = DEFAULT_CUTOFF_HZ,
     trim_s: float | None = None,
     filter_tau: bool = False,
+    max_gap_s: float | None = None,
 ) -> Validation:
     """Compare a model's torques with a measured log, without and with friction.
 
@@ -108,7 +109,7 @@ def validate(
     friction : FrictionModel, optional
         Friction added to the prediction (e.g. :func:`own_friction` of the model, or a
         fitted sigmoid).
-    cutoff_hz, trim_s, filter_tau
+    cutoff_hz, trim_s, filter_tau, max_gap_s
         Preparation of the log (:func:`~dynid.friction.fit.friction_residual`).
 
     Returns
@@ -124,7 +125,9 @@ def validate(
     """
     if friction is not None and friction.n != log.n:
         raise ShapeError(f"friction model has {friction.n} joints; the log has {log.n}")
-    res = friction_residual(model, log, cutoff_hz=cutoff_hz, trim_s=trim_s, filter_tau=filter_tau)
+    res = friction_residual(
+        model, log, cutoff_hz=cutoff_hz, trim_s=trim_s, filter_tau=filter_tau, max_gap_s=max_gap_s
+    )
     p = res.log
     without = torque_errors(p.tau, res.tau_model)
     tf = with_ = None

@@ -87,6 +87,7 @@ def identify_from_log(
     *,
     cutoff_hz: float | None = DEFAULT_CUTOFF_HZ,
     trim_s: float | None = None,
+    max_gap_s: float | None = None,
     decimate: int | None = None,
     max_std_percent: float | None = None,
     friction: bool = True,
@@ -107,6 +108,8 @@ def identify_from_log(
         differentiated).
     trim_s : float, optional
         Seconds dropped at each end after filtering (default ``2 / cutoff_hz``).
+    max_gap_s : float, optional
+        Longest gap bridged [s] (:func:`~dynid.identification.log.prepare_log`).
     decimate : int, optional
         Keep every ``decimate``-th sample after filtering; default
         :func:`auto_decimation`.
@@ -141,7 +144,7 @@ def identify_from_log(
     if log.n != n:
         raise ShapeError(f"log has {log.n} joints; robot {robot.name!r} has {n}")
     fs = log.sample_rate
-    prepared = prepare_log(log, cutoff_hz=cutoff_hz, trim_s=trim_s)
+    prepared = prepare_log(log, cutoff_hz=cutoff_hz, trim_s=trim_s, max_gap_s=max_gap_s)
     k = auto_decimation(fs, cutoff_hz) if decimate is None else int(decimate)
     if k < 1:
         raise ShapeError(f"decimate must be >= 1; got {decimate}")

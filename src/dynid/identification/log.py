@@ -17,8 +17,10 @@ Validation and cleaning (what is handled and what is rejected):
   :class:`LogCleaning`.
 * Gaps (dropped samples: a step longer than ``gap_factor`` times the median step) are
   reported in ``cleaning.gaps``. :func:`prepare_log` resamples the log onto a uniform
-  grid, bridging gaps up to ``max_gap_s`` by linear interpolation, and rejects longer
-  ones (a DataError with the gap's times; hint: split the log).
+  grid, bridging gaps up to ``max_gap_s`` by linear interpolation (default
+  :func:`default_max_gap`: 2.5 median steps, at least 0.02 s, so any rate from 10 Hz
+  up works), and rejects longer ones (a DataError with the gap's times; hint: split the
+  log or raise ``max_gap_s``).
 
 :func:`prepare_log` turns a raw log into the input of identification and validation:
 resample (when not uniform), zero-phase low-pass ``q``, ``dq`` (and a given ``ddq``) and,
@@ -29,15 +31,16 @@ zero-phase filter adds no delay, so the signals stay aligned in time.
 
 from __future__ import annotations
 
+import warnings
 from dataclasses import dataclass, field
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from .. import _checks, signals
-from ..exceptions import DataError, ShapeError
+from ..exceptions import DataError, DynidWarning, ShapeError
 
-__all__ = ["DEFAULT_CUTOFF_HZ", "LogCleaning", "TorqueLog", "prepare_log"]
+__all__ = ["DEFAULT_CUTOFF_HZ", "LogCleaning", "TorqueLog", "default_max_gap", "prepare_log"]
 
 #: Default cutoff of the zero-phase low-pass for identification and validation [Hz].
 #: Gaz et al. 2019 filtered at 1 Hz; that attenuates the paper's own validation sinusoid
@@ -47,6 +50,15 @@ __all__ = ["DEFAULT_CUTOFF_HZ", "LogCleaning", "TorqueLog", "prepare_log"]
 DEFAULT_CUTOFF_HZ = 5.0
 
 _SIGNALS = ("q", "dq", "tau", "ddq")
+
+#: Shortest gap :func:`prepare_log` refuses to bridge by default [s] (Panda: 20 samples).
+MIN_MAX_GAP_S = 0.02
+
+
+def default_max_gap(dt_median: float) -> float:
+    """Longest gap bridged by default [s]: 2.5 median steps (one or two lost samples), at
+    least :data:`MIN_MAX_GAP_S`."""
+    return max(MIN_MAX_GAP_S, 2.5 * float(dt_median))
 
 
 @dataclass(frozen=True, slots=True)
@@ -274,7 +286,7 @@ def prepare_log(
     cutoff_hz: float | None = DEFAULT_CUTOFF_HZ,
     trim_s: float | None = None,
     fs: float | None = None,
-    max_gap_s: float = 0.02,
+    max_gap_s: float | None = None,
     jitter_rtol: float = 1e-6,
     filter_tau: bool = True,
 ) -> TorqueLog:
@@ -302,8 +314,9 @@ def prepare_log(
         Seconds dropped at each end.
     fs : float, optional
         Rate of the uniform grid [Hz]; default the log's median rate.
-    max_gap_s : float
-        Longest gap bridged by interpolation [s].
+    max_gap_s : float, optional
+        Longest gap bridged by interpolation [s]; default :func:`default_max_gap` of the
+        median step.
     jitter_rtol : float
         Relative step tolerance under which the log counts as uniform.
     filter_tau : bool
@@ -322,16 +335,24 @@ def prepare_log(
     DataError
         A gap longer than ``max_gap_s``; a cutoff not below the Nyquist frequency; too few
         samples to filter, or nothing left after trimming.
+
+    Warns
+    -----
+    DynidWarning
+        The default cutoff :data:`DEFAULT_CUTOFF_HZ` is not below the log's Nyquist
+        frequency (a log slower than 10 Hz): a quarter of the rate is used instead.
     """
     t = log.t
     dt = np.diff(t)
-    big = np.flatnonzero(dt > max_gap_s)
+    if max_gap_s is None:
+        max_gap_s = default_max_gap(float(np.median(dt)))
+    big = np.flatnonzero(dt > max_gap_s * (1.0 + 1e-9))
     if big.size:
         k = int(big[0])
         raise DataError(
             f"gap of {dt[k]:.4g} s in the log between t = {t[k]:.6g} s and t = {t[k + 1]:.6g} s "
-            f"exceeds max_gap_s = {max_gap_s:g} s; hint: split the log at the gap or raise "
-            "max_gap_s"
+            f"exceeds the longest gap bridged, {max_gap_s:g} s; hint: split the log at the gap "
+            "or raise max_gap_s (--max-gap)"
         )
     rate = signals.sample_rate(t) if fs is None else float(fs)
     data = {k: getattr(log, k) for k in _SIGNALS if getattr(log, k) is not None}
@@ -341,6 +362,20 @@ def prepare_log(
         t, res = signals.resample_uniform(t, stacked, rate)
         parts = np.split(res, len(data), axis=1)
         data = dict(zip(data, parts, strict=True))
+    if cutoff_hz is not None and cutoff_hz == DEFAULT_CUTOFF_HZ and cutoff_hz >= rate / 2:
+        warnings.warn(
+            f"the default cutoff {DEFAULT_CUTOFF_HZ:g} Hz is not below the Nyquist frequency "
+            f"of this {rate:.4g} Hz log; filtering at {rate / 4:.4g} Hz instead (choose with "
+            "cutoff_hz / --cutoff)",
+            DynidWarning,
+            stacklevel=2,
+        )
+        cutoff_hz = rate / 4
+    if cutoff_hz is not None and log.n_samples <= 15:
+        raise DataError(
+            f"the log has {log.n_samples} samples; filtering needs more (a longer log, or "
+            "no filter: cutoff_hz=None)"
+        )
     if cutoff_hz is not None:
         for k in [k for k in data if filter_tau or k != "tau"]:
             data[k] = signals.lowpass(data[k], rate, cutoff_hz)

@@ -166,14 +166,17 @@ def model_from_dict(d: Mapping[str, Any]) -> IdentifiedModel:
         robot = robot_from_dict(d["robot"])
         b = d["base"]
         coefs = d["coefficients"]
-        r = int(b["rank"])
-        if len(coefs) != r:
-            raise DataError(f"identified model: {len(coefs)} coefficients for base rank {r}")
-        K_d = np.asarray(b["K_d"], dtype=np.float64).reshape(r, -1)
+        r = _int(b["rank"], "base.rank")
+        if not isinstance(coefs, list) or len(coefs) != r:
+            raise DataError(
+                f"identified model: 'coefficients' must list {r} coefficients (base rank); "
+                f"got {len(coefs) if isinstance(coefs, list) else type(coefs).__name__}"
+            )
+        independent, dependent, K_d = _base_indices(b, r, 10 * robot.n)
         base = BaseParameters(
             std_labels=tuple(b["std_labels"]),
-            independent=_frozen(np.asarray(b["independent"], dtype=np.intp)),
-            dependent=_frozen(np.asarray(b["dependent"], dtype=np.intp)),
+            independent=_frozen(independent),
+            dependent=_frozen(dependent),
             K_d=_frozen(K_d),
             rank=r,
             rtol=float(b["rtol"]),
@@ -204,13 +207,35 @@ def model_from_dict(d: Mapping[str, Any]) -> IdentifiedModel:
             covariance=_covariance(d.get("covariance"), r),
         )
         friction = d.get("friction")
-        metadata = dict(d.get("metadata") or {})
+        if friction is not None:
+            friction = np.asarray(friction, dtype=np.float64)
+            if friction.shape != (robot.n, 3):
+                raise DataError(
+                    f"identified model: 'friction' must be null or {robot.n} rows of "
+                    f"[fv, fc, fo]; got shape {friction.shape}"
+                )
+        for name, arr in (("value", fit.beta), ("std", fit.std)):
+            if not np.all(np.isfinite(arr)):
+                k = int(np.flatnonzero(~np.isfinite(arr))[0])
+                raise DataError(f"identified model: coefficient {k + 1} {name!r} is not finite")
+        if np.any(fit.std < 0):
+            k = int(np.flatnonzero(fit.std < 0)[0])
+            raise DataError(f"identified model: coefficient {k + 1} has a negative 'std'")
+        metadata = d.get("metadata") or {}
+        if not isinstance(metadata, dict):
+            raise DataError("identified model: 'metadata' must be an object")
+        metadata = dict(metadata)
     except KeyError as exc:
         raise DataError(f"identified model: missing field {exc.args[0]!r}") from None
     except (TypeError, ValueError) as exc:
         if isinstance(exc, DataError):
             raise
         raise DataError(f"identified model: malformed field ({exc})") from exc
+    if len(base.std_labels) != 10 * robot.n:
+        raise DataError(
+            f"identified model: base.std_labels has {len(base.std_labels)} labels; the robot "
+            f"has {robot.n} joints ({10 * robot.n} parameters)"
+        )
     if base.n_std != 10 * robot.n:
         raise DataError(
             f"identified model: base has {base.n_std} standard parameters; the robot has "
@@ -244,6 +269,48 @@ def load_model_json(path: str | Path) -> IdentifiedModel:
         return model_from_dict(d)
     except DataError as exc:
         raise DataError(f"{path.name}: {exc}") from exc
+
+
+def _int(x: Any, where: str) -> int:
+    if isinstance(x, bool) or not isinstance(x, int):
+        raise DataError(f"identified model: {where!r} must be an integer; got {x!r}")
+    return x
+
+
+def _base_indices(
+    b: Mapping[str, Any], r: int, p: int
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """``independent`` (r,), ``dependent`` (p - r,) and ``K_d`` (r, p - r), checked: integer
+    indices of the p standard parameters, each exactly once, finite K_d of that shape."""
+    ind, dep = b["independent"], b["dependent"]
+    for name, v in (("base.independent", ind), ("base.dependent", dep)):
+        if not isinstance(v, list):
+            raise DataError(f"identified model: {name!r} must be a list of indices")
+        for k, x in enumerate(v):
+            if isinstance(x, bool) or not isinstance(x, int) or not 0 <= x < p:
+                raise DataError(
+                    f"identified model: {name}[{k}] = {x!r} is not an index in 0..{p - 1} "
+                    f"(the robot has {p} standard parameters)"
+                )
+    if len(ind) != r:
+        raise DataError(
+            f"identified model: 'base.independent' has {len(ind)} indices for base rank {r}"
+        )
+    if sorted(ind + dep) != list(range(p)):
+        raise DataError(
+            f"identified model: 'base.independent' and 'base.dependent' must hold each of the "
+            f"{p} parameter indices exactly once"
+        )
+    K_d = np.asarray(b["K_d"], dtype=np.float64)
+    if K_d.size == 0 and len(dep) == 0:
+        K_d = K_d.reshape(r, 0)
+    if K_d.shape != (r, len(dep)):
+        raise DataError(
+            f"identified model: 'base.K_d' must have shape {(r, len(dep))}; got {K_d.shape}"
+        )
+    if not np.all(np.isfinite(K_d)):
+        raise DataError("identified model: 'base.K_d' holds a non-finite number")
+    return np.asarray(ind, dtype=np.intp), np.asarray(dep, dtype=np.intp), K_d
 
 
 def _float(x: Any) -> float:
