@@ -132,7 +132,10 @@ def main(argv: Sequence[str] | None = None) -> int:
     """Entry point of the ``dynid`` console script; returns the exit code."""
     argv = join_negative_values(sys.argv[1:] if argv is None else list(argv))
     parser = build_parser()
-    args = parser.parse_args(argv)
+    try:
+        args = parser.parse_args(argv)
+    except SystemExit as exc:  # --help, --version, or a refused option (one line printed)
+        return exc.code if isinstance(exc.code, int) else 2
     level = (
         logging.ERROR
         if args.quiet

@@ -15,7 +15,7 @@ from typing import Any
 import numpy as np
 
 from .. import _checks, spatial
-from ..exceptions import DataError, DynidError, ShapeError
+from ..exceptions import DynidError, ShapeError
 from ..io._files import open_atomic
 from ..io._json import dumps
 from ..model.panda import panda
@@ -101,10 +101,10 @@ def add_log_options(p: argparse.ArgumentParser, *, drop_invalid: bool = True) ->
 
 @contextlib.contextmanager
 def about(path: Path) -> Iterator[None]:
-    """Prefix the file's name to a :class:`DataError` raised inside, if it lacks it."""
+    """Prefix the file's name to a :class:`DynidError` raised inside, if it lacks it."""
     try:
         yield
-    except DataError as exc:
+    except DynidError as exc:
         if str(exc).startswith(path.name):
             raise
         raise type(exc)(f"{path.name}: {exc}") from exc
@@ -134,9 +134,11 @@ def load_robot(args: argparse.Namespace) -> Robot:
         return panda()
     path = Path(spec)
     if path.suffix.lower() == ".urdf":
-        return Robot.from_urdf(path, base_link=args.base, tip_link=args.tip)
+        with about(path):
+            return Robot.from_urdf(path, base_link=args.base, tip_link=args.tip)
     if path.suffix.lower() == ".toml":
-        return Robot.from_toml(path)
+        with about(path):
+            return Robot.from_toml(path)
     raise DynidError(f"--robot must be 'panda', a .urdf or a .toml file; got {spec!r}")
 
 

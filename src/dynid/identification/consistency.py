@@ -80,7 +80,7 @@ def recorded_robot_mismatch(
         diff = float(np.max(np.abs(theirs - mine))) if theirs.size else 0.0
         if not diff <= atol:
             return (
-                f"the recorded kinematics differ from robot {robot.name!r}'s: largest "
+                f"the recorded kinematics differ from those of robot {robot.name!r}: largest "
                 f"difference {diff:.3g} in {key}"
             )
     return None

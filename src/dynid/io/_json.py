@@ -73,7 +73,7 @@ def save_json(path: str | Path, obj: Mapping[str, Any], *, schema: str | None = 
     )
     try:
         text = dumps(doc)
-    except DataError as exc:
+    except (DataError, NonFiniteError) as exc:
         raise type(exc)(f"{path.name}: {exc}") from None
     return write_text(path, text + "\n")
 

@@ -1,0 +1,652 @@
+"""Bad inputs and faults through the command line: one line, the right exit code (issue 12).
+
+The table ``CASES`` holds one row per case: an id, a function that writes the bad input
+into the work folder (or None), the arguments, the expected exit code and a fragment of
+the expected stderr (or, for exit 0, of the expected warning; "" for none). Add a row to
+cover a new class of input. Every case also checks that nothing is a traceback and that
+a failing command leaves no output of its own behind.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import io
+import json
+import shutil
+import zipfile
+from collections.abc import Callable
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from dynid.cli.__main__ import main
+
+NEUTRAL = "0,-0.785,0,-2.356,0,1.571,0.785"
+
+
+@pytest.fixture(scope="module")
+def base(tmp_path_factory) -> Path:
+    """Good inputs: noise-free static data (60 configurations), a 4 s log at 200 Hz, a
+    model identified from the static data."""
+    d = tmp_path_factory.mktemp("bad_inputs_base")
+    sink = io.StringIO()
+    with contextlib.redirect_stdout(sink), contextlib.redirect_stderr(sink):
+        assert main(["acquire-static", "--n", "60", "--seed", "3", "--out", str(d / "s.csv")]) == 0
+        assert main(["acquire-static", "--n", "60", "--seed", "3", "--out", str(d / "s.npz")]) == 0
+        assert (
+            main(["simulate", "--duration", "4", "--rate", "200", "--out", str(d / "log.csv")]) == 0
+        )
+        assert main(["identify", "--data", str(d / "s.csv"), "--out", str(d / "res")]) == 0
+    return d
+
+
+# ------------------------------------------------------------------ input builders
+def _lines(path: Path) -> list[str]:
+    return path.read_text(encoding="utf-8").splitlines()
+
+
+def _write(path: Path, lines: list[str], *, bom: bool = False) -> None:
+    path.write_text(("\ufeff" if bom else "") + "\n".join(lines) + "\n", encoding="utf-8")
+
+
+def _header_index(lines: list[str]) -> int:
+    return next(i for i, s in enumerate(lines) if s and not s.startswith("#"))
+
+
+def _edit_log(d: Path, name: str, edit: Callable[[list[list[str]]], None]) -> None:
+    """Copy log.csv to ``name`` with ``edit`` applied to its rows of cells (header first)."""
+    lines = _lines(d / "log.csv")
+    h = _header_index(lines)
+    rows = [s.split(",") for s in lines[h:]]
+    edit(rows)
+    comments = [s for s in lines[:h] if not s.startswith("# rows:")]
+    _write(d / name, comments + [",".join(r) for r in rows])
+
+
+def truncated_static(d: Path) -> None:
+    """A static CSV cut short, as a killed writer of dynid 0.1 left it."""
+    lines = _lines(d / "s.csv")
+    _write(d / "bad.csv", lines[: len(lines) // 2])
+
+
+def truncated_npz(d: Path) -> None:
+    """An NPZ cut in half."""
+    data = (d / "s.npz").read_bytes()
+    (d / "bad.npz").write_bytes(data[: len(data) // 2])
+
+
+def empty_npz(d: Path) -> None:
+    """An empty file named .npz."""
+    (d / "bad.npz").write_bytes(b"")
+
+
+def npz_short_rows(d: Path) -> None:
+    """An NPZ whose recorded row count is larger than its arrays."""
+    with np.load(d / "s.npz") as z:
+        arrays = {k: z[k] for k in z.files}
+    arrays["n_rows"] = np.array(int(arrays["n_rows"]) + 5)
+    np.savez(d / "bad.npz", **arrays)
+
+
+def static_bom(d: Path) -> None:
+    """A spreadsheet export: the static CSV with a UTF-8 byte-order mark."""
+    _write(d / "bom.csv", _lines(d / "s.csv"), bom=True)
+
+
+def static_xarm(d: Path) -> None:
+    """Static data that record another 7-joint arm."""
+    lines = [s.replace('"robot": "panda"', '"robot": "xarm7"') for s in _lines(d / "s.csv")]
+    _write(d / "bad.csv", lines)
+
+
+def static_other_kinematics(d: Path) -> None:
+    """Static data whose recorded kinematics are not the Panda's (name removed)."""
+    lines = _lines(d / "s.csv")
+    k = next(i for i, s in enumerate(lines) if s.startswith("# metadata:"))
+    meta = json.loads(lines[k][len("# metadata:") :])
+    del meta["robot"]
+    meta["kinematics"]["T_parent_joint"][3][0][3] += 0.01
+    lines[k] = "# metadata: " + json.dumps(meta)
+    _write(d / "bad.csv", lines)
+
+
+def static_outside_limits(d: Path) -> None:
+    """Noise-free data with one configuration past joint 4's upper limit (-0.0698 rad)."""
+    lines = _lines(d / "s.csv")
+    h = _header_index(lines)
+    cells = lines[h + 1].split(",")
+    q4 = float(cells[3])
+    lines[h + 1] = ",".join(cells)
+    assert q4 < 0
+    # move the data set's first configuration: replace its row by the Panda's own values
+    import dynid
+
+    robot = dynid.panda()
+    q = np.array([float(c) for c in cells[:7]])
+    q[3] = 0.2
+    M, g = dynid.mass_matrix(robot, q), dynid.gravity_torques(robot, q)
+    i, j = np.tril_indices(7)
+    row = np.concatenate([q, M[i, j], g])
+    lines[h + 1] = ",".join(f"{v:.17g}" for v in row)
+    _write(d / "lim.csv", lines)
+
+
+def log_dup_column(d: Path) -> None:
+    """A log with tau1 twice (the last one used to win)."""
+
+    def edit(rows):
+        k = rows[0].index("tau1")
+        for r in rows:
+            r.append(r[k])
+
+    _edit_log(d, "bad.csv", edit)
+
+
+def log_unknown_column(d: Path) -> None:
+    """A log with an extra column of no known name."""
+
+    def edit(rows):
+        rows[0].append("temperature")
+        for r in rows[1:]:
+            r.append("20")
+
+    _edit_log(d, "bad.csv", edit)
+
+
+def log_lone_ddq(d: Path) -> None:
+    """A log with ddq1 but no ddq2..ddq7."""
+
+    def edit(rows):
+        rows[0].append("ddq1")
+        for r in rows[1:]:
+            r.append("0")
+
+    _edit_log(d, "bad.csv", edit)
+
+
+def log_nan_row(d: Path) -> None:
+    """A log with a NaN torque in data row 10."""
+
+    def edit(rows):
+        rows[11][rows[0].index("tau3")] = "nan"
+
+    _edit_log(d, "bad.csv", edit)
+
+
+def log_repeated_stamp(d: Path) -> None:
+    """A log whose data row 20 repeats row 19's timestamp."""
+
+    def edit(rows):
+        rows[21][0] = rows[20][0]
+
+    _edit_log(d, "bad.csv", edit)
+
+
+def log_huge_torque(d: Path) -> None:
+    """A log with one torque of 1e308 (finite, but it overflows every statistic)."""
+
+    def edit(rows):
+        rows[300][rows[0].index("tau2")] = "1e308"
+
+    _edit_log(d, "bad.csv", edit)
+
+
+def log_bom(d: Path) -> None:
+    """The log with a UTF-8 byte-order mark."""
+    _write(d / "bom.csv", _lines(d / "log.csv"), bom=True)
+
+
+def log_gap(d: Path) -> None:
+    """The log with 0.1 s of samples missing (20 rows at 200 Hz)."""
+    lines = _lines(d / "log.csv")
+    h = _header_index(lines)
+    lines = [s for s in lines if not s.startswith("# rows:")]
+    h = _header_index(lines)
+    _write(d / "gap.csv", lines[: h + 300] + lines[h + 320 :])
+
+
+def _edit_model(d: Path, edit: Callable[[dict], None]) -> None:
+    doc = json.loads((d / "res" / "identification.json").read_text())
+    edit(doc)
+    (d / "bad.json").write_text(json.dumps(doc))
+
+
+def model_bad_index(d: Path) -> None:
+    """A hand-edited identification.json with a column index of -1."""
+    _edit_model(d, lambda doc: doc["base"]["independent"].__setitem__(0, -1))
+
+
+def model_big_index(d: Path) -> None:
+    """An identification.json with an index past the 70 standard parameters."""
+    _edit_model(d, lambda doc: doc["base"]["dependent"].__setitem__(0, 70))
+
+
+def model_bad_friction(d: Path) -> None:
+    """An identification.json with a malformed friction block."""
+    _edit_model(d, lambda doc: doc.__setitem__("friction", {"fv": 1}))
+
+
+def model_nan(d: Path) -> None:
+    """An identification.json with NaN (not JSON) as a value."""
+    text = (d / "res" / "identification.json").read_text()
+    (d / "bad.json").write_text(text.replace('"sigma": ', '"sigma": NaN, "x": ', 1))
+
+
+def model_duplicate_key(d: Path) -> None:
+    """An identification.json with a key twice."""
+    text = (d / "res" / "identification.json").read_text()
+    (d / "bad.json").write_text(text.replace('"rank": ', '"rank": 43, "rank": ', 1))
+
+
+def model_bom(d: Path) -> None:
+    """identification.json with a byte-order mark."""
+    text = (d / "res" / "identification.json").read_text()
+    (d / "bom.json").write_text("\ufeff" + text, encoding="utf-8")
+
+
+def friction_nan(d: Path) -> None:
+    """A friction.json with Infinity."""
+    (d / "f.json").write_text(
+        '{"schema": "dynid-friction/1", "model": "classical", "joints": '
+        '[{"fv": Infinity, "fc": 0, "fo": 0}]}'
+    )
+
+
+# ------------------------------------------------------------------ the table
+@dataclass(frozen=True)
+class Case:
+    """One bad input: how to make it, the command, the exit code, a stderr fragment."""
+
+    id: str
+    make: Callable[[Path], None] | None
+    argv: tuple[str, ...]
+    code: int
+    fragment: str
+
+
+def C(id, make, argv, code, fragment):  # noqa: N802 - short name for the table
+    return Case(id, make, tuple(argv.split()), code, fragment)
+
+
+OUT = "{d}/out"
+# fmt: off
+CASES = [
+    # option values (argparse types): one line, exit 2
+    C(
+        "seed-negative",
+        None,
+        f"acquire-static --seed -1 --out {OUT}/x.csv",
+        2,
+        "--seed: must be an integer >= 0",
+    ),
+    C(
+        "simulate-seed",
+        None,
+        f"simulate --seed -1 --out {OUT}/x.csv",
+        2,
+        "--seed: must be an integer >= 0",
+    ),
+    C(
+        "retrieve-seed",
+        None,
+        f"retrieve --model {{d}}/res/identification.json --seed -1 --out {OUT}",
+        2,
+        "--seed",
+    ),
+    C("ik-seed", None, "ik --goal-xyz 0.4,0.1,0.5 --seed -1", 2, "--seed"),
+    C("demo-seed", None, f"demo --seed -1 --out {OUT}", 2, "--seed"),
+    C("n-zero", None, f"acquire-static --n 0 --out {OUT}/x.csv", 2, "--n: must be an integer >= 1"),
+    C(
+        "noise-negative",
+        None,
+        f"acquire-static --noise -1 --out {OUT}/x.csv",
+        2,
+        "--noise: must be a finite number >= 0",
+    ),
+    C(
+        "noise-nan",
+        None,
+        f"acquire-static --noise nan --out {OUT}/x.csv",
+        2,
+        "--noise: must be a finite number",
+    ),
+    C(
+        "max-std-zero",
+        None,
+        f"identify --data {{d}}/s.csv --max-std-percent 0 --out {OUT}",
+        2,
+        "--max-std-percent: must be a finite number > 0",
+    ),
+    C(
+        "rtol-one",
+        None,
+        f"identify --data {{d}}/s.csv --rtol 1 --out {OUT}",
+        2,
+        "--rtol: must be a finite number > 0 and < 1",
+    ),
+    C(
+        "runs-zero",
+        None,
+        f"retrieve --model {{d}}/res/identification.json --runs 0 --out {OUT}",
+        2,
+        "--runs",
+    ),
+    C("drop-too-much", None, f"simulate --drop 0.7 --out {OUT}/x.csv", 2, "--drop"),
+    C("q-nan", None, "fk --q nan,0,0,0,0,0,0", 2, "--q must be finite"),
+    C("q-count", None, "fk --q -0.1,0.2", 2, "--q must have 7 values"),
+    # negative comma lists parse as values
+    C("q-negative-list", None, "fk --q -0.1,-0.785,0,-2.356,0,1.571,0.785 --json", 0, ""),
+    C(
+        "predict-negative-list",
+        None,
+        f"predict --model {{d}}/res/identification.json --q -0.1,{NEUTRAL[2:]} --dq -0.1,0,0,0,0,0,0",
+        0,
+        "",
+    ),
+    # files cut short: refused, not read as smaller data sets
+    C(
+        "static-truncated",
+        truncated_static,
+        f"identify --data {{d}}/bad.csv --out {OUT}",
+        2,
+        "records 60 rows but holds",
+    ),
+    C(
+        "npz-truncated",
+        truncated_npz,
+        f"identify --data {{d}}/bad.npz --out {OUT}",
+        2,
+        "bad.npz: not a readable NPZ",
+    ),
+    C(
+        "npz-empty",
+        empty_npz,
+        f"identify --data {{d}}/bad.npz --out {OUT}",
+        2,
+        "bad.npz: not a readable NPZ",
+    ),
+    C(
+        "npz-row-count",
+        npz_short_rows,
+        f"identify --data {{d}}/bad.npz --out {OUT}",
+        2,
+        "records 65 rows but holds 60",
+    ),
+    C("missing-file", None, f"identify --data {{d}}/nothing.csv --out {OUT}", 2, "nothing.csv"),
+    # torque logs: strict columns and rows
+    C(
+        "log-duplicated-column",
+        log_dup_column,
+        f"validate --robot panda --data {{d}}/bad.csv --out {OUT}",
+        2,
+        "duplicated column(s) ['tau1']",
+    ),
+    C(
+        "log-unknown-column",
+        log_unknown_column,
+        f"validate --robot panda --data {{d}}/bad.csv --out {OUT}",
+        2,
+        "unknown column(s) ['temperature']",
+    ),
+    C(
+        "log-lone-ddq",
+        log_lone_ddq,
+        f"identify --data {{d}}/bad.csv --out {OUT}",
+        2,
+        "all of ddq1..ddq7 or none",
+    ),
+    C(
+        "log-nan-row",
+        log_nan_row,
+        f"validate --robot panda --data {{d}}/bad.csv --out {OUT}",
+        2,
+        "1 row(s) hold NaN, inf or an empty cell; first row 10",
+    ),
+    C(
+        "log-nan-row-dropped",
+        log_nan_row,
+        f"validate --robot panda --data {{d}}/bad.csv --drop-invalid --no-figures --out {OUT}",
+        0,
+        "dropped 1 row(s) of 801 holding NaN",
+    ),
+    C(
+        "log-repeated-stamp",
+        log_repeated_stamp,
+        f"friction --robot panda --data {{d}}/bad.csv --out {OUT}",
+        2,
+        "repeat the previous timestamp; first row 20",
+    ),
+    C(
+        "log-repeated-stamp-dropped",
+        log_repeated_stamp,
+        f"validate --robot panda --data {{d}}/bad.csv --drop-invalid --no-figures --out {OUT}",
+        0,
+        "dropped 1 row(s) of 801 repeating",
+    ),
+    C(
+        "log-huge-torque",
+        log_huge_torque,
+        f"validate --robot panda --data {{d}}/bad.csv --out {OUT}",
+        2,
+        "overflow",
+    ),
+    C(
+        "log-bom",
+        log_bom,
+        f"validate --robot panda --data {{d}}/bom.csv --no-figures --out {OUT}",
+        0,
+        "",
+    ),
+    C(
+        "log-gap-bridged",
+        log_gap,
+        f"validate --robot panda --data {{d}}/gap.csv --max-gap 0.2 --no-figures --out {OUT}",
+        0,
+        "",
+    ),
+    C(
+        "log-gap-refused",
+        log_gap,
+        f"validate --robot panda --data {{d}}/gap.csv --out {OUT}",
+        2,
+        "exceeds the longest gap bridged, 0.02 s",
+    ),
+    C(
+        "log-wrong-robot",
+        None,
+        f"validate --robot {{d}}/two.toml --data {{d}}/log.csv --out {OUT}",
+        2,
+        "the log has 7 joints",
+    ),
+    # static data: robot consistency and BOM
+    C("static-bom", static_bom, f"identify --data {{d}}/bom.csv --out {OUT}", 0, ""),
+    C(
+        "static-other-robot",
+        static_xarm,
+        f"identify --data {{d}}/bad.csv --out {OUT}",
+        2,
+        "recorded with robot 'xarm7'; the robot given is 'panda'",
+    ),
+    C(
+        "static-other-kinematics",
+        static_other_kinematics,
+        f"identify --data {{d}}/bad.csv --out {OUT}",
+        2,
+        "kinematics differ from those of robot 'panda': largest difference 0.01",
+    ),
+    C(
+        "static-outside-limits",
+        static_outside_limits,
+        f"identify --data {{d}}/lim.csv --out {OUT}",
+        0,
+        "1 of 60 configurations lie outside the joint limits",
+    ),
+    # model and friction JSON: validated before use
+    C(
+        "model-index-minus-one",
+        model_bad_index,
+        "predict --model {d}/bad.json --q " + NEUTRAL,
+        2,
+        "base.independent[0] = -1 is not an index",
+    ),
+    C(
+        "model-index-too-big",
+        model_big_index,
+        "predict --model {d}/bad.json --q " + NEUTRAL,
+        2,
+        "base.dependent[0] = 70 is not an index",
+    ),
+    C(
+        "model-bad-friction",
+        model_bad_friction,
+        f"validate --model {{d}}/bad.json --data {{d}}/log.csv --out {OUT}",
+        2,
+        "malformed",
+    ),
+    C(
+        "model-nan",
+        model_nan,
+        "predict --model {d}/bad.json --q " + NEUTRAL,
+        2,
+        "NaN is not a JSON number",
+    ),
+    C(
+        "model-duplicate-key",
+        model_duplicate_key,
+        "predict --model {d}/bad.json --q " + NEUTRAL,
+        2,
+        "duplicated key 'rank'",
+    ),
+    C("model-bom", model_bom, "predict --model {d}/bom.json --q " + NEUTRAL, 0, ""),
+    C(
+        "friction-infinity",
+        friction_nan,
+        f"validate --robot panda --friction {{d}}/f.json --data {{d}}/log.csv --out {OUT}",
+        2,
+        "Infinity is not a JSON number",
+    ),
+]
+
+
+# fmt: on
+
+
+TWO_JOINT_TOML = """name = "two"
+[[joints]]
+name = "j1"
+type = "revolute"
+parent = "l0"
+child = "l1"
+axis = [0, 0, 1]
+[[joints]]
+name = "j2"
+type = "revolute"
+parent = "l1"
+child = "l2"
+origin = { xyz = [0.5, 0, 0] }
+axis = [0, 0, 1]
+"""
+
+
+@pytest.mark.parametrize("case", CASES, ids=[c.id for c in CASES])
+def test_bad_input_gives_one_line_and_exit_code(case, base, tmp_path, capsys, caplog):
+    """Each bad input exits with its code, one stderr line holding the fragment, no
+    traceback, and a failing command leaves no output behind."""
+    d = tmp_path
+    for f in base.iterdir():
+        (shutil.copytree if f.is_dir() else shutil.copy)(f, d / f.name)
+    (d / "two.toml").write_text(TWO_JOINT_TOML)
+    if case.make is not None:
+        case.make(d)
+    capsys.readouterr()
+    argv = [a.replace("{d}", str(d)) for a in case.argv]
+    code = main(argv)
+    assert code == case.code, capsys.readouterr().err
+    err = capsys.readouterr().err
+    assert "Traceback" not in err
+    if case.code != 0:
+        lines = [s for s in err.splitlines() if s.strip()]
+        assert len(lines) == 1, err
+        assert case.fragment in lines[0], err
+        assert not (d / "out").exists(), "a failing command left output behind"
+    elif case.fragment:  # a warning: printed, or logged (stderr through logging)
+        assert case.fragment in err + caplog.text, err
+
+
+def test_unexpected_error_is_one_line_with_debug_hint(monkeypatch, capsys):
+    """A bug (any exception that is not a DynidError) prints one line naming it and
+    'run with --debug', exit 2; --debug shows the traceback."""
+    from dynid.cli import fk
+
+    def boom(args):
+        raise ZeroDivisionError("division by zero")
+
+    monkeypatch.setattr(fk, "run", boom)
+    assert main(["fk", "--q", NEUTRAL]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert err == [
+        "dynid fk: error: unexpected ZeroDivisionError: division by zero (run with --debug "
+        "for the traceback)"
+    ]
+    with pytest.raises(ZeroDivisionError):
+        main(["fk", "--q", NEUTRAL, "--debug"])
+
+
+def test_figures_are_skipped_without_matplotlib(base, tmp_path, monkeypatch, capsys):
+    """Without matplotlib, validate writes validation.json, notes the skipped figures in one
+    line each and exits 0."""
+    import sys
+
+    for name in [m for m in sys.modules if m == "matplotlib" or m.startswith("matplotlib.")]:
+        monkeypatch.delitem(sys.modules, name)
+    monkeypatch.setitem(sys.modules, "matplotlib", None)
+    out = tmp_path / "val"
+    assert (
+        main(["validate", "--robot", "panda", "--data", str(base / "log.csv"), "--out", str(out)])
+        == 0
+    )
+    err = capsys.readouterr().err.strip().splitlines()
+    assert err == [
+        "note: matplotlib is not installed; skipped the figure validation_torques.png",
+        "note: matplotlib is not installed; skipped the figure validation_rms.png",
+    ]
+    assert sorted(p.name for p in out.iterdir()) == ["validation.json"]
+
+
+def test_strict_json_out_never_writes_nan(tmp_path):
+    """The JSON writer refuses NaN/inf, naming the key path, and writes nothing."""
+    from dynid.exceptions import NonFiniteError
+    from dynid.io._json import save_json
+
+    with pytest.raises(NonFiniteError, match=r"x.json: rms\[1\] is inf"):
+        save_json(tmp_path / "x.json", {"rms": [1.0, np.inf]}, schema="s/1")
+    assert list(tmp_path.iterdir()) == []
+
+
+def test_atomic_write_leaves_the_old_file_when_interrupted(tmp_path):
+    """An exception (Ctrl-C included) inside a write keeps the previous file and removes
+    the temporary one; a new folder is removed by the failed transaction."""
+    from dynid.io._files import open_atomic, output_transaction, write_text
+
+    p = write_text(tmp_path / "a.txt", "old\n")
+    with pytest.raises(KeyboardInterrupt), open_atomic(p) as fh:
+        fh.write("new, half")
+        raise KeyboardInterrupt
+    assert p.read_text() == "old\n" and sorted(x.name for x in tmp_path.iterdir()) == ["a.txt"]
+    with pytest.raises(RuntimeError), output_transaction():
+        write_text(tmp_path / "new" / "deep" / "b.txt", "b")
+        raise RuntimeError("fail after writing")
+    assert sorted(x.name for x in tmp_path.iterdir()) == ["a.txt"]
+
+
+def test_npz_members_are_checked(tmp_path):
+    """A zip with a truncated member raises DataError, not zipfile's or numpy's errors."""
+    from dynid.exceptions import DataError
+    from dynid.io.static_data import load_static_npz
+
+    with zipfile.ZipFile(tmp_path / "z.npz", "w") as z:
+        z.writestr("q.npy", b"\x93NUMPY garbage")
+    with pytest.raises(DataError, match="z.npz"):
+        load_static_npz(tmp_path / "z.npz")
