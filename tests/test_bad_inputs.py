@@ -133,6 +133,22 @@ def static_outside_limits(d: Path) -> None:
     _write(d / "lim.csv", lines)
 
 
+def static_misfit(d: Path) -> None:
+    """Noise-free data (as recorded) that no Panda model fits: g scaled by 1.05 in half the
+    rows, the recorded robot name and kinematics removed."""
+    lines = _lines(d / "s.csv")
+    k = next(i for i, s in enumerate(lines) if s.startswith("# metadata:"))
+    meta = json.loads(lines[k][len("# metadata:") :])
+    del meta["robot"], meta["kinematics"]
+    lines[k] = "# metadata: " + json.dumps(meta)
+    h = _header_index(lines)
+    for r in range(h + 1, len(lines), 2):
+        cells = lines[r].split(",")
+        cells[-7:] = [f"{1.05 * float(c):.17g}" for c in cells[-7:]]
+        lines[r] = ",".join(cells)
+    _write(d / "mis.csv", lines)
+
+
 def log_dup_column(d: Path) -> None:
     """A log with tau1 twice (the last one used to win)."""
 
@@ -483,6 +499,7 @@ CASES = [
         0,
         "1 of 60 configurations lie outside the joint limits",
     ),
+    C("static-misfit", static_misfit, f"identify --data {{d}}/mis.csv --out {OUT}", 0, "on data recorded with relative noise 0 (expected at most 1e-06 %): the data do not fit"),
     # model and friction JSON: validated before use
     C(
         "model-index-minus-one",
@@ -650,3 +667,129 @@ def test_npz_members_are_checked(tmp_path):
         z.writestr("q.npy", b"\x93NUMPY garbage")
     with pytest.raises(DataError, match="z.npz"):
         load_static_npz(tmp_path / "z.npz")
+
+
+def test_exact_data_of_an_arm_with_a_prismatic_joint_give_zero_not_nan_std():
+    """Noise-free static data of an RPR arm: every std is finite (0 to rounding) with the
+    robust and the classical estimator, over several seeds (issue 12: NaN std, then a
+    JSON error and an empty folder)."""
+    import dynid
+    from dynid.identification.static import identify_static
+    from dynid.simulation.controller import SimulatedController, acquire_static
+
+    rng = np.random.default_rng(1201)
+    robot = dynid.Robot.from_mdh(
+        [0.0, 0.1, 0.2],
+        [0.3, 0.0, 0.1],
+        [0.0, np.pi / 2, -np.pi / 2],
+        joint_types="RPR",
+        mass=[2.0, 1.5, 1.0],
+        com=rng.uniform(-0.05, 0.05, (3, 3)),
+        inertia=np.stack([np.diag(rng.uniform(0.01, 0.05, 3)) for _ in range(3)]),
+        q_min=[-2.0, 0.0, -2.0],
+        q_max=[2.0, 0.5, 2.0],
+    )
+    for seed in range(4):
+        data = acquire_static(SimulatedController(robot, 0.0), 50, np.random.default_rng(seed))
+        for est in ("robust", "classical"):
+            fit = identify_static(robot, data, std_estimator=est).fit
+            assert np.all(np.isfinite(fit.std)) and np.all(fit.std >= 0)
+            assert np.all(np.isfinite(fit.std_percent[fit.kept]))
+            assert fit.relative_error_percent < 1e-8
+
+
+def test_warnings_print_as_one_line(monkeypatch, capsys):
+    """A library warning during a command is one stderr line without the source line."""
+    import warnings
+
+    from dynid.cli import fk
+    from dynid.exceptions import DynidWarning
+
+    real = fk.run
+
+    def run(args):
+        warnings.warn("something recoverable", DynidWarning, stacklevel=2)
+        return real(args)
+
+    monkeypatch.setattr(fk, "run", run)
+    assert main(["fk", "--q", NEUTRAL]) == 0
+    err = capsys.readouterr().err
+    assert err == "dynid fk: warning: something recoverable\n"
+
+
+def _dynid(*args: str, **kw):
+    import subprocess
+    import sys
+
+    return subprocess.Popen(
+        [sys.executable, "-m", "dynid", *args],
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        text=True,
+        **kw,
+    )
+
+
+def _children(pid: int) -> list[int]:
+    """Process ids whose parent is ``pid`` (from /proc)."""
+    out = []
+    for p in Path("/proc").iterdir():
+        if p.name.isdigit():
+            with contextlib.suppress(OSError):
+                fields = (p / "stat").read_text().rsplit(")", 1)[1].split()
+                if int(fields[1]) == pid:
+                    out.append(int(p.name))
+    return out
+
+
+def _wait_for(cond, timeout: float) -> bool:
+    import time
+
+    end = time.monotonic() + timeout
+    while time.monotonic() < end:
+        if cond():
+            return True
+        time.sleep(0.05)
+    return False
+
+
+@pytest.mark.slow
+@pytest.mark.skipif(not Path("/proc").exists(), reason="needs /proc to find worker processes")
+def test_sigterm_stops_retrieve_and_its_workers_without_output(base, tmp_path):
+    """SIGTERM during a parallel retrieval: exit 143 with one line, the worker processes
+    are gone, and the output folder was never created (issue 12: workers leaked)."""
+    import signal
+
+    out = tmp_path / "feasible"
+    proc = _dynid(
+        "retrieve", "--model", str(base / "res" / "identification.json"), "--runs", "4",
+        "--workers", "2", "--seed", "0", "--out", str(out),
+    )  # fmt: skip
+    assert _wait_for(lambda: len(_children(proc.pid)) >= 2, 60), "workers did not start"
+    workers = _children(proc.pid)
+    proc.send_signal(signal.SIGTERM)
+    _, err = proc.communicate(timeout=30)
+    assert proc.returncode == 143
+    assert err.strip().splitlines()[-1] == (
+        "dynid retrieve: terminated (SIGTERM); no partial output left"
+    )
+    assert "Traceback" not in err
+    assert _wait_for(lambda: not any(Path(f"/proc/{w}").exists() for w in workers), 10)
+    assert not out.exists()
+
+
+@pytest.mark.slow
+def test_ctrl_c_stops_a_write_without_a_partial_file(tmp_path):
+    """SIGINT while acquire-static computes or writes: exit 130, one line, no file and no
+    temporary file left (issue 12: a killed write left a truncated file)."""
+    import signal
+    import time
+
+    out = tmp_path / "big.csv"
+    proc = _dynid("acquire-static", "--n", "400000", "--out", str(out))
+    time.sleep(4.0)
+    proc.send_signal(signal.SIGINT)
+    _, err = proc.communicate(timeout=30)
+    assert proc.returncode == 130, err
+    assert err.strip().splitlines() == ["dynid acquire-static: interrupted; no partial output left"]
+    assert list(tmp_path.iterdir()) == []
