@@ -209,6 +209,26 @@ def log_huge_torque(d: Path) -> None:
     _edit_log(d, "bad.csv", edit)
 
 
+def log_at(rate: int) -> Callable[[Path], None]:
+    """A builder: dynid's own simulate at ``rate`` Hz (issue 12: 50 Hz logs were refused)."""
+
+    def make(d: Path) -> None:
+        with contextlib.redirect_stdout(io.StringIO()):
+            argv = [
+                "simulate",
+                "--duration",
+                "6",
+                "--rate",
+                str(rate),
+                "--out",
+                str(d / "slow.csv"),
+            ]
+            assert main(argv) == 0
+
+    make.__doc__ = f"A {rate} Hz log from dynid simulate."
+    return make
+
+
 def log_bom(d: Path) -> None:
     """The log with a UTF-8 byte-order mark."""
     _write(d / "bom.csv", _lines(d / "log.csv"), bom=True)
@@ -290,260 +310,59 @@ OUT = "{d}/out"
 # fmt: off
 CASES = [
     # option values (argparse types): one line, exit 2
-    C(
-        "seed-negative",
-        None,
-        f"acquire-static --seed -1 --out {OUT}/x.csv",
-        2,
-        "--seed: must be an integer >= 0",
-    ),
-    C(
-        "simulate-seed",
-        None,
-        f"simulate --seed -1 --out {OUT}/x.csv",
-        2,
-        "--seed: must be an integer >= 0",
-    ),
-    C(
-        "retrieve-seed",
-        None,
-        f"retrieve --model {{d}}/res/identification.json --seed -1 --out {OUT}",
-        2,
-        "--seed",
-    ),
+    C("seed-negative", None, f"acquire-static --seed -1 --out {OUT}/x.csv", 2, "--seed: must be an integer >= 0"),
+    C("simulate-seed", None, f"simulate --seed -1 --out {OUT}/x.csv", 2, "--seed: must be an integer >= 0"),
+    C("retrieve-seed", None, f"retrieve --model {{d}}/res/identification.json --seed -1 --out {OUT}", 2, "--seed"),
     C("ik-seed", None, "ik --goal-xyz 0.4,0.1,0.5 --seed -1", 2, "--seed"),
     C("demo-seed", None, f"demo --seed -1 --out {OUT}", 2, "--seed"),
     C("n-zero", None, f"acquire-static --n 0 --out {OUT}/x.csv", 2, "--n: must be an integer >= 1"),
-    C(
-        "noise-negative",
-        None,
-        f"acquire-static --noise -1 --out {OUT}/x.csv",
-        2,
-        "--noise: must be a finite number >= 0",
-    ),
-    C(
-        "noise-nan",
-        None,
-        f"acquire-static --noise nan --out {OUT}/x.csv",
-        2,
-        "--noise: must be a finite number",
-    ),
-    C(
-        "max-std-zero",
-        None,
-        f"identify --data {{d}}/s.csv --max-std-percent 0 --out {OUT}",
-        2,
-        "--max-std-percent: must be a finite number > 0",
-    ),
-    C(
-        "rtol-one",
-        None,
-        f"identify --data {{d}}/s.csv --rtol 1 --out {OUT}",
-        2,
-        "--rtol: must be a finite number > 0 and < 1",
-    ),
-    C(
-        "runs-zero",
-        None,
-        f"retrieve --model {{d}}/res/identification.json --runs 0 --out {OUT}",
-        2,
-        "--runs",
-    ),
+    C("noise-negative", None, f"acquire-static --noise -1 --out {OUT}/x.csv", 2, "--noise: must be a finite number >= 0"),
+    C("noise-nan", None, f"acquire-static --noise nan --out {OUT}/x.csv", 2, "--noise: must be a finite number"),
+    C("max-std-zero", None, f"identify --data {{d}}/s.csv --max-std-percent 0 --out {OUT}", 2, "--max-std-percent: must be a finite number > 0"),
+    C("rtol-one", None, f"identify --data {{d}}/s.csv --rtol 1 --out {OUT}", 2, "--rtol: must be a finite number > 0 and < 1"),
+    C("runs-zero", None, f"retrieve --model {{d}}/res/identification.json --runs 0 --out {OUT}", 2, "--runs"),
     C("drop-too-much", None, f"simulate --drop 0.7 --out {OUT}/x.csv", 2, "--drop"),
     C("q-nan", None, "fk --q nan,0,0,0,0,0,0", 2, "--q must be finite"),
     C("q-count", None, "fk --q -0.1,0.2", 2, "--q must have 7 values"),
     # negative comma lists parse as values
     C("q-negative-list", None, "fk --q -0.1,-0.785,0,-2.356,0,1.571,0.785 --json", 0, ""),
-    C(
-        "predict-negative-list",
-        None,
-        f"predict --model {{d}}/res/identification.json --q -0.1,{NEUTRAL[2:]} --dq -0.1,0,0,0,0,0,0",
-        0,
-        "",
-    ),
+    C("predict-negative-list", None, f"predict --model {{d}}/res/identification.json --q -0.1,{NEUTRAL[2:]} --dq -0.1,0,0,0,0,0,0", 0, ""),
     # files cut short: refused, not read as smaller data sets
-    C(
-        "static-truncated",
-        truncated_static,
-        f"identify --data {{d}}/bad.csv --out {OUT}",
-        2,
-        "records 60 rows but holds",
-    ),
-    C(
-        "npz-truncated",
-        truncated_npz,
-        f"identify --data {{d}}/bad.npz --out {OUT}",
-        2,
-        "bad.npz: not a readable NPZ",
-    ),
-    C(
-        "npz-empty",
-        empty_npz,
-        f"identify --data {{d}}/bad.npz --out {OUT}",
-        2,
-        "bad.npz: not a readable NPZ",
-    ),
-    C(
-        "npz-row-count",
-        npz_short_rows,
-        f"identify --data {{d}}/bad.npz --out {OUT}",
-        2,
-        "records 65 rows but holds 60",
-    ),
+    C("static-truncated", truncated_static, f"identify --data {{d}}/bad.csv --out {OUT}", 2, "records 60 rows but holds"),
+    C("npz-truncated", truncated_npz, f"identify --data {{d}}/bad.npz --out {OUT}", 2, "bad.npz: not a readable NPZ"),
+    C("npz-empty", empty_npz, f"identify --data {{d}}/bad.npz --out {OUT}", 2, "bad.npz: not a readable NPZ"),
+    C("npz-row-count", npz_short_rows, f"identify --data {{d}}/bad.npz --out {OUT}", 2, "records 65 rows but holds 60"),
     C("missing-file", None, f"identify --data {{d}}/nothing.csv --out {OUT}", 2, "nothing.csv"),
     # torque logs: strict columns and rows
-    C(
-        "log-duplicated-column",
-        log_dup_column,
-        f"validate --robot panda --data {{d}}/bad.csv --out {OUT}",
-        2,
-        "duplicated column(s) ['tau1']",
-    ),
-    C(
-        "log-unknown-column",
-        log_unknown_column,
-        f"validate --robot panda --data {{d}}/bad.csv --out {OUT}",
-        2,
-        "unknown column(s) ['temperature']",
-    ),
-    C(
-        "log-lone-ddq",
-        log_lone_ddq,
-        f"identify --data {{d}}/bad.csv --out {OUT}",
-        2,
-        "all of ddq1..ddq7 or none",
-    ),
-    C(
-        "log-nan-row",
-        log_nan_row,
-        f"validate --robot panda --data {{d}}/bad.csv --out {OUT}",
-        2,
-        "1 row(s) hold NaN, inf or an empty cell; first row 10",
-    ),
-    C(
-        "log-nan-row-dropped",
-        log_nan_row,
-        f"validate --robot panda --data {{d}}/bad.csv --drop-invalid --no-figures --out {OUT}",
-        0,
-        "dropped 1 row(s) of 801 holding NaN",
-    ),
-    C(
-        "log-repeated-stamp",
-        log_repeated_stamp,
-        f"friction --robot panda --data {{d}}/bad.csv --out {OUT}",
-        2,
-        "repeat the previous timestamp; first row 20",
-    ),
-    C(
-        "log-repeated-stamp-dropped",
-        log_repeated_stamp,
-        f"validate --robot panda --data {{d}}/bad.csv --drop-invalid --no-figures --out {OUT}",
-        0,
-        "dropped 1 row(s) of 801 repeating",
-    ),
-    C(
-        "log-huge-torque",
-        log_huge_torque,
-        f"validate --robot panda --data {{d}}/bad.csv --out {OUT}",
-        2,
-        "overflow",
-    ),
-    C(
-        "log-bom",
-        log_bom,
-        f"validate --robot panda --data {{d}}/bom.csv --no-figures --out {OUT}",
-        0,
-        "",
-    ),
-    C(
-        "log-gap-bridged",
-        log_gap,
-        f"validate --robot panda --data {{d}}/gap.csv --max-gap 0.2 --no-figures --out {OUT}",
-        0,
-        "",
-    ),
-    C(
-        "log-gap-refused",
-        log_gap,
-        f"validate --robot panda --data {{d}}/gap.csv --out {OUT}",
-        2,
-        "exceeds the longest gap bridged, 0.02 s",
-    ),
-    C(
-        "log-wrong-robot",
-        None,
-        f"validate --robot {{d}}/two.toml --data {{d}}/log.csv --out {OUT}",
-        2,
-        "the log has 7 joints",
-    ),
+    C("log-duplicated-column", log_dup_column, f"validate --robot panda --data {{d}}/bad.csv --out {OUT}", 2, "duplicated column(s) ['tau1']"),
+    C("log-unknown-column", log_unknown_column, f"validate --robot panda --data {{d}}/bad.csv --out {OUT}", 2, "unknown column(s) ['temperature']"),
+    C("log-lone-ddq", log_lone_ddq, f"identify --data {{d}}/bad.csv --out {OUT}", 2, "all of ddq1..ddq7 or none"),
+    C("log-nan-row", log_nan_row, f"validate --robot panda --data {{d}}/bad.csv --out {OUT}", 2, "1 row(s) hold NaN, inf or an empty cell; first row 10"),
+    C("log-nan-row-dropped", log_nan_row, f"validate --robot panda --data {{d}}/bad.csv --drop-invalid --no-figures --out {OUT}", 0, "dropped 1 row(s) of 801 holding NaN"),
+    C("log-repeated-stamp", log_repeated_stamp, f"friction --robot panda --data {{d}}/bad.csv --out {OUT}", 2, "repeat the previous timestamp; first row 20"),
+    C("log-repeated-stamp-dropped", log_repeated_stamp, f"validate --robot panda --data {{d}}/bad.csv --drop-invalid --no-figures --out {OUT}", 0, "dropped 1 row(s) of 801 repeating"),
+    C("log-huge-torque", log_huge_torque, f"validate --robot panda --data {{d}}/bad.csv --out {OUT}", 2, "overflow"),
+    C("log-bom", log_bom, f"validate --robot panda --data {{d}}/bom.csv --no-figures --out {OUT}", 0, ""),
+    C("log-gap-bridged", log_gap, f"validate --robot panda --data {{d}}/gap.csv --max-gap 0.2 --no-figures --out {OUT}", 0, ""),
+    C("log-gap-refused", log_gap, f"validate --robot panda --data {{d}}/gap.csv --out {OUT}", 2, "exceeds the longest gap bridged, 0.02 s"),
+    C("log-50hz", log_at(50), f"validate --robot panda --data {{d}}/slow.csv --no-figures --out {OUT}", 0, ""),
+    C("log-50hz-friction", log_at(50), f"friction --robot panda --data {{d}}/slow.csv --no-figures --out {OUT}", 0, ""),
+    C("log-10hz", log_at(10), f"validate --robot panda --data {{d}}/slow.csv --no-figures --out {OUT}", 0, "the default cutoff 5 Hz is not below the Nyquist frequency of this 10 Hz log"),
+    C("log-wrong-robot", None, f"validate --robot {{d}}/two.toml --data {{d}}/log.csv --out {OUT}", 2, "the log has 7 joints"),
     # static data: robot consistency and BOM
     C("static-bom", static_bom, f"identify --data {{d}}/bom.csv --out {OUT}", 0, ""),
-    C(
-        "static-other-robot",
-        static_xarm,
-        f"identify --data {{d}}/bad.csv --out {OUT}",
-        2,
-        "recorded with robot 'xarm7'; the robot given is 'panda'",
-    ),
-    C(
-        "static-other-kinematics",
-        static_other_kinematics,
-        f"identify --data {{d}}/bad.csv --out {OUT}",
-        2,
-        "kinematics differ from those of robot 'panda': largest difference 0.01",
-    ),
-    C(
-        "static-outside-limits",
-        static_outside_limits,
-        f"identify --data {{d}}/lim.csv --out {OUT}",
-        0,
-        "1 of 60 configurations lie outside the joint limits",
-    ),
+    C("static-other-robot", static_xarm, f"identify --data {{d}}/bad.csv --out {OUT}", 2, "recorded with robot 'xarm7'; the robot given is 'panda'"),
+    C("static-other-kinematics", static_other_kinematics, f"identify --data {{d}}/bad.csv --out {OUT}", 2, "kinematics differ from those of robot 'panda': largest difference 0.01"),
+    C("static-outside-limits", static_outside_limits, f"identify --data {{d}}/lim.csv --out {OUT}", 0, "1 of 60 configurations lie outside the joint limits"),
     C("static-misfit", static_misfit, f"identify --data {{d}}/mis.csv --out {OUT}", 0, "on data recorded with relative noise 0 (expected at most 1e-06 %): the data do not fit"),
     # model and friction JSON: validated before use
-    C(
-        "model-index-minus-one",
-        model_bad_index,
-        "predict --model {d}/bad.json --q " + NEUTRAL,
-        2,
-        "base.independent[0] = -1 is not an index",
-    ),
-    C(
-        "model-index-too-big",
-        model_big_index,
-        "predict --model {d}/bad.json --q " + NEUTRAL,
-        2,
-        "base.dependent[0] = 70 is not an index",
-    ),
-    C(
-        "model-bad-friction",
-        model_bad_friction,
-        f"validate --model {{d}}/bad.json --data {{d}}/log.csv --out {OUT}",
-        2,
-        "malformed",
-    ),
-    C(
-        "model-nan",
-        model_nan,
-        "predict --model {d}/bad.json --q " + NEUTRAL,
-        2,
-        "NaN is not a JSON number",
-    ),
-    C(
-        "model-duplicate-key",
-        model_duplicate_key,
-        "predict --model {d}/bad.json --q " + NEUTRAL,
-        2,
-        "duplicated key 'rank'",
-    ),
+    C("model-index-minus-one", model_bad_index, "predict --model {d}/bad.json --q " + NEUTRAL, 2, "base.independent[0] = -1 is not an index"),
+    C("model-index-too-big", model_big_index, "predict --model {d}/bad.json --q " + NEUTRAL, 2, "base.dependent[0] = 70 is not an index"),
+    C("model-bad-friction", model_bad_friction, f"validate --model {{d}}/bad.json --data {{d}}/log.csv --out {OUT}", 2, "malformed"),
+    C("model-nan", model_nan, "predict --model {d}/bad.json --q " + NEUTRAL, 2, "NaN is not a JSON number"),
+    C("model-duplicate-key", model_duplicate_key, "predict --model {d}/bad.json --q " + NEUTRAL, 2, "duplicated key 'rank'"),
     C("model-bom", model_bom, "predict --model {d}/bom.json --q " + NEUTRAL, 0, ""),
-    C(
-        "friction-infinity",
-        friction_nan,
-        f"validate --robot panda --friction {{d}}/f.json --data {{d}}/log.csv --out {OUT}",
-        2,
-        "Infinity is not a JSON number",
-    ),
+    C("friction-infinity", friction_nan, f"validate --robot panda --friction {{d}}/f.json --data {{d}}/log.csv --out {OUT}", 2, "Infinity is not a JSON number"),
 ]
 
 

@@ -154,7 +154,9 @@ def test_friction_json_round_trip(tmp_path, panda):
     (tmp_path / "bad.json").write_text(json.dumps(doc))
     with pytest.raises(DataError, match="joint 3 has no 'phi2'"):
         read_friction_json(tmp_path / "bad.json")
-    (tmp_path / "bad2.json").write_text('{"schema": "dynid-friction/1", "model": "stribeck", "joints": []}')
+    (tmp_path / "bad2.json").write_text(
+        '{"schema": "dynid-friction/1", "model": "stribeck", "joints": []}'
+    )
     with pytest.raises(DataError, match="'model' must be"):
         read_friction_json(tmp_path / "bad2.json")
 
