@@ -149,6 +149,33 @@ def static_misfit(d: Path) -> None:
     _write(d / "mis.csv", lines)
 
 
+def static_huge(d: Path) -> None:
+    """Static data with one entry of 1e300 (finite; the least squares overflow)."""
+    lines = _lines(d / "s.csv")
+    h = _header_index(lines)
+    cells = lines[h + 3].split(",")
+    cells[20] = "1e300"
+    lines[h + 3] = ",".join(cells)
+    _write(d / "bad.csv", lines)
+
+
+def truncated_log(d: Path) -> None:
+    """A torque log cut short (its '# rows:' line says 801)."""
+    lines = _lines(d / "log.csv")
+    _write(d / "bad.csv", lines[:500])
+
+
+def truncated_log_npz(d: Path) -> None:
+    """A torque-log NPZ whose n_rows says more than its arrays hold."""
+    from dynid.io.torque_log import read_torque_log, write_torque_log
+
+    write_torque_log(d / "log.npz", read_torque_log(d / "log.csv"))
+    with np.load(d / "log.npz") as z:
+        arrays = {k: z[k] for k in z.files}
+    arrays["n_rows"] = np.array(900)
+    np.savez(d / "bad.npz", **arrays)
+
+
 def log_dup_column(d: Path) -> None:
     """A log with tau1 twice (the last one used to win)."""
 
@@ -333,6 +360,8 @@ CASES = [
     C("npz-empty", empty_npz, f"identify --data {{d}}/bad.npz --out {OUT}", 2, "bad.npz: not a readable NPZ"),
     C("npz-row-count", npz_short_rows, f"identify --data {{d}}/bad.npz --out {OUT}", 2, "records 65 rows but holds 60"),
     C("missing-file", None, f"identify --data {{d}}/nothing.csv --out {OUT}", 2, "nothing.csv"),
+    C("log-truncated", truncated_log, f"validate --robot panda --data {{d}}/bad.csv --out {OUT}", 2, "bad.csv: the file records 801 rows but holds 497"),
+    C("log-npz-row-count", truncated_log_npz, f"friction --robot panda --data {{d}}/bad.npz --out {OUT}", 2, "records 900 rows but holds 801"),
     # torque logs: strict columns and rows
     C("log-duplicated-column", log_dup_column, f"validate --robot panda --data {{d}}/bad.csv --out {OUT}", 2, "duplicated column(s) ['tau1']"),
     C("log-unknown-column", log_unknown_column, f"validate --robot panda --data {{d}}/bad.csv --out {OUT}", 2, "unknown column(s) ['temperature']"),
@@ -355,6 +384,7 @@ CASES = [
     C("static-other-kinematics", static_other_kinematics, f"identify --data {{d}}/bad.csv --out {OUT}", 2, "kinematics differ from those of robot 'panda': largest difference 0.01"),
     C("static-outside-limits", static_outside_limits, f"identify --data {{d}}/lim.csv --out {OUT}", 0, "1 of 60 configurations lie outside the joint limits"),
     C("static-misfit", static_misfit, f"identify --data {{d}}/mis.csv --out {OUT}", 0, "on data recorded with relative noise 0 (expected at most 1e-06 %): the data do not fit"),
+    C("static-1e300", static_huge, f"identify --data {{d}}/bad.csv --out {OUT}", 2, "bad.csv: least squares overflowed: the data hold values up to 1e+300"),
     # model and friction JSON: validated before use
     C("model-index-minus-one", model_bad_index, "predict --model {d}/bad.json --q " + NEUTRAL, 2, "base.independent[0] = -1 is not an index"),
     C("model-index-too-big", model_big_index, "predict --model {d}/bad.json --q " + NEUTRAL, 2, "base.dependent[0] = 70 is not an index"),

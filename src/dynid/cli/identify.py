@@ -224,9 +224,14 @@ def identify_static_file(robot: Robot, path: Path, args: argparse.Namespace) -> 
     outside = limit_violations(robot, data.q)
     if outside is not None:
         warn(args, f"{path.name}: {outside}")
-    model = identify_static(
-        robot, data, max_std_percent=args.max_std_percent, rtol=args.rtol, std_estimator=args.std
-    )
+    with about(path):
+        model = identify_static(
+            robot,
+            data,
+            max_std_percent=args.max_std_percent,
+            rtol=args.rtol,
+            std_estimator=args.std,
+        )
     misfit = fit_mismatch(model.fit.relative_error_percent, data.metadata)
     if misfit is not None:
         warn(args, f"{path.name}: {misfit}")

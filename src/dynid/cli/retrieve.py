@@ -331,6 +331,14 @@ def run(args: argparse.Namespace) -> int:
 
         robot = _friction_robot(load_robot(args), args.friction)
         data, _ = load_static_data(args.static, robot)
+        from ..identification.consistency import recorded_robot_mismatch
+
+        mismatch = recorded_robot_mismatch(robot, data.metadata)
+        if mismatch is not None:
+            raise DynidError(
+                f"{args.static.name}: {mismatch}; hint: pass --robot for the arm that "
+                "recorded the data"
+            )
         bounds = _bounds(args, robot)
         source = str(args.static)
         if not quiet:

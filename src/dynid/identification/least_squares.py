@@ -75,7 +75,7 @@ import scipy.linalg
 from numpy.typing import ArrayLike, NDArray
 
 from .. import _checks
-from ..exceptions import OptionError, RankDeficientError, ShapeError
+from ..exceptions import NonFiniteError, OptionError, RankDeficientError, ShapeError
 
 __all__ = ["LeastSquaresFit", "fit_least_squares", "fit_with_pruning"]
 
@@ -223,13 +223,22 @@ def _fit(
         used = np.concatenate([np.arange(a, b) for a, b, _ in blk] + [np.zeros(0, np.intp)])
     yu = y if used is None else y[used]
     solved = None
-    if m > 4 * (rk + 1) and rk > 0:
-        solved = _solve_semi_normal(Wk, blk, yu, G, rtol, covariance)
-    if solved is None:
-        Wu = Wk if used is None else Wk[used]
-        _checks.finite("W", W if used is None else Wu)
-        solved = _solve_qr(Wu, yu, rtol, covariance)
+    # entries near the float range (1e300) overflow in the products: checked below, once
+    with np.errstate(over="ignore", invalid="ignore", divide="ignore"):
+        if m > 4 * (rk + 1) and rk > 0:
+            solved = _solve_semi_normal(Wk, blk, yu, G, rtol, covariance)
+        if solved is None:
+            Wu = Wk if used is None else Wk[used]
+            _checks.finite("W", W if used is None else Wu)
+            solved = _solve_qr(Wu, yu, rtol, covariance)
     rank, cond, bk, e, cov_s, scale = solved
+    if not (np.all(np.isfinite(bk)) and np.all(np.isfinite(e)) and np.all(np.isfinite(cov_s))):
+        k = int(np.argmax(np.abs(yu)))
+        raise NonFiniteError(
+            f"least squares overflowed: the data hold values up to {float(np.abs(yu[k])):.3g} "
+            f"(y[{k}]) and the regressor up to {float(np.max(np.abs(Wk))):.3g}; values this "
+            "large are not measurements: check the data"
+        )
     ss = float(e @ e)
     sigma = np.sqrt(ss / max(m - rk, 1))
     cov_k = cov_s / np.outer(scale, scale)
