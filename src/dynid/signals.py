@@ -252,7 +252,14 @@ def derivative(t: ArrayLike, x: ArrayLike) -> NDArray[np.float64]:
         raise ShapeError(
             f"derivative needs t (N,) with N >= 3 and x (N, ...); got {t.shape} and {x.shape}"
         )
-    return np.gradient(x, t, axis=0, edge_order=2)
+    if x.ndim < 2:
+        return np.gradient(x, t, edge_order=2)
+    # one signal at a time: np.gradient's temporaries stay the size of one column
+    out = np.empty(x.shape)
+    flat, fout = x.reshape(x.shape[0], -1), out.reshape(x.shape[0], -1)
+    for k in range(flat.shape[1]):
+        fout[:, k] = np.gradient(flat[:, k], t, edge_order=2)
+    return out
 
 
 def filtered_derivative(

@@ -106,6 +106,8 @@ def run(args: argparse.Namespace) -> int:
         raise DataError(
             f"{args.data.name}: the log has {log.n} joints; the model ({label}) has {robot.n}"
         )
+    logs = [log]  # handed over: validate frees the raw signals once it has filtered them
+    del log
     if args.friction is not None:
         friction = read_friction_json(args.friction)
     elif args.no_friction:
@@ -117,13 +119,15 @@ def run(args: argparse.Namespace) -> int:
 
             friction = load_feasible_linear_friction(args.params) or friction
     with about(args.data):
-        val = validate(model, log, friction=friction, cutoff_hz=args.cutoff, max_gap_s=args.max_gap)
+        val = validate(
+            model, logs.pop(), friction=friction, cutoff_hz=args.cutoff, max_gap_s=args.max_gap
+        )
     errors = val.errors
     if not np.isfinite(errors.relative_error_percent) or not np.all(np.isfinite(errors.rms)):
         raise DataError(
             f"{args.data.name}: the torque errors overflow (relative error "
             f"{errors.relative_error_percent}); the log holds values far outside a robot's "
-            f"range (largest |tau| {float(np.max(np.abs(log.tau))):.3g} N m)"
+            f"range (largest |tau| {float(np.max(np.abs(val.log.tau))):.3g} N m)"
         )
     doc = val.as_dict()
     doc["model"] = label

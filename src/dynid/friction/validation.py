@@ -128,15 +128,23 @@ def validate(
     res = friction_residual(
         model, log, cutoff_hz=cutoff_hz, trim_s=trim_s, filter_tau=filter_tau, max_gap_s=max_gap_s
     )
-    p = res.log
-    without = torque_errors(p.tau, res.tau_model)
+    p, tau_model = res.log, res.tau_model
+    # free what is no longer needed before the friction torques (a long log's raw signals,
+    # when the caller holds no other reference, and the residual)
+    del res, log
+    without = torque_errors(p.tau, tau_model)
     tf = with_ = None
     if friction is not None:
-        tf = friction.torques(p.dq)
-        with_ = torque_errors(p.tau, res.tau_model + tf)
+        tf = np.empty(p.dq.shape)
+        step = 65_536  # blocks of rows: a long log needs no full-size temporaries
+        for k in range(0, p.dq.shape[0], step):
+            tf[k : k + step] = friction.torques(p.dq[k : k + step])
+        tau_hat = tau_model + tf
+        with_ = torque_errors(p.tau, tau_hat)
+        del tau_hat
     return Validation(
         log=p,
-        tau_model=res.tau_model,
+        tau_model=tau_model,
         tau_friction=tf,
         without_friction=without,
         with_friction=with_,
