@@ -43,6 +43,7 @@ from typing import Any
 import numpy as np
 
 from ..io._files import write_text
+from ..io._json import save_json
 from ..kinematics.forward import fk
 from ..kinematics.ik import IKOptions, ik
 from ..kinematics.jacobian import jacobian
@@ -174,8 +175,6 @@ def stage_feasible(ctx: DemoContext) -> None:
 
 def stage_consistent(ctx: DemoContext) -> None:
     """Stage 5: convex retrieval against the penalty method, on a Panda with model error."""
-    import json
-
     from ..feasibility.compare import compare_methods, perturbed_robot
     from ..identification.static import identify_static
     from ..io.feasible import save_feasible_json, save_report_json
@@ -186,7 +185,6 @@ def stage_consistent(ctx: DemoContext) -> None:
 
     _header(5, "physically consistent parameters: convex (LMI) against the penalty method")
     out = ctx.out / "consistent"
-    out.mkdir(parents=True, exist_ok=True)
     rng = np.random.default_rng(np.random.SeedSequence([ctx.seed, 55]))
     truth = perturbed_robot(ctx.robot, rng)
     effects = UnmodelledEffects.typical(ctx.robot.n, rng)
@@ -232,14 +230,13 @@ def stage_consistent(ctx: DemoContext) -> None:
     ctx.files.append(save_feasible_json(out / "feasible.json", sdp))
     ctx.files.append(save_report_json(out / "report.json", sdp, seed=ctx.seed))
     doc = {"seed": ctx.seed, "methods": [r.as_dict() for r in rows]}
-    path = out / "comparison.json"
-    path.write_text(json.dumps(doc, indent=1, allow_nan=False) + "\n", encoding="utf-8")
-    ctx.files.append(path)
-    fig = plot_consistent([r.result for r in rows], labels=[r.name for r in rows], truth=truth)
-    ctx.save_figure(fig, "consistent/comparison.png")
-    import matplotlib.pyplot as plt
-
-    plt.close(fig)
+    ctx.files.append(save_json(out / "comparison.json", doc))
+    ctx.save_figure(
+        lambda: plot_consistent(
+            [r.result for r in rows], labels=[r.name for r in rows], truth=truth
+        ),
+        "consistent/comparison.png",
+    )
     ctx.results["consistent"] = {
         "rows": [r.as_dict() for r in rows],
         "notes": list(sdp.notes),

@@ -264,8 +264,19 @@ def run_consistent(robot: Robot, args: argparse.Namespace) -> int:
     data: Any
     if data_kind(args.data, column_map(args)) == "torque_log":
         data = read_log(args, args.data, robot.n)
+        if data.n != robot.n:
+            raise DataError(
+                f"{args.data.name}: the log has {data.n} joints; robot {robot.name!r} has "
+                f"{robot.n}; hint: pass the robot the log was recorded with"
+            )
     else:
         data = read_static_file(robot, args.data, args)
+        mismatch = recorded_robot_mismatch(robot, data.metadata)
+        if mismatch is not None:
+            raise DataError(
+                f"{args.data.name}: {mismatch}; hint: pass --robot for the arm that recorded "
+                "the data"
+            )
     band = None
     if args.total_mass is not None:
         v = parse_vector(args.total_mass, "--total-mass", 2)
@@ -273,18 +284,18 @@ def run_consistent(robot: Robot, args: argparse.Namespace) -> int:
             raise DataError(f"--total-mass must be MIN,MAX, 0 <= MIN <= MAX; got {args.total_mass}")
         band = (float(v[0]), float(v[1]))
     kw = {} if args.cutoff is None else {"cutoff_hz": args.cutoff}
-    result = identify_consistent(
-        robot,
-        data,
-        prior=load_prior(args, robot),
-        total_mass=band,
-        options=sdp_options(args),
-        rtol=args.rtol,
-        **kw,
-    )
+    with about(args.data):
+        result = identify_consistent(
+            robot,
+            data,
+            prior=load_prior(args, robot),
+            total_mass=band,
+            options=sdp_options(args),
+            rtol=args.rtol,
+            **kw,
+        )
     if result.identified is None:  # pragma: no cover - identify_consistent always sets it
         raise DataError("the one-step identification returned no unconstrained fit")
-    args.out.mkdir(parents=True, exist_ok=True)
     files = [save_model_json(args.out / "identification.json", result.identified)]
     files += write_outputs(args.out, result, figures=not args.no_figures, source=str(args.data))
     if not args.quiet:
