@@ -82,6 +82,12 @@ def empty_npz(d: Path) -> None:
     (d / "bad.npz").write_bytes(b"")
 
 
+def npz_single_array(d: Path) -> None:
+    """A single .npy array saved under an .npz name."""
+    with open(d / "bad.npz", "wb") as fh:
+        np.save(fh, np.zeros((3, 7)))
+
+
 def npz_short_rows(d: Path) -> None:
     """An NPZ whose recorded row count is larger than its arrays."""
     with np.load(d / "s.npz") as z:
@@ -358,6 +364,8 @@ CASES = [
     C("static-truncated", truncated_static, f"identify --data {{d}}/bad.csv --out {OUT}", 2, "records 60 rows but holds"),
     C("npz-truncated", truncated_npz, f"identify --data {{d}}/bad.npz --out {OUT}", 2, "bad.npz: not a readable NPZ"),
     C("npz-empty", empty_npz, f"identify --data {{d}}/bad.npz --out {OUT}", 2, "bad.npz: not a readable NPZ"),
+    C("npz-single-array", npz_single_array, f"identify --data {{d}}/bad.npz --out {OUT}", 2, "bad.npz: a single array, not an NPZ archive"),
+    C("log-npz-single-array", npz_single_array, f"validate --robot panda --data {{d}}/bad.npz --out {OUT}", 2, "bad.npz: a single .npy array"),
     C("npz-row-count", npz_short_rows, f"identify --data {{d}}/bad.npz --out {OUT}", 2, "records 65 rows but holds 60"),
     C("missing-file", None, f"identify --data {{d}}/nothing.csv --out {OUT}", 2, "nothing.csv"),
     C("log-truncated", truncated_log, f"validate --robot panda --data {{d}}/bad.csv --out {OUT}", 2, "bad.csv: the file records 801 rows but holds 497"),
@@ -611,8 +619,8 @@ def test_sigterm_stops_retrieve_and_its_workers_without_output(base, tmp_path):
 
     out = tmp_path / "feasible"
     proc = _dynid(
-        "retrieve", "--model", str(base / "res" / "identification.json"), "--runs", "4",
-        "--workers", "2", "--seed", "0", "--out", str(out),
+        "retrieve", "--model", str(base / "res" / "identification.json"), "--method",
+        "penalty", "--runs", "4", "--workers", "2", "--seed", "0", "--out", str(out),
     )  # fmt: skip
     assert _wait_for(lambda: len(_children(proc.pid)) >= 2, 60), "workers did not start"
     workers = _children(proc.pid)

@@ -168,7 +168,7 @@ def data_kind(path: Path, columns: Any = None) -> str:
                 keys = set(z.files)
         except (ValueError, EOFError, zipfile.BadZipFile) as exc:
             raise DataError(f"{path.name}: not a readable NPZ file ({exc})") from exc
-        except AttributeError:  # a single .npy array: np.load gives an array
+        except (AttributeError, TypeError):  # a single .npy array: np.load gives an array
             raise DataError(f"{path.name}: a single array, not an NPZ archive") from None
         return "torque_log" if "t" in keys or "tau" in keys else "static"
     raise DataError(f"--data must be a .csv or .npz file; got {path.name!r}")

@@ -316,6 +316,8 @@ def load_static_npz(
             arrays = {k: np.asarray(z[k]) for k in _NPZ_KEYS}
             meta_text = str(z["metadata"]) if "metadata" in keys else "{}"
             n_recorded = _npz_rows(path, z) if "n_rows" in keys else None
+    except (AttributeError, TypeError):  # a single .npy array: np.load gives an array
+        raise DataError(f"{path.name}: a single array, not an NPZ archive of q, M, g") from None
     except (zipfile.BadZipFile, OSError, ValueError, EOFError, KeyError) as exc:
         if isinstance(exc, DataError):
             raise
