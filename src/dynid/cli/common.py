@@ -15,7 +15,7 @@ from typing import Any
 import numpy as np
 
 from .. import _checks, spatial
-from ..exceptions import DynidError, ShapeError
+from ..exceptions import DataError, DynidError, ShapeError
 from ..io._files import open_atomic
 from ..io._json import dumps
 from ..model.panda import panda

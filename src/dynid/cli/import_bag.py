@@ -23,7 +23,7 @@ from pathlib import Path
 from ..identification.log import DEFAULT_CUTOFF_HZ
 from ..io.rosbag import read_joint_state_bag
 from ..io.torque_log import write_torque_log
-from .common import add_robot_options, load_robot, print_json
+from .common import add_robot_options, load_robot, positive_type, print_json
 
 NAME = "import"
 
@@ -45,7 +45,7 @@ def register(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParser:
     )
     p.add_argument(
         "--cutoff",
-        type=float,
+        type=positive_type,
         default=DEFAULT_CUTOFF_HZ,
         metavar="HZ",
         help="low-pass cutoff [Hz] when velocities are derived from positions",

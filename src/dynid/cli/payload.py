@@ -25,9 +25,10 @@ from ..exceptions import DynidError
 from ..feasibility.payload import identify_payload, robot_with_payload
 from ..identification.log import DEFAULT_CUTOFF_HZ
 from ..identification.model import IdentifiedModel
+from ..io._files import write_text
 from ..io.columns import ColumnMap, read_mapped_static_data
 from ..io.payload_json import save_payload_json
-from .common import add_column_options, column_map, read_log
+from .common import add_column_options, column_map, positive_type, read_log
 from .identify import data_kind
 from .validate import load_model_source
 
@@ -54,7 +55,7 @@ def register(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParser:
     p.add_argument("--frame", default="flange", help="frame the load is fixed to")
     p.add_argument("--gravity-only", action="store_true", help="static data: use g alone")
     p.add_argument(
-        "--cutoff", type=float, default=DEFAULT_CUTOFF_HZ, help="torque logs: low-pass [Hz]"
+        "--cutoff", type=positive_type, default=DEFAULT_CUTOFF_HZ, help="torque logs: low-pass [Hz]"
     )
     p.add_argument("--out", type=Path, required=True, help="output folder")
     return p
@@ -85,10 +86,9 @@ def run(args: argparse.Namespace) -> int:
         unloaded=unloaded,
         cutoff_hz=args.cutoff if kind == "torque_log" else None,
     )
-    args.out.mkdir(parents=True, exist_ok=True)
     base = arm.equivalent_robot if isinstance(arm, IdentifiedModel) else arm
     tool = robot_with_payload(base, est)
-    tool.to_toml(args.out / "robot_with_payload.toml")
+    write_text(args.out / "robot_with_payload.toml", tool.to_toml())
     path = save_payload_json(
         args.out / "payload.json", est, kin, with_tool="robot_with_payload.toml"
     )

@@ -19,6 +19,7 @@ from pathlib import Path
 from ..exceptions import DataError
 from ..friction.model import ClassicalFriction
 from ..model.robot import Robot
+from ._files import write_text
 from .mjcf_export import save_mjcf
 from .urdf_export import save_urdf
 
@@ -91,6 +92,4 @@ def save_robot(
         )
     if fmt == "mjcf":
         return save_mjcf(path, robot, friction=friction)
-    path = Path(path)
-    robot.to_toml(path)
-    return path
+    return write_text(path, robot.to_toml())

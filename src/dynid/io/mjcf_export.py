@@ -45,6 +45,7 @@ from ..friction.model import ClassicalFriction
 from ..friction.mujoco import CoulombViscous, coulomb_viscous_from_sigmoid
 from ..model.inertia import inertia6_from_matrix
 from ..model.robot import Robot
+from ._files import write_text
 
 __all__ = ["mjcf_from_robot", "save_mjcf"]
 
@@ -163,5 +164,5 @@ def save_mjcf(path: str | Path, robot: Robot, *, friction: bool | ClassicalFrict
     """Write :func:`mjcf_from_robot` to ``path``; returns the path."""
     path = Path(path)
     text, _ = mjcf_from_robot(robot, friction=friction)
-    path.write_text(text, encoding="utf-8")
+    write_text(path, text)
     return path

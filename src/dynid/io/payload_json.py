@@ -22,7 +22,6 @@ identified). Floats use Python's shortest round-trip representation.
 
 from __future__ import annotations
 
-import json
 from pathlib import Path
 from typing import Any
 
@@ -32,6 +31,7 @@ from .. import __version__, spatial
 from ..feasibility.payload import PayloadEstimate
 from ..model.inertia import INERTIA_ORDER, inertia6_from_matrix
 from ..model.robot import Robot
+from ._json import save_json
 
 __all__ = ["PAYLOAD_SCHEMA", "payload_to_dict", "save_payload_json"]
 
@@ -103,7 +103,4 @@ def save_payload_json(
     path: str | Path, est: PayloadEstimate, robot: Robot, *, with_tool: str | None = None
 ) -> Path:
     """Write :func:`payload_to_dict` to ``path``; returns the path."""
-    path = Path(path)
-    text = json.dumps(payload_to_dict(est, robot, with_tool=with_tool), indent=1, allow_nan=False)
-    path.write_text(text + "\n", encoding="utf-8")
-    return path
+    return save_json(path, payload_to_dict(est, robot, with_tool=with_tool))
