@@ -377,8 +377,8 @@ def prepare_log(
             "no filter: cutoff_hz=None)"
         )
     if cutoff_hz is not None:
-        for k in [k for k in data if filter_tau or k != "tau"]:
-            data[k] = signals.lowpass(data[k], rate, cutoff_hz)
+        for name in [k for k in data if filter_tau or k != "tau"]:
+            data[name] = signals.lowpass(data[name], rate, cutoff_hz)
     if "ddq" not in data:
         data["ddq"] = signals.derivative(t, data["dq"])
     if trim_s is None:
@@ -387,8 +387,8 @@ def prepare_log(
     if keep.sum() < 2:
         raise DataError(f"fewer than 2 samples left after trimming {trim_s:g} s at each end")
 
-    k = np.flatnonzero(keep)
-    rows = slice(int(k[0]), int(k[-1]) + 1)  # trimming keeps one contiguous block
+    kept = np.flatnonzero(keep)
+    rows = slice(int(kept[0]), int(kept[-1]) + 1)  # trimming keeps one contiguous block
 
     def pick(a: NDArray[np.float64]) -> NDArray[np.float64]:
         a.setflags(write=False)  # so that TorqueLog keeps a view, not a copy, of big logs

@@ -35,7 +35,7 @@ import re
 import warnings
 import zipfile
 from pathlib import Path
-from typing import IO
+from typing import IO, Any
 
 import numpy as np
 from numpy.typing import NDArray
@@ -73,11 +73,12 @@ def write_torque_log(path: str | Path, log: TorqueLog) -> Path:
     path = Path(path)
     suffix = path.suffix.lower()
     if suffix == ".npz":
-        arrays = {"t": log.t, "q": log.q, "dq": log.dq, "tau": log.tau}
+        arrays: dict[str, Any] = {"t": log.t, "q": log.q, "dq": log.dq, "tau": log.tau}
         if log.ddq is not None:
             arrays["ddq"] = log.ddq
+        arrays["n_rows"] = np.array(log.n_samples)
         with open_atomic(path, "wb") as f:
-            np.savez(f, n_rows=np.array(log.n_samples), **arrays)
+            np.savez(f, **arrays)
         return path
     if suffix != ".csv":
         raise DataError(f"torque log must be a .csv or .npz file; got {path.name!r}")
@@ -389,7 +390,7 @@ def _fast_parse(
         if flat.size != rows * width:
             return None
         table = flat.reshape(rows, width)
-        if out is not None and row + rows <= n_rows:
+        if out is not None and n_rows is not None and row + rows <= n_rows:
             for k, cols in layout.items():
                 out[k][row : row + rows] = table[:, cols]
         else:
