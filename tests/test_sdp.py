@@ -214,3 +214,29 @@ def test_an_arm_with_a_prismatic_joint_is_retrieved_from_noisy_static_data():
     np.testing.assert_allclose(dynid.gravity_torques(res.robot, q), g, atol=1e-2 * np.abs(g).max())
     M = dynid.mass_matrix(truth, q)
     np.testing.assert_allclose(dynid.mass_matrix(res.robot, q), M, atol=1e-2 * np.abs(M).max())
+
+
+def test_specifications_that_exclude_the_robot_are_reported_not_hidden():
+    """A margin above the truth's fails data_fit and names the options; a total-mass band the
+    data leave open is met and the bounds that decided it are named; a bad covariance is refused."""
+    import dataclasses
+
+    from dynid.exceptions import DataError
+
+    robot = dynid.panda()
+    ctl = dynid.SimulatedController(robot, relative_noise=1e-4, rng=np.random.default_rng(51))
+    data = dynid.acquire_static(ctl, 200, np.random.default_rng(52))
+    model = dynid.identify_static(robot, data)
+    tight = retrieve_sdp(model, prior=robot, options=SDPOptions(margin=0.02))
+    assert not tight.feasible and tight.residual_ratio > 1.1
+    assert any("--margin" in s for s in tight.notes)
+    heavy = retrieve_sdp(model, prior=robot, total_mass=(19.5, 20.0))
+    assert heavy.robot.mass.sum() >= 19.5 - 1e-6
+    assert any("set by the bounds" in s and "total mass" in s for s in heavy.notes)
+    no_cov = dataclasses.replace(model, fit=dataclasses.replace(model.fit, covariance=None))
+    assert any("no covariance" in s for s in retrieve_sdp(no_cov, prior=robot).notes)
+    bad = dataclasses.replace(
+        model, fit=dataclasses.replace(model.fit, covariance=-np.asarray(model.fit.covariance))
+    )
+    with pytest.raises(DataError, match="not positive semidefinite"):
+        retrieve_sdp(bad, prior=robot)

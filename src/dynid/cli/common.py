@@ -165,7 +165,7 @@ def add_consistency_options(p: argparse.ArgumentParser) -> None:
     g.add_argument(
         "--objective",
         choices=("logdet", "euclidean"),
-        default="logdet",
+        default=None,
         help="distance to the prior: log-det (Bregman) divergence (default) or Euclidean",
     )
     g.add_argument(
@@ -206,6 +206,8 @@ def load_prior(args: argparse.Namespace, robot: Robot) -> Robot | None:
             prior = load_feasible_json(path)
         else:
             raise DynidError(f"--prior must be 'panda', a .urdf, .toml or .json file; got {spec!r}")
+    if spec != "panda":
+        prior = prior.replace(name=Path(spec).name)  # reports name the file
     kinds = ("".join("P" if x else "R" for x in r.prismatic) for r in (prior, robot))
     pk, rk = kinds
     if pk != rk:
@@ -225,7 +227,7 @@ def sdp_options(args: argparse.Namespace) -> Any:
     from ..feasibility.sdp import DEFAULT_SDP_MARGIN, SDPOptions
 
     return SDPOptions(
-        objective=args.objective,
+        objective=args.objective or "logdet",
         prior_weight=args.prior_weight,
         margin=DEFAULT_SDP_MARGIN if args.margin is None else args.margin,
     )

@@ -299,6 +299,9 @@ def run(args: argparse.Namespace) -> int:
     """Retrieve, write the outputs, print the summary; 0 if feasible, 1 if not."""
     if args.method == "sdp":
         return run_sdp(args)
+    for flag, value in (("--margin", args.margin), ("--objective", args.objective)):
+        if value is not None:
+            raise DynidError(f"{flag} applies to --method sdp only")
     quiet = bool(getattr(args, "quiet", False))
     try:
         extra_opts = {} if args.prior_weight is None else {"prior_weight": args.prior_weight}

@@ -37,7 +37,8 @@ the published Panda's links lie between 2e-4 and 2e-3 of their trace.
 
 **Solver**: cvxpy with Clarabel, in whitened variables ``X_i = S0_i^{-1} J_i S0_i^{-T}``
 (``J0_i = S0_i S0_i^T``); when the interior-point method stalls it is retried with
-``max_iter=500`` and static regularisation ``1e-7``, then with SCS; a failure raises
+``max_iter=500`` and static regularisation ``1e-7``, then with SCS (``eps=1e-7``, 20 000
+iterations); a failure raises
 :class:`~dynid.exceptions.SolverError` with the solver's status. An equality that no
 consistent set meets is reported (``feasible = False``, status ``"infeasible"``) with the
 closest consistent set (least relative coefficient error) and how far it is.
@@ -55,7 +56,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
-from ..exceptions import InfeasibleError, ModelError, ShapeError, SolverError
+from ..exceptions import DataError, InfeasibleError, ModelError, ShapeError, SolverError
 from ..identification.least_squares import LeastSquaresFit
 from ..identification.model import IdentifiedModel
 from ..model.inertia import inertial_from_phi
@@ -67,6 +68,7 @@ from .constraints import (
     default_bounds,
     feasibility_report,
     params_from_inertial,
+    segment_points,
 )
 from .lmi import (
     log_det_divergence,
@@ -133,8 +135,12 @@ class SDPOptions:
         Masses within ``[m0 / f, f m0]`` of the prior's (intersected with the bounds);
         None: the bounds alone. Not applied with the generic prior (a guess).
     residual_tol : float
-        Two-step: the report's ``data_fit`` holds when the relative residual on the
-        coefficients is below this (weighted fit) or below 1e-6 (equality).
+        The report's ``data_fit`` holds when the parameters reproduce the data: with an
+        exact fit, a relative residual on the coefficients below 1e-6; with a weighted fit,
+        a residual RMS at most ``residual_tol`` (default 10 %) above the unconstrained
+        fit's. Beyond it the result is reported not consistent with the specification: the
+        constraints (margin, bounds, total-mass band) or the prior exclude what the data
+        say.
     tol : float
         Relative tolerance of the feasibility report.
     """
@@ -145,7 +151,7 @@ class SDPOptions:
     margin: float = DEFAULT_SDP_MARGIN
     fit: str = "auto"
     mass_factor: float | None = 3.0
-    residual_tol: float = 0.05
+    residual_tol: float = 0.10
     tol: float = 1e-9
 
     def __post_init__(self) -> None:
@@ -185,6 +191,8 @@ class DataTerm:
         ``k``: 0, or ``3 n`` classical friction coefficients (``fv, fc, fo`` per joint).
     labels : tuple of str
         Names of the entries of ``x``.
+    notes : tuple of str
+        What the user should know about the data term (a missing covariance).
     """
 
     P: NDArray[np.float64]
@@ -194,6 +202,7 @@ class DataTerm:
     exact: bool
     n_friction: int = 0
     labels: tuple[str, ...] = ()
+    notes: tuple[str, ...] = ()
 
     @property
     def r(self) -> int:
@@ -232,11 +241,23 @@ def coefficient_term(model: IdentifiedModel, *, with_friction: bool = False) -> 
     kept_b = kept[:r_all]
     P = model.base.projection[kept_b]
     x_hat = np.asarray(fit.beta, dtype=np.float64)[kept]
-    cov = (
-        np.diag(np.asarray(fit.std, dtype=np.float64) ** 2)
-        if fit.covariance is None
-        else np.asarray(fit.covariance, dtype=np.float64)
-    )[np.ix_(kept, kept)]
+    notes: tuple[str, ...] = ()
+    if fit.covariance is None:
+        cov = np.diag(np.asarray(fit.std, dtype=np.float64) ** 2)
+        notes = (
+            "no covariance of the coefficients (an older file): their standard deviations "
+            "are used as if uncorrelated",
+        )
+    else:
+        cov = np.asarray(fit.covariance, dtype=np.float64)
+    cov = cov[np.ix_(kept, kept)]
+    if cov.size:
+        ev = np.linalg.eigvalsh(0.5 * (cov + cov.T))
+        if ev[0] < -1e-9 * max(float(ev[-1]), 0.0) or not ev[-1] >= 0:
+            raise DataError(
+                "the covariance of the coefficients is not positive semidefinite (eigenvalues "
+                f"{ev[0]:.3g} .. {ev[-1]:.3g}); re-run the identification"
+            )
     rel = fit.relative_error_percent / 100.0
     exact = bool(fit.sigma == 0.0 or rel < EXACT_RTOL or not np.any(cov))
     labels = tuple(
@@ -256,6 +277,7 @@ def coefficient_term(model: IdentifiedModel, *, with_friction: bool = False) -> 
         exact=exact,
         n_friction=int(kept[r_all:].sum()) if k else 0,
         labels=labels,
+        notes=notes,
     )
 
 
@@ -488,7 +510,7 @@ class _Problem:
         attempts: list[tuple[str, dict[str, Any]]] = [
             ("CLARABEL", {}),
             ("CLARABEL", {"max_iter": 500, "static_regularization_constant": 1e-7}),
-            ("SCS", {"eps": 1e-9, "max_iters": 200_000}),
+            ("SCS", {"eps": 1e-7, "max_iters": 20_000}),
         ]
         seen: list[str] = []
         inaccurate = None
@@ -549,6 +571,52 @@ def _polish(phi: NDArray[np.float64], term: DataTerm, prior: Prior) -> NDArray[n
     return x.reshape(phi.shape)
 
 
+def _active_and_implausible(
+    robot: Robot,
+    m: NDArray[np.float64],
+    c: NDArray[np.float64],
+    I: NDArray[np.float64],
+    bounds: Bounds,
+    band: tuple[float, float] | None,
+) -> list[str]:
+    """Notes: the bounds the result sits on (they, not the data, decided those values) and
+    links whose mass or size is implausible (a link under 1 % of the total mass, or a
+    radius of gyration about the CoM larger than the link's extent)."""
+    out: list[str] = []
+    names = robot.link_names[1:]
+    act: list[str] = []
+    for i in range(robot.n):
+        w = max(bounds.mass_max[i] - bounds.mass_min[i], 1e-12)
+        for side, b in (("lower", bounds.mass_min[i]), ("upper", bounds.mass_max[i])):
+            if abs(m[i] - b) <= 1e-4 * w:
+                act.append(f"{names[i]} mass {m[i]:.4g} kg at its {side} bound")
+        for k, ax in enumerate("xyz"):
+            wc = max(bounds.com_max[i, k] - bounds.com_min[i, k], 1e-12)
+            for side, b in (("lower", bounds.com_min[i, k]), ("upper", bounds.com_max[i, k])):
+                if abs(c[i, k] - b) <= 1e-4 * wc:
+                    act.append(f"{names[i]} CoM {ax} {c[i, k]:+.4f} m at its {side} bound")
+    if band is not None:
+        M = float(m.sum())
+        for side, b in (("lower", band[0]), ("upper", band[1])):
+            if abs(M - b) <= 1e-4 * max(band[1] - band[0], 1e-3):
+                act.append(f"total mass {M:.4g} kg at the {side} end of its band")
+    if act:
+        out.append("set by the bounds, not by the data: " + "; ".join(act))
+    M = float(m.sum())
+    lam = np.linalg.eigvalsh(I)
+    for i in range(robot.n):
+        ext = max(float(np.linalg.norm(np.ptp(segment_points(robot, i), axis=0))), 0.05)
+        rg = math.sqrt(max(float(lam[i].sum()), 0.0) / (2.0 * m[i])) if m[i] > 0 else math.inf
+        if m[i] < 0.01 * M:
+            out.append(f"implausible: {names[i]} weighs {m[i]:.3g} kg, under 1 % of the total")
+        elif rg > ext:
+            out.append(
+                f"implausible: {names[i]} has a radius of gyration of {rg:.3g} m about its CoM, "
+                f"more than its extent of {ext:.3g} m"
+            )
+    return out
+
+
 def _finish(
     robot: Robot,
     phi: NDArray[np.float64],
@@ -566,8 +634,13 @@ def _finish(
     t0: float,
     notes: list[str],
 ) -> ConsistentResult:
+    if f is not None and term.n_friction:
+        f = f.copy()
+        f[0::3] = np.maximum(f[0::3], 0.0)  # fv, fc >= 0 held to the solver's tolerance
+        f[1::3] = np.maximum(f[1::3], 0.0)
     m, c, I = inertial_from_phi(phi)
     out = robot.with_params(phi)
+    notes = notes + _active_and_implausible(robot, m, c, I, bounds, band)
     x = term.P @ phi.reshape(-1)
     if f is not None:
         x = np.concatenate([x, f])
@@ -581,9 +654,12 @@ def _finish(
         Constraint("pseudo_inertia", i + 1, float(marg[i]), "1", bool(marg[i] > 0))
         for i in range(robot.n)
     ]
-    if kind == "coefficients":
-        tol = 1e-6 if fit == "equality" else options.residual_tol
-        extra.append(Constraint("data_fit", None, tol - rel, "1", bool(rel <= tol)))
+    if fit == "equality":
+        extra.append(Constraint("data_fit", None, 1e-6 - rel, "1", bool(rel <= 1e-6)))
+    else:
+        over = ratio - 1.0
+        tol = options.residual_tol
+        extra.append(Constraint("data_fit", None, tol - over, "1", bool(over <= tol)))
     report = FeasibilityReport(
         tuple(c for c in rep.constraints if c.name != "inertia_in_bounds") + tuple(extra), rep.tol
     )
@@ -684,6 +760,7 @@ def solve_consistent(
     if pr.n != n:
         raise ShapeError(f"prior {pr.source!r} has {pr.n} links; robot {robot.name!r} has {n}")
     lo, hi, notes = _mass_bounds(pr, b, opts.mass_factor)
+    notes = list(term.notes) + notes
     _check_band(lo, hi, band)
     nb = Bounds(lo, hi, b.com_min, b.com_max, b.inertia_min, b.inertia_max, band, b.link_names)
     equality = opts.fit == "equality" or (opts.fit == "auto" and term.exact)
@@ -723,17 +800,24 @@ def solve_consistent(
             raise InfeasibleError("the bounds and constraints admit no consistent parameters")
         return finish(*prob.values(), opts.prior_weight, "weighted", status)
     w, limit, status, phi, f, search[:] = _auto_weight(prob, term, opts)
+    top = w >= WEIGHT_RANGE[1] * (1 - 1e-9)
     if limit > 1.0 + opts.residual_increase:
         notes.append(
-            f"the data are not consistent with a rigid body within {100 * opts.residual_increase:g}"
-            f" %: the closest consistent fit raises the residual RMS by "
-            f"{100 * (search[0][1] - 1):.2f} %; the prior weight {w:.3g} keeps it within "
-            f"{100 * opts.residual_increase:g} % of that fit"
+            "no parameter set that meets the constraints (margin, bounds, total-mass band) fits "
+            f"the data within {100 * opts.residual_increase:g} %: the closest raises the residual "
+            f"RMS by {100 * (search[0][1] - 1):.2f} % (effects outside the rigid-body model, "
+            "or a constraint that excludes the robot: check --margin, --total-mass, --bounds); "
+            f"the prior weight {w:.3g} keeps it within {100 * opts.residual_increase:g} % of that"
         )
     else:
         notes.append(
-            f"prior weight {w:.3g}: the largest keeping the residual RMS within "
-            f"{100 * opts.residual_increase:g} % of the unconstrained fit"
+            f"prior weight {w:.3g}: "
+            + (
+                "the top of the search range (the data leave the prior almost free)"
+                if top
+                else "the largest keeping the residual RMS within "
+                f"{100 * opts.residual_increase:g} % of the unconstrained fit"
+            )
         )
     return finish(phi, f, w, "weighted", status)
 
