@@ -250,9 +250,10 @@ def test_model_json_round_trip_predicts_identically(tmp_path, panda_model):
         "residual_rms",
         "sigma",
         "n_rows",
+        "scaled_condition_number",
     ):
         assert getattr(back.fit, f) == getattr(model.fit, f)
-    assert back.base.expressions == model.base.expressions
+    assert back.base.expressions == model.base.expressions and back.base.gap == model.base.gap
     np.testing.assert_array_equal(back.base.K_d, model.base.K_d)
     assert back.metadata["dropped_rows"] == ["g1"]
 
@@ -269,6 +270,7 @@ def test_model_json_has_the_documented_keys_and_is_strict_json(tmp_path, panda_m
     for key in (
         "rank",
         "condition_number",
+        "scaled_condition_number",
         "relative_error_percent",
         "dropped_rows",
         "coefficients",

@@ -27,16 +27,17 @@ on the real Panda.
 from __future__ import annotations
 
 import dataclasses
+import warnings
 from typing import Any
 
 import numpy as np
 from numpy.typing import NDArray
 
-from ..exceptions import ShapeError
+from ..exceptions import DynidWarning, RankDeficientError, ShapeError
 from ..model.robot import Robot
-from ..regressors.base import BaseParameters, base_parameters
+from ..regressors.base import BaseParameters, base_parameters, identifiability
 from ..regressors.torque import _torque_regressor
-from .least_squares import LeastSquaresFit, fit_with_pruning
+from .least_squares import LeastSquaresFit, conditioning_advice, fit_with_pruning
 from .log import DEFAULT_CUTOFF_HZ, TorqueLog, prepare_log
 from .model import IdentifiedModel
 
@@ -92,7 +93,7 @@ def identify_from_log(
     max_std_percent: float | None = None,
     friction: bool = True,
     base: BaseParameters | None = None,
-    rtol: float = 1e-10,
+    rtol: float | None = None,
 ) -> IdentifiedModel:
     """Identify base parameters (and linear friction) from a torque log.
 
@@ -120,8 +121,10 @@ def identify_from_log(
         Identify ``fv, fc, fo`` per joint together with the base parameters.
     base : BaseParameters, optional
         Base parameters to use; default ``base_parameters(robot, kind="torque")``.
-    rtol : float
-        Relative rank tolerance of the least squares.
+    rtol : float, optional
+        Relative rank tolerance of the base parameters and of the least squares; default:
+        the base parameters' rank from the first clear gap of the singular values
+        (:func:`dynid.regressors.base.rank_from_gap`) and ``1e-10`` for the fit.
 
     Returns
     -------
@@ -138,7 +141,14 @@ def identify_from_log(
     DataError
         From the preparation of the log (gaps, too short, bad cutoff).
     RankDeficientError
-        The trajectory does not excite every base parameter (and friction column).
+        The trajectory does not excite every base parameter (and friction column); the
+        message names the nearly dependent columns.
+
+    Warns
+    -----
+    DynidWarning
+        Ill-conditioned regressor or coefficients above 1000 % std
+        (:func:`~dynid.identification.least_squares.conditioning_advice`).
     """
     n = robot.n
     if log.n != n:
@@ -150,7 +160,7 @@ def identify_from_log(
         raise ShapeError(f"decimate must be >= 1; got {decimate}")
     sl = slice(None, None, k)
     q, dq, ddq, tau = prepared.q[sl], prepared.dq[sl], prepared.ddq[sl], prepared.tau[sl]
-    bp = base_parameters(robot, kind="torque") if base is None else base
+    bp = base_parameters(robot, kind="torque", rtol=rtol) if base is None else base
     N = q.shape[0]
     Y = _torque_regressor(robot, q, dq, ddq, robot.gravity)
     Yb = Y[..., bp.independent]  # reduce columns before stacking
@@ -158,9 +168,26 @@ def identify_from_log(
         Yb = np.concatenate([Yb, friction_regressor(dq)], axis=-1)
     W = Yb.reshape(N * n, -1)
     y = tau.reshape(-1)
-    fit = fit_with_pruning(W, y, max_std_percent=max_std_percent, rtol=rtol, covariance="classical")
     r = bp.rank
     labels = bp.labels + (friction_labels(n) if friction else ())
+    fit_rtol = 1e-10 if rtol is None else rtol
+    try:
+        fit = fit_with_pruning(
+            W,
+            y,
+            max_std_percent=max_std_percent,
+            rtol=fit_rtol,
+            covariance="classical",
+            labels=labels,
+        )
+    except RankDeficientError as exc:
+        raise RankDeficientError(
+            f"torque log: {exc}; hint: a trajectory that moves every joint at varied "
+            "speeds in both directions excites them (dynid excite optimises one); a joint "
+            "that never moves leaves its friction unidentifiable"
+        ) from exc
+    for msg in conditioning_advice(fit, labels, what="the trajectory"):
+        warnings.warn(msg, DynidWarning, stacklevel=2)
     fr = None
     meta: dict[str, Any] = {
         "route": "classical",
@@ -181,7 +208,10 @@ def identify_from_log(
         "n_duplicates": log.cleaning.n_duplicates,
         "n_gaps": len(log.cleaning.gaps),
         "condition_number": fit.condition_number,
+        "scaled_condition_number": fit.scaled_condition_number,
         "relative_error_percent": fit.relative_error_percent,
+        "rank_gap": None if bp.gap is None else list(bp.gap),
+        "identifiability": dict(zip(bp.std_labels, identifiability(bp), strict=True)),
     }
     if friction:
         fb = np.asarray(fit.beta[r:]).reshape(n, 3)

@@ -5,8 +5,11 @@
 solved on the column-scaled ``W`` (never with a normal-equation inverse); see Method.
 Statistics:
 
-* ``condition_number`` of the column-scaled ``W`` (the paper reports 49 for the static
-  Panda data and 122 for the exciting trajectory);
+* ``condition_number`` ``sigma_max / sigma_min`` of ``W`` itself, unscaled, as Gaz et al.
+  report it (48.9 for the static Panda data, rows ``[tril M; g]`` of their 1010
+  configurations, and 121.88 for the exciting trajectory, base regressor with friction
+  columns), and ``scaled_condition_number`` of the column-scaled ``W`` (unit column
+  norms; the one that decides rank and accuracy, independent of units);
 * ``relative_error_percent`` ``= 100 ||y - W beta|| / ||y||``;
 * ``sigma^2 = ||y - W beta||^2 / (m - r)`` and ``cov(beta) = sigma^2 (W^T W)^{-1}``
   (from ``R^{-1}``), ``std`` its root diagonal and ``std_percent = 100 std / |beta|``
@@ -59,8 +62,12 @@ the pivoted QR would find every ``|R_kk| > rtol |R_00|``, that is full rank; the
 ``cond * rtol < 0.1`` keeps a factor 10 of margin, and everything else (the Cholesky
 factorisation fails, the Gram matrix is not finite or out of range, the condition number
 exceeds the guard) goes to QR, whose rank decision at ``rtol`` and
-:class:`RankDeficientError` are unchanged. ``condition_number`` is ``sigma_max /
-sigma_min`` of the ``R`` used.
+:class:`RankDeficientError` are unchanged. ``scaled_condition_number`` is ``sigma_max /
+sigma_min`` of the ``R`` used and ``condition_number`` that of ``R D`` (``W = Q R D``).
+
+:func:`conditioning_advice` turns a fit into warnings: an ill-conditioned ``W`` (the
+columns that are nearly dependent, from the right singular vector of the smallest
+singular value) and coefficients whose relative standard deviation exceeds 1000 %.
 
 Coefficients whose ``std_percent`` exceeds a threshold (the paper used 30 %) can be
 removed and the rest re-fitted (:func:`fit_with_pruning`).
@@ -68,7 +75,7 @@ removed and the rest re-fitted (:func:`fit_with_pruning`).
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 import scipy.linalg
@@ -77,7 +84,7 @@ from numpy.typing import ArrayLike, NDArray
 from .. import _checks
 from ..exceptions import NonFiniteError, OptionError, RankDeficientError, ShapeError
 
-__all__ = ["LeastSquaresFit", "fit_least_squares", "fit_with_pruning"]
+__all__ = ["LeastSquaresFit", "conditioning_advice", "fit_least_squares", "fit_with_pruning"]
 
 
 @dataclass(frozen=True, slots=True, eq=False)
@@ -97,7 +104,8 @@ class LeastSquaresFit:
     rank : int
         Numerical rank of the (scaled) regressor of the kept columns.
     condition_number : float
-        Of the column-scaled regressor of the kept columns.
+        ``sigma_max / sigma_min`` of the (unscaled) regressor of the kept columns, the
+        figure Gaz et al. 2019 report.
     relative_error_percent : float
     residual_rms : float
     sigma : float
@@ -108,6 +116,17 @@ class LeastSquaresFit:
         Full covariance of ``beta`` (same estimator as ``std``; zero rows and columns for
         removed coefficients), so that ``std = sqrt(diag(covariance))``. None when not
         known (files written before it was kept).
+    scaled_condition_number : float
+        Of the column-scaled regressor (unit column norms) of the kept columns.
+    weakest : ndarray, shape (r,)
+        Unit right singular vector of the smallest singular value of the column-scaled
+        regressor (0 for removed columns): its large entries are the columns that are
+        nearly dependent. Empty when unknown.
+    effect_percent : ndarray, shape (r,)
+        ``100 std_k ||W_k|| / ||y||``: how much one standard deviation of each coefficient
+        moves the fitted data, in % of their norm (0 for removed coefficients; empty when
+        unknown). A coefficient with a large ``std_percent`` but a negligible effect is
+        merely near zero, not undetermined.
     """
 
     beta: NDArray[np.float64]
@@ -122,6 +141,79 @@ class LeastSquaresFit:
     n_rows: int
     rtol: float
     covariance: NDArray[np.float64] | None = None
+    scaled_condition_number: float = float("nan")
+    weakest: NDArray[np.float64] = field(default_factory=lambda: np.zeros(0))
+    effect_percent: NDArray[np.float64] = field(default_factory=lambda: np.zeros(0))
+
+    def nearly_dependent(self, labels: tuple[str, ...], *, share: float = 0.1) -> list[str]:
+        """Labels of the columns that carry the weakest direction (``|v_k| >= share``).
+
+        Sorted by weight, largest first; empty when ``weakest`` is unknown.
+        """
+        v = np.abs(np.asarray(self.weakest))
+        if v.size != len(labels) or not v.any():
+            return []
+        order = np.argsort(-v)
+        return [labels[k] for k in order if v[k] >= share * v.max()]
+
+
+#: Scaled condition number above which :func:`conditioning_advice` warns.
+ILL_CONDITIONED = 1e3
+#: Relative standard deviation [%] above which a kept coefficient is reported...
+LARGE_STD_PERCENT = 1e3
+#: ... unless one standard deviation moves the data by less than this [% of their norm]
+#: (round-off of exact data: the coefficient is zero, not undetermined).
+NEGLIGIBLE_EFFECT_PERCENT = 1e-7
+
+
+def conditioning_advice(
+    fit: LeastSquaresFit, labels: tuple[str, ...], *, what: str = "the data"
+) -> list[str]:
+    """Warnings about a fit's conditioning, each one sentence with a remedy (may be empty).
+
+    Parameters
+    ----------
+    fit : LeastSquaresFit
+    labels : tuple of str, length r
+        Column labels of the fit.
+    what : str
+        Names the data in the messages ("the configurations", "the trajectory").
+    """
+    out = []
+    if fit.scaled_condition_number > ILL_CONDITIONED:
+        cols = fit.nearly_dependent(labels)
+        out.append(
+            f"{what} are ill-conditioned (scaled condition number "
+            f"{fit.scaled_condition_number:.3g} > {ILL_CONDITIONED:g}); nearly dependent "
+            f"columns: {', '.join(cols[:8]) or '?'}; hint: use more or different "
+            "configurations (dynid acquire-static --pool) or a longer, optimised trajectory "
+            "(dynid excite), or fix these parameters (--max-std-percent drops them)"
+        )
+    pct = np.asarray(fit.std_percent)
+    eff = np.asarray(fit.effect_percent)
+    moves = eff > NEGLIGIBLE_EFFECT_PERCENT if eff.shape == pct.shape else np.ones(pct.shape, bool)
+    big = np.flatnonzero(np.asarray(fit.kept) & (pct > LARGE_STD_PERCENT) & moves)
+    if big.size:
+        names = ", ".join(f"{labels[k]} ({pct[k]:.3g} %)" for k in big[:8])
+        out.append(
+            f"{big.size} kept coefficient(s) have a standard deviation above "
+            f"{LARGE_STD_PERCENT:g} %: {names}; they are indistinguishable from zero with "
+            f"{what}; hint: --max-std-percent removes them, or add excitation"
+        )
+    return out
+
+
+def _column_names(
+    labels: tuple[str, ...] | None, v: NDArray[np.float64], keep: NDArray[np.bool_]
+) -> str:
+    """The columns with large weight in ``v`` (a null or weakest direction), named."""
+    a = np.abs(v)
+    if not a.size or not a.max() > 0:
+        return "?"
+    idx = np.flatnonzero(a >= 0.1 * a.max())
+    idx = np.flatnonzero(keep)[idx[np.argsort(-a[idx])][:8]]
+    names = [labels[k] if labels is not None else f"column {k}" for k in idx]
+    return ", ".join(names)
 
 
 def fit_least_squares(
@@ -188,6 +280,7 @@ def _fit(
     covariance: str,
     blocks: ArrayLike | None = None,
     gram: NDArray[np.float64] | None = None,
+    labels: tuple[str, ...] | None = None,
 ) -> LeastSquaresFit:
     """:func:`fit_least_squares` on validated ``W`` (M, r) and ``y`` (M,).
 
@@ -230,8 +323,14 @@ def _fit(
         if solved is None:
             Wu = Wk if used is None else Wk[used]
             _checks.finite("W", W if used is None else Wu)
-            solved = _solve_qr(Wu, yu, rtol, covariance)
-    rank, cond, bk, e, cov_s, scale = solved
+            try:
+                solved = _solve_qr(Wu, yu, rtol, covariance)
+            except _RankDeficient as exc:
+                names = _column_names(labels, exc.null, keep)
+                raise RankDeficientError(
+                    f"{exc.args[0]}; nearly dependent columns: {names}"
+                ) from None
+    rank, cond, bk, e, cov_s, scale, cond_u, vmin = solved
     if not (np.all(np.isfinite(bk)) and np.all(np.isfinite(e)) and np.all(np.isfinite(cov_s))):
         k = int(np.argmax(np.abs(yu)))
         raise NonFiniteError(
@@ -249,23 +348,30 @@ def _fit(
     cov = np.zeros((r, r))
     beta[keep], std[keep] = bk, sk
     cov[np.ix_(keep, keep)] = cov_k
+    ny = float(np.linalg.norm(yu))
+    effect = np.zeros(r)
+    effect[keep] = 100.0 * sk * scale / ny if ny > 0 else 0.0
+    weakest = np.zeros(r)
+    weakest[keep] = vmin
     with np.errstate(divide="ignore", invalid="ignore"):
         pct = np.where(keep, 100.0 * std / np.abs(beta), np.nan)
     pct = np.where(keep & (std == 0.0), 0.0, pct)
-    ny = float(np.linalg.norm(yu))
     return LeastSquaresFit(
         beta=_checks.frozen(beta),
         std=_checks.frozen(std),
         std_percent=_checks.frozen(pct),
         kept=_checks.frozen(keep),
         rank=rank,
-        condition_number=cond,
+        condition_number=cond_u,
         relative_error_percent=100.0 * np.sqrt(ss) / ny if ny > 0 else 0.0,
         residual_rms=float(np.sqrt(ss / m)),
         sigma=float(sigma),
         n_rows=m,
         rtol=rtol,
         covariance=_checks.frozen(cov),
+        scaled_condition_number=cond,
+        weakest=_checks.frozen(weakest),
+        effect_percent=_checks.frozen(effect),
     )
 
 
@@ -356,8 +462,41 @@ _CSNE_RANK_MARGIN = 0.1
 _GRAM_RANGE = (1e-250, 1e250)
 
 _Solved = tuple[
-    int, float, NDArray[np.float64], NDArray[np.float64], NDArray[np.float64], NDArray[np.float64]
+    int,
+    float,
+    NDArray[np.float64],
+    NDArray[np.float64],
+    NDArray[np.float64],
+    NDArray[np.float64],
+    float,
+    NDArray[np.float64],
 ]
+
+
+class _RankDeficient(Exception):
+    """Internal: rank deficiency, with the null direction (column order) for the message."""
+
+    def __init__(self, msg: str, null: NDArray[np.float64]) -> None:
+        super().__init__(msg)
+        self.null = null
+
+
+def _conditioning(
+    R: NDArray[np.float64], scale: NDArray[np.float64]
+) -> tuple[float, float, NDArray[np.float64]]:
+    """Scaled and unscaled condition numbers of ``R`` and ``R D``, and the weakest direction.
+
+    ``R`` (k, k) is the triangular factor of the column-scaled regressor (columns in the
+    order of ``scale``); the unscaled regressor is ``Q R D``. Returns ``(cond(R),
+    cond(R D), v)`` with ``v`` the unit right singular vector of the smallest singular
+    value of ``R``.
+    """
+    _, sv, Vt = np.linalg.svd(R)
+    cond = float(sv[0] / sv[-1]) if sv.size and sv[-1] > 0 else float("inf")
+    su = np.linalg.svd(R * scale[None, :], compute_uv=False)
+    cond_u = float(su[0] / su[-1]) if su.size and su[-1] > 0 else float("inf")
+    v = Vt[-1] if sv.size else np.zeros(0)
+    return cond, cond_u, v
 
 
 def _solve_semi_normal(
@@ -389,10 +528,9 @@ def _solve_semi_normal(
     R, info = scipy.linalg.lapack.dpotrf(Gs, lower=0, clean=1, overwrite_a=1)
     if info != 0:
         return None
-    sv = np.linalg.svd(R, compute_uv=False)
-    if not sv[-1] > 0:
+    cond, cond_u, vmin = _conditioning(R, scale)
+    if not np.isfinite(cond):
         return None
-    cond = float(sv[0] / sv[-1])
     if not (cond <= _CSNE_MAX_COND and cond * rtol < _CSNE_RANK_MARGIN):
         return None
     # R^T R z = D^{-1} W^T y, then one correction with the residual (Björck 1987)
@@ -409,7 +547,7 @@ def _solve_semi_normal(
     else:  # HC1: (R^T R)^{-1} D^{-1} W^T diag(e^2) W D^{-1} (R^T R)^{-1}
         meat = meat / scale[:, None] / scale[None, :]
         cov_s = Gi @ meat @ Gi * (m / dof)
-    return rk, cond, bk, e, cov_s, scale
+    return rk, cond, bk, e, cov_s, scale, cond_u, vmin
 
 
 def _solve_qr(
@@ -417,14 +555,18 @@ def _solve_qr(
 ) -> _Solved:
     """Column-scaled Householder QR with column pivoting (two stages when ``W`` is tall).
 
-    Returns ``(rank, cond, beta, e, cov_s, scale)``: the rank at ``rtol``, the condition
-    number of the scaled ``W``, the estimates, the residual ``y - W beta``, the covariance
-    of the scaled coefficients (divide by ``outer(scale, scale)`` for ``beta``'s).
+    Returns ``(rank, cond, beta, e, cov_s, scale, cond_u, v)``: the rank at ``rtol``, the
+    condition number of the scaled ``W``, the estimates, the residual ``y - W beta``, the
+    covariance of the scaled coefficients (divide by ``outer(scale, scale)`` for
+    ``beta``'s), the condition number of ``W`` unscaled and the weakest direction (column
+    order).
 
     Raises
     ------
     RankDeficientError
-        Fewer rows than columns, or rank below the column count.
+        Fewer rows than columns.
+    _RankDeficient
+        Rank below the column count (with the null direction, for naming the columns).
     """
     m, rk = Wk.shape
     norms = np.sqrt(np.einsum("ij,ij->j", Wk, Wk))
@@ -449,12 +591,14 @@ def _solve_qr(
         raise RankDeficientError(
             f"Regressor rank {rank} < {rk}: {m} rows for {rk} coefficients; add configurations"
         )
-    sv = np.linalg.svd(R, compute_uv=False)
-    cond = float(sv[0] / sv[-1]) if sv[-1] > 0 else float("inf")
+    cond, cond_u, vp = _conditioning(R, scale[piv])
+    vmin = np.empty(rk)
+    vmin[piv] = vp
     if rank < rk:
-        raise RankDeficientError(
-            f"Regressor rank {rank} < {rk} at rtol={rtol:g} (cond {cond:.3g}); add configurations "
-            "or excite the trajectory more, or drop unidentifiable parameters"
+        raise _RankDeficient(
+            f"Regressor rank {rank} < {rk} at rtol={rtol:g} (scaled cond {cond:.3g}); add "
+            "configurations or excite the trajectory more, or drop unidentifiable parameters",
+            vmin,
         )
     z = scipy.linalg.solve_triangular(R, Q.T @ b)
     bs = np.empty(rk)
@@ -474,7 +618,7 @@ def _solve_qr(
         cov_p = G @ meat[np.ix_(piv, piv)] @ G * (m / dof)
     cov_s = np.empty((rk, rk))
     cov_s[np.ix_(piv, piv)] = cov_p
-    return rank, cond, bk, e, cov_s, scale
+    return rank, cond, bk, e, cov_s, scale, cond_u, vmin
 
 
 def fit_with_pruning(
@@ -484,15 +628,17 @@ def fit_with_pruning(
     max_std_percent: float | None = None,
     rtol: float = 1e-10,
     covariance: str = "classical",
+    labels: tuple[str, ...] | None = None,
 ) -> LeastSquaresFit:
     """Fit, then (optionally) remove coefficients with ``std_percent > max_std_percent`` and re-fit.
 
     Gaz et al. 2019 discard coefficients whose relative standard deviation exceeds 30 %.
-    One removal pass, as in the paper. ``covariance`` as in :func:`fit_least_squares`.
+    One removal pass, as in the paper. ``covariance`` as in :func:`fit_least_squares`;
+    ``labels`` (r,) name the columns in a rank-deficiency error.
     """
     W, y = _validated(W, y, covariance)
     return _fit_with_pruning(
-        W, y, max_std_percent=max_std_percent, rtol=rtol, covariance=covariance
+        W, y, max_std_percent=max_std_percent, rtol=rtol, covariance=covariance, labels=labels
     )
 
 
@@ -505,12 +651,15 @@ def _fit_with_pruning(
     covariance: str,
     blocks: ArrayLike | None = None,
     gram: NDArray[np.float64] | None = None,
+    labels: tuple[str, ...] | None = None,
 ) -> LeastSquaresFit:
-    """:func:`fit_with_pruning` on validated input; ``blocks`` and ``gram`` as in :func:`_fit`."""
-    fit = _fit(W, y, rtol=rtol, covariance=covariance, blocks=blocks, gram=gram)
+    """:func:`fit_with_pruning` on validated input; ``blocks``, ``gram``, ``labels`` as in
+    :func:`_fit`."""
+    kw = {"blocks": blocks, "gram": gram, "labels": labels}
+    fit = _fit(W, y, rtol=rtol, covariance=covariance, **kw)
     if max_std_percent is None:
         return fit
     keep = ~(fit.std_percent > max_std_percent)
     if keep.all():
         return fit
-    return _fit(W, y, kept=keep, rtol=rtol, covariance=covariance, blocks=blocks, gram=gram)
+    return _fit(W, y, kept=keep, rtol=rtol, covariance=covariance, **kw)

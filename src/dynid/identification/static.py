@@ -49,19 +49,24 @@ from numpy.typing import ArrayLike, NDArray
 from .. import _checks
 from ..exceptions import DynidWarning, OptionError, RankDeficientError, ShapeError
 from ..model.robot import Robot
-from ..regressors.base import BaseParameters, base_parameters
+from ..regressors.base import BaseParameters, base_parameters, identifiability
 from ..regressors.static import (
     _static_first_columns,
     _static_regressor_columns,
     static_labels,
 )
 from .data import StaticDataset
-from .least_squares import _block_grams, _fit_with_pruning
+from .least_squares import _block_grams, _fit_with_pruning, conditioning_advice
 from .model import IdentifiedModel
 
 __all__ = ["identify_static", "informative_static_rows", "basis_transform", "coefficients_in_basis"]
 
 _log = logging.getLogger(__name__)
+
+#: Rank tolerance of the fit (diagonal of R, column-scaled) when none is given: the base
+#: parameters' columns are independent by construction, so only a degenerate data set
+#: (too few or repeated configurations) falls below it.
+DEFAULT_FIT_RTOL = 1e-10
 
 #: A dropped row whose data exceed this fraction of the largest |entry| triggers a warning:
 #: the robot says the row is identically zero, the data say otherwise.
@@ -101,7 +106,7 @@ def identify_static(
     data: StaticDataset,
     *,
     max_std_percent: float | None = None,
-    rtol: float = 1e-10,
+    rtol: float | None = None,
     base: BaseParameters | None = None,
     std_estimator: str = "robust",
 ) -> IdentifiedModel:
@@ -122,9 +127,12 @@ def identify_static(
     max_std_percent : float, optional
         Remove the coefficients whose relative standard deviation exceeds this (the paper
         used 30 %) and re-fit the rest (one pass); removed coefficients are 0.
-    rtol : float
-        Relative rank tolerance (column-scaled R diagonal) of the base parameters and of
-        the fit, and threshold for uninformative rows (:func:`informative_static_rows`).
+    rtol : float, optional
+        Relative rank tolerance of the base parameters (singular values of the
+        column-scaled regressor), of the fit (diagonal of R) and threshold for
+        uninformative rows (:func:`informative_static_rows`). Default: the base
+        parameters' rank from the first clear gap in the singular values
+        (:func:`dynid.regressors.base.rank_from_gap`), and ``1e-10`` for the rest.
     base : BaseParameters, optional
         The base parameters to identify; default ``base_parameters(robot, rtol=rtol)``
         (the structural ones, from random configurations).
@@ -158,7 +166,10 @@ def identify_static(
     -----
     DynidWarning
         A dropped (identically zero) row holds non-zero data: the gravity vector or the
-        kinematics probably differ from the controller's.
+        kinematics probably differ from the controller's. The regressor is
+        ill-conditioned, or a kept coefficient has a standard deviation above 1000 %
+        (:func:`~dynid.identification.least_squares.conditioning_advice`: the message names
+        the columns and what to do).
 
     Notes
     -----
@@ -177,6 +188,7 @@ def identify_static(
             f"base was built for {base.n_std} standard parameters; robot {robot.name!r} has "
             f"{10 * robot.n}"
         )
+    fit_rtol = DEFAULT_FIT_RTOL if rtol is None else rtol
     N, n, r = data.n_configurations, robot.n, base.rank
     labels = static_labels(n)
     # base regressor with the configurations last: Yb[c, k, b] = coefficient c, row k of
@@ -193,7 +205,7 @@ def identify_static(
     ks = np.arange(len(labels))
     rows = np.column_stack([ks * N, (ks + 1) * N, _static_first_columns(n, base.independent)])
     grams = _block_grams(W, rows)
-    info = _informative(np.einsum("kjj->jk", grams), rtol)
+    info = _informative(np.einsum("kjj->jk", grams), fit_rtol)
     dropped = [labels[k] for k in np.flatnonzero(~info)]
     if dropped:
         big = np.max(np.abs(S[~info]))
@@ -214,18 +226,23 @@ def identify_static(
             W,
             y,
             max_std_percent=max_std_percent,
-            rtol=rtol,
+            rtol=fit_rtol,
             covariance=std_estimator,
             blocks=rows[info],
             gram=grams[info].sum(axis=0),
+            labels=base.labels,
         )
     except RankDeficientError as exc:
-        rank = _rank(Yb[:, info].reshape(r, -1).T, rtol)
+        rank = _rank(Yb[:, info].reshape(r, -1).T, fit_rtol)
+        cols = str(exc).split("nearly dependent columns: ")[-1]
         raise RankDeficientError(
             f"static regressor of {N} configuration(s) ({m} rows) has rank {rank} < {r} "
-            f"needed for the base parameters (rtol={rtol:g}); add configurations spread over "
-            "the joint ranges (Gaz et al. 2019 used 1010)"
+            f"needed for the base parameters (rtol={fit_rtol:g}); nearly dependent columns: "
+            f"{cols}; add configurations spread over the joint ranges (Gaz et al. 2019 used "
+            "1010; dynid acquire-static --pool selects them)"
         ) from exc
+    for msg in conditioning_advice(fit, base.labels, what="the configurations"):
+        warnings.warn(msg, DynidWarning, stacklevel=2)
     pruned = [base.labels[k] for k in np.flatnonzero(~fit.kept)]
     if pruned:
         _log.info(
@@ -242,6 +259,8 @@ def identify_static(
         "max_std_percent": max_std_percent,
         "std_estimator": std_estimator,
         "rtol": rtol,
+        "rank_gap": None if base.gap is None else list(base.gap),
+        "identifiability": dict(zip(base.std_labels, identifiability(base), strict=True)),
         "data": dict(data.metadata),
     }
     return IdentifiedModel(robot=robot, base=base, fit=fit, metadata=meta)

@@ -4,22 +4,26 @@ Layout of the file (top-level keys)::
 
     schema, dynid_version, route, seed,
     rank, condition_number, relative_error_percent, residual_rms, sigma, n_rows, rtol,
-    dropped_rows, pruned, std_estimator,
+    scaled_condition_number, dropped_rows, pruned, std_estimator,
     coefficients: [{"name", "expression", "value", "std", "std_percent", "kept"}, ...],
     covariance: (r x r) covariance of the values, or null,
-    base: {"std_labels", "independent", "dependent", "K_d", "rank", "rtol"},
+    base: {"std_labels", "independent", "dependent", "K_d", "rank", "rtol", "gap"},
     friction: null or (n, 3) linear friction [fv N m s/rad, fc N m, fo N m],
     robot: the kinematics (:mod:`dynid.io.robot_json`),
     metadata: everything else the identification recorded,
     units, conventions
 
-``rank`` is the rank of the fit (the kept coefficients; all of them without pruning),
-``base.rank`` the number of base parameters. ``value`` is the identified base parameter
-``beta_k`` in SI units (the unit of its expression: kg, kg m or kg m^2); ``std`` its
-standard deviation, ``std_percent`` ``100 std / |value|`` (``null`` when undefined:
-removed coefficients); ``kept`` is false for coefficients removed by pruning (their value
-is 0). ``expression`` writes the coefficient in the standard parameters (``m<i>`` kg,
-``mc<i>x`` kg m, ``J<i>xx`` kg m^2 about the link origin, link axes).
+``condition_number`` is that of the unscaled regressor (the figure Gaz et al. report),
+``scaled_condition_number`` that of the column-scaled one; ``base.gap`` the singular
+values either side of the rank cut (relative to the largest; optional on reading, as is
+``scaled_condition_number``). ``rank`` is the rank of the fit (the kept coefficients; all
+of them without pruning), ``base.rank`` the number of base parameters. ``value`` is the
+identified base parameter ``beta_k`` in SI units (the unit of its expression: kg, kg m or
+kg m^2); ``std`` its standard deviation, ``std_percent`` ``100 std / |value|`` (``null``
+when undefined: removed coefficients); ``kept`` is false for coefficients removed by
+pruning (their value is 0). ``expression`` writes the coefficient in the standard
+parameters (``m<i>`` kg, ``mc<i>x`` kg m, ``J<i>xx`` kg m^2 about the link origin, link
+axes).
 
 Floats are written with Python's shortest round-trip representation, so
 :func:`load_model_json` rebuilds a model whose predictions are bit-identical.
@@ -55,6 +59,7 @@ _FIT_SCALARS = (
     "sigma",
     "n_rows",
     "rtol",
+    "scaled_condition_number",
 )
 
 
@@ -120,6 +125,7 @@ def model_to_dict(model: IdentifiedModel, *, seed: int | None = None) -> dict[st
         "K_d": base.K_d.tolist(),
         "rank": base.rank,
         "rtol": base.rtol,
+        "gap": None if base.gap is None else list(base.gap),
     }
     out["friction"] = None if model.friction is None else model.friction.tolist()
     out["robot"] = robot_to_dict(model.robot)
@@ -182,6 +188,7 @@ def model_from_dict(d: Mapping[str, Any]) -> IdentifiedModel:
             rtol=float(b["rtol"]),
             labels=tuple(c["name"] for c in coefs),
             expressions=tuple(c["expression"] for c in coefs),
+            gap=None if b.get("gap") is None else (float(b["gap"][0]), float(b["gap"][1])),
         )
         kept = np.array([bool(c["kept"]) for c in coefs])
         pct = np.array(
@@ -205,6 +212,7 @@ def model_from_dict(d: Mapping[str, Any]) -> IdentifiedModel:
             n_rows=int(d["n_rows"]),
             rtol=float(d["rtol"]),
             covariance=_covariance(d.get("covariance"), r),
+            scaled_condition_number=_float(d.get("scaled_condition_number")),
         )
         friction = d.get("friction")
         if friction is not None:

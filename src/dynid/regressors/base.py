@@ -15,7 +15,17 @@ of dependent ones, printed as ``J3yy + J2zz + 0.099856*m3 + ...``. The coefficie
 significant digits (``clean_digits``).
 
 Columns are scaled to unit norm before the rank decision (parameters mix kg, kg m and
-kg m^2); the rank threshold is ``rtol`` times the largest scaled column norm, returned.
+kg m^2). The rank is read from a clear gap in the singular values ``s`` of the scaled
+regressor (:func:`rank_from_gap`): the first cut, from the top, between ``s[k-1]`` and
+``s[k]`` with ``s[k] <= RANK_FLOOR s[0]`` and ``s[k-1] / s[k] >= RANK_GAP``. A
+near-dependency below that floor (a URDF whose angles are rounded, ``rpy="1.5708 0 0"``,
+leaves singular values near 1e-4 where the exact kinematics have zeros) is a dependency:
+fitting it would give coefficients with standard deviations of 1e8 %. The gap found is
+returned (``gap``, the two singular values relative to ``s[0]``) and ``rtol`` is the cut
+level, their geometric mean. An explicit ``rtol`` instead cuts at ``rtol s[0]``.
+
+:func:`identifiability` classifies every standard parameter: identifiable alone,
+unidentifiable (it acts on nothing) or identifiable only in combination.
 
 Which standard parameters are independent is decided by the pivot order. After scaling
 every column has norm 1, so pivoting on the largest norm (LAPACK's ``geqp3``) would choose
@@ -39,7 +49,22 @@ from ..model.robot import Robot
 from .static import static_regressor
 from .torque import _torque_regressor
 
-__all__ = ["BaseParameters", "base_parameters", "base_parameters_from_regressor"]
+__all__ = [
+    "RANK_FLOOR",
+    "RANK_GAP",
+    "BaseParameters",
+    "base_parameters",
+    "base_parameters_from_regressor",
+    "identifiability",
+    "rank_from_gap",
+]
+
+#: Only singular values (of the column-scaled regressor) at or below this fraction of the
+#: largest may be cut off as a dependency. Above it a direction is identifiable, if
+#: perhaps poorly (the fit warns about ill-conditioning).
+RANK_FLOOR = 1e-3
+#: A rank cut needs at least this ratio between the singular values on either side.
+RANK_GAP = 1e3
 
 
 @dataclass(frozen=True, slots=True, eq=False)
@@ -58,11 +83,15 @@ class BaseParameters:
         Combination coefficients [m or m^2 per entry, as the units demand].
     rank : int
     rtol : float
-        Relative rank threshold used.
+        Relative rank threshold used: the geometric mean of the gap, or the ``rtol`` given.
     labels : tuple of str, length r
         ``beta1 .. beta_r``.
     expressions : tuple of str, length r
         Each base parameter in the standard ones.
+    gap : tuple of float, optional
+        Singular values of the column-scaled regressor just above and just below the rank
+        cut, relative to the largest (``(s[r-1], s[r]) / s[0]``; ``s[r]`` is 0 when the
+        rank is full). None when unknown (a model read from a file).
     """
 
     std_labels: tuple[str, ...]
@@ -73,6 +102,7 @@ class BaseParameters:
     rtol: float
     labels: tuple[str, ...]
     expressions: tuple[str, ...]
+    gap: tuple[float, float] | None = None
 
     @property
     def n_std(self) -> int:
@@ -127,32 +157,81 @@ def _term(coef: float, label: str) -> str:
 INDEPENDENCE_THRESHOLD = 1e-6
 
 
+def rank_from_gap(
+    sv: ArrayLike, rtol: float | None = None
+) -> tuple[int, tuple[float, float], float]:
+    """Rank of a column-scaled regressor from its singular values.
+
+    Parameters
+    ----------
+    sv : array_like, shape (k,)
+        Singular values, in decreasing order.
+    rtol : float, optional
+        If given, the rank is the number of singular values above ``rtol sv[0]``.
+        Otherwise it is read from the first clear gap from the top: the smallest ``k``
+        with ``sv[k] <= RANK_FLOOR sv[0]`` and ``sv[k-1] >= RANK_GAP sv[k]``; without
+        such a gap every singular value counts.
+
+    Returns
+    -------
+    rank : int
+    gap : tuple of float
+        ``(sv[rank-1], sv[rank]) / sv[0]`` (0 past the end).
+    cut : float
+        The relative threshold: ``rtol``, or the geometric mean of the gap (for a full
+        rank, half the smallest relative singular value).
+    """
+    s = np.asarray(sv, dtype=np.float64)
+    if s.size == 0 or not s[0] > 0:
+        return 0, (0.0, 0.0), float(rtol or 0.0)
+    rel = s / s[0]
+    if rtol is not None:
+        r = int(np.sum(rel > rtol))
+    else:
+        r = s.size
+        for k in range(1, s.size):
+            if rel[k] <= RANK_FLOOR and (rel[k] == 0.0 or rel[k - 1] / rel[k] >= RANK_GAP):
+                r = k
+                break
+    above = float(rel[r - 1]) if r > 0 else 1.0
+    below = float(rel[r]) if r < s.size else 0.0
+    if rtol is not None:
+        cut = float(rtol)
+    elif below > 0.0:
+        cut = float(np.sqrt(above * below))
+    else:
+        cut = 0.5 * above if r == s.size else min(1e-12, 0.5 * above)
+    return r, (above, below), cut
+
+
 def _pivoted_r(
-    A: NDArray[np.float64], rtol: float
-) -> tuple[NDArray[np.float64], NDArray[np.intp], int]:
-    """``R`` (min(m, p), p), pivots and rank of a QR with column pivoting of ``A`` (m, p).
+    A: NDArray[np.float64], rtol: float | None
+) -> tuple[NDArray[np.float64], NDArray[np.intp], int, tuple[float, float], float]:
+    """``R`` (min(m, p), p), pivots, rank, gap and cut of a pivoted QR of ``A`` (m, p).
 
     First the triangular factor ``R0`` of ``A`` without pivoting: an orthogonal
-    transformation keeps every column norm and the pivoted factorisation. Then Householder
-    steps on the small ``R0``: at each step the first column (in parameter order) whose
-    remaining norm is at least ``INDEPENDENCE_THRESHOLD`` is chosen; if none is, the
-    column of largest remaining norm while it exceeds ``rtol`` times the first step's
-    largest norm; the rank is the number of steps taken. The choice then depends on the
-    structure of the regressor, not on rounding or on the particular samples.
+    transformation keeps every column norm and the pivoted factorisation. The rank comes
+    from the singular values of ``R0`` (:func:`rank_from_gap`). Then Householder steps on
+    the small ``R0``: at each step the first column (in parameter order) whose remaining
+    norm is at least the cut level (and ``INDEPENDENCE_THRESHOLD``) is chosen; if none
+    is, the column of largest remaining norm; ``rank`` steps are taken. The choice then
+    depends on the structure of the regressor, not on rounding or on the samples.
     """
     m, p = A.shape
     R0 = scipy.linalg.qr(A, mode="r", overwrite_a=True, check_finite=False)[0]
     R = np.array(R0[: min(m, p)], dtype=np.float64)
+    sv = np.linalg.svd(R, compute_uv=False)
+    r_target, gap, cut = rank_from_gap(sv, rtol)
+    s0 = float(sv[0]) if sv.size else 0.0
+    threshold = max(INDEPENDENCE_THRESHOLD, cut * s0)
     piv = np.arange(p)
-    first = None
     rank = 0
-    for k in range(R.shape[0]):
+    for k in range(min(R.shape[0], r_target)):
         norms = np.sqrt(np.einsum("ij,ij->j", R[k:, k:], R[k:, k:]))
         top = norms.max(initial=0.0)
-        first = top if first is None else first
-        if top == 0.0 or top <= rtol * first:
+        if top == 0.0:
             break
-        ok = np.flatnonzero(norms >= INDEPENDENCE_THRESHOLD)
+        ok = np.flatnonzero(norms >= threshold)
         j = k + (int(ok[np.argmin(piv[k + ok])]) if ok.size else int(np.argmax(norms)))
         if j != k:
             R[:, [k, j]] = R[:, [j, k]]
@@ -166,14 +245,14 @@ def _pivoted_r(
             R[k:, k:] -= np.outer(v, (2.0 / vv) * (v @ R[k:, k:]))
         R[k + 1 :, k] = 0.0
         rank = k + 1
-    return np.triu(R), piv, rank
+    return np.triu(R), piv, rank, gap, cut
 
 
 def base_parameters_from_regressor(
     W: ArrayLike,
     std_labels: tuple[str, ...] | None = None,
     *,
-    rtol: float = 1e-10,
+    rtol: float | None = None,
     clean_digits: int = 10,
 ) -> BaseParameters:
     """Base parameters of a stacked regressor.
@@ -183,8 +262,9 @@ def base_parameters_from_regressor(
     W : array_like, shape (m, p)
         Stacked regressor (``m >= p`` rows that excite every identifiable combination).
     std_labels : tuple of str, length p, optional
-    rtol : float
-        Relative rank tolerance on the diagonal of R (scaled columns).
+    rtol : float, optional
+        Relative rank tolerance on the singular values of the scaled columns; default:
+        the rank at the first clear gap (:func:`rank_from_gap`).
     clean_digits : int
         Significant digits kept in ``K_d`` (removes round-off; 0 keeps raw values).
 
@@ -200,7 +280,7 @@ def base_parameters_from_regressor(
     if len(labels) != p:
         raise ShapeError(f"std_labels must have {p} entries; got {len(labels)}")
     norms = np.linalg.norm(W, axis=0)
-    null, scale = _null_and_scale(norms)
+    null, scale = _null_and_scale(norms, rtol)
     Ws = np.empty((m, p), order="F")  # column-major, as LAPACK takes it (no further copy)
     np.divide(W, scale, out=Ws)
     Ws[:, null] = 0.0
@@ -208,12 +288,23 @@ def base_parameters_from_regressor(
 
 
 def _null_and_scale(
-    norms: NDArray[np.float64],
+    norms: NDArray[np.float64], rtol: float | None = None
 ) -> tuple[NDArray[np.bool_], NDArray[np.float64]]:
-    """Columns at round-off level, and the column scales (1 for those)."""
-    # columns at round-off level relative to the largest act on nothing: zero them, since
-    # scaling them to unit norm would turn round-off into a spurious direction
-    null = norms <= 1e-12 * np.max(norms, initial=0.0)
+    """Columns that act on nothing, and the column scales (1 for those).
+
+    A column at round-off level relative to the largest acts on nothing; so does one that
+    lies below a clear gap in the sorted column norms (:func:`rank_from_gap` on the
+    norms): a parameter that acts only through a rounding error of the kinematics (a
+    link mass seen by gravity through an axis tilted by 1e-5 rad). Both are zeroed, since
+    scaling them to unit norm would turn round-off into a spurious direction. With an
+    explicit ``rtol`` the columns at or below ``max(rtol, 1e-12)`` of the largest are.
+    """
+    top = np.max(norms, initial=0.0)
+    null = norms <= (1e-12 if rtol is None else max(rtol, 1e-12)) * top
+    if top > 0 and rtol is None:
+        order = np.argsort(-norms)
+        k = rank_from_gap(norms[order])[0]
+        null[order[k:]] = True
     return null, np.where(null, 1.0, norms)
 
 
@@ -221,7 +312,7 @@ def _from_scaled(
     Ws: NDArray[np.float64],
     scale: NDArray[np.float64],
     labels: tuple[str, ...],
-    rtol: float,
+    rtol: float | None,
     clean_digits: int,
 ) -> BaseParameters:
     """Base parameters from the column-scaled regressor ``Ws`` (m, p), column-major.
@@ -229,12 +320,14 @@ def _from_scaled(
     ``Ws`` is overwritten by its QR factorisation.
     """
     m, p = Ws.shape
-    R, piv, r = _pivoted_r(Ws, rtol)
+    R, piv, r, gap, cut = _pivoted_r(Ws, rtol)
     ind, dep = np.sort(piv[:r]), np.sort(piv[r:])
     # K_d from the scaled problem: Ws_b K = Ws_d  <=>  R11 K = R12 (pivot order); then rows
     # and columns in sorted column order
     Kp = scipy.linalg.solve_triangular(R[:r, :r], R[:r, r:]) if r else np.zeros((0, p - r))
     Ks = Kp[np.argsort(piv[:r])][:, np.argsort(piv[r:])]
+    # a coefficient below the cut level (scaled units) is a rounding effect, not structure
+    Ks = np.where(np.abs(Ks) <= cut, 0.0, Ks)
     K_d = (Ks / scale[ind][:, None]) * scale[dep][None, :]
     if clean_digits:
         K_d = _clean(K_d, clean_digits, float(np.max(np.abs(K_d), initial=0.0)))
@@ -250,9 +343,10 @@ def _from_scaled(
         dependent=_checks.frozen(dep),
         K_d=_checks.frozen(K_d),
         rank=r,
-        rtol=rtol,
+        rtol=cut,
         labels=tuple(f"beta{k + 1}" for k in range(r)),
         expressions=tuple(exprs),
+        gap=gap,
     )
 
 
@@ -262,7 +356,7 @@ def base_parameters(
     kind: str = "static",
     n_samples: int = 64,
     rng: np.random.Generator | None = None,
-    rtol: float = 1e-10,
+    rtol: float | None = None,
 ) -> BaseParameters:
     """Base parameters of a robot's structure, from random states.
 
@@ -277,6 +371,9 @@ def base_parameters(
         velocities and accelerations. Both give the same space for a fixed base.
     rng : numpy.random.Generator, optional
         Source of the random states (default: seeded 0, reproducible).
+    rtol : float, optional
+        Relative rank tolerance; default: the rank at the first clear gap of the singular
+        values (:func:`rank_from_gap`).
     """
     rng = np.random.default_rng(0) if rng is None else rng
     lo = np.where(np.isfinite(robot.q_min), robot.q_min, -np.pi)
@@ -291,3 +388,46 @@ def base_parameters(
     else:
         raise OptionError(f"kind must be 'static' or 'torque'; got {kind!r}")
     return base_parameters_from_regressor(W, robot.param_labels, rtol=rtol)
+
+
+#: Labels of :func:`identifiability`.
+IDENTIFIABLE, UNIDENTIFIABLE, IN_COMBINATION = "identifiable", "unidentifiable", "combination"
+
+
+def identifiability(base: BaseParameters, *, tol: float = 1e-8) -> tuple[str, ...]:
+    """Whether each standard parameter can be identified, alone or only in combination.
+
+    With ``P`` the base projection (``beta = P phi``), a standard parameter ``phi_j`` is
+
+    * ``"identifiable"`` when ``e_j`` lies in the row space of ``P`` (``phi_j`` is a
+      linear function of ``beta``);
+    * ``"unidentifiable"`` when column ``j`` of ``P`` is zero (it acts on nothing);
+    * ``"combination"`` otherwise: it is known only through the base parameters whose
+      expressions contain it.
+
+    Parameters
+    ----------
+    base : BaseParameters
+    tol : float
+        Tolerance on the distance of ``e_j`` from the row space (``e_j`` has norm 1).
+
+    Returns
+    -------
+    status : tuple of str, length p
+        In the order of ``base.std_labels``.
+    """
+    P = base.projection
+    if base.rank == 0:
+        return (UNIDENTIFIABLE,) * base.n_std
+    U = np.linalg.svd(P, full_matrices=False)[2]  # (r, p), orthonormal rows span row(P)
+    inside = np.einsum("kj,kj->j", U, U)  # squared norm of the projection of each e_j
+    col = np.linalg.norm(P, axis=0)
+    out = []
+    for j in range(base.n_std):
+        if col[j] <= tol * max(float(col.max()), 1.0):
+            out.append(UNIDENTIFIABLE)
+        elif inside[j] >= 1.0 - tol:
+            out.append(IDENTIFIABLE)
+        else:
+            out.append(IN_COMBINATION)
+    return tuple(out)
