@@ -23,7 +23,16 @@ import numpy as np
 
 from .robot import Robot
 
-__all__ = ["panda", "PANDA_NEUTRAL_Q"]
+__all__ = [
+    "panda",
+    "PANDA_NEUTRAL_Q",
+    "GAZ2019_EXCITING_A",
+    "GAZ2019_EXCITING_B",
+    "GAZ2019_EXCITING_Q_START",
+    "GAZ2019_EXCITING_W_F",
+    "GAZ2019_EXCITING_DURATION",
+    "GAZ2019_EXCITING_RAMP",
+]
 
 _A = [0.0, 0.0, 0.0, 0.0825, -0.0825, 0.0, 0.088]
 _D = [0.333, 0.0, 0.316, 0.0, 0.384, 0.0, 0.0]
@@ -66,6 +75,40 @@ _TAU_MAX = [87.0, 87.0, 87.0, 87.0, 12.0, 12.0, 12.0]
 #: Neutral pose [rad] (franka_ros' "ready" pose), used as the default start for IK and demos.
 PANDA_NEUTRAL_Q = np.array([0.0, -np.pi / 4, 0.0, -3 * np.pi / 4, 0.0, np.pi / 2, np.pi / 4])
 PANDA_NEUTRAL_Q.setflags(write=False)
+
+
+#: The exciting trajectory of Gaz et al. 2019 (supplementary material Sec. II; their
+#: "Trajectory_1", files ``gen_params.txt`` and ``gen_q0.txt`` of the authors' repository
+#: marcocognetti/FrankaEmikaPandaDynModel, matlab/data/Exciting_Traj): velocity
+#: coefficients ``a`` (cosine) and ``b`` (sine) [rad/s] of 5 harmonics of
+#: ``w_f = 0.15 pi`` rad/s per joint (rows joints 1..7), for 20 s between (1 - cos) ramps
+#: of 0.5 s each, starting at rest at ``GAZ2019_EXCITING_Q_START`` [rad].
+GAZ2019_EXCITING_A = (
+    (-0.2031, 0.1295, -0.0090, 0.2319, -0.7598),
+    (-0.0699, -0.5380, -0.2015, -0.5535, 0.2352),
+    (0.3076, 0.5864, -0.4813, -0.1228, -0.5273),
+    (0.1269, -0.0253, -0.2405, 0.2178, 0.6984),
+    (-0.2773, -0.0857, 0.4810, 0.5311, -0.1639),
+    (0.2100, -0.1194, -0.0950, -0.0964, -0.0399),
+    (-0.2273, -0.5636, -0.2099, 0.5725, -0.3748),
+)
+#: Sine coefficients [rad/s] of the same trajectory (see :data:`GAZ2019_EXCITING_A`).
+GAZ2019_EXCITING_B = (
+    (-0.1136, 0.6600, -0.1858, 0.1867, 0.2357),
+    (-0.2437, 0.1820, -0.2390, -0.2647, 0.4252),
+    (0.3898, -0.0268, 0.0179, 0.4767, 0.2726),
+    (0.0401, -0.1503, 0.2359, -0.2022, 0.3693),
+    (0.5491, 0.1046, 0.0407, -0.0432, 0.2448),
+    (0.0692, -0.6946, -0.4442, -0.5749, -0.0698),
+    (0.2023, -0.2570, -0.5010, 0.0774, -0.4833),
+)
+#: Start (rest) position [rad] of the same trajectory.
+GAZ2019_EXCITING_Q_START = (-0.9584, 0.5622, -1.4576, -2.2141, -2.5711, 3.0661, -0.164597)
+#: Base angular frequency [rad/s], duration of the Fourier part [s] and of the two ramps
+#: together [s] of the same trajectory.
+GAZ2019_EXCITING_W_F = 0.15 * np.pi
+GAZ2019_EXCITING_DURATION = 20.0
+GAZ2019_EXCITING_RAMP = 1.0
 
 
 def panda() -> Robot:

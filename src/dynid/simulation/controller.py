@@ -32,6 +32,7 @@ from dataclasses import dataclass, field
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from .. import _checks
 from ..dynamics.terms import gravity_torques, mass_matrix
 from ..exceptions import LimitError, OptionError
 from ..identification.data import StaticDataset
@@ -39,7 +40,13 @@ from ..model.panda import panda
 from ..model.robot import Robot
 from .unmodelled import UnmodelledEffects
 
-__all__ = ["SimulatedController", "sample_configurations", "acquire_static", "DEFAULT_MARGIN"]
+__all__ = [
+    "SimulatedController",
+    "sample_configurations",
+    "acquire_static",
+    "acquire_static_at",
+    "DEFAULT_MARGIN",
+]
 
 _log = logging.getLogger(__name__)
 
@@ -193,6 +200,18 @@ def acquire_static(
         records the source, the robot name, the noise level and the margin.
     """
     q = sample_configurations(controller.robot, n, rng, margin=margin)
+    return acquire_static_at(controller, q, margin=margin)
+
+
+def acquire_static_at(
+    controller: SimulatedController, q: ArrayLike, *, margin: float | None = None
+) -> StaticDataset:
+    """Query a controller at given static configurations ``q`` (N, dof) [rad].
+
+    ``margin`` is recorded in the metadata only (e.g. the one the configurations were
+    drawn with, :func:`dynid.simulation.static_selection.select_static_configurations`).
+    """
+    q = _checks.as_batch("q", q, (controller.robot.n,)).reshape(-1, controller.robot.n)
     _log.info("acquiring M(q) and g(q) at %d configurations", len(q))
     M, g = controller.read(q)
     meta = {

@@ -1,0 +1,253 @@
+"""Capsule model of a serial arm, obstacles (planes, boxes) and distances for collision checks.
+
+Geometry. Capsule ``k`` (``k = 0 .. n``) is the segment from the origin of link frame ``k``
+to the origin of link frame ``k + 1`` (for ``k = n``, the ``flange``), swept by a sphere
+of radius ``r_k``; it belongs to link ``k`` (0 = the base), and both ends are fixed in
+that link, so its length is a constant of the kinematics. A modified-DH link with both an
+``a`` and a ``d`` offset is an L; the straight segment cuts the corner, which the radius
+covers for radii above about a third of the shorter leg. Default radius
+:data:`DEFAULT_RADIUS` = 0.06 m for every capsule: the Panda's links are 0.11-0.13 m
+across (Franka's collision meshes), so the capsules enclose the arm's cross-section; pass
+``radii`` for another arm, a tool or a gripper.
+
+Self-collision. Two capsules are checked when the links strictly between them are longer
+in total than the sum of their radii ("non-adjacent": a zero-length link, such as the
+Panda's links 1 and 5 whose frame origins coincide with the next one, does not separate
+its neighbours, which touch by construction).
+
+Obstacles, in the base frame [m]: a :class:`Plane` (``point`` and a ``normal`` pointing
+to the free side; a floor or a table top) and axis-aligned :class:`Box` es (``center``,
+``size``). Capsules 0 and 1 (the base and the first link, which only turns about the
+mounting axis) are not checked against obstacles: they stand on the support. The
+distance from a capsule to a box is evaluated at :data:`BOX_SAMPLES` points along the
+segment (exact for planes); its error is at most a half sample spacing times the sine of
+the angle to the nearest face, covered by the margins.
+
+Distances are signed: positive when apart, negative when penetrating [m].
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+
+from .. import _checks
+from ..exceptions import ShapeError
+from ..kinematics.forward import link_poses
+from ..model.robot import Robot
+
+__all__ = [
+    "BOX_SAMPLES",
+    "DEFAULT_RADIUS",
+    "Box",
+    "CapsuleModel",
+    "Obstacles",
+    "Plane",
+    "capsule_model",
+    "capsule_segments",
+    "obstacle_distances",
+    "self_distances",
+]
+
+#: Default capsule radius [m] (see the module docstring).
+DEFAULT_RADIUS = 0.06
+#: Points along a capsule's segment at which its distance to a box is evaluated.
+BOX_SAMPLES = 9
+
+
+@dataclass(frozen=True, slots=True)
+class Plane:
+    """A half-space boundary: ``normal . (p - point) >= 0`` is free [m]."""
+
+    point: tuple[float, float, float]
+    normal: tuple[float, float, float]
+
+    def __post_init__(self) -> None:
+        p = _checks.as_exact("point", self.point, (3,))
+        nrm = _checks.as_exact("normal", self.normal, (3,))
+        norm = float(np.linalg.norm(nrm))
+        if not norm > 0:
+            raise ShapeError("plane normal must be non-zero")
+        object.__setattr__(self, "point", tuple(float(x) for x in p))
+        object.__setattr__(self, "normal", tuple(float(x) / norm for x in nrm))
+
+
+@dataclass(frozen=True, slots=True)
+class Box:
+    """An axis-aligned box in the base frame: ``center`` and edge lengths ``size`` [m]."""
+
+    center: tuple[float, float, float]
+    size: tuple[float, float, float]
+
+    def __post_init__(self) -> None:
+        c = _checks.as_exact("center", self.center, (3,))
+        s = _checks.as_exact("size", self.size, (3,))
+        if np.any(s <= 0):
+            raise ShapeError(f"box size must be positive; got {tuple(s)}")
+        object.__setattr__(self, "center", tuple(float(x) for x in c))
+        object.__setattr__(self, "size", tuple(float(x) for x in s))
+
+
+@dataclass(frozen=True, slots=True)
+class Obstacles:
+    """Planes and boxes around the robot, with names for reports."""
+
+    planes: tuple[Plane, ...] = ()
+    boxes: tuple[Box, ...] = ()
+    names: tuple[str, ...] = field(default=())
+
+    def __post_init__(self) -> None:
+        k = len(self.planes) + len(self.boxes)
+        if not self.names:
+            names = [f"plane{i + 1}" for i in range(len(self.planes))]
+            names += [f"box{i + 1}" for i in range(len(self.boxes))]
+            object.__setattr__(self, "names", tuple(names))
+        elif len(self.names) != k:
+            raise ShapeError(f"obstacles need {k} names (planes, then boxes); got {self.names}")
+
+    def __len__(self) -> int:
+        return len(self.planes) + len(self.boxes)
+
+    @classmethod
+    def floor(cls, height: float = 0.0) -> Obstacles:
+        """The plane ``z = height`` of the base frame, free above (the mounting surface)."""
+        return cls(planes=(Plane((0.0, 0.0, height), (0.0, 0.0, 1.0)),), names=("floor",))
+
+
+@dataclass(frozen=True, slots=True, eq=False)
+class CapsuleModel:
+    """Capsules of a robot: radii, lengths and the self-collision pairs.
+
+    Attributes
+    ----------
+    radii : ndarray, shape (n + 1,)
+        Radius of capsule ``k`` (link ``k``; 0 = base) [m].
+    lengths : ndarray, shape (n + 1,)
+        Segment lengths [m].
+    pairs : ndarray of int, shape (k, 2)
+        Capsule pairs checked for self-collision (``i < j``).
+    """
+
+    radii: NDArray[np.float64]
+    lengths: NDArray[np.float64]
+    pairs: NDArray[np.intp]
+
+
+def capsule_segments(robot: Robot, q: ArrayLike) -> NDArray[np.float64]:
+    """Capsule segment end points in the base frame: (..., n) -> (..., n + 1, 2, 3) [m]."""
+    T = link_poses(robot, q)  # (..., n + 1, 4, 4)
+    fl = robot.frames["flange"]
+    T_f = T[..., fl.link, :, :] @ fl.T_link_frame
+    starts = T[..., :, :3, 3]
+    ends = np.concatenate([T[..., 1:, :3, 3], T_f[..., None, :3, 3]], axis=-2)
+    return np.stack([starts, ends], axis=-2)
+
+
+def capsule_model(robot: Robot, radii: ArrayLike | float | None = None) -> CapsuleModel:
+    """Capsules of ``robot`` with ``radii`` (scalar or (n + 1,); default :data:`DEFAULT_RADIUS`).
+
+    Raises
+    ------
+    ShapeError
+        ``radii`` not a scalar or (n + 1,), or not positive.
+    """
+    n1 = robot.n + 1
+    r = np.full(n1, DEFAULT_RADIUS) if radii is None else np.asarray(radii, dtype=np.float64)
+    if r.ndim == 0:
+        r = np.full(n1, float(r))
+    if r.shape != (n1,) or not np.all(r > 0):
+        raise ShapeError(f"radii must be positive, a scalar or shape ({n1},); got {r}")
+    seg = capsule_segments(robot, np.zeros(robot.n))
+    lengths = np.linalg.norm(seg[:, 1] - seg[:, 0], axis=-1)
+    pairs = [
+        (i, j)
+        for i in range(n1)
+        for j in range(i + 2, n1)
+        if lengths[i + 1 : j].sum() > r[i] + r[j]
+    ]
+    return CapsuleModel(
+        radii=_checks.frozen(r),
+        lengths=_checks.frozen(lengths),
+        pairs=_checks.frozen(np.array(pairs, dtype=np.intp).reshape(-1, 2)),
+    )
+
+
+def _segment_distance(
+    p1: NDArray[np.float64],
+    q1: NDArray[np.float64],
+    p2: NDArray[np.float64],
+    q2: NDArray[np.float64],
+) -> NDArray[np.float64]:
+    """Distance of segments ``p1 q1``, ``p2 q2``: (..., 3) -> (...,) (Ericson 2005, 5.1.9)."""
+    d1, d2, r = q1 - p1, q2 - p2, p1 - p2
+    a = np.einsum("...i,...i", d1, d1)
+    e = np.einsum("...i,...i", d2, d2)
+    f = np.einsum("...i,...i", d2, r)
+    c = np.einsum("...i,...i", d1, r)
+    b = np.einsum("...i,...i", d1, d2)
+    eps = 1e-12
+    with np.errstate(divide="ignore", invalid="ignore"):
+        denom = a * e - b * b
+        s = np.where(
+            denom > eps * np.maximum(a * e, eps), np.clip((b * f - c * e) / denom, 0, 1), 0.0
+        )
+        t = np.where(e > eps, (b * s + f) / e, 0.0)
+        s = np.where(t < 0, np.where(a > eps, np.clip(-c / a, 0, 1), 0.0), s)
+        s = np.where(t > 1, np.where(a > eps, np.clip((b - c) / a, 0, 1), 0.0), s)
+        t = np.clip(t, 0, 1)
+    c1 = p1 + s[..., None] * d1
+    c2 = p2 + t[..., None] * d2
+    return np.linalg.norm(c1 - c2, axis=-1)
+
+
+def self_distances(
+    robot: Robot, q: ArrayLike, model: CapsuleModel, *, segments: NDArray | None = None
+) -> NDArray[np.float64]:
+    """Signed distances of the self-collision pairs: (..., n) -> (..., k) [m].
+
+    ``segments`` (from :func:`capsule_segments`) skips the kinematics when given.
+    """
+    seg = capsule_segments(robot, q) if segments is None else segments
+    i, j = model.pairs[:, 0], model.pairs[:, 1]
+    d = _segment_distance(
+        seg[..., i, 0, :], seg[..., i, 1, :], seg[..., j, 0, :], seg[..., j, 1, :]
+    )
+    return d - model.radii[i] - model.radii[j]
+
+
+def obstacle_distances(
+    robot: Robot,
+    q: ArrayLike,
+    obstacles: Obstacles,
+    model: CapsuleModel,
+    *,
+    segments: NDArray | None = None,
+) -> NDArray[np.float64]:
+    """Signed distance of capsules 2 .. n to each obstacle: (..., n) -> (..., len(obstacles)) [m].
+
+    The smallest over the capsules checked (see the module docstring).
+    """
+    seg = capsule_segments(robot, q) if segments is None else segments
+    seg = seg[..., 2:, :, :]
+    rad = model.radii[2:]
+    out = []
+    for pl in obstacles.planes:
+        nrm, p0 = np.asarray(pl.normal), np.asarray(pl.point)
+        h = np.einsum("...i,i->...", seg - p0, nrm).min(axis=-1) - rad
+        out.append(h.min(axis=-1))
+    if obstacles.boxes:
+        u = np.linspace(0.0, 1.0, BOX_SAMPLES)
+        pts = seg[..., :1, :] + u[:, None] * (seg[..., 1:2, :] - seg[..., :1, :])  # (..., c, S, 3)
+        for bx in obstacles.boxes:
+            c, h = np.asarray(bx.center), 0.5 * np.asarray(bx.size)
+            o = np.abs(pts - c) - h
+            outside = np.linalg.norm(np.maximum(o, 0.0), axis=-1)
+            inside = np.minimum(o.max(axis=-1), 0.0)
+            d = (outside + inside).min(axis=-1) - rad
+            out.append(d.min(axis=-1))
+    if not out:
+        shape = np.shape(seg)[:-3]
+        return np.zeros(shape + (0,))
+    return np.stack(out, axis=-1)

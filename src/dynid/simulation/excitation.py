@@ -1,0 +1,664 @@
+"""Exciting trajectories: finite Fourier series with (1 - cos) ramps, optimised for identification.
+
+Form (Gaz et al. 2019, supplementary material Sec. II). Per joint ``j``, ``L`` harmonics of
+``w_f`` between two ramps of ``T / 2`` each (``T = ramp``); with ``tau = t - T / 2``:
+
+.. math:: \\dot q_j(\\tau) = \\sum_{l=1}^{L} a_{jl} \\cos(l w_f \\tau) + b_{jl} \\sin(l w_f \\tau),
+          \\quad 0 \\le \\tau \\le D
+
+and ``q_j`` its integral. The ramp in, ``dq = (A / 2) (1 - cos(2 pi t / T))`` for
+``0 <= t <= T / 2`` with ``A = dq(tau = 0)``, starts at rest at ``q_start``; the ramp out,
+``dq = (V / 2) (1 + cos(2 pi u / T))`` for ``0 <= u <= T / 2`` with ``V = dq(tau = D)``,
+ends at rest. Total length ``D + T`` (the paper: ``D = 20`` s, ``T = 1`` s,
+``w_f = 0.15 pi`` rad/s, ``L = 5``). The velocity is continuous; the acceleration is
+continuous when ``ddq(tau = 0) = ddq(tau = D) = 0``, which the optimiser imposes (the
+paper's own trajectory has steps there).
+
+Optimisation (:func:`optimise_excitation`). The coefficients and the start position
+minimise the condition number of the classical regressor ``[Y_b(q, dq, ddq), F(dq)]``
+(base parameters of :func:`~dynid.regressors.base.base_parameters` ``kind="torque"``,
+then ``fv, fc, fo`` per joint; unscaled, as Gaz et al. report it; Swevers et al., IEEE TRA
+13(5), 1997, and FIGAROH/FloBaRoID/BIRDy do the same) or, with ``criterion="logdet"``,
+maximise ``log det`` of its column-scaled Gram matrix (D-optimality). Constraints:
+
+* position, velocity and acceleration limits with margins hold by construction: each
+  candidate is scaled per joint into ``[q_min + m_q, q_max - m_q]``,
+  ``|dq| <= dq_max - m_dq`` and ``|ddq| <= (1 - m_ddq) ddq_max`` on a 100 Hz grid, and its
+  start position is the requested one clipped to where the motion fits;
+* torques ``|M ddq + c + g + tau_f(dq)| <= (1 - m_tau) tau_max`` (the model's, with its
+  friction), capsule clearances to obstacles and between non-adjacent links
+  (:mod:`dynid.simulation.collision`) enter as quadratic penalties;
+* the result is checked at 1 kHz; if a torque or clearance is still violated the
+  amplitudes are reduced until none is (``status`` says so).
+
+scipy's L-BFGS-B with finite-difference gradients; the start is the best of ``n_starts``
+seeded random candidates. Seeded and reproducible; ``progress(iteration, max_iter, cond)``
+is called after each iteration.
+"""
+
+from __future__ import annotations
+
+import logging
+from collections.abc import Callable
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+import scipy.optimize
+from numpy.typing import ArrayLike, NDArray
+
+from .. import _checks
+from ..dynamics.rnea import rnea
+from ..exceptions import ShapeError
+from ..friction.model import sigmoid_friction
+from ..identification.classical import friction_regressor
+from ..kinematics.trajectories import Trajectory, uniform_times
+from ..model.robot import Robot
+from ..regressors.base import BaseParameters, base_parameters
+from ..regressors.torque import _torque_regressor
+from .collision import (
+    CapsuleModel,
+    Obstacles,
+    capsule_model,
+    capsule_segments,
+    obstacle_distances,
+    self_distances,
+)
+
+__all__ = [
+    "ExcitationOptions",
+    "ExcitationResult",
+    "ExcitingTrajectory",
+    "excitation_condition_number",
+    "limit_margins",
+    "optimise_excitation",
+]
+
+_log = logging.getLogger(__name__)
+
+
+@dataclass(frozen=True, slots=True, eq=False)
+class ExcitingTrajectory:
+    """Fourier-series joint motion between (1 - cos) ramps, starting and ending at rest.
+
+    Attributes
+    ----------
+    w_f : float
+        Base angular frequency [rad/s].
+    a, b : ndarray, shape (n, L)
+        Cosine and sine velocity coefficients [rad/s].
+    q_start : ndarray, shape (n,)
+        Rest position at ``t = 0`` [rad].
+    duration : float
+        Length ``D`` of the Fourier part [s].
+    ramp : float
+        ``T``: the two ramps together [s] (``T / 2`` each).
+    """
+
+    w_f: float
+    a: NDArray[np.float64]
+    b: NDArray[np.float64]
+    q_start: NDArray[np.float64]
+    duration: float
+    ramp: float = 1.0
+
+    def __post_init__(self) -> None:
+        if not (self.w_f > 0 and self.duration > 0 and self.ramp > 0):
+            raise ShapeError(
+                f"w_f, duration and ramp must be positive; got {self.w_f}, {self.duration}, "
+                f"{self.ramp}"
+            )
+        a = _checks.as_array("a", self.a)
+        if a.ndim != 2:
+            raise ShapeError(f"a must have shape (n, L); got {a.shape}")
+        object.__setattr__(self, "a", _checks.frozen(a))
+        object.__setattr__(self, "b", _checks.frozen(_checks.as_exact("b", self.b, a.shape)))
+        q0 = _checks.as_exact("q_start", self.q_start, (a.shape[0],))
+        object.__setattr__(self, "q_start", _checks.frozen(q0))
+        for k in ("w_f", "duration", "ramp"):
+            object.__setattr__(self, k, float(getattr(self, k)))
+
+    @property
+    def n(self) -> int:
+        """Number of joints."""
+        return self.a.shape[0]
+
+    @property
+    def total_duration(self) -> float:
+        """``duration + ramp`` [s]."""
+        return self.duration + self.ramp
+
+    def __call__(self, t: ArrayLike) -> Trajectory:
+        """Samples at times ``t`` (N,) [s]; at rest at ``q_start`` before 0 and at the end after."""
+        t = _checks.as_array("t", t)
+        if t.ndim != 1:
+            raise ShapeError(f"t must have shape (N,); got {t.shape}")
+        Pq, Pd, Pa = _basis(t, self.w_f, self.a.shape[1], self.duration, self.ramp)
+        c = np.concatenate([self.a, self.b], axis=1)  # (n, 2L)
+        q = self.q_start + Pq @ c.T
+        return Trajectory(t=t, q=q, dq=Pd @ c.T, ddq=Pa @ c.T)
+
+    def sample(self, fs: float = 1000.0) -> Trajectory:
+        """Samples at ``k / fs`` over ``[0, total_duration]`` (N,)."""
+        return self(uniform_times(self.total_duration, fs))
+
+    def to_dict(self) -> dict[str, Any]:
+        """Plain numbers (JSON), with the form's parameters and units."""
+        return {
+            "form": "Fourier series between (1 - cos) ramps (Gaz et al. 2019, suppl. Sec. II)",
+            "w_f_rad_s": self.w_f,
+            "base_frequency_hz": self.w_f / (2 * np.pi),
+            "harmonics": int(self.a.shape[1]),
+            "duration_s": self.duration,
+            "ramp_s": self.ramp,
+            "total_duration_s": self.total_duration,
+            "a_rad_s": self.a.tolist(),
+            "b_rad_s": self.b.tolist(),
+            "q_start_rad": self.q_start.tolist(),
+        }
+
+    @classmethod
+    def from_dict(cls, d: dict[str, Any]) -> ExcitingTrajectory:
+        """Inverse of :meth:`to_dict`."""
+        return cls(
+            w_f=float(d["w_f_rad_s"]),
+            a=np.asarray(d["a_rad_s"], dtype=np.float64),
+            b=np.asarray(d["b_rad_s"], dtype=np.float64),
+            q_start=np.asarray(d["q_start_rad"], dtype=np.float64),
+            duration=float(d["duration_s"]),
+            ramp=float(d["ramp_s"]),
+        )
+
+
+def _basis(
+    t: NDArray[np.float64], w_f: float, L: int, D: float, T: float
+) -> tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.float64]]:
+    """Maps (N, 2L) from the coefficients ``[a, b]`` of one joint to ``q - q_start``, dq, ddq."""
+    lw = w_f * np.arange(1, L + 1)
+    h = 0.5 * T
+    tau = np.clip(t - h, 0.0, D)
+    s, c = np.sin(tau[:, None] * lw), np.cos(tau[:, None] * lw)
+    # Fourier part relative to its start (q = 0 at tau = 0)
+    Fq = np.concatenate([s / lw, (1.0 - c) / lw], axis=1)
+    Fd = np.concatenate([c, s], axis=1)
+    Fa = np.concatenate([-s * lw, c * lw], axis=1)
+    sD, cD = np.sin(D * lw), np.cos(D * lw)
+    A_row = np.concatenate([np.ones(L), np.zeros(L)])  # dq at tau = 0
+    V_row = np.concatenate([cD, sD])  # dq at tau = D
+    qD_row = np.concatenate([sD / lw, (1.0 - cD) / lw])
+    w = 2 * np.pi / T
+    t_in = np.clip(t, 0.0, h)
+    u = np.clip(t - h - D, 0.0, h)
+    # ramp in: q = A/2 (t - sin(w t)/w) over [0, h], then A T / 4 from there on
+    ramp_q_in = 0.5 * (t_in - np.sin(w * t_in) / w)
+    ramp_d_in = np.where(t <= h, 0.5 * (1 - np.cos(w * t_in)), 0.0)
+    ramp_a_in = np.where(t <= h, 0.5 * w * np.sin(w * t_in), 0.0)
+    # ramp out: dq = V/2 (1 + cos(w u)), q = V/2 (u + sin(w u)/w)
+    out = t > h + D
+    ramp_q_out = 0.5 * (u + np.sin(w * u) / w)
+    ramp_d_out = np.where(out, 0.5 * (1 + np.cos(w * u)), 0.0)
+    ramp_a_out = np.where(out, -0.5 * w * np.sin(w * u), 0.0)
+    inside = (t > h) & (t <= h + D)
+    Pq = ramp_q_in[:, None] * A_row + Fq + ramp_q_out[:, None] * V_row
+    Pq[t <= h] = ramp_q_in[t <= h, None] * A_row  # before the Fourier part starts
+    Pq[out] = (h / 2) * A_row + qD_row + ramp_q_out[out, None] * V_row
+    Pd = np.where(inside[:, None], Fd, 0.0) + ramp_d_in[:, None] * A_row
+    Pd += ramp_d_out[:, None] * V_row
+    Pa = np.where(inside[:, None], Fa, 0.0) + ramp_a_in[:, None] * A_row
+    Pa += ramp_a_out[:, None] * V_row
+    return Pq, Pd, Pa
+
+
+@dataclass(frozen=True, slots=True)
+class ExcitationOptions:
+    """Settings of :func:`optimise_excitation` (defaults: the paper's form and margins).
+
+    Attributes
+    ----------
+    duration : float
+        Fourier part [s] (20).
+    harmonics : int
+        ``L`` (5).
+    base_frequency : float
+        ``w_f / (2 pi)`` [Hz] (0.075, the paper's 0.15 pi rad/s).
+    ramp : float
+        Both ramps together [s] (1).
+    position_margin : float
+        Distance kept from the position limits [rad] (5 degrees, the paper's).
+    velocity_margin : float
+        Subtracted from the velocity limits [rad/s] (10 degrees/s, the paper's).
+    acceleration_margin : float
+        Fraction of the acceleration limits kept free (0.1).
+    torque_margin : float
+        Fraction of the torque limits kept free (0.1).
+    obstacle_clearance : float
+        Smallest capsule distance to an obstacle [m] (0.05).
+    self_clearance : float
+        Smallest distance between non-adjacent capsules [m] (0.02).
+    radii : float or tuple of float, optional
+        Capsule radii [m] (default :data:`~dynid.simulation.collision.DEFAULT_RADIUS`).
+    criterion : {"cond", "logdet"}
+        Minimise the (unscaled) condition number, or maximise ``log det`` of the
+        column-scaled Gram matrix.
+    max_iter : int
+        L-BFGS-B iterations (60).
+    max_evaluations : int
+        Objective evaluations allowed to L-BFGS-B (6000; about 14 ms each for the Panda).
+    n_starts : int
+        Random candidates the start is chosen from (16).
+    fs_regressor, fs_limits, fs_collision : float
+        Grids [Hz] of the regressor (5), of the limit and torque checks (100) and of
+        the collision checks (15) during the optimisation; the clearances there are
+        required with 1 cm to spare (the result is checked at 1 kHz).
+    """
+
+    duration: float = 20.0
+    harmonics: int = 5
+    base_frequency: float = 0.075
+    ramp: float = 1.0
+    position_margin: float = float(np.deg2rad(5.0))
+    velocity_margin: float = float(np.deg2rad(10.0))
+    acceleration_margin: float = 0.1
+    torque_margin: float = 0.1
+    obstacle_clearance: float = 0.05
+    self_clearance: float = 0.02
+    radii: float | tuple[float, ...] | None = None
+    criterion: str = "cond"
+    max_iter: int = 60
+    max_evaluations: int = 6000
+    n_starts: int = 16
+    fs_regressor: float = 10.0
+    fs_limits: float = 100.0
+    fs_collision: float = 15.0
+
+    def __post_init__(self) -> None:
+        if self.criterion not in ("cond", "logdet"):
+            raise ShapeError(f"criterion must be 'cond' or 'logdet'; got {self.criterion!r}")
+        if self.harmonics < 1 or not (self.duration > 0 and self.base_frequency > 0):
+            raise ShapeError("harmonics must be >= 1, duration and base_frequency positive")
+        for k in ("acceleration_margin", "torque_margin"):
+            if not 0 <= getattr(self, k) < 1:
+                raise ShapeError(f"{k} must be in [0, 1); got {getattr(self, k)}")
+
+
+@dataclass(frozen=True, slots=True, eq=False)
+class ExcitationResult:
+    """An optimised exciting trajectory and its checks at 1 kHz.
+
+    Attributes
+    ----------
+    trajectory : ExcitingTrajectory
+    condition_number : float
+        Unscaled condition number of ``[Y_b, F]`` along the trajectory (200 Hz samples).
+    scaled_condition_number : float
+        The same with unit column norms.
+    initial_condition_number : float
+        That of the start of the optimisation.
+    margins : dict
+        Smallest margin to every limit at 1 kHz (:func:`limit_margins`), plus
+        ``"obstacles"`` (name -> smallest clearance minus the required one [m]) and
+        ``"self_collision"`` (smallest clearance between non-adjacent capsules minus the
+        required one [m]); all >= 0 when the trajectory is admissible.
+    status : str
+        ``"ok"``, or ``"reduced"`` when the amplitudes had to be reduced after the
+        optimisation.
+    iterations : int
+    evaluations : int
+    history : tuple of float
+        Condition number after each iteration.
+    options : ExcitationOptions
+    obstacles : Obstacles
+    """
+
+    trajectory: ExcitingTrajectory
+    condition_number: float
+    scaled_condition_number: float
+    initial_condition_number: float
+    margins: dict[str, Any]
+    status: str
+    iterations: int
+    evaluations: int
+    history: tuple[float, ...]
+    options: ExcitationOptions
+    obstacles: Obstacles = field(default_factory=Obstacles)
+
+
+def _classical_regressor(
+    robot: Robot, base: BaseParameters, traj: Trajectory
+) -> NDArray[np.float64]:
+    """``[Y_b, F]`` stacked sample-major (N n, r + 3 n)."""
+    Y = _torque_regressor(robot, traj.q, traj.dq, traj.ddq, robot.gravity)[..., base.independent]
+    W = np.concatenate([Y, friction_regressor(np.asarray(traj.dq))], axis=-1)
+    return W.reshape(-1, W.shape[-1])
+
+
+def _conds(W: NDArray[np.float64]) -> tuple[float, float]:
+    s = np.linalg.svd(W, compute_uv=False)
+    nrm = np.linalg.norm(W, axis=0)
+    ss = np.linalg.svd(W / np.where(nrm > 0, nrm, 1.0), compute_uv=False)
+    cu = float(s[0] / s[-1]) if s[-1] > 0 else float("inf")
+    cs = float(ss[0] / ss[-1]) if ss[-1] > 0 else float("inf")
+    return cu, cs
+
+
+def excitation_condition_number(
+    robot: Robot,
+    traj: Trajectory | ExcitingTrajectory,
+    *,
+    base: BaseParameters | None = None,
+    fs: float = 200.0,
+) -> tuple[float, float]:
+    """Unscaled and scaled condition numbers of the classical regressor along a trajectory.
+
+    ``[Y_b(q, dq, ddq), F(dq)]`` (base parameters ``kind="torque"``, then ``fv, fc, fo``
+    per joint; Gaz et al. 2019 report 121.88 for theirs), sampled at ``fs`` [Hz] when an
+    :class:`ExcitingTrajectory` is given, at its own samples otherwise.
+    """
+    base = base_parameters(robot, kind="torque") if base is None else base
+    tr = traj.sample(fs) if isinstance(traj, ExcitingTrajectory) else traj
+    return _conds(_classical_regressor(robot, base, tr))
+
+
+def _motor_torques(robot: Robot, tr: Trajectory) -> NDArray[np.float64]:
+    tau = rnea(robot, tr.q, tr.dq, tr.ddq)
+    if robot.friction is not None:
+        f = np.asarray(robot.friction)
+        tau = tau + sigmoid_friction(tr.dq, f[:, 0], f[:, 1], f[:, 2])
+    return tau
+
+
+def limit_margins(
+    robot: Robot,
+    tr: Trajectory,
+    options: ExcitationOptions = ExcitationOptions(),
+) -> dict[str, list[float]]:
+    """Smallest margin of each joint to each limit, after the required margins (>= 0: ok).
+
+    Keys ``position`` [rad], ``velocity`` [rad/s], ``acceleration`` [rad/s^2] and
+    ``torque`` [N m], each a list of n floats: e.g. ``min_t (q_max - m_q - q_j(t))`` and
+    the same at the lower limit; ``inf`` where a limit is infinite. Torques are the
+    model's (``M ddq + c + g`` plus its friction).
+    """
+    q, dq, ddq = np.asarray(tr.q), np.asarray(tr.dq), np.asarray(tr.ddq)
+    m = options
+    with np.errstate(invalid="ignore"):
+        pos = np.minimum(
+            (robot.q_max - m.position_margin) - q.max(axis=0),
+            q.min(axis=0) - (robot.q_min + m.position_margin),
+        )
+        vel = (robot.dq_max - m.velocity_margin) - np.abs(dq).max(axis=0)
+        acc = (1 - m.acceleration_margin) * robot.ddq_max - np.abs(ddq).max(axis=0)
+        tau = (1 - m.torque_margin) * robot.tau_max - np.abs(_motor_torques(robot, tr)).max(axis=0)
+    return {
+        k: [float(x) for x in v]
+        for k, v in (("position", pos), ("velocity", vel), ("acceleration", acc), ("torque", tau))
+    }
+
+
+class _Problem:
+    """Precomputed grids and maps of one optimisation (internal)."""
+
+    def __init__(
+        self,
+        robot: Robot,
+        opts: ExcitationOptions,
+        obstacles: Obstacles,
+        caps: CapsuleModel,
+        base: BaseParameters,
+        q_start: NDArray[np.float64],
+    ) -> None:
+        self.robot, self.opts, self.obstacles, self.caps, self.base = (
+            robot,
+            opts,
+            obstacles,
+            caps,
+            base,
+        )
+        n, L = robot.n, opts.harmonics
+        self.n, self.L = n, L
+        self.w_f = 2 * np.pi * opts.base_frequency
+        total = opts.duration + opts.ramp
+        D, T = opts.duration, opts.ramp
+        self.t_lim = uniform_times(total, opts.fs_limits)
+        self.t_reg = uniform_times(total, opts.fs_regressor)
+        self.t_col = uniform_times(total, opts.fs_collision)
+        self.B_lim = _basis(self.t_lim, self.w_f, L, D, T)
+        self.B_reg = _basis(self.t_reg, self.w_f, L, D, T)
+        self.B_col = _basis(self.t_col, self.w_f, L, D, T)[0]
+        # continuity of the acceleration at both ends of the Fourier part: C c = 0
+        lw = self.w_f * np.arange(1, L + 1)
+        C = np.stack(
+            [
+                np.concatenate([np.zeros(L), lw]),
+                np.concatenate([-np.sin(D * lw) * lw, np.cos(D * lw) * lw]),
+            ]
+        )
+        self.Pi = np.eye(2 * L) - C.T @ np.linalg.solve(C @ C.T, C)
+        finite = np.isfinite(robot.q_min) & np.isfinite(robot.q_max)
+        self.lo = np.where(finite, robot.q_min + opts.position_margin, -np.pi)
+        self.hi = np.where(finite, robot.q_max - opts.position_margin, np.pi)
+        self.vmax = np.where(np.isfinite(robot.dq_max), robot.dq_max - opts.velocity_margin, 2.0)
+        self.amax = np.where(
+            np.isfinite(robot.ddq_max), (1 - opts.acceleration_margin) * robot.ddq_max, 10.0
+        )
+        self.tmax = (1 - opts.torque_margin) * robot.tau_max
+        self.q_start = q_start
+        self.evaluations = 0
+
+    def coefficients(self, x: NDArray[np.float64]) -> tuple[NDArray, NDArray]:
+        """Coefficients (n, 2L) within the limits and start position (n,) of ``x``."""
+        n, L = self.n, self.L
+        c = x[: n * 2 * L].reshape(n, 2 * L) @ self.Pi.T
+        Pq, Pd, Pa = self.B_lim
+        q, dq, ddq = Pq @ c.T, Pd @ c.T, Pa @ c.T
+        span = q.max(axis=0) - q.min(axis=0)
+        with np.errstate(divide="ignore", invalid="ignore"):
+            s = np.minimum.reduce(
+                [
+                    np.ones(n),
+                    (self.hi - self.lo) / span,
+                    self.vmax / np.abs(dq).max(axis=0),
+                    self.amax / np.abs(ddq).max(axis=0),
+                ]
+            )
+        # 1e-3 to spare: the peaks between the 100 Hz samples are higher by < 5e-4
+        s = np.where(np.isfinite(s), s, 1.0) * (1 - 1e-3)
+        c = c * s[:, None]
+        qmin, qmax = q.min(axis=0) * s, q.max(axis=0) * s
+        tol = 2.5e-4 * (self.hi - self.lo)  # inside the 1e-3 spared by the scaling
+        q0 = np.clip(self.q_start + x[n * 2 * L :], self.lo - qmin + tol, self.hi - qmax - tol)
+        return c, q0
+
+    def trajectory(self, x: NDArray[np.float64]) -> ExcitingTrajectory:
+        c, q0 = self.coefficients(x)
+        return ExcitingTrajectory(
+            self.w_f, c[:, : self.L], c[:, self.L :], q0, self.opts.duration, self.opts.ramp
+        )
+
+    def _traj(self, B: tuple, c: NDArray, q0: NDArray, t: NDArray) -> Trajectory:
+        Pq, Pd, Pa = B
+        return Trajectory(t=t, q=q0 + Pq @ c.T, dq=Pd @ c.T, ddq=Pa @ c.T)
+
+    def objective(self, x: NDArray[np.float64]) -> float:
+        self.evaluations += 1
+        c, q0 = self.coefficients(x)
+        tr = self._traj(self.B_reg, c, q0, self.t_reg)
+        W = _classical_regressor(self.robot, self.base, tr)
+        if self.opts.criterion == "cond":
+            s = np.linalg.svd(W, compute_uv=False)
+            f = float(np.log(s[0] / max(s[-1], 1e-300)))
+        else:
+            nrm = np.linalg.norm(W, axis=0)
+            s = np.linalg.svd(W / np.where(nrm > 0, nrm, 1.0), compute_uv=False)
+            f = -float(np.mean(np.log(np.maximum(s, 1e-300))))
+        return f + self.penalty(c, q0)
+
+    def penalty(self, c: NDArray, q0: NDArray) -> float:
+        pen = 0.0
+        if np.any(np.isfinite(self.tmax)):
+            tr = self._traj(self.B_lim, c, q0, self.t_lim)
+            tau = np.abs(_motor_torques(self.robot, tr)).max(axis=0)
+            with np.errstate(invalid="ignore"):
+                v = np.where(np.isfinite(self.tmax), (tau - self.tmax) / self.tmax, 0.0)
+            pen += float(np.sum(np.maximum(v, 0.0) ** 2))
+        qc = q0 + self.B_col @ c.T
+        seg = capsule_segments(self.robot, qc)
+        o = self.opts
+        if self.caps.pairs.size:
+            d = self_distances(self.robot, qc, self.caps, segments=seg).min(axis=0)
+            pen += float(np.sum(np.maximum(o.self_clearance + 0.01 - d, 0.0) ** 2)) / 0.05**2
+        if len(self.obstacles):
+            d = obstacle_distances(self.robot, qc, self.obstacles, self.caps, segments=seg)
+            d = d.min(axis=0)
+            pen += float(np.sum(np.maximum(o.obstacle_clearance + 0.01 - d, 0.0) ** 2)) / 0.05**2
+        return 100.0 * pen
+
+
+def _check(
+    robot: Robot,
+    traj: ExcitingTrajectory,
+    opts: ExcitationOptions,
+    obstacles: Obstacles,
+    caps: CapsuleModel,
+) -> dict[str, Any]:
+    """Margins at 1 kHz (limits, obstacles, self-collision)."""
+    tr = traj.sample(1000.0)
+    margins: dict[str, Any] = limit_margins(robot, tr, opts)
+    seg = capsule_segments(robot, tr.q)
+    if len(obstacles):
+        d = obstacle_distances(robot, tr.q, obstacles, caps, segments=seg).min(axis=0)
+        margins["obstacles"] = {
+            name: float(v - opts.obstacle_clearance)
+            for name, v in zip(obstacles.names, d, strict=True)
+        }
+    else:
+        margins["obstacles"] = {}
+    if caps.pairs.size:
+        d = self_distances(robot, tr.q, caps, segments=seg).min()
+        margins["self_collision"] = float(d - opts.self_clearance)
+    else:
+        margins["self_collision"] = float("inf")
+    return margins
+
+
+def _violations(m: dict[str, Any]) -> list[str]:
+    """Names of the negative margins (``velocity[3]``, ``obstacles[floor]``, ...)."""
+    out = [
+        f"{k}[{j + 1}] {v:.3g}"
+        for k in ("position", "velocity", "acceleration", "torque")
+        for j, v in enumerate(m[k])
+        if v < -1e-9
+    ]
+    out += [f"obstacles[{k}] {v:.3g}" for k, v in m["obstacles"].items() if v < -1e-9]
+    if m["self_collision"] < -1e-9:
+        out.append(f"self_collision {m['self_collision']:.3g}")
+    return out
+
+
+def _admissible(m: dict[str, Any]) -> bool:
+    vals = [v for k in ("position", "velocity", "acceleration", "torque") for v in m[k]]
+    vals += list(m["obstacles"].values()) + [m["self_collision"]]
+    return bool(np.all(np.asarray(vals) >= -1e-9))
+
+
+def optimise_excitation(
+    robot: Robot,
+    rng: np.random.Generator,
+    options: ExcitationOptions = ExcitationOptions(),
+    *,
+    obstacles: Obstacles | None = None,
+    q_start: ArrayLike | None = None,
+    base: BaseParameters | None = None,
+    progress: Callable[[int, int, float], None] | None = None,
+) -> ExcitationResult:
+    """Optimise an exciting trajectory for the classical identification.
+
+    Parameters
+    ----------
+    robot : Robot
+        Kinematics, dynamics (for the torques), limits and friction.
+    rng : numpy.random.Generator
+        Source of the random starts.
+    options : ExcitationOptions
+    obstacles : Obstacles, optional
+        Default :meth:`Obstacles.floor` (the plane ``z = 0`` of the base frame).
+    q_start : array_like, shape (n,), optional
+        Preferred rest position [rad] (the optimiser moves it where the motion fits);
+        default the middle of the limits (``robot.q_neutral`` if set).
+    base : BaseParameters, optional
+        Default ``base_parameters(robot, kind="torque")``.
+    progress : callable, optional
+        ``progress(iteration, max_iter, condition_number)``.
+
+    Returns
+    -------
+    ExcitationResult
+
+    Raises
+    ------
+    ShapeError
+        ``q_start`` not (n,).
+    """
+    obstacles = Obstacles.floor() if obstacles is None else obstacles
+    base = base_parameters(robot, kind="torque") if base is None else base
+    caps = capsule_model(robot, options.radii)
+    if q_start is None:
+        finite = np.isfinite(robot.q_min) & np.isfinite(robot.q_max)
+        mid = np.where(finite, 0.5 * (robot.q_min + robot.q_max), 0.0)
+        q_start = robot.q_neutral if robot.q_neutral is not None else mid
+    q_start = _checks.as_exact("q_start", q_start, (robot.n,))
+    prob = _Problem(robot, options, obstacles, caps, base, q_start)
+    n, L = robot.n, options.harmonics
+    starts = []
+    for _ in range(max(options.n_starts, 1)):
+        x = np.concatenate([rng.standard_normal(n * 2 * L), 0.3 * rng.standard_normal(n)])
+        starts.append((prob.objective(x), x))
+    f0, x0 = min(starts, key=lambda p: p[0])
+    init_cond = float(np.exp(f0)) if options.criterion == "cond" else float("nan")
+    history: list[float] = []
+
+    def callback(xk: NDArray[np.float64]) -> None:
+        c, q0 = prob.coefficients(xk)
+        tr = prob._traj(prob.B_reg, c, q0, prob.t_reg)
+        cond = _conds(_classical_regressor(robot, base, tr))[0]
+        history.append(cond)
+        if progress is not None:
+            progress(len(history), options.max_iter, cond)
+
+    res = scipy.optimize.minimize(
+        prob.objective,
+        x0,
+        method="L-BFGS-B",
+        callback=callback,
+        options={"maxiter": options.max_iter, "maxfun": options.max_evaluations, "eps": 1e-4},
+    )
+    traj = prob.trajectory(res.x)
+    margins = _check(robot, traj, options, obstacles, caps)
+    status = "ok"
+    shrink = 0
+    while not _admissible(margins) and shrink < 60:
+        _log.info("violated at 1 kHz: %s", _violations(margins))
+        shrink += 1
+        status = "reduced"
+        # smaller excursions about the start stay inside the position limits
+        traj = ExcitingTrajectory(
+            traj.w_f, 0.97 * traj.a, 0.97 * traj.b, traj.q_start, traj.duration, traj.ramp
+        )
+        margins = _check(robot, traj, options, obstacles, caps)
+    if not _admissible(margins):
+        status = "infeasible"
+    cu, cs = excitation_condition_number(robot, traj, base=base)
+    _log.info("excitation: cond %.4g -> %.4g (%s)", init_cond, cu, status)
+    return ExcitationResult(
+        trajectory=traj,
+        condition_number=cu,
+        scaled_condition_number=cs,
+        initial_condition_number=init_cond,
+        margins=margins,
+        status=status,
+        iterations=int(res.nit),
+        evaluations=prob.evaluations,
+        history=tuple(history),
+        options=options,
+        obstacles=obstacles,
+    )
