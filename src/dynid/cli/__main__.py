@@ -33,6 +33,7 @@ SUBCOMMANDS = (
     "acquire_static",
     "identify",
     "predict",
+    "excite",
     "simulate",
     "friction",
     "validate",

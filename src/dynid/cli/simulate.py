@@ -5,6 +5,8 @@ Trajectories:
             default A, T of their Table I for 7 joints), started so that each sweep is
             centred in its joint range
   fourier   a seeded random finite Fourier series (Swevers et al. 1997) inside the limits
+  FILE      a trajectory.csv (t, q, dq, ddq; its own sample times) or trajectory.json
+            (coefficients, sampled at --rate over its whole length) written by `dynid excite`
 
 The measured torques are M ddq + c + g + friction(dq) + noise, with the robot's own
 friction (the published sigmoid for the built-in Panda) unless --no-friction. Limits are
@@ -59,7 +61,12 @@ def register(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParser:
         formatter_class=argparse.RawDescriptionHelpFormatter,
     )
     add_robot_options(p)
-    p.add_argument("--trajectory", choices=("sinusoid", "fourier"), default="sinusoid")
+    p.add_argument(
+        "--trajectory",
+        default="sinusoid",
+        metavar="{sinusoid,fourier,FILE}",
+        help="sinusoid (default), fourier, or a trajectory .csv/.json from dynid excite",
+    )
     p.add_argument("--duration", type=positive_type, default=20.0, help="seconds (default 20)")
     p.add_argument(
         "--rate", type=positive_type, default=1000.0, help="sample rate [Hz] (default 1000)"
@@ -126,7 +133,11 @@ def run(args: argparse.Namespace) -> int:
     rng = np.random.default_rng(args.seed)
     t = sample_times(args.duration, args.rate, jitter_std=args.jitter, rng=rng)
     q0 = None if args.q0 is None else parse_vector(args.q0, "--q0", n)
-    if args.trajectory == "sinusoid":
+    if args.trajectory not in ("sinusoid", "fourier"):
+        from ..io.excitation import load_trajectory
+
+        traj = load_trajectory(Path(args.trajectory), n, fs=args.rate)
+    elif args.trajectory == "sinusoid":
         if n != len(GAZ2019_SINUSOID_AMPLITUDES) and (
             args.amplitudes is None or args.periods is None
         ):
