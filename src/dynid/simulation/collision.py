@@ -197,6 +197,10 @@ def _segment_distance(
         s = np.where(t < 0, np.where(a > eps, np.clip(-c / a, 0, 1), 0.0), s)
         s = np.where(t > 1, np.where(a > eps, np.clip((b - c) / a, 0, 1), 0.0), s)
         t = np.clip(t, 0, 1)
+        # the second segment a point: t = 0 and s from the first segment alone
+        point2 = e <= eps
+        s = np.where(point2, np.where(a > eps, np.clip(-c / np.where(a > eps, a, 1), 0, 1), 0), s)
+        t = np.where(point2, 0.0, t)
     c1 = p1 + s[..., None] * d1
     c2 = p2 + t[..., None] * d2
     return np.linalg.norm(c1 - c2, axis=-1)

@@ -433,7 +433,7 @@ class _Problem:
                 np.concatenate([-np.sin(D * lw) * lw, np.cos(D * lw) * lw]),
             ]
         )
-        self.Pi = np.eye(2 * L) - C.T @ np.linalg.solve(C @ C.T, C)
+        self.Pi = np.eye(2 * L) - np.linalg.pinv(C) @ C  # (rows equal when D w_f = 2 pi k)
         finite = np.isfinite(robot.q_min) & np.isfinite(robot.q_max)
         self.lo = np.where(finite, robot.q_min + opts.position_margin, -np.pi)
         self.hi = np.where(finite, robot.q_max - opts.position_margin, np.pi)
