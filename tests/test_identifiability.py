@@ -16,7 +16,7 @@ from dynid.identification.log import TorqueLog
 from dynid.model.urdf import robot_from_urdf_string
 from dynid.regressors.base import base_parameters, identifiability, rank_from_gap
 from dynid.regressors.static import static_regressor
-from dynid.simulation.controller import SimulatedController, acquire_static
+from dynid.simulation.controller import SimulatedController, acquire_static, acquire_static_at
 
 from conftest import planar_2r, robot_data_urdf
 
@@ -185,6 +185,18 @@ def test_torque_log_rank_error_names_the_friction_columns_of_a_still_joint():
     log = TorqueLog(t=t, q=q, dq=dq, tau=tau, ddq=ddq)
     with pytest.raises(RankDeficientError, match=r"nearly dependent columns: .*(fv7|fc7)"):
         identify_from_log(robot, log, cutoff_hz=None, decimate=1)
+
+
+def test_condition_number_on_the_papers_1010_configurations_is_the_papers_48_9():
+    """Issue 9: the paper's own configurations give its reported 48.9 (unscaled)."""
+    from pathlib import Path
+
+    q = np.loadtxt(Path(__file__).parent / "data" / "gaz2019_static_configurations.txt")
+    assert q.shape == (1010, 7)
+    robot = dynid.panda()
+    model = dynid.identify_static(robot, acquire_static_at(SimulatedController(robot), q))
+    assert round(model.fit.condition_number, 1) == 48.9
+    assert model.fit.scaled_condition_number < 7.0
 
 
 def test_condition_number_is_the_unscaled_one_of_tril_m_and_g_rows():
