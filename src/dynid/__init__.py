@@ -7,11 +7,14 @@ The pipeline, in the order data flows (each name is re-exported here):
   trajectories (:func:`sinusoid_trajectory`, :func:`random_fourier`, :func:`check_limits`)
 * dynamics: :func:`rnea`, :func:`mass_matrix`, :func:`gravity_torques`, :func:`coriolis`,
   :func:`coriolis_matrix`, :func:`forward_dynamics`
-* regressors: :func:`torque_regressor`, :func:`static_regressor`, :func:`base_parameters`
+* regressors: :func:`torque_regressor`, :func:`static_regressor`, :func:`base_parameters`,
+  :func:`identifiability`
 * identification: :func:`identify_static` (Gaz et al. 2019, Sec. IV-A),
   :func:`identify_from_log` (classical route), :class:`IdentifiedModel`
 * friction: :func:`fit_friction`, :func:`sigmoid_friction`, :func:`validate_torques`
-* simulation: :class:`SimulatedController`, :func:`acquire_static`, :func:`simulate_measurement`
+* simulation: :class:`SimulatedController`, :func:`acquire_static`, :func:`simulate_measurement`,
+  :func:`select_static_configurations`, :func:`optimise_excitation` (:class:`ExcitingTrajectory`,
+  :class:`ExcitationOptions`, :class:`Obstacles`)
 * feasibility: see :mod:`dynid.feasibility`
 * files: :mod:`dynid.io`; figures: :mod:`dynid.plots` (matplotlib, imported lazily)
 
@@ -65,21 +68,39 @@ from .kinematics.trajectories import (
 from .model.inertia import inertial_from_phi, param_labels, phi_from_inertial
 from .model.panda import PANDA_NEUTRAL_Q, panda
 from .model.robot import Frame, Robot
-from .regressors.base import BaseParameters, base_parameters
+from .regressors.base import BaseParameters, base_parameters, identifiability
 from .regressors.static import static_regressor
 from .regressors.torque import torque_regressor
-from .simulation.controller import SimulatedController, acquire_static, sample_configurations
+from .simulation.collision import Box, Obstacles, Plane
+from .simulation.controller import (
+    SimulatedController,
+    acquire_static,
+    acquire_static_at,
+    sample_configurations,
+)
+from .simulation.excitation import (
+    ExcitationOptions,
+    ExcitationResult,
+    ExcitingTrajectory,
+    excitation_condition_number,
+    optimise_excitation,
+)
 from .simulation.measurement import SensorNoise, simulate_measurement
+from .simulation.static_selection import StaticSelection, select_static_configurations
 
 __version__ = "0.1.0"
 
 __all__ = [
     "BaseParameters",
+    "Box",
     "ClassicalFriction",
     "ConvergenceError",
     "DataError",
     "DynidError",
     "DynidWarning",
+    "ExcitationOptions",
+    "ExcitationResult",
+    "ExcitingTrajectory",
     "Frame",
     "FrictionFit",
     "IKOptions",
@@ -90,7 +111,9 @@ __all__ = [
     "LimitError",
     "ModelError",
     "NonFiniteError",
+    "Obstacles",
     "PANDA_NEUTRAL_Q",
+    "Plane",
     "RankDeficientError",
     "Robot",
     "SensorNoise",
@@ -99,22 +122,26 @@ __all__ = [
     "SigmoidFriction",
     "SimulatedController",
     "StaticDataset",
+    "StaticSelection",
     "TorqueLog",
     "Trajectory",
     "UnknownNameError",
     "Validation",
     "__version__",
     "acquire_static",
+    "acquire_static_at",
     "base_parameters",
     "check_limits",
     "classical_friction",
     "coriolis",
     "coriolis_matrix",
+    "excitation_condition_number",
     "fit_friction",
     "fit_least_squares",
     "fk",
     "forward_dynamics",
     "gravity_torques",
+    "identifiability",
     "identify_from_log",
     "identify_static",
     "ik",
@@ -124,6 +151,7 @@ __all__ = [
     "joint_transforms",
     "link_poses",
     "mass_matrix",
+    "optimise_excitation",
     "panda",
     "param_labels",
     "phi_from_inertial",
@@ -131,6 +159,7 @@ __all__ = [
     "rnea",
     "sample_configurations",
     "scale_into_limits",
+    "select_static_configurations",
     "sigmoid_friction",
     "simulate_measurement",
     "sinusoid_trajectory",
