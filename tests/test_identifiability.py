@@ -132,6 +132,9 @@ def test_rounded_arm_identification_predicts_held_out_m_and_g(rounded_arm, noise
     # noise-free: the rounding (about 1e-5 rad) bounds the error; noisy: the noise level
     bound = 1e-9 if noise == 0 else 20 * noise
     assert eM < bound and eg < bound
+    dq, ddq = np.random.default_rng(14).uniform(-1, 1, (2, 100, 6))
+    tau = dynid.rnea(rounded_arm, q, dq, ddq)
+    assert np.abs(model.torques(q, dq, ddq) - tau).max() < bound * np.abs(tau).max()
     assert model.fit.scaled_condition_number < 20
     fit = model.fit
     loud = np.flatnonzero(fit.kept & (fit.std_percent > 1e3) & (fit.effect_percent > 1e-7))
