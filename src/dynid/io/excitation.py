@@ -29,7 +29,7 @@ from .. import __version__
 from ..exceptions import DataError, DynidError
 from ..kinematics.trajectories import Trajectory
 from ..model.robot import Robot
-from ..simulation.collision import Box, Obstacles, Plane
+from ..simulation.collision import Box, Obstacles, Plane, capsule_model
 from ..simulation.excitation import ExcitationResult, ExcitingTrajectory
 
 __all__ = [
@@ -136,7 +136,7 @@ def save_excitation_json(
             "obstacle_clearance_m": o.obstacle_clearance,
             "self_clearance_m": o.self_clearance,
         },
-        "capsule_radii_m": None if o.radii is None else o.radii,
+        "capsule_radii_m": capsule_model(robot, o.radii).radii.tolist(),
         "obstacles": obstacles_to_dict(result.obstacles),
         "smallest_margins_at_1khz": {
             "position_rad": result.margins["position"],
