@@ -213,6 +213,7 @@ def test_condition_number_is_the_unscaled_one_of_tril_m_and_g_rows():
     assert model.fit.scaled_condition_number == pytest.approx(np.linalg.cond(Ws), rel=1e-8)
 
 
+@pytest.mark.parametrize("noise", [0.0, 1e-4])
 @pytest.mark.parametrize(
     ("rel", "base", "tip"),
     [
@@ -222,18 +223,24 @@ def test_condition_number_is_the_unscaled_one_of_tril_m_and_g_rows():
         ("so_arm_description/urdf/so100.urdf", None, None),
     ],
 )
-def test_example_robot_data_arms_identify_from_noisy_static_data(rel, base, tip):
-    """Arms of example-robot-data: 1e-4 noise, held-out M and g to the noise level."""
+def test_example_robot_data_arms_identify_from_static_data(rel, base, tip, noise):
+    """Arms of example-robot-data, noise-free and 1e-4: held-out M, g and tau to the truth's
+    accuracy (round-off, or the noise level); the rank cut sits in a clear gap."""
     robot = dynid.Robot.from_urdf(robot_data_urdf(rel), base, tip)
-    ctrl = SimulatedController(robot, 1e-4, rng=np.random.default_rng(51))
+    ctrl = SimulatedController(robot, noise, rng=np.random.default_rng(51))
     data = acquire_static(ctrl, 500, np.random.default_rng(52))
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", DynidWarning)
         model = dynid.identify_static(robot, data)
     lo = np.maximum(robot.q_min, -np.pi)
     hi = np.minimum(robot.q_max, np.pi)
-    q = np.random.default_rng(53).uniform(lo, hi, (100, robot.n))
+    rng = np.random.default_rng(53)
+    q = rng.uniform(lo, hi, (100, robot.n))
+    dq, ddq = rng.uniform(-1, 1, (2, 100, robot.n))
+    bound = 1e-9 if noise == 0 else 2e-3
     M, g = dynid.mass_matrix(robot, q), dynid.gravity_torques(robot, q)
-    assert np.abs(model.mass_matrix(q) - M).max() < 2e-3 * np.abs(M).max()
-    assert np.abs(model.gravity_torques(q) - g).max() < 2e-3 * np.abs(g).max()
+    tau = dynid.rnea(robot, q, dq, ddq)
+    assert np.abs(model.mass_matrix(q) - M).max() < bound * np.abs(M).max()
+    assert np.abs(model.gravity_torques(q) - g).max() < bound * np.abs(g).max()
+    assert np.abs(model.torques(q, dq, ddq) - tau).max() < bound * np.abs(tau).max()
     assert model.base.gap[0] > 1e-2 and model.base.gap[1] < 1e-10
