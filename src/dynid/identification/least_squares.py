@@ -655,11 +655,19 @@ def _fit_with_pruning(
 ) -> LeastSquaresFit:
     """:func:`fit_with_pruning` on validated input; ``blocks``, ``gram``, ``labels`` as in
     :func:`_fit`."""
-    kw = {"blocks": blocks, "gram": gram, "labels": labels}
-    fit = _fit(W, y, rtol=rtol, covariance=covariance, **kw)
+    fit = _fit(W, y, rtol=rtol, covariance=covariance, blocks=blocks, gram=gram, labels=labels)
     if max_std_percent is None:
         return fit
     keep = ~(fit.std_percent > max_std_percent)
     if keep.all():
         return fit
-    return _fit(W, y, kept=keep, rtol=rtol, covariance=covariance, **kw)
+    return _fit(
+        W,
+        y,
+        kept=keep,
+        rtol=rtol,
+        covariance=covariance,
+        blocks=blocks,
+        gram=gram,
+        labels=labels,
+    )

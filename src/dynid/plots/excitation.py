@@ -73,9 +73,13 @@ def plot_excitation(
         for bx in obstacles.boxes:
             from matplotlib.patches import Rectangle
 
-            c, s = bx.center, bx.size
-            ax_xz.add_patch(Rectangle((c[0] - s[0] / 2, c[2] - s[2] / 2), s[0], s[2], fc="0.7"))
-            ax_xy.add_patch(Rectangle((c[0] - s[0] / 2, c[1] - s[1] / 2), s[0], s[1], fc="0.7"))
+            ctr, sz = bx.center, bx.size
+            ax_xz.add_patch(
+                Rectangle((ctr[0] - sz[0] / 2, ctr[2] - sz[2] / 2), sz[0], sz[2], fc="0.7")
+            )
+            ax_xy.add_patch(
+                Rectangle((ctr[0] - sz[0] / 2, ctr[1] - sz[1] / 2), sz[0], sz[1], fc="0.7")
+            )
     ax_xz.set_title("swept capsules (side view)")
     ax_xy.set_title("swept capsules (top view)")
     fig.suptitle(title or f"exciting trajectory of {robot.name}")

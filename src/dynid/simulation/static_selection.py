@@ -29,7 +29,7 @@ from collections.abc import Callable
 from dataclasses import dataclass
 
 import numpy as np
-from numpy.typing import NDArray
+from numpy.typing import ArrayLike, NDArray
 
 from .. import _checks
 from ..exceptions import LimitError, ShapeError
@@ -90,7 +90,7 @@ def _collision_free_pool(
     rng: np.random.Generator,
     margin: float,
     obstacles: Obstacles | None,
-    radii: object,
+    radii: float | ArrayLike | None,
     clearance: float,
 ) -> NDArray[np.float64]:
     caps = capsule_model(robot, radii)
@@ -122,7 +122,7 @@ def select_static_configurations(
     pool_factor: int = 5,
     margin: float = DEFAULT_MARGIN,
     obstacles: Obstacles | None = None,
-    radii: object = None,
+    radii: float | ArrayLike | None = None,
     clearance: float = 0.0,
     batches: int = 50,
     exchange: int = 40,
