@@ -114,6 +114,7 @@ def test_rounded_urdf_angles_give_the_rank_of_the_exact_kinematics(rounded_arm):
     assert tilt.any() and np.all(n[tilt] < 1e-4 * n.max())
     # a fixed tolerance below the near-dependencies keeps them (the behaviour of issue 9)
     assert base_parameters(rounded_arm, rtol=1e-10).rank > 32
+    assert base_parameters(rounded_arm, rtol=1e-4).rank == 32  # the threshold --help suggests
 
 
 @pytest.mark.parametrize("noise", [0.0, 1e-4])
@@ -162,7 +163,7 @@ def test_identify_help_documents_rtol_and_max_std_percent(capsys):
     with pytest.raises(SystemExit):
         main(["identify", "--help"])
     out = " ".join(capsys.readouterr().out.split())
-    assert "default: the first clear gap" in out and "1e-6" in out
+    assert "default: the first clear gap" in out and "1e-4" in out
     assert "default: keep all" in out and "paper: 30" in out and "Pruning" in out
 
 
