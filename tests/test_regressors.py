@@ -89,19 +89,33 @@ def test_base_expressions_use_exact_kinematic_constants(panda):
     text = " ".join(bp.expressions)
     for const in ("0.099856*m3", "0.632*mc3z", "0.007744*m7", "0.768*mc5z"):
         assert const in text
-    assert "J2yy + J1zz" in bp.expressions or "J1zz" in text
+    # joint 1's axis sees J1zz plus link 2's inertia about the axis it shares at q2 = 0
+    # (the MDH frames of links 1 and 2 share their origin; alpha_1 = -pi/2 turns z1 into y2)
+    assert "J1zz + J2yy" in bp.expressions
 
 
 def test_planar_2r_base_parameters_match_closed_form():
-    """Planar 2R in a vertical plane: 6 base parameters (Khalil and Dombre).
+    """Planar 2R in a vertical plane: the 6 base parameters of Khalil and Dombre.
 
-    ZZ1R, MX1R, MY1, ZZ2, MX2, MY2.
+    ZZ1R = J1zz + l1^2 m2, MX1R = mc1x + l1 m2, MY1 = mc1y, ZZ2 = J2zz, MX2 = mc2x,
+    MY2 = mc2y (J about the link origins): the identified combinations span exactly these.
     """
-    r = planar_2r()
+    l1 = 0.7
+    r = planar_2r(l1=l1)
     bp = base_parameters(r)
+    labels = r.param_labels
+    C = np.zeros((6, 20))
+    idx = {name: k for k, name in enumerate(labels)}
+    C[0, idx["J1zz"]], C[0, idx["m2"]] = 1.0, l1**2
+    C[1, idx["mc1x"]], C[1, idx["m2"]] = 1.0, l1
+    for row, name in enumerate(("mc1y", "J2zz", "mc2x", "mc2y"), start=2):
+        C[row, idx[name]] = 1.0
+    P = bp.projection
+    assert bp.rank == 6
+    assert np.linalg.matrix_rank(C) == 6
+    assert np.linalg.matrix_rank(np.vstack([P, C]), tol=1e-9) == 6  # same row space
     W = static_regressor(r, np.random.default_rng(15).uniform(-3, 3, (50, 2))).reshape(-1, 20)
     assert bp.rank == np.linalg.matrix_rank(W)
-    assert bp.rank == 6
 
 
 def test_rank_of_rank_deficient_regressor_is_reported():

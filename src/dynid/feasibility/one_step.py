@@ -44,7 +44,7 @@ def identify_consistent(
     constraints: Sequence[Callable[..., Any]] = (),
     cutoff_hz: float | None = DEFAULT_CUTOFF_HZ,
     decimate: int | None = None,
-    rtol: float = 1e-10,
+    rtol: float | None = None,
 ) -> ConsistentResult:
     """Physically consistent link parameters (and friction) identified from data.
 
@@ -58,8 +58,9 @@ def identify_consistent(
         As in :func:`~dynid.feasibility.sdp.solve_consistent`.
     cutoff_hz, decimate
         Torque logs: the classical route's filtering and decimation.
-    rtol : float
-        Rank tolerance of the unconstrained fit.
+    rtol : float, optional
+        Rank tolerance of the unconstrained fit; None: the identification's default (the
+        rank at a clear gap of the singular values).
 
     Returns
     -------

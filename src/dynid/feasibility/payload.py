@@ -209,7 +209,7 @@ def identify_payload(
     unloaded: StaticDataset | TorqueLog | None = None,
     margin: float = 1e-6,
     cutoff_hz: float | None = DEFAULT_CUTOFF_HZ,
-    rtol: float = 1e-10,
+    rtol: float | None = None,
 ) -> PayloadEstimate:
     """Estimate the load fixed to ``frame`` from data recorded with it on a known arm.
 
@@ -231,8 +231,10 @@ def identify_payload(
         LMI margin: ``lambda_min(J) >= margin tr(J)``.
     cutoff_hz : float or None
         Torque logs: zero-phase low-pass cutoff [Hz] (None: no filtering).
-    rtol : float
-        Relative rank tolerance of the least squares.
+    rtol : float, optional
+        Relative rank tolerance: of the unloaded arm's identification (None: its default,
+        the rank at a clear singular-value gap) and of the load's least squares (None:
+        1e-10).
 
     Returns
     -------
@@ -307,7 +309,7 @@ def identify_payload(
         notes.append("classical friction fv, fc, fo per joint estimated alongside")
     if unloaded is not None:
         route += ", difference"
-    fit = fit_least_squares(W, yv, rtol=rtol, covariance="robust")
+    fit = fit_least_squares(W, yv, rtol=1e-10 if rtol is None else rtol, covariance="robust")
     p = 4 if (static and gravity_only) else 10
     est = np.asarray(fit.beta)
     cov = np.asarray(fit.covariance)[:p, :p]
