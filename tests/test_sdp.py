@@ -227,7 +227,7 @@ def test_specifications_that_exclude_the_robot_are_reported_not_hidden():
     ctl = dynid.SimulatedController(robot, relative_noise=1e-4, rng=np.random.default_rng(51))
     data = dynid.acquire_static(ctl, 200, np.random.default_rng(52))
     model = dynid.identify_static(robot, data)
-    tight = retrieve_sdp(model, prior=robot, options=SDPOptions(margin=0.02))
+    tight = retrieve_sdp(model, prior=robot, options=SDPOptions(margin=0.02, prior_weight=1.0))
     assert not tight.feasible and tight.residual_ratio > 1.1
     assert any("--margin" in s for s in tight.notes)
     heavy = retrieve_sdp(model, prior=robot, total_mass=(19.5, 20.0))

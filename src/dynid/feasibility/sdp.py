@@ -660,6 +660,13 @@ def _finish(
         over = ratio - 1.0
         tol = options.residual_tol
         extra.append(Constraint("data_fit", None, tol - over, "1", bool(over <= tol)))
+        if over > tol:
+            notes = notes + [
+                f"the result fits the data {100 * over:.3g} % worse than least squares (more "
+                f"than {100 * tol:g} %): the constraints (margin {options.margin:g}, bounds, "
+                "total-mass band) or the prior's weight exclude what the data say; check "
+                "--margin, --total-mass, --bounds and --prior-weight"
+            ]
     report = FeasibilityReport(
         tuple(c for c in rep.constraints if c.name != "inertia_in_bounds") + tuple(extra), rep.tol
     )
