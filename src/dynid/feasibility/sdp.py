@@ -581,7 +581,7 @@ def _active_and_implausible(
 ) -> list[str]:
     """Notes: the bounds the result sits on (they, not the data, decided those values) and
     links whose mass or size is implausible (a link under 1 % of the total mass, or a
-    radius of gyration about the CoM larger than the link's extent)."""
+    radius of gyration about the CoM over 1.5 times the link's extent)."""
     out: list[str] = []
     names = robot.link_names[1:]
     act: list[str] = []
@@ -609,10 +609,11 @@ def _active_and_implausible(
         rg = math.sqrt(max(float(lam[i].sum()), 0.0) / (2.0 * m[i])) if m[i] > 0 else math.inf
         if m[i] < 0.01 * M:
             out.append(f"implausible: {names[i]} weighs {m[i]:.3g} kg, under 1 % of the total")
-        elif rg > ext:
+        elif rg > 1.5 * ext:
             out.append(
                 f"implausible: {names[i]} has a radius of gyration of {rg:.3g} m about its CoM, "
-                f"more than its extent of {ext:.3g} m"
+                f"more than 1.5 times its extent of {ext:.3g} m (rotor inertia the link "
+                "absorbed, or inertia the data cannot see)"
             )
     return out
 
