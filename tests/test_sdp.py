@@ -137,7 +137,7 @@ def test_a_cad_prior_violating_the_triangle_inequality_is_repaired_and_reported(
     bad = robot.with_inertials(m, c, I)
     pr = prior_from_robot(bad, source="cad.urdf", total_mass=(30.0, 40.0))
     assert 4 in pr.repaired
-    assert any("link 4" in s and "floored" in s for s in pr.notes)
+    assert any("4 (link4" in s and "floored" in s for s in pr.notes)
     assert any("outside the band" in s for s in pr.notes)
     assert pseudo_inertia_margin(pr.phi).min() >= 2e-4 * (1 - 1e-9)
 

@@ -208,12 +208,14 @@ def prior_from_robot(
             repaired.append(int(i) + 1)
     before = pseudo_inertia_margin(phi)
     phi, changed = repair_pseudo_inertia(phi, margin)
-    for i in np.flatnonzero(changed):
+    if np.any(changed):
+        idx = np.flatnonzero(changed)
+        links = ", ".join(f"{i + 1} ({robot.link_names[i + 1]}: {before[i]:.3g})" for i in idx)
         notes.append(
-            f"prior {name}: link {i + 1} ({robot.link_names[i + 1]}) has lambda_min(J)/tr(J) "
-            f"= {before[i]:.3g} < {margin:g}; its pseudo-inertia eigenvalues were floored"
+            f"prior {name}: lambda_min(J)/tr(J) below {margin:g} on link(s) {links}; their "
+            "pseudo-inertia eigenvalues were floored to it"
         )
-        repaired.append(int(i) + 1)
+        repaired += [int(i) + 1 for i in idx]
     if total_mass is not None:
         M = float(phi[:, 0].sum())
         lo, hi = (float(x) for x in total_mass)
