@@ -76,6 +76,12 @@ def register(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParser:
     p.add_argument(
         "--obstacles", type=Path, default=None, help="with --pool: obstacles JSON (default none)"
     )
+    p.add_argument(
+        "--unmodelled",
+        action="store_true",
+        help="add effects outside the rigid-body model, as real arms have (rotor inertia on "
+        "the diagonal of M, a 0.3 deg gravity tilt; drawn from --seed, recorded in the file)",
+    )
     p.add_argument("--out", type=Path, required=True, help="output file, .csv or .npz")
     return p
 
@@ -90,10 +96,17 @@ def run(args: argparse.Namespace) -> int:
     """Acquire and write the data set; returns the exit code."""
     robot = load_robot(args)
     rng_q, rng_noise = streams(args.seed)
-    controller = SimulatedController(robot, args.noise, rng=rng_noise)
+    effects = None
+    if args.unmodelled:
+        from ..simulation.unmodelled import UnmodelledEffects
+
+        effects = UnmodelledEffects.typical(robot.n, np.random.default_rng([args.seed, 7]))
+    controller = SimulatedController(robot, args.noise, rng=rng_noise, effects=effects)
     if args.pool is None:
         data = acquire_static(controller, args.n, rng_q, margin=args.margin)
         data = data.with_metadata(seed=args.seed, kinematics=kinematics_record(robot))
+        if effects is not None:
+            data = data.with_metadata(unmodelled=effects.as_dict())
     else:
         from ..io.excitation import load_obstacles
         from ..simulation.static_selection import select_static_configurations

@@ -120,6 +120,12 @@ def register(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParser:
         help="Fourier base frequency [Hz] (default 0.1)",
     )
     p.add_argument("--with-ddq", action="store_true", help="also write the true accelerations")
+    p.add_argument(
+        "--unmodelled",
+        action="store_true",
+        help="add effects outside the rigid-body model, as real arms have (rotor inertia, "
+        "torque-sensor offsets, a 0.3 deg gravity tilt; drawn from --seed and printed)",
+    )
     add_seed_option(p)
     p.add_argument("--out", required=True, type=Path, help="output .csv or .npz")
     return p
@@ -170,6 +176,12 @@ def run(args: argparse.Namespace) -> int:
             what = "amplitude scaled by" if args.scale == "amplitude" else "time stretched by"
             say(f"{what} {factor:.4f}; now: {check_limits(robot, traj)}")
     noise = SensorNoise(tau_std=args.noise, q_std=args.q_noise, dq_std=args.dq_noise)
+    effects = None
+    if args.unmodelled:
+        from ..simulation.unmodelled import UnmodelledEffects
+
+        effects = UnmodelledEffects.typical(n, np.random.default_rng([args.seed, 7]))
+        say(f"effects outside the rigid-body model: {effects.describe()}")
     measured = simulate_measurement(
         robot,
         traj,
@@ -178,6 +190,7 @@ def run(args: argparse.Namespace) -> int:
         friction=None if args.no_friction else "robot",
         drop_fraction=args.drop,
         with_ddq=args.with_ddq,
+        effects=effects,
     )
     write_torque_log(args.out, measured)
     say(

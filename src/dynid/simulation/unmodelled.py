@@ -83,6 +83,26 @@ class UnmodelledEffects:
             tilt_axis=np.array([math.cos(a), math.sin(a), 0.0]),
         )
 
+    def as_dict(self) -> dict[str, list[float] | float]:
+        """JSON-ready: ``rotor_inertia`` [kg m^2], ``torque_offset`` [N m], ``gravity_tilt``
+        [rad], ``tilt_axis``."""
+        return {
+            "rotor_inertia": [float(x) for x in self.rotor_inertia],
+            "torque_offset": [float(x) for x in self.torque_offset],
+            "gravity_tilt": self.gravity_tilt,
+            "tilt_axis": [float(x) for x in np.asarray(self.tilt_axis)],
+        }
+
+    def describe(self) -> str:
+        """One line: rotor inertia, offsets and tilt."""
+        return (
+            "rotor inertia "
+            + " ".join(f"{x:.3f}" for x in self.rotor_inertia)
+            + " kg m^2; torque offsets "
+            + " ".join(f"{x:+.3f}" for x in self.torque_offset)
+            + f" N m; gravity tilted {math.degrees(self.gravity_tilt):.2f} deg"
+        )
+
     @property
     def n(self) -> int:
         """Number of joints."""
