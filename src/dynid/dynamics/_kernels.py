@@ -1,17 +1,14 @@
 """Compiled (numba) kernels: inverse dynamics, gravity torques and the mass matrix.
 
-This module imports numba, so it is imported lazily, on the first call of a dynamics
-function (see :func:`dynid.dynamics.rnea.kernels`), never by ``import dynid``. Each kernel
-is compiled on its first call for the argument types it meets and cached on disk
-(``cache=True``); later processes load it instead of compiling it again.
+Imported lazily, on the first dynamics call (:func:`dynid._compiled.kernels`), never by
+``import dynid``; compiled once and cached on disk (:func:`dynid.kinematics._chain.jit`).
 
-The kernels take the robot's constant arrays as arguments: ``T`` (``T_parent_joint``,
-(n, 4, 4)), ``axes`` (n, 3), ``prismatic`` (n,) bool, ``phi`` (n, 10) and ``g``
-(``gravity``, (3,) [m/s^2] in the base frame); see :mod:`dynid.model.robot`. Joint
-arrays are flat, C-contiguous float64 of length ``B * n``, sample-major (a (B, n) array
-reshaped); ``dq`` and ``ddq`` of :func:`rnea` may also have length ``n``, one row for every
-sample. Results are written into a flat output array of length ``B * n`` (``B * n * n``
-for the mass matrices, row-major), which spares the boxing of a new array on each call.
+Arguments: ``C``, the robot's packed constants (:func:`dynid._compiled.pack`: joint
+transforms, axes, joint types, standard parameters ``phi`` and gravity [m/s^2] in the base
+frame). Joint arrays are C-contiguous float64 read flat, length ``B * n``, sample-major (a
+(B, n) array); ``dq`` and ``ddq`` of :func:`rnea` may also have length ``n``, one row for
+every sample. Results go into a C-contiguous output array read flat, ``B * n`` (``B * n *
+n`` for the mass matrices, row-major), which spares the boxing of a new array on each call.
 Every kernel checks that its joint inputs are finite and returns ``ok``; with
 ``ok = False`` the output is unfinished and the caller raises the error that names the
 bad entry.
@@ -33,21 +30,21 @@ calls, so that the compiler vectorises it (SIMD over samples). Revolute and pris
 joints go through the same arithmetic with exact 0/1 selectors (a prismatic joint has
 ``sin = 0, cos = 1``, a revolute one no translation), which changes no rounding.
 
-The compiler may fuse ``a * b + c`` into one multiply-add (numba ``fastmath={"contract"}``,
-no other fast-math flag): one rounding instead of two, so the kernels and the numpy path
-differ by rounding only (the tests hold them to 1e-12 relative).
-
-Sine and cosine come from :func:`_sincos`, Cephes' ``sin.c``/``cos.c`` (S. L. Moshier)
-polynomials with its three-part reduction by pi/4, branch-free so that it vectorises;
-its error is below 2.3e-16 absolute for ``|q| <= 1e8`` (the math library is used above).
+The joint transform is the chain core's (:mod:`dynid.kinematics._chain`), as are the
+compiler settings (fused multiply-add only) and the sine and cosine (Cephes, vectorisable);
+kernels and numpy path differ by rounding only (the tests hold them to 1e-12 relative).
 """
 
 from __future__ import annotations
 
 import math
 
-import numba
 import numpy as np
+
+from .._compiled import C_AXIS, C_PHI, C_PRISMATIC
+from ..kinematics._chain import SINCOS_MAX as _SINCOS_MAX
+from ..kinematics._chain import jit, joint, joint_sc
+from ..kinematics._chain import sincos as _sincos
 
 __all__ = ["BLOCK", "rnea", "gravity_torques", "mass_matrix"]
 
@@ -63,60 +60,17 @@ _F, _N = 26, 29  # force and moment on the link (and its children) about its ori
 _TAU = 32
 _ROWS = 33
 
-# Cephes sin.c: pi/4 = DP1 + DP2 + DP3 (DP1 and DP2 with short mantissas, so that y * DP1
-# and y * DP2 are exact for the y that occur) and the minimax polynomials on [-pi/4, pi/4]
-_FOPI = 1.27323954473516268615  # 4 / pi
-_DP1 = 7.85398125648498535156e-1
-_DP2 = 3.77489470793079817668e-8
-_DP3 = 2.69515142907905952645e-15
-# a * b + c may be one fused multiply-add (one rounding instead of two); no reassociation,
-# no approximate functions, NaN and inf semantics kept
-_FASTMATH = {"contract"}
-_SINCOS_MAX = 1.0e8  # |q| above which the math library's sin and cos are used
-_S0, _S1, _S2 = 1.58962301576546568060e-10, -2.50507477628578072866e-8, 2.75573136213857245213e-6
-_S3, _S4, _S5 = -1.98412698295895385996e-4, 8.33333333332211858878e-3, -1.66666666666666307295e-1
-_C0, _C1, _C2 = -1.13585365213876817300e-11, 2.08757008419747316778e-9, -2.75573141792967388112e-7
-_C3, _C4, _C5 = 2.48015872888517045348e-5, -1.38888888888730564116e-3, 4.16666666666665929218e-2
 
-
-def _jit(fn):
-    """``numba.njit(cache=True)`` allowing fused multiply-add, and nothing else of fastmath.
-
-    Without the disk cache when numba finds no writable cache folder.
-    """
-    try:
-        return numba.njit(cache=True, fastmath=_FASTMATH)(fn)
-    except RuntimeError:  # no writable cache location
-        return numba.njit(fastmath=_FASTMATH)(fn)
-
-
-@numba.njit(inline="always")
-def _sincos(x):
-    """``(sin x, cos x)`` for ``|x| <= 1e8``, branch-free (Cephes ``sin.c``, ``cos.c``)."""
-    ax = abs(x)
-    j = np.int64(ax * _FOPI)
-    j += j & 1  # even octant: z in [-pi/4, pi/4]
-    y = float(j)
-    z = ((ax - y * _DP1) - y * _DP2) - y * _DP3
-    zz = z * z
-    ps = z + z * zz * (((((_S0 * zz + _S1) * zz + _S2) * zz + _S3) * zz + _S4) * zz + _S5)
-    pc = (
-        1.0
-        - 0.5 * zz
-        + zz * zz * (((((_C0 * zz + _C1) * zz + _C2) * zz + _C3) * zz + _C4) * zz + _C5)
-    )
-    m = (j >> 1) & 3  # quadrant: x = m pi/2 + z (mod 2 pi)
-    s = pc if m & 1 else ps
-    c = ps if m & 1 else pc
-    s = -s if (m >> 1) & 1 else s
-    c = -c if ((m + 1) >> 1) & 1 else c
-    s = -s if x < 0.0 else s
-    return s, c
-
-
-def _rnea(T, axes, prismatic, phi, g, q, dq, ddq, tau):
+@jit
+def rnea(C, q, dq, ddq, tau):
     """Joint torques into ``tau`` (B n,) for q (B n,), dq and ddq (B n,) or (n,); ``ok``."""
-    n = T.shape[0]
+    q, dq, ddq, tau = (
+        q.reshape(q.size),
+        dq.reshape(dq.size),
+        ddq.reshape(ddq.size),
+        tau.reshape(tau.size),
+    )
+    n = C.shape[0] - 1
     B = q.shape[0] // n
     # the block length is a compile-time constant, so the row stride of X is known and the
     # sample loops vectorise without run-time aliasing checks
@@ -124,9 +78,9 @@ def _rnea(T, axes, prismatic, phi, g, q, dq, ddq, tau):
     sv, sa = dq.shape[0] == q.shape[0], ddq.shape[0] == q.shape[0]  # else one row for all
     # base (link 0): at rest, accelerating at -g; virtual link n + 1: identity, no wrench
     X[0, _W : _A + 3] = 0.0
-    X[0, _A] = -g[0]
-    X[0, _A + 1] = -g[1]
-    X[0, _A + 2] = -g[2]
+    X[0, _A] = -C[n, 0]
+    X[0, _A + 1] = -C[n, 1]
+    X[0, _A + 2] = -C[n, 2]
     X[n + 1] = 0.0
     X[n + 1, _R] = 1.0
     X[n + 1, _R + 4] = 1.0
@@ -147,7 +101,7 @@ def _rnea(T, axes, prismatic, phi, g, q, dq, ddq, tau):
                 X[i + 1, _V, k] = v
                 X[i + 1, _AC, k] = a
         for l in range(1, n + 1):
-            if prismatic[l - 1]:
+            if C[l - 1, C_PRISMATIC] != 0.0:
                 for k in range(nb):
                     X[l, _S, k] = 0.0
                     X[l, _C, k] = 1.0
@@ -163,42 +117,14 @@ def _rnea(T, axes, prismatic, phi, g, q, dq, ddq, tau):
         # outward pass: link l from its parent l - 1
         for l in range(1, n + 1):
             i = l - 1
-            t00, t01, t02, t03 = T[i, 0, 0], T[i, 0, 1], T[i, 0, 2], T[i, 0, 3]
-            t10, t11, t12, t13 = T[i, 1, 0], T[i, 1, 1], T[i, 1, 2], T[i, 1, 3]
-            t20, t21, t22, t23 = T[i, 2, 0], T[i, 2, 1], T[i, 2, 2], T[i, 2, 3]
-            ax, ay, az = axes[i, 0], axes[i, 1], axes[i, 2]
-            kxx, kyy, kzz = ax * ax - 1.0, ay * ay - 1.0, az * az - 1.0
-            kxy, kxz, kyz = ax * ay, ax * az, ay * az
-            ep = 1.0 if prismatic[i] else 0.0
+            ax, ay, az = C[i, C_AXIS], C[i, C_AXIS + 1], C[i, C_AXIS + 2]
+            ep = C[i, C_PRISMATIC]
             er = 1.0 - ep
             for k in range(nb):
-                # R = T_fix Rot(axis, q) (Rodrigues: E + s K + (1 - c) K K, K K = a a^T - E)
-                s, c = X[l, _S, k], X[l, _C, k]
-                v = 1.0 - c
-                q00 = 1.0 + v * kxx
-                q11 = 1.0 + v * kyy
-                q22 = 1.0 + v * kzz
-                q01 = -s * az + v * kxy
-                q10 = s * az + v * kxy
-                q02 = s * ay + v * kxz
-                q20 = -s * ay + v * kxz
-                q12 = -s * ax + v * kyz
-                q21 = s * ax + v * kyz
-                r00 = t00 * q00 + t01 * q10 + t02 * q20
-                r01 = t00 * q01 + t01 * q11 + t02 * q21
-                r02 = t00 * q02 + t01 * q12 + t02 * q22
-                r10 = t10 * q00 + t11 * q10 + t12 * q20
-                r11 = t10 * q01 + t11 * q11 + t12 * q21
-                r12 = t10 * q02 + t11 * q12 + t12 * q22
-                r20 = t20 * q00 + t21 * q10 + t22 * q20
-                r21 = t20 * q01 + t21 * q11 + t22 * q21
-                r22 = t20 * q02 + t21 * q12 + t22 * q22
-                # p = p_fix + T_fix (q a) for a prismatic joint
-                d = ep * X[l, _Q, k]
-                dx, dy, dz = d * ax, d * ay, d * az
-                px = t03 + (t00 * dx + t01 * dy + t02 * dz)
-                py = t13 + (t10 * dx + t11 * dy + t12 * dz)
-                pz = t23 + (t20 * dx + t21 * dy + t22 * dz)
+                # pose of link l in link l - 1 (the chain core's joint transform)
+                r00, r01, r02, r10, r11, r12, r20, r21, r22, px, py, pz = joint_sc(
+                    C, i, X[l, _S, k], X[l, _C, k], ep * X[l, _Q, k]
+                )
                 X[l, _R, k] = r00
                 X[l, _R + 1, k] = r01
                 X[l, _R + 2, k] = r02
@@ -248,12 +174,12 @@ def _rnea(T, axes, prismatic, phi, g, q, dq, ddq, tau):
         # inward pass: wrench on link l and its children, about origin l, link-l coordinates
         for l in range(n, 0, -1):
             i = l - 1
-            m = phi[i, 0]
-            hx, hy, hz = phi[i, 1], phi[i, 2], phi[i, 3]
-            Jxx, Jxy, Jxz = phi[i, 4], phi[i, 5], phi[i, 6]
-            Jyy, Jyz, Jzz = phi[i, 7], phi[i, 8], phi[i, 9]
-            ax, ay, az = axes[i, 0], axes[i, 1], axes[i, 2]
-            ep = 1.0 if prismatic[i] else 0.0
+            m = C[i, C_PHI]
+            hx, hy, hz = C[i, C_PHI + 1], C[i, C_PHI + 2], C[i, C_PHI + 3]
+            Jxx, Jxy, Jxz = C[i, C_PHI + 4], C[i, C_PHI + 5], C[i, C_PHI + 6]
+            Jyy, Jyz, Jzz = C[i, C_PHI + 7], C[i, C_PHI + 8], C[i, C_PHI + 9]
+            ax, ay, az = C[i, C_AXIS], C[i, C_AXIS + 1], C[i, C_AXIS + 2]
+            ep = C[i, C_PRISMATIC]
             er = 1.0 - ep
             c = l + 1
             for k in range(nb):
@@ -318,15 +244,18 @@ def _rnea(T, axes, prismatic, phi, g, q, dq, ddq, tau):
     return True
 
 
-def _gravity(T, axes, prismatic, phi, g, q, tau):
+@jit
+def gravity_torques(C, q, tau):
     """Gravity torques into ``tau`` (B n,) for q (B n,); returns ``ok``."""
-    zero = np.zeros(T.shape[0])
-    return _rnea_kernel(T, axes, prismatic, phi, g, q, zero, zero, tau)
+    zero = np.zeros(C.shape[0] - 1)
+    return rnea(C, q, zero, zero, tau)
 
 
-def _mass_matrix(T, axes, prismatic, phi, q, M):
+@jit
+def mass_matrix(C, q, M):
     """Mass matrices into ``M`` (B n n,) for q (B n,), composite-rigid-body; returns ``ok``."""
-    n = T.shape[0]
+    q, M = q.reshape(q.size), M.reshape(M.size)
+    n = C.shape[0] - 1
     B = q.shape[0] // n
     R = np.empty((n, 3, 3))
     p = np.empty((n, 3))
@@ -335,34 +264,10 @@ def _mass_matrix(T, axes, prismatic, phi, q, M):
             qi = q[b * n + i]
             if not math.isfinite(qi):
                 return False
-            ax, ay, az = axes[i, 0], axes[i, 1], axes[i, 2]
-            if prismatic[i]:
-                for r in range(3):
-                    R[i, r, 0], R[i, r, 1], R[i, r, 2] = T[i, r, 0], T[i, r, 1], T[i, r, 2]
-                    p[i, r] = T[i, r, 3] + (
-                        T[i, r, 0] * (qi * ax) + T[i, r, 1] * (qi * ay) + T[i, r, 2] * (qi * az)
-                    )
-                continue
-            if abs(qi) > _SINCOS_MAX:
-                s, c = math.sin(qi), math.cos(qi)
-            else:
-                s, c = _sincos(qi)
-            v = 1.0 - c
-            q00 = 1.0 + v * (ax * ax - 1.0)
-            q11 = 1.0 + v * (ay * ay - 1.0)
-            q22 = 1.0 + v * (az * az - 1.0)
-            q01 = -s * az + v * (ax * ay)
-            q10 = s * az + v * (ax * ay)
-            q02 = s * ay + v * (ax * az)
-            q20 = -s * ay + v * (ax * az)
-            q12 = -s * ax + v * (ay * az)
-            q21 = s * ax + v * (ay * az)
+            Ti = joint(C, i, qi)
             for r in range(3):
-                t0, t1, t2 = T[i, r, 0], T[i, r, 1], T[i, r, 2]
-                R[i, r, 0] = t0 * q00 + t1 * q10 + t2 * q20
-                R[i, r, 1] = t0 * q01 + t1 * q11 + t2 * q21
-                R[i, r, 2] = t0 * q02 + t1 * q12 + t2 * q22
-                p[i, r] = T[i, r, 3]
+                R[i, r, 0], R[i, r, 1], R[i, r, 2] = Ti[3 * r], Ti[3 * r + 1], Ti[3 * r + 2]
+                p[i, r] = Ti[9 + r]
         # composite inertia (mc, h, J) of links i.. about origin i, link-i axes
         mc = 0.0
         hx = hy = hz = 0.0
@@ -399,19 +304,19 @@ def _mass_matrix(T, axes, prismatic, phi, q, M):
                 nzz = r20 * s02 + r21 * s12 + r22 * s22 + mc * (pp - pz * pz) + pu2 - 2.0 * uz * pz
                 hx, hy, hz = ux + mc * px, uy + mc * py, uz + mc * pz
                 Jxx, Jxy, Jxz, Jyy, Jyz, Jzz = nxx, nxy, nxz, nyy, nyz, nzz
-            mc += phi[i, 0]
-            hx += phi[i, 1]
-            hy += phi[i, 2]
-            hz += phi[i, 3]
-            Jxx += phi[i, 4]
-            Jxy += phi[i, 5]
-            Jxz += phi[i, 6]
-            Jyy += phi[i, 7]
-            Jyz += phi[i, 8]
-            Jzz += phi[i, 9]
+            mc += C[i, C_PHI]
+            hx += C[i, C_PHI + 1]
+            hy += C[i, C_PHI + 2]
+            hz += C[i, C_PHI + 3]
+            Jxx += C[i, C_PHI + 4]
+            Jxy += C[i, C_PHI + 5]
+            Jxz += C[i, C_PHI + 6]
+            Jyy += C[i, C_PHI + 7]
+            Jyz += C[i, C_PHI + 8]
+            Jzz += C[i, C_PHI + 9]
             # wrench (moment N about origin i, force F) of the composite for unit motion of joint i
-            ax, ay, az = axes[i, 0], axes[i, 1], axes[i, 2]
-            if prismatic[i]:  # F = m a, N = h x a
+            ax, ay, az = C[i, C_AXIS], C[i, C_AXIS + 1], C[i, C_AXIS + 2]
+            if C[i, C_PRISMATIC] != 0.0:  # F = m a, N = h x a
                 Fx, Fy, Fz = mc * ax, mc * ay, mc * az
                 Nx = hy * az - hz * ay
                 Ny = hz * ax - hx * az
@@ -425,10 +330,11 @@ def _mass_matrix(T, axes, prismatic, phi, q, M):
                 Fz = ax * hy - ay * hx
             j = i
             while True:
-                if prismatic[j]:
-                    e = Fx * axes[j, 0] + Fy * axes[j, 1] + Fz * axes[j, 2]
+                bx, by, bz = C[j, C_AXIS], C[j, C_AXIS + 1], C[j, C_AXIS + 2]
+                if C[j, C_PRISMATIC] != 0.0:
+                    e = Fx * bx + Fy * by + Fz * bz
                 else:
-                    e = Nx * axes[j, 0] + Ny * axes[j, 1] + Nz * axes[j, 2]
+                    e = Nx * bx + Ny * by + Nz * bz
                 M[(b * n + j) * n + i] = e
                 M[(b * n + i) * n + j] = e
                 if j == 0:
@@ -450,13 +356,3 @@ def _mass_matrix(T, axes, prismatic, phi, q, M):
                 Fx, Fy, Fz = RFx, RFy, RFz
                 j -= 1
     return True
-
-
-_rnea_kernel = _jit(_rnea)
-
-#: ``rnea(T, axes, prismatic, phi, g, q, dq, ddq, tau) -> ok``
-rnea = _rnea_kernel
-#: ``gravity_torques(T, axes, prismatic, phi, g, q, tau) -> ok``
-gravity_torques = _jit(_gravity)
-#: ``mass_matrix(T, axes, prismatic, phi, q, M) -> ok``
-mass_matrix = _jit(_mass_matrix)

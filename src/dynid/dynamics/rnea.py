@@ -28,8 +28,8 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from .. import _checks, _compiled
+from .._compiled import constants as _constants
 from .._compiled import flat as _flat
-from .._compiled import readonly as _readonly
 from ..exceptions import ShapeError
 from ..kinematics.forward import _joint_rotations_translations
 from ..model.inertia import matrix_from_inertia6
@@ -49,8 +49,21 @@ def kernels() -> ModuleType | None:
     """
     global _KERNELS, _LOADED
     if not _LOADED:
-        _KERNELS, _LOADED = _compiled.optional(f"{__package__}._kernels"), True
+        _KERNELS, _LOADED = _compiled.kernels(__package__), True
     return _KERNELS
+
+
+_F64 = np.dtype(np.float64)
+
+
+def _c64(x: ArrayLike) -> NDArray[np.float64] | None:
+    """``x`` as a float64 C-contiguous array (no copy when it is one), or None."""
+    if type(x) is np.ndarray and x.dtype is _F64 and x.flags.c_contiguous:
+        return x
+    try:
+        return np.ascontiguousarray(x, dtype=np.float64)
+    except (TypeError, ValueError):
+        return None
 
 
 def cross(a: NDArray[np.float64], b: NDArray[np.float64]) -> NDArray[np.float64]:
@@ -178,29 +191,15 @@ def rnea(
     """
     K = _KERNELS if _LOADED else kernels()
     if K is not None and gravity is None:
-        # lean path for the common call: same shapes, float64-convertible; the kernel
-        # checks finiteness and any failure falls through to the full validation below
-        try:
-            qa = np.asarray(q, dtype=np.float64)
-            va = np.asarray(dq, dtype=np.float64)
-            aa = np.asarray(ddq, dtype=np.float64)
-        except (TypeError, ValueError):
-            pass
-        else:
+        # thin path for the common call: float64 C arrays of one shape (..., n) go to the
+        # kernel as they are; the kernel checks finiteness, and anything else (or a
+        # failure) falls through to the full validation below
+        qa, va, aa = _c64(q), _c64(dq), _c64(ddq)
+        if qa is not None and va is not None and aa is not None:
             shape = qa.shape
             if shape == va.shape == aa.shape and shape and shape[-1] == len(robot.joint_names):
                 tau = np.empty(shape)
-                if K.rnea(
-                    robot.T_parent_joint,
-                    robot.axes,
-                    robot.prismatic,
-                    robot.phi,
-                    robot.gravity,
-                    _flat(qa),
-                    _flat(va),
-                    _flat(aa),
-                    tau if len(shape) == 1 else tau.reshape(-1),
-                ):
+                if K.rnea(_constants(robot), qa, va, aa, tau):
                     return tau
     shape, (q2, dq2, ddq2) = _prepare(robot, q, dq, ddq)
     g = robot.gravity if gravity is None else _checks.as_exact("gravity", gravity, (3,))
@@ -242,17 +241,11 @@ def _rnea(
         B, n = q.shape
         if dq.shape[0] in (1, B) and ddq.shape[0] in (1, B):
             tau = np.empty((B, n))
-            if K.rnea(
-                robot.T_parent_joint,
-                robot.axes,
-                robot.prismatic,
-                robot.phi if phi is robot.phi else _readonly(np.asarray(phi, dtype=np.float64)),
-                robot.gravity if gravity is robot.gravity else _readonly(gravity),
-                _flat(q),
-                _flat(dq),
-                _flat(ddq),
-                tau.reshape(-1),
-            ):
+            if phi is robot.phi and gravity is robot.gravity:
+                C = _constants(robot)
+            else:
+                C = _compiled.pack(robot, np.asarray(phi, dtype=np.float64), gravity)
+            if K.rnea(C, _flat(q), _flat(dq), _flat(ddq), tau):
                 return tau
     return _rnea_numpy(robot, phi, q, dq, ddq, gravity)
 

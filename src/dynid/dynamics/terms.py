@@ -21,8 +21,10 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from .. import _checks
+from .._compiled import constants as _constants
 from ..model.robot import Robot
-from .rnea import _flat, _prepare, _rnea, _rnea_numpy, kernels
+from . import rnea as _rnea_module
+from .rnea import _c64, _flat, _prepare, _rnea, _rnea_numpy, kernels
 
 __all__ = [
     "mass_matrix",
@@ -37,29 +39,13 @@ __all__ = [
 _ZERO_G = _checks.frozen(np.zeros(3))
 
 
-def _lean_q(robot: Robot, q: ArrayLike) -> NDArray[np.float64] | None:
-    """``q`` as a float64 array when it is plainly (..., n), else None (full validation).
-
-    No finiteness check here: the kernels do it.
-    """
-    try:
-        qa = np.asarray(q, dtype=np.float64)
-    except (TypeError, ValueError):
-        return None
-    if qa.ndim == 0 or qa.shape[-1] != len(robot.joint_names):
-        return None
-    return qa
-
-
 def _mass_matrix(robot: Robot, q2: NDArray[np.float64]) -> NDArray[np.float64]:
     """(B, n, n) mass matrices for validated (B, n) positions (kernel when available)."""
     K = kernels()
     if K is not None:
         B, n = q2.shape
         M = np.empty((B, n, n))
-        if K.mass_matrix(
-            robot.T_parent_joint, robot.axes, robot.prismatic, robot.phi, _flat(q2), M.reshape(-1)
-        ):
+        if K.mass_matrix(_constants(robot), _flat(q2), M):
             return M
     return _mass_matrix_numpy(robot, q2)
 
@@ -96,19 +82,14 @@ def mass_matrix(robot: Robot, q: ArrayLike) -> NDArray[np.float64]:
     Composite-rigid-body algorithm in the compiled kernel when available; otherwise
     :func:`mass_matrix_numpy`.
     """
-    K = kernels()
+    K = _rnea_module._KERNELS if _rnea_module._LOADED else kernels()
     if K is not None:
-        qa = _lean_q(robot, q)
-        if qa is not None:
-            M = np.empty(qa.shape + qa.shape[-1:])
-            if K.mass_matrix(
-                robot.T_parent_joint,
-                robot.axes,
-                robot.prismatic,
-                robot.phi,
-                _flat(qa),
-                M.reshape(-1),
-            ):
+        # thin path: a float64 C array (..., n) goes to the kernel as it is
+        qa = _c64(q)
+        n = len(robot.joint_names)
+        if qa is not None and qa.ndim and qa.shape[-1] == n:
+            M = np.empty((n, n) if qa.ndim == 1 else qa.shape + (n,))
+            if K.mass_matrix(_constants(robot), qa, M):
                 return M
     q = _checks.as_batch("q", q, (robot.n,))
     return _mass_matrix(robot, q.reshape(-1, robot.n)).reshape(q.shape + (robot.n,))
@@ -127,20 +108,13 @@ def gravity_torques(robot: Robot, q: ArrayLike) -> NDArray[np.float64]:
     ------
     ShapeError, NonFiniteError
     """
-    K = kernels()
+    K = _rnea_module._KERNELS if _rnea_module._LOADED else kernels()
     if K is not None:
-        qa = _lean_q(robot, q)
-        if qa is not None:
+        # thin path: a float64 C array (..., n) goes to the kernel as it is
+        qa = _c64(q)
+        if qa is not None and qa.ndim and qa.shape[-1] == len(robot.joint_names):
             tau = np.empty(qa.shape)
-            if K.gravity_torques(
-                robot.T_parent_joint,
-                robot.axes,
-                robot.prismatic,
-                robot.phi,
-                robot.gravity,
-                _flat(qa),
-                tau if tau.ndim == 1 else tau.reshape(-1),
-            ):
+            if K.gravity_torques(_constants(robot), qa, tau):
                 return tau
     q = _checks.as_batch("q", q, (robot.n,))
     q2 = q.reshape(-1, robot.n)

@@ -24,7 +24,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from .. import _checks, _compiled
-from .._compiled import flat as _flat
+from .._compiled import constants as _constants
 from .._compiled import readonly as _readonly
 from ..model.robot import Robot
 
@@ -40,32 +40,50 @@ __all__ = [
 
 _KERNELS: ModuleType | None = None
 _LOADED = False
+_F64 = np.dtype(np.float64)
 
 
 def kernels() -> ModuleType | None:
     """The compiled kernels module, or None when numba is missing or ``DYNID_NO_NUMBA`` is set.
 
-    Imported once, on the first call; ``DYNID_NO_NUMBA`` is read then. Any value other
-    than ``""`` and ``"0"`` selects the numpy reference path.
+    Imported once, on the first call (:func:`dynid._compiled.kernels`); ``DYNID_NO_NUMBA``
+    is read then. Any value other than ``""`` and ``"0"`` selects the numpy reference path.
     """
     global _KERNELS, _LOADED
     if not _LOADED:
-        _KERNELS, _LOADED = _compiled.optional(f"{__package__}._kernels"), True
+        _KERNELS, _LOADED = _compiled.kernels(__package__), True
     return _KERNELS
 
 
 def _as_q(robot: Robot, q: ArrayLike) -> NDArray[np.float64] | None:
-    """``q`` as float64 when that is cheap and its shape is ``(..., n)``, else None.
+    """``q`` as a flat-able float64 C array when that is cheap and its shape is ``(..., n)``.
 
-    The lean path of the public functions: finiteness is left to the kernels, and None
-    sends the call to the full validation, which raises the documented errors.
+    The thin path of the public functions: a float64 C-contiguous ndarray passes with two
+    attribute reads, no copy; finiteness is left to the kernels, and None sends the call to
+    the full validation, which raises the documented errors.
     """
-    try:
-        qa = np.asarray(q, dtype=np.float64)
-    except (TypeError, ValueError):
-        return None
-    shape = qa.shape
-    return qa if shape and shape[-1] == len(robot.joint_names) and shape[-1] else None
+    if type(q) is not np.ndarray or q.dtype is not _F64 or not q.flags.c_contiguous:
+        try:
+            q = np.ascontiguousarray(q, dtype=np.float64)
+        except (TypeError, ValueError):
+            return None
+    shape = q.shape
+    return q if shape and shape[-1] == len(robot.joint_names) and shape[-1] else None
+
+
+_FRAMES: dict[tuple[int, str], tuple[Robot, int, NDArray[np.float64]]] = {}
+
+
+def _frame_in_link(robot: Robot, frame: str) -> tuple[int, NDArray[np.float64]]:
+    """``robot.frame(frame)`` as ``(link, T_link_frame)``, remembered for a few robots."""
+    hit = _FRAMES.get((id(robot), frame))
+    if hit is not None and hit[0] is robot:
+        return hit[1], hit[2]
+    f = robot.frame(frame)
+    if len(_FRAMES) >= 64:
+        _FRAMES.pop(next(iter(_FRAMES)))
+    _FRAMES[(id(robot), frame)] = (robot, f.link, f.T_link_frame)
+    return f.link, f.T_link_frame
 
 
 def check_q(robot: Robot, q: ArrayLike, name: str = "q") -> NDArray[np.float64]:
@@ -159,9 +177,7 @@ def link_poses(robot: Robot, q: ArrayLike) -> NDArray[np.float64]:
         qa = _as_q(robot, q)
         if qa is not None:
             T = np.empty(qa.shape[:-1] + (qa.shape[-1] + 1, 4, 4))
-            if K.link_poses(
-                robot.T_parent_joint, robot.axes, robot.prismatic, _flat(qa), T.reshape(-1)
-            ):
+            if K.link_poses(_constants(robot), qa, T):
                 return T
     return link_poses_numpy(robot, q)
 
@@ -180,11 +196,10 @@ def frame_pose_in_link(
     robot: Robot, frame: str, tool: ArrayLike | None = None
 ) -> tuple[int, NDArray[np.float64]]:
     """The link that carries ``frame`` and the pose of ``frame`` (then ``tool``) in that link."""
-    f = robot.frame(frame)
-    T = f.T_link_frame
+    link, T = _frame_in_link(robot, frame)
     if tool is not None:
-        T = T @ _checks.as_exact("tool", tool, (4, 4))
-    return f.link, T
+        T = _readonly(T @ _checks.as_exact("tool", tool, (4, 4)))
+    return link, T
 
 
 def fk(
@@ -221,21 +236,20 @@ def fk(
     -----
     Uses the compiled kernel when available (see :func:`kernels`), else :func:`fk_numpy`.
     """
-    link, T_link_frame = frame_pose_in_link(robot, frame, tool)
+    if tool is None:
+        link, T_link_frame = _frame_in_link(robot, frame)
+    else:
+        link, T_link_frame = frame_pose_in_link(robot, frame, tool)
     K = _KERNELS if _LOADED else kernels()
     if K is not None:
-        qa = _as_q(robot, q)
-        if qa is not None:
-            T = np.empty(qa.shape[:-1] + (4, 4))
-            if K.frame_pose(
-                robot.T_parent_joint,
-                robot.axes,
-                robot.prismatic,
-                link,
-                T_link_frame if tool is None else _readonly(T_link_frame),
-                _flat(qa),
-                T.reshape(-1),
-            ):
+        # thin path: a float64 C array of shape (..., n) goes to the kernel as it is
+        if type(q) is np.ndarray and q.dtype is _F64 and q.flags.c_contiguous:
+            qa: NDArray[np.float64] | None = q
+        else:
+            qa = _as_q(robot, q)
+        if qa is not None and qa.ndim and qa.shape[-1] == len(robot.joint_names):
+            T = np.empty((4, 4) if qa.ndim == 1 else qa.shape[:-1] + (4, 4))
+            if K.frame_pose(_constants(robot), link, T_link_frame, qa, T):
                 return T
     return _fk_numpy(robot, q, link, T_link_frame)
 

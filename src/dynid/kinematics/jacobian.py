@@ -18,7 +18,15 @@ from .. import _checks
 from ..exceptions import ShapeError
 from ..model.robot import Robot
 from . import forward as _forward
-from .forward import _as_q, _flat, _link_poses, _readonly, check_q, frame_pose_in_link
+from .forward import (
+    _F64,
+    _as_q,
+    _constants,
+    _frame_in_link,
+    _link_poses,
+    check_q,
+    frame_pose_in_link,
+)
 
 __all__ = ["jacobian", "jacobian_numpy", "jacobian_to_tool"]
 
@@ -54,22 +62,21 @@ def jacobian(
     Uses the compiled kernel when available (see :func:`dynid.kinematics.forward.kernels`),
     else :func:`jacobian_numpy`.
     """
-    link, T_link_frame = frame_pose_in_link(robot, frame, tool)
+    if tool is None:
+        link, T_link_frame = _frame_in_link(robot, frame)
+    else:
+        link, T_link_frame = frame_pose_in_link(robot, frame, tool)
     K = _forward._KERNELS if _forward._LOADED else _forward.kernels()
     if K is not None:
-        qa = _as_q(robot, q)
-        if qa is not None:
-            n = qa.shape[-1]
-            J = np.empty(qa.shape[:-1] + (6, n))
-            if K.jacobian(
-                robot.T_parent_joint,
-                robot.axes,
-                robot.prismatic,
-                link,
-                T_link_frame if tool is None else _readonly(T_link_frame),
-                _flat(qa),
-                J.reshape(-1),
-            ):
+        # thin path: a float64 C array of shape (..., n) goes to the kernel as it is
+        if type(q) is np.ndarray and q.dtype is _F64 and q.flags.c_contiguous:
+            qa: NDArray[np.float64] | None = q
+        else:
+            qa = _as_q(robot, q)
+        n = len(robot.joint_names)
+        if qa is not None and qa.ndim and qa.shape[-1] == n:
+            J = np.empty((6, n) if qa.ndim == 1 else qa.shape[:-1] + (6, n))
+            if K.jacobian(_constants(robot), link, T_link_frame, qa, J):
                 return J
     return _jacobian_numpy(robot, q, link, T_link_frame)
 
