@@ -42,7 +42,8 @@ def kernel_fk(robot, q, frame, tool=None):
     link, T_lf = frame_pose_in_link(robot, frame, tool)
     T_lf = forward_module._readonly(T_lf)  # the type the public functions pass
     T = np.empty((q.shape[0], 4, 4))
-    ok = _kernels.frame_pose(_compiled.pack(robot), link, T_lf, q.reshape(-1), T.reshape(-1))
+    CF = _compiled.pack_frame(_compiled.pack(robot), link, T_lf)
+    ok = _kernels.frame_pose(CF, q.reshape(-1), T.reshape(-1))
     assert ok
     return T
 
@@ -52,7 +53,8 @@ def kernel_jacobian(robot, q, frame, tool=None):
     link, T_lf = frame_pose_in_link(robot, frame, tool)
     T_lf = forward_module._readonly(T_lf)  # the type the public functions pass
     J = np.empty((q.shape[0], 6, robot.n))
-    ok = _kernels.jacobian(_compiled.pack(robot), link, T_lf, q.reshape(-1), J.reshape(-1))
+    CF = _compiled.pack_frame(_compiled.pack(robot), link, T_lf)
+    ok = _kernels.jacobian(CF, q.reshape(-1), J.reshape(-1))
     assert ok
     return J
 

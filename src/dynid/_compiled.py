@@ -19,7 +19,10 @@ columns    row ``i`` (joint ``i + 1``, link ``i + 1`` in link ``i``)
 16-25      standard parameters ``phi[i]`` (``m, m c, J`` about the link origin)
 =========  =====================================================================
 
-Row ``n``, columns 0-2: gravity in the base frame [m/s^2].
+Row ``n``, columns 0-2: gravity in the base frame [m/s^2]. The kinematics kernels take a
+frame too: :func:`pack_frame` appends row ``n + 1`` holding the frame's pose ``T_lf`` in
+its link (16 entries, row-major, a tool already multiplied in) and, in column 16, the link
+(0 = base).
 """
 
 from __future__ import annotations
@@ -85,22 +88,59 @@ def pack(robot: Any, phi: Any = None, gravity: Any = None) -> NDArray[np.float64
     return C
 
 
-# a few robots' constants, by identity (robots are immutable; the entry keeps its robot
-# alive, so the id cannot be reused while the entry exists)
-_CACHE: dict[int, tuple[Any, NDArray[np.float64]]] = {}
+#: ``id(robot) -> (robot, C, n)`` for a few robots (robots are immutable; an entry keeps
+#: its robot alive, so the id cannot be reused while the entry exists). The thin
+#: single-sample paths read it directly.
+CACHE: dict[int, tuple[Any, NDArray[np.float64], int]] = {}
 _CACHE_SIZE = 16
 
 
 def constants(robot: Any) -> NDArray[np.float64]:
     """:func:`pack` of ``robot``, computed once per robot (a small cache by identity)."""
-    hit = _CACHE.get(id(robot))
+    hit = CACHE.get(id(robot))
     if hit is not None and hit[0] is robot:
         return hit[1]
     C = pack(robot)
-    if len(_CACHE) >= _CACHE_SIZE:
-        _CACHE.pop(next(iter(_CACHE)))
-    _CACHE[id(robot)] = (robot, C)
+    if len(CACHE) >= _CACHE_SIZE:
+        CACHE.pop(next(iter(CACHE)))
+    CACHE[id(robot)] = (robot, C, C.shape[0] - 1)
     return C
+
+
+#: float64 (the thin paths check ``x.dtype is F64``)
+F64 = np.dtype(np.float64)
+#: a float64 vector of any strides: the type of the thin paths' joint vectors ('A' layout)
+VECTOR = np.zeros(2)[::2]
+
+
+def entry(kernel: Any, *args: Any) -> Any:
+    """The compiled entry point of ``kernel`` for the numba types of ``args``.
+
+    Calling it skips numba's per-call type dispatch (a few hundred ns for five array
+    arguments), which dominates a single-sample call. The caller must then pass arguments
+    of exactly these kinds: the thin paths check ``type(x) is np.ndarray``, float64 and
+    the number of dimensions; the joint vectors are typed with any strides
+    (:data:`VECTOR`), the outputs are new C arrays. Returns ``kernel`` when numba offers no
+    entry point.
+    """
+    try:
+        from numba import typeof
+
+        sig = tuple(typeof(a) for a in args)
+        kernel.compile(sig)
+        return kernel.overloads[sig].entry_point
+    except Exception:  # noqa: BLE001 (an internal of numba moved: use the dispatcher)
+        return kernel
+
+
+def pack_frame(C: NDArray[np.float64], link: int, T_lf: NDArray[np.float64]) -> NDArray:
+    """``C`` with a last row for the frame ``T_lf`` (4, 4) of ``link`` (read-only)."""
+    CF = np.zeros((C.shape[0] + 1, C_WIDTH))
+    CF[:-1] = C
+    CF[-1, :16] = np.asarray(T_lf, dtype=np.float64).reshape(16)
+    CF[-1, 16] = link
+    CF.setflags(write=False)
+    return CF
 
 
 def flat(x: NDArray[np.float64]) -> NDArray[np.float64]:

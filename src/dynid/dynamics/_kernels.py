@@ -5,10 +5,10 @@ Imported lazily, on the first dynamics call (:func:`dynid._compiled.kernels`), n
 
 Arguments: ``C``, the robot's packed constants (:func:`dynid._compiled.pack`: joint
 transforms, axes, joint types, standard parameters ``phi`` and gravity [m/s^2] in the base
-frame). Joint arrays are C-contiguous float64 read flat, length ``B * n``, sample-major (a
-(B, n) array); ``dq`` and ``ddq`` of :func:`rnea` may also have length ``n``, one row for
-every sample. Results go into a C-contiguous output array read flat, ``B * n`` (``B * n *
-n`` for the mass matrices, row-major), which spares the boxing of a new array on each call.
+frame). Joint arrays are flat C-contiguous float64, length ``B * n``, sample-major (a
+(B, n) array reshaped); ``dq`` and ``ddq`` of :func:`rnea` may also have length ``n``, one
+row for every sample. Results go into a flat output array, ``B * n`` (the mass matrices:
+any C-contiguous shape, read flat, row-major), which spares the boxing of a new array.
 Every kernel checks that its joint inputs are finite and returns ``ok``; with
 ``ok = False`` the output is unfinished and the caller raises the error that names the
 bad entry.
@@ -42,14 +42,16 @@ import math
 import numpy as np
 
 from .._compiled import C_AXIS, C_PHI, C_PRISMATIC
+from ..kinematics._chain import IDENTITY, compose, finite, inline, jit, joint, joint_sc, joint_scd
 from ..kinematics._chain import SINCOS_MAX as _SINCOS_MAX
-from ..kinematics._chain import jit, joint, joint_sc
 from ..kinematics._chain import sincos as _sincos
 
 __all__ = ["BLOCK", "rnea", "gravity_torques", "mass_matrix"]
 
 #: Samples per block of :func:`rnea` (the length of the vectorised inner loop).
 BLOCK = 32
+#: Fewer samples than this take the scalar recursion (no block scratch to set up).
+SMALL = 4
 
 # rows of the scratch array X[link, row, sample] of the block kernel
 _Q, _V, _AC, _S, _C = 0, 1, 2, 3, 4  # q, dq, ddq, sin q, cos q of the joint into the link
@@ -61,21 +63,170 @@ _TAU = 32
 _ROWS = 33
 
 
+@inline
+def motion(T, w, dw, a, ex, ey, ez, ep, v, acc):
+    """Angular velocity, angular acceleration and origin acceleration (minus gravity) of a link.
+
+    ``T`` (12 floats) is the link's pose in its parent, ``w, dw, a`` (3-tuples) the parent's
+    motion in parent coordinates, ``(ex, ey, ez)`` the joint axis, ``ep`` 1.0 for a
+    prismatic joint (0.0 revolute), ``v, acc`` the joint rate and acceleration. Returns the
+    link's ``(w, dw, a)`` in link coordinates (9 floats; Featherstone 2008, sec. 5.3):
+    ``a' = R^T (a + dw x p + w x (w x p))``, then for a revolute joint ``w' += v e``,
+    ``dw' += w' x v e + acc e``, for a prismatic one ``a' += 2 w' x v e + acc e``.
+    """
+    r00, r01, r02, r10, r11, r12, r20, r21, r22, px, py, pz = T
+    wx, wy, wz = w
+    dwx, dwy, dwz = dw
+    ux = wy * pz - wz * py
+    uy = wz * px - wx * pz
+    uz = wx * py - wy * px
+    bx = a[0] + (dwy * pz - dwz * py) + (wy * uz - wz * uy)
+    by = a[1] + (dwz * px - dwx * pz) + (wz * ux - wx * uz)
+    bz = a[2] + (dwx * py - dwy * px) + (wx * uy - wy * ux)
+    apx = r00 * bx + r10 * by + r20 * bz
+    apy = r01 * bx + r11 * by + r21 * bz
+    apz = r02 * bx + r12 * by + r22 * bz
+    wpx = r00 * wx + r10 * wy + r20 * wz
+    wpy = r01 * wx + r11 * wy + r21 * wz
+    wpz = r02 * wx + r12 * wy + r22 * wz
+    dpx = r00 * dwx + r10 * dwy + r20 * dwz
+    dpy = r01 * dwx + r11 * dwy + r21 * dwz
+    dpz = r02 * dwx + r12 * dwy + r22 * dwz
+    vx, vy, vz = v * ex, v * ey, v * ez
+    cx = wpy * vz - wpz * vy
+    cy = wpz * vx - wpx * vz
+    cz = wpx * vy - wpy * vx
+    er = 1.0 - ep
+    return (
+        wpx + er * vx,
+        wpy + er * vy,
+        wpz + er * vz,
+        dpx + er * (cx + acc * ex),
+        dpy + er * (cy + acc * ey),
+        dpz + er * (cz + acc * ez),
+        apx + ep * (2.0 * cx + acc * ex),
+        apy + ep * (2.0 * cy + acc * ey),
+        apz + ep * (2.0 * cz + acc * ez),
+    )
+
+
+@inline
+def wrench(C, i, w, dw, a):
+    """Wrench ``(f, n)`` (6 floats) on link ``i + 1`` about its origin, link coordinates.
+
+    ``f = m a + dw x h + w x (w x h)``, ``n = J dw + w x (J w) + h x a`` with the link's
+    standard parameters ``m, h = m c, J`` (about the origin) from ``C``.
+    """
+    m = C[i, C_PHI]
+    hx, hy, hz = C[i, C_PHI + 1], C[i, C_PHI + 2], C[i, C_PHI + 3]
+    Jxx, Jxy, Jxz = C[i, C_PHI + 4], C[i, C_PHI + 5], C[i, C_PHI + 6]
+    Jyy, Jyz, Jzz = C[i, C_PHI + 7], C[i, C_PHI + 8], C[i, C_PHI + 9]
+    wx, wy, wz = w
+    dwx, dwy, dwz = dw
+    a0x, a0y, a0z = a
+    ux = wy * hz - wz * hy
+    uy = wz * hx - wx * hz
+    uz = wx * hy - wy * hx
+    jx = Jxx * wx + Jxy * wy + Jxz * wz
+    jy = Jxy * wx + Jyy * wy + Jyz * wz
+    jz = Jxz * wx + Jyz * wy + Jzz * wz
+    return (
+        m * a0x + (dwy * hz - dwz * hy) + (wy * uz - wz * uy),
+        m * a0y + (dwz * hx - dwx * hz) + (wz * ux - wx * uz),
+        m * a0z + (dwx * hy - dwy * hx) + (wx * uy - wy * ux),
+        (Jxx * dwx + Jxy * dwy + Jxz * dwz) + (wy * jz - wz * jy) + (hy * a0z - hz * a0y),
+        (Jxy * dwx + Jyy * dwy + Jyz * dwz) + (wz * jx - wx * jz) + (hz * a0x - hx * a0z),
+        (Jxz * dwx + Jyz * dwy + Jzz * dwz) + (wx * jy - wy * jx) + (hx * a0y - hy * a0x),
+    )
+
+
+@inline
+def carry(T, F, N):
+    """A link's wrench ``(F, N)`` about its origin carried into its parent (pose ``T``).
+
+    ``(R F, R N + p x R F)``, 6 floats.
+    """
+    r00, r01, r02, r10, r11, r12, r20, r21, r22, px, py, pz = T
+    Fx, Fy, Fz = F
+    Nx, Ny, Nz = N
+    RFx = r00 * Fx + r01 * Fy + r02 * Fz
+    RFy = r10 * Fx + r11 * Fy + r12 * Fz
+    RFz = r20 * Fx + r21 * Fy + r22 * Fz
+    RNx = r00 * Nx + r01 * Ny + r02 * Nz
+    RNy = r10 * Nx + r11 * Ny + r12 * Nz
+    RNz = r20 * Nx + r21 * Ny + r22 * Nz
+    return (
+        RFx,
+        RFy,
+        RFz,
+        RNx + (py * RFz - pz * RFy),
+        RNy + (pz * RFx - px * RFz),
+        RNz + (px * RFy - py * RFx),
+    )
+
+
+@inline
+def _rnea_sample(C, q, dq, ddq, oq, ov, oa, tau, S):
+    """RNEA of one sample (``q[oq : oq + n]``, ...) into ``tau[oq : oq + n]``; scratch ``S``.
+
+    The recursion of the block kernel in scalar form, for few samples (no block scratch).
+    """
+    n = C.shape[0] - 1
+    w = (0.0, 0.0, 0.0)
+    dw = (0.0, 0.0, 0.0)
+    a = (-C[n, 0], -C[n, 1], -C[n, 2])
+    for i in range(n):
+        s, c, d = joint_scd(C, i, q[oq + i])
+        T = joint_sc(C, i, s, c, d)
+        ep = C[i, C_PRISMATIC]
+        ex, ey, ez = C[i, C_AXIS], C[i, C_AXIS + 1], C[i, C_AXIS + 2]
+        M = motion(T, w, dw, a, ex, ey, ez, ep, dq[ov + i], ddq[oa + i])
+        w, dw, a = (M[0], M[1], M[2]), (M[3], M[4], M[5]), (M[6], M[7], M[8])
+        for k in range(12):
+            S[i, k] = T[k]
+        for k in range(9):
+            S[i, 12 + k] = M[k]
+    F = (0.0, 0.0, 0.0)
+    N = (0.0, 0.0, 0.0)
+    for i in range(n - 1, -1, -1):
+        f = wrench(
+            C, i, (S[i, 12], S[i, 13], S[i, 14]), (S[i, 15], S[i, 16], S[i, 17]),
+            (S[i, 18], S[i, 19], S[i, 20]),
+        )  # fmt: skip
+        if i < n - 1:
+            Tc = (
+                S[i + 1, 0], S[i + 1, 1], S[i + 1, 2], S[i + 1, 3], S[i + 1, 4], S[i + 1, 5],
+                S[i + 1, 6], S[i + 1, 7], S[i + 1, 8], S[i + 1, 9], S[i + 1, 10], S[i + 1, 11],
+            )  # fmt: skip
+            W = carry(Tc, F, N)
+            F = (f[0] + W[0], f[1] + W[1], f[2] + W[2])
+            N = (f[3] + W[3], f[4] + W[4], f[5] + W[5])
+        else:
+            F, N = (f[0], f[1], f[2]), (f[3], f[4], f[5])
+        ex, ey, ez = C[i, C_AXIS], C[i, C_AXIS + 1], C[i, C_AXIS + 2]
+        if C[i, C_PRISMATIC] != 0.0:
+            tau[oq + i] = F[0] * ex + F[1] * ey + F[2] * ez
+        else:
+            tau[oq + i] = N[0] * ex + N[1] * ey + N[2] * ez
+
+
 @jit
 def rnea(C, q, dq, ddq, tau):
     """Joint torques into ``tau`` (B n,) for q (B n,), dq and ddq (B n,) or (n,); ``ok``."""
-    q, dq, ddq, tau = (
-        q.reshape(q.size),
-        dq.reshape(dq.size),
-        ddq.reshape(ddq.size),
-        tau.reshape(tau.size),
-    )
     n = C.shape[0] - 1
     B = q.shape[0] // n
+    sv, sa = dq.shape[0] == q.shape[0], ddq.shape[0] == q.shape[0]  # else one row for all
+    if B < SMALL:  # a few samples: scalar recursion, no block scratch
+        S = np.empty((n, 21))
+        for b in range(B):
+            ov, oa = b * n if sv else 0, b * n if sa else 0
+            if not (finite(q, b * n, n) and finite(dq, ov, n) and finite(ddq, oa, n)):
+                return False
+            _rnea_sample(C, q, dq, ddq, b * n, ov, oa, tau, S)
+        return True
     # the block length is a compile-time constant, so the row stride of X is known and the
     # sample loops vectorise without run-time aliasing checks
     X = np.empty((n + 2, _ROWS, BLOCK))
-    sv, sa = dq.shape[0] == q.shape[0], ddq.shape[0] == q.shape[0]  # else one row for all
     # base (link 0): at rest, accelerating at -g; virtual link n + 1: identity, no wrench
     X[0, _W : _A + 3] = 0.0
     X[0, _A] = -C[n, 0]
@@ -119,7 +270,6 @@ def rnea(C, q, dq, ddq, tau):
             i = l - 1
             ax, ay, az = C[i, C_AXIS], C[i, C_AXIS + 1], C[i, C_AXIS + 2]
             ep = C[i, C_PRISMATIC]
-            er = 1.0 - ep
             for k in range(nb):
                 # pose of link l in link l - 1 (the chain core's joint transform)
                 r00, r01, r02, r10, r11, r12, r20, r21, r22, px, py, pz = joint_sc(
@@ -137,98 +287,55 @@ def rnea(C, q, dq, ddq, tau):
                 X[l, _P, k] = px
                 X[l, _P + 1, k] = py
                 X[l, _P + 2, k] = pz
-                wx, wy, wz = X[i, _W, k], X[i, _W + 1, k], X[i, _W + 2, k]
-                dwx, dwy, dwz = X[i, _DW, k], X[i, _DW + 1, k], X[i, _DW + 2, k]
-                # acceleration of the origin, parent coordinates: a0 + dw0 x p + w0 x (w0 x p)
-                ux = wy * pz - wz * py
-                uy = wz * px - wx * pz
-                uz = wx * py - wy * px
-                bx = X[i, _A, k] + (dwy * pz - dwz * py) + (wy * uz - wz * uy)
-                by = X[i, _A + 1, k] + (dwz * px - dwx * pz) + (wz * ux - wx * uz)
-                bz = X[i, _A + 2, k] + (dwx * py - dwy * px) + (wx * uy - wy * ux)
-                # into link coordinates: R^T
-                apx = r00 * bx + r10 * by + r20 * bz
-                apy = r01 * bx + r11 * by + r21 * bz
-                apz = r02 * bx + r12 * by + r22 * bz
-                wpx = r00 * wx + r10 * wy + r20 * wz
-                wpy = r01 * wx + r11 * wy + r21 * wz
-                wpz = r02 * wx + r12 * wy + r22 * wz
-                dpx = r00 * dwx + r10 * dwy + r20 * dwz
-                dpy = r01 * dwx + r11 * dwy + r21 * dwz
-                dpz = r02 * dwx + r12 * dwy + r22 * dwz
-                vi, ai = X[l, _V, k], X[l, _AC, k]
-                vx, vy, vz = vi * ax, vi * ay, vi * az
-                cx = wpy * vz - wpz * vy
-                cy = wpz * vx - wpx * vz
-                cz = wpx * vy - wpy * vx
-                # revolute: w += dq a, dw += w x dq a + ddq a; prismatic: a += 2 w x dq a + ddq a
-                X[l, _W, k] = wpx + er * vx
-                X[l, _W + 1, k] = wpy + er * vy
-                X[l, _W + 2, k] = wpz + er * vz
-                X[l, _DW, k] = dpx + er * (cx + ai * ax)
-                X[l, _DW + 1, k] = dpy + er * (cy + ai * ay)
-                X[l, _DW + 2, k] = dpz + er * (cz + ai * az)
-                X[l, _A, k] = apx + ep * (2.0 * cx + ai * ax)
-                X[l, _A + 1, k] = apy + ep * (2.0 * cy + ai * ay)
-                X[l, _A + 2, k] = apz + ep * (2.0 * cz + ai * az)
+                M = motion(
+                    (r00, r01, r02, r10, r11, r12, r20, r21, r22, px, py, pz),
+                    (X[i, _W, k], X[i, _W + 1, k], X[i, _W + 2, k]),
+                    (X[i, _DW, k], X[i, _DW + 1, k], X[i, _DW + 2, k]),
+                    (X[i, _A, k], X[i, _A + 1, k], X[i, _A + 2, k]),
+                    ax,
+                    ay,
+                    az,
+                    ep,
+                    X[l, _V, k],
+                    X[l, _AC, k],
+                )
+                X[l, _W, k] = M[0]
+                X[l, _W + 1, k] = M[1]
+                X[l, _W + 2, k] = M[2]
+                X[l, _DW, k] = M[3]
+                X[l, _DW + 1, k] = M[4]
+                X[l, _DW + 2, k] = M[5]
+                X[l, _A, k] = M[6]
+                X[l, _A + 1, k] = M[7]
+                X[l, _A + 2, k] = M[8]
         # inward pass: wrench on link l and its children, about origin l, link-l coordinates
         for l in range(n, 0, -1):
             i = l - 1
-            m = C[i, C_PHI]
-            hx, hy, hz = C[i, C_PHI + 1], C[i, C_PHI + 2], C[i, C_PHI + 3]
-            Jxx, Jxy, Jxz = C[i, C_PHI + 4], C[i, C_PHI + 5], C[i, C_PHI + 6]
-            Jyy, Jyz, Jzz = C[i, C_PHI + 7], C[i, C_PHI + 8], C[i, C_PHI + 9]
             ax, ay, az = C[i, C_AXIS], C[i, C_AXIS + 1], C[i, C_AXIS + 2]
             ep = C[i, C_PRISMATIC]
             er = 1.0 - ep
             c = l + 1
             for k in range(nb):
-                wx, wy, wz = X[l, _W, k], X[l, _W + 1, k], X[l, _W + 2, k]
-                dwx, dwy, dwz = X[l, _DW, k], X[l, _DW + 1, k], X[l, _DW + 2, k]
-                a0x, a0y, a0z = X[l, _A, k], X[l, _A + 1, k], X[l, _A + 2, k]
-                # f = m a + dw x h + w x (w x h)
-                ux = wy * hz - wz * hy
-                uy = wz * hx - wx * hz
-                uz = wx * hy - wy * hx
-                fx = m * a0x + (dwy * hz - dwz * hy) + (wy * uz - wz * uy)
-                fy = m * a0y + (dwz * hx - dwx * hz) + (wz * ux - wx * uz)
-                fz = m * a0z + (dwx * hy - dwy * hx) + (wx * uy - wy * ux)
-                # n = J dw + w x (J w) + h x a
-                jx = Jxx * wx + Jxy * wy + Jxz * wz
-                jy = Jxy * wx + Jyy * wy + Jyz * wz
-                jz = Jxz * wx + Jyz * wy + Jzz * wz
-                nx = (
-                    (Jxx * dwx + Jxy * dwy + Jxz * dwz)
-                    + (wy * jz - wz * jy)
-                    + (hy * a0z - hz * a0y)
+                f = wrench(
+                    C,
+                    i,
+                    (X[l, _W, k], X[l, _W + 1, k], X[l, _W + 2, k]),
+                    (X[l, _DW, k], X[l, _DW + 1, k], X[l, _DW + 2, k]),
+                    (X[l, _A, k], X[l, _A + 1, k], X[l, _A + 2, k]),
                 )
-                ny = (
-                    (Jxy * dwx + Jyy * dwy + Jyz * dwz)
-                    + (wz * jx - wx * jz)
-                    + (hz * a0x - hx * a0z)
-                )
-                nz = (
-                    (Jxz * dwx + Jyz * dwy + Jzz * dwz)
-                    + (wx * jy - wy * jx)
-                    + (hx * a0y - hy * a0x)
-                )
-                # plus the child's wrench carried into this frame: R F, R N + p x R F
-                r00, r01, r02 = X[c, _R, k], X[c, _R + 1, k], X[c, _R + 2, k]
-                r10, r11, r12 = X[c, _R + 3, k], X[c, _R + 4, k], X[c, _R + 5, k]
-                r20, r21, r22 = X[c, _R + 6, k], X[c, _R + 7, k], X[c, _R + 8, k]
-                px, py, pz = X[c, _P, k], X[c, _P + 1, k], X[c, _P + 2, k]
-                Fx, Fy, Fz = X[c, _F, k], X[c, _F + 1, k], X[c, _F + 2, k]
-                Nx, Ny, Nz = X[c, _N, k], X[c, _N + 1, k], X[c, _N + 2, k]
-                RFx = r00 * Fx + r01 * Fy + r02 * Fz
-                RFy = r10 * Fx + r11 * Fy + r12 * Fz
-                RFz = r20 * Fx + r21 * Fy + r22 * Fz
-                RNx = r00 * Nx + r01 * Ny + r02 * Nz
-                RNy = r10 * Nx + r11 * Ny + r12 * Nz
-                RNz = r20 * Nx + r21 * Ny + r22 * Nz
-                Nx = nx + RNx + (py * RFz - pz * RFy)
-                Ny = ny + RNy + (pz * RFx - px * RFz)
-                Nz = nz + RNz + (px * RFy - py * RFx)
-                Fx, Fy, Fz = fx + RFx, fy + RFy, fz + RFz
+                # plus the child's wrench carried into this frame
+                W = carry(
+                    (
+                        X[c, _R, k], X[c, _R + 1, k], X[c, _R + 2, k],
+                        X[c, _R + 3, k], X[c, _R + 4, k], X[c, _R + 5, k],
+                        X[c, _R + 6, k], X[c, _R + 7, k], X[c, _R + 8, k],
+                        X[c, _P, k], X[c, _P + 1, k], X[c, _P + 2, k],
+                    ),
+                    (X[c, _F, k], X[c, _F + 1, k], X[c, _F + 2, k]),
+                    (X[c, _N, k], X[c, _N + 1, k], X[c, _N + 2, k]),
+                )  # fmt: skip
+                Fx, Fy, Fz = f[0] + W[0], f[1] + W[1], f[2] + W[2]
+                Nx, Ny, Nz = f[3] + W[3], f[4] + W[4], f[5] + W[5]
                 X[l, _F, k] = Fx
                 X[l, _F + 1, k] = Fy
                 X[l, _F + 2, k] = Fz
@@ -246,15 +353,58 @@ def rnea(C, q, dq, ddq, tau):
 
 @jit
 def gravity_torques(C, q, tau):
-    """Gravity torques into ``tau`` (B n,) for q (B n,); returns ``ok``."""
-    zero = np.zeros(C.shape[0] - 1)
-    return rnea(C, q, zero, zero, tau)
+    """Gravity torques into ``tau`` (B n,) for q (B n,); returns ``ok``.
+
+    From the potential energy rather than a full RNEA (the velocities are zero): with
+    ``G = -g``, ``o_i``, ``z_i`` the origin and axis of joint i in the base frame and the
+    suffix sums ``M_i = sum_{l >= i} m_l``, ``S_i = sum_{l >= i} m_l p_l`` (``m_l p_l =
+    m_l o_l + R_l h_l``, the first moment of link l about the base origin),
+    ``tau_i = z_i . ((S_i - M_i o_i) x G)`` for a revolute joint and ``z_i . (M_i G)`` for a
+    prismatic one (Siciliano et al., *Robotics*, 2009, sec. 7.1.2).
+    """
+    n = C.shape[0] - 1
+    B = q.shape[0] // n
+    Gx, Gy, Gz = -C[n, 0], -C[n, 1], -C[n, 2]
+    S = np.empty((n, 9))  # per link: o, z, m p (base frame)
+    for b in range(B):
+        o = b * n
+        if not finite(q, o, n):
+            return False
+        P = IDENTITY
+        for i in range(n):
+            P = compose(P, joint(C, i, q[o + i]))
+            r00, r01, r02, r10, r11, r12, r20, r21, r22, ox, oy, oz = P
+            ex, ey, ez = C[i, C_AXIS], C[i, C_AXIS + 1], C[i, C_AXIS + 2]
+            m = C[i, C_PHI]
+            hx, hy, hz = C[i, C_PHI + 1], C[i, C_PHI + 2], C[i, C_PHI + 3]
+            S[i, 0], S[i, 1], S[i, 2] = ox, oy, oz
+            S[i, 3] = r00 * ex + r01 * ey + r02 * ez
+            S[i, 4] = r10 * ex + r11 * ey + r12 * ez
+            S[i, 5] = r20 * ex + r21 * ey + r22 * ez
+            S[i, 6] = m * ox + (r00 * hx + r01 * hy + r02 * hz)
+            S[i, 7] = m * oy + (r10 * hx + r11 * hy + r12 * hz)
+            S[i, 8] = m * oz + (r20 * hx + r21 * hy + r22 * hz)
+        M = Sx = Sy = Sz = 0.0
+        for i in range(n - 1, -1, -1):
+            M += C[i, C_PHI]
+            Sx += S[i, 6]
+            Sy += S[i, 7]
+            Sz += S[i, 8]
+            zx, zy, zz = S[i, 3], S[i, 4], S[i, 5]
+            if C[i, C_PRISMATIC] != 0.0:
+                tau[o + i] = M * (zx * Gx + zy * Gy + zz * Gz)
+            else:
+                rx, ry, rz = Sx - M * S[i, 0], Sy - M * S[i, 1], Sz - M * S[i, 2]
+                tau[o + i] = (
+                    zx * (ry * Gz - rz * Gy) + zy * (rz * Gx - rx * Gz) + zz * (rx * Gy - ry * Gx)
+                )
+    return True
 
 
 @jit
 def mass_matrix(C, q, M):
     """Mass matrices into ``M`` (B n n,) for q (B n,), composite-rigid-body; returns ``ok``."""
-    q, M = q.reshape(q.size), M.reshape(M.size)
+    M = M.reshape(M.size)
     n = C.shape[0] - 1
     B = q.shape[0] // n
     R = np.empty((n, 3, 3))

@@ -22,7 +22,7 @@ it.
 from __future__ import annotations
 
 from types import ModuleType
-from typing import NamedTuple
+from typing import Any, NamedTuple
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -53,7 +53,28 @@ def kernels() -> ModuleType | None:
     return _KERNELS
 
 
-_F64 = np.dtype(np.float64)
+_ND, _F64, _CACHE = np.ndarray, _compiled.F64, _compiled.CACHE
+#: compiled entry points of the kernels for one sample, by name (see :func:`_single`)
+_ONE: dict[str, Any] = {}
+
+
+def _single(name: str) -> Any:
+    """Kernel ``name``'s entry point for one sample, made on first use (kernels loaded).
+
+    Types: a read-only ``C``, float64 joint vectors of any strides, a new C output (see
+    :func:`dynid._compiled.entry`).
+    """
+    e = _ONE.get(name)
+    if e is None:
+        C = _checks.frozen(np.zeros((2, _compiled.C_WIDTH)))
+        v, tau, M = _compiled.VECTOR, np.zeros(1), np.zeros((1, 1))
+        args = {
+            "rnea": (C, v, v, v, tau),
+            "gravity_torques": (C, v, tau),
+            "mass_matrix": (C, v, M),
+        }[name]
+        e = _ONE[name] = _compiled.entry(getattr(_KERNELS, name), *args)
+    return e
 
 
 def _c64(x: ArrayLike) -> NDArray[np.float64] | None:
@@ -189,17 +210,33 @@ def rnea(
     -----
     Uses the compiled kernel when available (see :func:`kernels`), else :func:`rnea_numpy`.
     """
+    # single sample: three float64 (n,) arrays go straight to the kernel's compiled entry
+    # point (no conversion, no copy, no dispatch; the kernel checks finiteness)
+    hit = _CACHE.get(id(robot))
+    if hit is not None and _KERNELS is not None and gravity is None:
+        n = hit[2]
+        if (
+            hit[0] is robot
+            and type(q) is type(dq) is type(ddq) is _ND
+            and q.dtype is dq.dtype is ddq.dtype is _F64
+            and q.ndim == dq.ndim == ddq.ndim == 1
+            and len(q) == len(dq) == len(ddq) == n
+        ):
+            tau = np.empty(n)
+            if _single("rnea")(hit[1], q, dq, ddq, tau):
+                return tau
     K = _KERNELS if _LOADED else kernels()
     if K is not None and gravity is None:
-        # thin path for the common call: float64 C arrays of one shape (..., n) go to the
-        # kernel as they are; the kernel checks finiteness, and anything else (or a
-        # failure) falls through to the full validation below
+        # lean path: float64 C arrays of one shape (..., n) go to the kernel as they are;
+        # the kernel checks finiteness, and anything else (or a failure) falls through to
+        # the full validation below
         qa, va, aa = _c64(q), _c64(dq), _c64(ddq)
         if qa is not None and va is not None and aa is not None:
             shape = qa.shape
             if shape == va.shape == aa.shape and shape and shape[-1] == len(robot.joint_names):
                 tau = np.empty(shape)
-                if K.rnea(_constants(robot), qa, va, aa, tau):
+                f = _single("rnea") if len(shape) == 1 else K.rnea
+                if f(_constants(robot), _flat(qa), _flat(va), _flat(aa), tau.reshape(-1)):
                     return tau
     shape, (q2, dq2, ddq2) = _prepare(robot, q, dq, ddq)
     g = robot.gravity if gravity is None else _checks.as_exact("gravity", gravity, (3,))
@@ -245,7 +282,7 @@ def _rnea(
                 C = _constants(robot)
             else:
                 C = _compiled.pack(robot, np.asarray(phi, dtype=np.float64), gravity)
-            if K.rnea(C, _flat(q), _flat(dq), _flat(ddq), tau):
+            if K.rnea(C, _flat(q), _flat(dq), _flat(ddq), tau.reshape(-1)):
                 return tau
     return _rnea_numpy(robot, phi, q, dq, ddq, gravity)
 

@@ -24,7 +24,7 @@ from .. import _checks
 from .._compiled import constants as _constants
 from ..model.robot import Robot
 from . import rnea as _rnea_module
-from .rnea import _c64, _flat, _prepare, _rnea, _rnea_numpy, kernels
+from .rnea import _CACHE, _F64, _ND, _c64, _flat, _prepare, _rnea, _rnea_numpy, _single, kernels
 
 __all__ = [
     "mass_matrix",
@@ -82,14 +82,23 @@ def mass_matrix(robot: Robot, q: ArrayLike) -> NDArray[np.float64]:
     Composite-rigid-body algorithm in the compiled kernel when available; otherwise
     :func:`mass_matrix_numpy`.
     """
+    # single sample: a float64 (n,) array goes straight to the kernel's compiled entry point
+    hit = _CACHE.get(id(robot))
+    if hit is not None and _rnea_module._KERNELS is not None:
+        n = hit[2]
+        if hit[0] is robot and type(q) is _ND and q.dtype is _F64 and q.ndim == 1 and len(q) == n:
+            M = np.empty((n, n))
+            if _single("mass_matrix")(hit[1], q, M):
+                return M
     K = _rnea_module._KERNELS if _rnea_module._LOADED else kernels()
     if K is not None:
-        # thin path: a float64 C array (..., n) goes to the kernel as it is
+        # lean path: a float64 C array (..., n) goes to the kernel as it is
         qa = _c64(q)
         n = len(robot.joint_names)
         if qa is not None and qa.ndim and qa.shape[-1] == n:
             M = np.empty((n, n) if qa.ndim == 1 else qa.shape + (n,))
-            if K.mass_matrix(_constants(robot), qa, M):
+            f = _single("mass_matrix") if qa.ndim == 1 else K.mass_matrix
+            if f(_constants(robot), _flat(qa), M):
                 return M
     q = _checks.as_batch("q", q, (robot.n,))
     return _mass_matrix(robot, q.reshape(-1, robot.n)).reshape(q.shape + (robot.n,))
@@ -108,13 +117,22 @@ def gravity_torques(robot: Robot, q: ArrayLike) -> NDArray[np.float64]:
     ------
     ShapeError, NonFiniteError
     """
+    # single sample: a float64 (n,) array goes straight to the kernel's compiled entry point
+    hit = _CACHE.get(id(robot))
+    if hit is not None and _rnea_module._KERNELS is not None:
+        n = hit[2]
+        if hit[0] is robot and type(q) is _ND and q.dtype is _F64 and q.ndim == 1 and len(q) == n:
+            tau = np.empty(n)
+            if _single("gravity_torques")(hit[1], q, tau):
+                return tau
     K = _rnea_module._KERNELS if _rnea_module._LOADED else kernels()
     if K is not None:
-        # thin path: a float64 C array (..., n) goes to the kernel as it is
+        # lean path: a float64 C array (..., n) goes to the kernel as it is
         qa = _c64(q)
         if qa is not None and qa.ndim and qa.shape[-1] == len(robot.joint_names):
             tau = np.empty(qa.shape)
-            if K.gravity_torques(_constants(robot), qa, tau):
+            f = _single("gravity_torques") if qa.ndim == 1 else K.gravity_torques
+            if f(_constants(robot), _flat(qa), tau.reshape(-1)):
                 return tau
     q = _checks.as_batch("q", q, (robot.n,))
     q2 = q.reshape(-1, robot.n)

@@ -3,11 +3,12 @@
 Imported lazily, on the first kinematics call (:func:`dynid._compiled.kernels`), never by
 ``import dynid``; compiled once and cached on disk (:func:`dynid.kinematics._chain.jit`).
 
-Arguments: ``C``, the robot's packed constants (:func:`dynid._compiled.pack`); a frame as
-its ``link`` (0 = base) and its pose ``T_lf`` (4, 4) in that link, a tool already
-multiplied in; joint positions ``q``, flat C-contiguous float64 of length ``B * n``,
-sample-major (a (B, n) array, any C-contiguous shape is read flat). Results go into a
-C-contiguous output array, read flat, row-major:
+Arguments: ``C``, the robot's packed constants (:func:`dynid._compiled.pack`), with a
+last row for the frame (:func:`dynid._compiled.pack_frame`: its ``link``, 0 = base, and its
+pose ``T_lf`` in that link, a tool already multiplied in) for :func:`frame_pose` and
+:func:`jacobian`; joint positions ``q``, flat float64 of length ``B * n``,
+sample-major (a (B, n) array reshaped). Results go into a C-contiguous output array of
+any shape, read flat, row-major:
 ``B * (n + 1) * 16`` for the link poses, ``B * 16`` for a frame pose, ``B * 6 * n`` for a
 Jacobian. Every kernel checks that ``q`` is finite and returns ``ok``; with ``ok = False``
 the output is unfinished and the caller raises the error that names the bad entry.
@@ -41,22 +42,22 @@ def _put_pose(P, out, o):
 
 
 @inline
-def _frame(P, T_lf, out, o):
-    """``[R p; 0 1] @ T_lf`` into ``out[o : o + 16]``, row-major."""
+def _frame(P, C, f, out, o):
+    """``[R p; 0 1] @ T_lf`` into ``out[o : o + 16]``, row-major; ``T_lf`` is row ``f`` of C."""
     for r in range(3):
         a0, a1, a2, a3 = P[3 * r], P[3 * r + 1], P[3 * r + 2], P[9 + r]
         for c in range(4):
             out[o + 4 * r + c] = (
-                a0 * T_lf[0, c] + a1 * T_lf[1, c] + a2 * T_lf[2, c] + a3 * T_lf[3, c]
+                a0 * C[f, c] + a1 * C[f, 4 + c] + a2 * C[f, 8 + c] + a3 * C[f, 12 + c]
             )
     for c in range(4):
-        out[o + 12 + c] = T_lf[3, c]
+        out[o + 12 + c] = C[f, 12 + c]
 
 
 @jit
 def link_poses(C, q, out):
     """Link poses into ``out`` (B (n + 1) 16,) for q (B n,); returns ``ok``."""
-    q, out = q.reshape(q.size), out.reshape(out.size)
+    out = out.reshape(out.size)
     n = C.shape[0] - 1
     B = q.shape[0] // n
     for b in range(B):
@@ -72,10 +73,11 @@ def link_poses(C, q, out):
 
 
 @jit
-def frame_pose(C, link, T_lf, q, out):
-    """Pose of the frame ``T_lf`` of ``link`` into ``out`` (B 16,) for q (B n,); ``ok``."""
-    q, out = q.reshape(q.size), out.reshape(out.size)
-    n = C.shape[0] - 1
+def frame_pose(C, q, out):
+    """Pose of the frame of ``C``'s last row into ``out`` (B 16,) for q (B n,); ``ok``."""
+    out = out.reshape(out.size)
+    n = C.shape[0] - 2
+    link = int(C[n + 1, 16])
     B = q.shape[0] // n
     for b in range(B):
         if not finite(q, b * n, n):
@@ -83,15 +85,17 @@ def frame_pose(C, link, T_lf, q, out):
         P = IDENTITY
         for i in range(link):
             P = compose(P, joint(C, i, q[b * n + i]))
-        _frame(P, T_lf, out, b * 16)
+        _frame(P, C, n + 1, out, b * 16)
     return True
 
 
 @jit
-def jacobian(C, link, T_lf, q, J):
-    """Jacobian of the origin of frame ``T_lf`` of ``link`` into ``J`` (B 6 n,); ``ok``."""
-    q, J = q.reshape(q.size), J.reshape(J.size)
-    n = C.shape[0] - 1
+def jacobian(C, q, J):
+    """Jacobian of the origin of the frame of ``C``'s last row into ``J`` (B 6 n,); ``ok``."""
+    J = J.reshape(J.size)
+    n = C.shape[0] - 2
+    f = n + 1
+    link = int(C[f, 16])
     B = q.shape[0] // n
     for b in range(B):
         if not finite(q, b * n, n):
@@ -112,9 +116,9 @@ def jacobian(C, link, T_lf, q, J):
             for r in range(6):
                 J[o + r * n + i] = 0.0
         # the frame origin p, then the columns
-        px = P[0] * T_lf[0, 3] + P[1] * T_lf[1, 3] + P[2] * T_lf[2, 3] + P[9] * T_lf[3, 3]
-        py = P[3] * T_lf[0, 3] + P[4] * T_lf[1, 3] + P[5] * T_lf[2, 3] + P[10] * T_lf[3, 3]
-        pz = P[6] * T_lf[0, 3] + P[7] * T_lf[1, 3] + P[8] * T_lf[2, 3] + P[11] * T_lf[3, 3]
+        px = P[0] * C[f, 3] + P[1] * C[f, 7] + P[2] * C[f, 11] + P[9] * C[f, 15]
+        py = P[3] * C[f, 3] + P[4] * C[f, 7] + P[5] * C[f, 11] + P[10] * C[f, 15]
+        pz = P[6] * C[f, 3] + P[7] * C[f, 7] + P[8] * C[f, 11] + P[11] * C[f, 15]
         for i in range(link):
             zx, zy, zz = J[o + 3 * n + i], J[o + 4 * n + i], J[o + 5 * n + i]
             if C[i, C_PRISMATIC] != 0.0:

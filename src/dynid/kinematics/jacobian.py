@@ -20,10 +20,14 @@ from ..model.robot import Robot
 from . import forward as _forward
 from .forward import (
     _F64,
+    _FRAMES,
+    _ND,
+    _ONE,
     _as_q,
-    _constants,
-    _frame_in_link,
+    _flat,
+    _frame_constants,
     _link_poses,
+    _single,
     check_q,
     frame_pose_in_link,
 )
@@ -62,13 +66,27 @@ def jacobian(
     Uses the compiled kernel when available (see :func:`dynid.kinematics.forward.kernels`),
     else :func:`jacobian_numpy`.
     """
-    if tool is None:
-        link, T_link_frame = _frame_in_link(robot, frame)
-    else:
-        link, T_link_frame = frame_pose_in_link(robot, frame, tool)
+    # single sample: a float64 (n,) array goes straight to the kernel's compiled entry
+    # point (no conversion, no copy, no dispatch; the kernel checks finiteness)
+    hit = _FRAMES.get((id(robot), frame))
+    e = _ONE.get("jacobian")
+    if (
+        e is not None
+        and hit is not None
+        and tool is None
+        and hit[0] is robot
+        and type(q) is _ND
+        and q.dtype is _F64
+        and q.ndim == 1
+        and len(q) == hit[4]
+    ):
+        J = np.empty((6, hit[4]))
+        if e(hit[3], q, J):
+            return J
+    link, T_link_frame, CF = _frame_constants(robot, frame, tool)
     K = _forward._KERNELS if _forward._LOADED else _forward.kernels()
     if K is not None:
-        # thin path: a float64 C array of shape (..., n) goes to the kernel as it is
+        # lean path: a float64 C array of shape (..., n) goes to the kernel as it is
         if type(q) is np.ndarray and q.dtype is _F64 and q.flags.c_contiguous:
             qa: NDArray[np.float64] | None = q
         else:
@@ -76,7 +94,8 @@ def jacobian(
         n = len(robot.joint_names)
         if qa is not None and qa.ndim and qa.shape[-1] == n:
             J = np.empty((6, n) if qa.ndim == 1 else qa.shape[:-1] + (6, n))
-            if K.jacobian(_constants(robot), link, T_link_frame, qa, J):
+            f = _single("jacobian") if qa.ndim == 1 else K.jacobian
+            if f(CF, _flat(qa), J):
                 return J
     return _jacobian_numpy(robot, q, link, T_link_frame)
 

@@ -30,6 +30,7 @@ import math
 import numpy as np
 
 from .._compiled import C_AXIS, C_PRISMATIC
+from ..dynamics._kernels import motion
 from ..kinematics._chain import IDENTITY, compose, finite, jit, joint
 
 __all__ = ["BLOCK", "static_regressor"]
@@ -182,7 +183,6 @@ def torque_regressor(C, q, dq, ddq, cols, Y):
     other columns of ``Y`` are left as they are. Every entry of a written column is
     written (zeros where link ``l`` comes before joint ``i``).
     """
-    q, dq, ddq = q.reshape(q.size), dq.reshape(dq.size), ddq.reshape(ddq.size)
     n = C.shape[0] - 1
     B = q.shape[0] // n
     WF = np.empty((n, 3, 4))  # force columns (m, mc) of link l's wrench, base frame
@@ -198,42 +198,12 @@ def torque_regressor(C, q, dq, ddq, cols, Y):
         ax0, ay0, az0 = -C[n, 0], -C[n, 1], -C[n, 2]
         for i in range(n):
             T = joint(C, i, q[o + i])
-            r00, r01, r02, r10, r11, r12, r20, r21, r22, px, py, pz = T
-            # origin acceleration (minus gravity) in the parent: a + dw x p + w x (w x p)
-            ux = wy * pz - wz * py
-            uy = wz * px - wx * pz
-            uz = wx * py - wy * px
-            bx = ax0 + (dwy * pz - dwz * py) + (wy * uz - wz * uy)
-            by = ay0 + (dwz * px - dwx * pz) + (wz * ux - wx * uz)
-            bz = az0 + (dwx * py - dwy * px) + (wx * uy - wy * ux)
-            # into link coordinates: R^T
-            apx = r00 * bx + r10 * by + r20 * bz
-            apy = r01 * bx + r11 * by + r21 * bz
-            apz = r02 * bx + r12 * by + r22 * bz
-            wpx = r00 * wx + r10 * wy + r20 * wz
-            wpy = r01 * wx + r11 * wy + r21 * wz
-            wpz = r02 * wx + r12 * wy + r22 * wz
-            dpx = r00 * dwx + r10 * dwy + r20 * dwz
-            dpy = r01 * dwx + r11 * dwy + r21 * dwz
-            dpz = r02 * dwx + r12 * dwy + r22 * dwz
             ex, ey, ez = C[i, C_AXIS], C[i, C_AXIS + 1], C[i, C_AXIS + 2]
-            vi, ai = dq[o + i], ddq[o + i]
-            vx, vy, vz = vi * ex, vi * ey, vi * ez
-            cx = wpy * vz - wpz * vy
-            cy = wpz * vx - wpx * vz
-            cz = wpx * vy - wpy * vx
-            if C[i, C_PRISMATIC] != 0.0:
-                wx, wy, wz = wpx, wpy, wpz
-                dwx, dwy, dwz = dpx, dpy, dpz
-                ax0 = apx + (2.0 * cx + ai * ex)
-                ay0 = apy + (2.0 * cy + ai * ey)
-                az0 = apz + (2.0 * cz + ai * ez)
-            else:
-                wx, wy, wz = wpx + vx, wpy + vy, wpz + vz
-                dwx = dpx + (cx + ai * ex)
-                dwy = dpy + (cy + ai * ey)
-                dwz = dpz + (cz + ai * ez)
-                ax0, ay0, az0 = apx, apy, apz
+            M = motion(
+                T, (wx, wy, wz), (dwx, dwy, dwz), (ax0, ay0, az0), ex, ey, ez,
+                C[i, C_PRISMATIC], dq[o + i], ddq[o + i],
+            )  # fmt: skip
+            wx, wy, wz, dwx, dwy, dwz, ax0, ay0, az0 = M
             P = compose(P, T)  # base pose of link i + 1
             R00, R01, R02, R10, R11, R12, R20, R21, R22, ox, oy, oz = P
             # joint axis z in the base frame and the projection [F; N] -> tau_i
