@@ -89,48 +89,59 @@ def frame_pose(C, q, out):
     return True
 
 
+@inline
+def frame_jacobian(C, q, oq, link, J, oj, stride):
+    """Jacobian columns ``0..link-1`` of the origin of ``C``'s frame (its last row).
+
+    ``q[oq : oq + link]`` moves the frame; column ``i``, row ``r`` goes to
+    ``J[oj + r * stride + i]``. Returns the pose of ``link`` in the base (12 floats).
+    """
+    f = C.shape[0] - 1
+    P = IDENTITY
+    # first pass: joint axis z_i into rows 3-5 and link origin o_i into rows 0-2
+    for i in range(link):
+        P = compose(P, joint(C, i, q[oq + i]))
+        ax, ay, az = C[i, C_AXIS], C[i, C_AXIS + 1], C[i, C_AXIS + 2]
+        J[oj + i] = P[9]
+        J[oj + stride + i] = P[10]
+        J[oj + 2 * stride + i] = P[11]
+        J[oj + 3 * stride + i] = P[0] * ax + P[1] * ay + P[2] * az
+        J[oj + 4 * stride + i] = P[3] * ax + P[4] * ay + P[5] * az
+        J[oj + 5 * stride + i] = P[6] * ax + P[7] * ay + P[8] * az
+    # the frame origin p, then the columns
+    px = P[0] * C[f, 3] + P[1] * C[f, 7] + P[2] * C[f, 11] + P[9] * C[f, 15]
+    py = P[3] * C[f, 3] + P[4] * C[f, 7] + P[5] * C[f, 11] + P[10] * C[f, 15]
+    pz = P[6] * C[f, 3] + P[7] * C[f, 7] + P[8] * C[f, 11] + P[11] * C[f, 15]
+    for i in range(link):
+        zx, zy, zz = J[oj + 3 * stride + i], J[oj + 4 * stride + i], J[oj + 5 * stride + i]
+        if C[i, C_PRISMATIC] != 0.0:
+            J[oj + i], J[oj + stride + i], J[oj + 2 * stride + i] = zx, zy, zz
+            J[oj + 3 * stride + i] = 0.0
+            J[oj + 4 * stride + i] = 0.0
+            J[oj + 5 * stride + i] = 0.0
+        else:
+            rx = px - J[oj + i]
+            ry = py - J[oj + stride + i]
+            rz = pz - J[oj + 2 * stride + i]
+            J[oj + i] = zy * rz - zz * ry
+            J[oj + stride + i] = zz * rx - zx * rz
+            J[oj + 2 * stride + i] = zx * ry - zy * rx
+    return P
+
+
 @jit
 def jacobian(C, q, J):
     """Jacobian of the origin of the frame of ``C``'s last row into ``J`` (B 6 n,); ``ok``."""
     J = J.reshape(J.size)
     n = C.shape[0] - 2
-    f = n + 1
-    link = int(C[f, 16])
+    link = int(C[n + 1, 16])
     B = q.shape[0] // n
     for b in range(B):
         if not finite(q, b * n, n):
             return False
         o = b * 6 * n
-        P = IDENTITY
-        # first pass: joint axis z_i into rows 3-5 and link origin o_i into rows 0-2
-        for i in range(link):
-            P = compose(P, joint(C, i, q[b * n + i]))
-            ax, ay, az = C[i, C_AXIS], C[i, C_AXIS + 1], C[i, C_AXIS + 2]
-            J[o + i] = P[9]
-            J[o + n + i] = P[10]
-            J[o + 2 * n + i] = P[11]
-            J[o + 3 * n + i] = P[0] * ax + P[1] * ay + P[2] * az
-            J[o + 4 * n + i] = P[3] * ax + P[4] * ay + P[5] * az
-            J[o + 5 * n + i] = P[6] * ax + P[7] * ay + P[8] * az
+        frame_jacobian(C, q, b * n, link, J, o, n)
         for i in range(link, n):
             for r in range(6):
                 J[o + r * n + i] = 0.0
-        # the frame origin p, then the columns
-        px = P[0] * C[f, 3] + P[1] * C[f, 7] + P[2] * C[f, 11] + P[9] * C[f, 15]
-        py = P[3] * C[f, 3] + P[4] * C[f, 7] + P[5] * C[f, 11] + P[10] * C[f, 15]
-        pz = P[6] * C[f, 3] + P[7] * C[f, 7] + P[8] * C[f, 11] + P[11] * C[f, 15]
-        for i in range(link):
-            zx, zy, zz = J[o + 3 * n + i], J[o + 4 * n + i], J[o + 5 * n + i]
-            if C[i, C_PRISMATIC] != 0.0:
-                J[o + i], J[o + n + i], J[o + 2 * n + i] = zx, zy, zz
-                J[o + 3 * n + i] = 0.0
-                J[o + 4 * n + i] = 0.0
-                J[o + 5 * n + i] = 0.0
-            else:
-                rx = px - J[o + i]
-                ry = py - J[o + n + i]
-                rz = pz - J[o + 2 * n + i]
-                J[o + i] = zy * rz - zz * ry
-                J[o + n + i] = zz * rx - zx * rz
-                J[o + 2 * n + i] = zx * ry - zy * rx
     return True
