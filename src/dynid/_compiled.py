@@ -29,6 +29,7 @@ from __future__ import annotations
 
 import importlib
 import os
+import sys
 from types import ModuleType
 from typing import Any
 
@@ -65,6 +66,16 @@ def optional(module: str) -> ModuleType | None:
             mod = None
     _LOADED[module] = mod
     return mod
+
+
+def numba_loaded() -> bool:
+    """numba is already imported in this process.
+
+    A single sample takes a kernel only then (or once its kernels are loaded): importing
+    numba and loading a kernel cost about a second, the numpy path tens of microseconds,
+    so a one-shot call (a command line call on one configuration) stays on the numpy path.
+    """
+    return "numba" in sys.modules
 
 
 def kernels(package: str) -> ModuleType | None:

@@ -53,6 +53,18 @@ def kernels() -> ModuleType | None:
     return _KERNELS
 
 
+def _kernels_for(ndim: int) -> ModuleType | None:
+    """The kernels for an input with ``ndim`` dimensions, or None for the numpy path.
+
+    A batch (``ndim > 1``) loads them; a single sample uses them once they are loaded or
+    numba is imported (:func:`dynid._compiled.numba_loaded`), else the numpy path, which
+    gives the same numbers to rounding without the start-up cost of the kernels.
+    """
+    if _LOADED:
+        return _KERNELS
+    return kernels() if ndim > 1 or _compiled.numba_loaded() else None
+
+
 _ND, _F64, _CACHE = np.ndarray, _compiled.F64, _compiled.CACHE
 #: compiled entry points of the kernels for one sample, by name (see :func:`_single`)
 _ONE: dict[str, Any] = {}
@@ -225,13 +237,13 @@ def rnea(
             tau = np.empty(n)
             if _single("rnea")(hit[1], q, dq, ddq, tau):
                 return tau
-    K = _KERNELS if _LOADED else kernels()
-    if K is not None and gravity is None:
+    if gravity is None:
         # lean path: float64 C arrays of one shape (..., n) go to the kernel as they are;
         # the kernel checks finiteness, and anything else (or a failure) falls through to
         # the full validation below
         qa, va, aa = _c64(q), _c64(dq), _c64(ddq)
-        if qa is not None and va is not None and aa is not None:
+        K = None if qa is None else _kernels_for(qa.ndim)
+        if K is not None and qa is not None and va is not None and aa is not None:
             shape = qa.shape
             if shape == va.shape == aa.shape and shape and shape[-1] == len(robot.joint_names):
                 tau = np.empty(shape)
@@ -273,7 +285,7 @@ def _rnea(
     The compiled kernel when available, else :func:`_rnea_numpy`. ``dq`` and ``ddq`` may
     also be (1, n), one row for every sample.
     """
-    K = _KERNELS if _LOADED else kernels()
+    K = _kernels_for(1 + (q.shape[0] > 1))
     if K is not None:
         B, n = q.shape
         if dq.shape[0] in (1, B) and ddq.shape[0] in (1, B):

@@ -90,12 +90,12 @@ def mass_matrix(robot: Robot, q: ArrayLike) -> NDArray[np.float64]:
             M = np.empty((n, n))
             if _single("mass_matrix")(hit[1], q, M):
                 return M
-    K = _rnea_module._KERNELS if _rnea_module._LOADED else kernels()
-    if K is not None:
-        # lean path: a float64 C array (..., n) goes to the kernel as it is
-        qa = _c64(q)
+    # lean path: a float64 C array (..., n) goes to the kernel as it is
+    qa = _c64(q)
+    K = None if qa is None else _rnea_module._kernels_for(qa.ndim)
+    if K is not None and qa is not None:
         n = len(robot.joint_names)
-        if qa is not None and qa.ndim and qa.shape[-1] == n:
+        if qa.ndim and qa.shape[-1] == n:
             M = np.empty((n, n) if qa.ndim == 1 else qa.shape + (n,))
             f = _single("mass_matrix") if qa.ndim == 1 else K.mass_matrix
             if f(_constants(robot), _flat(qa), M):
@@ -125,11 +125,11 @@ def gravity_torques(robot: Robot, q: ArrayLike) -> NDArray[np.float64]:
             tau = np.empty(n)
             if _single("gravity_torques")(hit[1], q, tau):
                 return tau
-    K = _rnea_module._KERNELS if _rnea_module._LOADED else kernels()
-    if K is not None:
-        # lean path: a float64 C array (..., n) goes to the kernel as it is
-        qa = _c64(q)
-        if qa is not None and qa.ndim and qa.shape[-1] == len(robot.joint_names):
+    # lean path: a float64 C array (..., n) goes to the kernel as it is
+    qa = _c64(q)
+    K = None if qa is None else _rnea_module._kernels_for(qa.ndim)
+    if K is not None and qa is not None:
+        if qa.ndim and qa.shape[-1] == len(robot.joint_names):
             tau = np.empty(qa.shape)
             f = _single("gravity_torques") if qa.ndim == 1 else K.gravity_torques
             if f(_constants(robot), _flat(qa), tau.reshape(-1)):

@@ -57,6 +57,18 @@ def kernels() -> ModuleType | None:
     return _KERNELS
 
 
+def _kernels_for(ndim: int) -> ModuleType | None:
+    """The kernels for an input with ``ndim`` dimensions, or None for the numpy path.
+
+    A batch (``ndim > 1``) loads them; a single sample uses them once they are loaded or
+    numba is imported (:func:`dynid._compiled.numba_loaded`), else the numpy path, which
+    gives the same numbers to rounding without the start-up cost of the kernels.
+    """
+    if _LOADED:
+        return _KERNELS
+    return kernels() if ndim > 1 or _compiled.numba_loaded() else None
+
+
 _ND = np.ndarray
 #: compiled entry points of the kernels for one sample, by name (see :func:`_single`)
 _ONE: dict[str, Any] = {}
@@ -208,13 +220,12 @@ def link_poses(robot: Robot, q: ArrayLike) -> NDArray[np.float64]:
     T_base_link : ndarray, shape (..., n + 1, 4, 4)
         Index 0 is the base (identity), index i is link i; translations in [m].
     """
-    K = _KERNELS if _LOADED else kernels()
-    if K is not None:
-        qa = _as_q(robot, q)
-        if qa is not None:
-            T = np.empty(qa.shape[:-1] + (qa.shape[-1] + 1, 4, 4))
-            if K.link_poses(_constants(robot), _flat(qa), T):
-                return T
+    qa = _as_q(robot, q)
+    K = None if qa is None else _kernels_for(qa.ndim)
+    if K is not None and qa is not None:
+        T = np.empty(qa.shape[:-1] + (qa.shape[-1] + 1, 4, 4))
+        if K.link_poses(_constants(robot), _flat(qa), T):
+            return T
     return link_poses_numpy(robot, q)
 
 
@@ -290,14 +301,14 @@ def fk(
         if e(hit[3], q, T):
             return T
     link, T_link_frame, CF = _frame_constants(robot, frame, tool)
-    K = _KERNELS if _LOADED else kernels()
-    if K is not None:
-        # lean path: a float64 C array of shape (..., n) goes to the kernel as it is
-        if type(q) is np.ndarray and q.dtype is _F64 and q.flags.c_contiguous:
-            qa: NDArray[np.float64] | None = q
-        else:
-            qa = _as_q(robot, q)
-        if qa is not None and qa.ndim and qa.shape[-1] == len(robot.joint_names):
+    # lean path: a float64 C array of shape (..., n) goes to the kernel as it is
+    if type(q) is np.ndarray and q.dtype is _F64 and q.flags.c_contiguous:
+        qa: NDArray[np.float64] | None = q
+    else:
+        qa = _as_q(robot, q)
+    K = None if qa is None else _kernels_for(qa.ndim)
+    if K is not None and qa is not None:
+        if qa.ndim and qa.shape[-1] == len(robot.joint_names):
             T = np.empty((4, 4) if qa.ndim == 1 else qa.shape[:-1] + (4, 4))
             f = _single("frame_pose") if qa.ndim == 1 else K.frame_pose
             if f(CF, _flat(qa), T):

@@ -75,7 +75,6 @@ from typing import Any
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
-from scipy.linalg import lapack
 
 from .. import _checks, _compiled
 from ..exceptions import DataError, LimitError, ShapeError, WrongTypeError
@@ -364,6 +363,8 @@ def _rotvec(R: NDArray[np.float64]) -> tuple[float, float, float, float]:
 
 def _dls(J: NDArray[np.float64], e: NDArray[np.float64], lam_max: float, eps: float) -> NDArray:
     """Damped least-squares solution ``J^# e`` with singular-value dependent damping."""
+    from scipy.linalg import lapack  # the numpy loop only: not on the import path
+
     U, s, Vt, info = lapack.dgesdd(J, full_matrices=0)
     if info != 0:  # LAPACK did not converge: numpy's driver raises a clear error
         U, s, Vt = np.linalg.svd(J, full_matrices=False)
@@ -560,7 +561,8 @@ def ik(
     fpar, ipar = _parameters(opts)
     path = np.empty((opts.max_iterations + 1, n))
     path[0] = q
-    K = _kernel() if m > 0 else None
+    # one goal: the kernel once numba is imported (else the numpy loop: no start-up cost)
+    K = _kernel() if m > 0 and _compiled.numba_loaded() else None
     q_best = np.empty(n)
     q_restart = np.empty((0, m))
     while True:  # a second pass only when the first one asks for restart configurations

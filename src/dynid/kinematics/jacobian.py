@@ -84,15 +84,15 @@ def jacobian(
         if e(hit[3], q, J):
             return J
     link, T_link_frame, CF = _frame_constants(robot, frame, tool)
-    K = _forward._KERNELS if _forward._LOADED else _forward.kernels()
-    if K is not None:
-        # lean path: a float64 C array of shape (..., n) goes to the kernel as it is
-        if type(q) is np.ndarray and q.dtype is _F64 and q.flags.c_contiguous:
-            qa: NDArray[np.float64] | None = q
-        else:
-            qa = _as_q(robot, q)
+    # lean path: a float64 C array of shape (..., n) goes to the kernel as it is
+    if type(q) is np.ndarray and q.dtype is _F64 and q.flags.c_contiguous:
+        qa: NDArray[np.float64] | None = q
+    else:
+        qa = _as_q(robot, q)
+    K = None if qa is None else _forward._kernels_for(qa.ndim)
+    if K is not None and qa is not None:
         n = len(robot.joint_names)
-        if qa is not None and qa.ndim and qa.shape[-1] == n:
+        if qa.ndim and qa.shape[-1] == n:
             J = np.empty((6, n) if qa.ndim == 1 else qa.shape[:-1] + (6, n))
             f = _single("jacobian") if qa.ndim == 1 else K.jacobian
             if f(CF, _flat(qa), J):
