@@ -601,8 +601,9 @@ def ik(
 
 def _check_within_limits(robot: Robot, q: NDArray[np.float64]) -> None:
     """Raise :class:`LimitError` naming the first start (row of ``q`` (B, n)) outside."""
-    outside = np.argwhere((q < robot.q_min) | (q > robot.q_max))
-    if outside.size:
+    bad = (q < robot.q_min) | (q > robot.q_max)
+    if bad.any():
+        outside = np.argwhere(bad)
         b, j = (int(x) for x in outside[0])
         where = "" if q.shape[0] == 1 else f" (start {b})"
         raise LimitError(
@@ -611,18 +612,37 @@ def _check_within_limits(robot: Robot, q: NDArray[np.float64]) -> None:
         )
 
 
+_LIMITS: dict[tuple[int, int, bool], tuple[Robot, tuple[NDArray, NDArray, NDArray]]] = {}
+
+
 def _limits(robot: Robot, m: int, opts: IKOptions) -> tuple[NDArray, NDArray, NDArray]:
-    """Position limits and inverse velocity limits (0: none) of the first ``m`` joints."""
+    """Position limits and inverse velocity limits (0: none) of the first ``m`` joints.
+
+    Remembered for a few robots (by identity; robots are immutable); never written to.
+    """
+    key = (id(robot), m, bool(opts.velocity_limits))
+    hit = _LIMITS.get(key)
+    if hit is not None and hit[0] is robot:
+        return hit[1]
     q_min, q_max = np.array(robot.q_min[:m]), np.array(robot.q_max[:m])
     inv_vmax = np.zeros(m)
     if opts.velocity_limits:
         dq_max = robot.dq_max[:m]
         inv_vmax = np.where(np.isfinite(dq_max), 1.0 / dq_max, 0.0)
+    if len(_LIMITS) >= 16:
+        _LIMITS.pop(next(iter(_LIMITS)))
+    _LIMITS[key] = (robot, (q_min, q_max, inv_vmax))
     return q_min, q_max, inv_vmax
 
 
+_PARAMETERS: dict[int, tuple[IKOptions, tuple[NDArray[np.float64], NDArray[np.int64]]]] = {}
+
+
 def _parameters(opts: IKOptions) -> tuple[NDArray[np.float64], NDArray[np.int64]]:
-    """The options as the solvers' ``fpar`` and ``ipar`` arrays."""
+    """The options as the solvers' ``fpar`` and ``ipar`` arrays (remembered per options)."""
+    hit = _PARAMETERS.get(id(opts))
+    if hit is not None and hit[0] is opts:
+        return hit[1]
     fpar = np.array(
         [
             opts.dt,
@@ -637,6 +657,9 @@ def _parameters(opts: IKOptions) -> tuple[NDArray[np.float64], NDArray[np.int64]
         ]
     )
     ipar = np.array([opts.max_iterations, opts.stall_iterations, opts.max_restarts], np.int64)
+    if len(_PARAMETERS) >= 16:
+        _PARAMETERS.pop(next(iter(_PARAMETERS)))
+    _PARAMETERS[id(opts)] = (opts, (fpar, ipar))
     return fpar, ipar
 
 
