@@ -121,7 +121,7 @@ def constants(robot: Any) -> NDArray[np.float64]:
 #: float64 (the thin paths check ``x.dtype is F64``)
 F64 = np.dtype(np.float64)
 #: a float64 vector of any strides: the type of the thin paths' joint vectors ('A' layout)
-VECTOR = np.zeros(2)[::2]
+VECTOR = np.zeros(4)[::2]  # (2,) with stride 16: not contiguous, so typed with any strides
 
 
 def entry(kernel: Any, *args: Any) -> Any:
