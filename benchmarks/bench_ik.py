@@ -12,7 +12,8 @@ on the 200 goals times N (the loop itself would take minutes). Targets (issue 11
 one-goal solve under 60 us, a batch at over 20,000 goals/s, 200/200 goals reached.
 
 The kernels are loaded before timing (a single goal takes the compiled solver once numba
-is loaded; a one-shot call takes the numpy loop, see ``dynid._compiled.numba_loaded``).
+is loaded; a one-shot call takes the numpy loop, see
+``dynid._compiled.small_call_uses_kernels``).
 """
 
 from __future__ import annotations

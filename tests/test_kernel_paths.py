@@ -131,14 +131,20 @@ def test_single_sample_thin_path_takes_the_kernel_and_checks_its_input(panda):
         dynid.mass_matrix(panda, q[:6])
 
 
-def test_one_sample_call_in_a_fresh_process_does_not_load_numba():
-    """A one-shot single-sample call stays on the numpy path; a batch call loads the kernels."""
+@pytest.mark.parametrize("then", ["batch", "many single calls"])
+def test_one_sample_call_in_a_fresh_process_does_not_load_numba(then):
+    """A one-shot single sample stays on numpy; a batch or SMALL_CALLS more load the kernels."""
     code = (
         "import sys, numpy as np, dynid\n"
+        "from dynid import _compiled\n"
         "r = dynid.panda(); q = np.linspace(-1, 1, 7)\n"
         "dynid.fk(r, q); dynid.rnea(r, q, q, q); dynid.jacobian(r, q)\n"
         "assert 'numba' not in sys.modules, 'numba imported by a single sample'\n"
-        "dynid.fk(r, np.stack([q, q]))\n"
-        "assert 'numba' in sys.modules\n"
+        + (
+            "dynid.fk(r, np.stack([q, q]))\n"
+            if then == "batch"
+            else "for _ in range(_compiled.SMALL_CALLS): dynid.gravity_torques(r, q)\n"
+        )
+        + "assert 'numba' in sys.modules\n"
     )
     subprocess.run([sys.executable, "-c", code], check=True)

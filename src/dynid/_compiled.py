@@ -69,13 +69,29 @@ def optional(module: str) -> ModuleType | None:
 
 
 def numba_loaded() -> bool:
-    """numba is already imported in this process.
-
-    A single sample takes a kernel only then (or once its kernels are loaded): importing
-    numba and loading a kernel cost about a second, the numpy path tens of microseconds,
-    so a one-shot call (a command line call on one configuration) stays on the numpy path.
-    """
+    """numba is already imported in this process."""
     return "numba" in sys.modules
+
+
+#: single-sample calls that take the numpy path before the kernels are loaded for them
+SMALL_CALLS = 256
+_small_calls = 0
+
+
+def small_call_uses_kernels() -> bool:
+    """Whether a single-sample call should load and use the compiled kernels.
+
+    Importing numba and loading a kernel cost about a second, a single sample on the numpy
+    path tens of microseconds to a millisecond: a one-shot call (a command line call on one
+    configuration) stays on the numpy path. Once numba is imported (by any batch call) or
+    after :data:`SMALL_CALLS` single-sample calls in the process, the kernels are used
+    (rent or buy). Both paths give the same numbers to rounding (about 1e-15 relative).
+    """
+    global _small_calls
+    if "numba" in sys.modules:
+        return True
+    _small_calls += 1
+    return _small_calls > SMALL_CALLS
 
 
 def kernels(package: str) -> ModuleType | None:

@@ -60,13 +60,13 @@ def kernels() -> ModuleType | None:
 def _kernels_for(ndim: int) -> ModuleType | None:
     """The kernels for an input with ``ndim`` dimensions, or None for the numpy path.
 
-    A batch (``ndim > 1``) loads them; a single sample uses them once they are loaded or
-    numba is imported (:func:`dynid._compiled.numba_loaded`), else the numpy path, which
-    gives the same numbers to rounding without the start-up cost of the kernels.
+    A batch (``ndim > 1``) loads them; a single sample uses them once they are loaded,
+    else as :func:`dynid._compiled.small_call_uses_kernels` decides (the numpy path gives
+    the same numbers to rounding without the start-up cost of the kernels).
     """
     if _LOADED:
         return _KERNELS
-    return kernels() if ndim > 1 or _compiled.numba_loaded() else None
+    return kernels() if ndim > 1 or _compiled.small_call_uses_kernels() else None
 
 
 _ND = np.ndarray

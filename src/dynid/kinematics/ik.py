@@ -561,8 +561,9 @@ def ik(
     fpar, ipar = _parameters(opts)
     path = np.empty((opts.max_iterations + 1, n))
     path[0] = q
-    # one goal: the kernel once numba is imported (else the numpy loop: no start-up cost)
-    K = _kernel() if m > 0 and _compiled.numba_loaded() else None
+    # one goal: the kernel once loaded or as small_call_uses_kernels decides (a one-shot
+    # call takes the numpy loop: no start-up cost)
+    K = _kernel() if m > 0 and _compiled.small_call_uses_kernels() else None
     q_best = np.empty(n)
     q_restart = np.empty((0, m))
     while True:  # a second pass only when the first one asks for restart configurations
