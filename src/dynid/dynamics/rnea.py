@@ -225,7 +225,8 @@ def rnea(
     # single sample: three float64 (n,) arrays go straight to the kernel's compiled entry
     # point (no conversion, no copy, no dispatch; the kernel checks finiteness)
     hit = _CACHE.get(id(robot))
-    if hit is not None and _KERNELS is not None and gravity is None:
+    e = _ONE.get("rnea")
+    if hit is not None and e is not None and gravity is None:
         n = hit[2]
         if (
             hit[0] is robot
@@ -235,7 +236,7 @@ def rnea(
             and len(q) == len(dq) == len(ddq) == n
         ):
             tau = np.empty(n)
-            if _single("rnea")(hit[1], q, dq, ddq, tau):
+            if e(hit[1], q, dq, ddq, tau):
                 return tau
     if gravity is None:
         # lean path: float64 C arrays of one shape (..., n) go to the kernel as they are;

@@ -24,7 +24,19 @@ from .. import _checks
 from .._compiled import constants as _constants
 from ..model.robot import Robot
 from . import rnea as _rnea_module
-from .rnea import _CACHE, _F64, _ND, _c64, _flat, _prepare, _rnea, _rnea_numpy, _single, kernels
+from .rnea import (
+    _CACHE,
+    _F64,
+    _ND,
+    _ONE,
+    _c64,
+    _flat,
+    _prepare,
+    _rnea,
+    _rnea_numpy,
+    _single,
+    kernels,
+)
 
 __all__ = [
     "mass_matrix",
@@ -84,11 +96,12 @@ def mass_matrix(robot: Robot, q: ArrayLike) -> NDArray[np.float64]:
     """
     # single sample: a float64 (n,) array goes straight to the kernel's compiled entry point
     hit = _CACHE.get(id(robot))
-    if hit is not None and _rnea_module._KERNELS is not None:
+    e = _ONE.get("mass_matrix")
+    if hit is not None and e is not None:
         n = hit[2]
         if hit[0] is robot and type(q) is _ND and q.dtype is _F64 and q.ndim == 1 and len(q) == n:
             M = np.empty((n, n))
-            if _single("mass_matrix")(hit[1], q, M):
+            if e(hit[1], q, M):
                 return M
     # lean path: a float64 C array (..., n) goes to the kernel as it is
     qa = _c64(q)
@@ -119,11 +132,12 @@ def gravity_torques(robot: Robot, q: ArrayLike) -> NDArray[np.float64]:
     """
     # single sample: a float64 (n,) array goes straight to the kernel's compiled entry point
     hit = _CACHE.get(id(robot))
-    if hit is not None and _rnea_module._KERNELS is not None:
+    e = _ONE.get("gravity_torques")
+    if hit is not None and e is not None:
         n = hit[2]
         if hit[0] is robot and type(q) is _ND and q.dtype is _F64 and q.ndim == 1 and len(q) == n:
             tau = np.empty(n)
-            if _single("gravity_torques")(hit[1], q, tau):
+            if e(hit[1], q, tau):
                 return tau
     # lean path: a float64 C array (..., n) goes to the kernel as it is
     qa = _c64(q)
