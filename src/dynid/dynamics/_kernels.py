@@ -42,7 +42,18 @@ import math
 import numpy as np
 
 from .._compiled import C_AXIS, C_PHI, C_PRISMATIC
-from ..kinematics._chain import IDENTITY, compose, finite, inline, jit, joint, joint_sc, joint_scd
+from ..kinematics._chain import (
+    IDENTITY,
+    compose,
+    finite,
+    fixed,
+    inline,
+    jit,
+    joint,
+    joint_from,
+    joint_sc,
+    joint_scd,
+)
 from ..kinematics._chain import SINCOS_MAX as _SINCOS_MAX
 from ..kinematics._chain import sincos as _sincos
 
@@ -111,16 +122,22 @@ def motion(T, w, dw, a, ex, ey, ez, ep, v, acc):
 
 
 @inline
-def wrench(C, i, w, dw, a):
-    """Wrench ``(f, n)`` (6 floats) on link ``i + 1`` about its origin, link coordinates.
+def inertial(C, i):
+    """Link ``i + 1``'s standard parameters ``(m, hx, hy, hz, Jxx, Jxy, Jxz, Jyy, Jyz, Jzz)``."""
+    return (
+        C[i, C_PHI], C[i, C_PHI + 1], C[i, C_PHI + 2], C[i, C_PHI + 3], C[i, C_PHI + 4],
+        C[i, C_PHI + 5], C[i, C_PHI + 6], C[i, C_PHI + 7], C[i, C_PHI + 8], C[i, C_PHI + 9],
+    )  # fmt: skip
+
+
+@inline
+def wrench(phi, w, dw, a):
+    """Wrench ``(f, n)`` (6 floats) on a link about its origin, link coordinates.
 
     ``f = m a + dw x h + w x (w x h)``, ``n = J dw + w x (J w) + h x a`` with the link's
-    standard parameters ``m, h = m c, J`` (about the origin) from ``C``.
+    standard parameters ``phi = (m, h = m c, J)`` (:func:`inertial`, J about the origin).
     """
-    m = C[i, C_PHI]
-    hx, hy, hz = C[i, C_PHI + 1], C[i, C_PHI + 2], C[i, C_PHI + 3]
-    Jxx, Jxy, Jxz = C[i, C_PHI + 4], C[i, C_PHI + 5], C[i, C_PHI + 6]
-    Jyy, Jyz, Jzz = C[i, C_PHI + 7], C[i, C_PHI + 8], C[i, C_PHI + 9]
+    m, hx, hy, hz, Jxx, Jxy, Jxz, Jyy, Jyz, Jzz = phi
     wx, wy, wz = w
     dwx, dwy, dwz = dw
     a0x, a0y, a0z = a
@@ -190,7 +207,7 @@ def _rnea_sample(C, q, dq, ddq, oq, ov, oa, tau, S):
     N = (0.0, 0.0, 0.0)
     for i in range(n - 1, -1, -1):
         f = wrench(
-            C, i, (S[i, 12], S[i, 13], S[i, 14]), (S[i, 15], S[i, 16], S[i, 17]),
+            inertial(C, i), (S[i, 12], S[i, 13], S[i, 14]), (S[i, 15], S[i, 16], S[i, 17]),
             (S[i, 18], S[i, 19], S[i, 20]),
         )  # fmt: skip
         if i < n - 1:
@@ -270,10 +287,11 @@ def rnea(C, q, dq, ddq, tau):
             i = l - 1
             ax, ay, az = C[i, C_AXIS], C[i, C_AXIS + 1], C[i, C_AXIS + 2]
             ep = C[i, C_PRISMATIC]
+            F, e = fixed(C, i)  # constants out of the sample loop (it vectorises)
             for k in range(nb):
                 # pose of link l in link l - 1 (the chain core's joint transform)
-                r00, r01, r02, r10, r11, r12, r20, r21, r22, px, py, pz = joint_sc(
-                    C, i, X[l, _S, k], X[l, _C, k], ep * X[l, _Q, k]
+                r00, r01, r02, r10, r11, r12, r20, r21, r22, px, py, pz = joint_from(
+                    F, e, X[l, _S, k], X[l, _C, k], ep * X[l, _Q, k]
                 )
                 X[l, _R, k] = r00
                 X[l, _R + 1, k] = r01
@@ -315,10 +333,10 @@ def rnea(C, q, dq, ddq, tau):
             ep = C[i, C_PRISMATIC]
             er = 1.0 - ep
             c = l + 1
+            phi = inertial(C, i)  # constants out of the sample loop (it vectorises)
             for k in range(nb):
                 f = wrench(
-                    C,
-                    i,
+                    phi,
                     (X[l, _W, k], X[l, _W + 1, k], X[l, _W + 2, k]),
                     (X[l, _DW, k], X[l, _DW + 1, k], X[l, _DW + 2, k]),
                     (X[l, _A, k], X[l, _A + 1, k], X[l, _A + 2, k]),
@@ -355,7 +373,8 @@ def rnea(C, q, dq, ddq, tau):
 def gravity_torques(C, q, tau):
     """Gravity torques into ``tau`` (B n,) for q (B n,); returns ``ok``.
 
-    From the potential energy rather than a full RNEA (the velocities are zero): with
+    Many samples: :func:`rnea` at rest (vectorised over samples). A few: from the potential
+    energy rather than a full RNEA (the velocities are zero): with
     ``G = -g``, ``o_i``, ``z_i`` the origin and axis of joint i in the base frame and the
     suffix sums ``M_i = sum_{l >= i} m_l``, ``S_i = sum_{l >= i} m_l p_l`` (``m_l p_l =
     m_l o_l + R_l h_l``, the first moment of link l about the base origin),
@@ -364,6 +383,9 @@ def gravity_torques(C, q, tau):
     """
     n = C.shape[0] - 1
     B = q.shape[0] // n
+    if B >= SMALL:  # many samples: the vectorised RNEA block kernel at rest is faster
+        zero = np.zeros(n)
+        return rnea(C, q, zero, zero, tau)
     Gx, Gy, Gz = -C[n, 0], -C[n, 1], -C[n, 2]
     S = np.empty((n, 9))  # per link: o, z, m p (base frame)
     for b in range(B):

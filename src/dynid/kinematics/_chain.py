@@ -34,7 +34,17 @@ import numpy as np
 
 from .._compiled import C_AXIS, C_PRISMATIC, C_T
 
-__all__ = ["jit", "sincos", "joint_sc", "joint", "compose", "IDENTITY", "SINCOS_MAX"]
+__all__ = [
+    "jit",
+    "sincos",
+    "fixed",
+    "joint_from",
+    "joint_sc",
+    "joint",
+    "compose",
+    "IDENTITY",
+    "SINCOS_MAX",
+]
 
 #: a * b + c may be one fused multiply-add; no reassociation, no approximate functions
 FASTMATH = {"contract"}
@@ -110,12 +120,24 @@ def joint_scd(C, i, qi):
 
 
 @inline
-def joint_sc(C, i, s, c, d):
-    """Pose of link ``i + 1`` in link ``i`` as 12 floats ``(R row-major, p)``.
+def fixed(C, i):
+    """Joint ``i``'s fixed transform (12 floats ``(R row-major, p)``) and unit axis (3)."""
+    T = (
+        C[i, C_T], C[i, C_T + 1], C[i, C_T + 2], C[i, C_T + 4], C[i, C_T + 5], C[i, C_T + 6],
+        C[i, C_T + 8], C[i, C_T + 9], C[i, C_T + 10], C[i, C_T + 3], C[i, C_T + 7],
+        C[i, C_T + 11],
+    )  # fmt: skip
+    return T, (C[i, C_AXIS], C[i, C_AXIS + 1], C[i, C_AXIS + 2])
 
-    ``T_parent_joint[i] [Rot(a, s, c), d a; 0, 1]``; see the module docstring.
+
+@inline
+def joint_from(F, a, s, c, d):
+    """Pose of a link in its parent (12 floats) from its joint's :func:`fixed` constants.
+
+    ``F [Rot(a, s, c), d a; 0, 1]`` (Rodrigues, ``K K = a a^T - E``); see the module
+    docstring. Loops over samples hoist ``fixed`` out and call this inside.
     """
-    ax, ay, az = C[i, C_AXIS], C[i, C_AXIS + 1], C[i, C_AXIS + 2]
+    ax, ay, az = a
     v = 1.0 - c
     q00 = 1.0 + v * (ax * ax - 1.0)
     q11 = 1.0 + v * (ay * ay - 1.0)
@@ -127,9 +149,7 @@ def joint_sc(C, i, s, c, d):
     q12 = -s * ax + v * (ay * az)
     q21 = s * ax + v * (ay * az)
     dx, dy, dz = d * ax, d * ay, d * az
-    t00, t01, t02, t03 = C[i, C_T], C[i, C_T + 1], C[i, C_T + 2], C[i, C_T + 3]
-    t10, t11, t12, t13 = C[i, C_T + 4], C[i, C_T + 5], C[i, C_T + 6], C[i, C_T + 7]
-    t20, t21, t22, t23 = C[i, C_T + 8], C[i, C_T + 9], C[i, C_T + 10], C[i, C_T + 11]
+    t00, t01, t02, t10, t11, t12, t20, t21, t22, t03, t13, t23 = F
     return (
         t00 * q00 + t01 * q10 + t02 * q20,
         t00 * q01 + t01 * q11 + t02 * q21,
@@ -144,6 +164,13 @@ def joint_sc(C, i, s, c, d):
         t13 + (t10 * dx + t11 * dy + t12 * dz),
         t23 + (t20 * dx + t21 * dy + t22 * dz),
     )
+
+
+@inline
+def joint_sc(C, i, s, c, d):
+    """Pose of link ``i + 1`` in link ``i`` as 12 floats ``(R row-major, p)``."""
+    F, a = fixed(C, i)
+    return joint_from(F, a, s, c, d)
 
 
 @inline
