@@ -209,7 +209,7 @@ class IKResult:
     iterations: Any
     position_error: Any
     orientation_error: Any
-    path: NDArray[np.float64] | None
+    path: Any
     restarts: Any = 0
 
 
