@@ -35,7 +35,6 @@ from .rnea import (
     _rnea,
     _rnea_numpy,
     _single,
-    kernels,
 )
 
 __all__ = [
@@ -53,7 +52,7 @@ _ZERO_G = _checks.frozen(np.zeros(3))
 
 def _mass_matrix(robot: Robot, q2: NDArray[np.float64]) -> NDArray[np.float64]:
     """(B, n, n) mass matrices for validated (B, n) positions (kernel when available)."""
-    K = kernels()
+    K = _rnea_module._kernels_for(1 + (q2.shape[0] > 1))
     if K is not None:
         B, n = q2.shape
         M = np.empty((B, n, n))
