@@ -62,8 +62,8 @@ numpy loop (``_solve_numpy``) otherwise or when the environment variable
 ``DYNID_NO_NUMBA=1`` is set before the first call. Both take the same steps, and the
 tests check that their paths agree. The kernel takes the frame pose and the Jacobian from
 the chain core (:func:`dynid.kinematics._kernels.frame_jacobian`); the numpy loop from
-``_Chain``, checked against :func:`dynid.kinematics.forward.fk` and
-:func:`dynid.kinematics.jacobian.jacobian`. For one goal, restart configurations are
+the numpy reference path of :func:`dynid.kinematics.forward.fk` and
+:func:`dynid.kinematics.jacobian.jacobian` (``_Chain``). For one goal, restart configurations are
 drawn from ``rng`` only when a stall asks for them.
 """
 
@@ -80,6 +80,7 @@ from .. import _checks, _compiled
 from ..exceptions import DataError, LimitError, ShapeError, WrongTypeError
 from ..model.robot import Robot
 from .forward import _frame_constants
+from .jacobian import _frame_pose_jacobian_numpy
 
 __all__ = ["IKOptions", "IKResult", "check_pose", "default_q0", "ik"]
 
@@ -269,66 +270,25 @@ def check_pose(name: str, T: ArrayLike) -> NDArray[np.float64]:
 
 # ---------------------------------------------------------------------- single sample
 class _Chain:
-    """Single-sample forward kinematics and Jacobian of one frame, with small arrays.
+    """Pose and Jacobian of one frame for one sample, for the numpy loop.
 
-    The motion of revolute joint ``i`` is ``T_fix (I + sin q K + (1 - cos q) K^2)`` with
-    ``K = [a]x``, of a prismatic one ``T_fix (I + q [0 a; 0 0])``. Both are affine in
-    ``(1, sin q, cos q, q)``: ``A[0] + sin q A[1] + cos q A[2] + q A[3]``, so the
-    coefficients ``A`` (4, m, 4, 4) are formed once and a call costs a few broadcast
-    operations. Only the ``m`` joints up to the frame's link move it.
+    The numpy reference path of :func:`dynid.kinematics.forward.fk` and
+    :func:`dynid.kinematics.jacobian.jacobian` (one pass of link poses for both), so the
+    forward kinematics is not written again here. Only the ``m = link`` joints up to the
+    frame's link move it.
     """
 
-    __slots__ = ("m", "A", "axes", "rev", "T_link_frame")
+    __slots__ = ("robot", "m", "T_link_frame")
 
     def __init__(self, robot: Robot, link: int, T_link_frame: NDArray[np.float64]) -> None:
-        m = link
-        a = robot.axes[:m]
-        rev = ~robot.prismatic[:m]
-        K = np.zeros((m, 3, 3))  # [a]x, zero for prismatic joints
-        K[:, 0, 1], K[:, 0, 2], K[:, 1, 2] = -a[:, 2], a[:, 1], -a[:, 0]
-        K[:, 1, 0], K[:, 2, 0], K[:, 2, 1] = a[:, 2], -a[:, 1], a[:, 0]
-        K *= rev[:, None, None]
-        KK = K @ K
-        Rf = robot.T_parent_joint[:m, :3, :3]
-        A = np.zeros((4, m, 4, 4))
-        A[0, :, :3, :3] = Rf + Rf @ KK
-        A[0, :, :3, 3] = robot.T_parent_joint[:m, :3, 3]
-        A[0, :, 3, 3] = 1.0
-        A[1, :, :3, :3] = Rf @ K
-        A[2, :, :3, :3] = -(Rf @ KK)
-        A[3, :, :3, 3] = (Rf @ (a * ~rev[:, None])[:, :, None])[:, :, 0]
-        self.m = m
-        self.A = A
-        self.axes = np.array(a)
-        self.rev = np.array(rev)
+        self.robot = robot
+        self.m = link
         self.T_link_frame = np.array(T_link_frame)
 
     def pose_jacobian(self, q: NDArray[np.float64]) -> tuple[NDArray, NDArray]:
         """``T_base_frame`` (4, 4) and the Jacobian (6, m) of the first ``m`` joints."""
-        m = self.m
-        if m == 0:
-            return self.T_link_frame.copy(), np.zeros((6, 0))
-        qm = q[:m]
-        A = self.A
-        T = A[0] + np.sin(qm)[:, None, None] * A[1] + np.cos(qm)[:, None, None] * A[2]
-        if not self.rev.all():
-            T += qm[:, None, None] * A[3]
-        d = 1
-        while d < m:  # prefix products T_base_link_i (Hillis-Steele scan)
-            T[d:] = T[:-d] @ T[d:]
-            d *= 2
-        Te = T[m - 1] @ self.T_link_frame
-        z = (T[:, :3, :3] @ self.axes[:, :, None])[:, :, 0]  # joint axes in the base frame
-        r = Te[:3, 3] - T[:, :3, 3]  # joint origins to the frame origin
-        J = np.empty((6, m))
-        J[0] = z[:, 1] * r[:, 2] - z[:, 2] * r[:, 1]
-        J[1] = z[:, 2] * r[:, 0] - z[:, 0] * r[:, 2]
-        J[2] = z[:, 0] * r[:, 1] - z[:, 1] * r[:, 0]
-        J[3:] = z.T
-        if not self.rev.all():
-            J[:3, ~self.rev] = z[~self.rev].T
-            J[3:, ~self.rev] = 0.0
-        return Te, J
+        T, J = _frame_pose_jacobian_numpy(self.robot, q[None], self.m, self.T_link_frame)
+        return T[0], J[0, :, : self.m]
 
 
 def _rotvec(R: NDArray[np.float64]) -> tuple[float, float, float, float]:

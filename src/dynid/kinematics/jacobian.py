@@ -116,18 +116,31 @@ def _jacobian_numpy(
 ) -> NDArray[np.float64]:
     """The numpy path of :func:`jacobian` once the frame is resolved: validates ``q``."""
     q = check_q(robot, q)
-    T = _link_poses(robot, q.reshape(-1, robot.n))
-    p = (T[:, link] @ T_link_frame)[:, :3, 3]  # (B, 3)
+    J = _frame_pose_jacobian_numpy(robot, q.reshape(-1, robot.n), link, T_link_frame)[1]
+    return J.reshape(q.shape[:-1] + (6, robot.n))
+
+
+def _frame_pose_jacobian_numpy(
+    robot: Robot, q2: NDArray[np.float64], link: int, T_link_frame: NDArray[np.float64]
+) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+    """Frame pose (B, 4, 4) and Jacobian (B, 6, n) for validated (B, n) ``q2``, numpy path.
+
+    One pass of :func:`dynid.kinematics.forward._link_poses` for both (the numpy loop of
+    :func:`dynid.kinematics.ik.ik` uses it too).
+    """
+    T = _link_poses(robot, q2)
+    Tf = T[:, link] @ T_link_frame
+    p = Tf[:, :3, 3]  # (B, 3)
     z = (T[:, 1:, :3, :3] @ robot.axes[:, :, None])[..., 0]  # (B, n, 3)
     o = T[:, 1:, :3, 3]
-    J = np.zeros((q.reshape(-1, robot.n).shape[0], 6, robot.n))
+    J = np.zeros((q2.shape[0], 6, robot.n))
     rev = ~robot.prismatic
     lin = np.where(rev[:, None], np.cross(z, p[:, None, :] - o), z)
     ang = np.where(rev[:, None], z, 0.0)
     active = np.arange(1, robot.n + 1) <= link
     J[:, :3, :] = np.swapaxes(lin, 1, 2) * active
     J[:, 3:, :] = np.swapaxes(ang, 1, 2) * active
-    return J.reshape(q.shape[:-1] + (6, robot.n))
+    return Tf, J
 
 
 def jacobian_to_tool(
