@@ -10,6 +10,7 @@ import pytest
 
 import dynid
 from dynid import spatial
+from dynid.exceptions import DataError, LimitError, ShapeError
 from dynid.kinematics import IKOptions, IKResult, default_q0, ik
 
 from conftest import random_states
@@ -170,8 +171,8 @@ def test_ik_compiled_kernel_and_numpy_loop_agree(panda, monkeypatch):
     goals.append((spatial.transform_from_xyz_rpy([1.5, 0.0, 0.3]), None))  # unreachable
     opts = IKOptions(max_restarts=3)
     compiled = [ik(panda, T, tool=tool, options=opts) for T, tool in goals]
-    assert ik_module._COMPILED["kernel"] is not None
-    monkeypatch.setitem(ik_module._COMPILED, "kernel", None)
+    assert ik_module._kernel() is not None
+    monkeypatch.setattr(ik_module, "_kernel", lambda: None)
     restarts = 0
     for (T, tool), rc in zip(goals, compiled, strict=True):
         rn = ik(panda, T, tool=tool, options=opts)
@@ -181,6 +182,44 @@ def test_ik_compiled_kernel_and_numpy_loop_agree(panda, monkeypatch):
         np.testing.assert_allclose(rn.position_error, rc.position_error, rtol=1e-6, atol=1e-12)
         restarts += rn.restarts
     assert restarts > 0  # the restart branch was exercised
+
+
+def test_ik_batch_of_goals_equals_the_loop_of_single_goals(panda, monkeypatch):
+    """Goals (3, 2, 4, 4) with q0 broadcast: each result equals its one-goal solve (issue 11)."""
+    rng = np.random.default_rng(31)
+    q_true = rng.uniform(panda.q_min, panda.q_max, (3, 2, 7))
+    goals = dynid.fk(panda, q_true, tool=TOOL)
+    goals[2, 1] = spatial.transform_from_xyz_rpy([1.5, 0.0, 0.3])  # unreachable: restarts
+    q0 = np.array(dynid.PANDA_NEUTRAL_Q)
+    opts = IKOptions(max_restarts=2)
+    for numpy_loop in (False, True):
+        if numpy_loop:
+            monkeypatch.setattr(ik_module, "_kernel", lambda: None)
+        res = ik(panda, goals, q0, tool=TOOL, options=opts)
+        assert res.q.shape == (3, 2, 7) and res.path is None
+        for name in ("converged", "iterations", "position_error", "orientation_error"):
+            assert getattr(res, name).shape == (3, 2)
+        for idx in np.ndindex(3, 2):
+            one = ik(panda, goals[idx], q0, tool=TOOL, options=opts)
+            assert (res.converged[idx], res.iterations[idx]) == (one.converged, one.iterations)
+            assert res.restarts[idx] == one.restarts
+            np.testing.assert_allclose(res.q[idx], one.q, atol=1e-9)
+            np.testing.assert_allclose(res.position_error[idx], one.position_error, atol=1e-9)
+        assert res.converged.sum() >= 4 and not res.converged[2, 1]
+
+
+def test_ik_batch_checks_every_goal_and_start(panda):
+    """A bad goal or start in a batch raises and names its index."""
+    goals = np.stack([np.eye(4)] * 3)
+    goals[1, 0, 0] = 2.0
+    with pytest.raises(DataError, match=r"T_goal\[1\] rotation block"):
+        ik(panda, goals)
+    q0 = np.tile(np.array(dynid.PANDA_NEUTRAL_Q), (3, 1))
+    q0[2, 0] = 10.0
+    with pytest.raises(LimitError, match="start 2"):
+        ik(panda, np.stack([np.eye(4)] * 3), q0)
+    with pytest.raises(ShapeError, match="broadcast"):
+        ik(panda, np.stack([np.eye(4)] * 3), np.zeros((2, 7)))
 
 
 def test_single_sample_chain_equals_fk_and_jacobian(panda):

@@ -11,6 +11,7 @@ import numpy as np
 import pytest
 
 import dynid
+from dynid import _compiled
 from dynid.dynamics import rnea as rnea_module
 from dynid.dynamics.rnea import _rnea, _rnea_numpy, rnea_numpy
 from dynid.dynamics.terms import gravity_torques_numpy, mass_matrix_numpy
@@ -19,6 +20,7 @@ from conftest import pinocchio_panda_urdf, random_states
 
 pytest.importorskip("numba")
 from dynid.dynamics import _kernels  # noqa: E402  (after the skip: imports numba)
+from dynid.kinematics import _chain  # noqa: E402
 
 
 @pytest.fixture(autouse=True)
@@ -33,11 +35,7 @@ def kernel_rnea(robot, q, dq, ddq, gravity=None):
     g = robot.gravity if gravity is None else gravity
     tau = np.empty(q.shape)
     ok = _kernels.rnea(
-        robot.T_parent_joint,
-        robot.axes,
-        robot.prismatic,
-        robot.phi,
-        g,
+        _compiled.pack(robot, gravity=g),
         q.reshape(-1),
         dq.reshape(-1),
         ddq.reshape(-1),
@@ -50,9 +48,7 @@ def kernel_rnea(robot, q, dq, ddq, gravity=None):
 def kernel_mass_matrix(robot, q):
     """The mass-matrix kernel called directly on (B, n) positions."""
     M = np.empty(q.shape + q.shape[-1:])
-    ok = _kernels.mass_matrix(
-        robot.T_parent_joint, robot.axes, robot.prismatic, robot.phi, q.reshape(-1), M.reshape(-1)
-    )
+    ok = _kernels.mass_matrix(_compiled.pack(robot), q.reshape(-1), M.reshape(-1))
     assert ok
     return M
 
@@ -60,15 +56,7 @@ def kernel_mass_matrix(robot, q):
 def kernel_gravity(robot, q):
     """The gravity kernel called directly on (B, n) positions."""
     tau = np.empty(q.shape)
-    ok = _kernels.gravity_torques(
-        robot.T_parent_joint,
-        robot.axes,
-        robot.prismatic,
-        robot.phi,
-        robot.gravity,
-        q.reshape(-1),
-        tau.reshape(-1),
-    )
+    ok = _kernels.gravity_torques(_compiled.pack(robot), q.reshape(-1), tau.reshape(-1))
     assert ok
     return tau
 
@@ -301,11 +289,11 @@ def test_sincos_matches_the_math_library():
     """The vectorisable sine and cosine are within 2.3e-16 of numpy's, up to |x| = 1e8."""
     import numba
 
-    @numba.njit(fastmath=_kernels._FASTMATH)  # as the kernels compile it
+    @numba.njit(fastmath=_chain.FASTMATH)  # as the kernels compile it
     def both(x):
         s, c = np.empty_like(x), np.empty_like(x)
         for k in range(x.size):
-            s[k], c[k] = _kernels._sincos(x[k])
+            s[k], c[k] = _chain.sincos(x[k])
         return s, c
 
     rng = np.random.default_rng(21)

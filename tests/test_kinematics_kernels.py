@@ -11,6 +11,7 @@ import numpy as np
 import pytest
 
 import dynid
+from dynid import _compiled
 from dynid.kinematics import forward as forward_module
 from dynid.kinematics.forward import fk_numpy, frame_pose_in_link, link_poses_numpy
 from dynid.kinematics.jacobian import jacobian_numpy
@@ -31,9 +32,7 @@ def _kernels_in_use():
 def kernel_link_poses(robot, q):
     """The link-pose kernel called directly on (B, n) positions."""
     T = np.empty((q.shape[0], robot.n + 1, 4, 4))
-    ok = _kernels.link_poses(
-        robot.T_parent_joint, robot.axes, robot.prismatic, q.reshape(-1), T.reshape(-1)
-    )
+    ok = _kernels.link_poses(_compiled.pack(robot), q.reshape(-1), T.reshape(-1))
     assert ok
     return T
 
@@ -43,9 +42,8 @@ def kernel_fk(robot, q, frame, tool=None):
     link, T_lf = frame_pose_in_link(robot, frame, tool)
     T_lf = forward_module._readonly(T_lf)  # the type the public functions pass
     T = np.empty((q.shape[0], 4, 4))
-    ok = _kernels.frame_pose(
-        robot.T_parent_joint, robot.axes, robot.prismatic, link, T_lf, q.reshape(-1), T.reshape(-1)
-    )
+    CF = _compiled.pack_frame(_compiled.pack(robot), link, T_lf)
+    ok = _kernels.frame_pose(CF, q.reshape(-1), T.reshape(-1))
     assert ok
     return T
 
@@ -55,9 +53,8 @@ def kernel_jacobian(robot, q, frame, tool=None):
     link, T_lf = frame_pose_in_link(robot, frame, tool)
     T_lf = forward_module._readonly(T_lf)  # the type the public functions pass
     J = np.empty((q.shape[0], 6, robot.n))
-    ok = _kernels.jacobian(
-        robot.T_parent_joint, robot.axes, robot.prismatic, link, T_lf, q.reshape(-1), J.reshape(-1)
-    )
+    CF = _compiled.pack_frame(_compiled.pack(robot), link, T_lf)
+    ok = _kernels.jacobian(CF, q.reshape(-1), J.reshape(-1))
     assert ok
     return J
 

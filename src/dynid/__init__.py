@@ -23,14 +23,9 @@ poses), ``T_a_b`` is the pose of frame b in frame a, gravity 9.80665 m/s^2 along
 base by default; standard parameters are 10 per link (m, m c, J about the link origin).
 """
 
-from .dynamics.rnea import rnea
-from .dynamics.terms import (
-    coriolis,
-    coriolis_matrix,
-    forward_dynamics,
-    gravity_torques,
-    mass_matrix,
-)
+import importlib
+from typing import TYPE_CHECKING, Any
+
 from .exceptions import (
     ConvergenceError,
     DataError,
@@ -45,48 +40,130 @@ from .exceptions import (
     SolverError,
     UnknownNameError,
 )
-from .friction.fit import FrictionFit, fit_friction
-from .friction.model import ClassicalFriction, SigmoidFriction, classical_friction, sigmoid_friction
-from .friction.validation import Validation
-from .friction.validation import validate as validate_torques
-from .identification.classical import identify_from_log
-from .identification.data import StaticDataset
-from .identification.least_squares import LeastSquaresFit, fit_least_squares
-from .identification.log import TorqueLog
-from .identification.model import IdentifiedModel
-from .identification.static import identify_static
-from .kinematics.forward import fk, joint_transforms, link_poses
-from .kinematics.ik import IKOptions, IKResult, ik
-from .kinematics.jacobian import jacobian, jacobian_to_tool
-from .kinematics.trajectories import (
-    Trajectory,
-    check_limits,
-    random_fourier,
-    scale_into_limits,
-    sinusoid_trajectory,
-)
-from .model.inertia import inertial_from_phi, param_labels, phi_from_inertial
-from .model.panda import PANDA_NEUTRAL_Q, panda
-from .model.robot import Frame, Robot
-from .regressors.base import BaseParameters, base_parameters, identifiability
-from .regressors.static import static_regressor
-from .regressors.torque import torque_regressor
-from .simulation.collision import Box, Obstacles, Plane
-from .simulation.controller import (
-    SimulatedController,
-    acquire_static,
-    acquire_static_at,
-    sample_configurations,
-)
-from .simulation.excitation import (
-    ExcitationOptions,
-    ExcitationResult,
-    ExcitingTrajectory,
-    excitation_condition_number,
-    optimise_excitation,
-)
-from .simulation.measurement import SensorNoise, simulate_measurement
-from .simulation.static_selection import StaticSelection, select_static_configurations
+
+if TYPE_CHECKING:  # the names as static imports, for type checkers and editors
+    from .dynamics.rnea import rnea
+    from .dynamics.terms import (
+        coriolis,
+        coriolis_matrix,
+        forward_dynamics,
+        gravity_torques,
+        mass_matrix,
+    )
+    from .friction.fit import FrictionFit, fit_friction
+    from .friction.model import (
+        ClassicalFriction,
+        SigmoidFriction,
+        classical_friction,
+        sigmoid_friction,
+    )
+    from .friction.validation import Validation
+    from .friction.validation import validate as validate_torques
+    from .identification.classical import identify_from_log
+    from .identification.data import StaticDataset
+    from .identification.least_squares import LeastSquaresFit, fit_least_squares
+    from .identification.log import TorqueLog
+    from .identification.model import IdentifiedModel
+    from .identification.static import identify_static
+    from .kinematics.forward import fk, joint_transforms, link_poses
+    from .kinematics.ik import IKOptions, IKResult, ik
+    from .kinematics.jacobian import jacobian, jacobian_to_tool
+    from .kinematics.trajectories import (
+        Trajectory,
+        check_limits,
+        random_fourier,
+        scale_into_limits,
+        sinusoid_trajectory,
+    )
+    from .model.inertia import inertial_from_phi, param_labels, phi_from_inertial
+    from .model.panda import PANDA_NEUTRAL_Q, panda
+    from .model.robot import Frame, Robot
+    from .regressors.base import BaseParameters, base_parameters, identifiability
+    from .regressors.static import static_regressor
+    from .regressors.torque import torque_regressor
+    from .simulation.collision import Box, Obstacles, Plane
+    from .simulation.controller import (
+        SimulatedController,
+        acquire_static,
+        acquire_static_at,
+        sample_configurations,
+    )
+    from .simulation.excitation import (
+        ExcitationOptions,
+        ExcitationResult,
+        ExcitingTrajectory,
+        excitation_condition_number,
+        optimise_excitation,
+    )
+    from .simulation.measurement import SensorNoise, simulate_measurement
+    from .simulation.static_selection import StaticSelection, select_static_configurations
+
+#: public name -> (module under dynid, attribute): imported on first use (PEP 562), so that
+#: ``import dynid`` (and every command line call) loads only what it uses
+_LAZY: dict[str, tuple[str, str]] = {
+    "BaseParameters": ("regressors.base", "BaseParameters"),
+    "Box": ("simulation.collision", "Box"),
+    "ClassicalFriction": ("friction.model", "ClassicalFriction"),
+    "ExcitationOptions": ("simulation.excitation", "ExcitationOptions"),
+    "ExcitationResult": ("simulation.excitation", "ExcitationResult"),
+    "ExcitingTrajectory": ("simulation.excitation", "ExcitingTrajectory"),
+    "Frame": ("model.robot", "Frame"),
+    "FrictionFit": ("friction.fit", "FrictionFit"),
+    "IKOptions": ("kinematics.ik", "IKOptions"),
+    "IKResult": ("kinematics.ik", "IKResult"),
+    "IdentifiedModel": ("identification.model", "IdentifiedModel"),
+    "LeastSquaresFit": ("identification.least_squares", "LeastSquaresFit"),
+    "Obstacles": ("simulation.collision", "Obstacles"),
+    "PANDA_NEUTRAL_Q": ("model.panda", "PANDA_NEUTRAL_Q"),
+    "Plane": ("simulation.collision", "Plane"),
+    "Robot": ("model.robot", "Robot"),
+    "SensorNoise": ("simulation.measurement", "SensorNoise"),
+    "SigmoidFriction": ("friction.model", "SigmoidFriction"),
+    "SimulatedController": ("simulation.controller", "SimulatedController"),
+    "StaticDataset": ("identification.data", "StaticDataset"),
+    "StaticSelection": ("simulation.static_selection", "StaticSelection"),
+    "TorqueLog": ("identification.log", "TorqueLog"),
+    "Trajectory": ("kinematics.trajectories", "Trajectory"),
+    "Validation": ("friction.validation", "Validation"),
+    "acquire_static": ("simulation.controller", "acquire_static"),
+    "acquire_static_at": ("simulation.controller", "acquire_static_at"),
+    "base_parameters": ("regressors.base", "base_parameters"),
+    "check_limits": ("kinematics.trajectories", "check_limits"),
+    "classical_friction": ("friction.model", "classical_friction"),
+    "coriolis": ("dynamics.terms", "coriolis"),
+    "coriolis_matrix": ("dynamics.terms", "coriolis_matrix"),
+    "excitation_condition_number": ("simulation.excitation", "excitation_condition_number"),
+    "fit_friction": ("friction.fit", "fit_friction"),
+    "fit_least_squares": ("identification.least_squares", "fit_least_squares"),
+    "fk": ("kinematics.forward", "fk"),
+    "forward_dynamics": ("dynamics.terms", "forward_dynamics"),
+    "gravity_torques": ("dynamics.terms", "gravity_torques"),
+    "identifiability": ("regressors.base", "identifiability"),
+    "identify_from_log": ("identification.classical", "identify_from_log"),
+    "identify_static": ("identification.static", "identify_static"),
+    "ik": ("kinematics.ik", "ik"),
+    "inertial_from_phi": ("model.inertia", "inertial_from_phi"),
+    "jacobian": ("kinematics.jacobian", "jacobian"),
+    "jacobian_to_tool": ("kinematics.jacobian", "jacobian_to_tool"),
+    "joint_transforms": ("kinematics.forward", "joint_transforms"),
+    "link_poses": ("kinematics.forward", "link_poses"),
+    "mass_matrix": ("dynamics.terms", "mass_matrix"),
+    "optimise_excitation": ("simulation.excitation", "optimise_excitation"),
+    "panda": ("model.panda", "panda"),
+    "param_labels": ("model.inertia", "param_labels"),
+    "phi_from_inertial": ("model.inertia", "phi_from_inertial"),
+    "random_fourier": ("kinematics.trajectories", "random_fourier"),
+    "rnea": ("dynamics.rnea", "rnea"),
+    "sample_configurations": ("simulation.controller", "sample_configurations"),
+    "scale_into_limits": ("kinematics.trajectories", "scale_into_limits"),
+    "select_static_configurations": ("simulation.static_selection", "select_static_configurations"),
+    "sigmoid_friction": ("friction.model", "sigmoid_friction"),
+    "simulate_measurement": ("simulation.measurement", "simulate_measurement"),
+    "sinusoid_trajectory": ("kinematics.trajectories", "sinusoid_trajectory"),
+    "static_regressor": ("regressors.static", "static_regressor"),
+    "torque_regressor": ("regressors.torque", "torque_regressor"),
+    "validate_torques": ("friction.validation", "validate"),
+}
 
 __version__ = "0.1.0"
 
@@ -167,3 +244,29 @@ __all__ = [
     "torque_regressor",
     "validate_torques",
 ]
+
+
+#: subpackages and modules reachable as attributes (``dynid.spatial``), imported on first use
+_SUBMODULES = frozenset(
+    (
+        "cli dynamics feasibility friction identification io kinematics model plots "
+        "regressors signals simulation spatial"
+    ).split()
+)
+
+
+def __getattr__(name: str) -> Any:
+    """Import a public name or a subpackage on first use (PEP 562)."""
+    if name in _SUBMODULES:
+        return importlib.import_module(f"{__name__}.{name}")
+    try:
+        module, attr = _LAZY[name]
+    except KeyError:
+        raise AttributeError(f"module 'dynid' has no attribute {name!r}") from None
+    value = getattr(importlib.import_module(f"{__name__}.{module}"), attr)
+    globals()[name] = value
+    return value
+
+
+def __dir__() -> list[str]:
+    return sorted(set(globals()) | set(_LAZY))

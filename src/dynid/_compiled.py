@@ -1,30 +1,173 @@
 """Optional compiled kernels: loading them, and laying arrays out for them.
 
-The numba kernels (``dynamics/_kernels.py``, ``kinematics/_kernels.py``, ...) are optional:
+The numba kernels (``kinematics/_kernels.py``, ``dynamics/_kernels.py``,
+``regressors/_kernels.py``, built on the chain core ``kinematics/_chain.py``) are optional:
 without numba, or with the environment variable ``DYNID_NO_NUMBA`` set to anything but
-``""`` or ``"0"``, the numpy reference paths run instead.
+``""`` or ``"0"``, the numpy reference paths run instead. :func:`kernels` is the one loader.
+
+Every kernel takes the robot as one read-only float64 array ``C`` of shape ``(n + 1, W)``
+(:func:`constants`): row ``i < n`` holds joint ``i``'s constants, the last row the gravity
+vector. One array instead of five keeps the call overhead of a single-sample call small
+(numba types each argument on every call).
+
+=========  =====================================================================
+columns    row ``i`` (joint ``i + 1``, link ``i + 1`` in link ``i``)
+=========  =====================================================================
+0-11       ``T_parent_joint[i, :3, :]`` row-major (rotation and origin [m])
+12-14      unit joint axis in the child link's frame
+15         1.0 for a prismatic joint, 0.0 for a revolute one
+16-25      standard parameters ``phi[i]`` (``m, m c, J`` about the link origin)
+=========  =====================================================================
+
+Row ``n``, columns 0-2: gravity in the base frame [m/s^2]. The kinematics kernels take a
+frame too: :func:`pack_frame` appends row ``n + 1`` holding the frame's pose ``T_lf`` in
+its link (16 entries, row-major, a tool already multiplied in) and, in column 16, the link
+(0 = base).
 """
 
 from __future__ import annotations
 
 import importlib
 import os
+import sys
 from types import ModuleType
+from typing import Any
 
 import numpy as np
 from numpy.typing import NDArray
 
 from . import _checks
 
+#: Column offsets of the packed constants (see the module docstring).
+C_T, C_AXIS, C_PRISMATIC, C_PHI, C_WIDTH = 0, 12, 15, 16, 26
+
+_LOADED: dict[str, ModuleType | None] = {}
+
+
+def enabled() -> bool:
+    """False when ``DYNID_NO_NUMBA`` asks for the numpy reference paths."""
+    return os.environ.get("DYNID_NO_NUMBA", "") in ("", "0")
+
 
 def optional(module: str) -> ModuleType | None:
-    """Import a kernel module, or None when numba is missing or ``DYNID_NO_NUMBA`` is set."""
-    if os.environ.get("DYNID_NO_NUMBA", "") not in ("", "0"):
-        return None
+    """Import a kernel module once, or None when numba is missing or ``DYNID_NO_NUMBA`` is set.
+
+    ``DYNID_NO_NUMBA`` is read on the first call for each module.
+    """
     try:
-        return importlib.import_module(module)
-    except ImportError:  # numba is not installed
-        return None
+        return _LOADED[module]
+    except KeyError:
+        pass
+    mod = None
+    if enabled():
+        try:
+            mod = importlib.import_module(module)
+        except ImportError:  # numba is not installed
+            mod = None
+    _LOADED[module] = mod
+    return mod
+
+
+def numba_loaded() -> bool:
+    """numba is already imported in this process."""
+    return "numba" in sys.modules
+
+
+#: single-sample calls that take the numpy path before the kernels are loaded for them
+SMALL_CALLS = 256
+_small_calls = 0
+
+
+def small_call_uses_kernels() -> bool:
+    """Whether a single-sample call should load and use the compiled kernels.
+
+    Importing numba and loading a kernel cost about a second, a single sample on the numpy
+    path tens of microseconds to a millisecond: a one-shot call (a command line call on one
+    configuration) stays on the numpy path. Once numba is imported (by any batch call) or
+    after :data:`SMALL_CALLS` single-sample calls in the process, the kernels are used
+    (rent or buy). Both paths give the same numbers to rounding (about 1e-15 relative).
+    """
+    global _small_calls
+    if "numba" in sys.modules:
+        return True
+    _small_calls += 1
+    return _small_calls > SMALL_CALLS
+
+
+def kernels(package: str) -> ModuleType | None:
+    """The ``_kernels`` module of ``package`` (``"dynid.dynamics"``, ...), or None."""
+    return optional(f"{package}._kernels")
+
+
+def pack(robot: Any, phi: Any = None, gravity: Any = None) -> NDArray[np.float64]:
+    """The constants ``C`` (n + 1, W) of ``robot`` (see the module docstring), read-only.
+
+    ``phi`` (n, 10) and ``gravity`` (3,) replace the robot's when given (validated arrays).
+    """
+    n = robot.T_parent_joint.shape[0]
+    C = np.zeros((n + 1, C_WIDTH))
+    C[:n, C_T : C_T + 12] = robot.T_parent_joint[:, :3, :].reshape(n, 12)
+    C[:n, C_AXIS : C_AXIS + 3] = robot.axes
+    C[:n, C_PRISMATIC] = robot.prismatic
+    C[:n, C_PHI : C_PHI + 10] = robot.phi if phi is None else phi
+    C[n, :3] = robot.gravity if gravity is None else gravity
+    C.setflags(write=False)
+    return C
+
+
+#: ``id(robot) -> (robot, C, n)`` for a few robots (robots are immutable; an entry keeps
+#: its robot alive, so the id cannot be reused while the entry exists). The thin
+#: single-sample paths read it directly.
+CACHE: dict[int, tuple[Any, NDArray[np.float64], int]] = {}
+_CACHE_SIZE = 16
+
+
+def constants(robot: Any) -> NDArray[np.float64]:
+    """:func:`pack` of ``robot``, computed once per robot (a small cache by identity)."""
+    hit = CACHE.get(id(robot))
+    if hit is not None and hit[0] is robot:
+        return hit[1]
+    C = pack(robot)
+    if len(CACHE) >= _CACHE_SIZE:
+        CACHE.pop(next(iter(CACHE)))
+    CACHE[id(robot)] = (robot, C, C.shape[0] - 1)
+    return C
+
+
+#: float64 (the thin paths check ``x.dtype is F64``)
+F64 = np.dtype(np.float64)
+#: a float64 vector of any strides: the type of the thin paths' joint vectors ('A' layout)
+VECTOR = np.zeros(4)[::2]  # (2,) with stride 16: not contiguous, so typed with any strides
+
+
+def entry(kernel: Any, *args: Any) -> Any:
+    """The compiled entry point of ``kernel`` for the numba types of ``args``.
+
+    Calling it skips numba's per-call type dispatch (a few hundred ns for five array
+    arguments), which dominates a single-sample call. The caller must then pass arguments
+    of exactly these kinds: the thin paths check ``type(x) is np.ndarray``, float64 and
+    the number of dimensions; the joint vectors are typed with any strides
+    (:data:`VECTOR`), the outputs are new C arrays. Returns ``kernel`` when numba offers no
+    entry point.
+    """
+    try:
+        from numba import typeof
+
+        sig = tuple(typeof(a) for a in args)
+        kernel.compile(sig)
+        return kernel.overloads[sig].entry_point
+    except Exception:  # noqa: BLE001 (an internal of numba moved: use the dispatcher)
+        return kernel
+
+
+def pack_frame(C: NDArray[np.float64], link: int, T_lf: NDArray[np.float64]) -> NDArray:
+    """``C`` with a last row for the frame ``T_lf`` (4, 4) of ``link`` (read-only)."""
+    CF = np.zeros((C.shape[0] + 1, C_WIDTH))
+    CF[:-1] = C
+    CF[-1, :16] = np.asarray(T_lf, dtype=np.float64).reshape(16)
+    CF[-1, 16] = link
+    CF.setflags(write=False)
+    return CF
 
 
 def flat(x: NDArray[np.float64]) -> NDArray[np.float64]:

@@ -44,8 +44,8 @@ SUBCOMMANDS = (
 )
 
 
-def _modules():
-    for name in SUBCOMMANDS:
+def _modules(names: Sequence[str] = SUBCOMMANDS):
+    for name in names:
         try:
             yield importlib.import_module(f"{__package__}.{name}")
         except ModuleNotFoundError as exc:  # a subcommand not built yet
@@ -60,8 +60,19 @@ class _Parser(argparse.ArgumentParser):
         self.exit(2, f"{self.prog}: error: {message} (see {self.prog} --help)\n")
 
 
-def build_parser() -> argparse.ArgumentParser:
-    """The argument parser with every subcommand."""
+def _command(argv: Sequence[str]) -> str | None:
+    """The subcommand module named by the first non-option argument, if it names one."""
+    first = next((a for a in argv if not a.startswith("-")), None)
+    name = None if first is None else first.replace("-", "_")
+    return name if name in SUBCOMMANDS else None
+
+
+def build_parser(commands: Sequence[str] = SUBCOMMANDS) -> argparse.ArgumentParser:
+    """The argument parser with the subcommands ``commands`` (default: all of them).
+
+    :func:`main` registers only the subcommand being run, so that a call imports only
+    the library modules it uses (start-up time); ``dynid --help`` lists them all.
+    """
     parser = _Parser(
         prog="dynid", description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter
     )
@@ -69,7 +80,7 @@ def build_parser() -> argparse.ArgumentParser:
 
     parser.add_argument("--version", action="version", version=f"dynid {__version__}")
     sub = parser.add_subparsers(dest="command", metavar="COMMAND", required=True)
-    for mod in _modules():
+    for mod in _modules(commands):
         p = mod.register(sub)
         p.add_argument("-v", "--verbose", action="count", default=0, help="more log output")
         p.add_argument("-q", "--quiet", action="store_true", help="errors only")
@@ -132,7 +143,8 @@ def _signals_and_warnings(command: str) -> Iterator[None]:
 def main(argv: Sequence[str] | None = None) -> int:
     """Entry point of the ``dynid`` console script; returns the exit code."""
     argv = join_negative_values(sys.argv[1:] if argv is None else list(argv))
-    parser = build_parser()
+    command = _command(argv)
+    parser = build_parser(SUBCOMMANDS if command is None else (command,))
     try:
         args = parser.parse_args(argv)
     except SystemExit as exc:  # --help, --version, or a refused option (one line printed)

@@ -1,17 +1,14 @@
 """Compiled (numba) kernels: inverse dynamics, gravity torques and the mass matrix.
 
-This module imports numba, so it is imported lazily, on the first call of a dynamics
-function (see :func:`dynid.dynamics.rnea.kernels`), never by ``import dynid``. Each kernel
-is compiled on its first call for the argument types it meets and cached on disk
-(``cache=True``); later processes load it instead of compiling it again.
+Imported lazily, on the first dynamics call (:func:`dynid._compiled.kernels`), never by
+``import dynid``; compiled once and cached on disk (:func:`dynid.kinematics._chain.jit`).
 
-The kernels take the robot's constant arrays as arguments: ``T`` (``T_parent_joint``,
-(n, 4, 4)), ``axes`` (n, 3), ``prismatic`` (n,) bool, ``phi`` (n, 10) and ``g``
-(``gravity``, (3,) [m/s^2] in the base frame); see :mod:`dynid.model.robot`. Joint
-arrays are flat, C-contiguous float64 of length ``B * n``, sample-major (a (B, n) array
-reshaped); ``dq`` and ``ddq`` of :func:`rnea` may also have length ``n``, one row for every
-sample. Results are written into a flat output array of length ``B * n`` (``B * n * n``
-for the mass matrices, row-major), which spares the boxing of a new array on each call.
+Arguments: ``C``, the robot's packed constants (:func:`dynid._compiled.pack`: joint
+transforms, axes, joint types, standard parameters ``phi`` and gravity [m/s^2] in the base
+frame). Joint arrays are flat C-contiguous float64, length ``B * n``, sample-major (a
+(B, n) array reshaped); ``dq`` and ``ddq`` of :func:`rnea` may also have length ``n``, one
+row for every sample. Results go into a flat output array, ``B * n`` (the mass matrices:
+any C-contiguous shape, read flat, row-major), which spares the boxing of a new array.
 Every kernel checks that its joint inputs are finite and returns ``ok``; with
 ``ok = False`` the output is unfinished and the caller raises the error that names the
 bad entry.
@@ -33,26 +30,39 @@ calls, so that the compiler vectorises it (SIMD over samples). Revolute and pris
 joints go through the same arithmetic with exact 0/1 selectors (a prismatic joint has
 ``sin = 0, cos = 1``, a revolute one no translation), which changes no rounding.
 
-The compiler may fuse ``a * b + c`` into one multiply-add (numba ``fastmath={"contract"}``,
-no other fast-math flag): one rounding instead of two, so the kernels and the numpy path
-differ by rounding only (the tests hold them to 1e-12 relative).
-
-Sine and cosine come from :func:`_sincos`, Cephes' ``sin.c``/``cos.c`` (S. L. Moshier)
-polynomials with its three-part reduction by pi/4, branch-free so that it vectorises;
-its error is below 2.3e-16 absolute for ``|q| <= 1e8`` (the math library is used above).
+The joint transform is the chain core's (:mod:`dynid.kinematics._chain`), as are the
+compiler settings (fused multiply-add only) and the sine and cosine (Cephes, vectorisable);
+kernels and numpy path differ by rounding only (the tests hold them to 1e-12 relative).
 """
 
 from __future__ import annotations
 
 import math
 
-import numba
 import numpy as np
+
+from .._compiled import C_AXIS, C_PHI, C_PRISMATIC
+from ..kinematics._chain import (
+    IDENTITY,
+    compose,
+    finite,
+    fixed,
+    inline,
+    jit,
+    joint,
+    joint_from,
+    joint_sc,
+    joint_scd,
+)
+from ..kinematics._chain import SINCOS_MAX as _SINCOS_MAX
+from ..kinematics._chain import sincos as _sincos
 
 __all__ = ["BLOCK", "rnea", "gravity_torques", "mass_matrix"]
 
 #: Samples per block of :func:`rnea` (the length of the vectorised inner loop).
 BLOCK = 32
+#: Fewer samples than this take the scalar recursion (no block scratch to set up).
+SMALL = 4
 
 # rows of the scratch array X[link, row, sample] of the block kernel
 _Q, _V, _AC, _S, _C = 0, 1, 2, 3, 4  # q, dq, ddq, sin q, cos q of the joint into the link
@@ -63,70 +73,182 @@ _F, _N = 26, 29  # force and moment on the link (and its children) about its ori
 _TAU = 32
 _ROWS = 33
 
-# Cephes sin.c: pi/4 = DP1 + DP2 + DP3 (DP1 and DP2 with short mantissas, so that y * DP1
-# and y * DP2 are exact for the y that occur) and the minimax polynomials on [-pi/4, pi/4]
-_FOPI = 1.27323954473516268615  # 4 / pi
-_DP1 = 7.85398125648498535156e-1
-_DP2 = 3.77489470793079817668e-8
-_DP3 = 2.69515142907905952645e-15
-# a * b + c may be one fused multiply-add (one rounding instead of two); no reassociation,
-# no approximate functions, NaN and inf semantics kept
-_FASTMATH = {"contract"}
-_SINCOS_MAX = 1.0e8  # |q| above which the math library's sin and cos are used
-_S0, _S1, _S2 = 1.58962301576546568060e-10, -2.50507477628578072866e-8, 2.75573136213857245213e-6
-_S3, _S4, _S5 = -1.98412698295895385996e-4, 8.33333333332211858878e-3, -1.66666666666666307295e-1
-_C0, _C1, _C2 = -1.13585365213876817300e-11, 2.08757008419747316778e-9, -2.75573141792967388112e-7
-_C3, _C4, _C5 = 2.48015872888517045348e-5, -1.38888888888730564116e-3, 4.16666666666665929218e-2
 
+@inline
+def motion(T, w, dw, a, ex, ey, ez, ep, v, acc):
+    """Angular velocity, angular acceleration and origin acceleration (minus gravity) of a link.
 
-def _jit(fn):
-    """``numba.njit(cache=True)`` allowing fused multiply-add, and nothing else of fastmath.
-
-    Without the disk cache when numba finds no writable cache folder.
+    ``T`` (12 floats) is the link's pose in its parent, ``w, dw, a`` (3-tuples) the parent's
+    motion in parent coordinates, ``(ex, ey, ez)`` the joint axis, ``ep`` 1.0 for a
+    prismatic joint (0.0 revolute), ``v, acc`` the joint rate and acceleration. Returns the
+    link's ``(w, dw, a)`` in link coordinates (9 floats; Featherstone 2008, sec. 5.3):
+    ``a' = R^T (a + dw x p + w x (w x p))``, then for a revolute joint ``w' += v e``,
+    ``dw' += w' x v e + acc e``, for a prismatic one ``a' += 2 w' x v e + acc e``.
     """
-    try:
-        return numba.njit(cache=True, fastmath=_FASTMATH)(fn)
-    except RuntimeError:  # no writable cache location
-        return numba.njit(fastmath=_FASTMATH)(fn)
-
-
-@numba.njit(inline="always")
-def _sincos(x):
-    """``(sin x, cos x)`` for ``|x| <= 1e8``, branch-free (Cephes ``sin.c``, ``cos.c``)."""
-    ax = abs(x)
-    j = np.int64(ax * _FOPI)
-    j += j & 1  # even octant: z in [-pi/4, pi/4]
-    y = float(j)
-    z = ((ax - y * _DP1) - y * _DP2) - y * _DP3
-    zz = z * z
-    ps = z + z * zz * (((((_S0 * zz + _S1) * zz + _S2) * zz + _S3) * zz + _S4) * zz + _S5)
-    pc = (
-        1.0
-        - 0.5 * zz
-        + zz * zz * (((((_C0 * zz + _C1) * zz + _C2) * zz + _C3) * zz + _C4) * zz + _C5)
+    r00, r01, r02, r10, r11, r12, r20, r21, r22, px, py, pz = T
+    wx, wy, wz = w
+    dwx, dwy, dwz = dw
+    ux = wy * pz - wz * py
+    uy = wz * px - wx * pz
+    uz = wx * py - wy * px
+    bx = a[0] + (dwy * pz - dwz * py) + (wy * uz - wz * uy)
+    by = a[1] + (dwz * px - dwx * pz) + (wz * ux - wx * uz)
+    bz = a[2] + (dwx * py - dwy * px) + (wx * uy - wy * ux)
+    apx = r00 * bx + r10 * by + r20 * bz
+    apy = r01 * bx + r11 * by + r21 * bz
+    apz = r02 * bx + r12 * by + r22 * bz
+    wpx = r00 * wx + r10 * wy + r20 * wz
+    wpy = r01 * wx + r11 * wy + r21 * wz
+    wpz = r02 * wx + r12 * wy + r22 * wz
+    dpx = r00 * dwx + r10 * dwy + r20 * dwz
+    dpy = r01 * dwx + r11 * dwy + r21 * dwz
+    dpz = r02 * dwx + r12 * dwy + r22 * dwz
+    vx, vy, vz = v * ex, v * ey, v * ez
+    cx = wpy * vz - wpz * vy
+    cy = wpz * vx - wpx * vz
+    cz = wpx * vy - wpy * vx
+    er = 1.0 - ep
+    return (
+        wpx + er * vx,
+        wpy + er * vy,
+        wpz + er * vz,
+        dpx + er * (cx + acc * ex),
+        dpy + er * (cy + acc * ey),
+        dpz + er * (cz + acc * ez),
+        apx + ep * (2.0 * cx + acc * ex),
+        apy + ep * (2.0 * cy + acc * ey),
+        apz + ep * (2.0 * cz + acc * ez),
     )
-    m = (j >> 1) & 3  # quadrant: x = m pi/2 + z (mod 2 pi)
-    s = pc if m & 1 else ps
-    c = ps if m & 1 else pc
-    s = -s if (m >> 1) & 1 else s
-    c = -c if ((m + 1) >> 1) & 1 else c
-    s = -s if x < 0.0 else s
-    return s, c
 
 
-def _rnea(T, axes, prismatic, phi, g, q, dq, ddq, tau):
+@inline
+def inertial(C, i):
+    """Link ``i + 1``'s standard parameters ``(m, hx, hy, hz, Jxx, Jxy, Jxz, Jyy, Jyz, Jzz)``."""
+    return (
+        C[i, C_PHI], C[i, C_PHI + 1], C[i, C_PHI + 2], C[i, C_PHI + 3], C[i, C_PHI + 4],
+        C[i, C_PHI + 5], C[i, C_PHI + 6], C[i, C_PHI + 7], C[i, C_PHI + 8], C[i, C_PHI + 9],
+    )  # fmt: skip
+
+
+@inline
+def wrench(phi, w, dw, a):
+    """Wrench ``(f, n)`` (6 floats) on a link about its origin, link coordinates.
+
+    ``f = m a + dw x h + w x (w x h)``, ``n = J dw + w x (J w) + h x a`` with the link's
+    standard parameters ``phi = (m, h = m c, J)`` (:func:`inertial`, J about the origin).
+    """
+    m, hx, hy, hz, Jxx, Jxy, Jxz, Jyy, Jyz, Jzz = phi
+    wx, wy, wz = w
+    dwx, dwy, dwz = dw
+    a0x, a0y, a0z = a
+    ux = wy * hz - wz * hy
+    uy = wz * hx - wx * hz
+    uz = wx * hy - wy * hx
+    jx = Jxx * wx + Jxy * wy + Jxz * wz
+    jy = Jxy * wx + Jyy * wy + Jyz * wz
+    jz = Jxz * wx + Jyz * wy + Jzz * wz
+    return (
+        m * a0x + (dwy * hz - dwz * hy) + (wy * uz - wz * uy),
+        m * a0y + (dwz * hx - dwx * hz) + (wz * ux - wx * uz),
+        m * a0z + (dwx * hy - dwy * hx) + (wx * uy - wy * ux),
+        (Jxx * dwx + Jxy * dwy + Jxz * dwz) + (wy * jz - wz * jy) + (hy * a0z - hz * a0y),
+        (Jxy * dwx + Jyy * dwy + Jyz * dwz) + (wz * jx - wx * jz) + (hz * a0x - hx * a0z),
+        (Jxz * dwx + Jyz * dwy + Jzz * dwz) + (wx * jy - wy * jx) + (hx * a0y - hy * a0x),
+    )
+
+
+@inline
+def carry(T, F, N):
+    """A link's wrench ``(F, N)`` about its origin carried into its parent (pose ``T``).
+
+    ``(R F, R N + p x R F)``, 6 floats.
+    """
+    r00, r01, r02, r10, r11, r12, r20, r21, r22, px, py, pz = T
+    Fx, Fy, Fz = F
+    Nx, Ny, Nz = N
+    RFx = r00 * Fx + r01 * Fy + r02 * Fz
+    RFy = r10 * Fx + r11 * Fy + r12 * Fz
+    RFz = r20 * Fx + r21 * Fy + r22 * Fz
+    RNx = r00 * Nx + r01 * Ny + r02 * Nz
+    RNy = r10 * Nx + r11 * Ny + r12 * Nz
+    RNz = r20 * Nx + r21 * Ny + r22 * Nz
+    return (
+        RFx,
+        RFy,
+        RFz,
+        RNx + (py * RFz - pz * RFy),
+        RNy + (pz * RFx - px * RFz),
+        RNz + (px * RFy - py * RFx),
+    )
+
+
+@inline
+def _rnea_sample(C, q, dq, ddq, oq, ov, oa, tau, S):
+    """RNEA of one sample (``q[oq : oq + n]``, ...) into ``tau[oq : oq + n]``; scratch ``S``.
+
+    The recursion of the block kernel in scalar form, for few samples (no block scratch).
+    """
+    n = C.shape[0] - 1
+    w = (0.0, 0.0, 0.0)
+    dw = (0.0, 0.0, 0.0)
+    a = (-C[n, 0], -C[n, 1], -C[n, 2])
+    for i in range(n):
+        s, c, d = joint_scd(C, i, q[oq + i])
+        T = joint_sc(C, i, s, c, d)
+        ep = C[i, C_PRISMATIC]
+        ex, ey, ez = C[i, C_AXIS], C[i, C_AXIS + 1], C[i, C_AXIS + 2]
+        M = motion(T, w, dw, a, ex, ey, ez, ep, dq[ov + i], ddq[oa + i])
+        w, dw, a = (M[0], M[1], M[2]), (M[3], M[4], M[5]), (M[6], M[7], M[8])
+        for k in range(12):
+            S[i, k] = T[k]
+        for k in range(9):
+            S[i, 12 + k] = M[k]
+    F = (0.0, 0.0, 0.0)
+    N = (0.0, 0.0, 0.0)
+    for i in range(n - 1, -1, -1):
+        f = wrench(
+            inertial(C, i), (S[i, 12], S[i, 13], S[i, 14]), (S[i, 15], S[i, 16], S[i, 17]),
+            (S[i, 18], S[i, 19], S[i, 20]),
+        )  # fmt: skip
+        if i < n - 1:
+            Tc = (
+                S[i + 1, 0], S[i + 1, 1], S[i + 1, 2], S[i + 1, 3], S[i + 1, 4], S[i + 1, 5],
+                S[i + 1, 6], S[i + 1, 7], S[i + 1, 8], S[i + 1, 9], S[i + 1, 10], S[i + 1, 11],
+            )  # fmt: skip
+            W = carry(Tc, F, N)
+            F = (f[0] + W[0], f[1] + W[1], f[2] + W[2])
+            N = (f[3] + W[3], f[4] + W[4], f[5] + W[5])
+        else:
+            F, N = (f[0], f[1], f[2]), (f[3], f[4], f[5])
+        ex, ey, ez = C[i, C_AXIS], C[i, C_AXIS + 1], C[i, C_AXIS + 2]
+        if C[i, C_PRISMATIC] != 0.0:
+            tau[oq + i] = F[0] * ex + F[1] * ey + F[2] * ez
+        else:
+            tau[oq + i] = N[0] * ex + N[1] * ey + N[2] * ez
+
+
+@jit
+def rnea(C, q, dq, ddq, tau):
     """Joint torques into ``tau`` (B n,) for q (B n,), dq and ddq (B n,) or (n,); ``ok``."""
-    n = T.shape[0]
+    n = C.shape[0] - 1
     B = q.shape[0] // n
+    sv, sa = dq.shape[0] == q.shape[0], ddq.shape[0] == q.shape[0]  # else one row for all
+    if B < SMALL:  # a few samples: scalar recursion, no block scratch
+        S = np.empty((n, 21))
+        for b in range(B):
+            ov, oa = b * n if sv else 0, b * n if sa else 0
+            if not (finite(q, b * n, n) and finite(dq, ov, n) and finite(ddq, oa, n)):
+                return False
+            _rnea_sample(C, q, dq, ddq, b * n, ov, oa, tau, S)
+        return True
     # the block length is a compile-time constant, so the row stride of X is known and the
     # sample loops vectorise without run-time aliasing checks
     X = np.empty((n + 2, _ROWS, BLOCK))
-    sv, sa = dq.shape[0] == q.shape[0], ddq.shape[0] == q.shape[0]  # else one row for all
     # base (link 0): at rest, accelerating at -g; virtual link n + 1: identity, no wrench
     X[0, _W : _A + 3] = 0.0
-    X[0, _A] = -g[0]
-    X[0, _A + 1] = -g[1]
-    X[0, _A + 2] = -g[2]
+    X[0, _A] = -C[n, 0]
+    X[0, _A + 1] = -C[n, 1]
+    X[0, _A + 2] = -C[n, 2]
     X[n + 1] = 0.0
     X[n + 1, _R] = 1.0
     X[n + 1, _R + 4] = 1.0
@@ -147,7 +269,7 @@ def _rnea(T, axes, prismatic, phi, g, q, dq, ddq, tau):
                 X[i + 1, _V, k] = v
                 X[i + 1, _AC, k] = a
         for l in range(1, n + 1):
-            if prismatic[l - 1]:
+            if C[l - 1, C_PRISMATIC] != 0.0:
                 for k in range(nb):
                     X[l, _S, k] = 0.0
                     X[l, _C, k] = 1.0
@@ -163,42 +285,14 @@ def _rnea(T, axes, prismatic, phi, g, q, dq, ddq, tau):
         # outward pass: link l from its parent l - 1
         for l in range(1, n + 1):
             i = l - 1
-            t00, t01, t02, t03 = T[i, 0, 0], T[i, 0, 1], T[i, 0, 2], T[i, 0, 3]
-            t10, t11, t12, t13 = T[i, 1, 0], T[i, 1, 1], T[i, 1, 2], T[i, 1, 3]
-            t20, t21, t22, t23 = T[i, 2, 0], T[i, 2, 1], T[i, 2, 2], T[i, 2, 3]
-            ax, ay, az = axes[i, 0], axes[i, 1], axes[i, 2]
-            kxx, kyy, kzz = ax * ax - 1.0, ay * ay - 1.0, az * az - 1.0
-            kxy, kxz, kyz = ax * ay, ax * az, ay * az
-            ep = 1.0 if prismatic[i] else 0.0
-            er = 1.0 - ep
+            ax, ay, az = C[i, C_AXIS], C[i, C_AXIS + 1], C[i, C_AXIS + 2]
+            ep = C[i, C_PRISMATIC]
+            F, e = fixed(C, i)  # constants out of the sample loop (it vectorises)
             for k in range(nb):
-                # R = T_fix Rot(axis, q) (Rodrigues: E + s K + (1 - c) K K, K K = a a^T - E)
-                s, c = X[l, _S, k], X[l, _C, k]
-                v = 1.0 - c
-                q00 = 1.0 + v * kxx
-                q11 = 1.0 + v * kyy
-                q22 = 1.0 + v * kzz
-                q01 = -s * az + v * kxy
-                q10 = s * az + v * kxy
-                q02 = s * ay + v * kxz
-                q20 = -s * ay + v * kxz
-                q12 = -s * ax + v * kyz
-                q21 = s * ax + v * kyz
-                r00 = t00 * q00 + t01 * q10 + t02 * q20
-                r01 = t00 * q01 + t01 * q11 + t02 * q21
-                r02 = t00 * q02 + t01 * q12 + t02 * q22
-                r10 = t10 * q00 + t11 * q10 + t12 * q20
-                r11 = t10 * q01 + t11 * q11 + t12 * q21
-                r12 = t10 * q02 + t11 * q12 + t12 * q22
-                r20 = t20 * q00 + t21 * q10 + t22 * q20
-                r21 = t20 * q01 + t21 * q11 + t22 * q21
-                r22 = t20 * q02 + t21 * q12 + t22 * q22
-                # p = p_fix + T_fix (q a) for a prismatic joint
-                d = ep * X[l, _Q, k]
-                dx, dy, dz = d * ax, d * ay, d * az
-                px = t03 + (t00 * dx + t01 * dy + t02 * dz)
-                py = t13 + (t10 * dx + t11 * dy + t12 * dz)
-                pz = t23 + (t20 * dx + t21 * dy + t22 * dz)
+                # pose of link l in link l - 1 (the chain core's joint transform)
+                r00, r01, r02, r10, r11, r12, r20, r21, r22, px, py, pz = joint_from(
+                    F, e, X[l, _S, k], X[l, _C, k], ep * X[l, _Q, k]
+                )
                 X[l, _R, k] = r00
                 X[l, _R + 1, k] = r01
                 X[l, _R + 2, k] = r02
@@ -211,98 +305,55 @@ def _rnea(T, axes, prismatic, phi, g, q, dq, ddq, tau):
                 X[l, _P, k] = px
                 X[l, _P + 1, k] = py
                 X[l, _P + 2, k] = pz
-                wx, wy, wz = X[i, _W, k], X[i, _W + 1, k], X[i, _W + 2, k]
-                dwx, dwy, dwz = X[i, _DW, k], X[i, _DW + 1, k], X[i, _DW + 2, k]
-                # acceleration of the origin, parent coordinates: a0 + dw0 x p + w0 x (w0 x p)
-                ux = wy * pz - wz * py
-                uy = wz * px - wx * pz
-                uz = wx * py - wy * px
-                bx = X[i, _A, k] + (dwy * pz - dwz * py) + (wy * uz - wz * uy)
-                by = X[i, _A + 1, k] + (dwz * px - dwx * pz) + (wz * ux - wx * uz)
-                bz = X[i, _A + 2, k] + (dwx * py - dwy * px) + (wx * uy - wy * ux)
-                # into link coordinates: R^T
-                apx = r00 * bx + r10 * by + r20 * bz
-                apy = r01 * bx + r11 * by + r21 * bz
-                apz = r02 * bx + r12 * by + r22 * bz
-                wpx = r00 * wx + r10 * wy + r20 * wz
-                wpy = r01 * wx + r11 * wy + r21 * wz
-                wpz = r02 * wx + r12 * wy + r22 * wz
-                dpx = r00 * dwx + r10 * dwy + r20 * dwz
-                dpy = r01 * dwx + r11 * dwy + r21 * dwz
-                dpz = r02 * dwx + r12 * dwy + r22 * dwz
-                vi, ai = X[l, _V, k], X[l, _AC, k]
-                vx, vy, vz = vi * ax, vi * ay, vi * az
-                cx = wpy * vz - wpz * vy
-                cy = wpz * vx - wpx * vz
-                cz = wpx * vy - wpy * vx
-                # revolute: w += dq a, dw += w x dq a + ddq a; prismatic: a += 2 w x dq a + ddq a
-                X[l, _W, k] = wpx + er * vx
-                X[l, _W + 1, k] = wpy + er * vy
-                X[l, _W + 2, k] = wpz + er * vz
-                X[l, _DW, k] = dpx + er * (cx + ai * ax)
-                X[l, _DW + 1, k] = dpy + er * (cy + ai * ay)
-                X[l, _DW + 2, k] = dpz + er * (cz + ai * az)
-                X[l, _A, k] = apx + ep * (2.0 * cx + ai * ax)
-                X[l, _A + 1, k] = apy + ep * (2.0 * cy + ai * ay)
-                X[l, _A + 2, k] = apz + ep * (2.0 * cz + ai * az)
+                M = motion(
+                    (r00, r01, r02, r10, r11, r12, r20, r21, r22, px, py, pz),
+                    (X[i, _W, k], X[i, _W + 1, k], X[i, _W + 2, k]),
+                    (X[i, _DW, k], X[i, _DW + 1, k], X[i, _DW + 2, k]),
+                    (X[i, _A, k], X[i, _A + 1, k], X[i, _A + 2, k]),
+                    ax,
+                    ay,
+                    az,
+                    ep,
+                    X[l, _V, k],
+                    X[l, _AC, k],
+                )
+                X[l, _W, k] = M[0]
+                X[l, _W + 1, k] = M[1]
+                X[l, _W + 2, k] = M[2]
+                X[l, _DW, k] = M[3]
+                X[l, _DW + 1, k] = M[4]
+                X[l, _DW + 2, k] = M[5]
+                X[l, _A, k] = M[6]
+                X[l, _A + 1, k] = M[7]
+                X[l, _A + 2, k] = M[8]
         # inward pass: wrench on link l and its children, about origin l, link-l coordinates
         for l in range(n, 0, -1):
             i = l - 1
-            m = phi[i, 0]
-            hx, hy, hz = phi[i, 1], phi[i, 2], phi[i, 3]
-            Jxx, Jxy, Jxz = phi[i, 4], phi[i, 5], phi[i, 6]
-            Jyy, Jyz, Jzz = phi[i, 7], phi[i, 8], phi[i, 9]
-            ax, ay, az = axes[i, 0], axes[i, 1], axes[i, 2]
-            ep = 1.0 if prismatic[i] else 0.0
+            ax, ay, az = C[i, C_AXIS], C[i, C_AXIS + 1], C[i, C_AXIS + 2]
+            ep = C[i, C_PRISMATIC]
             er = 1.0 - ep
             c = l + 1
+            phi = inertial(C, i)  # constants out of the sample loop (it vectorises)
             for k in range(nb):
-                wx, wy, wz = X[l, _W, k], X[l, _W + 1, k], X[l, _W + 2, k]
-                dwx, dwy, dwz = X[l, _DW, k], X[l, _DW + 1, k], X[l, _DW + 2, k]
-                a0x, a0y, a0z = X[l, _A, k], X[l, _A + 1, k], X[l, _A + 2, k]
-                # f = m a + dw x h + w x (w x h)
-                ux = wy * hz - wz * hy
-                uy = wz * hx - wx * hz
-                uz = wx * hy - wy * hx
-                fx = m * a0x + (dwy * hz - dwz * hy) + (wy * uz - wz * uy)
-                fy = m * a0y + (dwz * hx - dwx * hz) + (wz * ux - wx * uz)
-                fz = m * a0z + (dwx * hy - dwy * hx) + (wx * uy - wy * ux)
-                # n = J dw + w x (J w) + h x a
-                jx = Jxx * wx + Jxy * wy + Jxz * wz
-                jy = Jxy * wx + Jyy * wy + Jyz * wz
-                jz = Jxz * wx + Jyz * wy + Jzz * wz
-                nx = (
-                    (Jxx * dwx + Jxy * dwy + Jxz * dwz)
-                    + (wy * jz - wz * jy)
-                    + (hy * a0z - hz * a0y)
+                f = wrench(
+                    phi,
+                    (X[l, _W, k], X[l, _W + 1, k], X[l, _W + 2, k]),
+                    (X[l, _DW, k], X[l, _DW + 1, k], X[l, _DW + 2, k]),
+                    (X[l, _A, k], X[l, _A + 1, k], X[l, _A + 2, k]),
                 )
-                ny = (
-                    (Jxy * dwx + Jyy * dwy + Jyz * dwz)
-                    + (wz * jx - wx * jz)
-                    + (hz * a0x - hx * a0z)
-                )
-                nz = (
-                    (Jxz * dwx + Jyz * dwy + Jzz * dwz)
-                    + (wx * jy - wy * jx)
-                    + (hx * a0y - hy * a0x)
-                )
-                # plus the child's wrench carried into this frame: R F, R N + p x R F
-                r00, r01, r02 = X[c, _R, k], X[c, _R + 1, k], X[c, _R + 2, k]
-                r10, r11, r12 = X[c, _R + 3, k], X[c, _R + 4, k], X[c, _R + 5, k]
-                r20, r21, r22 = X[c, _R + 6, k], X[c, _R + 7, k], X[c, _R + 8, k]
-                px, py, pz = X[c, _P, k], X[c, _P + 1, k], X[c, _P + 2, k]
-                Fx, Fy, Fz = X[c, _F, k], X[c, _F + 1, k], X[c, _F + 2, k]
-                Nx, Ny, Nz = X[c, _N, k], X[c, _N + 1, k], X[c, _N + 2, k]
-                RFx = r00 * Fx + r01 * Fy + r02 * Fz
-                RFy = r10 * Fx + r11 * Fy + r12 * Fz
-                RFz = r20 * Fx + r21 * Fy + r22 * Fz
-                RNx = r00 * Nx + r01 * Ny + r02 * Nz
-                RNy = r10 * Nx + r11 * Ny + r12 * Nz
-                RNz = r20 * Nx + r21 * Ny + r22 * Nz
-                Nx = nx + RNx + (py * RFz - pz * RFy)
-                Ny = ny + RNy + (pz * RFx - px * RFz)
-                Nz = nz + RNz + (px * RFy - py * RFx)
-                Fx, Fy, Fz = fx + RFx, fy + RFy, fz + RFz
+                # plus the child's wrench carried into this frame
+                W = carry(
+                    (
+                        X[c, _R, k], X[c, _R + 1, k], X[c, _R + 2, k],
+                        X[c, _R + 3, k], X[c, _R + 4, k], X[c, _R + 5, k],
+                        X[c, _R + 6, k], X[c, _R + 7, k], X[c, _R + 8, k],
+                        X[c, _P, k], X[c, _P + 1, k], X[c, _P + 2, k],
+                    ),
+                    (X[c, _F, k], X[c, _F + 1, k], X[c, _F + 2, k]),
+                    (X[c, _N, k], X[c, _N + 1, k], X[c, _N + 2, k]),
+                )  # fmt: skip
+                Fx, Fy, Fz = f[0] + W[0], f[1] + W[1], f[2] + W[2]
+                Nx, Ny, Nz = f[3] + W[3], f[4] + W[4], f[5] + W[5]
                 X[l, _F, k] = Fx
                 X[l, _F + 1, k] = Fy
                 X[l, _F + 2, k] = Fz
@@ -318,15 +369,65 @@ def _rnea(T, axes, prismatic, phi, g, q, dq, ddq, tau):
     return True
 
 
-def _gravity(T, axes, prismatic, phi, g, q, tau):
-    """Gravity torques into ``tau`` (B n,) for q (B n,); returns ``ok``."""
-    zero = np.zeros(T.shape[0])
-    return _rnea_kernel(T, axes, prismatic, phi, g, q, zero, zero, tau)
+@jit
+def gravity_torques(C, q, tau):
+    """Gravity torques into ``tau`` (B n,) for q (B n,); returns ``ok``.
+
+    Many samples: :func:`rnea` at rest (vectorised over samples). A few: from the potential
+    energy rather than a full RNEA (the velocities are zero): with
+    ``G = -g``, ``o_i``, ``z_i`` the origin and axis of joint i in the base frame and the
+    suffix sums ``M_i = sum_{l >= i} m_l``, ``S_i = sum_{l >= i} m_l p_l`` (``m_l p_l =
+    m_l o_l + R_l h_l``, the first moment of link l about the base origin),
+    ``tau_i = z_i . ((S_i - M_i o_i) x G)`` for a revolute joint and ``z_i . (M_i G)`` for a
+    prismatic one (Siciliano et al., *Robotics*, 2009, sec. 7.1.2).
+    """
+    n = C.shape[0] - 1
+    B = q.shape[0] // n
+    if B >= SMALL:  # many samples: the vectorised RNEA block kernel at rest is faster
+        zero = np.zeros(n)
+        return rnea(C, q, zero, zero, tau)
+    Gx, Gy, Gz = -C[n, 0], -C[n, 1], -C[n, 2]
+    S = np.empty((n, 9))  # per link: o, z, m p (base frame)
+    for b in range(B):
+        o = b * n
+        if not finite(q, o, n):
+            return False
+        P = IDENTITY
+        for i in range(n):
+            P = compose(P, joint(C, i, q[o + i]))
+            r00, r01, r02, r10, r11, r12, r20, r21, r22, ox, oy, oz = P
+            ex, ey, ez = C[i, C_AXIS], C[i, C_AXIS + 1], C[i, C_AXIS + 2]
+            m = C[i, C_PHI]
+            hx, hy, hz = C[i, C_PHI + 1], C[i, C_PHI + 2], C[i, C_PHI + 3]
+            S[i, 0], S[i, 1], S[i, 2] = ox, oy, oz
+            S[i, 3] = r00 * ex + r01 * ey + r02 * ez
+            S[i, 4] = r10 * ex + r11 * ey + r12 * ez
+            S[i, 5] = r20 * ex + r21 * ey + r22 * ez
+            S[i, 6] = m * ox + (r00 * hx + r01 * hy + r02 * hz)
+            S[i, 7] = m * oy + (r10 * hx + r11 * hy + r12 * hz)
+            S[i, 8] = m * oz + (r20 * hx + r21 * hy + r22 * hz)
+        M = Sx = Sy = Sz = 0.0
+        for i in range(n - 1, -1, -1):
+            M += C[i, C_PHI]
+            Sx += S[i, 6]
+            Sy += S[i, 7]
+            Sz += S[i, 8]
+            zx, zy, zz = S[i, 3], S[i, 4], S[i, 5]
+            if C[i, C_PRISMATIC] != 0.0:
+                tau[o + i] = M * (zx * Gx + zy * Gy + zz * Gz)
+            else:
+                rx, ry, rz = Sx - M * S[i, 0], Sy - M * S[i, 1], Sz - M * S[i, 2]
+                tau[o + i] = (
+                    zx * (ry * Gz - rz * Gy) + zy * (rz * Gx - rx * Gz) + zz * (rx * Gy - ry * Gx)
+                )
+    return True
 
 
-def _mass_matrix(T, axes, prismatic, phi, q, M):
+@jit
+def mass_matrix(C, q, M):
     """Mass matrices into ``M`` (B n n,) for q (B n,), composite-rigid-body; returns ``ok``."""
-    n = T.shape[0]
+    M = M.reshape(M.size)
+    n = C.shape[0] - 1
     B = q.shape[0] // n
     R = np.empty((n, 3, 3))
     p = np.empty((n, 3))
@@ -335,34 +436,10 @@ def _mass_matrix(T, axes, prismatic, phi, q, M):
             qi = q[b * n + i]
             if not math.isfinite(qi):
                 return False
-            ax, ay, az = axes[i, 0], axes[i, 1], axes[i, 2]
-            if prismatic[i]:
-                for r in range(3):
-                    R[i, r, 0], R[i, r, 1], R[i, r, 2] = T[i, r, 0], T[i, r, 1], T[i, r, 2]
-                    p[i, r] = T[i, r, 3] + (
-                        T[i, r, 0] * (qi * ax) + T[i, r, 1] * (qi * ay) + T[i, r, 2] * (qi * az)
-                    )
-                continue
-            if abs(qi) > _SINCOS_MAX:
-                s, c = math.sin(qi), math.cos(qi)
-            else:
-                s, c = _sincos(qi)
-            v = 1.0 - c
-            q00 = 1.0 + v * (ax * ax - 1.0)
-            q11 = 1.0 + v * (ay * ay - 1.0)
-            q22 = 1.0 + v * (az * az - 1.0)
-            q01 = -s * az + v * (ax * ay)
-            q10 = s * az + v * (ax * ay)
-            q02 = s * ay + v * (ax * az)
-            q20 = -s * ay + v * (ax * az)
-            q12 = -s * ax + v * (ay * az)
-            q21 = s * ax + v * (ay * az)
+            Ti = joint(C, i, qi)
             for r in range(3):
-                t0, t1, t2 = T[i, r, 0], T[i, r, 1], T[i, r, 2]
-                R[i, r, 0] = t0 * q00 + t1 * q10 + t2 * q20
-                R[i, r, 1] = t0 * q01 + t1 * q11 + t2 * q21
-                R[i, r, 2] = t0 * q02 + t1 * q12 + t2 * q22
-                p[i, r] = T[i, r, 3]
+                R[i, r, 0], R[i, r, 1], R[i, r, 2] = Ti[3 * r], Ti[3 * r + 1], Ti[3 * r + 2]
+                p[i, r] = Ti[9 + r]
         # composite inertia (mc, h, J) of links i.. about origin i, link-i axes
         mc = 0.0
         hx = hy = hz = 0.0
@@ -399,19 +476,19 @@ def _mass_matrix(T, axes, prismatic, phi, q, M):
                 nzz = r20 * s02 + r21 * s12 + r22 * s22 + mc * (pp - pz * pz) + pu2 - 2.0 * uz * pz
                 hx, hy, hz = ux + mc * px, uy + mc * py, uz + mc * pz
                 Jxx, Jxy, Jxz, Jyy, Jyz, Jzz = nxx, nxy, nxz, nyy, nyz, nzz
-            mc += phi[i, 0]
-            hx += phi[i, 1]
-            hy += phi[i, 2]
-            hz += phi[i, 3]
-            Jxx += phi[i, 4]
-            Jxy += phi[i, 5]
-            Jxz += phi[i, 6]
-            Jyy += phi[i, 7]
-            Jyz += phi[i, 8]
-            Jzz += phi[i, 9]
+            mc += C[i, C_PHI]
+            hx += C[i, C_PHI + 1]
+            hy += C[i, C_PHI + 2]
+            hz += C[i, C_PHI + 3]
+            Jxx += C[i, C_PHI + 4]
+            Jxy += C[i, C_PHI + 5]
+            Jxz += C[i, C_PHI + 6]
+            Jyy += C[i, C_PHI + 7]
+            Jyz += C[i, C_PHI + 8]
+            Jzz += C[i, C_PHI + 9]
             # wrench (moment N about origin i, force F) of the composite for unit motion of joint i
-            ax, ay, az = axes[i, 0], axes[i, 1], axes[i, 2]
-            if prismatic[i]:  # F = m a, N = h x a
+            ax, ay, az = C[i, C_AXIS], C[i, C_AXIS + 1], C[i, C_AXIS + 2]
+            if C[i, C_PRISMATIC] != 0.0:  # F = m a, N = h x a
                 Fx, Fy, Fz = mc * ax, mc * ay, mc * az
                 Nx = hy * az - hz * ay
                 Ny = hz * ax - hx * az
@@ -425,10 +502,11 @@ def _mass_matrix(T, axes, prismatic, phi, q, M):
                 Fz = ax * hy - ay * hx
             j = i
             while True:
-                if prismatic[j]:
-                    e = Fx * axes[j, 0] + Fy * axes[j, 1] + Fz * axes[j, 2]
+                bx, by, bz = C[j, C_AXIS], C[j, C_AXIS + 1], C[j, C_AXIS + 2]
+                if C[j, C_PRISMATIC] != 0.0:
+                    e = Fx * bx + Fy * by + Fz * bz
                 else:
-                    e = Nx * axes[j, 0] + Ny * axes[j, 1] + Nz * axes[j, 2]
+                    e = Nx * bx + Ny * by + Nz * bz
                 M[(b * n + j) * n + i] = e
                 M[(b * n + i) * n + j] = e
                 if j == 0:
@@ -450,13 +528,3 @@ def _mass_matrix(T, axes, prismatic, phi, q, M):
                 Fx, Fy, Fz = RFx, RFy, RFz
                 j -= 1
     return True
-
-
-_rnea_kernel = _jit(_rnea)
-
-#: ``rnea(T, axes, prismatic, phi, g, q, dq, ddq, tau) -> ok``
-rnea = _rnea_kernel
-#: ``gravity_torques(T, axes, prismatic, phi, g, q, tau) -> ok``
-gravity_torques = _jit(_gravity)
-#: ``mass_matrix(T, axes, prismatic, phi, q, M) -> ok``
-mass_matrix = _jit(_mass_matrix)

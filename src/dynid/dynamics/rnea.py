@@ -22,14 +22,14 @@ it.
 from __future__ import annotations
 
 from types import ModuleType
-from typing import NamedTuple
+from typing import Any, NamedTuple
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from .. import _checks, _compiled
+from .._compiled import constants as _constants
 from .._compiled import flat as _flat
-from .._compiled import readonly as _readonly
 from ..exceptions import ShapeError
 from ..kinematics.forward import _joint_rotations_translations
 from ..model.inertia import matrix_from_inertia6
@@ -49,8 +49,54 @@ def kernels() -> ModuleType | None:
     """
     global _KERNELS, _LOADED
     if not _LOADED:
-        _KERNELS, _LOADED = _compiled.optional(f"{__package__}._kernels"), True
+        _KERNELS, _LOADED = _compiled.kernels(__package__), True
     return _KERNELS
+
+
+def _kernels_for(ndim: int) -> ModuleType | None:
+    """The kernels for an input with ``ndim`` dimensions, or None for the numpy path.
+
+    A batch (``ndim > 1``) loads them; a single sample uses them once they are loaded,
+    else as :func:`dynid._compiled.small_call_uses_kernels` decides (the numpy path gives
+    the same numbers to rounding without the start-up cost of the kernels).
+    """
+    if _LOADED:
+        return _KERNELS
+    return kernels() if ndim > 1 or _compiled.small_call_uses_kernels() else None
+
+
+_ND, _F64, _CACHE = np.ndarray, _compiled.F64, _compiled.CACHE
+#: compiled entry points of the kernels for one sample, by name (see :func:`_single`)
+_ONE: dict[str, Any] = {}
+
+
+def _single(name: str) -> Any:
+    """Kernel ``name``'s entry point for one sample, made on first use (kernels loaded).
+
+    Types: a read-only ``C``, float64 joint vectors of any strides, a new C output (see
+    :func:`dynid._compiled.entry`).
+    """
+    e = _ONE.get(name)
+    if e is None:
+        C = _checks.frozen(np.zeros((2, _compiled.C_WIDTH)))
+        v, tau, M = _compiled.VECTOR, np.zeros(1), np.zeros((1, 1))
+        args = {
+            "rnea": (C, v, v, v, tau),
+            "gravity_torques": (C, v, tau),
+            "mass_matrix": (C, v, M),
+        }[name]
+        e = _ONE[name] = _compiled.entry(getattr(_KERNELS, name), *args)
+    return e
+
+
+def _c64(x: ArrayLike) -> NDArray[np.float64] | None:
+    """``x`` as a float64 C-contiguous array (no copy when it is one), or None."""
+    if type(x) is np.ndarray and x.dtype is _F64 and x.flags.c_contiguous:
+        return x
+    try:
+        return np.ascontiguousarray(x, dtype=np.float64)
+    except (TypeError, ValueError):
+        return None
 
 
 def cross(a: NDArray[np.float64], b: NDArray[np.float64]) -> NDArray[np.float64]:
@@ -176,31 +222,34 @@ def rnea(
     -----
     Uses the compiled kernel when available (see :func:`kernels`), else :func:`rnea_numpy`.
     """
-    K = _KERNELS if _LOADED else kernels()
-    if K is not None and gravity is None:
-        # lean path for the common call: same shapes, float64-convertible; the kernel
-        # checks finiteness and any failure falls through to the full validation below
-        try:
-            qa = np.asarray(q, dtype=np.float64)
-            va = np.asarray(dq, dtype=np.float64)
-            aa = np.asarray(ddq, dtype=np.float64)
-        except (TypeError, ValueError):
-            pass
-        else:
+    # single sample: three float64 (n,) arrays go straight to the kernel's compiled entry
+    # point (no conversion, no copy, no dispatch; the kernel checks finiteness)
+    hit = _CACHE.get(id(robot))
+    e = _ONE.get("rnea")
+    if hit is not None and e is not None and gravity is None:
+        n = hit[2]
+        if (
+            hit[0] is robot
+            and type(q) is type(dq) is type(ddq) is _ND
+            and q.dtype is dq.dtype is ddq.dtype is _F64
+            and q.ndim == dq.ndim == ddq.ndim == 1
+            and len(q) == len(dq) == len(ddq) == n
+        ):
+            tau = np.empty(n)
+            if e(hit[1], q, dq, ddq, tau):
+                return tau
+    if gravity is None:
+        # lean path: float64 C arrays of one shape (..., n) go to the kernel as they are;
+        # the kernel checks finiteness, and anything else (or a failure) falls through to
+        # the full validation below
+        qa, va, aa = _c64(q), _c64(dq), _c64(ddq)
+        K = None if qa is None else _kernels_for(qa.ndim)
+        if K is not None and qa is not None and va is not None and aa is not None:
             shape = qa.shape
             if shape == va.shape == aa.shape and shape and shape[-1] == len(robot.joint_names):
                 tau = np.empty(shape)
-                if K.rnea(
-                    robot.T_parent_joint,
-                    robot.axes,
-                    robot.prismatic,
-                    robot.phi,
-                    robot.gravity,
-                    _flat(qa),
-                    _flat(va),
-                    _flat(aa),
-                    tau if len(shape) == 1 else tau.reshape(-1),
-                ):
+                f = _single("rnea") if len(shape) == 1 else K.rnea
+                if f(_constants(robot), _flat(qa), _flat(va), _flat(aa), tau.reshape(-1)):
                     return tau
     shape, (q2, dq2, ddq2) = _prepare(robot, q, dq, ddq)
     g = robot.gravity if gravity is None else _checks.as_exact("gravity", gravity, (3,))
@@ -237,22 +286,16 @@ def _rnea(
     The compiled kernel when available, else :func:`_rnea_numpy`. ``dq`` and ``ddq`` may
     also be (1, n), one row for every sample.
     """
-    K = _KERNELS if _LOADED else kernels()
+    K = _kernels_for(1 + (q.shape[0] > 1))
     if K is not None:
         B, n = q.shape
         if dq.shape[0] in (1, B) and ddq.shape[0] in (1, B):
             tau = np.empty((B, n))
-            if K.rnea(
-                robot.T_parent_joint,
-                robot.axes,
-                robot.prismatic,
-                robot.phi if phi is robot.phi else _readonly(np.asarray(phi, dtype=np.float64)),
-                robot.gravity if gravity is robot.gravity else _readonly(gravity),
-                _flat(q),
-                _flat(dq),
-                _flat(ddq),
-                tau.reshape(-1),
-            ):
+            if phi is robot.phi and gravity is robot.gravity:
+                C = _constants(robot)
+            else:
+                C = _compiled.pack(robot, np.asarray(phi, dtype=np.float64), gravity)
+            if K.rnea(C, _flat(q), _flat(dq), _flat(ddq), tau.reshape(-1)):
                 return tau
     return _rnea_numpy(robot, phi, q, dq, ddq, gravity)
 

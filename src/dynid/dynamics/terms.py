@@ -21,8 +21,21 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from .. import _checks
+from .._compiled import constants as _constants
 from ..model.robot import Robot
-from .rnea import _flat, _prepare, _rnea, _rnea_numpy, kernels
+from . import rnea as _rnea_module
+from .rnea import (
+    _CACHE,
+    _F64,
+    _ND,
+    _ONE,
+    _c64,
+    _flat,
+    _prepare,
+    _rnea,
+    _rnea_numpy,
+    _single,
+)
 
 __all__ = [
     "mass_matrix",
@@ -37,29 +50,13 @@ __all__ = [
 _ZERO_G = _checks.frozen(np.zeros(3))
 
 
-def _lean_q(robot: Robot, q: ArrayLike) -> NDArray[np.float64] | None:
-    """``q`` as a float64 array when it is plainly (..., n), else None (full validation).
-
-    No finiteness check here: the kernels do it.
-    """
-    try:
-        qa = np.asarray(q, dtype=np.float64)
-    except (TypeError, ValueError):
-        return None
-    if qa.ndim == 0 or qa.shape[-1] != len(robot.joint_names):
-        return None
-    return qa
-
-
 def _mass_matrix(robot: Robot, q2: NDArray[np.float64]) -> NDArray[np.float64]:
     """(B, n, n) mass matrices for validated (B, n) positions (kernel when available)."""
-    K = kernels()
+    K = _rnea_module._kernels_for(1 + (q2.shape[0] > 1))
     if K is not None:
         B, n = q2.shape
         M = np.empty((B, n, n))
-        if K.mass_matrix(
-            robot.T_parent_joint, robot.axes, robot.prismatic, robot.phi, _flat(q2), M.reshape(-1)
-        ):
+        if K.mass_matrix(_constants(robot), _flat(q2), M):
             return M
     return _mass_matrix_numpy(robot, q2)
 
@@ -96,19 +93,24 @@ def mass_matrix(robot: Robot, q: ArrayLike) -> NDArray[np.float64]:
     Composite-rigid-body algorithm in the compiled kernel when available; otherwise
     :func:`mass_matrix_numpy`.
     """
-    K = kernels()
-    if K is not None:
-        qa = _lean_q(robot, q)
-        if qa is not None:
-            M = np.empty(qa.shape + qa.shape[-1:])
-            if K.mass_matrix(
-                robot.T_parent_joint,
-                robot.axes,
-                robot.prismatic,
-                robot.phi,
-                _flat(qa),
-                M.reshape(-1),
-            ):
+    # single sample: a float64 (n,) array goes straight to the kernel's compiled entry point
+    hit = _CACHE.get(id(robot))
+    e = _ONE.get("mass_matrix")
+    if hit is not None and e is not None:
+        n = hit[2]
+        if hit[0] is robot and type(q) is _ND and q.dtype is _F64 and q.ndim == 1 and len(q) == n:
+            M = np.empty((n, n))
+            if e(hit[1], q, M):
+                return M
+    # lean path: a float64 C array (..., n) goes to the kernel as it is
+    qa = _c64(q)
+    K = None if qa is None else _rnea_module._kernels_for(qa.ndim)
+    if K is not None and qa is not None:
+        n = len(robot.joint_names)
+        if qa.ndim and qa.shape[-1] == n:
+            M = np.empty((n, n) if qa.ndim == 1 else qa.shape + (n,))
+            f = _single("mass_matrix") if qa.ndim == 1 else K.mass_matrix
+            if f(_constants(robot), _flat(qa), M):
                 return M
     q = _checks.as_batch("q", q, (robot.n,))
     return _mass_matrix(robot, q.reshape(-1, robot.n)).reshape(q.shape + (robot.n,))
@@ -127,20 +129,23 @@ def gravity_torques(robot: Robot, q: ArrayLike) -> NDArray[np.float64]:
     ------
     ShapeError, NonFiniteError
     """
-    K = kernels()
-    if K is not None:
-        qa = _lean_q(robot, q)
-        if qa is not None:
+    # single sample: a float64 (n,) array goes straight to the kernel's compiled entry point
+    hit = _CACHE.get(id(robot))
+    e = _ONE.get("gravity_torques")
+    if hit is not None and e is not None:
+        n = hit[2]
+        if hit[0] is robot and type(q) is _ND and q.dtype is _F64 and q.ndim == 1 and len(q) == n:
+            tau = np.empty(n)
+            if e(hit[1], q, tau):
+                return tau
+    # lean path: a float64 C array (..., n) goes to the kernel as it is
+    qa = _c64(q)
+    K = None if qa is None else _rnea_module._kernels_for(qa.ndim)
+    if K is not None and qa is not None:
+        if qa.ndim and qa.shape[-1] == len(robot.joint_names):
             tau = np.empty(qa.shape)
-            if K.gravity_torques(
-                robot.T_parent_joint,
-                robot.axes,
-                robot.prismatic,
-                robot.phi,
-                robot.gravity,
-                _flat(qa),
-                tau if tau.ndim == 1 else tau.reshape(-1),
-            ):
+            f = _single("gravity_torques") if qa.ndim == 1 else K.gravity_torques
+            if f(_constants(robot), _flat(qa), tau.reshape(-1)):
                 return tau
     q = _checks.as_batch("q", q, (robot.n,))
     q2 = q.reshape(-1, robot.n)

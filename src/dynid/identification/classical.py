@@ -162,10 +162,13 @@ def identify_from_log(
     q, dq, ddq, tau = prepared.q[sl], prepared.dq[sl], prepared.ddq[sl], prepared.tau[sl]
     bp = base_parameters(robot, kind="torque", rtol=rtol) if base is None else base
     N = q.shape[0]
-    Y = _torque_regressor(robot, q, dq, ddq, robot.gravity)
-    Yb = Y[..., bp.independent]  # reduce columns before stacking
+    # only the base columns, with room for the friction columns after them
+    r0 = len(bp.independent)
+    Yb = _torque_regressor(
+        robot, q, dq, ddq, robot.gravity, columns=bp.independent, width=r0 + 3 * n * friction
+    )
     if friction:
-        Yb = np.concatenate([Yb, friction_regressor(dq)], axis=-1)
+        Yb[..., r0:] = friction_regressor(dq)
     W = Yb.reshape(N * n, -1)
     y = tau.reshape(-1)
     r = bp.rank

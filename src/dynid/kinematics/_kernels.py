@@ -1,260 +1,147 @@
 """Compiled (numba) kernels: link poses, frame poses and geometric Jacobians.
 
-This module imports numba, so it is imported lazily, on the first call of a kinematics
-function (see :func:`dynid.kinematics.forward.kernels`), never by ``import dynid``. Each
-kernel is compiled on its first call for the argument types it meets and cached on disk
-(``cache=True``); later processes load it instead of compiling it again.
+Imported lazily, on the first kinematics call (:func:`dynid._compiled.kernels`), never by
+``import dynid``; compiled once and cached on disk (:func:`dynid.kinematics._chain.jit`).
 
-The kernels take the robot's constant arrays as arguments: ``T`` (``T_parent_joint``,
-(n, 4, 4)), ``axes`` (n, 3, unit joint axes in the child link's frame, any direction) and
-``prismatic`` (n,) bool; see :mod:`dynid.model.robot`. A frame is given by its ``link``
-(0 = base) and its pose ``T_lf`` (4, 4) in that link, a tool already multiplied in.
-Joint positions ``q`` are a flat, C-contiguous float64 array of length ``B * n``,
-sample-major (a (B, n) array reshaped). Results are written into a flat output array,
-row-major: ``B * (n + 1) * 16`` for the link poses, ``B * 16`` for a frame pose,
-``B * 6 * n`` for a Jacobian. Every kernel checks that ``q`` is finite and returns ``ok``;
-with ``ok = False`` the output is unfinished and the caller raises the error that names
-the bad entry.
+Arguments: ``C``, the robot's packed constants (:func:`dynid._compiled.pack`), with a
+last row for the frame (:func:`dynid._compiled.pack_frame`: its ``link``, 0 = base, and its
+pose ``T_lf`` in that link, a tool already multiplied in) for :func:`frame_pose` and
+:func:`jacobian`; joint positions ``q``, flat float64 of length ``B * n``,
+sample-major (a (B, n) array reshaped). Results go into a C-contiguous output array of
+any shape, read flat, row-major:
+``B * (n + 1) * 16`` for the link poses, ``B * 16`` for a frame pose, ``B * 6 * n`` for a
+Jacobian. Every kernel checks that ``q`` is finite and returns ``ok``; with ``ok = False``
+the output is unfinished and the caller raises the error that names the bad entry.
 
-Equations: the same as the numpy reference path of :mod:`dynid.kinematics.forward` and
-:mod:`dynid.kinematics.jacobian`, in the same order of operations. The motion of a
-revolute joint about the unit axis ``a`` is Rodrigues' ``E + sin q K + (1 - cos q) K K``
-with ``K = [a]x``; a prismatic joint translates by ``q a``. Then
-``T_{i-1,i} = T_parent_joint[i] T_joint(q_i)`` and the poses are chained from the base,
-``p_i = p_{i-1} + R_{i-1} p_{i-1,i}``, ``R_i = R_{i-1} R_{i-1,i}``. Column ``i`` of the
-Jacobian of the frame origin ``p`` is ``[z_i x (p - o_i); z_i]`` (revolute) or
-``[z_i; 0]`` (prismatic), ``z_i = R_i a_i``, ``o_i = p_i`` (Siciliano et al., *Robotics*,
-2009, eq. 3.30); columns of joints after the frame's link are zero.
-
-The compiler may fuse ``a * b + c`` into one multiply-add (numba ``fastmath={"contract"}``,
-no other fast-math flag), so the kernels and the numpy path differ by rounding only (the
-tests hold them to 1e-12). Sine and cosine are the math library's.
+Equations: the joint transform and chaining of :mod:`dynid.kinematics._chain`. Column
+``i`` of the Jacobian of the frame origin ``p`` is ``[z_i x (p - o_i); z_i]`` (revolute)
+or ``[z_i; 0]`` (prismatic), ``z_i = R_i a_i``, ``o_i = p_i`` (Siciliano et al.,
+*Robotics*, 2009, eq. 3.30); columns of joints after the frame's link are zero.
 """
 
 from __future__ import annotations
 
-import math
-
-import numba
-import numpy as np
+from .._compiled import C_AXIS, C_PRISMATIC
+from ._chain import IDENTITY, compose, finite, inline, jit, joint
 
 __all__ = ["link_poses", "frame_pose", "jacobian"]
 
-# a * b + c may be one fused multiply-add (one rounding instead of two); no reassociation,
-# no approximate functions, NaN and inf semantics kept
-_FASTMATH = {"contract"}
 
-
-def _jit(fn):
-    """``numba.njit(cache=True)`` allowing fused multiply-add, and nothing else of fastmath.
-
-    Without the disk cache when numba finds no writable cache folder.
-    """
-    try:
-        return numba.njit(cache=True, fastmath=_FASTMATH)(fn)
-    except RuntimeError:  # no writable cache location
-        return numba.njit(fastmath=_FASTMATH)(fn)
-
-
-@numba.njit(inline="always")
-def _kk(axes, KK):
-    """``K K`` (n, 3, 3) for ``K = [a]x`` of every axis, summed as ``K @ K`` is."""
-    n = axes.shape[0]
-    K = np.zeros((3, 3))
-    for i in range(n):
-        ax, ay, az = axes[i, 0], axes[i, 1], axes[i, 2]
-        K[0, 1], K[0, 2], K[1, 2] = -az, ay, -ax
-        K[1, 0], K[2, 0], K[2, 1] = az, -ay, ax
-        for r in range(3):
-            for c in range(3):
-                KK[i, r, c] = K[r, 0] * K[0, c] + K[r, 1] * K[1, c] + K[r, 2] * K[2, c]
-
-
-@numba.njit(inline="always")
-def _finite(q, b, n):
-    """All of sample ``b``'s ``n`` joint positions are finite."""
-    for i in range(n):
-        if not math.isfinite(q[b * n + i]):
-            return False
-    return True
-
-
-@numba.njit(inline="always")
-def _step(T, axes, prismatic, KK, i, qi, Rb, pb):
-    """Carry the base pose ``(Rb, pb)`` of link ``i`` to link ``i + 1`` in place."""
-    # motion of the joint in its own frame: Rq, pq
-    if prismatic[i]:
-        # R = Rf (Rq = E), p = pf + Rf (q a)
-        dx, dy, dz = qi * axes[i, 0], qi * axes[i, 1], qi * axes[i, 2]
-        r00, r01, r02 = T[i, 0, 0], T[i, 0, 1], T[i, 0, 2]
-        r10, r11, r12 = T[i, 1, 0], T[i, 1, 1], T[i, 1, 2]
-        r20, r21, r22 = T[i, 2, 0], T[i, 2, 1], T[i, 2, 2]
-        px = T[i, 0, 3] + (r00 * dx + r01 * dy + r02 * dz)
-        py = T[i, 1, 3] + (r10 * dx + r11 * dy + r12 * dz)
-        pz = T[i, 2, 3] + (r20 * dx + r21 * dy + r22 * dz)
-    else:
-        s, c = math.sin(qi), math.cos(qi)
-        v = 1.0 - c
-        ax, ay, az = axes[i, 0], axes[i, 1], axes[i, 2]
-        # E + s K + v K K
-        q00 = 1.0 + v * KK[i, 0, 0]
-        q01 = -s * az + v * KK[i, 0, 1]
-        q02 = s * ay + v * KK[i, 0, 2]
-        q10 = s * az + v * KK[i, 1, 0]
-        q11 = 1.0 + v * KK[i, 1, 1]
-        q12 = -s * ax + v * KK[i, 1, 2]
-        q20 = -s * ay + v * KK[i, 2, 0]
-        q21 = s * ax + v * KK[i, 2, 1]
-        q22 = 1.0 + v * KK[i, 2, 2]
-        t00, t01, t02 = T[i, 0, 0], T[i, 0, 1], T[i, 0, 2]
-        t10, t11, t12 = T[i, 1, 0], T[i, 1, 1], T[i, 1, 2]
-        t20, t21, t22 = T[i, 2, 0], T[i, 2, 1], T[i, 2, 2]
-        r00 = t00 * q00 + t01 * q10 + t02 * q20
-        r01 = t00 * q01 + t01 * q11 + t02 * q21
-        r02 = t00 * q02 + t01 * q12 + t02 * q22
-        r10 = t10 * q00 + t11 * q10 + t12 * q20
-        r11 = t10 * q01 + t11 * q11 + t12 * q21
-        r12 = t10 * q02 + t11 * q12 + t12 * q22
-        r20 = t20 * q00 + t21 * q10 + t22 * q20
-        r21 = t20 * q01 + t21 * q11 + t22 * q21
-        r22 = t20 * q02 + t21 * q12 + t22 * q22
-        px, py, pz = T[i, 0, 3], T[i, 1, 3], T[i, 2, 3]
-    # pb += Rb p, then Rb = Rb R
-    b00, b01, b02 = Rb[0], Rb[1], Rb[2]
-    b10, b11, b12 = Rb[3], Rb[4], Rb[5]
-    b20, b21, b22 = Rb[6], Rb[7], Rb[8]
-    pb[0] = pb[0] + (b00 * px + b01 * py + b02 * pz)
-    pb[1] = pb[1] + (b10 * px + b11 * py + b12 * pz)
-    pb[2] = pb[2] + (b20 * px + b21 * py + b22 * pz)
-    Rb[0] = b00 * r00 + b01 * r10 + b02 * r20
-    Rb[1] = b00 * r01 + b01 * r11 + b02 * r21
-    Rb[2] = b00 * r02 + b01 * r12 + b02 * r22
-    Rb[3] = b10 * r00 + b11 * r10 + b12 * r20
-    Rb[4] = b10 * r01 + b11 * r11 + b12 * r21
-    Rb[5] = b10 * r02 + b11 * r12 + b12 * r22
-    Rb[6] = b20 * r00 + b21 * r10 + b22 * r20
-    Rb[7] = b20 * r01 + b21 * r11 + b22 * r21
-    Rb[8] = b20 * r02 + b21 * r12 + b22 * r22
-
-
-@numba.njit(inline="always")
-def _reset(Rb, pb):
-    """The base pose: identity."""
-    for k in range(9):
-        Rb[k] = 0.0
-    Rb[0] = Rb[4] = Rb[8] = 1.0
-    pb[0] = pb[1] = pb[2] = 0.0
-
-
-@numba.njit(inline="always")
-def _frame(Rb, pb, T_lf, out, o):
-    """``[Rb pb; 0 0 0 1] @ T_lf`` into ``out[o : o + 16]``, row-major."""
+@inline
+def _put_pose(P, out, o):
+    """Pose ``P`` (12 floats) as a 4x4 row-major matrix into ``out[o : o + 16]``."""
     for r in range(3):
-        a0, a1, a2, a3 = Rb[3 * r], Rb[3 * r + 1], Rb[3 * r + 2], pb[r]
+        out[o + 4 * r] = P[3 * r]
+        out[o + 4 * r + 1] = P[3 * r + 1]
+        out[o + 4 * r + 2] = P[3 * r + 2]
+        out[o + 4 * r + 3] = P[9 + r]
+    out[o + 12] = 0.0
+    out[o + 13] = 0.0
+    out[o + 14] = 0.0
+    out[o + 15] = 1.0
+
+
+@inline
+def _frame(P, C, f, out, o):
+    """``[R p; 0 1] @ T_lf`` into ``out[o : o + 16]``, row-major; ``T_lf`` is row ``f`` of C."""
+    for r in range(3):
+        a0, a1, a2, a3 = P[3 * r], P[3 * r + 1], P[3 * r + 2], P[9 + r]
         for c in range(4):
             out[o + 4 * r + c] = (
-                a0 * T_lf[0, c] + a1 * T_lf[1, c] + a2 * T_lf[2, c] + a3 * T_lf[3, c]
+                a0 * C[f, c] + a1 * C[f, 4 + c] + a2 * C[f, 8 + c] + a3 * C[f, 12 + c]
             )
     for c in range(4):
-        out[o + 12 + c] = T_lf[3, c]
+        out[o + 12 + c] = C[f, 12 + c]
 
 
-def _link_poses(T, axes, prismatic, q, out):
+@jit
+def link_poses(C, q, out):
     """Link poses into ``out`` (B (n + 1) 16,) for q (B n,); returns ``ok``."""
-    n = T.shape[0]
+    out = out.reshape(out.size)
+    n = C.shape[0] - 1
     B = q.shape[0] // n
-    KK = np.empty((n, 3, 3))
-    _kk(axes, KK)
-    Rb = np.empty(9)
-    pb = np.empty(3)
     for b in range(B):
-        if not _finite(q, b, n):
+        if not finite(q, b * n, n):
             return False
-        _reset(Rb, pb)
-        for i in range(n + 1):
-            if i > 0:
-                _step(T, axes, prismatic, KK, i - 1, q[b * n + i - 1], Rb, pb)
-            o = (b * (n + 1) + i) * 16
-            for r in range(3):
-                out[o + 4 * r] = Rb[3 * r]
-                out[o + 4 * r + 1] = Rb[3 * r + 1]
-                out[o + 4 * r + 2] = Rb[3 * r + 2]
-                out[o + 4 * r + 3] = pb[r]
-            out[o + 12] = 0.0
-            out[o + 13] = 0.0
-            out[o + 14] = 0.0
-            out[o + 15] = 1.0
+        P = IDENTITY
+        o = b * (n + 1) * 16
+        _put_pose(P, out, o)
+        for i in range(n):
+            P = compose(P, joint(C, i, q[b * n + i]))
+            _put_pose(P, out, o + (i + 1) * 16)
     return True
 
 
-def _frame_pose(T, axes, prismatic, link, T_lf, q, out):
-    """Pose of the frame ``T_lf`` of ``link`` into ``out`` (B 16,) for q (B n,); ``ok``."""
-    n = T.shape[0]
+@jit
+def frame_pose(C, q, out):
+    """Pose of the frame of ``C``'s last row into ``out`` (B 16,) for q (B n,); ``ok``."""
+    out = out.reshape(out.size)
+    n = C.shape[0] - 2
+    link = int(C[n + 1, 16])
     B = q.shape[0] // n
-    KK = np.empty((n, 3, 3))
-    _kk(axes, KK)
-    Rb = np.empty(9)
-    pb = np.empty(3)
     for b in range(B):
-        if not _finite(q, b, n):
+        if not finite(q, b * n, n):
             return False
-        _reset(Rb, pb)
+        P = IDENTITY
         for i in range(link):
-            _step(T, axes, prismatic, KK, i, q[b * n + i], Rb, pb)
-        _frame(Rb, pb, T_lf, out, b * 16)
+            P = compose(P, joint(C, i, q[b * n + i]))
+        _frame(P, C, n + 1, out, b * 16)
     return True
 
 
-def _jacobian(T, axes, prismatic, link, T_lf, q, J):
-    """Jacobian of the origin of frame ``T_lf`` of ``link`` into ``J`` (B 6 n,); ``ok``."""
-    n = T.shape[0]
+@inline
+def frame_jacobian(C, q, oq, link, J, oj, stride):
+    """Jacobian columns ``0..link-1`` of the origin of ``C``'s frame (its last row).
+
+    ``q[oq : oq + link]`` moves the frame; column ``i``, row ``r`` goes to
+    ``J[oj + r * stride + i]``. Returns the pose of ``link`` in the base (12 floats).
+    """
+    f = C.shape[0] - 1
+    P = IDENTITY
+    # first pass: joint axis z_i into rows 3-5 and link origin o_i into rows 0-2
+    for i in range(link):
+        P = compose(P, joint(C, i, q[oq + i]))
+        ax, ay, az = C[i, C_AXIS], C[i, C_AXIS + 1], C[i, C_AXIS + 2]
+        J[oj + i] = P[9]
+        J[oj + stride + i] = P[10]
+        J[oj + 2 * stride + i] = P[11]
+        J[oj + 3 * stride + i] = P[0] * ax + P[1] * ay + P[2] * az
+        J[oj + 4 * stride + i] = P[3] * ax + P[4] * ay + P[5] * az
+        J[oj + 5 * stride + i] = P[6] * ax + P[7] * ay + P[8] * az
+    # the frame origin p, then the columns
+    px = P[0] * C[f, 3] + P[1] * C[f, 7] + P[2] * C[f, 11] + P[9] * C[f, 15]
+    py = P[3] * C[f, 3] + P[4] * C[f, 7] + P[5] * C[f, 11] + P[10] * C[f, 15]
+    pz = P[6] * C[f, 3] + P[7] * C[f, 7] + P[8] * C[f, 11] + P[11] * C[f, 15]
+    for i in range(link):
+        zx, zy, zz = J[oj + 3 * stride + i], J[oj + 4 * stride + i], J[oj + 5 * stride + i]
+        if C[i, C_PRISMATIC] != 0.0:
+            J[oj + i], J[oj + stride + i], J[oj + 2 * stride + i] = zx, zy, zz
+            J[oj + 3 * stride + i] = 0.0
+            J[oj + 4 * stride + i] = 0.0
+            J[oj + 5 * stride + i] = 0.0
+        else:
+            rx = px - J[oj + i]
+            ry = py - J[oj + stride + i]
+            rz = pz - J[oj + 2 * stride + i]
+            J[oj + i] = zy * rz - zz * ry
+            J[oj + stride + i] = zz * rx - zx * rz
+            J[oj + 2 * stride + i] = zx * ry - zy * rx
+    return P
+
+
+@jit
+def jacobian(C, q, J):
+    """Jacobian of the origin of the frame of ``C``'s last row into ``J`` (B 6 n,); ``ok``."""
+    J = J.reshape(J.size)
+    n = C.shape[0] - 2
+    link = int(C[n + 1, 16])
     B = q.shape[0] // n
-    KK = np.empty((n, 3, 3))
-    _kk(axes, KK)
-    Rb = np.empty(9)
-    pb = np.empty(3)
     for b in range(B):
-        if not _finite(q, b, n):
+        if not finite(q, b * n, n):
             return False
         o = b * 6 * n
-        _reset(Rb, pb)
-        # first pass: joint axis z_i into rows 3-5 and link origin o_i into rows 0-2
-        for i in range(link):
-            _step(T, axes, prismatic, KK, i, q[b * n + i], Rb, pb)
-            ax, ay, az = axes[i, 0], axes[i, 1], axes[i, 2]
-            J[o + i] = pb[0]
-            J[o + n + i] = pb[1]
-            J[o + 2 * n + i] = pb[2]
-            J[o + 3 * n + i] = Rb[0] * ax + Rb[1] * ay + Rb[2] * az
-            J[o + 4 * n + i] = Rb[3] * ax + Rb[4] * ay + Rb[5] * az
-            J[o + 5 * n + i] = Rb[6] * ax + Rb[7] * ay + Rb[8] * az
+        frame_jacobian(C, q, b * n, link, J, o, n)
         for i in range(link, n):
             for r in range(6):
                 J[o + r * n + i] = 0.0
-        # the frame origin p, then the columns
-        px = Rb[0] * T_lf[0, 3] + Rb[1] * T_lf[1, 3] + Rb[2] * T_lf[2, 3] + pb[0] * T_lf[3, 3]
-        py = Rb[3] * T_lf[0, 3] + Rb[4] * T_lf[1, 3] + Rb[5] * T_lf[2, 3] + pb[1] * T_lf[3, 3]
-        pz = Rb[6] * T_lf[0, 3] + Rb[7] * T_lf[1, 3] + Rb[8] * T_lf[2, 3] + pb[2] * T_lf[3, 3]
-        for i in range(link):
-            zx, zy, zz = J[o + 3 * n + i], J[o + 4 * n + i], J[o + 5 * n + i]
-            if prismatic[i]:
-                J[o + i], J[o + n + i], J[o + 2 * n + i] = zx, zy, zz
-                J[o + 3 * n + i] = 0.0
-                J[o + 4 * n + i] = 0.0
-                J[o + 5 * n + i] = 0.0
-            else:
-                rx = px - J[o + i]
-                ry = py - J[o + n + i]
-                rz = pz - J[o + 2 * n + i]
-                J[o + i] = zy * rz - zz * ry
-                J[o + n + i] = zz * rx - zx * rz
-                J[o + 2 * n + i] = zx * ry - zy * rx
     return True
-
-
-#: ``link_poses(T, axes, prismatic, q, out) -> ok``
-link_poses = _jit(_link_poses)
-#: ``frame_pose(T, axes, prismatic, link, T_lf, q, out) -> ok``
-frame_pose = _jit(_frame_pose)
-#: ``jacobian(T, axes, prismatic, link, T_lf, q, J) -> ok``
-jacobian = _jit(_jacobian)

@@ -19,11 +19,13 @@ variable ``DYNID_NO_NUMBA=1`` before the first kinematics call to force the nump
 from __future__ import annotations
 
 from types import ModuleType
+from typing import Any
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from .. import _checks, _compiled
+from .._compiled import constants as _constants
 from .._compiled import flat as _flat
 from .._compiled import readonly as _readonly
 from ..model.robot import Robot
@@ -40,32 +42,96 @@ __all__ = [
 
 _KERNELS: ModuleType | None = None
 _LOADED = False
+_F64 = _compiled.F64
 
 
 def kernels() -> ModuleType | None:
     """The compiled kernels module, or None when numba is missing or ``DYNID_NO_NUMBA`` is set.
 
-    Imported once, on the first call; ``DYNID_NO_NUMBA`` is read then. Any value other
-    than ``""`` and ``"0"`` selects the numpy reference path.
+    Imported once, on the first call (:func:`dynid._compiled.kernels`); ``DYNID_NO_NUMBA``
+    is read then. Any value other than ``""`` and ``"0"`` selects the numpy reference path.
     """
     global _KERNELS, _LOADED
     if not _LOADED:
-        _KERNELS, _LOADED = _compiled.optional(f"{__package__}._kernels"), True
+        _KERNELS, _LOADED = _compiled.kernels(__package__), True
     return _KERNELS
 
 
-def _as_q(robot: Robot, q: ArrayLike) -> NDArray[np.float64] | None:
-    """``q`` as float64 when that is cheap and its shape is ``(..., n)``, else None.
+def _kernels_for(ndim: int) -> ModuleType | None:
+    """The kernels for an input with ``ndim`` dimensions, or None for the numpy path.
 
-    The lean path of the public functions: finiteness is left to the kernels, and None
-    sends the call to the full validation, which raises the documented errors.
+    A batch (``ndim > 1``) loads them; a single sample uses them once they are loaded,
+    else as :func:`dynid._compiled.small_call_uses_kernels` decides (the numpy path gives
+    the same numbers to rounding without the start-up cost of the kernels).
     """
-    try:
-        qa = np.asarray(q, dtype=np.float64)
-    except (TypeError, ValueError):
-        return None
-    shape = qa.shape
-    return qa if shape and shape[-1] == len(robot.joint_names) and shape[-1] else None
+    if _LOADED:
+        return _KERNELS
+    return kernels() if ndim > 1 or _compiled.small_call_uses_kernels() else None
+
+
+_ND = np.ndarray
+#: compiled entry points of the kernels for one sample, by name (see :func:`_single`)
+_ONE: dict[str, Any] = {}
+
+
+def _single(name: str) -> Any:
+    """Kernel ``name``'s entry point for one sample, made on first use (kernels loaded).
+
+    Types: read-only frame constants, a float64 joint vector of any strides, a new C
+    output (see :func:`dynid._compiled.entry`).
+    """
+    e = _ONE.get(name)
+    if e is None:
+        CF, v = _checks.frozen(np.zeros((3, _compiled.C_WIDTH))), _compiled.VECTOR
+        out = np.zeros((4, 4)) if name == "frame_pose" else np.zeros((6, 1))
+        e = _ONE[name] = _compiled.entry(getattr(_KERNELS, name), CF, v, out)
+    return e
+
+
+def _as_q(robot: Robot, q: ArrayLike) -> NDArray[np.float64] | None:
+    """``q`` as a flat-able float64 C array when that is cheap and its shape is ``(..., n)``.
+
+    The thin path of the public functions: a float64 C-contiguous ndarray passes with two
+    attribute reads, no copy; finiteness is left to the kernels, and None sends the call to
+    the full validation, which raises the documented errors.
+    """
+    if type(q) is not np.ndarray or q.dtype is not _F64 or not q.flags.c_contiguous:
+        try:
+            q = np.ascontiguousarray(q, dtype=np.float64)
+        except (TypeError, ValueError):
+            return None
+    shape = q.shape
+    return q if shape and shape[-1] == len(robot.joint_names) and shape[-1] else None
+
+
+#: ``(id(robot), frame) -> (robot, link, T_link_frame, CF, n)`` for a few robots and
+#: frames, ``CF`` the kernels' constants with the frame (:func:`dynid._compiled.pack_frame`)
+_FRAMES: dict[tuple[int, str], tuple[Robot, int, NDArray, NDArray, int]] = {}
+
+
+def _frame_entry(robot: Robot, frame: str) -> tuple[Robot, int, NDArray, NDArray, int]:
+    """The :data:`_FRAMES` entry of ``frame``, made on first use."""
+    hit = _FRAMES.get((id(robot), frame))
+    if hit is not None and hit[0] is robot:
+        return hit
+    f = robot.frame(frame)
+    T = _readonly(f.T_link_frame)
+    CF = _compiled.pack_frame(_constants(robot), f.link, T)
+    if len(_FRAMES) >= 64:
+        _FRAMES.pop(next(iter(_FRAMES)))
+    hit = _FRAMES[(id(robot), frame)] = (robot, f.link, T, CF, robot.n)
+    return hit
+
+
+def _frame_constants(
+    robot: Robot, frame: str, tool: ArrayLike | None
+) -> tuple[int, NDArray[np.float64], NDArray[np.float64]]:
+    """``(link, T_link_frame, CF)`` of ``frame`` with ``tool`` multiplied in."""
+    if tool is None:
+        _, link, T, CF, _ = _frame_entry(robot, frame)
+        return link, T, CF
+    link, T = frame_pose_in_link(robot, frame, tool)
+    return link, T, _compiled.pack_frame(_constants(robot), link, T)
 
 
 def check_q(robot: Robot, q: ArrayLike, name: str = "q") -> NDArray[np.float64]:
@@ -154,15 +220,12 @@ def link_poses(robot: Robot, q: ArrayLike) -> NDArray[np.float64]:
     T_base_link : ndarray, shape (..., n + 1, 4, 4)
         Index 0 is the base (identity), index i is link i; translations in [m].
     """
-    K = _KERNELS if _LOADED else kernels()
-    if K is not None:
-        qa = _as_q(robot, q)
-        if qa is not None:
-            T = np.empty(qa.shape[:-1] + (qa.shape[-1] + 1, 4, 4))
-            if K.link_poses(
-                robot.T_parent_joint, robot.axes, robot.prismatic, _flat(qa), T.reshape(-1)
-            ):
-                return T
+    qa = _as_q(robot, q)
+    K = None if qa is None else _kernels_for(qa.ndim)
+    if K is not None and qa is not None:
+        T = np.empty(qa.shape[:-1] + (qa.shape[-1] + 1, 4, 4))
+        if K.link_poses(_constants(robot), _flat(qa), T):
+            return T
     return link_poses_numpy(robot, q)
 
 
@@ -180,11 +243,10 @@ def frame_pose_in_link(
     robot: Robot, frame: str, tool: ArrayLike | None = None
 ) -> tuple[int, NDArray[np.float64]]:
     """The link that carries ``frame`` and the pose of ``frame`` (then ``tool``) in that link."""
-    f = robot.frame(frame)
-    T = f.T_link_frame
+    _, link, T, _, _ = _frame_entry(robot, frame)
     if tool is not None:
-        T = T @ _checks.as_exact("tool", tool, (4, 4))
-    return f.link, T
+        T = _readonly(T @ _checks.as_exact("tool", tool, (4, 4)))
+    return link, T
 
 
 def fk(
@@ -221,21 +283,35 @@ def fk(
     -----
     Uses the compiled kernel when available (see :func:`kernels`), else :func:`fk_numpy`.
     """
-    link, T_link_frame = frame_pose_in_link(robot, frame, tool)
-    K = _KERNELS if _LOADED else kernels()
-    if K is not None:
+    # single sample: a float64 (n,) array goes straight to the kernel's compiled entry
+    # point (no conversion, no copy, no dispatch; the kernel checks finiteness)
+    hit = _FRAMES.get((id(robot), frame))
+    e = _ONE.get("frame_pose")
+    if (
+        e is not None
+        and hit is not None
+        and tool is None
+        and hit[0] is robot
+        and type(q) is _ND
+        and q.dtype is _F64
+        and q.ndim == 1
+        and len(q) == hit[4]
+    ):
+        T = np.empty((4, 4))
+        if e(hit[3], q, T):
+            return T
+    link, T_link_frame, CF = _frame_constants(robot, frame, tool)
+    # lean path: a float64 C array of shape (..., n) goes to the kernel as it is
+    if type(q) is np.ndarray and q.dtype is _F64 and q.flags.c_contiguous:
+        qa: NDArray[np.float64] | None = q
+    else:
         qa = _as_q(robot, q)
-        if qa is not None:
-            T = np.empty(qa.shape[:-1] + (4, 4))
-            if K.frame_pose(
-                robot.T_parent_joint,
-                robot.axes,
-                robot.prismatic,
-                link,
-                T_link_frame if tool is None else _readonly(T_link_frame),
-                _flat(qa),
-                T.reshape(-1),
-            ):
+    K = None if qa is None else _kernels_for(qa.ndim)
+    if K is not None and qa is not None:
+        if qa.ndim and qa.shape[-1] == len(robot.joint_names):
+            T = np.empty((4, 4) if qa.ndim == 1 else qa.shape[:-1] + (4, 4))
+            f = _single("frame_pose") if qa.ndim == 1 else K.frame_pose
+            if f(CF, _flat(qa), T):
                 return T
     return _fk_numpy(robot, q, link, T_link_frame)
 

@@ -49,35 +49,38 @@ Conventions:
   velocity limits the path stays a continuous, velocity-limited motion (without them the
   transfer is one step). ``max_restarts=0`` gives the plain local simulation.
 
-One goal per call: iteration counts differ between goals, so :func:`ik` does not batch
-(loop over goals; with the compiled kernel a Panda solve typically takes 0.1-0.3 ms).
+Batches: ``T_goal`` of shape (..., 4, 4) (with ``q0`` (n,) or broadcast to (..., n))
+solves every goal independently, in parallel across cores with the compiled kernel, and
+returns arrays of the batch shape (no paths). With the default ``rng`` each goal's result
+equals the one-goal call's; the restart configurations are drawn once, up front, for the
+whole batch (one ``rng.random((max_restarts, m))``, shared by the goals).
 
-Implementation: the loop runs in a compiled kernel (``_solve_kernel``) when numba is
-installed (compiled on first use, cached on disk; importing dynid does not import numba)
-and in a numpy loop (``_solve_numpy``) otherwise or when the environment variable
+Implementation: the whole solve (iterations, damping, limits, restarts) runs in one
+compiled call per goal (:mod:`dynid.kinematics._ik_kernel`) when numba is installed
+(compiled on first use, cached on disk; importing dynid does not import numba), and in a
+numpy loop (``_solve_numpy``) otherwise or when the environment variable
 ``DYNID_NO_NUMBA=1`` is set before the first call. Both take the same steps, and the
-tests check that their paths agree. Both compute the forward kinematics and the Jacobian
-of one sample directly (scalar code in the kernel, ``_Chain`` in the numpy loop), checked
-against
-:func:`dynid.kinematics.forward.fk` and :func:`dynid.kinematics.jacobian.jacobian`.
-Restart configurations are drawn from ``rng`` only when a stall asks for them.
+tests check that their paths agree. The kernel takes the frame pose and the Jacobian from
+the chain core (:func:`dynid.kinematics._kernels.frame_jacobian`); the numpy loop from
+the numpy reference path of :func:`dynid.kinematics.forward.fk` and
+:func:`dynid.kinematics.jacobian.jacobian` (``_Chain``). For one goal, restart configurations are
+drawn from ``rng`` only when a stall asks for them.
 """
 
 from __future__ import annotations
 
 import math
-import os
 from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
-from scipy.linalg import lapack
 
-from .. import _checks
-from ..exceptions import DataError, LimitError, WrongTypeError
+from .. import _checks, _compiled
+from ..exceptions import DataError, LimitError, ShapeError, WrongTypeError
 from ..model.robot import Robot
-from .forward import frame_pose_in_link
+from .forward import _frame_constants
+from .jacobian import _frame_pose_jacobian_numpy
 
 __all__ = ["IKOptions", "IKResult", "check_pose", "default_q0", "ik"]
 
@@ -177,6 +180,11 @@ class IKOptions:
 class IKResult:
     """Outcome of :func:`ik`.
 
+    For one goal (``T_goal`` of shape (4, 4)) the fields are as listed; for a batch of
+    goals (shape (..., 4, 4)) every field but ``path`` is an array with the batch shape
+    ``...`` in front (``q`` (..., n), ``converged`` (...) bool, ``iterations`` and
+    ``restarts`` (...) int, the errors (...) float) and ``path`` is None.
+
     Attributes
     ----------
     q : ndarray, shape (n,)
@@ -190,20 +198,20 @@ class IKResult:
         ``|p_goal - p(q)|`` at ``q`` [m], base frame.
     orientation_error : float
         Angle of ``R_goal R(q)^T`` at ``q`` [rad].
-    path : ndarray, shape (iterations + 1, n)
+    path : ndarray, shape (iterations + 1, n), or None
         The simulated joint motion from ``q0``; row ``k`` is the state after ``k`` steps
-        (time ``k * dt``).
+        (time ``k * dt``). None for a batch of goals.
     restarts : int
         Number of restarts used.
     """
 
     q: NDArray[np.float64]
-    converged: bool
-    iterations: int
-    position_error: float
-    orientation_error: float
-    path: NDArray[np.float64]
-    restarts: int = 0
+    converged: Any
+    iterations: Any
+    position_error: Any
+    orientation_error: Any
+    path: Any
+    restarts: Any = 0
 
 
 def default_q0(robot: Robot) -> NDArray[np.float64]:
@@ -262,66 +270,25 @@ def check_pose(name: str, T: ArrayLike) -> NDArray[np.float64]:
 
 # ---------------------------------------------------------------------- single sample
 class _Chain:
-    """Single-sample forward kinematics and Jacobian of one frame, with small arrays.
+    """Pose and Jacobian of one frame for one sample, for the numpy loop.
 
-    The motion of revolute joint ``i`` is ``T_fix (I + sin q K + (1 - cos q) K^2)`` with
-    ``K = [a]x``, of a prismatic one ``T_fix (I + q [0 a; 0 0])``. Both are affine in
-    ``(1, sin q, cos q, q)``: ``A[0] + sin q A[1] + cos q A[2] + q A[3]``, so the
-    coefficients ``A`` (4, m, 4, 4) are formed once and a call costs a few broadcast
-    operations. Only the ``m`` joints up to the frame's link move it.
+    The numpy reference path of :func:`dynid.kinematics.forward.fk` and
+    :func:`dynid.kinematics.jacobian.jacobian` (one pass of link poses for both), so the
+    forward kinematics is not written again here. Only the ``m = link`` joints up to the
+    frame's link move it.
     """
 
-    __slots__ = ("m", "A", "axes", "rev", "T_link_frame")
+    __slots__ = ("robot", "m", "T_link_frame")
 
     def __init__(self, robot: Robot, link: int, T_link_frame: NDArray[np.float64]) -> None:
-        m = link
-        a = robot.axes[:m]
-        rev = ~robot.prismatic[:m]
-        K = np.zeros((m, 3, 3))  # [a]x, zero for prismatic joints
-        K[:, 0, 1], K[:, 0, 2], K[:, 1, 2] = -a[:, 2], a[:, 1], -a[:, 0]
-        K[:, 1, 0], K[:, 2, 0], K[:, 2, 1] = a[:, 2], -a[:, 1], a[:, 0]
-        K *= rev[:, None, None]
-        KK = K @ K
-        Rf = robot.T_parent_joint[:m, :3, :3]
-        A = np.zeros((4, m, 4, 4))
-        A[0, :, :3, :3] = Rf + Rf @ KK
-        A[0, :, :3, 3] = robot.T_parent_joint[:m, :3, 3]
-        A[0, :, 3, 3] = 1.0
-        A[1, :, :3, :3] = Rf @ K
-        A[2, :, :3, :3] = -(Rf @ KK)
-        A[3, :, :3, 3] = (Rf @ (a * ~rev[:, None])[:, :, None])[:, :, 0]
-        self.m = m
-        self.A = A
-        self.axes = np.array(a)
-        self.rev = np.array(rev)
+        self.robot = robot
+        self.m = link
         self.T_link_frame = np.array(T_link_frame)
 
     def pose_jacobian(self, q: NDArray[np.float64]) -> tuple[NDArray, NDArray]:
         """``T_base_frame`` (4, 4) and the Jacobian (6, m) of the first ``m`` joints."""
-        m = self.m
-        if m == 0:
-            return self.T_link_frame.copy(), np.zeros((6, 0))
-        qm = q[:m]
-        A = self.A
-        T = A[0] + np.sin(qm)[:, None, None] * A[1] + np.cos(qm)[:, None, None] * A[2]
-        if not self.rev.all():
-            T += qm[:, None, None] * A[3]
-        d = 1
-        while d < m:  # prefix products T_base_link_i (Hillis-Steele scan)
-            T[d:] = T[:-d] @ T[d:]
-            d *= 2
-        Te = T[m - 1] @ self.T_link_frame
-        z = (T[:, :3, :3] @ self.axes[:, :, None])[:, :, 0]  # joint axes in the base frame
-        r = Te[:3, 3] - T[:, :3, 3]  # joint origins to the frame origin
-        J = np.empty((6, m))
-        J[0] = z[:, 1] * r[:, 2] - z[:, 2] * r[:, 1]
-        J[1] = z[:, 2] * r[:, 0] - z[:, 0] * r[:, 2]
-        J[2] = z[:, 0] * r[:, 1] - z[:, 1] * r[:, 0]
-        J[3:] = z.T
-        if not self.rev.all():
-            J[:3, ~self.rev] = z[~self.rev].T
-            J[3:, ~self.rev] = 0.0
-        return Te, J
+        T, J = _frame_pose_jacobian_numpy(self.robot, q[None], self.m, self.T_link_frame)
+        return T[0], J[0, :, : self.m]
 
 
 def _rotvec(R: NDArray[np.float64]) -> tuple[float, float, float, float]:
@@ -356,6 +323,8 @@ def _rotvec(R: NDArray[np.float64]) -> tuple[float, float, float, float]:
 
 def _dls(J: NDArray[np.float64], e: NDArray[np.float64], lam_max: float, eps: float) -> NDArray:
     """Damped least-squares solution ``J^# e`` with singular-value dependent damping."""
+    from scipy.linalg import lapack  # the numpy loop only: not on the import path
+
     U, s, Vt, info = lapack.dgesdd(J, full_matrices=0)
     if info != 0:  # LAPACK did not converge: numpy's driver raises a clear error
         U, s, Vt = np.linalg.svd(J, full_matrices=False)
@@ -379,7 +348,7 @@ def _solve_numpy(
     ipar: NDArray,
     path: NDArray,
 ) -> tuple[int, int, float, float, bool, int, bool]:
-    """The simulation loop with numpy; same steps and outputs as :func:`_solve_kernel`."""
+    """The simulation loop with numpy; same steps as :mod:`dynid.kinematics._ik_kernel`."""
     dt, K, lam, eps, tol_p, tol_o, step_p, step_o, e_damp = (float(x) for x in fpar)
     max_iter, stall, max_restarts = int(ipar[0]), int(ipar[1]), int(ipar[2])
     m = chain.m
@@ -455,352 +424,16 @@ def _solve_numpy(
     return k, best_k, best_p, best_o, converged, restarts, False
 
 
-# ---------------------------------------------------------------------- compiled loop
-def _solve_kernel(
-    Tf, axes, rev, T_lf, q_min, q_max, inv_vmax, q_restart, p_goal, R_goal, fpar, ipar, path
-):  # pragma: no cover (compiled by numba)
-    """The simulation loop in scalar form, compiled with numba; see :func:`_solve_numpy`.
-
-    ``Tf`` (m, 4, 4), ``axes`` (m, 3) and ``rev`` (m,) are the robot's ``T_parent_joint``,
-    ``axes`` and ``~prismatic`` of the ``m`` joints that move the frame, ``T_lf`` the
-    frame's pose in link m. ``path`` (max_iterations + 1, n) holds ``q0`` in row 0 and
-    receives the motion. ``ipar`` is ``(max_iterations, stall_iterations, max_restarts)``.
-    Returns ``(iterations, best row, position error, orientation error, converged,
-    restarts, need_restarts)``; ``need_restarts`` asks the caller to run again with the
-    ``max_restarts`` configurations in ``q_restart`` (drawn only when needed).
-
-    The damped least-squares step is formed from the eigen-decomposition (cyclic Jacobi
-    rotations) of the smaller Gram matrix, ``J J^T`` (then ``J^# e = J^T V (W + lambda^2)^-1
-    V^T e``) or ``J^T J`` (then ``V (W + lambda^2)^-1 V^T J^T e``), with ``W = diag(s^2)``:
-    the same step as the SVD form of :func:`_dls`, several times faster than a LAPACK call
-    on a 6 x 7 matrix.
-    """
-    dt, K, lam, eps = fpar[0], fpar[1], fpar[2], fpar[3]
-    tol_p, tol_o, step_p, step_o, e_damp = fpar[4], fpar[5], fpar[6], fpar[7], fpar[8]
-    max_iter, stall, max_restarts = ipar[0], ipar[1], ipar[2]
-    n, m, n_restart = path.shape[1], axes.shape[0], q_restart.shape[0]
-    use_vmax = False
-    for j in range(m):
-        if inv_vmax[j] > 0.0:
-            use_vmax = True
-    q = path[0].copy()
-    Tc = np.empty((m, 3, 4))
-    rel = np.empty((3, 4))
-    Rq = np.empty((3, 3))
-    Te = np.empty((3, 4))
-    J = np.empty((6, m))
-    e = np.empty(6)
-    M = np.empty((3, 3))
-    dq = np.zeros(m)
-    free = np.empty(m, dtype=np.bool_)
-    target = np.empty(m)
-    Jf = np.empty((6, m))
-    G = np.empty((6, 6))
-    V = np.empty((6, 6))
-    bvec = np.empty(6)
-    y = np.empty(6)
-    k = 0
-    best_k = 0
-    best_err = np.inf
-    best_p = np.inf
-    best_o = np.inf
-    ref = np.inf
-    k_ref = 0
-    restarts = 0
-    converged = False
-    transfer = False
-    while True:
-        if transfer:
-            ratio = 0.0
-            for j in range(m):
-                dq[j] = (target[j] - q[j]) / dt
-                if use_vmax:
-                    ratio = max(ratio, abs(dq[j]) * inv_vmax[j])
-            if ratio <= 1.0:
-                for j in range(m):
-                    q[j] = target[j]
-                transfer = False
-                ref = np.inf
-                k_ref = k + 1
-            else:
-                for j in range(m):
-                    q[j] = min(max(q[j] + (dt / ratio) * dq[j], q_min[j]), q_max[j])
-            k += 1
-            for j in range(n):
-                path[k, j] = q[j]
-            if k >= max_iter:
-                break
-            continue
-        # forward kinematics: T_base_link_i (3 x 4) and the frame pose Te
-        for i in range(m):
-            ax, ay, az, qi = axes[i, 0], axes[i, 1], axes[i, 2], q[i]
-            if rev[i]:  # Rodrigues: Rq = c I + s [a]x + (1 - c) a a^T
-                s, c = math.sin(qi), math.cos(qi)
-                v = 1.0 - c
-                Rq[0, 0] = c + v * ax * ax
-                Rq[1, 1] = c + v * ay * ay
-                Rq[2, 2] = c + v * az * az
-                Rq[0, 1], Rq[1, 0] = v * ax * ay - s * az, v * ax * ay + s * az
-                Rq[0, 2], Rq[2, 0] = v * ax * az + s * ay, v * ax * az - s * ay
-                Rq[1, 2], Rq[2, 1] = v * ay * az - s * ax, v * ay * az + s * ax
-                for r in range(3):
-                    for col in range(3):
-                        rel[r, col] = (
-                            Tf[i, r, 0] * Rq[0, col]
-                            + Tf[i, r, 1] * Rq[1, col]
-                            + Tf[i, r, 2] * Rq[2, col]
-                        )
-                    rel[r, 3] = Tf[i, r, 3]
-            else:
-                for r in range(3):
-                    for col in range(3):
-                        rel[r, col] = Tf[i, r, col]
-                    rel[r, 3] = Tf[i, r, 3] + qi * (
-                        Tf[i, r, 0] * ax + Tf[i, r, 1] * ay + Tf[i, r, 2] * az
-                    )
-            if i == 0:
-                for r in range(3):
-                    for col in range(4):
-                        Tc[0, r, col] = rel[r, col]
-            else:
-                for r in range(3):
-                    for col in range(4):
-                        v = (
-                            Tc[i - 1, r, 0] * rel[0, col]
-                            + Tc[i - 1, r, 1] * rel[1, col]
-                            + Tc[i - 1, r, 2] * rel[2, col]
-                        )
-                        if col == 3:
-                            v += Tc[i - 1, r, 3]
-                        Tc[i, r, col] = v
-        for r in range(3):
-            for col in range(4):
-                v = (
-                    Tc[m - 1, r, 0] * T_lf[0, col]
-                    + Tc[m - 1, r, 1] * T_lf[1, col]
-                    + Tc[m - 1, r, 2] * T_lf[2, col]
-                )
-                if col == 3:
-                    v += Tc[m - 1, r, 3]
-                Te[r, col] = v
-        # geometric Jacobian of the frame origin, base frame
-        for i in range(m):
-            zx = Tc[i, 0, 0] * axes[i, 0] + Tc[i, 0, 1] * axes[i, 1] + Tc[i, 0, 2] * axes[i, 2]
-            zy = Tc[i, 1, 0] * axes[i, 0] + Tc[i, 1, 1] * axes[i, 1] + Tc[i, 1, 2] * axes[i, 2]
-            zz = Tc[i, 2, 0] * axes[i, 0] + Tc[i, 2, 1] * axes[i, 1] + Tc[i, 2, 2] * axes[i, 2]
-            if rev[i]:
-                rx, ry, rz = Te[0, 3] - Tc[i, 0, 3], Te[1, 3] - Tc[i, 1, 3], Te[2, 3] - Tc[i, 2, 3]
-                J[0, i], J[1, i], J[2, i] = zy * rz - zz * ry, zz * rx - zx * rz, zx * ry - zy * rx
-                J[3, i], J[4, i], J[5, i] = zx, zy, zz
-            else:
-                J[0, i], J[1, i], J[2, i] = zx, zy, zz
-                J[3, i], J[4, i], J[5, i] = 0.0, 0.0, 0.0
-        # pose error in the base frame: position, then angle-axis of R_goal Te^T
-        for r in range(3):
-            e[r] = p_goal[r] - Te[r, 3]
-        for r in range(3):
-            for col in range(3):
-                M[r, col] = (
-                    R_goal[r, 0] * Te[col, 0]
-                    + R_goal[r, 1] * Te[col, 1]
-                    + R_goal[r, 2] * Te[col, 2]
-                )
-        vx, vy, vz = 0.5 * (M[2, 1] - M[1, 2]), 0.5 * (M[0, 2] - M[2, 0]), 0.5 * (M[1, 0] - M[0, 1])
-        cs = min(1.0, max(-1.0, 0.5 * (M[0, 0] + M[1, 1] + M[2, 2] - 1.0)))
-        sn = math.sqrt(vx * vx + vy * vy + vz * vz)
-        theta = math.atan2(sn, cs)
-        if cs > -0.9:
-            f = theta / sn if sn > 1e-12 else 1.0 + theta * theta / 6.0
-            e[3], e[4], e[5] = f * vx, f * vy, f * vz
-        else:
-            w = 1.0 / (1.0 - cs)
-            dx, dy, dz = (M[0, 0] - cs) * w, (M[1, 1] - cs) * w, (M[2, 2] - cs) * w
-            sxy, sxz = 0.5 * (M[0, 1] + M[1, 0]) * w, 0.5 * (M[0, 2] + M[2, 0]) * w
-            syz = 0.5 * (M[1, 2] + M[2, 1]) * w
-            if dx >= dy and dx >= dz:
-                ux, uy, uz = dx, sxy, sxz
-            elif dy >= dz:
-                ux, uy, uz = sxy, dy, syz
-            else:
-                ux, uy, uz = sxz, syz, dz
-            norm = math.sqrt(ux * ux + uy * uy + uz * uz)
-            if ux * vx + uy * vy + uz * vz < 0.0:
-                norm = -norm
-            e[3], e[4], e[5] = theta * ux / norm, theta * uy / norm, theta * uz / norm
-        err_o = theta
-        err_p = math.sqrt(e[0] * e[0] + e[1] * e[1] + e[2] * e[2])
-        err = math.sqrt(err_p * err_p + err_o * err_o)
-        done = err_p <= tol_p and err_o <= tol_o
-        if done or err < best_err:
-            best_k, best_err, best_p, best_o = k, err, err_p, err_o
-        if done:
-            converged = True
-            break
-        if err < ref * (1.0 - 1e-3):  # _PROGRESS
-            ref = err
-            k_ref = k
-        if k >= max_iter or m == 0:
-            break
-        if k - k_ref >= stall:
-            if restarts == max_restarts:
-                break
-            if restarts == n_restart:  # ask the caller for restart configurations
-                return k, best_k, best_p, best_o, converged, restarts, True
-            for j in range(m):
-                target[j] = q_restart[restarts, j]
-            restarts += 1
-            transfer = True
-            continue
-        if err_p > step_p:
-            for r in range(3):
-                e[r] *= step_p / err_p
-        if err_o > step_o:
-            for r in range(3, 6):
-                e[r] *= step_o / err_o
-        # damped least squares with the active set of the joint limits
-        for j in range(m):
-            free[j] = True
-        for _ in range(m + 1):
-            nf = 0
-            for j in range(m):
-                if free[j]:
-                    nf += 1
-            for j in range(m):
-                dq[j] = 0.0
-            if nf > 0:
-                # J^# e from the eigen-decomposition G = V diag(w) V^T of the smaller Gram
-                # matrix (J J^T if nf >= 6, else J^T J; w = s^2), by cyclic Jacobi rotations
-                col = 0
-                for j in range(m):
-                    if free[j]:
-                        for r in range(6):
-                            Jf[r, col] = J[r, j]
-                        col += 1
-                d = 6 if nf >= 6 else nf
-                tot = 0.0
-                for a in range(d):
-                    for b in range(d):
-                        acc = 0.0
-                        if nf >= 6:
-                            for t in range(nf):
-                                acc += Jf[a, t] * Jf[b, t]
-                        else:
-                            for t in range(6):
-                                acc += Jf[t, a] * Jf[t, b]
-                        G[a, b] = acc
-                        V[a, b] = 1.0 if a == b else 0.0
-                        tot += acc * acc
-                for _sweep in range(50):
-                    off = 0.0
-                    for a in range(d - 1):
-                        for b in range(a + 1, d):
-                            off += G[a, b] * G[a, b]
-                    if off <= 1e-30 * tot:
-                        break
-                    for a in range(d - 1):
-                        for b in range(a + 1, d):
-                            gab = G[a, b]
-                            if gab == 0.0:
-                                continue
-                            th = (G[b, b] - G[a, a]) / (2.0 * gab)
-                            t = 1.0 / (abs(th) + math.sqrt(th * th + 1.0))
-                            if th < 0.0:
-                                t = -t
-                            c = 1.0 / math.sqrt(t * t + 1.0)
-                            sn = t * c
-                            for r in range(d):
-                                g1, g2 = G[r, a], G[r, b]
-                                G[r, a], G[r, b] = c * g1 - sn * g2, sn * g1 + c * g2
-                            for r in range(d):
-                                g1, g2 = G[a, r], G[b, r]
-                                G[a, r], G[b, r] = c * g1 - sn * g2, sn * g1 + c * g2
-                            for r in range(d):
-                                g1, g2 = V[r, a], V[r, b]
-                                V[r, a], V[r, b] = c * g1 - sn * g2, sn * g1 + c * g2
-                w_max, w_min = 0.0, np.inf
-                for a in range(d):
-                    w_max = max(w_max, G[a, a])
-                    w_min = min(w_min, G[a, a])
-                s_min = math.sqrt(max(w_min, 0.0))
-                lam2 = (1.0 - (s_min / eps) ** 2) * lam * lam if s_min < eps else 0.0
-                if err < e_damp:
-                    lam2 *= err / e_damp
-                cut = 1e-24 * w_max
-                for a in range(d):  # b = e (nf >= 6) or J^T e (nf < 6)
-                    acc = 0.0
-                    if nf >= 6:
-                        acc = e[a]
-                    else:
-                        for r in range(6):
-                            acc += Jf[r, a] * e[r]
-                    bvec[a] = acc
-                for a in range(d):  # y = diag(1 / (w + lam^2)) V^T b, zero where w <= cut
-                    acc = 0.0
-                    for r in range(d):
-                        acc += V[r, a] * bvec[r]
-                    y[a] = acc / (G[a, a] + lam2) if G[a, a] > cut else 0.0
-                col = 0
-                for j in range(m):
-                    if free[j]:
-                        acc = 0.0
-                        if nf >= 6:  # dq = J^T V y
-                            for r in range(6):
-                                vy = 0.0
-                                for a in range(d):
-                                    vy += V[r, a] * y[a]
-                                acc += Jf[r, col] * vy
-                        else:  # dq = V y
-                            for a in range(d):
-                                acc += V[col, a] * y[a]
-                        dq[j] = acc
-                        col += 1
-            pushed = False
-            for j in range(m):
-                if free[j] and (
-                    (q[j] <= q_min[j] and dq[j] < 0.0) or (q[j] >= q_max[j] and dq[j] > 0.0)
-                ):
-                    free[j] = False
-                    pushed = True
-            if not pushed:
-                break
-        ratio = 0.0
-        for j in range(m):
-            dq[j] *= K
-            if use_vmax:
-                ratio = max(ratio, abs(dq[j]) * inv_vmax[j])
-        scale = dt / ratio if ratio > 1.0 else dt
-        for j in range(m):
-            q[j] = min(max(q[j] + scale * dq[j], q_min[j]), q_max[j])
-        k += 1
-        for j in range(n):
-            path[k, j] = q[j]
-    return k, best_k, best_p, best_o, converged, restarts, False
-
-
-_COMPILED: dict[str, Any] = {}
 _DEFAULT_OPTIONS = IKOptions()
 
 
-def _compiled_kernel() -> Any:
-    """The numba-compiled :func:`_solve_kernel`, or None for the numpy loop.
+def _kernel() -> Any:
+    """The compiled solver (:mod:`dynid.kinematics._ik_kernel`), or None for the numpy loop.
 
-    None when numba is not installed or the environment variable ``DYNID_NO_NUMBA`` is set
-    to anything but ``""`` or ``"0"`` (read on the first call, as :mod:`dynid.dynamics`
-    does).
+    None when numba is not installed or ``DYNID_NO_NUMBA`` is set (read on the first call;
+    :func:`dynid._compiled.optional`).
     """
-    if "kernel" not in _COMPILED:
-        try:
-            if os.environ.get("DYNID_NO_NUMBA", "") not in ("", "0"):
-                raise ImportError("DYNID_NO_NUMBA is set")
-            import numba
-        except ImportError:
-            _COMPILED["kernel"] = None
-        else:
-            try:
-                _COMPILED["kernel"] = numba.njit(cache=True)(_solve_kernel)
-            except RuntimeError:  # no writable cache folder: compile in memory only
-                _COMPILED["kernel"] = numba.njit(_solve_kernel)
-    return _COMPILED["kernel"]
+    return _compiled.optional(f"{__package__}._ik_kernel")
 
 
 # ---------------------------------------------------------------------- solver
@@ -823,10 +456,12 @@ def ik(
     Parameters
     ----------
     robot : Robot
-    T_goal : array_like, shape (4, 4)
+    T_goal : array_like, shape (4, 4) or (..., 4, 4)
         Goal pose of the frame (of the tool when given) in the base frame [m]. The
-        rotation block must be orthonormal to 1e-5; it is re-orthonormalised.
-    q0 : array_like, shape (n,), optional
+        rotation block must be orthonormal to 1e-5; it is re-orthonormalised. A batch of
+        goals (an ndarray with more than two dimensions) is solved goal by goal, in
+        parallel (see the module docstring).
+    q0 : array_like, shape (n,) or broadcastable to (..., n), optional
         Start [rad or m], within the position limits. Default :func:`default_q0`: the
         Panda's neutral pose :data:`~dynid.model.panda.PANDA_NEUTRAL_Q`, else the middle
         of the limits.
@@ -844,12 +479,14 @@ def ik(
     -------
     IKResult
         ``converged=False`` (no exception) when the goal is not reached: ``q`` is then
-        the point of the path with the smallest ``|[e_p; e_o]|``, with its errors.
+        the point of the path with the smallest ``|[e_p; e_o]|``, with its errors. For a
+        batch, arrays of the batch shape and ``path=None``.
 
     Raises
     ------
     ShapeError
-        ``T_goal`` or ``tool`` is not (4, 4), or ``q0`` is not (n,).
+        ``T_goal`` or ``tool`` is not (4, 4) (or (..., 4, 4)), or ``q0`` is not (n,) (or
+        does not broadcast to the goals' batch shape).
     NonFiniteError
         ``T_goal``, ``tool`` or ``q0`` holds NaN or inf.
     DataError
@@ -871,24 +508,102 @@ def ik(
     opts = _DEFAULT_OPTIONS if options is None else options
     if not isinstance(opts, IKOptions):
         raise WrongTypeError(f"options must be an IKOptions; got {type(opts).__name__}")
-    link, T_link_frame = frame_pose_in_link(robot, frame, tool)
-    T_goal = check_pose("T_goal", T_goal)
+    link, T_link_frame, CF = _frame_constants(robot, frame, tool)
     n = robot.n
+    Tg = np.asarray(T_goal) if isinstance(T_goal, np.ndarray) else None
+    if Tg is not None and Tg.ndim > 2:
+        return _ik_batch(robot, Tg, q0, link, T_link_frame, CF, opts, rng)
+    T_goal = check_pose("T_goal", T_goal)
     q = default_q0(robot) if q0 is None else _checks.as_exact("q0", q0, (n,))
-    outside = np.flatnonzero((q < robot.q_min) | (q > robot.q_max))
-    if outside.size:
-        j = int(outside[0])
+    _check_within_limits(robot, q[None])
+    m = link  # joints 1..m move the frame
+    q_min, q_max, inv_vmax = _limits(robot, m, opts)
+    fpar, ipar = _parameters(opts)
+    path = np.empty((opts.max_iterations + 1, n))
+    path[0] = q
+    # one goal: the kernel once loaded or as small_call_uses_kernels decides (a one-shot
+    # call takes the numpy loop: no start-up cost)
+    K = _kernel() if m > 0 and _compiled.small_call_uses_kernels() else None
+    q_best = np.empty(n)
+    q_restart = np.empty((0, m))
+    while True:  # a second pass only when the first one asks for restart configurations
+        if K is not None:
+            k, best_k, err_p, err_o, converged, restarts, more = K.solve_one(
+                CF, m, q_min, q_max, inv_vmax, q_restart, T_goal, fpar, ipar, path, q_best
+            )
+        else:
+            k, best_k, err_p, err_o, converged, restarts, more = _solve_numpy(
+                _Chain(robot, link, T_link_frame),
+                q_min,
+                q_max,
+                inv_vmax,
+                q_restart,
+                np.array(T_goal[:3, 3]),
+                np.array(T_goal[:3, :3]),
+                fpar,
+                ipar,
+                path,
+            )
+        if not more:
+            break
+        rng = np.random.default_rng(0) if rng is None else rng
+        q_restart = _restart_configurations(q_min, q_max, q[None, :m], opts, rng)[0]
+    path = _checks.frozen(path[: k + 1])
+    return IKResult(
+        q=_checks.frozen(path[best_k]),
+        converged=bool(converged),
+        iterations=int(k),
+        position_error=float(err_p),
+        orientation_error=float(err_o),
+        path=path,
+        restarts=int(restarts),
+    )
+
+
+def _check_within_limits(robot: Robot, q: NDArray[np.float64]) -> None:
+    """Raise :class:`LimitError` naming the first start (row of ``q`` (B, n)) outside."""
+    bad = (q < robot.q_min) | (q > robot.q_max)
+    if bad.any():
+        outside = np.argwhere(bad)
+        b, j = (int(x) for x in outside[0])
+        where = "" if q.shape[0] == 1 else f" (start {b})"
         raise LimitError(
-            f"q0 must lie within the joint limits; {robot.joint_names[j]} = {q[j]:.6g} is "
-            f"outside [{robot.q_min[j]:.6g}, {robot.q_max[j]:.6g}]"
+            f"q0 must lie within the joint limits{where}; {robot.joint_names[j]} = "
+            f"{q[b, j]:.6g} is outside [{robot.q_min[j]:.6g}, {robot.q_max[j]:.6g}]"
         )
 
-    m = link  # joints 1..m move the frame
+
+_LIMITS: dict[tuple[int, int, bool], tuple[Robot, tuple[NDArray, NDArray, NDArray]]] = {}
+
+
+def _limits(robot: Robot, m: int, opts: IKOptions) -> tuple[NDArray, NDArray, NDArray]:
+    """Position limits and inverse velocity limits (0: none) of the first ``m`` joints.
+
+    Remembered for a few robots (by identity; robots are immutable); never written to.
+    """
+    key = (id(robot), m, bool(opts.velocity_limits))
+    hit = _LIMITS.get(key)
+    if hit is not None and hit[0] is robot:
+        return hit[1]
     q_min, q_max = np.array(robot.q_min[:m]), np.array(robot.q_max[:m])
     inv_vmax = np.zeros(m)
     if opts.velocity_limits:
         dq_max = robot.dq_max[:m]
         inv_vmax = np.where(np.isfinite(dq_max), 1.0 / dq_max, 0.0)
+    if len(_LIMITS) >= 16:
+        _LIMITS.pop(next(iter(_LIMITS)))
+    _LIMITS[key] = (robot, (q_min, q_max, inv_vmax))
+    return q_min, q_max, inv_vmax
+
+
+_PARAMETERS: dict[int, tuple[IKOptions, tuple[NDArray[np.float64], NDArray[np.int64]]]] = {}
+
+
+def _parameters(opts: IKOptions) -> tuple[NDArray[np.float64], NDArray[np.int64]]:
+    """The options as the solvers' ``fpar`` and ``ipar`` arrays (remembered per options)."""
+    hit = _PARAMETERS.get(id(opts))
+    if hit is not None and hit[0] is opts:
+        return hit[1]
     fpar = np.array(
         [
             opts.dt,
@@ -903,37 +618,114 @@ def ik(
         ]
     )
     ipar = np.array([opts.max_iterations, opts.stall_iterations, opts.max_restarts], np.int64)
-    path = np.empty((opts.max_iterations + 1, n))
-    path[0] = q
-    p_goal, R_goal = np.array(T_goal[:3, 3]), np.array(T_goal[:3, :3])
-    kernel = _compiled_kernel() if m > 0 else None
-    if kernel is not None:
-        args = (
-            np.array(robot.T_parent_joint[:m]),
-            np.array(robot.axes[:m]),
-            ~robot.prismatic[:m],
-            np.array(T_link_frame),
+    if len(_PARAMETERS) >= 16:
+        _PARAMETERS.pop(next(iter(_PARAMETERS)))
+    _PARAMETERS[id(opts)] = (opts, (fpar, ipar))
+    return fpar, ipar
+
+
+def _restart_configurations(
+    q_min: NDArray, q_max: NDArray, q0: NDArray, opts: IKOptions, rng: np.random.Generator
+) -> NDArray[np.float64]:
+    """Restart configurations (B, max_restarts, m) within the limits, one draw for all B.
+
+    Unbounded joints draw within pi of the start ``q0`` (B, m).
+    """
+    lo = np.where(np.isfinite(q_min), q_min, np.minimum(q0, q_max) - np.pi)
+    hi = np.where(np.isfinite(q_max), q_max, np.maximum(q0, q_min) + np.pi)
+    u = rng.random((opts.max_restarts, q_min.shape[0]))
+    return lo[:, None, :] + (hi - lo)[:, None, :] * u
+
+
+def check_poses(name: str, T: ArrayLike) -> NDArray[np.float64]:
+    """:func:`check_pose` for a batch (..., 4, 4): a new array; errors name the first pose."""
+    T = np.array(_checks.as_batch(name, T, (4, 4)))
+    flat = T.reshape(-1, 4, 4)
+    last = np.max(np.abs(flat[:, 3] - (0.0, 0.0, 0.0, 1.0)), axis=-1)
+    bad = np.flatnonzero(last > ORTHONORMALITY_TOLERANCE)
+    if bad.size:
+        b = int(bad[0])
+        raise DataError(f"{name}[{b}] must have last row [0, 0, 0, 1]; got {flat[b, 3].tolist()}")
+    R = flat[:, :3, :3]
+    dev = np.max(np.abs(np.swapaxes(R, 1, 2) @ R - np.eye(3)), axis=(1, 2))
+    det = np.linalg.det(R)
+    bad = np.flatnonzero((dev > ORTHONORMALITY_TOLERANCE) | (det <= 0))
+    if bad.size:
+        b = int(bad[0])
+        raise DataError(
+            f"{name}[{b}] rotation block must be orthonormal with det +1 (max |R^T R - I| <= "
+            f"{ORTHONORMALITY_TOLERANCE:g}); got deviation {dev[b]:.3g}, det {det[b]:.3g}"
         )
-    else:
-        kernel, args = _solve_numpy, (_Chain(robot, link, T_link_frame),)
-    q_restart = np.empty((0, m))
-    while True:  # a second pass only when the first one asks for restart configurations
-        k, best_k, err_p, err_o, converged, restarts, more = kernel(
-            *args, q_min, q_max, inv_vmax, q_restart, p_goal, R_goal, fpar, ipar, path
-        )
-        if not more:
-            break
-        lo = np.where(np.isfinite(q_min), q_min, np.minimum(q[:m], q_max) - np.pi)
-        hi = np.where(np.isfinite(q_max), q_max, np.maximum(q[:m], q_min) + np.pi)
+    fix = np.flatnonzero(dev > 1e-13)
+    if fix.size:
+        U, _, Vt = np.linalg.svd(R[fix])
+        flat[fix, :3, :3] = U @ Vt
+    flat[:, 3] = (0.0, 0.0, 0.0, 1.0)
+    return T
+
+
+def _ik_batch(
+    robot: Robot,
+    T_goal: NDArray,
+    q0: ArrayLike | None,
+    link: int,
+    T_link_frame: NDArray[np.float64],
+    CF: NDArray[np.float64],
+    opts: IKOptions,
+    rng: np.random.Generator | None,
+) -> IKResult:
+    """:func:`ik` for goals (..., 4, 4): every goal from its start, in parallel if compiled."""
+    goals = check_poses("T_goal", T_goal)
+    shape = goals.shape[:-2]
+    n, m = robot.n, link
+    start = default_q0(robot) if q0 is None else _checks.as_batch("q0", q0, (n,))
+    try:
+        starts = np.ascontiguousarray(np.broadcast_to(start, shape + (n,))).reshape(-1, n)
+    except ValueError:
+        raise ShapeError(
+            f"q0 must broadcast to the goals' batch shape {shape}; got {np.shape(start)}"
+        ) from None
+    _check_within_limits(robot, starts)
+    G = starts.shape[0]
+    goals = goals.reshape(G, 4, 4)
+    q_min, q_max, inv_vmax = _limits(robot, m, opts)
+    fpar, ipar = _parameters(opts)
+    if opts.max_restarts > 0 and m > 0:
         rng = np.random.default_rng(0) if rng is None else rng
-        q_restart = lo + (hi - lo) * rng.random((opts.max_restarts, m))
-    path = _checks.frozen(path[: k + 1])
+        q_restart = _restart_configurations(q_min, q_max, starts[:, :m], opts, rng)
+    else:
+        q_restart = np.empty((G, 0, m))
+    K = _kernel() if m > 0 else None
+    out = np.array(starts)
+    stats = np.zeros((G, 6))
+    if K is not None:
+        K.solve_batch(
+            CF, m, q_min, q_max, inv_vmax, q_restart, goals, fpar, ipar, starts, out, stats
+        )
+    elif m > 0:
+        chain = _Chain(robot, link, T_link_frame)
+        path = np.empty((opts.max_iterations + 1, n))
+        for g in range(G):
+            path[0] = starts[g]
+            k, best_k, ep, eo, conv, rs, _ = _solve_numpy(
+                chain, q_min, q_max, inv_vmax, q_restart[g], np.array(goals[g, :3, 3]),
+                np.array(goals[g, :3, :3]), fpar, ipar, path,
+            )  # fmt: skip
+            out[g] = path[best_k]
+            stats[g] = (k, ep, eo, conv, rs, 0.0)
+    else:  # the frame is fixed to the base: nothing moves
+        for g in range(G):
+            T = T_link_frame
+            ep = float(np.linalg.norm(goals[g, :3, 3] - T[:3, 3]))
+            eo = _rotvec(goals[g, :3, :3] @ T[:3, :3].T)[3]
+            conv = ep <= opts.position_tolerance and eo <= opts.orientation_tolerance
+            stats[g] = (0, ep, eo, conv, 0, 0.0)
     return IKResult(
-        q=_checks.frozen(path[best_k]),
-        converged=bool(converged),
-        iterations=int(k),
-        position_error=float(err_p),
-        orientation_error=float(err_o),
-        path=path,
-        restarts=int(restarts),
+        q=_checks.frozen(out.reshape(shape + (n,))),
+        converged=_checks.frozen(stats[:, 3].reshape(shape) > 0.5),
+        iterations=_checks.frozen(stats[:, 0].astype(np.int64).reshape(shape)),
+        position_error=_checks.frozen(stats[:, 1].reshape(shape)),
+        orientation_error=_checks.frozen(stats[:, 2].reshape(shape)),
+        path=None,
+        restarts=_checks.frozen(stats[:, 4].astype(np.int64).reshape(shape)),
     )

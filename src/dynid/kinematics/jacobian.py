@@ -18,7 +18,19 @@ from .. import _checks
 from ..exceptions import ShapeError
 from ..model.robot import Robot
 from . import forward as _forward
-from .forward import _as_q, _flat, _link_poses, _readonly, check_q, frame_pose_in_link
+from .forward import (
+    _F64,
+    _FRAMES,
+    _ND,
+    _ONE,
+    _as_q,
+    _flat,
+    _frame_constants,
+    _link_poses,
+    _single,
+    check_q,
+    frame_pose_in_link,
+)
 
 __all__ = ["jacobian", "jacobian_numpy", "jacobian_to_tool"]
 
@@ -54,22 +66,36 @@ def jacobian(
     Uses the compiled kernel when available (see :func:`dynid.kinematics.forward.kernels`),
     else :func:`jacobian_numpy`.
     """
-    link, T_link_frame = frame_pose_in_link(robot, frame, tool)
-    K = _forward._KERNELS if _forward._LOADED else _forward.kernels()
-    if K is not None:
+    # single sample: a float64 (n,) array goes straight to the kernel's compiled entry
+    # point (no conversion, no copy, no dispatch; the kernel checks finiteness)
+    hit = _FRAMES.get((id(robot), frame))
+    e = _ONE.get("jacobian")
+    if (
+        e is not None
+        and hit is not None
+        and tool is None
+        and hit[0] is robot
+        and type(q) is _ND
+        and q.dtype is _F64
+        and q.ndim == 1
+        and len(q) == hit[4]
+    ):
+        J = np.empty((6, hit[4]))
+        if e(hit[3], q, J):
+            return J
+    link, T_link_frame, CF = _frame_constants(robot, frame, tool)
+    # lean path: a float64 C array of shape (..., n) goes to the kernel as it is
+    if type(q) is np.ndarray and q.dtype is _F64 and q.flags.c_contiguous:
+        qa: NDArray[np.float64] | None = q
+    else:
         qa = _as_q(robot, q)
-        if qa is not None:
-            n = qa.shape[-1]
-            J = np.empty(qa.shape[:-1] + (6, n))
-            if K.jacobian(
-                robot.T_parent_joint,
-                robot.axes,
-                robot.prismatic,
-                link,
-                T_link_frame if tool is None else _readonly(T_link_frame),
-                _flat(qa),
-                J.reshape(-1),
-            ):
+    K = None if qa is None else _forward._kernels_for(qa.ndim)
+    if K is not None and qa is not None:
+        n = len(robot.joint_names)
+        if qa.ndim and qa.shape[-1] == n:
+            J = np.empty((6, n) if qa.ndim == 1 else qa.shape[:-1] + (6, n))
+            f = _single("jacobian") if qa.ndim == 1 else K.jacobian
+            if f(CF, _flat(qa), J):
                 return J
     return _jacobian_numpy(robot, q, link, T_link_frame)
 
@@ -90,18 +116,31 @@ def _jacobian_numpy(
 ) -> NDArray[np.float64]:
     """The numpy path of :func:`jacobian` once the frame is resolved: validates ``q``."""
     q = check_q(robot, q)
-    T = _link_poses(robot, q.reshape(-1, robot.n))
-    p = (T[:, link] @ T_link_frame)[:, :3, 3]  # (B, 3)
+    J = _frame_pose_jacobian_numpy(robot, q.reshape(-1, robot.n), link, T_link_frame)[1]
+    return J.reshape(q.shape[:-1] + (6, robot.n))
+
+
+def _frame_pose_jacobian_numpy(
+    robot: Robot, q2: NDArray[np.float64], link: int, T_link_frame: NDArray[np.float64]
+) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+    """Frame pose (B, 4, 4) and Jacobian (B, 6, n) for validated (B, n) ``q2``, numpy path.
+
+    One pass of :func:`dynid.kinematics.forward._link_poses` for both (the numpy loop of
+    :func:`dynid.kinematics.ik.ik` uses it too).
+    """
+    T = _link_poses(robot, q2)
+    Tf = T[:, link] @ T_link_frame
+    p = Tf[:, :3, 3]  # (B, 3)
     z = (T[:, 1:, :3, :3] @ robot.axes[:, :, None])[..., 0]  # (B, n, 3)
     o = T[:, 1:, :3, 3]
-    J = np.zeros((q.reshape(-1, robot.n).shape[0], 6, robot.n))
+    J = np.zeros((q2.shape[0], 6, robot.n))
     rev = ~robot.prismatic
     lin = np.where(rev[:, None], np.cross(z, p[:, None, :] - o), z)
     ang = np.where(rev[:, None], z, 0.0)
     active = np.arange(1, robot.n + 1) <= link
     J[:, :3, :] = np.swapaxes(lin, 1, 2) * active
     J[:, 3:, :] = np.swapaxes(ang, 1, 2) * active
-    return J.reshape(q.shape[:-1] + (6, robot.n))
+    return Tf, J
 
 
 def jacobian_to_tool(

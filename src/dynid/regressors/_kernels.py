@@ -29,7 +29,9 @@ import math
 
 import numpy as np
 
-from ..dynamics._kernels import _SINCOS_MAX, _jit, _sincos
+from .._compiled import C_AXIS, C_PRISMATIC
+from ..dynamics._kernels import motion
+from ..kinematics._chain import IDENTITY, compose, finite, jit, joint
 
 __all__ = ["BLOCK", "static_regressor"]
 
@@ -39,10 +41,12 @@ BLOCK = 128
 _JPAIR = np.array([[0, 0], [0, 1], [0, 2], [1, 1], [1, 2], [2, 2]], dtype=np.int64)
 
 
-def _static_regressor(T, axes, prismatic, g, q, cols, Y):
+@jit
+def static_regressor(C, q, cols, Y):
     """Static regressor into the zeroed ``Y`` (c, s, B) for q (B n,), columns ``cols``; ``ok``."""
-    n = T.shape[0]
+    n = C.shape[0] - 1
     B = q.shape[0] // n
+    g0, g1, g2 = C[n, 0], C[n, 1], C[n, 2]
     nm = n * (n + 1) // 2
     # per block of samples, the sample index innermost (contiguous runs of Y, SIMD)
     Rb = np.empty((n, 9, BLOCK))  # rotation of each link in the base frame, row-major
@@ -59,44 +63,8 @@ def _static_regressor(T, axes, prismatic, g, q, cols, Y):
                 qi = q[(b0 + kk) * n + i]
                 if not math.isfinite(qi):
                     return False
-                ax, ay, az = axes[i, 0], axes[i, 1], axes[i, 2]
-                if prismatic[i]:
-                    q00, q01, q02 = 1.0, 0.0, 0.0
-                    q10, q11, q12 = 0.0, 1.0, 0.0
-                    q20, q21, q22 = 0.0, 0.0, 1.0
-                    dx, dy, dz = qi * ax, qi * ay, qi * az
-                else:
-                    if abs(qi) > _SINCOS_MAX:
-                        s, c = math.sin(qi), math.cos(qi)
-                    else:
-                        s, c = _sincos(qi)
-                    u = 1.0 - c
-                    q00 = 1.0 + u * (ax * ax - 1.0)
-                    q11 = 1.0 + u * (ay * ay - 1.0)
-                    q22 = 1.0 + u * (az * az - 1.0)
-                    q01 = -s * az + u * (ax * ay)
-                    q10 = s * az + u * (ax * ay)
-                    q02 = s * ay + u * (ax * az)
-                    q20 = -s * ay + u * (ax * az)
-                    q12 = -s * ax + u * (ay * az)
-                    q21 = s * ax + u * (ay * az)
-                    dx = dy = dz = 0.0
-                # R_rel = T_fix Rot(axis, q), p_rel = p_fix + R_fix (q a)
-                t0, t1, t2 = T[i, 0, 0], T[i, 0, 1], T[i, 0, 2]
-                a00 = t0 * q00 + t1 * q10 + t2 * q20
-                a01 = t0 * q01 + t1 * q11 + t2 * q21
-                a02 = t0 * q02 + t1 * q12 + t2 * q22
-                p0 = T[i, 0, 3] + (t0 * dx + t1 * dy + t2 * dz)
-                t0, t1, t2 = T[i, 1, 0], T[i, 1, 1], T[i, 1, 2]
-                a10 = t0 * q00 + t1 * q10 + t2 * q20
-                a11 = t0 * q01 + t1 * q11 + t2 * q21
-                a12 = t0 * q02 + t1 * q12 + t2 * q22
-                p1 = T[i, 1, 3] + (t0 * dx + t1 * dy + t2 * dz)
-                t0, t1, t2 = T[i, 2, 0], T[i, 2, 1], T[i, 2, 2]
-                a20 = t0 * q00 + t1 * q10 + t2 * q20
-                a21 = t0 * q01 + t1 * q11 + t2 * q21
-                a22 = t0 * q02 + t1 * q12 + t2 * q22
-                p2 = T[i, 2, 3] + (t0 * dx + t1 * dy + t2 * dz)
+                ax, ay, az = C[i, C_AXIS], C[i, C_AXIS + 1], C[i, C_AXIS + 2]
+                a00, a01, a02, a10, a11, a12, a20, a21, a22, p0, p1, p2 = joint(C, i, qi)
                 if i == 0:
                     Rb[0, 0, kk], Rb[0, 1, kk], Rb[0, 2, kk] = a00, a01, a02
                     Rb[0, 3, kk], Rb[0, 4, kk], Rb[0, 5, kk] = a10, a11, a12
@@ -120,7 +88,7 @@ def _static_regressor(T, axes, prismatic, g, q, cols, Y):
         for l in range(n):
             # Jacobian columns of the origin of link l for joints k <= l, link-l coordinates
             for k in range(l + 1):
-                pk = prismatic[k]
+                pk = C[k, C_PRISMATIC] != 0.0
                 for kk in range(nb):
                     r00, r01, r02 = Rb[l, 0, kk], Rb[l, 1, kk], Rb[l, 2, kk]
                     r10, r11, r12 = Rb[l, 3, kk], Rb[l, 4, kk], Rb[l, 5, kk]
@@ -144,9 +112,9 @@ def _static_regressor(T, axes, prismatic, g, q, cols, Y):
                     w[k, 1, kk] = r01 * ux + r11 * uy + r21 * uz
                     w[k, 2, kk] = r02 * ux + r12 * uy + r22 * uz
             for kk in range(nb):
-                gl[0, kk] = Rb[l, 0, kk] * g[0] + Rb[l, 3, kk] * g[1] + Rb[l, 6, kk] * g[2]
-                gl[1, kk] = Rb[l, 1, kk] * g[0] + Rb[l, 4, kk] * g[1] + Rb[l, 7, kk] * g[2]
-                gl[2, kk] = Rb[l, 2, kk] * g[0] + Rb[l, 5, kk] * g[1] + Rb[l, 8, kk] * g[2]
+                gl[0, kk] = Rb[l, 0, kk] * g0 + Rb[l, 3, kk] * g1 + Rb[l, 6, kk] * g2
+                gl[1, kk] = Rb[l, 1, kk] * g0 + Rb[l, 4, kk] * g1 + Rb[l, 7, kk] * g2
+                gl[2, kk] = Rb[l, 2, kk] * g0 + Rb[l, 5, kk] * g1 + Rb[l, 8, kk] * g2
             c0 = 10 * l
             # rows of tril M: pair (i, j), j <= i, at i (i + 1) / 2 + j (zero for i > l)
             for i in range(l + 1):
@@ -207,5 +175,99 @@ def _static_regressor(T, axes, prismatic, g, q, cols, Y):
     return True
 
 
-#: ``static_regressor(T, axes, prismatic, g, q, cols, Y) -> ok``
-static_regressor = _jit(_static_regressor)
+@jit
+def torque_regressor(C, q, dq, ddq, cols, Y):
+    """Torque regressor into ``Y`` (B, n, width) for q, dq, ddq (B n,); returns ``ok``.
+
+    Standard parameter ``j`` goes to column ``cols[j]`` of ``Y`` (``-1``: skipped); the
+    other columns of ``Y`` are left as they are. Every entry of a written column is
+    written (zeros where link ``l`` comes before joint ``i``).
+    """
+    n = C.shape[0] - 1
+    B = q.shape[0] // n
+    WF = np.empty((n, 3, 4))  # force columns (m, mc) of link l's wrench, base frame
+    WN = np.empty((n, 3, 10))  # moment columns about the base origin, base frame
+    A = np.empty((n, 6))  # joint i's projection of a base-frame wrench [F; N]
+    for b in range(B):
+        o = b * n
+        if not (finite(q, o, n) and finite(dq, o, n) and finite(ddq, o, n)):
+            return False
+        P = IDENTITY
+        wx = wy = wz = 0.0
+        dwx = dwy = dwz = 0.0
+        ax0, ay0, az0 = -C[n, 0], -C[n, 1], -C[n, 2]
+        for i in range(n):
+            T = joint(C, i, q[o + i])
+            ex, ey, ez = C[i, C_AXIS], C[i, C_AXIS + 1], C[i, C_AXIS + 2]
+            M = motion(
+                T, (wx, wy, wz), (dwx, dwy, dwz), (ax0, ay0, az0), ex, ey, ez,
+                C[i, C_PRISMATIC], dq[o + i], ddq[o + i],
+            )  # fmt: skip
+            wx, wy, wz, dwx, dwy, dwz, ax0, ay0, az0 = M
+            P = compose(P, T)  # base pose of link i + 1
+            R00, R01, R02, R10, R11, R12, R20, R21, R22, ox, oy, oz = P
+            # joint axis z in the base frame and the projection [F; N] -> tau_i
+            zx = R00 * ex + R01 * ey + R02 * ez
+            zy = R10 * ex + R11 * ey + R12 * ez
+            zz = R20 * ex + R21 * ey + R22 * ez
+            if C[i, C_PRISMATIC] != 0.0:
+                A[i, 0], A[i, 1], A[i, 2] = zx, zy, zz
+                A[i, 3], A[i, 4], A[i, 5] = 0.0, 0.0, 0.0
+            else:
+                A[i, 0] = oy * zz - oz * zy
+                A[i, 1] = oz * zx - ox * zz
+                A[i, 2] = ox * zy - oy * zx
+                A[i, 3], A[i, 4], A[i, 5] = zx, zy, zz
+            # wrench regressor of link i + 1 about its origin, link coordinates:
+            # f = m a + (S(dw) + w w^T - |w|^2 E) h, n = -S(a) h + (L(dw) + S(w) L(w)) J
+            ww = wx * wx + wy * wy + wz * wz
+            F = (
+                (ax0, wx * wx - ww, wx * wy - dwz, wx * wz + dwy),
+                (ay0, wy * wx + dwz, wy * wy - ww, wy * wz - dwx),
+                (az0, wz * wx - dwy, wz * wy + dwx, wz * wz - ww),
+            )
+            # columns Jxx, Jxy, Jxz, Jyy, Jyz, Jzz: L(dw) + w x L(w), with the columns of
+            # L(v): (x,0,0) (y,x,0) (z,0,x) (0,y,0) (0,z,y) (0,0,z)
+            N = (
+                (0.0, 0.0, az0, -ay0, dwx, dwy - wz * wx, dwz + wx * wy, -wz * wy,
+                 wy * wy - wz * wz, wy * wz),
+                (0.0, -az0, 0.0, ax0, wz * wx, dwx + wz * wy, wz * wz - wx * wx, dwy,
+                 dwz - wx * wy, -wx * wz),
+                (0.0, ay0, -ax0, 0.0, -wy * wx, wx * wx - wy * wy, dwx - wy * wz, wx * wy,
+                 dwy + wx * wz, dwz),
+            )  # fmt: skip
+            for c in range(4):
+                f0 = R00 * F[0][c] + R01 * F[1][c] + R02 * F[2][c]
+                f1 = R10 * F[0][c] + R11 * F[1][c] + R12 * F[2][c]
+                f2 = R20 * F[0][c] + R21 * F[1][c] + R22 * F[2][c]
+                WF[i, 0, c], WF[i, 1, c], WF[i, 2, c] = f0, f1, f2
+                WN[i, 0, c] = oy * f2 - oz * f1
+                WN[i, 1, c] = oz * f0 - ox * f2
+                WN[i, 2, c] = ox * f1 - oy * f0
+            for c in range(1, 10):
+                m0 = R00 * N[0][c] + R01 * N[1][c] + R02 * N[2][c]
+                m1 = R10 * N[0][c] + R11 * N[1][c] + R12 * N[2][c]
+                m2 = R20 * N[0][c] + R21 * N[1][c] + R22 * N[2][c]
+                if c < 4:
+                    WN[i, 0, c] += m0
+                    WN[i, 1, c] += m1
+                    WN[i, 2, c] += m2
+                else:
+                    WN[i, 0, c], WN[i, 1, c], WN[i, 2, c] = m0, m1, m2
+        # tau_i = A_i . [F; N] of every link l >= i (links before joint i do not act on it)
+        for i in range(n):
+            A0, A1, A2, A3, A4, A5 = A[i, 0], A[i, 1], A[i, 2], A[i, 3], A[i, 4], A[i, 5]
+            for l in range(n):
+                for e in range(10):
+                    oc = cols[10 * l + e]
+                    if oc < 0:
+                        continue
+                    if l < i:
+                        Y[b, i, oc] = 0.0
+                    elif e < 4:
+                        Y[b, i, oc] = (A0 * WF[l, 0, e] + A1 * WF[l, 1, e] + A2 * WF[l, 2, e]) + (
+                            A3 * WN[l, 0, e] + A4 * WN[l, 1, e] + A5 * WN[l, 2, e]
+                        )
+                    else:
+                        Y[b, i, oc] = A3 * WN[l, 0, e] + A4 * WN[l, 1, e] + A5 * WN[l, 2, e]
+    return True

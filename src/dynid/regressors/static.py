@@ -21,7 +21,7 @@ vector in link ``l`` coordinates.
 
 Two implementations compute the same rows (to rounding): the compiled kernel of
 :mod:`dynid.regressors._kernels` (numba; one pass over the samples, writing only the
-columns asked for), used when :func:`dynid.dynamics.rnea.kernels` finds the compiled
+columns asked for), used when :func:`dynid._compiled.kernels` finds the compiled
 kernels, and the numpy path (samples vectorised, a loop over links), used otherwise or
 with ``DYNID_NO_NUMBA=1`` (:func:`static_regressor_numpy` always takes it).
 """
@@ -33,8 +33,9 @@ from types import ModuleType
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from .. import _checks
-from ..dynamics.rnea import _flat, kernels
+from .. import _checks, _compiled
+from .._compiled import constants as _constants
+from ..dynamics.rnea import _flat
 from ..kinematics.forward import _link_poses
 from ..model.robot import Robot
 
@@ -46,21 +47,10 @@ __all__ = [
     "static_rows",
 ]
 
-_KERNEL: ModuleType | None = None
-
 
 def _kernel() -> ModuleType | None:
-    """The compiled static-regressor kernel module, or None (numpy path).
-
-    Follows :func:`dynid.dynamics.rnea.kernels`: None when numba is missing or
-    ``DYNID_NO_NUMBA`` is set. Imported on the first call.
-    """
-    global _KERNEL
-    if _KERNEL is None and kernels() is not None:
-        from . import _kernels
-
-        _KERNEL = _kernels
-    return _KERNEL
+    """The compiled regressor kernels, or None (numpy path): :func:`dynid._compiled.kernels`."""
+    return _compiled.kernels(__package__)
 
 
 def static_rows(n: int) -> int:
@@ -133,9 +123,7 @@ def _static_regressor_columns(
         cols = np.full(p, -1, dtype=np.int64)  # output column of each standard parameter
         cols[idx] = np.arange(idx.size)
         Y = np.zeros((idx.size, static_rows(n), B))  # the kernel writes the non-zeros
-        if K.static_regressor(
-            robot.T_parent_joint, robot.axes, robot.prismatic, robot.gravity, _flat(q2), cols, Y
-        ):
+        if K.static_regressor(_constants(robot), _flat(q2), cols, Y):
             return Y
     Yt = _static_regressor_numpy(robot, q2).transpose(1, 0, 2)  # (10 n, s, B) view
     return np.ascontiguousarray(Yt if columns is None else Yt[idx])

@@ -16,6 +16,12 @@ of links ``j >= i`` onto joint ``i``.
 
 Stacking for least squares is sample-major: ``Y.reshape(-1, 10 n)`` has row ``s*n + i``
 for sample ``s``, joint ``i``.
+
+Two implementations compute the same regressor (to rounding): the compiled kernel of
+:mod:`dynid.regressors._kernels` (numba; one pass over the samples, the link wrench
+regressors carried to the base frame and projected on the joints, writing only the columns
+asked for), used when numba is available and ``DYNID_NO_NUMBA`` is unset, and the numpy
+path (:func:`torque_regressor_numpy`: samples vectorised, a loop over joints).
 """
 
 from __future__ import annotations
@@ -23,11 +29,11 @@ from __future__ import annotations
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from .. import _checks
-from ..dynamics.rnea import _prepare, link_motion
+from .. import _checks, _compiled
+from ..dynamics.rnea import _flat, _prepare, link_motion
 from ..model.robot import Robot
 
-__all__ = ["torque_regressor", "link_wrench_regressor"]
+__all__ = ["torque_regressor", "torque_regressor_numpy", "link_wrench_regressor"]
 
 
 def _skew(v: NDArray[np.float64]) -> NDArray[np.float64]:
@@ -70,8 +76,48 @@ def _torque_regressor(
     dq: NDArray[np.float64],
     ddq: NDArray[np.float64],
     gravity: NDArray[np.float64],
+    columns: NDArray[np.intp] | None = None,
+    width: int | None = None,
 ) -> NDArray[np.float64]:
     """(B, n, 10 n) regressor for validated (B, n) inputs; gravity (3,) or (B, 3).
+
+    With ``columns`` (distinct standard-parameter indices), only those columns, in that
+    order, as the first ``len(columns)`` of a (B, n, ``width``) array (default width:
+    ``len(columns)``) whose other columns are uninitialised, for the caller to fill. The
+    compiled kernel (:mod:`dynid.regressors._kernels`) writes them directly when it is
+    available, else :func:`_torque_regressor_numpy` gathers them.
+    """
+    B, n = q.shape
+    idx = np.arange(10 * n) if columns is None else np.asarray(columns, dtype=np.intp)
+    w = idx.size if width is None else int(width)
+    K = _compiled.kernels(__package__)
+    if K is not None and np.ndim(gravity) == 1:
+        cols = np.full(10 * n, -1, dtype=np.int64)  # output column of each parameter
+        cols[idx] = np.arange(idx.size)
+        C = (
+            _compiled.constants(robot)
+            if gravity is robot.gravity
+            else _compiled.pack(robot, gravity=gravity)
+        )
+        Y = np.empty((B, n, w))
+        if K.torque_regressor(C, _flat(q), _flat(dq), _flat(ddq), cols, Y):
+            return Y
+    Yn = _torque_regressor_numpy(robot, q, dq, ddq, gravity)
+    if columns is None and width is None:
+        return Yn
+    Y = np.empty((B, n, w))
+    Y[..., : idx.size] = Yn[..., idx]
+    return Y
+
+
+def _torque_regressor_numpy(
+    robot: Robot,
+    q: NDArray[np.float64],
+    dq: NDArray[np.float64],
+    ddq: NDArray[np.float64],
+    gravity: NDArray[np.float64],
+) -> NDArray[np.float64]:
+    """Numpy path: (B, n, 10 n) regressor for validated (B, n) inputs; gravity (3,) or (B, 3).
 
     Every link's wrench regressor is carried to the base frame (moment about the base
     origin), then projected on every joint at once: for a revolute joint i with axis z_i
@@ -143,8 +189,31 @@ def torque_regressor(
     Raises
     ------
     ShapeError, NonFiniteError
+
+    Notes
+    -----
+    Compiled over the batch (:mod:`dynid.regressors._kernels`) when numba is available,
+    else :func:`torque_regressor_numpy`.
     """
     shape, (q2, dq2, ddq2) = _prepare(robot, q, dq, ddq)
     g = robot.gravity if gravity is None else _checks.as_exact("gravity", gravity, (3,))
     Y = _torque_regressor(robot, q2, dq2, ddq2, g)
+    return Y.reshape(shape + (10 * robot.n,))
+
+
+def torque_regressor_numpy(
+    robot: Robot,
+    q: ArrayLike,
+    dq: ArrayLike,
+    ddq: ArrayLike,
+    *,
+    gravity: ArrayLike | None = None,
+) -> NDArray[np.float64]:
+    """:func:`torque_regressor` by the numpy reference path, never the compiled kernel.
+
+    Same parameters, result, shapes and errors as :func:`torque_regressor`.
+    """
+    shape, (q2, dq2, ddq2) = _prepare(robot, q, dq, ddq)
+    g = robot.gravity if gravity is None else _checks.as_exact("gravity", gravity, (3,))
+    Y = _torque_regressor_numpy(robot, q2, dq2, ddq2, g)
     return Y.reshape(shape + (10 * robot.n,))
