@@ -471,6 +471,14 @@ def solve_one(C, m, q_min, q_max, inv_vmax, q_restart, goal, fpar, ipar, path, q
     return _solve(C, m, q_min, q_max, inv_vmax, q_restart, goal, fpar, ipar, path, True, q_best)
 
 
+@jit
+def _solve_goal(C, m, q_min, q_max, inv_vmax, q_restart, goal, fpar, ipar, path, q_best):
+    """One goal without its path: a compiled call, not inlined, so that the parallel loop
+    of :func:`solve_batch` does not analyse the solver's tuples (numba's parfor array
+    analysis fails on them when it compiles afresh)."""
+    return _solve(C, m, q_min, q_max, inv_vmax, q_restart, goal, fpar, ipar, path, False, q_best)
+
+
 @jit(parallel=True)
 def solve_batch(C, m, q_min, q_max, inv_vmax, q_restart, goals, fpar, ipar, q0, out, stats):
     """Goals ``goals`` (G, 4, 4) from ``q0`` (G, n), in parallel; the paths are not kept.
@@ -485,8 +493,8 @@ def solve_batch(C, m, q_min, q_max, inv_vmax, q_restart, goals, fpar, ipar, q0, 
         path = np.empty((1, n))
         for j in range(n):
             path[0, j] = q0[g, j]
-        k, _, ep, eo, conv, rs, more = _solve(
-            C, m, q_min, q_max, inv_vmax, q_restart[g], goals[g], fpar, ipar, path, False, out[g]
+        k, _, ep, eo, conv, rs, more = _solve_goal(
+            C, m, q_min, q_max, inv_vmax, q_restart[g], goals[g], fpar, ipar, path, out[g]
         )
         stats[g, 0] = k
         stats[g, 1] = ep
