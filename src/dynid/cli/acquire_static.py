@@ -35,18 +35,25 @@ from ..simulation.controller import (
     acquire_static,
     acquire_static_at,
 )
-from .common import add_robot_options, add_seed_option, count_type, load_robot, nonnegative_type
+from .common import (
+    add_robot_options,
+    add_seed_option,
+    add_subcommand,
+    count_type,
+    load_robot,
+    nonnegative_type,
+)
 
 NAME = "acquire-static"
 
 
 def register(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParser:
     """Add the ``acquire-static`` subcommand."""
-    p = subparsers.add_parser(
+    p = add_subcommand(
+        subparsers,
         NAME,
+        __doc__,
         help="M(q) and g(q) from a simulated controller at random static configurations",
-        description=__doc__,
-        formatter_class=argparse.RawDescriptionHelpFormatter,
     )
     add_robot_options(p)
     p.add_argument(

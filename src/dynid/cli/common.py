@@ -16,7 +16,6 @@ import numpy as np
 
 from .. import _checks, spatial
 from ..exceptions import DataError, DynidError, ShapeError
-from ..io._files import open_atomic
 from ..io._json import dumps
 from ..model.panda import panda
 from ..model.robot import Robot
@@ -73,6 +72,19 @@ count_type = number(int, min=1)
 positive_type = number(float, min=0, min_open=True)
 #: Non-negative finite floats (noise levels, margins).
 nonnegative_type = number(float, min=0)
+
+
+def add_subcommand(
+    subparsers: argparse._SubParsersAction, name: str, doc: str | None, *, help: str
+) -> argparse.ArgumentParser:
+    """Add the subcommand ``name``: ``help`` is its line in ``dynid --help``, ``doc`` (the
+    module docstring) its ``--help`` text, shown as written."""
+    return subparsers.add_parser(
+        name,
+        help=help,
+        description=doc,
+        formatter_class=argparse.RawDescriptionHelpFormatter,
+    )
 
 
 def add_seed_option(p: argparse.ArgumentParser, help: str = "random seed (default: 0)") -> None:
@@ -255,27 +267,20 @@ def print_json(obj: Any) -> None:
 
 
 def save_figure(fig_factory: Callable[[], Any], path: Path, *, dpi: int = 110) -> Path | None:
-    """Render ``fig_factory()`` to ``path`` (atomically); without matplotlib, skip it with a
-    one-line note on stderr and return None.
+    """Render ``fig_factory()`` to ``path`` with :func:`dynid.plots.save.save_figure`;
+    without matplotlib, skip it with a one-line note on stderr and return None.
 
     The plots extra is optional: every data file is written before the figures, and a
     missing matplotlib never fails a command.
     """
     try:
-        import matplotlib
-
-        matplotlib.use("Agg")
-        import matplotlib.pyplot as plt
+        import matplotlib  # noqa: F401
     except ImportError:
         print(f"note: matplotlib is not installed; skipped the figure {path.name}", file=sys.stderr)
         return None
-    fig = fig_factory()
-    try:
-        with open_atomic(path, "wb") as fh:
-            fig.savefig(fh, format=path.suffix.lstrip(".") or "png", dpi=dpi)
-    finally:
-        plt.close(fig)
-    return path
+    from ..plots.save import save_figure as write_figure
+
+    return write_figure(fig_factory, path, dpi=dpi)
 
 
 def format_matrix(A: np.ndarray, fmt: str = "{:+.6f}") -> str:

@@ -35,18 +35,18 @@ import numpy as np
 
 from ..io.excitation import load_obstacles, save_excitation_json, save_trajectory_csv
 from ..simulation.excitation import ExcitationOptions, optimise_excitation
-from .common import add_robot_options, load_robot
+from .common import add_robot_options, add_subcommand, load_robot, save_figure
 
 NAME = "excite"
 
 
 def register(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParser:
     """Add the ``excite`` subcommand."""
-    p = subparsers.add_parser(
+    p = add_subcommand(
+        subparsers,
         NAME,
+        __doc__,
         help="optimise an exciting trajectory within limits and obstacles",
-        description=__doc__,
-        formatter_class=argparse.RawDescriptionHelpFormatter,
     )
     add_robot_options(p)
     d = ExcitationOptions()
@@ -117,10 +117,12 @@ def run(args: argparse.Namespace) -> int:
     if not args.no_figure:
         from ..plots.excitation import plot_excitation
 
-        fig = plot_excitation(robot, samples, obstacles=res.obstacles)
-        png = args.out / "excitation.png"
-        fig.savefig(png, dpi=110)
-        written.append(png)
+        png = save_figure(
+            lambda: plot_excitation(robot, samples, obstacles=res.obstacles),
+            args.out / "excitation.png",
+            dpi=110,
+        )
+        written += [png] if png is not None else []
     if not args.quiet:
         m = res.margins
         print(

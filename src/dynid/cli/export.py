@@ -32,17 +32,18 @@ from ..io.feasible import load_feasible_json
 from ..io.urdf_patch import MERGED_POLICIES
 from ..model.panda import panda
 from ..model.robot import Robot
+from .common import add_subcommand
 
 NAME = "export"
 
 
 def register(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParser:
     """Add the ``export`` subcommand."""
-    p = subparsers.add_parser(
+    p = add_subcommand(
+        subparsers,
         NAME,
+        __doc__,
         help="write a robot as URDF (optionally patching the original), MJCF or TOML",
-        description=__doc__,
-        formatter_class=argparse.RawDescriptionHelpFormatter,
     )
     p.add_argument("--params", required=True, help="feasible.json, a robot .toml, or 'panda'")
     p.add_argument("--format", choices=EXPORT_FORMATS, default=None, help="default: by suffix")

@@ -23,6 +23,7 @@ from ..spatial import rpy_from_matrix
 from .common import (
     add_frame_tool_options,
     add_robot_options,
+    add_subcommand,
     format_joint_table,
     format_matrix,
     load_robot,
@@ -36,12 +37,7 @@ NAME = "fk"
 
 def register(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParser:
     """Add the ``fk`` subcommand."""
-    p = subparsers.add_parser(
-        NAME,
-        help="pose of a frame or tool in the base frame",
-        description=__doc__,
-        formatter_class=argparse.RawDescriptionHelpFormatter,
-    )
+    p = add_subcommand(subparsers, NAME, __doc__, help="pose of a frame or tool in the base frame")
     add_robot_options(p)
     add_q_option(p)
     add_frame_tool_options(p)

@@ -31,6 +31,7 @@ from ..spatial import matrix_from_rpy, transform
 from .common import (
     add_frame_tool_options,
     add_robot_options,
+    add_subcommand,
     count_type,
     format_joint_table,
     format_matrix,
@@ -48,11 +49,8 @@ NAME = "ik"
 
 def register(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParser:
     """Add the ``ik`` subcommand."""
-    p = subparsers.add_parser(
-        NAME,
-        help="joint positions for a goal pose (inverse kinematics)",
-        description=__doc__,
-        formatter_class=argparse.RawDescriptionHelpFormatter,
+    p = add_subcommand(
+        subparsers, NAME, __doc__, help="joint positions for a goal pose (inverse kinematics)"
     )
     add_robot_options(p)
     add_frame_tool_options(p)

@@ -23,18 +23,18 @@ from pathlib import Path
 from ..identification.log import DEFAULT_CUTOFF_HZ
 from ..io.rosbag import read_joint_state_bag
 from ..io.torque_log import write_torque_log
-from .common import add_robot_options, load_robot, positive_type, print_json
+from .common import add_robot_options, add_subcommand, load_robot, positive_type, print_json
 
 NAME = "import"
 
 
 def register(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParser:
     """Add the ``import`` subcommand."""
-    p = subparsers.add_parser(
+    p = add_subcommand(
+        subparsers,
         NAME,
+        __doc__,
         help="torque log from sensor_msgs/JointState in a ROS 1 or ROS 2 bag",
-        description=__doc__,
-        formatter_class=argparse.RawDescriptionHelpFormatter,
     )
     p.add_argument("bag", type=Path, help="ROS 1 .bag file or ROS 2 bag folder")
     p.add_argument("--out", type=Path, required=True, help="torque log to write (.csv or .npz)")

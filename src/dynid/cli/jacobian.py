@@ -20,6 +20,7 @@ from ..kinematics.jacobian import jacobian
 from .common import (
     add_frame_tool_options,
     add_robot_options,
+    add_subcommand,
     format_joint_table,
     load_robot,
     parse_tool,
@@ -35,11 +36,8 @@ ROWS = ("vx", "vy", "vz", "wx", "wy", "wz")
 
 def register(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParser:
     """Add the ``jacobian`` subcommand."""
-    p = subparsers.add_parser(
-        NAME,
-        help="geometric Jacobian of a frame or tool (base frame)",
-        description=__doc__,
-        formatter_class=argparse.RawDescriptionHelpFormatter,
+    p = add_subcommand(
+        subparsers, NAME, __doc__, help="geometric Jacobian of a frame or tool (base frame)"
     )
     add_robot_options(p)
     add_q_option(p)

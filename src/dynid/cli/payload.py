@@ -28,7 +28,7 @@ from ..identification.model import IdentifiedModel
 from ..io._files import write_text
 from ..io.columns import ColumnMap, read_mapped_static_data
 from ..io.payload_json import save_payload_json
-from .common import add_column_options, column_map, positive_type, read_log
+from .common import add_column_options, add_subcommand, column_map, positive_type, read_log
 from .identify import data_kind
 from .validate import load_model_source
 
@@ -37,11 +37,8 @@ NAME = "payload"
 
 def register(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParser:
     """Add the ``payload`` subcommand."""
-    p = subparsers.add_parser(
-        NAME,
-        help="identify a load's mass, CoM and inertia on a known arm",
-        description=__doc__,
-        formatter_class=argparse.RawDescriptionHelpFormatter,
+    p = add_subcommand(
+        subparsers, NAME, __doc__, help="identify a load's mass, CoM and inertia on a known arm"
     )
     src = p.add_mutually_exclusive_group(required=True)
     src.add_argument("--robot", help="'panda', a .urdf or a .toml with the arm's parameters")

@@ -17,18 +17,15 @@ from pathlib import Path
 
 from ..exceptions import DynidError
 from ..io.model_json import load_model_json
-from .common import format_matrix, parse_vector, print_json
+from .common import add_subcommand, format_matrix, parse_vector, print_json
 
 NAME = "predict"
 
 
 def register(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParser:
     """Add the ``predict`` subcommand."""
-    p = subparsers.add_parser(
-        NAME,
-        help="M, g (and c, tau) of an identified model at one state",
-        description=__doc__,
-        formatter_class=argparse.RawDescriptionHelpFormatter,
+    p = add_subcommand(
+        subparsers, NAME, __doc__, help="M, g (and c, tau) of an identified model at one state"
     )
     p.add_argument("--model", type=Path, required=True, help="identification.json")
     p.add_argument("--q", required=True, help="joint positions [rad], comma-separated")

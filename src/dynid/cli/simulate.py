@@ -40,6 +40,7 @@ from ..simulation.measurement import SensorNoise, sample_times, simulate_measure
 from .common import (
     add_robot_options,
     add_seed_option,
+    add_subcommand,
     count_type,
     load_robot,
     nonnegative_type,
@@ -54,11 +55,11 @@ log = logging.getLogger(__name__)
 
 def register(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParser:
     """Add the ``simulate`` subcommand."""
-    p = subparsers.add_parser(
+    p = add_subcommand(
+        subparsers,
         NAME,
+        __doc__,
         help="simulate a torque log of a trajectory (sinusoids or Fourier series)",
-        description=__doc__,
-        formatter_class=argparse.RawDescriptionHelpFormatter,
     )
     add_robot_options(p)
     p.add_argument(

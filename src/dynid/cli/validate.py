@@ -39,7 +39,15 @@ from ..identification.model import IdentifiedModel
 from ..io._json import save_json
 from ..io.friction_json import read_friction_json
 from ..model.robot import Robot
-from .common import about, add_column_options, add_log_options, load_robot, positive_type, read_log
+from .common import (
+    about,
+    add_column_options,
+    add_log_options,
+    add_subcommand,
+    load_robot,
+    positive_type,
+    read_log,
+)
 from .friction import VALIDATION_SCHEMA, format_rms_table, save_validation_figures
 
 NAME = "validate"
@@ -47,11 +55,11 @@ NAME = "validate"
 
 def register(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParser:
     """Add the ``validate`` subcommand."""
-    p = subparsers.add_parser(
+    p = add_subcommand(
+        subparsers,
         NAME,
+        __doc__,
         help="compare a model's torques (without and with friction) with a measured log",
-        description=__doc__,
-        formatter_class=argparse.RawDescriptionHelpFormatter,
     )
     src = p.add_mutually_exclusive_group(required=True)
     src.add_argument("--model", type=Path, help="identification.json of an identified model")
