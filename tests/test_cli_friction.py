@@ -229,10 +229,11 @@ def test_cli_errors_are_one_line_with_exit_code_2(workdir, capsys):
     assert "missing column" in capsys.readouterr().err
 
 
-def test_demo_stages_fit_friction_and_validate(tmp_path, panda, capsys):
-    """demo_stages returns per-joint RMS before/after and writes its files."""
-    from dynid.cli.friction import demo_stages
+def test_demo_friction_stage_fits_friction_validates_and_writes_its_files(tmp_path, panda):
+    """The demo's stage 3 (library) gives per-joint RMS before/after; the CLI writes its files."""
+    from dynid.cli.friction import format_demo_stage, save_demo_stage
     from dynid.kinematics.trajectories import random_fourier
+    from dynid.pipeline import friction_stage
     from dynid.simulation.measurement import sample_times, simulate_measurement
 
     series = random_fourier(panda, np.random.default_rng(51))
@@ -240,14 +241,16 @@ def test_demo_stages_fit_friction_and_validate(tmp_path, panda, capsys):
         panda, series(sample_times(15.0)), rng=np.random.default_rng(52), friction=None
     )
     model = identify_from_log(panda, log, friction=False)
-    out = demo_stages(tmp_path / "demo", model, seed=3)
-    assert np.all(np.array(out["rms_with_friction"]) < 0.06)
-    assert np.all(np.array(out["rms_without_friction"]) > 0.1)
-    assert np.all(np.array(out["friction_curve_rms"]) < 0.01)
-    assert out["scale"] == pytest.approx(0.95 * 2.175 / 2.21, rel=1e-4)
-    for f in out["files"]:
-        assert (tmp_path / "demo" / f.split("/")[-1]).stat().st_size > 0
-    assert "RMS + friction" in capsys.readouterr().out
+    out = friction_stage(model, seed=3)
+    assert np.all(out.rms_with_friction < 0.06)
+    assert np.all(out.rms_without_friction > 0.1)
+    assert out.friction_curve_rms is not None and np.all(out.friction_curve_rms < 0.01)
+    assert out.scale == pytest.approx(0.95 * 2.175 / 2.21, rel=1e-4)
+    files = save_demo_stage(tmp_path / "demo", out)
+    assert {f.name for f in files} >= {"friction.json", "validation.json", "friction.png"}
+    for f in files:
+        assert (tmp_path / "demo" / f.name).stat().st_size > 0
+    assert "RMS + friction" in format_demo_stage(out)
 
 
 def test_identify_routes_a_torque_log_to_the_classical_identification(tmp_path):

@@ -9,7 +9,8 @@ import pytest
 
 import dynid
 from dynid.cli.__main__ import main
-from dynid.cli.identify import demo_stage
+from dynid.cli.identify import format_summary, save_demo_stage
+from dynid.pipeline import identification_stage
 
 from conftest import random_states
 
@@ -173,10 +174,12 @@ def test_bad_inputs_exit_non_zero_with_one_stderr_line(tmp_path, identified, cap
     )
 
 
-def test_demo_stage_returns_the_key_numbers(tmp_path, capsys):
-    """demo_stage writes the data and identification.json and returns rank, cond, errors."""
-    out = demo_stage(tmp_path, seed=5)
-    assert out["rank"] == 43 and out["n_configurations"] == 1010 and out["dropped_rows"] == ["g1"]
-    assert out["relative_error_percent"] < 0.05 and out["max_error_in_std"] < 5.0
+def test_demo_identification_stage_returns_the_key_numbers_and_writes_its_files(tmp_path):
+    """The demo's stage 2 (library) gives rank, cond, errors; the CLI writes data and model."""
+    out = identification_stage(dynid.panda(), seed=5)
+    assert out.rank == 43 and out.n_configurations == 1010 and out.dropped_rows == ["g1"]
+    assert out.relative_error_percent < 0.05 and out.max_error_in_std < 5.0
+    files = save_demo_stage(tmp_path, out)
+    assert files == [tmp_path / "static.csv", tmp_path / "identification.json"]
     assert (tmp_path / "static.csv").exists() and (tmp_path / "identification.json").exists()
-    assert "rank 43" in capsys.readouterr().out
+    assert "rank 43" in format_summary(out.model)

@@ -165,11 +165,18 @@ def test_bad_input_exits_nonzero_with_one_stderr_line(capsys, argv, message):
     assert message in lines[0]
 
 
-def test_demo_stage_1_runs_headless_and_writes_a_png(capsys, tmp_path):
-    """demo --out DIR writes a non-empty PNG of the IK joint motion and reports convergence."""
+def test_demo_kinematics_stage_runs_headless_and_writes_a_png(tmp_path):
+    """The demo's stage 1 (library) solves the IK; the CLI writes a non-empty PNG of the joint
+    motion and reports convergence."""
+    from dynid.cli.demo import format_kinematics, save_kinematics
+    from dynid.model.panda import PANDA_NEUTRAL_Q
+    from dynid.pipeline import kinematics_stage
+
+    robot = dynid.panda()
+    res = kinematics_stage(robot, PANDA_NEUTRAL_Q, np.random.default_rng(3))
+    text = format_kinematics(robot, res)
     out_dir = tmp_path / "demo"
-    assert main(["demo", "--out", str(out_dir), "--seed", "3"]) == 0
-    text = capsys.readouterr().out
+    assert save_kinematics(out_dir, robot, res) == [out_dir / "ik_joint_motion.png"]
     png = out_dir / "ik_joint_motion.png"
     assert png.stat().st_size > 1000
     assert png.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"

@@ -190,10 +190,12 @@ def test_retrieve_error_is_one_line_with_exit_code_2(model_file, tmp_path, capsy
     assert len(err.strip().splitlines()) == 1
 
 
-def test_demo_stage_retrieves_exports_and_validates(tmp_path, capsys):
-    """demo_stage: feasible parameters, files, Newton-Euler validation against a log."""
-    from dynid.cli.retrieve import demo_stage
+def test_demo_feasible_stage_retrieves_validates_and_writes_its_files(tmp_path):
+    """The demo's stage 4 (library): feasible parameters validated by Newton-Euler against a
+    log; the CLI writes the exports and the validation."""
+    from dynid.cli.retrieve import format_demo_stage, save_demo_stage
     from dynid.friction.model import SigmoidFriction
+    from dynid.pipeline import feasible_stage
 
     panda = dynid.panda()
     rng = np.random.default_rng(23)
@@ -205,14 +207,17 @@ def test_demo_stage_retrieves_exports_and_validates(tmp_path, capsys):
     fr = SigmoidFriction.from_array(panda.friction)
     tau = dynid.rnea(panda, q, dq, ddq) + fr.torques(dq) + rng.normal(0, 0.01, q.shape)
     log = TorqueLog(t, q, dq, tau, ddq)
-    out = demo_stage(tmp_path / "demo", _model(), log, fr, seed=0)
-    text = capsys.readouterr().out
-    assert out["feasible"] and out["relative_residual"] <= 1e-4
-    assert out["max_torque_difference"] < 1e-6
-    assert np.all(np.array(out["rms_newton_euler"]) < 0.05)
-    assert "RMS NE" in text
-    for f in out["files"]:
-        assert (tmp_path / "demo" / f.split("/")[-1]).is_file()
+    runs = []
+    out = feasible_stage(_model(), log, fr, seed=0, progress=runs.append)
+    assert out.feasible and out.relative_residual <= 1e-4
+    assert out.max_torque_difference < 1e-6
+    assert np.all(out.rms_newton_euler < 0.05)
+    assert len(runs) == out.retrieval.options.runs and runs[-1].done == runs[-1].total
+    assert "RMS NE" in format_demo_stage(out)
+    files = save_demo_stage(tmp_path / "demo", out)
+    assert {f.name for f in files} >= {"feasible.json", "robot.urdf", "feasible_validation.json"}
+    for f in files:
+        assert (tmp_path / "demo" / f.name).is_file()
 
 
 def test_validate_with_retrieved_parameters_uses_rnea(model_file, tmp_path):

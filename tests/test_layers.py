@@ -18,6 +18,7 @@ LAYERS = [
     {"friction"},
     {"simulation"},
     {"feasibility"},
+    {"pipeline"},
     {"io"},
     {"plots"},
     {"cli", "__main__"},

@@ -19,7 +19,7 @@ from __future__ import annotations
 
 import argparse
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
@@ -31,29 +31,25 @@ from ..friction.fit import (
     fit_sigmoid,
     friction_residual,
 )
-from ..friction.model import SigmoidFriction
-from ..friction.validation import Validation, validate
+from ..friction.validation import Validation
 from ..identification.log import DEFAULT_CUTOFF_HZ
 from ..identification.model import IdentifiedModel
 from ..io._json import save_json
 from ..io.friction_json import write_friction_json
-from ..kinematics.trajectories import (
-    centered_start,
-    check_limits,
-    scale_into_limits,
-    sinusoid_trajectory,
-)
 from ..model.robot import Robot
-from ..simulation.measurement import SensorNoise, sample_times, simulate_measurement
 from .common import (
     about,
     add_column_options,
     add_log_options,
+    add_subcommand,
     load_robot,
     positive_type,
     read_log,
     save_figure,
 )
+
+if TYPE_CHECKING:  # pragma: no cover
+    from ..pipeline.stages import FrictionStageResult
 
 NAME = "friction"
 
@@ -63,11 +59,11 @@ VALIDATION_SCHEMA = "dynid-validation/1"
 
 def register(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParser:
     """Add the ``friction`` subcommand."""
-    p = subparsers.add_parser(
+    p = add_subcommand(
+        subparsers,
         NAME,
+        __doc__,
         help="fit joint friction (sigmoid or classical) to a model's torque residual",
-        description=__doc__,
-        formatter_class=argparse.RawDescriptionHelpFormatter,
     )
     src = p.add_mutually_exclusive_group(required=True)
     src.add_argument("--model", type=Path, help="identification.json of an identified model")
@@ -198,118 +194,61 @@ def run(args: argparse.Namespace) -> int:
     return 0
 
 
-def demo_stages(
-    out_dir: Path, model: IdentifiedModel, seed: int, *, truth: Robot | None = None
-) -> dict[str, Any]:
-    """Friction and validation stages of the demo, from a static identified model.
-
-    1. Simulate two 20 s logs at 1 kHz of the velocity-mode sinusoids (Gaz et al. 2019,
-       eq. 31, Table I; started centred in the joint ranges and scaled in amplitude into
-       the limits) on the true robot, with independent sensor noise (0.05 N m): one to
-       fit the friction, one to validate.
-    2. Validate the model without friction; fit the sigmoid friction on the first log's
-       residual; validate with friction on the second log.
-    3. Write ``friction.json``, ``validation.json`` and the figures under ``out_dir``, print
-       the per-joint RMS before/after table.
-
-    Parameters
-    ----------
-    out_dir : Path
-    model : IdentifiedModel
-        The rigid-body model to validate (e.g. from the static route).
-    seed : int
-    truth : Robot, optional
-        The robot that plays the real one (its link parameters and sigmoid friction);
-        default ``model.robot`` (for the built-in Panda: the published values).
-
-    Returns
-    -------
-    dict
-        ``rms_without_friction``, ``rms_with_friction``, ``rms_friction_fit_before`` /
-        ``_after`` (n lists, N m), ``relative_error_percent_without`` / ``_with``,
-        ``friction`` (n, 3) fitted sigmoid parameters, ``friction_curve_rms`` (RMS of the
-        fitted minus true friction over the visited velocities, or None), ``scale``,
-        ``files``.
-    """
-    truth = model.robot if truth is None else truth
-    if not np.any(truth.phi):
-        raise DynidError(
-            "the model's robot has no link parameters to simulate with (read from JSON?); "
-            "pass truth=<Robot>"
-        )
+def save_demo_stage(out_dir: Path, res: FrictionStageResult) -> list[Path]:
+    """Write the demo's friction stage under ``out_dir``: ``friction.json``,
+    ``validation.json``, ``friction.png`` and the validation figures; returns the paths."""
     out_dir = Path(out_dir)
-    rng = np.random.default_rng(seed)
-    t = sample_times(20.0, 1000.0)
-    traj = sinusoid_trajectory(t, centered_start(truth))
-    report = check_limits(truth, traj)
-    traj, scale = scale_into_limits(truth, traj, method="amplitude")
-    noise = SensorNoise()
-    fit_log = simulate_measurement(truth, traj, rng=rng, noise=noise)
-    val_log = simulate_measurement(truth, traj, rng=rng, noise=noise)
-    names = list(truth.joint_names)
-    res = friction_residual(model, fit_log)
-    fit = fit_sigmoid(res.dq, res.residual)
-    val = validate(model, val_log, friction=fit.friction)
+    names = list(res.truth.joint_names)
     write_friction_json(
-        out_dir / "friction.json", fit, metadata={"seed": seed, "source": "demo, sinusoids"}
+        out_dir / "friction.json", res.fit, metadata={"seed": res.seed, "source": "demo, sinusoids"}
     )
-    doc = val.as_dict()
-    doc["seed"] = seed
+    doc = res.validation.as_dict()
+    doc["seed"] = res.seed
     doc["units"] = {"rms": "N m", "mse": "N^2 m^2", "relative_error_percent": "%"}
     save_json(out_dir / "validation.json", doc, schema=VALIDATION_SCHEMA)
     files: list[Path | None] = [out_dir / "friction.json", out_dir / "validation.json"]
     files.append(
         save_friction_figure(
             out_dir / "friction.png",
-            res,
-            fit,
+            res.residual,
+            res.fit,
             names=names,
-            reference=SigmoidFriction.from_array(truth.friction)
-            if truth.friction is not None
-            else None,
+            reference=res.reference_friction,
             reference_label="true (published) friction",
             title="sigmoid friction fitted to the residual of the identified model",
         )
     )
     files += save_validation_figures(
         out_dir,
-        val,
+        res.validation,
         names=names,
-        noise_std=float(noise.tau_std),
+        noise_std=float(np.max(res.noise.tau_std)),  # one level for every joint: the largest
         title="validation on the sinusoids of Gaz et al. 2019 (eq. 31)",
     )
-    curve = None
-    if truth.friction is not None:
-        v = np.linspace(-1.0, 1.0, 801)[:, None] * np.max(np.abs(traj.dq), axis=0)
-        true_f = SigmoidFriction.from_array(truth.friction)
-        curve = np.sqrt(np.mean((fit.friction.torques(v) - true_f.torques(v)) ** 2, axis=0))
-    assert val.with_friction is not None
-    if not report.ok:
-        print(
-            f"sinusoids of Table I exceed the limits; amplitudes scaled by {scale:.4f}:\n{report}"
+    return [f for f in files if f is not None]
+
+
+def format_demo_stage(res: FrictionStageResult) -> str:
+    """The demo's friction stage: the limit note (if the sinusoids were scaled), the
+    per-joint RMS without and with friction, the relative errors."""
+    lines = []
+    if not res.limits.ok:
+        lines.append(
+            f"sinusoids of Table I exceed the limits; amplitudes scaled by {res.scale:.4f}:\n"
+            f"{res.limits}"
         )
-    print(
+    names = list(res.truth.joint_names)
+    lines.append(
         format_rms_table(
             names,
             {
-                "RMS no friction [N m]": val.without_friction.rms,
-                "RMS + friction [N m]": val.with_friction.rms,
+                "RMS no friction [N m]": res.rms_without_friction,
+                "RMS + friction [N m]": res.rms_with_friction,
             },
         )
     )
-    print(
-        f"relative error: {val.without_friction.relative_error_percent:.2f} % without friction, "
-        f"{val.with_friction.relative_error_percent:.2f} % with (sensor noise {noise.tau_std} N m)"
+    lines.append(
+        f"relative error: {res.relative_error_percent_without:.2f} % without friction, "
+        f"{res.relative_error_percent_with:.2f} % with (sensor noise {res.noise.tau_std} N m)"
     )
-    return {
-        "rms_without_friction": val.without_friction.rms.tolist(),
-        "rms_with_friction": val.with_friction.rms.tolist(),
-        "rms_friction_fit_before": fit.rms_before.tolist(),
-        "rms_friction_fit_after": fit.rms_after.tolist(),
-        "relative_error_percent_without": val.without_friction.relative_error_percent,
-        "relative_error_percent_with": val.with_friction.relative_error_percent,
-        "friction": fit.friction.as_array().tolist(),
-        "friction_curve_rms": None if curve is None else curve.tolist(),
-        "scale": scale,
-        "files": [str(f) for f in files if f is not None],
-    }
+    return "\n".join(lines)

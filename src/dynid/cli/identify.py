@@ -63,7 +63,7 @@ import sys
 import warnings
 import zipfile
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
@@ -74,17 +74,15 @@ from ..identification.model import IdentifiedModel
 from ..identification.static import identify_static
 from ..io.model_json import save_model_json
 from ..io.static_data import load_static_data, save_static_data
-from ..model.panda import panda
 from ..model.robot import Robot
 from ..regressors.base import identifiability
-from ..simulation.controller import SimulatedController, acquire_static
-from .acquire_static import streams
 from .common import (
     about,
     add_column_options,
     add_consistency_options,
     add_log_options,
     add_robot_options,
+    add_subcommand,
     column_map,
     load_prior,
     load_robot,
@@ -96,21 +94,21 @@ from .common import (
     warn,
 )
 
-NAME = "identify"
+if TYPE_CHECKING:  # pragma: no cover
+    from ..pipeline.stages import IdentificationStageResult
 
-#: Relative noise of the simulated controller in :func:`demo_stage`.
-DEMO_RELATIVE_NOISE = 1e-4
+NAME = "identify"
 
 _log = logging.getLogger(__name__)
 
 
 def register(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParser:
     """Add the ``identify`` subcommand."""
-    p = subparsers.add_parser(
+    p = add_subcommand(
+        subparsers,
         NAME,
+        __doc__,
         help="identify the base parameters from static data (or a torque log)",
-        description=__doc__,
-        formatter_class=argparse.RawDescriptionHelpFormatter,
     )
     add_robot_options(p)
     p.add_argument("--data", type=Path, required=True, help="data file: .csv or .npz")
@@ -393,35 +391,11 @@ def format_summary(model: IdentifiedModel, *, width: int = 60) -> str:
     return "\n".join(head + rows)
 
 
-def demo_stage(out_dir: Path, seed: int) -> dict[str, Any]:
-    """Static identification of the simulated Panda, for ``dynid demo``.
-
-    Acquires 1010 configurations from the simulated controller with relative noise
-    :data:`DEMO_RELATIVE_NOISE`, identifies, writes ``out_dir/static.csv`` and
-    ``out_dir/identification.json``, prints the summary and returns the key numbers:
-    ``rank``, ``condition_number``, ``relative_error_percent``, ``n_configurations``,
-    ``dropped_rows``, ``max_abs_error`` (largest |beta - beta_true|, SI) and
-    ``max_error_in_std`` (largest |beta - beta_true| / std), plus the two paths.
-    """
+def save_demo_stage(out_dir: Path, res: IdentificationStageResult) -> list[Path]:
+    """Write the demo's identification stage: ``out_dir/static.csv`` (the data) and
+    ``out_dir/identification.json`` (the model, with the seed); returns the two paths."""
     out_dir = Path(out_dir)
-    robot = panda()
-    rng_q, rng_noise = streams(seed)
-    controller = SimulatedController(robot, DEMO_RELATIVE_NOISE, rng=rng_noise)
-    data = acquire_static(controller, 1010, rng_q).with_metadata(seed=seed)
-    data_path = save_static_data(out_dir / "static.csv", data)
-    model = identify_static(robot, data)
-    model_path = save_model_json(out_dir / "identification.json", model, seed=seed)
-    print(format_summary(model))
-    err = np.abs(model.beta - model.base.beta_from_phi(robot.phi))
-    return {
-        "n_configurations": data.n_configurations,
-        "rank": model.fit.rank,
-        "condition_number": model.fit.condition_number,
-        "relative_error_percent": model.fit.relative_error_percent,
-        "dropped_rows": list(model.metadata["dropped_rows"]),
-        "max_abs_error": float(err.max()),
-        "max_error_in_std": float(np.max(err / model.fit.std)),
-        "relative_noise": DEMO_RELATIVE_NOISE,
-        "data": str(data_path),
-        "model": str(model_path),
-    }
+    return [
+        save_static_data(out_dir / "static.csv", res.data),
+        save_model_json(out_dir / "identification.json", res.model, seed=res.seed),
+    ]

@@ -47,11 +47,9 @@ example:
 from __future__ import annotations
 
 import argparse
-import os
 import sys
-import time
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
@@ -65,7 +63,7 @@ from ..feasibility.retrieve import (
     retrieve_from_static,
 )
 from ..feasibility.sdp import ConsistentResult
-from ..feasibility.validate import NewtonEulerValidation, validate_newton_euler
+from ..feasibility.validate import NewtonEulerValidation
 from ..friction.model import ClassicalFriction
 from ..identification.model import IdentifiedModel
 from ..io._json import save_json
@@ -76,6 +74,7 @@ from .common import (
     add_consistency_options,
     add_robot_options,
     add_seed_option,
+    add_subcommand,
     count_type,
     load_prior,
     load_robot,
@@ -84,19 +83,19 @@ from .common import (
     sdp_options,
 )
 
-NAME = "retrieve"
+if TYPE_CHECKING:  # pragma: no cover
+    from ..pipeline.stages import FeasibleStageResult
 
-#: Processes used by :func:`demo_stage` at most.
-DEMO_WORKERS = 2
+NAME = "retrieve"
 
 
 def register(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParser:
     """Add the ``retrieve`` subcommand."""
-    p = subparsers.add_parser(
+    p = add_subcommand(
+        subparsers,
         NAME,
+        __doc__,
         help="retrieve feasible link parameters from identified coefficients",
-        description=__doc__,
-        formatter_class=argparse.RawDescriptionHelpFormatter,
     )
     src = p.add_mutually_exclusive_group(required=True)
     src.add_argument("--model", type=Path, help="identification.json of an identified model")
@@ -401,127 +400,36 @@ def run_sdp(args: argparse.Namespace) -> int:
 
 
 # ------------------------------------------------------------------------------ demo
-def _validation_log(robot: Robot, seed: int) -> Any:
-    """A 10 s random Fourier trajectory at 1 kHz, simulated with sensor noise on ``robot``."""
-    from ..kinematics.trajectories import random_fourier
-    from ..simulation.measurement import SensorNoise, sample_times, simulate_measurement
-
-    rng = np.random.default_rng(np.random.SeedSequence([seed, 5]))
-    series = random_fourier(robot, rng, n_harmonics=5)
-    traj = series(sample_times(10.0, 1000.0))
-    return simulate_measurement(robot, traj, rng=rng, noise=SensorNoise())
-
-
-def demo_stage(
-    out_dir: Path,
-    model: IdentifiedModel,
-    validation_log: Any = None,
-    friction: Any = None,
-    seed: int = 0,
-    *,
-    truth: Robot | None = None,
-) -> dict[str, Any]:
-    """Feasible-parameter retrieval and its Newton-Euler validation, for ``dynid demo``.
-
-    1. Retrieve feasible parameters from the static ``model`` with the default options
-       and bounds (on ``min(2, cores)`` workers, seeded).
-    2. Write ``feasible.json``, ``robot.urdf``, ``robot.toml``, ``report.json`` and
-       ``retrieval.png`` under ``out_dir``.
-    3. Newton-Euler validation: RNEA with the feasible parameters plus ``friction``
-       against the measured torques of ``validation_log`` (a trajectory the friction was
-       not fitted on), and the identified model's torques for comparison; figure
-       ``feasible_validation.png``, ``feasible_validation.json``.
-    4. Print a short table and return the numbers.
-
-    Parameters
-    ----------
-    out_dir : Path
-    model : IdentifiedModel
-        Identified static coefficients (e.g. from ``cli.identify.demo_stage``).
-    validation_log : TorqueLog, optional
-        Measured validation trajectory, used as it is when it has ``ddq``, else prepared
-        with :func:`dynid.identification.log.prepare_log` (zero-phase filtered states,
-        ``ddq`` differentiated, torques kept unfiltered). Default: a 10 s random Fourier
-        trajectory simulated on ``truth`` with sensor noise.
-    friction : SigmoidFriction, ClassicalFriction, array_like (n, 3) or None
-        Friction added to the Newton-Euler torques (e.g. the fitted sigmoid of the
-        friction stage); None: none.
-    seed : int
-    truth : Robot, optional
-        Robot that plays the real one for the default validation log (default
-        ``model.robot``; it must have link parameters).
-
-    Returns
-    -------
-    dict
-        ``feasible``, ``relative_residual``, ``min_margin`` (per constraint name),
-        ``run_time_s``, ``workers``, ``stage_costs``, ``total_mass``, ``rms_newton_euler``
-        and ``rms_identified`` (per joint [N m]), ``relative_error_percent_newton_euler`` /
-        ``_identified``, ``max_torque_difference`` (largest |NE - identified| over the
-        validation samples, friction excluded [N m]), ``files``.
-    """
-    from ..identification.log import prepare_log
-
-    out_dir = Path(out_dir)
-    workers = max(1, min(DEMO_WORKERS, os.cpu_count() or 1))
-    t0 = time.perf_counter()
-    result = retrieve(model, seed=seed, workers=workers, progress=progress_printer(sys.stdout))
-    files = write_outputs(out_dir, result, seed=seed)
-    if validation_log is None:
-        truth = model.robot if truth is None else truth
-        if not np.any(truth.phi):
-            raise DynidError(
-                "no validation log given and the model's robot has no link parameters to "
-                "simulate with; pass truth="
-            )
-        validation_log = _validation_log(truth, seed)
-    log = (
-        validation_log
-        if validation_log.ddq is not None
-        else prepare_log(validation_log, filter_tau=False)
-    )
-    val = validate_newton_euler(
-        result.robot, log.t, log.q, log.dq, log.ddq, log.tau, friction=friction, reference=model
-    )
+def save_demo_stage(out_dir: Path, res: FeasibleStageResult) -> list[Path]:
+    """Write the demo's feasible stage under ``out_dir``: the files of :func:`write_outputs`
+    (with the seed), ``feasible_validation.json`` and ``feasible_validation.png``."""
     from ..plots.feasible import plot_newton_euler_validation
 
-    doc = val.as_dict() | {"seed": seed}
+    out_dir = Path(out_dir)
+    files = write_outputs(out_dir, res.retrieval, seed=res.seed)
+    doc = res.validation.as_dict() | {"seed": res.seed}
     files.append(save_json(out_dir / "feasible_validation.json", doc))
     fig = save_figure(
         lambda: plot_newton_euler_validation(
-            val,
+            res.validation,
             title="Newton-Euler with the retrieved feasible parameters (validation trajectory)",
         ),
         out_dir / "feasible_validation.png",
     )
-    files += [fig] if fig is not None else []
-    diff = float(np.max(np.abs(val.tau_rigid - model.torques(log.q, log.dq, log.ddq))))
-    print(format_summary(result))
-    print(_rms_table(val))
-    print(f"max |NE(feasible) - identified model| on the validation states: {diff:.3g} N m")
-    print(
-        f"retrieval stage: {time.perf_counter() - t0:.1f} s; wrote {len(files)} files in {out_dir}"
+    return files + ([fig] if fig is not None else [])
+
+
+def format_demo_stage(res: FeasibleStageResult) -> str:
+    """The demo's feasible stage: the retrieval summary, the Newton-Euler RMS table and the
+    largest difference to the identified model."""
+    return "\n".join(
+        [
+            format_summary(res.retrieval),
+            _rms_table(res.validation),
+            "max |NE(feasible) - identified model| on the validation states: "
+            f"{res.max_torque_difference:.3g} N m",
+        ]
     )
-    rep = result.report
-    return {
-        "feasible": bool(result.feasible),
-        "relative_residual": float(result.relative_residual),
-        "min_margin": {n: rep.min_margin(n) for n in rep.names},
-        "run_time_s": float(result.run_time),
-        "workers": int(result.workers),
-        "stage_costs": result.stage_costs.tolist(),
-        "total_mass": float(np.sum(result.mass)),
-        "rms_newton_euler": val.errors.rms.tolist(),
-        "rms_identified": None
-        if val.errors_reference is None
-        else val.errors_reference.rms.tolist(),
-        "relative_error_percent_newton_euler": float(val.errors.relative_error_percent),
-        "relative_error_percent_identified": None
-        if val.errors_reference is None
-        else float(val.errors_reference.relative_error_percent),
-        "max_torque_difference": diff,
-        "files": [str(f) for f in files],
-    }
 
 
 def _rms_table(val: NewtonEulerValidation) -> str:
