@@ -17,6 +17,8 @@ def test_demo_runs_every_stage_and_writes_the_report(tmp_path, capsys):
     text = capsys.readouterr().out
     for stage in ("stage 1", "stage 2", "stage 3", "stage 4", "stage 5"):
         assert stage in text
+    for line in ("IK converged", "rank 43", "RMS + friction", "RMS NE", "truth: the published"):
+        assert line in text, line
     for rel in (
         "ik_joint_motion.png",
         "identification/identification.json",

@@ -48,3 +48,50 @@ def test_friction_stage_refuses_a_truth_without_link_parameters():
     """A model read back from a file cannot play the real robot: the stage asks for truth=."""
     with pytest.raises(dynid.DynidError, match="pass truth="):
         friction_stage(kinematics_only(_model(dynid.panda())), seed=0)
+
+
+def test_run_demo_chains_the_stages_and_reports_progress(monkeypatch):
+    """run_demo runs stages 1-5 in order, hands stages 3 and 4 the kinematics-only model and
+    the fitted friction, and brackets every stage with started/finished events."""
+    import dynid.pipeline.demo as demo
+    from dynid.pipeline import StageFinished, StageStarted, run_demo
+
+    robot = dynid.panda()
+    model = _model(robot)
+    calls = []
+
+    class Fit:
+        friction = "fitted friction"
+
+    def stage(name, result):
+        def run(*args, **kw):
+            calls.append((name, args, kw))
+            return result
+
+        return run
+
+    ident = type("Ident", (), {"model": model})()
+    fric = type("Fric", (), {"fit": Fit()})()
+    monkeypatch.setattr(demo, "kinematics_stage", stage("kinematics", "k"))
+    monkeypatch.setattr(demo, "identification_stage", stage("identification", ident))
+    monkeypatch.setattr(demo, "friction_stage", stage("friction", fric))
+    monkeypatch.setattr(demo, "feasible_stage", stage("feasible", "f"))
+    monkeypatch.setattr(demo, "consistent_stage", stage("consistent", "c"))
+    events = []
+    res = run_demo(robot, 7, progress=events.append)
+    assert [c[0] for c in calls] == [
+        "kinematics",
+        "identification",
+        "friction",
+        "feasible",
+        "consistent",
+    ]
+    assert [(type(e), e.number) for e in events] == [
+        (t, k) for k in range(1, 6) for t in (StageStarted, StageFinished)
+    ]
+    np.testing.assert_array_equal(calls[0][1][1], robot.q_neutral)
+    handed = calls[2][1][0]
+    assert not np.any(handed.robot.phi) and calls[2][2]["truth"] is robot
+    assert calls[3][1][0] is handed and calls[3][2]["truth"] is robot
+    assert calls[3][2]["friction"] == "fitted friction" and calls[3][2]["seed"] == 7
+    assert (res.kinematics, res.feasible, res.consistent, res.seed) == ("k", "f", "c", 7)

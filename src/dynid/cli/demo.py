@@ -44,8 +44,8 @@ from ..feasibility.retrieve import RetrievalProgress
 from ..io._files import write_text
 from ..io._json import save_json
 from ..model.panda import panda
+from ..model.robot import Robot
 from ..pipeline import (
-    DEMO_TOOL_XYZ,
     ConsistentSetup,
     ConsistentStageResult,
     DemoResult,
@@ -66,7 +66,7 @@ NAME = "demo"
 
 
 # ---------------------------------------------------------------------- stage 1
-def format_kinematics(robot: Any, res: KinematicsStageResult) -> str:
+def format_kinematics(robot: Robot, res: KinematicsStageResult) -> str:
     """The printed lines of stage 1: pose, flange pose, Jacobian, IK goal and solution."""
     ik = res.ik
     status = "converged" if ik.converged else "did NOT converge"
@@ -77,7 +77,7 @@ def format_kinematics(robot: Any, res: KinematicsStageResult) -> str:
             f"  roll, pitch, yaw [rad]: {format_matrix(res.rpy)}",
             "flange Jacobian, base frame (rows vx vy vz [m/rad], wx wy wz [rad/rad]):",
             format_matrix(res.J),
-            f"IK goal for a tool at {DEMO_TOOL_XYZ} m in the flange, T_base_tool [m]:",
+            f"IK goal for a tool at {res.tool_xyz} m in the flange, T_base_tool [m]:",
             format_matrix(res.T_base_tool_goal),
             f"IK {status} in {ik.iterations} steps of {res.options.dt} s ({ik.restarts} "
             f"restarts): position error {ik.position_error:.2e} m, "
@@ -87,7 +87,7 @@ def format_kinematics(robot: Any, res: KinematicsStageResult) -> str:
     )
 
 
-def save_kinematics(out: Path, robot: Any, res: KinematicsStageResult) -> list[Path]:
+def save_kinematics(out: Path, robot: Robot, res: KinematicsStageResult) -> list[Path]:
     """``out/ik_joint_motion.png``: the simulated joint motion of the IK solve."""
     from ..plots.kinematics import plot_ik_path
 
@@ -281,7 +281,7 @@ class _Renderer:
     """The ``progress`` callback of :func:`~dynid.pipeline.run_demo`: prints each stage and
     writes its files as soon as it finishes."""
 
-    def __init__(self, out: Path, robot: Any) -> None:
+    def __init__(self, out: Path, robot: Robot) -> None:
         from .retrieve import progress_printer
 
         self.out, self.robot = out, robot

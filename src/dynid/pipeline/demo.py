@@ -7,6 +7,7 @@ before each stage, the stage's own events, and a :class:`StageFinished` with its
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass
 from typing import Any
 
@@ -90,7 +91,7 @@ def run_demo(
     q0 = 0.5 * (robot.q_min + robot.q_max) if robot.q_neutral is None else robot.q_neutral
     rng = np.random.default_rng(seed)
 
-    def stage(number: int, compute: Any) -> Any:
+    def stage(number: int, compute: Callable[[], Any]) -> Any:
         say(StageStarted(number, STAGE_TITLES[number]))
         result = compute()
         say(StageFinished(number, result))

@@ -27,7 +27,7 @@ from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
-from numpy.typing import NDArray
+from numpy.typing import ArrayLike, NDArray
 
 from ..exceptions import DynidError
 from ..feasibility.compare import MethodSummary, compare_methods, perturbed_robot
@@ -123,6 +123,8 @@ class KinematicsStageResult:
         Its roll, pitch, yaw [rad].
     J : ndarray, shape (6, n)
         Flange Jacobian at ``q``, base frame, rows ``[v; w]``.
+    tool_xyz : tuple of float
+        The tool's offset in the flange [m].
     T_flange_tool : ndarray, shape (4, 4)
         The tool [m].
     q_goal : ndarray, shape (n,)
@@ -137,6 +139,7 @@ class KinematicsStageResult:
     T_base_flange: FloatArray
     rpy: FloatArray
     J: FloatArray
+    tool_xyz: tuple[float, ...]
     T_flange_tool: FloatArray
     q_goal: FloatArray
     T_base_tool_goal: FloatArray
@@ -145,7 +148,7 @@ class KinematicsStageResult:
 
 
 def kinematics_stage(
-    robot: Robot, q: Any, rng: np.random.Generator, *, tool_xyz: Any = DEMO_TOOL_XYZ
+    robot: Robot, q: ArrayLike, rng: np.random.Generator, *, tool_xyz: ArrayLike = DEMO_TOOL_XYZ
 ) -> KinematicsStageResult:
     """Flange pose and Jacobian at ``q``; IK for a tool at ``tool_xyz`` [m] in the flange, to
     the tool pose at a configuration drawn from ``rng`` within 0.5 rad of ``q``.
@@ -156,13 +159,14 @@ def kinematics_stage(
     q = np.array(q, dtype=np.float64)
     T = fk(robot, q)
     J = jacobian(robot, q)
-    T_flange_tool = transform_from_xyz_rpy(tool_xyz)
+    xyz = tuple(float(x) for x in np.asarray(tool_xyz, dtype=np.float64).reshape(3))
+    T_flange_tool = transform_from_xyz_rpy(xyz)
     q_goal = np.clip(q + rng.uniform(-0.5, 0.5, robot.n), robot.q_min + 0.1, robot.q_max - 0.1)
     T_goal = fk(robot, q_goal, tool=T_flange_tool)
     options = IKOptions(dt=0.01, gain=20.0)
     res = ik(robot, T_goal, q, tool=T_flange_tool, options=options, rng=rng)
     return KinematicsStageResult(
-        q, T, rpy_from_matrix(T[:3, :3]), J, T_flange_tool, q_goal, T_goal, options, res
+        q, T, rpy_from_matrix(T[:3, :3]), J, xyz, T_flange_tool, q_goal, T_goal, options, res
     )
 
 
