@@ -5,18 +5,16 @@
 files: the command line renders the results and saves them.
 """
 
+from .consistent import ConsistentSetup, ConsistentStageResult, consistent_stage
 from .demo import STAGE_TITLES, DemoResult, StageFinished, StageStarted, run_demo
 from .stages import (
     DEMO_RELATIVE_NOISE,
     DEMO_TOOL_XYZ,
     DEMO_WORKERS,
-    ConsistentSetup,
-    ConsistentStageResult,
     FeasibleStageResult,
     FrictionStageResult,
     IdentificationStageResult,
     KinematicsStageResult,
-    consistent_stage,
     feasible_stage,
     friction_stage,
     identification_stage,

@@ -15,14 +15,13 @@ import numpy as np
 
 from ..model.panda import panda
 from ..model.robot import Robot
+from .consistent import ConsistentStageResult, consistent_stage
 from .stages import (
-    ConsistentStageResult,
     FeasibleStageResult,
     FrictionStageResult,
     IdentificationStageResult,
     KinematicsStageResult,
     Progress,
-    consistent_stage,
     feasible_stage,
     friction_stage,
     identification_stage,

@@ -14,14 +14,13 @@ Stages (Gaz et al., IEEE RA-L 4(4), 2019):
    (eq. 25), validation with friction (Sec. IV-B, VI).
 4. :func:`feasible_stage`: feasible link parameters (Algorithm 1, Sec. V) and their
    Newton-Euler validation.
-5. :func:`consistent_stage`: beyond the paper, the convex (LMI) retrieval against the
-   penalty method on a robot with model error.
+5. :func:`~dynid.pipeline.consistent.consistent_stage`: beyond the paper, the convex
+   (LMI) retrieval against the penalty method on a robot with model error.
 """
 
 from __future__ import annotations
 
 import os
-import warnings
 from collections.abc import Callable
 from dataclasses import dataclass
 from typing import Any
@@ -30,7 +29,6 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from ..exceptions import DynidError
-from ..feasibility.compare import MethodSummary, compare_methods, perturbed_robot
 from ..feasibility.retrieve import RetrievalResult, retrieve
 from ..feasibility.validate import NewtonEulerValidation, validate_newton_euler
 from ..friction.fit import FrictionFit, FrictionResidual, fit_sigmoid, friction_residual
@@ -54,20 +52,16 @@ from ..kinematics.trajectories import (
 from ..model.robot import Robot
 from ..simulation.controller import SimulatedController, acquire_static
 from ..simulation.measurement import SensorNoise, sample_times, simulate_measurement
-from ..simulation.unmodelled import UnmodelledEffects
 from ..spatial import rpy_from_matrix, transform_from_xyz_rpy
 
 __all__ = [
     "DEMO_RELATIVE_NOISE",
     "DEMO_TOOL_XYZ",
     "DEMO_WORKERS",
-    "ConsistentSetup",
-    "ConsistentStageResult",
     "FeasibleStageResult",
     "FrictionStageResult",
     "IdentificationStageResult",
     "KinematicsStageResult",
-    "consistent_stage",
     "feasible_stage",
     "friction_stage",
     "identification_stage",
@@ -85,8 +79,8 @@ DEMO_WORKERS = 2
 #: Static configurations acquired in stages 2 and 5.
 DEMO_CONFIGURATIONS = 1010
 
-#: A progress callback: receives :class:`RetrievalProgress` (one per finished run of the
-#: penalty method) and :class:`ConsistentSetup` (stage 5, before its retrievals).
+#: A progress callback: receives a :class:`~dynid.feasibility.retrieve.RetrievalProgress`
+#: per finished run of the penalty method, and the events of the stage that runs.
 Progress = Callable[[Any], None]
 
 FloatArray = NDArray[np.float64]
@@ -461,79 +455,3 @@ def feasible_stage(
     )
     diff = float(np.max(np.abs(val.tau_rigid - model.torques(log.q, log.dq, log.ddq))))
     return FeasibleStageResult(result, val, diff, seed)
-
-
-# ----------------------------------------------------------------------------- stage 5
-@dataclass(frozen=True, slots=True, eq=False)
-class ConsistentSetup:
-    """Stage 5's simulated truth, sent to ``progress`` before the retrievals start.
-
-    Attributes
-    ----------
-    truth : Robot
-        The published robot with every parameter scaled by up to +-20 %.
-    effects : UnmodelledEffects
-        Rotor inertia and gravity tilt that no rigid body reproduces.
-    """
-
-    truth: Robot
-    effects: UnmodelledEffects
-
-
-@dataclass(frozen=True, slots=True, eq=False)
-class ConsistentStageResult:
-    """Stage 5: convex (LMI) retrieval against the penalty method on data with model error.
-
-    Attributes
-    ----------
-    truth : Robot
-    effects : UnmodelledEffects
-    model : IdentifiedModel
-        Coefficients identified from the truth's static data.
-    rows : tuple of MethodSummary
-        ``sdp``, ``penalty``, ``penalty + prior``, in that order.
-    prior_mass_error_truth : float
-        Median over links 2..n of the prior's relative mass error against the truth.
-    seed : int
-    """
-
-    truth: Robot
-    effects: UnmodelledEffects
-    model: IdentifiedModel
-    rows: tuple[MethodSummary, ...]
-    prior_mass_error_truth: float
-    seed: int
-
-    @property
-    def notes(self) -> list[str]:
-        """Notes of the convex method."""
-        return list(self.rows[0].result.notes)
-
-
-def consistent_stage(
-    robot: Robot,
-    seed: int,
-    *,
-    workers: int = DEMO_WORKERS,
-    progress: Progress | None = None,
-) -> ConsistentStageResult:
-    """Convex retrieval against the penalty method (without and with a prior) on a robot
-    that differs from ``robot`` (the prior) by up to 20 % per parameter, with rotor inertia
-    and a gravity tilt; 1010 static configurations with 1e-4 relative noise.
-
-    ``progress`` receives a :class:`ConsistentSetup` once the truth is drawn, then a
-    :class:`~dynid.feasibility.retrieve.RetrievalProgress` per finished penalty run.
-    """
-    rng = np.random.default_rng(np.random.SeedSequence([seed, 55]))
-    truth = perturbed_robot(robot, rng)
-    effects = UnmodelledEffects.typical(robot.n, rng)
-    if progress is not None:
-        progress(ConsistentSetup(truth, effects))
-    ctrl = SimulatedController(truth, relative_noise=1e-4, rng=rng, effects=effects)
-    data = acquire_static(ctrl, DEMO_CONFIGURATIONS, rng)
-    with warnings.catch_warnings():  # the tilt puts data in the uninformative g1 row: expected
-        warnings.simplefilter("ignore")
-        model = identify_static(robot, data)
-    rows = compare_methods(model, robot, truth=truth, workers=workers, seed=seed, progress=progress)
-    prior_err = float(np.median(np.abs(robot.mass - truth.mass)[1:] / truth.mass[1:]))
-    return ConsistentStageResult(truth, effects, model, tuple(rows), prior_err, seed)
