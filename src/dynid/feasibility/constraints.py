@@ -217,12 +217,12 @@ class Bounds:
         if np.any(self.mass_min < 0):
             raise OptionError(f"mass_min must be >= 0; got {self.mass_min.tolist()}")
         if self.total_mass is not None:
-            lo, hi = (float(x) for x in self.total_mass)
-            if not (math.isfinite(lo) and math.isfinite(hi)) or lo < 0 or lo > hi:
+            m_lo, m_hi = (float(x) for x in self.total_mass)
+            if not (math.isfinite(m_lo) and math.isfinite(m_hi)) or m_lo < 0 or m_lo > m_hi:
                 raise OptionError(
                     f"total_mass must be (min, max) with 0 <= min <= max; got {self.total_mass}"
                 )
-            put("total_mass", (lo, hi))
+            put("total_mass", (m_lo, m_hi))
         if self.link_names is not None:
             names = tuple(str(x) for x in self.link_names)
             if len(names) != n:
@@ -611,7 +611,7 @@ class FeasibilityReport:
 def principal_moments(inertia: ArrayLike) -> NDArray[np.float64]:
     """Principal moments [kg m^2], ascending, of inertia tensors (..., 3, 3) -> (..., 3)."""
     I = _checks.as_batch("inertia", inertia, (3, 3))
-    return np.linalg.eigvalsh(0.5 * (I + np.swapaxes(I, -1, -2)))
+    return np.asarray(np.linalg.eigvalsh(0.5 * (I + np.swapaxes(I, -1, -2))), dtype=np.float64)
 
 
 def feasibility_report(

@@ -495,8 +495,9 @@ def _run_all(
     runs: list[RetrievalRun | None] = [None] * options.runs
     if workers <= 1 or options.runs == 1:
         for i, s in enumerate(seqs):
-            runs[i] = _one_run(problem, s, options, i)
-            on_done(runs[i])
+            run = _one_run(problem, s, options, i)
+            runs[i] = run
+            on_done(run)
     else:
         with process_pool(workers) as ex:
             futs = {ex.submit(_one_run, problem, s, options, i): i for i, s in enumerate(seqs)}

@@ -33,7 +33,7 @@ from dataclasses import dataclass
 import numpy as np
 import scipy.linalg
 import scipy.special
-from numpy.typing import NDArray
+from numpy.typing import ArrayLike, NDArray
 
 from .. import _checks
 from ..dynamics.rnea import rnea
@@ -150,6 +150,7 @@ def friction_residual(
     p = prepare_log(
         log, cutoff_hz=cutoff_hz, trim_s=trim_s, filter_tau=filter_tau, max_gap_s=max_gap_s
     )
+    assert p.ddq is not None  # prepare_log always fills ddq
     tau_m = rigid_body_torques(model, p.q, p.dq, p.ddq)
     return FrictionResidual(log=p, tau_model=tau_m, residual=p.tau - tau_m)
 
@@ -291,7 +292,7 @@ def fit_classical(dq: NDArray[np.float64], residual: NDArray[np.float64]) -> Fri
     return _result(fr, dq, residual, np.ones(n, bool), np.zeros(n, int))
 
 
-def _pair(dq: object, residual: object) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+def _pair(dq: ArrayLike, residual: ArrayLike) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
     a = _checks.as_array("dq", dq)
     b = _checks.as_array("residual", residual)
     if a.ndim != 2 or a.shape != b.shape or a.shape[0] < 4:

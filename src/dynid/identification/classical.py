@@ -159,6 +159,7 @@ def identify_from_log(
     if k < 1:
         raise ShapeError(f"decimate must be >= 1; got {decimate}")
     sl = slice(None, None, k)
+    assert prepared.ddq is not None  # prepare_log always fills ddq
     q, dq, ddq, tau = prepared.q[sl], prepared.dq[sl], prepared.ddq[sl], prepared.tau[sl]
     bp = base_parameters(robot, kind="torque", rtol=rtol) if base is None else base
     N = q.shape[0]

@@ -145,10 +145,10 @@ class TorqueLog:
             raise ShapeError(f"q must have shape ({t.shape[0]}, n) like t; got {q.shape}")
         object.__setattr__(self, "t", _checks.frozen(t))
         object.__setattr__(self, "q", _checks.frozen(q))
-        for k in ("dq", "tau", "ddq"):
-            v = getattr(self, k)
+        for attr in ("dq", "tau", "ddq"):
+            v = getattr(self, attr)
             if v is not None:
-                object.__setattr__(self, k, _checks.frozen(_checks.as_exact(k, v, q.shape)))
+                object.__setattr__(self, attr, _checks.frozen(_checks.as_exact(attr, v, q.shape)))
 
     @property
     def n(self) -> int:
@@ -241,10 +241,10 @@ class TorqueLog:
         dt = np.diff(tt)
         back = np.flatnonzero(dt < 0)
         if back.size:
-            k = int(back[0])
+            i = int(back[0])
             raise DataError(
-                f"timestamps run backwards at row {int(rows[k + 1])}: "
-                f"t = {float(tt[k + 1])!r} after t = {float(tt[k])!r}; the log is out of order "
+                f"timestamps run backwards at row {int(rows[i + 1])}: "
+                f"t = {float(tt[i + 1])!r} after t = {float(tt[i])!r}; the log is out of order "
                 "and cannot be repaired safely"
             )
         keep = np.concatenate([[True], dt > 0])

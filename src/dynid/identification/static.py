@@ -316,7 +316,7 @@ def basis_transform(
     if A.ndim != 2 or A.shape[1] != p:
         raise ShapeError(f"A must have shape (k, {p}); got {A.shape}")
     P = base.projection
-    T = np.linalg.lstsq(P.T, A.T, rcond=None)[0].T
+    T = np.asarray(np.linalg.lstsq(P.T, A.T, rcond=None)[0].T, dtype=np.float64)
     res = np.linalg.norm(T @ P - A, axis=1)
     scale = np.linalg.norm(A, axis=1)
     bad = np.flatnonzero(res > rtol * np.maximum(scale, np.finfo(float).tiny))

@@ -61,8 +61,11 @@ def write_friction_json(
     from .. import __version__
 
     path = Path(path)
-    fit = friction if isinstance(friction, FrictionFit) else None
-    model = fit.friction if fit is not None else friction
+    fit: FrictionFit | None
+    if isinstance(friction, FrictionFit):
+        fit, model = friction, friction.friction
+    else:
+        fit, model = None, friction
     P = model.as_array()
     joints = []
     for j in range(model.n):

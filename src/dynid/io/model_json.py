@@ -34,7 +34,7 @@ from __future__ import annotations
 import math
 from collections.abc import Mapping
 from pathlib import Path
-from typing import Any
+from typing import Any, SupportsFloat
 
 import numpy as np
 from numpy.typing import NDArray
@@ -63,7 +63,7 @@ _FIT_SCALARS = (
 )
 
 
-def _num(x: float) -> float | None:
+def _num(x: SupportsFloat) -> float | None:
     """A JSON number, or None for NaN/inf (JSON has neither)."""
     x = float(x)
     return x if math.isfinite(x) else None

@@ -266,8 +266,9 @@ def _assemble(
     cache: dict[tuple[str, ...], list[int] | None] = {}
     for k, (_, m) in enumerate(msgs):
         key = tuple(m.name)
-        idx = cache.get(key, -1)  # type: ignore[arg-type]
-        if idx == -1:
+        if key in cache:
+            idx = cache[key]
+        else:
             pos = {s: i for i, s in enumerate(key)}
             idx = [pos[s] for s in mapping] if all(s in pos for s in mapping) else None
             cache[key] = idx

@@ -101,9 +101,9 @@ class Trajectory:
         shape = q.shape
         object.__setattr__(self, "t", _checks.frozen(t))
         object.__setattr__(self, "q", _checks.frozen(q))
-        for k in ("dq", "ddq"):
+        for attr in ("dq", "ddq"):
             object.__setattr__(
-                self, k, _checks.frozen(_checks.as_exact(k, getattr(self, k), shape))
+                self, attr, _checks.frozen(_checks.as_exact(attr, getattr(self, attr), shape))
             )
 
     @property

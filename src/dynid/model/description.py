@@ -323,7 +323,7 @@ def robot_from_toml_string(text: str, *, source: str = "TOML text") -> Robot:
             tau_max=lim["effort"],
             gravity=gravity,
             frames=frames,
-            friction=np.stack(friction) if all(given) else None,
+            friction=np.stack([f for f in friction if f is not None]) if all(given) else None,
             q_neutral=q_neutral,
         )
     except DynidError as exc:

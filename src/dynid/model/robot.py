@@ -382,6 +382,13 @@ class Robot:
             np.zeros((n, 3, 3)) if inertia is None else inertia,
         )
         inf = np.full(n, np.inf)
+
+        def limit(
+            name: str, x: ArrayLike | None, default: NDArray[np.float64]
+        ) -> NDArray[np.float64]:
+            # the same conversion __post_init__ does; it checks the shape and NaN after
+            return default if x is None else _checks.as_array(name, x, allow_nonfinite=True)
+
         return cls(
             name=name,
             joint_names=tuple(joint_names or [f"joint{i}" for i in range(1, n + 1)]),
@@ -390,11 +397,11 @@ class Robot:
             axes=np.tile([0.0, 0.0, 1.0], (n, 1)),
             prismatic=pri,
             phi=phi,
-            q_min=-inf if q_min is None else q_min,
-            q_max=inf if q_max is None else q_max,
-            dq_max=inf if dq_max is None else dq_max,
-            ddq_max=inf if ddq_max is None else ddq_max,
-            tau_max=inf if tau_max is None else tau_max,
+            q_min=limit("q_min", q_min, -inf),
+            q_max=limit("q_max", q_max, inf),
+            dq_max=limit("dq_max", dq_max, inf),
+            ddq_max=limit("ddq_max", ddq_max, inf),
+            tau_max=limit("tau_max", tau_max, inf),
             gravity=np.asarray(gravity, dtype=np.float64),
             frames=frames,
             friction=None if friction is None else np.asarray(friction, dtype=np.float64),

@@ -21,6 +21,7 @@ from ..feasibility.retrieve import RetrievalResult
 from ..feasibility.validate import NewtonEulerValidation
 
 if TYPE_CHECKING:  # pragma: no cover
+    from matplotlib.axes import Axes
     from matplotlib.figure import Figure
 
 __all__ = ["plot_consistent", "plot_newton_euler_validation", "plot_retrieval"]
@@ -71,7 +72,7 @@ def plot_newton_euler_validation(
         fig = plt.figure(figsize=(5.0 * ncols, 2.1 * nrows + 0.6))
     else:
         fig.clear()
-    axes = fig.subplots(nrows, ncols, sharex=True, squeeze=False).ravel()
+    axes: list[Axes] = list(fig.subplots(nrows, ncols, sharex=True, squeeze=False).ravel())
     s = _stride(v.t.shape[0], max_points)
     t = v.t[s]
     label_ne = "Newton-Euler, feasible p" + (" + friction" if v.tau_friction is not None else "")

@@ -73,13 +73,14 @@ def plot_ik_path(
         if lim is not None:
             limits.append(_checks.as_exact(label, lim, (n,), allow_nonfinite=True))
 
-    if ax is None:
-        from matplotlib.figure import Figure
+    from matplotlib.figure import Figure
 
+    if ax is None:
         fig = Figure(figsize=(8.0, 4.5), layout="constrained")
         ax = fig.add_subplot()
     else:
-        fig = ax.figure
+        parent = ax.figure  # a Figure, or a SubFigure inside one: return the whole Figure
+        fig = parent if isinstance(parent, Figure) else parent.figure
     x = np.arange(P.shape[0], dtype=float)
     if dt is not None:
         x = x * dt

@@ -132,11 +132,13 @@ def plot_rms_comparison(
     matplotlib.figure.Figure
     """
     import matplotlib.pyplot as plt
+    from matplotlib.figure import Figure
 
     if ax is None:
         fig, ax = plt.subplots(figsize=(8, 3.6))
     else:
-        fig = ax.figure
+        parent = ax.figure  # a Figure, or a SubFigure inside one: lay out the whole Figure
+        fig = parent if isinstance(parent, Figure) else parent.figure
     vals = [np.asarray(v, dtype=float) for v in rms.values()]
     n = vals[0].shape[0]
     names = list(joint_names) if joint_names is not None else [f"{j + 1}" for j in range(n)]
