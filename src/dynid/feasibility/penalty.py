@@ -12,54 +12,24 @@ vector ``b`` precomputed once,
 
 .. math:: f_0(p) = \\| A \\phi(p) - b \\|^2 + f_{off}
 
-* Two-step (:func:`coefficient_problem`, eq. 29):
-  ``A = S^{-1} P_kept``, ``b = S^{-1} \\hat\\pi_kept`` with the base projection ``P``
-  (``beta = P phi``) restricted to the kept coefficients and ``S`` diagonal with
+from the identified coefficients, each divided by its size or standard deviation
+(two-step, :func:`coefficient_problem`, eq. 29), or from the static data compressed by a QR
+factorisation (single-step, :func:`static_problem`).
 
-  .. math:: s_k = \\max(|\\hat\\pi_k|, \\sigma_k, \\epsilon_{u(k)})
-
-  so that every coefficient counts by its relative error whether it is in kg, kg m or
-  kg m^2; ``sigma_k`` is its standard deviation (a coefficient known to 20 % need not be
-  met to 1 %) and the floor ``epsilon_u = scale_floor * max |pi_hat_j|`` over the kept
-  coefficients ``j`` of the same unit ``u`` (stops a coefficient that is zero up to noise
-  from dominating).
-* Single-step (:func:`static_problem`, supplementary material): the static data
-  ``||Y_s phi - s||^2`` directly. Each row type of ``s`` (``M_ij`` in kg m^2, ``g_j`` in
-  N m) is divided by its RMS over the configurations, and the stack is compressed by a
-  QR factorisation of the weighted base regressor, ``W_w = Q R``: ``A = R P``,
-  ``b = Q^T y_w``, ``f_off = ||y_w||^2 - ||Q^T y_w||^2``; the term is finally scaled by
-  ``r / ||y_w||^2`` (r coefficients), so that it is ``r`` at ``phi = 0`` as the two-step
-  term is.
-
-**Constraints** ``h_j(p) >= delta_j``, each divided by a scale ``s_j``:
-
-* per link, the triangle inequality ``tr(I)/2 - lambda_max(I)`` and positive
-  definiteness ``lambda_min(I)`` [kg m^2], scale ``s_I`` = the link's largest bound of a
-  principal moment (:meth:`~dynid.feasibility.constraints.Bounds.inertia_scale`),
-  target margin ``delta = margin * s_I``;
-* the total-mass band, ``M - M_min`` and ``M_max - M`` [kg], scale ``M_max``, target
-  ``margin * M_max``;
-* user constraints, whose violation ``v(p) >= 0`` enters as it is.
-
-The violation distance (eq. 32) is ``g_j = max(0, delta_j - h_j) / s_j`` (``v`` for a
-user constraint). Masses, CoMs and inertia entries are kept inside their box by the
-optimisers themselves: the box is shrunk by ``margin`` times its width so that every
-bound holds with a margin too.
+**Constraints** ``h_j(p) >= delta_j``, each divided by a scale ``s_j``: per link the
+triangle inequality and positive definiteness of the inertia [kg m^2], the total-mass band
+[kg], and user constraints. The violation distance (eq. 32) is
+``g_j = max(0, delta_j - h_j) / s_j``.
 
 **Stage objective** (eq. 29, stage ``k`` with penalty weight ``xi_k``):
 
 .. math:: F_k(p) = f_0(p) + \\xi_k \\sum_j g_j(p)^2
 
-(:meth:`PenaltyProblem.stage_cost`). Departure from the paper, on purpose: Gaz et al.
-add ``xi_k sum_j g_j`` (the distances themselves). The squared distances have the same
-zero set, so the same minimisers wherever the constraints can be met, but make ``F_k``
-differentiable and a sum of squares: the annealing and the local refinement (a
-Levenberg-Marquardt method on the residual vector ``[A phi - b; sqrt(xi_k) g]``,
-:meth:`PenaltyProblem.lsq_residual`, :meth:`PenaltyProblem.lsq_jacobian`) then minimise
-the same function. With the distances, the annealing traded real data fit for
-round-off-sized violations that the refinement then undid. The target margins
-``delta_j`` keep the result strictly feasible although a quadratic penalty leaves
-violations of order ``1 / xi`` of the targets.
+(:meth:`PenaltyProblem.stage_cost`). Departure from the paper, on purpose: Gaz et al. add
+the distances ``g_j`` themselves; their squares have the same minimisers where the
+constraints can be met and make ``F_k`` a differentiable sum of squares, which the
+Levenberg-Marquardt refinement minimises too. The scalings, the target margins and the
+reasons are in ``docs/feasible-retrieval-penalty.md``.
 """
 
 from __future__ import annotations

@@ -20,50 +20,12 @@ Statistics:
   rows' errors differ in size: the static data stack kg m^2 and N m, and a relative error
   scales with each entry.
 
-Method. ``D`` holds the column norms of ``W`` and ``R`` is the triangular factor of the
-column-scaled ``W D^{-1}``; every route below gives ``R^T R = D^{-1} W^T W D^{-1}`` (up to
-rounding), so the estimates and their covariance ``D^{-1} (R^T R)^{-1} D^{-1}`` are the
-same whichever is taken.
-
-* Corrected semi-normal equations (CSNE; Björck, "Stability analysis of the method of
-  seminormal equations for linear least squares problems", Linear Algebra Appl. 88/89,
-  1987, pp. 31-48), for a tall ``W`` (more than four rows per column) whose scaled
-  condition number is at most 100 (and below ``0.1 / rtol``):
-
-  1. the Gram matrix ``W^T W`` (symmetric rank-k products over the rows, BLAS ``syrk``),
-     scaled to unit diagonal, ``G_s = D^{-1} W^T W D^{-1}`` (the scaling is applied to
-     the small Gram matrix, not to a copy of ``W``);
-  2. its Cholesky factor ``R``, and ``R^T R z = D^{-1} W^T y``;
-  3. one correction step with the residual ``e = y - W D^{-1} z``:
-     ``R^T R dz = D^{-1} W^T e``, ``z += dz``, ``beta = D^{-1} z``.
-
-* Householder QR with column pivoting of ``W D^{-1}``, ``R z = Q^T y``, in every other
-  case (ill-conditioned, rank-deficient or short ``W``). For a tall ``W`` ``R`` is
-  obtained in two stages: the triangular factor of ``[W D^{-1}  y]`` by Householder QR
-  without pivoting, then the pivoted QR of its leading square block. Both stages are
-  orthogonal, so the pivoted ``R``, the rank decision and ``Q^T y`` are those of a
-  pivoted QR of ``W`` itself, without forming the ``m x r`` matrix ``Q``.
-
-Departure from "use QR" (STYLE.md, Numerics), and why it is safe. The semi-normal route
-reads ``W`` in a few blocked passes (``m r^2`` flops for the Gram matrix against ``2 m
-r^2`` in Householder steps that are mostly matrix-vector work): on the static Panda problem
-(34 340 x 43, condition number 6.6) the fit takes under a third of the time of the QR route,
-and about a sixth in :func:`dynid.identification.static.identify_static`, which also skips
-the regressor's zero blocks.
-Accuracy: with the correction step the error of ``beta`` is that of QR when ``eps
-cond^2`` is small (Björck 1987); the covariance from the Gram matrix has a relative error
-of order ``eps cond^2`` against ``eps cond`` for QR. The guard ``cond <= 100`` keeps the
-semi-normal results within about 1e-13 relative of exact ones (measured against an
-extended-precision solution of random problems: standard deviations 4e-14 classical and
-1.4e-13 robust at cond 80, but 8e-12 and 2e-11 at cond 800, which is why the guard is not
-higher; ``beta`` 1e-15 normwise). Rank: for any triangular factor ``R`` of the scaled
-``W``, ``|R_kk| >= sigma_min`` and ``|R_00| <= sigma_max``, so when ``cond * rtol < 1``
-the pivoted QR would find every ``|R_kk| > rtol |R_00|``, that is full rank; the guard
-``cond * rtol < 0.1`` keeps a factor 10 of margin, and everything else (the Cholesky
-factorisation fails, the Gram matrix is not finite or out of range, the condition number
-exceeds the guard) goes to QR, whose rank decision at ``rtol`` and
-:class:`RankDeficientError` are unchanged. ``scaled_condition_number`` is ``sigma_max /
-sigma_min`` of the ``R`` used and ``condition_number`` that of ``R D`` (``W = Q R D``).
+Method: corrected semi-normal equations (Björck 1987) for a tall ``W`` whose scaled
+condition number is at most 100, Householder QR with column pivoting otherwise (short,
+ill-conditioned or rank-deficient ``W``); both work on the column-scaled ``W`` and give
+the same estimates and covariance to about 1e-13 relative. The semi-normal route is about
+three times faster on the static Panda problem. The steps, the accuracy argument and the
+rank guard are in ``docs/least-squares.md``.
 
 :func:`conditioning_advice` turns a fit into warnings: an ill-conditioned ``W`` (the
 columns that are nearly dependent, from the right singular vector of the smallest

@@ -18,17 +18,10 @@ Conventions:
   :func:`dynid.spatial.angle_axis_from_matrix`, angle in ``[0, pi]``). ``J`` is the
   geometric Jacobian of the same origin, rows ``[v; w]`` in the base frame
   (:func:`dynid.kinematics.jacobian.jacobian`), so both halves of ``e`` match its rows.
-* ``J^#`` is the damped least-squares inverse (Nakamura and Hanafusa 1986; Wampler 1986)
-  with the damping schedule of Maciejewski and Klein 1988 and Chiaverini 1997: with
-  ``s_i`` the singular values of ``J``,
-  ``J^# = sum_i s_i / (s_i^2 + lambda^2) v_i u_i^T`` and
-  ``lambda^2 = (1 - (s_min / eps)^2) lambda_max^2`` when ``s_min < eps``, else 0. Away
-  from singularities it is the exact pseudo-inverse. Damping is needed only while the
-  steps are large, so ``lambda^2`` is further scaled by ``min(1, |e| / damping_error)``
-  (as Sugihara, "Solvability-unconcerned inverse kinematics by the Levenberg-Marquardt
-  method", IEEE T-RO 27(5), 2011, lets the damping fall with the error): a goal at a
-  near-singular configuration is still reached to the tolerances instead of creeping
-  towards it.
+* ``J^#`` is the damped least-squares inverse (Nakamura and Hanafusa 1986; Wampler 1986),
+  the exact pseudo-inverse away from singularities; the damping grows as the smallest
+  singular value falls below ``eps`` (Maciejewski and Klein 1988; Chiaverini 1997) and
+  shrinks with the error (Sugihara 2011).
 * Joint position limits: ``q`` is clipped into ``[q_min, q_max]`` after every step, and a
   joint resting on a limit whose step would push it further out is removed from ``J`` for
   that step (an active set), so that the other joints take over the task. Every row of
@@ -41,30 +34,15 @@ Conventions:
   is approached along a line instead of through one large linearised step.
 * ``dt * gain = 1`` (the default) is a full Gauss-Newton step; the discrete loop contracts
   the error when ``0 < dt * gain < 2``.
-* Restarts: a local method can stall in a local minimum of the error (a joint limit
-  blocks the way, or a singular configuration). When the error has not fallen by 0.1 %
-  for ``stall_iterations`` steps, the simulation moves the arm at the velocity limits,
-  along a straight line in joint space, to a random configuration within the limits
-  (drawn from ``rng``) and resumes from there, at most ``max_restarts`` times. With
-  velocity limits the path stays a continuous, velocity-limited motion (without them the
-  transfer is one step). ``max_restarts=0`` gives the plain local simulation.
+* Restarts: when the error stalls for ``stall_iterations`` steps, the arm moves (at the
+  velocity limits) to a random configuration drawn from ``rng`` and the simulation
+  resumes, at most ``max_restarts`` times (0: the plain local simulation).
 
-Batches: ``T_goal`` of shape (..., 4, 4) (with ``q0`` (n,) or broadcast to (..., n))
-solves every goal independently, in parallel across cores with the compiled kernel, and
-returns arrays of the batch shape (no paths). With the default ``rng`` each goal's result
-equals the one-goal call's; the restart configurations are drawn once, up front, for the
-whole batch (one ``rng.random((max_restarts, m))``, shared by the goals).
-
-Implementation: the whole solve (iterations, damping, limits, restarts) runs in one
-compiled call per goal (:mod:`dynid.kinematics._ik_kernel`) when numba is installed
-(compiled on first use, cached on disk; importing dynid does not import numba), and in a
-numpy loop (``_solve_numpy``) otherwise or when the environment variable
-``DYNID_NO_NUMBA=1`` is set before the first call. Both take the same steps, and the
-tests check that their paths agree. The kernel takes the frame pose and the Jacobian from
-the chain core (:func:`dynid.kinematics._kernels.frame_jacobian`); the numpy loop from
-the numpy reference path of :func:`dynid.kinematics.forward.fk` and
-:func:`dynid.kinematics.jacobian.jacobian` (``_Chain``). For one goal, restart configurations are
-drawn from ``rng`` only when a stall asks for them.
+Batches: ``T_goal`` of shape (..., 4, 4) solves every goal independently and returns
+arrays of the batch shape (no paths). The solve runs in one compiled call per goal when
+numba is installed, in a numpy loop otherwise (or with ``DYNID_NO_NUMBA=1``); both take
+the same steps. The damping schedule, the restarts, batches and the two implementations
+are described in ``docs/inverse-kinematics.md``.
 """
 
 from __future__ import annotations

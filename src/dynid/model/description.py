@@ -7,57 +7,12 @@ friction, gravity and named frames. Units are SI throughout (m, rad, kg, kg m^2,
 angles are never in degrees. Writing and reading a robot gives the same robot to about
 1e-15 (floats are written with ``repr``).
 
-Schema
-------
-Top-level keys::
-
-    format_version = 1                    # optional; the only version
-    name = "panda"                        # optional, default "robot"
-    gravity = [0.0, 0.0, -9.80665]        # optional; base frame [m/s^2], default standard gravity
-    q_neutral = [0.0, -0.785, ...]        # optional; a neutral pose [rad or m] (IK start, demos)
-
-One ``[[joints]]`` table per joint, listed from the base to the tip::
-
-    [[joints]]
-    name = "joint1"                       # required, unique
-    type = "revolute"                     # required: "revolute" or "prismatic"
-    parent = "link0"                      # required: the base link for the first joint,
-                                          #   the previous joint's child afterwards
-    child = "link1"                       # required, unique; names the link the joint moves
-    origin = { xyz = [0.0, 0.0, 0.333], rpy = [0.0, 0.0, 0.0] }
-                                          # pose of the joint frame (= child link frame at
-                                          #   q = 0) in the parent link [m, rad]; URDF rpy
-                                          #   Rz(yaw) Ry(pitch) Rx(roll); xyz, rpy default 0
-    # mdh = { a = 0.0, d = 0.333, alpha = 0.0, theta = 0.0 }
-                                          # alternative to origin: Craig's modified DH,
-                                          #   RotX(alpha) TransX(a) RotZ(theta) TransZ(d);
-                                          #   a, d, alpha required, theta default 0
-    axis = [0.0, 0.0, 1.0]                # optional, child-link coordinates, normalised;
-                                          #   default z
-    limits = { lower = -2.8973, upper = 2.8973, velocity = 2.175, acceleration = 15.0,
-               effort = 87.0 }            # optional, each key optional; omitted = unbounded
-                                          #   [rad or m, rad/s or m/s, rad/s^2 or m/s^2,
-                                          #   N m or N] (write inline tables on one line)
-    friction = [0.5, 5.0, 0.04]           # optional sigmoid friction phi1 [N m], phi2 [s/rad],
-                                          #   phi3 [rad/s] (Gaz et al. 2019 eq. 25);
-                                          #   give it for every joint or for none
-
-    [joints.inertial]                     # optional; omitted = massless link
-    mass = 4.970684                       # [kg]
-    com = [0.003875, 0.002081, 0.0]       # centre of mass in the child link frame [m]
-    inertia = [0.70337, -0.000139, 0.006772, 0.70661, 0.019169, 0.009117]
-                                          # xx, xy, xz, yy, yz, zz about the CoM, in
-                                          #   child-link axes [kg m^2]
-
-Extra named frames, optional (every link name is a frame already; ``flange`` defaults to
-the last link's frame)::
-
-    [[frames]]
-    name = "flange"                       # required, unique
-    parent = "link7"                      # required: a link name or a frame listed earlier
-    xyz = [0.0, 0.0, 0.107]               # pose in the parent frame [m, rad], default 0
-    rpy = [0.0, 0.0, 0.0]
-    # mdh = { a = 0.0, d = 0.107, alpha = 0.0, theta = 0.0 }   # alternative to xyz/rpy
+Layout: optional top-level ``format_version = 1``, ``name``, ``gravity`` and
+``q_neutral``; one ``[[joints]]`` table per joint from the base to the tip (``name``,
+``type`` "revolute" or "prismatic", ``parent``, ``child``, an ``origin`` (xyz, URDF rpy) or
+``mdh`` pose, ``axis``, ``limits``, ``friction`` and a ``[joints.inertial]`` table with
+``mass``, ``com`` and ``inertia`` about the CoM); optional ``[[frames]]``. The full schema,
+with an annotated example, is in ``docs/robot-description.md``.
 
 Unknown keys are rejected, so that a misspelt key does not silently fall back to a
 default. Every error names the joint or frame and the key.
