@@ -101,6 +101,7 @@ def _check_admissible(robot, traj, opts, obstacles):
     return tr
 
 
+@pytest.mark.slow
 def test_short_optimisation_respects_every_limit_at_1khz_and_is_reproducible():
     """Panda, 4 s, 3 harmonics, a few iterations: admissible at 1 kHz, seeded."""
     robot = dynid.panda()

@@ -63,6 +63,7 @@ def test_acquire_static_pool_writes_the_chosen_configurations(tmp_path, capsys):
     np.testing.assert_allclose(data.M, dynid.mass_matrix(dynid.panda(), data.q), rtol=1e-12)
 
 
+@pytest.mark.slow
 def test_1010_chosen_configurations_beat_1010_random_ones_and_the_papers():
     """Issue 9: 1010 of 5050 chosen beat 1010 random ones (3 draws) and the paper's 48.9."""
     robot = dynid.panda()
