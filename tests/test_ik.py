@@ -184,7 +184,6 @@ def test_ik_compiled_kernel_and_numpy_loop_agree(panda, monkeypatch):
     assert restarts > 0  # the restart branch was exercised
 
 
-@pytest.mark.slow
 def test_ik_batch_of_goals_equals_the_loop_of_single_goals(panda, monkeypatch):
     """Goals (3, 2, 4, 4) with q0 broadcast: each result equals its one-goal solve (issue 11)."""
     rng = np.random.default_rng(31)
