@@ -37,12 +37,12 @@ bench: $(TESTS)
 	$(PY) benchmarks/run_all.py
 
 lint: $(TESTS)
-	$(PY) -m pip install -q ruff
+	$(PY) -m pip install -q "ruff==0.17.6"
 	$(PY) -m ruff check src tests benchmarks examples
 	$(PY) -m ruff format --check src tests benchmarks examples
 
 types: $(TESTS)
-	$(PY) -m pip install -q mypy
+	$(PY) -m pip install -q "mypy==2.4.1"
 	$(PY) -m mypy src/dynid
 
 clean:
