@@ -45,10 +45,10 @@ import dynid  # noqa: E402
 from dynid.friction.model import ClassicalFriction  # noqa: E402
 from dynid.identification.classical import identify_from_log  # noqa: E402
 from dynid.identification.log import prepare_log  # noqa: E402
-from dynid.kinematics.trajectories import random_fourier  # noqa: E402
 from dynid.regressors.base import base_parameters  # noqa: E402
 from dynid.regressors.torque import torque_regressor  # noqa: E402
 from dynid.simulation.measurement import sample_times, simulate_measurement  # noqa: E402
+from dynid.simulation.trajectories import random_fourier  # noqa: E402
 
 #: dynid order (m, mcx, mcy, mcz, Jxx, Jxy, Jxz, Jyy, Jyz, Jzz) from Pinocchio's
 #: (m, mcx, mcy, mcz, Ixx, Ixy, Iyy, Ixz, Iyz, Izz)

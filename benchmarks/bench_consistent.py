@@ -41,9 +41,9 @@ from dynid.feasibility.retrieve import retrieve  # noqa: E402
 from dynid.feasibility.sdp import retrieve_sdp  # noqa: E402
 from dynid.identification.least_squares import LeastSquaresFit  # noqa: E402
 from dynid.identification.model import IdentifiedModel  # noqa: E402
-from dynid.kinematics.trajectories import random_fourier  # noqa: E402
 from dynid.regressors.base import base_parameters  # noqa: E402
 from dynid.simulation.measurement import sample_times, simulate_measurement  # noqa: E402
+from dynid.simulation.trajectories import random_fourier  # noqa: E402
 from dynid.simulation.unmodelled import UnmodelledEffects  # noqa: E402
 
 

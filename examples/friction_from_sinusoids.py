@@ -12,7 +12,7 @@ import dynid
 
 robot = dynid.panda()
 t = np.arange(0.0, 20.0, 0.001)
-traj = dynid.sinusoid_trajectory(t, dynid.kinematics.trajectories.centered_start(robot))
+traj = dynid.sinusoid_trajectory(t, dynid.simulation.trajectories.centered_start(robot))
 traj, scale = dynid.scale_into_limits(robot, traj)
 log = dynid.simulate_measurement(robot, traj, rng=np.random.default_rng(0))
 

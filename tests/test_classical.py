@@ -15,9 +15,9 @@ from dynid.identification.classical import (
 )
 from dynid.identification.log import TorqueLog
 from dynid.identification.metrics import mse, relative_error_percent, rms, torque_errors
-from dynid.kinematics.trajectories import random_fourier, sinusoid_trajectory
 from dynid.regressors.base import base_parameters
 from dynid.simulation.measurement import SensorNoise, sample_times, simulate_measurement
+from dynid.simulation.trajectories import random_fourier, sinusoid_trajectory
 
 NOISE = 0.05
 

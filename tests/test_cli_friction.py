@@ -232,9 +232,9 @@ def test_cli_errors_are_one_line_with_exit_code_2(workdir, capsys):
 def test_demo_friction_stage_fits_friction_validates_and_writes_its_files(tmp_path, panda):
     """The demo's stage 3 (library) gives per-joint RMS before/after; the CLI writes its files."""
     from dynid.cli.friction import format_demo_stage, save_demo_stage
-    from dynid.kinematics.trajectories import random_fourier
     from dynid.pipeline import friction_stage
     from dynid.simulation.measurement import sample_times, simulate_measurement
+    from dynid.simulation.trajectories import random_fourier
 
     series = random_fourier(panda, np.random.default_rng(51))
     log = simulate_measurement(

@@ -332,8 +332,8 @@ def test_identify_consistent_on_a_log_writes_both_models_and_validate_uses_its_f
     >= 0), which validate --params uses."""
     from dynid.io.feasible import load_feasible_linear_friction
     from dynid.io.torque_log import write_torque_log
-    from dynid.kinematics.trajectories import random_fourier
     from dynid.simulation.measurement import sample_times, simulate_measurement
+    from dynid.simulation.trajectories import random_fourier
 
     panda = dynid.panda()
     rng = np.random.default_rng(31)

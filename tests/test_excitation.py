@@ -14,7 +14,6 @@ from dynid.exceptions import DataError, DynidWarning
 from dynid.friction.model import sigmoid_friction
 from dynid.identification.classical import identify_from_log
 from dynid.io.excitation import load_obstacles, load_trajectory
-from dynid.kinematics.trajectories import random_fourier, uniform_times
 from dynid.model import panda as P
 from dynid.regressors.base import base_parameters
 from dynid.regressors.torque import torque_regressor
@@ -31,6 +30,7 @@ from dynid.simulation.excitation import (
     optimise_excitation,
 )
 from dynid.simulation.measurement import simulate_measurement
+from dynid.simulation.trajectories import random_fourier, uniform_times
 
 
 def paper_trajectory() -> ExcitingTrajectory:

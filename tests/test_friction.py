@@ -17,8 +17,8 @@ from dynid.friction.model import (
 )
 from dynid.friction.validation import own_friction, validate
 from dynid.io.friction_json import read_friction_json, write_friction_json
-from dynid.kinematics.trajectories import centered_start, scale_into_limits, sinusoid_trajectory
 from dynid.simulation.measurement import SensorNoise, sample_times, simulate_measurement
+from dynid.simulation.trajectories import centered_start, scale_into_limits, sinusoid_trajectory
 
 NOISE = 0.05  # torque sensor noise [N m]
 

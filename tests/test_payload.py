@@ -24,9 +24,9 @@ from dynid.feasibility.payload import (
 )
 from dynid.identification.data import StaticDataset
 from dynid.io.static_data import save_static_csv
-from dynid.kinematics.trajectories import random_fourier, uniform_times
 from dynid.model.inertia import inertia6_from_matrix, phi_from_inertial
 from dynid.simulation.measurement import simulate_measurement
+from dynid.simulation.trajectories import random_fourier, uniform_times
 
 MASS = 0.83
 COM = np.array([0.012, -0.021, 0.064])

@@ -18,8 +18,8 @@ from dynid.feasibility.one_step import identify_consistent
 from dynid.feasibility.prior import generic_prior, prior_from_robot
 from dynid.feasibility.sdp import SDPOptions, retrieve_sdp
 from dynid.identification.log import prepare_log
-from dynid.kinematics.trajectories import random_fourier
 from dynid.simulation.measurement import SensorNoise, sample_times, simulate_measurement
+from dynid.simulation.trajectories import random_fourier
 from dynid.simulation.unmodelled import UnmodelledEffects
 
 from conftest import exact_model, perturbed_robot, robot_data_urdf

@@ -8,8 +8,8 @@ import pytest
 from dynid.exceptions import DataError, NonFiniteError, ShapeError
 from dynid.identification.log import TorqueLog, prepare_log
 from dynid.io.torque_log import read_torque_log, torque_log_columns, write_torque_log
-from dynid.kinematics.trajectories import sinusoid_trajectory
 from dynid.simulation.measurement import SensorNoise, sample_times, simulate_measurement
+from dynid.simulation.trajectories import sinusoid_trajectory
 
 
 def _log(rng, N=50, n=3, ddq=False):

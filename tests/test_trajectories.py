@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 from dynid.exceptions import DataError, LimitError, ShapeError
-from dynid.kinematics.trajectories import (
+from dynid.simulation.trajectories import (
     GAZ2019_SINUSOID_AMPLITUDES,
     GAZ2019_SINUSOID_PERIODS,
     FourierSeries,

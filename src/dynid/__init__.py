@@ -3,8 +3,7 @@
 The pipeline, in the order data flows (each name is re-exported here):
 
 * model: :func:`panda`, :class:`Robot` (``from_mdh``, ``from_urdf``, ``from_toml``)
-* kinematics: :func:`fk`, :func:`jacobian`, :func:`jacobian_to_tool`, :func:`ik`,
-  trajectories (:func:`sinusoid_trajectory`, :func:`random_fourier`, :func:`check_limits`)
+* kinematics: :func:`fk`, :func:`jacobian`, :func:`jacobian_to_tool`, :func:`ik`
 * dynamics: :func:`rnea`, :func:`mass_matrix`, :func:`gravity_torques`, :func:`coriolis`,
   :func:`coriolis_matrix`, :func:`forward_dynamics`
 * regressors: :func:`torque_regressor`, :func:`static_regressor`, :func:`base_parameters`,
@@ -12,7 +11,9 @@ The pipeline, in the order data flows (each name is re-exported here):
 * identification: :func:`identify_static` (Gaz et al. 2019, Sec. IV-A),
   :func:`identify_from_log` (classical route), :class:`IdentifiedModel`
 * friction: :func:`fit_friction`, :func:`sigmoid_friction`, :func:`validate_torques`
-* simulation: :class:`SimulatedController`, :func:`acquire_static`, :func:`simulate_measurement`,
+* simulation: trajectories (:func:`sinusoid_trajectory`, :func:`random_fourier`,
+  :func:`check_limits`), :class:`SimulatedController`, :func:`acquire_static`,
+  :func:`simulate_measurement`,
   :func:`select_static_configurations`, :func:`optimise_excitation` (:class:`ExcitingTrajectory`,
   :class:`ExcitationOptions`, :class:`Obstacles`)
 * feasibility: see :mod:`dynid.feasibility`
@@ -68,13 +69,6 @@ if TYPE_CHECKING:  # the names as static imports, for type checkers and editors
     from .kinematics.forward import fk, joint_transforms, link_poses
     from .kinematics.ik import IKOptions, IKResult, ik
     from .kinematics.jacobian import jacobian, jacobian_to_tool
-    from .kinematics.trajectories import (
-        Trajectory,
-        check_limits,
-        random_fourier,
-        scale_into_limits,
-        sinusoid_trajectory,
-    )
     from .model.inertia import inertial_from_phi, param_labels, phi_from_inertial
     from .model.panda import PANDA_NEUTRAL_Q, panda
     from .model.robot import Frame, Robot
@@ -97,6 +91,13 @@ if TYPE_CHECKING:  # the names as static imports, for type checkers and editors
     )
     from .simulation.measurement import SensorNoise, simulate_measurement
     from .simulation.static_selection import StaticSelection, select_static_configurations
+    from .simulation.trajectories import (
+        Trajectory,
+        check_limits,
+        random_fourier,
+        scale_into_limits,
+        sinusoid_trajectory,
+    )
 
 #: public name -> (module under dynid, attribute): imported on first use (PEP 562), so that
 #: ``import dynid`` (and every command line call) loads only what it uses
@@ -123,12 +124,12 @@ _LAZY: dict[str, tuple[str, str]] = {
     "StaticDataset": ("identification.data", "StaticDataset"),
     "StaticSelection": ("simulation.static_selection", "StaticSelection"),
     "TorqueLog": ("identification.log", "TorqueLog"),
-    "Trajectory": ("kinematics.trajectories", "Trajectory"),
+    "Trajectory": ("simulation.trajectories", "Trajectory"),
     "Validation": ("friction.validation", "Validation"),
     "acquire_static": ("simulation.controller", "acquire_static"),
     "acquire_static_at": ("simulation.controller", "acquire_static_at"),
     "base_parameters": ("regressors.base", "base_parameters"),
-    "check_limits": ("kinematics.trajectories", "check_limits"),
+    "check_limits": ("simulation.trajectories", "check_limits"),
     "classical_friction": ("friction.model", "classical_friction"),
     "coriolis": ("dynamics.terms", "coriolis"),
     "coriolis_matrix": ("dynamics.terms", "coriolis_matrix"),
@@ -152,14 +153,14 @@ _LAZY: dict[str, tuple[str, str]] = {
     "panda": ("model.panda", "panda"),
     "param_labels": ("model.inertia", "param_labels"),
     "phi_from_inertial": ("model.inertia", "phi_from_inertial"),
-    "random_fourier": ("kinematics.trajectories", "random_fourier"),
+    "random_fourier": ("simulation.trajectories", "random_fourier"),
     "rnea": ("dynamics.rnea", "rnea"),
     "sample_configurations": ("simulation.controller", "sample_configurations"),
-    "scale_into_limits": ("kinematics.trajectories", "scale_into_limits"),
+    "scale_into_limits": ("simulation.trajectories", "scale_into_limits"),
     "select_static_configurations": ("simulation.static_selection", "select_static_configurations"),
     "sigmoid_friction": ("friction.model", "sigmoid_friction"),
     "simulate_measurement": ("simulation.measurement", "simulate_measurement"),
-    "sinusoid_trajectory": ("kinematics.trajectories", "sinusoid_trajectory"),
+    "sinusoid_trajectory": ("simulation.trajectories", "sinusoid_trajectory"),
     "static_regressor": ("regressors.static", "static_regressor"),
     "torque_regressor": ("regressors.torque", "torque_regressor"),
     "validate_torques": ("friction.validation", "validate"),

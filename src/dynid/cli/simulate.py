@@ -27,7 +27,8 @@ import numpy as np
 
 from ..exceptions import DynidError
 from ..io.torque_log import write_torque_log
-from ..kinematics.trajectories import (
+from ..simulation.measurement import SensorNoise, sample_times, simulate_measurement
+from ..simulation.trajectories import (
     GAZ2019_SINUSOID_AMPLITUDES,
     GAZ2019_SINUSOID_PERIODS,
     centered_start,
@@ -36,7 +37,6 @@ from ..kinematics.trajectories import (
     scale_into_limits,
     sinusoid_trajectory,
 )
-from ..simulation.measurement import SensorNoise, sample_times, simulate_measurement
 from .common import (
     add_robot_options,
     add_seed_option,

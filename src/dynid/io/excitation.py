@@ -27,10 +27,10 @@ import numpy as np
 
 from .. import __version__
 from ..exceptions import DataError, DynidError
-from ..kinematics.trajectories import Trajectory
 from ..model.robot import Robot
 from ..simulation.collision import Box, Obstacles, Plane, capsule_model
 from ..simulation.excitation import ExcitationResult, ExcitingTrajectory
+from ..simulation.trajectories import Trajectory
 
 __all__ = [
     "EXCITATION_SCHEMA",

@@ -41,7 +41,10 @@ from ..identification.static import identify_static
 from ..kinematics.forward import fk
 from ..kinematics.ik import IKOptions, IKResult, ik
 from ..kinematics.jacobian import jacobian
-from ..kinematics.trajectories import (
+from ..model.robot import Robot
+from ..simulation.controller import SimulatedController, acquire_static
+from ..simulation.measurement import SensorNoise, sample_times, simulate_measurement
+from ..simulation.trajectories import (
     LimitReport,
     centered_start,
     check_limits,
@@ -49,9 +52,6 @@ from ..kinematics.trajectories import (
     scale_into_limits,
     sinusoid_trajectory,
 )
-from ..model.robot import Robot
-from ..simulation.controller import SimulatedController, acquire_static
-from ..simulation.measurement import SensorNoise, sample_times, simulate_measurement
 from ..spatial import rpy_from_matrix, transform_from_xyz_rpy
 
 __all__ = [

@@ -10,9 +10,9 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from ..kinematics.trajectories import Trajectory
 from ..model.robot import Robot
 from ..simulation.collision import Obstacles, capsule_segments
+from ..simulation.trajectories import Trajectory
 
 if TYPE_CHECKING:  # pragma: no cover
     from matplotlib.figure import Figure

@@ -52,7 +52,6 @@ from ..dynamics.rnea import rnea
 from ..exceptions import ShapeError
 from ..friction.model import sigmoid_friction
 from ..identification.classical import friction_regressor
-from ..kinematics.trajectories import Trajectory, uniform_times
 from ..model.robot import Robot
 from ..regressors.base import BaseParameters, base_parameters
 from ..regressors.torque import _torque_regressor
@@ -64,6 +63,7 @@ from .collision import (
     obstacle_distances,
     self_distances,
 )
+from .trajectories import Trajectory, uniform_times
 
 __all__ = [
     "ExcitationOptions",

@@ -1,7 +1,7 @@
 """Simulated torque measurements of a robot following a joint trajectory.
 
 The robot tracks the trajectory exactly (``q``, ``dq``, ``ddq`` of the
-:class:`~dynid.kinematics.trajectories.Trajectory` are the true states). The link-side
+:class:`~dynid.simulation.trajectories.Trajectory` are the true states). The link-side
 torque sensors then read
 
 .. math:: \\tau_{meas} = M(q)\\ddot q + c(q, \\dot q) + g(q) + \\tau_f(\\dot q) + e_\\tau
@@ -31,8 +31,8 @@ from ..dynamics.rnea import rnea
 from ..exceptions import ShapeError
 from ..friction.model import FrictionModel, SigmoidFriction
 from ..identification.log import TorqueLog
-from ..kinematics.trajectories import Trajectory
 from ..model.robot import Robot
+from .trajectories import Trajectory
 from .unmodelled import UnmodelledEffects
 
 __all__ = ["SensorNoise", "sample_times", "simulate_measurement"]
