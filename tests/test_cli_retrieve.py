@@ -13,7 +13,7 @@ import pytest
 
 import dynid
 from dynid.cli.__main__ import main
-from dynid.feasibility.constraints import panda_bounds
+from dynid.feasibility.bounds import panda_bounds
 from dynid.friction.model import SigmoidFriction
 from dynid.identification.data import StaticDataset
 from dynid.identification.least_squares import LeastSquaresFit

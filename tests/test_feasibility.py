@@ -17,14 +17,11 @@ import pytest
 
 import dynid
 from dynid.exceptions import DataError, InfeasibleError, ShapeError
+from dynid.feasibility.bounds import Bounds, default_bounds, kinematic_bounds, panda_bounds
 from dynid.feasibility.constraints import (
-    Bounds,
     UserConstraint,
-    default_bounds,
     feasibility_report,
-    kinematic_bounds,
     link_params,
-    panda_bounds,
     user_constraints,
     validate,
 )

@@ -12,7 +12,7 @@ import pytest
 
 import dynid
 from dynid.exceptions import InfeasibleError, ModelError, ShapeError
-from dynid.feasibility.constraints import panda_bounds
+from dynid.feasibility.bounds import panda_bounds
 from dynid.feasibility.lmi import pseudo_inertia_margin
 from dynid.feasibility.one_step import identify_consistent
 from dynid.feasibility.prior import generic_prior, prior_from_robot

@@ -54,7 +54,8 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from ..exceptions import DynidError
-from ..feasibility.constraints import default_bounds, principal_moments
+from ..feasibility.bounds import default_bounds
+from ..feasibility.constraints import principal_moments
 from ..feasibility.retrieve import (
     RetrievalOptions,
     RetrievalProgress,

@@ -11,8 +11,9 @@
   (:mod:`.constraints`); :func:`validate_newton_euler` (:mod:`.validate`).
 """
 
+from .bounds import Bounds, default_bounds, kinematic_bounds, panda_bounds
 from .compare import MethodSummary, compare_methods, perturbed_robot
-from .constraints import Bounds, default_bounds, feasibility_report, kinematic_bounds, panda_bounds
+from .constraints import feasibility_report
 from .lmi import log_det_divergence, pseudo_inertia, pseudo_inertia_margin
 from .one_step import identify_consistent
 from .payload import PayloadEstimate, identify_payload, robot_with_payload

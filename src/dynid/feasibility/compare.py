@@ -20,7 +20,8 @@ from numpy.typing import NDArray
 from ..identification.model import IdentifiedModel
 from ..model.inertia import inertial_from_phi, phi_from_inertial
 from ..model.robot import Robot
-from .constraints import Bounds, feasibility_report
+from .bounds import Bounds
+from .constraints import feasibility_report
 from .lmi import pseudo_inertia_margin, repair_pseudo_inertia
 from .prior import Prior, prior_from_robot
 from .retrieve import RetrievalOptions, retrieve

@@ -26,7 +26,7 @@ from ..identification.data import StaticDataset
 from ..identification.log import DEFAULT_CUTOFF_HZ, TorqueLog
 from ..identification.static import identify_static
 from ..model.robot import Robot
-from .constraints import Bounds
+from .bounds import Bounds
 from .prior import Prior
 from .sdp import ConsistentResult, SDPOptions, coefficient_term, solve_consistent
 

@@ -2,7 +2,7 @@
 
 Decision variables: ``p = (m_i, c_i, I_i)`` per link (:data:`~dynid.feasibility.
 constraints.DECISION_FIELDS`, inertia about the CoM), inside the box of
-:class:`~dynid.feasibility.constraints.Bounds`. The optimisers work on normalised
+:class:`~dynid.feasibility.bounds.Bounds`. The optimisers work on normalised
 variables ``z`` in ``[0, 1]^{10 n}``, ``p = lo + z (hi - lo)``.
 
 **Data term.** The standard parameters follow from ``p`` by the parallel-axis theorem,
@@ -48,7 +48,8 @@ from ..exceptions import DataError, OptionError, ShapeError
 from ..model.robot import Robot
 from ..regressors.base import BaseParameters, base_parameters
 from ..regressors.static import static_regressor, static_vector
-from .constraints import Bounds, UserConstraint, default_bounds, user_constraints
+from .bounds import Bounds, default_bounds
+from .constraints import UserConstraint, user_constraints
 from .prior import prior_scales
 
 __all__ = [
@@ -432,7 +433,7 @@ def coefficient_problem(
     kept : array_like of bool, shape (r,), optional
         Coefficients to use (pruned ones are ignored); default all.
     bounds : Bounds, optional
-        Default :func:`~dynid.feasibility.constraints.default_bounds`.
+        Default :func:`~dynid.feasibility.bounds.default_bounds`.
     total_mass : (float, float), optional
         Overrides ``bounds.total_mass`` [kg].
     extra : sequence

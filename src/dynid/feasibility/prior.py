@@ -31,7 +31,7 @@ from numpy.typing import NDArray
 from ..exceptions import ModelError
 from ..model.inertia import phi_from_inertial
 from ..model.robot import Robot
-from .constraints import segment_points
+from .bounds import segment_points
 from .lmi import pseudo_inertia, pseudo_inertia_margin, repair_pseudo_inertia
 
 __all__ = [
@@ -109,7 +109,7 @@ def prior_scales(phi0: NDArray[np.float64]) -> NDArray[np.float64]:
 
 def _segment(robot: Robot, i: int) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
     """End points [m] in link ``i``'s frame (0-based): the two farthest apart of the points
-    that bound it (:func:`~dynid.feasibility.constraints.segment_points`)."""
+    that bound it (:func:`~dynid.feasibility.bounds.segment_points`)."""
     P = segment_points(robot, i)
     d = np.linalg.norm(P[:, None] - P[None], axis=-1)
     a, b = np.unravel_index(int(np.argmax(d)), d.shape)

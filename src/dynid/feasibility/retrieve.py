@@ -3,7 +3,7 @@
 Identified coefficients (base parameters) fix only combinations of the link parameters,
 and a least-squares estimate of the combinations need not come from any physical body.
 The retrieval searches the link parameters ``p = (m_i, c_i, I_i)`` (mass, CoM, inertia
-about the CoM, per link) inside a box (:class:`~dynid.feasibility.constraints.Bounds`)
+about the CoM, per link) inside a box (:class:`~dynid.feasibility.bounds.Bounds`)
 that reproduce the coefficients and satisfy the feasibility constraints, by the penalised
 objective of :mod:`dynid.feasibility.penalty`:
 
@@ -61,14 +61,8 @@ from ..identification.model import IdentifiedModel
 from ..model.inertia import matrix_from_inertia6
 from ..model.robot import Robot
 from ..regressors.base import BaseParameters
-from .constraints import (
-    Bounds,
-    Constraint,
-    FeasibilityReport,
-    default_bounds,
-    feasibility_report,
-    link_params,
-)
+from .bounds import Bounds, default_bounds
+from .constraints import Constraint, FeasibilityReport, feasibility_report, link_params
 from .penalty import (
     DEFAULT_MARGIN,
     DEFAULT_SCALE_FLOOR,
@@ -671,7 +665,7 @@ def retrieve_from_coefficients(
     kept : array_like of bool, shape (r,), optional
         Coefficients to match (pruned ones are ignored).
     bounds : Bounds, optional
-        Search box; default :func:`~dynid.feasibility.constraints.default_bounds`.
+        Search box; default :func:`~dynid.feasibility.bounds.default_bounds`.
     total_mass : (float, float), optional
         Band on the total mass [kg]; overrides ``bounds.total_mass``.
     extra : sequence

@@ -61,15 +61,8 @@ from ..identification.least_squares import LeastSquaresFit
 from ..identification.model import IdentifiedModel
 from ..model.inertia import inertial_from_phi
 from ..model.robot import Robot
-from .constraints import (
-    Bounds,
-    Constraint,
-    FeasibilityReport,
-    default_bounds,
-    feasibility_report,
-    params_from_inertial,
-    segment_points,
-)
+from .bounds import Bounds, default_bounds, segment_points
+from .constraints import Constraint, FeasibilityReport, feasibility_report, params_from_inertial
 from .lmi import (
     log_det_divergence,
     pseudo_inertia,
@@ -723,7 +716,7 @@ def solve_consistent(
         :func:`~dynid.feasibility.prior.generic_prior`.
     bounds : Bounds, optional
         Mass and CoM boxes and the total-mass band; default
-        :func:`~dynid.feasibility.constraints.default_bounds`. The inertia-entry bounds of
+        :func:`~dynid.feasibility.bounds.default_bounds`. The inertia-entry bounds of
         the penalty method are not used (the pseudo-inertia LMI replaces them).
     total_mass : (float, float), optional
         Overrides ``bounds.total_mass`` [kg].

@@ -30,7 +30,7 @@ for any robot::
 
 or in TOML ``total_mass = [16.0, 20.0]`` and one ``[[links]]`` table per link with the same
 keys. Every key but ``name`` is optional: what a file leaves out comes from
-:func:`dynid.feasibility.constraints.default_bounds` of the robot. Unknown keys are
+:func:`dynid.feasibility.bounds.default_bounds` of the robot. Unknown keys are
 rejected. Floats are written with Python's shortest round-trip representation.
 """
 
@@ -47,7 +47,8 @@ import numpy as np
 
 from .. import __version__
 from ..exceptions import DataError, ModelError, ShapeError
-from ..feasibility.constraints import Bounds, FeasibilityReport, default_bounds
+from ..feasibility.bounds import Bounds, default_bounds
+from ..feasibility.constraints import FeasibilityReport
 from ..feasibility.retrieve import RetrievalResult
 from ..feasibility.sdp import ConsistentResult
 from ..friction.model import ClassicalFriction

@@ -32,6 +32,10 @@ __all__ = [
     "GAZ2019_EXCITING_W_F",
     "GAZ2019_EXCITING_DURATION",
     "GAZ2019_EXCITING_RAMP",
+    "PANDA_RETRIEVAL_COM_BOX",
+    "PANDA_RETRIEVAL_INERTIA_DIAG_MAX",
+    "PANDA_RETRIEVAL_MASS",
+    "PANDA_RETRIEVAL_TOTAL_MASS",
 ]
 
 _A = [0.0, 0.0, 0.0, 0.0825, -0.0825, 0.0, 0.088]
@@ -137,3 +141,21 @@ def panda() -> Robot:
         name="panda",
     )
     return robot.replace(q_neutral=PANDA_NEUTRAL_Q)
+
+
+#: Bounds of the Panda used by Gaz et al. 2019 for the retrieval (marcocognetti/
+#: FrankaEmikaPandaDynModel, matlab/parameters_retrieval/bounds_gM.csv): masses 0..10 kg,
+#: CoM boxes from the link geometry in the MDH frames [m] (x, y, z ranges per link),
+#: total mass of links 1..7 in 16..20 kg (error_fcn_gM_LMI.m).
+PANDA_RETRIEVAL_COM_BOX = (
+    ((-0.05, 0.05), (-0.05, 0.05), (-0.40, 0.05)),
+    ((-0.05, 0.05), (-0.15, 0.05), (-0.05, 0.05)),
+    ((-0.05, 0.15), (-0.05, 0.05), (-0.10, 0.05)),
+    ((-0.15, 0.05), (-0.05, 0.15), (-0.05, 0.05)),
+    ((-0.05, 0.05), (-0.05, 0.05), (-0.35, 0.05)),
+    ((-0.05, 0.15), (-0.05, 0.05), (-0.05, 0.05)),
+    ((-0.05, 0.05), (-0.05, 0.05), (0.04, 0.15)),
+)
+PANDA_RETRIEVAL_MASS = (0.0, 10.0)
+PANDA_RETRIEVAL_TOTAL_MASS = (16.0, 20.0)
+PANDA_RETRIEVAL_INERTIA_DIAG_MAX = 1.0
