@@ -6,6 +6,7 @@ import numpy as np
 import pytest
 
 import dynid
+from dynid.io.export import save_robot
 from dynid.model.description import robot_from_toml, robot_from_toml_string, toml_from_robot
 
 from conftest import random_states, robot_data_urdf
@@ -38,7 +39,8 @@ def test_panda_round_trip_through_a_file_keeps_the_robot(tmp_path):
     """dynid.panda() written to TOML and read back is the same robot (limits, friction, frames)."""
     panda = dynid.panda()
     path = tmp_path / "panda.toml"
-    text = panda.to_toml(path)
+    text = panda.to_toml()
+    save_robot(path, panda)
     assert path.read_text() == text
     assert_same_robot(panda, dynid.Robot.from_toml(path), seed=41)
     assert_same_robot(panda, robot_from_toml(str(path)), seed=41)

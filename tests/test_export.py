@@ -17,6 +17,7 @@ from dynid.feasibility.bounds import default_bounds, panda_bounds
 from dynid.feasibility.retrieve import RetrievalOptions, retrieve_from_coefficients
 from dynid.identification.least_squares import LeastSquaresFit
 from dynid.identification.model import IdentifiedModel
+from dynid.io.export import save_robot
 from dynid.io.feasible import (
     bounds_from_dict,
     feasible_to_dict,
@@ -184,7 +185,7 @@ def test_toml_round_trip(retrieved, tmp_path):
     """The retrieved robot written as dynid TOML reads back with the same parameters."""
     _, res = retrieved
     path = tmp_path / "robot.toml"
-    res.robot.to_toml(path)
+    save_robot(path, res.robot)
     back = dynid.Robot.from_toml(path)
     np.testing.assert_allclose(back.phi, res.robot.phi, atol=1e-14)
     np.testing.assert_allclose(back.T_parent_joint, res.robot.T_parent_joint, atol=1e-15)

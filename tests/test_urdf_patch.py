@@ -15,6 +15,7 @@ import pytest
 import dynid
 from dynid.cli.__main__ import main
 from dynid.exceptions import DynidWarning, ModelError
+from dynid.io.export import save_robot
 from dynid.io.urdf_export import save_urdf, urdf_from_robot
 from dynid.io.urdf_patch import patch_urdf_inertials
 from dynid.model.urdf import robot_from_urdf_string
@@ -181,7 +182,7 @@ def test_cli_export_urdf_template_and_mjcf(tmp_path, capsys):
     pytest.importorskip("mujoco")
     path, chain = _template_chain()
     params = tmp_path / "robot.toml"
-    _identified(chain, seed=8).to_toml(params)
+    save_robot(params, _identified(chain, seed=8))
     out = tmp_path / "patched.urdf"
     argv = ["export", "--params", str(params), "--out", str(out), "--urdf-template", path]
     assert main(argv + ["--base", "panda_link0", "--tip", "panda_hand"]) == 0

@@ -426,14 +426,12 @@ class Robot:
 
         return robot_from_toml(path)
 
-    def to_toml(self, path: str | Path | None = None) -> str:
-        """The dynid TOML description of this robot; written to ``path`` when given."""
+    def to_toml(self) -> str:
+        """The dynid TOML description of this robot (write it with
+        :func:`dynid.io.export.save_robot`: the model layer writes no files)."""
         from .description import toml_from_robot
 
-        text = toml_from_robot(self)
-        if path is not None:
-            Path(path).write_text(text, encoding="utf-8")
-        return text
+        return toml_from_robot(self)
 
     def __repr__(self) -> str:
         kinds = "".join("P" if p else "R" for p in self.prismatic)
