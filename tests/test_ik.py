@@ -15,8 +15,10 @@ from dynid.kinematics import IKOptions, IKResult, default_q0, ik
 
 from conftest import random_states
 
-# the package attribute ``dynid.kinematics.ik`` is the function; the module is in sys.modules
-ik_module = importlib.import_module("dynid.kinematics.ik")
+# the IK driver module (the function ``ik`` is also exported by dynid.kinematics)
+ik_module = importlib.import_module(
+    "dynid.kinematics.inverse"
+)  # the module, beside the function ik
 
 TOOL = spatial.transform_from_xyz_rpy([0.0, 0.0, 0.1])
 

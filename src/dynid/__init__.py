@@ -67,7 +67,7 @@ if TYPE_CHECKING:  # the names as static imports, for type checkers and editors
     from .identification.model import IdentifiedModel
     from .identification.static import identify_static
     from .kinematics.forward import fk, joint_transforms, link_poses
-    from .kinematics.ik import IKOptions, IKResult, ik
+    from .kinematics.inverse import IKOptions, IKResult, ik
     from .kinematics.jacobian import jacobian, jacobian_to_tool
     from .model.inertia import inertial_from_phi, param_labels, phi_from_inertial
     from .model.panda import PANDA_NEUTRAL_Q, panda
@@ -110,8 +110,8 @@ _LAZY: dict[str, tuple[str, str]] = {
     "ExcitingTrajectory": ("simulation.excitation", "ExcitingTrajectory"),
     "Frame": ("model.robot", "Frame"),
     "FrictionFit": ("friction.fit", "FrictionFit"),
-    "IKOptions": ("kinematics.ik", "IKOptions"),
-    "IKResult": ("kinematics.ik", "IKResult"),
+    "IKOptions": ("kinematics.inverse", "IKOptions"),
+    "IKResult": ("kinematics.inverse", "IKResult"),
     "IdentifiedModel": ("identification.model", "IdentifiedModel"),
     "LeastSquaresFit": ("identification.least_squares", "LeastSquaresFit"),
     "Obstacles": ("simulation.collision", "Obstacles"),
@@ -142,7 +142,7 @@ _LAZY: dict[str, tuple[str, str]] = {
     "identifiability": ("regressors.base", "identifiability"),
     "identify_from_log": ("identification.classical", "identify_from_log"),
     "identify_static": ("identification.static", "identify_static"),
-    "ik": ("kinematics.ik", "ik"),
+    "ik": ("kinematics.inverse", "ik"),
     "inertial_from_phi": ("model.inertia", "inertial_from_phi"),
     "jacobian": ("kinematics.jacobian", "jacobian"),
     "jacobian_to_tool": ("kinematics.jacobian", "jacobian_to_tool"),

@@ -18,7 +18,7 @@ import argparse
 import numpy as np
 
 from ..kinematics.forward import fk
-from ..kinematics.ik import default_q0
+from ..kinematics.inverse import default_q0
 from ..spatial import rpy_from_matrix
 from .common import (
     add_frame_tool_options,

@@ -26,7 +26,7 @@ import numpy as np
 
 from ..exceptions import DynidError
 from ..kinematics.forward import fk
-from ..kinematics.ik import IKOptions, default_q0, ik
+from ..kinematics.inverse import IKOptions, default_q0, ik
 from ..spatial import matrix_from_rpy, transform
 from .common import (
     add_frame_tool_options,

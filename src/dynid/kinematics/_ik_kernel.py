@@ -1,8 +1,8 @@
 """Compiled (numba) inverse kinematics: the whole solve for one goal, and batches of goals.
 
-Imported lazily by :func:`dynid.kinematics.ik.ik` (:func:`dynid._compiled.kernels`),
+Imported lazily by :func:`dynid.kinematics.inverse.ik` (:func:`dynid._compiled.kernels`),
 never by ``import dynid``; compiled once and cached on disk. The loop, its damping, limits
-and restarts are documented in :mod:`dynid.kinematics.ik`; :func:`_solve` takes the same
+and restarts are documented in :mod:`dynid.kinematics.inverse`; :func:`_solve` takes the same
 steps as the numpy loop ``_solve_numpy`` there (the tests hold their paths to 1e-9). The
 frame pose and Jacobian come from the chain core (:func:`dynid.kinematics._kernels.
 frame_jacobian`), so forward kinematics is not written again here.
@@ -157,7 +157,7 @@ def _cholesky_solve(L, d, b, y):
 
 @inline
 def _solve(C, m, q_min, q_max, inv_vmax, q_restart, goal, fpar, ipar, path, keep, q_best):
-    """The simulation loop for one goal; see :func:`dynid.kinematics.ik._solve_numpy`.
+    """The simulation loop for one goal; see :func:`dynid.kinematics.inverse._solve_numpy`.
 
     ``C`` holds the robot and the frame (:func:`dynid._compiled.pack_frame`); joints
     ``0..m-1`` move the frame. ``path`` (rows, n) holds ``q0`` in row 0 and, when ``keep``,

@@ -126,7 +126,7 @@ def _frame_pose_jacobian_numpy(
     """Frame pose (B, 4, 4) and Jacobian (B, 6, n) for validated (B, n) ``q2``, numpy path.
 
     One pass of :func:`dynid.kinematics.forward._link_poses` for both (the numpy loop of
-    :func:`dynid.kinematics.ik.ik` uses it too).
+    :func:`dynid.kinematics.inverse.ik` uses it too).
     """
     T = _link_poses(robot, q2)
     Tf = T[:, link] @ T_link_frame

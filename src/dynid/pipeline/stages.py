@@ -39,7 +39,7 @@ from ..identification.log import TorqueLog, prepare_log
 from ..identification.model import IdentifiedModel
 from ..identification.static import identify_static
 from ..kinematics.forward import fk
-from ..kinematics.ik import IKOptions, IKResult, ik
+from ..kinematics.inverse import IKOptions, IKResult, ik
 from ..kinematics.jacobian import jacobian
 from ..model.robot import Robot
 from ..simulation.controller import SimulatedController, acquire_static
