@@ -16,36 +16,20 @@ from dynid.cli.__main__ import main
 from dynid.feasibility.bounds import panda_bounds
 from dynid.friction.model import SigmoidFriction
 from dynid.identification.data import StaticDataset
-from dynid.identification.least_squares import LeastSquaresFit
 from dynid.identification.log import TorqueLog
 from dynid.identification.model import IdentifiedModel
 from dynid.io.feasible import load_feasible_json, save_bounds
 from dynid.io.friction_json import write_friction_json
 from dynid.io.model_json import save_model_json
 from dynid.io.static_data import save_static_data
-from dynid.regressors.base import base_parameters
 
-from conftest import random_states
+from conftest import exact_model, random_states
 
 
 def _model() -> IdentifiedModel:
+    """Exact coefficients of the published Panda."""
     panda = dynid.panda()
-    base = base_parameters(panda)
-    r = base.rank
-    fit = LeastSquaresFit(
-        base.beta_from_phi(panda.phi),
-        np.zeros(r),
-        np.zeros(r),
-        np.ones(r, bool),
-        r,
-        1.0,
-        0.0,
-        0.0,
-        0.0,
-        0,
-        1e-10,
-    )
-    return IdentifiedModel(panda, base, fit)
+    return exact_model(panda, panda)
 
 
 @pytest.fixture(scope="module")

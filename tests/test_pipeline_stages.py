@@ -6,30 +6,16 @@ import numpy as np
 import pytest
 
 import dynid
-from dynid.identification.least_squares import LeastSquaresFit
 from dynid.identification.model import IdentifiedModel
 from dynid.io.model_json import load_model_json, save_model_json
 from dynid.pipeline import friction_stage, kinematics_only
-from dynid.regressors.base import base_parameters
+
+from conftest import exact_model
 
 
 def _model(robot: dynid.Robot) -> IdentifiedModel:
-    base = base_parameters(robot)
-    r = base.rank
-    fit = LeastSquaresFit(
-        base.beta_from_phi(robot.phi),
-        np.zeros(r),
-        np.zeros(r),
-        np.ones(r, bool),
-        r,
-        1.0,
-        0.0,
-        0.0,
-        0.0,
-        0,
-        1e-10,
-    )
-    return IdentifiedModel(robot, base, fit)
+    """Exact coefficients of ``robot``'s own parameters."""
+    return exact_model(robot, robot)
 
 
 def test_kinematics_only_keeps_what_an_identification_file_records(tmp_path):
