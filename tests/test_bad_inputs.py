@@ -173,9 +173,9 @@ def truncated_log(d: Path) -> None:
 
 def truncated_log_npz(d: Path) -> None:
     """A torque-log NPZ whose n_rows says more than its arrays hold."""
-    from dynid.io.torque_log import read_torque_log, write_torque_log
+    from dynid.io.torque_log import load_torque_log, save_torque_log
 
-    write_torque_log(d / "log.npz", read_torque_log(d / "log.csv"))
+    save_torque_log(d / "log.npz", load_torque_log(d / "log.csv"))
     with np.load(d / "log.npz") as z:
         arrays = {k: z[k] for k in z.files}
     arrays["n_rows"] = np.array(900)

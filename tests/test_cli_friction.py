@@ -10,7 +10,7 @@ import pytest
 
 from dynid.cli.__main__ import main
 from dynid.identification.classical import identify_from_log
-from dynid.io.torque_log import read_torque_log
+from dynid.io.torque_log import load_torque_log
 
 matplotlib.use("Agg")
 
@@ -45,7 +45,7 @@ def workdir(tmp_path_factory, panda):
         )
         == 0
     )
-    model = identify_from_log(panda, read_torque_log(d / "fourier.npz"))
+    model = identify_from_log(panda, load_torque_log(d / "fourier.npz"))
     save_model_json(d / "identification.json", model, seed=1)
     assert (
         main(
@@ -69,7 +69,7 @@ def workdir(tmp_path_factory, panda):
 
 def test_simulate_writes_a_readable_log(workdir, capsys):
     """simulate writes 1 kHz logs of the requested duration and reports the scaling."""
-    log = read_torque_log(workdir / "sin.csv")
+    log = load_torque_log(workdir / "sin.csv")
     assert log.n == 7 and log.n_samples == 12001
     assert log.sample_rate == pytest.approx(1000.0)
     assert (
@@ -92,7 +92,7 @@ def test_simulate_writes_a_readable_log(workdir, capsys):
     )
     out = capsys.readouterr().out
     assert "velocity limit of joint1 exceeded" in out and "amplitude scaled by 0.935" in out
-    short = read_torque_log(workdir / "short.npz")
+    short = load_torque_log(workdir / "short.npz")
     assert short.n_samples == 2001 - 20 and len(short.cleaning.gaps) > 0
 
 

@@ -19,7 +19,7 @@ from dynid.identification.data import StaticDataset
 from dynid.identification.log import TorqueLog
 from dynid.identification.model import IdentifiedModel
 from dynid.io.feasible import load_feasible_json, save_bounds
-from dynid.io.friction_json import write_friction_json
+from dynid.io.friction_json import save_friction_json
 from dynid.io.model_json import save_model_json
 from dynid.io.static_data import save_static_data
 
@@ -268,7 +268,7 @@ def test_validate_with_retrieved_parameters_uses_rnea(model_file, tmp_path):
     assert max(d["rms"]) > 0.1  # the log carries friction that this model lacks
     # with the published sigmoid friction the residual falls to the sensor noise (0.05 N m)
     fr = tmp_path / "friction.json"
-    write_friction_json(fr, SigmoidFriction.from_array(dynid.panda().friction))
+    save_friction_json(fr, SigmoidFriction.from_array(dynid.panda().friction))
     assert (
         main(
             [
@@ -315,7 +315,7 @@ def test_identify_consistent_on_a_log_writes_both_models_and_validate_uses_its_f
     """identify --consistent: identification.json + feasible.json with linear friction (fv, fc
     >= 0), which validate --params uses."""
     from dynid.io.feasible import load_feasible_linear_friction
-    from dynid.io.torque_log import write_torque_log
+    from dynid.io.torque_log import save_torque_log
     from dynid.simulation.measurement import sample_times, simulate_measurement
     from dynid.simulation.trajectories import random_fourier
 
@@ -323,7 +323,7 @@ def test_identify_consistent_on_a_log_writes_both_models_and_validate_uses_its_f
     rng = np.random.default_rng(31)
     traj = random_fourier(panda, rng, n_harmonics=5)(sample_times(12.0, 500.0))
     log = simulate_measurement(panda, traj, rng=rng)
-    path = write_torque_log(tmp_path / "log.csv", log)
+    path = save_torque_log(tmp_path / "log.csv", log)
     out = tmp_path / "c"
     rc = main(
         ["identify", "--data", str(path), "--consistent", "--prior", "panda", "--out", str(out)]

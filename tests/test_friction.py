@@ -16,7 +16,7 @@ from dynid.friction.model import (
     sigmoid_friction,
 )
 from dynid.friction.validation import own_friction, validate
-from dynid.io.friction_json import read_friction_json, write_friction_json
+from dynid.io.friction_json import load_friction_json, save_friction_json
 from dynid.simulation.measurement import SensorNoise, sample_times, simulate_measurement
 from dynid.simulation.trajectories import centered_start, scale_into_limits, sinusoid_trajectory
 
@@ -144,8 +144,8 @@ def test_friction_json_round_trip(tmp_path, panda):
     sig = SigmoidFriction.from_array(panda.friction)
     cls = ClassicalFriction([0.1, 0.2], [0.3, 0.4], [0.0, -0.1])
     for fr in (sig, cls):
-        p = write_friction_json(tmp_path / f"{fr.kind}.json", fr)
-        back = read_friction_json(p)
+        p = save_friction_json(tmp_path / f"{fr.kind}.json", fr)
+        back = load_friction_json(p)
         assert type(back) is type(fr)
         np.testing.assert_array_equal(back.as_array(), fr.as_array())
     doc = json.loads((tmp_path / "sigmoid.json").read_text())
@@ -153,12 +153,12 @@ def test_friction_json_round_trip(tmp_path, panda):
     del doc["joints"][2]["phi2"]
     (tmp_path / "bad.json").write_text(json.dumps(doc))
     with pytest.raises(DataError, match="joint 3 has no 'phi2'"):
-        read_friction_json(tmp_path / "bad.json")
+        load_friction_json(tmp_path / "bad.json")
     (tmp_path / "bad2.json").write_text(
         '{"schema": "dynid-friction/1", "model": "stribeck", "joints": []}'
     )
     with pytest.raises(DataError, match="'model' must be"):
-        read_friction_json(tmp_path / "bad2.json")
+        load_friction_json(tmp_path / "bad2.json")
 
 
 def test_friction_json_of_a_fit_holds_rms(tmp_path):
@@ -167,6 +167,6 @@ def test_friction_json_of_a_fit_holds_rms(tmp_path):
     dq = rng.uniform(-1, 1, (500, 2))
     r = 0.2 * dq + 0.1 * np.sign(dq) + rng.normal(0, 0.01, dq.shape)
     fit = fit_classical(dq, r)
-    doc = json.loads(write_friction_json(tmp_path / "f.json", fit).read_text())
+    doc = json.loads(save_friction_json(tmp_path / "f.json", fit).read_text())
     assert doc["joints"][1]["rms_after"] == pytest.approx(fit.rms_after[1])
     assert doc["joints"][0]["fv"] == pytest.approx(0.2, abs=0.01)

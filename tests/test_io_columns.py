@@ -16,9 +16,9 @@ from dynid.identification.log import TorqueLog
 from dynid.io.columns import (
     ColumnMap,
     load_column_map,
+    load_mapped_static_data,
+    load_mapped_torque_log,
     parse_column_map,
-    read_mapped_static_data,
-    read_mapped_torque_log,
 )
 from dynid.io.model_json import load_model_json
 from dynid.io.static_data import save_static_csv
@@ -57,7 +57,7 @@ def test_renamed_rescaled_log_reads_as_the_original(tmp_path):
         "t=time_ms,q=position_{i0},dq=velocity_{i0},tau=effort_{i0}",
         "t=ms,q=deg,dq=deg/s,tau=mNm",
     )
-    got = read_mapped_torque_log(path, cmap)
+    got = load_mapped_torque_log(path, cmap)
     np.testing.assert_allclose(got.log.t, log.t, rtol=1e-15, atol=1e-18)
     for k in ("q", "dq", "tau"):
         np.testing.assert_allclose(getattr(got.log, k), getattr(log, k), rtol=1e-14, atol=1e-15)
@@ -70,7 +70,7 @@ def test_positions_only_gives_filtered_derivative_velocities(tmp_path):
     path = tmp_path / "pos.csv"
     _write_renamed(path, log, with_dq=False)
     cmap = parse_column_map("t=time_ms,q=position_{i0},tau=effort_{i0}", "t=ms,q=deg,tau=mNm")
-    got = read_mapped_torque_log(path, cmap, n=3)
+    got = load_mapped_torque_log(path, cmap, n=3)
     assert any("velocities derived" in s for s in got.notes)
     inner = slice(1000, -1000)  # 1 s at each end: the filter's transient (1e-4 relative)
     err = np.abs(got.log.dq[inner] - log.dq[inner])
@@ -84,7 +84,7 @@ def test_npz_arrays_and_toml_map(tmp_path):
     (tmp_path / "map.toml").write_text(
         '[columns]\nt = "stamp"\nq = "pos"\ndq = "vel"\ntau = "eff"\n[units]\nq = "deg"\n'
     )
-    got = read_mapped_torque_log(tmp_path / "log.npz", load_column_map(tmp_path / "map.toml"))
+    got = load_mapped_torque_log(tmp_path / "log.npz", load_column_map(tmp_path / "map.toml"))
     np.testing.assert_allclose(got.log.q, log.q, rtol=1e-14, atol=1e-15)
     np.testing.assert_array_equal(got.log.tau, log.tau)
 
@@ -102,9 +102,9 @@ def test_column_map_errors_name_what_is_wrong(tmp_path):
     path = tmp_path / "other.csv"
     _write_renamed(path, _log(4))
     with pytest.raises(DataError, match=r"no column 'effort1' for 'tau'.*--columns"):
-        read_mapped_torque_log(path, parse_column_map("t=time_ms,q=position_{i0},tau=effort{i}"))
+        load_mapped_torque_log(path, parse_column_map("t=time_ms,q=position_{i0},tau=effort{i}"))
     with pytest.raises(DataError, match="no time column 't'"):
-        read_mapped_torque_log(path, parse_column_map("q=position_{i0}"))
+        load_mapped_torque_log(path, parse_column_map("q=position_{i0}"))
     (tmp_path / "bad.toml").write_text('[cols]\nq = "x"\n')
     with pytest.raises(DataError, match=r"bad.toml: unknown key\(s\) \['cols'\]"):
         load_column_map(tmp_path / "bad.toml")
@@ -126,7 +126,7 @@ def test_static_data_through_a_map(tmp_path):
     table = np.stack([cols[k] for k in names], axis=1)
     np.savetxt(path, table, delimiter=",", header=",".join(names), comments="", fmt="%.17g")
     cmap = parse_column_map("q=joint{i0}_deg,M=inertia_{i0}_{j0},g=gravity{i0}", "q=deg,g=mNm")
-    got = read_mapped_static_data(path, cmap, robot).data
+    got = load_mapped_static_data(path, cmap, robot).data
     np.testing.assert_allclose(got.q, data.q, rtol=1e-14, atol=1e-15)
     np.testing.assert_array_equal(got.M, data.M)
     np.testing.assert_allclose(got.g, data.g, rtol=1e-14, atol=1e-13)

@@ -13,8 +13,8 @@ import dynid
 from dynid.cli.__main__ import main
 from dynid.exceptions import DataError
 from dynid.identification.log import TorqueLog
-from dynid.io.rosbag import match_joints, read_joint_state_bag
-from dynid.io.torque_log import read_torque_log, write_torque_log
+from dynid.io.rosbag import load_joint_state_bag, match_joints
+from dynid.io.torque_log import load_torque_log, save_torque_log
 
 rosbags = pytest.importorskip("rosbags")
 from rosbags.rosbag1 import Writer as Writer1  # noqa: E402
@@ -86,8 +86,8 @@ def csv_log(tmp_path_factory):
     N, n = 20_000, 7
     t = np.arange(N) * 1e-3
     log = TorqueLog(t, rng.normal(size=(N, n)), rng.normal(size=(N, n)), rng.normal(size=(N, n)))
-    path = write_torque_log(tmp_path_factory.mktemp("csv") / "log.csv", log)
-    return read_torque_log(path)
+    path = save_torque_log(tmp_path_factory.mktemp("csv") / "log.csv", log)
+    return load_torque_log(path)
 
 
 @pytest.mark.parametrize("kind", ["mcap", "sqlite3", "ros1"])
@@ -96,7 +96,7 @@ def test_bag_with_shuffled_names_imports_to_the_csv_log(kind, csv_log, tmp_path)
     robot = dynid.panda()
     path = tmp_path / ("log.bag" if kind == "ros1" else "bag")
     write_bag(path, kind, _shuffled(csv_log, robot, seed=1), extra_topic=5)
-    res = read_joint_state_bag(path, robot.joint_names)
+    res = load_joint_state_bag(path, robot.joint_names)
     assert res.joints == tuple(_bag_names(robot)) and res.time_source == "header"
     assert res.t0_ns == T0_NS and res.n_messages == 20_000 and res.n_other_topics == 5
     np.testing.assert_allclose(res.log.t, csv_log.t, rtol=0, atol=1e-9)
@@ -131,7 +131,7 @@ def test_bad_messages_are_dropped_and_counted(tmp_path):
     a, b = msgs[20], msgs[21]  # stamps out of order, received in order
     msgs[20], msgs[21] = (a[0], *b[1:]), (b[0], *a[1:])
     write_bag(tmp_path / "b", "mcap", msgs, extra_topic=3)
-    res = read_joint_state_bag(tmp_path / "b", robot.joint_names)
+    res = load_joint_state_bag(tmp_path / "b", robot.joint_names)
     assert (res.n_missing, res.n_nonfinite, res.n_duplicate_stamps) == (2, 1, 1)
     assert res.n_out_of_order == 1 and res.n_other_topics == 3
     keep = np.setdiff1d(np.arange(log.n_samples), [5, 6, 7])
@@ -146,7 +146,7 @@ def test_unset_stamps_fall_back_to_receive_time(tmp_path):
     log = _small(robot)
     msgs = [(T0_NS + 10**7 * k, 0, *m[2:]) for k, m in enumerate(_shuffled(log, robot, 4))]
     write_bag(tmp_path / "b.bag", "ros1", msgs)
-    res = read_joint_state_bag(tmp_path / "b.bag", robot.joint_names)
+    res = load_joint_state_bag(tmp_path / "b.bag", robot.joint_names)
     assert res.time_source == "receive" and any("receive times" in s for s in res.notes)
     np.testing.assert_allclose(res.log.t, log.t, atol=1e-9)
 
@@ -160,7 +160,7 @@ def test_positions_only_bag_derives_velocities(tmp_path):
     names = _bag_names(robot)
     msgs = [(T0_NS + int(t[k] * 1e9),) * 2 + (names, q[k], [], np.zeros(7)) for k in range(len(t))]
     write_bag(tmp_path / "b", "sqlite3", msgs)
-    res = read_joint_state_bag(tmp_path / "b", robot.joint_names)
+    res = load_joint_state_bag(tmp_path / "b", robot.joint_names)
     assert res.velocity_derived and any("derived from positions" in s for s in res.notes)
     dq = 2 * np.pi * f * np.cos(2 * np.pi * f * t[:, None])
     inner = slice(1000, -1000)
@@ -187,19 +187,19 @@ def test_bag_errors(tmp_path):
     """Missing bag, wrong topic, no effort: DataError naming the bag and what is wrong."""
     robot = dynid.panda()
     with pytest.raises(DataError, match="bag not found"):
-        read_joint_state_bag(tmp_path / "none.bag", robot.joint_names)
+        load_joint_state_bag(tmp_path / "none.bag", robot.joint_names)
     log = _small(robot)
     write_bag(tmp_path / "b", "mcap", _shuffled(log, robot, 5), extra_topic=1)
     with pytest.raises(
         DataError, match=r"no topic '/js'; the bag has \['/chatter', '/joint_states'\]"
     ):
-        read_joint_state_bag(tmp_path / "b", robot.joint_names, topic="/js")
+        load_joint_state_bag(tmp_path / "b", robot.joint_names, topic="/js")
     with pytest.raises(DataError, match="holds std_msgs/msg/String, not JointState"):
-        read_joint_state_bag(tmp_path / "b", robot.joint_names, topic="/chatter")
+        load_joint_state_bag(tmp_path / "b", robot.joint_names, topic="/chatter")
     msgs = [(*m[:5], []) for m in _shuffled(log, robot, 6)]
     write_bag(tmp_path / "c", "mcap", msgs)
     with pytest.raises(DataError, match="holds effort"):
-        read_joint_state_bag(tmp_path / "c", robot.joint_names)
+        load_joint_state_bag(tmp_path / "c", robot.joint_names)
 
 
 def test_cli_import_writes_a_log_every_command_reads(tmp_path, capsys):
@@ -209,7 +209,7 @@ def test_cli_import_writes_a_log_every_command_reads(tmp_path, capsys):
     write_bag(tmp_path / "b.bag", "ros1", _shuffled(log, robot, 7))
     for out in ("log.csv", "log.npz"):
         assert main(["import", str(tmp_path / "b.bag"), "--out", str(tmp_path / out)]) == 0
-        back = read_torque_log(tmp_path / out)
+        back = load_torque_log(tmp_path / out)
         np.testing.assert_array_equal(back.tau, log.tau)
     assert "joint1 <- panda_joint1" in capsys.readouterr().out
     argv = ["import", str(tmp_path / "b.bag"), "--out", str(tmp_path / "x.csv")]

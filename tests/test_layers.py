@@ -88,3 +88,18 @@ def test_import_dynid_does_not_load_matplotlib():
     code = "import sys, dynid; print('matplotlib' in sys.modules)"
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
     assert out.stdout.strip() == "False"
+
+
+def test_io_exports_every_public_name_lazily_and_only_save_load_verbs():
+    """dynid.io resolves each exported name on first use; every file verb is save_/load_."""
+    import importlib
+    import re
+
+    io = importlib.import_module("dynid.io")
+    for name in io.__all__:
+        assert callable(getattr(io, name)), name
+        assert name.startswith(("save_", "load_")), name
+    defs = set()
+    for path in (SRC / "io").glob("*.py"):
+        defs |= set(re.findall(r"^def ((?:read|write)_\w+)\(", path.read_text(), re.M))
+    assert defs <= {"write_text", "write_bytes"}, sorted(defs)  # the atomic primitives only

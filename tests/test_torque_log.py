@@ -7,7 +7,7 @@ import pytest
 
 from dynid.exceptions import DataError, NonFiniteError, ShapeError
 from dynid.identification.log import TorqueLog, prepare_log
-from dynid.io.torque_log import read_torque_log, torque_log_columns, write_torque_log
+from dynid.io.torque_log import load_torque_log, save_torque_log, torque_log_columns
 from dynid.simulation.measurement import SensorNoise, sample_times, simulate_measurement
 from dynid.simulation.trajectories import sinusoid_trajectory
 
@@ -23,7 +23,7 @@ def _log(rng, N=50, n=3, ddq=False):
 def test_round_trip_is_exact(tmp_path, suffix, with_ddq):
     """Writing then reading a log gives back the same arrays, bit for bit."""
     log = _log(np.random.default_rng(41), ddq=with_ddq)
-    back = read_torque_log(write_torque_log(tmp_path / f"log{suffix}", log))
+    back = load_torque_log(save_torque_log(tmp_path / f"log{suffix}", log))
     for k in ("t", "q", "dq", "tau"):
         np.testing.assert_array_equal(getattr(back, k), getattr(log, k))
     if with_ddq:
@@ -35,7 +35,7 @@ def test_round_trip_is_exact(tmp_path, suffix, with_ddq):
 
 def test_csv_header_names_columns_and_units(tmp_path):
     """The CSV starts with a units comment and the t, q1..qn, dq1..dqn, tau1..taun header."""
-    path = write_torque_log(tmp_path / "log.csv", _log(np.random.default_rng(42), n=2))
+    path = save_torque_log(tmp_path / "log.csv", _log(np.random.default_rng(42), n=2))
     lines = path.read_text().splitlines()
     assert lines[0].startswith("#") and "tau [N m]" in lines[0]
     assert lines[1] == "# rows: 50"
@@ -92,7 +92,7 @@ def test_from_raw_rejects_time_running_backwards():
 def test_csv_with_empty_and_nan_cells_is_refused_or_dropped_on_request(tmp_path, caplog):
     """Empty or 'nan' cells make a row invalid: refused by default (issue 12), dropped and
     counted with drop_invalid, with a warning that says how many and where."""
-    path = write_torque_log(tmp_path / "log.csv", _log(np.random.default_rng(43), N=20, n=2))
+    path = save_torque_log(tmp_path / "log.csv", _log(np.random.default_rng(43), N=20, n=2))
     lines = path.read_text().splitlines()
     cells = lines[5].split(",")
     cells[3] = ""
@@ -102,15 +102,15 @@ def test_csv_with_empty_and_nan_cells_is_refused_or_dropped_on_request(tmp_path,
     lines[9] = ",".join(cells)
     path.write_text("\n".join(lines) + "\n")
     with pytest.raises(DataError, match=r"2 row\(s\) hold NaN.*first row 2 \(line 6\) in 'dq1'"):
-        read_torque_log(path)
-    log = read_torque_log(path, drop_invalid=True)
+        load_torque_log(path)
+    log = load_torque_log(path, drop_invalid=True)
     assert log.n_samples == 18 and log.cleaning.n_nan_rows == 2
     assert "dropped 2 row(s) of 20" in caplog.text and "row 6 (line 10)" in caplog.text
 
 
 def test_csv_errors_name_the_line_and_column(tmp_path):
     """Non-numeric cells, short rows and missing columns raise DataError with the place."""
-    path = write_torque_log(tmp_path / "log.csv", _log(np.random.default_rng(44), N=10, n=2))
+    path = save_torque_log(tmp_path / "log.csv", _log(np.random.default_rng(44), N=10, n=2))
     lines = path.read_text().splitlines()
     bad = lines.copy()
     cells = bad[4].split(",")
@@ -118,26 +118,26 @@ def test_csv_errors_name_the_line_and_column(tmp_path):
     bad[4] = ",".join(cells)
     (tmp_path / "a.csv").write_text("\n".join(bad))
     with pytest.raises(DataError, match=r"a.csv, line 5, column 'tau1': not a number: 'abc'"):
-        read_torque_log(tmp_path / "a.csv")
+        load_torque_log(tmp_path / "a.csv")
     bad = lines.copy()
     bad[6] = ",".join(bad[6].split(",")[:-1])
     (tmp_path / "b.csv").write_text("\n".join(bad))
     with pytest.raises(DataError, match="b.csv, line 7: expected 7 fields"):
-        read_torque_log(tmp_path / "b.csv")
+        load_torque_log(tmp_path / "b.csv")
     bad = lines.copy()
     bad[2] = bad[2].replace("tau2", "torque2")
     (tmp_path / "c.csv").write_text("\n".join(bad))
     with pytest.raises(DataError, match=r"missing column\(s\) \['tau2'\]"):
-        read_torque_log(tmp_path / "c.csv")
+        load_torque_log(tmp_path / "c.csv")
     with pytest.raises(DataError, match="must be a .csv or .npz"):
-        read_torque_log(tmp_path / "log.txt")
+        load_torque_log(tmp_path / "log.txt")
 
 
 def test_npz_errors(tmp_path):
     """A missing array or an object array in an NPZ raises DataError."""
     np.savez(tmp_path / "a.npz", t=np.arange(3.0), q=np.zeros((3, 1)), dq=np.zeros((3, 1)))
     with pytest.raises(DataError, match=r"missing array\(s\) \['tau'\]"):
-        read_torque_log(tmp_path / "a.npz")
+        load_torque_log(tmp_path / "a.npz")
     np.savez(
         tmp_path / "b.npz",
         t=np.arange(3.0),
@@ -146,7 +146,7 @@ def test_npz_errors(tmp_path):
         tau=np.array([[{}], [{}], [{}]], dtype=object),
     )
     with pytest.raises(DataError, match="b.npz"):
-        read_torque_log(tmp_path / "b.npz")
+        load_torque_log(tmp_path / "b.npz")
 
 
 def test_prepare_log_resamples_jittered_and_dropped_samples(panda):

@@ -372,15 +372,15 @@ def read_log(args: argparse.Namespace, path: Path, n: int | None = None) -> Any:
     it dropped (NaN/inf, repeated timestamps) are an error here unless ``--drop-invalid``,
     as for a log read directly.
     """
-    from ..io.torque_log import read_torque_log
+    from ..io.torque_log import load_torque_log
 
     drop = bool(getattr(args, "drop_invalid", False))
     cmap = column_map(args)
     if cmap is None:
-        return read_torque_log(path, drop_invalid=drop)
-    from ..io.columns import read_mapped_torque_log
+        return load_torque_log(path, drop_invalid=drop)
+    from ..io.columns import load_mapped_torque_log
 
-    mapped = read_mapped_torque_log(path, cmap, n=n)
+    mapped = load_mapped_torque_log(path, cmap, n=n)
     for note in mapped.notes:
         _log.warning("%s: %s", path.name, note)
     c = mapped.log.cleaning

@@ -35,7 +35,7 @@ from ..friction.validation import Validation
 from ..identification.log import DEFAULT_CUTOFF_HZ
 from ..identification.model import IdentifiedModel
 from ..io._json import save_json
-from ..io.friction_json import write_friction_json
+from ..io.friction_json import save_friction_json
 from ..model.robot import Robot
 from .common import (
     about,
@@ -175,7 +175,7 @@ def run(args: argparse.Namespace) -> int:
         "n_samples": fit.n_samples,
         "converged": [bool(x) for x in fit.converged],
     }
-    write_friction_json(args.out / "friction.json", fit, metadata=meta)
+    save_friction_json(args.out / "friction.json", fit, metadata=meta)
     names = _joint_names(model)
     if not args.no_figures:
         save_friction_figure(
@@ -199,7 +199,7 @@ def save_demo_stage(out_dir: Path, res: FrictionStageResult) -> list[Path]:
     ``validation.json``, ``friction.png`` and the validation figures; returns the paths."""
     out_dir = Path(out_dir)
     names = list(res.truth.joint_names)
-    write_friction_json(
+    save_friction_json(
         out_dir / "friction.json", res.fit, metadata={"seed": res.seed, "source": "demo, sinusoids"}
     )
     doc = res.validation.as_dict()

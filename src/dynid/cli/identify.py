@@ -226,9 +226,9 @@ def read_static_file(robot: Robot, path: Path, args: argparse.Namespace) -> Stat
     """Static data (checked), through ``--columns``/``--units`` when given; notes logged."""
     cmap = column_map(args)
     if cmap is not None:
-        from ..io.columns import read_mapped_static_data
+        from ..io.columns import load_mapped_static_data
 
-        mapped = read_mapped_static_data(path, cmap, robot)
+        mapped = load_mapped_static_data(path, cmap, robot)
         for note in mapped.notes:
             _log.warning("%s: %s", path.name, note)
         return mapped.data

@@ -21,8 +21,8 @@ import argparse
 from pathlib import Path
 
 from ..identification.log import DEFAULT_CUTOFF_HZ
-from ..io.rosbag import read_joint_state_bag
-from ..io.torque_log import write_torque_log
+from ..io.rosbag import load_joint_state_bag
+from ..io.torque_log import save_torque_log
 from .common import add_robot_options, add_subcommand, load_robot, positive_type, print_json
 
 NAME = "import"
@@ -58,10 +58,10 @@ def run(args: argparse.Namespace) -> int:
     """Read the bag, write the log, print what was found; returns the exit code."""
     robot = load_robot(args)
     joints = None if args.joints is None else [s.strip() for s in args.joints.split(",")]
-    res = read_joint_state_bag(
+    res = load_joint_state_bag(
         args.bag, robot.joint_names, topic=args.topic, joints=joints, velocity_cutoff_hz=args.cutoff
     )
-    path = write_torque_log(args.out, res.log)
+    path = save_torque_log(args.out, res.log)
     summary = {
         "bag": str(args.bag.name),
         "topic": res.topic,

@@ -26,7 +26,7 @@ from ..feasibility.payload import identify_payload, robot_with_payload
 from ..identification.log import DEFAULT_CUTOFF_HZ
 from ..identification.model import IdentifiedModel
 from ..io._files import write_text
-from ..io.columns import ColumnMap, read_mapped_static_data
+from ..io.columns import ColumnMap, load_mapped_static_data
 from ..io.payload_json import save_payload_json
 from .common import add_column_options, add_subcommand, column_map, positive_type, read_log
 from .identify import data_kind
@@ -62,7 +62,7 @@ def _read(args: argparse.Namespace, path: Path, robot, kind: str):  # noqa: ANN0
     if kind == "torque_log":
         return read_log(args, path, robot.n)
     cmap = column_map(args) or ColumnMap()
-    mapped = read_mapped_static_data(path, cmap, robot, require_M=not args.gravity_only)
+    mapped = load_mapped_static_data(path, cmap, robot, require_M=not args.gravity_only)
     return mapped.data
 
 

@@ -287,9 +287,9 @@ def _friction_robot(robot: Robot, path: Path | None) -> Robot:
     if path is None:
         return robot
     from ..friction.model import SigmoidFriction
-    from ..io.friction_json import read_friction_json
+    from ..io.friction_json import load_friction_json
 
-    fr = read_friction_json(path)
+    fr = load_friction_json(path)
     if not isinstance(fr, SigmoidFriction):
         raise DynidError(f"{path.name}: a robot holds sigmoid friction; got a {fr.kind} model")
     return robot.with_friction(fr.as_array())

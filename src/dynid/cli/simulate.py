@@ -26,7 +26,7 @@ from pathlib import Path
 import numpy as np
 
 from ..exceptions import DynidError
-from ..io.torque_log import write_torque_log
+from ..io.torque_log import save_torque_log
 from ..simulation.measurement import SensorNoise, sample_times, simulate_measurement
 from ..simulation.trajectories import (
     GAZ2019_SINUSOID_AMPLITUDES,
@@ -193,7 +193,7 @@ def run(args: argparse.Namespace) -> int:
         with_ddq=args.with_ddq,
         effects=effects,
     )
-    write_torque_log(args.out, measured)
+    save_torque_log(args.out, measured)
     say(
         f"wrote {args.out}: {measured.n_samples} samples, {measured.duration:.2f} s, "
         f"{n} joints, torque noise {args.noise:g} N m, seed {args.seed}"

@@ -37,7 +37,7 @@ from ..friction.validation import own_friction, validate
 from ..identification.log import DEFAULT_CUTOFF_HZ
 from ..identification.model import IdentifiedModel
 from ..io._json import save_json
-from ..io.friction_json import read_friction_json
+from ..io.friction_json import load_friction_json
 from ..model.robot import Robot
 from .common import (
     about,
@@ -117,7 +117,7 @@ def run(args: argparse.Namespace) -> int:
     logs = [log]  # handed over: validate frees the raw signals once it has filtered them
     del log
     if args.friction is not None:
-        friction = read_friction_json(args.friction)
+        friction = load_friction_json(args.friction)
     elif args.no_friction:
         friction = None
     else:

@@ -47,8 +47,8 @@ __all__ = [
     "MappedStatic",
     "load_column_map",
     "parse_column_map",
-    "read_mapped_static_data",
-    "read_mapped_torque_log",
+    "load_mapped_static_data",
+    "load_mapped_torque_log",
 ]
 
 _DEFAULT = {
@@ -308,7 +308,7 @@ class MappedLog:
     notes: tuple[str, ...] = ()
 
 
-def read_mapped_torque_log(
+def load_mapped_torque_log(
     path: str | Path, columns: ColumnMap, *, n: int | None = None, gap_factor: float = 1.5
 ) -> MappedLog:
     """Read a torque log (CSV or NPZ) through a column map; SI out.
@@ -376,7 +376,7 @@ class MappedStatic:
     notes: tuple[str, ...] = ()
 
 
-def read_mapped_static_data(
+def load_mapped_static_data(
     path: str | Path, columns: ColumnMap, robot: Robot | None = None, *, require_M: bool = True
 ) -> MappedStatic:
     """Read static data ``q, M, g`` (CSV or NPZ) through a column map; SI out.

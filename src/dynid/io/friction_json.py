@@ -26,7 +26,7 @@ from ..friction.fit import FrictionFit
 from ..friction.model import ClassicalFriction, FrictionModel, SigmoidFriction
 from ._json import load_json, save_json
 
-__all__ = ["FORMAT", "read_friction_json", "write_friction_json"]
+__all__ = ["FORMAT", "load_friction_json", "save_friction_json"]
 
 FORMAT = "dynid-friction/1"
 
@@ -46,7 +46,7 @@ _CLASSES: dict[str, type[SigmoidFriction] | type[ClassicalFriction]] = {
 }
 
 
-def write_friction_json(
+def save_friction_json(
     path: str | Path,
     friction: FrictionModel | FrictionFit,
     *,
@@ -89,7 +89,7 @@ def write_friction_json(
     return save_json(path, doc)
 
 
-def read_friction_json(path: str | Path) -> FrictionModel:
+def load_friction_json(path: str | Path) -> FrictionModel:
     """Read a friction model from ``path``.
 
     Raises

@@ -1,6 +1,6 @@
 """Torque logs from ROS bags: ``sensor_msgs/JointState`` in ROS 1 and ROS 2 recordings.
 
-:func:`read_joint_state_bag` reads a ROS 1 bag (``.bag``) or a ROS 2 bag (a folder with
+:func:`load_joint_state_bag` reads a ROS 1 bag (``.bag``) or a ROS 2 bag (a folder with
 ``metadata.yaml``, sqlite3 or MCAP storage) with ``rosbags`` (pure Python, optional extra
 ``dynid[ros]``) and returns a :class:`BagImport`: the torque log and what was found.
 
@@ -35,7 +35,7 @@ from .. import signals
 from ..exceptions import DataError
 from ..identification.log import DEFAULT_CUTOFF_HZ, TorqueLog
 
-__all__ = ["JOINT_STATE_TYPES", "BagImport", "match_joints", "read_joint_state_bag"]
+__all__ = ["JOINT_STATE_TYPES", "BagImport", "match_joints", "load_joint_state_bag"]
 
 JOINT_STATE_TYPES = ("sensor_msgs/msg/JointState", "sensor_msgs/JointState")
 
@@ -158,7 +158,7 @@ def _open(path: Path):  # noqa: ANN202 (a rosbags reader)
     return AnyReader([path], default_typestore=get_typestore(store))
 
 
-def read_joint_state_bag(
+def load_joint_state_bag(
     path: str | Path,
     robot_joints: Sequence[str],
     *,

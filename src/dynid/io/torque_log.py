@@ -45,7 +45,7 @@ from ..identification.log import TorqueLog
 from ._files import open_atomic
 from .static_data import check_row_count
 
-__all__ = ["read_torque_log", "write_torque_log", "torque_log_columns"]
+__all__ = ["load_torque_log", "save_torque_log", "torque_log_columns"]
 
 _log = logging.getLogger(__name__)
 
@@ -62,7 +62,7 @@ def torque_log_columns(n: int, *, with_ddq: bool = False) -> list[str]:
     return cols
 
 
-def write_torque_log(path: str | Path, log: TorqueLog) -> Path:
+def save_torque_log(path: str | Path, log: TorqueLog) -> Path:
     """Write ``log`` to ``path`` (``.csv`` or ``.npz``, by suffix); returns the path.
 
     Raises
@@ -101,7 +101,7 @@ def write_torque_log(path: str | Path, log: TorqueLog) -> Path:
     return path
 
 
-def read_torque_log(
+def load_torque_log(
     path: str | Path, *, gap_factor: float = 1.5, drop_invalid: bool = False
 ) -> TorqueLog:
     """Read a torque log from a ``.csv`` or ``.npz`` file, strictly.
