@@ -21,9 +21,9 @@ from dynid.feasibility.bounds import Bounds, default_bounds, kinematic_bounds, p
 from dynid.feasibility.constraints import (
     UserConstraint,
     feasibility_report,
+    is_physically_valid,
     link_params,
     user_constraints,
-    validate,
 )
 from dynid.feasibility.penalty import coefficient_problem, phi_from_params
 from dynid.feasibility.retrieve import (
@@ -32,8 +32,8 @@ from dynid.feasibility.retrieve import (
     retrieve_from_coefficients,
     retrieve_from_static,
 )
-from dynid.feasibility.validate import validate_newton_euler
 from dynid.friction.model import SigmoidFriction
+from dynid.friction.validation import validate_newton_euler
 from dynid.identification.model import IdentifiedModel
 from dynid.regressors.base import base_parameters
 
@@ -78,7 +78,7 @@ def test_thin_rod_violates_nothing():
     R = _rotation(rng)
     I = R @ np.diag([0.0, m * L**2 / 12, m * L**2 / 12]) @ R.T
     rep = feasibility_report(_one_link(m, I, (0.1, 0.0, 0.0)))
-    assert rep.ok and validate(_one_link(m, I))
+    assert rep.ok and is_physically_valid(_one_link(m, I))
     assert abs(rep.min_margin("inertia_positive_definite")) < 1e-15
     assert abs(rep.min_margin("triangle_inequality")) < 1e-15
 
@@ -150,11 +150,11 @@ def test_published_panda_is_valid_and_identified_equivalent_is_reported_not_reje
     """The published p_hat is valid; an identified model's equivalent parameter set is held
     (a Robot) and reported infeasible rather than rejected."""
     panda = dynid.panda()
-    assert validate(panda)
+    assert is_physically_valid(panda)
     assert feasibility_report(panda, panda_bounds()).ok
     eq = _noise_free_model(panda).equivalent_robot
     rep = feasibility_report(eq)
-    assert not rep.ok and not validate(eq)
+    assert not rep.ok and not is_physically_valid(eq)
     assert len(rep.constraints) == 3 * panda.n
 
 

@@ -15,7 +15,7 @@ from dynid.friction.model import (
     classical_friction,
     sigmoid_friction,
 )
-from dynid.friction.validation import own_friction, validate
+from dynid.friction.validation import own_friction, validate_torques
 from dynid.io.friction_json import load_friction_json, save_friction_json
 from dynid.simulation.measurement import SensorNoise, sample_times, simulate_measurement
 from dynid.simulation.trajectories import centered_start, scale_into_limits, sinusoid_trajectory
@@ -114,7 +114,7 @@ def test_sigmoid_fit_rejects_bad_shapes():
 def test_validation_of_the_true_model_is_at_the_noise_level(panda, sinusoid_log):
     """The robot's own parameters and friction predict the measured torques to the noise."""
     _, log = sinusoid_log
-    val = validate(panda, log, friction=own_friction(panda))
+    val = validate_torques(panda, log, friction=own_friction(panda))
     np.testing.assert_allclose(val.with_friction.rms, NOISE, rtol=0.03)
     np.testing.assert_allclose(val.with_friction.mse, val.with_friction.rms**2)
     assert np.all(val.without_friction.rms > 2.5 * NOISE)
@@ -125,7 +125,7 @@ def test_validation_of_the_true_model_is_at_the_noise_level(panda, sinusoid_log)
     d = val.as_dict()
     assert set(d) >= {"rms", "mse", "relative_error_percent", "without_friction"}
     with pytest.raises(ShapeError, match="friction model has 2 joints"):
-        validate(panda, log, friction=ClassicalFriction([0, 0], [0, 0], [0, 0]))
+        validate_torques(panda, log, friction=ClassicalFriction([0, 0], [0, 0], [0, 0]))
 
 
 def test_validate_accepts_a_callable_model(panda, sinusoid_log):
@@ -133,10 +133,10 @@ def test_validate_accepts_a_callable_model(panda, sinusoid_log):
     _, log = sinusoid_log
     from dynid import rnea
 
-    val = validate(lambda q, dq, ddq: rnea(panda, q, dq, ddq), log)
+    val = validate_torques(lambda q, dq, ddq: rnea(panda, q, dq, ddq), log)
     assert val.with_friction is None and val.errors is val.without_friction
     with pytest.raises(ShapeError, match="model torques must have shape"):
-        validate(lambda q, dq, ddq: q[:, :3], log)
+        validate_torques(lambda q, dq, ddq: q[:, :3], log)
 
 
 def test_friction_json_round_trip(tmp_path, panda):

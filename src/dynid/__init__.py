@@ -58,8 +58,7 @@ if TYPE_CHECKING:  # the names as static imports, for type checkers and editors
         classical_friction,
         sigmoid_friction,
     )
-    from .friction.validation import Validation
-    from .friction.validation import validate as validate_torques
+    from .friction.validation import Validation, validate_torques
     from .identification.classical import identify_from_log
     from .identification.data import StaticDataset
     from .identification.least_squares import LeastSquaresFit, fit_least_squares
@@ -163,7 +162,7 @@ _LAZY: dict[str, tuple[str, str]] = {
     "sinusoid_trajectory": ("simulation.trajectories", "sinusoid_trajectory"),
     "static_regressor": ("regressors.static", "static_regressor"),
     "torque_regressor": ("regressors.torque", "torque_regressor"),
-    "validate_torques": ("friction.validation", "validate"),
+    "validate_torques": ("friction.validation", "validate_torques"),
 }
 
 __version__ = "0.1.0"

@@ -64,8 +64,8 @@ from ..feasibility.retrieve import (
     retrieve_from_static,
 )
 from ..feasibility.sdp import ConsistentResult
-from ..feasibility.validate import NewtonEulerValidation
 from ..friction.model import ClassicalFriction
+from ..friction.validation import NewtonEulerValidation
 from ..identification.model import IdentifiedModel
 from ..io._json import save_json
 from ..io.export import save_robot

@@ -33,7 +33,7 @@ from pathlib import Path
 import numpy as np
 
 from ..exceptions import DataError, DynidError
-from ..friction.validation import own_friction, validate
+from ..friction.validation import own_friction, validate_torques
 from ..identification.log import DEFAULT_CUTOFF_HZ
 from ..identification.model import IdentifiedModel
 from ..io._json import save_json
@@ -127,7 +127,7 @@ def run(args: argparse.Namespace) -> int:
 
             friction = load_feasible_linear_friction(args.params) or friction
     with about(args.data):
-        val = validate(
+        val = validate_torques(
             model, logs.pop(), friction=friction, cutoff_hz=args.cutoff, max_gap_s=args.max_gap
         )
     errors = val.errors

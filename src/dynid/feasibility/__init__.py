@@ -8,9 +8,10 @@
 * :func:`identify_payload`: a load's mass, CoM and inertia on a known arm, with the same
   LMI (:mod:`.payload`).
 * :func:`feasibility_report`, :class:`Bounds`: constraints and their margins
-  (:mod:`.constraints`); :func:`validate_newton_euler` (:mod:`.validate`).
+  (:mod:`.constraints`); :func:`validate_newton_euler` (from :mod:`dynid.friction.validation`).
 """
 
+from ..friction.validation import validate_newton_euler
 from .bounds import Bounds, default_bounds, kinematic_bounds, panda_bounds
 from .compare import MethodSummary, compare_methods, perturbed_robot
 from .constraints import feasibility_report
@@ -20,7 +21,6 @@ from .payload import PayloadEstimate, identify_payload, robot_with_payload
 from .prior import Prior, generic_prior, prior_from_robot
 from .retrieve import RetrievalOptions, RetrievalResult, retrieve, retrieve_from_static
 from .sdp import ConsistentResult, SDPOptions, retrieve_sdp, solve_consistent
-from .validate import validate_newton_euler
 
 __all__ = [
     "Bounds",

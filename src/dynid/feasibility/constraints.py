@@ -23,7 +23,7 @@ its boundary, negative outside; its unit is the constraint's (kg, m or kg m^2). 
 constraint is *satisfied* when its margin is ``>= -tol * scale`` (limiting bodies such as
 a thin rod, a lamina or a point mass are valid, as in Drake), except the mass, which
 must be strictly positive. Identified parameters can be infeasible: they are held and
-reported, never rejected (:func:`feasibility_report`, :func:`validate`).
+reported, never rejected (:func:`feasibility_report`, :func:`is_physically_valid`).
 
 Decision-variable layout (the parameters the retrieval searches, per link, link-major)::
 
@@ -65,7 +65,7 @@ __all__ = [
     "params_from_inertial",
     "principal_moments",
     "user_constraints",
-    "validate",
+    "is_physically_valid",
 ]
 
 #: Per-link decision variables, in order: mass [kg], CoM [m], inertia about the CoM [kg m^2].
@@ -386,7 +386,7 @@ def feasibility_report(
     return FeasibilityReport(tuple(out), tol)
 
 
-def validate(robot_or_params: Any, *, tol: float = DEFAULT_TOL) -> bool:
+def is_physically_valid(robot_or_params: Any, *, tol: float = DEFAULT_TOL) -> bool:
     """Whether every link is physically valid (Drake's ``IsPhysicallyValid``).
 
     True when every link has ``m > 0``, a positive semi-definite inertia about its CoM and

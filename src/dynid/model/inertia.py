@@ -112,7 +112,7 @@ def inertial_from_phi(
 
     A link of zero mass has its CoM set to the origin (its first moment must then be zero
     for the result to describe the same body; this is not checked here, see
-    ``feasibility.validate``).
+    ``feasibility.constraints.is_physically_valid``).
     """
     p = _checks.as_batch("phi", phi, (10,))
     m = p[..., 0]

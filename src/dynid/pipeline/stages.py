@@ -30,10 +30,14 @@ from numpy.typing import ArrayLike, NDArray
 
 from ..exceptions import DynidError
 from ..feasibility.retrieve import RetrievalResult, retrieve
-from ..feasibility.validate import NewtonEulerValidation, validate_newton_euler
 from ..friction.fit import FrictionFit, FrictionResidual, fit_sigmoid, friction_residual
 from ..friction.model import SigmoidFriction
-from ..friction.validation import Validation, validate
+from ..friction.validation import (
+    NewtonEulerValidation,
+    Validation,
+    validate_newton_euler,
+    validate_torques,
+)
 from ..identification.data import StaticDataset
 from ..identification.log import TorqueLog, prepare_log
 from ..identification.model import IdentifiedModel
@@ -328,7 +332,7 @@ def friction_stage(
     val_log = simulate_measurement(truth, traj, rng=rng, noise=noise)
     res = friction_residual(model, fit_log)
     fit = fit_sigmoid(res.dq, res.residual)
-    val = validate(model, val_log, friction=fit.friction)
+    val = validate_torques(model, val_log, friction=fit.friction)
     assert val.with_friction is not None
     curve = None
     if truth.friction is not None:

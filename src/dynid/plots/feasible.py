@@ -18,7 +18,7 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from ..feasibility.retrieve import RetrievalResult
-from ..feasibility.validate import NewtonEulerValidation
+from ..friction.validation import NewtonEulerValidation
 
 if TYPE_CHECKING:  # pragma: no cover
     from matplotlib.axes import Axes
@@ -45,7 +45,7 @@ def plot_newton_euler_validation(
     Parameters
     ----------
     validation : NewtonEulerValidation
-        From :func:`dynid.feasibility.validate.validate_newton_euler`.
+        From :func:`dynid.friction.validation.validate_newton_euler`.
     joint_names : sequence of str, optional
         Panel titles (default ``validation.joint_names``).
     max_points : int

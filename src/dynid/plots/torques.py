@@ -42,7 +42,7 @@ def plot_torque_validation(
     Parameters
     ----------
     validation : Validation
-        From :func:`dynid.friction.validation.validate`.
+        From :func:`dynid.friction.validation.validate_torques`.
     joint_names : sequence of str, optional
         Row labels (default ``joint 1 .. n``).
     max_points : int
