@@ -1,7 +1,7 @@
 """Bounds of the link parameters for the retrieval, and the generic ones from the kinematics.
 
 :class:`Bounds` boxes every link's decision parameters (mass [kg], CoM in the link frame [m],
-inertia entries about the CoM [kg m^2], :data:`~dynid.feasibility.constraints.DECISION_FIELDS`)
+inertia entries about the CoM [kg m^2], :data:`~dynid.model.inertia.DECISION_FIELDS`)
 and bands the total mass. :func:`panda_bounds` are Gaz et al.'s for the Panda (their numbers
 live with the Panda, :mod:`dynid.model.panda`); :func:`kinematic_bounds` derives generic ones
 from the link lengths; :func:`default_bounds` picks between them.

@@ -45,73 +45,27 @@ from numpy.typing import ArrayLike, NDArray
 from .. import _checks
 from ..exceptions import ShapeError, WrongTypeError
 from ..model.inertia import (
-    INERTIA_ORDER,
-    inertia6_from_matrix,
     inertial_from_phi,
     matrix_from_inertia6,
+    params_from_inertial,
 )
 from ..model.robot import Robot
 from .bounds import Bounds
 
 __all__ = [
-    "DECISION_FIELDS",
     "Constraint",
     "FeasibilityReport",
     "UserConstraint",
-    "decision_labels",
     "feasibility_report",
-    "inertial_from_params",
     "link_params",
-    "params_from_inertial",
     "principal_moments",
     "user_constraints",
     "is_physically_valid",
 ]
 
-#: Per-link decision variables, in order: mass [kg], CoM [m], inertia about the CoM [kg m^2].
-DECISION_FIELDS = ("m", "cx", "cy", "cz") + tuple(f"I{ax}" for ax in INERTIA_ORDER)
 
 #: Default relative tolerance of :func:`feasibility_report` (see the module docstring).
 DEFAULT_TOL = 1e-9
-
-
-def decision_labels(n: int) -> tuple[str, ...]:
-    """Labels of the ``10 n`` decision variables: ``m1, c1x, c1y, c1z, I1xx, ..., I1zz, m2``..."""
-    out: list[str] = []
-    for i in range(1, n + 1):
-        out += [f"m{i}", f"c{i}x", f"c{i}y", f"c{i}z"] + [f"I{i}{ax}" for ax in INERTIA_ORDER]
-    return tuple(out)
-
-
-def params_from_inertial(
-    mass: ArrayLike, com: ArrayLike, inertia: ArrayLike
-) -> NDArray[np.float64]:
-    """Decision parameters ``p`` (n, 10) from masses (n,) [kg], CoMs (n, 3) [m] and
-    inertias about the CoM (n, 3, 3) or (n, 6) [kg m^2]."""
-    m = _checks.as_array("mass", mass)
-    if m.ndim != 1:
-        raise ShapeError(f"mass must have shape (n,); got {m.shape}")
-    n = m.shape[0]
-    c = _checks.as_exact("com", com, (n, 3))
-    I = _checks.as_array("inertia", inertia)
-    if I.shape == (n, 3, 3):
-        I = inertia6_from_matrix(I)
-    elif I.shape != (n, 6):
-        raise ShapeError(f"inertia must have shape ({n}, 3, 3) or ({n}, 6); got {I.shape}")
-    return np.concatenate([m[:, None], c, I], axis=1)
-
-
-def inertial_from_params(
-    p: ArrayLike,
-) -> tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.float64]]:
-    """Masses (n,) [kg], CoMs (n, 3) [m] and inertias about the CoM (n, 3, 3) [kg m^2]
-    from decision parameters ``p`` of shape (n, 10) or (10 n,)."""
-    a = _checks.as_array("p", p)
-    if a.ndim == 1 and a.size % 10 == 0:
-        a = a.reshape(-1, 10)
-    if a.ndim != 2 or a.shape[1] != 10:
-        raise ShapeError(f"p must have shape (n, 10) or (10 n,); got {a.shape}")
-    return a[:, 0].copy(), a[:, 1:4].copy(), matrix_from_inertia6(a[:, 4:])
 
 
 def link_params(robot_or_params: Any) -> NDArray[np.float64]:

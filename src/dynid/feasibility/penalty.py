@@ -1,7 +1,7 @@
 """The penalised objective of the feasible-parameter retrieval (Gaz et al. 2019, Sec. V).
 
-Decision variables: ``p = (m_i, c_i, I_i)`` per link (:data:`~dynid.feasibility.
-constraints.DECISION_FIELDS`, inertia about the CoM), inside the box of
+Decision variables: ``p = (m_i, c_i, I_i)`` per link
+(:data:`~dynid.model.inertia.DECISION_FIELDS`, inertia about the CoM), inside the box of
 :class:`~dynid.feasibility.bounds.Bounds`. The optimisers work on normalised
 variables ``z`` in ``[0, 1]^{10 n}``, ``p = lo + z (hi - lo)``.
 

@@ -59,10 +59,10 @@ from numpy.typing import NDArray
 from ..exceptions import DataError, InfeasibleError, ModelError, ShapeError, SolverError
 from ..identification.least_squares import LeastSquaresFit
 from ..identification.model import IdentifiedModel
-from ..model.inertia import inertial_from_phi
+from ..model.inertia import inertial_from_phi, params_from_inertial
 from ..model.robot import Robot
 from .bounds import Bounds, default_bounds, segment_points
-from .constraints import Constraint, FeasibilityReport, feasibility_report, params_from_inertial
+from .constraints import Constraint, FeasibilityReport, feasibility_report
 from .lmi import (
     log_det_divergence,
     pseudo_inertia,

@@ -20,6 +20,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from .. import _checks
+from ..exceptions import ShapeError
 
 __all__ = [
     "PARAMS_PER_LINK",
@@ -30,11 +31,18 @@ __all__ = [
     "phi_from_inertial",
     "inertial_from_phi",
     "parallel_axis",
+    "DECISION_FIELDS",
+    "decision_labels",
+    "params_from_inertial",
+    "inertial_from_params",
 ]
 
 PARAMS_PER_LINK = 10
 INERTIA_ORDER = ("xx", "xy", "xz", "yy", "yz", "zz")
 _I6 = ((0, 0), (0, 1), (0, 2), (1, 1), (1, 2), (2, 2))
+#: Per-link decision variables of the feasibility retrieval, in order: mass [kg], CoM [m],
+#: inertia about the CoM [kg m^2].
+DECISION_FIELDS = ("m", "cx", "cy", "cz") + tuple(f"I{ax}" for ax in INERTIA_ORDER)
 
 
 def param_labels(n: int) -> tuple[str, ...]:
@@ -120,3 +128,43 @@ def inertial_from_phi(
     c = np.where((m != 0.0)[..., None], p[..., 1:4] / safe[..., None], 0.0)
     J = matrix_from_inertia6(p[..., 4:])
     return m.copy(), c, J - parallel_axis(m, c)
+
+
+# ------------------------------------------------ the retrieval's layout (about the CoM)
+def decision_labels(n: int) -> tuple[str, ...]:
+    """Labels of the ``10 n`` decision variables: ``m1, c1x, c1y, c1z, I1xx, ..., I1zz, m2``..."""
+    out: list[str] = []
+    for i in range(1, n + 1):
+        out += [f"m{i}", f"c{i}x", f"c{i}y", f"c{i}z"] + [f"I{i}{ax}" for ax in INERTIA_ORDER]
+    return tuple(out)
+
+
+def params_from_inertial(
+    mass: ArrayLike, com: ArrayLike, inertia: ArrayLike
+) -> NDArray[np.float64]:
+    """Decision parameters ``p`` (n, 10) from masses (n,) [kg], CoMs (n, 3) [m] and
+    inertias about the CoM (n, 3, 3) or (n, 6) [kg m^2]."""
+    m = _checks.as_array("mass", mass)
+    if m.ndim != 1:
+        raise ShapeError(f"mass must have shape (n,); got {m.shape}")
+    n = m.shape[0]
+    c = _checks.as_exact("com", com, (n, 3))
+    I = _checks.as_array("inertia", inertia)
+    if I.shape == (n, 3, 3):
+        I = inertia6_from_matrix(I)
+    elif I.shape != (n, 6):
+        raise ShapeError(f"inertia must have shape ({n}, 3, 3) or ({n}, 6); got {I.shape}")
+    return np.concatenate([m[:, None], c, I], axis=1)
+
+
+def inertial_from_params(
+    p: ArrayLike,
+) -> tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.float64]]:
+    """Masses (n,) [kg], CoMs (n, 3) [m] and inertias about the CoM (n, 3, 3) [kg m^2]
+    from decision parameters ``p`` of shape (n, 10) or (10 n,)."""
+    a = _checks.as_array("p", p)
+    if a.ndim == 1 and a.size % 10 == 0:
+        a = a.reshape(-1, 10)
+    if a.ndim != 2 or a.shape[1] != 10:
+        raise ShapeError(f"p must have shape (n, 10) or (10 n,); got {a.shape}")
+    return a[:, 0].copy(), a[:, 1:4].copy(), matrix_from_inertia6(a[:, 4:])
