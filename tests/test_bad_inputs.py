@@ -492,7 +492,7 @@ def test_figures_are_skipped_without_matplotlib(base, tmp_path, monkeypatch, cap
 def test_strict_json_out_never_writes_nan(tmp_path):
     """The JSON writer refuses NaN/inf, naming the key path, and writes nothing."""
     from dynid.exceptions import NonFiniteError
-    from dynid.io._json import save_json
+    from dynid.io.json_files import save_json
 
     with pytest.raises(NonFiniteError, match=r"x.json: rms\[1\] is inf"):
         save_json(tmp_path / "x.json", {"rms": [1.0, np.inf]}, schema="s/1")
@@ -502,7 +502,7 @@ def test_strict_json_out_never_writes_nan(tmp_path):
 def test_atomic_write_leaves_the_old_file_when_interrupted(tmp_path):
     """An exception (Ctrl-C included) inside a write keeps the previous file and removes
     the temporary one; a new folder is removed by the failed transaction."""
-    from dynid.io._files import open_atomic, output_transaction, write_text
+    from dynid.io.atomic import open_atomic, output_transaction, write_text
 
     p = write_text(tmp_path / "a.txt", "old\n")
     with pytest.raises(KeyboardInterrupt), open_atomic(p) as fh:

@@ -21,7 +21,7 @@ import warnings
 from collections.abc import Iterator, Sequence
 
 from ..exceptions import DynidError
-from ..io._files import output_transaction
+from ..io.atomic import output_transaction
 
 #: Subcommands in pipeline order; each is the module ``dynid.cli.<module>`` with
 #: ``NAME``, ``register(subparsers)`` and ``run(args) -> int``.

@@ -16,7 +16,7 @@ import numpy as np
 
 from .. import _checks, spatial
 from ..exceptions import DataError, DynidError, ShapeError
-from ..io._json import dumps
+from ..io.json_files import dumps
 from ..model.panda import panda
 from ..model.robot import Robot
 

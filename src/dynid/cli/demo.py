@@ -41,8 +41,8 @@ from typing import Any
 import numpy as np
 
 from ..feasibility.retrieve import RetrievalProgress
-from ..io._files import write_text
-from ..io._json import save_json
+from ..io.atomic import write_text
+from ..io.json_files import save_json
 from ..model.panda import panda
 from ..model.robot import Robot
 from ..pipeline import (

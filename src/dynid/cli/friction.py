@@ -34,8 +34,8 @@ from ..friction.fit import (
 from ..friction.validation import Validation
 from ..identification.log import DEFAULT_CUTOFF_HZ
 from ..identification.model import IdentifiedModel
-from ..io._json import save_json
 from ..io.friction_json import save_friction_json
+from ..io.json_files import save_json
 from ..model.robot import Robot
 from .common import (
     about,

@@ -25,7 +25,7 @@ from ..exceptions import DynidError
 from ..feasibility.payload import identify_payload, robot_with_payload
 from ..identification.log import DEFAULT_CUTOFF_HZ
 from ..identification.model import IdentifiedModel
-from ..io._files import write_text
+from ..io.atomic import write_text
 from ..io.columns import ColumnMap, load_mapped_static_data
 from ..io.payload_json import save_payload_json
 from .common import add_column_options, add_subcommand, column_map, positive_type, read_log

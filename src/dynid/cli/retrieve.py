@@ -67,9 +67,9 @@ from ..feasibility.sdp import ConsistentResult
 from ..friction.model import ClassicalFriction
 from ..friction.validation import NewtonEulerValidation
 from ..identification.model import IdentifiedModel
-from ..io._json import save_json
 from ..io.export import save_robot
 from ..io.feasible import load_bounds, save_feasible_json, save_report_json
+from ..io.json_files import save_json
 from ..model.robot import Robot
 from .common import (
     add_consistency_options,

@@ -36,8 +36,8 @@ from ..exceptions import DataError, DynidError
 from ..friction.validation import own_friction, validate_torques
 from ..identification.log import DEFAULT_CUTOFF_HZ
 from ..identification.model import IdentifiedModel
-from ..io._json import save_json
 from ..io.friction_json import load_friction_json
+from ..io.json_files import save_json
 from ..model.robot import Robot
 from .common import (
     about,

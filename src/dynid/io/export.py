@@ -19,7 +19,7 @@ from pathlib import Path
 from ..exceptions import DataError
 from ..friction.model import ClassicalFriction
 from ..model.robot import Robot
-from ._files import write_text
+from .atomic import write_text
 from .mjcf_export import save_mjcf
 from .urdf_export import save_urdf
 

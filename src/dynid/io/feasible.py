@@ -54,8 +54,8 @@ from ..feasibility.sdp import ConsistentResult
 from ..friction.model import ClassicalFriction
 from ..model.inertia import INERTIA_ORDER, inertia6_from_matrix, inertial_from_phi
 from ..model.robot import Robot
-from ._files import write_text
-from ._json import load_json, save_json
+from .atomic import write_text
+from .json_files import load_json, save_json
 from .robot_json import robot_from_dict, robot_to_dict
 
 __all__ = [

@@ -24,7 +24,7 @@ import numpy as np
 from ..exceptions import DataError
 from ..friction.fit import FrictionFit
 from ..friction.model import ClassicalFriction, FrictionModel, SigmoidFriction
-from ._json import load_json, save_json
+from .json_files import load_json, save_json
 
 __all__ = ["FORMAT", "load_friction_json", "save_friction_json"]
 

@@ -45,7 +45,7 @@ from ..friction.model import ClassicalFriction
 from ..friction.mujoco import CoulombViscous, coulomb_viscous_from_sigmoid
 from ..model.inertia import inertia6_from_matrix
 from ..model.robot import Robot
-from ._files import write_text
+from .atomic import write_text
 
 __all__ = ["mjcf_from_robot", "save_mjcf"]
 

@@ -44,7 +44,7 @@ from ..exceptions import DataError
 from ..identification.least_squares import LeastSquaresFit
 from ..identification.model import IdentifiedModel
 from ..regressors.base import BaseParameters
-from ._json import load_json, save_json
+from .json_files import load_json, save_json
 from .robot_json import robot_from_dict, robot_to_dict
 
 __all__ = ["MODEL_SCHEMA", "model_to_dict", "model_from_dict", "save_model_json", "load_model_json"]

@@ -31,7 +31,7 @@ from .. import __version__, spatial
 from ..feasibility.payload import PayloadEstimate
 from ..model.inertia import INERTIA_ORDER, inertia6_from_matrix
 from ..model.robot import Robot
-from ._json import save_json
+from .json_files import save_json
 
 __all__ = ["PAYLOAD_SCHEMA", "payload_to_dict", "save_payload_json"]
 

@@ -14,7 +14,7 @@ rows. A UTF-8 byte-order mark (spreadsheet exports) is accepted. Columns (any or
 NPZ: arrays ``q`` (N, n), ``M`` (N, n, n), ``g`` (N, n) and optionally ``n_rows`` (N)
 and ``metadata`` (a JSON string); read with ``allow_pickle=False``.
 
-Files are written atomically (:mod:`dynid.io._files`) and record their row count; when
+Files are written atomically (:mod:`dynid.io.atomic`) and record their row count; when
 a file states one, loading checks it, so a file cut short (a copy interrupted, a disk
 full) is refused rather than read as a smaller data set.
 
@@ -42,8 +42,8 @@ from ..exceptions import DataError
 from ..identification.data import DEFAULT_SYMMETRY_RTOL, StaticDataset
 from ..model.robot import Robot
 from ..regressors.static import static_labels
-from ._files import open_atomic
-from ._json import dumps, loads
+from .atomic import open_atomic
+from .json_files import dumps, loads
 
 __all__ = [
     "static_columns",

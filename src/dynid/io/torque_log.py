@@ -22,7 +22,7 @@ the file records its row count (``# rows:``, ``n_rows``), a different count is a
 (a file cut short). Malformed files raise :class:`~dynid.exceptions.DataError` naming
 the file, the column and the line.
 
-Writing is atomic (:mod:`dynid.io._files`) with 17 significant digits, so a round trip is
+Writing is atomic (:mod:`dynid.io.atomic`) with 17 significant digits, so a round trip is
 exact. The CSV reader parses the body in one pass with numpy's C reader straight from the
 file (no copy of the text), so a 2-million-row log needs about the memory of its arrays.
 """
@@ -42,7 +42,7 @@ from numpy.typing import NDArray
 
 from ..exceptions import DataError
 from ..identification.log import TorqueLog
-from ._files import open_atomic
+from .atomic import open_atomic
 from .static_data import check_row_count
 
 __all__ = ["load_torque_log", "save_torque_log", "torque_log_columns"]

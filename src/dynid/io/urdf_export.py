@@ -40,7 +40,7 @@ from .. import __version__, spatial
 from ..exceptions import ModelError
 from ..model.inertia import inertia6_from_matrix
 from ..model.robot import Robot
-from ._files import write_text
+from .atomic import write_text
 from .urdf_patch import patch_urdf_inertials
 
 __all__ = ["save_urdf", "tip_name", "urdf_from_robot"]

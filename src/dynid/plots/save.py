@@ -10,7 +10,7 @@ from collections.abc import Callable
 from pathlib import Path
 from typing import Any
 
-from ..io._files import open_atomic
+from ..io.atomic import open_atomic
 
 __all__ = ["save_figure"]
 

@@ -4,7 +4,7 @@ Writing (:func:`dumps`, :func:`save_json`): numpy arrays and scalars become list
 numbers; a NaN or infinite number raises :class:`~dynid.exceptions.NonFiniteError` naming
 its key path (``rms[3]``) instead of writing ``NaN``/``Infinity``, which strict parsers
 reject (write ``None`` for "undefined" on purpose). Files are written atomically
-(:mod:`dynid.io._files`), indented, UTF-8, with a ``schema`` key first.
+(:mod:`dynid.io.atomic`), indented, UTF-8, with a ``schema`` key first.
 
 Reading (:func:`load_json`): UTF-8 with or without a byte-order mark; ``NaN``,
 ``Infinity``, numbers that overflow a float, duplicated keys and a top level other than
@@ -23,7 +23,7 @@ from typing import Any
 import numpy as np
 
 from ..exceptions import DataError, NonFiniteError
-from ._files import write_text
+from .atomic import write_text
 
 __all__ = ["dumps", "jsonable", "load_json", "loads", "save_json"]
 
