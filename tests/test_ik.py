@@ -15,10 +15,9 @@ from dynid.kinematics import IKOptions, IKResult, default_q0, ik
 
 from conftest import random_states
 
-# the IK driver module (the function ``ik`` is also exported by dynid.kinematics)
-ik_module = importlib.import_module(
-    "dynid.kinematics.inverse"
-)  # the module, beside the function ik
+# the IK driver module and its numpy reference loop
+ik_module = importlib.import_module("dynid.kinematics.inverse")
+ik_numpy = importlib.import_module("dynid.kinematics._ik_numpy")
 
 TOOL = spatial.transform_from_xyz_rpy([0.0, 0.0, 0.1])
 
@@ -228,13 +227,13 @@ def test_single_sample_chain_equals_fk_and_jacobian(panda):
     """The solver's single-sample fk + Jacobian equals fk and jacobian (tool, prismatic)."""
     q, _, _ = random_states(panda, 10, seed=28)
     T_link_frame = panda.frame("flange").T_link_frame @ TOOL
-    chain = ik_module._Chain(panda, 7, T_link_frame)
+    chain = ik_numpy._Chain(panda, 7, T_link_frame)
     for qs in q:
         T, J = chain.pose_jacobian(qs)
         np.testing.assert_allclose(T, dynid.fk(panda, qs, tool=TOOL), atol=1e-14)
         np.testing.assert_allclose(J, dynid.jacobian(panda, qs, tool=TOOL), atol=1e-14)
     robot = dynid.Robot.from_mdh([0, 0.2, 0.1], [0.1, 0, 0.2], [0, 1.0, -0.5], joint_types="RPR")
-    chain = ik_module._Chain(robot, 3, robot.frame("flange").T_link_frame)
+    chain = ik_numpy._Chain(robot, 3, robot.frame("flange").T_link_frame)
     rng = np.random.default_rng(28)
     for qs in rng.uniform(-1, 1, (5, 3)):
         T, J = chain.pose_jacobian(qs)
@@ -252,7 +251,7 @@ def test_orientation_error_helper_round_trips_near_0_and_pi():
         u = rng.normal(size=3)
         w = a * u / np.linalg.norm(u)
         R = spatial.matrix_from_angle_axis(w)
-        *v, theta = ik_module._rotvec(R)
+        *v, theta = ik_numpy._rotvec(R)
         assert abs(theta - a) < 1e-9
         np.testing.assert_allclose(spatial.matrix_from_angle_axis(v), R, atol=1e-12)
         if a < np.pi - 1e-6:
