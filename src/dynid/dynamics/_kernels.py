@@ -53,6 +53,7 @@ from ..kinematics._chain import (
     joint_from,
     joint_sc,
     joint_scd,
+    motion,
 )
 from ..kinematics._chain import SINCOS_MAX as _SINCOS_MAX
 from ..kinematics._chain import sincos as _sincos
@@ -72,53 +73,6 @@ _W, _DW, _A = 17, 20, 23  # angular velocity, acceleration, origin acceleration 
 _F, _N = 26, 29  # force and moment on the link (and its children) about its origin
 _TAU = 32
 _ROWS = 33
-
-
-@inline
-def motion(T, w, dw, a, ex, ey, ez, ep, v, acc):
-    """Angular velocity, angular acceleration and origin acceleration (minus gravity) of a link.
-
-    ``T`` (12 floats) is the link's pose in its parent, ``w, dw, a`` (3-tuples) the parent's
-    motion in parent coordinates, ``(ex, ey, ez)`` the joint axis, ``ep`` 1.0 for a
-    prismatic joint (0.0 revolute), ``v, acc`` the joint rate and acceleration. Returns the
-    link's ``(w, dw, a)`` in link coordinates (9 floats; Featherstone 2008, sec. 5.3):
-    ``a' = R^T (a + dw x p + w x (w x p))``, then for a revolute joint ``w' += v e``,
-    ``dw' += w' x v e + acc e``, for a prismatic one ``a' += 2 w' x v e + acc e``.
-    """
-    r00, r01, r02, r10, r11, r12, r20, r21, r22, px, py, pz = T
-    wx, wy, wz = w
-    dwx, dwy, dwz = dw
-    ux = wy * pz - wz * py
-    uy = wz * px - wx * pz
-    uz = wx * py - wy * px
-    bx = a[0] + (dwy * pz - dwz * py) + (wy * uz - wz * uy)
-    by = a[1] + (dwz * px - dwx * pz) + (wz * ux - wx * uz)
-    bz = a[2] + (dwx * py - dwy * px) + (wx * uy - wy * ux)
-    apx = r00 * bx + r10 * by + r20 * bz
-    apy = r01 * bx + r11 * by + r21 * bz
-    apz = r02 * bx + r12 * by + r22 * bz
-    wpx = r00 * wx + r10 * wy + r20 * wz
-    wpy = r01 * wx + r11 * wy + r21 * wz
-    wpz = r02 * wx + r12 * wy + r22 * wz
-    dpx = r00 * dwx + r10 * dwy + r20 * dwz
-    dpy = r01 * dwx + r11 * dwy + r21 * dwz
-    dpz = r02 * dwx + r12 * dwy + r22 * dwz
-    vx, vy, vz = v * ex, v * ey, v * ez
-    cx = wpy * vz - wpz * vy
-    cy = wpz * vx - wpx * vz
-    cz = wpx * vy - wpy * vx
-    er = 1.0 - ep
-    return (
-        wpx + er * vx,
-        wpy + er * vy,
-        wpz + er * vz,
-        dpx + er * (cx + acc * ex),
-        dpy + er * (cy + acc * ey),
-        dpz + er * (cz + acc * ez),
-        apx + ep * (2.0 * cx + acc * ex),
-        apy + ep * (2.0 * cy + acc * ey),
-        apz + ep * (2.0 * cz + acc * ez),
-    )
 
 
 @inline

@@ -30,8 +30,7 @@ import math
 import numpy as np
 
 from .._compiled import C_AXIS, C_PRISMATIC
-from ..dynamics._kernels import motion
-from ..kinematics._chain import IDENTITY, compose, finite, jit, joint
+from ..kinematics._chain import IDENTITY, compose, finite, jit, joint, motion
 
 __all__ = ["BLOCK", "static_regressor"]
 
