@@ -31,7 +31,7 @@ from .. import _checks, _compiled
 from .._compiled import constants as _constants
 from .._compiled import flat as _flat
 from ..exceptions import ShapeError
-from ..kinematics.forward import _joint_rotations_translations
+from ..kinematics.forward import joint_rotations_translations
 from ..model.inertia import matrix_from_inertia6
 from ..model.robot import Robot
 
@@ -144,7 +144,7 @@ def link_motion(
 ) -> LinkMotion:
     """Velocities and accelerations of every link for validated (B, n) inputs."""
     B, n = q.shape
-    R, p = _joint_rotations_translations(robot, q)
+    R, p = joint_rotations_translations(robot, q)
     w = np.zeros((B, n, 3))
     dw = np.zeros((B, n, 3))
     a = np.zeros((B, n, 3))
@@ -169,7 +169,9 @@ def link_motion(
     return LinkMotion(R, p, w, dw, a)
 
 
-def _prepare(robot: Robot, q: ArrayLike, dq: ArrayLike, ddq: ArrayLike):
+def prepare_states(robot: Robot, q: ArrayLike, dq: ArrayLike, ddq: ArrayLike):
+    """Checked states for the batched routines (here and in the regressors): the broadcast
+    batch shape and ``q, dq, ddq`` as float64 arrays of shape (B, n)."""
     n = robot.n
     q = _checks.as_batch("q", q, (n,))
     dq = _checks.as_batch("dq", dq, (n,))
@@ -251,7 +253,7 @@ def rnea(
                 f = _single("rnea") if len(shape) == 1 else K.rnea
                 if f(_constants(robot), _flat(qa), _flat(va), _flat(aa), tau.reshape(-1)):
                     return tau
-    shape, (q2, dq2, ddq2) = _prepare(robot, q, dq, ddq)
+    shape, (q2, dq2, ddq2) = prepare_states(robot, q, dq, ddq)
     g = robot.gravity if gravity is None else _checks.as_exact("gravity", gravity, (3,))
     return _rnea(robot, robot.phi, q2, dq2, ddq2, g).reshape(shape)
 
@@ -268,7 +270,7 @@ def rnea_numpy(
 
     Same parameters, result, shapes and errors as :func:`rnea`.
     """
-    shape, (q2, dq2, ddq2) = _prepare(robot, q, dq, ddq)
+    shape, (q2, dq2, ddq2) = prepare_states(robot, q, dq, ddq)
     g = robot.gravity if gravity is None else _checks.as_exact("gravity", gravity, (3,))
     return _rnea_numpy(robot, robot.phi, q2, dq2, ddq2, g).reshape(shape)
 

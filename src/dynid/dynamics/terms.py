@@ -31,10 +31,10 @@ from .rnea import (
     _ONE,
     _c64,
     _flat,
-    _prepare,
     _rnea,
     _rnea_numpy,
     _single,
+    prepare_states,
 )
 
 __all__ = [
@@ -173,7 +173,7 @@ def coriolis(robot: Robot, q: ArrayLike, dq: ArrayLike) -> NDArray[np.float64]:
     -------
     c : ndarray, shape (..., n)
     """
-    shape, (q2, dq2, _) = _prepare(robot, q, dq, np.zeros(robot.n))
+    shape, (q2, dq2, _) = prepare_states(robot, q, dq, np.zeros(robot.n))
     return _rnea(robot, robot.phi, q2, dq2, np.zeros((1, robot.n)), _ZERO_G).reshape(shape)
 
 
@@ -236,7 +236,7 @@ def forward_dynamics(
     -------
     ddq : ndarray, shape (..., n) [rad/s^2]
     """
-    shape, (q2, dq2, tau2) = _prepare(robot, q, dq, tau)
+    shape, (q2, dq2, tau2) = prepare_states(robot, q, dq, tau)
     bias = _rnea(robot, robot.phi, q2, dq2, np.zeros_like(q2), robot.gravity)
     M = _mass_matrix(robot, q2)
     return np.linalg.solve(M, (tau2 - bias)[..., None])[..., 0].reshape(shape)

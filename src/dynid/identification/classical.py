@@ -36,7 +36,7 @@ from numpy.typing import NDArray
 from ..exceptions import DynidWarning, RankDeficientError, ShapeError
 from ..model.robot import Robot
 from ..regressors.base import BaseParameters, base_parameters, identifiability
-from ..regressors.torque import _torque_regressor
+from ..regressors.torque import torque_regressor_prepared
 from .least_squares import LeastSquaresFit, conditioning_advice, fit_with_pruning
 from .log import DEFAULT_CUTOFF_HZ, TorqueLog, prepare_log
 from .model import IdentifiedModel
@@ -165,7 +165,7 @@ def identify_from_log(
     N = q.shape[0]
     # only the base columns, with room for the friction columns after them
     r0 = len(bp.independent)
-    Yb = _torque_regressor(
+    Yb = torque_regressor_prepared(
         robot, q, dq, ddq, robot.gravity, columns=bp.independent, width=r0 + 3 * n * friction
     )
     if friction:

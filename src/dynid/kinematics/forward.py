@@ -159,7 +159,7 @@ def _joint_motion(robot: Robot, q: NDArray[np.float64]) -> tuple[NDArray, NDArra
     return R, p
 
 
-def _joint_rotations_translations(
+def joint_rotations_translations(
     robot: Robot, q: NDArray[np.float64]
 ) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
     """Rotation R_{i-1,i} (B, n, 3, 3) and origin p_{i-1,i} (B, n, 3) of each link in its parent.
@@ -186,16 +186,16 @@ def joint_transforms(robot: Robot, q: ArrayLike) -> NDArray[np.float64]:
     T : ndarray, shape (..., n, 4, 4)
     """
     q = check_q(robot, q)
-    R, p = _joint_rotations_translations(robot, q.reshape(-1, robot.n))
+    R, p = joint_rotations_translations(robot, q.reshape(-1, robot.n))
     T = np.zeros(R.shape[:-2] + (4, 4))
     T[..., :3, :3], T[..., :3, 3], T[..., 3, 3] = R, p, 1.0
     return T.reshape(q.shape[:-1] + (robot.n, 4, 4))
 
 
-def _link_poses(robot: Robot, q2: NDArray[np.float64]) -> NDArray[np.float64]:
+def link_poses_prepared(robot: Robot, q2: NDArray[np.float64]) -> NDArray[np.float64]:
     """(B, n + 1, 4, 4) link poses for validated ``q2`` of shape (B, n)."""
     B, n = q2.shape
-    R, p = _joint_rotations_translations(robot, q2)
+    R, p = joint_rotations_translations(robot, q2)
     T = np.zeros((B, n + 1, 4, 4))
     T[:, :, 3, 3] = 1.0
     T[:, 0, :3, :3] = np.eye(3)
@@ -235,7 +235,7 @@ def link_poses_numpy(robot: Robot, q: ArrayLike) -> NDArray[np.float64]:
     Same parameters, result, shapes and errors as :func:`link_poses`.
     """
     q = check_q(robot, q)
-    T = _link_poses(robot, q.reshape(-1, robot.n))
+    T = link_poses_prepared(robot, q.reshape(-1, robot.n))
     return T.reshape(q.shape[:-1] + (robot.n + 1, 4, 4))
 
 
@@ -332,5 +332,5 @@ def _fk_numpy(
 ) -> NDArray[np.float64]:
     """The numpy path of :func:`fk` once the frame is resolved: validates ``q``."""
     q = check_q(robot, q)
-    T = _link_poses(robot, q.reshape(-1, robot.n))[:, link] @ T_link_frame
+    T = link_poses_prepared(robot, q.reshape(-1, robot.n))[:, link] @ T_link_frame
     return T.reshape(q.shape[:-1] + (4, 4))

@@ -26,10 +26,10 @@ from .forward import (
     _as_q,
     _flat,
     _frame_constants,
-    _link_poses,
     _single,
     check_q,
     frame_pose_in_link,
+    link_poses_prepared,
 )
 
 __all__ = ["jacobian", "jacobian_numpy", "jacobian_to_tool"]
@@ -125,10 +125,10 @@ def _frame_pose_jacobian_numpy(
 ) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
     """Frame pose (B, 4, 4) and Jacobian (B, 6, n) for validated (B, n) ``q2``, numpy path.
 
-    One pass of :func:`dynid.kinematics.forward._link_poses` for both (the numpy loop of
+    One pass of :func:`dynid.kinematics.forward.link_poses_prepared` for both (the numpy loop of
     :func:`dynid.kinematics.inverse.ik` uses it too).
     """
-    T = _link_poses(robot, q2)
+    T = link_poses_prepared(robot, q2)
     Tf = T[:, link] @ T_link_frame
     p = Tf[:, :3, 3]  # (B, 3)
     z = (T[:, 1:, :3, :3] @ robot.axes[:, :, None])[..., 0]  # (B, n, 3)

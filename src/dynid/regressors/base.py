@@ -47,7 +47,7 @@ from .. import _checks
 from ..exceptions import OptionError, ShapeError
 from ..model.robot import Robot
 from .static import static_regressor
-from .torque import _torque_regressor
+from .torque import torque_regressor_prepared
 
 __all__ = [
     "RANK_FLOOR",
@@ -384,7 +384,7 @@ def base_parameters(
     elif kind == "torque":
         dq = rng.uniform(-2, 2, q.shape)
         ddq = rng.uniform(-5, 5, q.shape)
-        W = _torque_regressor(robot, q, dq, ddq, robot.gravity).reshape(-1, 10 * robot.n)
+        W = torque_regressor_prepared(robot, q, dq, ddq, robot.gravity).reshape(-1, 10 * robot.n)
     else:
         raise OptionError(f"kind must be 'static' or 'torque'; got {kind!r}")
     return base_parameters_from_regressor(W, robot.param_labels, rtol=rtol)

@@ -35,8 +35,8 @@ from numpy.typing import ArrayLike, NDArray
 
 from .. import _checks, _compiled
 from .._compiled import constants as _constants
-from ..dynamics.rnea import _flat
-from ..kinematics.forward import _link_poses
+from .._compiled import flat as _flat
+from ..kinematics.forward import link_poses_prepared
 from ..model.robot import Robot
 
 __all__ = [
@@ -132,7 +132,7 @@ def _static_regressor_columns(
 def _static_regressor_numpy(robot: Robot, q2: NDArray[np.float64]) -> NDArray[np.float64]:
     """Numpy path: the static regressor with the samples on the last axis (s, 10 n, B)."""
     B, n = q2.shape
-    T = _link_poses(robot, q2)
+    T = link_poses_prepared(robot, q2)
     # samples on the last axis: the arithmetic below runs on contiguous (.., B) rows
     R = np.ascontiguousarray(T[:, 1:, :3, :3].transpose(1, 2, 3, 0))  # (n, 3, 3, B)
     o = np.ascontiguousarray(T[:, 1:, :3, 3].transpose(1, 2, 0))  # (n, 3, B)

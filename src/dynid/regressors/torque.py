@@ -30,7 +30,8 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from .. import _checks, _compiled
-from ..dynamics.rnea import _flat, _prepare, link_motion
+from .._compiled import flat as _flat
+from ..dynamics.rnea import link_motion, prepare_states
 from ..model.robot import Robot
 
 __all__ = ["torque_regressor", "torque_regressor_numpy", "link_wrench_regressor"]
@@ -70,7 +71,7 @@ def link_wrench_regressor(
     return K
 
 
-def _torque_regressor(
+def torque_regressor_prepared(
     robot: Robot,
     q: NDArray[np.float64],
     dq: NDArray[np.float64],
@@ -195,9 +196,9 @@ def torque_regressor(
     Compiled over the batch (:mod:`dynid.regressors._kernels`) when numba is available,
     else :func:`torque_regressor_numpy`.
     """
-    shape, (q2, dq2, ddq2) = _prepare(robot, q, dq, ddq)
+    shape, (q2, dq2, ddq2) = prepare_states(robot, q, dq, ddq)
     g = robot.gravity if gravity is None else _checks.as_exact("gravity", gravity, (3,))
-    Y = _torque_regressor(robot, q2, dq2, ddq2, g)
+    Y = torque_regressor_prepared(robot, q2, dq2, ddq2, g)
     return Y.reshape(shape + (10 * robot.n,))
 
 
@@ -213,7 +214,7 @@ def torque_regressor_numpy(
 
     Same parameters, result, shapes and errors as :func:`torque_regressor`.
     """
-    shape, (q2, dq2, ddq2) = _prepare(robot, q, dq, ddq)
+    shape, (q2, dq2, ddq2) = prepare_states(robot, q, dq, ddq)
     g = robot.gravity if gravity is None else _checks.as_exact("gravity", gravity, (3,))
     Y = _torque_regressor_numpy(robot, q2, dq2, ddq2, g)
     return Y.reshape(shape + (10 * robot.n,))

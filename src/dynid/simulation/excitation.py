@@ -54,7 +54,7 @@ from ..friction.model import sigmoid_friction
 from ..identification.classical import friction_regressor
 from ..model.robot import Robot
 from ..regressors.base import BaseParameters, base_parameters
-from ..regressors.torque import _torque_regressor
+from ..regressors.torque import torque_regressor_prepared
 from .collision import (
     CapsuleModel,
     Obstacles,
@@ -327,7 +327,9 @@ def _classical_regressor(
     robot: Robot, base: BaseParameters, traj: Trajectory
 ) -> NDArray[np.float64]:
     """``[Y_b, F]`` stacked sample-major (N n, r + 3 n)."""
-    Y = _torque_regressor(robot, traj.q, traj.dq, traj.ddq, robot.gravity)[..., base.independent]
+    Y = torque_regressor_prepared(robot, traj.q, traj.dq, traj.ddq, robot.gravity)[
+        ..., base.independent
+    ]
     W = np.concatenate([Y, friction_regressor(np.asarray(traj.dq))], axis=-1)
     return W.reshape(-1, W.shape[-1])
 
