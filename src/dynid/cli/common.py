@@ -141,17 +141,14 @@ def add_robot_options(p: argparse.ArgumentParser) -> None:
 
 def load_robot(args: argparse.Namespace) -> Robot:
     """The robot named by ``--robot`` (and ``--base``/``--tip`` for a URDF)."""
+    from ..io.export import load_robot as load_robot_file
+
     spec = args.robot
     if spec == "panda":
         return panda()
     path = Path(spec)
-    if path.suffix.lower() == ".urdf":
-        with about(path):
-            return Robot.from_urdf(path, base_link=args.base, tip_link=args.tip)
-    if path.suffix.lower() == ".toml":
-        with about(path):
-            return Robot.from_toml(path)
-    raise DynidError(f"--robot must be 'panda', a .urdf or a .toml file; got {spec!r}")
+    with about(path):
+        return load_robot_file(path, base=args.base, tip=args.tip, what="--robot")
 
 
 def add_consistency_options(p: argparse.ArgumentParser) -> None:
@@ -194,30 +191,22 @@ def load_prior(args: argparse.Namespace, robot: Robot) -> Robot | None:
     spec = getattr(args, "prior", None)
     if spec is None:
         return None
+    from ..io.export import load_robot as load_robot_file
+
     if spec == "panda":
         prior = panda()
     else:
         path = Path(spec)
-        suffix = path.suffix.lower()
-        if not path.exists():
-            raise DynidError(f"--prior: {spec} does not exist")
-        if suffix == ".urdf":
-            base = args.prior_base or robot.link_names[0]
-            tip = args.prior_tip or robot.link_names[-1]
-            try:
-                prior = Robot.from_urdf(path, base_link=base, tip_link=tip)
-            except DynidError as exc:
-                raise DynidError(
-                    f"--prior {path.name}: {exc} (name the chain with --prior-base/--prior-tip)"
-                ) from None
-        elif suffix == ".toml":
-            prior = Robot.from_toml(path)
-        elif suffix == ".json":
-            from ..io.feasible import load_feasible_json
-
-            prior = load_feasible_json(path)
-        else:
-            raise DynidError(f"--prior must be 'panda', a .urdf, .toml or .json file; got {spec!r}")
+        base = args.prior_base or robot.link_names[0]
+        tip = args.prior_tip or robot.link_names[-1]
+        try:
+            prior = load_robot_file(path, base=base, tip=tip, what="--prior")
+        except DynidError as exc:
+            hint = (
+                " (name the chain with --prior-base/--prior-tip)" if path.suffix == ".urdf" else ""
+            )
+            msg = str(exc) if str(exc).startswith("--prior") else f"--prior {path.name}: {exc}"
+            raise DynidError(msg + hint) from None
     if spec != "panda":
         prior = prior.replace(name=Path(spec).name)  # reports name the file
     kinds = ("".join("P" if x else "R" for x in r.prismatic) for r in (prior, robot))

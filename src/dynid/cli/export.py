@@ -28,9 +28,7 @@ from pathlib import Path
 from ..exceptions import DynidError
 from ..friction.mujoco import coulomb_viscous_from_sigmoid
 from ..io.export import EXPORT_FORMATS, save_robot
-from ..io.feasible import load_feasible_json
 from ..io.urdf_patch import MERGED_POLICIES
-from ..model.panda import panda
 from ..model.robot import Robot
 from .common import add_subcommand
 
@@ -65,15 +63,11 @@ def register(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParser:
 
 def load_params(spec: str) -> Robot:
     """The robot of ``--params``: feasible.json, a robot .toml, or ``panda``."""
-    if spec == "panda":
-        return panda()
-    path = Path(spec)
-    suffix = path.suffix.lower()
-    if suffix == ".json":
-        return load_feasible_json(path)
-    if suffix == ".toml":
-        return Robot.from_toml(path)
-    raise DynidError(f"--params must be feasible.json, a robot .toml or 'panda'; got {spec!r}")
+    from ..io.export import load_robot
+
+    if Path(spec).suffix.lower() == ".urdf":
+        raise DynidError(f"--params must be feasible.json, a robot .toml or 'panda'; got {spec!r}")
+    return load_robot(spec, what="--params")
 
 
 def run(args: argparse.Namespace) -> int:

@@ -27,6 +27,7 @@ _NAMES = {
     "save_bounds": "feasible",
     "load_bounds": "feasible",
     "save_robot": "export",
+    "load_robot": "export",
     "save_urdf": "urdf_export",
     "save_mjcf": "mjcf_export",
     "save_payload_json": "payload_json",

@@ -93,3 +93,43 @@ def save_robot(
     if fmt == "mjcf":
         return save_mjcf(path, robot, friction=friction)
     return write_text(path, robot.to_toml())
+
+
+#: Robot files :func:`load_robot` reads, by suffix.
+ROBOT_FILE_SUFFIXES = (".urdf", ".toml", ".json")
+
+
+def load_robot(
+    spec: str | Path, *, base: str | None = None, tip: str | None = None, what: str = "robot"
+) -> Robot:
+    """A robot from ``"panda"`` or a file, by its suffix: the one dispatch of robot files.
+
+    ``.urdf`` (the chain from ``base`` to ``tip``: :meth:`Robot.from_urdf`), ``.toml``
+    (:meth:`Robot.from_toml`) or ``.json`` (a ``feasible.json``,
+    :func:`dynid.io.feasible.load_feasible_json`). ``what`` names the option in errors.
+
+    Raises
+    ------
+    DataError
+        Another suffix, or a file that does not exist.
+    """
+    if str(spec) == "panda":
+        from ..model.panda import panda
+
+        return panda()
+    path = Path(spec)
+    suffix = path.suffix.lower()
+    if suffix not in ROBOT_FILE_SUFFIXES:
+        raise DataError(
+            f"{what} must be 'panda' or a .urdf, .toml or .json (feasible.json) file; "
+            f"got {str(spec)!r}"
+        )
+    if not path.exists():
+        raise DataError(f"{what}: {path} does not exist")
+    if suffix == ".urdf":
+        return Robot.from_urdf(path, base_link=base, tip_link=tip)
+    if suffix == ".toml":
+        return Robot.from_toml(path)
+    from .feasible import load_feasible_json
+
+    return load_feasible_json(path)
