@@ -156,6 +156,29 @@ def _cholesky_solve(L, d, b, y):
 
 
 @inline
+def _damping(s_min, eps, lam, err, e_damp):
+    """Squared damping: ``(1 - (s_min/eps)^2) lam^2`` below ``eps``, scaled down by
+    ``err / e_damp`` near the goal."""
+    lam2 = (1.0 - (s_min / eps) ** 2) * lam * lam if s_min < eps else 0.0
+    if err < e_damp:
+        lam2 *= err / e_damp
+    return lam2
+
+
+@inline
+def _rhs(Jf, e, nf, d, bvec):
+    """``b = e`` (6 or more free joints) or ``J^T e`` (fewer) into ``bvec[:d]``."""
+    for a in range(d):
+        acc = 0.0
+        if nf >= 6:
+            acc = e[a]
+        else:
+            for r in range(6):
+                acc += Jf[r, a] * e[r]
+        bvec[a] = acc
+
+
+@inline
 def _solve(C, m, q_min, q_max, inv_vmax, q_restart, goal, fpar, ipar, path, keep, q_best):
     """The simulation loop for one goal; see :func:`dynid.kinematics.inverse._solve_numpy`.
 
@@ -351,19 +374,10 @@ def _solve(C, m, q_min, q_max, inv_vmax, q_restart, goal, fpar, ipar, path, keep
                     fast = _cholesky(G, d, 0.0, L)
                 else:
                     s_min = math.sqrt(max(_min_eigenvalue(G, d, A6, w6, o6), 0.0))
-                    lam2 = (1.0 - (s_min / eps) ** 2) * lam * lam if s_min < eps else 0.0
-                    if err < e_damp:
-                        lam2 *= err / e_damp
+                    lam2 = _damping(s_min, eps, lam, err, e_damp)
                     fast = lam2 > 0.0 and _cholesky(G, d, -lam2, L)
                 if fast:
-                    for a in range(d):  # b = e (nf >= 6) or J^T e (nf < 6)
-                        acc = 0.0
-                        if nf >= 6:
-                            acc = e[a]
-                        else:
-                            for r in range(6):
-                                acc += Jf[r, a] * e[r]
-                        bvec[a] = acc
+                    _rhs(Jf, e, nf, d, bvec)
                     _cholesky_solve(L, d, bvec, y)
                     col = 0
                     for j in range(m):
@@ -409,18 +423,9 @@ def _solve(C, m, q_min, q_max, inv_vmax, q_restart, goal, fpar, ipar, path, keep
                         w_max = max(w_max, G[a, a])
                         w_min = min(w_min, G[a, a])
                     s_min = math.sqrt(max(w_min, 0.0))
-                    lam2 = (1.0 - (s_min / eps) ** 2) * lam * lam if s_min < eps else 0.0
-                    if err < e_damp:
-                        lam2 *= err / e_damp
+                    lam2 = _damping(s_min, eps, lam, err, e_damp)
                     cut = 1e-24 * w_max
-                    for a in range(d):  # b = e (nf >= 6) or J^T e (nf < 6)
-                        acc = 0.0
-                        if nf >= 6:
-                            acc = e[a]
-                        else:
-                            for r in range(6):
-                                acc += Jf[r, a] * e[r]
-                        bvec[a] = acc
+                    _rhs(Jf, e, nf, d, bvec)
                     for a in range(d):  # y = diag(1 / (w + lam^2)) V^T b, zero where w <= cut
                         acc = 0.0
                         for r in range(d):
