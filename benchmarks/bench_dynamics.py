@@ -38,7 +38,7 @@ from common import (  # noqa: E402  (the folder of this script)
     Case,
     bench_parser,
     check_close,
-    measure,
+    measure_pair,
     pinocchio_panda,
     random_states,
     report,
@@ -237,9 +237,7 @@ def main(argv: list[str] | None = None) -> int:
     for name, n, ours, ref, ref_answer, atol in specs:
         check_close(name, ours(), (ref_answer or ref)(), atol)
         kw = timed_batch if n > 1 else timed
-        cases.append(
-            Case(name, n, measure(ours, **kw), measure(ref, **kw), note=notes.get(name, ""))
-        )
+        cases.append(Case(name, n, *measure_pair(ours, ref, **kw), note=notes.get(name, "")))
     cold = None if args.no_compile_time else cold_compile_times()
     extra = {
         "batch samples": N,

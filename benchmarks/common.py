@@ -22,6 +22,9 @@ API
     calls per repeat (a repeat lasts at least 0.2 s, scaled up to ``min_time``) and
     ``timeit.Timer.repeat`` runs ``repeats`` repeats. The garbage collector is off while
     timing (timeit's default).
+``measure_pair(ours, ref, **same) -> (Timing, Timing)``
+    :func:`measure` of both with their repeats alternated, so that both see the same load
+    drift (the single-sample cases, whose ratios drift most).
 ``Timing(median, min, max, number, repeats)``
     Seconds per call over the repeats; ``timing.per(k)`` divides by ``k`` (per sample).
 ``Case(name, n, dynid, ref, ref_name="pinocchio", note="")``
@@ -118,6 +121,40 @@ def measure(
         number = math.ceil(number * min_time / t * 1.05)
     per_call = [t / number for t in timer.repeat(repeat=repeats, number=number)]
     return Timing(statistics.median(per_call), min(per_call), max(per_call), number, repeats)
+
+
+def measure_pair(
+    ours: Callable[[], Any],
+    ref: Callable[[], Any],
+    *,
+    min_time: float = 0.2,
+    repeats: int = 5,
+    warmup: int = 3,
+) -> tuple[Timing, Timing]:
+    """:func:`measure` of two functions with their repeats interleaved (ours, ref, ours, ...).
+
+    On a shared machine the load drifts within seconds; alternating the repeats exposes
+    both functions to the same drift, so their ratio holds better than two runs in turn.
+    """
+    timers, numbers = [], []
+    for fn in (ours, ref):
+        for _ in range(warmup):
+            fn()
+        timer = timeit.Timer(fn)
+        number, t = timer.autorange()
+        if t < min_time:
+            number = math.ceil(number * min_time / t * 1.05)
+        timers.append(timer)
+        numbers.append(number)
+    per_call: list[list[float]] = [[], []]
+    for _ in range(repeats):
+        for k in (0, 1):
+            per_call[k].append(timers[k].timeit(numbers[k]) / numbers[k])
+    a, b = (
+        Timing(statistics.median(p), min(p), max(p), numbers[k], repeats)
+        for k, p in enumerate(per_call)
+    )
+    return a, b
 
 
 @dataclass(frozen=True)

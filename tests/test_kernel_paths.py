@@ -123,8 +123,9 @@ def test_single_sample_thin_path_takes_the_kernel_and_checks_its_input(panda):
     q = np.linspace(-1.0, 1.0, 7)
     dynid.rnea(panda, q, q, q), dynid.mass_matrix(panda, q), dynid.gravity_torques(panda, q)
     dynid.fk(panda, q), dynid.jacobian(panda, q)
-    assert {"rnea", "mass_matrix", "gravity_torques"} <= set(rnea_module._ONE)
-    assert {"frame_pose", "jacobian"} <= set(forward_module._ONE)
+    assert {"rnea_one", "mass_matrix_one", "gravity_torques_one"} <= set(rnea_module.ONE)
+    assert {"frame_pose", "jacobian"} <= set(forward_module.ONE)
+    assert rnea_module._RNEA_ONE is not None and forward_module._FK_ONE is not None
     # a strided view and a read-only vector are single samples too
     strided = np.repeat(q, 2)[::2]
     frozen = _compiled.readonly(q)
@@ -141,6 +142,53 @@ def test_single_sample_thin_path_takes_the_kernel_and_checks_its_input(panda):
         dynid.fk(panda, bad)
     with pytest.raises(dynid.ShapeError, match=r"q must have shape \(\.\.\., 7\)"):
         dynid.mass_matrix(panda, q[:6])
+
+
+class _ArrayLookalike:
+    """Has a float64 dtype and an (n,) shape, is not a numpy array (as a pandas Series)."""
+
+    def __init__(self, x):
+        self.x, self.shape, self.dtype = x, x.shape, x.dtype
+
+    def __array__(self, dtype=None, copy=None):
+        return np.asarray(self.x, dtype=dtype)
+
+
+def test_single_sample_thin_path_leaves_other_inputs_to_the_general_path(panda):
+    """Integers, array look-alikes and a chain too long for the stack scratch are exact."""
+    q = np.linspace(-1.0, 1.0, 7)
+    dynid.rnea(panda, q, q, q), dynid.mass_matrix(panda, q), dynid.gravity_torques(panda, q)
+    dynid.fk(panda, q), dynid.jacobian(panda, q)  # the thin paths are live
+    ints = np.arange(-3, 4)  # int64: same item size as float64, must not be read as one
+    like = _ArrayLookalike(q)
+    for x, ref in ((ints, ints.astype(float)), (like, q)):
+        for ours, theirs in (
+            (dynid.rnea(panda, x, x, x), rnea_numpy(panda, ref, ref, ref)),
+            (dynid.mass_matrix(panda, x), mass_matrix_numpy(panda, ref)),
+            (dynid.gravity_torques(panda, x), gravity_torques_numpy(panda, ref)),
+            (dynid.fk(panda, x), fk_numpy(panda, ref)),
+            (dynid.jacobian(panda, x), jacobian_numpy(panda, ref)),
+        ):
+            np.testing.assert_allclose(ours, theirs, rtol=1e-12, atol=1e-12)
+    # 100 joints: the single-sample kernels decline (their scratch lives on the stack) and
+    # the batch kernels answer
+    n = 100
+    alpha = np.where(np.arange(n) % 2, np.pi / 2, -np.pi / 2)
+    long = dynid.Robot.from_mdh(
+        np.full(n, 0.05), np.full(n, 0.02), alpha, mass=np.full(n, 0.5),
+        com=np.tile([0.01, 0.02, 0.03], (n, 1)), inertia=np.tile(np.eye(3) * 1e-3, (n, 1, 1)),
+    )  # fmt: skip
+    assert n * 21 > _chain.STACK
+    x = np.random.default_rng(7).uniform(-1.0, 1.0, 100)
+    np.testing.assert_allclose(
+        dynid.rnea(long, x, x, x), rnea_numpy(long, x, x, x), rtol=1e-12, atol=1e-12
+    )
+    np.testing.assert_allclose(
+        dynid.mass_matrix(long, x), mass_matrix_numpy(long, x), rtol=1e-12, atol=1e-12
+    )
+    np.testing.assert_allclose(
+        dynid.gravity_torques(long, x), gravity_torques_numpy(long, x), rtol=1e-12, atol=1e-12
+    )
 
 
 @pytest.mark.parametrize("then", ["batch", "many single calls"])
@@ -735,3 +783,30 @@ def test_import_dynid_does_not_import_numba_or_the_kernels():
         "assert 'dynid.kinematics._kernels' not in sys.modules\n"
     )
     subprocess.run([sys.executable, "-c", code], check=True)
+
+
+def test_packed_arrays_belong_to_one_robot(panda):
+    """A robot derived from a used one packs its own constants: nothing stale is reused."""
+    q = np.linspace(-1.0, 1.0, 7)
+    for _ in range(2):  # the second call takes the thin paths
+        tau, J = dynid.rnea(panda, q, q, q), dynid.jacobian(panda, q)
+    assert panda._packed is not None
+    variants = {
+        "heavier": panda.with_params(panda.phi * 1.5),
+        "tilted": panda.with_gravity([1.0, 0.0, -9.7]),
+        "moved flange": panda.replace(
+            frames={**panda.frames, "flange": dynid.Frame(7, tool_pose())}
+        ),
+    }
+    for name, other in variants.items():
+        assert other._packed is None, name
+        for _ in range(2):
+            np.testing.assert_allclose(
+                dynid.rnea(other, q, q, q), rnea_numpy(other, q, q, q), rtol=1e-12, atol=1e-12
+            )
+            np.testing.assert_allclose(
+                dynid.jacobian(other, q), jacobian_numpy(other, q), rtol=1e-12, atol=1e-12
+            )
+        assert not np.allclose(dynid.rnea(other, q, q, q), tau) or not np.allclose(
+            dynid.jacobian(other, q), J
+        ), name

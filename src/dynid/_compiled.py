@@ -17,7 +17,13 @@ columns    row ``i`` (joint ``i + 1``, link ``i + 1`` in link ``i``)
 12-14      unit joint axis in the child link's frame
 15         1.0 for a prismatic joint, 0.0 for a revolute one
 16-25      standard parameters ``phi[i]`` (``m, m c, J`` about the link origin)
+26-52      ``A0, A1, A2`` (row-major) of the joint rotation ``A0 + cos q A1 + sin q A2``
+53-55      ``u = F a``, the joint's slide direction in link ``i`` (``p = p0 + q u``)
 =========  =====================================================================
+
+With ``F`` the rotation of ``T_parent_joint[i]`` and ``a`` the axis, ``A0 = F a a^T``,
+``A1 = F (E - a a^T)``, ``A2 = F [a]x`` for a revolute joint (Rodrigues' formula with
+``F`` multiplied in) and ``0, F, 0`` for a prismatic one.
 
 Row ``n``, columns 0-2: gravity in the base frame [m/s^2]. The kinematics kernels take a
 frame too: :func:`pack_frame` appends row ``n + 1`` holding the frame's pose ``T_lf`` in
@@ -39,7 +45,7 @@ from numpy.typing import NDArray
 from . import _checks
 
 #: Column offsets of the packed constants (see the module docstring).
-C_T, C_AXIS, C_PRISMATIC, C_PHI, C_WIDTH = 0, 12, 15, 16, 26
+C_T, C_AXIS, C_PRISMATIC, C_PHI, C_ROT, C_SLIDE, C_WIDTH = 0, 12, 15, 16, 26, 53, 56
 
 _LOADED: dict[str, ModuleType | None] = {}
 
@@ -110,28 +116,53 @@ def pack(robot: Any, phi: Any = None, gravity: Any = None) -> NDArray[np.float64
     C[:n, C_AXIS : C_AXIS + 3] = robot.axes
     C[:n, C_PRISMATIC] = robot.prismatic
     C[:n, C_PHI : C_PHI + 10] = robot.phi if phi is None else phi
+    F, a = robot.T_parent_joint[:, :3, :3], robot.axes
+    aa = a[:, :, None] * a[:, None, :]
+    K = np.zeros((n, 3, 3))
+    K[:, 0, 1], K[:, 0, 2], K[:, 1, 2] = -a[:, 2], a[:, 1], -a[:, 0]
+    K[:, 1, 0], K[:, 2, 0], K[:, 2, 1] = a[:, 2], -a[:, 1], a[:, 0]
+    pri = robot.prismatic[:, None, None]
+    A0 = np.where(pri, 0.0, F @ aa)
+    A1 = np.where(pri, F, F @ (np.eye(3) - aa))
+    A2 = np.where(pri, 0.0, F @ K)
+    C[:n, C_ROT : C_ROT + 27] = np.concatenate([A.reshape(n, 9) for A in (A0, A1, A2)], axis=1)
+    C[:n, C_SLIDE : C_SLIDE + 3] = (F @ a[:, :, None])[:, :, 0]
     C[n, :3] = robot.gravity if gravity is None else gravity
     C.setflags(write=False)
     return C
 
 
-#: ``id(robot) -> (robot, C, n)`` for a few robots (robots are immutable; an entry keeps
-#: its robot alive, so the id cannot be reused while the entry exists). The thin
-#: single-sample paths read it directly.
-CACHE: dict[int, tuple[Any, NDArray[np.float64], int]] = {}
-_CACHE_SIZE = 16
+class Packed:
+    """A robot's arrays for the kernels, made once per robot and kept on it (``_packed``).
+
+    ``C``: the constants (:func:`pack`); ``vector``, ``matrix``, ``jacobian``: the shapes
+    ``(n,)``, ``(n, n)`` and ``(6, n)`` of the single-sample paths; ``frames``: frame name ->
+    ``(link, T_link_frame, CF)`` (:func:`pack_frame`), filled as frames are used. Robots are
+    immutable, so nothing here goes stale.
+    """
+
+    __slots__ = ("C", "vector", "matrix", "jacobian", "frames")
+
+    def __init__(self, robot: Any) -> None:
+        self.C = pack(robot)
+        n = self.C.shape[0] - 1
+        self.vector, self.matrix, self.jacobian = (n,), (n, n), (6, n)
+        self.frames: dict[str, tuple[int, NDArray[np.float64], NDArray[np.float64]]] = {}
+
+
+def packed(robot: Any) -> Packed:
+    """``robot``'s :class:`Packed` arrays, made on the first call."""
+    p = robot._packed
+    if p is None:
+        p = Packed(robot)
+        object.__setattr__(robot, "_packed", p)  # a memo on the immutable robot
+    return p
 
 
 def constants(robot: Any) -> NDArray[np.float64]:
-    """:func:`pack` of ``robot``, computed once per robot (a small cache by identity)."""
-    hit = CACHE.get(id(robot))
-    if hit is not None and hit[0] is robot:
-        return hit[1]
-    C = pack(robot)
-    if len(CACHE) >= _CACHE_SIZE:
-        CACHE.pop(next(iter(CACHE)))
-    CACHE[id(robot)] = (robot, C, C.shape[0] - 1)
-    return C
+    """:func:`pack` of ``robot``, computed once per robot."""
+    p = robot._packed
+    return packed(robot).C if p is None else p.C
 
 
 #: float64 (the thin paths check ``x.dtype is F64``)
@@ -145,10 +176,11 @@ def entry(kernel: Any, *args: Any) -> Any:
 
     Calling it skips numba's per-call type dispatch (a few hundred ns for five array
     arguments), which dominates a single-sample call. The caller must then pass arguments
-    of exactly these kinds: the thin paths check ``type(x) is np.ndarray``, float64 and
-    the number of dimensions; the joint vectors are typed with any strides
-    (:data:`VECTOR`), the outputs are new C arrays. Returns ``kernel`` when numba offers no
-    entry point.
+    of exactly these kinds, because the entry point reads an array as the type it was
+    compiled for without checking its item type or number of dimensions: the thin paths
+    check that the class is ``np.ndarray``, the dtype float64 and the shape ``(n,)``; the
+    joint vectors are typed with any strides (:data:`VECTOR`), the outputs are new C
+    arrays. Returns ``kernel`` when numba offers no entry point.
     """
     try:
         from numba import typeof

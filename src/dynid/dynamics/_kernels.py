@@ -44,21 +44,32 @@ import numpy as np
 from .._compiled import C_AXIS, C_PHI, C_PRISMATIC
 from ..kinematics._chain import (
     IDENTITY,
+    angles,
     compose,
     finite,
     fixed,
+    flat_view,
     inline,
     jit,
-    joint,
+    joint_at,
     joint_from,
-    joint_sc,
-    joint_scd,
+    lean,
     motion,
+    stack,
 )
 from ..kinematics._chain import SINCOS_MAX as _SINCOS_MAX
+from ..kinematics._chain import STACK as _STACK
 from ..kinematics._chain import sincos as _sincos
 
-__all__ = ["BLOCK", "rnea", "gravity_torques", "mass_matrix"]
+__all__ = [
+    "BLOCK",
+    "rnea",
+    "gravity_torques",
+    "mass_matrix",
+    "rnea_one",
+    "gravity_torques_one",
+    "mass_matrix_one",
+]
 
 #: Samples per block of :func:`rnea` (the length of the vectorised inner loop).
 BLOCK = 32
@@ -137,18 +148,19 @@ def carry(T, F, N):
 
 
 @inline
-def _rnea_sample(C, q, dq, ddq, oq, ov, oa, tau, S):
-    """RNEA of one sample (``q[oq : oq + n]``, ...) into ``tau[oq : oq + n]``; scratch ``S``.
+def _rnea_sample(C, A, dq, ddq, oq, ov, oa, tau, S):
+    """RNEA of one sample into ``tau[oq : oq + n]``; scratch ``S`` (n, 21).
 
-    The recursion of the block kernel in scalar form, for few samples (no block scratch).
+    The recursion of the block kernel in scalar form, for few samples (no block scratch):
+    ``A`` the :func:`~dynid.kinematics._chain.angles` of ``q``, the rates
+    ``dq[ov : ov + n]``, the accelerations ``ddq[oa : oa + n]``.
     """
     n = C.shape[0] - 1
     w = (0.0, 0.0, 0.0)
     dw = (0.0, 0.0, 0.0)
     a = (-C[n, 0], -C[n, 1], -C[n, 2])
     for i in range(n):
-        s, c, d = joint_scd(C, i, q[oq + i])
-        T = joint_sc(C, i, s, c, d)
+        T = joint_at(C, i, A)
         ep = C[i, C_PRISMATIC]
         ex, ey, ez = C[i, C_AXIS], C[i, C_AXIS + 1], C[i, C_AXIS + 2]
         M = motion(T, w, dw, a, ex, ey, ez, ep, dq[ov + i], ddq[oa + i])
@@ -189,11 +201,13 @@ def rnea(C, q, dq, ddq, tau):
     sv, sa = dq.shape[0] == q.shape[0], ddq.shape[0] == q.shape[0]  # else one row for all
     if B < SMALL:  # a few samples: scalar recursion, no block scratch
         S = np.empty((n, 21))
+        A = np.empty((3, n))
         for b in range(B):
             ov, oa = b * n if sv else 0, b * n if sa else 0
-            if not (finite(q, b * n, n) and finite(dq, ov, n) and finite(ddq, oa, n)):
+            ok = angles(C, q, b * n, A)
+            if not (ok and finite(dq, ov, n) and finite(ddq, oa, n)):
                 return False
-            _rnea_sample(C, q, dq, ddq, b * n, ov, oa, tau, S)
+            _rnea_sample(C, A, dq, ddq, b * n, ov, oa, tau, S)
         return True
     # the block length is a compile-time constant, so the row stride of X is known and the
     # sample loops vectorise without run-time aliasing checks
@@ -241,11 +255,11 @@ def rnea(C, q, dq, ddq, tau):
             i = l - 1
             ax, ay, az = C[i, C_AXIS], C[i, C_AXIS + 1], C[i, C_AXIS + 2]
             ep = C[i, C_PRISMATIC]
-            F, e = fixed(C, i)  # constants out of the sample loop (it vectorises)
+            F = fixed(C, i)  # constants out of the sample loop (it vectorises)
             for k in range(nb):
                 # pose of link l in link l - 1 (the chain core's joint transform)
                 r00, r01, r02, r10, r11, r12, r20, r21, r22, px, py, pz = joint_from(
-                    F, e, X[l, _S, k], X[l, _C, k], ep * X[l, _Q, k]
+                    F, X[l, _S, k], X[l, _C, k], ep * X[l, _Q, k]
                 )
                 X[l, _R, k] = r00
                 X[l, _R + 1, k] = r01
@@ -323,12 +337,30 @@ def rnea(C, q, dq, ddq, tau):
     return True
 
 
-@jit
-def gravity_torques(C, q, tau):
-    """Gravity torques into ``tau`` (B n,) for q (B n,); returns ``ok``.
+@lean
+def rnea_one(C, q, dq, ddq, tau):
+    """:func:`rnea` of one sample (q, dq, ddq of length n, any strides), scratch on the stack.
 
-    Many samples: :func:`rnea` at rest (vectorised over samples). A few: from the potential
-    energy rather than a full RNEA (the velocities are zero): with
+    Returns ``ok``; False also for a robot too long for the stack scratch (the caller then
+    takes :func:`rnea`).
+    """
+    n = C.shape[0] - 1
+    if n * 21 > _STACK:
+        return False
+    A = stack(3, n)
+    if not (angles(C, q, 0, A) and finite(dq, 0, n) and finite(ddq, 0, n)):
+        return False
+    _rnea_sample(C, A, dq, ddq, 0, 0, 0, tau, stack(n, 21))
+    return True
+
+
+@inline
+def _gravity_sample(C, A, o, tau, S):
+    """Gravity torques of a sample into ``tau[o : o + n]``; scratch S (n, 9).
+
+    ``A``: the :func:`~dynid.kinematics._chain.angles` of the sample's ``q``.
+
+    From the potential energy rather than a full RNEA (the velocities are zero): with
     ``G = -g``, ``o_i``, ``z_i`` the origin and axis of joint i in the base frame and the
     suffix sums ``M_i = sum_{l >= i} m_l``, ``S_i = sum_{l >= i} m_l p_l`` (``m_l p_l =
     m_l o_l + R_l h_l``, the first moment of link l about the base origin),
@@ -336,45 +368,169 @@ def gravity_torques(C, q, tau):
     prismatic one (Siciliano et al., *Robotics*, 2009, sec. 7.1.2).
     """
     n = C.shape[0] - 1
+    Gx, Gy, Gz = -C[n, 0], -C[n, 1], -C[n, 2]
+    P = IDENTITY
+    for i in range(n):
+        P = compose(P, joint_at(C, i, A))
+        r00, r01, r02, r10, r11, r12, r20, r21, r22, ox, oy, oz = P
+        ex, ey, ez = C[i, C_AXIS], C[i, C_AXIS + 1], C[i, C_AXIS + 2]
+        m = C[i, C_PHI]
+        hx, hy, hz = C[i, C_PHI + 1], C[i, C_PHI + 2], C[i, C_PHI + 3]
+        S[i, 0], S[i, 1], S[i, 2] = ox, oy, oz
+        S[i, 3] = r00 * ex + r01 * ey + r02 * ez
+        S[i, 4] = r10 * ex + r11 * ey + r12 * ez
+        S[i, 5] = r20 * ex + r21 * ey + r22 * ez
+        S[i, 6] = m * ox + (r00 * hx + r01 * hy + r02 * hz)
+        S[i, 7] = m * oy + (r10 * hx + r11 * hy + r12 * hz)
+        S[i, 8] = m * oz + (r20 * hx + r21 * hy + r22 * hz)
+    M = Sx = Sy = Sz = 0.0
+    for i in range(n - 1, -1, -1):
+        M += C[i, C_PHI]
+        Sx += S[i, 6]
+        Sy += S[i, 7]
+        Sz += S[i, 8]
+        zx, zy, zz = S[i, 3], S[i, 4], S[i, 5]
+        if C[i, C_PRISMATIC] != 0.0:
+            tau[o + i] = M * (zx * Gx + zy * Gy + zz * Gz)
+        else:
+            rx, ry, rz = Sx - M * S[i, 0], Sy - M * S[i, 1], Sz - M * S[i, 2]
+            tau[o + i] = (
+                zx * (ry * Gz - rz * Gy) + zy * (rz * Gx - rx * Gz) + zz * (rx * Gy - ry * Gx)
+            )
+
+
+@jit
+def gravity_torques(C, q, tau):
+    """Gravity torques into ``tau`` (B n,) for q (B n,); returns ``ok``.
+
+    Many samples: :func:`rnea` at rest (vectorised over samples); a few: from the potential
+    energy (:func:`_gravity_sample`).
+    """
+    n = C.shape[0] - 1
     B = q.shape[0] // n
     if B >= SMALL:  # many samples: the vectorised RNEA block kernel at rest is faster
         zero = np.zeros(n)
         return rnea(C, q, zero, zero, tau)
-    Gx, Gy, Gz = -C[n, 0], -C[n, 1], -C[n, 2]
-    S = np.empty((n, 9))  # per link: o, z, m p (base frame)
+    S = np.empty((n, 9))
+    A = np.empty((3, n))
     for b in range(B):
-        o = b * n
-        if not finite(q, o, n):
+        if not angles(C, q, b * n, A):
             return False
-        P = IDENTITY
-        for i in range(n):
-            P = compose(P, joint(C, i, q[o + i]))
-            r00, r01, r02, r10, r11, r12, r20, r21, r22, ox, oy, oz = P
-            ex, ey, ez = C[i, C_AXIS], C[i, C_AXIS + 1], C[i, C_AXIS + 2]
-            m = C[i, C_PHI]
-            hx, hy, hz = C[i, C_PHI + 1], C[i, C_PHI + 2], C[i, C_PHI + 3]
-            S[i, 0], S[i, 1], S[i, 2] = ox, oy, oz
-            S[i, 3] = r00 * ex + r01 * ey + r02 * ez
-            S[i, 4] = r10 * ex + r11 * ey + r12 * ez
-            S[i, 5] = r20 * ex + r21 * ey + r22 * ez
-            S[i, 6] = m * ox + (r00 * hx + r01 * hy + r02 * hz)
-            S[i, 7] = m * oy + (r10 * hx + r11 * hy + r12 * hz)
-            S[i, 8] = m * oz + (r20 * hx + r21 * hy + r22 * hz)
-        M = Sx = Sy = Sz = 0.0
-        for i in range(n - 1, -1, -1):
-            M += C[i, C_PHI]
-            Sx += S[i, 6]
-            Sy += S[i, 7]
-            Sz += S[i, 8]
-            zx, zy, zz = S[i, 3], S[i, 4], S[i, 5]
-            if C[i, C_PRISMATIC] != 0.0:
-                tau[o + i] = M * (zx * Gx + zy * Gy + zz * Gz)
-            else:
-                rx, ry, rz = Sx - M * S[i, 0], Sy - M * S[i, 1], Sz - M * S[i, 2]
-                tau[o + i] = (
-                    zx * (ry * Gz - rz * Gy) + zy * (rz * Gx - rx * Gz) + zz * (rx * Gy - ry * Gx)
-                )
+        _gravity_sample(C, A, b * n, tau, S)
     return True
+
+
+@lean
+def gravity_torques_one(C, q, tau):
+    """:func:`gravity_torques` of one sample (q of length n, any strides); ``ok``.
+
+    False also for a robot too long for the stack scratch (the caller then takes
+    :func:`gravity_torques`).
+    """
+    n = C.shape[0] - 1
+    if n * 9 > _STACK:
+        return False
+    A = stack(3, n)
+    if not angles(C, q, 0, A):
+        return False
+    _gravity_sample(C, A, 0, tau, stack(n, 9))
+    return True
+
+
+@inline
+def _crba_sample(C, A, o, M, S):
+    """Mass matrix of a sample into ``M[o n : (o + n) n]`` (flat, row-major).
+
+    Composite-rigid-body algorithm; ``A`` the :func:`~dynid.kinematics._chain.angles` of
+    the sample's ``q``, scratch S (n, 12) for the joint poses.
+    """
+    n = C.shape[0] - 1
+    for i in range(n):
+        T = joint_at(C, i, A)
+        for k in range(12):
+            S[i, k] = T[k]
+    # composite inertia (mc, h, J) of links i.. about origin i, link-i axes
+    mc = 0.0
+    hx = hy = hz = 0.0
+    Jxx = Jxy = Jxz = Jyy = Jyz = Jzz = 0.0
+    for i in range(n - 1, -1, -1):
+        if i < n - 1:
+            # carry the composite from frame i + 1 into frame i (u = R h):
+            # h' = u + m p,  J' = R J R^T + m (p.p E - p p^T) + 2 (p.u) E - u p^T - p u^T
+            k = i + 1
+            r00, r01, r02 = S[k, 0], S[k, 1], S[k, 2]
+            r10, r11, r12 = S[k, 3], S[k, 4], S[k, 5]
+            r20, r21, r22 = S[k, 6], S[k, 7], S[k, 8]
+            px, py, pz = S[k, 9], S[k, 10], S[k, 11]
+            ux = r00 * hx + r01 * hy + r02 * hz
+            uy = r10 * hx + r11 * hy + r12 * hz
+            uz = r20 * hx + r21 * hy + r22 * hz
+            # S = J R^T, then R S
+            s00 = Jxx * r00 + Jxy * r01 + Jxz * r02
+            s10 = Jxy * r00 + Jyy * r01 + Jyz * r02
+            s20 = Jxz * r00 + Jyz * r01 + Jzz * r02
+            s01 = Jxx * r10 + Jxy * r11 + Jxz * r12
+            s11 = Jxy * r10 + Jyy * r11 + Jyz * r12
+            s21 = Jxz * r10 + Jyz * r11 + Jzz * r12
+            s02 = Jxx * r20 + Jxy * r21 + Jxz * r22
+            s12 = Jxy * r20 + Jyy * r21 + Jyz * r22
+            s22 = Jxz * r20 + Jyz * r21 + Jzz * r22
+            pp = px * px + py * py + pz * pz
+            pu2 = 2.0 * (px * ux + py * uy + pz * uz)
+            nxx = r00 * s00 + r01 * s10 + r02 * s20 + mc * (pp - px * px) + pu2 - 2.0 * ux * px
+            nxy = r00 * s01 + r01 * s11 + r02 * s21 - mc * px * py - ux * py - px * uy
+            nxz = r00 * s02 + r01 * s12 + r02 * s22 - mc * px * pz - ux * pz - px * uz
+            nyy = r10 * s01 + r11 * s11 + r12 * s21 + mc * (pp - py * py) + pu2 - 2.0 * uy * py
+            nyz = r10 * s02 + r11 * s12 + r12 * s22 - mc * py * pz - uy * pz - py * uz
+            nzz = r20 * s02 + r21 * s12 + r22 * s22 + mc * (pp - pz * pz) + pu2 - 2.0 * uz * pz
+            hx, hy, hz = ux + mc * px, uy + mc * py, uz + mc * pz
+            Jxx, Jxy, Jxz, Jyy, Jyz, Jzz = nxx, nxy, nxz, nyy, nyz, nzz
+        mc += C[i, C_PHI]
+        hx += C[i, C_PHI + 1]
+        hy += C[i, C_PHI + 2]
+        hz += C[i, C_PHI + 3]
+        Jxx += C[i, C_PHI + 4]
+        Jxy += C[i, C_PHI + 5]
+        Jxz += C[i, C_PHI + 6]
+        Jyy += C[i, C_PHI + 7]
+        Jyz += C[i, C_PHI + 8]
+        Jzz += C[i, C_PHI + 9]
+        # wrench (moment N about origin i, force F) of the composite for unit motion of joint i
+        ax, ay, az = C[i, C_AXIS], C[i, C_AXIS + 1], C[i, C_AXIS + 2]
+        if C[i, C_PRISMATIC] != 0.0:  # F = m a, N = h x a
+            Fx, Fy, Fz = mc * ax, mc * ay, mc * az
+            Nx = hy * az - hz * ay
+            Ny = hz * ax - hx * az
+            Nz = hx * ay - hy * ax
+        else:  # N = J a, F = a x h
+            Nx = Jxx * ax + Jxy * ay + Jxz * az
+            Ny = Jxy * ax + Jyy * ay + Jyz * az
+            Nz = Jxz * ax + Jyz * ay + Jzz * az
+            Fx = ay * hz - az * hy
+            Fy = az * hx - ax * hz
+            Fz = ax * hy - ay * hx
+        j = i
+        while True:
+            bx, by, bz = C[j, C_AXIS], C[j, C_AXIS + 1], C[j, C_AXIS + 2]
+            if C[j, C_PRISMATIC] != 0.0:
+                e = Fx * bx + Fy * by + Fz * bz
+            else:
+                e = Nx * bx + Ny * by + Nz * bz
+            M[(o + j) * n + i] = e
+            M[(o + i) * n + j] = e
+            if j == 0:
+                break
+            # the wrench from frame j into frame j - 1
+            W = carry(
+                (
+                    S[j, 0], S[j, 1], S[j, 2], S[j, 3], S[j, 4], S[j, 5],
+                    S[j, 6], S[j, 7], S[j, 8], S[j, 9], S[j, 10], S[j, 11],
+                ),
+                (Fx, Fy, Fz),
+                (Nx, Ny, Nz),
+            )  # fmt: skip
+            Fx, Fy, Fz, Nx, Ny, Nz = W
+            j -= 1
 
 
 @jit
@@ -383,102 +539,27 @@ def mass_matrix(C, q, M):
     M = M.reshape(M.size)
     n = C.shape[0] - 1
     B = q.shape[0] // n
-    R = np.empty((n, 3, 3))
-    p = np.empty((n, 3))
+    S = np.empty((n, 12))
+    A = np.empty((3, n))
     for b in range(B):
-        for i in range(n):
-            qi = q[b * n + i]
-            if not math.isfinite(qi):
-                return False
-            Ti = joint(C, i, qi)
-            for r in range(3):
-                R[i, r, 0], R[i, r, 1], R[i, r, 2] = Ti[3 * r], Ti[3 * r + 1], Ti[3 * r + 2]
-                p[i, r] = Ti[9 + r]
-        # composite inertia (mc, h, J) of links i.. about origin i, link-i axes
-        mc = 0.0
-        hx = hy = hz = 0.0
-        Jxx = Jxy = Jxz = Jyy = Jyz = Jzz = 0.0
-        for i in range(n - 1, -1, -1):
-            if i < n - 1:
-                # carry the composite from frame i + 1 into frame i (u = R h):
-                # h' = u + m p,  J' = R J R^T + m (p.p E - p p^T) + 2 (p.u) E - u p^T - p u^T
-                k = i + 1
-                r00, r01, r02 = R[k, 0, 0], R[k, 0, 1], R[k, 0, 2]
-                r10, r11, r12 = R[k, 1, 0], R[k, 1, 1], R[k, 1, 2]
-                r20, r21, r22 = R[k, 2, 0], R[k, 2, 1], R[k, 2, 2]
-                px, py, pz = p[k, 0], p[k, 1], p[k, 2]
-                ux = r00 * hx + r01 * hy + r02 * hz
-                uy = r10 * hx + r11 * hy + r12 * hz
-                uz = r20 * hx + r21 * hy + r22 * hz
-                # S = J R^T, then R S
-                s00 = Jxx * r00 + Jxy * r01 + Jxz * r02
-                s10 = Jxy * r00 + Jyy * r01 + Jyz * r02
-                s20 = Jxz * r00 + Jyz * r01 + Jzz * r02
-                s01 = Jxx * r10 + Jxy * r11 + Jxz * r12
-                s11 = Jxy * r10 + Jyy * r11 + Jyz * r12
-                s21 = Jxz * r10 + Jyz * r11 + Jzz * r12
-                s02 = Jxx * r20 + Jxy * r21 + Jxz * r22
-                s12 = Jxy * r20 + Jyy * r21 + Jyz * r22
-                s22 = Jxz * r20 + Jyz * r21 + Jzz * r22
-                pp = px * px + py * py + pz * pz
-                pu2 = 2.0 * (px * ux + py * uy + pz * uz)
-                nxx = r00 * s00 + r01 * s10 + r02 * s20 + mc * (pp - px * px) + pu2 - 2.0 * ux * px
-                nxy = r00 * s01 + r01 * s11 + r02 * s21 - mc * px * py - ux * py - px * uy
-                nxz = r00 * s02 + r01 * s12 + r02 * s22 - mc * px * pz - ux * pz - px * uz
-                nyy = r10 * s01 + r11 * s11 + r12 * s21 + mc * (pp - py * py) + pu2 - 2.0 * uy * py
-                nyz = r10 * s02 + r11 * s12 + r12 * s22 - mc * py * pz - uy * pz - py * uz
-                nzz = r20 * s02 + r21 * s12 + r22 * s22 + mc * (pp - pz * pz) + pu2 - 2.0 * uz * pz
-                hx, hy, hz = ux + mc * px, uy + mc * py, uz + mc * pz
-                Jxx, Jxy, Jxz, Jyy, Jyz, Jzz = nxx, nxy, nxz, nyy, nyz, nzz
-            mc += C[i, C_PHI]
-            hx += C[i, C_PHI + 1]
-            hy += C[i, C_PHI + 2]
-            hz += C[i, C_PHI + 3]
-            Jxx += C[i, C_PHI + 4]
-            Jxy += C[i, C_PHI + 5]
-            Jxz += C[i, C_PHI + 6]
-            Jyy += C[i, C_PHI + 7]
-            Jyz += C[i, C_PHI + 8]
-            Jzz += C[i, C_PHI + 9]
-            # wrench (moment N about origin i, force F) of the composite for unit motion of joint i
-            ax, ay, az = C[i, C_AXIS], C[i, C_AXIS + 1], C[i, C_AXIS + 2]
-            if C[i, C_PRISMATIC] != 0.0:  # F = m a, N = h x a
-                Fx, Fy, Fz = mc * ax, mc * ay, mc * az
-                Nx = hy * az - hz * ay
-                Ny = hz * ax - hx * az
-                Nz = hx * ay - hy * ax
-            else:  # N = J a, F = a x h
-                Nx = Jxx * ax + Jxy * ay + Jxz * az
-                Ny = Jxy * ax + Jyy * ay + Jyz * az
-                Nz = Jxz * ax + Jyz * ay + Jzz * az
-                Fx = ay * hz - az * hy
-                Fy = az * hx - ax * hz
-                Fz = ax * hy - ay * hx
-            j = i
-            while True:
-                bx, by, bz = C[j, C_AXIS], C[j, C_AXIS + 1], C[j, C_AXIS + 2]
-                if C[j, C_PRISMATIC] != 0.0:
-                    e = Fx * bx + Fy * by + Fz * bz
-                else:
-                    e = Nx * bx + Ny * by + Nz * bz
-                M[(b * n + j) * n + i] = e
-                M[(b * n + i) * n + j] = e
-                if j == 0:
-                    break
-                # the wrench from frame j into frame j - 1
-                r00, r01, r02 = R[j, 0, 0], R[j, 0, 1], R[j, 0, 2]
-                r10, r11, r12 = R[j, 1, 0], R[j, 1, 1], R[j, 1, 2]
-                r20, r21, r22 = R[j, 2, 0], R[j, 2, 1], R[j, 2, 2]
-                px, py, pz = p[j, 0], p[j, 1], p[j, 2]
-                RFx = r00 * Fx + r01 * Fy + r02 * Fz
-                RFy = r10 * Fx + r11 * Fy + r12 * Fz
-                RFz = r20 * Fx + r21 * Fy + r22 * Fz
-                RNx = r00 * Nx + r01 * Ny + r02 * Nz
-                RNy = r10 * Nx + r11 * Ny + r12 * Nz
-                RNz = r20 * Nx + r21 * Ny + r22 * Nz
-                Nx = RNx + (py * RFz - pz * RFy)
-                Ny = RNy + (pz * RFx - px * RFz)
-                Nz = RNz + (px * RFy - py * RFx)
-                Fx, Fy, Fz = RFx, RFy, RFz
-                j -= 1
+        if not angles(C, q, b * n, A):
+            return False
+        _crba_sample(C, A, b * n, M, S)
+    return True
+
+
+@lean
+def mass_matrix_one(C, q, M):
+    """:func:`mass_matrix` of one sample (q of length n, any strides, M (n, n)); ``ok``.
+
+    False also for a robot too long for the stack scratch (the caller then takes
+    :func:`mass_matrix`).
+    """
+    n = C.shape[0] - 1
+    if n * 12 > _STACK:
+        return False
+    A = stack(3, n)
+    if not angles(C, q, 0, A):
+        return False
+    _crba_sample(C, A, 0, flat_view(M), stack(n, 12))
     return True

@@ -65,27 +65,34 @@ def _kernels_for(ndim: int) -> ModuleType | None:
     return kernels() if ndim > 1 or _compiled.small_call_uses_kernels() else None
 
 
-_ND, _F64, _CACHE = np.ndarray, _compiled.F64, _compiled.CACHE
-#: compiled entry points of the kernels for one sample, by name (see :func:`_single`)
-_ONE: dict[str, Any] = {}
+_F64, _ND = _compiled.F64, np.ndarray
+#: the single-sample kernels' compiled entry points (:func:`dynid._compiled.entry`), by
+#: kernel name, made by :func:`one` once the kernels are loaded
+ONE: dict[str, Any] = {}
+#: ``ONE["rnea_one"]`` for the thin path of :func:`rnea` (None until a single-sample call
+#: has loaded it)
+_RNEA_ONE: Any = None
 
 
-def _single(name: str) -> Any:
-    """Kernel ``name``'s entry point for one sample, made on first use (kernels loaded).
+def one(name: str) -> Any:
+    """The compiled entry point of the single-sample kernel ``name`` (kernels loaded).
 
     Types: a read-only ``C``, float64 joint vectors of any strides, a new C output (see
     :func:`dynid._compiled.entry`).
     """
-    e = _ONE.get(name)
+    global _RNEA_ONE
+    e = ONE.get(name)
     if e is None:
         C = _checks.frozen(np.zeros((2, _compiled.C_WIDTH)))
         v, tau, M = _compiled.VECTOR, np.zeros(1), np.zeros((1, 1))
         args = {
-            "rnea": (C, v, v, v, tau),
-            "gravity_torques": (C, v, tau),
-            "mass_matrix": (C, v, M),
+            "rnea_one": (C, v, v, v, tau),
+            "gravity_torques_one": (C, v, tau),
+            "mass_matrix_one": (C, v, M),
         }[name]
-        e = _ONE[name] = _compiled.entry(getattr(_KERNELS, name), *args)
+        e = ONE[name] = _compiled.entry(getattr(_KERNELS, name), *args)
+        if name == "rnea_one":
+            _RNEA_ONE = e
     return e
 
 
@@ -224,22 +231,21 @@ def rnea(
     -----
     Uses the compiled kernel when available (see :func:`kernels`), else :func:`rnea_numpy`.
     """
-    # single sample: three float64 (n,) arrays go straight to the kernel's compiled entry
-    # point (no conversion, no copy, no dispatch; the kernel checks finiteness)
-    hit = _CACHE.get(id(robot))
-    e = _ONE.get("rnea")
-    if hit is not None and e is not None and gravity is None:
-        n = hit[2]
-        if (
-            hit[0] is robot
-            and type(q) is type(dq) is type(ddq) is _ND
-            and q.dtype is dq.dtype is ddq.dtype is _F64
-            and q.ndim == dq.ndim == ddq.ndim == 1
-            and len(q) == len(dq) == len(ddq) == n
-        ):
-            tau = np.empty(n)
-            if e(hit[1], q, dq, ddq, tau):
-                return tau
+    # single sample: three float64 (n,) numpy arrays of any strides go straight to the
+    # compiled single-sample kernel (no conversion, no copy, no dispatch; it checks
+    # finiteness)
+    p = robot._packed
+    if (
+        p is not None
+        and gravity is None
+        and q.__class__ is dq.__class__ is ddq.__class__ is _ND
+        and q.dtype is dq.dtype is ddq.dtype is _F64
+        and q.shape == dq.shape == ddq.shape == p.vector
+        and _RNEA_ONE is not None
+    ):
+        tau = np.empty(p.vector)
+        if _RNEA_ONE(p.C, q, dq, ddq, tau):
+            return tau
     if gravity is None:
         # lean path: float64 C arrays of one shape (..., n) go to the kernel as they are;
         # the kernel checks finiteness, and anything else (or a failure) falls through to
@@ -250,7 +256,7 @@ def rnea(
             shape = qa.shape
             if shape == va.shape == aa.shape and shape and shape[-1] == len(robot.joint_names):
                 tau = np.empty(shape)
-                f = _single("rnea") if len(shape) == 1 else K.rnea
+                f = one("rnea_one") if len(shape) == 1 else K.rnea
                 if f(_constants(robot), _flat(qa), _flat(va), _flat(aa), tau.reshape(-1)):
                     return tau
     shape, (q2, dq2, ddq2) = prepare_states(robot, q, dq, ddq)

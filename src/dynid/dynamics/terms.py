@@ -17,6 +17,8 @@ it everywhere). Both agree to rounding.
 
 from __future__ import annotations
 
+from typing import Any
+
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
@@ -25,15 +27,13 @@ from .._compiled import constants as _constants
 from ..model.robot import Robot
 from . import rnea as _rnea_module
 from .rnea import (
-    _CACHE,
     _F64,
     _ND,
-    _ONE,
     _c64,
     _flat,
     _rnea,
     _rnea_numpy,
-    _single,
+    one,
     prepare_states,
 )
 
@@ -48,6 +48,20 @@ __all__ = [
 ]
 
 _ZERO_G = _checks.frozen(np.zeros(3))
+#: the single-sample kernels' entry points for the thin paths (set by :func:`_one`)
+_MASS_ONE: Any = None
+_GRAVITY_ONE: Any = None
+
+
+def _one(name: str) -> Any:
+    """:func:`dynid.dynamics.rnea.one`, kept for the thin paths of this module."""
+    global _MASS_ONE, _GRAVITY_ONE
+    e = one(name)
+    if name == "mass_matrix_one":
+        _MASS_ONE = e
+    else:
+        _GRAVITY_ONE = e
+    return e
 
 
 def _mass_matrix(robot: Robot, q2: NDArray[np.float64]) -> NDArray[np.float64]:
@@ -93,15 +107,20 @@ def mass_matrix(robot: Robot, q: ArrayLike) -> NDArray[np.float64]:
     Composite-rigid-body algorithm in the compiled kernel when available; otherwise
     :func:`mass_matrix_numpy`.
     """
-    # single sample: a float64 (n,) array goes straight to the kernel's compiled entry point
-    hit = _CACHE.get(id(robot))
-    e = _ONE.get("mass_matrix")
-    if hit is not None and e is not None:
-        n = hit[2]
-        if hit[0] is robot and type(q) is _ND and q.dtype is _F64 and q.ndim == 1 and len(q) == n:
-            M = np.empty((n, n))
-            if e(hit[1], q, M):
-                return M
+    # single sample: a float64 (n,) numpy array of any strides goes straight to the
+    # compiled single-sample kernel (no conversion, no copy, no dispatch; it checks
+    # finiteness)
+    p = robot._packed
+    if (
+        p is not None
+        and q.__class__ is _ND
+        and q.dtype is _F64
+        and q.shape == p.vector
+        and _MASS_ONE is not None
+    ):
+        M = np.empty(p.matrix)
+        if _MASS_ONE(p.C, q, M):
+            return M
     # lean path: a float64 C array (..., n) goes to the kernel as it is
     qa = _c64(q)
     K = None if qa is None else _rnea_module._kernels_for(qa.ndim)
@@ -109,7 +128,7 @@ def mass_matrix(robot: Robot, q: ArrayLike) -> NDArray[np.float64]:
         n = len(robot.joint_names)
         if qa.ndim and qa.shape[-1] == n:
             M = np.empty((n, n) if qa.ndim == 1 else qa.shape + (n,))
-            f = _single("mass_matrix") if qa.ndim == 1 else K.mass_matrix
+            f = _one("mass_matrix_one") if qa.ndim == 1 else K.mass_matrix
             if f(_constants(robot), _flat(qa), M):
                 return M
     q = _checks.as_batch("q", q, (robot.n,))
@@ -129,22 +148,25 @@ def gravity_torques(robot: Robot, q: ArrayLike) -> NDArray[np.float64]:
     ------
     ShapeError, NonFiniteError
     """
-    # single sample: a float64 (n,) array goes straight to the kernel's compiled entry point
-    hit = _CACHE.get(id(robot))
-    e = _ONE.get("gravity_torques")
-    if hit is not None and e is not None:
-        n = hit[2]
-        if hit[0] is robot and type(q) is _ND and q.dtype is _F64 and q.ndim == 1 and len(q) == n:
-            tau = np.empty(n)
-            if e(hit[1], q, tau):
-                return tau
+    # single sample: as in :func:`mass_matrix`
+    p = robot._packed
+    if (
+        p is not None
+        and q.__class__ is _ND
+        and q.dtype is _F64
+        and q.shape == p.vector
+        and _GRAVITY_ONE is not None
+    ):
+        tau = np.empty(p.vector)
+        if _GRAVITY_ONE(p.C, q, tau):
+            return tau
     # lean path: a float64 C array (..., n) goes to the kernel as it is
     qa = _c64(q)
     K = None if qa is None else _rnea_module._kernels_for(qa.ndim)
     if K is not None and qa is not None:
         if qa.ndim and qa.shape[-1] == len(robot.joint_names):
             tau = np.empty(qa.shape)
-            f = _single("gravity_torques") if qa.ndim == 1 else K.gravity_torques
+            f = _one("gravity_torques_one") if qa.ndim == 1 else K.gravity_torques
             if f(_constants(robot), _flat(qa), tau.reshape(-1)):
                 return tau
     q = _checks.as_batch("q", q, (robot.n,))

@@ -9,15 +9,22 @@ The robot is the packed constant array ``C`` of :func:`dynid._compiled.pack`.
 
 Joint transform (pose of link ``i + 1`` in link ``i``): ``T_i = T_parent_joint[i]
 T_joint(q_i)`` with, for a revolute joint about the unit axis ``a`` (``K = [a]x``),
-Rodrigues' ``R = E + sin q K + (1 - cos q) K K`` (``K K = a a^T - E``) and no translation;
-for a prismatic joint ``R = E`` and the translation ``q a``. :func:`joint_sc` takes
-``(s, c, d) = (sin q, cos q, 0)`` or ``(0, 1, q)``, exact selectors that change no rounding,
-so that a loop over samples has no branch and vectorises. Chaining (:func:`compose`):
+Rodrigues' ``R = a a^T + cos q (E - a a^T) + sin q K`` and no translation; for a prismatic
+joint ``R = E`` and the translation ``q a``. With ``F`` the rotation of ``T_parent_joint[i]``
+the products ``A0 = F a a^T``, ``A1 = F (E - a a^T)``, ``A2 = F K`` (``0, F, 0`` for a
+prismatic joint) and ``u = F a`` are made once (:func:`dynid._compiled.pack`), so a joint
+costs 21 multiply-adds: ``R = A0 + c A1 + s A2``, ``p = p0 + d u``. :func:`joint_from` takes
+``(s, c, d) = (sin q, cos q, 0)`` or ``(0, 1, q)``, exact selectors, so that a loop over
+samples has no branch and vectorises. For an axis along z (every modified-DH joint) the
+products are exact (they only pick and negate entries of ``F``). Chaining (:func:`compose`):
 ``p_b' = p_b + R_b p``, ``R_b' = R_b R`` (Craig, *Introduction to Robotics*, 2005, ch. 3).
 
 Compiler settings (:func:`jit`): ``cache=True`` (compiled once, then loaded from disk) and
 ``fastmath={"contract"}``: ``a * b + c`` may be one fused multiply-add, no other fast-math
-flag, so kernels and the numpy paths differ by rounding only.
+flag, so kernels and the numpy paths differ by rounding only. Kernels that allocate nothing
+(the kinematics kernels and the one-sample dynamics kernels) are compiled :func:`lean`,
+without numba's memory manager, which halves the cost of entering them; their scratch is
+on the stack (:func:`stack`), and :func:`flat_view` views an output flat.
 
 Sine and cosine (:func:`sincos`) are Cephes' ``sin.c``/``cos.c`` (S. L. Moshier)
 polynomials with its three-part reduction by pi/4, branch-free so that they vectorise; the
@@ -28,19 +35,30 @@ used above).
 from __future__ import annotations
 
 import math
+from typing import Any
 
 import numba
 import numpy as np
+from numba import types
+from numba.core import cgutils
+from numba.core.imputils import impl_ret_borrowed
+from numba.extending import intrinsic
+from numba.np.arrayobj import make_array, populate_array
 
-from .._compiled import C_AXIS, C_PRISMATIC, C_T
+from .._compiled import C_PRISMATIC, C_ROT, C_SLIDE, C_T
 
 __all__ = [
     "jit",
+    "lean",
+    "stack",
+    "flat_view",
+    "STACK",
     "sincos",
     "fixed",
     "joint_from",
-    "joint_sc",
     "joint",
+    "angles",
+    "joint_at",
     "compose",
     "motion",
     "IDENTITY",
@@ -85,6 +103,89 @@ def inline(fn):
     return numba.njit(inline="always", fastmath=FASTMATH)(fn)
 
 
+def lean(fn):
+    """:func:`jit` without numba's reference-counted memory manager, for one-sample kernels.
+
+    Entering such a kernel costs about half as much (no memory record is made for each
+    array argument), which is most of a single-sample call. The kernel must not allocate
+    arrays: its scratch lives on the stack (:func:`stack`). Where numba refuses the option,
+    a plain :func:`jit` kernel computes the same.
+    """
+    try:
+        return jit(fn, _nrt=False)
+    except (KeyError, TypeError, ValueError):  # pragma: no cover (numba dropped the option)
+        return jit(fn)
+
+
+#: floats of stack scratch in a one-sample kernel (:func:`stack`); robots whose scratch
+#: would not fit take the batch kernels
+STACK = 2048
+
+
+@intrinsic
+def _stack(typingctx, rows, cols):
+    """A (rows, cols) float64 C array on the calling kernel's stack, ``rows * cols <= STACK``.
+
+    Uninitialised, like ``np.empty``, and valid until the kernel returns; no memory manager
+    is involved, so lean kernels (:func:`lean`) can use it. The caller checks the size.
+    """
+    if not (isinstance(rows, types.Integer) and isinstance(cols, types.Integer)):
+        return None
+    arr = types.Array(types.float64, 2, "C")
+
+    def codegen(context, builder, sig, args):
+        intp = context.get_value_type(types.intp)
+        r = context.cast(builder, args[0], sig.args[0], types.intp)
+        c = context.cast(builder, args[1], sig.args[1], types.intp)
+        data = cgutils.alloca_once(builder, context.get_value_type(types.float64), size=STACK)
+        item = intp(8)
+        ary = make_array(arr)(context, builder)
+        populate_array(
+            ary,
+            data=data,
+            shape=cgutils.pack_array(builder, [r, c]),
+            strides=cgutils.pack_array(builder, [builder.mul(c, item), item]),
+            itemsize=item,
+            meminfo=None,
+        )
+        return ary._getvalue()
+
+    return arr(rows, cols), codegen
+
+
+#: ``stack(rows, cols)`` in a kernel (an intrinsic's Python signature also has the typing
+#: context, which type checkers would ask for)
+stack: Any = _stack
+
+
+@intrinsic
+def _flat_view(typingctx, arr):
+    """A C-contiguous array seen as 1-d (``arr.reshape(arr.size)`` without its checks)."""
+    if not (isinstance(arr, types.Array) and arr.layout == "C"):
+        return None
+    out = types.Array(arr.dtype, 1, "C")
+
+    def codegen(context, builder, sig, args):
+        src = make_array(sig.args[0])(context, builder, args[0])
+        dst = make_array(out)(context, builder)
+        populate_array(
+            dst,
+            data=src.data,
+            shape=cgutils.pack_array(builder, [src.nitems]),
+            strides=cgutils.pack_array(builder, [src.itemsize]),
+            itemsize=src.itemsize,
+            meminfo=src.meminfo,
+            parent=src.parent,
+        )
+        return impl_ret_borrowed(context, builder, out, dst._getvalue())
+
+    return out(arr), codegen
+
+
+#: ``flat_view(arr)`` in a kernel (see :data:`stack`)
+flat_view: Any = _flat_view
+
+
 @inline
 def sincos(x):
     """``(sin x, cos x)`` for ``|x| <= 1e8``, branch-free (Cephes ``sin.c``, ``cos.c``)."""
@@ -122,63 +223,101 @@ def joint_scd(C, i, qi):
 
 @inline
 def fixed(C, i):
-    """Joint ``i``'s fixed transform (12 floats ``(R row-major, p)``) and unit axis (3)."""
-    T = (
-        C[i, C_T], C[i, C_T + 1], C[i, C_T + 2], C[i, C_T + 4], C[i, C_T + 5], C[i, C_T + 6],
-        C[i, C_T + 8], C[i, C_T + 9], C[i, C_T + 10], C[i, C_T + 3], C[i, C_T + 7],
-        C[i, C_T + 11],
+    """Joint ``i``'s constants for :func:`joint_from`: ``(A0, A1, A2, p0, u)``.
+
+    ``A0, A1, A2`` (9 floats each, row-major) with ``R = A0 + cos q A1 + sin q A2``, ``p0``
+    the joint origin and ``u = R_parent_joint a`` (3 floats each), so that
+    ``p = p0 + d u`` (:func:`dynid._compiled.pack`).
+    """
+    A0 = (
+        C[i, C_ROT], C[i, C_ROT + 1], C[i, C_ROT + 2], C[i, C_ROT + 3], C[i, C_ROT + 4],
+        C[i, C_ROT + 5], C[i, C_ROT + 6], C[i, C_ROT + 7], C[i, C_ROT + 8],
     )  # fmt: skip
-    return T, (C[i, C_AXIS], C[i, C_AXIS + 1], C[i, C_AXIS + 2])
+    A1 = (
+        C[i, C_ROT + 9], C[i, C_ROT + 10], C[i, C_ROT + 11], C[i, C_ROT + 12],
+        C[i, C_ROT + 13], C[i, C_ROT + 14], C[i, C_ROT + 15], C[i, C_ROT + 16],
+        C[i, C_ROT + 17],
+    )  # fmt: skip
+    A2 = (
+        C[i, C_ROT + 18], C[i, C_ROT + 19], C[i, C_ROT + 20], C[i, C_ROT + 21],
+        C[i, C_ROT + 22], C[i, C_ROT + 23], C[i, C_ROT + 24], C[i, C_ROT + 25],
+        C[i, C_ROT + 26],
+    )  # fmt: skip
+    p0 = (C[i, C_T + 3], C[i, C_T + 7], C[i, C_T + 11])
+    u = (C[i, C_SLIDE], C[i, C_SLIDE + 1], C[i, C_SLIDE + 2])
+    return A0, A1, A2, p0, u
 
 
 @inline
-def joint_from(F, a, s, c, d):
+def joint_from(F, s, c, d):
     """Pose of a link in its parent (12 floats) from its joint's :func:`fixed` constants.
 
-    ``F [Rot(a, s, c), d a; 0, 1]`` (Rodrigues, ``K K = a a^T - E``); see the module
-    docstring. Loops over samples hoist ``fixed`` out and call this inside.
+    ``R = A0 + c A1 + s A2``, ``p = p0 + d u``: Rodrigues' formula with the fixed rotation
+    multiplied in once, in :func:`dynid._compiled.pack` (see the module docstring). Loops
+    over samples hoist ``fixed`` out and call this inside.
     """
-    ax, ay, az = a
-    v = 1.0 - c
-    q00 = 1.0 + v * (ax * ax - 1.0)
-    q11 = 1.0 + v * (ay * ay - 1.0)
-    q22 = 1.0 + v * (az * az - 1.0)
-    q01 = -s * az + v * (ax * ay)
-    q10 = s * az + v * (ax * ay)
-    q02 = s * ay + v * (ax * az)
-    q20 = -s * ay + v * (ax * az)
-    q12 = -s * ax + v * (ay * az)
-    q21 = s * ax + v * (ay * az)
-    dx, dy, dz = d * ax, d * ay, d * az
-    t00, t01, t02, t10, t11, t12, t20, t21, t22, t03, t13, t23 = F
+    A0, A1, A2, p0, u = F
     return (
-        t00 * q00 + t01 * q10 + t02 * q20,
-        t00 * q01 + t01 * q11 + t02 * q21,
-        t00 * q02 + t01 * q12 + t02 * q22,
-        t10 * q00 + t11 * q10 + t12 * q20,
-        t10 * q01 + t11 * q11 + t12 * q21,
-        t10 * q02 + t11 * q12 + t12 * q22,
-        t20 * q00 + t21 * q10 + t22 * q20,
-        t20 * q01 + t21 * q11 + t22 * q21,
-        t20 * q02 + t21 * q12 + t22 * q22,
-        t03 + (t00 * dx + t01 * dy + t02 * dz),
-        t13 + (t10 * dx + t11 * dy + t12 * dz),
-        t23 + (t20 * dx + t21 * dy + t22 * dz),
+        A0[0] + c * A1[0] + s * A2[0],
+        A0[1] + c * A1[1] + s * A2[1],
+        A0[2] + c * A1[2] + s * A2[2],
+        A0[3] + c * A1[3] + s * A2[3],
+        A0[4] + c * A1[4] + s * A2[4],
+        A0[5] + c * A1[5] + s * A2[5],
+        A0[6] + c * A1[6] + s * A2[6],
+        A0[7] + c * A1[7] + s * A2[7],
+        A0[8] + c * A1[8] + s * A2[8],
+        p0[0] + d * u[0],
+        p0[1] + d * u[1],
+        p0[2] + d * u[2],
     )
-
-
-@inline
-def joint_sc(C, i, s, c, d):
-    """Pose of link ``i + 1`` in link ``i`` as 12 floats ``(R row-major, p)``."""
-    F, a = fixed(C, i)
-    return joint_from(F, a, s, c, d)
 
 
 @inline
 def joint(C, i, qi):
     """Pose of link ``i + 1`` in link ``i`` at joint position ``qi`` (12 floats)."""
     s, c, d = joint_scd(C, i, qi)
-    return joint_sc(C, i, s, c, d)
+    return joint_from(fixed(C, i), s, c, d)
+
+
+@inline
+def angles(C, q, o, A):
+    """``(d, s, c)`` of every joint of the sample ``q[o : o + n]`` into the rows of ``A`` (3, n).
+
+    Row 0 the slide ``d`` (``q`` for a prismatic joint, else 0), rows 1 and 2 ``sin q`` and
+    ``cos q`` (``0, 1`` for a prismatic joint): :func:`joint_scd` for the whole chain, with
+    exact selectors and the sines and cosines in one loop, which vectorises. Returns
+    whether every ``q`` is finite (``A`` is filled either way).
+    """
+    n = A.shape[1]
+    ok = True
+    big = False
+    for i in range(n):
+        x = q[o + i]
+        ok = ok & math.isfinite(x)
+        big = big | (abs(x) > SINCOS_MAX)
+    if big:
+        for i in range(n):
+            A[1, i] = math.sin(q[o + i])
+            A[2, i] = math.cos(q[o + i])
+    else:
+        for i in range(n):
+            s, c = sincos(q[o + i])
+            A[1, i] = s
+            A[2, i] = c
+    for i in range(n):
+        ep = C[i, C_PRISMATIC]
+        er = 1.0 - ep
+        A[0, i] = ep * q[o + i]
+        A[1, i] = er * A[1, i]
+        A[2, i] = er * A[2, i] + ep
+    return ok
+
+
+@inline
+def joint_at(C, i, A):
+    """Pose of link ``i + 1`` in link ``i`` (12 floats) from the :func:`angles` ``A``."""
+    return joint_from(fixed(C, i), A[1, i], A[2, i], A[0, i])
 
 
 @inline

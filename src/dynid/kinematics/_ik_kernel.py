@@ -18,7 +18,7 @@ import math
 import numba
 import numpy as np
 
-from ._chain import inline, jit
+from ._chain import angles, inline, jit
 from ._kernels import frame_jacobian
 
 __all__ = ["solve_one", "solve_batch"]
@@ -212,6 +212,7 @@ def _solve(C, m, q_min, q_max, inv_vmax, q_restart, goal, fpar, ipar, path, keep
     for j in range(n):
         q_best[j] = q[j]
     Te = np.empty((3, 4))
+    Aq = np.empty((3, m))
     Jflat = np.empty(6 * m)
     J = Jflat.reshape(6, m)
     L = np.empty((6, 6))
@@ -262,7 +263,8 @@ def _solve(C, m, q_min, q_max, inv_vmax, q_restart, goal, fpar, ipar, path, keep
                 break
             continue
         # frame pose Te and geometric Jacobian of its origin (the chain core's kernels)
-        P = frame_jacobian(C, q, 0, m, Jflat, 0, m)
+        angles(C, q, 0, Aq)
+        P = frame_jacobian(C, Aq, m, Jflat, 0, m)
         f = C.shape[0] - 1
         for r in range(3):
             a0, a1, a2, a3 = P[3 * r], P[3 * r + 1], P[3 * r + 2], P[9 + r]

@@ -11,7 +11,11 @@ sample-major (a (B, n) array reshaped). Results go into a C-contiguous output ar
 any shape, read flat, row-major:
 ``B * (n + 1) * 16`` for the link poses, ``B * 16`` for a frame pose, ``B * 6 * n`` for a
 Jacobian. Every kernel checks that ``q`` is finite and returns ``ok``; with ``ok = False``
-the output is unfinished and the caller raises the error that names the bad entry.
+the output is unfinished and the caller raises the error that names the bad entry. The
+kernels allocate nothing, so they are compiled lean (:func:`dynid.kinematics._chain.lean`):
+a single-sample call enters them at half the cost. Their scratch (the joints' sines and
+cosines, :func:`dynid.kinematics._chain.angles`) is on the stack; a chain too long for it
+(over ``STACK / 3`` joints) returns ``ok = False`` and the caller takes the numpy path.
 
 Equations: the joint transform and chaining of :mod:`dynid.kinematics._chain`. Column
 ``i`` of the Jacobian of the frame origin ``p`` is ``[z_i x (p - o_i); z_i]`` (revolute)
@@ -22,7 +26,7 @@ or ``[z_i; 0]`` (prismatic), ``z_i = R_i a_i``, ``o_i = p_i`` (Siciliano et al.,
 from __future__ import annotations
 
 from .._compiled import C_AXIS, C_PRISMATIC
-from ._chain import IDENTITY, compose, finite, inline, jit, joint
+from ._chain import IDENTITY, STACK, angles, compose, flat_view, inline, joint_at, lean, stack
 
 __all__ = ["link_poses", "frame_pose", "jacobian"]
 
@@ -54,53 +58,60 @@ def _frame(P, C, f, out, o):
         out[o + 12 + c] = C[f, 12 + c]
 
 
-@jit
+@lean
 def link_poses(C, q, out):
     """Link poses into ``out`` (B (n + 1) 16,) for q (B n,); returns ``ok``."""
-    out = out.reshape(out.size)
+    out = flat_view(out)
     n = C.shape[0] - 1
     B = q.shape[0] // n
+    if 3 * n > STACK:
+        return False
+    A = stack(3, n)
     for b in range(B):
-        if not finite(q, b * n, n):
+        if not angles(C, q, b * n, A):
             return False
         P = IDENTITY
         o = b * (n + 1) * 16
         _put_pose(P, out, o)
         for i in range(n):
-            P = compose(P, joint(C, i, q[b * n + i]))
+            P = compose(P, joint_at(C, i, A))
             _put_pose(P, out, o + (i + 1) * 16)
     return True
 
 
-@jit
+@lean
 def frame_pose(C, q, out):
     """Pose of the frame of ``C``'s last row into ``out`` (B 16,) for q (B n,); ``ok``."""
-    out = out.reshape(out.size)
+    out = flat_view(out)
     n = C.shape[0] - 2
     link = int(C[n + 1, 16])
     B = q.shape[0] // n
+    if 3 * n > STACK:
+        return False
+    A = stack(3, n)
     for b in range(B):
-        if not finite(q, b * n, n):
+        if not angles(C, q, b * n, A):
             return False
         P = IDENTITY
         for i in range(link):
-            P = compose(P, joint(C, i, q[b * n + i]))
+            P = compose(P, joint_at(C, i, A))
         _frame(P, C, n + 1, out, b * 16)
     return True
 
 
 @inline
-def frame_jacobian(C, q, oq, link, J, oj, stride):
+def frame_jacobian(C, A, link, J, oj, stride):
     """Jacobian columns ``0..link-1`` of the origin of ``C``'s frame (its last row).
 
-    ``q[oq : oq + link]`` moves the frame; column ``i``, row ``r`` goes to
-    ``J[oj + r * stride + i]``. Returns the pose of ``link`` in the base (12 floats).
+    ``A`` holds the :func:`~dynid.kinematics._chain.angles` of the sample; column ``i``,
+    row ``r`` goes to ``J[oj + r * stride + i]``. Returns the pose of ``link`` in the base
+    (12 floats).
     """
     f = C.shape[0] - 1
     P = IDENTITY
     # first pass: joint axis z_i into rows 3-5 and link origin o_i into rows 0-2
     for i in range(link):
-        P = compose(P, joint(C, i, q[oq + i]))
+        P = compose(P, joint_at(C, i, A))
         ax, ay, az = C[i, C_AXIS], C[i, C_AXIS + 1], C[i, C_AXIS + 2]
         J[oj + i] = P[9]
         J[oj + stride + i] = P[10]
@@ -129,18 +140,21 @@ def frame_jacobian(C, q, oq, link, J, oj, stride):
     return P
 
 
-@jit
+@lean
 def jacobian(C, q, J):
     """Jacobian of the origin of the frame of ``C``'s last row into ``J`` (B 6 n,); ``ok``."""
-    J = J.reshape(J.size)
+    J = flat_view(J)
     n = C.shape[0] - 2
     link = int(C[n + 1, 16])
     B = q.shape[0] // n
+    if 3 * n > STACK:
+        return False
+    A = stack(3, n)
     for b in range(B):
-        if not finite(q, b * n, n):
+        if not angles(C, q, b * n, A):
             return False
         o = b * 6 * n
-        frame_jacobian(C, q, b * n, link, J, o, n)
+        frame_jacobian(C, A, link, J, o, n)
         for i in range(link, n):
             for r in range(6):
                 J[o + r * n + i] = 0.0

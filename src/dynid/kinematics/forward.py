@@ -42,7 +42,7 @@ __all__ = [
 
 _KERNELS: ModuleType | None = None
 _LOADED = False
-_F64 = _compiled.F64
+_F64, _ND = _compiled.F64, np.ndarray
 
 
 def kernels() -> ModuleType | None:
@@ -69,22 +69,26 @@ def _kernels_for(ndim: int) -> ModuleType | None:
     return kernels() if ndim > 1 or _compiled.small_call_uses_kernels() else None
 
 
-_ND = np.ndarray
-#: compiled entry points of the kernels for one sample, by name (see :func:`_single`)
-_ONE: dict[str, Any] = {}
+#: compiled entry points of the kernels for one sample, by name (see :func:`one`)
+ONE: dict[str, Any] = {}
+#: the entry point of :func:`fk`'s thin path (None until a single-sample call made it)
+_FK_ONE: Any = None
 
 
-def _single(name: str) -> Any:
+def one(name: str) -> Any:
     """Kernel ``name``'s entry point for one sample, made on first use (kernels loaded).
 
     Types: read-only frame constants, a float64 joint vector of any strides, a new C
     output (see :func:`dynid._compiled.entry`).
     """
-    e = _ONE.get(name)
+    global _FK_ONE
+    e = ONE.get(name)
     if e is None:
         CF, v = _checks.frozen(np.zeros((3, _compiled.C_WIDTH))), _compiled.VECTOR
         out = np.zeros((4, 4)) if name == "frame_pose" else np.zeros((6, 1))
-        e = _ONE[name] = _compiled.entry(getattr(_KERNELS, name), CF, v, out)
+        e = ONE[name] = _compiled.entry(getattr(_KERNELS, name), CF, v, out)
+        if name == "frame_pose":
+            _FK_ONE = e
     return e
 
 
@@ -104,22 +108,15 @@ def _as_q(robot: Robot, q: ArrayLike) -> NDArray[np.float64] | None:
     return q if shape and shape[-1] == len(robot.joint_names) and shape[-1] else None
 
 
-#: ``(id(robot), frame) -> (robot, link, T_link_frame, CF, n)`` for a few robots and
-#: frames, ``CF`` the kernels' constants with the frame (:func:`dynid._compiled.pack_frame`)
-_FRAMES: dict[tuple[int, str], tuple[Robot, int, NDArray, NDArray, int]] = {}
-
-
-def _frame_entry(robot: Robot, frame: str) -> tuple[Robot, int, NDArray, NDArray, int]:
-    """The :data:`_FRAMES` entry of ``frame``, made on first use."""
-    hit = _FRAMES.get((id(robot), frame))
-    if hit is not None and hit[0] is robot:
-        return hit
-    f = robot.frame(frame)
-    T = _readonly(f.T_link_frame)
-    CF = _compiled.pack_frame(_constants(robot), f.link, T)
-    if len(_FRAMES) >= 64:
-        _FRAMES.pop(next(iter(_FRAMES)))
-    hit = _FRAMES[(id(robot), frame)] = (robot, f.link, T, CF, robot.n)
+def _frame_entry(robot: Robot, frame: str) -> tuple[int, NDArray, NDArray]:
+    """``(link, T_link_frame, CF)`` of ``frame`` (:class:`dynid._compiled.Packed`), made on
+    first use; ``CF`` are the kernels' constants with the frame."""
+    frames = _compiled.packed(robot).frames
+    hit = frames.get(frame)
+    if hit is None:
+        f = robot.frame(frame)
+        T = _readonly(f.T_link_frame)
+        hit = frames[frame] = (f.link, T, _compiled.pack_frame(_constants(robot), f.link, T))
     return hit
 
 
@@ -128,8 +125,7 @@ def _frame_constants(
 ) -> tuple[int, NDArray[np.float64], NDArray[np.float64]]:
     """``(link, T_link_frame, CF)`` of ``frame`` with ``tool`` multiplied in."""
     if tool is None:
-        _, link, T, CF, _ = _frame_entry(robot, frame)
-        return link, T, CF
+        return _frame_entry(robot, frame)
     link, T = frame_pose_in_link(robot, frame, tool)
     return link, T, _compiled.pack_frame(_constants(robot), link, T)
 
@@ -243,7 +239,7 @@ def frame_pose_in_link(
     robot: Robot, frame: str, tool: ArrayLike | None = None
 ) -> tuple[int, NDArray[np.float64]]:
     """The link that carries ``frame`` and the pose of ``frame`` (then ``tool``) in that link."""
-    _, link, T, _, _ = _frame_entry(robot, frame)
+    link, T, _ = _frame_entry(robot, frame)
     if tool is not None:
         T = _readonly(T @ _checks.as_exact("tool", tool, (4, 4)))
     return link, T
@@ -283,23 +279,15 @@ def fk(
     -----
     Uses the compiled kernel when available (see :func:`kernels`), else :func:`fk_numpy`.
     """
-    # single sample: a float64 (n,) array goes straight to the kernel's compiled entry
-    # point (no conversion, no copy, no dispatch; the kernel checks finiteness)
-    hit = _FRAMES.get((id(robot), frame))
-    e = _ONE.get("frame_pose")
-    if (
-        e is not None
-        and hit is not None
-        and tool is None
-        and hit[0] is robot
-        and type(q) is _ND
-        and q.dtype is _F64
-        and q.ndim == 1
-        and len(q) == hit[4]
-    ):
-        T = np.empty((4, 4))
-        if e(hit[3], q, T):
-            return T
+    # single sample: a float64 (n,) numpy array of any strides goes straight to the
+    # compiled kernel (no conversion, no copy, no dispatch; it checks finiteness)
+    p = robot._packed
+    if p is not None and tool is None and _FK_ONE is not None:
+        hit = p.frames.get(frame)
+        if hit is not None and q.__class__ is _ND and q.dtype is _F64 and q.shape == p.vector:
+            T = np.empty((4, 4))
+            if _FK_ONE(hit[2], q, T):
+                return T
     link, T_link_frame, CF = _frame_constants(robot, frame, tool)
     # lean path: a float64 C array of shape (..., n) goes to the kernel as it is
     if type(q) is np.ndarray and q.dtype is _F64 and q.flags.c_contiguous:
@@ -310,7 +298,7 @@ def fk(
     if K is not None and qa is not None:
         if qa.ndim and qa.shape[-1] == len(robot.joint_names):
             T = np.empty((4, 4) if qa.ndim == 1 else qa.shape[:-1] + (4, 4))
-            f = _single("frame_pose") if qa.ndim == 1 else K.frame_pose
+            f = one("frame_pose") if qa.ndim == 1 else K.frame_pose
             if f(CF, _flat(qa), T):
                 return T
     return _fk_numpy(robot, q, link, T_link_frame)

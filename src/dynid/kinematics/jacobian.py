@@ -11,6 +11,8 @@ is installed and the numpy reference path (:func:`jacobian_numpy`) otherwise or 
 
 from __future__ import annotations
 
+from typing import Any
+
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
@@ -20,19 +22,27 @@ from ..model.robot import Robot
 from . import forward as _forward
 from .forward import (
     _F64,
-    _FRAMES,
     _ND,
-    _ONE,
     _as_q,
     _flat,
     _frame_constants,
-    _single,
     check_q,
     frame_pose_in_link,
     link_poses_prepared,
 )
 
 __all__ = ["jacobian", "jacobian_numpy", "jacobian_to_tool"]
+
+#: the single-sample entry point of the jacobian kernel for the thin path (set by
+#: :func:`_one`)
+_JACOBIAN_ONE: Any = None
+
+
+def _one() -> Any:
+    """:func:`dynid.kinematics.forward.one` of the jacobian kernel, kept for the thin path."""
+    global _JACOBIAN_ONE
+    _JACOBIAN_ONE = _forward.one("jacobian")
+    return _JACOBIAN_ONE
 
 
 def jacobian(
@@ -66,23 +76,14 @@ def jacobian(
     Uses the compiled kernel when available (see :func:`dynid.kinematics.forward.kernels`),
     else :func:`jacobian_numpy`.
     """
-    # single sample: a float64 (n,) array goes straight to the kernel's compiled entry
-    # point (no conversion, no copy, no dispatch; the kernel checks finiteness)
-    hit = _FRAMES.get((id(robot), frame))
-    e = _ONE.get("jacobian")
-    if (
-        e is not None
-        and hit is not None
-        and tool is None
-        and hit[0] is robot
-        and type(q) is _ND
-        and q.dtype is _F64
-        and q.ndim == 1
-        and len(q) == hit[4]
-    ):
-        J = np.empty((6, hit[4]))
-        if e(hit[3], q, J):
-            return J
+    # single sample: as in :func:`dynid.kinematics.forward.fk`
+    p, e = robot._packed, _JACOBIAN_ONE
+    if p is not None and tool is None and e is not None:
+        hit = p.frames.get(frame)
+        if hit is not None and q.__class__ is _ND and q.dtype is _F64 and q.shape == p.vector:
+            J = np.empty(p.jacobian)
+            if e(hit[2], q, J):
+                return J
     link, T_link_frame, CF = _frame_constants(robot, frame, tool)
     # lean path: a float64 C array of shape (..., n) goes to the kernel as it is
     if type(q) is np.ndarray and q.dtype is _F64 and q.flags.c_contiguous:
@@ -94,7 +95,7 @@ def jacobian(
         n = len(robot.joint_names)
         if qa.ndim and qa.shape[-1] == n:
             J = np.empty((6, n) if qa.ndim == 1 else qa.shape[:-1] + (6, n))
-            f = _single("jacobian") if qa.ndim == 1 else K.jacobian
+            f = _one() if qa.ndim == 1 else K.jacobian
             if f(CF, _flat(qa), J):
                 return J
     return _jacobian_numpy(robot, q, link, T_link_frame)

@@ -116,6 +116,9 @@ class Robot:
     frames: Mapping[str, Frame] = field(default_factory=dict)
     friction: NDArray[np.float64] | None = None
     q_neutral: NDArray[np.float64] | None = None
+    #: derived read-only arrays for the compiled kernels, made on first use (see
+    #: :class:`dynid._compiled.Packed`); never set by the user, not part of the model
+    _packed: Any = field(default=None, init=False, repr=False, compare=False)
 
     def __post_init__(self) -> None:
         n = len(self.joint_names)
