@@ -49,7 +49,10 @@ def _min_eigenvalue(G, d, A, w, off):
 
     Householder reduction to tridiagonal form, then the implicit QL iteration with
     Wilkinson shifts, eigenvalues only (Press et al., *Numerical Recipes*, 3rd ed., 2007,
-    sec. 11.3-11.4, ``tred2`` and ``tqli``); absolute error about ``1e-16 |G|``.
+    sec. 11.3-11.4, ``tred2`` and ``tqli``); absolute error about ``1e-16 |G|``. The
+    rotations' radii are ``sqrt(f^2 + g^2)`` rather than ``hypot``: the entries are bounded
+    by ``|G|`` and the shift ratio by about ``1e16`` (larger off-diagonals are split off), so
+    nothing overflows, and the library call cost a third of an iteration of the solver.
     """
     for i in range(d):
         for j in range(d):
@@ -106,7 +109,7 @@ def _min_eigenvalue(G, d, A, w, off):
             if mm == lo:
                 break
             g = (w[lo + 1] - w[lo]) / (2.0 * off[lo])
-            r = math.hypot(g, 1.0)
+            r = math.sqrt(g * g + 1.0)
             g = w[mm] - w[lo] + off[lo] / (g + (r if g >= 0.0 else -r))
             sn = 1.0
             c = 1.0
@@ -115,7 +118,7 @@ def _min_eigenvalue(G, d, A, w, off):
             for i in range(mm - 1, lo - 1, -1):
                 f = sn * off[i]
                 b = c * off[i]
-                r = math.hypot(f, g)
+                r = math.sqrt(f * f + g * g)
                 off[i + 1] = r
                 if r == 0.0:
                     w[i + 1] -= p
@@ -357,8 +360,8 @@ def _solve(C, m, q_min, q_max, inv_vmax, q_restart, goal, fpar, ipar, path, keep
                         col += 1
                 d = 6 if nf >= 6 else nf
                 tot = 0.0
-                for a in range(d):
-                    for b in range(d):
+                for a in range(d):  # G is symmetric: the upper triangle, mirrored
+                    for b in range(a, d):
                         acc = 0.0
                         if nf >= 6:
                             for t in range(nf):
@@ -367,8 +370,10 @@ def _solve(C, m, q_min, q_max, inv_vmax, q_restart, goal, fpar, ipar, path, keep
                             for t in range(6):
                                 acc += Jf[t, a] * Jf[t, b]
                         G[a, b] = acc
+                        G[b, a] = acc
                         V[a, b] = 1.0 if a == b else 0.0
-                        tot += acc * acc
+                        V[b, a] = V[a, b]
+                        tot += acc * acc if a == b else 2.0 * acc * acc
                 # the smallest eigenvalue w_min = s_min^2 of G decides the damping: none when
                 # a Cholesky factorisation of G - eps^2 E succeeds, else from the QL
                 # eigenvalues; then a Cholesky solve of (G + lambda^2 E) y = b

@@ -219,16 +219,18 @@ def check_pose(name: str, T: ArrayLike) -> NDArray[np.float64]:
         (``max |R^T R - I| > 1e-5`` or ``det R <= 0``).
     """
     T = np.array(_checks.as_exact(name, T, (4, 4)))
-    rows = T.tolist()
-    last = max(abs(x - y) for x, y in zip(rows[3], (0.0, 0.0, 0.0, 1.0), strict=True))
+    (a, b, c, _), (d, e, f, _), (g, h, i, _), (w0, w1, w2, w3) = T.tolist()
+    last = max(abs(w0), abs(w1), abs(w2), abs(w3 - 1.0))
     if last > ORTHONORMALITY_TOLERANCE:
-        raise DataError(f"{name} must have last row [0, 0, 0, 1]; got {rows[3]}")
-    (a, b, c, _), (d, e, f, _), (g, h, i, _) = rows[:3]
-    cols = ((a, d, g), (b, e, h), (c, f, i))
+        raise DataError(f"{name} must have last row [0, 0, 0, 1]; got {[w0, w1, w2, w3]}")
+    # max |R^T R - I| over the six distinct entries (columns (a, d, g), (b, e, h), (c, f, i))
     dev = max(
-        abs(sum(x * y for x, y in zip(cols[j], cols[k], strict=True)) - float(j == k))
-        for j in range(3)
-        for k in range(j, 3)
+        abs(a * a + d * d + g * g - 1.0),
+        abs(b * b + e * e + h * h - 1.0),
+        abs(c * c + f * f + i * i - 1.0),
+        abs(a * b + d * e + g * h),
+        abs(a * c + d * f + g * i),
+        abs(b * c + e * f + h * i),
     )
     det = a * (e * i - f * h) - b * (d * i - f * g) + c * (d * h - e * g)
     if dev > ORTHONORMALITY_TOLERANCE or det <= 0:
@@ -381,6 +383,11 @@ def ik(
 
 def _check_within_limits(robot: Robot, q: NDArray[np.float64]) -> None:
     """Raise :class:`LimitError` naming the first start (row of ``q`` (B, n)) outside."""
+    if q.shape[0] == 1:  # one start: a Python loop beats four numpy calls
+        row = q[0].tolist()
+        lo, hi = robot.q_min.tolist(), robot.q_max.tolist()
+        if all(lo[j] <= row[j] <= hi[j] for j in range(len(row))):
+            return
     bad = (q < robot.q_min) | (q > robot.q_max)
     if bad.any():
         outside = np.argwhere(bad)
