@@ -40,6 +40,28 @@ def test_fk_json_equals_library(capsys):
     np.testing.assert_array_equal(np.array(obj["T"]), T_ref)
 
 
+def test_fk_on_the_panda_imports_neither_scipy_nor_numba():
+    """A one-shot ``dynid fk`` loads only what it uses (the start-up target of issue 11)."""
+    import subprocess
+    import sys
+
+    code = (
+        "import sys\n"
+        "from dynid.cli.__main__ import main\n"
+        "assert main(['fk', '--robot', 'panda', '--q=0,0,0,-1.5,0,1.5,0.7', '--json']) == 0\n"
+        "heavy = sorted(m for m in ('scipy', 'numba', 'matplotlib') if m in sys.modules)\n"
+        "assert not heavy, heavy\n"
+    )
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True)
+    assert out.returncode == 0, out.stderr
+    np.testing.assert_allclose(
+        json.loads(out.stdout)["T"],
+        dynid.fk(dynid.panda(), [0, 0, 0, -1.5, 0, 1.5, 0.7]),
+        rtol=0,
+        atol=1e-14,
+    )
+
+
 def test_fk_default_q_is_the_neutral_pose(capsys):
     """Without --q, fk uses the documented neutral pose PANDA_NEUTRAL_Q."""
     obj = _run_json(capsys, ["fk", "--json"])

@@ -141,7 +141,7 @@ def add_robot_options(p: argparse.ArgumentParser) -> None:
 
 def load_robot(args: argparse.Namespace) -> Robot:
     """The robot named by ``--robot`` (and ``--base``/``--tip`` for a URDF)."""
-    from ..io.export import load_robot as load_robot_file
+    from ..io.robot_file import load_robot as load_robot_file
 
     spec = args.robot
     if spec == "panda":
@@ -191,7 +191,7 @@ def load_prior(args: argparse.Namespace, robot: Robot) -> Robot | None:
     spec = getattr(args, "prior", None)
     if spec is None:
         return None
-    from ..io.export import load_robot as load_robot_file
+    from ..io.robot_file import load_robot as load_robot_file
 
     if spec == "panda":
         prior = panda()

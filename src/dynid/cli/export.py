@@ -63,7 +63,7 @@ def register(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParser:
 
 def load_params(spec: str) -> Robot:
     """The robot of ``--params``: feasible.json, a robot .toml, or ``panda``."""
-    from ..io.export import load_robot
+    from ..io.robot_file import load_robot
 
     if Path(spec).suffix.lower() == ".urdf":
         raise DynidError(f"--params must be feasible.json, a robot .toml or 'panda'; got {spec!r}")

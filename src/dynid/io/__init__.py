@@ -27,7 +27,7 @@ _NAMES = {
     "save_bounds": "feasible",
     "load_bounds": "feasible",
     "save_robot": "export",
-    "load_robot": "export",
+    "load_robot": "robot_file",
     "save_urdf": "urdf_export",
     "save_mjcf": "mjcf_export",
     "save_payload_json": "payload_json",

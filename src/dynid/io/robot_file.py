@@ -1,0 +1,54 @@
+"""One entry point for reading a robot: ``"panda"``, a URDF, a dynid TOML or a feasible.json.
+
+:func:`load_robot` picks the reader by the file's suffix; every command line option that
+names a robot (``--robot``, ``--prior``, ``--params``) reads through it. It imports only
+the reader it needs, so a command on the built-in Panda loads no file reader at all.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+from ..exceptions import DataError
+from ..model.robot import Robot
+
+__all__ = ["ROBOT_FILE_SUFFIXES", "load_robot"]
+
+#: Robot files :func:`load_robot` reads, by suffix.
+ROBOT_FILE_SUFFIXES = (".urdf", ".toml", ".json")
+
+
+def load_robot(
+    spec: str | Path, *, base: str | None = None, tip: str | None = None, what: str = "robot"
+) -> Robot:
+    """A robot from ``"panda"`` or a file, by its suffix: the one dispatch of robot files.
+
+    ``.urdf`` (the chain from ``base`` to ``tip``: :meth:`Robot.from_urdf`), ``.toml``
+    (:meth:`Robot.from_toml`) or ``.json`` (a ``feasible.json``,
+    :func:`dynid.io.feasible.load_feasible_json`). ``what`` names the option in errors.
+
+    Raises
+    ------
+    DataError
+        Another suffix, or a file that does not exist.
+    """
+    if str(spec) == "panda":
+        from ..model.panda import panda
+
+        return panda()
+    path = Path(spec)
+    suffix = path.suffix.lower()
+    if suffix not in ROBOT_FILE_SUFFIXES:
+        raise DataError(
+            f"{what} must be 'panda' or a .urdf, .toml or .json (feasible.json) file; "
+            f"got {str(spec)!r}"
+        )
+    if not path.exists():
+        raise DataError(f"{what}: {path} does not exist")
+    if suffix == ".urdf":
+        return Robot.from_urdf(path, base_link=base, tip_link=tip)
+    if suffix == ".toml":
+        return Robot.from_toml(path)
+    from .feasible import load_feasible_json
+
+    return load_feasible_json(path)
