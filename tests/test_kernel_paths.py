@@ -124,7 +124,7 @@ def test_single_sample_thin_path_takes_the_kernel_and_checks_its_input(panda):
     dynid.rnea(panda, q, q, q), dynid.mass_matrix(panda, q), dynid.gravity_torques(panda, q)
     dynid.fk(panda, q), dynid.jacobian(panda, q)
     assert {"rnea_one", "mass_matrix_one", "gravity_torques_one"} <= set(rnea_module.ONE)
-    assert {"frame_pose", "jacobian"} <= set(forward_module.ONE)
+    assert {"frame_pose", "jacobian_one"} <= set(forward_module.ONE)
     assert rnea_module._RNEA_ONE is not None and forward_module._FK_ONE is not None
     # a strided view and a read-only vector are single samples too
     strided = np.repeat(q, 2)[::2]

@@ -28,7 +28,7 @@ from __future__ import annotations
 from .._compiled import C_AXIS, C_PRISMATIC
 from ._chain import IDENTITY, STACK, angles, compose, flat_view, inline, joint_at, lean, stack
 
-__all__ = ["link_poses", "frame_pose", "jacobian"]
+__all__ = ["link_poses", "frame_pose", "jacobian", "jacobian_one"]
 
 
 @inline
@@ -158,4 +158,24 @@ def jacobian(C, q, J):
         for i in range(link, n):
             for r in range(6):
                 J[o + r * n + i] = 0.0
+    return True
+
+
+@lean
+def jacobian_one(C, q, J):
+    """:func:`jacobian` of one sample (q of length n, any strides, J (6, n)); ``ok``.
+
+    The batch kernel without its loop over samples, for the single-sample path.
+    """
+    n = C.shape[0] - 2
+    if 3 * n > STACK:
+        return False
+    A = stack(3, n)
+    if not angles(C, q, 0, A):
+        return False
+    link = int(C[n + 1, 16])
+    frame_jacobian(C, A, link, flat_view(J), 0, n)
+    for i in range(link, n):
+        for r in range(6):
+            J[r, i] = 0.0
     return True

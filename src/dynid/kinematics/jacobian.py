@@ -41,7 +41,7 @@ _JACOBIAN_ONE: Any = None
 def _one() -> Any:
     """:func:`dynid.kinematics.forward.one` of the jacobian kernel, kept for the thin path."""
     global _JACOBIAN_ONE
-    _JACOBIAN_ONE = _forward.one("jacobian")
+    _JACOBIAN_ONE = _forward.one("jacobian_one")
     return _JACOBIAN_ONE
 
 
