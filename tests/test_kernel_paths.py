@@ -810,3 +810,72 @@ def test_packed_arrays_belong_to_one_robot(panda):
         assert not np.allclose(dynid.rnea(other, q, q, q), tau) or not np.allclose(
             dynid.jacobian(other, q), J
         ), name
+
+
+class _FakeClassArray:
+    """Claims to be an ndarray (``__class__``), as proxies do; numpy converts it."""
+
+    def __init__(self, x):
+        self._x, self.dtype, self.shape = x, x.dtype, x.shape
+
+    @property  # type: ignore[misc]
+    def __class__(self):
+        return np.ndarray
+
+    def __array__(self, dtype=None, copy=None):
+        return np.asarray(self._x, dtype=dtype)
+
+
+def test_thin_paths_refuse_what_only_looks_like_an_array(panda):
+    """An object faking the ndarray class gets the general path's numbers, not an error."""
+    q = np.linspace(-1.0, 1.0, 7)
+    dynid.rnea(panda, q, q, q), dynid.mass_matrix(panda, q), dynid.gravity_torques(panda, q)
+    dynid.fk(panda, q), dynid.jacobian(panda, q)  # the thin paths are live
+    x = _FakeClassArray(q)
+    for ours, theirs in (
+        (dynid.rnea(panda, q, x, q), rnea_numpy(panda, q, q, q)),
+        (dynid.mass_matrix(panda, x), mass_matrix_numpy(panda, q)),
+        (dynid.gravity_torques(panda, x), gravity_torques_numpy(panda, q)),
+        (dynid.fk(panda, x), fk_numpy(panda, q)),
+        (dynid.jacobian(panda, x), jacobian_numpy(panda, q)),
+    ):
+        np.testing.assert_allclose(ours, theirs, rtol=1e-12, atol=1e-12)
+
+
+def test_a_robot_does_not_change_when_the_callers_arrays_do(panda):
+    """Read-only arrays the caller owns are copied: unlocking and editing them later changes
+    neither the robot nor what the kernels packed from it."""
+    q = np.linspace(-1.0, 1.0, 7)
+    phi, g, T = np.array(panda.phi), np.array([0.5, 0.0, -9.8]), tool_pose()
+    for a in (phi, g, T):
+        a.setflags(write=False)
+    robot = panda.with_params(phi).with_gravity(g).with_frame("tcp", T)
+    before = (dynid.rnea(robot, q, q, q), dynid.fk(robot, q, "tcp"))
+    for _ in range(2):  # the second call takes the thin paths
+        dynid.rnea(robot, q, q, q), dynid.fk(robot, q, "tcp")
+    for a in (phi, g, T):
+        a.setflags(write=True)
+        a *= 2.0
+    with pytest.raises(ValueError):
+        robot.phi.setflags(write=True)
+    np.testing.assert_array_equal(dynid.rnea(robot, q, q, q), before[0])
+    np.testing.assert_array_equal(dynid.fk(robot, q, "tcp"), before[1])
+    np.testing.assert_array_equal(rnea_numpy(robot, q, q, q), rnea_numpy(robot, q, q, q))
+    np.testing.assert_allclose(rnea_numpy(robot, q, q, q), before[0], rtol=1e-12, atol=1e-12)
+
+
+def test_a_scalar_is_not_a_joint_vector_of_a_one_joint_robot():
+    """q = 0.3 for a one-joint robot raises ShapeError on every path, kernels loaded or not."""
+    r1 = dynid.Robot.from_mdh([0.0], [0.0], [0.0], mass=[1.0], com=[[0.1, 0.0, 0.0]])
+    z = np.zeros((2, 1))
+    dynid.fk(r1, z), dynid.rnea(r1, z, z, z)  # the kernels are loaded
+    for x in (0.3, np.float32(0.3), np.array(0.3, dtype=">f8"), np.array(3)):
+        for f, args in (
+            (dynid.fk, (x,)),
+            (dynid.jacobian, (x,)),
+            (dynid.rnea, (x, x, x)),
+            (dynid.mass_matrix, (x,)),
+            (dynid.gravity_torques, (x,)),
+        ):
+            with pytest.raises(dynid.ShapeError, match=r"shape \(\.\.\., 1\)"):
+                f(r1, *args)

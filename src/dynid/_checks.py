@@ -62,22 +62,32 @@ def as_exact(name: str, x: ArrayLike, shape: tuple[int, ...], **kw: Any) -> NDAr
 
 
 def _read_only_throughout(a: Any) -> bool:
-    """True for a read-only array whose data belong to read-only numpy arrays only (a
-    view of such an array cannot be made writable: nobody can change it)."""
+    """True for a read-only array whose memory nobody can write to: its chain of bases ends
+    in a read-only buffer (the bytes of :func:`frozen`, a memory map opened read-only), not
+    in an array that owns its data (whoever holds that one may make it writable again)."""
     while isinstance(a, np.ndarray):
-        if a.flags.writeable:
+        if a.flags.writeable or a.base is None:
             return False
-        if a.base is None:
-            return True
         a = a.base
-    return False
+    try:
+        return memoryview(a).readonly
+    except TypeError:
+        return False
 
 
 def frozen(a: NDArray[Any]) -> NDArray[Any]:
-    """Return a read-only copy of ``a``, or ``a`` itself when it is read-only throughout
-    (nobody can write into it, and a large log is not copied again)."""
+    """``a`` as an array nobody can write to: ``a`` itself when it already is one (a large
+    log is not copied again), else a copy kept in an immutable ``bytes`` buffer.
+
+    A read-only copy that owned its data could be made writable again by anyone holding
+    it (``setflags(write=True)``); over ``bytes`` numpy refuses. So a model built from the
+    caller's arrays cannot change behind its back, and what is derived from it once (the
+    compiled kernels' packed constants) stays valid.
+    """
     if _read_only_throughout(a):
         return a
-    b = np.array(a, copy=True)
-    b.setflags(write=False)
-    return b
+    if a.dtype.hasobject:  # no bytes for Python objects: a read-only copy
+        b = np.array(a, copy=True)
+        b.setflags(write=False)
+        return b
+    return np.frombuffer(a.tobytes(), dtype=a.dtype).reshape(a.shape)

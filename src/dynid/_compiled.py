@@ -202,6 +202,21 @@ def pack_frame(C: NDArray[np.float64], link: int, T_lf: NDArray[np.float64]) -> 
     return CF
 
 
+def c_float64(x: Any) -> NDArray[np.float64] | None:
+    """``x`` as a float64 C-contiguous array of at least one dimension (no copy when it is
+    one), or None (a scalar, or not numeric): the input of the kernels' lean paths; None
+    sends a call to the full validation, which raises the documented errors."""
+    if type(x) is np.ndarray and x.dtype is F64 and x.flags.c_contiguous:
+        return x if x.ndim else None
+    try:
+        a = np.asarray(x, dtype=np.float64)
+    except (TypeError, ValueError):
+        return None
+    if not a.ndim:
+        return None
+    return a if a.flags.c_contiguous else np.ascontiguousarray(a)
+
+
 def flat(x: NDArray[np.float64]) -> NDArray[np.float64]:
     """``x`` as a flat C-contiguous, aligned, writeable array (a view when it can be).
 

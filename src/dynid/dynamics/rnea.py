@@ -66,6 +66,7 @@ def _kernels_for(ndim: int) -> ModuleType | None:
 
 
 _F64, _ND = _compiled.F64, np.ndarray
+_c64 = _compiled.c_float64
 #: the single-sample kernels' compiled entry points (:func:`dynid._compiled.entry`), by
 #: kernel name, made by :func:`one` once the kernels are loaded
 ONE: dict[str, Any] = {}
@@ -94,16 +95,6 @@ def one(name: str) -> Any:
         if name == "rnea_one":
             _RNEA_ONE = e
     return e
-
-
-def _c64(x: ArrayLike) -> NDArray[np.float64] | None:
-    """``x`` as a float64 C-contiguous array (no copy when it is one), or None."""
-    if type(x) is np.ndarray and x.dtype is _F64 and x.flags.c_contiguous:
-        return x
-    try:
-        return np.ascontiguousarray(x, dtype=np.float64)
-    except (TypeError, ValueError):
-        return None
 
 
 def cross(a: NDArray[np.float64], b: NDArray[np.float64]) -> NDArray[np.float64]:
@@ -244,8 +235,11 @@ def rnea(
         and _RNEA_ONE is not None
     ):
         tau = np.empty(p.vector)
-        if _RNEA_ONE(p.C, q, dq, ddq, tau):
-            return tau
+        try:  # (an object can fake its class; the entry point then refuses it)
+            if _RNEA_ONE(p.C, q, dq, ddq, tau):
+                return tau
+        except TypeError:
+            pass
     if gravity is None:
         # lean path: float64 C arrays of one shape (..., n) go to the kernel as they are;
         # the kernel checks finiteness, and anything else (or a failure) falls through to

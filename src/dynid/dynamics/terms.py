@@ -119,8 +119,11 @@ def mass_matrix(robot: Robot, q: ArrayLike) -> NDArray[np.float64]:
         and _MASS_ONE is not None
     ):
         M = np.empty(p.matrix)
-        if _MASS_ONE(p.C, q, M):
-            return M
+        try:  # (an object can fake its class; the entry point then refuses it)
+            if _MASS_ONE(p.C, q, M):
+                return M
+        except TypeError:
+            pass
     # lean path: a float64 C array (..., n) goes to the kernel as it is
     qa = _c64(q)
     K = None if qa is None else _rnea_module._kernels_for(qa.ndim)
@@ -158,8 +161,11 @@ def gravity_torques(robot: Robot, q: ArrayLike) -> NDArray[np.float64]:
         and _GRAVITY_ONE is not None
     ):
         tau = np.empty(p.vector)
-        if _GRAVITY_ONE(p.C, q, tau):
-            return tau
+        try:
+            if _GRAVITY_ONE(p.C, q, tau):
+                return tau
+        except TypeError:
+            pass
     # lean path: a float64 C array (..., n) goes to the kernel as it is
     qa = _c64(q)
     K = None if qa is None else _rnea_module._kernels_for(qa.ndim)

@@ -99,13 +99,8 @@ def _as_q(robot: Robot, q: ArrayLike) -> NDArray[np.float64] | None:
     attribute reads, no copy; finiteness is left to the kernels, and None sends the call to
     the full validation, which raises the documented errors.
     """
-    if type(q) is not np.ndarray or q.dtype is not _F64 or not q.flags.c_contiguous:
-        try:
-            q = np.ascontiguousarray(q, dtype=np.float64)
-        except (TypeError, ValueError):
-            return None
-    shape = q.shape
-    return q if shape and shape[-1] == len(robot.joint_names) and shape[-1] else None
+    a = _compiled.c_float64(q)
+    return a if a is not None and a.shape[-1] == len(robot.joint_names) else None
 
 
 def _frame_entry(robot: Robot, frame: str) -> tuple[int, NDArray, NDArray]:
@@ -286,8 +281,11 @@ def fk(
         hit = p.frames.get(frame)
         if hit is not None and q.__class__ is _ND and q.dtype is _F64 and q.shape == p.vector:
             T = np.empty((4, 4))
-            if _FK_ONE(hit[2], q, T):
-                return T
+            try:  # (an object can fake its class; the entry point then refuses it)
+                if _FK_ONE(hit[2], q, T):
+                    return T
+            except TypeError:
+                pass
     link, T_link_frame, CF = _frame_constants(robot, frame, tool)
     # lean path: a float64 C array of shape (..., n) goes to the kernel as it is
     if type(q) is np.ndarray and q.dtype is _F64 and q.flags.c_contiguous:

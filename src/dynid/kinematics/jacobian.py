@@ -82,8 +82,11 @@ def jacobian(
         hit = p.frames.get(frame)
         if hit is not None and q.__class__ is _ND and q.dtype is _F64 and q.shape == p.vector:
             J = np.empty(p.jacobian)
-            if e(hit[2], q, J):
-                return J
+            try:
+                if e(hit[2], q, J):
+                    return J
+            except TypeError:
+                pass
     link, T_link_frame, CF = _frame_constants(robot, frame, tool)
     # lean path: a float64 C array of shape (..., n) goes to the kernel as it is
     if type(q) is np.ndarray and q.dtype is _F64 and q.flags.c_contiguous:
