@@ -879,3 +879,12 @@ def test_a_scalar_is_not_a_joint_vector_of_a_one_joint_robot():
         ):
             with pytest.raises(dynid.ShapeError, match=r"shape \(\.\.\., 1\)"):
                 f(r1, *args)
+
+
+def test_a_frame_that_is_not_a_name_is_an_unknown_frame(panda):
+    """An unhashable frame raises UnknownNameError on every path, as a wrong name does."""
+    q = np.zeros(7)
+    dynid.fk(panda, q), dynid.jacobian(panda, q)
+    for f in (dynid.fk, dynid.jacobian, fk_numpy, jacobian_numpy):
+        with pytest.raises(dynid.UnknownNameError, match="available"):
+            f(panda, q, frame=["flange"])

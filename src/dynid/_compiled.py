@@ -137,17 +137,19 @@ class Packed:
 
     ``C``: the constants (:func:`pack`); ``vector``, ``matrix``, ``jacobian``: the shapes
     ``(n,)``, ``(n, n)`` and ``(6, n)`` of the single-sample paths; ``frames``: frame name ->
-    ``(link, T_link_frame, CF)`` (:func:`pack_frame`), filled as frames are used. Robots are
-    immutable, so nothing here goes stale.
+    ``(link, T_link_frame, CF)`` (:func:`pack_frame`), filled as frames are used, and
+    ``flange`` the flange's ``CF`` (the default frame, read without a lookup) once made.
+    Robots are immutable, so nothing here goes stale.
     """
 
-    __slots__ = ("C", "vector", "matrix", "jacobian", "frames")
+    __slots__ = ("C", "vector", "matrix", "jacobian", "frames", "flange")
 
     def __init__(self, robot: Any) -> None:
         self.C = pack(robot)
         n = self.C.shape[0] - 1
         self.vector, self.matrix, self.jacobian = (n,), (n, n), (6, n)
         self.frames: dict[str, tuple[int, NDArray[np.float64], NDArray[np.float64]]] = {}
+        self.flange: NDArray[np.float64] | None = None
 
 
 def packed(robot: Any) -> Packed:

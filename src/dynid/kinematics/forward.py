@@ -106,12 +106,14 @@ def _as_q(robot: Robot, q: ArrayLike) -> NDArray[np.float64] | None:
 def _frame_entry(robot: Robot, frame: str) -> tuple[int, NDArray, NDArray]:
     """``(link, T_link_frame, CF)`` of ``frame`` (:class:`dynid._compiled.Packed`), made on
     first use; ``CF`` are the kernels' constants with the frame."""
-    frames = _compiled.packed(robot).frames
-    hit = frames.get(frame)
+    p = _compiled.packed(robot)
+    hit = p.frames.get(frame) if isinstance(frame, str) else None
     if hit is None:
-        f = robot.frame(frame)
+        f = robot.frame(frame)  # raises UnknownNameError for anything but a frame's name
         T = _readonly(f.T_link_frame)
-        hit = frames[frame] = (f.link, T, _compiled.pack_frame(_constants(robot), f.link, T))
+        hit = p.frames[frame] = (f.link, T, _compiled.pack_frame(p.C, f.link, T))
+        if frame == "flange":
+            p.flange = hit[2]
     return hit
 
 
@@ -277,15 +279,22 @@ def fk(
     # single sample: a float64 (n,) numpy array of any strides goes straight to the
     # compiled kernel (no conversion, no copy, no dispatch; it checks finiteness)
     p = robot._packed
-    if p is not None and tool is None and _FK_ONE is not None:
-        hit = p.frames.get(frame)
-        if hit is not None and q.__class__ is _ND and q.dtype is _F64 and q.shape == p.vector:
-            T = np.empty((4, 4))
-            try:  # (an object can fake its class; the entry point then refuses it)
-                if _FK_ONE(hit[2], q, T):
+    if (
+        p is not None
+        and q.__class__ is _ND
+        and tool is None
+        and q.dtype is _F64
+        and q.shape == p.vector
+        and _FK_ONE is not None
+    ):
+        try:  # (unhashable frames, and objects that fake their class, go the general way)
+            CF = p.flange if frame == "flange" else p.frames.get(frame, (None,) * 3)[2]
+            if CF is not None:
+                T = np.empty((4, 4))
+                if _FK_ONE(CF, q, T):
                     return T
-            except TypeError:
-                pass
+        except TypeError:
+            pass
     link, T_link_frame, CF = _frame_constants(robot, frame, tool)
     # lean path: a float64 C array of shape (..., n) goes to the kernel as it is
     if type(q) is np.ndarray and q.dtype is _F64 and q.flags.c_contiguous:

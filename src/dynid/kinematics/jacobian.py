@@ -77,16 +77,23 @@ def jacobian(
     else :func:`jacobian_numpy`.
     """
     # single sample: as in :func:`dynid.kinematics.forward.fk`
-    p, e = robot._packed, _JACOBIAN_ONE
-    if p is not None and tool is None and e is not None:
-        hit = p.frames.get(frame)
-        if hit is not None and q.__class__ is _ND and q.dtype is _F64 and q.shape == p.vector:
-            J = np.empty(p.jacobian)
-            try:
-                if e(hit[2], q, J):
+    p = robot._packed
+    if (
+        p is not None
+        and q.__class__ is _ND
+        and tool is None
+        and q.dtype is _F64
+        and q.shape == p.vector
+        and _JACOBIAN_ONE is not None
+    ):
+        try:  # (unhashable frames, and objects that fake their class, go the general way)
+            CF = p.flange if frame == "flange" else p.frames.get(frame, (None,) * 3)[2]
+            if CF is not None:
+                J = np.empty(p.jacobian)
+                if _JACOBIAN_ONE(CF, q, J):
                     return J
-            except TypeError:
-                pass
+        except TypeError:
+            pass
     link, T_link_frame, CF = _frame_constants(robot, frame, tool)
     # lean path: a float64 C array of shape (..., n) goes to the kernel as it is
     if type(q) is np.ndarray and q.dtype is _F64 and q.flags.c_contiguous:

@@ -215,7 +215,7 @@ class Robot:
         """The named frame; raises :class:`UnknownNameError` listing the available ones."""
         try:
             return self.frames[name]
-        except KeyError:
+        except (KeyError, TypeError):  # TypeError: not a name (unhashable)
             raise UnknownNameError(
                 f"Unknown frame {name!r}; available: {sorted(self.frames)}"
             ) from None
