@@ -11,7 +11,9 @@ and the inertials and gravity of ``dynid.panda()``):
 * ``fk`` (flange pose) vs ``pinocchio.forwardKinematics`` + ``updateFramePlacements`` and
   reading the frame's pose;
 * ``jacobian`` (flange, base frame) vs ``pinocchio.computeFrameJacobian``
-  (``LOCAL_WORLD_ALIGNED``).
+  (``LOCAL_WORLD_ALIGNED``);
+* ``coriolis`` vs ``pinocchio.nonLinearEffects`` without gravity; ``forward_dynamics`` vs
+  ``pinocchio.aba`` (the torques are the random accelerations' values).
 
 Every case checks that both give the same answer before timing it; the kernels are loaded
 first (single samples use them once loaded). The header also gives the time of dynid's
@@ -156,6 +158,9 @@ def main(argv: list[str] | None = None) -> int:
     pin_grav_loop = pin_loop(lambda k: pin.computeGeneralizedGravity(model, data, Q[k]), (7,))
     pin_fk_loop = pin_loop(lambda k: pin_fk(Q[k]), (4, 4))
     pin_jac_loop = pin_loop(lambda k: pin_jac(Q[k]), (6, 7))
+    model0, data0 = pinocchio_panda(robot.with_gravity([0.0, 0.0, 0.0]))  # c(q, dq)
+    pin_cor_loop = pin_loop(lambda k: pin.nonLinearEffects(model0, data0, Q[k], DQ[k]), (7,))
+    pin_aba_loop = pin_loop(lambda k: pin.aba(model, data, Q[k], DQ[k], DDQ[k]), (7,))
 
     specs = [
         # name, samples, dynid call, pinocchio call, pinocchio answer for the check, atol
@@ -226,12 +231,39 @@ def main(argv: list[str] | None = None) -> int:
             1e-12,
         ),
         ("jacobian flange, batch", N, lambda: dynid.jacobian(robot, Q), pin_jac_loop, None, 1e-12),
+        (
+            "coriolis, 1 sample",
+            1,
+            lambda: dynid.coriolis(robot, q, dq),
+            lambda: pin.nonLinearEffects(model0, data0, q, dq),
+            None,
+            1e-10,
+        ),
+        ("coriolis, batch", N, lambda: dynid.coriolis(robot, Q, DQ), pin_cor_loop, None, 1e-10),
+        (
+            "forward_dynamics, 1 sample",
+            1,
+            lambda: dynid.forward_dynamics(robot, q, dq, ddq),
+            lambda: pin.aba(model, data, q, dq, ddq),
+            None,
+            1e-8,
+        ),
+        (
+            "forward_dynamics, batch",
+            N,
+            lambda: dynid.forward_dynamics(robot, Q, DQ, DDQ),
+            pin_aba_loop,
+            None,
+            1e-8,
+        ),
     ]
     notes = {
         "rnea, batch": "reference: Python loop of pinocchio.rnea over the samples",
         "rnea, batch, numpy path": "dynid's numpy reference path (rnea_numpy), not the kernel",
         "mass_matrix, 1 sample": "pinocchio.crba fills the upper triangle only (timed as is)",
         "fk flange, 1 sample": "reference: forwardKinematics + updateFramePlacements + oMf read",
+        "coriolis, 1 sample": "reference: nonLinearEffects of the model without gravity",
+        "forward_dynamics, 1 sample": "reference: pinocchio.aba (dynid: RNEA, CRBA, Cholesky)",
     }
     cases = []
     for name, n, ours, ref, ref_answer, atol in specs:

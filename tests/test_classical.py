@@ -68,6 +68,7 @@ def test_noise_free_identification_from_filtered_velocities(panda, torque_base):
     assert np.max(np.abs(model.beta - beta)) < 1e-3 * np.max(np.abs(beta))
 
 
+@pytest.mark.filterwarnings("ignore:.*indistinguishable from zero")  # expected: weak coefficients
 def test_noisy_identification_predicts_held_out_torques_to_the_noise_level(panda, torque_base):
     """With 0.05 N m sensor noise the model predicts another trajectory to the noise level."""
     t = sample_times(20.0, 1000.0)

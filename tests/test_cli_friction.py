@@ -67,6 +67,7 @@ def workdir(tmp_path_factory, panda):
     return d
 
 
+@pytest.mark.filterwarnings("ignore:.*indistinguishable from zero")  # expected: weak coefficients
 def test_simulate_writes_a_readable_log(workdir, capsys):
     """simulate writes 1 kHz logs of the requested duration and reports the scaling."""
     log = load_torque_log(workdir / "sin.csv")

@@ -68,6 +68,18 @@ def rpr_tilted() -> dynid.Robot:
 
 ROBOTS = {"panda": dynid.panda, "rpr_tilted": rpr_tilted}
 
+
+def _coriolis_numpy(robot, q, dq):
+    """c(q, dq): the numpy RNEA without gravity at zero acceleration."""
+    return rnea_numpy(robot, q, dq, np.zeros_like(q), gravity=np.zeros(3))
+
+
+def _forward_dynamics_numpy(robot, q, dq, tau):
+    """M^-1 (tau - c - g) from the numpy mass matrix and RNEA, by numpy's LU solve."""
+    bias = rnea_numpy(robot, q, dq, np.zeros_like(q))
+    return np.linalg.solve(mass_matrix_numpy(robot, q), (tau - bias)[..., None])[..., 0]
+
+
 #: name -> (public function, numpy reference, arguments built from (robot, q, dq, ddq))
 PAIRS = {
     "link_poses": (dynid.link_poses, link_poses_numpy, lambda r, q, v, a: (r, q)),
@@ -89,6 +101,12 @@ PAIRS = {
         dynid.gravity_torques,
         gravity_torques_numpy,
         lambda r, q, v, a: (r, q),
+    ),
+    "coriolis": (dynid.coriolis, _coriolis_numpy, lambda r, q, v, a: (r, q, v)),
+    "forward_dynamics": (
+        dynid.forward_dynamics,
+        _forward_dynamics_numpy,
+        lambda r, q, v, a: (r, q, v, a),
     ),
     "torque_regressor": (torque_regressor, torque_regressor_numpy, lambda r, q, v, a: (r, q, v, a)),
     "static_regressor": (
@@ -116,6 +134,8 @@ def test_kernel_equals_numpy_reference(pair, robot_name, shape):
     a, b = ours(*make(robot, q, dq, ddq)), ref(*make(robot, q, dq, ddq))
     assert a.shape == b.shape and a.shape[: len(shape)] == shape
     assert np.max(np.abs(a - b)) <= 1e-12 * max(1.0, np.max(np.abs(b)))
+    # a second call (a single sample then takes its thin path) gives the same numbers
+    np.testing.assert_allclose(ours(*make(robot, q, dq, ddq)), a, rtol=1e-13, atol=1e-13)
 
 
 def test_single_sample_thin_path_takes_the_kernel_and_checks_its_input(panda):

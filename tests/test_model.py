@@ -88,3 +88,30 @@ def test_unknown_frame_lists_available(panda):
         dynid.fk(panda, np.zeros(7), "hand")
     with pytest.raises(KeyError):
         panda.joint_index("panda_joint8")
+
+
+def test_a_robot_pickles_and_copies_bit_for_bit(panda):
+    """pickle and copy.deepcopy give the same model (for process pools); arrays stay frozen."""
+    import copy
+    import pickle
+
+    robot = panda.with_friction(np.tile([0.5, 30.0, 0.01], (7, 1))).with_frame(
+        "tcp", np.diag([1.0, -1.0, -1.0, 1.0])
+    )
+    q = np.linspace(-1.0, 1.0, 7)
+    dynid.rnea(robot, q, q, q)  # the packed arrays exist and must not travel
+    for other in (pickle.loads(pickle.dumps(robot)), copy.deepcopy(robot)):
+        assert other._packed is None and other.frames.keys() == robot.frames.keys()
+        for name in ("T_parent_joint", "axes", "prismatic", "phi", "q_min", "q_max", "dq_max",
+                     "ddq_max", "tau_max", "gravity", "friction", "q_neutral"):  # fmt: skip
+            a, b = getattr(robot, name), getattr(other, name)
+            np.testing.assert_array_equal(a, b)
+            assert not b.flags.writeable
+        tcp = (r.frame("tcp").T_link_frame for r in (other, robot))
+        np.testing.assert_array_equal(*tcp)
+        np.testing.assert_array_equal(dynid.rnea(other, q, q, q), dynid.rnea(robot, q, q, q))
+        assert (other.name, other.joint_names, other.link_names) == (
+            robot.name,
+            robot.joint_names,
+            robot.link_names,
+        )

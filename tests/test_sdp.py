@@ -72,6 +72,7 @@ def test_noisy_static_coefficients_with_model_error_give_a_strictly_consistent_s
     assert any("not consistent with a rigid body" in s or "prior weight" in s for s in res.notes)
 
 
+@pytest.mark.filterwarnings("ignore:.*indistinguishable from zero")  # expected: weak coefficients
 def test_one_step_on_a_log_with_model_error_predicts_held_out_torques_like_least_squares():
     """Held-out torque RMS within 10 % of the unconstrained classical identification's."""
     robot = dynid.panda()

@@ -135,18 +135,22 @@ def pack(robot: Any, phi: Any = None, gravity: Any = None) -> NDArray[np.float64
 class Packed:
     """A robot's arrays for the kernels, made once per robot and kept on it (``_packed``).
 
-    ``C``: the constants (:func:`pack`); ``vector``, ``matrix``, ``jacobian``: the shapes
+    ``C``: the constants (:func:`pack`); ``C0``: the same without gravity (for the
+    Coriolis and centrifugal torques); ``zeros``: a read-only ``(n,)`` zero vector;
+    ``vector``, ``matrix``, ``jacobian``: the shapes
     ``(n,)``, ``(n, n)`` and ``(6, n)`` of the single-sample paths; ``frames``: frame name ->
     ``(link, T_link_frame, CF)`` (:func:`pack_frame`), filled as frames are used, and
     ``flange`` the flange's ``CF`` (the default frame, read without a lookup) once made.
     Robots are immutable, so nothing here goes stale.
     """
 
-    __slots__ = ("C", "vector", "matrix", "jacobian", "frames", "flange")
+    __slots__ = ("C", "C0", "zeros", "vector", "matrix", "jacobian", "frames", "flange")
 
     def __init__(self, robot: Any) -> None:
         self.C = pack(robot)
         n = self.C.shape[0] - 1
+        self.C0 = pack(robot, gravity=np.zeros(3))
+        self.zeros = _checks.frozen(np.zeros(n))
         self.vector, self.matrix, self.jacobian = (n,), (n, n), (6, n)
         self.frames: dict[str, tuple[int, NDArray[np.float64], NDArray[np.float64]]] = {}
         self.flange: NDArray[np.float64] | None = None

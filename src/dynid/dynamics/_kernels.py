@@ -69,6 +69,7 @@ __all__ = [
     "rnea_one",
     "gravity_torques_one",
     "mass_matrix_one",
+    "forward_dynamics_one",
 ]
 
 #: Samples per block of :func:`rnea` (the length of the vectorised inner loop).
@@ -562,4 +563,53 @@ def mass_matrix_one(C, q, M):
     if not angles(C, q, 0, A):
         return False
     _crba_sample(C, A, 0, flat_view(M), stack(n, 12))
+    return True
+
+
+@lean
+def forward_dynamics_one(C, q, dq, tau, ddq):
+    """Accelerations ``M^-1 (tau - rnea(q, dq, 0))`` of one sample into ``ddq``; ``ok``.
+
+    The bias (RNEA at zero acceleration) and the composite-rigid-body ``M`` share the
+    sample's sines and cosines; ``M`` is solved by its Cholesky factor, in place. False
+    also when ``M`` is not positive definite (the caller's general solve then reports it)
+    or the robot is too long for the stack scratch.
+    """
+    n = C.shape[0] - 1
+    if n * 21 > _STACK or n * n > _STACK:
+        return False
+    A = stack(3, n)
+    if not (angles(C, q, 0, A) and finite(dq, 0, n) and finite(tau, 0, n)):
+        return False
+    W = stack(2, n)
+    zero, bias = W[0], W[1]
+    for i in range(n):
+        zero[i] = 0.0
+    S = stack(n, 21)
+    _rnea_sample(C, A, dq, zero, 0, 0, 0, bias, S)
+    M = stack(n, n)
+    _crba_sample(C, A, 0, flat_view(M), S)
+    for j in range(n):  # M = L L^T, L in the lower triangle of M
+        s = M[j, j]
+        for k in range(j):
+            s -= M[j, k] * M[j, k]
+        if not s > 0.0:
+            return False
+        d = math.sqrt(s)
+        M[j, j] = d
+        for i in range(j + 1, n):
+            t = M[i, j]
+            for k in range(j):
+                t -= M[i, k] * M[j, k]
+            M[i, j] = t / d
+    for i in range(n):  # L y = tau - bias
+        t = tau[i] - bias[i]
+        for k in range(i):
+            t -= M[i, k] * ddq[k]
+        ddq[i] = t / M[i, i]
+    for i in range(n - 1, -1, -1):  # L^T ddq = y
+        t = ddq[i]
+        for k in range(i + 1, n):
+            t -= M[k, i] * ddq[k]
+        ddq[i] = t / M[i, i]
     return True

@@ -66,6 +66,8 @@ def _kernels_for(ndim: int) -> ModuleType | None:
 
 
 _F64, _ND = _compiled.F64, np.ndarray
+#: gravity off (the Coriolis and centrifugal torques, the mass matrix's columns)
+ZERO_GRAVITY = _checks.frozen(np.zeros(3))
 _c64 = _compiled.c_float64
 #: the single-sample kernels' compiled entry points (:func:`dynid._compiled.entry`), by
 #: kernel name, made by :func:`one` once the kernels are loaded
@@ -90,6 +92,7 @@ def one(name: str) -> Any:
             "rnea_one": (C, v, v, v, tau),
             "gravity_torques_one": (C, v, tau),
             "mass_matrix_one": (C, v, M),
+            "forward_dynamics_one": (C, v, v, v, tau),
         }[name]
         e = ONE[name] = _compiled.entry(getattr(_KERNELS, name), *args)
         if name == "rnea_one":
@@ -295,6 +298,8 @@ def _rnea(
             tau = np.empty((B, n))
             if phi is robot.phi and gravity is robot.gravity:
                 C = _constants(robot)
+            elif phi is robot.phi and gravity is ZERO_GRAVITY:
+                C = _compiled.packed(robot).C0
             else:
                 C = _compiled.pack(robot, np.asarray(phi, dtype=np.float64), gravity)
             if K.rnea(C, _flat(q), _flat(dq), _flat(ddq), tau.reshape(-1)):

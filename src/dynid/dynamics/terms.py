@@ -10,9 +10,10 @@ form ``c(q, v)`` by polarization.
 
 With numba installed (see :func:`dynid.dynamics.rnea.kernels`), ``M`` comes from the
 composite-rigid-body algorithm and ``g`` and the RNEA calls from the compiled kernels of
-:mod:`dynid.dynamics._kernels`; :func:`mass_matrix_numpy` and
-:func:`gravity_torques_numpy` are the numpy reference path (``DYNID_NO_NUMBA=1`` selects
-it everywhere). Both agree to rounding.
+:mod:`dynid.dynamics._kernels` (a single sample of :func:`forward_dynamics` is one compiled
+call: RNEA for ``c + g``, the composite-rigid-body ``M`` and its Cholesky solve);
+:func:`mass_matrix_numpy` and :func:`gravity_torques_numpy` are the numpy reference path
+(``DYNID_NO_NUMBA=1`` selects it everywhere). Both agree to rounding.
 """
 
 from __future__ import annotations
@@ -22,13 +23,14 @@ from typing import Any
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from .. import _checks
+from .. import _checks, _compiled
 from .._compiled import constants as _constants
 from ..model.robot import Robot
 from . import rnea as _rnea_module
 from .rnea import (
     _F64,
     _ND,
+    ZERO_GRAVITY,
     _c64,
     _flat,
     _rnea,
@@ -47,20 +49,23 @@ __all__ = [
     "forward_dynamics",
 ]
 
-_ZERO_G = _checks.frozen(np.zeros(3))
+_ZERO_G = ZERO_GRAVITY
 #: the single-sample kernels' entry points for the thin paths (set by :func:`_one`)
 _MASS_ONE: Any = None
 _GRAVITY_ONE: Any = None
+_FORWARD_ONE: Any = None
 
 
 def _one(name: str) -> Any:
     """:func:`dynid.dynamics.rnea.one`, kept for the thin paths of this module."""
-    global _MASS_ONE, _GRAVITY_ONE
+    global _MASS_ONE, _GRAVITY_ONE, _FORWARD_ONE
     e = one(name)
     if name == "mass_matrix_one":
         _MASS_ONE = e
-    else:
+    elif name == "gravity_torques_one":
         _GRAVITY_ONE = e
+    else:
+        _FORWARD_ONE = e
     return e
 
 
@@ -201,7 +206,25 @@ def coriolis(robot: Robot, q: ArrayLike, dq: ArrayLike) -> NDArray[np.float64]:
     -------
     c : ndarray, shape (..., n)
     """
+    # single sample: the single-sample RNEA kernel without gravity, at zero acceleration
+    p, e = robot._packed, _rnea_module._RNEA_ONE
+    if (
+        p is not None
+        and q.__class__ is dq.__class__ is _ND
+        and q.dtype is dq.dtype is _F64
+        and q.shape == dq.shape == p.vector
+        and e is not None
+    ):
+        c = np.empty(p.vector)
+        try:  # (an object can fake its class; the entry point then refuses it)
+            if e(p.C0, q, dq, p.zeros, c):
+                return c
+        except TypeError:
+            pass
     shape, (q2, dq2, _) = prepare_states(robot, q, dq, np.zeros(robot.n))
+    if shape == (robot.n,) and _rnea_module._LOADED and _rnea_module._KERNELS is not None:
+        one("rnea_one")  # the next single sample takes the thin path
+        _compiled.packed(robot)
     return _rnea(robot, robot.phi, q2, dq2, np.zeros((1, robot.n)), _ZERO_G).reshape(shape)
 
 
@@ -264,7 +287,25 @@ def forward_dynamics(
     -------
     ddq : ndarray, shape (..., n) [rad/s^2]
     """
+    # single sample: one compiled call (bias, mass matrix and its Cholesky solve)
+    p = robot._packed
+    if (
+        p is not None
+        and q.__class__ is dq.__class__ is tau.__class__ is _ND
+        and q.dtype is dq.dtype is tau.dtype is _F64
+        and q.shape == dq.shape == tau.shape == p.vector
+        and _FORWARD_ONE is not None
+    ):
+        ddq = np.empty(p.vector)
+        try:
+            if _FORWARD_ONE(p.C, q, dq, tau, ddq):
+                return ddq
+        except TypeError:
+            pass
     shape, (q2, dq2, tau2) = prepare_states(robot, q, dq, tau)
+    if shape == (robot.n,) and _rnea_module._LOADED and _rnea_module._KERNELS is not None:
+        _one("forward_dynamics_one")  # the next single sample takes the thin path
+        _compiled.packed(robot)
     bias = _rnea(robot, robot.phi, q2, dq2, np.zeros_like(q2), robot.gravity)
     M = _mass_matrix(robot, q2)
     return np.linalg.solve(M, (tau2 - bias)[..., None])[..., 0].reshape(shape)

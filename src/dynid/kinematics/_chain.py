@@ -117,9 +117,9 @@ def lean(fn):
         return jit(fn)
 
 
-#: floats of stack scratch in a one-sample kernel (:func:`stack`); robots whose scratch
-#: would not fit take the batch kernels
-STACK = 2048
+#: floats of one stack scratch array (:func:`stack`, 8 KiB); robots whose scratch would
+#: not fit (over 48 joints for the one-sample RNEA) take the batch kernels
+STACK = 1024
 
 
 @intrinsic

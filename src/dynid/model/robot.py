@@ -63,6 +63,19 @@ def _fixed_frames(frames: Mapping[str, Frame]) -> Mapping[str, Frame]:
     return MappingProxyType(out)
 
 
+def _restore_robot(state: dict[str, Any]) -> Robot:
+    """The robot of :meth:`Robot.__reduce__`'s ``state`` (arrays frozen again)."""
+    robot = object.__new__(Robot)
+    for k, v in state.items():
+        if k == "frames":
+            v = _fixed_frames(v)
+        elif isinstance(v, np.ndarray):
+            v = _checks.frozen(v)
+        object.__setattr__(robot, k, v)
+    object.__setattr__(robot, "_packed", None)
+    return robot
+
+
 @dataclass(frozen=True, slots=True, eq=False)
 class Robot:
     """Immutable serial-chain robot: kinematics, inertial parameters, limits, friction.
@@ -435,6 +448,13 @@ class Robot:
         from .description import toml_from_robot
 
         return toml_from_robot(self)
+
+    def __reduce__(self) -> tuple[Any, tuple[dict[str, Any]]]:
+        """Pickle (and copy) by the model's fields, restored as they are, not re-validated
+        (so not re-normalised: bit for bit); the kernels' packed arrays are made anew."""
+        state = {f.name: getattr(self, f.name) for f in dataclasses.fields(self) if f.init}
+        state["frames"] = dict(self.frames)
+        return _restore_robot, (state,)
 
     def __repr__(self) -> str:
         kinds = "".join("P" if p else "R" for p in self.prismatic)
