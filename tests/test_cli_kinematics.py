@@ -40,26 +40,38 @@ def test_fk_json_equals_library(capsys):
     np.testing.assert_array_equal(np.array(obj["T"]), T_ref)
 
 
-def test_fk_on_the_panda_imports_neither_scipy_nor_numba():
-    """A one-shot ``dynid fk`` loads only what it uses (the start-up target of issue 11)."""
+@pytest.mark.parametrize(
+    "argv",
+    [
+        ["fk", "--q=0,0,0,-1.5,0,1.5,0.7"],
+        ["jacobian", "--q=0,0,0,-1.5,0,1.5,0.7"],
+        ["ik", "--goal-xyz", "0.4,0.1,0.4", "--goal-rpy", "3.1416,0,0"],
+    ],
+    ids=["fk", "jacobian", "ik"],
+)
+def test_one_shot_kinematics_imports_neither_scipy_nor_numba(argv):
+    """A one-shot ``dynid fk/jacobian/ik`` on the Panda loads only what it uses (start-up
+    target of issue 11), and prints what the library computes."""
     import subprocess
     import sys
 
     code = (
         "import sys\n"
         "from dynid.cli.__main__ import main\n"
-        "assert main(['fk', '--robot', 'panda', '--q=0,0,0,-1.5,0,1.5,0.7', '--json']) == 0\n"
+        f"assert main({argv + ['--robot', 'panda', '--json']!r}) == 0\n"
         "heavy = sorted(m for m in ('scipy', 'numba', 'matplotlib') if m in sys.modules)\n"
         "assert not heavy, heavy\n"
     )
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True)
     assert out.returncode == 0, out.stderr
-    np.testing.assert_allclose(
-        json.loads(out.stdout)["T"],
-        dynid.fk(dynid.panda(), [0, 0, 0, -1.5, 0, 1.5, 0.7]),
-        rtol=0,
-        atol=1e-14,
-    )
+    got, robot, q = json.loads(out.stdout), dynid.panda(), [0, 0, 0, -1.5, 0, 1.5, 0.7]
+    if argv[0] == "fk":
+        np.testing.assert_allclose(got["T"], dynid.fk(robot, q), rtol=0, atol=1e-14)
+    elif argv[0] == "jacobian":
+        np.testing.assert_allclose(got["J"], dynid.jacobian(robot, q), rtol=0, atol=1e-14)
+    else:
+        assert got["converged"]
+        np.testing.assert_allclose(dynid.fk(robot, got["q"])[:3, 3], [0.4, 0.1, 0.4], atol=1e-6)
 
 
 def test_fk_default_q_is_the_neutral_pose(capsys):

@@ -78,11 +78,9 @@ def _rotvec(R: NDArray[np.float64]) -> tuple[float, float, float, float]:
 
 def _dls(J: NDArray[np.float64], e: NDArray[np.float64], lam_max: float, eps: float) -> NDArray:
     """Damped least-squares solution ``J^# e`` with singular-value dependent damping."""
-    from scipy.linalg import lapack  # the numpy loop only: not on the import path
-
-    U, s, Vt, info = lapack.dgesdd(J, full_matrices=0)
-    if info != 0:  # LAPACK did not converge: numpy's driver raises a clear error
-        U, s, Vt = np.linalg.svd(J, full_matrices=False)
+    # numpy's driver (LAPACK gesdd): importing scipy.linalg for it would cost a one-shot
+    # command line call more (0.13 s) than all its iterations
+    U, s, Vt = np.linalg.svd(J, full_matrices=False)
     s_min = s[-1]
     lam2 = (1.0 - (s_min / eps) ** 2) * lam_max**2 if s_min < eps else 0.0
     keep = s > 1e-12 * s[0]
