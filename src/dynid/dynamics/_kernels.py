@@ -60,6 +60,7 @@ from ..kinematics._chain import (
 from ..kinematics._chain import SINCOS_MAX as _SINCOS_MAX
 from ..kinematics._chain import STACK as _STACK
 from ..kinematics._chain import sincos as _sincos
+from ..kinematics._dense import cholesky, cholesky_solve
 
 __all__ = [
     "BLOCK",
@@ -571,9 +572,9 @@ def forward_dynamics_one(C, q, dq, tau, ddq):
     """Accelerations ``M^-1 (tau - rnea(q, dq, 0))`` of one sample into ``ddq``; ``ok``.
 
     The bias (RNEA at zero acceleration) and the composite-rigid-body ``M`` share the
-    sample's sines and cosines; ``M`` is solved by its Cholesky factor, in place. False
-    also when ``M`` is not positive definite (the caller's general solve then reports it)
-    or the robot is too long for the stack scratch.
+    sample's sines and cosines; ``M`` is solved by its Cholesky factor. False also when
+    ``M`` is not positive definite (the caller's general solve then reports it) or the
+    robot is too long for the stack scratch.
     """
     n = C.shape[0] - 1
     if n * 21 > _STACK or n * n > _STACK:
@@ -589,27 +590,10 @@ def forward_dynamics_one(C, q, dq, tau, ddq):
     _rnea_sample(C, A, dq, zero, 0, 0, 0, bias, S)
     M = stack(n, n)
     _crba_sample(C, A, 0, flat_view(M), S)
-    for j in range(n):  # M = L L^T, L in the lower triangle of M
-        s = M[j, j]
-        for k in range(j):
-            s -= M[j, k] * M[j, k]
-        if not s > 0.0:
-            return False
-        d = math.sqrt(s)
-        M[j, j] = d
-        for i in range(j + 1, n):
-            t = M[i, j]
-            for k in range(j):
-                t -= M[i, k] * M[j, k]
-            M[i, j] = t / d
-    for i in range(n):  # L y = tau - bias
-        t = tau[i] - bias[i]
-        for k in range(i):
-            t -= M[i, k] * ddq[k]
-        ddq[i] = t / M[i, i]
-    for i in range(n - 1, -1, -1):  # L^T ddq = y
-        t = ddq[i]
-        for k in range(i + 1, n):
-            t -= M[k, i] * ddq[k]
-        ddq[i] = t / M[i, i]
+    L = stack(n, n)
+    if not cholesky(M, n, 0.0, L):
+        return False
+    for i in range(n):
+        bias[i] = tau[i] - bias[i]
+    cholesky_solve(L, n, bias, ddq)
     return True

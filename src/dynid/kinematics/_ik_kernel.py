@@ -19,28 +19,10 @@ import numba
 import numpy as np
 
 from ._chain import angles, inline, jit
+from ._dense import cholesky, cholesky_solve
 from ._kernels import frame_jacobian
 
 __all__ = ["solve_one", "solve_batch"]
-
-
-@inline
-def _cholesky(G, d, shift, L):
-    """Cholesky factor of ``G[:d, :d] - shift E`` into ``L``; False unless positive definite."""
-    for j in range(d):
-        s = G[j, j] - shift
-        for k in range(j):
-            s -= L[j, k] * L[j, k]
-        if not s > 0.0:
-            return False
-        ljj = math.sqrt(s)
-        L[j, j] = ljj
-        for i in range(j + 1, d):
-            t = G[i, j]
-            for k in range(j):
-                t -= L[i, k] * L[j, k]
-            L[i, j] = t / ljj
-    return True
 
 
 @inline
@@ -141,21 +123,6 @@ def _min_eigenvalue(G, d, A, w, off):
     for i in range(1, d):
         w_min = min(w_min, w[i])
     return w_min
-
-
-@inline
-def _cholesky_solve(L, d, b, y):
-    """``y = (L L^T)^-1 b`` for the factor of :func:`_cholesky`."""
-    for i in range(d):
-        t = b[i]
-        for k in range(i):
-            t -= L[i, k] * y[k]
-        y[i] = t / L[i, i]
-    for i in range(d - 1, -1, -1):
-        t = y[i]
-        for k in range(i + 1, d):
-            t -= L[k, i] * y[k]
-        y[i] = t / L[i, i]
 
 
 @inline
@@ -377,15 +344,15 @@ def _solve(C, m, q_min, q_max, inv_vmax, q_restart, goal, fpar, ipar, path, keep
                 # the smallest eigenvalue w_min = s_min^2 of G decides the damping: none when
                 # a Cholesky factorisation of G - eps^2 E succeeds, else from the QL
                 # eigenvalues; then a Cholesky solve of (G + lambda^2 E) y = b
-                if _cholesky(G, d, eps * eps, L):
-                    fast = _cholesky(G, d, 0.0, L)
+                if cholesky(G, d, eps * eps, L):
+                    fast = cholesky(G, d, 0.0, L)
                 else:
                     s_min = math.sqrt(max(_min_eigenvalue(G, d, A6, w6, o6), 0.0))
                     lam2 = _damping(s_min, eps, lam, err, e_damp)
-                    fast = lam2 > 0.0 and _cholesky(G, d, -lam2, L)
+                    fast = lam2 > 0.0 and cholesky(G, d, -lam2, L)
                 if fast:
                     _rhs(Jf, e, nf, d, bvec)
-                    _cholesky_solve(L, d, bvec, y)
+                    cholesky_solve(L, d, bvec, y)
                     col = 0
                     for j in range(m):
                         if free[j]:
