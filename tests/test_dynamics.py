@@ -94,3 +94,25 @@ def test_dynamics_reject_bad_shapes_and_nan(panda):
         dynid.mass_matrix(panda, q)
     with pytest.raises(dynid.ShapeError, match="broadcast"):
         dynid.rnea(panda, np.zeros((2, 7)), np.zeros((3, 7)), np.zeros(7))
+
+
+def test_forward_dynamics_of_a_singular_mass_matrix_is_a_model_error():
+    """A massless first link on the second joint's axis: M is singular; every path says so."""
+    robot = dynid.Robot.from_mdh(
+        [0.0, 0.0, 0.3], [0.0, 0.0, 0.0], [0.0, 0.0, np.pi / 2], mass=[0.0, 1.0, 1.0],
+        com=[[0.0, 0.0, 0.0], [0.1, 0.0, 0.0], [0.1, 0.0, 0.0]],
+        inertia=[np.zeros((3, 3)), np.eye(3) * 0.01, np.eye(3) * 0.01],
+    )  # fmt: skip
+    q, dq, tau = np.random.default_rng(3).normal(size=(3, 3))
+    dynid.rnea(robot, q[None], dq[None], dq[None])  # compiled kernels loaded
+    for args in ((q, dq, tau), (q, dq, tau), (q[None], dq[None], tau[None])):
+        with pytest.raises(dynid.ModelError, match="mass matrix is singular"):
+            dynid.forward_dynamics(robot, *args)
+
+
+def test_forward_dynamics_names_tau_in_its_errors(panda):
+    q = np.zeros(7)
+    with pytest.raises(dynid.NonFiniteError, match="tau must be finite"):
+        dynid.forward_dynamics(panda, q, q, [0, 0, 0, np.nan, 0, 0, 0])
+    with pytest.raises(dynid.ShapeError, match=r"tau must have shape \(\.\.\., 7\)"):
+        dynid.forward_dynamics(panda, q, q, np.zeros(6))

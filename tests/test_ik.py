@@ -170,6 +170,9 @@ def test_ik_compiled_kernel_and_numpy_loop_agree(panda, monkeypatch):
     goals = [(dynid.fk(panda, qt, tool=TOOL), TOOL) for qt in q_true[:15]]
     goals += [(dynid.fk(panda, qt), None) for qt in q_true[15:]]
     goals.append((spatial.transform_from_xyz_rpy([1.5, 0.0, 0.3]), None))  # unreachable
+    flipped = dynid.fk(panda, dynid.PANDA_NEUTRAL_Q)
+    flipped[:3, :3] = flipped[:3, :3] @ np.diag([1.0, -1.0, -1.0])
+    goals.append((flipped, None))  # exactly pi from the start: the axis sign is a convention
     opts = IKOptions(max_restarts=3)
     compiled = [ik(panda, T, tool=tool, options=opts) for T, tool in goals]
     assert ik_module._kernel() is not None
@@ -339,3 +342,16 @@ def test_default_q0_is_the_panda_neutral_pose(panda):
     """The Panda (also with a tool frame) starts at PANDA_NEUTRAL_Q."""
     np.testing.assert_array_equal(default_q0(panda), dynid.PANDA_NEUTRAL_Q)
     np.testing.assert_array_equal(default_q0(panda.with_tool(TOOL, 0.5)), dynid.PANDA_NEUTRAL_Q)
+
+
+def test_ik_goal_absurdly_far_reports_finite_errors(panda, monkeypatch):
+    """A goal 1e160 m away: not converged, q0 kept, errors finite (no overflow), both loops."""
+    goal = np.eye(4)
+    goal[0, 3] = 1e160
+    results = [ik(panda, goal)]
+    monkeypatch.setattr(ik_module, "_kernel", lambda: None)
+    results.append(ik(panda, goal))
+    for r in results:
+        assert not r.converged
+        np.testing.assert_allclose(r.position_error, 1e160, rtol=1e-6)
+        assert np.isfinite(r.orientation_error) and r.orientation_error <= np.pi

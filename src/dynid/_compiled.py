@@ -47,6 +47,11 @@ from . import _checks
 #: Column offsets of the packed constants (see the module docstring).
 C_T, C_AXIS, C_PRISMATIC, C_PHI, C_ROT, C_SLIDE, C_WIDTH = 0, 12, 15, 16, 26, 53, 56
 
+#: Cholesky pivot^2 over the diagonal of the mass matrix below which a joint moves no
+#: inertia of its own (independent of the joints before it): the mass matrix is singular
+#: to rounding (the forward dynamics' kernel and its Python path share it)
+SINGULAR_PIVOT = 1e-12
+
 _LOADED: dict[str, ModuleType | None] = {}
 
 

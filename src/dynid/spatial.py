@@ -139,7 +139,8 @@ def angle_axis_from_matrix(R: ArrayLike) -> NDArray[np.float64]:
         rows = np.take_along_axis(uu, k[:, None, None], axis=-2)[:, 0, :]
         u = rows / np.sqrt(np.take_along_axis(rows, k[:, None], axis=-1))
         vp = v[near_pi]
-        sign = np.where(np.einsum("...i,...i->...", u, vp) < 0.0, -1.0, 1.0)
+        # within 1e-12 of pi the skew part is rounding noise: keep u's largest entry positive
+        sign = np.where(np.einsum("...i,...i->...", u, vp) < -1e-12, -1.0, 1.0)
         out[near_pi] = (sign * theta[near_pi])[..., None] * u
     return out
 

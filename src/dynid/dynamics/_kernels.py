@@ -41,7 +41,7 @@ import math
 
 import numpy as np
 
-from .._compiled import C_AXIS, C_PHI, C_PRISMATIC
+from .._compiled import C_AXIS, C_PHI, C_PRISMATIC, SINGULAR_PIVOT
 from ..kinematics._chain import (
     IDENTITY,
     angles,
@@ -573,8 +573,9 @@ def forward_dynamics_one(C, q, dq, tau, ddq):
 
     The bias (RNEA at zero acceleration) and the composite-rigid-body ``M`` share the
     sample's sines and cosines; ``M`` is solved by its Cholesky factor. False also when
-    ``M`` is not positive definite (the caller's general solve then reports it) or the
-    robot is too long for the stack scratch.
+    ``M`` is not positive definite or singular to rounding (a Cholesky pivot^2 below
+    ``SINGULAR_PIVOT`` of its diagonal; the caller's general path then reports it), or
+    the robot is too long for the stack scratch.
     """
     n = C.shape[0] - 1
     if n * 21 > _STACK or n * n > _STACK:
@@ -593,6 +594,9 @@ def forward_dynamics_one(C, q, dq, tau, ddq):
     L = stack(n, n)
     if not cholesky(M, n, 0.0, L):
         return False
+    for j in range(n):  # singular to rounding: the caller's general path reports it
+        if L[j, j] * L[j, j] < SINGULAR_PIVOT * M[j, j]:
+            return False
     for i in range(n):
         bias[i] = tau[i] - bias[i]
     cholesky_solve(L, n, bias, ddq)

@@ -170,18 +170,26 @@ def link_motion(
     return LinkMotion(R, p, w, dw, a)
 
 
-def prepare_states(robot: Robot, q: ArrayLike, dq: ArrayLike, ddq: ArrayLike):
+def prepare_states(
+    robot: Robot,
+    q: ArrayLike,
+    dq: ArrayLike,
+    ddq: ArrayLike,
+    names: tuple[str, str, str] = ("q", "dq", "ddq"),
+):
     """Checked states for the batched routines (here and in the regressors): the broadcast
-    batch shape and ``q, dq, ddq`` as float64 arrays of shape (B, n)."""
+    batch shape and ``q, dq, ddq`` as float64 arrays of shape (B, n); errors use ``names``
+    (the third is ``tau`` for the forward dynamics)."""
     n = robot.n
-    q = _checks.as_batch("q", q, (n,))
-    dq = _checks.as_batch("dq", dq, (n,))
-    ddq = _checks.as_batch("ddq", ddq, (n,))
+    q = _checks.as_batch(names[0], q, (n,))
+    dq = _checks.as_batch(names[1], dq, (n,))
+    ddq = _checks.as_batch(names[2], ddq, (n,))
     try:
         shape = np.broadcast_shapes(q.shape, dq.shape, ddq.shape)
     except ValueError:
         raise ShapeError(
-            f"q, dq and ddq must broadcast together; got {q.shape}, {dq.shape}, {ddq.shape}"
+            f"{names[0]}, {names[1]} and {names[2]} must broadcast together; got {q.shape}, "
+            f"{dq.shape}, {ddq.shape}"
         ) from None
     flat = [np.broadcast_to(x, shape).reshape(-1, n) for x in (q, dq, ddq)]
     return shape, flat

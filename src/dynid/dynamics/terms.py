@@ -25,6 +25,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from .. import _checks, _compiled
 from .._compiled import constants as _constants
+from ..exceptions import ModelError
 from ..model.robot import Robot
 from . import rnea as _rnea_module
 from .rnea import (
@@ -302,10 +303,43 @@ def forward_dynamics(
                 return ddq
         except TypeError:
             pass
-    shape, (q2, dq2, tau2) = prepare_states(robot, q, dq, tau)
+    shape, (q2, dq2, tau2) = prepare_states(robot, q, dq, tau, ("q", "dq", "tau"))
     if shape == (robot.n,) and _rnea_module._LOADED and _rnea_module._KERNELS is not None:
         _one("forward_dynamics_one")  # the next single sample takes the thin path
         _compiled.packed(robot)
     bias = _rnea(robot, robot.phi, q2, dq2, np.zeros_like(q2), robot.gravity)
     M = _mass_matrix(robot, q2)
-    return np.linalg.solve(M, (tau2 - bias)[..., None])[..., 0].reshape(shape)
+    return _solve_mass_matrix(robot, M, tau2 - bias).reshape(shape)
+
+
+def _solve_mass_matrix(
+    robot: Robot, M: NDArray[np.float64], rhs: NDArray[np.float64]
+) -> NDArray[np.float64]:
+    """``M^-1 rhs`` for (B, n, n) and (B, n); :class:`ModelError` when an ``M`` is singular.
+
+    Positive definite ``M`` (a physical model) are checked by their Cholesky pivots;
+    others (parameters that are not physical) are solved by LU, which reports exact
+    singularity only.
+    """
+    B = M.shape[0]
+    try:
+        L = np.linalg.cholesky(M)
+    except np.linalg.LinAlgError:
+        L = None
+    bad: tuple[int, int] | None = None
+    if L is not None:
+        share = np.diagonal(L, axis1=-2, axis2=-1) ** 2 / np.diagonal(M, axis1=-2, axis2=-1)
+        low = np.argwhere(share < _compiled.SINGULAR_PIVOT)
+        if low.size:
+            bad = (int(low[0, 0]), int(low[0, 1]))
+    if bad is None:
+        try:
+            return np.asarray(np.linalg.solve(M, rhs[..., None])[..., 0], dtype=np.float64)
+        except np.linalg.LinAlgError:
+            bad = (-1, -1)
+    where = "" if B == 1 or bad[0] < 0 else f" at sample {bad[0]}"
+    who = "" if bad[1] < 0 else f": joint {robot.joint_names[bad[1]]} moves no inertia of its own"
+    raise ModelError(
+        f"the mass matrix is singular{where}{who}; the forward dynamics is undefined "
+        "(check the link inertials: a massless link, or joints that move the same inertia)"
+    )

@@ -271,12 +271,15 @@ def _solve(C, m, q_min, q_max, inv_vmax, q_restart, goal, fpar, ipar, path, keep
             else:
                 ux, uy, uz = sxz, syz, dz
             norm = math.sqrt(ux * ux + uy * uy + uz * uz)
-            if ux * vx + uy * vy + uz * vz < 0.0:
+            if ux * vx + uy * vy + uz * vz < -1e-12 * norm:  # as in _ik_numpy._rotvec
                 norm = -norm
             e[3], e[4], e[5] = theta * ux / norm, theta * uy / norm, theta * uz / norm
         err_o = theta
         err_p = math.sqrt(e[0] * e[0] + e[1] * e[1] + e[2] * e[2])
-        err = math.sqrt(err_p * err_p + err_o * err_o)
+        if err_p > 1e150:  # a goal absurdly far: the squares overflow, scale them
+            big = max(abs(e[0]), abs(e[1]), abs(e[2]))
+            err_p = big * math.sqrt((e[0] / big) ** 2 + (e[1] / big) ** 2 + (e[2] / big) ** 2)
+        err = math.sqrt(err_p * err_p + err_o * err_o) if err_p < 1e150 else err_p
         done = err_p <= tol_p and err_o <= tol_o
         if done or err < best_err:
             best_k, best_err, best_p, best_o = k, err, err_p, err_o

@@ -51,7 +51,9 @@ def _rotvec(R: NDArray[np.float64]) -> tuple[float, float, float, float]:
 
     Scalar form of :func:`dynid.spatial.angle_axis_from_matrix`: the skew part is
     ``sin(theta) u``; near pi the axis comes from the symmetric part
-    ``(R + R^T) / 2 = cos(theta) I + (1 - cos(theta)) u u^T``, signed by the skew part.
+    ``(R + R^T) / 2 = cos(theta) I + (1 - cos(theta)) u u^T``, signed by the skew part
+    (within 1e-12 of pi the skew part is rounding noise and ``u`` keeps the sign of its
+    largest entry, so that the numpy loop and the kernel turn the same way).
     """
     (r00, r01, r02), (r10, r11, r12), (r20, r21, r22) = R.tolist()
     vx, vy, vz = 0.5 * (r21 - r12), 0.5 * (r02 - r20), 0.5 * (r10 - r01)
@@ -71,7 +73,7 @@ def _rotvec(R: NDArray[np.float64]) -> tuple[float, float, float, float]:
     else:
         ux, uy, uz = sxz, syz, dz
     norm = math.sqrt(ux * ux + uy * uy + uz * uz)
-    if ux * vx + uy * vy + uz * vz < 0.0:
+    if ux * vx + uy * vy + uz * vz < -1e-12 * norm:  # within 1e-12 of pi: keep u as read
         norm = -norm
     return theta * ux / norm, theta * uy / norm, theta * uz / norm, theta
 
@@ -130,8 +132,8 @@ def _solve_numpy(
         e[:3] = p_goal - T[:3, 3]
         ox, oy, oz, err_o = _rotvec(R_goal @ T[:3, :3].T)
         e[3], e[4], e[5] = ox, oy, oz
-        err_p = math.sqrt(e[0] * e[0] + e[1] * e[1] + e[2] * e[2])
-        err = math.sqrt(err_p * err_p + err_o * err_o)
+        err_p = math.hypot(e[0], e[1], e[2])  # no overflow for a goal absurdly far
+        err = math.sqrt(err_p * err_p + err_o * err_o) if err_p < 1e150 else err_p
         if (err_p <= tol_p and err_o <= tol_o) or err < best_err:
             best_k, best_err, best_p, best_o = k, err, err_p, err_o
         if err_p <= tol_p and err_o <= tol_o:
