@@ -287,6 +287,14 @@ def forward_dynamics(
     Returns
     -------
     ddq : ndarray, shape (..., n) [rad/s^2]
+
+    Raises
+    ------
+    ShapeError, NonFiniteError
+        An input does not end in ``n``, the shapes do not broadcast, or NaN/inf.
+    ModelError
+        ``M`` is singular (to rounding: a Cholesky pivot^2 below ``1e-12`` of its diagonal,
+        a joint that moves no inertia of its own), so the accelerations are undefined.
     """
     # single sample: one compiled call (bias, mass matrix and its Cholesky solve)
     p = robot._packed
