@@ -908,3 +908,16 @@ def test_a_frame_that_is_not_a_name_is_an_unknown_frame(panda):
     for f in (dynid.fk, dynid.jacobian, fk_numpy, jacobian_numpy):
         with pytest.raises(dynid.UnknownNameError, match="available"):
             f(panda, q, frame=["flange"])
+
+
+def test_none_is_not_an_array(panda):
+    """None is refused as a missing input, not read as NaN."""
+    q = np.zeros(7)
+    for call in (
+        lambda: dynid.rnea(panda, None, q, q),
+        lambda: dynid.fk(panda, None),
+        lambda: dynid.forward_dynamics(panda, q, q, None),
+        lambda: dynid.ik(panda, None),
+    ):
+        with pytest.raises(dynid.ShapeError, match="got None"):
+            call()

@@ -34,6 +34,8 @@ def finite(name: str, x: NDArray[np.float64]) -> None:
 
 def as_array(name: str, x: ArrayLike, *, allow_nonfinite: bool = False) -> NDArray[np.float64]:
     """Convert to a float64 array (a copy when needed) and check finiteness."""
+    if x is None:  # numpy would read None as NaN
+        raise ShapeError(f"{name} must be numeric array_like; got None")
     try:
         a = np.asarray(x, dtype=np.float64)
     except (TypeError, ValueError) as exc:
