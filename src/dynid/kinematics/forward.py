@@ -297,17 +297,13 @@ def fk(
             pass
     link, T_link_frame, CF = _frame_constants(robot, frame, tool)
     # lean path: a float64 C array of shape (..., n) goes to the kernel as it is
-    if type(q) is np.ndarray and q.dtype is _F64 and q.flags.c_contiguous:
-        qa: NDArray[np.float64] | None = q
-    else:
-        qa = _as_q(robot, q)
+    qa = _as_q(robot, q)
     K = None if qa is None else _kernels_for(qa.ndim)
     if K is not None and qa is not None:
-        if qa.ndim and qa.shape[-1] == len(robot.joint_names):
-            T = np.empty((4, 4) if qa.ndim == 1 else qa.shape[:-1] + (4, 4))
-            f = one("frame_pose") if qa.ndim == 1 else K.frame_pose
-            if f(CF, _flat(qa), T):
-                return T
+        T = np.empty((4, 4) if qa.ndim == 1 else qa.shape[:-1] + (4, 4))
+        f = one("frame_pose") if qa.ndim == 1 else K.frame_pose
+        if f(CF, _flat(qa), T):
+            return T
     return _fk_numpy(robot, q, link, T_link_frame)
 
 

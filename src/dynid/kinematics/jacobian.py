@@ -96,18 +96,14 @@ def jacobian(
             pass
     link, T_link_frame, CF = _frame_constants(robot, frame, tool)
     # lean path: a float64 C array of shape (..., n) goes to the kernel as it is
-    if type(q) is np.ndarray and q.dtype is _F64 and q.flags.c_contiguous:
-        qa: NDArray[np.float64] | None = q
-    else:
-        qa = _as_q(robot, q)
+    qa = _as_q(robot, q)
     K = None if qa is None else _forward._kernels_for(qa.ndim)
     if K is not None and qa is not None:
-        n = len(robot.joint_names)
-        if qa.ndim and qa.shape[-1] == n:
-            J = np.empty((6, n) if qa.ndim == 1 else qa.shape[:-1] + (6, n))
-            f = _one() if qa.ndim == 1 else K.jacobian
-            if f(CF, _flat(qa), J):
-                return J
+        n = qa.shape[-1]
+        J = np.empty((6, n) if qa.ndim == 1 else qa.shape[:-1] + (6, n))
+        f = _one() if qa.ndim == 1 else K.jacobian
+        if f(CF, _flat(qa), J):
+            return J
     return _jacobian_numpy(robot, q, link, T_link_frame)
 
 
