@@ -176,6 +176,20 @@ def constants(robot: Any) -> NDArray[np.float64]:
     return packed(robot).C if p is None else p.C
 
 
+def constants_for(robot: Any, phi: Any, gravity: Any) -> NDArray[np.float64]:
+    """The constants of ``robot`` with parameters ``phi`` (n, 10) and ``gravity`` (3,).
+
+    The robot's own packed arrays when these are the robot's (``C``) or the robot's with
+    gravity off (``C0``); otherwise packed anew (validated arrays).
+    """
+    if phi is robot.phi:
+        if gravity is robot.gravity:
+            return constants(robot)
+        if gravity.tolist() == [0.0, 0.0, 0.0]:
+            return packed(robot).C0
+    return pack(robot, np.asarray(phi, dtype=np.float64), gravity)
+
+
 #: float64 (the thin paths check ``x.dtype is F64``)
 F64 = np.dtype(np.float64)
 #: a float64 vector of any strides: the type of the thin paths' joint vectors ('A' layout)

@@ -304,12 +304,7 @@ def _rnea(
         B, n = q.shape
         if dq.shape[0] in (1, B) and ddq.shape[0] in (1, B):
             tau = np.empty((B, n))
-            if phi is robot.phi and gravity is robot.gravity:
-                C = _constants(robot)
-            elif phi is robot.phi and gravity is ZERO_GRAVITY:
-                C = _compiled.packed(robot).C0
-            else:
-                C = _compiled.pack(robot, np.asarray(phi, dtype=np.float64), gravity)
+            C = _compiled.constants_for(robot, phi, gravity)
             if K.rnea(C, _flat(q), _flat(dq), _flat(ddq), tau.reshape(-1)):
                 return tau
     return _rnea_numpy(robot, phi, q, dq, ddq, gravity)

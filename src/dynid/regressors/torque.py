@@ -95,11 +95,7 @@ def torque_regressor_prepared(
     if K is not None and np.ndim(gravity) == 1:
         cols = np.full(10 * n, -1, dtype=np.int64)  # output column of each parameter
         cols[idx] = np.arange(idx.size)
-        C = (
-            _compiled.constants(robot)
-            if gravity is robot.gravity
-            else _compiled.pack(robot, gravity=gravity)
-        )
+        C = _compiled.constants_for(robot, robot.phi, gravity)
         Y = np.empty((B, n, w))
         if K.torque_regressor(C, _flat(q), _flat(dq), _flat(ddq), cols, Y):
             return Y
