@@ -2,7 +2,7 @@
 
 The pipeline, in the order data flows (each name is re-exported here):
 
-* model: :func:`panda`, :class:`Robot` (``from_mdh``, ``from_urdf``, ``from_toml``)
+* model: :func:`panda`, :func:`fr3`, :class:`Robot` (``from_mdh``, ``from_urdf``, ``from_toml``)
 * kinematics: :func:`fk`, :func:`jacobian`, :func:`jacobian_to_tool`, :func:`ik`
 * dynamics: :func:`rnea`, :func:`mass_matrix`, :func:`gravity_torques`, :func:`coriolis`,
   :func:`coriolis_matrix`, :func:`forward_dynamics`
@@ -68,6 +68,7 @@ if TYPE_CHECKING:  # the names as static imports, for type checkers and editors
     from .kinematics.forward import fk, joint_transforms, link_poses
     from .kinematics.inverse import IKOptions, IKResult, ik
     from .kinematics.jacobian import jacobian, jacobian_to_tool
+    from .model.fr3 import fr3
     from .model.inertia import inertial_from_phi, param_labels, phi_from_inertial
     from .model.panda import PANDA_NEUTRAL_Q, panda
     from .model.robot import Frame, Robot
@@ -136,6 +137,7 @@ _LAZY: dict[str, tuple[str, str]] = {
     "fit_friction": ("friction.fit", "fit_friction"),
     "fit_least_squares": ("identification.least_squares", "fit_least_squares"),
     "fk": ("kinematics.forward", "fk"),
+    "fr3": ("model.fr3", "fr3"),
     "forward_dynamics": ("dynamics.terms", "forward_dynamics"),
     "gravity_torques": ("dynamics.terms", "gravity_torques"),
     "identifiability": ("regressors.base", "identifiability"),
@@ -217,6 +219,7 @@ __all__ = [
     "fit_least_squares",
     "fk",
     "forward_dynamics",
+    "fr3",
     "gravity_torques",
     "identifiability",
     "identify_from_log",

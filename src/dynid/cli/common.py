@@ -17,7 +17,7 @@ import numpy as np
 from .. import _checks, spatial
 from ..exceptions import DataError, DynidError, ShapeError
 from ..io.json_files import dumps
-from ..model.panda import panda
+from ..model.builtin import BUILTIN_ROBOTS, builtin_robot
 from ..model.robot import Robot
 
 _log = logging.getLogger(__name__)
@@ -128,10 +128,19 @@ def warn(args: argparse.Namespace, message: str) -> None:
         print(f"dynid {args.command}: warning: {message}", file=sys.stderr)
 
 
+def note(args: argparse.Namespace, message: str) -> None:
+    """One note line on stderr (``dynid CMD: note: ...``), unless ``-q``."""
+    if not getattr(args, "quiet", False):
+        print(f"dynid {args.command}: note: {message}", file=sys.stderr)
+
+
 def add_robot_options(p: argparse.ArgumentParser) -> None:
-    """``--robot panda|FILE.urdf|FILE.toml`` with ``--base``/``--tip`` for URDF chains."""
+    """``--robot panda|fr3|FILE.urdf|FILE.toml`` with ``--base``/``--tip`` for URDF chains."""
     p.add_argument(
-        "--robot", default="panda", help="'panda', a .urdf or a .toml file (default: panda)"
+        "--robot",
+        default="panda",
+        help="'panda', 'fr3' (the Panda's link parameters), a .urdf or a .toml file "
+        "(default: panda)",
     )
     p.add_argument("--base", default=None, help="URDF base link of the chain (default: the root)")
     p.add_argument(
@@ -144,8 +153,8 @@ def load_robot(args: argparse.Namespace) -> Robot:
     from ..io.robot_file import load_robot as load_robot_file
 
     spec = args.robot
-    if spec == "panda":
-        return panda()
+    if spec in BUILTIN_ROBOTS:
+        return builtin_robot(spec)
     path = Path(spec)
     with about(path):
         return load_robot_file(path, base=args.base, tip=args.tip, what="--robot")
@@ -157,9 +166,10 @@ def add_consistency_options(p: argparse.ArgumentParser) -> None:
     g.add_argument(
         "--prior",
         default=None,
-        metavar="panda|FILE",
-        help="prior link parameters: 'panda', a .urdf (with --prior-base/--prior-tip), a "
-        ".toml or a feasible.json; default: a solid cylinder per link from the kinematics",
+        metavar="panda|fr3|FILE",
+        help="prior link parameters: 'panda', 'fr3' (the Panda's), a .urdf (with "
+        "--prior-base/--prior-tip), a .toml or a feasible.json; default: a solid cylinder "
+        "per link from the kinematics",
     )
     g.add_argument("--prior-base", default=None, help="URDF base link of the prior's chain")
     g.add_argument("--prior-tip", default=None, help="URDF tip link of the prior's chain")
@@ -193,8 +203,10 @@ def load_prior(args: argparse.Namespace, robot: Robot) -> Robot | None:
         return None
     from ..io.robot_file import load_robot as load_robot_file
 
-    if spec == "panda":
-        prior = panda()
+    if spec in BUILTIN_ROBOTS:
+        prior = builtin_robot(spec)
+        if BUILTIN_ROBOTS[spec].parameter_note is not None:
+            note(args, f"--prior {spec}: {BUILTIN_ROBOTS[spec].parameter_note}")
     else:
         path = Path(spec)
         base = args.prior_base or robot.link_names[0]
@@ -207,7 +219,7 @@ def load_prior(args: argparse.Namespace, robot: Robot) -> Robot | None:
             )
             msg = str(exc) if str(exc).startswith("--prior") else f"--prior {path.name}: {exc}"
             raise DynidError(msg + hint) from None
-    if spec != "panda":
+    if spec not in BUILTIN_ROBOTS:
         prior = prior.replace(name=Path(spec).name)  # reports name the file
     kinds = ("".join("P" if x else "R" for x in r.prismatic) for r in (prior, robot))
     pk, rk = kinds

@@ -1,7 +1,7 @@
 """Write a robot with its (identified, feasible) parameters as URDF, MJCF or TOML.
 
---params takes feasible.json (from `dynid retrieve`), a robot .toml or 'panda'. The format
-comes from --format or the suffix of --out (.urdf, .xml/.mjcf, .toml).
+--params takes feasible.json (from `dynid retrieve`), a robot .toml, 'panda' or 'fr3'. The
+format comes from --format or the suffix of --out (.urdf, .xml/.mjcf, .toml).
 
 URDF without a template: the chain with the source robot's link and joint names. With
 --urdf-template ORIGINAL.urdf (and --base/--tip for its chain): the original file written
@@ -43,7 +43,7 @@ def register(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParser:
         __doc__,
         help="write a robot as URDF (optionally patching the original), MJCF or TOML",
     )
-    p.add_argument("--params", required=True, help="feasible.json, a robot .toml, or 'panda'")
+    p.add_argument("--params", required=True, help="feasible.json, a robot .toml, 'panda' or 'fr3'")
     p.add_argument("--format", choices=EXPORT_FORMATS, default=None, help="default: by suffix")
     p.add_argument("--out", type=Path, required=True, help="output file")
     p.add_argument("--urdf-template", type=Path, default=None, help="the original URDF file")
@@ -62,11 +62,13 @@ def register(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParser:
 
 
 def load_params(spec: str) -> Robot:
-    """The robot of ``--params``: feasible.json, a robot .toml, or ``panda``."""
+    """The robot of ``--params``: feasible.json, a robot .toml, ``panda`` or ``fr3``."""
     from ..io.robot_file import load_robot
 
     if Path(spec).suffix.lower() == ".urdf":
-        raise DynidError(f"--params must be feasible.json, a robot .toml or 'panda'; got {spec!r}")
+        raise DynidError(
+            f"--params must be feasible.json, a robot .toml, 'panda' or 'fr3'; got {spec!r}"
+        )
     return load_robot(spec, what="--params")
 
 

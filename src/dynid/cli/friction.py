@@ -67,7 +67,7 @@ def register(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParser:
     )
     src = p.add_mutually_exclusive_group(required=True)
     src.add_argument("--model", type=Path, help="identification.json of an identified model")
-    src.add_argument("--robot", help="'panda', a .urdf or a .toml: the robot's own link parameters")
+    src.add_argument("--robot", help="'panda', 'fr3', a .urdf or a .toml: its link parameters")
     p.add_argument("--base", default=None, help="URDF base link (with --robot)")
     p.add_argument("--tip", default=None, help="URDF tip link (with --robot)")
     p.add_argument("--data", type=Path, required=True, help="torque log (.csv or .npz)")

@@ -41,7 +41,7 @@ def register(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParser:
         subparsers, NAME, __doc__, help="identify a load's mass, CoM and inertia on a known arm"
     )
     src = p.add_mutually_exclusive_group(required=True)
-    src.add_argument("--robot", help="'panda', a .urdf or a .toml with the arm's parameters")
+    src.add_argument("--robot", help="'panda', 'fr3', a .urdf or a .toml with the arm's parameters")
     src.add_argument("--model", type=Path, help="identification.json of the arm")
     src.add_argument("--params", type=Path, help="feasible.json of the arm")
     p.add_argument("--base", default=None, help="URDF base link (with --robot)")

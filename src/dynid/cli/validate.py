@@ -63,7 +63,7 @@ def register(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParser:
     )
     src = p.add_mutually_exclusive_group(required=True)
     src.add_argument("--model", type=Path, help="identification.json of an identified model")
-    src.add_argument("--robot", help="'panda', a .urdf or a .toml: the robot's own parameters")
+    src.add_argument("--robot", help="'panda', 'fr3', a .urdf or a .toml: its own parameters")
     src.add_argument(
         "--params", type=Path, help="feasible.json of retrieved link parameters (RNEA)"
     )

@@ -1,8 +1,9 @@
-"""One entry point for reading a robot: ``"panda"``, a URDF, a dynid TOML or a feasible.json.
+"""One entry point for reading a robot: a built-in name, a URDF, a dynid TOML or a feasible.json.
 
-:func:`load_robot` picks the reader by the file's suffix; every command line option that
-names a robot (``--robot``, ``--prior``, ``--params``) reads through it. It imports only
-the reader it needs, so a command on the built-in Panda loads no file reader at all.
+:func:`load_robot` takes a name of :data:`dynid.model.builtin.BUILTIN_ROBOTS` (``"panda"``,
+``"fr3"``) or picks the reader by the file's suffix; every command line option that names a
+robot (``--robot``, ``--prior``, ``--params``) reads through it. It imports only the reader
+it needs, so a command on a built-in robot loads no file reader at all.
 """
 
 from __future__ import annotations
@@ -10,6 +11,7 @@ from __future__ import annotations
 from pathlib import Path
 
 from ..exceptions import DataError
+from ..model.builtin import BUILTIN_ROBOTS, builtin_robot
 from ..model.robot import Robot
 
 __all__ = ["ROBOT_FILE_SUFFIXES", "load_robot"]
@@ -21,8 +23,9 @@ ROBOT_FILE_SUFFIXES = (".urdf", ".toml", ".json")
 def load_robot(
     spec: str | Path, *, base: str | None = None, tip: str | None = None, what: str = "robot"
 ) -> Robot:
-    """A robot from ``"panda"`` or a file, by its suffix: the one dispatch of robot files.
+    """A built-in robot by name, or a robot file by its suffix: the one dispatch of robots.
 
+    A name of :data:`~dynid.model.builtin.BUILTIN_ROBOTS` (``"panda"``, ``"fr3"``); else
     ``.urdf`` (the chain from ``base`` to ``tip``: :meth:`Robot.from_urdf`), ``.toml``
     (:meth:`Robot.from_toml`) or ``.json`` (a ``feasible.json``,
     :func:`dynid.io.feasible.load_feasible_json`). ``what`` names the option in errors.
@@ -32,15 +35,13 @@ def load_robot(
     DataError
         Another suffix, or a file that does not exist.
     """
-    if str(spec) == "panda":
-        from ..model.panda import panda
-
-        return panda()
+    if str(spec) in BUILTIN_ROBOTS:
+        return builtin_robot(str(spec))
     path = Path(spec)
     suffix = path.suffix.lower()
     if suffix not in ROBOT_FILE_SUFFIXES:
         raise DataError(
-            f"{what} must be 'panda' or a .urdf, .toml or .json (feasible.json) file; "
+            f"{what} must be {_names()} or a .urdf, .toml or .json (feasible.json) file; "
             f"got {str(spec)!r}"
         )
     if not path.exists():
@@ -52,3 +53,8 @@ def load_robot(
     from .feasible import load_feasible_json
 
     return load_feasible_json(path)
+
+
+def _names() -> str:
+    """The built-in names as a user reads them in an error: ``'panda', 'fr3'``."""
+    return ", ".join(repr(k) for k in BUILTIN_ROBOTS)
