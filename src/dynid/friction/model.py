@@ -34,9 +34,11 @@ from numpy.typing import ArrayLike, NDArray
 
 from .. import _checks
 from ..exceptions import ShapeError
+from ..model.drive import Drive
 
 __all__ = [
     "ClassicalFriction",
+    "DriveFriction",
     "FrictionModel",
     "SigmoidFriction",
     "classical_friction",
@@ -195,6 +197,50 @@ class ClassicalFriction:
         return classical_friction(dq, self.fv, self.fc, self.fo)
 
 
-#: Either friction model; both have ``kind``, ``names``, ``n``, ``torques(dq)`` and
-#: ``as_array()``.
-FrictionModel = SigmoidFriction | ClassicalFriction
+@dataclass(frozen=True, slots=True, eq=False)
+class DriveFriction:
+    """A friction law acting at the motors of a drive: ``tau_f = K^T f(K dq)``.
+
+    Attributes
+    ----------
+    law : SigmoidFriction or ClassicalFriction
+        The law per motor, in motor units (velocities [rad/s] and torques [N m] at the
+        motor).
+    drive : Drive
+        The transmission ``K`` (:mod:`dynid.model.drive`); with ``friction_at="joint"`` the
+        law acts at the joints.
+    """
+
+    law: SigmoidFriction | ClassicalFriction
+    drive: Drive
+
+    def __post_init__(self) -> None:
+        self.drive.check(self.law.n)
+
+    @property
+    def kind(self) -> str:
+        """The law's kind (``"classical"`` or ``"sigmoid"``)."""
+        return self.law.kind
+
+    @property
+    def names(self) -> tuple[str, ...]:
+        """The law's parameter names."""
+        return self.law.names
+
+    @property
+    def n(self) -> int:
+        """Number of joints."""
+        return self.law.n
+
+    def as_array(self) -> NDArray[np.float64]:
+        """The law's parameters (n, k), per motor."""
+        return self.law.as_array()
+
+    def torques(self, dq: ArrayLike) -> NDArray[np.float64]:
+        """Joint friction torques [N m] (..., n) at joint velocities ``dq`` (..., n)."""
+        v = _checks.as_batch("dq", dq, (self.n,))
+        return self.drive.joint_friction(self.law.torques(self.drive.motor_velocities(v)))
+
+
+#: A friction model; each has ``kind``, ``names``, ``n``, ``torques(dq)`` and ``as_array()``.
+FrictionModel = SigmoidFriction | ClassicalFriction | DriveFriction

@@ -33,7 +33,7 @@ from ..identification.metrics import TorqueErrors, torque_errors
 from ..identification.model import IdentifiedModel
 from ..model.robot import Robot
 from .fit import TorqueModel, friction_residual
-from .model import ClassicalFriction, FrictionModel, SigmoidFriction
+from .model import ClassicalFriction, DriveFriction, FrictionModel, SigmoidFriction
 
 __all__ = [
     "NewtonEulerValidation",
@@ -48,7 +48,10 @@ def own_friction(model: TorqueModel) -> FrictionModel | None:
     """The friction that comes with a model: an IdentifiedModel's classical ``friction``,
     a Robot's sigmoid ``friction``, or None."""
     if isinstance(model, IdentifiedModel) and model.friction is not None:
-        return ClassicalFriction.from_array(model.friction)
+        law = ClassicalFriction.from_array(model.friction)
+        if model.drive is not None and model.drive.friction_at == "motor":
+            return DriveFriction(law, model.drive)
+        return law
     if isinstance(model, Robot) and model.friction is not None:
         return SigmoidFriction.from_array(model.friction)
     return None

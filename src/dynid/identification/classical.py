@@ -34,33 +34,33 @@ import numpy as np
 from numpy.typing import NDArray
 
 from ..exceptions import DynidWarning, RankDeficientError, ShapeError
+from ..model.drive import Drive
 from ..model.robot import Robot
 from ..regressors.base import BaseParameters, base_parameters, identifiability
+from ..regressors.terms import (
+    LinearFriction,
+    ModelTerm,
+    base_term_columns,
+    drive_terms,
+    friction_labels,
+)
 from ..regressors.torque import torque_regressor_prepared
 from .least_squares import LeastSquaresFit, conditioning_advice, fit_with_pruning
-from .log import DEFAULT_CUTOFF_HZ, TorqueLog, prepare_log
+from .log import DEFAULT_CUTOFF_HZ, TorqueLog, joint_side_log, prepare_log
 from .model import IdentifiedModel
 
 __all__ = ["friction_labels", "friction_regressor", "identify_from_log", "auto_decimation"]
 
-
-def friction_labels(n: int) -> tuple[str, ...]:
-    """``fv1, fc1, fo1, fv2, ...`` for ``n`` joints."""
-    return tuple(f"{k}{j + 1}" for j in range(n) for k in ("fv", "fc", "fo"))
+_ = friction_labels  # re-exported: the labels of friction_regressor
 
 
 def friction_regressor(dq: NDArray[np.float64]) -> NDArray[np.float64]:
-    """Regressor ``F`` (..., n, 3 n) of the classical friction, columns :func:`friction_labels`.
+    """Regressor ``F`` (..., n, 3 n) of the classical friction at the joints, columns
+    :func:`~dynid.regressors.terms.friction_labels`.
 
     ``F[..., j, 3 j : 3 j + 3] = (dq_j, sign(dq_j), 1)``; zero elsewhere.
     """
-    n = dq.shape[-1]
-    F = np.zeros(dq.shape + (3 * n,))
-    j = np.arange(n)
-    F[..., j, 3 * j] = dq
-    F[..., j, 3 * j + 1] = np.sign(dq)
-    F[..., j, 3 * j + 2] = 1.0
-    return F
+    return LinearFriction(Drive.identity(dq.shape[-1])).torque_columns(dq, dq, dq)
 
 
 def auto_decimation(fs: float, cutoff_hz: float | None) -> int:
@@ -94,6 +94,7 @@ def identify_from_log(
     friction: bool = True,
     base: BaseParameters | None = None,
     rtol: float | None = None,
+    drive: Drive | None = None,
 ) -> IdentifiedModel:
     """Identify base parameters (and linear friction) from a torque log.
 
@@ -125,6 +126,12 @@ def identify_from_log(
         Relative rank tolerance of the base parameters and of the least squares; default:
         the base parameters' rank from the first clear gap of the singular values
         (:func:`dynid.regressors.base.rank_from_gap`) and ``1e-10`` for the fit.
+    drive : Drive, optional
+        The drive train (:mod:`dynid.model.drive`): the log is read on its side and with its
+        effort (motor positions and torques or currents become joint ones), its rotor
+        inertias are identified with the links (or subtracted when known) and the friction
+        acts where it says (the motors for a gear train). Default: link-side torques of a
+        direct drive.
 
     Returns
     -------
@@ -153,27 +160,27 @@ def identify_from_log(
     n = robot.n
     if log.n != n:
         raise ShapeError(f"log has {log.n} joints; robot {robot.name!r} has {n}")
+    if drive is not None:
+        drive.check(n)
     fs = log.sample_rate
-    prepared = prepare_log(log, cutoff_hz=cutoff_hz, trim_s=trim_s, max_gap_s=max_gap_s)
+    prepared = prepare_log(
+        joint_side_log(log, drive), cutoff_hz=cutoff_hz, trim_s=trim_s, max_gap_s=max_gap_s
+    )
     k = auto_decimation(fs, cutoff_hz) if decimate is None else int(decimate)
     if k < 1:
         raise ShapeError(f"decimate must be >= 1; got {decimate}")
     sl = slice(None, None, k)
     assert prepared.ddq is not None  # prepare_log always fills ddq
     q, dq, ddq, tau = prepared.q[sl], prepared.dq[sl], prepared.ddq[sl], prepared.tau[sl]
-    bp = base_parameters(robot, kind="torque", rtol=rtol) if base is None else base
+    terms = drive_terms(drive, n, friction=friction)
+    bp = base_parameters(robot, kind="torque", rtol=rtol, terms=terms) if base is None else base
     N = q.shape[0]
-    # only the base columns, with room for the friction columns after them
-    r0 = len(bp.independent)
-    Yb = torque_regressor_prepared(
-        robot, q, dq, ddq, robot.gravity, columns=bp.independent, width=r0 + 3 * n * friction
-    )
-    if friction:
-        Yb[..., r0:] = friction_regressor(dq)
+    Yb, labels = term_regressor(robot, bp, terms, q, dq, ddq)
     W = Yb.reshape(N * n, -1)
+    if drive is not None and drive.rotor_inertia is not None:  # known: not identified
+        tau = tau - drive.rotor_torques(ddq, drive.rotor_inertia)
     y = tau.reshape(-1)
     r = bp.rank
-    labels = bp.labels + (friction_labels(n) if friction else ())
     fit_rtol = 1e-10 if rtol is None else rtol
     try:
         fit = fit_with_pruning(
@@ -217,6 +224,8 @@ def identify_from_log(
         "rank_gap": None if bp.gap is None else list(bp.gap),
         "identifiability": dict(zip(bp.std_labels, identifiability(bp), strict=True)),
     }
+    if drive is not None:
+        meta["drive"] = drive.as_dict()
     if friction:
         fb = np.asarray(fit.beta[r:]).reshape(n, 3)
         fr = fb
@@ -230,4 +239,37 @@ def identify_from_log(
         friction=fr,
         metadata=meta,
         joint_fit=fit if friction else None,
+        drive=drive,
     )
+
+
+def term_regressor(
+    robot: Robot,
+    base: BaseParameters,
+    terms: tuple[ModelTerm, ...],
+    q: NDArray[np.float64],
+    dq: NDArray[np.float64],
+    ddq: NDArray[np.float64],
+) -> tuple[NDArray[np.float64], tuple[str, ...]]:
+    """The regressor (N, n, r + p_t) of the base parameters and the appended terms.
+
+    Columns: the independent base columns in ``base.independent`` order (link parameters
+    from the compiled regressor, then those of the ``in_base`` terms), then every column of
+    each term that is not ``in_base`` (friction). Returns it with its labels.
+    """
+    ind = np.asarray(base.independent)
+    rigid = ind[ind < 10 * robot.n]
+    appended = [t for t in terms if not t.in_base]
+    width = ind.size + sum(len(t.labels) for t in appended)
+    Y = torque_regressor_prepared(robot, q, dq, ddq, robot.gravity, columns=rigid, width=width)
+    c = rigid.size
+    for t, sel in base_term_columns(terms, ind, robot.n):
+        if sel.size:
+            Y[..., c : c + sel.size] = t.torque_columns(q, dq, ddq)[..., sel]
+            c += sel.size
+    labels = base.labels
+    for t in appended:
+        Y[..., c : c + len(t.labels)] = t.torque_columns(q, dq, ddq)
+        c += len(t.labels)
+        labels = labels + t.labels
+    return Y, labels

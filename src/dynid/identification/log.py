@@ -39,8 +39,16 @@ from numpy.typing import ArrayLike, NDArray
 
 from .. import _checks, signals
 from ..exceptions import DataError, DynidWarning, ShapeError
+from ..model.drive import Drive
 
-__all__ = ["DEFAULT_CUTOFF_HZ", "LogCleaning", "TorqueLog", "default_max_gap", "prepare_log"]
+__all__ = [
+    "DEFAULT_CUTOFF_HZ",
+    "LogCleaning",
+    "TorqueLog",
+    "default_max_gap",
+    "joint_side_log",
+    "prepare_log",
+]
 
 #: Default cutoff of the zero-phase low-pass for identification and validation [Hz].
 #: Gaz et al. 2019 filtered at 1 Hz; that attenuates the paper's own validation sinusoid
@@ -278,6 +286,33 @@ class TorqueLog:
             ddq=pick(arrays["ddq"]) if "ddq" in arrays else None,
             cleaning=cleaning,
         )
+
+
+def joint_side_log(log: TorqueLog, drive: Drive | None) -> TorqueLog:
+    """The log in joint coordinates and joint torques [N m], through a drive.
+
+    A motor-side log becomes ``q = K^-1 q_m + q_0``, ``dq = K^-1 dq_m`` (and ``ddq``),
+    ``tau = K^T tau_m``; currents are multiplied by the torque constants first
+    (:class:`~dynid.model.drive.Drive`). The log itself when there is nothing to convert.
+
+    Raises
+    ------
+    ShapeError
+        The drive is for another number of joints.
+    """
+    if drive is None or drive.is_identity:
+        return log
+    drive.check(log.n)
+    rates = (log.dq,) if log.ddq is None else (log.dq, log.ddq)
+    q, *joint_rates = drive.joint_states(log.q, *rates)
+    return TorqueLog(
+        t=log.t,
+        q=q,
+        dq=joint_rates[0],
+        tau=drive.joint_torques(log.tau),
+        ddq=joint_rates[1] if log.ddq is not None else None,
+        cleaning=log.cleaning,
+    )
 
 
 def prepare_log(

@@ -7,6 +7,11 @@ The model is evaluated through an *equivalent robot*: standard parameters equal 
 ``beta`` at the independent columns and 0 elsewhere map to ``beta`` by the base
 projection, so RNEA, ``M``, ``g`` and ``c`` of that (generally non-physical) parameter set
 are exactly those of the identified model.
+
+With a drive (:mod:`dynid.model.drive`) whose rotor inertias are identified, the standard
+parameters continue after the links' ``10 n`` with ``Ia1 .. Ia_n`` and the equivalent model
+adds ``K^T diag(I_a) K`` of its rotor entries to ``M`` (known rotor inertias are added as
+given); ``g`` and ``c`` are those of the links.
 """
 
 from __future__ import annotations
@@ -17,8 +22,11 @@ from typing import Any
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from .. import _checks
 from ..dynamics.rnea import rnea
 from ..dynamics.terms import coriolis, gravity_torques, mass_matrix
+from ..exceptions import ShapeError
+from ..model.drive import Drive
 from ..model.robot import Robot
 from ..regressors.base import BaseParameters
 from .least_squares import LeastSquaresFit
@@ -44,6 +52,9 @@ class IdentifiedModel:
         the classical route; None otherwise.
     metadata : dict
         Route, data source, row counts, dropped rows, seed.
+    drive : Drive, optional
+        The drive train the model includes (rotor inertia, friction at the motors); None
+        for link-side torques of a direct drive.
     joint_fit : LeastSquaresFit, optional
         Classical route with friction: the fit of every column (the ``r`` base parameters,
         then ``fv, fc, fo`` per joint), whose covariance couples both (consistent
@@ -56,12 +67,28 @@ class IdentifiedModel:
     friction: NDArray[np.float64] | None = None
     metadata: dict[str, Any] = field(default_factory=dict)
     joint_fit: LeastSquaresFit | None = None
+    drive: Drive | None = None
     equivalent_robot: Robot = field(init=False)
+    rotor_inertia: NDArray[np.float64] | None = field(init=False)
 
     def __post_init__(self) -> None:
         phi = np.zeros(self.base.n_std)
         phi[self.base.independent] = self.fit.beta
-        object.__setattr__(self, "equivalent_robot", self.robot.with_params(phi))
+        p = 10 * self.robot.n
+        object.__setattr__(self, "equivalent_robot", self.robot.with_params(phi[:p]))
+        ia = None
+        if self.drive is not None:
+            self.drive.check(self.robot.n)
+            if self.drive.rotor_inertia is not None:
+                ia = np.array(self.drive.rotor_inertia)
+            elif self.base.n_std == p + self.robot.n:
+                ia = phi[p:]
+        elif self.base.n_std != p:
+            raise ShapeError(
+                f"base parameters over {self.base.n_std} standard parameters need a drive "
+                f"(the robot's links have {p})"
+            )
+        object.__setattr__(self, "rotor_inertia", None if ia is None else _checks.frozen(ia))
 
     @property
     def beta(self) -> NDArray[np.float64]:
@@ -69,8 +96,11 @@ class IdentifiedModel:
         return self.fit.beta
 
     def mass_matrix(self, q: ArrayLike) -> NDArray[np.float64]:
-        """Identified ``M(q)``: (..., n) -> (..., n, n) [kg m^2]."""
-        return mass_matrix(self.equivalent_robot, q)
+        """Identified ``M(q)`` (rotor inertia included): (..., n) -> (..., n, n) [kg m^2]."""
+        M = mass_matrix(self.equivalent_robot, q)
+        if self.rotor_inertia is not None and self.drive is not None:
+            M = M + self.drive.rotor_mass_matrix(self.rotor_inertia)
+        return M
 
     def gravity_torques(self, q: ArrayLike) -> NDArray[np.float64]:
         """Identified ``g(q)`` [N m]: (..., n) -> (..., n)."""
@@ -81,5 +111,10 @@ class IdentifiedModel:
         return coriolis(self.equivalent_robot, q, dq)
 
     def torques(self, q: ArrayLike, dq: ArrayLike, ddq: ArrayLike) -> NDArray[np.float64]:
-        """Identified ``M ddq + c + g`` [N m], friction not included: (..., n)."""
-        return rnea(self.equivalent_robot, q, dq, ddq)
+        """Identified ``M ddq + c + g`` [N m] (rotor inertia included), friction not
+        included: (..., n)."""
+        tau = rnea(self.equivalent_robot, q, dq, ddq)
+        if self.rotor_inertia is not None and self.drive is not None:
+            a = _checks.as_batch("ddq", ddq, (self.robot.n,))
+            tau = tau + self.drive.rotor_torques(a, self.rotor_inertia)
+        return tau

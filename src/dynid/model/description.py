@@ -40,7 +40,8 @@ __all__ = ["FORMAT_VERSION", "robot_from_toml", "robot_from_toml_string", "toml_
 #: Version of the schema written by :func:`toml_from_robot`.
 FORMAT_VERSION = 1
 
-_TOP_KEYS = {"format_version", "name", "gravity", "q_neutral", "joints", "frames"}
+_TOP_KEYS = {"format_version", "name", "gravity", "q_neutral", "joints", "frames", "drive"}
+#: ``[drive]`` (a drive train) is read by :func:`dynid.io.drive_file.load_drive`, not here.
 _JOINT_KEYS = {
     "name",
     "type",

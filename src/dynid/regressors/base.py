@@ -37,6 +37,7 @@ parameters depend on the robot's structure only (see :func:`_pivoted_r`).
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from dataclasses import dataclass
 
 import numpy as np
@@ -47,6 +48,7 @@ from .. import _checks
 from ..exceptions import OptionError, ShapeError
 from ..model.robot import Robot
 from .static import static_regressor
+from .terms import ModelTerm
 from .torque import torque_regressor_prepared
 
 __all__ = [
@@ -357,6 +359,7 @@ def base_parameters(
     n_samples: int = 64,
     rng: np.random.Generator | None = None,
     rtol: float | None = None,
+    terms: Sequence[ModelTerm] = (),
 ) -> BaseParameters:
     """Base parameters of a robot's structure, from random states.
 
@@ -374,20 +377,32 @@ def base_parameters(
     rtol : float, optional
         Relative rank tolerance; default: the rank at the first clear gap of the singular
         values (:func:`rank_from_gap`).
+    terms : sequence of ModelTerm
+        Extra model terms (:mod:`dynid.regressors.terms`); those ``in_base`` (a rotor
+        inertia) join the standard parameters after the links' ``10 n``, with their labels,
+        so that they regroup with the link parameters (``beta = J1zz + Ia1``).
     """
     rng = np.random.default_rng(0) if rng is None else rng
+    extra = [t for t in terms if t.in_base]
     lo = np.where(np.isfinite(robot.q_min), robot.q_min, -np.pi)
     hi = np.where(np.isfinite(robot.q_max), robot.q_max, np.pi)
     q = rng.uniform(lo, hi, (n_samples, robot.n))
     if kind == "static":
-        W = static_regressor(robot, q).reshape(-1, 10 * robot.n)
+        blocks = [static_regressor(robot, q)]
+        for t in extra:  # (p, s, N) -> (N, s, p); a term that does not act at rest: zeros
+            C = t.static_columns(n_samples)
+            shape = (n_samples, blocks[0].shape[1], len(t.labels))
+            blocks.append(np.zeros(shape) if C is None else C.transpose(2, 1, 0))
     elif kind == "torque":
         dq = rng.uniform(-2, 2, q.shape)
         ddq = rng.uniform(-5, 5, q.shape)
-        W = torque_regressor_prepared(robot, q, dq, ddq, robot.gravity).reshape(-1, 10 * robot.n)
+        blocks = [torque_regressor_prepared(robot, q, dq, ddq, robot.gravity)]
+        blocks += [t.torque_columns(q, dq, ddq) for t in extra]
     else:
         raise OptionError(f"kind must be 'static' or 'torque'; got {kind!r}")
-    return base_parameters_from_regressor(W, robot.param_labels, rtol=rtol)
+    labels = robot.param_labels + tuple(lab for t in extra for lab in t.labels)
+    W = np.concatenate(blocks, axis=-1).reshape(-1, len(labels))
+    return base_parameters_from_regressor(W, labels, rtol=rtol)
 
 
 #: Labels of :func:`identifiability`.

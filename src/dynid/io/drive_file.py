@@ -1,0 +1,173 @@
+"""Drive descriptions in TOML: a file of its own, or a ``[drive]`` table in a robot TOML.
+
+Keys (all optional but ``schema`` in a file of its own; n = the robot's joint count)::
+
+    schema = "dynid-drive/1"
+    side = "joint" | "motor"          # what the log's q, dq, ddq, tau columns are (joint)
+    gear_ratio = [...]                # n motor turns per joint unit (1)
+    coupling = [[motor, joint, value], ...]   # 1-based entries of K off the diagonal
+    offset = [...]                    # n encoder zero offsets [rad or m], q = K^-1 qm + offset
+    effort = "torque" | "current"     # what the tau columns hold (torque)
+    torque_constant = [...]           # n [N m / A]: at the motor for side = "motor"
+    rotor_inertia = "identify" | [...]  # n [kg m^2] at the motors (identify)
+    friction_at = "motor" | "joint"   # default motor when K is not the identity
+
+``qm = K (q - offset)``, ``dqm = K dq``, ``tau_joint = K^T tau_motor``
+(:mod:`dynid.model.drive`). Every fault (an unknown key, a wrong type or length, a singular
+``K``, a coupling outside the chain, currents without constants) is one
+:class:`~dynid.exceptions.DataError` naming the file and the key, before anything is computed.
+"""
+
+from __future__ import annotations
+
+import math
+import tomllib
+from collections.abc import Mapping
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+from numpy.typing import NDArray
+
+from ..exceptions import DataError, DynidError
+from ..model.drive import DRIVE_SCHEMA, Drive
+
+__all__ = ["drive_from_mapping", "load_drive"]
+
+_KEYS = {
+    "schema",
+    "side",
+    "gear_ratio",
+    "coupling",
+    "offset",
+    "effort",
+    "torque_constant",
+    "rotor_inertia",
+    "friction_at",
+}
+_CHOICES = {
+    "side": ("joint", "motor"),
+    "effort": ("torque", "current"),
+    "friction_at": ("motor", "joint"),
+}
+
+
+def _number(value: Any, where: str) -> float:
+    if isinstance(value, bool) or not isinstance(value, int | float):
+        raise DataError(f"{where} must be a number; got {_short(value)}")
+    try:
+        x = float(value)
+    except OverflowError:
+        raise DataError(f"{where} must be a finite number; got an integer too large") from None
+    if not math.isfinite(x):
+        raise DataError(f"{where} must be finite; got {value!r}")
+    return x
+
+
+def _short(value: Any) -> str:
+    text = repr(value)
+    return text if len(text) <= 80 else text[:77] + "..."
+
+
+def _vector(table: Mapping[str, Any], key: str, n: int, where: str) -> NDArray[np.float64]:
+    value = table[key]
+    if not isinstance(value, list) or len(value) != n:
+        got = f"{len(value)} entries" if isinstance(value, list) else _short(value)
+        raise DataError(
+            f"{where}: key {key!r} must be a list of {n} numbers (one per joint); got {got}"
+        )
+    return np.array([_number(v, f"{where}: {key}[{k}]") for k, v in enumerate(value)])
+
+
+def drive_from_mapping(table: Mapping[str, Any], n: int, *, source: str = "drive") -> Drive:
+    """A :class:`~dynid.model.drive.Drive` of ``n`` joints from a parsed TOML table.
+
+    Raises
+    ------
+    DataError
+        An unknown key, a wrong type, length or choice, or an invalid drive (singular ``K``,
+        currents without torque constants, ...): the message names ``source`` and the key.
+    """
+    if not isinstance(table, Mapping):
+        raise DataError(f"{source} must be a table; got {type(table).__name__}")
+    unknown = sorted(set(table) - _KEYS)
+    if unknown:
+        raise DataError(f"{source}: unknown key {unknown[0]!r}; allowed: {sorted(_KEYS)}")
+    schema = table.get("schema", DRIVE_SCHEMA)
+    if schema != DRIVE_SCHEMA:
+        raise DataError(f"{source}: key 'schema' must be {DRIVE_SCHEMA!r}; got {_short(schema)}")
+    kw: dict[str, Any] = {}
+    for key, allowed in _CHOICES.items():
+        if key in table:
+            if table[key] not in allowed:
+                got = _short(table[key])
+                raise DataError(f"{source}: key {key!r} must be one of {list(allowed)}; got {got}")
+            kw[key] = table[key]
+    gear = _vector(table, "gear_ratio", n, source) if "gear_ratio" in table else np.ones(n)
+    coupling = table.get("coupling", [])
+    if not isinstance(coupling, list):
+        raise DataError(f"{source}: key 'coupling' must be a list of [motor, joint, value]")
+    entries = []
+    for k, entry in enumerate(coupling):
+        where = f"{source}: coupling[{k}]"
+        if not isinstance(entry, list) or len(entry) != 3:
+            raise DataError(f"{where} must be [motor, joint, value]; got {_short(entry)}")
+        m, j = entry[0], entry[1]
+        for what, idx in (("motor", m), ("joint", j)):
+            if isinstance(idx, bool) or not isinstance(idx, int) or not 1 <= idx <= n:
+                raise DataError(
+                    f"{where}: {what} must be an integer in 1..{n} (1-based, the robot has "
+                    f"{n} joints); got {_short(idx)}"
+                )
+        if m == j:
+            raise DataError(f"{where}: motor {m} on joint {j} is the gear ratio; use gear_ratio")
+        entries.append((m, j, _number(entry[2], f"{where}: value")))
+    for key in ("offset", "torque_constant"):
+        if key in table:
+            kw[key] = _vector(table, key, n, source)
+    ia = table.get("rotor_inertia", "identify")
+    if ia != "identify":
+        if isinstance(ia, str):
+            raise DataError(
+                f"{source}: key 'rotor_inertia' must be 'identify' or a list of {n} numbers "
+                f"[kg m^2]; got {_short(ia)}"
+            )
+        kw["rotor_inertia"] = _vector(table, "rotor_inertia", n, source)
+    try:
+        return Drive.from_gears(gear, entries, **kw)
+    except DynidError as exc:
+        raise DataError(f"{source}: {exc}") from exc
+
+
+def load_drive(path: str | Path, n: int) -> Drive:
+    """The drive of a TOML file: a drive description, or a robot TOML's ``[drive]`` table.
+
+    Parameters
+    ----------
+    path : str or Path
+        ``.toml`` file.
+    n : int
+        The robot's joint count.
+
+    Raises
+    ------
+    DataError
+        A missing or unreadable file, invalid TOML, a robot TOML without ``[drive]``, or an
+        invalid description (:func:`drive_from_mapping`).
+    """
+    p = Path(path)
+    try:
+        text = p.read_text(encoding="utf-8")
+    except (OSError, UnicodeDecodeError) as exc:
+        raise DataError(f"drive file {p}: cannot read ({exc})") from exc
+    try:
+        doc = tomllib.loads(text)
+    except (tomllib.TOMLDecodeError, RecursionError) as exc:
+        raise DataError(f"drive file {p.name} is not valid TOML: {str(exc)[:200]}") from None
+    if "joints" in doc:  # a robot description
+        if "drive" not in doc:
+            raise DataError(f"{p.name}: a robot TOML without a [drive] table")
+        return drive_from_mapping(doc["drive"], n, source=f"{p.name} [drive]")
+    if "schema" not in doc:
+        raise DataError(f"{p.name}: missing key 'schema' (expected {DRIVE_SCHEMA!r})")
+    return drive_from_mapping(doc, n, source=p.name)

@@ -1,0 +1,202 @@
+"""Model terms beyond the rigid links: regressor columns that identification stacks.
+
+The joint torques of an arm are linear in every parameter of the model:
+
+.. math:: \\tau = Y(q, \\dot q, \\ddot q)\\, \\phi + \\sum_t Y_t(q, \\dot q, \\ddot q)\\, \\theta_t
+
+with ``Y`` the rigid-body regressor (:mod:`dynid.regressors.torque`) and one block ``Y_t``
+per extra term ``t``. A term is an object with the :class:`ModelTerm` protocol: its labels
+and units, its torque columns, its columns of the static regressor ``[tril M; g]`` (None when
+it does not act at rest), whether it regroups with the link parameters (``in_base``: its
+columns join the rigid-body ones before the base parameters are found, as a rotor inertia
+regroups with its link's ``Izz``) and which of its parameters a physically consistent model
+keeps non-negative. Adding a term (a spring, a payload) is one class here and its entry in
+:func:`drive_terms`.
+
+Terms of a :class:`~dynid.model.drive.Drive`:
+
+* :class:`RotorInertia`: ``K^T diag(I_a) K ddq``, labels ``Ia1 .. Ia_n`` [kg m^2], in the
+  base (the rotor of a base joint with a vertical axis regroups with link 1's ``J1zz``);
+* :class:`LinearFriction`: ``K^T (f_v K dq + f_c sign(K dq) + f_o)`` per motor (or per joint
+  with ``friction_at="joint"``), labels ``fv1, fc1, fo1, fv2, ...`` (Gaz et al. 2019, eq. 24
+  at the motors); appended after the base parameters.
+
+Rows are sample-major as everywhere (row ``k n + j`` of a stack is sample ``k``, joint ``j``).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Protocol
+
+import numpy as np
+from numpy.typing import NDArray
+
+from ..model.drive import Drive
+
+__all__ = [
+    "LinearFriction",
+    "ModelTerm",
+    "RotorInertia",
+    "base_term_columns",
+    "drive_terms",
+    "friction_labels",
+]
+
+
+class ModelTerm(Protocol):
+    """What identification needs of a model term (module docstring)."""
+
+    @property
+    def name(self) -> str:
+        """Short name, used in files and summaries."""
+        ...
+
+    @property
+    def in_base(self) -> bool:
+        """True when it regroups with the link parameters (its columns enter the base)."""
+        ...
+
+    @property
+    def labels(self) -> tuple[str, ...]:
+        """One label per parameter."""
+        ...
+
+    @property
+    def units(self) -> tuple[str, ...]:
+        """One SI unit per parameter."""
+        ...
+
+    @property
+    def nonnegative(self) -> NDArray[np.bool_]:
+        """Parameters a physically consistent model keeps ``>= 0``."""
+        ...
+
+    def torque_columns(
+        self, q: NDArray[np.float64], dq: NDArray[np.float64], ddq: NDArray[np.float64]
+    ) -> NDArray[np.float64]:
+        """Joint-torque columns (B, n, p) of (B, n) joint states."""
+        ...
+
+    def static_columns(self, n_samples: int) -> NDArray[np.float64] | None:
+        """Columns (p, n (n + 1) / 2 + n, N) of the static regressor, or None."""
+        ...
+
+
+def friction_labels(n: int) -> tuple[str, ...]:
+    """``fv1, fc1, fo1, fv2, ...`` for ``n`` joints (or motors)."""
+    return tuple(f"{k}{j + 1}" for j in range(n) for k in ("fv", "fc", "fo"))
+
+
+@dataclass(frozen=True, slots=True, eq=False)
+class RotorInertia:
+    """Rotor inertias ``I_a`` [kg m^2] at the motors: ``K^T diag(I_a) K ddq``."""
+
+    drive: Drive
+    name: str = "rotor_inertia"
+    in_base: bool = True
+
+    @property
+    def labels(self) -> tuple[str, ...]:
+        """``Ia1 .. Ia_n``."""
+        return self.drive.rotor_labels
+
+    @property
+    def units(self) -> tuple[str, ...]:
+        """kg m^2 each."""
+        return ("kg m^2",) * self.drive.n
+
+    @property
+    def nonnegative(self) -> NDArray[np.bool_]:
+        """Every rotor inertia is ``>= 0``."""
+        return np.ones(self.drive.n, dtype=bool)
+
+    def torque_columns(
+        self, q: NDArray[np.float64], dq: NDArray[np.float64], ddq: NDArray[np.float64]
+    ) -> NDArray[np.float64]:
+        """(B, n, n): column ``k`` is ``K[k]^T (K[k] . ddq)``."""
+        return self.drive.rotor_columns(ddq)
+
+    def static_columns(self, n_samples: int) -> NDArray[np.float64]:
+        """(n, s, N): ``tril(K[k] K[k]^T)`` in the rows of ``M``, zero in those of ``g``."""
+        n = self.drive.n
+        i, j = np.tril_indices(n)
+        C = np.zeros((n, i.size + n, n_samples))
+        C[:, : i.size, :] = self.drive.rotor_mass_columns()[:, i, j][:, :, None]
+        return C
+
+
+@dataclass(frozen=True, slots=True, eq=False)
+class LinearFriction:
+    """Viscous, Coulomb and offset friction where the drive says (motors or joints)."""
+
+    drive: Drive
+    name: str = "friction"
+    in_base: bool = False
+
+    @property
+    def labels(self) -> tuple[str, ...]:
+        """``fv1, fc1, fo1, fv2, ...``."""
+        return friction_labels(self.drive.n)
+
+    @property
+    def units(self) -> tuple[str, ...]:
+        """N m s/rad, N m, N m per joint (motor)."""
+        return ("N m s/rad", "N m", "N m") * self.drive.n
+
+    @property
+    def nonnegative(self) -> NDArray[np.bool_]:
+        """``fv, fc >= 0``; the offset ``fo`` has either sign."""
+        return np.tile([True, True, False], self.drive.n)
+
+    def torque_columns(
+        self, q: NDArray[np.float64], dq: NDArray[np.float64], ddq: NDArray[np.float64]
+    ) -> NDArray[np.float64]:
+        """(B, n, 3 n): motor ``m``'s ``(v, sign v, 1)`` with ``v = (K dq)_m``, mapped by
+        ``K^T`` onto the joints (``K = 1`` at the joints)."""
+        v = self.drive.motor_velocities(dq)
+        n = v.shape[-1]
+        F = np.zeros(v.shape + (3 * n,))
+        m = np.arange(n)
+        F[..., m, 3 * m] = v
+        F[..., m, 3 * m + 1] = np.sign(v)
+        F[..., m, 3 * m + 2] = 1.0
+        if self.drive.friction_at == "joint":
+            return F
+        return np.einsum("mj,...mc->...jc", self.drive.transmission, F)
+
+    def static_columns(self, n_samples: int) -> None:
+        """None: friction does not act at rest."""
+        return None
+
+
+def drive_terms(drive: Drive | None, n: int, *, friction: bool = True) -> tuple[ModelTerm, ...]:
+    """The extra terms of an arm of ``n`` joints: the rotor inertia of a drive (when it is
+    identified) and, with ``friction``, linear friction where the drive says (at the joints
+    without a drive)."""
+    terms: list[ModelTerm] = []
+    if drive is not None and drive.identifies_rotor_inertia:
+        terms.append(RotorInertia(drive))
+    if friction:
+        terms.append(LinearFriction(Drive.identity(n) if drive is None else drive))
+    return tuple(terms)
+
+
+def base_term_columns(
+    terms: tuple[ModelTerm, ...], independent: NDArray[np.intp], n_links: int
+) -> list[tuple[ModelTerm, NDArray[np.intp]]]:
+    """Which parameters of each ``in_base`` term are independent base columns.
+
+    The standard parameters of a base continue after the ``10 n_links`` link parameters
+    with the labels of the ``in_base`` terms in order (:func:`dynid.regressors.base.
+    base_parameters`); returns each such term with the indices of its own parameters that
+    are in ``independent``, in that order.
+    """
+    ind = np.asarray(independent, dtype=np.intp)
+    start, out = 10 * n_links, []
+    for t in terms:
+        if t.in_base:
+            k = len(t.labels)
+            out.append((t, ind[(ind >= start) & (ind < start + k)] - start))
+            start += k
+    return out

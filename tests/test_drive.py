@@ -1,0 +1,199 @@
+"""Drive trains: gear ratios, a coupled wrist, encoder offsets, rotor inertia, motor friction,
+motor currents (issue 17).
+
+The reference torques come from Pinocchio's RNEA on example-robot-data's UR5 plus the drive
+terms written out here, independently of dynid:
+``tau = rnea(q, dq, ddq) + K^T diag(Ia) K ddq + K^T (fv * dqm + fc * sign(dqm) + fo)``,
+``dqm = K dq``; a motor-side log records ``qm = K (q - offset)``, ``dqm``, ``ddqm`` and
+``tau_m = K^-T tau`` (or the currents ``tau_m / kt``).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+import dynid
+from dynid.exceptions import DataError, ModelError
+from dynid.identification.classical import identify_from_log
+from dynid.identification.log import TorqueLog
+from dynid.io.drive_file import drive_from_mapping, load_drive
+from dynid.model.drive import Drive
+
+from conftest import robot_data_urdf
+
+pin = pytest.importorskip("pinocchio")
+
+GEAR = np.array([101.0, 101.0, 101.0, 81.0, 81.0, 51.0])
+# motor 6 turns with joints 5 and 6 (a coupled wrist): qm6 = 51 q6 + 30 q5
+COUPLING = [(6, 5, 30.0)]
+IA = np.array([3.0e-5, 3.0e-5, 2.5e-5, 1.2e-5, 1.0e-5, 0.8e-5])  # [kg m^2] at the motors
+FV = np.array([2.0e-4, 1.5e-4, 1.2e-4, 0.6e-4, 0.5e-4, 0.4e-4])  # [N m s/rad] at the motors
+FC = np.array([0.03, 0.03, 0.025, 0.012, 0.01, 0.008])  # [N m] at the motors
+FO = np.array([0.002, -0.001, 0.0015, 0.0005, -0.0004, 0.0003])  # [N m] at the motors
+OFFSET = np.array([0.01, -0.02, 0.015, 0.0, 0.03, -0.01])  # [rad]
+KT = np.array([0.12, 0.12, 0.1, 0.07, 0.07, 0.05])  # [N m / A] at the motors
+
+
+def _ur5() -> tuple[dynid.Robot, object, object]:
+    path = robot_data_urdf("ur_description/urdf/ur5_robot.urdf")
+    robot = dynid.Robot.from_urdf(path, "base_link", "tool0")
+    model = pin.buildModelFromUrdf(path)
+    model.gravity.linear = np.asarray(robot.gravity)
+    return robot, model, model.createData()
+
+
+def _drive(**kw: object) -> Drive:
+    kw.setdefault("side", "motor")
+    kw.setdefault("offset", OFFSET)
+    return Drive.from_gears(GEAR, COUPLING, **kw)
+
+
+def _trajectory(n: int, seed: int, duration: float = 6.0, fs: float = 250.0):
+    """Sums of sinusoids with their exact derivatives: t (N,), q, dq, ddq (N, n)."""
+    rng = np.random.default_rng(seed)
+    t = np.arange(0.0, duration, 1.0 / fs)
+    w = 2 * np.pi * rng.uniform(0.1, 0.6, (4, n))
+    a = rng.uniform(0.1, 0.5, (4, n))
+    ph = rng.uniform(0, 2 * np.pi, (4, n))
+    arg = t[:, None, None] * w[None] + ph[None]
+    q = np.sum(a * np.sin(arg), axis=1)
+    dq = np.sum(a * w * np.cos(arg), axis=1)
+    ddq = -np.sum(a * w**2 * np.sin(arg), axis=1)
+    return t, q, dq, ddq
+
+
+def _joint_torques(model, data, q, dq, ddq) -> np.ndarray:
+    """Reference joint torques: Pinocchio's RNEA plus the drive terms, written out."""
+    K = Drive.from_gears(GEAR, COUPLING, offset=OFFSET).transmission
+    tau = np.array([pin.rnea(model, data, *s) for s in zip(q, dq, ddq, strict=True)])
+    dqm, ddqm = dq @ K.T, ddq @ K.T
+    tau += (IA * ddqm) @ K
+    tau += (FV * dqm + FC * np.sign(dqm) + FO) @ K
+    return tau
+
+
+def _motor_log(model, data, seed: int, currents: bool = False) -> tuple[TorqueLog, np.ndarray]:
+    """A motor-side log (exact ddq) and its joint torques."""
+    t, q, dq, ddq = _trajectory(6, seed)
+    tau = _joint_torques(model, data, q, dq, ddq)
+    K = Drive.from_gears(GEAR, COUPLING).transmission
+    tau_m = np.linalg.solve(K.T, tau.T).T
+    effort = tau_m / KT if currents else tau_m
+    log = TorqueLog(t, (q - OFFSET) @ K.T, dq @ K.T, effort, ddq @ K.T)
+    return log, tau
+
+
+def test_drive_maps_motor_states_and_torques_by_power_conservation():
+    """q = K^-1 qm + offset, dq = K^-1 dqm, tau = K^T tau_m, and the inverse maps back."""
+    d = _drive(effort="current", torque_constant=KT)
+    rng = np.random.default_rng(0)
+    q, dq = rng.normal(size=(2, 5, 6))
+    qm, dqm = d.recorded_states(q, dq)
+    np.testing.assert_allclose(qm, (q - OFFSET) @ d.transmission.T, rtol=1e-14)
+    back = d.joint_states(qm, dqm)
+    np.testing.assert_allclose(back[0], q, rtol=0, atol=1e-13)
+    np.testing.assert_allclose(back[1], dq, rtol=0, atol=1e-13)
+    tau = rng.normal(size=(5, 6))
+    i = d.recorded_efforts(tau)
+    np.testing.assert_allclose(d.joint_torques(i), tau, rtol=0, atol=1e-12)
+    # the motor power equals the joint power
+    np.testing.assert_allclose(np.sum(i * KT * dqm, axis=1), np.sum(tau * dq, axis=1), atol=1e-12)
+
+
+def test_identify_motor_side_coupled_wrist_predicts_held_out_torques_to_round_off():
+    """Noise-free motor-side torques with exact ddq: held-out joint torques to 1e-6 relative,
+    and the rotor of motor 2..6 identified (its own base parameter or in a combination)."""
+    robot, model, data = _ur5()
+    train, _ = _motor_log(model, data, seed=1)
+    held, tau_held = _motor_log(model, data, seed=2)
+    drive = _drive()
+    m = identify_from_log(robot, train, cutoff_hz=None, decimate=1, drive=drive)
+    assert "Ia1" in m.base.std_labels
+    assert any("Ia6" in e for e in m.base.expressions)
+    h = dynid.identification.log.joint_side_log(held, drive)
+    tau_hat = m.torques(h.q, h.dq, h.ddq) + dynid.friction.validation.own_friction(m).torques(h.dq)
+    err = np.linalg.norm(tau_hat - tau_held) / np.linalg.norm(tau_held)
+    assert err < 1e-6
+
+
+def test_identify_motor_currents_with_torque_constants():
+    """Motor currents times the torque constants give the same model as motor torques."""
+    robot, model, data = _ur5()
+    train, _ = _motor_log(model, data, seed=1, currents=True)
+    held, tau_held = _motor_log(model, data, seed=3)
+    drive = _drive(effort="current", torque_constant=KT)
+    m = identify_from_log(robot, train, cutoff_hz=None, decimate=1, drive=drive)
+    h = dynid.identification.log.joint_side_log(held, _drive())
+    tau_hat = m.torques(h.q, h.dq, h.ddq) + dynid.friction.validation.own_friction(m).torques(h.dq)
+    assert np.linalg.norm(tau_hat - tau_held) / np.linalg.norm(tau_held) < 1e-6
+
+
+def test_without_the_coupling_the_fit_is_worse():
+    """The coupled rotor's inertia and friction are what a diagonal drive cannot represent."""
+    robot, model, data = _ur5()
+    train, _ = _motor_log(model, data, seed=1)
+    held, tau_held = _motor_log(model, data, seed=2)
+    wrong = Drive.from_gears(GEAR, side="motor", offset=OFFSET)
+    # the log is the coupled one: read it as joint torques through the true transmission
+    h = dynid.identification.log.joint_side_log(held, _drive())
+    tr = dynid.identification.log.joint_side_log(train, _drive())
+    m = identify_from_log(
+        robot, tr, cutoff_hz=None, decimate=1, drive=Drive.from_gears(GEAR, offset=0 * OFFSET)
+    )
+    assert wrong.n == 6
+    tau_hat = m.torques(h.q, h.dq, h.ddq) + dynid.friction.validation.own_friction(m).torques(h.dq)
+    assert np.linalg.norm(tau_hat - tau_held) / np.linalg.norm(tau_held) > 1e-4
+
+
+@pytest.mark.parametrize(
+    ("table", "match"),
+    [
+        ({"gear_ratio": [1, 2]}, "list of 3 numbers"),
+        ({"gear_ratio": [1, 0, 1]}, "singular"),
+        ({"coupling": [[4, 1, 2.0]]}, "1..3"),
+        ({"coupling": [[1, 1, 2.0]]}, "gear_ratio"),
+        ({"effort": "current"}, "torque_constant"),
+        ({"side": "motors"}, "'side' must be one of"),
+        ({"gear": [1, 2, 3]}, "unknown key 'gear'"),
+        ({"offset": [0, True, 0]}, "must be a number"),
+        ({"rotor_inertia": [0.1, -0.1, 0.0]}, "rotor_inertia must be >= 0"),
+        ({"rotor_inertia": "fit"}, "'identify' or a list"),
+        ({"schema": "dynid-drive/9"}, "schema"),
+    ],
+)
+def test_drive_file_errors_name_the_key(table, match):
+    """A wrong drive description is one DataError naming the key, before any computation."""
+    with pytest.raises(DataError, match=match):
+        drive_from_mapping(table, 3, source="drive.toml")
+
+
+def test_drive_file_and_robot_toml_drive_table(tmp_path):
+    """A drive file and a robot TOML's [drive] table give the same drive."""
+    text = (
+        'side = "motor"\ngear_ratio = [100, 80]\ncoupling = [[2, 1, 20]]\n'
+        'offset = [0.1, 0.0]\neffort = "current"\ntorque_constant = [0.1, 0.2]\n'
+    )
+    f = tmp_path / "drive.toml"
+    f.write_text('schema = "dynid-drive/1"\n' + text)
+    d = load_drive(f, 2)
+    np.testing.assert_array_equal(d.transmission, [[100.0, 0.0], [20.0, 80.0]])
+    assert d.friction_at == "motor" and d.identifies_rotor_inertia
+    r = tmp_path / "arm.toml"
+    r.write_text(
+        'name = "two"\n[[joints]]\nname = "j1"\nparent = "l0"\nchild = "l1"\n'
+        '[[joints]]\nname = "j2"\nparent = "l1"\nchild = "l2"\n[drive]\n' + text
+    )
+    d2 = load_drive(r, 2)
+    np.testing.assert_array_equal(d2.transmission, d.transmission)
+    with pytest.raises(DataError, match="missing key 'schema'"):
+        (tmp_path / "bad.toml").write_text(text)
+        load_drive(tmp_path / "bad.toml", 2)
+
+
+def test_drive_model_errors():
+    """A singular transmission and currents without constants are ModelErrors."""
+    with pytest.raises(ModelError, match="singular"):
+        Drive(transmission=np.ones((2, 2)), offset=np.zeros(2))
+    with pytest.raises(ModelError, match="torque_constant"):
+        Drive(transmission=np.eye(2), offset=np.zeros(2), effort="current")
