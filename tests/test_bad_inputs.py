@@ -276,6 +276,38 @@ def log_gap(d: Path) -> None:
     _write(d / "gap.csv", lines[: h + 300] + lines[h + 320 :])
 
 
+def _log_still(d: Path, name: str, joints: list[int]) -> None:
+    """A 4 s log at 200 Hz of the Table I sinusoids with ``joints`` (0-based) held still;
+    their measured velocities are only the sensor noise."""
+    import dynid
+    from dynid.io.torque_log import save_torque_log
+    from dynid.simulation.measurement import sample_times, simulate_measurement
+    from dynid.simulation.trajectories import (
+        Trajectory,
+        centered_start,
+        scale_into_limits,
+        sinusoid_trajectory,
+    )
+
+    robot = dynid.panda()
+    q0 = centered_start(robot)
+    traj, _ = scale_into_limits(robot, sinusoid_trajectory(sample_times(4.0, 200.0), q0))
+    q, dq, ddq = traj.q.copy(), traj.dq.copy(), traj.ddq.copy()
+    q[:, joints], dq[:, joints], ddq[:, joints] = q0[joints], 0.0, 0.0
+    still = Trajectory(t=traj.t, q=q, dq=dq, ddq=ddq)
+    save_torque_log(d / name, simulate_measurement(robot, still, rng=np.random.default_rng(20)))
+
+
+def log_joint4_still(d: Path) -> None:
+    """A log in which joint 4 never moves (issue 20: phi1 = -9.4e6 N m was fitted)."""
+    _log_still(d, "still4.csv", [3])
+
+
+def log_all_still(d: Path) -> None:
+    """A log in which no joint moves."""
+    _log_still(d, "still.csv", list(range(7)))
+
+
 def _edit_model(d: Path, edit: Callable[[dict], None]) -> None:
     doc = json.loads((d / "res" / "identification.json").read_text())
     edit(doc)
@@ -385,6 +417,9 @@ CASES = [
     C("log-50hz", log_at(50), f"validate --robot panda --data {{d}}/slow.csv --no-figures --out {OUT}", 0, ""),
     C("log-50hz-friction", log_at(50), f"friction --robot panda --data {{d}}/slow.csv --no-figures --out {OUT}", 0, ""),
     C("log-10hz", log_at(10), f"validate --robot panda --data {{d}}/slow.csv --no-figures --out {OUT}", 0, "the default cutoff 5 Hz is not below the Nyquist frequency of this 10 Hz log"),
+    # friction is never fitted from noise (issue 20)
+    C("friction-joint-still", log_joint4_still, f"friction --robot panda --data {{d}}/still4.csv --no-figures --out {OUT}", 0, "joint(s) [4] never move beyond their velocity noise band"),
+    C("friction-all-still", log_all_still, f"friction --robot panda --data {{d}}/still.csv --out {OUT}", 2, "no joint moves beyond its velocity noise band"),
     C("log-wrong-robot", None, f"validate --robot {{d}}/two.toml --data {{d}}/log.csv --out {OUT}", 2, "the log has 7 joints"),
     # static data: robot consistency and BOM
     C("static-bom", static_bom, f"identify --data {{d}}/bom.csv --out {OUT}", 0, ""),

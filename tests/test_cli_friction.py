@@ -117,7 +117,8 @@ def test_friction_then_validate_write_json_and_figures(workdir, capsys):
     doc = json.loads((fr / "friction.json").read_text())
     assert doc["model"] == "sigmoid" and len(doc["joints"]) == 7
     j = doc["joints"][3]
-    assert set(j) == {"phi1", "phi2", "phi3", "rms_before", "rms_after"}
+    assert set(j) == {"phi1", "phi2", "phi3", "rms_before", "rms_after", "identified"}
+    assert j["identified"] is True
     assert j["rms_after"] < j["rms_before"]
     assert _png(fr / "friction.png")
     assert "RMS after" in capsys.readouterr().out
@@ -193,7 +194,7 @@ def test_classical_friction_model_option(workdir):
     )
     doc = json.loads((out / "friction.json").read_text())
     assert doc["model"] == "classical"
-    assert set(doc["joints"][0]) == {"fv", "fc", "fo", "rms_before", "rms_after"}
+    assert set(doc["joints"][0]) == {"fv", "fc", "fo", "rms_before", "rms_after", "identified"}
 
 
 def test_cli_errors_are_one_line_with_exit_code_2(workdir, capsys):

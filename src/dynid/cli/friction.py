@@ -164,9 +164,9 @@ def run(args: argparse.Namespace) -> int:
     with about(args.data):
         res = friction_residual(model, log, cutoff_hz=args.cutoff, max_gap_s=args.max_gap)
         fit = (
-            fit_sigmoid(res.dq, res.residual)
+            fit_sigmoid(res.dq, res.residual, dq_noise_std=res.dq_noise_std)
             if args.friction_model == "sigmoid"
-            else fit_classical(res.dq, res.residual)
+            else fit_classical(res.dq, res.residual, dq_noise_std=res.dq_noise_std)
         )
     meta = {
         "data": str(args.data.name),

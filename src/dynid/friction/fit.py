@@ -21,12 +21,21 @@ compensation is at the noise level for a correct model.
   ``phi1``).
 * **classical** (eq. 24): per joint, linear least squares on ``(dq, sign dq, 1)``.
 
+A joint whose velocity never leaves its noise band carries no information on its
+friction: fitted anyway, the sigmoid's span ``phi1`` runs off to millions of N m. Such a
+joint gets no parameters (zero friction) and a :class:`~dynid.exceptions.DynidWarning`
+names it (:func:`moving_joints`: at least 1 % of its samples beyond
+:data:`NOISE_BAND_STD` times the white-noise std of the measured velocity, and beyond
+:data:`MIN_MOTION`); a log in which no joint moves is a
+:class:`~dynid.exceptions.DataError`.
+
 The result reports the per-joint RMS of the residual before and after subtracting the
-fitted friction.
+fitted friction, and which joints were identified.
 """
 
 from __future__ import annotations
 
+import warnings
 from collections.abc import Callable
 from dataclasses import dataclass
 
@@ -37,7 +46,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from .. import _checks
 from ..dynamics.rnea import rnea
-from ..exceptions import ConvergenceError, ShapeError
+from ..exceptions import ConvergenceError, DataError, DynidWarning, ShapeError
 from ..identification.log import DEFAULT_CUTOFF_HZ, TorqueLog, prepare_log
 from ..identification.model import IdentifiedModel
 from ..model.robot import Robot
@@ -51,8 +60,18 @@ __all__ = [
     "fit_friction",
     "fit_sigmoid",
     "friction_residual",
+    "moving_joints",
     "rigid_body_torques",
+    "velocity_noise_std",
 ]
+
+#: Width of the velocity noise band, in standard deviations of the velocity noise.
+NOISE_BAND_STD = 5.0
+#: Smallest velocity [rad/s] (m/s for a prismatic joint) counted as motion, whatever the
+#: noise: below it no friction law can be told apart (noise-free logs of a frozen joint).
+MIN_MOTION = 1e-3
+#: Fraction of the samples that must lie outside the noise band for a joint to move.
+MOVING_FRACTION = 0.01
 
 #: A rigid-body torque model: identified, a robot's own parameters, or a callable
 #: ``f(q, dq, ddq) -> tau`` on (N, n) arrays [rad, rad/s, rad/s^2 -> N m].
@@ -112,11 +131,15 @@ class FrictionResidual:
         Rigid-body torques of the model [N m].
     residual : ndarray, shape (N, n)
         ``log.tau - tau_model`` [N m].
+    dq_noise_std : ndarray, shape (n,), optional
+        White-noise std of the measured (unfiltered) velocities [rad/s]
+        (:func:`velocity_noise_std` of the log before preparation); None when unknown.
     """
 
     log: TorqueLog
     tau_model: NDArray[np.float64]
     residual: NDArray[np.float64]
+    dq_noise_std: NDArray[np.float64] | None = None
 
     @property
     def dq(self) -> NDArray[np.float64]:
@@ -152,7 +175,97 @@ def friction_residual(
     )
     assert p.ddq is not None  # prepare_log always fills ddq
     tau_m = rigid_body_torques(model, p.q, p.dq, p.ddq)
-    return FrictionResidual(log=p, tau_model=tau_m, residual=p.tau - tau_m)
+    noise = _checks.frozen(velocity_noise_std(log.dq))
+    return FrictionResidual(log=p, tau_model=tau_m, residual=p.tau - tau_m, dq_noise_std=noise)
+
+
+def velocity_noise_std(dq: ArrayLike) -> NDArray[np.float64]:
+    """Std [rad/s] (n,) of the white noise on velocity samples ``dq`` (N, n), robustly.
+
+    .. math:: \\hat\\sigma_j = 1.4826 \\, \\mathrm{MAD}(\\Delta^2 \\dot q_j) / \\sqrt 6
+
+    The second difference of white noise of std ``sigma`` has std ``sqrt(6) sigma``, while
+    that of a smooth motion sampled fast is far smaller; the median absolute deviation
+    (scaled to a std for Gaussian noise) ignores the few steps of a fast reversal. Give
+    the measured velocities: a low-pass filter hides the noise from this estimate.
+
+    Parameters
+    ----------
+    dq : array_like, shape (N, n)
+        Measured joint velocities [rad/s], N >= 3.
+
+    Returns
+    -------
+    ndarray, shape (n,)
+
+    Raises
+    ------
+    ShapeError
+        ``dq`` not of shape (N, n) with N >= 3.
+    """
+    a = _checks.as_array("dq", dq)
+    if a.ndim != 2 or a.shape[0] < 3:
+        raise ShapeError(f"dq must have shape (N, n), N >= 3; got {a.shape}")
+    d2 = np.diff(a, n=2, axis=0)
+    mad = np.median(np.abs(d2 - np.median(d2, axis=0)), axis=0)
+    out: NDArray[np.float64] = 1.4826 * mad / np.sqrt(6.0)
+    return out
+
+
+def moving_joints(dq: ArrayLike, noise_std: ArrayLike | None = None) -> NDArray[np.bool_]:
+    """Which joints move beyond their velocity noise band (n,) bool.
+
+    A joint moves when more than :data:`MOVING_FRACTION` of its samples ``|dq|`` exceed
+    ``max(NOISE_BAND_STD * noise_std, MIN_MOTION)``.
+
+    Parameters
+    ----------
+    dq : array_like, shape (N, n)
+        Joint velocities [rad/s] (filtered or not).
+    noise_std : array_like, shape (n,) or scalar, optional
+        White-noise std of the measured velocities [rad/s]; default
+        :func:`velocity_noise_std` of ``dq`` (right for unfiltered velocities).
+
+    Returns
+    -------
+    ndarray of bool, shape (n,)
+
+    Raises
+    ------
+    ShapeError
+        ``dq`` not of shape (N, n) with N >= 3, or ``noise_std`` of another joint count.
+    """
+    a = _checks.as_array("dq", dq)
+    if a.ndim != 2 or a.shape[0] < 3:
+        raise ShapeError(f"dq must have shape (N, n), N >= 3; got {a.shape}")
+    sd = velocity_noise_std(a) if noise_std is None else _checks.as_array("noise_std", noise_std)
+    sd = np.broadcast_to(sd, (a.shape[1],)) if sd.ndim == 0 else sd
+    if sd.shape != (a.shape[1],):
+        raise ShapeError(f"noise_std must have shape ({a.shape[1]},); got {sd.shape}")
+    band = np.maximum(NOISE_BAND_STD * sd, MIN_MOTION)
+    out: NDArray[np.bool_] = np.quantile(np.abs(a), 1.0 - MOVING_FRACTION, axis=0) > band
+    return out
+
+
+def _identifiable(dq: NDArray[np.float64], noise_std: ArrayLike | None) -> NDArray[np.bool_]:
+    """The moving joints; warn about the others, raise when none moves."""
+    moving = moving_joints(dq, 0.0 if noise_std is None else noise_std)
+    still = [int(j) + 1 for j in np.flatnonzero(~moving)]
+    if not moving.any():
+        raise DataError(
+            f"no joint moves beyond its velocity noise band (largest |dq| "
+            f"{float(np.max(np.abs(dq))):.3g} rad/s): friction cannot be fitted from this log; "
+            "hint: record a trajectory that moves every joint in both directions"
+        )
+    if still:
+        warnings.warn(
+            f"joint(s) {still} never move beyond their velocity noise band: their friction is "
+            "not identifiable from this log and is set to zero; hint: record a trajectory "
+            "that moves them",
+            DynidWarning,
+            stacklevel=3,
+        )
+    return moving
 
 
 @dataclass(frozen=True, slots=True, eq=False)
@@ -173,6 +286,9 @@ class FrictionFit:
         Optimiser iterations per joint (0 for the classical fit).
     n_samples : int
         Samples used.
+    identified : ndarray of bool, shape (n,)
+        Joints whose friction was fitted; the others never left their velocity noise
+        band and have zero friction (:func:`moving_joints`).
     """
 
     friction: FrictionModel
@@ -181,6 +297,7 @@ class FrictionFit:
     converged: NDArray[np.bool_]
     iterations: NDArray[np.int_]
     n_samples: int
+    identified: NDArray[np.bool_]
 
     @property
     def kind(self) -> str:
@@ -232,7 +349,11 @@ def _fit_sigmoid_joint(
 
 
 def fit_sigmoid(
-    dq: NDArray[np.float64], residual: NDArray[np.float64], *, maxiter: int = 4000
+    dq: NDArray[np.float64],
+    residual: NDArray[np.float64],
+    *,
+    maxiter: int = 4000,
+    dq_noise_std: ArrayLike | None = None,
 ) -> FrictionFit:
     """Per-joint Nelder-Mead fit of the sigmoid (eq. 25) to a residual.
 
@@ -244,6 +365,11 @@ def fit_sigmoid(
         Torque residual [N m].
     maxiter : int
         Nelder-Mead iteration limit per joint.
+    dq_noise_std : array_like, shape (n,), optional
+        White-noise std of the measured velocities [rad/s]
+        (:attr:`FrictionResidual.dq_noise_std`). Joints whose ``dq`` does not leave the
+        noise band (:func:`moving_joints`) get zero friction; None: no noise, only
+        :data:`MIN_MOTION` bounds the band.
 
     Returns
     -------
@@ -252,23 +378,36 @@ def fit_sigmoid(
     Raises
     ------
     ShapeError, NonFiniteError
+    DataError
+        No joint moves beyond its velocity noise band.
     ConvergenceError
         The optimiser returned non-finite parameters.
+
+    Warns
+    -----
+    DynidWarning
+        Some joints do not move (named, 1-based): their friction is set to zero.
     """
     dq, residual = _pair(dq, residual)
+    moving = _identifiable(dq, dq_noise_std)
     n = dq.shape[1]
     P = np.zeros((n, 3))
-    ok = np.zeros(n, bool)
+    ok = np.ones(n, bool)
     it = np.zeros(n, int)
-    for j in range(n):
+    for j in np.flatnonzero(moving):
         P[j], ok[j], it[j] = _fit_sigmoid_joint(dq[:, j], residual[:, j], maxiter=maxiter)
     if not np.all(np.isfinite(P)):
         raise ConvergenceError(f"sigmoid fit gave non-finite parameters: {P.tolist()}")
     fr = SigmoidFriction.from_array(P)
-    return _result(fr, dq, residual, ok, it)
+    return _result(fr, dq, residual, ok, it, moving)
 
 
-def fit_classical(dq: NDArray[np.float64], residual: NDArray[np.float64]) -> FrictionFit:
+def fit_classical(
+    dq: NDArray[np.float64],
+    residual: NDArray[np.float64],
+    *,
+    dq_noise_std: ArrayLike | None = None,
+) -> FrictionFit:
     """Per-joint linear least squares of ``fv dq + fc sign(dq) + fo`` (eq. 24) to a residual.
 
     Parameters
@@ -277,19 +416,33 @@ def fit_classical(dq: NDArray[np.float64], residual: NDArray[np.float64]) -> Fri
         Joint velocities [rad/s].
     residual : array_like, shape (N, n)
         Torque residual [N m].
+    dq_noise_std : array_like, shape (n,), optional
+        As in :func:`fit_sigmoid`.
 
     Returns
     -------
     FrictionFit
+
+    Raises
+    ------
+    ShapeError, NonFiniteError
+    DataError
+        No joint moves beyond its velocity noise band.
+
+    Warns
+    -----
+    DynidWarning
+        Some joints do not move (named, 1-based): their friction is set to zero.
     """
     dq, residual = _pair(dq, residual)
+    moving = _identifiable(dq, dq_noise_std)
     n = dq.shape[1]
     P = np.zeros((n, 3))
-    for j in range(n):
+    for j in np.flatnonzero(moving):
         A = np.stack([dq[:, j], np.sign(dq[:, j]), np.ones(dq.shape[0])], axis=1)
         P[j] = scipy.linalg.lstsq(A, residual[:, j])[0]
     fr = ClassicalFriction.from_array(P)
-    return _result(fr, dq, residual, np.ones(n, bool), np.zeros(n, int))
+    return _result(fr, dq, residual, np.ones(n, bool), np.zeros(n, int), moving)
 
 
 def _pair(dq: ArrayLike, residual: ArrayLike) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
@@ -308,6 +461,7 @@ def _result(
     residual: NDArray[np.float64],
     ok: NDArray[np.bool_],
     it: NDArray[np.int_],
+    identified: NDArray[np.bool_],
 ) -> FrictionFit:
     after = residual - fr.torques(dq)
     return FrictionFit(
@@ -317,6 +471,7 @@ def _result(
         converged=_checks.frozen(ok),
         iterations=_checks.frozen(it),
         n_samples=dq.shape[0],
+        identified=_checks.frozen(identified),
     )
 
 
@@ -350,11 +505,16 @@ def fit_friction(
     ShapeError
         Unknown ``kind`` or joint counts that differ.
     DataError
-        From the preparation of the log.
+        From the preparation of the log; no joint moves beyond its velocity noise band.
+
+    Warns
+    -----
+    DynidWarning
+        Some joints do not move: their friction is set to zero (:func:`fit_sigmoid`).
     """
     if kind not in ("sigmoid", "classical"):
         raise ShapeError(f"kind must be 'sigmoid' or 'classical'; got {kind!r}")
     res = friction_residual(model, log, cutoff_hz=cutoff_hz, trim_s=trim_s, filter_tau=filter_tau)
     if kind == "sigmoid":
-        return fit_sigmoid(res.dq, res.residual)
-    return fit_classical(res.dq, res.residual)
+        return fit_sigmoid(res.dq, res.residual, dq_noise_std=res.dq_noise_std)
+    return fit_classical(res.dq, res.residual, dq_noise_std=res.dq_noise_std)

@@ -10,8 +10,10 @@
      "metadata": {...}}
 
 The classical model stores ``fv``, ``fc``, ``fo`` per joint instead (Gaz et al. 2019,
-eqs. 24 and 25; :mod:`dynid.friction.model`). ``rms_before``/``rms_after`` are written
-when a :class:`~dynid.friction.fit.FrictionFit` is saved and are optional on reading.
+eqs. 24 and 25; :mod:`dynid.friction.model`). ``rms_before``/``rms_after`` and ``identified``
+(false: the joint never moved beyond its velocity noise band, its parameters are zero) are
+written when a :class:`~dynid.friction.fit.FrictionFit` is saved and are optional on
+reading.
 """
 
 from __future__ import annotations
@@ -69,10 +71,11 @@ def save_friction_json(
     P = model.as_array()
     joints = []
     for j in range(model.n):
-        d: dict[str, float] = {k: float(P[j, i]) for i, k in enumerate(model.names)}
+        d: dict[str, float | bool] = {k: float(P[j, i]) for i, k in enumerate(model.names)}
         if fit is not None:
             d["rms_before"] = float(fit.rms_before[j])
             d["rms_after"] = float(fit.rms_after[j])
+            d["identified"] = bool(fit.identified[j])
         joints.append(d)
     units = dict(_UNITS[model.kind])
     if fit is not None:

@@ -331,7 +331,7 @@ def friction_stage(
     fit_log = simulate_measurement(truth, traj, rng=rng, noise=noise)
     val_log = simulate_measurement(truth, traj, rng=rng, noise=noise)
     res = friction_residual(model, fit_log)
-    fit = fit_sigmoid(res.dq, res.residual)
+    fit = fit_sigmoid(res.dq, res.residual, dq_noise_std=res.dq_noise_std)
     val = validate_torques(model, val_log, friction=fit.friction)
     assert val.with_friction is not None
     curve = None
