@@ -148,6 +148,30 @@ def add_robot_options(p: argparse.ArgumentParser) -> None:
     )
 
 
+def add_drive_option(p: argparse.ArgumentParser) -> None:
+    """``--drive FILE.toml``: the drive train (gear ratios, coupling, offsets, currents)."""
+    p.add_argument(
+        "--drive",
+        type=Path,
+        default=None,
+        metavar="FILE.toml",
+        help="drive train (schema dynid-drive/1: side, gear_ratio, coupling, offset, effort, "
+        "torque_constant, rotor_inertia, friction_at; see the README); default: the [drive] "
+        "table of a --robot TOML, else link-side torques of a direct drive",
+    )
+
+
+def load_drive_arg(args: argparse.Namespace, n: int) -> Any:
+    """The :class:`~dynid.model.drive.Drive` of ``--drive`` (or of a --robot TOML's
+    ``[drive]`` table), or None."""
+    from ..io.drive_file import drive_of_robot_file, load_drive
+
+    if getattr(args, "drive", None) is not None:
+        return load_drive(args.drive, n)
+    spec = getattr(args, "robot", None)
+    return None if spec is None else drive_of_robot_file(spec, n)
+
+
 def load_robot(args: argparse.Namespace) -> Robot:
     """The robot named by ``--robot`` (and ``--base``/``--tip`` for a URDF)."""
     from ..io.robot_file import load_robot as load_robot_file

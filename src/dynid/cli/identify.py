@@ -80,10 +80,12 @@ from .common import (
     about,
     add_column_options,
     add_consistency_options,
+    add_drive_option,
     add_log_options,
     add_robot_options,
     add_subcommand,
     column_map,
+    load_drive_arg,
     load_prior,
     load_robot,
     number,
@@ -111,6 +113,7 @@ def register(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParser:
         help="identify the base parameters from static data (or a torque log)",
     )
     add_robot_options(p)
+    add_drive_option(p)
     p.add_argument("--data", type=Path, required=True, help="data file: .csv or .npz")
     add_column_options(p)
     p.add_argument("--out", type=Path, required=True, help="output folder")
@@ -215,6 +218,7 @@ def identify_torque_log(robot: Robot, path: Path, args: argparse.Namespace) -> I
             max_std_percent=args.max_std_percent,
             rtol=args.rtol,
             max_gap_s=args.max_gap,
+            drive=load_drive_arg(args, robot.n),
             **kw,
         )
 

@@ -9,7 +9,9 @@ Trajectories:
             (coefficients, sampled at --rate over its whole length) written by `dynid excite`
 
 The measured torques are M ddq + c + g + friction(dq) + noise, with the robot's own
-friction (the published sigmoid for the built-in Panda) unless --no-friction. Limits are
+friction (the published sigmoid for the built-in Panda) unless --no-friction. With --drive
+the drive's known rotor inertias are added and the log is written on its side (motor
+positions and torques, or currents) with its encoder offsets. Limits are
 checked; by default a trajectory that exceeds them is scaled down in amplitude
 (--scale amplitude), or slowed down (--scale time), or kept (--scale none).
 
@@ -38,10 +40,12 @@ from ..simulation.trajectories import (
     sinusoid_trajectory,
 )
 from .common import (
+    add_drive_option,
     add_robot_options,
     add_seed_option,
     add_subcommand,
     count_type,
+    load_drive_arg,
     load_robot,
     nonnegative_type,
     number,
@@ -62,6 +66,7 @@ def register(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParser:
         help="simulate a torque log of a trajectory (sinusoids or Fourier series)",
     )
     add_robot_options(p)
+    add_drive_option(p)
     p.add_argument(
         "--trajectory",
         default="sinusoid",
@@ -177,6 +182,9 @@ def run(args: argparse.Namespace) -> int:
             what = "amplitude scaled by" if args.scale == "amplitude" else "time stretched by"
             say(f"{what} {factor:.4f}; now: {check_limits(robot, traj)}")
     noise = SensorNoise(tau_std=args.noise, q_std=args.q_noise, dq_std=args.dq_noise)
+    drive = load_drive_arg(args, n)
+    if drive is not None:
+        say(f"drive: {drive.describe()}; the log is written on the {drive.side} side")
     effects = None
     if args.unmodelled:
         from ..simulation.unmodelled import UnmodelledEffects
@@ -192,6 +200,7 @@ def run(args: argparse.Namespace) -> int:
         drop_fraction=args.drop,
         with_ddq=args.with_ddq,
         effects=effects,
+        drive=drive,
     )
     save_torque_log(args.out, measured)
     say(

@@ -33,7 +33,7 @@ from pathlib import Path
 import numpy as np
 
 from ..exceptions import DataError, DynidError
-from ..friction.validation import own_friction, validate_torques
+from ..friction.validation import own_friction, recorded_cutoff, validate_torques
 from ..identification.log import DEFAULT_CUTOFF_HZ
 from ..identification.model import IdentifiedModel
 from ..io.friction_json import load_friction_json
@@ -42,8 +42,10 @@ from ..model.robot import Robot
 from .common import (
     about,
     add_column_options,
+    add_drive_option,
     add_log_options,
     add_subcommand,
+    load_drive_arg,
     load_robot,
     positive_type,
     read_log,
@@ -78,9 +80,11 @@ def register(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParser:
     p.add_argument(
         "--cutoff",
         type=positive_type,
-        default=DEFAULT_CUTOFF_HZ,
-        help=f"low-pass cutoff of the states [Hz] (default {DEFAULT_CUTOFF_HZ:g})",
+        default=None,
+        help="low-pass cutoff of the states [Hz] (default: the one --model was identified "
+        f"with, else {DEFAULT_CUTOFF_HZ:g})",
     )
+    add_drive_option(p)
     add_log_options(p)
     p.add_argument("--no-figures", action="store_true", help="skip the PNG figures")
     return p
@@ -126,9 +130,16 @@ def run(args: argparse.Namespace) -> int:
             from ..io.feasible import load_feasible_linear_friction
 
             friction = load_feasible_linear_friction(args.params) or friction
+    cutoff = recorded_cutoff(model) if args.cutoff is None else args.cutoff
+    drive = load_drive_arg(args, robot.n)
     with about(args.data):
         val = validate_torques(
-            model, logs.pop(), friction=friction, cutoff_hz=args.cutoff, max_gap_s=args.max_gap
+            model,
+            logs.pop(),
+            friction=friction,
+            cutoff_hz=cutoff,
+            max_gap_s=args.max_gap,
+            drive=drive,
         )
     errors = val.errors
     if not np.isfinite(errors.relative_error_percent) or not np.all(np.isfinite(errors.rms)):
@@ -145,7 +156,7 @@ def run(args: argparse.Namespace) -> int:
         else ("model" if friction is not None else None)
     )
     doc["data"] = str(args.data.name)
-    doc["cutoff_hz"] = args.cutoff
+    doc["cutoff_hz"] = cutoff
     doc["units"] = {"rms": "N m", "mse": "N^2 m^2", "relative_error_percent": "%"}
     save_json(args.out / "validation.json", doc, schema=VALIDATION_SCHEMA)
     names = list(robot.joint_names)

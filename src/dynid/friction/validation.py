@@ -20,25 +20,29 @@ correct model equals the sensor noise.
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import Any
+from typing import Any, Literal
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from .. import _checks
 from ..dynamics.rnea import rnea
-from ..exceptions import OptionError, ShapeError
-from ..identification.log import DEFAULT_CUTOFF_HZ, TorqueLog
+from ..exceptions import DataError, OptionError, ShapeError
+from ..identification.log import DEFAULT_CUTOFF_HZ, TorqueLog, joint_side_log
 from ..identification.metrics import TorqueErrors, torque_errors
 from ..identification.model import IdentifiedModel
+from ..model.drive import Drive
 from ..model.robot import Robot
 from .fit import TorqueModel, friction_residual
 from .model import ClassicalFriction, DriveFriction, FrictionModel, SigmoidFriction
 
 __all__ = [
+    "RECORDED",
     "NewtonEulerValidation",
     "Validation",
+    "model_drive",
     "own_friction",
+    "recorded_cutoff",
     "validate_newton_euler",
     "validate_torques",
 ]
@@ -106,15 +110,48 @@ class Validation:
         return out
 
 
+#: ``cutoff_hz`` of :func:`validate_torques`: the cut-off the model was identified with.
+RECORDED: Literal["recorded"] = "recorded"
+
+
+def recorded_cutoff(model: TorqueModel) -> float | None:
+    """The low-pass cut-off [Hz] an identified model's torque log was prepared with
+    (``metadata["cutoff_hz"]`` of the classical route), else the library default."""
+    if isinstance(model, IdentifiedModel) and "cutoff_hz" in model.metadata:
+        c = model.metadata["cutoff_hz"]
+        return None if c is None else float(c)
+    return DEFAULT_CUTOFF_HZ
+
+
+def model_drive(model: TorqueModel, drive: Drive | None) -> Drive | None:
+    """The drive a log is read through: an identified model's own, or ``drive``.
+
+    Raises
+    ------
+    DataError
+        ``drive`` differs from the one the model was identified with.
+    """
+    own = model.drive if isinstance(model, IdentifiedModel) else None
+    if drive is None or own is None:
+        return own if drive is None else drive
+    if drive.as_dict() != own.as_dict():
+        raise DataError(
+            "the drive given differs from the one the model was identified with "
+            f"({own.describe()}); hint: leave out --drive to use the model's"
+        )
+    return own
+
+
 def validate_torques(
     model: TorqueModel,
     log: TorqueLog,
     *,
     friction: FrictionModel | None = None,
-    cutoff_hz: float | None = DEFAULT_CUTOFF_HZ,
+    cutoff_hz: float | None | Literal["recorded"] = RECORDED,
     trim_s: float | None = None,
     filter_tau: bool = False,
     max_gap_s: float | None = None,
+    drive: Drive | None = None,
 ) -> Validation:
     """Compare a model's torques with a measured log, without and with friction.
 
@@ -128,7 +165,12 @@ def validate_torques(
         Friction added to the prediction (e.g. :func:`own_friction` of the model, or a
         fitted sigmoid).
     cutoff_hz, trim_s, filter_tau, max_gap_s
-        Preparation of the log (:func:`~dynid.friction.fit.friction_residual`).
+        Preparation of the log (:func:`~dynid.friction.fit.friction_residual`);
+        ``cutoff_hz="recorded"`` (default): the cut-off an identified model was identified
+        with (:func:`recorded_cutoff`), else the library default.
+    drive : Drive, optional
+        The drive the log was recorded through (motor side, currents); default: an
+        identified model's own (:func:`model_drive`). Errors are in joint torques.
 
     Returns
     -------
@@ -139,12 +181,14 @@ def validate_torques(
     ShapeError
         The friction model's joint count differs from the log's.
     DataError
-        From the preparation of the log.
+        From the preparation of the log; a drive other than the model's.
     """
     if friction is not None and friction.n != log.n:
         raise ShapeError(f"friction model has {friction.n} joints; the log has {log.n}")
+    log = joint_side_log(log, model_drive(model, drive))
+    cut = recorded_cutoff(model) if isinstance(cutoff_hz, str) else cutoff_hz
     res = friction_residual(
-        model, log, cutoff_hz=cutoff_hz, trim_s=trim_s, filter_tau=filter_tau, max_gap_s=max_gap_s
+        model, log, cutoff_hz=cut, trim_s=trim_s, filter_tau=filter_tau, max_gap_s=max_gap_s
     )
     p, tau_model = res.log, res.tau_model
     # free what is no longer needed before the friction torques (a long log's raw signals,

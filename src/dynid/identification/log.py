@@ -48,6 +48,9 @@ __all__ = [
     "default_max_gap",
     "joint_side_log",
     "prepare_log",
+    "recorded_side_log",
+    "velocity_note",
+    "with_derived_velocities",
 ]
 
 #: Default cutoff of the zero-phase low-pass for identification and validation [Hz].
@@ -288,6 +291,22 @@ class TorqueLog:
         )
 
 
+def with_derived_velocities(log: TorqueLog, cutoff_hz: float = DEFAULT_CUTOFF_HZ) -> TorqueLog:
+    """The log with ``dq`` from the zero-phase filtered derivative of ``q``
+    (:func:`dynid.signals.filtered_derivative`, low-pass at ``cutoff_hz`` [Hz]); for logs that
+    record positions only (whatever ``log.dq`` holds is replaced). ``ddq`` is kept."""
+    dq = signals.filtered_derivative(log.t, log.q, cutoff_hz)
+    return TorqueLog(log.t, log.q, dq, log.tau, log.ddq, log.cleaning)
+
+
+def velocity_note(cutoff_hz: float) -> str:
+    """The note said when :func:`with_derived_velocities` derives a log's velocities."""
+    return (
+        "no velocity columns: velocities derived from the positions (zero-phase low-pass at "
+        f"{cutoff_hz:g} Hz, then central differences)"
+    )
+
+
 def joint_side_log(log: TorqueLog, drive: Drive | None) -> TorqueLog:
     """The log in joint coordinates and joint torques [N m], through a drive.
 
@@ -311,6 +330,22 @@ def joint_side_log(log: TorqueLog, drive: Drive | None) -> TorqueLog:
         dq=joint_rates[0],
         tau=drive.joint_torques(log.tau),
         ddq=joint_rates[1] if log.ddq is not None else None,
+        cleaning=log.cleaning,
+    )
+
+
+def recorded_side_log(log: TorqueLog, drive: Drive) -> TorqueLog:
+    """Inverse of :func:`joint_side_log`: a joint-side log as the drive records it (motor
+    positions and torques, or currents; encoder offsets removed)."""
+    drive.check(log.n)
+    rates = (log.dq,) if log.ddq is None else (log.dq, log.ddq)
+    q, *rec = drive.recorded_states(log.q, *rates)
+    return TorqueLog(
+        t=log.t,
+        q=q,
+        dq=rec[0],
+        tau=drive.recorded_efforts(log.tau),
+        ddq=rec[1] if log.ddq is not None else None,
         cleaning=log.cleaning,
     )
 

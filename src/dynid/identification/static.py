@@ -48,6 +48,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from .. import _checks
 from ..exceptions import DynidWarning, OptionError, RankDeficientError, ShapeError
+from ..model.drive import Drive
 from ..model.robot import Robot
 from ..regressors.base import BaseParameters, base_parameters, identifiability
 from ..regressors.static import (
@@ -55,6 +56,7 @@ from ..regressors.static import (
     _static_regressor_columns,
     static_labels,
 )
+from ..regressors.terms import base_term_columns, drive_terms
 from .data import StaticDataset
 from .least_squares import _block_grams, _fit_with_pruning, conditioning_advice
 from .model import IdentifiedModel
@@ -109,6 +111,7 @@ def identify_static(
     rtol: float | None = None,
     base: BaseParameters | None = None,
     std_estimator: str = "robust",
+    drive: Drive | None = None,
 ) -> IdentifiedModel:
     """Identify the base parameters from inertia matrices and gravity torques at rest.
 
@@ -140,6 +143,11 @@ def identify_static(
         Standard deviations from the heteroscedasticity-consistent covariance (White 1980,
         HC1; default) or from ``sigma^2 (W^T W)^{-1}`` (the paper's formula, valid when
         every row has the same error variance).
+    drive : Drive, optional
+        A drive train whose rotors the controller's ``M`` includes
+        (``K^T diag(I_a) K``, :mod:`dynid.model.drive`): unknown rotor inertias are
+        identified with the links (``Ia1 .. Ia_n`` after the link parameters in
+        ``base.std_labels``), known ones subtracted from ``M``.
 
     Returns
     -------
@@ -181,12 +189,14 @@ def identify_static(
         raise OptionError(f"max_std_percent must be positive or None; got {max_std_percent}")
     if std_estimator not in ("robust", "classical"):
         raise OptionError(f"std_estimator must be 'robust' or 'classical'; got {std_estimator!r}")
+    terms = drive_terms(drive, robot.n, friction=False)
+    p = 10 * robot.n + sum(len(t.labels) for t in terms)
     if base is None:
-        base = base_parameters(robot, kind="static", rtol=rtol)
-    elif base.n_std != 10 * robot.n:
+        base = base_parameters(robot, kind="static", rtol=rtol, terms=terms)
+    elif base.n_std != p:
         raise ShapeError(
             f"base was built for {base.n_std} standard parameters; robot {robot.name!r} has "
-            f"{10 * robot.n}"
+            f"{p}"
         )
     fit_rtol = DEFAULT_FIT_RTOL if rtol is None else rtol
     N, n, r = data.n_configurations, robot.n, base.rank
@@ -195,10 +205,20 @@ def identify_static(
     # s(q), configuration b (only the independent columns are computed). Its transpose W
     # (s N, r) is column-major for LAPACK and BLAS without a copy; row k N + b is row k of
     # s at configuration b (the order of the rows does not change a least-squares fit)
-    Yb = _static_regressor_columns(robot, data.q, base.independent)
+    ind = np.asarray(base.independent)
+    Yb = _static_regressor_columns(robot, data.q, ind[ind < 10 * n])
+    extra = []
+    for t, sel in base_term_columns(terms, ind, n):  # rotor inertias: constant columns of M
+        C = t.static_columns(N)
+        extra.append(np.zeros((sel.size, Yb.shape[1], N)) if C is None else C[sel])
+    if extra:
+        Yb = np.concatenate([Yb, *extra], axis=0)
     W = Yb.reshape(r, -1).T
     i, j = np.tril_indices(n)
-    S = np.concatenate([data.M[:, i, j], data.g], axis=1).T  # (s, N), rows as static_labels
+    M = data.M
+    if drive is not None and drive.rotor_inertia is not None:  # known: not identified
+        M = M - drive.rotor_mass_matrix(drive.rotor_inertia)
+    S = np.concatenate([M[:, i, j], data.g], axis=1).T  # (s, N), rows as static_labels
     # one block of N rows per row k of s, exactly zero before column first[k] (the links
     # before the row's first link do not act on it); the Gram matrix of each block gives
     # the sums of squares of the row check, and their sum over the rows kept that of W
@@ -263,7 +283,9 @@ def identify_static(
         "identifiability": dict(zip(base.std_labels, identifiability(base), strict=True)),
         "data": dict(data.metadata),
     }
-    return IdentifiedModel(robot=robot, base=base, fit=fit, metadata=meta)
+    if drive is not None:
+        meta["drive"] = drive.as_dict()
+    return IdentifiedModel(robot=robot, base=base, fit=fit, metadata=meta, drive=drive)
 
 
 def _rank(W: NDArray[np.float64], rtol: float) -> int:

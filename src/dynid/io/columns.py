@@ -35,10 +35,14 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
-from .. import signals
 from ..exceptions import DataError
 from ..identification.data import StaticDataset
-from ..identification.log import DEFAULT_CUTOFF_HZ, TorqueLog
+from ..identification.log import (
+    DEFAULT_CUTOFF_HZ,
+    TorqueLog,
+    velocity_note,
+    with_derived_velocities,
+)
 from ..model.robot import Robot
 
 __all__ = [
@@ -359,13 +363,8 @@ def load_mapped_torque_log(
         raw = TorqueLog.from_raw(t, q, np.zeros_like(q), tau, ddq, gap_factor=gap_factor)
     except DataError as exc:
         raise DataError(f"{path.name}: {exc}") from exc
-    dq = signals.filtered_derivative(raw.t, raw.q, columns.velocity_cutoff_hz)
-    notes.append(
-        "velocities derived from positions: zero-phase low-pass at "
-        f"{columns.velocity_cutoff_hz:g} Hz, then central differences"
-    )
-    log = TorqueLog(raw.t, raw.q, dq, raw.tau, raw.ddq, raw.cleaning)
-    return MappedLog(log, tuple(notes))
+    notes.append(velocity_note(columns.velocity_cutoff_hz))
+    return MappedLog(with_derived_velocities(raw, columns.velocity_cutoff_hz), tuple(notes))
 
 
 @dataclass(frozen=True, slots=True)

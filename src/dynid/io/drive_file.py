@@ -32,7 +32,7 @@ from numpy.typing import NDArray
 from ..exceptions import DataError, DynidError
 from ..model.drive import DRIVE_SCHEMA, Drive
 
-__all__ = ["drive_from_mapping", "load_drive"]
+__all__ = ["drive_from_mapping", "drive_from_record", "drive_of_robot_file", "load_drive"]
 
 _KEYS = {
     "schema",
@@ -171,3 +171,55 @@ def load_drive(path: str | Path, n: int) -> Drive:
     if "schema" not in doc:
         raise DataError(f"{p.name}: missing key 'schema' (expected {DRIVE_SCHEMA!r})")
     return drive_from_mapping(doc, n, source=p.name)
+
+
+def drive_from_record(record: Mapping[str, Any], n: int) -> Drive:
+    """The drive of a JSON record (:meth:`~dynid.model.drive.Drive.as_dict`: the
+    transmission as rows), as identification.json and feasible.json hold it.
+
+    Raises
+    ------
+    DataError
+        A malformed record (the field is named).
+    """
+    if not isinstance(record, Mapping) or record.get("schema") != DRIVE_SCHEMA:
+        raise DataError(f"drive: must be an object with schema {DRIVE_SCHEMA!r}")
+    K = record.get("transmission")
+    if (
+        not isinstance(K, list)
+        or len(K) != n
+        or any(not isinstance(row, list) or len(row) != n for row in K)
+    ):
+        raise DataError(f"drive: 'transmission' must be {n} rows of {n} numbers")
+    rows = [
+        [_number(x, f"drive: transmission[{i}][{j}]") for j, x in enumerate(row)]
+        for i, row in enumerate(K)
+    ]
+    table = {k: record[k] for k in ("offset", "torque_constant") if record.get(k) is not None}
+    kw: dict[str, Any] = {k: _vector(table, k, n, "drive") for k in table}
+    ia = record.get("rotor_inertia", "identify")
+    if ia != "identify":
+        kw["rotor_inertia"] = _vector({"rotor_inertia": ia}, "rotor_inertia", n, "drive")
+    for key in _CHOICES:
+        if key in record:
+            kw[key] = record[key]
+    kw.setdefault("offset", np.zeros(n))
+    try:
+        return Drive(transmission=np.array(rows), **kw)
+    except DynidError as exc:
+        raise DataError(f"drive: {exc}") from exc
+
+
+def drive_of_robot_file(spec: str | Path, n: int) -> Drive | None:
+    """The ``[drive]`` table of a robot TOML named by ``--robot``, or None (any other robot
+    source, or a TOML without one)."""
+    p = Path(spec)
+    if p.suffix.lower() != ".toml" or not p.is_file():
+        return None
+    try:
+        doc = tomllib.loads(p.read_text(encoding="utf-8"))
+    except (OSError, UnicodeDecodeError, tomllib.TOMLDecodeError, RecursionError):
+        return None  # the robot reader reports the file's faults
+    if "drive" not in doc:
+        return None
+    return drive_from_mapping(doc["drive"], n, source=f"{p.name} [drive]")

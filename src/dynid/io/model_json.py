@@ -8,7 +8,11 @@ Layout of the file (top-level keys)::
     coefficients: [{"name", "expression", "value", "std", "std_percent", "kept"}, ...],
     covariance: (r x r) covariance of the values, or null,
     base: {"std_labels", "independent", "dependent", "K_d", "rank", "rtol", "gap"},
-    friction: null or (n, 3) linear friction [fv N m s/rad, fc N m, fo N m],
+    friction: null or (n, 3) linear friction [fv N m s/rad, fc N m, fo N m] (per motor with a
+        drive whose friction acts at the motors),
+    drive: null or the drive train (dynid-drive/1: side, effort, transmission rows, offset,
+        torque_constant, rotor_inertia "identify" or values, friction_at); with identified
+        rotor inertias base.std_labels continue with Ia1 .. Ia_n after the links' 10 n,
     robot: the kinematics (:mod:`dynid.io.robot_json`),
     metadata: everything else the identification recorded,
     units, conventions
@@ -44,6 +48,7 @@ from ..exceptions import DataError
 from ..identification.least_squares import LeastSquaresFit
 from ..identification.model import IdentifiedModel
 from ..regressors.base import BaseParameters
+from .drive_file import drive_from_record
 from .json_files import load_json, save_json
 from .robot_json import robot_from_dict, robot_to_dict
 
@@ -128,6 +133,7 @@ def model_to_dict(model: IdentifiedModel, *, seed: int | None = None) -> dict[st
         "gap": None if base.gap is None else list(base.gap),
     }
     out["friction"] = None if model.friction is None else model.friction.tolist()
+    out["drive"] = None if model.drive is None else model.drive.as_dict()
     out["robot"] = robot_to_dict(model.robot)
     out["metadata"] = _jsonable(meta)
     out["units"] = {
@@ -178,7 +184,11 @@ def model_from_dict(d: Mapping[str, Any]) -> IdentifiedModel:
                 f"identified model: 'coefficients' must list {r} coefficients (base rank); "
                 f"got {len(coefs) if isinstance(coefs, list) else type(coefs).__name__}"
             )
-        independent, dependent, K_d = _base_indices(b, r, 10 * robot.n)
+        drive = None if d.get("drive") is None else drive_from_record(d["drive"], robot.n)
+        p = 10 * robot.n
+        if drive is not None and drive.identifies_rotor_inertia:
+            p += robot.n
+        independent, dependent, K_d = _base_indices(b, r, p)
         base = BaseParameters(
             std_labels=tuple(b["std_labels"]),
             independent=_frozen(independent),
@@ -239,15 +249,11 @@ def model_from_dict(d: Mapping[str, Any]) -> IdentifiedModel:
         if isinstance(exc, DataError):
             raise
         raise DataError(f"identified model: malformed field ({exc})") from exc
-    if len(base.std_labels) != 10 * robot.n:
+    if base.n_std != p:
         raise DataError(
-            f"identified model: base.std_labels has {len(base.std_labels)} labels; the robot "
-            f"has {robot.n} joints ({10 * robot.n} parameters)"
-        )
-    if base.n_std != 10 * robot.n:
-        raise DataError(
-            f"identified model: base has {base.n_std} standard parameters; the robot has "
-            f"{robot.n} joints ({10 * robot.n} parameters)"
+            f"identified model: base.std_labels has {base.n_std} labels; the robot has "
+            f"{robot.n} joints ({p} parameters"
+            + (" with the rotor inertias)" if p > 10 * robot.n else ")")
         )
     return IdentifiedModel(
         robot=robot,
@@ -255,6 +261,7 @@ def model_from_dict(d: Mapping[str, Any]) -> IdentifiedModel:
         fit=fit,
         friction=None if friction is None else _frozen(np.asarray(friction, dtype=np.float64)),
         metadata=metadata,
+        drive=drive,
     )
 
 

@@ -41,7 +41,12 @@ import numpy as np
 from numpy.typing import NDArray
 
 from ..exceptions import DataError
-from ..identification.log import TorqueLog
+from ..identification.log import (
+    DEFAULT_CUTOFF_HZ,
+    TorqueLog,
+    velocity_note,
+    with_derived_velocities,
+)
 from .atomic import open_atomic
 from .static_data import check_row_count
 
@@ -139,8 +144,15 @@ def load_torque_log(
     else:
         raise DataError(f"torque log must be a .csv or .npz file; got {path.name!r}")
     _check_rows(path, arrays, lines, drop_invalid)
+    derive = "dq" not in arrays
+    if derive:
+        arrays["dq"] = np.zeros_like(arrays["q"])
     try:
-        return TorqueLog.from_raw(**arrays, gap_factor=gap_factor)
+        log = TorqueLog.from_raw(**arrays, gap_factor=gap_factor)
+        if derive:
+            _log.warning("%s: %s", path.name, velocity_note(DEFAULT_CUTOFF_HZ))
+            log = with_derived_velocities(log, DEFAULT_CUTOFF_HZ)
+        return log
     except DataError as exc:
         raise DataError(f"{path.name}: {exc}") from exc
 
@@ -220,11 +232,11 @@ def _read_npz(path: Path) -> dict[str, NDArray[np.float64]]:
     arrays = {}
     try:
         with npz:
-            missing = [k for k in ("t", "q", "dq", "tau") if k not in npz.files]
+            missing = [k for k in ("t", "q", "tau") if k not in npz.files]
             if missing:
                 raise DataError(
-                    f"{path.name}: missing array(s) {missing}; expected t, q, dq, tau "
-                    f"(optional ddq); found {sorted(npz.files)}"
+                    f"{path.name}: missing array(s) {missing}; expected t, q, tau (optional "
+                    f"dq, derived from q when absent, and ddq); found {sorted(npz.files)}"
                 )
             extra = sorted(set(npz.files) - {"t", "n_rows", *_SIGNALS})
             if extra:
@@ -282,6 +294,8 @@ def _columns(path: Path, names: list[str], line: int) -> tuple[int, bool]:
         gap = sorted(set(range(1, max(qs) + 1)) - set(qs))
         raise DataError(f"{where}: joint position columns must be q1..qn; missing q{gap[0]}")
     need = torque_log_columns(n)
+    if not any(f"dq{j}" in names for j in range(1, n + 1)):  # positions only
+        need = [c for c in need if not c.startswith("dq")]
     missing = [c for c in need if c not in names]
     if missing:
         raise DataError(f"{path.name}: missing column(s) {missing} (n = {n} from q1..q{n})")
@@ -295,7 +309,8 @@ def _columns(path: Path, names: list[str], line: int) -> tuple[int, bool]:
     if unknown:
         raise DataError(
             f"{where}: unknown column(s) {unknown}; a torque log has t, q1..q{n}, "
-            f"dq1..dq{n}, tau1..tau{n} and optionally ddq1..ddq{n}"
+            f"dq1..dq{n} (optional: derived from q when absent), tau1..tau{n} and optionally "
+            f"ddq1..ddq{n}"
         )
     return n, bool(have)
 
@@ -329,7 +344,8 @@ def _read_csv(path: Path) -> tuple[dict[str, NDArray[np.float64]], tuple[int, in
         index = {c: k for k, c in enumerate(names)}
         layout = {"t": [index["t"]]}
         for k in _SIGNALS if with_ddq else _SIGNALS[:3]:
-            layout[k] = [index[f"{k}{j}"] for j in range(1, n + 1)]
+            if f"{k}1" in index:  # dq may be absent (positions only)
+                layout[k] = [index[f"{k}{j}"] for j in range(1, n + 1)]
         start = fb.tell()
         arrays = _fast_parse(fb, len(names), layout, recorded)
         if arrays is None:  # the fast reader refused the text: find and name the problem

@@ -30,7 +30,8 @@ from .. import _checks
 from ..dynamics.rnea import rnea
 from ..exceptions import ShapeError
 from ..friction.model import FrictionModel, SigmoidFriction
-from ..identification.log import TorqueLog
+from ..identification.log import TorqueLog, recorded_side_log
+from ..model.drive import Drive
 from ..model.robot import Robot
 from .trajectories import Trajectory
 from .unmodelled import UnmodelledEffects
@@ -123,6 +124,7 @@ def simulate_measurement(
     drop_fraction: float = 0.0,
     with_ddq: bool = False,
     effects: UnmodelledEffects | None = None,
+    drive: Drive | None = None,
 ) -> TorqueLog:
     """Simulated torque log of ``robot`` following ``traj``.
 
@@ -148,6 +150,11 @@ def simulate_measurement(
     effects : UnmodelledEffects, optional
         Rotor inertia, torque offsets and a gravity tilt added to the torques
         (:mod:`dynid.simulation.unmodelled`); None: a rigid body.
+    drive : Drive, optional
+        A drive train (:mod:`dynid.model.drive`): its known rotor inertias add
+        ``K^T diag(I_a) K ddq`` to the joint torques (none when they are to be identified),
+        and the log is written on the drive's side with its effort (motor positions and
+        torques or currents, encoder offsets); the noise is added at the joints.
 
     Returns
     -------
@@ -180,6 +187,10 @@ def simulate_measurement(
         tau = rnea(robot, traj.q, traj.dq, traj.ddq)
     if friction is not None:
         tau = tau + friction.torques(traj.dq)
+    if drive is not None:
+        drive.check(n)
+        if drive.rotor_inertia is not None:
+            tau = tau + drive.rotor_torques(traj.ddq, drive.rotor_inertia)
     N = len(traj)
     sd_tau = _std("noise.tau_std", noise.tau_std, n)
     sd_q = _std("noise.q_std", noise.q_std, n)
@@ -192,10 +203,11 @@ def simulate_measurement(
         k = int(round(drop_fraction * (N - 2)))
         drop = rng.choice(np.arange(1, N - 1), size=k, replace=False)
         rows = np.setdiff1d(rows, drop)
-    return TorqueLog(
+    log = TorqueLog(
         t=traj.t[rows],
         q=q[rows],
         dq=dq[rows],
         tau=tau[rows],
         ddq=traj.ddq[rows] if with_ddq else None,
     )
+    return log if drive is None else recorded_side_log(log, drive)
