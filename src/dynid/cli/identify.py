@@ -258,6 +258,7 @@ def identify_static_file(robot: Robot, path: Path, args: argparse.Namespace) -> 
             max_std_percent=args.max_std_percent,
             rtol=args.rtol,
             std_estimator=args.std,
+            drive=load_drive_arg(args, robot.n),
         )
     misfit = fit_mismatch(model.fit.relative_error_percent, data.metadata)
     if misfit is not None:

@@ -195,8 +195,7 @@ def identify_static(
         base = base_parameters(robot, kind="static", rtol=rtol, terms=terms)
     elif base.n_std != p:
         raise ShapeError(
-            f"base was built for {base.n_std} standard parameters; robot {robot.name!r} has "
-            f"{p}"
+            f"base was built for {base.n_std} standard parameters; robot {robot.name!r} has {p}"
         )
     fit_rtol = DEFAULT_FIT_RTOL if rtol is None else rtol
     N, n, r = data.n_configurations, robot.n, base.rank
