@@ -5,8 +5,9 @@ VENV ?= .venv
 PY := $(VENV)/bin/python
 RUNTIME := $(VENV)/.installed-runtime
 TESTS := $(VENV)/.installed-tests
+DOCS := $(VENV)/.installed-docs
 
-.PHONY: demo test test-fast bench lint types clean
+.PHONY: demo test test-fast bench lint types docs clean
 
 # The problems here are tall and thin (e.g. 34,000 x 44): threaded BLAS only adds overhead
 # on a small machine. Override with OPENBLAS_NUM_THREADS=N make ...
@@ -23,6 +24,10 @@ $(TESTS): $(RUNTIME)
 	$(PY) -m pip install -q -e ".[test,plots]"
 	touch $(TESTS)
 
+$(DOCS): $(RUNTIME)
+	$(PY) -m pip install -q -e ".[docs]"
+	touch $(DOCS)
+
 demo: $(RUNTIME)
 	$(VENV)/bin/dynid demo --out out
 
@@ -38,12 +43,17 @@ bench: $(TESTS)
 
 lint: $(TESTS)
 	$(PY) -m pip install -q "ruff==0.17.6"
-	$(PY) -m ruff check src tests benchmarks examples
-	$(PY) -m ruff format --check src tests benchmarks examples
+	$(PY) -m ruff check src tests benchmarks examples docs
+	$(PY) -m ruff format --check src tests benchmarks examples docs
 
 types: $(TESTS)
 	$(PY) -m pip install -q "mypy==2.4.1"
 	$(PY) -m mypy src/dynid
 
+# the documentation site in site/, strict: every warning (a broken link, an unresolved API
+# page, a module left out of the API reference) is an error
+docs: $(DOCS)
+	NO_MKDOCS_2_WARNING=1 $(PY) -m mkdocs build --strict --site-dir site
+
 clean:
-	rm -rf $(VENV) out build src/*.egg-info
+	rm -rf $(VENV) out build site src/*.egg-info
