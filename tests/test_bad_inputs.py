@@ -308,6 +308,61 @@ def log_all_still(d: Path) -> None:
     _log_still(d, "still.csv", list(range(7)))
 
 
+def _trajectory(d: Path) -> list[str]:
+    """Lines of a trajectory.csv as excite writes it (2 s of slow sinusoids at 1 kHz)."""
+    import dynid
+    from dynid.io.excitation import save_trajectory_csv
+    from dynid.simulation.trajectories import centered_start, sinusoid_trajectory
+
+    robot = dynid.panda()
+    t = np.linspace(0.0, 2.0, 2001)
+    q0 = centered_start(robot, np.full(7, 0.2), np.full(7, 4.0))
+    save_trajectory_csv(
+        d / "traj.csv", sinusoid_trajectory(t, q0, np.full(7, 0.2), np.full(7, 4.0))
+    )
+    return _lines(d / "traj.csv")
+
+
+def trajectory_dup_column(d: Path) -> None:
+    """trajectory.csv with a second q1 column (joint 1 then did not move)."""
+    lines = _trajectory(d)
+    cells = [s.split(",") for s in lines[2:]]
+    _write(d / "bad.csv", lines[:2] + [",".join(r + [r[1]]) for r in cells])
+
+
+def trajectory_unknown_column(d: Path) -> None:
+    """trajectory.csv with a column of no known name (it was ignored)."""
+    lines = _trajectory(d)
+    _write(d / "bad.csv", lines[:2] + [lines[2] + ",gripper"] + [s + ",0" for s in lines[3:]])
+
+
+def trajectory_cut(d: Path) -> None:
+    """trajectory.csv cut to 1,000 of its 2,004 lines (it was simulated without complaint)."""
+    _write(d / "bad.csv", _trajectory(d)[:1000])
+
+
+def obstacles_dup_planes(d: Path) -> None:
+    """An obstacles file with 'planes' twice: the floor used to disappear."""
+    (d / "obs.json").write_text(
+        '{"schema": "dynid-obstacles/1", "planes": [{"name": "floor", "point": [0, 0, 0], '
+        '"normal": [0, 0, 1]}], "planes": []}'
+    )
+
+
+def obstacles_unknown_key(d: Path) -> None:
+    """An obstacles file with a misspelt key ('box' for 'boxes')."""
+    (d / "obs.json").write_text(
+        '{"schema": "dynid-obstacles/1", "box": [{"center": [0.5, 0, 0.1], "size": [1, 1, 1]}]}'
+    )
+
+
+def obstacles_deep(d: Path) -> None:
+    """An obstacles file nested 10,000 deep (RecursionError)."""
+    (d / "obs.json").write_text(
+        '{"schema": "dynid-obstacles/1", "planes": ' + "[" * 10000 + "]" * 10000 + "}"
+    )
+
+
 def _edit_model(d: Path, edit: Callable[[dict], None]) -> None:
     doc = json.loads((d / "res" / "identification.json").read_text())
     edit(doc)
@@ -421,6 +476,13 @@ CASES = [
     C("friction-joint-still", log_joint4_still, f"friction --robot panda --data {{d}}/still4.csv --no-figures --out {OUT}", 0, "joint(s) [4] never move beyond their velocity noise band"),
     C("friction-all-still", log_all_still, f"friction --robot panda --data {{d}}/still.csv --out {OUT}", 2, "no joint moves beyond its velocity noise band"),
     C("log-wrong-robot", None, f"validate --robot {{d}}/two.toml --data {{d}}/log.csv --out {OUT}", 2, "the log has 7 joints"),
+    # excite's files and obstacles: read as strictly as torque logs (issue 20)
+    C("trajectory-duplicated-column", trajectory_dup_column, f"simulate --trajectory {{d}}/bad.csv --out {OUT}/x.csv", 2, "bad.csv, line 3: duplicated column(s) ['q1']"),
+    C("trajectory-unknown-column", trajectory_unknown_column, f"simulate --trajectory {{d}}/bad.csv --out {OUT}/x.csv", 2, "unknown column(s) ['gripper']"),
+    C("trajectory-cut", trajectory_cut, f"simulate --trajectory {{d}}/bad.csv --out {OUT}/x.csv", 2, "records 2001 rows but holds 997"),
+    C("obstacles-duplicated-planes", obstacles_dup_planes, f"excite --obstacles {{d}}/obs.json --out {OUT}", 2, "obs.json: not strict JSON (duplicated key 'planes')"),
+    C("obstacles-unknown-key", obstacles_unknown_key, f"excite --obstacles {{d}}/obs.json --out {OUT}", 2, "obs.json: unknown key(s) ['box']"),
+    C("obstacles-nested-deep", obstacles_deep, f"excite --obstacles {{d}}/obs.json --out {OUT}", 2, "nested too deeply"),
     # static data: robot consistency and BOM
     C("static-bom", static_bom, f"identify --data {{d}}/bom.csv --out {OUT}", 0, ""),
     C("static-other-robot", static_xarm, f"identify --data {{d}}/bad.csv --out {OUT}", 2, "recorded with robot 'xarm7'; the robot given is 'panda'"),

@@ -198,9 +198,153 @@ def test_obstacles_file_is_read_and_errors_name_the_problem(tmp_path):
     obs = load_obstacles(p)
     assert obs.names == ("table", "fixture") and obs.planes[0].normal == (0.0, 0.0, 1.0)
     p.write_text(json.dumps({"schema": "dynid-obstacles/1", "boxes": [{"center": [0, 0, 0]}]}))
-    with pytest.raises(DataError, match="misses 'size'"):
+    with pytest.raises(DataError, match=r"boxes\[0\] \('box1'\): missing key 'size'"):
         load_obstacles(p)
     p.write_text(json.dumps({"schema": "other"}))
-    with pytest.raises(DataError, match="schema must be"):
+    with pytest.raises(DataError, match="'schema' must be"):
         load_obstacles(p)
     assert main(["excite", "--obstacles", str(p), "--out", str(tmp_path / "x")]) == 2
+
+
+_PLANE = '{"name": "floor", "point": [0, 0, 0], "normal": [0, 0, 1]}'
+_BAD_OBSTACLES = [
+    # (id, the file's text, the message expected) -- issue 20: each was accepted
+    ("duplicated-planes", f'{{"schema": "dynid-obstacles/1", "planes": [{_PLANE}], "planes": []}}',
+     "duplicated key 'planes'"),
+    ("unknown-top-key", f'{{"schema": "dynid-obstacles/1", "plane": [{_PLANE}]}}',
+     "unknown key(s) ['plane']"),
+    ("unknown-plane-key", '{"schema": "dynid-obstacles/1", "planes": [{"point": [0, 0, 0], '
+     '"normal": [0, 0, 1], "offset": 0.1}]}', "planes[0] ('plane1'): unknown key(s) ['offset']"),
+    ("boolean-coordinate", '{"schema": "dynid-obstacles/1", "planes": [{"point": [0, 0, true], '
+     '"normal": [0, 0, 1]}]}', "point[2] must be a number; got True"),
+    ("string-coordinate", '{"schema": "dynid-obstacles/1", "boxes": [{"center": [0, 0, "0.1"], '
+     '"size": [1, 1, 1]}]}', "center[2] must be a number; got '0.1'"),
+    ("two-coordinates", '{"schema": "dynid-obstacles/1", "boxes": [{"center": [0, 0], '
+     '"size": [1, 1, 1]}]}', "center must be a list of shape (3,)"),
+    ("zero-normal", '{"schema": "dynid-obstacles/1", "planes": [{"point": [0, 0, 0], '
+     '"normal": [0, 0, 0]}]}', "plane normal must be non-zero"),
+    ("flat-box", '{"schema": "dynid-obstacles/1", "boxes": [{"center": [0, 0, 0], '
+     '"size": [1, 0, 1]}]}', "box size must be positive"),
+    ("repeated-name", f'{{"schema": "dynid-obstacles/1", "planes": [{_PLANE}, {_PLANE}]}}',
+     "planes[1] ('floor'): the name is used by another obstacle"),
+    ("planes-not-a-list", '{"schema": "dynid-obstacles/1", "planes": {"point": [0, 0, 0]}}',
+     "'planes' must be a list"),
+    ("integer-of-400-digits", '{"schema": "dynid-obstacles/1", "planes": [{"point": [0, 0, 1'
+     + "0" * 400 + '], "normal": [0, 0, 1]}]}', "an integer of 401 digits overflows a float"),
+    ("nested-10000-deep", '{"schema": "dynid-obstacles/1", "planes": ' + "[" * 10000
+     + "]" * 10000 + "}", "nested too deeply"),
+]  # fmt: skip
+
+
+@pytest.mark.parametrize("text,message", [c[1:] for c in _BAD_OBSTACLES],
+                         ids=[c[0] for c in _BAD_OBSTACLES])  # fmt: skip
+def test_obstacles_files_are_read_strictly(tmp_path, text, message):
+    """Every malformed obstacles file is one DataError naming the file and the fault; none
+    drops or alters an obstacle silently (issue 20: a second 'planes' key removed the
+    floor)."""
+    p = tmp_path / "obs.json"
+    p.write_text(text)
+    with pytest.raises(DataError) as info:
+        load_obstacles(p)
+    msg = str(info.value)
+    assert msg.startswith("obs.json: ") and message in msg and len(msg) < 400, msg
+
+
+def test_a_plane_normal_of_huge_or_tiny_numbers_keeps_its_direction(tmp_path):
+    """[0, 0, 1e300] and [1e-300, 0, 0] are the unit normals [0, 0, 1] and [1, 0, 0] (the
+    norm of the first overflowed, which made a zero normal)."""
+    p = tmp_path / "obs.json"
+    p.write_text(
+        '{"schema": "dynid-obstacles/1", "planes": [{"point": [0, 0, 0], "normal": [0, 0, 1e300]},'
+        ' {"point": [0, 0, 0], "normal": [1e-300, 0, 0]}]}'
+    )
+    obs = load_obstacles(p)
+    assert [pl.normal for pl in obs.planes] == [(0.0, 0.0, 1.0), (1.0, 0.0, 0.0)]
+    assert obs.names == ("plane1", "plane2")
+
+
+def _sinusoid_csv(path, n_joints=7):
+    from dynid.io.excitation import save_trajectory_csv
+    from dynid.simulation.trajectories import sinusoid_trajectory
+
+    t = uniform_times(1.0, 1000.0)
+    traj = sinusoid_trajectory(
+        t, np.zeros(n_joints), np.full(n_joints, 0.3), np.full(n_joints, 2.0)
+    )
+    save_trajectory_csv(path, traj)
+    return traj
+
+
+def test_trajectory_csv_records_its_rows_and_is_read_strictly(tmp_path):
+    """trajectory.csv round-trips with its '# rows:' line; a duplicated, unknown or missing
+    column, a file cut short, a BOM-less non-number and a row count the file cannot hold
+    are refused with the line (issue 20: two q1 columns were used, an unknown one ignored,
+    a file cut to 2,500 of 6,003 lines simulated)."""
+    traj = _sinusoid_csv(tmp_path / "trajectory.csv")
+    lines = (tmp_path / "trajectory.csv").read_text().splitlines()
+    assert lines[1] == "# rows: 1001"
+    back = load_trajectory(tmp_path / "trajectory.csv", 7)
+    np.testing.assert_allclose(back.q, traj.q, rtol=1e-9, atol=1e-12)
+    np.testing.assert_allclose(back.ddq, traj.ddq, rtol=1e-9, atol=1e-12)
+
+    def variant(name, header=None, rows=None):
+        """trajectory.csv with its header line or its data rows replaced."""
+        text = lines[:2] + [header or lines[2]] + (lines[3:] if rows is None else rows)
+        (tmp_path / name).write_text("\n".join(text) + "\n")
+        return tmp_path / name
+
+    word = lines[3:]
+    cells = word[9].split(",")
+    word[9] = ",".join(cells[:3] + ["abc"] + cells[4:])
+    cases = [
+        (variant("dup.csv", lines[2] + ",q1", [r + ",0" for r in lines[3:]]),
+         r"dup.csv, line 3: duplicated column\(s\) \['q1'\]"),
+        (variant("unknown.csv", lines[2] + ",temp", [r + ",20" for r in lines[3:]]),
+         r"unknown.csv, line 3: unknown column\(s\) \['temp'\]"),
+        (variant("missing.csv", lines[2].rsplit(",", 1)[0],
+                 [r.rsplit(",", 1)[0] for r in lines[3:]]),
+         r"missing column\(s\) \['ddq7'\] for 7 joints"),
+        (variant("cut.csv", rows=lines[3:502]), "records 1001 rows but holds 499"),
+        (variant("word.csv", rows=word), "word.csv, line 13, column 'q3': not a number: 'abc'"),
+    ]  # fmt: skip
+    (tmp_path / "absurd.csv").write_text("\n".join([lines[0], "# rows: 1000000000000"] + lines[2:]))
+    cases.append(
+        (
+            tmp_path / "absurd.csv",
+            "records 1000000000000 rows but its .* bytes of data hold at most",
+        )
+    )
+    for path, message in cases:
+        with pytest.raises(DataError, match=message):
+            load_trajectory(path, 7)
+    with pytest.raises(DataError, match="trajectory has 7 joints .q1..q7.; the robot has 6"):
+        load_trajectory(tmp_path / "trajectory.csv", 6)
+
+
+def test_trajectory_json_is_read_strictly(tmp_path):
+    """trajectory.json: an unknown key in 'trajectory', a boolean or string number, a
+    duplicated key are refused; the file written by excite reads back."""
+    from dynid.simulation.excitation import ExcitingTrajectory
+
+    tr = ExcitingTrajectory(
+        w_f=0.6, a=np.full((2, 2), 0.1), b=np.zeros((2, 2)), q_start=np.zeros(2),
+        duration=2.0, ramp=0.5,
+    )  # fmt: skip
+    doc = {"schema": "dynid-exciting-trajectory/1", "trajectory": tr.to_dict()}
+    p = tmp_path / "t.json"
+    p.write_text(json.dumps(doc))
+    np.testing.assert_allclose(load_trajectory(p, 2, fs=100.0).q, tr.sample(100.0).q)
+    for edit, message in [
+        (lambda d: d["trajectory"].update(extra=1), r"trajectory: unknown key\(s\) \['extra'\]"),
+        (lambda d: d["trajectory"].update(ramp_s=True), "ramp_s must be a number; got True"),
+        (lambda d: d["trajectory"]["a_rad_s"][0].__setitem__(1, "0.1"), r"a_rad_s\[0\]\[1\]"),
+        (lambda d: d["trajectory"].pop("b_rad_s"), r"missing key\(s\) \['b_rad_s'\]"),
+    ]:
+        bad = json.loads(json.dumps(doc))
+        edit(bad)
+        p.write_text(json.dumps(bad))
+        with pytest.raises(DataError, match=message):
+            load_trajectory(p, 2)
+    p.write_text(json.dumps(doc)[:-1] + ', "trajectory": {}}')
+    with pytest.raises(DataError, match="duplicated key 'trajectory'"):
+        load_trajectory(p, 2)

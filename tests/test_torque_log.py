@@ -181,3 +181,38 @@ def test_prepare_log_rejects_long_gaps():
     z = np.zeros((200, 2))
     with pytest.raises(DataError, match=r"gap of 0.051 s .* t = 0.099 s"):
         prepare_log(TorqueLog(t, z, z, z), cutoff_hz=None)
+
+
+def test_blank_lines_keep_the_fast_reader_and_the_same_arrays(tmp_path, monkeypatch):
+    """A log with blank lines (one after the header, one inside, two at a block's end) is
+    read by the fast reader, not the slow per-cell one, into the same arrays (issue 20: one
+    blank line in 2 million rows took 38 s and 2.3 GB instead of 23 s and 1.2 GB)."""
+    from dynid.io import torque_log
+
+    log = _log(np.random.default_rng(47), N=300)
+    lines = save_torque_log(tmp_path / "log.csv", log).read_text().splitlines()
+    h = lines.index(",".join(torque_log_columns(3)))
+    blank = lines[: h + 1] + [""] + lines[h + 1 : h + 100] + ["", ""] + lines[h + 100 :] + [""]
+    (tmp_path / "blank.csv").write_text("\n".join(blank) + "\n")
+
+    def refuse(*args, **kw):
+        raise AssertionError("the slow reader was used")
+
+    monkeypatch.setattr(torque_log, "_slow_parse", refuse)
+    back = load_torque_log(tmp_path / "blank.csv")
+    for k in ("t", "q", "dq", "tau"):
+        np.testing.assert_array_equal(getattr(back, k), getattr(log, k))
+    monkeypatch.setattr(torque_log, "_CHUNK_BYTES", 1000)  # blank lines across block ends
+    back = load_torque_log(tmp_path / "blank.csv")
+    np.testing.assert_array_equal(back.tau, log.tau)
+
+
+def test_a_declared_row_count_the_file_cannot_hold_is_refused_before_allocating(tmp_path):
+    """'# rows: 1000000000000' over a few kB of rows: refused by the file's size, before
+    arrays of 1e12 rows are allocated (issue 20: they were allocated)."""
+    lines = save_torque_log(tmp_path / "log.csv", _log(np.random.default_rng(48))).read_text()
+    text = lines.replace("# rows: 50", "# rows: 1000000000000")
+    (tmp_path / "big.csv").write_text(text)
+    size = len(text.split("tau3\n", 1)[1].encode())
+    with pytest.raises(DataError, match=f"records 1000000000000 rows but its {size} bytes"):
+        load_torque_log(tmp_path / "big.csv")

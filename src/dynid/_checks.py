@@ -93,3 +93,61 @@ def frozen(a: NDArray[Any]) -> NDArray[Any]:
         b.setflags(write=False)
         return b
     return np.frombuffer(a.tobytes(), dtype=a.dtype).reshape(a.shape)
+
+
+#: Longest echo of a user's input in an error message [characters]: a value, a key or a
+#: header line of megabytes is cut to this, with a note of its length.
+ECHO_LIMIT = 200
+
+
+def short(value: Any, limit: int = ECHO_LIMIT) -> str:
+    """``repr(value)`` cut to ``limit`` characters (with the length of what was cut)."""
+    if isinstance(value, int) and not isinstance(value, bool) and value.bit_length() > 600:
+        return f"an integer of about {int(value.bit_length() * math.log10(2)) + 1} digits"
+    big = isinstance(value, str | bytes) and len(value) > limit
+    text = repr(value[:limit] if big else value)
+    if len(text) <= limit and not big:
+        return text
+    unit = "characters" if isinstance(value, str) else "bytes" if big else "items"
+    size = f" ({len(value)} {unit})" if hasattr(value, "__len__") else ""
+    return text[: limit - 3] + "..." + size
+
+
+def one_line(text: str, limit: int = 2 * ECHO_LIMIT + 200) -> str:
+    """``text`` on one line (line breaks and runs of spaces joined) and cut to ``limit``."""
+    flat = " ".join(text.split())
+    if len(flat) <= limit:
+        return flat
+    return flat[: limit - 3] + f"... ({len(flat)} characters)"
+
+
+def number(value: Any, where: str, error: type[Exception]) -> float:
+    """A finite float from a parsed document's ``value`` (TOML, JSON), strictly.
+
+    Booleans, strings and other types, integers beyond the float range and NaN/inf raise
+    ``error`` naming ``where`` (``"joints[2]: key 'axis'"``) and the value, cut short.
+    """
+    if isinstance(value, bool) or not isinstance(value, int | float):
+        raise error(f"{where} must be a number; got {short(value)}")
+    try:
+        x = float(value)
+    except OverflowError:
+        raise error(f"{where} must be a finite number; got {short(value)}") from None
+    if not math.isfinite(x):
+        raise error(f"{where} must be finite; got {short(value)}")
+    return x
+
+
+def parse_toml(text: str, where: str, error: type[Exception]) -> dict[str, Any]:
+    """``tomllib.loads(text)``, every parse failure one ``error`` naming ``where``: invalid
+    TOML, nesting too deep for the parser, integers of more than 4300 digits."""
+    import tomllib
+
+    try:
+        return tomllib.loads(text)
+    except tomllib.TOMLDecodeError as exc:
+        raise error(f"{where} is not valid TOML ({one_line(str(exc))})") from None
+    except RecursionError:
+        raise error(f"{where} is not valid TOML (arrays or tables nested too deeply)") from None
+    except ValueError as exc:  # int() refusing a literal of more than 4300 digits
+        raise error(f"{where} is not valid TOML ({short(str(exc), 120)})") from None

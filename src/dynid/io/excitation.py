@@ -1,8 +1,8 @@
 """Exciting trajectories and obstacles to and from files.
 
-* ``trajectory.csv``: a units line, then columns ``t, q1..qn, dq1..dqn, ddq1..ddqn``
-  [s, rad, rad/s, rad/s^2], one row per sample (1 kHz from ``dynid excite``), ready for a
-  position or velocity controller.
+* ``trajectory.csv``: a units line, the row count (``# rows: N``), then columns ``t,
+  q1..qn, dq1..dqn, ddq1..ddqn`` [s, rad, rad/s, rad/s^2], one row per sample (1 kHz from
+  ``dynid excite``), ready for a position or velocity controller.
 * ``trajectory.json`` (schema ``dynid-exciting-trajectory/1``): the coefficients and the
   form (:meth:`~dynid.simulation.excitation.ExcitingTrajectory.to_dict`), the limits and
   margins, the obstacles, the capsule radii, the condition numbers and the smallest margin
@@ -14,23 +14,32 @@
        "boxes": [{"name": "fixture", "center": [0.5, 0, 0.1], "size": [0.2, 0.3, 0.2]}]}
 
   A plane's normal points to the free side; boxes are axis-aligned.
+
+Every file is read strictly, with the rules of torque logs: strict JSON (a duplicated key,
+such as a second ``planes`` list that would silently replace the first, is an error),
+unknown keys and columns refused, numbers finite and never booleans or strings, the
+recorded row count of a CSV checked.
 """
 
 from __future__ import annotations
 
 import json
 import math
+import re
 from pathlib import Path
 from typing import Any
 
 import numpy as np
+from numpy.typing import NDArray
 
-from .. import __version__
+from .. import __version__, _checks
 from ..exceptions import DataError, DynidError
 from ..model.robot import Robot
 from ..simulation.collision import Box, Obstacles, Plane, capsule_model
 from ..simulation.excitation import ExcitationResult, ExcitingTrajectory
 from ..simulation.trajectories import Trajectory
+from .json_files import load_json
+from .torque_log import read_csv_table
 
 __all__ = [
     "EXCITATION_SCHEMA",
@@ -40,6 +49,7 @@ __all__ = [
     "obstacles_to_dict",
     "save_excitation_json",
     "save_trajectory_csv",
+    "trajectory_columns",
 ]
 
 EXCITATION_SCHEMA = "dynid-exciting-trajectory/1"
@@ -72,13 +82,11 @@ def _write_text(path: Path, text: str) -> Path:
 def save_trajectory_csv(path: str | Path, traj: Trajectory) -> Path:
     """Write ``t, q, dq, ddq`` to a CSV (columns named, units in the first line)."""
     path = Path(path)
-    n = traj.n
-    cols = ["t"] + [f"{k}{j + 1}" for k in ("q", "dq", "ddq") for j in range(n)]
+    cols = trajectory_columns(traj.n)
     data = np.column_stack([traj.t, traj.q, traj.dq, traj.ddq])
     tmp = path.with_name(path.name + ".tmp")
-    np.savetxt(
-        tmp, data, delimiter=",", fmt="%.10g", header=_UNITS + "\n" + ",".join(cols), comments=""
-    )
+    header = "\n".join([_UNITS, f"# rows: {len(data)}", ",".join(cols)])
+    np.savetxt(tmp, data, delimiter=",", fmt="%.10g", header=header, comments="")
     tmp.replace(path)
     return path
 
@@ -152,90 +160,176 @@ def save_excitation_json(
     return _write_text(Path(path), text)
 
 
+_OBSTACLE_KEYS = {"schema", "planes", "boxes"}
+_SHAPE_KEYS = {"planes": ("plane", "point", "normal"), "boxes": ("box", "center", "size")}
+_TRAJECTORY_KEYS = {
+    "form",
+    "w_f_rad_s",
+    "base_frequency_hz",
+    "harmonics",
+    "duration_s",
+    "ramp_s",
+    "total_duration_s",
+    "a_rad_s",
+    "b_rad_s",
+    "q_start_rad",
+}
+
+
+def _keys(d: dict[str, Any], allowed: set[str], where: str) -> None:
+    unknown = sorted(set(d) - allowed)
+    if unknown:
+        raise DataError(
+            f"{where}: unknown key(s) {_checks.short(unknown)}; allowed: {sorted(allowed)}"
+        )
+
+
+def _numbers(value: Any, where: str, shape: tuple[int, ...] | None = None) -> NDArray[np.float64]:
+    """A nested list of finite JSON numbers (no booleans, no strings) as an array."""
+
+    def walk(v: Any, at: str) -> Any:
+        if isinstance(v, list):
+            return [walk(x, f"{at}[{i}]") for i, x in enumerate(v)]
+        return _checks.number(v, at, DataError)
+
+    a = np.array(walk(value, where), dtype=np.float64)
+    if shape is not None and a.shape != shape:
+        raise DataError(f"{where} must be a list of shape {shape}; got {_checks.short(value)}")
+    return a
+
+
 def load_obstacles(path: str | Path) -> Obstacles:
-    """Read an obstacles file (see the module docstring).
+    """Read an obstacles file (see the module docstring), strictly.
 
     Raises
     ------
     DataError
-        Not JSON, wrong schema, or a malformed plane or box (named).
+        Not strict JSON (duplicated keys included: a second ``planes`` list would drop the
+        first), wrong schema, an unknown key, a plane or box that is not an object of a
+        name and three finite numbers per vector, a zero normal or a box without volume,
+        or two obstacles of one name (each message names the file and the obstacle).
+    OSError
+        The file cannot be read.
     """
     path = Path(path)
-    d = _read_json(path)
-    if d.get("schema") != OBSTACLES_SCHEMA:
-        raise DataError(
-            f"{path.name}: schema must be {OBSTACLES_SCHEMA!r}; got {d.get('schema')!r}"
-        )
-    planes, boxes, names = [], [], []
-    try:
-        for k, p in enumerate(d.get("planes", [])):
-            names.append(str(p.get("name", f"plane{k + 1}")))
-            planes.append(Plane(tuple(p["point"]), tuple(p["normal"])))
-        for k, b in enumerate(d.get("boxes", [])):
-            names.append(str(b.get("name", f"box{k + 1}")))
-            boxes.append(Box(tuple(b["center"]), tuple(b["size"])))
-    except KeyError as exc:
-        raise DataError(f"{path.name}: obstacle {len(names)} misses {exc.args[0]!r}") from None
-    except (TypeError, ValueError, DynidError) as exc:
-        raise DataError(f"{path.name}: obstacle {names[-1]!r} is malformed ({exc})") from None
-    return Obstacles(planes=tuple(planes), boxes=tuple(boxes), names=tuple(names))
-
-
-def _read_json(path: Path) -> dict[str, Any]:
-    try:
-        d = json.loads(path.read_text(encoding="utf-8"))
-    except (json.JSONDecodeError, UnicodeDecodeError) as exc:
-        raise DataError(f"{path.name}: not a JSON file ({exc})") from exc
-    if not isinstance(d, dict):
-        raise DataError(f"{path.name}: expected a JSON object")
-    return d
+    d = load_json(path, schema=OBSTACLES_SCHEMA, what="obstacles file")
+    _keys(d, _OBSTACLE_KEYS, path.name)
+    shapes: dict[str, list[Plane | Box]] = {"planes": [], "boxes": []}
+    names: list[str] = []
+    for kind, (one, k1, k2) in _SHAPE_KEYS.items():
+        items = d.get(kind, [])
+        if not isinstance(items, list):
+            raise DataError(f"{path.name}: {kind!r} must be a list of objects")
+        for k, item in enumerate(items):
+            where = f"{path.name}: {kind}[{k}]"
+            if not isinstance(item, dict):
+                raise DataError(f"{where} must be an object; got {_checks.short(item)}")
+            name = item.get("name", f"{one}{k + 1}")
+            if not isinstance(name, str) or not name:
+                raise DataError(f"{where}: 'name' must be a non-empty string")
+            where = f"{path.name}: {kind}[{k}] ({_checks.short(name)})"
+            _keys(item, {"name", k1, k2}, where)
+            if name in names:
+                raise DataError(f"{where}: the name is used by another obstacle")
+            missing = [key for key in (k1, k2) if key not in item]
+            if missing:
+                raise DataError(f"{where}: missing key {missing[0]!r}")
+            v1, v2 = (tuple(_numbers(item[key], f"{where}: {key}", (3,))) for key in (k1, k2))
+            try:
+                shapes[kind].append(Plane(v1, v2) if kind == "planes" else Box(v1, v2))
+            except DynidError as exc:
+                raise DataError(f"{where}: {exc}") from None
+            names.append(name)
+    return Obstacles(
+        planes=tuple(x for x in shapes["planes"] if isinstance(x, Plane)),
+        boxes=tuple(x for x in shapes["boxes"] if isinstance(x, Box)),
+        names=tuple(names),
+    )
 
 
 def load_trajectory(path: str | Path, n: int, *, fs: float = 1000.0) -> Trajectory:
     """A trajectory from ``trajectory.csv`` or ``trajectory.json`` (sampled at ``fs`` [Hz]).
 
+    Both are read strictly, as torque logs are. CSV: a UTF-8 byte-order mark is accepted;
+    the header must name exactly ``t, q1..qn, dq1..dqn, ddq1..ddqn`` (a duplicated or
+    unknown column is refused, not silently used or ignored); the ``# rows:`` count, when
+    recorded, must match. JSON: strict JSON, the schema, the known keys of the
+    trajectory only, finite numbers.
+
     Raises
     ------
     DataError
-        Unknown suffix, wrong schema, missing columns, a joint count other than ``n``.
+        Unknown suffix, wrong schema, missing, duplicated or unknown columns or keys, a
+        joint count other than ``n``, a row count other than the recorded one, a
+        malformed cell or row (its line), times not increasing.
+    OSError
+        The file cannot be read.
     """
     path = Path(path)
     suffix = path.suffix.lower()
     if suffix == ".json":
-        d = _read_json(path)
-        if d.get("schema") != EXCITATION_SCHEMA:
-            raise DataError(
-                f"{path.name}: schema must be {EXCITATION_SCHEMA!r}; got {d.get('schema')!r}"
-            )
+        d = load_json(path, schema=EXCITATION_SCHEMA, what="trajectory file (dynid excite)")
+        tr = d.get("trajectory")
+        if not isinstance(tr, dict):
+            raise DataError(f"{path.name}: 'trajectory' must be an object")
+        _keys(tr, _TRAJECTORY_KEYS, f"{path.name}: trajectory")
+        need = ("w_f_rad_s", "duration_s", "ramp_s", "a_rad_s", "b_rad_s", "q_start_rad")
+        missing = [k for k in need if k not in tr]
+        if missing:
+            raise DataError(f"{path.name}: trajectory: missing key(s) {missing}")
+        num = {k: _numbers(tr[k], f"{path.name}: trajectory.{k}") for k in need}
         try:
-            traj = ExcitingTrajectory.from_dict(d["trajectory"])
-        except (KeyError, TypeError, ValueError, DynidError) as exc:
+            traj = ExcitingTrajectory(
+                w_f=float(num["w_f_rad_s"]),
+                a=num["a_rad_s"],
+                b=num["b_rad_s"],
+                q_start=num["q_start_rad"],
+                duration=float(num["duration_s"]),
+                ramp=float(num["ramp_s"]),
+            )
+        except (TypeError, ValueError, DynidError) as exc:
             raise DataError(f"{path.name}: malformed trajectory ({exc})") from None
         if traj.n != n:
             raise DataError(f"{path.name}: trajectory has {traj.n} joints; the robot has {n}")
         return traj.sample(fs)
     if suffix != ".csv":
         raise DataError(f"--trajectory file must be .csv or .json; got {path.name!r}")
-    lines = [ln for ln in path.read_text(encoding="utf-8").splitlines() if ln.strip()]
-    lines = [ln for ln in lines if not ln.lstrip().startswith("#")]
-    if not lines:
-        raise DataError(f"{path.name}: empty")
-    cols = [c.strip() for c in lines[0].split(",")]
-    want = ["t"] + [f"{k}{j + 1}" for k in ("q", "dq", "ddq") for j in range(n)]
-    missing = [c for c in want if c not in cols]
-    if missing:
-        raise DataError(f"{path.name}: missing column(s) {missing} for {n} joints")
-    try:
-        data = np.loadtxt(lines[1:], delimiter=",", ndmin=2)
-    except ValueError as exc:
-        raise DataError(f"{path.name}: non-numeric cell ({exc})") from None
-    if data.shape[1] != len(cols):
-        raise DataError(f"{path.name}: rows have {data.shape[1]} fields; header {len(cols)}")
-    idx = [cols.index(c) for c in want]
-    a = data[:, idx]
+    want = trajectory_columns(n)
+
+    def layout(names: list[str], line: int) -> dict[str, list[int]]:
+        where = f"{path.name}, line {line}"
+        dup = sorted({c for c in names if names.count(c) > 1})
+        if dup:
+            raise DataError(
+                f"{where}: duplicated column(s) {_checks.short(dup)}; each column must appear once"
+            )
+        k = sum(1 for c in names if re.fullmatch(r"q[1-9]\d*", c))
+        if k != n and f"q{k}" in names:
+            raise DataError(f"{where}: trajectory has {k} joints (q1..q{k}); the robot has {n}")
+        missing = [c for c in want if c not in names]
+        if missing:
+            raise DataError(f"{where}: missing column(s) {_checks.short(missing)} for {n} joints")
+        unknown = [c for c in names if c not in want]
+        if unknown:
+            raise DataError(
+                f"{where}: unknown column(s) {_checks.short(unknown)}; a trajectory of {n} "
+                f"joints has t, q1..q{n}, dq1..dq{n}, ddq1..ddq{n}"
+            )
+        return {"a": [names.index(c) for c in want]}
+
+    arrays, _ = read_csv_table(path, layout, ",".join(want[:2]) + ",...")
+    a = arrays["a"]
+    if not np.all(np.isfinite(a)):
+        r = int(np.flatnonzero(~np.isfinite(a).all(axis=1))[0])
+        raise DataError(f"{path.name}: data row {r} holds NaN, inf or an empty cell")
     try:
         return Trajectory(
             t=a[:, 0], q=a[:, 1 : n + 1], dq=a[:, n + 1 : 2 * n + 1], ddq=a[:, 2 * n + 1 :]
         )
     except DynidError as exc:
         raise DataError(f"{path.name}: {exc}") from None
+
+
+def trajectory_columns(n: int) -> list[str]:
+    """Column names of ``trajectory.csv``: ``t, q1..qn, dq1..dqn, ddq1..ddqn``."""
+    return ["t"] + [f"{k}{j + 1}" for k in ("q", "dq", "ddq") for j in range(n)]

@@ -7,8 +7,9 @@ reject (write ``None`` for "undefined" on purpose). Files are written atomically
 (:mod:`dynid.io.atomic`), indented, UTF-8, with a ``schema`` key first.
 
 Reading (:func:`load_json`): UTF-8 with or without a byte-order mark; ``NaN``,
-``Infinity``, numbers that overflow a float, duplicated keys and a top level other than
-an object are rejected with a :class:`~dynid.exceptions.DataError` naming the file; the
+``Infinity``, numbers that overflow a float (integers of more than 308 digits included),
+duplicated keys, nesting too deep for the parser and a top level other than an object
+are rejected with a :class:`~dynid.exceptions.DataError` naming the file; the
 ``schema`` key must be one of the accepted ones.
 """
 
@@ -22,6 +23,7 @@ from typing import Any
 
 import numpy as np
 
+from .. import _checks
 from ..exceptions import DataError, NonFiniteError
 from .atomic import write_text
 
@@ -89,23 +91,40 @@ def _finite_float(text: str) -> float:
     return v
 
 
+def _float_range_int(text: str) -> int:
+    if len(text.lstrip("-")) > 308:  # beyond 1.8e308 no number of dynid's means anything
+        raise ValueError(f"an integer of {len(text.lstrip('-'))} digits overflows a float")
+    return int(text)
+
+
 def _unique_keys(pairs: list[tuple[str, Any]]) -> dict[str, Any]:
     d: dict[str, Any] = {}
     for k, v in pairs:
         if k in d:
-            raise ValueError(f"duplicated key {k!r}")
+            raise ValueError(f"duplicated key {_checks.short(k)}")
         d[k] = v
     return d
 
 
 def loads(text: str) -> Any:
-    """Parse strict JSON text (no NaN/Infinity, no overflow, no duplicated key)."""
-    return json.loads(
-        text,
-        parse_constant=_no_constant,
-        parse_float=_finite_float,
-        object_pairs_hook=_unique_keys,
-    )
+    """Parse strict JSON text (no NaN/Infinity, no overflow, no duplicated key).
+
+    Raises
+    ------
+    ValueError
+        Not strict JSON (:class:`json.JSONDecodeError` for the syntax), including
+        integers beyond the float range and nesting too deep for the parser.
+    """
+    try:
+        return json.loads(
+            text,
+            parse_constant=_no_constant,
+            parse_float=_finite_float,
+            parse_int=_float_range_int,
+            object_pairs_hook=_unique_keys,
+        )
+    except RecursionError:
+        raise ValueError("arrays or objects nested too deeply") from None
 
 
 def load_json(
@@ -140,8 +159,8 @@ def load_json(
         raise DataError(
             f"{path.name}: not a JSON file ({exc.msg} at line {exc.lineno}, column {exc.colno})"
         ) from None
-    except (ValueError, RecursionError) as exc:
-        raise DataError(f"{path.name}: not strict JSON ({exc})") from None
+    except ValueError as exc:
+        raise DataError(f"{path.name}: not strict JSON ({_checks.one_line(str(exc))})") from None
     if not isinstance(d, dict):
         raise DataError(f"{path.name}: expected a JSON object ({what}); got {type(d).__name__}")
     if schema is not None:

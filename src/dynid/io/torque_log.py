@@ -34,6 +34,7 @@ import logging
 import re
 import warnings
 import zipfile
+from collections.abc import Callable
 from pathlib import Path
 from typing import IO, Any
 
@@ -50,7 +51,7 @@ from ..identification.log import (
 from .atomic import open_atomic
 from .static_data import check_row_count
 
-__all__ = ["load_torque_log", "save_torque_log", "torque_log_columns"]
+__all__ = ["load_torque_log", "read_csv_table", "save_torque_log", "torque_log_columns"]
 
 _log = logging.getLogger(__name__)
 
@@ -317,6 +318,50 @@ def _columns(path: Path, names: list[str], line: int) -> tuple[int, bool]:
 
 def _read_csv(path: Path) -> tuple[dict[str, NDArray[np.float64]], tuple[int, int] | None]:
     """The arrays of a CSV log, and (line of the first data row, rows) for messages."""
+
+    def layout(names: list[str], line: int) -> dict[str, list[int]]:
+        n, with_ddq = _columns(path, names, line)
+        index = {c: k for k, c in enumerate(names)}
+        out = {"t": [index["t"]]}
+        for k in _SIGNALS if with_ddq else _SIGNALS[:3]:
+            if f"{k}1" in index:  # dq may be absent (positions only)
+                out[k] = [index[f"{k}{j}"] for j in range(1, n + 1)]
+        return out
+
+    arrays, lines = read_csv_table(path, layout, "t,q1,...,dq1,...,tau1,...")
+    arrays["t"] = arrays["t"].reshape(-1)
+    return arrays, lines
+
+
+def read_csv_table(
+    path: Path,
+    layout_of: Callable[[list[str], int], dict[str, list[int]]],
+    expected: str,
+) -> tuple[dict[str, NDArray[np.float64]], tuple[int, int] | None]:
+    """Read a dynid CSV table: comment lines (``# rows: N`` checked), a header, numbers.
+
+    Parameters
+    ----------
+    path : Path
+    layout_of : callable
+        ``layout_of(names, line)`` checks the header's column names (found on ``line``)
+        and returns, per output array, the indices of its columns.
+    expected : str
+        The header expected, for the message when there is none.
+
+    Returns
+    -------
+    arrays : dict of str to ndarray, shape (N, k) each, read-only
+    lines : (int, int) or None
+        Line number of data row 0 and the row count, when rows map to lines one to one.
+
+    Raises
+    ------
+    DataError
+        No header, a refused header, no row, a malformed row (its line), a declared row
+        count the file cannot hold (refused before anything is allocated) or other than
+        the rows found.
+    """
     with open(path, "rb") as fb:
         recorded = None
         lineno = 0
@@ -338,28 +383,38 @@ def _read_csv(path: Path) -> tuple[dict[str, NDArray[np.float64]], tuple[int, in
             names = [c.strip() for c in s.split(",")]
             break
         if names is None:
-            raise DataError(f"{path.name}: no header line (t,q1,...,dq1,...,tau1,...) found")
-        n, with_ddq = _columns(path, names, lineno)
+            raise DataError(f"{path.name}: no header line ({expected}) found")
+        layout = layout_of(names, lineno)
         first = lineno + 1
-        index = {c: k for k, c in enumerate(names)}
-        layout = {"t": [index["t"]]}
-        for k in _SIGNALS if with_ddq else _SIGNALS[:3]:
-            if f"{k}1" in index:  # dq may be absent (positions only)
-                layout[k] = [index[f"{k}{j}"] for j in range(1, n + 1)]
         start = fb.tell()
-        arrays = _fast_parse(fb, len(names), layout, recorded)
-        if arrays is None:  # the fast reader refused the text: find and name the problem
+        _check_declared_rows(path, recorded, len(names), fb.seek(0, io.SEEK_END) - start)
+        fb.seek(start)
+        parsed = _fast_parse(fb, len(names), layout, recorded)
+        one_to_one = True
+        if parsed is None:  # the fast reader refused the text: find and name the problem
             fb.seek(start)
             table = _slow_parse(path, io.TextIOWrapper(fb, encoding="utf-8"), first, names)
             arrays = {k: table[:, cols] for k, cols in layout.items()}
-    N = arrays["t"].shape[0]
+        else:
+            arrays, one_to_one = parsed
+    N = next(iter(arrays.values())).shape[0]
     if N == 0:
         raise DataError(f"{path.name}: no data rows after the header")
     check_row_count(path, recorded, N)
-    arrays["t"] = arrays["t"].reshape(N)
     for a in arrays.values():
         a.setflags(write=False)  # fresh and owned: TorqueLog keeps them without a copy
-    return arrays, (first, N)
+    return arrays, ((first, N) if one_to_one else None)
+
+
+def _check_declared_rows(path: Path, recorded: int | None, width: int, size: int) -> None:
+    """Refuse a ``# rows:`` count that ``size`` bytes of rows of ``width`` cells cannot
+    hold (each row is at least one character and a separator per cell), before the
+    arrays for that count are allocated."""
+    if recorded is not None and recorded > size // (2 * width):
+        raise DataError(
+            f"{path.name}: the file records {recorded} rows but its {size} bytes of data hold "
+            f"at most {size // (2 * width)}; it is incomplete or was edited; regenerate it"
+        )
 
 
 #: Bytes of CSV text parsed at a time (bounded memory whatever the file size).
@@ -368,16 +423,18 @@ _CHUNK_BYTES = 32 << 20
 
 def _fast_parse(
     fb: IO[bytes], width: int, layout: dict[str, list[int]], n_rows: int | None
-) -> dict[str, NDArray[np.float64]] | None:
+) -> tuple[dict[str, NDArray[np.float64]], bool] | None:
     """Parse the data rows in blocks with numpy's C number reader, straight into the
-    per-signal arrays; None when a block is not a clean table of numbers (a short row, an
-    empty cell, a word, a blank or comment line), for :func:`_slow_parse` to explain."""
+    per-signal arrays, and say whether rows map to lines one to one (no blank line
+    skipped); None when a block is not a clean table of numbers (a short row, an empty
+    cell, a word, a comment line), for :func:`_slow_parse` to explain."""
     blocks: dict[str, list[NDArray[np.float64]]] = {k: [] for k in layout}
     out: dict[str, NDArray[np.float64]] | None = None
     if n_rows is not None and n_rows > 0:
         out = {k: np.empty((n_rows, len(c))) for k, c in layout.items()}
     row = 0
     tail = b""
+    one_to_one = True
     while True:
         chunk = fb.read(_CHUNK_BYTES)
         last = not chunk
@@ -393,8 +450,17 @@ def _fast_parse(
             buf, tail = buf[:cut], buf[cut:]
             if not buf:
                 continue
+        if buf.startswith(b"\n") or b"\n\n" in buf:  # blank lines: skipped, as the slow reader does
+            one_to_one = False
+            while b"\n\n" in buf:
+                buf = buf.replace(b"\n\n", b"\n")
+            buf = buf.lstrip(b"\n")
+            if not buf:
+                if last:
+                    break
+                continue
         rows = buf.count(b"\n")
-        if b"\n\n" in buf or b"#" in buf or b",," in buf:
+        if b"#" in buf or b",," in buf:
             return None
         with warnings.catch_warnings():
             warnings.simplefilter("error")
@@ -420,8 +486,11 @@ def _fast_parse(
         if last:
             break
     if out is not None:
-        return {k: a[:row] if row < a.shape[0] else a for k, a in out.items()}
-    return {k: np.concatenate(b) if b else np.empty((0, len(layout[k]))) for k, b in blocks.items()}
+        return {k: a[:row] if row < a.shape[0] else a for k, a in out.items()}, one_to_one
+    arrays = {
+        k: np.concatenate(b) if b else np.empty((0, len(layout[k]))) for k, b in blocks.items()
+    }
+    return arrays, one_to_one
 
 
 def _rows(path: Path, lineno: int, text: str) -> int:

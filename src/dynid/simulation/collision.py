@@ -67,11 +67,12 @@ class Plane:
     def __post_init__(self) -> None:
         p = _checks.as_exact("point", self.point, (3,))
         nrm = _checks.as_exact("normal", self.normal, (3,))
-        norm = float(np.linalg.norm(nrm))
-        if not norm > 0:
+        big = float(np.max(np.abs(nrm)))
+        if not big > 0:
             raise ShapeError("plane normal must be non-zero")
+        u = nrm / big  # scaled first: the norm of [0, 0, 1e300] overflows, of 1e-300 not
         object.__setattr__(self, "point", tuple(float(x) for x in p))
-        object.__setattr__(self, "normal", tuple(float(x) / norm for x in nrm))
+        object.__setattr__(self, "normal", tuple(float(x) for x in u / np.linalg.norm(u)))
 
 
 @dataclass(frozen=True, slots=True)
