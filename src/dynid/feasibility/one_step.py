@@ -25,6 +25,7 @@ from ..identification.classical import identify_from_log
 from ..identification.data import StaticDataset
 from ..identification.log import DEFAULT_CUTOFF_HZ, TorqueLog
 from ..identification.static import identify_static
+from ..model.drive import Drive
 from ..model.robot import Robot
 from .bounds import Bounds
 from .prior import Prior
@@ -45,6 +46,7 @@ def identify_consistent(
     cutoff_hz: float | None = DEFAULT_CUTOFF_HZ,
     decimate: int | None = None,
     rtol: float | None = None,
+    drive: Drive | None = None,
 ) -> ConsistentResult:
     """Physically consistent link parameters (and friction) identified from data.
 
@@ -61,6 +63,10 @@ def identify_consistent(
     rtol : float, optional
         Rank tolerance of the unconstrained fit; None: the identification's default (the
         rank at a clear gap of the singular values).
+    drive : Drive, optional
+        The drive train (:mod:`dynid.model.drive`): the log is read through it, its rotor
+        inertias are identified with the links (``>= 0``) and its friction acts at the
+        motors (``fv, fc >= 0``).
 
     Returns
     -------
@@ -77,12 +83,18 @@ def identify_consistent(
     """
     if isinstance(data, TorqueLog):
         model = identify_from_log(
-            robot, data, cutoff_hz=cutoff_hz, decimate=decimate, friction=True, rtol=rtol
+            robot,
+            data,
+            cutoff_hz=cutoff_hz,
+            decimate=decimate,
+            friction=True,
+            rtol=rtol,
+            drive=drive,
         )
         term = coefficient_term(model, with_friction=True)
         kind = "log"
     elif isinstance(data, StaticDataset):
-        model = identify_static(robot, data, rtol=rtol, std_estimator="classical")
+        model = identify_static(robot, data, rtol=rtol, std_estimator="classical", drive=drive)
         term = coefficient_term(model)
         kind = "static"
     else:

@@ -170,8 +170,10 @@ class DataTerm:
 
     Attributes
     ----------
-    P : ndarray, shape (r, 10 n)
-        Standard to base parameters (kept coefficients only).
+    P : ndarray, shape (r, 10 n) or (r, 11 n)
+        Standard to base parameters (kept coefficients only); with identified rotor
+        inertias (:mod:`dynid.model.drive`) the last ``n`` columns are ``Ia1 .. Ia_n``, kept
+        ``>= 0`` in the consistent fit.
     x_hat : ndarray, shape (r + k,)
         Least-squares estimate (base parameters, then ``k`` friction coefficients).
     A : ndarray, shape (s, r + k)
@@ -328,6 +330,9 @@ class ConsistentResult:
         Recorded for files (the convex problem uses no randomness).
     identified : IdentifiedModel or None
         One-step: the unconstrained least-squares identification of the same data.
+    rotor_inertia : ndarray, shape (n,), or None
+        Rotor inertias [kg m^2] at the motors (``>= 0``), identified with the links when
+        the data term holds them (a drive with ``rotor_inertia = "identify"``).
     """
 
     robot: Robot
@@ -354,6 +359,7 @@ class ConsistentResult:
     method: str = "sdp"
     seed: int | None = None
     identified: IdentifiedModel | None = None
+    rotor_inertia: NDArray[np.float64] | None = None
 
     @property
     def mass(self) -> NDArray[np.float64]:
@@ -464,7 +470,15 @@ class _Problem:
             div = sum(cp.sum_squares(X - np.eye(4)) for X in self.X)
         k = term.n_friction
         self.f = cp.Variable(k, name="f") if k else None
-        x = term.P @ phi
+        p_links = 10 * n
+        self.ia = (
+            cp.Variable(term.P.shape[1] - p_links, nonneg=True, name="Ia")
+            if term.P.shape[1] > p_links
+            else None
+        )
+        x = term.P[:, :p_links] @ phi
+        if self.ia is not None:  # rotor inertias >= 0, regrouped with the links in P
+            x = x + term.P[:, p_links:] @ self.ia
         if self.f is not None:
             x = cp.hstack([x, self.f])
             if friction_nonneg:  # fv, fc >= 0 (every joint's fo is free)
@@ -531,16 +545,29 @@ class _Problem:
             return "infeasible"
         raise SolverError("convex retrieval: the solver did not converge (" + "; ".join(seen) + ")")
 
-    def _read(self) -> tuple[list[NDArray[np.float64]], NDArray[np.float64] | None]:
+    def _read(self) -> tuple[list[NDArray[np.float64]], NDArray[np.float64] | None, Any]:
         Xs = [np.array(X.value, dtype=float) for X in self.X]
         f = None if self.f is None else np.array(self.f.value, dtype=float)
-        return Xs, f
+        ia = None if self.ia is None else np.maximum(np.array(self.ia.value, dtype=float), 0.0)
+        return Xs, f, ia
 
-    def values(self) -> tuple[NDArray[np.float64], NDArray[np.float64] | None]:
-        """``phi`` (n, 10) and the friction (k,) at the solution (margins enforced)."""
-        Xs, f = self._snapshot
+    def values(self) -> _Values:
+        """``phi`` (n, 10), the friction (k,) and the rotor inertias (n,) at the solution
+        (margins enforced; None for what the problem does not hold)."""
+        Xs, f, ia = self._snapshot
         phi = np.stack([self.B[i] @ X.reshape(-1) for i, X in enumerate(Xs)])
-        return _with_margin(phi, self.margin), f
+        return _with_margin(phi, self.margin), f, ia
+
+
+#: ``phi`` (n, 10), friction (k,) or None, rotor inertias (n,) or None.
+_Values = tuple[NDArray[np.float64], NDArray[np.float64] | None, NDArray[np.float64] | None]
+
+
+def _x(term: DataTerm, phi: NDArray[np.float64], f: Any, ia: Any) -> NDArray[np.float64]:
+    """``x = [P [phi; Ia]; f]`` of a solution."""
+    std = phi.reshape(-1) if ia is None else np.concatenate([phi.reshape(-1), ia])
+    x = term.P @ std
+    return x if f is None else np.concatenate([x, f])
 
 
 def _with_margin(phi: NDArray[np.float64], margin: float) -> NDArray[np.float64]:
@@ -553,13 +580,18 @@ def _with_margin(phi: NDArray[np.float64], margin: float) -> NDArray[np.float64]
     return out
 
 
-def _polish(phi: NDArray[np.float64], term: DataTerm, prior: Prior) -> NDArray[np.float64]:
-    """Minimum-norm correction (in the prior's scales) so that ``P phi = beta`` to round-off."""
+def _polish(
+    phi: NDArray[np.float64], term: DataTerm, prior: Prior, ia: Any = None
+) -> NDArray[np.float64]:
+    """Minimum-norm correction (in the prior's scales) so that ``P phi = beta`` to round-off
+    (rotor inertias kept as solved)."""
     scale = prior_scales(prior.phi)
+    P = term.P[:, : phi.size]
+    target = term.x_hat[: term.r] - (0.0 if ia is None else term.P[:, phi.size :] @ ia)
     x = phi.reshape(-1)
     for _ in range(2):
-        e = term.x_hat[: term.r] - term.P @ x  # the base part; friction is met exactly
-        PD = term.P * scale
+        e = target - P @ x  # the base part; friction is met exactly
+        PD = P * scale
         x = x + scale * np.linalg.lstsq(PD, e, rcond=None)[0]
     return x.reshape(phi.shape)
 
@@ -627,6 +659,7 @@ def _finish(
     kind: str,
     t0: float,
     notes: list[str],
+    ia: NDArray[np.float64] | None = None,
 ) -> ConsistentResult:
     if f is not None and term.n_friction:
         f = f.copy()
@@ -635,9 +668,7 @@ def _finish(
     m, c, I = inertial_from_phi(phi)
     out = robot.with_params(phi)
     notes = notes + _active_and_implausible(robot, m, c, I, bounds, band)
-    x = term.P @ phi.reshape(-1)
-    if f is not None:
-        x = np.concatenate([x, f])
+    x = _x(term, phi, f, ia)
     beta = term.x_hat[: term.r]
     nb = float(np.linalg.norm(beta))
     rel = float(np.linalg.norm(x[: term.r] - beta) / nb) if nb > 0 else 0.0
@@ -669,6 +700,7 @@ def _finish(
         robot=out,
         phi=phi,
         friction=None if f is None else f.reshape(-1, 3),
+        rotor_inertia=ia,
         relative_residual=rel,
         residual_ratio=ratio,
         feasible=bool(report.ok) and status != "infeasible",
@@ -744,7 +776,7 @@ def solve_consistent(
     t0 = time.perf_counter()
     opts = SDPOptions() if options is None else options
     n = robot.n
-    if term.P.shape[1] != 10 * n:
+    if term.P.shape[1] not in (10 * n, 11 * n):
         raise ShapeError(f"data term is for {term.P.shape[1] // 10} links; robot has {n}")
     b = default_bounds(robot) if bounds is None else bounds
     if b.n != n:
@@ -771,10 +803,15 @@ def solve_consistent(
     search: list[tuple[float, float]] = []
 
     def finish(
-        phi: NDArray[np.float64], f: NDArray[np.float64] | None, w: float, fit: str, status: str
+        phi: NDArray[np.float64],
+        f: NDArray[np.float64] | None,
+        ia: NDArray[np.float64] | None,
+        w: float,
+        fit: str,
+        status: str,
     ) -> ConsistentResult:
         return _finish(
-            robot, phi, f, term, pr, w, search, nb, band, opts, fit, status, kind, t0, notes
+            robot, phi, f, term, pr, w, search, nb, band, opts, fit, status, kind, t0, notes, ia
         )
 
     if equality:
@@ -789,18 +826,18 @@ def solve_consistent(
             if prob.solve(1.0).startswith("infeasible"):
                 raise InfeasibleError("the bounds and constraints admit no consistent parameters")
             return finish(*prob.values(), 1.0, "equality", "infeasible")
-        phi, f = prob.values()
-        phi = _polish(phi, term, pr)
+        phi, f, ia = prob.values()
+        phi = _polish(phi, term, pr, ia)
         if f is not None:
             f = term.x_hat[term.r :].copy()
-        return finish(phi, f, 1.0, "equality", status)
+        return finish(phi, f, ia, 1.0, "equality", status)
     prob = _Problem(*common, False, False, friction_nonneg, constraints)
     if opts.prior_weight is not None:
         status = prob.solve(opts.prior_weight)
         if status.startswith("infeasible"):
             raise InfeasibleError("the bounds and constraints admit no consistent parameters")
         return finish(*prob.values(), opts.prior_weight, "weighted", status)
-    w, limit, status, phi, f, search[:] = _auto_weight(prob, term, opts)
+    w, limit, status, (phi, f, ia), search[:] = _auto_weight(prob, term, opts)
     top = w >= WEIGHT_RANGE[1] * (1 - 1e-9)
     if limit > 1.0 + opts.residual_increase:
         notes.append(
@@ -820,37 +857,33 @@ def solve_consistent(
                 f"{100 * opts.residual_increase:g} % of the unconstrained fit"
             )
         )
-    return finish(phi, f, w, "weighted", status)
+    return finish(phi, f, ia, w, "weighted", status)
 
 
 def _auto_weight(
     prob: _Problem, term: DataTerm, opts: SDPOptions
-) -> tuple[
-    float, float, str, NDArray[np.float64], NDArray[np.float64] | None, list[tuple[float, float]]
-]:
+) -> tuple[float, float, str, _Values, list[tuple[float, float]]]:
     """Largest weight in :data:`WEIGHT_RANGE` whose residual ratio stays within the limit.
 
     The limit is ``1 + residual_increase``, or, when the consistent fit at the smallest
     weight already exceeds it (data that no rigid body fits within the allowance),
     ``(1 + residual_increase)`` times that fit's ratio. Decades upwards from the smallest
     weight, then :data:`WEIGHT_BISECTIONS` bisections of the logarithm. Returns the weight,
-    the limit used, the status, ``phi``, the friction and every ``(w, ratio)`` tried.
+    the limit used, the status, the solution (:meth:`_Problem.values`) and every
+    ``(w, ratio)`` tried.
     """
     search: list[tuple[float, float]] = []
-    cache: dict[float, tuple[str, NDArray[np.float64], NDArray[np.float64] | None]] = {}
+    cache: dict[float, tuple[str, _Values]] = {}
 
     def ratio(e: float) -> float:
         w = 10.0**e
         status = prob.solve(w)
         if status.startswith("infeasible"):
             raise InfeasibleError("the bounds and constraints admit no consistent parameters")
-        phi, f = prob.values()
-        x = term.P @ phi.reshape(-1)
-        if f is not None:
-            x = np.concatenate([x, f])
-        rr = math.sqrt(1.0 + term.chi2(x) / term.dof)
+        values = prob.values()
+        rr = math.sqrt(1.0 + term.chi2(_x(term, *values)) / term.dof)
         search.append((w, rr))
-        cache[e] = (status, phi, f)
+        cache[e] = (status, values)
         return rr
 
     lo_e, hi_e = (math.log10(x) for x in WEIGHT_RANGE)
@@ -873,8 +906,8 @@ def _auto_weight(
                 good = mid
             else:
                 bad = mid
-    status, phi, f = cache[good]
-    return 10.0**good, limit, status, phi, f, search
+    status, values = cache[good]
+    return 10.0**good, limit, status, values, search
 
 
 def retrieve_sdp(

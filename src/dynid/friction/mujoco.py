@@ -28,7 +28,7 @@ from .. import _checks
 from ..exceptions import ShapeError
 from .model import sigmoid_friction
 
-__all__ = ["CoulombViscous", "coulomb_viscous_from_sigmoid"]
+__all__ = ["CoulombViscous", "DriveJointTerms", "coulomb_viscous_from_sigmoid", "drive_joint_terms"]
 
 
 @dataclass(frozen=True, slots=True)
@@ -100,3 +100,75 @@ def coulomb_viscous_from_sigmoid(
         offset[j] = (up[-1] + down[-1]) / 2.0
         rms[j] = float(np.sqrt(np.mean((A @ x - odd) ** 2)))
     return CoulombViscous(coulomb, viscous, offset, rms, vmax)
+
+
+@dataclass(frozen=True, slots=True)
+class DriveJointTerms:
+    """What MuJoCo's joints can hold of a drive train: per-joint diagonal terms.
+
+    Attributes
+    ----------
+    armature : ndarray, shape (n,)
+        ``diag(K^T diag(I_a) K)`` [kg m^2]: the rotors' inertia reflected to each joint.
+    damping : ndarray, shape (n,)
+        ``diag(K^T diag(f_v) K)`` [N m s/rad] of friction at the motors (``f_v`` itself at
+        the joints).
+    frictionloss : ndarray, shape (n,)
+        ``|K_jj| f_c,j`` [N m]: each joint's own motor's Coulomb friction.
+    notes : tuple of str
+        What MuJoCo cannot express and is dropped (a coupled rotor's off-diagonal inertia,
+        coupled friction, offsets), one line each.
+    """
+
+    armature: NDArray[np.float64]
+    damping: NDArray[np.float64]
+    frictionloss: NDArray[np.float64]
+    notes: tuple[str, ...] = ()
+
+
+def drive_joint_terms(
+    K: NDArray[np.float64],
+    rotor_inertia: NDArray[np.float64] | None,
+    fv: NDArray[np.float64] | None,
+    fc: NDArray[np.float64] | None,
+    *,
+    friction_at_motor: bool = True,
+) -> DriveJointTerms:
+    """MuJoCo's joint terms (armature, damping, frictionloss) of a drive train.
+
+    ``K`` (n, n) is the transmission (:mod:`dynid.model.drive`); ``rotor_inertia`` (n,)
+    [kg m^2] at the motors; ``fv`` [N m s/rad], ``fc`` [N m] per motor (per joint when
+    ``friction_at_motor`` is False). The reflected inertia ``K^T diag(I_a) K`` and viscous
+    friction ``K^T diag(f_v) K`` are exact on the diagonal; their off-diagonal parts (a
+    coupled wrist) and the coupled Coulomb terms have no MuJoCo counterpart and are named
+    in ``notes``.
+    """
+    n = K.shape[0]
+    Kf = K if friction_at_motor else np.eye(n)
+    notes: list[str] = []
+
+    def reflected(d: NDArray[np.float64], T: NDArray[np.float64], what: str) -> NDArray[np.float64]:
+        A = T.T @ (d[:, None] * T)
+        off = A - np.diag(np.diag(A))
+        if np.any(np.abs(off) > 1e-12 * max(float(np.abs(A).max()), 1e-300)):
+            i, j = np.unravel_index(int(np.argmax(np.abs(off))), off.shape)
+            notes.append(
+                f"{what}: the coupling's off-diagonal terms are not expressible in MJCF and "
+                f"are dropped (largest: joints {i + 1}-{j + 1}, {A[i, j]:.4g})"
+            )
+        return np.diag(A).copy()
+
+    z = np.zeros(n)
+    arm = z if rotor_inertia is None else reflected(np.asarray(rotor_inertia), K, "armature")
+    damp = z if fv is None else reflected(np.asarray(fv), Kf, "viscous friction (damping)")
+    loss = z
+    if fc is not None:
+        fcv = np.asarray(fc)
+        loss = np.abs(np.diag(Kf)) * fcv
+        off = Kf - np.diag(np.diag(Kf))
+        if np.any(off * fcv[:, None]):
+            notes.append(
+                "Coulomb friction of coupled motors on other joints is not expressible in MJCF "
+                "and is dropped (frictionloss holds each joint's own motor)"
+            )
+    return DriveJointTerms(arm, damp, loss, tuple(notes))

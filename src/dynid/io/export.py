@@ -17,7 +17,8 @@ from __future__ import annotations
 from pathlib import Path
 
 from ..exceptions import DataError
-from ..friction.model import ClassicalFriction
+from ..friction.model import ClassicalFriction, DriveFriction
+from ..model.drive import Drive
 from ..model.robot import Robot
 from .atomic import write_text
 from .mjcf_export import save_mjcf
@@ -59,8 +60,9 @@ def save_robot(
     base: str | None = None,
     tip: str | None = None,
     merged: str = "subtract",
-    friction: bool | ClassicalFriction = True,
+    friction: bool | ClassicalFriction | DriveFriction = True,
     all_frames: bool = False,
+    drive: Drive | None = None,
 ) -> Path:
     """Write ``robot`` as URDF, MJCF or TOML; returns the path.
 
@@ -72,9 +74,11 @@ def save_robot(
         Default: from the suffix of ``path``.
     template, base, tip, merged, all_frames
         URDF only (:func:`dynid.io.urdf_export.save_urdf`).
-    friction : bool or ClassicalFriction
-        MJCF only: the robot's friction, identified classical friction, or none
-        (:func:`dynid.io.mjcf_export.save_mjcf`).
+    friction : bool, ClassicalFriction or DriveFriction
+        MJCF only: the robot's friction, identified classical friction (at the joints or
+        the motors), or none (:func:`dynid.io.mjcf_export.save_mjcf`).
+    drive : Drive, optional
+        MJCF only: a drive with known rotor inertias, written as ``armature``.
 
     Raises
     ------
@@ -91,5 +95,5 @@ def save_robot(
             path, robot, all_frames=all_frames, template=template, base=base, tip=tip, merged=merged
         )
     if fmt == "mjcf":
-        return save_mjcf(path, robot, friction=friction)
+        return save_mjcf(path, robot, friction=friction, drive=drive)
     return write_text(path, robot.to_toml())

@@ -33,6 +33,7 @@ Numbers use Python's shortest round-trip representation.
 
 from __future__ import annotations
 
+import warnings
 from pathlib import Path
 from xml.sax.saxutils import quoteattr
 
@@ -40,9 +41,10 @@ import numpy as np
 from scipy.spatial.transform import Rotation
 
 from .. import __version__
-from ..exceptions import ShapeError
-from ..friction.model import ClassicalFriction
-from ..friction.mujoco import CoulombViscous, coulomb_viscous_from_sigmoid
+from ..exceptions import DynidWarning, ShapeError
+from ..friction.model import ClassicalFriction, DriveFriction
+from ..friction.mujoco import CoulombViscous, coulomb_viscous_from_sigmoid, drive_joint_terms
+from ..model.drive import Drive
 from ..model.inertia import inertia6_from_matrix
 from ..model.robot import Robot
 from .atomic import write_text
@@ -66,18 +68,28 @@ def _pose(T: np.ndarray) -> str:
 
 
 def mjcf_from_robot(
-    robot: Robot, *, friction: bool | ClassicalFriction = True, comment: str | None = None
+    robot: Robot,
+    *,
+    friction: bool | ClassicalFriction | DriveFriction = True,
+    comment: str | None = None,
+    drive: Drive | None = None,
 ) -> tuple[str, CoulombViscous | None]:
     """The MJCF document of a robot, and the friction approximation it holds.
 
     Parameters
     ----------
     robot : Robot
-    friction : bool or ClassicalFriction
+    friction : bool, ClassicalFriction or DriveFriction
         True: the robot's sigmoid friction (if any) as ``frictionloss`` and ``damping``;
-        a classical model: its ``fc`` and ``fv``; False: none.
+        a classical model: its ``fc`` and ``fv``; classical friction at the motors of a
+        drive: reflected to the joints (:func:`dynid.friction.mujoco.drive_joint_terms`);
+        False: none.
     comment : str, optional
         Text of an XML comment at the top (default: the writer and the conventions).
+    drive : Drive, optional
+        A drive with known rotor inertias: ``armature`` = ``diag(K^T diag(I_a) K)``; what
+        MJCF cannot hold (a coupled rotor's off-diagonal inertia) is said in a
+        :class:`~dynid.exceptions.DynidWarning` and in the comment, never dropped silently.
 
     Returns
     -------
@@ -88,7 +100,32 @@ def mjcf_from_robot(
     """
     n = robot.n
     approx = None
-    if isinstance(friction, ClassicalFriction):
+    notes: tuple[str, ...] = ()
+    armature = None
+    if isinstance(friction, DriveFriction) or drive is not None:
+        d = friction.drive if isinstance(friction, DriveFriction) else drive
+        assert d is not None
+        d.check(n)
+        law = friction.law if isinstance(friction, DriveFriction) else None
+        if law is not None and not isinstance(law, ClassicalFriction):
+            raise ShapeError("MJCF export of friction at the motors needs the classical law")
+        jt = drive_joint_terms(
+            d.transmission,
+            d.rotor_inertia,
+            None if law is None else np.asarray(law.fv),
+            None if law is None else np.asarray(law.fc),
+            friction_at_motor=d.friction_at == "motor",
+        )
+        notes = jt.notes
+        armature = jt.armature if d.rotor_inertia is not None else None
+        if law is not None:
+            z = np.zeros(n)
+            approx = CoulombViscous(jt.frictionloss, jt.damping, np.asarray(law.fo), z, z)
+        elif friction is True and robot.friction is not None:
+            approx = coulomb_viscous_from_sigmoid(robot.friction, robot.dq_max)
+        for note in notes:
+            warnings.warn(f"MJCF export: {note}", DynidWarning, stacklevel=2)
+    elif isinstance(friction, ClassicalFriction):
         if friction.n != n:
             raise ShapeError(f"friction has {friction.n} joints; robot {robot.name!r} has {n}")
         z = np.zeros(n)
@@ -107,6 +144,8 @@ def mjcf_from_robot(
             if approx is not None
             else "; frictionless joints"
         )
+        + ("; rotor inertia as armature" if armature is not None else "")
+        + "".join(f"; {note}" for note in notes)
     )
     sites: dict[int, list[str]] = {}
     links = set(robot.link_names)
@@ -135,6 +174,8 @@ def mjcf_from_robot(
             attrs += f' range="{_f(lo)} {_f(hi)}"'
         if approx is not None:
             attrs += f' frictionloss="{_f(approx.coulomb[i])}" damping="{_f(approx.viscous[i])}"'
+        if armature is not None:
+            attrs += f' armature="{_f(armature[i])}"'
         lines += [
             f"{ind[:-2]}<body name={quoteattr(robot.link_names[i + 1])} "
             f"{_pose(robot.T_parent_joint[i])}>",
@@ -160,9 +201,15 @@ def mjcf_from_robot(
     return "\n".join(lines) + "\n", approx
 
 
-def save_mjcf(path: str | Path, robot: Robot, *, friction: bool | ClassicalFriction = True) -> Path:
+def save_mjcf(
+    path: str | Path,
+    robot: Robot,
+    *,
+    friction: bool | ClassicalFriction | DriveFriction = True,
+    drive: Drive | None = None,
+) -> Path:
     """Write :func:`mjcf_from_robot` to ``path``; returns the path."""
     path = Path(path)
-    text, _ = mjcf_from_robot(robot, friction=friction)
+    text, _ = mjcf_from_robot(robot, friction=friction, drive=drive)
     write_text(path, text)
     return path
