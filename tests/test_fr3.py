@@ -128,7 +128,8 @@ def test_excite_robot_fr3_keeps_the_fr3_limits(tmp_path):
         assert d["limits"][f"{key}_{unit}"] == PUBLISHED[key], key
     assert d["limits"]["ddq_max_rad_s2"] == PUBLISHED["ddq_max"]
     assert d["limits"]["tau_max_nm"] == PUBLISHED["tau_max"]
-    header, *rows = (out / "trajectory.csv").read_text().splitlines()[1:]
+    text = (out / "trajectory.csv").read_text()
+    header, *rows = [s for s in text.splitlines() if not s.startswith("#")]
     table = np.array([[float(x) for x in row.split(",")] for row in rows])
     cols = header.split(",")
     q = table[:, [cols.index(f"q{j}") for j in range(1, 8)]]
