@@ -282,3 +282,73 @@ def test_static_route_identifies_rotor_inertia_of_the_controller_model():
     plain = identify_static(robot, data)
     err0 = np.abs(plain.mass_matrix(held.q) - held.M).max() / np.abs(held.M).max()
     assert err0 > 1e-3
+
+
+def test_noisy_motor_torques_give_errors_of_the_order_of_their_std():
+    """Motor-torque noise of 0.01 N m: the base parameters (rotors included) and the motor
+    friction deviate from the truth by about one reported standard deviation."""
+    robot, model, data = _ur5()
+    t, q, dq, ddq = _trajectory(6, 2, duration=12.0, fs=500.0)
+    tau = _joint_torques(model, data, q, dq, ddq)
+    K = Drive.from_gears(GEAR, COUPLING).transmission
+    noise = np.random.default_rng(0).normal(0.0, 0.01, tau.shape)
+    log = TorqueLog(
+        t, (q - OFFSET) @ K.T, dq @ K.T, np.linalg.solve(K.T, tau.T).T + noise, ddq @ K.T
+    )
+    m = identify_from_log(robot, log, cutoff_hz=None, decimate=1, drive=_drive())
+    beta = m.base.beta_from_phi(np.concatenate([robot.phi.reshape(-1), IA]))
+    f_true = np.stack([FV, FC, FO], axis=1).reshape(-1)
+    r = m.base.rank
+    z = np.concatenate(
+        [(m.fit.beta - beta) / m.fit.std, (m.joint_fit.beta[r:] - f_true) / m.joint_fit.std[r:]]
+    )
+    assert 0.4 < np.sqrt(np.mean(z**2)) < 2.0
+    assert np.abs(z).max() < 4.5
+
+
+@pytest.mark.slow
+def test_cli_consistent_fit_with_a_coupled_drive_keeps_the_rotors_out_of_the_links(tmp_path):
+    """simulate (motor side, known rotors) -> identify --consistent --drive (rotors
+    identified, >= 0) -> feasible.json and robot.toml keep the drive with the identified
+    rotor inertias (within 5 % of the truth; 0.05 N m of noise), robot.xml carries them as
+    armature, and validate --params predicts a held-out log as well as the unconstrained
+    fit."""
+    import json
+
+    from dynid.cli.__main__ import main
+
+    path = robot_data_urdf("ur_description/urdf/ur5_robot.urdf")
+    R = ["--robot", path, "--base", "base_link", "--tip", "tool0"]
+    coupling = ", ".join(f"[{m}, {j}, {v}]" for m, j, v in COUPLING)
+    text = (
+        f'schema = "dynid-drive/1"\nside = "motor"\ngear_ratio = {GEAR.tolist()}\n'
+        f"coupling = [{coupling}]\noffset = {OFFSET.tolist()}\n"
+    )
+    (tmp_path / "drive.toml").write_text(text)
+    (tmp_path / "truth.toml").write_text(text + f"rotor_inertia = {IA.tolist()}\n")
+    sim = [*R, "--drive", str(tmp_path / "truth.toml"), "--trajectory", "fourier"]
+    sim += ["--duration", "10", "--rate", "250", "--noise", "0.05", "-q"]
+    for seed, name in ((1, "log.csv"), (2, "held.csv")):
+        out = ["--seed", str(seed), "--out", str(tmp_path / name)]
+        assert main(["simulate", *sim, *out]) == 0
+    args = ["identify", *R, "--drive", str(tmp_path / "drive.toml"), "--consistent"]
+    args += ["--prior", path, "--data", str(tmp_path / "log.csv"), "--out", str(tmp_path / "c")]
+    assert main([*args, "-q", "--no-figures"]) == 0
+    feas = json.loads((tmp_path / "c" / "feasible.json").read_text())
+    ia = np.array(feas["drive"]["rotor_inertia"])
+    np.testing.assert_allclose(ia, IA, rtol=0.05)
+    assert load_drive(tmp_path / "c" / "robot.toml", 6).rotor_inertia == pytest.approx(ia)
+    mj = pytest.importorskip("mujoco")
+    model = mj.MjModel.from_xml_path(str(tmp_path / "c" / "robot.xml"))
+    K = Drive.from_gears(GEAR, COUPLING).transmission
+    np.testing.assert_allclose(model.dof_armature, np.diag(K.T @ np.diag(ia) @ K), rtol=1e-12)
+    for src, out in (("--params", "c/feasible.json"), ("--model", "c/identification.json")):
+        v = ["validate", src, str(tmp_path / out), "--data", str(tmp_path / "held.csv")]
+        assert main([*v, "--out", str(tmp_path / out.replace("/", "_")), "-q", "--no-figures"]) == 0
+    err = {
+        k: json.loads((tmp_path / f"c_{k}.json" / "validation.json").read_text())[
+            "relative_error_percent"
+        ]
+        for k in ("feasible", "identification")
+    }
+    assert err["feasible"] < 1.05 * err["identification"] + 0.05

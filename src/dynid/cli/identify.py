@@ -328,6 +328,7 @@ def run_consistent(robot: Robot, args: argparse.Namespace) -> int:
             total_mass=band,
             options=sdp_options(args),
             rtol=args.rtol,
+            drive=load_drive_arg(args, robot.n),
             **kw,
         )
     if result.identified is None:  # pragma: no cover - identify_consistent always sets it

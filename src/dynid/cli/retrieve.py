@@ -64,7 +64,7 @@ from ..feasibility.retrieve import (
     retrieve_from_static,
 )
 from ..feasibility.sdp import ConsistentResult
-from ..friction.model import ClassicalFriction
+from ..friction.model import ClassicalFriction, DriveFriction
 from ..friction.validation import NewtonEulerValidation
 from ..identification.model import IdentifiedModel
 from ..io.export import save_robot
@@ -229,11 +229,17 @@ def format_consistent_summary(result: ConsistentResult) -> str:
         f"solver {r.solver}: {r.status}, {r.run_time:.2f} s",
     ]
     if r.friction is not None:
+        at = "motors" if r.drive is not None and r.drive.friction_at == "motor" else "joints"
         lines.append(
-            "friction fv [N m s/rad]: "
-            + " ".join(f"{x:.4f}" for x in r.friction[:, 0])
+            f"friction at the {at}: fv [N m s/rad]: "
+            + " ".join(f"{x:.4g}" for x in r.friction[:, 0])
             + "; fc [N m]: "
-            + " ".join(f"{x:.4f}" for x in r.friction[:, 1])
+            + " ".join(f"{x:.4g}" for x in r.friction[:, 1])
+        )
+    if r.rotor_inertia is not None:
+        lines.append(
+            "rotor inertia at the motors [kg m^2] (>= 0): "
+            + " ".join(f"{x:.4g}" for x in r.rotor_inertia)
         )
     lines += [f"note: {s}" for s in r.notes]
     if not r.feasible:
@@ -251,9 +257,14 @@ def write_outputs(
     """Write feasible.json, robot.urdf, robot.xml, robot.toml, report.json (and retrieval.png)."""
     files = [save_feasible_json(out / "feasible.json", result)]
     fr = getattr(result, "friction", None)  # one-step on a log: classical fv, fc, fo
-    mj = ClassicalFriction.from_array(fr) if fr is not None else True
+    drive = getattr(result, "drive", None)
+    mj: Any = True
+    if fr is not None:
+        law = ClassicalFriction.from_array(fr)
+        at_motors = drive is not None and drive.friction_at == "motor"
+        mj = DriveFriction(law, drive) if drive is not None and at_motors else law
     files += [
-        save_robot(out / f"robot.{ext}", result.robot, friction=mj)
+        save_robot(out / f"robot.{ext}", result.robot, friction=mj, drive=drive)
         for ext in ("urdf", "xml", "toml")
     ]
     files.append(save_report_json(out / "report.json", result, **report_extra))

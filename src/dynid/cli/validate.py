@@ -132,6 +132,10 @@ def run(args: argparse.Namespace) -> int:
             friction = load_feasible_linear_friction(args.params) or friction
     cutoff = recorded_cutoff(model) if args.cutoff is None else args.cutoff
     drive = load_drive_arg(args, robot.n)
+    if drive is None and args.params is not None:
+        from ..io.feasible import load_feasible_drive
+
+        drive = load_feasible_drive(args.params)
     with about(args.data):
         val = validate_torques(
             model,

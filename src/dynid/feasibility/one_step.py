@@ -29,7 +29,7 @@ from ..model.drive import Drive
 from ..model.robot import Robot
 from .bounds import Bounds
 from .prior import Prior
-from .sdp import ConsistentResult, SDPOptions, coefficient_term, solve_consistent
+from .sdp import ConsistentResult, SDPOptions, coefficient_term, solve_consistent, with_drive
 
 __all__ = ["identify_consistent"]
 
@@ -109,4 +109,5 @@ def identify_consistent(
         constraints=constraints,
         kind=kind,
     )
-    return replace(res, identified=model)
+    res = replace(res, identified=model)
+    return res if drive is None else with_drive(res, drive)

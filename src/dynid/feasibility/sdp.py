@@ -46,6 +46,7 @@ closest consistent set (least relative coefficient error) and how far it is.
 
 from __future__ import annotations
 
+import dataclasses
 import math
 import time
 import warnings
@@ -59,6 +60,7 @@ from numpy.typing import NDArray
 from ..exceptions import DataError, InfeasibleError, ModelError, ShapeError, SolverError
 from ..identification.least_squares import LeastSquaresFit
 from ..identification.model import IdentifiedModel
+from ..model.drive import Drive
 from ..model.inertia import inertial_from_phi, params_from_inertial
 from ..model.robot import Robot
 from .bounds import Bounds, default_bounds, segment_points
@@ -333,6 +335,9 @@ class ConsistentResult:
     rotor_inertia : ndarray, shape (n,), or None
         Rotor inertias [kg m^2] at the motors (``>= 0``), identified with the links when
         the data term holds them (a drive with ``rotor_inertia = "identify"``).
+    drive : Drive or None
+        The drive train of the data, its rotor inertias those of the result
+        (:func:`with_drive`).
     """
 
     robot: Robot
@@ -360,6 +365,7 @@ class ConsistentResult:
     seed: int | None = None
     identified: IdentifiedModel | None = None
     rotor_inertia: NDArray[np.float64] | None = None
+    drive: Drive | None = None
 
     @property
     def mass(self) -> NDArray[np.float64]:
@@ -933,7 +939,7 @@ def retrieve_sdp(
     >>> data = dynid.acquire_static(dynid.SimulatedController(robot), 100, np.random.default_rng(0))
     >>> res = retrieve_sdp(dynid.identify_static(robot, data), prior=robot)  # doctest: +SKIP
     """
-    return solve_consistent(
+    res = solve_consistent(
         model.robot,
         coefficient_term(model),
         prior=prior,
@@ -943,3 +949,13 @@ def retrieve_sdp(
         constraints=constraints,
         kind="coefficients",
     )
+    return res if model.drive is None else with_drive(res, model.drive)
+
+
+def with_drive(res: ConsistentResult, drive: Drive) -> ConsistentResult:
+    """The result with its drive, whose rotor inertias are the identified ones (known from
+    then on: a simulator or a validation takes them as given)."""
+    ia = res.rotor_inertia if drive.rotor_inertia is None else drive.rotor_inertia
+    if ia is None:
+        return dataclasses.replace(res, drive=drive)
+    return dataclasses.replace(res, drive=dataclasses.replace(drive, rotor_inertia=ia))

@@ -170,7 +170,8 @@ def validate_torques(
         with (:func:`recorded_cutoff`), else the library default.
     drive : Drive, optional
         The drive the log was recorded through (motor side, currents); default: an
-        identified model's own (:func:`model_drive`). Errors are in joint torques.
+        identified model's own (:func:`model_drive`). Its known rotor inertias are added to
+        a robot's torques (an identified model holds its own). Errors are in joint torques.
 
     Returns
     -------
@@ -185,12 +186,16 @@ def validate_torques(
     """
     if friction is not None and friction.n != log.n:
         raise ShapeError(f"friction model has {friction.n} joints; the log has {log.n}")
-    log = joint_side_log(log, model_drive(model, drive))
+    d = model_drive(model, drive)
+    log = joint_side_log(log, d)
     cut = recorded_cutoff(model) if isinstance(cutoff_hz, str) else cutoff_hz
     res = friction_residual(
         model, log, cutoff_hz=cut, trim_s=trim_s, filter_tau=filter_tau, max_gap_s=max_gap_s
     )
     p, tau_model = res.log, res.tau_model
+    if d is not None and d.rotor_inertia is not None and not isinstance(model, IdentifiedModel):
+        assert p.ddq is not None  # prepare_log always fills ddq
+        tau_model = tau_model + d.rotor_torques(p.ddq, d.rotor_inertia)  # a robot's links only
     # free what is no longer needed before the friction torques (a long log's raw signals,
     # when the caller holds no other reference, and the residual)
     del res, log

@@ -23,6 +23,8 @@ _NAMES = {
     "save_feasible_json": "feasible",
     "load_feasible_json": "feasible",
     "load_feasible_linear_friction": "feasible",
+    "load_feasible_drive": "feasible",
+    "load_drive": "drive_file",
     "save_report_json": "feasible",
     "save_bounds": "feasible",
     "load_bounds": "feasible",

@@ -32,7 +32,13 @@ from numpy.typing import NDArray
 from ..exceptions import DataError, DynidError
 from ..model.drive import DRIVE_SCHEMA, Drive
 
-__all__ = ["drive_from_mapping", "drive_from_record", "drive_of_robot_file", "load_drive"]
+__all__ = [
+    "drive_from_mapping",
+    "drive_from_record",
+    "drive_of_robot_file",
+    "drive_toml",
+    "load_drive",
+]
 
 _KEYS = {
     "schema",
@@ -223,3 +229,30 @@ def drive_of_robot_file(spec: str | Path, n: int) -> Drive | None:
     if "drive" not in doc:
         return None
     return drive_from_mapping(doc["drive"], n, source=f"{p.name} [drive]")
+
+
+def drive_toml(drive: Drive) -> str:
+    """The drive as a ``[drive]`` TOML table (gear ratios and coupling entries), which
+    :func:`load_drive` reads back to the same drive (floats as ``repr``)."""
+    K = drive.transmission
+    n = drive.n
+
+    def vec(v: Any) -> str:
+        return "[" + ", ".join(repr(float(x)) for x in v) + "]"
+
+    off = [(i, j) for i in range(n) for j in range(n) if i != j and K[i, j] != 0.0]
+    lines = [
+        "[drive]",
+        f'schema = "{DRIVE_SCHEMA}"',
+        f'side = "{drive.side}"',
+        f'effort = "{drive.effort}"',
+        f"gear_ratio = {vec(np.diag(K))}",
+        "coupling = [" + ", ".join(f"[{i + 1}, {j + 1}, {float(K[i, j])!r}]" for i, j in off) + "]",
+        f"offset = {vec(drive.offset)}",
+        f'friction_at = "{drive.friction_at}"',
+    ]
+    if drive.torque_constant is not None:
+        lines.append(f"torque_constant = {vec(drive.torque_constant)}")
+    ia = drive.rotor_inertia
+    lines.append('rotor_inertia = "identify"' if ia is None else f"rotor_inertia = {vec(ia)}")
+    return "\n".join(lines) + "\n"

@@ -21,6 +21,7 @@ from ..friction.model import ClassicalFriction, DriveFriction
 from ..model.drive import Drive
 from ..model.robot import Robot
 from .atomic import write_text
+from .drive_file import drive_toml
 from .mjcf_export import save_mjcf
 from .urdf_export import save_urdf
 
@@ -78,7 +79,8 @@ def save_robot(
         MJCF only: the robot's friction, identified classical friction (at the joints or
         the motors), or none (:func:`dynid.io.mjcf_export.save_mjcf`).
     drive : Drive, optional
-        MJCF only: a drive with known rotor inertias, written as ``armature``.
+        MJCF: a drive with known rotor inertias, written as ``armature``; TOML: the drive
+        as a ``[drive]`` table.
 
     Raises
     ------
@@ -96,4 +98,7 @@ def save_robot(
         )
     if fmt == "mjcf":
         return save_mjcf(path, robot, friction=friction, drive=drive)
-    return write_text(path, robot.to_toml())
+    text = robot.to_toml()
+    if drive is not None:  # the drive train with it, as a [drive] table
+        text = text.rstrip("\n") + "\n\n" + drive_toml(drive)
+    return write_text(path, text)

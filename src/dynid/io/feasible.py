@@ -10,6 +10,8 @@ friction, so that it loads back as a complete :class:`~dynid.model.robot.Robot`:
     {"schema": "dynid-feasible-parameters/1", "dynid_version": ..., "name": ...,
      "links": [{"name": "link1", "mass": 4.97, "com": [...], "inertia": [...]}, ...],
      "friction": null | {"model": "sigmoid", "phi1": [...], "phi2": [...], "phi3": [...]},
+     "linear_friction": null | {"model": "classical", "fv": [...], "fc": [...], "fo": [...]},
+     "drive": null | {dynid-drive/1 record, rotor_inertia: the identified values},
      "kinematics": {...}, "feasible": true, "relative_residual": ..., "seed": ...,
      "units": {...}, "conventions": {...}}
 
@@ -51,10 +53,12 @@ from ..feasibility.bounds import Bounds, default_bounds
 from ..feasibility.constraints import FeasibilityReport
 from ..feasibility.retrieve import RetrievalResult
 from ..feasibility.sdp import ConsistentResult
-from ..friction.model import ClassicalFriction
+from ..friction.model import ClassicalFriction, DriveFriction
+from ..model.drive import Drive
 from ..model.inertia import INERTIA_ORDER, inertia6_from_matrix, inertial_from_phi
 from ..model.robot import Robot
 from .atomic import write_text
+from .drive_file import drive_from_record
 from .json_files import load_json, save_json
 from .robot_json import robot_from_dict, robot_to_dict
 
@@ -68,6 +72,7 @@ __all__ = [
     "load_bounds",
     "consistent_report_to_dict",
     "load_feasible_json",
+    "load_feasible_drive",
     "load_feasible_linear_friction",
     "report_to_dict",
     "robot_from_feasible_dict",
@@ -113,7 +118,9 @@ def feasible_to_dict(source: Any, *, seed: int | None = None) -> dict[str, Any]:
     source : RetrievalResult, ConsistentResult or Robot
         A result also records ``method``, ``feasible``, ``relative_residual`` and its seed;
         a consistent identification from a torque log its classical friction
-        (``linear_friction``: ``fv, fc >= 0`` identified with the links).
+        (``linear_friction``: ``fv, fc >= 0`` identified with the links; per motor with a
+        drive whose friction acts at the motors), and with a drive its record (``drive``,
+        the identified rotor inertias [kg m^2] in ``rotor_inertia``).
     seed : int, optional
         Recorded when ``source`` is a Robot.
     """
@@ -148,6 +155,8 @@ def feasible_to_dict(source: Any, *, seed: int | None = None) -> dict[str, Any]:
         "units": _UNITS,
         "conventions": _CONVENTIONS,
     }
+    drive = getattr(source, "drive", None) if not isinstance(source, Robot) else None
+    d["drive"] = None if drive is None else drive.as_dict()
     if not isinstance(source, Robot):
         d["method"] = getattr(source, "method", "penalty")
         d["feasible"] = bool(source.feasible)
@@ -263,11 +272,12 @@ def load_feasible_json(path: str | Path, robot: Robot | None = None) -> Robot:
         raise DataError(f"{name}: {exc}") from exc
 
 
-def load_feasible_linear_friction(path: str | Path) -> ClassicalFriction | None:
+def load_feasible_linear_friction(path: str | Path) -> ClassicalFriction | DriveFriction | None:
     """The classical friction (``fv, fc, fo`` per joint) held by ``feasible.json``, or None.
 
     Written by a consistent identification from a torque log; ``dynid validate --params``
-    uses it unless another friction is given.
+    uses it unless another friction is given. With a drive whose friction acts at the
+    motors, the law per motor mapped through the transmission (:class:`DriveFriction`).
     """
     d = _read_json(path)
     lin = d.get("linear_friction")
@@ -276,11 +286,29 @@ def load_feasible_linear_friction(path: str | Path) -> ClassicalFriction | None:
     name = Path(path).name
     try:
         n = len(d["links"])
-        return ClassicalFriction(
+        law = ClassicalFriction(
             *(_vec(lin[k], n, f"{name}: linear_friction {k}") for k in ("fv", "fc", "fo"))
         )
     except (KeyError, TypeError):
         raise DataError(f"{name}: linear_friction needs fv, fc, fo per joint") from None
+    drive = load_feasible_drive(path)
+    return DriveFriction(law, drive) if drive is not None and drive.friction_at == "motor" else law
+
+
+def load_feasible_drive(path: str | Path) -> Drive | None:
+    """The drive train held by ``feasible.json`` (its rotor inertias the identified ones), or
+    None."""
+    d = _read_json(path)
+    if d.get("drive") is None:
+        return None
+    try:
+        n = len(d["links"])
+    except (KeyError, TypeError):
+        raise DataError(f"{Path(path).name}: 'links' must be a list") from None
+    try:
+        return drive_from_record(d["drive"], n)
+    except DataError as exc:
+        raise DataError(f"{Path(path).name}: {exc}") from exc
 
 
 # ------------------------------------------------------------------------ the report

@@ -140,7 +140,13 @@ def mjcf_from_robot(
         f"written by dynid {__version__}: inertials about the CoM in link axes [kg, m, kg m^2]"
         + (
             "; friction: Coulomb as frictionloss, viscous as damping"
-            + ("" if isinstance(friction, ClassicalFriction) else " (fit of the sigmoid)")
+            + (
+                " (fit of the sigmoid)"
+                if not isinstance(friction, ClassicalFriction | DriveFriction)
+                else " (reflected from the motors)"
+                if isinstance(friction, DriveFriction)
+                else ""
+            )
             if approx is not None
             else "; frictionless joints"
         )
