@@ -363,6 +363,84 @@ def obstacles_deep(d: Path) -> None:
     )
 
 
+def _two_joint(d: Path, name: str, old: str, new: str, *, prefix: str = "") -> None:
+    """two.toml with ``old`` replaced by ``new`` (and ``prefix`` before it)."""
+    assert old in TWO_JOINT_TOML
+    (d / name).write_text(prefix + TWO_JOINT_TOML.replace(old, new, 1), encoding="utf-8")
+
+
+def toml_axis_1e300(d: Path) -> None:
+    """A joint axis [0, 0, 1e300]: its norm overflowed and the axis became zero silently."""
+    _two_joint(d, "bad.toml", "axis = [0, 0, 1]", "axis = [0, 0, 1e300]")
+
+
+def toml_int_400_digits(d: Path) -> None:
+    """An axis entry that is an integer of 401 digits (OverflowError)."""
+    _two_joint(d, "bad.toml", "axis = [0, 0, 1]", "axis = [0, 0, 1" + "0" * 400 + "]")
+
+
+def toml_int_5000_digits(d: Path) -> None:
+    """An integer of 5,001 digits (Python refuses to convert it: ValueError)."""
+    _two_joint(d, "bad.toml", "axis = [0, 0, 1]", "axis = [0, 0, 1" + "0" * 5000 + "]")
+
+
+def toml_deep(d: Path) -> None:
+    """A TOML document nested 10,000 deep (RecursionError)."""
+    _two_joint(
+        d,
+        "bad.toml",
+        'name = "two"',
+        'name = "two"',
+        prefix="x = " + "[" * 10000 + "]" * 10000 + "\n",
+    )
+
+
+def toml_huge_mass(d: Path) -> None:
+    """A link of 1e12 kg."""
+    _two_joint(
+        d,
+        "bad.toml",
+        "axis = [0, 0, 1]\n[[joints]]",
+        "axis = [0, 0, 1]\n[joints.inertial]\n"
+        "mass = 1e12\ncom = [0.1, 0, 0]\ninertia = [1, 0, 0, 1, 0, 1]\n[[joints]]",
+    )
+
+
+def toml_boolean_mass(d: Path) -> None:
+    """A link mass written as true."""
+    _two_joint(
+        d,
+        "bad.toml",
+        "axis = [0, 0, 1]\n[[joints]]",
+        "axis = [0, 0, 1]\n[joints.inertial]\n"
+        "mass = true\ncom = [0.1, 0, 0]\ninertia = [1, 0, 0, 1, 0, 1]\n[[joints]]",
+    )
+
+
+def toml_long_name(d: Path) -> None:
+    """A joint type of a million characters (the message echoed all of it)."""
+    _two_joint(d, "bad.toml", 'type = "revolute"', 'type = "' + "x" * 1_000_000 + '"')
+
+
+def bounds_boolean_mass(d: Path) -> None:
+    """A bounds file with true as a mass bound (it was accepted, exit 0)."""
+    (d / "bounds.json").write_text(
+        '{"schema": "dynid-feasibility-bounds/1", "links": [{"name": "link1", "mass": [true, 5]}]}'
+    )
+
+
+def bounds_string_mass(d: Path) -> None:
+    """A bounds file (TOML) with a string where a number belongs."""
+    (d / "bounds.toml").write_text(
+        'schema = "dynid-feasibility-bounds/1"\n[[links]]\nname = "link1"\nmass = ["1", 5]\n'
+    )
+
+
+def bounds_deep(d: Path) -> None:
+    """A bounds TOML nested 10,000 deep."""
+    (d / "bounds.toml").write_text("x = " + "[" * 10000 + "]" * 10000 + "\n")
+
+
 def _edit_model(d: Path, edit: Callable[[dict], None]) -> None:
     doc = json.loads((d / "res" / "identification.json").read_text())
     edit(doc)
@@ -483,6 +561,18 @@ CASES = [
     C("obstacles-duplicated-planes", obstacles_dup_planes, f"excite --obstacles {{d}}/obs.json --out {OUT}", 2, "obs.json: not strict JSON (duplicated key 'planes')"),
     C("obstacles-unknown-key", obstacles_unknown_key, f"excite --obstacles {{d}}/obs.json --out {OUT}", 2, "obs.json: unknown key(s) ['box']"),
     C("obstacles-nested-deep", obstacles_deep, f"excite --obstacles {{d}}/obs.json --out {OUT}", 2, "nested too deeply"),
+    # robot descriptions: absurd numbers and deep nesting are one clear line (issue 20)
+    C("toml-axis-1e300", toml_axis_1e300, "fk --robot {d}/bad.toml --q 0.1,0.2", 2, "key 'axis' = [0.0, 0.0, 1e+300] is too large to normalise (its squared length overflows a float)"),
+    C("toml-integer-400-digits", toml_int_400_digits, "fk --robot {d}/bad.toml --q 0.1,0.2", 2, "key 'axis' must be a finite number; got an integer of about 401 digits"),
+    C("toml-integer-5000-digits", toml_int_5000_digits, "fk --robot {d}/bad.toml --q 0.1,0.2", 2, "is not valid TOML (an integer of more than 4300 digits)"),
+    C("toml-nested-deep", toml_deep, "fk --robot {d}/bad.toml --q 0.1,0.2", 2, "is not valid TOML (arrays or tables nested too deeply)"),
+    C("toml-mass-1e12", toml_huge_mass, "fk --robot {d}/bad.toml --q 0.1,0.2", 2, "key 'inertial.mass' must lie in [0, 1e+06] kg; got 1000000000000.0"),
+    C("toml-mass-true", toml_boolean_mass, "fk --robot {d}/bad.toml --q 0.1,0.2", 2, "key 'inertial.mass' must be a number; got True"),
+    C("toml-long-string", toml_long_name, "fk --robot {d}/bad.toml --q 0.1,0.2", 2, "... (1000000 characters)"),
+    # bounds files: numbers only where numbers belong
+    C("bounds-mass-true", bounds_boolean_mass, f"retrieve --model {{d}}/res/identification.json --bounds {{d}}/bounds.json --out {OUT}", 2, "bounds.json: links[0] mass[0] must be a number; got True"),
+    C("bounds-mass-string", bounds_string_mass, f"retrieve --model {{d}}/res/identification.json --bounds {{d}}/bounds.toml --out {OUT}", 2, "bounds.toml: links[0] mass[0] must be a number; got '1'"),
+    C("bounds-nested-deep", bounds_deep, f"retrieve --model {{d}}/res/identification.json --bounds {{d}}/bounds.toml --out {OUT}", 2, "bounds.toml is not valid TOML (arrays or tables nested too deeply)"),
     # static data: robot consistency and BOM
     C("static-bom", static_bom, f"identify --data {{d}}/bom.csv --out {OUT}", 0, ""),
     C("static-other-robot", static_xarm, f"identify --data {{d}}/bad.csv --out {OUT}", 2, "recorded with robot 'xarm7'; the robot given is 'panda'"),
@@ -539,8 +629,9 @@ def test_bad_input_gives_one_line_and_exit_code(case, base, tmp_path, capsys, ca
     assert "Traceback" not in err
     if case.code != 0:
         lines = [s for s in err.splitlines() if s.strip()]
-        assert len(lines) == 1, err
-        assert case.fragment in lines[0], err
+        assert len(lines) == 1, err[:2000]
+        assert case.fragment in lines[0], err[:2000]
+        assert len(lines[0]) < 700, f"{len(lines[0])} characters: {lines[0][:2000]}"
         assert not (d / "out").exists(), "a failing command left output behind"
     elif case.fragment:  # a warning: printed, or logged (stderr through logging)
         assert case.fragment in err + caplog.text, err

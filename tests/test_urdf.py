@@ -491,3 +491,36 @@ def test_urdf_link_named_flange_off_the_tip_warns():
     with pytest.warns(dynid.DynidWarning, match="URDF link 'flange' is not the tip link 'tcp'"):
         robot = robot_from_urdf_string(text)
     np.testing.assert_array_equal(robot.frames["flange"].T_link_frame[:3, 3], [0.0, 0.0, 0.1])
+
+
+def test_absurd_axes_and_masses_are_refused_by_every_reader():
+    """An axis [0, 0, 1e300] (its norm overflows, so it became a zero axis) and a link of
+    1e12 kg are ModelErrors naming the joint or link, from the URDF reader, the TOML reader
+    and the Robot itself (issue 20); an axis of 1e150 still normalises to [0, 0, 1]."""
+    from dynid.exceptions import ModelError
+    from dynid.model.description import robot_from_toml_string
+
+    urdf = """<robot name="r"><link name="a"/><link name="b"><inertial><mass value="{m}"/>
+      <inertia ixx="0.1" iyy="0.1" izz="0.1"/></inertial></link>
+      <joint name="j" type="revolute"><parent link="a"/><child link="b"/>
+      <axis xyz="{ax}"/></joint></robot>"""
+    ok = robot_from_urdf_string(urdf.format(m=1, ax="0 0 1e150"))
+    np.testing.assert_array_equal(ok.axes, [[0.0, 0.0, 1.0]])
+    with pytest.raises(
+        ModelError, match=r"joint 'j' axis \[0.0, 0.0, 1e\+300\] is too large to normalise"
+    ):
+        robot_from_urdf_string(urdf.format(m=1, ax="0 0 1e300"))
+    with pytest.raises(ModelError, match=r"link 'b' <inertial> <mass> must be at most 1e\+06"):
+        robot_from_urdf_string(urdf.format(m=1e12, ax="0 0 1"))
+    toml = '[[joints]]\nname = "j"\ntype = "revolute"\nparent = "a"\nchild = "b"\naxis = {ax}\n'
+    with pytest.raises(
+        ModelError, match=r"key 'axis' = \[0.0, 1e\+300, 0.0\] is too large to normalise"
+    ):
+        robot_from_toml_string(toml.format(ax="[0, 1e300, 0]"))
+    with pytest.raises(ModelError, match="joint axis of j, .* is too large to normalise"):
+        dynid.Robot(
+            name="r", joint_names=("j",), link_names=("a", "b"), T_parent_joint=np.eye(4)[None],
+            axes=[[1e300, 1e300, 0.0]], prismatic=[False], phi=np.zeros((1, 10)),
+            q_min=[-1.0], q_max=[1.0], dq_max=[1.0], ddq_max=[1.0], tau_max=[1.0],
+            gravity=[0.0, 0.0, -9.81],
+        )  # fmt: skip

@@ -25,7 +25,6 @@ from __future__ import annotations
 
 import io
 import math
-import tomllib
 from collections.abc import Mapping
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -35,6 +34,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
+from .. import _checks
 from ..exceptions import DataError
 from ..identification.data import StaticDataset
 from ..identification.log import (
@@ -182,10 +182,7 @@ def load_column_map(path: str | Path, **kw: Any) -> ColumnMap:
         Not TOML, other tables or keys, an unknown quantity or unit.
     """
     path = Path(path)
-    try:
-        d = tomllib.loads(path.read_text(encoding="utf-8"))
-    except tomllib.TOMLDecodeError as exc:
-        raise DataError(f"{path.name}: not valid TOML ({exc})") from exc
+    d = _checks.parse_toml(path.read_text(encoding="utf-8"), path.name, DataError)
     extra = sorted(set(d) - {"columns", "units", "velocity_cutoff_hz"})
     if extra:
         raise DataError(f"{path.name}: unknown key(s) {extra}; expected [columns], [units]")

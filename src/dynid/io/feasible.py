@@ -40,14 +40,13 @@ from __future__ import annotations
 
 import json
 import math
-import tomllib
 from collections.abc import Mapping
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 
-from .. import __version__
+from .. import __version__, _checks
 from ..exceptions import DataError, ModelError, ShapeError
 from ..feasibility.bounds import Bounds, default_bounds
 from ..feasibility.constraints import FeasibilityReport
@@ -173,13 +172,10 @@ def save_feasible_json(path: str | Path, source: Any) -> Path:
 
 
 def _vec(v: Any, size: int, where: str) -> np.ndarray:
-    try:
-        a = np.asarray(v, dtype=np.float64)
-    except (TypeError, ValueError):
-        raise DataError(f"{where} must be {size} numbers; got {v!r}") from None
-    if a.shape != (size,) or not np.all(np.isfinite(a)):
-        raise DataError(f"{where} must be {size} finite numbers; got {v!r}")
-    return a
+    """A list of ``size`` finite numbers, strictly (a boolean or a string is refused)."""
+    if not isinstance(v, list | tuple) or len(v) != size:
+        raise DataError(f"{where} must be a list of {size} numbers; got {_checks.short(v)}")
+    return np.array([_checks.number(x, f"{where}[{k}]", DataError) for k, x in enumerate(v)])
 
 
 def robot_from_feasible_dict(d: Mapping[str, Any], robot: Robot | None = None) -> Robot:
@@ -512,23 +508,28 @@ def bounds_from_dict(d: Mapping[str, Any], robot: Robot, *, source: str = "bound
     """
     unknown = sorted(set(d) - {"schema", "total_mass", "links", "units"})
     if unknown:
-        raise DataError(f"{source}: unknown keys {unknown}")
+        raise DataError(f"{source}: unknown keys {_checks.short(unknown)}")
     schema = d.get("schema", BOUNDS_SCHEMA)
     if schema != BOUNDS_SCHEMA:
         raise DataError(f"{source}: schema {schema!r}, expected {BOUNDS_SCHEMA!r}")
     base = default_bounds(robot)
     lo, hi = base.lower.copy(), base.upper.copy()
     names = list(robot.link_names[1:])
-    for k, link in enumerate(d.get("links", []) or []):
+    links = d.get("links", []) or []
+    if not isinstance(links, list):
+        raise DataError(f"{source}: 'links' must be a list of tables/objects")
+    for k, link in enumerate(links):
         where = f"{source}: links[{k}]"
         if not isinstance(link, Mapping):
             raise DataError(f"{where} must be a table/object")
         bad = sorted(set(link) - _BOUND_KEYS)
         if bad:
-            raise DataError(f"{where}: unknown keys {bad}; allowed: {sorted(_BOUND_KEYS)}")
+            raise DataError(
+                f"{where}: unknown keys {_checks.short(bad)}; allowed: {sorted(_BOUND_KEYS)}"
+            )
         name = link.get("name")
         if name not in names:
-            raise DataError(f"{where}: unknown link {name!r}; available: {names}")
+            raise DataError(f"{where}: unknown link {_checks.short(name)}; available: {names}")
         i = names.index(name)
         if "mass" in link:
             lo[i, 0], hi[i, 0] = _vec(link["mass"], 2, f"{where} mass")
@@ -568,9 +569,10 @@ def load_bounds(path: str | Path, robot: Robot) -> Bounds:
         d = _read_json(path)
     elif suffix == ".toml":
         try:
-            d = tomllib.loads(path.read_text(encoding="utf-8-sig"))
-        except (tomllib.TOMLDecodeError, UnicodeDecodeError) as exc:
-            raise DataError(f"{path.name}: not a TOML file ({exc})") from exc
+            text = path.read_text(encoding="utf-8-sig")
+        except UnicodeDecodeError as exc:
+            raise DataError(f"{path.name}: not a UTF-8 text file ({exc.reason})") from None
+        d = _checks.parse_toml(text, path.name, DataError)
     else:
         raise DataError(f"{path.name}: bounds files are .json or .toml; got {suffix!r}")
     return bounds_from_dict(d, robot, source=path.name)

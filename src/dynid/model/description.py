@@ -15,14 +15,15 @@ Layout: optional top-level ``format_version = 1``, ``name``, ``gravity`` and
 with an annotated example, is in ``docs/robot-description.md``.
 
 Unknown keys are rejected, so that a misspelt key does not silently fall back to a
-default. Every error names the joint or frame and the key.
+default; numbers must be finite TOML numbers (never booleans or strings), an axis of a
+squared length beyond the float range and a mass outside ``[0, MAX_LINK_MASS]`` are refused.
+Every error names the joint or frame and the key.
 """
 
 from __future__ import annotations
 
 import json
 import math
-import tomllib
 from collections.abc import Mapping, Sequence
 from pathlib import Path
 from typing import Any
@@ -30,10 +31,10 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
-from .. import spatial
+from .. import _checks, spatial
 from ..exceptions import DynidError, ModelError
 from .inertia import inertia6_from_matrix, phi_from_inertial
-from .robot import STANDARD_GRAVITY, Frame, Robot, mdh_transform
+from .robot import MAX_LINK_MASS, STANDARD_GRAVITY, Frame, Robot, mdh_transform
 
 __all__ = ["FORMAT_VERSION", "robot_from_toml", "robot_from_toml_string", "toml_from_robot"]
 
@@ -66,7 +67,9 @@ _TYPES = {"revolute": False, "prismatic": True}
 def _check_keys(table: Mapping[str, Any], allowed: set[str], where: str) -> None:
     unknown = sorted(set(table) - allowed)
     if unknown:
-        raise ModelError(f"{where}: unknown key {unknown[0]!r}; allowed: {sorted(allowed)}")
+        raise ModelError(
+            f"{where}: unknown key {_checks.short(unknown[0])}; allowed: {sorted(allowed)}"
+        )
 
 
 def _table(value: Any, where: str) -> Mapping[str, Any]:
@@ -77,29 +80,28 @@ def _table(value: Any, where: str) -> Mapping[str, Any]:
 
 def _require(table: Mapping[str, Any], key: str, where: str) -> Any:
     if key not in table:
-        raise ModelError(f"{where}: missing key {key!r}")
+        raise ModelError(f"{where}: missing key {_checks.short(key)}")
     return table[key]
 
 
 def _string(table: Mapping[str, Any], key: str, where: str) -> str:
     value = _require(table, key, where)
     if not isinstance(value, str) or not value:
-        raise ModelError(f"{where}: key {key!r} must be a non-empty string; got {value!r}")
+        raise ModelError(
+            f"{where}: key {key!r} must be a non-empty string; got {_checks.short(value)}"
+        )
     return value
 
 
 def _number(value: Any, where: str, key: str, *, finite: bool = True) -> float:
-    if isinstance(value, bool) or not isinstance(value, int | float):
-        raise ModelError(f"{where}: key {key!r} must be a number; got {value!r}")
-    x = float(value)
-    if math.isnan(x) or (finite and not math.isfinite(x)):
-        raise ModelError(f"{where}: key {key!r} must be finite; got {value!r}")
-    return x
+    if not finite and isinstance(value, float) and math.isinf(value):
+        return value  # limits may be inf (none)
+    return _checks.number(value, f"{where}: key {key!r}", ModelError)
 
 
 def _vector(value: Any, size: int, where: str, key: str) -> NDArray[np.float64]:
     if not isinstance(value, list) or len(value) != size:
-        got = f"{len(value)} entries" if isinstance(value, list) else repr(value)
+        got = f"{len(value)} entries" if isinstance(value, list) else _checks.short(value)
         raise ModelError(f"{where}: key {key!r} must be a list of {size} numbers; got {got}")
     return np.array([_number(v, where, key) for v in value])
 
@@ -150,19 +152,16 @@ def robot_from_toml_string(text: str, *, source: str = "TOML text") -> Robot:
         unknown, names repeat, or the robot is otherwise invalid (limits, axes); the
         message names the joint or frame and the key.
     """
-    try:
-        doc = tomllib.loads(text)
-    except tomllib.TOMLDecodeError as exc:
-        raise ModelError(f"{source} is not valid TOML: {exc}") from exc
+    doc = _checks.parse_toml(text, source, ModelError)
     _check_keys(doc, _TOP_KEYS, source)
     version = doc.get("format_version", FORMAT_VERSION)
     if version != FORMAT_VERSION:
         raise ModelError(
-            f"{source}: key 'format_version' must be {FORMAT_VERSION}; got {version!r}"
+            f"{source}: key 'format_version' must be {FORMAT_VERSION}; got {_checks.short(version)}"
         )
     name = doc.get("name", "robot")
     if not isinstance(name, str):
-        raise ModelError(f"{source}: key 'name' must be a string; got {name!r}")
+        raise ModelError(f"{source}: key 'name' must be a string; got {_checks.short(name)}")
     gravity = _vector(doc.get("gravity", [0.0, 0.0, -STANDARD_GRAVITY]), 3, source, "gravity")
     q_neutral = (
         _vector(doc["q_neutral"], len(doc.get("joints", [])), source, "q_neutral")
@@ -191,7 +190,9 @@ def robot_from_toml_string(text: str, *, source: str = "TOML text") -> Robot:
         _check_keys(jt, _JOINT_KEYS, where)
         kind = _string(jt, "type", where)
         if kind not in _TYPES:
-            raise ModelError(f"{where}: key 'type' must be one of {sorted(_TYPES)}; got {kind!r}")
+            raise ModelError(
+                f"{where}: key 'type' must be one of {sorted(_TYPES)}; got {_checks.short(kind)}"
+            )
         parent, child = _string(jt, "parent", where), _string(jt, "child", where)
         if i == 0:
             link_names.append(parent)
@@ -204,15 +205,24 @@ def robot_from_toml_string(text: str, *, source: str = "TOML text") -> Robot:
         link_names.append(child)
         T_fix[i] = _pose(jt, where, nested=True)
         axes[i] = _vector(jt.get("axis", [0.0, 0.0, 1.0]), 3, where, "axis")
-        if np.linalg.norm(axes[i]) < 1e-12:
+        with np.errstate(over="ignore"):
+            norm = float(np.linalg.norm(axes[i]))
+        if norm < 1e-12:
             raise ModelError(f"{where}: key 'axis' must not be zero")
+        if not math.isfinite(norm):
+            raise ModelError(
+                f"{where}: key 'axis' = {axes[i].tolist()} is too large to normalise "
+                "(its squared length overflows a float); give the axis as a unit vector"
+            )
         prismatic[i] = _TYPES[kind]
         limits = _table(jt.get("limits", {}), f"{where}: key 'limits'")
         _check_keys(limits, set(_LIMIT_KEYS), f"{where}: limits")
         for k, v in limits.items():
             lim[k][i] = _number(v, where, f"limits.{k}", finite=False)
             if k not in ("lower", "upper") and not lim[k][i] > 0.0:
-                raise ModelError(f"{where}: key 'limits.{k}' must be positive; got {v!r}")
+                raise ModelError(
+                    f"{where}: key 'limits.{k}' must be positive; got {_checks.short(v)}"
+                )
         if not lim["lower"][i] < lim["upper"][i]:
             raise ModelError(
                 f"{where}: key 'limits.lower' must be below 'limits.upper'; "
@@ -224,6 +234,11 @@ def robot_from_toml_string(text: str, *, source: str = "TOML text") -> Robot:
             mass[i] = _number(
                 _require(inertial, "mass", f"{where}: inertial"), where, "inertial.mass"
             )
+            if not 0.0 <= mass[i] <= MAX_LINK_MASS:
+                raise ModelError(
+                    f"{where}: key 'inertial.mass' must lie in [0, {MAX_LINK_MASS:g}] kg; got "
+                    f"{float(mass[i])!r}"
+                )
             com[i] = _vector(
                 _require(inertial, "com", f"{where}: inertial"), 3, where, "inertial.com"
             )

@@ -33,10 +33,14 @@ from .. import _checks
 from ..exceptions import ModelError, ShapeError, UnknownNameError
 from .inertia import inertial_from_phi, param_labels, phi_from_inertial
 
-__all__ = ["Frame", "Robot", "STANDARD_GRAVITY"]
+__all__ = ["Frame", "MAX_LINK_MASS", "Robot", "STANDARD_GRAVITY"]
 
 #: Standard acceleration of gravity [m/s^2] (CGPM 1901, ISO 80000-3), used by Gaz et al. 2019.
 STANDARD_GRAVITY = 9.80665
+#: Largest link mass [kg] the robot readers (TOML, URDF) accept: a thousand tonnes, far
+#: above any manipulator; a mass of 1e12 kg is a typing error, and the identification's
+#: scaling (and the retrieval's bounds) would lose its other links to rounding.
+MAX_LINK_MASS = 1e6
 
 
 @dataclass(frozen=True, slots=True, eq=False)
@@ -154,9 +158,16 @@ class Robot:
             _checks.frozen(_checks.as_exact("T_parent_joint", self.T_parent_joint, (n, 4, 4))),
         )
         axes = _checks.as_exact("axes", self.axes, (n, 3))
-        norm = np.linalg.norm(axes, axis=1)
+        with np.errstate(over="ignore"):
+            norm = np.linalg.norm(axes, axis=1)
         if np.any(norm < 1e-9):
             raise ModelError(f"joint axis of {self.joint_names[int(np.argmin(norm))]} is zero")
+        if not np.all(np.isfinite(norm)):  # [0, 0, 1e300]: the norm overflows, axis / inf = 0
+            j = int(np.argmax(~np.isfinite(norm)))
+            raise ModelError(
+                f"joint axis of {self.joint_names[j]}, {axes[j].tolist()}, is too large to "
+                "normalise (its squared length overflows a float); give the axis as a unit vector"
+            )
         put("axes", _checks.frozen(axes / norm[:, None]))
         pri = np.asarray(self.prismatic, dtype=bool)
         if pri.shape != (n,):

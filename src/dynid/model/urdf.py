@@ -44,10 +44,10 @@ from pathlib import Path
 import numpy as np
 from numpy.typing import NDArray
 
-from .. import spatial
+from .. import _checks, spatial
 from ..exceptions import DynidWarning, ModelError, UnknownNameError
 from .inertia import phi_from_inertial
-from .robot import Frame, Robot
+from .robot import MAX_LINK_MASS, Frame, Robot
 
 __all__ = ["robot_from_urdf", "robot_from_urdf_string"]
 
@@ -91,11 +91,13 @@ def _floats(
     try:
         values = np.array([float(x) for x in parts], dtype=np.float64)
     except ValueError:
-        raise ModelError(f"{what} must hold {count} numbers; got {text!r}") from None
+        raise ModelError(f"{what} must hold {count} numbers; got {_checks.short(text)}") from None
     if values.shape != (count,):
-        raise ModelError(f"{what} must hold {count} numbers; got {len(parts)} in {text!r}")
+        raise ModelError(
+            f"{what} must hold {count} numbers; got {len(parts)} in {_checks.short(text)}"
+        )
     if not np.all(np.isfinite(values)):
-        raise ModelError(f"{what} must be finite; got {text!r}")
+        raise ModelError(f"{what} must be finite; got {_checks.short(text)}")
     return values
 
 
@@ -107,7 +109,9 @@ def _float(elem: ET.Element, attr: str, what: str) -> float | None:
     try:
         value = float(text)
     except ValueError:
-        raise ModelError(f"{what} attribute {attr!r} must be a number; got {text!r}") from None
+        raise ModelError(
+            f"{what} attribute {attr!r} must be a number; got {_checks.short(text)}"
+        ) from None
     if np.isnan(value):
         raise ModelError(f"{what} attribute {attr!r} is NaN")
     return value
@@ -219,6 +223,8 @@ def _inertial(
     mass = None if mass_el is None else _float(mass_el, "value", f"{what} <mass>")
     if mass is None or not np.isfinite(mass):
         raise ModelError(f"{what} needs a finite <mass value=...>")
+    if mass > MAX_LINK_MASS:
+        raise ModelError(f"{what} <mass> must be at most {MAX_LINK_MASS:g} kg; got {mass!r}")
     I6 = np.zeros(6)
     inertia_el = _child(inertial, "inertia")
     if inertia_el is not None:
@@ -409,9 +415,15 @@ def _robot_from_text(
                 f"joint {joint.name!r} axis",
                 (1.0, 0.0, 0.0),
             )
-            norm = float(np.linalg.norm(axis))
+            with np.errstate(over="ignore"):
+                norm = float(np.linalg.norm(axis))
             if norm < 1e-12:
                 raise ModelError(f"joint {joint.name!r} has a zero axis")
+            if not np.isfinite(norm):
+                raise ModelError(
+                    f"joint {joint.name!r} axis {axis.tolist()} is too large to normalise "
+                    "(its squared length overflows a float); give the axis as a unit vector"
+                )
             joint_names.append(joint.name)
             T_fix.append(T)
             axes.append(axis / norm)
