@@ -121,11 +121,57 @@ def test_merged_move_puts_the_body_on_the_moving_link():
     np.testing.assert_allclose(float(m7), new.phi[6, 0], rtol=1e-15)
 
 
-def test_subtract_warns_when_the_rest_is_inconsistent():
-    """The published link 7 (0.74 kg) minus the template's 0.73 kg hand is not a rigid body."""
+def test_subtract_refuses_a_rest_that_is_not_a_body(tmp_path, capsys):
+    """The published link 7 (0.74 kg, identified without the hand) minus the template's
+    0.73 kg hand is not a rigid body: an error naming the link, the hand and both remedies,
+    through the library and the CLI (exit 2, no file written); --merged move writes it
+    (issue 20: a 0.049 kg link with negative principal moments was written, exit 0)."""
     path, _ = _template_chain()
-    with pytest.warns(DynidWarning, match="panda_link7.*merged='move'"):
-        patch_urdf_inertials(open(path).read(), dynid.panda(), base="panda_link0", tip="panda_hand")
+    text = open(path).read()
+    with pytest.raises(ModelError) as info:
+        patch_urdf_inertials(text, dynid.panda(), base="panda_link0", tip="panda_hand")
+    msg = str(info.value)
+    assert "link 'panda_link7'" in msg and "panda_hand" in msg, msg
+    assert "--merged move" in msg and "identified data did not include those bodies" in msg
+    fixed = re.search(r"fixed links (\[.*?\])", msg).group(1)
+    hand = sum(  # masses of the fixed links named, read from the template's text
+        float(re.search(rf'<link name="{name}">.*?<mass value="([^"]+)"', text, re.S).group(1))
+        for name in re.findall(r"'([^']+)'", fixed)
+    )
+    assert f"mass {dynid.panda().phi[6, 0] - hand:.6g} kg" in msg, msg
+    out = tmp_path / "p.urdf"
+    argv = ["export", "--params", "panda", "--out", str(out), "--urdf-template", path]
+    assert main(argv + ["--base", "panda_link0", "--tip", "panda_hand"]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and "link 'panda_link7'" in err[0] and "--merged move" in err[0]
+    assert not out.exists() and list(tmp_path.iterdir()) == []
+    argv += ["--base", "panda_link0", "--tip", "panda_hand", "--merged", "move"]
+    assert main(argv) == 0 and out.exists()
+
+
+def test_names_with_xml_references_are_patched():
+    """Link names written with character references and predefined entities (a&amp;b,
+    &#99;) are the names the XML parser reads (issue 20: KeyError 'a&b')."""
+    text = """<robot name="r">
+  <link name="base"/>
+  <joint name="j1" type="revolute"><parent link="base"/><child link="a&amp;b"/>
+    <axis xyz="0 0 1"/><limit lower="-1" upper="1" effort="1" velocity="1"/></joint>
+  <link name="a&amp;b"><inertial><mass value="1"/><inertia ixx="0.1" iyy="0.1" izz="0.1"/>
+  </inertial></link>
+  <joint name="j2" type="revolute"><parent link="a&#38;b"/><child link="&#99;&lt;d&quot;"/>
+    <origin xyz="0.5 0 0"/><axis xyz="0 1 0"/><limit lower="-1" upper="1" effort="1"
+    velocity="1"/></joint>
+  <link name='&#x63;&lt;d&quot;'/>
+</robot>
+"""
+    chain = robot_from_urdf_string(text)
+    assert chain.link_names == ("base", "a&b", 'c<d"')
+    new = chain.with_inertials(
+        [1.5, 2.0], [[0.1, 0, 0], [0, 0.2, 0]], np.tile([0.1, 0, 0, 0.2, 0, 0.3], (2, 1))
+    )
+    out = patch_urdf_inertials(text, new)
+    np.testing.assert_allclose(robot_from_urdf_string(out).phi, new.phi, rtol=1e-15, atol=1e-17)
+    assert '<link name="a&amp;b">' in out and "<link name='&#x63;&lt;d&quot;'>" in out
 
 
 def test_template_with_another_chain_is_refused():

@@ -197,7 +197,9 @@ def save_urdf(
     Raises
     ------
     ModelError
-        The template cannot be read or its chain does not match the robot's.
+        The template cannot be read, its chain does not match the robot's, or (``merged``
+        ``"subtract"``) a moving link minus the template's fixed links is not a physically
+        consistent body; nothing is written then.
     """
     path = Path(path)
     if template is None:

@@ -10,9 +10,11 @@ Merged fixed links. dynid lumps links fixed to moving link ``k`` (``panda_link8`
 hand) into body ``k`` (:mod:`dynid.model.urdf`). Two ways to write body ``k`` back:
 
 * ``merged="subtract"`` (default): the fixed links keep their inertials and the moving
-  link gets the rest, ``phi_k - sum(phi_fixed)`` (a :class:`DynidWarning` when that rest
-  is not physically consistent: the identified body is lighter than the template's
-  fixed links);
+  link gets the rest, ``phi_k - sum(phi_fixed)``. When that rest is not physically
+  consistent (a positive mass, positive principal moments meeting the triangle
+  inequality) the identified body did not hold those fixed links (a link 7 identified
+  without the hand), and nothing is written: a :class:`~dynid.exceptions.ModelError`
+  names the link, the fixed links and both remedies;
 * ``merged="move"``: the moving link gets all of ``phi_k`` and the ``<inertial>`` of each
   fixed link merged into body ``k`` is removed.
 
@@ -26,6 +28,7 @@ Inertials are written as ``<origin xyz="c" rpy="0 0 0"/>`` (CoM in the link fram
 
 from __future__ import annotations
 
+import html
 import re
 import warnings
 import xml.etree.ElementTree as ET
@@ -33,7 +36,7 @@ import xml.etree.ElementTree as ET
 import numpy as np
 from numpy.typing import NDArray
 
-from .. import spatial
+from .. import _checks, spatial
 from ..exceptions import DynidWarning, ModelError
 from ..model.inertia import inertia6_from_matrix, inertial_from_phi, phi_from_inertial
 from ..model.robot import Robot
@@ -99,13 +102,14 @@ def _link_spans(text: str) -> dict[str, tuple[int, int, int, bool]]:
     masked = _COMMENT.sub(lambda m: " " * len(m.group(0)), text)
     spans = {}
     for m in _LINK.finditer(masked):
+        name = html.unescape(m.group(2))  # the name as the parser reads it: &amp; -> &
         if m.group(3) == "/":
-            spans[m.group(2)] = (m.start(), m.end(), m.end(), True)
+            spans[name] = (m.start(), m.end(), m.end(), True)
         else:
             end = masked.find("</link>", m.end())
             if end < 0:
-                raise ModelError(f"link {m.group(2)!r} has no closing </link>")
-            spans[m.group(2)] = (m.start(), m.end(), end, False)
+                raise ModelError(f"link {_checks.short(name)} has no closing </link>")
+            spans[name] = (m.start(), m.end(), end, False)
     return spans
 
 
@@ -161,14 +165,12 @@ def patch_urdf_inertials(
     Raises
     ------
     ModelError
-        Malformed template, chains that do not match, an unknown ``merged`` policy.
+        Malformed template, chains that do not match, an unknown ``merged`` policy;
+        ``merged="subtract"`` would leave a moving link with an inertial that is not
+        physically consistent (the message names the link, its fixed links and the
+        remedies).
     UnknownNameError
         ``base`` or ``tip`` is not a link of the template.
-
-    Warns
-    -----
-    DynidWarning
-        ``merged="subtract"`` leaves a moving link with an inconsistent inertial.
     """
     if merged not in MERGED_POLICIES:
         raise ModelError(f"merged must be one of {MERGED_POLICIES}; got {merged!r}")
@@ -186,7 +188,13 @@ def patch_urdf_inertials(
         own = _own_phi(elems[link])
         if merged == "subtract":
             phi = robot.phi[k - 1] - (chain.phi[k - 1] - own)
-            _warn_if_inconsistent(link, phi)
+            fixed = [
+                name
+                for name, fr in chain.frames.items()
+                if fr.link == k and name in elems and name not in moving
+                and elems[name].find("inertial") is not None
+            ]  # fmt: skip
+            _check_consistent(link, phi, fixed, source)
         else:
             phi = np.array(robot.phi[k - 1])
             for name, fr in chain.frames.items():
@@ -241,14 +249,17 @@ def _indent_step(indent: str, link_indent: str) -> str:
     return step or "  "
 
 
-def _warn_if_inconsistent(link: str, phi: NDArray[np.float64]) -> None:
+def _check_consistent(link: str, phi: NDArray[np.float64], fixed: list[str], source: str) -> None:
+    """Raise when the rest of body ``link`` after subtracting ``fixed`` is not a body."""
     m, _, I = inertial_from_phi(phi)
     lam = np.linalg.eigvalsh(I)
-    if m <= 0 or lam[0] < 0 or lam[0] + lam[1] < lam[2]:
-        warnings.warn(
-            f"link {link!r}: the identified body minus the template's fixed links is not "
-            f"physically consistent (mass {float(m):.6g} kg, principal moments {lam.tolist()}); "
-            "use merged='move' to put the whole body on the moving link",
-            DynidWarning,
-            stacklevel=3,
-        )
+    if m > 0 and lam[0] >= 0 and lam[0] + lam[1] >= lam[2]:
+        return
+    raise ModelError(
+        f"{source}: link {_checks.short(link)}: the identified body minus the template's "
+        f"fixed links {_checks.short(fixed)} is not physically consistent (mass "
+        f"{float(m):.6g} kg, principal moments {[float(f'{x:.4g}') for x in lam]} kg m^2); "
+        "export with --merged move (merged='move') to put the whole body on the moving link, "
+        "or, if the identified data did not include those bodies, use a template without "
+        "them (or identify with them mounted)"
+    )
