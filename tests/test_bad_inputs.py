@@ -441,6 +441,54 @@ def bounds_deep(d: Path) -> None:
     (d / "bounds.toml").write_text("x = " + "[" * 10000 + "]" * 10000 + "\n")
 
 
+ONE_JOINT_TOML = """name = "one"
+[[joints]]
+name = "j1"
+type = "revolute"
+parent = "l0"
+child = "l1"
+axis = [0, 1, 0]
+limits = { lower = -2, upper = 2, velocity = 2, acceleration = 10, effort = 50 }
+[joints.inertial]
+mass = 2.0
+com = [0.3, 0, 0]
+inertia = [0.01, 0, 0, 0.01, 0, 0.01]
+"""
+
+PRISMATIC_TOML = """name = "xz"
+[[joints]]
+name = "z"
+type = "prismatic"
+parent = "l0"
+child = "l1"
+axis = [0, 0, 1]
+limits = { lower = 0, upper = 0.5, velocity = 0.5, acceleration = 5, effort = 200 }
+[joints.inertial]
+mass = 2.0
+com = [0.0, 0, 0.1]
+inertia = [0.01, 0, 0, 0.01, 0, 0.01]
+[[joints]]
+name = "x"
+type = "prismatic"
+parent = "l1"
+child = "l2"
+axis = [1, 0, 0]
+limits = { lower = -0.3, upper = 0.3, velocity = 0.5, acceleration = 5, effort = 200 }
+[joints.inertial]
+mass = 1.0
+com = [0.1, 0, 0]
+inertia = [0.01, 0, 0, 0.01, 0, 0.01]
+"""
+
+
+def small_arms(d: Path) -> None:
+    """A one-joint arm, a prismatic-only (x-z gantry) arm, and an obstacles file without
+    obstacles (the gantry's slide starts at the floor)."""
+    (d / "one.toml").write_text(ONE_JOINT_TOML)
+    (d / "xz.toml").write_text(PRISMATIC_TOML)
+    (d / "none.json").write_text('{"schema": "dynid-obstacles/1"}')
+
+
 def _edit_model(d: Path, edit: Callable[[dict], None]) -> None:
     doc = json.loads((d / "res" / "identification.json").read_text())
     edit(doc)
@@ -573,6 +621,9 @@ CASES = [
     C("bounds-mass-true", bounds_boolean_mass, f"retrieve --model {{d}}/res/identification.json --bounds {{d}}/bounds.json --out {OUT}", 2, "bounds.json: links[0] mass[0] must be a number; got True"),
     C("bounds-mass-string", bounds_string_mass, f"retrieve --model {{d}}/res/identification.json --bounds {{d}}/bounds.toml --out {OUT}", 2, "bounds.toml: links[0] mass[0] must be a number; got '1'"),
     C("bounds-nested-deep", bounds_deep, f"retrieve --model {{d}}/res/identification.json --bounds {{d}}/bounds.toml --out {OUT}", 2, "bounds.toml is not valid TOML (arrays or tables nested too deeply)"),
+    # one-joint and prismatic-only arms (issue 20: excite failed on a zero-size minimum)
+    C("excite-one-joint", small_arms, f"excite --robot {{d}}/one.toml --duration 3 --harmonics 2 --max-iter 3 --no-figure --out {OUT}", 0, ""),
+    C("excite-prismatic-only", small_arms, f"excite --robot {{d}}/xz.toml --obstacles {{d}}/none.json --duration 3 --harmonics 2 --max-iter 3 --no-figure --out {OUT}", 0, ""),
     # static data: robot consistency and BOM
     C("static-bom", static_bom, f"identify --data {{d}}/bom.csv --out {OUT}", 0, ""),
     C("static-other-robot", static_xarm, f"identify --data {{d}}/bad.csv --out {OUT}", 2, "recorded with robot 'xarm7'; the robot given is 'panda'"),

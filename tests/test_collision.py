@@ -100,3 +100,12 @@ def test_obstacle_validation_names_the_problem():
         Box((0, 0, 0), (1, 0, 1))
     with pytest.raises(ShapeError, match="obstacles need 1 names"):
         Obstacles(planes=(Plane((0, 0, 0), (0, 0, 1)),), names=("a", "b"))
+
+
+def test_a_one_joint_arm_has_no_capsule_to_check_against_obstacles():
+    """Capsules 0 and 1 stand on the support, so a one-joint arm is infinitely far from
+    every obstacle: shape (..., k) of inf, not a reduction over nothing (issue 20)."""
+    robot = dynid.Robot.from_mdh([0.3], [0.0], [0.0])
+    obstacles = Obstacles(planes=(Plane((0, 0, 0), (0, 0, 1)),), boxes=(Box((0, 0, 0), (1, 1, 1)),))
+    d = obstacle_distances(robot, np.zeros((4, 1)), obstacles, capsule_model(robot))
+    assert d.shape == (4, 2) and np.all(d == np.inf)

@@ -232,11 +232,14 @@ def obstacle_distances(
 ) -> NDArray[np.float64]:
     """Signed distance of capsules 2 .. n to each obstacle: (..., n) -> (..., len(obstacles)) [m].
 
-    The smallest over the capsules checked (see the module docstring).
+    The smallest over the capsules checked (see the module docstring); ``inf`` for a
+    one-joint arm, which has no capsule to check.
     """
     seg = capsule_segments(robot, q) if segments is None else segments
     seg = seg[..., 2:, :, :]
     rad = model.radii[2:]
+    if seg.shape[-3] == 0:  # a one-joint arm: no capsule is checked, none can touch
+        return np.full(seg.shape[:-3] + (len(obstacles),), np.inf)
     out = []
     for pl in obstacles.planes:
         nrm, p0 = np.asarray(pl.normal), np.asarray(pl.point)
