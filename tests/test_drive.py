@@ -352,3 +352,37 @@ def test_cli_consistent_fit_with_a_coupled_drive_keeps_the_rotors_out_of_the_lin
         for k in ("feasible", "identification")
     }
     assert err["feasible"] < 1.05 * err["identification"] + 0.05
+
+
+def test_links_only_and_the_retrievals_of_a_model_with_rotors():
+    """links_only() drops the rotors that are base parameters of their own (M of the links
+    plus those rotors is the full model's M); the penalty method refuses a model with rotors;
+    the convex retrieval identifies them (>= 0) next to the links."""
+    from dynid.exceptions import ModelError
+    from dynid.feasibility.retrieve import retrieve
+    from dynid.feasibility.sdp import retrieve_sdp
+    from dynid.identification.static import identify_static
+    from dynid.simulation.controller import SimulatedController, acquire_static
+    from dynid.simulation.unmodelled import UnmodelledEffects
+
+    robot = dynid.panda()
+    ia = np.array([0.05, 0.04, 0.06, 0.03, 0.02, 0.025, 0.01])
+    ctrl = SimulatedController(
+        robot, effects=UnmodelledEffects(rotor_inertia=ia, torque_offset=np.zeros(7))
+    )
+    data = acquire_static(ctrl, 200, np.random.default_rng(6))
+    drive = Drive.identity(7)
+    m = identify_static(robot, data, drive=drive)
+    links = m.links_only()
+    assert links.base.rank == 43 and links.base.n_std == 70 and links.drive is None
+    assert not any("Ia" in e for e in links.base.expressions)
+    q = data.q[:5]
+    rotors = drive.rotor_mass_matrix(m.rotor_inertia)
+    np.testing.assert_allclose(links.mass_matrix(q) + rotors, m.mass_matrix(q), atol=1e-12)
+    with pytest.raises(ModelError, match="--method sdp"):
+        retrieve(m, workers=1)
+    res = retrieve_sdp(m, prior=robot)
+    assert res.feasible and res.drive is not None
+    np.testing.assert_allclose(res.rotor_inertia[2:], ia[2:], rtol=1e-4)
+    np.testing.assert_allclose(res.drive.rotor_inertia, res.rotor_inertia)
+    assert np.all(res.rotor_inertia >= 0)

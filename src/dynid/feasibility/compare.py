@@ -109,10 +109,14 @@ def _summary(
     name: str, res: Any, model: IdentifiedModel, prior: Prior, truth: Robot | None, t: float
 ) -> MethodSummary:
     phi = res.robot.phi.reshape(res.robot.n, 10)
+    ia = getattr(res, "rotor_inertia", None)
+    if model.base.n_std > phi.size and ia is None:  # a method of the links alone
+        model = model.links_only()
     keep = np.asarray(model.fit.kept, dtype=bool)
     P = model.base.projection[keep]
     beta = np.asarray(model.fit.beta)[keep]
-    rel = float(np.linalg.norm(P @ phi.reshape(-1) - beta) / np.linalg.norm(beta))
+    std = phi.reshape(-1) if model.base.n_std == phi.size else np.concatenate([phi.ravel(), ia])
+    rel = float(np.linalg.norm(P @ std - beta) / np.linalg.norm(beta))
     rep = feasibility_report(res.robot)
     margins = {n: float(rep.min_margin(n)) for n in _PHYSICAL}
     margins["pseudo_inertia"] = float(pseudo_inertia_margin(phi).min())
@@ -146,7 +150,9 @@ def compare_methods(
     Parameters
     ----------
     model : IdentifiedModel
-        The coefficients (with their covariance) all methods start from.
+        The coefficients (with their covariance) all methods start from; the penalty
+        method gets :meth:`~dynid.identification.model.IdentifiedModel.links_only` (its
+        rotor inertias of their own left out), the convex one identifies them too.
     prior : Prior or Robot
         Prior parameters (the convex method, and the third run of the penalty method).
     truth : Robot, optional
@@ -164,10 +170,11 @@ def compare_methods(
     t0 = time.perf_counter()
     sdp = retrieve_sdp(model, prior=pr, bounds=bounds, options=sdp_options)
     out.append(_summary("sdp", sdp, model, pr, truth, time.perf_counter() - t0))
+    links = model.links_only()  # the penalty method knows link parameters only
     for name, p in (("penalty", None), ("penalty + prior", pr)):
         t0 = time.perf_counter()
         res = retrieve(
-            model,
+            links,
             bounds=bounds,
             options=penalty_options,
             workers=workers,

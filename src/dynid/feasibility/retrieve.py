@@ -56,7 +56,7 @@ from numpy.typing import ArrayLike, NDArray
 from scipy.optimize import dual_annealing
 
 from .._parallel import process_pool
-from ..exceptions import InfeasibleError, OptionError, ShapeError
+from ..exceptions import InfeasibleError, ModelError, OptionError, ShapeError
 from ..identification.model import IdentifiedModel
 from ..model.inertia import matrix_from_inertia6
 from ..model.robot import Robot
@@ -760,6 +760,12 @@ def retrieve(
     >>> res.feasible, res.relative_residual < 1e-4  # doctest: +SKIP
     (True, True)
     """
+    if model.base.n_std != 10 * model.robot.n:
+        raise ModelError(
+            "the penalty method retrieves link parameters only, and this model identified "
+            "rotor inertias with them (a drive); use the convex method (--method sdp), which "
+            "keeps them >= 0, or model.links_only()"
+        )
     return retrieve_from_coefficients(
         model.robot,
         model.base,

@@ -16,6 +16,8 @@ given); ``g`` and ``c`` are those of the links.
 
 from __future__ import annotations
 
+import dataclasses
+import re
 from dataclasses import dataclass, field
 from typing import Any
 
@@ -90,6 +92,48 @@ class IdentifiedModel:
             )
         object.__setattr__(self, "rotor_inertia", None if ia is None else _checks.frozen(ia))
 
+    def links_only(self) -> IdentifiedModel:
+        """The model of the links alone: base parameters that are rotor inertias of their own
+        (``beta_k = Ia_k``) are removed; a rotor that regroups with link parameters
+        (``J1zz + Ia1``) stays in that combination, which the links then carry. ``self`` when
+        the model has no rotor parameters. For methods that know only link parameters (the
+        penalty method)."""
+        p = 10 * self.robot.n
+        if self.base.n_std == p:
+            return self
+        base, fit = self.base, self.fit
+        keep = np.flatnonzero(np.asarray(base.independent) < p)
+        dep = np.asarray(base.dependent)
+        dcols = np.flatnonzero(dep < p)
+        sub = BaseParameters(
+            std_labels=base.std_labels[:p],
+            independent=_checks.frozen(np.asarray(base.independent)[keep]),
+            dependent=_checks.frozen(dep[dcols]),
+            K_d=_checks.frozen(np.asarray(base.K_d)[np.ix_(keep, dcols)]),
+            rank=int(keep.size),
+            rtol=base.rtol,
+            labels=tuple(base.labels[k] for k in keep),
+            expressions=tuple(_without_rotor_terms(base.expressions[k]) for k in keep),
+            gap=base.gap,
+        )
+        cov = None if fit.covariance is None else np.asarray(fit.covariance)[np.ix_(keep, keep)]
+        sub_fit = dataclasses.replace(
+            fit,
+            beta=fit.beta[keep],
+            std=fit.std[keep],
+            std_percent=fit.std_percent[keep],
+            kept=fit.kept[keep],
+            rank=int(np.sum(fit.kept[keep])),
+            covariance=cov,
+        )
+        return IdentifiedModel(
+            robot=self.robot,
+            base=sub,
+            fit=sub_fit,
+            friction=self.friction,
+            metadata=dict(self.metadata),
+        )
+
     @property
     def beta(self) -> NDArray[np.float64]:
         """Identified base parameters (r,)."""
@@ -118,3 +162,10 @@ class IdentifiedModel:
             a = _checks.as_batch("ddq", ddq, (self.robot.n,))
             tau = tau + self.drive.rotor_torques(a, self.rotor_inertia)
         return tau
+
+
+def _without_rotor_terms(expression: str) -> str:
+    """A base parameter's expression without its ``Ia`` terms (``J1zz + Ia1`` -> ``J1zz``)."""
+    terms = expression.replace(" - ", " + -").split(" + ")
+    kept = [t for t in terms if not re.fullmatch(r"-?([0-9.e+-]+\*)?Ia\d+", t)]
+    return " + ".join(kept).replace(" + -", " - ")

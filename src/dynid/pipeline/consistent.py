@@ -3,8 +3,10 @@
 
 The truth is the given robot with every parameter scaled by up to +-20 %, plus rotor
 inertia and a gravity tilt that no rigid body reproduces; its coefficients are identified
-from static data as in stage 2, and the methods retrieve link parameters from them with
-the given robot as prior (:func:`dynid.feasibility.compare.compare_methods`).
+from static data as in stage 2, with the rotor inertias as model terms of a direct drive
+(:mod:`dynid.model.drive`), and the methods retrieve link parameters from them with the
+given robot as prior (:func:`dynid.feasibility.compare.compare_methods`): the convex method
+identifies the rotor inertias too (``>= 0``), the penalty method gets the links' part.
 """
 
 from __future__ import annotations
@@ -17,6 +19,7 @@ import numpy as np
 from ..feasibility.compare import MethodSummary, compare_methods, perturbed_robot
 from ..identification.model import IdentifiedModel
 from ..identification.static import identify_static
+from ..model.drive import Drive
 from ..model.robot import Robot
 from ..simulation.controller import SimulatedController, acquire_static
 from ..simulation.unmodelled import UnmodelledEffects
@@ -94,7 +97,8 @@ def consistent_stage(
     data = acquire_static(ctrl, DEMO_CONFIGURATIONS, rng)
     with warnings.catch_warnings():  # the tilt puts data in the uninformative g1 row: expected
         warnings.simplefilter("ignore")
-        model = identify_static(robot, data)
+        # the controller's M holds the rotors: identified with the links (a direct drive)
+        model = identify_static(robot, data, drive=Drive.identity(robot.n))
     rows = compare_methods(model, robot, truth=truth, workers=workers, seed=seed, progress=progress)
     prior_err = float(np.median(np.abs(robot.mass - truth.mass)[1:] / truth.mass[1:]))
     return ConsistentStageResult(truth, effects, model, tuple(rows), prior_err, seed)
