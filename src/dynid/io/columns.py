@@ -44,6 +44,7 @@ from ..identification.log import (
     with_derived_velocities,
 )
 from ..model.robot import Robot
+from .npz_files import check_npz
 
 __all__ = [
     "ColumnMap",
@@ -219,11 +220,16 @@ class _Table:
 def _read_table(path: Path) -> _Table:
     suffix = path.suffix.lower()
     if suffix == ".npz":
+        check_npz(path)
         try:
             with np.load(path, allow_pickle=False) as npz:
-                arrays = {k: np.asarray(npz[k], dtype=np.float64) for k in npz.files}
+                raw = {k: np.asarray(npz[k]) for k in npz.files}
+            complex_ = [k for k, a in raw.items() if np.iscomplexobj(a)]
+            arrays = {k: a.astype(np.float64) for k, a in raw.items() if k not in complex_}
         except ValueError as exc:
             raise DataError(f"{path.name}: not a numeric NPZ file without pickles ({exc})") from exc
+        if complex_:
+            raise DataError(f"{path.name}: array {complex_[0]!r} holds complex numbers")
         return _Table(path.name, arrays)
     if suffix != ".csv":
         raise DataError(f"{path.name}: expected a .csv or .npz file")

@@ -44,6 +44,7 @@ from ..model.robot import Robot
 from ..regressors.static import static_labels
 from .atomic import open_atomic
 from .json_files import dumps, loads
+from .npz_files import check_npz
 
 __all__ = [
     "static_columns",
@@ -302,6 +303,7 @@ def load_static_npz(
     the wrong shape, raise :class:`DataError` naming the key.
     """
     path = Path(path)
+    check_npz(path)
     try:
         with np.load(path, allow_pickle=False) as z:
             keys = set(z.files)
@@ -323,8 +325,8 @@ def load_static_npz(
             raise
         raise DataError(f"{path.name}: not a readable NPZ file of arrays ({exc})") from exc
     for k, a in arrays.items():
-        if not np.issubdtype(a.dtype, np.number):
-            raise DataError(f"{path.name}: array {k!r} must be numeric; got dtype {a.dtype}")
+        if not np.issubdtype(a.dtype, np.number) or np.iscomplexobj(a):
+            raise DataError(f"{path.name}: array {k!r} must be real numbers; got dtype {a.dtype}")
     q, M, g = (arrays[k].astype(np.float64) for k in _NPZ_KEYS)
     if q.ndim != 2 or q.shape[0] < 1:
         raise DataError(f"{path.name}: array 'q' must have shape (N, n); got {q.shape}")

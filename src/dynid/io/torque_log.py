@@ -49,6 +49,7 @@ from ..identification.log import (
     with_derived_velocities,
 )
 from .atomic import open_atomic
+from .npz_files import check_npz
 from .static_data import check_row_count
 
 __all__ = ["load_torque_log", "read_csv_table", "save_torque_log", "torque_log_columns"]
@@ -224,6 +225,7 @@ def _check_rows(
 
 
 def _read_npz(path: Path) -> dict[str, NDArray[np.float64]]:
+    check_npz(path)
     try:
         npz = np.load(path, allow_pickle=False)
     except (ValueError, OSError, EOFError, zipfile.BadZipFile) as exc:
