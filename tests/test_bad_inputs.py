@@ -889,3 +889,23 @@ def test_ctrl_c_stops_a_write_without_a_partial_file(tmp_path):
     assert proc.returncode == 130, err
     assert err.strip().splitlines() == ["dynid acquire-static: interrupted; no partial output left"]
     assert list(tmp_path.iterdir()) == []
+
+
+@pytest.mark.parametrize("kind", ["DataError", "ValueError"])
+def test_an_error_echoing_megabytes_is_one_short_line(monkeypatch, capsys, kind):
+    """A message of 6 MB over many lines (a library echoing its input) prints as one line of
+    at most 1000 characters that keeps its start and its hint (issue 20: 6-50 MB lines)."""
+    from dynid.cli import fk
+    from dynid.exceptions import DataError
+
+    cls = DataError if kind == "DataError" else ValueError
+
+    def run(args):
+        raise cls("x.csv: bad header " + "col,\n" * 1_200_000 + "; hint: fix the header")
+
+    monkeypatch.setattr(fk, "run", run)
+    assert main(["fk", "--q", NEUTRAL]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and len(err) <= 1100, len(err)
+    assert err.startswith("dynid fk: error: ") and "x.csv: bad header col, col," in err
+    assert "characters cut" in err and "; hint: fix the header" in err

@@ -216,3 +216,27 @@ def test_cli_import_writes_a_log_every_command_reads(tmp_path, capsys):
     assert main(argv + ["--topic", "/nope"]) == 2
     err = capsys.readouterr().err
     assert err.startswith("dynid import: error:") and err.count("\n") == 1
+
+
+@pytest.mark.parametrize(
+    "yaml_text",
+    [
+        "rosbag2_bagfile_information:\n  version: [1,\n  storage_identifier: mcap\n: : :\n",
+        "rosbag2_bagfile_information:\n\tversion: 5\n",
+        "x: " + "[" * 5000 + "]" * 5000 + "\n",
+    ],
+    ids=["broken-flow", "tab-indent", "nested-5000"],
+)
+def test_malformed_bag_metadata_is_one_line(tmp_path, capsys, yaml_text):
+    """A ROS 2 bag whose metadata.yaml is not YAML: one short error line naming the bag
+    (issue 20: YAML errors spread over 4-5 lines)."""
+    robot = dynid.panda()
+    write_bag(tmp_path / "b", "mcap", _shuffled(_small(robot), robot, 8))
+    (tmp_path / "b" / "metadata.yaml").write_text(yaml_text)
+    code = main(["import", str(tmp_path / "b"), "--out", str(tmp_path / "x.csv")])
+    err = capsys.readouterr().err
+    assert code == 2 and err.count("\n") == 1 and len(err) < 800, err
+    assert (
+        err.startswith("dynid import: error: b: cannot read the bag (") and "Traceback" not in err
+    )
+    assert not (tmp_path / "x.csv").exists()

@@ -114,11 +114,14 @@ def short(value: Any, limit: int = ECHO_LIMIT) -> str:
 
 
 def one_line(text: str, limit: int = 2 * ECHO_LIMIT + 200) -> str:
-    """``text`` on one line (line breaks and runs of spaces joined) and cut to ``limit``."""
+    """``text`` on one line (line breaks and runs of spaces joined), at most ``limit``
+    characters: a longer text keeps its start and its end (where the hint is)."""
     flat = " ".join(text.split())
     if len(flat) <= limit:
         return flat
-    return flat[: limit - 3] + f"... ({len(flat)} characters)"
+    tail = min(200, limit // 3)
+    cut = len(flat) - (limit - tail - 40)
+    return f"{flat[: limit - tail - 40]} ...({cut - tail} characters cut)... {flat[-tail:]}"
 
 
 def number(value: Any, where: str, error: type[Exception]) -> float:

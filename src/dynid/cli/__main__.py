@@ -20,8 +20,13 @@ import sys
 import warnings
 from collections.abc import Iterator, Sequence
 
+from .._checks import one_line
 from ..exceptions import DynidError
 from ..io.atomic import output_transaction
+
+#: Longest error line printed [characters]: a message echoing megabytes of input keeps
+#: its start and its end (the hint).
+ERROR_LINE_LIMIT = 1000
 
 #: Subcommands in pipeline order; each is the module ``dynid.cli.<module>`` with
 #: ``NAME``, ``register(subparsers)`` and ``run(args) -> int``.
@@ -174,14 +179,14 @@ def main(argv: Sequence[str] | None = None) -> int:
     except (DynidError, OSError) as exc:
         if args.debug:
             raise
-        print(f"{say}: error: {exc}", file=sys.stderr)
+        print(f"{say}: error: {one_line(str(exc), ERROR_LINE_LIMIT)}", file=sys.stderr)
         return 2
     except Exception as exc:  # anything unexpected: one line, never a traceback
         if args.debug:
             raise
         print(
-            f"{say}: error: unexpected {type(exc).__name__}: {exc} (run with --debug for "
-            "the traceback)",
+            f"{say}: error: unexpected {type(exc).__name__}: "
+            f"{one_line(str(exc), ERROR_LINE_LIMIT)} (run with --debug for the traceback)",
             file=sys.stderr,
         )
         return 2

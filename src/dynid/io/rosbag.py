@@ -31,7 +31,7 @@ from pathlib import Path
 
 import numpy as np
 
-from .. import signals
+from .. import _checks, signals
 from ..exceptions import DataError
 from ..identification.log import DEFAULT_CUTOFF_HZ, TorqueLog
 
@@ -200,12 +200,12 @@ def load_joint_state_bag(
     try:
         reader.open()
     except Exception as exc:  # rosbags raises its own error classes
-        raise DataError(f"{path.name}: cannot read the bag ({exc})") from exc
+        raise DataError(f"{path.name}: cannot read the bag ({_checks.one_line(str(exc))})") from exc
     try:
         conns = [c for c in reader.connections if c.topic == topic]
         if not conns:
             topics = sorted({c.topic for c in reader.connections})
-            raise DataError(f"{path.name}: no topic {topic!r}; the bag has {topics}")
+            raise DataError(f"{path.name}: no topic {topic!r}; the bag has {_checks.short(topics)}")
         bad = [c.msgtype for c in conns if c.msgtype not in JOINT_STATE_TYPES]
         if bad:
             raise DataError(f"{path.name}: topic {topic!r} holds {bad[0]}, not JointState")
@@ -216,7 +216,7 @@ def load_joint_state_bag(
     except DataError:
         raise
     except Exception as exc:
-        raise DataError(f"{path.name}: cannot read the bag ({exc})") from exc
+        raise DataError(f"{path.name}: cannot read the bag ({_checks.one_line(str(exc))})") from exc
     finally:
         reader.close()
     return _assemble(
