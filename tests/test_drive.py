@@ -386,3 +386,30 @@ def test_links_only_and_the_retrievals_of_a_model_with_rotors():
     np.testing.assert_allclose(res.rotor_inertia[2:], ia[2:], rtol=1e-4)
     np.testing.assert_allclose(res.drive.rotor_inertia, res.rotor_inertia)
     assert np.all(res.rotor_inertia >= 0)
+
+
+def test_friction_fitted_per_motor_through_the_coupled_drive(tmp_path):
+    """The residual of an identified model on a held-out motor-side log, mapped to the
+    motors (K^-T r at K dq), gives back the motors' own viscous, Coulomb and offset friction;
+    friction.json keeps the drive and loads back to the same joint torques."""
+    from dynid.friction.fit import fit_friction_through, friction_residual
+    from dynid.friction.model import DriveFriction
+    from dynid.io.friction_json import load_friction_json, save_friction_json
+
+    robot, model, data = _ur5()
+    train, _ = _motor_log(model, data, seed=1)
+    held, _ = _motor_log(model, data, seed=2)
+    m = identify_from_log(robot, train, cutoff_hz=None, decimate=1, drive=_drive())
+    res = friction_residual(m, held, cutoff_hz=None)  # read through the model's drive
+    fit = fit_friction_through(res, m.drive, "classical")
+    assert isinstance(fit.friction, DriveFriction)
+    law = fit.friction.law
+    np.testing.assert_allclose(law.fv, FV, rtol=1e-6)
+    np.testing.assert_allclose(law.fc, FC, rtol=1e-6)
+    np.testing.assert_allclose(law.fo, FO, rtol=1e-5, atol=1e-9)
+    assert np.all(fit.rms_after < 1e-6 * fit.rms_before)
+    path = save_friction_json(tmp_path / "friction.json", fit)
+    back = load_friction_json(path)
+    assert isinstance(back, DriveFriction)
+    h = dynid.identification.log.joint_side_log(held, _drive())
+    np.testing.assert_allclose(back.torques(h.dq), fit.friction.torques(h.dq), rtol=1e-14)

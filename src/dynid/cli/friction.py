@@ -4,7 +4,9 @@ The residual tau_measured - (M ddq + c + g) of the model (an identification.json
 robot's own link parameters with --robot) is fitted per joint by the sigmoid of Gaz et
 al. 2019 (eq. 25, Nelder-Mead; default) or the classical viscous + Coulomb + offset model
 (eq. 24, least squares). The states are low-pass filtered with zero phase (--cutoff) and
-the accelerations differentiated from the filtered velocities.
+the accelerations differentiated from the filtered velocities. With a drive (--drive, or the
+model's own) the log is read through it and the law is fitted per motor at the motor
+velocities where the drive's friction acts there (tau_f = K^T f(K dq)).
 
 Writes OUT/friction.json (parameters, RMS of the residual before and after) and
 OUT/friction.png (residual against velocity with the fitted curve, per joint; skipped,
@@ -27,9 +29,9 @@ from ..exceptions import DataError, DynidError
 from ..friction.fit import (
     FrictionFit,
     FrictionResidual,
-    fit_classical,
-    fit_sigmoid,
+    fit_friction_through,
     friction_residual,
+    model_drive,
 )
 from ..friction.validation import Validation
 from ..identification.log import DEFAULT_CUTOFF_HZ
@@ -40,8 +42,10 @@ from ..model.robot import Robot
 from .common import (
     about,
     add_column_options,
+    add_drive_option,
     add_log_options,
     add_subcommand,
+    load_drive_arg,
     load_robot,
     positive_type,
     read_log,
@@ -72,6 +76,7 @@ def register(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParser:
     p.add_argument("--tip", default=None, help="URDF tip link (with --robot)")
     p.add_argument("--data", type=Path, required=True, help="torque log (.csv or .npz)")
     add_column_options(p)
+    add_drive_option(p)
     p.add_argument("--out", type=Path, required=True, help="output directory")
     p.add_argument("--friction-model", choices=("sigmoid", "classical"), default="sigmoid")
     p.add_argument(
@@ -161,13 +166,12 @@ def run(args: argparse.Namespace) -> int:
     log = read_log(args, args.data, n)
     if log.n != n:
         raise DataError(f"{args.data.name}: the log has {log.n} joints; the model has {n}")
+    drive = model_drive(model, load_drive_arg(args, n))
     with about(args.data):
-        res = friction_residual(model, log, cutoff_hz=args.cutoff, max_gap_s=args.max_gap)
-        fit = (
-            fit_sigmoid(res.dq, res.residual, dq_noise_std=res.dq_noise_std)
-            if args.friction_model == "sigmoid"
-            else fit_classical(res.dq, res.residual, dq_noise_std=res.dq_noise_std)
+        res = friction_residual(
+            model, log, cutoff_hz=args.cutoff, max_gap_s=args.max_gap, drive=drive
         )
+        fit = fit_friction_through(res, drive, args.friction_model)
     meta = {
         "data": str(args.data.name),
         "model": str(args.model.name) if args.model is not None else args.robot,

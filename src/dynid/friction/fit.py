@@ -37,7 +37,7 @@ from __future__ import annotations
 
 import warnings
 from collections.abc import Callable
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 import scipy.linalg
@@ -46,11 +46,12 @@ from numpy.typing import ArrayLike, NDArray
 
 from .. import _checks
 from ..dynamics.rnea import rnea
-from ..exceptions import ConvergenceError, DataError, DynidWarning, ShapeError
-from ..identification.log import DEFAULT_CUTOFF_HZ, TorqueLog, prepare_log
+from ..exceptions import ConvergenceError, DataError, DynidWarning, OptionError, ShapeError
+from ..identification.log import DEFAULT_CUTOFF_HZ, TorqueLog, joint_side_log, prepare_log
 from ..identification.model import IdentifiedModel
+from ..model.drive import Drive
 from ..model.robot import Robot
-from .model import ClassicalFriction, FrictionModel, SigmoidFriction
+from .model import ClassicalFriction, DriveFriction, FrictionModel, SigmoidFriction
 
 __all__ = [
     "FrictionFit",
@@ -59,7 +60,9 @@ __all__ = [
     "fit_classical",
     "fit_friction",
     "fit_sigmoid",
+    "fit_friction_through",
     "friction_residual",
+    "model_drive",
     "moving_joints",
     "rigid_body_torques",
     "velocity_noise_std",
@@ -147,6 +150,25 @@ class FrictionResidual:
         return self.log.dq
 
 
+def model_drive(model: TorqueModel, drive: Drive | None) -> Drive | None:
+    """The drive a log is read through: an identified model's own, or ``drive``.
+
+    Raises
+    ------
+    DataError
+        ``drive`` differs from the one the model was identified with.
+    """
+    own = model.drive if isinstance(model, IdentifiedModel) else None
+    if drive is None or own is None:
+        return own if drive is None else drive
+    if drive.as_dict() != own.as_dict():
+        raise DataError(
+            "the drive given differs from the one the model was identified with "
+            f"({own.describe()}); hint: leave out --drive to use the model's"
+        )
+    return own
+
+
 def friction_residual(
     model: TorqueModel,
     log: TorqueLog,
@@ -155,6 +177,7 @@ def friction_residual(
     trim_s: float | None = None,
     max_gap_s: float | None = None,
     filter_tau: bool = False,
+    drive: Drive | None = None,
 ) -> FrictionResidual:
     """Prepare ``log`` and compute the torque residual of ``model``.
 
@@ -165,11 +188,15 @@ def friction_residual(
     cutoff_hz, trim_s, filter_tau, max_gap_s
         Passed to :func:`~dynid.identification.log.prepare_log` (``cutoff_hz=None``: no
         filtering).
+    drive : Drive, optional
+        The drive the log was recorded through; default: an identified model's own
+        (:func:`model_drive`). The residual is in joint torques.
 
     Returns
     -------
     FrictionResidual
     """
+    log = joint_side_log(log, model_drive(model, drive))
     p = prepare_log(
         log, cutoff_hz=cutoff_hz, trim_s=trim_s, filter_tau=filter_tau, max_gap_s=max_gap_s
     )
@@ -518,3 +545,41 @@ def fit_friction(
     if kind == "sigmoid":
         return fit_sigmoid(res.dq, res.residual, dq_noise_std=res.dq_noise_std)
     return fit_classical(res.dq, res.residual, dq_noise_std=res.dq_noise_std)
+
+
+def fit_friction_through(
+    res: FrictionResidual, drive: Drive | None, kind: str = "sigmoid"
+) -> FrictionFit:
+    """Fit a friction law where the drive says it acts (the motors of a gear train).
+
+    At the motors the joint residual ``r`` becomes motor torques ``K^-T r`` at the motor
+    velocities ``K dq`` (exact: ``K`` is invertible), each motor is fitted on its own
+    (:func:`fit_sigmoid` or :func:`fit_classical`), and the result is a
+    :class:`~dynid.friction.model.DriveFriction` whose RMS before and after are those of
+    the joint torques. Without a drive (or with friction at the joints) the joints are fitted.
+
+    Raises
+    ------
+    OptionError
+        ``kind`` is neither ``"sigmoid"`` nor ``"classical"``.
+    """
+    fit_law = {"sigmoid": fit_sigmoid, "classical": fit_classical}.get(kind)
+    if fit_law is None:
+        raise OptionError(f"friction model must be 'sigmoid' or 'classical'; got {kind!r}")
+    if drive is None or drive.friction_at == "joint":
+        return fit_law(res.dq, res.residual, dq_noise_std=res.dq_noise_std)
+    K = drive.transmission
+    v = drive.motor_velocities(res.dq)
+    r = np.asarray(np.linalg.solve(K.T, res.residual.T).T, dtype=np.float64)
+    noise = None if res.dq_noise_std is None else np.sqrt((K**2) @ res.dq_noise_std**2)
+    fit = fit_law(v, r, dq_noise_std=noise)
+    law = fit.friction
+    assert isinstance(law, SigmoidFriction | ClassicalFriction)  # a law per motor
+    fr = DriveFriction(law, drive)
+    after = res.residual - fr.torques(res.dq)
+    return replace(
+        fit,
+        friction=fr,
+        rms_before=np.sqrt(np.mean(res.residual**2, axis=0)),
+        rms_after=np.sqrt(np.mean(after**2, axis=0)),
+    )

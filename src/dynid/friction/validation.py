@@ -27,20 +27,19 @@ from numpy.typing import ArrayLike, NDArray
 
 from .. import _checks
 from ..dynamics.rnea import rnea
-from ..exceptions import DataError, OptionError, ShapeError
-from ..identification.log import DEFAULT_CUTOFF_HZ, TorqueLog, joint_side_log
+from ..exceptions import OptionError, ShapeError
+from ..identification.log import DEFAULT_CUTOFF_HZ, TorqueLog
 from ..identification.metrics import TorqueErrors, torque_errors
 from ..identification.model import IdentifiedModel
 from ..model.drive import Drive
 from ..model.robot import Robot
-from .fit import TorqueModel, friction_residual
+from .fit import TorqueModel, friction_residual, model_drive
 from .model import ClassicalFriction, DriveFriction, FrictionModel, SigmoidFriction
 
 __all__ = [
     "RECORDED",
     "NewtonEulerValidation",
     "Validation",
-    "model_drive",
     "own_friction",
     "recorded_cutoff",
     "validate_newton_euler",
@@ -123,25 +122,6 @@ def recorded_cutoff(model: TorqueModel) -> float | None:
     return DEFAULT_CUTOFF_HZ
 
 
-def model_drive(model: TorqueModel, drive: Drive | None) -> Drive | None:
-    """The drive a log is read through: an identified model's own, or ``drive``.
-
-    Raises
-    ------
-    DataError
-        ``drive`` differs from the one the model was identified with.
-    """
-    own = model.drive if isinstance(model, IdentifiedModel) else None
-    if drive is None or own is None:
-        return own if drive is None else drive
-    if drive.as_dict() != own.as_dict():
-        raise DataError(
-            "the drive given differs from the one the model was identified with "
-            f"({own.describe()}); hint: leave out --drive to use the model's"
-        )
-    return own
-
-
 def validate_torques(
     model: TorqueModel,
     log: TorqueLog,
@@ -187,10 +167,15 @@ def validate_torques(
     if friction is not None and friction.n != log.n:
         raise ShapeError(f"friction model has {friction.n} joints; the log has {log.n}")
     d = model_drive(model, drive)
-    log = joint_side_log(log, d)
     cut = recorded_cutoff(model) if isinstance(cutoff_hz, str) else cutoff_hz
     res = friction_residual(
-        model, log, cutoff_hz=cut, trim_s=trim_s, filter_tau=filter_tau, max_gap_s=max_gap_s
+        model,
+        log,
+        cutoff_hz=cut,
+        trim_s=trim_s,
+        filter_tau=filter_tau,
+        max_gap_s=max_gap_s,
+        drive=d,
     )
     p, tau_model = res.log, res.tau_model
     if d is not None and d.rotor_inertia is not None and not isinstance(model, IdentifiedModel):

@@ -25,7 +25,8 @@ import numpy as np
 
 from ..exceptions import DataError
 from ..friction.fit import FrictionFit
-from ..friction.model import ClassicalFriction, FrictionModel, SigmoidFriction
+from ..friction.model import ClassicalFriction, DriveFriction, FrictionModel, SigmoidFriction
+from .drive_file import drive_from_record
 from .json_files import load_json, save_json
 
 __all__ = ["FORMAT", "load_friction_json", "save_friction_json"]
@@ -68,6 +69,7 @@ def save_friction_json(
         fit, model = friction, friction.friction
     else:
         fit, model = None, friction
+    drive = model.drive if isinstance(model, DriveFriction) else None
     P = model.as_array()
     joints = []
     for j in range(model.n):
@@ -87,6 +89,7 @@ def save_friction_json(
         "convention": _CONVENTION[model.kind],
         "units": units,
         "joints": joints,
+        "drive": None if drive is None else drive.as_dict(),
         "metadata": metadata or {},
     }
     return save_json(path, doc)
@@ -130,4 +133,10 @@ def load_friction_json(path: str | Path) -> FrictionModel:
                 ) from None
     if not np.all(np.isfinite(P)):
         raise DataError(f"{path.name}: non-finite friction parameters")
-    return cls.from_array(P)
+    law = cls.from_array(P)
+    if doc.get("drive") is None:
+        return law
+    try:
+        return DriveFriction(law, drive_from_record(doc["drive"], len(joints)))
+    except DataError as exc:
+        raise DataError(f"{path.name}: {exc}") from exc
