@@ -342,6 +342,15 @@ def test_cli_consistent_fit_with_a_coupled_drive_keeps_the_rotors_out_of_the_lin
     model = mj.MjModel.from_xml_path(str(tmp_path / "c" / "robot.xml"))
     K = Drive.from_gears(GEAR, COUPLING).transmission
     np.testing.assert_allclose(model.dof_armature, np.diag(K.T @ np.diag(ia) @ K), rtol=1e-12)
+    # export from feasible.json keeps the drive's armature and the friction identified
+    # with the links (reflected from the motors), as identify --consistent wrote it
+    xml = tmp_path / "e.xml"
+    assert (
+        main(["export", "--params", str(tmp_path / "c" / "feasible.json"), "--out", str(xml)]) == 0
+    )
+    exported = mj.MjModel.from_xml_path(str(xml))
+    np.testing.assert_allclose(exported.dof_armature, model.dof_armature, rtol=1e-12)
+    np.testing.assert_allclose(exported.dof_damping, model.dof_damping, rtol=1e-12)
     for src, out in (("--params", "c/feasible.json"), ("--model", "c/identification.json")):
         v = ["validate", src, str(tmp_path / out), "--data", str(tmp_path / "held.csv")]
         assert main([*v, "--out", str(tmp_path / out.replace("/", "_")), "-q", "--no-figures"]) == 0

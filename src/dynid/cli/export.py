@@ -11,8 +11,12 @@ and the moving link gets the rest (--merged subtract, default), or the moving li
 whole body and the fixed links lose their inertials (--merged move).
 
 MJCF (MuJoCo): bodies, hinge/slide joints with ranges, full inertials, gravity, motors, and
-the sigmoid friction approximated as frictionloss + damping (its odd part fitted over the
-velocity range; --no-friction for frictionless joints).
+the friction as frictionloss + damping: the linear friction a consistent identification
+stored in feasible.json, else the sigmoid approximated (its odd part fitted over the
+velocity range); --no-friction for frictionless joints. A drive (feasible.json's, a robot
+TOML's [drive] table, or --drive) adds its rotor inertias as armature and reflects friction
+at the motors to the joints; what MJCF cannot hold (a coupled rotor's off-diagonal inertia)
+is named in a warning. TOML keeps the drive as a [drive] table.
 
 examples:
   dynid export --params feasible/feasible.json --out panda.xml
@@ -24,13 +28,15 @@ from __future__ import annotations
 
 import argparse
 from pathlib import Path
+from typing import Any
 
 from ..exceptions import DynidError
+from ..friction.model import DriveFriction
 from ..friction.mujoco import coulomb_viscous_from_sigmoid
-from ..io.export import EXPORT_FORMATS, save_robot
+from ..io.export import EXPORT_FORMATS, model_terms_of, save_robot
 from ..io.urdf_patch import MERGED_POLICIES
 from ..model.robot import Robot
-from .common import add_subcommand
+from .common import add_drive_option, add_subcommand, load_drive_arg
 
 NAME = "export"
 
@@ -58,6 +64,7 @@ def register(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParser:
     )
     p.add_argument("--no-friction", action="store_true", help="MJCF: frictionless joints")
     p.add_argument("--all-frames", action="store_true", help="URDF chain: every named frame")
+    add_drive_option(p)
     return p
 
 
@@ -77,6 +84,18 @@ def run(args: argparse.Namespace) -> int:
     robot = load_params(args.params)
     if args.urdf_template is None and (args.base or args.tip):
         raise DynidError("--base/--tip choose the chain of --urdf-template; give the template")
+    linear, drive = model_terms_of(args.params, robot.n)
+    if args.drive is not None:
+        drive = load_drive_arg(args, robot.n)
+    friction: Any = False if args.no_friction else True
+    if linear is not None and not args.no_friction:
+        friction = linear
+        if (
+            drive is not None
+            and drive.friction_at == "motor"
+            and not isinstance(linear, DriveFriction)
+        ):
+            friction = DriveFriction(linear, drive)
     path = save_robot(
         args.out,
         robot,
@@ -85,12 +104,15 @@ def run(args: argparse.Namespace) -> int:
         base=args.base,
         tip=args.tip,
         merged=args.merged,
-        friction=not args.no_friction,
+        friction=friction,
         all_frames=args.all_frames,
+        drive=drive,
     )
     print(f"wrote {path}")
+    if drive is not None:
+        print(f"drive: {drive.describe()}")
     mjcf = args.format == "mjcf" or path.suffix.lower() in (".xml", ".mjcf")
-    if mjcf and not args.no_friction and robot.friction is not None:
+    if mjcf and friction is True and robot.friction is not None:
         approx = coulomb_viscous_from_sigmoid(robot.friction, robot.dq_max)
         print("friction as MuJoCo holds it (odd part of the sigmoid, fitted up to dq_max):")
         for j, name in enumerate(robot.joint_names):

@@ -290,7 +290,9 @@ def _load_model(args: argparse.Namespace) -> tuple[IdentifiedModel, Robot]:
     model = load_model_json(args.model)
     robot = _friction_robot(model.robot, args.friction)
     if robot is not model.robot:
-        model = IdentifiedModel(robot, model.base, model.fit, model.friction, dict(model.metadata))
+        model = IdentifiedModel(
+            robot, model.base, model.fit, model.friction, dict(model.metadata), drive=model.drive
+        )
     return model, robot
 
 

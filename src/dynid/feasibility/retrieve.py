@@ -764,7 +764,7 @@ def retrieve(
         raise ModelError(
             "the penalty method retrieves link parameters only, and this model identified "
             "rotor inertias with them (a drive); use the convex method (--method sdp), which "
-            "keeps them >= 0, or model.links_only()"
+            "identifies them with the links (>= 0)"
         )
     return retrieve_from_coefficients(
         model.robot,

@@ -102,3 +102,23 @@ def save_robot(
     if drive is not None:  # the drive train with it, as a [drive] table
         text = text.rstrip("\n") + "\n\n" + drive_toml(drive)
     return write_text(path, text)
+
+
+def model_terms_of(
+    spec: str | Path, n: int
+) -> tuple[ClassicalFriction | DriveFriction | None, Drive | None]:
+    """The model terms a robot file holds beside its links, for an export: the linear
+    friction identified with the links and the drive of a ``feasible.json`` (its rotor
+    inertias the identified ones), or the ``[drive]`` table of a robot TOML; ``(None, None)``
+    for anything else (``panda``, a URDF, a TOML without a drive)."""
+    p = Path(spec)
+    suffix = p.suffix.lower()
+    if suffix == ".json":
+        from .feasible import load_feasible_drive, load_feasible_linear_friction
+
+        return load_feasible_linear_friction(p), load_feasible_drive(p)
+    if suffix == ".toml":
+        from .drive_file import drive_of_robot_file
+
+        return None, drive_of_robot_file(p, n)
+    return None, None
