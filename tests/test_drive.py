@@ -422,3 +422,34 @@ def test_friction_fitted_per_motor_through_the_coupled_drive(tmp_path):
     assert isinstance(back, DriveFriction)
     h = dynid.identification.log.joint_side_log(held, _drive())
     np.testing.assert_allclose(back.torques(h.dq), fit.friction.torques(h.dq), rtol=1e-14)
+
+
+def test_validate_reads_a_log_as_the_model_was_identified(tmp_path):
+    """identify records --columns/--units (and the drive); validate --model reuses them on
+    a log of the same kind without being told, and refuses other ones."""
+    from dynid.cli.__main__ import main
+
+    robot, model, data = _ur5()
+    path = robot_data_urdf("ur_description/urdf/ur5_robot.urdf")
+    for seed, name in ((1, "log.csv"), (2, "held.csv")):
+        log, _ = _motor_log(model, data, seed=seed)
+        head = ["time"] + [f"pos_{j}" for j in range(1, 7)] + [f"eff_{j}" for j in range(1, 7)]
+        table = np.column_stack([log.t * 1e3, log.q, log.tau * 1e3])  # ms and mN m
+        np.savetxt(tmp_path / name, table, delimiter=",", header=",".join(head), comments="")
+    coupling = ", ".join(f"[{m}, {j}, {v}]" for m, j, v in COUPLING)
+    (tmp_path / "drive.toml").write_text(
+        f'schema = "dynid-drive/1"\nside = "motor"\ngear_ratio = {GEAR.tolist()}\n'
+        f"coupling = [{coupling}]\noffset = {OFFSET.tolist()}\n"
+    )
+    cols = ["--columns", "t=time,q=pos_{i},tau=eff_{i}", "--units", "t=ms,tau=mNm"]
+    args = ["identify", "--robot", path, "--base", "base_link", "--tip", "tool0", *cols]
+    args += ["--drive", str(tmp_path / "drive.toml"), "--data", str(tmp_path / "log.csv")]
+    assert main([*args, "--out", str(tmp_path / "r"), "-q"]) == 0
+    val = ["validate", "--model", str(tmp_path / "r" / "identification.json")]
+    val += ["--data", str(tmp_path / "held.csv"), "--no-figures", "-q"]
+    assert main([*val, "--out", str(tmp_path / "v")]) == 0
+    import json
+
+    doc = json.loads((tmp_path / "v" / "validation.json").read_text())
+    assert doc["relative_error_percent"] < 2.0
+    assert main([*val, "--out", str(tmp_path / "v2"), "--units", "t=s,tau=mNm"]) == 2

@@ -372,6 +372,36 @@ def add_column_options(p: argparse.ArgumentParser) -> None:
     )
 
 
+def record_columns(args: argparse.Namespace, metadata: dict[str, Any]) -> None:
+    """Record ``--columns``/``--units`` in a model's metadata (``"column_map"``), so that
+    ``validate`` reads a log of the same kind the same way (:func:`reuse_columns`)."""
+    spec, units = getattr(args, "columns", None), getattr(args, "units", None)
+    if spec is not None or units is not None:
+        metadata["column_map"] = {"columns": spec, "units": units}
+
+
+def reuse_columns(args: argparse.Namespace, metadata: Any) -> None:
+    """Take the ``--columns``/``--units`` a model was identified with when none are given;
+    other ones than recorded are an error (the log would be read another way)."""
+    rec = dict(metadata or {}).get("column_map")
+    if not isinstance(rec, dict):
+        return
+    given = (getattr(args, "columns", None), getattr(args, "units", None))
+    if given == (None, None):
+        args.columns, args.units = rec.get("columns"), rec.get("units")
+        _log.warning(
+            "reading --data as the model's data were read: --columns %r --units %r",
+            args.columns,
+            args.units,
+        )
+    elif given != (rec.get("columns"), rec.get("units")):
+        raise DataError(
+            f"--columns {given[0]!r} --units {given[1]!r} differ from those the model was "
+            f"identified with ({rec.get('columns')!r}, {rec.get('units')!r}); hint: leave "
+            "them out to use the model's"
+        )
+
+
 def column_map(args: argparse.Namespace) -> Any:
     """The :class:`~dynid.io.columns.ColumnMap` of ``--columns``/``--units``, or None."""
     from ..io.columns import load_column_map, parse_column_map

@@ -49,6 +49,7 @@ from .common import (
     load_robot,
     positive_type,
     read_log,
+    reuse_columns,
     save_figure,
 )
 
@@ -162,6 +163,8 @@ def run(args: argparse.Namespace) -> int:
     """Fit friction, write friction.json and the figure, print the RMS table (unless -q)."""
     say = (lambda *a: None) if getattr(args, "quiet", False) else print
     model = load_torque_model(args)
+    if isinstance(model, IdentifiedModel):
+        reuse_columns(args, model.metadata)
     n = _joint_count(model)
     log = read_log(args, args.data, n)
     if log.n != n:

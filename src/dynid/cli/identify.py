@@ -92,6 +92,7 @@ from .common import (
     parse_vector,
     positive_type,
     read_log,
+    record_columns,
     sdp_options,
     warn,
 )
@@ -282,6 +283,7 @@ def run(args: argparse.Namespace) -> int:
             print(f"dynid {NAME}: warning: {w.message}", file=sys.stderr)
         else:
             warnings.warn_explicit(w.message, w.category, w.filename, w.lineno)
+    record_columns(args, model.metadata)
     args.out.mkdir(parents=True, exist_ok=True)
     path = save_model_json(args.out / "identification.json", model)
     if not args.quiet:
@@ -333,6 +335,7 @@ def run_consistent(robot: Robot, args: argparse.Namespace) -> int:
         )
     if result.identified is None:  # pragma: no cover - identify_consistent always sets it
         raise DataError("the one-step identification returned no unconstrained fit")
+    record_columns(args, result.identified.metadata)
     files = [save_model_json(args.out / "identification.json", result.identified)]
     files += write_outputs(args.out, result, figures=not args.no_figures, source=str(args.data))
     if not args.quiet:

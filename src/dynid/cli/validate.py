@@ -49,6 +49,7 @@ from .common import (
     load_robot,
     positive_type,
     read_log,
+    reuse_columns,
 )
 from .friction import VALIDATION_SCHEMA, format_rms_table, save_validation_figures
 
@@ -113,6 +114,8 @@ def run(args: argparse.Namespace) -> int:
     say = (lambda *a: None) if getattr(args, "quiet", False) else print
     model, label = load_model_source(args)
     robot = model.robot if isinstance(model, IdentifiedModel) else model
+    if isinstance(model, IdentifiedModel):
+        reuse_columns(args, model.metadata)
     log = read_log(args, args.data, robot.n)
     if log.n != robot.n:
         raise DataError(
