@@ -453,3 +453,22 @@ def test_validate_reads_a_log_as_the_model_was_identified(tmp_path):
     doc = json.loads((tmp_path / "v" / "validation.json").read_text())
     assert doc["relative_error_percent"] < 2.0
     assert main([*val, "--out", str(tmp_path / "v2"), "--units", "t=s,tau=mNm"]) == 2
+
+
+def test_urdf_export_writes_identified_friction_as_dynamics(tmp_path):
+    """Classical friction reflected from the motors of a diagonal drive: the URDF chain holds
+    <dynamics damping="k^2 fv" friction="|k| fc"> per joint."""
+    import xml.etree.ElementTree as ET
+
+    from dynid.friction.model import ClassicalFriction, DriveFriction
+    from dynid.io.export import save_robot
+
+    robot, _, _ = _ur5()
+    drive = Drive.from_gears(GEAR, side="motor")
+    fr = DriveFriction(ClassicalFriction(FV, FC, FO), drive)
+    path = save_robot(tmp_path / "arm.urdf", robot, friction=fr)
+    dyn = [j.find("dynamics") for j in ET.parse(path).getroot().iter("joint")]
+    dyn = [d for d in dyn if d is not None]
+    assert len(dyn) == 6
+    np.testing.assert_allclose([float(d.get("damping")) for d in dyn], GEAR**2 * FV, rtol=1e-14)
+    np.testing.assert_allclose([float(d.get("friction")) for d in dyn], GEAR * FC, rtol=1e-14)

@@ -26,9 +26,15 @@ from numpy.typing import ArrayLike, NDArray
 
 from .. import _checks
 from ..exceptions import ShapeError
-from .model import sigmoid_friction
+from .model import ClassicalFriction, DriveFriction, sigmoid_friction
 
-__all__ = ["CoulombViscous", "DriveJointTerms", "coulomb_viscous_from_sigmoid", "drive_joint_terms"]
+__all__ = [
+    "CoulombViscous",
+    "DriveJointTerms",
+    "coulomb_viscous_from_sigmoid",
+    "drive_joint_terms",
+    "joint_coulomb_viscous",
+]
 
 
 @dataclass(frozen=True, slots=True)
@@ -172,3 +178,23 @@ def drive_joint_terms(
                 "and is dropped (frictionloss holds each joint's own motor)"
             )
     return DriveJointTerms(arm, damp, loss, tuple(notes))
+
+
+def joint_coulomb_viscous(friction: ClassicalFriction | DriveFriction) -> DriveJointTerms:
+    """Per-joint Coulomb (``frictionloss``, URDF ``friction``) and viscous (``damping``)
+    coefficients of identified linear friction, at the joints or reflected from the motors
+    of a drive (:func:`drive_joint_terms`; what has no per-joint form is in ``notes``)."""
+    if isinstance(friction, DriveFriction):
+        law = friction.law
+        if not isinstance(law, ClassicalFriction):
+            raise ShapeError("friction at the motors must be the classical law to export")
+        d = friction.drive
+        return drive_joint_terms(
+            d.transmission,
+            None,
+            np.asarray(law.fv),
+            np.asarray(law.fc),
+            friction_at_motor=d.friction_at == "motor",
+        )
+    z = np.zeros(friction.n)
+    return DriveJointTerms(z, np.asarray(friction.fv), np.asarray(friction.fc))

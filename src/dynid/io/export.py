@@ -18,6 +18,7 @@ from pathlib import Path
 
 from ..exceptions import DataError
 from ..friction.model import ClassicalFriction, DriveFriction
+from ..friction.mujoco import joint_coulomb_viscous
 from ..model.drive import Drive
 from ..model.robot import Robot
 from .atomic import write_text
@@ -76,8 +77,9 @@ def save_robot(
     template, base, tip, merged, all_frames
         URDF only (:func:`dynid.io.urdf_export.save_urdf`).
     friction : bool, ClassicalFriction or DriveFriction
-        MJCF only: the robot's friction, identified classical friction (at the joints or
-        the motors), or none (:func:`dynid.io.mjcf_export.save_mjcf`).
+        MJCF: the robot's friction, identified classical friction (at the joints or the
+        motors), or none (:func:`dynid.io.mjcf_export.save_mjcf`); URDF chain: identified
+        classical friction as ``<dynamics damping friction>``.
     drive : Drive, optional
         MJCF: a drive with known rotor inertias, written as ``armature``; TOML: the drive
         as a ``[drive]`` table.
@@ -93,8 +95,19 @@ def save_robot(
     if template is not None and fmt != "urdf":
         raise DataError(f"a URDF template applies to the urdf format only; got format {fmt!r}")
     if fmt == "urdf":
+        dyn = None
+        if isinstance(friction, ClassicalFriction | DriveFriction):
+            jt = joint_coulomb_viscous(friction)
+            dyn = (jt.damping, jt.frictionloss)
         return save_urdf(
-            path, robot, all_frames=all_frames, template=template, base=base, tip=tip, merged=merged
+            path,
+            robot,
+            all_frames=all_frames,
+            template=template,
+            base=base,
+            tip=tip,
+            merged=merged,
+            dynamics=dyn,
         )
     if fmt == "mjcf":
         return save_mjcf(path, robot, friction=friction, drive=drive)

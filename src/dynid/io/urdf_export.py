@@ -24,7 +24,8 @@ per joint, keeping the robot's link and joint names:
 * with ``template=`` the original URDF is written back with only the chain's
   ``<inertial>`` elements replaced (:func:`dynid.io.urdf_patch.patch_urdf_inertials`).
 
-Gravity and friction are not part of URDF and are not written. Numbers use Python's
+Gravity is not part of URDF; identified linear friction (``dynamics=``) is written as
+``<dynamics damping friction>`` per joint, the sigmoid is not. Numbers use Python's
 shortest round-trip representation, so the parameters read back exactly.
 """
 
@@ -35,6 +36,7 @@ from pathlib import Path
 from xml.sax.saxutils import quoteattr
 
 import numpy as np
+from numpy.typing import NDArray
 
 from .. import __version__, spatial
 from ..exceptions import ModelError
@@ -92,7 +94,13 @@ def tip_name(robot: Robot) -> str | None:
     return "flange"
 
 
-def urdf_from_robot(robot: Robot, *, all_frames: bool = False, comment: str | None = None) -> str:
+def urdf_from_robot(
+    robot: Robot,
+    *,
+    all_frames: bool = False,
+    comment: str | None = None,
+    dynamics: tuple[NDArray[np.float64], NDArray[np.float64]] | None = None,
+) -> str:
     """The URDF document of a robot: kinematics, limits and link inertials.
 
     Parameters
@@ -103,6 +111,9 @@ def urdf_from_robot(robot: Robot, *, all_frames: bool = False, comment: str | No
         massless link (see the module docstring).
     comment : str, optional
         Text of an XML comment at the top (default: the writer and the conventions).
+    dynamics : (ndarray, ndarray), optional
+        Per-joint ``damping`` [N m s/rad] and Coulomb ``friction`` [N m], written as
+        ``<dynamics damping friction>`` (identified linear friction).
 
     Returns
     -------
@@ -113,8 +124,12 @@ def urdf_from_robot(robot: Robot, *, all_frames: bool = False, comment: str | No
     I6 = inertia6_from_matrix(robot.inertia)
     mass, com = robot.mass, robot.com
     text = comment or (
-        f"written by dynid {__version__}: inertials about the CoM in link axes [kg, m, kg m^2]; "
-        "gravity and friction are not part of URDF"
+        f"written by dynid {__version__}: inertials about the CoM in link axes [kg, m, kg m^2]"
+        + (
+            "; joint friction as <dynamics damping friction>"
+            if dynamics is not None
+            else "; gravity and friction are not part of URDF"
+        )
     )
     lines = [
         '<?xml version="1.0"?>',
@@ -147,6 +162,11 @@ def urdf_from_robot(robot: Robot, *, all_frames: bool = False, comment: str | No
             f'    <origin xyz="{_v(T[:3, 3])}" rpy="{_v(rpy)}"/>',
             f'    <axis xyz="{_v(robot.axes[i])}"/>',
             f"    <limit {limit}/>",
+            *(
+                [f'    <dynamics damping="{_f(dynamics[0][i])}" friction="{_f(dynamics[1][i])}"/>']
+                if dynamics is not None
+                else []
+            ),
             "  </joint>",
             f"  <link name={quoteattr(child)}>",
             "    <inertial>",
@@ -180,6 +200,7 @@ def save_urdf(
     base: str | None = None,
     tip: str | None = None,
     merged: str = "subtract",
+    dynamics: tuple[NDArray[np.float64], NDArray[np.float64]] | None = None,
 ) -> Path:
     """Write the robot as URDF to ``path``; returns the path.
 
@@ -193,6 +214,8 @@ def save_urdf(
         The original URDF file: written back with only the chain's ``<inertial>``
         elements replaced (:func:`dynid.io.urdf_patch.patch_urdf_inertials`, with
         ``base``, ``tip`` and ``merged``).
+    dynamics : (ndarray, ndarray), optional
+        Chain export only: per-joint damping and Coulomb friction (:func:`urdf_from_robot`).
 
     Raises
     ------
@@ -203,7 +226,7 @@ def save_urdf(
     """
     path = Path(path)
     if template is None:
-        text = urdf_from_robot(robot, all_frames=all_frames)
+        text = urdf_from_robot(robot, all_frames=all_frames, dynamics=dynamics)
     else:
         tpath = Path(template)
         try:
