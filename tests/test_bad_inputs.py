@@ -909,3 +909,36 @@ def test_an_error_echoing_megabytes_is_one_short_line(monkeypatch, capsys, kind)
     assert err.count("\n") == 1 and len(err) <= 1100, len(err)
     assert err.startswith("dynid fk: error: ") and "x.csv: bad header col, col," in err
     assert "characters cut" in err and "; hint: fix the header" in err
+
+
+def test_non_ascii_names_under_an_ascii_locale(tmp_path):
+    """LANG=C without UTF-8 mode: a robot with non-ASCII joint and link names prints them
+    escaped (exit 0), and a log with a non-ASCII file name gets its friction fit and figure
+    (issue 20: UnicodeEncodeError on stdout, a figure title matplotlib refused)."""
+    import os
+    import subprocess
+    import sys
+
+    text = ONE_JOINT_TOML.replace('"j1"', '"gelenk_\u00e4"').replace('"l1"', '"glied_\u00fc"')
+    (tmp_path / "arm.toml").write_text(text, encoding="utf-8")
+    env = dict(os.environ, LANG="C", LC_ALL="C", PYTHONUTF8="0", PYTHONCOERCECLOCALE="0")
+    env["PYTHONPATH"] = str(Path(__file__).resolve().parents[1] / "src")
+
+    def dynid(*args):
+        return subprocess.run([sys.executable, "-m", "dynid", *args], cwd=tmp_path, env=env,
+                              capture_output=True, timeout=300)  # fmt: skip
+
+    fk = dynid("fk", "--robot", "arm.toml", "--q", "0.1")
+    assert fk.returncode == 0, fk.stderr
+    assert b"gelenk_\\xe4" in fk.stdout and b"Traceback" not in fk.stderr
+    log = "l\u00f6g.csv".encode()  # UTF-8 bytes, as a user's shell passes them
+    sim = dynid("simulate", "--robot", "arm.toml", "--trajectory", "fourier", "--duration", "3",
+                "--out", os.fsdecode(log))  # fmt: skip
+    assert sim.returncode == 0, sim.stderr
+    fr = dynid("friction", "--robot", "arm.toml", "--data", os.fsdecode(log), "--out", "fr")
+    assert fr.returncode == 0, fr.stderr
+    assert (tmp_path / "fr" / "friction.json").exists() and (
+        tmp_path / "fr" / "friction.png"
+    ).exists()
+    bad = dynid("fk", "--robot", "arm.toml", "--q", "0.1", "--frame", "n\u00f6")
+    assert bad.returncode == 2 and bad.stderr.count(b"\n") == 1, bad.stderr

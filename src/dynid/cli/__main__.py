@@ -13,6 +13,7 @@ from __future__ import annotations
 import argparse
 import contextlib
 import importlib
+import io
 import logging
 import re
 import signal
@@ -145,8 +146,21 @@ def _signals_and_warnings(command: str) -> Iterator[None]:
             signal.signal(signal.SIGTERM, old)
 
 
+def _printable_streams() -> None:
+    """Under an ASCII locale (``LANG=C`` without UTF-8 mode) print names that the terminal
+    cannot show as ``\\xe9`` escapes instead of failing on them."""
+    for stream in (sys.stdout, sys.stderr):
+        if not isinstance(stream, io.TextIOWrapper):  # captured, redirected to a StringIO
+            continue
+        try:
+            "\u00e9\u2014".encode(stream.encoding)
+        except (UnicodeEncodeError, LookupError):
+            stream.reconfigure(errors="backslashreplace")
+
+
 def main(argv: Sequence[str] | None = None) -> int:
     """Entry point of the ``dynid`` console script; returns the exit code."""
+    _printable_streams()
     argv = join_negative_values(sys.argv[1:] if argv is None else list(argv))
     command = _command(argv)
     parser = build_parser(SUBCOMMANDS if command is None else (command,))

@@ -122,6 +122,13 @@ def about(path: Path) -> Iterator[None]:
         raise type(exc)(f"{path.name}: {exc}") from exc
 
 
+def shown(text: str) -> str:
+    """``text`` as it can be drawn: a file name given under an ASCII locale (its UTF-8
+    bytes escaped as surrogates, ``l\\udcc3\\udcb6g.csv``) back to its characters
+    (``l\u00f6g.csv``); bytes that are not UTF-8 become U+FFFD."""
+    return text.encode("utf-8", "surrogateescape").decode("utf-8", "replace")
+
+
 def warn(args: argparse.Namespace, message: str) -> None:
     """One warning line on stderr (``dynid CMD: warning: ...``), unless ``-q``."""
     if not getattr(args, "quiet", False):

@@ -51,6 +51,7 @@ from .common import (
     read_log,
     reuse_columns,
     save_figure,
+    shown,
 )
 
 if TYPE_CHECKING:  # pragma: no cover
@@ -190,7 +191,7 @@ def run(args: argparse.Namespace) -> int:
             res,
             fit,
             names=names,
-            title=f"{fit.kind} friction fitted to the torque residual ({args.data.name})",
+            title=shown(f"{fit.kind} friction fitted to the torque residual ({args.data.name})"),
         )
     print(
         format_rms_table(

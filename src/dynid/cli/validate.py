@@ -50,6 +50,7 @@ from .common import (
     positive_type,
     read_log,
     reuse_columns,
+    shown,
 )
 from .friction import VALIDATION_SCHEMA, format_rms_table, save_validation_figures
 
@@ -168,7 +169,9 @@ def run(args: argparse.Namespace) -> int:
     save_json(args.out / "validation.json", doc, schema=VALIDATION_SCHEMA)
     names = list(robot.joint_names)
     if not args.no_figures:
-        save_validation_figures(args.out, val, names=names, title=f"{label} on {args.data.name}")
+        save_validation_figures(
+            args.out, val, names=names, title=shown(f"{label} on {args.data.name}")
+        )
     cols = {"RMS no friction [N m]": val.without_friction.rms}
     if val.with_friction is not None:
         cols["RMS + friction [N m]"] = val.with_friction.rms
