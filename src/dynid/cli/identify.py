@@ -137,8 +137,16 @@ def register(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParser:
     p.add_argument(
         "--std",
         choices=("robust", "classical"),
-        default="robust",
-        help="standard deviations: heteroscedasticity-consistent (default) or sigma^2 (W^T W)^-1",
+        default=None,
+        help="standard deviations: heteroscedasticity-consistent or sigma^2 (W^T W)^-1 "
+        "(default: robust for static data, classical for torque logs; honoured on both)",
+    )
+    p.add_argument(
+        "--estimator",
+        choices=("ols", "wls", "irls"),
+        default="ols",
+        help="least squares: ordinary (default), weighted by each joint's (static: each row's) "
+        "noise level from a first fit, or Huber-reweighted against outliers",
     )
     p.add_argument(
         "--rtol",
@@ -220,6 +228,8 @@ def identify_torque_log(robot: Robot, path: Path, args: argparse.Namespace) -> I
             rtol=args.rtol,
             max_gap_s=args.max_gap,
             drive=load_drive_arg(args, robot.n),
+            estimator=args.estimator,
+            std=args.std or "classical",
             **kw,
         )
 
@@ -258,8 +268,9 @@ def identify_static_file(robot: Robot, path: Path, args: argparse.Namespace) -> 
             data,
             max_std_percent=args.max_std_percent,
             rtol=args.rtol,
-            std_estimator=args.std,
+            std_estimator=args.std or "robust",
             drive=load_drive_arg(args, robot.n),
+            estimator=args.estimator,
         )
     misfit = fit_mismatch(model.fit.relative_error_percent, data.metadata)
     if misfit is not None:
@@ -299,6 +310,11 @@ def run_consistent(robot: Robot, args: argparse.Namespace) -> int:
 
     if args.max_std_percent is not None:
         raise DataError("--max-std-percent does not apply to --consistent (nothing is pruned)")
+    if args.std is not None:
+        raise DataError(
+            "--std does not apply to --consistent: its data term is the residual itself "
+            "(weighted by --estimator)"
+        )
     data: Any
     if data_kind(args.data, column_map(args)) == "torque_log":
         data = read_log(args, args.data, robot.n)
@@ -331,6 +347,7 @@ def run_consistent(robot: Robot, args: argparse.Namespace) -> int:
             options=sdp_options(args),
             rtol=args.rtol,
             drive=load_drive_arg(args, robot.n),
+            estimator=args.estimator,
             **kw,
         )
     if result.identified is None:  # pragma: no cover - identify_consistent always sets it
@@ -360,7 +377,8 @@ def format_summary(model: IdentifiedModel, *, width: int = 60) -> str:
         + (f", dropped rows {', '.join(meta['dropped_rows'])}" if meta.get("dropped_rows") else ""),
         f"rank {fit.rank}, condition number {fit.condition_number:.4g} (unscaled, as the "
         f"paper), scaled {fit.scaled_condition_number:.4g}, relative error "
-        f"{fit.relative_error_percent:.4g} %, std {meta.get('std_estimator', '?')}"
+        f"{fit.relative_error_percent:.4g} %, estimator {meta.get('estimator', 'ols')}, "
+        f"std {meta.get('std_estimator', '?')}"
         + (
             f", pruned {len(meta['pruned'])} above {meta['max_std_percent']:g} %"
             if meta.get("pruned")

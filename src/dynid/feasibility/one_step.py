@@ -23,6 +23,7 @@ from typing import Any
 from ..exceptions import ShapeError
 from ..identification.classical import identify_from_log
 from ..identification.data import StaticDataset
+from ..identification.estimators import Estimator, EstimatorName
 from ..identification.log import DEFAULT_CUTOFF_HZ, TorqueLog
 from ..identification.static import identify_static
 from ..model.drive import Drive
@@ -47,6 +48,7 @@ def identify_consistent(
     decimate: int | None = None,
     rtol: float | None = None,
     drive: Drive | None = None,
+    estimator: EstimatorName | Estimator = "ols",
 ) -> ConsistentResult:
     """Physically consistent link parameters (and friction) identified from data.
 
@@ -67,6 +69,9 @@ def identify_consistent(
         The drive train (:mod:`dynid.model.drive`): the log is read through it, its rotor
         inertias are identified with the links (``>= 0``) and its friction acts at the
         motors (``fv, fc >= 0``).
+    estimator : {"ols", "wls", "irls"} or Estimator
+        The unconstrained fit's estimator; its weighted covariance is the consistent fit's
+        data term (:mod:`dynid.identification.estimators`).
 
     Returns
     -------
@@ -90,11 +95,14 @@ def identify_consistent(
             friction=True,
             rtol=rtol,
             drive=drive,
+            estimator=estimator,
         )
         term = coefficient_term(model, with_friction=True)
         kind = "log"
     elif isinstance(data, StaticDataset):
-        model = identify_static(robot, data, rtol=rtol, std_estimator="classical", drive=drive)
+        model = identify_static(
+            robot, data, rtol=rtol, std_estimator="classical", drive=drive, estimator=estimator
+        )
         term = coefficient_term(model)
         kind = "static"
     else:

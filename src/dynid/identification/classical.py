@@ -28,12 +28,13 @@ from __future__ import annotations
 
 import dataclasses
 import warnings
-from typing import Any
+from typing import Any, Literal
 
 import numpy as np
 from numpy.typing import NDArray
 
-from ..exceptions import DynidWarning, RankDeficientError, ShapeError
+from .. import _checks
+from ..exceptions import DynidWarning, OptionError, RankDeficientError, ShapeError
 from ..model.drive import Drive
 from ..model.robot import Robot
 from ..regressors.base import BaseParameters, base_parameters, identifiability
@@ -45,7 +46,8 @@ from ..regressors.terms import (
     friction_labels,
 )
 from ..regressors.torque import torque_regressor_prepared
-from .least_squares import LeastSquaresFit, conditioning_advice, fit_with_pruning
+from .estimators import Estimator, EstimatorName, estimator_named
+from .least_squares import LeastSquaresFit, conditioning_advice
 from .log import DEFAULT_CUTOFF_HZ, TorqueLog, joint_side_log, prepare_log
 from .model import IdentifiedModel
 
@@ -95,6 +97,8 @@ def identify_from_log(
     base: BaseParameters | None = None,
     rtol: float | None = None,
     drive: Drive | None = None,
+    estimator: EstimatorName | Estimator = "ols",
+    std: Literal["classical", "robust"] = "classical",
 ) -> IdentifiedModel:
     """Identify base parameters (and linear friction) from a torque log.
 
@@ -132,6 +136,12 @@ def identify_from_log(
         inertias are identified with the links (or subtracted when known) and the friction
         acts where it says (the motors for a gear train). Default: link-side torques of a
         direct drive.
+    estimator : {"ols", "wls", "irls"} or Estimator
+        Ordinary, per-joint weighted or Huber-robust least squares
+        (:mod:`dynid.identification.estimators`).
+    std : {"classical", "robust"}
+        Standard deviations from ``sigma^2 (W^T W)^-1`` (default) or the
+        heteroscedasticity-consistent estimate.
 
     Returns
     -------
@@ -182,13 +192,18 @@ def identify_from_log(
     y = tau.reshape(-1)
     r = bp.rank
     fit_rtol = 1e-10 if rtol is None else rtol
+    est = estimator_named(estimator)
+    if std not in ("classical", "robust"):
+        raise OptionError(f"std must be 'classical' or 'robust'; got {std!r}")
     try:
-        fit = fit_with_pruning(
+        _checks.finite("regressor", W)
+        fit = est.fit(
             W,
             y,
-            max_std_percent=max_std_percent,
+            np.tile(np.arange(n), N),  # row k n + j: joint j
             rtol=fit_rtol,
-            covariance="classical",
+            covariance=std,
+            max_std_percent=max_std_percent,
             labels=labels,
         )
     except RankDeficientError as exc:
@@ -205,7 +220,8 @@ def identify_from_log(
         "reference": "Gaz et al. 2019, Sec. IV-B, eq. 24 (classical friction)",
         "pruned": [labels[j] for j in np.flatnonzero(~np.asarray(fit.kept))],
         "max_std_percent": max_std_percent,
-        "std_estimator": "classical",
+        "std_estimator": std,
+        "estimator": est.name,
         "dropped_rows": [],
         "cutoff_hz": cutoff_hz,
         "trim_s": float(prepared.t[0] - log.t[0]),

@@ -58,6 +58,7 @@ from ..regressors.static import (
 )
 from ..regressors.terms import base_term_columns, drive_terms
 from .data import StaticDataset
+from .estimators import Estimator, EstimatorName, estimator_named
 from .least_squares import _block_grams, _fit_with_pruning, conditioning_advice
 from .model import IdentifiedModel
 
@@ -112,6 +113,7 @@ def identify_static(
     base: BaseParameters | None = None,
     std_estimator: str = "robust",
     drive: Drive | None = None,
+    estimator: EstimatorName | Estimator = "ols",
 ) -> IdentifiedModel:
     """Identify the base parameters from inertia matrices and gravity torques at rest.
 
@@ -148,6 +150,9 @@ def identify_static(
         (``K^T diag(I_a) K``, :mod:`dynid.model.drive`): unknown rotor inertias are
         identified with the links (``Ia1 .. Ia_n`` after the link parameters in
         ``base.std_labels``), known ones subtracted from ``M``.
+    estimator : {"ols", "wls", "irls"} or Estimator
+        Ordinary least squares (default), weighted by the noise level of each row of
+        ``[tril M; g]``, or Huber-robust (:mod:`dynid.identification.estimators`).
 
     Returns
     -------
@@ -240,17 +245,30 @@ def identify_static(
     y = S.reshape(-1)
     m = int(info.sum()) * N
     _log.info("static identification: %d configurations, %d rows, %d base parameters", N, m, r)
+    est = estimator_named(estimator)
     try:
-        fit = _fit_with_pruning(
-            W,
-            y,
-            max_std_percent=max_std_percent,
-            rtol=fit_rtol,
-            covariance=std_estimator,
-            blocks=rows[info],
-            gram=grams[info].sum(axis=0),
-            labels=base.labels,
-        )
+        if est.name == "ols":  # the blocked fast path
+            fit = _fit_with_pruning(
+                W,
+                y,
+                max_std_percent=max_std_percent,
+                rtol=fit_rtol,
+                covariance=std_estimator,
+                blocks=rows[info],
+                gram=grams[info].sum(axis=0),
+                labels=base.labels,
+            )
+        else:  # one noise group per row of [tril M; g]
+            used = np.flatnonzero(np.repeat(info, N))
+            fit = est.fit(
+                W[used],
+                y[used],
+                used // N,
+                rtol=fit_rtol,
+                covariance=std_estimator,
+                max_std_percent=max_std_percent,
+                labels=base.labels,
+            )
     except RankDeficientError as exc:
         rank = _rank(Yb[:, info].reshape(r, -1).T, fit_rtol)
         cols = str(exc).split("nearly dependent columns: ")[-1]
@@ -277,6 +295,7 @@ def identify_static(
         "pruned": pruned,
         "max_std_percent": max_std_percent,
         "std_estimator": std_estimator,
+        "estimator": est.name,
         "rtol": rtol,
         "rank_gap": None if base.gap is None else list(base.gap),
         "identifiability": dict(zip(base.std_labels, identifiability(base), strict=True)),
