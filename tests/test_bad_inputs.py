@@ -725,7 +725,7 @@ def test_figures_are_skipped_without_matplotlib(base, tmp_path, monkeypatch, cap
         "note: matplotlib is not installed; skipped the figure validation_torques.png",
         "note: matplotlib is not installed; skipped the figure validation_rms.png",
     ]
-    assert sorted(p.name for p in out.iterdir()) == ["validation.json"]
+    assert sorted(p.name for p in out.iterdir()) == [".dynid-run.json", "validation.json"]
 
 
 def test_strict_json_out_never_writes_nan(tmp_path):

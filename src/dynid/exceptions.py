@@ -42,6 +42,10 @@ class DataError(DynidError, ValueError):
     """A data set or log file is malformed."""
 
 
+class OutputError(DynidError):
+    """An output cannot be written as asked (read-only, or holding files of another run)."""
+
+
 class LimitError(DynidError, ValueError):
     """A value lies outside the robot's limits where that matters."""
 

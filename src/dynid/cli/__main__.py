@@ -6,6 +6,12 @@ Exit status: 0 success; 1 a command's documented negative result (retrieve: no f
 set); 2 an error (one line on stderr; --debug shows the traceback); 130 interrupted
 (Ctrl-C); 143 terminated (SIGTERM). A failed or interrupted command leaves no file or
 folder of its own behind, and no file is ever half written.
+
+Output folders: a command writes its files into a hidden staging folder beside --out and
+moves the complete set into place when it succeeds; a rerun of the same command replaces
+the previous set as a whole (its files that the new run does not write are removed). A
+folder holding another command's outputs, a file no dynid run wrote, or a read-only file
+is not replaced without --force. Concurrent runs into one folder never mix their files.
 """
 
 from __future__ import annotations
@@ -24,6 +30,7 @@ from collections.abc import Iterator, Sequence
 from .._checks import one_line
 from ..exceptions import DynidError
 from ..io.atomic import output_transaction
+from ..io.run_output import run_output
 
 #: Longest error line printed [characters]: a message echoing megabytes of input keeps
 #: its start and its end (the hint).
@@ -91,7 +98,15 @@ def build_parser(commands: Sequence[str] = SUBCOMMANDS) -> argparse.ArgumentPars
         p.add_argument("-v", "--verbose", action="count", default=0, help="more log output")
         p.add_argument("-q", "--quiet", action="store_true", help="errors only")
         p.add_argument("--debug", action="store_true", help="show tracebacks of errors")
-        p.set_defaults(_run=mod.run)
+        output = getattr(mod, "OUTPUT", None)
+        if output is not None:
+            p.add_argument(
+                "--force",
+                action="store_true",
+                help="replace read-only files, files of another command's outputs and files "
+                "no dynid run wrote in --out",
+            )
+        p.set_defaults(_run=mod.run, _output=output)
     return parser
 
 
@@ -158,6 +173,19 @@ def _printable_streams() -> None:
             stream.reconfigure(errors="backslashreplace")
 
 
+@contextlib.contextmanager
+def _output_set(args: argparse.Namespace, argv: Sequence[str]) -> Iterator[object]:
+    """The run's output set under ``--out`` (:func:`dynid.io.run_output.run_output`)."""
+    kind, out = getattr(args, "_output", None), getattr(args, "out", None)
+    if kind is None or out is None:
+        yield None
+        return
+    with run_output(
+        out, command=args.command, kind=kind, force=args.force, argv=["dynid", *argv]
+    ) as run:
+        yield run
+
+
 def main(argv: Sequence[str] | None = None) -> int:
     """Entry point of the ``dynid`` console script; returns the exit code."""
     _printable_streams()
@@ -178,7 +206,11 @@ def main(argv: Sequence[str] | None = None) -> int:
     logging.basicConfig(level=level, format="%(levelname)s %(name)s: %(message)s")
     say = f"dynid {args.command}"
     try:
-        with _signals_and_warnings(args.command), output_transaction():
+        with (
+            _signals_and_warnings(args.command),
+            output_transaction(),
+            _output_set(args, argv),
+        ):
             return int(args._run(args) or 0)
     except KeyboardInterrupt:
         if args.debug:

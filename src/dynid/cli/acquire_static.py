@@ -45,6 +45,8 @@ from .common import (
 )
 
 NAME = "acquire-static"
+#: ``--out`` is the one file written (:mod:`dynid.io.run_output`).
+OUTPUT = "file"
 
 
 def register(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParser:

@@ -63,6 +63,8 @@ from .common import (
 )
 
 NAME = "demo"
+#: ``--out`` is a folder: its files are one output set (:mod:`dynid.io.run_output`).
+OUTPUT = "folder"
 
 
 # ---------------------------------------------------------------------- stage 1
@@ -180,8 +182,9 @@ def _table(header: list[str], rows: list[list[str]]) -> str:
     return "\n".join(lines + ["| " + " | ".join(r) + " |" for r in rows])
 
 
-def write_report(out: Path, demo: DemoResult) -> Path:
-    """``out/report.md``: the tables and figures of every stage, with links to the files."""
+def write_report(out: Path, demo: DemoResult, files: list[Path]) -> Path:
+    """``out/report.md``: the tables and figures of every stage, with links to the files
+    (``files``: those written by the stages)."""
     from .. import __version__
 
     names = demo.robot.joint_names
@@ -248,7 +251,11 @@ def write_report(out: Path, demo: DemoResult) -> Path:
         "Files: [feasible.json](feasible/feasible.json), [robot.urdf](feasible/robot.urdf), "
         "[robot.toml](feasible/robot.toml), [report.json](feasible/report.json).",
     ]
-    parts += [f"![{p.stem}](feasible/{p.name})" for p in sorted((out / "feasible").glob("*.png"))]
+    parts += [
+        f"![{p.stem}](feasible/{p.name})"
+        for p in sorted(files)
+        if p.parent.name == "feasible" and p.suffix == ".png"
+    ]
     c = demo.consistent
     rows5 = [
         [
@@ -373,7 +380,7 @@ def run(args: argparse.Namespace) -> int:
     t0 = time.perf_counter()
     render = _Renderer(args.out, robot)
     demo = run_demo(robot, args.seed, progress=render)
-    report = write_report(args.out, demo)
+    report = write_report(args.out, demo, render.files)
     render.files.append(report)
     print(f"\nreport: {report} ({time.perf_counter() - t0:.0f} s)")
     print(f"\ndone: {len(render.files)} files in {args.out}")

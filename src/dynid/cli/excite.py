@@ -38,6 +38,8 @@ from ..simulation.excitation import ExcitationOptions, optimise_excitation
 from .common import add_robot_options, add_subcommand, load_robot, save_figure
 
 NAME = "excite"
+#: ``--out`` is a folder: its files are one output set (:mod:`dynid.io.run_output`).
+OUTPUT = "folder"
 
 
 def register(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParser:
@@ -109,7 +111,6 @@ def run(args: argparse.Namespace) -> int:
     )
     if show:
         print(file=sys.stderr)
-    args.out.mkdir(parents=True, exist_ok=True)
     samples = res.trajectory.sample(1000.0)
     csv = save_trajectory_csv(args.out / "trajectory.csv", samples)
     js = save_excitation_json(args.out / "trajectory.json", res, robot, seed=args.seed)

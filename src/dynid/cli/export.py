@@ -39,6 +39,8 @@ from ..model.robot import Robot
 from .common import add_drive_option, add_subcommand, load_drive_arg
 
 NAME = "export"
+#: ``--out`` is the one file written (:mod:`dynid.io.run_output`).
+OUTPUT = "file"
 
 
 def register(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParser:

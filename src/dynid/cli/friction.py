@@ -58,6 +58,8 @@ if TYPE_CHECKING:  # pragma: no cover
     from ..pipeline.stages import FrictionStageResult
 
 NAME = "friction"
+#: ``--out`` is a folder: its files are one output set (:mod:`dynid.io.run_output`).
+OUTPUT = "folder"
 
 #: ``schema`` of validation.json (written by ``validate`` and by the demo).
 VALIDATION_SCHEMA = "dynid-validation/1"

@@ -101,6 +101,8 @@ if TYPE_CHECKING:  # pragma: no cover
     from ..pipeline.stages import IdentificationStageResult
 
 NAME = "identify"
+#: ``--out`` is a folder: its files are one output set (:mod:`dynid.io.run_output`).
+OUTPUT = "folder"
 
 _log = logging.getLogger(__name__)
 
@@ -295,7 +297,6 @@ def run(args: argparse.Namespace) -> int:
         else:
             warnings.warn_explicit(w.message, w.category, w.filename, w.lineno)
     record_columns(args, model.metadata)
-    args.out.mkdir(parents=True, exist_ok=True)
     path = save_model_json(args.out / "identification.json", model)
     if not args.quiet:
         print(format_summary(model))

@@ -26,6 +26,8 @@ from ..io.torque_log import save_torque_log
 from .common import add_robot_options, add_subcommand, load_robot, positive_type, print_json
 
 NAME = "import"
+#: ``--out`` is the one file written (:mod:`dynid.io.run_output`).
+OUTPUT = "file"
 
 
 def register(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParser:

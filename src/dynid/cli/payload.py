@@ -33,6 +33,8 @@ from .identify import data_kind
 from .validate import load_model_source
 
 NAME = "payload"
+#: ``--out`` is a folder: its files are one output set (:mod:`dynid.io.run_output`).
+OUTPUT = "folder"
 
 
 def register(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParser:

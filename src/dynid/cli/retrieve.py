@@ -88,6 +88,8 @@ if TYPE_CHECKING:  # pragma: no cover
     from ..pipeline.stages import FeasibleStageResult
 
 NAME = "retrieve"
+#: ``--out`` is a folder: its files are one output set (:mod:`dynid.io.run_output`).
+OUTPUT = "folder"
 
 
 def register(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParser:

@@ -54,6 +54,8 @@ from .common import (
 )
 
 NAME = "simulate"
+#: ``--out`` is the one file written (:mod:`dynid.io.run_output`).
+OUTPUT = "file"
 log = logging.getLogger(__name__)
 
 

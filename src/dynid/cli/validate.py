@@ -55,6 +55,8 @@ from .common import (
 from .friction import VALIDATION_SCHEMA, format_rms_table, save_validation_figures
 
 NAME = "validate"
+#: ``--out`` is a folder: its files are one output set (:mod:`dynid.io.run_output`).
+OUTPUT = "folder"
 
 
 def register(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParser:

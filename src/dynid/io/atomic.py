@@ -10,6 +10,9 @@ Every writer of dynid goes through this module:
 * :func:`open_atomic`, :func:`write_text` and :func:`write_bytes` are the same for a file
   object, a string and bytes.
 * The destination folder is created only when a file is written into it.
+* Inside :func:`dynid.io.run_output.run_output` (every command that writes into
+  ``--out``), a path under ``--out`` is written into that run's staging folder instead;
+  :func:`current_location` says where a file written in the run is now.
 * :func:`output_transaction` groups the files of one command: on failure, the files and
   folders it created are removed again (files it replaced keep their new content, since
   each was complete when renamed).
@@ -27,10 +30,39 @@ from collections.abc import Iterator
 from pathlib import Path
 from typing import IO, Any
 
-__all__ = ["atomic_path", "open_atomic", "output_transaction", "write_bytes", "write_text"]
+__all__ = [
+    "atomic_path",
+    "current_location",
+    "open_atomic",
+    "output_transaction",
+    "write_bytes",
+    "write_text",
+]
 
 #: Stack of active transactions; each records (created files, created folders).
 _TRANSACTIONS: list[tuple[list[Path], list[Path]]] = []
+#: Active run outputs (:class:`dynid.io.run_output.RunOutput`): each has ``stage(path)``
+#: (the staged path of a file under its ``--out``, or None) and ``location(path)``.
+_REDIRECTS: list[Any] = []
+
+
+def _staged(path: Path) -> Path | None:
+    """The staging path of ``path`` in the innermost run output that holds it, or None."""
+    for r in reversed(_REDIRECTS):
+        staged = r.stage(path)
+        if staged is not None:
+            return staged
+    return None
+
+
+def current_location(path: str | Path) -> Path:
+    """Where a file written in the current run under ``--out`` is now (its staged copy
+    until the run ends); ``path`` itself for any other file."""
+    for r in reversed(_REDIRECTS):
+        where = r.location(path)
+        if where != Path(path):
+            return where
+    return Path(path)
 
 
 def _make_parents(folder: Path) -> None:
@@ -62,8 +94,13 @@ def atomic_path(path: str | Path) -> Iterator[Path]:
     empty, when the block starts).
     """
     path = Path(path)
-    _make_parents(path.parent)
-    existed = path.exists()
+    staged = _staged(path)
+    if staged is not None:  # a file of a run's output set: written into its staging folder
+        path = staged
+        path.parent.mkdir(parents=True, exist_ok=True)
+    else:
+        _make_parents(path.parent)
+    existed = path.exists() or staged is not None
     fd, name = tempfile.mkstemp(
         dir=path.parent, prefix=f".{path.name}.", suffix=f".tmp{path.suffix}"
     )

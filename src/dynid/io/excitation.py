@@ -38,6 +38,7 @@ from ..model.robot import Robot
 from ..simulation.collision import Box, Obstacles, Plane, capsule_model
 from ..simulation.excitation import ExcitationResult, ExcitingTrajectory
 from ..simulation.trajectories import Trajectory
+from .atomic import open_atomic, write_text
 from .json_files import load_json
 from .torque_log import read_csv_table
 
@@ -71,23 +72,14 @@ def _jsonable(x: Any) -> Any:
     return x
 
 
-def _write_text(path: Path, text: str) -> Path:
-    """Write atomically: a temporary file in the same folder, then rename."""
-    tmp = path.with_name(path.name + ".tmp")
-    tmp.write_text(text, encoding="utf-8")
-    tmp.replace(path)
-    return path
-
-
 def save_trajectory_csv(path: str | Path, traj: Trajectory) -> Path:
     """Write ``t, q, dq, ddq`` to a CSV (columns named, units in the first line)."""
     path = Path(path)
     cols = trajectory_columns(traj.n)
     data = np.column_stack([traj.t, traj.q, traj.dq, traj.ddq])
-    tmp = path.with_name(path.name + ".tmp")
     header = "\n".join([_UNITS, f"# rows: {len(data)}", ",".join(cols)])
-    np.savetxt(tmp, data, delimiter=",", fmt="%.10g", header=header, comments="")
-    tmp.replace(path)
+    with open_atomic(path, "w") as fh:
+        np.savetxt(fh, data, delimiter=",", fmt="%.10g", header=header, comments="")
     return path
 
 
@@ -157,7 +149,7 @@ def save_excitation_json(
         "history": list(result.history),
     }
     text = json.dumps(_jsonable(d), indent=1, allow_nan=False) + "\n"
-    return _write_text(Path(path), text)
+    return write_text(Path(path), text)
 
 
 _OBSTACLE_KEYS = {"schema", "planes", "boxes"}

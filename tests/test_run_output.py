@@ -1,0 +1,343 @@
+"""Output folders a user can trust (issue 20): real processes write, fail, are killed and
+race into one ``--out``; the folder always holds one complete set, of one run.
+
+Every case compares the folder with a snapshot taken before (names, bytes, modes), so a
+failed run that touched anything is caught, whatever it touched.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import fcntl
+import json
+import os
+import signal
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+import pytest
+
+from dynid.io.run_output import MANIFEST
+
+pytestmark = pytest.mark.skipif(sys.platform == "win32", reason="POSIX locks and signals")
+
+
+def _env() -> dict[str, str]:
+    return {**os.environ, "MPLBACKEND": "Agg", "OPENBLAS_NUM_THREADS": "1"}
+
+
+def _dynid(*args: str, **kw) -> subprocess.Popen:
+    return subprocess.Popen(
+        [sys.executable, "-m", "dynid", *args],
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        text=True,
+        env=_env(),
+        **kw,
+    )
+
+
+def _run(*args: str, **kw) -> subprocess.CompletedProcess:
+    proc = _dynid(*args, **kw)
+    out, err = proc.communicate(timeout=120)
+    return subprocess.CompletedProcess(proc.args, proc.returncode, out, err)
+
+
+def _snapshot(folder: Path) -> dict[str, tuple[bytes, int]]:
+    """Every entry under ``folder`` (hidden ones too): relative name -> (bytes, mode)."""
+    snap = {}
+    for p in sorted(folder.rglob("*")):
+        st = p.lstat()
+        snap[p.relative_to(folder).as_posix()] = (
+            p.read_bytes() if p.is_file() else b"",
+            st.st_mode,
+        )
+    return snap
+
+
+def _staging(parent: Path) -> list[str]:
+    return sorted(p.name for p in parent.iterdir() if ".dynid-" in p.name)
+
+
+def _complete_set(folder: Path) -> list[str]:
+    """The names of the folder's recorded set, checked to be exactly what it holds."""
+    doc = json.loads((folder / MANIFEST).read_text())
+    assert doc["state"] == "complete"
+    present = sorted(p.name for p in folder.iterdir() if p.name != MANIFEST)
+    assert present == sorted(doc["files"]), (present, doc["files"])
+    for name in doc["files"]:
+        if name.endswith(".json"):
+            json.loads((folder / name).read_text())  # complete, parseable
+    return present
+
+
+CONSISTENT_SET = [
+    "feasible.json",
+    "identification.json",
+    "report.json",
+    "retrieval.png",
+    "robot.toml",
+    "robot.urdf",
+    "robot.xml",
+]
+
+
+@pytest.fixture(scope="module")
+def data(tmp_path_factory) -> Path:
+    """Two static data sets (60 configurations, seeds 3 and 4) and a model from the first."""
+    d = tmp_path_factory.mktemp("run_output")
+    for seed in (3, 4):
+        r = _run(
+            "acquire-static", "--n", "60", "--seed", str(seed), "--out", str(d / f"s{seed}.csv")
+        )
+        assert r.returncode == 0, r.stderr
+    r = _run("identify", "--data", str(d / "s3.csv"), "--out", str(d / "model"), "-q")
+    assert r.returncode == 0, r.stderr
+    return d
+
+
+def test_a_rerun_replaces_the_set_as_a_whole(data, tmp_path):
+    """identify --consistent, then plain identify into the same folder: the consistent
+    files of the first run go once the second set is complete; a file of the user stays."""
+    out = tmp_path / "res"
+    r = _run("identify", "--data", str(data / "s3.csv"), "--consistent", "--out", str(out), "-q")
+    assert r.returncode == 0, r.stderr
+    assert _complete_set(out) == CONSISTENT_SET
+    (out / "notes.txt").write_text("mine\n")
+    r = _run("identify", "--data", str(data / "s4.csv"), "--out", str(out), "-q")
+    assert r.returncode == 0, r.stderr
+    assert sorted(p.name for p in out.iterdir()) == [MANIFEST, "identification.json", "notes.txt"]
+    assert (out / "notes.txt").read_text() == "mine\n"
+    assert "s4.csv" in json.loads((out / MANIFEST).read_text())["argv"][3]
+    assert _staging(tmp_path) == []
+
+
+def test_another_commands_folder_and_foreign_files_need_force(data, tmp_path):
+    """retrieve into identify's folder, or over a file no run wrote: refused before any
+    computation, the folder unchanged; --force writes."""
+    out = tmp_path / "res"
+    assert _run("identify", "--data", str(data / "s3.csv"), "--out", str(out), "-q").returncode == 0
+    before = _snapshot(out)
+    model = str(data / "model" / "identification.json")
+    r = _run("retrieve", "--model", model, "--out", str(out), "-q")
+    assert r.returncode == 2
+    assert r.stderr.strip() == (
+        f"dynid retrieve: error: --out {out}: holds the outputs of `dynid identify` "
+        "(identification.json); choose another --out or pass --force to write into it"
+    )
+    assert _snapshot(out) == before
+    theirs = tmp_path / "theirs"
+    theirs.mkdir()
+    (theirs / "feasible.json").write_text("{}\n")
+    r = _run("retrieve", "--model", model, "--out", str(theirs), "-q")
+    assert r.returncode == 2 and "feasible.json exists and no dynid run recorded it" in r.stderr
+    assert (theirs / "feasible.json").read_text() == "{}\n"
+    assert sorted(p.name for p in theirs.iterdir()) == ["feasible.json"]
+    r = _run("retrieve", "--model", model, "--out", str(theirs), "--force", "-q")
+    assert r.returncode == 0, r.stderr
+    assert json.loads((theirs / "feasible.json").read_text())["schema"].startswith("dynid-feasible")
+    assert _staging(tmp_path) == []
+
+
+def test_a_read_only_file_is_not_replaced_without_force(data, tmp_path):
+    """A 0444 file of the folder's own set, and a 0444 --out file: refused, kept; --force
+    replaces them."""
+    out = tmp_path / "res"
+    args = ("identify", "--data", str(data / "s3.csv"), "--out", str(out), "-q")
+    assert _run(*args).returncode == 0
+    (out / "identification.json").chmod(0o444)
+    before = _snapshot(out)
+    r = _run(*args)
+    assert r.returncode == 2
+    assert "identification.json is read-only; pass --force" in r.stderr, r.stderr
+    assert _snapshot(out) == before
+    assert _run(*args, "--force").returncode == 0
+    assert (out / "identification.json").stat().st_mode & 0o200  # a new file, writable
+
+    log = tmp_path / "log.csv"
+    log.write_text("precious\n")
+    log.chmod(0o444)
+    sim = ("simulate", "--duration", "1", "--rate", "100", "--out", str(log), "-q")
+    r = _run(*sim)
+    assert r.returncode == 2 and "log.csv is read-only" in r.stderr, r.stderr
+    assert log.read_text() == "precious\n"
+    assert _run(*sim, "--force").returncode == 0
+    assert log.read_text().startswith("#")
+    assert _staging(tmp_path) == []
+
+
+def _limit_file_size(limit: int):
+    """preexec_fn: files larger than ``limit`` bytes cannot be written (a full disk);
+    SIGXFSZ ignored so that the write fails with EFBIG instead of killing the process."""
+    import resource
+
+    def apply() -> None:
+        signal.signal(signal.SIGXFSZ, signal.SIG_IGN)
+        resource.setrlimit(resource.RLIMIT_FSIZE, (limit, limit))
+
+    return apply
+
+
+def test_a_full_disk_leaves_no_new_folder_and_an_old_folder_as_it_was(data, tmp_path):
+    """RLIMIT_FSIZE: a run into a new folder (with new parents) leaves nothing; a rerun
+    into an existing folder whose writes fail half-way leaves it byte for byte as it was
+    (issue 20: new feasible.json and robot.* next to the old report.json)."""
+    new = tmp_path / "a" / "b" / "res"
+    r = _run(
+        "identify", "--data", str(data / "s3.csv"), "--out", str(new), "-q",
+        preexec_fn=_limit_file_size(20_000),
+    )  # fmt: skip
+    assert r.returncode == 2 and "File too large" in r.stderr, r.stderr
+    assert list(tmp_path.iterdir()) == []
+
+    out = tmp_path / "feasible"
+    model = str(data / "model" / "identification.json")
+    r = _run("retrieve", "--model", model, "--objective", "euclidean", "--out", str(out), "-q")
+    assert r.returncode in (0, 1), r.stderr  # 1: not consistent; its files are written
+    before = _snapshot(out)
+    # feasible.json (~9 kB) and robot.* fit, report.json (~11 kB) does not
+    r = _run(
+        "retrieve", "--model", model, "--out", str(out), "-q",
+        preexec_fn=_limit_file_size(10_000),
+    )  # fmt: skip
+    assert r.returncode == 2 and "File too large" in r.stderr, r.stderr
+    assert _snapshot(out) == before
+    assert _staging(tmp_path) == []
+
+
+def _wait_for(cond, timeout: float) -> bool:
+    end = time.monotonic() + timeout
+    while time.monotonic() < end:
+        if cond():
+            return True
+        time.sleep(0.05)
+    return False
+
+
+@pytest.mark.slow
+def test_sigkill_then_rerun_removes_the_stale_files(data, tmp_path):
+    """A run killed with SIGKILL leaves its staging folder; the next run removes it and a
+    writer's temporary file of a killed older run, and writes the complete set."""
+    out = tmp_path / "res"
+    args = ("identify", "--data", str(data / "s3.csv"), "--consistent", "--out", str(out), "-q")
+    assert _run(*args).returncode == 0
+    stale_tmp = out / ".feasible.json.k2j4x9.tmp.json"
+    stale_tmp.write_text('{"half": ')
+    before = _snapshot(out)
+    proc = _dynid(*args)
+    assert _wait_for(lambda: _staging(tmp_path), 30), "no staging folder appeared"
+    time.sleep(0.5)
+    proc.send_signal(signal.SIGKILL)
+    proc.communicate(timeout=30)
+    assert proc.returncode == -signal.SIGKILL
+    assert _snapshot(out) == before  # nothing of the killed run in the folder
+    assert len(_staging(tmp_path)) == 1
+    r = _run(*args)
+    assert r.returncode == 0, r.stderr
+    assert _staging(tmp_path) == []
+    assert not stale_tmp.exists()
+    assert _complete_set(out) == CONSISTENT_SET
+
+
+def test_a_failing_run_never_removes_files_of_a_concurrent_run(data, tmp_path):
+    """Run A (identify --consistent, seconds) and run B (a bad data file, fails at once)
+    into one new folder: A's set is complete (issue 20: B's clean-up removed A's files)."""
+    out = tmp_path / "res"
+    bad = tmp_path / "bad.csv"
+    bad.write_text("q1,q2\n1,2\n")
+    a = _dynid("identify", "--data", str(data / "s3.csv"), "--consistent", "--out", str(out), "-q")
+    assert _wait_for(lambda: _staging(tmp_path), 30)
+    b = _run("identify", "--data", str(bad), "--consistent", "--out", str(out), "-q")
+    assert b.returncode == 2
+    _, err = a.communicate(timeout=120)
+    assert a.returncode == 0, err
+    assert _complete_set(out) == CONSISTENT_SET
+    assert _staging(tmp_path) == []
+
+
+@pytest.mark.slow
+def test_concurrent_runs_wait_for_each_other_and_never_mix(data, tmp_path):
+    """While another process holds the folder's lock (``flock`` on its parent), a finished
+    run waits with its set staged (nothing moves); released, it moves the whole set. Two
+    identical runs at once both succeed and leave one complete set (issue 20: one failed
+    on a vanished file)."""
+    out = tmp_path / "res"
+    args = ("identify", "--data", str(data / "s3.csv"), "--consistent", "--out", str(out), "-q")
+    proc = _dynid(*args)
+    assert _wait_for(lambda: _staging(tmp_path), 30), "no staging folder appeared"
+    fd = os.open(tmp_path, os.O_RDONLY)
+    try:
+        fcntl.flock(fd, fcntl.LOCK_EX)
+
+        def staged_png() -> bool:
+            return any((tmp_path / s / "retrieval.png").exists() for s in _staging(tmp_path))
+
+        assert _wait_for(staged_png, 60), "the run did not finish its files"
+        time.sleep(0.5)
+        assert proc.poll() is None and not out.exists()
+    finally:
+        os.close(fd)  # releases the lock
+    _, err = proc.communicate(timeout=60)
+    assert proc.returncode == 0, err
+    assert _complete_set(out) == CONSISTENT_SET
+
+    other = ("identify", "--data", str(data / "s4.csv"), "--consistent", "--out", str(out), "-q")
+    procs = [_dynid(*args), _dynid(*other)]
+    for p in procs:
+        _, err = p.communicate(timeout=120)
+        assert p.returncode == 0, err
+    assert _complete_set(out) == CONSISTENT_SET
+    winner = json.loads((out / MANIFEST).read_text())["argv"][3]
+    report = json.loads((out / "report.json").read_text())
+    assert Path(winner).name in json.dumps(report)  # the report of the same run
+    assert _staging(tmp_path) == []
+
+
+def test_a_file_out_is_staged_too(tmp_path):
+    """simulate --out FILE: the old log stays until the new one is complete; SIGTERM
+    during the run leaves it untouched and no staging folder."""
+    log = tmp_path / "log.csv"
+    assert (
+        _run("simulate", "--duration", "1", "--rate", "100", "--out", str(log), "-q").returncode
+        == 0
+    )
+    before = log.read_bytes()
+    proc = _dynid("simulate", "--duration", "400", "--rate", "1000", "--out", str(log), "-q")
+    assert _wait_for(lambda: _staging(tmp_path), 30)
+    time.sleep(1.0)
+    proc.send_signal(signal.SIGTERM)
+    _, err = proc.communicate(timeout=60)
+    assert proc.returncode == 143, err
+    assert log.read_bytes() == before
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["log.csv"]
+
+
+def test_library_writers_outside_a_run_are_unchanged(tmp_path):
+    """Without a run, the writers write where they are told (no staging, no manifest)."""
+    from dynid.io.atomic import current_location, write_text
+
+    p = write_text(tmp_path / "x" / "a.txt", "a")
+    assert p.read_text() == "a" and current_location(p) == p
+    assert sorted(q.name for q in tmp_path.rglob("*")) == ["a.txt", "x"]
+
+
+def test_run_output_stages_and_names_the_staged_location(tmp_path):
+    """Inside run_output, a file under --out is written in the staging folder beside it
+    and current_location says where; it appears under --out when the block ends."""
+    from dynid.io.atomic import current_location, write_text
+    from dynid.io.run_output import run_output
+
+    out = tmp_path / "o"
+    with run_output(out, command="test") as run:
+        p = write_text(out / "sub" / "a.txt", "a")
+        assert not out.exists()
+        staged = current_location(p)
+        assert staged != p and staged.read_text() == "a" and staged.parent.parent == run.staging
+    assert (out / "sub" / "a.txt").read_text() == "a"
+    assert json.loads((out / MANIFEST).read_text())["files"] == ["sub/a.txt"]
+    with contextlib.suppress(RuntimeError), run_output(out, command="test"):
+        write_text(out / "b.txt", "b")
+        raise RuntimeError("fails")
+    assert sorted(q.name for q in tmp_path.rglob("*")) == [MANIFEST, "a.txt", "o", "sub"]
