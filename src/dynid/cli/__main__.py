@@ -4,8 +4,10 @@ Run ``dynid <command> --help`` for the options of one command.
 
 Exit status: 0 success; 1 a command's documented negative result (retrieve: no feasible
 set); 2 an error (one line on stderr; --debug shows the traceback); 130 interrupted
-(Ctrl-C); 143 terminated (SIGTERM). A failed or interrupted command leaves no file or
-folder of its own behind, and no file is ever half written.
+(Ctrl-C); 129, 131, 143 terminated by SIGHUP, SIGQUIT, SIGTERM; 141 stdout was closed
+before everything was printed (`dynid fk ... | head -1`: the run completes quietly, its
+files are written). A failed or interrupted command leaves no file or folder of its own
+behind, and no file is ever half written.
 
 Output folders: a command writes its files into a hidden staging folder beside --out and
 moves the complete set into place when it succeeds; a rerun of the same command replaces
@@ -21,6 +23,7 @@ import contextlib
 import importlib
 import io
 import logging
+import os
 import re
 import signal
 import sys
@@ -31,6 +34,7 @@ from .._checks import one_line
 from ..exceptions import DynidError
 from ..io.atomic import output_transaction
 from ..io.run_output import run_output
+from .run_report import RunRecord
 
 #: Longest error line printed [characters]: a message echoing megabytes of input keeps
 #: its start and its end (the hint).
@@ -134,8 +138,18 @@ def join_negative_values(argv: Sequence[str]) -> list[str]:
     return out
 
 
+#: Exit status when stdout was closed by its reader (128 + SIGPIPE, as a shell reports a
+#: writer that SIGPIPE stopped).
+STDOUT_CLOSED = 141
+#: Signals that stop a run as termination (exit 128 + the signal's number).
+TERMINATING = tuple(
+    getattr(signal, name) for name in ("SIGTERM", "SIGHUP", "SIGQUIT") if hasattr(signal, name)
+)
+
+
 class Terminated(BaseException):
-    """Raised in the main thread when a termination signal (SIGTERM) arrives."""
+    """Raised in the main thread when a termination signal (SIGTERM, SIGHUP, SIGQUIT)
+    arrives; ``args[0]`` is the signal's number."""
 
 
 def _terminate(signum: int, frame: object) -> None:
@@ -144,10 +158,12 @@ def _terminate(signum: int, frame: object) -> None:
 
 @contextlib.contextmanager
 def _signals_and_warnings(command: str) -> Iterator[None]:
-    """SIGTERM raises :class:`Terminated`; warnings print as one line (no source line)."""
-    old = None
+    """SIGTERM, SIGHUP and SIGQUIT raise :class:`Terminated`; warnings print as one line
+    (no source line)."""
+    old = {}
     with contextlib.suppress(ValueError):  # not the main thread: leave signals alone
-        old = signal.signal(signal.SIGTERM, _terminate)
+        for sig in TERMINATING:
+            old[sig] = signal.signal(sig, _terminate)
 
     def show(message, category, filename, lineno, file=None, line=None):  # noqa: ANN001
         print(f"dynid {command}: warning: {message}", file=sys.stderr)
@@ -157,8 +173,8 @@ def _signals_and_warnings(command: str) -> Iterator[None]:
             warnings.showwarning = show
             yield
     finally:
-        if old is not None:
-            signal.signal(signal.SIGTERM, old)
+        for sig, handler in old.items():
+            signal.signal(sig, handler)
 
 
 def _printable_streams() -> None:
@@ -205,23 +221,33 @@ def main(argv: Sequence[str] | None = None) -> int:
     )
     logging.basicConfig(level=level, format="%(levelname)s %(name)s: %(message)s")
     say = f"dynid {args.command}"
+    record = RunRecord()
     try:
         with (
+            record,
             _signals_and_warnings(args.command),
             output_transaction(),
             _output_set(args, argv),
         ):
-            return int(args._run(args) or 0)
+            code = int(args._run(args) or 0)
+        if record.stdout_closed:
+            _drop_stdout()
+            return STDOUT_CLOSED
+        return code
     except KeyboardInterrupt:
         if args.debug:
             raise
         print(f"{say}: interrupted; no partial output left", file=sys.stderr)
         return 130
-    except Terminated:
+    except Terminated as exc:
         if args.debug:
             raise
-        print(f"{say}: terminated (SIGTERM); no partial output left", file=sys.stderr)
-        return 143
+        signum = int(exc.args[0]) if exc.args else int(signal.SIGTERM)
+        print(
+            f"{say}: terminated ({signal.Signals(signum).name}); no partial output left",
+            file=sys.stderr,
+        )
+        return 128 + signum
     except (DynidError, OSError) as exc:
         if args.debug:
             raise
@@ -236,6 +262,17 @@ def main(argv: Sequence[str] | None = None) -> int:
             file=sys.stderr,
         )
         return 2
+
+
+def _drop_stdout() -> None:
+    """Point stdout at the null device, so that the interpreter's last flush of a closed
+    pipe cannot fail."""
+    with contextlib.suppress(OSError, ValueError, AttributeError):
+        sys.stdout.flush()
+    with contextlib.suppress(OSError, ValueError, AttributeError):
+        fd = os.open(os.devnull, os.O_WRONLY)
+        os.dup2(fd, sys.stdout.fileno())
+        os.close(fd)
 
 
 if __name__ == "__main__":

@@ -300,19 +300,35 @@ def print_json(obj: Any) -> None:
 
 def save_figure(fig_factory: Callable[[], Any], path: Path, *, dpi: int = 110) -> Path | None:
     """Render ``fig_factory()`` to ``path`` with :func:`dynid.plots.save.save_figure`;
-    without matplotlib, skip it with a one-line note on stderr and return None.
+    when that fails for any reason (matplotlib missing or broken, a bad ``MPLBACKEND``, an
+    error while drawing or writing), skip it with a one-line note on stderr and return None.
 
-    The plots extra is optional: every data file is written before the figures, and a
-    missing matplotlib never fails a command.
+    Figures are optional: every data file is written before them, and a figure never
+    fails a command.
     """
     try:
         import matplotlib  # noqa: F401
     except ImportError:
         print(f"note: matplotlib is not installed; skipped the figure {path.name}", file=sys.stderr)
         return None
-    from ..plots.save import save_figure as write_figure
+    except Exception as exc:  # a broken installation or configuration
+        _skipped(path, exc)
+        return None
+    try:
+        from ..plots.save import save_figure as write_figure
 
-    return write_figure(fig_factory, path, dpi=dpi)
+        return write_figure(fig_factory, path, dpi=dpi)
+    except Exception as exc:
+        _skipped(path, exc)
+        return None
+
+
+def _skipped(path: Path, exc: BaseException) -> None:
+    reason = " ".join(f"{type(exc).__name__}: {exc}".split())
+    if len(reason) > 200:
+        reason = reason[:200] + " ..."
+    print(f"note: skipped the figure {path.name}: {reason}", file=sys.stderr)
+    _log.debug("figure %s", path.name, exc_info=exc)
 
 
 def format_matrix(A: np.ndarray, fmt: str = "{:+.6f}") -> str:

@@ -126,7 +126,10 @@ def register(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParser:
         "--stages", type=count_type, default=d.stages, help=f"stages K per run (default {d.stages})"
     )
     p.add_argument(
-        "--workers", type=count_type, default=None, help="processes (default: min(runs, cores))"
+        "--workers",
+        type=count_type,
+        default=None,
+        help="processes (default: min(runs, cores); more than that is capped, with a note)",
     )
     add_seed_option(p)
     p.add_argument(
@@ -326,6 +329,17 @@ def run(args: argparse.Namespace) -> int:
     band = _band(args)
     if args.workers is not None and args.workers < 1:
         raise DynidError(f"--workers must be >= 1; got {args.workers}")
+    if args.workers is not None:
+        from .._parallel import available_cores
+
+        cores = available_cores()
+        cap = min(cores, args.runs)
+        if args.workers > cap:
+            print(
+                f"note: --workers {args.workers}: using {cap} ({cores} cores, {args.runs} runs)",
+                file=sys.stderr,
+            )
+            args.workers = cap
     common: dict[str, Any] = dict(
         options=options,
         workers=args.workers,

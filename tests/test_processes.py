@@ -1,0 +1,207 @@
+"""Processes and signals (issue 20): workers die with their parent whatever kills it,
+SIGHUP and SIGQUIT stop a run as SIGTERM does, --workers is capped at the cores, a closed
+stdout exits quietly with its own code, and failing figures never cost a data file."""
+
+from __future__ import annotations
+
+import contextlib
+import os
+import signal
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+import pytest
+
+from dynid.cli.__main__ import main
+
+pytestmark = pytest.mark.skipif(
+    not Path("/proc").exists(), reason="needs /proc to find worker processes"
+)
+NEUTRAL = "0,-0.785,0,-2.356,0,1.571,0.785"
+
+
+def _env(**extra: str) -> dict[str, str]:
+    return {**os.environ, "MPLBACKEND": "Agg", "OPENBLAS_NUM_THREADS": "1", **extra}
+
+
+def _dynid(*args: str, env: dict[str, str] | None = None, **kw) -> subprocess.Popen:
+    kw.setdefault("stdout", subprocess.PIPE)
+    return subprocess.Popen(
+        [sys.executable, "-m", "dynid", *args],
+        stderr=subprocess.PIPE,
+        text=True,
+        env=env or _env(),
+        **kw,
+    )
+
+
+def _children(pid: int) -> list[int]:
+    """Process ids whose parent is ``pid`` (from /proc)."""
+    out = []
+    for p in Path("/proc").iterdir():
+        if p.name.isdigit():
+            with contextlib.suppress(OSError, IndexError):
+                fields = (p / "stat").read_text().rsplit(")", 1)[1].split()
+                if int(fields[1]) == pid and fields[0] != "Z":
+                    out.append(int(p.name))
+    return out
+
+
+def _alive(pid: int) -> bool:
+    with contextlib.suppress(OSError, IndexError):
+        state = (Path(f"/proc/{pid}") / "stat").read_text().rsplit(")", 1)[1].split()[0]
+        return state != "Z"
+    return False
+
+
+def _wait_for(cond, timeout: float) -> bool:
+    end = time.monotonic() + timeout
+    while time.monotonic() < end:
+        if cond():
+            return True
+        time.sleep(0.05)
+    return False
+
+
+@pytest.fixture(scope="module")
+def model(tmp_path_factory) -> Path:
+    """identification.json of noise-free static data (60 configurations)."""
+    d = tmp_path_factory.mktemp("processes")
+    sink = open(os.devnull, "w")  # noqa: SIM115
+    with contextlib.redirect_stdout(sink):
+        assert main(["acquire-static", "--n", "60", "--seed", "3", "--out", str(d / "s.csv")]) == 0
+        assert main(["identify", "--data", str(d / "s.csv"), "--out", str(d / "res")]) == 0
+    sink.close()
+    return d / "res" / "identification.json"
+
+
+def _penalty(model: Path, out: Path, *extra: str) -> subprocess.Popen:
+    return _dynid(
+        "retrieve", "--model", str(model), "--method", "penalty", "--runs", "4",
+        "--workers", "2", "--seed", "0", "--out", str(out), *extra,
+    )  # fmt: skip
+
+
+@pytest.mark.slow
+@pytest.mark.skipif((os.cpu_count() or 1) < 2, reason="needs two cores for two workers")
+@pytest.mark.parametrize(
+    "sig, code",
+    [(signal.SIGKILL, -signal.SIGKILL), (signal.SIGHUP, 129), (signal.SIGQUIT, 131)],
+    ids=["SIGKILL", "SIGHUP", "SIGQUIT"],
+)
+def test_workers_die_with_their_parent(model, tmp_path, sig, code):
+    """Whatever stops retrieve --method penalty, its workers go too (issue 20: after
+    SIGKILL, SIGHUP or SIGQUIT they ran on at 100 % CPU); SIGHUP and SIGQUIT exit with
+    128 + the signal and one line, and leave no output."""
+    out = tmp_path / "feasible"
+    proc = _penalty(model, out)
+    assert _wait_for(lambda: len(_children(proc.pid)) >= 2, 60), "workers did not start"
+    workers = _children(proc.pid)
+    time.sleep(0.3)
+    proc.send_signal(sig)
+    _, err = proc.communicate(timeout=30)
+    assert proc.returncode == code, err
+    try:
+        assert _wait_for(lambda: not any(_alive(w) for w in workers), 10), "a worker outlived it"
+    finally:  # do not leave them running if they did
+        for w in workers:
+            with contextlib.suppress(OSError):
+                os.kill(w, signal.SIGKILL)
+    if sig != signal.SIGKILL:
+        name = signal.Signals(sig).name
+        assert err.strip().splitlines()[-1] == (
+            f"dynid retrieve: terminated ({name}); no partial output left"
+        )
+        assert "Traceback" not in err
+    assert not out.exists()
+
+
+@pytest.mark.skipif(
+    len(os.sched_getaffinity(0)) > 8, reason="the cap is only visible with few cores"
+)
+def test_workers_are_capped_at_the_cores(model, tmp_path):
+    """--workers 64 on a small machine starts no more processes than cores, with a note
+    (issue 20: 64 processes, 3.5 GB)."""
+    cores = len(os.sched_getaffinity(0))
+    proc = _dynid(
+        "retrieve", "--model", str(model), "--method", "penalty", "--runs", "2", "--stages",
+        "1", "--workers", "64", "--out", str(tmp_path / "f"), "-q",
+    )  # fmt: skip
+    most = 0
+    while proc.poll() is None:
+        most = max(most, len(_children(proc.pid)))
+        time.sleep(0.05)
+    _, err = proc.communicate(timeout=60)
+    assert proc.returncode in (0, 1), err
+    assert f"note: --workers 64: using {min(cores, 2)}" in err, err
+    assert most <= min(cores, 2)
+
+
+def _closed_pipe() -> int:
+    """The write end of a pipe whose read end is already closed (``| true``)."""
+    r, w = os.pipe()
+    os.close(r)
+    return w
+
+
+@pytest.mark.parametrize("json_flag", [False, True], ids=["table", "json"])
+def test_a_closed_stdout_exits_quietly_with_its_own_code(json_flag):
+    """`dynid fk ... | true`: exit 141 (not 1, 'no feasible set'), nothing on stderr."""
+    w = _closed_pipe()
+    try:
+        proc = _dynid("fk", "--q", NEUTRAL, *(["--json"] if json_flag else []), stdout=w)
+    finally:
+        os.close(w)
+    _, err = proc.communicate(timeout=60)
+    assert (proc.returncode, err) == (141, "")
+
+
+def test_a_closed_stdout_keeps_the_files_of_a_run(model, tmp_path):
+    """identify ... | true: the output set is written all the same, exit 141."""
+    w = _closed_pipe()
+    data = model.parent.parent / "s.csv"
+    try:
+        proc = _dynid("identify", "--data", str(data), "--out", str(tmp_path / "r"), stdout=w)
+    finally:
+        os.close(w)
+    _, err = proc.communicate(timeout=60)
+    assert (proc.returncode, err) == (141, "")
+    assert (tmp_path / "r" / "identification.json").is_file()
+
+
+def test_a_bad_backend_skips_the_figures_and_keeps_the_data(model, tmp_path):
+    """MPLBACKEND=nonexistent: validate exits 0 with its data file and one note per figure
+    (issue 20: exit 2 and the data files removed)."""
+    log = tmp_path / "log.csv"
+    sim = _dynid("simulate", "--duration", "2", "--rate", "200", "--out", str(log), "-q")
+    assert sim.wait(timeout=60) == 0
+    out = tmp_path / "val"
+    proc = _dynid(
+        "validate", "--robot", "panda", "--data", str(log), "--out", str(out),
+        env=_env(MPLBACKEND="nonexistent"),
+    )  # fmt: skip
+    _, err = proc.communicate(timeout=60)
+    assert proc.returncode == 0, err
+    notes = [s for s in err.splitlines() if s.startswith("note:")]
+    assert len(notes) == 2 and all("skipped the figure validation_" in s for s in notes), err
+    assert all("nonexistent" in s for s in notes), err
+    assert (out / "validation.json").is_file()
+    assert not list(out.glob("*.png"))
+
+
+def test_a_failing_figure_is_skipped_with_a_note(model, tmp_path, monkeypatch, capsys):
+    """Any error while drawing (here: the plotting function raises) skips that figure with
+    a note naming the error; the data files are written and the run exits 0."""
+    import dynid.plots.feasible as feasible_plots
+
+    def broken(*a, **k):
+        raise RuntimeError("the plot is broken")
+
+    monkeypatch.setattr(feasible_plots, "plot_consistent", broken)
+    out = tmp_path / "f"
+    assert main(["retrieve", "--model", str(model), "--out", str(out), "-q"]) in (0, 1)
+    err = capsys.readouterr().err
+    assert "note: skipped the figure retrieval.png: RuntimeError: the plot is broken" in err
+    assert (out / "feasible.json").is_file() and not (out / "retrieval.png").exists()
