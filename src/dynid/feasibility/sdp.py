@@ -185,7 +185,11 @@ class DataTerm:
     exact : bool
         The estimate is exact (noise-free): the equality ``P phi = beta`` applies.
     n_friction : int
-        ``k``: 0, or ``3 n`` classical friction coefficients (``fv, fc, fo`` per joint).
+        ``k``: 0, or the classical friction coefficients fitted (``fv, fc, fo`` per joint,
+        less those of joints that never moved).
+    friction_index : ndarray of int, shape (k,), optional
+        Where each friction unknown sits in the ``(n, 3)`` layout ``fv, fc, fo`` per joint
+        (flattened); None: all ``3 n`` in order.
     labels : tuple of str
         Names of the entries of ``x``.
     notes : tuple of str
@@ -198,6 +202,7 @@ class DataTerm:
     dof: int
     exact: bool
     n_friction: int = 0
+    friction_index: NDArray[np.intp] | None = None
     labels: tuple[str, ...] = ()
     notes: tuple[str, ...] = ()
 
@@ -205,6 +210,19 @@ class DataTerm:
     def r(self) -> int:
         """Number of base parameters in ``x``."""
         return int(self.P.shape[0])
+
+    def friction_layout(self) -> NDArray[np.intp]:
+        """:attr:`friction_index`, or ``0 .. k-1`` when every coefficient is fitted."""
+        if self.friction_index is None:
+            return np.arange(self.n_friction)
+        return np.asarray(self.friction_index)
+
+    def friction_table(self, f: NDArray[np.float64], n: int) -> NDArray[np.float64]:
+        """The fitted friction unknowns ``f`` (k,) as the (n, 3) table ``fv, fc, fo`` (zero
+        for the coefficients not fitted)."""
+        out = np.zeros(3 * n)
+        out[self.friction_layout()] = f
+        return out.reshape(n, 3)
 
     def chi2(self, x: NDArray[np.float64]) -> float:
         """``||A (x - x_hat)||^2``: the increase of the residual sum of squares / sigma^2."""
@@ -273,6 +291,7 @@ def coefficient_term(model: IdentifiedModel, *, with_friction: bool = False) -> 
         dof=max(int(fit.n_rows) - int(fit.rank), 1),
         exact=exact,
         n_friction=int(kept[r_all:].sum()) if k else 0,
+        friction_index=np.flatnonzero(kept[r_all:]) if k else None,
         labels=labels,
         notes=notes,
     )
@@ -488,9 +507,9 @@ class _Problem:
         if self.f is not None:
             x = cp.hstack([x, self.f])
             if friction_nonneg:  # fv, fc >= 0 (every joint's fo is free)
-                sel = np.zeros((2 * (k // 3), k))
-                for j in range(k // 3):
-                    sel[2 * j, 3 * j] = sel[2 * j + 1, 3 * j + 1] = 1.0
+                pos = np.flatnonzero(term.friction_layout() % 3 != 2)  # fv, fc (not fo)
+                sel = np.zeros((pos.size, k))
+                sel[np.arange(pos.size), pos] = 1.0
                 cons.append(sel @ self.f >= 0)
         for make in constraints:
             cons += list(make(phis, self.J))
@@ -669,8 +688,8 @@ def _finish(
 ) -> ConsistentResult:
     if f is not None and term.n_friction:
         f = f.copy()
-        f[0::3] = np.maximum(f[0::3], 0.0)  # fv, fc >= 0 held to the solver's tolerance
-        f[1::3] = np.maximum(f[1::3], 0.0)
+        nonneg = term.friction_layout() % 3 != 2
+        f[nonneg] = np.maximum(f[nonneg], 0.0)  # fv, fc >= 0 held to the solver's tolerance
     m, c, I = inertial_from_phi(phi)
     out = robot.with_params(phi)
     notes = notes + _active_and_implausible(robot, m, c, I, bounds, band)
@@ -705,7 +724,7 @@ def _finish(
     return ConsistentResult(
         robot=out,
         phi=phi,
-        friction=None if f is None else f.reshape(-1, 3),
+        friction=None if f is None else term.friction_table(f, robot.n),
         rotor_inertia=ia,
         relative_residual=rel,
         residual_ratio=ratio,

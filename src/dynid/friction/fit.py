@@ -49,6 +49,10 @@ from ..dynamics.rnea import rnea
 from ..exceptions import ConvergenceError, DataError, DynidWarning, OptionError, ShapeError
 from ..identification.log import DEFAULT_CUTOFF_HZ, TorqueLog, joint_side_log, prepare_log
 from ..identification.model import IdentifiedModel
+from ..identification.sanity import (
+    moving_joints,
+    velocity_noise_std,
+)
 from ..model.drive import Drive
 from ..model.robot import Robot
 from .model import ClassicalFriction, DriveFriction, FrictionModel, SigmoidFriction
@@ -67,14 +71,6 @@ __all__ = [
     "rigid_body_torques",
     "velocity_noise_std",
 ]
-
-#: Width of the velocity noise band, in standard deviations of the velocity noise.
-NOISE_BAND_STD = 5.0
-#: Smallest velocity [rad/s] (m/s for a prismatic joint) counted as motion, whatever the
-#: noise: below it no friction law can be told apart (noise-free logs of a frozen joint).
-MIN_MOTION = 1e-3
-#: Fraction of the samples that must lie outside the noise band for a joint to move.
-MOVING_FRACTION = 0.01
 
 #: A rigid-body torque model: identified, a robot's own parameters, or a callable
 #: ``f(q, dq, ddq) -> tau`` on (N, n) arrays [rad, rad/s, rad/s^2 -> N m].
@@ -204,74 +200,6 @@ def friction_residual(
     tau_m = rigid_body_torques(model, p.q, p.dq, p.ddq)
     noise = _checks.frozen(velocity_noise_std(log.dq))
     return FrictionResidual(log=p, tau_model=tau_m, residual=p.tau - tau_m, dq_noise_std=noise)
-
-
-def velocity_noise_std(dq: ArrayLike) -> NDArray[np.float64]:
-    """Std [rad/s] (n,) of the white noise on velocity samples ``dq`` (N, n), robustly.
-
-    .. math:: \\hat\\sigma_j = 1.4826 \\, \\mathrm{MAD}(\\Delta^2 \\dot q_j) / \\sqrt 6
-
-    The second difference of white noise of std ``sigma`` has std ``sqrt(6) sigma``, while
-    that of a smooth motion sampled fast is far smaller; the median absolute deviation
-    (scaled to a std for Gaussian noise) ignores the few steps of a fast reversal. Give
-    the measured velocities: a low-pass filter hides the noise from this estimate.
-
-    Parameters
-    ----------
-    dq : array_like, shape (N, n)
-        Measured joint velocities [rad/s], N >= 3.
-
-    Returns
-    -------
-    ndarray, shape (n,)
-
-    Raises
-    ------
-    ShapeError
-        ``dq`` not of shape (N, n) with N >= 3.
-    """
-    a = _checks.as_array("dq", dq)
-    if a.ndim != 2 or a.shape[0] < 3:
-        raise ShapeError(f"dq must have shape (N, n), N >= 3; got {a.shape}")
-    d2 = np.diff(a, n=2, axis=0)
-    mad = np.median(np.abs(d2 - np.median(d2, axis=0)), axis=0)
-    out: NDArray[np.float64] = 1.4826 * mad / np.sqrt(6.0)
-    return out
-
-
-def moving_joints(dq: ArrayLike, noise_std: ArrayLike | None = None) -> NDArray[np.bool_]:
-    """Which joints move beyond their velocity noise band (n,) bool.
-
-    A joint moves when more than :data:`MOVING_FRACTION` of its samples ``|dq|`` exceed
-    ``max(NOISE_BAND_STD * noise_std, MIN_MOTION)``.
-
-    Parameters
-    ----------
-    dq : array_like, shape (N, n)
-        Joint velocities [rad/s] (filtered or not).
-    noise_std : array_like, shape (n,) or scalar, optional
-        White-noise std of the measured velocities [rad/s]; default
-        :func:`velocity_noise_std` of ``dq`` (right for unfiltered velocities).
-
-    Returns
-    -------
-    ndarray of bool, shape (n,)
-
-    Raises
-    ------
-    ShapeError
-        ``dq`` not of shape (N, n) with N >= 3, or ``noise_std`` of another joint count.
-    """
-    a = _checks.as_array("dq", dq)
-    if a.ndim != 2 or a.shape[0] < 3:
-        raise ShapeError(f"dq must have shape (N, n), N >= 3; got {a.shape}")
-    sd = velocity_noise_std(a) if noise_std is None else _checks.as_array("noise_std", noise_std)
-    sd = np.broadcast_to(sd, (a.shape[1],)) if sd.ndim == 0 else sd
-    if sd.shape != (a.shape[1],):
-        raise ShapeError(f"noise_std must have shape ({a.shape[1]},); got {sd.shape}")
-    band = np.maximum(NOISE_BAND_STD * sd, MIN_MOTION)
-    out: NDArray[np.bool_] = np.quantile(np.abs(a), 1.0 - MOVING_FRACTION, axis=0) > band
-    return out
 
 
 def _identifiable(dq: NDArray[np.float64], noise_std: ArrayLike | None) -> NDArray[np.bool_]:

@@ -50,6 +50,7 @@ from .estimators import Estimator, EstimatorName, estimator_named
 from .least_squares import LeastSquaresFit, conditioning_advice
 from .log import DEFAULT_CUTOFF_HZ, TorqueLog, joint_side_log, prepare_log
 from .model import IdentifiedModel
+from .sanity import check_torque_log, moving_joints
 
 __all__ = ["friction_labels", "friction_regressor", "identify_from_log", "auto_decimation"]
 
@@ -173,9 +174,12 @@ def identify_from_log(
     if drive is not None:
         drive.check(n)
     fs = log.sample_rate
-    prepared = prepare_log(
-        joint_side_log(log, drive), cutoff_hz=cutoff_hz, trim_s=trim_s, max_gap_s=max_gap_s
-    )
+    jlog = joint_side_log(log, drive)
+    for finding in check_torque_log(robot, jlog):  # sign, units, frozen joints: said first
+        warnings.warn(finding, DynidWarning, stacklevel=2)
+    still = _still_friction(jlog, drive) if friction else np.zeros(0, dtype=bool)
+    prepared = prepare_log(jlog, cutoff_hz=cutoff_hz, trim_s=trim_s, max_gap_s=max_gap_s)
+    del jlog
     k = auto_decimation(fs, cutoff_hz) if decimate is None else int(decimate)
     if k < 1:
         raise ShapeError(f"decimate must be >= 1; got {decimate}")
@@ -195,6 +199,11 @@ def identify_from_log(
     est = estimator_named(estimator)
     if std not in ("classical", "robust"):
         raise OptionError(f"std must be 'classical' or 'robust'; got {std!r}")
+    # the viscous and Coulomb columns of a joint (motor) that never moves are not fitted
+    cols = np.ones(W.shape[1], dtype=bool)
+    if still.any():
+        cols[bp.rank :][np.repeat(still, 3) & (np.arange(3 * n) % 3 != 2)] = False
+        W = W[:, cols]
     try:
         _checks.finite("regressor", W)
         fit = est.fit(
@@ -204,7 +213,7 @@ def identify_from_log(
             rtol=fit_rtol,
             covariance=std,
             max_std_percent=max_std_percent,
-            labels=labels,
+            labels=tuple(lab for lab, c in zip(labels, cols, strict=True) if c),
         )
     except RankDeficientError as exc:
         raise RankDeficientError(
@@ -212,6 +221,8 @@ def identify_from_log(
             "speeds in both directions excites them (dynid excite optimises one); a joint "
             "that never moves leaves its friction unidentifiable"
         ) from exc
+    if not cols.all():
+        fit = _expanded(fit, cols)
     for msg in conditioning_advice(fit, labels, what="the trajectory"):
         warnings.warn(msg, DynidWarning, stacklevel=2)
     fr = None
@@ -256,6 +267,42 @@ def identify_from_log(
         metadata=meta,
         joint_fit=fit if friction else None,
         drive=drive,
+    )
+
+
+def _still_friction(log: TorqueLog, drive: Drive | None) -> NDArray[np.bool_]:
+    """Joints (motors, where the drive's friction acts there) whose velocity never leaves
+    its noise band: their viscous and Coulomb friction is not fitted from noise."""
+    if drive is None:
+        return ~moving_joints(log.dq)
+    return ~moving_joints(log.dq @ drive.friction_transmission.T)
+
+
+def _expanded(fit: LeastSquaresFit, cols: NDArray[np.bool_]) -> LeastSquaresFit:
+    """A fit over the columns ``cols`` selected, written over all of them (0 and not kept
+    for the others)."""
+    k = cols.size
+
+    def put(v: NDArray[Any], fill: Any) -> NDArray[Any]:
+        out = np.full(k, fill, dtype=np.asarray(v).dtype)
+        out[cols] = v
+        return out
+
+    cov = None
+    if fit.covariance is not None:
+        cov = np.zeros((k, k))
+        cov[np.ix_(cols, cols)] = fit.covariance
+    return dataclasses.replace(
+        fit,
+        beta=put(fit.beta, 0.0),
+        std=put(fit.std, 0.0),
+        std_percent=put(fit.std_percent, np.nan),
+        kept=put(fit.kept, False),
+        covariance=cov,
+        weakest=put(fit.weakest, 0.0) if np.size(fit.weakest) == cols.sum() else fit.weakest,
+        effect_percent=put(fit.effect_percent, 0.0)
+        if np.size(fit.effect_percent) == cols.sum()
+        else fit.effect_percent,
     )
 
 

@@ -1,0 +1,220 @@
+"""Checks of a torque log before fitting: sign, scale, units and joints that never move.
+
+Real logs come with conventions of their own. Each check here returns one line that says
+what looks wrong, the numbers, and the remedy as the user types it; identification warns
+with them before fitting (:func:`log_findings`). None of them changes the data.
+
+* **Sign**: the measured torques against the model's gravity torques ``g(q)`` at the logged
+  configurations (with the robot's own link parameters, when it has any): a correlation
+  below ``-0.5`` on a joint that gravity loads means the torque sign is opposite to the
+  model's (``--units tau=-1``).
+* **Scale**: the least-squares factor ``a`` in ``tau ~ a g(q)`` over the gravity-loaded
+  joints; ``a`` near 1e3 or 1e-3 is a unit off by a power of ten (mN m against N m), and
+  currents logged as torques show as a factor far from 1 (a drive file with
+  ``torque_constant``).
+* **Degrees**: positions whose range exceeds ``2 pi`` on a revolute joint while the range
+  divided by ``180 / pi`` fits in the joint's limits (``--units q=deg``).
+* **Milliseconds**: logged velocities ``1e3`` times the derivative of the positions (or a
+  median time step of at least 0.5 s with integer steps when no velocities were logged):
+  ``--units t=ms``.
+* **Frozen joints**: a joint whose velocity never leaves its noise band (fewer than 1 % of
+  the samples beyond 5 times the robust noise level, :func:`velocity_noise_std`, and
+  :data:`MIN_MOTION`); its friction cannot be identified (:func:`moving_joints`).
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+
+from .. import _checks
+from ..dynamics.terms import gravity_torques
+from ..exceptions import ShapeError
+from ..model.robot import Robot
+from .log import TorqueLog
+
+__all__ = [
+    "MIN_MOTION",
+    "MOVING_FRACTION",
+    "NOISE_BAND_STD",
+    "check_torque_log",
+    "moving_joints",
+    "velocity_noise_std",
+]
+
+_MAX_SAMPLES = 4000  # samples used by the checks (evenly spaced): they are statistics
+
+#: Width of the velocity noise band, in standard deviations of the velocity noise.
+NOISE_BAND_STD = 5.0
+#: Smallest velocity [rad/s] (m/s for a prismatic joint) counted as motion, whatever the
+#: noise: below it no friction law can be told apart (noise-free logs of a frozen joint).
+MIN_MOTION = 1e-3
+#: Fraction of the samples that must lie outside the noise band for a joint to move.
+MOVING_FRACTION = 0.01
+
+
+def velocity_noise_std(dq: ArrayLike) -> NDArray[np.float64]:
+    """Std [rad/s] (n,) of the white noise on velocity samples ``dq`` (N, n), robustly.
+
+    .. math:: \\hat\\sigma_j = 1.4826 \\, \\mathrm{MAD}(\\Delta^2 \\dot q_j) / \\sqrt 6
+
+    The second difference of white noise of std ``sigma`` has std ``sqrt(6) sigma``, while
+    that of a smooth motion sampled fast is far smaller; the median absolute deviation
+    (scaled to a std for Gaussian noise) ignores the few steps of a fast reversal. Give
+    the measured velocities: a low-pass filter hides the noise from this estimate.
+
+    Parameters
+    ----------
+    dq : array_like, shape (N, n)
+        Measured joint velocities [rad/s], N >= 3.
+
+    Returns
+    -------
+    ndarray, shape (n,)
+
+    Raises
+    ------
+    ShapeError
+        ``dq`` not of shape (N, n) with N >= 3.
+    """
+    a = _checks.as_array("dq", dq)
+    if a.ndim != 2 or a.shape[0] < 3:
+        raise ShapeError(f"dq must have shape (N, n), N >= 3; got {a.shape}")
+    d2 = np.diff(a, n=2, axis=0)
+    mad = np.median(np.abs(d2 - np.median(d2, axis=0)), axis=0)
+    out: NDArray[np.float64] = 1.4826 * mad / np.sqrt(6.0)
+    return out
+
+
+def moving_joints(dq: ArrayLike, noise_std: ArrayLike | None = None) -> NDArray[np.bool_]:
+    """Which joints move beyond their velocity noise band (n,) bool.
+
+    A joint moves when more than :data:`MOVING_FRACTION` of its samples ``|dq|`` exceed
+    ``max(NOISE_BAND_STD * noise_std, MIN_MOTION)``.
+
+    Parameters
+    ----------
+    dq : array_like, shape (N, n)
+        Joint velocities [rad/s] (filtered or not).
+    noise_std : array_like, shape (n,) or scalar, optional
+        White-noise std of the measured velocities [rad/s]; default
+        :func:`velocity_noise_std` of ``dq`` (right for unfiltered velocities).
+
+    Returns
+    -------
+    ndarray of bool, shape (n,)
+
+    Raises
+    ------
+    ShapeError
+        ``dq`` not of shape (N, n) with N >= 3, or ``noise_std`` of another joint count.
+    """
+    a = _checks.as_array("dq", dq)
+    if a.ndim != 2 or a.shape[0] < 3:
+        raise ShapeError(f"dq must have shape (N, n), N >= 3; got {a.shape}")
+    sd = velocity_noise_std(a) if noise_std is None else _checks.as_array("noise_std", noise_std)
+    sd = np.broadcast_to(sd, (a.shape[1],)) if sd.ndim == 0 else sd
+    if sd.shape != (a.shape[1],):
+        raise ShapeError(f"noise_std must have shape ({a.shape[1]},); got {sd.shape}")
+    band = np.maximum(NOISE_BAND_STD * sd, MIN_MOTION)
+    out: NDArray[np.bool_] = np.quantile(np.abs(a), 1.0 - MOVING_FRACTION, axis=0) > band
+    return out
+
+
+def check_torque_log(robot: Robot, log: TorqueLog) -> list[str]:
+    """One line per finding on a joint-side log of ``robot`` (module docstring); empty when
+    nothing looks wrong."""
+    step = max(1, log.n_samples // _MAX_SAMPLES)
+    q, dq, tau, t = log.q[::step], log.dq[::step], log.tau[::step], log.t[::step]
+    out: list[str] = []
+    names = robot.joint_names
+    if np.any(robot.phi):  # the robot's own parameters: a model to compare with
+        out += _sign_and_scale(robot, q, tau, names)
+    out += _degrees(robot, log.q)
+    out += _milliseconds(log)
+    frozen = ~moving_joints(log.dq)
+    if np.any(frozen) and not np.all(frozen):
+        which = ", ".join(names[j] for j in np.flatnonzero(frozen))
+        out.append(
+            f"joint(s) {which} never leave their velocity noise band: their friction is "
+            "unidentifiable and is left out (zero) rather than fitted from noise; hint: a "
+            "trajectory that moves every joint identifies them"
+        )
+    del t, dq
+    return out
+
+
+def _sign_and_scale(
+    robot: Robot, q: NDArray[np.float64], tau: NDArray[np.float64], names: tuple[str, ...]
+) -> list[str]:
+    g = gravity_torques(robot, q)
+    spread = np.std(g, axis=0)
+    loaded = spread > 0.05 * max(float(spread.max()), 1e-300)
+    if not np.any(loaded) or not np.any(spread > 0):
+        return []
+    gc = g - g.mean(axis=0)
+    tc = tau - tau.mean(axis=0)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        corr = np.sum(gc * tc, axis=0) / np.sqrt(np.sum(gc**2, axis=0) * np.sum(tc**2, axis=0))
+    corr = np.where(np.isfinite(corr), corr, 0.0)
+    out = []
+    neg = loaded & (corr < -0.5)
+    if np.any(neg) and np.sum(corr[loaded] < 0) > np.sum(corr[loaded] > 0):
+        j = int(np.flatnonzero(neg)[np.argmin(corr[neg])])
+        out.append(
+            f"the measured torques are anti-correlated with the model's gravity torques "
+            f"(correlation {corr[j]:+.2f} on {names[j]}): the torque sign is probably opposite "
+            "to the model's; hint: --units tau=-1 (or a drive file whose transmission has "
+            "the sign)"
+        )
+        return out
+    a = float(np.sum(gc[:, loaded] * tc[:, loaded]) / np.sum(gc[:, loaded] ** 2))
+    if abs(a) > 30 or 0 < abs(a) < 1 / 30:
+        p = round(math.log10(abs(a)))
+        hint = (
+            "--units tau=mNm"
+            if p == 3
+            else "--units tau=kNm"
+            if p == -3
+            else "currents need a drive file with torque_constant"
+        )
+        out.append(
+            f"the measured torques are {abs(a):.3g} times the model's gravity torques: a unit "
+            f"off by a power of ten, or currents logged as torques; hint: {hint}"
+        )
+    return out
+
+
+def _degrees(robot: Robot, q: NDArray[np.float64]) -> list[str]:
+    rev = ~np.asarray(robot.prismatic)
+    lo, hi = np.min(q, axis=0), np.max(q, axis=0)
+    span = hi - lo
+    lim_lo = np.where(np.isfinite(robot.q_min), robot.q_min, -2 * np.pi)
+    lim_hi = np.where(np.isfinite(robot.q_max), robot.q_max, 2 * np.pi)
+    r = np.pi / 180.0
+    suspect = rev & (span > 2 * np.pi) & (lo * r >= lim_lo - 0.1) & (hi * r <= lim_hi + 0.1)
+    if np.sum(suspect) >= max(1, int(np.sum(rev & (span > 0.1))) // 2):
+        j = int(np.flatnonzero(suspect)[0])
+        return [
+            f"positions look like degrees: joint {robot.joint_names[j]} spans "
+            f"{span[j]:.4g} rad, which in degrees fits its limits; hint: --units q=deg"
+        ]
+    return []
+
+
+def _milliseconds(log: TorqueLog) -> list[str]:
+    t, q, dq = log.t, log.q, log.dq
+    if t.size < 5:
+        return []
+    fd = np.gradient(q, t, axis=0)
+    den = float(np.sum(dq * dq))
+    if den > 0:
+        k = float(np.sum(fd * dq) / den)
+        if 3e-4 < k < 3e-3:
+            return [
+                f"the velocities are {1 / k:.3g} times the derivative of the positions: the "
+                "time column looks like milliseconds; hint: --units t=ms"
+            ]
+    return []

@@ -1,0 +1,78 @@
+"""Checks of a torque log before fitting (issue 18): a flipped sign, mN m, degrees,
+milliseconds and a frozen joint are named, with the remedy, before any fit; a frozen joint's
+friction is not fitted from noise."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+import dynid
+from dynid.exceptions import DynidWarning
+from dynid.identification.classical import identify_from_log
+from dynid.identification.log import TorqueLog
+from dynid.identification.sanity import check_torque_log
+from dynid.simulation.measurement import sample_times, simulate_measurement
+from dynid.simulation.trajectories import random_fourier
+
+
+@pytest.fixture(scope="module")
+def panda_log() -> TorqueLog:
+    robot = dynid.panda()
+    traj = random_fourier(robot, np.random.default_rng(0))(sample_times(10.0, 250.0))
+    return simulate_measurement(robot, traj, rng=np.random.default_rng(1))
+
+
+def test_a_clean_log_has_no_findings(panda_log):
+    """The simulated Panda log of the Panda: nothing to say."""
+    assert check_torque_log(dynid.panda(), panda_log) == []
+
+
+@pytest.mark.parametrize(
+    ("change", "match"),
+    [
+        (lambda g: TorqueLog(g.t, g.q, g.dq, -g.tau), "--units tau=-1"),
+        (lambda g: TorqueLog(g.t, g.q, g.dq, 1e3 * g.tau), "--units tau=mNm"),
+        (lambda g: TorqueLog(g.t, np.degrees(g.q), np.degrees(g.dq), g.tau), "--units q=deg"),
+        (lambda g: TorqueLog(1e3 * g.t, g.q, g.dq, g.tau), "--units t=ms"),
+    ],
+    ids=["flipped sign", "mNm", "degrees", "milliseconds"],
+)
+def test_unit_and_sign_faults_are_named_with_their_remedy(panda_log, change, match):
+    """Each fault gives one finding that names the flag that fixes it."""
+    found = check_torque_log(dynid.panda(), change(panda_log))
+    assert len(found) == 1 and match in found[0]
+
+
+@pytest.mark.filterwarnings("ignore:.*indistinguishable from zero")  # expected: weak coefficients
+def test_identification_warns_about_a_flipped_sign_before_fitting(panda_log):
+    """identify_from_log names the sign in a DynidWarning (the fit itself would succeed)."""
+    flipped = TorqueLog(panda_log.t, panda_log.q, panda_log.dq, -panda_log.tau)
+    with pytest.warns(DynidWarning, match="anti-correlated"):
+        identify_from_log(dynid.panda(), flipped)
+
+
+@pytest.mark.filterwarnings("ignore:.*indistinguishable from zero")  # expected: weak coefficients
+def test_a_frozen_joint_gets_no_friction_fitted_from_noise():
+    """Joint 4 held still (its encoder and velocity noise only): its viscous and Coulomb
+    friction are reported not fitted (0, not kept) instead of fitted from noise, the others
+    are fitted, and held-out torques of the moving joints are still predicted."""
+    robot = dynid.panda()
+    t = sample_times(12.0, 250.0)
+    traj = random_fourier(robot, np.random.default_rng(4))(t)
+    q = np.array(traj.q)
+    q[:, 3] = -1.5
+    frozen = type(traj)(
+        t=traj.t,
+        q=q,
+        dq=np.where(np.arange(7) == 3, 0.0, traj.dq),
+        ddq=np.where(np.arange(7) == 3, 0.0, traj.ddq),
+    )
+    log = simulate_measurement(robot, frozen, rng=np.random.default_rng(5))
+    with pytest.warns(DynidWarning, match="never leave their velocity noise band"):
+        m = identify_from_log(robot, log)
+    r = m.base.rank
+    kept = np.asarray(m.joint_fit.kept[r:]).reshape(7, 3)
+    assert not kept[3, 0] and not kept[3, 1] and kept[3, 2]
+    np.testing.assert_array_equal(m.friction[3, :2], 0.0)
+    assert kept[[0, 1, 2, 4, 5, 6], :2].all()
