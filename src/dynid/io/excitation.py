@@ -40,7 +40,7 @@ from ..simulation.excitation import ExcitationResult, ExcitingTrajectory
 from ..simulation.trajectories import Trajectory
 from .atomic import open_atomic, write_text
 from .json_files import load_json
-from .torque_log import read_csv_table
+from .torque_log import csv_table
 
 __all__ = [
     "EXCITATION_SCHEMA",
@@ -309,7 +309,7 @@ def load_trajectory(path: str | Path, n: int, *, fs: float = 1000.0) -> Trajecto
             )
         return {"a": [names.index(c) for c in want]}
 
-    arrays, _ = read_csv_table(path, layout, ",".join(want[:2]) + ",...")
+    arrays, _ = csv_table(path, layout, ",".join(want[:2]) + ",...")
     a = arrays["a"]
     if not np.all(np.isfinite(a)):
         r = int(np.flatnonzero(~np.isfinite(a).all(axis=1))[0])

@@ -52,7 +52,7 @@ from .atomic import open_atomic
 from .npz_files import check_npz
 from .static_data import check_row_count
 
-__all__ = ["load_torque_log", "read_csv_table", "save_torque_log", "torque_log_columns"]
+__all__ = ["load_torque_log", "csv_table", "save_torque_log", "torque_log_columns"]
 
 _log = logging.getLogger(__name__)
 
@@ -330,12 +330,12 @@ def _read_csv(path: Path) -> tuple[dict[str, NDArray[np.float64]], tuple[int, in
                 out[k] = [index[f"{k}{j}"] for j in range(1, n + 1)]
         return out
 
-    arrays, lines = read_csv_table(path, layout, "t,q1,...,dq1,...,tau1,...")
+    arrays, lines = csv_table(path, layout, "t,q1,...,dq1,...,tau1,...")
     arrays["t"] = arrays["t"].reshape(-1)
     return arrays, lines
 
 
-def read_csv_table(
+def csv_table(
     path: Path,
     layout_of: Callable[[list[str], int], dict[str, list[int]]],
     expected: str,
