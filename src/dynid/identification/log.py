@@ -33,6 +33,7 @@ from __future__ import annotations
 
 import warnings
 from dataclasses import dataclass, field
+from typing import Any
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -321,31 +322,27 @@ def joint_side_log(log: TorqueLog, drive: Drive | None) -> TorqueLog:
     """
     if drive is None or drive.is_identity:
         return log
-    drive.check(log.n)
-    rates = (log.dq,) if log.ddq is None else (log.dq, log.ddq)
-    q, *joint_rates = drive.joint_states(log.q, *rates)
-    return TorqueLog(
-        t=log.t,
-        q=q,
-        dq=joint_rates[0],
-        tau=drive.joint_torques(log.tau),
-        ddq=joint_rates[1] if log.ddq is not None else None,
-        cleaning=log.cleaning,
-    )
+    return _mapped(log, drive, drive.joint_states, drive.joint_torques)
 
 
 def recorded_side_log(log: TorqueLog, drive: Drive) -> TorqueLog:
     """Inverse of :func:`joint_side_log`: a joint-side log as the drive records it (motor
     positions and torques, or currents; encoder offsets removed)."""
+    return _mapped(log, drive, drive.recorded_states, drive.recorded_efforts)
+
+
+def _mapped(log: TorqueLog, drive: Drive, states: Any, efforts: Any) -> TorqueLog:
+    """The log with its positions and rates mapped by ``states`` and its torques by
+    ``efforts`` (one direction of the drive)."""
     drive.check(log.n)
     rates = (log.dq,) if log.ddq is None else (log.dq, log.ddq)
-    q, *rec = drive.recorded_states(log.q, *rates)
+    q, *mapped = states(log.q, *rates)
     return TorqueLog(
         t=log.t,
         q=q,
-        dq=rec[0],
-        tau=drive.recorded_efforts(log.tau),
-        ddq=rec[1] if log.ddq is not None else None,
+        dq=mapped[0],
+        tau=efforts(log.tau),
+        ddq=mapped[1] if log.ddq is not None else None,
         cleaning=log.cleaning,
     )
 

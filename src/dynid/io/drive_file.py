@@ -20,7 +20,6 @@ Keys (all optional but ``schema`` in a file of its own; n = the robot's joint co
 
 from __future__ import annotations
 
-import math
 import tomllib
 from collections.abc import Mapping
 from pathlib import Path
@@ -29,6 +28,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
+from .. import _checks
 from ..exceptions import DataError, DynidError
 from ..model.drive import DRIVE_SCHEMA, Drive
 
@@ -59,26 +59,13 @@ _CHOICES = {
 
 
 def _number(value: Any, where: str) -> float:
-    if isinstance(value, bool) or not isinstance(value, int | float):
-        raise DataError(f"{where} must be a number; got {_short(value)}")
-    try:
-        x = float(value)
-    except OverflowError:
-        raise DataError(f"{where} must be a finite number; got an integer too large") from None
-    if not math.isfinite(x):
-        raise DataError(f"{where} must be finite; got {value!r}")
-    return x
-
-
-def _short(value: Any) -> str:
-    text = repr(value)
-    return text if len(text) <= 80 else text[:77] + "..."
+    return _checks.number(value, where, DataError)
 
 
 def _vector(table: Mapping[str, Any], key: str, n: int, where: str) -> NDArray[np.float64]:
     value = table[key]
     if not isinstance(value, list) or len(value) != n:
-        got = f"{len(value)} entries" if isinstance(value, list) else _short(value)
+        got = f"{len(value)} entries" if isinstance(value, list) else _checks.short(value)
         raise DataError(
             f"{where}: key {key!r} must be a list of {n} numbers (one per joint); got {got}"
         )
@@ -101,12 +88,14 @@ def drive_from_mapping(table: Mapping[str, Any], n: int, *, source: str = "drive
         raise DataError(f"{source}: unknown key {unknown[0]!r}; allowed: {sorted(_KEYS)}")
     schema = table.get("schema", DRIVE_SCHEMA)
     if schema != DRIVE_SCHEMA:
-        raise DataError(f"{source}: key 'schema' must be {DRIVE_SCHEMA!r}; got {_short(schema)}")
+        raise DataError(
+            f"{source}: key 'schema' must be {DRIVE_SCHEMA!r}; got {_checks.short(schema)}"
+        )
     kw: dict[str, Any] = {}
     for key, allowed in _CHOICES.items():
         if key in table:
             if table[key] not in allowed:
-                got = _short(table[key])
+                got = _checks.short(table[key])
                 raise DataError(f"{source}: key {key!r} must be one of {list(allowed)}; got {got}")
             kw[key] = table[key]
     gear = _vector(table, "gear_ratio", n, source) if "gear_ratio" in table else np.ones(n)
@@ -117,13 +106,13 @@ def drive_from_mapping(table: Mapping[str, Any], n: int, *, source: str = "drive
     for k, entry in enumerate(coupling):
         where = f"{source}: coupling[{k}]"
         if not isinstance(entry, list) or len(entry) != 3:
-            raise DataError(f"{where} must be [motor, joint, value]; got {_short(entry)}")
+            raise DataError(f"{where} must be [motor, joint, value]; got {_checks.short(entry)}")
         m, j = entry[0], entry[1]
         for what, idx in (("motor", m), ("joint", j)):
             if isinstance(idx, bool) or not isinstance(idx, int) or not 1 <= idx <= n:
                 raise DataError(
                     f"{where}: {what} must be an integer in 1..{n} (1-based, the robot has "
-                    f"{n} joints); got {_short(idx)}"
+                    f"{n} joints); got {_checks.short(idx)}"
                 )
         if m == j:
             raise DataError(f"{where}: motor {m} on joint {j} is the gear ratio; use gear_ratio")
@@ -136,7 +125,7 @@ def drive_from_mapping(table: Mapping[str, Any], n: int, *, source: str = "drive
         if isinstance(ia, str):
             raise DataError(
                 f"{source}: key 'rotor_inertia' must be 'identify' or a list of {n} numbers "
-                f"[kg m^2]; got {_short(ia)}"
+                f"[kg m^2]; got {_checks.short(ia)}"
             )
         kw["rotor_inertia"] = _vector(table, "rotor_inertia", n, source)
     try:
