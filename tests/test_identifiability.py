@@ -179,8 +179,10 @@ def test_rank_error_names_the_dependent_columns():
         fit_least_squares(W, A @ [1.0, 2.0, 3.0])
 
 
-def test_torque_log_rank_error_names_the_friction_columns_of_a_still_joint():
-    """A log where joint 7 never moves: its friction columns are named in the error."""
+def test_torque_log_leaves_out_the_friction_columns_of_a_still_joint():
+    """A log where joint 7 never moves: its viscous and Coulomb columns are named in a
+    warning and left out (zero, not kept) instead of making the fit rank deficient
+    (issues 18 and 20: nothing is fitted from a joint that does not move)."""
     robot = dynid.panda()
     fs = 200.0
     t = np.arange(0, 10, 1 / fs)
@@ -190,8 +192,12 @@ def test_torque_log_rank_error_names_the_friction_columns_of_a_still_joint():
     q[:, 6], dq[:, 6], ddq[:, 6] = 0.3, 0.0, 0.0
     tau = dynid.rnea(robot, q, dq, ddq)
     log = TorqueLog(t=t, q=q, dq=dq, tau=tau, ddq=ddq)
-    with pytest.raises(RankDeficientError, match=r"nearly dependent columns: .*(fv7|fc7)"):
-        identify_from_log(robot, log, cutoff_hz=None, decimate=1)
+    with pytest.warns(DynidWarning, match="joint7 never leave"):
+        model = identify_from_log(robot, log, cutoff_hz=None, decimate=1)
+    r = model.base.rank
+    kept = np.asarray(model.joint_fit.kept[r:]).reshape(7, 3)
+    assert not kept[6, 0] and not kept[6, 1]
+    np.testing.assert_array_equal(model.friction[6, :2], 0.0)
 
 
 def test_condition_number_on_the_papers_1010_configurations_is_the_papers_48_9():
