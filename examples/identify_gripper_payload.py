@@ -13,8 +13,8 @@ from scipy.spatial.transform import Rotation
 
 import dynid
 from dynid.feasibility import identify_payload, robot_with_payload
-from dynid.io.mjcf_export import save_mjcf
 from dynid.io.payload_json import payload_to_dict
+from dynid.io.robot.mjcf import save_mjcf
 
 arm = dynid.panda()
 R = Rotation.from_euler("z", np.pi / 4).as_matrix()

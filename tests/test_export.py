@@ -28,7 +28,7 @@ from dynid.io.feasible import (
     save_feasible_json,
     save_report_json,
 )
-from dynid.io.urdf_export import save_urdf, urdf_from_robot
+from dynid.io.robot.urdf import save_urdf, urdf_from_robot
 from dynid.regressors.base import base_parameters
 
 from conftest import random_states, robot_data_urdf

@@ -13,7 +13,7 @@ import dynid
 from dynid.exceptions import DataError, ShapeError
 from dynid.friction.mujoco import coulomb_viscous_from_sigmoid
 from dynid.io.export import export_format, save_robot
-from dynid.io.mjcf_export import mjcf_from_robot, save_mjcf
+from dynid.io.robot.mjcf import mjcf_from_robot, save_mjcf
 
 from conftest import planar_2r, random_states, robot_data_urdf
 

@@ -13,7 +13,7 @@ from dynid.exceptions import DynidWarning, RankDeficientError
 from dynid.identification.classical import identify_from_log
 from dynid.identification.least_squares import fit_least_squares
 from dynid.identification.log import TorqueLog
-from dynid.model.urdf import robot_from_urdf_string
+from dynid.io.robot.urdf import robot_from_urdf_string
 from dynid.regressors.base import base_parameters, identifiability, rank_from_gap
 from dynid.regressors.static import static_regressor
 from dynid.simulation.controller import SimulatedController, acquire_static, acquire_static_at

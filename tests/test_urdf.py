@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 
 import dynid
-from dynid.model.urdf import robot_from_urdf, robot_from_urdf_string
+from dynid.io.robot.urdf import load_urdf, robot_from_urdf_string
 
 from conftest import random_states, robot_data_urdf
 
@@ -62,7 +62,7 @@ def panda_urdf() -> str:
 @pytest.mark.parametrize("tip", ["panda_link8", "panda_hand"])
 def test_panda_urdf_matches_pinocchio_on_random_states(panda_urdf, tip):
     """URDF Panda (fingers locked) equals Pinocchio on the same file: FK, J, RNEA, M, g, c."""
-    robot = robot_from_urdf(panda_urdf, "panda_link0", tip)
+    robot = load_urdf(panda_urdf, "panda_link0", tip)
     full = pin.buildModelFromUrdf(panda_urdf)
     fingers = [full.getJointId(k) for k in ("panda_finger_joint1", "panda_finger_joint2")]
     # Pinocchio merges the locked fingers into link 7; the fingers are off our chain, so add
@@ -127,13 +127,13 @@ def test_panda_urdf_loads_without_warnings(panda_urdf):
     """The Panda URDF's inertials are consistent, so loading it warns about nothing."""
     with warnings.catch_warnings():
         warnings.simplefilter("error")
-        robot_from_urdf(panda_urdf, tip_link="panda_hand")
+        load_urdf(panda_urdf, tip_link="panda_hand")
 
 
 def test_panda_urdf_equals_builtin_mdh_panda(panda_urdf):
     """URDF and MDH (Gaz et al. 2019) Pandas agree in FK and, with equal inertials, in dynamics."""
     mdh = dynid.panda()
-    urdf = robot_from_urdf(panda_urdf, "panda_link0", "panda_link8")
+    urdf = load_urdf(panda_urdf, "panda_link0", "panda_link8")
     q, dq, ddq = random_states(mdh, 100, seed=12)
     np.testing.assert_allclose(
         dynid.link_poses(urdf, q)[:, 1:], dynid.link_poses(mdh, q)[:, 1:], atol=1e-12
@@ -156,7 +156,7 @@ def test_panda_urdf_equals_builtin_mdh_panda(panda_urdf):
 
 def test_panda_hand_inertia_folds_into_link7(panda_urdf):
     """Link 7 carries link 7 plus the hand (0.73 kg at (-0.01, 0, 0.03) in the hand frame)."""
-    robot = robot_from_urdf(panda_urdf, "panda_link0", "panda_link8")
+    robot = load_urdf(panda_urdf, "panda_link0", "panda_link8")
     m7, c7 = 0.735522, np.array([1.0517e-02, -4.252e-03, 6.1597e-02])
     T7_hand = robot.frames["panda_hand"].T_link_frame
     c_hand = T7_hand[:3, :3] @ [-0.01, 0.0, 0.03] + T7_hand[:3, 3]
@@ -168,7 +168,7 @@ def test_panda_hand_inertia_folds_into_link7(panda_urdf):
 def test_ur5_urdf_matches_pinocchio_on_random_states():
     """UR5 (not modified DH; fixed world and tool links) equals Pinocchio: FK, J, RNEA, M, g, c."""
     path = robot_data_urdf(UR5)
-    robot = robot_from_urdf(path, tip_link="tool0")
+    robot = load_urdf(path, tip_link="tool0")
     assert robot.link_names[0] == "world"
     assert robot.joint_names[0] == "shoulder_pan_joint"
     assert {"base_link", "base", "ee_link", "tool0"} <= set(robot.frames)
@@ -330,7 +330,7 @@ BRANCHED = (
 def test_missing_file_raises_model_error(tmp_path):
     """A path that does not exist raises ModelError naming the file."""
     with pytest.raises(dynid.ModelError, match="URDF file not found.*nothere.urdf"):
-        robot_from_urdf(tmp_path / "nothere.urdf")
+        load_urdf(tmp_path / "nothere.urdf")
 
 
 def test_malformed_xml_raises_model_error(tmp_path):
@@ -338,7 +338,7 @@ def test_malformed_xml_raises_model_error(tmp_path):
     path = tmp_path / "bad.urdf"
     path.write_text('<robot name="r"><link name="a"></robot>')
     with pytest.raises(dynid.ModelError, match="not well-formed XML") as info:
-        robot_from_urdf(path)
+        load_urdf(path)
     assert info.value.__cause__ is not None
 
 
@@ -498,7 +498,7 @@ def test_absurd_axes_and_masses_are_refused_by_every_reader():
     1e12 kg are ModelErrors naming the joint or link, from the URDF reader, the TOML reader
     and the Robot itself (issue 20); an axis of 1e150 still normalises to [0, 0, 1]."""
     from dynid.exceptions import ModelError
-    from dynid.model.description import robot_from_toml_string
+    from dynid.io.robot.toml import robot_from_toml_string
 
     urdf = """<robot name="r"><link name="a"/><link name="b"><inertial><mass value="{m}"/>
       <inertia ixx="0.1" iyy="0.1" izz="0.1"/></inertial></link>

@@ -16,9 +16,8 @@ import dynid
 from dynid.cli.__main__ import main
 from dynid.exceptions import DynidWarning, ModelError
 from dynid.io.export import save_robot
-from dynid.io.urdf_export import save_urdf, urdf_from_robot
-from dynid.io.urdf_patch import patch_urdf_inertials
-from dynid.model.urdf import robot_from_urdf_string
+from dynid.io.robot.urdf import robot_from_urdf_string, save_urdf, urdf_from_robot
+from dynid.io.robot.urdf_patch import patch_urdf_inertials
 
 from conftest import pinocchio_panda_urdf, random_states, robot_data_urdf
 

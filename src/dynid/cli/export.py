@@ -34,7 +34,7 @@ from ..exceptions import DynidError
 from ..friction.model import DriveFriction
 from ..friction.mujoco import coulomb_viscous_from_sigmoid
 from ..io.export import EXPORT_FORMATS, model_terms_of, save_robot
-from ..io.urdf_patch import MERGED_POLICIES
+from ..io.robot.urdf_patch import MERGED_POLICIES
 from ..model.robot import Robot
 from .common import add_drive_option, add_subcommand, load_drive_arg
 

@@ -25,9 +25,9 @@ from ..exceptions import DynidError
 from ..feasibility.payload import identify_payload, robot_with_payload
 from ..identification.log import DEFAULT_CUTOFF_HZ
 from ..identification.model import IdentifiedModel
-from ..io.atomic import write_text
 from ..io.columns import ColumnMap, load_mapped_static_data
 from ..io.payload_json import save_payload_json
+from ..io.robot.toml import save_toml
 from .common import add_column_options, add_subcommand, column_map, positive_type, read_log
 from .identify import data_kind
 from .validate import load_model_source
@@ -87,7 +87,7 @@ def run(args: argparse.Namespace) -> int:
     )
     base = arm.equivalent_robot if isinstance(arm, IdentifiedModel) else arm
     tool = robot_with_payload(base, est)
-    write_text(args.out / "robot_with_payload.toml", tool.to_toml())
+    save_toml(args.out / "robot_with_payload.toml", tool)
     path = save_payload_json(
         args.out / "payload.json", est, kin, with_tool="robot_with_payload.toml"
     )

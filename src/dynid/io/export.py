@@ -3,11 +3,12 @@
 :func:`save_robot` picks the writer by ``format`` (or the file suffix: ``.urdf``;
 ``.xml``/``.mjcf``; ``.toml``) and passes its options on:
 
-* URDF: :func:`dynid.io.urdf_export.save_urdf` (chain export, or ``template=`` the
+* URDF: :func:`dynid.io.robot.urdf.save_urdf` (chain export, or ``template=`` the
   original URDF patched with the new inertials);
-* MJCF: :func:`dynid.io.mjcf_export.save_mjcf` (``friction`` as ``frictionloss`` and
+* MJCF: :func:`dynid.io.robot.mjcf.save_mjcf` (``friction`` as ``frictionloss`` and
   ``damping``);
-* TOML: :meth:`dynid.Robot.to_toml` (kinematics, inertials, limits, sigmoid friction).
+* TOML: :func:`dynid.io.robot.toml.save_toml` (kinematics, inertials, limits, sigmoid
+  friction, a drive as a ``[drive]`` table).
 
 ``dynid export``, ``dynid retrieve`` and ``identify --consistent`` write through it.
 """
@@ -21,10 +22,9 @@ from ..friction.model import ClassicalFriction, DriveFriction
 from ..friction.mujoco import joint_coulomb_viscous
 from ..model.drive import Drive
 from ..model.robot import Robot
-from .atomic import write_text
-from .drive_file import drive_toml
-from .mjcf_export import save_mjcf
-from .urdf_export import save_urdf
+from .robot.mjcf import save_mjcf
+from .robot.toml import save_toml
+from .robot.urdf import save_urdf
 
 __all__ = ["EXPORT_FORMATS", "export_format", "save_mjcf", "save_robot", "save_urdf"]
 
@@ -75,10 +75,10 @@ def save_robot(
     format : {"urdf", "mjcf", "toml"}, optional
         Default: from the suffix of ``path``.
     template, base, tip, merged, all_frames
-        URDF only (:func:`dynid.io.urdf_export.save_urdf`).
+        URDF only (:func:`dynid.io.robot.urdf.save_urdf`).
     friction : bool, ClassicalFriction or DriveFriction
         MJCF: the robot's friction, identified classical friction (at the joints or the
-        motors), or none (:func:`dynid.io.mjcf_export.save_mjcf`); URDF chain: identified
+        motors), or none (:func:`dynid.io.robot.mjcf.save_mjcf`); URDF chain: identified
         classical friction as ``<dynamics damping friction>``.
     drive : Drive, optional
         MJCF: a drive with known rotor inertias, written as ``armature``; TOML: the drive
@@ -111,10 +111,7 @@ def save_robot(
         )
     if fmt == "mjcf":
         return save_mjcf(path, robot, friction=friction, drive=drive)
-    text = robot.to_toml()
-    if drive is not None:  # the drive train with it, as a [drive] table
-        text = text.rstrip("\n") + "\n\n" + drive_toml(drive)
-    return write_text(path, text)
+    return save_toml(path, robot, drive=drive)
 
 
 def model_terms_of(

@@ -2,7 +2,7 @@
 
 **feasible.json** (:func:`save_feasible_json`, :func:`load_feasible_json`): the
 parameters of every moving link, in the schema of the robot description's inertials
-(:mod:`dynid.model.description`): ``mass`` [kg], ``com`` [m] in the link frame,
+(:mod:`dynid.io.robot.toml`): ``mass`` [kg], ``com`` [m] in the link frame,
 ``inertia`` ``[xx, xy, xz, yy, yz, zz]`` [kg m^2] **about the CoM**, link-frame axes.
 It also holds the robot's kinematics (:mod:`dynid.io.robot_json`) and its sigmoid
 friction, so that it loads back as a complete :class:`~dynid.model.robot.Robot`::

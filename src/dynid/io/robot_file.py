@@ -26,8 +26,8 @@ def load_robot(
     """A built-in robot by name, or a robot file by its suffix: the one dispatch of robots.
 
     A name of :data:`~dynid.model.builtin.BUILTIN_ROBOTS` (``"panda"``, ``"fr3"``); else
-    ``.urdf`` (the chain from ``base`` to ``tip``: :meth:`Robot.from_urdf`), ``.toml``
-    (:meth:`Robot.from_toml`) or ``.json`` (a ``feasible.json``,
+    ``.urdf`` (the chain from ``base`` to ``tip``: :func:`dynid.io.robot.urdf.load_urdf`),
+    ``.toml`` (:func:`dynid.io.robot.toml.load_toml`) or ``.json`` (a ``feasible.json``,
     :func:`dynid.io.feasible.load_feasible_json`). ``what`` names the option in errors.
 
     Raises
@@ -47,9 +47,13 @@ def load_robot(
     if not path.exists():
         raise DataError(f"{what}: {path} does not exist")
     if suffix == ".urdf":
-        return Robot.from_urdf(path, base_link=base, tip_link=tip)
+        from .robot.urdf import load_urdf
+
+        return load_urdf(path, base_link=base, tip_link=tip)
     if suffix == ".toml":
-        return Robot.from_toml(path)
+        from .robot.toml import load_toml
+
+        return load_toml(path)
     from .feasible import load_feasible_json
 
     return load_feasible_json(path)

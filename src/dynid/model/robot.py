@@ -434,31 +434,31 @@ class Robot:
             friction=None if friction is None else np.asarray(friction, dtype=np.float64),
         )
 
+    # The two file constructors are facades over dynid.io.robot, imported when called: the
+    # model layer holds no file format, and importing it loads no reader (tests/test_layers.py
+    # allows exactly these two deferred imports).
     @classmethod
     def from_urdf(
         cls, path: str | Path, base_link: str | None = None, tip_link: str | None = None
     ) -> Robot:
         """Serial chain of a URDF file between ``base_link`` and ``tip_link``.
 
-        See :func:`dynid.model.urdf.robot_from_urdf`.
+        The same as :func:`dynid.io.robot.urdf.load_urdf` (see it for the conventions,
+        Raises and Warns).
         """
-        from .urdf import robot_from_urdf
+        from ..io.robot.urdf import load_urdf
 
-        return robot_from_urdf(path, base_link=base_link, tip_link=tip_link)
+        return load_urdf(path, base_link=base_link, tip_link=tip_link)
 
     @classmethod
     def from_toml(cls, path: str | Path) -> Robot:
-        """Robot from a dynid TOML description (see :mod:`dynid.model.description`)."""
-        from .description import robot_from_toml
+        """Robot from a dynid TOML description file.
 
-        return robot_from_toml(path)
+        The same as :func:`dynid.io.robot.toml.load_toml` (see it for the schema and Raises).
+        """
+        from ..io.robot.toml import load_toml
 
-    def to_toml(self) -> str:
-        """The dynid TOML description of this robot (write it with
-        :func:`dynid.io.export.save_robot`: the model layer writes no files)."""
-        from .description import toml_from_robot
-
-        return toml_from_robot(self)
+        return load_toml(path)
 
     def __reduce__(self) -> tuple[Any, tuple[dict[str, Any]]]:
         """Pickle (and copy) by the model's fields, restored as they are, not re-validated

@@ -1,7 +1,10 @@
-"""Export a robot (e.g. with retrieved feasible parameters) as URDF for simulators.
+"""URDF robot descriptions: read a serial chain, write a robot, patch a template.
 
-:func:`urdf_from_robot` writes one ``<link>`` per link of the robot and one ``<joint>``
-per joint, keeping the robot's link and joint names:
+Reading (:func:`load_urdf`, :func:`robot_from_urdf_string`): the serial chain between a
+base and a tip link, fixed joints merged (:mod:`dynid.io.robot.urdf_parse` states the
+conventions). Writing (:func:`save_urdf`, :func:`urdf_from_robot`; a robot with retrieved
+feasible parameters, say, for simulators) gives one ``<link>`` per link of the robot and one
+``<joint>`` per joint, keeping the robot's link and joint names:
 
 * link ``i`` (1..n) carries an ``<inertial>``: ``<origin xyz="c_i" rpy="0 0 0"/>`` (the
   CoM in the link frame [m]), ``<mass value="m_i"/>`` [kg] and ``<inertia ixx ixy ixz iyy
@@ -19,10 +22,10 @@ per joint, keeping the robot's link and joint names:
   that link is written as a ``fixed`` joint ``<tip>_joint`` to a massless link ``<tip>``;
   when the tip is the last moving link itself nothing is added; otherwise (an MDH robot)
   a massless link ``flange`` is added. The file's only leaf is the tip, so
-  ``Robot.from_urdf(path)`` needs no ``tip_link``. With ``all_frames=True`` every other
+  :func:`load_urdf` needs no ``tip_link``. With ``all_frames=True`` every other
   named frame is written the same way (then load with ``tip_link=`` the tip's name).
 * with ``template=`` the original URDF is written back with only the chain's
-  ``<inertial>`` elements replaced (:func:`dynid.io.urdf_patch.patch_urdf_inertials`).
+  ``<inertial>`` elements replaced (:func:`dynid.io.robot.urdf_patch.patch_urdf_inertials`).
 
 Gravity is not part of URDF; identified linear friction (``dynamics=``) is written as
 ``<dynamics damping friction>`` per joint, the sigmoid is not. Numbers use Python's
@@ -38,14 +41,15 @@ from xml.sax.saxutils import quoteattr
 import numpy as np
 from numpy.typing import NDArray
 
-from .. import __version__, spatial
-from ..exceptions import ModelError
-from ..model.inertia import inertia6_from_matrix
-from ..model.robot import Robot
-from .atomic import write_text
+from ... import __version__, spatial
+from ...exceptions import ModelError
+from ...model.inertia import inertia6_from_matrix
+from ...model.robot import Robot
+from ..atomic import write_text
+from .urdf_parse import load_urdf, robot_from_urdf_string
 from .urdf_patch import patch_urdf_inertials
 
-__all__ = ["save_urdf", "tip_name", "urdf_from_robot"]
+__all__ = ["load_urdf", "robot_from_urdf_string", "save_urdf", "tip_name", "urdf_from_robot"]
 
 _BIG = sys.float_info.max
 
@@ -212,7 +216,7 @@ def save_urdf(
         Chain export only: also write every named frame (:func:`urdf_from_robot`).
     template : str or Path, optional
         The original URDF file: written back with only the chain's ``<inertial>``
-        elements replaced (:func:`dynid.io.urdf_patch.patch_urdf_inertials`, with
+        elements replaced (:func:`dynid.io.robot.urdf_patch.patch_urdf_inertials`, with
         ``base``, ``tip`` and ``merged``).
     dynamics : (ndarray, ndarray), optional
         Chain export only: per-joint damping and Coulomb friction (:func:`urdf_from_robot`).

@@ -7,7 +7,7 @@ formatting). The robot's link ``k`` must be the chain's moving link ``k``: the s
 number of joints and the same joint frames and axes (checked to 1e-9 m/rad).
 
 Merged fixed links. dynid lumps links fixed to moving link ``k`` (``panda_link8``, a
-hand) into body ``k`` (:mod:`dynid.model.urdf`). Two ways to write body ``k`` back:
+hand) into body ``k`` (:mod:`dynid.io.robot.urdf_parse`). Two ways to write body ``k`` back:
 
 * ``merged="subtract"`` (default): the fixed links keep their inertials and the moving
   link gets the rest, ``phi_k - sum(phi_fixed)``. When that rest is not physically
@@ -36,11 +36,11 @@ import xml.etree.ElementTree as ET
 import numpy as np
 from numpy.typing import NDArray
 
-from .. import _checks, spatial
-from ..exceptions import DynidWarning, ModelError
-from ..model.inertia import inertia6_from_matrix, inertial_from_phi, phi_from_inertial
-from ..model.robot import Robot
-from ..model.urdf import robot_from_urdf_string
+from ... import _checks, spatial
+from ...exceptions import DynidWarning, ModelError
+from ...model.inertia import inertia6_from_matrix, inertial_from_phi, phi_from_inertial
+from ...model.robot import Robot
+from .urdf_parse import robot_from_urdf_string
 
 __all__ = ["MERGED_POLICIES", "patch_urdf_inertials"]
 
@@ -150,7 +150,7 @@ def patch_urdf_inertials(
     robot : Robot
         The robot whose ``phi`` (n, 10) is written; its chain must match the template's.
     base, tip : str, optional
-        Chain of the template (defaults as in :func:`dynid.model.urdf.robot_from_urdf`).
+        Chain of the template (defaults as in :func:`dynid.io.robot.urdf.load_urdf`).
     merged : {"subtract", "move"}
         How body ``k`` is split over the moving link and the fixed links merged into it
         (module docstring).

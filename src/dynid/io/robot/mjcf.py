@@ -40,14 +40,14 @@ from xml.sax.saxutils import quoteattr
 import numpy as np
 from scipy.spatial.transform import Rotation
 
-from .. import __version__
-from ..exceptions import DynidWarning, ShapeError
-from ..friction.model import ClassicalFriction, DriveFriction
-from ..friction.mujoco import CoulombViscous, coulomb_viscous_from_sigmoid, drive_joint_terms
-from ..model.drive import Drive
-from ..model.inertia import inertia6_from_matrix
-from ..model.robot import Robot
-from .atomic import write_text
+from ... import __version__
+from ...exceptions import DynidWarning, ShapeError
+from ...friction.model import ClassicalFriction, DriveFriction
+from ...friction.mujoco import CoulombViscous, coulomb_viscous_from_sigmoid, drive_joint_terms
+from ...model.drive import Drive
+from ...model.inertia import inertia6_from_matrix
+from ...model.robot import Robot
+from ..atomic import write_text
 
 __all__ = ["mjcf_from_robot", "save_mjcf"]
 

@@ -1,8 +1,8 @@
-"""Serial chains read from URDF robot descriptions.
+"""Serial chains read from URDF text: the reading half of :mod:`dynid.io.robot.urdf`.
 
-:func:`robot_from_urdf` extracts the serial chain between a base link and a tip link of a
-URDF file and returns a :class:`~dynid.model.robot.Robot`; :func:`robot_from_urdf_string`
-does the same for URDF text. Only the standard library's ``xml.etree.ElementTree`` is used.
+:func:`robot_from_urdf_string` extracts the serial chain between a base link and a tip link
+of a URDF document and returns a :class:`~dynid.model.robot.Robot`; :func:`load_urdf` does
+the same for a file. Only the standard library's ``xml.etree.ElementTree`` is used.
 
 Conventions
 -----------
@@ -44,12 +44,12 @@ from pathlib import Path
 import numpy as np
 from numpy.typing import NDArray
 
-from .. import _checks, spatial
-from ..exceptions import DynidWarning, ModelError, UnknownNameError
-from .inertia import phi_from_inertial
-from .robot import MAX_LINK_MASS, Frame, Robot
+from ... import _checks, spatial
+from ...exceptions import DynidWarning, ModelError, UnknownNameError
+from ...model.inertia import phi_from_inertial
+from ...model.robot import MAX_LINK_MASS, Frame, Robot
 
-__all__ = ["robot_from_urdf", "robot_from_urdf_string"]
+__all__ = ["load_urdf", "robot_from_urdf_string"]
 
 _MOVING = {"revolute": False, "continuous": False, "prismatic": True}  # type -> prismatic
 _UNSUPPORTED = ("floating", "planar")
@@ -491,9 +491,7 @@ def _robot_from_text(
     )
 
 
-def robot_from_urdf(
-    path: str | Path, base_link: str | None = None, tip_link: str | None = None
-) -> Robot:
+def load_urdf(path: str | Path, base_link: str | None = None, tip_link: str | None = None) -> Robot:
     """Serial chain between ``base_link`` and ``tip_link`` of a URDF file.
 
     Parameters
@@ -527,7 +525,7 @@ def robot_from_urdf(
 
     Examples
     --------
-    >>> robot = robot_from_urdf("panda.urdf", "panda_link0", "panda_hand")  # doctest: +SKIP
+    >>> robot = load_urdf("panda.urdf", "panda_link0", "panda_hand")  # doctest: +SKIP
     >>> robot.joint_names[0]  # doctest: +SKIP
     'panda_joint1'
     """

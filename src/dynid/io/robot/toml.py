@@ -1,8 +1,8 @@
 """dynid's own TOML robot description, read and written.
 
-:func:`robot_from_toml` (or :func:`robot_from_toml_string`) reads a description,
-:func:`toml_from_robot` writes one. The description holds everything a
-:class:`~dynid.model.robot.Robot` holds: kinematics, inertial parameters, limits,
+:func:`load_toml` (or :func:`robot_from_toml_string`) reads a description,
+:func:`save_toml` (or :func:`toml_from_robot`) writes one. The description holds everything
+a :class:`~dynid.model.robot.Robot` holds: kinematics, inertial parameters, limits,
 friction, gravity and named frames. Units are SI throughout (m, rad, kg, kg m^2, s);
 angles are never in degrees. Writing and reading a robot gives the same robot to about
 1e-15 (floats are written with ``repr``).
@@ -31,12 +31,21 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
-from .. import _checks, spatial
-from ..exceptions import DynidError, ModelError
-from .inertia import inertia6_from_matrix, phi_from_inertial
-from .robot import MAX_LINK_MASS, STANDARD_GRAVITY, Frame, Robot, mdh_transform
+from ... import _checks, spatial
+from ...exceptions import DynidError, ModelError
+from ...model.drive import Drive
+from ...model.inertia import inertia6_from_matrix, phi_from_inertial
+from ...model.robot import MAX_LINK_MASS, STANDARD_GRAVITY, Frame, Robot, mdh_transform
+from ..atomic import write_text
+from ..drive_file import drive_toml
 
-__all__ = ["FORMAT_VERSION", "robot_from_toml", "robot_from_toml_string", "toml_from_robot"]
+__all__ = [
+    "FORMAT_VERSION",
+    "load_toml",
+    "robot_from_toml_string",
+    "save_toml",
+    "toml_from_robot",
+]
 
 #: Version of the schema written by :func:`toml_from_robot`.
 FORMAT_VERSION = 1
@@ -301,7 +310,7 @@ def robot_from_toml_string(text: str, *, source: str = "TOML text") -> Robot:
         raise ModelError(f"{source}: {exc}") from exc
 
 
-def robot_from_toml(path: str | Path) -> Robot:
+def load_toml(path: str | Path) -> Robot:
     """Robot from a dynid TOML description file (schema: see the module docstring).
 
     Parameters
@@ -372,7 +381,7 @@ def toml_from_robot(robot: Robot) -> str:
         The TOML document.
     """
     out = [
-        "# dynid robot description; schema: dynid.model.description",
+        "# dynid robot description; schema: dynid.io.robot.toml",
         "# units: m, rad, kg, kg m^2, s; inertia about the CoM, in link axes",
         f"format_version = {FORMAT_VERSION}",
         f"name = {_s(robot.name)}",
@@ -427,3 +436,25 @@ def toml_from_robot(robot: Robot) -> str:
             f"rpy = {rpy}",
         ]
     return "\n".join(out) + "\n"
+
+
+def save_toml(path: str | Path, robot: Robot, *, drive: Drive | None = None) -> Path:
+    """Write the TOML description of ``robot`` (:func:`toml_from_robot`) to ``path``.
+
+    Parameters
+    ----------
+    path : str or Path
+    robot : Robot
+    drive : Drive, optional
+        A drive train, written with the robot as a ``[drive]`` table
+        (:func:`dynid.io.drive_file.drive_toml`).
+
+    Returns
+    -------
+    Path
+        The path written.
+    """
+    text = toml_from_robot(robot)
+    if drive is not None:
+        text = text.rstrip("\n") + "\n\n" + drive_toml(drive)
+    return write_text(path, text)
