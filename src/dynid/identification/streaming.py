@@ -1,0 +1,551 @@
+"""Least squares over blocks of rows: the stacked regressor is never held whole.
+
+A long torque log stacks a regressor of millions of rows (5 million samples at 1 kHz,
+decimated by 20, of a 7-joint arm: 1.75 million rows of 65 columns, 0.9 GB, and the
+estimators' weighted copies on top). Here the rows come in blocks from a *block source*,
+a callable that returns a fresh iterable of ``(W_b, y_b, groups_b)`` (rows of the
+regressor, their targets, their noise groups) each time it is called, always in the same
+order; only small triangular factors are kept between blocks.
+
+**Factors by groups (one pass).** For every noise group ``g`` (a joint of a torque log,
+a row of ``[tril M; g]`` of static data) the triangular factor ``R_g`` (c+1, c+1) of
+``[W_g y_g]`` is updated block by block, ``R_g <- qr([R_g; W_gb y_gb])`` (a tall-skinny
+QR, TSQR; Demmel et al. 2012): the same factor as the QR of the whole stack, better
+conditioned than the normal equations ``W^T W`` (whose condition number is the square).
+From these factors alone:
+
+* the factor of all rows is the QR of ``[R_1; R_2; ...]`` and that of the rows weighted
+  by ``w_g`` per group the QR of ``[w_1 R_1; w_2 R_2; ...]`` (exact: ``diag(w) [W y] =
+  diag(w) Q R``);
+* the residual of any estimate in group ``g`` has norm ``||R_g [beta; -1]||`` (WLS's
+  per-group noise, the unweighted residual of a weighted fit);
+* the factor of a subset of the columns is the QR of those columns of ``R`` (pruning).
+
+The fit on a factor is the one of :func:`~dynid.identification.least_squares.fit_least_squares`
+(column-scaled Householder QR with column pivoting, its rank guard and statistics); the
+estimates and standard deviations agree with the stacked fit to about 1e-12 relative.
+
+**Passes over the data.** OLS and WLS with classical standard deviations take one pass;
+the heteroscedasticity-consistent covariance (``"robust"``) needs ``W^T diag(e^2) W`` of
+the final residual: one pass more (two with pruning). Huber IRLS reweights every row from
+the median of its group's residuals: two passes per iteration (the weighted factor, then
+the residuals), holding the residuals, weights and groups of every row (24 bytes a row,
+not ``8 c``).
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import os
+from collections.abc import Callable, Iterable
+from dataclasses import dataclass
+
+import numpy as np
+import scipy.linalg
+from numpy.typing import NDArray
+
+from .. import _checks
+from ..exceptions import DataError, NonFiniteError, OptionError, RankDeficientError, ShapeError
+from .estimators import IRLS, OLS, WLS, Estimator
+from .least_squares import LeastSquaresFit, _conditioning
+
+__all__ = [
+    "BLOCK_ROWS",
+    "BlockSource",
+    "GroupFactors",
+    "MAX_STACK_BYTES",
+    "fit_streamed",
+    "group_factors",
+    "max_stack_bytes",
+    "streams",
+]
+
+#: A source of row blocks: called once per pass, it returns ``(W_b (m_b, c), y_b (m_b,),
+#: groups_b (m_b,) int)`` triples in the same order every time.
+Block = tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.intp]]
+BlockSource = Callable[[], Iterable[Block]]
+
+#: Rows per block a source should aim at (about 17 MB of a 65-column regressor).
+BLOCK_ROWS = 32_768
+
+#: Largest stacked regressor [bytes] a route holds whole before it streams its rows
+#: (``DYNID_MAX_STACK_BYTES`` overrides): below it the stacked fit is the faster one.
+MAX_STACK_BYTES = 256 << 20
+
+_ENV = "DYNID_MAX_STACK_BYTES"
+
+
+def max_stack_bytes() -> int:
+    """The largest stacked regressor [bytes] held whole: ``DYNID_MAX_STACK_BYTES`` when
+    set (an integer number of bytes), else :data:`MAX_STACK_BYTES`.
+
+    Raises
+    ------
+    OptionError
+        ``DYNID_MAX_STACK_BYTES`` is not a non-negative integer.
+    """
+    text = os.environ.get(_ENV)
+    if text is None or not text.strip():
+        return MAX_STACK_BYTES
+    try:
+        value = int(text.strip())
+    except ValueError:
+        value = -1
+    if value < 0:
+        raise OptionError(f"{_ENV} must be a non-negative number of bytes; got {text!r}")
+    return value
+
+
+def streams(n_rows: int, n_columns: int) -> bool:
+    """True when a regressor of ``n_rows`` x ``n_columns`` float64 exceeds
+    :func:`max_stack_bytes` (the route then fits with :func:`fit_streamed`)."""
+    return 8 * int(n_rows) * (int(n_columns) + 1) > max_stack_bytes()
+
+
+@dataclass(frozen=True, slots=True, eq=False)
+class GroupFactors:
+    """Triangular factors of ``[W_g y_g]`` per noise group (module docstring).
+
+    Attributes
+    ----------
+    R : ndarray, shape (k, c + 1, c + 1)
+        Upper triangular factor of each group's rows (zero for a group without rows).
+    rows : ndarray of int, shape (k,)
+        Rows of each group.
+    groups : ndarray of int, shape (m,) or None
+        The group of every row in block order (kept for IRLS only).
+    """
+
+    R: NDArray[np.float64]
+    rows: NDArray[np.intp]
+    groups: NDArray[np.intp] | None = None
+
+    @property
+    def n_rows(self) -> int:
+        """Rows over all groups."""
+        return int(self.rows.sum())
+
+    def combined(self, w: NDArray[np.float64] | None = None) -> NDArray[np.float64]:
+        """The factor (c+1, c+1) of all rows, each group's rows times ``w[g]`` (default 1)."""
+        R = self.R if w is None else self.R * w[:, None, None]
+        return _triangular(R.reshape(-1, R.shape[-1]))
+
+    def residual_ss(self, beta: NDArray[np.float64]) -> NDArray[np.float64]:
+        """``||y_g - W_g beta||^2`` of each group (k,)."""
+        v = np.append(beta, -1.0)
+        r = self.R @ v
+        return np.einsum("kj,kj->k", r, r)
+
+    def target_ss(self) -> NDArray[np.float64]:
+        """``||y_g||^2`` of each group (k,)."""
+        return np.einsum("kj,kj->k", self.R[:, :, -1], self.R[:, :, -1])
+
+
+def _triangular(X: NDArray[np.float64]) -> NDArray[np.float64]:
+    """The upper triangular factor (c+1, c+1) of ``X`` (M, c+1), M >= c+1, zero-padded."""
+    k = X.shape[1]
+    R = scipy.linalg.qr(X, mode="r", overwrite_a=True, check_finite=False)[0][:k]
+    if R.shape[0] < k:
+        R = np.vstack([R, np.zeros((k - R.shape[0], k))])
+    return R
+
+
+def _blocks(source: BlockSource) -> Iterable[Block]:
+    """The source's blocks checked: shapes, finite values, integer groups."""
+    c = None
+    for W, y, g in source():
+        W = np.asarray(W, dtype=np.float64)
+        y = np.asarray(y, dtype=np.float64)
+        g = np.asarray(g, dtype=np.intp)
+        if W.ndim != 2 or y.shape != (W.shape[0],) or g.shape != y.shape:
+            raise ShapeError(
+                f"a regressor block must be W (m, c), y (m,), groups (m,); got {W.shape}, "
+                f"{y.shape}, {g.shape}"
+            )
+        if c is not None and W.shape[1] != c:
+            raise ShapeError(f"regressor blocks must all have {c} columns; got {W.shape[1]}")
+        c = W.shape[1]
+        if g.size and g.min() < 0:
+            raise ShapeError("noise groups must be non-negative integers")
+        _checks.finite("regressor", W)
+        _checks.finite("y", y)
+        yield W, y, g
+
+
+def group_factors(source: BlockSource, *, keep_groups: bool = False) -> GroupFactors:
+    """One pass over the blocks: the triangular factor of ``[W_g y_g]`` of every group.
+
+    Parameters
+    ----------
+    source : BlockSource
+    keep_groups : bool
+        Also return the group of every row (IRLS).
+
+    Raises
+    ------
+    ShapeError
+        Blocks of inconsistent shapes, negative groups, or no rows at all.
+    NonFiniteError
+        NaN or inf in a block.
+    """
+    R: dict[int, NDArray[np.float64]] = {}
+    rows: dict[int, int] = {}
+    seen: list[NDArray[np.intp]] = []
+    c = 0
+    for W, y, g in _blocks(source):
+        c = W.shape[1]
+        X = np.empty((W.shape[0], c + 1), order="F")
+        X[:, :c] = W
+        X[:, c] = y
+        for gv in np.unique(g):
+            sel = X[g == gv]
+            prev = R.get(int(gv))
+            R[int(gv)] = _triangular(sel if prev is None else np.vstack([prev, sel]))
+            rows[int(gv)] = rows.get(int(gv), 0) + sel.shape[0]
+        if keep_groups:
+            seen.append(g.copy())
+    if not R:
+        raise ShapeError("no regressor rows: the data hold no block")
+    k = max(R) + 1
+    out = np.zeros((k, c + 1, c + 1))
+    cnt = np.zeros(k, dtype=np.intp)
+    for gv, Rg in R.items():
+        out[gv], cnt[gv] = Rg, rows[gv]
+    groups = np.concatenate(seen) if keep_groups else None
+    return GroupFactors(R=out, rows=cnt, groups=groups)
+
+
+@dataclass(frozen=True, slots=True)
+class _Solved:
+    """A fit on a triangular factor, over the kept columns."""
+
+    rank: int
+    cond: float
+    cond_u: float
+    vmin: NDArray[np.float64]
+    beta: NDArray[np.float64]
+    ss: float
+    gi: NDArray[np.float64]  # (R^T R)^-1 of the column-scaled kept columns
+    scale: NDArray[np.float64]
+
+
+def _solve(
+    Raug: NDArray[np.float64],
+    m: int,
+    keep: NDArray[np.bool_],
+    rtol: float,
+    labels: tuple[str, ...] | None,
+) -> _Solved:
+    """The least-squares fit of the kept columns from the factor ``Raug`` of ``[W y]``."""
+    c = Raug.shape[1] - 1
+    idx = np.flatnonzero(keep)
+    rk = idx.size
+    T = Raug[:, np.append(idx, c)]
+    if rk < c:
+        T = _triangular(np.array(T))
+    A, b, rres = T[:rk, :rk], T[:rk, rk], float(T[rk, rk])
+    norms = np.sqrt(np.einsum("ij,ij->j", A, A))
+    scale = np.where(norms > 0, norms, 1.0)
+    Q, R, piv = scipy.linalg.qr(A / scale, mode="economic", pivoting=True)
+    d = np.abs(np.diag(R))
+    rank = int(np.sum(d > rtol * d[0])) if d.size and d[0] > 0 else 0
+    if m < rk:
+        raise RankDeficientError(
+            f"Regressor rank {rank} < {rk}: {m} rows for {rk} coefficients; add configurations"
+        )
+    cond, cond_u, vp = _conditioning(R, scale[piv])
+    vmin = np.empty(rk)
+    vmin[piv] = vp
+    if rank < rk:
+        raise RankDeficientError(
+            f"Regressor rank {rank} < {rk} at rtol={rtol:g} (scaled cond {cond:.3g}); add "
+            "configurations or excite the trajectory more, or drop unidentifiable parameters; "
+            f"nearly dependent columns: {_names(labels, vmin, idx)}"
+        )
+    z = scipy.linalg.solve_triangular(R, Q.T @ b)
+    bs = np.empty(rk)
+    bs[piv] = z
+    beta = bs / scale
+    r = A @ beta - b
+    Rinv = scipy.linalg.solve_triangular(R, np.eye(rk))
+    gi = np.empty((rk, rk))
+    gi[np.ix_(piv, piv)] = Rinv @ Rinv.T
+    ss = float(r @ r) + rres * rres
+    return _Solved(rank, cond, cond_u, vmin, beta, ss, gi, scale)
+
+
+def _names(labels: tuple[str, ...] | None, v: NDArray[np.float64], idx: NDArray[np.intp]) -> str:
+    """The kept columns with large weight in ``v``, named (largest first, at most 8)."""
+    a = np.abs(v)
+    if not a.size or not a.max() > 0:
+        return "?"
+    big = np.flatnonzero(a >= 0.1 * a.max())
+    cols = idx[big[np.argsort(-a[big])][:8]]
+    return ", ".join(labels[k] if labels is not None else f"column {k}" for k in cols)
+
+
+def _meat(
+    source: BlockSource,
+    beta: NDArray[np.float64],
+    keep: NDArray[np.bool_],
+    weights: Callable[[int, NDArray[np.intp]], NDArray[np.float64]] | None,
+) -> NDArray[np.float64]:
+    """``Ww^T diag(ew^2) Ww`` over the kept columns, ``Ww`` the weighted rows and ``ew``
+    the weighted residual of ``beta`` (one pass; HC1's middle factor)."""
+    rk = int(keep.sum())
+    meat = np.zeros((rk, rk))
+    o = 0
+    for W, y, g in _blocks(source):
+        Wk = W[:, keep]
+        e = y - Wk @ beta
+        if weights is not None:
+            w = weights(o, g)
+            Wk, e = Wk * w[:, None], e * w
+        We = Wk * e[:, None]
+        meat += We.T @ We
+        o += y.size
+    return meat
+
+
+def _fit_factor(
+    Raug: NDArray[np.float64],
+    m: int,
+    *,
+    keep: NDArray[np.bool_],
+    rtol: float,
+    covariance: str,
+    labels: tuple[str, ...] | None,
+    meat: Callable[[NDArray[np.float64], NDArray[np.bool_]], NDArray[np.float64]],
+) -> LeastSquaresFit:
+    """:func:`~dynid.identification.least_squares.fit_least_squares` from the factor of
+    ``[W y]`` (m rows); ``meat(beta, keep)`` gives HC1's middle factor by a pass."""
+    c = Raug.shape[1] - 1
+    s = _solve(Raug, m, keep, rtol, labels)
+    rk = s.beta.size
+    dof = max(m - rk, 1)
+    if covariance == "classical":
+        cov_s = s.gi * (s.ss / dof)
+    else:
+        mt = meat(s.beta, keep) / np.outer(s.scale, s.scale)
+        cov_s = s.gi @ mt @ s.gi * (m / dof)
+    if not (np.all(np.isfinite(s.beta)) and np.all(np.isfinite(cov_s)) and np.isfinite(s.ss)):
+        raise NonFiniteError(
+            "least squares overflowed: the data or the regressor hold values too large to be "
+            "measurements; check the data"
+        )
+    cov_k = cov_s / np.outer(s.scale, s.scale)
+    cov_k = 0.5 * (cov_k + cov_k.T)
+    sk = np.sqrt(np.maximum(np.diag(cov_k), 0.0))
+    beta, std, cov = np.zeros(c), np.zeros(c), np.zeros((c, c))
+    beta[keep], std[keep] = s.beta, sk
+    cov[np.ix_(keep, keep)] = cov_k
+    ny = float(np.linalg.norm(Raug[:, c]))
+    effect = np.zeros(c)
+    effect[keep] = 100.0 * sk * s.scale / ny if ny > 0 else 0.0
+    weakest = np.zeros(c)
+    weakest[keep] = s.vmin
+    with np.errstate(divide="ignore", invalid="ignore"):
+        pct = np.where(keep, 100.0 * std / np.abs(beta), np.nan)
+    pct = np.where(keep & (std == 0.0), 0.0, pct)
+    return LeastSquaresFit(
+        beta=_checks.frozen(beta),
+        std=_checks.frozen(std),
+        std_percent=_checks.frozen(pct),
+        kept=_checks.frozen(keep.copy()),
+        rank=s.rank,
+        condition_number=s.cond_u,
+        relative_error_percent=100.0 * np.sqrt(s.ss) / ny if ny > 0 else 0.0,
+        residual_rms=float(np.sqrt(s.ss / m)),
+        sigma=float(np.sqrt(s.ss / dof)),
+        n_rows=m,
+        rtol=rtol,
+        covariance=_checks.frozen(cov),
+        scaled_condition_number=s.cond,
+        weakest=_checks.frozen(weakest),
+        effect_percent=_checks.frozen(effect),
+    )
+
+
+def _fit_pruned(
+    Raug: NDArray[np.float64],
+    m: int,
+    *,
+    rtol: float,
+    covariance: str,
+    max_std_percent: float | None,
+    labels: tuple[str, ...] | None,
+    meat: Callable[[NDArray[np.float64], NDArray[np.bool_]], NDArray[np.float64]],
+) -> LeastSquaresFit:
+    """Fit, then (``max_std_percent``) remove the coefficients above it and re-fit once."""
+    keep = np.ones(Raug.shape[1] - 1, dtype=bool)
+    kw = {"rtol": rtol, "covariance": covariance, "labels": labels, "meat": meat}
+    fit = _fit_factor(Raug, m, keep=keep, **kw)  # type: ignore[arg-type]
+    if max_std_percent is None:
+        return fit
+    keep = ~(np.asarray(fit.std_percent) > max_std_percent)
+    if keep.all():
+        return fit
+    return _fit_factor(Raug, m, keep=keep, **kw)  # type: ignore[arg-type]
+
+
+def _unweighted(fit: LeastSquaresFit, F: GroupFactors) -> LeastSquaresFit:
+    """The fit with the residual statistics of the unweighted rows (as the estimators)."""
+    ss = float(F.residual_ss(np.asarray(fit.beta)).sum())
+    ny = float(np.sqrt(F.target_ss().sum()))
+    return dataclasses.replace(
+        fit,
+        relative_error_percent=100.0 * np.sqrt(ss) / ny if ny > 0 else 0.0,
+        residual_rms=float(np.sqrt(ss / max(F.n_rows, 1))),
+    )
+
+
+def _noise(F: GroupFactors, rtol: float) -> NDArray[np.float64]:
+    """WLS's noise std per group from the residual of a first OLS fit
+    (:func:`~dynid.identification.estimators.group_noise`)."""
+    m, c = F.n_rows, F.R.shape[-1] - 1
+    first = _solve(F.combined(), m, np.ones(c, dtype=bool), rtol, None)
+    ss = F.residual_ss(first.beta)
+    s = np.sqrt(ss / np.maximum(F.rows * (1.0 - c / max(m, 1)), 1.0))
+    pos = s[s > 0]
+    floor = float(pos.min()) if pos.size else 1.0
+    return np.where(s > 0, s, floor)
+
+
+def fit_streamed(
+    source: BlockSource,
+    estimator: Estimator,
+    *,
+    rtol: float,
+    covariance: str = "classical",
+    max_std_percent: float | None = None,
+    labels: tuple[str, ...] | None = None,
+) -> LeastSquaresFit:
+    """Fit ``W beta = y`` with an estimator over the blocks of ``source`` (module docstring).
+
+    The estimates and statistics are those of ``estimator.fit`` on the stacked rows
+    (:mod:`dynid.identification.estimators`), to rounding.
+
+    Parameters
+    ----------
+    source : BlockSource
+        Blocks ``(W_b (m_b, c), y_b (m_b,), groups_b (m_b,))``, the same at every call.
+    estimator : OLS, WLS or IRLS
+    rtol : float
+        Relative rank tolerance on the diagonal of R of the column-scaled regressor.
+    covariance : {"classical", "robust"}
+    max_std_percent : float, optional
+        Remove the coefficients above this relative standard deviation and re-fit once.
+    labels : tuple of str, length c, optional
+        Column names for a rank-deficiency message.
+
+    Raises
+    ------
+    OptionError
+        An estimator other than OLS, WLS, IRLS (they need the stacked rows), or an unknown
+        ``covariance``.
+    ShapeError
+        Inconsistent blocks.
+    NonFiniteError
+        NaN or inf in a block.
+    RankDeficientError
+        Rank below the column count.
+    """
+    if covariance not in ("classical", "robust"):
+        raise OptionError(f"covariance must be 'classical' or 'robust'; got {covariance!r}")
+    if not isinstance(estimator, OLS | WLS | IRLS):
+        raise OptionError(
+            f"estimator {estimator.name!r} needs the whole regressor, which is too large here "
+            f"to hold; use ols, wls or irls, or raise {_ENV}"
+        )
+    F = group_factors(source, keep_groups=isinstance(estimator, IRLS))
+    m = F.n_rows
+    kw = {"rtol": rtol, "max_std_percent": max_std_percent, "labels": labels}
+    if isinstance(estimator, OLS):
+        return _fit_pruned(
+            F.combined(),
+            m,
+            covariance=covariance,
+            meat=lambda b, k: _meat(source, b, k, None),
+            **kw,  # type: ignore[arg-type]
+        )
+    s0 = _noise(F, rtol)
+    if isinstance(estimator, WLS):
+        wg = 1.0 / s0
+        fit = _fit_pruned(
+            F.combined(wg),
+            m,
+            covariance=covariance,
+            meat=lambda b, k: _meat(source, b, k, lambda o, g: wg[g]),
+            **kw,  # type: ignore[arg-type]
+        )
+        return _unweighted(fit, F)
+    return _irls(source, estimator, F, s0, covariance=covariance, **kw)  # type: ignore[arg-type]
+
+
+def _irls(
+    source: BlockSource,
+    est: IRLS,
+    F: GroupFactors,
+    s0: NDArray[np.float64],
+    *,
+    rtol: float,
+    covariance: str,
+    max_std_percent: float | None,
+    labels: tuple[str, ...] | None,
+) -> LeastSquaresFit:
+    """Huber IRLS as :class:`~dynid.identification.estimators.IRLS`, two passes an
+    iteration (the weighted factor, the residuals)."""
+    assert F.groups is not None
+    groups = F.groups
+    m, c = F.n_rows, F.R.shape[-1] - 1
+    present = np.flatnonzero(F.rows)
+    w = 1.0 / s0[groups]
+    e = np.empty(m)
+    beta = None
+    for _ in range(est.max_iter):
+        Rw = _weighted_factor(source, w, c)
+        fb = _solve(Rw, m, np.ones(c, dtype=bool), rtol, labels).beta
+        o = 0
+        for W, y, _g in _blocks(source):
+            np.subtract(y, W @ fb, out=e[o : o + y.size])
+            o += y.size
+        if o != m:
+            raise DataError(f"the regressor blocks changed between passes ({o} rows, then {m})")
+        s = s0.copy()
+        for gv in present:
+            mad = float(np.median(np.abs(e[groups == gv])))
+            if mad > 0:
+                s[gv] = 1.4826 * mad
+        u = np.abs(e) / s[groups]
+        w = np.sqrt(np.minimum(1.0, est.c / np.maximum(u, 1e-300))) / s[groups]
+        done = beta is not None and np.linalg.norm(fb - beta) <= est.tol * max(
+            float(np.linalg.norm(fb)), 1e-300
+        )
+        beta = fb
+        if done:
+            break
+    del e
+    fit = _fit_pruned(
+        _weighted_factor(source, w, c),
+        m,
+        rtol=rtol,
+        covariance=covariance,
+        max_std_percent=max_std_percent,
+        labels=labels,
+        meat=lambda b, k: _meat(source, b, k, lambda o, g: w[o : o + g.size]),
+    )
+    return _unweighted(fit, F)
+
+
+def _weighted_factor(source: BlockSource, w: NDArray[np.float64], c: int) -> NDArray[np.float64]:
+    """The factor (c+1, c+1) of ``diag(w) [W y]`` over every row (one pass)."""
+    R = np.zeros((c + 1, c + 1))
+    o = 0
+    for W, y, _g in _blocks(source):
+        X = np.empty((y.size, c + 1), order="F")
+        wb = w[o : o + y.size]
+        np.multiply(W, wb[:, None], out=X[:, :c])
+        np.multiply(y, wb, out=X[:, c])
+        R = _triangular(np.vstack([R, X]))
+        o += y.size
+    return R

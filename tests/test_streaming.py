@@ -1,0 +1,126 @@
+"""Least squares over blocks of rows (identification/streaming.py, issue 20 item 5).
+
+References: the stacked estimators of identification/estimators.py on the same rows
+(a different algorithm: the whole regressor, semi-normal equations or one QR) and
+numpy's lstsq (SVD) for the ordinary and weighted estimates.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from dynid.exceptions import NonFiniteError, OptionError, RankDeficientError, ShapeError
+from dynid.identification.estimators import IRLS, OLS, WLS
+from dynid.identification.streaming import (
+    fit_streamed,
+    group_factors,
+    max_stack_bytes,
+    streams,
+)
+
+
+def _problem(seed: int, m: int = 6000, c: int = 6, k: int = 3, weak: float = 1.0):
+    """Rows in ``k`` noise groups of very different noise, columns of very different
+    scale, 3 % of the rows hit by outliers."""
+    rng = np.random.default_rng(seed)
+    W = rng.normal(size=(m, c)) * np.logspace(-2, 2, c)
+    W[:, 2] *= weak
+    beta = rng.normal(size=c)
+    groups = np.arange(m) % k
+    sig = np.logspace(-2, 0, k)
+    y = W @ beta + rng.normal(size=m) * sig[groups]
+    bad = rng.choice(m, m // 33, replace=False)
+    y[bad] += rng.normal(scale=20.0, size=bad.size)
+    return W, y, groups
+
+
+def _source(W, y, g, step: int):
+    return lambda: (
+        (W[a : a + step], y[a : a + step], g[a : a + step]) for a in range(0, y.size, step)
+    )
+
+
+def _same(a, b, rtol=1e-10):
+    np.testing.assert_allclose(a.beta, b.beta, rtol=rtol, atol=1e-13)
+    np.testing.assert_allclose(a.std, b.std, rtol=rtol, atol=1e-15)
+    np.testing.assert_array_equal(a.kept, b.kept)
+    for f in ("sigma", "relative_error_percent", "residual_rms", "condition_number"):
+        assert getattr(a, f) == pytest.approx(getattr(b, f), rel=1e-9), f
+    assert a.scaled_condition_number == pytest.approx(b.scaled_condition_number, rel=1e-9)
+    assert a.n_rows == b.n_rows and a.rank == b.rank
+
+
+@pytest.mark.parametrize("est", [OLS(), WLS(), IRLS()], ids=["ols", "wls", "irls"])
+@pytest.mark.parametrize("cov", ["classical", "robust"])
+def test_streamed_fit_equals_the_stacked_fit(est, cov):
+    """Blocks of 700 rows (groups split unevenly across them) give the stacked estimator's
+    estimates, standard deviations and statistics to 1e-10 relative."""
+    W, y, g = _problem(3)
+    ref = est.fit(W, y, g, rtol=1e-10, covariance=cov)
+    got = fit_streamed(_source(W, y, g, 700), est, rtol=1e-10, covariance=cov)
+    _same(got, ref)
+
+
+@pytest.mark.parametrize("est", [OLS(), WLS(), IRLS()], ids=["ols", "wls", "irls"])
+def test_streamed_pruning_equals_the_stacked_pruning(est):
+    """With --max-std-percent the same coefficients are removed and the re-fit agrees."""
+    W, y, g = _problem(4, weak=1e-4)  # column 2's coefficient is lost in the noise
+    ref = est.fit(W, y, g, rtol=1e-10, covariance="robust", max_std_percent=30.0)
+    assert not np.all(ref.kept)
+    got = fit_streamed(
+        _source(W, y, g, 999), est, rtol=1e-10, covariance="robust", max_std_percent=30.0
+    )
+    _same(got, ref)
+
+
+def test_ordinary_and_weighted_estimates_equal_lstsq():
+    """OLS equals numpy's SVD least squares; the factors of the groups reproduce each
+    group's residual norm, and the weighted factor the weighted least squares."""
+    W, y, g = _problem(5, k=4)
+    F = group_factors(_source(W, y, g, 512))
+    fit = fit_streamed(_source(W, y, g, 512), OLS(), rtol=1e-10)
+    ref = np.linalg.lstsq(W, y, rcond=None)[0]
+    np.testing.assert_allclose(fit.beta, ref, rtol=1e-11)
+    e = y - W @ ref
+    np.testing.assert_allclose(
+        F.residual_ss(ref), [np.sum(e[g == j] ** 2) for j in range(4)], rtol=1e-10
+    )
+    w = np.array([1.0, 2.0, 0.5, 3.0])
+    Rw = F.combined(w)
+    c = W.shape[1]
+    wref = np.linalg.lstsq(W * w[g][:, None], y * w[g], rcond=None)[0]
+    np.testing.assert_allclose(np.linalg.solve(Rw[:c, :c], Rw[:c, c]), wref, rtol=1e-10)
+    assert F.n_rows == y.size and list(F.rows) == [np.sum(g == j) for j in range(4)]
+
+
+def test_rank_deficiency_and_bad_blocks_are_named():
+    """A dependent column is named; NaN, ragged blocks and another estimator are refused."""
+    rng = np.random.default_rng(6)
+    W = rng.normal(size=(400, 3))
+    W[:, 2] = 2 * W[:, 0]
+    y = rng.normal(size=400)
+    g = np.zeros(400, dtype=np.intp)
+    with pytest.raises(RankDeficientError, match="a, c|c, a"):
+        fit_streamed(_source(W, y, g, 100), OLS(), rtol=1e-10, labels=("a", "b", "c"))
+    W[5, 1] = np.nan
+    with pytest.raises(NonFiniteError, match="regressor"):
+        fit_streamed(_source(W, y, g, 100), OLS(), rtol=1e-10)
+    with pytest.raises(ShapeError):
+        fit_streamed(lambda: iter([(W[:10], y[:9], g[:10])]), OLS(), rtol=1e-10)
+
+    class Other:
+        name = "other"
+
+    with pytest.raises(OptionError, match="DYNID_MAX_STACK_BYTES"):
+        fit_streamed(_source(W, y, g, 100), Other(), rtol=1e-10)  # type: ignore[arg-type]
+
+
+def test_stack_limit_from_the_environment(monkeypatch):
+    """DYNID_MAX_STACK_BYTES sets when a route streams; a bad value is one OptionError."""
+    monkeypatch.setenv("DYNID_MAX_STACK_BYTES", "8000")
+    assert max_stack_bytes() == 8000
+    assert streams(101, 9) and not streams(100, 9)  # 8 bytes x 100 x (9 + 1)
+    monkeypatch.setenv("DYNID_MAX_STACK_BYTES", "lots")
+    with pytest.raises(OptionError, match="DYNID_MAX_STACK_BYTES"):
+        max_stack_bytes()
