@@ -76,6 +76,7 @@ def _complete_set(folder: Path) -> list[str]:
 CONSISTENT_SET = [
     "feasible.json",
     "identification.json",
+    "report.html",
     "report.json",
     "retrieval.png",
     "robot.toml",
@@ -108,7 +109,12 @@ def test_a_rerun_replaces_the_set_as_a_whole(data, tmp_path):
     (out / "notes.txt").write_text("mine\n")
     r = _run("identify", "--data", str(data / "s4.csv"), "--out", str(out), "-q")
     assert r.returncode == 0, r.stderr
-    assert sorted(p.name for p in out.iterdir()) == [MANIFEST, "identification.json", "notes.txt"]
+    assert sorted(p.name for p in out.iterdir()) == [
+        MANIFEST,
+        "identification.json",
+        "notes.txt",
+        "report.html",
+    ]
     assert (out / "notes.txt").read_text() == "mine\n"
     assert "s4.csv" in json.loads((out / MANIFEST).read_text())["argv"][3]
     assert _staging(tmp_path) == []

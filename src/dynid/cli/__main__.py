@@ -14,6 +14,8 @@ moves the complete set into place when it succeeds; a rerun of the same command 
 the previous set as a whole (its files that the new run does not write are removed). A
 folder holding another command's outputs, a file no dynid run wrote, or a read-only file
 is not replaced without --force. Concurrent runs into one folder never mix their files.
+A command that writes a folder also writes report.html there: one page with the run's
+inputs, results, figures, warnings and notes.
 """
 
 from __future__ import annotations
@@ -33,8 +35,8 @@ from collections.abc import Iterator, Sequence
 from .._checks import one_line
 from ..exceptions import DynidError
 from ..io.atomic import output_transaction
-from ..io.run_output import run_output
-from .run_report import RunRecord
+from ..io.run_output import RunOutput, run_output
+from .run_report import RunRecord, save_run_report
 
 #: Longest error line printed [characters]: a message echoing megabytes of input keeps
 #: its start and its end (the hint).
@@ -190,7 +192,7 @@ def _printable_streams() -> None:
 
 
 @contextlib.contextmanager
-def _output_set(args: argparse.Namespace, argv: Sequence[str]) -> Iterator[object]:
+def _output_set(args: argparse.Namespace, argv: Sequence[str]) -> Iterator[RunOutput | None]:
     """The run's output set under ``--out`` (:func:`dynid.io.run_output.run_output`)."""
     kind, out = getattr(args, "_output", None), getattr(args, "out", None)
     if kind is None or out is None:
@@ -227,9 +229,11 @@ def main(argv: Sequence[str] | None = None) -> int:
             record,
             _signals_and_warnings(args.command),
             output_transaction(),
-            _output_set(args, argv),
+            _output_set(args, argv) as run,
         ):
             code = int(args._run(args) or 0)
+            if run is not None and run.kind == "folder":
+                save_run_report(run, record, args, argv, code)
         if record.stdout_closed:
             _drop_stdout()
             return STDOUT_CLOSED

@@ -1,20 +1,28 @@
-"""What a run printed and warned.
+"""What a run printed and warned, and the report made of it.
 
 :class:`RunRecord` stands in for ``sys.stdout`` and ``sys.stderr`` during a command: it
 passes everything through, keeps a copy (the printed summary, the warning and note lines)
 and keeps a closed stdout (``dynid fk ... | head -1``) from failing the run: what cannot
 be printed is dropped and :attr:`RunRecord.stdout_closed` says so.
+
+:func:`save_run_report` writes ``report.html`` (:mod:`dynid.io.html_report`) into a
+command's output folder from that record and the files the run wrote.
 """
 
 from __future__ import annotations
 
+import argparse
 import contextlib
 import logging
 import sys
 import time
+from collections.abc import Sequence
 from typing import Any, TextIO
 
-__all__ = ["RunRecord"]
+from ..io.html_report import REPORT_NAME, ReportTable, RunSummary, save_html_report
+from ..io.run_output import RunOutput
+
+__all__ = ["RunRecord", "save_run_report"]
 
 
 class _Tee:
@@ -105,3 +113,52 @@ class _Collect(logging.Handler):
     def emit(self, record: logging.LogRecord) -> None:
         with contextlib.suppress(Exception):
             self._into.append(record.getMessage())
+
+
+def save_run_report(
+    run: RunOutput,
+    record: RunRecord,
+    args: argparse.Namespace,
+    argv: Sequence[str],
+    code: int,
+) -> None:
+    """Write ``report.html`` into the run's output folder (staged with its other files).
+
+    Parameters
+    ----------
+    run : RunOutput
+        The run's output set (a folder).
+    record : RunRecord
+        What the run printed, warned and noted, and the tables it added.
+    args : argparse.Namespace
+        The parsed options (every option and its value is listed in the report).
+    argv : sequence of str
+        The command line after ``dynid``.
+    code : int
+        The run's exit status.
+
+    Raises
+    ------
+    OSError
+        The report cannot be written.
+    """
+    options = tuple(
+        (f"--{k.replace('_', '-')}", "" if v is None else str(v))
+        for k, v in sorted(vars(args).items())
+        if not k.startswith("_") and k != "command"
+    )
+    summary = RunSummary(
+        command=args.command,
+        argv=("dynid", *argv),
+        options=options,
+        printed=record.printed,
+        warnings=tuple(record.lines("warning: ")),
+        notes=tuple(record.lines("note: ")),
+        tables=tuple(
+            ReportTable(title, tuple(head), tuple(map(tuple, rows)))
+            for title, head, rows in record.tables
+        ),
+        exit_code=code,
+        elapsed_s=time.time() - record.started,
+    )
+    save_html_report(run.out / REPORT_NAME, summary, run.written())
