@@ -9,17 +9,11 @@ from __future__ import annotations
 
 import base64
 import json
-import shutil
 import struct
-import subprocess
 import urllib.parse
 import zlib
 from html.parser import HTMLParser
-from pathlib import Path
 
-import pytest
-
-from dynid.cli.__main__ import main
 from dynid.io.html_report import (
     REPORT_NAME,
     ReportTable,
@@ -108,7 +102,7 @@ def _png(width: int, height: int, seed: int) -> bytes:
     )
 
 
-HOSTILE = 'données <b>&amp;"x\' #?%'
+HOSTILE = "données <b>&amp;\"x' #?%"
 
 
 def test_user_text_is_escaped_everywhere(tmp_path):
