@@ -131,7 +131,7 @@ def test_another_commands_folder_and_foreign_files_need_force(data, tmp_path):
     assert r.returncode == 2
     assert r.stderr.strip() == (
         f"dynid retrieve: error: --out {out}: holds the outputs of `dynid identify` "
-        "(identification.json); choose another --out or pass --force to write into it"
+        "(identification.json, report.html); choose another --out or pass --force to write into it"
     )
     assert _snapshot(out) == before
     theirs = tmp_path / "theirs"
