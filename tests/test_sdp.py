@@ -233,7 +233,7 @@ def test_specifications_that_exclude_the_robot_are_reported_not_hidden():
     assert any("--margin" in s for s in tight.notes)
     heavy = retrieve_sdp(model, prior=robot, total_mass=(19.5, 20.0))
     assert heavy.robot.mass.sum() >= 19.5 - 1e-6
-    assert any("set by the bounds" in s and "total mass" in s for s in heavy.notes)
+    assert any("decided by the bound, not the data" in s and "total mass" in s for s in heavy.notes)
     no_cov = dataclasses.replace(model, fit=dataclasses.replace(model.fit, covariance=None))
     assert any("no covariance" in s for s in retrieve_sdp(no_cov, prior=robot).notes)
     bad = dataclasses.replace(

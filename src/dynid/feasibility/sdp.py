@@ -24,9 +24,14 @@ residual sum of squares in units of its noise variance (``Delta chi^2``).
   or on static ``[tril M; g]`` data. The data term is then exactly
   ``||W x - y||^2 / sigma^2`` up to a constant, ``W`` the stacked regressor.
 
-**The prior's weight** ``w``: by default the largest weight (over a logarithmic search)
-whose fit keeps the identification's residual RMS within ``residual_increase`` (1 %) of the
-unconstrained least squares, ``Delta chi^2 <= ((1 + 0.01)^2 - 1) dof``: the prior decides
+**The prior's weight** ``w``: when the data term holds held-out folds (torque logs: k-fold
+over contiguous time blocks, or a separate log), the largest weight whose *held-out* error
+is within ``residual_increase`` (1 %) of the best, and the result is accepted when its
+held-out error is within ``heldout_tol`` (5 %) of unconstrained least squares', whatever its
+training residual (:mod:`dynid.feasibility.heldout`). Otherwise (static data,
+coefficients) the largest weight (over a logarithmic search) whose fit keeps the
+identification's residual RMS within ``residual_increase`` (1 %) of the unconstrained
+least squares, ``Delta chi^2 <= ((1 + 0.01)^2 - 1) dof``. Either way the prior decides
 only what the data leave open. A larger weight trusts the prior more.
 
 **Margin** ``epsilon`` (default 1e-4): ``lambda_min(J) >= epsilon tr(J)`` for every link;
@@ -58,6 +63,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from ..exceptions import DataError, InfeasibleError, ModelError, ShapeError, SolverError
+from ..identification.holdout import HeldOut, cross_validate
 from ..identification.least_squares import LeastSquaresFit
 from ..identification.model import IdentifiedModel
 from ..model.drive import Drive
@@ -65,6 +71,7 @@ from ..model.inertia import inertial_from_phi, params_from_inertial
 from ..model.robot import Robot
 from .bounds import Bounds, default_bounds, segment_points
 from .constraints import Constraint, FeasibilityReport, feasibility_report
+from .heldout import DEFAULT_HELDOUT_TOL, HeldOutJudgement, search_weight
 from .lmi import (
     log_det_divergence,
     pseudo_inertia,
@@ -135,7 +142,10 @@ class SDPOptions:
         a residual RMS at most ``residual_tol`` (default 10 %) above the unconstrained
         fit's. Beyond it the result is reported not consistent with the specification: the
         constraints (margin, bounds, total-mass band) or the prior exclude what the data
-        say.
+        say. Not used when the data term holds held-out folds (``heldout_tol`` decides).
+    heldout_tol : float
+        With held-out folds: ``data_fit`` holds when the consistent fit's held-out error is
+        at most this fraction (default 5 %) above unconstrained least squares'.
     tol : float
         Relative tolerance of the feasibility report.
     """
@@ -147,6 +157,7 @@ class SDPOptions:
     fit: str = "auto"
     mass_factor: float | None = 3.0
     residual_tol: float = 0.10
+    heldout_tol: float = DEFAULT_HELDOUT_TOL
     tol: float = 1e-9
 
     def __post_init__(self) -> None:
@@ -194,6 +205,10 @@ class DataTerm:
         Names of the entries of ``x``.
     notes : tuple of str
         What the user should know about the data term (a missing covariance).
+    holdout : HeldOut, optional
+        Normal equations of the held-out folds over the entries of ``x``
+        (:mod:`dynid.identification.holdout`): the weight and the acceptance are then
+        judged on held-out data.
     """
 
     P: NDArray[np.float64]
@@ -205,6 +220,7 @@ class DataTerm:
     friction_index: NDArray[np.intp] | None = None
     labels: tuple[str, ...] = ()
     notes: tuple[str, ...] = ()
+    holdout: HeldOut | None = None
 
     @property
     def r(self) -> int:
@@ -284,6 +300,9 @@ def coefficient_term(model: IdentifiedModel, *, with_friction: bool = False) -> 
         )
         if kk
     )
+    held = model.holdout
+    if held is not None and held.whole.p != kept.size:
+        held = None  # folds over other columns (friction left out of the term)
     return DataTerm(
         P=P,
         x_hat=x_hat,
@@ -294,6 +313,7 @@ def coefficient_term(model: IdentifiedModel, *, with_friction: bool = False) -> 
         friction_index=np.flatnonzero(kept[r_all:]) if k else None,
         labels=labels,
         notes=notes,
+        holdout=None if held is None else held.restricted(np.flatnonzero(kept)),
     )
 
 
@@ -357,6 +377,12 @@ class ConsistentResult:
     drive : Drive or None
         The drive train of the data, its rotor inertias those of the result
         (:func:`with_drive`).
+    heldout : HeldOutJudgement or None
+        Training and held-out errors against least squares, the weight's choice and the
+        acceptance, when the data term holds held-out folds.
+    on_bound : tuple of str
+        Parameters that sit on a bound (mass box, CoM box, total-mass band): decided by the
+        bound, not the data.
     """
 
     robot: Robot
@@ -385,6 +411,8 @@ class ConsistentResult:
     identified: IdentifiedModel | None = None
     rotor_inertia: NDArray[np.float64] | None = None
     drive: Drive | None = None
+    heldout: HeldOutJudgement | None = None
+    on_bound: tuple[str, ...] = ()
 
     @property
     def mass(self) -> NDArray[np.float64]:
@@ -628,10 +656,11 @@ def _active_and_implausible(
     I: NDArray[np.float64],
     bounds: Bounds,
     band: tuple[float, float] | None,
-) -> list[str]:
+) -> tuple[list[str], list[str]]:
     """Notes: the bounds the result sits on (they, not the data, decided those values) and
     links whose mass or size is implausible (a link under 1 % of the total mass, or a
-    radius of gyration about the CoM over 1.5 times the link's extent)."""
+    radius of gyration about the CoM over 1.5 times the link's extent); and the parameters
+    on a bound, one string each."""
     out: list[str] = []
     names = robot.link_names[1:]
     act: list[str] = []
@@ -651,7 +680,7 @@ def _active_and_implausible(
             if abs(M - b) <= 1e-4 * max(band[1] - band[0], 1e-3):
                 act.append(f"total mass {M:.4g} kg at the {side} end of its band")
     if act:
-        out.append("set by the bounds, not by the data: " + "; ".join(act))
+        out.append("decided by the bound, not the data: " + "; ".join(act))
     M = float(m.sum())
     lam = np.linalg.eigvalsh(I)
     for i in range(robot.n):
@@ -665,7 +694,7 @@ def _active_and_implausible(
                 f"more than 1.5 times its extent of {ext:.3g} m (rotor inertia the link "
                 "absorbed, or inertia the data cannot see)"
             )
-    return out
+    return out, act
 
 
 def _finish(
@@ -685,6 +714,7 @@ def _finish(
     t0: float,
     notes: list[str],
     ia: NDArray[np.float64] | None = None,
+    judgement: HeldOutJudgement | None = None,
 ) -> ConsistentResult:
     if f is not None and term.n_friction:
         f = f.copy()
@@ -692,7 +722,8 @@ def _finish(
         f[nonneg] = np.maximum(f[nonneg], 0.0)  # fv, fc >= 0 held to the solver's tolerance
     m, c, I = inertial_from_phi(phi)
     out = robot.with_params(phi)
-    notes = notes + _active_and_implausible(robot, m, c, I, bounds, band)
+    found, act = _active_and_implausible(robot, m, c, I, bounds, band)
+    notes = notes + found
     x = _x(term, phi, f, ia)
     beta = term.x_hat[: term.r]
     nb = float(np.linalg.norm(beta))
@@ -706,6 +737,16 @@ def _finish(
     ]
     if fit == "equality":
         extra.append(Constraint("data_fit", None, 1e-6 - rel, "1", bool(rel <= 1e-6)))
+    elif judgement is not None:
+        extra.append(_heldout_fit(judgement))
+        if not judgement.accepted:
+            notes = notes + [
+                f"the result predicts held-out torques {100 * (judgement.ratio - 1):.3g} % worse "
+                f"than least squares (more than {100 * judgement.tolerance:g} %): the "
+                f"constraints (margin {options.margin:g}, bounds, total-mass band) or the "
+                "prior's weight exclude what the data say; check --margin, --total-mass, "
+                "--bounds and --prior-weight"
+            ]
     else:
         over = ratio - 1.0
         tol = options.residual_tol
@@ -744,7 +785,15 @@ def _finish(
         total_mass=band,
         options=options,
         notes=tuple(prior.notes) + tuple(notes),
+        heldout=judgement,
+        on_bound=tuple(act),
     )
+
+
+def _heldout_fit(j: HeldOutJudgement) -> Constraint:
+    """``data_fit`` judged on held-out data: the tolerance minus the excess over least
+    squares' held-out error (>= 0 holds)."""
+    return Constraint("data_fit", None, j.tolerance - (j.ratio - 1.0), "1", j.accepted)
 
 
 def solve_consistent(
@@ -834,9 +883,26 @@ def solve_consistent(
         w: float,
         fit: str,
         status: str,
+        judgement: HeldOutJudgement | None = None,
     ) -> ConsistentResult:
         return _finish(
-            robot, phi, f, term, pr, w, search, nb, band, opts, fit, status, kind, t0, notes, ia
+            robot,
+            phi,
+            f,
+            term,
+            pr,
+            w,
+            search,
+            nb,
+            band,
+            opts,
+            fit,
+            status,
+            kind,
+            t0,
+            notes,
+            ia,
+            judgement,
         )
 
     if equality:
@@ -857,6 +923,17 @@ def solve_consistent(
             f = term.x_hat[term.r :].copy()
         return finish(phi, f, ia, 1.0, "equality", status)
     prob = _Problem(*common, False, False, friction_nonneg, constraints)
+    if term.holdout is not None:
+        folds = [
+            _Problem(ft, *common[1:], False, False, friction_nonneg, constraints)
+            for ft in _fold_terms(term, term.holdout)
+        ]
+        w, judgement = _judged(folds, term.holdout, opts)
+        status = _solved(prob, w)
+        values = prob.values()
+        judgement = _with_training(judgement, term.holdout, _x(term, *values))
+        notes.append(f"prior weight {w:.3g}: {judgement.choice}")
+        return finish(*values, w, "weighted", status, judgement)
     if opts.prior_weight is not None:
         status = prob.solve(opts.prior_weight)
         if status.startswith("infeasible"):
@@ -883,6 +960,78 @@ def solve_consistent(
             )
         )
     return finish(phi, f, ia, w, "weighted", status)
+
+
+def _solved(prob: _Problem, w: float) -> str:
+    """Solve at ``w``; an infeasible problem raises."""
+    status = prob.solve(w)
+    if status.startswith("infeasible"):
+        raise InfeasibleError("the bounds and constraints admit no consistent parameters")
+    return status
+
+
+def _fold_terms(term: DataTerm, held: HeldOut) -> list[DataTerm]:
+    """The data term of each fold's training rows, ``||W x - y||^2 / sigma^2`` up to a
+    constant, ``sigma`` the noise of the fit on all data."""
+    out = []
+    for t in held.train:
+        out.append(
+            dataclasses.replace(
+                term,
+                x_hat=t.solve(),
+                A=t.sqrt() / max(held.noise, 1e-300),
+                dof=max(t.rows - t.p, 1),
+                exact=False,
+                holdout=None,
+            )
+        )
+    return out
+
+
+def _judged(
+    folds: list[_Problem],
+    held: HeldOut,
+    opts: SDPOptions,
+) -> tuple[float, HeldOutJudgement]:
+    """The weight (the given one, or :func:`~dynid.feasibility.heldout.search_weight`) and
+    the held-out errors of the consistent fit and of least squares over the folds. The folds
+    are solved at ``w`` times their share of the rows (the full fit's balance of data and
+    prior); the training errors are filled in by :func:`replace_training`."""
+    share = held.training_share
+    fold_terms = [p.term for p in folds]
+
+    def heldout_at(w: float) -> float:
+        xs = []
+        for p, ft in zip(folds, fold_terms, strict=True):
+            _solved(p, w * share)
+            xs.append(_x(ft, *p.values()))
+        return held.heldout_error_percent(xs)
+
+    if opts.prior_weight is not None:
+        w = opts.prior_weight
+        search = [(w, heldout_at(w))]
+        choice = "given"
+    else:
+        w, search, choice = search_weight(heldout_at, opts.residual_increase, WEIGHT_RANGE)
+    ls = cross_validate(held)
+    return w, HeldOutJudgement(
+        scheme=held.scheme,
+        folds=held.folds,
+        ls_training_percent=ls.training_percent,
+        ls_heldout_percent=ls.heldout_percent,
+        training_percent=math.nan,
+        heldout_percent=dict(search)[w],
+        tolerance=opts.heldout_tol,
+        weight_search=tuple(search),
+        choice=choice,
+    )
+
+
+def _with_training(
+    judgement: HeldOutJudgement, held: HeldOut, x: NDArray[np.float64]
+) -> HeldOutJudgement:
+    """The judgement with the training error of the fit ``x`` on all data."""
+    return dataclasses.replace(judgement, training_percent=held.whole.relative_error_percent(x))
 
 
 def _auto_weight(

@@ -47,6 +47,7 @@ from ..regressors.terms import (
 )
 from ..regressors.torque import torque_regressor_prepared
 from .estimators import Estimator, EstimatorName, estimator_named
+from .holdout import DEFAULT_FOLDS, HeldOut, block_labels, block_normals, cross_validate
 from .least_squares import LeastSquaresFit, conditioning_advice
 from .log import DEFAULT_CUTOFF_HZ, TorqueLog, joint_side_log, prepare_log
 from .model import IdentifiedModel
@@ -100,6 +101,8 @@ def identify_from_log(
     drive: Drive | None = None,
     estimator: EstimatorName | Estimator = "ols",
     std: Literal["classical", "robust"] = "classical",
+    folds: int = DEFAULT_FOLDS,
+    validate_on: TorqueLog | None = None,
 ) -> IdentifiedModel:
     """Identify base parameters (and linear friction) from a torque log.
 
@@ -143,6 +146,12 @@ def identify_from_log(
     std : {"classical", "robust"}
         Standard deviations from ``sigma^2 (W^T W)^-1`` (default) or the
         heteroscedasticity-consistent estimate.
+    folds : int
+        Contiguous time blocks of the held-out judgement
+        (:mod:`dynid.identification.holdout`); a log too short for them is not judged.
+    validate_on : TorqueLog, optional
+        A separate recording (same joints, read the same way) that the held-out error is
+        measured on instead of the blocks.
 
     Returns
     -------
@@ -150,7 +159,8 @@ def identify_from_log(
         ``fit`` holds the ``r`` base parameters (with the statistics of the whole fit:
         condition number, relative error, sigma); ``friction`` (n, 3) columns
         ``fv, fc, fo`` or None; ``metadata`` the route, filter settings, sample counts,
-        the friction labels and their standard deviations.
+        the friction labels and their standard deviations, ``heldout`` the training and
+        held-out errors of least squares; ``holdout`` the folds' normal equations.
 
     Raises
     ------
@@ -221,6 +231,16 @@ def identify_from_log(
             "speeds in both directions excites them (dynid excite optimises one); a joint "
             "that never moves leaves its friction unidentifiable"
         ) from exc
+    held = _held_out(W, y, n, folds, fit.sigma, cols)
+    if validate_on is not None:
+        vW, vy = _validation_rows(
+            robot, validate_on, drive, bp, terms, cols, cutoff_hz, trim_s, fs / k
+        )
+        held = HeldOut.separate(
+            block_normals(W, y, np.zeros(y.size, dtype=np.intp))[0].expanded(cols),
+            block_normals(vW, vy, np.zeros(vy.size, dtype=np.intp))[0].expanded(cols),
+            fit.sigma,
+        )
     if not cols.all():
         fit = _expanded(fit, cols)
     for msg in conditioning_advice(fit, labels, what="the trajectory"):
@@ -253,6 +273,8 @@ def identify_from_log(
     }
     if drive is not None:
         meta["drive"] = drive.as_dict()
+    if held is not None:
+        meta["heldout"] = cross_validate(held.restricted(np.flatnonzero(fit.kept))).as_dict()
     if friction:
         fb = np.asarray(fit.beta[r:]).reshape(n, 3)
         fr = fb
@@ -267,7 +289,54 @@ def identify_from_log(
         metadata=meta,
         joint_fit=fit if friction else None,
         drive=drive,
+        holdout=held,
     )
+
+
+def _held_out(
+    W: NDArray[np.float64],
+    y: NDArray[np.float64],
+    n: int,
+    folds: int,
+    sigma: float,
+    cols: NDArray[np.bool_],
+) -> HeldOut | None:
+    """The k-fold time blocks of the rows (sample-major, ``n`` rows a sample) over all the
+    columns (``cols`` those of ``W``); None when the log is too short for them."""
+    N = y.size // n
+    try:
+        labels = np.repeat(block_labels(N, folds), n)
+    except OptionError:
+        return None
+    return HeldOut.k_fold(block_normals(W, y, labels), sigma).expanded(cols)
+
+
+def _validation_rows(
+    robot: Robot,
+    log: TorqueLog,
+    drive: Drive | None,
+    bp: BaseParameters,
+    terms: tuple[ModelTerm, ...],
+    cols: NDArray[np.bool_],
+    cutoff_hz: float | None,
+    trim_s: float | None,
+    rate_hz: float,
+) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+    """Regressor and torques of a validation log, prepared as the identification's was
+    (decimated to about ``rate_hz``)."""
+    if log.n != robot.n:
+        raise ShapeError(
+            f"--validate-on log has {log.n} joints; robot {robot.name!r} has {robot.n}"
+        )
+    p = prepare_log(joint_side_log(log, drive), cutoff_hz=cutoff_hz, trim_s=trim_s)
+    step = max(1, int(round(log.sample_rate / rate_hz)))
+    sl = slice(None, None, step)
+    assert p.ddq is not None
+    q, dq, ddq, tau = p.q[sl], p.dq[sl], p.ddq[sl], p.tau[sl]
+    Y, _ = term_regressor(robot, bp, terms, q, dq, ddq)
+    if drive is not None and drive.rotor_inertia is not None:
+        tau = tau - drive.rotor_torques(ddq, drive.rotor_inertia)
+    return Y.reshape(q.shape[0] * robot.n, -1)[:, cols], tau.reshape(-1)
 
 
 def _still_friction(log: TorqueLog, drive: Drive | None) -> NDArray[np.bool_]:

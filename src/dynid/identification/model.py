@@ -31,6 +31,7 @@ from ..exceptions import ShapeError
 from ..model.drive import Drive
 from ..model.robot import Robot
 from ..regressors.base import BaseParameters
+from .holdout import HeldOut
 from .least_squares import LeastSquaresFit
 
 __all__ = ["IdentifiedModel"]
@@ -61,6 +62,10 @@ class IdentifiedModel:
         Classical route with friction: the fit of every column (the ``r`` base parameters,
         then ``fv, fc, fo`` per joint), whose covariance couples both (consistent
         identification uses it); not saved to files.
+    holdout : HeldOut, optional
+        Classical route: the normal equations of the contiguous time blocks (or of the
+        ``--validate-on`` log) over the columns of ``joint_fit`` (or ``fit``), for held-out
+        judgement (:mod:`dynid.identification.holdout`); not saved to files.
     """
 
     robot: Robot
@@ -70,6 +75,7 @@ class IdentifiedModel:
     metadata: dict[str, Any] = field(default_factory=dict)
     joint_fit: LeastSquaresFit | None = None
     drive: Drive | None = None
+    holdout: HeldOut | None = None
     equivalent_robot: Robot = field(init=False)
     rotor_inertia: NDArray[np.float64] | None = field(init=False)
 

@@ -1,0 +1,303 @@
+"""Held-out judgement: contiguous time blocks, their normal equations, cross-validated errors.
+
+A fit judged on the data it was fitted to rewards over-fitting: unconstrained least squares
+absorbs noise and effects outside the model into coefficients that predict new data worse.
+Every decision that weighs a fit against another (the consistent fit's acceptance, the
+prior's weight, a friction law) is therefore taken on **held-out** data:
+
+* **k-fold over contiguous time blocks** (default :data:`DEFAULT_FOLDS` = 5): the rows are
+  cut into ``k`` contiguous blocks of samples (never interleaved: neighbouring samples of a
+  filtered log are correlated, a random split would leak them into the training set); fold
+  ``j`` is fitted on the other ``k - 1`` blocks and predicts block ``j``. The pooled
+  held-out error is ``sqrt(sum_j SSE_j / sum_j ||y_j||^2)``.
+* **a separate recording** (``--validate-on FILE``): fitted on all of the identification
+  data, predicting the other log.
+
+Both are built from the **normal equations of each block**, ``G = W^T W``, ``b = W^T y``,
+``c = y^T y`` and the number of rows (:class:`Normals`): the fit of a fold is the total
+minus its block, and the squared error of *any* candidate ``x`` on a block is the
+quadratic form ``x^T G x - 2 b^T x + c``, so a constrained fit (the consistent one) is judged
+without the raw rows. Errors are relative, in % of the measured torques' norm, on the
+unweighted rows.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Sequence
+from dataclasses import dataclass
+
+import numpy as np
+from numpy.typing import NDArray
+
+from ..exceptions import OptionError, ShapeError
+
+__all__ = [
+    "DEFAULT_FOLDS",
+    "HeldOut",
+    "HeldOutErrors",
+    "Normals",
+    "block_labels",
+    "block_normals",
+    "cross_validate",
+]
+
+#: Default number of contiguous time blocks (folds) of the held-out judgement.
+DEFAULT_FOLDS = 5
+#: Fewest samples a block may hold.
+MIN_BLOCK_SAMPLES = 10
+
+
+@dataclass(frozen=True, slots=True, eq=False)
+class Normals:
+    """Normal equations of a set of rows ``W x = y``.
+
+    Attributes
+    ----------
+    G : ndarray, shape (p, p)
+        ``W^T W``.
+    b : ndarray, shape (p,)
+        ``W^T y``.
+    c : float
+        ``y^T y``.
+    rows : int
+        Number of rows.
+    """
+
+    G: NDArray[np.float64]
+    b: NDArray[np.float64]
+    c: float
+    rows: int
+
+    @property
+    def p(self) -> int:
+        """Number of columns."""
+        return int(self.b.shape[0])
+
+    def __add__(self, other: Normals) -> Normals:
+        return Normals(self.G + other.G, self.b + other.b, self.c + other.c, self.rows + other.rows)
+
+    def __sub__(self, other: Normals) -> Normals:
+        return Normals(self.G - other.G, self.b - other.b, self.c - other.c, self.rows - other.rows)
+
+    def sse(self, x: NDArray[np.float64]) -> float:
+        """``||W x - y||^2`` of a candidate ``x`` (p,) (floored at 0 against round-off)."""
+        x = np.asarray(x, dtype=np.float64)
+        return max(float(x @ self.G @ x - 2.0 * self.b @ x + self.c), 0.0)
+
+    def relative_error_percent(self, x: NDArray[np.float64]) -> float:
+        """``100 ||W x - y|| / ||y||``."""
+        return 100.0 * math.sqrt(self.sse(x) / self.c) if self.c > 0 else 0.0
+
+    def solve(self, rtol: float = 1e-10) -> NDArray[np.float64]:
+        """Least-squares ``x`` (p,): minimum norm in the column-scaled coordinates,
+        directions with a scaled eigenvalue below ``rtol^2`` times the largest left out."""
+        d = np.sqrt(np.maximum(np.diag(self.G), 0.0))
+        d = np.where(d > 0, d, 1.0)
+        Gs = self.G / np.outer(d, d)
+        s, U = np.linalg.eigh(0.5 * (Gs + Gs.T))
+        keep = s > (rtol**2) * max(float(s[-1]), 0.0) if s.size else s > 0
+        z = U[:, keep] @ ((U[:, keep].T @ (self.b / d)) / s[keep])
+        return np.asarray(z / d, dtype=np.float64)
+
+    def sqrt(self) -> NDArray[np.float64]:
+        """``A`` (s, p) with ``A^T A = G`` (directions of zero eigenvalue dropped)."""
+        s, U = np.linalg.eigh(0.5 * (self.G + self.G.T))
+        keep = s > 1e-14 * max(float(s[-1]), 0.0) if s.size else s > 0
+        return np.asarray((U[:, keep] * np.sqrt(s[keep])).T, dtype=np.float64)
+
+    def restricted(self, columns: NDArray[np.intp]) -> Normals:
+        """The normal equations of the columns ``columns`` only."""
+        ix = np.asarray(columns, dtype=np.intp)
+        return Normals(self.G[np.ix_(ix, ix)], self.b[ix], self.c, self.rows)
+
+    def expanded(self, mask: NDArray[np.bool_]) -> Normals:
+        """Written over ``mask.size`` columns, these at ``mask`` (zero for the others)."""
+        ix = np.flatnonzero(mask)
+        G = np.zeros((mask.size, mask.size))
+        G[np.ix_(ix, ix)] = self.G
+        b = np.zeros(mask.size)
+        b[ix] = self.b
+        return Normals(G, b, self.c, self.rows)
+
+
+def block_labels(n_samples: int, folds: int = DEFAULT_FOLDS) -> NDArray[np.intp]:
+    """The contiguous block (0 .. folds-1) of each sample, blocks as equal as possible.
+
+    Raises
+    ------
+    OptionError
+        ``folds < 2``, or fewer than :data:`MIN_BLOCK_SAMPLES` samples per block.
+    """
+    if folds < 2:
+        raise OptionError(f"--folds must be at least 2; got {folds}")
+    if n_samples < folds * MIN_BLOCK_SAMPLES:
+        raise OptionError(
+            f"{n_samples} samples cannot be cut into {folds} time blocks of at least "
+            f"{MIN_BLOCK_SAMPLES} samples; lower --folds or record a longer log"
+        )
+    return np.minimum((np.arange(n_samples) * folds) // n_samples, folds - 1).astype(np.intp)
+
+
+def block_normals(
+    W: NDArray[np.float64], y: NDArray[np.float64], labels: NDArray[np.intp]
+) -> tuple[Normals, ...]:
+    """Normal equations of each block of rows.
+
+    Parameters
+    ----------
+    W : ndarray, shape (m, p)
+        Regressor.
+    y : ndarray, shape (m,)
+        Measurements.
+    labels : ndarray of int, shape (m,)
+        The block of each row, ``0 .. k-1`` (every block present).
+
+    Raises
+    ------
+    ShapeError
+        ``W``, ``y`` and ``labels`` disagree in their rows.
+    """
+    if W.ndim != 2 or y.shape != (W.shape[0],) or labels.shape != (W.shape[0],):
+        raise ShapeError(
+            f"block_normals: W {W.shape}, y {y.shape} and labels {labels.shape} must share rows"
+        )
+    k = int(labels.max()) + 1 if labels.size else 0
+    out = []
+    for j in range(k):
+        sel = labels == j
+        Wj, yj = W[sel], y[sel]
+        out.append(Normals(Wj.T @ Wj, Wj.T @ yj, float(yj @ yj), int(sel.sum())))
+    return tuple(out)
+
+
+@dataclass(frozen=True, slots=True, eq=False)
+class HeldOut:
+    """Training and held-out normal equations of every fold.
+
+    Attributes
+    ----------
+    train : tuple of Normals
+        What fold ``j`` is fitted on.
+    test : tuple of Normals
+        What fold ``j`` predicts.
+    whole : Normals
+        All of the identification data (the final fit's).
+    scheme : str
+        ``"blocks"`` (k-fold over contiguous time blocks) or ``"file"`` (a separate log).
+    noise : float
+        Residual standard deviation of the fit on all data (scales a fold's data term).
+    """
+
+    train: tuple[Normals, ...]
+    test: tuple[Normals, ...]
+    whole: Normals
+    scheme: str
+    noise: float = 1.0
+
+    @classmethod
+    def k_fold(cls, blocks: Sequence[Normals], noise: float = 1.0) -> HeldOut:
+        """Fold ``j`` fitted on every block but ``j``, predicting block ``j``."""
+        whole = blocks[0]
+        for blk in blocks[1:]:
+            whole = whole + blk
+        return cls(tuple(whole - b for b in blocks), tuple(blocks), whole, "blocks", noise)
+
+    @classmethod
+    def separate(cls, whole: Normals, test: Normals, noise: float = 1.0) -> HeldOut:
+        """One fold: fitted on all of ``whole``, predicting ``test`` (another recording)."""
+        return cls((whole,), (test,), whole, "file", noise)
+
+    @property
+    def folds(self) -> int:
+        """Number of folds."""
+        return len(self.test)
+
+    @property
+    def training_share(self) -> float:
+        """Mean share of all rows a fold is fitted on (``(k-1)/k`` for k blocks, 1 for a file)."""
+        return float(np.mean([t.rows for t in self.train])) / max(self.whole.rows, 1)
+
+    def restricted(self, columns: NDArray[np.intp]) -> HeldOut:
+        """The same folds over the columns ``columns`` only."""
+        return HeldOut(
+            tuple(t.restricted(columns) for t in self.train),
+            tuple(t.restricted(columns) for t in self.test),
+            self.whole.restricted(columns),
+            self.scheme,
+            self.noise,
+        )
+
+    def expanded(self, mask: NDArray[np.bool_]) -> HeldOut:
+        """Written over ``mask.size`` columns (:meth:`Normals.expanded`)."""
+        return HeldOut(
+            tuple(t.expanded(mask) for t in self.train),
+            tuple(t.expanded(mask) for t in self.test),
+            self.whole.expanded(mask),
+            self.scheme,
+            self.noise,
+        )
+
+    def heldout_error_percent(self, xs: Sequence[NDArray[np.float64]]) -> float:
+        """Pooled held-out error [%] of one candidate per fold,
+        ``100 sqrt(sum_j SSE_j(x_j) / sum_j ||y_j||^2)``."""
+        if len(xs) != self.folds:
+            raise ShapeError(f"{len(xs)} candidates for {self.folds} folds")
+        sse = sum(t.sse(x) for t, x in zip(self.test, xs, strict=True))
+        c = sum(t.c for t in self.test)
+        return 100.0 * math.sqrt(sse / c) if c > 0 else 0.0
+
+    def describe(self) -> str:
+        """How the data were held out, for a summary."""
+        if self.scheme == "file":
+            return "a separate log"
+        return f"{self.folds} contiguous time blocks (k-fold)"
+
+
+@dataclass(frozen=True, slots=True)
+class HeldOutErrors:
+    """Training and held-out errors of unconstrained least squares.
+
+    Attributes
+    ----------
+    scheme : str
+        ``"blocks"`` or ``"file"``.
+    folds : int
+    training_percent : float
+        Relative error [%] of the fit on all data, on those data.
+    heldout_percent : float
+        Pooled relative error [%] of the folds' fits on their held-out rows.
+    """
+
+    scheme: str
+    folds: int
+    training_percent: float
+    heldout_percent: float
+
+    def as_dict(self) -> dict[str, float | int | str]:
+        """JSON-ready (``identification.json``'s ``heldout``)."""
+        return {
+            "scheme": self.scheme,
+            "folds": self.folds,
+            "training_error_percent": self.training_percent,
+            "heldout_error_percent": self.heldout_percent,
+        }
+
+
+def cross_validate(held: HeldOut, rtol: float = 1e-10) -> HeldOutErrors:
+    """Training and held-out errors of unconstrained least squares over the folds.
+
+    Parameters
+    ----------
+    held : HeldOut
+        The folds (:meth:`HeldOut.k_fold` or :meth:`HeldOut.separate`).
+    rtol : float
+        Rank tolerance of each fold's fit (:meth:`Normals.solve`).
+    """
+    xs = [t.solve(rtol) for t in held.train]
+    return HeldOutErrors(
+        held.scheme,
+        held.folds,
+        held.whole.relative_error_percent(held.whole.solve(rtol)),
+        held.heldout_error_percent(xs),
+    )
