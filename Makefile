@@ -31,12 +31,15 @@ $(DOCS): $(RUNTIME)
 demo: $(RUNTIME)
 	$(VENV)/bin/dynid demo --out out
 
+# one worker per core (pytest-xdist); PYTEST_WORKERS=0 runs in one process
+PYTEST_WORKERS ?= auto
+
 test: $(TESTS)
-	MPLBACKEND=Agg $(PY) -m pytest -q
+	MPLBACKEND=Agg $(PY) -m pytest -q -n $(PYTEST_WORKERS)
 
 # everything but the tests marked slow (over about 10 s each)
 test-fast: $(TESTS)
-	MPLBACKEND=Agg $(PY) -m pytest -q -m "not slow"
+	MPLBACKEND=Agg $(PY) -m pytest -q -n $(PYTEST_WORKERS) -m "not slow"
 
 bench: $(TESTS)
 	$(PY) benchmarks/run_all.py

@@ -7,7 +7,7 @@ from pathlib import Path
 
 SRC = Path(__file__).resolve().parents[1] / "src" / "dynid"
 
-#: Layers in data-flow order (STYLE.md section 1).
+#: Layers in data-flow order (ARCHITECTURE.md, "Layers").
 LAYERS = [
     {"exceptions", "_checks", "_compiled", "_parallel", "spatial", "signals"},
     {"model"},
