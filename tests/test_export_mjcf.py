@@ -146,6 +146,37 @@ def test_export_format_by_suffix_and_errors(tmp_path):
     np.testing.assert_allclose(dynid.Robot.from_toml(path).phi, dynid.panda().phi, rtol=1e-15)
 
 
+def test_a_format_is_one_line_of_the_table(tmp_path, monkeypatch):
+    """A format registered in ROBOT_FORMATS is chosen by name and suffix, gets the export
+    options, is a --format choice's source and has its file in an output folder."""
+    from dynid.io import export
+    from dynid.io.atomic import write_text
+    from dynid.io.robot.export_options import ExportOptions, RobotFormat
+
+    seen = []
+
+    def export_names(path, robot, options):
+        seen.append(options)
+        return write_text(path, "\n".join(robot.joint_names) + "\n")
+
+    monkeypatch.setitem(
+        export.ROBOT_FORMATS, "names", RobotFormat("names", (".names", ".txt"), export_names)
+    )
+    panda = dynid.panda()
+    assert export_format("a.txt") == "names"
+    path = save_robot(tmp_path / "a.names", panda, all_frames=True)
+    assert path.read_text().split() == [f"joint{i}" for i in range(1, 8)]
+    assert seen[-1].all_frames is True
+    with pytest.raises(DataError, match="URDF template applies"):
+        save_robot(tmp_path / "b.txt", panda, template=tmp_path / "t.urdf")
+    files = export.save_robot_files(tmp_path / "out", panda, ExportOptions(friction=False))
+    assert [f.name for f in files] == ["robot.urdf", "robot.xml", "robot.toml", "robot.names"]
+    assert seen[-1].friction is False
+    back = dynid.Robot.from_urdf(files[0])  # the table's other writers wrote theirs
+    np.testing.assert_allclose(back.phi, panda.phi, rtol=1e-15, atol=1e-18)
+    np.testing.assert_allclose(dynid.Robot.from_toml(files[2]).phi, panda.phi, rtol=1e-15)
+
+
 def test_identified_classical_friction_is_written_as_it_is():
     """Classical fv, fc go to damping and frictionloss exactly; the offset fo is reported."""
     robot = dynid.panda()

@@ -33,7 +33,7 @@ from typing import Any
 from ..exceptions import DynidError
 from ..friction.model import DriveFriction
 from ..friction.mujoco import coulomb_viscous_from_sigmoid
-from ..io.export import EXPORT_FORMATS, model_terms_of, save_robot
+from ..io.export import EXPORT_FORMATS, export_format, model_terms_of, save_robot
 from ..io.robot.urdf_patch import MERGED_POLICIES
 from ..model.robot import Robot
 from .common import add_drive_option, add_subcommand, load_drive_arg
@@ -113,7 +113,7 @@ def run(args: argparse.Namespace) -> int:
     print(f"wrote {path}")
     if drive is not None:
         print(f"drive: {drive.describe()}")
-    mjcf = args.format == "mjcf" or path.suffix.lower() in (".xml", ".mjcf")
+    mjcf = export_format(path, args.format) == "mjcf"
     if mjcf and friction is True and robot.friction is not None:
         approx = coulomb_viscous_from_sigmoid(robot.friction, robot.dq_max)
         print("friction as MuJoCo holds it (odd part of the sigmoid, fitted up to dq_max):")

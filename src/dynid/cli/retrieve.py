@@ -67,7 +67,7 @@ from ..feasibility.sdp import ConsistentResult
 from ..friction.model import ClassicalFriction, DriveFriction
 from ..friction.validation import NewtonEulerValidation
 from ..identification.model import IdentifiedModel
-from ..io.export import save_robot
+from ..io.export import ExportOptions, save_robot_files
 from ..io.feasible import load_bounds, save_feasible_json, save_report_json
 from ..io.json_files import save_json
 from ..model.robot import Robot
@@ -259,7 +259,8 @@ def write_outputs(
     figures: bool = True,
     **report_extra: Any,
 ) -> list[Path]:
-    """Write feasible.json, robot.urdf, robot.xml, robot.toml, report.json (and retrieval.png)."""
+    """Write feasible.json, the robot files (robot.urdf, robot.xml, robot.toml: one per export
+    format), report.json (and retrieval.png)."""
     files = [save_feasible_json(out / "feasible.json", result)]
     fr = getattr(result, "friction", None)  # one-step on a log: classical fv, fc, fo
     drive = getattr(result, "drive", None)
@@ -268,10 +269,7 @@ def write_outputs(
         law = ClassicalFriction.from_array(fr)
         at_motors = drive is not None and drive.friction_at == "motor"
         mj = DriveFriction(law, drive) if drive is not None and at_motors else law
-    files += [
-        save_robot(out / f"robot.{ext}", result.robot, friction=mj, drive=drive)
-        for ext in ("urdf", "xml", "toml")
-    ]
+    files += save_robot_files(out, result.robot, ExportOptions(friction=mj, drive=drive))
     files.append(save_report_json(out / "report.json", result, **report_extra))
     if figures:
         from ..plots.feasible import plot_consistent, plot_retrieval

@@ -1,35 +1,58 @@
-"""One entry point for writing a robot description: URDF, MJCF or dynid TOML.
+"""One entry point for writing a robot, and the table of the formats it can write.
 
-:func:`save_robot` picks the writer by ``format`` (or the file suffix: ``.urdf``;
-``.xml``/``.mjcf``; ``.toml``) and passes its options on:
+:data:`ROBOT_FORMATS` lists every robot file format of the exports, each one module of
+:mod:`dynid.io.robot` and one :class:`~dynid.io.robot.export_options.RobotFormat` line:
 
-* URDF: :func:`dynid.io.robot.urdf.save_urdf` (chain export, or ``template=`` the
-  original URDF patched with the new inertials);
-* MJCF: :func:`dynid.io.robot.mjcf.save_mjcf` (``friction`` as ``frictionloss`` and
-  ``damping``);
-* TOML: :func:`dynid.io.robot.toml.save_toml` (kinematics, inertials, limits, sigmoid
-  friction, a drive as a ``[drive]`` table).
+* ``urdf`` (``.urdf``): :func:`dynid.io.robot.urdf.export_urdf` (chain export, or
+  ``template=`` the original URDF patched with the new inertials);
+* ``mjcf`` (``.xml``, ``.mjcf``): :func:`dynid.io.robot.mjcf.export_mjcf` (``friction`` as
+  ``frictionloss`` and ``damping``, a drive's rotors as ``armature``);
+* ``toml`` (``.toml``): :func:`dynid.io.robot.toml.export_toml` (kinematics, inertials,
+  limits, sigmoid friction, a drive as a ``[drive]`` table).
 
-``dynid export``, ``dynid retrieve`` and ``identify --consistent`` write through it.
+:func:`save_robot` picks the format by ``format`` or the file suffix; :func:`save_robot_files`
+writes one file per format into an output folder. ``dynid export`` (its ``--format``
+choices), ``dynid retrieve`` and ``identify --consistent`` read this table, so a new format
+is a module and a line here.
 """
 
 from __future__ import annotations
 
+from dataclasses import replace
 from pathlib import Path
 
 from ..exceptions import DataError
 from ..friction.model import ClassicalFriction, DriveFriction
-from ..friction.mujoco import joint_coulomb_viscous
 from ..model.drive import Drive
 from ..model.robot import Robot
-from .robot.mjcf import save_mjcf
-from .robot.toml import save_toml
-from .robot.urdf import save_urdf
+from .robot.export_options import ExportOptions, RobotFormat
+from .robot.mjcf import export_mjcf
+from .robot.toml import export_toml
+from .robot.urdf import export_urdf
 
-__all__ = ["EXPORT_FORMATS", "export_format", "save_mjcf", "save_robot", "save_urdf"]
+__all__ = [
+    "EXPORT_FORMATS",
+    "ROBOT_FORMATS",
+    "ExportOptions",
+    "RobotFormat",
+    "export_format",
+    "model_terms_of",
+    "save_robot",
+    "save_robot_files",
+]
 
-EXPORT_FORMATS = ("urdf", "mjcf", "toml")
-_BY_SUFFIX = {".urdf": "urdf", ".xml": "mjcf", ".mjcf": "mjcf", ".toml": "toml"}
+#: The robot file formats of the exports, by name (``--format``), in the order an output
+#: folder lists them.
+ROBOT_FORMATS: dict[str, RobotFormat] = {
+    f.name: f
+    for f in (
+        RobotFormat("urdf", (".urdf",), export_urdf, template=True),
+        RobotFormat("mjcf", (".xml", ".mjcf"), export_mjcf),
+        RobotFormat("toml", (".toml",), export_toml),
+    )
+}
+#: Their names (``dynid export --format`` choices).
+EXPORT_FORMATS = tuple(ROBOT_FORMATS)
 
 
 def export_format(path: str | Path, format: str | None = None) -> str:
@@ -40,17 +63,20 @@ def export_format(path: str | Path, format: str | None = None) -> str:
     DataError
         Unknown format, or a suffix that names none.
     """
+    names = tuple(ROBOT_FORMATS)
     if format is not None:
-        if format not in EXPORT_FORMATS:
-            raise DataError(f"format must be one of {EXPORT_FORMATS}; got {format!r}")
+        if format not in ROBOT_FORMATS:
+            raise DataError(f"format must be one of {names}; got {format!r}")
         return format
     suffix = Path(path).suffix.lower()
-    if suffix not in _BY_SUFFIX:
-        raise DataError(
-            f"cannot tell the format of {Path(path).name!r} from its suffix; "
-            f"use .urdf, .xml/.mjcf or .toml, or give the format ({EXPORT_FORMATS})"
-        )
-    return _BY_SUFFIX[suffix]
+    for f in ROBOT_FORMATS.values():
+        if suffix in f.suffixes:
+            return f.name
+    use = ", ".join("/".join(f.suffixes) for f in ROBOT_FORMATS.values())
+    raise DataError(
+        f"cannot tell the format of {Path(path).name!r} from its suffix; "
+        f"use {use}, or give the format ({names})"
+    )
 
 
 def save_robot(
@@ -66,14 +92,15 @@ def save_robot(
     all_frames: bool = False,
     drive: Drive | None = None,
 ) -> Path:
-    """Write ``robot`` as URDF, MJCF or TOML; returns the path.
+    """Write ``robot`` in one of :data:`ROBOT_FORMATS`; returns the path.
 
     Parameters
     ----------
     path : str or Path
     robot : Robot
-    format : {"urdf", "mjcf", "toml"}, optional
-        Default: from the suffix of ``path``.
+    format : str, optional
+        A name of :data:`ROBOT_FORMATS` (``"urdf"``, ``"mjcf"``, ``"toml"``). Default:
+        from the suffix of ``path``.
     template, base, tip, merged, all_frames
         URDF only (:func:`dynid.io.robot.urdf.save_urdf`).
     friction : bool, ClassicalFriction or DriveFriction
@@ -91,27 +118,37 @@ def save_robot(
     ModelError
         The template's chain does not match the robot.
     """
-    fmt = export_format(path, format)
-    if template is not None and fmt != "urdf":
-        raise DataError(f"a URDF template applies to the urdf format only; got format {fmt!r}")
-    if fmt == "urdf":
-        dyn = None
-        if isinstance(friction, ClassicalFriction | DriveFriction):
-            jt = joint_coulomb_viscous(friction)
-            dyn = (jt.damping, jt.frictionloss)
-        return save_urdf(
-            path,
-            robot,
-            all_frames=all_frames,
-            template=template,
-            base=base,
-            tip=tip,
-            merged=merged,
-            dynamics=dyn,
-        )
-    if fmt == "mjcf":
-        return save_mjcf(path, robot, friction=friction, drive=drive)
-    return save_toml(path, robot, drive=drive)
+    fmt = ROBOT_FORMATS[export_format(path, format)]
+    if template is not None and not fmt.template:
+        raise DataError(f"a URDF template applies to the urdf format only; got format {fmt.name!r}")
+    options = ExportOptions(
+        template=None if template is None else Path(template),
+        base=base,
+        tip=tip,
+        merged=merged,
+        friction=friction,
+        all_frames=all_frames,
+        drive=drive,
+    )
+    return fmt.save(path, robot, options)
+
+
+def save_robot_files(
+    folder: str | Path, robot: Robot, options: ExportOptions, *, stem: str = "robot"
+) -> list[Path]:
+    """Write ``robot`` once per format of :data:`ROBOT_FORMATS` into ``folder``.
+
+    The files are ``<stem><first suffix>`` (``robot.urdf``, ``robot.xml``, ``robot.toml``),
+    each written with ``options`` (a template, which one format takes, is not used here).
+
+    Returns
+    -------
+    list of Path
+        The files written, in the table's order.
+    """
+    folder = Path(folder)
+    plain = replace(options, template=None)
+    return [f.save(folder / f"{stem}{f.suffixes[0]}", robot, plain) for f in ROBOT_FORMATS.values()]
 
 
 def model_terms_of(

@@ -48,8 +48,9 @@ from ...model.drive import Drive
 from ...model.inertia import inertia6_from_matrix
 from ...model.robot import Robot
 from ..atomic import write_text
+from .export_options import ExportOptions
 
-__all__ = ["mjcf_from_robot", "save_mjcf"]
+__all__ = ["export_mjcf", "mjcf_from_robot", "save_mjcf"]
 
 
 def _f(x: float) -> str:
@@ -219,3 +220,9 @@ def save_mjcf(
     text, _ = mjcf_from_robot(robot, friction=friction, drive=drive)
     write_text(path, text)
     return path
+
+
+def export_mjcf(path: str | Path, robot: Robot, options: ExportOptions) -> Path:
+    """:func:`save_mjcf` with the export options' ``friction`` and ``drive`` (the entry of
+    ``mjcf`` in the exports)."""
+    return save_mjcf(path, robot, friction=options.friction, drive=options.drive)

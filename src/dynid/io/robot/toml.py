@@ -38,9 +38,11 @@ from ...model.inertia import inertia6_from_matrix, phi_from_inertial
 from ...model.robot import MAX_LINK_MASS, STANDARD_GRAVITY, Frame, Robot, mdh_transform
 from ..atomic import write_text
 from ..drive_file import drive_toml
+from .export_options import ExportOptions
 
 __all__ = [
     "FORMAT_VERSION",
+    "export_toml",
     "load_toml",
     "robot_from_toml_string",
     "save_toml",
@@ -458,3 +460,9 @@ def save_toml(path: str | Path, robot: Robot, *, drive: Drive | None = None) -> 
     if drive is not None:
         text = text.rstrip("\n") + "\n\n" + drive_toml(drive)
     return write_text(path, text)
+
+
+def export_toml(path: str | Path, robot: Robot, options: ExportOptions) -> Path:
+    """:func:`save_toml` with the export options' ``drive`` (the entry of ``toml`` in the
+    exports; the robot's own sigmoid friction is part of the description)."""
+    return save_toml(path, robot, drive=options.drive)

@@ -43,13 +43,23 @@ from numpy.typing import NDArray
 
 from ... import __version__, spatial
 from ...exceptions import ModelError
+from ...friction.model import ClassicalFriction, DriveFriction
+from ...friction.mujoco import joint_coulomb_viscous
 from ...model.inertia import inertia6_from_matrix
 from ...model.robot import Robot
 from ..atomic import write_text
+from .export_options import ExportOptions
 from .urdf_parse import load_urdf, robot_from_urdf_string
 from .urdf_patch import patch_urdf_inertials
 
-__all__ = ["load_urdf", "robot_from_urdf_string", "save_urdf", "tip_name", "urdf_from_robot"]
+__all__ = [
+    "export_urdf",
+    "load_urdf",
+    "robot_from_urdf_string",
+    "save_urdf",
+    "tip_name",
+    "urdf_from_robot",
+]
 
 _BIG = sys.float_info.max
 
@@ -247,3 +257,31 @@ def save_urdf(
         )
     write_text(path, text)
     return path
+
+
+def export_urdf(path: str | Path, robot: Robot, options: ExportOptions) -> Path:
+    """:func:`save_urdf` with the export options (the entry of ``urdf`` in the exports).
+
+    Identified classical friction (``options.friction``, at the joints or reflected from
+    the motors of a drive) is written as ``<dynamics damping friction>``; the sigmoid and
+    the drive are not part of URDF.
+
+    Raises
+    ------
+    ModelError
+        As :func:`save_urdf` (a template that cannot be read or does not match).
+    """
+    dynamics = None
+    if isinstance(options.friction, ClassicalFriction | DriveFriction):
+        jt = joint_coulomb_viscous(options.friction)
+        dynamics = (jt.damping, jt.frictionloss)
+    return save_urdf(
+        path,
+        robot,
+        all_frames=options.all_frames,
+        template=options.template,
+        base=options.base,
+        tip=options.tip,
+        merged=options.merged,
+        dynamics=dynamics,
+    )
