@@ -356,8 +356,9 @@ def prepare_log(
     max_gap_s: float | None = None,
     jitter_rtol: float = 1e-6,
     filter_tau: bool = True,
+    decimate: int = 1,
 ) -> TorqueLog:
-    """Resample, zero-phase filter, differentiate and trim a torque log.
+    """Resample, zero-phase filter, differentiate, trim and decimate a torque log.
 
     Steps (:mod:`dynid.signals`):
 
@@ -371,6 +372,11 @@ def prepare_log(
        (second-order differences).
     4. Drop ``trim_s`` seconds at each end (default ``2 / cutoff_hz`` when filtering,
        else 0).
+    5. Keep every ``decimate``-th sample of what is left.
+
+    Steps 2-5 run one column at a time, so that a long log needs, beside its own arrays,
+    the decimated result and a few full-length columns (not full-length copies of every
+    filtered signal); the values are those of the steps applied to whole arrays.
 
     Parameters
     ----------
@@ -391,6 +397,9 @@ def prepare_log(
         False keeps the measured torques (resampled and trimmed only), as the friction
         fit and the validation do: a filtered torque smears the fast friction reversals
         that the friction model, evaluated on the velocities, keeps sharp.
+    decimate : int
+        Keep every ``decimate``-th sample after trimming (the classical route's
+        decimation, :func:`~dynid.identification.classical.auto_decimation`).
 
     Returns
     -------
@@ -402,6 +411,8 @@ def prepare_log(
     DataError
         A gap longer than ``max_gap_s``; a cutoff not below the Nyquist frequency; too few
         samples to filter, or nothing left after trimming.
+    ShapeError
+        ``decimate < 1``.
 
     Warns
     -----
@@ -421,14 +432,16 @@ def prepare_log(
             f"exceeds the longest gap bridged, {max_gap_s:g} s; hint: split the log at the gap "
             "or raise max_gap_s (--max-gap)"
         )
+    if int(decimate) != decimate or decimate < 1:
+        raise ShapeError(f"decimate must be an integer >= 1; got {decimate}")
     rate = signals.sample_rate(t) if fs is None else float(fs)
     data = {k: getattr(log, k) for k in _SIGNALS if getattr(log, k) is not None}
     uniform = signals.is_uniform(t, rtol=jitter_rtol) and abs(rate * np.median(dt) - 1.0) < 1e-9
-    if not uniform:
-        stacked = np.concatenate([data[k] for k in data], axis=1)
-        t, res = signals.resample_uniform(t, stacked, rate)
-        parts = np.split(res, len(data), axis=1)
-        data = dict(zip(data, parts, strict=True))
+    if not uniform:  # one signal at a time: no stacked copy of the whole log
+        tu = t
+        for name in list(data):
+            tu, data[name] = signals.resample_uniform(t, data[name], rate)
+        t = tu
     if cutoff_hz is not None and cutoff_hz == DEFAULT_CUTOFF_HZ and cutoff_hz >= rate / 2:
         warnings.warn(
             f"the default cutoff {DEFAULT_CUTOFF_HZ:g} Hz is not below the Nyquist frequency "
@@ -443,29 +456,65 @@ def prepare_log(
             f"the log has {log.n_samples} samples; filtering needs more (a longer log, or "
             "no filter: cutoff_hz=None)"
         )
-    if cutoff_hz is not None:
-        for name in [k for k in data if filter_tau or k != "tau"]:
-            data[name] = signals.lowpass(data[name], rate, cutoff_hz)
-    if "ddq" not in data:
-        data["ddq"] = signals.derivative(t, data["dq"])
     if trim_s is None:
         trim_s = signals.edge_seconds(cutoff_hz) if cutoff_hz is not None else 0.0
     keep = signals.trim_edges(t, trim_s)
     if keep.sum() < 2:
         raise DataError(f"fewer than 2 samples left after trimming {trim_s:g} s at each end")
-
     kept = np.flatnonzero(keep)
-    rows = slice(int(kept[0]), int(kept[-1]) + 1)  # trimming keeps one contiguous block
-
-    def pick(a: NDArray[np.float64]) -> NDArray[np.float64]:
-        a.setflags(write=False)  # so that TorqueLog keeps a view, not a copy, of big logs
-        return a[rows]
-
+    rows = slice(int(kept[0]), int(kept[-1]) + 1, int(decimate))  # one contiguous block
+    out = _conditioned(t, data, rows, rate, cutoff_hz, filter_tau)
+    if out["t"].shape[0] < 2:
+        raise DataError(
+            f"fewer than 2 samples left after trimming {trim_s:g} s at each end and keeping "
+            f"every {decimate}-th"
+        )
     return TorqueLog(
-        t=pick(t),
-        q=pick(data["q"]),
-        dq=pick(data["dq"]),
-        tau=pick(data["tau"]),
-        ddq=pick(data["ddq"]),
+        t=out["t"],
+        q=out["q"],
+        dq=out["dq"],
+        tau=out["tau"],
+        ddq=out["ddq"],
         cleaning=log.cleaning,
     )
+
+
+def _conditioned(
+    t: NDArray[np.float64],
+    data: dict[str, NDArray[np.float64]],
+    rows: slice,
+    rate: float,
+    cutoff_hz: float | None,
+    filter_tau: bool,
+) -> dict[str, NDArray[np.float64]]:
+    """Steps 2-5 of :func:`prepare_log`, one column at a time: the signals (and ``ddq``
+    from the filtered ``dq`` when absent) low-passed, at the samples ``rows``, read-only.
+
+    A signal that needs no filtering and no decimation is returned as a view of its input.
+    """
+
+    def frozen(a: NDArray[np.float64]) -> NDArray[np.float64]:
+        a.setflags(write=False)  # so that TorqueLog keeps it without a copy
+        return a
+
+    out = {"t": frozen(np.array(t[rows]))}
+    derive = "ddq" not in data
+    for name, x in data.items():
+        filtered = cutoff_hz is not None and (filter_tau or name != "tau")
+        if not filtered and not (derive and name == "dq"):
+            out[name] = frozen(x[rows]) if rows.step == 1 else frozen(np.array(x[rows]))
+            continue
+        y = np.empty((len(range(*rows.indices(x.shape[0]))), x.shape[1]))
+        dy = np.empty(y.shape) if derive and name == "dq" else None
+        for j in range(x.shape[1]):
+            col = np.ascontiguousarray(x[:, j])
+            if filtered:
+                assert cutoff_hz is not None
+                col = signals.lowpass(col, rate, cutoff_hz)
+            y[:, j] = col[rows]
+            if dy is not None:
+                dy[:, j] = signals.derivative(t, col)[rows]
+        out[name] = frozen(y)
+        if dy is not None:
+            out["ddq"] = frozen(dy)
+    return out
