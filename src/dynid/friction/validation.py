@@ -28,12 +28,12 @@ from numpy.typing import ArrayLike, NDArray
 from .. import _checks
 from ..dynamics.rnea import rnea
 from ..exceptions import OptionError, ShapeError
-from ..identification.log import DEFAULT_CUTOFF_HZ, TorqueLog
+from ..identification.log import DEFAULT_CUTOFF_HZ, TorqueLog, joint_side_log, prepare_log
 from ..identification.metrics import TorqueErrors, torque_errors
 from ..identification.model import IdentifiedModel
 from ..model.drive import Drive
 from ..model.robot import Robot
-from .fit import TorqueModel, friction_residual, model_drive
+from .fit import TorqueModel, model_drive, rigid_body_torques
 from .model import ClassicalFriction, DriveFriction, FrictionModel, SigmoidFriction
 
 __all__ = [
@@ -168,32 +168,24 @@ def validate_torques(
         raise ShapeError(f"friction model has {friction.n} joints; the log has {log.n}")
     d = model_drive(model, drive)
     cut = recorded_cutoff(model) if isinstance(cutoff_hz, str) else cutoff_hz
-    res = friction_residual(
-        model,
-        log,
-        cutoff_hz=cut,
-        trim_s=trim_s,
-        filter_tau=filter_tau,
-        max_gap_s=max_gap_s,
-        drive=d,
-    )
-    p, tau_model = res.log, res.tau_model
+    jlog = joint_side_log(log, d)
+    del log  # a long log's raw signals are freed here when the caller holds no other reference
+    p = prepare_log(jlog, cutoff_hz=cut, trim_s=trim_s, filter_tau=filter_tau, max_gap_s=max_gap_s)
+    del jlog
+    assert p.ddq is not None  # prepare_log always fills ddq
+    tau_model = rigid_body_torques(model, p.q, p.dq, p.ddq)
     if d is not None and d.rotor_inertia is not None and not isinstance(model, IdentifiedModel):
-        assert p.ddq is not None  # prepare_log always fills ddq
-        tau_model = tau_model + d.rotor_torques(p.ddq, d.rotor_inertia)  # a robot's links only
-    # free what is no longer needed before the friction torques (a long log's raw signals,
-    # when the caller holds no other reference, and the residual)
-    del res, log
+        if not isinstance(model, Robot):  # a callable's array is its own: not changed here
+            tau_model = np.array(tau_model)
+        for b in _blocks(p.n_samples):  # a robot's links only: add the known rotors
+            tau_model[b] += d.rotor_torques(p.ddq[b], d.rotor_inertia)
     without = torque_errors(p.tau, tau_model)
     tf = with_ = None
     if friction is not None:
         tf = np.empty(p.dq.shape)
-        step = 65_536  # blocks of rows: a long log needs no full-size temporaries
-        for k in range(0, p.dq.shape[0], step):
-            tf[k : k + step] = friction.torques(p.dq[k : k + step])
-        tau_hat = tau_model + tf
-        with_ = torque_errors(p.tau, tau_hat)
-        del tau_hat
+        for b in _blocks(p.n_samples):
+            tf[b] = friction.torques(p.dq[b])
+        with_ = _errors_of_sum(p.tau, tau_model, tf)
     return Validation(
         log=p,
         tau_model=tau_model,
@@ -201,6 +193,47 @@ def validate_torques(
         without_friction=without,
         with_friction=with_,
         friction=friction,
+    )
+
+
+#: Samples per block of the predictions of a long log (temporaries of one block only).
+BLOCK_SAMPLES = 65_536
+
+
+def _blocks(N: int) -> list[slice]:
+    """Slices of :data:`BLOCK_SAMPLES` samples covering ``N``."""
+    return [slice(a, a + BLOCK_SAMPLES) for a in range(0, N, BLOCK_SAMPLES)]
+
+
+def _errors_of_sum(
+    tau: NDArray[np.float64], a: NDArray[np.float64], b: NDArray[np.float64]
+) -> TorqueErrors:
+    """:func:`~dynid.identification.metrics.torque_errors` of ``a + b`` against ``tau``
+    (N, n), without a full-length ``a + b``: a long log is summed block by block."""
+    N = tau.shape[0]
+    if N <= BLOCK_SAMPLES:
+        return torque_errors(tau, a + b)
+    n = tau.shape[1]
+    se2, sa2 = np.zeros(n), np.zeros(n)
+    for k in _blocks(N):
+        hat = a[k] + b[k]
+        _checks.finite("tau_hat", hat)
+        d = tau[k] - hat
+        se2 += np.einsum("ij,ij->j", d, d)
+        sa2 += np.einsum("ij,ij->j", tau[k], tau[k])
+    m = se2 / N
+    na_all = float(np.sqrt(sa2.sum()))
+    na = np.sqrt(sa2)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        per = np.where(na > 0, 100.0 * np.sqrt(se2) / na, np.inf)
+    return TorqueErrors(
+        rms=_checks.frozen(np.sqrt(m)),
+        mse=_checks.frozen(m),
+        relative_error_percent=100.0 * float(np.sqrt(se2.sum())) / na_all
+        if na_all > 0
+        else float("inf"),
+        relative_error_percent_per_joint=_checks.frozen(per),
+        n_samples=N,
     )
 
 
