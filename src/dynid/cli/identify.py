@@ -178,7 +178,30 @@ def register(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParser:
         metavar="HZ",
         help="torque logs: zero-phase low-pass cutoff [Hz] (default: the library's)",
     )
+    p.add_argument(
+        "--folds",
+        type=number(int, min=2),
+        default=None,
+        metavar="K",
+        help="torque logs: contiguous time blocks of the held-out judgement (default 5)",
+    )
+    p.add_argument(
+        "--validate-on",
+        type=Path,
+        default=None,
+        metavar="FILE",
+        help="torque logs: judge on this separate log (read as --data) instead of time blocks",
+    )
     return p
+
+
+def heldout_options(args: argparse.Namespace, n: int) -> dict[str, Any]:
+    """``folds`` and ``validate_on`` of the torque-log routes from ``--folds``/``--validate-on``."""
+    kw: dict[str, Any] = {} if args.folds is None else {"folds": args.folds}
+    if args.validate_on is not None:
+        with about(args.validate_on):
+            kw["validate_on"] = read_log(args, args.validate_on, n)
+    return kw
 
 
 def data_kind(path: Path, columns: Any = None) -> str:
@@ -233,6 +256,7 @@ def identify_torque_log(robot: Robot, path: Path, args: argparse.Namespace) -> I
             estimator=args.estimator,
             std=args.std or "classical",
             **kw,
+            **heldout_options(args, robot.n),
         )
 
 
@@ -241,6 +265,10 @@ def identify_torque_log(robot: Robot, path: Path, args: argparse.Namespace) -> I
 
 def read_static_file(robot: Robot, path: Path, args: argparse.Namespace) -> StaticDataset:
     """Static data (checked), through ``--columns``/``--units`` when given; notes logged."""
+    if args.folds is not None or args.validate_on is not None:
+        raise DataError(
+            f"{path.name}: --folds and --validate-on apply to torque logs, not static data"
+        )
     cmap = column_map(args)
     if cmap is not None:
         from ..io.columns import load_mapped_static_data
@@ -324,7 +352,9 @@ def run_consistent(robot: Robot, args: argparse.Namespace) -> int:
                 f"{args.data.name}: the log has {data.n} joints; robot {robot.name!r} has "
                 f"{robot.n}; hint: pass the robot the log was recorded with"
             )
+        kw = heldout_options(args, robot.n)
     else:
+        kw = {}
         data = read_static_file(robot, args.data, args)
         mismatch = recorded_robot_mismatch(robot, data.metadata)
         if mismatch is not None:
@@ -338,7 +368,8 @@ def run_consistent(robot: Robot, args: argparse.Namespace) -> int:
         if not 0.0 <= v[0] <= v[1]:
             raise DataError(f"--total-mass must be MIN,MAX, 0 <= MIN <= MAX; got {args.total_mass}")
         band = (float(v[0]), float(v[1]))
-    kw = {} if args.cutoff is None else {"cutoff_hz": args.cutoff}
+    if args.cutoff is not None:
+        kw["cutoff_hz"] = args.cutoff
     with about(args.data):
         result = identify_consistent(
             robot,
@@ -388,6 +419,9 @@ def format_summary(model: IdentifiedModel, *, width: int = 60) -> str:
     ]
     if fit.residual_rms == 0.0 or not np.any(fit.std[fit.kept]):
         head.append("the residual is zero to rounding (exact data): standard deviations are 0")
+    ho = meta.get("heldout")
+    if ho:
+        head.append(heldout_line(ho))
     if model.base.gap is not None:
         hi, lo = model.base.gap
         head.append(
@@ -417,6 +451,19 @@ def format_summary(model: IdentifiedModel, *, width: int = 60) -> str:
             f"{'yes' if fit.kept[k] else 'no':<4}  {e}"
         )
     return "\n".join(head + rows)
+
+
+def heldout_line(ho: dict[str, Any]) -> str:
+    """The training and held-out errors of least squares (``metadata["heldout"]``)."""
+    how = (
+        "on the --validate-on log"
+        if ho.get("scheme") == "file"
+        else f"over {ho.get('folds')} contiguous time blocks"
+    )
+    return (
+        f"least squares: training error {ho['training_error_percent']:.4g} %, held-out "
+        f"error {ho['heldout_error_percent']:.4g} % ({how})"
+    )
 
 
 def save_demo_stage(out_dir: Path, res: IdentificationStageResult) -> list[Path]:

@@ -56,6 +56,7 @@ import numpy as np
 from ..exceptions import DynidError
 from ..feasibility.bounds import default_bounds
 from ..feasibility.constraints import principal_moments
+from ..feasibility.heldout import HeldOutJudgement
 from ..feasibility.retrieve import (
     RetrievalOptions,
     RetrievalProgress,
@@ -233,6 +234,8 @@ def format_consistent_summary(result: ConsistentResult) -> str:
         f"{100 * (r.residual_ratio - 1):.3f} % above the unconstrained fit",
         f"solver {r.solver}: {r.status}, {r.run_time:.2f} s",
     ]
+    if r.heldout is not None:
+        lines += heldout_table(r.heldout)
     if r.friction is not None:
         at = "motors" if r.drive is not None and r.drive.friction_at == "motor" else "joints"
         lines.append(
@@ -250,6 +253,19 @@ def format_consistent_summary(result: ConsistentResult) -> str:
     if not r.feasible:
         lines.append(str(r.report))
     return "\n".join(lines)
+
+
+def heldout_table(j: HeldOutJudgement) -> list[str]:
+    """Training against held-out errors of least squares and of the consistent fit."""
+    how = "the --validate-on log" if j.scheme == "file" else f"{j.folds} contiguous time blocks"
+    verdict = "accepted" if j.accepted else "NOT accepted"
+    return [
+        f"torque error [%]      {'training':>9}  {'held-out':>9}   (held out: {how})",
+        f"least squares         {j.ls_training_percent:>9.4g}  {j.ls_heldout_percent:>9.4g}",
+        f"consistent            {j.training_percent:>9.4g}  {j.heldout_percent:>9.4g}",
+        f"{verdict}: held-out error {100 * (j.ratio - 1):+.3g} % against least squares "
+        f"(tolerance +{100 * j.tolerance:g} %); the training residual does not decide",
+    ]
 
 
 def write_outputs(

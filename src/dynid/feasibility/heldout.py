@@ -142,8 +142,8 @@ def search_weight(
             w,
             search,
             (
-                f"the top of the search range: the held-out error stays within "
-                f"{100 * allowance:g} % of the best ({best:.3g} %) at every weight"
+                f"the top of the search range, whose held-out error is within "
+                f"{100 * allowance:g} % of the best ({best:.3g} %)"
             ),
         )
     a, b = grid[good], grid[good + 1]

@@ -24,6 +24,7 @@ from ..exceptions import ShapeError
 from ..identification.classical import identify_from_log
 from ..identification.data import StaticDataset
 from ..identification.estimators import Estimator, EstimatorName
+from ..identification.holdout import DEFAULT_FOLDS
 from ..identification.log import DEFAULT_CUTOFF_HZ, TorqueLog
 from ..identification.static import identify_static
 from ..model.drive import Drive
@@ -49,6 +50,8 @@ def identify_consistent(
     rtol: float | None = None,
     drive: Drive | None = None,
     estimator: EstimatorName | Estimator = "ols",
+    folds: int = DEFAULT_FOLDS,
+    validate_on: TorqueLog | None = None,
 ) -> ConsistentResult:
     """Physically consistent link parameters (and friction) identified from data.
 
@@ -72,6 +75,10 @@ def identify_consistent(
     estimator : {"ols", "wls", "irls"} or Estimator
         The unconstrained fit's estimator; its weighted covariance is the consistent fit's
         data term (:mod:`dynid.identification.estimators`).
+    folds, validate_on
+        Torque logs: the held-out judgement (contiguous time blocks, or a separate log) that
+        chooses the prior's weight and accepts the result
+        (:mod:`dynid.feasibility.heldout`).
 
     Returns
     -------
@@ -96,6 +103,8 @@ def identify_consistent(
             rtol=rtol,
             drive=drive,
             estimator=estimator,
+            folds=folds,
+            validate_on=validate_on,
         )
         term = coefficient_term(model, with_friction=True)
         kind = "log"

@@ -46,7 +46,7 @@ from ..regressors.terms import (
     friction_labels,
 )
 from ..regressors.torque import torque_regressor_prepared
-from .estimators import Estimator, EstimatorName, estimator_named
+from .estimators import Estimator, EstimatorName, estimator_named, row_weights
 from .holdout import DEFAULT_FOLDS, HeldOut, block_labels, block_normals, cross_validate
 from .least_squares import LeastSquaresFit, conditioning_advice
 from .log import DEFAULT_CUTOFF_HZ, TorqueLog, joint_side_log, prepare_log
@@ -231,16 +231,17 @@ def identify_from_log(
             "speeds in both directions excites them (dynid excite optimises one); a joint "
             "that never moves leaves its friction unidentifiable"
         ) from exc
-    held = _held_out(W, y, n, folds, fit.sigma, cols)
+    rw = row_weights(est, W, y, np.tile(np.arange(n), N), fit.beta)
+    held = _held_out(W * rw[:, None], y * rw, n, folds, cols)
     if validate_on is not None:
         vW, vy = _validation_rows(
             robot, validate_on, drive, bp, terms, cols, cutoff_hz, trim_s, fs / k
         )
+        vw = row_weights(est, vW, vy, np.tile(np.arange(n), vy.size // n), fit.beta)
         held = HeldOut.separate(
-            block_normals(W, y, np.zeros(y.size, dtype=np.intp))[0].expanded(cols),
-            block_normals(vW, vy, np.zeros(vy.size, dtype=np.intp))[0].expanded(cols),
-            fit.sigma,
-        )
+            block_normals(W * rw[:, None], y * rw, np.zeros(y.size, dtype=np.intp))[0],
+            block_normals(vW * vw[:, None], vy * vw, np.zeros(vy.size, dtype=np.intp))[0],
+        ).expanded(cols)
     if not cols.all():
         fit = _expanded(fit, cols)
     for msg in conditioning_advice(fit, labels, what="the trajectory"):
@@ -298,17 +299,17 @@ def _held_out(
     y: NDArray[np.float64],
     n: int,
     folds: int,
-    sigma: float,
     cols: NDArray[np.bool_],
 ) -> HeldOut | None:
     """The k-fold time blocks of the rows (sample-major, ``n`` rows a sample) over all the
-    columns (``cols`` those of ``W``); None when the log is too short for them."""
+    columns (``cols`` those of ``W``, rows weighted as the estimator weighs them); None
+    when the log is too short for them."""
     N = y.size // n
     try:
         labels = np.repeat(block_labels(N, folds), n)
     except OptionError:
         return None
-    return HeldOut.k_fold(block_normals(W, y, labels), sigma).expanded(cols)
+    return HeldOut.k_fold(block_normals(W, y, labels)).expanded(cols)
 
 
 def _validation_rows(

@@ -35,7 +35,16 @@ from numpy.typing import NDArray
 from ..exceptions import OptionError
 from .least_squares import LeastSquaresFit, _fit_with_pruning
 
-__all__ = ["ESTIMATORS", "IRLS", "OLS", "WLS", "Estimator", "EstimatorName", "estimator_named"]
+__all__ = [
+    "ESTIMATORS",
+    "IRLS",
+    "OLS",
+    "WLS",
+    "Estimator",
+    "EstimatorName",
+    "estimator_named",
+    "row_weights",
+]
 
 EstimatorName = Literal["ols", "wls", "irls"]
 
@@ -233,6 +242,32 @@ class IRLS:
 
 #: The estimators by name (``--estimator``).
 ESTIMATORS: dict[str, type[OLS] | type[WLS] | type[IRLS]] = {"ols": OLS, "wls": WLS, "irls": IRLS}
+
+
+def row_weights(
+    estimator: Estimator,
+    W: NDArray[np.float64],
+    y: NDArray[np.float64],
+    groups: NDArray[np.intp],
+    beta: NDArray[np.float64],
+) -> NDArray[np.float64]:
+    """The weight of every row (m,) at the estimate ``beta``, as the estimator weighs it:
+    1 (OLS, and estimators of a user's), ``1 / sigma_g`` (WLS), Huber's
+    ``sqrt(min(1, c / |e / s_g|)) / s_g`` (IRLS), from the residual ``e = y - W beta``. For
+    held-out judgement in the estimator's terms (an outlier weighs there as in the fit)."""
+    if not isinstance(estimator, WLS | IRLS):
+        return np.ones(y.size)
+    e = y - W @ beta
+    s = group_noise(e, groups, 1.0 - W.shape[1] / max(y.size, 1))
+    if isinstance(estimator, WLS):
+        return np.asarray(1.0 / s[groups], dtype=np.float64)
+    for g in np.unique(groups):
+        mad = float(np.median(np.abs(e[groups == g])))
+        if mad > 0:
+            s[g] = 1.4826 * mad
+    u = np.abs(e) / s[groups]
+    hub = np.minimum(1.0, estimator.c / np.maximum(u, 1e-300))
+    return np.asarray(np.sqrt(hub) / s[groups], dtype=np.float64)
 
 
 def estimator_named(estimator: str | Estimator) -> Estimator:

@@ -121,6 +121,12 @@ class Normals:
         return Normals(G, b, self.c, self.rows)
 
 
+def _noise(whole: Normals) -> float:
+    """``sqrt(SSE / (m - p))`` of least squares on ``whole`` (1 without residual)."""
+    s = math.sqrt(whole.sse(whole.solve()) / max(whole.rows - whole.p, 1))
+    return s if s > 0 else 1.0
+
+
 def block_labels(n_samples: int, folds: int = DEFAULT_FOLDS) -> NDArray[np.intp]:
     """The contiguous block (0 .. folds-1) of each sample, blocks as equal as possible.
 
@@ -186,7 +192,8 @@ class HeldOut:
     scheme : str
         ``"blocks"`` (k-fold over contiguous time blocks) or ``"file"`` (a separate log).
     noise : float
-        Residual standard deviation of the fit on all data (scales a fold's data term).
+        Residual standard deviation of least squares on all data, ``sqrt(SSE / (m - p))``
+        (scales a fold's data term).
     """
 
     train: tuple[Normals, ...]
@@ -196,17 +203,17 @@ class HeldOut:
     noise: float = 1.0
 
     @classmethod
-    def k_fold(cls, blocks: Sequence[Normals], noise: float = 1.0) -> HeldOut:
+    def k_fold(cls, blocks: Sequence[Normals]) -> HeldOut:
         """Fold ``j`` fitted on every block but ``j``, predicting block ``j``."""
         whole = blocks[0]
         for blk in blocks[1:]:
             whole = whole + blk
-        return cls(tuple(whole - b for b in blocks), tuple(blocks), whole, "blocks", noise)
+        return cls(tuple(whole - b for b in blocks), tuple(blocks), whole, "blocks", _noise(whole))
 
     @classmethod
-    def separate(cls, whole: Normals, test: Normals, noise: float = 1.0) -> HeldOut:
+    def separate(cls, whole: Normals, test: Normals) -> HeldOut:
         """One fold: fitted on all of ``whole``, predicting ``test`` (another recording)."""
-        return cls((whole,), (test,), whole, "file", noise)
+        return cls((whole,), (test,), whole, "file", _noise(whole))
 
     @property
     def folds(self) -> int:

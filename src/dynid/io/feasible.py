@@ -161,6 +161,9 @@ def feasible_to_dict(source: Any, *, seed: int | None = None) -> dict[str, Any]:
         d["feasible"] = bool(source.feasible)
         d["relative_residual"] = _num(source.relative_residual)
         d["seed"] = source.seed
+        ho = getattr(source, "heldout", None)
+        if ho is not None:
+            d["heldout"] = ho.as_dict()
     elif seed is not None:
         d["seed"] = seed
     return d
@@ -395,7 +398,10 @@ def consistent_report_to_dict(result: ConsistentResult) -> dict[str, Any]:
     ``lambda_min(J)/tr(J)``), ``pseudo_inertia_margin`` and ``divergence`` per link,
     ``distance_to_prior`` (mass [kg], CoM [m] per link), ``friction`` (classical, when
     identified), ``solver``, ``status``, ``run_time_s``, ``notes``, ``options``,
-    ``total_mass``, ``bounds``.
+    ``total_mass``, ``bounds``; ``heldout`` (training and held-out torque errors of least
+    squares and of the consistent fit, the weight search ``[w, held-out error %]``, the
+    acceptance; None without held-out folds) and ``on_bound`` (parameters decided by a
+    bound, not the data).
     """
     rep = result.report
     o = result.options
@@ -436,6 +442,8 @@ def consistent_report_to_dict(result: ConsistentResult) -> dict[str, Any]:
         "run_time_s": float(result.run_time),
         "seed": result.seed,
         "notes": list(result.notes),
+        "heldout": None if result.heldout is None else result.heldout.as_dict(),
+        "on_bound": list(result.on_bound),
         "options": {
             "objective": o.objective,
             "prior_weight": o.prior_weight,
@@ -444,6 +452,7 @@ def consistent_report_to_dict(result: ConsistentResult) -> dict[str, Any]:
             "fit": o.fit,
             "mass_factor": o.mass_factor,
             "residual_tol": o.residual_tol,
+            "heldout_tol": o.heldout_tol,
             "tol": o.tol,
         },
         "total_mass": None if result.total_mass is None else list(result.total_mass),
