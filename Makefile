@@ -34,7 +34,15 @@ demo: $(RUNTIME)
 # one worker per core (pytest-xdist); PYTEST_WORKERS=0 runs in one process
 PYTEST_WORKERS ?= auto
 
+# Chromium renders the HTML reports in tests/test_html_report.py (skipped without it): when
+# it is missing, install Debian's package where apt-get can (root, a Debian system); any
+# failure is ignored, quietly.
+CHROMIUM_INSTALL = command -v chromium >/dev/null 2>&1 || { \
+	(DEBIAN_FRONTEND=noninteractive apt-get update -qq && \
+	 DEBIAN_FRONTEND=noninteractive apt-get install -y -qq chromium) >/dev/null 2>&1 || true; }
+
 test: $(TESTS)
+	@$(CHROMIUM_INSTALL)
 	MPLBACKEND=Agg $(PY) -m pytest -q -n $(PYTEST_WORKERS)
 
 # everything but the tests marked slow (over about 10 s each)

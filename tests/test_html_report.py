@@ -9,11 +9,19 @@ from __future__ import annotations
 
 import base64
 import json
+import re
+import shutil
 import struct
+import subprocess
 import urllib.parse
 import zlib
 from html.parser import HTMLParser
+from pathlib import Path
 
+import numpy as np
+import pytest
+
+from dynid.cli.__main__ import main
 from dynid.io.html_report import (
     REPORT_NAME,
     ReportTable,
@@ -22,6 +30,7 @@ from dynid.io.html_report import (
     render_html_report,
     save_html_report,
 )
+from dynid.io.run_output import MANIFEST
 
 
 class _Page(HTMLParser):
@@ -80,7 +89,7 @@ class _Page(HTMLParser):
 
 def _png(width: int, height: int, seed: int) -> bytes:
     """A valid RGB PNG of random pixels, built from the format's definition (zlib, CRCs)."""
-    rng = __import__("numpy").random.default_rng(seed)
+    rng = np.random.default_rng(seed)
     rows = b"".join(
         b"\x00" + rng.integers(0, 256, 3 * width, dtype="uint8").tobytes() for _ in range(height)
     )
@@ -220,3 +229,139 @@ def test_input_files_are_the_existing_files_outside_the_output(tmp_path):
 def test_save_writes_the_page(tmp_path):
     p = save_html_report(tmp_path / REPORT_NAME, RunSummary(command="excite"), {})
     assert p.read_text(encoding="utf-8").startswith("<!DOCTYPE html>")
+
+
+# ---------------------------------------------------------------------- every command
+#: The commands that write a folder, each with a short run (output folder -> argv).
+COMMANDS = {
+    "identify": ["identify", "--data", "{d}/s.csv"],
+    "consistent": ["identify", "--data", "{d}/s.csv", "--consistent"],
+    "friction": ["friction", "--model", "{d}/identify/identification.json", "--data", "{d}/l.csv"],
+    "validate": [
+        "validate",
+        "--model",
+        "{d}/identify/identification.json",
+        "--friction",
+        "{d}/friction/friction.json",
+        "--data",
+        "{d}/l.csv",
+    ],
+    "retrieve": ["retrieve", "--model", "{d}/identify/identification.json"],
+    "payload": ["payload", "--robot", "panda", "--data", "{d}/s.csv"],
+    "excite": [
+        "excite",
+        "--duration",
+        "1",
+        "--harmonics",
+        "1",
+        "--base-frequency",
+        "0.5",
+        "--max-iter",
+        "1",
+    ],
+}
+
+
+@pytest.fixture(scope="module")
+def runs(tmp_path_factory) -> Path:
+    """One short run of each command, in order, each into its own folder."""
+    d = tmp_path_factory.mktemp("reports")
+    assert main(["acquire-static", "--n", "60", "--seed", "3", "--out", f"{d}/s.csv", "-q"]) == 0
+    sim = ["simulate", "--trajectory", "sinusoid", "--duration", "2", "--rate", "200"]
+    assert main([*sim, "--seed", "1", "--out", f"{d}/l.csv", "-q"]) == 0
+    for name, argv in COMMANDS.items():
+        code = main([a.format(d=d) for a in argv] + ["--out", str(d / name), "-q"])
+        assert code == 0, name
+    return d
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("name", list(COMMANDS))
+def test_every_command_writes_its_report(runs, name):
+    """report.html is part of the folder's set; it embeds every figure of the run and
+    links every other file; the JSON results are tables, the command line is shown."""
+    out = runs / name
+    files = json.loads((out / MANIFEST).read_text())["files"]
+    assert REPORT_NAME in files
+    page_text = (out / REPORT_NAME).read_text(encoding="utf-8")
+    page = _Page(page_text)
+    pngs = sorted(f for f in files if f.endswith(".png"))
+    embedded = {img["alt"]: base64.b64decode(img["src"].split(",", 1)[1]) for img in page.images}
+    assert embedded == {f: (out / f).read_bytes() for f in pngs}
+    linked = {urllib.parse.unquote(h) for h in page.links}
+    assert set(files) - {REPORT_NAME} <= linked
+    assert all((out / h).exists() for h in linked if not h.startswith("../"))
+    for f in files:
+        if f.endswith(".json"):
+            schema = json.loads((out / f).read_text())["schema"]
+            assert schema in page.cells() or schema in "".join(page.text)
+    assert len(page.tables) >= 3  # inputs, files, and at least one result
+    assert COMMANDS[name][0] in "".join(page.text) and page.external == []
+    inputs = {a.replace("{d}/", "../") for a in COMMANDS[name] if a.startswith("{d}/")}
+    assert inputs <= linked  # the input files, linked from the folder
+
+
+# ---------------------------------------------------------------------- in a browser
+CHROMIUM = next(
+    (p for p in map(shutil.which, ("chromium", "chromium-browser", "google-chrome")) if p), None
+)
+needs_chromium = pytest.mark.skipif(
+    CHROMIUM is None, reason="no chromium on PATH (make test installs it where apt-get can)"
+)
+
+
+def _browser(page: Path, profile: Path, *args: str) -> subprocess.CompletedProcess:
+    assert CHROMIUM is not None
+    argv = [CHROMIUM, "--headless", "--no-sandbox", "--disable-gpu", "--hide-scrollbars"]
+    argv += [f"--user-data-dir={profile}", "--virtual-time-budget=10000", *args]
+    return subprocess.run(
+        [*argv, page.resolve().as_uri()], capture_output=True, text=True, timeout=180
+    )
+
+
+def _check_in_browser(page: Path, tmp_path: Path) -> None:
+    """The rendered page: every figure decoded at its file's width, the tables in the
+    document, and a screenshot that is not blank."""
+    text = page.read_text(encoding="utf-8")
+    widths = [
+        struct.unpack(">I", base64.b64decode(src)[16:20])[0]  # IHDR width of the PNG
+        for src in re.findall(r'src="data:image/png;base64,([^"]+)"', text)
+    ]
+    dom = _browser(page, tmp_path / "profile", "--dump-dom")
+    if dom.returncode != 0 or "<body" not in dom.stdout:
+        pytest.skip(f"chromium cannot run here: {dom.stderr.strip()[-300:]}")
+    decoded = re.search(r'data-figures-decoded="(\d+)"', dom.stdout)
+    assert decoded is not None, "the page's script did not run"
+    assert int(decoded.group(1)) == len(widths) > 0
+    assert [int(w) for w in re.findall(r'data-natural-width="(\d+)"', dom.stdout)] == widths
+    assert len(_Page(dom.stdout).tables) == len(_Page(text).tables) >= 3
+    shot = tmp_path / "shot.png"
+    r = _browser(page, tmp_path / "profile", f"--screenshot={shot}", "--window-size=1200,2000")
+    assert r.returncode == 0 and shot.is_file(), r.stderr[-300:]
+    image = pytest.importorskip("PIL.Image")
+    with image.open(shot) as im:
+        gray = np.asarray(im.convert("L"), dtype=float)
+    assert gray.shape == (2000, 1200)
+    assert gray.std() > 10 and (gray < 128).mean() > 0.01  # text, tables and figures drawn
+
+
+@needs_chromium
+def test_a_report_renders_in_chromium(tmp_path):
+    """A report of synthetic results with two figures, rendered headless."""
+    out = tmp_path / "run"
+    (out / "sub").mkdir(parents=True)
+    (out / "a.png").write_bytes(_png(400, 300, seed=3))
+    (out / "sub" / "b.png").write_bytes(_png(250, 120, seed=4))
+    doc = {"schema": "dynid-test/1", "rank": 7, "joints": [{"fv": 1.0}, {"fv": 2.0}]}
+    (out / "r.json").write_text(json.dumps(doc))
+    files = {f: out / f for f in ("r.json", "a.png", "sub/b.png")}
+    summary = RunSummary(command="demo", argv=("dynid", "demo"), warnings=("w",))
+    save_html_report(out / REPORT_NAME, summary, files)
+    _check_in_browser(out / REPORT_NAME, tmp_path)
+
+
+@pytest.mark.slow
+@needs_chromium
+def test_the_validate_report_renders_in_chromium(runs, tmp_path):
+    """validate's report (two figures of the command) shows its figures in Chromium."""
+    _check_in_browser(runs / "validate" / REPORT_NAME, tmp_path)

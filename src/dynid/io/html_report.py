@@ -57,6 +57,8 @@ MAX_MATRIX = (12, 12)
 MAX_VECTOR = 12
 #: Nesting of JSON objects shown (deeper ones are named and left in the file).
 MAX_DEPTH = 3
+#: Tables of more rows than this start collapsed.
+LONG_TABLE = 20
 #: Printed output longer than this many lines starts collapsed.
 LONG_PRINTOUT = 60
 
@@ -225,11 +227,17 @@ def _with_unit(key: str, units: Mapping[str, str]) -> str:
     return key
 
 
+def _names(n: int, labels: Sequence[list[str]]) -> list[str]:
+    """The first of ``labels`` (joint names, link names) with ``n`` entries, else 1..n."""
+    return next((names for names in labels if len(names) == n), [str(i + 1) for i in range(n)])
+
+
 def _records_table(
-    key: str, records: list[dict], units: Mapping[str, str], labels: list[str] | None = None
+    key: str, records: list[dict], units: Mapping[str, str], labels: Sequence[list[str]] = ()
 ) -> str:
     """Records (``joints[]``) as a table, one row each; rows without a name of their own
-    are named by ``labels`` (the joint names, when as many) or numbered."""
+    are named by ``labels`` (the joint names, when as many) or numbered. A long table
+    starts collapsed."""
     columns: list[str] = []
     for r in records:
         columns += [k for k in r if k not in columns]
@@ -237,21 +245,24 @@ def _records_table(
     rows = [[_cell(r.get(c)) for c in columns] for r in shown]
     headers = [_with_unit(c, units) for c in columns]
     if not {"name", "link", "joint", "method"} & set(columns):
-        names = labels if labels is not None and len(labels) == len(records) else None
+        names = _names(len(records), labels)
         headers.insert(0, "")
         for i, row in enumerate(rows):
-            row.insert(0, _e(names[i] if names else i + 1))
+            row.insert(0, _e(names[i]))
     more = len(records) - len(shown)
     tail = f'<p class="dim">{more} more rows in the file.</p>' if more > 0 else ""
-    return f"<h4>{_e(key)}</h4>" + _table(headers, rows) + tail
+    table = _table(headers, rows) + tail
+    if len(records) > LONG_TABLE:
+        return f"<details><summary>{_e(key)} ({len(records)} rows)</summary>{table}</details>"
+    return f"<h4>{_e(key)}</h4>" + table
 
 
 def _vectors_table(
-    vectors: dict[str, list], labels: list[str] | None, units: Mapping[str, str]
+    vectors: dict[str, list], labels: Sequence[list[str]], units: Mapping[str, str]
 ) -> str:
-    """Same-length numeric vectors side by side, one row per element (joint)."""
+    """Same-length numeric vectors side by side, one row per element (joint, link)."""
     n = len(next(iter(vectors.values())))
-    names = labels if labels is not None and len(labels) == n else [str(i + 1) for i in range(n)]
+    names = _names(n, labels)
     rows = [[_e(names[i])] + [_number(v[i]) for v in vectors.values()] for i in range(n)]
     return _table(["", *(_with_unit(k, units) for k in vectors)], rows)
 
@@ -265,15 +276,15 @@ def _matrix_table(key: str, m: list[list]) -> str:
 def _object_html(
     doc: Mapping[str, Any],
     depth: int,
-    labels: list[str] | None = None,
+    labels: Sequence[list[str]] = (),
     units: Mapping[str, str] | None = None,
 ) -> str:
     """A JSON object: its scalars as a key/value table, then its vectors, records,
     matrices and nested objects (nested objects in collapsible blocks). ``labels`` name
     the rows of per-joint vectors (``joint_names``); ``units`` (the file's ``units``)
     give units to keys."""
-    own_labels = doc.get("joint_names") if _is_string_list(doc.get("joint_names")) else None
-    labels = own_labels or labels
+    own = [doc[k] for k in ("joint_names", "link_names") if _is_string_list(doc.get(k))]
+    labels = [*own, *labels]
     own_units = doc.get("units") if isinstance(doc.get("units"), dict) else None
     units = own_units or units or {}
     scalars, vectors, records, matrices, objects, other = [], {}, [], [], [], []
@@ -297,8 +308,9 @@ def _object_html(
     for key, v in vectors.items():
         by_length.setdefault(len(v), {})[key] = v
     for group in by_length.values():
-        if len(group) == 1 and len(next(iter(group.values()))) <= MAX_VECTOR:
-            scalars += list(group.items())
+        n = len(next(iter(group.values())))
+        if not _has_names(n, labels) and (n <= 3 or (len(group) == 1 and n <= MAX_VECTOR)):
+            scalars += list(group.items())  # xyz, a few values: inline
         elif len(next(iter(group.values()))) <= MAX_ROWS:
             parts.append(_vectors_table(group, labels, units))
         else:
@@ -317,6 +329,10 @@ def _object_html(
         inner = _object_html(v, depth + 1, labels, units) if v else '<p class="dim">empty</p>'
         parts.append(f"<details><summary>{_e(key)}</summary>{inner}</details>")
     return "".join(parts)
+
+
+def _has_names(n: int, labels: Sequence[list[str]]) -> bool:
+    return any(len(names) == n for names in labels)
 
 
 def _is_string_list(v: object) -> bool:
@@ -347,21 +363,23 @@ def _key_numbers(docs: Sequence[tuple[str, Any]]) -> list[tuple[str, str, Any]]:
         places = [("", doc)] + [
             (f"{k.replace('_', ' ')}: ", v)
             for k, v in doc.items()
-            if isinstance(v, dict) and k not in _NOT_RESULTS
+            if isinstance(v, dict)
+            and k not in _NOT_RESULTS
+            and sum(key in v for key, _ in KEY_NUMBERS) >= 2
         ]
         for prefix, obj in places:
             for key, label in KEY_NUMBERS:
                 v = obj.get(key)
-                if not _is_scalar(v) or v is None or (prefix + label, _cell(v)) in seen:
+                if not _is_scalar(v) or v is None or (key, _cell(v)) in seen:
                     continue
-                seen.add((prefix + label, _cell(v)))
+                seen.add((key, _cell(v)))
                 found.append((rel, prefix + label, v))
     return found
 
 
 #: Objects of a JSON result that describe rather than result (not searched for key numbers).
 _NOT_RESULTS = frozenset(
-    {"units", "conventions", "base", "metadata", "robot", "kinematics", "options", "bounds"}
+    {"units", "conventions", "base", "metadata", "robot", "kinematics", "options", "bounds", "std"}
 )
 
 
@@ -542,10 +560,12 @@ def render_html_report(
     meta.append(f"exit status {summary.exit_code}")
     body = [f"<h1>{_e(title)}</h1>", f'<p class="meta">{_e(" | ".join(meta))}</p>']
     if summary.warnings or summary.notes:
-        body.append(
-            f'<p class="banner"><a href="#messages">{len(summary.warnings)} warning(s), '
-            f"{len(summary.notes)} note(s)</a></p>"
-        )
+        counts = [
+            f"{n} {word}{'' if n == 1 else 's'}"
+            for n, word in ((len(summary.warnings), "warning"), (len(summary.notes), "note"))
+            if n
+        ]
+        body.append(f'<p class="banner"><a href="#messages">{", ".join(counts)}</a></p>')
     body.append(f'<h2 id="inputs">Run</h2>{_inputs_html(summary, outdir)}')
     keys = _key_numbers(docs)
     if keys:
