@@ -13,7 +13,7 @@ one-goal solve under 60 us, a batch at over 20,000 goals/s, 200/200 goals reache
 
 The kernels are loaded before timing (a single goal takes the compiled solver once numba
 is loaded; a one-shot call takes the numpy loop, see
-``dynid._compiled.small_call_uses_kernels``).
+``dynid._kernels.small_call_uses_kernels``).
 """
 
 from __future__ import annotations

@@ -175,8 +175,8 @@ def test_ik_compiled_kernel_and_numpy_loop_agree(panda, monkeypatch):
     goals.append((flipped, None))  # exactly pi from the start: the axis sign is a convention
     opts = IKOptions(max_restarts=3)
     compiled = [ik(panda, T, tool=tool, options=opts) for T, tool in goals]
-    assert ik_module._kernel() is not None
-    monkeypatch.setattr(ik_module, "_kernel", lambda: None)
+    assert ik_module._kernel(1) is not None
+    monkeypatch.setattr(ik_module, "_kernel", lambda ndim: None)
     restarts = 0
     for (T, tool), rc in zip(goals, compiled, strict=True):
         rn = ik(panda, T, tool=tool, options=opts)
@@ -198,7 +198,7 @@ def test_ik_batch_of_goals_equals_the_loop_of_single_goals(panda, monkeypatch):
     opts = IKOptions(max_restarts=2)
     for numpy_loop in (False, True):
         if numpy_loop:
-            monkeypatch.setattr(ik_module, "_kernel", lambda: None)
+            monkeypatch.setattr(ik_module, "_kernel", lambda ndim: None)
         res = ik(panda, goals, q0, tool=TOOL, options=opts)
         assert res.q.shape == (3, 2, 7) and res.path is None
         for name in ("converged", "iterations", "position_error", "orientation_error"):
@@ -230,13 +230,13 @@ def test_single_sample_chain_equals_fk_and_jacobian(panda):
     """The solver's single-sample fk + Jacobian equals fk and jacobian (tool, prismatic)."""
     q, _, _ = random_states(panda, 10, seed=28)
     T_link_frame = panda.frame("flange").T_link_frame @ TOOL
-    chain = ik_numpy._Chain(panda, 7, T_link_frame)
+    chain = ik_numpy.Chain(panda, 7, T_link_frame)
     for qs in q:
         T, J = chain.pose_jacobian(qs)
         np.testing.assert_allclose(T, dynid.fk(panda, qs, tool=TOOL), atol=1e-14)
         np.testing.assert_allclose(J, dynid.jacobian(panda, qs, tool=TOOL), atol=1e-14)
     robot = dynid.Robot.from_mdh([0, 0.2, 0.1], [0.1, 0, 0.2], [0, 1.0, -0.5], joint_types="RPR")
-    chain = ik_numpy._Chain(robot, 3, robot.frame("flange").T_link_frame)
+    chain = ik_numpy.Chain(robot, 3, robot.frame("flange").T_link_frame)
     rng = np.random.default_rng(28)
     for qs in rng.uniform(-1, 1, (5, 3)):
         T, J = chain.pose_jacobian(qs)
@@ -254,7 +254,7 @@ def test_orientation_error_helper_round_trips_near_0_and_pi():
         u = rng.normal(size=3)
         w = a * u / np.linalg.norm(u)
         R = spatial.matrix_from_angle_axis(w)
-        *v, theta = ik_numpy._rotvec(R)
+        *v, theta = ik_numpy.rotvec(R)
         assert abs(theta - a) < 1e-9
         np.testing.assert_allclose(spatial.matrix_from_angle_axis(v), R, atol=1e-12)
         if a < np.pi - 1e-6:
@@ -349,7 +349,7 @@ def test_ik_goal_absurdly_far_reports_finite_errors(panda, monkeypatch):
     goal = np.eye(4)
     goal[0, 3] = 1e160
     results = [ik(panda, goal)]
-    monkeypatch.setattr(ik_module, "_kernel", lambda: None)
+    monkeypatch.setattr(ik_module, "_kernel", lambda ndim: None)
     results.append(ik(panda, goal))
     for r in results:
         assert not r.converged

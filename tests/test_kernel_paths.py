@@ -20,7 +20,7 @@ import numpy as np
 import pytest
 
 import dynid
-from dynid import _compiled
+from dynid import _kernels
 from dynid.dynamics import rnea as rnea_module
 from dynid.dynamics.rnea import _rnea, _rnea_numpy, rnea_numpy
 from dynid.dynamics.terms import gravity_torques_numpy, mass_matrix_numpy
@@ -33,9 +33,9 @@ from dynid.regressors.torque import torque_regressor, torque_regressor_numpy
 from conftest import pinocchio_panda_urdf, random_states
 
 pytest.importorskip("numba")
-from dynid.dynamics import _kernels as dyn_kernels  # noqa: E402  (after the skip: imports numba)
-from dynid.kinematics import _chain  # noqa: E402
-from dynid.kinematics import _kernels as kin_kernels  # noqa: E402
+from dynid._kernels import chain as _chain  # noqa: E402  (after the skip: imports numba)
+from dynid._kernels import dynamics as dyn_kernels  # noqa: E402
+from dynid._kernels import kinematics as kin_kernels  # noqa: E402
 
 TOOL = dynid.spatial.transform_from_xyz_rpy([0.02, -0.01, 0.1], [0.1, -0.2, 0.3])
 
@@ -143,12 +143,11 @@ def test_single_sample_thin_path_takes_the_kernel_and_checks_its_input(panda):
     q = np.linspace(-1.0, 1.0, 7)
     dynid.rnea(panda, q, q, q), dynid.mass_matrix(panda, q), dynid.gravity_torques(panda, q)
     dynid.fk(panda, q), dynid.jacobian(panda, q)
-    assert {"rnea_one", "mass_matrix_one", "gravity_torques_one"} <= set(rnea_module.ONE)
-    assert {"frame_pose", "jacobian_one"} <= set(forward_module.ONE)
-    assert rnea_module._RNEA_ONE is not None and forward_module._FK_ONE is not None
+    for name in ("rnea", "mass_matrix", "gravity_torques", "frame_pose", "jacobian"):
+        assert _kernels.KERNELS[name].one is not None, name
     # a strided view and a read-only vector are single samples too
     strided = np.repeat(q, 2)[::2]
-    frozen = _compiled.readonly(q)
+    frozen = _kernels.readonly(q)
     for x in (strided, frozen):
         np.testing.assert_allclose(
             dynid.rnea(panda, x, x, x), rnea_numpy(panda, q, q, q), atol=1e-12
@@ -216,14 +215,14 @@ def test_one_sample_call_in_a_fresh_process_does_not_load_numba(then):
     """A one-shot single sample stays on numpy; a batch or SMALL_CALLS more load the kernels."""
     code = (
         "import sys, numpy as np, dynid\n"
-        "from dynid import _compiled\n"
+        "from dynid import _kernels\n"
         "r = dynid.panda(); q = np.linspace(-1, 1, 7)\n"
         "dynid.fk(r, q); dynid.rnea(r, q, q, q); dynid.jacobian(r, q)\n"
         "assert 'numba' not in sys.modules, 'numba imported by a single sample'\n"
         + (
             "dynid.fk(r, np.stack([q, q]))\n"
             if then == "batch"
-            else "for _ in range(_compiled.SMALL_CALLS): dynid.gravity_torques(r, q)\n"
+            else "for _ in range(_kernels.SMALL_CALLS): dynid.gravity_torques(r, q)\n"
         )
         + "assert 'numba' in sys.modules\n"
     )
@@ -238,7 +237,7 @@ def kernel_rnea(robot, q, dq, ddq, gravity=None):
     g = robot.gravity if gravity is None else gravity
     tau = np.empty(q.shape)
     ok = dyn_kernels.rnea(
-        _compiled.pack(robot, gravity=g),
+        _kernels.pack(robot, gravity=g),
         q.reshape(-1),
         dq.reshape(-1),
         ddq.reshape(-1),
@@ -251,7 +250,7 @@ def kernel_rnea(robot, q, dq, ddq, gravity=None):
 def kernel_mass_matrix(robot, q):
     """The mass-matrix kernel called directly on (B, n) positions."""
     M = np.empty(q.shape + q.shape[-1:])
-    ok = dyn_kernels.mass_matrix(_compiled.pack(robot), q.reshape(-1), M.reshape(-1))
+    ok = dyn_kernels.mass_matrix(_kernels.pack(robot), q.reshape(-1), M.reshape(-1))
     assert ok
     return M
 
@@ -259,7 +258,7 @@ def kernel_mass_matrix(robot, q):
 def kernel_gravity(robot, q):
     """The gravity kernel called directly on (B, n) positions."""
     tau = np.empty(q.shape)
-    ok = dyn_kernels.gravity_torques(_compiled.pack(robot), q.reshape(-1), tau.reshape(-1))
+    ok = dyn_kernels.gravity_torques(_kernels.pack(robot), q.reshape(-1), tau.reshape(-1))
     assert ok
     return tau
 
@@ -267,7 +266,7 @@ def kernel_gravity(robot, q):
 def kernel_link_poses(robot, q):
     """The link-pose kernel called directly on (B, n) positions."""
     T = np.empty((q.shape[0], robot.n + 1, 4, 4))
-    ok = kin_kernels.link_poses(_compiled.pack(robot), q.reshape(-1), T.reshape(-1))
+    ok = kin_kernels.link_poses(_kernels.pack(robot), q.reshape(-1), T.reshape(-1))
     assert ok
     return T
 
@@ -275,9 +274,9 @@ def kernel_link_poses(robot, q):
 def kernel_fk(robot, q, frame, tool=None):
     """The frame-pose kernel called directly on (B, n) positions."""
     link, T_lf = frame_pose_in_link(robot, frame, tool)
-    T_lf = forward_module._readonly(T_lf)  # the type the public functions pass
+    T_lf = _kernels.readonly(T_lf)  # the type the public functions pass
     T = np.empty((q.shape[0], 4, 4))
-    CF = _compiled.pack_frame(_compiled.pack(robot), link, T_lf)
+    CF = _kernels.pack_frame(_kernels.pack(robot), link, T_lf)
     ok = kin_kernels.frame_pose(CF, q.reshape(-1), T.reshape(-1))
     assert ok
     return T
@@ -286,9 +285,9 @@ def kernel_fk(robot, q, frame, tool=None):
 def kernel_jacobian(robot, q, frame, tool=None):
     """The Jacobian kernel called directly on (B, n) positions."""
     link, T_lf = frame_pose_in_link(robot, frame, tool)
-    T_lf = forward_module._readonly(T_lf)  # the type the public functions pass
+    T_lf = _kernels.readonly(T_lf)  # the type the public functions pass
     J = np.empty((q.shape[0], 6, robot.n))
-    CF = _compiled.pack_frame(_compiled.pack(robot), link, T_lf)
+    CF = _kernels.pack_frame(_kernels.pack(robot), link, T_lf)
     ok = kin_kernels.jacobian(CF, q.reshape(-1), J.reshape(-1))
     assert ok
     return J
@@ -799,8 +798,9 @@ def test_import_dynid_does_not_import_numba_or_the_kernels():
     code = (
         "import sys, dynid\n"
         "assert 'numba' not in sys.modules\n"
-        "assert 'dynid.dynamics._kernels' not in sys.modules\n"
-        "assert 'dynid.kinematics._kernels' not in sys.modules\n"
+        "assert 'dynid._kernels.dynamics' not in sys.modules\n"
+        "assert 'dynid._kernels.kinematics' not in sys.modules\n"
+        "assert 'dynid._kernels.chain' not in sys.modules\n"
     )
     subprocess.run([sys.executable, "-c", code], check=True)
 
@@ -810,7 +810,7 @@ def test_packed_arrays_belong_to_one_robot(panda):
     q = np.linspace(-1.0, 1.0, 7)
     for _ in range(2):  # the second call takes the thin paths
         tau, J = dynid.rnea(panda, q, q, q), dynid.jacobian(panda, q)
-    assert panda._packed is not None
+    assert _kernels.cached(panda) is not None
     variants = {
         "heavier": panda.with_params(panda.phi * 1.5),
         "tilted": panda.with_gravity([1.0, 0.0, -9.7]),
@@ -819,7 +819,7 @@ def test_packed_arrays_belong_to_one_robot(panda):
         ),
     }
     for name, other in variants.items():
-        assert other._packed is None, name
+        assert _kernels.cached(other) is None, name
         for _ in range(2):
             np.testing.assert_allclose(
                 dynid.rnea(other, q, q, q), rnea_numpy(other, q, q, q), rtol=1e-12, atol=1e-12
@@ -921,3 +921,39 @@ def test_none_is_not_an_array(panda):
     ):
         with pytest.raises(dynid.ShapeError, match="got None"):
             call()
+
+
+def test_packed_constants_are_dropped_with_their_robot():
+    """The kernels' memo of a robot lives outside it and goes when the robot is collected.
+
+    (The test robot lives at least until the call with ``other``: nothing else holds it,
+    so its id is not reused before the check.)
+    """
+    import gc
+
+    robot = dynid.panda().with_gravity([0.0, 0.0, -9.7])
+    q = np.linspace(-1.0, 1.0, 7)
+    tau = dynid.rnea(robot, q, q, q)
+    np.testing.assert_allclose(tau, rnea_numpy(robot, q, q, q), rtol=1e-12, atol=1e-12)
+    key = id(robot)
+    assert _kernels.cached(robot) is not None and key in _kernels.CACHE.robots
+    assert _kernels.CACHE.robot is robot  # the last robot used is held until another is
+    other = dynid.panda()
+    dynid.rnea(other, q, q, q)
+    assert _kernels.CACHE.robot is other
+    del robot
+    gc.collect()
+    assert key not in _kernels.CACHE.robots
+    assert _kernels.cached(other) is not None
+
+
+def test_every_kernel_is_registered_with_a_numpy_twin():
+    """Each row of the registry names a kernel of its module and a callable numpy twin."""
+    import importlib
+
+    for name, k in _kernels.KERNELS.items():
+        mod = importlib.import_module(f"dynid._kernels.{k.module}")
+        for fn in (k.batch_name, k.one_name):
+            assert fn is None or callable(getattr(mod, fn)), (name, fn)
+        where, twin = k.twin.split(":")
+        assert callable(getattr(importlib.import_module(where), twin)), name

@@ -95,13 +95,15 @@ def test_a_robot_pickles_and_copies_bit_for_bit(panda):
     import copy
     import pickle
 
+    from dynid import _kernels
+
     robot = panda.with_friction(np.tile([0.5, 30.0, 0.01], (7, 1))).with_frame(
         "tcp", np.diag([1.0, -1.0, -1.0, 1.0])
     )
     q = np.linspace(-1.0, 1.0, 7)
     dynid.rnea(robot, q, q, q)  # the packed arrays exist and must not travel
     for other in (pickle.loads(pickle.dumps(robot)), copy.deepcopy(robot)):
-        assert other._packed is None and other.frames.keys() == robot.frames.keys()
+        assert _kernels.cached(other) is None and other.frames.keys() == robot.frames.keys()
         for name in ("T_parent_joint", "axes", "prismatic", "phi", "q_min", "q_max", "dq_max",
                      "ddq_max", "tau_max", "gravity", "friction", "q_neutral"):  # fmt: skip
             a, b = getattr(robot, name), getattr(other, name)

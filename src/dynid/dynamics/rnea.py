@@ -8,7 +8,7 @@ origin), which makes the torques linear in ``phi`` (the basis of the regressors)
 
 Two implementations compute the same torques (to rounding, about 1e-15 relative):
 
-* the compiled kernels of :mod:`dynid.dynamics._kernels` (numba), used when numba is
+* the compiled kernels of :mod:`dynid._kernels.dynamics` (numba), used when numba is
   installed: a loop over samples and joints, compiled on the first call and cached on
   disk; importing dynid does not import numba;
 * the numpy reference path (:func:`rnea_numpy`): samples vectorised, a loop over joints.
@@ -22,14 +22,12 @@ it.
 from __future__ import annotations
 
 from types import ModuleType
-from typing import Any, NamedTuple
+from typing import NamedTuple
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from .. import _checks, _compiled
-from .._compiled import constants as _constants
-from .._compiled import flat as _flat
+from .. import _checks, _kernels
 from ..exceptions import ShapeError
 from ..kinematics.forward import joint_rotations_translations
 from ..model.inertia import matrix_from_inertia6
@@ -37,67 +35,19 @@ from ..model.robot import Robot
 
 __all__ = ["rnea", "rnea_numpy", "kernels", "LinkMotion", "link_motion"]
 
-_KERNELS: ModuleType | None = None
-_LOADED = False
+_F64, _ND = _kernels.F64, np.ndarray
+#: the kernels' one cache (:data:`dynid._kernels.CACHE`)
+_CACHE = _kernels.CACHE
+_RNEA = _kernels.KERNELS["rnea"]
+#: gravity off (the Coriolis and centrifugal torques, the mass matrix's columns)
+ZERO_GRAVITY = _checks.frozen(np.zeros(3))
 
 
 def kernels() -> ModuleType | None:
-    """The compiled kernels module, or None when numba is missing or ``DYNID_NO_NUMBA`` is set.
-
-    Imported once, on the first call; ``DYNID_NO_NUMBA`` is read then. Any value other
-    than ``""`` and ``"0"`` selects the numpy reference path.
-    """
-    global _KERNELS, _LOADED
-    if not _LOADED:
-        _KERNELS, _LOADED = _compiled.kernels(__package__), True
-    return _KERNELS
-
-
-def _kernels_for(ndim: int) -> ModuleType | None:
-    """The kernels for an input with ``ndim`` dimensions, or None for the numpy path.
-
-    A batch (``ndim > 1``) loads them; a single sample uses them once they are loaded,
-    else as :func:`dynid._compiled.small_call_uses_kernels` decides (the numpy path gives
-    the same numbers to rounding without the start-up cost of the kernels).
-    """
-    if _LOADED:
-        return _KERNELS
-    return kernels() if ndim > 1 or _compiled.small_call_uses_kernels() else None
-
-
-_F64, _ND = _compiled.F64, np.ndarray
-#: gravity off (the Coriolis and centrifugal torques, the mass matrix's columns)
-ZERO_GRAVITY = _checks.frozen(np.zeros(3))
-_c64 = _compiled.c_float64
-#: the single-sample kernels' compiled entry points (:func:`dynid._compiled.entry`), by
-#: kernel name, made by :func:`one` once the kernels are loaded
-ONE: dict[str, Any] = {}
-#: ``ONE["rnea_one"]`` for the thin path of :func:`rnea` (None until a single-sample call
-#: has loaded it)
-_RNEA_ONE: Any = None
-
-
-def one(name: str) -> Any:
-    """The compiled entry point of the single-sample kernel ``name`` (kernels loaded).
-
-    Types: a read-only ``C``, float64 joint vectors of any strides, a new C output (see
-    :func:`dynid._compiled.entry`).
-    """
-    global _RNEA_ONE
-    e = ONE.get(name)
-    if e is None:
-        C = _checks.frozen(np.zeros((2, _compiled.C_WIDTH)))
-        v, tau, M = _compiled.VECTOR, np.zeros(1), np.zeros((1, 1))
-        args = {
-            "rnea_one": (C, v, v, v, tau),
-            "gravity_torques_one": (C, v, tau),
-            "mass_matrix_one": (C, v, M),
-            "forward_dynamics_one": (C, v, v, v, tau),
-        }[name]
-        e = ONE[name] = _compiled.entry(getattr(_KERNELS, name), *args)
-        if name == "rnea_one":
-            _RNEA_ONE = e
-    return e
+    """The compiled dynamics kernels, or None when numba is missing or ``DYNID_NO_NUMBA``
+    is set (:func:`dynid._kernels.dispatch.load`; ``DYNID_NO_NUMBA`` is read on the first
+    call, and any value other than ``""`` and ``"0"`` selects the numpy reference path)."""
+    return _kernels.load("dynamics")
 
 
 def cross(a: NDArray[np.float64], b: NDArray[np.float64]) -> NDArray[np.float64]:
@@ -236,34 +186,28 @@ def rnea(
     # single sample: three float64 (n,) numpy arrays of any strides go straight to the
     # compiled single-sample kernel (no conversion, no copy, no dispatch; it checks
     # finiteness)
-    p = robot._packed
+    e = _RNEA.one
     if (
-        p is not None
+        e is not None
         and gravity is None
         and q.__class__ is dq.__class__ is ddq.__class__ is _ND
         and q.dtype is dq.dtype is ddq.dtype is _F64
-        and q.shape == dq.shape == ddq.shape == p.vector
-        and _RNEA_ONE is not None
     ):
-        tau = np.empty(p.vector)
-        try:  # (an object can fake its class; the entry point then refuses it)
-            if _RNEA_ONE(p.C, q, dq, ddq, tau):
-                return tau
-        except TypeError:
-            pass
-    if gravity is None:
-        # lean path: float64 C arrays of one shape (..., n) go to the kernel as they are;
-        # the kernel checks finiteness, and anything else (or a failure) falls through to
-        # the full validation below
-        qa, va, aa = _c64(q), _c64(dq), _c64(ddq)
-        K = None if qa is None else _kernels_for(qa.ndim)
-        if K is not None and qa is not None and va is not None and aa is not None:
-            shape = qa.shape
-            if shape == va.shape == aa.shape and shape and shape[-1] == len(robot.joint_names):
-                tau = np.empty(shape)
-                f = one("rnea_one") if len(shape) == 1 else K.rnea
-                if f(_constants(robot), _flat(qa), _flat(va), _flat(aa), tau.reshape(-1)):
+        p = _CACHE.last if _CACHE.robot is robot else _kernels.find(robot)
+        if p is not None and q.shape == dq.shape == ddq.shape == p.vector:
+            tau = np.empty(p.vector)
+            try:  # (an object can fake its class; the entry point then refuses it)
+                if e(p.C, q, dq, ddq, tau):
                     return tau
+            except TypeError:
+                pass
+    if gravity is None:
+        # float64 arrays of one shape (..., n) go to the kernel as they are; the kernel
+        # checks finiteness, and anything else (or a failure) falls through to the full
+        # validation below
+        tau = _kernels.run(_RNEA, robot, (q, dq, ddq), (len(robot.joint_names),))
+        if tau is not None:
+            return tau
     shape, (q2, dq2, ddq2) = prepare_states(robot, q, dq, ddq)
     g = robot.gravity if gravity is None else _checks.as_exact("gravity", gravity, (3,))
     return _rnea(robot, robot.phi, q2, dq2, ddq2, g).reshape(shape)
@@ -299,13 +243,14 @@ def _rnea(
     The compiled kernel when available, else :func:`_rnea_numpy`. ``dq`` and ``ddq`` may
     also be (1, n), one row for every sample.
     """
-    K = _kernels_for(1 + (q.shape[0] > 1))
+    K = _kernels.compiled(_RNEA, 1 + (q.shape[0] > 1))
     if K is not None:
         B, n = q.shape
         if dq.shape[0] in (1, B) and ddq.shape[0] in (1, B):
             tau = np.empty((B, n))
-            C = _compiled.constants_for(robot, phi, gravity)
-            if K.rnea(C, _flat(q), _flat(dq), _flat(ddq), tau.reshape(-1)):
+            C = _kernels.constants_for(robot, phi, gravity)
+            f = _RNEA.batch  # (the batch kernel takes one row of dq or ddq for all)
+            if f(C, _kernels.flat(q), _kernels.flat(dq), _kernels.flat(ddq), tau.reshape(-1)):
                 return tau
     return _rnea_numpy(robot, phi, q, dq, ddq, gravity)
 

@@ -10,7 +10,7 @@ form ``c(q, v)`` by polarization.
 
 With numba installed (see :func:`dynid.dynamics.rnea.kernels`), ``M`` comes from the
 composite-rigid-body algorithm and ``g`` and the RNEA calls from the compiled kernels of
-:mod:`dynid.dynamics._kernels` (a single sample of :func:`forward_dynamics` is one compiled
+:mod:`dynid._kernels.dynamics` (a single sample of :func:`forward_dynamics` is one compiled
 call: RNEA for ``c + g``, the composite-rigid-body ``M`` and its Cholesky solve);
 :func:`mass_matrix_numpy` and :func:`gravity_torques_numpy` are the numpy reference path
 (``DYNID_NO_NUMBA=1`` selects it everywhere). Both agree to rounding.
@@ -18,27 +18,13 @@ call: RNEA for ``c + g``, the composite-rigid-body ``M`` and its Cholesky solve)
 
 from __future__ import annotations
 
-from typing import Any
-
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from .. import _checks, _compiled
-from .._compiled import constants as _constants
+from .. import _checks, _kernels
 from ..exceptions import ModelError
 from ..model.robot import Robot
-from . import rnea as _rnea_module
-from .rnea import (
-    _F64,
-    _ND,
-    ZERO_GRAVITY,
-    _c64,
-    _flat,
-    _rnea,
-    _rnea_numpy,
-    one,
-    prepare_states,
-)
+from .rnea import ZERO_GRAVITY, _rnea, _rnea_numpy, prepare_states
 
 __all__ = [
     "mass_matrix",
@@ -48,35 +34,24 @@ __all__ = [
     "coriolis",
     "coriolis_matrix",
     "forward_dynamics",
+    "forward_dynamics_numpy",
 ]
 
 _ZERO_G = ZERO_GRAVITY
-#: the single-sample kernels' entry points for the thin paths (set by :func:`_one`)
-_MASS_ONE: Any = None
-_GRAVITY_ONE: Any = None
-_FORWARD_ONE: Any = None
-
-
-def _one(name: str) -> Any:
-    """:func:`dynid.dynamics.rnea.one`, kept for the thin paths of this module."""
-    global _MASS_ONE, _GRAVITY_ONE, _FORWARD_ONE
-    e = one(name)
-    if name == "mass_matrix_one":
-        _MASS_ONE = e
-    elif name == "gravity_torques_one":
-        _GRAVITY_ONE = e
-    else:
-        _FORWARD_ONE = e
-    return e
+_F64, _ND = _kernels.F64, np.ndarray
+#: the kernels' one cache (:data:`dynid._kernels.CACHE`)
+_CACHE = _kernels.CACHE
+_KERNELS = _kernels.KERNELS
+_RNEA, _MASS = _KERNELS["rnea"], _KERNELS["mass_matrix"]
+_GRAVITY, _FORWARD = _KERNELS["gravity_torques"], _KERNELS["forward_dynamics"]
 
 
 def _mass_matrix(robot: Robot, q2: NDArray[np.float64]) -> NDArray[np.float64]:
     """(B, n, n) mass matrices for validated (B, n) positions (kernel when available)."""
-    K = _rnea_module._kernels_for(1 + (q2.shape[0] > 1))
-    if K is not None:
-        B, n = q2.shape
+    B, n = q2.shape
+    if _kernels.compiled(_MASS, 1 + (B > 1)) is not None:
         M = np.empty((B, n, n))
-        if K.mass_matrix(_constants(robot), _flat(q2), M):
+        if _MASS.batch(_kernels.constants(robot), _kernels.flat(q2), M.reshape(-1)):
             return M
     return _mass_matrix_numpy(robot, q2)
 
@@ -116,30 +91,20 @@ def mass_matrix(robot: Robot, q: ArrayLike) -> NDArray[np.float64]:
     # single sample: a float64 (n,) numpy array of any strides goes straight to the
     # compiled single-sample kernel (no conversion, no copy, no dispatch; it checks
     # finiteness)
-    p = robot._packed
-    if (
-        p is not None
-        and q.__class__ is _ND
-        and q.dtype is _F64
-        and q.shape == p.vector
-        and _MASS_ONE is not None
-    ):
-        M = np.empty(p.matrix)
-        try:  # (an object can fake its class; the entry point then refuses it)
-            if _MASS_ONE(p.C, q, M):
-                return M
-        except TypeError:
-            pass
-    # lean path: a float64 C array (..., n) goes to the kernel as it is
-    qa = _c64(q)
-    K = None if qa is None else _rnea_module._kernels_for(qa.ndim)
-    if K is not None and qa is not None:
-        n = len(robot.joint_names)
-        if qa.ndim and qa.shape[-1] == n:
-            M = np.empty((n, n) if qa.ndim == 1 else qa.shape + (n,))
-            f = _one("mass_matrix_one") if qa.ndim == 1 else K.mass_matrix
-            if f(_constants(robot), _flat(qa), M):
-                return M
+    e = _MASS.one
+    if e is not None and q.__class__ is _ND and q.dtype is _F64:
+        p = _CACHE.last if _CACHE.robot is robot else _kernels.find(robot)
+        if p is not None and q.shape == p.vector:
+            M = np.empty(p.matrix)
+            try:  # (an object can fake its class; the entry point then refuses it)
+                if e(p.C, q, M):
+                    return M
+            except TypeError:
+                pass
+    n = len(robot.joint_names)
+    out = _kernels.run(_MASS, robot, (q,), (n, n))
+    if out is not None:
+        return out
     q = _checks.as_batch("q", q, (robot.n,))
     return _mass_matrix(robot, q.reshape(-1, robot.n)).reshape(q.shape + (robot.n,))
 
@@ -158,29 +123,19 @@ def gravity_torques(robot: Robot, q: ArrayLike) -> NDArray[np.float64]:
     ShapeError, NonFiniteError
     """
     # single sample: as in :func:`mass_matrix`
-    p = robot._packed
-    if (
-        p is not None
-        and q.__class__ is _ND
-        and q.dtype is _F64
-        and q.shape == p.vector
-        and _GRAVITY_ONE is not None
-    ):
-        tau = np.empty(p.vector)
-        try:
-            if _GRAVITY_ONE(p.C, q, tau):
-                return tau
-        except TypeError:
-            pass
-    # lean path: a float64 C array (..., n) goes to the kernel as it is
-    qa = _c64(q)
-    K = None if qa is None else _rnea_module._kernels_for(qa.ndim)
-    if K is not None and qa is not None:
-        if qa.ndim and qa.shape[-1] == len(robot.joint_names):
-            tau = np.empty(qa.shape)
-            f = _one("gravity_torques_one") if qa.ndim == 1 else K.gravity_torques
-            if f(_constants(robot), _flat(qa), tau.reshape(-1)):
-                return tau
+    e = _GRAVITY.one
+    if e is not None and q.__class__ is _ND and q.dtype is _F64:
+        p = _CACHE.last if _CACHE.robot is robot else _kernels.find(robot)
+        if p is not None and q.shape == p.vector:
+            tau = np.empty(p.vector)
+            try:
+                if e(p.C, q, tau):
+                    return tau
+            except TypeError:
+                pass
+    out = _kernels.run(_GRAVITY, robot, (q,), (len(robot.joint_names),))
+    if out is not None:
+        return out
     q = _checks.as_batch("q", q, (robot.n,))
     q2 = q.reshape(-1, robot.n)
     z = np.zeros((1, robot.n))
@@ -208,24 +163,19 @@ def coriolis(robot: Robot, q: ArrayLike, dq: ArrayLike) -> NDArray[np.float64]:
     c : ndarray, shape (..., n)
     """
     # single sample: the single-sample RNEA kernel without gravity, at zero acceleration
-    p, e = robot._packed, _rnea_module._RNEA_ONE
-    if (
-        p is not None
-        and q.__class__ is dq.__class__ is _ND
-        and q.dtype is dq.dtype is _F64
-        and q.shape == dq.shape == p.vector
-        and e is not None
-    ):
-        c = np.empty(p.vector)
-        try:  # (an object can fake its class; the entry point then refuses it)
-            if e(p.C0, q, dq, p.zeros, c):
-                return c
-        except TypeError:
-            pass
+    e = _RNEA.one
+    if e is not None and q.__class__ is dq.__class__ is _ND and q.dtype is dq.dtype is _F64:
+        p = _CACHE.last if _CACHE.robot is robot else _kernels.find(robot)
+        if p is not None and q.shape == dq.shape == p.vector:
+            c = np.empty(p.vector)
+            try:  # (an object can fake its class; the entry point then refuses it)
+                if e(p.C0, q, dq, p.zeros, c):
+                    return c
+            except TypeError:
+                pass
     shape, (q2, dq2, _) = prepare_states(robot, q, dq, np.zeros(robot.n))
-    if shape == (robot.n,) and _rnea_module._LOADED and _rnea_module._KERNELS is not None:
-        one("rnea_one")  # the next single sample takes the thin path
-        _compiled.packed(robot)
+    if shape == (robot.n,) and _kernels.loaded(_RNEA) is not None:
+        _kernels.packed(robot)  # the next single sample takes the thin path
     return _rnea(robot, robot.phi, q2, dq2, np.zeros((1, robot.n)), _ZERO_G).reshape(shape)
 
 
@@ -297,26 +247,38 @@ def forward_dynamics(
         a joint that moves no inertia of its own), so the accelerations are undefined.
     """
     # single sample: one compiled call (bias, mass matrix and its Cholesky solve)
-    p = robot._packed
+    e = _FORWARD.one
     if (
-        p is not None
+        e is not None
         and q.__class__ is dq.__class__ is tau.__class__ is _ND
         and q.dtype is dq.dtype is tau.dtype is _F64
-        and q.shape == dq.shape == tau.shape == p.vector
-        and _FORWARD_ONE is not None
     ):
-        ddq = np.empty(p.vector)
-        try:
-            if _FORWARD_ONE(p.C, q, dq, tau, ddq):
-                return ddq
-        except TypeError:
-            pass
+        p = _CACHE.last if _CACHE.robot is robot else _kernels.find(robot)
+        if p is not None and q.shape == dq.shape == tau.shape == p.vector:
+            ddq = np.empty(p.vector)
+            try:
+                if e(p.C, q, dq, tau, ddq):
+                    return ddq
+            except TypeError:
+                pass
     shape, (q2, dq2, tau2) = prepare_states(robot, q, dq, tau, ("q", "dq", "tau"))
-    if shape == (robot.n,) and _rnea_module._LOADED and _rnea_module._KERNELS is not None:
-        _one("forward_dynamics_one")  # the next single sample takes the thin path
-        _compiled.packed(robot)
+    if shape == (robot.n,) and _kernels.loaded(_FORWARD) is not None:
+        _kernels.packed(robot)  # the next single sample takes the thin path
     bias = _rnea(robot, robot.phi, q2, dq2, np.zeros_like(q2), robot.gravity)
     M = _mass_matrix(robot, q2)
+    return _solve_mass_matrix(robot, M, tau2 - bias).reshape(shape)
+
+
+def forward_dynamics_numpy(
+    robot: Robot, q: ArrayLike, dq: ArrayLike, tau: ArrayLike
+) -> NDArray[np.float64]:
+    """:func:`forward_dynamics` by the numpy reference path, never the compiled kernels.
+
+    Same parameters, result, shapes and errors as :func:`forward_dynamics`.
+    """
+    shape, (q2, dq2, tau2) = prepare_states(robot, q, dq, tau, ("q", "dq", "tau"))
+    bias = _rnea_numpy(robot, robot.phi, q2, dq2, np.zeros_like(q2), robot.gravity)
+    M = _mass_matrix_numpy(robot, q2)
     return _solve_mass_matrix(robot, M, tau2 - bias).reshape(shape)
 
 
@@ -337,7 +299,7 @@ def _solve_mass_matrix(
     bad: tuple[int, int] | None = None
     if L is not None:
         share = np.diagonal(L, axis1=-2, axis2=-1) ** 2 / np.diagonal(M, axis1=-2, axis2=-1)
-        low = np.argwhere(share < _compiled.SINGULAR_PIVOT)
+        low = np.argwhere(share < _kernels.SINGULAR_PIVOT)
         if low.size:
             bad = (int(low[0, 0]), int(low[0, 1]))
     if bad is None:

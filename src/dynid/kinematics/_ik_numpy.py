@@ -1,6 +1,6 @@
 """The numpy reference of the inverse-kinematics solve (the documented fallback).
 
-The same simulation loop as the compiled :mod:`dynid.kinematics._ik_kernel`, step for step:
+The same simulation loop as the compiled :mod:`dynid._kernels.ik`, step for step:
 a damped least-squares velocity towards the goal, joint limits and velocity scaling,
 restarts from the given configurations when a solve stalls (see
 :mod:`dynid.kinematics.inverse` for the method and its options). Used when numba is absent
@@ -17,14 +17,14 @@ from numpy.typing import NDArray
 from ..model.robot import Robot
 from .jacobian import _frame_pose_jacobian_numpy
 
-__all__: list[str] = []
+__all__ = ["Chain", "rotvec", "solve_numpy"]
 
 #: Relative decrease of the error norm that counts as progress (see ``stall_iterations``;
 #: the compiled loop writes the same 1e-3).
 _PROGRESS = 1e-3
 
 
-class _Chain:
+class Chain:
     """Pose and Jacobian of one frame for one sample, for the numpy loop.
 
     The numpy reference path of :func:`dynid.kinematics.forward.fk` and
@@ -46,7 +46,7 @@ class _Chain:
         return T[0], J[0, :, : self.m]
 
 
-def _rotvec(R: NDArray[np.float64]) -> tuple[float, float, float, float]:
+def rotvec(R: NDArray[np.float64]) -> tuple[float, float, float, float]:
     """Angle-axis vector (x, y, z) [rad] and angle in [0, pi] of one rotation matrix.
 
     Scalar form of :func:`dynid.spatial.angle_axis_from_matrix`: the skew part is
@@ -91,8 +91,8 @@ def _dls(J: NDArray[np.float64], e: NDArray[np.float64], lam_max: float, eps: fl
 
 
 # ---------------------------------------------------------------------- numpy loop
-def _solve_numpy(
-    chain: _Chain,
+def solve_numpy(
+    chain: Chain,
     q_min: NDArray,
     q_max: NDArray,
     inv_vmax: NDArray,
@@ -103,7 +103,7 @@ def _solve_numpy(
     ipar: NDArray,
     path: NDArray,
 ) -> tuple[int, int, float, float, bool, int, bool]:
-    """The simulation loop with numpy; same steps as :mod:`dynid.kinematics._ik_kernel`."""
+    """The simulation loop with numpy; same steps as :mod:`dynid._kernels.ik`."""
     dt, K, lam, eps, tol_p, tol_o, step_p, step_o, e_damp = (float(x) for x in fpar)
     max_iter, stall, max_restarts = int(ipar[0]), int(ipar[1]), int(ipar[2])
     m = chain.m
@@ -130,7 +130,7 @@ def _solve_numpy(
             continue
         T, J = chain.pose_jacobian(q)
         e[:3] = p_goal - T[:3, 3]
-        ox, oy, oz, err_o = _rotvec(R_goal @ T[:3, :3].T)
+        ox, oy, oz, err_o = rotvec(R_goal @ T[:3, :3].T)
         e[3], e[4], e[5] = ox, oy, oz
         err_p = math.hypot(e[0], e[1], e[2])  # no overflow for a goal absurdly far
         err = math.sqrt(err_p * err_p + err_o * err_o) if err_p < 1e150 else err_p

@@ -5,7 +5,7 @@ the batch shape ``...``. Poses are ``T_base_x``: frame x in the base frame (link
 
 Two implementations compute the same poses (to rounding, about 1e-16 relative):
 
-* the compiled kernels of :mod:`dynid.kinematics._kernels` (numba), used when numba is
+* the compiled kernels of :mod:`dynid._kernels.kinematics` (numba), used when numba is
   installed: a loop over samples and joints, compiled on the first call and cached on
   disk; importing dynid does not import numba;
 * the numpy reference path (:func:`link_poses_numpy`, :func:`fk_numpy`): samples
@@ -19,15 +19,11 @@ variable ``DYNID_NO_NUMBA=1`` before the first kinematics call to force the nump
 from __future__ import annotations
 
 from types import ModuleType
-from typing import Any
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from .. import _checks, _compiled
-from .._compiled import constants as _constants
-from .._compiled import flat as _flat
-from .._compiled import readonly as _readonly
+from .. import _checks, _kernels
 from ..model.robot import Robot
 
 __all__ = [
@@ -40,91 +36,29 @@ __all__ = [
     "kernels",
 ]
 
-_KERNELS: ModuleType | None = None
-_LOADED = False
-_F64, _ND = _compiled.F64, np.ndarray
+_F64, _ND = _kernels.F64, np.ndarray
+#: the kernels' one cache (:data:`dynid._kernels.CACHE`)
+_CACHE = _kernels.CACHE
+_KERNELS = _kernels.KERNELS
+_LINK_POSES, _FRAME_POSE = _KERNELS["link_poses"], _KERNELS["frame_pose"]
 
 
 def kernels() -> ModuleType | None:
-    """The compiled kernels module, or None when numba is missing or ``DYNID_NO_NUMBA`` is set.
-
-    Imported once, on the first call (:func:`dynid._compiled.kernels`); ``DYNID_NO_NUMBA``
-    is read then. Any value other than ``""`` and ``"0"`` selects the numpy reference path.
-    """
-    global _KERNELS, _LOADED
-    if not _LOADED:
-        _KERNELS, _LOADED = _compiled.kernels(__package__), True
-    return _KERNELS
+    """The compiled kinematics kernels, or None when numba is missing or ``DYNID_NO_NUMBA``
+    is set (:func:`dynid._kernels.dispatch.load`; ``DYNID_NO_NUMBA`` is read on the first
+    call, and any value other than ``""`` and ``"0"`` selects the numpy reference path)."""
+    return _kernels.load("kinematics")
 
 
-def _kernels_for(ndim: int) -> ModuleType | None:
-    """The kernels for an input with ``ndim`` dimensions, or None for the numpy path.
-
-    A batch (``ndim > 1``) loads them; a single sample uses them once they are loaded,
-    else as :func:`dynid._compiled.small_call_uses_kernels` decides (the numpy path gives
-    the same numbers to rounding without the start-up cost of the kernels).
-    """
-    if _LOADED:
-        return _KERNELS
-    return kernels() if ndim > 1 or _compiled.small_call_uses_kernels() else None
-
-
-#: compiled entry points of the kernels for one sample, by name (see :func:`one`)
-ONE: dict[str, Any] = {}
-#: the entry point of :func:`fk`'s thin path (None until a single-sample call made it)
-_FK_ONE: Any = None
-
-
-def one(name: str) -> Any:
-    """Kernel ``name``'s entry point for one sample, made on first use (kernels loaded).
-
-    Types: read-only frame constants, a float64 joint vector of any strides, a new C
-    output (see :func:`dynid._compiled.entry`).
-    """
-    global _FK_ONE
-    e = ONE.get(name)
-    if e is None:
-        CF, v = _checks.frozen(np.zeros((3, _compiled.C_WIDTH))), _compiled.VECTOR
-        out = np.zeros((4, 4)) if name == "frame_pose" else np.zeros((6, 1))
-        e = ONE[name] = _compiled.entry(getattr(_KERNELS, name), CF, v, out)
-        if name == "frame_pose":
-            _FK_ONE = e
-    return e
-
-
-def _as_q(robot: Robot, q: ArrayLike) -> NDArray[np.float64] | None:
-    """``q`` as a flat-able float64 C array when that is cheap and its shape is ``(..., n)``.
-
-    The thin path of the public functions: a float64 C-contiguous ndarray passes with two
-    attribute reads, no copy; finiteness is left to the kernels, and None sends the call to
-    the full validation, which raises the documented errors.
-    """
-    a = _compiled.c_float64(q)
-    return a if a is not None and a.shape[-1] == len(robot.joint_names) else None
-
-
-def _frame_entry(robot: Robot, frame: str) -> tuple[int, NDArray, NDArray]:
-    """``(link, T_link_frame, CF)`` of ``frame`` (:class:`dynid._compiled.Packed`), made on
-    first use; ``CF`` are the kernels' constants with the frame."""
-    p = _compiled.packed(robot)
-    hit = p.frames.get(frame) if isinstance(frame, str) else None
-    if hit is None:
-        f = robot.frame(frame)  # raises UnknownNameError for anything but a frame's name
-        T = _readonly(f.T_link_frame)
-        hit = p.frames[frame] = (f.link, T, _compiled.pack_frame(p.C, f.link, T))
-        if frame == "flange":
-            p.flange = hit[2]
-    return hit
-
-
-def _frame_constants(
+def frame_constants(
     robot: Robot, frame: str, tool: ArrayLike | None
 ) -> tuple[int, NDArray[np.float64], NDArray[np.float64]]:
-    """``(link, T_link_frame, CF)`` of ``frame`` with ``tool`` multiplied in."""
+    """``(link, T_link_frame, CF)`` of ``frame`` with ``tool`` multiplied in; ``CF`` are the
+    kernels' constants with the frame (:func:`dynid._kernels.dispatch.frame_entry`)."""
     if tool is None:
-        return _frame_entry(robot, frame)
+        return _kernels.frame_entry(robot, frame)
     link, T = frame_pose_in_link(robot, frame, tool)
-    return link, T, _compiled.pack_frame(_constants(robot), link, T)
+    return link, T, _kernels.pack_frame(_kernels.constants(robot), link, T)
 
 
 def check_q(robot: Robot, q: ArrayLike, name: str = "q") -> NDArray[np.float64]:
@@ -213,12 +147,9 @@ def link_poses(robot: Robot, q: ArrayLike) -> NDArray[np.float64]:
     T_base_link : ndarray, shape (..., n + 1, 4, 4)
         Index 0 is the base (identity), index i is link i; translations in [m].
     """
-    qa = _as_q(robot, q)
-    K = None if qa is None else _kernels_for(qa.ndim)
-    if K is not None and qa is not None:
-        T = np.empty(qa.shape[:-1] + (qa.shape[-1] + 1, 4, 4))
-        if K.link_poses(_constants(robot), _flat(qa), T):
-            return T
+    T = _kernels.run(_LINK_POSES, robot, (q,), (len(robot.joint_names) + 1, 4, 4))
+    if T is not None:
+        return T
     return link_poses_numpy(robot, q)
 
 
@@ -236,9 +167,9 @@ def frame_pose_in_link(
     robot: Robot, frame: str, tool: ArrayLike | None = None
 ) -> tuple[int, NDArray[np.float64]]:
     """The link that carries ``frame`` and the pose of ``frame`` (then ``tool``) in that link."""
-    link, T, _ = _frame_entry(robot, frame)
+    link, T, _ = _kernels.frame_entry(robot, frame)
     if tool is not None:
-        T = _readonly(T @ _checks.as_exact("tool", tool, (4, 4)))
+        T = _kernels.readonly(T @ _checks.as_exact("tool", tool, (4, 4)))
     return link, T
 
 
@@ -278,32 +209,22 @@ def fk(
     """
     # single sample: a float64 (n,) numpy array of any strides goes straight to the
     # compiled kernel (no conversion, no copy, no dispatch; it checks finiteness)
-    p = robot._packed
-    if (
-        p is not None
-        and q.__class__ is _ND
-        and tool is None
-        and q.dtype is _F64
-        and q.shape == p.vector
-        and _FK_ONE is not None
-    ):
-        try:  # (unhashable frames, and objects that fake their class, go the general way)
-            CF = p.flange if frame == "flange" else p.frames.get(frame, (None,) * 3)[2]
-            if CF is not None:
-                T = np.empty((4, 4))
-                if _FK_ONE(CF, q, T):
-                    return T
-        except TypeError:
-            pass
-    link, T_link_frame, CF = _frame_constants(robot, frame, tool)
-    # lean path: a float64 C array of shape (..., n) goes to the kernel as it is
-    qa = _as_q(robot, q)
-    K = None if qa is None else _kernels_for(qa.ndim)
-    if K is not None and qa is not None:
-        T = np.empty((4, 4) if qa.ndim == 1 else qa.shape[:-1] + (4, 4))
-        f = one("frame_pose") if qa.ndim == 1 else K.frame_pose
-        if f(CF, _flat(qa), T):
-            return T
+    e = _FRAME_POSE.one
+    if e is not None and q.__class__ is _ND and tool is None and q.dtype is _F64:
+        p = _CACHE.last if _CACHE.robot is robot else _kernels.find(robot)
+        if p is not None and q.shape == p.vector:
+            try:  # (unhashable frames, and objects that fake their class, go the general way)
+                CF = p.flange if frame == "flange" else p.frames.get(frame, (None,) * 3)[2]
+                if CF is not None:
+                    T = np.empty((4, 4))
+                    if e(CF, q, T):
+                        return T
+            except TypeError:
+                pass
+    link, T_link_frame, CF = frame_constants(robot, frame, tool)
+    out = _kernels.run(_FRAME_POSE, robot, (q,), (4, 4), CF)
+    if out is not None:
+        return out
     return _fk_numpy(robot, q, link, T_link_frame)
 
 

@@ -54,11 +54,11 @@ from typing import Any
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from .. import _checks, _compiled
+from .. import _checks, _kernels
 from ..exceptions import DataError, LimitError, ShapeError, WrongTypeError
 from ..model.robot import Robot
-from ._ik_numpy import _Chain, _rotvec, _solve_numpy
-from .forward import _frame_constants
+from ._ik_numpy import Chain, rotvec, solve_numpy
+from .forward import frame_constants
 
 __all__ = ["IKOptions", "IKResult", "check_pose", "default_q0", "ik"]
 
@@ -248,13 +248,14 @@ def check_pose(name: str, T: ArrayLike) -> NDArray[np.float64]:
 _DEFAULT_OPTIONS = IKOptions()
 
 
-def _kernel() -> Any:
-    """The compiled solver (:mod:`dynid.kinematics._ik_kernel`), or None for the numpy loop.
+_IK = _kernels.KERNELS["ik"]
 
-    None when numba is not installed or ``DYNID_NO_NUMBA`` is set (read on the first call;
-    :func:`dynid._compiled.optional`).
-    """
-    return _compiled.optional(f"{__package__}._ik_kernel")
+
+def _kernel(ndim: int) -> Any:
+    """The compiled solver (:mod:`dynid._kernels.ik`) for one goal (``ndim`` 1) or a batch
+    of goals, or None for the numpy loop (:func:`dynid._kernels.dispatch.compiled`: numba
+    missing or ``DYNID_NO_NUMBA`` set, or a one-shot single goal)."""
+    return _kernels.compiled(_IK, ndim)
 
 
 # ---------------------------------------------------------------------- solver
@@ -329,11 +330,25 @@ def ik(
     opts = _DEFAULT_OPTIONS if options is None else options
     if not isinstance(opts, IKOptions):
         raise WrongTypeError(f"options must be an IKOptions; got {type(opts).__name__}")
-    link, T_link_frame, CF = _frame_constants(robot, frame, tool)
-    n = robot.n
+    link, T_link_frame, CF = frame_constants(robot, frame, tool)
     Tg = np.asarray(T_goal) if isinstance(T_goal, np.ndarray) else None
     if Tg is not None and Tg.ndim > 2:
         return _ik_batch(robot, Tg, q0, link, T_link_frame, CF, opts, rng)
+    return _ik_one(robot, T_goal, q0, link, T_link_frame, CF, opts, rng)
+
+
+def _ik_one(
+    robot: Robot,
+    T_goal: ArrayLike,
+    q0: ArrayLike | None,
+    link: int,
+    T_link_frame: NDArray[np.float64],
+    CF: NDArray[np.float64],
+    opts: IKOptions,
+    rng: np.random.Generator | None,
+) -> IKResult:
+    """:func:`ik` for one goal (4, 4), keeping the path."""
+    n = robot.n
     T_goal = check_pose("T_goal", T_goal)
     q = default_q0(robot) if q0 is None else _checks.as_exact("q0", q0, (n,))
     _check_within_limits(robot, q[None])
@@ -342,29 +357,21 @@ def ik(
     fpar, ipar = _parameters(opts)
     path = np.empty((opts.max_iterations + 1, n))
     path[0] = q
-    # one goal: the kernel once loaded or as small_call_uses_kernels decides (a one-shot
-    # call takes the numpy loop: no start-up cost)
-    K = _kernel() if m > 0 and _compiled.small_call_uses_kernels() else None
+    # one goal: the kernel once loaded or as the dispatcher decides (a one-shot call takes
+    # the numpy loop: no start-up cost)
+    solve = _kernel(1) if m > 0 else None
     q_best = np.empty(n)
     q_restart = np.empty((0, m))
     while True:  # a second pass only when the first one asks for restart configurations
-        if K is not None:
-            k, best_k, err_p, err_o, converged, restarts, more = K.solve_one(
+        if solve is not None:
+            k, best_k, err_p, err_o, converged, restarts, more = solve(
                 CF, m, q_min, q_max, inv_vmax, q_restart, T_goal, fpar, ipar, path, q_best
             )
         else:
-            k, best_k, err_p, err_o, converged, restarts, more = _solve_numpy(
-                _Chain(robot, link, T_link_frame),
-                q_min,
-                q_max,
-                inv_vmax,
-                q_restart,
-                np.array(T_goal[:3, 3]),
-                np.array(T_goal[:3, :3]),
-                fpar,
-                ipar,
-                path,
-            )
+            k, best_k, err_p, err_o, converged, restarts, more = solve_numpy(
+                Chain(robot, link, T_link_frame), q_min, q_max, inv_vmax, q_restart,
+                np.array(T_goal[:3, 3]), np.array(T_goal[:3, :3]), fpar, ipar, path,
+            )  # fmt: skip
         if not more:
             break
         rng = np.random.default_rng(0) if rng is None else rng
@@ -399,37 +406,33 @@ def _check_within_limits(robot: Robot, q: NDArray[np.float64]) -> None:
         )
 
 
-_LIMITS: dict[tuple[int, int, bool], tuple[Robot, tuple[NDArray, NDArray, NDArray]]] = {}
-
-
 def _limits(robot: Robot, m: int, opts: IKOptions) -> tuple[NDArray, NDArray, NDArray]:
     """Position limits and inverse velocity limits (0: none) of the first ``m`` joints.
 
-    Remembered for a few robots (by identity; robots are immutable); never written to.
+    Remembered per robot in the kernels' cache (:class:`dynid._kernels.dispatch.Packed`;
+    robots are immutable); never written to.
     """
-    key = (id(robot), m, bool(opts.velocity_limits))
-    hit = _LIMITS.get(key)
-    if hit is not None and hit[0] is robot:
-        return hit[1]
+    memo = _kernels.packed(robot).limits
+    key = (m, bool(opts.velocity_limits))
+    hit = memo.get(key)
+    if hit is not None:
+        return hit
     q_min, q_max = np.array(robot.q_min[:m]), np.array(robot.q_max[:m])
     inv_vmax = np.zeros(m)
     if opts.velocity_limits:
         dq_max = robot.dq_max[:m]
         inv_vmax = np.where(np.isfinite(dq_max), 1.0 / dq_max, 0.0)
-    if len(_LIMITS) >= 16:
-        _LIMITS.pop(next(iter(_LIMITS)))
-    _LIMITS[key] = (robot, (q_min, q_max, inv_vmax))
+    memo[key] = (q_min, q_max, inv_vmax)
     return q_min, q_max, inv_vmax
 
 
-_PARAMETERS: dict[int, tuple[IKOptions, tuple[NDArray[np.float64], NDArray[np.int64]]]] = {}
-
-
 def _parameters(opts: IKOptions) -> tuple[NDArray[np.float64], NDArray[np.int64]]:
-    """The options as the solvers' ``fpar`` and ``ipar`` arrays (remembered per options)."""
-    hit = _PARAMETERS.get(id(opts))
-    if hit is not None and hit[0] is opts:
-        return hit[1]
+    """The options as the solvers' ``fpar`` and ``ipar`` arrays (remembered per options in
+    the kernels' cache, :data:`dynid._kernels.CACHE`; at most 16)."""
+    memo = _kernels.CACHE.options
+    hit = memo.get(opts)
+    if hit is not None:
+        return hit
     fpar = np.array(
         [
             opts.dt,
@@ -444,9 +447,9 @@ def _parameters(opts: IKOptions) -> tuple[NDArray[np.float64], NDArray[np.int64]
         ]
     )
     ipar = np.array([opts.max_iterations, opts.stall_iterations, opts.max_restarts], np.int64)
-    if len(_PARAMETERS) >= 16:
-        _PARAMETERS.pop(next(iter(_PARAMETERS)))
-    _PARAMETERS[id(opts)] = (opts, (fpar, ipar))
+    if len(memo) >= 16:
+        memo.pop(next(iter(memo)))
+    memo[opts] = (fpar, ipar)
     return fpar, ipar
 
 
@@ -521,19 +524,17 @@ def _ik_batch(
         q_restart = _restart_configurations(q_min, q_max, starts[:, :m], opts, rng)
     else:
         q_restart = np.empty((G, 0, m))
-    K = _kernel() if m > 0 else None
+    solve = _kernel(2) if m > 0 else None
     out = np.array(starts)
     stats = np.zeros((G, 6))
-    if K is not None:
-        K.solve_batch(
-            CF, m, q_min, q_max, inv_vmax, q_restart, goals, fpar, ipar, starts, out, stats
-        )
+    if solve is not None:
+        solve(CF, m, q_min, q_max, inv_vmax, q_restart, goals, fpar, ipar, starts, out, stats)
     elif m > 0:
-        chain = _Chain(robot, link, T_link_frame)
+        chain = Chain(robot, link, T_link_frame)
         path = np.empty((opts.max_iterations + 1, n))
         for g in range(G):
             path[0] = starts[g]
-            k, best_k, ep, eo, conv, rs, _ = _solve_numpy(
+            k, best_k, ep, eo, conv, rs, _ = solve_numpy(
                 chain, q_min, q_max, inv_vmax, q_restart[g], np.array(goals[g, :3, 3]),
                 np.array(goals[g, :3, :3]), fpar, ipar, path,
             )  # fmt: skip
@@ -543,7 +544,7 @@ def _ik_batch(
         for g in range(G):
             T = T_link_frame
             ep = float(np.linalg.norm(goals[g, :3, 3] - T[:3, 3]))
-            eo = _rotvec(goals[g, :3, :3] @ T[:3, :3].T)[3]
+            eo = rotvec(goals[g, :3, :3] @ T[:3, :3].T)[3]
             conv = ep <= opts.position_tolerance and eo <= opts.orientation_tolerance
             stats[g] = (0, ep, eo, conv, 0, 0.0)
     return IKResult(

@@ -4,45 +4,27 @@
 origin, then angular velocity), both expressed in the base frame: ``[v; w] = J(q) dq``.
 Linear rows are in [m/rad] (revolute) or [m/m] (prismatic), angular rows in [rad/rad].
 
-:func:`jacobian` uses the compiled kernel of :mod:`dynid.kinematics._kernels` when numba
+:func:`jacobian` uses the compiled kernel of :mod:`dynid._kernels.kinematics` when numba
 is installed and the numpy reference path (:func:`jacobian_numpy`) otherwise or with
 ``DYNID_NO_NUMBA=1``, as :mod:`dynid.kinematics.forward` does; both agree to rounding.
 """
 
 from __future__ import annotations
 
-from typing import Any
-
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from .. import _checks
+from .. import _checks, _kernels
 from ..exceptions import ShapeError
 from ..model.robot import Robot
-from . import forward as _forward
-from .forward import (
-    _F64,
-    _ND,
-    _as_q,
-    _flat,
-    _frame_constants,
-    check_q,
-    frame_pose_in_link,
-    link_poses_prepared,
-)
+from .forward import check_q, frame_constants, frame_pose_in_link, link_poses_prepared
 
 __all__ = ["jacobian", "jacobian_numpy", "jacobian_to_tool"]
 
-#: the single-sample entry point of the jacobian kernel for the thin path (set by
-#: :func:`_one`)
-_JACOBIAN_ONE: Any = None
-
-
-def _one() -> Any:
-    """:func:`dynid.kinematics.forward.one` of the jacobian kernel, kept for the thin path."""
-    global _JACOBIAN_ONE
-    _JACOBIAN_ONE = _forward.one("jacobian_one")
-    return _JACOBIAN_ONE
+_F64, _ND = _kernels.F64, np.ndarray
+#: the kernels' one cache (:data:`dynid._kernels.CACHE`)
+_CACHE = _kernels.CACHE
+_JACOBIAN = _kernels.KERNELS["jacobian"]
 
 
 def jacobian(
@@ -73,37 +55,26 @@ def jacobian(
 
     Notes
     -----
-    Uses the compiled kernel when available (see :func:`dynid.kinematics.forward.kernels`),
+    Uses the compiled kernel when available (:func:`dynid._kernels.dispatch.compiled`),
     else :func:`jacobian_numpy`.
     """
     # single sample: as in :func:`dynid.kinematics.forward.fk`
-    p = robot._packed
-    if (
-        p is not None
-        and q.__class__ is _ND
-        and tool is None
-        and q.dtype is _F64
-        and q.shape == p.vector
-        and _JACOBIAN_ONE is not None
-    ):
-        try:  # (unhashable frames, and objects that fake their class, go the general way)
-            CF = p.flange if frame == "flange" else p.frames.get(frame, (None,) * 3)[2]
-            if CF is not None:
-                J = np.empty(p.jacobian)
-                if _JACOBIAN_ONE(CF, q, J):
-                    return J
-        except TypeError:
-            pass
-    link, T_link_frame, CF = _frame_constants(robot, frame, tool)
-    # lean path: a float64 C array of shape (..., n) goes to the kernel as it is
-    qa = _as_q(robot, q)
-    K = None if qa is None else _forward._kernels_for(qa.ndim)
-    if K is not None and qa is not None:
-        n = qa.shape[-1]
-        J = np.empty((6, n) if qa.ndim == 1 else qa.shape[:-1] + (6, n))
-        f = _one() if qa.ndim == 1 else K.jacobian
-        if f(CF, _flat(qa), J):
-            return J
+    e = _JACOBIAN.one
+    if e is not None and q.__class__ is _ND and tool is None and q.dtype is _F64:
+        p = _CACHE.last if _CACHE.robot is robot else _kernels.find(robot)
+        if p is not None and q.shape == p.vector:
+            try:  # (unhashable frames, and objects that fake their class, go the general way)
+                CF = p.flange if frame == "flange" else p.frames.get(frame, (None,) * 3)[2]
+                if CF is not None:
+                    J = np.empty(p.jacobian)
+                    if e(CF, q, J):
+                        return J
+            except TypeError:
+                pass
+    link, T_link_frame, CF = frame_constants(robot, frame, tool)
+    out = _kernels.run(_JACOBIAN, robot, (q,), (6, len(robot.joint_names)), CF)
+    if out is not None:
+        return out
     return _jacobian_numpy(robot, q, link, T_link_frame)
 
 

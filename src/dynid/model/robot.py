@@ -76,11 +76,10 @@ def _restore_robot(state: dict[str, Any]) -> Robot:
         elif isinstance(v, np.ndarray):
             v = _checks.frozen(v)
         object.__setattr__(robot, k, v)
-    object.__setattr__(robot, "_packed", None)
     return robot
 
 
-@dataclass(frozen=True, slots=True, eq=False)
+@dataclass(frozen=True, slots=True, eq=False, weakref_slot=True)
 class Robot:
     """Immutable serial-chain robot: kinematics, inertial parameters, limits, friction.
 
@@ -133,9 +132,6 @@ class Robot:
     frames: Mapping[str, Frame] = field(default_factory=dict)
     friction: NDArray[np.float64] | None = None
     q_neutral: NDArray[np.float64] | None = None
-    #: derived read-only arrays for the compiled kernels, made on first use (see
-    #: :class:`dynid._compiled.Packed`); never set by the user, not part of the model
-    _packed: Any = field(default=None, init=False, repr=False, compare=False)
 
     def __post_init__(self) -> None:
         n = len(self.joint_names)

@@ -20,8 +20,8 @@ and its potential energy ``-g_0 \\cdot (m_l p_l + R_l h_l)`` gives
 vector in link ``l`` coordinates.
 
 Two implementations compute the same rows (to rounding): the compiled kernel of
-:mod:`dynid.regressors._kernels` (numba; one pass over the samples, writing only the
-columns asked for), used when :func:`dynid._compiled.kernels` finds the compiled
+:mod:`dynid._kernels.regressors` (numba; one pass over the samples, writing only the
+columns asked for), used when :func:`dynid._kernels.dispatch.compiled` finds the compiled
 kernels, and the numpy path (samples vectorised, a loop over links), used otherwise or
 with ``DYNID_NO_NUMBA=1`` (:func:`static_regressor_numpy` always takes it).
 """
@@ -33,9 +33,7 @@ from types import ModuleType
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from .. import _checks, _compiled
-from .._compiled import constants as _constants
-from .._compiled import flat as _flat
+from .. import _checks, _kernels
 from ..kinematics.forward import link_poses_prepared
 from ..model.robot import Robot
 
@@ -48,9 +46,12 @@ __all__ = [
 ]
 
 
+_STATIC = _kernels.KERNELS["static_regressor"]
+
+
 def _kernel() -> ModuleType | None:
-    """The compiled regressor kernels, or None (numpy path): :func:`dynid._compiled.kernels`."""
-    return _compiled.kernels(__package__)
+    """The compiled regressor kernels, or None (numpy path): :func:`dynid._kernels.load`."""
+    return _kernels.load(_STATIC.module)
 
 
 def static_rows(n: int) -> int:
@@ -123,7 +124,8 @@ def _static_regressor_columns(
         cols = np.full(p, -1, dtype=np.int64)  # output column of each standard parameter
         cols[idx] = np.arange(idx.size)
         Y = np.zeros((idx.size, static_rows(n), B))  # the kernel writes the non-zeros
-        if K.static_regressor(_constants(robot), _flat(q2), cols, Y):
+        f = _kernels.compiled(_STATIC, 2)
+        if f is not None and f(_kernels.constants(robot), _kernels.flat(q2), cols, Y):
             return Y
     Yt = _static_regressor_numpy(robot, q2).transpose(1, 0, 2)  # (10 n, s, B) view
     return np.ascontiguousarray(Yt if columns is None else Yt[idx])

@@ -18,7 +18,7 @@ Stacking for least squares is sample-major: ``Y.reshape(-1, 10 n)`` has row ``s*
 for sample ``s``, joint ``i``.
 
 Two implementations compute the same regressor (to rounding): the compiled kernel of
-:mod:`dynid.regressors._kernels` (numba; one pass over the samples, the link wrench
+:mod:`dynid._kernels.regressors` (numba; one pass over the samples, the link wrench
 regressors carried to the base frame and projected on the joints, writing only the columns
 asked for), used when numba is available and ``DYNID_NO_NUMBA`` is unset, and the numpy
 path (:func:`torque_regressor_numpy`: samples vectorised, a loop over joints).
@@ -29,12 +29,13 @@ from __future__ import annotations
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from .. import _checks, _compiled
-from .._compiled import flat as _flat
+from .. import _checks, _kernels
 from ..dynamics.rnea import link_motion, prepare_states
 from ..model.robot import Robot
 
 __all__ = ["torque_regressor", "torque_regressor_numpy", "link_wrench_regressor"]
+
+_TORQUE = _kernels.KERNELS["torque_regressor"]
 
 
 def _skew(v: NDArray[np.float64]) -> NDArray[np.float64]:
@@ -85,19 +86,20 @@ def torque_regressor_prepared(
     With ``columns`` (distinct standard-parameter indices), only those columns, in that
     order, as the first ``len(columns)`` of a (B, n, ``width``) array (default width:
     ``len(columns)``) whose other columns are uninitialised, for the caller to fill. The
-    compiled kernel (:mod:`dynid.regressors._kernels`) writes them directly when it is
+    compiled kernel (:mod:`dynid._kernels.regressors`) writes them directly when it is
     available, else :func:`_torque_regressor_numpy` gathers them.
     """
     B, n = q.shape
     idx = np.arange(10 * n) if columns is None else np.asarray(columns, dtype=np.intp)
     w = idx.size if width is None else int(width)
-    K = _compiled.kernels(__package__)
-    if K is not None and np.ndim(gravity) == 1:
+    K = _kernels.compiled(_TORQUE, 2) if np.ndim(gravity) == 1 else None
+    if K is not None:
         cols = np.full(10 * n, -1, dtype=np.int64)  # output column of each parameter
         cols[idx] = np.arange(idx.size)
-        C = _compiled.constants_for(robot, robot.phi, gravity)
+        C = _kernels.constants_for(robot, robot.phi, gravity)
         Y = np.empty((B, n, w))
-        if K.torque_regressor(C, _flat(q), _flat(dq), _flat(ddq), cols, Y):
+        flat = _kernels.flat
+        if K(C, flat(q), flat(dq), flat(ddq), cols, Y):
             return Y
     Yn = _torque_regressor_numpy(robot, q, dq, ddq, gravity)
     if columns is None and width is None:
@@ -189,7 +191,7 @@ def torque_regressor(
 
     Notes
     -----
-    Compiled over the batch (:mod:`dynid.regressors._kernels`) when numba is available,
+    Compiled over the batch (:mod:`dynid._kernels.regressors`) when numba is available,
     else :func:`torque_regressor_numpy`.
     """
     shape, (q2, dq2, ddq2) = prepare_states(robot, q, dq, ddq)

@@ -9,7 +9,7 @@ from __future__ import annotations
 
 import math
 
-from ._chain import inline
+from .chain import inline
 
 __all__ = ["cholesky", "cholesky_solve"]
 

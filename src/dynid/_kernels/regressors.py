@@ -5,8 +5,8 @@ This module imports numba, so it is imported lazily, on the first call of
 :func:`dynid.dynamics.rnea.kernels` finds the compiled kernels (numba installed and
 ``DYNID_NO_NUMBA`` unset), never by ``import dynid``. The kernel is compiled on its first
 call and cached on disk (``cache=True``), with the same compiler options as
-:mod:`dynid.dynamics._kernels` (fused multiply-add allowed, no other fast-math flag) and
-its sine and cosine (Cephes, :func:`dynid.dynamics._kernels._sincos`).
+:mod:`dynid._kernels.dynamics` (fused multiply-add allowed, no other fast-math flag) and
+its sine and cosine (Cephes, :func:`dynid._kernels.dynamics._sincos`).
 
 Equations: those of the numpy path, :mod:`dynid.regressors.static` (link poses in the
 base frame, the Jacobian columns of each link origin in link coordinates, then the rows of
@@ -29,8 +29,8 @@ import math
 
 import numpy as np
 
-from .._compiled import C_AXIS, C_PRISMATIC
-from ..kinematics._chain import IDENTITY, compose, finite, jit, joint, motion
+from .chain import IDENTITY, compose, finite, jit, joint, motion
+from .layout import C_AXIS, C_PRISMATIC
 
 __all__ = ["BLOCK", "static_regressor"]
 

@@ -3,16 +3,16 @@
 Every numba kernel of dynid (forward kinematics, Jacobians, inverse dynamics, the mass
 matrix, the regressors and inverse kinematics) builds on these helpers, so the joint
 transform and the chaining are written once. This module imports numba; it is imported
-only by the kernel modules, which are loaded lazily (:func:`dynid._compiled.kernels`).
+only by the kernel modules, which are loaded lazily (:func:`dynid._kernels.dispatch.compiled`).
 
-The robot is the packed constant array ``C`` of :func:`dynid._compiled.pack`.
+The robot is the packed constant array ``C`` of :func:`dynid._kernels.layout.pack`.
 
 Joint transform (pose of link ``i + 1`` in link ``i``): ``T_i = T_parent_joint[i]
 T_joint(q_i)`` with, for a revolute joint about the unit axis ``a`` (``K = [a]x``),
 Rodrigues' ``R = a a^T + cos q (E - a a^T) + sin q K`` and no translation; for a prismatic
 joint ``R = E`` and the translation ``q a``. With ``F`` the rotation of ``T_parent_joint[i]``
 the products ``A0 = F a a^T``, ``A1 = F (E - a a^T)``, ``A2 = F K`` (``0, F, 0`` for a
-prismatic joint) and ``u = F a`` are made once (:func:`dynid._compiled.pack`), so a joint
+prismatic joint) and ``u = F a`` are made once (:func:`dynid._kernels.layout.pack`), so a joint
 costs 21 multiply-adds: ``R = A0 + c A1 + s A2``, ``p = p0 + d u``. :func:`joint_from` takes
 ``(s, c, d) = (sin q, cos q, 0)`` or ``(0, 1, q)``, exact selectors, so that a loop over
 samples has no branch and vectorises. For an axis along z (every modified-DH joint) the
@@ -45,7 +45,7 @@ from numba.core.imputils import impl_ret_borrowed
 from numba.extending import intrinsic
 from numba.np.arrayobj import make_array, populate_array
 
-from .._compiled import C_PRISMATIC, C_ROT, C_SLIDE, C_T
+from .layout import C_PRISMATIC, C_ROT, C_SLIDE, C_T
 
 __all__ = [
     "jit",
@@ -227,7 +227,7 @@ def fixed(C, i):
 
     ``A0, A1, A2`` (9 floats each, row-major) with ``R = A0 + cos q A1 + sin q A2``, ``p0``
     the joint origin and ``u = R_parent_joint a`` (3 floats each), so that
-    ``p = p0 + d u`` (:func:`dynid._compiled.pack`).
+    ``p = p0 + d u`` (:func:`dynid._kernels.layout.pack`).
     """
     A0 = (
         C[i, C_ROT], C[i, C_ROT + 1], C[i, C_ROT + 2], C[i, C_ROT + 3], C[i, C_ROT + 4],
@@ -253,7 +253,7 @@ def joint_from(F, s, c, d):
     """Pose of a link in its parent (12 floats) from its joint's :func:`fixed` constants.
 
     ``R = A0 + c A1 + s A2``, ``p = p0 + d u``: Rodrigues' formula with the fixed rotation
-    multiplied in once, in :func:`dynid._compiled.pack` (see the module docstring). Loops
+    multiplied in once, in :func:`dynid._kernels.layout.pack` (see the module docstring). Loops
     over samples hoist ``fixed`` out and call this inside.
     """
     A0, A1, A2, p0, u = F

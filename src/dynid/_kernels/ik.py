@@ -1,11 +1,13 @@
 """Compiled (numba) inverse kinematics: the whole solve for one goal, and batches of goals.
 
-Imported lazily by :func:`dynid.kinematics.inverse.ik` (:func:`dynid._compiled.kernels`),
-never by ``import dynid``; compiled once and cached on disk. The loop, its damping, limits
-and restarts are documented in :mod:`dynid.kinematics.inverse`; :func:`_solve` takes the same
-steps as the numpy loop ``_solve_numpy`` there (the tests hold their paths to 1e-9). The
-frame pose and Jacobian come from the chain core (:func:`dynid.kinematics._kernels.
-frame_jacobian`), so forward kinematics is not written again here.
+Imported lazily by :func:`dynid.kinematics.inverse.ik` through the dispatcher
+(:func:`dynid._kernels.dispatch.compiled`), never by ``import dynid``; compiled once and
+cached on disk. The loop, its damping, limits and restarts are documented in
+:mod:`dynid.kinematics.inverse`; :func:`_solve` takes the same steps as the numpy loop
+:func:`dynid.kinematics._ik_numpy.solve_numpy` (the tests hold their paths to 1e-9). The
+frame pose and Jacobian come from the chain core
+(:func:`dynid._kernels.kinematics.frame_jacobian`), so forward kinematics is not written
+again here.
 
 :func:`solve_batch` solves many goals in parallel (numba ``prange``, one goal per
 iteration; the threads are numba's, ``NUMBA_NUM_THREADS``), without keeping the paths.
@@ -18,9 +20,9 @@ import math
 import numba
 import numpy as np
 
-from ._chain import angles, inline, jit
-from ._dense import cholesky, cholesky_solve
-from ._kernels import frame_jacobian
+from .chain import angles, inline, jit
+from .dense import cholesky, cholesky_solve
+from .kinematics import frame_jacobian
 
 __all__ = ["solve_one", "solve_batch"]
 
@@ -150,9 +152,9 @@ def _rhs(Jf, e, nf, d, bvec):
 
 @inline
 def _solve(C, m, q_min, q_max, inv_vmax, q_restart, goal, fpar, ipar, path, keep, q_best):
-    """The simulation loop for one goal; see :func:`dynid.kinematics.inverse._solve_numpy`.
+    """The simulation loop for one goal; see :func:`dynid.kinematics._ik_numpy.solve_numpy`.
 
-    ``C`` holds the robot and the frame (:func:`dynid._compiled.pack_frame`); joints
+    ``C`` holds the robot and the frame (:func:`dynid._kernels.layout.pack_frame`); joints
     ``0..m-1`` move the frame. ``path`` (rows, n) holds ``q0`` in row 0 and, when ``keep``,
     receives the motion (``max_iterations + 1`` rows); ``q_best`` (n,) receives the best
     point. ``goal`` (4, 4) is the goal pose, ``ipar`` ``(max_iterations, stall_iterations,
@@ -166,7 +168,7 @@ def _solve(C, m, q_min, q_max, inv_vmax, q_restart, goal, fpar, ipar, path, keep
     by a Cholesky factorisation of ``G``; otherwise from the eigen-decomposition
     ``G = V diag(w) V^T`` (cyclic Jacobi rotations) with the damping of ``s_min``:
     ``J^# e = J^T V (W + lambda^2)^-1 V^T e`` or ``V (W + lambda^2)^-1 V^T J^T e``, the same
-    step as the SVD form of ``_dls``.
+    step as the SVD form of the numpy loop.
     """
     dt, K, lam, eps = fpar[0], fpar[1], fpar[2], fpar[3]
     tol_p, tol_o, step_p, step_o, e_damp = fpar[4], fpar[5], fpar[6], fpar[7], fpar[8]
@@ -271,7 +273,7 @@ def _solve(C, m, q_min, q_max, inv_vmax, q_restart, goal, fpar, ipar, path, keep
             else:
                 ux, uy, uz = sxz, syz, dz
             norm = math.sqrt(ux * ux + uy * uy + uz * uz)
-            if ux * vx + uy * vy + uz * vz < -1e-12 * norm:  # as in _ik_numpy._rotvec
+            if ux * vx + uy * vy + uz * vz < -1e-12 * norm:  # as in _ik_numpy.rotvec
                 norm = -norm
             e[3], e[4], e[5] = theta * ux / norm, theta * uy / norm, theta * uz / norm
         err_o = theta

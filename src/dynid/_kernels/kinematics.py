@@ -1,10 +1,10 @@
 """Compiled (numba) kernels: link poses, frame poses and geometric Jacobians.
 
-Imported lazily, on the first kinematics call (:func:`dynid._compiled.kernels`), never by
-``import dynid``; compiled once and cached on disk (:func:`dynid.kinematics._chain.jit`).
+Imported lazily, on the first kinematics call (:func:`dynid._kernels.dispatch.compiled`), never by
+``import dynid``; compiled once and cached on disk (:func:`dynid._kernels.chain.jit`).
 
-Arguments: ``C``, the robot's packed constants (:func:`dynid._compiled.pack`), with a
-last row for the frame (:func:`dynid._compiled.pack_frame`: its ``link``, 0 = base, and its
+Arguments: ``C``, the robot's packed constants (:func:`dynid._kernels.layout.pack`), with a
+last row for the frame (:func:`dynid._kernels.layout.pack_frame`: its ``link``, 0 = base, and its
 pose ``T_lf`` in that link, a tool already multiplied in) for :func:`frame_pose` and
 :func:`jacobian`; joint positions ``q``, flat float64 of length ``B * n``,
 sample-major (a (B, n) array reshaped). Results go into a C-contiguous output array of
@@ -12,12 +12,12 @@ any shape, read flat, row-major:
 ``B * (n + 1) * 16`` for the link poses, ``B * 16`` for a frame pose, ``B * 6 * n`` for a
 Jacobian. Every kernel checks that ``q`` is finite and returns ``ok``; with ``ok = False``
 the output is unfinished and the caller raises the error that names the bad entry. The
-kernels allocate nothing, so they are compiled lean (:func:`dynid.kinematics._chain.lean`):
+kernels allocate nothing, so they are compiled lean (:func:`dynid._kernels.chain.lean`):
 a single-sample call enters them at half the cost. Their scratch (the joints' sines and
-cosines, :func:`dynid.kinematics._chain.angles`) is on the stack; a chain too long for it
+cosines, :func:`dynid._kernels.chain.angles`) is on the stack; a chain too long for it
 (over ``STACK / 3`` joints) returns ``ok = False`` and the caller takes the numpy path.
 
-Equations: the joint transform and chaining of :mod:`dynid.kinematics._chain`. Column
+Equations: the joint transform and chaining of :mod:`dynid._kernels.chain`. Column
 ``i`` of the Jacobian of the frame origin ``p`` is ``[z_i x (p - o_i); z_i]`` (revolute)
 or ``[z_i; 0]`` (prismatic), ``z_i = R_i a_i``, ``o_i = p_i`` (Siciliano et al.,
 *Robotics*, 2009, eq. 3.30); columns of joints after the frame's link are zero.
@@ -25,8 +25,8 @@ or ``[z_i; 0]`` (prismatic), ``z_i = R_i a_i``, ``o_i = p_i`` (Siciliano et al.,
 
 from __future__ import annotations
 
-from .._compiled import C_AXIS, C_PRISMATIC
-from ._chain import IDENTITY, STACK, angles, compose, flat_view, inline, joint_at, lean, stack
+from .chain import IDENTITY, STACK, angles, compose, flat_view, inline, joint_at, lean, stack
+from .layout import C_AXIS, C_PRISMATIC
 
 __all__ = ["link_poses", "frame_pose", "jacobian", "jacobian_one"]
 
@@ -103,7 +103,7 @@ def frame_pose(C, q, out):
 def frame_jacobian(C, A, link, J, oj, stride):
     """Jacobian columns ``0..link-1`` of the origin of ``C``'s frame (its last row).
 
-    ``A`` holds the :func:`~dynid.kinematics._chain.angles` of the sample; column ``i``,
+    ``A`` holds the :func:`~dynid._kernels.chain.angles` of the sample; column ``i``,
     row ``r`` goes to ``J[oj + r * stride + i]``. Returns the pose of ``link`` in the base
     (12 floats).
     """

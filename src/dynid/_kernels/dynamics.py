@@ -1,9 +1,9 @@
 """Compiled (numba) kernels: inverse dynamics, gravity torques and the mass matrix.
 
-Imported lazily, on the first dynamics call (:func:`dynid._compiled.kernels`), never by
-``import dynid``; compiled once and cached on disk (:func:`dynid.kinematics._chain.jit`).
+Imported lazily, on the first dynamics call (:func:`dynid._kernels.dispatch.compiled`), never by
+``import dynid``; compiled once and cached on disk (:func:`dynid._kernels.chain.jit`).
 
-Arguments: ``C``, the robot's packed constants (:func:`dynid._compiled.pack`: joint
+Arguments: ``C``, the robot's packed constants (:func:`dynid._kernels.layout.pack`: joint
 transforms, axes, joint types, standard parameters ``phi`` and gravity [m/s^2] in the base
 frame). Joint arrays are flat C-contiguous float64, length ``B * n``, sample-major (a
 (B, n) array reshaped); ``dq`` and ``ddq`` of :func:`rnea` may also have length ``n``, one
@@ -30,7 +30,7 @@ calls, so that the compiler vectorises it (SIMD over samples). Revolute and pris
 joints go through the same arithmetic with exact 0/1 selectors (a prismatic joint has
 ``sin = 0, cos = 1``, a revolute one no translation), which changes no rounding.
 
-The joint transform is the chain core's (:mod:`dynid.kinematics._chain`), as are the
+The joint transform is the chain core's (:mod:`dynid._kernels.chain`), as are the
 compiler settings (fused multiply-add only) and the sine and cosine (Cephes, vectorisable);
 kernels and numpy path differ by rounding only (the tests hold them to 1e-12 relative).
 """
@@ -41,8 +41,7 @@ import math
 
 import numpy as np
 
-from .._compiled import C_AXIS, C_PHI, C_PRISMATIC, SINGULAR_PIVOT
-from ..kinematics._chain import (
+from .chain import (
     IDENTITY,
     angles,
     compose,
@@ -57,10 +56,11 @@ from ..kinematics._chain import (
     motion,
     stack,
 )
-from ..kinematics._chain import SINCOS_MAX as _SINCOS_MAX
-from ..kinematics._chain import STACK as _STACK
-from ..kinematics._chain import sincos as _sincos
-from ..kinematics._dense import cholesky, cholesky_solve
+from .chain import SINCOS_MAX as _SINCOS_MAX
+from .chain import STACK as _STACK
+from .chain import sincos as _sincos
+from .dense import cholesky, cholesky_solve
+from .layout import C_AXIS, C_PHI, C_PRISMATIC, SINGULAR_PIVOT
 
 __all__ = [
     "BLOCK",
@@ -154,7 +154,7 @@ def _rnea_sample(C, A, dq, ddq, oq, ov, oa, tau, S):
     """RNEA of one sample into ``tau[oq : oq + n]``; scratch ``S`` (n, 21).
 
     The recursion of the block kernel in scalar form, for few samples (no block scratch):
-    ``A`` the :func:`~dynid.kinematics._chain.angles` of ``q``, the rates
+    ``A`` the :func:`~dynid._kernels.chain.angles` of ``q``, the rates
     ``dq[ov : ov + n]``, the accelerations ``ddq[oa : oa + n]``.
     """
     n = C.shape[0] - 1
@@ -360,7 +360,7 @@ def rnea_one(C, q, dq, ddq, tau):
 def _gravity_sample(C, A, o, tau, S):
     """Gravity torques of a sample into ``tau[o : o + n]``; scratch S (n, 9).
 
-    ``A``: the :func:`~dynid.kinematics._chain.angles` of the sample's ``q``.
+    ``A``: the :func:`~dynid._kernels.chain.angles` of the sample's ``q``.
 
     From the potential energy rather than a full RNEA (the velocities are zero): with
     ``G = -g``, ``o_i``, ``z_i`` the origin and axis of joint i in the base frame and the
@@ -443,7 +443,7 @@ def gravity_torques_one(C, q, tau):
 def _crba_sample(C, A, o, M, S):
     """Mass matrix of a sample into ``M[o n : (o + n) n]`` (flat, row-major).
 
-    Composite-rigid-body algorithm; ``A`` the :func:`~dynid.kinematics._chain.angles` of
+    Composite-rigid-body algorithm; ``A`` the :func:`~dynid._kernels.chain.angles` of
     the sample's ``q``, scratch S (n, 12) for the joint poses.
     """
     n = C.shape[0] - 1
