@@ -7,7 +7,7 @@ import json
 import numpy as np
 import pytest
 
-from dynid.exceptions import DataError, ShapeError
+from dynid.exceptions import DataError, OptionError, ShapeError
 from dynid.friction.fit import fit_classical, fit_friction, fit_sigmoid, friction_residual
 from dynid.friction.model import (
     ClassicalFriction,
@@ -107,8 +107,8 @@ def test_sigmoid_fit_rejects_bad_shapes():
     """dq and residual must be (N, n) of the same shape."""
     with pytest.raises(ShapeError, match="dq and residual"):
         fit_sigmoid(np.zeros((10, 2)), np.zeros((10, 3)))
-    with pytest.raises(ShapeError, match="kind must be"):
-        fit_friction(lambda q, dq, ddq: q, None, kind="stribeck")
+    with pytest.raises(OptionError, match="--friction-model must be one of"):
+        fit_friction(lambda q, dq, ddq: q, None, kind="stribek")
 
 
 def test_validation_of_the_true_model_is_at_the_noise_level(panda, sinusoid_log):
@@ -155,7 +155,7 @@ def test_friction_json_round_trip(tmp_path, panda):
     with pytest.raises(DataError, match="joint 3 has no 'phi2'"):
         load_friction_json(tmp_path / "bad.json")
     (tmp_path / "bad2.json").write_text(
-        '{"schema": "dynid-friction/1", "model": "stribeck", "joints": []}'
+        '{"schema": "dynid-friction/1", "model": "stribek", "joints": []}'
     )
     with pytest.raises(DataError, match="'model' must be"):
         load_friction_json(tmp_path / "bad2.json")

@@ -1,14 +1,19 @@
 """Fit joint friction to the torque residual of a dynamic model on a measured log.
 
 The residual tau_measured - (M ddq + c + g) of the model (an identification.json, or a
-robot's own link parameters with --robot) is fitted per joint by the sigmoid of Gaz et
-al. 2019 (eq. 25, Nelder-Mead; default) or the classical viscous + Coulomb + offset model
-(eq. 24, least squares). The states are low-pass filtered with zero phase (--cutoff) and
-the accelerations differentiated from the filtered velocities. With a drive (--drive, or the
+robot's own link parameters with --robot) is fitted per joint by a friction law:
+--friction-model auto (default) fits every law (none, classical, smooth, asymmetric,
+stribeck, sigmoid) on 5 contiguous blocks of the log in turn, predicts the block left out,
+keeps the law with the lowest held-out error (the model's own friction is a candidate too,
+so the result never predicts worse than it) and prints the table; a law's name fits that
+law. Coulomb friction is off where |dq| is inside the velocity noise band. The states are
+low-pass filtered with zero phase (--cutoff) and the accelerations differentiated from the
+filtered velocities. With a drive (--drive, or the
 model's own) the log is read through it and the law is fitted per motor at the motor
 velocities where the drive's friction acts there (tau_f = K^T f(K dq)).
 
-Writes OUT/friction.json (parameters, RMS of the residual before and after) and
+Writes OUT/friction.json (parameters, RMS of the residual before and after, the held-out
+table) and
 OUT/friction.png (residual against velocity with the fitted curve, per joint; skipped,
 with a note, without matplotlib). The log is read strictly: rows with NaN/inf or a
 repeated timestamp are an error unless --drop-invalid; gaps up to --max-gap are bridged.
@@ -33,7 +38,9 @@ from ..friction.fit import (
     friction_residual,
     model_drive,
 )
-from ..friction.validation import Validation
+from ..friction.laws import LAWS
+from ..friction.select import select_friction
+from ..friction.validation import Validation, own_friction
 from ..identification.log import DEFAULT_CUTOFF_HZ
 from ..identification.model import IdentifiedModel
 from ..io.friction_json import save_friction_json
@@ -71,7 +78,7 @@ def register(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParser:
         subparsers,
         NAME,
         __doc__,
-        help="fit joint friction (sigmoid or classical) to a model's torque residual",
+        help="fit joint friction (the law chosen on held-out data) to a model's torque residual",
     )
     src = p.add_mutually_exclusive_group(required=True)
     src.add_argument("--model", type=Path, help="identification.json of an identified model")
@@ -82,7 +89,12 @@ def register(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParser:
     add_column_options(p)
     add_drive_option(p)
     p.add_argument("--out", type=Path, required=True, help="output directory")
-    p.add_argument("--friction-model", choices=("sigmoid", "classical"), default="sigmoid")
+    p.add_argument(
+        "--friction-model",
+        choices=("auto", *LAWS),
+        default="auto",
+        help="friction law; auto (default): the one with the lowest held-out error",
+    )
     p.add_argument(
         "--cutoff",
         type=positive_type,
@@ -177,7 +189,12 @@ def run(args: argparse.Namespace) -> int:
         res = friction_residual(
             model, log, cutoff_hz=args.cutoff, max_gap_s=args.max_gap, drive=drive
         )
-        fit = fit_friction_through(res, drive, args.friction_model)
+        if args.friction_model == "auto":
+            sel = select_friction(res, drive, own=own_friction(model))
+            fit, selection = sel.fit, sel.as_dict()
+            print(sel.table())
+        else:
+            fit, selection = fit_friction_through(res, drive, args.friction_model), None
     meta = {
         "data": str(args.data.name),
         "model": str(args.model.name) if args.model is not None else args.robot,
@@ -185,7 +202,7 @@ def run(args: argparse.Namespace) -> int:
         "n_samples": fit.n_samples,
         "converged": [bool(x) for x in fit.converged],
     }
-    save_friction_json(args.out / "friction.json", fit, metadata=meta)
+    save_friction_json(args.out / "friction.json", fit, metadata=meta, selection=selection)
     names = _joint_names(model)
     if not args.no_figures:
         save_friction_figure(

@@ -14,12 +14,11 @@ fast friction reversals that the friction model, evaluated on the velocity, keep
 The residual then holds the friction plus the sensor noise, and the RMS after
 compensation is at the noise level for a correct model.
 
-* **sigmoid** (eq. 25): per joint, Nelder-Mead (``scipy.optimize.minimize``) on the mean
-  squared residual. The variables are scaled, ``z = (phi1 / s1, ln(phi2 / s2), phi3 / s3)``
-  (``phi2`` stays positive), and the start comes from a grid over ``phi2`` and ``phi3``
-  with ``phi1`` solved in closed form for each grid point (the model is linear in
-  ``phi1``).
-* **classical** (eq. 24): per joint, linear least squares on ``(dq, sign dq, 1)``.
+Each law of the registry (:mod:`dynid.friction.laws`: classical eq. 24, smooth Coulomb,
+asymmetric, Stribeck, the sigmoid of eq. 25) is fitted joint by joint by its own
+deterministic fit (:func:`fit_law`); Coulomb terms are off where ``|dq|`` is inside the
+joint's velocity noise band (the standstill rule, :mod:`dynid.friction.laws.base`).
+Which law predicts held-out data best is :func:`~dynid.friction.select.select_friction`.
 
 A joint whose velocity never leaves its noise band carries no information on its
 friction: fitted anyway, the sigmoid's span ``phi1`` runs off to millions of N m. Such a
@@ -40,22 +39,18 @@ from collections.abc import Callable
 from dataclasses import dataclass, replace
 
 import numpy as np
-import scipy.linalg
-import scipy.special
 from numpy.typing import ArrayLike, NDArray
 
 from .. import _checks
 from ..dynamics.rnea import rnea
-from ..exceptions import ConvergenceError, DataError, DynidWarning, OptionError, ShapeError
+from ..exceptions import ConvergenceError, DataError, DynidWarning, ShapeError
 from ..identification.log import DEFAULT_CUTOFF_HZ, TorqueLog, joint_side_log, prepare_log
 from ..identification.model import IdentifiedModel
-from ..identification.sanity import (
-    moving_joints,
-    velocity_noise_std,
-)
+from ..identification.sanity import moving_joints, noise_band, velocity_noise_std
 from ..model.drive import Drive
 from ..model.robot import Robot
-from .model import ClassicalFriction, DriveFriction, FrictionModel, SigmoidFriction
+from .laws import FrictionLaw, law_named
+from .model import DriveFriction, FrictionModel
 
 __all__ = [
     "FrictionFit",
@@ -65,6 +60,8 @@ __all__ = [
     "fit_friction",
     "fit_sigmoid",
     "fit_friction_through",
+    "fit_law",
+    "fit_law_through",
     "friction_residual",
     "model_drive",
     "moving_joints",
@@ -260,71 +257,33 @@ class FrictionFit:
         return self.friction.kind
 
 
-def _sigmoid_basis(dq: NDArray[np.float64], phi2: float, phi3: float) -> NDArray[np.float64]:
-    return scipy.special.expit(phi2 * (dq + phi3)) - scipy.special.expit(phi2 * phi3)
-
-
-def _fit_sigmoid_joint(
-    dq: NDArray[np.float64], r: NDArray[np.float64], *, maxiter: int
-) -> tuple[NDArray[np.float64], bool, int]:
-    """(phi1, phi2, phi3), success, iterations for one joint's (N,) velocity and residual."""
-    scale = float(np.sqrt(np.mean(r**2))) or 1.0
-    rs = r / scale
-    # start: grid over (phi2, phi3), phi1 by closed-form least squares (on a subsample)
-    step = max(1, dq.size // 4000)
-    dg, rg = dq[::step], rs[::step]
-    best = (np.inf, 1.0, 10.0, 0.0)
-    for phi2 in np.geomspace(1.0, 100.0, 15):
-        for phi3 in np.linspace(-0.1, 0.1, 9):
-            b = _sigmoid_basis(dg, phi2, phi3)
-            bb = float(b @ b)
-            if bb <= 0:
-                continue
-            a = float(b @ rg) / bb
-            sse = float(np.sum((rg - a * b) ** 2))
-            if sse < best[0]:
-                best = (sse, a, phi2, phi3)
-    _, a0, s2, p30 = best
-    s1 = a0 if abs(a0) > 1e-6 else 1.0
-    s3 = 0.05
-
-    def cost(z: NDArray[np.float64]) -> float:
-        e = rs - z[0] * s1 * _sigmoid_basis(dq, s2 * np.exp(z[1]), z[2] * s3)
-        return float(np.mean(e**2))
-
-    from scipy.optimize import minimize  # imported here: slow to import, rarely needed
-
-    z0 = np.array([1.0, 0.0, p30 / s3])
-    res = minimize(
-        cost, z0, method="Nelder-Mead", options={"xatol": 1e-7, "fatol": 1e-12, "maxiter": maxiter}
-    )
-    z = res.x
-    phi = np.array([z[0] * s1 * scale, s2 * np.exp(z[1]), z[2] * s3])
-    return phi, bool(res.success), int(res.nit)
-
-
-def fit_sigmoid(
-    dq: NDArray[np.float64],
-    residual: NDArray[np.float64],
+def fit_law(
+    law: str | FrictionLaw,
+    dq: ArrayLike,
+    residual: ArrayLike,
     *,
-    maxiter: int = 4000,
     dq_noise_std: ArrayLike | None = None,
+    warn: bool = True,
 ) -> FrictionFit:
-    """Per-joint Nelder-Mead fit of the sigmoid (eq. 25) to a residual.
+    """Fit a law of the registry (:mod:`dynid.friction.laws`) to a residual, joint by joint.
 
     Parameters
     ----------
+    law : str or FrictionLaw
+        Registry name (``"classical"``, ``"sigmoid"``, ...) or the law.
     dq : array_like, shape (N, n)
         Joint velocities [rad/s].
     residual : array_like, shape (N, n)
         Torque residual [N m].
-    maxiter : int
-        Nelder-Mead iteration limit per joint.
     dq_noise_std : array_like, shape (n,), optional
         White-noise std of the measured velocities [rad/s]
-        (:attr:`FrictionResidual.dq_noise_std`). Joints whose ``dq`` does not leave the
-        noise band (:func:`moving_joints`) get zero friction; None: no noise, only
-        :data:`MIN_MOTION` bounds the band.
+        (:attr:`FrictionResidual.dq_noise_std`). It sets each joint's standstill band
+        (:func:`~dynid.identification.sanity.noise_band`): Coulomb terms are off inside it,
+        in the fit and in the fitted model. Joints whose ``dq`` does not leave the band
+        (:func:`moving_joints`) get zero friction; None: no noise, the band is
+        :data:`~dynid.identification.sanity.MIN_MOTION`.
+    warn : bool
+        Warn about joints that do not move (False: silently zero, as in cross-validation).
 
     Returns
     -------
@@ -333,28 +292,68 @@ def fit_sigmoid(
     Raises
     ------
     ShapeError, NonFiniteError
+    OptionError
+        Unknown law name.
     DataError
         No joint moves beyond its velocity noise band.
     ConvergenceError
-        The optimiser returned non-finite parameters.
+        The fit returned non-finite parameters.
 
     Warns
     -----
     DynidWarning
         Some joints do not move (named, 1-based): their friction is set to zero.
     """
+    lw = law_named(law) if isinstance(law, str) else law
     dq, residual = _pair(dq, residual)
-    moving = _identifiable(dq, dq_noise_std)
     n = dq.shape[1]
-    P = np.zeros((n, 3))
+    noise = np.zeros(n) if dq_noise_std is None else np.broadcast_to(dq_noise_std, (n,))
+    band = noise_band(noise)
+    if warn:
+        moving = _identifiable(dq, noise)
+    else:
+        moving = moving_joints(dq, noise)
+        if not moving.any():
+            raise DataError("no joint moves beyond its velocity noise band")
+    P = np.zeros((n, len(lw.params)))
     ok = np.ones(n, bool)
     it = np.zeros(n, int)
     for j in np.flatnonzero(moving):
-        P[j], ok[j], it[j] = _fit_sigmoid_joint(dq[:, j], residual[:, j], maxiter=maxiter)
+        jf = lw.fit(dq[:, j], residual[:, j], float(band[j]))
+        P[j], ok[j], it[j] = jf.params, jf.converged, jf.iterations
     if not np.all(np.isfinite(P)):
-        raise ConvergenceError(f"sigmoid fit gave non-finite parameters: {P.tolist()}")
-    fr = SigmoidFriction.from_array(P)
-    return _result(fr, dq, residual, ok, it, moving)
+        raise ConvergenceError(f"{lw.name} friction fit gave non-finite parameters: {P.tolist()}")
+    return _result(lw.model(P, band), dq, residual, ok, it, moving)
+
+
+def fit_sigmoid(
+    dq: NDArray[np.float64],
+    residual: NDArray[np.float64],
+    *,
+    dq_noise_std: ArrayLike | None = None,
+) -> FrictionFit:
+    """Per-joint fit of the sigmoid (eq. 25) to a residual: :func:`fit_law` with
+    ``"sigmoid"`` (Nelder-Mead, :mod:`dynid.friction.laws.sigmoid`).
+
+    Parameters
+    ----------
+    dq : array_like, shape (N, n)
+        Joint velocities [rad/s].
+    residual : array_like, shape (N, n)
+        Torque residual [N m].
+    dq_noise_std : array_like, shape (n,), optional
+        As in :func:`fit_law`.
+
+    Returns
+    -------
+    FrictionFit
+
+    Raises
+    ------
+    ShapeError, NonFiniteError, DataError, ConvergenceError
+        As :func:`fit_law`.
+    """
+    return fit_law("sigmoid", dq, residual, dq_noise_std=dq_noise_std)
 
 
 def fit_classical(
@@ -363,7 +362,8 @@ def fit_classical(
     *,
     dq_noise_std: ArrayLike | None = None,
 ) -> FrictionFit:
-    """Per-joint linear least squares of ``fv dq + fc sign(dq) + fo`` (eq. 24) to a residual.
+    """Per-joint bounded least squares of ``fv dq + fc s(dq) + fo`` (eq. 24) to a residual:
+    :func:`fit_law` with ``"classical"`` (``fv, fc >= 0``; ``s`` is 0 in the standstill band).
 
     Parameters
     ----------
@@ -372,7 +372,7 @@ def fit_classical(
     residual : array_like, shape (N, n)
         Torque residual [N m].
     dq_noise_std : array_like, shape (n,), optional
-        As in :func:`fit_sigmoid`.
+        As in :func:`fit_law`.
 
     Returns
     -------
@@ -380,24 +380,10 @@ def fit_classical(
 
     Raises
     ------
-    ShapeError, NonFiniteError
-    DataError
-        No joint moves beyond its velocity noise band.
-
-    Warns
-    -----
-    DynidWarning
-        Some joints do not move (named, 1-based): their friction is set to zero.
+    ShapeError, NonFiniteError, DataError
+        As :func:`fit_law`.
     """
-    dq, residual = _pair(dq, residual)
-    moving = _identifiable(dq, dq_noise_std)
-    n = dq.shape[1]
-    P = np.zeros((n, 3))
-    for j in np.flatnonzero(moving):
-        A = np.stack([dq[:, j], np.sign(dq[:, j]), np.ones(dq.shape[0])], axis=1)
-        P[j] = scipy.linalg.lstsq(A, residual[:, j])[0]
-    fr = ClassicalFriction.from_array(P)
-    return _result(fr, dq, residual, np.ones(n, bool), np.zeros(n, int), moving)
+    return fit_law("classical", dq, residual, dq_noise_std=dq_noise_std)
 
 
 def _pair(dq: ArrayLike, residual: ArrayLike) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
@@ -439,7 +425,7 @@ def fit_friction(
     trim_s: float | None = None,
     filter_tau: bool = False,
 ) -> FrictionFit:
-    """Fit a friction model to the residual of ``model`` on a torque log.
+    """Fit a friction law to the residual of ``model`` on a torque log.
 
     Parameters
     ----------
@@ -447,7 +433,9 @@ def fit_friction(
         Rigid-body model (friction not included): IdentifiedModel, Robot or callable.
     log : TorqueLog
         Measured log of a trajectory that visits both signs of every joint velocity.
-    kind : {"sigmoid", "classical"}
+    kind : str
+        A law of the registry (:mod:`dynid.friction.laws`); the choice among them on
+        held-out data is :func:`~dynid.friction.select.select_friction`.
     cutoff_hz, trim_s, filter_tau
         Preparation of the log (:func:`friction_residual`).
 
@@ -457,57 +445,110 @@ def fit_friction(
 
     Raises
     ------
+    OptionError
+        Unknown ``kind``.
     ShapeError
-        Unknown ``kind`` or joint counts that differ.
+        Joint counts that differ.
     DataError
         From the preparation of the log; no joint moves beyond its velocity noise band.
 
     Warns
     -----
     DynidWarning
-        Some joints do not move: their friction is set to zero (:func:`fit_sigmoid`).
+        Some joints do not move: their friction is set to zero (:func:`fit_law`).
     """
-    if kind not in ("sigmoid", "classical"):
-        raise ShapeError(f"kind must be 'sigmoid' or 'classical'; got {kind!r}")
+    law = law_named(kind)
     res = friction_residual(model, log, cutoff_hz=cutoff_hz, trim_s=trim_s, filter_tau=filter_tau)
-    if kind == "sigmoid":
-        return fit_sigmoid(res.dq, res.residual, dq_noise_std=res.dq_noise_std)
-    return fit_classical(res.dq, res.residual, dq_noise_std=res.dq_noise_std)
+    return fit_law(law, res.dq, res.residual, dq_noise_std=res.dq_noise_std)
 
 
 def fit_friction_through(
-    res: FrictionResidual, drive: Drive | None, kind: str = "sigmoid"
+    res: FrictionResidual, drive: Drive | None, kind: str = "sigmoid", *, warn: bool = True
+) -> FrictionFit:
+    """Fit a friction law where the drive says it acts: :func:`fit_law_through` on the
+    residual of :func:`friction_residual`.
+
+    Parameters
+    ----------
+    res : FrictionResidual
+    drive : Drive or None
+    kind : str
+        A law of the registry (:mod:`dynid.friction.laws`).
+    warn : bool
+        As in :func:`fit_law`.
+
+    Returns
+    -------
+    FrictionFit
+
+    Raises
+    ------
+    OptionError
+        ``kind`` is not a law of the registry.
+    DataError
+        No joint moves beyond its velocity noise band.
+    """
+    return fit_law_through(
+        kind, res.dq, res.residual, drive, dq_noise_std=res.dq_noise_std, warn=warn
+    )
+
+
+def fit_law_through(
+    law: str | FrictionLaw,
+    dq: ArrayLike,
+    residual: ArrayLike,
+    drive: Drive | None,
+    *,
+    dq_noise_std: ArrayLike | None = None,
+    warn: bool = True,
 ) -> FrictionFit:
     """Fit a friction law where the drive says it acts (the motors of a gear train).
 
     At the motors the joint residual ``r`` becomes motor torques ``K^-T r`` at the motor
     velocities ``K dq`` (exact: ``K`` is invertible), each motor is fitted on its own
-    (:func:`fit_sigmoid` or :func:`fit_classical`), and the result is a
-    :class:`~dynid.friction.model.DriveFriction` whose RMS before and after are those of
-    the joint torques. Without a drive (or with friction at the joints) the joints are fitted.
+    (:func:`fit_law`, the motor velocity noise ``sqrt(K^2 sigma^2)`` setting the standstill
+    band), and the result is a :class:`~dynid.friction.model.DriveFriction` whose RMS
+    before and after are those of the joint torques. Without a drive (or with friction at
+    the joints) the joints are fitted.
+
+    Parameters
+    ----------
+    law : str or FrictionLaw
+        A law of the registry (:mod:`dynid.friction.laws`).
+    dq : array_like, shape (N, n)
+        Joint velocities [rad/s].
+    residual : array_like, shape (N, n)
+        Joint torque residual [N m].
+    drive : Drive or None
+    dq_noise_std : array_like, shape (n,), optional
+        White-noise std of the measured joint velocities [rad/s].
+    warn : bool
+        As in :func:`fit_law`.
+
+    Returns
+    -------
+    FrictionFit
 
     Raises
     ------
     OptionError
-        ``kind`` is neither ``"sigmoid"`` nor ``"classical"``.
+        ``law`` is not a law of the registry.
+    ShapeError, DataError, ConvergenceError
+        As :func:`fit_law`.
     """
-    fit_law = {"sigmoid": fit_sigmoid, "classical": fit_classical}.get(kind)
-    if fit_law is None:
-        raise OptionError(f"friction model must be 'sigmoid' or 'classical'; got {kind!r}")
     if drive is None or drive.friction_at == "joint":
-        return fit_law(res.dq, res.residual, dq_noise_std=res.dq_noise_std)
+        return fit_law(law, dq, residual, dq_noise_std=dq_noise_std, warn=warn)
+    dq, residual = _pair(dq, residual)
     K = drive.transmission
-    v = drive.motor_velocities(res.dq)
-    r = np.asarray(np.linalg.solve(K.T, res.residual.T).T, dtype=np.float64)
-    noise = None if res.dq_noise_std is None else np.sqrt((K**2) @ res.dq_noise_std**2)
-    fit = fit_law(v, r, dq_noise_std=noise)
-    law = fit.friction
-    assert isinstance(law, SigmoidFriction | ClassicalFriction)  # a law per motor
-    fr = DriveFriction(law, drive)
-    after = res.residual - fr.torques(res.dq)
+    v = drive.motor_velocities(dq)
+    r = np.asarray(np.linalg.solve(K.T, residual.T).T, dtype=np.float64)
+    noise = None if dq_noise_std is None else np.sqrt((K**2) @ np.asarray(dq_noise_std) ** 2)
+    fit = fit_law(law, v, r, dq_noise_std=noise, warn=warn)
+    fr = DriveFriction(fit.friction, drive)  # type: ignore[arg-type]  # a law per motor
+    after = residual - fr.torques(dq)
     return replace(
         fit,
         friction=fr,
-        rms_before=np.sqrt(np.mean(res.residual**2, axis=0)),
+        rms_before=np.sqrt(np.mean(residual**2, axis=0)),
         rms_after=np.sqrt(np.mean(after**2, axis=0)),
     )

@@ -19,15 +19,20 @@ so ``tau_f`` has the sign of the velocity for a dissipative joint.
 
   .. math:: \\tau_f(\\dot q) = f_v \\dot q + f_c \\, \\mathrm{sign}(\\dot q) + f_o
 
-  with ``sign(0) = 0``; ``fv`` [N m s/rad], ``fc`` [N m], ``fo`` [N m].
+  with ``sign(0) = 0``; ``fv`` [N m s/rad], ``fc`` [N m], ``fo`` [N m]. With a standstill
+  band ``b`` (n,) [rad/s] the sign is 0 where ``|dq| <= b`` (:func:`coulomb_sign`: at rest
+  the measured velocity is encoder noise, whose sign must not switch Coulomb friction on).
 
-Both evaluate on velocities of shape ``(..., n)`` and return torques of the same shape.
+* :class:`LawFriction`: any other law of the registry (:mod:`dynid.friction.laws`) with
+  its parameters per joint.
+
+All evaluate on velocities of shape ``(..., n)`` and return torques of the same shape.
 """
 
 from __future__ import annotations
 
-from dataclasses import dataclass
-from typing import ClassVar
+from dataclasses import dataclass, field
+from typing import TYPE_CHECKING, ClassVar
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -36,14 +41,40 @@ from .. import _checks
 from ..exceptions import ShapeError
 from ..model.drive import Drive
 
+if TYPE_CHECKING:  # pragma: no cover
+    from .laws.base import FrictionLaw
+
 __all__ = [
     "ClassicalFriction",
     "DriveFriction",
     "FrictionModel",
+    "LawFriction",
     "SigmoidFriction",
     "classical_friction",
+    "coulomb_sign",
     "sigmoid_friction",
 ]
+
+
+def coulomb_sign(dq: ArrayLike, band: ArrayLike = 0.0) -> NDArray[np.float64]:
+    """``sign(dq)`` outside the standstill band, 0 inside: (..., n).
+
+    Parameters
+    ----------
+    dq : array_like, shape (..., n)
+        Velocities [rad/s].
+    band : array_like, shape (n,) or scalar
+        Standstill band per joint [rad/s]; 0 gives the plain ``sign(dq)`` (``sign(0) = 0``).
+
+    Returns
+    -------
+    ndarray, shape (..., n)
+    """
+    v = np.asarray(dq, dtype=np.float64)
+    out: NDArray[np.float64] = np.where(
+        np.abs(v) > np.asarray(band, dtype=np.float64), np.sign(v), 0.0
+    )
+    return out
 
 
 def sigmoid_friction(
@@ -72,7 +103,7 @@ def sigmoid_friction(
 
 
 def classical_friction(
-    dq: ArrayLike, fv: ArrayLike, fc: ArrayLike, fo: ArrayLike
+    dq: ArrayLike, fv: ArrayLike, fc: ArrayLike, fo: ArrayLike, band: ArrayLike = 0.0
 ) -> NDArray[np.float64]:
     """Viscous + Coulomb + offset friction torques (Gaz et al. 2019, eq. 24).
 
@@ -82,6 +113,8 @@ def classical_friction(
         Joint velocities [rad/s].
     fv, fc, fo : array_like, shape (n,)
         Viscous [N m s/rad], Coulomb [N m] and offset [N m] coefficients.
+    band : array_like, shape (n,) or scalar
+        Standstill band [rad/s] of the Coulomb term (:func:`coulomb_sign`); default 0.
 
     Returns
     -------
@@ -90,7 +123,7 @@ def classical_friction(
     """
     dq = _checks.as_array("dq", dq)
     fv, fc, fo = (np.asarray(p, dtype=np.float64) for p in (fv, fc, fo))
-    return fv * dq + fc * np.sign(dq) + fo
+    return fv * dq + fc * coulomb_sign(dq, band) + fo
 
 
 def _params(cls_name: str, names: tuple[str, ...], obj: object) -> int:
@@ -162,25 +195,34 @@ class ClassicalFriction:
         Coulomb coefficients [N m].
     fo : ndarray, shape (n,)
         Offsets [N m].
+    band : ndarray, shape (n,)
+        Standstill band of the Coulomb term [rad/s] (:func:`coulomb_sign`); zeros (the
+        plain ``sign(dq)``) when not given.
     """
 
     fv: NDArray[np.float64]
     fc: NDArray[np.float64]
     fo: NDArray[np.float64]
+    band: NDArray[np.float64] = field(default_factory=lambda: np.zeros(0))
 
     kind: ClassVar[str] = "classical"
     names: ClassVar[tuple[str, ...]] = ("fv", "fc", "fo")
 
     def __post_init__(self) -> None:
-        _params("ClassicalFriction", self.names, self)
+        n = _params("ClassicalFriction", self.names, self)
+        b = np.zeros(n) if np.size(self.band) == 0 else _checks.as_exact("band", self.band, (n,))
+        object.__setattr__(self, "band", _checks.frozen(b))
 
     @classmethod
-    def from_array(cls, params: ArrayLike) -> ClassicalFriction:
-        """From an (n, 3) array with columns ``fv, fc, fo`` (as ``IdentifiedModel.friction``)."""
+    def from_array(cls, params: ArrayLike, band: ArrayLike | None = None) -> ClassicalFriction:
+        """From an (n, 3) array with columns ``fv, fc, fo`` (as ``IdentifiedModel.friction``)
+        and an optional standstill band (n,) [rad/s]."""
         p = _checks.as_array("params", params)
         if p.ndim != 2 or p.shape[1] != 3:
             raise ShapeError(f"params must have shape (n, 3); got {p.shape}")
-        return cls(p[:, 0], p[:, 1], p[:, 2])
+        if band is None:
+            return cls(p[:, 0], p[:, 1], p[:, 2])
+        return cls(p[:, 0], p[:, 1], p[:, 2], np.asarray(band, dtype=np.float64))
 
     def as_array(self) -> NDArray[np.float64]:
         """The parameters as an (n, 3) array, columns ``fv, fc, fo``."""
@@ -194,7 +236,62 @@ class ClassicalFriction:
     def torques(self, dq: ArrayLike) -> NDArray[np.float64]:
         """Friction torques [N m] (..., n) at velocities ``dq`` [rad/s] (..., n)."""
         dq = _checks.as_batch("dq", dq, (self.n,))
-        return classical_friction(dq, self.fv, self.fc, self.fo)
+        return classical_friction(dq, self.fv, self.fc, self.fo, self.band)
+
+
+@dataclass(frozen=True, slots=True, eq=False)
+class LawFriction:
+    """A registry law with parameters per joint; arrays read-only.
+
+    Attributes
+    ----------
+    law : FrictionLaw
+    params : ndarray, shape (n, k)
+        Parameters per joint, columns ``law.params``.
+    band : ndarray, shape (n,)
+        Standstill band [rad/s] (:func:`coulomb_sign`); zeros when not given.
+    """
+
+    law: FrictionLaw
+    params: NDArray[np.float64]
+    band: NDArray[np.float64] = field(default_factory=lambda: np.zeros(0))
+
+    def __post_init__(self) -> None:
+        p = _checks.as_array("params", self.params)
+        k = len(self.law.params)
+        if p.ndim != 2 or p.shape[1] != k:
+            raise ShapeError(
+                f"params of the {self.law.name} law must have shape (n, {k}); got {p.shape}"
+            )
+        n = p.shape[0]
+        b = np.zeros(n) if np.size(self.band) == 0 else _checks.as_exact("band", self.band, (n,))
+        object.__setattr__(self, "params", _checks.frozen(p))
+        object.__setattr__(self, "band", _checks.frozen(b))
+
+    @property
+    def kind(self) -> str:
+        """The law's registry name."""
+        return self.law.name
+
+    @property
+    def names(self) -> tuple[str, ...]:
+        """The parameter names."""
+        return self.law.params
+
+    @property
+    def n(self) -> int:
+        """Number of joints."""
+        return int(self.params.shape[0])
+
+    def as_array(self) -> NDArray[np.float64]:
+        """The parameters (n, k)."""
+        return np.array(self.params)
+
+    def torques(self, dq: ArrayLike) -> NDArray[np.float64]:
+        """Friction torques [N m] (..., n) at velocities ``dq`` [rad/s] (..., n)."""
+        v = _checks.as_batch("dq", dq, (self.n,))
+        out: NDArray[np.float64] = np.asarray(self.law.torques(v, self.params, self.band))
+        return out
 
 
 @dataclass(frozen=True, slots=True, eq=False)
@@ -203,7 +300,7 @@ class DriveFriction:
 
     Attributes
     ----------
-    law : SigmoidFriction or ClassicalFriction
+    law : SigmoidFriction, ClassicalFriction or LawFriction
         The law per motor, in motor units (velocities [rad/s] and torques [N m] at the
         motor).
     drive : Drive
@@ -211,7 +308,7 @@ class DriveFriction:
         law acts at the joints.
     """
 
-    law: SigmoidFriction | ClassicalFriction
+    law: SigmoidFriction | ClassicalFriction | LawFriction
     drive: Drive
 
     def __post_init__(self) -> None:
@@ -219,7 +316,7 @@ class DriveFriction:
 
     @property
     def kind(self) -> str:
-        """The law's kind (``"classical"`` or ``"sigmoid"``)."""
+        """The law's registry name (:mod:`dynid.friction.laws`)."""
         return self.law.kind
 
     @property
@@ -243,4 +340,4 @@ class DriveFriction:
 
 
 #: A friction model; each has ``kind``, ``names``, ``n``, ``torques(dq)`` and ``as_array()``.
-FrictionModel = SigmoidFriction | ClassicalFriction | DriveFriction
+FrictionModel = SigmoidFriction | ClassicalFriction | LawFriction | DriveFriction

@@ -34,7 +34,7 @@ from ..identification.model import IdentifiedModel
 from ..model.drive import Drive
 from ..model.robot import Robot
 from .fit import TorqueModel, model_drive, rigid_body_torques
-from .model import ClassicalFriction, DriveFriction, FrictionModel, SigmoidFriction
+from .model import ClassicalFriction, DriveFriction, FrictionModel, LawFriction, SigmoidFriction
 
 __all__ = [
     "RECORDED",
@@ -299,7 +299,7 @@ class NewtonEulerValidation:
         return out
 
 
-def _friction_model(robot: Robot, friction: Any) -> SigmoidFriction | ClassicalFriction | None:
+def _friction_model(robot: Robot, friction: Any) -> FrictionModel | None:
     if isinstance(friction, str):
         if friction != "robot":
             raise OptionError(
@@ -307,7 +307,9 @@ def _friction_model(robot: Robot, friction: Any) -> SigmoidFriction | ClassicalF
                 f"got {friction!r}"
             )
         return None if robot.friction is None else SigmoidFriction.from_array(robot.friction)
-    if friction is None or isinstance(friction, (SigmoidFriction, ClassicalFriction)):
+    if friction is None or isinstance(
+        friction, (SigmoidFriction, ClassicalFriction, LawFriction, DriveFriction)
+    ):
         model = friction
     else:
         model = SigmoidFriction.from_array(friction)
@@ -344,7 +346,7 @@ def validate_newton_euler(
         Joint positions [rad], velocities [rad/s], accelerations [rad/s^2].
     tau : array_like, shape (N, n)
         Measured joint torques [N m] (friction included).
-    friction : "robot", None, SigmoidFriction, ClassicalFriction or array_like (n, 3)
+    friction : "robot", None, FrictionModel or array_like (n, 3)
         ``"robot"`` (default) uses ``robot.friction`` (sigmoid; none if the robot has
         none); an (n, 3) array is sigmoid ``phi1, phi2, phi3`` per joint.
     reference : IdentifiedModel, optional

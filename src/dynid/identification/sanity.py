@@ -41,6 +41,7 @@ __all__ = [
     "NOISE_BAND_STD",
     "check_torque_log",
     "moving_joints",
+    "noise_band",
     "velocity_noise_std",
 ]
 
@@ -88,6 +89,27 @@ def velocity_noise_std(dq: ArrayLike) -> NDArray[np.float64]:
     return out
 
 
+def noise_band(noise_std: ArrayLike) -> NDArray[np.float64]:
+    """The velocity noise band [rad/s]: ``max(NOISE_BAND_STD * noise_std, MIN_MOTION)``.
+
+    Joints whose velocity stays inside it do not move (:func:`moving_joints`), and friction
+    laws do not switch Coulomb friction on inside it (:mod:`dynid.friction.laws.base`).
+
+    Parameters
+    ----------
+    noise_std : array_like, shape (n,) or scalar
+        White-noise std of the measured velocities [rad/s] (:func:`velocity_noise_std`).
+
+    Returns
+    -------
+    ndarray, same shape as ``noise_std``
+    """
+    out: NDArray[np.float64] = np.maximum(
+        NOISE_BAND_STD * np.asarray(noise_std, dtype=np.float64), MIN_MOTION
+    )
+    return out
+
+
 def moving_joints(dq: ArrayLike, noise_std: ArrayLike | None = None) -> NDArray[np.bool_]:
     """Which joints move beyond their velocity noise band (n,) bool.
 
@@ -118,7 +140,7 @@ def moving_joints(dq: ArrayLike, noise_std: ArrayLike | None = None) -> NDArray[
     sd = np.broadcast_to(sd, (a.shape[1],)) if sd.ndim == 0 else sd
     if sd.shape != (a.shape[1],):
         raise ShapeError(f"noise_std must have shape ({a.shape[1]},); got {sd.shape}")
-    band = np.maximum(NOISE_BAND_STD * sd, MIN_MOTION)
+    band = noise_band(sd)
     out: NDArray[np.bool_] = np.quantile(np.abs(a), 1.0 - MOVING_FRACTION, axis=0) > band
     return out
 

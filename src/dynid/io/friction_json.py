@@ -7,13 +7,19 @@
      "convention": "tau = M ddq + c + g + tau_f(dq); tau_f = ...",
      "units": {"phi1": "N m", "phi2": "s/rad", "phi3": "rad/s", "rms_before": "N m", ...},
      "joints": [{"phi1": ..., "phi2": ..., "phi3": ..., "rms_before": ..., "rms_after": ...}, ...],
+     "selection": {...},
      "metadata": {...}}
 
-The classical model stores ``fv``, ``fc``, ``fo`` per joint instead (Gaz et al. 2019,
-eqs. 24 and 25; :mod:`dynid.friction.model`). ``rms_before``/``rms_after`` and ``identified``
-(false: the joint never moved beyond its velocity noise band, its parameters are zero) are
-written when a :class:`~dynid.friction.fit.FrictionFit` is saved and are optional on
-reading.
+``model`` is a law of the registry (:mod:`dynid.friction.laws`: ``none``, ``classical``,
+``smooth``, ``asymmetric``, ``stribeck``, ``sigmoid``) and each joint holds that law's
+parameters (``fv``, ``fc``, ``fo`` for the classical law, ...). ``standstill_band``
+[rad/s] per joint is the velocity band inside which Coulomb friction is off (files
+without it, as those of earlier versions: 0, the plain ``sign(dq)``). ``rms_before``/
+``rms_after`` and ``identified`` (false: the joint never moved beyond its velocity noise
+band, its parameters are zero) are written when a
+:class:`~dynid.friction.fit.FrictionFit` is saved and are optional on reading;
+``selection`` (the held-out comparison of :mod:`dynid.friction.select`) when the law was
+chosen on held-out data.
 """
 
 from __future__ import annotations
@@ -25,7 +31,8 @@ import numpy as np
 
 from ..exceptions import DataError
 from ..friction.fit import FrictionFit
-from ..friction.model import ClassicalFriction, DriveFriction, FrictionModel, SigmoidFriction
+from ..friction.laws import LAWS
+from ..friction.model import DriveFriction, FrictionModel
 from .drive_file import drive_from_record
 from .json_files import load_json, save_json
 
@@ -33,20 +40,7 @@ __all__ = ["FORMAT", "load_friction_json", "save_friction_json"]
 
 FORMAT = "dynid-friction/1"
 
-_CONVENTION = {
-    "sigmoid": "tau = M ddq + c + g + tau_f(dq); "
-    "tau_f = phi1/(1+exp(-phi2 (dq+phi3))) - phi1/(1+exp(-phi2 phi3)) (Gaz et al. 2019, eq. 25)",
-    "classical": "tau = M ddq + c + g + tau_f(dq); tau_f = fv dq + fc sign(dq) + fo "
-    "(Gaz et al. 2019, eq. 24)",
-}
-_UNITS = {
-    "sigmoid": {"phi1": "N m", "phi2": "s/rad", "phi3": "rad/s"},
-    "classical": {"fv": "N m s/rad", "fc": "N m", "fo": "N m"},
-}
-_CLASSES: dict[str, type[SigmoidFriction] | type[ClassicalFriction]] = {
-    "sigmoid": SigmoidFriction,
-    "classical": ClassicalFriction,
-}
+_CONVENTION = "tau = M ddq + c + g + tau_f(dq); "
 
 
 def save_friction_json(
@@ -54,8 +48,12 @@ def save_friction_json(
     friction: FrictionModel | FrictionFit,
     *,
     metadata: dict[str, Any] | None = None,
+    selection: dict[str, Any] | None = None,
 ) -> Path:
     """Write a friction model (or a fit, with its RMS before/after) to ``path``.
+
+    ``selection``: the held-out comparison of the candidate laws
+    (:meth:`~dynid.friction.select.FrictionSelection.as_dict`), written as ``selection``.
 
     Returns
     -------
@@ -70,28 +68,36 @@ def save_friction_json(
     else:
         fit, model = None, friction
     drive = model.drive if isinstance(model, DriveFriction) else None
+    law = LAWS[model.kind]
     P = model.as_array()
+    band = getattr(model.law if isinstance(model, DriveFriction) else model, "band", None)
     joints = []
     for j in range(model.n):
         d: dict[str, float | bool] = {k: float(P[j, i]) for i, k in enumerate(model.names)}
+        if band is not None:
+            d["standstill_band"] = float(band[j])
         if fit is not None:
             d["rms_before"] = float(fit.rms_before[j])
             d["rms_after"] = float(fit.rms_after[j])
             d["identified"] = bool(fit.identified[j])
         joints.append(d)
-    units = dict(_UNITS[model.kind])
+    units = dict(zip(law.params, law.units, strict=True))
+    if band is not None:
+        units["standstill_band"] = "rad/s"
     if fit is not None:
         units.update(rms_before="N m", rms_after="N m")
     doc = {
         "schema": FORMAT,
         "dynid_version": __version__,
         "model": model.kind,
-        "convention": _CONVENTION[model.kind],
+        "convention": _CONVENTION + law.formula,
         "units": units,
         "joints": joints,
         "drive": None if drive is None else drive.as_dict(),
         "metadata": metadata or {},
     }
+    if selection is not None:
+        doc["selection"] = selection
     return save_json(path, doc)
 
 
@@ -114,15 +120,18 @@ def load_friction_json(path: str | Path) -> FrictionModel:
             f"{path.name}: not a friction file: 'schema' must be {FORMAT!r}; got {tag!r}"
         )
     kind = doc.get("model")
-    if kind not in _CLASSES:
-        raise DataError(f"{path.name}: 'model' must be 'sigmoid' or 'classical'; got {kind!r}")
+    if kind not in LAWS:
+        raise DataError(f"{path.name}: 'model' must be one of {', '.join(LAWS)}; got {kind!r}")
     joints = doc.get("joints")
     if not isinstance(joints, list) or not joints:
         raise DataError(f"{path.name}: 'joints' must be a non-empty list of objects")
-    cls = _CLASSES[kind]
-    P = np.zeros((len(joints), 3))
+    law = LAWS[kind]
+    names = law.params + ("standstill_band",)
+    P = np.zeros((len(joints), len(names)))
     for j, d in enumerate(joints):
-        for i, k in enumerate(cls.names):
+        for i, k in enumerate(names):
+            if k == "standstill_band" and isinstance(d, dict) and k not in d:
+                continue  # files of earlier versions: the plain sign
             if not isinstance(d, dict) or k not in d:
                 raise DataError(f"{path.name}: joint {j + 1} has no {k!r} (model {kind!r})")
             try:
@@ -133,10 +142,12 @@ def load_friction_json(path: str | Path) -> FrictionModel:
                 ) from None
     if not np.all(np.isfinite(P)):
         raise DataError(f"{path.name}: non-finite friction parameters")
-    law = cls.from_array(P)
+    if np.any(P[:, -1] < 0):
+        raise DataError(f"{path.name}: 'standstill_band' must be >= 0")
+    fr = law.model(P[:, :-1], P[:, -1])
     if doc.get("drive") is None:
-        return law
+        return fr
     try:
-        return DriveFriction(law, drive_from_record(doc["drive"], len(joints)))
+        return DriveFriction(fr, drive_from_record(doc["drive"], len(joints)))
     except DataError as exc:
         raise DataError(f"{path.name}: {exc}") from exc

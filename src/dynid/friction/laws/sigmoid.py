@@ -1,0 +1,124 @@
+"""The sigmoid of Gaz et al. 2019 (eq. 25), zero at rest: ``phi1`` [N m] the span between
+the two saturation levels, ``phi2`` [s/rad] the steepness, ``phi3`` [rad/s] the velocity
+offset of the transition (:func:`~dynid.friction.model.sigmoid_friction`).
+
+Fit, per joint: Nelder-Mead (``scipy.optimize.minimize``) on the mean squared residual in
+scaled variables ``z = (phi1 / s1, ln(phi2 / s2), phi3 / s3)`` (``phi2`` stays positive),
+started from a grid over ``phi2`` and ``phi3`` with ``phi1`` solved in closed form for each
+grid point (the law is linear in ``phi1``); deterministic. The law is smooth and zero at
+rest, so it needs no standstill band.
+
+MuJoCo holds the odd part of the sigmoid, ``(tau_f(dq) - tau_f(-dq)) / 2``, fitted by
+``fc sign(dq) + fv dq`` (non-negative least squares on velocities up to ``dq_max``,
+:func:`odd_part`); the even part (an offset at large speed) is dropped.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import scipy.optimize
+import scipy.special
+from numpy.typing import NDArray
+
+from ..model import SigmoidFriction, sigmoid_friction
+from .base import FrictionLaw, JointFit, MjcfTerms
+
+__all__ = ["LAW", "odd_part"]
+
+#: Nelder-Mead iteration limit per joint.
+MAXITER = 4000
+
+
+def _basis(dq: NDArray[np.float64], phi2: float, phi3: float) -> NDArray[np.float64]:
+    out: NDArray[np.float64] = scipy.special.expit(phi2 * (dq + phi3)) - scipy.special.expit(
+        phi2 * phi3
+    )
+    return out
+
+
+def fit_joint(dq: NDArray[np.float64], r: NDArray[np.float64], band: float = 0.0) -> JointFit:
+    """(phi1, phi2, phi3) of one joint's (N,) velocity [rad/s] and residual [N m]; ``band``
+    is not used (the sigmoid is zero at rest)."""
+    scale = float(np.sqrt(np.mean(r**2))) or 1.0
+    rs = r / scale
+    # start: grid over (phi2, phi3), phi1 by closed-form least squares (on a subsample)
+    step = max(1, dq.size // 4000)
+    dg, rg = dq[::step], rs[::step]
+    best = (np.inf, 1.0, 10.0, 0.0)
+    for phi2 in np.geomspace(1.0, 100.0, 15):
+        for phi3 in np.linspace(-0.1, 0.1, 9):
+            b = _basis(dg, phi2, phi3)
+            bb = float(b @ b)
+            if bb <= 0:
+                continue
+            a = float(b @ rg) / bb
+            sse = float(np.sum((rg - a * b) ** 2))
+            if sse < best[0]:
+                best = (sse, a, phi2, phi3)
+    _, a0, s2, p30 = best
+    s1 = a0 if abs(a0) > 1e-6 else 1.0
+    s3 = 0.05
+
+    def cost(z: NDArray[np.float64]) -> float:
+        e = rs - z[0] * s1 * _basis(dq, s2 * np.exp(z[1]), z[2] * s3)
+        return float(np.mean(e**2))
+
+    z0 = np.array([1.0, 0.0, p30 / s3])
+    res = scipy.optimize.minimize(
+        cost, z0, method="Nelder-Mead", options={"xatol": 1e-7, "fatol": 1e-12, "maxiter": MAXITER}
+    )
+    z = res.x
+    phi = np.array([z[0] * s1 * scale, s2 * np.exp(z[1]), z[2] * s3])
+    return JointFit(phi, bool(res.success), int(res.nit))
+
+
+def odd_part(
+    P: NDArray[np.float64], dq_max: NDArray[np.float64], n_points: int = 200
+) -> tuple[NDArray[np.float64], ...]:
+    """``fc sign(dq) + fv dq`` fitted to the odd part of sigmoids (n, 3) on ``n_points``
+    velocities in ``(0, dq_max]`` (n,) [rad/s]: ``(fc, fv, offset, rms)``, each (n,), with
+    ``fc, fv >= 0``, ``offset`` the even part at ``dq_max`` [N m] and ``rms`` the fit's RMS
+    error [N m]."""
+    n = P.shape[0]
+    coulomb, viscous, offset, rms = (np.zeros(n) for _ in range(4))
+    for j in range(n):
+        v = np.linspace(dq_max[j] / n_points, dq_max[j], n_points)
+        p1, p2, p3 = P[j]
+        up = sigmoid_friction(v, p1, p2, p3)
+        down = sigmoid_friction(-v, p1, p2, p3)
+        odd = (up - down) / 2.0
+        A = np.stack([np.ones_like(v), v], axis=1)
+        x, _ = scipy.optimize.nnls(A, odd)
+        coulomb[j], viscous[j] = x
+        offset[j] = (up[-1] + down[-1]) / 2.0
+        rms[j] = float(np.sqrt(np.mean((A @ x - odd) ** 2)))
+    return coulomb, viscous, offset, rms
+
+
+def _torques(
+    dq: NDArray[np.float64], P: NDArray[np.float64], band: NDArray[np.float64]
+) -> NDArray[np.float64]:
+    return sigmoid_friction(dq, P[:, 0], P[:, 1], P[:, 2])
+
+
+def _mjcf(P: NDArray[np.float64], dq_max: NDArray[np.float64]) -> MjcfTerms:
+    fc, fv, offset, _ = odd_part(P, dq_max)
+    return MjcfTerms(fv, fc, offset, "the even part of the sigmoid (an offset at large speed)")
+
+
+def _make(P: NDArray[np.float64], band: object) -> SigmoidFriction:
+    return SigmoidFriction.from_array(P)
+
+
+LAW = FrictionLaw(
+    "sigmoid",
+    ("phi1", "phi2", "phi3"),
+    ("N m", "s/rad", "rad/s"),
+    "tau_f = phi1/(1+exp(-phi2 (dq+phi3))) - phi1/(1+exp(-phi2 phi3)) (Gaz et al. 2019, eq. 25)",
+    _torques,
+    fit_joint,
+    (-np.inf, 0.0, -np.inf),
+    (np.inf, np.inf, np.inf),
+    _mjcf,
+    _make,
+)

@@ -1,0 +1,45 @@
+"""Smooth Coulomb: viscous, a Coulomb term rounded at rest by ``tanh``, and an offset.
+
+.. math:: \\tau_f(\\dot q) = f_v \\dot q + f_c \\tanh(\\dot q / v_s) + f_o
+
+``v_s`` [rad/s] is not fitted: it is the joint's standstill band (the velocity noise band,
+:mod:`dynid.friction.laws.base`), so the Coulomb torque reaches 76 % of ``fc`` where the
+velocity leaves the noise and is near zero where encoder noise alone moves ``dq``
+(without a band, ``v_s = 0``: the plain sign). Linear in ``fv`` [N m s/rad] ``>= 0``,
+``fc`` [N m] ``>= 0`` and ``fo`` [N m]. MuJoCo holds ``fv`` as ``damping`` and ``fc`` as
+``frictionloss`` (its dry friction is itself a smoothed constraint); the offset is dropped.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from numpy.typing import NDArray
+
+from .base import MjcfTerms, linear_law
+
+__all__ = ["LAW", "columns"]
+
+
+def columns(dq: NDArray[np.float64], band: NDArray[np.float64]) -> NDArray[np.float64]:
+    """Regressor (..., n, 3): ``(dq, tanh(dq / v_s), 1)`` per joint, ``v_s = band``."""
+    vs = np.asarray(band, dtype=np.float64)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        s = np.where(vs > 0, np.tanh(dq / np.where(vs > 0, vs, 1.0)), np.sign(dq))
+    return np.stack([dq, s, np.ones_like(dq)], axis=-1)
+
+
+def _mjcf(P: NDArray[np.float64], dq_max: NDArray[np.float64]) -> MjcfTerms:
+    dropped = "the offset fo" if np.any(P[:, 2] != 0) else ""
+    return MjcfTerms(P[:, 0].copy(), P[:, 1].copy(), P[:, 2].copy(), dropped)
+
+
+LAW = linear_law(
+    "smooth",
+    ("fv", "fc", "fo"),
+    ("N m s/rad", "N m", "N m"),
+    "tau_f = fv dq + fc tanh(dq / v_s) + fo, v_s = standstill_band (the velocity noise band)",
+    columns,
+    (0.0, 0.0, -np.inf),
+    (np.inf, np.inf, np.inf),
+    _mjcf,
+)

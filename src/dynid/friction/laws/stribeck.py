@@ -1,0 +1,94 @@
+"""Stribeck friction: Coulomb friction that rises to a static level ``fs`` near rest.
+
+.. math:: \\tau_f(\\dot q) = f_v \\dot q
+          + \\big(f_c + (f_s - f_c)\\, e^{-(\\dot q / v_{st})^2}\\big)\\, s(\\dot q) + f_o
+
+with ``s`` the sign outside the standstill band (:func:`~dynid.friction.model.coulomb_sign`).
+``fv`` [N m s/rad], ``fc``, ``fs`` [N m] ``>= 0``, the Stribeck velocity ``vst`` [rad/s]
+in ``[1e-3, 10]``, the offset ``fo`` [N m] of either sign. Given ``vst`` the law is linear
+in the others; the fit is a variable projection: bounded linear least squares for each
+``vst`` on a logarithmic grid, then a bounded scalar search of ``ln vst`` between the grid
+neighbours of the best point (deterministic). MuJoCo holds ``fv`` as ``damping`` and ``fc``
+as ``frictionloss``; the peak ``fs - fc`` at low speed and the offset are dropped.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import scipy.optimize
+from numpy.typing import NDArray
+
+from ..model import coulomb_sign
+from .base import FrictionLaw, JointFit, MjcfTerms, bounded_lstsq
+
+__all__ = ["LAW"]
+
+_LOWER = (0.0, 0.0, 0.0, 1e-3, -np.inf)
+_UPPER = (np.inf, np.inf, np.inf, 10.0, np.inf)
+_LIN = [0, 1, 2, 4]  # the parameters the law is linear in: fv, fc, fs, fo
+
+
+def _columns(
+    dq: NDArray[np.float64], band: NDArray[np.float64], vst: NDArray[np.float64]
+) -> NDArray[np.float64]:
+    s = coulomb_sign(dq, band)
+    e = np.exp(-((dq / vst) ** 2))
+    return np.stack([dq, s * (1.0 - e), s * e, np.ones_like(dq)], axis=-1)
+
+
+def _torques(
+    dq: NDArray[np.float64], P: NDArray[np.float64], band: NDArray[np.float64]
+) -> NDArray[np.float64]:
+    C = _columns(dq, band, P[:, 3])
+    out: NDArray[np.float64] = np.einsum("...jk,jk->...j", C, P[:, _LIN])
+    return out
+
+
+def _fit(dq: NDArray[np.float64], r: NDArray[np.float64], band: float) -> JointFit:
+    lo = np.asarray(_LOWER)[_LIN]
+    hi = np.asarray(_UPPER)[_LIN]
+    step = max(1, dq.size // 20_000)  # the search on a subsample, the final solve on all
+    dqs, rs = dq[::step], r[::step]
+
+    def solve(
+        ln_vst: float, v: NDArray[np.float64], rr: NDArray[np.float64]
+    ) -> tuple[NDArray[np.float64], float]:
+        A = _columns(v, np.asarray(band), np.asarray(np.exp(ln_vst)))
+        x = bounded_lstsq(A, rr, lo, hi)
+        return x, float(np.sum((A @ x - rr) ** 2))
+
+    top = min(_UPPER[3], max(float(np.max(np.abs(dq))), 2 * _LOWER[3]))
+    grid = np.linspace(np.log(max(_LOWER[3], band)), np.log(top), 24)
+    costs = [solve(g, dqs, rs)[1] for g in grid]
+    k = int(np.argmin(costs))
+    a, b = grid[max(k - 1, 0)], grid[min(k + 1, grid.size - 1)]
+    res = scipy.optimize.minimize_scalar(
+        lambda g: solve(g, dqs, rs)[1], bounds=(a, b), method="bounded", options={"xatol": 1e-4}
+    )
+    g = float(res.x) if res.fun <= costs[k] else float(grid[k])
+    x, _ = solve(g, dq, r)
+    p = np.array([x[0], x[1], x[2], np.exp(g), x[3]])
+    return JointFit(p, bool(res.success), int(res.nfev) + grid.size)
+
+
+def _mjcf(P: NDArray[np.float64], dq_max: NDArray[np.float64]) -> MjcfTerms:
+    dropped = []
+    if np.any(P[:, 2] != P[:, 1]):
+        dropped.append("the Stribeck peak fs - fc at low speed")
+    if np.any(P[:, 4] != 0):
+        dropped.append("the offset fo")
+    return MjcfTerms(P[:, 0].copy(), P[:, 1].copy(), P[:, 4].copy(), " and ".join(dropped))
+
+
+LAW = FrictionLaw(
+    "stribeck",
+    ("fv", "fc", "fs", "vst", "fo"),
+    ("N m s/rad", "N m", "N m", "rad/s", "N m"),
+    "tau_f = fv dq + (fc + (fs - fc) exp(-(dq / vst)^2)) s(dq) + fo, "
+    "s(dq) = sign(dq) where |dq| > standstill_band, else 0",
+    _torques,
+    _fit,
+    _LOWER,
+    _UPPER,
+    _mjcf,
+)
