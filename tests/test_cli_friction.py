@@ -98,7 +98,10 @@ def test_simulate_writes_a_readable_log(workdir, capsys):
 
 
 def test_friction_then_validate_write_json_and_figures(workdir, capsys):
-    """friction writes friction.json and its figure; validate uses it and writes its own."""
+    """friction writes friction.json and its figure; validate uses it and writes its own.
+    Without --friction-model the laws are compared on held-out blocks: the simulated truth
+    (the published sigmoid) is kept, and it predicts the held-out blocks better than the
+    identification's own classical friction and than no friction."""
     fr = workdir / "fr"
     assert (
         main(
@@ -121,7 +124,13 @@ def test_friction_then_validate_write_json_and_figures(workdir, capsys):
     assert j["identified"] is True
     assert j["rms_after"] < j["rms_before"]
     assert _png(fr / "friction.png")
-    assert "RMS after" in capsys.readouterr().out
+    out = capsys.readouterr().out
+    assert "RMS after" in out and "held-out [%]" in out and "* sigmoid" in out
+    sel = doc["selection"]
+    assert sel["chosen"] == "sigmoid" and sel["folds"] == 5
+    held = {c["model"]: c["heldout_error_percent"] for c in sel["candidates"]}
+    assert set(held) == {"own", "none", "classical", "smooth", "asymmetric", "stribeck", "sigmoid"}
+    assert held["sigmoid"] == min(held.values()) < held["own"] < held["none"]
 
     val = workdir / "val"
     assert (
@@ -194,7 +203,9 @@ def test_classical_friction_model_option(workdir):
     )
     doc = json.loads((out / "friction.json").read_text())
     assert doc["model"] == "classical"
-    assert set(doc["joints"][0]) == {"fv", "fc", "fo", "rms_before", "rms_after", "identified"}
+    assert set(doc["joints"][0]) == {
+        "fv", "fc", "fo", "standstill_band", "rms_before", "rms_after", "identified"
+    }  # fmt: skip
 
 
 def test_cli_errors_are_one_line_with_exit_code_2(workdir, capsys):
