@@ -280,8 +280,8 @@ def fit_law(
         (:attr:`FrictionResidual.dq_noise_std`). It sets each joint's standstill band
         (:func:`~dynid.identification.sanity.noise_band`): Coulomb terms are off inside it,
         in the fit and in the fitted model. Joints whose ``dq`` does not leave the band
-        (:func:`moving_joints`) get zero friction; None: no noise, the band is
-        :data:`~dynid.identification.sanity.MIN_MOTION`.
+        (:func:`moving_joints`) get zero friction; None: no noise (no band; only
+        :data:`~dynid.identification.sanity.MIN_MOTION` tells still joints).
     warn : bool
         Warn about joints that do not move (False: silently zero, as in cross-validation).
 

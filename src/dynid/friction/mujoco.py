@@ -18,15 +18,16 @@ velocity-independent torque [N m] dropped at large speeds) so that callers can r
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
-import scipy.optimize
 from numpy.typing import ArrayLike, NDArray
 
 from .. import _checks
 from ..exceptions import ShapeError
-from .model import ClassicalFriction, DriveFriction, sigmoid_friction
+from .laws import LAWS
+from .laws.sigmoid import odd_part
+from .model import DriveFriction, FrictionModel
 
 __all__ = [
     "CoulombViscous",
@@ -93,18 +94,7 @@ def coulomb_viscous_from_sigmoid(
     n = f.shape[0]
     vmax = _checks.as_exact("dq_max", dq_max, (n,), allow_nonfinite=True)
     vmax = np.where(np.isfinite(vmax) & (vmax > 0), vmax, 2.0)
-    coulomb, viscous, offset, rms = (np.zeros(n) for _ in range(4))
-    for j in range(n):
-        v = np.linspace(vmax[j] / n_points, vmax[j], n_points)
-        p1, p2, p3 = f[j]
-        up = sigmoid_friction(v, p1, p2, p3)
-        down = sigmoid_friction(-v, p1, p2, p3)
-        odd = (up - down) / 2.0
-        A = np.stack([np.ones_like(v), v], axis=1)
-        x, _ = scipy.optimize.nnls(A, odd)
-        coulomb[j], viscous[j] = x
-        offset[j] = (up[-1] + down[-1]) / 2.0
-        rms[j] = float(np.sqrt(np.mean((A @ x - odd) ** 2)))
+    coulomb, viscous, offset, rms = odd_part(f, vmax, n_points)
     return CoulombViscous(coulomb, viscous, offset, rms, vmax)
 
 
@@ -180,21 +170,43 @@ def drive_joint_terms(
     return DriveJointTerms(arm, damp, loss, tuple(notes))
 
 
-def joint_coulomb_viscous(friction: ClassicalFriction | DriveFriction) -> DriveJointTerms:
+def joint_coulomb_viscous(
+    friction: FrictionModel, dq_max: ArrayLike | None = None
+) -> DriveJointTerms:
     """Per-joint Coulomb (``frictionloss``, URDF ``friction``) and viscous (``damping``)
-    coefficients of identified linear friction, at the joints or reflected from the motors
-    of a drive (:func:`drive_joint_terms`; what has no per-joint form is in ``notes``)."""
+    coefficients of a friction model, at the joints or reflected from the motors of a drive
+    (:func:`drive_joint_terms`).
+
+    Each law of the registry maps itself (:attr:`~dynid.friction.laws.base.FrictionLaw.mjcf`:
+    the classical law's ``fv`` and ``fc``, the asymmetric law's means, ...); what MJCF cannot
+    hold (an offset, an asymmetry, a Stribeck peak, coupled terms) is named in ``notes``.
+
+    Parameters
+    ----------
+    friction : FrictionModel
+    dq_max : array_like, shape (n,), optional
+        Velocity range [rad/s] of the sigmoid's approximation (default 2 rad/s).
+
+    Returns
+    -------
+    DriveJointTerms
+    """
+    law = friction.law if isinstance(friction, DriveFriction) else friction
+    n = law.n
+    vmax = np.full(n, 2.0) if dq_max is None else _checks.as_exact("dq_max", dq_max, (n,))
+    terms = LAWS[law.kind].mjcf(law.as_array(), vmax)
+    notes = (f"{law.kind} friction: {terms.dropped} is not expressible in MJCF",) * bool(
+        terms.dropped
+    )
     if isinstance(friction, DriveFriction):
-        law = friction.law
-        if not isinstance(law, ClassicalFriction):
-            raise ShapeError("friction at the motors must be the classical law to export")
         d = friction.drive
-        return drive_joint_terms(
+        jt = drive_joint_terms(
             d.transmission,
             None,
-            np.asarray(law.fv),
-            np.asarray(law.fc),
+            terms.damping,
+            terms.frictionloss,
             friction_at_motor=d.friction_at == "motor",
         )
-    z = np.zeros(friction.n)
-    return DriveJointTerms(z, np.asarray(friction.fv), np.asarray(friction.fc))
+        return replace(jt, notes=notes + jt.notes)
+    z = np.zeros(n)
+    return DriveJointTerms(z, terms.damping, terms.frictionloss, notes)

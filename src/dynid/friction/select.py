@@ -7,7 +7,9 @@ to:
 
 1. The prepared log (:func:`~dynid.friction.fit.friction_residual`) is split into
    :data:`FOLDS` contiguous blocks of equal length (contiguous, not shuffled: neighbouring
-   samples of a filtered log are correlated, and a shuffled split would leak them).
+   samples of a filtered log are correlated, and a shuffled split would leak them), the
+   blocks of the identification's own held-out judgement
+   (:func:`~dynid.identification.holdout.block_labels`).
 2. For each block, every candidate law is fitted (:func:`~dynid.friction.fit.fit_law_through`,
    so a drive's motors are fitted where its friction acts) on the other blocks and predicts
    the held-out block.
@@ -35,6 +37,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from ..exceptions import DataError, DynidWarning, OptionError
+from ..identification.holdout import DEFAULT_FOLDS, block_labels
 from ..model.drive import Drive
 from .fit import FrictionFit, FrictionResidual, fit_friction_through, fit_law_through
 from .laws import LAWS
@@ -42,8 +45,8 @@ from .model import FrictionModel
 
 __all__ = ["FOLDS", "OWN", "CandidateScore", "FrictionSelection", "select_friction"]
 
-#: Number of contiguous blocks of the cross-validation.
-FOLDS = 5
+#: Number of contiguous blocks of the cross-validation (the identification's default).
+FOLDS = DEFAULT_FOLDS
 #: Name of the candidate "the model's own friction, as it is".
 OWN = "own"
 
@@ -122,21 +125,15 @@ class FrictionSelection:
         return "\n".join(rows)
 
 
-def _blocks(n_samples: int, folds: int) -> list[slice]:
-    edges = np.linspace(0, n_samples, folds + 1).round().astype(int)
-    return [slice(int(a), int(b)) for a, b in zip(edges[:-1], edges[1:], strict=True)]
-
-
 def _heldout_torques(
-    res: FrictionResidual, drive: Drive | None, name: str, blocks: list[slice]
+    res: FrictionResidual, drive: Drive | None, name: str, labels: NDArray[np.intp]
 ) -> NDArray[np.float64]:
     """Each block's friction torques (N, n) predicted by ``name`` fitted on the others; a
     block whose training blocks move no joint gets zero."""
-    N = res.dq.shape[0]
     out = np.zeros(res.dq.shape)
-    for b in blocks:
-        keep = np.ones(N, bool)
-        keep[b] = False
+    for k in range(int(labels.max()) + 1):
+        b = labels == k
+        keep = ~b
         noise = res.dq_noise_std
         try:
             fit = fit_law_through(
@@ -179,7 +176,7 @@ def select_friction(
     Raises
     ------
     OptionError
-        ``folds < 2``, fewer than ``4 folds`` samples, or an unknown candidate.
+        ``folds < 2``, fewer than 10 samples per block, or an unknown candidate.
     DataError
         No joint moves beyond its velocity noise band.
 
@@ -192,12 +189,7 @@ def select_friction(
     unknown = [c for c in names if c not in LAWS]
     if unknown:
         raise OptionError(f"--friction-model must be one of {', '.join(LAWS)}; got {unknown[0]!r}")
-    N = res.dq.shape[0]
-    if folds < 2 or N < 4 * folds:
-        raise OptionError(
-            f"the selection needs folds >= 2 and 4 samples per fold; got {folds}, N={N}"
-        )
-    blocks = _blocks(N, folds)
+    labels = block_labels(res.dq.shape[0], folds)
     r = res.residual
     scale = float(np.linalg.norm(res.log.tau)) or 1.0
 
@@ -216,7 +208,7 @@ def select_friction(
                 warnings.simplefilter("ignore", DynidWarning)
             fits[name] = fit_friction_through(res, drive, name)
         train = err(fits[name].friction.torques(res.dq))
-        held = err(_heldout_torques(res, drive, name, blocks))
+        held = err(_heldout_torques(res, drive, name, labels))
         scores.append(CandidateScore(name, LAWS[name].params, train, held))
     best = min(scores, key=lambda s: s.heldout_error_percent)  # first of the lowest: simpler
     return FrictionSelection(fits[best.name], best.name, tuple(scores), folds)

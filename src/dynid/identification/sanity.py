@@ -59,11 +59,14 @@ MOVING_FRACTION = 0.01
 def velocity_noise_std(dq: ArrayLike) -> NDArray[np.float64]:
     """Std [rad/s] (n,) of the white noise on velocity samples ``dq`` (N, n), robustly.
 
-    .. math:: \\hat\\sigma_j = 1.4826 \\, \\mathrm{MAD}(\\Delta^2 \\dot q_j) / \\sqrt 6
+    .. math:: \\hat\\sigma_j = 1.4826 \\, \\min\\big(\\mathrm{MAD}(\\Delta^2 \\dot q_j) / \\sqrt 6,
+              \\; \\mathrm{MAD}(\\Delta^3 \\dot q_j) / \\sqrt{20}\\big)
 
-    The second difference of white noise of std ``sigma`` has std ``sqrt(6) sigma``, while
-    that of a smooth motion sampled fast is far smaller; the median absolute deviation
-    (scaled to a std for Gaussian noise) ignores the few steps of a fast reversal. Give
+    The second and third differences of white noise of std ``sigma`` have std
+    ``sqrt(6) sigma`` and ``sqrt(20) sigma``, while those of a smooth motion sampled fast
+    are far smaller, the third smaller than the second: the smaller of the two estimates
+    leaves a noise-free log (a simulation) with a band near zero. The median absolute
+    deviation (scaled to a std for Gaussian noise) ignores the few steps of a fast reversal. Give
     the measured velocities: a low-pass filter hides the noise from this estimate.
 
     Parameters
@@ -83,17 +86,21 @@ def velocity_noise_std(dq: ArrayLike) -> NDArray[np.float64]:
     a = _checks.as_array("dq", dq)
     if a.ndim != 2 or a.shape[0] < 3:
         raise ShapeError(f"dq must have shape (N, n), N >= 3; got {a.shape}")
-    d2 = np.diff(a, n=2, axis=0)
-    mad = np.median(np.abs(d2 - np.median(d2, axis=0)), axis=0)
-    out: NDArray[np.float64] = 1.4826 * mad / np.sqrt(6.0)
+    est = []
+    for order, var in ((2, 6.0), (3, 20.0)):
+        d = np.diff(a, n=order, axis=0)
+        mad = np.median(np.abs(d - np.median(d, axis=0)), axis=0)
+        est.append(1.4826 * mad / np.sqrt(var))
+    out: NDArray[np.float64] = np.minimum(*est)
     return out
 
 
 def noise_band(noise_std: ArrayLike) -> NDArray[np.float64]:
-    """The velocity noise band [rad/s]: ``max(NOISE_BAND_STD * noise_std, MIN_MOTION)``.
+    """The velocity noise band [rad/s]: ``NOISE_BAND_STD * noise_std``.
 
-    Joints whose velocity stays inside it do not move (:func:`moving_joints`), and friction
-    laws do not switch Coulomb friction on inside it (:mod:`dynid.friction.laws.base`).
+    Joints whose velocity stays inside it (or below :data:`MIN_MOTION`) do not move
+    (:func:`moving_joints`), and friction laws do not switch Coulomb friction on inside it
+    (:mod:`dynid.friction.laws.base`).
 
     Parameters
     ----------
@@ -104,9 +111,7 @@ def noise_band(noise_std: ArrayLike) -> NDArray[np.float64]:
     -------
     ndarray, same shape as ``noise_std``
     """
-    out: NDArray[np.float64] = np.maximum(
-        NOISE_BAND_STD * np.asarray(noise_std, dtype=np.float64), MIN_MOTION
-    )
+    out: NDArray[np.float64] = NOISE_BAND_STD * np.asarray(noise_std, dtype=np.float64)
     return out
 
 
@@ -140,7 +145,7 @@ def moving_joints(dq: ArrayLike, noise_std: ArrayLike | None = None) -> NDArray[
     sd = np.broadcast_to(sd, (a.shape[1],)) if sd.ndim == 0 else sd
     if sd.shape != (a.shape[1],):
         raise ShapeError(f"noise_std must have shape ({a.shape[1]},); got {sd.shape}")
-    band = noise_band(sd)
+    band = np.maximum(noise_band(sd), MIN_MOTION)
     out: NDArray[np.bool_] = np.quantile(np.abs(a), 1.0 - MOVING_FRACTION, axis=0) > band
     return out
 

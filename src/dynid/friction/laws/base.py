@@ -11,9 +11,10 @@ stands still the measured velocity is encoder noise: ``sign(dq)`` of noise would
 full Coulomb torque on at rest. Every law here uses :func:`coulomb_sign`, which is
 ``sign(dq)`` where ``|dq|`` exceeds the joint's standstill band ``b`` and 0 inside it, in
 fitting and in evaluation alike. The band is the velocity noise band of
-:func:`~dynid.identification.sanity.noise_band` (``max(5 sigma, 1e-3 rad/s)``, ``sigma``
-the white-noise std of the measured velocity); a model with ``b = 0`` uses the plain
-``sign(dq)`` (``sign(0) = 0``), as files without a band do.
+:func:`~dynid.identification.sanity.noise_band` (``5 sigma``, ``sigma`` the white-noise std
+of the measured velocity, the band inside which a joint counts as still); a model with
+``b = 0`` (a noise-free log, or a file without a band) uses the plain ``sign(dq)``
+(``sign(0) = 0``).
 """
 
 from __future__ import annotations

@@ -47,7 +47,7 @@ def _torques(
 def _fit(dq: NDArray[np.float64], r: NDArray[np.float64], band: float) -> JointFit:
     lo = np.asarray(_LOWER)[_LIN]
     hi = np.asarray(_UPPER)[_LIN]
-    step = max(1, dq.size // 20_000)  # the search on a subsample, the final solve on all
+    step = max(1, dq.size // 5_000)  # the search on a subsample, the final solve on all
     dqs, rs = dq[::step], r[::step]
 
     def solve(

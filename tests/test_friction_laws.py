@@ -1,0 +1,246 @@
+"""The registry of friction laws: each law recovers its own simulated parameters, the
+standstill rule, the held-out selection, friction.json of every law and the MuJoCo terms."""
+
+from __future__ import annotations
+
+import json
+
+import numpy as np
+import pytest
+
+from dynid.friction.fit import FrictionResidual, fit_law, fit_law_through
+from dynid.friction.laws import LAWS, law_named
+from dynid.friction.model import ClassicalFriction, DriveFriction, LawFriction
+from dynid.friction.mujoco import coulomb_viscous_from_sigmoid, joint_coulomb_viscous
+from dynid.friction.select import select_friction
+from dynid.identification.log import TorqueLog
+from dynid.io.friction_json import load_friction_json, save_friction_json
+from dynid.model.drive import Drive
+
+TAU_NOISE = 0.02  # torque noise [N m]
+DQ_NOISE = 1e-3  # velocity noise [rad/s]
+BAND = 5 * DQ_NOISE  # the velocity noise band of identification.sanity
+
+
+def _s(dq, band):
+    """sign(dq) outside the band, 0 inside (written out)."""
+    return np.sign(dq) * (np.abs(dq) > band)
+
+
+#: Each law written out from its definition (independent of the library's evaluation),
+#: with two joints' true parameters.
+REFERENCE = {
+    "classical": (
+        lambda v, p, b: p[0] * v + p[1] * _s(v, b) + p[2],
+        [[0.3, 0.8, 0.1], [0.05, 0.4, -0.2]],
+    ),
+    "smooth": (
+        lambda v, p, b: p[0] * v + p[1] * np.tanh(v / b) + p[2],
+        [[0.3, 0.8, 0.1], [0.05, 0.4, -0.2]],
+    ),
+    "asymmetric": (
+        lambda v, p, b: (
+            np.where(v > 0, p[0] * v, p[1] * v) + p[2] * (_s(v, b) > 0) - p[3] * (_s(v, b) < 0)
+        ),
+        [[0.3, 0.5, 0.8, 0.6], [0.1, 0.05, 0.2, 0.5]],
+    ),
+    "stribeck": (
+        lambda v, p, b: (
+            p[0] * v + (p[1] + (p[2] - p[1]) * np.exp(-((v / p[3]) ** 2))) * _s(v, b) + p[4]
+        ),
+        [[0.3, 0.6, 1.2, 0.08, 0.1], [0.1, 0.3, 0.5, 0.15, -0.05]],
+    ),
+    "sigmoid": (
+        lambda v, p, b: p[0] / (1 + np.exp(-p[1] * (v + p[2]))) - p[0] / (1 + np.exp(-p[1] * p[2])),
+        [[1.5, 20.0, 0.02], [0.8, 35.0, -0.01]],
+    ),
+}
+
+
+def _sweep(N=20_000, fs=1000.0):
+    """Two joints sweeping both directions at different rates: velocities (N, 2) [rad/s]."""
+    t = np.arange(N) / fs
+    return t, np.stack(
+        [1.0 * np.sin(2 * np.pi * 0.3 * t), 0.6 * np.sin(2 * np.pi * 0.45 * t + 1.0)], axis=1
+    )
+
+
+def _friction(name, dq, P, band=BAND):
+    f, _ = REFERENCE[name]
+    return np.stack([f(dq[:, j], np.asarray(P[j]), band) for j in range(dq.shape[1])], axis=1)
+
+
+def test_the_registry_names_every_law_and_refuses_others():
+    """The registry holds the five laws and 'none'; an unknown name names the flag."""
+    assert list(LAWS) == ["none", "classical", "smooth", "asymmetric", "stribeck", "sigmoid"]
+    for law in LAWS.values():
+        assert len(law.params) == len(law.units) == len(law.lower) == len(law.upper)
+    with pytest.raises(Exception, match="--friction-model must be one of none, classical"):
+        law_named("coulomb")
+
+
+@pytest.mark.parametrize("name", sorted(REFERENCE))
+def test_every_law_recovers_its_own_simulated_parameters(name):
+    """Torques of the law written out plus 0.02 N m noise: the fit returns the true
+    parameters (to 1 %, 3 % for the Stribeck velocity and the sigmoid's steepness), and the
+    RMS after is the noise; the fitted model's torques are the written-out law's."""
+    rng = np.random.default_rng(40 + sorted(REFERENCE).index(name))
+    _, dq = _sweep()
+    P = np.array(REFERENCE[name][1])
+    r = _friction(name, dq, P) + rng.normal(0.0, TAU_NOISE, dq.shape)
+    fit = fit_law(name, dq, r, dq_noise_std=np.full(2, DQ_NOISE))
+    got = fit.friction.as_array()
+    scale = np.maximum(np.abs(P), 0.05)
+    rtol = np.full(P.shape, 0.01)
+    if name in ("stribeck", "sigmoid"):
+        rtol[:, 3 if name == "stribeck" else 1] = 0.03
+    assert np.all(np.abs(got - P) <= rtol * scale + 2e-3), (got, P)
+    np.testing.assert_allclose(fit.rms_after, TAU_NOISE, rtol=0.05)
+    v = np.linspace(-1.2, 1.2, 1001)[:, None] * np.ones(2)
+    np.testing.assert_allclose(fit.friction.torques(v), _friction(name, v, got), atol=1e-12)
+
+
+def test_standstill_samples_do_not_switch_coulomb_friction_on():
+    """A joint that rests half the time (its measured velocity there is encoder noise) with
+    classical friction that is zero at rest: with the standstill rule, the fitted friction
+    predicts the rest samples (and the whole log) far better than the plain sign of the
+    noisy velocity, fitted or with the true coefficients."""
+    rng = np.random.default_rng(50)
+    t = np.arange(20_000) / 1000.0
+    v = np.where(t < 10.0, 0.8 * np.sin(2 * np.pi * 0.4 * t), 0.0)[:, None]
+    dq = v + rng.normal(0.0, DQ_NOISE, v.shape)  # measured
+    fv, fc = 0.3, 1.0
+    r = fv * v + fc * np.sign(v) + rng.normal(0.0, TAU_NOISE, v.shape)  # at rest: no friction
+    rest = t >= 10.0
+    with_rule = fit_law("classical", dq, r, dq_noise_std=[DQ_NOISE])
+    plain = ClassicalFriction([fv], [fc], [0.0])  # the true law, sign of the noise
+    e_rule = np.sqrt(np.mean((r - with_rule.friction.torques(dq))[rest] ** 2))
+    e_plain = np.sqrt(np.mean((r - plain.torques(dq))[rest] ** 2))
+    assert e_rule < 1.5 * TAU_NOISE < 0.5 * fc < e_plain
+    np.testing.assert_allclose(with_rule.friction.as_array()[0, :2], [fv, fc], rtol=0.02)
+    # the rule in the fit, too: fitted with the plain sign, the Coulomb level is pulled down
+    no_rule = ClassicalFriction.from_array(
+        np.linalg.lstsq(np.hstack([dq, np.sign(dq), np.ones_like(dq)]), r[:, 0], rcond=None)[0][
+            None
+        ]
+    )
+    assert np.sqrt(np.mean((r - no_rule.torques(dq)) ** 2)) > 2 * with_rule.rms_after[0]
+
+
+def _residual(dq_true, r, seed):
+    """A FrictionResidual of a log whose velocities carry DQ_NOISE and whose model
+    torques are zero (the residual is the measured torque)."""
+    rng = np.random.default_rng(seed)
+    N, n = dq_true.shape
+    t = np.arange(N) / 1000.0
+    dq = dq_true + rng.normal(0.0, DQ_NOISE, dq_true.shape)
+    log = TorqueLog(t=t, q=np.cumsum(dq_true, axis=0) / 1000.0, dq=dq, tau=r)
+    return FrictionResidual(log, np.zeros((N, n)), r, np.full(n, DQ_NOISE))
+
+
+@pytest.mark.parametrize("name", ["classical", "asymmetric", "stribeck", "sigmoid"])
+def test_the_selection_keeps_the_true_law_and_never_predicts_worse_than_none(name):
+    """Simulated friction of one law: the held-out selection keeps that law, its held-out
+    error is the lowest and below that of no friction and of an own friction given."""
+    rng = np.random.default_rng(60 + list(LAWS).index(name))
+    _, dq = _sweep(10_000)
+    r = _friction(name, dq, np.array(REFERENCE[name][1])) + rng.normal(0, TAU_NOISE, dq.shape)
+    own = ClassicalFriction([0.2, 0.2], [0.5, 0.5], [0.0, 0.0])
+    sel = select_friction(_residual(dq, r, 61), own=own)
+    held = {s.name: s.heldout_error_percent for s in sel.scores}
+    assert sel.chosen == name, sel.table()
+    assert held[name] == min(held.values()) < min(held["none"], held["own"])
+    assert sel.fit.kind == name and "* " + name in sel.table()
+    doc = sel.as_dict()
+    assert doc["chosen"] == name and len(doc["candidates"]) == len(LAWS) + 1
+
+
+def test_the_selection_keeps_the_own_friction_when_nothing_predicts_better():
+    """A residual of pure noise: no law predicts the held-out blocks better than none, and
+    the kept friction's held-out error is never above no friction's."""
+    rng = np.random.default_rng(70)
+    _, dq = _sweep(5_000)
+    r = rng.normal(0.0, TAU_NOISE, dq.shape) + 1.0  # a constant torque: nothing to do with dq
+    sel = select_friction(_residual(dq, r, 71), candidates=["none", "classical", "sigmoid"])
+    held = {s.name: s.heldout_error_percent for s in sel.scores}
+    assert held[sel.chosen] <= held["none"]
+
+
+@pytest.mark.parametrize("name", list(LAWS))
+def test_friction_json_round_trip_of_every_law(tmp_path, name):
+    """Every law, at the joints and at the motors of a drive, reads back as written
+    (parameters, standstill band, torques)."""
+    rng = np.random.default_rng(80 + list(LAWS).index(name))
+    law = LAWS[name]
+    P = np.array(REFERENCE[name][1]) if name in REFERENCE else np.zeros((2, 0))
+    fr = law.model(P, [0.004, 0.006])
+    K = np.array([[50.0, 0.0], [-1.0, 40.0]])
+    for model in (fr, DriveFriction(fr, Drive(transmission=K, offset=np.zeros(2)))):
+        path = save_friction_json(tmp_path / f"{name}.json", model)
+        back = load_friction_json(path)
+        assert back.kind == name and type(back) is type(model)
+        np.testing.assert_array_equal(back.as_array(), model.as_array())
+        v = rng.uniform(-1, 1, (50, 2))
+        np.testing.assert_allclose(back.torques(v), model.torques(v), atol=1e-15)
+    doc = json.loads(path.read_text())
+    assert doc["model"] == name and set(law.params) <= set(doc["joints"][0])
+
+
+def test_a_classical_file_of_an_earlier_version_loads_with_the_plain_sign(tmp_path):
+    """friction.json without standstill_band (earlier versions) loads; sign(0) = 0."""
+    (tmp_path / "old.json").write_text(
+        json.dumps(
+            {
+                "schema": "dynid-friction/1",
+                "model": "classical",
+                "joints": [{"fv": 0.1, "fc": 0.3, "fo": 0.0}],
+            }
+        )
+    )
+    fr = load_friction_json(tmp_path / "old.json")
+    assert isinstance(fr, ClassicalFriction)
+    np.testing.assert_allclose(
+        fr.torques([[1e-6], [0.0], [-1e-6]])[:, 0], [0.3, 0.0, -0.3], atol=1e-6
+    )
+
+
+def test_mujoco_terms_of_every_law():
+    """MuJoCo holds viscous as damping and Coulomb as frictionloss: the linear laws' own
+    coefficients, the asymmetric law's means, the Stribeck law's fv and fc, the sigmoid's
+    odd-part fit; what MJCF cannot hold is named."""
+    expect = {
+        "classical": ([0.3, 0.05], [0.8, 0.4], "offset"),
+        "smooth": ([0.3, 0.05], [0.8, 0.4], "offset"),
+        "asymmetric": ([0.4, 0.075], [0.7, 0.35], "asymmetry"),
+        "stribeck": ([0.3, 0.1], [0.6, 0.3], "Stribeck peak"),
+    }
+    for name, (damping, loss, note) in expect.items():
+        fr = law_named(name).model(np.array(REFERENCE[name][1]))
+        jt = joint_coulomb_viscous(fr)
+        np.testing.assert_allclose(jt.damping, damping, rtol=1e-12)
+        np.testing.assert_allclose(jt.frictionloss, loss, rtol=1e-12)
+        assert any(note in x for x in jt.notes), jt.notes
+    P = np.array(REFERENCE["sigmoid"][1])
+    jt = joint_coulomb_viscous(law_named("sigmoid").model(P), dq_max=np.array([2.0, 2.0]))
+    ref = coulomb_viscous_from_sigmoid(P, [2.0, 2.0])
+    np.testing.assert_allclose(jt.frictionloss, ref.coulomb)
+    np.testing.assert_allclose(jt.damping, ref.viscous)
+
+
+def test_a_law_at_the_motors_is_fitted_per_motor():
+    """Asymmetric friction at the motors of a coupled drive, ``K^T f(K dq)`` with the motor
+    velocity noise ``sqrt(K^2 sigma^2)`` setting the band: fitted through the drive, the
+    motor parameters are recovered."""
+    rng = np.random.default_rng(90)
+    K = np.array([[20.0, 0.0], [-2.0, 15.0]])
+    drive = Drive(transmission=K, offset=np.zeros(2))
+    _, dq = _sweep()
+    dq = dq / 15.0  # motor velocities of the order of 1 rad/s
+    P = np.array(REFERENCE["asymmetric"][1])
+    band = 5 * np.sqrt((K**2) @ np.full(2, DQ_NOISE) ** 2)
+    vm = dq @ K.T
+    tau = np.stack([REFERENCE["asymmetric"][0](vm[:, m], P[m], band[m]) for m in range(2)], 1)
+    tau = tau @ K + rng.normal(0.0, TAU_NOISE, dq.shape)
+    fit = fit_law_through("asymmetric", dq, tau, drive, dq_noise_std=np.full(2, DQ_NOISE))
+    assert isinstance(fit.friction, DriveFriction) and isinstance(fit.friction.law, LawFriction)
+    np.testing.assert_allclose(fit.friction.as_array(), P, rtol=0.02, atol=0.01)
