@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import base64
 import json
 
 import pytest
@@ -11,7 +12,8 @@ from dynid.cli.__main__ import main
 
 @pytest.mark.slow
 def test_demo_runs_every_stage_and_writes_the_report(tmp_path, capsys):
-    """The demo writes every stage's files, figures and report.md, with the expected outcomes."""
+    """The demo writes every stage's files, figures, report.md and report.html, with the
+    expected outcomes."""
     out = tmp_path / "out"
     assert main(["demo", "--out", str(out), "--seed", "1"]) == 0
     text = capsys.readouterr().out
@@ -56,3 +58,9 @@ def test_demo_runs_every_stage_and_writes_the_report(tmp_path, capsys):
     assert sdp["lightest_link_kg"] >= 0.3 and sdp["relative_residual"] < 0.05
     assert cmp["penalty"]["relative_residual"] < 1e-4
     assert "## 5. Physically consistent parameters" in md
+    # report.html over every stage: each stage's figures embedded, its data files linked
+    page = (out / "report.html").read_text(encoding="utf-8")
+    for png in sorted(out.rglob("*.png")):
+        assert base64.b64encode(png.read_bytes()).decode("ascii") in page, png.name
+    for rel in ("identification/static.csv", "feasible/robot.urdf", "report.md"):
+        assert f'href="{rel}"' in page, rel

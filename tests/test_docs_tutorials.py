@@ -89,7 +89,7 @@ def test_the_pages_have_commands():
 def test_page_runs_as_written(page, tmp_path):
     """Each block exits 0, in order, in one folder; the JSON files written name a schema
     and top-level keys that docs/file-formats.md describes (a list of records as
-    ``key[]``)."""
+    ``key[]``); every output folder holds its report.html."""
     env = _environment(tmp_path)
     for k, (language, code) in enumerate(runnable_blocks(page.read_text("utf-8"))):
         _run(language, code, k, tmp_path, env)
@@ -99,3 +99,9 @@ def test_page_runs_as_written(page, tmp_path):
         assert f"`{doc['schema']}`" in formats, f"{where}: schema {doc['schema']} undocumented"
         missing = [k for k in doc if not re.search(rf"`{re.escape(k)}(\[\])?`", formats)]
         assert not missing, f"{where}: keys {missing} not in docs/file-formats.md"
+    # every output folder a page writes holds its run's report, which the page describes
+    for manifest in tmp_path.rglob(".dynid-run.json"):
+        where = manifest.parent.relative_to(tmp_path)
+        assert "report.html" in json.loads(manifest.read_text("utf-8"))["files"], where
+        assert (manifest.parent / "report.html").is_file(), where
+        assert "### report.html" in formats

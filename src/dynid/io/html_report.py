@@ -58,7 +58,7 @@ MAX_VECTOR = 12
 #: Nesting of JSON objects shown (deeper ones are named and left in the file).
 MAX_DEPTH = 3
 #: Tables of more rows than this start collapsed.
-LONG_TABLE = 20
+LONG_TABLE = 50
 #: Printed output longer than this many lines starts collapsed.
 LONG_PRINTOUT = 60
 
@@ -135,11 +135,15 @@ def _href(path: str) -> str:
 
 
 def _size(n: int) -> str:
-    for unit in ("B", "kB", "MB", "GB"):
-        if n < 1000 or unit == "GB":
-            return f"{n} {unit}" if unit == "B" else f"{n:.1f} {unit}"
-        n /= 1000  # type: ignore[assignment]
-    return f"{n} B"  # pragma: no cover
+    """A file size for people: ``812 B``, ``54.3 kB``, ``1.4 MB``."""
+    if n < 1000:
+        return f"{n} B"
+    value = float(n)
+    for unit in ("kB", "MB"):
+        value /= 1000
+        if value < 1000:
+            return f"{value:.1f} {unit}"
+    return f"{value / 1000:.1f} GB"
 
 
 # ---------------------------------------------------------------------- values
@@ -347,6 +351,8 @@ def _json_section(rel: str, doc: Any) -> str:
         body = _object_html(doc, 1)
     elif _is_records(doc):
         body = _records_table(rel, doc, {})
+    elif doc is None:
+        body = '<p class="dim">not readable as JSON; see the file</p>'
     else:
         body = f"<p>{_cell(doc)}</p>"
     return f'<section class="result">{head}{body}</section>'
@@ -547,6 +553,12 @@ def render_html_report(
     -------
     str
         The HTML document.
+
+    Raises
+    ------
+    OSError
+        A figure of ``files`` cannot be read (JSON files that cannot be read or parsed
+        are shown as such, not raised).
     """
     outdir = Path(os.path.abspath(out)) if out is not None else None
     folder_name = outdir.name if outdir is not None else ""
