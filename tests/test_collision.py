@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 import dynid
-from dynid.exceptions import ShapeError
+from dynid.exceptions import OptionError, ShapeError
 from dynid.simulation.collision import (
     DEFAULT_RADIUS,
     Box,
@@ -94,9 +94,9 @@ def test_self_distance_of_a_folded_panda_is_negative():
 
 def test_obstacle_validation_names_the_problem():
     """A zero normal, a non-positive box size and a name count mismatch are rejected."""
-    with pytest.raises(ShapeError, match="normal must be non-zero"):
+    with pytest.raises(OptionError, match="normal must be non-zero"):
         Plane((0, 0, 0), (0, 0, 0))
-    with pytest.raises(ShapeError, match="box size must be positive"):
+    with pytest.raises(OptionError, match="box size must be positive"):
         Box((0, 0, 0), (1, 0, 1))
     with pytest.raises(ShapeError, match="obstacles need 1 names"):
         Obstacles(planes=(Plane((0, 0, 0), (0, 0, 1)),), names=("a", "b"))

@@ -7,7 +7,7 @@ import pytest
 
 import dynid
 from dynid.cli.__main__ import main
-from dynid.exceptions import ShapeError
+from dynid.exceptions import OptionError
 from dynid.io.static_data import load_static_data
 from dynid.regressors.base import base_parameters
 from dynid.regressors.static import static_regressor
@@ -41,12 +41,12 @@ def test_selection_beats_random_configurations_and_stays_admissible():
 
 
 def test_selection_is_reproducible_and_validates_its_options():
-    """The same seed gives the same configurations; bad options raise ShapeError."""
+    """The same seed gives the same configurations; bad options raise OptionError."""
     robot = dynid.panda()
     a = select_static_configurations(robot, 40, np.random.default_rng(75), batches=5, exchange=3)
     b = select_static_configurations(robot, 40, np.random.default_rng(75), batches=5, exchange=3)
     np.testing.assert_array_equal(a.q, b.q)
-    with pytest.raises(ShapeError, match="pool_factor >= 2"):
+    with pytest.raises(OptionError, match="pool_factor >= 2"):
         select_static_configurations(robot, 10, np.random.default_rng(0), pool_factor=1)
 
 

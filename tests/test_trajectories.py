@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from dynid.exceptions import DataError, LimitError, ShapeError
+from dynid.exceptions import DataError, LimitError, OptionError, ShapeError
 from dynid.simulation.trajectories import (
     GAZ2019_SINUSOID_AMPLITUDES,
     GAZ2019_SINUSOID_PERIODS,
@@ -185,5 +185,5 @@ def test_trajectory_rejects_bad_input(panda):
     with pytest.raises(DataError, match="strictly increasing"):
         Trajectory(np.array([0.0, 1.0, 1.0, 2.0]), z, z, z)
     z7 = np.zeros((4, 7))
-    with pytest.raises(ShapeError, match="method must be"):
+    with pytest.raises(OptionError, match="method must be"):
         scale_into_limits(panda, Trajectory(t, z7 - 1.0, z7 + 3.0, z7), method="speed")

@@ -18,6 +18,8 @@ The pipeline, in the order data flows (each name is re-exported here):
   :class:`ExcitationOptions`, :class:`Obstacles`)
 * feasibility: see :mod:`dynid.feasibility`
 * files: :mod:`dynid.io`; figures: :mod:`dynid.plots` (matplotlib, imported lazily)
+* errors: :class:`DynidError` and every subclass of :mod:`dynid.exceptions` (each also a
+  builtin: ``ShapeError`` a ``ValueError``, ``WrongTypeError`` a ``TypeError``, ...)
 
 Conventions: SI units, batch-first arrays (``(..., n)`` joint vectors, ``(..., 4, 4)``
 poses), ``T_a_b`` is the pose of frame b in frame a, gravity 9.80665 m/s^2 along -z of the
@@ -36,10 +38,13 @@ from .exceptions import (
     LimitError,
     ModelError,
     NonFiniteError,
+    OptionError,
+    OutputError,
     RankDeficientError,
     ShapeError,
     SolverError,
     UnknownNameError,
+    WrongTypeError,
 )
 
 if TYPE_CHECKING:  # the names as static imports, for type checkers and editors
@@ -191,6 +196,8 @@ __all__ = [
     "ModelError",
     "NonFiniteError",
     "Obstacles",
+    "OptionError",
+    "OutputError",
     "PANDA_NEUTRAL_Q",
     "Plane",
     "RankDeficientError",
@@ -206,6 +213,7 @@ __all__ = [
     "Trajectory",
     "UnknownNameError",
     "Validation",
+    "WrongTypeError",
     "__version__",
     "acquire_static",
     "acquire_static_at",

@@ -65,11 +65,7 @@ SUBCOMMANDS = (
 
 def _modules(names: Sequence[str] = SUBCOMMANDS):
     for name in names:
-        try:
-            yield importlib.import_module(f"{__package__}.{name}")
-        except ModuleNotFoundError as exc:  # a subcommand not built yet
-            if exc.name != f"{__package__}.{name}":
-                raise
+        yield importlib.import_module(f"{__package__}.{name}")
 
 
 class _Parser(argparse.ArgumentParser):

@@ -20,7 +20,7 @@ from collections.abc import Callable, Sequence
 from dataclasses import replace
 from typing import Any
 
-from ..exceptions import ShapeError
+from ..exceptions import WrongTypeError
 from ..identification.classical import identify_from_log
 from ..identification.data import StaticDataset
 from ..identification.estimators import Estimator, EstimatorName
@@ -90,7 +90,7 @@ def identify_consistent(
     ------
     RankDeficientError
         The data do not excite every base parameter (from the unconstrained fit).
-    ShapeError
+    WrongTypeError
         ``data`` is neither a torque log nor static data.
     """
     if isinstance(data, TorqueLog):
@@ -115,7 +115,9 @@ def identify_consistent(
         term = coefficient_term(model)
         kind = "static"
     else:
-        raise ShapeError(f"data must be a TorqueLog or a StaticDataset; got {type(data).__name__}")
+        raise WrongTypeError(
+            f"data must be a TorqueLog or a StaticDataset; got {type(data).__name__}"
+        )
     res = solve_consistent(
         robot,
         term,

@@ -174,13 +174,6 @@ class PenaltyProblem:
         """Decision parameters (n, 10) from normalised variables (10 n,)."""
         return (self.lower + np.asarray(z) * (self.upper - self.lower)).reshape(self.n, 10)
 
-    def z_from_p(self, p: ArrayLike) -> NDArray[np.float64]:
-        """Normalised variables (10 n,) of decision parameters (n, 10), clipped to [0, 1]."""
-        w = self.upper - self.lower
-        safe = np.where(w > 0, w, 1.0)
-        z = (np.asarray(p, dtype=np.float64).reshape(-1) - self.lower) / safe
-        return np.clip(np.where(w > 0, z, 0.5), 0.0, 1.0)
-
     # ------------------------------------------------------------------ data term
     def residual(self, z: NDArray[np.float64]) -> NDArray[np.float64]:
         """Scaled data residual ``A phi(p) - b`` (m,)."""

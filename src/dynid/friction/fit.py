@@ -43,7 +43,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from .. import _checks
 from ..dynamics.rnea import rnea
-from ..exceptions import ConvergenceError, DataError, DynidWarning, ShapeError
+from ..exceptions import ConvergenceError, DataError, DynidWarning, ShapeError, WrongTypeError
 from ..identification.log import DEFAULT_CUTOFF_HZ, TorqueLog, joint_side_log, prepare_log
 from ..identification.model import IdentifiedModel
 from ..identification.sanity import moving_joints, noise_band, velocity_noise_std
@@ -107,7 +107,7 @@ def _rigid_body_torques(
     elif callable(model):
         tau = _checks.as_array("model(q, dq, ddq)", model(q, dq, ddq))
     else:
-        raise ShapeError(
+        raise WrongTypeError(
             f"model must be an IdentifiedModel, a Robot or a callable; got {type(model).__name__}"
         )
     if tau.shape != q.shape:

@@ -384,11 +384,6 @@ class FeasibleStageResult:
     def rms_newton_euler(self) -> FloatArray:
         return self.validation.errors.rms
 
-    @property
-    def rms_identified(self) -> FloatArray | None:
-        e = self.validation.errors_reference
-        return None if e is None else e.rms
-
 
 def _validation_log(robot: Robot, seed: int) -> TorqueLog:
     """A 10 s random Fourier trajectory at 1 kHz, simulated with sensor noise on ``robot``."""

@@ -34,7 +34,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from .. import _checks
-from ..exceptions import ShapeError
+from ..exceptions import OptionError, ShapeError
 from ..kinematics.forward import link_poses
 from ..model.robot import Robot
 
@@ -69,7 +69,7 @@ class Plane:
         nrm = _checks.as_exact("normal", self.normal, (3,))
         big = float(np.max(np.abs(nrm)))
         if not big > 0:
-            raise ShapeError("plane normal must be non-zero")
+            raise OptionError("plane normal must be non-zero")
         u = nrm / big  # scaled first: the norm of [0, 0, 1e300] overflows, of 1e-300 not
         object.__setattr__(self, "point", tuple(float(x) for x in p))
         object.__setattr__(self, "normal", tuple(float(x) for x in u / np.linalg.norm(u)))
@@ -86,7 +86,7 @@ class Box:
         c = _checks.as_exact("center", self.center, (3,))
         s = _checks.as_exact("size", self.size, (3,))
         if np.any(s <= 0):
-            raise ShapeError(f"box size must be positive; got {tuple(s)}")
+            raise OptionError(f"box size must be positive; got {tuple(s)}")
         object.__setattr__(self, "center", tuple(float(x) for x in c))
         object.__setattr__(self, "size", tuple(float(x) for x in s))
 

@@ -49,7 +49,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from .. import _checks
 from ..dynamics.rnea import rnea
-from ..exceptions import ShapeError
+from ..exceptions import OptionError, ShapeError
 from ..friction.model import sigmoid_friction
 from ..identification.classical import friction_regressor
 from ..model.robot import Robot
@@ -104,7 +104,7 @@ class ExcitingTrajectory:
 
     def __post_init__(self) -> None:
         if not (self.w_f > 0 and self.duration > 0 and self.ramp > 0):
-            raise ShapeError(
+            raise OptionError(
                 f"w_f, duration and ramp must be positive; got {self.w_f}, {self.duration}, "
                 f"{self.ramp}"
             )
@@ -273,12 +273,12 @@ class ExcitationOptions:
 
     def __post_init__(self) -> None:
         if self.criterion not in ("cond", "logdet"):
-            raise ShapeError(f"criterion must be 'cond' or 'logdet'; got {self.criterion!r}")
+            raise OptionError(f"criterion must be 'cond' or 'logdet'; got {self.criterion!r}")
         if self.harmonics < 1 or not (self.duration > 0 and self.base_frequency > 0):
-            raise ShapeError("harmonics must be >= 1, duration and base_frequency positive")
+            raise OptionError("harmonics must be >= 1, duration and base_frequency positive")
         for k in ("acceleration_margin", "torque_margin"):
             if not 0 <= getattr(self, k) < 1:
-                raise ShapeError(f"{k} must be in [0, 1); got {getattr(self, k)}")
+                raise OptionError(f"{k} must be in [0, 1); got {getattr(self, k)}")
 
 
 @dataclass(frozen=True, slots=True, eq=False)

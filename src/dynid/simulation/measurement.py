@@ -28,7 +28,7 @@ from numpy.typing import NDArray
 
 from .. import _checks
 from ..dynamics.rnea import rnea
-from ..exceptions import ShapeError
+from ..exceptions import OptionError, ShapeError
 from ..friction.model import FrictionModel, SigmoidFriction
 from ..identification.log import TorqueLog, recorded_side_log
 from ..model.drive import Drive
@@ -92,11 +92,11 @@ def sample_times(
         [s].
     """
     if not (duration > 0 and fs > 0):
-        raise ShapeError(f"duration and fs must be positive; got {duration} s and {fs} Hz")
+        raise OptionError(f"duration and fs must be positive; got {duration} s and {fs} Hz")
     t = np.arange(int(round(duration * fs)) + 1) / float(fs)
     if jitter_std > 0:
         if rng is None:
-            raise ShapeError("rng is required when jitter_std > 0")
+            raise OptionError("rng is required when jitter_std > 0")
         e = np.clip(rng.normal(0.0, jitter_std, t.shape), -0.4 / fs, 0.4 / fs)
         e[0] = 0.0
         t = t + e
@@ -110,7 +110,7 @@ def _std(name: str, v: float | tuple[float, ...], n: int) -> NDArray[np.float64]
     elif a.shape != (n,):
         raise ShapeError(f"{name} must be a number or have shape ({n},); got {a.shape}")
     if np.any(a < 0):
-        raise ShapeError(f"{name} must be >= 0; got {a}")
+        raise OptionError(f"{name} must be >= 0; got {a}")
     return a
 
 
@@ -164,17 +164,18 @@ def simulate_measurement(
     Raises
     ------
     ShapeError
-        ``traj.n != robot.n``, a friction model for another number of joints, negative
-        noise or ``drop_fraction`` outside [0, 0.5).
+        ``traj.n != robot.n``, a friction model for another number of joints.
+    OptionError
+        Negative noise, ``drop_fraction`` outside [0, 0.5), an unknown ``friction`` name.
     """
     n = robot.n
     if traj.n != n:
         raise ShapeError(f"trajectory has {traj.n} joints; robot {robot.name!r} has {n}")
     if not 0.0 <= drop_fraction < 0.5:
-        raise ShapeError(f"drop_fraction must be in [0, 0.5); got {drop_fraction}")
+        raise OptionError(f"drop_fraction must be in [0, 0.5); got {drop_fraction}")
     if isinstance(friction, str):
         if friction != "robot":
-            raise ShapeError(
+            raise OptionError(
                 f"friction must be a friction model, None or 'robot'; got {friction!r}"
             )
         friction = None if robot.friction is None else SigmoidFriction.from_array(robot.friction)

@@ -32,7 +32,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from .. import _checks
-from ..exceptions import LimitError, ShapeError
+from ..exceptions import LimitError, OptionError
 from ..model.robot import Robot
 from ..regressors.base import BaseParameters, base_parameters
 from ..regressors.static import static_regressor
@@ -170,13 +170,13 @@ def select_static_configurations(
 
     Raises
     ------
-    ShapeError
-        ``n < 1``, ``pool_factor < 2`` or ``batches < 1``.
+    OptionError
+        ``n < 1``, ``pool_factor < 2``, ``batches < 1`` or ``exchange < 0``.
     LimitError
         Too few collision-free configurations, or limits narrower than the margin.
     """
     if n < 1 or pool_factor < 2 or batches < 1 or exchange < 0:
-        raise ShapeError(
+        raise OptionError(
             f"need n >= 1, pool_factor >= 2, batches >= 1 and exchange >= 0; got {n}, "
             f"{pool_factor}, {batches}, {exchange}"
         )

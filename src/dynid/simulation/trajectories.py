@@ -35,7 +35,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from .. import _checks
-from ..exceptions import DataError, LimitError, ShapeError
+from ..exceptions import DataError, LimitError, OptionError, ShapeError
 from ..model.robot import Robot
 
 __all__ = [
@@ -123,7 +123,7 @@ class Trajectory:
 def uniform_times(duration: float, fs: float = 1000.0) -> NDArray[np.float64]:
     """Times ``k / fs`` for ``k = 0 .. round(duration fs)`` [s], shape (N,)."""
     if not (duration > 0 and fs > 0):
-        raise ShapeError(f"duration and fs must be positive; got {duration} s and {fs} Hz")
+        raise OptionError(f"duration and fs must be positive; got {duration} s and {fs} Hz")
     return np.arange(int(round(duration * fs)) + 1) / float(fs)
 
 
@@ -162,7 +162,9 @@ def sinusoid_trajectory(
     Raises
     ------
     ShapeError
-        ``q0``, ``amplitudes`` and ``periods`` differ in shape, or a period is not positive.
+        ``q0``, ``amplitudes`` and ``periods`` differ in shape.
+    OptionError
+        A period is not positive.
     """
     t = _times(t)
     q0 = _checks.as_array("q0", q0)
@@ -172,7 +174,7 @@ def sinusoid_trajectory(
     A = _checks.as_exact("amplitudes", amplitudes, (n,))
     T = _checks.as_exact("periods", periods, (n,))
     if np.any(T <= 0):
-        raise ShapeError(f"periods must be positive; got {T}")
+        raise OptionError(f"periods must be positive; got {T}")
     w = 2.0 * np.pi / T
     ph = np.outer(t, w)
     return Trajectory(
@@ -225,7 +227,7 @@ class FourierSeries:
 
     def __post_init__(self) -> None:
         if not self.w_f > 0:
-            raise ShapeError(f"w_f must be positive; got {self.w_f}")
+            raise OptionError(f"w_f must be positive; got {self.w_f}")
         a = _checks.as_array("a", self.a)
         if a.ndim != 2:
             raise ShapeError(f"a must have shape (n, L); got {a.shape}")
@@ -311,7 +313,7 @@ def random_fourier(
         ``q0`` is not strictly inside the position limits.
     """
     if not 0 < margin <= 1:
-        raise ShapeError(f"margin must be in (0, 1]; got {margin}")
+        raise OptionError(f"margin must be in (0, 1]; got {margin}")
     lo, hi = robot.q_min, robot.q_max
     if q0 is None:
         q0 = np.where(np.isfinite(lo) & np.isfinite(hi), 0.5 * (lo + hi), 0.0)
@@ -483,11 +485,13 @@ def scale_into_limits(
     LimitError
         ``"time"`` with positions outside the limits, or ``"amplitude"`` with a start
         configuration outside the shrunk position range.
+    OptionError
+        Unknown ``method``, or ``margin`` not in (0, 1].
     ShapeError
-        Unknown ``method``, ``margin`` not in (0, 1], or ``traj.n != robot.n``.
+        ``traj.n != robot.n``.
     """
     if not 0 < margin <= 1:
-        raise ShapeError(f"margin must be in (0, 1]; got {margin}")
+        raise OptionError(f"margin must be in (0, 1]; got {margin}")
     if traj.n != robot.n:
         raise ShapeError(f"trajectory has {traj.n} joints; robot {robot.name!r} has {robot.n}")
     vmax = np.max(np.abs(traj.dq), axis=0)
@@ -513,7 +517,7 @@ def scale_into_limits(
         t0 = traj.t[0]
         return Trajectory(t0 + k * (traj.t - t0), traj.q, traj.dq / k, traj.ddq / k**2), k
     if method != "amplitude":
-        raise ShapeError(f"method must be 'amplitude' or 'time'; got {method!r}")
+        raise OptionError(f"method must be 'amplitude' or 'time'; got {method!r}")
     qs = traj.q[0]
     outside = np.flatnonzero((qs < lo) | (qs > hi))
     if outside.size:
