@@ -788,7 +788,7 @@ def test_exact_data_of_an_arm_with_a_prismatic_joint_give_zero_not_nan_std():
     for seed in range(4):
         data = acquire_static(SimulatedController(robot, 0.0), 50, np.random.default_rng(seed))
         for est in ("robust", "classical"):
-            fit = identify_static(robot, data, std_estimator=est).fit
+            fit = identify_static(robot, data, std=est).fit
             assert np.all(np.isfinite(fit.std)) and np.all(fit.std >= 0)
             assert np.all(np.isfinite(fit.std_percent[fit.kept]))
             assert fit.relative_error_percent < 1e-8

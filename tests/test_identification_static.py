@@ -420,8 +420,8 @@ def test_wrong_joint_count_raises_data_error(noise_free):
         identify_static(robot, data, base=base_parameters(planar_2r()))
     with pytest.raises(ValueError, match="max_std_percent must be positive"):
         identify_static(robot, data, max_std_percent=0.0)
-    with pytest.raises(ValueError, match="std_estimator must be 'robust' or 'classical'"):
-        identify_static(robot, data, std_estimator="sandwich")
+    with pytest.raises(ValueError, match="std must be 'classical' or 'robust'"):
+        identify_static(robot, data, std="sandwich")  # type: ignore[arg-type]
 
 
 @pytest.mark.filterwarnings("ignore:.*indistinguishable from zero")  # expected: weak coefficients

@@ -18,10 +18,10 @@ from dynid.regressors.base import (
     base_parameters_from_regressor,
 )
 from dynid.regressors.static import (
-    _static_first_columns,
-    _static_regressor_columns,
+    static_first_columns,
     static_labels,
     static_regressor,
+    static_regressor_columns,
     static_regressor_numpy,
     static_vector,
 )
@@ -157,7 +157,7 @@ def test_static_regressor_kernel_matches_the_numpy_path(B):
         np.testing.assert_allclose(Y, ref, rtol=0, atol=1e-13 * np.abs(ref).max())
         # a subset of the columns, in any order, as written by the kernel directly
         cols = np.random.default_rng(B).permutation(10 * robot.n)[: 4 * robot.n]
-        sub = _static_regressor_columns(robot, q, cols)
+        sub = static_regressor_columns(robot, q, cols)
         np.testing.assert_allclose(
             sub, ref.transpose(2, 1, 0)[cols], rtol=0, atol=1e-13 * np.abs(ref).max()
         )
@@ -200,16 +200,16 @@ def test_static_regressor_rows_are_exactly_zero_before_their_first_column():
         q, _, _ = random_states(robot, 40, seed=212)
         bp = base_parameters(robot)
         for cols in (np.arange(10 * robot.n), bp.independent):
-            first = _static_first_columns(robot.n, cols)
+            first = static_first_columns(robot.n, cols)
             for numpy_path in (False, True):
-                Y = _static_regressor_columns(robot, q, cols, numpy_path=numpy_path)
+                Y = static_regressor_columns(robot, q, cols, numpy_path=numpy_path)
                 for k, c in enumerate(first):
                     assert np.all(Y[:c, k] == 0.0)
     # the Panda's g7 and M7_j rows start at link 7's mass (column 60); M1_1 at column 0
-    first = _static_first_columns(7, np.arange(70))
+    first = static_first_columns(7, np.arange(70))
     assert first[0] == 0 and first[21:28].tolist() == [60] * 7 and first[-1] == 60
     # no structure is claimed for columns out of order
-    assert np.all(_static_first_columns(7, np.array([30, 10, 50])) == 0)
+    assert np.all(static_first_columns(7, np.array([30, 10, 50])) == 0)
 
 
 def test_no_numba_environment_variable_selects_the_numpy_static_regressor():

@@ -51,7 +51,31 @@ class LimitError(DynidError, ValueError):
 
 
 class RankDeficientError(DynidError, ValueError):
-    """A regressor does not have the rank needed to identify the parameters."""
+    """A regressor does not have the rank needed to identify the parameters.
+
+    Attributes
+    ----------
+    rank : int or None
+        The numerical rank found (None when not computed).
+    needed : int or None
+        The rank needed: the number of columns (coefficients) to identify.
+    dependent : tuple of str
+        Labels of the nearly dependent columns (the null direction's large entries,
+        largest first); empty when not known.
+    """
+
+    def __init__(
+        self,
+        message: str,
+        *,
+        rank: int | None = None,
+        needed: int | None = None,
+        dependent: tuple[str, ...] = (),
+    ) -> None:
+        super().__init__(message)
+        self.rank = rank
+        self.needed = needed
+        self.dependent = tuple(dependent)
 
 
 class InfeasibleError(DynidError, ValueError):

@@ -298,7 +298,7 @@ def identify_static_file(robot: Robot, path: Path, args: argparse.Namespace) -> 
             data,
             max_std_percent=args.max_std_percent,
             rtol=args.rtol,
-            std_estimator=args.std or "robust",
+            std=args.std or "robust",
             drive=load_drive_arg(args, robot.n),
             estimator=args.estimator,
         )

@@ -110,7 +110,7 @@ def identify_consistent(
         kind = "log"
     elif isinstance(data, StaticDataset):
         model = identify_static(
-            robot, data, rtol=rtol, std_estimator="classical", drive=drive, estimator=estimator
+            robot, data, rtol=rtol, std="classical", drive=drive, estimator=estimator
         )
         term = coefficient_term(model)
         kind = "static"

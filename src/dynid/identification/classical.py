@@ -26,18 +26,19 @@ on the real Panda.
 
 from __future__ import annotations
 
-import dataclasses
 import warnings
+from collections.abc import Iterator
+from dataclasses import dataclass
 from typing import Any, Literal
 
 import numpy as np
 from numpy.typing import NDArray
 
 from .. import _checks
-from ..exceptions import DynidWarning, OptionError, RankDeficientError, ShapeError
+from ..exceptions import DynidWarning, OptionError, ShapeError
 from ..model.drive import Drive
 from ..model.robot import Robot
-from ..regressors.base import BaseParameters, base_parameters, identifiability
+from ..regressors.base import BaseParameters
 from ..regressors.terms import (
     LinearFriction,
     ModelTerm,
@@ -46,14 +47,23 @@ from ..regressors.terms import (
     friction_labels,
 )
 from ..regressors.torque import torque_regressor_prepared
+from .core import Judge, ModelColumns, RegressorBlock, RegressorStack, identify
 from .estimators import Estimator, EstimatorName, estimator_named, row_weights
-from .holdout import DEFAULT_FOLDS, HeldOut, block_labels, block_normals, cross_validate
-from .least_squares import LeastSquaresFit, conditioning_advice
-from .log import DEFAULT_CUTOFF_HZ, TorqueLog, joint_side_log, prepare_log
+from .holdout import DEFAULT_FOLDS, HeldOut, block_labels, block_normals
+from .least_squares import StdMethod
+from .log import DEFAULT_CUTOFF_HZ, LogCleaning, TorqueLog, joint_side_log, prepare_log
 from .model import IdentifiedModel
 from .sanity import check_torque_log, moving_joints
 
-__all__ = ["friction_labels", "friction_regressor", "identify_from_log", "auto_decimation"]
+__all__ = [
+    "PreparedLog",
+    "auto_decimation",
+    "friction_labels",
+    "friction_regressor",
+    "identify_from_log",
+    "prepare_torque_log",
+    "term_regressor",
+]
 
 _ = friction_labels  # re-exported: the labels of friction_regressor
 
@@ -74,18 +84,6 @@ def auto_decimation(fs: float, cutoff_hz: float | None) -> int:
     return max(1, int(np.floor(fs / (10.0 * cutoff_hz))))
 
 
-def _split_fit(fit: LeastSquaresFit, r: int) -> LeastSquaresFit:
-    """The fit restricted to its first ``r`` coefficients; global statistics kept."""
-    return dataclasses.replace(
-        fit,
-        beta=fit.beta[:r],
-        std=fit.std[:r],
-        std_percent=fit.std_percent[:r],
-        kept=fit.kept[:r],
-        covariance=None if fit.covariance is None else fit.covariance[:r, :r],
-    )
-
-
 def identify_from_log(
     robot: Robot,
     log: TorqueLog,
@@ -100,7 +98,7 @@ def identify_from_log(
     rtol: float | None = None,
     drive: Drive | None = None,
     estimator: EstimatorName | Estimator = "ols",
-    std: Literal["classical", "robust"] = "classical",
+    std: StdMethod = "classical",
     folds: int = DEFAULT_FOLDS,
     validate_on: TorqueLog | None = None,
 ) -> IdentifiedModel:
@@ -178,120 +176,61 @@ def identify_from_log(
         Ill-conditioned regressor or coefficients above 1000 % std
         (:func:`~dynid.identification.least_squares.conditioning_advice`).
     """
-    n = robot.n
-    if log.n != n:
-        raise ShapeError(f"log has {log.n} joints; robot {robot.name!r} has {n}")
-    if drive is not None:
-        drive.check(n)
-    fs = log.sample_rate
-    jlog = joint_side_log(log, drive)
-    for finding in check_torque_log(robot, jlog):  # sign, units, frozen joints: said first
-        warnings.warn(finding, DynidWarning, stacklevel=2)
-    still = _still_friction(jlog, drive) if friction else np.zeros(0, dtype=bool)
-    prepared = prepare_log(jlog, cutoff_hz=cutoff_hz, trim_s=trim_s, max_gap_s=max_gap_s)
-    del jlog
-    k = auto_decimation(fs, cutoff_hz) if decimate is None else int(decimate)
-    if k < 1:
-        raise ShapeError(f"decimate must be >= 1; got {decimate}")
-    sl = slice(None, None, k)
-    assert prepared.ddq is not None  # prepare_log always fills ddq
-    q, dq, ddq, tau = prepared.q[sl], prepared.dq[sl], prepared.ddq[sl], prepared.tau[sl]
-    terms = drive_terms(drive, n, friction=friction)
-    bp = base_parameters(robot, kind="torque", rtol=rtol, terms=terms) if base is None else base
-    N = q.shape[0]
-    Yb, labels = term_regressor(robot, bp, terms, q, dq, ddq)
-    W = Yb.reshape(N * n, -1)
-    if drive is not None and drive.rotor_inertia is not None:  # known: not identified
-        tau = tau - drive.rotor_torques(ddq, drive.rotor_inertia)
-    y = tau.reshape(-1)
-    r = bp.rank
-    fit_rtol = 1e-10 if rtol is None else rtol
+    prepared = prepare_torque_log(
+        robot,
+        log,
+        cutoff_hz=cutoff_hz,
+        trim_s=trim_s,
+        max_gap_s=max_gap_s,
+        decimate=decimate,
+        drive=drive,
+    )
+    return identify(
+        robot,
+        prepared,
+        drive=drive,
+        terms=drive_terms(drive, robot.n, friction=friction),
+        base=base,
+        estimator=estimator,
+        std=std,
+        max_std_percent=max_std_percent,
+        rtol=rtol,
+        judge=_judge(robot, prepared, estimator, folds, validate_on, cutoff_hz, trim_s),
+    )
+
+
+def _judge(
+    robot: Robot,
+    prepared: PreparedLog,
+    estimator: EstimatorName | Estimator,
+    folds: int,
+    validate_on: TorqueLog | None,
+    cutoff_hz: float | None,
+    trim_s: float | None,
+) -> Judge:
+    """The held-out judgement of the classical route: ``folds`` contiguous time blocks of
+    the log, or the separate log ``validate_on`` prepared the same way; rows weighted as the
+    estimator weighs them (:func:`~dynid.identification.estimators.row_weights`)."""
+    n = prepared.n
     est = estimator_named(estimator)
-    if std not in ("classical", "robust"):
-        raise OptionError(f"std must be 'classical' or 'robust'; got {std!r}")
-    # the viscous and Coulomb columns of a joint (motor) that never moves are not fitted
-    cols = np.ones(W.shape[1], dtype=bool)
-    if still.any():
-        cols[bp.rank :][np.repeat(still, 3) & (np.arange(3 * n) % 3 != 2)] = False
-        W = W[:, cols]
-    try:
-        _checks.finite("regressor", W)
-        fit = est.fit(
-            W,
-            y,
-            np.tile(np.arange(n), N),  # row k n + j: joint j
-            rtol=fit_rtol,
-            covariance=std,
-            max_std_percent=max_std_percent,
-            labels=tuple(lab for lab, c in zip(labels, cols, strict=True) if c),
-        )
-    except RankDeficientError as exc:
-        raise RankDeficientError(
-            f"torque log: {exc}; hint: a trajectory that moves every joint at varied "
-            "speeds in both directions excites them (dynid excite optimises one); a joint "
-            "that never moves leaves its friction unidentifiable"
-        ) from exc
-    rw = row_weights(est, W, y, np.tile(np.arange(n), N), fit.beta)
-    held = _held_out(W * rw[:, None], y * rw, n, folds, cols)
-    if validate_on is not None:
-        vW, vy = _validation_rows(
-            robot, validate_on, drive, bp, terms, cols, cutoff_hz, trim_s, fs / k
-        )
-        vw = row_weights(est, vW, vy, np.tile(np.arange(n), vy.size // n), fit.beta)
-        held = HeldOut.separate(
+
+    def judge(
+        stack: RegressorStack, columns: ModelColumns, cols: NDArray[np.bool_], beta: NDArray[Any]
+    ) -> HeldOut | None:
+        W, y = (stack.W if cols.all() else stack.W[:, cols]), stack.y
+        b = np.asarray(beta)[cols]
+        rw = row_weights(est, W, y, stack.groups, b)
+        if validate_on is None:
+            return _held_out(W * rw[:, None], y * rw, n, folds, cols)
+        rate = prepared.sample_rate_hz / prepared.decimate
+        vW, vy = _validation_rows(robot, validate_on, columns, cols, cutoff_hz, trim_s, rate)
+        vw = row_weights(est, vW, vy, np.tile(np.arange(n), vy.size // n), b)
+        return HeldOut.separate(
             block_normals(W * rw[:, None], y * rw, np.zeros(y.size, dtype=np.intp))[0],
             block_normals(vW * vw[:, None], vy * vw, np.zeros(vy.size, dtype=np.intp))[0],
         ).expanded(cols)
-    if not cols.all():
-        fit = _expanded(fit, cols)
-    for msg in conditioning_advice(fit, labels, what="the trajectory"):
-        warnings.warn(msg, DynidWarning, stacklevel=2)
-    fr = None
-    meta: dict[str, Any] = {
-        "route": "classical",
-        "reference": "Gaz et al. 2019, Sec. IV-B, eq. 24 (classical friction)",
-        "pruned": [labels[j] for j in np.flatnonzero(~np.asarray(fit.kept))],
-        "max_std_percent": max_std_percent,
-        "std_estimator": std,
-        "estimator": est.name,
-        "dropped_rows": [],
-        "cutoff_hz": cutoff_hz,
-        "trim_s": float(prepared.t[0] - log.t[0]),
-        "decimate": k,
-        "sample_rate_hz": fs,
-        "n_samples_log": log.n_samples,
-        "n_samples_used": int(N),
-        "n_rows": int(N * n),
-        "duration_s": log.duration,
-        "n_nan_rows": log.cleaning.n_nan_rows,
-        "n_duplicates": log.cleaning.n_duplicates,
-        "n_gaps": len(log.cleaning.gaps),
-        "condition_number": fit.condition_number,
-        "scaled_condition_number": fit.scaled_condition_number,
-        "relative_error_percent": fit.relative_error_percent,
-        "rank_gap": None if bp.gap is None else list(bp.gap),
-        "identifiability": dict(zip(bp.std_labels, identifiability(bp), strict=True)),
-    }
-    if drive is not None:
-        meta["drive"] = drive.as_dict()
-    if held is not None:
-        meta["heldout"] = cross_validate(held.restricted(np.flatnonzero(fit.kept))).as_dict()
-    if friction:
-        fb = np.asarray(fit.beta[r:]).reshape(n, 3)
-        fr = fb
-        meta["friction_labels"] = list(friction_labels(n))
-        meta["friction_std"] = [float(x) for x in fit.std[r:]]
-        meta["friction_kept"] = [bool(x) for x in fit.kept[r:]]
-    return IdentifiedModel(
-        robot=robot,
-        base=bp,
-        fit=_split_fit(fit, r) if friction else fit,
-        friction=fr,
-        metadata=meta,
-        joint_fit=fit if friction else None,
-        drive=drive,
-        holdout=held,
-    )
+
+    return judge
 
 
 def _held_out(
@@ -315,9 +254,7 @@ def _held_out(
 def _validation_rows(
     robot: Robot,
     log: TorqueLog,
-    drive: Drive | None,
-    bp: BaseParameters,
-    terms: tuple[ModelTerm, ...],
+    columns: ModelColumns,
     cols: NDArray[np.bool_],
     cutoff_hz: float | None,
     trim_s: float | None,
@@ -329,15 +266,193 @@ def _validation_rows(
         raise ShapeError(
             f"--validate-on log has {log.n} joints; robot {robot.name!r} has {robot.n}"
         )
+    drive = columns.drive
     p = prepare_log(joint_side_log(log, drive), cutoff_hz=cutoff_hz, trim_s=trim_s)
     step = max(1, int(round(log.sample_rate / rate_hz)))
     sl = slice(None, None, step)
     assert p.ddq is not None
     q, dq, ddq, tau = p.q[sl], p.dq[sl], p.ddq[sl], p.tau[sl]
-    Y, _ = term_regressor(robot, bp, terms, q, dq, ddq)
+    Y, _ = term_regressor(robot, columns.base, columns.terms, q, dq, ddq)
     if drive is not None and drive.rotor_inertia is not None:
         tau = tau - drive.rotor_torques(ddq, drive.rotor_inertia)
     return Y.reshape(q.shape[0] * robot.n, -1)[:, cols], tau.reshape(-1)
+
+
+@dataclass(frozen=True, slots=True, eq=False)
+class PreparedLog:
+    """A torque log ready for identification (the :class:`~dynid.identification.core.Dataset`
+    of the classical route): joint side, filtered, decimated, with ``ddq``.
+
+    Attributes
+    ----------
+    log : TorqueLog
+        The prepared samples: ``q`` [rad], ``dq`` [rad/s], ``ddq`` [rad/s^2], ``tau`` [N m]
+        on the joint side of ``drive``, every ``decimate``-th sample.
+    drive : Drive, optional
+        The drive the log was read through.
+    still : ndarray of bool, shape (n,)
+        Joints (motors, where the drive's friction acts there) whose velocity never leaves
+        its noise band in the raw log: their viscous and Coulomb friction is not fitted.
+    cutoff_hz, trim_s : float or None
+        Low-pass cutoff [Hz] and seconds trimmed at the start.
+    decimate : int
+    sample_rate_hz : float
+        Of the raw log.
+    raw : TorqueLog
+        The raw log's counts (``n_samples``, ``duration``, ``cleaning``).
+    """
+
+    log: TorqueLog
+    drive: Drive | None
+    still: NDArray[np.bool_]
+    cutoff_hz: float | None
+    trim_s: float
+    decimate: int
+    sample_rate_hz: float
+    n_samples_log: int
+    duration_s: float
+    cleaning: LogCleaning
+
+    @property
+    def route(self) -> Literal["classical"]:
+        """``"classical"`` (Gaz et al. 2019, Sec. IV-B)."""
+        return "classical"
+
+    @property
+    def regressor_kind(self) -> Literal["torque"]:
+        """Joint torques."""
+        return "torque"
+
+    @property
+    def moving(self) -> bool:
+        """True: friction acts."""
+        return True
+
+    @property
+    def n(self) -> int:
+        """Joints."""
+        return self.log.n
+
+    @property
+    def source(self) -> str:
+        """``"torque log of N samples"``."""
+        return f"torque log of {self.log.n_samples} samples"
+
+    @property
+    def hint(self) -> str:
+        """What to do when the trajectory does not excite every column."""
+        return (
+            "hint: a trajectory that moves every joint at varied speeds in both directions "
+            "excites them (dynid excite optimises one); a joint that never moves leaves its "
+            "friction unidentifiable"
+        )
+
+    def check_robot(self, robot: Robot) -> None:
+        """Raise :class:`ShapeError` unless the log has ``robot.n`` joints."""
+        if self.n != robot.n:
+            raise ShapeError(f"log has {self.n} joints; robot {robot.name!r} has {robot.n}")
+
+    def frozen_columns(self, columns: ModelColumns) -> NDArray[np.bool_]:
+        """The viscous and Coulomb columns of the joints (motors) that never move."""
+        out = np.zeros(len(columns.labels), dtype=bool)
+        sl = columns.term_slice("friction")
+        if sl is not None and self.still.any():
+            n = self.n
+            out[sl] = np.repeat(self.still, 3) & (np.arange(3 * n) % 3 != 2)
+        return out
+
+    def blocks(self, robot: Robot, columns: ModelColumns) -> Iterator[RegressorBlock]:
+        """One block: rows sample-major (row ``k n + j`` is sample ``k``, joint ``j``, its
+        noise group ``j``); known rotor torques of ``columns.drive`` subtracted."""
+        if columns.drive is not self.drive:
+            raise OptionError("the log was prepared for another drive than the model's")
+        log = self.log
+        assert log.ddq is not None  # prepare_log always fills ddq
+        N, n = log.n_samples, log.n
+        Y, _ = term_regressor(robot, columns.base, columns.terms, log.q, log.dq, log.ddq)
+        tau = log.tau
+        drive = columns.drive
+        if drive is not None and drive.rotor_inertia is not None:  # known: not identified
+            tau = tau - drive.rotor_torques(log.ddq, drive.rotor_inertia)
+        W = Y.reshape(N * n, -1)
+        _checks.finite("regressor", W)
+        yield RegressorBlock(W=W, y=tau.reshape(-1), groups=np.tile(np.arange(n), N))
+
+    def record(self, n_rows: int) -> dict[str, Any]:
+        """Filtering, decimation and sample counts."""
+        return {
+            "reference": "Gaz et al. 2019, Sec. IV-B, eq. 24 (classical friction)",
+            "cutoff_hz": self.cutoff_hz,
+            "trim_s": self.trim_s,
+            "decimate": self.decimate,
+            "sample_rate_hz": self.sample_rate_hz,
+            "n_samples_log": self.n_samples_log,
+            "n_samples_used": self.log.n_samples,
+            "duration_s": self.duration_s,
+            "n_nan_rows": self.cleaning.n_nan_rows,
+            "n_duplicates": self.cleaning.n_duplicates,
+            "n_gaps": len(self.cleaning.gaps),
+        }
+
+
+def prepare_torque_log(
+    robot: Robot,
+    log: TorqueLog,
+    *,
+    cutoff_hz: float | None = DEFAULT_CUTOFF_HZ,
+    trim_s: float | None = None,
+    max_gap_s: float | None = None,
+    decimate: int | None = None,
+    drive: Drive | None = None,
+) -> PreparedLog:
+    """Read a torque log through the drive, check it, filter and decimate it.
+
+    The checks of :func:`~dynid.identification.sanity.check_torque_log` (sign, units,
+    frozen joints) are warned first; then :func:`~dynid.identification.log.prepare_log`
+    and every ``decimate``-th sample (default :func:`auto_decimation`). Parameters as in
+    :func:`identify_from_log`.
+
+    Raises
+    ------
+    ShapeError
+        ``log.n != robot.n`` or ``decimate < 1``.
+    DataError
+        From :func:`~dynid.identification.log.prepare_log`.
+
+    Warns
+    -----
+    DynidWarning
+        The findings of the checks.
+    """
+    n = robot.n
+    if log.n != n:
+        raise ShapeError(f"log has {log.n} joints; robot {robot.name!r} has {n}")
+    if drive is not None:
+        drive.check(n)
+    fs = log.sample_rate
+    jlog = joint_side_log(log, drive)
+    for finding in check_torque_log(robot, jlog):  # sign, units, frozen joints: said first
+        warnings.warn(finding, DynidWarning, stacklevel=3)
+    still = _still_friction(jlog, drive)
+    k = auto_decimation(fs, cutoff_hz) if decimate is None else int(decimate)
+    if k < 1:
+        raise ShapeError(f"decimate must be >= 1; got {decimate}")
+    prepared = prepare_log(
+        jlog, cutoff_hz=cutoff_hz, trim_s=trim_s, max_gap_s=max_gap_s, decimate=k
+    )
+    del jlog
+    return PreparedLog(
+        log=prepared,
+        drive=drive,
+        still=still,
+        cutoff_hz=cutoff_hz,
+        trim_s=float(prepared.t[0] - log.t[0]),
+        decimate=k,
+        sample_rate_hz=fs,
+        n_samples_log=log.n_samples,
+        duration_s=log.duration,
+        cleaning=log.cleaning,
+    )
 
 
 def _still_friction(log: TorqueLog, drive: Drive | None) -> NDArray[np.bool_]:
@@ -346,34 +461,6 @@ def _still_friction(log: TorqueLog, drive: Drive | None) -> NDArray[np.bool_]:
     if drive is None:
         return ~moving_joints(log.dq)
     return ~moving_joints(log.dq @ drive.friction_transmission.T)
-
-
-def _expanded(fit: LeastSquaresFit, cols: NDArray[np.bool_]) -> LeastSquaresFit:
-    """A fit over the columns ``cols`` selected, written over all of them (0 and not kept
-    for the others)."""
-    k = cols.size
-
-    def put(v: NDArray[Any], fill: Any) -> NDArray[Any]:
-        out = np.full(k, fill, dtype=np.asarray(v).dtype)
-        out[cols] = v
-        return out
-
-    cov = None
-    if fit.covariance is not None:
-        cov = np.zeros((k, k))
-        cov[np.ix_(cols, cols)] = fit.covariance
-    return dataclasses.replace(
-        fit,
-        beta=put(fit.beta, 0.0),
-        std=put(fit.std, 0.0),
-        std_percent=put(fit.std_percent, np.nan),
-        kept=put(fit.kept, False),
-        covariance=cov,
-        weakest=put(fit.weakest, 0.0) if np.size(fit.weakest) == cols.sum() else fit.weakest,
-        effect_percent=put(fit.effect_percent, 0.0)
-        if np.size(fit.effect_percent) == cols.sum()
-        else fit.effect_percent,
-    )
 
 
 def term_regressor(

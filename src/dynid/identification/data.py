@@ -14,10 +14,10 @@ rows of a recorded file) belongs to :mod:`dynid.io.static_data`.
 
 from __future__ import annotations
 
-from collections.abc import Mapping
+from collections.abc import Iterator, Mapping
 from dataclasses import dataclass, field
 from types import MappingProxyType
-from typing import Any
+from typing import Any, Literal
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -25,6 +25,9 @@ from numpy.typing import ArrayLike, NDArray
 from .. import _checks
 from ..exceptions import DataError, NonFiniteError, ShapeError
 from ..model.robot import Robot
+from ..regressors.static import static_first_columns, static_labels, static_regressor_columns
+from ..regressors.terms import base_term_columns
+from .core import ModelColumns, RegressorBlock
 
 __all__ = ["StaticDataset", "DEFAULT_SYMMETRY_RTOL"]
 
@@ -115,6 +118,85 @@ class StaticDataset:
                 f"static data set has {self.n} joints (q of shape {self.q.shape}); robot "
                 f"{robot.name!r} has {robot.n}; hint: pass the robot the data were recorded with"
             )
+
+    # the Dataset protocol of dynid.identification.core
+    @property
+    def route(self) -> Literal["static"]:
+        """``"static"`` (Gaz et al. 2019, Sec. IV-A)."""
+        return "static"
+
+    @property
+    def regressor_kind(self) -> Literal["static"]:
+        """Rows ``[tril M; g]``."""
+        return "static"
+
+    @property
+    def moving(self) -> bool:
+        """False: nothing moves, friction does not act."""
+        return False
+
+    @property
+    def source(self) -> str:
+        """``"static regressor of N configuration(s)"``."""
+        return f"static regressor of {self.n_configurations} configuration(s)"
+
+    @property
+    def hint(self) -> str:
+        """What to do when the configurations do not excite every base parameter."""
+        return (
+            "add configurations spread over the joint ranges (Gaz et al. 2019 used 1010; "
+            "dynid acquire-static --pool selects them)"
+        )
+
+    def frozen_columns(self, columns: ModelColumns) -> NDArray[np.bool_]:
+        """None: every column acts at rest or is structurally zero (a rank error says so)."""
+        return np.zeros(len(columns.labels), dtype=bool)
+
+    def blocks(self, robot: Robot, columns: ModelColumns) -> Iterator[RegressorBlock]:
+        """One block of ``N`` rows per row of ``s = [tril M; g]`` (``static_labels``).
+
+        Row ``(i, j)`` of ``tril M`` and row ``g_i`` do not depend on the parameters of the
+        links before link ``i``: each block is exactly zero in those leading columns
+        (``first``). Known rotor inertias of ``columns.drive`` are subtracted from ``M``.
+        """
+        N, n = self.n_configurations, self.n
+        ind = np.asarray(columns.base.independent)
+        # Yb[c, k, b]: column c, row k of s, configuration b (only the base columns computed)
+        Yb = static_regressor_columns(robot, self.q, ind[ind < 10 * n])
+        extra = []
+        for t, sel in base_term_columns(columns.terms, ind, n):  # rotor inertia: constant
+            C = t.static_columns(N)
+            extra.append(np.zeros((sel.size, Yb.shape[1], N)) if C is None else C[sel])
+        for t in columns.appended:  # terms that do not act at rest give zero columns
+            C = t.static_columns(N)
+            extra.append(np.zeros((len(t.labels), Yb.shape[1], N)) if C is None else C)
+        if extra:
+            Yb = np.concatenate([Yb, *extra], axis=0)
+        M = self.M
+        drive = columns.drive
+        if drive is not None and drive.rotor_inertia is not None:  # known: not identified
+            M = M - drive.rotor_mass_matrix(drive.rotor_inertia)
+        i, j = np.tril_indices(n)
+        S = np.concatenate([M[:, i, j], self.g], axis=1)  # (N, s), columns as static_labels
+        first = static_first_columns(n, np.asarray(columns.base.independent))
+        for k, label in enumerate(static_labels(n)):
+            yield RegressorBlock(
+                W=Yb[:, k, :].T,
+                y=S[:, k],
+                groups=np.full(N, k, dtype=np.intp),
+                label=label,
+                first=int(first[k]),
+            )
+
+    def record(self, n_rows: int) -> dict[str, Any]:
+        """Configurations, rows per configuration and the data set's own metadata."""
+        N = self.n_configurations
+        return {
+            "reference": "Gaz et al. 2019, Sec. IV-A, eqs. 17-21",
+            "n_configurations": N,
+            "rows_per_configuration": n_rows // N,
+            "data": dict(self.metadata),
+        }
 
     def select(self, rows: ArrayLike) -> StaticDataset:
         """A data set of some rows: integer indices or a boolean mask of length N."""

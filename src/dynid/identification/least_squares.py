@@ -38,6 +38,7 @@ removed and the rest re-fitted (:func:`fit_with_pruning`).
 from __future__ import annotations
 
 from dataclasses import dataclass, field
+from typing import Literal
 
 import numpy as np
 import scipy.linalg
@@ -46,7 +47,20 @@ from numpy.typing import ArrayLike, NDArray
 from .. import _checks
 from ..exceptions import NonFiniteError, OptionError, RankDeficientError, ShapeError
 
-__all__ = ["LeastSquaresFit", "conditioning_advice", "fit_least_squares", "fit_with_pruning"]
+__all__ = [
+    "LeastSquaresFit",
+    "StdMethod",
+    "block_grams",
+    "conditioning_advice",
+    "fit_blocks",
+    "fit_least_squares",
+    "fit_with_pruning",
+]
+
+#: How the standard deviations are estimated (``std=``, ``--std``): ``"classical"``
+#: ``sigma^2 (W^T W)^{-1}`` (Gaz et al. 2019) or ``"robust"``, heteroscedasticity-consistent
+#: (White 1980, HC1).
+StdMethod = Literal["classical", "robust"]
 
 
 @dataclass(frozen=True, slots=True, eq=False)
@@ -167,15 +181,15 @@ def conditioning_advice(
 
 def _column_names(
     labels: tuple[str, ...] | None, v: NDArray[np.float64], keep: NDArray[np.bool_]
-) -> str:
-    """The columns with large weight in ``v`` (a null or weakest direction), named."""
+) -> tuple[str, ...]:
+    """The columns with large weight in ``v`` (a null or weakest direction), named, largest
+    first (at most 8; empty when ``v`` is zero)."""
     a = np.abs(v)
     if not a.size or not a.max() > 0:
-        return "?"
+        return ()
     idx = np.flatnonzero(a >= 0.1 * a.max())
     idx = np.flatnonzero(keep)[idx[np.argsort(-a[idx])][:8]]
-    names = [labels[k] if labels is not None else f"column {k}" for k in idx]
-    return ", ".join(names)
+    return tuple(labels[k] if labels is not None else f"column {k}" for k in idx)
 
 
 def fit_least_squares(
@@ -290,7 +304,10 @@ def _fit(
             except _RankDeficient as exc:
                 names = _column_names(labels, exc.null, keep)
                 raise RankDeficientError(
-                    f"{exc.args[0]}; nearly dependent columns: {names}"
+                    f"{exc.args[0]}; nearly dependent columns: {', '.join(names) or '?'}",
+                    rank=exc.rank,
+                    needed=rk,
+                    dependent=names,
                 ) from None
     rank, cond, bk, e, cov_s, scale, cond_u, vmin = solved
     if not (np.all(np.isfinite(bk)) and np.all(np.isfinite(e)) and np.all(np.isfinite(cov_s))):
@@ -363,8 +380,9 @@ def _gram(W: NDArray[np.float64], blk: NDArray[np.intp]) -> NDArray[np.float64]:
     return G
 
 
-def _block_grams(W: NDArray[np.float64], blk: NDArray[np.intp]) -> NDArray[np.float64]:
-    """``W_b^T W_b`` of each row block (k, r, r) (its leading zero columns skipped)."""
+def block_grams(W: NDArray[np.float64], blk: NDArray[np.intp]) -> NDArray[np.float64]:
+    """``W_b^T W_b`` of each row block: W (M, r), ``blk`` (k, 3) rows of ``(start, stop,
+    first)`` -> (k, r, r); the block's leading ``first`` columns (exactly zero) are skipped."""
     r = W.shape[1]
     out = np.zeros((len(blk), r, r))
     for k, (a, b, c) in enumerate(blk):
@@ -438,9 +456,10 @@ _Solved = tuple[
 class _RankDeficient(Exception):
     """Internal: rank deficiency, with the null direction (column order) for the message."""
 
-    def __init__(self, msg: str, null: NDArray[np.float64]) -> None:
+    def __init__(self, msg: str, null: NDArray[np.float64], rank: int) -> None:
         super().__init__(msg)
         self.null = null
+        self.rank = rank
 
 
 def _conditioning(
@@ -551,7 +570,9 @@ def _solve_qr(
     rank = int(np.sum(d > rtol * d[0])) if d.size and d[0] > 0 else 0
     if m < rk:
         raise RankDeficientError(
-            f"Regressor rank {rank} < {rk}: {m} rows for {rk} coefficients; add configurations"
+            f"Regressor rank {rank} < {rk}: {m} rows for {rk} coefficients; add configurations",
+            rank=rank,
+            needed=rk,
         )
     cond, cond_u, vp = _conditioning(R, scale[piv])
     vmin = np.empty(rk)
@@ -561,6 +582,7 @@ def _solve_qr(
             f"Regressor rank {rank} < {rk} at rtol={rtol:g} (scaled cond {cond:.3g}); add "
             "configurations or excite the trajectory more, or drop unidentifiable parameters",
             vmin,
+            rank,
         )
     z = scipy.linalg.solve_triangular(R, Q.T @ b)
     bs = np.empty(rk)
@@ -601,6 +623,43 @@ def fit_with_pruning(
     W, y = _validated(W, y, covariance)
     return _fit_with_pruning(
         W, y, max_std_percent=max_std_percent, rtol=rtol, covariance=covariance, labels=labels
+    )
+
+
+def fit_blocks(
+    W: NDArray[np.float64],
+    y: NDArray[np.float64],
+    *,
+    rows: NDArray[np.intp],
+    gram: NDArray[np.float64] | None = None,
+    std: StdMethod = "classical",
+    max_std_percent: float | None = None,
+    rtol: float = 1e-10,
+    labels: tuple[str, ...] | None = None,
+) -> LeastSquaresFit:
+    """:func:`fit_with_pruning` over row blocks of ``W`` (M, r) and ``y`` (M,).
+
+    ``rows`` (k, 3) holds ``(start, stop, first)`` of each block used (``W[start:stop,
+    :first]`` exactly zero, so the products skip it); ``gram`` ``W^T W`` over those rows
+    when known (:func:`block_grams` summed).
+
+    Raises
+    ------
+    RankDeficientError
+        Rank below the column count (``rank``, ``needed``, ``dependent`` set).
+    NonFiniteError
+        NaN or inf in ``W`` or ``y``.
+    """
+    W, y = _validated(W, y, std)
+    return _fit_with_pruning(
+        W,
+        y,
+        max_std_percent=max_std_percent,
+        rtol=rtol,
+        covariance=std,
+        blocks=rows,
+        gram=gram,
+        labels=labels,
     )
 
 

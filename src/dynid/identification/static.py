@@ -27,9 +27,12 @@ axis (``g1`` of the Panda). Keeping them would add equations ``0 = 0`` that lowe
 residual variance estimate. Their labels are recorded in the model's metadata.
 
 Standard deviations are by default the heteroscedasticity-consistent ones
-(``std_estimator="robust"``): the stacked vector mixes kg m^2 and N m and a controller's
-errors scale with each entry, so the paper's single-variance formula
-(``std_estimator="classical"``) misstates them (see :func:`identify_static`).
+(``std="robust"``): the stacked vector mixes kg m^2 and N m and a controller's errors scale
+with each entry, so the paper's single-variance formula (``std="classical"``) misstates
+them (see :func:`identify_static`).
+
+The steps are those of every route (:func:`dynid.identification.core.identify`); the
+static data set's rows are :meth:`~dynid.identification.data.StaticDataset.blocks`.
 
 :func:`basis_transform` and :func:`coefficients_in_basis` express identified coefficients
 in another basis defined on the standard parameters, e.g. the 43 expressions printed by
@@ -38,42 +41,21 @@ Gaz et al. (supplementary Table III).
 
 from __future__ import annotations
 
-import logging
-import warnings
-from typing import Any
-
 import numpy as np
-import scipy.linalg
 from numpy.typing import ArrayLike, NDArray
 
 from .. import _checks
-from ..exceptions import DynidWarning, OptionError, RankDeficientError, ShapeError
+from ..exceptions import RankDeficientError, ShapeError
 from ..model.drive import Drive
 from ..model.robot import Robot
-from ..regressors.base import BaseParameters, base_parameters, identifiability
-from ..regressors.static import (
-    _static_first_columns,
-    _static_regressor_columns,
-    static_labels,
-)
-from ..regressors.terms import base_term_columns, drive_terms
+from ..regressors.base import BaseParameters
+from .core import identify, informative_blocks
 from .data import StaticDataset
-from .estimators import Estimator, EstimatorName, estimator_named
-from .least_squares import _block_grams, _fit_with_pruning, conditioning_advice
+from .estimators import Estimator, EstimatorName
+from .least_squares import StdMethod
 from .model import IdentifiedModel
 
 __all__ = ["identify_static", "informative_static_rows", "basis_transform", "coefficients_in_basis"]
-
-_log = logging.getLogger(__name__)
-
-#: Rank tolerance of the fit (diagonal of R, column-scaled) when none is given: the base
-#: parameters' columns are independent by construction, so only a degenerate data set
-#: (too few or repeated configurations) falls below it.
-DEFAULT_FIT_RTOL = 1e-10
-
-#: A dropped row whose data exceed this fraction of the largest |entry| triggers a warning:
-#: the robot says the row is identically zero, the data say otherwise.
-_DROPPED_ROW_DATA_RTOL = 1e-6
 
 
 def informative_static_rows(Y_b: ArrayLike, *, rtol: float = 1e-10) -> NDArray[np.bool_]:
@@ -94,14 +76,7 @@ def informative_static_rows(Y_b: ArrayLike, *, rtol: float = 1e-10) -> NDArray[n
     Y = _checks.as_array("Y_b", Y_b)
     if Y.ndim != 3:
         raise ShapeError(f"Y_b must have shape (N, s, r); got {Y.shape}")
-    return _informative(np.einsum("bkj,bkj->jk", Y, Y), rtol)
-
-
-def _informative(ss: NDArray[np.float64], rtol: float) -> NDArray[np.bool_]:
-    """Rows with information from the sums of squares ``ss[j, k]`` of coefficient j, row k."""
-    col = ss.sum(axis=1)
-    block = np.sqrt(np.sum(ss / np.where(col > 0, col, 1.0)[:, None], axis=0))
-    return block > rtol * float(np.max(block, initial=0.0))
+    return informative_blocks(np.einsum("bkj,bkj->jk", Y, Y), rtol)
 
 
 def identify_static(
@@ -111,7 +86,7 @@ def identify_static(
     max_std_percent: float | None = None,
     rtol: float | None = None,
     base: BaseParameters | None = None,
-    std_estimator: str = "robust",
+    std: StdMethod = "robust",
     drive: Drive | None = None,
     estimator: EstimatorName | Estimator = "ols",
 ) -> IdentifiedModel:
@@ -141,7 +116,7 @@ def identify_static(
     base : BaseParameters, optional
         The base parameters to identify; default ``base_parameters(robot, rtol=rtol)``
         (the structural ones, from random configurations).
-    std_estimator : {"robust", "classical"}
+    std : {"robust", "classical"}
         Standard deviations from the heteroscedasticity-consistent covariance (White 1980,
         HC1; default) or from ``sigma^2 (W^T W)^{-1}`` (the paper's formula, valid when
         every row has the same error variance).
@@ -172,8 +147,8 @@ def identify_static(
     RankDeficientError
         The stacked regressor has rank below the number of base parameters (too few or
         too similar configurations); the message gives the rank found and the rank needed.
-    ValueError
-        ``max_std_percent`` not positive, or an unknown ``std_estimator``.
+    OptionError
+        ``max_std_percent`` not positive, or an unknown ``std``.
 
     Warns
     -----
@@ -189,130 +164,16 @@ def identify_static(
     With the Panda, 1010 configurations and noise-free data the fit recovers the
     coefficients of the generating parameters to round-off; rank 43 after ``g1`` is dropped.
     """
-    data.check_robot(robot)
-    if max_std_percent is not None and not max_std_percent > 0:
-        raise OptionError(f"max_std_percent must be positive or None; got {max_std_percent}")
-    if std_estimator not in ("robust", "classical"):
-        raise OptionError(f"std_estimator must be 'robust' or 'classical'; got {std_estimator!r}")
-    terms = drive_terms(drive, robot.n, friction=False)
-    p = 10 * robot.n + sum(len(t.labels) for t in terms)
-    if base is None:
-        base = base_parameters(robot, kind="static", rtol=rtol, terms=terms)
-    elif base.n_std != p:
-        raise ShapeError(
-            f"base was built for {base.n_std} standard parameters; robot {robot.name!r} has {p}"
-        )
-    fit_rtol = DEFAULT_FIT_RTOL if rtol is None else rtol
-    N, n, r = data.n_configurations, robot.n, base.rank
-    labels = static_labels(n)
-    # base regressor with the configurations last: Yb[c, k, b] = coefficient c, row k of
-    # s(q), configuration b (only the independent columns are computed). Its transpose W
-    # (s N, r) is column-major for LAPACK and BLAS without a copy; row k N + b is row k of
-    # s at configuration b (the order of the rows does not change a least-squares fit)
-    ind = np.asarray(base.independent)
-    Yb = _static_regressor_columns(robot, data.q, ind[ind < 10 * n])
-    extra = []
-    for t, sel in base_term_columns(terms, ind, n):  # rotor inertias: constant columns of M
-        C = t.static_columns(N)
-        extra.append(np.zeros((sel.size, Yb.shape[1], N)) if C is None else C[sel])
-    if extra:
-        Yb = np.concatenate([Yb, *extra], axis=0)
-    W = Yb.reshape(r, -1).T
-    i, j = np.tril_indices(n)
-    M = data.M
-    if drive is not None and drive.rotor_inertia is not None:  # known: not identified
-        M = M - drive.rotor_mass_matrix(drive.rotor_inertia)
-    S = np.concatenate([M[:, i, j], data.g], axis=1).T  # (s, N), rows as static_labels
-    # one block of N rows per row k of s, exactly zero before column first[k] (the links
-    # before the row's first link do not act on it); the Gram matrix of each block gives
-    # the sums of squares of the row check, and their sum over the rows kept that of W
-    ks = np.arange(len(labels))
-    rows = np.column_stack([ks * N, (ks + 1) * N, _static_first_columns(n, base.independent)])
-    grams = _block_grams(W, rows)
-    info = _informative(np.einsum("kjj->jk", grams), fit_rtol)
-    dropped = [labels[k] for k in np.flatnonzero(~info)]
-    if dropped:
-        big = np.max(np.abs(S[~info]))
-        if big > _DROPPED_ROW_DATA_RTOL * np.max(np.abs(S)):
-            warnings.warn(
-                f"rows {dropped} carry no information for robot {robot.name!r} (its regressor "
-                f"is zero there) but the data reach |{big:.3g}|; hint: check the gravity "
-                "vector and the kinematics against the source of the data",
-                DynidWarning,
-                stacklevel=2,
-            )
-        _log.info("dropping rows without information: %s", ", ".join(dropped))
-    y = S.reshape(-1)
-    m = int(info.sum()) * N
-    _log.info("static identification: %d configurations, %d rows, %d base parameters", N, m, r)
-    est = estimator_named(estimator)
-    try:
-        if est.name == "ols":  # the blocked fast path
-            fit = _fit_with_pruning(
-                W,
-                y,
-                max_std_percent=max_std_percent,
-                rtol=fit_rtol,
-                covariance=std_estimator,
-                blocks=rows[info],
-                gram=grams[info].sum(axis=0),
-                labels=base.labels,
-            )
-        else:  # one noise group per row of [tril M; g]
-            used = np.flatnonzero(np.repeat(info, N))
-            fit = est.fit(
-                W[used],
-                y[used],
-                used // N,
-                rtol=fit_rtol,
-                covariance=std_estimator,
-                max_std_percent=max_std_percent,
-                labels=base.labels,
-            )
-    except RankDeficientError as exc:
-        rank = _rank(Yb[:, info].reshape(r, -1).T, fit_rtol)
-        cols = str(exc).split("nearly dependent columns: ")[-1]
-        raise RankDeficientError(
-            f"static regressor of {N} configuration(s) ({m} rows) has rank {rank} < {r} "
-            f"needed for the base parameters (rtol={fit_rtol:g}); nearly dependent columns: "
-            f"{cols}; add configurations spread over the joint ranges (Gaz et al. 2019 used "
-            "1010; dynid acquire-static --pool selects them)"
-        ) from exc
-    for msg in conditioning_advice(fit, base.labels, what="the configurations"):
-        warnings.warn(msg, DynidWarning, stacklevel=2)
-    pruned = [base.labels[k] for k in np.flatnonzero(~fit.kept)]
-    if pruned:
-        _log.info(
-            "pruned %d coefficient(s) above %g %% std: %s", len(pruned), max_std_percent, pruned
-        )
-    meta: dict[str, Any] = {
-        "route": "static",
-        "reference": "Gaz et al. 2019, Sec. IV-A, eqs. 17-21",
-        "n_configurations": N,
-        "n_rows": m,
-        "rows_per_configuration": int(info.sum()),
-        "dropped_rows": dropped,
-        "pruned": pruned,
-        "max_std_percent": max_std_percent,
-        "std_estimator": std_estimator,
-        "estimator": est.name,
-        "rtol": rtol,
-        "rank_gap": None if base.gap is None else list(base.gap),
-        "identifiability": dict(zip(base.std_labels, identifiability(base), strict=True)),
-        "data": dict(data.metadata),
-    }
-    if drive is not None:
-        meta["drive"] = drive.as_dict()
-    return IdentifiedModel(robot=robot, base=base, fit=fit, metadata=meta, drive=drive)
-
-
-def _rank(W: NDArray[np.float64], rtol: float) -> int:
-    """Numerical rank of the column-scaled ``W`` (pivoted QR, as the fit decides it)."""
-    norms = np.linalg.norm(W, axis=0)
-    Ws = W / np.where(norms > 0, norms, 1.0)
-    R = scipy.linalg.qr(Ws, mode="r", pivoting=True)[0]
-    d = np.abs(np.diag(R))
-    return int(np.sum(d > rtol * d[0])) if d.size and d[0] > 0 else 0
+    return identify(
+        robot,
+        data,
+        drive=drive,
+        base=base,
+        estimator=estimator,
+        std=std,
+        max_std_percent=max_std_percent,
+        rtol=rtol,
+    )
 
 
 def basis_transform(

@@ -34,11 +34,14 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from .. import _checks, _kernels
+from ..exceptions import ShapeError
 from ..kinematics.forward import link_poses_prepared
 from ..model.robot import Robot
 
 __all__ = [
+    "static_first_columns",
     "static_regressor",
+    "static_regressor_columns",
     "static_regressor_numpy",
     "static_labels",
     "static_vector",
@@ -76,7 +79,7 @@ def static_vector(M: ArrayLike, g: ArrayLike) -> NDArray[np.float64]:
     return np.concatenate([M[..., i, j], np.broadcast_to(g, M.shape[:-2] + (n,))], axis=-1)
 
 
-def _static_first_columns(n: int, columns: NDArray[np.intp]) -> NDArray[np.intp]:
+def static_first_columns(n: int, columns: NDArray[np.intp]) -> NDArray[np.intp]:
     """For each row of ``s``, the first of ``columns`` where its regressor can be non-zero.
 
     Row ``(i, j)`` of ``tril M`` and row ``g_i`` depend only on the parameters of links
@@ -97,14 +100,14 @@ def _static_first_columns(n: int, columns: NDArray[np.intp]) -> NDArray[np.intp]
 def _static_regressor(robot: Robot, q2: NDArray[np.float64]) -> NDArray[np.float64]:
     """(B, n (n + 1) / 2 + n, 10 n) static regressor for validated (B, n) positions.
 
-    A transposed view of :func:`_static_regressor_columns` (not C-contiguous).
+    A transposed view of :func:`static_regressor_columns` (not C-contiguous).
     """
-    return _static_regressor_columns(robot, q2).transpose(2, 1, 0)
+    return static_regressor_columns(robot, q2).transpose(2, 1, 0)
 
 
-def _static_regressor_columns(
+def static_regressor_columns(
     robot: Robot,
-    q2: NDArray[np.float64],
+    q: ArrayLike,
     columns: NDArray[np.intp] | None = None,
     *,
     numpy_path: bool = False,
@@ -112,10 +115,20 @@ def _static_regressor_columns(
     """Columns of the static regressor, samples last: (c, n (n + 1) / 2 + n, B), C order.
 
     ``Y[c, k, b]`` is standard parameter ``columns[c]`` (all ``10 n`` in order when None),
-    row ``k`` of ``s``, sample ``b`` of the validated (B, n) positions ``q2``; a column of
-    the stacked regressor (rows, then samples) is contiguous. The compiled kernel writes
-    only these columns; the numpy path (``numpy_path=True`` or no kernel) gathers them.
+    row ``k`` of ``s``, sample ``b`` of the (B, n) positions ``q`` [rad]; a column of the
+    stacked regressor (rows, then samples) is contiguous. The compiled kernel writes only
+    these columns; the numpy path (``numpy_path=True`` or no kernel) gathers them.
+
+    Raises
+    ------
+    ShapeError
+        ``q`` not (B, n) for the robot's ``n`` joints.
+    NonFiniteError
+        NaN or inf in ``q``.
     """
+    q2 = _checks.as_batch("q", q, (robot.n,))
+    if q2.ndim != 2:
+        raise ShapeError(f"q must have shape (B, {robot.n}); got {q2.shape}")
     B, n = q2.shape
     p = 10 * n
     idx = np.arange(p) if columns is None else np.asarray(columns, dtype=np.intp)

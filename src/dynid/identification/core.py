@@ -1,0 +1,660 @@
+"""One identification core: base parameters (and model terms) from any data set.
+
+Every route is the same steps over a :class:`Dataset`:
+
+1. **columns** (:func:`model_columns`): the base parameters of the data's regressor kind
+   (``"static"``: rows ``[tril M; g]``; ``"torque"``: joint torques) with the model terms
+   (:mod:`dynid.regressors.terms`: a drive's rotor inertia, friction), in the order
+   ``beta1 .. beta_r`` then every appended term's parameters;
+2. **stack** (:func:`stack_dataset`): the data's regressor blocks ``W`` (rows, columns)
+   with targets ``y`` and a noise group per row, stacked; a block whose regressor is zero
+   for this robot (``g1`` of the Panda, its joint-1 axis along gravity) carries no
+   information and is dropped, with a warning when its data are not zero;
+3. **fit** (:func:`fit_stack`): an estimator (:mod:`dynid.identification.estimators`)
+   solves ``W x = y``; columns the data cannot excite (the friction of a joint that never
+   moves) are left out and reported as not kept;
+4. **model**: the fit, the friction and the record of what was done, as an
+   :class:`~dynid.identification.model.IdentifiedModel`.
+
+A data set is anything with the :class:`Dataset` protocol: static data
+(:class:`~dynid.identification.data.StaticDataset`) and prepared torque logs
+(:class:`~dynid.identification.classical.PreparedLog`). Its blocks come as an iterator so
+that a long log can be read in pieces; they are concatenated here.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import logging
+import warnings
+from collections.abc import Callable, Iterable, Iterator
+from dataclasses import dataclass
+from typing import Any, Literal, Protocol
+
+import numpy as np
+from numpy.typing import NDArray
+
+from .. import _checks
+from ..exceptions import DynidWarning, OptionError, RankDeficientError, ShapeError
+from ..model.drive import Drive
+from ..model.robot import Robot
+from ..regressors.base import BaseParameters, base_parameters, identifiability
+from ..regressors.terms import ModelTerm, drive_terms
+from .estimators import OLS, Estimator, EstimatorName, estimator_named
+from .holdout import HeldOut, cross_validate
+from .least_squares import (
+    LeastSquaresFit,
+    StdMethod,
+    block_grams,
+    conditioning_advice,
+    fit_blocks,
+)
+from .model import IdentifiedModel
+
+__all__ = [
+    "DEFAULT_FIT_RTOL",
+    "Dataset",
+    "Judge",
+    "ModelColumns",
+    "RegressorBlock",
+    "RegressorKind",
+    "RegressorStack",
+    "Route",
+    "fit_stack",
+    "identify",
+    "informative_blocks",
+    "model_columns",
+    "stack_dataset",
+]
+
+_log = logging.getLogger(__name__)
+
+#: The identification routes: static data (Gaz et al. 2019, Sec. IV-A) or a torque log
+#: (Sec. IV-B).
+Route = Literal["static", "classical"]
+#: Which regressor a data set stacks (the kind of :func:`~dynid.regressors.base.
+#: base_parameters`).
+RegressorKind = Literal["static", "torque"]
+
+#: Rank tolerance of the fit (diagonal of R, column-scaled) when none is given: the base
+#: parameters' columns are independent by construction, so only degenerate data fall below.
+DEFAULT_FIT_RTOL = 1e-10
+
+#: A dropped block whose data exceed this fraction of the largest |y| triggers a warning:
+#: the robot says the rows are identically zero, the data say otherwise.
+_DROPPED_DATA_RTOL = 1e-6
+
+
+@dataclass(frozen=True, slots=True, eq=False)
+class ModelColumns:
+    """The columns of a model: base parameters, then the appended terms' parameters.
+
+    Attributes
+    ----------
+    base : BaseParameters
+        Over the link parameters and the ``in_base`` terms (rotor inertias).
+    terms : tuple of ModelTerm
+        Every term; those not ``in_base`` (friction) append their columns after ``beta``.
+    drive : Drive, optional
+        The drive the data are read through (known rotor inertias are subtracted).
+    """
+
+    base: BaseParameters
+    terms: tuple[ModelTerm, ...] = ()
+    drive: Drive | None = None
+
+    @property
+    def appended(self) -> tuple[ModelTerm, ...]:
+        """The terms whose columns follow the base parameters."""
+        return tuple(t for t in self.terms if not t.in_base)
+
+    @property
+    def labels(self) -> tuple[str, ...]:
+        """One label per column: ``base.labels`` then the appended terms' labels."""
+        out = self.base.labels
+        for t in self.appended:
+            out = out + t.labels
+        return out
+
+    def term_slice(self, name: str) -> slice | None:
+        """The columns of the appended term named ``name``, or None."""
+        c = self.base.rank
+        for t in self.appended:
+            if t.name == name:
+                return slice(c, c + len(t.labels))
+            c += len(t.labels)
+        return None
+
+
+@dataclass(frozen=True, slots=True, eq=False)
+class RegressorBlock:
+    """Rows of the stacked regressor of one kind, with their targets and noise groups.
+
+    Attributes
+    ----------
+    W : ndarray, shape (m, c)
+        Regressor rows over the model's columns (:class:`ModelColumns` order).
+    y : ndarray, shape (m,)
+        Measured targets (SI: N m, kg m^2).
+    groups : ndarray of int, shape (m,)
+        Noise group of each row (joint of a torque log, row of ``[tril M; g]``).
+    label : str
+        What the rows are (``"g1"``); names a dropped block.
+    first : int
+        ``W[:, :first]`` is exactly zero (products over the rows skip those columns).
+    """
+
+    W: NDArray[np.float64]
+    y: NDArray[np.float64]
+    groups: NDArray[np.intp]
+    label: str = ""
+    first: int = 0
+
+
+class Dataset(Protocol):
+    """What the core needs of data (module docstring)."""
+
+    @property
+    def route(self) -> Route:
+        """``"static"`` or ``"classical"``: recorded in the model."""
+        ...
+
+    @property
+    def regressor_kind(self) -> RegressorKind:
+        """The regressor it stacks: ``"static"`` or ``"torque"``."""
+        ...
+
+    @property
+    def moving(self) -> bool:
+        """True when the data move (friction acts and can be identified)."""
+        ...
+
+    @property
+    def source(self) -> str:
+        """The data in a few words, for messages (``"static regressor of 5 configuration(s)"``)."""
+        ...
+
+    @property
+    def hint(self) -> str:
+        """What to do when the data do not excite every column (ends a rank error)."""
+        ...
+
+    def check_robot(self, robot: Robot) -> None:
+        """Raise unless the data belong to a robot with ``robot.n`` joints."""
+        ...
+
+    def frozen_columns(self, columns: ModelColumns) -> NDArray[np.bool_]:
+        """Columns (c,) the data cannot excite (left out of the fit)."""
+        ...
+
+    def blocks(self, robot: Robot, columns: ModelColumns) -> Iterator[RegressorBlock]:
+        """The regressor blocks over ``columns`` with their targets."""
+        ...
+
+    def record(self, n_rows: int) -> dict[str, Any]:
+        """What the model records about the data, given the rows used."""
+        ...
+
+
+@dataclass(frozen=True, slots=True, eq=False)
+class RegressorStack:
+    """Blocks concatenated: ``W`` (m, c) column-major, ``y`` (m,), ``groups`` (m,).
+
+    Attributes
+    ----------
+    W, y, groups : ndarray
+        Every block's rows, in block order.
+    rows : ndarray of int, shape (k, 3)
+        ``(start, stop, first)`` of each block.
+    labels : tuple of str
+        Each block's label.
+    kept : ndarray of bool, shape (k,)
+        False for the blocks dropped (no information).
+    grams : ndarray, shape (k, c, c), optional
+        Each block's Gram matrix ``W_b^T W_b`` (None for a single block).
+    """
+
+    W: NDArray[np.float64]
+    y: NDArray[np.float64]
+    groups: NDArray[np.intp]
+    rows: NDArray[np.intp]
+    labels: tuple[str, ...]
+    kept: NDArray[np.bool_]
+    grams: NDArray[np.float64] | None = None
+
+    @property
+    def dropped(self) -> tuple[str, ...]:
+        """Labels of the blocks dropped."""
+        return tuple(self.labels[k] for k in np.flatnonzero(~self.kept))
+
+    @property
+    def used_rows(self) -> NDArray[np.intp]:
+        """``(start, stop, first)`` of the blocks kept."""
+        return self.rows[self.kept]
+
+    @property
+    def n_rows(self) -> int:
+        """Rows used (in the kept blocks)."""
+        r = self.used_rows
+        return int(np.sum(r[:, 1] - r[:, 0]))
+
+    def used(self) -> NDArray[np.intp]:
+        """Indices of the rows used, block after block."""
+        return np.concatenate(
+            [np.arange(a, b) for a, b, _ in self.used_rows] + [np.zeros(0, dtype=np.intp)]
+        )
+
+    def select(self, blocks: NDArray[np.bool_]) -> RegressorStack:
+        """The stack with only the kept blocks among ``blocks`` (k,) used (held-out fits)."""
+        return dataclasses.replace(self, kept=self.kept & np.asarray(blocks, dtype=bool))
+
+
+#: Held-out judgement of a fit (:mod:`dynid.identification.holdout`): called with the stack,
+#: the model's columns, the columns fitted (c,) and the estimates over every column (c,);
+#: returns the folds' normal equations over every column, or None when the data are too
+#: short to judge.
+Judge = Callable[
+    [RegressorStack, ModelColumns, NDArray[np.bool_], NDArray[np.float64]], HeldOut | None
+]
+
+
+def informative_blocks(ss: NDArray[np.float64], rtol: float) -> NDArray[np.bool_]:
+    """Blocks with information, from the sums of squares ``ss[j, k]`` of column j, block k.
+
+    A block is uninformative when the norm of its column-scaled regressor is at most
+    ``rtol`` times the largest block's.
+    """
+    col = ss.sum(axis=1)
+    block = np.sqrt(np.sum(ss / np.where(col > 0, col, 1.0)[:, None], axis=0))
+    return block > rtol * float(np.max(block, initial=0.0))
+
+
+def model_columns(
+    robot: Robot,
+    data: Dataset,
+    *,
+    drive: Drive | None = None,
+    terms: tuple[ModelTerm, ...] | None = None,
+    base: BaseParameters | None = None,
+    rtol: float | None = None,
+) -> ModelColumns:
+    """The model's columns for ``data``: ``terms`` (default: the drive's rotor inertia, and
+    friction when the data move) and ``base`` (default: the structural base parameters of
+    the data's regressor kind).
+
+    Raises
+    ------
+    ShapeError
+        ``base`` was built for another number of standard parameters.
+    """
+    if terms is None:
+        terms = drive_terms(drive, robot.n, friction=data.moving)
+    p = 10 * robot.n + sum(len(t.labels) for t in terms if t.in_base)
+    if base is None:
+        base = base_parameters(robot, kind=data.regressor_kind, rtol=rtol, terms=terms)
+    elif base.n_std != p:
+        raise ShapeError(
+            f"base was built for {base.n_std} standard parameters; robot {robot.name!r} has {p}"
+        )
+    return ModelColumns(base=base, terms=tuple(terms), drive=drive)
+
+
+def stack_dataset(
+    robot: Robot, data: Dataset, columns: ModelColumns, *, rtol: float = DEFAULT_FIT_RTOL
+) -> RegressorStack:
+    """Concatenate the data's blocks and drop those without information.
+
+    A seam for held-out judgement: :meth:`RegressorStack.select` keeps some blocks for
+    :func:`fit_stack`.
+
+    Warns
+    -----
+    DynidWarning
+        A dropped block holds non-zero data (gravity or kinematics differ from the source's).
+    """
+    stack = _concatenated(data.blocks(robot, columns), len(columns.labels))
+    if stack.rows.shape[0] < 2:
+        return stack
+    grams = block_grams(stack.W, stack.rows)
+    info = informative_blocks(np.einsum("kjj->jk", grams), rtol)
+    stack = dataclasses.replace(stack, kept=info, grams=grams)
+    if info.all():
+        return stack
+    dropped = stack.dropped
+    y_out = np.concatenate([stack.y[a:b] for a, b, _ in stack.rows[~info]])
+    big = float(np.max(np.abs(y_out), initial=0.0))
+    if big > _DROPPED_DATA_RTOL * float(np.max(np.abs(stack.y), initial=0.0)):
+        warnings.warn(
+            f"rows {list(dropped)} carry no information for robot {robot.name!r} (its "
+            f"regressor is zero there) but the data reach |{big:.3g}|; hint: check the "
+            "gravity vector and the kinematics against the source of the data",
+            DynidWarning,
+            stacklevel=3,
+        )
+    _log.info("dropping rows without information: %s", ", ".join(dropped))
+    return stack
+
+
+def _concatenated(blocks: Iterable[RegressorBlock], c: int) -> RegressorStack:
+    """One stack of the blocks, every block kept."""
+    blks = list(blocks)
+    for b in blks:
+        if b.W.ndim != 2 or b.W.shape[1] != c or b.y.shape != (b.W.shape[0],):
+            raise ShapeError(
+                f"a regressor block must be (m, {c}) with y (m,); got {b.W.shape}, {b.y.shape}"
+            )
+    sizes = np.array([b.W.shape[0] for b in blks], dtype=np.intp)
+    stops = np.cumsum(sizes)
+    rows = np.column_stack([stops - sizes, stops, [b.first for b in blks]]).astype(np.intp)
+    if len(blks) == 1:
+        W, y, groups = blks[0].W, blks[0].y, blks[0].groups
+    else:
+        W = np.empty((int(stops[-1]) if blks else 0, c), order="F")
+        for b, (a, e, _) in zip(blks, rows, strict=True):
+            W[a:e] = b.W
+        y = np.concatenate([b.y for b in blks] + [np.zeros(0)])
+        groups = np.concatenate([b.groups for b in blks] + [np.zeros(0, np.intp)])
+    return RegressorStack(
+        W,
+        y,
+        np.asarray(groups, dtype=np.intp),
+        rows,
+        tuple(b.label for b in blks),
+        np.ones(len(blks), dtype=bool),
+    )
+
+
+def fit_stack(
+    stack: RegressorStack,
+    labels: tuple[str, ...],
+    *,
+    estimator: EstimatorName | Estimator = "ols",
+    std: StdMethod = "classical",
+    max_std_percent: float | None = None,
+    rtol: float = DEFAULT_FIT_RTOL,
+    frozen: NDArray[np.bool_] | None = None,
+) -> LeastSquaresFit:
+    """Fit the stacked rows with an estimator; ``frozen`` columns are left out (0, not kept).
+
+    Ordinary least squares takes the blocked path (Gram matrices of the blocks, columns
+    known to be zero skipped); other estimators get the rows used and their groups.
+
+    Raises
+    ------
+    RankDeficientError
+        From the estimator (``rank``, ``needed``, ``dependent`` set).
+    NonFiniteError
+        NaN or inf in the regressor.
+    """
+    est = estimator_named(estimator)
+    cols = np.ones(len(labels), dtype=bool) if frozen is None else ~np.asarray(frozen, bool)
+    W, rows = stack.W, stack.used_rows
+    grams = None if stack.grams is None else stack.grams[stack.kept]
+    if not cols.all():
+        W = W[:, cols]
+        rows = rows.copy()
+        rows[:, 2] = 0
+        grams = None if grams is None else grams[:, cols][:, :, cols]
+    kept_labels = tuple(lab for lab, c in zip(labels, cols, strict=True) if c)
+    if isinstance(est, OLS):
+        fit = fit_blocks(
+            W,
+            stack.y,
+            rows=rows,
+            gram=None if grams is None else grams.sum(axis=0),
+            std=std,
+            max_std_percent=max_std_percent,
+            rtol=rtol,
+            labels=kept_labels,
+        )
+    else:
+        used = stack.used()
+        if used.size != stack.y.size:
+            Wu, yu, gu = W[used], stack.y[used], stack.groups[used]
+        else:
+            Wu, yu, gu = W, stack.y, stack.groups
+        _checks.finite("regressor", Wu)
+        fit = est.fit(
+            Wu,
+            yu,
+            gu,
+            rtol=rtol,
+            covariance=std,
+            max_std_percent=max_std_percent,
+            labels=kept_labels,
+        )
+    return fit if cols.all() else _expanded(fit, cols)
+
+
+def identify(
+    robot: Robot,
+    data: Dataset,
+    *,
+    drive: Drive | None = None,
+    terms: tuple[ModelTerm, ...] | None = None,
+    base: BaseParameters | None = None,
+    estimator: EstimatorName | Estimator = "ols",
+    std: StdMethod = "classical",
+    max_std_percent: float | None = None,
+    rtol: float | None = None,
+    judge: Judge | None = None,
+) -> IdentifiedModel:
+    """Identify the base parameters (and the appended terms: friction) from a data set.
+
+    Parameters
+    ----------
+    robot : Robot
+        Kinematics and gravity the data belong to; its inertial parameters are not used.
+    data : Dataset
+        Static data (:class:`~dynid.identification.data.StaticDataset`) or a prepared
+        torque log (:func:`~dynid.identification.classical.prepare_torque_log`).
+    drive : Drive, optional
+        The drive train: its rotor inertias are identified with the links (known ones
+        subtracted) and its friction acts where it says.
+    terms : tuple of ModelTerm, optional
+        The model terms; default :func:`~dynid.regressors.terms.drive_terms` of ``drive``
+        with friction when the data move.
+    base : BaseParameters, optional
+        The base parameters to identify; default the structural ones of the data's
+        regressor kind (``rtol`` as below).
+    estimator : {"ols", "wls", "irls"} or Estimator
+        :mod:`dynid.identification.estimators`.
+    std : {"classical", "robust"}
+        Standard deviations from ``sigma^2 (W^T W)^-1`` or the heteroscedasticity-consistent
+        (HC1) covariance.
+    max_std_percent : float, optional
+        Remove coefficients with a larger relative standard deviation and re-fit once.
+    rtol : float, optional
+        Rank tolerance of the base parameters (default: at the first clear gap of the
+        singular values) and of the fit (default :data:`DEFAULT_FIT_RTOL`).
+    judge : callable, optional
+        Held-out judgement (:data:`Judge`): its folds are kept (``holdout``) and their
+        errors recorded (``heldout``).
+
+    Returns
+    -------
+    IdentifiedModel
+        ``fit`` over the ``r`` base parameters (global statistics of the whole fit);
+        ``joint_fit`` over every column and ``friction`` (n, 3) when friction is appended.
+
+    Raises
+    ------
+    OptionError
+        ``max_std_percent`` not positive, or ``std`` not ``"classical"``/``"robust"``.
+    ShapeError, DataError
+        Data of another robot, or ``base`` of another size.
+    RankDeficientError
+        The data do not excite every column; ``rank``, ``needed`` and ``dependent`` say
+        how and the message adds the data's hint.
+
+    Warns
+    -----
+    DynidWarning
+        Dropped blocks holding data, an ill-conditioned regressor or coefficients above
+        1000 % std (:func:`~dynid.identification.least_squares.conditioning_advice`).
+    """
+    data.check_robot(robot)
+    check_options(std=std, max_std_percent=max_std_percent)
+    if drive is not None:
+        drive.check(robot.n)
+    columns = model_columns(robot, data, drive=drive, terms=terms, base=base, rtol=rtol)
+    fit_rtol = DEFAULT_FIT_RTOL if rtol is None else rtol
+    stack = stack_dataset(robot, data, columns, rtol=fit_rtol)
+    labels = columns.labels
+    _log.info("%s: %d rows, %d columns", data.source, stack.n_rows, len(labels))
+    est = estimator_named(estimator)
+    frozen = data.frozen_columns(columns)
+    try:
+        fit = fit_stack(
+            stack,
+            labels,
+            estimator=est,
+            std=std,
+            max_std_percent=max_std_percent,
+            rtol=fit_rtol,
+            frozen=frozen,
+        )
+    except RankDeficientError as exc:
+        raise _rank_error(exc, data, columns, stack, fit_rtol) from exc
+    held = None if judge is None else judge(stack, columns, ~frozen, fit.beta)
+    for msg in conditioning_advice(fit, labels, what=_what(data)):
+        warnings.warn(msg, DynidWarning, stacklevel=2)
+    meta = _record(data, columns, fit, stack, est.name, std, max_std_percent, rtol)
+    if held is not None:
+        meta["heldout"] = cross_validate(held.restricted(np.flatnonzero(fit.kept))).as_dict()
+    return _model(robot, columns, fit, meta, held)
+
+
+def check_options(*, std: str, max_std_percent: float | None) -> None:
+    """Raise :class:`OptionError` for an unknown ``std`` or a non-positive threshold."""
+    if max_std_percent is not None and not max_std_percent > 0:
+        raise OptionError(f"max_std_percent must be positive or None; got {max_std_percent}")
+    if std not in ("classical", "robust"):
+        raise OptionError(f"std must be 'classical' or 'robust' (--std); got {std!r}")
+
+
+def _what(data: Dataset) -> str:
+    return "the configurations" if data.regressor_kind == "static" else "the trajectory"
+
+
+def _rank_error(
+    exc: RankDeficientError,
+    data: Dataset,
+    columns: ModelColumns,
+    stack: RegressorStack,
+    rtol: float,
+) -> RankDeficientError:
+    """The estimator's rank error said for the data, with the data's hint."""
+    needed = exc.needed if exc.needed is not None else len(columns.labels)
+    what = "the base parameters" + "".join(f" and {t.name}" for t in columns.appended)
+    cols = ", ".join(exc.dependent) or "?"
+    return RankDeficientError(
+        f"{data.source} ({stack.n_rows} rows) has rank {exc.rank} < {needed} needed for "
+        f"{what} (rtol={rtol:g}); nearly dependent columns: {cols}; {data.hint}",
+        rank=exc.rank,
+        needed=needed,
+        dependent=exc.dependent,
+    )
+
+
+def _record(
+    data: Dataset,
+    columns: ModelColumns,
+    fit: LeastSquaresFit,
+    stack: RegressorStack,
+    estimator: str,
+    std: str,
+    max_std_percent: float | None,
+    rtol: float | None,
+) -> dict[str, Any]:
+    """The model's record: what was fitted, how, and the data's own entries."""
+    labels, base = columns.labels, columns.base
+    pruned = [labels[k] for k in np.flatnonzero(~np.asarray(fit.kept))]
+    if pruned:
+        _log.info("pruned %d coefficient(s): %s", len(pruned), pruned)
+    meta: dict[str, Any] = {
+        "route": data.route,
+        "n_rows": stack.n_rows,
+        "dropped_rows": list(stack.dropped),
+        "pruned": pruned,
+        "max_std_percent": max_std_percent,
+        "std_estimator": std,
+        "estimator": estimator,
+        "rtol": rtol,
+        "rank_gap": None if base.gap is None else list(base.gap),
+        "identifiability": dict(zip(base.std_labels, identifiability(base), strict=True)),
+    }
+    meta.update(data.record(stack.n_rows))
+    if columns.drive is not None:
+        meta["drive"] = columns.drive.as_dict()
+    sl = columns.term_slice("friction")
+    if sl is not None:
+        meta["friction_labels"] = list(labels[sl])
+        meta["friction_std"] = [float(x) for x in fit.std[sl]]
+        meta["friction_kept"] = [bool(x) for x in fit.kept[sl]]
+    return meta
+
+
+def _model(
+    robot: Robot,
+    columns: ModelColumns,
+    fit: LeastSquaresFit,
+    meta: dict[str, Any],
+    held: HeldOut | None,
+) -> IdentifiedModel:
+    """The identified model: the base parameters' fit, friction and the full fit."""
+    r = columns.base.rank
+    sl = columns.term_slice("friction")
+    friction = None if sl is None else np.asarray(fit.beta[sl]).reshape(robot.n, 3)
+    appended = bool(columns.appended)
+    return IdentifiedModel(
+        robot=robot,
+        base=columns.base,
+        fit=_split_fit(fit, r) if appended else fit,
+        friction=friction,
+        metadata=meta,
+        joint_fit=fit if appended else None,
+        drive=columns.drive,
+        holdout=held,
+    )
+
+
+def _split_fit(fit: LeastSquaresFit, r: int) -> LeastSquaresFit:
+    """The fit restricted to its first ``r`` coefficients; global statistics kept."""
+    return dataclasses.replace(
+        fit,
+        beta=fit.beta[:r],
+        std=fit.std[:r],
+        std_percent=fit.std_percent[:r],
+        kept=fit.kept[:r],
+        covariance=None if fit.covariance is None else fit.covariance[:r, :r],
+    )
+
+
+def _expanded(fit: LeastSquaresFit, cols: NDArray[np.bool_]) -> LeastSquaresFit:
+    """A fit over the columns ``cols`` selected, written over all of them (0 and not kept
+    for the others)."""
+    k = cols.size
+
+    def put(v: NDArray[Any], fill: Any) -> NDArray[Any]:
+        out = np.full(k, fill, dtype=np.asarray(v).dtype)
+        out[cols] = v
+        return out
+
+    cov = None
+    if fit.covariance is not None:
+        cov = np.zeros((k, k))
+        cov[np.ix_(cols, cols)] = fit.covariance
+    n_sel = int(cols.sum())
+    return dataclasses.replace(
+        fit,
+        beta=put(fit.beta, 0.0),
+        std=put(fit.std, 0.0),
+        std_percent=put(fit.std_percent, np.nan),
+        kept=put(fit.kept, False),
+        covariance=cov,
+        weakest=put(fit.weakest, 0.0) if np.size(fit.weakest) == n_sel else fit.weakest,
+        effect_percent=put(fit.effect_percent, 0.0)
+        if np.size(fit.effect_percent) == n_sel
+        else fit.effect_percent,
+    )
