@@ -244,3 +244,38 @@ def test_a_law_at_the_motors_is_fitted_per_motor():
     fit = fit_law_through("asymmetric", dq, tau, drive, dq_noise_std=np.full(2, DQ_NOISE))
     assert isinstance(fit.friction, DriveFriction) and isinstance(fit.friction.law, LawFriction)
     np.testing.assert_allclose(fit.friction.as_array(), P, rtol=0.02, atol=0.01)
+
+
+def test_simulate_takes_the_ground_truth_friction_of_any_law(tmp_path):
+    """dynid simulate --friction FILE (a Stribeck law): the logged torques minus those of the
+    same run without friction are the law, written out, at the logged velocities (no
+    sensor noise)."""
+    from dynid.cli.__main__ import main
+    from dynid.io.torque_log import load_torque_log
+
+    P = np.tile([0.2, 0.5, 0.9, 0.1, 0.05], (7, 1))
+    save_friction_json(tmp_path / "f.json", law_named("stribeck").model(P, np.full(7, 0.004)))
+    base = ["simulate", "--robot", "panda", "--trajectory", "sinusoid", "--duration", "2",
+            "--rate", "200", "--seed", "3", "--noise", "0", "--q-noise", "0", "--dq-noise", "0",
+            "-q"]  # fmt: skip
+    assert (
+        main([*base, "--out", str(tmp_path / "a.csv"), "--friction", str(tmp_path / "f.json")]) == 0
+    )
+    assert main([*base, "--out", str(tmp_path / "b.csv"), "--no-friction"]) == 0
+    a, b = load_torque_log(tmp_path / "a.csv"), load_torque_log(tmp_path / "b.csv")
+    np.testing.assert_allclose(a.tau - b.tau, _friction("stribeck", a.dq, P, band=0.004), atol=1e-9)
+
+
+def test_the_classical_law_has_the_identification_s_friction_columns():
+    """Without a band, the classical law's regressor per joint is the identification's
+    friction columns (fv, fc, fo of joint j in columns 3j .. 3j+2, row j)."""
+    from dynid.friction.laws.classical import columns
+    from dynid.identification.classical import friction_regressor
+
+    rng = np.random.default_rng(95)
+    dq = rng.uniform(-1, 1, (6, 3))
+    dq[0, 1] = 0.0
+    F = friction_regressor(dq)
+    C = columns(dq, np.zeros(3))
+    for j in range(3):
+        np.testing.assert_array_equal(F[:, j, 3 * j : 3 * j + 3], C[:, j, :])

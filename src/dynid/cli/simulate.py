@@ -9,7 +9,8 @@ Trajectories:
             (coefficients, sampled at --rate over its whole length) written by `dynid excite`
 
 The measured torques are M ddq + c + g + friction(dq) + noise, with the robot's own
-friction (the published sigmoid for the built-in Panda) unless --no-friction. With --drive
+friction (the published sigmoid for the built-in Panda), or any law of a friction.json
+(--friction FILE, as `dynid friction` writes it), unless --no-friction. With --drive
 the drive's known rotor inertias are added and the log is written on its side (motor
 positions and torques, or currents) with its encoder offsets. Limits are
 checked; by default a trajectory that exceeds them is scaled down in amplitude
@@ -28,6 +29,8 @@ from pathlib import Path
 import numpy as np
 
 from ..exceptions import DynidError
+from ..friction.model import FrictionModel
+from ..io.friction_json import load_friction_json
 from ..io.torque_log import save_torque_log
 from ..simulation.measurement import SensorNoise, sample_times, simulate_measurement
 from ..simulation.trajectories import (
@@ -100,7 +103,14 @@ def register(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParser:
         default=0.0,
         help="fraction of samples dropped at random (default 0)",
     )
-    p.add_argument("--no-friction", action="store_true", help="simulate without joint friction")
+    fr = p.add_mutually_exclusive_group()
+    fr.add_argument("--no-friction", action="store_true", help="simulate without joint friction")
+    fr.add_argument(
+        "--friction",
+        type=Path,
+        default=None,
+        help="friction.json: the ground-truth friction (any law; default the robot's own)",
+    )
     p.add_argument(
         "--scale",
         choices=("amplitude", "time", "none"),
@@ -137,6 +147,13 @@ def register(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParser:
     add_seed_option(p)
     p.add_argument("--out", required=True, type=Path, help="output .csv or .npz")
     return p
+
+
+def _friction(args: argparse.Namespace) -> FrictionModel | str:
+    """The ground-truth friction: a friction.json's law (--friction), else the robot's."""
+    if args.friction is None:
+        return "robot"
+    return load_friction_json(args.friction)
 
 
 def run(args: argparse.Namespace) -> int:
@@ -198,7 +215,7 @@ def run(args: argparse.Namespace) -> int:
         traj,
         rng=rng,
         noise=noise,
-        friction=None if args.no_friction else "robot",
+        friction=None if args.no_friction else _friction(args),
         drop_fraction=args.drop,
         with_ddq=args.with_ddq,
         effects=effects,
