@@ -190,6 +190,37 @@ def test_identified_classical_friction_is_written_as_it_is():
         mjcf_from_robot(robot, friction=dynid.ClassicalFriction(np.ones(2), np.ones(2), np.ones(2)))
 
 
+def test_every_friction_law_is_written_as_its_mujoco_terms():
+    """Each law of the registry: MuJoCo's compiled damping and frictionloss are what the
+    law holds of viscous and dry friction (the smooth law's fv, fc; the asymmetric law's
+    means; the Stribeck law's fv, fc), and what MJCF cannot hold is named in a warning."""
+    from dynid.exceptions import DynidWarning
+    from dynid.friction.laws import law_named
+
+    robot = dynid.panda()
+    r = np.linspace(1.0, 2.0, 7)[:, None]
+    cases = {
+        "smooth": (np.hstack([0.1 * r, 0.3 * r, 0.05 * r]), 0.1 * r, 0.3 * r, None),
+        "asymmetric": (
+            np.hstack([0.1 * r, 0.3 * r, 0.5 * r, 0.3 * r]), 0.2 * r, 0.4 * r, "asymmetry"
+        ),
+        "stribeck": (
+            np.hstack([0.1 * r, 0.3 * r, 0.6 * r, 0.05 + 0 * r, 0 * r]), 0.1 * r, 0.3 * r,
+            "Stribeck peak",
+        ),
+    }  # fmt: skip
+    for name, (P, damping, loss, note) in cases.items():
+        fr = law_named(name).model(P)
+        if note is None:
+            text, _ = mjcf_from_robot(robot, friction=fr)
+        else:
+            with pytest.warns(DynidWarning, match=note):
+                text, _ = mjcf_from_robot(robot, friction=fr)
+        model = mujoco.MjModel.from_xml_string(text)
+        np.testing.assert_allclose(model.dof_damping, damping[:, 0], rtol=1e-12)
+        np.testing.assert_allclose(model.dof_frictionloss, loss[:, 0], rtol=1e-12)
+
+
 def test_massless_link_compiles_with_negligible_bound(tmp_path):
     """A massless moving link compiles (bounded to 1e-10 kg) and mj_inverse still equals rnea."""
     inertia = np.stack([np.zeros((3, 3)), np.diag([0.01, 0.02, 0.025])])

@@ -113,13 +113,17 @@ class DriveJointTerms:
         ``|K_jj| f_c,j`` [N m]: each joint's own motor's Coulomb friction.
     notes : tuple of str
         What MuJoCo cannot express and is dropped (a coupled rotor's off-diagonal inertia,
-        coupled friction, offsets), one line each.
+        coupled friction, an asymmetry), one line each.
+    offset : ndarray, shape (n,), or None
+        The friction law's velocity-independent torque [N m] per joint (per motor at the
+        motors), which MJCF cannot hold either; None when not computed.
     """
 
     armature: NDArray[np.float64]
     damping: NDArray[np.float64]
     frictionloss: NDArray[np.float64]
     notes: tuple[str, ...] = ()
+    offset: NDArray[np.float64] | None = None
 
 
 def drive_joint_terms(
@@ -207,6 +211,6 @@ def joint_coulomb_viscous(
             terms.frictionloss,
             friction_at_motor=d.friction_at == "motor",
         )
-        return replace(jt, notes=notes + jt.notes)
+        return replace(jt, notes=notes + jt.notes, offset=terms.offset)
     z = np.zeros(n)
-    return DriveJointTerms(z, terms.damping, terms.frictionloss, notes)
+    return DriveJointTerms(z, terms.damping, terms.frictionloss, notes, terms.offset)

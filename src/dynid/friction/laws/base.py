@@ -53,8 +53,9 @@ class JointFit:
 @dataclass(frozen=True, slots=True)
 class MjcfTerms:
     """What MuJoCo's joints hold of a law: ``damping`` [N m s/rad] and ``frictionloss``
-    [N m] per joint (n,), the velocity-independent torque ``offset`` [N m] (n,) it drops,
-    and ``dropped``: one line naming what else MJCF cannot hold (empty: nothing)."""
+    [N m] per joint (n,), the velocity-independent torque ``offset`` [N m] (n,) it drops
+    (reported by the export), and ``dropped``: one line naming what else MJCF cannot hold
+    (empty: nothing)."""
 
     damping: NDArray[np.float64]
     frictionloss: NDArray[np.float64]

@@ -29,8 +29,7 @@ def columns(dq: NDArray[np.float64], band: NDArray[np.float64]) -> NDArray[np.fl
 
 
 def _mjcf(P: NDArray[np.float64], dq_max: NDArray[np.float64]) -> MjcfTerms:
-    dropped = "the offset fo" if np.any(P[:, 2] != 0) else ""
-    return MjcfTerms(P[:, 0].copy(), P[:, 1].copy(), P[:, 2].copy(), dropped)
+    return MjcfTerms(P[:, 0].copy(), P[:, 1].copy(), P[:, 2].copy())
 
 
 LAW = linear_law(

@@ -72,12 +72,9 @@ def _fit(dq: NDArray[np.float64], r: NDArray[np.float64], band: float) -> JointF
 
 
 def _mjcf(P: NDArray[np.float64], dq_max: NDArray[np.float64]) -> MjcfTerms:
-    dropped = []
-    if np.any(P[:, 2] != P[:, 1]):
-        dropped.append("the Stribeck peak fs - fc at low speed")
-    if np.any(P[:, 4] != 0):
-        dropped.append("the offset fo")
-    return MjcfTerms(P[:, 0].copy(), P[:, 1].copy(), P[:, 4].copy(), " and ".join(dropped))
+    peak = np.any(P[:, 2] != P[:, 1])
+    dropped = "the Stribeck peak fs - fc at low speed" if peak else ""
+    return MjcfTerms(P[:, 0].copy(), P[:, 1].copy(), P[:, 4].copy(), dropped)
 
 
 LAW = FrictionLaw(

@@ -24,7 +24,9 @@ keeping the robot's link and joint names:
   (:func:`dynid.friction.mujoco.coulomb_viscous_from_sigmoid`; an approximation: MuJoCo
   cannot hold the sigmoid's offset and curvature). ``friction=`` a
   :class:`~dynid.friction.model.ClassicalFriction` (identified ``fv, fc, fo``) is written
-  as it is, ``frictionloss = fc``, ``damping = fv``; only the offset ``fo`` is dropped.
+  as it is, ``frictionloss = fc``, ``damping = fv``; only the offset ``fo`` is dropped. Any
+  other law of the registry (:mod:`dynid.friction.laws`) maps itself (the asymmetric law's
+  means, the Stribeck law's ``fv`` and ``fc``), what MJCF cannot hold named in a warning.
   With ``friction=False`` the joints are frictionless, and ``mj_inverse`` equals
   :func:`dynid.rnea`.
 
@@ -38,12 +40,18 @@ from pathlib import Path
 from xml.sax.saxutils import quoteattr
 
 import numpy as np
+from numpy.typing import NDArray
 from scipy.spatial.transform import Rotation
 
 from ... import __version__
 from ...exceptions import DynidWarning, ShapeError
-from ...friction.model import ClassicalFriction, DriveFriction
-from ...friction.mujoco import CoulombViscous, coulomb_viscous_from_sigmoid, drive_joint_terms
+from ...friction.model import DriveFriction, FrictionModel, SigmoidFriction
+from ...friction.mujoco import (
+    CoulombViscous,
+    coulomb_viscous_from_sigmoid,
+    drive_joint_terms,
+    joint_coulomb_viscous,
+)
 from ...model.drive import Drive
 from ...model.inertia import inertia6_from_matrix
 from ...model.robot import Robot
@@ -68,10 +76,23 @@ def _pose(T: np.ndarray) -> str:
     return f'pos="{_v(T[:3, 3])}" quat="{_v(np.array([w, x, y, z]))}"'
 
 
+def _law_terms(
+    friction: FrictionModel, dq_max: NDArray[np.float64]
+) -> tuple[CoulombViscous, tuple[str, ...]]:
+    """A friction model as MuJoCo holds it, and what it drops (one line each)."""
+    law = friction.law if isinstance(friction, DriveFriction) else friction
+    if isinstance(law, SigmoidFriction) and not isinstance(friction, DriveFriction):
+        return coulomb_viscous_from_sigmoid(law.as_array(), dq_max), ()
+    jt = joint_coulomb_viscous(friction, np.where(np.isfinite(dq_max), dq_max, 2.0))
+    z = np.zeros(friction.n)
+    offset = z if jt.offset is None else jt.offset
+    return CoulombViscous(jt.frictionloss, jt.damping, offset, z, z), jt.notes
+
+
 def mjcf_from_robot(
     robot: Robot,
     *,
-    friction: bool | ClassicalFriction | DriveFriction = True,
+    friction: bool | FrictionModel = True,
     comment: str | None = None,
     drive: Drive | None = None,
 ) -> tuple[str, CoulombViscous | None]:
@@ -80,11 +101,13 @@ def mjcf_from_robot(
     Parameters
     ----------
     robot : Robot
-    friction : bool, ClassicalFriction or DriveFriction
+    friction : bool or FrictionModel
         True: the robot's sigmoid friction (if any) as ``frictionloss`` and ``damping``;
-        a classical model: its ``fc`` and ``fv``; classical friction at the motors of a
-        drive: reflected to the joints (:func:`dynid.friction.mujoco.drive_joint_terms`);
-        False: none.
+        a friction model of any law: what its law maps to them
+        (:func:`dynid.friction.mujoco.joint_coulomb_viscous`: a classical model's ``fc`` and
+        ``fv``; what MJCF cannot hold is named in a :class:`~dynid.exceptions.DynidWarning`);
+        friction at the motors of a drive: reflected to the joints
+        (:func:`dynid.friction.mujoco.drive_joint_terms`); False: none.
     comment : str, optional
         Text of an XML comment at the top (default: the writer and the conventions).
     drive : Drive, optional
@@ -107,32 +130,25 @@ def mjcf_from_robot(
         d = friction.drive if isinstance(friction, DriveFriction) else drive
         assert d is not None
         d.check(n)
-        law = friction.law if isinstance(friction, DriveFriction) else None
-        if law is not None and not isinstance(law, ClassicalFriction):
-            raise ShapeError("MJCF export of friction at the motors needs the classical law")
         jt = drive_joint_terms(
-            d.transmission,
-            d.rotor_inertia,
-            None if law is None else np.asarray(law.fv),
-            None if law is None else np.asarray(law.fc),
-            friction_at_motor=d.friction_at == "motor",
+            d.transmission, d.rotor_inertia, None, None, friction_at_motor=d.friction_at == "motor"
         )
         notes = jt.notes
         armature = jt.armature if d.rotor_inertia is not None else None
-        if law is not None:
-            z = np.zeros(n)
-            approx = CoulombViscous(jt.frictionloss, jt.damping, np.asarray(law.fo), z, z)
+        if isinstance(friction, DriveFriction):
+            d.check(friction.n)
+            approx, more = _law_terms(friction, robot.dq_max)
+            notes += more
         elif friction is True and robot.friction is not None:
             approx = coulomb_viscous_from_sigmoid(robot.friction, robot.dq_max)
         for note in notes:
             warnings.warn(f"MJCF export: {note}", DynidWarning, stacklevel=2)
-    elif isinstance(friction, ClassicalFriction):
+    elif not isinstance(friction, bool):
         if friction.n != n:
             raise ShapeError(f"friction has {friction.n} joints; robot {robot.name!r} has {n}")
-        z = np.zeros(n)
-        approx = CoulombViscous(
-            np.asarray(friction.fc), np.asarray(friction.fv), np.asarray(friction.fo), z, z
-        )
+        approx, notes = _law_terms(friction, robot.dq_max)
+        for note in notes:
+            warnings.warn(f"MJCF export: {note}", DynidWarning, stacklevel=2)
     elif friction and robot.friction is not None:
         approx = coulomb_viscous_from_sigmoid(robot.friction, robot.dq_max)
     I6 = inertia6_from_matrix(robot.inertia)[:, [0, 3, 5, 1, 2, 4]]  # xx yy zz xy xz yz
@@ -143,7 +159,7 @@ def mjcf_from_robot(
             "; friction: Coulomb as frictionloss, viscous as damping"
             + (
                 " (fit of the sigmoid)"
-                if not isinstance(friction, ClassicalFriction | DriveFriction)
+                if isinstance(friction, bool)
                 else " (reflected from the motors)"
                 if isinstance(friction, DriveFriction)
                 else ""
@@ -212,7 +228,7 @@ def save_mjcf(
     path: str | Path,
     robot: Robot,
     *,
-    friction: bool | ClassicalFriction | DriveFriction = True,
+    friction: bool | FrictionModel = True,
     drive: Drive | None = None,
 ) -> Path:
     """Write :func:`mjcf_from_robot` to ``path``; returns the path."""
