@@ -195,26 +195,33 @@ def _rnea_sample(C, A, dq, ddq, oq, ov, oa, tau, S):
             tau[oq + i] = N[0] * ex + N[1] * ey + N[2] * ez
 
 
-@jit
-def rnea(C, q, dq, ddq, tau):
-    """Joint torques into ``tau`` (B n,) for q (B n,), dq and ddq (B n,) or (n,); ``ok``."""
+@inline
+def _rnea_few(C, q, dq, ddq, tau, sv, sa):
+    """:func:`rnea` for a few samples: the scalar recursion per sample, no block scratch."""
     n = C.shape[0] - 1
     B = q.shape[0] // n
-    sv, sa = dq.shape[0] == q.shape[0], ddq.shape[0] == q.shape[0]  # else one row for all
-    if B < SMALL:  # a few samples: scalar recursion, no block scratch
-        S = np.empty((n, 21))
-        A = np.empty((3, n))
-        for b in range(B):
-            ov, oa = b * n if sv else 0, b * n if sa else 0
-            ok = angles(C, q, b * n, A)
-            if not (ok and finite(dq, ov, n) and finite(ddq, oa, n)):
-                return False
-            _rnea_sample(C, A, dq, ddq, b * n, ov, oa, tau, S)
-        return True
-    # the block length is a compile-time constant, so the row stride of X is known and the
-    # sample loops vectorise without run-time aliasing checks
+    S = np.empty((n, 21))
+    A = np.empty((3, n))
+    for b in range(B):
+        ov, oa = b * n if sv else 0, b * n if sa else 0
+        ok = angles(C, q, b * n, A)
+        if not (ok and finite(dq, ov, n) and finite(ddq, oa, n)):
+            return False
+        _rnea_sample(C, A, dq, ddq, b * n, ov, oa, tau, S)
+    return True
+
+
+@inline
+def _block_scratch(C):
+    """The block scratch ``X`` (n + 2, rows, BLOCK) with the base and the virtual last link.
+
+    The base (link 0) is at rest, accelerating at ``-g``; the virtual link ``n + 1`` is the
+    identity and carries no wrench. The block length is a compile-time constant, so the
+    row stride of X is known and the sample loops vectorise without run-time aliasing
+    checks.
+    """
+    n = C.shape[0] - 1
     X = np.empty((n + 2, _ROWS, BLOCK))
-    # base (link 0): at rest, accelerating at -g; virtual link n + 1: identity, no wrench
     X[0, _W : _A + 3] = 0.0
     X[0, _A] = -C[n, 0]
     X[0, _A + 1] = -C[n, 1]
@@ -223,116 +230,153 @@ def rnea(C, q, dq, ddq, tau):
     X[n + 1, _R] = 1.0
     X[n + 1, _R + 4] = 1.0
     X[n + 1, _R + 8] = 1.0
+    return X
+
+
+@inline
+def _load_block(C, q, dq, ddq, sv, sa, b0, nb, X):
+    """Samples ``b0 .. b0 + nb`` into ``X`` (q, dq, ddq, sin q, cos q); False if not finite."""
+    n = C.shape[0] - 1
+    big = False
+    for k in range(nb):
+        b = b0 + k
+        for i in range(n):
+            x = q[b * n + i]
+            v = dq[b * n + i if sv else i]
+            a = ddq[b * n + i if sa else i]
+            if not (math.isfinite(x) and math.isfinite(v) and math.isfinite(a)):
+                return False
+            big = big or abs(x) > _SINCOS_MAX
+            X[i + 1, _Q, k] = x
+            X[i + 1, _V, k] = v
+            X[i + 1, _AC, k] = a
+    for l in range(1, n + 1):
+        if C[l - 1, C_PRISMATIC] != 0.0:
+            for k in range(nb):
+                X[l, _S, k] = 0.0
+                X[l, _C, k] = 1.0
+        elif big:
+            for k in range(nb):
+                X[l, _S, k] = math.sin(X[l, _Q, k])
+                X[l, _C, k] = math.cos(X[l, _Q, k])
+        else:
+            for k in range(nb):
+                s, c = _sincos(X[l, _Q, k])
+                X[l, _S, k] = s
+                X[l, _C, k] = c
+    return True
+
+
+@inline
+def _outward_block(C, nb, X):
+    """Outward pass over a block: link ``l``'s pose in its parent and its motion."""
+    n = C.shape[0] - 1
+    for l in range(1, n + 1):
+        i = l - 1
+        ax, ay, az = C[i, C_AXIS], C[i, C_AXIS + 1], C[i, C_AXIS + 2]
+        ep = C[i, C_PRISMATIC]
+        F = fixed(C, i)  # constants out of the sample loop (it vectorises)
+        for k in range(nb):
+            # pose of link l in link l - 1 (the chain core's joint transform)
+            r00, r01, r02, r10, r11, r12, r20, r21, r22, px, py, pz = joint_from(
+                F, X[l, _S, k], X[l, _C, k], ep * X[l, _Q, k]
+            )
+            X[l, _R, k] = r00
+            X[l, _R + 1, k] = r01
+            X[l, _R + 2, k] = r02
+            X[l, _R + 3, k] = r10
+            X[l, _R + 4, k] = r11
+            X[l, _R + 5, k] = r12
+            X[l, _R + 6, k] = r20
+            X[l, _R + 7, k] = r21
+            X[l, _R + 8, k] = r22
+            X[l, _P, k] = px
+            X[l, _P + 1, k] = py
+            X[l, _P + 2, k] = pz
+            M = motion(
+                (r00, r01, r02, r10, r11, r12, r20, r21, r22, px, py, pz),
+                (X[i, _W, k], X[i, _W + 1, k], X[i, _W + 2, k]),
+                (X[i, _DW, k], X[i, _DW + 1, k], X[i, _DW + 2, k]),
+                (X[i, _A, k], X[i, _A + 1, k], X[i, _A + 2, k]),
+                ax,
+                ay,
+                az,
+                ep,
+                X[l, _V, k],
+                X[l, _AC, k],
+            )
+            X[l, _W, k] = M[0]
+            X[l, _W + 1, k] = M[1]
+            X[l, _W + 2, k] = M[2]
+            X[l, _DW, k] = M[3]
+            X[l, _DW + 1, k] = M[4]
+            X[l, _DW + 2, k] = M[5]
+            X[l, _A, k] = M[6]
+            X[l, _A + 1, k] = M[7]
+            X[l, _A + 2, k] = M[8]
+
+
+@inline
+def _inward_block(C, nb, X):
+    """Inward pass over a block: the wrench on link ``l`` and its children, about origin
+    ``l`` in link-``l`` coordinates, and the joint torque."""
+    n = C.shape[0] - 1
+    for l in range(n, 0, -1):
+        i = l - 1
+        ax, ay, az = C[i, C_AXIS], C[i, C_AXIS + 1], C[i, C_AXIS + 2]
+        ep = C[i, C_PRISMATIC]
+        er = 1.0 - ep
+        c = l + 1
+        phi = inertial(C, i)  # constants out of the sample loop (it vectorises)
+        for k in range(nb):
+            f = wrench(
+                phi,
+                (X[l, _W, k], X[l, _W + 1, k], X[l, _W + 2, k]),
+                (X[l, _DW, k], X[l, _DW + 1, k], X[l, _DW + 2, k]),
+                (X[l, _A, k], X[l, _A + 1, k], X[l, _A + 2, k]),
+            )
+            # plus the child's wrench carried into this frame
+            W = carry(
+                (
+                    X[c, _R, k], X[c, _R + 1, k], X[c, _R + 2, k],
+                    X[c, _R + 3, k], X[c, _R + 4, k], X[c, _R + 5, k],
+                    X[c, _R + 6, k], X[c, _R + 7, k], X[c, _R + 8, k],
+                    X[c, _P, k], X[c, _P + 1, k], X[c, _P + 2, k],
+                ),
+                (X[c, _F, k], X[c, _F + 1, k], X[c, _F + 2, k]),
+                (X[c, _N, k], X[c, _N + 1, k], X[c, _N + 2, k]),
+            )  # fmt: skip
+            Fx, Fy, Fz = f[0] + W[0], f[1] + W[1], f[2] + W[2]
+            Nx, Ny, Nz = f[3] + W[3], f[4] + W[4], f[5] + W[5]
+            X[l, _F, k] = Fx
+            X[l, _F + 1, k] = Fy
+            X[l, _F + 2, k] = Fz
+            X[l, _N, k] = Nx
+            X[l, _N + 1, k] = Ny
+            X[l, _N + 2, k] = Nz
+            X[l, _TAU, k] = ep * (Fx * ax + Fy * ay + Fz * az) + er * (Nx * ax + Ny * ay + Nz * az)
+
+
+@jit
+def rnea(C, q, dq, ddq, tau):
+    """Joint torques into ``tau`` (B n,) for q (B n,), dq and ddq (B n,) or (n,); ``ok``.
+
+    A few samples: :func:`_rnea_few`; more: blocks of ``BLOCK`` samples in the scratch
+    ``X`` (:func:`_block_scratch`): :func:`_load_block`, :func:`_outward_block`,
+    :func:`_inward_block`, then the torques out.
+    """
+    n = C.shape[0] - 1
+    B = q.shape[0] // n
+    sv, sa = dq.shape[0] == q.shape[0], ddq.shape[0] == q.shape[0]  # else one row for all
+    if B < SMALL:
+        return _rnea_few(C, q, dq, ddq, tau, sv, sa)
+    X = _block_scratch(C)
     for b0 in range(0, B, BLOCK):
         nb = min(BLOCK, B - b0)
-        big = False
-        for k in range(nb):
-            b = b0 + k
-            for i in range(n):
-                x = q[b * n + i]
-                v = dq[b * n + i if sv else i]
-                a = ddq[b * n + i if sa else i]
-                if not (math.isfinite(x) and math.isfinite(v) and math.isfinite(a)):
-                    return False
-                big = big or abs(x) > _SINCOS_MAX
-                X[i + 1, _Q, k] = x
-                X[i + 1, _V, k] = v
-                X[i + 1, _AC, k] = a
-        for l in range(1, n + 1):
-            if C[l - 1, C_PRISMATIC] != 0.0:
-                for k in range(nb):
-                    X[l, _S, k] = 0.0
-                    X[l, _C, k] = 1.0
-            elif big:
-                for k in range(nb):
-                    X[l, _S, k] = math.sin(X[l, _Q, k])
-                    X[l, _C, k] = math.cos(X[l, _Q, k])
-            else:
-                for k in range(nb):
-                    s, c = _sincos(X[l, _Q, k])
-                    X[l, _S, k] = s
-                    X[l, _C, k] = c
-        # outward pass: link l from its parent l - 1
-        for l in range(1, n + 1):
-            i = l - 1
-            ax, ay, az = C[i, C_AXIS], C[i, C_AXIS + 1], C[i, C_AXIS + 2]
-            ep = C[i, C_PRISMATIC]
-            F = fixed(C, i)  # constants out of the sample loop (it vectorises)
-            for k in range(nb):
-                # pose of link l in link l - 1 (the chain core's joint transform)
-                r00, r01, r02, r10, r11, r12, r20, r21, r22, px, py, pz = joint_from(
-                    F, X[l, _S, k], X[l, _C, k], ep * X[l, _Q, k]
-                )
-                X[l, _R, k] = r00
-                X[l, _R + 1, k] = r01
-                X[l, _R + 2, k] = r02
-                X[l, _R + 3, k] = r10
-                X[l, _R + 4, k] = r11
-                X[l, _R + 5, k] = r12
-                X[l, _R + 6, k] = r20
-                X[l, _R + 7, k] = r21
-                X[l, _R + 8, k] = r22
-                X[l, _P, k] = px
-                X[l, _P + 1, k] = py
-                X[l, _P + 2, k] = pz
-                M = motion(
-                    (r00, r01, r02, r10, r11, r12, r20, r21, r22, px, py, pz),
-                    (X[i, _W, k], X[i, _W + 1, k], X[i, _W + 2, k]),
-                    (X[i, _DW, k], X[i, _DW + 1, k], X[i, _DW + 2, k]),
-                    (X[i, _A, k], X[i, _A + 1, k], X[i, _A + 2, k]),
-                    ax,
-                    ay,
-                    az,
-                    ep,
-                    X[l, _V, k],
-                    X[l, _AC, k],
-                )
-                X[l, _W, k] = M[0]
-                X[l, _W + 1, k] = M[1]
-                X[l, _W + 2, k] = M[2]
-                X[l, _DW, k] = M[3]
-                X[l, _DW + 1, k] = M[4]
-                X[l, _DW + 2, k] = M[5]
-                X[l, _A, k] = M[6]
-                X[l, _A + 1, k] = M[7]
-                X[l, _A + 2, k] = M[8]
-        # inward pass: wrench on link l and its children, about origin l, link-l coordinates
-        for l in range(n, 0, -1):
-            i = l - 1
-            ax, ay, az = C[i, C_AXIS], C[i, C_AXIS + 1], C[i, C_AXIS + 2]
-            ep = C[i, C_PRISMATIC]
-            er = 1.0 - ep
-            c = l + 1
-            phi = inertial(C, i)  # constants out of the sample loop (it vectorises)
-            for k in range(nb):
-                f = wrench(
-                    phi,
-                    (X[l, _W, k], X[l, _W + 1, k], X[l, _W + 2, k]),
-                    (X[l, _DW, k], X[l, _DW + 1, k], X[l, _DW + 2, k]),
-                    (X[l, _A, k], X[l, _A + 1, k], X[l, _A + 2, k]),
-                )
-                # plus the child's wrench carried into this frame
-                W = carry(
-                    (
-                        X[c, _R, k], X[c, _R + 1, k], X[c, _R + 2, k],
-                        X[c, _R + 3, k], X[c, _R + 4, k], X[c, _R + 5, k],
-                        X[c, _R + 6, k], X[c, _R + 7, k], X[c, _R + 8, k],
-                        X[c, _P, k], X[c, _P + 1, k], X[c, _P + 2, k],
-                    ),
-                    (X[c, _F, k], X[c, _F + 1, k], X[c, _F + 2, k]),
-                    (X[c, _N, k], X[c, _N + 1, k], X[c, _N + 2, k]),
-                )  # fmt: skip
-                Fx, Fy, Fz = f[0] + W[0], f[1] + W[1], f[2] + W[2]
-                Nx, Ny, Nz = f[3] + W[3], f[4] + W[4], f[5] + W[5]
-                X[l, _F, k] = Fx
-                X[l, _F + 1, k] = Fy
-                X[l, _F + 2, k] = Fz
-                X[l, _N, k] = Nx
-                X[l, _N + 1, k] = Ny
-                X[l, _N + 2, k] = Nz
-                X[l, _TAU, k] = ep * (Fx * ax + Fy * ay + Fz * az) + er * (
-                    Nx * ax + Ny * ay + Nz * az
-                )
+        if not _load_block(C, q, dq, ddq, sv, sa, b0, nb, X):
+            return False
+        _outward_block(C, nb, X)
+        _inward_block(C, nb, X)
         for k in range(nb):
             for i in range(n):
                 tau[(b0 + k) * n + i] = X[i + 1, _TAU, k]

@@ -151,6 +151,231 @@ def _rhs(Jf, e, nf, d, bvec):
 
 
 @inline
+def _transfer_step(q, target, dq, m, dt, use_vmax, inv_vmax, q_min, q_max):
+    """One step towards the restart configuration ``target`` at the velocity limits; True
+    when it is reached (``q`` is then ``target``)."""
+    ratio = 0.0
+    for j in range(m):
+        dq[j] = (target[j] - q[j]) / dt
+        if use_vmax:
+            ratio = max(ratio, abs(dq[j]) * inv_vmax[j])
+    if ratio <= 1.0:
+        for j in range(m):
+            q[j] = target[j]
+        return True
+    for j in range(m):
+        q[j] = min(max(q[j] + (dt / ratio) * dq[j], q_min[j]), q_max[j])
+    return False
+
+
+@inline
+def _pose_error(C, m, q, Aq, Jflat, Te, M, p_goal, R_goal, e):
+    """Pose error ``e`` (6,) of the frame at ``q`` in the base frame, and its Jacobian.
+
+    The frame pose ``Te`` and the Jacobian (into ``Jflat``, (6, m)) come from the chain
+    core's kernels; ``e`` is the position error, then the angle-axis vector of
+    ``R_goal Te^T`` (as :func:`dynid.kinematics._ik_numpy.rotvec`). Returns the position
+    and orientation errors [m, rad].
+    """
+    angles(C, q, 0, Aq)
+    P = frame_jacobian(C, Aq, m, Jflat, 0, m)
+    f = C.shape[0] - 1
+    for r in range(3):
+        a0, a1, a2, a3 = P[3 * r], P[3 * r + 1], P[3 * r + 2], P[9 + r]
+        for col in range(4):
+            Te[r, col] = (
+                a0 * C[f, col] + a1 * C[f, 4 + col] + a2 * C[f, 8 + col] + a3 * C[f, 12 + col]
+            )
+    for r in range(3):
+        e[r] = p_goal[r] - Te[r, 3]
+    for r in range(3):
+        for col in range(3):
+            M[r, col] = (
+                R_goal[r, 0] * Te[col, 0] + R_goal[r, 1] * Te[col, 1] + R_goal[r, 2] * Te[col, 2]
+            )
+    vx, vy, vz = 0.5 * (M[2, 1] - M[1, 2]), 0.5 * (M[0, 2] - M[2, 0]), 0.5 * (M[1, 0] - M[0, 1])
+    cs = min(1.0, max(-1.0, 0.5 * (M[0, 0] + M[1, 1] + M[2, 2] - 1.0)))
+    sn = math.sqrt(vx * vx + vy * vy + vz * vz)
+    theta = math.atan2(sn, cs)
+    if cs > -0.9:
+        g = theta / sn if sn > 1e-12 else 1.0 + theta * theta / 6.0
+        e[3], e[4], e[5] = g * vx, g * vy, g * vz
+    else:
+        w = 1.0 / (1.0 - cs)
+        dx, dy, dz = (M[0, 0] - cs) * w, (M[1, 1] - cs) * w, (M[2, 2] - cs) * w
+        sxy, sxz = 0.5 * (M[0, 1] + M[1, 0]) * w, 0.5 * (M[0, 2] + M[2, 0]) * w
+        syz = 0.5 * (M[1, 2] + M[2, 1]) * w
+        if dx >= dy and dx >= dz:
+            ux, uy, uz = dx, sxy, sxz
+        elif dy >= dz:
+            ux, uy, uz = sxy, dy, syz
+        else:
+            ux, uy, uz = sxz, syz, dz
+        norm = math.sqrt(ux * ux + uy * uy + uz * uz)
+        if ux * vx + uy * vy + uz * vz < -1e-12 * norm:  # as in _ik_numpy.rotvec
+            norm = -norm
+        e[3], e[4], e[5] = theta * ux / norm, theta * uy / norm, theta * uz / norm
+    err_p = math.sqrt(e[0] * e[0] + e[1] * e[1] + e[2] * e[2])
+    if err_p > 1e150:  # a goal absurdly far: the squares overflow, scale them
+        big = max(abs(e[0]), abs(e[1]), abs(e[2]))
+        err_p = big * math.sqrt((e[0] / big) ** 2 + (e[1] / big) ** 2 + (e[2] / big) ** 2)
+    return err_p, theta
+
+
+@inline
+def _gram(Jf, nf, d, G, V):
+    """The Gram matrix ``G`` (``Jf Jf^T`` if ``nf >= 6``, else ``Jf^T Jf``; d x d) of the
+    free columns, ``V = E``; returns the squared Frobenius norm of ``G``."""
+    tot = 0.0
+    for a in range(d):  # G is symmetric: the upper triangle, mirrored
+        for b in range(a, d):
+            acc = 0.0
+            if nf >= 6:
+                for t in range(nf):
+                    acc += Jf[a, t] * Jf[b, t]
+            else:
+                for t in range(6):
+                    acc += Jf[t, a] * Jf[t, b]
+            G[a, b] = acc
+            G[b, a] = acc
+            V[a, b] = 1.0 if a == b else 0.0
+            V[b, a] = V[a, b]
+            tot += acc * acc if a == b else 2.0 * acc * acc
+    return tot
+
+
+@inline
+def _jacobi(G, V, d, tot):
+    """Cyclic Jacobi rotations: ``G`` becomes ``diag(w)`` and ``V`` its eigenvectors."""
+    for _sweep in range(50):
+        off = 0.0
+        for a in range(d - 1):
+            for b in range(a + 1, d):
+                off += G[a, b] * G[a, b]
+        if off <= 1e-30 * tot:
+            break
+        for a in range(d - 1):
+            for b in range(a + 1, d):
+                gab = G[a, b]
+                if gab == 0.0:
+                    continue
+                th = (G[b, b] - G[a, a]) / (2.0 * gab)
+                t = 1.0 / (abs(th) + math.sqrt(th * th + 1.0))
+                if th < 0.0:
+                    t = -t
+                c = 1.0 / math.sqrt(t * t + 1.0)
+                sn = t * c
+                for r in range(d):
+                    g1, g2 = G[r, a], G[r, b]
+                    G[r, a], G[r, b] = c * g1 - sn * g2, sn * g1 + c * g2
+                for r in range(d):
+                    g1, g2 = G[a, r], G[b, r]
+                    G[a, r], G[b, r] = c * g1 - sn * g2, sn * g1 + c * g2
+                for r in range(d):
+                    g1, g2 = V[r, a], V[r, b]
+                    V[r, a], V[r, b] = c * g1 - sn * g2, sn * g1 + c * g2
+
+
+@inline
+def _dls_free(Jf, nf, e, m, free, lam, eps, err, e_damp, S, dq):
+    """The damped least-squares step ``J^# e`` of the ``nf > 0`` free joints into ``dq``.
+
+    ``Jf`` holds the free columns of ``J``; scratch ``S`` = ``(G, V, L, A6, w6, o6, bvec,
+    y)``. See :func:`_solve` for the two ways of solving it.
+    """
+    G, V, L, A6, w6, o6, bvec, y = S
+    d = 6 if nf >= 6 else nf
+    tot = _gram(Jf, nf, d, G, V)
+    # the smallest eigenvalue w_min = s_min^2 of G decides the damping: none when a
+    # Cholesky factorisation of G - eps^2 E succeeds, else from the QL eigenvalues; then
+    # a Cholesky solve of (G + lambda^2 E) y = b
+    if cholesky(G, d, eps * eps, L):
+        fast = cholesky(G, d, 0.0, L)
+    else:
+        s_min = math.sqrt(max(_min_eigenvalue(G, d, A6, w6, o6), 0.0))
+        lam2 = _damping(s_min, eps, lam, err, e_damp)
+        fast = lam2 > 0.0 and cholesky(G, d, -lam2, L)
+    if fast:
+        _rhs(Jf, e, nf, d, bvec)
+        cholesky_solve(L, d, bvec, y)
+        col = 0
+        for j in range(m):
+            if free[j]:
+                acc = 0.0
+                if nf >= 6:  # dq = J^T y
+                    for r in range(6):
+                        acc += Jf[r, col] * y[r]
+                else:  # dq = y
+                    acc = y[col]
+                dq[j] = acc
+                col += 1
+        return
+    # J^# e from the eigen-decomposition G = V diag(w) V^T (cyclic Jacobi rotations)
+    _jacobi(G, V, d, tot)
+    w_max, w_min = 0.0, np.inf
+    for a in range(d):
+        w_max = max(w_max, G[a, a])
+        w_min = min(w_min, G[a, a])
+    s_min = math.sqrt(max(w_min, 0.0))
+    lam2 = _damping(s_min, eps, lam, err, e_damp)
+    cut = 1e-24 * w_max
+    _rhs(Jf, e, nf, d, bvec)
+    for a in range(d):  # y = diag(1 / (w + lam^2)) V^T b, zero where w <= cut
+        acc = 0.0
+        for r in range(d):
+            acc += V[r, a] * bvec[r]
+        y[a] = acc / (G[a, a] + lam2) if G[a, a] > cut else 0.0
+    col = 0
+    for j in range(m):
+        if free[j]:
+            acc = 0.0
+            if nf >= 6:  # dq = J^T V y
+                for r in range(6):
+                    vy = 0.0
+                    for a in range(d):
+                        vy += V[r, a] * y[a]
+                    acc += Jf[r, col] * vy
+            else:  # dq = V y
+                for a in range(d):
+                    acc += V[col, a] * y[a]
+            dq[j] = acc
+            col += 1
+
+
+@inline
+def _step(J, e, m, q, q_min, q_max, lam, eps, err, e_damp, free, Jf, S, dq):
+    """The damped least-squares velocity ``dq`` (m,) with the active set of the joint
+    limits: a joint resting on a limit that the step pushes further out is frozen, and the
+    step is solved again without it."""
+    for j in range(m):
+        free[j] = True
+    for _ in range(m + 1):
+        nf = 0
+        for j in range(m):
+            if free[j]:
+                nf += 1
+        for j in range(m):
+            dq[j] = 0.0
+        if nf > 0:
+            col = 0
+            for j in range(m):
+                if free[j]:
+                    for r in range(6):
+                        Jf[r, col] = J[r, j]
+                    col += 1
+            _dls_free(Jf, nf, e, m, free, lam, eps, err, e_damp, S, dq)
+        pushed = False
+        for j in range(m):
+            if free[j] and (
+                (q[j] <= q_min[j] and dq[j] < 0.0) or (q[j] >= q_max[j] and dq[j] > 0.0)
+            ):
+                free[j] = False
+                pushed = True
+        if not pushed:
+            break
+
+
+@inline
 def _solve(C, m, q_min, q_max, inv_vmax, q_restart, goal, fpar, ipar, path, keep, q_best):
     """The simulation loop for one goal; see :func:`dynid.kinematics._ik_numpy.solve_numpy`.
 
@@ -162,11 +387,14 @@ def _solve(C, m, q_min, q_max, inv_vmax, q_restart, goal, fpar, ipar, path, keep
     converged, restarts, need_restarts)``; ``need_restarts`` asks the caller to run again
     with the ``max_restarts`` configurations in ``q_restart`` (drawn only when needed).
 
-    The damped least-squares step: when the Gram matrix ``G`` (``J J^T`` if 6 or more
-    joints are free, else ``J^T J``) has all eigenvalues above ``eps^2`` (a Cholesky
-    factorisation of ``G - eps^2 E`` succeeds), no damping applies and the step is solved
-    by a Cholesky factorisation of ``G``; otherwise from the eigen-decomposition
-    ``G = V diag(w) V^T`` (cyclic Jacobi rotations) with the damping of ``s_min``:
+    Each step: the pose error (:func:`_pose_error`), the damped least-squares velocity with
+    the joint limits' active set (:func:`_step`), or a step of the move to a restart
+    configuration (:func:`_transfer_step`). The damped least-squares step
+    (:func:`_dls_free`): when the Gram matrix ``G`` (``J J^T`` if 6 or more joints are
+    free, else ``J^T J``) has all eigenvalues above ``eps^2`` (a Cholesky factorisation of
+    ``G - eps^2 E`` succeeds), no damping applies and the step is solved by a Cholesky
+    factorisation of ``G``; otherwise from the eigen-decomposition ``G = V diag(w) V^T``
+    (cyclic Jacobi rotations) with the damping of ``s_min``:
     ``J^# e = J^T V (W + lambda^2)^-1 V^T e`` or ``V (W + lambda^2)^-1 V^T J^T e``, the same
     step as the SVD form of the numpy loop.
     """
@@ -187,20 +415,16 @@ def _solve(C, m, q_min, q_max, inv_vmax, q_restart, goal, fpar, ipar, path, keep
     Aq = np.empty((3, m))
     Jflat = np.empty(6 * m)
     J = Jflat.reshape(6, m)
-    L = np.empty((6, 6))
-    A6 = np.empty((6, 6))
-    w6 = np.empty(6)
-    o6 = np.empty(6)
+    S = (
+        np.empty((6, 6)), np.empty((6, 6)), np.empty((6, 6)), np.empty((6, 6)),
+        np.empty(6), np.empty(6), np.empty(6), np.empty(6),
+    )  # fmt: skip
     e = np.empty(6)
     M = np.empty((3, 3))
     dq = np.zeros(m)
     free = np.empty(m, dtype=np.bool_)
     target = np.empty(m)
     Jf = np.empty((6, m))
-    G = np.empty((6, 6))
-    V = np.empty((6, 6))
-    bvec = np.empty(6)
-    y = np.empty(6)
     k = 0
     best_k = 0
     best_err = np.inf
@@ -213,20 +437,10 @@ def _solve(C, m, q_min, q_max, inv_vmax, q_restart, goal, fpar, ipar, path, keep
     transfer = False
     while True:
         if transfer:
-            ratio = 0.0
-            for j in range(m):
-                dq[j] = (target[j] - q[j]) / dt
-                if use_vmax:
-                    ratio = max(ratio, abs(dq[j]) * inv_vmax[j])
-            if ratio <= 1.0:
-                for j in range(m):
-                    q[j] = target[j]
+            if _transfer_step(q, target, dq, m, dt, use_vmax, inv_vmax, q_min, q_max):
                 transfer = False
                 ref = np.inf
                 k_ref = k + 1
-            else:
-                for j in range(m):
-                    q[j] = min(max(q[j] + (dt / ratio) * dq[j], q_min[j]), q_max[j])
             k += 1
             if keep:
                 for j in range(n):
@@ -234,53 +448,7 @@ def _solve(C, m, q_min, q_max, inv_vmax, q_restart, goal, fpar, ipar, path, keep
             if k >= max_iter:
                 break
             continue
-        # frame pose Te and geometric Jacobian of its origin (the chain core's kernels)
-        angles(C, q, 0, Aq)
-        P = frame_jacobian(C, Aq, m, Jflat, 0, m)
-        f = C.shape[0] - 1
-        for r in range(3):
-            a0, a1, a2, a3 = P[3 * r], P[3 * r + 1], P[3 * r + 2], P[9 + r]
-            for col in range(4):
-                Te[r, col] = (
-                    a0 * C[f, col] + a1 * C[f, 4 + col] + a2 * C[f, 8 + col] + a3 * C[f, 12 + col]
-                )
-        # pose error in the base frame: position, then angle-axis of R_goal Te^T
-        for r in range(3):
-            e[r] = p_goal[r] - Te[r, 3]
-        for r in range(3):
-            for col in range(3):
-                M[r, col] = (
-                    R_goal[r, 0] * Te[col, 0]
-                    + R_goal[r, 1] * Te[col, 1]
-                    + R_goal[r, 2] * Te[col, 2]
-                )
-        vx, vy, vz = 0.5 * (M[2, 1] - M[1, 2]), 0.5 * (M[0, 2] - M[2, 0]), 0.5 * (M[1, 0] - M[0, 1])
-        cs = min(1.0, max(-1.0, 0.5 * (M[0, 0] + M[1, 1] + M[2, 2] - 1.0)))
-        sn = math.sqrt(vx * vx + vy * vy + vz * vz)
-        theta = math.atan2(sn, cs)
-        if cs > -0.9:
-            f = theta / sn if sn > 1e-12 else 1.0 + theta * theta / 6.0
-            e[3], e[4], e[5] = f * vx, f * vy, f * vz
-        else:
-            w = 1.0 / (1.0 - cs)
-            dx, dy, dz = (M[0, 0] - cs) * w, (M[1, 1] - cs) * w, (M[2, 2] - cs) * w
-            sxy, sxz = 0.5 * (M[0, 1] + M[1, 0]) * w, 0.5 * (M[0, 2] + M[2, 0]) * w
-            syz = 0.5 * (M[1, 2] + M[2, 1]) * w
-            if dx >= dy and dx >= dz:
-                ux, uy, uz = dx, sxy, sxz
-            elif dy >= dz:
-                ux, uy, uz = sxy, dy, syz
-            else:
-                ux, uy, uz = sxz, syz, dz
-            norm = math.sqrt(ux * ux + uy * uy + uz * uz)
-            if ux * vx + uy * vy + uz * vz < -1e-12 * norm:  # as in _ik_numpy.rotvec
-                norm = -norm
-            e[3], e[4], e[5] = theta * ux / norm, theta * uy / norm, theta * uz / norm
-        err_o = theta
-        err_p = math.sqrt(e[0] * e[0] + e[1] * e[1] + e[2] * e[2])
-        if err_p > 1e150:  # a goal absurdly far: the squares overflow, scale them
-            big = max(abs(e[0]), abs(e[1]), abs(e[2]))
-            err_p = big * math.sqrt((e[0] / big) ** 2 + (e[1] / big) ** 2 + (e[2] / big) ** 2)
+        err_p, err_o = _pose_error(C, m, q, Aq, Jflat, Te, M, p_goal, R_goal, e)
         err = math.sqrt(err_p * err_p + err_o * err_o) if err_p < 1e150 else err_p
         done = err_p <= tol_p and err_o <= tol_o
         if done or err < best_err:
@@ -311,129 +479,7 @@ def _solve(C, m, q_min, q_max, inv_vmax, q_restart, goal, fpar, ipar, path, keep
         if err_o > step_o:
             for r in range(3, 6):
                 e[r] *= step_o / err_o
-        # damped least squares with the active set of the joint limits
-        for j in range(m):
-            free[j] = True
-        for _ in range(m + 1):
-            nf = 0
-            for j in range(m):
-                if free[j]:
-                    nf += 1
-            for j in range(m):
-                dq[j] = 0.0
-            if nf > 0:
-                # J^# e from the eigen-decomposition G = V diag(w) V^T of the smaller Gram
-                # matrix (J J^T if nf >= 6, else J^T J; w = s^2), by cyclic Jacobi rotations
-                col = 0
-                for j in range(m):
-                    if free[j]:
-                        for r in range(6):
-                            Jf[r, col] = J[r, j]
-                        col += 1
-                d = 6 if nf >= 6 else nf
-                tot = 0.0
-                for a in range(d):  # G is symmetric: the upper triangle, mirrored
-                    for b in range(a, d):
-                        acc = 0.0
-                        if nf >= 6:
-                            for t in range(nf):
-                                acc += Jf[a, t] * Jf[b, t]
-                        else:
-                            for t in range(6):
-                                acc += Jf[t, a] * Jf[t, b]
-                        G[a, b] = acc
-                        G[b, a] = acc
-                        V[a, b] = 1.0 if a == b else 0.0
-                        V[b, a] = V[a, b]
-                        tot += acc * acc if a == b else 2.0 * acc * acc
-                # the smallest eigenvalue w_min = s_min^2 of G decides the damping: none when
-                # a Cholesky factorisation of G - eps^2 E succeeds, else from the QL
-                # eigenvalues; then a Cholesky solve of (G + lambda^2 E) y = b
-                if cholesky(G, d, eps * eps, L):
-                    fast = cholesky(G, d, 0.0, L)
-                else:
-                    s_min = math.sqrt(max(_min_eigenvalue(G, d, A6, w6, o6), 0.0))
-                    lam2 = _damping(s_min, eps, lam, err, e_damp)
-                    fast = lam2 > 0.0 and cholesky(G, d, -lam2, L)
-                if fast:
-                    _rhs(Jf, e, nf, d, bvec)
-                    cholesky_solve(L, d, bvec, y)
-                    col = 0
-                    for j in range(m):
-                        if free[j]:
-                            acc = 0.0
-                            if nf >= 6:  # dq = J^T y
-                                for r in range(6):
-                                    acc += Jf[r, col] * y[r]
-                            else:  # dq = y
-                                acc = y[col]
-                            dq[j] = acc
-                            col += 1
-                else:
-                    for _sweep in range(50):
-                        off = 0.0
-                        for a in range(d - 1):
-                            for b in range(a + 1, d):
-                                off += G[a, b] * G[a, b]
-                        if off <= 1e-30 * tot:
-                            break
-                        for a in range(d - 1):
-                            for b in range(a + 1, d):
-                                gab = G[a, b]
-                                if gab == 0.0:
-                                    continue
-                                th = (G[b, b] - G[a, a]) / (2.0 * gab)
-                                t = 1.0 / (abs(th) + math.sqrt(th * th + 1.0))
-                                if th < 0.0:
-                                    t = -t
-                                c = 1.0 / math.sqrt(t * t + 1.0)
-                                sn = t * c
-                                for r in range(d):
-                                    g1, g2 = G[r, a], G[r, b]
-                                    G[r, a], G[r, b] = c * g1 - sn * g2, sn * g1 + c * g2
-                                for r in range(d):
-                                    g1, g2 = G[a, r], G[b, r]
-                                    G[a, r], G[b, r] = c * g1 - sn * g2, sn * g1 + c * g2
-                                for r in range(d):
-                                    g1, g2 = V[r, a], V[r, b]
-                                    V[r, a], V[r, b] = c * g1 - sn * g2, sn * g1 + c * g2
-                    w_max, w_min = 0.0, np.inf
-                    for a in range(d):
-                        w_max = max(w_max, G[a, a])
-                        w_min = min(w_min, G[a, a])
-                    s_min = math.sqrt(max(w_min, 0.0))
-                    lam2 = _damping(s_min, eps, lam, err, e_damp)
-                    cut = 1e-24 * w_max
-                    _rhs(Jf, e, nf, d, bvec)
-                    for a in range(d):  # y = diag(1 / (w + lam^2)) V^T b, zero where w <= cut
-                        acc = 0.0
-                        for r in range(d):
-                            acc += V[r, a] * bvec[r]
-                        y[a] = acc / (G[a, a] + lam2) if G[a, a] > cut else 0.0
-                    col = 0
-                    for j in range(m):
-                        if free[j]:
-                            acc = 0.0
-                            if nf >= 6:  # dq = J^T V y
-                                for r in range(6):
-                                    vy = 0.0
-                                    for a in range(d):
-                                        vy += V[r, a] * y[a]
-                                    acc += Jf[r, col] * vy
-                            else:  # dq = V y
-                                for a in range(d):
-                                    acc += V[col, a] * y[a]
-                            dq[j] = acc
-                            col += 1
-            pushed = False
-            for j in range(m):
-                if free[j] and (
-                    (q[j] <= q_min[j] and dq[j] < 0.0) or (q[j] >= q_max[j] and dq[j] > 0.0)
-                ):
-                    free[j] = False
-                    pushed = True
-            if not pushed:
-                break
+        _step(J, e, m, q, q_min, q_max, lam, eps, err, e_damp, free, Jf, S, dq)
         ratio = 0.0
         for j in range(m):
             dq[j] *= K

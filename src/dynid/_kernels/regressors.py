@@ -29,7 +29,7 @@ import math
 
 import numpy as np
 
-from .chain import IDENTITY, compose, finite, jit, joint, motion
+from .chain import IDENTITY, compose, finite, inline, jit, joint, motion
 from .layout import C_AXIS, C_PRISMATIC
 
 __all__ = ["BLOCK", "static_regressor"]
@@ -40,14 +40,153 @@ BLOCK = 128
 _JPAIR = np.array([[0, 0], [0, 1], [0, 2], [1, 1], [1, 2], [2, 2]], dtype=np.int64)
 
 
+@inline
+def _base_poses(C, q, b0, nb, Rb, ob, z):
+    """Base-frame rotation ``Rb``, origin ``ob`` and joint axis ``z`` of every link for the
+    samples ``b0 .. b0 + nb`` (sample index last); False if a ``q`` is not finite.
+
+    ``R_l = R_{l-1} R_{l-1,l}``, ``o_l = o_{l-1} + R_{l-1} p_{l-1,l}``.
+    """
+    n = C.shape[0] - 1
+    for kk in range(nb):
+        for i in range(n):
+            qi = q[(b0 + kk) * n + i]
+            if not math.isfinite(qi):
+                return False
+            ax, ay, az = C[i, C_AXIS], C[i, C_AXIS + 1], C[i, C_AXIS + 2]
+            a00, a01, a02, a10, a11, a12, a20, a21, a22, p0, p1, p2 = joint(C, i, qi)
+            if i == 0:
+                Rb[0, 0, kk], Rb[0, 1, kk], Rb[0, 2, kk] = a00, a01, a02
+                Rb[0, 3, kk], Rb[0, 4, kk], Rb[0, 5, kk] = a10, a11, a12
+                Rb[0, 6, kk], Rb[0, 7, kk], Rb[0, 8, kk] = a20, a21, a22
+                ob[0, 0, kk], ob[0, 1, kk], ob[0, 2, kk] = p0, p1, p2
+            else:
+                for a in range(3):
+                    P0 = Rb[i - 1, 3 * a, kk]
+                    P1 = Rb[i - 1, 3 * a + 1, kk]
+                    P2 = Rb[i - 1, 3 * a + 2, kk]
+                    ob[i, a, kk] = ob[i - 1, a, kk] + (P0 * p0 + P1 * p1 + P2 * p2)
+                    Rb[i, 3 * a, kk] = P0 * a00 + P1 * a10 + P2 * a20
+                    Rb[i, 3 * a + 1, kk] = P0 * a01 + P1 * a11 + P2 * a21
+                    Rb[i, 3 * a + 2, kk] = P0 * a02 + P1 * a12 + P2 * a22
+            for a in range(3):
+                z[i, a, kk] = (
+                    Rb[i, 3 * a, kk] * ax + Rb[i, 3 * a + 1, kk] * ay + Rb[i, 3 * a + 2, kk] * az
+                )
+    return True
+
+
+@inline
+def _link_columns(C, l, nb, Rb, ob, z, v, w, gl):
+    """Jacobian columns ``v[k]``, ``w[k]`` of the origin of link ``l`` for joints ``k <= l``
+    and the gravity ``gl``, all in link-``l`` coordinates, for a block of ``nb`` samples."""
+    n = C.shape[0] - 1
+    g0, g1, g2 = C[n, 0], C[n, 1], C[n, 2]
+    for k in range(l + 1):
+        pk = C[k, C_PRISMATIC] != 0.0
+        for kk in range(nb):
+            r00, r01, r02 = Rb[l, 0, kk], Rb[l, 1, kk], Rb[l, 2, kk]
+            r10, r11, r12 = Rb[l, 3, kk], Rb[l, 4, kk], Rb[l, 5, kk]
+            r20, r21, r22 = Rb[l, 6, kk], Rb[l, 7, kk], Rb[l, 8, kk]
+            zx, zy, zz = z[k, 0, kk], z[k, 1, kk], z[k, 2, kk]
+            if pk:
+                lx, ly, lz = zx, zy, zz
+                ux = uy = uz = 0.0
+            else:
+                px = ob[l, 0, kk] - ob[k, 0, kk]
+                py = ob[l, 1, kk] - ob[k, 1, kk]
+                pz = ob[l, 2, kk] - ob[k, 2, kk]
+                lx = zy * pz - zz * py
+                ly = zz * px - zx * pz
+                lz = zx * py - zy * px
+                ux, uy, uz = zx, zy, zz
+            v[k, 0, kk] = r00 * lx + r10 * ly + r20 * lz
+            v[k, 1, kk] = r01 * lx + r11 * ly + r21 * lz
+            v[k, 2, kk] = r02 * lx + r12 * ly + r22 * lz
+            w[k, 0, kk] = r00 * ux + r10 * uy + r20 * uz
+            w[k, 1, kk] = r01 * ux + r11 * uy + r21 * uz
+            w[k, 2, kk] = r02 * ux + r12 * uy + r22 * uz
+    for kk in range(nb):
+        gl[0, kk] = Rb[l, 0, kk] * g0 + Rb[l, 3, kk] * g1 + Rb[l, 6, kk] * g2
+        gl[1, kk] = Rb[l, 1, kk] * g0 + Rb[l, 4, kk] * g1 + Rb[l, 7, kk] * g2
+        gl[2, kk] = Rb[l, 2, kk] * g0 + Rb[l, 5, kk] * g1 + Rb[l, 8, kk] * g2
+
+
+@inline
+def _mass_rows(l, cols, b0, nb, v, w, Y):
+    """Link ``l``'s share of the rows of ``tril M``: pair ``(i, j)``, ``j <= i <= l``, at row
+    ``i (i + 1) / 2 + j`` (zero for ``i > l``), into the columns ``cols`` of ``Y``."""
+    c0 = 10 * l
+    for i in range(l + 1):
+        for j in range(i + 1):
+            row = i * (i + 1) // 2 + j
+            for e in range(10):
+                oc = cols[c0 + e]
+                if oc < 0:
+                    continue
+                out = Y[oc, row, b0 : b0 + nb]
+                if e == 0:
+                    for kk in range(nb):
+                        out[kk] = (
+                            v[i, 0, kk] * v[j, 0, kk]
+                            + v[i, 1, kk] * v[j, 1, kk]
+                            + v[i, 2, kk] * v[j, 2, kk]
+                        )
+                elif e <= 3:
+                    # (v_i x w_j + v_j x w_i) along axis e - 1
+                    a1 = e % 3  # the next two axes after e - 1, cyclically
+                    a2 = (e + 1) % 3
+                    for kk in range(nb):
+                        out[kk] = (v[i, a1, kk] * w[j, a2, kk] - v[i, a2, kk] * w[j, a1, kk]) + (
+                            v[j, a1, kk] * w[i, a2, kk] - v[j, a2, kk] * w[i, a1, kk]
+                        )
+                else:
+                    # J entries xx, xy, xz, yy, yz, zz: (w_i)_a (w_j)_c, symmetrised
+                    a1, a2 = _JPAIR[e - 4, 0], _JPAIR[e - 4, 1]
+                    if a1 == a2:
+                        for kk in range(nb):
+                            out[kk] = w[i, a1, kk] * w[j, a1, kk]
+                    else:
+                        for kk in range(nb):
+                            out[kk] = w[i, a1, kk] * w[j, a2, kk] + w[i, a2, kk] * w[j, a1, kk]
+
+
+@inline
+def _gravity_rows(l, nm, cols, b0, nb, v, w, gl, Y):
+    """Link ``l``'s share of the rows of ``g``: ``-m g_l . v_k + h . (w_k x g_l)`` for
+    ``k <= l`` (zero for ``k > l``, and in the inertia columns), at row ``nm + k``."""
+    c0 = 10 * l
+    for k in range(l + 1):
+        row = nm + k
+        for e in range(4):
+            oc = cols[c0 + e]
+            if oc < 0:
+                continue
+            out = Y[oc, row, b0 : b0 + nb]
+            if e == 0:
+                for kk in range(nb):
+                    out[kk] = -(
+                        v[k, 0, kk] * gl[0, kk] + v[k, 1, kk] * gl[1, kk] + v[k, 2, kk] * gl[2, kk]
+                    )
+            else:
+                a1 = e % 3
+                a2 = (e + 1) % 3
+                for kk in range(nb):
+                    out[kk] = w[k, a1, kk] * gl[a2, kk] - w[k, a2, kk] * gl[a1, kk]
+
+
 @jit
 def static_regressor(C, q, cols, Y):
-    """Static regressor into the zeroed ``Y`` (c, s, B) for q (B n,), columns ``cols``; ``ok``."""
+    """Static regressor into the zeroed ``Y`` (c, s, B) for q (B n,), columns ``cols``; ``ok``.
+
+    Per block of samples, the sample index innermost (contiguous runs of Y, SIMD): the
+    link poses (:func:`_base_poses`), then per link its Jacobian columns
+    (:func:`_link_columns`) and its share of the rows of ``tril M`` (:func:`_mass_rows`)
+    and ``g`` (:func:`_gravity_rows`).
+    """
     n = C.shape[0] - 1
     B = q.shape[0] // n
-    g0, g1, g2 = C[n, 0], C[n, 1], C[n, 2]
     nm = n * (n + 1) // 2
-    # per block of samples, the sample index innermost (contiguous runs of Y, SIMD)
     Rb = np.empty((n, 9, BLOCK))  # rotation of each link in the base frame, row-major
     ob = np.empty((n, 3, BLOCK))  # origin of each link in the base frame
     z = np.empty((n, 3, BLOCK))  # joint axes in the base frame
@@ -56,121 +195,12 @@ def static_regressor(C, q, cols, Y):
     gl = np.empty((3, BLOCK))  # gravity in link-l coordinates
     for b0 in range(0, B, BLOCK):
         nb = min(BLOCK, B - b0)
-        # link poses: R_l = R_{l-1} R_{l-1,l}, o_l = o_{l-1} + R_{l-1} p_{l-1,l}
-        for kk in range(nb):
-            for i in range(n):
-                qi = q[(b0 + kk) * n + i]
-                if not math.isfinite(qi):
-                    return False
-                ax, ay, az = C[i, C_AXIS], C[i, C_AXIS + 1], C[i, C_AXIS + 2]
-                a00, a01, a02, a10, a11, a12, a20, a21, a22, p0, p1, p2 = joint(C, i, qi)
-                if i == 0:
-                    Rb[0, 0, kk], Rb[0, 1, kk], Rb[0, 2, kk] = a00, a01, a02
-                    Rb[0, 3, kk], Rb[0, 4, kk], Rb[0, 5, kk] = a10, a11, a12
-                    Rb[0, 6, kk], Rb[0, 7, kk], Rb[0, 8, kk] = a20, a21, a22
-                    ob[0, 0, kk], ob[0, 1, kk], ob[0, 2, kk] = p0, p1, p2
-                else:
-                    for a in range(3):
-                        P0 = Rb[i - 1, 3 * a, kk]
-                        P1 = Rb[i - 1, 3 * a + 1, kk]
-                        P2 = Rb[i - 1, 3 * a + 2, kk]
-                        ob[i, a, kk] = ob[i - 1, a, kk] + (P0 * p0 + P1 * p1 + P2 * p2)
-                        Rb[i, 3 * a, kk] = P0 * a00 + P1 * a10 + P2 * a20
-                        Rb[i, 3 * a + 1, kk] = P0 * a01 + P1 * a11 + P2 * a21
-                        Rb[i, 3 * a + 2, kk] = P0 * a02 + P1 * a12 + P2 * a22
-                for a in range(3):
-                    z[i, a, kk] = (
-                        Rb[i, 3 * a, kk] * ax
-                        + Rb[i, 3 * a + 1, kk] * ay
-                        + Rb[i, 3 * a + 2, kk] * az
-                    )
+        if not _base_poses(C, q, b0, nb, Rb, ob, z):
+            return False
         for l in range(n):
-            # Jacobian columns of the origin of link l for joints k <= l, link-l coordinates
-            for k in range(l + 1):
-                pk = C[k, C_PRISMATIC] != 0.0
-                for kk in range(nb):
-                    r00, r01, r02 = Rb[l, 0, kk], Rb[l, 1, kk], Rb[l, 2, kk]
-                    r10, r11, r12 = Rb[l, 3, kk], Rb[l, 4, kk], Rb[l, 5, kk]
-                    r20, r21, r22 = Rb[l, 6, kk], Rb[l, 7, kk], Rb[l, 8, kk]
-                    zx, zy, zz = z[k, 0, kk], z[k, 1, kk], z[k, 2, kk]
-                    if pk:
-                        lx, ly, lz = zx, zy, zz
-                        ux = uy = uz = 0.0
-                    else:
-                        px = ob[l, 0, kk] - ob[k, 0, kk]
-                        py = ob[l, 1, kk] - ob[k, 1, kk]
-                        pz = ob[l, 2, kk] - ob[k, 2, kk]
-                        lx = zy * pz - zz * py
-                        ly = zz * px - zx * pz
-                        lz = zx * py - zy * px
-                        ux, uy, uz = zx, zy, zz
-                    v[k, 0, kk] = r00 * lx + r10 * ly + r20 * lz
-                    v[k, 1, kk] = r01 * lx + r11 * ly + r21 * lz
-                    v[k, 2, kk] = r02 * lx + r12 * ly + r22 * lz
-                    w[k, 0, kk] = r00 * ux + r10 * uy + r20 * uz
-                    w[k, 1, kk] = r01 * ux + r11 * uy + r21 * uz
-                    w[k, 2, kk] = r02 * ux + r12 * uy + r22 * uz
-            for kk in range(nb):
-                gl[0, kk] = Rb[l, 0, kk] * g0 + Rb[l, 3, kk] * g1 + Rb[l, 6, kk] * g2
-                gl[1, kk] = Rb[l, 1, kk] * g0 + Rb[l, 4, kk] * g1 + Rb[l, 7, kk] * g2
-                gl[2, kk] = Rb[l, 2, kk] * g0 + Rb[l, 5, kk] * g1 + Rb[l, 8, kk] * g2
-            c0 = 10 * l
-            # rows of tril M: pair (i, j), j <= i, at i (i + 1) / 2 + j (zero for i > l)
-            for i in range(l + 1):
-                for j in range(i + 1):
-                    row = i * (i + 1) // 2 + j
-                    for e in range(10):
-                        oc = cols[c0 + e]
-                        if oc < 0:
-                            continue
-                        out = Y[oc, row, b0 : b0 + nb]
-                        if e == 0:
-                            for kk in range(nb):
-                                out[kk] = (
-                                    v[i, 0, kk] * v[j, 0, kk]
-                                    + v[i, 1, kk] * v[j, 1, kk]
-                                    + v[i, 2, kk] * v[j, 2, kk]
-                                )
-                        elif e <= 3:
-                            # (v_i x w_j + v_j x w_i) along axis e - 1
-                            a1 = e % 3  # the next two axes after e - 1, cyclically
-                            a2 = (e + 1) % 3
-                            for kk in range(nb):
-                                out[kk] = (
-                                    v[i, a1, kk] * w[j, a2, kk] - v[i, a2, kk] * w[j, a1, kk]
-                                ) + (v[j, a1, kk] * w[i, a2, kk] - v[j, a2, kk] * w[i, a1, kk])
-                        else:
-                            # J entries xx, xy, xz, yy, yz, zz: (w_i)_a (w_j)_c, symmetrised
-                            a1, a2 = _JPAIR[e - 4, 0], _JPAIR[e - 4, 1]
-                            if a1 == a2:
-                                for kk in range(nb):
-                                    out[kk] = w[i, a1, kk] * w[j, a1, kk]
-                            else:
-                                for kk in range(nb):
-                                    out[kk] = (
-                                        w[i, a1, kk] * w[j, a2, kk] + w[i, a2, kk] * w[j, a1, kk]
-                                    )
-            # rows of g: -m g_l . v_k + h . (w_k x g_l) for k <= l (zero for k > l, and in
-            # the inertia columns)
-            for k in range(l + 1):
-                row = nm + k
-                for e in range(4):
-                    oc = cols[c0 + e]
-                    if oc < 0:
-                        continue
-                    out = Y[oc, row, b0 : b0 + nb]
-                    if e == 0:
-                        for kk in range(nb):
-                            out[kk] = -(
-                                v[k, 0, kk] * gl[0, kk]
-                                + v[k, 1, kk] * gl[1, kk]
-                                + v[k, 2, kk] * gl[2, kk]
-                            )
-                    else:
-                        a1 = e % 3
-                        a2 = (e + 1) % 3
-                        for kk in range(nb):
-                            out[kk] = w[k, a1, kk] * gl[a2, kk] - w[k, a2, kk] * gl[a1, kk]
+            _link_columns(C, l, nb, Rb, ob, z, v, w, gl)
+            _mass_rows(l, cols, b0, nb, v, w, Y)
+            _gravity_rows(l, nm, cols, b0, nb, v, w, gl, Y)
     return True
 
 

@@ -114,6 +114,62 @@ def _collision_free_pool(
     return pool
 
 
+def _greedy_design(
+    B: NDArray[np.float64],
+    n: int,
+    batches: int,
+    exchange: int,
+    p: float,
+    progress: Callable[[int, int], None] | None,
+) -> NDArray[np.bool_]:
+    """Which of the pool's regressor blocks ``B`` (P, s, r) to choose, ``n`` of them.
+
+    Greedy construction in ``batches`` steps on the first-order gains of the surrogate
+    ``J(G)`` (see the module docstring), then up to ``exchange`` passes that swap
+    ``max(n // 50, 1)`` blocks while a swap improves ``J`` to first order; ``progress`` as
+    in :func:`select_static_configurations`. Returns a (P,) bool mask.
+    """
+    P, s, r = B.shape
+    flat = B.reshape(-1, r)
+
+    def block_gram(idx: NDArray[np.intp]) -> NDArray[np.float64]:
+        Bi = B[idx].reshape(-1, r)
+        return Bi.T @ Bi
+
+    def gains() -> NDArray[np.float64]:
+        lam, V = np.linalg.eigh(G)
+        lam = np.maximum(lam / lam.max(), 1e-300)
+        w = lam ** (p - 1) / np.sum(lam**p) - lam ** (-p - 1) / np.sum(lam**-p)
+        E = ((flat @ V) ** 2).reshape(P, s, r).sum(axis=1)  # ||B_c v_i||^2
+        return E @ w  # dJ for adding c: negative helps
+
+    chosen = np.zeros(P, bool)
+    seed = np.arange(min(n, max(n // batches, -(-2 * r // s))))
+    chosen[seed] = True
+    G = block_gram(seed)
+    sizes = np.diff(np.linspace(seed.size, n, batches + 1).round().astype(int))
+    for step, k in enumerate(sizes, start=1):
+        if k > 0:
+            g = np.where(chosen, np.inf, gains())
+            pick = np.argpartition(g, k - 1)[:k]
+            chosen[pick] = True
+            G = G + block_gram(pick)
+        if progress is not None:
+            progress(step, batches + exchange)
+    m = max(n // 50, 1)
+    for step in range(exchange):
+        g = gains()
+        add = np.argpartition(np.where(chosen, np.inf, g), m - 1)[:m]
+        drop = np.argpartition(np.where(chosen, -g, np.inf), m - 1)[:m]
+        if np.sum(g[add]) >= np.sum(g[drop]):
+            break  # no swap improves the surrogate to first order
+        chosen[add], chosen[drop] = True, False
+        G = G + block_gram(add) - block_gram(drop)
+        if progress is not None:
+            progress(batches + step + 1, batches + exchange)
+    return chosen
+
+
 def select_static_configurations(
     robot: Robot,
     n: int,
@@ -181,53 +237,16 @@ def select_static_configurations(
             f"{pool_factor}, {batches}, {exchange}"
         )
     base = base_parameters(robot) if base is None else base
-    r = base.rank
     pool = _collision_free_pool(robot, pool_factor * n, rng, margin, obstacles, radii, clearance)
     B = static_regressor(robot, pool)[..., base.independent]  # (P, s, r)
     if scaled:
         scale = np.sqrt(np.einsum("psr,psr->r", B, B))
         B /= np.where(scale > 0, scale, 1.0)
-    P, s = B.shape[:2]
-    flat = B.reshape(-1, r)
-
-    def block_gram(idx: NDArray[np.intp]) -> NDArray[np.float64]:
-        Bi = B[idx].reshape(-1, r)
-        return Bi.T @ Bi
-
-    def gains() -> NDArray[np.float64]:
-        lam, V = np.linalg.eigh(G)
-        lam = np.maximum(lam / lam.max(), 1e-300)
-        w = lam ** (p - 1) / np.sum(lam**p) - lam ** (-p - 1) / np.sum(lam**-p)
-        E = ((flat @ V) ** 2).reshape(P, s, r).sum(axis=1)  # ||B_c v_i||^2
-        return E @ w  # dJ for adding c: negative helps
-
-    chosen = np.zeros(P, bool)
-    seed = np.arange(min(n, max(n // batches, -(-2 * r // s))))
-    chosen[seed] = True
-    G = block_gram(seed)
-    sizes = np.diff(np.linspace(seed.size, n, batches + 1).round().astype(int))
-    for step, k in enumerate(sizes, start=1):
-        if k > 0:
-            g = np.where(chosen, np.inf, gains())
-            pick = np.argpartition(g, k - 1)[:k]
-            chosen[pick] = True
-            G = G + block_gram(pick)
-        if progress is not None:
-            progress(step, batches + exchange)
-    m = max(n // 50, 1)
-    for step in range(exchange):
-        g = gains()
-        add = np.argpartition(np.where(chosen, np.inf, g), m - 1)[:m]
-        drop = np.argpartition(np.where(chosen, -g, np.inf), m - 1)[:m]
-        if np.sum(g[add]) >= np.sum(g[drop]):
-            break  # no swap improves the surrogate to first order
-        chosen[add], chosen[drop] = True, False
-        G = G + block_gram(add) - block_gram(drop)
-        if progress is not None:
-            progress(batches + step + 1, batches + exchange)
+    chosen = _greedy_design(B, n, batches, exchange, p, progress)
     order = np.flatnonzero(chosen)
     q = pool[order]
     cond, scond = stacked_condition_numbers(robot, q, base)
+    P = B.shape[0]
     ref = pool[rng.permutation(P)[:n]]
     return StaticSelection(
         q=_checks.frozen(q),
