@@ -693,7 +693,7 @@ def test_unexpected_error_is_one_line_with_debug_hint(monkeypatch, capsys):
     'run with --debug', exit 2; --debug shows the traceback."""
     from dynid.cli import fk
 
-    def boom(args):
+    def boom(args, console):
         raise ZeroDivisionError("division by zero")
 
     monkeypatch.setattr(fk, "run", boom)
@@ -803,9 +803,9 @@ def test_warnings_print_as_one_line(monkeypatch, capsys):
 
     real = fk.run
 
-    def run(args):
+    def run(args, console):
         warnings.warn("something recoverable", DynidWarning, stacklevel=2)
-        return real(args)
+        return real(args, console)
 
     monkeypatch.setattr(fk, "run", run)
     assert main(["fk", "--q", NEUTRAL]) == 0
@@ -900,7 +900,7 @@ def test_an_error_echoing_megabytes_is_one_short_line(monkeypatch, capsys, kind)
 
     cls = DataError if kind == "DataError" else ValueError
 
-    def run(args):
+    def run(args, console):
         raise cls("x.csv: bad header " + "col,\n" * 1_200_000 + "; hint: fix the header")
 
     monkeypatch.setattr(fk, "run", run)

@@ -244,7 +244,7 @@ def test_cli_errors_are_one_line_with_exit_code_2(workdir, capsys):
 
 def test_demo_friction_stage_fits_friction_validates_and_writes_its_files(tmp_path, panda):
     """The demo's stage 3 (library) gives per-joint RMS before/after; the CLI writes its files."""
-    from dynid.cli.friction import format_demo_stage, save_demo_stage
+    from dynid.cli.demo_stages import format_friction_stage, save_friction_stage
     from dynid.pipeline import friction_stage
     from dynid.simulation.measurement import sample_times, simulate_measurement
     from dynid.simulation.trajectories import random_fourier
@@ -259,11 +259,11 @@ def test_demo_friction_stage_fits_friction_validates_and_writes_its_files(tmp_pa
     assert np.all(out.rms_without_friction > 0.1)
     assert out.friction_curve_rms is not None and np.all(out.friction_curve_rms < 0.01)
     assert out.scale == pytest.approx(0.95 * 2.175 / 2.21, rel=1e-4)
-    files = save_demo_stage(tmp_path / "demo", out)
+    files = save_friction_stage(tmp_path / "demo", out)
     assert {f.name for f in files} >= {"friction.json", "validation.json", "friction.png"}
     for f in files:
         assert (tmp_path / "demo" / f.name).stat().st_size > 0
-    assert "RMS + friction" in format_demo_stage(out)
+    assert "RMS + friction" in format_friction_stage(out)
 
 
 def test_identify_routes_a_torque_log_to_the_classical_identification(tmp_path):

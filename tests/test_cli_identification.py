@@ -9,7 +9,8 @@ import pytest
 
 import dynid
 from dynid.cli.__main__ import main
-from dynid.cli.identify import format_summary, save_demo_stage
+from dynid.cli.demo_stages import save_identification_stage
+from dynid.cli.summaries import format_identification
 from dynid.pipeline import identification_stage
 
 from conftest import random_states
@@ -180,7 +181,7 @@ def test_demo_identification_stage_returns_the_key_numbers_and_writes_its_files(
     out = identification_stage(dynid.panda(), seed=5)
     assert out.rank == 43 and out.n_configurations == 1010 and out.dropped_rows == ["g1"]
     assert out.relative_error_percent < 0.05 and out.max_error_in_std < 5.0
-    files = save_demo_stage(tmp_path, out)
+    files = save_identification_stage(tmp_path, out)
     assert files == [tmp_path / "static.csv", tmp_path / "identification.json"]
     assert (tmp_path / "static.csv").exists() and (tmp_path / "identification.json").exists()
-    assert "rank 43" in format_summary(out.model)
+    assert "rank 43" in format_identification(out.model)

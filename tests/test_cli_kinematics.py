@@ -202,7 +202,7 @@ def test_bad_input_exits_nonzero_with_one_stderr_line(capsys, argv, message):
 def test_demo_kinematics_stage_runs_headless_and_writes_a_png(tmp_path):
     """The demo's stage 1 (library) solves the IK; the CLI writes a non-empty PNG of the joint
     motion and reports convergence."""
-    from dynid.cli.demo import format_kinematics, save_kinematics
+    from dynid.cli.demo_stages import format_kinematics, save_kinematics
     from dynid.model.panda import PANDA_NEUTRAL_Q
     from dynid.pipeline import kinematics_stage
 

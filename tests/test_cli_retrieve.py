@@ -177,7 +177,7 @@ def test_retrieve_error_is_one_line_with_exit_code_2(model_file, tmp_path, capsy
 def test_demo_feasible_stage_retrieves_validates_and_writes_its_files(tmp_path):
     """The demo's stage 4 (library): feasible parameters validated by Newton-Euler against a
     log; the CLI writes the exports and the validation."""
-    from dynid.cli.retrieve import format_demo_stage, save_demo_stage
+    from dynid.cli.demo_stages import format_feasible_stage, save_feasible_stage
     from dynid.friction.model import SigmoidFriction
     from dynid.pipeline import feasible_stage
 
@@ -197,8 +197,8 @@ def test_demo_feasible_stage_retrieves_validates_and_writes_its_files(tmp_path):
     assert out.max_torque_difference < 1e-6
     assert np.all(out.rms_newton_euler < 0.05)
     assert len(runs) == out.retrieval.options.runs and runs[-1].done == runs[-1].total
-    assert "RMS NE" in format_demo_stage(out)
-    files = save_demo_stage(tmp_path / "demo", out)
+    assert "RMS NE" in format_feasible_stage(out)
+    files = save_feasible_stage(tmp_path / "demo", out)
     assert {f.name for f in files} >= {"feasible.json", "robot.urdf", "feasible_validation.json"}
     for f in files:
         assert (tmp_path / "demo" / f.name).is_file()

@@ -13,6 +13,7 @@ import pytest
 import dynid
 from dynid.cli.__main__ import main
 from dynid.cli.common import load_prior
+from dynid.cli.console import Console
 from dynid.exceptions import UnknownNameError
 from dynid.io.robot_file import load_robot
 from dynid.model import fr3 as fr3_module
@@ -84,13 +85,13 @@ def test_builtin_names_read_through_one_table():
 
 def test_prior_fr3_is_said_to_be_the_pandas(capsys):
     """--prior fr3 prints one note that its link parameters are the Panda's; -q silences it."""
-    args = argparse.Namespace(prior="fr3", command="identify", quiet=False)
-    prior = load_prior(args, dynid.fr3())
+    args = argparse.Namespace(prior="fr3", prior_base=None, prior_tip=None)
+    prior = load_prior(args, dynid.fr3(), Console("identify"))
     assert prior is not None and prior.name == "fr3"
     err = capsys.readouterr().err.strip().splitlines()
     assert err == [f"dynid identify: note: --prior fr3: {fr3_module.FR3_PARAMETER_NOTE}"]
     assert "Panda's" in err[0]
-    load_prior(argparse.Namespace(prior="fr3", command="identify", quiet=True), dynid.fr3())
+    load_prior(args, dynid.fr3(), Console("identify", quiet=True))
     assert capsys.readouterr().err == ""
 
 

@@ -20,6 +20,7 @@ LAYERS = [
     {"feasibility"},
     {"pipeline"},
     {"io"},
+    {"workflows"},
     {"plots"},
     {"cli", "__main__"},
 ]

@@ -32,10 +32,12 @@ import sys
 import warnings
 from collections.abc import Iterator, Sequence
 
+from .. import __version__
 from .._checks import one_line
 from ..exceptions import DynidError
 from ..io.atomic import output_transaction
 from ..io.run_output import RunOutput, run_output
+from .console import Console
 from .run_report import RunRecord, save_run_report
 
 #: Longest error line printed [characters]: a message echoing megabytes of input keeps
@@ -43,7 +45,7 @@ from .run_report import RunRecord, save_run_report
 ERROR_LINE_LIMIT = 1000
 
 #: Subcommands in pipeline order; each is the module ``dynid.cli.<module>`` with
-#: ``NAME``, ``register(subparsers)`` and ``run(args) -> int``.
+#: ``NAME``, ``register(subparsers)`` and ``run(args, console) -> int``.
 SUBCOMMANDS = (
     "fk",
     "jacobian",
@@ -91,8 +93,6 @@ def build_parser(commands: Sequence[str] = SUBCOMMANDS) -> argparse.ArgumentPars
     parser = _Parser(
         prog="dynid", description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter
     )
-    from .. import __version__
-
     parser.add_argument("--version", action="version", version=f"dynid {__version__}")
     sub = parser.add_subparsers(dest="command", metavar="COMMAND", required=True)
     for mod in _modules(commands):
@@ -155,9 +155,9 @@ def _terminate(signum: int, frame: object) -> None:
 
 
 @contextlib.contextmanager
-def _signals_and_warnings(command: str) -> Iterator[None]:
+def _signals_and_warnings(command: str, *, quiet: bool = False) -> Iterator[None]:
     """SIGTERM, SIGHUP and SIGQUIT raise :class:`Terminated`; warnings print as one line
-    (no source line)."""
+    (no source line), none with ``quiet``."""
     old = {}
     with contextlib.suppress(ValueError):  # not the main thread: leave signals alone
         for sig in TERMINATING:
@@ -169,6 +169,8 @@ def _signals_and_warnings(command: str) -> Iterator[None]:
     try:
         with warnings.catch_warnings():
             warnings.showwarning = show
+            if quiet:
+                warnings.simplefilter("ignore")
             yield
     finally:
         for sig, handler in old.items():
@@ -219,15 +221,16 @@ def main(argv: Sequence[str] | None = None) -> int:
     )
     logging.basicConfig(level=level, format="%(levelname)s %(name)s: %(message)s")
     say = f"dynid {args.command}"
+    console = Console(args.command, quiet=args.quiet, verbose=args.verbose)
     record = RunRecord()
     try:
         with (
             record,
-            _signals_and_warnings(args.command),
+            _signals_and_warnings(args.command, quiet=args.quiet),
             output_transaction(),
             _output_set(args, argv) as run,
         ):
-            code = int(args._run(args) or 0)
+            code = int(args._run(args, console) or 0)
             if run is not None and run.kind == "folder":
                 save_run_report(run, record, args, argv, code)
         if record.stdout_closed:

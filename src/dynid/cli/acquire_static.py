@@ -43,6 +43,7 @@ from .common import (
     load_robot,
     nonnegative_type,
 )
+from .console import Console
 
 NAME = "acquire-static"
 #: ``--out`` is the one file written (:mod:`dynid.io.run_output`).
@@ -101,7 +102,7 @@ def streams(seed: int) -> tuple[np.random.Generator, np.random.Generator]:
     return np.random.default_rng(a), np.random.default_rng(b)
 
 
-def run(args: argparse.Namespace) -> int:
+def run(args: argparse.Namespace, console: Console) -> int:
     """Acquire and write the data set; returns the exit code."""
     robot = load_robot(args)
     rng_q, rng_noise = streams(args.seed)
@@ -132,16 +133,14 @@ def run(args: argparse.Namespace) -> int:
             condition_number=sel.condition_number,
             random_condition_number=sel.pool_condition_number,
         )
-        if not args.quiet:
-            print(
-                f"chose {args.n} of {sel.pool_size} configurations: condition number "
-                f"{sel.condition_number:.4g} (unscaled; {sel.pool_condition_number:.4g} for "
-                f"{args.n} random ones of the pool), scaled {sel.scaled_condition_number:.4g}"
-            )
-    path = save_static_data(args.out, data)
-    if not args.quiet:
-        print(
-            f"wrote {data.n_configurations} configurations of {robot.name} "
-            f"(noise {args.noise:g}, seed {args.seed}) to {path}"
+        console.print(
+            f"chose {args.n} of {sel.pool_size} configurations: condition number "
+            f"{sel.condition_number:.4g} (unscaled; {sel.pool_condition_number:.4g} for "
+            f"{args.n} random ones of the pool), scaled {sel.scaled_condition_number:.4g}"
         )
+    path = save_static_data(args.out, data)
+    console.print(
+        f"wrote {data.n_configurations} configurations of {robot.name} "
+        f"(noise {args.noise:g}, seed {args.seed}) to {path}"
+    )
     return 0

@@ -1,5 +1,5 @@
-"""Options and helpers shared by the subcommands: robot selection, vectors, JSON output,
-argparse types for checked option values, figures that are skipped without matplotlib."""
+"""Options and helpers shared by the subcommands: robot selection, vectors, argparse types
+for checked option values, figures that are skipped without matplotlib."""
 
 from __future__ import annotations
 
@@ -16,9 +16,15 @@ import numpy as np
 
 from .. import _checks, spatial
 from ..exceptions import DataError, DynidError, ShapeError
-from ..io.json_files import dumps
+from ..identification.log import TorqueLog
+from ..io.drive_file import drive_of_robot_file, load_drive
+from ..io.robot_file import load_robot as load_robot_file
 from ..model.builtin import BUILTIN_ROBOTS, builtin_robot
 from ..model.robot import Robot
+from ..plots.save import save_figure as write_figure
+from ..workflows.data_files import column_map, read_torque_log, recorded_columns
+from ..workflows.prior import load_prior as workflow_prior
+from .console import Console
 
 _log = logging.getLogger(__name__)
 
@@ -129,18 +135,6 @@ def shown(text: str) -> str:
     return text.encode("utf-8", "surrogateescape").decode("utf-8", "replace")
 
 
-def warn(args: argparse.Namespace, message: str) -> None:
-    """One warning line on stderr (``dynid CMD: warning: ...``), unless ``-q``."""
-    if not getattr(args, "quiet", False):
-        print(f"dynid {args.command}: warning: {message}", file=sys.stderr)
-
-
-def note(args: argparse.Namespace, message: str) -> None:
-    """One note line on stderr (``dynid CMD: note: ...``), unless ``-q``."""
-    if not getattr(args, "quiet", False):
-        print(f"dynid {args.command}: note: {message}", file=sys.stderr)
-
-
 def add_robot_options(p: argparse.ArgumentParser) -> None:
     """``--robot panda|fr3|FILE.urdf|FILE.toml`` with ``--base``/``--tip`` for URDF chains."""
     p.add_argument(
@@ -171,8 +165,6 @@ def add_drive_option(p: argparse.ArgumentParser) -> None:
 def load_drive_arg(args: argparse.Namespace, n: int) -> Any:
     """The :class:`~dynid.model.drive.Drive` of ``--drive`` (or of a --robot TOML's
     ``[drive]`` table), or None."""
-    from ..io.drive_file import drive_of_robot_file, load_drive
-
     if getattr(args, "drive", None) is not None:
         return load_drive(args.drive, n)
     spec = getattr(args, "robot", None)
@@ -181,8 +173,6 @@ def load_drive_arg(args: argparse.Namespace, n: int) -> Any:
 
 def load_robot(args: argparse.Namespace) -> Robot:
     """The robot named by ``--robot`` (and ``--base``/``--tip`` for a URDF)."""
-    from ..io.robot_file import load_robot as load_robot_file
-
     spec = args.robot
     if spec in BUILTIN_ROBOTS:
         return builtin_robot(spec)
@@ -227,48 +217,34 @@ def add_consistency_options(p: argparse.ArgumentParser) -> None:
     )
 
 
-def load_prior(args: argparse.Namespace, robot: Robot) -> Robot | None:
-    """The prior robot named by ``--prior`` (None: the generic prior), checked against ``robot``."""
+def note_prior(args: argparse.Namespace, console: Console) -> None:
+    """Print the note of a built-in ``--prior`` on its parameters (``fr3``: the Panda's)."""
     spec = getattr(args, "prior", None)
-    if spec is None:
-        return None
-    from ..io.robot_file import load_robot as load_robot_file
+    if isinstance(spec, str) and spec in BUILTIN_ROBOTS and BUILTIN_ROBOTS[spec].parameter_note:
+        console.note(f"--prior {spec}: {BUILTIN_ROBOTS[spec].parameter_note}")
 
-    if spec in BUILTIN_ROBOTS:
-        prior = builtin_robot(spec)
-        if BUILTIN_ROBOTS[spec].parameter_note is not None:
-            note(args, f"--prior {spec}: {BUILTIN_ROBOTS[spec].parameter_note}")
-    else:
-        path = Path(spec)
-        base = args.prior_base or robot.link_names[0]
-        tip = args.prior_tip or robot.link_names[-1]
-        try:
-            prior = load_robot_file(path, base=base, tip=tip, what="--prior")
-        except DynidError as exc:
-            hint = (
-                " (name the chain with --prior-base/--prior-tip)" if path.suffix == ".urdf" else ""
-            )
-            msg = str(exc) if str(exc).startswith("--prior") else f"--prior {path.name}: {exc}"
-            raise DynidError(msg + hint) from None
-    if spec not in BUILTIN_ROBOTS:
-        prior = prior.replace(name=Path(spec).name)  # reports name the file
-    kinds = ("".join("P" if x else "R" for x in r.prismatic) for r in (prior, robot))
-    pk, rk = kinds
-    if pk != rk:
-        raise DynidError(f"--prior {spec}: joints {pk}; the robot's are {rk}")
-    if not np.allclose(prior.T_parent_joint, robot.T_parent_joint, atol=1e-3):
-        _log.warning(
-            "--prior %s: its joint frames differ from the robot's by up to %.3g m; its link "
-            "parameters are used in the robot's link frames as they are",
-            spec,
-            float(np.max(np.abs(prior.T_parent_joint - robot.T_parent_joint))),
-        )
-    return prior
+
+def load_prior(args: argparse.Namespace, robot: Robot, console: Console) -> Robot | None:
+    """The prior robot named by ``--prior`` (None: the generic prior), checked against
+    ``robot`` (:func:`dynid.workflows.prior.load_prior`); a built-in prior's note on its
+    parameters is printed."""
+    note_prior(args, console)
+    return workflow_prior(args.prior, robot, base=args.prior_base, tip=args.prior_tip)
+
+
+def parse_mass_band(text: str | None) -> tuple[float, float] | None:
+    """``--total-mass MIN,MAX`` [kg] (0 <= MIN <= MAX), or None."""
+    if text is None:
+        return None
+    v = parse_vector(text, "--total-mass", 2)
+    if not 0.0 <= v[0] <= v[1]:
+        raise DataError(f"--total-mass must be MIN,MAX, 0 <= MIN <= MAX; got {text}")
+    return float(v[0]), float(v[1])
 
 
 def sdp_options(args: argparse.Namespace) -> Any:
     """:class:`~dynid.feasibility.sdp.SDPOptions` from the consistency options."""
-    from ..feasibility.sdp import DEFAULT_SDP_MARGIN, SDPOptions
+    from ..feasibility.sdp import DEFAULT_SDP_MARGIN, SDPOptions  # scipy: kept off fk's start-up
 
     return SDPOptions(
         objective=args.objective or "logdet",
@@ -293,11 +269,6 @@ def parse_vector(
     return v
 
 
-def print_json(obj: Any) -> None:
-    """One strict JSON object on stdout (a NaN or infinity is an error, not ``NaN``)."""
-    sys.stdout.write(dumps(obj, indent=None) + "\n")
-
-
 def save_figure(fig_factory: Callable[[], Any], path: Path, *, dpi: int = 110) -> Path | None:
     """Render ``fig_factory()`` to ``path`` with :func:`dynid.plots.save.save_figure`;
     when that fails for any reason (matplotlib missing or broken, a bad ``MPLBACKEND``, an
@@ -315,8 +286,6 @@ def save_figure(fig_factory: Callable[[], Any], path: Path, *, dpi: int = 110) -
         _skipped(path, exc)
         return None
     try:
-        from ..plots.save import save_figure as write_figure
-
         return write_figure(fig_factory, path, dpi=dpi)
     except Exception as exc:
         _skipped(path, exc)
@@ -395,81 +364,19 @@ def add_column_options(p: argparse.ArgumentParser) -> None:
     )
 
 
-def record_columns(args: argparse.Namespace, metadata: dict[str, Any]) -> None:
-    """Record ``--columns``/``--units`` in a model's metadata (``"column_map"``), so that
-    ``validate`` reads a log of the same kind the same way (:func:`reuse_columns`)."""
-    spec, units = getattr(args, "columns", None), getattr(args, "units", None)
-    if spec is not None or units is not None:
-        metadata["column_map"] = {"columns": spec, "units": units}
-
-
-def reuse_columns(args: argparse.Namespace, metadata: Any) -> None:
-    """Take the ``--columns``/``--units`` a model was identified with when none are given;
-    other ones than recorded are an error (the log would be read another way)."""
-    rec = dict(metadata or {}).get("column_map")
-    if not isinstance(rec, dict):
-        return
-    given = (getattr(args, "columns", None), getattr(args, "units", None))
-    if given == (None, None):
-        args.columns, args.units = rec.get("columns"), rec.get("units")
-        _log.warning(
-            "reading --data as the model's data were read: --columns %r --units %r",
-            args.columns,
-            args.units,
-        )
-    elif given != (rec.get("columns"), rec.get("units")):
-        raise DataError(
-            f"--columns {given[0]!r} --units {given[1]!r} differ from those the model was "
-            f"identified with ({rec.get('columns')!r}, {rec.get('units')!r}); hint: leave "
-            "them out to use the model's"
-        )
-
-
-def column_map(args: argparse.Namespace) -> Any:
-    """The :class:`~dynid.io.columns.ColumnMap` of ``--columns``/``--units``, or None."""
-    from ..io.columns import load_column_map, parse_column_map
-
-    spec, units = getattr(args, "columns", None), getattr(args, "units", None)
-    if spec is None and units is None:
-        return None
-    kw = {} if getattr(args, "cutoff", None) is None else {"velocity_cutoff_hz": args.cutoff}
-    if spec is not None and spec.lower().endswith(".toml"):
-        cmap = load_column_map(spec, **kw)
-        if units is not None:
-            extra = parse_column_map(None, units)
-            cmap = type(cmap)(cmap.columns, {**cmap.factors, **extra.factors}, **kw)
-        return cmap
-    return parse_column_map(spec, units, **kw)
-
-
-def read_log(args: argparse.Namespace, path: Path, n: int | None = None) -> Any:
-    """The torque log ``path``, read strictly (``--drop-invalid`` relaxes it), through
-    ``--columns``/``--units`` when given (notes logged).
-
-    A mapped log is cleaned by :meth:`~dynid.identification.log.TorqueLog.from_raw`: rows
-    it dropped (NaN/inf, repeated timestamps) are an error here unless ``--drop-invalid``,
-    as for a log read directly.
-    """
-    from ..io.torque_log import load_torque_log
-
-    drop = bool(getattr(args, "drop_invalid", False))
-    cmap = column_map(args)
-    if cmap is None:
-        return load_torque_log(path, drop_invalid=drop)
-    from ..io.columns import load_mapped_torque_log
-
-    mapped = load_mapped_torque_log(path, cmap, n=n)
-    for note in mapped.notes:
-        _log.warning("%s: %s", path.name, note)
-    c = mapped.log.cleaning
-    if c.n_nan_rows or c.n_duplicates:
-        what = (
-            f"{c.n_nan_rows} row(s) of {c.n_input_rows} hold NaN or inf and {c.n_duplicates} "
-            "repeat the previous timestamp"
-        )
-        if not drop:
-            raise DataError(
-                f"{path.name}: {what}; hint: fix the file or pass --drop-invalid to drop them"
-            )
-        _log.warning("%s: dropped: %s", path.name, what)
-    return mapped.log
+def read_data_log(
+    args: argparse.Namespace, n: int, *, owner: str, metadata: Any = None
+) -> TorqueLog:
+    """``--data`` read as a torque log of ``n`` joints (:func:`~dynid.workflows.data_files.
+    read_torque_log`), through ``--columns``/``--units``, or those a model's ``metadata``
+    records when none are given (:func:`~dynid.workflows.data_files.recorded_columns`)."""
+    columns, units = recorded_columns(
+        metadata, getattr(args, "columns", None), getattr(args, "units", None)
+    )
+    return read_torque_log(
+        args.data,
+        n,
+        columns=column_map(columns, units, cutoff_hz=getattr(args, "cutoff", None)),
+        drop_invalid=bool(getattr(args, "drop_invalid", False)),
+        owner=owner,
+    )

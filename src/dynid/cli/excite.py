@@ -36,6 +36,7 @@ import numpy as np
 from ..io.excitation import load_obstacles, save_excitation_json, save_trajectory_csv
 from ..simulation.excitation import ExcitationOptions, optimise_excitation
 from .common import add_robot_options, add_subcommand, load_robot, save_figure
+from .console import Console
 
 NAME = "excite"
 #: ``--out`` is a folder: its files are one output set (:mod:`dynid.io.run_output`).
@@ -85,7 +86,7 @@ def register(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParser:
     return p
 
 
-def run(args: argparse.Namespace) -> int:
+def run(args: argparse.Namespace, console: Console) -> int:
     """Optimise, write the trajectory files and the figure; returns the exit code."""
     robot = load_robot(args)
     obstacles = None if args.obstacles is None else load_obstacles(args.obstacles)
@@ -99,7 +100,7 @@ def run(args: argparse.Namespace) -> int:
         criterion=args.criterion,
         max_iter=args.max_iter,
     )
-    show = not args.quiet and sys.stderr.isatty()
+    show = not console.quiet and sys.stderr.isatty()
 
     def progress(k: int, total: int, cond: float) -> None:
         if show:
@@ -124,23 +125,22 @@ def run(args: argparse.Namespace) -> int:
             dpi=110,
         )
         written += [png] if png is not None else []
-    if not args.quiet:
-        m = res.margins
-        print(
-            f"exciting trajectory for {robot.name}: {res.trajectory.total_duration:g} s, "
-            f"condition number {res.condition_number:.4g} (unscaled; start "
-            f"{res.initial_condition_number:.4g}), scaled {res.scaled_condition_number:.4g}, "
-            f"{res.iterations} iterations, status {res.status}"
-        )
-        print(
-            "smallest margins at 1 kHz: position "
-            f"{min(m['position']):.3g} rad, velocity {min(m['velocity']):.3g} rad/s, "
-            f"acceleration {min(m['acceleration']):.3g} rad/s^2, torque "
-            f"{min(m['torque']):.3g} N m, self-collision {m['self_collision']:.3g} m"
-            + "".join(f", {k} {v:.3g} m" for k, v in m["obstacles"].items())
-        )
-        for p in written:
-            print(f"wrote {p}")
+    m = res.margins
+    console.print(
+        f"exciting trajectory for {robot.name}: {res.trajectory.total_duration:g} s, "
+        f"condition number {res.condition_number:.4g} (unscaled; start "
+        f"{res.initial_condition_number:.4g}), scaled {res.scaled_condition_number:.4g}, "
+        f"{res.iterations} iterations, status {res.status}"
+    )
+    console.print(
+        "smallest margins at 1 kHz: position "
+        f"{min(m['position']):.3g} rad, velocity {min(m['velocity']):.3g} rad/s, "
+        f"acceleration {min(m['acceleration']):.3g} rad/s^2, torque "
+        f"{min(m['torque']):.3g} N m, self-collision {m['self_collision']:.3g} m"
+        + "".join(f", {k} {v:.3g} m" for k, v in m["obstacles"].items())
+    )
+    for p in written:
+        console.print(f"wrote {p}")
     if res.status == "infeasible":
         print(
             f"dynid {NAME}: error: no admissible trajectory found (files written for "

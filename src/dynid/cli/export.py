@@ -37,6 +37,7 @@ from ..io.export import EXPORT_FORMATS, export_format, model_terms_of, save_robo
 from ..io.robot.urdf_patch import MERGED_POLICIES
 from ..model.robot import Robot
 from .common import add_drive_option, add_subcommand, load_drive_arg
+from .console import Console
 
 NAME = "export"
 #: ``--out`` is the one file written (:mod:`dynid.io.run_output`).
@@ -81,7 +82,7 @@ def load_params(spec: str) -> Robot:
     return load_robot(spec, what="--params")
 
 
-def run(args: argparse.Namespace) -> int:
+def run(args: argparse.Namespace, console: Console) -> int:
     """Load, write, print a summary; returns the exit code."""
     robot = load_params(args.params)
     if args.urdf_template is None and (args.base or args.tip):
@@ -110,15 +111,15 @@ def run(args: argparse.Namespace) -> int:
         all_frames=args.all_frames,
         drive=drive,
     )
-    print(f"wrote {path}")
+    console.print(f"wrote {path}")
     if drive is not None:
-        print(f"drive: {drive.describe()}")
+        console.print(f"drive: {drive.describe()}")
     mjcf = export_format(path, args.format) == "mjcf"
     if mjcf and friction is True and robot.friction is not None:
         approx = coulomb_viscous_from_sigmoid(robot.friction, robot.dq_max)
-        print("friction as MuJoCo holds it (odd part of the sigmoid, fitted up to dq_max):")
+        console.print("friction as MuJoCo holds it (odd part of the sigmoid, fitted up to dq_max):")
         for j, name in enumerate(robot.joint_names):
-            print(
+            console.print(
                 f"  {name}: frictionloss {approx.coulomb[j]:.4g} N m, damping "
                 f"{approx.viscous[j]:.4g} N m s/rad, dropped offset {approx.offset[j]:+.3g} "
                 f"N m, fit RMS {approx.rms_error[j]:.3g} N m"

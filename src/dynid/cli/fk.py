@@ -29,8 +29,8 @@ from .common import (
     load_robot,
     parse_q,
     parse_tool,
-    print_json,
 )
+from .console import Console
 
 NAME = "fk"
 
@@ -60,18 +60,18 @@ def joint_positions(args: argparse.Namespace, robot) -> np.ndarray:
     return default_q0(robot) if args.q is None else parse_q(args.q, robot)
 
 
-def run(args: argparse.Namespace) -> int:
+def run(args: argparse.Namespace, console: Console) -> int:
     """Print the pose (table or JSON)."""
     robot = load_robot(args)
     q = joint_positions(args, robot)
     T = fk(robot, q, args.frame, parse_tool(args.tool))
     if args.json:
-        print_json({"T": T})
+        console.json({"T": T})
         return 0
     what = f"tool on frame {args.frame!r}" if args.tool else f"frame {args.frame!r}"
-    print(f"{robot.name}: pose of the {what} in the base frame")
-    print(f"q:\n{format_joint_table(robot, q)}")
-    print(f"T_base_{'tool' if args.tool else args.frame} [m]:\n{format_matrix(T)}")
-    print(f"position x, y, z [m]:        {format_matrix(T[:3, 3])}")
-    print(f"URDF roll, pitch, yaw [rad]: {format_matrix(rpy_from_matrix(T[:3, :3]))}")
+    console.print(f"{robot.name}: pose of the {what} in the base frame")
+    console.print(f"q:\n{format_joint_table(robot, q)}")
+    console.print(f"T_base_{'tool' if args.tool else args.frame} [m]:\n{format_matrix(T)}")
+    console.print(f"position x, y, z [m]:        {format_matrix(T[:3, 3])}")
+    console.print(f"URDF roll, pitch, yaw [rad]: {format_matrix(rpy_from_matrix(T[:3, :3]))}")
     return 0

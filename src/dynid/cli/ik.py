@@ -40,9 +40,9 @@ from .common import (
     parse_tool,
     parse_vector,
     positive_type,
-    print_json,
     seed_type,
 )
+from .console import Console
 
 NAME = "ik"
 
@@ -118,7 +118,7 @@ def goal_pose(args: argparse.Namespace, robot, q0: np.ndarray, tool) -> np.ndarr
     return transform(R, xyz)
 
 
-def run(args: argparse.Namespace) -> int:
+def run(args: argparse.Namespace, console: Console) -> int:
     """Solve and print (table or JSON); exit status 1 when not converged."""
     robot = load_robot(args)
     tool = parse_tool(args.tool)
@@ -131,7 +131,7 @@ def run(args: argparse.Namespace) -> int:
     )
     res = ik(robot, T_goal, q0, args.frame, tool, options, rng=np.random.default_rng(args.seed))
     if args.json:
-        print_json(
+        console.json(
             {
                 "q": res.q,
                 "converged": res.converged,
@@ -142,11 +142,13 @@ def run(args: argparse.Namespace) -> int:
         )
         return 0 if res.converged else 1
     what = f"tool on frame {args.frame!r}" if args.tool else f"frame {args.frame!r}"
-    print(f"{robot.name}: inverse kinematics of the {what}")
-    print(f"goal T_base_{'tool' if args.tool else args.frame} [m]:\n{format_matrix(T_goal)}")
+    console.print(f"{robot.name}: inverse kinematics of the {what}")
+    console.print(
+        f"goal T_base_{'tool' if args.tool else args.frame} [m]:\n{format_matrix(T_goal)}"
+    )
     status = "converged" if res.converged else "NOT converged (best configuration found)"
-    print(f"{status} after {res.iterations} iterations, {res.restarts} restarts")
-    print(f"position error:    {res.position_error:.3e} m")
-    print(f"orientation error: {res.orientation_error:.3e} rad")
-    print(f"q:\n{format_joint_table(robot, res.q)}")
+    console.print(f"{status} after {res.iterations} iterations, {res.restarts} restarts")
+    console.print(f"position error:    {res.position_error:.3e} m")
+    console.print(f"orientation error: {res.orientation_error:.3e} rad")
+    console.print(f"q:\n{format_joint_table(robot, res.q)}")
     return 0 if res.converged else 1

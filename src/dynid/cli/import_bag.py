@@ -23,7 +23,8 @@ from pathlib import Path
 from ..identification.log import DEFAULT_CUTOFF_HZ
 from ..io.rosbag import load_joint_state_bag
 from ..io.torque_log import save_torque_log
-from .common import add_robot_options, add_subcommand, load_robot, positive_type, print_json
+from .common import add_robot_options, add_subcommand, load_robot, positive_type
+from .console import Console
 
 NAME = "import"
 #: ``--out`` is the one file written (:mod:`dynid.io.run_output`).
@@ -56,7 +57,7 @@ def register(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParser:
     return p
 
 
-def run(args: argparse.Namespace) -> int:
+def run(args: argparse.Namespace, console: Console) -> int:
     """Read the bag, write the log, print what was found; returns the exit code."""
     robot = load_robot(args)
     joints = None if args.joints is None else [s.strip() for s in args.joints.split(",")]
@@ -84,17 +85,16 @@ def run(args: argparse.Namespace) -> int:
         "notes": list(res.notes),
     }
     if args.json:
-        print_json(summary)
+        console.json(summary)
         return 0
-    if not args.quiet:
-        print(
-            f"{res.log.n_samples} samples, {res.log.duration:.3f} s at "
-            f"{res.log.sample_rate:.1f} Hz from {res.n_messages} messages on {res.topic}; "
-            f"time from {res.time_source} stamps, t = 0 at {res.t0_ns} ns"
-        )
-        for rj, bj in zip(robot.joint_names, res.joints, strict=True):
-            print(f"  {rj} <- {bj}")
-        for note in res.notes:
-            print(f"note: {note}")
-        print(f"wrote {path}")
+    console.print(
+        f"{res.log.n_samples} samples, {res.log.duration:.3f} s at "
+        f"{res.log.sample_rate:.1f} Hz from {res.n_messages} messages on {res.topic}; "
+        f"time from {res.time_source} stamps, t = 0 at {res.t0_ns} ns"
+    )
+    for rj, bj in zip(robot.joint_names, res.joints, strict=True):
+        console.print(f"  {rj} <- {bj}")
+    for note in res.notes:
+        console.print(f"note: {note}")
+    console.print(f"wrote {path}")
     return 0

@@ -24,8 +24,8 @@ from .common import (
     format_joint_table,
     load_robot,
     parse_tool,
-    print_json,
 )
+from .console import Console
 from .fk import add_q_option, joint_positions
 
 NAME = "jacobian"
@@ -46,19 +46,19 @@ def register(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParser:
     return p
 
 
-def run(args: argparse.Namespace) -> int:
+def run(args: argparse.Namespace, console: Console) -> int:
     """Print the Jacobian (table or JSON)."""
     robot = load_robot(args)
     q = joint_positions(args, robot)
     J = jacobian(robot, q, args.frame, parse_tool(args.tool))
     if args.json:
-        print_json({"J": J, "rows": list(ROWS)})
+        console.json({"J": J, "rows": list(ROWS)})
         return 0
     what = f"tool on frame {args.frame!r}" if args.tool else f"frame {args.frame!r}"
-    print(f"{robot.name}: geometric Jacobian of the {what}, base frame")
-    print(f"q:\n{format_joint_table(robot, q)}")
+    console.print(f"{robot.name}: geometric Jacobian of the {what}, base frame")
+    console.print(f"q:\n{format_joint_table(robot, q)}")
     width = max(10, *(len(s) + 1 for s in robot.joint_names))
-    print("    " + "".join(f"{s:>{width}}" for s in robot.joint_names))
+    console.print("    " + "".join(f"{s:>{width}}" for s in robot.joint_names))
     for label, row in zip(ROWS, J, strict=True):
-        print(f"{label:<4}" + "".join(f"{v:>+{width}.6f}" for v in row))
+        console.print(f"{label:<4}" + "".join(f"{v:>+{width}.6f}" for v in row))
     return 0

@@ -20,6 +20,7 @@ from __future__ import annotations
 
 import argparse
 from pathlib import Path
+from typing import Any
 
 from ..exceptions import DynidError
 from ..feasibility.payload import identify_payload, robot_with_payload
@@ -28,9 +29,12 @@ from ..identification.model import IdentifiedModel
 from ..io.columns import ColumnMap, load_mapped_static_data
 from ..io.payload_json import save_payload_json
 from ..io.robot.toml import save_toml
-from .common import add_column_options, add_subcommand, column_map, positive_type, read_log
-from .identify import data_kind
-from .validate import load_model_source
+from ..model.inertia import INERTIA_ORDER, inertia6_from_matrix
+from ..model.robot import Robot
+from ..workflows.data_files import column_map, data_kind, read_torque_log
+from .common import add_column_options, add_subcommand, positive_type
+from .console import Console
+from .sources import load_model_source
 
 NAME = "payload"
 #: ``--out`` is a folder: its files are one output set (:mod:`dynid.io.run_output`).
@@ -60,23 +64,25 @@ def register(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParser:
     return p
 
 
-def _read(args: argparse.Namespace, path: Path, robot, kind: str):  # noqa: ANN001, ANN202
+def _read(args: argparse.Namespace, path: Path, robot: Robot, kind: str, cmap: Any) -> Any:
     if kind == "torque_log":
-        return read_log(args, path, robot.n)
-    cmap = column_map(args) or ColumnMap()
-    mapped = load_mapped_static_data(path, cmap, robot, require_M=not args.gravity_only)
+        return read_torque_log(path, robot.n, columns=cmap, owner=f"robot {robot.name!r}")
+    mapped = load_mapped_static_data(
+        path, cmap or ColumnMap(), robot, require_M=not args.gravity_only
+    )
     return mapped.data
 
 
-def run(args: argparse.Namespace) -> int:
+def run(args: argparse.Namespace, console: Console) -> int:
     """Identify, write payload.json and the robot with the load, print a summary."""
     arm, label = load_model_source(args)
     kin = arm.robot if isinstance(arm, IdentifiedModel) else arm
-    kind = data_kind(args.data, column_map(args))
+    cmap = column_map(args.columns, args.units, cutoff_hz=args.cutoff)
+    kind = data_kind(args.data, cmap)
     if args.gravity_only and kind != "static":
         raise DynidError("--gravity-only applies to static data (q, g), not to a torque log")
-    data = _read(args, args.data, kin, kind)
-    unloaded = None if args.unloaded is None else _read(args, args.unloaded, kin, kind)
+    data = _read(args, args.data, kin, kind, cmap)
+    unloaded = None if args.unloaded is None else _read(args, args.unloaded, kin, kind, cmap)
     est = identify_payload(
         arm,
         data,
@@ -91,20 +97,17 @@ def run(args: argparse.Namespace) -> int:
     path = save_payload_json(
         args.out / "payload.json", est, kin, with_tool="robot_with_payload.toml"
     )
-    if not args.quiet:
-        print(f"payload on frame {est.frame!r} ({est.route}; arm: {label})")
-        print(f"  mass     {est.mass:.6g} kg  (std {est.std_mass:.2g})")
-        com = ", ".join(f"{x:+.5f}" for x in est.com)
-        std = ", ".join(f"{x:.2g}" for x in est.std_com)
-        print(f"  com      [{com}] m  (std [{std}])")
-        if est.inertia_identified:
-            from ..model.inertia import INERTIA_ORDER, inertia6_from_matrix
-
-            for name, v, s in zip(
-                INERTIA_ORDER, inertia6_from_matrix(est.inertia), est.std_inertia, strict=True
-            ):
-                print(f"  I{name}      {v:+.4e} kg m^2  (std {s:.2g})")
-        for note in est.notes:
-            print(f"note: {note}")
-        print(f"wrote {path} and {args.out / 'robot_with_payload.toml'}")
+    console.print(f"payload on frame {est.frame!r} ({est.route}; arm: {label})")
+    console.print(f"  mass     {est.mass:.6g} kg  (std {est.std_mass:.2g})")
+    com = ", ".join(f"{x:+.5f}" for x in est.com)
+    std = ", ".join(f"{x:.2g}" for x in est.std_com)
+    console.print(f"  com      [{com}] m  (std [{std}])")
+    if est.inertia_identified:
+        for name, v, s in zip(
+            INERTIA_ORDER, inertia6_from_matrix(est.inertia), est.std_inertia, strict=True
+        ):
+            console.print(f"  I{name}      {v:+.4e} kg m^2  (std {s:.2g})")
+    for note in est.notes:
+        console.print(f"note: {note}")
+    console.print(f"wrote {path} and {args.out / 'robot_with_payload.toml'}")
     return 0

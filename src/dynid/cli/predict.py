@@ -17,7 +17,8 @@ from pathlib import Path
 
 from ..exceptions import DynidError
 from ..io.model_json import load_model_json
-from .common import add_subcommand, format_matrix, parse_vector, print_json
+from .common import add_subcommand, format_matrix, parse_vector
+from .console import Console
 
 NAME = "predict"
 
@@ -35,7 +36,7 @@ def register(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParser:
     return p
 
 
-def run(args: argparse.Namespace) -> int:
+def run(args: argparse.Namespace, console: Console) -> int:
     """Evaluate and print; returns the exit code."""
     model = load_model_json(args.model)
     n = model.robot.n
@@ -50,10 +51,10 @@ def run(args: argparse.Namespace) -> int:
             ddq = parse_vector(args.ddq, "--ddq", n)
             out["tau"] = model.torques(q, dq, ddq)
     if args.json:
-        print_json(out)
+        console.json(out)
         return 0
-    print(f"M(q) [kg m^2]:\n{format_matrix(out['M'])}")
+    console.print(f"M(q) [kg m^2]:\n{format_matrix(out['M'])}")
     for key, label in (("g", "g(q) [N m]"), ("c", "c(q, dq) [N m]"), ("tau", "tau [N m]")):
         if key in out:
-            print(f"{label}:\n{format_matrix(out[key])}")
+            console.print(f"{label}:\n{format_matrix(out[key])}")
     return 0

@@ -55,6 +55,7 @@ from .common import (
     parse_vector,
     positive_type,
 )
+from .console import Console
 
 NAME = "simulate"
 #: ``--out`` is the one file written (:mod:`dynid.io.run_output`).
@@ -156,9 +157,9 @@ def _friction(args: argparse.Namespace) -> FrictionModel | str:
     return load_friction_json(args.friction)
 
 
-def run(args: argparse.Namespace) -> int:
+def run(args: argparse.Namespace, console: Console) -> int:
     """Simulate and write the log; prints the limit report and a summary (unless -q)."""
-    say = (lambda *a: None) if getattr(args, "quiet", False) else print
+    say = console.print
     robot = load_robot(args)
     n = robot.n
     rng = np.random.default_rng(args.seed)

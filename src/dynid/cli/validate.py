@@ -32,13 +32,13 @@ from pathlib import Path
 
 import numpy as np
 
-from ..exceptions import DataError, DynidError
+from ..exceptions import DataError
 from ..friction.validation import own_friction, recorded_cutoff, validate_torques
 from ..identification.log import DEFAULT_CUTOFF_HZ
 from ..identification.model import IdentifiedModel
+from ..io.feasible import load_feasible_drive, load_feasible_linear_friction
 from ..io.friction_json import load_friction_json
-from ..io.json_files import save_json
-from ..model.robot import Robot
+from ..io.validation_json import save_validation_json
 from .common import (
     about,
     add_column_options,
@@ -46,13 +46,14 @@ from .common import (
     add_log_options,
     add_subcommand,
     load_drive_arg,
-    load_robot,
     positive_type,
-    read_log,
-    reuse_columns,
+    read_data_log,
     shown,
 )
-from .friction import VALIDATION_SCHEMA, format_rms_table, save_validation_figures
+from .console import Console
+from .figures import save_validation_figures
+from .sources import load_model_source
+from .summaries import format_rms_table
 
 NAME = "validate"
 #: ``--out`` is a folder: its files are one output set (:mod:`dynid.io.run_output`).
@@ -94,36 +95,12 @@ def register(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParser:
     return p
 
 
-def load_model_source(args: argparse.Namespace) -> tuple[IdentifiedModel | Robot, str]:
-    """The rigid-body model and a label, from --model, --robot or --params."""
-    if args.model is not None:
-        from ..io.model_json import load_model_json
-
-        return load_model_json(args.model), str(args.model.name)
-    if args.robot is not None:
-        return load_robot(args), f"robot {args.robot}"
-    if args.params is not None:
-        from ..io.feasible import load_feasible_json
-
-        return load_feasible_json(args.params), str(args.params.name)
-    raise DynidError(
-        "give one model source: --model identification.json, --robot ROBOT "
-        "or --params feasible.json"
-    )
-
-
-def run(args: argparse.Namespace) -> int:
+def run(args: argparse.Namespace, console: Console) -> int:
     """Validate, write validation.json and the figures, print the RMS table (unless -q)."""
-    say = (lambda *a: None) if getattr(args, "quiet", False) else print
     model, label = load_model_source(args)
     robot = model.robot if isinstance(model, IdentifiedModel) else model
-    if isinstance(model, IdentifiedModel):
-        reuse_columns(args, model.metadata)
-    log = read_log(args, args.data, robot.n)
-    if log.n != robot.n:
-        raise DataError(
-            f"{args.data.name}: the log has {log.n} joints; the model ({label}) has {robot.n}"
-        )
+    recorded = model.metadata if isinstance(model, IdentifiedModel) else None
+    log = read_data_log(args, robot.n, owner=f"the model ({label})", metadata=recorded)
     logs = [log]  # handed over: validate frees the raw signals once it has filtered them
     del log
     if args.friction is not None:
@@ -133,14 +110,10 @@ def run(args: argparse.Namespace) -> int:
     else:
         friction = own_friction(model)
         if args.params is not None:
-            from ..io.feasible import load_feasible_linear_friction
-
             friction = load_feasible_linear_friction(args.params) or friction
     cutoff = recorded_cutoff(model) if args.cutoff is None else args.cutoff
     drive = load_drive_arg(args, robot.n)
     if drive is None and args.params is not None:
-        from ..io.feasible import load_feasible_drive
-
         drive = load_feasible_drive(args.params)
     with about(args.data):
         val = validate_torques(
@@ -158,17 +131,18 @@ def run(args: argparse.Namespace) -> int:
             f"{errors.relative_error_percent}); the log holds values far outside a robot's "
             f"range (largest |tau| {float(np.max(np.abs(val.log.tau))):.3g} N m)"
         )
-    doc = val.as_dict()
-    doc["model"] = label
-    doc["friction_source"] = (
-        str(args.friction.name)
-        if args.friction is not None
-        else ("model" if friction is not None else None)
+    path = save_validation_json(
+        args.out / "validation.json",
+        val,
+        model=label,
+        friction_source=(
+            str(args.friction.name)
+            if args.friction is not None
+            else ("model" if friction is not None else None)
+        ),
+        data=str(args.data.name),
+        cutoff_hz=cutoff,
     )
-    doc["data"] = str(args.data.name)
-    doc["cutoff_hz"] = cutoff
-    doc["units"] = {"rms": "N m", "mse": "N^2 m^2", "relative_error_percent": "%"}
-    save_json(args.out / "validation.json", doc, schema=VALIDATION_SCHEMA)
     names = list(robot.joint_names)
     if not args.no_figures:
         save_validation_figures(
@@ -177,9 +151,8 @@ def run(args: argparse.Namespace) -> int:
     cols = {"RMS no friction [N m]": val.without_friction.rms}
     if val.with_friction is not None:
         cols["RMS + friction [N m]"] = val.with_friction.rms
-    say(format_rms_table(names, cols))
-    say(
-        f"relative error {val.errors.relative_error_percent:.3f} %; "
-        f"wrote {args.out / 'validation.json'}"
+    console.print(
+        format_rms_table(names, cols),
+        f"relative error {val.errors.relative_error_percent:.3f} %; wrote {path}",
     )
     return 0

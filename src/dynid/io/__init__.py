@@ -36,6 +36,8 @@ _NAMES = {
     "load_toml": "robot.toml",
     "save_mjcf": "robot.mjcf",
     "save_payload_json": "payload_json",
+    "save_validation_json": "validation_json",
+    "save_feasible_bundle": "feasible_bundle",
     "save_trajectory_csv": "excitation",
     "save_excitation_json": "excitation",
     "load_trajectory": "excitation",

@@ -39,6 +39,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from ..exceptions import DataError
+from ..identification.consistency import recorded_robot_mismatch
 from ..identification.data import DEFAULT_SYMMETRY_RTOL, StaticDataset
 from ..model.robot import Robot
 from ..regressors.static import static_labels
@@ -87,14 +88,48 @@ def save_static_data(path: str | Path, data: StaticDataset) -> Path:
 def load_static_data(
     path: str | Path, robot: Robot | None = None, *, drop_invalid: bool = False
 ) -> tuple[StaticDataset, int]:
-    """Read a ``.csv`` or ``.npz`` static data set; see :func:`load_static_csv`."""
+    """Read a ``.csv`` or ``.npz`` static data set of ``robot``.
+
+    Parameters
+    ----------
+    path : str or Path
+        The file (:func:`load_static_csv`, :func:`load_static_npz`).
+    robot : Robot, optional
+        The robot the data belong to: the file must have ``robot.n`` joints and, when it
+        records the robot it was acquired with (``metadata`` ``robot`` and
+        ``kinematics``, as ``dynid acquire-static`` writes them), that robot must be this
+        one (name and kinematics).
+    drop_invalid : bool
+        Drop invalid rows (counted) instead of raising.
+
+    Returns
+    -------
+    data : StaticDataset
+        ``q`` (N, n) [rad], ``M`` (N, n, n) [kg m^2], ``g`` (N, n) [N m] and metadata.
+    n_dropped : int
+        Rows dropped (0 unless ``drop_invalid``).
+
+    Raises
+    ------
+    DataError
+        A file that is not ``.csv``/``.npz``, a bad file (:func:`load_static_csv`), or
+        data recorded with another robot than ``robot`` (named, with the hint to pass
+        ``--robot`` for the arm that recorded them).
+    """
     path = Path(path)
     suffix = path.suffix.lower()
     if suffix == ".csv":
-        return load_static_csv(path, robot, drop_invalid=drop_invalid)
-    if suffix == ".npz":
-        return load_static_npz(path, robot, drop_invalid=drop_invalid)
-    raise DataError(f"static data file must end in .csv or .npz; got {path.name!r}")
+        data, n_dropped = load_static_csv(path, robot, drop_invalid=drop_invalid)
+    elif suffix == ".npz":
+        data, n_dropped = load_static_npz(path, robot, drop_invalid=drop_invalid)
+    else:
+        raise DataError(f"static data file must end in .csv or .npz; got {path.name!r}")
+    mismatch = None if robot is None else recorded_robot_mismatch(robot, data.metadata)
+    if mismatch is not None:
+        raise DataError(
+            f"{path.name}: {mismatch}; hint: pass --robot for the arm that recorded the data"
+        )
+    return data, n_dropped
 
 
 # ---------------------------------------------------------------------------- CSV

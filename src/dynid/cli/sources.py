@@ -1,0 +1,30 @@
+"""The model a command compares with data or carries a load on: ``--model``,
+``--robot`` or ``--params`` (kept apart from :mod:`.common`, which the kinematics commands
+import: reading feasible.json loads the feasibility package)."""
+
+from __future__ import annotations
+
+import argparse
+
+from ..exceptions import DynidError
+from ..identification.model import IdentifiedModel
+from ..io.feasible import load_feasible_json
+from ..io.model_json import load_model_json
+from ..model.robot import Robot
+from .common import load_robot
+
+__all__ = ["load_model_source"]
+
+
+def load_model_source(args: argparse.Namespace) -> tuple[IdentifiedModel | Robot, str]:
+    """The rigid-body model and a label, from --model, --robot or --params."""
+    if args.model is not None:
+        return load_model_json(args.model), str(args.model.name)
+    if args.robot is not None:
+        return load_robot(args), f"robot {args.robot}"
+    if args.params is not None:
+        return load_feasible_json(args.params), str(args.params.name)
+    raise DynidError(
+        "give one model source: --model identification.json, --robot ROBOT "
+        "or --params feasible.json"
+    )

@@ -1,0 +1,248 @@
+"""The tables and summaries the commands print (text only: printing is the console's)."""
+
+from __future__ import annotations
+
+import sys
+from typing import Any
+
+import numpy as np
+
+from ..feasibility.constraints import principal_moments
+from ..feasibility.heldout import HeldOutJudgement
+from ..feasibility.retrieve import RetrievalProgress, RetrievalResult
+from ..feasibility.sdp import ConsistentResult
+from ..friction.validation import NewtonEulerValidation
+from ..identification.model import IdentifiedModel
+from ..regressors.base import identifiability
+
+__all__ = [
+    "format_consistent",
+    "format_identification",
+    "format_newton_euler_rms",
+    "format_retrieval",
+    "format_rms_table",
+    "heldout_line",
+    "heldout_table",
+    "progress_printer",
+]
+
+
+def format_identification(model: IdentifiedModel, *, width: int = 60) -> str:
+    """A readable summary: metrics, then one line per coefficient (expressions shortened)."""
+    fit, meta = model.fit, model.metadata
+    head = [
+        f"{meta.get('route', '?')} identification of {model.robot.name}: "
+        + (
+            f"{meta['n_configurations']} configurations"
+            if "n_configurations" in meta
+            else f"{meta.get('n_samples_used', '?')} samples of {meta.get('n_samples_log', '?')}"
+        )
+        + f", {fit.n_rows} rows"
+        + (f", dropped rows {', '.join(meta['dropped_rows'])}" if meta.get("dropped_rows") else ""),
+        f"rank {fit.rank}, condition number {fit.condition_number:.4g} (unscaled, as the "
+        f"paper), scaled {fit.scaled_condition_number:.4g}, relative error "
+        f"{fit.relative_error_percent:.4g} %, estimator {meta.get('estimator', 'ols')}, "
+        f"std {meta.get('std_estimator', '?')}"
+        + (
+            f", pruned {len(meta['pruned'])} above {meta['max_std_percent']:g} %"
+            if meta.get("pruned")
+            else ""
+        ),
+    ]
+    if fit.residual_rms == 0.0 or not np.any(fit.std[fit.kept]):
+        head.append("the residual is zero to rounding (exact data): standard deviations are 0")
+    ho = meta.get("heldout")
+    if ho:
+        head.append(heldout_line(ho))
+    if model.base.gap is not None:
+        hi, lo = model.base.gap
+        head.append(
+            f"base parameters: {model.base.rank}, rank cut between singular values {hi:.3g} "
+            f"and {lo:.3g} (relative to the largest, column-scaled regressor)"
+        )
+    status = identifiability(model.base)
+    groups = {
+        k: [lab for lab, st in zip(model.base.std_labels, status, strict=True) if st == k]
+        for k in ("identifiable", "combination", "unidentifiable")
+    }
+    head.append(
+        f"standard parameters: {len(groups['identifiable'])} identifiable, "
+        f"{len(groups['combination'])} only in combination, "
+        f"{len(groups['unidentifiable'])} unidentifiable"
+        + (f" ({', '.join(groups['unidentifiable'])})" if groups["unidentifiable"] else "")
+    )
+    head.append(f"{'#':>3}  {'name':<7} {'value':>13} {'std %':>9}  kept  expression")
+    rows = []
+    for k in range(model.base.rank):
+        e = model.base.expressions[k]
+        e = e if len(e) <= width else e[: width - 3] + "..."
+        pct = fit.std_percent[k]
+        rows.append(
+            f"{k + 1:>3}  {model.base.labels[k]:<7} {fit.beta[k]:>+13.6g} "
+            f"{'-' if not np.isfinite(pct) else f'{pct:.3g}':>9}  "
+            f"{'yes' if fit.kept[k] else 'no':<4}  {e}"
+        )
+    return "\n".join(head + rows)
+
+
+def heldout_line(ho: dict[str, Any]) -> str:
+    """The training and held-out errors of least squares (``metadata["heldout"]``)."""
+    how = (
+        "on the --validate-on log"
+        if ho.get("scheme") == "file"
+        else f"over {ho.get('folds')} contiguous time blocks"
+    )
+    return (
+        f"least squares: training error {ho['training_error_percent']:.4g} %, held-out "
+        f"error {ho['heldout_error_percent']:.4g} % ({how})"
+    )
+
+
+def heldout_table(j: HeldOutJudgement) -> list[str]:
+    """Training against held-out errors of least squares and of the consistent fit."""
+    how = "the --validate-on log" if j.scheme == "file" else f"{j.folds} contiguous time blocks"
+    verdict = "accepted" if j.accepted else "NOT accepted"
+    return [
+        f"torque error [%]      {'training':>9}  {'held-out':>9}   (held out: {how})",
+        f"least squares         {j.ls_training_percent:>9.4g}  {j.ls_heldout_percent:>9.4g}",
+        f"consistent            {j.training_percent:>9.4g}  {j.heldout_percent:>9.4g}",
+        f"{verdict}: held-out error {100 * (j.ratio - 1):+.3g} % against least squares "
+        f"(tolerance +{100 * j.tolerance:g} %); the training residual does not decide",
+    ]
+
+
+def progress_printer(stream: Any = None, *, header: str | None = None) -> Any:
+    """A ``progress`` callback that prints one line per finished run on ``stream`` (stderr),
+    after ``header`` (printed with the first run's line)."""
+    pending = [header] if header is not None else []
+
+    def show(p: RetrievalProgress) -> None:
+        out = sys.stderr if stream is None else stream
+        while pending:
+            out.write(f"{pending.pop()}\n")
+        state = "feasible" if p.feasible else "INFEASIBLE"
+        out.write(
+            f"  run {p.done:>2}/{p.total} (#{p.run}): cost {p.cost:.3e}, relative residual "
+            f"{p.relative_residual:.2e}, {state}  [{p.elapsed:6.1f} s]\n"
+        )
+        out.flush()
+
+    return show
+
+
+def _band_margin(r: RetrievalResult) -> float:
+    return min(r.report.min_margin("total_mass_min"), r.report.min_margin("total_mass_max"))
+
+
+def format_retrieval(result: RetrievalResult) -> str:
+    """Readable summary: per link mass, CoM, principal moments and triangle margin; totals."""
+    r = result
+    lam = principal_moments(r.inertia)
+    tri = {c.link: c.margin for c in r.report.select("triangle_inequality")}
+    names = r.robot.link_names[1:]
+    w = max(len(s) for s in names)
+    lines = [
+        f"{'link':<{w}}  {'mass [kg]':>9}  {'CoM [m]':^26}  "
+        f"{'principal moments [kg m^2]':^30}  {'triangle':>9}",
+    ]
+    for i, name in enumerate(names):
+        c = " ".join(f"{x:+.4f}" for x in r.com[i])
+        m = " ".join(f"{x:.3e}" for x in lam[i])
+        lines.append(f"{name:<{w}}  {r.mass[i]:>9.4f}  {c:^26}  {m:^30}  {tri[i + 1]:>9.2e}")
+    status = "FEASIBLE" if r.feasible else "INFEASIBLE (least-violating solution)"
+    lines += [
+        f"total mass {float(np.sum(r.mass)):.4f} kg"
+        + ("" if r.total_mass is None else f" (band {r.total_mass[0]:g}..{r.total_mass[1]:g} kg)"),
+        f"{status}: relative residual {r.relative_residual:.3e} ({r.kind}); "
+        f"{r.n_feasible_runs}/{len(r.runs)} runs feasible; kept run {r.best_run}",
+        "min margins: "
+        + ", ".join(
+            f"{n} {r.report.min_margin(n):.3g}"
+            for n in (
+                "mass_positive",
+                "inertia_positive_definite",
+                "triangle_inequality",
+                "com_in_box",
+            )
+            if r.report.select(n)
+        )
+        + (f", total mass {_band_margin(r):.3g} kg" if r.report.select("total_mass_min") else ""),
+        f"stage costs {', '.join(f'{x:.3g}' for x in r.stage_costs)}; "
+        f"{r.run_time:.1f} s on {r.workers} worker(s), seed {r.seed}",
+    ]
+    if not r.feasible:
+        lines.append(str(r.report))
+    return "\n".join(lines)
+
+
+def format_consistent(result: ConsistentResult) -> str:
+    """Readable summary of a convex retrieval: per link mass, CoM, margin; fit; notes."""
+    r = result
+    names = r.robot.link_names[1:]
+    w = max(len(s) for s in names)
+    lines = [
+        f"{'link':<{w}}  {'mass [kg]':>9}  {'prior [kg]':>10}  {'CoM [m]':^26}  "
+        f"{'lambda_min(J)/tr(J)':>19}",
+    ]
+    for i, name in enumerate(names):
+        c = " ".join(f"{x:+.4f}" for x in r.com[i])
+        lines.append(
+            f"{name:<{w}}  {r.mass[i]:>9.4f}  {r.prior.mass[i]:>10.4f}  {c:^26}  "
+            f"{r.pseudo_inertia_margin[i]:>19.3e}"
+        )
+    status = "CONSISTENT" if r.feasible else "NOT CONSISTENT WITH THE SPECIFICATION (closest set)"
+    lines += [
+        f"total mass {float(np.sum(r.mass)):.4f} kg"
+        + ("" if r.total_mass is None else f" (band {r.total_mass[0]:g}..{r.total_mass[1]:g} kg)"),
+        f"{status}: method sdp ({r.options.objective}, prior {r.prior.source}), fit {r.fit}, "
+        f"relative residual on the coefficients {r.relative_residual:.3e}, data residual "
+        f"{100 * (r.residual_ratio - 1):.3f} % above the unconstrained fit",
+        f"solver {r.solver}: {r.status}, {r.run_time:.2f} s",
+    ]
+    if r.heldout is not None:
+        lines += heldout_table(r.heldout)
+    if r.friction is not None:
+        at = "motors" if r.drive is not None and r.drive.friction_at == "motor" else "joints"
+        lines.append(
+            f"friction at the {at}: fv [N m s/rad]: "
+            + " ".join(f"{x:.4g}" for x in r.friction[:, 0])
+            + "; fc [N m]: "
+            + " ".join(f"{x:.4g}" for x in r.friction[:, 1])
+        )
+    if r.rotor_inertia is not None:
+        lines.append(
+            "rotor inertia at the motors [kg m^2] (>= 0): "
+            + " ".join(f"{x:.4g}" for x in r.rotor_inertia)
+        )
+    lines += [f"note: {s}" for s in r.notes]
+    if not r.feasible:
+        lines.append(str(r.report))
+    return "\n".join(lines)
+
+
+def format_rms_table(names: list[str], columns: dict[str, np.ndarray]) -> str:
+    """A per-joint table of RMS values [N m]."""
+    head = f"{'joint':<10}" + "".join(f"{k:>22}" for k in columns)
+    rows = [head]
+    for j, name in enumerate(names):
+        rows.append(f"{name:<10}" + "".join(f"{float(v[j]):>22.4f}" for v in columns.values()))
+    return "\n".join(rows)
+
+
+def format_newton_euler_rms(val: NewtonEulerValidation) -> str:
+    """Per-joint RMS of the Newton-Euler torques with retrieved parameters [N m] (and of
+    the identified model, when compared)."""
+    names = val.joint_names
+    w = max(len(s) for s in names)
+    head = f"{'joint':<{w}}  {'RMS NE [N m]':>12}" + (
+        "  {:>18}".format("RMS identified [N m]") if val.errors_reference is not None else ""
+    )
+    rows = [head]
+    for j, name in enumerate(names):
+        row = f"{name:<{w}}  {val.errors.rms[j]:>12.4f}"
+        if val.errors_reference is not None:
+            row += f"  {val.errors_reference.rms[j]:>20.4f}"
+        rows.append(row)
+    fr = "with " + val.friction_kind + " friction" if val.friction_kind else "without friction"
+    rows.append(f"(torques {fr}; relative error NE {val.errors.relative_error_percent:.2f} %)")
+    return "\n".join(rows)

@@ -1,0 +1,68 @@
+"""The files of a retrieval or a consistent fit: ``feasible.json``, ``robot.urdf``,
+``robot.xml`` (MJCF), ``robot.toml`` and ``report.json`` in one folder.
+
+Written alike by ``dynid retrieve``, ``dynid identify --consistent`` and the demo's
+feasible stage. The friction a one-step fit identified with the links (classical ``fv``,
+``fc``, ``fo`` per joint, at the joints or, with a drive whose friction acts there, at the
+motors) goes on the exported robots.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Any
+
+from ..feasibility.retrieve import RetrievalResult
+from ..feasibility.sdp import ConsistentResult
+from ..friction.model import ClassicalFriction, DriveFriction
+from .export import ROBOT_FORMATS, ExportOptions, save_robot_files
+from .feasible import save_feasible_json, save_report_json
+
+__all__ = ["FEASIBLE_BUNDLE", "save_feasible_bundle"]
+
+#: The files :func:`save_feasible_bundle` writes, in order: feasible.json, one robot file
+#: per export format (:data:`~dynid.io.export.ROBOT_FORMATS`: robot.urdf, robot.xml,
+#: robot.toml), report.json.
+FEASIBLE_BUNDLE = (
+    "feasible.json",
+    *(f"robot{f.suffixes[0]}" for f in ROBOT_FORMATS.values()),
+    "report.json",
+)
+
+
+def save_feasible_bundle(
+    folder: str | Path, result: RetrievalResult | ConsistentResult, **report_extra: Any
+) -> list[Path]:
+    """Write :data:`FEASIBLE_BUNDLE` for ``result`` into ``folder``.
+
+    Parameters
+    ----------
+    folder : str or Path
+        An existing folder.
+    result : RetrievalResult or ConsistentResult
+        A retrieval (penalty method) or a convex retrieval / one-step consistent fit.
+    **report_extra
+        Extra keys of ``report.json`` (``source``, ``seed``), JSON values.
+
+    Returns
+    -------
+    list of Path
+        The files, in the order of :data:`FEASIBLE_BUNDLE`.
+
+    Raises
+    ------
+    NonFiniteError
+        A NaN or infinite number in a JSON file (named).
+    """
+    folder = Path(folder)
+    files = [save_feasible_json(folder / "feasible.json", result)]
+    fr = getattr(result, "friction", None)  # one-step on a log: classical fv, fc, fo
+    drive = getattr(result, "drive", None)
+    friction: Any = True
+    if fr is not None:
+        law = ClassicalFriction.from_array(fr)
+        at_motors = drive is not None and drive.friction_at == "motor"
+        friction = DriveFriction(law, drive) if drive is not None and at_motors else law
+    files += save_robot_files(folder, result.robot, ExportOptions(friction=friction, drive=drive))
+    files.append(save_report_json(folder / "report.json", result, **report_extra))
+    return files

@@ -1,0 +1,14 @@
+"""Workflows on files: the entry points the commands call, with every check and policy a
+command applies, so that the Python API and the ``dynid`` commands behave the same.
+
+* :mod:`~dynid.workflows.data_files`: the kind of a data file; torque logs and static
+  data read strictly and checked against the robot (joint count, recorded robot, log
+  cleaning); the column map a model's data were read with.
+* :mod:`~dynid.workflows.prior`: the prior of a consistent fit (``--prior``), checked.
+* :mod:`~dynid.workflows.identify`: identification from a data file (both routes, and
+  the one-step consistent fit).
+* :mod:`~dynid.workflows.retrieve`: feasible parameters from a model or static data file.
+
+The layer sits above :mod:`dynid.io` (it reads files) and below the command line, which
+parses, calls one of these, prints and saves.
+"""

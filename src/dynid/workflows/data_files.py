@@ -1,0 +1,240 @@
+"""Measured data files as every workflow reads them: the kind of a file, torque logs and
+static data read strictly (through a column map for files of other tools), checked
+against the robot they belong to.
+
+The policies, the same for the Python API and every command:
+
+* a torque log whose cleaning dropped rows (NaN/inf, a repeated timestamp) is an error
+  unless ``drop_invalid``; so is a log with another joint count than the robot's;
+* a static data file must have the robot's joint count and, when it records the robot
+  it was acquired with, be of that robot (:func:`dynid.io.static_data.load_static_data`);
+* a model records the column map its data were read with (``metadata["column_map"]``);
+  a log validated against it is read the same way (:func:`recorded_columns`).
+"""
+
+from __future__ import annotations
+
+import logging
+import zipfile
+from collections.abc import Mapping
+from pathlib import Path
+from typing import Any, Literal
+
+import numpy as np
+
+from ..exceptions import DataError
+from ..identification.data import StaticDataset
+from ..identification.log import TorqueLog
+from ..io.columns import (
+    ColumnMap,
+    load_column_map,
+    load_mapped_static_data,
+    load_mapped_torque_log,
+    parse_column_map,
+)
+from ..io.static_data import load_static_data
+from ..io.torque_log import load_torque_log
+from ..model.robot import Robot
+
+__all__ = [
+    "DataKind",
+    "column_map",
+    "data_kind",
+    "read_static_file",
+    "read_torque_log",
+    "recorded_columns",
+]
+
+_log = logging.getLogger(__name__)
+
+#: What a data file holds.
+DataKind = Literal["static", "torque_log"]
+
+
+def column_map(
+    columns: str | None = None, units: str | None = None, *, cutoff_hz: float | None = None
+) -> ColumnMap | None:
+    """The column map of ``--columns`` (text or a ``.toml`` file) and ``--units``, or None.
+
+    Parameters
+    ----------
+    columns : str, optional
+        ``'q=position_{i0},tau=effort_{i0}'`` or a TOML file with ``[columns]`` and
+        ``[units]``.
+    units : str, optional
+        ``'q=deg,tau=mNm,t=ms'``; added to (and overriding) a TOML file's units.
+    cutoff_hz : float, optional
+        Cut-off [Hz] of the velocities derived from positions (default: the library's).
+
+    Raises
+    ------
+    DataError
+        A malformed map or unit (named).
+    """
+    if columns is None and units is None:
+        return None
+    kw = {} if cutoff_hz is None else {"velocity_cutoff_hz": cutoff_hz}
+    if columns is not None and columns.lower().endswith(".toml"):
+        cmap = load_column_map(columns, **kw)
+        if units is not None:
+            extra = parse_column_map(None, units)
+            cmap = type(cmap)(cmap.columns, {**cmap.factors, **extra.factors}, **kw)
+        return cmap
+    return parse_column_map(columns, units, **kw)
+
+
+def data_kind(path: str | Path, columns: ColumnMap | None = None) -> DataKind:
+    """``"static"`` or ``"torque_log"``.
+
+    A CSV with a ``t`` column or an NPZ with ``t``/``tau`` is a torque log; with a column
+    map, mapping ``t``, ``dq``, ``ddq`` or ``tau`` makes a torque log and mapping ``M`` or
+    ``g`` static data.
+
+    Raises
+    ------
+    DataError
+        Neither ``.csv`` nor ``.npz``, a CSV without a header line, an unreadable NPZ.
+    """
+    path = Path(path)
+    if columns is not None:
+        if any(columns.mapped(k) for k in ("t", "dq", "tau", "ddq")):
+            return "torque_log"
+        if any(columns.mapped(k) for k in ("M", "g")):
+            return "static"
+    suffix = path.suffix.lower()
+    if suffix == ".csv":
+        with path.open(encoding="utf-8-sig", errors="replace") as fh:
+            for line in fh:
+                s = line.strip()
+                if s and not s.startswith("#"):
+                    cols = [c.strip() for c in s.split(",")]
+                    return "torque_log" if "t" in cols else "static"
+        raise DataError(f"{path.name}: no header line")
+    if suffix == ".npz":
+        try:
+            with np.load(path, allow_pickle=False) as z:
+                keys = set(z.files)
+        except (ValueError, EOFError, zipfile.BadZipFile) as exc:
+            raise DataError(f"{path.name}: not a readable NPZ file ({exc})") from exc
+        except (AttributeError, TypeError):  # a single .npy array: np.load gives an array
+            raise DataError(f"{path.name}: a single array, not an NPZ archive") from None
+        return "torque_log" if "t" in keys or "tau" in keys else "static"
+    raise DataError(f"--data must be a .csv or .npz file; got {path.name!r}")
+
+
+def read_torque_log(
+    path: str | Path,
+    n: int | None = None,
+    *,
+    columns: ColumnMap | None = None,
+    drop_invalid: bool = False,
+    owner: str | None = None,
+) -> TorqueLog:
+    """The torque log ``path``, read strictly, with ``n`` joints.
+
+    Parameters
+    ----------
+    path : str or Path
+        A dynid torque log (CSV/NPZ), or a file of another tool read through ``columns``.
+    n : int, optional
+        Joint count the log must have.
+    columns : ColumnMap, optional
+        Column names and units of another tool's file (notes are logged as warnings).
+    drop_invalid : bool
+        Drop rows with NaN/inf or a repeated timestamp (logged) instead of failing.
+    owner : str, optional
+        What has ``n`` joints, for the message (default ``"the robot"``).
+
+    Returns
+    -------
+    TorqueLog
+        ``t`` (N,) [s], ``q``, ``dq``, ``tau`` (N, n) [rad, rad/s, N m].
+
+    Raises
+    ------
+    DataError
+        A bad file; invalid rows without ``drop_invalid``; another joint count than ``n``.
+    """
+    path = Path(path)
+    if columns is None:
+        log = load_torque_log(path, drop_invalid=drop_invalid)
+    else:
+        mapped = load_mapped_torque_log(path, columns, n=n)
+        for note in mapped.notes:
+            _log.warning("%s: %s", path.name, note)
+        c = mapped.log.cleaning
+        if c.n_nan_rows or c.n_duplicates:
+            what = (
+                f"{c.n_nan_rows} row(s) of {c.n_input_rows} hold NaN or inf and "
+                f"{c.n_duplicates} repeat the previous timestamp"
+            )
+            if not drop_invalid:
+                raise DataError(
+                    f"{path.name}: {what}; hint: fix the file or pass --drop-invalid to drop them"
+                )
+            _log.warning("%s: dropped: %s", path.name, what)
+        log = mapped.log
+    if n is not None and log.n != n:
+        raise DataError(
+            f"{path.name}: the log has {log.n} joints; {owner or 'the robot'} has {n}; "
+            "hint: pass the robot the log was recorded with"
+        )
+    return log
+
+
+def read_static_file(
+    path: str | Path,
+    robot: Robot,
+    *,
+    columns: ColumnMap | None = None,
+    drop_invalid: bool = False,
+) -> StaticDataset:
+    """Static data ``q, M, g`` of ``robot`` from ``path``, read strictly.
+
+    A dynid file is read by :func:`~dynid.io.static_data.load_static_data` (its recorded
+    robot checked against ``robot``); a file of another tool through ``columns`` (notes
+    logged as warnings).
+
+    Raises
+    ------
+    DataError
+        A bad file, another joint count than ``robot.n``, data recorded with another robot.
+    """
+    path = Path(path)
+    if columns is not None:
+        mapped = load_mapped_static_data(path, columns, robot)
+        for note in mapped.notes:
+            _log.warning("%s: %s", path.name, note)
+        return mapped.data
+    data, _ = load_static_data(path, robot, drop_invalid=drop_invalid)
+    return data
+
+
+def recorded_columns(
+    metadata: Mapping[str, Any] | None, columns: str | None, units: str | None
+) -> tuple[str | None, str | None]:
+    """The ``--columns``/``--units`` to read a log with for a model identified with
+    ``metadata["column_map"]``: the recorded ones when none are given (logged).
+
+    Raises
+    ------
+    DataError
+        Other ones than recorded (the log would be read another way).
+    """
+    rec = dict(metadata or {}).get("column_map")
+    if not isinstance(rec, dict):
+        return columns, units
+    if (columns, units) == (None, None):
+        columns, units = rec.get("columns"), rec.get("units")
+        _log.warning(
+            "reading --data as the model's data were read: --columns %r --units %r",
+            columns,
+            units,
+        )
+    elif (columns, units) != (rec.get("columns"), rec.get("units")):
+        raise DataError(
+            f"--columns {columns!r} --units {units!r} differ from those the model was "
+            f"identified with ({rec.get('columns')!r}, {rec.get('units')!r}); hint: leave "
+            "them out to use the model's"
+        )
+    return columns, units

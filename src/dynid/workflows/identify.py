@@ -1,0 +1,260 @@
+"""Identify from a data file: the entry point of ``dynid identify``, with every check the
+command applies, so that the Python API behaves as the command does.
+
+* The file's kind (static data or a torque log, :func:`~.data_files.data_kind`) picks the
+  route; the data are read strictly and checked against the robot
+  (:mod:`dynid.workflows.data_files`: joint count, recorded robot, log cleaning).
+* Static data: configurations outside the joint limits and a relative error far above
+  the recorded noise level are :class:`~dynid.exceptions.DynidWarning` warnings.
+* ``std`` (standard deviations, ``--std``) is honoured on both routes (default: robust
+  for static data, classical for torque logs); the consistent fit refuses it and
+  ``max_std_percent``, which do not apply to it.
+* The column map the data were read with is recorded in the model's metadata.
+"""
+
+from __future__ import annotations
+
+import warnings
+from pathlib import Path
+from typing import Any, Literal
+
+from ..exceptions import DataError, DynidError, DynidWarning
+from ..feasibility.one_step import identify_consistent
+from ..feasibility.sdp import ConsistentResult, SDPOptions
+from ..identification.classical import identify_from_log
+from ..identification.consistency import fit_mismatch, limit_violations
+from ..identification.estimators import EstimatorName
+from ..identification.log import DEFAULT_CUTOFF_HZ
+from ..identification.model import IdentifiedModel
+from ..identification.static import identify_static
+from ..model.drive import Drive
+from ..model.robot import Robot
+from .data_files import column_map, data_kind, read_static_file, read_torque_log
+
+__all__ = ["ColumnSpec", "identify_consistent_file", "identify_file"]
+
+#: ``--columns``/``--units`` as typed (text or a TOML file; units), or None.
+ColumnSpec = tuple[str | None, str | None]
+
+
+def _columns(spec: ColumnSpec | None, cutoff_hz: float | None) -> Any:
+    return None if spec is None else column_map(*spec, cutoff_hz=cutoff_hz)
+
+
+def _heldout(
+    path: Path,
+    kind: str,
+    folds: int | None,
+    validate_on: str | Path | None,
+    n: int,
+    cmap: Any,
+    drop_invalid: bool,
+) -> dict[str, Any]:
+    """``folds``/``validate_on`` of the torque-log routes (the log read as ``path`` is);
+    refused for static data."""
+    if folds is None and validate_on is None:
+        return {}
+    if kind != "torque_log":
+        raise DataError(
+            f"{path.name}: --folds and --validate-on apply to torque logs, not static data"
+        )
+    kw: dict[str, Any] = {} if folds is None else {"folds": folds}
+    if validate_on is not None:
+        kw["validate_on"] = read_torque_log(validate_on, n, columns=cmap, drop_invalid=drop_invalid)
+    return kw
+
+
+def _record(metadata: dict[str, Any], spec: ColumnSpec | None) -> None:
+    if spec is not None and spec != (None, None):
+        metadata["column_map"] = {"columns": spec[0], "units": spec[1]}
+
+
+def identify_file(
+    robot: Robot,
+    path: str | Path,
+    *,
+    columns: ColumnSpec | None = None,
+    drop_invalid: bool = False,
+    max_std_percent: float | None = None,
+    rtol: float | None = None,
+    std: Literal["robust", "classical"] | None = None,
+    estimator: EstimatorName = "ols",
+    drive: Drive | None = None,
+    cutoff_hz: float | None = None,
+    max_gap_s: float | None = None,
+    folds: int | None = None,
+    validate_on: str | Path | None = None,
+) -> IdentifiedModel:
+    """The base parameters (and, from a torque log, friction) of ``robot`` from ``path``.
+
+    Parameters
+    ----------
+    robot : Robot
+        The robot the data belong to.
+    path : str or Path
+        Static data (``q, M, g``) or a torque log, ``.csv`` or ``.npz``.
+    columns : (str or None, str or None), optional
+        ``--columns`` and ``--units`` of a file of another tool (recorded in the model).
+    drop_invalid : bool
+        Drop invalid rows (counted, named) instead of failing.
+    max_std_percent, rtol, estimator, drive
+        As :func:`~dynid.identification.static.identify_static`.
+    std : {"robust", "classical"}, optional
+        Standard deviations (default robust for static data, classical for a log).
+    cutoff_hz : float, optional
+        Torque logs: zero-phase low-pass cutoff [Hz] (default: the library's); also the
+        cutoff of velocities derived from positions through ``columns``.
+    max_gap_s : float, optional
+        Torque logs: longest gap bridged by interpolation [s].
+    folds : int, optional
+        Torque logs: contiguous time blocks of the held-out judgement (``--folds``).
+    validate_on : str or Path, optional
+        Torque logs: judge on this separate log (read as ``path``) instead of time blocks.
+
+    Returns
+    -------
+    IdentifiedModel
+
+    Raises
+    ------
+    DataError
+        A bad file, data of another robot or joint count, invalid rows without
+        ``drop_invalid``; ``folds`` or ``validate_on`` with static data.
+    """
+    path = Path(path)
+    cmap = _columns(columns, cutoff_hz)
+    kind = data_kind(path, cmap)
+    heldout = _heldout(path, kind, folds, validate_on, robot.n, cmap, drop_invalid)
+    if kind == "torque_log":
+        log = read_torque_log(
+            path,
+            robot.n,
+            columns=cmap,
+            drop_invalid=drop_invalid,
+            owner=f"robot {robot.name!r}",
+        )
+        model = _in_file(
+            path,
+            lambda: identify_from_log(
+                robot,
+                log,
+                max_std_percent=max_std_percent,
+                rtol=rtol,
+                max_gap_s=max_gap_s,
+                drive=drive,
+                estimator=estimator,
+                std=std or "classical",
+                cutoff_hz=DEFAULT_CUTOFF_HZ if cutoff_hz is None else cutoff_hz,
+                **heldout,
+            ),
+        )
+    else:
+        data = read_static_file(path, robot, columns=cmap, drop_invalid=drop_invalid)
+        outside = limit_violations(robot, data.q)
+        if outside is not None:
+            warnings.warn(f"{path.name}: {outside}", DynidWarning, stacklevel=2)
+        model = _in_file(
+            path,
+            lambda: identify_static(
+                robot,
+                data,
+                max_std_percent=max_std_percent,
+                rtol=rtol,
+                std=std or "robust",
+                drive=drive,
+                estimator=estimator,
+            ),
+        )
+        misfit = fit_mismatch(model.fit.relative_error_percent, data.metadata)
+        if misfit is not None:
+            warnings.warn(f"{path.name}: {misfit}", DynidWarning, stacklevel=2)
+    _record(model.metadata, columns)
+    return model
+
+
+def identify_consistent_file(
+    robot: Robot,
+    path: str | Path,
+    *,
+    prior: Robot | None = None,
+    total_mass: tuple[float, float] | None = None,
+    options: SDPOptions | None = None,
+    columns: ColumnSpec | None = None,
+    drop_invalid: bool = False,
+    rtol: float | None = None,
+    estimator: EstimatorName = "ols",
+    drive: Drive | None = None,
+    cutoff_hz: float | None = None,
+    max_std_percent: float | None = None,
+    std: str | None = None,
+    folds: int | None = None,
+    validate_on: str | Path | None = None,
+) -> ConsistentResult:
+    """Physically consistent link parameters of ``robot`` identified in one step from
+    ``path`` (:func:`~dynid.feasibility.one_step.identify_consistent`), the data read and
+    checked as by :func:`identify_file`.
+
+    ``max_std_percent`` and ``std`` are refused (nothing is pruned; the data term is the
+    residual itself, weighted by ``estimator``); they are parameters so that a caller
+    passing them learns it. ``folds``/``validate_on`` (torque logs) choose the held-out
+    judgement of the prior weight and of the fit. Other parameters as :func:`identify_file` and
+    :func:`~dynid.feasibility.one_step.identify_consistent`.
+
+    Returns
+    -------
+    ConsistentResult
+        ``identified`` holds the unconstrained fit (with the column map recorded).
+
+    Raises
+    ------
+    DataError
+        ``max_std_percent`` or ``std`` given; a bad file or data of another robot.
+    """
+    if max_std_percent is not None:
+        raise DataError("--max-std-percent does not apply to --consistent (nothing is pruned)")
+    if std is not None:
+        raise DataError(
+            "--std does not apply to --consistent: its data term is the residual itself "
+            "(weighted by --estimator)"
+        )
+    path = Path(path)
+    cmap = _columns(columns, cutoff_hz)
+    kind = data_kind(path, cmap)
+    heldout = _heldout(path, kind, folds, validate_on, robot.n, cmap, drop_invalid)
+    data: Any
+    if kind == "torque_log":
+        data = read_torque_log(
+            path, robot.n, columns=cmap, drop_invalid=drop_invalid, owner=f"robot {robot.name!r}"
+        )
+    else:
+        data = read_static_file(path, robot, columns=cmap, drop_invalid=drop_invalid)
+    result = _in_file(
+        path,
+        lambda: identify_consistent(
+            robot,
+            data,
+            prior=prior,
+            total_mass=total_mass,
+            options=options,
+            rtol=rtol,
+            drive=drive,
+            estimator=estimator,
+            cutoff_hz=DEFAULT_CUTOFF_HZ if cutoff_hz is None else cutoff_hz,
+            **heldout,
+        ),
+    )
+    if result.identified is None:  # pragma: no cover - identify_consistent always sets it
+        raise DataError("the one-step identification returned no unconstrained fit")
+    _record(result.identified.metadata, columns)
+    return result
+
+
+def _in_file(path: Path, fit: Any) -> Any:
+    """``fit()``, a :class:`~dynid.exceptions.DynidError` it raises prefixed with the
+    file's name when it lacks it."""
+    try:
+        return fit()
+    except DynidError as exc:
+        if str(exc).startswith(path.name):
+            raise
+        raise type(exc)(f"{path.name}: {exc}") from exc

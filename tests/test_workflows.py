@@ -1,0 +1,244 @@
+"""Every check a command applies lives in the library entry point it calls: the Python API
+(dynid.workflows, dynid.io) and every command refuse the same inputs with the same line,
+honour the same options, and ``-q`` silences every command."""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+import dynid
+from dynid.cli.__main__ import main
+from dynid.exceptions import DataError, DynidError
+from dynid.io.feasible_bundle import FEASIBLE_BUNDLE
+from dynid.io.robot.toml import save_toml
+from dynid.io.static_data import load_static_data
+from dynid.workflows.data_files import column_map, read_torque_log
+from dynid.workflows.identify import identify_consistent_file, identify_file
+from dynid.workflows.prior import load_prior
+from dynid.workflows.retrieve import retrieve_file
+
+from conftest import planar_2r
+
+
+@pytest.fixture(scope="module")
+def files(tmp_path_factory) -> Path:
+    """Static data and a torque log of the Panda, another robot's description (the Panda's
+    kinematics named 'other') and a two-joint arm."""
+    d = tmp_path_factory.mktemp("workflows")
+    static = ["acquire-static", "--n", "60", "--noise", "1e-4", "--seed", "1"]
+    assert main([*static, "--out", str(d / "s.csv"), "-q"]) == 0
+    sim = ["simulate", "--duration", "4", "--rate", "200", "--seed", "2"]
+    assert main([*sim, "--out", str(d / "log.csv"), "-q"]) == 0
+    save_toml(d / "other.toml", dynid.panda().replace(name="other"))
+    save_toml(d / "two.toml", planar_2r())
+    assert main(["identify", "--data", str(d / "s.csv"), "--out", str(d / "id"), "-q"]) == 0
+    return d
+
+
+def _refusal(capsys, argv: list[str]) -> str:
+    """The one error line of a refused command (exit 2)."""
+    assert main(argv) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1, err
+    return err[0]
+
+
+OTHER = "s.csv: the data were recorded with robot 'panda'; the robot given is 'other'"
+
+
+@pytest.mark.parametrize(
+    "argv",
+    [
+        ["identify"],
+        ["identify", "--consistent"],
+        ["retrieve", "--method", "sdp"],
+        ["retrieve", "--method", "penalty", "--runs", "1", "--stages", "1"],
+    ],
+    ids=["identify", "identify-consistent", "retrieve-sdp", "retrieve-penalty"],
+)
+def test_static_data_of_another_robot_is_refused_by_the_api_and_every_command(
+    files, tmp_path, capsys, argv
+):
+    """The recorded robot is checked where the data are read (load_static_data): the API's
+    entry points and identify, identify --consistent, retrieve --static (both methods)
+    give the same line."""
+    other = dynid.panda().replace(name="other")
+    with pytest.raises(DataError) as api:
+        load_static_data(files / "s.csv", other)
+    assert str(api.value).startswith(OTHER)
+    for call in (
+        lambda: identify_file(other, files / "s.csv"),
+        lambda: identify_consistent_file(other, files / "s.csv"),
+        lambda: retrieve_file(files / "s.csv", kind="static", robot=other),
+        lambda: retrieve_file(files / "s.csv", kind="static", robot=other, method="penalty"),
+    ):
+        with pytest.raises(DataError, match="recorded with robot 'panda'") as exc:
+            call()
+        assert str(exc.value) == str(api.value)
+    flag = "--static" if argv[0] == "retrieve" else "--data"
+    line = _refusal(
+        capsys,
+        [
+            *argv,
+            flag,
+            str(files / "s.csv"),
+            "--robot",
+            str(files / "other.toml"),
+            "--out",
+            str(tmp_path / "o"),
+        ],
+    )
+    assert line == f"dynid {argv[0]}: error: {api.value}"
+    assert not (tmp_path / "o").exists()
+
+
+@pytest.mark.parametrize(
+    "argv",
+    [
+        ["identify", "--robot"],
+        ["identify", "--consistent", "--robot"],
+        ["friction", "--robot"],
+        ["validate", "--robot"],
+    ],
+    ids=["identify", "identify-consistent", "friction", "validate"],
+)
+def test_a_log_of_another_joint_count_is_refused_alike(files, tmp_path, capsys, argv):
+    """A 7-joint log given with a two-joint robot: read_torque_log (the API) and every
+    command that reads a log name the joint counts."""
+    with pytest.raises(DataError, match="the log has 7 joints; the robot has 2"):
+        read_torque_log(files / "log.csv", 2)
+    with pytest.raises(DataError, match="the log has 7 joints; robot 'planar2r' has 2"):
+        identify_file(planar_2r(), files / "log.csv")
+    line = _refusal(
+        capsys,
+        [*argv, str(files / "two.toml"), "--data", str(files / "log.csv"), "--out", str(tmp_path)],
+    )
+    assert "log.csv: the log has 7 joints;" in line and " has 2; hint:" in line
+
+
+def test_log_cleaning_through_a_column_map_is_strict_alike(files, tmp_path, capsys):
+    """A mapped log with a NaN row is an error unless --drop-invalid / drop_invalid, in the
+    API and in identify; dropping it leaves one row fewer."""
+    log = dynid.io.load_torque_log(files / "log.csv")
+    n = log.n
+    cols = ["time"] + [f"pos{i}" for i in range(n)] + [f"vel{i}" for i in range(n)]
+    cols += [f"eff{i}" for i in range(n)]
+    table = np.column_stack([log.t, log.q, log.dq, log.tau])
+    table[5, 3] = np.nan
+    path = tmp_path / "other_tool.csv"
+    np.savetxt(path, table, delimiter=",", header=",".join(cols), comments="")
+    spec = ("t=time,q=pos{i0},dq=vel{i0},tau=eff{i0}", None)
+    cmap = column_map(*spec)
+    with pytest.raises(DataError, match=r"1 row\(s\) of \d+ hold NaN or inf") as api:
+        read_torque_log(path, n, columns=cmap)
+    assert read_torque_log(path, n, columns=cmap, drop_invalid=True).n_samples == len(log.t) - 1
+    line = _refusal(
+        capsys,
+        ["identify", "--data", str(path), "--columns", spec[0], "--out", str(tmp_path / "o")],
+    )
+    assert line == f"dynid identify: error: {api.value}"
+
+
+def test_a_prior_with_other_joints_is_refused_alike(files, tmp_path, capsys):
+    """The prior's joint types are checked in the library (load_prior) and by
+    identify --consistent and retrieve."""
+    panda = dynid.panda()
+    with pytest.raises(DynidError, match="joints RR; the robot's are RRRRRRR") as api:
+        load_prior(files / "two.toml", panda)
+    argv = ["identify", "--consistent", "--data", str(files / "s.csv")]
+    line = _refusal(capsys, [*argv, "--prior", str(files / "two.toml"), "--out", str(tmp_path)])
+    assert line == f"dynid identify: error: {api.value}"
+
+
+def test_std_is_honoured_on_every_route_or_refused(files, tmp_path, capsys):
+    """--std robust/classical is what the model records on static data and on a torque
+    log, through the API and the command; the consistent fit refuses it in both."""
+    panda = dynid.panda()
+    for data in ("s.csv", "log.csv"):
+        for std in ("robust", "classical"):
+            model = identify_file(panda, files / data, std=std)
+            assert model.metadata["std_estimator"] == std
+            out = tmp_path / f"{data}-{std}"
+            argv = ["identify", "--data", str(files / data), "--std", std, "--out", str(out)]
+            assert main([*argv, "-q"]) == 0
+            doc = json.loads((out / "identification.json").read_text())
+            assert doc["std_estimator"] == std
+            got = [c["std"] for c in doc["coefficients"]]
+            np.testing.assert_allclose(got, model.fit.std[: len(got)], rtol=1e-9, atol=0)
+    with pytest.raises(DataError, match="--std does not apply to --consistent") as api:
+        identify_consistent_file(panda, files / "s.csv", std="robust")
+    argv = ["identify", "--consistent", "--std", "robust", "--data", str(files / "s.csv")]
+    assert _refusal(capsys, [*argv, "--out", str(tmp_path / "c")]) == (
+        f"dynid identify: error: {api.value}"
+    )
+
+
+def test_the_output_bundle_of_a_consistent_fit_is_the_same_for_identify_and_retrieve(
+    files, tmp_path
+):
+    """identify --consistent and retrieve write the bundle of dynid.io.feasible_bundle
+    (plus retrieval.png); the feasible.json of retrieve --static equals the API's."""
+    a, b = tmp_path / "identify", tmp_path / "retrieve"
+    s = str(files / "s.csv")
+    assert main(["identify", "--consistent", "--data", s, "--out", str(a), "-q"]) in (0, 1)
+    assert main(["retrieve", "--static", s, "--out", str(b), "-q"]) in (0, 1)
+    for folder in (a, b):
+        names = {p.name for p in folder.iterdir() if not p.name.startswith(".")}
+        assert set(FEASIBLE_BUNDLE) <= names
+    api = retrieve_file(files / "s.csv", kind="static", robot=dynid.panda())
+    doc = json.loads((b / "feasible.json").read_text())
+    got = np.array([link["mass"] for link in doc["links"]])
+    np.testing.assert_allclose(got, api.mass, rtol=1e-6)
+
+
+QUIET = [
+    ["fk"],
+    ["jacobian"],
+    ["ik", "--goal-xyz", "0.4,0.1,0.4"],
+    ["acquire-static", "--n", "20", "--out", "{t}/s.csv"],
+    ["simulate", "--duration", "1", "--rate", "100", "--out", "{t}/log.csv"],
+    ["identify", "--data", "{d}/s.csv", "--out", "{t}/id"],
+    ["identify", "--data", "{d}/log.csv", "--out", "{t}/id"],
+    ["identify", "--consistent", "--data", "{d}/s.csv", "--out", "{t}/id", "--no-figures"],
+    ["friction", "--robot", "panda", "--data", "{d}/log.csv", "--out", "{t}/f", "--no-figures"],
+    ["validate", "--robot", "panda", "--data", "{d}/log.csv", "--out", "{t}/v", "--no-figures"],
+    ["retrieve", "--static", "{d}/s.csv", "--out", "{t}/r", "--no-figures"],
+    ["payload", "--robot", "panda", "--data", "{d}/s.csv", "--out", "{t}/p"],
+    ["export", "--params", "panda", "--out", "{t}/panda.urdf"],
+    ["predict", "--model", "{d}/id/identification.json", "--q", "0,0,0,-1.5,0,1.5,0.7"],
+    [
+        "excite",
+        "--duration",
+        "3",
+        "--harmonics",
+        "2",
+        "--max-iter",
+        "2",
+        "--no-figure",
+        "--out",
+        "{t}/e",
+    ],
+]
+
+
+@pytest.mark.parametrize("argv", QUIET, ids=[" ".join(a[:2]) for a in QUIET])
+def test_quiet_silences_every_command(files, tmp_path, capsys, argv):
+    """-q prints nothing (no table, summary, progress, note or warning) for every command;
+    without it the same command prints its summary."""
+    argv = [a.format(d=files, t=tmp_path) for a in argv]
+    assert main([*argv, "-q"]) in (0, 1)
+    out, err = capsys.readouterr()
+    assert (out, err) == ("", "")
+    assert main(argv) in (0, 1)
+    assert capsys.readouterr().out.strip()
+
+
+def test_quiet_keeps_a_json_result(capsys):
+    """--json is the result asked for: printed also with -q."""
+    assert main(["fk", "--json", "-q"]) == 0
+    T = np.array(json.loads(capsys.readouterr().out)["T"])
+    np.testing.assert_allclose(T, dynid.fk(dynid.panda(), dynid.PANDA_NEUTRAL_Q), atol=1e-14)
