@@ -155,22 +155,20 @@ def _terminate(signum: int, frame: object) -> None:
 
 
 @contextlib.contextmanager
-def _signals_and_warnings(command: str, *, quiet: bool = False) -> Iterator[None]:
-    """SIGTERM, SIGHUP and SIGQUIT raise :class:`Terminated`; warnings print as one line
-    (no source line), none with ``quiet``."""
+def _signals_and_warnings(console: Console) -> Iterator[None]:
+    """SIGTERM, SIGHUP and SIGQUIT raise :class:`Terminated`; warnings go to
+    :meth:`Console.warn` (one line, no source line; kept for the run's report with -q)."""
     old = {}
     with contextlib.suppress(ValueError):  # not the main thread: leave signals alone
         for sig in TERMINATING:
             old[sig] = signal.signal(sig, _terminate)
 
     def show(message, category, filename, lineno, file=None, line=None):  # noqa: ANN001
-        print(f"dynid {command}: warning: {message}", file=sys.stderr)
+        console.warn(str(message))
 
     try:
         with warnings.catch_warnings():
             warnings.showwarning = show
-            if quiet:
-                warnings.simplefilter("ignore")
             yield
     finally:
         for sig, handler in old.items():
@@ -221,12 +219,12 @@ def main(argv: Sequence[str] | None = None) -> int:
     )
     logging.basicConfig(level=level, format="%(levelname)s %(name)s: %(message)s")
     say = f"dynid {args.command}"
-    console = Console(args.command, quiet=args.quiet, verbose=args.verbose)
     record = RunRecord()
+    console = Console(args.command, quiet=args.quiet, verbose=args.verbose, record=record)
     try:
         with (
             record,
-            _signals_and_warnings(args.command, quiet=args.quiet),
+            _signals_and_warnings(console),
             output_transaction(),
             _output_set(args, argv) as run,
         ):

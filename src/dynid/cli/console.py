@@ -6,6 +6,9 @@ means the same for every command: errors only. Tables, summaries, ``wrote ...`` 
 progress, notes and warnings are dropped; a result asked for on stdout with ``--json``
 is still printed (it is the command's output, as a file under ``--out`` is still written),
 and so is a notice that something asked for was not done as asked (:meth:`Console.notice`).
+What ``-q`` keeps off the terminal still goes to the run's record
+(:class:`~dynid.cli.run_report.RunRecord`), so that a run's report holds its summary and
+warnings either way.
 """
 
 from __future__ import annotations
@@ -15,6 +18,7 @@ from collections.abc import Mapping
 from typing import Any
 
 from ..io.json_files import dumps
+from .run_report import RunRecord
 
 __all__ = ["Console"]
 
@@ -31,17 +35,35 @@ class Console:
         ``-q``: print errors only (and ``--json`` results).
     verbose : int
         ``-v`` count: 1 shows informational log lines, 2 debug ones (set up by ``main``).
+    record : RunRecord, optional
+        The run's record: receives what ``-q`` keeps off the terminal.
     """
 
-    def __init__(self, command: str, *, quiet: bool = False, verbose: int = 0) -> None:
+    def __init__(
+        self,
+        command: str,
+        *,
+        quiet: bool = False,
+        verbose: int = 0,
+        record: RunRecord | None = None,
+    ) -> None:
         self.command, self.quiet, self.verbose = command, bool(quiet), int(verbose)
+        self._record = record
+
+    def _write(self, text: str, *, stdout: bool) -> None:
+        if self.quiet:
+            if self._record is not None:
+                (self._record.out_parts if stdout else self._record.err_parts).append(text)
+            return
+        stream = sys.stdout if stdout else sys.stderr
+        stream.write(text)
+        if not stdout:
+            stream.flush()
 
     def print(self, *lines: str) -> None:
         """The command's tables and summaries on stdout, one argument per line; nothing
         with ``-q``."""
-        if not self.quiet:
-            for line in lines:
-                sys.stdout.write(f"{line}\n")
+        self._write("".join(f"{line}\n" for line in lines), stdout=True)
 
     def wrote(self, *paths: Any) -> None:
         """``wrote A, B`` on stdout; nothing with ``-q``."""
@@ -49,9 +71,7 @@ class Console:
 
     def progress(self, text: str) -> None:
         """A progress line on stderr (flushed); nothing with ``-q``."""
-        if not self.quiet:
-            sys.stderr.write(f"{text}\n")
-            sys.stderr.flush()
+        self._write(f"{text}\n", stdout=False)
 
     def note(self, message: str) -> None:
         """``dynid CMD: note: message`` on stderr; nothing with ``-q``."""
