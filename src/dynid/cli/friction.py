@@ -2,8 +2,8 @@
 
 The residual tau_measured - (M ddq + c + g) of the model (an identification.json, or a
 robot's own link parameters with --robot) is fitted per joint by a friction law:
---friction-model auto (default) fits every law (none, classical, smooth, asymmetric,
-stribeck, sigmoid) on 5 contiguous blocks of the log in turn, predicts the block left out,
+--friction-model auto (default) fits every law of the registry (listed below, with none:
+no extra friction) on 4 of 5 contiguous blocks of the log in turn, predicts the block left out,
 keeps the law with the lowest held-out error (the model's own friction is a candidate too,
 so the result never predicts worse than it) and prints the table; a law's name fits that
 law. Coulomb friction is off where |dq| is inside the velocity noise band. The states are
@@ -79,7 +79,9 @@ def register(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParser:
         "--friction-model",
         choices=("auto", *LAWS),
         default="auto",
-        help="friction law; auto (default): the one with the lowest held-out error",
+        help="friction law; auto (default): the one with the lowest held-out error; the laws "
+        "and their parameters per joint: "
+        + ", ".join(f"{law.name} ({' '.join(law.params) or 'zero'})" for law in LAWS.values()),
     )
     p.add_argument(
         "--cutoff",
