@@ -25,6 +25,7 @@ from __future__ import annotations
 import json
 import math
 from collections.abc import Mapping, Sequence
+from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
@@ -141,6 +142,143 @@ def _pose(table: Mapping[str, Any], where: str, *, nested: bool) -> NDArray[np.f
     return spatial.transform_from_xyz_rpy(xyz, rpy)
 
 
+@dataclass(frozen=True, slots=True)
+class _JointRow:
+    """One ``[[joints]]`` table, read and checked."""
+
+    name: str
+    parent: str
+    child: str
+    T_parent_joint: NDArray[np.float64]
+    axis: NDArray[np.float64]
+    prismatic: bool
+    limits: dict[str, float]
+    mass: float
+    com: NDArray[np.float64]
+    inertia: NDArray[np.float64]
+    friction: NDArray[np.float64] | None
+
+
+def _axis(jt: Mapping[str, Any], where: str) -> NDArray[np.float64]:
+    """The joint axis (3,) as given (the robot normalises it); zero or overflowing refused."""
+    axis = _vector(jt.get("axis", [0.0, 0.0, 1.0]), 3, where, "axis")
+    with np.errstate(over="ignore"):
+        norm = float(np.linalg.norm(axis))
+    if norm < 1e-12:
+        raise ModelError(f"{where}: key 'axis' must not be zero")
+    if not math.isfinite(norm):
+        raise ModelError(
+            f"{where}: key 'axis' = {axis.tolist()} is too large to normalise "
+            "(its squared length overflows a float); give the axis as a unit vector"
+        )
+    return axis
+
+
+def _limits(jt: Mapping[str, Any], where: str) -> dict[str, float]:
+    """``lower``, ``upper``, ``velocity``, ``acceleration``, ``effort`` (inf where none)."""
+    lim = dict.fromkeys(_LIMIT_KEYS, math.inf)
+    lim["lower"] = -math.inf
+    table = _table(jt.get("limits", {}), f"{where}: key 'limits'")
+    _check_keys(table, set(_LIMIT_KEYS), f"{where}: limits")
+    for k, v in table.items():
+        lim[k] = _number(v, where, f"limits.{k}", finite=False)
+        if k not in ("lower", "upper") and not lim[k] > 0.0:
+            raise ModelError(f"{where}: key 'limits.{k}' must be positive; got {_checks.short(v)}")
+    if not lim["lower"] < lim["upper"]:
+        raise ModelError(
+            f"{where}: key 'limits.lower' must be below 'limits.upper'; "
+            f"got {lim['lower']!r} >= {lim['upper']!r}"
+        )
+    return lim
+
+
+def _inertial(
+    jt: Mapping[str, Any], where: str
+) -> tuple[float, NDArray[np.float64], NDArray[np.float64]]:
+    """Mass [kg], CoM [m] (3,) and inertia about the CoM (6,) of ``[joints.inertial]``."""
+    if "inertial" not in jt:
+        return 0.0, np.zeros(3), np.zeros(6)
+    inertial = _table(jt["inertial"], f"{where}: key 'inertial'")
+    _check_keys(inertial, _INERTIAL_KEYS, f"{where}: inertial")
+    inside = f"{where}: inertial"
+    mass = _number(_require(inertial, "mass", inside), where, "inertial.mass")
+    if not 0.0 <= mass <= MAX_LINK_MASS:
+        raise ModelError(
+            f"{where}: key 'inertial.mass' must lie in [0, {MAX_LINK_MASS:g}] kg; got {mass!r}"
+        )
+    com = _vector(_require(inertial, "com", inside), 3, where, "inertial.com")
+    inertia = _vector(_require(inertial, "inertia", inside), 6, where, "inertial.inertia")
+    return mass, com, inertia
+
+
+def _joint_row(i: int, raw: Any) -> _JointRow:
+    """Joint ``i`` (0-based) of the ``[[joints]]`` array, every key checked."""
+    jt = _table(raw, f"joints[{i}]")
+    jname = _string(jt, "name", f"joints[{i}]")
+    where = f"joints[{i}] ({jname!r})"
+    _check_keys(jt, _JOINT_KEYS, where)
+    kind = _string(jt, "type", where)
+    if kind not in _TYPES:
+        raise ModelError(
+            f"{where}: key 'type' must be one of {sorted(_TYPES)}; got {_checks.short(kind)}"
+        )
+    parent, child = _string(jt, "parent", where), _string(jt, "child", where)
+    T, axis, limits = _pose(jt, where, nested=True), _axis(jt, where), _limits(jt, where)
+    mass, com, inertia = _inertial(jt, where)
+    friction = _vector(jt["friction"], 3, where, "friction") if "friction" in jt else None
+    return _JointRow(
+        jname, parent, child, T, axis, _TYPES[kind], limits, mass, com, inertia, friction
+    )
+
+
+def _joint_rows(joints: list[Any], source: str) -> list[_JointRow]:
+    """Every joint, checked to form a chain and to give friction for all joints or none."""
+    rows: list[_JointRow] = []
+    for i, raw in enumerate(joints):
+        row = _joint_row(i, raw)
+        if rows and row.parent != rows[-1].child:
+            raise ModelError(
+                f"joints[{i}] ({row.name!r}): unknown parent {row.parent!r}; joints must form "
+                f"a chain, so the parent must be the previous joint's child {rows[-1].child!r}"
+            )
+        rows.append(row)
+    given = [r.friction is not None for r in rows]
+    if any(given) and not all(given):
+        missing = rows[given.index(False)].name
+        raise ModelError(
+            f"{source}: key 'friction' is given for some joints but not for joint {missing!r}; "
+            "give it for every joint or for none"
+        )
+    return rows
+
+
+def _frames(doc: Mapping[str, Any], source: str, link_names: list[str]) -> dict[str, Frame]:
+    """The ``[[frames]]``, each fixed to a link or to an earlier frame."""
+    frames: dict[str, Frame] = {}
+    raw_frames = doc.get("frames", [])
+    if not isinstance(raw_frames, list):
+        raise ModelError(f"{source}: 'frames' must be an array of tables ([[frames]])")
+    for i, raw in enumerate(raw_frames):
+        ft = _table(raw, f"frames[{i}]")
+        fname = _string(ft, "name", f"frames[{i}]")
+        where = f"frames[{i}] ({fname!r})"
+        _check_keys(ft, _FRAME_KEYS, where)
+        if fname in frames:
+            raise ModelError(f"{where}: duplicate frame name {fname!r}")
+        parent = _string(ft, "parent", where)
+        if parent in link_names:
+            link, T_link_parent = link_names.index(parent), np.eye(4)
+        elif parent in frames:
+            link, T_link_parent = frames[parent].link, frames[parent].T_link_frame
+        else:
+            raise ModelError(
+                f"{where}: unknown parent {parent!r}; available: links {link_names} "
+                f"and earlier frames {list(frames)}"
+            )
+        frames[fname] = Frame(link, T_link_parent @ _pose(ft, where, nested=False))
+    return frames
+
+
 def robot_from_toml_string(text: str, *, source: str = "TOML text") -> Robot:
     """Robot from the text of a dynid TOML description (schema: see the module docstring).
 
@@ -182,122 +320,24 @@ def robot_from_toml_string(text: str, *, source: str = "TOML text") -> Robot:
     joints = _require(doc, "joints", source)
     if not isinstance(joints, list) or not joints:
         raise ModelError(f"{source}: 'joints' must be a non-empty array of tables ([[joints]])")
-
-    n = len(joints)
-    joint_names: list[str] = []
-    link_names: list[str] = []
-    T_fix = np.empty((n, 4, 4))
-    axes = np.empty((n, 3))
-    prismatic = np.empty(n, dtype=bool)
-    lim = {k: np.full(n, np.inf) for k in _LIMIT_KEYS}
-    lim["lower"][:] = -np.inf
-    mass, com, inertia = np.zeros(n), np.zeros((n, 3)), np.zeros((n, 6))
-    friction: list[NDArray[np.float64] | None] = []
-    for i, raw in enumerate(joints):
-        where = f"joints[{i}]"
-        jt = _table(raw, where)
-        jname = _string(jt, "name", where)
-        where = f"joints[{i}] ({jname!r})"
-        _check_keys(jt, _JOINT_KEYS, where)
-        kind = _string(jt, "type", where)
-        if kind not in _TYPES:
-            raise ModelError(
-                f"{where}: key 'type' must be one of {sorted(_TYPES)}; got {_checks.short(kind)}"
-            )
-        parent, child = _string(jt, "parent", where), _string(jt, "child", where)
-        if i == 0:
-            link_names.append(parent)
-        elif parent != link_names[-1]:
-            raise ModelError(
-                f"{where}: unknown parent {parent!r}; joints must form a chain, so the parent "
-                f"must be the previous joint's child {link_names[-1]!r}"
-            )
-        joint_names.append(jname)
-        link_names.append(child)
-        T_fix[i] = _pose(jt, where, nested=True)
-        axes[i] = _vector(jt.get("axis", [0.0, 0.0, 1.0]), 3, where, "axis")
-        with np.errstate(over="ignore"):
-            norm = float(np.linalg.norm(axes[i]))
-        if norm < 1e-12:
-            raise ModelError(f"{where}: key 'axis' must not be zero")
-        if not math.isfinite(norm):
-            raise ModelError(
-                f"{where}: key 'axis' = {axes[i].tolist()} is too large to normalise "
-                "(its squared length overflows a float); give the axis as a unit vector"
-            )
-        prismatic[i] = _TYPES[kind]
-        limits = _table(jt.get("limits", {}), f"{where}: key 'limits'")
-        _check_keys(limits, set(_LIMIT_KEYS), f"{where}: limits")
-        for k, v in limits.items():
-            lim[k][i] = _number(v, where, f"limits.{k}", finite=False)
-            if k not in ("lower", "upper") and not lim[k][i] > 0.0:
-                raise ModelError(
-                    f"{where}: key 'limits.{k}' must be positive; got {_checks.short(v)}"
-                )
-        if not lim["lower"][i] < lim["upper"][i]:
-            raise ModelError(
-                f"{where}: key 'limits.lower' must be below 'limits.upper'; "
-                f"got {lim['lower'][i]!r} >= {lim['upper'][i]!r}"
-            )
-        if "inertial" in jt:
-            inertial = _table(jt["inertial"], f"{where}: key 'inertial'")
-            _check_keys(inertial, _INERTIAL_KEYS, f"{where}: inertial")
-            mass[i] = _number(
-                _require(inertial, "mass", f"{where}: inertial"), where, "inertial.mass"
-            )
-            if not 0.0 <= mass[i] <= MAX_LINK_MASS:
-                raise ModelError(
-                    f"{where}: key 'inertial.mass' must lie in [0, {MAX_LINK_MASS:g}] kg; got "
-                    f"{float(mass[i])!r}"
-                )
-            com[i] = _vector(
-                _require(inertial, "com", f"{where}: inertial"), 3, where, "inertial.com"
-            )
-            inertia[i] = _vector(
-                _require(inertial, "inertia", f"{where}: inertial"), 6, where, "inertial.inertia"
-            )
-        friction.append(_vector(jt["friction"], 3, where, "friction") if "friction" in jt else None)
-    given = [f is not None for f in friction]
-    if any(given) and not all(given):
-        missing = joint_names[given.index(False)]
-        raise ModelError(
-            f"{source}: key 'friction' is given for some joints but not for joint {missing!r}; "
-            "give it for every joint or for none"
-        )
-
-    frames: dict[str, Frame] = {}
-    raw_frames = doc.get("frames", [])
-    if not isinstance(raw_frames, list):
-        raise ModelError(f"{source}: 'frames' must be an array of tables ([[frames]])")
-    for i, raw in enumerate(raw_frames):
-        where = f"frames[{i}]"
-        ft = _table(raw, where)
-        fname = _string(ft, "name", where)
-        where = f"frames[{i}] ({fname!r})"
-        _check_keys(ft, _FRAME_KEYS, where)
-        if fname in frames:
-            raise ModelError(f"{where}: duplicate frame name {fname!r}")
-        parent = _string(ft, "parent", where)
-        if parent in link_names:
-            link, T_link_parent = link_names.index(parent), np.eye(4)
-        elif parent in frames:
-            link, T_link_parent = frames[parent].link, frames[parent].T_link_frame
-        else:
-            raise ModelError(
-                f"{where}: unknown parent {parent!r}; available: links {link_names} "
-                f"and earlier frames {list(frames)}"
-            )
-        frames[fname] = Frame(link, T_link_parent @ _pose(ft, where, nested=False))
-
+    rows = _joint_rows(joints, source)
+    link_names = [rows[0].parent] + [r.child for r in rows]
+    frames = _frames(doc, source, link_names)
+    lim = {k: np.array([r.limits[k] for r in rows]) for k in _LIMIT_KEYS}
+    friction = [r.friction for r in rows if r.friction is not None]
     try:
         return Robot(
             name=name,
-            joint_names=tuple(joint_names),
+            joint_names=tuple(r.name for r in rows),
             link_names=tuple(link_names),
-            T_parent_joint=T_fix,
-            axes=axes,
-            prismatic=prismatic,
-            phi=phi_from_inertial(mass, com, inertia),
+            T_parent_joint=np.stack([r.T_parent_joint for r in rows]),
+            axes=np.stack([r.axis for r in rows]),
+            prismatic=np.array([r.prismatic for r in rows]),
+            phi=phi_from_inertial(
+                np.array([r.mass for r in rows]),
+                np.stack([r.com for r in rows]),
+                np.stack([r.inertia for r in rows]),
+            ),
             q_min=lim["lower"],
             q_max=lim["upper"],
             dq_max=lim["velocity"],
@@ -305,7 +345,7 @@ def robot_from_toml_string(text: str, *, source: str = "TOML text") -> Robot:
             tau_max=lim["effort"],
             gravity=gravity,
             frames=frames,
-            friction=np.stack([f for f in friction if f is not None]) if all(given) else None,
+            friction=np.stack(friction) if len(friction) == len(rows) else None,
             q_neutral=q_neutral,
         )
     except DynidError as exc:

@@ -258,7 +258,7 @@ def _warn_if_inconsistent(link: str, mass: float, I: NDArray[np.float64]) -> Non
             f"link {link!r} has a physically inconsistent inertial: {'; '.join(problems)}; "
             "kept as given",
             DynidWarning,
-            stacklevel=5,
+            stacklevel=6,
         )
 
 
@@ -283,7 +283,7 @@ def _limits(joint: _Joint) -> tuple[float, float, float, float]:
             warnings.warn(
                 f"joint {joint.name!r} has {attr} limit {v}; treated as unbounded",
                 DynidWarning,
-                stacklevel=4,
+                stacklevel=5,
             )
             v = None
         out.append(np.inf if v is None else v)
@@ -344,16 +344,15 @@ def robot_from_urdf_string(
     return _robot_from_text(text, base_link, tip_link, source)
 
 
-def _robot_from_text(
-    text: str | bytes, base_link: str | None, tip_link: str | None, source: str
-) -> Robot:
-    """Body of the two public readers (called directly by both, so warnings point at the caller)."""
-    try:
-        root = ET.fromstring(text)
-    except ET.ParseError as exc:
-        raise ModelError(f"{source} is not well-formed XML: {exc}") from exc
-    name, links, parent_joint, child_joints = _parse_tree(root)
-
+def _chain_ends(
+    source: str,
+    links: dict[str, ET.Element],
+    parent_joint: dict[str, _Joint],
+    child_joints: dict[str, list[_Joint]],
+    base_link: str | None,
+    tip_link: str | None,
+) -> tuple[str, str]:
+    """The base and tip links: as given (checked to exist), else the unique root and leaf."""
     for role, given in (("base", base_link), ("tip", tip_link)):
         if given is not None and given not in links:
             raise UnknownNameError(f"Unknown {role} link {given!r}; available: {sorted(links)}")
@@ -372,7 +371,11 @@ def _robot_from_text(
                 "pass tip_link= to choose the end of the chain"
             )
         tip_link = leaves[0]
-    path = _chain(base_link, tip_link, parent_joint)
+    return base_link, tip_link
+
+
+def _check_chain(path: list[_Joint], base_link: str, tip_link: str) -> None:
+    """Refuse joints a serial chain cannot hold, and a chain without a moving joint."""
     for joint in path:
         if joint.type in _UNSUPPORTED:
             raise ModelError(
@@ -392,66 +395,89 @@ def _robot_from_text(
             f"and tip link {tip_link!r}"
         )
 
-    # Walk the chain: body index k (0 = base) and pose of the current URDF link in link k.
-    on_chain = {j.name for j in path}
-    link_names = [base_link]
-    joint_names: list[str] = []
-    T_fix: list[NDArray[np.float64]] = []
-    axes: list[NDArray[np.float64]] = []
-    prismatic: list[bool] = []
-    limits: list[tuple[float, float, float, float]] = []
-    placed: dict[str, tuple[int, NDArray[np.float64]]] = {base_link: (0, np.eye(4))}
-    order = [base_link]  # URDF links in the order they are placed
+
+def _axis(joint: _Joint) -> NDArray[np.float64]:
+    """Unit axis (3,) of a moving joint in its child link (URDF default ``(1, 0, 0)``)."""
+    axis_el = _child(joint.elem, "axis")
+    axis = _floats(
+        None if axis_el is None else axis_el.get("xyz"),
+        3,
+        f"joint {joint.name!r} axis",
+        (1.0, 0.0, 0.0),
+    )
+    with np.errstate(over="ignore"):
+        norm = float(np.linalg.norm(axis))
+    if norm < 1e-12:
+        raise ModelError(f"joint {joint.name!r} has a zero axis")
+    if not np.isfinite(norm):
+        raise ModelError(
+            f"joint {joint.name!r} axis {axis.tolist()} is too large to normalise "
+            "(its squared length overflows a float); give the axis as a unit vector"
+        )
+    return axis / norm
+
+
+@dataclass
+class _Walk:
+    """The chain walked from the base: the robot's joints and where every URDF link sits.
+
+    ``placed[link] = (k, T_k_link)``: the link is rigidly part of body ``k`` (0 = base) at
+    pose ``T_k_link``; ``order`` lists the placed links in the order they were placed.
+    """
+
+    link_names: list[str]
+    joint_names: list[str]
+    T_fix: list[NDArray[np.float64]]
+    axes: list[NDArray[np.float64]]
+    prismatic: list[bool]
+    limits: list[tuple[float, float, float, float]]
+    placed: dict[str, tuple[int, NDArray[np.float64]]]
+    order: list[str]
+
+
+def _walk(path: list[_Joint], base_link: str) -> _Walk:
+    """Walk the chain: fixed joints fold into the next joint's pose or the current body."""
+    w = _Walk([base_link], [], [], [], [], [], {base_link: (0, np.eye(4))}, [base_link])
     k, T_k_cur = 0, np.eye(4)
     for joint in path:
         T = T_k_cur @ _origin(joint.elem, f"joint {joint.name!r}")
         if joint.type == "fixed":
             T_k_cur = T
         else:
-            axis_el = _child(joint.elem, "axis")
-            axis = _floats(
-                None if axis_el is None else axis_el.get("xyz"),
-                3,
-                f"joint {joint.name!r} axis",
-                (1.0, 0.0, 0.0),
-            )
-            with np.errstate(over="ignore"):
-                norm = float(np.linalg.norm(axis))
-            if norm < 1e-12:
-                raise ModelError(f"joint {joint.name!r} has a zero axis")
-            if not np.isfinite(norm):
-                raise ModelError(
-                    f"joint {joint.name!r} axis {axis.tolist()} is too large to normalise "
-                    "(its squared length overflows a float); give the axis as a unit vector"
-                )
-            joint_names.append(joint.name)
-            T_fix.append(T)
-            axes.append(axis / norm)
-            prismatic.append(_MOVING[joint.type])
-            limits.append(_limits(joint))
-            link_names.append(joint.child)
+            w.axes.append(_axis(joint))
+            w.joint_names.append(joint.name)
+            w.T_fix.append(T)
+            w.prismatic.append(_MOVING[joint.type])
+            w.limits.append(_limits(joint))
+            w.link_names.append(joint.child)
             k, T_k_cur = k + 1, np.eye(4)
-        placed[joint.child] = (k, T_k_cur)
-        order.append(joint.child)
+        w.placed[joint.child] = (k, T_k_cur)
+        w.order.append(joint.child)
+    return w
 
-    # Links hanging off chain links through fixed joints only (hands, TCP frames).
-    stack = list(reversed(order))
+
+def _place_fixed_links(w: _Walk, path: list[_Joint], child_joints: dict[str, list[_Joint]]) -> None:
+    """Add the links hanging off placed links through fixed joints only (hands, TCP frames)."""
+    on_chain = {j.name for j in path}
+    stack = list(reversed(w.order))
     while stack:
         link = stack.pop()
-        kl, T_k_link = placed[link]
+        kl, T_k_link = w.placed[link]
         for joint in child_joints[link]:
             if joint.name in on_chain or joint.type != "fixed":
                 continue
-            if joint.child in placed:
+            if joint.child in w.placed:
                 raise ModelError(f"the joints form a cycle through link {joint.child!r}")
-            placed[joint.child] = (kl, T_k_link @ _origin(joint.elem, f"joint {joint.name!r}"))
-            order.append(joint.child)
+            w.placed[joint.child] = (kl, T_k_link @ _origin(joint.elem, f"joint {joint.name!r}"))
+            w.order.append(joint.child)
             stack.append(joint.child)
 
-    n = len(joint_names)
-    phi = np.zeros((n, 10))
-    for link in order:
-        kl, T_k_link = placed[link]
+
+def _body_phi(w: _Walk, links: dict[str, ET.Element]) -> NDArray[np.float64]:
+    """Standard parameters (n, 10) of each body: its links' inertials summed in its frame."""
+    phi = np.zeros((len(w.joint_names), 10))
+    for link in w.order:
+        kl, T_k_link = w.placed[link]
         if kl == 0:
             continue
         inertial = _inertial(link, links[link])
@@ -460,27 +486,45 @@ def _robot_from_text(
         mass, c_link, I_link = inertial
         R, p = T_k_link[:3, :3], T_k_link[:3, 3]
         phi[kl - 1] += phi_from_inertial(mass, R @ c_link + p, R @ I_link @ R.T)
+    return phi
 
-    moving_links = set(link_names)
-    frames = {link: Frame(kl, T) for link, (kl, T) in placed.items() if link not in moving_links}
-    if "flange" in placed and tip_link != "flange":
+
+def _robot_from_text(
+    text: str | bytes, base_link: str | None, tip_link: str | None, source: str
+) -> Robot:
+    """Body of the two public readers (called directly by both, so warnings point at the caller)."""
+    try:
+        root = ET.fromstring(text)
+    except ET.ParseError as exc:
+        raise ModelError(f"{source} is not well-formed XML: {exc}") from exc
+    name, links, parent_joint, child_joints = _parse_tree(root)
+    base, tip = _chain_ends(source, links, parent_joint, child_joints, base_link, tip_link)
+    path = _chain(base, tip, parent_joint)
+    _check_chain(path, base, tip)
+    w = _walk(path, base)
+    _place_fixed_links(w, path, child_joints)
+    phi = _body_phi(w, links)
+
+    moving_links = set(w.link_names)
+    frames = {link: Frame(kl, T) for link, (kl, T) in w.placed.items() if link not in moving_links}
+    if "flange" in w.placed and tip != "flange":
         warnings.warn(
-            f"URDF link 'flange' is not the tip link {tip_link!r}; the frame 'flange' is the "
-            "tip link's",
+            f"URDF link 'flange' is not the tip link {tip!r}; the frame 'flange' is the tip link's",
             DynidWarning,
             stacklevel=3,
         )
-    k_tip, T_tip = placed[tip_link]
+    k_tip, T_tip = w.placed[tip]
     frames["flange"] = Frame(k_tip, T_tip)
 
-    lim = np.array(limits)
+    n = len(w.joint_names)
+    lim = np.array(w.limits)
     return Robot(
         name=name,
-        joint_names=tuple(joint_names),
-        link_names=tuple(link_names),
-        T_parent_joint=np.stack(T_fix),
-        axes=np.stack(axes),
-        prismatic=np.array(prismatic),
+        joint_names=tuple(w.joint_names),
+        link_names=tuple(w.link_names),
+        T_parent_joint=np.stack(w.T_fix),
+        axes=np.stack(w.axes),
+        prismatic=np.array(w.prismatic),
         phi=phi,
         q_min=lim[:, 0],
         q_max=lim[:, 1],
