@@ -89,6 +89,121 @@ def _law_terms(
     return CoulombViscous(jt.frictionloss, jt.damping, offset, z, z), jt.notes
 
 
+def _joint_terms(
+    robot: Robot, friction: bool | FrictionModel, drive: Drive | None
+) -> tuple[CoulombViscous | None, NDArray[np.float64] | None, tuple[str, ...]]:
+    """The friction written to the joints, the rotor ``armature`` and what MJCF cannot hold.
+
+    Returns ``(approximation, armature, notes)``: the Coulomb and viscous terms per joint
+    (None: frictionless), the armature (n,) [kg m^2] (None: no drive with rotor inertias)
+    and one note per thing dropped (:func:`dynid.friction.mujoco.drive_joint_terms`,
+    :func:`_law_terms`).
+    """
+    n = robot.n
+    if isinstance(friction, DriveFriction) or drive is not None:
+        d = friction.drive if isinstance(friction, DriveFriction) else drive
+        assert d is not None
+        d.check(n)
+        jt = drive_joint_terms(
+            d.transmission, d.rotor_inertia, None, None, friction_at_motor=d.friction_at == "motor"
+        )
+        notes = jt.notes
+        armature = jt.armature if d.rotor_inertia is not None else None
+        approx = None
+        if isinstance(friction, DriveFriction):
+            d.check(friction.n)
+            approx, more = _law_terms(friction, robot.dq_max)
+            notes += more
+        elif friction is True and robot.friction is not None:
+            approx = coulomb_viscous_from_sigmoid(robot.friction, robot.dq_max)
+        return approx, armature, notes
+    if not isinstance(friction, bool):
+        if friction.n != n:
+            raise ShapeError(f"friction has {friction.n} joints; robot {robot.name!r} has {n}")
+        approx, notes = _law_terms(friction, robot.dq_max)
+        return approx, None, notes
+    if friction and robot.friction is not None:
+        return coulomb_viscous_from_sigmoid(robot.friction, robot.dq_max), None, ()
+    return None, None, ()
+
+
+def _comment(
+    friction: bool | FrictionModel,
+    approx: CoulombViscous | None,
+    armature: NDArray[np.float64] | None,
+    notes: tuple[str, ...],
+) -> str:
+    """The default comment: the writer, the units, how friction and rotors are written."""
+    text = f"written by dynid {__version__}: inertials about the CoM in link axes [kg, m, kg m^2]"
+    if approx is None:
+        text += "; frictionless joints"
+    else:
+        text += "; friction: Coulomb as frictionloss, viscous as damping"
+        if isinstance(friction, bool):
+            text += " (fit of the sigmoid)"
+        elif isinstance(friction, DriveFriction):
+            text += " (reflected from the motors)"
+    if armature is not None:
+        text += "; rotor inertia as armature"
+    return text + "".join(f"; {note}" for note in notes)
+
+
+def _bodies(
+    robot: Robot, approx: CoulombViscous | None, armature: NDArray[np.float64] | None
+) -> list[str]:
+    """The nested ``<body>`` lines of the links (the base's sites first), closed."""
+    n = robot.n
+    I6 = inertia6_from_matrix(robot.inertia)[:, [0, 3, 5, 1, 2, 4]]  # xx yy zz xy xz yz
+    mass, com = robot.mass, robot.com
+    sites: dict[int, list[str]] = {}
+    links = set(robot.link_names)
+    for name, fr in robot.frames.items():
+        if name not in links:
+            sites.setdefault(fr.link, []).append(
+                f'<site name={quoteattr(name)} {_pose(fr.T_link_frame)} size="0.005"/>'
+            )
+    lines = [f'    <body name={quoteattr(robot.link_names[0])} pos="0 0 0">']
+    lines += ["      " + s for s in sites.get(0, [])]
+    for i in range(n):
+        ind = "    " + "  " * (i + 2)
+        kind = "slide" if robot.prismatic[i] else "hinge"
+        attrs = f'name={quoteattr(robot.joint_names[i])} type="{kind}" axis="{_v(robot.axes[i])}"'
+        lo, hi = robot.q_min[i], robot.q_max[i]
+        if np.isfinite(lo) and np.isfinite(hi):
+            attrs += f' range="{_f(lo)} {_f(hi)}"'
+        if approx is not None:
+            attrs += f' frictionloss="{_f(approx.coulomb[i])}" damping="{_f(approx.viscous[i])}"'
+        if armature is not None:
+            attrs += f' armature="{_f(armature[i])}"'
+        lines += [
+            f"{ind[:-2]}<body name={quoteattr(robot.link_names[i + 1])} "
+            f"{_pose(robot.T_parent_joint[i])}>",
+            f"{ind}<joint {attrs}/>",
+        ]
+        if np.any(robot.phi[i] != 0.0):  # MuJoCo refuses a zero fullinertia; omit it
+            lines.append(
+                f'{ind}<inertial pos="{_v(com[i])}" mass="{_f(mass[i])}" '
+                f'fullinertia="{_v(I6[i])}"/>'
+            )
+        lines += [ind + s for s in sites.get(i + 1, [])]
+    for i in reversed(range(n)):
+        lines.append("    " + "  " * (i + 1) + "</body>")
+    return lines + ["    </body>"]
+
+
+def _actuators(robot: Robot) -> list[str]:
+    """One ``<motor>`` per joint, gear 1, ``ctrlrange`` the torque limit when finite."""
+    lines = []
+    for i in range(robot.n):
+        t = robot.tau_max[i]
+        rng = f' ctrlrange="{_f(-t)} {_f(t)}"' if np.isfinite(t) else ""
+        lines.append(
+            f"    <motor name={quoteattr(robot.joint_names[i] + '_motor')} "
+            f'joint={quoteattr(robot.joint_names[i])} gear="1"{rng}/>'
+        )
+    return lines
+
+
 def mjcf_from_robot(
     robot: Robot,
     *,
@@ -122,62 +237,10 @@ def mjcf_from_robot(
     approximation : CoulombViscous or None
         The fitted friction written to the joints, or None when none was written.
     """
-    n = robot.n
-    approx = None
-    notes: tuple[str, ...] = ()
-    armature = None
-    if isinstance(friction, DriveFriction) or drive is not None:
-        d = friction.drive if isinstance(friction, DriveFriction) else drive
-        assert d is not None
-        d.check(n)
-        jt = drive_joint_terms(
-            d.transmission, d.rotor_inertia, None, None, friction_at_motor=d.friction_at == "motor"
-        )
-        notes = jt.notes
-        armature = jt.armature if d.rotor_inertia is not None else None
-        if isinstance(friction, DriveFriction):
-            d.check(friction.n)
-            approx, more = _law_terms(friction, robot.dq_max)
-            notes += more
-        elif friction is True and robot.friction is not None:
-            approx = coulomb_viscous_from_sigmoid(robot.friction, robot.dq_max)
-        for note in notes:
-            warnings.warn(f"MJCF export: {note}", DynidWarning, stacklevel=2)
-    elif not isinstance(friction, bool):
-        if friction.n != n:
-            raise ShapeError(f"friction has {friction.n} joints; robot {robot.name!r} has {n}")
-        approx, notes = _law_terms(friction, robot.dq_max)
-        for note in notes:
-            warnings.warn(f"MJCF export: {note}", DynidWarning, stacklevel=2)
-    elif friction and robot.friction is not None:
-        approx = coulomb_viscous_from_sigmoid(robot.friction, robot.dq_max)
-    I6 = inertia6_from_matrix(robot.inertia)[:, [0, 3, 5, 1, 2, 4]]  # xx yy zz xy xz yz
-    mass, com = robot.mass, robot.com
-    text = comment or (
-        f"written by dynid {__version__}: inertials about the CoM in link axes [kg, m, kg m^2]"
-        + (
-            "; friction: Coulomb as frictionloss, viscous as damping"
-            + (
-                " (fit of the sigmoid)"
-                if isinstance(friction, bool)
-                else " (reflected from the motors)"
-                if isinstance(friction, DriveFriction)
-                else ""
-            )
-            if approx is not None
-            else "; frictionless joints"
-        )
-        + ("; rotor inertia as armature" if armature is not None else "")
-        + "".join(f"; {note}" for note in notes)
-    )
-    sites: dict[int, list[str]] = {}
-    links = set(robot.link_names)
-    for name, fr in robot.frames.items():
-        if name in links:
-            continue
-        sites.setdefault(fr.link, []).append(
-            f'<site name={quoteattr(name)} {_pose(fr.T_link_frame)} size="0.005"/>'
-        )
+    approx, armature, notes = _joint_terms(robot, friction, drive)
+    for note in notes:
+        warnings.warn(f"MJCF export: {note}", DynidWarning, stacklevel=2)
+    text = comment or _comment(friction, approx, armature, notes)
     lines = [
         '<?xml version="1.0"?>',
         f"<!-- {text.replace('--', '- -')} -->",
@@ -185,42 +248,13 @@ def mjcf_from_robot(
         '  <compiler angle="radian" autolimits="true" boundmass="1e-10" boundinertia="1e-14"/>',
         f'  <option gravity="{_v(robot.gravity)}"/>',
         "  <worldbody>",
-        f'    <body name={quoteattr(robot.link_names[0])} pos="0 0 0">',
+        *_bodies(robot, approx, armature),
+        "  </worldbody>",
+        "  <actuator>",
+        *_actuators(robot),
+        "  </actuator>",
+        "</mujoco>",
     ]
-    lines += ["      " + s for s in sites.get(0, [])]
-    for i in range(n):
-        ind = "    " + "  " * (i + 2)
-        kind = "slide" if robot.prismatic[i] else "hinge"
-        attrs = f'name={quoteattr(robot.joint_names[i])} type="{kind}" axis="{_v(robot.axes[i])}"'
-        lo, hi = robot.q_min[i], robot.q_max[i]
-        if np.isfinite(lo) and np.isfinite(hi):
-            attrs += f' range="{_f(lo)} {_f(hi)}"'
-        if approx is not None:
-            attrs += f' frictionloss="{_f(approx.coulomb[i])}" damping="{_f(approx.viscous[i])}"'
-        if armature is not None:
-            attrs += f' armature="{_f(armature[i])}"'
-        lines += [
-            f"{ind[:-2]}<body name={quoteattr(robot.link_names[i + 1])} "
-            f"{_pose(robot.T_parent_joint[i])}>",
-            f"{ind}<joint {attrs}/>",
-        ]
-        if np.any(robot.phi[i] != 0.0):  # MuJoCo refuses a zero fullinertia; omit it
-            lines.append(
-                f'{ind}<inertial pos="{_v(com[i])}" mass="{_f(mass[i])}" '
-                f'fullinertia="{_v(I6[i])}"/>'
-            )
-        lines += [ind + s for s in sites.get(i + 1, [])]
-    for i in reversed(range(n)):
-        lines.append("    " + "  " * (i + 1) + "</body>")
-    lines += ["    </body>", "  </worldbody>", "  <actuator>"]
-    for i in range(n):
-        t = robot.tau_max[i]
-        rng = f' ctrlrange="{_f(-t)} {_f(t)}"' if np.isfinite(t) else ""
-        lines.append(
-            f"    <motor name={quoteattr(robot.joint_names[i] + '_motor')} "
-            f'joint={quoteattr(robot.joint_names[i])} gear="1"{rng}/>'
-        )
-    lines += ["  </actuator>", "</mujoco>"]
     return "\n".join(lines) + "\n", approx
 
 
