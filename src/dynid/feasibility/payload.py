@@ -264,77 +264,21 @@ def identify_payload(
         raise ShapeError(f"data have {data.q.shape[-1]} joints; robot {kin.name!r} has {n}")
     notes: list[str] = []
     static = isinstance(data, StaticDataset)
-    if unloaded is not None:
-        if isinstance(unloaded, StaticDataset) != static:
-            raise ShapeError("unloaded must be the same kind of data as data (static or log)")
-        if static:
-            model = identify_static(kin, unloaded, rtol=rtol)  # type: ignore[arg-type]
-        else:
-            model = identify_from_log(kin, unloaded, cutoff_hz=cutoff_hz, rtol=rtol)  # type: ignore[arg-type]
-        robot = model.equivalent_robot
-        notes.append(
-            f"difference method: arm identified from the unloaded data "
-            f"({model.base.rank} base parameters); the standard deviations leave out "
-            "the uncertainty of that fit"
-        )
-    else:
-        robot = _arm(arm)
+    robot = _arm_without_load(arm, kin, unloaded, static, cutoff_hz, rtol, notes)
     A = link_params_from_frame(f.T_link_frame)
     cols = slice(10 * (k - 1), 10 * k)
-    friction = None
     if isinstance(data, StaticDataset):
-        q = data.q
-        Y = static_regressor(robot, q)[..., cols] @ A
-        y = static_vector(data.M, data.g) - static_vector(
-            mass_matrix(robot, q), gravity_torques(robot, q)
-        )
-        route = "static M and g"
-        if gravity_only:
-            rows = n * (n + 1) // 2
-            Y, y = Y[:, rows:, :4], y[:, rows:]
-            route = "static g"
-            notes.append("g only: mass and CoM identified, the inertia is not")
-        W, yv = Y.reshape(-1, Y.shape[-1]), y.reshape(-1)
+        W, yv, route = _static_rows(robot, data, cols, A, gravity_only, notes)
     else:
-        log = prepare_log(data, cutoff_hz=cutoff_hz)
-        ddq = log.ddq
-        assert ddq is not None  # prepare_log always differentiates
-        sl = slice(None, None, auto_decimation(data.sample_rate, cutoff_hz))
-        q_, dq_, ddq_ = log.q[sl], log.dq[sl], ddq[sl]
-        Y = torque_regressor(robot, q_, dq_, ddq_)[..., cols] @ A
-        y = np.asarray(log.tau[sl]) - rnea(robot, q_, dq_, ddq_)
-        Y = np.concatenate([Y, friction_regressor(dq_)], axis=-1)
-        W, yv = Y.reshape(-1, Y.shape[-1]), y.reshape(-1)
-        route = "torque log"
-        notes.append("classical friction fv, fc, fo per joint estimated alongside")
+        W, yv, route = _log_rows(robot, data, cols, A, cutoff_hz, notes)
     if unloaded is not None:
         route += ", difference"
     fit = fit_least_squares(W, yv, rtol=1e-10 if rtol is None else rtol, covariance="robust")
     p = 4 if (static and gravity_only) else 10
     est = np.asarray(fit.beta)
     cov = np.asarray(fit.covariance)[:p, :p]
-    phi_ls = np.zeros(10)
-    phi_ls[:p] = est[:p]
-    if not static:
-        friction = est[10:].reshape(n, 3)
-    if p == 4:
-        if phi_ls[0] <= 0:
-            raise DataError(
-                f"the estimated load mass is {phi_ls[0]:.6g} kg (not positive); "
-                "is a load mounted, and is the arm's model right?"
-            )
-        phi, active, marg = phi_ls, False, float("nan")
-    else:
-        import scipy.linalg
-
-        R = scipy.linalg.qr(W[:, :10], mode="r")[0][:10]
-        phi, active = _consistent(phi_ls, R, margin)
-        marg = float(pseudo_inertia_margin(phi))
-        if active:
-            notes.append(
-                "the least-squares estimate was not physically consistent; the LMI "
-                f"(margin {margin:g}) moved it; standard deviations are the unconstrained ones"
-            )
+    friction = None if static else est[10:].reshape(n, 3)
+    phi, active, marg = _load_parameters(est[:p], W, margin, notes)
     m, c, I, sm, sc, si = _summary(phi, cov, p == 10)
     return PayloadEstimate(
         frame=frame,
@@ -358,6 +302,103 @@ def identify_payload(
         friction=friction,
         notes=tuple(notes),
     )
+
+
+def _arm_without_load(
+    arm: Robot | IdentifiedModel,
+    kin: Robot,
+    unloaded: StaticDataset | TorqueLog | None,
+    static: bool,
+    cutoff_hz: float | None,
+    rtol: float | None,
+    notes: list[str],
+) -> Robot:
+    """The arm's robot: ``arm``'s own parameters, or identified from ``unloaded``."""
+    if unloaded is None:
+        return _arm(arm)
+    if isinstance(unloaded, StaticDataset) != static:
+        raise ShapeError("unloaded must be the same kind of data as data (static or log)")
+    if isinstance(unloaded, StaticDataset):
+        model = identify_static(kin, unloaded, rtol=rtol)
+    else:
+        model = identify_from_log(kin, unloaded, cutoff_hz=cutoff_hz, rtol=rtol)
+    notes.append(
+        f"difference method: arm identified from the unloaded data "
+        f"({model.base.rank} base parameters); the standard deviations leave out "
+        "the uncertainty of that fit"
+    )
+    return model.equivalent_robot
+
+
+def _static_rows(
+    robot: Robot,
+    data: StaticDataset,
+    cols: slice,
+    A: NDArray[np.float64],
+    gravity_only: bool,
+    notes: list[str],
+) -> tuple[NDArray[np.float64], NDArray[np.float64], str]:
+    """Regressor rows (in the load's frame parameters) and targets of static data."""
+    n, q = robot.n, data.q
+    Y = static_regressor(robot, q)[..., cols] @ A
+    y = static_vector(data.M, data.g) - static_vector(
+        mass_matrix(robot, q), gravity_torques(robot, q)
+    )
+    route = "static M and g"
+    if gravity_only:
+        rows = n * (n + 1) // 2
+        Y, y = Y[:, rows:, :4], y[:, rows:]
+        route = "static g"
+        notes.append("g only: mass and CoM identified, the inertia is not")
+    return Y.reshape(-1, Y.shape[-1]), y.reshape(-1), route
+
+
+def _log_rows(
+    robot: Robot,
+    data: TorqueLog,
+    cols: slice,
+    A: NDArray[np.float64],
+    cutoff_hz: float | None,
+    notes: list[str],
+) -> tuple[NDArray[np.float64], NDArray[np.float64], str]:
+    """Regressor rows (the load's parameters, then classical friction per joint) and
+    targets of a torque log, filtered and decimated."""
+    log = prepare_log(data, cutoff_hz=cutoff_hz)
+    ddq = log.ddq
+    assert ddq is not None  # prepare_log always differentiates
+    sl = slice(None, None, auto_decimation(data.sample_rate, cutoff_hz))
+    q_, dq_, ddq_ = log.q[sl], log.dq[sl], ddq[sl]
+    Y = torque_regressor(robot, q_, dq_, ddq_)[..., cols] @ A
+    y = np.asarray(log.tau[sl]) - rnea(robot, q_, dq_, ddq_)
+    Y = np.concatenate([Y, friction_regressor(dq_)], axis=-1)
+    notes.append("classical friction fv, fc, fo per joint estimated alongside")
+    return Y.reshape(-1, Y.shape[-1]), y.reshape(-1), "torque log"
+
+
+def _load_parameters(
+    est: NDArray[np.float64], W: NDArray[np.float64], margin: float, notes: list[str]
+) -> tuple[NDArray[np.float64], bool, float]:
+    """The load's 10 parameters from the least-squares ``est`` (4: mass and first
+    moments, checked for a positive mass; 10: moved into the consistent set by the LMI)."""
+    phi_ls = np.zeros(10)
+    phi_ls[: est.size] = est
+    if est.size == 4:
+        if phi_ls[0] <= 0:
+            raise DataError(
+                f"the estimated load mass is {phi_ls[0]:.6g} kg (not positive); "
+                "is a load mounted, and is the arm's model right?"
+            )
+        return phi_ls, False, float("nan")
+    import scipy.linalg  # as the rest of the module: scipy on first use
+
+    R = scipy.linalg.qr(W[:, :10], mode="r")[0][:10]
+    phi, active = _consistent(phi_ls, R, margin)
+    if active:
+        notes.append(
+            "the least-squares estimate was not physically consistent; the LMI "
+            f"(margin {margin:g}) moved it; standard deviations are the unconstrained ones"
+        )
+    return phi, active, float(pseudo_inertia_margin(phi))
 
 
 def robot_with_payload(robot: Robot, est: PayloadEstimate, *, name: str = "payload") -> Robot:
