@@ -88,8 +88,11 @@ def velocity_noise_std(dq: ArrayLike) -> NDArray[np.float64]:
         raise ShapeError(f"dq must have shape (N, n), N >= 3; got {a.shape}")
     est = []
     for order, var in ((2, 6.0), (3, 20.0)):
-        d = np.diff(a, n=order, axis=0)
-        mad = np.median(np.abs(d - np.median(d, axis=0)), axis=0)
+        mad = np.empty(a.shape[1])
+        for j in range(a.shape[1]):  # one joint at a time: temporaries of one column
+            d = np.diff(a[:, j], n=order)
+            d -= np.median(d)
+            mad[j] = np.median(np.abs(d, out=d))
         est.append(1.4826 * mad / np.sqrt(var))
     out: NDArray[np.float64] = np.minimum(*est)
     return out
@@ -146,7 +149,10 @@ def moving_joints(dq: ArrayLike, noise_std: ArrayLike | None = None) -> NDArray[
     if sd.shape != (a.shape[1],):
         raise ShapeError(f"noise_std must have shape ({a.shape[1]},); got {sd.shape}")
     band = np.maximum(noise_band(sd), MIN_MOTION)
-    out: NDArray[np.bool_] = np.quantile(np.abs(a), 1.0 - MOVING_FRACTION, axis=0) > band
+    level = np.array(
+        [np.quantile(np.abs(a[:, j]), 1.0 - MOVING_FRACTION) for j in range(a.shape[1])]
+    )
+    out: NDArray[np.bool_] = level > band
     return out
 
 
@@ -235,10 +241,13 @@ def _milliseconds(log: TorqueLog) -> list[str]:
     t, q, dq = log.t, log.q, log.dq
     if t.size < 5:
         return []
-    fd = np.gradient(q, t, axis=0)
-    den = float(np.sum(dq * dq))
+    num = den = 0.0
+    for j in range(q.shape[1]):  # one joint at a time: temporaries of one column (long logs)
+        v = np.ascontiguousarray(dq[:, j])
+        num += float(np.gradient(q[:, j], t) @ v)
+        den += float(v @ v)
     if den > 0:
-        k = float(np.sum(fd * dq) / den)
+        k = num / den
         if 3e-4 < k < 3e-3:
             return [
                 f"the velocities are {1 / k:.3g} times the derivative of the positions: the "
