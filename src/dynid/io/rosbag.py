@@ -30,6 +30,7 @@ from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
+from numpy.typing import NDArray
 
 from .. import _checks, signals
 from ..exceptions import DataError
@@ -210,9 +211,9 @@ def load_joint_state_bag(
         if bad:
             raise DataError(f"{path.name}: topic {topic!r} holds {bad[0]}, not JointState")
         n_total = int(reader.message_count)
-        msgs = []
+        msgs = _Messages(sum(int(getattr(c, "msgcount", 0) or 0) for c in conns))
         for conn, recv_ns, raw in reader.messages(connections=conns):
-            msgs.append((recv_ns, reader.deserialize(raw, conn.msgtype)))
+            msgs.add(recv_ns, reader.deserialize(raw, conn.msgtype))
     except DataError:
         raise
     except Exception as exc:
@@ -224,68 +225,127 @@ def load_joint_state_bag(
     )
 
 
+#: Messages per chunk of the arrays a bag is read into.
+_CHUNK = 16_384
+
+
+class _Chunk:
+    """Up to :data:`_CHUNK` messages of one joint-name list: their index in the bag and
+    their ``position``, ``velocity``, ``effort`` in the list's order (NaN where short)."""
+
+    def __init__(self, width: int) -> None:
+        self.index = np.empty(_CHUNK, dtype=np.int64)
+        self.values = np.full((3, _CHUNK, width), np.nan)
+        self.size = 0
+
+
+class _Messages:
+    """JointState messages read one at a time into numpy chunks, grouped by their
+    joint-name list (a bag of 1.6 million messages is never a list of message objects).
+
+    ``count`` is the expected number of messages (0 when unknown); the per-message
+    arrays grow beyond it when needed.
+    """
+
+    def __init__(self, count: int) -> None:
+        self.n = 0
+        self.stamp = np.empty(max(count, 1024), dtype=np.int64)
+        self.recv = np.empty_like(self.stamp)
+        self.short = np.zeros(self.stamp.size, dtype=bool)  # position or effort short
+        self.short_vel = np.zeros(self.stamp.size, dtype=bool)
+        self.keys: dict[tuple[str, ...], list[_Chunk]] = {}
+        self.any_velocity = False
+        self.any_effort = False
+
+    def add(self, recv_ns: int, m: object) -> None:
+        """Store one message (``sensor_msgs/JointState``)."""
+        k = self.n
+        if k == self.stamp.size:
+            for a in ("stamp", "recv", "short", "short_vel"):
+                old = getattr(self, a)
+                new = np.zeros(2 * old.size, dtype=old.dtype)
+                new[: old.size] = old
+                setattr(self, a, new)
+        st = m.header.stamp  # type: ignore[attr-defined]
+        self.stamp[k] = int(st.sec) * 1_000_000_000 + int(st.nanosec)
+        self.recv[k] = int(recv_ns)
+        key = tuple(m.name)  # type: ignore[attr-defined]
+        w = len(key)
+        chunks = self.keys.setdefault(key, [])
+        if not chunks or chunks[-1].size == _CHUNK:
+            chunks.append(_Chunk(w))
+        c = chunks[-1]
+        c.index[c.size] = k
+        fields = (m.position, m.velocity, m.effort)  # type: ignore[attr-defined]
+        for f, v in enumerate(fields):
+            if len(v) >= w:
+                c.values[f, c.size] = np.asarray(v[:w], dtype=np.float64)
+        self.any_velocity |= len(fields[1]) > 0
+        self.any_effort |= len(fields[2]) > 0
+        self.short[k] = len(fields[0]) < w or len(fields[2]) < w
+        self.short_vel[k] = len(fields[1]) < w
+        c.size += 1
+        self.n += 1
+
+    def names(self) -> list[str]:
+        """Every joint name, in the order of first appearance."""
+        seen: dict[str, None] = {}
+        for key in self.keys:
+            seen.update(dict.fromkeys(key))
+        return list(seen)
+
+    def arrays(
+        self, mapping: list[str]
+    ) -> tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.float64], NDArray[np.bool_]]:
+        """``q, dq, tau`` (N, n) in the order of ``mapping`` and which messages hold every
+        joint of it."""
+        n, N = len(mapping), self.n
+        out = np.full((3, N, n), np.nan)
+        has = np.zeros(N, dtype=bool)
+        for key, chunks in self.keys.items():
+            pos = {s: i for i, s in enumerate(key)}
+            if not all(s in pos for s in mapping):
+                continue
+            idx = [pos[s] for s in mapping]
+            for c in chunks:
+                rows = c.index[: c.size]
+                out[:, rows] = c.values[:, : c.size][:, :, idx]
+                has[rows] = True
+        return out[0], out[1], out[2], has
+
+
 def _assemble(
     name: str,
     topic: str,
-    msgs: list,
+    msgs: _Messages,
     n_total: int,
     robot_joints: Sequence[str],
     joints: Sequence[str] | None,
     cutoff_hz: float,
     gap_factor: float,
 ) -> BagImport:
-    n_msg = len(msgs)
+    n_msg = msgs.n
     if n_msg == 0:
         raise DataError(f"{name}: topic {topic!r} holds no message")
-    seen: dict[str, None] = {}
-    for _, m in msgs:
-        seen.update(dict.fromkeys(m.name))
-    mapping = match_joints(robot_joints, list(seen), joints)
-    n = len(mapping)
-    stamps = np.array(
-        [int(m.header.stamp.sec) * 1_000_000_000 + int(m.header.stamp.nanosec) for _, m in msgs],
-        dtype=np.int64,
-    )
+    mapping = match_joints(robot_joints, msgs.names(), joints)
+    stamps = msgs.stamp[:n_msg]
     notes = []
     if np.any(stamps == 0):
-        stamps = np.array([r for r, _ in msgs], dtype=np.int64)
+        stamps = msgs.recv[:n_msg]
         source = "receive"
         notes.append("header stamps unset (zero): receive times of the bag used instead")
     else:
         source = "header"
-    has_vel = any(len(m.velocity) for _, m in msgs)
-    if not any(len(m.effort) for _, m in msgs):
+    has_vel = msgs.any_velocity
+    if not msgs.any_effort:
         raise DataError(
             f"{name}: no JointState message on {topic!r} holds effort; a torque log needs torques"
         )
-    q = np.full((n_msg, n), np.nan)
-    dq = np.full((n_msg, n), np.nan)
-    tau = np.full((n_msg, n), np.nan)
-    keep = np.ones(n_msg, dtype=bool)
-    n_missing = 0
-    cache: dict[tuple[str, ...], list[int] | None] = {}
-    for k, (_, m) in enumerate(msgs):
-        key = tuple(m.name)
-        if key in cache:
-            idx = cache[key]
-        else:
-            pos = {s: i for i, s in enumerate(key)}
-            idx = [pos[s] for s in mapping] if all(s in pos for s in mapping) else None
-            cache[key] = idx
-        w = len(key)
-        if (
-            idx is None
-            or len(m.position) < w
-            or len(m.effort) < w
-            or (has_vel and len(m.velocity) < w)
-        ):
-            keep[k] = False
-            n_missing += 1
-            continue
-        q[k] = np.asarray(m.position, dtype=np.float64)[idx]
-        tau[k] = np.asarray(m.effort, dtype=np.float64)[idx]
-        if has_vel:
-            dq[k] = np.asarray(m.velocity, dtype=np.float64)[idx]
+    q, dq, tau, keep = msgs.arrays(mapping)
+    keep &= ~msgs.short[:n_msg]
+    if has_vel:
+        keep &= ~msgs.short_vel[:n_msg]
+    n_missing = int(np.count_nonzero(~keep))
     finite = np.all(np.isfinite(q), 1) & np.all(np.isfinite(tau), 1)
     if has_vel:
         finite &= np.all(np.isfinite(dq), 1)
