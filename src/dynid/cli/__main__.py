@@ -254,6 +254,11 @@ def main(argv: Sequence[str] | None = None) -> int:
             raise
         print(f"{say}: error: {one_line(str(exc), ERROR_LINE_LIMIT)}", file=sys.stderr)
         return 2
+    except MemoryError as exc:
+        if args.debug:
+            raise
+        print(f"{say}: error: {out_of_memory(exc)}", file=sys.stderr)
+        return 2
     except Exception as exc:  # anything unexpected: one line, never a traceback
         if args.debug:
             raise
@@ -263,6 +268,23 @@ def main(argv: Sequence[str] | None = None) -> int:
             file=sys.stderr,
         )
         return 2
+
+
+def out_of_memory(exc: MemoryError) -> str:
+    """One line for a process out of memory: the step (the innermost dynid function) and
+    how to raise or avoid the limit."""
+    where = "?"
+    tb = exc.__traceback__
+    while tb is not None:
+        mod = str(tb.tb_frame.f_globals.get("__name__", ""))
+        if mod.startswith("dynid."):
+            where = f"{tb.tb_frame.f_code.co_name} ({mod})"
+        tb = tb.tb_next
+    return (
+        f"out of memory in {where}; hint: the limit is the process's address space (ulimit "
+        "-v) or the machine's memory: raise it, or give a shorter log (a long one streams "
+        "its regressor in blocks above DYNID_MAX_STACK_BYTES bytes: lower it)"
+    )
 
 
 def _drop_stdout() -> None:

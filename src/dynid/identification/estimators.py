@@ -43,6 +43,7 @@ __all__ = [
     "Estimator",
     "EstimatorName",
     "estimator_named",
+    "residual_weights",
     "row_weights",
 ]
 
@@ -257,8 +258,17 @@ def row_weights(
     held-out judgement in the estimator's terms (an outlier weighs there as in the fit)."""
     if not isinstance(estimator, WLS | IRLS):
         return np.ones(y.size)
-    e = y - W @ beta
-    s = group_noise(e, groups, 1.0 - W.shape[1] / max(y.size, 1))
+    return residual_weights(estimator, y - W @ beta, groups, W.shape[1])
+
+
+def residual_weights(
+    estimator: Estimator, e: NDArray[np.float64], groups: NDArray[np.intp], n_columns: int
+) -> NDArray[np.float64]:
+    """:func:`row_weights` from the residual ``e`` (m,) of a fit of ``n_columns``
+    coefficients (the regressor itself not needed: a streamed fit's rows)."""
+    if not isinstance(estimator, WLS | IRLS):
+        return np.ones(e.size)
+    s = group_noise(e, groups, 1.0 - n_columns / max(e.size, 1))
     if isinstance(estimator, WLS):
         return np.asarray(1.0 / s[groups], dtype=np.float64)
     for g in np.unique(groups):

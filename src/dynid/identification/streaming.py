@@ -47,16 +47,19 @@ from numpy.typing import NDArray
 from .. import _checks
 from ..exceptions import DataError, NonFiniteError, OptionError, RankDeficientError, ShapeError
 from .estimators import IRLS, OLS, WLS, Estimator
+from .holdout import Normals
 from .least_squares import LeastSquaresFit, _conditioning
 
 __all__ = [
     "BLOCK_ROWS",
+    "Block",
     "BlockSource",
     "GroupFactors",
     "MAX_STACK_BYTES",
     "fit_streamed",
     "group_factors",
     "max_stack_bytes",
+    "normals_by_label",
     "streams",
 ]
 
@@ -549,3 +552,45 @@ def _weighted_factor(source: BlockSource, w: NDArray[np.float64], c: int) -> NDA
         R = _triangular(np.vstack([R, X]))
         o += y.size
     return R
+
+
+def normals_by_label(
+    source: BlockSource,
+    labels: NDArray[np.intp],
+    weights: NDArray[np.float64] | None = None,
+) -> tuple[Normals, ...]:
+    """Normal equations (:class:`~dynid.identification.holdout.Normals`) of the rows of each
+    label, one pass: ``labels`` (m,) gives the label ``0 .. k-1`` of every row in block
+    order (the time block of a held-out judgement); ``weights`` (m,), when given, multiply
+    the rows (and their targets) first.
+
+    Raises
+    ------
+    ShapeError
+        The blocks hold another number of rows than ``labels``.
+    """
+    k = int(labels.max()) + 1 if labels.size else 0
+    G: NDArray[np.float64] | None = None
+    b = np.zeros((k, 0))
+    c = np.zeros(k)
+    o = 0
+    for W, y, _g in _blocks(source):
+        if G is None:
+            G, b = np.zeros((k, W.shape[1], W.shape[1])), np.zeros((k, W.shape[1]))
+        lab = labels[o : o + y.size]
+        if lab.size != y.size:
+            raise ShapeError(f"labels hold {labels.size} rows; the blocks more")
+        for j in np.unique(lab):
+            sel = lab == j
+            Wj, yj = W[sel], y[sel]
+            if weights is not None:
+                wj = weights[o : o + y.size][sel]
+                Wj, yj = Wj * wj[:, None], yj * wj
+            G[j] += Wj.T @ Wj
+            b[j] += Wj.T @ yj
+            c[j] += float(yj @ yj)
+        o += y.size
+    if o != labels.size or G is None:
+        raise ShapeError(f"labels hold {labels.size} rows; the blocks {o}")
+    cnt = np.bincount(labels, minlength=k)
+    return tuple(Normals(G[j], b[j], float(c[j]), int(cnt[j])) for j in range(k))

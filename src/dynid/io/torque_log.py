@@ -41,6 +41,7 @@ from typing import IO, Any
 import numpy as np
 from numpy.typing import NDArray
 
+from .. import _checks
 from ..exceptions import DataError
 from ..identification.log import (
     DEFAULT_CUTOFF_HZ,
@@ -264,7 +265,8 @@ def _read_npz(path: Path) -> dict[str, NDArray[np.float64]]:
                     raise DataError(
                         f"{path.name}: array {k!r} must be real numbers; got dtype {a.dtype}"
                     )
-                arrays[k] = a.astype(np.float64, copy=False)
+                arrays[k] = _checks.frozen(a.astype(np.float64, copy=False))  # kept as is
+                del a
     except (zipfile.BadZipFile, EOFError, OSError) as exc:
         raise DataError(f"{path.name}: not a readable NPZ file ({exc})") from exc
     t = arrays["t"]
@@ -403,8 +405,8 @@ def csv_table(
     if N == 0:
         raise DataError(f"{path.name}: no data rows after the header")
     check_row_count(path, recorded, N)
-    for a in arrays.values():
-        a.setflags(write=False)  # fresh and owned: TorqueLog keeps them without a copy
+    for k in list(arrays):  # immutable one at a time (TorqueLog keeps them without a copy):
+        arrays[k] = _checks.frozen(arrays.pop(k))  # the copy of one array at a time only
     return arrays, ((first, N) if one_to_one else None)
 
 
