@@ -7,14 +7,23 @@ the error formulas written out with numpy; a subprocess under an address-space l
 
 from __future__ import annotations
 
+import os
+import subprocess
+import sys
+
 import numpy as np
 import pytest
 import scipy.signal
 
+import dynid
 from dynid.exceptions import ShapeError
 from dynid.friction.model import ClassicalFriction
 from dynid.friction.validation import BLOCK_SAMPLES, validate_torques
+from dynid.identification.classical import identify_from_log
 from dynid.identification.log import TorqueLog, prepare_log
+from dynid.io.torque_log import save_torque_log
+from dynid.simulation.measurement import sample_times, simulate_measurement
+from dynid.simulation.trajectories import random_fourier
 
 
 def _log(seed: int, N: int, n: int = 3) -> TorqueLog:
@@ -80,3 +89,81 @@ def test_validation_of_a_long_log_sums_its_errors_by_blocks():
         rtol=1e-12,
     )
     assert val.with_friction.n_samples == p.n_samples
+
+
+@pytest.mark.parametrize("estimator", ["ols", "wls"])
+def test_classical_route_streamed_equals_stacked(monkeypatch, estimator):
+    """A log identified with its regressor streamed in blocks (DYNID_MAX_STACK_BYTES=0)
+    gives the stacked fit's estimates, standard deviations, friction and held-out errors
+    (the stacked estimators on the whole regressor) to 1e-9."""
+    robot = dynid.panda()
+    series = random_fourier(robot, np.random.default_rng(7))
+    log = simulate_measurement(
+        robot, series(sample_times(40.0, 1000.0)), rng=np.random.default_rng(8)
+    )
+    ref = identify_from_log(robot, log, estimator=estimator)
+    monkeypatch.setenv("DYNID_MAX_STACK_BYTES", "0")
+    got = identify_from_log(robot, log, estimator=estimator)
+    np.testing.assert_allclose(got.fit.beta, ref.fit.beta, rtol=1e-9, atol=1e-12)
+    np.testing.assert_allclose(got.fit.std, ref.fit.std, rtol=1e-9, atol=1e-14)
+    np.testing.assert_allclose(got.friction, ref.friction, rtol=1e-9, atol=1e-12)
+    assert got.fit.relative_error_percent == pytest.approx(ref.fit.relative_error_percent, rel=1e-9)
+    h, hr = got.metadata["heldout"], ref.metadata["heldout"]
+    assert h["heldout_error_percent"] == pytest.approx(hr["heldout_error_percent"], rel=1e-9)
+    assert got.metadata["n_rows"] == ref.metadata["n_rows"]
+
+
+_VM_RUN = """
+import resource, sys
+limit = int(sys.argv[1])
+if limit > 0:
+    resource.setrlimit(resource.RLIMIT_AS, (limit, limit))
+from dynid.cli.__main__ import main
+code = main(sys.argv[2:])
+peak = [l for l in open("/proc/self/status") if l.startswith("VmPeak")][0].split()[1]
+print("VMPEAK", int(peak) * 1024)
+sys.exit(code)
+"""
+
+
+def _identify_limited(tmp_path, log, limit: int, stack_bytes: int):
+    """``dynid identify`` of ``log`` in a subprocess under RLIMIT_AS ``limit`` bytes (0:
+    none), the regressor stacked whole up to ``stack_bytes``; exit code, peak virtual
+    memory [bytes] (None when it died), stderr."""
+
+    env = {**os.environ, "DYNID_MAX_STACK_BYTES": str(stack_bytes), "OPENBLAS_NUM_THREADS": "1"}
+    out = tmp_path / f"out-{limit}-{stack_bytes}"
+    cmd = [sys.executable, "-c", _VM_RUN, str(limit), "identify", "--robot", "panda"]
+    cmd += ["--data", str(log), "--cutoff", "50", "--out", str(out), "--no-figures", "-q"]
+    proc = subprocess.run(cmd, capture_output=True, text=True, env=env, timeout=600)
+    peak = [int(s.split()[1]) for s in proc.stdout.splitlines() if s.startswith("VMPEAK")]
+    return proc.returncode, (peak[0] if peak else None), proc.stderr
+
+
+@pytest.mark.slow
+def test_a_long_log_identifies_under_an_address_space_limit(tmp_path):
+    """A 300,000-row log at 1 kHz identified with a 50 Hz cutoff (decimated by 2: a stacked
+    regressor of 1.05 million rows, 0.55 GB): streamed in blocks it identifies under an
+    address-space limit 150 MB above its own peak, where the stacked regressor runs out of
+    memory and says so in one line (exit 2, no traceback)."""
+    resource = pytest.importorskip("resource")
+    if not hasattr(resource, "RLIMIT_AS") or not os.path.exists("/proc/self/status"):
+        pytest.skip("needs RLIMIT_AS and /proc/self/status (Linux)")
+    robot = dynid.panda()
+    series = random_fourier(robot, np.random.default_rng(11))
+    log = simulate_measurement(
+        robot, series(sample_times(299.999, 1000.0)), rng=np.random.default_rng(12)
+    )
+    path = tmp_path / "long.npz"
+    save_torque_log(path, log)
+    del log
+    code, peak, err = _identify_limited(tmp_path, path, 0, 0)
+    assert code == 0, err
+    assert peak is not None
+    limit = peak + 150 * 2**20
+    code, _, err = _identify_limited(tmp_path, path, limit, 0)
+    assert code == 0, err
+    code, _, err = _identify_limited(tmp_path, path, limit, 1 << 50)
+    lines = err.strip().splitlines()
+    assert code == 2 and "out of memory in" in lines[-1], err
+    assert "Traceback" not in err and "DYNID_MAX_STACK_BYTES" in lines[-1]

@@ -47,13 +47,28 @@ from ..regressors.terms import (
     friction_labels,
 )
 from ..regressors.torque import torque_regressor_prepared
-from .core import Judge, ModelColumns, RegressorBlock, RegressorStack, identify
-from .estimators import Estimator, EstimatorName, estimator_named, row_weights
+from .core import (
+    Judge,
+    ModelColumns,
+    RegressorBlock,
+    RegressorStack,
+    StreamedRows,
+    identify,
+    selected_columns,
+)
+from .estimators import (
+    Estimator,
+    EstimatorName,
+    estimator_named,
+    residual_weights,
+    row_weights,
+)
 from .holdout import DEFAULT_FOLDS, HeldOut, block_labels, block_normals
 from .least_squares import StdMethod
 from .log import DEFAULT_CUTOFF_HZ, LogCleaning, TorqueLog, joint_side_log, prepare_log
 from .model import IdentifiedModel
 from .sanity import check_torque_log, moving_joints
+from .streaming import BLOCK_ROWS, BlockSource, normals_by_label, streams
 
 __all__ = [
     "PreparedLog",
@@ -215,10 +230,15 @@ def _judge(
     est = estimator_named(estimator)
 
     def judge(
-        stack: RegressorStack, columns: ModelColumns, cols: NDArray[np.bool_], beta: NDArray[Any]
+        stack: RegressorStack | StreamedRows,
+        columns: ModelColumns,
+        cols: NDArray[np.bool_],
+        beta: NDArray[Any],
     ) -> HeldOut | None:
-        W, y = (stack.W if cols.all() else stack.W[:, cols]), stack.y
         b = np.asarray(beta)[cols]
+        if isinstance(stack, StreamedRows):
+            return _held_out_streamed(selected_columns(stack.source, cols), b, cols, columns)
+        W, y = (stack.W if cols.all() else stack.W[:, cols]), stack.y
         rw = row_weights(est, W, y, stack.groups, b)
         if validate_on is None:
             return _held_out(W * rw[:, None], y * rw, n, folds, cols)
@@ -227,6 +247,31 @@ def _judge(
         vw = row_weights(est, vW, vy, np.tile(np.arange(n), vy.size // n), b)
         return HeldOut.separate(
             block_normals(W * rw[:, None], y * rw, np.zeros(y.size, dtype=np.intp))[0],
+            block_normals(vW * vw[:, None], vy * vw, np.zeros(vy.size, dtype=np.intp))[0],
+        ).expanded(cols)
+
+    def _held_out_streamed(
+        source: BlockSource,
+        b: NDArray[np.float64],
+        cols: NDArray[np.bool_],
+        columns: ModelColumns,
+    ) -> HeldOut | None:
+        """The judgement of rows left in blocks (a long log), from their normal equations."""
+        e = np.concatenate([y - W @ b for W, y, _ in source()])
+        N = e.size // n
+        rw = residual_weights(est, e, np.tile(np.arange(n, dtype=np.intp), N), b.size)
+        del e
+        if validate_on is None:
+            try:
+                labels = np.repeat(block_labels(N, folds), n)
+            except OptionError:
+                return None
+            return HeldOut.k_fold(normals_by_label(source, labels, rw)).expanded(cols)
+        rate = prepared.sample_rate_hz / prepared.decimate
+        vW, vy = _validation_rows(robot, validate_on, columns, cols, cutoff_hz, trim_s, rate)
+        vw = row_weights(est, vW, vy, np.tile(np.arange(n), vy.size // n), b)
+        return HeldOut.separate(
+            normals_by_label(source, np.zeros(N * n, dtype=np.intp), rw)[0],
             block_normals(vW * vw[:, None], vy * vw, np.zeros(vy.size, dtype=np.intp))[0],
         ).expanded(cols)
 
@@ -369,14 +414,19 @@ class PreparedLog:
         log = self.log
         assert log.ddq is not None  # prepare_log always fills ddq
         N, n = log.n_samples, log.n
-        Y, _ = term_regressor(robot, columns.base, columns.terms, log.q, log.dq, log.ddq)
-        tau = log.tau
         drive = columns.drive
-        if drive is not None and drive.rotor_inertia is not None:  # known: not identified
-            tau = tau - drive.rotor_torques(log.ddq, drive.rotor_inertia)
-        W = Y.reshape(N * n, -1)
-        _checks.finite("regressor", W)
-        yield RegressorBlock(W=W, y=tau.reshape(-1), groups=np.tile(np.arange(n), N))
+        # a log whose regressor exceeds DYNID_MAX_STACK_BYTES comes in blocks of samples
+        step = max(1, BLOCK_ROWS // n) if streams(N * n, len(columns.labels)) else N
+        for a in range(0, N, step):
+            b = slice(a, a + step)
+            q, dq, ddq, tau = log.q[b], log.dq[b], log.ddq[b], log.tau[b]
+            Y, _ = term_regressor(robot, columns.base, columns.terms, q, dq, ddq)
+            if drive is not None and drive.rotor_inertia is not None:  # known: subtracted
+                tau = tau - drive.rotor_torques(ddq, drive.rotor_inertia)
+            m = Y.shape[0]
+            W = Y.reshape(m * n, -1)
+            _checks.finite("regressor", W)
+            yield RegressorBlock(W=W, y=tau.reshape(-1), groups=np.tile(np.arange(n), m))
 
     def record(self, n_rows: int) -> dict[str, Any]:
         """Filtering, decimation and sample counts."""

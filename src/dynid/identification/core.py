@@ -25,6 +25,7 @@ that a long log can be read in pieces; they are concatenated here.
 from __future__ import annotations
 
 import dataclasses
+import itertools
 import logging
 import warnings
 from collections.abc import Callable, Iterable, Iterator
@@ -50,6 +51,7 @@ from .least_squares import (
     fit_blocks,
 )
 from .model import IdentifiedModel
+from .streaming import BlockSource, fit_streamed
 
 __all__ = [
     "DEFAULT_FIT_RTOL",
@@ -60,6 +62,7 @@ __all__ = [
     "RegressorKind",
     "RegressorStack",
     "Route",
+    "StreamedRows",
     "fit_stack",
     "identify",
     "informative_blocks",
@@ -253,8 +256,29 @@ class RegressorStack:
 #: the model's columns, the columns fitted (c,) and the estimates over every column (c,);
 #: returns the folds' normal equations over every column, or None when the data are too
 #: short to judge.
+@dataclass(frozen=True, slots=True, eq=False)
+class StreamedRows:
+    """A data set's rows left in blocks, too many to stack (a long torque log): ``source``
+    yields ``(W, y, groups)`` again for every pass of the fit
+    (:mod:`dynid.identification.streaming`).
+
+    Attributes
+    ----------
+    source : BlockSource
+    n_rows : int
+        Rows over all blocks (0 until the fit has counted them).
+    dropped : tuple of str
+        Always empty (blocks are not judged for information).
+    """
+
+    source: BlockSource
+    n_rows: int = 0
+    dropped: tuple[str, ...] = ()
+
+
 Judge = Callable[
-    [RegressorStack, ModelColumns, NDArray[np.bool_], NDArray[np.float64]], HeldOut | None
+    [RegressorStack | StreamedRows, ModelColumns, NDArray[np.bool_], NDArray[np.float64]],
+    HeldOut | None,
 ]
 
 
@@ -301,8 +325,9 @@ def model_columns(
 
 def stack_dataset(
     robot: Robot, data: Dataset, columns: ModelColumns, *, rtol: float = DEFAULT_FIT_RTOL
-) -> RegressorStack:
-    """Concatenate the data's blocks and drop those without information.
+) -> RegressorStack | StreamedRows:
+    """Concatenate the data's blocks and drop those without information; a torque log
+    that comes in several blocks (too long to stack) is left in them (:class:`StreamedRows`).
 
     A seam for held-out judgement: :meth:`RegressorStack.select` keeps some blocks for
     :func:`fit_stack`.
@@ -312,7 +337,12 @@ def stack_dataset(
     DynidWarning
         A dropped block holds non-zero data (gravity or kinematics differ from the source's).
     """
-    stack = _concatenated(data.blocks(robot, columns), len(columns.labels))
+    blocks = iter(data.blocks(robot, columns))
+    head = list(itertools.islice(blocks, 2))
+    if data.route == "classical" and len(head) > 1:  # a long log: blocks of rows, streamed
+        del head, blocks
+        return StreamedRows(lambda: ((b.W, b.y, b.groups) for b in data.blocks(robot, columns)))
+    stack = _concatenated(itertools.chain(head, blocks), len(columns.labels))
     if stack.rows.shape[0] < 2:
         return stack
     grams = block_grams(stack.W, stack.rows)
@@ -365,7 +395,7 @@ def _concatenated(blocks: Iterable[RegressorBlock], c: int) -> RegressorStack:
 
 
 def fit_stack(
-    stack: RegressorStack,
+    stack: RegressorStack | StreamedRows,
     labels: tuple[str, ...],
     *,
     estimator: EstimatorName | Estimator = "ols",
@@ -388,6 +418,17 @@ def fit_stack(
     """
     est = estimator_named(estimator)
     cols = np.ones(len(labels), dtype=bool) if frozen is None else ~np.asarray(frozen, bool)
+    kept_labels = tuple(lab for lab, c in zip(labels, cols, strict=True) if c)
+    if isinstance(stack, StreamedRows):
+        fit = fit_streamed(
+            selected_columns(stack.source, cols),
+            est,
+            rtol=rtol,
+            covariance=std,
+            max_std_percent=max_std_percent,
+            labels=kept_labels,
+        )
+        return fit if cols.all() else _expanded(fit, cols)
     W, rows = stack.W, stack.used_rows
     grams = None if stack.grams is None else stack.grams[stack.kept]
     if not cols.all():
@@ -395,7 +436,6 @@ def fit_stack(
         rows = rows.copy()
         rows[:, 2] = 0
         grams = None if grams is None else grams[:, cols][:, :, cols]
-    kept_labels = tuple(lab for lab, c in zip(labels, cols, strict=True) if c)
     if isinstance(est, OLS):
         fit = fit_blocks(
             W,
@@ -424,6 +464,13 @@ def fit_stack(
             labels=kept_labels,
         )
     return fit if cols.all() else _expanded(fit, cols)
+
+
+def selected_columns(source: BlockSource, cols: NDArray[np.bool_]) -> BlockSource:
+    """The blocks of ``source`` with only the columns ``cols`` (c,) bool."""
+    if np.all(cols):
+        return source
+    return lambda: ((W[:, cols], y, g) for W, y, g in source())
 
 
 def identify(
@@ -516,6 +563,8 @@ def identify(
         )
     except RankDeficientError as exc:
         raise _rank_error(exc, data, columns, stack, fit_rtol) from exc
+    if isinstance(stack, StreamedRows):
+        stack = dataclasses.replace(stack, n_rows=fit.n_rows)
     held = None if judge is None else judge(stack, columns, ~frozen, fit.beta)
     for msg in conditioning_advice(fit, labels, what=_what(data)):
         warnings.warn(msg, DynidWarning, stacklevel=2)
@@ -541,7 +590,7 @@ def _rank_error(
     exc: RankDeficientError,
     data: Dataset,
     columns: ModelColumns,
-    stack: RegressorStack,
+    stack: RegressorStack | StreamedRows,
     rtol: float,
 ) -> RankDeficientError:
     """The estimator's rank error said for the data, with the data's hint."""
@@ -561,7 +610,7 @@ def _record(
     data: Dataset,
     columns: ModelColumns,
     fit: LeastSquaresFit,
-    stack: RegressorStack,
+    stack: RegressorStack | StreamedRows,
     estimator: str,
     std: str,
     max_std_percent: float | None,
