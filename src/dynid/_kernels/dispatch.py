@@ -174,7 +174,8 @@ class Cache:
     arrays were asked for last, and those arrays (the single-sample paths check
     ``CACHE.robot is robot``, which costs no call; this one robot is held until another
     is used); ``small_calls``: single-sample calls so far (:func:`small_call_uses_kernels`);
-    ``options``: inverse-kinematics options -> their ``(fpar, ipar)`` arrays.
+    ``options``: ``id(options)`` -> the inverse-kinematics options (kept alive, so the id
+    is theirs) and their ``(fpar, ipar)`` arrays.
     """
 
     __slots__ = ("modules", "robots", "robot", "last", "small_calls", "options")
@@ -185,7 +186,7 @@ class Cache:
         self.robot: Any = None
         self.last: Packed | None = None
         self.small_calls = 0
-        self.options: dict[Any, tuple[NDArray[np.float64], NDArray[np.int64]]] = {}
+        self.options: dict[int, tuple[Any, tuple[NDArray[np.float64], NDArray[np.int64]]]] = {}
 
 
 #: the one cache of the kernels
@@ -295,25 +296,29 @@ def run(
     does not pass, :func:`compiled` says numpy, or the kernel declines (``ok = False``:
     a non-finite input, or a chain too long for a single-sample kernel's stack scratch).
     """
-    xs = []
-    for x in arrays:
-        a = c_float64(x)
-        if a is None:
-            return None
-        xs.append(a)
-    shape = xs[0].shape
-    if shape[-1] != len(robot.joint_names) or any(a.shape != shape for a in xs[1:]):
+    a = c_float64(arrays[0])
+    if a is None:
         return None
-    f = compiled(kernel, len(shape))
+    shape = a.shape
+    if shape[-1] != len(robot.joint_names):
+        return None
+    flats = [flat(a)]
+    for x in arrays[1:]:
+        a = c_float64(x)
+        if a is None or a.shape != shape:
+            return None
+        flats.append(flat(a))
+    ndim = len(shape)
+    f = compiled(kernel, ndim)
     if f is None:
         return None
+    if C is None:
+        c = CACHE
+        C = c.last.C if c.robot is robot and c.last is not None else packed(robot).C
     out = np.empty(shape[:-1] + tail)  # (tail: the result of one sample, e.g. (n,))
-    one = len(shape) == 1 and kernel.one_name is not None
-    if f(
-        constants(robot) if C is None else C,
-        *[flat(a) for a in xs],
-        out if one else out.reshape(-1),
-    ):
+    # one sample: the output as it is (the entry points are typed for it); a batch: flat,
+    # so that a batch kernel is compiled once whatever the batch shape
+    if f(C, *flats, out if ndim == 1 else out.reshape(-1)):
         return out
     return None
 

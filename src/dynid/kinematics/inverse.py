@@ -430,9 +430,9 @@ def _parameters(opts: IKOptions) -> tuple[NDArray[np.float64], NDArray[np.int64]
     """The options as the solvers' ``fpar`` and ``ipar`` arrays (remembered per options in
     the kernels' cache, :data:`dynid._kernels.CACHE`; at most 16)."""
     memo = _kernels.CACHE.options
-    hit = memo.get(opts)
-    if hit is not None:
-        return hit
+    hit = memo.get(id(opts))  # (by identity: hashing the options costs a Python call)
+    if hit is not None and hit[0] is opts:
+        return hit[1]
     fpar = np.array(
         [
             opts.dt,
@@ -449,7 +449,7 @@ def _parameters(opts: IKOptions) -> tuple[NDArray[np.float64], NDArray[np.int64]
     ipar = np.array([opts.max_iterations, opts.stall_iterations, opts.max_restarts], np.int64)
     if len(memo) >= 16:
         memo.pop(next(iter(memo)))
-    memo[opts] = (fpar, ipar)
+    memo[id(opts)] = (opts, (fpar, ipar))
     return fpar, ipar
 
 
