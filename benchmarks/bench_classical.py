@@ -139,8 +139,8 @@ def main(argv: list[str] | None = None) -> int:
         "meets_target": bool(end_to_end.median < 1.0),
         "with_drive_median_s": round(with_drive.median, 4),
         "with_drive_meets_target": bool(with_drive.median < 1.0),
-        "decimation": ident.metadata["decimate"],
-        "rows_in_least_squares": ident.metadata["n_rows"],
+        "decimation": ident.info.log.decimate if ident.info.log else None,
+        "rows_in_least_squares": ident.info.n_rows,
         "condition_number": round(ident.fit.condition_number, 2),
         "relative_error_percent": round(ident.fit.relative_error_percent, 4),
         "median_relative_beta_error_percent": round(

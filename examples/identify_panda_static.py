@@ -19,7 +19,7 @@ fit = model.fit
 print(
     f"rank {fit.rank}, condition number {fit.condition_number:.3g}, "
     f"relative error {fit.relative_error_percent:.3g} %, "
-    f"dropped rows {model.metadata['dropped_rows']}"
+    f"dropped rows {list(model.info.dropped_rows)}"
 )
 truth = model.base.beta_from_phi(robot.phi)
 k = int(np.argmax(np.abs(model.beta - truth) / fit.std))

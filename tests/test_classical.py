@@ -46,8 +46,9 @@ def test_noise_free_identification_recovers_base_parameters_and_friction(panda, 
     np.testing.assert_allclose(model.beta, beta, rtol=1e-6, atol=1e-9 * np.max(np.abs(beta)))
     np.testing.assert_allclose(model.friction, truth.as_array(), atol=1e-9)
     assert model.fit.relative_error_percent < 1e-7
-    assert model.metadata["route"] == "classical"
-    assert model.metadata["friction_labels"][:4] == ["fv1", "fc1", "fo1", "fv2"]
+    assert model.info.route == "classical"
+    assert model.info.friction is not None
+    assert model.info.friction.labels[:4] == ("fv1", "fc1", "fo1", "fv2")
     assert np.isfinite(model.fit.condition_number) and model.fit.rank == torque_base.rank + 21
 
 

@@ -100,7 +100,7 @@ def test_classical_route_with_outliers_and_a_noisy_joint():
     err = {k: np.linalg.norm(m.beta - truth) / np.linalg.norm(truth) for k, m in fits.items()}
     assert err["irls"] < 0.5 * err["ols"]
     assert err["wls"] < err["ols"]
-    assert fits["irls"].metadata["estimator"] == "irls"
+    assert fits["irls"].info.estimator == "irls"
 
 
 def test_cli_std_and_estimator_are_honoured_on_both_routes(tmp_path):

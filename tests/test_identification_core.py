@@ -2,8 +2,10 @@
 
 from __future__ import annotations
 
+import json
 from collections.abc import Iterator
-from typing import Any, Literal
+from pathlib import Path
+from typing import Literal
 
 import numpy as np
 import pytest
@@ -18,6 +20,8 @@ from dynid.identification.core import (
     stack_dataset,
 )
 from dynid.identification.data import StaticDataset
+from dynid.identification.info import IdentificationInfo
+from dynid.io.model_json import info_from_dict, load_model_json, model_to_dict
 from dynid.regressors.base import base_parameters
 from dynid.regressors.torque import torque_regressor
 
@@ -51,8 +55,8 @@ class _TorqueRows:
                 W=Yb[:, j, :], y=self.tau[:, j], groups=np.full(len(self.q), j), label=f"j{j}"
             )
 
-    def record(self, n_rows: int) -> dict[str, Any]:
-        return {"n_samples_used": len(self.q)}
+    def record(self, n_rows: int) -> IdentificationInfo:
+        return IdentificationInfo(reference="exact torques", notes=(f"{len(self.q)} samples",))
 
 
 def test_a_new_data_set_needs_only_the_protocol_and_recovers_the_base_parameters():
@@ -64,7 +68,8 @@ def test_a_new_data_set_needs_only_the_protocol_and_recovers_the_base_parameters
     want = base.beta_from_phi(robot.phi)
     np.testing.assert_allclose(model.beta, want, rtol=1e-9, atol=1e-12)
     assert model.friction is None and model.fit.n_rows == 80
-    assert model.metadata["route"] == "classical" and model.metadata["n_samples_used"] == 40
+    assert model.info.route == "classical" and model.info.notes == ("40 samples",)
+    assert model.info.n_rows == 80 and model.info.reference == "exact torques"
 
 
 def test_static_blocks_stack_to_the_rows_of_tril_m_and_g():
@@ -99,3 +104,34 @@ def test_rank_error_carries_rank_needed_and_dependent_columns():
     assert exc.rank == np.linalg.matrix_rank(W / np.linalg.norm(W, axis=0))
     assert exc.dependent and set(exc.dependent) <= set(base.labels)
     assert f"nearly dependent columns: {exc.dependent[0]}" in str(exc)
+
+
+@pytest.mark.parametrize(
+    "name", ["identification_static_v1.json", "identification_classical_v1.json"]
+)
+def test_identification_files_of_the_previous_version_load_with_their_record(name):
+    """A file whose metadata was a free dictionary loads into the typed record, and saving
+    it again writes the same metadata entries (those the fit already holds aside)."""
+    path = Path(__file__).parent / "data" / name
+    meta = json.loads(path.read_text())["metadata"]
+    model = load_model_json(path)
+    info = model.info
+    assert info.route == meta["route"] and info.reference == meta["reference"]
+    assert list(info.dropped_rows) == meta["dropped_rows"] and list(info.pruned) == meta["pruned"]
+    assert info.std == meta["std_estimator"] and info.estimator == meta["estimator"]
+    assert dict(info.identifiability) == meta["identifiability"]
+    if meta["route"] == "static":
+        assert info.static is not None and info.log is None
+        assert info.static.n_configurations == meta["n_configurations"]
+        assert dict(info.data) == meta["data"] and info.seed is None
+    else:
+        assert info.log is not None and info.friction is not None
+        assert (info.log.decimate, info.log.cutoff_hz) == (meta["decimate"], meta["cutoff_hz"])
+        assert list(info.friction.labels) == meta["friction_labels"]
+        assert list(info.friction.std) == meta["friction_std"]
+    again = model_to_dict(model)["metadata"]
+    derived = {"condition_number", "scaled_condition_number", "relative_error_percent"}
+    assert {k: again[k] for k in meta if k not in derived} == {
+        k: v for k, v in meta.items() if k not in derived
+    }
+    assert info_from_dict(again) == info

@@ -61,10 +61,10 @@ def test_panda_rank_is_43_after_the_joint1_gravity_row_is_dropped(noise_free):
     """Rank 43 (Gaz et al. 2019); g1 is dropped because gravity is along the joint-1 axis."""
     robot, data, model = noise_free
     assert model.fit.rank == model.base.rank == 43
-    assert model.metadata["dropped_rows"] == ["g1"]
-    assert model.metadata["route"] == "static"
-    assert model.metadata["n_configurations"] == 1010
-    assert model.fit.n_rows == model.metadata["n_rows"] == 1010 * 34
+    assert model.info.dropped_rows == ("g1",)
+    assert model.info.route == "static"
+    assert model.info.static is not None and model.info.static.n_configurations == 1010
+    assert model.fit.n_rows == model.info.n_rows == 1010 * 34
     # independent reason: g1 vanishes for any parameters, since gravity is along joint 1's axis
     q, _, _ = random_states(robot, 50, seed=102)
     phi = np.random.default_rng(103).normal(size=(7, 10))
@@ -232,7 +232,7 @@ def test_pruning_removes_uncertain_coefficients_and_refits_the_rest(panda_base):
     removed = full.fit.std_percent > 5.0
     assert removed.any()
     np.testing.assert_array_equal(model.fit.kept, ~removed)
-    assert model.metadata["pruned"] == [panda_base.labels[k] for k in np.flatnonzero(removed)]
+    assert model.info.pruned == tuple(panda_base.labels[k] for k in np.flatnonzero(removed))
     np.testing.assert_array_equal(model.beta[removed], 0.0)
     # independent re-fit: sample-major stack from the public regressor, g1 dropped
     Yb = panda_base.reduce(static_regressor(robot, data.q))
@@ -325,7 +325,7 @@ def test_ur5_from_urdf_identified_from_pinocchio_m_and_g():
     W = np.concatenate(rows)
     Ws = W / np.where(np.linalg.norm(W, axis=0) > 0, np.linalg.norm(W, axis=0), 1.0)
     assert ident.fit.rank == ident.base.rank == np.linalg.matrix_rank(Ws)
-    assert ident.metadata["dropped_rows"] == ["g1"]
+    assert ident.info.dropped_rows == ("g1",)
     # Pinocchio's regressor times its parameters reproduces its M and g (the data)
     phi_pin = np.concatenate([model.inertias[k].toDynamicParameters() for k in range(1, n + 1)])
     np.testing.assert_allclose(W @ phi_pin, static_vector(M, g).reshape(-1), atol=1e-10)
@@ -571,6 +571,6 @@ def test_identify_static_is_the_same_with_the_numpy_regressor(monkeypatch, noise
     compiled = identify_static(robot, data, base=base)
     monkeypatch.setattr(static_module, "_kernel", lambda: None)
     numpy_path = identify_static(robot, data, base=base)
-    assert compiled.metadata["dropped_rows"] == numpy_path.metadata["dropped_rows"] == ["g1"]
+    assert compiled.info.dropped_rows == numpy_path.info.dropped_rows == ("g1",)
     np.testing.assert_allclose(compiled.beta, numpy_path.beta, rtol=1e-12, atol=1e-15)
     np.testing.assert_allclose(compiled.fit.std, numpy_path.fit.std, rtol=1e-10)

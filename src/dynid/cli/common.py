@@ -365,13 +365,14 @@ def add_column_options(p: argparse.ArgumentParser) -> None:
 
 
 def read_data_log(
-    args: argparse.Namespace, n: int, *, owner: str, metadata: Any = None
+    args: argparse.Namespace, n: int, *, owner: str, recorded: Any = None
 ) -> TorqueLog:
     """``--data`` read as a torque log of ``n`` joints (:func:`~dynid.workflows.data_files.
-    read_torque_log`), through ``--columns``/``--units``, or those a model's ``metadata``
-    records when none are given (:func:`~dynid.workflows.data_files.recorded_columns`)."""
+    read_torque_log`), through ``--columns``/``--units``, or those a model recorded
+    (``recorded``, its ``info.column_map``) when none are given
+    (:func:`~dynid.workflows.data_files.recorded_columns`)."""
     columns, units = recorded_columns(
-        metadata, getattr(args, "columns", None), getattr(args, "units", None)
+        recorded, getattr(args, "columns", None), getattr(args, "units", None)
     )
     return read_torque_log(
         args.data,

@@ -116,8 +116,8 @@ def run(args: argparse.Namespace, console: Console) -> int:
     """Fit friction, write friction.json and the figure, print the RMS table (unless -q)."""
     model = load_torque_model(args)
     n = _joint_count(model)
-    recorded = model.metadata if isinstance(model, IdentifiedModel) else None
-    log = read_data_log(args, n, owner="the model", metadata=recorded)
+    recorded = model.info.column_map if isinstance(model, IdentifiedModel) else None
+    log = read_data_log(args, n, owner="the model", recorded=recorded)
     drive = model_drive(model, load_drive_arg(args, n))
     with about(args.data):
         res = friction_residual(

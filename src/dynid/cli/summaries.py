@@ -29,31 +29,32 @@ __all__ = [
 
 def format_identification(model: IdentifiedModel, *, width: int = 60) -> str:
     """A readable summary: metrics, then one line per coefficient (expressions shortened)."""
-    fit, meta = model.fit, model.metadata
+    fit, info = model.fit, model.info
+    if info.static is not None:
+        data = f"{info.static.n_configurations} configurations"
+    elif info.log is not None:
+        data = f"{info.log.n_samples_used} samples of {info.log.n_samples_log}"
+    else:
+        data = "? samples"
     head = [
-        f"{meta.get('route', '?')} identification of {model.robot.name}: "
-        + (
-            f"{meta['n_configurations']} configurations"
-            if "n_configurations" in meta
-            else f"{meta.get('n_samples_used', '?')} samples of {meta.get('n_samples_log', '?')}"
-        )
+        f"{info.route or '?'} identification of {model.robot.name}: {data}"
         + f", {fit.n_rows} rows"
-        + (f", dropped rows {', '.join(meta['dropped_rows'])}" if meta.get("dropped_rows") else ""),
+        + (f", dropped rows {', '.join(info.dropped_rows)}" if info.dropped_rows else ""),
         f"rank {fit.rank}, condition number {fit.condition_number:.4g} (unscaled, as the "
         f"paper), scaled {fit.scaled_condition_number:.4g}, relative error "
-        f"{fit.relative_error_percent:.4g} %, estimator {meta.get('estimator', 'ols')}, "
-        f"std {meta.get('std_estimator', '?')}"
+        f"{fit.relative_error_percent:.4g} %, estimator {info.estimator}, "
+        f"std {info.std or '?'}"
         + (
-            f", pruned {len(meta['pruned'])} above {meta['max_std_percent']:g} %"
-            if meta.get("pruned")
+            f", pruned {len(info.pruned)} above {info.max_std_percent:g} %"
+            if info.pruned and info.max_std_percent is not None
             else ""
         ),
     ]
     if fit.residual_rms == 0.0 or not np.any(fit.std[fit.kept]):
         head.append("the residual is zero to rounding (exact data): standard deviations are 0")
-    ho = meta.get("heldout")
+    ho = info.heldout
     if ho:
-        head.append(heldout_line(ho))
+        head.append(heldout_line(dict(ho)))
     if model.base.gap is not None:
         hi, lo = model.base.gap
         head.append(
@@ -86,7 +87,7 @@ def format_identification(model: IdentifiedModel, *, width: int = 60) -> str:
 
 
 def heldout_line(ho: dict[str, Any]) -> str:
-    """The training and held-out errors of least squares (``metadata["heldout"]``)."""
+    """The training and held-out errors of least squares (``info.heldout``)."""
     how = (
         "on the --validate-on log"
         if ho.get("scheme") == "file"

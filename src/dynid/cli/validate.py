@@ -99,8 +99,8 @@ def run(args: argparse.Namespace, console: Console) -> int:
     """Validate, write validation.json and the figures, print the RMS table (unless -q)."""
     model, label = load_model_source(args)
     robot = model.robot if isinstance(model, IdentifiedModel) else model
-    recorded = model.metadata if isinstance(model, IdentifiedModel) else None
-    log = read_data_log(args, robot.n, owner=f"the model ({label})", metadata=recorded)
+    recorded = model.info.column_map if isinstance(model, IdentifiedModel) else None
+    log = read_data_log(args, robot.n, owner=f"the model ({label})", recorded=recorded)
     logs = [log]  # handed over: validate frees the raw signals once it has filtered them
     del log
     if args.friction is not None:

@@ -294,7 +294,7 @@ def coefficient_term(model: IdentifiedModel, *, with_friction: bool = False) -> 
     labels = tuple(
         lab
         for lab, kk in zip(
-            model.base.labels + tuple(model.metadata.get("friction_labels", ()))[:k],
+            model.base.labels + _friction_labels(model)[:k],
             kept,
             strict=False,
         )
@@ -315,6 +315,12 @@ def coefficient_term(model: IdentifiedModel, *, with_friction: bool = False) -> 
         notes=notes,
         holdout=None if held is None else held.restricted(np.flatnonzero(kept)),
     )
+
+
+def _friction_labels(model: IdentifiedModel) -> tuple[str, ...]:
+    """The labels of the model's friction columns (empty without friction)."""
+    fr = model.info.friction
+    return () if fr is None else fr.labels
 
 
 @dataclass(frozen=True, slots=True, eq=False)

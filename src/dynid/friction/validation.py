@@ -115,10 +115,9 @@ RECORDED: Literal["recorded"] = "recorded"
 
 def recorded_cutoff(model: TorqueModel) -> float | None:
     """The low-pass cut-off [Hz] an identified model's torque log was prepared with
-    (``metadata["cutoff_hz"]`` of the classical route), else the library default."""
-    if isinstance(model, IdentifiedModel) and "cutoff_hz" in model.metadata:
-        c = model.metadata["cutoff_hz"]
-        return None if c is None else float(c)
+    (``info.log.cutoff_hz`` of the classical route), else the library default."""
+    if isinstance(model, IdentifiedModel) and model.info.log is not None:
+        return model.info.log.cutoff_hz
     return DEFAULT_CUTOFF_HZ
 
 

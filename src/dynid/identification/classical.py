@@ -64,6 +64,7 @@ from .estimators import (
     row_weights,
 )
 from .holdout import DEFAULT_FOLDS, HeldOut, block_labels, block_normals
+from .info import IdentificationInfo, LogInfo
 from .least_squares import StdMethod
 from .log import DEFAULT_CUTOFF_HZ, LogCleaning, TorqueLog, joint_side_log, prepare_log
 from .model import IdentifiedModel
@@ -428,21 +429,23 @@ class PreparedLog:
             _checks.finite("regressor", W)
             yield RegressorBlock(W=W, y=tau.reshape(-1), groups=np.tile(np.arange(n), m))
 
-    def record(self, n_rows: int) -> dict[str, Any]:
+    def record(self, n_rows: int) -> IdentificationInfo:
         """Filtering, decimation and sample counts."""
-        return {
-            "reference": "Gaz et al. 2019, Sec. IV-B, eq. 24 (classical friction)",
-            "cutoff_hz": self.cutoff_hz,
-            "trim_s": self.trim_s,
-            "decimate": self.decimate,
-            "sample_rate_hz": self.sample_rate_hz,
-            "n_samples_log": self.n_samples_log,
-            "n_samples_used": self.log.n_samples,
-            "duration_s": self.duration_s,
-            "n_nan_rows": self.cleaning.n_nan_rows,
-            "n_duplicates": self.cleaning.n_duplicates,
-            "n_gaps": len(self.cleaning.gaps),
-        }
+        return IdentificationInfo(
+            reference="Gaz et al. 2019, Sec. IV-B, eq. 24 (classical friction)",
+            log=LogInfo(
+                cutoff_hz=self.cutoff_hz,
+                trim_s=self.trim_s,
+                decimate=self.decimate,
+                sample_rate_hz=self.sample_rate_hz,
+                n_samples_log=self.n_samples_log,
+                n_samples_used=self.log.n_samples,
+                duration_s=self.duration_s,
+                n_nan_rows=self.cleaning.n_nan_rows,
+                n_duplicates=self.cleaning.n_duplicates,
+                n_gaps=len(self.cleaning.gaps),
+            ),
+        )
 
 
 def prepare_torque_log(

@@ -43,6 +43,7 @@ from ..regressors.base import BaseParameters, base_parameters, identifiability
 from ..regressors.terms import ModelTerm, drive_terms
 from .estimators import OLS, Estimator, EstimatorName, estimator_named
 from .holdout import HeldOut, cross_validate
+from .info import FrictionInfo, IdentificationInfo, Route
 from .least_squares import (
     LeastSquaresFit,
     StdMethod,
@@ -72,9 +73,6 @@ __all__ = [
 
 _log = logging.getLogger(__name__)
 
-#: The identification routes: static data (Gaz et al. 2019, Sec. IV-A) or a torque log
-#: (Sec. IV-B).
-Route = Literal["static", "classical"]
 #: Which regressor a data set stacks (the kind of :func:`~dynid.regressors.base.
 #: base_parameters`).
 RegressorKind = Literal["static", "torque"]
@@ -194,8 +192,9 @@ class Dataset(Protocol):
         """The regressor blocks over ``columns`` with their targets."""
         ...
 
-    def record(self, n_rows: int) -> dict[str, Any]:
-        """What the model records about the data, given the rows used."""
+    def record(self, n_rows: int) -> IdentificationInfo:
+        """The data's part of the model's record (reference, counts, preparation), given
+        the rows used; the core fills in the rest."""
         ...
 
 
@@ -568,10 +567,11 @@ def identify(
     held = None if judge is None else judge(stack, columns, ~frozen, fit.beta)
     for msg in conditioning_advice(fit, labels, what=_what(data)):
         warnings.warn(msg, DynidWarning, stacklevel=2)
-    meta = _record(data, columns, fit, stack, est.name, std, max_std_percent, rtol)
+    info = _record(data, columns, fit, stack, est.name, std, max_std_percent, rtol)
     if held is not None:
-        meta["heldout"] = cross_validate(held.restricted(np.flatnonzero(fit.kept))).as_dict()
-    return _model(robot, columns, fit, meta, held)
+        errors = cross_validate(held.restricted(np.flatnonzero(fit.kept)))
+        info = dataclasses.replace(info, heldout=errors.as_dict())
+    return _model(robot, columns, fit, info, held)
 
 
 def check_options(*, std: str, max_std_percent: float | None) -> None:
@@ -612,43 +612,44 @@ def _record(
     fit: LeastSquaresFit,
     stack: RegressorStack | StreamedRows,
     estimator: str,
-    std: str,
+    std: StdMethod,
     max_std_percent: float | None,
     rtol: float | None,
-) -> dict[str, Any]:
-    """The model's record: what was fitted, how, and the data's own entries."""
+) -> IdentificationInfo:
+    """The model's record: the data's own part, then what was fitted and how."""
     labels, base = columns.labels, columns.base
-    pruned = [labels[k] for k in np.flatnonzero(~np.asarray(fit.kept))]
+    pruned = tuple(labels[k] for k in np.flatnonzero(~np.asarray(fit.kept)))
     if pruned:
         _log.info("pruned %d coefficient(s): %s", len(pruned), pruned)
-    meta: dict[str, Any] = {
-        "route": data.route,
-        "n_rows": stack.n_rows,
-        "dropped_rows": list(stack.dropped),
-        "pruned": pruned,
-        "max_std_percent": max_std_percent,
-        "std_estimator": std,
-        "estimator": estimator,
-        "rtol": rtol,
-        "rank_gap": None if base.gap is None else list(base.gap),
-        "identifiability": dict(zip(base.std_labels, identifiability(base), strict=True)),
-    }
-    meta.update(data.record(stack.n_rows))
-    if columns.drive is not None:
-        meta["drive"] = columns.drive.as_dict()
     sl = columns.term_slice("friction")
+    friction = None
     if sl is not None:
-        meta["friction_labels"] = list(labels[sl])
-        meta["friction_std"] = [float(x) for x in fit.std[sl]]
-        meta["friction_kept"] = [bool(x) for x in fit.kept[sl]]
-    return meta
+        friction = FrictionInfo(
+            labels=labels[sl],
+            std=tuple(float(x) for x in fit.std[sl]),
+            kept=tuple(bool(x) for x in fit.kept[sl]),
+        )
+    return dataclasses.replace(
+        data.record(stack.n_rows),
+        route=data.route,
+        n_rows=stack.n_rows,
+        dropped_rows=stack.dropped,
+        pruned=pruned,
+        max_std_percent=max_std_percent,
+        std=std,
+        estimator=estimator,
+        rtol=rtol,
+        rank_gap=base.gap,
+        identifiability=dict(zip(base.std_labels, identifiability(base), strict=True)),
+        friction=friction,
+    )
 
 
 def _model(
     robot: Robot,
     columns: ModelColumns,
     fit: LeastSquaresFit,
-    meta: dict[str, Any],
+    info: IdentificationInfo,
     held: HeldOut | None,
 ) -> IdentifiedModel:
     """The identified model: the base parameters' fit, friction and the full fit."""
@@ -661,7 +662,7 @@ def _model(
         base=columns.base,
         fit=_split_fit(fit, r) if appended else fit,
         friction=friction,
-        metadata=meta,
+        info=info,
         joint_fit=fit if appended else None,
         drive=columns.drive,
         holdout=held,

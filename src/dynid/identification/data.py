@@ -28,6 +28,7 @@ from ..model.robot import Robot
 from ..regressors.static import static_first_columns, static_labels, static_regressor_columns
 from ..regressors.terms import base_term_columns
 from .core import ModelColumns, RegressorBlock
+from .info import IdentificationInfo, StaticInfo
 
 __all__ = ["StaticDataset", "DEFAULT_SYMMETRY_RTOL"]
 
@@ -188,15 +189,16 @@ class StaticDataset:
                 first=int(first[k]),
             )
 
-    def record(self, n_rows: int) -> dict[str, Any]:
+    def record(self, n_rows: int) -> IdentificationInfo:
         """Configurations, rows per configuration and the data set's own metadata."""
         N = self.n_configurations
-        return {
-            "reference": "Gaz et al. 2019, Sec. IV-A, eqs. 17-21",
-            "n_configurations": N,
-            "rows_per_configuration": n_rows // N,
-            "data": dict(self.metadata),
-        }
+        seed = self.metadata.get("seed")
+        return IdentificationInfo(
+            reference="Gaz et al. 2019, Sec. IV-A, eqs. 17-21",
+            static=StaticInfo(n_configurations=N, rows_per_configuration=n_rows // N),
+            data=dict(self.metadata),
+            seed=seed if isinstance(seed, int) else None,
+        )
 
     def select(self, rows: ArrayLike) -> StaticDataset:
         """A data set of some rows: integer indices or a boolean mask of length N."""

@@ -19,7 +19,6 @@ from __future__ import annotations
 import dataclasses
 import re
 from dataclasses import dataclass, field
-from typing import Any
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -32,6 +31,7 @@ from ..model.drive import Drive
 from ..model.robot import Robot
 from ..regressors.base import BaseParameters
 from .holdout import HeldOut
+from .info import IdentificationInfo
 from .least_squares import LeastSquaresFit
 
 __all__ = ["IdentifiedModel"]
@@ -53,8 +53,9 @@ class IdentifiedModel:
     friction : ndarray, shape (n, 3), optional
         Linear friction ``fv [N m s/rad], fc [N m], fo [N m]`` per joint, identified with
         the classical route; None otherwise.
-    metadata : dict
-        Route, data source, row counts, dropped rows, seed.
+    info : IdentificationInfo
+        What the identification did: route, data, rows used and dropped, estimator,
+        standard deviations, filtering (:mod:`dynid.identification.info`).
     drive : Drive, optional
         The drive train the model includes (rotor inertia, friction at the motors); None
         for link-side torques of a direct drive.
@@ -72,7 +73,7 @@ class IdentifiedModel:
     base: BaseParameters
     fit: LeastSquaresFit
     friction: NDArray[np.float64] | None = None
-    metadata: dict[str, Any] = field(default_factory=dict)
+    info: IdentificationInfo = field(default_factory=IdentificationInfo)
     joint_fit: LeastSquaresFit | None = None
     drive: Drive | None = None
     holdout: HeldOut | None = None
@@ -137,7 +138,7 @@ class IdentifiedModel:
             base=sub,
             fit=sub_fit,
             friction=self.friction,
-            metadata=dict(self.metadata),
+            info=self.info,
         )
 
     @property

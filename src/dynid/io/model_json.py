@@ -14,7 +14,13 @@ Layout of the file (top-level keys)::
         torque_constant, rotor_inertia "identify" or values, friction_at); with identified
         rotor inertias base.std_labels continue with Ia1 .. Ia_n after the links' 10 n,
     robot: the kinematics (:mod:`dynid.io.robot_json`),
-    metadata: everything else the identification recorded,
+    metadata: the identification's record (IdentificationInfo, flat): route, reference,
+        n_rows, dropped_rows, pruned, max_std_percent, std_estimator, estimator, rtol,
+        rank_gap, identifiability, [seed], static: n_configurations,
+        rows_per_configuration, data; classical: cutoff_hz, trim_s, decimate,
+        sample_rate_hz, n_samples_log, n_samples_used, duration_s, n_nan_rows,
+        n_duplicates, n_gaps, friction_labels, friction_std, friction_kept, [heldout];
+        [column_map], [notes], drive; unknown keys are kept,
     units, conventions
 
 ``condition_number`` is that of the unscaled regressor (the figure Gaz et al. report),
@@ -37,6 +43,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Mapping
+from dataclasses import fields
 from pathlib import Path
 from typing import Any, SupportsFloat
 
@@ -45,14 +52,24 @@ from numpy.typing import NDArray
 
 from .. import __version__, _checks
 from ..exceptions import DataError
+from ..identification.info import FrictionInfo, IdentificationInfo, LogInfo, StaticInfo
 from ..identification.least_squares import LeastSquaresFit
 from ..identification.model import IdentifiedModel
+from ..model.drive import Drive
 from ..regressors.base import BaseParameters
 from .drive_file import drive_from_record
 from .json_files import load_json, save_json
 from .robot_json import robot_from_dict, robot_to_dict
 
-__all__ = ["MODEL_SCHEMA", "model_to_dict", "model_from_dict", "save_model_json", "load_model_json"]
+__all__ = [
+    "MODEL_SCHEMA",
+    "info_from_dict",
+    "info_to_dict",
+    "load_model_json",
+    "model_from_dict",
+    "model_to_dict",
+    "save_model_json",
+]
 
 MODEL_SCHEMA = "dynid-identified-model/1"
 
@@ -95,11 +112,11 @@ def _jsonable(x: Any) -> Any:
 def model_to_dict(model: IdentifiedModel, *, seed: int | None = None) -> dict[str, Any]:
     """The JSON-ready dictionary of an identified model (layout in the module docstring).
 
-    ``seed`` defaults to ``model.metadata["seed"]`` or the data set's recorded seed.
+    ``seed`` defaults to ``model.info.seed`` or the data set's recorded seed.
     """
-    fit, base, meta = model.fit, model.base, dict(model.metadata)
+    fit, base, info = model.fit, model.base, model.info
     if seed is None:
-        seed = meta.get("seed", dict(meta.get("data", {})).get("seed"))
+        seed = info.seed if info.seed is not None else dict(info.data).get("seed")
     coefficients = [
         {
             "name": base.labels[k],
@@ -114,13 +131,13 @@ def model_to_dict(model: IdentifiedModel, *, seed: int | None = None) -> dict[st
     out: dict[str, Any] = {
         "schema": MODEL_SCHEMA,
         "dynid_version": __version__,
-        "route": meta.get("route"),
+        "route": info.route,
         "seed": seed,
     }
     out.update({k: _jsonable(getattr(fit, k)) for k in _FIT_SCALARS})
-    out["dropped_rows"] = list(meta.get("dropped_rows", []))
-    out["pruned"] = list(meta.get("pruned", []))
-    out["std_estimator"] = meta.get("std_estimator")
+    out["dropped_rows"] = list(info.dropped_rows)
+    out["pruned"] = list(info.pruned)
+    out["std_estimator"] = info.std
     out["coefficients"] = coefficients
     out["covariance"] = None if fit.covariance is None else np.asarray(fit.covariance).tolist()
     out["base"] = {
@@ -135,7 +152,7 @@ def model_to_dict(model: IdentifiedModel, *, seed: int | None = None) -> dict[st
     out["friction"] = None if model.friction is None else model.friction.tolist()
     out["drive"] = None if model.drive is None else model.drive.as_dict()
     out["robot"] = robot_to_dict(model.robot)
-    out["metadata"] = _jsonable(meta)
+    out["metadata"] = info_to_dict(info, model.drive)
     out["units"] = {
         "value": "SI of each expression: m kg, mc kg m, J kg m^2",
         "std": "as value",
@@ -150,6 +167,135 @@ def model_to_dict(model: IdentifiedModel, *, seed: int | None = None) -> dict[st
         "reference": "Gaz et al. 2019, IEEE RA-L 4(4):4147-4154",
     }
     return out
+
+
+#: Keys of the ``metadata`` object read into typed fields (others are kept in ``extra``).
+_LOG_KEYS = tuple(f.name for f in fields(LogInfo))
+#: Keys older files wrote that the model already holds elsewhere (fit, drive): not kept.
+_DERIVED_KEYS = (
+    "drive",
+    "condition_number",
+    "scaled_condition_number",
+    "relative_error_percent",
+)
+
+
+def info_to_dict(info: IdentificationInfo, drive: Drive | None = None) -> dict[str, Any]:
+    """The ``metadata`` object of ``identification.json``: the keys of earlier files, flat.
+
+    ``drive`` is written under ``"drive"`` as before (the top-level ``drive`` is the one
+    read back).
+    """
+    out: dict[str, Any] = dict(info.extra)
+    out.update(
+        {
+            "route": info.route,
+            "reference": info.reference,
+            "n_rows": info.n_rows,
+            "dropped_rows": list(info.dropped_rows),
+            "pruned": list(info.pruned),
+            "max_std_percent": info.max_std_percent,
+            "std_estimator": info.std,
+            "estimator": info.estimator,
+            "rtol": info.rtol,
+            "rank_gap": None if info.rank_gap is None else list(info.rank_gap),
+            "identifiability": dict(info.identifiability),
+        }
+    )
+    if info.seed is not None:
+        out["seed"] = info.seed
+    if info.static is not None:
+        out["n_configurations"] = info.static.n_configurations
+        out["rows_per_configuration"] = info.static.rows_per_configuration
+    if info.route == "static" or info.data:
+        out["data"] = dict(info.data)
+    if info.log is not None:
+        out.update({k: getattr(info.log, k) for k in _LOG_KEYS})
+    if info.friction is not None:
+        out["friction_labels"] = list(info.friction.labels)
+        out["friction_std"] = list(info.friction.std)
+        out["friction_kept"] = list(info.friction.kept)
+    if info.heldout is not None:
+        out["heldout"] = dict(info.heldout)
+    if info.column_map is not None:
+        out["column_map"] = dict(info.column_map)
+    if info.notes:
+        out["notes"] = list(info.notes)
+    if drive is not None:
+        out["drive"] = drive.as_dict()
+    return _jsonable(out)
+
+
+def info_from_dict(meta: Mapping[str, Any]) -> IdentificationInfo:
+    """The :class:`IdentificationInfo` of a file's ``metadata`` object (any version).
+
+    Raises
+    ------
+    DataError
+        A known entry of the wrong type or value (named).
+    """
+    m = dict(meta)
+    route, std = m.pop("route", None), m.pop("std_estimator", None)
+    if route not in (None, "static", "classical"):
+        raise DataError(
+            f"identified model: metadata.route must be 'static' or 'classical'; got {route!r}"
+        )
+    if std not in (None, "classical", "robust"):
+        raise DataError(
+            f"identified model: metadata.std_estimator must be 'classical' or 'robust'; got {std!r}"
+        )
+    try:
+        static, log, friction = _route_parts(m)
+        gap = m.pop("rank_gap", None)
+        seed = m.pop("seed", None)
+        return IdentificationInfo(
+            route=route,
+            reference=str(m.pop("reference", "")),
+            n_rows=int(m.pop("n_rows", 0)),
+            dropped_rows=tuple(str(x) for x in m.pop("dropped_rows", ())),
+            pruned=tuple(str(x) for x in m.pop("pruned", ())),
+            max_std_percent=_opt_float(m.pop("max_std_percent", None)),
+            std=std,
+            estimator=str(m.pop("estimator", "ols")),
+            rtol=_opt_float(m.pop("rtol", None)),
+            rank_gap=None if gap is None else (float(gap[0]), float(gap[1])),
+            identifiability={str(k): str(v) for k, v in dict(m.pop("identifiability", {})).items()},
+            seed=None if seed is None else int(seed),
+            data=dict(m.pop("data", {})),
+            static=static,
+            log=log,
+            friction=friction,
+            heldout=None if m.get("heldout") is None else dict(m.pop("heldout")),
+            column_map=None if m.get("column_map") is None else dict(m.pop("column_map")),
+            notes=tuple(str(x) for x in m.pop("notes", ())),
+            extra={k: v for k, v in m.items() if k not in _DERIVED_KEYS},
+        )
+    except (TypeError, ValueError, IndexError) as exc:
+        raise DataError(f"identified model: malformed metadata ({exc})") from exc
+
+
+def _route_parts(
+    m: dict[str, Any],
+) -> tuple[StaticInfo | None, LogInfo | None, FrictionInfo | None]:
+    """The static, log and friction parts of a ``metadata`` object (their keys removed)."""
+    static = log = friction = None
+    if "n_configurations" in m:
+        n_conf = int(m.pop("n_configurations"))
+        static = StaticInfo(n_conf, int(m.pop("rows_per_configuration", 0)))
+    if "decimate" in m:
+        vals = {k: m.pop(k) for k in _LOG_KEYS if k in m}
+        log = LogInfo(**vals)
+    if "friction_labels" in m:
+        friction = FrictionInfo(
+            labels=tuple(str(x) for x in m.pop("friction_labels")),
+            std=tuple(_float(x) for x in m.pop("friction_std", ())),
+            kept=tuple(bool(x) for x in m.pop("friction_kept", ())),
+        )
+    return static, log, friction
+
+
+def _opt_float(x: Any) -> float | None:
+    return None if x is None else float(x)
 
 
 def _covariance(c: Any, r: int) -> NDArray[np.float64] | None:
@@ -242,7 +388,7 @@ def model_from_dict(d: Mapping[str, Any]) -> IdentifiedModel:
         metadata = d.get("metadata") or {}
         if not isinstance(metadata, dict):
             raise DataError("identified model: 'metadata' must be an object")
-        metadata = dict(metadata)
+        info = info_from_dict(metadata)
     except KeyError as exc:
         raise DataError(f"identified model: missing field {exc.args[0]!r}") from None
     except (TypeError, ValueError) as exc:
@@ -260,7 +406,7 @@ def model_from_dict(d: Mapping[str, Any]) -> IdentifiedModel:
         base=base,
         fit=fit,
         friction=None if friction is None else _frozen(np.asarray(friction, dtype=np.float64)),
-        metadata=metadata,
+        info=info,
         drive=drive,
     )
 

@@ -102,7 +102,7 @@ def kinematics_only(model: IdentifiedModel) -> IdentifiedModel:
     or neutral pose): what an identification file records, and all later stages may use."""
     robot = model.robot.replace(phi=np.zeros((model.robot.n, 10)), friction=None, q_neutral=None)
     return IdentifiedModel(
-        robot, model.base, model.fit, model.friction, dict(model.metadata), model.joint_fit
+        robot, model.base, model.fit, model.friction, model.info, model.joint_fit
     )
 
 
@@ -211,7 +211,7 @@ class IdentificationStageResult:
 
     @property
     def dropped_rows(self) -> list[str]:
-        return list(self.model.metadata["dropped_rows"])
+        return list(self.model.info.dropped_rows)
 
 
 def identification_stage(

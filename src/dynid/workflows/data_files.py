@@ -8,7 +8,7 @@ The policies, the same for the Python API and every command:
   unless ``drop_invalid``; so is a log with another joint count than the robot's;
 * a static data file must have the robot's joint count and, when it records the robot
   it was acquired with, be of that robot (:func:`dynid.io.static_data.load_static_data`);
-* a model records the column map its data were read with (``metadata["column_map"]``);
+* a model records the column map its data were read with (``info.column_map``);
   a log validated against it is read the same way (:func:`recorded_columns`).
 """
 
@@ -211,18 +211,19 @@ def read_static_file(
 
 
 def recorded_columns(
-    metadata: Mapping[str, Any] | None, columns: str | None, units: str | None
+    recorded: Mapping[str, Any] | None, columns: str | None, units: str | None
 ) -> tuple[str | None, str | None]:
-    """The ``--columns``/``--units`` to read a log with for a model identified with
-    ``metadata["column_map"]``: the recorded ones when none are given (logged).
+    """The ``--columns``/``--units`` to read a log with for a model identified with the
+    column map ``recorded`` (its ``info.column_map``): the recorded ones when none are
+    given (logged).
 
     Raises
     ------
     DataError
         Other ones than recorded (the log would be read another way).
     """
-    rec = dict(metadata or {}).get("column_map")
-    if not isinstance(rec, dict):
+    rec = recorded
+    if rec is None:
         return columns, units
     if (columns, units) == (None, None):
         columns, units = rec.get("columns"), rec.get("units")

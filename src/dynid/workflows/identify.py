@@ -9,11 +9,12 @@ command applies, so that the Python API behaves as the command does.
 * ``std`` (standard deviations, ``--std``) is honoured on both routes (default: robust
   for static data, classical for torque logs); the consistent fit refuses it and
   ``max_std_percent``, which do not apply to it.
-* The column map the data were read with is recorded in the model's metadata.
+* The column map the data were read with is recorded in the model (``info.column_map``).
 """
 
 from __future__ import annotations
 
+import dataclasses
 import warnings
 from pathlib import Path
 from typing import Any, Literal
@@ -64,9 +65,12 @@ def _heldout(
     return kw
 
 
-def _record(metadata: dict[str, Any], spec: ColumnSpec | None) -> None:
-    if spec is not None and spec != (None, None):
-        metadata["column_map"] = {"columns": spec[0], "units": spec[1]}
+def _record(model: IdentifiedModel, spec: ColumnSpec | None) -> IdentifiedModel:
+    """The model with the column map its data were read with (``info.column_map``)."""
+    if spec is None or spec == (None, None):
+        return model
+    info = dataclasses.replace(model.info, column_map={"columns": spec[0], "units": spec[1]})
+    return dataclasses.replace(model, info=info)
 
 
 def identify_file(
@@ -168,8 +172,7 @@ def identify_file(
         misfit = fit_mismatch(model.fit.relative_error_percent, data.metadata)
         if misfit is not None:
             warnings.warn(f"{path.name}: {misfit}", DynidWarning, stacklevel=2)
-    _record(model.metadata, columns)
-    return model
+    return _record(model, columns)
 
 
 def identify_consistent_file(
@@ -245,8 +248,7 @@ def identify_consistent_file(
     )
     if result.identified is None:  # pragma: no cover - identify_consistent always sets it
         raise DataError("the one-step identification returned no unconstrained fit")
-    _record(result.identified.metadata, columns)
-    return result
+    return dataclasses.replace(result, identified=_record(result.identified, columns))
 
 
 def _in_file(path: Path, fit: Any) -> Any:

@@ -78,7 +78,7 @@ def load_model_with_friction(
     if robot is model.robot:
         return model
     return IdentifiedModel(
-        robot, model.base, model.fit, model.friction, dict(model.metadata), drive=model.drive
+        robot, model.base, model.fit, model.friction, model.info, drive=model.drive
     )
 
 

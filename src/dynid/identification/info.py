@@ -1,0 +1,166 @@
+"""What an identification did: the typed record an identified model carries.
+
+:class:`IdentificationInfo` replaces a free dictionary: the route, the reference, the rows
+used and dropped, the coefficients pruned, the estimator and how the standard deviations
+were estimated, the rank tolerance and gap, the identifiability of every standard
+parameter, and the route's own part: :class:`StaticInfo` (configurations) or
+:class:`LogInfo` (filtering, decimation, sample counts), :class:`FrictionInfo` (the
+appended friction columns' labels, standard deviations and which were kept). It is
+written to and read from the ``metadata`` object of ``identification.json`` with the keys
+that file has always used (:mod:`dynid.io.model_json`); keys this version does not know are
+kept in ``extra``.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping
+from dataclasses import dataclass, field
+from typing import Any, Literal
+
+from .least_squares import StdMethod
+
+__all__ = ["FrictionInfo", "IdentificationInfo", "LogInfo", "Route", "StaticInfo"]
+
+#: The identification routes: static data (Gaz et al. 2019, Sec. IV-A) or a torque log
+#: (Sec. IV-B).
+Route = Literal["static", "classical"]
+
+
+@dataclass(frozen=True, slots=True)
+class StaticInfo:
+    """The static route's data.
+
+    Attributes
+    ----------
+    n_configurations : int
+        Configurations ``N``.
+    rows_per_configuration : int
+        Rows of ``[tril M; g]`` used per configuration (after dropping those without
+        information).
+    """
+
+    n_configurations: int
+    rows_per_configuration: int
+
+
+@dataclass(frozen=True, slots=True)
+class LogInfo:
+    """The classical route's preparation of the torque log.
+
+    Attributes
+    ----------
+    cutoff_hz : float or None
+        Zero-phase low-pass cutoff [Hz]; None without filtering.
+    trim_s : float
+        Seconds dropped at the start (filter edge).
+    decimate : int
+        Every ``decimate``-th sample was kept.
+    sample_rate_hz : float
+        Rate of the raw log [Hz].
+    n_samples_log, n_samples_used : int
+        Samples in the raw log and in the fit.
+    duration_s : float
+        Length of the raw log [s].
+    n_nan_rows, n_duplicates, n_gaps : int
+        What cleaning the raw log found (:class:`~dynid.identification.log.LogCleaning`).
+    """
+
+    cutoff_hz: float | None
+    trim_s: float
+    decimate: int
+    sample_rate_hz: float
+    n_samples_log: int
+    n_samples_used: int
+    duration_s: float
+    n_nan_rows: int = 0
+    n_duplicates: int = 0
+    n_gaps: int = 0
+
+
+@dataclass(frozen=True, slots=True)
+class FrictionInfo:
+    """The friction columns fitted after the base parameters.
+
+    Attributes
+    ----------
+    labels : tuple of str
+        ``fv1, fc1, fo1, fv2, ...``.
+    std : tuple of float
+        Their standard deviations (units of each parameter).
+    kept : tuple of bool
+        False for columns left out (a joint that never moves) or pruned.
+    """
+
+    labels: tuple[str, ...]
+    std: tuple[float, ...]
+    kept: tuple[bool, ...]
+
+
+@dataclass(frozen=True, slots=True)
+class IdentificationInfo:
+    """What an identification did (module docstring).
+
+    Attributes
+    ----------
+    route : {"static", "classical"} or None
+        None for a model built by hand.
+    reference : str
+        The method's source (paper, section, equations).
+    n_rows : int
+        Rows in the least squares.
+    dropped_rows : tuple of str
+        Rows without information for this robot (``"g1"``).
+    pruned : tuple of str
+        Labels of the coefficients removed above ``max_std_percent``.
+    max_std_percent : float or None
+    std : {"classical", "robust"} or None
+        How the standard deviations were estimated (``std=``, ``--std``; the file's
+        ``std_estimator``).
+    estimator : str
+        ``"ols"``, ``"wls"``, ``"irls"`` or a user's estimator's name.
+    rtol : float or None
+        The rank tolerance asked for (None: the defaults).
+    rank_gap : tuple of float, optional
+        Singular values either side of the base parameters' rank cut (relative).
+    identifiability : mapping
+        ``identifiable``, ``combination`` or ``unidentifiable`` per standard parameter.
+    seed : int or None
+        The seed of simulated data, when known.
+    data : mapping
+        The static data set's own metadata (source, noise, seed, robot).
+    static, log : StaticInfo or LogInfo, optional
+        The route's own part.
+    friction : FrictionInfo, optional
+        The appended friction columns.
+    heldout : mapping, optional
+        Training and held-out errors of least squares
+        (:meth:`~dynid.identification.holdout.HeldOutErrors.as_dict`).
+    column_map : mapping, optional
+        ``{"columns": ..., "units": ...}``: how the data file's columns were read
+        (``--columns``/``--units``), so that validation reads a log the same way.
+    notes : tuple of str
+        Remarks for the reader (one sentence each).
+    extra : mapping
+        Entries of a file that this version does not know (kept when saved again).
+    """
+
+    route: Route | None = None
+    reference: str = ""
+    n_rows: int = 0
+    dropped_rows: tuple[str, ...] = ()
+    pruned: tuple[str, ...] = ()
+    max_std_percent: float | None = None
+    std: StdMethod | None = None
+    estimator: str = "ols"
+    rtol: float | None = None
+    rank_gap: tuple[float, float] | None = None
+    identifiability: Mapping[str, str] = field(default_factory=dict)
+    seed: int | None = None
+    data: Mapping[str, Any] = field(default_factory=dict)
+    static: StaticInfo | None = None
+    log: LogInfo | None = None
+    friction: FrictionInfo | None = None
+    heldout: Mapping[str, Any] | None = None
+    column_map: Mapping[str, str | None] | None = None
+    notes: tuple[str, ...] = ()
+    extra: Mapping[str, Any] = field(default_factory=dict)
