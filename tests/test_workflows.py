@@ -161,7 +161,7 @@ def test_std_is_honoured_on_every_route_or_refused(files, tmp_path, capsys):
     for data in ("s.csv", "log.csv"):
         for std in ("robust", "classical"):
             model = identify_file(panda, files / data, std=std)
-            assert model.metadata["std_estimator"] == std
+            assert model.info.std == std
             out = tmp_path / f"{data}-{std}"
             argv = ["identify", "--data", str(files / data), "--std", std, "--out", str(out)]
             assert main([*argv, "-q"]) == 0
