@@ -185,7 +185,11 @@ def test_json_results_become_tables(tmp_path):
         "joint_names": ["j1", "j2", "j3"],
         "rms": [0.5, 0.25, 0.125],
         "mse": [0.25, 0.0625, 0.015625],
-        "joints": [{"fv": 1.5, "fc": 0.25}, {"fv": 2.5, "fc": 0.5}, {"fv": 3.5, "fc": 0.75}],
+        "joints": [
+            {"fv": 1.5, "fc": 0.25, "rms_after": 0.03},
+            {"fv": 2.5, "fc": 0.5, "rms_after": 0.07},
+            {"fv": 3.5, "fc": 0.75, "rms_after": 0.05},
+        ],
         "friction": [[1.0, 2.0], [3.0, 4.0]],
         "covariance": [[0.0] * 43] * 43,
         "units": {"rms": "N m"},
@@ -198,12 +202,13 @@ def test_json_results_become_tables(tmp_path):
     assert ["relative_error_percent", "0.1235"] in rows
     assert ["", "rms [N m]", "mse"] in rows
     assert ["j2", "0.25", "0.0625"] in rows
-    assert ["j3", "3.5", "0.75"] in rows  # records named by the joint names
+    assert ["j3", "3.5", "0.75", "0.05"] in rows  # records named by the joint names
     assert ["2", "3", "4"] in rows  # the 2 x 2 matrix
     assert any(r[0] == "covariance" and "43 x 43" in r[1] for r in rows)
-    # the key numbers come first
+    # the key numbers come first; the largest RMS after friction over the joints is one
     text = " ".join(page.text)
     assert text.index("Key numbers") < text.index("r.json")
+    assert re.search(r"0\.07\s+RMS after, largest of 3 joints", text)
 
 
 def test_input_files_are_the_existing_files_outside_the_output(tmp_path):

@@ -80,6 +80,10 @@ KEY_NUMBERS = (
 )
 
 
+#: Columns of JSON records (``joints[]``) whose largest value is a key number: (key, label).
+KEY_COLUMNS = (("rms_before", "RMS before"), ("rms_after", "RMS after"))
+
+
 @dataclass(frozen=True)
 class ReportTable:
     """A table a command adds to its report: a title, column headers and rows of text."""
@@ -335,6 +339,12 @@ def _object_html(
     return "".join(parts)
 
 
+def _units(doc: Mapping[str, Any]) -> Mapping[str, str]:
+    """The ``units`` of a JSON result (key -> unit), or none."""
+    units = doc.get("units")
+    return units if isinstance(units, dict) else {}
+
+
 def _has_names(n: int, labels: Sequence[list[str]]) -> bool:
     return any(len(names) == n for names in labels)
 
@@ -380,6 +390,15 @@ def _key_numbers(docs: Sequence[tuple[str, Any]]) -> list[tuple[str, str, Any]]:
                     continue
                 seen.add((key, _cell(v)))
                 found.append((rel, prefix + label, v))
+        for key, records in doc.items():
+            if not _is_records(records):
+                continue
+            for column, label in KEY_COLUMNS:
+                values = [r.get(column) for r in records]
+                if values and all(_is_number(x) for x in values):
+                    unit = _with_unit(column, _units(doc))[len(column) :]
+                    text = f"{label}{unit}, largest of {len(values)} {key}"
+                    found.append((rel, text, max(values)))
     return found
 
 
