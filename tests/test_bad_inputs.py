@@ -708,8 +708,8 @@ def test_unexpected_error_is_one_line_with_debug_hint(monkeypatch, capsys):
 
 
 def test_figures_are_skipped_without_matplotlib(base, tmp_path, monkeypatch, capsys):
-    """Without matplotlib, validate writes validation.json, notes the skipped figures in one
-    line each and exits 0."""
+    """Without matplotlib, validate writes validation.json and its report, notes the skipped
+    figures in one line each and exits 0."""
     import sys
 
     for name in [m for m in sys.modules if m == "matplotlib" or m.startswith("matplotlib.")]:
@@ -725,7 +725,13 @@ def test_figures_are_skipped_without_matplotlib(base, tmp_path, monkeypatch, cap
         "note: matplotlib is not installed; skipped the figure validation_torques.png",
         "note: matplotlib is not installed; skipped the figure validation_rms.png",
     ]
-    assert sorted(p.name for p in out.iterdir()) == [".dynid-run.json", "validation.json"]
+    assert sorted(p.name for p in out.iterdir()) == [
+        ".dynid-run.json",
+        "report.html",
+        "validation.json",
+    ]
+    page = (out / "report.html").read_text(encoding="utf-8")  # without figures, with the notes
+    assert "<img" not in page and "skipped the figure validation_rms.png" in page
 
 
 def test_strict_json_out_never_writes_nan(tmp_path):
