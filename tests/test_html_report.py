@@ -293,9 +293,11 @@ def test_every_command_writes_its_report(runs, name):
     pngs = sorted(f for f in files if f.endswith(".png"))
     embedded = {img["alt"]: base64.b64decode(img["src"].split(",", 1)[1]) for img in page.images}
     assert embedded == {f: (out / f).read_bytes() for f in pngs}
-    linked = {urllib.parse.unquote(h) for h in page.links}
+    linked = {urllib.parse.unquote(h) for h in page.links if not h.startswith("#")}
     assert set(files) - {REPORT_NAME} <= linked
     assert all((out / h).exists() for h in linked if not h.startswith("../"))
+    anchors = {h[1:] for h in page.links if h.startswith("#")}
+    assert all(f'id="{a}"' in page_text for a in anchors)  # in-page links land
     for f in files:
         if f.endswith(".json"):
             schema = json.loads((out / f).read_text())["schema"]
