@@ -60,6 +60,7 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
+from ..identification.estimators import ESTIMATORS
 from ..io.feasible_bundle import save_feasible_bundle
 from ..io.model_json import save_model_json
 from ..workflows.identify import identify_consistent_file, identify_file
@@ -125,7 +126,7 @@ def register(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParser:
     )
     p.add_argument(
         "--estimator",
-        choices=("ols", "wls", "irls"),
+        choices=sorted(ESTIMATORS),
         default="ols",
         help="least squares: ordinary (default), weighted by each joint's (static: each row's) "
         "noise level from a first fit, or Huber-reweighted against outliers",
