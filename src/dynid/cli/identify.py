@@ -126,7 +126,7 @@ def register(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParser:
     )
     p.add_argument(
         "--estimator",
-        choices=sorted(ESTIMATORS),
+        choices=list(ESTIMATORS),
         default="ols",
         help="least squares: ordinary (default), weighted by each joint's (static: each row's) "
         "noise level from a first fit, or Huber-reweighted against outliers",
