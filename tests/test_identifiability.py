@@ -154,7 +154,7 @@ def test_rounded_arm_cli_acquire_noise_free_and_identify_without_traceback(
     assert main(["acquire-static", *common, "--n", "300", "--noise", "0", "--out", str(data)]) == 0
     assert main(["identify", *common, "--data", str(data), "--out", str(tmp_path / "r")]) == 0
     out = capsys.readouterr().out
-    assert "base parameters: 32, rank cut between singular values" in out
+    assert "the 32 base parameters: rank cut between singular values" in out
     assert "only in combination" in out and "unidentifiable" in out
 
 

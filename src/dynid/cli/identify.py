@@ -157,7 +157,9 @@ def register(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParser:
         type=positive_type,
         default=None,
         metavar="HZ",
-        help="torque logs: zero-phase low-pass cutoff [Hz] (default: the library's)",
+        help="torque logs: zero-phase low-pass cutoff [Hz] (default: 10 x the motion's highest "
+        "significant frequency, read from the log; decimation keeps at least 10 %% of the "
+        "samples)",
     )
     p.add_argument(
         "--folds",

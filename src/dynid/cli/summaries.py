@@ -12,6 +12,7 @@ from ..feasibility.heldout import HeldOutJudgement
 from ..feasibility.retrieve import RetrievalProgress, RetrievalResult
 from ..feasibility.sdp import ConsistentResult
 from ..friction.validation import NewtonEulerValidation
+from ..identification.info import LogInfo
 from ..identification.model import IdentifiedModel
 from ..regressors.base import identifiability
 
@@ -33,14 +34,14 @@ def format_identification(model: IdentifiedModel, *, width: int = 60) -> str:
     if info.static is not None:
         data = f"{info.static.n_configurations} configurations"
     elif info.log is not None:
-        data = f"{info.log.n_samples_used} samples of {info.log.n_samples_log}"
+        data = samples_text(info.log)
     else:
         data = "? samples"
     head = [
         f"{info.route or '?'} identification of {model.robot.name}: {data}"
         + f", {fit.n_rows} rows"
         + (f", dropped rows {', '.join(info.dropped_rows)}" if info.dropped_rows else ""),
-        f"rank {fit.rank}, condition number {fit.condition_number:.4g} (unscaled, as the "
+        f"{columns_text(model)}, condition number {fit.condition_number:.4g} (unscaled, as the "
         f"paper), scaled {fit.scaled_condition_number:.4g}, relative error "
         f"{fit.relative_error_percent:.4g} %, estimator {info.estimator}, "
         f"std {info.std or '?'}"
@@ -58,7 +59,7 @@ def format_identification(model: IdentifiedModel, *, width: int = 60) -> str:
     if model.base.gap is not None:
         hi, lo = model.base.gap
         head.append(
-            f"base parameters: {model.base.rank}, rank cut between singular values {hi:.3g} "
+            f"the {model.base.rank} base parameters: rank cut between singular values {hi:.3g} "
             f"and {lo:.3g} (relative to the largest, column-scaled regressor)"
         )
     status = identifiability(model.base)
@@ -84,6 +85,30 @@ def format_identification(model: IdentifiedModel, *, width: int = 60) -> str:
             f"{'yes' if fit.kept[k] else 'no':<4}  {e}"
         )
     return "\n".join(head + rows)
+
+
+def samples_text(log: LogInfo) -> str:
+    """The samples of a torque log: used and recorded, the filter and decimation that chose
+    them, and the resampling when the timestamps were not uniform."""
+    cut = log.cutoff_hz
+    how = "no low-pass" if cut is None else f"{cut:.3g} Hz low-pass"
+    if log.cutoff_source == "motion" and log.motion_frequency_hz:
+        how += f" (10 x the motion's {log.motion_frequency_hz:.3g} Hz)"
+    text = (
+        f"{log.n_samples_used} samples used (1 in {log.decimate} after the {how} and trimming "
+        f"of {log.n_samples_log} recorded"
+    )
+    if log.resampled:
+        text += f", resampled onto a uniform grid, {log.n_gaps} gap(s) bridged"
+    return text + ")"
+
+
+def columns_text(model: IdentifiedModel) -> str:
+    """The base parameters, the friction columns and the rank, counted separately."""
+    r = model.base.rank
+    k = 0 if model.joint_fit is None else int(np.size(model.joint_fit.beta)) - r
+    cols = f"{r} base parameters" + (f" and {k} friction columns" if k else "")
+    return f"columns: {cols}, rank {model.fit.rank} of {r + k}"
 
 
 def heldout_line(ho: dict[str, Any]) -> str:

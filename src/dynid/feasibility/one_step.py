@@ -18,14 +18,14 @@ from __future__ import annotations
 
 from collections.abc import Callable, Sequence
 from dataclasses import replace
-from typing import Any
+from typing import Any, Literal
 
 from ..exceptions import WrongTypeError
 from ..identification.classical import identify_from_log
 from ..identification.data import StaticDataset
 from ..identification.estimators import Estimator, EstimatorName
 from ..identification.holdout import DEFAULT_FOLDS
-from ..identification.log import DEFAULT_CUTOFF_HZ, TorqueLog
+from ..identification.log import TorqueLog
 from ..identification.static import identify_static
 from ..model.drive import Drive
 from ..model.robot import Robot
@@ -45,7 +45,7 @@ def identify_consistent(
     total_mass: tuple[float, float] | None = None,
     options: SDPOptions | None = None,
     constraints: Sequence[Callable[..., Any]] = (),
-    cutoff_hz: float | None = DEFAULT_CUTOFF_HZ,
+    cutoff_hz: float | Literal["auto"] | None = "auto",
     decimate: int | None = None,
     rtol: float | None = None,
     drive: Drive | None = None,

@@ -63,6 +63,12 @@ class LogInfo:
         Length of the raw log [s].
     n_nan_rows, n_duplicates, n_gaps : int
         What cleaning the raw log found (:class:`~dynid.identification.log.LogCleaning`).
+    cutoff_source : {"given", "motion"}
+        The cut-off was given, or read from the motion (:mod:`dynid.identification.rate`).
+    motion_frequency_hz : float or None
+        The motion's highest significant frequency [Hz] when the cut-off was read from it.
+    resampled : bool
+        The timestamps were not uniform: the log was resampled onto a uniform grid.
     """
 
     cutoff_hz: float | None
@@ -75,6 +81,9 @@ class LogInfo:
     n_nan_rows: int = 0
     n_duplicates: int = 0
     n_gaps: int = 0
+    cutoff_source: str = "given"
+    motion_frequency_hz: float | None = None
+    resampled: bool = False
 
 
 @dataclass(frozen=True, slots=True)

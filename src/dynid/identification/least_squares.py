@@ -159,7 +159,7 @@ def conditioning_advice(
     if fit.scaled_condition_number > ILL_CONDITIONED:
         cols = fit.nearly_dependent(labels)
         out.append(
-            f"{what} are ill-conditioned (scaled condition number "
+            f"the regressor of {what} is ill-conditioned (scaled condition number "
             f"{fit.scaled_condition_number:.3g} > {ILL_CONDITIONED:g}); nearly dependent "
             f"columns: {', '.join(cols[:8]) or '?'}; hint: use more or different "
             "configurations (dynid acquire-static --pool) or a longer, optimised trajectory "

@@ -25,7 +25,6 @@ from ..feasibility.sdp import ConsistentResult, SDPOptions
 from ..identification.classical import identify_from_log
 from ..identification.consistency import fit_mismatch, limit_violations
 from ..identification.estimators import EstimatorName
-from ..identification.log import DEFAULT_CUTOFF_HZ
 from ..identification.model import IdentifiedModel
 from ..identification.static import identify_static
 from ..model.drive import Drive
@@ -106,7 +105,8 @@ def identify_file(
     std : {"robust", "classical"}, optional
         Standard deviations (default robust for static data, classical for a log).
     cutoff_hz : float, optional
-        Torque logs: zero-phase low-pass cutoff [Hz] (default: the library's); also the
+        Torque logs: zero-phase low-pass cutoff [Hz] (default: read from the log,
+        :mod:`dynid.identification.rate`); also the
         cutoff of velocities derived from positions through ``columns``.
     max_gap_s : float, optional
         Torque logs: longest gap bridged by interpolation [s].
@@ -148,7 +148,7 @@ def identify_file(
                 drive=drive,
                 estimator=estimator,
                 std=std or "classical",
-                cutoff_hz=DEFAULT_CUTOFF_HZ if cutoff_hz is None else cutoff_hz,
+                cutoff_hz="auto" if cutoff_hz is None else cutoff_hz,
                 **heldout,
             ),
         )
@@ -242,7 +242,7 @@ def identify_consistent_file(
             rtol=rtol,
             drive=drive,
             estimator=estimator,
-            cutoff_hz=DEFAULT_CUTOFF_HZ if cutoff_hz is None else cutoff_hz,
+            cutoff_hz="auto" if cutoff_hz is None else cutoff_hz,
             **heldout,
         ),
     )

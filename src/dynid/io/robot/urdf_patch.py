@@ -259,7 +259,7 @@ def _check_consistent(link: str, phi: NDArray[np.float64], fixed: list[str], sou
         f"{source}: link {_checks.short(link)}: the identified body minus the template's "
         f"fixed links {_checks.short(fixed)} is not physically consistent (mass "
         f"{float(m):.6g} kg, principal moments {[float(f'{x:.4g}') for x in lam]} kg m^2); "
-        "export with --merged move (merged='move') to put the whole body on the moving link, "
+        "export with --merged move to put the whole body on the moving link, "
         "or, if the identified data did not include those bodies, use a template without "
         "them (or identify with them mounted)"
     )

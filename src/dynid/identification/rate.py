@@ -1,0 +1,108 @@
+"""The low-pass cut-off and the decimation of a torque log, read from the log itself.
+
+A fixed cut-off suits one kind of log: 5 Hz fits a slow exciting trajectory sampled at
+1 kHz, but on a fast motion it distorts the accelerations, and on a 5 kHz log with the
+decimation that follows from it (``fs / k >= 10 cutoff``) it keeps one sample in a
+hundred. The classical route therefore reads both from the data by default:
+
+* **cut-off** ``= CUTOFF_MULTIPLE (10) x f_q``, ``f_q`` the motion's highest significant
+  frequency: per moving joint, the frequency below which ``SIGNIFICANT_POWER`` (99.9 %) of
+  the power of ``q`` lies (its mean and linear trend removed, a Hann window against
+  leakage), the largest over the joints. The torques hold products of the motion's
+  harmonics (``M(q) ddq``, ``dq^T C dq``, ``sin q`` in ``g``), hence the multiple. Clamped
+  to ``[MIN_CUTOFF_HZ, fs / 4]``. A log whose joints do not move falls back to
+  :data:`~dynid.identification.log.DEFAULT_CUTOFF_HZ`.
+* **decimation** ``k``: the largest with ``fs / k >= 10 cutoff`` (the filtered signals
+  hold nothing above a few times the cut-off), but keeping at least ``MIN_KEPT_SHARE``
+  (10 %) of the samples: ``k <= 10``.
+
+Both are printed by ``identify`` and recorded in ``identification.json``
+(``metadata.cutoff_hz``, ``cutoff_source``, ``motion_frequency_hz``, ``decimate``);
+``validate`` reuses the recorded cut-off.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from numpy.typing import NDArray
+
+from .log import DEFAULT_CUTOFF_HZ
+from .sanity import moving_joints
+
+__all__ = [
+    "CUTOFF_MULTIPLE",
+    "MIN_CUTOFF_HZ",
+    "MIN_KEPT_SHARE",
+    "SIGNIFICANT_POWER",
+    "cutoff_from_motion",
+    "decimation",
+    "motion_frequency",
+]
+
+#: The cut-off is this multiple of the motion's highest significant frequency.
+CUTOFF_MULTIPLE = 10.0
+#: Share of the power of ``q`` below the significant frequency.
+SIGNIFICANT_POWER = 0.999
+#: Lowest cut-off chosen from the data [Hz].
+MIN_CUTOFF_HZ = 1.0
+#: Decimation keeps at least this share of the samples.
+MIN_KEPT_SHARE = 0.1
+
+
+def motion_frequency(
+    q: NDArray[np.float64], fs: float, moving: NDArray[np.bool_] | None = None
+) -> float:
+    """The highest significant frequency of the motion [Hz] (module docstring).
+
+    Parameters
+    ----------
+    q : ndarray, shape (N, n)
+        Joint positions [rad or m], uniformly sampled.
+    fs : float
+        Sample rate [Hz].
+    moving : ndarray of bool, shape (n,), optional
+        Joints to look at; default all.
+
+    Returns
+    -------
+    float
+        0 when no joint is looked at or the log is too short (fewer than 8 samples).
+        Joints whose motion is a linear trend alone (power below 1e-6 of the largest
+        joint's once the trend is removed) are not looked at.
+    """
+    N = q.shape[0]
+    cols = np.arange(q.shape[1]) if moving is None else np.flatnonzero(moving)
+    if N < 8 or cols.size == 0:
+        return 0.0
+    A = np.stack([np.ones(N), np.linspace(-1.0, 1.0, N)], axis=1)
+    y = q[:, cols]
+    x = y - A @ np.linalg.lstsq(A, y, rcond=None)[0]  # mean and linear trend removed
+    p = np.abs(np.fft.rfft(x * np.hanning(N)[:, None], axis=0)) ** 2
+    f = np.fft.rfftfreq(N, 1.0 / fs)
+    cum = np.cumsum(p, axis=0)
+    total = cum[-1]
+    out = 0.0
+    for j in range(cols.size):
+        if total[j] > 1e-6 * float(total.max()) and total[j] > 0:  # not a trend alone
+            out = max(out, float(f[np.searchsorted(cum[:, j], SIGNIFICANT_POWER * total[j])]))
+    return out
+
+
+def cutoff_from_motion(q: NDArray[np.float64], dq: NDArray[np.float64], fs: float) -> float:
+    """The cut-off [Hz] read from the motion (module docstring): ``CUTOFF_MULTIPLE`` times
+    :func:`motion_frequency` over the moving joints, in ``[MIN_CUTOFF_HZ, fs / 4]``;
+    :data:`~dynid.identification.log.DEFAULT_CUTOFF_HZ` (at most ``fs / 4``) when no joint
+    moves."""
+    f = motion_frequency(q, fs, moving_joints(dq))
+    c = CUTOFF_MULTIPLE * f if f > 0 else DEFAULT_CUTOFF_HZ
+    return float(min(max(c, MIN_CUTOFF_HZ), fs / 4.0))
+
+
+def decimation(fs: float, cutoff_hz: float | None) -> int:
+    """Largest ``k`` with ``fs / k >= 10 cutoff_hz`` that keeps at least ``MIN_KEPT_SHARE``
+    of the samples (1 without filtering)."""
+    if cutoff_hz is None:
+        return 1
+    return max(1, min(int(math.floor(fs / (10.0 * cutoff_hz))), int(round(1 / MIN_KEPT_SHARE))))
