@@ -16,13 +16,12 @@ import numpy as np
 
 from .. import _checks, spatial
 from ..exceptions import DataError, DynidError, ShapeError
-from ..identification.log import TorqueLog
 from ..io.drive_file import drive_of_robot_file, load_drive
 from ..io.robot_file import load_robot as load_robot_file
+from ..kinematics.inverse import default_q0
 from ..model.builtin import BUILTIN_ROBOTS, builtin_robot
 from ..model.robot import Robot
 from ..plots.save import save_figure as write_figure
-from ..workflows.data_files import column_map, read_torque_log, recorded_columns
 from ..workflows.prior import load_prior as workflow_prior
 from .console import Console
 
@@ -306,6 +305,21 @@ def format_matrix(A: np.ndarray, fmt: str = "{:+.6f}") -> str:
 
 
 # ---------------------------------------------------------------------- kinematics options
+def add_q_option(p: argparse.ArgumentParser) -> None:
+    """``--q`` joint positions, defaulting to the documented start pose."""
+    p.add_argument(
+        "--q",
+        default=None,
+        metavar="Q1,...,QN",
+        help="joint positions [rad or m], comma-separated (default: the neutral pose)",
+    )
+
+
+def joint_positions(args: argparse.Namespace, robot: Robot) -> np.ndarray:
+    """``--q`` parsed, or the documented start pose."""
+    return default_q0(robot) if args.q is None else parse_q(args.q, robot)
+
+
 def add_frame_tool_options(p: argparse.ArgumentParser) -> None:
     """``--frame NAME`` (default flange) and ``--tool x,y,z[,roll,pitch,yaw]``."""
     p.add_argument("--frame", default="flange", help="a frame of the robot (default: flange)")
@@ -361,23 +375,4 @@ def add_column_options(p: argparse.ArgumentParser) -> None:
         default=None,
         metavar="MAP",
         help="units of --data: 'q=deg,tau=mNm,t=ms' (converted to SI)",
-    )
-
-
-def read_data_log(
-    args: argparse.Namespace, n: int, *, owner: str, recorded: Any = None
-) -> TorqueLog:
-    """``--data`` read as a torque log of ``n`` joints (:func:`~dynid.workflows.data_files.
-    read_torque_log`), through ``--columns``/``--units``, or those a model recorded
-    (``recorded``, its ``info.column_map``) when none are given
-    (:func:`~dynid.workflows.data_files.recorded_columns`)."""
-    columns, units = recorded_columns(
-        recorded, getattr(args, "columns", None), getattr(args, "units", None)
-    )
-    return read_torque_log(
-        args.data,
-        n,
-        columns=column_map(columns, units, cutoff_hz=getattr(args, "cutoff", None)),
-        drop_invalid=bool(getattr(args, "drop_invalid", False)),
-        owner=owner,
     )

@@ -15,19 +15,17 @@ from __future__ import annotations
 
 import argparse
 
-import numpy as np
-
 from ..kinematics.forward import fk
-from ..kinematics.inverse import default_q0
 from ..spatial import rpy_from_matrix
 from .common import (
     add_frame_tool_options,
+    add_q_option,
     add_robot_options,
     add_subcommand,
     format_joint_table,
     format_matrix,
+    joint_positions,
     load_robot,
-    parse_q,
     parse_tool,
 )
 from .console import Console
@@ -43,21 +41,6 @@ def register(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParser:
     add_frame_tool_options(p)
     p.add_argument("--json", action="store_true", help="print one JSON object")
     return p
-
-
-def add_q_option(p: argparse.ArgumentParser) -> None:
-    """``--q`` joint positions, defaulting to the documented start pose."""
-    p.add_argument(
-        "--q",
-        default=None,
-        metavar="Q1,...,QN",
-        help="joint positions [rad or m], comma-separated (default: the neutral pose)",
-    )
-
-
-def joint_positions(args: argparse.Namespace, robot) -> np.ndarray:
-    """``--q`` parsed, or the documented start pose."""
-    return default_q0(robot) if args.q is None else parse_q(args.q, robot)
 
 
 def run(args: argparse.Namespace, console: Console) -> int:

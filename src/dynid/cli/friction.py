@@ -46,11 +46,11 @@ from .common import (
     load_drive_arg,
     load_robot,
     positive_type,
-    read_data_log,
     shown,
 )
 from .console import Console
 from .figures import save_friction_figure
+from .sources import read_data_log
 from .summaries import format_rms_table
 
 NAME = "friction"

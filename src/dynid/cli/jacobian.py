@@ -19,14 +19,15 @@ import argparse
 from ..kinematics.jacobian import jacobian
 from .common import (
     add_frame_tool_options,
+    add_q_option,
     add_robot_options,
     add_subcommand,
     format_joint_table,
+    joint_positions,
     load_robot,
     parse_tool,
 )
 from .console import Console
-from .fk import add_q_option, joint_positions
 
 NAME = "jacobian"
 

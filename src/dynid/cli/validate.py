@@ -47,12 +47,11 @@ from .common import (
     add_subcommand,
     load_drive_arg,
     positive_type,
-    read_data_log,
     shown,
 )
 from .console import Console
 from .figures import save_validation_figures
-from .sources import load_model_source
+from .sources import load_model_source, read_data_log
 from .summaries import format_rms_table
 
 NAME = "validate"
