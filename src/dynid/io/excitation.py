@@ -23,8 +23,6 @@ recorded row count of a CSV checked.
 
 from __future__ import annotations
 
-import json
-import math
 import re
 from pathlib import Path
 from typing import Any
@@ -38,8 +36,8 @@ from ..model.robot import Robot
 from ..simulation.collision import Box, Obstacles, Plane, capsule_model
 from ..simulation.excitation import ExcitationResult, ExcitingTrajectory
 from ..simulation.trajectories import Trajectory
-from .atomic import open_atomic, write_text
-from .json_files import load_json
+from .atomic import open_atomic
+from .json_files import finite_or_none, load_json, save_json
 from .torque_log import csv_table
 
 __all__ = [
@@ -56,20 +54,6 @@ __all__ = [
 EXCITATION_SCHEMA = "dynid-exciting-trajectory/1"
 OBSTACLES_SCHEMA = "dynid-obstacles/1"
 _UNITS = "# dynid trajectory; units: t [s], q [rad], dq [rad/s], ddq [rad/s^2]"
-
-
-def _jsonable(x: Any) -> Any:
-    if isinstance(x, dict):
-        return {str(k): _jsonable(v) for k, v in x.items()}
-    if isinstance(x, (list, tuple)):
-        return [_jsonable(v) for v in x]
-    if isinstance(x, (float, np.floating)):
-        return float(x) if math.isfinite(float(x)) else None
-    if isinstance(x, np.integer):
-        return int(x)
-    if isinstance(x, np.ndarray):
-        return _jsonable(x.tolist())
-    return x
 
 
 def save_trajectory_csv(path: str | Path, traj: Trajectory) -> Path:
@@ -148,8 +132,8 @@ def save_excitation_json(
         },
         "history": list(result.history),
     }
-    text = json.dumps(_jsonable(d), indent=1, allow_nan=False) + "\n"
-    return write_text(Path(path), text)
+    # limits, margins and condition numbers may be infinite (no limit, no obstacle): null
+    return save_json(path, finite_or_none(d))
 
 
 _OBSTACLE_KEYS = {"schema", "planes", "boxes"}

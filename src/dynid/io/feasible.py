@@ -39,7 +39,6 @@ rejected. Floats are written with Python's shortest round-trip representation.
 from __future__ import annotations
 
 import json
-import math
 from collections.abc import Mapping
 from pathlib import Path
 from typing import Any
@@ -58,7 +57,7 @@ from ..model.inertia import INERTIA_ORDER, inertia6_from_matrix, inertial_from_p
 from ..model.robot import Robot
 from .atomic import write_text
 from .drive_file import drive_from_record
-from .json_files import load_json, save_json
+from .json_files import finite_or_none, load_json, save_json
 from .robot_json import robot_from_dict, robot_to_dict
 
 __all__ = [
@@ -93,11 +92,6 @@ _CONVENTIONS = {
 }
 _LINK_KEYS = {"name", "mass", "com", "inertia"}
 _BOUND_KEYS = {"name", "mass", "com_min", "com_max", "inertia_min", "inertia_max"}
-
-
-def _num(x: float) -> float | None:
-    x = float(x)
-    return x if math.isfinite(x) else None
 
 
 def _write_json(path: str | Path, d: Mapping[str, Any]) -> Path:
@@ -159,7 +153,7 @@ def feasible_to_dict(source: Any, *, seed: int | None = None) -> dict[str, Any]:
     if not isinstance(source, Robot):
         d["method"] = getattr(source, "method", "penalty")
         d["feasible"] = bool(source.feasible)
-        d["relative_residual"] = _num(source.relative_residual)
+        d["relative_residual"] = finite_or_none(source.relative_residual)
         d["seed"] = source.seed
         ho = getattr(source, "heldout", None)
         if ho is not None:
@@ -316,7 +310,7 @@ def _report_constraints(report: FeasibilityReport) -> list[dict[str, Any]]:
         {
             "name": c.name,
             "link": c.link,
-            "margin": _num(c.margin),
+            "margin": finite_or_none(c.margin),
             "unit": c.unit,
             "satisfied": bool(c.satisfied),
         }
@@ -341,12 +335,12 @@ def report_to_dict(result: RetrievalResult) -> dict[str, Any]:
         "kind": result.kind,
         "robot": result.robot.name,
         "link_names": list(result.robot.link_names[1:]),
-        "relative_residual": _num(result.relative_residual),
-        "cost": _num(result.cost),
+        "relative_residual": finite_or_none(result.relative_residual),
+        "cost": finite_or_none(result.cost),
         "feasible": bool(result.feasible),
-        "min_margin": {name: _num(rep.min_margin(name)) for name in rep.names},
+        "min_margin": {name: finite_or_none(rep.min_margin(name)) for name in rep.names},
         "constraints": _report_constraints(rep),
-        "stage_costs": [_num(x) for x in result.stage_costs],
+        "stage_costs": [finite_or_none(x) for x in result.stage_costs],
         "xi": list(opts.schedule()),
         "run_time_s": float(result.run_time),
         "seed": result.seed,
@@ -356,11 +350,11 @@ def report_to_dict(result: RetrievalResult) -> dict[str, Any]:
         "runs": [
             {
                 "index": r.index,
-                "cost": _num(r.stage_costs[-1]),
-                "stage_costs": [_num(x) for x in r.stage_costs],
-                "relative_residual": _num(r.relative_residual),
+                "cost": finite_or_none(r.stage_costs[-1]),
+                "stage_costs": [finite_or_none(x) for x in r.stage_costs],
+                "relative_residual": finite_or_none(r.relative_residual),
                 "feasible": bool(r.feasible),
-                "violation": _num(r.violation),
+                "violation": finite_or_none(r.violation),
                 "n_evaluations": int(r.n_evaluations),
                 "time_s": float(r.time),
             }
@@ -419,15 +413,15 @@ def consistent_report_to_dict(result: ConsistentResult) -> dict[str, Any]:
             "repaired_links": list(result.prior.repaired),
             "mass": [float(x) for x in pm],
         },
-        "prior_weight": _num(result.prior_weight),
-        "weight_search": [[_num(w), _num(r)] for w, r in result.weight_search],
-        "relative_residual": _num(result.relative_residual),
-        "residual_ratio": _num(result.residual_ratio),
+        "prior_weight": finite_or_none(result.prior_weight),
+        "weight_search": [[finite_or_none(w), finite_or_none(r)] for w, r in result.weight_search],
+        "relative_residual": finite_or_none(result.relative_residual),
+        "residual_ratio": finite_or_none(result.residual_ratio),
         "feasible": bool(result.feasible),
-        "min_margin": {name: _num(rep.min_margin(name)) for name in rep.names},
+        "min_margin": {name: finite_or_none(rep.min_margin(name)) for name in rep.names},
         "constraints": _report_constraints(rep),
-        "pseudo_inertia_margin": [_num(x) for x in result.pseudo_inertia_margin],
-        "divergence": [_num(x) for x in result.divergence],
+        "pseudo_inertia_margin": [finite_or_none(x) for x in result.pseudo_inertia_margin],
+        "divergence": [finite_or_none(x) for x in result.divergence],
         "distance_to_prior": {
             "mass": [float(x) for x in np.abs(result.mass - pm)],
             "com": [float(x) for x in np.linalg.norm(result.com - pc, axis=1)],

@@ -1,10 +1,15 @@
-"""Strict JSON: the one reader and writer of dynid's JSON files.
+"""Strict JSON: the one reader and writer of dynid's JSON files, and their one number policy.
+
+The policy, the same for every file: a JSON number is finite. A field that may have no
+value (no limit, no obstacle, a percentage of zero) is written ``null``, on purpose, through
+:func:`finite_or_none`, and file-formats.md says so for that field; any other NaN or infinite
+number is a fault, and writing it raises :class:`~dynid.exceptions.NonFiniteError` naming
+its key path (``rms[3]``) and writes nothing. ``NaN``/``Infinity`` are never written
+(strict parsers reject them) and never read.
 
 Writing (:func:`dumps`, :func:`save_json`): numpy arrays and scalars become lists and
-numbers; a NaN or infinite number raises :class:`~dynid.exceptions.NonFiniteError` naming
-its key path (``rms[3]``) instead of writing ``NaN``/``Infinity``, which strict parsers
-reject (write ``None`` for "undefined" on purpose). Files are written atomically
-(:mod:`dynid.io.atomic`), indented, UTF-8, with a ``schema`` key first.
+numbers. Files are written atomically (:mod:`dynid.io.atomic`), indented, UTF-8, with a
+``schema`` key first.
 
 Reading (:func:`load_json`): UTF-8 with or without a byte-order mark; ``NaN``,
 ``Infinity``, numbers that overflow a float (integers of more than 308 digits included),
@@ -27,7 +32,7 @@ from .. import _checks
 from ..exceptions import DataError, NonFiniteError
 from .atomic import write_text
 
-__all__ = ["dumps", "jsonable", "load_json", "loads", "save_json"]
+__all__ = ["dumps", "finite_or_none", "jsonable", "load_json", "loads", "save_json"]
 
 
 def jsonable(x: Any, where: str = "") -> Any:
@@ -52,6 +57,25 @@ def jsonable(x: Any, where: str = "") -> Any:
     if isinstance(x, Path):
         return str(x)
     raise DataError(f"{where or 'value'}: cannot write a {type(x).__name__} as JSON")
+
+
+def finite_or_none(x: Any) -> Any:
+    """``x`` with every number that is not finite replaced by None (JSON ``null``).
+
+    The one way a writer states "no value" for a field that may have none (module
+    docstring): recursively through mappings, lists, tuples and arrays; other values are
+    returned as they are (numpy integers and booleans are converted by :func:`jsonable`).
+    """
+    if isinstance(x, Mapping):
+        return {str(k): finite_or_none(v) for k, v in x.items()}
+    if isinstance(x, np.ndarray):
+        return finite_or_none(x.tolist())
+    if isinstance(x, (list, tuple)):
+        return [finite_or_none(v) for v in x]
+    if isinstance(x, (float, np.floating)):
+        v = float(x)
+        return v if math.isfinite(v) else None
+    return x
 
 
 def dumps(obj: Any, *, indent: int | None = 1) -> str:

@@ -41,11 +41,10 @@ Floats are written with Python's shortest round-trip representation, so
 
 from __future__ import annotations
 
-import math
 from collections.abc import Mapping
 from dataclasses import fields
 from pathlib import Path
-from typing import Any, SupportsFloat
+from typing import Any
 
 import numpy as np
 from numpy.typing import NDArray
@@ -58,7 +57,7 @@ from ..identification.model import IdentifiedModel
 from ..model.drive import Drive
 from ..regressors.base import BaseParameters
 from .drive_file import drive_from_record
-from .json_files import load_json, save_json
+from .json_files import finite_or_none, load_json, save_json
 from .robot_json import robot_from_dict, robot_to_dict
 
 __all__ = [
@@ -85,12 +84,6 @@ _FIT_SCALARS = (
 )
 
 
-def _num(x: SupportsFloat) -> float | None:
-    """A JSON number, or None for NaN/inf (JSON has neither)."""
-    x = float(x)
-    return x if math.isfinite(x) else None
-
-
 def _jsonable(x: Any) -> Any:
     if isinstance(x, Mapping):
         return {str(k): _jsonable(v) for k, v in x.items()}
@@ -103,7 +96,7 @@ def _jsonable(x: Any) -> Any:
     if isinstance(x, (int, np.integer)):
         return int(x)
     if isinstance(x, (float, np.floating)):
-        return _num(x)
+        return finite_or_none(x)
     if x is None or isinstance(x, str):
         return x
     return str(x)
@@ -123,7 +116,7 @@ def model_to_dict(model: IdentifiedModel, *, seed: int | None = None) -> dict[st
             "expression": base.expressions[k],
             "value": float(fit.beta[k]),
             "std": float(fit.std[k]),
-            "std_percent": _num(fit.std_percent[k]),
+            "std_percent": finite_or_none(fit.std_percent[k]),
             "kept": bool(fit.kept[k]),
         }
         for k in range(base.rank)

@@ -22,15 +22,12 @@ import numpy as np
 
 from ..exceptions import DataError, ModelError, ShapeError
 from ..model.robot import Frame, Robot
+from .json_files import finite_or_none
 
 __all__ = ["robot_to_dict", "robot_from_dict", "ROBOT_SCHEMA"]
 
 ROBOT_SCHEMA = "dynid-robot-kinematics/1"
 _LIMITS = ("q_min", "q_max", "dq_max", "ddq_max", "tau_max")
-
-
-def _finite_or_none(v: np.ndarray) -> list[float | None]:
-    return [float(x) if np.isfinite(x) else None for x in v]
 
 
 def robot_to_dict(robot: Robot) -> dict[str, Any]:
@@ -43,7 +40,7 @@ def robot_to_dict(robot: Robot) -> dict[str, Any]:
         "T_parent_joint": robot.T_parent_joint.tolist(),
         "axes": robot.axes.tolist(),
         "prismatic": [bool(p) for p in robot.prismatic],
-        "limits": {k: _finite_or_none(getattr(robot, k)) for k in _LIMITS},
+        "limits": {k: finite_or_none(getattr(robot, k)) for k in _LIMITS},
         "gravity": robot.gravity.tolist(),
         "frames": {
             name: {"link": int(f.link), "T_link_frame": f.T_link_frame.tolist()}
