@@ -32,7 +32,10 @@ def _columns(
     dq: NDArray[np.float64], band: NDArray[np.float64], vst: NDArray[np.float64]
 ) -> NDArray[np.float64]:
     s = coulomb_sign(dq, band)
-    e = np.exp(-((dq / vst) ** 2))
+    # vst = 0 is a joint left unidentified (it never moved; every coefficient 0): the limit
+    # of exp(-(dq / vst)^2) as vst -> 0, without dividing by zero
+    moving = np.asarray(vst) > 0
+    e = np.where(moving, np.exp(-((dq / np.where(moving, vst, 1.0)) ** 2)), 0.0)
     return np.stack([dq, s * (1.0 - e), s * e, np.ones_like(dq)], axis=-1)
 
 
