@@ -129,13 +129,22 @@ class RunSummary:
 
 
 def _e(text: object) -> str:
-    """``text`` escaped for HTML text and attribute values."""
-    return html.escape(str(text), quote=True)
+    """``text`` escaped for HTML text and attribute values; a name given under an ASCII
+    locale (undecodable bytes held as surrogates) shows as the characters its bytes spell."""
+    return html.escape(_shown(str(text)), quote=True)
+
+
+def _shown(text: str) -> str:
+    """``text`` with surrogate escapes turned back into the characters of their UTF-8 bytes
+    (U+FFFD where the bytes are not UTF-8), so that the page can be written as UTF-8."""
+    return text.encode("utf-8", "surrogateescape").decode("utf-8", "replace")
 
 
 def _href(path: str) -> str:
-    """A relative address for ``path`` (POSIX separators), percent-encoded and escaped."""
-    return _e(urllib.parse.quote(path.replace(os.sep, "/"), safe="/"))
+    """A relative address for ``path`` (POSIX separators), percent-encoded from its bytes as
+    the file system holds them, and escaped."""
+    raw = os.fsencode(path.replace(os.sep, "/"))
+    return html.escape(urllib.parse.quote(raw, safe="/"), quote=True)
 
 
 def _size(n: int) -> str:
