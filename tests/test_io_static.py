@@ -255,7 +255,7 @@ def test_model_json_round_trip_predicts_identically(tmp_path, panda_model):
         assert getattr(back.fit, f) == getattr(model.fit, f)
     assert back.base.expressions == model.base.expressions and back.base.gap == model.base.gap
     np.testing.assert_array_equal(back.base.K_d, model.base.K_d)
-    assert back.metadata["dropped_rows"] == ["g1"]
+    assert back.info.dropped_rows == ("g1",)
 
 
 def test_model_json_has_the_documented_keys_and_is_strict_json(tmp_path, panda_model):

@@ -108,9 +108,9 @@ def test_classical_route_streamed_equals_stacked(monkeypatch, estimator):
     np.testing.assert_allclose(got.fit.std, ref.fit.std, rtol=1e-9, atol=1e-14)
     np.testing.assert_allclose(got.friction, ref.friction, rtol=1e-9, atol=1e-12)
     assert got.fit.relative_error_percent == pytest.approx(ref.fit.relative_error_percent, rel=1e-9)
-    h, hr = got.metadata["heldout"], ref.metadata["heldout"]
+    h, hr = got.info.heldout, ref.info.heldout
     assert h["heldout_error_percent"] == pytest.approx(hr["heldout_error_percent"], rel=1e-9)
-    assert got.metadata["n_rows"] == ref.metadata["n_rows"]
+    assert got.info.n_rows == ref.info.n_rows
 
 
 _VM_RUN = """
