@@ -172,7 +172,7 @@ _LAZY: dict[str, tuple[str, str]] = {
     "validate_torques": ("friction.validation", "validate_torques"),
 }
 
-__version__ = "0.1.0"
+__version__ = "0.2.0"
 
 __all__ = [
     "BaseParameters",
