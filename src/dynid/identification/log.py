@@ -422,16 +422,7 @@ def prepare_log(
     """
     t = log.t
     dt = np.diff(t)
-    if max_gap_s is None:
-        max_gap_s = default_max_gap(float(np.median(dt)))
-    big = np.flatnonzero(dt > max_gap_s * (1.0 + 1e-9))
-    if big.size:
-        k = int(big[0])
-        raise DataError(
-            f"gap of {dt[k]:.4g} s in the log between t = {t[k]:.6g} s and t = {t[k + 1]:.6g} s "
-            f"exceeds the longest gap bridged, {max_gap_s:g} s; hint: split the log at the gap "
-            "or raise max_gap_s (--max-gap)"
-        )
+    _check_gaps(t, dt, max_gap_s)
     if int(decimate) != decimate or decimate < 1:
         raise ShapeError(f"decimate must be an integer >= 1; got {decimate}")
     rate = signals.sample_rate(t) if fs is None else float(fs)
@@ -442,20 +433,7 @@ def prepare_log(
         for name in list(data):
             tu, data[name] = signals.resample_uniform(t, data[name], rate)
         t = tu
-    if cutoff_hz is not None and cutoff_hz == DEFAULT_CUTOFF_HZ and cutoff_hz >= rate / 2:
-        warnings.warn(
-            f"the default cutoff {DEFAULT_CUTOFF_HZ:g} Hz is not below the Nyquist frequency "
-            f"of this {rate:.4g} Hz log; filtering at {rate / 4:.4g} Hz instead (choose with "
-            "cutoff_hz / --cutoff)",
-            DynidWarning,
-            stacklevel=2,
-        )
-        cutoff_hz = rate / 4
-    if cutoff_hz is not None and log.n_samples <= 15:
-        raise DataError(
-            f"the log has {log.n_samples} samples; filtering needs more (a longer log, or "
-            "no filter: cutoff_hz=None)"
-        )
+    cutoff_hz = _usable_cutoff(cutoff_hz, rate, log.n_samples)
     if trim_s is None:
         trim_s = signals.edge_seconds(cutoff_hz) if cutoff_hz is not None else 0.0
     keep = signals.trim_edges(t, trim_s)
@@ -477,6 +455,41 @@ def prepare_log(
         ddq=out["ddq"],
         cleaning=log.cleaning,
     )
+
+
+def _check_gaps(t: NDArray[np.float64], dt: NDArray[np.float64], max_gap_s: float | None) -> None:
+    """Refuse a gap longer than ``max_gap_s`` (default :func:`default_max_gap`) [s]."""
+    if max_gap_s is None:
+        max_gap_s = default_max_gap(float(np.median(dt)))
+    big = np.flatnonzero(dt > max_gap_s * (1.0 + 1e-9))
+    if big.size:
+        k = int(big[0])
+        raise DataError(
+            f"gap of {dt[k]:.4g} s in the log between t = {t[k]:.6g} s and t = {t[k + 1]:.6g} s "
+            f"exceeds the longest gap bridged, {max_gap_s:g} s; hint: split the log at the gap "
+            "or raise max_gap_s (--max-gap)"
+        )
+
+
+def _usable_cutoff(cutoff_hz: float | None, rate: float, n_samples: int) -> float | None:
+    """The cut-off [Hz] to filter at: the default one moved below the Nyquist frequency of a
+    slow log (with a warning pointing at :func:`prepare_log`'s caller); refused for a log too
+    short to filter."""
+    if cutoff_hz is not None and cutoff_hz == DEFAULT_CUTOFF_HZ and cutoff_hz >= rate / 2:
+        warnings.warn(
+            f"the default cutoff {DEFAULT_CUTOFF_HZ:g} Hz is not below the Nyquist frequency "
+            f"of this {rate:.4g} Hz log; filtering at {rate / 4:.4g} Hz instead (choose with "
+            "cutoff_hz / --cutoff)",
+            DynidWarning,
+            stacklevel=3,
+        )
+        cutoff_hz = rate / 4
+    if cutoff_hz is not None and n_samples <= 15:
+        raise DataError(
+            f"the log has {n_samples} samples; filtering needs more (a longer log, or "
+            "no filter: cutoff_hz=None)"
+        )
+    return cutoff_hz
 
 
 def _conditioned(
