@@ -855,23 +855,8 @@ def solve_consistent(
     """
     t0 = time.perf_counter()
     opts = SDPOptions() if options is None else options
-    n = robot.n
-    if term.P.shape[1] not in (10 * n, 11 * n):
-        raise ShapeError(f"data term is for {term.P.shape[1] // 10} links; robot has {n}")
-    b = default_bounds(robot) if bounds is None else bounds
-    if b.n != n:
-        raise ShapeError(f"bounds are for {b.n} links; robot {robot.name!r} has {n}")
-    band = total_mass if total_mass is not None else b.total_mass
-    if band is not None:
-        band = (float(band[0]), float(band[1]))
-    if prior is None:
-        pr = generic_prior(robot, band)
-    elif isinstance(prior, Prior):
-        pr = prior
-    else:
-        pr = prior_from_robot(prior, total_mass=band)
-    if pr.n != n:
-        raise ShapeError(f"prior {pr.source!r} has {pr.n} links; robot {robot.name!r} has {n}")
+    b, band = _checked_bounds(robot, term, bounds, total_mass)
+    pr = _resolved_prior(prior, robot, band)
     lo, hi, notes = _mass_bounds(pr, b, opts.mass_factor)
     notes = list(term.notes) + notes
     _check_band(lo, hi, band)
@@ -912,22 +897,7 @@ def solve_consistent(
         )
 
     if equality:
-        prob = _Problem(*common, True, False, friction_nonneg, constraints)
-        status = prob.solve(1.0)
-        if status.startswith("infeasible"):
-            notes.append(
-                "no consistent parameter set reproduces the coefficients exactly within the "
-                "bounds; the closest one (least relative coefficient error) is returned"
-            )
-            prob = _Problem(*common, False, True, friction_nonneg, constraints)
-            if prob.solve(1.0).startswith("infeasible"):
-                raise InfeasibleError("the bounds and constraints admit no consistent parameters")
-            return finish(*prob.values(), 1.0, "equality", "infeasible")
-        phi, f, ia = prob.values()
-        phi = _polish(phi, term, pr, ia)
-        if f is not None:
-            f = term.x_hat[term.r :].copy()
-        return finish(phi, f, ia, 1.0, "equality", status)
+        return _solve_equality(common, friction_nonneg, constraints, notes, finish)
     prob = _Problem(*common, False, False, friction_nonneg, constraints)
     if term.holdout is not None:
         folds = [
@@ -946,26 +916,93 @@ def solve_consistent(
             raise InfeasibleError("the bounds and constraints admit no consistent parameters")
         return finish(*prob.values(), opts.prior_weight, "weighted", status)
     w, limit, status, (phi, f, ia), search[:] = _auto_weight(prob, term, opts)
-    top = w >= WEIGHT_RANGE[1] * (1 - 1e-9)
-    if limit > 1.0 + opts.residual_increase:
+    notes.append(_auto_weight_note(w, limit, search, opts))
+    return finish(phi, f, ia, w, "weighted", status)
+
+
+def _checked_bounds(
+    robot: Robot,
+    term: DataTerm,
+    bounds: Bounds | None,
+    total_mass: tuple[float, float] | None,
+) -> tuple[Bounds, tuple[float, float] | None]:
+    """The bounds (default :func:`~dynid.feasibility.bounds.default_bounds`) and the total-mass
+    band [kg] (``total_mass`` over the bounds' own), both checked against the robot and the
+    data term's number of links."""
+    n = robot.n
+    if term.P.shape[1] not in (10 * n, 11 * n):
+        raise ShapeError(f"data term is for {term.P.shape[1] // 10} links; robot has {n}")
+    b = default_bounds(robot) if bounds is None else bounds
+    if b.n != n:
+        raise ShapeError(f"bounds are for {b.n} links; robot {robot.name!r} has {n}")
+    band = total_mass if total_mass is not None else b.total_mass
+    return b, None if band is None else (float(band[0]), float(band[1]))
+
+
+def _resolved_prior(
+    prior: Prior | Robot | None, robot: Robot, band: tuple[float, float] | None
+) -> Prior:
+    """The prior as a :class:`Prior` (the generic one for None), checked against the robot."""
+    if prior is None:
+        pr = generic_prior(robot, band)
+    elif isinstance(prior, Prior):
+        pr = prior
+    else:
+        pr = prior_from_robot(prior, total_mass=band)
+    if pr.n != robot.n:
+        raise ShapeError(
+            f"prior {pr.source!r} has {pr.n} links; robot {robot.name!r} has {robot.n}"
+        )
+    return pr
+
+
+def _solve_equality(
+    common: tuple[Any, ...],
+    friction_nonneg: bool,
+    constraints: Sequence[Callable[..., Any]],
+    notes: list[str],
+    finish: Callable[..., ConsistentResult],
+) -> ConsistentResult:
+    """Exact coefficients: ``P phi = beta`` met exactly, or, where the bounds exclude that, the
+    closest consistent set (least relative coefficient error) with a note."""
+    term, pr, lo, hi, nb, band, opts = common
+    prob = _Problem(term, pr, lo, hi, nb, band, opts, True, False, friction_nonneg, constraints)
+    status = prob.solve(1.0)
+    if status.startswith("infeasible"):
         notes.append(
+            "no consistent parameter set reproduces the coefficients exactly within the "
+            "bounds; the closest one (least relative coefficient error) is returned"
+        )
+        prob = _Problem(term, pr, lo, hi, nb, band, opts, False, True, friction_nonneg, constraints)
+        if prob.solve(1.0).startswith("infeasible"):
+            raise InfeasibleError("the bounds and constraints admit no consistent parameters")
+        return finish(*prob.values(), 1.0, "equality", "infeasible")
+    phi, f, ia = prob.values()
+    phi = _polish(phi, term, pr, ia)
+    if f is not None:
+        f = term.x_hat[term.r :].copy()
+    return finish(phi, f, ia, 1.0, "equality", status)
+
+
+def _auto_weight_note(
+    w: float, limit: float, search: list[tuple[float, float]], opts: SDPOptions
+) -> str:
+    """What the automatic prior weight (training residual, :func:`_auto_weight`) means."""
+    if limit > 1.0 + opts.residual_increase:
+        return (
             "no parameter set that meets the constraints (margin, bounds, total-mass band) fits "
             f"the data within {100 * opts.residual_increase:g} %: the closest raises the residual "
             f"RMS by {100 * (search[0][1] - 1):.2f} % (effects outside the rigid-body model, "
             "or a constraint that excludes the robot: check --margin, --total-mass, --bounds); "
             f"the prior weight {w:.3g} keeps it within {100 * opts.residual_increase:g} % of that"
         )
-    else:
-        notes.append(
-            f"prior weight {w:.3g}: "
-            + (
-                "the top of the search range (the data leave the prior almost free)"
-                if top
-                else "the largest keeping the residual RMS within "
-                f"{100 * opts.residual_increase:g} % of the unconstrained fit"
-            )
-        )
-    return finish(phi, f, ia, w, "weighted", status)
+    top = w >= WEIGHT_RANGE[1] * (1 - 1e-9)
+    return f"prior weight {w:.3g}: " + (
+        "the top of the search range (the data leave the prior almost free)"
+        if top
+        else "the largest keeping the residual RMS within "
+        f"{100 * opts.residual_increase:g} % of the unconstrained fit"
+    )
 
 
 def _solved(prob: _Problem, w: float) -> str:
