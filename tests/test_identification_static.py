@@ -205,7 +205,7 @@ def test_classical_and_robust_std_match_their_formulas():
     classical = np.sqrt(np.diag(G) * (e @ e) / (m - r))
     robust = np.sqrt(np.diag(G @ (W.T * e**2) @ W @ G) * m / (m - r))
     a = fit_least_squares(W, y)
-    b = fit_least_squares(W, y, covariance="robust")
+    b = fit_least_squares(W, y, std="robust")
     np.testing.assert_allclose(a.beta, beta, rtol=1e-10)
     np.testing.assert_allclose(a.std, classical, rtol=1e-10)
     np.testing.assert_allclose(b.std, robust, rtol=1e-10)
@@ -466,19 +466,17 @@ def _tall_problem(seed, m=3000, r=12, cond=10.0):
     return W, y
 
 
-@pytest.mark.parametrize("covariance", ["classical", "robust"])
-def test_semi_normal_route_equals_the_qr_route_on_a_well_conditioned_problem(
-    monkeypatch, covariance
-):
+@pytest.mark.parametrize("std", ["classical", "robust"])
+def test_semi_normal_route_equals_the_qr_route_on_a_well_conditioned_problem(monkeypatch, std):
     """Issue 3: CSNE (tall, cond <= 100) and pivoted QR give the same fit to 1e-10."""
     from dynid.identification import least_squares as ls
 
     W, y = _tall_problem(120)
     calls = _spy_qr(monkeypatch)
-    fast = fit_least_squares(W, y, covariance=covariance)
+    fast = fit_least_squares(W, y, std=std)
     assert calls == []  # the semi-normal route was taken
     monkeypatch.setattr(ls, "_CSNE_MAX_COND", 0.0)  # force the QR route
-    qr = fit_least_squares(W, y, covariance=covariance)
+    qr = fit_least_squares(W, y, std=std)
     assert len(calls) == 1
     assert fast.rank == qr.rank == 12 and fast.n_rows == qr.n_rows == 3000
     np.testing.assert_allclose(fast.beta, qr.beta, rtol=1e-10)
@@ -499,7 +497,7 @@ def test_ill_conditioned_or_rank_deficient_regressor_takes_the_qr_route(monkeypa
     """Above the guard the fit is the QR route's; a rank-deficient W raises as before."""
     calls = _spy_qr(monkeypatch)
     W, y = _tall_problem(121, cond=1e6)
-    fit = fit_least_squares(W, y, covariance="robust")
+    fit = fit_least_squares(W, y, std="robust")
     assert len(calls) == 1 and fit.rank == 12 and fit.scaled_condition_number > 1e5
     # a duplicated column: rank 3 of 4, the QR route's message
     rng = np.random.default_rng(122)
@@ -529,11 +527,11 @@ def test_non_finite_tall_regressor_raises_non_finite_error():
         fit_least_squares(W, y)
     W[1234, 5] = np.inf
     with pytest.raises(NonFiniteError, match=r"W must be finite; got inf"):
-        fit_least_squares(W, y, covariance="robust")
+        fit_least_squares(W, y, std="robust")
 
 
-@pytest.mark.parametrize("covariance", ["classical", "robust"])
-def test_fit_on_row_blocks_equals_the_fit_on_the_stacked_rows(covariance):
+@pytest.mark.parametrize("std", ["classical", "robust"])
+def test_fit_on_row_blocks_equals_the_fit_on_the_stacked_rows(std):
     """Row blocks (rows used, leading zero columns skipped) give the fit of those rows."""
     from dynid.identification.least_squares import _fit
 
@@ -542,13 +540,13 @@ def test_fit_on_row_blocks_equals_the_fit_on_the_stacked_rows(covariance):
     for a, b, c in blocks:
         W[a:b, :c] = 0.0  # the structure the blocks declare
     rows = np.concatenate([np.arange(a, b) for a, b, _ in blocks])
-    ref = fit_least_squares(W[rows], y[rows], covariance=covariance)
-    got = _fit(W, y, rtol=1e-10, covariance=covariance, blocks=blocks)
+    ref = fit_least_squares(W[rows], y[rows], std=std)
+    got = _fit(W, y, rtol=1e-10, std=std, blocks=blocks)
     G = W[rows].T @ W[rows]
-    with_gram = _fit(W, y, rtol=1e-10, covariance=covariance, blocks=blocks, gram=G)
+    with_gram = _fit(W, y, rtol=1e-10, std=std, blocks=blocks, gram=G)
     keep = np.arange(8) != 4
-    pruned = _fit(W, y, kept=keep, rtol=1e-10, covariance=covariance, blocks=blocks, gram=G)
-    ref_pruned = fit_least_squares(W[rows], y[rows], kept=keep, covariance=covariance)
+    pruned = _fit(W, y, kept=keep, rtol=1e-10, std=std, blocks=blocks, gram=G)
+    ref_pruned = fit_least_squares(W[rows], y[rows], kept=keep, std=std)
     for fit, want in ((got, ref), (with_gram, ref), (pruned, ref_pruned)):
         assert fit.n_rows == want.n_rows == rows.size
         np.testing.assert_allclose(fit.beta, want.beta, rtol=1e-12)

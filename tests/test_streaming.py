@@ -57,8 +57,8 @@ def test_streamed_fit_equals_the_stacked_fit(est, cov):
     """Blocks of 700 rows (groups split unevenly across them) give the stacked estimator's
     estimates, standard deviations and statistics to 1e-10 relative."""
     W, y, g = _problem(3)
-    ref = est.fit(W, y, g, rtol=1e-10, covariance=cov)
-    got = fit_streamed(_source(W, y, g, 700), est, rtol=1e-10, covariance=cov)
+    ref = est.fit(W, y, g, rtol=1e-10, std=cov)
+    got = fit_streamed(_source(W, y, g, 700), est, rtol=1e-10, std=cov)
     _same(got, ref)
 
 
@@ -66,11 +66,9 @@ def test_streamed_fit_equals_the_stacked_fit(est, cov):
 def test_streamed_pruning_equals_the_stacked_pruning(est):
     """With --max-std-percent the same coefficients are removed and the re-fit agrees."""
     W, y, g = _problem(4, weak=1e-4)  # column 2's coefficient is lost in the noise
-    ref = est.fit(W, y, g, rtol=1e-10, covariance="robust", max_std_percent=30.0)
+    ref = est.fit(W, y, g, rtol=1e-10, std="robust", max_std_percent=30.0)
     assert not np.all(ref.kept)
-    got = fit_streamed(
-        _source(W, y, g, 999), est, rtol=1e-10, covariance="robust", max_std_percent=30.0
-    )
+    got = fit_streamed(_source(W, y, g, 999), est, rtol=1e-10, std="robust", max_std_percent=30.0)
     _same(got, ref)
 
 

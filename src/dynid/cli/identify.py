@@ -61,6 +61,7 @@ import argparse
 from pathlib import Path
 
 from ..identification.estimators import ESTIMATORS
+from ..identification.least_squares import STD_METHODS
 from ..io.feasible_bundle import save_feasible_bundle
 from ..io.model_json import save_model_json
 from ..workflows.identify import identify_consistent_file, identify_file
@@ -119,7 +120,7 @@ def register(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParser:
     add_log_options(p, drop_invalid=False)
     p.add_argument(
         "--std",
-        choices=("robust", "classical"),
+        choices=STD_METHODS,
         default=None,
         help="standard deviations: heteroscedasticity-consistent or sigma^2 (W^T W)^-1 "
         "(default: robust for static data, classical for torque logs; honoured on both)",

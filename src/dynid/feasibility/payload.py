@@ -273,7 +273,7 @@ def identify_payload(
         W, yv, route = _log_rows(robot, data, cols, A, cutoff_hz, notes)
     if unloaded is not None:
         route += ", difference"
-    fit = fit_least_squares(W, yv, rtol=1e-10 if rtol is None else rtol, covariance="robust")
+    fit = fit_least_squares(W, yv, rtol=1e-10 if rtol is None else rtol, std="robust")
     p = 4 if (static and gravity_only) else 10
     est = np.asarray(fit.beta)
     cov = np.asarray(fit.covariance)[:p, :p]

@@ -48,6 +48,7 @@ from .least_squares import (
     LeastSquaresFit,
     StdMethod,
     block_grams,
+    checked_std,
     conditioning_advice,
     fit_blocks,
 )
@@ -423,7 +424,7 @@ def fit_stack(
             selected_columns(stack.source, cols),
             est,
             rtol=rtol,
-            covariance=std,
+            std=std,
             max_std_percent=max_std_percent,
             labels=kept_labels,
         )
@@ -458,7 +459,7 @@ def fit_stack(
             yu,
             gu,
             rtol=rtol,
-            covariance=std,
+            std=std,
             max_std_percent=max_std_percent,
             labels=kept_labels,
         )
@@ -578,8 +579,7 @@ def check_options(*, std: str, max_std_percent: float | None) -> None:
     """Raise :class:`OptionError` for an unknown ``std`` or a non-positive threshold."""
     if max_std_percent is not None and not max_std_percent > 0:
         raise OptionError(f"max_std_percent must be positive or None; got {max_std_percent}")
-    if std not in ("classical", "robust"):
-        raise OptionError(f"std must be 'classical' or 'robust' (--std); got {std!r}")
+    checked_std(std)
 
 
 def _what(data: Dataset) -> str:

@@ -16,7 +16,7 @@ rows of ``[tril M; g]`` of static data. An estimator turns them into a
   than ``tol`` relative (Huber 1981; Holland and Welsch 1977): outliers (spikes, dropped
   packets read as zeros) lose their pull.
 
-Standard deviations come from the last weighted fit (``covariance`` ``"classical"`` or
+Standard deviations come from the last weighted fit (``std`` ``"classical"`` or
 ``"robust"``, :func:`~dynid.identification.least_squares.fit_least_squares`); the residual
 statistics (``relative_error_percent``, ``residual_rms``) are those of the unweighted data,
 so that they compare across estimators. A new estimator is one class with the
@@ -33,7 +33,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from ..exceptions import OptionError
-from .least_squares import LeastSquaresFit, _fit_with_pruning
+from .least_squares import LeastSquaresFit, StdMethod, _fit_with_pruning
 
 __all__ = [
     "ESTIMATORS",
@@ -65,7 +65,7 @@ class Estimator(Protocol):
         groups: NDArray[np.intp],
         *,
         rtol: float,
-        covariance: str,
+        std: StdMethod,
         max_std_percent: float | None = None,
         labels: tuple[str, ...] | None = None,
     ) -> LeastSquaresFit:
@@ -79,7 +79,7 @@ def _weighted(
     w: NDArray[np.float64],
     *,
     rtol: float,
-    covariance: str,
+    std: StdMethod,
     max_std_percent: float | None,
     labels: tuple[str, ...] | None,
 ) -> LeastSquaresFit:
@@ -89,7 +89,7 @@ def _weighted(
         y * w,
         max_std_percent=max_std_percent,
         rtol=rtol,
-        covariance=covariance,
+        std=std,
         labels=labels,
     )
     e = y - W @ fit.beta
@@ -128,13 +128,13 @@ class OLS:
         groups: NDArray[np.intp],
         *,
         rtol: float,
-        covariance: str,
+        std: StdMethod,
         max_std_percent: float | None = None,
         labels: tuple[str, ...] | None = None,
     ) -> LeastSquaresFit:
         """:func:`~dynid.identification.least_squares.fit_with_pruning` as it is."""
         return _fit_with_pruning(
-            W, y, max_std_percent=max_std_percent, rtol=rtol, covariance=covariance, labels=labels
+            W, y, max_std_percent=max_std_percent, rtol=rtol, std=std, labels=labels
         )
 
 
@@ -148,7 +148,7 @@ class WLS:
         self, W: NDArray[np.float64], y: NDArray[np.float64], groups: NDArray[np.intp], rtol: float
     ) -> NDArray[np.float64]:
         """Noise std ``sigma_g`` of each group, from the residual of an OLS fit."""
-        first = _fit_with_pruning(W, y, max_std_percent=None, rtol=rtol, covariance="classical")
+        first = _fit_with_pruning(W, y, max_std_percent=None, rtol=rtol, std="classical")
         e = y - W @ first.beta
         return group_noise(e, groups, 1.0 - W.shape[1] / max(y.size, 1))
 
@@ -159,7 +159,7 @@ class WLS:
         groups: NDArray[np.intp],
         *,
         rtol: float,
-        covariance: str,
+        std: StdMethod,
         max_std_percent: float | None = None,
         labels: tuple[str, ...] | None = None,
     ) -> LeastSquaresFit:
@@ -170,7 +170,7 @@ class WLS:
             y,
             w,
             rtol=rtol,
-            covariance=covariance,
+            std=std,
             max_std_percent=max_std_percent,
             labels=labels,
         )
@@ -202,7 +202,7 @@ class IRLS:
         groups: NDArray[np.intp],
         *,
         rtol: float,
-        covariance: str,
+        std: StdMethod,
         max_std_percent: float | None = None,
         labels: tuple[str, ...] | None = None,
     ) -> LeastSquaresFit:
@@ -213,7 +213,7 @@ class IRLS:
         beta = None
         for _ in range(self.max_iter):
             fit = _weighted(
-                W, y, w, rtol=rtol, covariance="classical", max_std_percent=None, labels=labels
+                W, y, w, rtol=rtol, std="classical", max_std_percent=None, labels=labels
             )
             e = y - W @ fit.beta
             s = s0.copy()  # a group whose residual is exactly zero keeps its WLS level
@@ -235,7 +235,7 @@ class IRLS:
             y,
             w,
             rtol=rtol,
-            covariance=covariance,
+            std=std,
             max_std_percent=max_std_percent,
             labels=labels,
         )

@@ -13,9 +13,9 @@ Statistics:
 * ``relative_error_percent`` ``= 100 ||y - W beta|| / ||y||``;
 * ``sigma^2 = ||y - W beta||^2 / (m - r)`` and ``cov(beta) = sigma^2 (W^T W)^{-1}``
   (from ``R^{-1}``), ``std`` its root diagonal and ``std_percent = 100 std / |beta|``
-  (``covariance="classical"``, the paper's formula, which assumes errors of equal
+  (``std="classical"``, the paper's formula, which assumes errors of equal
   variance in every row);
-* or, with ``covariance="robust"``, the heteroscedasticity-consistent covariance (White
+* or, with ``std="robust"``, the heteroscedasticity-consistent covariance (White
   1980, HC1) ``m / (m - r) (W^T W)^{-1} W^T diag(e^2) W (W^T W)^{-1}``, valid when the
   rows' errors differ in size: the static data stack kg m^2 and N m, and a relative error
   scales with each entry.
@@ -38,7 +38,7 @@ removed and the rest re-fitted (:func:`fit_with_pruning`).
 from __future__ import annotations
 
 from dataclasses import dataclass, field
-from typing import Literal
+from typing import Literal, get_args
 
 import numpy as np
 import scipy.linalg
@@ -49,8 +49,10 @@ from ..exceptions import NonFiniteError, OptionError, RankDeficientError, ShapeE
 
 __all__ = [
     "LeastSquaresFit",
+    "STD_METHODS",
     "StdMethod",
     "block_grams",
+    "checked_std",
     "conditioning_advice",
     "fit_blocks",
     "fit_least_squares",
@@ -61,6 +63,23 @@ __all__ = [
 #: ``sigma^2 (W^T W)^{-1}`` (Gaz et al. 2019) or ``"robust"``, heteroscedasticity-consistent
 #: (White 1980, HC1).
 StdMethod = Literal["classical", "robust"]
+
+#: The values of :data:`StdMethod` (the choices of ``--std``).
+STD_METHODS: tuple[StdMethod, ...] = get_args(StdMethod)
+
+
+def checked_std(std: str) -> StdMethod:
+    """``std`` as a :data:`StdMethod`.
+
+    Raises
+    ------
+    OptionError
+        ``std`` not one of :data:`STD_METHODS`.
+    """
+    if std not in STD_METHODS:
+        choices = " or ".join(repr(s) for s in STD_METHODS)
+        raise OptionError(f"std must be {choices} (--std); got {std!r}")
+    return std
 
 
 @dataclass(frozen=True, slots=True, eq=False)
@@ -198,7 +217,7 @@ def fit_least_squares(
     *,
     kept: ArrayLike | None = None,
     rtol: float = 1e-10,
-    covariance: str = "classical",
+    std: StdMethod = "classical",
 ) -> LeastSquaresFit:
     """Least-squares estimate of ``beta`` in ``W beta = y`` with its statistics.
 
@@ -212,7 +231,7 @@ def fit_least_squares(
         Columns to use (others are fixed to 0).
     rtol : float
         Relative rank tolerance on the diagonal of R of the column-scaled ``W``.
-    covariance : {"classical", "robust"}
+    std : {"classical", "robust"}
         ``"classical"``: ``sigma^2 (W^T W)^{-1}`` (Gaz et al. 2019); ``"robust"``: the
         heteroscedasticity-consistent (HC1) estimate, for rows of unequal error variance.
 
@@ -226,14 +245,14 @@ def fit_least_squares(
         ``W`` has rank below its column count, or fewer rows than columns; the message
         gives the rank found and the rank needed.
     """
-    W, y = _validated(W, y, covariance)
-    return _fit(W, y, kept=kept, rtol=rtol, covariance=covariance)
+    W, y = _validated(W, y, std)
+    return _fit(W, y, kept=kept, rtol=rtol, std=std)
 
 
 def _validated(
-    W: ArrayLike, y: ArrayLike, covariance: str
+    W: ArrayLike, y: ArrayLike, std: StdMethod
 ) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
-    """``W`` and ``y`` as float64 arrays of matching shapes; ``covariance`` checked.
+    """``W`` and ``y`` as float64 arrays of matching shapes; ``std`` checked.
 
     The finiteness of ``W`` is checked by :func:`_fit` (on its Gram matrix on the
     semi-normal path: a non-finite ``W`` gives a non-finite Gram matrix).
@@ -242,8 +261,7 @@ def _validated(
     y = _checks.as_array("y", y)
     if W.ndim != 2 or y.shape != (W.shape[0],):
         raise ShapeError(f"W must be (m, r) and y (m,); got {W.shape} and {y.shape}")
-    if covariance not in ("classical", "robust"):
-        raise OptionError(f"covariance must be 'classical' or 'robust'; got {covariance!r}")
+    checked_std(std)
     return W, y
 
 
@@ -253,7 +271,7 @@ def _fit(
     *,
     kept: ArrayLike | None = None,
     rtol: float,
-    covariance: str,
+    std: StdMethod,
     blocks: ArrayLike | None = None,
     gram: NDArray[np.float64] | None = None,
     labels: tuple[str, ...] | None = None,
@@ -295,12 +313,12 @@ def _fit(
     # entries near the float range (1e300) overflow in the products: checked below, once
     with np.errstate(over="ignore", invalid="ignore", divide="ignore"):
         if m > 4 * (rk + 1) and rk > 0:
-            solved = _solve_semi_normal(Wk, blk, yu, G, rtol, covariance)
+            solved = _solve_semi_normal(Wk, blk, yu, G, rtol, std)
         if solved is None:
             Wu = Wk if used is None else Wk[used]
             _checks.finite("W", W if used is None else Wu)
             try:
-                solved = _solve_qr(Wu, yu, rtol, covariance)
+                solved = _solve_qr(Wu, yu, rtol, std)
             except _RankDeficient as exc:
                 names = _column_names(labels, exc.null, keep)
                 raise RankDeficientError(
@@ -323,9 +341,9 @@ def _fit(
     cov_k = 0.5 * (cov_k + cov_k.T)
     sk = np.sqrt(np.maximum(np.diag(cov_k), 0.0))
     beta = np.zeros(r)
-    std = np.zeros(r)
+    sd = np.zeros(r)
     cov = np.zeros((r, r))
-    beta[keep], std[keep] = bk, sk
+    beta[keep], sd[keep] = bk, sk
     cov[np.ix_(keep, keep)] = cov_k
     ny = float(np.linalg.norm(yu))
     effect = np.zeros(r)
@@ -333,11 +351,11 @@ def _fit(
     weakest = np.zeros(r)
     weakest[keep] = vmin
     with np.errstate(divide="ignore", invalid="ignore"):
-        pct = np.where(keep, 100.0 * std / np.abs(beta), np.nan)
-    pct = np.where(keep & (std == 0.0), 0.0, pct)
+        pct = np.where(keep, 100.0 * sd / np.abs(beta), np.nan)
+    pct = np.where(keep & (sd == 0.0), 0.0, pct)
     return LeastSquaresFit(
         beta=_checks.frozen(beta),
-        std=_checks.frozen(std),
+        std=_checks.frozen(sd),
         std_percent=_checks.frozen(pct),
         kept=_checks.frozen(keep),
         rank=rank,
@@ -486,7 +504,7 @@ def _solve_semi_normal(
     y: NDArray[np.float64],
     G: NDArray[np.float64] | None,
     rtol: float,
-    covariance: str,
+    std: StdMethod,
 ) -> _Solved | None:
     """Corrected semi-normal equations, or None when the QR path must decide.
 
@@ -519,11 +537,11 @@ def _solve_semi_normal(
     e, g = _residual(Wk, blk, y, z / scale, "rmatvec")  # g = W^T e
     z += scipy.linalg.cho_solve((R, False), g / scale, check_finite=False)
     bk = z / scale
-    e, meat = _residual(Wk, blk, y, bk, "meat" if covariance == "robust" else "rmatvec")
+    e, meat = _residual(Wk, blk, y, bk, "meat" if std == "robust" else "rmatvec")
     dof = max(m - rk, 1)
     Rinv = scipy.linalg.solve_triangular(R, np.eye(rk), check_finite=False)
     Gi = Rinv @ Rinv.T
-    if covariance == "classical":
+    if std == "classical":
         cov_s = Gi * (float(e @ e) / dof)
     else:  # HC1: (R^T R)^{-1} D^{-1} W^T diag(e^2) W D^{-1} (R^T R)^{-1}
         meat = meat / scale[:, None] / scale[None, :]
@@ -532,7 +550,7 @@ def _solve_semi_normal(
 
 
 def _solve_qr(
-    Wk: NDArray[np.float64], y: NDArray[np.float64], rtol: float, covariance: str
+    Wk: NDArray[np.float64], y: NDArray[np.float64], rtol: float, std: StdMethod
 ) -> _Solved:
     """Column-scaled Householder QR with column pivoting (two stages when ``W`` is tall).
 
@@ -594,7 +612,7 @@ def _solve_qr(
     sigma = np.sqrt(ss / dof)
     Rinv = scipy.linalg.solve_triangular(R, np.eye(rk))
     G = Rinv @ Rinv.T
-    if covariance == "classical":
+    if std == "classical":
         cov_p = G * sigma**2
     else:  # HC1: (R^T R)^{-1} Ws^T diag(e^2) Ws (R^T R)^{-1}, in pivoted order
         We = Wk * e[:, None]
@@ -611,18 +629,18 @@ def fit_with_pruning(
     *,
     max_std_percent: float | None = None,
     rtol: float = 1e-10,
-    covariance: str = "classical",
+    std: StdMethod = "classical",
     labels: tuple[str, ...] | None = None,
 ) -> LeastSquaresFit:
     """Fit, then (optionally) remove coefficients with ``std_percent > max_std_percent`` and re-fit.
 
     Gaz et al. 2019 discard coefficients whose relative standard deviation exceeds 30 %.
-    One removal pass, as in the paper. ``covariance`` as in :func:`fit_least_squares`;
+    One removal pass, as in the paper. ``std`` as in :func:`fit_least_squares`;
     ``labels`` (r,) name the columns in a rank-deficiency error.
     """
-    W, y = _validated(W, y, covariance)
+    W, y = _validated(W, y, std)
     return _fit_with_pruning(
-        W, y, max_std_percent=max_std_percent, rtol=rtol, covariance=covariance, labels=labels
+        W, y, max_std_percent=max_std_percent, rtol=rtol, std=std, labels=labels
     )
 
 
@@ -656,7 +674,7 @@ def fit_blocks(
         y,
         max_std_percent=max_std_percent,
         rtol=rtol,
-        covariance=std,
+        std=std,
         blocks=rows,
         gram=gram,
         labels=labels,
@@ -669,14 +687,14 @@ def _fit_with_pruning(
     *,
     max_std_percent: float | None,
     rtol: float,
-    covariance: str,
+    std: StdMethod,
     blocks: ArrayLike | None = None,
     gram: NDArray[np.float64] | None = None,
     labels: tuple[str, ...] | None = None,
 ) -> LeastSquaresFit:
     """:func:`fit_with_pruning` on validated input; ``blocks``, ``gram``, ``labels`` as in
     :func:`_fit`."""
-    fit = _fit(W, y, rtol=rtol, covariance=covariance, blocks=blocks, gram=gram, labels=labels)
+    fit = _fit(W, y, rtol=rtol, std=std, blocks=blocks, gram=gram, labels=labels)
     if max_std_percent is None:
         return fit
     keep = ~(fit.std_percent > max_std_percent)
@@ -687,7 +705,7 @@ def _fit_with_pruning(
         y,
         kept=keep,
         rtol=rtol,
-        covariance=covariance,
+        std=std,
         blocks=blocks,
         gram=gram,
         labels=labels,

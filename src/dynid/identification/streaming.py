@@ -48,7 +48,7 @@ from .. import _checks
 from ..exceptions import DataError, NonFiniteError, OptionError, RankDeficientError, ShapeError
 from .estimators import IRLS, OLS, WLS, Estimator
 from .holdout import Normals
-from .least_squares import LeastSquaresFit, _conditioning
+from .least_squares import LeastSquaresFit, StdMethod, _conditioning, checked_std
 
 __all__ = [
     "BLOCK_ROWS",
@@ -316,7 +316,7 @@ def _fit_factor(
     *,
     keep: NDArray[np.bool_],
     rtol: float,
-    covariance: str,
+    std: StdMethod,
     labels: tuple[str, ...] | None,
     meat: Callable[[NDArray[np.float64], NDArray[np.bool_]], NDArray[np.float64]],
 ) -> LeastSquaresFit:
@@ -326,7 +326,7 @@ def _fit_factor(
     s = _solve(Raug, m, keep, rtol, labels)
     rk = s.beta.size
     dof = max(m - rk, 1)
-    if covariance == "classical":
+    if std == "classical":
         cov_s = s.gi * (s.ss / dof)
     else:
         mt = meat(s.beta, keep) / np.outer(s.scale, s.scale)
@@ -339,8 +339,8 @@ def _fit_factor(
     cov_k = cov_s / np.outer(s.scale, s.scale)
     cov_k = 0.5 * (cov_k + cov_k.T)
     sk = np.sqrt(np.maximum(np.diag(cov_k), 0.0))
-    beta, std, cov = np.zeros(c), np.zeros(c), np.zeros((c, c))
-    beta[keep], std[keep] = s.beta, sk
+    beta, sd, cov = np.zeros(c), np.zeros(c), np.zeros((c, c))
+    beta[keep], sd[keep] = s.beta, sk
     cov[np.ix_(keep, keep)] = cov_k
     ny = float(np.linalg.norm(Raug[:, c]))
     effect = np.zeros(c)
@@ -348,11 +348,11 @@ def _fit_factor(
     weakest = np.zeros(c)
     weakest[keep] = s.vmin
     with np.errstate(divide="ignore", invalid="ignore"):
-        pct = np.where(keep, 100.0 * std / np.abs(beta), np.nan)
-    pct = np.where(keep & (std == 0.0), 0.0, pct)
+        pct = np.where(keep, 100.0 * sd / np.abs(beta), np.nan)
+    pct = np.where(keep & (sd == 0.0), 0.0, pct)
     return LeastSquaresFit(
         beta=_checks.frozen(beta),
-        std=_checks.frozen(std),
+        std=_checks.frozen(sd),
         std_percent=_checks.frozen(pct),
         kept=_checks.frozen(keep.copy()),
         rank=s.rank,
@@ -374,14 +374,14 @@ def _fit_pruned(
     m: int,
     *,
     rtol: float,
-    covariance: str,
+    std: StdMethod,
     max_std_percent: float | None,
     labels: tuple[str, ...] | None,
     meat: Callable[[NDArray[np.float64], NDArray[np.bool_]], NDArray[np.float64]],
 ) -> LeastSquaresFit:
     """Fit, then (``max_std_percent``) remove the coefficients above it and re-fit once."""
     keep = np.ones(Raug.shape[1] - 1, dtype=bool)
-    kw = {"rtol": rtol, "covariance": covariance, "labels": labels, "meat": meat}
+    kw = {"rtol": rtol, "std": std, "labels": labels, "meat": meat}
     fit = _fit_factor(Raug, m, keep=keep, **kw)  # type: ignore[arg-type]
     if max_std_percent is None:
         return fit
@@ -419,7 +419,7 @@ def fit_streamed(
     estimator: Estimator,
     *,
     rtol: float,
-    covariance: str = "classical",
+    std: StdMethod = "classical",
     max_std_percent: float | None = None,
     labels: tuple[str, ...] | None = None,
 ) -> LeastSquaresFit:
@@ -435,7 +435,7 @@ def fit_streamed(
     estimator : OLS, WLS or IRLS
     rtol : float
         Relative rank tolerance on the diagonal of R of the column-scaled regressor.
-    covariance : {"classical", "robust"}
+    std : {"classical", "robust"}
     max_std_percent : float, optional
         Remove the coefficients above this relative standard deviation and re-fit once.
     labels : tuple of str, length c, optional
@@ -445,7 +445,7 @@ def fit_streamed(
     ------
     OptionError
         An estimator other than OLS, WLS, IRLS (they need the stacked rows), or an unknown
-        ``covariance``.
+        ``std``.
     ShapeError
         Inconsistent blocks.
     NonFiniteError
@@ -453,8 +453,7 @@ def fit_streamed(
     RankDeficientError
         Rank below the column count.
     """
-    if covariance not in ("classical", "robust"):
-        raise OptionError(f"covariance must be 'classical' or 'robust'; got {covariance!r}")
+    checked_std(std)
     if not isinstance(estimator, OLS | WLS | IRLS):
         raise OptionError(
             f"estimator {estimator.name!r} needs the whole regressor, which is too large here "
@@ -467,7 +466,7 @@ def fit_streamed(
         return _fit_pruned(
             F.combined(),
             m,
-            covariance=covariance,
+            std=std,
             meat=lambda b, k: _meat(source, b, k, None),
             **kw,  # type: ignore[arg-type]
         )
@@ -477,12 +476,12 @@ def fit_streamed(
         fit = _fit_pruned(
             F.combined(wg),
             m,
-            covariance=covariance,
+            std=std,
             meat=lambda b, k: _meat(source, b, k, lambda o, g: wg[g]),
             **kw,  # type: ignore[arg-type]
         )
         return _unweighted(fit, F)
-    return _irls(source, estimator, F, s0, covariance=covariance, **kw)  # type: ignore[arg-type]
+    return _irls(source, estimator, F, s0, std=std, **kw)  # type: ignore[arg-type]
 
 
 def _irls(
@@ -492,7 +491,7 @@ def _irls(
     s0: NDArray[np.float64],
     *,
     rtol: float,
-    covariance: str,
+    std: StdMethod,
     max_std_percent: float | None,
     labels: tuple[str, ...] | None,
 ) -> LeastSquaresFit:
@@ -532,7 +531,7 @@ def _irls(
         _weighted_factor(source, w, c),
         m,
         rtol=rtol,
-        covariance=covariance,
+        std=std,
         max_std_percent=max_std_percent,
         labels=labels,
         meat=lambda b, k: _meat(source, b, k, lambda o, g: w[o : o + g.size]),
