@@ -347,3 +347,44 @@ def test_run_output_stages_and_names_the_staged_location(tmp_path):
         write_text(out / "b.txt", "b")
         raise RuntimeError("fails")
     assert sorted(q.name for q in tmp_path.rglob("*")) == [MANIFEST, "a.txt", "o", "sub"]
+
+
+def test_the_record_is_strict_json_and_outlives_a_signal_after_the_move(tmp_path):
+    """.dynid-run.json is written by the one JSON writer (``schema`` first, strict), and a
+    termination that arrives after the set moved (held back during the move) no longer
+    removes it: the set stays recorded, so a rerun does not call its files foreign."""
+    from dynid.io.atomic import output_transaction, write_text
+    from dynid.io.json_files import load_json
+    from dynid.io.run_output import run_output
+
+    out = tmp_path / "o"
+    out.mkdir()
+    with contextlib.suppress(RuntimeError), output_transaction():
+        with run_output(out, command="test"):
+            write_text(out / "a.txt", "a")
+        raise RuntimeError("SIGTERM delivered once the move is done")
+    text = (out / MANIFEST).read_text()
+    assert text.startswith('{\n "schema": "dynid-run/1"')
+    assert load_json(out / MANIFEST)["files"] == ["a.txt"]
+    with run_output(out, command="test"):
+        write_text(out / "a.txt", "b")
+    assert (out / "a.txt").read_text() == "b"
+
+
+def test_a_record_with_a_duplicated_key_is_not_trusted(tmp_path):
+    """A .dynid-run.json that is not strict JSON (a duplicated ``files`` key) records no
+    set: the file it names is the user's and is not replaced without force."""
+    from dynid.exceptions import OutputError
+    from dynid.io.atomic import write_text
+    from dynid.io.run_output import run_output
+
+    out = tmp_path / "o"
+    out.mkdir()
+    (out / "a.txt").write_text("mine")
+    (out / MANIFEST).write_text(
+        '{"schema": "dynid-run/1", "command": "test", "files": [], "files": ["a.txt"]}'
+    )
+    with pytest.raises(OutputError, match="a.txt exists and no dynid run recorded it"):
+        with run_output(out, command="test"):
+            write_text(out / "a.txt", "b")
+    assert (out / "a.txt").read_text() == "mine"

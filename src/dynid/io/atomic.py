@@ -42,7 +42,8 @@ __all__ = [
 #: Stack of active transactions; each records (created files, created folders).
 _TRANSACTIONS: list[tuple[list[Path], list[Path]]] = []
 #: Active run outputs (:class:`dynid.io.run_output.RunOutput`): each has ``stage(path)``
-#: (the staged path of a file under its ``--out``, or None) and ``location(path)``.
+#: (the staged path of a file under its ``--out``, or None), ``location(path)`` and
+#: ``manages(path)`` (its own record, which it puts back or removes itself).
 _REDIRECTS: list[Any] = []
 
 
@@ -100,7 +101,9 @@ def atomic_path(path: str | Path) -> Iterator[Path]:
         path.parent.mkdir(parents=True, exist_ok=True)
     else:
         _make_parents(path.parent)
-    existed = path.exists() or staged is not None
+    # staged files and a run output's own record are that run's to keep or drop, not the
+    # transaction's (a signal held back during the move must not remove the record)
+    existed = path.exists() or staged is not None or any(r.manages(path) for r in _REDIRECTS)
     fd, name = tempfile.mkstemp(
         dir=path.parent, prefix=f".{path.name}.", suffix=f".tmp{path.suffix}"
     )

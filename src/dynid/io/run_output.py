@@ -36,7 +36,6 @@ Without ``fcntl`` (not POSIX) runs are not locked against each other; the rest h
 from __future__ import annotations
 
 import contextlib
-import json
 import os
 import shutil
 import signal
@@ -45,8 +44,9 @@ import time
 from collections.abc import Iterator, Sequence
 from pathlib import Path
 
-from ..exceptions import OutputError
+from ..exceptions import DataError, OutputError
 from . import atomic
+from .json_files import load_json, save_json
 
 try:
     import fcntl
@@ -114,10 +114,8 @@ def _is_temporary(name: str, targets: set[str]) -> bool:
 def _read_manifest(folder: Path) -> dict | None:
     """The output record of ``folder``, or None (absent or unreadable: no recorded set)."""
     try:
-        doc = json.loads((folder / MANIFEST).read_text(encoding="utf-8"))
-    except (OSError, ValueError, RecursionError):
-        return None
-    if not isinstance(doc, dict) or doc.get("schema") != _SCHEMA:
+        doc = load_json(folder / MANIFEST, schema=_SCHEMA, what="dynid run record")
+    except (OSError, DataError):
         return None
     files = doc.get("files")
     if not isinstance(files, list) or not all(isinstance(f, str) for f in files):
@@ -126,19 +124,8 @@ def _read_manifest(folder: Path) -> dict | None:
 
 
 def _write_manifest(folder: Path, doc: dict) -> None:
-    """Write the record directly into ``folder`` (not staged), atomically."""
-    fd, name = tempfile.mkstemp(dir=folder, prefix=f".{MANIFEST}.", suffix=".tmp.json")
-    try:
-        with os.fdopen(fd, "w", encoding="utf-8", newline="\n") as fh:
-            fh.write(json.dumps(doc, indent=2) + "\n")
-            fh.flush()
-            os.fsync(fh.fileno())
-        os.chmod(name, atomic._mode())
-        os.replace(name, folder / MANIFEST)
-    except BaseException:
-        with contextlib.suppress(OSError):
-            os.unlink(name)
-        raise
+    """Write the record directly into ``folder`` (not staged), atomically, as strict JSON."""
+    save_json(folder / MANIFEST, doc, schema=_SCHEMA)
 
 
 def _writable(path: Path) -> bool:
@@ -262,6 +249,12 @@ class RunOutput:
         self._written[rel] = staged
         return staged
 
+    def manages(self, path: str | Path) -> bool:
+        """True for this run's record of its set (``.dynid-run.json`` in ``--out`` or in
+        the staging folder), which the run itself writes, puts back or removes."""
+        p = Path(os.path.abspath(path))
+        return p.name == MANIFEST and p.parent in (self.out, self.staging)
+
     def written(self) -> dict[str, Path]:
         """The files written so far: name relative to ``--out`` -> where it is now."""
         return {k: v for k, v in self._written.items() if v.exists()}
@@ -342,7 +335,6 @@ class RunOutput:
         from .. import __version__
 
         return {
-            "schema": _SCHEMA,
             "command": self.command,
             "state": state,
             "files": files,
