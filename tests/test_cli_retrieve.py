@@ -18,7 +18,8 @@ from dynid.friction.model import SigmoidFriction
 from dynid.identification.data import StaticDataset
 from dynid.identification.log import TorqueLog
 from dynid.identification.model import IdentifiedModel
-from dynid.io.feasible import load_feasible_json, save_bounds
+from dynid.io.bounds_file import save_bounds
+from dynid.io.feasible import load_feasible_json
 from dynid.io.friction_json import save_friction_json
 from dynid.io.model_json import save_model_json
 from dynid.io.static_data import save_static_data

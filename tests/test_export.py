@@ -17,17 +17,10 @@ from dynid.feasibility.bounds import default_bounds, panda_bounds
 from dynid.feasibility.retrieve import RetrievalOptions, retrieve_from_coefficients
 from dynid.identification.least_squares import LeastSquaresFit
 from dynid.identification.model import IdentifiedModel
+from dynid.io.bounds_file import bounds_from_dict, load_bounds, save_bounds
 from dynid.io.export import save_robot
-from dynid.io.feasible import (
-    bounds_from_dict,
-    feasible_to_dict,
-    load_bounds,
-    load_feasible_json,
-    report_to_dict,
-    save_bounds,
-    save_feasible_json,
-    save_report_json,
-)
+from dynid.io.feasible import feasible_to_dict, load_feasible_json, save_feasible_json
+from dynid.io.report_json import report_to_dict, save_report_json
 from dynid.io.robot.urdf import save_urdf, urdf_from_robot
 from dynid.regressors.base import base_parameters
 

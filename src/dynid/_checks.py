@@ -141,6 +141,17 @@ def number(value: Any, where: str, error: type[Exception]) -> float:
     return x
 
 
+def numbers(value: Any, size: int, where: str, error: type[Exception]) -> NDArray[np.float64]:
+    """A list of ``size`` finite floats from a parsed document, strictly (see :func:`number`).
+
+    Raises ``error`` naming ``where`` when ``value`` is not a list or tuple of that length, or
+    names ``where[k]`` for an element that is not a finite number.
+    """
+    if not isinstance(value, list | tuple) or len(value) != size:
+        raise error(f"{where} must be a list of {size} numbers; got {short(value)}")
+    return np.array([number(x, f"{where}[{k}]", error) for k, x in enumerate(value)])
+
+
 def parse_toml(text: str, where: str, error: type[Exception]) -> dict[str, Any]:
     """``tomllib.loads(text)``, every parse failure one ``error`` naming ``where``: invalid
     TOML, nesting too deep for the parser, integers of more than 4300 digits."""

@@ -13,11 +13,12 @@ import numpy as np
 
 from .. import __version__
 from ..io.atomic import write_text
-from ..io.feasible import save_feasible_json, save_report_json
+from ..io.feasible import save_feasible_json
 from ..io.feasible_bundle import save_feasible_bundle
 from ..io.friction_json import save_friction_json
 from ..io.json_files import save_json
 from ..io.model_json import save_model_json
+from ..io.report_json import save_report_json
 from ..io.static_data import save_static_data
 from ..io.validation_json import save_validation_json
 from ..model.robot import Robot

@@ -16,7 +16,8 @@ from ..feasibility.retrieve import RetrievalResult
 from ..feasibility.sdp import ConsistentResult
 from ..friction.model import ClassicalFriction, DriveFriction
 from .export import ROBOT_FORMATS, ExportOptions, save_robot_files
-from .feasible import save_feasible_json, save_report_json
+from .feasible import save_feasible_json
+from .report_json import save_report_json
 
 __all__ = ["FEASIBLE_BUNDLE", "save_feasible_bundle"]
 

@@ -26,7 +26,7 @@ from ..feasibility.retrieve import (
 from ..feasibility.sdp import ConsistentResult, SDPOptions, retrieve_sdp
 from ..friction.model import SigmoidFriction
 from ..identification.model import IdentifiedModel
-from ..io.feasible import load_bounds
+from ..io.bounds_file import load_bounds
 from ..io.friction_json import load_friction_json
 from ..io.model_json import load_model_json
 from ..model.robot import Robot
