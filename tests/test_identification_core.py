@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import dataclasses
 import json
 from collections.abc import Iterator
 from pathlib import Path
@@ -11,7 +12,7 @@ import numpy as np
 import pytest
 
 import dynid
-from dynid.exceptions import RankDeficientError
+from dynid.exceptions import RankDeficientError, WrongTypeError
 from dynid.identification.core import (
     ModelColumns,
     RegressorBlock,
@@ -20,6 +21,7 @@ from dynid.identification.core import (
     stack_dataset,
 )
 from dynid.identification.data import StaticDataset
+from dynid.identification.estimators import row_weights, weighted_fit
 from dynid.identification.info import IdentificationInfo
 from dynid.io.model_json import info_from_dict, load_model_json, model_to_dict
 from dynid.regressors.base import base_parameters
@@ -135,3 +137,77 @@ def test_identification_files_of_the_previous_version_load_with_their_record(nam
         k: v for k, v in meta.items() if k not in derived
     }
     assert info_from_dict(again) == info
+
+
+@dataclasses.dataclass(frozen=True)
+class _Huber:
+    """A user's estimator: Huber's M-estimator with a fixed threshold ``k`` [N m], fitted by
+    reweighting (the protocol of dynid.identification.estimators, defined outside it)."""
+
+    k: float
+    name: str = "huber"
+
+    def row_weights(self, e: np.ndarray, groups: np.ndarray, n_columns: int) -> np.ndarray:
+        return np.sqrt(np.minimum(1.0, self.k / np.maximum(np.abs(e), 1e-300)))
+
+    def fit(self, W, y, groups, *, rtol, std, max_std_percent=None, labels=None):
+        w = np.ones(y.size)
+        beta = np.zeros(W.shape[1])
+        for _ in range(500):
+            fit = weighted_fit(W, y, w, rtol=rtol, std=std, labels=labels)
+            done = np.linalg.norm(fit.beta - beta) <= 1e-14 * np.linalg.norm(fit.beta)
+            beta = np.asarray(fit.beta)
+            if done:
+                break
+            w = self.row_weights(y - W @ beta, groups, W.shape[1])
+        return weighted_fit(
+            W, y, w, rtol=rtol, std=std, max_std_percent=max_std_percent, labels=labels
+        )
+
+
+@pytest.mark.filterwarnings("ignore:.*indistinguishable from zero")  # OLS: a zero coefficient
+def test_a_users_estimator_with_the_protocol_is_taken_by_identify():
+    """A Huber estimator written outside dynid, on torques with noise and one gross outlier:
+    identify returns scipy's least_squares(loss="huber") minimiser to 1e-9, which the
+    outlier moves OLS away from by far more."""
+    from scipy.optimize import least_squares
+
+    robot = planar_2r()
+    data = _TorqueRows(robot, 40, seed=4)
+    rng = np.random.default_rng(5)
+    data.tau = data.tau + 0.01 * rng.normal(size=data.tau.shape)
+    data.tau[7, 1] += 3.0  # one gross outlier [N m]
+    est = _Huber(k=0.02)
+    model = identify(robot, data, estimator=est)
+    ols = identify(robot, data)
+    assert model.info.estimator == "huber"
+
+    base = base_parameters(robot, kind="torque")
+    Yb = base.reduce(torque_regressor(robot, data.q, data.dq, data.ddq))
+    W = np.concatenate([Yb[:, j, :] for j in range(robot.n)])  # the data set's block order
+    y = np.concatenate([data.tau[:, j] for j in range(robot.n)])
+    x0 = np.linalg.lstsq(W, y, rcond=None)[0]
+    ref = least_squares(
+        lambda b: W @ b - y, x0, loss="huber", f_scale=est.k, xtol=1e-15, ftol=1e-15, gtol=1e-15
+    ).x
+    scale = np.linalg.norm(ref)
+    assert np.linalg.norm(model.beta - ref) < 1e-9 * scale
+    assert np.linalg.norm(ols.beta - ref) > 1e3 * np.linalg.norm(model.beta - ref)
+    truth = base.beta_from_phi(robot.phi)
+    assert np.linalg.norm(model.beta - truth) < 0.2 * np.linalg.norm(ols.beta - truth)
+    # held-out data are judged with the estimator's own row weights
+    w = row_weights(est, W, y, np.zeros(y.size, dtype=np.intp), np.asarray(model.beta))
+    assert w[40 + 7] < 0.1 and np.median(w) == 1.0
+
+
+def test_an_object_without_the_estimator_protocol_is_refused():
+    """An estimator object lacking row_weights is a WrongTypeError naming the protocol."""
+
+    class _NoWeights:
+        name = "half"
+
+        def fit(self, W, y, groups, **kw):
+            raise AssertionError("never called")
+
+    with pytest.raises(WrongTypeError, match="the Estimator protocol"):
+        identify(planar_2r(), _TorqueRows(planar_2r(), 10, seed=6), estimator=_NoWeights())

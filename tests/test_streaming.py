@@ -92,8 +92,9 @@ def test_ordinary_and_weighted_estimates_equal_lstsq():
     assert F.n_rows == y.size and list(F.rows) == [np.sum(g == j) for j in range(4)]
 
 
-def test_rank_deficiency_and_bad_blocks_are_named():
-    """A dependent column is named; NaN, ragged blocks and another estimator are refused."""
+def test_rank_deficiency_and_bad_blocks_are_named(monkeypatch):
+    """A dependent column is named; NaN, ragged blocks and another estimator beyond the
+    stack limit are refused."""
     rng = np.random.default_rng(6)
     W = rng.normal(size=(400, 3))
     W[:, 2] = 2 * W[:, 0]
@@ -110,8 +111,35 @@ def test_rank_deficiency_and_bad_blocks_are_named():
     class Other:
         name = "other"
 
-    with pytest.raises(OptionError, match="DYNID_MAX_STACK_BYTES"):
-        fit_streamed(_source(W, y, g, 100), Other(), rtol=1e-10)  # type: ignore[arg-type]
+    monkeypatch.setenv("DYNID_MAX_STACK_BYTES", str(8 * 150 * 4))  # 150 rows of 3 columns
+    with pytest.raises(OptionError, match="'other' needs the whole regressor.*STACK_BYTES"):
+        fit_streamed(_source(W[6:], y[6:], g[6:], 100), Other(), rtol=1e-10)  # type: ignore[arg-type]
+
+
+def test_another_estimator_gets_the_blocks_stacked_within_the_limit():
+    """An estimator other than OLS, WLS, IRLS is handed the rows of every block, in order,
+    with their groups, and its fit is returned as it is."""
+    rng = np.random.default_rng(8)
+    W, y = rng.normal(size=(250, 3)), rng.normal(size=250)
+    g = np.arange(250, dtype=np.intp) % 2
+    seen = {}
+
+    class Recorder:
+        name = "recorder"
+
+        def fit(self, W, y, groups, **kw):
+            seen.update(W=W, y=y, groups=groups, kw=kw)
+            return OLS().fit(W, y, groups, **kw)
+
+        def row_weights(self, e, groups, n_columns):
+            return np.ones(e.size)
+
+    fit = fit_streamed(_source(W, y, g, 100), Recorder(), rtol=1e-10, std="robust")
+    np.testing.assert_array_equal(seen["W"], W)
+    np.testing.assert_array_equal(seen["y"], y)
+    np.testing.assert_array_equal(seen["groups"], g)
+    assert seen["kw"]["std"] == "robust"
+    np.testing.assert_allclose(fit.beta, np.linalg.lstsq(W, y, rcond=None)[0], rtol=1e-12)
 
 
 def test_stack_limit_from_the_environment(monkeypatch):

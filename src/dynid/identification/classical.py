@@ -63,7 +63,6 @@ from .estimators import (
     Estimator,
     EstimatorName,
     estimator_named,
-    residual_weights,
     row_weights,
 )
 from .holdout import DEFAULT_FOLDS, HeldOut, block_labels, block_normals
@@ -265,7 +264,7 @@ def _judge(
         """The judgement of rows left in blocks (a long log), from their normal equations."""
         e = np.concatenate([y - W @ b for W, y, _ in source()])
         N = e.size // n
-        rw = residual_weights(est, e, np.tile(np.arange(n, dtype=np.intp), N), b.size)
+        rw = est.row_weights(e, np.tile(np.arange(n, dtype=np.intp), N), b.size)
         del e
         if validate_on is None:
             try:

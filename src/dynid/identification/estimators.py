@@ -19,21 +19,29 @@ rows of ``[tril M; g]`` of static data. An estimator turns them into a
 Standard deviations come from the last weighted fit (``std`` ``"classical"`` or
 ``"robust"``, :func:`~dynid.identification.least_squares.fit_least_squares`); the residual
 statistics (``relative_error_percent``, ``residual_rms``) are those of the unweighted data,
-so that they compare across estimators. A new estimator is one class with the
-:class:`Estimator` protocol and its entry in :data:`ESTIMATORS`.
+so that they compare across estimators.
+
+**A new estimator** is one class with the :class:`Estimator` protocol (``name``, ``fit``
+and ``row_weights``, the weight of every row at a residual, with which held-out data are
+judged in the estimator's own terms) and its entry in :data:`ESTIMATORS`;
+:func:`weighted_fit` is the weighted least-squares step it can build on. Every route, the
+held-out judgement and the one-step consistent fit take it from there; a log too long to
+stack (``DYNID_MAX_STACK_BYTES``) is fitted block by block by OLS, WLS and IRLS only.
 """
 
 from __future__ import annotations
 
 import dataclasses
+from collections.abc import Callable
 from dataclasses import dataclass
-from typing import Literal, Protocol
+from typing import Literal, Protocol, runtime_checkable
 
 import numpy as np
-from numpy.typing import NDArray
+from numpy.typing import ArrayLike, NDArray
 
-from ..exceptions import OptionError
-from .least_squares import LeastSquaresFit, StdMethod, _fit_with_pruning
+from .. import _checks
+from ..exceptions import OptionError, ShapeError, WrongTypeError
+from .least_squares import LeastSquaresFit, StdMethod, _fit_with_pruning, checked_std
 
 __all__ = [
     "ESTIMATORS",
@@ -43,13 +51,16 @@ __all__ = [
     "Estimator",
     "EstimatorName",
     "estimator_named",
-    "residual_weights",
+    "group_noise",
+    "huber_weights",
     "row_weights",
+    "weighted_fit",
 ]
 
 EstimatorName = Literal["ols", "wls", "irls"]
 
 
+@runtime_checkable
 class Estimator(Protocol):
     """What a route needs of an estimator (module docstring)."""
 
@@ -72,6 +83,57 @@ class Estimator(Protocol):
         """Fit ``W beta = y``; ``groups`` (m,) the noise group of each row."""
         ...
 
+    def row_weights(
+        self, e: NDArray[np.float64], groups: NDArray[np.intp], n_columns: int
+    ) -> NDArray[np.float64]:
+        """The weight (m,) of every row at the residual ``e`` (m,) of a fit of ``n_columns``
+        coefficients, as the estimator weighs it (held-out data are judged with these)."""
+        ...
+
+
+def weighted_fit(
+    W: ArrayLike,
+    y: ArrayLike,
+    w: ArrayLike,
+    *,
+    rtol: float = 1e-10,
+    std: StdMethod = "classical",
+    max_std_percent: float | None = None,
+    labels: tuple[str, ...] | None = None,
+) -> LeastSquaresFit:
+    """The least-squares fit of ``diag(w) W beta = diag(w) y``, with the residual statistics
+    (``relative_error_percent``, ``residual_rms``) of the unweighted rows: the step a
+    reweighting estimator builds on.
+
+    Parameters
+    ----------
+    W : array_like, shape (m, r)
+    y : array_like, shape (m,)
+    w : array_like, shape (m,)
+        Row weights (the square roots of the weights of the squared residuals), in 1 / the
+        unit of ``y``.
+    rtol, std, max_std_percent, labels
+        As :func:`~dynid.identification.least_squares.fit_with_pruning`.
+
+    Raises
+    ------
+    ShapeError
+        ``W`` not (m, r), or ``y`` or ``w`` not (m,).
+    NonFiniteError
+        NaN or inf in ``W``, ``y`` or ``w``.
+    OptionError
+        ``std`` not ``"classical"``/``"robust"``.
+    RankDeficientError
+        The weighted regressor has rank below its column count.
+    """
+    W = _checks.as_array("W", W)
+    y, w = _checks.as_array("y", y), _checks.as_array("w", w)
+    if W.ndim != 2 or y.shape != (W.shape[0],) or w.shape != y.shape:
+        raise ShapeError(f"W must be (m, r), y and w (m,); got {W.shape}, {y.shape} and {w.shape}")
+    return _weighted(
+        W, y, w, rtol=rtol, std=checked_std(std), max_std_percent=max_std_percent, labels=labels
+    )
+
 
 def _weighted(
     W: NDArray[np.float64],
@@ -83,7 +145,7 @@ def _weighted(
     max_std_percent: float | None,
     labels: tuple[str, ...] | None,
 ) -> LeastSquaresFit:
-    """The fit of ``diag(w) W beta = diag(w) y`` with the unweighted residual statistics."""
+    """:func:`weighted_fit` on validated input."""
     fit = _fit_with_pruning(
         W * w[:, None],
         y * w,
@@ -115,6 +177,22 @@ def group_noise(
     return np.where(s > 0, s, floor)
 
 
+def huber_weights(
+    e: NDArray[np.float64], groups: NDArray[np.intp], fallback: NDArray[np.float64], c: float
+) -> NDArray[np.float64]:
+    """Huber's row weights ``sqrt(min(1, c / |e / s_g|)) / s_g`` (m,) at the residual ``e``
+    (m,), ``s_g`` each group's robust scale (1.4826 times its median absolute residual;
+    ``fallback[g]`` for a group whose residual is exactly zero)."""
+    s = np.array(fallback, dtype=np.float64)
+    for g in np.flatnonzero(np.bincount(groups)):  # the groups present
+        mad = float(np.median(np.abs(e[groups == g])))
+        if mad > 0:
+            s[g] = 1.4826 * mad
+    u = np.abs(e) / s[groups]
+    hub = np.minimum(1.0, c / np.maximum(u, 1e-300))
+    return np.asarray(np.sqrt(hub) / s[groups], dtype=np.float64)
+
+
 @dataclass(frozen=True, slots=True)
 class OLS:
     """Ordinary least squares (every row weighted alike)."""
@@ -136,6 +214,12 @@ class OLS:
         return _fit_with_pruning(
             W, y, max_std_percent=max_std_percent, rtol=rtol, std=std, labels=labels
         )
+
+    def row_weights(
+        self, e: NDArray[np.float64], groups: NDArray[np.intp], n_columns: int
+    ) -> NDArray[np.float64]:
+        """Every row weighs 1."""
+        return np.ones(np.shape(e))
 
 
 @dataclass(frozen=True, slots=True)
@@ -175,6 +259,13 @@ class WLS:
             labels=labels,
         )
 
+    def row_weights(
+        self, e: NDArray[np.float64], groups: NDArray[np.intp], n_columns: int
+    ) -> NDArray[np.float64]:
+        """``1 / sigma_g``, the group's noise level from the residual."""
+        s = group_noise(e, groups, 1.0 - n_columns / max(e.size, 1))
+        return np.asarray(1.0 / s[groups], dtype=np.float64)
+
 
 @dataclass(frozen=True, slots=True)
 class IRLS:
@@ -208,22 +299,14 @@ class IRLS:
     ) -> LeastSquaresFit:
         """WLS start, then Huber reweighting; pruning (if asked) on the last pass."""
         s0 = WLS().noise(W, y, groups, rtol)
-        present = np.unique(groups)
         w = 1.0 / s0[groups]
         beta = None
         for _ in range(self.max_iter):
             fit = _weighted(
                 W, y, w, rtol=rtol, std="classical", max_std_percent=None, labels=labels
             )
-            e = y - W @ fit.beta
-            s = s0.copy()  # a group whose residual is exactly zero keeps its WLS level
-            for g in present:
-                mad = float(np.median(np.abs(e[groups == g])))
-                if mad > 0:
-                    s[g] = 1.4826 * mad
-            u = np.abs(e) / s[groups]
-            hub = np.minimum(1.0, self.c / np.maximum(u, 1e-300))
-            w = np.sqrt(hub) / s[groups]
+            # a group whose residual is exactly zero keeps its WLS level
+            w = huber_weights(y - W @ fit.beta, groups, s0, self.c)
             done = beta is not None and np.linalg.norm(fit.beta - beta) <= self.tol * max(
                 float(np.linalg.norm(fit.beta)), 1e-300
             )
@@ -240,9 +323,16 @@ class IRLS:
             labels=labels,
         )
 
+    def row_weights(
+        self, e: NDArray[np.float64], groups: NDArray[np.intp], n_columns: int
+    ) -> NDArray[np.float64]:
+        """Huber's weights at the residual, scales as in the fit."""
+        s = group_noise(e, groups, 1.0 - n_columns / max(e.size, 1))
+        return huber_weights(e, groups, s, self.c)
 
-#: The estimators by name (``--estimator``).
-ESTIMATORS: dict[str, type[OLS] | type[WLS] | type[IRLS]] = {"ols": OLS, "wls": WLS, "irls": IRLS}
+
+#: The estimators by name (``--estimator``): each makes the estimator with its defaults.
+ESTIMATORS: dict[str, Callable[[], Estimator]] = {"ols": OLS, "wls": WLS, "irls": IRLS}
 
 
 def row_weights(
@@ -252,32 +342,11 @@ def row_weights(
     groups: NDArray[np.intp],
     beta: NDArray[np.float64],
 ) -> NDArray[np.float64]:
-    """The weight of every row (m,) at the estimate ``beta``, as the estimator weighs it:
-    1 (OLS, and estimators of a user's), ``1 / sigma_g`` (WLS), Huber's
-    ``sqrt(min(1, c / |e / s_g|)) / s_g`` (IRLS), from the residual ``e = y - W beta``. For
+    """The weight of every row (m,) at the estimate ``beta``, as the estimator weighs it
+    (:meth:`Estimator.row_weights` of the residual ``y - W beta``): 1 (OLS),
+    ``1 / sigma_g`` (WLS), Huber's ``sqrt(min(1, c / |e / s_g|)) / s_g`` (IRLS). For
     held-out judgement in the estimator's terms (an outlier weighs there as in the fit)."""
-    if not isinstance(estimator, WLS | IRLS):
-        return np.ones(y.size)
-    return residual_weights(estimator, y - W @ beta, groups, W.shape[1])
-
-
-def residual_weights(
-    estimator: Estimator, e: NDArray[np.float64], groups: NDArray[np.intp], n_columns: int
-) -> NDArray[np.float64]:
-    """:func:`row_weights` from the residual ``e`` (m,) of a fit of ``n_columns``
-    coefficients (the regressor itself not needed: a streamed fit's rows)."""
-    if not isinstance(estimator, WLS | IRLS):
-        return np.ones(e.size)
-    s = group_noise(e, groups, 1.0 - n_columns / max(e.size, 1))
-    if isinstance(estimator, WLS):
-        return np.asarray(1.0 / s[groups], dtype=np.float64)
-    for g in np.unique(groups):
-        mad = float(np.median(np.abs(e[groups == g])))
-        if mad > 0:
-            s[g] = 1.4826 * mad
-    u = np.abs(e) / s[groups]
-    hub = np.minimum(1.0, estimator.c / np.maximum(u, 1e-300))
-    return np.asarray(np.sqrt(hub) / s[groups], dtype=np.float64)
+    return estimator.row_weights(y - W @ beta, groups, W.shape[1])
 
 
 def estimator_named(estimator: str | Estimator) -> Estimator:
@@ -287,8 +356,15 @@ def estimator_named(estimator: str | Estimator) -> Estimator:
     ------
     OptionError
         An unknown name.
+    WrongTypeError
+        An object without the :class:`Estimator` protocol.
     """
     if not isinstance(estimator, str):
+        if not isinstance(estimator, Estimator):
+            raise WrongTypeError(
+                "estimator must be a name or an object with name, fit and row_weights (the "
+                f"Estimator protocol); got {type(estimator).__name__}"
+            )
         return estimator
     cls = ESTIMATORS.get(estimator)
     if cls is None:

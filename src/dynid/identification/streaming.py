@@ -46,7 +46,7 @@ from numpy.typing import NDArray
 
 from .. import _checks
 from ..exceptions import DataError, NonFiniteError, OptionError, RankDeficientError, ShapeError
-from .estimators import IRLS, OLS, WLS, Estimator
+from .estimators import IRLS, OLS, WLS, Estimator, huber_weights
 from .holdout import Normals
 from .least_squares import LeastSquaresFit, StdMethod, _conditioning, checked_std
 
@@ -432,7 +432,9 @@ def fit_streamed(
     ----------
     source : BlockSource
         Blocks ``(W_b (m_b, c), y_b (m_b,), groups_b (m_b,))``, the same at every call.
-    estimator : OLS, WLS or IRLS
+    estimator : Estimator
+        OLS, WLS and IRLS fit block by block; any other estimator's ``fit`` gets the rows
+        stacked, when they fit within :func:`max_stack_bytes`.
     rtol : float
         Relative rank tolerance on the diagonal of R of the column-scaled regressor.
     std : {"classical", "robust"}
@@ -444,8 +446,8 @@ def fit_streamed(
     Raises
     ------
     OptionError
-        An estimator other than OLS, WLS, IRLS (they need the stacked rows), or an unknown
-        ``std``.
+        An estimator other than OLS, WLS, IRLS (its ``fit`` takes the stacked rows) on rows
+        beyond :func:`max_stack_bytes`, or an unknown ``std``.
     ShapeError
         Inconsistent blocks.
     NonFiniteError
@@ -455,9 +457,9 @@ def fit_streamed(
     """
     checked_std(std)
     if not isinstance(estimator, OLS | WLS | IRLS):
-        raise OptionError(
-            f"estimator {estimator.name!r} needs the whole regressor, which is too large here "
-            f"to hold; use ols, wls or irls, or raise {_ENV}"
+        W, y, g = _stacked(source, estimator.name)
+        return estimator.fit(
+            W, y, g, rtol=rtol, std=std, max_std_percent=max_std_percent, labels=labels
         )
     F = group_factors(source, keep_groups=isinstance(estimator, IRLS))
     m = F.n_rows
@@ -484,6 +486,34 @@ def fit_streamed(
     return _irls(source, estimator, F, s0, std=std, **kw)  # type: ignore[arg-type]
 
 
+def _stacked(source: BlockSource, name: str) -> Block:
+    """The blocks of ``source`` stacked, for an estimator that needs every row at once.
+
+    Raises
+    ------
+    OptionError
+        The rows exceed :func:`max_stack_bytes`.
+    ShapeError
+        No rows, or inconsistent blocks.
+    NonFiniteError
+        NaN or inf in a block.
+    """
+    parts: list[Block] = []
+    size, limit = 0, max_stack_bytes()
+    for W, y, g in _blocks(source):
+        size += 8 * y.size * (W.shape[1] + 1)
+        if size > limit:
+            raise OptionError(
+                f"estimator {name!r} needs the whole regressor, which is too large here to "
+                f"hold; use ols, wls or irls, or raise {_ENV}"
+            )
+        parts.append((W, y, g))
+    if not parts:
+        raise ShapeError("the block source gave no rows")
+    W = np.concatenate([b[0] for b in parts])
+    return W, np.concatenate([b[1] for b in parts]), np.concatenate([b[2] for b in parts])
+
+
 def _irls(
     source: BlockSource,
     est: IRLS,
@@ -500,7 +530,6 @@ def _irls(
     assert F.groups is not None
     groups = F.groups
     m, c = F.n_rows, F.R.shape[-1] - 1
-    present = np.flatnonzero(F.rows)
     w = 1.0 / s0[groups]
     e = np.empty(m)
     beta = None
@@ -513,13 +542,7 @@ def _irls(
             o += y.size
         if o != m:
             raise DataError(f"the regressor blocks changed between passes ({o} rows, then {m})")
-        s = s0.copy()
-        for gv in present:
-            mad = float(np.median(np.abs(e[groups == gv])))
-            if mad > 0:
-                s[gv] = 1.4826 * mad
-        u = np.abs(e) / s[groups]
-        w = np.sqrt(np.minimum(1.0, est.c / np.maximum(u, 1e-300))) / s[groups]
+        w = huber_weights(e, groups, s0, est.c)
         done = beta is not None and np.linalg.norm(fb - beta) <= est.tol * max(
             float(np.linalg.norm(fb)), 1e-300
         )
