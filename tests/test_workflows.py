@@ -12,11 +12,12 @@ import pytest
 
 import dynid
 from dynid.cli.__main__ import main
-from dynid.exceptions import DataError, DynidError
+from dynid.exceptions import DataError, DynidError, OptionError
 from dynid.io.feasible_bundle import FEASIBLE_BUNDLE
 from dynid.io.robot.toml import save_toml
 from dynid.io.static_data import load_static_data
 from dynid.workflows.data_files import column_map, read_torque_log
+from dynid.workflows.friction import fit_friction_file
 from dynid.workflows.identify import identify_consistent_file, identify_file
 from dynid.workflows.prior import load_prior
 from dynid.workflows.retrieve import retrieve_file
@@ -242,3 +243,26 @@ def test_quiet_keeps_a_json_result(capsys):
     assert main(["fk", "--json", "-q"]) == 0
     T = np.array(json.loads(capsys.readouterr().out)["T"])
     np.testing.assert_allclose(T, dynid.fk(dynid.panda(), dynid.PANDA_NEUTRAL_Q), atol=1e-14)
+
+
+def test_the_friction_law_policy_is_the_library_s(files, tmp_path, capsys):
+    """fit_friction_file applies dynid friction's policy: auto compares every law on
+    held-out blocks (the model's own friction too) and keeps the lowest held-out error, a
+    named law is fitted as asked, an unknown one is refused; the command writes what the
+    API returns."""
+    panda = dynid.panda()
+    auto = fit_friction_file(panda, files / "log.csv")
+    assert auto.selection is not None and auto.fit is auto.selection.fit
+    held = {s.name: s.heldout_error_percent for s in auto.selection.scores}
+    assert held[auto.selection.chosen] == min(held.values()) and "own" in held
+    named = fit_friction_file(panda, files / "log.csv", law="classical")
+    assert named.selection is None and named.fit.kind == "classical"
+    with pytest.raises(OptionError, match="--friction-model must be auto or one of none"):
+        fit_friction_file(panda, files / "log.csv", law="coulomb")
+
+    out = tmp_path / "fr"
+    argv = ["friction", "--robot", "panda", "--data", str(files / "log.csv"), "--out", str(out)]
+    assert main([*argv, "--no-figures", "-q"]) == 0
+    doc = json.loads((out / "friction.json").read_text())
+    assert doc["selection"] == auto.selection.as_dict()
+    assert [j["rms_after"] for j in doc["joints"]] == list(auto.fit.rms_after)

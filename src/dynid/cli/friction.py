@@ -28,17 +28,14 @@ import argparse
 from pathlib import Path
 
 from ..exceptions import DynidError
-from ..friction.fit import fit_friction_through, friction_residual, model_drive
 from ..friction.laws import LAWS
-from ..friction.select import select_friction
-from ..friction.validation import own_friction
 from ..identification.log import DEFAULT_CUTOFF_HZ
 from ..identification.model import IdentifiedModel
 from ..io.friction_json import save_friction_json
 from ..io.model_json import load_model_json
 from ..model.robot import Robot
+from ..workflows.friction import fit_friction_file
 from .common import (
-    about,
     add_column_options,
     add_drive_option,
     add_log_options,
@@ -50,7 +47,6 @@ from .common import (
 )
 from .console import Console
 from .figures import save_friction_figure
-from .sources import read_data_log
 from .summaries import format_rms_table
 
 NAME = "friction"
@@ -103,32 +99,23 @@ def load_torque_model(args: argparse.Namespace) -> IdentifiedModel | Robot:
     raise DynidError("give --model identification.json or --robot ROBOT")
 
 
-def _joint_count(model: IdentifiedModel | Robot) -> int:
-    return (model.robot if isinstance(model, IdentifiedModel) else model).n
-
-
-def _joint_names(model: IdentifiedModel | Robot) -> list[str]:
-    robot = model.robot if isinstance(model, IdentifiedModel) else model
-    return list(robot.joint_names)
-
-
 def run(args: argparse.Namespace, console: Console) -> int:
     """Fit friction, write friction.json and the figure, print the RMS table (unless -q)."""
     model = load_torque_model(args)
-    n = _joint_count(model)
-    recorded = model.info.column_map if isinstance(model, IdentifiedModel) else None
-    log = read_data_log(args, n, owner="the model", recorded=recorded)
-    drive = model_drive(model, load_drive_arg(args, n))
-    with about(args.data):
-        res = friction_residual(
-            model, log, cutoff_hz=args.cutoff, max_gap_s=args.max_gap, drive=drive
-        )
-        if args.friction_model == "auto":
-            sel = select_friction(res, drive, own=own_friction(model))
-            fit, selection = sel.fit, sel.as_dict()
-            console.print(sel.table())
-        else:
-            fit, selection = fit_friction_through(res, drive, args.friction_model), None
+    robot = model.robot if isinstance(model, IdentifiedModel) else model
+    result = fit_friction_file(
+        model,
+        args.data,
+        law=args.friction_model,
+        columns=(args.columns, args.units),
+        drop_invalid=args.drop_invalid,
+        drive=load_drive_arg(args, robot.n),
+        cutoff_hz=args.cutoff,
+        max_gap_s=args.max_gap,
+    )
+    fit, sel = result.fit, result.selection
+    if sel is not None:
+        console.print(sel.table())
     meta = {
         "data": str(args.data.name),
         "model": str(args.model.name) if args.model is not None else args.robot,
@@ -136,12 +123,13 @@ def run(args: argparse.Namespace, console: Console) -> int:
         "n_samples": fit.n_samples,
         "converged": [bool(x) for x in fit.converged],
     }
+    selection = None if sel is None else sel.as_dict()
     save_friction_json(args.out / "friction.json", fit, metadata=meta, selection=selection)
-    names = _joint_names(model)
+    names = list(robot.joint_names)
     if not args.no_figures:
         save_friction_figure(
             args.out / "friction.png",
-            res,
+            result.residual,
             fit,
             names=names,
             title=shown(f"{fit.kind} friction fitted to the torque residual ({args.data.name})"),

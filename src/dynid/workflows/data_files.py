@@ -16,13 +16,13 @@ from __future__ import annotations
 
 import logging
 import zipfile
-from collections.abc import Mapping
+from collections.abc import Callable, Mapping
 from pathlib import Path
-from typing import Any, Literal
+from typing import Any, Literal, TypeVar
 
 import numpy as np
 
-from ..exceptions import DataError
+from ..exceptions import DataError, DynidError
 from ..identification.data import StaticDataset
 from ..identification.log import TorqueLog
 from ..io.columns import (
@@ -37,9 +37,11 @@ from ..io.torque_log import load_torque_log
 from ..model.robot import Robot
 
 __all__ = [
+    "ColumnSpec",
     "DataKind",
     "column_map",
     "data_kind",
+    "in_file",
     "read_static_file",
     "read_torque_log",
     "recorded_columns",
@@ -49,6 +51,28 @@ _log = logging.getLogger(__name__)
 
 #: What a data file holds.
 DataKind = Literal["static", "torque_log"]
+
+#: ``--columns``/``--units`` as typed (text or a TOML file; units), or None.
+ColumnSpec = tuple[str | None, str | None]
+
+_T = TypeVar("_T")
+
+
+def in_file(path: Path, fit: Callable[[], _T]) -> _T:
+    """``fit()``, a :class:`~dynid.exceptions.DynidError` it raises prefixed with the
+    file's name when it lacks it (the same error, of the same class).
+
+    Raises
+    ------
+    DynidError
+        Whatever ``fit`` raises, its message starting with ``path.name``.
+    """
+    try:
+        return fit()
+    except DynidError as exc:
+        if str(exc).startswith(path.name):
+            raise
+        raise type(exc)(f"{path.name}: {exc}") from exc
 
 
 def column_map(

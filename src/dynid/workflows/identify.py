@@ -17,24 +17,29 @@ from __future__ import annotations
 import dataclasses
 import warnings
 from pathlib import Path
-from typing import Any, Literal
+from typing import Any
 
-from ..exceptions import DataError, DynidError, DynidWarning
+from ..exceptions import DataError, DynidWarning
 from ..feasibility.one_step import identify_consistent
 from ..feasibility.sdp import ConsistentResult, SDPOptions
 from ..identification.classical import identify_from_log
 from ..identification.consistency import fit_mismatch, limit_violations
 from ..identification.estimators import EstimatorName
+from ..identification.least_squares import StdMethod
 from ..identification.model import IdentifiedModel
 from ..identification.static import identify_static
 from ..model.drive import Drive
 from ..model.robot import Robot
-from .data_files import column_map, data_kind, read_static_file, read_torque_log
+from .data_files import (
+    ColumnSpec,
+    column_map,
+    data_kind,
+    in_file,
+    read_static_file,
+    read_torque_log,
+)
 
 __all__ = ["ColumnSpec", "identify_consistent_file", "identify_file"]
-
-#: ``--columns``/``--units`` as typed (text or a TOML file; units), or None.
-ColumnSpec = tuple[str | None, str | None]
 
 
 def _columns(spec: ColumnSpec | None, cutoff_hz: float | None) -> Any:
@@ -80,7 +85,7 @@ def identify_file(
     drop_invalid: bool = False,
     max_std_percent: float | None = None,
     rtol: float | None = None,
-    std: Literal["robust", "classical"] | None = None,
+    std: StdMethod | None = None,
     estimator: EstimatorName = "ols",
     drive: Drive | None = None,
     cutoff_hz: float | None = None,
@@ -137,7 +142,7 @@ def identify_file(
             drop_invalid=drop_invalid,
             owner=f"robot {robot.name!r}",
         )
-        model = _in_file(
+        model = in_file(
             path,
             lambda: identify_from_log(
                 robot,
@@ -157,7 +162,7 @@ def identify_file(
         outside = limit_violations(robot, data.q)
         if outside is not None:
             warnings.warn(f"{path.name}: {outside}", DynidWarning, stacklevel=2)
-        model = _in_file(
+        model = in_file(
             path,
             lambda: identify_static(
                 robot,
@@ -231,7 +236,7 @@ def identify_consistent_file(
         )
     else:
         data = read_static_file(path, robot, columns=cmap, drop_invalid=drop_invalid)
-    result = _in_file(
+    result = in_file(
         path,
         lambda: identify_consistent(
             robot,
@@ -249,14 +254,3 @@ def identify_consistent_file(
     if result.identified is None:  # pragma: no cover - identify_consistent always sets it
         raise DataError("the one-step identification returned no unconstrained fit")
     return dataclasses.replace(result, identified=_record(result.identified, columns))
-
-
-def _in_file(path: Path, fit: Any) -> Any:
-    """``fit()``, a :class:`~dynid.exceptions.DynidError` it raises prefixed with the
-    file's name when it lacks it."""
-    try:
-        return fit()
-    except DynidError as exc:
-        if str(exc).startswith(path.name):
-            raise
-        raise type(exc)(f"{path.name}: {exc}") from exc
