@@ -166,8 +166,23 @@ def _weighted(
 def group_noise(
     e: NDArray[np.float64], groups: NDArray[np.intp], dof_share: float
 ) -> NDArray[np.float64]:
-    """Noise std of each group's residual (its RMS, corrected by the share of the degrees of
-    freedom, ``1 - r/m``); groups with zero residual get the smallest non-zero level."""
+    """Noise std of each group's residual: its RMS, corrected by the share of the degrees of
+    freedom ``1 - r/m``; a group with zero residual gets the smallest non-zero level.
+
+    Parameters
+    ----------
+    e : ndarray, shape (m,)
+        Residual, in the unit of the data.
+    groups : ndarray of int, shape (m,)
+        The noise group of every row (non-negative).
+    dof_share : float
+        ``1 - r/m`` of a fit of ``r`` coefficients on ``m`` rows.
+
+    Returns
+    -------
+    ndarray, shape (max(groups) + 1,)
+        ``sigma_g``, in the unit of ``e``.
+    """
     k = int(groups.max()) + 1 if groups.size else 0
     ss = np.bincount(groups, weights=e * e, minlength=k)
     cnt = np.bincount(groups, minlength=k).astype(float)
@@ -180,9 +195,25 @@ def group_noise(
 def huber_weights(
     e: NDArray[np.float64], groups: NDArray[np.intp], fallback: NDArray[np.float64], c: float
 ) -> NDArray[np.float64]:
-    """Huber's row weights ``sqrt(min(1, c / |e / s_g|)) / s_g`` (m,) at the residual ``e``
-    (m,), ``s_g`` each group's robust scale (1.4826 times its median absolute residual;
-    ``fallback[g]`` for a group whose residual is exactly zero)."""
+    """Huber's row weights ``sqrt(min(1, c / |e / s_g|)) / s_g`` at a residual (Huber 1981).
+
+    Parameters
+    ----------
+    e : ndarray, shape (m,)
+        Residual, in the unit of the data.
+    groups : ndarray of int, shape (m,)
+        The noise group of every row (non-negative).
+    fallback : ndarray, shape (k,)
+        Scale of each group whose residual is exactly zero (its MAD gives none).
+    c : float
+        Huber's threshold in robust standard deviations.
+
+    Returns
+    -------
+    ndarray, shape (m,)
+        The weights, in 1 / the unit of ``e``; ``s_g`` is each group's robust scale,
+        1.4826 times its median absolute residual.
+    """
     s = np.array(fallback, dtype=np.float64)
     for g in np.flatnonzero(np.bincount(groups)):  # the groups present
         mad = float(np.median(np.abs(e[groups == g])))

@@ -133,10 +133,10 @@ def identify_static(
     -------
     IdentifiedModel
         ``fit`` holds ``beta`` (r,) with std, std %, rank, condition number and relative
-        error (%); ``metadata`` holds ``route="static"``, ``n_configurations``,
-        ``n_rows``, ``dropped_rows`` (labels such as ``"g1"``), ``pruned`` (labels of
-        removed coefficients), ``max_std_percent``, ``std_estimator``, ``rtol`` and the
-        data set's own metadata under ``"data"``.
+        error (%); ``info`` records ``route="static"``, ``n_rows``, ``dropped_rows``
+        (labels such as ``"g1"``), ``pruned`` (labels of removed coefficients),
+        ``max_std_percent``, ``std``, ``estimator``, ``rtol``, the configurations
+        (``static``) and the data set's own metadata (``data``).
 
     Raises
     ------
