@@ -167,3 +167,105 @@ def test_a_long_log_identifies_under_an_address_space_limit(tmp_path):
     lines = err.strip().splitlines()
     assert code == 2 and "out of memory in" in lines[-1], err
     assert "Traceback" not in err and "DYNID_MAX_STACK_BYTES" in lines[-1]
+
+
+def _chain(n: int, seed: int) -> dynid.Robot:
+    """A revolute chain of ``n`` joints with random modified DH constants and inertias."""
+    rng = np.random.default_rng(seed)
+    a = rng.uniform(0.05, 0.2, n)
+    a[0] = 0.0
+    alpha = rng.choice([-np.pi / 2, np.pi / 2, 0.0], n)
+    alpha[0] = 0.0
+    A = rng.normal(size=(n, 3, 3))
+    return dynid.Robot.from_mdh(
+        a,
+        rng.uniform(0.0, 0.1, n),
+        alpha,
+        mass=rng.uniform(0.5, 2.0, n),
+        com=rng.uniform(-0.05, 0.05, (n, 3)),
+        inertia=0.01 * (A @ A.transpose(0, 2, 1) + np.eye(3)),
+        q_min=np.full(n, -2.8),
+        q_max=np.full(n, 2.8),
+        name=f"chain{n}",
+    )
+
+
+@pytest.mark.parametrize("kind", ["static", "torque"])
+def test_base_parameters_from_blocks_of_states_equal_the_stacked_ones(kind):
+    """Base parameters found block by block (the triangular factor of the random states'
+    rows, max_bytes small) are those of the stacked rows: the same independent columns,
+    the same combination coefficients, the same rank."""
+    from dynid.regressors.base import base_parameters
+
+    robot = _chain(6, 1)
+    ref = base_parameters(robot, kind=kind)
+    got = base_parameters(robot, kind=kind, max_bytes=20_000)
+    assert got.rank == ref.rank
+    np.testing.assert_array_equal(got.independent, ref.independent)
+    np.testing.assert_allclose(got.K_d, ref.K_d, rtol=1e-12, atol=1e-14)
+    assert got.expressions == ref.expressions
+
+
+@pytest.mark.parametrize(
+    ("estimator", "std"),
+    [("ols", "robust"), ("ols", "classical"), ("wls", "robust"), ("irls", "classical")],
+)
+@pytest.mark.parametrize("one_factor", [False, True])
+def test_static_route_streamed_equals_stacked(monkeypatch, estimator, std, one_factor):
+    """Static data fitted from pieces of configurations (DYNID_MAX_STACK_BYTES=0), with a
+    factor per row of [tril M; g] or one factor of all rows (GROUP_FACTOR_BYTES=0), give
+    the stacked fit's estimates, standard deviations and dropped rows (g1 of the Panda)
+    to 1e-10; with noise-free data both recover the generating parameters."""
+    from dynid.identification import data as data_module
+    from dynid.identification import streaming
+    from dynid.identification.static import identify_static
+
+    robot = dynid.panda()
+    ctrl = dynid.SimulatedController(robot, 1e-3, rng=np.random.default_rng(2))
+    data = dynid.acquire_static(ctrl, 300, np.random.default_rng(1))
+    ref = identify_static(robot, data, estimator=estimator, std=std, max_std_percent=30)
+    monkeypatch.setenv("DYNID_MAX_STACK_BYTES", "0")
+    monkeypatch.setattr(data_module, "_BLOCK_BYTES", 8 * 35 * 43 * 70)  # 5 pieces
+    if one_factor:
+        monkeypatch.setattr(streaming, "GROUP_FACTOR_BYTES", 0)
+    got = identify_static(robot, data, estimator=estimator, std=std, max_std_percent=30)
+    np.testing.assert_allclose(got.fit.beta, ref.fit.beta, rtol=1e-10, atol=1e-14)
+    np.testing.assert_allclose(got.fit.std, ref.fit.std, rtol=1e-10, atol=1e-16)
+    np.testing.assert_array_equal(got.fit.kept, ref.fit.kept)
+    assert got.info.dropped_rows == ref.info.dropped_rows == ("g1",)
+    assert got.info.n_rows == ref.info.n_rows == 300 * 34
+    assert got.fit.relative_error_percent == pytest.approx(ref.fit.relative_error_percent, 1e-10)
+    exact = dynid.acquire_static(dynid.SimulatedController(robot), 120, np.random.default_rng(3))
+    model = identify_static(robot, exact, std=std)
+    truth = model.base.beta_from_phi(robot.phi)  # the generating parameters
+    np.testing.assert_allclose(model.fit.beta, truth, rtol=1e-8, atol=1e-10)
+
+
+@pytest.mark.slow
+def test_static_data_of_a_50_joint_arm_identify_under_an_address_space_limit(tmp_path):
+    """A 50-joint arm (1325 rows of [tril M; g] per configuration, 500 standard parameters):
+    its static data identify through the command line under RLIMIT_AS 1.5 GiB (the Gram
+    matrices of the rows of s alone were 1.3 GB, the random states' rows 0.34 GB) and
+    recover the base parameters of the generating inertias."""
+    resource = pytest.importorskip("resource")
+    if not hasattr(resource, "RLIMIT_AS") or not os.path.exists("/proc/self/status"):
+        pytest.skip("needs RLIMIT_AS and /proc/self/status (Linux)")
+    from dynid.io.model_json import load_model_json
+    from dynid.io.robot.toml import save_toml
+    from dynid.io.static_data import save_static_data
+
+    robot = _chain(50, 4)
+    save_toml(tmp_path / "arm.toml", robot)
+    ctrl = dynid.SimulatedController(robot)
+    save_static_data(tmp_path / "s.npz", dynid.acquire_static(ctrl, 10, np.random.default_rng(5)))
+    limit = 3 * 2**29
+    env = {**os.environ, "OPENBLAS_NUM_THREADS": "1"}
+    env.pop("DYNID_MAX_STACK_BYTES", None)
+    cmd = [sys.executable, "-c", _VM_RUN, str(limit), "identify", "--robot"]
+    cmd += [str(tmp_path / "arm.toml"), "--data", str(tmp_path / "s.npz"), "--std", "classical"]
+    cmd += ["--out", str(tmp_path / "out"), "--no-figures", "-q"]
+    proc = subprocess.run(cmd, capture_output=True, text=True, env=env, timeout=900)
+    assert proc.returncode == 0, proc.stderr
+    model = load_model_json(tmp_path / "out" / "identification.json")
+    truth = model.base.beta_from_phi(robot.phi)
+    np.testing.assert_allclose(model.fit.beta, truth, rtol=1e-6, atol=1e-9 * np.abs(truth).max())

@@ -144,6 +144,11 @@ class RegressorBlock:
         What the rows are (``"g1"``); names a dropped block.
     first : int
         ``W[:, :first]`` is exactly zero (products over the rows skip those columns).
+    group_labels : tuple of str
+        Set on a block of rows of many groups that is one of several pieces of data too
+        large to stack (static data of a long chain): the name of every group. The core
+        then fits the pieces in passes (:class:`StreamedRows`), never concatenated, and
+        drops the groups without information by these names.
     """
 
     W: NDArray[np.float64]
@@ -151,6 +156,7 @@ class RegressorBlock:
     groups: NDArray[np.intp]
     label: str = ""
     first: int = 0
+    group_labels: tuple[str, ...] = ()
 
 
 class Dataset(Protocol):
@@ -268,7 +274,8 @@ class StreamedRows:
     n_rows : int
         Rows over all blocks (0 until the fit has counted them).
     dropped : tuple of str
-        Always empty (blocks are not judged for information).
+        Labels of the noise groups dropped (no information); empty for a torque log,
+        whose blocks are not judged.
     """
 
     source: BlockSource
@@ -339,9 +346,14 @@ def stack_dataset(
     """
     blocks = iter(data.blocks(robot, columns))
     head = list(itertools.islice(blocks, 2))
+    source: BlockSource = lambda: ((b.W, b.y, b.groups) for b in data.blocks(robot, columns))  # noqa: E731
+    if head and head[0].group_labels:  # pieces of many groups: streamed, groups judged
+        labels = head[0].group_labels
+        del head, blocks
+        return _streamed_groups(robot, source, labels, rtol)
     if data.route == "classical" and len(head) > 1:  # a long log: blocks of rows, streamed
         del head, blocks
-        return StreamedRows(lambda: ((b.W, b.y, b.groups) for b in data.blocks(robot, columns)))
+        return StreamedRows(source)
     stack = _concatenated(itertools.chain(head, blocks), len(columns.labels))
     if stack.rows.shape[0] < 2:
         return stack
@@ -350,19 +362,56 @@ def stack_dataset(
     stack = dataclasses.replace(stack, kept=info, grams=grams)
     if info.all():
         return stack
-    dropped = stack.dropped
     y_out = np.concatenate([stack.y[a:b] for a, b, _ in stack.rows[~info]])
-    big = float(np.max(np.abs(y_out), initial=0.0))
-    if big > _DROPPED_DATA_RTOL * float(np.max(np.abs(stack.y), initial=0.0)):
+    _warn_dropped(robot, stack.dropped, np.max(np.abs(y_out)), np.max(np.abs(stack.y)), 5)
+    return stack
+
+
+def _warn_dropped(
+    robot: Robot, dropped: tuple[str, ...], big: float, top: float, level: int
+) -> None:
+    """Warn when rows without information hold data (``big`` of the largest ``top``),
+    ``level`` frames above (at the caller of :func:`identify`)."""
+    if big > _DROPPED_DATA_RTOL * top:
         warnings.warn(
             f"rows {list(dropped)} carry no information for robot {robot.name!r} (its "
             f"regressor is zero there) but the data reach |{big:.3g}|; hint: check the "
             "gravity vector and the kinematics against the source of the data",
             DynidWarning,
-            stacklevel=3,
+            stacklevel=level,
         )
     _log.info("dropping rows without information: %s", ", ".join(dropped))
-    return stack
+
+
+def _streamed_groups(
+    robot: Robot, source: BlockSource, labels: tuple[str, ...], rtol: float
+) -> StreamedRows:
+    """Rows of many noise groups left in blocks, the groups without information dropped
+    as the stacked route drops its blocks (:func:`informative_blocks` on each group's
+    column sums of squares, one pass)."""
+    k = len(labels)
+    ss: NDArray[np.float64] | None = None
+    ymax = np.zeros(k)
+    for W, y, g in source():
+        if ss is None:
+            ss = np.zeros((W.shape[1], k))
+        for j in range(W.shape[1]):  # one column at a time: no squared copy of the block
+            ss[j] += np.bincount(g, W[:, j] ** 2, minlength=k)
+        np.maximum.at(ymax, g, np.abs(y))
+    if ss is None:
+        raise ShapeError("no regressor rows: the data hold no block")
+    info = informative_blocks(ss, rtol)
+    if info.all():
+        return StreamedRows(source)
+    dropped = tuple(lab for lab, ok in zip(labels, info, strict=True) if not ok)
+    _warn_dropped(robot, dropped, float(ymax[~info].max()), float(ymax.max()), 6)
+
+    def kept() -> Iterator[tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.intp]]]:
+        for W, y, g in source():
+            sel = info[g]
+            yield W[sel], y[sel], g[sel]
+
+    return StreamedRows(kept, dropped=dropped)
 
 
 def _concatenated(blocks: Iterable[RegressorBlock], c: int) -> RegressorStack:

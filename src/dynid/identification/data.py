@@ -25,10 +25,16 @@ from numpy.typing import ArrayLike, NDArray
 from .. import _checks
 from ..exceptions import DataError, NonFiniteError, ShapeError
 from ..model.robot import Robot
-from ..regressors.static import static_first_columns, static_labels, static_regressor_columns
+from ..regressors.static import (
+    static_first_columns,
+    static_labels,
+    static_regressor_columns,
+    static_rows,
+)
 from ..regressors.terms import base_term_columns
 from .core import ModelColumns, RegressorBlock
 from .info import IdentificationInfo, StaticInfo
+from .streaming import BLOCK_ROWS, streams
 
 __all__ = ["StaticDataset", "DEFAULT_SYMMETRY_RTOL"]
 
@@ -36,6 +42,9 @@ __all__ = ["StaticDataset", "DEFAULT_SYMMETRY_RTOL"]
 #: Loose enough for a model library that rounds its output, tight enough to catch a
 #: transposed or shifted matrix.
 DEFAULT_SYMMETRY_RTOL = 1e-8
+
+#: Largest piece of the static regressor [bytes] computed at once when it is streamed.
+_BLOCK_BYTES = 16 << 20
 
 
 @dataclass(frozen=True, slots=True, eq=False)
@@ -159,26 +168,30 @@ class StaticDataset:
         Row ``(i, j)`` of ``tril M`` and row ``g_i`` do not depend on the parameters of the
         links before link ``i``: each block is exactly zero in those leading columns
         (``first``). Known rotor inertias of ``columns.drive`` are subtracted from ``M``.
+
+        When the stacked regressor, or the Gram matrices of its blocks, would exceed
+        ``DYNID_MAX_STACK_BYTES`` (:func:`~dynid.identification.streaming.streams`; a
+        50-joint arm has 1325 rows per configuration and 345 columns: 1.3 GB of Gram
+        matrices), the blocks are pieces of configurations instead, each with
+        the rows of ``s`` of its configurations (row ``k`` its noise group, named in
+        ``group_labels``), computed when iterated: the core fits them in passes.
         """
         N, n = self.n_configurations, self.n
-        ind = np.asarray(columns.base.independent)
-        # Yb[c, k, b]: column c, row k of s, configuration b (only the base columns computed)
-        Yb = static_regressor_columns(robot, self.q, ind[ind < 10 * n])
-        extra = []
-        for t, sel in base_term_columns(columns.terms, ind, n):  # rotor inertia: constant
-            C = t.static_columns(N)
-            extra.append(np.zeros((sel.size, Yb.shape[1], N)) if C is None else C[sel])
-        for t in columns.appended:  # terms that do not act at rest give zero columns
-            C = t.static_columns(N)
-            extra.append(np.zeros((len(t.labels), Yb.shape[1], N)) if C is None else C)
-        if extra:
-            Yb = np.concatenate([Yb, *extra], axis=0)
-        M = self.M
-        drive = columns.drive
-        if drive is not None and drive.rotor_inertia is not None:  # known: not identified
-            M = M - drive.rotor_mass_matrix(drive.rotor_inertia)
-        i, j = np.tril_indices(n)
-        S = np.concatenate([M[:, i, j], self.g], axis=1)  # (N, s), columns as static_labels
+        s, c = static_rows(n), len(columns.labels)
+        if streams(N * s, c) or streams(s * c, c):  # the rows, or a Gram matrix per row of s
+            step = max(1, min(BLOCK_ROWS // s, _BLOCK_BYTES // (8 * s * c)))
+            labels = static_labels(n)
+            for a in range(0, N, step):
+                Yb, S = self._rows(robot, columns, slice(a, a + step))
+                B = S.shape[0]
+                yield RegressorBlock(
+                    W=Yb.reshape(Yb.shape[0], s * B).T,  # rows (k, b): row k of s, config b
+                    y=S.T.reshape(-1),
+                    groups=np.repeat(np.arange(s, dtype=np.intp), B),
+                    group_labels=labels,
+                )
+            return
+        Yb, S = self._rows(robot, columns, slice(0, N))
         first = static_first_columns(n, np.asarray(columns.base.independent))
         for k, label in enumerate(static_labels(n)):
             yield RegressorBlock(
@@ -188,6 +201,34 @@ class StaticDataset:
                 label=label,
                 first=int(first[k]),
             )
+
+    def _rows(
+        self, robot: Robot, columns: ModelColumns, b: slice
+    ) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+        """The regressor ``Yb[c, k, i]`` (column c, row k of ``s``, configuration i) and
+        the targets ``S[i, k]`` of the configurations ``b``."""
+        n = self.n
+        ind = np.asarray(columns.base.independent)
+        q = self.q[b]
+        B = q.shape[0]
+        # only the base columns computed
+        Yb = static_regressor_columns(robot, q, ind[ind < 10 * n])
+        extra = []
+        for t, sel in base_term_columns(columns.terms, ind, n):  # rotor inertia: constant
+            C = t.static_columns(B)
+            extra.append(np.zeros((sel.size, Yb.shape[1], B)) if C is None else C[sel])
+        for t in columns.appended:  # terms that do not act at rest give zero columns
+            C = t.static_columns(B)
+            extra.append(np.zeros((len(t.labels), Yb.shape[1], B)) if C is None else C)
+        if extra:
+            Yb = np.concatenate([Yb, *extra], axis=0)
+        M = self.M[b]
+        drive = columns.drive
+        if drive is not None and drive.rotor_inertia is not None:  # known: not identified
+            M = M - drive.rotor_mass_matrix(drive.rotor_inertia)
+        i, j = np.tril_indices(n)
+        S = np.concatenate([M[:, i, j], self.g[b]], axis=1)  # (B, s), columns as static_labels
+        return Yb, S
 
     def record(self, n_rows: int) -> IdentificationInfo:
         """Configurations, rows per configuration and the data set's own metadata."""

@@ -54,6 +54,7 @@ __all__ = [
     "BLOCK_ROWS",
     "Block",
     "BlockSource",
+    "GROUP_FACTOR_BYTES",
     "GroupFactors",
     "MAX_STACK_BYTES",
     "fit_streamed",
@@ -105,43 +106,91 @@ def streams(n_rows: int, n_columns: int) -> bool:
     return 8 * int(n_rows) * (int(n_columns) + 1) > max_stack_bytes()
 
 
+#: Largest memory [bytes] of the factors of every noise group. Above it (static data of
+#: a 50-joint arm: 1325 groups, the rows of ``[tril M; g]``, of 345 columns: 1.3 GB) one
+#: factor of all rows is kept, with each group's row count and ``||y_g||^2``; what needs a
+#: group's residual (WLS's noise levels, a weighted factor) takes a pass over the blocks.
+GROUP_FACTOR_BYTES = 64 << 20
+
+
 @dataclass(frozen=True, slots=True, eq=False)
 class GroupFactors:
     """Triangular factors of ``[W_g y_g]`` per noise group (module docstring).
 
     Attributes
     ----------
-    R : ndarray, shape (k, c + 1, c + 1)
-        Upper triangular factor of each group's rows (zero for a group without rows).
+    R : ndarray, shape (k, c + 1, c + 1), or None
+        Upper triangular factor of each group's rows (zero for a group without rows);
+        None when they would exceed :data:`GROUP_FACTOR_BYTES` (then ``total``).
     rows : ndarray of int, shape (k,)
         Rows of each group.
     groups : ndarray of int, shape (m,) or None
         The group of every row in block order (kept for IRLS only).
+    total : ndarray, shape (c + 1, c + 1), or None
+        The factor of all rows, when ``R`` is None.
+    target : ndarray, shape (k,), or None
+        ``||y_g||^2`` of each group, when ``R`` is None.
+    source : BlockSource or None
+        The blocks again, for the passes that replace ``R`` when it is None.
     """
 
-    R: NDArray[np.float64]
+    R: NDArray[np.float64] | None
     rows: NDArray[np.intp]
     groups: NDArray[np.intp] | None = None
+    total: NDArray[np.float64] | None = None
+    target: NDArray[np.float64] | None = None
+    source: BlockSource | None = None
 
     @property
     def n_rows(self) -> int:
         """Rows over all groups."""
         return int(self.rows.sum())
 
+    @property
+    def n_columns(self) -> int:
+        """Columns c of the regressor."""
+        F = self.R if self.R is not None else self.total
+        assert F is not None
+        return int(F.shape[-1]) - 1
+
     def combined(self, w: NDArray[np.float64] | None = None) -> NDArray[np.float64]:
         """The factor (c+1, c+1) of all rows, each group's rows times ``w[g]`` (default 1)."""
+        if self.R is None:
+            assert self.total is not None and self.source is not None
+            if w is None:
+                return self.total
+            wg = w
+            return _weighted_factor(self.source, lambda o, g: wg[g], self.n_columns)
         R = self.R if w is None else self.R * w[:, None, None]
         return _triangular(R.reshape(-1, R.shape[-1]))
 
     def residual_ss(self, beta: NDArray[np.float64]) -> NDArray[np.float64]:
         """``||y_g - W_g beta||^2`` of each group (k,)."""
+        if self.R is None:
+            assert self.source is not None
+            ss = np.zeros(self.rows.size)
+            for W, y, g in _blocks(self.source):
+                e = y - W @ beta
+                ss += np.bincount(g, e * e, minlength=ss.size)[: ss.size]
+            return ss
         v = np.append(beta, -1.0)
         r = self.R @ v
         return np.einsum("kj,kj->k", r, r)
 
     def target_ss(self) -> NDArray[np.float64]:
         """``||y_g||^2`` of each group (k,)."""
+        if self.R is None:
+            assert self.target is not None
+            return self.target
         return np.einsum("kj,kj->k", self.R[:, :, -1], self.R[:, :, -1])
+
+
+def _on_top(R: NDArray[np.float64], X: NDArray[np.float64]) -> NDArray[np.float64]:
+    """``[R; X]`` in column-major order (as LAPACK takes it, no further copy)."""
+    out = np.empty((R.shape[0] + X.shape[0], X.shape[1]), order="F")
+    out[: R.shape[0]] = R
+    out[R.shape[0] :] = X
+    return out
 
 
 def _triangular(X: NDArray[np.float64]) -> NDArray[np.float64]:
@@ -176,7 +225,8 @@ def _blocks(source: BlockSource) -> Iterable[Block]:
 
 
 def group_factors(source: BlockSource, *, keep_groups: bool = False) -> GroupFactors:
-    """One pass over the blocks: the triangular factor of ``[W_g y_g]`` of every group.
+    """One pass over the blocks: the triangular factor of ``[W_g y_g]`` of every group (or,
+    past :data:`GROUP_FACTOR_BYTES`, of all rows with the groups' counts and targets).
 
     Parameters
     ----------
@@ -194,27 +244,41 @@ def group_factors(source: BlockSource, *, keep_groups: bool = False) -> GroupFac
     R: dict[int, NDArray[np.float64]] = {}
     rows: dict[int, int] = {}
     seen: list[NDArray[np.intp]] = []
+    total: NDArray[np.float64] | None = None
+    count, target = np.zeros(0, dtype=np.intp), np.zeros(0)
     c = 0
     for W, y, g in _blocks(source):
         c = W.shape[1]
         X = np.empty((W.shape[0], c + 1), order="F")
         X[:, :c] = W
         X[:, c] = y
-        for gv in np.unique(g):
-            sel = X[g == gv]
-            prev = R.get(int(gv))
-            R[int(gv)] = _triangular(sel if prev is None else np.vstack([prev, sel]))
-            rows[int(gv)] = rows.get(int(gv), 0) + sel.shape[0]
+        k = max(count.size, int(g.max(initial=-1)) + 1)
+        count = np.bincount(g, minlength=k) + np.pad(count, (0, k - count.size))
+        target = np.bincount(g, y * y, minlength=k) + np.pad(target, (0, k - target.size))
+        if total is None and 8 * k * (c + 1) ** 2 > GROUP_FACTOR_BYTES:  # too many groups
+            total = _triangular(np.vstack([np.zeros((0, c + 1)), *R.values()]))
+            R.clear()
+        if total is not None:
+            total = _triangular(_on_top(total, X))
+        else:
+            for gv in np.unique(g):
+                sel = X[g == gv]
+                prev = R.get(int(gv))
+                R[int(gv)] = _triangular(sel if prev is None else np.vstack([prev, sel]))
+                rows[int(gv)] = rows.get(int(gv), 0) + sel.shape[0]
+        del X
         if keep_groups:
             seen.append(g.copy())
-    if not R:
+    if not R and total is None:
         raise ShapeError("no regressor rows: the data hold no block")
+    groups = np.concatenate(seen) if keep_groups else None
+    if total is not None:
+        return GroupFactors(None, count, groups, total=total, target=target, source=source)
     k = max(R) + 1
     out = np.zeros((k, c + 1, c + 1))
     cnt = np.zeros(k, dtype=np.intp)
     for gv, Rg in R.items():
         out[gv], cnt[gv] = Rg, rows[gv]
-    groups = np.concatenate(seen) if keep_groups else None
     return GroupFactors(R=out, rows=cnt, groups=groups)
 
 
@@ -405,7 +469,7 @@ def _unweighted(fit: LeastSquaresFit, F: GroupFactors) -> LeastSquaresFit:
 def _noise(F: GroupFactors, rtol: float) -> NDArray[np.float64]:
     """WLS's noise std per group from the residual of a first OLS fit
     (:func:`~dynid.identification.estimators.group_noise`)."""
-    m, c = F.n_rows, F.R.shape[-1] - 1
+    m, c = F.n_rows, F.n_columns
     first = _solve(F.combined(), m, np.ones(c, dtype=bool), rtol, None)
     ss = F.residual_ss(first.beta)
     s = np.sqrt(ss / np.maximum(F.rows * (1.0 - c / max(m, 1)), 1.0))
@@ -529,12 +593,12 @@ def _irls(
     iteration (the weighted factor, the residuals)."""
     assert F.groups is not None
     groups = F.groups
-    m, c = F.n_rows, F.R.shape[-1] - 1
+    m, c = F.n_rows, F.n_columns
     w = 1.0 / s0[groups]
     e = np.empty(m)
     beta = None
     for _ in range(est.max_iter):
-        Rw = _weighted_factor(source, w, c)
+        Rw = _weighted_factor(source, lambda o, g, w=w: w[o : o + g.size], c)
         fb = _solve(Rw, m, np.ones(c, dtype=bool), rtol, labels).beta
         o = 0
         for W, y, _g in _blocks(source):
@@ -551,7 +615,7 @@ def _irls(
             break
     del e
     fit = _fit_pruned(
-        _weighted_factor(source, w, c),
+        _weighted_factor(source, lambda o, g: w[o : o + g.size], c),
         m,
         rtol=rtol,
         std=std,
@@ -562,16 +626,22 @@ def _irls(
     return _unweighted(fit, F)
 
 
-def _weighted_factor(source: BlockSource, w: NDArray[np.float64], c: int) -> NDArray[np.float64]:
-    """The factor (c+1, c+1) of ``diag(w) [W y]`` over every row (one pass)."""
+def _weighted_factor(
+    source: BlockSource,
+    weights: Callable[[int, NDArray[np.intp]], NDArray[np.float64]],
+    c: int,
+) -> NDArray[np.float64]:
+    """The factor (c+1, c+1) of ``diag(w) [W y]`` over every row (one pass);
+    ``weights(o, g)`` gives the weights of a block's rows from its first row ``o`` and
+    its groups ``g``."""
     R = np.zeros((c + 1, c + 1))
     o = 0
-    for W, y, _g in _blocks(source):
+    for W, y, g in _blocks(source):
         X = np.empty((y.size, c + 1), order="F")
-        wb = w[o : o + y.size]
+        wb = weights(o, g)
         np.multiply(W, wb[:, None], out=X[:, :c])
         np.multiply(y, wb, out=X[:, c])
-        R = _triangular(np.vstack([R, X]))
+        R = _triangular(_on_top(R, X))
         o += y.size
     return R
 

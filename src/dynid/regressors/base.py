@@ -47,11 +47,12 @@ from numpy.typing import ArrayLike, NDArray
 from .. import _checks
 from ..exceptions import OptionError, ShapeError
 from ..model.robot import Robot
-from .static import static_regressor
+from .static import static_regressor, static_rows
 from .terms import ModelTerm
 from .torque import torque_regressor_prepared
 
 __all__ = [
+    "BLOCK_BYTES",
     "RANK_FLOOR",
     "RANK_GAP",
     "BaseParameters",
@@ -352,6 +353,13 @@ def _from_scaled(
     )
 
 
+#: Largest stack of random-state regressor rows [bytes] :func:`base_parameters` holds at
+#: once; a longer chain's rows (50 joints: 64 states of 1325 rows and 500 columns, 0.34 GB)
+#: are reduced block by block to their triangular factor, which gives the same base
+#: parameters (the factor keeps every column norm and every linear dependency).
+BLOCK_BYTES = 64 << 20
+
+
 def base_parameters(
     robot: Robot,
     *,
@@ -360,6 +368,7 @@ def base_parameters(
     rng: np.random.Generator | None = None,
     rtol: float | None = None,
     terms: Sequence[ModelTerm] = (),
+    max_bytes: int = BLOCK_BYTES,
 ) -> BaseParameters:
     """Base parameters of a robot's structure, from random states.
 
@@ -381,28 +390,70 @@ def base_parameters(
         Extra model terms (:mod:`dynid.regressors.terms`); those ``in_base`` (a rotor
         inertia) join the standard parameters after the links' ``10 n``, with their labels,
         so that they regroup with the link parameters (``beta = J1zz + Ia1``).
+    max_bytes : int
+        Largest block of stacked regressor rows [bytes] held at once. When the rows of all
+        states exceed it, they are computed a block of states at a time and reduced to
+        the triangular factor ``R`` of the stack (``W = Q R``, a tall-skinny QR), whose
+        column norms and dependencies are those of ``W``: the same base parameters, in
+        ``O(p^2)`` memory for ``p`` columns.
+
+    Raises
+    ------
+    OptionError
+        An unknown ``kind``.
     """
     rng = np.random.default_rng(0) if rng is None else rng
+    if kind not in ("static", "torque"):
+        raise OptionError(f"kind must be 'static' or 'torque'; got {kind!r}")
     extra = [t for t in terms if t.in_base]
     lo = np.where(np.isfinite(robot.q_min), robot.q_min, -np.pi)
     hi = np.where(np.isfinite(robot.q_max), robot.q_max, np.pi)
     q = rng.uniform(lo, hi, (n_samples, robot.n))
-    if kind == "static":
-        blocks = [static_regressor(robot, q)]
-        for t in extra:  # (p, s, N) -> (N, s, p); a term that does not act at rest: zeros
-            C = t.static_columns(n_samples)
-            shape = (n_samples, blocks[0].shape[1], len(t.labels))
-            blocks.append(np.zeros(shape) if C is None else C.transpose(2, 1, 0))
-    elif kind == "torque":
+    dq = ddq = q
+    if kind == "torque":
         dq = rng.uniform(-2, 2, q.shape)
         ddq = rng.uniform(-5, 5, q.shape)
+    labels = robot.param_labels + tuple(lab for t in extra for lab in t.labels)
+    rows = static_rows(robot.n) if kind == "static" else robot.n
+    step = max(1, int(max_bytes) // (8 * rows * len(labels)))
+    if step >= n_samples:
+        W = _random_rows(robot, kind, extra, q, dq, ddq)
+        return base_parameters_from_regressor(W, labels, rtol=rtol)
+    R = np.zeros((0, len(labels)))
+    for a in range(0, n_samples, step):
+        b = slice(a, a + step)
+        W = _random_rows(robot, kind, extra, q[b], dq[b], ddq[b])
+        X = np.empty((R.shape[0] + W.shape[0], W.shape[1]), order="F")  # as LAPACK takes it
+        X[: R.shape[0]], X[R.shape[0] :] = R, W
+        del W
+        R = scipy.linalg.qr(X, mode="r", overwrite_a=True, check_finite=False)[0]
+        R = R[: len(labels)]
+        del X
+    return base_parameters_from_regressor(R, labels, rtol=rtol)
+
+
+def _random_rows(
+    robot: Robot,
+    kind: str,
+    extra: Sequence[ModelTerm],
+    q: NDArray[np.float64],
+    dq: NDArray[np.float64],
+    ddq: NDArray[np.float64],
+) -> NDArray[np.float64]:
+    """The stacked regressor rows (B rows per state, p columns) of the states ``q`` (B, n)
+    (with ``dq``, ``ddq`` for the torque kind) over the links and the ``extra`` terms."""
+    B = q.shape[0]
+    if kind == "static":
+        blocks = [static_regressor(robot, q)]
+        for t in extra:  # (p, s, B) -> (B, s, p); a term that does not act at rest: zeros
+            C = t.static_columns(B)
+            shape = (B, blocks[0].shape[1], len(t.labels))
+            blocks.append(np.zeros(shape) if C is None else C.transpose(2, 1, 0))
+    else:
         blocks = [torque_regressor_prepared(robot, q, dq, ddq, robot.gravity)]
         blocks += [t.torque_columns(q, dq, ddq) for t in extra]
-    else:
-        raise OptionError(f"kind must be 'static' or 'torque'; got {kind!r}")
-    labels = robot.param_labels + tuple(lab for t in extra for lab in t.labels)
-    W = np.concatenate(blocks, axis=-1).reshape(-1, len(labels))
-    return base_parameters_from_regressor(W, labels, rtol=rtol)
+    W = np.concatenate(blocks, axis=-1)
+    return W.reshape(-1, W.shape[-1])
 
 
 #: Labels of :func:`identifiability`.
