@@ -15,7 +15,13 @@ from scipy.spatial.transform import Rotation
 
 import dynid
 from dynid.cli.__main__ import main
-from dynid.exceptions import DataError, ModelError, ShapeError, UnknownNameError
+from dynid.exceptions import (
+    DataError,
+    ModelError,
+    RankDeficientError,
+    ShapeError,
+    UnknownNameError,
+)
 from dynid.feasibility.lmi import pseudo_inertia_margin
 from dynid.feasibility.payload import (
     identify_payload,
@@ -26,7 +32,7 @@ from dynid.identification.data import StaticDataset
 from dynid.io.static_data import save_static_csv
 from dynid.model.inertia import inertia6_from_matrix, phi_from_inertial
 from dynid.simulation.measurement import simulate_measurement
-from dynid.simulation.trajectories import random_fourier, uniform_times
+from dynid.simulation.trajectories import random_fourier, sinusoid_trajectory, uniform_times
 
 MASS = 0.83
 COM = np.array([0.012, -0.021, 0.064])
@@ -274,3 +280,40 @@ def test_cli_payload_on_an_identified_arm(tmp_path):
     assert main(argv + ["--out", str(tmp_path / "p"), "-q"]) == 0
     d = json.loads((tmp_path / "p" / "payload.json").read_text())
     assert abs(d["mass"] - MASS) < 1e-8 and np.max(np.abs(np.subtract(d["com"], COM))) < 1e-8
+
+
+def _sinusoid_log(amplitudes, seed):
+    """A 10 s log at 500 Hz of the Panda carrying the load, sinusoids of ``amplitudes``
+    [rad/s], with the default sensor noise (1e-4 rad, 1e-3 rad/s, 0.05 N m)."""
+    arm = dynid.panda()
+    loaded = arm.with_tool(np.eye(4), MASS, COM, _inertia(), name="load")
+    traj = sinusoid_trajectory(
+        uniform_times(10.0, 500.0), q0=dynid.PANDA_NEUTRAL_Q, amplitudes=amplitudes
+    )
+    return arm, simulate_measurement(loaded, traj, rng=np.random.default_rng(seed))
+
+
+def test_a_load_that_rotates_about_one_axis_is_refused_not_fitted_from_noise():
+    """Only joint 1 moves: the load rotates about one fixed axis, which excites 7 of its
+    10 parameters (m, m c and the inertia's column about that axis); the other 3 were
+    fitted from position noise (a 0.73 kg load came out as 0.31 kg, its CoM 1.3 m away).
+    No joint moves: gravity at one pose leaves 3 (m and the horizontal moments)."""
+    arm, log = _sinusoid_log([1.5, 0, 0, 0, 0, 0, 0], 21)
+    with pytest.raises(RankDeficientError, match=r"rank 8 of 10; unexcited .*hint: a log that"):
+        identify_payload(arm, log)
+    arm, log = _sinusoid_log(np.zeros(7), 22)
+    with pytest.raises(RankDeficientError, match=r"rank [0-3] of 10; unexcited"):
+        identify_payload(arm, log)
+
+
+def test_a_joint_that_never_moves_gets_no_friction_from_a_payload_log():
+    """Joint 4 stays inside its velocity noise band: its fv, fc are zero (not fitted from
+    noise) and said so; the moving joints' Coulomb friction is the arm's (0.3 N m,
+    published sigmoid near its plateau), and the load is still found."""
+    amplitudes = [2.21, -2.21, 1.2, 0.0, -2.3, 2.1, -2.5]
+    arm, log = _sinusoid_log(amplitudes, 23)
+    est = identify_payload(arm, log)
+    assert np.all(est.friction[3, :2] == 0.0)
+    assert np.all(est.friction[[0, 1, 2, 4, 5, 6], 1] > 0.1)
+    assert any("joint(s) 4 never leave" in note for note in est.notes)
+    assert abs(est.mass - MASS) < 0.05 * MASS

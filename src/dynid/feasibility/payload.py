@@ -17,7 +17,10 @@ linear in the load's parameters ``phi_F = [m, m c, J_F]`` (about ``F``'s origin,
   differentiated (:func:`~dynid.identification.log.prepare_log`), decimated to about ten
   samples per cutoff period (as :func:`~dynid.identification.classical.identify_from_log`),
   ``Y`` the torque regressor, and the classical friction ``fv, fc, fo`` per joint
-  estimated alongside;
+  estimated alongside; a joint whose measured velocity never leaves its noise band
+  (:func:`~dynid.identification.sanity.moving_joints`) does not move: its velocity and
+  acceleration are zero in the regressor and its ``fv, fc`` are not fitted (zero), so
+  nothing is fitted from noise;
 * **difference method** (``unloaded=`` data of the same kind recorded without the load):
   the arm is first identified from the unloaded data (base parameters,
   :func:`~dynid.identification.static.identify_static` or
@@ -45,16 +48,19 @@ from numpy.typing import NDArray
 
 from ..dynamics.rnea import rnea
 from ..dynamics.terms import gravity_torques, mass_matrix
-from ..exceptions import DataError, ModelError, ShapeError, SolverError
+from ..exceptions import DataError, ModelError, RankDeficientError, ShapeError, SolverError
 from ..identification.classical import auto_decimation, friction_regressor, identify_from_log
 from ..identification.data import StaticDataset
-from ..identification.least_squares import fit_least_squares
+from ..identification.least_squares import LeastSquaresFit, fit_least_squares
 from ..identification.log import DEFAULT_CUTOFF_HZ, TorqueLog, prepare_log
 from ..identification.model import IdentifiedModel
+from ..identification.sanity import moving_joints
 from ..identification.static import identify_static
 from ..model.inertia import inertia6_from_matrix, inertial_from_phi
 from ..model.robot import Robot
+from ..regressors.base import RANK_FLOOR
 from ..regressors.static import static_regressor, static_vector
+from ..regressors.terms import friction_labels
 from ..regressors.torque import torque_regressor
 from .lmi import phi_from_pseudo_inertia, pseudo_inertia, pseudo_inertia_margin
 
@@ -249,7 +255,8 @@ def identify_payload(
     ShapeError
         Data of another joint count; ``unloaded`` of another kind than ``data``.
     RankDeficientError
-        The configurations do not excite the load's parameters.
+        The data do not excite the load's parameters (configurations too alike, a load
+        that never rotates, a log in which no joint moves); the message names them.
     DataError
         ``g`` only and the estimated mass is not positive.
     SolverError
@@ -267,14 +274,15 @@ def identify_payload(
     robot = _arm_without_load(arm, kin, unloaded, static, cutoff_hz, rtol, notes)
     A = link_params_from_frame(f.T_link_frame)
     cols = slice(10 * (k - 1), 10 * k)
+    kept = None
     if isinstance(data, StaticDataset):
         W, yv, route = _static_rows(robot, data, cols, A, gravity_only, notes)
     else:
-        W, yv, route = _log_rows(robot, data, cols, A, cutoff_hz, notes)
+        W, yv, route, kept = _log_rows(robot, data, cols, A, cutoff_hz, notes)
     if unloaded is not None:
         route += ", difference"
-    fit = fit_least_squares(W, yv, rtol=1e-10 if rtol is None else rtol, std="robust")
     p = 4 if (static and gravity_only) else 10
+    fit = _fit_load(W, yv, kept, rtol, p, static)
     est = np.asarray(fit.beta)
     cov = np.asarray(fit.covariance)[:p, :p]
     friction = None if static else est[10:].reshape(n, 3)
@@ -353,6 +361,89 @@ def _static_rows(
     return Y.reshape(-1, Y.shape[-1]), y.reshape(-1), route
 
 
+_LOAD_LABELS = ("m", "mcx", "mcy", "mcz", "Jxx", "Jxy", "Jxz", "Jyy", "Jyz", "Jzz")
+
+
+def _fit_load(
+    W: NDArray[np.float64],
+    y: NDArray[np.float64],
+    kept: NDArray[np.bool_] | None,
+    rtol: float | None,
+    p: int,
+    static: bool,
+) -> LeastSquaresFit:
+    """The least squares of the load (and friction) columns.
+
+    Without ``rtol``, every direction of the load's ``p`` parameters must be excited
+    (:func:`_excited`): a load rotated about one axis only excites some of its 10
+    parameters, and the noise of the measured positions would otherwise fill the others.
+
+    Raises
+    ------
+    RankDeficientError
+        Naming the load's parameters the data do not excite, and what would excite them.
+    """
+    labels = _LOAD_LABELS[:p] + friction_labels((W.shape[1] - p) // 3)
+    if rtol is None:
+        r, names = _excited(W, p, kept, labels)
+        if r < p:
+            raise _not_excited(r, p, names, static)
+    try:
+        return fit_least_squares(
+            W, y, kept=kept, rtol=1e-10 if rtol is None else rtol, std="robust"
+        )
+    except RankDeficientError as exc:
+        by_column = {f"column {i}": label for i, label in enumerate(labels)}
+        shown = tuple(by_column.get(d, d) for d in exc.dependent)
+        raise _not_excited(exc.rank, exc.needed, shown, static) from None
+
+
+def _excited(
+    W: NDArray[np.float64], p: int, kept: NDArray[np.bool_] | None, labels: tuple[str, ...]
+) -> tuple[int, tuple[str, ...]]:
+    """How many directions of the load's parameters (the first ``p`` columns) the data
+    excite, and the labels of the others' large entries.
+
+    Every column is scaled to unit norm; the load's columns are then freed of what the
+    other fitted columns (friction, offsets) explain, and a direction whose singular
+    value stays below :data:`~dynid.regressors.base.RANK_FLOOR` (a 1e-3 part of a unit
+    column) is not excited: its estimate would be noise amplified a thousandfold.
+    """
+    import scipy.linalg  # as the rest of the module: scipy on first use
+
+    cols = np.arange(W.shape[1]) if kept is None else np.flatnonzero(kept)
+    other = cols[cols >= p]
+    M = np.concatenate([W[:, other], W[:, :p]], axis=1)
+    if M.shape[0] < M.shape[1]:
+        return p, ()  # fewer rows than columns: the least squares says so
+    norms = np.linalg.norm(M, axis=0)
+    M /= np.where(norms > 0, norms, 1.0)
+    R = scipy.linalg.qr(M, mode="r")[0]
+    _, sv, Vt = np.linalg.svd(R[other.size : other.size + p, other.size :])
+    r = int(np.sum(sv > RANK_FLOOR))
+    null = np.abs(Vt[r:])
+    names = tuple(labels[i] for i in np.flatnonzero(null.max(axis=0, initial=0.0) > 0.3))
+    return r, names
+
+
+def _not_excited(
+    rank: int | None, needed: int | None, names: tuple[str, ...], static: bool
+) -> RankDeficientError:
+    hint = (
+        "static data at more varied configurations (with --gravity-only: mass and CoM only)"
+        if static
+        else "a log that moves the joints carrying the load, its wrist included, so that "
+        "the load rotates about several axes (or static data)"
+    )
+    return RankDeficientError(
+        f"the data do not excite the load's parameters (rank {rank} of {needed}; "
+        f"unexcited combinations of {', '.join(names) or '?'}); hint: {hint}",
+        rank=rank,
+        needed=needed,
+        dependent=names,
+    )
+
+
 def _log_rows(
     robot: Robot,
     data: TorqueLog,
@@ -360,19 +451,30 @@ def _log_rows(
     A: NDArray[np.float64],
     cutoff_hz: float | None,
     notes: list[str],
-) -> tuple[NDArray[np.float64], NDArray[np.float64], str]:
-    """Regressor rows (the load's parameters, then classical friction per joint) and
-    targets of a torque log, filtered and decimated."""
+) -> tuple[NDArray[np.float64], NDArray[np.float64], str, NDArray[np.bool_]]:
+    """Regressor rows (the load's parameters, then classical friction per joint), targets
+    of a torque log, filtered and decimated, and the columns fitted (the viscous and
+    Coulomb friction of joints that never leave their velocity noise band are not)."""
+    still = ~moving_joints(data.dq)
     log = prepare_log(data, cutoff_hz=cutoff_hz)
     ddq = log.ddq
     assert ddq is not None  # prepare_log always differentiates
     sl = slice(None, None, auto_decimation(data.sample_rate, cutoff_hz))
-    q_, dq_, ddq_ = log.q[sl], log.dq[sl], ddq[sl]
+    # a still joint's filtered velocity is noise: it does not move
+    q_, dq_, ddq_ = log.q[sl], log.dq[sl] * ~still, ddq[sl] * ~still
     Y = torque_regressor(robot, q_, dq_, ddq_)[..., cols] @ A
     y = np.asarray(log.tau[sl]) - rnea(robot, q_, dq_, ddq_)
     Y = np.concatenate([Y, friction_regressor(dq_)], axis=-1)
+    kept = np.ones(Y.shape[-1], dtype=bool)
+    kept[10:] = ~(np.repeat(still, 3) & (np.arange(3 * data.n) % 3 != 2))
     notes.append("classical friction fv, fc, fo per joint estimated alongside")
-    return Y.reshape(-1, Y.shape[-1]), y.reshape(-1), "torque log"
+    if still.any():
+        which = ", ".join(str(j + 1) for j in np.flatnonzero(still))
+        notes.append(
+            f"joint(s) {which} never leave their velocity noise band: taken as still, "
+            "their friction fv, fc is not identifiable and is zero (not fitted from noise)"
+        )
+    return Y.reshape(-1, Y.shape[-1]), y.reshape(-1), "torque log", kept
 
 
 def _load_parameters(
