@@ -4,6 +4,8 @@
   logs or static data): every link's pseudo-inertia kept positive definite, pulled towards
   a :class:`Prior` (:mod:`.sdp`, :mod:`.one_step`, :mod:`.lmi`, :mod:`.prior`).
 * :func:`retrieve`: Gaz et al. 2019, Algorithm 1 (:mod:`.retrieve`, :mod:`.penalty`).
+* :class:`FeasibleResult`: what both methods return (:class:`ConsistentResult`,
+  :class:`RetrievalResult`) and files and figures read (:mod:`.result`).
 * :func:`compare_methods`: both on the same coefficients (:mod:`.compare`).
 * :func:`identify_payload`: a load's mass, CoM and inertia on a known arm, with the same
   LMI (:mod:`.payload`).
@@ -19,12 +21,14 @@ from .lmi import log_det_divergence, pseudo_inertia, pseudo_inertia_margin
 from .one_step import identify_consistent
 from .payload import PayloadEstimate, identify_payload, robot_with_payload
 from .prior import Prior, generic_prior, prior_from_robot
+from .result import FeasibleResult
 from .retrieve import RetrievalOptions, RetrievalResult, retrieve, retrieve_from_static
 from .sdp import ConsistentResult, SDPOptions, retrieve_sdp, solve_consistent
 
 __all__ = [
     "Bounds",
     "ConsistentResult",
+    "FeasibleResult",
     "MethodSummary",
     "PayloadEstimate",
     "Prior",

@@ -22,8 +22,9 @@ from ..model.inertia import inertial_from_phi, phi_from_inertial
 from ..model.robot import Robot
 from .bounds import Bounds
 from .constraints import feasibility_report
-from .lmi import pseudo_inertia_margin, repair_pseudo_inertia
+from .lmi import repair_pseudo_inertia
 from .prior import Prior, prior_from_robot
+from .result import FeasibleResult
 from .retrieve import RetrievalOptions, retrieve
 from .sdp import SDPOptions, retrieve_sdp
 
@@ -40,7 +41,9 @@ class MethodSummary:
     ----------
     name : str
         ``"sdp"``, ``"penalty"`` or ``"penalty + prior"``.
-    result : ConsistentResult or RetrievalResult
+    result : FeasibleResult
+        :class:`~dynid.feasibility.sdp.ConsistentResult` or
+        :class:`~dynid.feasibility.retrieve.RetrievalResult`.
     feasible : bool
     relative_residual : float
         ``||P phi - beta|| / ||beta||`` over the kept coefficients.
@@ -60,7 +63,7 @@ class MethodSummary:
     """
 
     name: str
-    result: Any
+    result: FeasibleResult
     feasible: bool
     relative_residual: float
     min_margin: dict[str, float]
@@ -106,10 +109,15 @@ def _median_rel(m: NDArray[np.float64], ref: NDArray[np.float64]) -> float:
 
 
 def _summary(
-    name: str, res: Any, model: IdentifiedModel, prior: Prior, truth: Robot | None, t: float
+    name: str,
+    res: FeasibleResult,
+    model: IdentifiedModel,
+    prior: Prior,
+    truth: Robot | None,
+    t: float,
 ) -> MethodSummary:
-    phi = res.robot.phi.reshape(res.robot.n, 10)
-    ia = getattr(res, "rotor_inertia", None)
+    phi = res.phi
+    ia = res.rotor_inertia
     if model.base.n_std > phi.size and ia is None:  # a method of the links alone
         model = model.links_only()
     keep = np.asarray(model.fit.kept, dtype=bool)
@@ -119,7 +127,7 @@ def _summary(
     rel = float(np.linalg.norm(P @ std - beta) / np.linalg.norm(beta))
     rep = feasibility_report(res.robot)
     margins = {n: float(rep.min_margin(n)) for n in _PHYSICAL}
-    margins["pseudo_inertia"] = float(pseudo_inertia_margin(phi).min())
+    margins["pseudo_inertia"] = float(res.pseudo_inertia_margin.min())
     return MethodSummary(
         name=name,
         result=res,

@@ -48,7 +48,7 @@ import time
 from collections.abc import Callable, Sequence
 from concurrent.futures import as_completed
 from dataclasses import dataclass
-from typing import Any
+from typing import Any, ClassVar
 
 import numpy as np
 import scipy.linalg
@@ -71,6 +71,7 @@ from .penalty import (
     static_problem,
     with_prior,
 )
+from .result import FeasibleResult
 
 __all__ = [
     "ParameterDistance",
@@ -257,77 +258,48 @@ class ParameterDistance:
 
 
 @dataclass(frozen=True, slots=True, eq=False)
-class RetrievalResult:
-    """Result of a retrieval.
+class RetrievalResult(FeasibleResult):
+    """Result of the penalty method: a :class:`~dynid.feasibility.result.FeasibleResult`
+    (robot, relative residual, report, bounds, run time, seed, notes, ...) with the runs.
 
     Attributes
     ----------
-    robot : Robot
-        The robot (kinematics, limits, friction of the input) with the retrieved
-        parameters.
-    mass : ndarray, shape (n,)
-        Link masses [kg].
-    com : ndarray, shape (n, 3)
-        CoMs in the link frames [m].
-    inertia : ndarray, shape (n, 3, 3)
-        Inertias about the CoMs, link axes [kg m^2].
-    relative_residual : float
-        Two-step: ``||pi(p) - pi_hat|| / ||pi_hat||`` over the kept coefficients;
-        single-step: ``||Y_s phi(p) - s|| / ||s||``.
     cost : float
         Final stage objective of the kept run.
-    feasible : bool
-        Whether every constraint of ``report`` holds.
-    report : FeasibilityReport
-        Every constraint with its margin: physical, bounds, total mass, the user's and
-        ``data_fit`` (``residual_tol - relative_residual``, see :class:`RetrievalOptions`).
     stage_costs : ndarray, shape (kappa,)
         Stage objectives of the kept run.
-    run_time : float
-        Wall time [s].
-    seed : int or None
     runs : tuple of RetrievalRun
         Every run, in index order.
     best_run : int
         Index of the kept run.
-    bounds : Bounds
-    total_mass : (float, float) or None
-        The total-mass band used [kg].
     options : RetrievalOptions
-    kind : str
-        ``"coefficients"`` or ``"static"``.
     workers : int
         Processes used.
+
+    Notes
+    -----
+    ``relative_residual`` is ``||pi(p) - pi_hat|| / ||pi_hat||`` over the kept coefficients
+    (two-step) or ``||Y_s phi(p) - s|| / ||s||`` (single-step); ``report`` holds the physical
+    constraints, the bounds, the total mass, the user's and ``data_fit``
+    (``residual_tol - relative_residual``, see :class:`RetrievalOptions`); ``kind`` is
+    ``"coefficients"`` or ``"static"``.
     """
 
-    robot: Robot
-    mass: NDArray[np.float64]
-    com: NDArray[np.float64]
-    inertia: NDArray[np.float64]
-    relative_residual: float
     cost: float
-    feasible: bool
-    report: FeasibilityReport
     stage_costs: NDArray[np.float64]
-    run_time: float
-    seed: int | None
     runs: tuple[RetrievalRun, ...]
     best_run: int
-    bounds: Bounds
-    total_mass: tuple[float, float] | None
     options: RetrievalOptions
-    kind: str
     workers: int
+
+    method: ClassVar[str] = "penalty"
+    nullable_fields: ClassVar[frozenset[str]] = frozenset({"cost", "stage_costs", "runs"})
 
     @property
     def p(self) -> NDArray[np.float64]:
-        """Decision parameters (n, 10): ``m, cx, cy, cz, Ixx, Ixy, Ixz, Iyy, Iyz, Izz``."""
+        """Decision parameters (n, 10) of the kept run: ``m, cx, cy, cz, Ixx, Ixy, Ixz, Iyy,
+        Iyz, Izz`` (inertia about the CoM)."""
         return self.runs[self.best_run].p
-
-    @property
-    def phi(self) -> NDArray[np.float64]:
-        """Standard parameters (n, 10) (inertia about the link origin)."""
-        return self.robot.phi
 
     @property
     def n_feasible_runs(self) -> int:
@@ -346,6 +318,45 @@ class RetrievalResult:
             com=np.linalg.norm(self.p[:, 1:4] - q[:, 1:4], axis=1),
             inertia=np.linalg.norm(d_I, axis=(1, 2)),
         )
+
+    def report_fields(self) -> dict[str, Any]:
+        """``report.json``'s entries of the penalty method: ``cost``, ``stage_costs``, ``xi``
+        (the penalty weights), ``workers``, ``best_run``, ``n_feasible_runs``, ``runs`` (per
+        run: final cost, stage costs, relative residual, feasible, violation, evaluations,
+        time [s]) and ``options``."""
+        o = self.options
+        return {
+            "cost": float(self.cost),
+            "stage_costs": [float(x) for x in self.stage_costs],
+            "xi": list(o.schedule()),
+            "workers": int(self.workers),
+            "best_run": int(self.best_run),
+            "n_feasible_runs": int(self.n_feasible_runs),
+            "runs": [
+                {
+                    "index": r.index,
+                    "cost": float(r.stage_costs[-1]),
+                    "stage_costs": [float(x) for x in r.stage_costs],
+                    "relative_residual": float(r.relative_residual),
+                    "feasible": bool(r.feasible),
+                    "violation": float(r.violation),
+                    "n_evaluations": int(r.n_evaluations),
+                    "time_s": float(r.time),
+                }
+                for r in self.runs
+            ],
+            "options": {
+                "runs": o.runs,
+                "stages": o.stages,
+                "anneal_maxiter": o.anneal_maxiter,
+                "anneal_temperature": o.anneal_temperature,
+                "local_maxiter": o.local_maxiter,
+                "margin": o.margin,
+                "scale_floor": o.scale_floor,
+                "tol": o.tol,
+                "residual_tol": o.residual_tol,
+            },
+        }
 
 
 # ------------------------------------------------------------------------- local step
@@ -583,19 +594,16 @@ def _solve(
     else:
         best = min(runs, key=lambda r: (r.violation, r.stage_costs[-1], r.index))
     rep = reports[best.index]
+    notes: tuple[str, ...] = ()
     if not rep.ok:
         msg = f"no feasible parameters found in {options.runs} runs; least violating: {rep}"
         if require_feasible:
             raise InfeasibleError(msg + "; hint: check the bounds and the total-mass band")
         _log.warning(msg)
-    mass, com, I6 = best.p[:, 0], best.p[:, 1:4], best.p[:, 4:]
-    inertia = matrix_from_inertia6(I6)
-    new_robot = robot.with_inertials(mass, com, inertia)
+        notes = (msg,)
+    new_robot = robot.with_inertials(best.p[:, 0], best.p[:, 1:4], best.p[:, 4:])
     return RetrievalResult(
         robot=new_robot,
-        mass=mass.copy(),
-        com=com.copy(),
-        inertia=inertia,
         relative_residual=best.relative_residual,
         cost=float(best.stage_costs[-1]),
         feasible=rep.ok,
@@ -610,6 +618,7 @@ def _solve(
         options=options,
         kind=problem.kind,
         workers=w,
+        notes=notes,
     )
 
 

@@ -55,9 +55,10 @@ import dataclasses
 import math
 import time
 import warnings
-from collections.abc import Callable, Sequence
+from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass
-from typing import Any
+from types import MappingProxyType
+from typing import Any, ClassVar
 
 import numpy as np
 from numpy.typing import NDArray
@@ -67,7 +68,7 @@ from ..identification.holdout import HeldOut, cross_validate
 from ..identification.least_squares import LeastSquaresFit
 from ..identification.model import IdentifiedModel
 from ..model.drive import Drive
-from ..model.inertia import inertial_from_phi, params_from_inertial
+from ..model.inertia import inertial_from_phi
 from ..model.robot import Robot
 from .bounds import Bounds, default_bounds, segment_points
 from .constraints import Constraint, FeasibilityReport, feasibility_report
@@ -79,6 +80,7 @@ from .lmi import (
     repair_pseudo_inertia,
 )
 from .prior import Prior, generic_prior, prior_from_robot, prior_scales
+from .result import FeasibleResult
 
 __all__ = [
     "DEFAULT_SDP_MARGIN",
@@ -324,30 +326,17 @@ def _friction_labels(model: IdentifiedModel) -> tuple[str, ...]:
 
 
 @dataclass(frozen=True, slots=True, eq=False)
-class ConsistentResult:
-    """Physically consistent parameters from the convex retrieval or identification.
+class ConsistentResult(FeasibleResult):
+    """Result of the convex retrieval or identification: a
+    :class:`~dynid.feasibility.result.FeasibleResult` (robot, relative residual, report,
+    bounds, run time, notes, friction and rotor inertias identified with the links, drive,
+    held-out judgement) with the prior, its weight and the solver's account.
 
     Attributes
     ----------
-    robot : Robot
-        The input robot with the consistent link parameters (and its friction, if any).
-    phi : ndarray, shape (n, 10)
-        Standard parameters (m, m c, J about the link origin).
-    friction : ndarray, shape (n, 3) or None
-        One-step on a torque log: classical friction ``fv, fc, fo`` per joint identified
-        with the links (``fv, fc >= 0``) [N m s/rad, N m, N m].
-    relative_residual : float
-        ``||P phi - beta|| / ||beta||`` over the kept coefficients.
     residual_ratio : float
         Residual RMS of the identification's data with these parameters over that of the
         unconstrained least squares (1 for exact data met exactly): ``sqrt(1 + chi2/dof)``.
-    feasible : bool
-        Every constraint of ``report`` holds.
-    report : FeasibilityReport
-        Physical constraints, bounds, total mass, ``pseudo_inertia`` (margin
-        ``lambda_min(J)/tr(J)``, dimensionless) and ``data_fit``.
-    pseudo_inertia_margin : ndarray, shape (n,)
-        ``lambda_min(J_i) / tr(J_i)``.
     prior : Prior
     prior_weight : float
         The weight used (the automatic choice, or the one given).
@@ -361,44 +350,25 @@ class ConsistentResult:
         Solver status (``"optimal"``, ``"optimal_inaccurate"``, ``"infeasible"`` when the
         equality has no consistent solution and the closest set is returned).
     solver : str
-    kind : str
-        ``"coefficients"`` (two-step), ``"log"`` or ``"static"`` (one-step).
-    run_time : float
-        Wall time [s].
-    bounds : Bounds
-        The bounds used (masses narrowed by the prior).
-    total_mass : (float, float) or None
     options : SDPOptions
-    notes : tuple of str
-        What the user should know: the prior's repairs, the weight's choice.
-    method : str
-        ``"sdp"``.
-    seed : int or None
-        Recorded for files (the convex problem uses no randomness).
     identified : IdentifiedModel or None
         One-step: the unconstrained least-squares identification of the same data.
-    rotor_inertia : ndarray, shape (n,), or None
-        Rotor inertias [kg m^2] at the motors (``>= 0``), identified with the links when
-        the data term holds them (a drive with ``rotor_inertia = "identify"``).
-    drive : Drive or None
-        The drive train of the data, its rotor inertias those of the result
-        (:func:`with_drive`).
-    heldout : HeldOutJudgement or None
-        Training and held-out errors against least squares, the weight's choice and the
-        acceptance, when the data term holds held-out folds.
     on_bound : tuple of str
         Parameters that sit on a bound (mass box, CoM box, total-mass band): decided by the
         bound, not the data.
+
+    Notes
+    -----
+    ``relative_residual`` is ``||P phi - beta|| / ||beta||`` over the kept coefficients;
+    ``report`` holds the physical constraints, the bounds, the total mass,
+    ``pseudo_inertia`` (margin ``lambda_min(J)/tr(J)``) and ``data_fit``; ``bounds`` are
+    the masses narrowed by the prior; ``kind`` is ``"coefficients"`` (two-step), ``"log"``
+    or ``"static"`` (one-step); ``friction`` (one-step on a torque log) holds ``fv, fc >= 0``;
+    ``drive`` is the data's drive train with the identified rotor inertias
+    (:func:`with_drive`); ``notes`` the prior's repairs and the weight's choice.
     """
 
-    robot: Robot
-    phi: NDArray[np.float64]
-    friction: NDArray[np.float64] | None
-    relative_residual: float
     residual_ratio: float
-    feasible: bool
-    report: FeasibilityReport
-    pseudo_inertia_margin: NDArray[np.float64]
     prior: Prior
     prior_weight: float
     weight_search: tuple[tuple[float, float], ...]
@@ -406,39 +376,54 @@ class ConsistentResult:
     fit: str
     status: str
     solver: str
-    kind: str
-    run_time: float
-    bounds: Bounds
-    total_mass: tuple[float, float] | None
     options: SDPOptions
-    notes: tuple[str, ...] = ()
-    method: str = "sdp"
-    seed: int | None = None
     identified: IdentifiedModel | None = None
-    rotor_inertia: NDArray[np.float64] | None = None
-    drive: Drive | None = None
-    heldout: HeldOutJudgement | None = None
     on_bound: tuple[str, ...] = ()
 
-    @property
-    def mass(self) -> NDArray[np.float64]:
-        """Link masses [kg], (n,)."""
-        return self.robot.mass
+    method: ClassVar[str] = "sdp"
+    nullable_fields: ClassVar[frozenset[str]] = frozenset(
+        {"prior_weight", "weight_search", "residual_ratio", "divergence"}
+    )
+    field_units: ClassVar[Mapping[str, str]] = MappingProxyType({"residual_ratio": "1"})
 
-    @property
-    def com(self) -> NDArray[np.float64]:
-        """CoMs in the link frames [m], (n, 3)."""
-        return self.robot.com
-
-    @property
-    def inertia(self) -> NDArray[np.float64]:
-        """Inertias about the CoMs, link axes [kg m^2], (n, 3, 3)."""
-        return self.robot.inertia
-
-    @property
-    def p(self) -> NDArray[np.float64]:
-        """Decision layout (n, 10): ``m, c, I`` about the CoM (as the penalty method's)."""
-        return params_from_inertial(self.mass, self.com, self.inertia)
+    def report_fields(self) -> dict[str, Any]:
+        """``report.json``'s entries of the convex method: ``fit``, ``prior`` (source,
+        repaired links, mass [kg] per link), ``prior_weight``, ``weight_search``
+        (``[w, residual_ratio]``), ``residual_ratio``, ``divergence`` per link,
+        ``distance_to_prior`` (mass [kg], CoM [m] per link), ``solver``, ``status``,
+        ``on_bound`` and ``options``."""
+        pm, pc, _ = inertial_from_phi(self.prior.phi)
+        o = self.options
+        return {
+            "fit": self.fit,
+            "prior": {
+                "source": self.prior.source,
+                "repaired_links": list(self.prior.repaired),
+                "mass": [float(x) for x in pm],
+            },
+            "prior_weight": float(self.prior_weight),
+            "weight_search": [[float(w), float(r)] for w, r in self.weight_search],
+            "residual_ratio": float(self.residual_ratio),
+            "divergence": [float(x) for x in self.divergence],
+            "distance_to_prior": {
+                "mass": [float(x) for x in np.abs(self.mass - pm)],
+                "com": [float(x) for x in np.linalg.norm(self.com - pc, axis=1)],
+            },
+            "solver": self.solver,
+            "status": self.status,
+            "on_bound": list(self.on_bound),
+            "options": {
+                "objective": o.objective,
+                "prior_weight": o.prior_weight,
+                "residual_increase": o.residual_increase,
+                "margin": o.margin,
+                "fit": o.fit,
+                "mass_factor": o.mass_factor,
+                "residual_tol": o.residual_tol,
+                "heldout_tol": o.heldout_tol,
+                "tol": o.tol,
+            },
+        }
 
 
 # ------------------------------------------------------------------------- the problem
@@ -770,14 +755,12 @@ def _finish(
     div = log_det_divergence(pseudo_inertia(phi), prior.pseudo_inertia)
     return ConsistentResult(
         robot=out,
-        phi=phi,
         friction=None if f is None else term.friction_table(f, robot.n),
         rotor_inertia=ia,
         relative_residual=rel,
         residual_ratio=ratio,
         feasible=bool(report.ok) and status != "infeasible",
         report=report,
-        pseudo_inertia_margin=marg,
         prior=prior,
         prior_weight=float(weight),
         weight_search=tuple(search),

@@ -27,6 +27,7 @@ from numpy.typing import NDArray
 
 from .. import __version__, _checks
 from ..exceptions import DataError, ModelError, ShapeError
+from ..feasibility.result import FeasibleResult
 from ..friction.model import ClassicalFriction, DriveFriction
 from ..model.drive import Drive
 from ..model.inertia import INERTIA_ORDER, inertia6_from_matrix
@@ -61,20 +62,27 @@ def _numbers(v: Any, size: int, where: str) -> NDArray[np.float64]:
     return _checks.numbers(v, size, where, DataError)
 
 
-def feasible_to_dict(source: Any, *, seed: int | None = None) -> dict[str, Any]:
-    """The link parameters (and kinematics, friction) of a retrieval result or a robot.
+def feasible_to_dict(source: FeasibleResult | Robot, *, seed: int | None = None) -> dict[str, Any]:
+    """The link parameters (and kinematics, friction) of a consistent result or a robot.
 
     Parameters
     ----------
-    source : RetrievalResult, ConsistentResult or Robot
-        A result also records ``method``, ``feasible``, ``relative_residual`` and its seed;
-        a consistent identification from a torque log its classical friction
-        (``linear_friction``: ``fv, fc >= 0`` identified with the links; per motor with a
-        drive whose friction acts at the motors), and with a drive its record (``drive``,
-        the identified rotor inertias [kg m^2] in ``rotor_inertia``).
+    source : FeasibleResult or Robot
+        A result (either method) also records ``method``, ``feasible``,
+        ``relative_residual`` and its seed; the classical friction identified with the links
+        (``linear_friction``: ``fv, fc >= 0``; per motor with a drive whose friction acts
+        at the motors), its drive's record (``drive``, the identified rotor inertias
+        [kg m^2] in ``rotor_inertia``) and its held-out judgement (``heldout``) when it has
+        them.
     seed : int, optional
         Recorded when ``source`` is a Robot.
+
+    Returns
+    -------
+    dict
+        JSON-ready (module docstring).
     """
+    result = None if isinstance(source, Robot) else source
     robot = source if isinstance(source, Robot) else source.robot
     I6 = inertia6_from_matrix(robot.inertia)
     links = [
@@ -91,7 +99,8 @@ def feasible_to_dict(source: Any, *, seed: int | None = None) -> dict[str, Any]:
         fr = {"model": "sigmoid"} | {
             f"phi{k + 1}": [float(x) for x in robot.friction[:, k]] for k in range(3)
         }
-    lin = getattr(source, "friction", None) if not isinstance(source, Robot) else None
+    lin = None if result is None else result.friction
+    drive = None if result is None else result.drive
     d: dict[str, Any] = {
         "schema": FEASIBLE_SCHEMA,
         "dynid_version": __version__,
@@ -101,28 +110,31 @@ def feasible_to_dict(source: Any, *, seed: int | None = None) -> dict[str, Any]:
         "linear_friction": None
         if lin is None
         else {"model": "classical"}
-        | {k: [float(x) for x in np.asarray(lin)[:, j]] for j, k in enumerate(("fv", "fc", "fo"))},
+        | {k: [float(x) for x in lin[:, j]] for j, k in enumerate(("fv", "fc", "fo"))},
         "kinematics": robot_to_dict(robot),
         "units": _UNITS,
         "conventions": _CONVENTIONS,
+        "drive": None if drive is None else drive.as_dict(),
     }
-    drive = getattr(source, "drive", None) if not isinstance(source, Robot) else None
-    d["drive"] = None if drive is None else drive.as_dict()
-    if not isinstance(source, Robot):
-        d["method"] = getattr(source, "method", "penalty")
-        d["feasible"] = bool(source.feasible)
-        d["relative_residual"] = finite_or_none(source.relative_residual)
-        d["seed"] = source.seed
-        ho = getattr(source, "heldout", None)
-        if ho is not None:
-            d["heldout"] = ho.as_dict()
-    elif seed is not None:
-        d["seed"] = seed
+    if result is None:
+        return d if seed is None else d | {"seed": seed}
+    d["method"] = result.method
+    d["feasible"] = bool(result.feasible)
+    d["relative_residual"] = finite_or_none(result.relative_residual)
+    d["seed"] = result.seed
+    if result.heldout is not None:
+        d["heldout"] = result.heldout.as_dict()
     return d
 
 
-def save_feasible_json(path: str | Path, source: Any) -> Path:
-    """Write ``feasible.json`` (see :func:`feasible_to_dict`); returns the path."""
+def save_feasible_json(path: str | Path, source: FeasibleResult | Robot) -> Path:
+    """Write ``feasible.json`` (see :func:`feasible_to_dict`); returns the path.
+
+    Raises
+    ------
+    NonFiniteError
+        A NaN or infinite number in the parameters (named).
+    """
     return save_json(path, feasible_to_dict(source))
 
 

@@ -12,8 +12,7 @@ from __future__ import annotations
 from pathlib import Path
 from typing import Any
 
-from ..feasibility.retrieve import RetrievalResult
-from ..feasibility.sdp import ConsistentResult
+from ..feasibility.result import FeasibleResult
 from ..friction.model import ClassicalFriction, DriveFriction
 from .export import ROBOT_FORMATS, ExportOptions, save_robot_files
 from .feasible import save_feasible_json
@@ -32,7 +31,7 @@ FEASIBLE_BUNDLE = (
 
 
 def save_feasible_bundle(
-    folder: str | Path, result: RetrievalResult | ConsistentResult, **report_extra: Any
+    folder: str | Path, result: FeasibleResult, **report_extra: Any
 ) -> list[Path]:
     """Write :data:`FEASIBLE_BUNDLE` for ``result`` into ``folder``.
 
@@ -40,8 +39,10 @@ def save_feasible_bundle(
     ----------
     folder : str or Path
         An existing folder.
-    result : RetrievalResult or ConsistentResult
-        A retrieval (penalty method) or a convex retrieval / one-step consistent fit.
+    result : FeasibleResult
+        A retrieval (penalty method, :class:`~dynid.feasibility.retrieve.RetrievalResult`)
+        or a convex retrieval / one-step consistent fit
+        (:class:`~dynid.feasibility.sdp.ConsistentResult`).
     **report_extra
         Extra keys of ``report.json`` (``source``, ``seed``), JSON values.
 
@@ -57,8 +58,7 @@ def save_feasible_bundle(
     """
     folder = Path(folder)
     files = [save_feasible_json(folder / "feasible.json", result)]
-    fr = getattr(result, "friction", None)  # one-step on a log: classical fv, fc, fo
-    drive = getattr(result, "drive", None)
+    fr, drive = result.friction, result.drive  # one-step on a log: classical fv, fc, fo
     friction: Any = True
     if fr is not None:
         law = ClassicalFriction.from_array(fr)

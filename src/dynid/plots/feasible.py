@@ -17,7 +17,9 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
+from ..feasibility.result import FeasibleResult
 from ..feasibility.retrieve import RetrievalResult
+from ..feasibility.sdp import ConsistentResult
 from ..friction.validation import NewtonEulerValidation
 
 if TYPE_CHECKING:  # pragma: no cover
@@ -207,7 +209,7 @@ def plot_retrieval(
 
 
 def plot_consistent(
-    results: Sequence[Any],
+    results: Sequence[FeasibleResult],
     *,
     labels: Sequence[str] | None = None,
     truth: Any = None,
@@ -215,28 +217,26 @@ def plot_consistent(
 ) -> Figure:
     """Masses and pseudo-inertia margins per link of one or more parameter sets.
 
-    Left: link masses [kg] of each result (bars), the prior's (of the first result that has
-    one, open markers) and ``truth``'s (a Robot, crosses) when given. Right: the margin
+    Left: link masses [kg] of each result (bars), the prior's (of the first convex result,
+    open markers) and ``truth``'s (a Robot, crosses) when given. Right: the margin
     ``lambda_min(J)/tr(J)`` of each link's pseudo-inertia (log scale; non-positive margins
     drawn at the bottom, red), with the convex method's margin as a dashed line.
 
     Parameters
     ----------
-    results : sequence
+    results : sequence of FeasibleResult
         :class:`~dynid.feasibility.sdp.ConsistentResult` or
-        :class:`~dynid.feasibility.retrieve.RetrievalResult` (anything with ``robot``).
+        :class:`~dynid.feasibility.retrieve.RetrievalResult`.
     labels : sequence of str, optional
         Legend entries (default the results' ``method``).
     truth : Robot, optional
     """
     import matplotlib.pyplot as plt
 
-    from ..feasibility.lmi import pseudo_inertia_margin
-
     if fig is None:
         fig = plt.figure(figsize=(11, 4))
     ax1, ax2 = fig.subplots(1, 2)
-    names = labels or [getattr(r, "method", "penalty") for r in results]
+    names = labels or [r.method for r in results]
     n = results[0].robot.n
     x = np.arange(1, n + 1)
     w = 0.8 / len(results)
@@ -244,16 +244,17 @@ def plot_consistent(
     for k, (res, name) in enumerate(zip(results, names, strict=True)):
         off = (k - (len(results) - 1) / 2) * w
         ax1.bar(x + off, res.robot.mass, width=w, label=name)
-        mg = pseudo_inertia_margin(res.robot.phi.reshape(n, 10))
+        mg = res.pseudo_inertia_margin
         ok = mg > 0
         ax2.bar(x[ok] + off, mg[ok], width=w, label=name)
         ax2.bar(x[~ok] + off, np.full((~ok).sum(), floor), width=w, color="tab:red")
-    prior = next((r.prior for r in results if getattr(r, "prior", None) is not None), None)
+    convex = [r for r in results if isinstance(r, ConsistentResult)]  # a prior, a margin
+    prior = convex[0].prior if convex else None
     if prior is not None:
         ax1.plot(x, prior.mass, "o", mfc="none", mec="k", label=f"prior ({prior.source})")
     if truth is not None:
         ax1.plot(x, truth.mass, "kx", ms=8, label="truth")
-    eps = next((r.options.margin for r in results if hasattr(r.options, "margin")), None)
+    eps = convex[0].options.margin if convex else None
     if eps is not None:
         ax2.axhline(eps, ls="--", color="k", lw=0.8, label=f"margin {eps:g}")
     ax1.set_xlabel("link")
