@@ -312,7 +312,8 @@ def test_cli_consistent_fit_with_a_coupled_drive_keeps_the_rotors_out_of_the_lin
     identified, >= 0) -> feasible.json and robot.toml keep the drive with the identified
     rotor inertias (within 5 % of the truth; 0.05 N m of noise), robot.xml carries them as
     armature, and validate --params predicts a held-out log as well as the unconstrained
-    fit."""
+    fit. The prior weight is given: 1e6, the weight the automatic search picks on this log
+    (the top of its range); the search itself is test_heldout_consistent.py's subject."""
     import json
 
     from dynid.cli.__main__ import main
@@ -332,8 +333,8 @@ def test_cli_consistent_fit_with_a_coupled_drive_keeps_the_rotors_out_of_the_lin
         out = ["--seed", str(seed), "--out", str(tmp_path / name)]
         assert main(["simulate", *sim, *out]) == 0
     args = ["identify", *R, "--drive", str(tmp_path / "drive.toml"), "--consistent"]
-    args += ["--prior", path, "--data", str(tmp_path / "log.csv"), "--out", str(tmp_path / "c")]
-    assert main([*args, "-q", "--no-figures"]) == 0
+    args += ["--prior", path, "--prior-weight", "1e6", "--data", str(tmp_path / "log.csv")]
+    assert main([*args, "--out", str(tmp_path / "c"), "-q", "--no-figures"]) == 0
     feas = json.loads((tmp_path / "c" / "feasible.json").read_text())
     ia = np.array(feas["drive"]["rotor_inertia"])
     np.testing.assert_allclose(ia, IA, rtol=0.05)
