@@ -227,3 +227,16 @@ def test_partial_bounds_file_fills_defaults_and_rejects_unknowns(tmp_path):
     (tmp_path / "b.yaml").write_text("x")
     with pytest.raises(DataError, match=".json or .toml"):
         load_bounds(tmp_path / "b.yaml", panda)
+
+
+def test_bounds_file_values_are_lists_of_finite_numbers():
+    """A bound of the wrong length, a boolean or an infinite number is one DataError naming
+    the link, the key and the entry."""
+    panda = dynid.panda()
+    for value, message in (
+        ([1.0], r"links\[0\] mass must be a list of 2 numbers; got \[1.0\]"),
+        ([1.0, True], r"links\[0\] mass\[1\] must be a number; got True"),
+        ([0.0, float("inf")], r"links\[0\] mass\[1\] must be finite"),
+    ):
+        with pytest.raises(DataError, match=message):
+            bounds_from_dict({"links": [{"name": "link3", "mass": value}]}, panda, source="b.json")
