@@ -31,8 +31,10 @@ $(DOCS): $(RUNTIME)
 demo: $(RUNTIME)
 	$(VENV)/bin/dynid demo --out out
 
-# one worker per core (pytest-xdist); PYTEST_WORKERS=0 runs in one process
+# one worker per core (pytest-xdist); PYTEST_WORKERS=0 runs in one process. Tests marked
+# xdist_group(name) share a module fixture and run on one worker (--dist loadgroup).
 PYTEST_WORKERS ?= auto
+PYTEST_XDIST := -n $(PYTEST_WORKERS) --dist loadgroup
 
 # Chromium renders the HTML reports in tests/test_html_report.py (skipped without it): when
 # it is missing, install Debian's package where apt-get can (root, a Debian system); any
@@ -43,11 +45,11 @@ CHROMIUM_INSTALL = command -v chromium >/dev/null 2>&1 || { \
 
 test: $(TESTS)
 	@$(CHROMIUM_INSTALL)
-	MPLBACKEND=Agg $(PY) -m pytest -q -n $(PYTEST_WORKERS)
+	MPLBACKEND=Agg $(PY) -m pytest -q $(PYTEST_XDIST)
 
 # everything but the tests marked slow (over about 10 s each)
 test-fast: $(TESTS)
-	MPLBACKEND=Agg $(PY) -m pytest -q -n $(PYTEST_WORKERS) -m "not slow"
+	MPLBACKEND=Agg $(PY) -m pytest -q $(PYTEST_XDIST) -m "not slow"
 
 bench: $(TESTS)
 	$(PY) benchmarks/run_all.py

@@ -127,12 +127,24 @@ def test_short_optimisation_respects_every_limit_at_1khz_and_is_reproducible():
     np.testing.assert_array_equal(again.trajectory.q_start, res.trajectory.q_start)
 
 
+@pytest.fixture(scope="module")
+def default_optimisation():
+    """The Panda's trajectory optimised with the default options (the paper's form and
+    margins) from seed 0, computed once for the tests that only read it."""
+    return optimise_excitation(dynid.panda(), np.random.default_rng(0))
+
+
+# the tests sharing the default optimisation run on one xdist worker (`--dist loadgroup`)
+_SHARES_DEFAULT = pytest.mark.xdist_group("excitation-default-optimisation")
+
+
 @pytest.mark.slow
-def test_panda_20s_optimised_condition_number_is_at_most_half_the_papers():
+@_SHARES_DEFAULT
+def test_panda_20s_optimised_condition_number_is_at_most_half_the_papers(default_optimisation):
     """Issue 9: default options (the paper's form and margins), cond <= 0.5 x the paper's
     trajectory measured the same way, admissible at 1 kHz."""
     robot = dynid.panda()
-    res = optimise_excitation(robot, np.random.default_rng(0))
+    res = default_optimisation
     paper, _ = excitation_condition_number(robot, paper_trajectory())
     assert res.condition_number <= 0.5 * paper
     assert res.status == "ok"
@@ -140,13 +152,16 @@ def test_panda_20s_optimised_condition_number_is_at_most_half_the_papers():
 
 
 @pytest.mark.slow
-def test_identification_along_the_optimised_trajectory_beats_a_random_fourier_one():
+@_SHARES_DEFAULT
+def test_identification_along_the_optimised_trajectory_beats_a_random_fourier_one(
+    default_optimisation,
+):
     """Simulated logs (sensor noise, sigmoid friction), 3 seeds: lower base-parameter errors
     along the optimised trajectory than along random Fourier series of the same length."""
     robot = dynid.panda()
     base = base_parameters(robot, kind="torque")
     truth = base.beta_from_phi(robot.phi)
-    opt = optimise_excitation(robot, np.random.default_rng(0)).trajectory.sample(1000.0)
+    opt = default_optimisation.trajectory.sample(1000.0)
     t = uniform_times(opt.t[-1], 1000.0)
 
     def error(tr, seed):
