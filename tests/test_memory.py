@@ -21,7 +21,7 @@ from dynid.friction.model import ClassicalFriction
 from dynid.friction.validation import BLOCK_SAMPLES, validate_torques
 from dynid.identification.classical import identify_from_log
 from dynid.identification.log import TorqueLog, prepare_log
-from dynid.io.torque_log import save_torque_log
+from dynid.io.torque_log import load_torque_log, save_torque_log
 from dynid.simulation.measurement import sample_times, simulate_measurement
 from dynid.simulation.trajectories import random_fourier
 
@@ -269,3 +269,93 @@ def test_static_data_of_a_50_joint_arm_identify_under_an_address_space_limit(tmp
     model = load_model_json(tmp_path / "out" / "identification.json")
     truth = model.base.beta_from_phi(robot.phi)
     np.testing.assert_allclose(model.fit.beta, truth, rtol=1e-6, atol=1e-9 * np.abs(truth).max())
+
+
+def test_simulated_log_in_blocks_equals_the_whole_array_simulation():
+    """measured_blocks, a block of 1000 samples at a time, gives exactly the log of
+    simulate_measurement on the whole arrays (the same noise of every signal, the same
+    dropped samples, rotor and unmodelled torques, the drive's side), and leaves the
+    generator where the whole-array simulation leaves it."""
+    from dynid.model.drive import Drive
+    from dynid.simulation.measurement import measured_blocks
+    from dynid.simulation.unmodelled import UnmodelledEffects
+
+    robot = dynid.panda()
+    series = random_fourier(robot, np.random.default_rng(1))
+    traj = series(sample_times(7.5, 1000.0))
+    drive = Drive.from_gears(np.full(7, 50.0), offset=np.linspace(-0.1, 0.1, 7))
+    kw = {
+        "drop_fraction": 0.1,
+        "with_ddq": True,
+        "effects": UnmodelledEffects.typical(7, np.random.default_rng(2)),
+        "drive": drive,
+    }
+    rng_a, rng_b = np.random.default_rng(3), np.random.default_rng(3)
+    ref = simulate_measurement(robot, traj, rng=rng_a, **kw)
+    at = lambda b: series(traj.t[b])  # noqa: E731
+    got = measured_blocks(robot, at, len(traj), rng=rng_b, block=1000, **kw)
+    pieces = list(got())
+    assert len(pieces) == 8 and got.n_samples == ref.n_samples
+    for name in ("t", "q", "dq", "tau", "ddq"):
+        joined = np.concatenate([getattr(p, name) for p in pieces])
+        np.testing.assert_array_equal(joined, getattr(ref, name), err_msg=name)
+    assert rng_a.standard_normal() == rng_b.standard_normal()
+
+
+def test_limits_over_blocks_equal_those_of_the_whole_trajectory(panda):
+    """check_limits_blocks and limit_scaling over pieces of a trajectory that exceeds its
+    limits give the report and the factors of check_limits and scale_into_limits on the
+    whole (each written out on the joined arrays)."""
+    from dynid.simulation.trajectories import (
+        check_limits,
+        check_limits_blocks,
+        limit_scaling,
+        scale_into_limits,
+        sinusoid_trajectory,
+    )
+
+    t = sample_times(12.0, 500.0)
+    A = 1.6 * np.array([1.0, 1.0, 1.0, 1.0, 1.0, 2.0, 2.0])
+    T = np.array([3.68, 2.04, 2.98, 1.75, 4.43, 2.749, 1.06])
+    traj = sinusoid_trajectory(t, np.zeros(7), A, T)
+    at = [sinusoid_trajectory(t[a : a + 700], np.zeros(7), A, T) for a in range(0, t.size, 700)]
+    ref = check_limits(panda, traj)
+    assert not ref.ok
+    assert check_limits_blocks(panda, at) == ref
+    for method in ("amplitude", "time"):
+        try:
+            whole, factor = scale_into_limits(panda, traj, method=method)
+        except dynid.LimitError as exc:
+            with pytest.raises(dynid.LimitError, match=str(exc)[:40]):
+                limit_scaling(panda, lambda: iter(at), method=method)
+            continue
+        scaling = limit_scaling(panda, lambda: iter(at), method=method)
+        assert scaling.factor == factor
+        joined = [scaling.apply(p) for p in at]
+        np.testing.assert_array_equal(np.concatenate([p.q for p in joined]), whole.q)
+        np.testing.assert_array_equal(np.concatenate([p.t for p in joined]), whole.t)
+
+
+def _simulate_peak(tmp_path, seconds: float) -> int:
+    """Peak virtual memory [bytes] of ``dynid simulate`` of ``seconds`` at 1 kHz to NPZ."""
+    out = tmp_path / f"sim-{seconds:g}.npz"
+    cmd = [sys.executable, "-c", _VM_RUN, "0", "simulate", "--trajectory", "fourier"]
+    cmd += ["--duration", f"{seconds:g}", "--seed", "1", "--out", str(out), "-q"]
+    env = {**os.environ, "OPENBLAS_NUM_THREADS": "1"}
+    proc = subprocess.run(cmd, capture_output=True, text=True, env=env, timeout=600)
+    assert proc.returncode == 0, proc.stderr
+    log = load_torque_log(out)
+    assert log.n_samples == round(seconds * 1000) + 1
+    return [int(s.split()[1]) for s in proc.stdout.splitlines() if s.startswith("VMPEAK")][0]
+
+
+@pytest.mark.slow
+def test_simulate_memory_does_not_grow_with_the_length_of_the_log(tmp_path):
+    """dynid simulate computes and writes a log in blocks: 1,000,001 samples peak within
+    100 MB of 100,001 (the whole arrays of the longer log, trajectory and measurements,
+    are 0.7 GB more)."""
+    if not os.path.exists("/proc/self/status"):
+        pytest.skip("needs /proc/self/status (Linux)")
+    short = _simulate_peak(tmp_path, 100.0)
+    long = _simulate_peak(tmp_path, 1000.0)
+    assert long < short + 100 * 2**20, (short, long)

@@ -198,7 +198,7 @@ def test_blank_lines_keep_the_fast_reader_and_the_same_arrays(tmp_path, monkeypa
     def refuse(*args, **kw):
         raise AssertionError("the slow reader was used")
 
-    monkeypatch.setattr(torque_log, "_slow_parse", refuse)
+    monkeypatch.setattr(torque_log, "_slow_table", refuse)
     back = load_torque_log(tmp_path / "blank.csv")
     for k in ("t", "q", "dq", "tau"):
         np.testing.assert_array_equal(getattr(back, k), getattr(log, k))

@@ -24,22 +24,26 @@ from __future__ import annotations
 
 import argparse
 import logging
+from collections.abc import Callable, Iterator
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 
 from ..exceptions import DynidError
 from ..friction.model import FrictionModel
 from ..io.friction_json import load_friction_json
-from ..io.torque_log import save_torque_log
-from ..simulation.measurement import SensorNoise, sample_times, simulate_measurement
+from ..io.torque_log import save_torque_log_pieces
+from ..model.robot import Robot
+from ..simulation.measurement import BLOCK_SAMPLES, SensorNoise, measured_blocks, sample_times
 from ..simulation.trajectories import (
     GAZ2019_SINUSOID_AMPLITUDES,
     GAZ2019_SINUSOID_PERIODS,
+    Trajectory,
     centered_start,
-    check_limits,
+    check_limits_blocks,
+    limit_scaling,
     random_fourier,
-    scale_into_limits,
     sinusoid_trajectory,
 )
 from .common import (
@@ -157,50 +161,75 @@ def _friction(args: argparse.Namespace) -> FrictionModel | str:
     return load_friction_json(args.friction)
 
 
-def run(args: argparse.Namespace, console: Console) -> int:
-    """Simulate and write the log; prints the limit report and a summary (unless -q)."""
-    say = console.print
-    robot = load_robot(args)
+def _trajectory(
+    args: argparse.Namespace, robot: Robot, t: np.ndarray, rng: np.random.Generator
+) -> tuple[Callable[[slice], Trajectory], int]:
+    """The true trajectory, a slice of the sample times ``t`` at a time (a file's
+    trajectory is held; the sinusoids and the Fourier series are evaluated per slice),
+    and its number of samples."""
     n = robot.n
-    rng = np.random.default_rng(args.seed)
-    t = sample_times(args.duration, args.rate, jitter_std=args.jitter, rng=rng)
     q0 = None if args.q0 is None else parse_vector(args.q0, "--q0", n)
     if args.trajectory not in ("sinusoid", "fourier"):
         from ..io.excitation import load_trajectory
 
         traj = load_trajectory(Path(args.trajectory), n, fs=args.rate)
-    elif args.trajectory == "sinusoid":
-        if n != len(GAZ2019_SINUSOID_AMPLITUDES) and (
-            args.amplitudes is None or args.periods is None
-        ):
-            raise DynidError(
-                f"the default sinusoids are for 7 joints; robot {robot.name!r} has {n}: "
-                "give --amplitudes and --periods"
-            )
-        A = (
-            GAZ2019_SINUSOID_AMPLITUDES
-            if args.amplitudes is None
-            else parse_vector(args.amplitudes, "--amplitudes", n)
-        )
-        T = (
-            GAZ2019_SINUSOID_PERIODS
-            if args.periods is None
-            else parse_vector(args.periods, "--periods", n)
-        )
-        start = centered_start(robot, A, T) if q0 is None else q0
-        traj = sinusoid_trajectory(t, start, A, T)
-    else:
+        return lambda b: Trajectory(traj.t[b], traj.q[b], traj.dq[b], traj.ddq[b]), len(traj)
+    if args.trajectory == "fourier":
         series = random_fourier(
             robot, rng, n_harmonics=args.harmonics, w_f=2 * np.pi * args.base_freq, q0=q0
         )
-        traj = series(t)
-    report = check_limits(robot, traj)
-    if not report.ok:
-        say(f"limits exceeded by the {args.trajectory} trajectory:\n{report}")
-        if args.scale != "none":
-            traj, factor = scale_into_limits(robot, traj, method=args.scale)
-            what = "amplitude scaled by" if args.scale == "amplitude" else "time stretched by"
-            say(f"{what} {factor:.4f}; now: {check_limits(robot, traj)}")
+        return lambda b: series(t[b]), t.size
+    if n != len(GAZ2019_SINUSOID_AMPLITUDES) and (args.amplitudes is None or args.periods is None):
+        raise DynidError(
+            f"the default sinusoids are for 7 joints; robot {robot.name!r} has {n}: "
+            "give --amplitudes and --periods"
+        )
+    A = (
+        GAZ2019_SINUSOID_AMPLITUDES
+        if args.amplitudes is None
+        else parse_vector(args.amplitudes, "--amplitudes", n)
+    )
+    T = (
+        GAZ2019_SINUSOID_PERIODS
+        if args.periods is None
+        else parse_vector(args.periods, "--periods", n)
+    )
+    start = centered_start(robot, A, T) if q0 is None else q0
+    return lambda b: sinusoid_trajectory(t[b], start, A, T), t.size
+
+
+def _in_limits(
+    args: argparse.Namespace, robot: Robot, traj_at: Callable[[slice], Trajectory], N: int, say: Any
+) -> Callable[[slice], Trajectory]:
+    """The trajectory checked against the limits (a pass over its blocks) and, unless
+    ``--scale none``, scaled into them (one more pass)."""
+
+    def blocks(at: Callable[[slice], Trajectory]) -> Iterator[Trajectory]:
+        return (at(slice(a, a + BLOCK_SAMPLES)) for a in range(0, N, BLOCK_SAMPLES))
+
+    report = check_limits_blocks(robot, blocks(traj_at))
+    if report.ok or args.scale == "none":
+        if not report.ok:
+            say(f"limits exceeded by the {args.trajectory} trajectory:\n{report}")
+        return traj_at
+    say(f"limits exceeded by the {args.trajectory} trajectory:\n{report}")
+    scaling = limit_scaling(robot, lambda: blocks(traj_at), method=args.scale)
+    scaled = lambda b: scaling.apply(traj_at(b))  # noqa: E731
+    what = "amplitude scaled by" if args.scale == "amplitude" else "time stretched by"
+    say(f"{what} {scaling.factor:.4f}; now: {check_limits_blocks(robot, blocks(scaled))}")
+    return scaled
+
+
+def run(args: argparse.Namespace, console: Console) -> int:
+    """Simulate and write the log, a block of samples at a time; prints the limit report
+    and a summary (unless -q)."""
+    say = console.print
+    robot = load_robot(args)
+    n = robot.n
+    rng = np.random.default_rng(args.seed)
+    t = sample_times(args.duration, args.rate, jitter_std=args.jitter, rng=rng)
+    traj_at, N = _trajectory(args, robot, t, rng)
+    traj_at = _in_limits(args, robot, traj_at, N, say)
     noise = SensorNoise(tau_std=args.noise, q_std=args.q_noise, dq_std=args.dq_noise)
     drive = load_drive_arg(args, n)
     if drive is not None:
@@ -211,9 +240,10 @@ def run(args: argparse.Namespace, console: Console) -> int:
 
         effects = UnmodelledEffects.typical(n, np.random.default_rng([args.seed, 7]))
         say(f"effects outside the rigid-body model: {effects.describe()}")
-    measured = simulate_measurement(
+    measured = measured_blocks(
         robot,
-        traj,
+        traj_at,
+        N,
         rng=rng,
         noise=noise,
         friction=None if args.no_friction else _friction(args),
@@ -222,9 +252,12 @@ def run(args: argparse.Namespace, console: Console) -> int:
         effects=effects,
         drive=drive,
     )
-    save_torque_log(args.out, measured)
+    save_torque_log_pieces(
+        args.out, measured, n=n, n_rows=measured.n_samples, with_ddq=args.with_ddq
+    )
+    first, last = traj_at(slice(0, 1)).t[0], traj_at(slice(N - 1, N)).t[0]
     say(
-        f"wrote {args.out}: {measured.n_samples} samples, {measured.duration:.2f} s, "
+        f"wrote {args.out}: {measured.n_samples} samples, {last - first:.2f} s, "
         f"{n} joints, torque noise {args.noise:g} N m, seed {args.seed}"
     )
     return 0

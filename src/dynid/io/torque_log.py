@@ -34,9 +34,9 @@ import logging
 import re
 import warnings
 import zipfile
-from collections.abc import Callable
+from collections.abc import Callable, Iterable
 from pathlib import Path
-from typing import IO, Any
+from typing import IO
 
 import numpy as np
 from numpy.typing import NDArray
@@ -53,7 +53,13 @@ from .atomic import open_atomic
 from .npz_files import check_npz
 from .static_data import check_row_count
 
-__all__ = ["load_torque_log", "csv_table", "save_torque_log", "torque_log_columns"]
+__all__ = [
+    "load_torque_log",
+    "csv_table",
+    "save_torque_log",
+    "save_torque_log_pieces",
+    "torque_log_columns",
+]
 
 _log = logging.getLogger(__name__)
 
@@ -78,35 +84,95 @@ def save_torque_log(path: str | Path, log: TorqueLog) -> Path:
     DataError
         Unknown suffix.
     """
+    return save_torque_log_pieces(
+        path, lambda: (log,), n=log.n, n_rows=log.n_samples, with_ddq=log.ddq is not None
+    )
+
+
+def save_torque_log_pieces(
+    path: str | Path,
+    pieces: Callable[[], Iterable[TorqueLog]],
+    *,
+    n: int,
+    n_rows: int,
+    with_ddq: bool = False,
+) -> Path:
+    """Write a log given in consecutive pieces (never held whole) to ``path`` (``.csv``
+    or ``.npz``, by suffix), as :func:`save_torque_log` writes the pieces joined.
+
+    Parameters
+    ----------
+    pieces : callable
+        ``pieces()`` yields the pieces in order, the same at every call: one pass for a
+        CSV, one per array for an NPZ (each array is one member of the archive).
+    n : int
+        Joints.
+    n_rows : int
+        Samples over all pieces (recorded in the file).
+    with_ddq : bool
+        Whether the pieces hold accelerations (written as ``ddq``).
+
+    Raises
+    ------
+    DataError
+        Unknown suffix, or pieces of another joint count or total length.
+    """
     path = Path(path)
     suffix = path.suffix.lower()
     if suffix == ".npz":
-        arrays: dict[str, Any] = {"t": log.t, "q": log.q, "dq": log.dq, "tau": log.tau}
-        if log.ddq is not None:
-            arrays["ddq"] = log.ddq
-        arrays["n_rows"] = np.array(log.n_samples)
-        with open_atomic(path, "wb") as f:
-            np.savez(f, **arrays)
+        names = ["t", "q", "dq", "tau"] + (["ddq"] if with_ddq else [])
+        with open_atomic(path, "wb") as f, zipfile.ZipFile(f, "w", allowZip64=True) as zf:
+            for name in names:
+                shape = (n_rows,) if name == "t" else (n_rows, n)
+                with zf.open(f"{name}.npy", "w", force_zip64=True) as member:
+                    header = {"descr": "<f8", "fortran_order": False, "shape": shape}
+                    np.lib.format.write_array_header_1_0(member, header)
+                    rows = 0
+                    for log in pieces():
+                        a = np.ascontiguousarray(getattr(log, name), dtype="<f8")
+                        rows += _piece_rows(path, log, n)
+                        member.write(a.tobytes())
+                    _check_written(path, rows, n_rows)
+            with zf.open("n_rows.npy", "w") as member:
+                np.lib.format.write_array(member, np.array(n_rows))
         return path
     if suffix != ".csv":
         raise DataError(f"torque log must be a .csv or .npz file; got {path.name!r}")
-    parts = [log.t[:, None], log.q, log.dq, log.tau]
-    if log.ddq is not None:
-        parts.append(log.ddq)
     header = "\n".join(
         [
             _UNITS,
-            f"{_ROWS_PREFIX} {log.n_samples}",
-            ",".join(torque_log_columns(log.n, with_ddq=log.ddq is not None)),
+            f"{_ROWS_PREFIX} {n_rows}",
+            ",".join(torque_log_columns(n, with_ddq=with_ddq)),
         ]
     )
     with open_atomic(path, "w") as fh:
         fh.write(header + "\n")
-        step = 100_000  # bounded memory: format the table in blocks of rows
-        for a in range(0, log.n_samples, step):
-            block = np.concatenate([x[a : a + step] for x in parts], axis=1)
-            np.savetxt(fh, block, delimiter=",", fmt="%.17g")
+        rows = 0
+        for log in pieces():
+            rows += _piece_rows(path, log, n)
+            parts = [log.t[:, None], log.q, log.dq, log.tau]
+            if with_ddq:
+                assert log.ddq is not None
+                parts.append(log.ddq)
+            step = 100_000  # bounded memory: format the table in blocks of rows
+            for a in range(0, log.n_samples, step):
+                block = np.concatenate([x[a : a + step] for x in parts], axis=1)
+                np.savetxt(fh, block, delimiter=",", fmt="%.17g")
+        _check_written(path, rows, n_rows)
     return path
+
+
+def _piece_rows(path: Path, log: TorqueLog, n: int) -> int:
+    """The samples of a piece of a log of ``n`` joints written to ``path``."""
+    if log.n != n:
+        raise DataError(f"{path.name}: a piece of the log has {log.n} joints; expected {n}")
+    return log.n_samples
+
+
+def _check_written(path: Path, rows: int, n_rows: int) -> None:
+    """Refuse a written log whose pieces hold another number of rows than recorded."""
+    if rows != n_rows:
+        raise DataError(f"{path.name}: the pieces held {rows} rows; {n_rows} were recorded")
 
 
 def load_torque_log(
@@ -393,14 +459,7 @@ def csv_table(
         start = fb.tell()
         _check_declared_rows(path, recorded, len(names), fb.seek(0, io.SEEK_END) - start)
         fb.seek(start)
-        parsed = _fast_parse(fb, len(names), layout, recorded)
-        one_to_one = True
-        if parsed is None:  # the fast reader refused the text: find and name the problem
-            fb.seek(start)
-            table = _slow_parse(path, io.TextIOWrapper(fb, encoding="utf-8"), first, names)
-            arrays = {k: table[:, cols] for k, cols in layout.items()}
-        else:
-            arrays, one_to_one = parsed
+        arrays, one_to_one = _parse(path, fb, names, layout, recorded, first)
     N = next(iter(arrays.values())).shape[0]
     if N == 0:
         raise DataError(f"{path.name}: no data rows after the header")
@@ -425,18 +484,29 @@ def _check_declared_rows(path: Path, recorded: int | None, width: int, size: int
 _CHUNK_BYTES = 32 << 20
 
 
-def _fast_parse(
-    fb: IO[bytes], width: int, layout: dict[str, list[int]], n_rows: int | None
-) -> tuple[dict[str, NDArray[np.float64]], bool] | None:
-    """Parse the data rows in blocks with numpy's C number reader, straight into the
-    per-signal arrays, and say whether rows map to lines one to one (no blank line
-    skipped); None when a block is not a clean table of numbers (a short row, an empty
-    cell, a word, a comment line), for :func:`_slow_parse` to explain."""
+def _parse(
+    path: Path,
+    fb: IO[bytes],
+    names: list[str],
+    layout: dict[str, list[int]],
+    n_rows: int | None,
+    first: int,
+) -> tuple[dict[str, NDArray[np.float64]], bool]:
+    """Parse the data rows a chunk of text at a time straight into the per-signal arrays,
+    and say whether rows map to lines one to one (no blank or comment line skipped).
+
+    Each chunk is read by numpy's C number reader; a chunk that is not a clean table of
+    numbers (an empty cell, a comment line, a short row, a word) is read line by line, to
+    NaN for an empty cell or a column no array takes, or to an error naming the line.
+    Memory: the arrays and one chunk, whatever the file.
+    """
+    width = len(names)
+    used = sorted({c for cols in layout.values() for c in cols})
     blocks: dict[str, list[NDArray[np.float64]]] = {k: [] for k in layout}
     out: dict[str, NDArray[np.float64]] | None = None
     if n_rows is not None and n_rows > 0:
         out = {k: np.empty((n_rows, len(c))) for k, c in layout.items()}
-    row = 0
+    row, line = 0, first
     tail = b""
     one_to_one = True
     while True:
@@ -444,38 +514,24 @@ def _fast_parse(
         last = not chunk
         buf = tail + chunk
         if last:
-            buf = buf.rstrip()
-            if not buf:
+            buf, tail = buf.rstrip() + b"\n", b""
+            if buf == b"\n":
                 break
-            buf += b"\n"
-            tail = b""
         else:
             cut = buf.rfind(b"\n") + 1
             buf, tail = buf[:cut], buf[cut:]
             if not buf:
                 continue
-        if buf.startswith(b"\n") or b"\n\n" in buf:  # blank lines: skipped, as the slow reader does
-            one_to_one = False
-            while b"\n\n" in buf:
-                buf = buf.replace(b"\n\n", b"\n")
-            buf = buf.lstrip(b"\n")
-            if not buf:
-                if last:
-                    break
-                continue
-        rows = buf.count(b"\n")
-        if b"#" in buf or b",," in buf:
-            return None
-        with warnings.catch_warnings():
-            warnings.simplefilter("error")
-            try:
-                flat = np.fromstring(buf.replace(b"\n", b","), dtype=np.float64, sep=",")
-            except (ValueError, DeprecationWarning):
-                return None
+        lines = buf.count(b"\n")
+        fast = _fast_table(buf, width)
+        if fast is None:
+            table, skipped = _slow_table(path, buf, line, names, used)
+        else:
+            table, skipped = fast
+        one_to_one = one_to_one and not skipped
         del buf
-        if flat.size != rows * width:
-            return None
-        table = flat.reshape(rows, width)
+        line += lines
+        rows = table.shape[0]
         if out is not None and n_rows is not None and row + rows <= n_rows:
             for k, cols in layout.items():
                 out[k][row : row + rows] = table[:, cols]
@@ -497,40 +553,73 @@ def _fast_parse(
     return arrays, one_to_one
 
 
+def _fast_table(buf: bytes, width: int) -> tuple[NDArray[np.float64], bool] | None:
+    """The rows of ``buf`` (whole lines) as a table (rows, width) by numpy's C reader,
+    and whether blank lines were skipped; None unless it is a clean table of numbers."""
+    skipped = False
+    if b"\r" in buf:
+        buf = buf.replace(b"\r\n", b"\n")
+    if buf.startswith(b"\n") or b"\n\n" in buf:  # blank lines: skipped
+        skipped = True
+        while b"\n\n" in buf:
+            buf = buf.replace(b"\n\n", b"\n")
+        buf = buf.lstrip(b"\n")
+        if not buf:
+            return np.empty((0, width)), skipped
+    rows = buf.count(b"\n")
+    if b"#" in buf or b",," in buf:
+        return None
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        try:
+            flat = np.fromstring(buf.replace(b"\n", b","), dtype=np.float64, sep=",")
+        except (ValueError, DeprecationWarning):
+            return None
+    if flat.size != rows * width:
+        return None
+    return flat.reshape(rows, width), skipped
+
+
+def _slow_table(
+    path: Path, buf: bytes, first: int, names: list[str], used: list[int]
+) -> tuple[NDArray[np.float64], bool]:
+    """The rows of ``buf`` read line by line (the first is line ``first``): blank and
+    comment lines skipped (said by the flag), an empty cell and a column not in ``used``
+    NaN, anything else in a used column a number or an error naming the line."""
+    width = len(names)
+    try:
+        text = buf.decode("utf-8")
+    except UnicodeDecodeError as exc:
+        line = first + buf[: exc.start].count(b"\n")
+        raise DataError(f"{path.name}, line {line}: not UTF-8 text ({exc.reason})") from None
+    table: list[list[float]] = []
+    skipped = False
+    for i, raw in enumerate(text.split("\n")[:-1], start=first):
+        s = raw.strip()
+        if not s or s.startswith("#"):
+            skipped = True
+            continue
+        cells = s.split(",")
+        if len(cells) != width:
+            raise DataError(
+                f"{path.name}, line {i}: expected {width} fields like the header; got {len(cells)}"
+            )
+        row = [np.nan] * width
+        for k in used:
+            c = cells[k].strip()
+            if c:
+                try:
+                    row[k] = float(c)
+                except ValueError:
+                    raise DataError(
+                        f"{path.name}, line {i}, column {names[k]!r}: not a number: {c[:40]!r}"
+                    ) from None
+        table.append(row)
+    return np.array(table, dtype=np.float64).reshape(-1, width), skipped
+
+
 def _rows(path: Path, lineno: int, text: str) -> int:
     try:
         return int(text.strip())
     except ValueError:
         raise DataError(f"{path.name}, line {lineno}: '# rows:' must give an integer") from None
-
-
-def _slow_parse(path: Path, fh: IO[str], first: int, names: list[str]) -> NDArray[np.float64]:
-    width = len(names)
-    rows: list[list[float]] = []
-    try:
-        for i, line in enumerate(fh, start=first):
-            s = line.strip()
-            if not s or s.startswith("#"):
-                continue
-            cells = s.split(",")
-            if len(cells) != width:
-                raise DataError(
-                    f"{path.name}, line {i}: expected {width} fields like the header; "
-                    f"got {len(cells)}"
-                )
-            row = []
-            for c, name in zip(cells, names, strict=True):
-                c = c.strip()
-                if c == "":
-                    row.append(np.nan)
-                    continue
-                try:
-                    row.append(float(c))
-                except ValueError:
-                    raise DataError(
-                        f"{path.name}, line {i}, column {name!r}: not a number: {c!r}"
-                    ) from None
-            rows.append(row)
-    except UnicodeDecodeError as exc:
-        raise DataError(f"{path.name}: not a UTF-8 text file ({exc.reason})") from None
-    return np.array(rows, dtype=np.float64).reshape(-1, width)

@@ -21,6 +21,7 @@ samples (dropped packets) from the log.
 
 from __future__ import annotations
 
+from collections.abc import Callable, Iterator
 from dataclasses import dataclass
 
 import numpy as np
@@ -36,7 +37,14 @@ from ..model.robot import Robot
 from .trajectories import Trajectory
 from .unmodelled import UnmodelledEffects
 
-__all__ = ["SensorNoise", "sample_times", "simulate_measurement"]
+__all__ = [
+    "BLOCK_SAMPLES",
+    "MeasuredBlocks",
+    "SensorNoise",
+    "measured_blocks",
+    "sample_times",
+    "simulate_measurement",
+]
 
 
 @dataclass(frozen=True, slots=True)
@@ -171,6 +179,33 @@ def simulate_measurement(
     n = robot.n
     if traj.n != n:
         raise ShapeError(f"trajectory has {traj.n} joints; robot {robot.name!r} has {n}")
+    friction = _checked(robot, drop_fraction, friction, effects, drive)
+    tau = _true_torques(robot, traj, friction, effects, drive)
+    N = len(traj)
+    sd_tau, sd_q, sd_dq = _stds(noise, n)
+    tau = tau + rng.standard_normal((N, n)) * sd_tau
+    q = traj.q + rng.standard_normal((N, n)) * sd_q
+    dq = traj.dq + rng.standard_normal((N, n)) * sd_dq
+    rows = np.flatnonzero(_kept_rows(N, drop_fraction, rng))
+    log = TorqueLog(
+        t=traj.t[rows],
+        q=q[rows],
+        dq=dq[rows],
+        tau=tau[rows],
+        ddq=traj.ddq[rows] if with_ddq else None,
+    )
+    return log if drive is None else recorded_side_log(log, drive)
+
+
+def _checked(
+    robot: Robot,
+    drop_fraction: float,
+    friction: FrictionModel | None | str,
+    effects: UnmodelledEffects | None,
+    drive: Drive | None,
+) -> FrictionModel | None:
+    """Check the options of a simulation; the friction model (``"robot"`` resolved)."""
+    n = robot.n
     if not 0.0 <= drop_fraction < 0.5:
         raise OptionError(f"drop_fraction must be in [0, 0.5); got {drop_fraction}")
     if isinstance(friction, str):
@@ -183,32 +218,150 @@ def simulate_measurement(
         raise ShapeError(f"friction model has {friction.n} joints; robot has {n}")
     if effects is not None:
         effects.check(robot)
+    if drive is not None:
+        drive.check(n)
+    return friction
+
+
+def _true_torques(
+    robot: Robot,
+    traj: Trajectory,
+    friction: FrictionModel | None,
+    effects: UnmodelledEffects | None,
+    drive: Drive | None,
+) -> NDArray[np.float64]:
+    """Joint torques (N, n) [N m] of the robot following ``traj``, before the noise."""
+    if effects is not None:
         tau = rnea(effects.true_robot(robot), traj.q, traj.dq, traj.ddq) + effects.torques(traj.ddq)
     else:
         tau = rnea(robot, traj.q, traj.dq, traj.ddq)
     if friction is not None:
         tau = tau + friction.torques(traj.dq)
-    if drive is not None:
-        drive.check(n)
-        if drive.rotor_inertia is not None:
-            tau = tau + drive.rotor_torques(traj.ddq, drive.rotor_inertia)
-    N = len(traj)
-    sd_tau = _std("noise.tau_std", noise.tau_std, n)
-    sd_q = _std("noise.q_std", noise.q_std, n)
-    sd_dq = _std("noise.dq_std", noise.dq_std, n)
-    tau = tau + rng.standard_normal((N, n)) * sd_tau
-    q = traj.q + rng.standard_normal((N, n)) * sd_q
-    dq = traj.dq + rng.standard_normal((N, n)) * sd_dq
-    rows = np.arange(N)
+    if drive is not None and drive.rotor_inertia is not None:
+        tau = tau + drive.rotor_torques(traj.ddq, drive.rotor_inertia)
+    return tau
+
+
+def _stds(noise: SensorNoise, n: int) -> tuple[NDArray[np.float64], ...]:
+    """The noise levels (n,) of the torques, positions and velocities."""
+    return (
+        _std("noise.tau_std", noise.tau_std, n),
+        _std("noise.q_std", noise.q_std, n),
+        _std("noise.dq_std", noise.dq_std, n),
+    )
+
+
+def _kept_rows(N: int, drop_fraction: float, rng: np.random.Generator) -> NDArray[np.bool_]:
+    """The samples (N,) kept after dropping ``drop_fraction`` at random (never the first
+    or last)."""
+    keep = np.ones(N, dtype=bool)
     if drop_fraction > 0 and N > 2:
         k = int(round(drop_fraction * (N - 2)))
-        drop = rng.choice(np.arange(1, N - 1), size=k, replace=False)
-        rows = np.setdiff1d(rows, drop)
-    log = TorqueLog(
-        t=traj.t[rows],
-        q=q[rows],
-        dq=dq[rows],
-        tau=tau[rows],
-        ddq=traj.ddq[rows] if with_ddq else None,
-    )
-    return log if drive is None else recorded_side_log(log, drive)
+        keep[rng.choice(np.arange(1, N - 1), size=k, replace=False)] = False
+    return keep
+
+
+#: Samples simulated at a time by :func:`measured_blocks` (about 7 MB per array of 7 joints).
+BLOCK_SAMPLES = 1 << 17
+
+
+@dataclass(frozen=True, slots=True, eq=False)
+class MeasuredBlocks:
+    """A simulated log in consecutive pieces, computed again at every call (never whole).
+
+    Calling it yields the :class:`TorqueLog` pieces that :func:`simulate_measurement`
+    would return joined: the same noise (each signal's generator restarted where its
+    whole-array draw starts) and the same dropped samples.
+
+    Attributes
+    ----------
+    n : int
+        Joints.
+    n_samples : int
+        Samples over all pieces (after dropping).
+    with_ddq : bool
+        Whether the pieces hold the true accelerations.
+    """
+
+    n: int
+    n_samples: int
+    with_ddq: bool
+    pieces: Callable[[], Iterator[TorqueLog]]
+
+    def __call__(self) -> Iterator[TorqueLog]:
+        return self.pieces()
+
+
+def measured_blocks(
+    robot: Robot,
+    traj_at: Callable[[slice], Trajectory],
+    N: int,
+    *,
+    rng: np.random.Generator,
+    noise: SensorNoise = SensorNoise(),
+    friction: FrictionModel | None | str = "robot",
+    drop_fraction: float = 0.0,
+    with_ddq: bool = False,
+    effects: UnmodelledEffects | None = None,
+    drive: Drive | None = None,
+    block: int = BLOCK_SAMPLES,
+) -> MeasuredBlocks:
+    """:func:`simulate_measurement` of a long trajectory, a block of samples at a time.
+
+    Parameters
+    ----------
+    traj_at : callable
+        ``traj_at(slice)`` gives samples ``slice`` of the true trajectory (``N`` samples
+        in all); called once per block and pass.
+    N : int
+        Samples of the trajectory.
+    block : int
+        Samples per piece.
+    rng, noise, friction, drop_fraction, with_ddq, effects, drive
+        As :func:`simulate_measurement`; ``rng`` is advanced as that function advances it.
+
+    Returns
+    -------
+    MeasuredBlocks
+
+    Raises
+    ------
+    ShapeError, OptionError
+        As :func:`simulate_measurement`.
+    """
+    n = robot.n
+    fr = _checked(robot, drop_fraction, friction, effects, drive)
+    sds = _stds(noise, n)
+    states = []
+    for _ in sds:  # where each signal's draw starts; rng ends where the whole draws end
+        states.append(rng.bit_generator.state)
+        for a in range(0, N, block):
+            rng.standard_normal((min(block, N - a), n))
+    keep = _kept_rows(N, drop_fraction, rng)
+
+    def pieces() -> Iterator[TorqueLog]:
+        gens = []
+        for st in states:
+            bg = type(rng.bit_generator)()
+            bg.state = st
+            gens.append(np.random.Generator(bg))
+        for a in range(0, N, block):
+            traj = traj_at(slice(a, a + block))
+            if traj.n != n:
+                raise ShapeError(f"trajectory has {traj.n} joints; robot {robot.name!r} has {n}")
+            m = len(traj)
+            tau = _true_torques(robot, traj, fr, effects, drive)
+            tau = tau + gens[0].standard_normal((m, n)) * sds[0]
+            q = traj.q + gens[1].standard_normal((m, n)) * sds[1]
+            dq = traj.dq + gens[2].standard_normal((m, n)) * sds[2]
+            rows = np.flatnonzero(keep[a : a + m])
+            log = TorqueLog(
+                t=traj.t[rows],
+                q=q[rows],
+                dq=dq[rows],
+                tau=tau[rows],
+                ddq=traj.ddq[rows] if with_ddq else None,
+            )
+            yield log if drive is None else recorded_side_log(log, drive)
+
+    return MeasuredBlocks(n, int(keep.sum()), with_ddq, pieces)

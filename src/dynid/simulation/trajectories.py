@@ -29,6 +29,7 @@ A :class:`Trajectory` holds samples ``t`` (N,) [s] and ``q``, ``dq``, ``ddq`` (N
 
 from __future__ import annotations
 
+from collections.abc import Callable, Iterable
 from dataclasses import dataclass
 
 import numpy as np
@@ -43,10 +44,13 @@ __all__ = [
     "GAZ2019_SINUSOID_PERIODS",
     "FourierSeries",
     "LimitReport",
+    "LimitScaling",
     "LimitViolation",
     "Trajectory",
     "centered_start",
     "check_limits",
+    "check_limits_blocks",
+    "limit_scaling",
     "random_fourier",
     "scale_into_limits",
     "sinusoid_trajectory",
@@ -418,34 +422,95 @@ def check_limits(robot: Robot, traj: Trajectory) -> LimitReport:
     ShapeError
         ``traj.n != robot.n``.
     """
-    if traj.n != robot.n:
-        raise ShapeError(f"trajectory has {traj.n} joints; robot {robot.name!r} has {robot.n}")
+    return check_limits_blocks(robot, (traj,))
+
+
+#: Where a (quantity, joint, side) exceeds its limit, over blocks: samples outside, the
+#: first time, and the worst excess with its time and value.
+_Excess = dict[tuple[int, int, int], list[float]]
+
+
+def check_limits_blocks(robot: Robot, blocks: Iterable[Trajectory]) -> LimitReport:
+    """:func:`check_limits` of a trajectory given in consecutive pieces (a long one never
+    held whole): the same report as for the pieces joined.
+
+    Raises
+    ------
+    ShapeError
+        A piece with ``n != robot.n``.
+    """
+    seen: _Excess = {}
+    total = 0
+    for traj in blocks:
+        if traj.n != robot.n:
+            raise ShapeError(f"trajectory has {traj.n} joints; robot {robot.name!r} has {robot.n}")
+        total += len(traj)
+        checks = (
+            (traj.q, robot.q_min, robot.q_max),
+            (traj.dq, -robot.dq_max, robot.dq_max),
+            (traj.ddq, -robot.ddq_max, robot.ddq_max),
+        )
+        for i, (x, lo, hi) in enumerate(checks):
+            for j in range(robot.n):
+                for side, bound, bad in ((0, lo[j], x[:, j] < lo[j]), (1, hi[j], x[:, j] > hi[j])):
+                    if not bad.any():
+                        continue
+                    excess = np.where(bad, np.abs(x[:, j] - bound), -np.inf)
+                    k = int(np.argmax(excess))
+                    first = float(traj.t[int(np.argmax(bad))])
+                    rec = seen.setdefault((i, j, side), [0.0, first, -np.inf, 0.0, 0.0])
+                    rec[0] += float(bad.sum())
+                    if excess[k] > rec[2]:
+                        rec[2:] = [float(excess[k]), float(traj.t[k]), float(x[k, j])]
     out = []
-    checks = (
-        ("position", traj.q, robot.q_min, robot.q_max),
-        ("velocity", traj.dq, -robot.dq_max, robot.dq_max),
-        ("acceleration", traj.ddq, -robot.ddq_max, robot.ddq_max),
-    )
-    for kind, x, lo, hi in checks:
-        for j in range(robot.n):
-            for side, bad in ((lo[j], x[:, j] < lo[j]), (hi[j], x[:, j] > hi[j])):
-                if not bad.any():
-                    continue
-                excess = np.where(bad, np.abs(x[:, j] - side), -np.inf)
-                k = int(np.argmax(excess))
-                out.append(
-                    LimitViolation(
-                        kind=kind,
-                        joint=j,
-                        joint_name=robot.joint_names[j],
-                        time=float(traj.t[k]),
-                        value=float(x[k, j]),
-                        limit=float(side),
-                        first_time=float(traj.t[int(np.argmax(bad))]),
-                        fraction=float(bad.mean()),
-                    )
-                )
+    kinds = ("position", "velocity", "acceleration")
+    limits = ((robot.q_min, robot.q_max), (-robot.dq_max, robot.dq_max))
+    limits += ((-robot.ddq_max, robot.ddq_max),)
+    for (i, j, side), (count, first, _, time, value) in sorted(seen.items()):
+        out.append(
+            LimitViolation(
+                kind=kinds[i],
+                joint=j,
+                joint_name=robot.joint_names[j],
+                time=time,
+                value=value,
+                limit=float(limits[i][side][j]),
+                first_time=first,
+                fraction=count / total,
+            )
+        )
     return LimitReport(tuple(out))
+
+
+@dataclass(frozen=True, slots=True, eq=False)
+class LimitScaling:
+    """How :func:`scale_into_limits` changes a trajectory, to apply to each of its pieces.
+
+    Attributes
+    ----------
+    method : {"amplitude", "time"}
+    factor : float
+        ``s <= 1`` (amplitude) or ``k >= 1`` (time); 1 leaves the trajectory unchanged.
+    t0 : float
+        Start time [s] (time scaling is about it).
+    qs : ndarray, shape (n,)
+        Start configuration [rad] (amplitude scaling is about it).
+    """
+
+    method: str
+    factor: float
+    t0: float
+    qs: NDArray[np.float64]
+
+    def apply(self, traj: Trajectory) -> Trajectory:
+        """The scaled trajectory (``traj`` itself when the factor is 1)."""
+        if self.factor == 1.0:
+            return traj
+        if self.method == "time":
+            k, t0 = self.factor, self.t0
+            return Trajectory(t0 + k * (traj.t - t0), traj.q, traj.dq / k, traj.ddq / k**2)
+        s, qs = self.factor, self.qs
+        return Trajectory(traj.t, qs + s * (traj.q - qs), s * traj.dq, s * traj.ddq)
 
 
 def scale_into_limits(
@@ -490,50 +555,87 @@ def scale_into_limits(
     ShapeError
         ``traj.n != robot.n``.
     """
+    scaling = limit_scaling(robot, lambda: (traj,), method=method, margin=margin)
+    return scaling.apply(traj), scaling.factor
+
+
+def limit_scaling(
+    robot: Robot,
+    blocks: Callable[[], Iterable[Trajectory]],
+    *,
+    method: str = "amplitude",
+    margin: float = 0.95,
+) -> LimitScaling:
+    """The scaling of :func:`scale_into_limits` for a trajectory given in consecutive
+    pieces (``blocks()`` yields them, one pass): the same factor as for the pieces joined.
+
+    Raises
+    ------
+    LimitError, OptionError, ShapeError
+        As :func:`scale_into_limits`.
+    """
     if not 0 < margin <= 1:
         raise OptionError(f"margin must be in (0, 1]; got {margin}")
-    if traj.n != robot.n:
-        raise ShapeError(f"trajectory has {traj.n} joints; robot {robot.name!r} has {robot.n}")
-    vmax = np.max(np.abs(traj.dq), axis=0)
-    amax = np.max(np.abs(traj.ddq), axis=0)
-    with np.errstate(divide="ignore", invalid="ignore"):
-        rv = np.max(np.where(vmax > 0, vmax / (margin * robot.dq_max), 0.0))
-        ra = np.max(np.where(amax > 0, amax / (margin * robot.ddq_max), 0.0))
+    if method not in ("amplitude", "time"):
+        raise OptionError(f"method must be 'amplitude' or 'time'; got {method!r}")
+    n = robot.n
+    vmax, amax = np.zeros(n), np.zeros(n)
+    qlo, qhi = np.full(n, np.inf), np.full(n, -np.inf)
     width = robot.q_max - robot.q_min
     shrink = np.where(np.isfinite(width), 0.5 * (1.0 - margin) * width, 0.0)
     lo, hi = robot.q_min + shrink, robot.q_max - shrink
+    qs: NDArray[np.float64] | None = None
+    t0, rq = 0.0, 0.0
+    for traj in blocks():
+        if traj.n != n:
+            raise ShapeError(f"trajectory has {traj.n} joints; robot {robot.name!r} has {n}")
+        if qs is None:
+            qs, t0 = traj.q[0].copy(), float(traj.t[0])
+            _check_start(robot, qs, lo, hi, margin, method)
+        vmax = np.maximum(vmax, np.max(np.abs(traj.dq), axis=0))
+        amax = np.maximum(amax, np.max(np.abs(traj.ddq), axis=0))
+        qlo, qhi = np.minimum(qlo, traj.q.min(axis=0)), np.maximum(qhi, traj.q.max(axis=0))
+        if method == "amplitude":
+            d = traj.q - qs
+            with np.errstate(divide="ignore", invalid="ignore"):
+                rq_hi = np.where(d > 0, d / (hi - qs), 0.0)
+                rq_lo = np.where(d < 0, d / (lo - qs), 0.0)
+            r = np.nan_to_num(np.maximum(rq_hi, rq_lo), nan=0.0, posinf=np.inf)
+            rq = max(rq, float(np.max(r)))
+    if qs is None:
+        raise ShapeError("the trajectory has no sample")
+    with np.errstate(divide="ignore", invalid="ignore"):
+        rv = np.max(np.where(vmax > 0, vmax / (margin * robot.dq_max), 0.0))
+        ra = np.max(np.where(amax > 0, amax / (margin * robot.ddq_max), 0.0))
     if method == "time":
-        bad = np.flatnonzero(np.any((traj.q < robot.q_min) | (traj.q > robot.q_max), axis=0))
+        bad = np.flatnonzero((qlo < robot.q_min) | (qhi > robot.q_max))
         if bad.size:
             j = int(bad[0])
             raise LimitError(
                 f"time scaling cannot fix position limits; {robot.joint_names[j]} reaches "
-                f"[{traj.q[:, j].min():.4g}, {traj.q[:, j].max():.4g}] rad, limits "
+                f"[{qlo[j]:.4g}, {qhi[j]:.4g}] rad, limits "
                 f"[{robot.q_min[j]:.4g}, {robot.q_max[j]:.4g}]; hint: method='amplitude'"
             )
         k = max(1.0, float(rv), float(np.sqrt(ra)))
-        if k == 1.0:
-            return traj, 1.0
-        t0 = traj.t[0]
-        return Trajectory(t0 + k * (traj.t - t0), traj.q, traj.dq / k, traj.ddq / k**2), k
-    if method != "amplitude":
-        raise OptionError(f"method must be 'amplitude' or 'time'; got {method!r}")
-    qs = traj.q[0]
+        return LimitScaling("time", k, t0, qs)
+    r = max(1.0, float(rv), float(ra), rq)
+    return LimitScaling("amplitude", 1.0 if r == 1.0 else 1.0 / r, t0, qs)
+
+
+def _check_start(
+    robot: Robot,
+    qs: NDArray[np.float64],
+    lo: NDArray[np.float64],
+    hi: NDArray[np.float64],
+    margin: float,
+    method: str,
+) -> None:
+    """Amplitude scaling keeps the start: refuse one outside the shrunk range."""
     outside = np.flatnonzero((qs < lo) | (qs > hi))
-    if outside.size:
+    if method == "amplitude" and outside.size:
         j = int(outside[0])
         raise LimitError(
             f"amplitude scaling keeps the start; {robot.joint_names[j]} starts at {qs[j]:.4g} rad, "
             f"outside [{lo[j]:.4g}, {hi[j]:.4g}] (limits with margin {margin}); hint: choose "
             "another start (centered_start)"
         )
-    d = traj.q - qs
-    with np.errstate(divide="ignore", invalid="ignore"):
-        rq_hi = np.where(d > 0, d / (hi - qs), 0.0)
-        rq_lo = np.where(d < 0, d / (lo - qs), 0.0)
-    rq = float(np.max(np.nan_to_num(np.maximum(rq_hi, rq_lo), nan=0.0, posinf=np.inf)))
-    r = max(1.0, float(rv), float(ra), rq)
-    if r == 1.0:
-        return traj, 1.0
-    s = 1.0 / r
-    return Trajectory(traj.t, qs + s * d, s * traj.dq, s * traj.ddq), s
