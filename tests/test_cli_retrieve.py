@@ -6,6 +6,8 @@ report.json) and compared with the identified model's torques.
 
 from __future__ import annotations
 
+import contextlib
+import io
 import json
 
 import numpy as np
@@ -40,29 +42,28 @@ def model_file(tmp_path_factory):
     return path
 
 
-def test_retrieve_writes_feasible_parameters_urdf_toml_and_report(model_file, tmp_path, capsys):
+@pytest.fixture(scope="module")
+def retrieved(model_file):
+    """``dynid retrieve --method penalty`` (3 runs) of ``model_file``, run once for the tests
+    that read its files: (output folder, exit code, stdout, stderr)."""
+    out = model_file.parent / "feasible"
+    argv = ["retrieve", "--method", "penalty", "--model", str(model_file), "--runs", "3"]
+    stdout, stderr = io.StringIO(), io.StringIO()
+    with contextlib.redirect_stdout(stdout), contextlib.redirect_stderr(stderr):
+        rc = main([*argv, "--workers", "1", "--seed", "0", "--out", str(out)])
+    return out, rc, stdout.getvalue(), stderr.getvalue()
+
+
+# the tests reading `retrieved` run on one xdist worker (`--dist loadgroup`)
+_READS_RETRIEVED = pytest.mark.xdist_group("cli-retrieve-penalty")
+
+
+@_READS_RETRIEVED
+def test_retrieve_writes_feasible_parameters_urdf_toml_and_report(retrieved):
     """dynid retrieve writes the four files, reports progress on stderr and a summary on stdout."""
-    out = tmp_path / "feasible"
-    rc = main(
-        [
-            "retrieve",
-            "--method",
-            "penalty",
-            "--model",
-            str(model_file),
-            "--runs",
-            "3",
-            "--workers",
-            "1",
-            "--seed",
-            "0",
-            "--out",
-            str(out),
-        ]
-    )
-    cap = capsys.readouterr()
+    out, rc, stdout, stderr = retrieved
     assert rc == 0
-    assert "run  3/3" in cap.err and "FEASIBLE" in cap.out
+    assert "run  3/3" in stderr and "FEASIBLE" in stdout
     for name in (
         "feasible.json",
         "robot.urdf",
@@ -213,30 +214,11 @@ def test_demo_feasible_stage_retrieves_validates_and_writes_its_files(tmp_path, 
         assert (tmp_path / "demo" / f.name).is_file()
 
 
-def test_validate_with_retrieved_parameters_uses_rnea(model_file, tmp_path):
+@_READS_RETRIEVED
+def test_validate_with_retrieved_parameters_uses_rnea(retrieved, tmp_path):
     """dynid validate --params feasible.json validates RNEA with the retrieved parameters."""
-    out = tmp_path / "feasible"
-    assert (
-        main(
-            [
-                "retrieve",
-                "--method",
-                "penalty",
-                "--method",
-                "penalty",
-                "--model",
-                str(model_file),
-                "--runs",
-                "2",
-                "--workers",
-                "1",
-                "--out",
-                str(out),
-                "-q",
-            ]
-        )
-        == 0
-    )
+    out, rc, _, _ = retrieved
+    assert rc == 0
     log = tmp_path / "log.npz"
     assert (
         main(
