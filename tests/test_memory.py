@@ -142,8 +142,8 @@ def _identify_limited(tmp_path, log, limit: int, stack_bytes: int):
 
 @pytest.mark.slow
 def test_a_long_log_identifies_under_an_address_space_limit(tmp_path):
-    """A 300,000-row log at 1 kHz identified with a 50 Hz cutoff (decimated by 2: a stacked
-    regressor of 1.05 million rows, 0.55 GB): streamed in blocks it identifies under an
+    """A 150,000-row log at 1 kHz identified with a 50 Hz cutoff (decimated by 2: a stacked
+    regressor of 525,000 rows, 0.27 GB): streamed in blocks it identifies under an
     address-space limit 150 MB above its own peak, where the stacked regressor runs out of
     memory and says so in one line (exit 2, no traceback)."""
     resource = pytest.importorskip("resource")
@@ -152,7 +152,7 @@ def test_a_long_log_identifies_under_an_address_space_limit(tmp_path):
     robot = dynid.panda()
     series = random_fourier(robot, np.random.default_rng(11))
     log = simulate_measurement(
-        robot, series(sample_times(299.999, 1000.0)), rng=np.random.default_rng(12)
+        robot, series(sample_times(149.999, 1000.0)), rng=np.random.default_rng(12)
     )
     path = tmp_path / "long.npz"
     save_torque_log(path, log)
