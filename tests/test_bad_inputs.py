@@ -422,6 +422,28 @@ def toml_long_name(d: Path) -> None:
     _two_joint(d, "bad.toml", 'type = "revolute"', 'type = "' + "x" * 1_000_000 + '"')
 
 
+def toml_name_nul(d: Path) -> None:
+    """A joint name holding a NUL: accepted, and the URDF and MJCF exports were not XML."""
+    _two_joint(d, "bad.toml", 'name = "j1"', 'name = "j1\\u0000"')
+
+
+def toml_name_newline(d: Path) -> None:
+    """A joint name holding a line break (it broke the one-line messages that name it)."""
+    _two_joint(d, "bad.toml", 'name = "j1"', 'name = "j\\n1"')
+
+
+def devices(d: Path) -> None:
+    """/dev/zero under every suffix dynid reads: the readers read it until memory ran out
+    (the JSON, TOML and URDF readers could not even be stopped by SIGTERM)."""
+    for suffix in ("csv", "npz", "json", "toml", "urdf", "bag"):
+        (d / f"zero.{suffix}").symlink_to("/dev/zero")
+
+
+def a_folder_as_a_file(d: Path) -> None:
+    """A folder named like a log."""
+    (d / "folder.csv").mkdir()
+
+
 def bounds_boolean_mass(d: Path) -> None:
     """A bounds file with true as a mass bound (it was accepted, exit 0)."""
     (d / "bounds.json").write_text(
@@ -639,6 +661,22 @@ CASES = [
     C("model-duplicate-key", model_duplicate_key, "predict --model {d}/bad.json --q " + NEUTRAL, 2, "duplicated key 'rank'"),
     C("model-bom", model_bom, "predict --model {d}/bom.json --q " + NEUTRAL, 0, ""),
     C("friction-infinity", friction_nan, f"validate --robot panda --friction {{d}}/f.json --data {{d}}/log.csv --out {OUT}", 2, "Infinity is not a JSON number"),
+    # adversary round of issue 20: names, devices, folders
+    C("toml-name-nul", toml_name_nul, "export --params {d}/bad.toml --out {d}/out.urdf", 2, "joint name 'j1\\x00' holds the character '\\x00'; give a name without control characters"),
+    C("toml-name-newline", toml_name_newline, "fk --robot {d}/bad.toml --q 0.1,0.2", 2, "joint name 'j\\n1' holds the character '\\n'"),
+    C("device-model", devices, "predict --model {d}/zero.json --q " + NEUTRAL, 2, "zero.json: not a regular file (a device, a pipe or a socket"),
+    C("device-robot-toml", devices, "fk --robot {d}/zero.toml --q 0.1,0.2", 2, "zero.toml: not a regular file"),
+    C("device-robot-urdf", devices, "fk --robot {d}/zero.urdf --base a --tip b --q 0.1,0.2", 2, "zero.urdf: not a regular file"),
+    C("device-log-csv", devices, f"identify --data {{d}}/zero.csv --out {OUT}", 2, "zero.csv: not a regular file"),
+    C("device-log-npz", devices, f"validate --robot panda --data {{d}}/zero.npz --out {OUT}", 2, "zero.npz: not a regular file"),
+    C("device-columns", devices, f"identify --data {{d}}/log.csv --columns {{d}}/zero.toml --out {OUT}", 2, "zero.toml: not a regular file"),
+    C("device-drive", devices, f"identify --data {{d}}/log.csv --drive {{d}}/zero.toml --out {OUT}", 2, "zero.toml: not a regular file"),
+    C("device-bounds", devices, f"retrieve --model {{d}}/res/identification.json --bounds {{d}}/zero.json --out {OUT}", 2, "zero.json: not a regular file"),
+    C("device-trajectory", devices, f"simulate --trajectory {{d}}/zero.csv --out {OUT}/x.csv", 2, "zero.csv: not a regular file"),
+    C("device-obstacles", devices, f"excite --obstacles {{d}}/zero.json --out {OUT}", 2, "zero.json: not a regular file"),
+    C("device-template", devices, "export --params panda --urdf-template {d}/zero.urdf --out {d}/out.urdf", 2, "zero.urdf: not a regular file"),
+    C("device-bag", devices, "import {d}/zero.bag --robot panda --out {d}/out.csv", 2, "zero.bag: not a regular file"),
+    C("folder-as-log", a_folder_as_a_file, f"identify --data {{d}}/folder.csv --out {OUT}", 2, "is a folder; give a file"),
 ]
 
 
@@ -948,3 +986,18 @@ def test_non_ascii_names_under_an_ascii_locale(tmp_path):
     ).exists()
     bad = dynid("fk", "--robot", "arm.toml", "--q", "0.1", "--frame", "n\u00f6")
     assert bad.returncode == 2 and bad.stderr.count(b"\n") == 1, bad.stderr
+
+
+def test_a_text_file_above_the_limit_is_refused_before_it_is_read(tmp_path, monkeypatch):
+    """JSON, TOML and URDF files are read whole: one larger than DYNID_MAX_TEXT_BYTES is
+    one DataError saying how to raise the limit, and no more than the limit is read."""
+    from dynid.exceptions import DataError
+    from dynid.io.json_files import load_json
+
+    p = tmp_path / "big.json"
+    p.write_text('{"schema": "x", "pad": "' + "a" * 200 + '"}')
+    monkeypatch.setenv("DYNID_MAX_TEXT_BYTES", "100")
+    with pytest.raises(DataError, match=r"big.json: 226 bytes, above the 100 bytes .*DYNID_MAX"):
+        load_json(p)
+    monkeypatch.setenv("DYNID_MAX_TEXT_BYTES", "1000")
+    assert load_json(p)["schema"] == "x"

@@ -31,6 +31,7 @@ from ..feasibility.bounds import Bounds, default_bounds
 from ..model.inertia import INERTIA_ORDER
 from ..model.robot import Robot
 from .atomic import write_text
+from .input_files import file_text
 from .json_files import load_json, save_json
 
 __all__ = ["BOUNDS_SCHEMA", "bounds_from_dict", "bounds_to_dict", "load_bounds", "save_bounds"]
@@ -138,7 +139,7 @@ def load_bounds(path: str | Path, robot: Robot) -> Bounds:
         d = load_json(path)
     elif suffix == ".toml":
         try:
-            text = path.read_text(encoding="utf-8-sig")
+            text = file_text(path, "utf-8-sig")
         except UnicodeDecodeError as exc:
             raise DataError(f"{path.name}: not a UTF-8 text file ({exc.reason})") from None
         d = _checks.parse_toml(text, path.name, DataError)

@@ -44,6 +44,7 @@ from ..identification.log import (
     with_derived_velocities,
 )
 from ..model.robot import Robot
+from .input_files import file_text, regular_file
 from .npz_files import check_npz
 
 __all__ = [
@@ -183,7 +184,7 @@ def load_column_map(path: str | Path, **kw: Any) -> ColumnMap:
         Not TOML, other tables or keys, an unknown quantity or unit.
     """
     path = Path(path)
-    d = _checks.parse_toml(path.read_text(encoding="utf-8"), path.name, DataError)
+    d = _checks.parse_toml(file_text(path), path.name, DataError)
     extra = sorted(set(d) - {"columns", "units", "velocity_cutoff_hz"})
     if extra:
         raise DataError(f"{path.name}: unknown key(s) {extra}; expected [columns], [units]")
@@ -218,6 +219,7 @@ class _Table:
 
 
 def _read_table(path: Path) -> _Table:
+    regular_file(path)  # not a device that never ends
     suffix = path.suffix.lower()
     if suffix == ".npz":
         check_npz(path)

@@ -31,6 +31,7 @@ from numpy.typing import NDArray
 from .. import _checks
 from ..exceptions import DataError, DynidError
 from ..model.drive import DRIVE_SCHEMA, Drive
+from .input_files import file_text
 
 __all__ = [
     "drive_from_mapping",
@@ -152,7 +153,7 @@ def load_drive(path: str | Path, n: int) -> Drive:
     """
     p = Path(path)
     try:
-        text = p.read_text(encoding="utf-8")
+        text = file_text(p)
     except (OSError, UnicodeDecodeError) as exc:
         raise DataError(f"drive file {p}: cannot read ({exc})") from exc
     try:
@@ -212,8 +213,8 @@ def drive_of_robot_file(spec: str | Path, n: int) -> Drive | None:
     if p.suffix.lower() != ".toml" or not p.is_file():
         return None
     try:
-        doc = tomllib.loads(p.read_text(encoding="utf-8"))
-    except (OSError, UnicodeDecodeError, tomllib.TOMLDecodeError, RecursionError):
+        doc = tomllib.loads(file_text(p))
+    except (OSError, DataError, UnicodeDecodeError, tomllib.TOMLDecodeError, RecursionError):
         return None  # the robot reader reports the file's faults
     if "drive" not in doc:
         return None

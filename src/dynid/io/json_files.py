@@ -31,6 +31,7 @@ import numpy as np
 from .. import _checks
 from ..exceptions import DataError, NonFiniteError
 from .atomic import write_text
+from .input_files import file_bytes
 
 __all__ = ["dumps", "finite_or_none", "jsonable", "load_json", "loads", "save_json"]
 
@@ -167,12 +168,13 @@ def load_json(
     Raises
     ------
     DataError
-        Not UTF-8, not strict JSON (the line and column), not an object, wrong schema.
+        Not UTF-8, not strict JSON (the line and column), not an object, wrong schema;
+        not a regular file or too large (:mod:`dynid.io.input_files`).
     OSError
         The file cannot be read.
     """
     path = Path(path)
-    raw = path.read_bytes()
+    raw = file_bytes(path)
     try:
         text = raw.decode("utf-8-sig")
     except UnicodeDecodeError as exc:

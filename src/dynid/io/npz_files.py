@@ -26,6 +26,7 @@ from pathlib import Path
 import numpy as np
 
 from ..exceptions import DataError
+from .input_files import regular_file
 
 __all__ = ["MAX_COMPRESSION_RATIO", "MAX_NPZ_BYTES", "check_npz"]
 
@@ -60,6 +61,7 @@ def check_npz(path: str | Path) -> None:
         the member holds, or a member holds Python objects.
     """
     path = Path(path)
+    regular_file(path)  # not a device that never ends
     if not zipfile.is_zipfile(path):
         return
     try:

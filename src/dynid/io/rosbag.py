@@ -35,6 +35,7 @@ from numpy.typing import NDArray
 from .. import _checks, signals
 from ..exceptions import DataError
 from ..identification.log import DEFAULT_CUTOFF_HZ, TorqueLog
+from .input_files import regular_file
 
 __all__ = ["JOINT_STATE_TYPES", "BagImport", "match_joints", "load_joint_state_bag"]
 
@@ -153,7 +154,9 @@ def _open(path: Path):  # noqa: ANN202 (a rosbags reader)
         raise DataError(f"bag not found: {str(path)!r}")
     if path.is_dir() and not (path / "metadata.yaml").exists():
         raise DataError(f"{path.name}: a ROS 2 bag folder needs metadata.yaml")
-    if path.is_file() and path.suffix != ".bag":
+    if not path.is_dir():
+        regular_file(path)  # not a device (/dev/zero) that rosbags fails on unexpectedly
+    if not path.is_dir() and path.suffix != ".bag":
         raise DataError(f"{path.name}: give a ROS 1 .bag file or a ROS 2 bag folder")
     store = Stores.ROS1_NOETIC if path.suffix == ".bag" else Stores.ROS2_HUMBLE
     return AnyReader([path], default_typestore=get_typestore(store))

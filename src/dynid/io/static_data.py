@@ -44,6 +44,7 @@ from ..identification.data import DEFAULT_SYMMETRY_RTOL, StaticDataset
 from ..model.robot import Robot
 from ..regressors.static import static_labels
 from .atomic import open_atomic
+from .input_files import regular_file
 from .json_files import dumps, loads
 from .npz_files import check_npz
 
@@ -179,6 +180,7 @@ def load_static_csv(
         or no valid row at all.
     """
     path = Path(path)
+    regular_file(path)
     try:
         text = path.read_text(encoding="utf-8-sig")
     except UnicodeDecodeError as exc:

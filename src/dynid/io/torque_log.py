@@ -50,6 +50,7 @@ from ..identification.log import (
     with_derived_velocities,
 )
 from .atomic import open_atomic
+from .input_files import regular_file
 from .npz_files import check_npz
 from .static_data import check_row_count
 
@@ -432,6 +433,7 @@ def csv_table(
         count the file cannot hold (refused before anything is allocated) or other than
         the rows found.
     """
+    regular_file(path)
     with open(path, "rb") as fb:
         recorded = None
         lineno = 0

@@ -20,6 +20,7 @@ the base frame [m/s^2], by default ``(0, 0, -9.80665)``. Named frames are fixed 
 from __future__ import annotations
 
 import dataclasses
+import unicodedata
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -65,6 +66,22 @@ def _fixed_frames(frames: Mapping[str, Frame]) -> Mapping[str, Frame]:
         T = _checks.as_exact(f"frames[{k!r}].T_link_frame", f.T_link_frame, (4, 4))
         out[str(k)] = Frame(int(f.link), _checks.frozen(T))
     return MappingProxyType(out)
+
+
+def _check_names(kind: str, names: Sequence[str]) -> None:
+    """Refuse a name holding a control character other than a tab (NUL, a line break, ...)
+    or half of a surrogate pair: URDF and MJCF cannot hold it (a NUL made the export
+    unparseable), and it would break the one-line messages and CSV headers naming it."""
+    for name in names:
+        bad = next(
+            (c for c in str(name) if c != "\t" and unicodedata.category(c) in ("Cc", "Cs")),
+            None,
+        )
+        if bad is not None:
+            raise ModelError(
+                f"{kind} name {_checks.short(str(name))} holds the character "
+                f"{ascii(bad)}; give a name without control characters"
+            )
 
 
 def _restore_robot(state: dict[str, Any]) -> Robot:
@@ -193,6 +210,9 @@ class Robot:
         frames = {name: Frame(i, np.eye(4)) for i, name in enumerate(self.link_names)}
         frames.update(self.frames)
         frames.setdefault("flange", Frame(n, np.eye(4)))
+        _check_names("robot", [self.name])
+        _check_names("joint", self.joint_names)
+        _check_names("frame", list(frames))
         for k, f in frames.items():
             if not 0 <= int(f.link) <= n:
                 raise ModelError(f"frame {k!r} is attached to link {f.link}, not in 0..{n}")

@@ -32,6 +32,7 @@ from ..io.columns import (
     load_mapped_torque_log,
     parse_column_map,
 )
+from ..io.input_files import regular_file
 from ..io.static_data import load_static_data
 from ..io.torque_log import load_torque_log
 from ..model.robot import Robot
@@ -117,9 +118,13 @@ def data_kind(path: str | Path, columns: ColumnMap | None = None) -> DataKind:
     Raises
     ------
     DataError
-        Neither ``.csv`` nor ``.npz``, a CSV without a header line, an unreadable NPZ.
+        Neither ``.csv`` nor ``.npz``, a CSV without a header line, an unreadable NPZ, not
+        a regular file (a device, a pipe).
+    OSError
+        Missing, unreadable, a folder.
     """
     path = Path(path)
+    regular_file(path)  # not a device that never ends (nor a folder, nor missing)
     if columns is not None:
         if any(columns.mapped(k) for k in ("t", "dq", "tau", "ddq")):
             return "torque_log"

@@ -39,6 +39,7 @@ from ...model.inertia import inertia6_from_matrix, phi_from_inertial
 from ...model.robot import MAX_LINK_MASS, STANDARD_GRAVITY, Frame, Robot, mdh_transform
 from ..atomic import write_text
 from ..drive_file import drive_toml
+from ..input_files import file_text
 from .export_options import ExportOptions
 
 __all__ = [
@@ -372,7 +373,7 @@ def load_toml(path: str | Path) -> Robot:
     """
     p = Path(path)
     try:
-        text = p.read_text(encoding="utf-8")
+        text = file_text(p)
     except FileNotFoundError as exc:
         raise ModelError(f"TOML description not found: {str(p)!r}") from exc
     except (OSError, UnicodeDecodeError) as exc:

@@ -48,6 +48,7 @@ from ...friction.mujoco import joint_coulomb_viscous
 from ...model.inertia import inertia6_from_matrix
 from ...model.robot import Robot
 from ..atomic import write_text
+from ..input_files import file_text
 from .export_options import ExportOptions
 from .urdf_parse import load_urdf, robot_from_urdf_string
 from .urdf_patch import patch_urdf_inertials
@@ -244,7 +245,7 @@ def save_urdf(
     else:
         tpath = Path(template)
         try:
-            original = tpath.read_text(encoding="utf-8")
+            original = file_text(tpath)
         except OSError as exc:
             raise ModelError(f"cannot read URDF template {str(tpath)!r}: {exc}") from exc
         text = patch_urdf_inertials(

@@ -48,6 +48,7 @@ from ... import _checks, spatial
 from ...exceptions import DynidWarning, ModelError, UnknownNameError
 from ...model.inertia import phi_from_inertial
 from ...model.robot import MAX_LINK_MASS, Frame, Robot
+from ..input_files import file_bytes
 
 __all__ = ["load_urdf", "robot_from_urdf_string"]
 
@@ -575,7 +576,7 @@ def load_urdf(path: str | Path, base_link: str | None = None, tip_link: str | No
     """
     p = Path(path)
     try:
-        data = p.read_bytes()
+        data = file_bytes(p)
     except FileNotFoundError as exc:
         raise ModelError(f"URDF file not found: {str(p)!r}") from exc
     except OSError as exc:
