@@ -1,4 +1,5 @@
-"""Scale of the file route: a 5,000,001-row torque log under a 4 GB address-space limit.
+"""Scale of the file route: a 5,000,001-row torque log, and static data of a 50-joint arm,
+under a 4 GB address-space limit.
 
 ``dynid simulate`` writes a log of ``--rows`` samples at 1 kHz (the Panda on a seeded
 Fourier trajectory, with sensor noise); then, each in its own process under
@@ -13,6 +14,13 @@ system time, the memory its peak resident set size (``os.wait4``). Targets (issu
 every command succeeds under 4 GiB. There is no reference library here: the checks are
 that every command succeeds, that the streamed and the stacked fits agree and that
 validate finds the relative error the sensor noise implies (< 1 %).
+
+Static data of a long chain: ``dynid acquire-static`` writes ``--static-n`` (1010)
+configurations of a seeded 50-joint revolute arm (a TOML robot written here; 1325 rows of
+``[tril M; g]`` per configuration, 500 standard parameters), and ``dynid identify``
+reads them under the same limit (the stacked regressor would be 3.7 GB, the Gram matrices
+of its rows 1.3 GB); the check is that the noise-free coefficients are those of the arm's
+own inertias (relative error of the fit < 1e-6 %). ``--static-joints 0`` skips it.
 
 ``python benchmarks/bench_io.py [--rows N] [--data LOG] [--limit-gb G] [--dir DIR] [--keep]
 [--json [PATH]]``
@@ -80,6 +88,59 @@ def _has_rlimit_as() -> bool:
     return hasattr(resource, "RLIMIT_AS")
 
 
+def _arm_toml(path: Path, n: int) -> None:
+    """A seeded revolute arm of ``n`` joints (random modified DH constants and inertias)."""
+    import numpy as np
+
+    import dynid
+    from dynid.io.robot.toml import save_toml
+
+    rng = np.random.default_rng(0)
+    a, alpha = rng.uniform(0.05, 0.2, n), rng.choice([-np.pi / 2, np.pi / 2, 0.0], n)
+    a[0] = alpha[0] = 0.0
+    A = rng.normal(size=(n, 3, 3))
+    robot = dynid.Robot.from_mdh(
+        a,
+        rng.uniform(0.0, 0.1, n),
+        alpha,
+        mass=rng.uniform(0.5, 2.0, n),
+        com=rng.uniform(-0.05, 0.05, (n, 3)),
+        inertia=0.01 * (A @ A.transpose(0, 2, 1) + np.eye(3)),
+        q_min=np.full(n, -2.8),
+        q_max=np.full(n, 2.8),
+        name=f"arm{n}",
+    )
+    save_toml(path, robot)
+
+
+def _static(work: Path, dynid: list[str], joints: int, n_conf: int, lim: float) -> dict:
+    """acquire-static and identify of a long arm's static data, each under the limit."""
+    arm, data = work / f"arm{joints}.toml", work / f"static{joints}.csv"
+    _arm_toml(arm, joints)
+    out: dict[str, dict] = {}
+    out[f"acquire-static {joints} joints"] = run(
+        dynid
+        + ["acquire-static", "--robot", str(arm), "--n", str(n_conf), "--seed", "1"]
+        + ["--out", str(data)],
+        limit_gb=lim,
+    )
+    ident = work / f"static{joints}-id"
+    out[f"identify static {joints} joints"] = run(
+        dynid
+        + ["identify", "--robot", str(arm), "--data", str(data), "--no-figures"]
+        + ["--out", str(ident)],
+        limit_gb=lim,
+    )
+    if out[f"identify static {joints} joints"]["exit_code"] == 0:
+        doc = json.loads((ident / "identification.json").read_text())
+        err = float(doc["relative_error_percent"])
+        out[f"identify static {joints} joints"]["relative_error_percent"] = err
+        if not err < 1e-6:
+            out[f"identify static {joints} joints"]["exit_code"] = -1
+            out[f"identify static {joints} joints"]["stderr"] = f"relative error {err} %"
+    return out
+
+
 def main(argv: list[str] | None = None) -> int:
     p = argparse.ArgumentParser(description=(__doc__ or "").strip().splitlines()[0])
     p.add_argument("--rows", type=int, default=5_000_001, help="samples of the log")
@@ -88,6 +149,8 @@ def main(argv: list[str] | None = None) -> int:
     p.add_argument("--dir", type=Path, default=None, help="work folder (default: temporary)")
     p.add_argument("--keep", action="store_true", help="keep the log and the results")
     p.add_argument("--json", nargs="?", const="-", default=None, metavar="PATH")
+    p.add_argument("--static-joints", type=int, default=50, help="joints of the arm (0: skip)")
+    p.add_argument("--static-n", type=int, default=1010, help="static configurations")
     args = p.parse_args(argv)
     work = Path(tempfile.mkdtemp(prefix="dynid-bench-io-")) if args.dir is None else args.dir
     work.mkdir(parents=True, exist_ok=True)
@@ -118,6 +181,8 @@ def main(argv: list[str] | None = None) -> int:
             dynid + ["identify", *data, "--out", str(work / "id-stacked")],
             env={"DYNID_MAX_STACK_BYTES": str(1 << 50)},
         )
+        if args.static_joints:
+            results.update(_static(work, dynid, args.static_joints, args.static_n, lim))
         failed = [k for k, r in results.items() if r["exit_code"] != 0]
         for k in failed:
             print(f"{k} failed: {results[k]['stderr']}", file=sys.stderr)

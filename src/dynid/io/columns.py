@@ -23,8 +23,8 @@ cutoff ``velocity_cutoff_hz``), after cleaning; the returned notes say so.
 
 from __future__ import annotations
 
-import io
 import math
+import re
 from collections.abc import Mapping
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -46,6 +46,7 @@ from ..identification.log import (
 from ..model.robot import Robot
 from .input_files import file_text, regular_file
 from .npz_files import check_npz
+from .torque_log import csv_table
 
 __all__ = [
     "ColumnMap",
@@ -218,7 +219,10 @@ class _Table:
     columns: dict[str, NDArray[np.float64]]  # CSV column or NPZ array by name
 
 
-def _read_table(path: Path) -> _Table:
+def _read_table(path: Path, cmap: ColumnMap, quantities: tuple[str, ...]) -> _Table:
+    """The columns (CSV) or arrays (NPZ) of a file; of a CSV only those that the map's
+    templates of ``quantities`` name, read by the strict reader of torque logs
+    (:func:`~dynid.io.torque_log.csv_table`: one pass, a chunk of text at a time)."""
     regular_file(path)  # not a device that never ends
     suffix = path.suffix.lower()
     if suffix == ".npz":
@@ -235,31 +239,37 @@ def _read_table(path: Path) -> _Table:
         return _Table(path.name, arrays)
     if suffix != ".csv":
         raise DataError(f"{path.name}: expected a .csv or .npz file")
-    lines = path.read_text(encoding="utf-8").splitlines()
-    h = next((k for k, s in enumerate(lines) if s.strip() and not s.lstrip().startswith("#")), None)
-    if h is None:
-        raise DataError(f"{path.name}: no header line")
-    names = [c.strip() for c in lines[h].split(",")]
-    dup = sorted({c for c in names if names.count(c) > 1})
-    if dup:
-        raise DataError(f"{path.name}: duplicate column(s) {dup}")
-    body = "\n".join(lines[h + 1 :])
-    try:
-        data = np.genfromtxt(
-            io.StringIO(body),
-            delimiter=",",
-            comments="#",
-            dtype=np.float64,
-            ndmin=2,
-            invalid_raise=True,
-        )
-    except ValueError as exc:
-        raise DataError(f"{path.name}: a row does not match the header ({exc})") from exc
-    if data.size == 0:
-        raise DataError(f"{path.name}: no data rows after the header")
-    if data.shape[1] != len(names):
-        raise DataError(f"{path.name}: rows have {data.shape[1]} fields, the header {len(names)}")
-    return _Table(path.name, {c: data[:, k] for k, c in enumerate(names)})
+
+    def layout(names: list[str], line: int) -> dict[str, list[int]]:
+        dup = sorted({c for c in names if names.count(c) > 1})
+        if dup:
+            raise DataError(f"{path.name}, line {line}: duplicate column(s) {dup}")
+        wanted = _referenced(names, cmap, quantities)
+        if not wanted:
+            raise DataError(
+                f"{path.name}, line {line}: no column the map names (templates "
+                f"{[cmap.template(k) for k in quantities]}); the file has {names[:12]}"
+                f"{'...' if len(names) > 12 else ''}; hint: map them with --columns"
+            )
+        return {c: [k] for k, c in enumerate(names) if c in wanted}
+
+    arrays, _ = csv_table(path, layout, "a header naming the columns")
+    return _Table(path.name, {c: a[:, 0] for c, a in arrays.items()})
+
+
+def _referenced(names: list[str], cmap: ColumnMap, quantities: tuple[str, ...]) -> set[str]:
+    """The column names a map's templates of ``quantities`` can name (every column when a
+    template is more than ``{i}``, ``{i0}``, ``{j}``, ``{j0}`` in text)."""
+    patterns = []
+    for quantity in quantities:
+        tpl = cmap.template(quantity)
+        parts = re.split(r"(\{i0?\}|\{j0?\})", tpl)
+        text = "".join(parts[::2])  # the template without its joint fields
+        if "{" in text or "}" in text:  # another format field: read every column
+            return set(names)
+        patterns.append("".join(r"\d+" if k % 2 else re.escape(p) for k, p in enumerate(parts)))
+    rx = re.compile("|".join(f"(?:{p})" for p in patterns)) if patterns else None
+    return {c for c in names if rx is not None and rx.fullmatch(c)}
 
 
 def _vector(table: _Table, cmap: ColumnMap, quantity: str, n: int | None) -> NDArray | None:
@@ -344,7 +354,7 @@ def load_mapped_torque_log(
         other than ``n``, time running backwards.
     """
     path = Path(path)
-    table = _read_table(path)
+    table = _read_table(path, columns, ("t", "q", "dq", "tau", "ddq"))
     t = table.columns.get(columns.template("t"))
     if t is None:
         raise DataError(
@@ -396,7 +406,7 @@ def load_mapped_static_data(
         Missing columns (named), a joint count other than the robot's, NaN rows.
     """
     path = Path(path)
-    table = _read_table(path)
+    table = _read_table(path, columns, ("q", "g", "M"))
     n = robot.n if robot is not None else None
     q = _need(table, columns, "q", n)
     n = q.shape[1]

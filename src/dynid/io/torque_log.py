@@ -594,9 +594,12 @@ def _slow_table(
     except UnicodeDecodeError as exc:
         line = first + buf[: exc.start].count(b"\n")
         raise DataError(f"{path.name}, line {line}: not UTF-8 text ({exc.reason})") from None
-    table: list[list[float]] = []
+    lines = text.split("\n")[:-1]
+    del text
+    table = np.full((len(lines), width), np.nan)  # 8 bytes a cell, not a Python float
+    rows = 0
     skipped = False
-    for i, raw in enumerate(text.split("\n")[:-1], start=first):
+    for i, raw in enumerate(lines, start=first):
         s = raw.strip()
         if not s or s.startswith("#"):
             skipped = True
@@ -606,18 +609,17 @@ def _slow_table(
             raise DataError(
                 f"{path.name}, line {i}: expected {width} fields like the header; got {len(cells)}"
             )
-        row = [np.nan] * width
         for k in used:
             c = cells[k].strip()
             if c:
                 try:
-                    row[k] = float(c)
+                    table[rows, k] = float(c)
                 except ValueError:
                     raise DataError(
                         f"{path.name}, line {i}, column {names[k]!r}: not a number: {c[:40]!r}"
                     ) from None
-        table.append(row)
-    return np.array(table, dtype=np.float64).reshape(-1, width), skipped
+        rows += 1
+    return table[:rows], skipped
 
 
 def _rows(path: Path, lineno: int, text: str) -> int:
