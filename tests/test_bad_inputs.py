@@ -677,6 +677,8 @@ CASES = [
     C("device-template", devices, "export --params panda --urdf-template {d}/zero.urdf --out {d}/out.urdf", 2, "zero.urdf: not a regular file"),
     C("device-bag", devices, "import {d}/zero.bag --robot panda --out {d}/out.csv", 2, "zero.bag: not a regular file"),
     C("folder-as-log", a_folder_as_a_file, f"identify --data {{d}}/folder.csv --out {OUT}", 2, "is a folder; give a file"),
+    C("out-under-a-file", None, "identify --data {d}/s.csv --out {d}/s.csv/res", 2, "s.csv is a file, not a folder; choose another --out"),
+    C("out-file-under-a-file", None, "export --params panda --out {d}/s.csv/robot.urdf", 2, "s.csv is a file, not a folder"),
 ]
 
 

@@ -198,6 +198,10 @@ class RunOutput:
         while not p.exists():
             missing.append(p)
             p = p.parent
+        if not p.is_dir():
+            raise OutputError(
+                f"{self.flag} {self.given}: {p} is a file, not a folder; choose another {self.flag}"
+            )
         parent.mkdir(parents=True, exist_ok=True)
         self._created_parents = missing  # deepest first
         with _folder_lock(parent):
@@ -460,9 +464,9 @@ def run_output(
     Raises
     ------
     OutputError
-        ``out`` is a file where a folder is wanted (or the reverse), holds another
-        command's set, or the run would replace a read-only file or a file no run recorded
-        (each without ``force``). Nothing has moved when it is raised.
+        ``out`` is a file where a folder is wanted (or the reverse), lies under a file,
+        holds another command's set, or the run would replace a read-only file or a file
+        no run recorded (each without ``force``). Nothing has moved when it is raised.
     """
     run = RunOutput(Path(out), command=command, kind=kind, force=force, argv=argv)
     run.open()
