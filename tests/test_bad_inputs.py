@@ -444,6 +444,27 @@ def a_folder_as_a_file(d: Path) -> None:
     (d / "folder.csv").mkdir()
 
 
+def model_boolean_rank(d: Path) -> None:
+    """identification.json with ``"rank": true`` (cast to 1 and used, exit 0)."""
+    doc = json.loads((d / "res" / "identification.json").read_text())
+    doc["rank"] = True
+    (d / "bad.json").write_text(json.dumps(doc))
+
+
+def model_string_value(d: Path) -> None:
+    """A coefficient's value given as a string (cast by float(), or an unexpected error)."""
+    doc = json.loads((d / "res" / "identification.json").read_text())
+    doc["coefficients"][0]["value"] = "0.1"
+    (d / "bad.json").write_text(json.dumps(doc))
+
+
+def drive_bom(d: Path) -> None:
+    """A drive TOML saved with a byte-order mark (refused as "Invalid statement", while
+    JSON, CSV and bounds TOML files with one were read)."""
+    (d / "drive.toml").write_text('\ufeffschema = "dynid-drive/1"\n', encoding="utf-8")
+    _two_joint(d, "bom.toml", "", "", prefix="\ufeff")
+
+
 def bounds_boolean_mass(d: Path) -> None:
     """A bounds file with true as a mass bound (it was accepted, exit 0)."""
     (d / "bounds.json").write_text(
@@ -677,6 +698,10 @@ CASES = [
     C("device-template", devices, "export --params panda --urdf-template {d}/zero.urdf --out {d}/out.urdf", 2, "zero.urdf: not a regular file"),
     C("device-bag", devices, "import {d}/zero.bag --robot panda --out {d}/out.csv", 2, "zero.bag: not a regular file"),
     C("folder-as-log", a_folder_as_a_file, f"identify --data {{d}}/folder.csv --out {OUT}", 2, "is a folder; give a file"),
+    C("drive-bom", drive_bom, f"identify --data {{d}}/log.csv --drive {{d}}/drive.toml --out {OUT}", 0, ""),
+    C("robot-toml-bom", drive_bom, "fk --robot {d}/bom.toml --q 0.1,0.2", 0, ""),
+    C("model-rank-true", model_boolean_rank, "predict --model {d}/bad.json --q " + NEUTRAL, 2, "identified model: 'rank' must be an integer; got True"),
+    C("model-value-string", model_string_value, "predict --model {d}/bad.json --q " + NEUTRAL, 2, "identified model: 'coefficients[].value' must be a number; got '0.1'"),
     C("out-under-a-file", None, "identify --data {d}/s.csv --out {d}/s.csv/res", 2, "s.csv is a file, not a folder; choose another --out"),
     C("out-file-under-a-file", None, "export --params panda --out {d}/s.csv/robot.urdf", 2, "s.csv is a file, not a folder"),
 ]

@@ -139,7 +139,7 @@ def load_bounds(path: str | Path, robot: Robot) -> Bounds:
         d = load_json(path)
     elif suffix == ".toml":
         try:
-            text = file_text(path, "utf-8-sig")
+            text = file_text(path)
         except UnicodeDecodeError as exc:
             raise DataError(f"{path.name}: not a UTF-8 text file ({exc.reason})") from None
         d = _checks.parse_toml(text, path.name, DataError)

@@ -82,6 +82,7 @@ def file_bytes(path: str | Path) -> bytes:
     return data
 
 
-def file_text(path: str | Path, encoding: str = "utf-8") -> str:
-    """:func:`file_bytes` decoded (:class:`UnicodeDecodeError` as ``Path.read_text``)."""
+def file_text(path: str | Path, encoding: str = "utf-8-sig") -> str:
+    """:func:`file_bytes` decoded, UTF-8 with or without a byte-order mark by default (as
+    JSON and CSV files are read); :class:`UnicodeDecodeError` as ``Path.read_text``."""
     return file_bytes(path).decode(encoding)

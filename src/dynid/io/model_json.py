@@ -281,7 +281,7 @@ def _route_parts(
     if "friction_labels" in m:
         friction = FrictionInfo(
             labels=tuple(str(x) for x in m.pop("friction_labels")),
-            std=tuple(_float(x) for x in m.pop("friction_std", ())),
+            std=tuple(_float(x, "metadata.friction_std") for x in m.pop("friction_std", ())),
             kept=tuple(bool(x) for x in m.pop("friction_kept", ())),
         )
     return static, log, friction
@@ -342,26 +342,28 @@ def model_from_dict(d: Mapping[str, Any]) -> IdentifiedModel:
         kept = np.array([bool(c["kept"]) for c in coefs])
         pct = np.array(
             [
-                float(c["std_percent"])
+                _float(c["std_percent"], "coefficients[].std_percent")
                 if c["std_percent"] is not None
                 else (np.inf if c["kept"] else np.nan)
                 for c in coefs
             ]
         )
         fit = LeastSquaresFit(
-            beta=_frozen(np.array([float(c["value"]) for c in coefs])),
-            std=_frozen(np.array([float(c["std"]) for c in coefs])),
+            beta=_frozen(np.array([_float(c["value"], "coefficients[].value") for c in coefs])),
+            std=_frozen(np.array([_float(c["std"], "coefficients[].std") for c in coefs])),
             std_percent=_frozen(pct),
             kept=_frozen(kept),
-            rank=int(d["rank"]),
-            condition_number=_float(d["condition_number"]),
-            relative_error_percent=_float(d["relative_error_percent"]),
-            residual_rms=_float(d["residual_rms"]),
-            sigma=_float(d["sigma"]),
-            n_rows=int(d["n_rows"]),
-            rtol=float(d["rtol"]),
+            rank=_int(d["rank"], "rank"),
+            condition_number=_float(d["condition_number"], "condition_number"),
+            relative_error_percent=_float(d["relative_error_percent"], "relative_error_percent"),
+            residual_rms=_float(d["residual_rms"], "residual_rms"),
+            sigma=_float(d["sigma"], "sigma"),
+            n_rows=_int(d["n_rows"], "n_rows"),
+            rtol=_float(d["rtol"], "rtol"),
             covariance=_covariance(d.get("covariance"), r),
-            scaled_condition_number=_float(d.get("scaled_condition_number")),
+            scaled_condition_number=_float(
+                d.get("scaled_condition_number"), "scaled_condition_number"
+            ),
         )
         friction = d.get("friction")
         if friction is not None:
@@ -467,8 +469,12 @@ def _base_indices(
     return np.asarray(ind, dtype=np.intp), np.asarray(dep, dtype=np.intp), K_d
 
 
-def _float(x: Any) -> float:
-    return float("nan") if x is None else float(x)
+def _float(x: Any, where: str) -> float:
+    """``null`` as NaN (a value the fit has none of); otherwise a finite number, strictly
+    (a boolean or a string where a number belongs is refused, not cast)."""
+    return (
+        float("nan") if x is None else _checks.number(x, f"identified model: {where!r}", DataError)
+    )
 
 
 def _frozen(a: np.ndarray) -> np.ndarray:
