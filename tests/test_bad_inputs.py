@@ -465,6 +465,16 @@ def drive_bom(d: Path) -> None:
     _two_joint(d, "bom.toml", "", "", prefix="\ufeff")
 
 
+def static_nan_cell(d: Path) -> None:
+    """Static data with a NaN cell (the hint named the Python argument, not the flag)."""
+    lines = _lines(d / "s.csv")
+    h = _header_index(lines)
+    cells = lines[h + 3].split(",")
+    cells[10] = "nan"
+    lines[h + 3] = ",".join(cells)
+    _write(d / "bad.csv", lines)
+
+
 def bounds_boolean_mass(d: Path) -> None:
     """A bounds file with true as a mass bound (it was accepted, exit 0)."""
     (d / "bounds.json").write_text(
@@ -698,6 +708,7 @@ CASES = [
     C("device-template", devices, "export --params panda --urdf-template {d}/zero.urdf --out {d}/out.urdf", 2, "zero.urdf: not a regular file"),
     C("device-bag", devices, "import {d}/zero.bag --robot panda --out {d}/out.csv", 2, "zero.bag: not a regular file"),
     C("folder-as-log", a_folder_as_a_file, f"identify --data {{d}}/folder.csv --out {OUT}", 2, "is a folder; give a file"),
+    C("static-nan-cell", static_nan_cell, f"identify --data {{d}}/bad.csv --out {OUT}", 2, "holds nan; hint: fix the file or pass --drop-invalid (drop_invalid=True)"),
     C("drive-bom", drive_bom, f"identify --data {{d}}/log.csv --drive {{d}}/drive.toml --out {OUT}", 0, ""),
     C("robot-toml-bom", drive_bom, "fk --robot {d}/bom.toml --q 0.1,0.2", 0, ""),
     C("model-rank-true", model_boolean_rank, "predict --model {d}/bad.json --q " + NEUTRAL, 2, "identified model: 'rank' must be an integer; got True"),

@@ -235,7 +235,8 @@ def load_static_csv(
             msg = f"line {lineno} (row {len(good) + len(bad)}) {reason}"
             if not drop_invalid:
                 raise DataError(
-                    f"{path.name}: {msg}; hint: fix the file or load with drop_invalid=True"
+                    f"{path.name}: {msg}; hint: fix the file or pass --drop-invalid "
+                    "(drop_invalid=True) to drop such rows"
                 )
             bad.append(msg)
             continue
