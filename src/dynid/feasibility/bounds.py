@@ -106,7 +106,7 @@ class Bounds:
             m_lo, m_hi = (float(x) for x in self.total_mass)
             if not (math.isfinite(m_lo) and math.isfinite(m_hi)) or m_lo < 0 or m_lo > m_hi:
                 raise OptionError(
-                    f"total_mass must be (min, max) with 0 <= min <= max; got {self.total_mass}"
+                    f"total_mass must be (min, max) with 0 <= min <= max; got ({m_lo:g}, {m_hi:g})"
                 )
             put("total_mass", (m_lo, m_hi))
         if self.link_names is not None:
