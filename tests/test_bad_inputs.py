@@ -482,6 +482,14 @@ def bounds_total_inverted(d: Path) -> None:
     )
 
 
+def floor_only(d: Path) -> None:
+    """An obstacles file with the floor only."""
+    (d / "floor.json").write_text(
+        '{"schema": "dynid-obstacles/1", "planes": [{"name": "floor", "point": [0, 0, 0], '
+        '"normal": [0, 0, 1]}]}'
+    )
+
+
 def bounds_boolean_mass(d: Path) -> None:
     """A bounds file with true as a mass bound (it was accepted, exit 0)."""
     (d / "bounds.json").write_text(
@@ -715,6 +723,7 @@ CASES = [
     C("device-template", devices, "export --params panda --urdf-template {d}/zero.urdf --out {d}/out.urdf", 2, "zero.urdf: not a regular file"),
     C("device-bag", devices, "import {d}/zero.bag --robot panda --out {d}/out.csv", 2, "zero.bag: not a regular file"),
     C("folder-as-log", a_folder_as_a_file, f"identify --data {{d}}/folder.csv --out {OUT}", 2, "is a folder; give a file"),
+    C("acquire-obstacles-without-pool", floor_only, "acquire-static --n 5 --obstacles {d}/floor.json --out {d}/out.csv", 2, "--obstacles needs --pool"),
     C("bounds-total-inverted", bounds_total_inverted, f"retrieve --model {{d}}/res/identification.json --bounds {{d}}/bounds.json --out {OUT}", 2, "total_mass must be (min, max) with 0 <= min <= max; got (20, 16)"),
     C("static-nan-cell", static_nan_cell, f"identify --data {{d}}/bad.csv --out {OUT}", 2, "holds nan; hint: fix the file or pass --drop-invalid (drop_invalid=True)"),
     C("drive-bom", drive_bom, f"identify --data {{d}}/log.csv --drive {{d}}/drive.toml --out {OUT}", 0, ""),

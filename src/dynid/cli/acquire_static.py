@@ -27,6 +27,7 @@ from pathlib import Path
 
 import numpy as np
 
+from ..exceptions import OptionError
 from ..identification.consistency import kinematics_record
 from ..io.static_data import save_static_data
 from ..simulation.controller import (
@@ -104,6 +105,11 @@ def streams(seed: int) -> tuple[np.random.Generator, np.random.Generator]:
 
 def run(args: argparse.Namespace, console: Console) -> int:
     """Acquire and write the data set; returns the exit code."""
+    if args.obstacles is not None and args.pool is None:
+        raise OptionError(
+            "--obstacles needs --pool: only the chosen configurations are kept clear of "
+            "obstacles, random ones are not checked (give --pool 5, say)"
+        )
     robot = load_robot(args)
     rng_q, rng_noise = streams(args.seed)
     effects = None
