@@ -723,6 +723,7 @@ CASES = [
     C("device-template", devices, "export --params panda --urdf-template {d}/zero.urdf --out {d}/out.urdf", 2, "zero.urdf: not a regular file"),
     C("device-bag", devices, "import {d}/zero.bag --robot panda --out {d}/out.csv", 2, "zero.bag: not a regular file"),
     C("folder-as-log", a_folder_as_a_file, f"identify --data {{d}}/folder.csv --out {OUT}", 2, "is a folder; give a file"),
+    C("identify-prior-without-consistent", None, f"identify --data {{d}}/s.csv --prior panda --total-mass 16,20 --out {OUT}", 2, "--prior, --total-mass apply to --consistent only; add --consistent or leave them out"),
     C("acquire-obstacles-without-pool", floor_only, "acquire-static --n 5 --obstacles {d}/floor.json --out {d}/out.csv", 2, "--obstacles needs --pool"),
     C("bounds-total-inverted", bounds_total_inverted, f"retrieve --model {{d}}/res/identification.json --bounds {{d}}/bounds.json --out {OUT}", 2, "total_mass must be (min, max) with 0 <= min <= max; got (20, 16)"),
     C("static-nan-cell", static_nan_cell, f"identify --data {{d}}/bad.csv --out {OUT}", 2, "holds nan; hint: fix the file or pass --drop-invalid (drop_invalid=True)"),

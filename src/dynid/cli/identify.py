@@ -60,6 +60,7 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
+from ..exceptions import OptionError
 from ..identification.estimators import ESTIMATORS
 from ..identification.least_squares import STD_METHODS
 from ..io.feasible_bundle import save_feasible_bundle
@@ -181,6 +182,8 @@ def register(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParser:
 
 def run(args: argparse.Namespace, console: Console) -> int:
     """Identify, write DIR/identification.json and print the summary; returns the exit code."""
+    if not args.consistent:
+        _no_consistency_options(args)
     robot = load_robot(args)
     common = dict(
         columns=(args.columns, args.units),
@@ -201,6 +204,26 @@ def run(args: argparse.Namespace, console: Console) -> int:
     console.print(format_identification(model))
     console.wrote(path)
     return 0
+
+
+#: Options of the one-step consistent fit only: given without --consistent they would do
+#: nothing (a prior or a mass band silently ignored).
+_CONSISTENT_ONLY = (
+    "prior",
+    "prior_base",
+    "prior_tip",
+    "prior_weight",
+    "objective",
+    "margin",
+    "total_mass",
+)
+
+
+def _no_consistency_options(args: argparse.Namespace) -> None:
+    given = [k for k in _CONSISTENT_ONLY if getattr(args, k, None) is not None]
+    if given:
+        flags = ", ".join("--" + k.replace("_", "-") for k in given)
+        raise OptionError(f"{flags} apply to --consistent only; add --consistent or leave them out")
 
 
 def run_consistent(args: argparse.Namespace, console: Console, robot, common) -> int:  # noqa: ANN001
