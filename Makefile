@@ -31,10 +31,12 @@ $(DOCS): $(RUNTIME)
 demo: $(RUNTIME)
 	$(VENV)/bin/dynid demo --out out
 
-# one worker per core (pytest-xdist); PYTEST_WORKERS=0 runs in one process. Tests marked
-# xdist_group(name) share a module fixture and run on one worker (--dist loadgroup).
+# one worker per core (pytest-xdist); PYTEST_WORKERS=0 runs in one process. Each test file
+# runs on one worker (--dist loadscope), so a module-scoped fixture is computed once, not once
+# per worker; the files are handed out in collection order (--no-loadscope-reorder: the
+# default order, most tests first, would leave the one-test demo file for the end).
 PYTEST_WORKERS ?= auto
-PYTEST_XDIST := -n $(PYTEST_WORKERS) --dist loadgroup
+PYTEST_XDIST := -n $(PYTEST_WORKERS) --dist loadscope --no-loadscope-reorder
 
 # Chromium renders the HTML reports in tests/test_html_report.py (skipped without it): when
 # it is missing, install Debian's package where apt-get can (root, a Debian system); any

@@ -54,11 +54,6 @@ def retrieved(model_file):
     return out, rc, stdout.getvalue(), stderr.getvalue()
 
 
-# the tests reading `retrieved` run on one xdist worker (`--dist loadgroup`)
-_READS_RETRIEVED = pytest.mark.xdist_group("cli-retrieve-penalty")
-
-
-@_READS_RETRIEVED
 def test_retrieve_writes_feasible_parameters_urdf_toml_and_report(retrieved):
     """dynid retrieve writes the four files, reports progress on stderr and a summary on stdout."""
     out, rc, stdout, stderr = retrieved
@@ -214,7 +209,6 @@ def test_demo_feasible_stage_retrieves_validates_and_writes_its_files(tmp_path, 
         assert (tmp_path / "demo" / f.name).is_file()
 
 
-@_READS_RETRIEVED
 def test_validate_with_retrieved_parameters_uses_rnea(retrieved, tmp_path):
     """dynid validate --params feasible.json validates RNEA with the retrieved parameters."""
     out, rc, _, _ = retrieved

@@ -134,12 +134,7 @@ def default_optimisation():
     return optimise_excitation(dynid.panda(), np.random.default_rng(0))
 
 
-# the tests sharing the default optimisation run on one xdist worker (`--dist loadgroup`)
-_SHARES_DEFAULT = pytest.mark.xdist_group("excitation-default-optimisation")
-
-
 @pytest.mark.slow
-@_SHARES_DEFAULT
 def test_panda_20s_optimised_condition_number_is_at_most_half_the_papers(default_optimisation):
     """Issue 9: default options (the paper's form and margins), cond <= 0.5 x the paper's
     trajectory measured the same way, admissible at 1 kHz."""
@@ -152,7 +147,6 @@ def test_panda_20s_optimised_condition_number_is_at_most_half_the_papers(default
 
 
 @pytest.mark.slow
-@_SHARES_DEFAULT
 def test_identification_along_the_optimised_trajectory_beats_a_random_fourier_one(
     default_optimisation,
 ):
