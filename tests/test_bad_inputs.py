@@ -490,6 +490,11 @@ def floor_only(d: Path) -> None:
     )
 
 
+def friction_as_model(d: Path) -> None:
+    """A friction file given as --model (the message read "not a identified model")."""
+    (d / "bad.json").write_text('{"schema": "dynid-friction/1"}')
+
+
 def bounds_boolean_mass(d: Path) -> None:
     """A bounds file with true as a mass bound (it was accepted, exit 0)."""
     (d / "bounds.json").write_text(
@@ -723,6 +728,7 @@ CASES = [
     C("device-template", devices, "export --params panda --urdf-template {d}/zero.urdf --out {d}/out.urdf", 2, "zero.urdf: not a regular file"),
     C("device-bag", devices, "import {d}/zero.bag --robot panda --out {d}/out.csv", 2, "zero.bag: not a regular file"),
     C("folder-as-log", a_folder_as_a_file, f"identify --data {{d}}/folder.csv --out {OUT}", 2, "is a folder; give a file"),
+    C("model-is-friction", friction_as_model, "predict --model {d}/bad.json --q " + NEUTRAL, 2, "bad.json: not an identified model (dynid identify): 'schema' must be"),
     C("identify-prior-without-consistent", None, f"identify --data {{d}}/s.csv --prior panda --total-mass 16,20 --out {OUT}", 2, "--prior, --total-mass apply to --consistent only; add --consistent or leave them out"),
     C("acquire-obstacles-without-pool", floor_only, "acquire-static --n 5 --obstacles {d}/floor.json --out {d}/out.csv", 2, "--obstacles needs --pool"),
     C("bounds-total-inverted", bounds_total_inverted, f"retrieve --model {{d}}/res/identification.json --bounds {{d}}/bounds.json --out {OUT}", 2, "total_mass must be (min, max) with 0 <= min <= max; got (20, 16)"),

@@ -194,7 +194,8 @@ def load_json(
         got = d.get("schema")
         if got not in ok:
             raise DataError(
-                f"{path.name}: not a {what}: 'schema' must be {' or '.join(map(repr, ok))}; "
+                f"{path.name}: not {'an' if what[:1] in 'aeiou' else 'a'} {what}: 'schema' must "
+                f"be {' or '.join(map(repr, ok))}; "
                 f"got {got!r}"
             )
     return d
