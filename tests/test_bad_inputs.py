@@ -495,6 +495,22 @@ def friction_as_model(d: Path) -> None:
     (d / "bad.json").write_text('{"schema": "dynid-friction/1"}')
 
 
+def npz_duplicated_member(d: Path) -> None:
+    """Static data whose NPZ holds ``q.npy`` twice, the second all zeros (numpy read the
+    last one silently: every configuration at q = 0)."""
+    import warnings
+
+    with zipfile.ZipFile(d / "s.npz") as z, zipfile.ZipFile(d / "bad.npz", "w") as out:
+        for name in z.namelist():
+            out.writestr(name, z.read(name))
+        buf = io.BytesIO()
+        with np.load(d / "s.npz") as npz:
+            np.save(buf, np.zeros_like(npz["q"]))
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")  # zipfile warns of the duplicated name
+            out.writestr("q.npy", buf.getvalue())
+
+
 def bounds_boolean_mass(d: Path) -> None:
     """A bounds file with true as a mass bound (it was accepted, exit 0)."""
     (d / "bounds.json").write_text(
@@ -728,6 +744,7 @@ CASES = [
     C("device-template", devices, "export --params panda --urdf-template {d}/zero.urdf --out {d}/out.urdf", 2, "zero.urdf: not a regular file"),
     C("device-bag", devices, "import {d}/zero.bag --robot panda --out {d}/out.csv", 2, "zero.bag: not a regular file"),
     C("folder-as-log", a_folder_as_a_file, f"identify --data {{d}}/folder.csv --out {OUT}", 2, "is a folder; give a file"),
+    C("npz-duplicated-array", npz_duplicated_member, f"identify --data {{d}}/bad.npz --out {OUT}", 2, "bad.npz: duplicated array(s) ['q.npy']; an array may appear once"),
     C("model-is-friction", friction_as_model, "predict --model {d}/bad.json --q " + NEUTRAL, 2, "bad.json: not an identified model (dynid identify): 'schema' must be"),
     C("identify-prior-without-consistent", None, f"identify --data {{d}}/s.csv --prior panda --total-mass 16,20 --out {OUT}", 2, "--prior, --total-mass apply to --consistent only; add --consistent or leave them out"),
     C("acquire-obstacles-without-pool", floor_only, "acquire-static --n 5 --obstacles {d}/floor.json --out {d}/out.csv", 2, "--obstacles needs --pool"),

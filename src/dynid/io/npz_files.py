@@ -25,6 +25,7 @@ from pathlib import Path
 
 import numpy as np
 
+from .. import _checks
 from ..exceptions import DataError
 from .input_files import regular_file
 
@@ -58,7 +59,7 @@ def check_npz(path: str | Path) -> None:
     DataError
         The archive's uncompressed size exceeds the limit, a member's compression ratio
         exceeds :data:`MAX_COMPRESSION_RATIO`, a member's header declares more data than
-        the member holds, or a member holds Python objects.
+        the member holds, a member holds Python objects, or two members share a name.
     """
     path = Path(path)
     regular_file(path)  # not a device that never ends
@@ -67,6 +68,13 @@ def check_npz(path: str | Path) -> None:
     try:
         with zipfile.ZipFile(path) as zf:
             infos = zf.infolist()
+            seen: set[str] = set()
+            dup = sorted({i.filename for i in infos if i.filename in seen or seen.add(i.filename)})
+            if dup:  # numpy reads the last one of a name silently
+                raise DataError(
+                    f"{path.name}: duplicated array(s) {_checks.short(dup)}; an array may "
+                    "appear once"
+                )
             total = sum(i.file_size for i in infos)
             limit = _limit()
             if total > limit:
