@@ -511,6 +511,33 @@ def npz_duplicated_member(d: Path) -> None:
             out.writestr("q.npy", buf.getvalue())
 
 
+TWO_LINK_URDF = """<robot name="two">
+  <link name="base"/>
+  <joint name="j1" type="revolute">
+    <parent link="base"/><child link="l1"/><axis xyz="0 0 1"/>
+    <limit lower="-1" upper="1" effort="10" velocity="1"/>
+  </joint>
+  <link name="l1">
+    <inertial><mass value="1.0"/><inertia ixx="0.01" ixy="0" ixz="0" iyy="0.01" iyz="0" izz="0.01"/></inertial>
+  </link>
+</robot>
+"""
+
+
+def urdf_two_masses(d: Path) -> None:
+    """A link whose <inertial> holds two <mass> elements (the second was ignored)."""
+    text = TWO_LINK_URDF.replace('<mass value="1.0"/>', '<mass value="1.0"/><mass value="9.0"/>')
+    (d / "bad.urdf").write_text(text)
+
+
+def urdf_two_inertials(d: Path) -> None:
+    """A link with two <inertial> elements (the second was ignored)."""
+    i = TWO_LINK_URDF.index("<inertial>")
+    j = TWO_LINK_URDF.index("</inertial>") + len("</inertial>")
+    text = TWO_LINK_URDF[:j] + TWO_LINK_URDF[i:j] + TWO_LINK_URDF[j:]
+    (d / "bad.urdf").write_text(text)
+
+
 def bounds_boolean_mass(d: Path) -> None:
     """A bounds file with true as a mass bound (it was accepted, exit 0)."""
     (d / "bounds.json").write_text(
@@ -744,6 +771,8 @@ CASES = [
     C("device-template", devices, "export --params panda --urdf-template {d}/zero.urdf --out {d}/out.urdf", 2, "zero.urdf: not a regular file"),
     C("device-bag", devices, "import {d}/zero.bag --robot panda --out {d}/out.csv", 2, "zero.bag: not a regular file"),
     C("folder-as-log", a_folder_as_a_file, f"identify --data {{d}}/folder.csv --out {OUT}", 2, "is a folder; give a file"),
+    C("urdf-two-masses", urdf_two_masses, "fk --robot {d}/bad.urdf --base base --tip l1 --q 0.1", 2, "bad.urdf: <inertial> holds 2 <mass> elements; URDF allows one"),
+    C("urdf-two-inertials", urdf_two_inertials, "fk --robot {d}/bad.urdf --base base --tip l1 --q 0.1", 2, "<link name='l1'> holds 2 <inertial> elements"),
     C("npz-duplicated-array", npz_duplicated_member, f"identify --data {{d}}/bad.npz --out {OUT}", 2, "bad.npz: duplicated array(s) ['q.npy']; an array may appear once"),
     C("model-is-friction", friction_as_model, "predict --model {d}/bad.json --q " + NEUTRAL, 2, "bad.json: not an identified model (dynid identify): 'schema' must be"),
     C("identify-prior-without-consistent", None, f"identify --data {{d}}/s.csv --prior panda --total-mass 16,20 --out {OUT}", 2, "--prior, --total-mass apply to --consistent only; add --consistent or leave them out"),

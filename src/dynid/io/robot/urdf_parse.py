@@ -78,7 +78,13 @@ def _children(elem: ET.Element, tag: str) -> list[ET.Element]:
 
 
 def _child(elem: ET.Element, tag: str) -> ET.Element | None:
+    """The one ``<tag>`` child of ``elem`` or None; two are refused (a reader would take
+    the first and drop the other's numbers silently: a second ``<mass>``)."""
     found = _children(elem, tag)
+    if len(found) > 1:
+        name = elem.get("name")
+        owner = f"<{_tag(elem)}{'' if name is None else f' name={name!r}'}>"
+        raise ModelError(f"{owner} holds {len(found)} <{tag}> elements; URDF allows one")
     return found[0] if found else None
 
 
