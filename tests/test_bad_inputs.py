@@ -538,6 +538,13 @@ def urdf_two_inertials(d: Path) -> None:
     (d / "bad.urdf").write_text(text)
 
 
+def toml_frame_named_like_a_link(d: Path) -> None:
+    """A [[frames]] entry named l1 on link l2: it replaced link l1's own frame silently."""
+    _two_joint(d, "bad.toml", "", "")
+    with open(d / "bad.toml", "a") as fh:
+        fh.write('\n[[frames]]\nname = "l1"\nparent = "l2"\n')
+
+
 def bounds_boolean_mass(d: Path) -> None:
     """A bounds file with true as a mass bound (it was accepted, exit 0)."""
     (d / "bounds.json").write_text(
@@ -771,6 +778,7 @@ CASES = [
     C("device-template", devices, "export --params panda --urdf-template {d}/zero.urdf --out {d}/out.urdf", 2, "zero.urdf: not a regular file"),
     C("device-bag", devices, "import {d}/zero.bag --robot panda --out {d}/out.csv", 2, "zero.bag: not a regular file"),
     C("folder-as-log", a_folder_as_a_file, f"identify --data {{d}}/folder.csv --out {OUT}", 2, "is a folder; give a file"),
+    C("toml-frame-named-like-a-link", toml_frame_named_like_a_link, "fk --robot {d}/bad.toml --frame l1 --q 0.1,0.2", 2, "frame 'l1' has the name of a link but another pose (on link 2)"),
     C("urdf-two-masses", urdf_two_masses, "fk --robot {d}/bad.urdf --base base --tip l1 --q 0.1", 2, "bad.urdf: <inertial> holds 2 <mass> elements; URDF allows one"),
     C("urdf-two-inertials", urdf_two_inertials, "fk --robot {d}/bad.urdf --base base --tip l1 --q 0.1", 2, "<link name='l1'> holds 2 <inertial> elements"),
     C("npz-duplicated-array", npz_duplicated_member, f"identify --data {{d}}/bad.npz --out {OUT}", 2, "bad.npz: duplicated array(s) ['q.npy']; an array may appear once"),

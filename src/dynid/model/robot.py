@@ -84,6 +84,21 @@ def _check_names(kind: str, names: Sequence[str]) -> None:
             )
 
 
+def _check_link_frames(links: Mapping[str, Frame], frames: Mapping[str, Frame]) -> None:
+    """Refuse a named frame that has a link's name but another place: it would replace the
+    link's own frame silently (``fk --frame l1`` then gave another link's pose). ``flange``
+    is the mounting frame whatever link bears the name (the URDF reader warns)."""
+    for k, f in frames.items():
+        own = None if str(k) == "flange" else links.get(str(k))
+        if own is not None and not (
+            int(f.link) == own.link and np.array_equal(np.asarray(f.T_link_frame), np.eye(4))
+        ):
+            raise ModelError(
+                f"frame {str(k)!r} has the name of a link but another pose (on link "
+                f"{int(f.link)}); every link is a frame already: give the frame another name"
+            )
+
+
 def _restore_robot(state: dict[str, Any]) -> Robot:
     """The robot of :meth:`Robot.__reduce__`'s ``state`` (arrays frozen again)."""
     robot = object.__new__(Robot)
@@ -208,6 +223,7 @@ class Robot:
                 )
         put("gravity", _checks.frozen(_checks.as_exact("gravity", self.gravity, (3,))))
         frames = {name: Frame(i, np.eye(4)) for i, name in enumerate(self.link_names)}
+        _check_link_frames(frames, self.frames)
         frames.update(self.frames)
         frames.setdefault("flange", Frame(n, np.eye(4)))
         _check_names("robot", [self.name])
