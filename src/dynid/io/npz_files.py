@@ -68,8 +68,8 @@ def check_npz(path: str | Path) -> None:
     try:
         with zipfile.ZipFile(path) as zf:
             infos = zf.infolist()
-            seen: set[str] = set()
-            dup = sorted({i.filename for i in infos if i.filename in seen or seen.add(i.filename)})
+            names = [i.filename for i in infos]
+            dup = sorted({n for n in names if names.count(n) > 1})
             if dup:  # numpy reads the last one of a name silently
                 raise DataError(
                     f"{path.name}: duplicated array(s) {_checks.short(dup)}; an array may "
