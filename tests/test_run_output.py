@@ -1,5 +1,7 @@
-"""Output folders a user can trust (issue 20): real processes write, fail, are killed and
-race into one ``--out``; the folder always holds one complete set, of one run.
+"""Output folders a user can trust (issue 20): runs write, fail, are killed and race into
+one ``--out``; the folder always holds one complete set, of one run. Real processes where
+the case is about processes (a full disk under RLIMIT_FSIZE, signals, concurrent runs); the
+command line in-process where it is about the folder's contents.
 
 Every case compares the folder with a snapshot taken before (names, bytes, modes), so a
 failed run that touched anything is caught, whatever it touched.
@@ -9,6 +11,7 @@ from __future__ import annotations
 
 import contextlib
 import fcntl
+import io
 import json
 import os
 import signal
@@ -19,6 +22,7 @@ from pathlib import Path
 
 import pytest
 
+from dynid.cli.__main__ import main
 from dynid.io.run_output import MANIFEST
 
 pytestmark = pytest.mark.skipif(sys.platform == "win32", reason="POSIX locks and signals")
@@ -43,6 +47,14 @@ def _run(*args: str, **kw) -> subprocess.CompletedProcess:
     proc = _dynid(*args, **kw)
     out, err = proc.communicate(timeout=120)
     return subprocess.CompletedProcess(proc.args, proc.returncode, out, err)
+
+
+def _main(*args: str) -> subprocess.CompletedProcess:
+    """``dynid *args`` in this process: its exit code, stdout and stderr."""
+    out, err = io.StringIO(), io.StringIO()
+    with contextlib.redirect_stdout(out), contextlib.redirect_stderr(err):
+        code = main(list(args))
+    return subprocess.CompletedProcess(["dynid", *args], code, out.getvalue(), err.getvalue())
 
 
 def _snapshot(folder: Path) -> dict[str, tuple[bytes, int]]:
@@ -90,11 +102,11 @@ def data(tmp_path_factory) -> Path:
     """Two static data sets (60 configurations, seeds 3 and 4) and a model from the first."""
     d = tmp_path_factory.mktemp("run_output")
     for seed in (3, 4):
-        r = _run(
+        r = _main(
             "acquire-static", "--n", "60", "--seed", str(seed), "--out", str(d / f"s{seed}.csv")
         )
         assert r.returncode == 0, r.stderr
-    r = _run("identify", "--data", str(d / "s3.csv"), "--out", str(d / "model"), "-q")
+    r = _main("identify", "--data", str(d / "s3.csv"), "--out", str(d / "model"), "-q")
     assert r.returncode == 0, r.stderr
     return d
 
@@ -103,11 +115,11 @@ def test_a_rerun_replaces_the_set_as_a_whole(data, tmp_path):
     """identify --consistent, then plain identify into the same folder: the consistent
     files of the first run go once the second set is complete; a file of the user stays."""
     out = tmp_path / "res"
-    r = _run("identify", "--data", str(data / "s3.csv"), "--consistent", "--out", str(out), "-q")
+    r = _main("identify", "--data", str(data / "s3.csv"), "--consistent", "--out", str(out), "-q")
     assert r.returncode == 0, r.stderr
     assert _complete_set(out) == CONSISTENT_SET
     (out / "notes.txt").write_text("mine\n")
-    r = _run("identify", "--data", str(data / "s4.csv"), "--out", str(out), "-q")
+    r = _main("identify", "--data", str(data / "s4.csv"), "--out", str(out), "-q")
     assert r.returncode == 0, r.stderr
     assert sorted(p.name for p in out.iterdir()) == [
         MANIFEST,
@@ -124,10 +136,12 @@ def test_another_commands_folder_and_foreign_files_need_force(data, tmp_path):
     """retrieve into identify's folder, or over a file no run wrote: refused before any
     computation, the folder unchanged; --force writes."""
     out = tmp_path / "res"
-    assert _run("identify", "--data", str(data / "s3.csv"), "--out", str(out), "-q").returncode == 0
+    assert (
+        _main("identify", "--data", str(data / "s3.csv"), "--out", str(out), "-q").returncode == 0
+    )
     before = _snapshot(out)
     model = str(data / "model" / "identification.json")
-    r = _run("retrieve", "--model", model, "--out", str(out), "-q")
+    r = _main("retrieve", "--model", model, "--out", str(out), "-q")
     assert r.returncode == 2
     assert r.stderr.strip() == (
         f"dynid retrieve: error: --out {out}: holds the outputs of `dynid identify` "
@@ -137,11 +151,11 @@ def test_another_commands_folder_and_foreign_files_need_force(data, tmp_path):
     theirs = tmp_path / "theirs"
     theirs.mkdir()
     (theirs / "feasible.json").write_text("{}\n")
-    r = _run("retrieve", "--model", model, "--out", str(theirs), "-q")
+    r = _main("retrieve", "--model", model, "--out", str(theirs), "-q")
     assert r.returncode == 2 and "feasible.json exists and no dynid run recorded it" in r.stderr
     assert (theirs / "feasible.json").read_text() == "{}\n"
     assert sorted(p.name for p in theirs.iterdir()) == ["feasible.json"]
-    r = _run("retrieve", "--model", model, "--out", str(theirs), "--force", "-q")
+    r = _main("retrieve", "--model", model, "--out", str(theirs), "--force", "-q")
     assert r.returncode == 0, r.stderr
     assert json.loads((theirs / "feasible.json").read_text())["schema"].startswith("dynid-feasible")
     assert _staging(tmp_path) == []
@@ -152,24 +166,24 @@ def test_a_read_only_file_is_not_replaced_without_force(data, tmp_path):
     replaces them."""
     out = tmp_path / "res"
     args = ("identify", "--data", str(data / "s3.csv"), "--out", str(out), "-q")
-    assert _run(*args).returncode == 0
+    assert _main(*args).returncode == 0
     (out / "identification.json").chmod(0o444)
     before = _snapshot(out)
-    r = _run(*args)
+    r = _main(*args)
     assert r.returncode == 2
     assert "identification.json is read-only; pass --force" in r.stderr, r.stderr
     assert _snapshot(out) == before
-    assert _run(*args, "--force").returncode == 0
+    assert _main(*args, "--force").returncode == 0
     assert (out / "identification.json").stat().st_mode & 0o200  # a new file, writable
 
     log = tmp_path / "log.csv"
     log.write_text("precious\n")
     log.chmod(0o444)
     sim = ("simulate", "--duration", "1", "--rate", "100", "--out", str(log), "-q")
-    r = _run(*sim)
+    r = _main(*sim)
     assert r.returncode == 2 and "log.csv is read-only" in r.stderr, r.stderr
     assert log.read_text() == "precious\n"
-    assert _run(*sim, "--force").returncode == 0
+    assert _main(*sim, "--force").returncode == 0
     assert log.read_text().startswith("#")
     assert _staging(tmp_path) == []
 
