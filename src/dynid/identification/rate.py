@@ -77,16 +77,22 @@ def motion_frequency(
     if N < 8 or cols.size == 0:
         return 0.0
     A = np.stack([np.ones(N), np.linspace(-1.0, 1.0, N)], axis=1)
-    y = q[:, cols]
-    x = y - A @ np.linalg.lstsq(A, y, rcond=None)[0]  # mean and linear trend removed
-    p = np.abs(np.fft.rfft(x * np.hanning(N)[:, None], axis=0)) ** 2
+    window = np.hanning(N)
     f = np.fft.rfftfreq(N, 1.0 / fs)
-    cum = np.cumsum(p, axis=0)
-    total = cum[-1]
+    total = np.zeros(cols.size)
+    found = np.zeros(cols.size)
+    for k, j in enumerate(cols):  # one joint at a time: a long log's spectra never held whole
+        y = q[:, j]
+        x = y - A @ np.linalg.lstsq(A, y, rcond=None)[0]  # mean and linear trend removed
+        p = np.abs(np.fft.rfft(x * window)) ** 2
+        del x
+        cum = np.cumsum(p)
+        total[k] = cum[-1]
+        found[k] = f[np.searchsorted(cum, SIGNIFICANT_POWER * total[k])]
     out = 0.0
-    for j in range(cols.size):
-        if total[j] > 1e-6 * float(total.max()) and total[j] > 0:  # not a trend alone
-            out = max(out, float(f[np.searchsorted(cum[:, j], SIGNIFICANT_POWER * total[j])]))
+    for k in range(cols.size):
+        if total[k] > 1e-6 * float(total.max()) and total[k] > 0:  # not a trend alone
+            out = max(out, float(found[k]))
     return out
 
 
