@@ -1042,7 +1042,12 @@ def test_ctrl_c_stops_a_write_without_a_partial_file(tmp_path):
     import time
 
     out = tmp_path / "big.csv"
-    proc = _dynid("acquire-static", "--n", "400000", "--out", str(out))
+    # SIGINT back to its default in the child: a shell starts background jobs (`make test &`,
+    # nohup'd scripts) with SIGINT ignored, and Python then keeps it ignored (exit 0, no test)
+    proc = _dynid(
+        "acquire-static", "--n", "400000", "--out", str(out),
+        preexec_fn=lambda: signal.signal(signal.SIGINT, signal.SIG_DFL),
+    )  # fmt: skip
     time.sleep(4.0)
     proc.send_signal(signal.SIGINT)
     _, err = proc.communicate(timeout=30)
