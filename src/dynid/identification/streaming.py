@@ -254,7 +254,8 @@ def group_factors(source: BlockSource, *, keep_groups: bool = False) -> GroupFac
         X[:, c] = y
         k = max(count.size, int(g.max(initial=-1)) + 1)
         count = np.bincount(g, minlength=k) + np.pad(count, (0, k - count.size))
-        target = np.bincount(g, y * y, minlength=k) + np.pad(target, (0, k - target.size))
+        squares = np.asarray(np.bincount(g, y * y, minlength=k), dtype=np.float64)
+        target = squares + np.pad(target, (0, k - target.size))
         if total is None and 8 * k * (c + 1) ** 2 > GROUP_FACTOR_BYTES:  # too many groups
             total = _triangular(np.vstack([np.zeros((0, c + 1)), *R.values()]))
             R.clear()
@@ -597,8 +598,12 @@ def _irls(
     w = 1.0 / s0[groups]
     e = np.empty(m)
     beta = None
+
+    def row_weights(o: int, g: NDArray[np.intp]) -> NDArray[np.float64]:
+        return w[o : o + g.size]
+
     for _ in range(est.max_iter):
-        Rw = _weighted_factor(source, lambda o, g, w=w: w[o : o + g.size], c)
+        Rw = _weighted_factor(source, row_weights, c)
         fb = _solve(Rw, m, np.ones(c, dtype=bool), rtol, labels).beta
         o = 0
         for W, y, _g in _blocks(source):
@@ -615,7 +620,7 @@ def _irls(
             break
     del e
     fit = _fit_pruned(
-        _weighted_factor(source, lambda o, g: w[o : o + g.size], c),
+        _weighted_factor(source, row_weights, c),
         m,
         rtol=rtol,
         std=std,

@@ -139,7 +139,7 @@ def save_torque_log_pieces(
         return path
     if suffix != ".csv":
         raise DataError(f"torque log must be a .csv or .npz file; got {path.name!r}")
-    header = "\n".join(
+    preamble = "\n".join(
         [
             _UNITS,
             f"{_ROWS_PREFIX} {n_rows}",
@@ -147,7 +147,7 @@ def save_torque_log_pieces(
         ]
     )
     with open_atomic(path, "w") as fh:
-        fh.write(header + "\n")
+        fh.write(preamble + "\n")
         rows = 0
         for log in pieces():
             rows += _piece_rows(path, log, n)
@@ -156,8 +156,8 @@ def save_torque_log_pieces(
                 assert log.ddq is not None
                 parts.append(log.ddq)
             step = 100_000  # bounded memory: format the table in blocks of rows
-            for a in range(0, log.n_samples, step):
-                block = np.concatenate([x[a : a + step] for x in parts], axis=1)
+            for start in range(0, log.n_samples, step):
+                block = np.concatenate([x[start : start + step] for x in parts], axis=1)
                 np.savetxt(fh, block, delimiter=",", fmt="%.17g")
         _check_written(path, rows, n_rows)
     return path

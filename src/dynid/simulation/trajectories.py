@@ -464,8 +464,11 @@ def check_limits_blocks(robot: Robot, blocks: Iterable[Trajectory]) -> LimitRepo
                         rec[2:] = [float(excess[k]), float(traj.t[k]), float(x[k, j])]
     out = []
     kinds = ("position", "velocity", "acceleration")
-    limits = ((robot.q_min, robot.q_max), (-robot.dq_max, robot.dq_max))
-    limits += ((-robot.ddq_max, robot.ddq_max),)
+    limits = (
+        (robot.q_min, robot.q_max),
+        (-robot.dq_max, robot.dq_max),
+        (-robot.ddq_max, robot.ddq_max),
+    )
     for (i, j, side), (count, first, _, time, value) in sorted(seen.items()):
         out.append(
             LimitViolation(
@@ -618,8 +621,8 @@ def limit_scaling(
             )
         k = max(1.0, float(rv), float(np.sqrt(ra)))
         return LimitScaling("time", k, t0, qs)
-    r = max(1.0, float(rv), float(ra), rq)
-    return LimitScaling("amplitude", 1.0 if r == 1.0 else 1.0 / r, t0, qs)
+    worst = max(1.0, float(rv), float(ra), rq)
+    return LimitScaling("amplitude", 1.0 if worst == 1.0 else 1.0 / worst, t0, qs)
 
 
 def _check_start(
