@@ -37,6 +37,11 @@ demo: $(RUNTIME)
 # default order, most tests first, would leave the one-test demo file for the end).
 PYTEST_WORKERS ?= auto
 PYTEST_XDIST := -n $(PYTEST_WORKERS) --dist loadscope --no-loadscope-reorder
+# one BLAS thread per worker: each worker already has a core, and threaded BLAS on the small
+# matrices of these tests spins against the other worker (the excitation optimisation of
+# tests/test_excitation.py takes 41 s single-threaded, 56 s alone with two threads, and about
+# 220 s with two threads beside another worker)
+TEST_ENV := MPLBACKEND=Agg OPENBLAS_NUM_THREADS=1 OMP_NUM_THREADS=1 MKL_NUM_THREADS=1
 
 # Chromium renders the HTML reports in tests/test_html_report.py (skipped without it): when
 # it is missing, install Debian's package where apt-get can (root, a Debian system); any
@@ -47,11 +52,11 @@ CHROMIUM_INSTALL = command -v chromium >/dev/null 2>&1 || { \
 
 test: $(TESTS)
 	@$(CHROMIUM_INSTALL)
-	MPLBACKEND=Agg $(PY) -m pytest -q $(PYTEST_XDIST)
+	$(TEST_ENV) $(PY) -m pytest -q $(PYTEST_XDIST)
 
 # everything but the tests marked slow (over about 10 s each)
 test-fast: $(TESTS)
-	MPLBACKEND=Agg $(PY) -m pytest -q $(PYTEST_XDIST) -m "not slow"
+	$(TEST_ENV) $(PY) -m pytest -q $(PYTEST_XDIST) -m "not slow"
 
 bench: $(TESTS)
 	$(PY) benchmarks/run_all.py
