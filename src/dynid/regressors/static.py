@@ -102,7 +102,7 @@ def _static_regressor(robot: Robot, q2: NDArray[np.float64]) -> NDArray[np.float
 
     A transposed view of :func:`static_regressor_columns` (not C-contiguous).
     """
-    return static_regressor_columns(robot, q2).transpose(2, 1, 0)
+    return _static_columns(robot, q2, None, False).transpose(2, 1, 0)
 
 
 def static_regressor_columns(
@@ -129,6 +129,16 @@ def static_regressor_columns(
     q2 = _checks.as_batch("q", q, (robot.n,))
     if q2.ndim != 2:
         raise ShapeError(f"q must have shape (B, {robot.n}); got {q2.shape}")
+    return _static_columns(robot, q2, columns, numpy_path)
+
+
+def _static_columns(
+    robot: Robot,
+    q2: NDArray[np.float64],
+    columns: NDArray[np.intp] | None,
+    numpy_path: bool,
+) -> NDArray[np.float64]:
+    """:func:`static_regressor_columns` for validated (B, n) positions."""
     B, n = q2.shape
     p = 10 * n
     idx = np.arange(p) if columns is None else np.asarray(columns, dtype=np.intp)
