@@ -228,17 +228,21 @@ def load_joint_state_bag(
     )
 
 
-#: Messages per chunk of the arrays a bag is read into.
+#: Messages per chunk of the arrays a bag is read into (at most; the chunks of one
+#: joint-name list start at :data:`_FIRST` and double, so that a bag whose messages list the
+#: joints in many orders holds a small chunk per order, not a full one).
 _CHUNK = 16_384
+_FIRST = 4
 
 
 class _Chunk:
-    """Up to :data:`_CHUNK` messages of one joint-name list: their index in the bag and
+    """Up to ``capacity`` messages of one joint-name list: their index in the bag and
     their ``position``, ``velocity``, ``effort`` in the list's order (NaN where short)."""
 
-    def __init__(self, width: int) -> None:
-        self.index = np.empty(_CHUNK, dtype=np.int64)
-        self.values = np.full((3, _CHUNK, width), np.nan)
+    def __init__(self, width: int, capacity: int) -> None:
+        self.index = np.empty(capacity, dtype=np.int64)
+        self.values = np.full((3, capacity, width), np.nan)
+        self.capacity = capacity
         self.size = 0
 
 
@@ -275,8 +279,10 @@ class _Messages:
         key = tuple(m.name)  # type: ignore[attr-defined]
         w = len(key)
         chunks = self.keys.setdefault(key, [])
-        if not chunks or chunks[-1].size == _CHUNK:
-            chunks.append(_Chunk(w))
+        if not chunks:
+            chunks.append(_Chunk(w, _FIRST))
+        elif chunks[-1].size == chunks[-1].capacity:
+            chunks.append(_Chunk(w, min(2 * chunks[-1].capacity, _CHUNK)))
         c = chunks[-1]
         c.index[c.size] = k
         fields = (m.position, m.velocity, m.effort)  # type: ignore[attr-defined]
