@@ -138,3 +138,107 @@ def test_io_exports_every_public_name_lazily_and_only_save_load_verbs():
     for path in (SRC / "io").rglob("*.py"):
         defs |= set(re.findall(r"^def ((?:read|write)_\w+)\(", path.read_text(), re.M))
     assert defs <= {"write_text", "write_bytes"}, sorted(defs)  # the atomic primitives only
+
+
+def _module_name(path: Path) -> str:
+    parts = list(path.relative_to(SRC).with_suffix("").parts)
+    return ".".join(["dynid", *(parts[:-1] if parts[-1] == "__init__" else parts)])
+
+
+def _imports(path: Path, top_level_only: bool) -> list[tuple[str, str]]:
+    """(module, name) of each ``from dynid... import name`` of ``path``, absolute; only the
+    statements run on import when ``top_level_only`` (not in functions or TYPE_CHECKING)."""
+    own = _module_name(path).split(".")
+    pkg = own if path.name == "__init__.py" else own[:-1]
+    out = []
+
+    def visit(body: list[ast.stmt]) -> None:
+        for node in body:
+            if isinstance(node, ast.If) and "TYPE_CHECKING" in ast.unparse(node.test):
+                continue
+            if isinstance(node, ast.ImportFrom):
+                if node.level:
+                    base = pkg[: len(pkg) - (node.level - 1)]
+                    module = ".".join(base + (node.module.split(".") if node.module else []))
+                else:
+                    module = node.module or ""
+                if module.startswith("dynid"):
+                    out.extend((module, a.name) for a in node.names)
+            elif isinstance(node, ast.Import):
+                out.extend((a.name, "") for a in node.names if a.name.startswith("dynid"))
+            if isinstance(node, ast.If | ast.Try | ast.With):
+                visit(node.body)
+                visit(getattr(node, "orelse", []))
+                for h in getattr(node, "handlers", []):
+                    visit(h.body)
+                visit(getattr(node, "finalbody", []))
+            elif not top_level_only and isinstance(
+                node, ast.FunctionDef | ast.AsyncFunctionDef | ast.ClassDef
+            ):
+                visit(node.body)
+
+    visit(ast.parse(path.read_text()).body)
+    return out
+
+
+def test_no_function_over_120_lines_outside_the_compiled_kernels():
+    """Long functions are split into named steps; the numba kernels of _kernels/ may not be
+    (a call between compiled functions is not free in a per-sample loop)."""
+    long = [
+        f"{path.relative_to(SRC)}:{node.lineno} {node.name} ({node.end_lineno - node.lineno + 1})"
+        for path in SRC.rglob("*.py")
+        if path.relative_to(SRC).parts[0] != "_kernels"
+        for node in ast.walk(ast.parse(path.read_text()))
+        if isinstance(node, ast.FunctionDef | ast.AsyncFunctionDef)
+        and node.end_lineno is not None
+        and node.end_lineno - node.lineno + 1 > 120
+    ]
+    assert not long, long
+
+
+def test_no_private_name_is_imported_from_another_package():
+    """A private name (``_x``) is imported only inside its own subpackage; the shared private
+    modules of the root (``dynid._checks``, ``dynid._kernels``, ``dynid._parallel``) are
+    imported as modules."""
+    modules = {_module_name(p) for p in SRC.rglob("*.py")}
+    bad = []
+    for path in SRC.rglob("*.py"):
+        mine = _module_name(path).split(".")[:2]
+        for module, name in _imports(path, top_level_only=False):
+            full = f"{module}.{name}"
+            if not name.startswith("_") or name.startswith("__"):
+                continue
+            if full in modules and full.count(".") == 1:  # a root private module
+                continue
+            if module.split(".")[:2] != mine:
+                bad.append(f"{path.relative_to(SRC)} imports {full}")
+    assert not bad, bad
+
+
+def test_no_import_circle():
+    """The modules' import-time dependencies form no cycle (depth-first search)."""
+    modules = {_module_name(p): p for p in SRC.rglob("*.py")}
+    graph = {
+        name: {
+            f"{m}.{n}" if f"{m}.{n}" in modules else m
+            for m, n in _imports(path, top_level_only=True)
+        }
+        & (modules.keys() - {name})
+        for name, path in modules.items()
+    }
+    state: dict[str, int] = {}  # 1: on the current path, 2: done
+
+    def cycle_from(v: str, path: list[str]) -> list[str] | None:
+        state[v] = 1
+        for w in sorted(graph[v]):
+            if state.get(w) == 1:
+                return [*path, v, w]
+            if w not in state and (found := cycle_from(w, [*path, v])):
+                return found
+        state[v] = 2
+        return None
+
+    for v in sorted(graph):
+        if v not in state:
+            found = cycle_from(v, [])
+            assert found is None, " -> ".join(found or [])
