@@ -538,6 +538,30 @@ def urdf_two_inertials(d: Path) -> None:
     (d / "bad.urdf").write_text(text)
 
 
+def urdf_mass_with_underscore(d: Path) -> None:
+    """A URDF mass written "1_0" (Python's float read it as 10 kg)."""
+    (d / "bad.urdf").write_text(TWO_LINK_URDF.replace('<mass value="1.0"/>', '<mass value="1_0"/>'))
+
+
+def log_cell_with_underscore(d: Path) -> None:
+    """A log cell "1_0" in q3 (read as a 10 rad spike, silently)."""
+
+    def edit(rows):
+        rows[8][3] = "1_0"
+
+    _edit_log(d, "bad.csv", edit)
+
+
+def static_arabic_digit(d: Path) -> None:
+    """A static-data cell holding an Arabic-Indic digit one (read as 1.0, silently)."""
+    lines = _lines(d / "s.csv")
+    h = _header_index(lines)
+    cells = lines[h + 2].split(",")
+    cells[-1] = "\u0661"
+    lines[h + 2] = ",".join(cells)
+    _write(d / "bad.csv", lines)
+
+
 def toml_frame_named_like_a_link(d: Path) -> None:
     """A [[frames]] entry named l1 on link l2: it replaced link l1's own frame silently."""
     _two_joint(d, "bad.toml", "", "")
@@ -791,6 +815,10 @@ CASES = [
     C("robot-toml-bom", drive_bom, "fk --robot {d}/bom.toml --q 0.1,0.2", 0, ""),
     C("model-rank-true", model_boolean_rank, "predict --model {d}/bad.json --q " + NEUTRAL, 2, "identified model: 'rank' must be an integer; got True"),
     C("model-value-string", model_string_value, "predict --model {d}/bad.json --q " + NEUTRAL, 2, "identified model: 'coefficients[].value' must be a number; got '0.1'"),
+    # numbers in files: plain ASCII decimals only (Python's float reads "1_0" and other scripts)
+    C("urdf-mass-underscore", urdf_mass_with_underscore, "fk --robot {d}/bad.urdf --base base --tip l1 --q 0.1", 2, "<mass> attribute 'value' must be a number; got '1_0'"),
+    C("log-cell-underscore", log_cell_with_underscore, f"validate --robot panda --data {{d}}/bad.csv --out {OUT}", 2, "bad.csv, line 10, column 'q3': not a number: '1_0'"),
+    C("static-arabic-digit", static_arabic_digit, f"identify --data {{d}}/bad.csv --out {OUT}", 2, "column 'g7': '\u0661' is not a number"),
     C("out-under-a-file", None, "identify --data {d}/s.csv --out {d}/s.csv/res", 2, "s.csv is a file, not a folder; choose another --out"),
     C("out-file-under-a-file", None, "export --params panda --out {d}/s.csv/robot.urdf", 2, "s.csv is a file, not a folder"),
 ]

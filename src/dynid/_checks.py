@@ -7,6 +7,7 @@ finiteness; internal functions trust validated arrays.
 from __future__ import annotations
 
 import math
+import re
 from typing import Any
 
 import numpy as np
@@ -122,6 +123,46 @@ def one_line(text: str, limit: int = 2 * ECHO_LIMIT + 200) -> str:
     tail = min(200, limit // 3)
     cut = len(flat) - (limit - tail - 40)
     return f"{flat[: limit - tail - 40]} ...({cut - tail} characters cut)... {flat[-tail:]}"
+
+
+#: a number as files write it: ASCII digits, an optional sign, point and exponent, or a
+#: spelling of NaN or infinity (refused later, where finiteness is checked)
+_DECIMAL = re.compile(
+    r"[+-]?(?:(?:\d+\.?\d*|\.\d+)(?:[eE][+-]?\d+)?|inf(?:inity)?|nan)", re.ASCII | re.IGNORECASE
+)
+_INTEGER = re.compile(r"[+-]?\d+", re.ASCII)
+
+
+def decimal(text: str) -> float:
+    """``float(text)`` for a number in plain ASCII decimal notation only.
+
+    Python's ``float`` also reads underscores between digits (``"1_0"`` is 10.0) and the
+    digits of other scripts (``"\\u0661"``, an Arabic-Indic one, is 1.0); in a data file
+    they are a typing error, not a number. Surrounding white space is allowed.
+
+    Raises
+    ------
+    ValueError
+        ``text`` is not such a number.
+    """
+    s = text.strip()
+    if _DECIMAL.fullmatch(s) is None:
+        raise ValueError(f"not a decimal number: {short(text)}")
+    return float(s)
+
+
+def integer(text: str) -> int:
+    """``int(text)`` for ASCII digits with an optional sign only (see :func:`decimal`).
+
+    Raises
+    ------
+    ValueError
+        ``text`` is not such an integer.
+    """
+    s = text.strip()
+    if _INTEGER.fullmatch(s) is None:
+        raise ValueError(f"not an integer: {short(text)}")
+    return int(s)
 
 
 def number(value: Any, where: str, error: type[Exception]) -> float:

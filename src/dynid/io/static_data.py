@@ -38,6 +38,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
+from .. import _checks
 from ..exceptions import DataError
 from ..identification.consistency import recorded_robot_mismatch
 from ..identification.data import DEFAULT_SYMMETRY_RTOL, StaticDataset
@@ -223,7 +224,7 @@ def load_static_csv(
             values = []
             for k in order:
                 try:
-                    v = float(cells[k])
+                    v = _checks.decimal(cells[k])
                 except ValueError:
                     reason = f"column {header[k]!r}: {cells[k]!r} is not a number"
                     break
@@ -282,7 +283,7 @@ def _check_columns(path: Path, header: list[str], line: int, robot: Robot | None
 
 def _parse_rows(path: Path, lineno: int, text: str) -> int:
     try:
-        n = int(text.strip())
+        n = _checks.integer(text)
     except ValueError:
         raise DataError(f"{path.name}: line {lineno}: '# rows:' must give an integer") from None
     if n < 0:

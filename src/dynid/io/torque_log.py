@@ -613,7 +613,7 @@ def _slow_table(
             c = cells[k].strip()
             if c:
                 try:
-                    table[rows, k] = float(c)
+                    table[rows, k] = _checks.decimal(c)
                 except ValueError:
                     raise DataError(
                         f"{path.name}, line {i}, column {names[k]!r}: not a number: {c[:40]!r}"
@@ -624,6 +624,6 @@ def _slow_table(
 
 def _rows(path: Path, lineno: int, text: str) -> int:
     try:
-        return int(text.strip())
+        return _checks.integer(text)
     except ValueError:
         raise DataError(f"{path.name}, line {lineno}: '# rows:' must give an integer") from None

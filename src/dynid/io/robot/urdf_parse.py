@@ -96,7 +96,7 @@ def _floats(
         return np.array(default, dtype=np.float64)
     parts = text.split()
     try:
-        values = np.array([float(x) for x in parts], dtype=np.float64)
+        values = np.array([_checks.decimal(x) for x in parts], dtype=np.float64)
     except ValueError:
         raise ModelError(f"{what} must hold {count} numbers; got {_checks.short(text)}") from None
     if values.shape != (count,):
@@ -114,7 +114,7 @@ def _float(elem: ET.Element, attr: str, what: str) -> float | None:
     if text is None:
         return None
     try:
-        value = float(text)
+        value = _checks.decimal(text)
     except ValueError:
         raise ModelError(
             f"{what} attribute {attr!r} must be a number; got {_checks.short(text)}"
