@@ -562,6 +562,17 @@ def static_arabic_digit(d: Path) -> None:
     _write(d / "bad.csv", lines)
 
 
+def trajectory_json_duration_1e300(d: Path) -> None:
+    """A trajectory.json whose Fourier part lasts 1e300 s (numpy's "Maximum allowed size")."""
+    from dynid.simulation.excitation import ExcitingTrajectory
+
+    traj = ExcitingTrajectory(
+        w_f=0.5, a=np.zeros((7, 1)), b=np.zeros((7, 1)), q_start=np.zeros(7), duration=1e300
+    )
+    doc = {"schema": "dynid-exciting-trajectory/1", "trajectory": traj.to_dict()}
+    (d / "traj.json").write_text(json.dumps(doc))
+
+
 def toml_frame_named_like_a_link(d: Path) -> None:
     """A [[frames]] entry named l1 on link l2: it replaced link l1's own frame silently."""
     _two_joint(d, "bad.toml", "", "")
@@ -819,6 +830,11 @@ CASES = [
     C("urdf-mass-underscore", urdf_mass_with_underscore, "fk --robot {d}/bad.urdf --base base --tip l1 --q 0.1", 2, "<mass> attribute 'value' must be a number; got '1_0'"),
     C("log-cell-underscore", log_cell_with_underscore, f"validate --robot panda --data {{d}}/bad.csv --out {OUT}", 2, "bad.csv, line 10, column 'q3': not a number: '1_0'"),
     C("static-arabic-digit", static_arabic_digit, f"identify --data {{d}}/bad.csv --out {OUT}", 2, "column 'g7': '\u0661' is not a number"),
+    # sizes no memory holds: one line naming the option, before numpy's own error
+    C("simulate-duration-1e300", None, f"simulate --duration 1e300 --out {OUT}/x.csv", 2, "1e+300 s at 1000 Hz is 1e+303 samples, more than any memory holds"),
+    C("simulate-rate-1e300", None, f"simulate --rate 1e300 --out {OUT}/x.csv", 2, "samples, more than any memory holds"),
+    C("trajectory-json-duration-1e300", trajectory_json_duration_1e300, f"simulate --trajectory {{d}}/traj.json --out {OUT}/x.csv", 2, "at 1000 Hz is 1e+303 samples"),
+    C("acquire-n-1e20", None, f"acquire-static --n {10**20} --out {OUT}/x.csv", 2, "configurations of 7 joints are more than any memory holds"),
     C("out-under-a-file", None, "identify --data {d}/s.csv --out {d}/s.csv/res", 2, "s.csv is a file, not a folder; choose another --out"),
     C("out-file-under-a-file", None, "export --params panda --out {d}/s.csv/robot.urdf", 2, "s.csv is a file, not a folder"),
 ]

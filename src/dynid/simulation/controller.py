@@ -38,6 +38,7 @@ from ..exceptions import LimitError, OptionError
 from ..identification.data import StaticDataset
 from ..model.panda import panda
 from ..model.robot import Robot
+from .trajectories import MAX_SAMPLES
 from .unmodelled import UnmodelledEffects
 
 __all__ = [
@@ -152,12 +153,18 @@ def sample_configurations(
     Raises
     ------
     ValueError
-        ``n < 1`` or ``margin < 0``.
+        ``n < 1``, ``n robot.n`` above :data:`~dynid.simulation.trajectories.MAX_SAMPLES`
+        or ``margin < 0``.
     LimitError
         A joint's range is not wider than ``2 margin``.
     """
     if int(n) != n or n < 1:
         raise OptionError(f"n must be a positive integer; got {n}")
+    if n * robot.n > MAX_SAMPLES:
+        raise OptionError(
+            f"n = {n} configurations of {robot.n} joints are more than any memory holds "
+            f"(at most {MAX_SAMPLES:.3g} values); give a smaller n"
+        )
     if not np.isfinite(margin) or margin < 0:
         raise OptionError(f"margin must be finite and >= 0; got {margin}")
     rng = np.random.default_rng(0) if rng is None else rng

@@ -34,7 +34,7 @@ from ..friction.model import FrictionModel, SigmoidFriction
 from ..identification.log import TorqueLog, recorded_side_log
 from ..model.drive import Drive
 from ..model.robot import Robot
-from .trajectories import Trajectory
+from .trajectories import Trajectory, uniform_times
 from .unmodelled import UnmodelledEffects
 
 __all__ = [
@@ -98,10 +98,14 @@ def sample_times(
     -------
     t : ndarray, shape (N,)
         [s].
+
+    Raises
+    ------
+    OptionError
+        ``duration`` or ``fs`` not positive, more samples than
+        :data:`~dynid.simulation.trajectories.MAX_SAMPLES`, jitter without ``rng``.
     """
-    if not (duration > 0 and fs > 0):
-        raise OptionError(f"duration and fs must be positive; got {duration} s and {fs} Hz")
-    t = np.arange(int(round(duration * fs)) + 1) / float(fs)
+    t = uniform_times(duration, fs)
     if jitter_std > 0:
         if rng is None:
             raise OptionError("rng is required when jitter_std > 0")

@@ -46,6 +46,7 @@ __all__ = [
     "LimitReport",
     "LimitScaling",
     "LimitViolation",
+    "MAX_SAMPLES",
     "Trajectory",
     "centered_start",
     "check_limits",
@@ -124,11 +125,29 @@ class Trajectory:
         return self.t.shape[0]
 
 
+#: The most samples a uniform time grid may hold: 2**40 (8 TiB of float64 times alone).
+MAX_SAMPLES = 2**40
+
+
 def uniform_times(duration: float, fs: float = 1000.0) -> NDArray[np.float64]:
-    """Times ``k / fs`` for ``k = 0 .. round(duration fs)`` [s], shape (N,)."""
+    """Times ``k / fs`` for ``k = 0 .. round(duration fs)`` [s], shape (N,).
+
+    Raises
+    ------
+    OptionError
+        ``duration`` or ``fs`` not positive, or more than :data:`MAX_SAMPLES` samples
+        (``duration = 1e300``: no memory holds them, and numpy's own error says nothing
+        of the duration).
+    """
     if not (duration > 0 and fs > 0):
         raise OptionError(f"duration and fs must be positive; got {duration} s and {fs} Hz")
-    return np.arange(int(round(duration * fs)) + 1) / float(fs)
+    count = duration * fs
+    if not count < MAX_SAMPLES:
+        raise OptionError(
+            f"{duration:g} s at {fs:g} Hz is {count:.3g} samples, more than any memory holds "
+            f"(at most {MAX_SAMPLES:.3g}); give a shorter duration or a lower rate"
+        )
+    return np.arange(int(round(count)) + 1) / float(fs)
 
 
 def _times(t: ArrayLike) -> NDArray[np.float64]:
