@@ -573,6 +573,15 @@ def trajectory_json_duration_1e300(d: Path) -> None:
     (d / "traj.json").write_text(json.dumps(doc))
 
 
+def obstacles_far(d: Path) -> None:
+    """A table top at z = 1e300 m and a box of 1e200 m (squared distances overflowed, the
+    optimiser then reported "q must be finite")."""
+    plane = {"name": "t", "point": [0, 0, 1e300], "normal": [0, 0, 1]}
+    box = {"name": "b", "center": [0.5, 0, 0.1], "size": [1e200, 1e200, 1e200]}
+    for name, key, item in (("far.json", "planes", plane), ("huge.json", "boxes", box)):
+        (d / name).write_text(json.dumps({"schema": "dynid-obstacles/1", key: [item]}))
+
+
 def toml_frame_named_like_a_link(d: Path) -> None:
     """A [[frames]] entry named l1 on link l2: it replaced link l1's own frame silently."""
     _two_joint(d, "bad.toml", "", "")
@@ -835,6 +844,8 @@ CASES = [
     C("simulate-rate-1e300", None, f"simulate --rate 1e300 --out {OUT}/x.csv", 2, "samples, more than any memory holds"),
     C("trajectory-json-duration-1e300", trajectory_json_duration_1e300, f"simulate --trajectory {{d}}/traj.json --out {OUT}/x.csv", 2, "at 1000 Hz is 1e+303 samples"),
     C("acquire-n-1e20", None, f"acquire-static --n {10**20} --out {OUT}/x.csv", 2, "configurations of 7 joints are more than any memory holds"),
+    C("obstacles-point-1e300", obstacles_far, f"excite --obstacles {{d}}/far.json --out {OUT}", 2, "far.json: planes[0] ('t'): plane point must be at most 1e+06 m in absolute value; got [0.0, 0.0, 1e+300]"),
+    C("obstacles-box-1e200", obstacles_far, f"excite --obstacles {{d}}/huge.json --out {OUT}", 2, "huge.json: boxes[0] ('b'): box size must be at most 1e+06 m"),
     C("out-under-a-file", None, "identify --data {d}/s.csv --out {d}/s.csv/res", 2, "s.csv is a file, not a folder; choose another --out"),
     C("out-file-under-a-file", None, "export --params panda --out {d}/s.csv/robot.urdf", 2, "s.csv is a file, not a folder"),
 ]

@@ -41,6 +41,7 @@ from ..model.robot import Robot
 __all__ = [
     "BOX_SAMPLES",
     "DEFAULT_RADIUS",
+    "MAX_OBSTACLE_EXTENT",
     "Box",
     "CapsuleModel",
     "Obstacles",
@@ -55,17 +56,36 @@ __all__ = [
 DEFAULT_RADIUS = 0.06
 #: Points along a capsule's segment at which its distance to a box is evaluated.
 BOX_SAMPLES = 9
+#: The largest coordinate of a plane's point or a box's centre, and the largest box edge
+#: [m]: farther than any workspace, and small enough that squared distances stay finite.
+MAX_OBSTACLE_EXTENT = 1e6
+
+
+def _within_extent(what: str, x: NDArray[np.float64]) -> None:
+    big = float(np.max(np.abs(x)))
+    if not big <= MAX_OBSTACLE_EXTENT:
+        raise OptionError(
+            f"{what} must be at most {MAX_OBSTACLE_EXTENT:g} m in absolute value; got "
+            f"{[float(v) for v in x]}; give obstacles in metres"
+        )
 
 
 @dataclass(frozen=True, slots=True)
 class Plane:
-    """A half-space boundary: ``normal . (p - point) >= 0`` is free [m]."""
+    """A half-space boundary: ``normal . (p - point) >= 0`` is free [m].
+
+    Raises
+    ------
+    OptionError
+        A zero normal, or a point coordinate beyond :data:`MAX_OBSTACLE_EXTENT`.
+    """
 
     point: tuple[float, float, float]
     normal: tuple[float, float, float]
 
     def __post_init__(self) -> None:
         p = _checks.as_exact("point", self.point, (3,))
+        _within_extent("plane point", p)
         nrm = _checks.as_exact("normal", self.normal, (3,))
         big = float(np.max(np.abs(nrm)))
         if not big > 0:
@@ -77,7 +97,14 @@ class Plane:
 
 @dataclass(frozen=True, slots=True)
 class Box:
-    """An axis-aligned box in the base frame: ``center`` and edge lengths ``size`` [m]."""
+    """An axis-aligned box in the base frame: ``center`` and edge lengths ``size`` [m].
+
+    Raises
+    ------
+    OptionError
+        An edge not positive, or a centre coordinate or an edge beyond
+        :data:`MAX_OBSTACLE_EXTENT`.
+    """
 
     center: tuple[float, float, float]
     size: tuple[float, float, float]
@@ -85,8 +112,10 @@ class Box:
     def __post_init__(self) -> None:
         c = _checks.as_exact("center", self.center, (3,))
         s = _checks.as_exact("size", self.size, (3,))
+        _within_extent("box center", c)
         if np.any(s <= 0):
-            raise OptionError(f"box size must be positive; got {tuple(s)}")
+            raise OptionError(f"box size must be positive; got {[float(v) for v in s]}")
+        _within_extent("box size", s)
         object.__setattr__(self, "center", tuple(float(x) for x in c))
         object.__setattr__(self, "size", tuple(float(x) for x in s))
 
