@@ -28,9 +28,9 @@ def _env(**extra: str) -> dict[str, str]:
 
 def _dynid(*args: str, env: dict[str, str] | None = None, **kw) -> subprocess.Popen:
     kw.setdefault("stdout", subprocess.PIPE)
+    kw.setdefault("stderr", subprocess.PIPE)
     return subprocess.Popen(
         [sys.executable, "-m", "dynid", *args],
-        stderr=subprocess.PIPE,
         text=True,
         env=env or _env(),
         **kw,
@@ -169,6 +169,31 @@ def test_a_closed_stdout_keeps_the_files_of_a_run(model, tmp_path):
     _, err = proc.communicate(timeout=60)
     assert (proc.returncode, err) == (141, "")
     assert (tmp_path / "r" / "identification.json").is_file()
+
+
+def _closed_fd(fd: int) -> None:
+    """Run in the child before exec: start it with file descriptor ``fd`` closed (``>&-``)."""
+    os.close(fd)
+
+
+def test_a_run_started_without_stdout_keeps_its_files_and_exits_141(model, tmp_path):
+    """`dynid identify ... >&-` (Python's sys.stdout is None): exit 141 with the files, not
+    'unexpected AttributeError' (exit 2, no files) and 'Exception ignored' (exit 120)."""
+    data = model.parent.parent / "s.csv"
+    out = tmp_path / "r"
+    args = ("identify", "--data", str(data), "--out", str(out))
+    proc = _dynid(*args, stdout=None, preexec_fn=lambda: _closed_fd(1))
+    _, err = proc.communicate(timeout=60)
+    assert (proc.returncode, err) == (141, "")
+    assert (out / "identification.json").is_file()
+
+
+def test_an_error_without_stderr_never_goes_to_stdout():
+    """`dynid ... 2>&-` failing: exit 2 and nothing on stdout (print(file=None) wrote the
+    error line into the data stream)."""
+    proc = _dynid("fk", "--q", "nan,0,0,0,0,0,0", stderr=None, preexec_fn=lambda: _closed_fd(2))
+    out, _ = proc.communicate(timeout=60)
+    assert (proc.returncode, out) == (2, "")
 
 
 def test_a_bad_backend_skips_the_figures_and_keeps_the_data(model, tmp_path):

@@ -31,6 +31,7 @@ import signal
 import sys
 import warnings
 from collections.abc import Iterator, Sequence
+from typing import TextIO
 
 from .. import __version__
 from .._checks import one_line
@@ -238,7 +239,7 @@ def main(argv: Sequence[str] | None = None) -> int:
     except KeyboardInterrupt:
         if args.debug:
             raise
-        print(f"{say}: interrupted; no partial output left", file=sys.stderr)
+        print(f"{say}: interrupted; no partial output left", file=_stderr())
         return 130
     except Terminated as exc:
         if args.debug:
@@ -246,18 +247,18 @@ def main(argv: Sequence[str] | None = None) -> int:
         signum = int(exc.args[0]) if exc.args else int(signal.SIGTERM)
         print(
             f"{say}: terminated ({signal.Signals(signum).name}); no partial output left",
-            file=sys.stderr,
+            file=_stderr(),
         )
         return 128 + signum
     except (DynidError, OSError) as exc:
         if args.debug:
             raise
-        print(f"{say}: error: {one_line(str(exc), ERROR_LINE_LIMIT)}", file=sys.stderr)
+        print(f"{say}: error: {one_line(str(exc), ERROR_LINE_LIMIT)}", file=_stderr())
         return 2
     except MemoryError as exc:
         if args.debug:
             raise
-        print(f"{say}: error: {out_of_memory(exc)}", file=sys.stderr)
+        print(f"{say}: error: {out_of_memory(exc)}", file=_stderr())
         return 2
     except Exception as exc:  # anything unexpected: one line, never a traceback
         if args.debug:
@@ -265,7 +266,7 @@ def main(argv: Sequence[str] | None = None) -> int:
         print(
             f"{say}: error: unexpected {type(exc).__name__}: "
             f"{one_line(str(exc), ERROR_LINE_LIMIT)} (run with --debug for the traceback)",
-            file=sys.stderr,
+            file=_stderr(),
         )
         return 2
 
@@ -285,6 +286,12 @@ def out_of_memory(exc: MemoryError) -> str:
         "-v) or the machine's memory: raise it, or give a shorter log (a long one streams "
         "its regressor in blocks above DYNID_MAX_STACK_BYTES bytes: lower it)"
     )
+
+
+def _stderr() -> TextIO:
+    """Where the last line goes: stderr, or nowhere when the run started with file
+    descriptor 2 closed (``2>&-``; ``print(file=None)`` would write it to stdout)."""
+    return sys.stderr if sys.stderr is not None else io.StringIO()
 
 
 def _drop_stdout() -> None:

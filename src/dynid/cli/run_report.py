@@ -28,12 +28,14 @@ __all__ = ["RunRecord", "save_run_report"]
 class _Tee:
     """A text stream that writes through to ``stream`` and keeps a copy."""
 
-    def __init__(self, stream: TextIO, record: RunRecord, *, stdout: bool) -> None:
+    def __init__(self, stream: TextIO | None, record: RunRecord, *, stdout: bool) -> None:
         self._stream, self._record, self._stdout = stream, record, stdout
+        if stream is None and stdout:  # started with file descriptor 1 closed (``>&-``)
+            record.stdout_closed = True
 
     def write(self, text: str) -> int:
         (self._record.out_parts if self._stdout else self._record.err_parts).append(text)
-        if self._stdout and self._record.stdout_closed:
+        if self._stream is None or (self._stdout and self._record.stdout_closed):
             return len(text)
         try:
             return self._stream.write(text)
@@ -44,7 +46,7 @@ class _Tee:
             return len(text)
 
     def flush(self) -> None:
-        if self._stdout and self._record.stdout_closed:
+        if self._stream is None or (self._stdout and self._record.stdout_closed):
             return
         try:
             self._stream.flush()
@@ -80,7 +82,7 @@ class RunRecord:
     def __exit__(self, *exc: object) -> None:
         logging.getLogger().removeHandler(self._handler)
         try:
-            sys.stdout.flush()
+            sys.stdout.flush()  # the tee, even over a closed or missing stdout
         except BrokenPipeError:  # pragma: no cover - the tee catches it
             self.stdout_closed = True
         assert self._saved is not None
