@@ -465,6 +465,13 @@ def drive_bom(d: Path) -> None:
     _two_joint(d, "bom.toml", "", "", prefix="\ufeff")
 
 
+def drive_coupling_twice(d: Path) -> None:
+    """A drive file that gives the entry (motor 1, joint 2) of K twice (one was dropped)."""
+    (d / "drive.toml").write_text(
+        'schema = "dynid-drive/1"\ncoupling = [[1, 2, 0.5], [1, 2, 0.7]]\n', encoding="utf-8"
+    )
+
+
 def static_nan_cell(d: Path) -> None:
     """Static data with a NaN cell (the hint named the Python argument, not the flag)."""
     lines = _lines(d / "s.csv")
@@ -846,6 +853,7 @@ CASES = [
     C("acquire-n-1e20", None, f"acquire-static --n {10**20} --out {OUT}/x.csv", 2, "configurations of 7 joints are more than any memory holds"),
     C("obstacles-point-1e300", obstacles_far, f"excite --obstacles {{d}}/far.json --out {OUT}", 2, "far.json: planes[0] ('t'): plane point must be at most 1e+06 m in absolute value; got [0.0, 0.0, 1e+300]"),
     C("obstacles-box-1e200", obstacles_far, f"excite --obstacles {{d}}/huge.json --out {OUT}", 2, "huge.json: boxes[0] ('b'): box size must be at most 1e+06 m"),
+    C("drive-coupling-twice", drive_coupling_twice, f"identify --data {{d}}/log.csv --drive {{d}}/drive.toml --out {OUT}", 2, "drive.toml: coupling[1]: motor 1 on joint 2 is given twice"),
     C("out-under-a-file", None, "identify --data {d}/s.csv --out {d}/s.csv/res", 2, "s.csv is a file, not a folder; choose another --out"),
     C("out-file-under-a-file", None, "export --params panda --out {d}/s.csv/robot.urdf", 2, "s.csv is a file, not a folder"),
 ]

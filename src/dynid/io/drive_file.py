@@ -14,7 +14,7 @@ Keys (all optional but ``schema`` in a file of its own; n = the robot's joint co
 
 ``qm = K (q - offset)``, ``dqm = K dq``, ``tau_joint = K^T tau_motor``
 (:mod:`dynid.model.drive`). Every fault (an unknown key, a wrong type or length, a singular
-``K``, a coupling outside the chain, currents without constants) is one
+``K``, a coupling outside the chain or given twice, currents without constants) is one
 :class:`~dynid.exceptions.DataError` naming the file and the key, before anything is computed.
 """
 
@@ -117,6 +117,10 @@ def drive_from_mapping(table: Mapping[str, Any], n: int, *, source: str = "drive
                 )
         if m == j:
             raise DataError(f"{where}: motor {m} on joint {j} is the gear ratio; use gear_ratio")
+        if any(e[:2] == (m, j) for e in entries):
+            raise DataError(
+                f"{where}: motor {m} on joint {j} is given twice; give each entry of K once"
+            )
         entries.append((m, j, _number(entry[2], f"{where}: value")))
     for key in ("offset", "torque_constant"):
         if key in table:
