@@ -103,7 +103,7 @@ def drive_from_mapping(table: Mapping[str, Any], n: int, *, source: str = "drive
     coupling = table.get("coupling", [])
     if not isinstance(coupling, list):
         raise DataError(f"{source}: key 'coupling' must be a list of [motor, joint, value]")
-    entries = []
+    entries: list[tuple[int, int, float]] = []
     for k, entry in enumerate(coupling):
         where = f"{source}: coupling[{k}]"
         if not isinstance(entry, list) or len(entry) != 3:
