@@ -854,6 +854,12 @@ CASES = [
     C("obstacles-point-1e300", obstacles_far, f"excite --obstacles {{d}}/far.json --out {OUT}", 2, "far.json: planes[0] ('t'): plane point must be at most 1e+06 m in absolute value; got [0.0, 0.0, 1e+300]"),
     C("obstacles-box-1e200", obstacles_far, f"excite --obstacles {{d}}/huge.json --out {OUT}", 2, "huge.json: boxes[0] ('b'): box size must be at most 1e+06 m"),
     C("drive-coupling-twice", drive_coupling_twice, f"identify --data {{d}}/log.csv --drive {{d}}/drive.toml --out {OUT}", 2, "drive.toml: coupling[1]: motor 1 on joint 2 is given twice"),
+    # column maps: a quantity once, a column for one quantity only
+    C("columns-one-column-two-quantities", None, f"validate --robot panda --data {{d}}/log.csv --columns tau=q{{i}} --out {OUT}", 2, "log.csv: column 'q1' is named by the templates of both 'q' and 'tau'"),
+    C("static-columns-one-column-two-quantities", None, f"identify --data {{d}}/s.csv --columns g=q{{i}} --out {OUT}", 2, "s.csv: column 'q1' is named by the templates of both 'q' and 'g'"),
+    C("units-given-twice", None, f"validate --robot panda --data {{d}}/log.csv --units q=deg,q=rad --out {OUT}", 2, "--units: 'q' is given twice in 'q=deg,q=rad'"),
+    C("columns-given-twice", None, f"validate --robot panda --data {{d}}/log.csv --columns q=q{{i}},q=dq{{i}} --out {OUT}", 2, "--columns: 'q' is given twice"),
+    C("units-factor-underscore", None, f"validate --robot panda --data {{d}}/log.csv --units tau=1_0 --out {OUT}", 2, "unknown unit '1_0' for 'tau'"),
     C("out-under-a-file", None, "identify --data {d}/s.csv --out {d}/s.csv/res", 2, "s.csv is a file, not a folder; choose another --out"),
     C("out-file-under-a-file", None, "export --params panda --out {d}/s.csv/robot.urdf", 2, "s.csv is a file, not a folder"),
 ]

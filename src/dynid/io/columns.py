@@ -88,7 +88,7 @@ def _to_factor(quantity: str, unit: Any) -> float:
         table = _UNITS[quantity]
         key = str(unit).strip()
         try:
-            return _to_factor(quantity, float(key))
+            return _to_factor(quantity, _checks.decimal(key))
         except ValueError:
             pass
         if key not in table:
@@ -159,6 +159,8 @@ def _pairs(text: str, what: str) -> dict[str, str]:
         key, sep, value = part.partition("=")
         if not sep or not key.strip() or not value.strip():
             raise DataError(f"{what} must read 'quantity=value,...'; got {part!r} in {text!r}")
+        if key.strip() in out:
+            raise DataError(f"{what}: {key.strip()!r} is given twice in {_checks.short(text)}")
         out[key.strip()] = value.strip()
     return out
 
@@ -169,7 +171,7 @@ def parse_column_map(columns: str | None = None, units: str | None = None, **kw:
     Raises
     ------
     DataError
-        Malformed text, an unknown quantity or unit.
+        Malformed text, a quantity given twice, an unknown quantity or unit.
     """
     cols = _pairs(columns or "", "--columns")
     unit = _pairs(units or "", "--units")
@@ -298,6 +300,26 @@ def _vector(table: _Table, cmap: ColumnMap, quantity: str, n: int | None) -> NDA
     return np.stack([table.columns[c] for c in names], axis=1) * cmap.factor(quantity)
 
 
+def _check_distinct(table: _Table, cmap: ColumnMap, quantities: tuple[str, ...], n: int) -> None:
+    """Refuse a column (or NPZ array) that the templates of two quantities both name
+    (``tau = "q{i}"``: the positions were read as torques too)."""
+    owner: dict[str, str] = {}
+    for quantity in quantities:
+        tpl = cmap.template(quantity)
+        if "{" not in tpl:
+            names = [tpl]
+        elif "{j" in tpl:
+            names = [_fill(tpl, i, j) for i in range(n) for j in range(n)]
+        else:
+            names = [_fill(tpl, i) for i in range(n)]
+        for c in names:
+            if c in table.columns and owner.setdefault(c, quantity) != quantity:
+                raise DataError(
+                    f"{table.name}: column {c!r} is named by the templates of both "
+                    f"{owner[c]!r} and {quantity!r}; each column holds one quantity: fix --columns"
+                )
+
+
 def _need(table: _Table, cmap: ColumnMap, quantity: str, n: int | None) -> NDArray:
     a = _vector(table, cmap, quantity, n)
     if a is None:
@@ -350,8 +372,8 @@ def load_mapped_torque_log(
     Raises
     ------
     DataError
-        Missing columns (named with the template), a malformed file, a joint count
-        other than ``n``, time running backwards.
+        Missing columns (named with the template), a column named by two quantities'
+        templates, a malformed file, a joint count other than ``n``, time running backwards.
     """
     path = Path(path)
     table = _read_table(path, columns, ("t", "q", "dq", "tau", "ddq"))
@@ -367,6 +389,7 @@ def load_mapped_torque_log(
     tau = _need(table, columns, "tau", n)
     dq = _vector(table, columns, "dq", n)
     ddq = _vector(table, columns, "ddq", n)
+    _check_distinct(table, columns, ("t", "q", "dq", "tau", "ddq"), n)
     notes = [
         f"{k} scaled by {columns.factor(k):.17g} to SI" for k in columns.factors if k in _DEFAULT
     ]
@@ -403,7 +426,8 @@ def load_mapped_static_data(
     Raises
     ------
     DataError
-        Missing columns (named), a joint count other than the robot's, NaN rows.
+        Missing columns (named), a column named by two quantities' templates, a joint
+        count other than the robot's, NaN rows.
     """
     path = Path(path)
     table = _read_table(path, columns, ("q", "g", "M"))
@@ -411,6 +435,7 @@ def load_mapped_static_data(
     q = _need(table, columns, "q", n)
     n = q.shape[1]
     g = _need(table, columns, "g", n)
+    _check_distinct(table, columns, ("q", "g", "M"), n)
     tpl = columns.template("M")
     extra: tuple[str, ...] = ()
     has_M = (tpl in table.columns) if "{" not in tpl else (_fill(tpl, 0, 0) in table.columns)
