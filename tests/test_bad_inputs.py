@@ -603,6 +603,14 @@ def bounds_boolean_mass(d: Path) -> None:
     )
 
 
+def bounds_mass_1e300(d: Path) -> None:
+    """A bounds file with a link mass up to 1e300 kg (Clarabel panicked: a Rust backtrace,
+    exit 1, the code of "no feasible set")."""
+    (d / "bounds.json").write_text(
+        '{"schema": "dynid-feasibility-bounds/1", "links": [{"name": "link1", "mass": [0, 1e300]}]}'
+    )
+
+
 def bounds_string_mass(d: Path) -> None:
     """A bounds file (TOML) with a string where a number belongs."""
     (d / "bounds.toml").write_text(
@@ -860,6 +868,9 @@ CASES = [
     C("units-given-twice", None, f"validate --robot panda --data {{d}}/log.csv --units q=deg,q=rad --out {OUT}", 2, "--units: 'q' is given twice in 'q=deg,q=rad'"),
     C("columns-given-twice", None, f"validate --robot panda --data {{d}}/log.csv --columns q=q{{i}},q=dq{{i}} --out {OUT}", 2, "--columns: 'q' is given twice"),
     C("units-factor-underscore", None, f"validate --robot panda --data {{d}}/log.csv --units tau=1_0 --out {OUT}", 2, "unknown unit '1_0' for 'tau'"),
+    C("bounds-mass-1e300", bounds_mass_1e300, f"retrieve --model {{d}}/res/identification.json --bounds {{d}}/bounds.json --out {OUT}", 2, "bounds.json: mass_max must be at most 1e+06 kg per link; got [1e+300,"),
+    C("total-mass-1e300", None, f"retrieve --model {{d}}/res/identification.json --total-mass 0,1e300 --out {OUT}", 2, "total_mass max must be at most 7e+06 kg (7 links of at most 1e+06 kg); got 1e+300"),
+    C("penalty-total-mass-1e300", None, f"retrieve --model {{d}}/res/identification.json --method penalty --total-mass 0,1e300 --out {OUT}", 2, "total_mass max must be at most 7e+06 kg"),
     C("out-under-a-file", None, "identify --data {d}/s.csv --out {d}/s.csv/res", 2, "s.csv is a file, not a folder; choose another --out"),
     C("out-file-under-a-file", None, "export --params panda --out {d}/s.csv/robot.urdf", 2, "s.csv is a file, not a folder"),
 ]

@@ -24,7 +24,7 @@ from ..model.panda import (
     PANDA_RETRIEVAL_MASS,
     PANDA_RETRIEVAL_TOTAL_MASS,
 )
-from ..model.robot import Robot
+from ..model.robot import MAX_LINK_MASS, Robot
 
 __all__ = [
     "GENERIC_MASS_BASE",
@@ -65,8 +65,9 @@ class Bounds:
         A NaN or infinite bound (every bound must be finite: the retrieval samples
         uniformly inside the box).
     ValueError
-        A lower bound above its upper bound, a negative mass bound, or a total-mass band
-        with ``min > max`` or ``min < 0``.
+        A lower bound above its upper bound, a negative mass bound or one above
+        :data:`~dynid.model.robot.MAX_LINK_MASS`, or a total-mass band with ``min > max``,
+        ``min < 0`` or ``max`` above ``n MAX_LINK_MASS``.
     """
 
     mass_min: NDArray[np.float64]
@@ -102,11 +103,21 @@ class Bounds:
                 )
         if np.any(self.mass_min < 0):
             raise OptionError(f"mass_min must be >= 0; got {self.mass_min.tolist()}")
+        if np.any(self.mass_max > MAX_LINK_MASS):
+            raise OptionError(
+                f"mass_max must be at most {MAX_LINK_MASS:g} kg per link; got "
+                f"{self.mass_max.tolist()}"
+            )
         if self.total_mass is not None:
             m_lo, m_hi = (float(x) for x in self.total_mass)
             if not (math.isfinite(m_lo) and math.isfinite(m_hi)) or m_lo < 0 or m_lo > m_hi:
                 raise OptionError(
                     f"total_mass must be (min, max) with 0 <= min <= max; got ({m_lo:g}, {m_hi:g})"
+                )
+            if m_hi > n * MAX_LINK_MASS:
+                raise OptionError(
+                    f"total_mass max must be at most {n * MAX_LINK_MASS:g} kg ({n} links of at "
+                    f"most {MAX_LINK_MASS:g} kg); got {m_hi:g}"
                 )
             put("total_mass", (m_lo, m_hi))
         if self.link_names is not None:

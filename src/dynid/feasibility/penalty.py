@@ -370,13 +370,9 @@ def _common(
     b = default_bounds(robot) if bounds is None else bounds
     if b.n != robot.n:
         raise ShapeError(f"bounds are for {b.n} links; robot {robot.name!r} has {robot.n}")
-    band = total_mass if total_mass is not None else b.total_mass
-    if band is not None:
-        lo, hi = (float(x) for x in band)
-        if not (0 <= lo <= hi):
-            raise OptionError(f"total_mass must be (min, max) with 0 <= min <= max; got {band}")
-        band = (lo, hi)
-    return b, band, user_constraints(extra)
+    if total_mass is not None:  # checked as the bounds' own band is
+        b = b.with_total_mass(total_mass)
+    return b, b.total_mass, user_constraints(extra)
 
 
 def with_prior(problem: PenaltyProblem, phi0: ArrayLike, weight: float) -> PenaltyProblem:

@@ -918,8 +918,9 @@ def _checked_bounds(
     b = default_bounds(robot) if bounds is None else bounds
     if b.n != n:
         raise ShapeError(f"bounds are for {b.n} links; robot {robot.name!r} has {n}")
-    band = total_mass if total_mass is not None else b.total_mass
-    return b, None if band is None else (float(band[0]), float(band[1]))
+    if total_mass is not None:  # checked as the bounds' own band is
+        b = b.with_total_mass(total_mass)
+    return b, b.total_mass
 
 
 def _resolved_prior(
