@@ -611,6 +611,16 @@ def bounds_mass_1e300(d: Path) -> None:
     )
 
 
+def bounds_link_twice(d: Path) -> None:
+    """A bounds file that lists link1 twice (the second entry won silently) and one whose
+    units say pounds (ignored: the numbers were read as kg)."""
+    links = '[{"name": "link1", "mass": [1, 5]}, {"name": "link1", "mass": [2, 3]}]'
+    (d / "twice.json").write_text(
+        '{"schema": "dynid-feasibility-bounds/1", "links": ' + links + "}"
+    )
+    (d / "lb.json").write_text('{"schema": "dynid-feasibility-bounds/1", "units": {"mass": "lb"}}')
+
+
 def bounds_string_mass(d: Path) -> None:
     """A bounds file (TOML) with a string where a number belongs."""
     (d / "bounds.toml").write_text(
@@ -871,6 +881,8 @@ CASES = [
     C("bounds-mass-1e300", bounds_mass_1e300, f"retrieve --model {{d}}/res/identification.json --bounds {{d}}/bounds.json --out {OUT}", 2, "bounds.json: mass_max must be at most 1e+06 kg per link; got [1e+300,"),
     C("total-mass-1e300", None, f"retrieve --model {{d}}/res/identification.json --total-mass 0,1e300 --out {OUT}", 2, "total_mass max must be at most 7e+06 kg (7 links of at most 1e+06 kg); got 1e+300"),
     C("penalty-total-mass-1e300", None, f"retrieve --model {{d}}/res/identification.json --method penalty --total-mass 0,1e300 --out {OUT}", 2, "total_mass max must be at most 7e+06 kg"),
+    C("bounds-link-twice", bounds_link_twice, f"retrieve --model {{d}}/res/identification.json --bounds {{d}}/twice.json --out {OUT}", 2, "twice.json: links[1]: link 'link1' is listed twice"),
+    C("bounds-units-pounds", bounds_link_twice, f"retrieve --model {{d}}/res/identification.json --bounds {{d}}/lb.json --out {OUT}", 2, "lb.json: units.mass must be 'kg' (bounds are in SI units); got 'lb'"),
     C("out-under-a-file", None, "identify --data {d}/s.csv --out {d}/s.csv/res", 2, "s.csv is a file, not a folder; choose another --out"),
     C("out-file-under-a-file", None, "export --params panda --out {d}/s.csv/robot.urdf", 2, "s.csv is a file, not a folder"),
 ]

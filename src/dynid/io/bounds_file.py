@@ -67,14 +67,38 @@ def bounds_to_dict(bounds: Bounds) -> dict[str, Any]:
     }
 
 
+#: The unit each ``units`` entry must start with (what follows describes the frame).
+_UNITS = {"mass": "kg", "com": "m", "inertia": "kg m^2", "total_mass": "kg"}
+
+
+def _check_units(units: Any, source: str) -> None:
+    """Refuse a ``units`` table that is not the one dynid writes (``mass = "lb"`` was
+    ignored: the numbers were read as kg)."""
+    if units is None:
+        return
+    if not isinstance(units, Mapping):
+        raise DataError(f"{source}: 'units' must be a table/object; got {_checks.short(units)}")
+    for key, value in units.items():
+        if key not in _UNITS:
+            raise DataError(
+                f"{source}: units: unknown key {_checks.short(key)}; allowed: {sorted(_UNITS)}"
+            )
+        unit = value.split(",")[0].strip() if isinstance(value, str) else None
+        if unit != _UNITS[key]:
+            raise DataError(
+                f"{source}: units.{key} must be {_UNITS[key]!r} (bounds are in SI units); "
+                f"got {_checks.short(value)}"
+            )
+
+
 def bounds_from_dict(d: Mapping[str, Any], robot: Robot, *, source: str = "bounds") -> Bounds:
     """Bounds for ``robot`` from a bounds file's content; gaps filled from its defaults.
 
     Raises
     ------
     DataError
-        Unknown keys, a link name the robot does not have, malformed or inconsistent
-        values (lower above upper, negative mass).
+        Unknown keys, a link name the robot does not have or listed twice, units other
+        than SI, malformed or inconsistent values (lower above upper, negative mass).
     """
     unknown = sorted(set(d) - {"schema", "total_mass", "links", "units"})
     if unknown:
@@ -88,6 +112,8 @@ def bounds_from_dict(d: Mapping[str, Any], robot: Robot, *, source: str = "bound
     links = d.get("links", []) or []
     if not isinstance(links, list):
         raise DataError(f"{source}: 'links' must be a list of tables/objects")
+    _check_units(d.get("units"), source)
+    seen: set[str] = set()
     for k, link in enumerate(links):
         where = f"{source}: links[{k}]"
         if not isinstance(link, Mapping):
@@ -100,6 +126,9 @@ def bounds_from_dict(d: Mapping[str, Any], robot: Robot, *, source: str = "bound
         name = link.get("name")
         if name not in names:
             raise DataError(f"{where}: unknown link {_checks.short(name)}; available: {names}")
+        if name in seen:
+            raise DataError(f"{where}: link {name!r} is listed twice; give each link once")
+        seen.add(name)
         i = names.index(name)
         if "mass" in link:
             lo[i, 0], hi[i, 0] = _checks.numbers(link["mass"], 2, f"{where} mass", DataError)
