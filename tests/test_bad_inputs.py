@@ -589,6 +589,25 @@ def obstacles_far(d: Path) -> None:
         (d / name).write_text(json.dumps({"schema": "dynid-obstacles/1", key: [item]}))
 
 
+def trajectory_json_edited(d: Path) -> None:
+    """trajectory.json files edited by hand: an unknown top-level key, harmonics "five",
+    a duration that no longer matches the recorded total (each was ignored)."""
+    from dynid.simulation.excitation import ExcitingTrajectory
+
+    traj = ExcitingTrajectory(
+        w_f=0.5, a=np.zeros((7, 1)), b=np.zeros((7, 1)), q_start=np.zeros(7), duration=2.0
+    )
+    edits = {
+        "extra.json": lambda doc: doc.__setitem__("note", "x"),
+        "five.json": lambda doc: doc["trajectory"].__setitem__("harmonics", "five"),
+        "longer.json": lambda doc: doc["trajectory"].__setitem__("duration_s", 20.0),
+    }
+    for name, edit in edits.items():
+        doc = {"schema": "dynid-exciting-trajectory/1", "trajectory": traj.to_dict()}
+        edit(doc)
+        (d / name).write_text(json.dumps(doc))
+
+
 def toml_frame_named_like_a_link(d: Path) -> None:
     """A [[frames]] entry named l1 on link l2: it replaced link l1's own frame silently."""
     _two_joint(d, "bad.toml", "", "")
@@ -883,6 +902,9 @@ CASES = [
     C("penalty-total-mass-1e300", None, f"retrieve --model {{d}}/res/identification.json --method penalty --total-mass 0,1e300 --out {OUT}", 2, "total_mass max must be at most 7e+06 kg"),
     C("bounds-link-twice", bounds_link_twice, f"retrieve --model {{d}}/res/identification.json --bounds {{d}}/twice.json --out {OUT}", 2, "twice.json: links[1]: link 'link1' is listed twice"),
     C("bounds-units-pounds", bounds_link_twice, f"retrieve --model {{d}}/res/identification.json --bounds {{d}}/lb.json --out {OUT}", 2, "lb.json: units.mass must be 'kg' (bounds are in SI units); got 'lb'"),
+    C("trajectory-json-unknown-key", trajectory_json_edited, f"simulate --trajectory {{d}}/extra.json --out {OUT}/x.csv", 2, "extra.json: unknown key(s) ['note']"),
+    C("trajectory-json-harmonics-string", trajectory_json_edited, f"simulate --trajectory {{d}}/five.json --out {OUT}/x.csv", 2, "five.json: trajectory.harmonics must be a number; got 'five'"),
+    C("trajectory-json-duration-edited", trajectory_json_edited, f"simulate --trajectory {{d}}/longer.json --out {OUT}/x.csv", 2, "longer.json: trajectory.total_duration_s = 3 disagrees with the coefficients (21)"),
     C("out-under-a-file", None, "identify --data {d}/s.csv --out {d}/s.csv/res", 2, "s.csv is a file, not a folder; choose another --out"),
     C("out-file-under-a-file", None, "export --params panda --out {d}/s.csv/robot.urdf", 2, "s.csv is a file, not a folder"),
 ]

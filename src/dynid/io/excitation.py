@@ -23,6 +23,7 @@ recorded row count of a CSV checked.
 
 from __future__ import annotations
 
+import math
 import re
 from pathlib import Path
 from typing import Any
@@ -152,6 +153,31 @@ _TRAJECTORY_KEYS = {
 }
 
 
+#: the top-level keys of ``trajectory.json`` (:func:`save_excitation_json`)
+_EXCITATION_KEYS = {
+    "schema",
+    "dynid_version",
+    "robot",
+    "joint_names",
+    "seed",
+    "trajectory",
+    "condition_number",
+    "scaled_condition_number",
+    "initial_condition_number",
+    "criterion",
+    "condition_number_of",
+    "status",
+    "iterations",
+    "evaluations",
+    "limits",
+    "margins_required",
+    "capsule_radii_m",
+    "obstacles",
+    "smallest_margins_at_1khz",
+    "history",
+}
+
+
 def _keys(d: dict[str, Any], allowed: set[str], where: str) -> None:
     unknown = sorted(set(d) - allowed)
     if unknown:
@@ -229,15 +255,17 @@ def load_trajectory(path: str | Path, n: int, *, fs: float = 1000.0) -> Trajecto
     Both are read strictly, as torque logs are. CSV: a UTF-8 byte-order mark is accepted;
     the header must name exactly ``t, q1..qn, dq1..dqn, ddq1..ddqn`` (a duplicated or
     unknown column is refused, not silently used or ignored); the ``# rows:`` count, when
-    recorded, must match. JSON: strict JSON, the schema, the known keys of the
-    trajectory only, finite numbers.
+    recorded, must match. JSON: strict JSON, the schema, known keys only (at the top and in
+    the trajectory), finite numbers, and the derived keys (harmonics, base frequency, total
+    duration) consistent with the coefficients.
 
     Raises
     ------
     DataError
         Unknown suffix, wrong schema, missing, duplicated or unknown columns or keys, a
         joint count other than ``n``, a row count other than the recorded one, a
-        malformed cell or row (its line), times not increasing.
+        malformed cell or row (its line), times not increasing, derived keys that disagree
+        with the coefficients.
     OSError
         The file cannot be read.
     """
@@ -245,6 +273,7 @@ def load_trajectory(path: str | Path, n: int, *, fs: float = 1000.0) -> Trajecto
     suffix = path.suffix.lower()
     if suffix == ".json":
         d = load_json(path, schema=EXCITATION_SCHEMA, what="trajectory file (dynid excite)")
+        _keys(d, _EXCITATION_KEYS, path.name)
         tr = d.get("trajectory")
         if not isinstance(tr, dict):
             raise DataError(f"{path.name}: 'trajectory' must be an object")
@@ -267,6 +296,7 @@ def load_trajectory(path: str | Path, n: int, *, fs: float = 1000.0) -> Trajecto
             raise DataError(f"{path.name}: malformed trajectory ({exc})") from None
         if traj.n != n:
             raise DataError(f"{path.name}: trajectory has {traj.n} joints; the robot has {n}")
+        _check_derived(tr, traj, path.name)
         return traj.sample(fs)
     if suffix != ".csv":
         raise DataError(f"--trajectory file must be .csv or .json; got {path.name!r}")
@@ -304,6 +334,24 @@ def load_trajectory(path: str | Path, n: int, *, fs: float = 1000.0) -> Trajecto
         )
     except DynidError as exc:
         raise DataError(f"{path.name}: {exc}") from None
+
+
+def _check_derived(tr: dict[str, Any], traj: ExcitingTrajectory, name: str) -> None:
+    """Refuse a ``trajectory.json`` whose derived keys (harmonics, base frequency, total
+    duration) disagree with the coefficients they derive from: the file was edited."""
+    derived = {
+        "harmonics": float(traj.a.shape[1]),
+        "base_frequency_hz": traj.w_f / (2 * np.pi),
+        "total_duration_s": traj.total_duration,
+    }
+    for key, want in derived.items():
+        if key in tr:
+            got = float(_numbers(tr[key], f"{name}: trajectory.{key}"))
+            if not math.isclose(got, want, rel_tol=1e-9):
+                raise DataError(
+                    f"{name}: trajectory.{key} = {got:.10g} disagrees with the coefficients "
+                    f"({want:.10g}); the file was edited: regenerate it with dynid excite"
+                )
 
 
 def trajectory_columns(n: int) -> list[str]:
