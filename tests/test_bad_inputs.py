@@ -406,6 +406,18 @@ def toml_huge_mass(d: Path) -> None:
     )
 
 
+def toml_inertia_triangle(d: Path) -> None:
+    """A link whose principal moments 0.01, 0.01, 0.05 violate a + b >= c (the URDF reader
+    warned, the TOML reader said nothing)."""
+    _two_joint(
+        d,
+        "tri.toml",
+        "axis = [0, 0, 1]\n[[joints]]",
+        "axis = [0, 0, 1]\n[joints.inertial]\n"
+        "mass = 1.0\ncom = [0.1, 0, 0]\ninertia = [0.01, 0, 0, 0.01, 0, 0.05]\n[[joints]]",
+    )
+
+
 def toml_boolean_mass(d: Path) -> None:
     """A link mass written as true."""
     _two_joint(
@@ -905,6 +917,7 @@ CASES = [
     C("trajectory-json-unknown-key", trajectory_json_edited, f"simulate --trajectory {{d}}/extra.json --out {OUT}/x.csv", 2, "extra.json: unknown key(s) ['note']"),
     C("trajectory-json-harmonics-string", trajectory_json_edited, f"simulate --trajectory {{d}}/five.json --out {OUT}/x.csv", 2, "five.json: trajectory.harmonics must be a number; got 'five'"),
     C("trajectory-json-duration-edited", trajectory_json_edited, f"simulate --trajectory {{d}}/longer.json --out {OUT}/x.csv", 2, "longer.json: trajectory.total_duration_s = 3 disagrees with the coefficients (21)"),
+    C("toml-inertia-triangle", toml_inertia_triangle, "fk --robot {d}/tri.toml --q 0.1,0.2", 0, "the inertial is physically inconsistent: principal moments [0.01, 0.01, 0.05] violate the triangle inequality"),
     C("out-under-a-file", None, "identify --data {d}/s.csv --out {d}/s.csv/res", 2, "s.csv is a file, not a folder; choose another --out"),
     C("out-file-under-a-file", None, "export --params panda --out {d}/s.csv/robot.urdf", 2, "s.csv is a file, not a folder"),
 ]

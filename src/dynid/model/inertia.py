@@ -35,6 +35,7 @@ __all__ = [
     "decision_labels",
     "params_from_inertial",
     "inertial_from_params",
+    "inertial_problems",
 ]
 
 PARAMS_PER_LINK = 10
@@ -168,3 +169,34 @@ def inertial_from_params(
     if a.ndim != 2 or a.shape[1] != 10:
         raise ShapeError(f"p must have shape (n, 10) or (10 n,); got {a.shape}")
     return a[:, 0].copy(), a[:, 1:4].copy(), matrix_from_inertia6(a[:, 4:])
+
+
+def inertial_problems(mass: float, inertia: ArrayLike) -> list[str]:
+    """What makes one link's mass and inertia about its CoM physically inconsistent.
+
+    Parameters
+    ----------
+    mass : float
+        [kg].
+    inertia : array_like, shape (3, 3)
+        Inertia about the CoM [kg m^2], symmetric.
+
+    Returns
+    -------
+    list of str
+        One phrase per problem (a negative mass, a tensor not positive semi-definite,
+        principal moments violating the triangle inequality ``a + b >= c``); empty when
+        consistent, up to a relative tolerance of 1e-9 of the moments' sum.
+    """
+    problems = []
+    if mass < 0.0:
+        problems.append(f"negative mass {mass}")
+    lam = np.linalg.eigvalsh(np.asarray(inertia, dtype=np.float64))
+    tol = 1e-9 * max(float(np.sum(np.abs(lam))), 1e-300)
+    if lam[0] < -tol:
+        problems.append(f"inertia not positive semi-definite (eigenvalues {lam.tolist()})")
+    elif lam[0] + lam[1] < lam[2] - tol:
+        problems.append(
+            f"principal moments {lam.tolist()} violate the triangle inequality (a + b >= c)"
+        )
+    return problems

@@ -24,6 +24,7 @@ from __future__ import annotations
 
 import json
 import math
+import warnings
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 from pathlib import Path
@@ -33,9 +34,14 @@ import numpy as np
 from numpy.typing import NDArray
 
 from ... import _checks, spatial
-from ...exceptions import DynidError, ModelError
+from ...exceptions import DynidError, DynidWarning, ModelError
 from ...model.drive import Drive
-from ...model.inertia import inertia6_from_matrix, phi_from_inertial
+from ...model.inertia import (
+    inertia6_from_matrix,
+    inertial_problems,
+    matrix_from_inertia6,
+    phi_from_inertial,
+)
 from ...model.robot import MAX_LINK_MASS, STANDARD_GRAVITY, Frame, Robot, mdh_transform
 from ..atomic import write_text
 from ..drive_file import drive_toml
@@ -209,6 +215,14 @@ def _inertial(
         )
     com = _vector(_require(inertial, "com", inside), 3, where, "inertial.com")
     inertia = _vector(_require(inertial, "inertia", inside), 6, where, "inertial.inertia")
+    problems = inertial_problems(mass, matrix_from_inertia6(inertia))
+    if problems:  # as the URDF reader: kept, as a real description may round its numbers
+        warnings.warn(
+            f"{where}: the inertial is physically inconsistent: {'; '.join(problems)}; "
+            "kept as given",
+            DynidWarning,
+            stacklevel=2,
+        )
     return mass, com, inertia
 
 

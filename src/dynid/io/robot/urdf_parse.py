@@ -46,7 +46,7 @@ from numpy.typing import NDArray
 
 from ... import _checks, spatial
 from ...exceptions import DynidWarning, ModelError, UnknownNameError
-from ...model.inertia import phi_from_inertial
+from ...model.inertia import inertial_problems, phi_from_inertial
 from ...model.robot import MAX_LINK_MASS, Frame, Robot
 from ..input_files import file_bytes
 
@@ -249,17 +249,7 @@ def _inertial(
 
 def _warn_if_inconsistent(link: str, mass: float, I: NDArray[np.float64]) -> None:
     """Warn when mass < 0, I is not positive semi-definite or violates the triangle inequality."""
-    problems = []
-    if mass < 0.0:
-        problems.append(f"negative mass {mass}")
-    lam = np.linalg.eigvalsh(I)
-    tol = 1e-9 * max(float(np.sum(np.abs(lam))), 1e-300)
-    if lam[0] < -tol:
-        problems.append(f"inertia not positive semi-definite (eigenvalues {lam.tolist()})")
-    elif lam[0] + lam[1] < lam[2] - tol:
-        problems.append(
-            f"principal moments {lam.tolist()} violate the triangle inequality (a + b >= c)"
-        )
+    problems = inertial_problems(mass, I)
     if problems:
         warnings.warn(
             f"link {link!r} has a physically inconsistent inertial: {'; '.join(problems)}; "
