@@ -751,6 +751,29 @@ def model_bom(d: Path) -> None:
     (d / "bom.json").write_text("\ufeff" + text, encoding="utf-8")
 
 
+def feasible_edited(d: Path) -> None:
+    """feasible.json files edited by hand (each was exported silently): an unknown key at the
+    top and in the kinematics, 'feasible': "yes", a link of 1e12 kg, a CoM at 1e300 m
+    ("inertia must be finite"), a string as a joint limit, and a negative mass (kept, but
+    said)."""
+    from dynid.io.feasible import feasible_to_dict
+    from dynid.model.panda import panda
+
+    edits = {
+        "extra.json": lambda doc: doc.__setitem__("note", 1),
+        "kin.json": lambda doc: doc["kinematics"].__setitem__("note", 1),
+        "yes.json": lambda doc: doc.__setitem__("feasible", "yes"),
+        "heavy.json": lambda doc: doc["links"][0].__setitem__("mass", 1e12),
+        "far.json": lambda doc: doc["links"][0].__setitem__("com", [1e300, 0, 0]),
+        "limit.json": lambda doc: doc["kinematics"]["limits"].__setitem__("q_max", ["2.8"] * 7),
+        "negative.json": lambda doc: doc["links"][0].__setitem__("mass", -1.0),
+    }
+    for name, edit in edits.items():
+        doc = feasible_to_dict(panda())
+        edit(doc)
+        (d / name).write_text(json.dumps(doc))
+
+
 def friction_nan(d: Path) -> None:
     """A friction.json with Infinity."""
     (d / "f.json").write_text(
@@ -918,6 +941,14 @@ CASES = [
     C("trajectory-json-harmonics-string", trajectory_json_edited, f"simulate --trajectory {{d}}/five.json --out {OUT}/x.csv", 2, "five.json: trajectory.harmonics must be a number; got 'five'"),
     C("trajectory-json-duration-edited", trajectory_json_edited, f"simulate --trajectory {{d}}/longer.json --out {OUT}/x.csv", 2, "longer.json: trajectory.total_duration_s = 3 disagrees with the coefficients (21)"),
     C("toml-inertia-triangle", toml_inertia_triangle, "fk --robot {d}/tri.toml --q 0.1,0.2", 0, "the inertial is physically inconsistent: principal moments [0.01, 0.01, 0.05] violate the triangle inequality"),
+    # feasible.json read back by export: strict keys and types, sane masses and CoMs
+    C("feasible-unknown-key", feasible_edited, "export --params {d}/extra.json --out {d}/out.urdf", 2, "extra.json: feasible parameters: unknown key(s) ['note']"),
+    C("feasible-kinematics-unknown-key", feasible_edited, "export --params {d}/kin.json --out {d}/out.urdf", 2, "kin.json: robot description: unknown key(s) ['note']"),
+    C("feasible-flag-string", feasible_edited, "export --params {d}/yes.json --out {d}/out.urdf", 2, "'feasible' must be true or false; got 'yes'"),
+    C("feasible-mass-1e12", feasible_edited, "export --params {d}/heavy.json --out {d}/out.urdf", 2, "feasible parameters, link 1: mass must be at most 1e+06 kg; got 1000000000000.0"),
+    C("feasible-com-1e300", feasible_edited, "export --params {d}/far.json --out {d}/out.urdf", 2, "link 1: com must lie within 1000 m of the link frame"),
+    C("feasible-limit-string", feasible_edited, "export --params {d}/limit.json --out {d}/out.urdf", 2, "robot description: limits.q_max must be a number; got '2.8'"),
+    C("feasible-negative-mass", feasible_edited, "export --params {d}/negative.json --out {d}/out.urdf", 0, "feasible parameters, link 1 is physically inconsistent: negative mass -1.0; kept as given"),
     C("out-under-a-file", None, "identify --data {d}/s.csv --out {d}/s.csv/res", 2, "s.csv is a file, not a folder; choose another --out"),
     C("out-file-under-a-file", None, "export --params panda --out {d}/s.csv/robot.urdf", 2, "s.csv is a file, not a folder"),
 ]

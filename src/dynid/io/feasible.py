@@ -18,6 +18,7 @@ link, in the schema of the robot description's inertials (:mod:`dynid.io.robot.t
 
 from __future__ import annotations
 
+import warnings
 from collections.abc import Mapping
 from pathlib import Path
 from typing import Any
@@ -26,12 +27,17 @@ import numpy as np
 from numpy.typing import NDArray
 
 from .. import __version__, _checks
-from ..exceptions import DataError, ModelError, ShapeError
+from ..exceptions import DataError, DynidWarning, ModelError, ShapeError
 from ..feasibility.result import FeasibleResult
 from ..friction.model import ClassicalFriction, DriveFriction
 from ..model.drive import Drive
-from ..model.inertia import INERTIA_ORDER, inertia6_from_matrix
-from ..model.robot import Robot
+from ..model.inertia import (
+    INERTIA_ORDER,
+    inertia6_from_matrix,
+    inertial_problems,
+    matrix_from_inertia6,
+)
+from ..model.robot import MAX_LINK_MASS, Robot
 from .drive_file import drive_from_record
 from .json_files import finite_or_none, load_json, save_json
 from .robot_json import robot_from_dict, robot_to_dict
@@ -56,6 +62,27 @@ _CONVENTIONS = {
     "[phi1 N m, phi2 s/rad, phi3 rad/s] (Gaz et al. 2019, eq. 25)",
 }
 _LINK_KEYS = {"name", "mass", "com", "inertia"}
+#: the keys :func:`feasible_to_dict` writes
+_KEYS = {
+    "schema",
+    "dynid_version",
+    "name",
+    "links",
+    "friction",
+    "linear_friction",
+    "kinematics",
+    "units",
+    "conventions",
+    "drive",
+    "method",
+    "feasible",
+    "relative_residual",
+    "seed",
+    "heldout",
+}
+#: the farthest a link's centre of mass may lie from its frame [m] (a robot's links are
+#: metres long; 1e300 overflowed the parallel-axis inertia into NaN)
+MAX_COM_DISTANCE = 1e3
 
 
 def _numbers(v: Any, size: int, where: str) -> NDArray[np.float64]:
@@ -151,12 +178,27 @@ def robot_from_feasible_dict(d: Mapping[str, Any], robot: Robot | None = None) -
     Raises
     ------
     DataError
-        Wrong schema, missing or malformed field, link names that do not match ``robot``.
+        Wrong schema, an unknown key, a missing or malformed field, a mass beyond
+        ``MAX_LINK_MASS`` or a CoM beyond :data:`MAX_COM_DISTANCE`, link names that do not
+        match ``robot``.
+
+    Warns
+    -----
+    DynidWarning
+        A link whose parameters are not physically consistent (kept as given).
     """
     if d.get("schema") != FEASIBLE_SCHEMA:
         raise DataError(
             f"not a feasible-parameter file (schema {d.get('schema')!r}, "
             f"expected {FEASIBLE_SCHEMA!r})"
+        )
+    unknown = sorted(set(d) - _KEYS)
+    if unknown:
+        raise DataError(f"feasible parameters: unknown key(s) {_checks.short(unknown)}")
+    if not isinstance(d.get("feasible", False), bool):
+        raise DataError(
+            f"feasible parameters: 'feasible' must be true or false; got "
+            f"{_checks.short(d['feasible'])}"
         )
     try:
         links = list(d["links"])
@@ -202,10 +244,31 @@ def robot_from_feasible_dict(d: Mapping[str, Any], robot: Robot | None = None) -
             I6[i] = _numbers(link["inertia"], 6, f"{where} inertia")
         except KeyError as exc:
             raise DataError(f"{where}: missing {exc.args[0]!r}") from None
+        _check_link(where, mass[i], com[i], I6[i])
     try:
         return robot.with_inertials(mass, com, I6)
     except (ModelError, ShapeError) as exc:
         raise DataError(f"feasible parameters: {exc}") from exc
+
+
+def _check_link(where: str, mass: float, com: NDArray[np.float64], I6: NDArray[np.float64]) -> None:
+    """Refuse a mass or a CoM no robot description holds; warn, as the URDF reader does, on
+    parameters that are not physically consistent, a negative mass included (kept: those of
+    an infeasible result are not consistent)."""
+    if not abs(mass) <= MAX_LINK_MASS:
+        raise DataError(f"{where}: mass must be at most {MAX_LINK_MASS:g} kg; got {float(mass)!r}")
+    if not float(np.max(np.abs(com))) <= MAX_COM_DISTANCE:
+        raise DataError(
+            f"{where}: com must lie within {MAX_COM_DISTANCE:g} m of the link frame; got "
+            f"{com.tolist()}"
+        )
+    problems = inertial_problems(mass, matrix_from_inertia6(I6))
+    if problems:
+        warnings.warn(
+            f"{where} is physically inconsistent: {'; '.join(problems)}; kept as given",
+            DynidWarning,
+            stacklevel=4,
+        )
 
 
 def load_feasible_json(path: str | Path, robot: Robot | None = None) -> Robot:
