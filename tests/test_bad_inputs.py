@@ -745,6 +745,23 @@ def model_duplicate_key(d: Path) -> None:
     (d / "bad.json").write_text(text.replace('"rank": ', '"rank": 43, "rank": ', 1))
 
 
+def model_unknown_keys(d: Path) -> None:
+    """identification.json files edited by hand (each was read silently): an unknown key at
+    the top, one in a coefficient, and "kept": "yes"."""
+
+    def put(doc: dict, at: str, key: str, value: object) -> None:
+        (doc if at == "top" else doc["coefficients"][0])[key] = value
+
+    for name, at, key, value in (
+        ("top.json", "top", "note", 1),
+        ("coef.json", "coef", "note", 1),
+        ("kept.json", "coef", "kept", "yes"),
+    ):
+        doc = json.loads((d / "res" / "identification.json").read_text())
+        put(doc, at, key, value)
+        (d / name).write_text(json.dumps(doc))
+
+
 def model_bom(d: Path) -> None:
     """identification.json with a byte-order mark."""
     text = (d / "res" / "identification.json").read_text()
@@ -949,6 +966,9 @@ CASES = [
     C("feasible-com-1e300", feasible_edited, "export --params {d}/far.json --out {d}/out.urdf", 2, "link 1: com must lie within 1000 m of the link frame"),
     C("feasible-limit-string", feasible_edited, "export --params {d}/limit.json --out {d}/out.urdf", 2, "robot description: limits.q_max must be a number; got '2.8'"),
     C("feasible-negative-mass", feasible_edited, "export --params {d}/negative.json --out {d}/out.urdf", 0, "feasible parameters, link 1 is physically inconsistent: negative mass -1.0; kept as given"),
+    C("model-unknown-key", model_unknown_keys, "predict --model {d}/top.json --q " + NEUTRAL, 2, "top.json: identified model: unknown key(s) ['note']"),
+    C("model-coefficient-unknown-key", model_unknown_keys, "predict --model {d}/coef.json --q " + NEUTRAL, 2, "coef.json: identified model: coefficients[0]: unknown key(s) ['note']"),
+    C("model-kept-string", model_unknown_keys, "predict --model {d}/kept.json --q " + NEUTRAL, 2, "coefficients[0].kept must be true or false; got 'yes'"),
     C("out-under-a-file", None, "identify --data {d}/s.csv --out {d}/s.csv/res", 2, "s.csv is a file, not a folder; choose another --out"),
     C("out-file-under-a-file", None, "export --params panda --out {d}/s.csv/robot.urdf", 2, "s.csv is a file, not a folder"),
 ]

@@ -307,12 +307,14 @@ def model_from_dict(d: Mapping[str, Any]) -> IdentifiedModel:
     Raises
     ------
     DataError
-        Wrong schema, or a field missing or inconsistent (named in the message).
+        Wrong schema, an unknown key (at the top or in a coefficient; the metadata keep
+        theirs), or a field missing, of the wrong type or inconsistent (named).
     """
     if d.get("schema") != MODEL_SCHEMA:
         raise DataError(
             f"identified model: schema must be {MODEL_SCHEMA!r}; got {d.get('schema')!r}"
         )
+    _known_keys(d, _MODEL_KEYS, "identified model")
     try:
         robot = robot_from_dict(d["robot"])
         b = d["base"]
@@ -323,6 +325,15 @@ def model_from_dict(d: Mapping[str, Any]) -> IdentifiedModel:
                 f"identified model: 'coefficients' must list {r} coefficients (base rank); "
                 f"got {len(coefs) if isinstance(coefs, list) else type(coefs).__name__}"
             )
+        for k, c in enumerate(coefs):
+            if not isinstance(c, Mapping):
+                raise DataError(f"identified model: coefficients[{k}] must be an object")
+            _known_keys(c, _COEFFICIENT_KEYS, f"identified model: coefficients[{k}]")
+            if not isinstance(c["kept"], bool):
+                raise DataError(
+                    f"identified model: coefficients[{k}].kept must be true or false; got "
+                    f"{_checks.short(c['kept'])}"
+                )
         drive = None if d.get("drive") is None else drive_from_record(d["drive"], robot.n)
         p = 10 * robot.n
         if drive is not None and drive.identifies_rotor_inertia:
@@ -425,6 +436,19 @@ def load_model_json(path: str | Path) -> IdentifiedModel:
         return model_from_dict(d)
     except DataError as exc:
         raise DataError(f"{path.name}: {exc}") from exc
+
+
+#: the keys :func:`model_to_dict` writes, at the top and per coefficient
+_MODEL_KEYS = {"schema", "dynid_version", "route", "seed", *_FIT_SCALARS, "dropped_rows"}
+_MODEL_KEYS |= {"pruned", "std_estimator", "coefficients", "covariance", "base", "friction"}
+_MODEL_KEYS |= {"drive", "robot", "metadata", "units", "conventions"}
+_COEFFICIENT_KEYS = {"name", "expression", "value", "std", "std_percent", "kept"}
+
+
+def _known_keys(d: Mapping[str, Any], allowed: set[str], where: str) -> None:
+    unknown = sorted(set(d) - allowed)
+    if unknown:
+        raise DataError(f"{where}: unknown key(s) {_checks.short(unknown)}")
 
 
 def _int(x: Any, where: str) -> int:
