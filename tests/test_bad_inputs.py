@@ -799,6 +799,22 @@ def friction_nan(d: Path) -> None:
     )
 
 
+def friction_edited(d: Path) -> None:
+    """friction.json files edited by hand (each was read silently): an unknown key at the
+    top and in a joint, true and "0.1" as fv (read as 1 and 0.1), "identified": "no"."""
+    base = {"schema": "dynid-friction/1", "model": "classical"}
+    joint = {"fv": 0.1, "fc": 0.2, "fo": 0.0}
+    docs = {
+        "top.json": base | {"note": 1, "joints": [joint] * 7},
+        "joint.json": base | {"joints": [joint | {"note": 1}] * 7},
+        "true.json": base | {"joints": [joint | {"fv": True}] * 7},
+        "string.json": base | {"joints": [joint | {"fv": "0.1"}] * 7},
+        "flag.json": base | {"joints": [joint | {"identified": "no"}] * 7},
+    }
+    for name, doc in docs.items():
+        (d / name).write_text(json.dumps(doc))
+
+
 # ------------------------------------------------------------------ the table
 @dataclass(frozen=True)
 class Case:
@@ -969,6 +985,11 @@ CASES = [
     C("model-unknown-key", model_unknown_keys, "predict --model {d}/top.json --q " + NEUTRAL, 2, "top.json: identified model: unknown key(s) ['note']"),
     C("model-coefficient-unknown-key", model_unknown_keys, "predict --model {d}/coef.json --q " + NEUTRAL, 2, "coef.json: identified model: coefficients[0]: unknown key(s) ['note']"),
     C("model-kept-string", model_unknown_keys, "predict --model {d}/kept.json --q " + NEUTRAL, 2, "coefficients[0].kept must be true or false; got 'yes'"),
+    C("friction-unknown-key", friction_edited, f"validate --robot panda --friction {{d}}/top.json --data {{d}}/log.csv --out {OUT}", 2, "top.json: unknown key(s) ['note']"),
+    C("friction-joint-unknown-key", friction_edited, f"validate --robot panda --friction {{d}}/joint.json --data {{d}}/log.csv --out {OUT}", 2, "joint.json: joint 1: unknown key(s) ['note']"),
+    C("friction-boolean-parameter", friction_edited, f"validate --robot panda --friction {{d}}/true.json --data {{d}}/log.csv --out {OUT}", 2, "true.json: joint 1, 'fv' must be a number; got True"),
+    C("friction-string-parameter", friction_edited, f"validate --robot panda --friction {{d}}/string.json --data {{d}}/log.csv --out {OUT}", 2, "string.json: joint 1, 'fv' must be a number; got '0.1'"),
+    C("friction-identified-string", friction_edited, f"validate --robot panda --friction {{d}}/flag.json --data {{d}}/log.csv --out {OUT}", 2, "flag.json: joint 1, 'identified' must be true or false; got 'no'"),
     C("out-under-a-file", None, "identify --data {d}/s.csv --out {d}/s.csv/res", 2, "s.csv is a file, not a folder; choose another --out"),
     C("out-file-under-a-file", None, "export --params panda --out {d}/s.csv/robot.urdf", 2, "s.csv is a file, not a folder"),
 ]

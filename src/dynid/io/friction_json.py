@@ -29,6 +29,7 @@ from typing import Any
 
 import numpy as np
 
+from .. import _checks
 from ..exceptions import DataError
 from ..friction.fit import FrictionFit
 from ..friction.laws import LAWS
@@ -107,8 +108,9 @@ def load_friction_json(path: str | Path) -> FrictionModel:
     Raises
     ------
     DataError
-        Not JSON, unknown ``model``, no ``joints``, or a joint without a parameter (the
-        message names the joint and the key).
+        Not JSON, an unknown key, unknown ``model``, no ``joints``, a joint without a
+        parameter or with one that is not a finite number (a boolean or a string included;
+        the message names the joint and the key).
     OSError
         The file cannot be read.
     """
@@ -122,6 +124,9 @@ def load_friction_json(path: str | Path) -> FrictionModel:
     kind = doc.get("model")
     if kind not in LAWS:
         raise DataError(f"{path.name}: 'model' must be one of {', '.join(LAWS)}; got {kind!r}")
+    unknown = sorted(set(doc) - _KEYS)
+    if unknown:
+        raise DataError(f"{path.name}: unknown key(s) {_checks.short(unknown)}")
     joints = doc.get("joints")
     if not isinstance(joints, list) or not joints:
         raise DataError(f"{path.name}: 'joints' must be a non-empty list of objects")
@@ -129,17 +134,14 @@ def load_friction_json(path: str | Path) -> FrictionModel:
     names = law.params + ("standstill_band",)
     P = np.zeros((len(joints), len(names)))
     for j, d in enumerate(joints):
+        if isinstance(d, dict):
+            _check_joint(d, set(names), f"{path.name}: joint {j + 1}")
         for i, k in enumerate(names):
             if k == "standstill_band" and isinstance(d, dict) and k not in d:
                 continue  # files of earlier versions: the plain sign
             if not isinstance(d, dict) or k not in d:
                 raise DataError(f"{path.name}: joint {j + 1} has no {k!r} (model {kind!r})")
-            try:
-                P[j, i] = float(d[k])
-            except (TypeError, ValueError):
-                raise DataError(
-                    f"{path.name}: joint {j + 1}, {k!r} is not a number: {d[k]!r}"
-                ) from None
+            P[j, i] = _checks.number(d[k], f"{path.name}: joint {j + 1}, {k!r}", DataError)
     if not np.all(np.isfinite(P)):
         raise DataError(f"{path.name}: non-finite friction parameters")
     if np.any(P[:, -1] < 0):
@@ -151,3 +153,24 @@ def load_friction_json(path: str | Path) -> FrictionModel:
         return DriveFriction(fr, drive_from_record(doc["drive"], len(joints)))
     except DataError as exc:
         raise DataError(f"{path.name}: {exc}") from exc
+
+
+#: the keys :func:`save_friction_json` writes (``format``: files of dynid 0.1)
+_KEYS = {"schema", "format", "dynid_version", "model", "convention", "units", "joints"}
+_KEYS |= {"drive", "metadata", "selection"}
+#: the keys of a joint beside its law's parameters and ``standstill_band``
+_FIT_KEYS = {"rms_before", "rms_after", "identified"}
+
+
+def _check_joint(d: dict[str, Any], params: set[str], where: str) -> None:
+    """Refuse a joint's unknown key or a record of the fit of the wrong type."""
+    unknown = sorted(set(d) - params - _FIT_KEYS)
+    if unknown:
+        raise DataError(f"{where}: unknown key(s) {_checks.short(unknown)}")
+    for k in ("rms_before", "rms_after"):
+        if k in d:
+            _checks.number(d[k], f"{where}, {k!r}", DataError)
+    if "identified" in d and not isinstance(d["identified"], bool):
+        raise DataError(
+            f"{where}, 'identified' must be true or false; got {_checks.short(d['identified'])}"
+        )
