@@ -276,6 +276,18 @@ def log_gap(d: Path) -> None:
     _write(d / "gap.csv", lines[: h + 300] + lines[h + 320 :])
 
 
+def log_tau7_zero(d: Path) -> None:
+    """A log whose joint 7 torque is recorded as 0 throughout (an unpowered joint): its
+    relative error is undefined ("validation.json: ... is inf", exit 2, before)."""
+
+    def edit(rows):
+        k = rows[0].index("tau7")
+        for r in rows[1:]:
+            r[k] = "0"
+
+    _edit_log(d, "zero7.csv", edit)
+
+
 def _log_still(d: Path, name: str, joints: list[int]) -> None:
     """A 4 s log at 200 Hz of the Table I sinusoids with ``joints`` (0-based) held still;
     their measured velocities are only the sensor noise."""
@@ -990,6 +1002,7 @@ CASES = [
     C("friction-boolean-parameter", friction_edited, f"validate --robot panda --friction {{d}}/true.json --data {{d}}/log.csv --out {OUT}", 2, "true.json: joint 1, 'fv' must be a number; got True"),
     C("friction-string-parameter", friction_edited, f"validate --robot panda --friction {{d}}/string.json --data {{d}}/log.csv --out {OUT}", 2, "string.json: joint 1, 'fv' must be a number; got '0.1'"),
     C("friction-identified-string", friction_edited, f"validate --robot panda --friction {{d}}/flag.json --data {{d}}/log.csv --out {OUT}", 2, "flag.json: joint 1, 'identified' must be true or false; got 'no'"),
+    C("log-joint-torque-zero", log_tau7_zero, f"validate --robot panda --data {{d}}/zero7.csv --no-figures --out {OUT}", 0, ""),
     C("out-under-a-file", None, "identify --data {d}/s.csv --out {d}/s.csv/res", 2, "s.csv is a file, not a folder; choose another --out"),
     C("out-file-under-a-file", None, "export --params panda --out {d}/s.csv/robot.urdf", 2, "s.csv is a file, not a folder"),
 ]
@@ -1039,6 +1052,18 @@ def test_bad_input_gives_one_line_and_exit_code(case, base, tmp_path, capsys, ca
         assert not (d / "out").exists(), "a failing command left output behind"
     elif case.fragment:  # a warning: printed, or logged (stderr through logging)
         assert case.fragment in err + caplog.text, err
+
+
+def test_an_undefined_relative_error_is_null_in_validation_json(base, tmp_path, capsys):
+    """A joint whose measured torque is zero throughout has no relative error: null in
+    validation.json (documented), the other joints' errors as numbers."""
+    log_tau7_zero(base)
+    out = tmp_path / "v"
+    argv = ["validate", "--robot", "panda", "--data", str(base / "zero7.csv"), "--no-figures"]
+    assert main([*argv, "--out", str(out)]) == 0
+    doc = json.loads((out / "validation.json").read_text())
+    per = doc["without_friction"]["relative_error_percent_per_joint"]
+    assert per[6] is None and all(isinstance(x, float) for x in per[:6])
 
 
 def test_unexpected_error_is_one_line_with_debug_hint(monkeypatch, capsys):

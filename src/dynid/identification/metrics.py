@@ -78,16 +78,22 @@ class TorqueErrors:
     n_samples: int
 
     def as_dict(self) -> dict[str, object]:
-        """JSON-ready dictionary (lists of floats)."""
+        """JSON-ready dictionary (lists of floats); a relative error that is undefined (the
+        measured torque of a joint, or of all, is zero throughout: infinite) is None."""
         return {
             "rms": [float(x) for x in self.rms],
             "mse": [float(x) for x in self.mse],
-            "relative_error_percent": float(self.relative_error_percent),
+            "relative_error_percent": _defined(self.relative_error_percent),
             "relative_error_percent_per_joint": [
-                float(x) for x in self.relative_error_percent_per_joint
+                _defined(x) for x in self.relative_error_percent_per_joint
             ],
             "n_samples": int(self.n_samples),
         }
+
+
+def _defined(x: float) -> float | None:
+    """``x`` as a float, or None where it is not finite (a percentage of zero)."""
+    return float(x) if np.isfinite(x) else None
 
 
 def torque_errors(tau: ArrayLike, tau_hat: ArrayLike) -> TorqueErrors:
