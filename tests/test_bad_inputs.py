@@ -430,6 +430,12 @@ def toml_inertia_triangle(d: Path) -> None:
     )
 
 
+def toml_offset_1e200(d: Path) -> None:
+    """A joint 1e200 m from its parent (M overflowed: "M must be finite; got nan ... hint:
+    drop_invalid=True", "tau must be finite", "W must be finite")."""
+    _two_joint(d, "far.toml", "origin = { xyz = [0.5, 0, 0] }", "origin = { xyz = [1e200, 0, 0] }")
+
+
 def toml_boolean_mass(d: Path) -> None:
     """A link mass written as true."""
     _two_joint(
@@ -1003,6 +1009,7 @@ CASES = [
     C("friction-string-parameter", friction_edited, f"validate --robot panda --friction {{d}}/string.json --data {{d}}/log.csv --out {OUT}", 2, "string.json: joint 1, 'fv' must be a number; got '0.1'"),
     C("friction-identified-string", friction_edited, f"validate --robot panda --friction {{d}}/flag.json --data {{d}}/log.csv --out {OUT}", 2, "flag.json: joint 1, 'identified' must be true or false; got 'no'"),
     C("log-joint-torque-zero", log_tau7_zero, f"validate --robot panda --data {{d}}/zero7.csv --no-figures --out {OUT}", 0, ""),
+    C("toml-offset-1e200", toml_offset_1e200, f"acquire-static --robot {{d}}/far.toml --n 5 --out {OUT}/x.csv", 2, "joint 'j2' lies 1e+200 m from its link's frame; at most 10000 m"),
     C("out-under-a-file", None, "identify --data {d}/s.csv --out {d}/s.csv/res", 2, "s.csv is a file, not a folder; choose another --out"),
     C("out-file-under-a-file", None, "export --params panda --out {d}/s.csv/robot.urdf", 2, "s.csv is a file, not a folder"),
 ]

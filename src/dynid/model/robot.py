@@ -34,7 +34,7 @@ from .. import _checks
 from ..exceptions import ModelError, ShapeError, UnknownNameError
 from .inertia import inertial_from_phi, param_labels, phi_from_inertial
 
-__all__ = ["Frame", "MAX_LINK_MASS", "Robot", "STANDARD_GRAVITY"]
+__all__ = ["Frame", "MAX_LINK_MASS", "MAX_LINK_OFFSET", "Robot", "STANDARD_GRAVITY"]
 
 #: Standard acceleration of gravity [m/s^2] (CGPM 1901, ISO 80000-3), used by Gaz et al. 2019.
 STANDARD_GRAVITY = 9.80665
@@ -42,6 +42,10 @@ STANDARD_GRAVITY = 9.80665
 #: above any manipulator; a mass of 1e12 kg is a typing error, and the identification's
 #: scaling (and the retrieval's bounds) would lose its other links to rounding.
 MAX_LINK_MASS = 1e6
+#: Largest offset [m] of a joint from its parent link's frame, or of a named frame from its
+#: link: ten kilometres, far above any manipulator or gantry; at 1e200 m the inertia
+#: matrix overflows and every command failed on a NaN far from the cause.
+MAX_LINK_OFFSET = 1e4
 
 
 @dataclass(frozen=True, slots=True, eq=False)
@@ -82,6 +86,20 @@ def _check_names(kind: str, names: Sequence[str]) -> None:
                 f"{kind} name {_checks.short(str(name))} holds the character "
                 f"{ascii(bad)}; give a name without control characters"
             )
+
+
+def _check_offsets(kind: str, names: Sequence[str], T: NDArray[np.float64]) -> None:
+    """Refuse a joint or frame placed beyond :data:`MAX_LINK_OFFSET` from its link."""
+    if len(names) == 0:
+        return
+    far = np.max(np.abs(np.asarray(T)[:, :3, 3]), axis=1)
+    bad = np.flatnonzero(~(far <= MAX_LINK_OFFSET))
+    if bad.size:
+        k = int(bad[0])
+        raise ModelError(
+            f"{kind} {_checks.short(str(names[k]))} lies {far[k]:.3g} m from its link's frame; "
+            f"at most {MAX_LINK_OFFSET:g} m (lengths are in metres)"
+        )
 
 
 def _check_link_frames(links: Mapping[str, Frame], frames: Mapping[str, Frame]) -> None:
@@ -144,6 +162,12 @@ class Robot:
         (Gaz et al. 2019 eq. 25), or None for no friction model.
     q_neutral : ndarray, shape (n,), or None
         A documented neutral pose (start of IK, demos); None: the middle of the limits.
+
+    Raises
+    ------
+    ModelError
+        Among others: a zero or overflowing axis, limits out of order, a joint or frame
+        farther than :data:`MAX_LINK_OFFSET` from its link, a name with a control character.
     """
 
     name: str
@@ -185,6 +209,7 @@ class Robot:
             "T_parent_joint",
             _checks.frozen(_checks.as_exact("T_parent_joint", self.T_parent_joint, (n, 4, 4))),
         )
+        _check_offsets("joint", self.joint_names, self.T_parent_joint)
         axes = _checks.as_exact("axes", self.axes, (n, 3))
         with np.errstate(over="ignore"):
             norm = np.linalg.norm(axes, axis=1)
@@ -233,6 +258,9 @@ class Robot:
             if not 0 <= int(f.link) <= n:
                 raise ModelError(f"frame {k!r} is attached to link {f.link}, not in 0..{n}")
         put("frames", _fixed_frames(frames))
+        _check_offsets(
+            "frame", list(self.frames), np.array([f.T_link_frame for f in self.frames.values()])
+        )
         if self.friction is not None:
             put("friction", _checks.frozen(_checks.as_exact("friction", self.friction, (n, 3))))
         if self.q_neutral is not None:
