@@ -1061,6 +1061,22 @@ def test_bad_input_gives_one_line_and_exit_code(case, base, tmp_path, capsys, ca
         assert case.fragment in err + caplog.text, err
 
 
+def test_excite_without_an_admissible_trajectory_is_a_negative_result(tmp_path, capsys):
+    """The arm inside a 10 m box: no admissible trajectory. Exit 1, the documented negative
+    result, with the files written for inspection (it was exit 2, "error", which promises
+    that no file is left behind, and the files stayed)."""
+    box = {"name": "room", "center": [0, 0, 0.5], "size": [10, 10, 10]}
+    obs = tmp_path / "obs.json"
+    obs.write_text(json.dumps({"schema": "dynid-obstacles/1", "boxes": [box]}))
+    out = tmp_path / "out"
+    argv = ["excite", "--obstacles", str(obs), "--duration", "2", "--harmonics", "1"]
+    assert main([*argv, "--max-iter", "1", "--no-figure", "--out", str(out)]) == 1
+    err = [s for s in capsys.readouterr().err.splitlines() if s.strip()]
+    assert len(err) == 1 and "no admissible trajectory found" in err[0]
+    assert "error" not in err[0]
+    assert {p.name for p in out.iterdir()} >= {"trajectory.csv", "trajectory.json"}
+
+
 def test_an_undefined_relative_error_is_null_in_validation_json(base, tmp_path, capsys):
     """A joint whose measured torque is zero throughout has no relative error: null in
     validation.json (documented), the other joints' errors as numbers."""

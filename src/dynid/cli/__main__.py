@@ -2,9 +2,10 @@
 
 Run ``dynid <command> --help`` for the options of one command.
 
-Exit status: 0 success; 1 a command's documented negative result (retrieve: no feasible
-set); 2 an error (one line on stderr; --debug shows the traceback); 130 interrupted
-(Ctrl-C); 129, 131, 143 terminated by SIGHUP, SIGQUIT, SIGTERM; 141 stdout was closed
+Exit status: 0 success; 1 a command's documented negative result, its files written
+(retrieve: no feasible set; excite: no admissible trajectory); 2 an error (one line on
+stderr; --debug shows the traceback); 130 interrupted (Ctrl-C); 129, 131, 143
+terminated by SIGHUP, SIGQUIT, SIGTERM; 141 stdout was closed
 before everything was printed (`dynid fk ... | head -1`: the run completes quietly, its
 files are written). A failed or interrupted command leaves no file or folder of its own
 behind, and no file is ever half written.

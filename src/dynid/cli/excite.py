@@ -20,6 +20,8 @@ controller), DIR/trajectory.json (coefficients, limits, margins, obstacles, cond
 numbers, the smallest margin to every limit and obstacle at 1 kHz) and
 DIR/excitation.png (joint motion and swept workspace). Seeded; about a minute for the
 Panda. `dynid simulate --trajectory DIR/trajectory.csv` records a torque log along it.
+Exit status 1 when no admissible trajectory was found: the files are written for
+inspection (as retrieve's when no feasible set exists).
 
 example:
   dynid excite --robot panda --duration 20 --seed 1 --out excite
@@ -141,11 +143,11 @@ def run(args: argparse.Namespace, console: Console) -> int:
     )
     for p in written:
         console.print(f"wrote {p}")
-    if res.status == "infeasible":
+    if res.status == "infeasible":  # a negative result, as retrieve's: exit 1, files kept
         print(
-            f"dynid {NAME}: error: no admissible trajectory found (files written for "
-            "inspection); hint: fewer or smaller obstacles, smaller --radius or another --seed",
+            f"dynid {NAME}: no admissible trajectory found (files written for inspection); "
+            "hint: fewer or smaller obstacles, smaller --radius or another --seed",
             file=sys.stderr,
         )
-        return 2
+        return 1
     return 0

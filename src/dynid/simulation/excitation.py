@@ -615,14 +615,20 @@ def optimise_excitation(
     for _ in range(max(options.n_starts, 1)):
         x = np.concatenate([rng.standard_normal(n * 2 * L), 0.3 * rng.standard_normal(n)])
         starts.append((prob.objective(x), x))
-    f0, x0 = min(starts, key=lambda p: p[0])
-    init_cond = float(np.exp(f0)) if options.criterion == "cond" else float("nan")
+    _, x0 = min(starts, key=lambda p: p[0])
     history: list[float] = []
 
-    def callback(xk: NDArray[np.float64]) -> None:
+    def cond_at(xk: NDArray[np.float64]) -> float:
+        """The unscaled condition number at ``xk`` (the objective adds the penalties: its
+        exponential overflowed when the start violated a constraint)."""
         c, q0 = prob.coefficients(xk)
         tr = prob._traj(prob.B_reg, c, q0, prob.t_reg)
-        cond = _conds(_classical_regressor(robot, base, tr))[0]
+        return float(_conds(_classical_regressor(robot, base, tr))[0])
+
+    init_cond = cond_at(x0) if options.criterion == "cond" else float("nan")
+
+    def callback(xk: NDArray[np.float64]) -> None:
+        cond = cond_at(xk)
         history.append(cond)
         if progress is not None:
             progress(len(history), options.max_iter, cond)
