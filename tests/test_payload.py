@@ -212,6 +212,9 @@ def test_payload_errors():
     lighter = arm.with_params(np.array(arm.phi) * np.r_[np.ones(6), 0.9][:, None])
     with pytest.raises(DataError, match="not positive"):
         identify_payload(arm, _static(lighter, 60, 0.0, 12), gravity_only=True)
+    # the full route too: its LMI turned a negative mass into a load of about 1e-22 kg
+    with pytest.raises(DataError, match="not positive"):
+        identify_payload(arm, _static(lighter, 60, 0.0, 12))
 
 
 def test_cli_payload_writes_payload_json_and_the_robot(tmp_path, capsys):

@@ -258,7 +258,8 @@ def identify_payload(
         The data do not excite the load's parameters (configurations too alike, a load
         that never rotates, a log in which no joint moves); the message names them.
     DataError
-        ``g`` only and the estimated mass is not positive.
+        The least-squares estimate of the mass is not positive (no load in the data, or a
+        wrong model of the arm).
     SolverError
         The constrained problem failed.
     """
@@ -480,16 +481,16 @@ def _log_rows(
 def _load_parameters(
     est: NDArray[np.float64], W: NDArray[np.float64], margin: float, notes: list[str]
 ) -> tuple[NDArray[np.float64], bool, float]:
-    """The load's 10 parameters from the least-squares ``est`` (4: mass and first
-    moments, checked for a positive mass; 10: moved into the consistent set by the LMI)."""
+    """The load's 10 parameters from the least-squares ``est`` (checked for a positive
+    mass; 4: mass and first moments; 10: moved into the consistent set by the LMI)."""
     phi_ls = np.zeros(10)
     phi_ls[: est.size] = est
+    if phi_ls[0] <= 0:  # both routes: the LMI would turn no load into 1e-22 kg, silently
+        raise DataError(
+            f"the estimated load mass is {phi_ls[0]:.6g} kg (not positive); "
+            "is a load mounted, and is the arm's model right?"
+        )
     if est.size == 4:
-        if phi_ls[0] <= 0:
-            raise DataError(
-                f"the estimated load mass is {phi_ls[0]:.6g} kg (not positive); "
-                "is a load mounted, and is the arm's model right?"
-            )
         return phi_ls, False, float("nan")
     import scipy.linalg  # as the rest of the module: scipy on first use
 
