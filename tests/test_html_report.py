@@ -21,6 +21,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+import dynid
 from dynid.cli.__main__ import main
 from dynid.io.html_report import (
     REPORT_NAME,
@@ -30,6 +31,7 @@ from dynid.io.html_report import (
     render_html_report,
     save_html_report,
 )
+from dynid.io.robot.toml import save_toml
 from dynid.io.run_output import MANIFEST
 
 
@@ -252,7 +254,7 @@ COMMANDS = {
         "{d}/l.csv",
     ],
     "retrieve": ["retrieve", "--model", "{d}/identify/identification.json"],
-    "payload": ["payload", "--robot", "panda", "--data", "{d}/s.csv"],
+    "payload": ["payload", "--robot", "panda", "--data", "{d}/loaded.csv"],
     "excite": [
         "excite",
         "--duration",
@@ -272,6 +274,11 @@ def runs(tmp_path_factory) -> Path:
     """One short run of each command, in order, each into its own folder."""
     d = tmp_path_factory.mktemp("reports")
     assert main(["acquire-static", "--n", "60", "--seed", "3", "--out", f"{d}/s.csv", "-q"]) == 0
+    # a 1 kg load at the flange, for payload (data without a load are refused)
+    loaded = dynid.panda().with_tool(np.eye(4), mass=1.0, inertia=np.diag([1e-3] * 3))
+    save_toml(d / "loaded.toml", loaded)
+    static = ["acquire-static", "--robot", f"{d}/loaded.toml", "--n", "60", "--seed", "3"]
+    assert main([*static, "--out", f"{d}/loaded.csv", "-q"]) == 0
     sim = ["simulate", "--trajectory", "sinusoid", "--duration", "2", "--rate", "200"]
     assert main([*sim, "--seed", "1", "--out", f"{d}/l.csv", "-q"]) == 0
     for name, argv in COMMANDS.items():
