@@ -66,7 +66,7 @@ def _within_extent(what: str, x: NDArray[np.float64]) -> None:
     if not big <= MAX_OBSTACLE_EXTENT:
         raise OptionError(
             f"{what} must be at most {MAX_OBSTACLE_EXTENT:g} m in absolute value; got "
-            f"{[float(v) for v in x]}; give obstacles in metres"
+            f"{[float(v) for v in x]}; lengths are in metres"
         )
 
 
@@ -182,6 +182,8 @@ def capsule_model(robot: Robot, radii: ArrayLike | float | None = None) -> Capsu
     ------
     ShapeError
         ``radii`` not a scalar or (n + 1,), or not positive.
+    OptionError
+        A radius above :data:`MAX_OBSTACLE_EXTENT`.
     """
     n1 = robot.n + 1
     r = np.full(n1, DEFAULT_RADIUS) if radii is None else np.asarray(radii, dtype=np.float64)
@@ -189,6 +191,7 @@ def capsule_model(robot: Robot, radii: ArrayLike | float | None = None) -> Capsu
         r = np.full(n1, float(r))
     if r.shape != (n1,) or not np.all(r > 0):
         raise ShapeError(f"radii must be positive, a scalar or shape ({n1},); got {r}")
+    _within_extent("capsule radius", r)  # 1e300: squared distances overflowed
     seg = capsule_segments(robot, np.zeros(robot.n))
     lengths = np.linalg.norm(seg[:, 1] - seg[:, 0], axis=-1)
     pairs = [

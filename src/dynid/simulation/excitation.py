@@ -213,6 +213,12 @@ def _basis(
 class ExcitationOptions:
     """Settings of :func:`optimise_excitation` (defaults: the paper's form and margins).
 
+    Raises
+    ------
+    OptionError
+        An unknown criterion, no harmonic, a duration or frequency not positive, a margin
+        or clearance negative or infinite, a fractional margin outside [0, 1).
+
     Attributes
     ----------
     duration : float
@@ -279,6 +285,10 @@ class ExcitationOptions:
         for k in ("acceleration_margin", "torque_margin"):
             if not 0 <= getattr(self, k) < 1:
                 raise OptionError(f"{k} must be in [0, 1); got {getattr(self, k)}")
+        for k in ("position_margin", "velocity_margin", "obstacle_clearance", "self_clearance"):
+            if not 0 <= getattr(self, k) < float("inf"):  # a negative one widens the limits
+                flag = f" (--{k.replace('_', '-')})" if k.endswith("_margin") else ""
+                raise OptionError(f"{k}{flag} must be finite and >= 0; got {getattr(self, k):g}")
 
 
 @dataclass(frozen=True, slots=True, eq=False)
