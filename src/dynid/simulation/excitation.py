@@ -216,8 +216,9 @@ class ExcitationOptions:
     Raises
     ------
     OptionError
-        An unknown criterion, no harmonic, a duration or frequency not positive, a margin
-        or clearance negative or infinite, a fractional margin outside [0, 1).
+        An unknown criterion, no harmonic, a duration or frequency not positive, a highest
+        harmonic at or above half of ``fs_regressor``, a margin or clearance negative or
+        infinite, a fractional margin outside [0, 1).
 
     Attributes
     ----------
@@ -282,6 +283,13 @@ class ExcitationOptions:
             raise OptionError(f"criterion must be 'cond' or 'logdet'; got {self.criterion!r}")
         if self.harmonics < 1 or not (self.duration > 0 and self.base_frequency > 0):
             raise OptionError("harmonics must be >= 1, duration and base_frequency positive")
+        top = self.harmonics * self.base_frequency
+        if not top < 0.5 * self.fs_regressor:  # aliased: the optimum is of other samples
+            raise OptionError(
+                f"the highest harmonic, {self.harmonics} x {self.base_frequency:g} Hz = "
+                f"{top:g} Hz, must lie below {0.5 * self.fs_regressor:g} Hz, half the rate at "
+                "which the regressor is optimised; lower --base-frequency or --harmonics"
+            )
         for k in ("acceleration_margin", "torque_margin"):
             if not 0 <= getattr(self, k) < 1:
                 raise OptionError(f"{k} must be in [0, 1); got {getattr(self, k)}")
