@@ -432,6 +432,15 @@ def load_mapped_static_data(
     path = Path(path)
     table = _read_table(path, columns, ("q", "g", "M"))
     n = robot.n if robot is not None else None
+    tpl_q = columns.template("q")
+    if robot is not None and "{" in tpl_q and _fill(tpl_q, robot.n) in table.columns:
+        k = robot.n  # more joints than the robot's: their columns were ignored silently
+        while _fill(tpl_q, k) in table.columns:
+            k += 1
+        raise DataError(
+            f"{path.name}: data for {k} joints (columns {_fill(tpl_q, 0)}..{_fill(tpl_q, k - 1)}); "
+            f"robot {robot.name!r} has {robot.n}; hint: pass the robot the data were recorded with"
+        )
     q = _need(table, columns, "q", n)
     n = q.shape[1]
     g = _need(table, columns, "g", n)
