@@ -1014,6 +1014,7 @@ CASES = [
     C("excite-negative-velocity-margin", None, f"excite --velocity-margin -5 --out {OUT}", 2, "velocity_margin (--velocity-margin) must be finite and >= 0; got -0.0872665"),
     C("excite-base-frequency-1e300", None, f"excite --base-frequency 1e300 --out {OUT}", 2, "the highest harmonic, 5 x 1e+300 Hz = 5e+300 Hz, must lie below 5 Hz"),
     C("payload-data-of-more-joints", small_arms, f"payload --robot {{d}}/one.toml --data {{d}}/s.csv --out {OUT}", 2, "s.csv: data for 7 joints (columns q1..q7); robot 'one' has 1"),
+    C("payload-data-of-another-robot", None, f"payload --robot fr3 --data {{d}}/s.csv --out {OUT}", 2, "s.csv: the data were recorded with robot 'panda'; the robot given is 'fr3'"),
     C("out-under-a-file", None, "identify --data {d}/s.csv --out {d}/s.csv/res", 2, "s.csv is a file, not a folder; choose another --out"),
     C("out-file-under-a-file", None, "export --params panda --out {d}/s.csv/robot.urdf", 2, "s.csv is a file, not a folder"),
 ]

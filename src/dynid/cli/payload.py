@@ -26,12 +26,11 @@ from ..exceptions import DynidError
 from ..feasibility.payload import identify_payload, robot_with_payload
 from ..identification.log import DEFAULT_CUTOFF_HZ
 from ..identification.model import IdentifiedModel
-from ..io.columns import ColumnMap, load_mapped_static_data
 from ..io.payload_json import save_payload_json
 from ..io.robot.toml import save_toml
 from ..model.inertia import INERTIA_ORDER, inertia6_from_matrix
 from ..model.robot import Robot
-from ..workflows.data_files import column_map, data_kind, read_torque_log
+from ..workflows.data_files import column_map, data_kind, read_static_file, read_torque_log
 from .common import add_column_options, add_subcommand, positive_type
 from .console import Console
 from .sources import load_model_source
@@ -67,10 +66,7 @@ def register(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParser:
 def _read(args: argparse.Namespace, path: Path, robot: Robot, kind: str, cmap: Any) -> Any:
     if kind == "torque_log":
         return read_torque_log(path, robot.n, columns=cmap, owner=f"robot {robot.name!r}")
-    mapped = load_mapped_static_data(
-        path, cmap or ColumnMap(), robot, require_M=not args.gravity_only
-    )
-    return mapped.data
+    return read_static_file(path, robot, columns=cmap, require_M=not args.gravity_only)
 
 
 def run(args: argparse.Namespace, console: Console) -> int:

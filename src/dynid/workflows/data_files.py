@@ -217,12 +217,14 @@ def read_static_file(
     *,
     columns: ColumnMap | None = None,
     drop_invalid: bool = False,
+    require_M: bool = True,
 ) -> StaticDataset:
     """Static data ``q, M, g`` of ``robot`` from ``path``, read strictly.
 
     A dynid file is read by :func:`~dynid.io.static_data.load_static_data` (its recorded
     robot checked against ``robot``); a file of another tool through ``columns`` (notes
-    logged as warnings).
+    logged as warnings), as is one without ``M`` columns when ``require_M`` is False
+    (gravity torques only: ``M`` zero).
 
     Raises
     ------
@@ -230,8 +232,8 @@ def read_static_file(
         A bad file, another joint count than ``robot.n``, data recorded with another robot.
     """
     path = Path(path)
-    if columns is not None:
-        mapped = load_mapped_static_data(path, columns, robot)
+    if columns is not None or not require_M:
+        mapped = load_mapped_static_data(path, columns or ColumnMap(), robot, require_M=require_M)
         for note in mapped.notes:
             _log.warning("%s: %s", path.name, note)
         return mapped.data
