@@ -267,3 +267,17 @@ def test_malformed_bag_metadata_is_one_line(tmp_path, capsys, yaml_text):
         err.startswith("dynid import: error: b: cannot read the bag (") and "Traceback" not in err
     )
     assert not (tmp_path / "x.csv").exists()
+
+
+def test_a_message_naming_a_joint_twice_is_refused(tmp_path):
+    """joint7 listed twice with 0.1 and 5.0 rad: the last value was imported silently."""
+    robot = dynid.panda()
+    names = [*robot.joint_names, "joint7"]
+    q = np.r_[np.full(7, 0.1), 5.0]
+    msgs = [
+        (T0_NS + k * 10**7 + 1000, T0_NS + k * 10**7, names, q, np.zeros(8), np.ones(8))
+        for k in range(20)
+    ]
+    path = write_bag(tmp_path / "bag", "mcap", msgs)
+    with pytest.raises(DataError, match=r"bag: message 0 names joint\(s\) \['joint7'\] more"):
+        load_joint_state_bag(path, robot.joint_names)

@@ -217,8 +217,10 @@ def load_joint_state_bag(
         msgs = _Messages(sum(int(getattr(c, "msgcount", 0) or 0) for c in conns))
         for conn, recv_ns, raw in reader.messages(connections=conns):
             msgs.add(recv_ns, reader.deserialize(raw, conn.msgtype))
-    except DataError:
-        raise
+    except DataError as exc:
+        if str(exc).startswith(f"{path.name}:"):
+            raise
+        raise DataError(f"{path.name}: {exc}") from None
     except Exception as exc:
         raise DataError(f"{path.name}: cannot read the bag ({_checks.one_line(str(exc))})") from exc
     finally:
@@ -280,6 +282,12 @@ class _Messages:
         w = len(key)
         chunks = self.keys.setdefault(key, [])
         if not chunks:
+            dup = sorted({s for s in key if key.count(s) > 1})
+            if dup:  # the last value of the name was taken silently
+                raise DataError(
+                    f"message {k} names joint(s) {_checks.short(dup)} more than once; a "
+                    "JointState message lists each joint once"
+                )
             chunks.append(_Chunk(w, _FIRST))
         elif chunks[-1].size == chunks[-1].capacity:
             chunks.append(_Chunk(w, min(2 * chunks[-1].capacity, _CHUNK)))
