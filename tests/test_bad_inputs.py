@@ -436,6 +436,21 @@ def toml_offset_1e200(d: Path) -> None:
     _two_joint(d, "far.toml", "origin = { xyz = [0.5, 0, 0] }", "origin = { xyz = [1e200, 0, 0] }")
 
 
+def com_1e300(d: Path) -> None:
+    """A centre of mass 1e300 m from its link, in TOML and URDF ("inertia must be finite;
+    got nan at index (0, 0, 0)")."""
+    _two_joint(
+        d,
+        "com.toml",
+        "axis = [0, 0, 1]\n[[joints]]",
+        "axis = [0, 0, 1]\n[joints.inertial]\n"
+        "mass = 1.0\ncom = [1e300, 0, 0]\ninertia = [0.01, 0, 0, 0.01, 0, 0.01]\n[[joints]]",
+    )
+    (d / "com.urdf").write_text(
+        TWO_LINK_URDF.replace("<inertial>", '<inertial><origin xyz="1e300 0 0"/>', 1)
+    )
+
+
 def toml_boolean_mass(d: Path) -> None:
     """A link mass written as true."""
     _two_joint(
@@ -997,7 +1012,7 @@ CASES = [
     C("feasible-kinematics-unknown-key", feasible_edited, "export --params {d}/kin.json --out {d}/out.urdf", 2, "kin.json: robot description: unknown key(s) ['note']"),
     C("feasible-flag-string", feasible_edited, "export --params {d}/yes.json --out {d}/out.urdf", 2, "'feasible' must be true or false; got 'yes'"),
     C("feasible-mass-1e12", feasible_edited, "export --params {d}/heavy.json --out {d}/out.urdf", 2, "feasible parameters, link 1: mass must be at most 1e+06 kg; got 1000000000000.0"),
-    C("feasible-com-1e300", feasible_edited, "export --params {d}/far.json --out {d}/out.urdf", 2, "link 1: com must lie within 1000 m of the link frame"),
+    C("feasible-com-1e300", feasible_edited, "export --params {d}/far.json --out {d}/out.urdf", 2, "link 1: com must lie within 10000 m of the link frame"),
     C("feasible-limit-string", feasible_edited, "export --params {d}/limit.json --out {d}/out.urdf", 2, "robot description: limits.q_max must be a number; got '2.8'"),
     C("feasible-negative-mass", feasible_edited, "export --params {d}/negative.json --out {d}/out.urdf", 0, "feasible parameters, link 1 is physically inconsistent: negative mass -1.0; kept as given"),
     C("model-unknown-key", model_unknown_keys, "predict --model {d}/top.json --q " + NEUTRAL, 2, "top.json: identified model: unknown key(s) ['note']"),
@@ -1015,6 +1030,8 @@ CASES = [
     C("excite-base-frequency-1e300", None, f"excite --base-frequency 1e300 --out {OUT}", 2, "the highest harmonic, 5 x 1e+300 Hz = 5e+300 Hz, must lie below 5 Hz"),
     C("payload-data-of-more-joints", small_arms, f"payload --robot {{d}}/one.toml --data {{d}}/s.csv --out {OUT}", 2, "s.csv: data for 7 joints (columns q1..q7); robot 'one' has 1"),
     C("payload-data-of-another-robot", None, f"payload --robot fr3 --data {{d}}/s.csv --out {OUT}", 2, "s.csv: the data were recorded with robot 'panda'; the robot given is 'fr3'"),
+    C("toml-com-1e300", com_1e300, "fk --robot {d}/com.toml --q 0.1,0.2", 2, "key 'inertial.com' must lie within 10000 m of the link frame; got [1e+300, 0.0, 0.0]"),
+    C("urdf-com-1e300", com_1e300, "fk --robot {d}/com.urdf --base base --tip l1 --q 0.1", 2, "<inertial> origin must lie within 10000 m of the link frame"),
     C("out-under-a-file", None, "identify --data {d}/s.csv --out {d}/s.csv/res", 2, "s.csv is a file, not a folder; choose another --out"),
     C("out-file-under-a-file", None, "export --params panda --out {d}/s.csv/robot.urdf", 2, "s.csv is a file, not a folder"),
 ]

@@ -37,7 +37,7 @@ from ..model.inertia import (
     inertial_problems,
     matrix_from_inertia6,
 )
-from ..model.robot import MAX_LINK_MASS, Robot
+from ..model.robot import MAX_LINK_MASS, MAX_LINK_OFFSET, Robot
 from .drive_file import drive_from_record
 from .json_files import finite_or_none, load_json, save_json
 from .robot_json import robot_from_dict, robot_to_dict
@@ -80,9 +80,9 @@ _KEYS = {
     "seed",
     "heldout",
 }
-#: the farthest a link's centre of mass may lie from its frame [m] (a robot's links are
-#: metres long; 1e300 overflowed the parallel-axis inertia into NaN)
-MAX_COM_DISTANCE = 1e3
+#: the farthest a link's centre of mass may lie from its frame [m], as in the robot
+#: readers (1e300 overflowed the parallel-axis inertia into NaN)
+MAX_COM_DISTANCE = MAX_LINK_OFFSET
 
 
 def _numbers(v: Any, size: int, where: str) -> NDArray[np.float64]:

@@ -42,7 +42,14 @@ from ...model.inertia import (
     matrix_from_inertia6,
     phi_from_inertial,
 )
-from ...model.robot import MAX_LINK_MASS, STANDARD_GRAVITY, Frame, Robot, mdh_transform
+from ...model.robot import (
+    MAX_LINK_MASS,
+    MAX_LINK_OFFSET,
+    STANDARD_GRAVITY,
+    Frame,
+    Robot,
+    mdh_transform,
+)
 from ..atomic import write_text
 from ..drive_file import drive_toml
 from ..input_files import file_text
@@ -214,6 +221,11 @@ def _inertial(
             f"{where}: key 'inertial.mass' must lie in [0, {MAX_LINK_MASS:g}] kg; got {mass!r}"
         )
     com = _vector(_require(inertial, "com", inside), 3, where, "inertial.com")
+    if not float(np.max(np.abs(com))) <= MAX_LINK_OFFSET:  # 1e300: the inertia became NaN
+        raise ModelError(
+            f"{where}: key 'inertial.com' must lie within {MAX_LINK_OFFSET:g} m of the link "
+            f"frame; got {com.tolist()}"
+        )
     inertia = _vector(_require(inertial, "inertia", inside), 6, where, "inertial.inertia")
     problems = inertial_problems(mass, matrix_from_inertia6(inertia))
     if problems:  # as the URDF reader: kept, as a real description may round its numbers

@@ -47,7 +47,7 @@ from numpy.typing import NDArray
 from ... import _checks, spatial
 from ...exceptions import DynidWarning, ModelError, UnknownNameError
 from ...model.inertia import inertial_problems, phi_from_inertial
-from ...model.robot import MAX_LINK_MASS, Frame, Robot
+from ...model.robot import MAX_LINK_MASS, MAX_LINK_OFFSET, Frame, Robot
 from ..input_files import file_bytes
 
 __all__ = ["load_urdf", "robot_from_urdf_string"]
@@ -226,6 +226,11 @@ def _inertial(
         return None
     what = f"link {link!r} <inertial>"
     T_link_o = _origin(inertial, what)
+    if not float(np.max(np.abs(T_link_o[:3, 3]))) <= MAX_LINK_OFFSET:  # 1e300: NaN inertia
+        raise ModelError(
+            f"{what} origin must lie within {MAX_LINK_OFFSET:g} m of the link frame; got "
+            f"{T_link_o[:3, 3].tolist()}"
+        )
     mass_el = _child(inertial, "mass")
     mass = None if mass_el is None else _float(mass_el, "value", f"{what} <mass>")
     if mass is None or not np.isfinite(mass):
