@@ -625,6 +625,12 @@ def trajectory_json_duration_1e300(d: Path) -> None:
     (d / "traj.json").write_text(json.dumps(doc))
 
 
+def obstacles_name_nul(d: Path) -> None:
+    """An obstacle named "t" and a NUL (printed raw to the terminal; robot names refuse it)."""
+    plane = {"name": "t\x00", "point": [0, 0, 0], "normal": [0, 0, 1]}
+    (d / "nul.json").write_text(json.dumps({"schema": "dynid-obstacles/1", "planes": [plane]}))
+
+
 def obstacles_far(d: Path) -> None:
     """A table top at z = 1e300 m and a box of 1e200 m (squared distances overflowed, the
     optimiser then reported "q must be finite")."""
@@ -1032,6 +1038,7 @@ CASES = [
     C("payload-data-of-another-robot", None, f"payload --robot fr3 --data {{d}}/s.csv --out {OUT}", 2, "s.csv: the data were recorded with robot 'panda'; the robot given is 'fr3'"),
     C("toml-com-1e300", com_1e300, "fk --robot {d}/com.toml --q 0.1,0.2", 2, "key 'inertial.com' must lie within 10000 m of the link frame; got [1e+300, 0.0, 0.0]"),
     C("urdf-com-1e300", com_1e300, "fk --robot {d}/com.urdf --base base --tip l1 --q 0.1", 2, "<inertial> origin must lie within 10000 m of the link frame"),
+    C("obstacles-name-nul", obstacles_name_nul, f"excite --obstacles {{d}}/nul.json --out {OUT}", 2, "nul.json: planes[0]: name 't\\x00' holds the character '\\x00'"),
     C("out-under-a-file", None, "identify --data {d}/s.csv --out {d}/s.csv/res", 2, "s.csv is a file, not a folder; choose another --out"),
     C("out-file-under-a-file", None, "export --params panda --out {d}/s.csv/robot.urdf", 2, "s.csv is a file, not a folder"),
 ]

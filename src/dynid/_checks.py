@@ -8,6 +8,7 @@ from __future__ import annotations
 
 import math
 import re
+import unicodedata
 from typing import Any
 
 import numpy as np
@@ -163,6 +164,13 @@ def integer(text: str) -> int:
     if _INTEGER.fullmatch(s) is None:
         raise ValueError(f"not an integer: {short(text)}")
     return int(s)
+
+
+def control_character(name: str) -> str | None:
+    """The first control character other than a tab (NUL, a line break, ...) or half of a
+    surrogate pair in ``name``, or None: names with one cannot be written to URDF or MJCF and
+    break one-line messages and CSV headers."""
+    return next((c for c in name if c != "\t" and unicodedata.category(c) in ("Cc", "Cs")), None)
 
 
 def number(value: Any, where: str, error: type[Exception]) -> float:

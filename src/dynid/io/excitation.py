@@ -208,8 +208,9 @@ def load_obstacles(path: str | Path) -> Obstacles:
     DataError
         Not strict JSON (duplicated keys included: a second ``planes`` list would drop the
         first), wrong schema, an unknown key, a plane or box that is not an object of a
-        name and three finite numbers per vector, a zero normal or a box without volume,
-        or two obstacles of one name (each message names the file and the obstacle).
+        name (without control characters) and three finite numbers per vector, a zero
+        normal or a box without volume, or two obstacles of one name (each message names
+        the file and the obstacle).
     OSError
         The file cannot be read.
     """
@@ -229,6 +230,12 @@ def load_obstacles(path: str | Path) -> Obstacles:
             name = item.get("name", f"{one}{k + 1}")
             if not isinstance(name, str) or not name:
                 raise DataError(f"{where}: 'name' must be a non-empty string")
+            bad = _checks.control_character(name)
+            if bad is not None:  # as robot names: it was printed raw to the terminal
+                raise DataError(
+                    f"{where}: name {_checks.short(name)} holds the character {ascii(bad)}; "
+                    "give a name without control characters"
+                )
             where = f"{path.name}: {kind}[{k}] ({_checks.short(name)})"
             _keys(item, {"name", k1, k2}, where)
             if name in names:

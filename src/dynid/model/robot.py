@@ -20,7 +20,6 @@ the base frame [m/s^2], by default ``(0, 0, -9.80665)``. Named frames are fixed 
 from __future__ import annotations
 
 import dataclasses
-import unicodedata
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -77,10 +76,7 @@ def _check_names(kind: str, names: Sequence[str]) -> None:
     or half of a surrogate pair: URDF and MJCF cannot hold it (a NUL made the export
     unparseable), and it would break the one-line messages and CSV headers naming it."""
     for name in names:
-        bad = next(
-            (c for c in str(name) if c != "\t" and unicodedata.category(c) in ("Cc", "Cs")),
-            None,
-        )
+        bad = _checks.control_character(str(name))
         if bad is not None:
             raise ModelError(
                 f"{kind} name {_checks.short(str(name))} holds the character "
