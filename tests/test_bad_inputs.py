@@ -288,6 +288,17 @@ def log_tau7_zero(d: Path) -> None:
     _edit_log(d, "zero7.csv", edit)
 
 
+def log_all_nan(d: Path) -> None:
+    """A log whose q3 is NaN in every row ("unexpected IndexError" with --drop-invalid)."""
+
+    def edit(rows):
+        k = rows[0].index("q3")
+        for r in rows[1:]:
+            r[k] = "nan"
+
+    _edit_log(d, "allnan.csv", edit)
+
+
 def _log_still(d: Path, name: str, joints: list[int]) -> None:
     """A 4 s log at 200 Hz of the Table I sinusoids with ``joints`` (0-based) held still;
     their measured velocities are only the sensor noise."""
@@ -1039,6 +1050,8 @@ CASES = [
     C("toml-com-1e300", com_1e300, "fk --robot {d}/com.toml --q 0.1,0.2", 2, "key 'inertial.com' must lie within 10000 m of the link frame; got [1e+300, 0.0, 0.0]"),
     C("urdf-com-1e300", com_1e300, "fk --robot {d}/com.urdf --base base --tip l1 --q 0.1", 2, "<inertial> origin must lie within 10000 m of the link frame"),
     C("obstacles-name-nul", obstacles_name_nul, f"excite --obstacles {{d}}/nul.json --out {OUT}", 2, "nul.json: planes[0]: name 't\\x00' holds the character '\\x00'"),
+    C("log-every-row-dropped", log_all_nan, f"validate --robot panda --data {{d}}/allnan.csv --drop-invalid --out {OUT}", 2, "allnan.csv: fewer than 2 valid rows left of 801 (801 with NaN/inf)"),
+    C("friction-every-row-dropped", log_all_nan, f"friction --robot panda --data {{d}}/allnan.csv --drop-invalid --out {OUT}", 2, "fewer than 2 valid rows left of 801"),
     C("out-under-a-file", None, "identify --data {d}/s.csv --out {d}/s.csv/res", 2, "s.csv is a file, not a folder; choose another --out"),
     C("out-file-under-a-file", None, "export --params panda --out {d}/s.csv/robot.urdf", 2, "s.csv is a file, not a folder"),
 ]

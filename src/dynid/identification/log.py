@@ -249,6 +249,8 @@ class TorqueLog:
             finite &= np.all(np.isfinite(a), axis=1)
         rows = np.flatnonzero(finite)
         n_nan = N - rows.size
+        if rows.size == 0:  # every row invalid (the duplicate mask below needs one)
+            raise DataError(f"fewer than 2 valid rows left of {N} ({n_nan} with NaN/inf)")
         tt = t[rows]
         dt = np.diff(tt)
         back = np.flatnonzero(dt < 0)
