@@ -1052,6 +1052,7 @@ CASES = [
     C("obstacles-name-nul", obstacles_name_nul, f"excite --obstacles {{d}}/nul.json --out {OUT}", 2, "nul.json: planes[0]: name 't\\x00' holds the character '\\x00'"),
     C("log-every-row-dropped", log_all_nan, f"validate --robot panda --data {{d}}/allnan.csv --drop-invalid --out {OUT}", 2, "allnan.csv: fewer than 2 valid rows left of 801 (801 with NaN/inf)"),
     C("friction-every-row-dropped", log_all_nan, f"friction --robot panda --data {{d}}/allnan.csv --drop-invalid --out {OUT}", 2, "fewer than 2 valid rows left of 801"),
+    C("payload-drop-invalid", log_all_nan, f"payload --robot panda --data {{d}}/allnan.csv --drop-invalid --out {OUT}", 2, "allnan.csv: fewer than 2 valid rows left of 801"),
     C("out-under-a-file", None, "identify --data {d}/s.csv --out {d}/s.csv/res", 2, "s.csv is a file, not a folder; choose another --out"),
     C("out-file-under-a-file", None, "export --params panda --out {d}/s.csv/robot.urdf", 2, "s.csv is a file, not a folder"),
 ]

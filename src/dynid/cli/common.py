@@ -108,12 +108,17 @@ def add_log_options(p: argparse.ArgumentParser, *, drop_invalid: bool = True) ->
         "steps, at least 0.02 s; a log at any rate from 10 Hz up passes)",
     )
     if drop_invalid:
-        p.add_argument(
-            "--drop-invalid",
-            action="store_true",
-            help="drop rows with NaN, inf, empty cells or a repeated timestamp (reported: "
-            "how many and where) instead of failing",
-        )
+        add_drop_invalid(p)
+
+
+def add_drop_invalid(p: argparse.ArgumentParser) -> None:
+    """``--drop-invalid``: the option the readers' error messages name as the remedy."""
+    p.add_argument(
+        "--drop-invalid",
+        action="store_true",
+        help="drop rows with NaN, inf, empty cells or a repeated timestamp (reported: "
+        "how many and where) instead of failing",
+    )
 
 
 @contextlib.contextmanager

@@ -31,7 +31,7 @@ from ..io.robot.toml import save_toml
 from ..model.inertia import INERTIA_ORDER, inertia6_from_matrix
 from ..model.robot import Robot
 from ..workflows.data_files import column_map, data_kind, read_static_file, read_torque_log
-from .common import add_column_options, add_subcommand, positive_type
+from .common import add_column_options, add_drop_invalid, add_subcommand, positive_type
 from .console import Console
 from .sources import load_model_source
 
@@ -59,14 +59,19 @@ def register(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParser:
     p.add_argument(
         "--cutoff", type=positive_type, default=DEFAULT_CUTOFF_HZ, help="torque logs: low-pass [Hz]"
     )
+    add_drop_invalid(p)
     p.add_argument("--out", type=Path, required=True, help="output folder")
     return p
 
 
 def _read(args: argparse.Namespace, path: Path, robot: Robot, kind: str, cmap: Any) -> Any:
+    drop = args.drop_invalid
     if kind == "torque_log":
-        return read_torque_log(path, robot.n, columns=cmap, owner=f"robot {robot.name!r}")
-    return read_static_file(path, robot, columns=cmap, require_M=not args.gravity_only)
+        owner = f"robot {robot.name!r}"
+        return read_torque_log(path, robot.n, columns=cmap, drop_invalid=drop, owner=owner)
+    return read_static_file(
+        path, robot, columns=cmap, drop_invalid=drop, require_M=not args.gravity_only
+    )
 
 
 def run(args: argparse.Namespace, console: Console) -> int:
