@@ -2,6 +2,11 @@
 
 from __future__ import annotations
 
+import os
+import subprocess
+import sys
+from pathlib import Path
+
 import numpy as np
 import pytest
 
@@ -10,6 +15,27 @@ from dynid.feasibility.compare import perturbed_robot  # noqa: F401 (shared with
 from dynid.identification.least_squares import LeastSquaresFit
 from dynid.identification.model import IdentifiedModel
 from dynid.regressors.base import base_parameters
+
+
+def pytest_sessionstart(session: pytest.Session) -> None:
+    """With several test workers, compile the numba kernels first, in parallel groups
+    (``tests/warm_kernels.py``), so that no two workers compile the same kernel at once on
+    a clean checkout; a no-op in a worker, in a single-process run, or without numba."""
+    config = session.config
+    workers = getattr(config.option, "numprocesses", None)
+    if hasattr(config, "workerinput") or not workers or os.environ.get("DYNID_NO_NUMBA"):
+        return
+    script = Path(__file__).with_name("warm_kernels.py")
+    procs = [
+        subprocess.Popen(
+            [sys.executable, str(script), str(g)],
+            stdout=subprocess.DEVNULL,
+            stderr=subprocess.DEVNULL,
+        )
+        for g in range(2)
+    ]
+    for p in procs:
+        p.wait()  # (a failure is not checked here: the tests meet the same fault)
 
 
 @pytest.fixture(scope="session")

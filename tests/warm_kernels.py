@@ -1,0 +1,46 @@
+"""Compile the numba kernels into their disk cache before the test workers start.
+
+On a clean checkout nothing is cached: the workers of ``make test`` (one a core) would each
+compile the kernels the first test of theirs needs, the same kernel twice at once when two
+tests need it together (the inverse kinematics alone takes about a minute). The session
+start of ``tests/conftest.py`` runs this module in one process per group, in parallel,
+before the workers exist; they then load the kernels from the cache. Nothing here is
+checked: a kernel left out is compiled by the first test that needs it, as before.
+
+Usage: ``python tests/warm_kernels.py GROUP`` with GROUP 0 (kinematics, inverse kinematics
+included) or 1 (dynamics and regressors); each takes about a minute on one core.
+"""
+
+from __future__ import annotations
+
+import sys
+
+import numpy as np
+
+import dynid
+
+GROUPS = 2
+
+
+def warm(group: int) -> None:
+    """Call every compiled kernel of ``group`` once on the Panda, batch then single sample."""
+    robot = dynid.panda()
+    q = np.array([0.1, -0.3, 0.2, -1.8, 0.1, 1.6, 0.4])
+    Q = np.tile(q, (3, 1))
+    for x, v in ((Q, Q), (q, q)):  # a batch first: it loads the kernels for single samples
+        if group == 0:
+            dynid.ik(robot, dynid.fk(robot, x), q0=x)
+            dynid.jacobian(robot, x)
+            dynid.link_poses(robot, x)
+            continue
+        dynid.rnea(robot, x, v, v)
+        dynid.mass_matrix(robot, x)
+        dynid.gravity_torques(robot, x)
+        dynid.coriolis(robot, x, v)
+        dynid.forward_dynamics(robot, x, v, v)
+        dynid.static_regressor(robot, x)
+        dynid.torque_regressor(robot, x, v, v)
+
+
+if __name__ == "__main__":
+    warm(int(sys.argv[1]))
