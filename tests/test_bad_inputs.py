@@ -1412,3 +1412,21 @@ def test_a_text_file_above_the_limit_is_refused_before_it_is_read(tmp_path, monk
         load_json(p)
     monkeypatch.setenv("DYNID_MAX_TEXT_BYTES", "1000")
     assert load_json(p)["schema"] == "x"
+
+
+@pytest.mark.parametrize(
+    "command",
+    ["identify", "retrieve", "friction", "validate", "payload", "excite", "export", "simulate",
+     "acquire-static", "import", "demo"],
+)  # fmt: skip
+def test_an_empty_out_is_refused_not_read_as_the_current_folder(
+    command, tmp_path, monkeypatch, capsys
+):
+    """``--out ""`` (an unset shell variable) was ``Path("")``, the current folder, and a run
+    wrote its files there; it is an argument error (exit 2) and nothing is written."""
+    monkeypatch.chdir(tmp_path)
+    argv = [command, *(["bag.bag"] if command == "import" else []), "--out", ""]
+    assert main(argv) == 2
+    err = capsys.readouterr().err
+    assert "argument --out: must not be empty" in err and "Traceback" not in err
+    assert list(tmp_path.iterdir()) == []

@@ -43,6 +43,7 @@ from .common import (
     count_type,
     load_robot,
     nonnegative_type,
+    output_path,
 )
 from .console import Console
 
@@ -93,7 +94,7 @@ def register(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParser:
         help="add effects outside the rigid-body model, as real arms have (rotor inertia on "
         "the diagonal of M, a 0.3 deg gravity tilt; drawn from --seed, recorded in the file)",
     )
-    p.add_argument("--out", type=Path, required=True, help="output file, .csv or .npz")
+    p.add_argument("--out", type=output_path, required=True, help="output file, .csv or .npz")
     return p
 
 

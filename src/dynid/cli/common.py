@@ -92,6 +92,14 @@ def add_subcommand(
     )
 
 
+def output_path(text: str) -> Path:
+    """The ``--out`` argument: a path, never empty (``Path("")`` is the current folder, so an
+    unset shell variable in ``--out "$DIR"`` would write there)."""
+    if not text.strip():
+        raise argparse.ArgumentTypeError("must not be empty (give a file or folder name)")
+    return Path(text)
+
+
 def add_seed_option(p: argparse.ArgumentParser, help: str = "random seed (default: 0)") -> None:
     """``--seed N`` (N >= 0)."""
     p.add_argument("--seed", type=seed_type, default=0, metavar="N", help=help)

@@ -42,7 +42,7 @@ from ..feasibility.retrieve import RetrievalProgress
 from ..model.panda import panda
 from ..model.robot import Robot
 from ..pipeline import ConsistentSetup, StageFinished, StageStarted, run_demo
-from .common import add_seed_option, add_subcommand
+from .common import add_seed_option, add_subcommand, output_path
 from .console import Console
 from .demo_stages import (
     format_consistent_setup,
@@ -124,7 +124,9 @@ def register(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParser:
     p = add_subcommand(
         subparsers, NAME, __doc__, help="run the demonstration pipeline on the built-in Panda"
     )
-    p.add_argument("--out", type=Path, default=Path("out"), help="output folder (default: out)")
+    p.add_argument(
+        "--out", type=output_path, default=Path("out"), help="output folder (default: out)"
+    )
     add_seed_option(p)
     return p
 

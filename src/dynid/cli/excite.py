@@ -37,7 +37,7 @@ import numpy as np
 
 from ..io.excitation import load_obstacles, save_excitation_json, save_trajectory_csv
 from ..simulation.excitation import ExcitationOptions, optimise_excitation
-from .common import add_robot_options, add_subcommand, load_robot, save_figure
+from .common import add_robot_options, add_subcommand, load_robot, output_path, save_figure
 from .console import Console
 
 NAME = "excite"
@@ -84,7 +84,7 @@ def register(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParser:
     p.add_argument("--max-iter", type=int, default=d.max_iter, help="optimiser iterations (60)")
     p.add_argument("--seed", type=int, default=0, help="random seed (default 0)")
     p.add_argument("--no-figure", action="store_true", help="do not write excitation.png")
-    p.add_argument("--out", type=Path, required=True, help="output folder")
+    p.add_argument("--out", type=output_path, required=True, help="output folder")
     return p
 
 

@@ -36,7 +36,7 @@ from ..friction.mujoco import coulomb_viscous_from_sigmoid
 from ..io.export import EXPORT_FORMATS, export_format, model_terms_of, save_robot
 from ..io.robot.urdf_patch import MERGED_POLICIES
 from ..model.robot import Robot
-from .common import add_drive_option, add_subcommand, load_drive_arg
+from .common import add_drive_option, add_subcommand, load_drive_arg, output_path
 from .console import Console
 
 NAME = "export"
@@ -54,7 +54,7 @@ def register(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParser:
     )
     p.add_argument("--params", required=True, help="feasible.json, a robot .toml, 'panda' or 'fr3'")
     p.add_argument("--format", choices=EXPORT_FORMATS, default=None, help="default: by suffix")
-    p.add_argument("--out", type=Path, required=True, help="output file")
+    p.add_argument("--out", type=output_path, required=True, help="output file")
     p.add_argument("--urdf-template", type=Path, default=None, help="the original URDF file")
     p.add_argument("--base", default=None, help="base link of the template's chain")
     p.add_argument("--tip", default=None, help="tip link of the template's chain")

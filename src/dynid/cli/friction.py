@@ -42,6 +42,7 @@ from .common import (
     add_subcommand,
     load_drive_arg,
     load_robot,
+    output_path,
     positive_type,
     shown,
 )
@@ -70,7 +71,7 @@ def register(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParser:
     p.add_argument("--data", type=Path, required=True, help="torque log (.csv or .npz)")
     add_column_options(p)
     add_drive_option(p)
-    p.add_argument("--out", type=Path, required=True, help="output directory")
+    p.add_argument("--out", type=output_path, required=True, help="output directory")
     p.add_argument(
         "--friction-model",
         choices=("auto", *LAWS),

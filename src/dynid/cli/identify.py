@@ -77,6 +77,7 @@ from .common import (
     load_prior,
     load_robot,
     number,
+    output_path,
     parse_mass_band,
     positive_type,
     sdp_options,
@@ -102,7 +103,7 @@ def register(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParser:
     add_drive_option(p)
     p.add_argument("--data", type=Path, required=True, help="data file: .csv or .npz")
     add_column_options(p)
-    p.add_argument("--out", type=Path, required=True, help="output folder")
+    p.add_argument("--out", type=output_path, required=True, help="output folder")
     p.add_argument(
         "--max-std-percent",
         type=positive_type,

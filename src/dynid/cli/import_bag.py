@@ -23,7 +23,7 @@ from pathlib import Path
 from ..identification.log import DEFAULT_CUTOFF_HZ
 from ..io.rosbag import load_joint_state_bag
 from ..io.torque_log import save_torque_log
-from .common import add_robot_options, add_subcommand, load_robot, positive_type
+from .common import add_robot_options, add_subcommand, load_robot, output_path, positive_type
 from .console import Console
 
 NAME = "import"
@@ -40,7 +40,9 @@ def register(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParser:
         help="torque log from sensor_msgs/JointState in a ROS 1 or ROS 2 bag",
     )
     p.add_argument("bag", type=Path, help="ROS 1 .bag file or ROS 2 bag folder")
-    p.add_argument("--out", type=Path, required=True, help="torque log to write (.csv or .npz)")
+    p.add_argument(
+        "--out", type=output_path, required=True, help="torque log to write (.csv or .npz)"
+    )
     p.add_argument("--topic", default="/joint_states", help="JointState topic")
     add_robot_options(p)
     p.add_argument(

@@ -31,7 +31,7 @@ from ..io.robot.toml import save_toml
 from ..model.inertia import INERTIA_ORDER, inertia6_from_matrix
 from ..model.robot import Robot
 from ..workflows.data_files import column_map, data_kind, read_static_file, read_torque_log
-from .common import add_column_options, add_drop_invalid, add_subcommand, positive_type
+from .common import add_column_options, add_drop_invalid, add_subcommand, output_path, positive_type
 from .console import Console
 from .sources import load_model_source
 
@@ -60,7 +60,7 @@ def register(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParser:
         "--cutoff", type=positive_type, default=DEFAULT_CUTOFF_HZ, help="torque logs: low-pass [Hz]"
     )
     add_drop_invalid(p)
-    p.add_argument("--out", type=Path, required=True, help="output folder")
+    p.add_argument("--out", type=output_path, required=True, help="output folder")
     return p
 
 

@@ -62,6 +62,7 @@ from .common import (
     count_type,
     load_robot,
     note_prior,
+    output_path,
     parse_mass_band,
     sdp_options,
 )
@@ -117,7 +118,7 @@ def register(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParser:
     p.add_argument(
         "--friction", type=Path, default=None, help="friction.json (sigmoid) to put on the robot"
     )
-    p.add_argument("--out", type=Path, required=True, help="output folder")
+    p.add_argument("--out", type=output_path, required=True, help="output folder")
     p.add_argument("--no-figures", action="store_true", help="skip retrieval.png")
     return p
 

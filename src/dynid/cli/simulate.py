@@ -56,6 +56,7 @@ from .common import (
     load_robot,
     nonnegative_type,
     number,
+    output_path,
     parse_vector,
     positive_type,
 )
@@ -150,7 +151,7 @@ def register(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParser:
         "torque-sensor offsets, a 0.3 deg gravity tilt; drawn from --seed and printed)",
     )
     add_seed_option(p)
-    p.add_argument("--out", required=True, type=Path, help="output .csv or .npz")
+    p.add_argument("--out", required=True, type=output_path, help="output .csv or .npz")
     return p
 
 

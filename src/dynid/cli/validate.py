@@ -46,6 +46,7 @@ from .common import (
     add_log_options,
     add_subcommand,
     load_drive_arg,
+    output_path,
     positive_type,
     shown,
 )
@@ -80,7 +81,7 @@ def register(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParser:
     fr.add_argument("--no-friction", action="store_true", help="ignore the model's own friction")
     p.add_argument("--data", type=Path, required=True, help="torque log (.csv or .npz)")
     add_column_options(p)
-    p.add_argument("--out", type=Path, required=True, help="output directory")
+    p.add_argument("--out", type=output_path, required=True, help="output directory")
     p.add_argument(
         "--cutoff",
         type=positive_type,
