@@ -249,3 +249,23 @@ def test_velocity_noise_estimate_matches_the_simulated_noise(panda, sinusoid_log
     assert moving_joints(log.dq).tolist() == [True, False, True, True, True, True, True]
     with pytest.raises(ShapeError, match="noise_std must have shape"):
         moving_joints(log.dq, np.ones(3))
+
+
+def test_validation_warns_when_the_log_s_torque_sign_is_opposite_to_the_model_s(
+    panda, sinusoid_log
+):
+    """The same log with its torques negated (another recorder's convention) is about 200 %
+    off: validate_torques says why, and says nothing on the log as recorded."""
+    import dataclasses
+    import warnings
+
+    from dynid.exceptions import DynidWarning
+
+    _, log = sinusoid_log
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", DynidWarning)
+        validate_torques(panda, log)
+    flipped = dataclasses.replace(log, tau=-log.tau)
+    with pytest.warns(DynidWarning, match="torque sign is probably opposite"):
+        v = validate_torques(panda, flipped)
+    assert v.without_friction.relative_error_percent > 150

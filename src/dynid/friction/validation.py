@@ -19,6 +19,7 @@ correct model equals the sensor noise.
 
 from __future__ import annotations
 
+import warnings
 from dataclasses import dataclass
 from typing import Any, Literal
 
@@ -27,10 +28,11 @@ from numpy.typing import ArrayLike, NDArray
 
 from .. import _checks
 from ..dynamics.rnea import rnea
-from ..exceptions import OptionError, ShapeError
+from ..exceptions import DynidWarning, OptionError, ShapeError
 from ..identification.log import DEFAULT_CUTOFF_HZ, TorqueLog, joint_side_log, prepare_log
 from ..identification.metrics import TorqueErrors, torque_errors
 from ..identification.model import IdentifiedModel
+from ..identification.sanity import anticorrelated
 from ..model.drive import Drive
 from ..model.robot import Robot
 from .fit import TorqueModel, model_drive, rigid_body_torques
@@ -179,6 +181,7 @@ def validate_torques(
         for b in _blocks(p.n_samples):  # a robot's links only: add the known rotors
             tau_model[b] += d.rotor_torques(p.ddq[b], d.rotor_inertia)
     without = torque_errors(p.tau, tau_model)
+    _warn_opposite_sign(p.tau, tau_model)
     tf = with_ = None
     if friction is not None:
         tf = np.empty(p.dq.shape)
@@ -193,6 +196,27 @@ def validate_torques(
         with_friction=with_,
         friction=friction,
     )
+
+
+def _warn_opposite_sign(tau: NDArray[np.float64], tau_model: NDArray[np.float64]) -> None:
+    """A :class:`DynidWarning` when the measured torques (N, n) [N m] have the opposite sign
+    to the model's prediction on most joints (a log recorded with another sign convention
+    than the model's; the errors are then about 200 %)."""
+    step = max(1, tau.shape[0] // 20_000)
+    m, t = tau_model[::step], tau[::step]
+    mc, tc = m - m.mean(axis=0), t - t.mean(axis=0)
+    spread = np.std(m, axis=0)
+    found = anticorrelated(mc, tc, spread > 0.05 * max(float(spread.max(initial=0.0)), 1e-300))
+    if found is not None:
+        j, c = found
+        warnings.warn(
+            f"the measured torques are anti-correlated with the model's (correlation {c:+.2f} "
+            f"on joint {j + 1}): the log's torque sign is probably opposite to the one the "
+            "model was identified with; hint: a log recorded as the identification's was, or "
+            "its torque columns negated",
+            DynidWarning,
+            stacklevel=3,
+        )
 
 
 #: Samples per block of the predictions of a long log (temporaries of one block only).

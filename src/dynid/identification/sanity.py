@@ -37,6 +37,7 @@ from .log import TorqueLog
 
 __all__ = [
     "MIN_MOTION",
+    "anticorrelated",
     "MOVING_FRACTION",
     "NOISE_BAND_STD",
     "check_torque_log",
@@ -179,6 +180,28 @@ def check_torque_log(robot: Robot, log: TorqueLog) -> list[str]:
     return out
 
 
+def anticorrelated(
+    reference: NDArray[np.float64], tau: NDArray[np.float64], loaded: NDArray[np.bool_]
+) -> tuple[int, float] | None:
+    """The joint and correlation that show ``tau`` (N, n) of the opposite sign to
+    ``reference`` (N, n), both with their means removed, or None.
+
+    A sign is called opposite when more of the ``loaded`` joints correlate negatively than
+    positively and at least one correlates below -0.5 (that one, the most negative, is
+    returned).
+    """
+    with np.errstate(invalid="ignore", divide="ignore"):
+        corr = np.sum(reference * tau, axis=0) / np.sqrt(
+            np.sum(reference**2, axis=0) * np.sum(tau**2, axis=0)
+        )
+    corr = np.where(np.isfinite(corr), corr, 0.0)
+    neg = loaded & (corr < -0.5)
+    if not np.any(neg) or np.sum(corr[loaded] < 0) <= np.sum(corr[loaded] > 0):
+        return None
+    j = int(np.flatnonzero(neg)[np.argmin(corr[neg])])
+    return j, float(corr[j])
+
+
 def _sign_and_scale(
     robot: Robot, q: NDArray[np.float64], tau: NDArray[np.float64], names: tuple[str, ...]
 ) -> list[str]:
@@ -189,16 +212,13 @@ def _sign_and_scale(
         return []
     gc = g - g.mean(axis=0)
     tc = tau - tau.mean(axis=0)
-    with np.errstate(invalid="ignore", divide="ignore"):
-        corr = np.sum(gc * tc, axis=0) / np.sqrt(np.sum(gc**2, axis=0) * np.sum(tc**2, axis=0))
-    corr = np.where(np.isfinite(corr), corr, 0.0)
     out = []
-    neg = loaded & (corr < -0.5)
-    if np.any(neg) and np.sum(corr[loaded] < 0) > np.sum(corr[loaded] > 0):
-        j = int(np.flatnonzero(neg)[np.argmin(corr[neg])])
+    found = anticorrelated(gc, tc, loaded)
+    if found is not None:
+        j, c = found
         out.append(
             f"the measured torques are anti-correlated with the model's gravity torques "
-            f"(correlation {corr[j]:+.2f} on {names[j]}): the torque sign is probably opposite "
+            f"(correlation {c:+.2f} on {names[j]}): the torque sign is probably opposite "
             "to the model's; hint: --units tau=-1 (or a drive file whose transmission has "
             "the sign)"
         )
