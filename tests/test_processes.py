@@ -229,3 +229,38 @@ def test_a_failing_figure_is_skipped_with_a_note(model, tmp_path, monkeypatch, c
     err = capsys.readouterr().err
     assert "note: skipped the figure retrieval.png: RuntimeError: the plot is broken" in err
     assert (out / "feasible.json").is_file() and not (out / "retrieval.png").exists()
+
+
+_SCS_RUN = """
+import numpy as np, cvxpy as cp
+from dynid.feasibility.sdp import _scs
+rng = np.random.default_rng(0); n = 120
+C = rng.normal(size=(n, n)); C = C + C.T
+X = cp.Variable((n, n), PSD=True)
+prob = cp.Problem(cp.Minimize(cp.trace(C @ X)), [cp.trace(X) == 1, X[0, 1] >= 0.01])
+print("ready", flush=True)
+try:
+    prob.solve(solver=_scs(), eps=1e-12, max_iters=10**7)
+    print("finished", prob.status)
+except cp.error.SolverError as e:
+    print("solver error", e)
+"""
+
+
+def test_ctrl_c_during_the_scs_fallback_stops_the_run():
+    """SCS catches SIGINT itself and cvxpy reports a failed solve: through cvxpy's own
+    interface the convex fit's retries went on and the run ended with exit 0 and all its
+    files. The fallback the convex fit uses lets it through as a KeyboardInterrupt."""
+    p = subprocess.Popen(
+        [sys.executable, "-c", _SCS_RUN],
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        text=True,
+        preexec_fn=lambda: signal.signal(signal.SIGINT, signal.SIG_DFL),
+    )
+    assert p.stdout is not None and p.stdout.readline().strip() == "ready"
+    time.sleep(3.0)  # inside the solve (the tolerance is out of reach: it runs on)
+    p.send_signal(signal.SIGINT)
+    out, err = p.communicate(timeout=120)
+    assert "KeyboardInterrupt" in err and "finished" not in out and "solver error" not in out
+    assert p.returncode != 0

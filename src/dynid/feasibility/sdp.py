@@ -569,7 +569,7 @@ class _Problem:
             try:
                 with warnings.catch_warnings():  # the status says it; retried below
                     warnings.simplefilter("ignore", UserWarning)
-                    self.problem.solve(solver=solver, **kw)
+                    self.problem.solve(solver=_scs() if solver == "SCS" else solver, **kw)
             except (cp.error.SolverError, ArithmeticError, ValueError) as exc:
                 seen.append(f"{solver}: {exc}")
                 continue
@@ -604,6 +604,28 @@ class _Problem:
 
 
 #: ``phi`` (n, 10), friction (k,) or None, rotor inertias (n,) or None.
+def _scs() -> Any:
+    """cvxpy's SCS interface that lets a Ctrl-C through: SCS catches SIGINT itself and
+    returns its status -5, which cvxpy reports as a failed solve, so a retry or the rest of
+    the run would go on as if nothing were asked; here it is a :class:`KeyboardInterrupt`."""
+    from cvxpy.reductions.solvers.conic_solvers.scs_conif import SCS
+
+    class InterruptibleSCS(SCS):
+        def name(self) -> str:
+            return "DYNID_SCS"  # (cvxpy refuses a custom solver under a built-in name)
+
+        def invert(self, solution: Any, inverse_data: Any) -> Any:
+            if solution["info"]["status_val"] == SCS_SIGINT:
+                raise KeyboardInterrupt
+            return super().invert(solution, inverse_data)
+
+    return InterruptibleSCS()
+
+
+#: SCS's status after it caught SIGINT
+SCS_SIGINT = -5
+
+
 _Values = tuple[NDArray[np.float64], NDArray[np.float64] | None, NDArray[np.float64] | None]
 
 
