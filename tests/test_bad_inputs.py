@@ -983,7 +983,7 @@ CASES = [
     C("device-obstacles", devices, f"excite --obstacles {{d}}/zero.json --out {OUT}", 2, "zero.json: not a regular file"),
     C("device-template", devices, "export --params panda --urdf-template {d}/zero.urdf --out {d}/out.urdf", 2, "zero.urdf: not a regular file"),
     C("device-bag", devices, "import {d}/zero.bag --robot panda --out {d}/out.csv", 2, "zero.bag: not a regular file"),
-    C("folder-as-log", a_folder_as_a_file, f"identify --data {{d}}/folder.csv --out {OUT}", 2, "is a folder; give a file"),
+    C("folder-as-log", a_folder_as_a_file, f"identify --data {{d}}/folder.csv --out {OUT}", 2, "folder holds no .csv or .npz"),
     C("toml-frame-named-like-a-link", toml_frame_named_like_a_link, "fk --robot {d}/bad.toml --frame l1 --q 0.1,0.2", 2, "frame 'l1' has the name of a link but another pose (on link 2)"),
     C("urdf-two-masses", urdf_two_masses, "fk --robot {d}/bad.urdf --base base --tip l1 --q 0.1", 2, "bad.urdf: <inertial> holds 2 <mass> elements; URDF allows one"),
     C("urdf-two-inertials", urdf_two_inertials, "fk --robot {d}/bad.urdf --base base --tip l1 --q 0.1", 2, "<link name='l1'> holds 2 <inertial> elements"),

@@ -8,8 +8,23 @@ and the rest re-fitted (the paper used 30).
 
 Torque logs (a CSV with a `t` column, or an NPZ with `t` and `tau`, as written by
 `dynid simulate`) go to the classical route: zero-phase filtering, accelerations by
-differentiation, the torque regressor in the base parameters plus viscous, Coulomb and
-offset friction columns per joint, and the same least squares and statistics.
+differentiation (a `ddq` column set, when the log has one, is used instead and only
+filtered), the torque regressor in the base parameters plus the model's terms, and the
+same least squares and statistics. Several recordings are given as several files (or a
+folder): each recording, and each piece of one cut at a gap longer than --max-gap, is
+filtered, differentiated and decimated on its own and never joined to another; one
+cut-off serves all. Continuous joints recorded wrapped into [-pi, pi] are unwrapped.
+A log without velocity columns gets its velocities from the positions at that cut-off.
+
+Model structure. Beside the links' base parameters a torque log may need an armature
+(I_a ddq per joint; with a drive file, the rotor inertias at the motors), viscous and
+Coulomb friction (sign(dq) off inside each joint's velocity noise band) and torque
+offsets. By default every combination is fitted and judged on data it was not fitted to
+(one recording left out at a time when there are several, else --folds contiguous time
+blocks, or --validate-on), and the simplest within one standard error of the lowest
+held-out error is kept. The summary prints the table of candidates and the choice;
+identification.json records it. --terms fixes the structure by hand
+(e.g. --terms armature,viscous,coulomb,offset).
 
 Checks that the data belong to --robot: a static data file that records another robot
 (name, joint count or kinematics) is an error; configurations outside the joint limits,
@@ -101,7 +116,23 @@ def register(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParser:
     )
     add_robot_options(p)
     add_drive_option(p)
-    p.add_argument("--data", type=Path, required=True, help="data file: .csv or .npz")
+    p.add_argument(
+        "--data",
+        type=Path,
+        nargs="+",
+        required=True,
+        metavar="FILE",
+        help="data: one static data file, or one or more torque logs (a folder: its .csv and "
+        ".npz files), .csv or .npz",
+    )
+    p.add_argument(
+        "--terms",
+        default=None,
+        metavar="TERMS",
+        help="torque logs: the model's terms beside the links, comma-separated from armature, "
+        "viscous, coulomb, offset ('links' for none); default: chosen on held-out data "
+        "(see Model structure above)",
+    )
     add_column_options(p)
     p.add_argument("--out", type=output_path, required=True, help="output folder")
     p.add_argument(
@@ -200,7 +231,7 @@ def run(args: argparse.Namespace, console: Console) -> int:
     )
     if args.consistent:
         return run_consistent(args, console, robot, common)
-    model = identify_file(robot, args.data, max_gap_s=args.max_gap, **common)
+    model = identify_file(robot, args.data, terms=args.terms, max_gap_s=args.max_gap, **common)
     path = save_model_json(args.out / "identification.json", model)
     console.print(format_identification(model))
     console.wrote(path)
@@ -230,9 +261,14 @@ def _no_consistency_options(args: argparse.Namespace) -> None:
 def run_consistent(args: argparse.Namespace, console: Console, robot, common) -> int:  # noqa: ANN001
     """One-step consistent identification: identification.json plus the retrieve files;
     0 if the parameters are consistent, else 1."""
+    if len(args.data) > 1 or args.terms is not None:
+        raise OptionError(
+            "--consistent takes one --data file and the classical terms (no --terms) for now; "
+            "identify without --consistent to fit several recordings or choose the terms"
+        )
     result = identify_consistent_file(
         robot,
-        args.data,
+        args.data[0],
         prior=load_prior(args, robot, console),
         total_mass=parse_mass_band(args.total_mass),
         options=sdp_options(args),
@@ -240,7 +276,7 @@ def run_consistent(args: argparse.Namespace, console: Console, robot, common) ->
     )
     assert result.identified is not None  # identify_consistent_file says so
     files = [save_model_json(args.out / "identification.json", result.identified)]
-    files += save_feasible_bundle(args.out, result, source=str(args.data))
+    files += save_feasible_bundle(args.out, result, source=str(args.data[0]))
     files += [] if args.no_figures else save_retrieval_figure(args.out, result)
     console.print(format_identification(result.identified), "", format_consistent(result))
     console.wrote(*files)

@@ -73,6 +73,7 @@ def format_identification(model: IdentifiedModel, *, width: int = 60) -> str:
         f"{len(groups['unidentifiable'])} unidentifiable"
         + (f" ({', '.join(groups['unidentifiable'])})" if groups["unidentifiable"] else "")
     )
+    head += recordings_lines(info.recordings) + selection_lines(info.selection)
     head.append(f"{'#':>3}  {'name':<7} {'value':>13} {'std %':>9}  kept  expression")
     rows = []
     for k in range(model.base.rank):
@@ -85,6 +86,37 @@ def format_identification(model: IdentifiedModel, *, width: int = 60) -> str:
             f"{'yes' if fit.kept[k] else 'no':<4}  {e}"
         )
     return "\n".join(head + rows)
+
+
+def recordings_lines(recordings: Any) -> list[str]:
+    """One line per recording when there are several or one was cut into pieces."""
+    recs = list(recordings or ())
+    if len(recs) < 2 and all(r.get("pieces", 1) == 1 for r in recs):
+        return []
+    return [
+        f"recording {r['file']}: {r['pieces']} piece(s), {r['samples']} samples used "
+        f"({r['duration_s']:.4g} s)"
+        for r in recs
+    ]
+
+
+def selection_lines(selection: Any) -> list[str]:
+    """The model structures judged on held-out data, the one kept marked ``*``."""
+    if not selection:
+        return []
+    out = [
+        f"model structure chosen on held-out data ({selection['validation']}): "
+        f"{selection['chosen']} ({selection['rule']})",
+        f"    {'structure':<46} {'params':>6} {'train %':>9} {'held-out %':>11} {'+- se':>7}",
+    ]
+    for c in selection["candidates"]:
+        mark = "*" if c["name"] == selection["chosen"] else " "
+        out.append(
+            f"  {mark} {c['name']:<46} {c['n_params']:>6} {c['train_error_percent']:>9.4g} "
+            f"{c['heldout_error_percent']:>11.4g} {c['heldout_se_percent']:>7.2g}"
+        )
+    out += [f"  note: {line}" for line in selection.get("notes", ())]
+    return out
 
 
 def samples_text(log: LogInfo) -> str:
@@ -113,11 +145,10 @@ def columns_text(model: IdentifiedModel) -> str:
 
 def heldout_line(ho: dict[str, Any]) -> str:
     """The training and held-out errors of least squares (``info.heldout``)."""
-    how = (
-        "on the --validate-on log"
-        if ho.get("scheme") == "file"
-        else f"over {ho.get('folds')} contiguous time blocks"
-    )
+    how = {
+        "file": "on the --validate-on log",
+        "recordings": f"leaving out each of {ho.get('folds')} recordings in turn",
+    }.get(str(ho.get("scheme")), f"over {ho.get('folds')} contiguous time blocks")
     return (
         f"least squares: training error {ho['training_error_percent']:.4g} %, held-out "
         f"error {ho['heldout_error_percent']:.4g} % ({how})"

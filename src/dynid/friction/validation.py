@@ -53,7 +53,9 @@ def own_friction(model: TorqueModel) -> FrictionModel | None:
     """The friction that comes with a model: an IdentifiedModel's classical ``friction``,
     a Robot's sigmoid ``friction``, or None."""
     if isinstance(model, IdentifiedModel) and model.friction is not None:
-        law = ClassicalFriction.from_array(model.friction)
+        fr = model.info.friction
+        band = fr.band if fr is not None and fr.band else None
+        law = ClassicalFriction.from_array(model.friction, band)
         if model.drive is not None and model.drive.friction_at == "motor":
             return DriveFriction(law, model.drive)
         return law

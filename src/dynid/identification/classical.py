@@ -76,6 +76,8 @@ from .streaming import BLOCK_ROWS, BlockSource, normals_by_label, streams
 
 __all__ = [
     "PreparedLog",
+    "log_blocks",
+    "still_columns",
     "auto_decimation",
     "friction_labels",
     "friction_regressor",
@@ -411,34 +413,13 @@ class PreparedLog:
 
     def frozen_columns(self, columns: ModelColumns) -> NDArray[np.bool_]:
         """The viscous and Coulomb columns of the joints (motors) that never move."""
-        out = np.zeros(len(columns.labels), dtype=bool)
-        sl = columns.term_slice("friction")
-        if sl is not None and self.still.any():
-            n = self.n
-            out[sl] = np.repeat(self.still, 3) & (np.arange(3 * n) % 3 != 2)
-        return out
+        return still_columns(columns, self.still)
 
     def blocks(self, robot: Robot, columns: ModelColumns) -> Iterator[RegressorBlock]:
-        """One block: rows sample-major (row ``k n + j`` is sample ``k``, joint ``j``, its
-        noise group ``j``); known rotor torques of ``columns.drive`` subtracted."""
+        """One block (:func:`log_blocks`); several when the log is too long to stack."""
         if columns.drive is not self.drive:
             raise OptionError("the log was prepared for another drive than the model's")
-        log = self.log
-        assert log.ddq is not None  # prepare_log always fills ddq
-        N, n = log.n_samples, log.n
-        drive = columns.drive
-        # a log whose regressor exceeds DYNID_MAX_STACK_BYTES comes in blocks of samples
-        step = max(1, BLOCK_ROWS // n) if streams(N * n, len(columns.labels)) else N
-        for a in range(0, N, step):
-            b = slice(a, a + step)
-            q, dq, ddq, tau = log.q[b], log.dq[b], log.ddq[b], log.tau[b]
-            Y, _ = term_regressor(robot, columns.base, columns.terms, q, dq, ddq)
-            if drive is not None and drive.rotor_inertia is not None:  # known: subtracted
-                tau = tau - drive.rotor_torques(ddq, drive.rotor_inertia)
-            m = Y.shape[0]
-            W = Y.reshape(m * n, -1)
-            _checks.finite("regressor", W)
-            yield RegressorBlock(W=W, y=tau.reshape(-1), groups=np.tile(np.arange(n), m))
+        yield from log_blocks(robot, self.log, columns)
 
     def record(self, n_rows: int) -> IdentificationInfo:
         """Filtering, decimation and sample counts."""
@@ -528,6 +509,37 @@ def prepare_torque_log(
         motion_frequency_hz=f_q,
         resampled=not signals.is_uniform(log.t),
     )
+
+
+def log_blocks(
+    robot: Robot, log: TorqueLog, columns: ModelColumns, *, stream: bool | None = None
+) -> Iterator[RegressorBlock]:
+    """The regressor rows of a prepared log over ``columns``: sample-major (row ``k n + j``
+    is sample ``k``, joint ``j``, its noise group ``j``); known rotor torques of
+    ``columns.drive`` subtracted. One block, or blocks of :data:`BLOCK_ROWS` rows when
+    ``stream`` (default: when the regressor exceeds ``DYNID_MAX_STACK_BYTES``)."""
+    assert log.ddq is not None  # prepare_log always fills ddq
+    N, n = log.n_samples, log.n
+    drive = columns.drive
+    if stream is None:
+        stream = streams(N * n, len(columns.labels))
+    step = max(1, BLOCK_ROWS // n) if stream else N
+    for a in range(0, N, step):
+        b = slice(a, a + step)
+        q, dq, ddq, tau = log.q[b], log.dq[b], log.ddq[b], log.tau[b]
+        Y, _ = term_regressor(robot, columns.base, columns.terms, q, dq, ddq)
+        if drive is not None and drive.rotor_inertia is not None:  # known: subtracted
+            tau = tau - drive.rotor_torques(ddq, drive.rotor_inertia)
+        m = Y.shape[0]
+        W = Y.reshape(m * n, -1)
+        _checks.finite("regressor", W)
+        yield RegressorBlock(W=W, y=tau.reshape(-1), groups=np.tile(np.arange(n), m))
+
+
+def still_columns(columns: ModelColumns, still: NDArray[np.bool_]) -> NDArray[np.bool_]:
+    """Columns (c,) that need the motion of a joint (motor) flagged in ``still`` (n,)."""
+    need = columns.motion_columns()
+    return (need >= 0) & np.asarray(still, dtype=bool)[np.maximum(need, 0)]
 
 
 def _still_friction(log: TorqueLog, drive: Drive | None) -> NDArray[np.bool_]:

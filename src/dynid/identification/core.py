@@ -120,12 +120,26 @@ class ModelColumns:
 
     def term_slice(self, name: str) -> slice | None:
         """The columns of the appended term named ``name``, or None."""
+        found = self.appended_term(name)
+        return None if found is None else found[1]
+
+    def appended_term(self, name: str) -> tuple[ModelTerm, slice] | None:
+        """The appended term named ``name`` with its columns, or None."""
         c = self.base.rank
         for t in self.appended:
             if t.name == name:
-                return slice(c, c + len(t.labels))
+                return t, slice(c, c + len(t.labels))
             c += len(t.labels)
         return None
+
+    def motion_columns(self) -> NDArray[np.intp]:
+        """(c,): the joint (motor) whose motion each column needs to be identified, -1 for
+        none (a term's ``needs_motion``; the base parameters need none of their own)."""
+        out = [np.full(self.base.rank, -1, dtype=np.intp)]
+        for t in self.appended:
+            need = getattr(t, "needs_motion", None)
+            out.append(np.full(len(t.labels), -1, np.intp) if need is None else np.asarray(need))
+        return np.concatenate(out)
 
 
 @dataclass(frozen=True, slots=True, eq=False)
@@ -670,13 +684,15 @@ def _record(
     pruned = tuple(labels[k] for k in np.flatnonzero(~np.asarray(fit.kept)))
     if pruned:
         _log.info("pruned %d coefficient(s): %s", len(pruned), pruned)
-    sl = columns.term_slice("friction")
+    found = columns.appended_term("friction")
     friction = None
-    if sl is not None:
+    if found is not None:
+        term, sl = found
         friction = FrictionInfo(
             labels=labels[sl],
             std=tuple(float(x) for x in fit.std[sl]),
             kept=tuple(bool(x) for x in fit.kept[sl]),
+            band=tuple(float(b) for b in getattr(term, "band", ())),
         )
     return dataclasses.replace(
         data.record(stack.n_rows),
@@ -703,8 +719,13 @@ def _model(
 ) -> IdentifiedModel:
     """The identified model: the base parameters' fit, friction and the full fit."""
     r = columns.base.rank
-    sl = columns.term_slice("friction")
-    friction = None if sl is None else np.asarray(fit.beta[sl]).reshape(robot.n, 3)
+    found = columns.appended_term("friction")
+    friction = None
+    if found is not None:
+        term, sl = found
+        as_array = getattr(term, "as_array", None)
+        beta = np.asarray(fit.beta[sl])
+        friction = beta.reshape(robot.n, 3) if as_array is None else as_array(beta)
     appended = bool(columns.appended)
     return IdentifiedModel(
         robot=robot,

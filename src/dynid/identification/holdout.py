@@ -190,7 +190,8 @@ class HeldOut:
     whole : Normals
         All of the identification data (the final fit's).
     scheme : str
-        ``"blocks"`` (k-fold over contiguous time blocks) or ``"file"`` (a separate log).
+        ``"blocks"`` (k-fold over contiguous time blocks), ``"recordings"`` (one recording
+        left out at a time) or ``"file"`` (a separate log).
     noise : float
         Residual standard deviation of least squares on all data, ``sqrt(SSE / (m - p))``
         (scales a fold's data term).
@@ -258,6 +259,8 @@ class HeldOut:
         """How the data were held out, for a summary."""
         if self.scheme == "file":
             return "a separate log"
+        if self.scheme == "recordings":
+            return f"{self.folds} recordings, each left out in turn"
         return f"{self.folds} contiguous time blocks (k-fold)"
 
 

@@ -98,11 +98,15 @@ class FrictionInfo:
         Their standard deviations (units of each parameter).
     kept : tuple of bool
         False for columns left out (a joint that never moves) or pruned.
+    band : tuple of float
+        Standstill band [rad/s] per joint (motor) of the Coulomb columns: ``sign(dq)`` is 0
+        inside it; empty for the plain ``sign``.
     """
 
     labels: tuple[str, ...]
     std: tuple[float, ...]
     kept: tuple[bool, ...]
+    band: tuple[float, ...] = ()
 
 
 @dataclass(frozen=True, slots=True)
@@ -147,6 +151,12 @@ class IdentificationInfo:
     column_map : mapping, optional
         ``{"columns": ..., "units": ...}``: how the data file's columns were read
         (``--columns``/``--units``), so that validation reads a log the same way.
+    selection : mapping, optional
+        The model structure chosen on held-out data
+        (:mod:`dynid.identification.structure`): ``rule``, ``validation``, ``chosen`` and
+        every ``candidates`` entry with its parameters, training and held-out errors.
+    recordings : tuple of mapping
+        Torque logs: each recording read (``file``, ``pieces``, ``samples``, ``duration_s``).
     notes : tuple of str
         Remarks for the reader (one sentence each).
     extra : mapping
@@ -173,3 +183,5 @@ class IdentificationInfo:
     column_map: Mapping[str, str | None] | None = None
     notes: tuple[str, ...] = ()
     extra: Mapping[str, Any] = field(default_factory=dict)
+    selection: Mapping[str, Any] | None = None
+    recordings: tuple[Mapping[str, Any], ...] = ()

@@ -120,6 +120,11 @@ class TorqueLog:
         Joint accelerations [rad/s^2] when measured or already computed.
     cleaning : LogCleaning
         What cleaning found (all zeros for a log built directly).
+    dq_derived : bool
+        True when ``dq`` was derived from ``q`` (a log that records positions only,
+        :func:`with_derived_velocities`): identification derives it again at its own
+        cut-off (:func:`~dynid.identification.classical.prepare_torque_log`), never at a
+        reader's default.
 
     Raises
     ------
@@ -137,6 +142,7 @@ class TorqueLog:
     tau: NDArray[np.float64]
     ddq: NDArray[np.float64] | None = None
     cleaning: LogCleaning = field(default_factory=LogCleaning)
+    dq_derived: bool = False
 
     def __post_init__(self) -> None:
         t = _checks.as_array("t", self.t)
@@ -190,7 +196,13 @@ class TorqueLog:
         r = np.asarray(rows)
         pick = lambda x: None if x is None else x[r]  # noqa: E731
         return TorqueLog(
-            self.t[r], self.q[r], self.dq[r], self.tau[r], pick(self.ddq), self.cleaning
+            self.t[r],
+            self.q[r],
+            self.dq[r],
+            self.tau[r],
+            pick(self.ddq),
+            self.cleaning,
+            self.dq_derived,
         )
 
     @classmethod
@@ -299,14 +311,15 @@ def with_derived_velocities(log: TorqueLog, cutoff_hz: float = DEFAULT_CUTOFF_HZ
     (:func:`dynid.signals.filtered_derivative`, low-pass at ``cutoff_hz`` [Hz]); for logs that
     record positions only (whatever ``log.dq`` holds is replaced). ``ddq`` is kept."""
     dq = signals.filtered_derivative(log.t, log.q, cutoff_hz)
-    return TorqueLog(log.t, log.q, dq, log.tau, log.ddq, log.cleaning)
+    return TorqueLog(log.t, log.q, dq, log.tau, log.ddq, log.cleaning, dq_derived=True)
 
 
 def velocity_note(cutoff_hz: float) -> str:
     """The note said when :func:`with_derived_velocities` derives a log's velocities."""
     return (
-        "no velocity columns: velocities derived from the positions (zero-phase low-pass at "
-        f"{cutoff_hz:g} Hz, then central differences)"
+        "no velocity columns: velocities derived from the positions (zero-phase low-pass, "
+        "then central differences) at the cut-off of the step that prepares the log "
+        f"(identification, validation, friction; {cutoff_hz:g} Hz when read alone)"
     )
 
 
@@ -346,6 +359,7 @@ def _mapped(log: TorqueLog, drive: Drive, states: Any, efforts: Any) -> TorqueLo
         tau=efforts(log.tau),
         ddq=mapped[1] if log.ddq is not None else None,
         cleaning=log.cleaning,
+        dq_derived=log.dq_derived,
     )
 
 
@@ -371,7 +385,9 @@ def prepare_log(
        has it) with the zero-phase Butterworth (order 4 applied twice); ``tau`` only if
        ``filter_tau``.
     3. If the log has no ``ddq``: ``ddq`` = derivative of the (filtered) ``dq``
-       (second-order differences).
+       (second-order differences). A log whose ``dq`` was derived from ``q``
+       (``log.dq_derived``) gets it derived again at ``cutoff_hz`` first, so that
+       velocities, accelerations, positions and torques share one cut-off.
     4. Drop ``trim_s`` seconds at each end (default ``2 / cutoff_hz`` when filtering,
        else 0).
     5. Keep every ``decimate``-th sample of what is left.
@@ -436,6 +452,8 @@ def prepare_log(
             tu, data[name] = signals.resample_uniform(t, data[name], rate)
         t = tu
     cutoff_hz = _usable_cutoff(cutoff_hz, rate, log.n_samples)
+    if log.dq_derived and cutoff_hz is not None:  # positions only: dq at this cut-off
+        data["dq"] = signals.filtered_derivative(t, data["q"], cutoff_hz)
     if trim_s is None:
         trim_s = signals.edge_seconds(cutoff_hz) if cutoff_hz is not None else 0.0
     keep = signals.trim_edges(t, trim_s)

@@ -208,12 +208,18 @@ def info_to_dict(info: IdentificationInfo, drive: Drive | None = None) -> dict[s
         out["friction_labels"] = list(info.friction.labels)
         out["friction_std"] = list(info.friction.std)
         out["friction_kept"] = list(info.friction.kept)
+        if info.friction.band:
+            out["friction_band"] = list(info.friction.band)
     if info.heldout is not None:
         out["heldout"] = dict(info.heldout)
     if info.column_map is not None:
         out["column_map"] = dict(info.column_map)
     if info.notes:
         out["notes"] = list(info.notes)
+    if info.selection is not None:
+        out["selection"] = dict(info.selection)
+    if info.recordings:
+        out["recordings"] = [dict(r) for r in info.recordings]
     if drive is not None:
         out["drive"] = drive.as_dict()
     return _jsonable(out)
@@ -261,6 +267,8 @@ def info_from_dict(meta: Mapping[str, Any]) -> IdentificationInfo:
             heldout=None if m.get("heldout") is None else dict(m.pop("heldout")),
             column_map=None if m.get("column_map") is None else dict(m.pop("column_map")),
             notes=tuple(str(x) for x in m.pop("notes", ())),
+            selection=None if m.get("selection") is None else dict(m.pop("selection")),
+            recordings=tuple(dict(r) for r in m.pop("recordings", ())),
             extra={k: v for k, v in m.items() if k not in _DERIVED_KEYS},
         )
     except (TypeError, ValueError, IndexError) as exc:
@@ -283,6 +291,7 @@ def _route_parts(
             labels=tuple(str(x) for x in m.pop("friction_labels")),
             std=tuple(_float(x, "metadata.friction_std") for x in m.pop("friction_std", ())),
             kept=tuple(bool(x) for x in m.pop("friction_kept", ())),
+            band=tuple(_float(x, "metadata.friction_band") for x in m.pop("friction_band", ())),
         )
     return static, log, friction
 

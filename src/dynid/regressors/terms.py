@@ -32,9 +32,11 @@ from typing import Protocol
 import numpy as np
 from numpy.typing import NDArray
 
+from ..exceptions import OptionError
 from ..model.drive import Drive
 
 __all__ = [
+    "FRICTION_PARTS",
     "LinearFriction",
     "ModelTerm",
     "RotorInertia",
@@ -126,41 +128,89 @@ class RotorInertia:
         return C
 
 
+#: The parts of :class:`LinearFriction`, in column order: viscous ``fv dq``, Coulomb
+#: ``fc sign(dq)`` (0 inside the standstill band) and the offset ``fo``.
+FRICTION_PARTS = ("viscous", "coulomb", "offset")
+_PART_LABEL = {"viscous": "fv", "coulomb": "fc", "offset": "fo"}
+_PART_UNIT = {"viscous": "N m s/rad", "coulomb": "N m", "offset": "N m"}
+
+
 @dataclass(frozen=True, slots=True, eq=False)
 class LinearFriction:
-    """Viscous, Coulomb and offset friction where the drive says (motors or joints)."""
+    """Viscous, Coulomb and offset friction where the drive says (motors or joints).
+
+    Attributes
+    ----------
+    drive : Drive
+        Where the friction acts (its motors, or the joints with ``friction_at="joint"``).
+    parts : tuple of str
+        Which of :data:`FRICTION_PARTS` the term holds (default all three, eq. 24).
+    band : tuple of float
+        Standstill band [rad/s] per motor (joint): ``sign(v)`` is 0 where ``|v|`` is inside
+        it, so that the sign of velocity noise at rest does not switch Coulomb friction on;
+        empty for none (the plain ``sign``).
+    """
 
     drive: Drive
+    parts: tuple[str, ...] = FRICTION_PARTS
+    band: tuple[float, ...] = ()
     name: str = "friction"
     in_base: bool = False
 
+    def __post_init__(self) -> None:
+        if not self.parts or any(p not in FRICTION_PARTS for p in self.parts):
+            raise OptionError(f"friction parts must be among {FRICTION_PARTS}; got {self.parts}")
+        if self.band and len(self.band) != self.drive.n:
+            raise OptionError(f"band must have {self.drive.n} entries; got {len(self.band)}")
+        order = tuple(p for p in FRICTION_PARTS if p in self.parts)
+        object.__setattr__(self, "parts", order)
+
     @property
     def labels(self) -> tuple[str, ...]:
-        """``fv1, fc1, fo1, fv2, ...``."""
-        return friction_labels(self.drive.n)
+        """``fv1, fc1, fo1, fv2, ...`` (the parts held, per joint or motor)."""
+        return tuple(f"{_PART_LABEL[p]}{j + 1}" for j in range(self.drive.n) for p in self.parts)
 
     @property
     def units(self) -> tuple[str, ...]:
-        """N m s/rad, N m, N m per joint (motor)."""
-        return ("N m s/rad", "N m", "N m") * self.drive.n
+        """N m s/rad, N m, N m per joint (motor), for the parts held."""
+        return tuple(_PART_UNIT[p] for p in self.parts) * self.drive.n
 
     @property
     def nonnegative(self) -> NDArray[np.bool_]:
         """``fv, fc >= 0``; the offset ``fo`` has either sign."""
-        return np.tile([True, True, False], self.drive.n)
+        return np.tile([p != "offset" for p in self.parts], self.drive.n)
+
+    @property
+    def needs_motion(self) -> NDArray[np.intp]:
+        """(p,): the motor (joint) whose motion each column needs, -1 for none (the offset)."""
+        k = len(self.parts)
+        j = np.repeat(np.arange(self.drive.n), k)
+        return np.where(np.tile([p != "offset" for p in self.parts], self.drive.n), j, -1)
+
+    def as_array(self, params: NDArray[np.float64]) -> NDArray[np.float64]:
+        """The parameters (p,) as ``(n, 3)`` columns ``fv, fc, fo`` (0 for parts not held)."""
+        n, k = self.drive.n, len(self.parts)
+        out = np.zeros((n, 3))
+        out[:, [FRICTION_PARTS.index(p) for p in self.parts]] = np.reshape(params, (n, k))
+        return out
 
     def torque_columns(
         self, q: NDArray[np.float64], dq: NDArray[np.float64], ddq: NDArray[np.float64]
     ) -> NDArray[np.float64]:
-        """(B, n, 3 n): motor ``m``'s ``(v, sign v, 1)`` with ``v = (K dq)_m``, mapped by
-        ``K^T`` onto the joints (``K = 1`` at the joints)."""
+        """(B, n, k n): motor ``m``'s ``(v, sign v, 1)`` (the parts held) with
+        ``v = (K dq)_m``, mapped by ``K^T`` onto the joints (``K = 1`` at the joints)."""
         v = self.drive.motor_velocities(dq)
-        n = v.shape[-1]
-        F = np.zeros(v.shape + (3 * n,))
+        n, k = v.shape[-1], len(self.parts)
+        F = np.zeros(v.shape + (k * n,))
         m = np.arange(n)
-        F[..., m, 3 * m] = v
-        F[..., m, 3 * m + 1] = np.sign(v)
-        F[..., m, 3 * m + 2] = 1.0
+        band = np.asarray(self.band, dtype=np.float64) if self.band else np.zeros(n)
+        cols = {
+            "viscous": v,
+            "coulomb": np.where(np.abs(v) > band, np.sign(v), 0.0),
+            "offset": np.ones_like(v),
+        }
+        for i, p in enumerate(self.parts):
+            F[..., m, k * m + i] = cols[p]
         if self.drive.friction_at == "joint":
             return F
         return np.einsum("mj,...mc->...jc", self.drive.transmission, F)

@@ -16,18 +16,19 @@ from __future__ import annotations
 
 import dataclasses
 import warnings
+from collections.abc import Sequence
 from pathlib import Path
-from typing import Any
+from typing import Any, Literal
 
 from ..exceptions import DataError, DynidWarning
 from ..feasibility.one_step import identify_consistent
 from ..feasibility.sdp import ConsistentResult, SDPOptions
-from ..identification.classical import identify_from_log
 from ..identification.consistency import fit_mismatch, limit_violations
 from ..identification.estimators import EstimatorName
 from ..identification.least_squares import StdMethod
 from ..identification.model import IdentifiedModel
 from ..identification.static import identify_static
+from ..identification.structure import Structure, identify_recordings
 from ..model.drive import Drive
 from ..model.robot import Robot
 from .data_files import (
@@ -39,7 +40,7 @@ from .data_files import (
     read_torque_log,
 )
 
-__all__ = ["ColumnSpec", "identify_consistent_file", "identify_file"]
+__all__ = ["ColumnSpec", "data_files", "identify_consistent_file", "identify_file"]
 
 
 def _columns(spec: ColumnSpec | None, cutoff_hz: float | None) -> Any:
@@ -77,10 +78,45 @@ def _record(model: IdentifiedModel, spec: ColumnSpec | None) -> IdentifiedModel:
     return dataclasses.replace(model, info=info)
 
 
+def data_files(paths: str | Path | Sequence[str | Path]) -> list[Path]:
+    """The data files of ``--data``: the paths given, a folder standing for its ``.csv``
+    and ``.npz`` files in name order.
+
+    Raises
+    ------
+    DataError
+        No path, a folder without data files, or a file named twice.
+    """
+    given = [paths] if isinstance(paths, str | Path) else list(paths)
+    out: list[Path] = []
+    for p in map(Path, given):
+        if p.is_dir():
+            found = sorted(f for f in p.iterdir() if f.suffix.lower() in (".csv", ".npz"))
+            if not found:
+                raise DataError(f"{p.name}: the folder holds no .csv or .npz data file")
+            out += found
+        else:
+            out.append(p)
+    if not out:
+        raise DataError("no data file given")
+    twice = sorted({p.name for p in out if out.count(p) > 1})
+    if twice:
+        raise DataError(f"{', '.join(twice)}: data file given twice")
+    return out
+
+
+def _terms(terms: str | Structure | None) -> Structure | Literal["auto"]:
+    """``--terms``: ``"auto"``/None (chosen on held-out data) or the terms named."""
+    if terms is None or terms == "auto":
+        return "auto"
+    return terms if isinstance(terms, Structure) else Structure.parse(terms)
+
+
 def identify_file(
     robot: Robot,
-    path: str | Path,
+    path: str | Path | Sequence[str | Path],
     *,
+    terms: str | Structure | None = None,
     columns: ColumnSpec | None = None,
     drop_invalid: bool = False,
     max_std_percent: float | None = None,
@@ -99,8 +135,13 @@ def identify_file(
     ----------
     robot : Robot
         The robot the data belong to.
-    path : str or Path
-        Static data (``q, M, g``) or a torque log, ``.csv`` or ``.npz``.
+    path : str, Path or a sequence of them
+        Static data (``q, M, g``), or one or more torque logs (a folder: its ``.csv``
+        and ``.npz`` files), each ``.csv`` or ``.npz``.
+    terms : str or Structure, optional
+        Torque logs: the model's terms beside the links (``"armature,viscous"``,
+        :class:`~dynid.identification.structure.Structure`); default ``"auto"``: chosen on
+        held-out data (:mod:`dynid.identification.structure`).
     columns : (str or None, str or None), optional
         ``--columns`` and ``--units`` of a file of another tool (recorded in the model).
     drop_invalid : bool
@@ -114,7 +155,8 @@ def identify_file(
         :mod:`dynid.identification.rate`); also the
         cutoff of velocities derived from positions through ``columns``.
     max_gap_s : float, optional
-        Torque logs: longest gap bridged by interpolation [s].
+        Torque logs: longest gap bridged by interpolation [s]; a longer one cuts the log
+        into pieces prepared on their own.
     folds : int, optional
         Torque logs: contiguous time blocks of the held-out judgement (``--folds``).
     validate_on : str or Path, optional
@@ -130,34 +172,35 @@ def identify_file(
         A bad file, data of another robot or joint count, invalid rows without
         ``drop_invalid``; ``folds`` or ``validate_on`` with static data.
     """
-    path = Path(path)
+    paths = data_files(path)
+    path = paths[0]
     cmap = _columns(columns, cutoff_hz)
     kind = data_kind(path, cmap)
     heldout = _heldout(path, kind, folds, validate_on, robot.n, cmap, drop_invalid)
     if kind == "torque_log":
-        log = read_torque_log(
-            path,
-            robot.n,
-            columns=cmap,
-            drop_invalid=drop_invalid,
-            owner=f"robot {robot.name!r}",
+        logs = [
+            read_torque_log(
+                p, robot.n, columns=cmap, drop_invalid=drop_invalid, owner=f"robot {robot.name!r}"
+            )
+            for p in paths
+        ]
+        fit = lambda: identify_recordings(  # noqa: E731
+            robot,
+            logs,
+            [p.name for p in paths],
+            structure=_terms(terms),
+            max_std_percent=max_std_percent,
+            rtol=rtol,
+            max_gap_s=max_gap_s,
+            drive=drive,
+            estimator=estimator,
+            std=std or "classical",
+            cutoff_hz="auto" if cutoff_hz is None else cutoff_hz,
+            **heldout,
         )
-        model = in_file(
-            path,
-            lambda: identify_from_log(
-                robot,
-                log,
-                max_std_percent=max_std_percent,
-                rtol=rtol,
-                max_gap_s=max_gap_s,
-                drive=drive,
-                estimator=estimator,
-                std=std or "classical",
-                cutoff_hz="auto" if cutoff_hz is None else cutoff_hz,
-                **heldout,
-            ),
-        )
+        model = in_file(path, fit) if len(paths) == 1 else fit()
     else:
+        _one_static_file(paths, terms)
         data = read_static_file(path, robot, columns=cmap, drop_invalid=drop_invalid)
         outside = limit_violations(robot, data.q)
         if outside is not None:
@@ -178,6 +221,16 @@ def identify_file(
         if misfit is not None:
             warnings.warn(f"{path.name}: {misfit}", DynidWarning, stacklevel=2)
     return _record(model, columns)
+
+
+def _one_static_file(paths: list[Path], terms: object) -> None:
+    """Static data come in one file, and have no terms to choose."""
+    if len(paths) > 1:
+        raise DataError(
+            f"{paths[0].name} holds static data: give one static data file ({len(paths)} given)"
+        )
+    if terms is not None and terms != "auto":
+        raise DataError(f"{paths[0].name}: --terms applies to torque logs, not static data")
 
 
 def identify_consistent_file(
