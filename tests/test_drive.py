@@ -159,7 +159,7 @@ def test_without_the_coupling_the_fit_is_worse():
         ({"gear": [1, 2, 3]}, "unknown key 'gear'"),
         ({"offset": [0, True, 0]}, "must be a number"),
         ({"rotor_inertia": [0.1, -0.1, 0.0]}, "rotor_inertia must be >= 0"),
-        ({"rotor_inertia": "fit"}, "'identify' or a list"),
+        ({"rotor_inertia": "fit"}, "'identify', a number or a list"),
         ({"schema": "dynid-drive/9"}, "schema"),
     ],
 )
@@ -508,4 +508,32 @@ def test_geared_coupled_arm_base_is_complete_for_every_gear_ratio(ratio, ia):
     np.testing.assert_array_equal(m.base.independent, ref.independent)
     h = dynid.identification.log.joint_side_log(held, drive)
     tau_hat = m.torques(h.q, h.dq, h.ddq) + dynid.friction.validation.own_friction(m).torques(h.dq)
+    assert np.linalg.norm(tau_hat - tau_held) / np.linalg.norm(tau_held) < 1e-6
+
+
+def test_gear_ratio_1_in_a_drive_file_identifies_a_joint_side_armature(tmp_path):
+    """``gear_ratio = 1`` (the documented default, one number for every joint) with
+    ``rotor_inertia = "identify"``: a direct drive whose rotor term is a joint-side
+    armature ``I_a ddq``; on an exact joint-side UR5 log with armature and friction
+    (Pinocchio's RNEA plus both, written out), held-out torques to 1e-6 relative."""
+    f = tmp_path / "armature.toml"
+    f.write_text('schema = "dynid-drive/1"\ngear_ratio = 1\nrotor_inertia = "identify"\n')
+    drive = load_drive(f, 6)
+    np.testing.assert_array_equal(drive.transmission, np.eye(6))
+    assert drive.identifies_rotor_inertia and drive.friction_at == "joint"
+    np.testing.assert_array_equal(Drive.from_gears(1, n=6).transmission, np.eye(6))
+    robot, model, data = _ur5()
+    armature = np.array([0.3, 0.3, 0.2, 0.05, 0.05, 0.04])  # [kg m^2]
+
+    def log(seed: int) -> tuple[TorqueLog, np.ndarray]:
+        _, q, dq, ddq = _trajectory(6, seed, duration=4.0)
+        tau = np.array([pin.rnea(model, data, *s) for s in zip(q, dq, ddq, strict=True)])
+        tau += armature * ddq + 2.0 * dq + 3.0 * np.sign(dq)
+        return TorqueLog(np.arange(q.shape[0]) / 250.0, q, dq, tau, ddq), tau
+
+    (train, _), (held, tau_held) = log(1), log(2)
+    m = identify_from_log(robot, train, cutoff_hz=None, decimate=1, drive=drive)
+    assert "Ia6" in m.base.std_labels
+    tau_hat = m.torques(held.q, held.dq, held.ddq)
+    tau_hat = tau_hat + dynid.friction.validation.own_friction(m).torques(held.dq)
     assert np.linalg.norm(tau_hat - tau_held) / np.linalg.norm(tau_held) < 1e-6
