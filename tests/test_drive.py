@@ -19,6 +19,7 @@ from dynid.identification.classical import identify_from_log
 from dynid.identification.log import TorqueLog
 from dynid.io.drive_file import drive_from_mapping, load_drive
 from dynid.model.drive import Drive
+from dynid.regressors.terms import RotorInertia
 
 from conftest import robot_data_urdf
 
@@ -158,7 +159,7 @@ def test_without_the_coupling_the_fit_is_worse():
         ({"gear": [1, 2, 3]}, "unknown key 'gear'"),
         ({"offset": [0, True, 0]}, "must be a number"),
         ({"rotor_inertia": [0.1, -0.1, 0.0]}, "rotor_inertia must be >= 0"),
-        ({"rotor_inertia": "fit"}, "'identify' or a list"),
+        ({"rotor_inertia": "fit"}, "'identify', a number or a list"),
         ({"schema": "dynid-drive/9"}, "schema"),
     ],
 )
@@ -473,3 +474,66 @@ def test_urdf_export_writes_identified_friction_as_dynamics(tmp_path):
     assert len(dyn) == 6
     np.testing.assert_allclose([float(d.get("damping")) for d in dyn], GEAR**2 * FV, rtol=1e-14)
     np.testing.assert_allclose([float(d.get("friction")) for d in dyn], GEAR * FC, rtol=1e-14)
+
+
+@pytest.mark.parametrize(
+    ("ratio", "ia"),
+    [(1.0, 1e-2), (10.0, 1e-3), (50.0, 1e-4), (100.0, 3e-5), (150.0, 1e-5), (200.0, 1e-7)],
+)
+def test_geared_coupled_arm_base_is_complete_for_every_gear_ratio(ratio, ia):
+    """Gear ratios ``ratio * (1, 1, 1, 0.8, 0.8, 0.5)``, motor 6 on joint 5 too, rotor
+    inertias ``ia`` identified, friction at the motors, exact motor-side log: the base is
+    the structural one of ratio 1 (rotor columns 1 to 40,000 times larger do not push the
+    link columns below the rank cut) and held-out joint torques (Pinocchio's RNEA plus the
+    drive terms) are predicted to 1e-6 relative."""
+    robot, model, data = _ur5()
+    gear = ratio * np.array([1.0, 1.0, 1.0, 0.8, 0.8, 0.5])
+    drive = Drive.from_gears(gear, [(6, 5, 0.3 * ratio)], side="motor")
+    K = drive.transmission
+    rotor = ia * np.linspace(1.5, 0.5, 6)
+
+    def log(seed: int) -> tuple[TorqueLog, np.ndarray]:
+        _, q, dq, ddq = _trajectory(6, seed, duration=4.0)
+        tau = np.array([pin.rnea(model, data, *s) for s in zip(q, dq, ddq, strict=True)])
+        dqm, ddqm = dq @ K.T, ddq @ K.T
+        tau += (rotor * ddqm) @ K + (FV * dqm + FC * np.sign(dqm) + FO) @ K
+        t = np.arange(q.shape[0]) / 250.0
+        return TorqueLog(t, q @ K.T, dqm, np.linalg.solve(K.T, tau.T).T, ddqm), tau
+
+    (train, _), (held, tau_held) = log(1), log(2)
+    m = identify_from_log(robot, train, cutoff_hz=None, decimate=1, drive=drive)
+    one = Drive.from_gears(np.ones(6), [(6, 5, 0.6)], side="motor")
+    ref = dynid.base_parameters(robot, kind="torque", terms=(RotorInertia(one),))
+    assert m.base.rank == ref.rank == 40
+    np.testing.assert_array_equal(m.base.independent, ref.independent)
+    h = dynid.identification.log.joint_side_log(held, drive)
+    tau_hat = m.torques(h.q, h.dq, h.ddq) + dynid.friction.validation.own_friction(m).torques(h.dq)
+    assert np.linalg.norm(tau_hat - tau_held) / np.linalg.norm(tau_held) < 1e-6
+
+
+def test_gear_ratio_1_in_a_drive_file_identifies_a_joint_side_armature(tmp_path):
+    """``gear_ratio = 1`` (the documented default, one number for every joint) with
+    ``rotor_inertia = "identify"``: a direct drive whose rotor term is a joint-side
+    armature ``I_a ddq``; on an exact joint-side UR5 log with armature and friction
+    (Pinocchio's RNEA plus both, written out), held-out torques to 1e-6 relative."""
+    f = tmp_path / "armature.toml"
+    f.write_text('schema = "dynid-drive/1"\ngear_ratio = 1\nrotor_inertia = "identify"\n')
+    drive = load_drive(f, 6)
+    np.testing.assert_array_equal(drive.transmission, np.eye(6))
+    assert drive.identifies_rotor_inertia and drive.friction_at == "joint"
+    np.testing.assert_array_equal(Drive.from_gears(1, n=6).transmission, np.eye(6))
+    robot, model, data = _ur5()
+    armature = np.array([0.3, 0.3, 0.2, 0.05, 0.05, 0.04])  # [kg m^2]
+
+    def log(seed: int) -> tuple[TorqueLog, np.ndarray]:
+        _, q, dq, ddq = _trajectory(6, seed, duration=4.0)
+        tau = np.array([pin.rnea(model, data, *s) for s in zip(q, dq, ddq, strict=True)])
+        tau += armature * ddq + 2.0 * dq + 3.0 * np.sign(dq)
+        return TorqueLog(np.arange(q.shape[0]) / 250.0, q, dq, tau, ddq), tau
+
+    (train, _), (held, tau_held) = log(1), log(2)
+    m = identify_from_log(robot, train, cutoff_hz=None, decimate=1, drive=drive)
+    assert "Ia6" in m.base.std_labels
+    tau_hat = m.torques(held.q, held.dq, held.ddq)
+    tau_hat = tau_hat + dynid.friction.validation.own_friction(m).torques(held.dq)
+    assert np.linalg.norm(tau_hat - tau_held) / np.linalg.norm(tau_held) < 1e-6

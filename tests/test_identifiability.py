@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import re
 import warnings
 
 import numpy as np
@@ -254,3 +255,66 @@ def test_example_robot_data_arms_identify_from_static_data(rel, base, tip, noise
     assert np.abs(model.gravity_torques(q) - g).max() < bound * np.abs(g).max()
     assert np.abs(model.torques(q, dq, ddq) - tau).max() < bound * np.abs(tau).max()
     assert model.base.gap[0] > 1e-2 and model.base.gap[1] < 1e-10
+
+
+def test_reading_a_rounded_urdf_names_the_joints_and_the_unscaled_condition_numbers():
+    """rpy 3.1416 and 1.5708 on joints 2 and 3: one warning with the word "rounded", the
+    two joints (not the 60-degree ones) and the unscaled condition numbers of the
+    structural regressor, far larger as written than snapped; snap_angles=True reads them
+    as pi and pi/2 exactly (the poses of the exact file) and says nothing."""
+    with pytest.warns(DynidWarning, match="rounded") as caught:
+        robot_from_urdf_string(rounded_arm_urdf(), "base", "l6")
+    msgs = [str(w.message) for w in caught if "rounded" in str(w.message)]
+    assert len(msgs) == 1
+    msg = msgs[0]
+    assert "j2 (7.3e-06 rad off)" in msg and "j3 (3.7e-06 rad off)" in msg
+    assert "j5" not in msg and "--snap-angles" in msg
+    written, snapped = (float(x) for x in re.findall(r"number is (\S+) as written, (\S+)", msg)[0])
+    assert written > 1e6 and snapped < 100
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", DynidWarning)
+        snap = robot_from_urdf_string(rounded_arm_urdf(), "base", "l6", snap_angles=True)
+        exact = robot_from_urdf_string(rounded_arm_urdf(exact=True), "base", "l6")
+    np.testing.assert_array_equal(snap.T_parent_joint[:4], exact.T_parent_joint[:4])
+
+
+def test_cli_snap_angles_reads_a_rounded_urdf_exactly_and_is_refused_elsewhere(tmp_path, capsys):
+    """--snap-angles: fk of the rounded file equals fk of the exact one; with the Panda it
+    is refused in one line (exit 2)."""
+    rounded, exact = tmp_path / "rounded6.urdf", tmp_path / "exact6.urdf"
+    rounded.write_text(rounded_arm_urdf())
+    exact.write_text(rounded_arm_urdf(exact=True))
+    q = "0.1,0.2,0.3"  # the chain to l3: joints 5 and 6 (60 degrees, not snapped) left out
+    chain = ["--base", "base", "--tip", "l3", "--q", q, "--json"]
+    assert main(["fk", "--robot", str(rounded), "--snap-angles", *chain]) == 0
+    snapped = capsys.readouterr().out
+    assert main(["fk", "--robot", str(exact), *chain]) == 0
+    assert snapped == capsys.readouterr().out
+    assert main(["fk", "--robot", "panda", "--snap-angles", "--q", "0,0,0,0,0,0,0"]) == 2
+    err = capsys.readouterr().err
+    assert "--snap-angles applies to a URDF --robot" in err and len(err.strip().splitlines()) == 1
+
+
+def test_identify_help_says_when_a_ddq_column_is_used(capsys):
+    """identify --help: accelerations from ddq columns are used as given, else derived."""
+    try:
+        code = main(["identify", "--help"])
+    except SystemExit as exc:  # argparse's own exit
+        code = exc.code
+    assert code == 0
+    out = " ".join(capsys.readouterr().out.split())
+    assert "complete ddq1..ddqn set" in out and "used as given" in out
+    assert "derivative of the filtered velocities" in out and "--snap-angles" in out
+
+
+def test_a_harmless_rounding_is_logged_not_warned(caplog):
+    """example-robot-data's xArm7 writes its right angles 3.7e-6 rad off, without
+    near-dependencies (the same condition number snapped): an INFO line, no warning."""
+    import logging
+
+    path = robot_data_urdf("xarm_description/urdf/xarm7.urdf")
+    with caplog.at_level(logging.INFO, logger="dynid"), warnings.catch_warnings():
+        warnings.simplefilter("error", DynidWarning)
+        dynid.Robot.from_urdf(path)
+    text = " ".join(r.getMessage() for r in caplog.records)
+    assert "rounded" in text and "joint2 (3.7e-06 rad off)" in text and "harmless" in text

@@ -76,3 +76,44 @@ def test_a_frozen_joint_gets_no_friction_fitted_from_noise():
     assert not kept[3, 0] and not kept[3, 1] and kept[3, 2]
     np.testing.assert_array_equal(m.friction[3, :2], 0.0)
     assert kept[[0, 1, 2, 4, 5, 6], :2].all()
+
+
+def _turning_log(robot: dynid.Robot, seed: int) -> TorqueLog:
+    """Joints 1, 3, 5 and 7 turn at 1.5 rad/s (unwrapped, 15 rad over the log), with the
+    other joints' Fourier motion; simulated measurement of the Panda's torques."""
+    t = sample_times(10.0, 250.0)
+    traj = random_fourier(dynid.panda(), np.random.default_rng(seed))(t)
+    turning = np.isin(np.arange(7), [0, 2, 4, 6])
+    q = np.where(turning, -7.5 + 1.5 * t[:, None], traj.q)
+    dq = np.where(turning, 1.5, traj.dq)
+    ddq = np.where(turning, 0.0, traj.ddq)
+    moved = type(traj)(t=traj.t, q=q, dq=dq, ddq=ddq)
+    return simulate_measurement(robot, moved, rng=np.random.default_rng(seed + 1))
+
+
+def _continuous_panda() -> dynid.Robot:
+    """The Panda with joints 1, 3, 5 and 7 continuous (no position limits)."""
+    import dataclasses
+
+    robot = dynid.panda()
+    free = np.isin(np.arange(7), [0, 2, 4, 6])
+    return dataclasses.replace(
+        robot,
+        q_min=np.where(free, -np.inf, robot.q_min),
+        q_max=np.where(free, np.inf, robot.q_max),
+    )
+
+
+def test_unwrapped_continuous_joints_are_not_taken_for_degrees():
+    """Four continuous joints turning over 15 rad, with velocities that agree with the
+    derivative of the positions at 1.5 rad/s: radians, no degrees finding; the same
+    positions with radian velocities 57.3 times smaller than their derivative: degrees."""
+    robot = _continuous_panda()
+    log = _turning_log(robot, 6)
+    assert not any("degrees" in f for f in check_torque_log(robot, log))
+    deg = TorqueLog(log.t, np.degrees(log.q), log.dq, log.tau)
+    found = [f for f in check_torque_log(robot, deg) if "degrees" in f]
+    assert len(found) == 1 and "--units q=deg;" not in found[0] and "57.3 times" in found[0]
+    both = TorqueLog(log.t, np.degrees(log.q), np.degrees(log.dq), log.tau)
+    found = [f for f in check_torque_log(robot, both) if "degrees" in f]
+    assert len(found) == 1 and "--units q=deg,dq=deg/s" in found[0]

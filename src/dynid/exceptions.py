@@ -62,6 +62,9 @@ class RankDeficientError(DynidError, ValueError):
     dependent : tuple of str
         Labels of the nearly dependent columns (the null direction's large entries,
         largest first); empty when not known.
+    combinations : tuple of str
+        Every combination of the columns the data do not excite (``needed - rank`` of
+        them, ``"beta40 - 0.31*fc6"``); empty when not known.
     """
 
     def __init__(
@@ -71,11 +74,13 @@ class RankDeficientError(DynidError, ValueError):
         rank: int | None = None,
         needed: int | None = None,
         dependent: tuple[str, ...] = (),
+        combinations: tuple[str, ...] = (),
     ) -> None:
         super().__init__(message)
         self.rank = rank
         self.needed = needed
         self.dependent = tuple(dependent)
+        self.combinations = tuple(combinations)
 
 
 class InfeasibleError(DynidError, ValueError):

@@ -15,7 +15,7 @@ from typing import Any
 import numpy as np
 
 from .. import _checks, spatial
-from ..exceptions import DataError, DynidError, ShapeError
+from ..exceptions import DataError, DynidError, OptionError, ShapeError
 from ..io.drive_file import drive_of_robot_file, load_drive
 from ..io.robot_file import load_robot as load_robot_file
 from ..kinematics.inverse import default_q0
@@ -159,6 +159,13 @@ def add_robot_options(p: argparse.ArgumentParser) -> None:
     p.add_argument(
         "--tip", default=None, help="URDF tip link of the chain (default: the only leaf)"
     )
+    p.add_argument(
+        "--snap-angles",
+        action="store_true",
+        help="read URDF joint angles within 1e-3 rad of a multiple of pi/2 as that multiple "
+        '(rpy="1.5708" as pi/2); without it such rounded angles are reported with the '
+        "condition numbers they cause",
+    )
 
 
 def add_drive_option(p: argparse.ArgumentParser) -> None:
@@ -184,13 +191,23 @@ def load_drive_arg(args: argparse.Namespace, n: int) -> Any:
 
 
 def load_robot(args: argparse.Namespace) -> Robot:
-    """The robot named by ``--robot`` (and ``--base``/``--tip`` for a URDF)."""
+    """The robot named by ``--robot`` (and ``--base``/``--tip``/``--snap-angles`` for a
+    URDF).
+
+    Raises
+    ------
+    OptionError
+        ``--snap-angles`` with a robot that is not a URDF.
+    """
     spec = args.robot
+    snap = bool(getattr(args, "snap_angles", False))
+    if snap and Path(str(spec)).suffix.lower() != ".urdf":
+        raise OptionError(f"--snap-angles applies to a URDF --robot; got {str(spec)!r}")
     if spec in BUILTIN_ROBOTS:
         return builtin_robot(spec)
     path = Path(spec)
     with about(path):
-        return load_robot_file(path, base=args.base, tip=args.tip, what="--robot")
+        return load_robot_file(path, base=args.base, tip=args.tip, what="--robot", snap_angles=snap)
 
 
 def add_consistency_options(p: argparse.ArgumentParser) -> None:

@@ -33,7 +33,10 @@ rounding), are reported as one-line warnings with the numbers. On exact data the
 residual and the standard deviations are 0 (said in the summary), never NaN.
 
 Torque logs are read strictly: rows with NaN/inf or a repeated timestamp are an error
-unless --drop-invalid; gaps up to --max-gap are bridged.
+unless --drop-invalid; gaps up to --max-gap are bridged. Accelerations: a log with a
+complete ddq1..ddqn set (or a `ddq` array in an NPZ, or `--columns ddq=...`) has them
+used as given, low-pass filtered at the cut-off with the other signals; without one they
+are the derivative of the filtered velocities (an incomplete set is an error).
 
 Writes DIR/identification.json (coefficients, expressions, std, metrics, kinematics,
 identifiability of every standard parameter) and prints a summary table.
@@ -42,10 +45,12 @@ Rank and conditioning. The base parameters come from the robot's kinematics: the
 (the rank) is read from the first clear gap (a factor >= 1e3, below 1e-3 of the largest)
 in the singular values of the column-scaled regressor, and the gap is printed. A URDF
 whose angles are rounded (rpy="1.5708 0 0") has near-dependencies near 1e-4 that are
-treated as dependencies. --rtol overrides this with a fixed relative threshold: singular
-values (and column norms) at or below RTOL times the largest count as dependencies; set it
-above the near-dependencies (1e-4 for 4-digit angles) to drop them, below (1e-10) to keep
-them, at the price of an ill-conditioned fit. The summary gives the paper's condition
+treated as dependencies; reading it names the rounded joints with the unscaled condition
+numbers, and --snap-angles reads such angles as the multiples of pi/2. --rtol overrides
+this with a fixed relative threshold: singular values (and column norms) at or below RTOL
+times the largest count as dependencies; set it above the near-dependencies (1e-4 for
+4-digit angles) to drop them, below (1e-10) to keep them, at the price of an
+ill-conditioned fit. The summary gives the paper's condition
 number (unscaled regressor; 48.9 for the Panda's static data, 122 for its exciting
 trajectory) and the scaled one (unit column norms; above 1e3 the data are ill-conditioned
 and a warning names the nearly dependent columns). Each standard parameter is

@@ -660,12 +660,16 @@ def _rank_error(
     needed = exc.needed if exc.needed is not None else len(columns.labels)
     what = "the base parameters" + "".join(f" and {t.name}" for t in columns.appended)
     cols = ", ".join(exc.dependent) or "?"
+    combos = "; ".join(exc.combinations) or cols
     return RankDeficientError(
         f"{data.source} ({stack.n_rows} rows) has rank {exc.rank} < {needed} needed for "
-        f"{what} (rtol={rtol:g}); nearly dependent columns: {cols}; {data.hint}",
+        f"{what} (rtol={rtol:g}), the model's structural rank; not excited by the data: "
+        f"{combos}{columns.base.meaning(exc.combinations)}; nearly dependent columns: "
+        f"{cols}; {data.hint}",
         rank=exc.rank,
         needed=needed,
         dependent=exc.dependent,
+        combinations=exc.combinations,
     )
 
 

@@ -57,6 +57,7 @@ __all__ = [
     "fit_blocks",
     "fit_least_squares",
     "fit_with_pruning",
+    "unexcited_combinations",
 ]
 
 #: How the standard deviations are estimated (``std=``, ``--std``): ``"classical"``
@@ -211,6 +212,49 @@ def _column_names(
     return tuple(labels[k] if labels is not None else f"column {k}" for k in idx)
 
 
+def unexcited_combinations(
+    R: NDArray[np.float64],
+    scale: NDArray[np.float64],
+    rank: int,
+    labels: tuple[str, ...] | None = None,
+) -> tuple[str, ...]:
+    """Every combination of coefficients the data do not excite, one string each.
+
+    ``R`` (k, k) is the triangular factor of the column-scaled regressor (columns in the
+    order of ``scale``, any pivoting undone by the caller's ordering of ``scale``) whose
+    numerical rank is ``rank < k``. The ``k - rank`` right singular vectors of its smallest
+    singular values span the directions ``v`` with ``W v ~ 0``: moving the coefficients
+    along them leaves every fitted value unchanged. The basis is put in reduced echelon
+    form (each direction has coefficient 1 on a label of its own, 0 on the others'), the
+    labels chosen by their weight, so that the same null space is named the same way
+    whatever basis the factorisation gave: ``"beta39"`` (a column the data never excite),
+    ``"beta40 - 0.31*fc6"`` (two columns the data cannot tell apart). Coefficients are in
+    the coefficients' own units, to 3 significant digits; entries below 1e-3 of a
+    direction's largest (scaled) weight are left out.
+    """
+    k = R.shape[1]
+    d = k - rank
+    if d <= 0:
+        return ()
+    Vt = np.linalg.svd(R)[2]
+    N = Vt[k - d :]  # (d, k), scaled coefficients
+    piv = scipy.linalg.qr(N, mode="r", pivoting=True)[1][:d]  # labels of largest weight
+    B = N / scale[None, :]  # the same directions in the coefficients' units
+    E = np.linalg.solve(B[:, piv], B)  # reduced echelon: E[:, piv] = identity
+    names = labels if labels is not None else tuple(f"column {j}" for j in range(k))
+    out = []
+    for i, p in enumerate(piv):
+        w = np.abs(E[i] * scale)
+        parts = [names[p]]
+        for j in np.argsort(-w):
+            if j == p or w[j] < 1e-3 * w.max() or j in piv:
+                continue
+            c = float(E[i, j])
+            parts.append(f"{'-' if c < 0 else '+'} {abs(c):.3g}*{names[j]}")
+        out.append(" ".join(parts))
+    return tuple(out)
+
+
 def fit_least_squares(
     W: ArrayLike,
     y: ArrayLike,
@@ -317,15 +361,18 @@ def _fit(
         if solved is None:
             Wu = Wk if used is None else Wk[used]
             _checks.finite("W", W if used is None else Wu)
+            kl = None if labels is None else tuple(np.asarray(labels, dtype=object)[keep])
             try:
-                solved = _solve_qr(Wu, yu, rtol, std)
+                solved = _solve_qr(Wu, yu, rtol, std, kl)
             except _RankDeficient as exc:
                 names = _column_names(labels, exc.null, keep)
                 raise RankDeficientError(
-                    f"{exc.args[0]}; nearly dependent columns: {', '.join(names) or '?'}",
+                    f"{exc.args[0]}; nearly dependent columns: {', '.join(names) or '?'}; "
+                    f"not excited by the data: {'; '.join(exc.combinations)}",
                     rank=exc.rank,
                     needed=rk,
                     dependent=names,
+                    combinations=exc.combinations,
                 ) from None
     rank, cond, bk, e, cov_s, scale, cond_u, vmin = solved
     if not (np.all(np.isfinite(bk)) and np.all(np.isfinite(e)) and np.all(np.isfinite(cov_s))):
@@ -474,10 +521,13 @@ _Solved = tuple[
 class _RankDeficient(Exception):
     """Internal: rank deficiency, with the null direction (column order) for the message."""
 
-    def __init__(self, msg: str, null: NDArray[np.float64], rank: int) -> None:
+    def __init__(
+        self, msg: str, null: NDArray[np.float64], rank: int, combinations: tuple[str, ...]
+    ) -> None:
         super().__init__(msg)
         self.null = null
         self.rank = rank
+        self.combinations = combinations
 
 
 def _conditioning(
@@ -550,7 +600,11 @@ def _solve_semi_normal(
 
 
 def _solve_qr(
-    Wk: NDArray[np.float64], y: NDArray[np.float64], rtol: float, std: StdMethod
+    Wk: NDArray[np.float64],
+    y: NDArray[np.float64],
+    rtol: float,
+    std: StdMethod,
+    labels: tuple[str, ...] | None = None,
 ) -> _Solved:
     """Column-scaled Householder QR with column pivoting (two stages when ``W`` is tall).
 
@@ -596,11 +650,13 @@ def _solve_qr(
     vmin = np.empty(rk)
     vmin[piv] = vp
     if rank < rk:
+        order = np.argsort(piv)  # R's columns back in the regressor's order
         raise _RankDeficient(
             f"Regressor rank {rank} < {rk} at rtol={rtol:g} (scaled cond {cond:.3g}); add "
             "configurations or excite the trajectory more, or drop unidentifiable parameters",
             vmin,
             rank,
+            unexcited_combinations(R[:, order], scale, rank, labels),
         )
     z = scipy.linalg.solve_triangular(R, Q.T @ b)
     bs = np.empty(rk)

@@ -13,7 +13,12 @@ with them before fitting (:func:`log_findings`). None of them changes the data.
   currents logged as torques show as a factor far from 1 (a drive file with
   ``torque_constant``).
 * **Degrees**: positions whose range exceeds ``2 pi`` on a revolute joint while the range
-  divided by ``180 / pi`` fits in the joint's limits (``--units q=deg``).
+  divided by ``180 / pi`` fits in the joint's limits, unless the velocities say otherwise:
+  where ``dq`` agrees with the derivative of ``q`` (one unit for both) the positions are
+  radians unless the velocities are too fast for radians (above the joint's ``dq_max``,
+  or ``2 pi`` rad/s without one); an unwrapped continuous joint that turns several times
+  is not degrees. Velocities ``180 / pi`` times slower than the derivative of ``q`` are
+  (``--units q=deg``; both in degrees: ``--units q=deg,dq=deg/s``).
 * **Milliseconds**: logged velocities ``1e3`` times the derivative of the positions (or a
   median time step of at least 0.5 s with integer steps when no velocities were logged):
   ``--units t=ms``.
@@ -166,7 +171,7 @@ def check_torque_log(robot: Robot, log: TorqueLog) -> list[str]:
     names = robot.joint_names
     if np.any(robot.phi):  # the robot's own parameters: a model to compare with
         out += _sign_and_scale(robot, q, tau, names)
-    out += _degrees(robot, log.q)
+    out += _degrees(robot, log)
     out += _milliseconds(log)
     frozen = ~moving_joints(log.dq)
     if np.any(frozen) and not np.all(frozen):
@@ -240,7 +245,16 @@ def _sign_and_scale(
     return out
 
 
-def _degrees(robot: Robot, q: NDArray[np.float64]) -> list[str]:
+#: Relative tolerance of "``dq`` agrees with the derivative of ``q``" (filtered velocities
+#: lag and smooth: 25 % is far from the factor 57.3 of degrees either way).
+_RATE_AGREES = 0.25
+#: Speed [rad/s] above which velocities are too fast for radians on a joint without dq_max.
+_FAST_RAD_S = 2 * np.pi
+
+
+def _degrees(robot: Robot, log: TorqueLog) -> list[str]:
+    """The degrees finding (module docstring), or nothing."""
+    q = log.q
     rev = ~np.asarray(robot.prismatic)
     lo, hi = np.min(q, axis=0), np.max(q, axis=0)
     span = hi - lo
@@ -248,13 +262,54 @@ def _degrees(robot: Robot, q: NDArray[np.float64]) -> list[str]:
     lim_hi = np.where(np.isfinite(robot.q_max), robot.q_max, 2 * np.pi)
     r = np.pi / 180.0
     suspect = rev & (span > 2 * np.pi) & (lo * r >= lim_lo - 0.1) & (hi * r <= lim_hi + 0.1)
-    if np.sum(suspect) >= max(1, int(np.sum(rev & (span > 0.1))) // 2):
+    why: dict[int, tuple[str, str]] = {}
+    for j in map(int, np.flatnonzero(suspect)):
+        verdict = _rate_verdict(robot, log, j)
+        if verdict is None:
+            suspect[j] = False
+        else:
+            why[j] = verdict
+    if np.any(suspect) and np.sum(suspect) >= max(1, int(np.sum(rev & (span > 0.1))) // 2):
         j = int(np.flatnonzero(suspect)[0])
+        reason, hint = why[j]
         return [
             f"positions look like degrees: joint {robot.joint_names[j]} spans "
-            f"{span[j]:.4g} rad, which in degrees fits its limits; hint: --units q=deg"
+            f"{span[j]:.4g} rad, which in degrees fits its limits{reason}; hint: {hint}"
         ]
     return []
+
+
+def _rate_verdict(robot: Robot, log: TorqueLog, j: int) -> tuple[str, str] | None:
+    """What the velocities of joint ``j`` say of positions that may be degrees: None (they
+    are radians), or the reason and the hint of the warning.
+
+    ``k`` is the least-squares factor of ``d q / dt ~ k dq``: 1 when ``q`` and ``dq``
+    share a unit, ``180 / pi`` when ``q`` is in degrees and ``dq`` in radians per second.
+    """
+    t, q, v = log.t, log.q[:, j], np.ascontiguousarray(log.dq[:, j])
+    den = float(v @ v)
+    if t.size < 5 or not den > 0:
+        return "", "--units q=deg"
+    k = float(np.gradient(q, t) @ v) / den
+    deg = 180.0 / np.pi
+    if abs(k / deg - 1.0) < _RATE_AGREES:
+        return (
+            f", and its velocities are {k:.3g} times slower than the derivative of its "
+            "positions (degrees against radians per second)",
+            "--units q=deg",
+        )
+    if abs(k - 1.0) < _RATE_AGREES:
+        fast = float(robot.dq_max[j]) if np.isfinite(robot.dq_max[j]) else _FAST_RAD_S
+        peak = float(np.quantile(np.abs(v), 0.99))
+        if peak <= 1.5 * fast:
+            return None  # one unit, and plausible radians per second: radians
+        return (
+            f", and its velocities, which agree with the derivative of its positions, reach "
+            f"{peak:.4g} per second, too fast for radians (limit {fast:.3g} rad/s): both "
+            "look like degrees",
+            "--units q=deg,dq=deg/s" + (",ddq=deg/s^2" if log.ddq is not None else ""),
+        )
+    return "", "--units q=deg"
 
 
 def _milliseconds(log: TorqueLog) -> list[str]:

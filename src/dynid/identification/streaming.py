@@ -48,7 +48,13 @@ from .. import _checks
 from ..exceptions import DataError, NonFiniteError, OptionError, RankDeficientError, ShapeError
 from .estimators import IRLS, OLS, WLS, Estimator, huber_weights
 from .holdout import Normals
-from .least_squares import LeastSquaresFit, StdMethod, _conditioning, checked_std
+from .least_squares import (
+    LeastSquaresFit,
+    StdMethod,
+    _conditioning,
+    checked_std,
+    unexcited_combinations,
+)
 
 __all__ = [
     "BLOCK_ROWS",
@@ -325,10 +331,17 @@ def _solve(
     vmin = np.empty(rk)
     vmin[piv] = vp
     if rank < rk:
+        kl = tuple(labels[k] if labels is not None else f"column {k}" for k in idx)
+        combos = unexcited_combinations(R[:, np.argsort(piv)], scale, rank, kl)
+        names = _names(labels, vmin, idx)
         raise RankDeficientError(
             f"Regressor rank {rank} < {rk} at rtol={rtol:g} (scaled cond {cond:.3g}); add "
             "configurations or excite the trajectory more, or drop unidentifiable parameters; "
-            f"nearly dependent columns: {_names(labels, vmin, idx)}"
+            f"nearly dependent columns: {names}; not excited by the data: {'; '.join(combos)}",
+            rank=rank,
+            needed=rk,
+            dependent=tuple(names.split(", ")),
+            combinations=combos,
         )
     z = scipy.linalg.solve_triangular(R, Q.T @ b)
     bs = np.empty(rk)

@@ -4,7 +4,7 @@ Keys (all optional but ``schema`` in a file of its own; n = the robot's joint co
 
     schema = "dynid-drive/1"
     side = "joint" | "motor"          # what the log's q, dq, ddq, tau columns are (joint)
-    gear_ratio = [...]                # n motor turns per joint unit (1)
+    gear_ratio = [...]                # n motor turns per joint unit (1; one number: all)
     coupling = [[motor, joint, value], ...]   # 1-based entries of K off the diagonal
     offset = [...]                    # n encoder zero offsets [rad or m], q = K^-1 qm + offset
     effort = "torque" | "current"     # what the tau columns hold (torque)
@@ -12,6 +12,8 @@ Keys (all optional but ``schema`` in a file of its own; n = the robot's joint co
     rotor_inertia = "identify" | [...]  # n [kg m^2] at the motors (identify)
     friction_at = "motor" | "joint"   # default motor when K is not the identity
 
+Every per-joint list (``gear_ratio``, ``offset``, ``torque_constant``, ``rotor_inertia``)
+may be one number, used for every joint (``gear_ratio = 1``: a direct drive).
 ``qm = K (q - offset)``, ``dqm = K dq``, ``tau_joint = K^T tau_motor``
 (:mod:`dynid.model.drive`). Every fault (an unknown key, a wrong type or length, a singular
 ``K``, a coupling outside the chain or given twice, currents without constants) is one
@@ -64,11 +66,15 @@ def _number(value: Any, where: str) -> float:
 
 
 def _vector(table: Mapping[str, Any], key: str, n: int, where: str) -> NDArray[np.float64]:
+    """A list of ``n`` numbers, or one number for every joint (``gear_ratio = 1``)."""
     value = table[key]
+    if isinstance(value, int | float) and not isinstance(value, bool):
+        return np.full(n, _number(value, f"{where}: {key}"))
     if not isinstance(value, list) or len(value) != n:
         got = f"{len(value)} entries" if isinstance(value, list) else _checks.short(value)
         raise DataError(
-            f"{where}: key {key!r} must be a list of {n} numbers (one per joint); got {got}"
+            f"{where}: key {key!r} must be a number or a list of {n} numbers (one per "
+            f"joint); got {got}"
         )
     return np.array([_number(v, f"{where}: {key}[{k}]") for k, v in enumerate(value)])
 
@@ -129,8 +135,8 @@ def drive_from_mapping(table: Mapping[str, Any], n: int, *, source: str = "drive
     if ia != "identify":
         if isinstance(ia, str):
             raise DataError(
-                f"{source}: key 'rotor_inertia' must be 'identify' or a list of {n} numbers "
-                f"[kg m^2]; got {_checks.short(ia)}"
+                f"{source}: key 'rotor_inertia' must be 'identify', a number or a list of {n} "
+                f"numbers [kg m^2]; got {_checks.short(ia)}"
             )
         kw["rotor_inertia"] = _vector(table, "rotor_inertia", n, source)
     try:

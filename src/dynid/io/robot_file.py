@@ -21,12 +21,18 @@ ROBOT_FILE_SUFFIXES = (".urdf", ".toml", ".json")
 
 
 def load_robot(
-    spec: str | Path, *, base: str | None = None, tip: str | None = None, what: str = "robot"
+    spec: str | Path,
+    *,
+    base: str | None = None,
+    tip: str | None = None,
+    what: str = "robot",
+    snap_angles: bool = False,
 ) -> Robot:
     """A built-in robot by name, or a robot file by its suffix: the one dispatch of robots.
 
     A name of :data:`~dynid.model.builtin.BUILTIN_ROBOTS` (``"panda"``, ``"fr3"``); else
-    ``.urdf`` (the chain from ``base`` to ``tip``: :func:`dynid.io.robot.urdf.load_urdf`),
+    ``.urdf`` (the chain from ``base`` to ``tip``, rounded angles snapped with
+    ``snap_angles``: :func:`dynid.io.robot.urdf.load_urdf`),
     ``.toml`` (:func:`dynid.io.robot.toml.load_toml`) or ``.json`` (a ``feasible.json``,
     :func:`dynid.io.feasible.load_feasible_json`). ``what`` names the option in errors.
 
@@ -49,7 +55,7 @@ def load_robot(
     if suffix == ".urdf":
         from .robot.urdf import load_urdf
 
-        return load_urdf(path, base_link=base, tip_link=tip)
+        return load_urdf(path, base_link=base, tip_link=tip, snap_angles=snap_angles)
     if suffix == ".toml":
         from .robot.toml import load_toml
 

@@ -141,14 +141,19 @@ class Drive:
         cls,
         gear_ratio: ArrayLike,
         coupling: tuple[tuple[int, int, float], ...] | list[tuple[int, int, float]] = (),
+        *,
+        n: int | None = None,
         **kw: object,
     ) -> Drive:
         """``K = diag(gear_ratio)`` with ``coupling`` entries ``(motor, joint, value)``
         (1-based) set off the diagonal; other attributes as keywords (``offset`` defaults to
-        zeros)."""
+        zeros). A single ``gear_ratio`` (1: a direct drive) is every joint's, with ``n``."""
         g = _checks.as_array("gear_ratio", gear_ratio)
-        if g.ndim != 1 or g.size < 1:
-            raise ShapeError(f"gear_ratio must have shape (n,); got {g.shape}")
+        if g.ndim == 0 and n is not None:
+            g = np.full(int(n), float(g))
+        if g.ndim != 1 or g.size < 1 or (n is not None and g.size != n):
+            want = "(n,)" if n is None else f"({n},) or a single number"
+            raise ShapeError(f"gear_ratio must have shape {want}; got {g.shape}")
         n = g.size
         K = np.diag(g)
         for entry in coupling:

@@ -15,9 +15,14 @@ of dependent ones, printed as ``J3yy + J2zz + 0.099856*m3 + ...``. The coefficie
 significant digits (``clean_digits``).
 
 Columns are scaled to unit norm before the rank decision (parameters mix kg, kg m and
-kg m^2). The rank is read from a clear gap in the singular values ``s`` of the scaled
-regressor (:func:`rank_from_gap`): the first cut, from the top, between ``s[k-1]`` and
-``s[k]`` with ``s[k] <= RANK_FLOOR s[0]`` and ``s[k-1] / s[k] >= RANK_GAP``. A
+kg m^2, and a rotor's column grows with the square of its gear ratio), so that the rank and
+the base set do not depend on units, gear ratios or the size of a term's columns. A column
+is first zeroed when it acts on nothing: below 1e-12 of the largest (round-off), or below
+a clear gap in the column norms, each measured against the largest of its *family* (the
+links' masses, first moments, inertias: one unit each; a rotor's column alone). The rank
+is read from a clear gap in the singular values ``s`` of the
+scaled regressor (:func:`rank_from_gap`): the first cut, from the top, between ``s[k-1]``
+and ``s[k]`` with ``s[k] <= RANK_FLOOR s[0]`` and ``s[k-1] / s[k] >= RANK_GAP``. A
 near-dependency below that floor (a URDF whose angles are rounded, ``rpy="1.5708 0 0"``,
 leaves singular values near 1e-4 where the exact kinematics have zeros) is a dependency:
 fitting it would give coefficients with standard deviations of 1e8 %. The gap found is
@@ -59,6 +64,7 @@ __all__ = [
     "base_parameters",
     "base_parameters_from_regressor",
     "identifiability",
+    "link_families",
     "rank_from_gap",
 ]
 
@@ -128,6 +134,17 @@ class BaseParameters:
         if p.shape[-1:] != (self.n_std,):
             raise ShapeError(f"phi must have shape (..., {self.n_std}); got {p.shape}")
         return p[..., self.independent] + p[..., self.dependent] @ self.K_d.T
+
+    def meaning(self, combinations: Sequence[str], *, width: int = 60) -> str:
+        """`` (where beta3 = J3zz + ..., ...)`` for the base labels that ``combinations``
+        name (each expression cut at ``width`` characters), or ``""``."""
+        words = {w for c in combinations for w in c.split()}
+        parts = []
+        for lab, expr in zip(self.labels, self.expressions, strict=True):
+            if lab in words:
+                short = expr if len(expr) <= width else expr[: width - 3].rstrip() + "..."
+                parts.append(f"{lab} = {short}")
+        return f" (where {', '.join(parts)})" if parts else ""
 
     def reduce(self, Y: ArrayLike) -> NDArray[np.float64]:
         """Base regressor ``Y_b`` from a full regressor ``Y`` (..., p) -> (..., r)."""
@@ -257,6 +274,7 @@ def base_parameters_from_regressor(
     *,
     rtol: float | None = None,
     clean_digits: int = 10,
+    families: ArrayLike | None = None,
 ) -> BaseParameters:
     """Base parameters of a stacked regressor.
 
@@ -270,6 +288,12 @@ def base_parameters_from_regressor(
         the rank at the first clear gap (:func:`rank_from_gap`).
     clean_digits : int
         Significant digits kept in ``K_d`` (removes round-off; 0 keeps raw values).
+    families : array_like of int, shape (p,), optional
+        Columns of one family share their unit and their scale (the links' masses, first
+        moments, inertias: :func:`link_families`); each column's norm is measured against
+        the largest of its family before a gap in the norms is looked for
+        (:func:`_null_and_scale`), so that the base does not depend on units or gear
+        ratios. Default: one family (every column against the largest).
 
     Returns
     -------
@@ -283,7 +307,10 @@ def base_parameters_from_regressor(
     if len(labels) != p:
         raise ShapeError(f"std_labels must have {p} entries; got {len(labels)}")
     norms = np.linalg.norm(W, axis=0)
-    null, scale = _null_and_scale(norms, rtol)
+    fam = np.zeros(p, dtype=np.intp) if families is None else np.asarray(families, np.intp)
+    if fam.shape != (p,):
+        raise ShapeError(f"families must have {p} entries; got shape {fam.shape}")
+    null, scale = _null_and_scale(norms, rtol, fam)
     Ws = np.empty((m, p), order="F")  # column-major, as LAPACK takes it (no further copy)
     np.divide(W, scale, out=Ws)
     Ws[:, null] = 0.0
@@ -291,22 +318,34 @@ def base_parameters_from_regressor(
 
 
 def _null_and_scale(
-    norms: NDArray[np.float64], rtol: float | None = None
+    norms: NDArray[np.float64],
+    rtol: float | None = None,
+    families: NDArray[np.intp] | None = None,
 ) -> tuple[NDArray[np.bool_], NDArray[np.float64]]:
     """Columns that act on nothing, and the column scales (1 for those).
 
     A column at round-off level relative to the largest acts on nothing; so does one that
-    lies below a clear gap in the sorted column norms (:func:`rank_from_gap` on the
-    norms): a parameter that acts only through a rounding error of the kinematics (a
-    link mass seen by gravity through an axis tilted by 1e-5 rad). Both are zeroed, since
-    scaling them to unit norm would turn round-off into a spurious direction. With an
-    explicit ``rtol`` the columns at or below ``max(rtol, 1e-12)`` of the largest are.
+    lies below a clear gap in the sorted column norms (:func:`rank_from_gap` on the norms),
+    each relative to the largest of its family: a parameter that acts only through a
+    rounding error of the kinematics (a link mass seen by gravity through an axis tilted by
+    1e-5 rad). Both are zeroed, since scaling them to unit norm would turn round-off into a
+    spurious direction. Measuring each column against its own ``families`` (one unit, one
+    scale) makes the cut independent of units and gear ratios: a rotor's column, which
+    grows with the square of its gear ratio, or the links' masses in other units than their
+    inertias never push another family's columns below it. With an explicit ``rtol`` the
+    columns at or below ``max(rtol, 1e-12)`` of the largest are.
     """
     top = np.max(norms, initial=0.0)
     null = norms <= (1e-12 if rtol is None else max(rtol, 1e-12)) * top
     if top > 0 and rtol is None:
-        order = np.argsort(-norms)
-        k = rank_from_gap(norms[order])[0]
+        rel = norms / top
+        if families is not None:
+            for f in np.unique(families):
+                cols = families == f
+                ftop = np.max(norms[cols & ~null], initial=0.0)
+                rel[cols] = norms[cols] / ftop if ftop > 0 else 0.0
+        order = np.argsort(-rel)
+        k = rank_from_gap(rel[order])[0]
         null[order[k:]] = True
     return null, np.where(null, 1.0, norms)
 
@@ -351,6 +390,18 @@ def _from_scaled(
         expressions=tuple(exprs),
         gap=gap,
     )
+
+
+def link_families(n: int, n_extra: int = 0) -> NDArray[np.intp]:
+    """Families of the standard parameters of ``n`` links then ``n_extra`` term parameters.
+
+    The links' masses (family 0), first moments (1) and inertias (2) share a unit each and
+    do not depend on any gear; each term parameter (a rotor inertia, whose column grows with
+    the square of its gear ratio) is a family of its own (3, 4, ...). Returns (10 n +
+    n_extra,) ints, for :func:`base_parameters_from_regressor`.
+    """
+    one = np.array([0, 1, 1, 1, 2, 2, 2, 2, 2, 2], dtype=np.intp)
+    return np.concatenate([np.tile(one, n), 3 + np.arange(n_extra, dtype=np.intp)])
 
 
 #: Largest stack of random-state regressor rows [bytes] :func:`base_parameters` holds at
@@ -414,11 +465,12 @@ def base_parameters(
         dq = rng.uniform(-2, 2, q.shape)
         ddq = rng.uniform(-5, 5, q.shape)
     labels = robot.param_labels + tuple(lab for t in extra for lab in t.labels)
+    families = link_families(robot.n, len(labels) - 10 * robot.n)
     rows = static_rows(robot.n) if kind == "static" else robot.n
     step = max(1, int(max_bytes) // (8 * rows * len(labels)))
     if step >= n_samples:
         W = _random_rows(robot, kind, extra, q, dq, ddq)
-        return base_parameters_from_regressor(W, labels, rtol=rtol)
+        return base_parameters_from_regressor(W, labels, rtol=rtol, families=families)
     R = np.zeros((0, len(labels)))
     for a in range(0, n_samples, step):
         b = slice(a, a + step)
@@ -429,7 +481,7 @@ def base_parameters(
         R = scipy.linalg.qr(X, mode="r", overwrite_a=True, check_finite=False)[0]
         R = R[: len(labels)]
         del X
-    return base_parameters_from_regressor(R, labels, rtol=rtol)
+    return base_parameters_from_regressor(R, labels, rtol=rtol, families=families)
 
 
 def _random_rows(

@@ -36,6 +36,7 @@ Conventions
 
 from __future__ import annotations
 
+import logging
 import warnings
 import xml.etree.ElementTree as ET
 from dataclasses import dataclass
@@ -49,8 +50,11 @@ from ...exceptions import DynidWarning, ModelError, UnknownNameError
 from ...model.inertia import inertial_problems, phi_from_inertial
 from ...model.robot import MAX_LINK_MASS, MAX_LINK_OFFSET, Frame, Robot
 from ..input_files import file_bytes
+from .urdf_angles import AngleRounding, rounding_message
 
 __all__ = ["load_urdf", "robot_from_urdf_string"]
+
+_log = logging.getLogger(__name__)
 
 _MOVING = {"revolute": False, "continuous": False, "prismatic": True}  # type -> prismatic
 _UNSUPPORTED = ("floating", "planar")
@@ -124,13 +128,18 @@ def _float(elem: ET.Element, attr: str, what: str) -> float | None:
     return value
 
 
-def _origin(elem: ET.Element, what: str) -> NDArray[np.float64]:
-    """Pose given by the ``<origin xyz rpy>`` child of ``elem`` (identity when absent), (4, 4)."""
+def _origin(
+    elem: ET.Element, what: str, angles: AngleRounding | None = None, joint: str = ""
+) -> NDArray[np.float64]:
+    """Pose given by the ``<origin xyz rpy>`` child of ``elem`` (identity when absent), (4, 4);
+    a joint's ``rpy`` goes through ``angles`` (rounded angles recorded, snapped if asked)."""
     o = _child(elem, "origin")
     if o is None:
         return np.eye(4)
     xyz = _floats(o.get("xyz"), 3, f"{what} origin xyz", (0.0, 0.0, 0.0))
     rpy = _floats(o.get("rpy"), 3, f"{what} origin rpy", (0.0, 0.0, 0.0))
+    if angles is not None:
+        rpy = angles.rpy(joint, rpy)
     return spatial.transform_from_xyz_rpy(xyz, rpy)
 
 
@@ -260,7 +269,7 @@ def _warn_if_inconsistent(link: str, mass: float, I: NDArray[np.float64]) -> Non
             f"link {link!r} has a physically inconsistent inertial: {'; '.join(problems)}; "
             "kept as given",
             DynidWarning,
-            stacklevel=6,
+            stacklevel=7,
         )
 
 
@@ -285,7 +294,7 @@ def _limits(joint: _Joint) -> tuple[float, float, float, float]:
             warnings.warn(
                 f"joint {joint.name!r} has {attr} limit {v}; treated as unbounded",
                 DynidWarning,
-                stacklevel=5,
+                stacklevel=6,
             )
             v = None
         out.append(np.inf if v is None else v)
@@ -298,6 +307,7 @@ def robot_from_urdf_string(
     tip_link: str | None = None,
     *,
     source: str = "URDF text",
+    snap_angles: bool = False,
 ) -> Robot:
     """Serial chain between ``base_link`` and ``tip_link`` of a URDF document.
 
@@ -312,6 +322,9 @@ def robot_from_urdf_string(
         below ``base_link``.
     source : str
         Name of the document used in error messages (a file path, say).
+    snap_angles : bool
+        Snap the joint-origin ``rpy`` angles within 1e-3 rad of a multiple of pi/2 to it
+        (``rpy="1.5708"`` read as pi/2; :mod:`dynid.io.robot.urdf_angles`).
 
     Returns
     -------
@@ -341,9 +354,13 @@ def robot_from_urdf_string(
         (negative mass, inertia not positive semi-definite, triangle inequality violated):
         it is kept as given. A velocity or
         effort limit is not positive: it is treated as unbounded. A URDF link named
-        ``flange`` is not the tip link (the frame ``flange`` is the tip's).
+        ``flange`` is not the tip link (the frame ``flange`` is the tip's). Joint-origin
+        angles are rounded near multiples of pi/2 (``rpy="1.5708"``) in a way that
+        matters and ``snap_angles`` is False: the joints and the unscaled condition
+        numbers of the structural regressor as written and snapped are named (a harmless
+        rounding is logged).
     """
-    return _robot_from_text(text, base_link, tip_link, source)
+    return _robot_from_text(text, base_link, tip_link, source, snap_angles)
 
 
 def _chain_ends(
@@ -437,12 +454,12 @@ class _Walk:
     order: list[str]
 
 
-def _walk(path: list[_Joint], base_link: str) -> _Walk:
+def _walk(path: list[_Joint], base_link: str, angles: AngleRounding) -> _Walk:
     """Walk the chain: fixed joints fold into the next joint's pose or the current body."""
     w = _Walk([base_link], [], [], [], [], [], {base_link: (0, np.eye(4))}, [base_link])
     k, T_k_cur = 0, np.eye(4)
     for joint in path:
-        T = T_k_cur @ _origin(joint.elem, f"joint {joint.name!r}")
+        T = T_k_cur @ _origin(joint.elem, f"joint {joint.name!r}", angles, joint.name)
         if joint.type == "fixed":
             T_k_cur = T
         else:
@@ -492,9 +509,35 @@ def _body_phi(w: _Walk, links: dict[str, ET.Element]) -> NDArray[np.float64]:
 
 
 def _robot_from_text(
-    text: str | bytes, base_link: str | None, tip_link: str | None, source: str
+    text: str | bytes,
+    base_link: str | None,
+    tip_link: str | None,
+    source: str,
+    snap_angles: bool = False,
 ) -> Robot:
     """Body of the two public readers (called directly by both, so warnings point at the caller)."""
+    angles = AngleRounding(snap=snap_angles)
+    robot = _read_chain(text, base_link, tip_link, source, angles)
+    if angles.found and not snap_angles:
+        with warnings.catch_warnings():  # the inertials' warnings were given once
+            warnings.simplefilter("ignore", DynidWarning)
+            snapped = _read_chain(text, base_link, tip_link, source, AngleRounding(snap=True))
+        msg, harmful = rounding_message(source, angles.found, robot, snapped)
+        if harmful:
+            warnings.warn(msg, DynidWarning, stacklevel=3)
+        else:
+            _log.info("%s", msg)
+    return robot
+
+
+def _read_chain(
+    text: str | bytes,
+    base_link: str | None,
+    tip_link: str | None,
+    source: str,
+    angles: AngleRounding,
+) -> Robot:
+    """The robot of the chain, its joint-origin angles through ``angles``."""
     try:
         root = ET.fromstring(text)
     except ET.ParseError as exc:
@@ -503,7 +546,7 @@ def _robot_from_text(
     base, tip = _chain_ends(source, links, parent_joint, child_joints, base_link, tip_link)
     path = _chain(base, tip, parent_joint)
     _check_chain(path, base, tip)
-    w = _walk(path, base)
+    w = _walk(path, base, angles)
     _place_fixed_links(w, path, child_joints)
     phi = _body_phi(w, links)
 
@@ -513,7 +556,7 @@ def _robot_from_text(
         warnings.warn(
             f"URDF link 'flange' is not the tip link {tip!r}; the frame 'flange' is the tip link's",
             DynidWarning,
-            stacklevel=3,
+            stacklevel=4,
         )
     k_tip, T_tip = w.placed[tip]
     frames["flange"] = Frame(k_tip, T_tip)
@@ -537,7 +580,13 @@ def _robot_from_text(
     )
 
 
-def load_urdf(path: str | Path, base_link: str | None = None, tip_link: str | None = None) -> Robot:
+def load_urdf(
+    path: str | Path,
+    base_link: str | None = None,
+    tip_link: str | None = None,
+    *,
+    snap_angles: bool = False,
+) -> Robot:
     """Serial chain between ``base_link`` and ``tip_link`` of a URDF file.
 
     Parameters
@@ -549,6 +598,8 @@ def load_urdf(path: str | Path, base_link: str | None = None, tip_link: str | No
     tip_link : str, optional
         Last link of the chain; its frame is ``flange``. Default: the unique leaf link
         below ``base_link``.
+    snap_angles : bool
+        Snap joint-origin angles rounded near multiples of pi/2 (:func:`robot_from_urdf_string`).
 
     Returns
     -------
@@ -567,7 +618,7 @@ def load_urdf(path: str | Path, base_link: str | None = None, tip_link: str | No
     -----
     DynidWarning
         Physically inconsistent inertials (kept as given); non-positive velocity or effort
-        limits (treated as unbounded).
+        limits (treated as unbounded); joint-origin angles rounded near multiples of pi/2.
 
     Examples
     --------
@@ -582,4 +633,4 @@ def load_urdf(path: str | Path, base_link: str | None = None, tip_link: str | No
         raise ModelError(f"URDF file not found: {str(p)!r}") from exc
     except OSError as exc:
         raise ModelError(f"cannot read URDF file {str(p)!r}: {exc.strerror or exc}") from exc
-    return _robot_from_text(data, base_link, tip_link, f"URDF file {str(p)!r}")
+    return _robot_from_text(data, base_link, tip_link, f"URDF file {str(p)!r}", snap_angles)
