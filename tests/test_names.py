@@ -14,9 +14,14 @@ import contextlib
 import dataclasses
 import html
 import io
+import json
+import os
 import re
+import subprocess
+import sys
 import warnings
 import xml.etree.ElementTree as ET
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -31,7 +36,7 @@ from dynid.io.bounds_file import load_bounds, save_bounds
 from dynid.io.feasible import load_feasible_json, save_feasible_json
 from dynid.io.robot.mjcf import mjcf_from_robot
 from dynid.io.robot.toml import robot_from_toml_string, save_toml, toml_from_robot
-from dynid.io.robot.urdf import robot_from_urdf_string, tip_name, urdf_from_robot
+from dynid.io.robot.urdf import robot_from_urdf_string, save_urdf, tip_name, urdf_from_robot
 
 from conftest import planar_2r
 
@@ -159,3 +164,27 @@ def test_template_with_dtd_entity_link_names_exports(tmp_path):
     text = out.read_text(encoding="utf-8")
     assert "<!ENTITY l" in text and '<link name="&l;1">' in text  # the rest kept as written
     np.testing.assert_allclose(dynid.Robot.from_urdf(out).phi, new.phi, rtol=1e-12)
+
+
+def _run_c_locale(args: list[str], cwd: Path) -> subprocess.CompletedProcess:
+    """``dynid ARGS`` under a C locale without UTF-8 mode or locale coercion."""
+    env = dict(os.environ, LC_ALL="C", LANG="C", PYTHONUTF8="0", PYTHONCOERCECLOCALE="0")
+    env["PYTHONPATH"] = os.pathsep.join([str(Path(dynid.__file__).parents[1]), *sys.path])
+    return subprocess.run(
+        [sys.executable, "-m", "dynid", *args], cwd=cwd, env=env, capture_output=True, timeout=120
+    )
+
+
+def test_non_ascii_frame_name_under_c_locale(tmp_path):
+    """A non-ASCII --frame is found under LC_ALL=C without UTF-8 mode as under UTF-8 (it
+    arrived surrogate-escaped and was unknown), and a non-ASCII robot file still opens."""
+    r = _named(["b\u00e4se", "l\u00efnk1", "\u94fe2", "j1", "j2", "w\u00fcrfel", "t\u00f6ol", "r"])
+    urdf = tmp_path / "r\u00f6bot.urdf"
+    save_urdf(urdf, r, all_frames=True)
+    args = ["fk", "--robot", urdf.name, "--tip", "flange", "--q", "0.1,0.2", "--json"]
+    c = _run_c_locale([*args, "--frame", "w\u00fcrfel"], tmp_path)
+    assert c.returncode == 0, c.stderr.decode()
+    T = np.array(json.loads(c.stdout)["T"])
+    np.testing.assert_allclose(T, dynid.fk(r, np.array([0.1, 0.2]), "w\u00fcrfel"), atol=1e-12)
+    c = _run_c_locale([*args, "--frame", "nicht-da-\u00fc"], tmp_path)
+    assert c.returncode == 2 and b"Unknown frame 'nicht-da-\\xfc'" in c.stderr

@@ -189,6 +189,30 @@ def _printable_streams() -> None:
             stream.reconfigure(errors="backslashreplace")
 
 
+#: Options whose values may name files: they keep the form the locale gave them, which the
+#: file system needs (``--columns`` names a file only when it ends in ``.toml``).
+FILE_OPTIONS = frozenset({"robot", "params", "prior", "trajectory", "columns"})
+_SURROGATE = re.compile("[\udc80-\udcff]")
+
+
+def decode_text_options(args: argparse.Namespace) -> None:
+    """Decode, as UTF-8, the text options whose non-ASCII bytes the locale could not decode.
+
+    Under an ASCII locale without UTF-8 mode (``LC_ALL=C PYTHONUTF8=0``) the interpreter
+    gives each such byte as a surrogate escape (``w\\udcc3\\udcbcrfel``): a frame, link,
+    joint or column name would not be the name the robot or the file holds (read as UTF-8).
+    Names are decoded in place, so that they mean the same under every locale; values that
+    may name files (:data:`FILE_OPTIONS`, and every ``Path``) keep the escaped form, which
+    opens the file.
+    """
+    for dest, value in vars(args).items():
+        if not isinstance(value, str) or not _SURROGATE.search(value):
+            continue
+        if dest in FILE_OPTIONS and (dest != "columns" or value.lower().endswith(".toml")):
+            continue
+        setattr(args, dest, os.fsencode(value).decode("utf-8", "surrogateescape"))
+
+
 @contextlib.contextmanager
 def _output_set(args: argparse.Namespace, argv: Sequence[str]) -> Iterator[RunOutput | None]:
     """The run's output set under ``--out`` (:func:`dynid.io.run_output.run_output`)."""
@@ -212,6 +236,7 @@ def main(argv: Sequence[str] | None = None) -> int:
         args = parser.parse_args(argv)
     except SystemExit as exc:  # --help, --version, or a refused option (one line printed)
         return exc.code if isinstance(exc.code, int) else 2
+    decode_text_options(args)
     level = (
         logging.ERROR
         if args.quiet
