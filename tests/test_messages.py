@@ -13,7 +13,7 @@ from pathlib import Path
 
 import pytest
 
-from dynid.cli.__main__ import main
+from dynid.cli.__main__ import main, out_of_memory
 
 
 def _main(*args: str) -> subprocess.CompletedProcess:
@@ -44,3 +44,20 @@ def test_too_few_rows_name_the_dependent_columns(
     assert r.returncode == 2
     assert "rank 28 < 43" in r.stderr and "nearly dependent columns: beta" in r.stderr, r.stderr
     assert "?" not in r.stderr
+
+
+def test_a_huge_pool_is_refused_naming_pool(tmp_path):
+    """``acquire-static --pool 1000000000``: refused before sampling, naming --pool (it said
+    "give a smaller n", and a smaller pool that ran out of memory got a hint about logs)."""
+    r = _main("acquire-static", "--pool", "1000000000", "--out", str(tmp_path / "s.csv"))
+    assert r.returncode == 2 and "--pool" in r.stderr and "smaller n" not in r.stderr, r.stderr
+    assert not (tmp_path / "s.csv").exists()
+
+
+def test_out_of_memory_hint_fits_the_command():
+    """The out-of-memory hint names what the command can make smaller: configurations for
+    acquire-static, the log only for the commands that read one."""
+    assert "(--n, --pool)" in out_of_memory(MemoryError(), "acquire-static")
+    assert "log" not in out_of_memory(MemoryError(), "acquire-static")
+    assert "DYNID_MAX_STACK_BYTES" in out_of_memory(MemoryError(), "identify")
+    assert out_of_memory(MemoryError(), "retrieve").endswith("machine's memory: raise it")

@@ -284,7 +284,7 @@ def main(argv: Sequence[str] | None = None) -> int:
     except MemoryError as exc:
         if args.debug:
             raise
-        print(f"{say}: error: {out_of_memory(exc)}", file=_stderr())
+        print(f"{say}: error: {out_of_memory(exc, args.command)}", file=_stderr())
         return 2
     except Exception as exc:  # anything unexpected: one line, never a traceback
         if args.debug:
@@ -297,9 +297,22 @@ def main(argv: Sequence[str] | None = None) -> int:
         return 2
 
 
-def out_of_memory(exc: MemoryError) -> str:
+#: What makes each command's memory smaller, for the out-of-memory hint (the commands that
+#: read a torque log share the last entry).
+_SMALLER = {
+    "acquire-static": "or give fewer configurations (--n, --pool)",
+    "simulate": "or give a shorter log (--duration, --rate)",
+}
+_LOG_COMMANDS = ("identify", "validate", "friction", "payload", "import")
+_SMALLER_LOG = (
+    "or give a shorter log (a long one streams its regressor in blocks above "
+    "DYNID_MAX_STACK_BYTES bytes: lower it)"
+)
+
+
+def out_of_memory(exc: MemoryError, command: str | None = None) -> str:
     """One line for a process out of memory: the step (the innermost dynid function) and
-    how to raise or avoid the limit."""
+    how to raise the limit or, for ``command``, what to make smaller."""
     where = "?"
     tb = exc.__traceback__
     while tb is not None:
@@ -307,10 +320,10 @@ def out_of_memory(exc: MemoryError) -> str:
         if mod.startswith("dynid."):
             where = f"{tb.tb_frame.f_code.co_name} ({mod})"
         tb = tb.tb_next
+    smaller = _SMALLER_LOG if command in _LOG_COMMANDS else _SMALLER.get(command or "", "")
     return (
         f"out of memory in {where}; hint: the limit is the process's address space (ulimit "
-        "-v) or the machine's memory: raise it, or give a shorter log (a long one streams "
-        "its regressor in blocks above DYNID_MAX_STACK_BYTES bytes: lower it)"
+        f"-v) or the machine's memory: raise it{', ' + smaller if smaller else ''}"
     )
 
 

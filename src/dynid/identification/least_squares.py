@@ -322,8 +322,7 @@ def _fit(
             except _RankDeficient as exc:
                 names = _column_names(labels, exc.null, keep)
                 raise RankDeficientError(
-                    f"{exc.args[0]}; nearly dependent columns: "
-                    f"{', '.join(names) or 'none named'}",
+                    f"{exc.args[0]}; nearly dependent columns: {', '.join(names) or 'none named'}",
                     rank=exc.rank,
                     needed=rk,
                     dependent=names,
