@@ -229,6 +229,16 @@ def test_bag_errors(tmp_path):
         load_joint_state_bag(tmp_path / "c", robot.joint_names)
 
 
+def test_a_bag_whose_messages_share_one_stamp_names_them(tmp_path):
+    """Every message with the same header stamp: the error says so and gives the stamp (it
+    said "fewer than 2 usable messages (0 missing a joint or field, 0 with NaN)")."""
+    robot = dynid.panda()
+    msgs = [(T0_NS + k, T0_NS, *m[2:]) for k, m in enumerate(_shuffled(_small(robot), robot, 7))]
+    write_bag(tmp_path / "b", "mcap", msgs)
+    with pytest.raises(DataError, match=r"50 sharing one header stamp \(1700000000\.123456789 s\)"):
+        load_joint_state_bag(tmp_path / "b", robot.joint_names)
+
+
 def test_cli_import_writes_a_log_every_command_reads(tmp_path, capsys):
     """dynid import writes CSV/NPZ logs equal to the bag's; errors exit 2 with one line."""
     robot = dynid.panda()

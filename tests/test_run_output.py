@@ -173,6 +173,8 @@ def test_a_read_only_file_is_not_replaced_without_force(data, tmp_path):
     assert r.returncode == 2
     assert "identification.json is read-only; pass --force" in r.stderr, r.stderr
     assert _snapshot(out) == before
+    r = _main(*args[:-1])  # not quiet: it printed "wrote .../identification.json", then refused
+    assert r.returncode == 2 and "wrote" not in r.stdout, r.stdout
     assert _main(*args, "--force").returncode == 0
     assert (out / "identification.json").stat().st_mode & 0o200  # a new file, writable
 
@@ -180,8 +182,9 @@ def test_a_read_only_file_is_not_replaced_without_force(data, tmp_path):
     log.write_text("precious\n")
     log.chmod(0o444)
     sim = ("simulate", "--duration", "1", "--rate", "100", "--out", str(log), "-q")
-    r = _main(*sim)
+    r = _main(*sim[:-1])
     assert r.returncode == 2 and "log.csv is read-only" in r.stderr, r.stderr
+    assert "wrote" not in r.stdout, r.stdout
     assert log.read_text() == "precious\n"
     assert _main(*sim, "--force").returncode == 0
     assert log.read_text().startswith("#")

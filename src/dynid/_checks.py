@@ -6,6 +6,7 @@ finiteness; internal functions trust validated arrays.
 
 from __future__ import annotations
 
+import json
 import math
 import re
 import unicodedata
@@ -199,6 +200,14 @@ def numbers(value: Any, size: int, where: str, error: type[Exception]) -> NDArra
     if not isinstance(value, list | tuple) or len(value) != size:
         raise error(f"{where} must be a list of {size} numbers; got {short(value)}")
     return np.array([number(x, f"{where}[{k}]", error) for k, x in enumerate(value)])
+
+
+def toml_string(text: str) -> str:
+    """``text`` as a TOML basic string that reads back equal: JSON's escapes (valid in TOML)
+    for quotes, backslashes and control characters, DEL escaped, every other character as it
+    is (a ``\\ud83d`` surrogate escape, which JSON writes for characters beyond the BMP when
+    asked for ASCII, is not valid TOML)."""
+    return json.dumps(text, ensure_ascii=False).replace("\x7f", "\\u007f")
 
 
 def parse_toml(text: str, where: str, error: type[Exception]) -> dict[str, Any]:

@@ -189,6 +189,30 @@ def _printable_streams() -> None:
             stream.reconfigure(errors="backslashreplace")
 
 
+#: Options whose values may name files: they keep the form the locale gave them, which the
+#: file system needs (``--columns`` names a file only when it ends in ``.toml``).
+FILE_OPTIONS = frozenset({"robot", "params", "prior", "trajectory", "columns"})
+_SURROGATE = re.compile("[\udc80-\udcff]")
+
+
+def decode_text_options(args: argparse.Namespace) -> None:
+    """Decode, as UTF-8, the text options whose non-ASCII bytes the locale could not decode.
+
+    Under an ASCII locale without UTF-8 mode (``LC_ALL=C PYTHONUTF8=0``) the interpreter
+    gives each such byte as a surrogate escape (``w\\udcc3\\udcbcrfel``): a frame, link,
+    joint or column name would not be the name the robot or the file holds (read as UTF-8).
+    Names are decoded in place, so that they mean the same under every locale; values that
+    may name files (:data:`FILE_OPTIONS`, and every ``Path``) keep the escaped form, which
+    opens the file.
+    """
+    for dest, value in vars(args).items():
+        if not isinstance(value, str) or not _SURROGATE.search(value):
+            continue
+        if dest in FILE_OPTIONS and (dest != "columns" or value.lower().endswith(".toml")):
+            continue
+        setattr(args, dest, os.fsencode(value).decode("utf-8", "surrogateescape"))
+
+
 @contextlib.contextmanager
 def _output_set(args: argparse.Namespace, argv: Sequence[str]) -> Iterator[RunOutput | None]:
     """The run's output set under ``--out`` (:func:`dynid.io.run_output.run_output`)."""
@@ -212,6 +236,7 @@ def main(argv: Sequence[str] | None = None) -> int:
         args = parser.parse_args(argv)
     except SystemExit as exc:  # --help, --version, or a refused option (one line printed)
         return exc.code if isinstance(exc.code, int) else 2
+    decode_text_options(args)
     level = (
         logging.ERROR
         if args.quiet
@@ -259,7 +284,7 @@ def main(argv: Sequence[str] | None = None) -> int:
     except MemoryError as exc:
         if args.debug:
             raise
-        print(f"{say}: error: {out_of_memory(exc)}", file=_stderr())
+        print(f"{say}: error: {out_of_memory(exc, args.command)}", file=_stderr())
         return 2
     except Exception as exc:  # anything unexpected: one line, never a traceback
         if args.debug:
@@ -272,9 +297,22 @@ def main(argv: Sequence[str] | None = None) -> int:
         return 2
 
 
-def out_of_memory(exc: MemoryError) -> str:
+#: What makes each command's memory smaller, for the out-of-memory hint (the commands that
+#: read a torque log share the last entry).
+_SMALLER = {
+    "acquire-static": "or give fewer configurations (--n, --pool)",
+    "simulate": "or give a shorter log (--duration, --rate)",
+}
+_LOG_COMMANDS = ("identify", "validate", "friction", "payload", "import")
+_SMALLER_LOG = (
+    "or give a shorter log (a long one streams its regressor in blocks above "
+    "DYNID_MAX_STACK_BYTES bytes: lower it)"
+)
+
+
+def out_of_memory(exc: MemoryError, command: str | None = None) -> str:
     """One line for a process out of memory: the step (the innermost dynid function) and
-    how to raise or avoid the limit."""
+    how to raise the limit or, for ``command``, what to make smaller."""
     where = "?"
     tb = exc.__traceback__
     while tb is not None:
@@ -282,10 +320,10 @@ def out_of_memory(exc: MemoryError) -> str:
         if mod.startswith("dynid."):
             where = f"{tb.tb_frame.f_code.co_name} ({mod})"
         tb = tb.tb_next
+    smaller = _SMALLER_LOG if command in _LOG_COMMANDS else _SMALLER.get(command or "", "")
     return (
         f"out of memory in {where}; hint: the limit is the process's address space (ulimit "
-        "-v) or the machine's memory: raise it, or give a shorter log (a long one streams "
-        "its regressor in blocks above DYNID_MAX_STACK_BYTES bytes: lower it)"
+        f"-v) or the machine's memory: raise it{', ' + smaller if smaller else ''}"
     )
 
 

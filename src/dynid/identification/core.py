@@ -659,7 +659,7 @@ def _rank_error(
     """The estimator's rank error said for the data, with the data's hint."""
     needed = exc.needed if exc.needed is not None else len(columns.labels)
     what = "the base parameters" + "".join(f" and {t.name}" for t in columns.appended)
-    cols = ", ".join(exc.dependent) or "?"
+    cols = ", ".join(exc.dependent) or "none named"
     combos = "; ".join(exc.combinations) or cols
     return RankDeficientError(
         f"{data.source} ({stack.n_rows} rows) has rank {exc.rank} < {needed} needed for "

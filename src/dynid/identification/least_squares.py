@@ -367,8 +367,12 @@ def _fit(
             except _RankDeficient as exc:
                 names = _column_names(labels, exc.null, keep)
                 raise RankDeficientError(
-                    f"{exc.args[0]}; nearly dependent columns: {', '.join(names) or '?'}; "
-                    f"not excited by the data: {'; '.join(exc.combinations)}",
+                    f"{exc.args[0]}; nearly dependent columns: {', '.join(names) or 'none named'}"
+                    + (
+                        f"; not excited by the data: {'; '.join(exc.combinations)}"
+                        if exc.combinations
+                        else ""
+                    ),
                     rank=exc.rank,
                     needed=rk,
                     dependent=names,
@@ -616,10 +620,9 @@ def _solve_qr(
 
     Raises
     ------
-    RankDeficientError
-        Fewer rows than columns.
     _RankDeficient
-        Rank below the column count (with the null direction, for naming the columns).
+        Rank below the column count, fewer rows than columns included (with the null
+        direction, for naming the columns).
     """
     m, rk = Wk.shape
     norms = np.sqrt(np.einsum("ij,ij->j", Wk, Wk))
@@ -640,15 +643,16 @@ def _solve_qr(
     Q, R, piv = scipy.linalg.qr(A, mode="economic", pivoting=True)
     d = np.abs(np.diag(R))
     rank = int(np.sum(d > rtol * d[0])) if d.size and d[0] > 0 else 0
-    if m < rk:
-        raise RankDeficientError(
-            f"Regressor rank {rank} < {rk}: {m} rows for {rk} coefficients; add configurations",
-            rank=rank,
-            needed=rk,
-        )
-    cond, cond_u, vp = _conditioning(R, scale[piv])
+    cond, cond_u, vp = _conditioning(R, scale[piv])  # vp: a null direction when m < rk
     vmin = np.empty(rk)
     vmin[piv] = vp
+    if m < rk:
+        raise _RankDeficient(
+            f"Regressor rank {rank} < {rk}: {m} rows for {rk} coefficients; add configurations",
+            vmin,
+            rank,
+            (),
+        )
     if rank < rk:
         order = np.argsort(piv)  # R's columns back in the regressor's order
         raise _RankDeficient(

@@ -323,24 +323,30 @@ def _solve(
     Q, R, piv = scipy.linalg.qr(A / scale, mode="economic", pivoting=True)
     d = np.abs(np.diag(R))
     rank = int(np.sum(d > rtol * d[0])) if d.size and d[0] > 0 else 0
-    if m < rk:
-        raise RankDeficientError(
-            f"Regressor rank {rank} < {rk}: {m} rows for {rk} coefficients; add configurations"
-        )
     cond, cond_u, vp = _conditioning(R, scale[piv])
     vmin = np.empty(rk)
     vmin[piv] = vp
-    if rank < rk:
-        kl = tuple(labels[k] if labels is not None else f"column {k}" for k in idx)
-        combos = unexcited_combinations(R[:, np.argsort(piv)], scale, rank, kl)
+    if m < rk or rank < rk:
         names = _names(labels, vmin, idx)
+        combos: tuple[str, ...] = ()
+        if rank < rk and m >= rk:
+            kl = tuple(labels[k] if labels is not None else f"column {k}" for k in idx)
+            combos = unexcited_combinations(R[:, np.argsort(piv)], scale, rank, kl)
+        why = (
+            f"{m} rows for {rk} coefficients; add configurations"
+            if m < rk
+            else (
+                f"at rtol={rtol:g} (scaled cond {cond:.3g}); add configurations or excite the "
+                "trajectory more, or drop unidentifiable parameters"
+            )
+        )
         raise RankDeficientError(
-            f"Regressor rank {rank} < {rk} at rtol={rtol:g} (scaled cond {cond:.3g}); add "
-            "configurations or excite the trajectory more, or drop unidentifiable parameters; "
-            f"nearly dependent columns: {names}; not excited by the data: {'; '.join(combos)}",
+            f"Regressor rank {rank} < {rk} {why}; nearly dependent columns: "
+            f"{', '.join(names) or 'none named'}"
+            + (f"; not excited by the data: {'; '.join(combos)}" if combos else ""),
             rank=rank,
             needed=rk,
-            dependent=tuple(names.split(", ")),
+            dependent=names,
             combinations=combos,
         )
     z = scipy.linalg.solve_triangular(R, Q.T @ b)
@@ -355,14 +361,16 @@ def _solve(
     return _Solved(rank, cond, cond_u, vmin, beta, ss, gi, scale)
 
 
-def _names(labels: tuple[str, ...] | None, v: NDArray[np.float64], idx: NDArray[np.intp]) -> str:
+def _names(
+    labels: tuple[str, ...] | None, v: NDArray[np.float64], idx: NDArray[np.intp]
+) -> tuple[str, ...]:
     """The kept columns with large weight in ``v``, named (largest first, at most 8)."""
     a = np.abs(v)
     if not a.size or not a.max() > 0:
-        return "?"
+        return ()
     big = np.flatnonzero(a >= 0.1 * a.max())
     cols = idx[big[np.argsort(-a[big])][:8]]
-    return ", ".join(labels[k] if labels is not None else f"column {k}" for k in cols)
+    return tuple(labels[k] if labels is not None else f"column {k}" for k in cols)
 
 
 def _meat(

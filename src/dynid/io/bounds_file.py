@@ -20,7 +20,6 @@ rejected. Floats are written with Python's shortest round-trip representation.
 
 from __future__ import annotations
 
-import json
 from collections.abc import Mapping
 from pathlib import Path
 from typing import Any
@@ -179,7 +178,7 @@ def load_bounds(path: str | Path, robot: Robot) -> Bounds:
 
 def _toml_value(v: Any) -> str:
     if isinstance(v, str):
-        return json.dumps(v)
+        return _checks.toml_string(v)
     if isinstance(v, (list, tuple)):
         return "[" + ", ".join(_toml_value(x) for x in v) + "]"
     return repr(float(v))

@@ -376,9 +376,16 @@ def _assemble(
     n_dup = int(np.count_nonzero(~first))
     stamps, q, dq, tau = stamps[first], q[first], dq[first], tau[first]
     if stamps.size < 2:
+        same = ""
+        if n_dup:  # every usable message has the one stamp left
+            sec, ns = divmod(int(stamps[0]), 1_000_000_000)
+            same = (
+                f", {n_dup + 1} sharing one {source} stamp ({sec}.{ns:09d} s): a log needs "
+                "messages at distinct times"
+            )
         raise DataError(
             f"{name}: fewer than 2 usable JointState messages on {topic!r} "
-            f"({n_missing} missing a joint or field, {n_nonfinite} with NaN)"
+            f"({n_missing} missing a joint or field, {n_nonfinite} with NaN{same})"
         )
     t0 = int(stamps[0])
     t = (stamps - t0).astype(np.float64) * 1e-9

@@ -22,7 +22,9 @@
   replaced only with ``--force``; otherwise the run refuses before moving anything, with
   a line naming the files. A single ``--out FILE`` is the file the user named and is
   replaced.
-* **Read-only files** (no write permission) are never replaced without ``--force``.
+* **Read-only files** (no write permission) are never replaced without ``--force``. A
+  read-only or foreign target is refused as soon as the run writes the file (before the
+  command says it wrote it), and again when the set moves.
 * **Concurrent runs** into one folder are serialised at the moment of moving: each moves
   its complete set while holding a lock (``flock`` on the parent folder, released by the
   kernel when a process dies), so two sets never interleave; the last run's set stands.
@@ -233,7 +235,11 @@ class RunOutput:
 
     # ------------------------------------------------------------------ staging
     def stage(self, path: str | Path) -> Path | None:
-        """Where a file ``path`` of this run is written now (None: not under ``--out``)."""
+        """Where a file ``path`` of this run is written now (None: not under ``--out``).
+
+        Raises :class:`~dynid.exceptions.OutputError` when the file it would replace is
+        read-only or no run of this command recorded it (without ``--force``).
+        """
         if self.staging is None:
             return None
         p = Path(os.path.abspath(path))
@@ -248,6 +254,7 @@ class RunOutput:
                 return None
             if rel in (".", "") or rel == MANIFEST:
                 return None
+        self._check_targets([rel], self._owned())  # refused now, before "wrote" is said
         staged = self.staging / rel
         self._written.pop(rel, None)
         self._written[rel] = staged
@@ -273,6 +280,13 @@ class RunOutput:
         return Path(path)
 
     # ------------------------------------------------------------------ checks
+    def _owned(self) -> set[str]:
+        """The files of the folder's set that a run of this command may replace."""
+        old = _read_manifest(self.out) if self.kind == "folder" and self.out.is_dir() else None
+        return (
+            set(old["files"]) if old is not None and old.get("command") == self.command else set()
+        )
+
     def _check_other_command(self, manifest: dict | None) -> None:
         if manifest is None or manifest.get("command") == self.command:
             return
@@ -372,8 +386,7 @@ class RunOutput:
         old = _read_manifest(out) if out.is_dir() else None
         if old is not None and old.get("command") != self.command and not self.force:
             self._check_other_command(old)
-        same = old is not None and old.get("command") == self.command
-        owned = set(old["files"]) if same and old is not None else set()
+        owned = self._owned()
         self._check_targets(names, owned)
         with _signals_held():
             if not os.path.lexists(out):

@@ -25,6 +25,7 @@ random configurations to about 36.
 
 from __future__ import annotations
 
+import os
 from collections.abc import Callable
 from dataclasses import dataclass
 
@@ -170,6 +171,23 @@ def _greedy_design(
     return chosen
 
 
+def _check_pool_memory(robot: Robot, size: int) -> None:
+    """Refuse a pool whose static regressors (``size`` x (n(n+1)/2 + n) x 10 n floats, held
+    twice) need more than the machine's physical memory (unknown: not checked)."""
+    try:
+        memory = os.sysconf("SC_PHYS_PAGES") * os.sysconf("SC_PAGE_SIZE")
+    except (AttributeError, ValueError, OSError):  # pragma: no cover - not POSIX
+        return
+    n = robot.n
+    need = 2 * 8 * size * (n * (n + 1) // 2 + n) * 10 * n
+    if need > memory:
+        raise OptionError(
+            f"a pool of {size:.4g} configurations needs {need / 1e9:.3g} GB for their static "
+            f"regressors, more than this machine's {memory / 1e9:.3g} GB; give a smaller "
+            "pool_factor (--pool) or n (--n)"
+        )
+
+
 def select_static_configurations(
     robot: Robot,
     n: int,
@@ -227,7 +245,8 @@ def select_static_configurations(
     Raises
     ------
     OptionError
-        ``n < 1``, ``pool_factor < 2``, ``batches < 1`` or ``exchange < 0``.
+        ``n < 1``, ``pool_factor < 2``, ``batches < 1`` or ``exchange < 0``; a pool whose
+        static regressors need more than the machine's memory.
     LimitError
         Too few collision-free configurations, or limits narrower than the margin.
     """
@@ -236,6 +255,7 @@ def select_static_configurations(
             f"need n >= 1, pool_factor >= 2, batches >= 1 and exchange >= 0; got {n}, "
             f"{pool_factor}, {batches}, {exchange}"
         )
+    _check_pool_memory(robot, pool_factor * n)
     base = base_parameters(robot) if base is None else base
     pool = _collision_free_pool(robot, pool_factor * n, rng, margin, obstacles, radii, clearance)
     B = static_regressor(robot, pool)[..., base.independent]  # (P, s, r)

@@ -22,7 +22,6 @@ Every error names the joint or frame and the key.
 
 from __future__ import annotations
 
-import json
 import math
 import warnings
 from collections.abc import Mapping, Sequence
@@ -423,8 +422,8 @@ def _arr(v: Sequence[float] | NDArray[np.float64]) -> str:
 
 
 def _s(text: str) -> str:
-    """A TOML basic string (JSON escapes are valid TOML escapes)."""
-    return json.dumps(text, ensure_ascii=False)
+    """A TOML basic string (:func:`dynid._checks.toml_string`)."""
+    return _checks.toml_string(text)
 
 
 def _xyz_rpy(T: NDArray[np.float64]) -> tuple[str, str]:

@@ -97,12 +97,15 @@ def _line_indent(text: str, pos: int) -> str:
     return lead if lead.strip() == "" else ""
 
 
-def _link_spans(text: str) -> dict[str, tuple[int, int, int, bool]]:
-    """Link name -> (start, end of opening tag, end of element, self-closing), comments masked."""
+def _link_spans(text: str, names: list[str]) -> dict[str, tuple[int, int, int, bool]]:
+    """Link name -> (start, end of opening tag, end of element, self-closing), comments masked;
+    ``names``: the parser's, in document order (entities of the DTD resolved too)."""
     masked = _COMMENT.sub(lambda m: " " * len(m.group(0)), text)
     spans = {}
-    for m in _LINK.finditer(masked):
-        name = html.unescape(m.group(2))  # the name as the parser reads it: &amp; -> &
+    found = list(_LINK.finditer(masked))
+    if len(found) != len(names):
+        names = [html.unescape(m.group(2)) for m in found]  # &amp; -> &
+    for m, name in zip(found, names, strict=True):
         if m.group(3) == "/":
             spans[name] = (m.start(), m.end(), m.end(), True)
         else:
@@ -180,7 +183,7 @@ def patch_urdf_inertials(
     _check_same_chain(robot, chain, source)
     root = ET.fromstring(template)
     elems = {el.get("name"): el for el in root if el.tag.rsplit("}", 1)[-1] == "link"}
-    spans = _link_spans(template)
+    spans = _link_spans(template, [el.get("name", "") for el in root.iter("link")])
     moving = set(chain.link_names[1:])
     new_xml: dict[str, NDArray[np.float64] | None] = {}  # link -> phi, None: remove
     for k in range(1, robot.n + 1):

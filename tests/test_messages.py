@@ -1,0 +1,63 @@
+"""Messages that say what is true (issue 28): each case was a message that misled.
+
+Every case runs the command line in this process and checks the one line it prints (or the
+refusal of an option that does not apply to the route taken).
+"""
+
+from __future__ import annotations
+
+import contextlib
+import io
+import subprocess
+from pathlib import Path
+
+import pytest
+
+from dynid.cli.__main__ import main, out_of_memory
+
+
+def _main(*args: str) -> subprocess.CompletedProcess:
+    """``dynid *args`` in this process: its exit code, stdout and stderr."""
+    out, err = io.StringIO(), io.StringIO()
+    with contextlib.redirect_stdout(out), contextlib.redirect_stderr(err):
+        code = main(list(args))
+    return subprocess.CompletedProcess(["dynid", *args], code, out.getvalue(), err.getvalue())
+
+
+@pytest.fixture(scope="module")
+def one_configuration(tmp_path_factory) -> Path:
+    """Static data of one configuration: 34 rows for the Panda's 43 base parameters."""
+    path = tmp_path_factory.mktemp("messages") / "one.csv"
+    assert _main("acquire-static", "--n", "1", "--seed", "1", "--out", str(path)).returncode == 0
+    return path
+
+
+@pytest.mark.parametrize("stack_bytes", [None, "1000"], ids=["stacked", "streamed"])
+def test_too_few_rows_name_the_dependent_columns(
+    one_configuration, tmp_path, monkeypatch, stack_bytes
+):
+    """Fewer rows than coefficients names columns of a null direction; it said "nearly
+    dependent columns: ?" (and the streamed fit lost its names)."""
+    if stack_bytes is not None:
+        monkeypatch.setenv("DYNID_MAX_STACK_BYTES", stack_bytes)
+    r = _main("identify", "--data", str(one_configuration), "--out", str(tmp_path / "id"))
+    assert r.returncode == 2
+    assert "rank 28 < 43" in r.stderr and "nearly dependent columns: beta" in r.stderr, r.stderr
+    assert "?" not in r.stderr
+
+
+def test_a_huge_pool_is_refused_naming_pool(tmp_path):
+    """``acquire-static --pool 1000000000``: refused before sampling, naming --pool (it said
+    "give a smaller n", and a smaller pool that ran out of memory got a hint about logs)."""
+    r = _main("acquire-static", "--pool", "1000000000", "--out", str(tmp_path / "s.csv"))
+    assert r.returncode == 2 and "--pool" in r.stderr and "smaller n" not in r.stderr, r.stderr
+    assert not (tmp_path / "s.csv").exists()
+
+
+def test_out_of_memory_hint_fits_the_command():
+    """The out-of-memory hint names what the command can make smaller: configurations for
+    acquire-static, the log only for the commands that read one."""
+    assert "(--n, --pool)" in out_of_memory(MemoryError(), "acquire-static")
+    assert "log" not in out_of_memory(MemoryError(), "acquire-static")
+    assert "DYNID_MAX_STACK_BYTES" in out_of_memory(MemoryError(), "identify")
+    assert out_of_memory(MemoryError(), "retrieve").endswith("machine's memory: raise it")
