@@ -51,7 +51,7 @@ from pathlib import Path
 
 from .._parallel import available_cores
 from ..exceptions import DynidError
-from ..feasibility.retrieve import RetrievalOptions, RetrievalResult
+from ..feasibility.penalty import RetrievalOptions, RetrievalResult
 from ..io.feasible_bundle import save_feasible_bundle
 from ..workflows.retrieve import retrieve_file
 from .common import (

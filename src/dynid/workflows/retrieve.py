@@ -15,15 +15,14 @@ from typing import Literal
 
 from ..exceptions import DynidError
 from ..feasibility.bounds import Bounds, default_bounds
-from ..feasibility.one_step import identify_consistent
-from ..feasibility.retrieve import (
+from ..feasibility.convex import ConsistentResult, SDPOptions, identify_consistent, retrieve_sdp
+from ..feasibility.penalty import (
     RetrievalOptions,
     RetrievalProgress,
     RetrievalResult,
     retrieve,
     retrieve_from_static,
 )
-from ..feasibility.sdp import ConsistentResult, SDPOptions, retrieve_sdp
 from ..friction.model import SigmoidFriction
 from ..identification.model import IdentifiedModel
 from ..io.bounds_file import load_bounds

@@ -1,6 +1,10 @@
-"""Consistent identification straight from data (one step): torque logs or static data.
+"""The convex method's entry points: from identified coefficients (two-step,
+:func:`retrieve_sdp`) and from data (one step, :func:`identify_consistent`: torque logs or
+static data), and the drive adapter (:func:`with_drive`).
 
-The data's least-squares problem is the convex problem of :mod:`dynid.feasibility.sdp`
+Consistent identification straight from data (one step): torque logs or static data.
+
+One step: the data's least-squares problem is the convex problem of :mod:`dynid.feasibility.convex`
 with the data term taken on the data themselves: for ordinary least squares,
 
 .. math:: \\|W x - y\\|^2 = \\|W \\hat x - y\\|^2 + (x - \\hat x)^T W^T W (x - \\hat x),
@@ -16,24 +20,74 @@ fit is returned with the result (``result.identified``) for comparison.
 
 from __future__ import annotations
 
+import dataclasses
 from collections.abc import Callable, Sequence
 from dataclasses import replace
 from typing import Any, Literal
 
-from ..exceptions import WrongTypeError
-from ..identification.classical import identify_from_log
-from ..identification.data import StaticDataset
-from ..identification.estimators import Estimator, EstimatorName
-from ..identification.holdout import DEFAULT_FOLDS
-from ..identification.log import TorqueLog
-from ..identification.static import identify_static
-from ..model.drive import Drive
-from ..model.robot import Robot
-from .bounds import Bounds
-from .prior import Prior
-from .sdp import ConsistentResult, SDPOptions, coefficient_term, solve_consistent, with_drive
+from ...exceptions import WrongTypeError
+from ...identification.classical import identify_from_log
+from ...identification.data import StaticDataset
+from ...identification.estimators import Estimator, EstimatorName
+from ...identification.holdout import DEFAULT_FOLDS
+from ...identification.log import TorqueLog
+from ...identification.model import IdentifiedModel
+from ...identification.static import identify_static
+from ...model.drive import Drive
+from ...model.robot import Robot
+from ..bounds import Bounds
+from ..prior import Prior
+from .data_term import coefficient_term
+from .options import SDPOptions
+from .result import ConsistentResult
+from .solve import solve_consistent
 
-__all__ = ["identify_consistent"]
+__all__ = ["identify_consistent", "retrieve_sdp", "with_drive"]
+
+
+def retrieve_sdp(
+    model: IdentifiedModel,
+    *,
+    prior: Prior | Robot | None = None,
+    bounds: Bounds | None = None,
+    total_mass: tuple[float, float] | None = None,
+    options: SDPOptions | None = None,
+    constraints: Sequence[Callable[..., Any]] = (),
+) -> ConsistentResult:
+    """Consistent link parameters from identified coefficients (two-step, convex).
+
+    The coefficients' full covariance weighs the data term (``model.fit.covariance``);
+    exact coefficients are met exactly. Parameters as in :func:`solve_consistent`; the
+    result's robot carries ``model.robot``'s kinematics and friction.
+
+    Examples
+    --------
+    >>> import dynid
+    >>> from dynid.feasibility.convex import retrieve_sdp
+    >>> robot = dynid.panda()
+    >>> data = dynid.acquire_static(dynid.SimulatedController(robot), 100, np.random.default_rng(0))
+    >>> res = retrieve_sdp(dynid.identify_static(robot, data), prior=robot)  # doctest: +SKIP
+    """
+    res = solve_consistent(
+        model.robot,
+        coefficient_term(model),
+        prior=prior,
+        bounds=bounds,
+        total_mass=total_mass,
+        options=options,
+        constraints=constraints,
+        kind="coefficients",
+    )
+    return res if model.drive is None else with_drive(res, model.drive)
+
+
+def with_drive(res: ConsistentResult, drive: Drive) -> ConsistentResult:
+    """The result with its drive, whose rotor inertias are the identified ones (known from
+    then on: a simulator or a validation takes them as given)."""
+    ia = res.rotor_inertia if drive.rotor_inertia is None else drive.rotor_inertia
+    if ia is None:
+        return dataclasses.replace(res, drive=drive)
+    return dataclasses.replace(res, drive=dataclasses.replace(drive, rotor_inertia=ia))
 
 
 def identify_consistent(
@@ -62,7 +116,7 @@ def identify_consistent(
     data : TorqueLog or StaticDataset
         A torque log of an exciting trajectory, or static ``q, M, g`` data.
     prior, bounds, total_mass, options, constraints
-        As in :func:`~dynid.feasibility.sdp.solve_consistent`.
+        As in :func:`~dynid.feasibility.convex.solve.solve_consistent`.
     cutoff_hz, decimate
         Torque logs: the classical route's filtering and decimation.
     rtol : float, optional
