@@ -4,6 +4,8 @@
   logs or static data): every link's pseudo-inertia kept positive definite, pulled towards
   a :class:`Prior` (:mod:`.convex`, :mod:`.lmi`, :mod:`.prior`).
 * :func:`retrieve`: Gaz et al. 2019, Algorithm 1 (:mod:`.penalty`).
+* :data:`METHODS`: both methods behind one registry, each answering "from coefficients"
+  and "from data" (:class:`ConsistentMethod`, :mod:`.methods`).
 * :class:`FeasibleResult`: what both methods return (:class:`ConsistentResult`,
   :class:`RetrievalResult`) and files and figures read (:mod:`.result`).
 * :func:`compare_methods`: both on the same coefficients (:mod:`.compare`).
@@ -25,13 +27,16 @@ from .convex import (
     solve_consistent,
 )
 from .lmi import log_det_divergence, pseudo_inertia, pseudo_inertia_margin
+from .methods import METHODS, ConsistentMethod, method
 from .payload import PayloadEstimate, identify_payload, robot_with_payload
 from .penalty import RetrievalOptions, RetrievalResult, retrieve, retrieve_from_static
 from .prior import Prior, generic_prior, prior_from_robot
 from .result import FeasibleResult
 
 __all__ = [
+    "METHODS",
     "Bounds",
+    "ConsistentMethod",
     "ConsistentResult",
     "FeasibleResult",
     "MethodSummary",
@@ -48,6 +53,7 @@ __all__ = [
     "identify_payload",
     "kinematic_bounds",
     "log_det_divergence",
+    "method",
     "panda_bounds",
     "perturbed_robot",
     "prior_from_robot",

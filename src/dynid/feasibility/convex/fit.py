@@ -1,11 +1,11 @@
 """The convex method's entry points: from identified coefficients (two-step,
 :func:`retrieve_sdp`) and from data (one step, :func:`identify_consistent`: torque logs or
-static data), and the drive adapter (:func:`with_drive`).
+static data), the drive adapter (:func:`with_drive`) and the method's registry entry
+(:data:`METHOD`, :mod:`dynid.feasibility.methods`).
 
-Consistent identification straight from data (one step): torque logs or static data.
-
-One step: the data's least-squares problem is the convex problem of :mod:`dynid.feasibility.convex`
-with the data term taken on the data themselves: for ordinary least squares,
+One step: the data's least-squares problem is the convex problem of
+:mod:`dynid.feasibility.convex` with the data term taken on the data themselves: for
+ordinary least squares,
 
 .. math:: \\|W x - y\\|^2 = \\|W \\hat x - y\\|^2 + (x - \\hat x)^T W^T W (x - \\hat x),
 
@@ -25,7 +25,7 @@ from collections.abc import Callable, Sequence
 from dataclasses import replace
 from typing import Any, Literal
 
-from ...exceptions import WrongTypeError
+from ...exceptions import OptionError, WrongTypeError
 from ...identification.classical import identify_from_log
 from ...identification.data import StaticDataset
 from ...identification.estimators import Estimator, EstimatorName
@@ -42,7 +42,7 @@ from .options import SDPOptions
 from .result import ConsistentResult
 from .solve import solve_consistent
 
-__all__ = ["identify_consistent", "retrieve_sdp", "with_drive"]
+__all__ = ["METHOD", "ConvexMethod", "identify_consistent", "retrieve_sdp", "with_drive"]
 
 
 def retrieve_sdp(
@@ -184,3 +184,70 @@ def identify_consistent(
     )
     res = replace(res, identified=model)
     return res if drive is None else with_drive(res, drive)
+
+
+class ConvexMethod:
+    """The convex method in the registry of consistent-parameter methods
+    (:class:`~dynid.feasibility.methods.ConsistentMethod`): :func:`retrieve_sdp` from
+    coefficients, :func:`identify_consistent` from a torque log or static data.
+
+    One solver in this process: ``workers`` is refused, ``seed`` and ``progress`` (per
+    finished run of a method with runs) have nothing to act on.
+    """
+
+    name = "sdp"
+    description = "convex LMI retrieval with a prior (default)"
+    options_type: type = SDPOptions
+    parallel = False
+
+    def _checked(self, options: Any, workers: int | None) -> SDPOptions | None:
+        if workers is not None:
+            raise OptionError(
+                "workers apply to the penalty method (its runs); the convex method solves one "
+                "problem in this process"
+            )
+        if options is not None and not isinstance(options, SDPOptions):
+            raise WrongTypeError(
+                f"the convex method takes SDPOptions; got {type(options).__name__}"
+            )
+        return options
+
+    def from_coefficients(
+        self,
+        model: IdentifiedModel,
+        *,
+        prior: Prior | Robot | None = None,
+        bounds: Bounds | None = None,
+        total_mass: tuple[float, float] | None = None,
+        options: SDPOptions | None = None,
+        workers: int | None = None,
+        seed: int | None = 0,
+        progress: Callable[[Any], None] | None = None,
+    ) -> ConsistentResult:
+        """:func:`retrieve_sdp` (``workers`` refused: :class:`~dynid.exceptions.OptionError`)."""
+        opts = self._checked(options, workers)
+        return retrieve_sdp(model, prior=prior, bounds=bounds, total_mass=total_mass, options=opts)
+
+    def from_data(
+        self,
+        robot: Robot,
+        data: TorqueLog | StaticDataset,
+        *,
+        prior: Prior | Robot | None = None,
+        bounds: Bounds | None = None,
+        total_mass: tuple[float, float] | None = None,
+        options: SDPOptions | None = None,
+        workers: int | None = None,
+        seed: int | None = 0,
+        progress: Callable[[Any], None] | None = None,
+    ) -> ConsistentResult:
+        """:func:`identify_consistent` with its defaults for a torque log (the cut-off read
+        from the log, ordinary least squares, held-out folds) (``workers`` refused)."""
+        opts = self._checked(options, workers)
+        return identify_consistent(
+            robot, data, prior=prior, bounds=bounds, total_mass=total_mass, options=opts
+        )
+
+
+#: the convex method's entry in :data:`dynid.feasibility.methods.METHODS`
+METHOD = ConvexMethod()

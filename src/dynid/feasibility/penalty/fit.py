@@ -1,7 +1,8 @@
 """The penalty method's entry points: from identified coefficients (:func:`retrieve`,
 :func:`retrieve_from_coefficients`) and from static data (:func:`retrieve_from_static`, the
 single-step variant), each a :class:`~dynid.feasibility.penalty.objective.PenaltyProblem`
-solved by Algorithm 1 (:mod:`dynid.feasibility.penalty.algorithm`)."""
+solved by Algorithm 1 (:mod:`dynid.feasibility.penalty.algorithm`); the method's registry
+entry (:data:`METHOD`, :mod:`dynid.feasibility.methods`)."""
 
 from __future__ import annotations
 
@@ -10,7 +11,8 @@ from typing import Any
 
 from numpy.typing import ArrayLike
 
-from ...exceptions import ModelError, ShapeError
+from ...exceptions import ModelError, ShapeError, WrongTypeError
+from ...identification.log import TorqueLog
 from ...identification.model import IdentifiedModel
 from ...model.robot import Robot
 from ...regressors.base import BaseParameters
@@ -25,7 +27,13 @@ from .objective import (
 from .options import RetrievalOptions
 from .result import RetrievalProgress, RetrievalResult
 
-__all__ = ["retrieve", "retrieve_from_coefficients", "retrieve_from_static"]
+__all__ = [
+    "METHOD",
+    "PenaltyMethod",
+    "retrieve",
+    "retrieve_from_coefficients",
+    "retrieve_from_static",
+]
 
 
 def _prior_problem(
@@ -267,3 +275,83 @@ def retrieve_from_static(
         progress=progress,
         require_feasible=require_feasible,
     )
+
+
+class PenaltyMethod:
+    """The paper's penalty method in the registry of consistent-parameter methods
+    (:class:`~dynid.feasibility.methods.ConsistentMethod`): :func:`retrieve` from
+    coefficients, :func:`retrieve_from_static` from static data (a torque log is refused:
+    identify it first, or take the convex method)."""
+
+    name = "penalty"
+    description = "the paper's penalty method (Gaz et al. 2019, Algorithm 1)"
+    options_type: type = RetrievalOptions
+    parallel = True
+
+    @staticmethod
+    def _checked(options: Any) -> RetrievalOptions | None:
+        if options is not None and not isinstance(options, RetrievalOptions):
+            raise WrongTypeError(
+                f"the penalty method takes RetrievalOptions; got {type(options).__name__}"
+            )
+        return options
+
+    def from_coefficients(
+        self,
+        model: IdentifiedModel,
+        *,
+        prior: Any = None,
+        bounds: Bounds | None = None,
+        total_mass: tuple[float, float] | None = None,
+        options: RetrievalOptions | None = None,
+        workers: int | None = None,
+        seed: int | None = 0,
+        progress: Callable[[RetrievalProgress], None] | None = None,
+    ) -> RetrievalResult:
+        """:func:`retrieve`."""
+        return retrieve(
+            model,
+            prior=prior,
+            bounds=bounds,
+            total_mass=total_mass,
+            options=self._checked(options),
+            workers=workers,
+            seed=seed,
+            progress=progress,
+        )
+
+    def from_data(
+        self,
+        robot: Robot,
+        data: Any,
+        *,
+        prior: Any = None,
+        bounds: Bounds | None = None,
+        total_mass: tuple[float, float] | None = None,
+        options: RetrievalOptions | None = None,
+        workers: int | None = None,
+        seed: int | None = 0,
+        progress: Callable[[RetrievalProgress], None] | None = None,
+    ) -> RetrievalResult:
+        """:func:`retrieve_from_static`; a torque log raises
+        :class:`~dynid.exceptions.WrongTypeError`."""
+        if isinstance(data, TorqueLog):
+            raise WrongTypeError(
+                "the penalty method fits static data in one step, not a torque log: identify "
+                "the log first and retrieve from its coefficients, or use the convex method"
+            )
+        return retrieve_from_static(
+            robot,
+            data,
+            prior=prior,
+            bounds=bounds,
+            total_mass=total_mass,
+            options=self._checked(options),
+            workers=workers,
+            seed=seed,
+            progress=progress,
+        )
+
+
+#: the penalty method's entry in :data:`dynid.feasibility.methods.METHODS`
+METHOD = PenaltyMethod()
