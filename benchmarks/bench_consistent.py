@@ -35,10 +35,12 @@ from common import Case, Timing, bench_parser, check_close, report  # noqa: E402
 
 import dynid  # noqa: E402
 from dynid.feasibility.compare import perturbed_robot  # noqa: E402
+from dynid.feasibility.convex import (
+    identify_consistent,  # noqa: E402
+    retrieve_sdp,  # noqa: E402
+)
 from dynid.feasibility.lmi import pseudo_inertia_margin  # noqa: E402
-from dynid.feasibility.one_step import identify_consistent  # noqa: E402
-from dynid.feasibility.retrieve import retrieve  # noqa: E402
-from dynid.feasibility.sdp import retrieve_sdp  # noqa: E402
+from dynid.feasibility.penalty import retrieve  # noqa: E402
 from dynid.identification.least_squares import LeastSquaresFit  # noqa: E402
 from dynid.identification.model import IdentifiedModel  # noqa: E402
 from dynid.regressors.base import base_parameters  # noqa: E402

@@ -23,7 +23,7 @@ import numpy as np
 
 import dynid
 from dynid.feasibility.constraints import UserConstraint
-from dynid.feasibility.retrieve import RetrievalOptions, retrieve_from_coefficients
+from dynid.feasibility.penalty import RetrievalOptions, retrieve_from_coefficients
 from dynid.regressors.base import base_parameters
 
 

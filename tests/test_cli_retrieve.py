@@ -179,7 +179,7 @@ def test_demo_feasible_stage_retrieves_validates_and_writes_its_files(tmp_path, 
 
     import dynid.pipeline.stages as stages
     from dynid.cli.demo_stages import format_feasible_stage, save_feasible_stage
-    from dynid.feasibility.retrieve import RetrievalOptions
+    from dynid.feasibility.penalty import RetrievalOptions
     from dynid.friction.model import SigmoidFriction
     from dynid.pipeline import feasible_stage
 

@@ -370,8 +370,8 @@ def test_links_only_and_the_retrievals_of_a_model_with_rotors():
     plus those rotors is the full model's M); the penalty method refuses a model with rotors;
     the convex retrieval identifies them (>= 0) next to the links."""
     from dynid.exceptions import ModelError
-    from dynid.feasibility.retrieve import retrieve
-    from dynid.feasibility.sdp import retrieve_sdp
+    from dynid.feasibility.convex import retrieve_sdp
+    from dynid.feasibility.penalty import retrieve
     from dynid.identification.static import identify_static
     from dynid.simulation.controller import SimulatedController, acquire_static
     from dynid.simulation.unmodelled import UnmodelledEffects

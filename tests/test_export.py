@@ -14,7 +14,7 @@ import pytest
 import dynid
 from dynid.exceptions import DataError
 from dynid.feasibility.bounds import default_bounds, panda_bounds
-from dynid.feasibility.retrieve import RetrievalOptions, retrieve_from_coefficients
+from dynid.feasibility.penalty import RetrievalOptions, retrieve_from_coefficients
 from dynid.identification.least_squares import LeastSquaresFit
 from dynid.identification.model import IdentifiedModel
 from dynid.io.bounds_file import bounds_from_dict, load_bounds, save_bounds

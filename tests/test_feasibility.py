@@ -25,9 +25,10 @@ from dynid.feasibility.constraints import (
     link_params,
     user_constraints,
 )
-from dynid.feasibility.penalty import coefficient_problem, phi_from_params
-from dynid.feasibility.retrieve import (
+from dynid.feasibility.penalty import (
     RetrievalOptions,
+    coefficient_problem,
+    phi_from_params,
     retrieve,
     retrieve_from_coefficients,
     retrieve_from_static,

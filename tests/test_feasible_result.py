@@ -14,9 +14,9 @@ import numpy as np
 import pytest
 
 from dynid.feasibility.constraints import feasibility_report
+from dynid.feasibility.convex import ConsistentResult, retrieve_sdp
+from dynid.feasibility.penalty import RetrievalOptions, RetrievalResult, retrieve
 from dynid.feasibility.result import FeasibleResult
-from dynid.feasibility.retrieve import RetrievalOptions, RetrievalResult, retrieve
-from dynid.feasibility.sdp import ConsistentResult, retrieve_sdp
 from dynid.io.feasible import feasible_to_dict
 from dynid.io.report_json import report_to_dict, save_report_json
 

@@ -16,7 +16,7 @@ import pytest
 import dynid
 from dynid.cli.__main__ import main
 from dynid.feasibility.bounds import default_bounds
-from dynid.feasibility.one_step import identify_consistent
+from dynid.feasibility.convex import identify_consistent
 from dynid.model.drive import Drive
 from dynid.simulation.measurement import SensorNoise, sample_times, simulate_measurement
 from dynid.simulation.trajectories import random_fourier

@@ -233,7 +233,7 @@ def test_a_failing_figure_is_skipped_with_a_note(model, tmp_path, monkeypatch, c
 
 _SCS_RUN = """
 import numpy as np, cvxpy as cp
-from dynid.feasibility.sdp import _scs
+from dynid.feasibility.convex.problem import _scs
 rng = np.random.default_rng(0); n = 120
 C = rng.normal(size=(n, n)); C = C + C.T
 X = cp.Variable((n, n), PSD=True)

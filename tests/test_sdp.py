@@ -13,10 +13,9 @@ import pytest
 import dynid
 from dynid.exceptions import InfeasibleError, ModelError, ShapeError
 from dynid.feasibility.bounds import panda_bounds
+from dynid.feasibility.convex import SDPOptions, identify_consistent, retrieve_sdp
 from dynid.feasibility.lmi import pseudo_inertia_margin
-from dynid.feasibility.one_step import identify_consistent
 from dynid.feasibility.prior import generic_prior, prior_from_robot
-from dynid.feasibility.sdp import SDPOptions, retrieve_sdp
 from dynid.identification.log import prepare_log
 from dynid.simulation.measurement import SensorNoise, sample_times, simulate_measurement
 from dynid.simulation.trajectories import random_fourier

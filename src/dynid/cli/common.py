@@ -272,8 +272,8 @@ def parse_mass_band(text: str | None) -> tuple[float, float] | None:
 
 
 def sdp_options(args: argparse.Namespace) -> Any:
-    """:class:`~dynid.feasibility.sdp.SDPOptions` from the consistency options."""
-    from ..feasibility.sdp import DEFAULT_SDP_MARGIN, SDPOptions  # scipy: kept off fk's start-up
+    """:class:`~dynid.feasibility.convex.options.SDPOptions` from the consistency options."""
+    from ..feasibility.convex import DEFAULT_SDP_MARGIN, SDPOptions  # scipy: kept off fk's start-up
 
     return SDPOptions(
         objective=args.objective or "logdet",

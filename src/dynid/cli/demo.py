@@ -38,7 +38,7 @@ import time
 from pathlib import Path
 from typing import Any
 
-from ..feasibility.retrieve import RetrievalProgress
+from ..feasibility.penalty import RetrievalProgress
 from ..model.panda import panda
 from ..model.robot import Robot
 from ..pipeline import ConsistentSetup, StageFinished, StageStarted, run_demo

@@ -9,7 +9,7 @@ from __future__ import annotations
 from pathlib import Path
 from typing import Any
 
-from ..feasibility.sdp import ConsistentResult
+from ..feasibility.convex import ConsistentResult
 from ..friction.fit import FrictionFit, FrictionResidual
 from ..friction.validation import Validation
 from ..plots import feasible as feasible_plots

@@ -51,7 +51,9 @@ from pathlib import Path
 
 from .._parallel import available_cores
 from ..exceptions import DynidError
-from ..feasibility.retrieve import RetrievalOptions, RetrievalResult
+from ..feasibility.convex import ConsistentResult
+from ..feasibility.methods import METHODS
+from ..feasibility.penalty import RetrievalOptions, RetrievalResult
 from ..io.feasible_bundle import save_feasible_bundle
 from ..workflows.retrieve import retrieve_file
 from .common import (
@@ -91,9 +93,9 @@ def register(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParser:
     add_robot_options(p)
     p.add_argument(
         "--method",
-        choices=("sdp", "penalty"),
-        default="sdp",
-        help="convex LMI retrieval with a prior (default) or the paper's penalty method",
+        choices=tuple(METHODS),
+        default=next(iter(METHODS)),
+        help="; ".join(f"{m.name}: {m.description}" for m in METHODS.values()),
     )
     add_consistency_options(p)
     p.add_argument("--bounds", type=Path, default=None, help="bounds file (.json or .toml)")
@@ -103,16 +105,23 @@ def register(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParser:
     p.add_argument("--no-total-mass", action="store_true", help="drop the default total-mass band")
     d = RetrievalOptions()
     p.add_argument(
-        "--runs", type=count_type, default=d.runs, help=f"independent runs Q (default {d.runs})"
+        "--runs",
+        type=count_type,
+        default=None,
+        help=f"--method penalty: independent runs Q (default {d.runs})",
     )
     p.add_argument(
-        "--stages", type=count_type, default=d.stages, help=f"stages K per run (default {d.stages})"
+        "--stages",
+        type=count_type,
+        default=None,
+        help=f"--method penalty: stages K per run (default {d.stages})",
     )
     p.add_argument(
         "--workers",
         type=count_type,
         default=None,
-        help="processes (default: min(runs, cores); more than that is capped, with a note)",
+        help="--method penalty: processes (default: min(runs, cores); more than that is "
+        "capped, with a note)",
     )
     add_seed_option(p)
     p.add_argument(
@@ -123,23 +132,31 @@ def register(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParser:
     return p
 
 
+def _refuse(args: argparse.Namespace, flags: tuple[str, ...], method: str) -> None:
+    """One line naming the first of ``flags`` given, which apply to ``method`` only."""
+    for flag in flags:
+        if getattr(args, flag.removeprefix("--").replace("-", "_")) is not None:
+            raise DynidError(f"{flag} applies to --method {method} only")
+
+
 def _penalty_options(args: argparse.Namespace, console: Console) -> RetrievalOptions:
     """The penalty method's options; --margin and --objective are the convex method's;
     --workers above min(cores, runs) is capped, with a note."""
-    for flag, value in (("--margin", args.margin), ("--objective", args.objective)):
-        if value is not None:
-            raise DynidError(f"{flag} applies to --method sdp only")
+    _refuse(args, ("--margin", "--objective"), "sdp")
+    d = RetrievalOptions()
+    runs = d.runs if args.runs is None else args.runs
+    stages = d.stages if args.stages is None else args.stages
     try:
         extra = {} if args.prior_weight is None else {"prior_weight": args.prior_weight}
-        options = RetrievalOptions(runs=args.runs, stages=args.stages, **extra)
+        options = RetrievalOptions(runs=runs, stages=stages, **extra)
     except ValueError as exc:
         raise DynidError(f"--runs/--stages/--prior-weight: {exc}") from None
     if args.workers is not None:
         cores = available_cores()
-        cap = min(cores, args.runs)
+        cap = min(cores, runs)
         if args.workers > cap:
             console.notice(
-                f"note: --workers {args.workers}: using {cap} ({cores} cores, {args.runs} runs)"
+                f"note: --workers {args.workers}: using {cap} ({cores} cores, {runs} runs)"
             )
             args.workers = cap
     return options
@@ -148,7 +165,9 @@ def _penalty_options(args: argparse.Namespace, console: Console) -> RetrievalOpt
 def run(args: argparse.Namespace, console: Console) -> int:
     """Retrieve, write the outputs, print the summary; 0 if feasible, 1 if not."""
     penalty = args.method == "penalty"
-    options = _penalty_options(args, console) if penalty else None
+    if not penalty:  # the convex method solves one problem in this process
+        _refuse(args, ("--workers", "--runs", "--stages"), "penalty")
+    options = _penalty_options(args, console) if penalty else sdp_options(args)
     static = args.static is not None
     source = args.static if static else args.model
     note_prior(args, console)
@@ -164,7 +183,6 @@ def run(args: argparse.Namespace, console: Console) -> int:
         total_mass_band=not args.no_total_mass,
         total_mass=parse_mass_band(args.total_mass),
         friction=args.friction,
-        sdp_options=None if penalty else sdp_options(args),
         options=options,
         workers=args.workers,
         seed=args.seed,
@@ -174,7 +192,7 @@ def run(args: argparse.Namespace, console: Console) -> int:
     files += [] if args.no_figures else save_retrieval_figure(args.out, result)
     if isinstance(result, RetrievalResult):
         console.print(format_retrieval(result))
-    else:
+    elif isinstance(result, ConsistentResult):
         console.print(format_consistent(result))
     console.wrote(*files)
     return 0 if result.feasible else 1

@@ -8,9 +8,9 @@ from typing import Any
 import numpy as np
 
 from ..feasibility.constraints import principal_moments
+from ..feasibility.convex import ConsistentResult
 from ..feasibility.heldout import HeldOutJudgement
-from ..feasibility.retrieve import RetrievalProgress, RetrievalResult
-from ..feasibility.sdp import ConsistentResult
+from ..feasibility.penalty import RetrievalProgress, RetrievalResult
 from ..friction.validation import NewtonEulerValidation
 from ..identification.info import LogInfo
 from ..identification.model import IdentifiedModel

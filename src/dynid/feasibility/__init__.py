@@ -2,8 +2,10 @@
 
 * :func:`retrieve_sdp` (two-step) and :func:`identify_consistent` (one-step, from torque
   logs or static data): every link's pseudo-inertia kept positive definite, pulled towards
-  a :class:`Prior` (:mod:`.sdp`, :mod:`.one_step`, :mod:`.lmi`, :mod:`.prior`).
-* :func:`retrieve`: Gaz et al. 2019, Algorithm 1 (:mod:`.retrieve`, :mod:`.penalty`).
+  a :class:`Prior` (:mod:`.convex`, :mod:`.lmi`, :mod:`.prior`).
+* :func:`retrieve`: Gaz et al. 2019, Algorithm 1 (:mod:`.penalty`).
+* :data:`METHODS`: both methods behind one registry, each answering "from coefficients"
+  and "from data" (:class:`ConsistentMethod`, :mod:`.methods`).
 * :class:`FeasibleResult`: what both methods return (:class:`ConsistentResult`,
   :class:`RetrievalResult`) and files and figures read (:mod:`.result`).
 * :func:`compare_methods`: both on the same coefficients (:mod:`.compare`).
@@ -17,16 +19,24 @@ from ..friction.validation import validate_newton_euler
 from .bounds import Bounds, default_bounds, kinematic_bounds, panda_bounds
 from .compare import MethodSummary, compare_methods, perturbed_robot
 from .constraints import feasibility_report
+from .convex import (
+    ConsistentResult,
+    SDPOptions,
+    identify_consistent,
+    retrieve_sdp,
+    solve_consistent,
+)
 from .lmi import log_det_divergence, pseudo_inertia, pseudo_inertia_margin
-from .one_step import identify_consistent
+from .methods import METHODS, ConsistentMethod, method
 from .payload import PayloadEstimate, identify_payload, robot_with_payload
+from .penalty import RetrievalOptions, RetrievalResult, retrieve, retrieve_from_static
 from .prior import Prior, generic_prior, prior_from_robot
 from .result import FeasibleResult
-from .retrieve import RetrievalOptions, RetrievalResult, retrieve, retrieve_from_static
-from .sdp import ConsistentResult, SDPOptions, retrieve_sdp, solve_consistent
 
 __all__ = [
+    "METHODS",
     "Bounds",
+    "ConsistentMethod",
     "ConsistentResult",
     "FeasibleResult",
     "MethodSummary",
@@ -43,6 +53,7 @@ __all__ = [
     "identify_payload",
     "kinematic_bounds",
     "log_det_divergence",
+    "method",
     "panda_bounds",
     "perturbed_robot",
     "prior_from_robot",

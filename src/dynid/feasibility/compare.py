@@ -1,11 +1,12 @@
 """The consistent-parameter methods side by side on the same identified coefficients.
 
-:func:`compare_methods` runs the convex retrieval (:func:`~dynid.feasibility.sdp.retrieve_sdp`)
-and the paper's penalty method (:func:`~dynid.feasibility.retrieve.retrieve`, without and
-with the prior term) on one :class:`~dynid.identification.model.IdentifiedModel`, and
-summarises each (:class:`MethodSummary`): the residual on the coefficients, the smallest
-margin of every physical constraint, the distances to the prior and, in simulation, to the
-true parameters, and the wall time.
+:func:`compare_methods` runs the convex retrieval
+(:func:`~dynid.feasibility.convex.fit.retrieve_sdp`) and the paper's penalty method
+(:func:`~dynid.feasibility.penalty.fit.retrieve`, without and with the prior term) on one
+:class:`~dynid.identification.model.IdentifiedModel`, and summarises each
+(:class:`MethodSummary`): the residual on the coefficients, the smallest margin of every
+physical constraint, the distances to the prior and, in simulation, to the true
+parameters, and the wall time.
 """
 
 from __future__ import annotations
@@ -22,11 +23,11 @@ from ..model.inertia import inertial_from_phi, phi_from_inertial
 from ..model.robot import Robot
 from .bounds import Bounds
 from .constraints import feasibility_report
+from .convex import SDPOptions, retrieve_sdp
 from .lmi import repair_pseudo_inertia
+from .penalty import RetrievalOptions, retrieve
 from .prior import Prior, prior_from_robot
 from .result import FeasibleResult
-from .retrieve import RetrievalOptions, retrieve
-from .sdp import SDPOptions, retrieve_sdp
 
 __all__ = ["MethodSummary", "compare_methods", "perturbed_robot"]
 
@@ -42,8 +43,8 @@ class MethodSummary:
     name : str
         ``"sdp"``, ``"penalty"`` or ``"penalty + prior"``.
     result : FeasibleResult
-        :class:`~dynid.feasibility.sdp.ConsistentResult` or
-        :class:`~dynid.feasibility.retrieve.RetrievalResult`.
+        :class:`~dynid.feasibility.convex.result.ConsistentResult` or
+        :class:`~dynid.feasibility.penalty.result.RetrievalResult`.
     feasible : bool
     relative_residual : float
         ``||P phi - beta|| / ||beta||`` over the kept coefficients.

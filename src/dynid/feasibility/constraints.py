@@ -14,7 +14,7 @@ Sec. V, eqs. 14-16; Traversaro et al. 2016; Drake's ``IsPhysicallyValid``) when
 
   (equivalently ``lambda_1 + lambda_2 > lambda_3``; it implies positive definiteness).
 
-Retrieval (:mod:`dynid.feasibility.retrieve`) adds the search box of every parameter
+Retrieval (:mod:`dynid.feasibility.penalty`) adds the search box of every parameter
 (:class:`~dynid.feasibility.bounds.Bounds`: mass, CoM box, inertia entries) and a band on
 the total mass, and users may add constraints of their own (:class:`UserConstraint`).
 

@@ -1,6 +1,6 @@
 """Held-out judgement of the consistent fit: the prior's weight and the acceptance.
 
-The consistent fit (:mod:`dynid.feasibility.sdp`) trades the data against the prior with a
+The consistent fit (:mod:`dynid.feasibility.convex`) trades the data against the prior with a
 weight ``w``. On the training data, any constraint raises the residual, and unconstrained
 least squares, which absorbs noise and unmodelled effects into unphysical coefficients,
 always looks best; on data the fit has not seen it may predict worse than a consistent

@@ -1,7 +1,7 @@
 """Prior link parameters for consistent identification: checked, repaired, or made up.
 
 A prior is a complete set of standard parameters (10 per link, :mod:`dynid.model.inertia`)
-that the convex retrieval (:mod:`dynid.feasibility.sdp`) is pulled towards in the
+that the convex retrieval (:mod:`dynid.feasibility.convex`) is pulled towards in the
 directions the data cannot see. It comes from
 
 * a robot description with inertials (:func:`prior_from_robot`): the built-in Panda, a

@@ -1,7 +1,7 @@
 """What every method of physically consistent parameters returns: :class:`FeasibleResult`.
 
-The convex fit (:class:`~dynid.feasibility.sdp.ConsistentResult`, two-step and one-step)
-and the paper's penalty method (:class:`~dynid.feasibility.retrieve.RetrievalResult`,
+The convex fit (:class:`~dynid.feasibility.convex.result.ConsistentResult`, two-step and one-step)
+and the paper's penalty method (:class:`~dynid.feasibility.penalty.result.RetrievalResult`,
 Gaz et al. 2019, Algorithm 1) derive from it. It holds what both mean the same way: the
 robot with the consistent link parameters, how far they are from the identified
 coefficients, every constraint with its margin, the bounds, the run time, the seed, what

@@ -40,9 +40,9 @@ def save_feasible_bundle(
     folder : str or Path
         An existing folder.
     result : FeasibleResult
-        A retrieval (penalty method, :class:`~dynid.feasibility.retrieve.RetrievalResult`)
+        A retrieval (penalty method, :class:`~dynid.feasibility.penalty.result.RetrievalResult`)
         or a convex retrieval / one-step consistent fit
-        (:class:`~dynid.feasibility.sdp.ConsistentResult`).
+        (:class:`~dynid.feasibility.convex.result.ConsistentResult`).
     **report_extra
         Extra keys of ``report.json`` (``source``, ``seed``), JSON values.
 

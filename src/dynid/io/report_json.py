@@ -52,8 +52,8 @@ def report_to_dict(result: FeasibleResult) -> dict[str, Any]:
     Parameters
     ----------
     result : FeasibleResult
-        A :class:`~dynid.feasibility.sdp.ConsistentResult` or a
-        :class:`~dynid.feasibility.retrieve.RetrievalResult`.
+        A :class:`~dynid.feasibility.convex.result.ConsistentResult` or a
+        :class:`~dynid.feasibility.penalty.result.RetrievalResult`.
 
     Returns
     -------

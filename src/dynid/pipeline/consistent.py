@@ -86,7 +86,7 @@ def consistent_stage(
     and a gravity tilt; 1010 static configurations with 1e-4 relative noise.
 
     ``progress`` receives a :class:`ConsistentSetup` once the truth is drawn, then a
-    :class:`~dynid.feasibility.retrieve.RetrievalProgress` per finished penalty run.
+    :class:`~dynid.feasibility.penalty.result.RetrievalProgress` per finished penalty run.
     """
     rng = np.random.default_rng(np.random.SeedSequence([seed, 55]))
     truth = perturbed_robot(robot, rng)

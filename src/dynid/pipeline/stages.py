@@ -29,7 +29,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from ..exceptions import DynidError
-from ..feasibility.retrieve import RetrievalResult, retrieve
+from ..feasibility.penalty import RetrievalResult, retrieve
 from ..friction.fit import FrictionFit, FrictionResidual, fit_sigmoid, friction_residual
 from ..friction.model import SigmoidFriction
 from ..friction.validation import (
@@ -83,7 +83,7 @@ DEMO_WORKERS = 2
 #: Static configurations acquired in stages 2 and 5.
 DEMO_CONFIGURATIONS = 1010
 
-#: A progress callback: receives a :class:`~dynid.feasibility.retrieve.RetrievalProgress`
+#: A progress callback: receives a :class:`~dynid.feasibility.penalty.result.RetrievalProgress`
 #: per finished run of the penalty method, and the events of the stage that runs.
 Progress = Callable[[Any], None]
 
@@ -425,7 +425,7 @@ def feasible_stage(
     workers : int, optional
         Processes for the retrieval (default ``min(DEMO_WORKERS, cores)``).
     progress : callable, optional
-        Receives a :class:`~dynid.feasibility.retrieve.RetrievalProgress` per finished run.
+        Receives a :class:`~dynid.feasibility.penalty.result.RetrievalProgress` per finished run.
 
     Raises
     ------

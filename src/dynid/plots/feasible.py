@@ -17,9 +17,9 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
+from ..feasibility.convex import ConsistentResult
+from ..feasibility.penalty import RetrievalResult
 from ..feasibility.result import FeasibleResult
-from ..feasibility.retrieve import RetrievalResult
-from ..feasibility.sdp import ConsistentResult
 from ..friction.validation import NewtonEulerValidation
 
 if TYPE_CHECKING:  # pragma: no cover
@@ -225,8 +225,8 @@ def plot_consistent(
     Parameters
     ----------
     results : sequence of FeasibleResult
-        :class:`~dynid.feasibility.sdp.ConsistentResult` or
-        :class:`~dynid.feasibility.retrieve.RetrievalResult`.
+        :class:`~dynid.feasibility.convex.result.ConsistentResult` or
+        :class:`~dynid.feasibility.penalty.result.RetrievalResult`.
     labels : sequence of str, optional
         Legend entries (default the results' ``method``).
     truth : Robot, optional

@@ -21,8 +21,7 @@ from pathlib import Path
 from typing import Any, Literal
 
 from ..exceptions import DataError, DynidWarning
-from ..feasibility.one_step import identify_consistent
-from ..feasibility.sdp import ConsistentResult, SDPOptions
+from ..feasibility.convex import ConsistentResult, SDPOptions, identify_consistent
 from ..identification.consistency import fit_mismatch, limit_violations
 from ..identification.estimators import EstimatorName
 from ..identification.least_squares import StdMethod
@@ -252,14 +251,14 @@ def identify_consistent_file(
     validate_on: str | Path | None = None,
 ) -> ConsistentResult:
     """Physically consistent link parameters of ``robot`` identified in one step from
-    ``path`` (:func:`~dynid.feasibility.one_step.identify_consistent`), the data read and
+    ``path`` (:func:`~dynid.feasibility.convex.fit.identify_consistent`), the data read and
     checked as by :func:`identify_file`.
 
     ``max_std_percent`` and ``std`` are refused (nothing is pruned; the data term is the
     residual itself, weighted by ``estimator``); they are parameters so that a caller
     passing them learns it. ``folds``/``validate_on`` (torque logs) choose the held-out
     judgement of the prior weight and of the fit. Other parameters as :func:`identify_file` and
-    :func:`~dynid.feasibility.one_step.identify_consistent`.
+    :func:`~dynid.feasibility.convex.fit.identify_consistent`.
 
     Returns
     -------

@@ -1,8 +1,9 @@
 """Retrieve feasible link parameters from files: the entry point of ``dynid retrieve``.
 
-Both methods (``sdp``, the convex retrieval; ``penalty``, Gaz et al.'s Algorithm 1) and
-both sources (an identified model's ``identification.json``; static data, one step) go
-through :func:`retrieve_file`, which applies the command's checks for the Python API
+Every method of :data:`~dynid.feasibility.methods.METHODS` (``sdp``, the convex retrieval;
+``penalty``, Gaz et al.'s Algorithm 1) and both sources (an identified model's
+``identification.json``, the method's "from coefficients"; static data, its "from data")
+go through :func:`retrieve_file`, which applies the command's checks for the Python API
 too: static data must be of the robot (joint count, recorded robot), the prior's joints
 must be the robot's, a friction file on the robot must be sigmoid friction.
 """
@@ -11,19 +12,14 @@ from __future__ import annotations
 
 from collections.abc import Callable
 from pathlib import Path
-from typing import Literal
+from typing import Any, Literal
 
 from ..exceptions import DynidError
 from ..feasibility.bounds import Bounds, default_bounds
-from ..feasibility.one_step import identify_consistent
-from ..feasibility.retrieve import (
-    RetrievalOptions,
-    RetrievalProgress,
-    RetrievalResult,
-    retrieve,
-    retrieve_from_static,
-)
-from ..feasibility.sdp import ConsistentResult, SDPOptions, retrieve_sdp
+from ..feasibility.convex import SDPOptions
+from ..feasibility.methods import method as consistent_method
+from ..feasibility.penalty import RetrievalOptions, RetrievalProgress
+from ..feasibility.result import FeasibleResult
 from ..friction.model import SigmoidFriction
 from ..identification.model import IdentifiedModel
 from ..io.bounds_file import load_bounds
@@ -87,7 +83,7 @@ def retrieve_file(
     *,
     kind: Literal["model", "static"] = "model",
     robot: Robot | None = None,
-    method: Literal["sdp", "penalty"] = "sdp",
+    method: str = "sdp",
     prior: str | Path | None = None,
     prior_base: str | None = None,
     prior_tip: str | None = None,
@@ -96,11 +92,11 @@ def retrieve_file(
     total_mass: tuple[float, float] | None = None,
     friction: str | Path | None = None,
     sdp_options: SDPOptions | None = None,
-    options: RetrievalOptions | None = None,
+    options: SDPOptions | RetrievalOptions | None = None,
     workers: int | None = None,
     seed: int | None = 0,
     progress: Callable[[RetrievalProgress], None] | None = None,
-) -> RetrievalResult | ConsistentResult:
+) -> FeasibleResult:
     """Feasible link parameters from an identified model or from static data.
 
     Parameters
@@ -112,8 +108,9 @@ def retrieve_file(
         What ``source`` is.
     robot : Robot, optional
         Static data: the robot the data were recorded with (required).
-    method : {"sdp", "penalty"}
-        Convex retrieval with a prior, or the penalty method (Algorithm 1).
+    method : str
+        A name of :data:`~dynid.feasibility.methods.METHODS`: ``"sdp"``, the convex
+        retrieval with a prior, or ``"penalty"``, the penalty method (Algorithm 1).
     prior, prior_base, prior_tip
         ``--prior`` and its URDF chain (:func:`~dynid.workflows.prior.load_prior`).
     bounds : str or Path, optional
@@ -125,20 +122,28 @@ def retrieve_file(
     friction : str or Path, optional
         friction.json (sigmoid) put on the robot (exported with it).
     sdp_options : SDPOptions, optional
-        The convex method's options.
-    options, workers, seed, progress
-        The penalty method's options, processes, seed and per-run callback.
+        The convex method's options (as ``options``).
+    options : SDPOptions or RetrievalOptions, optional
+        The method's options (its ``options_type``).
+    workers, seed, progress
+        The penalty method's processes, seed and per-run callback; ``workers`` is refused
+        by a method that runs in this process (the convex one).
 
     Returns
     -------
-    ConsistentResult (sdp) or RetrievalResult (penalty)
+    FeasibleResult
+        The method's: ConsistentResult (sdp) or RetrievalResult (penalty).
 
     Raises
     ------
     DynidError
         A bad file; static data without a robot or of another robot; a prior whose
-        joints differ from the robot's.
+        joints differ from the robot's; an unknown method, options of another method,
+        ``workers`` for the convex method.
     """
+    m = consistent_method(method)
+    if sdp_options is not None and (m.name != "sdp" or options is not None):
+        raise DynidError("sdp_options are the convex method's options; pass one set, as options")
     if kind == "model":
         model = load_model_with_friction(source, friction)
         robot = model.robot
@@ -148,34 +153,15 @@ def retrieve_file(
         robot = _with_friction(robot, friction)
         data = read_static_file(source, robot)
     prior_robot = load_prior(prior, robot, base=prior_base, tip=prior_tip)
-    b = load_bounds_for(robot, bounds, total_mass_band=total_mass_band)
-    if method == "sdp":
-        if kind == "model":
-            return retrieve_sdp(
-                model, prior=prior_robot, bounds=b, total_mass=total_mass, options=sdp_options
-            )
-        return identify_consistent(
-            robot, data, prior=prior_robot, bounds=b, total_mass=total_mass, options=sdp_options
-        )
+    common: dict[str, Any] = {
+        "prior": prior_robot,
+        "bounds": load_bounds_for(robot, bounds, total_mass_band=total_mass_band),
+        "total_mass": total_mass,
+        "options": sdp_options if options is None and m.name == "sdp" else options,
+        "workers": workers,
+        "seed": seed,
+        "progress": progress,
+    }
     if kind == "model":
-        return retrieve(
-            model,
-            bounds=b,
-            total_mass=total_mass,
-            prior=prior_robot,
-            options=options,
-            workers=workers,
-            seed=seed,
-            progress=progress,
-        )
-    return retrieve_from_static(
-        robot,
-        data,
-        bounds=b,
-        total_mass=total_mass,
-        prior=prior_robot,
-        options=options,
-        workers=workers,
-        seed=seed,
-        progress=progress,
-    )
+        return m.from_coefficients(model, **common)
+    return m.from_data(robot, data, **common)

@@ -43,14 +43,14 @@ import numpy as np
 import scipy.linalg
 from numpy.typing import ArrayLike, NDArray
 
-from .. import _checks
-from ..exceptions import DataError, OptionError, ShapeError
-from ..model.robot import Robot
-from ..regressors.base import BaseParameters, base_parameters
-from ..regressors.static import static_regressor, static_vector
-from .bounds import Bounds, default_bounds
-from .constraints import UserConstraint, user_constraints
-from .prior import prior_scales
+from ... import _checks
+from ...exceptions import DataError, OptionError, ShapeError
+from ...model.robot import Robot
+from ...regressors.base import BaseParameters, base_parameters
+from ...regressors.static import static_regressor, static_vector
+from ..bounds import Bounds, default_bounds
+from ..constraints import UserConstraint, user_constraints
+from ..prior import prior_scales
 
 __all__ = [
     "DEFAULT_MARGIN",

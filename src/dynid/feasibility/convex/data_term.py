@@ -1,0 +1,163 @@
+"""The convex method's data term ``1/2 ||A (x - x_hat)||^2`` (:class:`DataTerm`) and the
+term of identified coefficients with their covariance (:func:`coefficient_term`)."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+from numpy.typing import NDArray
+
+from ...exceptions import DataError, ModelError
+from ...identification.holdout import HeldOut
+from ...identification.least_squares import LeastSquaresFit
+from ...identification.model import IdentifiedModel
+from .options import EXACT_RTOL
+
+__all__ = ["DataTerm", "coefficient_term"]
+
+
+@dataclass(frozen=True, slots=True, eq=False)
+class DataTerm:
+    """The data term ``1/2 ||A (x - x_hat)||^2`` over ``x = [P phi; f]``.
+
+    Attributes
+    ----------
+    P : ndarray, shape (r, 10 n) or (r, 11 n)
+        Standard to base parameters (kept coefficients only); with identified rotor
+        inertias (:mod:`dynid.model.drive`) the last ``n`` columns are ``Ia1 .. Ia_n``, kept
+        ``>= 0`` in the consistent fit.
+    x_hat : ndarray, shape (r + k,)
+        Least-squares estimate (base parameters, then ``k`` friction coefficients).
+    A : ndarray, shape (s, r + k)
+        Whitening: ``A^T A`` is the inverse covariance of ``x_hat``.
+    dof : int
+        Degrees of freedom of the fit's residual (rows minus coefficients).
+    exact : bool
+        The estimate is exact (noise-free): the equality ``P phi = beta`` applies.
+    n_friction : int
+        ``k``: 0, or the classical friction coefficients fitted (``fv, fc, fo`` per joint,
+        less those of joints that never moved).
+    friction_index : ndarray of int, shape (k,), optional
+        Where each friction unknown sits in the ``(n, 3)`` layout ``fv, fc, fo`` per joint
+        (flattened); None: all ``3 n`` in order.
+    labels : tuple of str
+        Names of the entries of ``x``.
+    notes : tuple of str
+        What the user should know about the data term (a missing covariance).
+    holdout : HeldOut, optional
+        Normal equations of the held-out folds over the entries of ``x``
+        (:mod:`dynid.identification.holdout`): the weight and the acceptance are then
+        judged on held-out data.
+    """
+
+    P: NDArray[np.float64]
+    x_hat: NDArray[np.float64]
+    A: NDArray[np.float64]
+    dof: int
+    exact: bool
+    n_friction: int = 0
+    friction_index: NDArray[np.intp] | None = None
+    labels: tuple[str, ...] = ()
+    notes: tuple[str, ...] = ()
+    holdout: HeldOut | None = None
+
+    @property
+    def r(self) -> int:
+        """Number of base parameters in ``x``."""
+        return int(self.P.shape[0])
+
+    def friction_layout(self) -> NDArray[np.intp]:
+        """:attr:`friction_index`, or ``0 .. k-1`` when every coefficient is fitted."""
+        if self.friction_index is None:
+            return np.arange(self.n_friction)
+        return np.asarray(self.friction_index)
+
+    def friction_table(self, f: NDArray[np.float64], n: int) -> NDArray[np.float64]:
+        """The fitted friction unknowns ``f`` (k,) as the (n, 3) table ``fv, fc, fo`` (zero
+        for the coefficients not fitted)."""
+        out = np.zeros(3 * n)
+        out[self.friction_layout()] = f
+        return out.reshape(n, 3)
+
+    def chi2(self, x: NDArray[np.float64]) -> float:
+        """``||A (x - x_hat)||^2``: the increase of the residual sum of squares / sigma^2."""
+        return float(np.sum((self.A @ (x - self.x_hat)) ** 2))
+
+
+def _whitening(cov: NDArray[np.float64]) -> NDArray[np.float64]:
+    """``A`` with ``A^T A = cov^+`` (directions of zero variance dropped)."""
+    cov = 0.5 * (cov + cov.T)
+    s, U = np.linalg.eigh(cov)
+    keep = s > 1e-14 * max(float(s.max()), 0.0)
+    return (U[:, keep] / np.sqrt(s[keep])).T
+
+
+def coefficient_term(model: IdentifiedModel, *, with_friction: bool = False) -> DataTerm:
+    """The data term of identified coefficients (and their friction) with their covariance.
+
+    Uses ``model.fit.covariance`` (or ``model.joint_fit``'s with friction); without a
+    covariance (a file written before it was kept) the standard deviations, uncorrelated.
+    Pruned coefficients are left out.
+    """
+    fit: LeastSquaresFit = model.fit
+    r_all = model.base.rank
+    k = 0
+    if with_friction:
+        if model.joint_fit is None:
+            raise ModelError("the model holds no friction identified with the coefficients")
+        fit = model.joint_fit
+        k = fit.beta.shape[0] - r_all
+    kept = np.asarray(fit.kept, dtype=bool)
+    kept_b = kept[:r_all]
+    P = model.base.projection[kept_b]
+    x_hat = np.asarray(fit.beta, dtype=np.float64)[kept]
+    notes: tuple[str, ...] = ()
+    if fit.covariance is None:
+        cov = np.diag(np.asarray(fit.std, dtype=np.float64) ** 2)
+        notes = (
+            "no covariance of the coefficients (an older file): their standard deviations "
+            "are used as if uncorrelated",
+        )
+    else:
+        cov = np.asarray(fit.covariance, dtype=np.float64)
+    cov = cov[np.ix_(kept, kept)]
+    if cov.size:
+        ev = np.linalg.eigvalsh(0.5 * (cov + cov.T))
+        if ev[0] < -1e-9 * max(float(ev[-1]), 0.0) or not ev[-1] >= 0:
+            raise DataError(
+                "the covariance of the coefficients is not positive semidefinite (eigenvalues "
+                f"{ev[0]:.3g} .. {ev[-1]:.3g}); re-run the identification"
+            )
+    rel = fit.relative_error_percent / 100.0
+    exact = bool(fit.sigma == 0.0 or rel < EXACT_RTOL or not np.any(cov))
+    labels = tuple(
+        lab
+        for lab, kk in zip(
+            model.base.labels + _friction_labels(model)[:k],
+            kept,
+            strict=False,
+        )
+        if kk
+    )
+    held = model.holdout
+    if held is not None and held.whole.p != kept.size:
+        held = None  # folds over other columns (friction left out of the term)
+    return DataTerm(
+        P=P,
+        x_hat=x_hat,
+        A=np.zeros((0, x_hat.size)) if exact else _whitening(cov),
+        dof=max(int(fit.n_rows) - int(fit.rank), 1),
+        exact=exact,
+        n_friction=int(kept[r_all:].sum()) if k else 0,
+        friction_index=np.flatnonzero(kept[r_all:]) if k else None,
+        labels=labels,
+        notes=notes,
+        holdout=None if held is None else held.restricted(np.flatnonzero(kept)),
+    )
+
+
+def _friction_labels(model: IdentifiedModel) -> tuple[str, ...]:
+    """The labels of the model's friction columns (empty without friction)."""
+    fr = model.info.friction
+    return () if fr is None else fr.labels

@@ -1,0 +1,253 @@
+"""The convex method's entry points: from identified coefficients (two-step,
+:func:`retrieve_sdp`) and from data (one step, :func:`identify_consistent`: torque logs or
+static data), the drive adapter (:func:`with_drive`) and the method's registry entry
+(:data:`METHOD`, :mod:`dynid.feasibility.methods`).
+
+One step: the data's least-squares problem is the convex problem of
+:mod:`dynid.feasibility.convex` with the data term taken on the data themselves: for
+ordinary least squares,
+
+.. math:: \\|W x - y\\|^2 = \\|W \\hat x - y\\|^2 + (x - \\hat x)^T W^T W (x - \\hat x),
+
+so the classical covariance ``sigma^2 (W^T W)^{-1}`` of the unconstrained fit ``x_hat`` gives
+the data term exactly (up to the constant ``RSS / sigma^2``). Torque logs go through the
+classical route (:func:`~dynid.identification.classical.identify_from_log`: filtering,
+decimation, base regressor plus viscous, Coulomb and offset friction per joint), with
+``fv, fc >= 0`` in the consistent problem; static data through
+:func:`~dynid.identification.static.identify_static` (``[tril M; g]``). The unconstrained
+fit is returned with the result (``result.identified``) for comparison.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+from collections.abc import Callable, Sequence
+from dataclasses import replace
+from typing import Any, Literal
+
+from ...exceptions import OptionError, WrongTypeError
+from ...identification.classical import identify_from_log
+from ...identification.data import StaticDataset
+from ...identification.estimators import Estimator, EstimatorName
+from ...identification.holdout import DEFAULT_FOLDS
+from ...identification.log import TorqueLog
+from ...identification.model import IdentifiedModel
+from ...identification.static import identify_static
+from ...model.drive import Drive
+from ...model.robot import Robot
+from ..bounds import Bounds
+from ..prior import Prior
+from .data_term import coefficient_term
+from .options import SDPOptions
+from .result import ConsistentResult
+from .solve import solve_consistent
+
+__all__ = ["METHOD", "ConvexMethod", "identify_consistent", "retrieve_sdp", "with_drive"]
+
+
+def retrieve_sdp(
+    model: IdentifiedModel,
+    *,
+    prior: Prior | Robot | None = None,
+    bounds: Bounds | None = None,
+    total_mass: tuple[float, float] | None = None,
+    options: SDPOptions | None = None,
+    constraints: Sequence[Callable[..., Any]] = (),
+) -> ConsistentResult:
+    """Consistent link parameters from identified coefficients (two-step, convex).
+
+    The coefficients' full covariance weighs the data term (``model.fit.covariance``);
+    exact coefficients are met exactly. Parameters as in :func:`solve_consistent`; the
+    result's robot carries ``model.robot``'s kinematics and friction.
+
+    Examples
+    --------
+    >>> import dynid
+    >>> from dynid.feasibility.convex import retrieve_sdp
+    >>> robot = dynid.panda()
+    >>> data = dynid.acquire_static(dynid.SimulatedController(robot), 100, np.random.default_rng(0))
+    >>> res = retrieve_sdp(dynid.identify_static(robot, data), prior=robot)  # doctest: +SKIP
+    """
+    res = solve_consistent(
+        model.robot,
+        coefficient_term(model),
+        prior=prior,
+        bounds=bounds,
+        total_mass=total_mass,
+        options=options,
+        constraints=constraints,
+        kind="coefficients",
+    )
+    return res if model.drive is None else with_drive(res, model.drive)
+
+
+def with_drive(res: ConsistentResult, drive: Drive) -> ConsistentResult:
+    """The result with its drive, whose rotor inertias are the identified ones (known from
+    then on: a simulator or a validation takes them as given)."""
+    ia = res.rotor_inertia if drive.rotor_inertia is None else drive.rotor_inertia
+    if ia is None:
+        return dataclasses.replace(res, drive=drive)
+    return dataclasses.replace(res, drive=dataclasses.replace(drive, rotor_inertia=ia))
+
+
+def identify_consistent(
+    robot: Robot,
+    data: TorqueLog | StaticDataset,
+    *,
+    prior: Prior | Robot | None = None,
+    bounds: Bounds | None = None,
+    total_mass: tuple[float, float] | None = None,
+    options: SDPOptions | None = None,
+    constraints: Sequence[Callable[..., Any]] = (),
+    cutoff_hz: float | Literal["auto"] | None = "auto",
+    decimate: int | None = None,
+    rtol: float | None = None,
+    drive: Drive | None = None,
+    estimator: EstimatorName | Estimator = "ols",
+    folds: int = DEFAULT_FOLDS,
+    validate_on: TorqueLog | None = None,
+) -> ConsistentResult:
+    """Physically consistent link parameters (and friction) identified from data.
+
+    Parameters
+    ----------
+    robot : Robot
+        Kinematics and gravity of the data.
+    data : TorqueLog or StaticDataset
+        A torque log of an exciting trajectory, or static ``q, M, g`` data.
+    prior, bounds, total_mass, options, constraints
+        As in :func:`~dynid.feasibility.convex.solve.solve_consistent`.
+    cutoff_hz, decimate
+        Torque logs: the classical route's filtering and decimation.
+    rtol : float, optional
+        Rank tolerance of the unconstrained fit; None: the identification's default (the
+        rank at a clear gap of the singular values).
+    drive : Drive, optional
+        The drive train (:mod:`dynid.model.drive`): the log is read through it, its rotor
+        inertias are identified with the links (``>= 0``) and its friction acts at the
+        motors (``fv, fc >= 0``).
+    estimator : {"ols", "wls", "irls"} or Estimator
+        The unconstrained fit's estimator; its weighted covariance is the consistent fit's
+        data term (:mod:`dynid.identification.estimators`).
+    folds, validate_on
+        Torque logs: the held-out judgement (contiguous time blocks, or a separate log) that
+        chooses the prior's weight and accepts the result
+        (:mod:`dynid.feasibility.heldout`).
+
+    Returns
+    -------
+    ConsistentResult
+        ``kind`` ``"log"`` (with ``friction`` (n, 3) ``fv, fc, fo``) or ``"static"``;
+        ``identified`` the unconstrained identification.
+
+    Raises
+    ------
+    RankDeficientError
+        The data do not excite every base parameter (from the unconstrained fit).
+    WrongTypeError
+        ``data`` is neither a torque log nor static data.
+    """
+    if isinstance(data, TorqueLog):
+        model = identify_from_log(
+            robot,
+            data,
+            cutoff_hz=cutoff_hz,
+            decimate=decimate,
+            friction=True,
+            rtol=rtol,
+            drive=drive,
+            estimator=estimator,
+            folds=folds,
+            validate_on=validate_on,
+        )
+        term = coefficient_term(model, with_friction=True)
+        kind = "log"
+    elif isinstance(data, StaticDataset):
+        model = identify_static(
+            robot, data, rtol=rtol, std="classical", drive=drive, estimator=estimator
+        )
+        term = coefficient_term(model)
+        kind = "static"
+    else:
+        raise WrongTypeError(
+            f"data must be a TorqueLog or a StaticDataset; got {type(data).__name__}"
+        )
+    res = solve_consistent(
+        robot,
+        term,
+        prior=prior,
+        bounds=bounds,
+        total_mass=total_mass,
+        options=options,
+        constraints=constraints,
+        kind=kind,
+    )
+    res = replace(res, identified=model)
+    return res if drive is None else with_drive(res, drive)
+
+
+class ConvexMethod:
+    """The convex method in the registry of consistent-parameter methods
+    (:class:`~dynid.feasibility.methods.ConsistentMethod`): :func:`retrieve_sdp` from
+    coefficients, :func:`identify_consistent` from a torque log or static data.
+
+    One solver in this process: ``workers`` is refused, ``seed`` and ``progress`` (per
+    finished run of a method with runs) have nothing to act on.
+    """
+
+    name = "sdp"
+    description = "convex LMI retrieval with a prior (default)"
+    options_type: type = SDPOptions
+    parallel = False
+
+    def _checked(self, options: Any, workers: int | None) -> SDPOptions | None:
+        if workers is not None:
+            raise OptionError(
+                "workers apply to the penalty method (its runs); the convex method solves one "
+                "problem in this process"
+            )
+        if options is not None and not isinstance(options, SDPOptions):
+            raise WrongTypeError(
+                f"the convex method takes SDPOptions; got {type(options).__name__}"
+            )
+        return options
+
+    def from_coefficients(
+        self,
+        model: IdentifiedModel,
+        *,
+        prior: Prior | Robot | None = None,
+        bounds: Bounds | None = None,
+        total_mass: tuple[float, float] | None = None,
+        options: SDPOptions | None = None,
+        workers: int | None = None,
+        seed: int | None = 0,
+        progress: Callable[[Any], None] | None = None,
+    ) -> ConsistentResult:
+        """:func:`retrieve_sdp` (``workers`` refused: :class:`~dynid.exceptions.OptionError`)."""
+        opts = self._checked(options, workers)
+        return retrieve_sdp(model, prior=prior, bounds=bounds, total_mass=total_mass, options=opts)
+
+    def from_data(
+        self,
+        robot: Robot,
+        data: TorqueLog | StaticDataset,
+        *,
+        prior: Prior | Robot | None = None,
+        bounds: Bounds | None = None,
+        total_mass: tuple[float, float] | None = None,
+        options: SDPOptions | None = None,
+        workers: int | None = None,
+        seed: int | None = 0,
+        progress: Callable[[Any], None] | None = None,
+    ) -> ConsistentResult:
+        """:func:`identify_consistent` with its defaults for a torque log (the cut-off read
+        from the log, ordinary least squares, held-out folds) (``workers`` refused)."""
+        opts = self._checked(options, workers)
+        return identify_consistent(
+            robot, data, prior=prior, bounds=bounds, total_mass=total_mass, options=opts
+        )
+
+
+#: the convex method's entry in :data:`dynid.feasibility.methods.METHODS`
+METHOD = ConvexMethod()

@@ -1,0 +1,277 @@
+"""The convex problem in cvxpy (:class:`ConvexProblem`), built once per data term and
+re-solved at each prior weight, with the solver fallback (Clarabel, Clarabel with
+regularisation, SCS) and the solution's read-out (margins enforced, exact fits polished)."""
+
+from __future__ import annotations
+
+import math
+import warnings
+from collections.abc import Callable, Sequence
+from typing import Any
+
+import numpy as np
+from numpy.typing import NDArray
+
+from ...exceptions import InfeasibleError, SolverError
+from ..bounds import Bounds
+from ..lmi import (
+    pseudo_inertia_margin,
+    repair_pseudo_inertia,
+)
+from ..prior import Prior, prior_scales
+from .data_term import DataTerm
+from .options import SDPOptions
+
+__all__ = ["SCS_SIGINT", "ConvexProblem", "Values"]
+
+
+#: Boxes and the band are shrunk by this fraction of their width inside the solver, so
+#: that its tolerance (about 1e-8) cannot put the solution outside them.
+_SHRINK = 1e-6
+#: T (10, 16): phi of a link from vec(J) (row-major 4x4): m, h, J_o = tr(S) 1 - S.
+_T = np.zeros((10, 16))
+_T[0, 15] = 1.0
+_T[1, 3] = _T[2, 7] = _T[3, 11] = 1.0
+for _k, (_i, _j) in enumerate(((0, 0), (0, 1), (0, 2), (1, 1), (1, 2), (2, 2))):
+    if _i == _j:
+        for _d in range(3):
+            if _d != _i:
+                _T[4 + _k, 5 * _d] = 1.0
+    else:
+        _T[4 + _k, 4 * _i + _j] = -1.0
+
+
+# ------------------------------------------------------------------------- the problem
+def mass_bounds(
+    prior: Prior, bounds: Bounds, factor: float | None
+) -> tuple[NDArray[np.float64], NDArray[np.float64], list[str]]:
+    lo = np.array(bounds.mass_min, dtype=float)
+    hi = np.array(bounds.mass_max, dtype=float)
+    notes: list[str] = []
+    if factor is None or prior.source == "generic":  # a guess does not bound the masses
+        return lo, hi, notes
+    m0 = prior.mass
+    plo, phi_ = m0 / factor, m0 * factor
+    nlo, nhi = np.maximum(lo, plo), np.minimum(hi, phi_)
+    empty = nlo > nhi
+    for i in np.flatnonzero(empty):
+        notes.append(
+            f"link {i + 1}: the prior's mass range {plo[i]:.3g}..{phi_[i]:.3g} kg lies outside "
+            f"the bounds {lo[i]:g}..{hi[i]:g} kg; the bounds alone are used"
+        )
+    return np.where(empty, lo, nlo), np.where(empty, hi, nhi), notes
+
+
+def check_band(lo: NDArray[np.float64], hi: NDArray[np.float64], band: Any) -> None:
+    if band is None:
+        return
+    a, b = (float(x) for x in band)
+    if not (math.isfinite(a) and math.isfinite(b)) or a < 0 or a > b:
+        raise InfeasibleError(f"total-mass band must be MIN,MAX with 0 <= MIN <= MAX; got {band}")
+    if lo.sum() > b or hi.sum() < a:
+        raise InfeasibleError(
+            f"total-mass band {a:g}..{b:g} kg cannot be met: the link mass bounds allow "
+            f"{lo.sum():.4g}..{hi.sum():.4g} kg in all"
+        )
+
+
+class ConvexProblem:
+    """The cvxpy problem, built once; the weight is a parameter (re-solved cheaply)."""
+
+    def __init__(
+        self,
+        term: DataTerm,
+        prior: Prior,
+        mass_lo: NDArray[np.float64],
+        mass_hi: NDArray[np.float64],
+        bounds: Bounds,
+        band: tuple[float, float] | None,
+        options: SDPOptions,
+        equality: bool,
+        closest: bool,
+        friction_nonneg: bool,
+        constraints: Sequence[Callable[..., Any]],
+    ) -> None:
+        import cvxpy as cp
+
+        n = prior.n
+        J0 = prior.pseudo_inertia
+        self.S0 = np.linalg.cholesky(J0)
+        self.X = [cp.Variable((4, 4), symmetric=True, name=f"X{i + 1}") for i in range(n)]
+        self.J = [self.S0[i] @ self.X[i] @ self.S0[i].T for i in range(n)]
+        B = np.stack([_T @ np.kron(self.S0[i], self.S0[i]) for i in range(n)])  # (n, 10, 16)
+        self.B = B
+        phis = [B[i] @ cp.vec(self.X[i], order="C") for i in range(n)]
+        phi = cp.hstack(phis)
+        self.phi_links = phis
+        self.w = cp.Parameter(nonneg=True, value=1.0, name="w")
+        eps = self.margin = options.margin
+        self.scale = 1.0 if equality or closest else float(max(term.dof, 1))
+        self.equality = equality
+        cons: list[Any] = []
+        for i in range(n):
+            C = self.S0[i].T @ self.S0[i]
+            Ci = np.linalg.inv(C)
+            Ci = 0.5 * (Ci + Ci.T)
+            cons.append(self.X[i] - eps * cp.trace(C @ self.X[i]) * Ci >> 0)
+            m, h = phis[i][0], phis[i][1:4]
+            dm = _SHRINK * (mass_hi[i] - mass_lo[i])
+            dc = _SHRINK * (bounds.com_max[i] - bounds.com_min[i])
+            cons += [m >= mass_lo[i] + dm, m <= mass_hi[i] - dm]
+            cons += [h >= m * (bounds.com_min[i] + dc), h <= m * (bounds.com_max[i] - dc)]
+        if band is not None:
+            M = sum(p[0] for p in phis)
+            db = _SHRINK * (band[1] - band[0])
+            cons += [M >= band[0] + db, M <= band[1] - db]
+        if options.objective == "logdet":
+            div = sum(-cp.log_det(X) + cp.trace(X) - 4.0 for X in self.X)
+        else:
+            div = sum(cp.sum_squares(X - np.eye(4)) for X in self.X)
+        k = term.n_friction
+        self.f = cp.Variable(k, name="f") if k else None
+        p_links = 10 * n
+        self.ia = (
+            cp.Variable(term.P.shape[1] - p_links, nonneg=True, name="Ia")
+            if term.P.shape[1] > p_links
+            else None
+        )
+        x = term.P[:, :p_links] @ phi
+        if self.ia is not None:  # rotor inertias >= 0, regrouped with the links in P
+            x = x + term.P[:, p_links:] @ self.ia
+        if self.f is not None:
+            x = cp.hstack([x, self.f])
+            if friction_nonneg:  # fv, fc >= 0 (every joint's fo is free)
+                pos = np.flatnonzero(term.friction_layout() % 3 != 2)  # fv, fc (not fo)
+                sel = np.zeros((pos.size, k))
+                sel[np.arange(pos.size), pos] = 1.0
+                cons.append(sel @ self.f >= 0)
+        for make in constraints:
+            cons += list(make(phis, self.J))
+        if equality:
+            s = np.maximum(np.abs(term.x_hat), 1e-6 * max(float(np.abs(term.x_hat).max()), 1e-12))
+            cons.append(cp.multiply(1.0 / s, x - term.x_hat) == 0)
+            obj = div
+        elif closest:
+            s = np.maximum(np.abs(term.x_hat), 1e-3 * max(float(np.abs(term.x_hat).max()), 1e-12))
+            obj = 1e-6 * div + 0.5 * cp.sum_squares(cp.multiply(1.0 / s, x - term.x_hat))
+        else:
+            # divided by dof (the data term's size at a good fit): same minimiser, better scaled
+            ks = 1.0 / math.sqrt(self.scale)
+            obj = self.w * div + 0.5 * cp.sum_squares(
+                (ks * term.A) @ x - (ks * term.A) @ term.x_hat
+            )
+        self.problem = cp.Problem(cp.Minimize(obj), cons)
+        self.term = term
+
+    def solve(self, w: float) -> str:
+        """Solve at weight ``w``; the status (retries as in the module docstring).
+
+        The first ``optimal`` attempt is kept; otherwise an ``optimal_inaccurate`` one;
+        ``infeasible`` only when every attempt says so (an interior-point method can
+        misreport a badly scaled feasible problem).
+        """
+        import cvxpy as cp
+
+        self.w.value = float(w) / self.scale
+        attempts: list[tuple[str, dict[str, Any]]] = [
+            ("CLARABEL", {}),
+            ("CLARABEL", {"max_iter": 500, "static_regularization_constant": 1e-7}),
+            ("SCS", {"eps": 1e-7, "max_iters": 20_000}),
+        ]
+        seen: list[str] = []
+        inaccurate = None
+        for solver, kw in attempts:
+            try:
+                with warnings.catch_warnings():  # the status says it; retried below
+                    warnings.simplefilter("ignore", UserWarning)
+                    self.problem.solve(solver=_scs() if solver == "SCS" else solver, **kw)
+            except (cp.error.SolverError, ArithmeticError, ValueError) as exc:
+                seen.append(f"{solver}: {exc}")
+                continue
+            status = str(self.problem.status)
+            seen.append(f"{solver}: {status}")
+            if status == "optimal":
+                self._snapshot = self._read()
+                return status
+            if status == "optimal_inaccurate" and inaccurate is None:
+                inaccurate = self._read()
+            if status.startswith("infeasible") and self.equality:
+                return status  # an exact fit with no consistent solution: a real answer
+        if inaccurate is not None:
+            self._snapshot = inaccurate
+            return "optimal_inaccurate"
+        if all(": infeasible" in x for x in seen):
+            return "infeasible"
+        raise SolverError("convex retrieval: the solver did not converge (" + "; ".join(seen) + ")")
+
+    def _read(self) -> tuple[list[NDArray[np.float64]], NDArray[np.float64] | None, Any]:
+        Xs = [np.array(X.value, dtype=float) for X in self.X]
+        f = None if self.f is None else np.array(self.f.value, dtype=float)
+        ia = None if self.ia is None else np.maximum(np.array(self.ia.value, dtype=float), 0.0)
+        return Xs, f, ia
+
+    def values(self) -> Values:
+        """``phi`` (n, 10), the friction (k,) and the rotor inertias (n,) at the solution
+        (margins enforced; None for what the problem does not hold)."""
+        Xs, f, ia = self._snapshot
+        phi = np.stack([self.B[i] @ X.reshape(-1) for i, X in enumerate(Xs)])
+        return _with_margin(phi, self.margin), f, ia
+
+
+#: ``phi`` (n, 10), friction (k,) or None, rotor inertias (n,) or None.
+def _scs() -> Any:
+    """cvxpy's SCS interface that lets a Ctrl-C through: SCS catches SIGINT itself and
+    returns its status -5, which cvxpy reports as a failed solve, so a retry or the rest of
+    the run would go on as if nothing were asked; here it is a :class:`KeyboardInterrupt`."""
+    from cvxpy.reductions.solvers.conic_solvers.scs_conif import SCS
+
+    class InterruptibleSCS(SCS):
+        def name(self) -> str:
+            return "DYNID_SCS"  # (cvxpy refuses a custom solver under a built-in name)
+
+        def invert(self, solution: Any, inverse_data: Any) -> Any:
+            if solution["info"]["status_val"] == SCS_SIGINT:
+                raise KeyboardInterrupt
+            return super().invert(solution, inverse_data)
+
+    return InterruptibleSCS()
+
+
+#: SCS's status after it caught SIGINT
+SCS_SIGINT = -5
+
+
+Values = tuple[NDArray[np.float64], NDArray[np.float64] | None, NDArray[np.float64] | None]
+
+
+def solution_x(term: DataTerm, phi: NDArray[np.float64], f: Any, ia: Any) -> NDArray[np.float64]:
+    """``x = [P [phi; Ia]; f]`` of a solution."""
+    std = phi.reshape(-1) if ia is None else np.concatenate([phi.reshape(-1), ia])
+    x = term.P @ std
+    return x if f is None else np.concatenate([x, f])
+
+
+def _with_margin(phi: NDArray[np.float64], margin: float) -> NDArray[np.float64]:
+    """Links the solver left a little below the margin (its tolerance) floored onto it."""
+    low = pseudo_inertia_margin(phi) < margin
+    if not np.any(low):
+        return phi
+    out = phi.copy()
+    out[low] = repair_pseudo_inertia(phi[low], margin)[0]
+    return out
+
+
+def polish(
+    phi: NDArray[np.float64], term: DataTerm, prior: Prior, ia: Any = None
+) -> NDArray[np.float64]:
+    """Minimum-norm correction (in the prior's scales) so that ``P phi = beta`` to round-off
+    (rotor inertias kept as solved)."""
+    scale = prior_scales(prior.phi)
+    P = term.P[:, : phi.size]
+    target = term.x_hat[: term.r] - (0.0 if ia is None else term.P[:, phi.size :] @ ia)
+    x = phi.reshape(-1)
+    for _ in range(2):
+        e = target - P @ x  # the base part; friction is met exactly
+        PD = P * scale
+        x = x + scale * np.linalg.lstsq(PD, e, rcond=None)[0]
+    return x.reshape(phi.shape)
