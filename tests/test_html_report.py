@@ -23,7 +23,9 @@ import pytest
 
 import dynid
 from dynid.cli.__main__ import main
-from dynid.io.html_report import (
+from dynid.io.robot.toml import save_toml
+from dynid.io.run_output import MANIFEST
+from dynid.report import (
     REPORT_NAME,
     ReportTable,
     RunSummary,
@@ -31,8 +33,6 @@ from dynid.io.html_report import (
     render_html_report,
     save_html_report,
 )
-from dynid.io.robot.toml import save_toml
-from dynid.io.run_output import MANIFEST
 
 
 class _Page(HTMLParser):

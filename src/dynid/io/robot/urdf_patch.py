@@ -199,7 +199,7 @@ def patch_urdf_inertials(
             and elems[name].find("inertial") is not None
         ]  # fmt: skip
         _check_masses(fixed, elems, source)
-        phi = np.array(robot.phi[k - 1])
+        phi: NDArray[np.float64] = np.array(robot.phi[k - 1])
         if merged == "subtract":
             phi = robot.phi[k - 1] - (chain.phi[k - 1] - own)
             _check_consistent(link, phi, fixed, source)
@@ -209,12 +209,12 @@ def patch_urdf_inertials(
             expected[k - 1] += chain.phi[k - 1] - own
         new_xml[link] = phi
     edits: list[tuple[int, int, str]] = []
-    for link, phi in new_xml.items():
+    for link, new in new_xml.items():
         start, open_end, end, closed = spans[link]
         body = template[open_end:end]
         masked = _COMMENT.sub(lambda m: " " * len(m.group(0)), body)
         found = _INERTIAL.search(masked)
-        if phi is None:
+        if new is None:
             if found is not None:
                 a, b = open_end + found.start(), open_end + found.end()
                 line_start = template.rfind("\n", 0, a)
@@ -227,16 +227,16 @@ def patch_urdf_inertials(
             a = open_end + found.start()
             indent = _line_indent(template, a) or link_indent + "  "
             step = _indent_step(indent, link_indent)
-            edits.append((a, open_end + found.end(), _inertial_xml(phi, indent, step)))
+            edits.append((a, open_end + found.end(), _inertial_xml(new, indent, step)))
         elif closed:
             indent = link_indent + "  "
             tag = template[start:open_end]
             opening = tag[:-2].rstrip() + ">"
-            xml = _inertial_xml(phi, indent, "  ")
+            xml = _inertial_xml(new, indent, "  ")
             edits.append((start, open_end, f"{opening}\n{indent}{xml}\n{link_indent}</link>"))
         else:
             indent = link_indent + "  "
-            xml = _inertial_xml(phi, indent, "  ")
+            xml = _inertial_xml(new, indent, "  ")
             edits.append((open_end, open_end, f"\n{indent}{xml}"))
     out = template
     for a, b, s in sorted(edits, reverse=True):
