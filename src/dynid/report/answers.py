@@ -2,7 +2,7 @@
 the run's files and returning an :class:`~dynid.report.run.Answer` or None.
 
 A command with several answers (``identify --consistent``: the identification and the
-consistent set) shows the first one's verdict and every one's parts. A run that wrote the
+consistent set) shows every verdict first, then every one's parts. A run that wrote the
 files of an observer (events, thresholds, residuals) gets that answer whatever its
 command. A command without an answer opens with its key numbers.
 """
@@ -33,8 +33,6 @@ def answer_for(run: RunFiles) -> Answer | None:
     found = [a for f in (*ANSWERS.get(run.summary.command, ()), observe.answer) if (a := f(run))]
     if not found:
         return None
-    more = [a.verdict.replace('id="verdict"', "", 1) for a in found[1:]]
-    sections = found[0].sections + tuple(
-        s for a, v in zip(found[1:], more, strict=True) for s in (v, *a.sections)
-    )
+    more = tuple(a.verdict.replace('id="verdict"', "", 1) for a in found[1:])
+    sections = more + tuple(s for a in found for s in a.sections)
     return Answer(found[0].verdict, sections, frozenset().union(*(a.shown for a in found)))

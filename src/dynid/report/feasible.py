@@ -44,10 +44,19 @@ def answer(run: RunFiles) -> Answer | None:
         f"Relative residual on the coefficients <b>{cell(res)}</b> (reproduces them below "
         f"{RESIDUAL_GOOD:g})",
     ]
-    margins = rep.get("min_margin") if isinstance(rep.get("min_margin"), dict) else {}
-    if margins:
-        name, value = min(margins.items(), key=lambda kv: kv[1] if is_number(kv[1]) else 1e300)
-        facts.append(f"Smallest constraint margin: {esc(name.replace('_', ' '))} {cell(value)}")
+    margins: dict[str, Any] = rep["min_margin"] if isinstance(rep.get("min_margin"), dict) else {}
+    constraints = [c for c in rep.get("constraints") or [] if isinstance(c, dict)]
+    failed = [c for c in constraints if c.get("satisfied") is False]
+    if constraints:
+        facts.append(
+            f"Constraints: {len(constraints) - len(failed)} of {len(constraints)} satisfied"
+            + (
+                f"; smallest pseudo-inertia margin (lambda_min(J) / tr(J)) "
+                f"{cell(margins['pseudo_inertia'])}"
+                if is_number(margins.get("pseudo_inertia"))
+                else ""
+            )
+        )
     masses = [link.get("mass") for link in feas["links"] if is_number(link.get("mass"))]
     band = rep.get("total_mass")
     facts.append(

@@ -201,10 +201,15 @@ def section(anchor: str, title: str, *parts: str) -> str:
 
 
 def verdict(level: str, headline: str, facts: Sequence[str]) -> str:
-    """The answer box at the top of a page: ``level`` good, fair or poor; ``headline`` and
-    ``facts`` are HTML."""
+    """The answer box at the top of a page: ``level`` good, fair or poor (a judgement), or
+    info (a finding, such as events detected); ``headline`` and ``facts`` are HTML."""
     items = "".join(f"<li>{f}</li>" for f in facts)
-    label = {"good": "good", "fair": "usable, with reservations", "poor": "not good enough"}
+    label = {
+        "good": "good",
+        "fair": "usable, with reservations",
+        "poor": "not good enough",
+        "info": "found",
+    }
     return (
         f'<section class="verdict {esc(level)}" id="verdict"><p class="headline">'
         f'<span class="level">{esc(label.get(level, level))}</span> {headline}</p>'

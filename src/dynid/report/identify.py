@@ -113,7 +113,11 @@ def _static_facts(doc: dict) -> tuple[list[str], list[str], str]:
         fact = (
             f"Relative error of M(q), g(q) <b>{percent(err)}</b> on data recorded with relative "
             f"noise {percent(floor)} ("
-            + ("explained by the noise)" if ok else "more than the noise explains)")
+            + (
+                ("noise-free data fit to rounding)" if floor == 0 else "explained by the noise)")
+                if ok
+                else "more than the noise explains)"
+            )
         )
         return (
             [fact],

@@ -37,7 +37,7 @@ def answer(run: RunFiles) -> Answer | None:
     if events is None:
         head, level = "The run wrote residuals; no events file to judge.", "fair"
     elif events:
-        head, level = f"{len(events)} event{'s' if len(events) != 1 else ''} detected.", "fair"
+        head, level = f"{len(events)} event{'s' if len(events) != 1 else ''} detected.", "info"
     else:
         head, level = "No event: every residual stayed below its threshold.", "good"
     if found["thresholds.json"] is not None:
@@ -46,17 +46,17 @@ def answer(run: RunFiles) -> Answer | None:
         rel = found["residuals.csv"]
         facts.append(f'Residuals over time: <a href="{href(rel)}">{esc(rel)}</a>')
     sections = []
-    if found["residuals.png"] is not None:
-        rel = found["residuals.png"]
-        sections.append(
-            section(
-                "residuals", "Residuals", figure(rel, run.files[rel], "Residuals and thresholds")
-            )
-        )
-    for key, title in (("events.json", "Events"), ("thresholds.json", "Thresholds")):
+    for key, title in (("events.json", "Events"),):
         name = found[key]
         if name is not None and name in run.docs:
-            sections.append(section(key.split(".")[0], title, json_section(name, run.docs[name])))
+            sections.append(section("events", title, json_section(name, run.docs[name])))
+    if found["residuals.png"] is not None:
+        rel = found["residuals.png"]
+        fig = figure(rel, run.files[rel], "Residuals and thresholds")
+        sections.append(section("residuals", "Residuals", fig))
+    name = found["thresholds.json"]
+    if name is not None and name in run.docs:
+        sections.append(section("thresholds", "Thresholds", json_section(name, run.docs[name])))
     shown = frozenset(r for r in (found["residuals.png"],) if r is not None)
     return Answer(
         verdict(level, esc(head), facts or ["Residuals, thresholds and events below"]),

@@ -6,6 +6,9 @@
 report is built from what the run recorded (:class:`RunSummary`: command line, options,
 printed summary, warnings and notes, tables a command adds) and from the files it wrote:
 
+* it opens with the command's answer (:mod:`dynid.report.answers`): a verdict, the figures
+  and the tables that answer the command's question; figures a run left out (matplotlib
+  missing) are named in the first lines with how to get them;
 * the JSON results become tables (their scalars, their records such as ``coefficients[]``
   or ``joints[]``, per-joint vectors side by side, small matrices; larger arrays are named
   with their shape and left in the file);
@@ -14,9 +17,11 @@ printed summary, warnings and notes, tables a command adds) and from the files i
 
 The page needs no network access: inline CSS, no fonts or scripts from elsewhere. A short
 inline script records, once the page has loaded, each figure's decoded width in its
-``data-natural-width`` attribute and the number of decoded figures in the body's
-``data-figures-decoded`` (what a headless browser test reads back). Every text that comes
-from a user or a file (names, values, messages) is escaped.
+``data-natural-width`` attribute, and in the body's attributes the number of decoded
+figures (``data-figures-decoded``), where the verdict ends and where the first figure
+starts [CSS px] (``data-verdict-bottom``, ``data-first-figure-top``): what a headless
+browser test reads back. Every text that comes from a user or a file (names, values,
+messages) is escaped.
 
 Pure string building: no template engine, no plotting library.
 """
@@ -390,6 +395,7 @@ border-left-width:8px}.verdict.good{background:#eef8f0;border-color:#2e8540}
 border-color:#c0392b}.verdict .headline{font-size:19px;font-weight:600;margin:4px 0 6px}
 .verdict .level{text-transform:uppercase;font-size:13px;letter-spacing:.04em;padding:2px 8px;
 border-radius:4px;margin-right:6px;color:#fff;vertical-align:middle}
+.verdict.info{background:#eef5ff;border-color:#3b73b9}.info .level{background:#3b73b9}
 .good .level{background:#2e8540}.fair .level{background:#b07d00}.poor .level{background:#c0392b}
 .verdict ul{margin:4px 0;padding-left:20px}.verdict li{margin:2px 0}
 tr.marked{background:#e7f3e9!important;font-weight:600}
@@ -407,7 +413,15 @@ window.addEventListener("load", function () {
     images[i].setAttribute("data-natural-width", String(images[i].naturalWidth));
     if (images[i].complete && images[i].naturalWidth > 0) { decoded++; }
   }
-  document.body.setAttribute("data-figures-decoded", String(decoded));
+  var body = document.body, verdict = document.getElementById("verdict");
+  var px = function (x) { return String(Math.round(x)); };
+  body.setAttribute("data-figures-decoded", String(decoded));
+  if (verdict) {
+    body.setAttribute("data-verdict-bottom", px(verdict.getBoundingClientRect().bottom));
+  }
+  if (images.length) {
+    body.setAttribute("data-first-figure-top", px(images[0].getBoundingClientRect().top));
+  }
 });
 """
 
