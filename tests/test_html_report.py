@@ -202,10 +202,11 @@ def test_json_results_become_tables(tmp_path):
     rows = [r for t in page.tables for r in t]
     assert ["rank", "43"] in rows and ["feasible", "yes"] in rows
     assert ["relative_error_percent", "0.1235"] in rows
-    assert ["", "rms [N m]", "mse"] in rows
+    assert ["name", "rms [N m]", "mse"] in rows  # every column named
     assert ["j2", "0.25", "0.0625"] in rows
     assert ["j3", "3.5", "0.75", "0.05"] in rows  # records named by the joint names
     assert ["2", "3", "4"] in rows  # the 2 x 2 matrix
+    assert ["#", "column 1", "column 2"] in rows
     assert any(r[0] == "covariance" and "43 x 43" in r[1] for r in rows)
     # the key numbers come first; the largest RMS after friction over the joints is one
     text = " ".join(page.text)

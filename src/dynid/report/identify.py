@@ -99,6 +99,11 @@ def _heldout_facts(doc: dict, held: dict | None) -> tuple[list[str], list[str], 
             )
         else:
             facts.append(f"On {where}, unfiltered: error {percent(err)} (noise floor unknown)")
+    elif headline:
+        facts.append(
+            "Sensor-noise floor not measured (heldout.json absent: the run was made with "
+            "--no-figures, or the log could not be read back)"
+        )
     return facts, problems, headline
 
 

@@ -72,6 +72,11 @@ def names_for(n: int, labels: Sequence[list[str]]) -> list[str]:
     return next((names for names in labels if len(names) == n), [str(i + 1) for i in range(n)])
 
 
+def _name_header(n: int, labels: Sequence[list[str]]) -> str:
+    """The header over the row names: ``name`` (joint or link names), else ``#``."""
+    return "name" if any(len(names) == n for names in labels) else "#"
+
+
 def _records_table(
     key: str, records: list[dict], units: Mapping[str, str], labels: Sequence[list[str]] = ()
 ) -> str:
@@ -86,7 +91,7 @@ def _records_table(
     headers = [_with_unit(c, units) for c in columns]
     if not {"name", "link", "joint", "method"} & set(columns):
         names = names_for(len(records), labels)
-        headers.insert(0, "")
+        headers.insert(0, _name_header(len(records), labels))
         for i, row in enumerate(rows):
             row.insert(0, esc(names[i]))
     more = len(records) - len(shown)
@@ -104,7 +109,7 @@ def _vectors_table(
     n = len(next(iter(vectors.values())))
     names = names_for(n, labels)
     rows = [[esc(names[i])] + [number(v[i]) for v in vectors.values()] for i in range(n)]
-    return table(["", *(_with_unit(k, units) for k in vectors)], rows)
+    return table([_name_header(n, labels), *(_with_unit(k, units) for k in vectors)], rows)
 
 
 #: Names of the columns of the matrices JSON results hold, by key (with their units).
@@ -116,7 +121,7 @@ def _matrix_table(key: str, m: list[list], labels: Sequence[list[str]] = ()) -> 
     rows = [[esc(names[i])] + [number(x) for x in r] for i, r in enumerate(m)]
     known = MATRIX_COLUMNS.get(key, ())
     columns = known if len(known) == len(m[0]) else [f"column {j + 1}" for j in range(len(m[0]))]
-    headers = ["row", *columns]
+    headers = [_name_header(len(m), labels), *columns]
     return f"<h4>{esc(key)}</h4>" + table(headers, rows, cls="matrix")
 
 
