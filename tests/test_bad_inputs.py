@@ -1176,6 +1176,9 @@ def test_figures_are_skipped_without_matplotlib(base, tmp_path, monkeypatch, cap
     ]
     page = (out / "report.html").read_text(encoding="utf-8")  # without figures, with the notes
     assert "<img" not in page and "skipped the figure validation_rms.png" in page
+    # and says so in its first lines, with how to get them (issue 29)
+    assert "Figures left out:</b> validation_torques.png, validation_rms.png." in page
+    assert page.index("Figures left out") < page.index('id="verdict"')
 
 
 def test_strict_json_out_never_writes_nan(tmp_path):

@@ -4,16 +4,22 @@ from __future__ import annotations
 
 import base64
 import json
+import re
+from pathlib import Path
 
+import numpy as np
 import pytest
+from test_html_report import CHROMIUM, Page, check_in_browser
 
 from dynid.cli.__main__ import main
+
+DATA = Path(__file__).resolve().parent / "data"
 
 
 @pytest.mark.slow
 def test_demo_runs_every_stage_and_writes_the_report(tmp_path, capsys):
-    """The demo writes every stage's files, figures, report.md and report.html, with the
-    expected outcomes."""
+    """The demo writes every stage's files, figures, paper.json and report.html, with the
+    expected outcomes; the report sets dynid's numbers beside the paper's."""
     out = tmp_path / "out"
     assert main(["demo", "--out", str(out), "--seed", "1"]) == 0
     text = capsys.readouterr().out
@@ -35,7 +41,8 @@ def test_demo_runs_every_stage_and_writes_the_report(tmp_path, capsys):
         "consistent/comparison.json",
         "consistent/comparison.png",
         "consistent/feasible.json",
-        "report.md",
+        "paper.json",
+        "report.html",
     ):
         assert (out / rel).stat().st_size > 0, rel
     ident = json.loads((out / "identification" / "identification.json").read_text())
@@ -44,8 +51,6 @@ def test_demo_runs_every_stage_and_writes_the_report(tmp_path, capsys):
     assert all(j["rms_after"] < 0.06 < j["rms_before"] for j in fr["joints"])
     rep = json.loads((out / "feasible" / "report.json").read_text())
     assert rep["feasible"] and rep["relative_residual"] < 1e-4
-    md = (out / "report.md").read_text()
-    assert "## 4. Feasible link parameters" in md and "](friction/friction.png)" in md
     # stage 5: the convex method is consistent with margin and plausible on data with model
     # error; both methods reproduce the coefficients
     cmp = {
@@ -57,10 +62,40 @@ def test_demo_runs_every_stage_and_writes_the_report(tmp_path, capsys):
     assert sdp["feasible"] and sdp["min_margin"]["pseudo_inertia"] >= 1e-4 * (1 - 1e-9)
     assert sdp["lightest_link_kg"] >= 0.3 and sdp["relative_residual"] < 0.05
     assert cmp["penalty"]["relative_residual"] < 1e-4
-    assert "## 5. Physically consistent parameters" in md
     # report.html over every stage: each stage's figures embedded, its data files linked
     page = (out / "report.html").read_text(encoding="utf-8")
     for png in sorted(out.rglob("*.png")):
         assert base64.b64encode(png.read_bytes()).decode("ascii") in page, png.name
-    for rel in ("identification/static.csv", "feasible/robot.urdf", "report.md"):
+    for rel in ("identification/static.csv", "feasible/robot.urdf", "paper.json"):
         assert f'href="{rel}"' in page, rel
+    assert not (out / "report.md").exists()  # one report
+    _paper_tables_match_the_reference(out, page)
+    if CHROMIUM is not None:
+        check_in_browser(out / "report.html", tmp_path, verdict=True, torques=False)
+
+
+def _paper_tables_match_the_reference(out: Path, page: str) -> None:
+    """paper.json and the page against the published Table III (tests/data, transcribed
+    from the paper): the printed values and the transcription errors are the paper's,
+    dynid's coefficients (identified from the published robot's noisy M, g) lie within
+    3 std of the expressions evaluated at the published p_hat, and the page shows the
+    43 rows with dynid's value, its std, the published value and the difference."""
+    ref = json.loads((DATA / "gaz2019_coefficients.json").read_text())["coefficients"]
+    paper = json.loads((out / "paper.json").read_text())
+    rows = paper["table_iii"]
+    assert [r["published"] for r in rows] == [c["pi_of_p_hat"] for c in ref]
+    typo = json.loads((DATA / "gaz2019_coefficients.json").read_text())["transcription_errors"]
+    assert [r["index"] for r in rows if r["transcription_error"]] == typo["indices"]
+    truth = np.array([c["pi_of_p_hat_recomputed_from_printed_p_hat"] for c in ref])
+    ours, std = np.array([r["dynid"] for r in rows]), np.array([r["dynid_std"] for r in rows])
+    assert np.all(np.abs(ours - truth) <= 3 * std + 1e-6), np.abs(ours - truth) / std
+    diff = [r["difference"] for r in rows if r["published"] is not None]
+    printed = [r for r in rows if r["published"] is not None]
+    np.testing.assert_allclose(diff, [r["dynid"] - r["published"] for r in printed], rtol=1e-12)
+    p = Page(page)
+    table = next(t for t in p.tables if t and "published pi(p_hat)" in t[0])
+    assert len(table) == 44 and "difference (dynid - published)" in table[0]
+    assert [r[0] for r in table[1:]] == [str(k) for k in range(1, 44)]
+    headline = re.search(r'<p class="headline">(.*?)</p>', page, re.S).group(1)
+    assert "dynid reproduces the paper" in headline
+    assert len(paper["friction"]) == 21 and len(paper["links"]) == 7

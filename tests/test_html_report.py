@@ -23,7 +23,9 @@ import pytest
 
 import dynid
 from dynid.cli.__main__ import main
-from dynid.io.html_report import (
+from dynid.io.robot.toml import save_toml
+from dynid.io.run_output import MANIFEST
+from dynid.report import (
     REPORT_NAME,
     ReportTable,
     RunSummary,
@@ -31,11 +33,9 @@ from dynid.io.html_report import (
     render_html_report,
     save_html_report,
 )
-from dynid.io.robot.toml import save_toml
-from dynid.io.run_output import MANIFEST
 
 
-class _Page(HTMLParser):
+class Page(HTMLParser):
     """The parts of a page the tests look at: tables (rows of cell text), images, links,
     scripts, and all text."""
 
@@ -135,7 +135,7 @@ def test_user_text_is_escaped_everywhere(tmp_path):
         tables=(ReportTable(HOSTILE, (HOSTILE, "b"), ((HOSTILE, "1"),)),),
     )
     page_text = render_html_report(summary, {res.name: res}, out=out)
-    page = _Page(page_text)
+    page = Page(page_text)
     assert page.scripts == 1  # ours only: the JSON's <script> is text
     assert "<script>alert" not in page_text and "<b>&amp;" not in page_text
     text = "".join(page.text)
@@ -165,7 +165,7 @@ def test_figures_are_embedded_byte_for_byte(tmp_path):
         p.parent.mkdir(parents=True, exist_ok=True)
         p.write_bytes(data)
         files[rel] = p
-    page = _Page(render_html_report(RunSummary(command="demo"), files, out=tmp_path))
+    page = Page(render_html_report(RunSummary(command="demo"), files, out=tmp_path))
     decoded = {}
     for img in page.images:
         head, _, payload = img["src"].partition(",")
@@ -198,14 +198,15 @@ def test_json_results_become_tables(tmp_path):
     }
     p = tmp_path / "r.json"
     p.write_text(json.dumps(doc))
-    page = _Page(render_html_report(RunSummary(command="validate"), {"r.json": p}, out=tmp_path))
+    page = Page(render_html_report(RunSummary(command="validate"), {"r.json": p}, out=tmp_path))
     rows = [r for t in page.tables for r in t]
     assert ["rank", "43"] in rows and ["feasible", "yes"] in rows
     assert ["relative_error_percent", "0.1235"] in rows
-    assert ["", "rms [N m]", "mse"] in rows
+    assert ["name", "rms [N m]", "mse"] in rows  # every column named
     assert ["j2", "0.25", "0.0625"] in rows
     assert ["j3", "3.5", "0.75", "0.05"] in rows  # records named by the joint names
     assert ["2", "3", "4"] in rows  # the 2 x 2 matrix
+    assert ["#", "column 1", "column 2"] in rows
     assert any(r[0] == "covariance" and "43 x 43" in r[1] for r in rows)
     # the key numbers come first; the largest RMS after friction over the joints is one
     text = " ".join(page.text)
@@ -242,6 +243,7 @@ def test_save_writes_the_page(tmp_path):
 #: The commands that write a folder, each with a short run (output folder -> argv).
 COMMANDS = {
     "identify": ["identify", "--data", "{d}/s.csv"],
+    "identify-log": ["identify", "--data", "{d}/l6.csv"],
     "consistent": ["identify", "--data", "{d}/s.csv", "--consistent"],
     "friction": ["friction", "--model", "{d}/identify/identification.json", "--data", "{d}/l.csv"],
     "validate": [
@@ -281,6 +283,8 @@ def runs(tmp_path_factory) -> Path:
     assert main([*static, "--out", f"{d}/loaded.csv", "-q"]) == 0
     sim = ["simulate", "--trajectory", "sinusoid", "--duration", "2", "--rate", "200"]
     assert main([*sim, "--seed", "1", "--out", f"{d}/l.csv", "-q"]) == 0
+    sim6 = ["simulate", "--trajectory", "sinusoid", "--duration", "6", "--rate", "200"]
+    assert main([*sim6, "--seed", "2", "--out", f"{d}/l6.csv", "-q"]) == 0  # noise 0.05 N m
     for name, argv in COMMANDS.items():
         code = main([a.format(d=d) for a in argv] + ["--out", str(d / name), "-q"])
         assert code == 0, name
@@ -296,7 +300,7 @@ def test_every_command_writes_its_report(runs, name):
     files = json.loads((out / MANIFEST).read_text())["files"]
     assert REPORT_NAME in files
     page_text = (out / REPORT_NAME).read_text(encoding="utf-8")
-    page = _Page(page_text)
+    page = Page(page_text)
     pngs = sorted(f for f in files if f.endswith(".png"))
     embedded = {img["alt"]: base64.b64decode(img["src"].split(",", 1)[1]) for img in page.images}
     assert embedded == {f: (out / f).read_bytes() for f in pngs}
@@ -333,22 +337,32 @@ def _browser(page: Path, profile: Path, *args: str) -> subprocess.CompletedProce
     )
 
 
-def _check_in_browser(page: Path, tmp_path: Path) -> None:
+def check_in_browser(
+    page: Path, tmp_path: Path, *, verdict: bool = False, torques: bool = False
+) -> str:
     """The rendered page: every figure decoded at its file's width, the tables in the
-    document, and a screenshot that is not blank."""
+    document, and a screenshot that is not blank; with ``verdict``, the verdict ends within
+    the first screen (1200 x 900), with ``torques`` a figure starts in it. Returns the DOM."""
     text = page.read_text(encoding="utf-8")
     widths = [
         struct.unpack(">I", base64.b64decode(src)[16:20])[0]  # IHDR width of the PNG
         for src in re.findall(r'src="data:image/png;base64,([^"]+)"', text)
     ]
-    dom = _browser(page, tmp_path / "profile", "--dump-dom")
+    dom = _browser(page, tmp_path / "profile", "--dump-dom", "--window-size=1200,900")
     if dom.returncode != 0 or "<body" not in dom.stdout:
         pytest.skip(f"chromium cannot run here: {dom.stderr.strip()[-300:]}")
     decoded = re.search(r'data-figures-decoded="(\d+)"', dom.stdout)
     assert decoded is not None, "the page's script did not run"
-    assert int(decoded.group(1)) == len(widths) > 0
+    assert int(decoded.group(1)) == len(widths)
+    assert widths or not torques  # a page of torques has their figure
     assert [int(w) for w in re.findall(r'data-natural-width="(\d+)"', dom.stdout)] == widths
-    assert len(_Page(dom.stdout).tables) == len(_Page(text).tables) >= 3
+    assert len(Page(dom.stdout).tables) == len(Page(text).tables) >= 3
+    if verdict:
+        bottom = re.search(r'data-verdict-bottom="(-?\d+)"', dom.stdout)
+        assert bottom is not None and 0 < int(bottom.group(1)) <= SCREEN[1], page
+    if torques:
+        top = re.search(r'data-first-figure-top="(-?\d+)"', dom.stdout)
+        assert top is not None and 0 < int(top.group(1)) < SCREEN[1], page
     shot = tmp_path / "shot.png"
     r = _browser(page, tmp_path / "profile", f"--screenshot={shot}", "--window-size=1200,2000")
     assert r.returncode == 0 and shot.is_file(), r.stderr[-300:]
@@ -357,6 +371,11 @@ def _check_in_browser(page: Path, tmp_path: Path) -> None:
         gray = np.asarray(im.convert("L"), dtype=float)
     assert gray.shape == (2000, 1200)
     assert gray.std() > 10 and (gray < 128).mean() > 0.01  # text, tables and figures drawn
+    return dom.stdout
+
+
+#: The first screen a user sees [CSS px]: width, height.
+SCREEN = (1200, 900)
 
 
 @needs_chromium
@@ -371,11 +390,139 @@ def test_a_report_renders_in_chromium(tmp_path):
     files = {f: out / f for f in ("r.json", "a.png", "sub/b.png")}
     summary = RunSummary(command="demo", argv=("dynid", "demo"), warnings=("w",))
     save_html_report(out / REPORT_NAME, summary, files)
-    _check_in_browser(out / REPORT_NAME, tmp_path)
+    check_in_browser(out / REPORT_NAME, tmp_path)
+
+
+#: The verdict each command's page opens with (command folder -> words of its headline),
+#: and whether a figure of torques is in the first screen.
+VERDICTS = {
+    "identify": ("The model reproduces M(q) and g(q) to", False),
+    "identify-log": ("The model predicts held-out torques to", True),
+    "consistent": ("The model reproduces M(q) and g(q) to", False),
+    "friction": ("Friction law chosen:", True),
+    "validate": ("The model predicts the log's torques to", True),
+    "retrieve": ("The link parameters are physically consistent", False),
+}
 
 
 @pytest.mark.slow
 @needs_chromium
-def test_the_validate_report_renders_in_chromium(runs, tmp_path):
-    """validate's report (two figures of the command) shows its figures in Chromium."""
-    _check_in_browser(runs / "validate" / REPORT_NAME, tmp_path)
+@pytest.mark.parametrize("name", list(VERDICTS))
+def test_each_report_opens_with_its_verdict_in_chromium(runs, name, tmp_path):
+    """Each command's page, rendered headless: every figure decoded, the tables present,
+    the verdict ending in the first screen (and a torque figure starting in it where the
+    command has torques), the headline the command's answer."""
+    words, torques = VERDICTS[name]
+    dom = check_in_browser(runs / name / REPORT_NAME, tmp_path, verdict=True, torques=torques)
+    headline = re.search(r'<p class="headline">(.*?)</p>', dom, re.S)
+    assert headline is not None and words in re.sub(r"<[^>]+>", "", headline.group(1))
+
+
+@pytest.mark.slow
+def test_identify_on_a_log_judges_held_out_torques_against_the_sensor_noise(runs):
+    """identify on a log stages heldout.json and the two figures; the noise it reads above
+    the cut-off is the simulated sensor's (0.05 N m); the page's verdict sets the held-out
+    error beside that floor, and its tables name their columns with units."""
+    out = runs / "identify-log"
+    held = json.loads((out / "heldout.json").read_text())
+    noise = np.array(held["noise_rms"])
+    assert np.all(np.abs(noise / 0.05 - 1.0) < 0.2), noise
+    for f in ("heldout_torques.png", "heldout_residuals.png"):
+        assert (out / f).read_bytes().startswith(b"\x89PNG")
+    page = Page((out / REPORT_NAME).read_text(encoding="utf-8"))
+    text = " ".join(" ".join(page.text).split())
+    floor = f"{held['noise_floor_percent']:.3g} %"
+    assert f"sensor-noise floor of {floor}" in text, text[:800]
+    headers = {h for t in page.tables for h in t[0]}
+    assert {"held-out RMS error [N m]", "sensor noise RMS [N m]", "fv [N m s/rad]"} <= headers
+    assert not any(h.isdigit() for h in headers)  # no "1, 2, 3" column names
+
+
+def _identification_doc(runs: Path) -> dict:
+    return json.loads((runs / "identify-log" / "identification.json").read_text())
+
+
+@pytest.mark.slow
+def test_model_structure_table_marks_the_chosen_candidate(runs, tmp_path):
+    """An identification record with ``selection`` gets the model-structure table, the
+    chosen candidate's row marked; one without it renders without that table."""
+    doc = _identification_doc(runs)
+    doc["selection"] = {
+        "rule": "lowest held-out error within one standard error",
+        "validation": "5 contiguous time blocks",
+        "chosen": "classical",
+        "candidates": [
+            {"name": "rigid", "terms": [], "n_params": 43, "train_error_percent": 2.5,
+             "heldout_error_percent": 2.6, "heldout_se_percent": 0.1},
+            {"name": "classical", "terms": ["fv", "fc", "fo"], "n_params": 64,
+             "train_error_percent": 0.38, "heldout_error_percent": 0.40,
+             "heldout_se_percent": 0.02},
+        ],
+    }  # fmt: skip
+    p = tmp_path / "identification.json"
+    p.write_text(json.dumps(doc))
+    page_text = render_html_report(RunSummary(command="identify"), {p.name: p}, out=tmp_path)
+    page = Page(page_text)
+    structure = next(t for t in page.tables if "candidate" in t[0])
+    assert structure[0][:2] == ["", "candidate"] and "held-out error [%]" in structure[0]
+    assert structure[2][:2] == ["\u2713 chosen", "classical"] and structure[1][0] == ""
+    assert '<tr class="marked"><td>&#10003; chosen</td><td>classical' in page_text
+    assert "Terms chosen: classical" in " ".join(" ".join(page.text).split())
+    del doc["selection"]
+    p.write_text(json.dumps(doc))
+    page = Page(render_html_report(RunSummary(command="identify"), {p.name: p}, out=tmp_path))
+    assert not any("candidate" in t[0] for t in page.tables)
+
+
+def test_figures_left_out_are_said_in_the_first_lines(tmp_path):
+    """A run without matplotlib: the page says first which figures were left out and how
+    to get them."""
+    notes = (
+        "matplotlib is not installed; skipped the figure validation_torques.png",
+        "matplotlib is not installed; skipped the figure validation_rms.png",
+    )
+    page_text = render_html_report(RunSummary(command="validate", notes=notes), {}, out=tmp_path)
+    text = " ".join(" ".join(Page(page_text).text).split())
+    said = "Figures left out: validation_torques.png, validation_rms.png."
+    assert said in text and "pip install matplotlib" in text
+    heading = text.rindex("dynid validate:")  # the heading (the first is the <title>)
+    assert 0 < text.index(said) - heading < 200  # after the heading and the run's time only
+
+
+@needs_chromium
+def test_an_observer_report_shows_residuals_thresholds_and_events(tmp_path):
+    """The observer's files (events, thresholds, residuals) are read generically: the
+    verdict counts the events, the figure and the tables are shown, the CSV is linked."""
+    out = tmp_path / "observe"
+    out.mkdir()
+    events = {
+        "schema": "x/1",
+        "events": [
+            {"t": 1.25, "joint": "joint4", "residual": 3.2},
+            {"t": 4.5, "joint": "joint2", "residual": 5.0},
+        ],
+    }
+    (out / "events.json").write_text(json.dumps(events))
+    (out / "thresholds.json").write_text(
+        json.dumps(
+            {
+                "joint_names": ["joint1", "joint2"],
+                "threshold": [1.5, 2.0],
+                "units": {"threshold": "N m"},
+            }
+        )
+    )
+    (out / "residuals.csv").write_text("t,r1,r2\n0,0,0\n")
+    (out / "residuals.png").write_bytes(_png(300, 200, seed=5))
+    files = {f.name: f for f in out.iterdir()}
+    summary = RunSummary(command="observe", argv=("dynid", "observe"))
+    save_html_report(out / REPORT_NAME, summary, files)
+    page_text = (out / REPORT_NAME).read_text(encoding="utf-8")
+    page = Page(page_text)
+    assert "2 events detected." in " ".join(page.text)
+    assert ["joint4", "1.25", "3.2"] in [r[:3] for t in page.tables for r in t] or any(
+        "joint4" in r for t in page.tables for r in t
+    )
+    assert ["joint2", "2"] in [r for t in page.tables for r in t]
+    assert "residuals.csv" in {urllib.parse.unquote(h) for h in page.links}
+    check_in_browser(out / REPORT_NAME, tmp_path, verdict=True, torques=True)

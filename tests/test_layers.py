@@ -20,6 +20,7 @@ LAYERS = [
     {"feasibility"},
     {"pipeline"},
     {"io"},
+    {"report"},
     {"workflows"},
     {"plots"},
     {"cli", "__main__"},

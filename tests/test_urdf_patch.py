@@ -131,7 +131,8 @@ def test_subtract_refuses_a_rest_that_is_not_a_body(tmp_path, capsys):
         patch_urdf_inertials(text, dynid.panda(), base="panda_link0", tip="panda_hand")
     msg = str(info.value)
     assert "link 'panda_link7'" in msg and "panda_hand" in msg, msg
-    assert "--merged move" in msg and "identified data did not include those bodies" in msg
+    assert all(f"--merged {p}" in msg for p in ("subtract", "keep", "move")), msg
+    assert "identified data did not include those bodies" in msg
     fixed = re.search(r"fixed links (\[.*?\])", msg).group(1)
     hand = sum(  # masses of the fixed links named, read from the template's text
         float(re.search(rf'<link name="{name}">.*?<mass value="([^"]+)"', text, re.S).group(1))
@@ -142,7 +143,7 @@ def test_subtract_refuses_a_rest_that_is_not_a_body(tmp_path, capsys):
     argv = ["export", "--params", "panda", "--out", str(out), "--urdf-template", path]
     assert main(argv + ["--base", "panda_link0", "--tip", "panda_hand"]) == 2
     err = capsys.readouterr().err.strip().splitlines()
-    assert len(err) == 1 and "link 'panda_link7'" in err[0] and "--merged move" in err[0]
+    assert len(err) == 1 and "link 'panda_link7'" in err[0] and "--merged keep" in err[0]
     assert not out.exists() and list(tmp_path.iterdir()) == []
     argv += ["--base", "panda_link0", "--tip", "panda_hand", "--merged", "move"]
     assert main(argv) == 0 and out.exists()
@@ -237,3 +238,85 @@ def test_cli_export_urdf_template_and_mjcf(tmp_path, capsys):
     assert main(argv + ["--tip", "panda_link3"]) == 2
     err = capsys.readouterr().err.strip()
     assert err.startswith("dynid export: error:") and "\n" not in err
+
+
+def test_merged_keep_exports_a_panda_identified_without_its_hand(tmp_path):
+    """--merged keep: the published Panda (identified without its hand) goes into the
+    vendor's URDF with the hand kept byte for byte; Pinocchio on the file gives the
+    published arm's M and g plus the hand's, computed from the template's own hand."""
+    path, chain = _template_chain()
+    text = open(path).read()
+    out = tmp_path / "p.urdf"
+    argv = ["export", "--params", "panda", "--out", str(out), "--urdf-template", path]
+    assert main([*argv, "--base", "panda_link0", "--tip", "panda_hand", "--merged", "keep"]) == 0
+    patched = out.read_text()
+    hand = r'<link name="panda_hand">.*?</link>'
+    assert re.search(hand, patched, re.S).group(0) == re.search(hand, text, re.S).group(0)
+    m7 = re.search(r'<link name="panda_link7">.*?<mass value="([^"]+)"', patched, re.S).group(1)
+    np.testing.assert_allclose(float(m7), dynid.panda().phi[6, 0], rtol=1e-15)
+    # Pinocchio on the files: from the template to the patch, M and g change exactly as
+    # between chain exports of the template's own links 1..7 and the published arm
+    own = chain.phi.copy()
+    own[6] = _own_link_phi(text, "panda_link7")
+    q, _, _ = random_states(chain, 30, seed=8)
+    M_t, g_t = _pin_M_g(path, q, lock=_FINGERS)
+    M_p, g_p = _pin_M_g(out, q, lock=_FINGERS)
+    M_new, g_new = _pin_M_g(save_urdf(tmp_path / "new.urdf", dynid.panda()), q)
+    M_old, g_old = _pin_M_g(save_urdf(tmp_path / "old.urdf", chain.with_params(own)), q)
+    np.testing.assert_allclose(M_p - M_t, M_new - M_old, atol=1e-10)
+    np.testing.assert_allclose(g_p - g_t, g_new - g_old, atol=1e-10)
+
+
+def _own_link_phi(text, name):
+    """phi (10,) of one link's own <inertial> in the template (no rotation in these files)."""
+    block = re.search(rf'<link name="{name}">.*?</link>', text, re.S).group(0)
+    m = float(re.search(r'<mass value="([^"]+)"', block).group(1))
+    c = np.array(
+        [float(x) for x in re.search(r'<origin[^>]*xyz="([^"]+)"', block).group(1).split()]
+    )
+    rpy = re.search(r'<origin[^>]*rpy="([^"]+)"', block)
+    assert rpy is None or not any(float(x) for x in rpy.group(1).split())
+    attrs = {
+        a: float(re.search(rf'{a}="([^"]+)"', block).group(1))
+        for a in ("ixx", "ixy", "ixz", "iyy", "iyz", "izz")
+    }
+    I = np.array(
+        [
+            [attrs["ixx"], attrs["ixy"], attrs["ixz"]],
+            [attrs["ixy"], attrs["iyy"], attrs["iyz"]],
+            [attrs["ixz"], attrs["iyz"], attrs["izz"]],
+        ]
+    )
+    J = I + m * (c @ c * np.eye(3) - np.outer(c, c))  # about the link origin (Steiner)
+    mc = m * c
+    return np.array([m, *mc, J[0, 0], J[0, 1], J[0, 2], J[1, 1], J[1, 2], J[2, 2]])
+
+
+def test_a_template_fixed_link_of_negative_mass_is_refused(tmp_path, capsys):
+    """A hand of negative mass in the template is refused in one line naming it, under
+    every --merged policy (issue 28: it was written silently)."""
+    path, chain = _template_chain()
+    text = open(path).read()
+    bad = re.sub(
+        r'(<link name="panda_hand">.*?<mass value=")([^"]+)(")',
+        r"\g<1>-0.73\g<3>",
+        text,
+        count=1,
+        flags=re.S,
+    )
+    template = tmp_path / "bad.urdf"
+    template.write_text(bad)
+    for policy in ("subtract", "move", "keep"):
+        with pytest.raises(ModelError, match=r"link 'panda_hand' has a negative mass \(-0.73 kg\)"):
+            patch_urdf_inertials(
+                bad,
+                _identified(chain, seed=9),
+                base="panda_link0",
+                tip="panda_hand",
+                merged=policy,
+            )
+    out = tmp_path / "p.urdf"
+    argv = ["export", "--params", "panda", "--out", str(out), "--urdf-template", str(template)]
+    assert main([*argv, "--base", "panda_link0", "--tip", "panda_hand", "--merged", "keep"]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and "negative mass" in err[0] and not out.exists()

@@ -1,8 +1,9 @@
-"""What the demo (``dynid demo``) prints and writes per stage, and its report.md.
+"""What the demo (``dynid demo``) prints and writes per stage, and the paper's numbers.
 
 Each stage of :func:`dynid.pipeline.run_demo` has a ``format_*`` (the printed text) and a
-``save_*`` (its files under the stage's folder, returned); :func:`write_report` gathers
-the tables and figures of every stage into ``report.md``.
+``save_*`` (its files under the stage's folder, returned); :func:`save_paper_comparison`
+writes ``paper.json``, dynid's results beside the published ones, which the run's
+``report.html`` opens with.
 """
 
 from __future__ import annotations
@@ -11,8 +12,6 @@ from pathlib import Path
 
 import numpy as np
 
-from .. import __version__
-from ..io.atomic import write_text
 from ..io.feasible import save_feasible_json
 from ..io.feasible_bundle import save_feasible_bundle
 from ..io.friction_json import save_friction_json
@@ -28,6 +27,7 @@ from ..pipeline import (
     DemoResult,
     KinematicsStageResult,
 )
+from ..pipeline.paper import paper_comparison
 from ..pipeline.stages import FeasibleStageResult, FrictionStageResult, IdentificationStageResult
 from ..plots.feasible import plot_consistent, plot_newton_euler_validation
 from ..plots.kinematics import plot_ik_path
@@ -260,148 +260,9 @@ def save_consistent(out: Path, res: ConsistentStageResult) -> list[Path]:
     return files + ([] if fig is None else [fig])
 
 
-# ---------------------------------------------------------------------- report
-def _table(header: list[str], rows: list[list[str]]) -> str:
-    lines = ["| " + " | ".join(header) + " |", "|" + "---|" * len(header)]
-    return "\n".join(lines + ["| " + " | ".join(r) + " |" for r in rows])
-
-
-def _report_kinematics(demo: DemoResult) -> list[str]:
-    ik = demo.kinematics.ik
-    return [
-        "## 1. Kinematics",
-        f"IK with a tool 0.1 m along the flange z: converged {ik.converged} in "
-        f"{ik.iterations} steps, position error {ik.position_error:.2e} m, "
-        f"orientation error {ik.orientation_error:.2e} rad.",
-        "![IK joint motion](ik_joint_motion.png)",
-    ]
-
-
-def _report_identification(demo: DemoResult) -> list[str]:
-    i = demo.identification
-    return [
-        "## 2. Identification from M(q) and g(q) at static configurations",
-        _table(
-            [
-                "configurations",
-                "rank",
-                "condition number",
-                "relative error [%]",
-                "dropped rows",
-                "largest error / std",
-            ],
-            [
-                [
-                    str(i.n_configurations),
-                    str(i.rank),
-                    f"{i.condition_number:.3g}",
-                    f"{i.relative_error_percent:.3g}",
-                    ", ".join(i.dropped_rows),
-                    f"{i.max_error_in_std:.2f}",
-                ]
-            ],
-        ),
-        "Coefficients, expressions and standard deviations: "
-        "[identification/identification.json](identification/identification.json).",
-    ]
-
-
-def _report_friction(demo: DemoResult) -> list[str]:
-    names = demo.robot.joint_names
-    f = demo.friction
-    rows = [
-        [n, f"{a:.4f}", f"{b:.4f}"]
-        for n, a, b in zip(names, f.rms_without_friction, f.rms_with_friction, strict=True)
-    ]
-    return [
-        "## 3. Validation on sinusoids and joint friction",
-        _table(["joint", "RMS without friction [N m]", "RMS with friction [N m]"], rows),
-        f"Relative error {f.relative_error_percent_without:.3g} % without friction, "
-        f"{f.relative_error_percent_with:.3g} % with.",
-        "![torques](friction/validation_torques.png)",
-        "![friction](friction/friction.png)",
-    ]
-
-
-def _report_feasible(demo: DemoResult, files: list[Path]) -> list[str]:
-    names = demo.robot.joint_names
-    e = demo.feasible
-    r4 = e.retrieval
-    rows = [[n, f"{a:.4f}"] for n, a in zip(names, e.rms_newton_euler, strict=True)]
-    parts = [
-        "## 4. Feasible link parameters and Newton-Euler validation",
-        f"Feasible: {e.feasible}; relative residual on the coefficients "
-        f"{e.relative_residual:.2e}; total mass {e.total_mass:.3f} kg; "
-        f"{float(r4.run_time):.1f} s on {int(r4.workers)} worker(s). Smallest margins: "
-        + ", ".join(f"{k} {v:.2e}" for k, v in e.min_margin.items())
-        + ".",
-        _table(["joint", "RMS Newton-Euler + friction [N m]"], rows),
-        "Files: [feasible.json](feasible/feasible.json), [robot.urdf](feasible/robot.urdf), "
-        "[robot.toml](feasible/robot.toml), [report.json](feasible/report.json).",
-    ]
-    parts += [
-        f"![{p.stem}](feasible/{p.name})"
-        for p in sorted(files)
-        if p.parent.name == "feasible" and p.suffix == ".png"
-    ]
-    return parts
-
-
-def _report_consistent(demo: DemoResult) -> list[str]:
-    c = demo.consistent
-    rows5 = [
-        [
-            m["method"],
-            str(m["feasible"]),
-            f"{m['relative_residual']:.2e}",
-            f"{m['min_margin']['pseudo_inertia']:.2e}",
-            f"{m['min_margin']['triangle_inequality']:.2e}",
-            f"{m['lightest_link_kg']:.3f}",
-            f"{100 * m['median_mass_error_truth']:.1f}",
-            f"{100 * m['median_mass_distance_prior']:.1f}",
-            f"{m['time_s']:.2f}",
-        ]
-        for m in (row.as_dict() for row in c.rows)
-    ]
-    return [
-        "## 5. Physically consistent parameters: convex (LMI) and penalty methods",
-        "A simulated Panda whose parameters differ from the published ones by up to 20 %, "
-        "with rotor inertia on the diagonal of M and a tilted gravity (no rigid body "
-        "reproduces its coefficients exactly); 1010 static configurations, 1e-4 noise. "
-        "Prior: the published parameters.",
-        _table(
-            [
-                "method",
-                "consistent",
-                "residual on beta",
-                "min lambda(J)/tr(J)",
-                "min triangle [kg m^2]",
-                "lightest link [kg]",
-                "median mass error vs truth [%]",
-                "median mass distance to prior [%]",
-                "time [s]",
-            ],
-            rows5,
-        ),
-        f"The prior itself is {100 * c.prior_mass_error_truth:.1f} % off the true masses "
-        "(median over links 2-7).",
-        "The rotor inertias are model terms identified with the links (the controller's M "
-        "holds them): " + rotor_line(c) + ". The penalty method fits the links alone.",
-        "Notes of the convex method: " + "; ".join(c.notes),
-        "![comparison](consistent/comparison.png)",
-    ]
-
-
-def write_report(out: Path, demo: DemoResult, files: list[Path]) -> Path:
-    """``out/report.md``: the tables and figures of every stage, with links to the files
-    (``files``: those written by the stages)."""
-    parts = [
-        "# dynid demo: the paper on the simulated Panda",
-        f"dynid {__version__}, seed {demo.seed}. Gaz et al., IEEE RA-L 4(4), 2019.",
-        *_report_kinematics(demo),
-        *_report_identification(demo),
-        *_report_friction(demo),
-        *_report_feasible(demo, files),
-        *_report_consistent(demo),
-    ]
-    return write_text(out / "report.md", "\n\n".join(parts) + "\n")
+# ---------------------------------------------------------------------- the paper
+def save_paper_comparison(out: Path, demo: DemoResult) -> Path:
+    """``out/paper.json``: dynid's results beside the paper's published values
+    (:func:`dynid.pipeline.paper.paper_comparison`), which report.html opens with."""
+    doc = {"seed": demo.seed, **paper_comparison(demo)}
+    return save_json(Path(out) / "paper.json", doc, schema="dynid-paper-comparison/1")

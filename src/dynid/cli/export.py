@@ -6,9 +6,12 @@ format comes from --format or the suffix of --out (.urdf, .xml/.mjcf, .toml).
 URDF without a template: the chain with the source robot's link and joint names. With
 --urdf-template ORIGINAL.urdf (and --base/--tip for its chain): the original file written
 back with only the chain's <inertial> elements replaced; names, meshes, other links, the
-gripper and <dynamics> are kept. Links fixed to a moving link (a hand) keep their inertials
-and the moving link gets the rest (--merged subtract, default), or the moving link gets the
-whole body and the fixed links lose their inertials (--merged move).
+gripper and <dynamics> are kept. Links fixed to a moving link (a hand): they keep their
+inertials and the moving link gets the rest of the identified body (--merged subtract,
+default: the body was identified with them); they keep their inertials and the moving link
+gets the whole identified body (--merged keep: identified without them, such as a Panda
+identified without its hand exported into the vendor's URDF with the hand); or the moving
+link gets the whole body and they lose their inertials (--merged move).
 
 MJCF (MuJoCo): bodies, hinge/slide joints with ranges, full inertials, gravity, motors, and
 the friction as frictionloss + damping: the linear friction a consistent identification
@@ -62,8 +65,9 @@ def register(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParser:
         "--merged",
         choices=MERGED_POLICIES,
         default="subtract",
-        help="template: links fixed to a moving link keep their inertials (subtract, default) "
-        "or give them to it (move)",
+        help="template: links fixed to a moving link (a hand) keep their inertials and the "
+        "moving link gets the rest of the body (subtract, default) or the whole body (keep: "
+        "identified without them), or they give theirs to it (move)",
     )
     p.add_argument("--no-friction", action="store_true", help="MJCF: frictionless joints")
     p.add_argument("--all-frames", action="store_true", help="URDF chain: every named frame")

@@ -1,23 +1,34 @@
 """The figures the commands write (skipped with a note when they cannot be drawn, see
-:func:`~dynid.cli.common.save_figure`): retrieval, friction fit, torque validation.
+:func:`~dynid.cli.common.save_figure`): retrieval, friction fit, torque validation, the
+identification's torques on held-out data.
 
 The plotting modules are called through their module (``feasible_plots.plot_consistent``)
 so that a test can replace a plotting function."""
 
 from __future__ import annotations
 
+import sys
 from pathlib import Path
 from typing import Any
 
 from ..feasibility.convex import ConsistentResult
 from ..friction.fit import FrictionFit, FrictionResidual
 from ..friction.validation import Validation
+from ..identification.model import IdentifiedModel
+from ..io.json_files import save_json
 from ..plots import feasible as feasible_plots
 from ..plots import friction as friction_plots
+from ..plots import identification as identification_plots
 from ..plots import torques as torque_plots
+from ..workflows.data_files import column_map, read_torque_log
 from .common import save_figure
 
-__all__ = ["save_friction_figure", "save_retrieval_figure", "save_validation_figures"]
+__all__ = [
+    "save_friction_figure",
+    "save_identify_figures",
+    "save_retrieval_figure",
+    "save_validation_figures",
+]
 
 
 def save_retrieval_figure(folder: Path, result: Any) -> list[Path]:
@@ -65,6 +76,45 @@ def save_validation_figures(
         save_figure(
             lambda: torque_plots.plot_rms_comparison(rms, noise_std=noise_std, title=title),
             out / f"{prefix}_rms.png",
+        ),
+    ]
+    return [p for p in paths if p is not None]
+
+
+def save_identify_figures(out: Path, model: IdentifiedModel, args: Any) -> list[Path]:
+    """A torque log's identification on held-out data, under ``out``: ``heldout.json``
+    (errors per joint against the sensor noise), ``heldout_torques.png`` (measured and
+    predicted torques) and ``heldout_residuals.png`` (residual histograms). Nothing for
+    static data or a model without held-out folds; a log that cannot be read back is
+    noted and skipped (the identification's own files are written)."""
+    if model.info.log is None or model.holdout is None:
+        return []
+    try:
+        cmap = column_map(args.columns, args.units, cutoff_hz=args.cutoff)
+        read = lambda p: read_torque_log(  # noqa: E731
+            p, model.robot.n, columns=cmap, drop_invalid=args.drop_invalid
+        )
+        separate = None if args.validate_on is None else read(args.validate_on)
+        data = args.data if isinstance(args.data, Path) else args.data[-1]
+        held = identification_plots.heldout_torques(model, read(data), separate=separate)
+    except Exception as exc:  # a figure never fails the command
+        print(f"note: skipped the held-out torque figures: {exc}", file=sys.stderr)
+        return []
+    if held is None:
+        return []
+    names = list(held.joint_names)
+    paths = [
+        save_json(Path(out) / "heldout.json", held.as_dict(), schema="dynid-heldout-torques/1"),
+        save_figure(
+            lambda: torque_plots.plot_torque_validation(
+                held.validation, joint_names=names, title=f"Held-out: {held.block}"
+            ),
+            Path(out) / "heldout_torques.png",
+            dpi=100,
+        ),
+        save_figure(
+            lambda: identification_plots.plot_residual_histograms(held),
+            Path(out) / "heldout_residuals.png",
         ),
     ]
     return [p for p in paths if p is not None]

@@ -103,7 +103,7 @@ from .common import (
     sdp_options,
 )
 from .console import Console
-from .figures import save_retrieval_figure
+from .figures import save_identify_figures, save_retrieval_figure
 from .summaries import format_consistent, format_identification
 
 NAME = "identify"
@@ -190,7 +190,11 @@ def register(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParser:
         metavar="MIN,MAX",
         help="--consistent: band on the total mass [kg]",
     )
-    p.add_argument("--no-figures", action="store_true", help="--consistent: skip retrieval.png")
+    p.add_argument(
+        "--no-figures",
+        action="store_true",
+        help="skip the figures (held-out torques of a log; --consistent: retrieval.png)",
+    )
     p.add_argument(
         "--cutoff",
         type=positive_type,
@@ -238,8 +242,9 @@ def run(args: argparse.Namespace, console: Console) -> int:
         return run_consistent(args, console, robot, common)
     model = identify_file(robot, args.data, terms=args.terms, max_gap_s=args.max_gap, **common)
     path = save_model_json(args.out / "identification.json", model)
+    figures = [] if args.no_figures else save_identify_figures(args.out, model, args)
     console.print(format_identification(model))
-    console.wrote(path)
+    console.wrote(path, *figures)
     return 0
 
 
@@ -281,6 +286,8 @@ def run_consistent(args: argparse.Namespace, console: Console, robot, common) ->
     )
     assert result.identified is not None  # identify_consistent_file says so
     files = [save_model_json(args.out / "identification.json", result.identified)]
+    if not args.no_figures:
+        files += save_identify_figures(args.out, result.identified, args)
     files += save_feasible_bundle(args.out, result, source=str(args.data[0]))
     files += [] if args.no_figures else save_retrieval_figure(args.out, result)
     console.print(format_identification(result.identified), "", format_consistent(result))

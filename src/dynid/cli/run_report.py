@@ -5,7 +5,7 @@ passes everything through, keeps a copy (the printed summary, the warning and no
 and keeps a closed stdout (``dynid fk ... | head -1``) from failing the run: what cannot
 be printed is dropped and :attr:`RunRecord.stdout_closed` says so.
 
-:func:`save_run_report` writes ``report.html`` (:mod:`dynid.io.html_report`) into a
+:func:`save_run_report` writes ``report.html`` (:mod:`dynid.report`) into a
 command's output folder from that record and the files the run wrote.
 """
 
@@ -19,8 +19,8 @@ import time
 from collections.abc import Sequence
 from typing import Any, TextIO
 
-from ..io.html_report import REPORT_NAME, ReportTable, RunSummary, save_html_report
 from ..io.run_output import RunOutput
+from ..report import REPORT_NAME, ReportTable, RunSummary, save_html_report
 
 __all__ = ["RunRecord", "save_run_report"]
 

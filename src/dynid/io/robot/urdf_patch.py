@@ -7,20 +7,25 @@ formatting). The robot's link ``k`` must be the chain's moving link ``k``: the s
 number of joints and the same joint frames and axes (checked to 1e-9 m/rad).
 
 Merged fixed links. dynid lumps links fixed to moving link ``k`` (``panda_link8``, a
-hand) into body ``k`` (:mod:`dynid.io.robot.urdf_parse`). Two ways to write body ``k`` back:
+hand) into body ``k`` (:mod:`dynid.io.robot.urdf_parse`). Three ways to write body ``k`` back:
 
 * ``merged="subtract"`` (default): the fixed links keep their inertials and the moving
   link gets the rest, ``phi_k - sum(phi_fixed)``. When that rest is not physically
   consistent (a positive mass, positive principal moments meeting the triangle
   inequality) the identified body did not hold those fixed links (a link 7 identified
   without the hand), and nothing is written: a :class:`~dynid.exceptions.ModelError`
-  names the link, the fixed links and both remedies;
+  names the link, the fixed links and the other two policies;
 * ``merged="move"``: the moving link gets all of ``phi_k`` and the ``<inertial>`` of each
-  fixed link merged into body ``k`` is removed.
+  fixed link merged into body ``k`` is removed;
+* ``merged="keep"``: the fixed links keep their inertials and the moving link gets all of
+  ``phi_k``: for a body identified without them (a Panda identified without its hand,
+  exported into the vendor's URDF with the hand).
 
-Either way the template read back between the same ``base`` and ``tip`` gives exactly the
-robot's ``phi`` (checked before returning). Links fixed to the base, and links reached
-through joints off the chain (fingers), are left as they are.
+With ``subtract`` and ``move`` the template read back between the same ``base`` and ``tip``
+gives exactly the robot's ``phi``; with ``keep``, the robot's ``phi`` plus the fixed links'
+(checked before returning). A fixed link of negative mass merged into a body is refused
+(the template is wrong). Links fixed to the base, and links reached through joints off the
+chain (fingers), are left as they are.
 
 Inertials are written as ``<origin xyz="c" rpy="0 0 0"/>`` (CoM in the link frame [m]),
 ``<mass>`` [kg] and ``<inertia>`` about the CoM in link axes [kg m^2].
@@ -44,7 +49,7 @@ from .urdf_parse import robot_from_urdf_string
 
 __all__ = ["MERGED_POLICIES", "patch_urdf_inertials"]
 
-MERGED_POLICIES = ("subtract", "move")
+MERGED_POLICIES = ("subtract", "move", "keep")
 
 _LINK = re.compile(r"<link\b[^>]*?\bname\s*=\s*([\"'])(.*?)\1[^>]*?(/?)>", re.S)
 _INERTIAL = re.compile(r"<inertial\b[^>]*?/>|<inertial\b.*?</inertial>", re.S)
@@ -154,7 +159,7 @@ def patch_urdf_inertials(
         The robot whose ``phi`` (n, 10) is written; its chain must match the template's.
     base, tip : str, optional
         Chain of the template (defaults as in :func:`dynid.io.robot.urdf.load_urdf`).
-    merged : {"subtract", "move"}
+    merged : {"subtract", "move", "keep"}
         How body ``k`` is split over the moving link and the fixed links merged into it
         (module docstring).
     source : str
@@ -168,10 +173,10 @@ def patch_urdf_inertials(
     Raises
     ------
     ModelError
-        Malformed template, chains that do not match, an unknown ``merged`` policy;
-        ``merged="subtract"`` would leave a moving link with an inertial that is not
-        physically consistent (the message names the link, its fixed links and the
-        remedies).
+        Malformed template, chains that do not match, an unknown ``merged`` policy, a
+        fixed link of negative mass merged into a body; ``merged="subtract"`` would
+        leave a moving link with an inertial that is not physically consistent (the
+        message names the link, its fixed links and the other policies).
     UnknownNameError
         ``base`` or ``tip`` is not a link of the template.
     """
@@ -186,32 +191,33 @@ def patch_urdf_inertials(
     spans = _link_spans(template, [el.get("name", "") for el in root.iter("link")])
     moving = set(chain.link_names[1:])
     new_xml: dict[str, NDArray[np.float64] | None] = {}  # link -> phi, None: remove
+    expected = np.array(robot.phi, dtype=float)  # what the patched template must read back as
     for k in range(1, robot.n + 1):
         link = chain.link_names[k]
         own = _own_phi(elems[link])
+        fixed = [
+            name
+            for name, fr in chain.frames.items()
+            if fr.link == k and name in elems and name not in moving
+            and elems[name].find("inertial") is not None
+        ]  # fmt: skip
+        _check_masses(fixed, elems, source)
+        phi: NDArray[np.float64] = np.array(robot.phi[k - 1])
         if merged == "subtract":
             phi = robot.phi[k - 1] - (chain.phi[k - 1] - own)
-            fixed = [
-                name
-                for name, fr in chain.frames.items()
-                if fr.link == k and name in elems and name not in moving
-                and elems[name].find("inertial") is not None
-            ]  # fmt: skip
             _check_consistent(link, phi, fixed, source)
-        else:
-            phi = np.array(robot.phi[k - 1])
-            for name, fr in chain.frames.items():
-                if fr.link == k and name in elems and name not in moving:
-                    if elems[name].find("inertial") is not None:
-                        new_xml[name] = None
+        elif merged == "move":
+            new_xml.update(dict.fromkeys(fixed))
+        else:  # keep: the fixed links stay, the body goes on the moving link
+            expected[k - 1] += chain.phi[k - 1] - own
         new_xml[link] = phi
     edits: list[tuple[int, int, str]] = []
-    for link, phi in new_xml.items():
+    for link, new in new_xml.items():
         start, open_end, end, closed = spans[link]
         body = template[open_end:end]
         masked = _COMMENT.sub(lambda m: " " * len(m.group(0)), body)
         found = _INERTIAL.search(masked)
-        if phi is None:
+        if new is None:
             if found is not None:
                 a, b = open_end + found.start(), open_end + found.end()
                 line_start = template.rfind("\n", 0, a)
@@ -224,16 +230,16 @@ def patch_urdf_inertials(
             a = open_end + found.start()
             indent = _line_indent(template, a) or link_indent + "  "
             step = _indent_step(indent, link_indent)
-            edits.append((a, open_end + found.end(), _inertial_xml(phi, indent, step)))
+            edits.append((a, open_end + found.end(), _inertial_xml(new, indent, step)))
         elif closed:
             indent = link_indent + "  "
             tag = template[start:open_end]
             opening = tag[:-2].rstrip() + ">"
-            xml = _inertial_xml(phi, indent, "  ")
+            xml = _inertial_xml(new, indent, "  ")
             edits.append((start, open_end, f"{opening}\n{indent}{xml}\n{link_indent}</link>"))
         else:
             indent = link_indent + "  "
-            xml = _inertial_xml(phi, indent, "  ")
+            xml = _inertial_xml(new, indent, "  ")
             edits.append((open_end, open_end, f"\n{indent}{xml}"))
     out = template
     for a, b, s in sorted(edits, reverse=True):
@@ -241,8 +247,8 @@ def patch_urdf_inertials(
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", DynidWarning)
         back = robot_from_urdf_string(out, base, tip, source=source)
-    scale = max(float(np.max(np.abs(robot.phi))), 1e-300)
-    if not np.allclose(back.phi, robot.phi, rtol=1e-9, atol=1e-12 * scale):
+    scale = max(float(np.max(np.abs(expected))), 1e-300)
+    if not np.allclose(back.phi, expected, rtol=1e-9, atol=1e-12 * scale):
         raise ModelError(f"{source}: the patched inertials do not read back as the robot's")
     return out
 
@@ -261,8 +267,20 @@ def _check_consistent(link: str, phi: NDArray[np.float64], fixed: list[str], sou
     raise ModelError(
         f"{source}: link {_checks.short(link)}: the identified body minus the template's "
         f"fixed links {_checks.short(fixed)} is not physically consistent (mass "
-        f"{float(m):.6g} kg, principal moments {[float(f'{x:.4g}') for x in lam]} kg m^2); "
-        "export with --merged move to put the whole body on the moving link, "
-        "or, if the identified data did not include those bodies, use a template without "
-        "them (or identify with them mounted)"
+        f"{float(m):.6g} kg, principal moments {[float(f'{x:.4g}') for x in lam]} kg m^2), "
+        "so --merged subtract cannot split it: if the identified data did not include those "
+        "bodies, export with --merged keep (the template's fixed links stay as they are, the "
+        "identified body goes on the moving link); with --merged move the whole body goes on "
+        "the moving link and the fixed links lose their inertials"
     )
+
+
+def _check_masses(fixed: list[str], elems: dict, source: str) -> None:
+    """Refuse a fixed link of the template whose own mass is negative."""
+    for name in fixed:
+        m = float(_own_phi(elems[name])[0])
+        if m < 0:
+            raise ModelError(
+                f"{source}: link {_checks.short(name)} has a negative mass ({m:.6g} kg); "
+                "correct its <inertial> in the template"
+            )

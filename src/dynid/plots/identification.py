@@ -1,0 +1,206 @@
+"""Figures of an identification on held-out data: measured against predicted torques, and
+the residuals against the sensor noise.
+
+:func:`heldout_torques` predicts data the fit did not see: the last of the contiguous time
+blocks of the held-out judgement (:mod:`dynid.identification.holdout`), with the
+coefficients and friction of the fold fitted on the other blocks (solved from the folds'
+normal equations the model keeps), or the separate ``--validate-on`` log with the model
+itself. The torques are compared unfiltered (:func:`dynid.friction.validation.validate_torques`),
+so a correct model leaves the sensor noise, which is read from the same torques above the
+low-pass cut-off (white noise: the band's share of its variance restored). The ratio of
+the two is the identification's distance to its noise floor.
+
+matplotlib is imported inside the plotting functions (never by ``import dynid``).
+"""
+
+from __future__ import annotations
+
+import dataclasses
+from dataclasses import dataclass
+from typing import TYPE_CHECKING, Any
+
+import numpy as np
+from numpy.typing import NDArray
+
+from ..friction.validation import Validation, own_friction, validate_torques
+from ..identification.log import TorqueLog
+from ..identification.model import IdentifiedModel
+from ..signals import lowpass
+
+if TYPE_CHECKING:  # pragma: no cover
+    from matplotlib.figure import Figure
+
+__all__ = ["HeldOutTorques", "heldout_torques", "plot_residual_histograms"]
+
+
+@dataclass(frozen=True, slots=True, eq=False)
+class HeldOutTorques:
+    """Predicted against measured torques on data the fit did not see.
+
+    Attributes
+    ----------
+    validation : Validation
+        The prediction on the held-out samples (unfiltered measured torques).
+    noise_rms : ndarray, shape (n,)
+        Sensor noise per joint, read above the cut-off [N m].
+    block : str
+        What was held out (``"the last of 5 time blocks, 8.2-10.0 s"``).
+    joint_names : tuple of str
+    """
+
+    validation: Validation
+    noise_rms: NDArray[np.float64]
+    block: str
+    joint_names: tuple[str, ...]
+
+    @property
+    def noise_floor_percent(self) -> float:
+        """The noise relative to the measured torques' norm [%]: the smallest relative
+        error a model can reach on these torques."""
+        tau = self.validation.log.tau
+        norm = float(np.linalg.norm(tau))
+        return 100.0 * float(np.sqrt(len(tau) * np.sum(self.noise_rms**2))) / norm if norm else 0.0
+
+    def as_dict(self) -> dict[str, Any]:
+        """JSON-ready: the errors per joint, the noise, the floor (schema ``heldout.json``)."""
+        e = self.validation.errors
+        return {
+            "block": self.block,
+            "joint_names": list(self.joint_names),
+            "n_samples": int(len(self.validation.log.tau)),
+            "rms": e.rms.tolist(),
+            "noise_rms": self.noise_rms.tolist(),
+            "relative_error_percent": float(e.relative_error_percent),
+            "relative_error_percent_per_joint": e.relative_error_percent_per_joint.tolist(),
+            "noise_floor_percent": self.noise_floor_percent,
+            "units": {"rms": "N m", "noise_rms": "N m", "relative_error_percent": "%"},
+        }
+
+
+def _fold_model(model: IdentifiedModel, fold: int) -> IdentifiedModel | None:
+    """The model fitted on every block but ``fold`` (None: the columns are not the base
+    parameters followed by ``fv, fc, fo`` per joint)."""
+    assert model.holdout is not None
+    x = model.holdout.train[fold].solve()
+    r, n = model.fit.beta.size, model.robot.n
+    labels = () if model.info.friction is None else model.info.friction.labels
+    if x.size != r + len(labels):
+        return None
+    friction = np.zeros((n, 3))
+    for lab, v in zip(labels, x[r:], strict=True):  # fv1, fc1, fo1, fv2, ...
+        friction[int(lab[2:]) - 1, ("fv", "fc", "fo").index(lab[:2])] = v
+    fit = dataclasses.replace(model.fit, beta=x[:r])
+    return IdentifiedModel(
+        robot=model.robot,
+        base=model.base,
+        fit=fit,
+        friction=friction if labels else None,
+        info=model.info,
+        drive=model.drive,
+    )
+
+
+def heldout_torques(
+    model: IdentifiedModel, log: TorqueLog, *, separate: TorqueLog | None = None
+) -> HeldOutTorques | None:
+    """The torques of data the identification held out, predicted.
+
+    Parameters
+    ----------
+    model : IdentifiedModel
+        Identified from ``log`` by the classical route (with its held-out folds).
+    log : TorqueLog
+        The log it was identified from, as read (several recordings: the last one).
+    separate : TorqueLog, optional
+        The ``--validate-on`` log (the model judged on it), as read.
+
+    Returns
+    -------
+    HeldOutTorques or None
+        None when the model keeps no held-out folds or its columns are not the base
+        parameters and the classical friction.
+    """
+    if model.holdout is None or model.info.log is None:
+        return None
+    if model.holdout.scheme == "file" and separate is not None:
+        fitted, held, block = model, separate, "the separate log (--validate-on)"
+    elif model.holdout.scheme == "blocks":
+        k = model.holdout.folds
+        fold = _fold_model(model, k - 1)
+        if fold is None:
+            return None
+        trim = model.info.log.trim_s
+        t0, t1 = float(log.t[0]) + trim, float(log.t[-1]) - trim
+        start = t0 + (k - 1) / k * (t1 - t0)
+        fitted, held = fold, log.select(log.t >= start - trim)
+        block = (
+            f"the last of {k} time blocks, {start:.1f}-{float(log.t[-1]):.1f} s, predicted by "
+            f"the fit of the other {k - 1}"
+        )
+    elif model.holdout.scheme == "recordings":  # ``log``: the last recording
+        k = model.holdout.folds
+        fold = _fold_model(model, k - 1)
+        if fold is None:
+            return None
+        fitted, held = fold, log
+        block = f"the last of {k} recordings, predicted by the fit of the other {k - 1}"
+    else:
+        return None
+    v = validate_torques(fitted, held, friction=own_friction(fitted))
+    cutoff = model.info.log.cutoff_hz or 0.2 * model.info.log.sample_rate_hz
+    return HeldOutTorques(v, _noise(v, cutoff), block, tuple(model.robot.joint_names))
+
+
+def _noise(v: Validation, cutoff_hz: float) -> NDArray[np.float64]:
+    """Per-joint sensor noise [N m] of the unfiltered torques: their part above the cut-off,
+    divided by the share of a white noise's variance found there."""
+    log = v.log
+    fs = 1.0 / float(np.median(np.diff(log.t)))
+    cut = min(cutoff_hz, 0.45 * fs)
+    high = log.tau - lowpass(log.tau, fs, cut)
+    share = max(1.0 - cut / (0.5 * fs), 0.05)
+    return np.sqrt(np.mean(high**2, axis=0) / share)
+
+
+def plot_residual_histograms(h: HeldOutTorques, *, title: str | None = None) -> Figure:
+    """Per joint, the histogram of the held-out residual (measured minus predicted) with
+    the normal density of the sensor noise over it.
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+        One panel per joint; residual [N m] on x, density [1/(N m)] on y.
+    """
+    import matplotlib.pyplot as plt
+
+    e = h.validation.log.tau - h.validation.tau_hat
+    n = e.shape[1]
+    cols = min(n, 4)
+    rows = int(np.ceil(n / cols))
+    fig, axes = plt.subplots(rows, cols, figsize=(3.2 * cols, 2.5 * rows), squeeze=False)
+    for j, ax in enumerate(axes.ravel()):
+        if j >= n:
+            ax.set_visible(False)
+            continue
+        s = float(h.noise_rms[j])
+        ax.hist(e[:, j], bins=40, density=True, color="tab:blue", alpha=0.6, label="residual")
+        if s > 0:
+            lo, hi = ax.get_xlim()
+            x = np.linspace(float(lo), float(hi), 200)
+            ax.plot(
+                x,
+                np.exp(-0.5 * (x / s) ** 2) / (s * np.sqrt(2 * np.pi)),
+                "k-",
+                lw=1.0,
+                label="sensor noise",
+            )
+        ax.set_title(
+            f"{h.joint_names[j]}: RMS {np.sqrt(np.mean(e[:, j] ** 2)):.3g} N m", fontsize=9
+        )
+        ax.set_xlabel("residual [N m]", fontsize=8)
+        ax.tick_params(labelsize=7)
+    axes[0, 0].set_ylabel("density [1/(N m)]", fontsize=8)
+    axes[0, 0].legend(fontsize=7)
+    fig.suptitle(title or f"Residuals on held-out data ({h.block})", fontsize=10)
+    fig.tight_layout()
+    return fig

@@ -1,0 +1,164 @@
+"""The answer of a consistent fit or retrieval (``retrieve``, ``identify --consistent``):
+are the link parameters physically consistent, how close to the coefficients, how far from
+the prior.
+
+The verdict: consistent or not, the residual on the coefficients, the smallest margin of
+the constraints, the total mass against its band, the bounds the result sits on. Below it:
+per link the mass with its bounds, the prior's mass and the difference, the centre of mass
+with its box, the pseudo-inertia margin; the constraints that are not satisfied; the
+figures (``retrieval.png``, ``comparison.png``).
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+from .html import cell, esc, figure, is_number, number, section, table, verdict
+from .run import Answer, RunFiles
+
+__all__ = ["answer"]
+
+#: Relative residual on the coefficients below which the consistent set reproduces them.
+RESIDUAL_GOOD = 0.05
+
+
+def _at(v: Any, k: int) -> Any:
+    return v[k] if isinstance(v, list) and k < len(v) else None
+
+
+def answer(run: RunFiles) -> Answer | None:
+    """The verdict and link table of feasible.json (with report.json), or None."""
+    feas, rep = run.doc("feasible.json"), run.doc("report.json") or {}
+    if feas is None or not isinstance(feas.get("links"), list):
+        return None
+    ok = bool(feas.get("feasible"))
+    res = feas.get("relative_residual")
+    facts = [
+        f"Physically consistent: <b>{'yes' if ok else 'no'}</b> (method {esc(feas.get('method'))}"
+        + (
+            f", solver {esc(rep['solver'])} {esc(rep.get('status', ''))}"
+            if rep.get("solver")
+            else ""
+        )
+        + ")",
+        f"Relative residual on the coefficients <b>{cell(res)}</b> (reproduces them below "
+        f"{RESIDUAL_GOOD:g})",
+    ]
+    margins: dict[str, Any] = rep["min_margin"] if isinstance(rep.get("min_margin"), dict) else {}
+    constraints = [c for c in rep.get("constraints") or [] if isinstance(c, dict)]
+    failed = [c for c in constraints if c.get("satisfied") is False]
+    if constraints:
+        facts.append(
+            f"Constraints: {len(constraints) - len(failed)} of {len(constraints)} satisfied"
+            + (
+                f"; smallest pseudo-inertia margin (lambda_min(J) / tr(J)) "
+                f"{cell(margins['pseudo_inertia'])}"
+                if is_number(margins.get("pseudo_inertia"))
+                else ""
+            )
+        )
+    masses = [link.get("mass") for link in feas["links"] if is_number(link.get("mass"))]
+    band = rep.get("total_mass")
+    facts.append(
+        f"Total mass {number(sum(masses))} kg"
+        + (f" (band {cell(band)} kg)" if isinstance(band, list) else "")
+    )
+    for note in rep.get("on_bound") or []:
+        facts.append("On a bound: " + esc(note))
+    held = rep.get("heldout")
+    if isinstance(held, dict):
+        facts.append(
+            "Held-out: " + cell({k: v for k, v in held.items() if not isinstance(v, (list, dict))})
+        )
+    good = ok and is_number(res) and res < RESIDUAL_GOOD
+    level = "poor" if not ok else "good" if good and not rep.get("on_bound") else "fair"
+    head = (
+        "The link parameters are physically consistent"
+        + (" and reproduce the identified coefficients." if good else ".")
+        if ok
+        else "No physically consistent set satisfies the constraints: the closest one is shown."
+    )
+    figs = [
+        (run.png(f), c)
+        for f, c in (("retrieval.png", "Retrieved links"), ("comparison.png", "Methods compared"))
+    ]
+    shown = frozenset(r for r, _ in figs if r is not None)
+    fig_html = "".join(figure(r, run.files[r], c) for r, c in figs if r is not None)
+    sections = (
+        _links_table(feas, rep),
+        _violations(rep),
+        f'<div class="figures">{fig_html}</div>' if fig_html else "",
+    )
+    return Answer(verdict(level, head, facts), sections, shown)
+
+
+def _links_table(feas: dict, rep: dict) -> str:
+    bounds = {
+        b.get("name"): b
+        for b in (rep.get("bounds") or {}).get("links") or []
+        if isinstance(b, dict)
+    }
+    prior = (rep.get("prior") or {}).get("mass") if isinstance(rep.get("prior"), dict) else None
+    margin = rep.get("pseudo_inertia_margin")
+    rows = []
+    for k, link in enumerate(feas["links"]):
+        b = bounds.get(link.get("name"), {})
+        m, pm = link.get("mass"), _at(prior, k)
+        box = (
+            "; ".join(
+                f"{number(lo, 3)}..{number(hi, 3)}"
+                for lo, hi in zip(b["com_min"], b["com_max"], strict=False)
+            )
+            if isinstance(b.get("com_min"), list) and isinstance(b.get("com_max"), list)
+            else None
+        )
+        inertia = link.get("inertia")
+        diag = (
+            [inertia[0], inertia[3], inertia[5]]
+            if isinstance(inertia, list) and len(inertia) == 6
+            else None
+        )
+        rows.append(
+            [
+                esc(link.get("name", k + 1)),
+                cell(m),
+                cell(b.get("mass")),
+                cell(pm),
+                cell(m - pm if is_number(m) and is_number(pm) else None),
+                cell(link.get("com")),
+                esc(box) if box else cell(None),
+                cell(diag),
+                cell(_at(margin, k)),
+            ]
+        )
+    headers = [
+        "link",
+        "mass [kg]",
+        "mass bounds [kg]",
+        "prior mass [kg]",
+        "mass - prior [kg]",
+        "centre of mass x, y, z [m]",
+        "CoM box x; y; z [m]",
+        "inertia xx, yy, zz about the CoM [kg m^2]",
+        "pseudo-inertia margin",
+    ]
+    return section("links", "Physical parameters per link", table(headers, rows))
+
+
+def _violations(rep: dict) -> str:
+    bad = [
+        c
+        for c in rep.get("constraints") or []
+        if isinstance(c, dict) and c.get("satisfied") is False
+    ]
+    if not bad:
+        return ""
+    rows = [
+        [esc(c.get("name", "")), cell(c.get("link")), cell(c.get("margin")), esc(c.get("unit", ""))]
+        for c in bad
+    ]
+    return section(
+        "violations",
+        "Constraints not satisfied",
+        table(["constraint", "link", "margin", "unit"], rows),
+    )

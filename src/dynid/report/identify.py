@@ -1,0 +1,341 @@
+"""The answer of ``dynid identify``: is the model good enough, and how sure are we.
+
+The verdict weighs the held-out error against the sensor-noise floor (``heldout.json``:
+the last time block predicted by the fit of the others, unfiltered torques, against the
+noise read from the log above the motion's band), the training against the held-out error
+(over-fitting), the rank against the columns of the model (the base parameters are the
+structural rank of the kinematics), and the relative standard deviations (the paper pruned
+above 30 %). Below it: the measured against the predicted torques on held-out data, the
+residuals, the model structure (``selection``, when the identification chose terms), the
+coefficients with their standard deviations as bars, and the friction.
+"""
+
+from __future__ import annotations
+
+import re
+from typing import Any
+
+from .html import bar, cell, esc, figure, is_number, number, percent, section, table, verdict
+from .run import Answer, RunFiles
+
+__all__ = ["answer", "coefficient_unit"]
+
+#: Relative standard deviation [%] above which a coefficient counts as poorly identified
+#: (the threshold Gaz et al. 2019 pruned at).
+UNCERTAIN_PERCENT = 30.0
+#: Held-out error / noise floor: at the floor up to FLOOR_GOOD, usable up to FLOOR_FAIR.
+FLOOR_GOOD, FLOOR_FAIR = 1.5, 3.0
+#: Held-out / training error above which the model over-fits (usable up to OVERFIT_FAIR).
+OVERFIT_GOOD, OVERFIT_FAIR = 1.1, 1.5
+#: Figures of the identification (written by the command when it has torques).
+FIGURES = (
+    ("heldout_torques.png", "Measured and predicted torques on held-out data"),
+    ("heldout_residuals.png", "Residuals on held-out data, per joint"),
+)
+
+
+def coefficient_unit(expression: str) -> str:
+    """The SI unit of a base parameter from its expression: kg m^2 when it holds an
+    inertia (``J``, ``Ia``), kg m for a first moment (``mc``), kg for masses."""
+    if re.search(r"\b(J\d|Ia\d)", expression):
+        return "kg m^2"
+    if re.search(r"\bmc\d", expression):
+        return "kg m"
+    if re.search(r"\bm\d", expression):
+        return "kg"
+    return ""
+
+
+def _get(doc: Any, *keys: str) -> Any:
+    for k in keys:
+        if not isinstance(doc, dict):
+            return None
+        doc = doc.get(k)
+    return doc
+
+
+def _heldout_facts(doc: dict, held: dict | None) -> tuple[list[str], list[str], str]:
+    """(facts, problems, headline) of the held-out judgement."""
+    facts, problems, headline = [], [], ""
+    ho = _get(doc, "metadata", "heldout")
+    train, test = _get(ho, "training_error_percent"), _get(ho, "heldout_error_percent")
+    if is_number(train) and is_number(test):
+        scheme = (
+            f"over {ho.get('folds')} contiguous time blocks"
+            if ho.get("scheme") == "blocks"
+            else "on the separate log"
+        )
+        ratio = test / train if train > 0 else 1.0
+        facts.append(
+            f"Held-out error <b>{percent(test)}</b> {esc(scheme)} (filtered torques, as "
+            f"fitted), training error "
+            f"{percent(train)} (ratio {ratio:.2f}: "
+            + ("no sign of over-fitting)" if ratio <= OVERFIT_GOOD else "the fit over-fits)")
+        )
+        if ratio > OVERFIT_FAIR:
+            problems.append("poor")
+        elif ratio > OVERFIT_GOOD:
+            problems.append("fair")
+        headline = f"The model predicts held-out torques to {percent(test)}"
+    if held is not None and is_number(held.get("relative_error_percent")):
+        err, floor = held["relative_error_percent"], held.get("noise_floor_percent")
+        where = esc(held.get("block", "held-out data"))
+        if is_number(floor) and floor > 0:
+            r = err / floor
+            facts.append(
+                f"On {where}, unfiltered: error {percent(err)} against a sensor-noise floor "
+                f"of {percent(floor)} (<b>{r:.2f} x the floor</b>"
+                + (
+                    ": only noise is left)"
+                    if r <= FLOOR_GOOD
+                    else ": effects outside the model remain, see the residuals)"
+                )
+            )
+            problems += ["poor"] if r > FLOOR_FAIR else ["fair"] if r > FLOOR_GOOD else []
+            level = "at" if r <= FLOOR_GOOD else f"{r:.1f} times"
+            headline = (
+                f"The model predicts held-out torques to {percent(err)}, {level} the "
+                f"sensor-noise floor of {percent(floor)} (unfiltered torques)"
+            )
+        else:
+            facts.append(f"On {where}, unfiltered: error {percent(err)} (noise floor unknown)")
+    elif headline:
+        facts.append(
+            "Sensor-noise floor not measured (heldout.json absent: the run was made with "
+            "--no-figures, or the log could not be read back)"
+        )
+    return facts, problems, headline
+
+
+def _static_facts(doc: dict) -> tuple[list[str], list[str], str]:
+    err = doc.get("relative_error_percent")
+    noise = _get(doc, "metadata", "data", "relative_noise")
+    if not is_number(err):
+        return [], [], ""
+    if is_number(noise):
+        floor = 100.0 * noise
+        ok = err <= max(3.0 * floor, 1e-6)
+        fact = (
+            f"Relative error of M(q), g(q) <b>{percent(err)}</b> on data recorded with relative "
+            f"noise {percent(floor)} ("
+            + (
+                ("noise-free data fit to rounding)" if floor == 0 else "explained by the noise)")
+                if ok
+                else "more than the noise explains)"
+            )
+        )
+        return (
+            [fact],
+            [] if ok else ["poor"],
+            f"The model reproduces M(q) and g(q) to {percent(err)}",
+        )
+    fact = f"Relative error of M(q), g(q) <b>{percent(err)}</b> (noise level not recorded)"
+    return [fact], ["fair"], f"The model reproduces M(q) and g(q) to {percent(err)}"
+
+
+def _rank_fact(doc: dict) -> tuple[str, list[str]]:
+    coefs = doc.get("coefficients") or []
+    friction = _get(doc, "metadata", "friction_labels") or []
+    columns = len(coefs) + len(friction)
+    rank, base = doc.get("rank"), _get(doc, "base", "rank")
+    parts = f"{base} base parameters (the structural rank of the kinematics)"
+    if friction:
+        parts += f" + {len(friction)} friction"
+    if not is_number(rank):
+        return f"Model columns: {parts}", []
+    full = rank >= columns
+    text = f"Rank <b>{rank} of {columns}</b> model columns: {parts}" + (
+        "; every column is excited" if full else "; the data leave columns unexcited"
+    )
+    return text, [] if full else ["poor"]
+
+
+def _certainty_fact(doc: dict) -> tuple[str, list[str]]:
+    coefs = [c for c in doc.get("coefficients") or [] if c.get("kept", True)]
+    stds = [(c.get("std_percent"), c) for c in coefs if is_number(c.get("std_percent"))]
+    if not stds:
+        return "", []
+    worst = sorted(stds, key=lambda x: -x[0])[:3]
+    within = sum(1 for s, _ in stds if s <= UNCERTAIN_PERCENT)
+    names = ", ".join(
+        f"{esc(c.get('name'))} ({esc(_short(c.get('expression', '')))}) &plusmn;{number(s, 3)} %"
+        for s, c in worst
+    )
+    text = (
+        f"{within} of {len(stds)} coefficients known to &plusmn;{UNCERTAIN_PERCENT:g} % "
+        f"(1 std); worst identified: {names}"
+    )
+    return text, []
+
+
+def _short(expression: str, n: int = 28) -> str:
+    return expression if len(expression) <= n else expression[: n - 3] + "..."
+
+
+def _terms_fact(doc: dict) -> str:
+    sel = doc.get("selection")
+    if isinstance(sel, dict) and sel.get("chosen"):
+        chosen = [c for c in sel.get("candidates") or [] if c.get("name") == sel["chosen"]]
+        listed = ", ".join(chosen[0].get("terms") or []) if chosen else ""
+        return (
+            f"Terms chosen: <b>{esc(sel['chosen'])}</b>"
+            + (f" ({esc(listed)})" if listed else "")
+            + f" by {esc(sel.get('rule', 'held-out error'))}"
+        )
+    terms = [f"rigid body ({len(doc.get('coefficients') or [])} base parameters)"]
+    if _get(doc, "metadata", "friction_labels"):
+        terms.append("classical friction fv, fc, fo per joint")
+    if doc.get("drive"):
+        terms.append("drive train (rotor inertia)")
+    return "Terms: " + esc(" + ".join(terms))
+
+
+def answer(run: RunFiles) -> Answer | None:
+    """The identify page's verdict and parts, or None without identification.json."""
+    rel = next((r for r in ("identification.json",) if r in run.docs), None)
+    doc = run.doc("identification.json")
+    if doc is None or rel is None:
+        return None
+    held = run.doc("heldout.json")
+    if doc.get("route") == "static":
+        facts, problems, headline = _static_facts(doc)
+    else:
+        facts, problems, headline = _heldout_facts(doc, held)
+    rank, p = _rank_fact(doc)
+    facts.append(rank)
+    problems += p
+    certainty, _ = _certainty_fact(doc)
+    facts += [certainty] if certainty else []
+    facts.append(_terms_fact(doc))
+    level = "poor" if "poor" in problems else "fair" if problems else "good"
+    if not headline:
+        headline = "The identification's record holds no error to judge it by"
+        level = "fair"
+    shown = frozenset(f for f, _ in FIGURES if f in run.files)
+    sections = [_torques_section(run, held), _structure_section(doc)]
+    sections += [_coefficients_section(doc), _friction_section(doc)]
+    return Answer(
+        verdict(level, esc(headline) + ".", facts),
+        tuple(s for s in sections if s),
+        shown,
+    )
+
+
+def _torques_section(run: RunFiles, held: dict | None) -> str:
+    figs = [figure(f, run.files[f], caption) for f, caption in FIGURES if f in run.files]
+    parts = [f'<div class="figures">{"".join(figs)}</div>'] if figs else []
+    if held is not None and isinstance(held.get("rms"), list):
+        names = held.get("joint_names") or [f"joint {j + 1}" for j in range(len(held["rms"]))]
+        noise = held.get("noise_rms") or [None] * len(names)
+        rel = held.get("relative_error_percent_per_joint") or [None] * len(names)
+        rows = []
+        for j, name in enumerate(names):
+            e, s = held["rms"][j], noise[j] if j < len(noise) else None
+            ratio = e / s if is_number(e) and is_number(s) and s > 0 else None
+            rows.append([esc(name), cell(e), cell(s), cell(ratio), cell(rel[j])])
+        headers = [
+            "joint",
+            "held-out RMS error [N m]",
+            "sensor noise RMS [N m]",
+            "error / noise",
+            "held-out relative error [%]",
+        ]
+        parts.append(f"<p>{esc(held.get('block', ''))}</p>" + table(headers, rows))
+    if not parts:
+        return ""
+    return section("torques", "Torques on held-out data", *parts)
+
+
+def _structure_section(doc: dict) -> str:
+    sel = doc.get("selection")
+    if not isinstance(sel, dict) or not sel.get("candidates"):
+        return ""
+    chosen = sel.get("chosen")
+    rows, marked = [], []
+    for c in sel["candidates"]:
+        mark = c.get("name") == chosen
+        rows.append(
+            [
+                "&#10003; chosen" if mark else "",
+                esc(c.get("name", "")),
+                cell(c.get("terms") or []),
+                cell(c.get("n_params")),
+                cell(c.get("train_error_percent")),
+                cell(c.get("heldout_error_percent")),
+                cell(c.get("heldout_se_percent")),
+            ]
+        )
+        marked.append(mark)
+    headers = [
+        "",
+        "candidate",
+        "terms",
+        "parameters",
+        "training error [%]",
+        "held-out error [%]",
+        "held-out std. error [%]",
+    ]
+    rule = f"Rule: {esc(sel.get('rule', ''))}; validation: {esc(sel.get('validation', ''))}."
+    return section(
+        "structure", "Model structure", f"<p>{rule}</p>", table(headers, rows, marked=marked)
+    )
+
+
+def _coefficients_section(doc: dict) -> str:
+    coefs = doc.get("coefficients") or []
+    if not coefs:
+        return ""
+    top = max([c.get("std_percent", 0) for c in coefs if is_number(c.get("std_percent"))] + [100])
+    rows = []
+    for k, c in enumerate(coefs):
+        s = c.get("std_percent")
+        rows.append(
+            [
+                str(k + 1),
+                esc(c.get("name", "")),
+                f'<span class="expr">{esc(c.get("expression", ""))}</span>',
+                cell(c.get("value")),
+                cell(c.get("std")),
+                esc(coefficient_unit(c.get("expression", ""))),
+                cell(s),
+                bar(s, top, log=True, bad=UNCERTAIN_PERCENT) if is_number(s) else "",
+                cell(c.get("kept")),
+            ]
+        )
+    headers = [
+        "#",
+        "coefficient",
+        "expression (standard parameters)",
+        "value",
+        "std",
+        "unit",
+        "std [%]",
+        f"std [%], log scale (red above {UNCERTAIN_PERCENT:g} %)",
+        "kept",
+    ]
+    return section(
+        "coefficients",
+        "Coefficients and their standard deviations",
+        table(headers, rows, cls="coefficients"),
+    )
+
+
+def _friction_section(doc: dict) -> str:
+    fr = doc.get("friction")
+    if not isinstance(fr, list) or not fr:
+        return ""
+    names = _get(doc, "robot", "joint_names") or [f"joint {j + 1}" for j in range(len(fr))]
+    std = _get(doc, "metadata", "friction_std") or []
+    rows = []
+    for j, row in enumerate(fr):
+        cells = [esc(names[j] if j < len(names) else j + 1)]
+        for k, v in enumerate(row):
+            s = std[3 * j + k] if 3 * j + k < len(std) else None
+            cells.append(cell(v) + (f" &plusmn; {number(s, 2)}" if is_number(s) else ""))
+        rows.append(cells)
+    headers = ["joint", "fv [N m s/rad]", "fc [N m]", "fo [N m]"]
+    return section(
+        "friction",
+        "Friction identified with the coefficients (value ± std)",
+        table(headers, rows),
+    )

@@ -1,0 +1,65 @@
+"""The answer of a run that watched a log for events (collision detection): the residuals,
+the thresholds and the events, from ``events.json``, ``thresholds.json``,
+``residuals.png`` and ``residuals.csv`` when the run wrote them.
+
+The files' layouts belong to the command that writes them; this page reads them
+generically: the events are the records of ``events.json`` (a list, or the list under
+``events``), the thresholds the file's tables.
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+from .html import esc, figure, href, section, verdict
+from .json_tables import json_section
+from .run import Answer, RunFiles
+
+__all__ = ["answer"]
+
+
+def _events(doc: Any) -> list | None:
+    if isinstance(doc, list):
+        return doc
+    if isinstance(doc, dict) and isinstance(doc.get("events"), list):
+        return doc["events"]
+    return None
+
+
+def answer(run: RunFiles) -> Answer | None:
+    """The events found, the thresholds and the residuals, or None without those files."""
+    names = ("events.json", "thresholds.json", "residuals.png", "residuals.csv")
+    found = {n: run.png(n) for n in names}
+    if all(v is None for v in found.values()):
+        return None
+    events = _events(run.docs.get(found["events.json"] or ""))
+    facts = []
+    if events is None:
+        head, level = "The run wrote residuals; no events file to judge.", "fair"
+    elif events:
+        head, level = f"{len(events)} event{'s' if len(events) != 1 else ''} detected.", "info"
+    else:
+        head, level = "No event: every residual stayed below its threshold.", "good"
+    if found["thresholds.json"] is not None:
+        facts.append("Thresholds: see the table below (from thresholds.json)")
+    if found["residuals.csv"] is not None:
+        rel = found["residuals.csv"]
+        facts.append(f'Residuals over time: <a href="{href(rel)}">{esc(rel)}</a>')
+    sections = []
+    for key, title in (("events.json", "Events"),):
+        name = found[key]
+        if name is not None and name in run.docs:
+            sections.append(section("events", title, json_section(name, run.docs[name])))
+    if found["residuals.png"] is not None:
+        rel = found["residuals.png"]
+        fig = figure(rel, run.files[rel], "Residuals and thresholds")
+        sections.append(section("residuals", "Residuals", fig))
+    name = found["thresholds.json"]
+    if name is not None and name in run.docs:
+        sections.append(section("thresholds", "Thresholds", json_section(name, run.docs[name])))
+    shown = frozenset(r for r in (found["residuals.png"],) if r is not None)
+    return Answer(
+        verdict(level, esc(head), facts or ["Residuals, thresholds and events below"]),
+        tuple(sections),
+        shown,
+    )

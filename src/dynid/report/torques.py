@@ -1,0 +1,189 @@
+"""The answers of ``dynid validate`` and ``dynid friction``: how well the model predicts the
+log's torques, without and with friction, and which friction law the data chose.
+
+validate: the relative error with and without friction, the errors per joint, the
+measured against the predicted torques. friction: per joint the law chosen and its
+parameters with their units, every candidate law's training and held-out error (the
+chosen one marked), the friction curve over the data.
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+from .html import cell, esc, figure, is_number, percent, section, table, verdict
+from .run import Answer, RunFiles
+
+__all__ = ["friction_answer", "validate_answer"]
+
+#: Relative validation error [%]: good below GOOD (the paper's fit of the real Panda's
+#: recorded torques left 4.6 %), usable below FAIR.
+GOOD, FAIR = 5.0, 15.0
+
+
+def _names(doc: dict, n: int) -> list[str]:
+    names = doc.get("joint_names")
+    if isinstance(names, list) and len(names) == n:
+        return [str(x) for x in names]
+    return [f"joint {j + 1}" for j in range(n)]
+
+
+def _figures(run: RunFiles, wanted: tuple[tuple[str, str], ...]) -> tuple[str, frozenset[str]]:
+    found = [(run.png(f), caption) for f, caption in wanted]
+    shown = [(rel, caption) for rel, caption in found if rel is not None]
+    html = "".join(figure(rel, run.files[rel], caption) for rel, caption in shown)
+    return (f'<div class="figures">{html}</div>' if html else ""), frozenset(r for r, _ in shown)
+
+
+def validate_answer(run: RunFiles) -> Answer | None:
+    """validate's verdict, errors per joint and figures, or None without validation.json."""
+    doc = run.doc("validation.json")
+    if doc is None:
+        return None
+    without, with_ = doc.get("without_friction") or {}, doc.get("with_friction")
+    best = doc.get("relative_error_percent")
+    if not is_number(best):
+        return None
+    level = "good" if best < GOOD else "fair" if best < FAIR else "poor"
+    facts = [
+        f"Relative error without friction {percent(without.get('relative_error_percent'))}"
+        + (
+            f", with friction ({esc(doc.get('friction_model'))}) "
+            f"<b>{percent(with_.get('relative_error_percent'))}</b>"
+            if isinstance(with_, dict)
+            else " (no friction model given)"
+        ),
+        f"Judged on {cell(doc.get('n_samples'))} samples of {esc(doc.get('data', 'the log'))}, "
+        f"model {esc(doc.get('model', ''))}; good below {GOOD:g} % (the paper's fit of the "
+        f"real Panda's recorded torques left 4.6 %), usable below {FAIR:g} %",
+    ]
+    rms = doc.get("rms")
+    if isinstance(rms, list) and rms:
+        worst = max(range(len(rms)), key=lambda j: rms[j])
+        facts.append(
+            f"Largest RMS error {cell(rms[worst])} N m on {esc(_names(doc, len(rms))[worst])}"
+        )
+    head = f"The model predicts the log's torques to {percent(best)}."
+    figs, shown = _figures(
+        run,
+        (
+            ("validation_torques.png", "Measured and predicted torques"),
+            ("validation_rms.png", "RMS error per joint, without and with friction"),
+        ),
+    )
+    return Answer(verdict(level, head, facts), (_joint_errors(doc), figs), shown)
+
+
+def _joint_errors(doc: dict) -> str:
+    w = doc.get("without_friction") or {}
+    f = doc.get("with_friction") or {}
+    r0, r1 = w.get("rms") or [], f.get("rms") or []
+    p0 = w.get("relative_error_percent_per_joint") or []
+    p1 = f.get("relative_error_percent_per_joint") or []
+    if not r0:
+        return ""
+    rows = []
+    for j, name in enumerate(_names(doc, len(r0))):
+        row = [esc(name), cell(r0[j]), cell(p0[j] if j < len(p0) else None)]
+        if r1:
+            gain = 100.0 * (1 - r1[j] / r0[j]) if r0[j] > 0 else None
+            row += [cell(r1[j]), cell(p1[j] if j < len(p1) else None), cell(gain)]
+        rows.append(row)
+    headers = ["joint", "RMS without friction [N m]", "relative error without [%]"]
+    if r1:
+        headers += [
+            "RMS with friction [N m]",
+            "relative error with [%]",
+            "friction lowers RMS by [%]",
+        ]
+    return section("errors", "Errors per joint", table(headers, rows))
+
+
+def friction_answer(run: RunFiles) -> Answer | None:
+    """friction's verdict, the law and parameters per joint, the candidates, the figure."""
+    doc = run.doc("friction.json")
+    if doc is None or not isinstance(doc.get("joints"), list):
+        return None
+    law, joints = doc.get("model"), doc["joints"]
+    sel: dict[str, Any] = doc["selection"] if isinstance(doc.get("selection"), dict) else {}
+    cands = [c for c in sel.get("candidates") or [] if isinstance(c, dict)]
+    chosen = next((c for c in cands if c.get("model") == sel.get("chosen")), None)
+    none = next((c for c in cands if c.get("model") == "none"), None)
+    facts = []
+    if chosen is not None:
+        facts.append(
+            f"Held-out error of {esc(law)} <b>{percent(chosen.get('heldout_error_percent'))}</b>"
+            f", the lowest of {len(cands)} candidates ({esc(sel.get('method', ''))}, "
+            f"{cell(sel.get('folds'))} folds)"
+            + (
+                f"; without friction {percent(none.get('heldout_error_percent'))}"
+                if none is not None
+                else ""
+            )
+        )
+    unidentified = [j for j, r in enumerate(joints) if r.get("identified") is False]
+    converged = _get_list(doc, "metadata", "converged")
+    stalled = [j for j, c in enumerate(converged) if c is False]
+    names = _names(doc, len(joints))
+    if unidentified:
+        facts.append(
+            "Not identified (joint did not move enough): "
+            + esc(", ".join(names[j] for j in unidentified))
+        )
+    if stalled:
+        facts.append("Fit did not converge: " + esc(", ".join(names[j] for j in stalled)))
+    before = [r.get("rms_before") for r in joints if is_number(r.get("rms_before"))]
+    after = [r.get("rms_after") for r in joints if is_number(r.get("rms_after"))]
+    if before and after:
+        facts.append(
+            f"Largest residual RMS over the joints {cell(max(before))} N m before friction, "
+            f"{cell(max(after))} N m after"
+        )
+    level = (
+        "poor"
+        if unidentified and len(unidentified) == len(joints)
+        else ("fair" if unidentified or stalled else "good")
+    )
+    head = f"Friction law chosen: {esc(law)}, on every joint."
+    figs, shown = _figures(run, (("friction.png", "Friction against velocity over the data"),))
+    sections = (_law_table(doc, names), _candidates_table(cands, sel.get("chosen")), figs)
+    return Answer(verdict(level, head, facts), sections, shown)
+
+
+def _get_list(doc: Any, *keys: str) -> list[Any]:
+    for k in keys:
+        doc = doc.get(k) if isinstance(doc, dict) else None
+    return doc if isinstance(doc, list) else []
+
+
+def _law_table(doc: dict, names: list[str]) -> str:
+    units: dict[str, Any] = doc["units"] if isinstance(doc.get("units"), dict) else {}
+    joints = doc["joints"]
+    params = [k for k in joints[0] if k not in ("rms_before", "rms_after", "identified")]
+    headers = ["joint", "law", *(f"{k} [{units[k]}]" if k in units else k for k in params)]
+    headers += ["residual RMS before [N m]", "residual RMS after [N m]", "identified"]
+    rows = [
+        [esc(names[j]), esc(doc.get("model", ""))]
+        + [cell(r.get(k)) for k in params]
+        + [cell(r.get("rms_before")), cell(r.get("rms_after")), cell(r.get("identified"))]
+        for j, r in enumerate(joints)
+    ]
+    return section("law", "Law and parameters per joint", table(headers, rows))
+
+
+def _candidates_table(cands: list[dict], chosen: Any) -> str:
+    if not cands:
+        return ""
+    rows = [
+        [
+            "&#10003; chosen" if c.get("model") == chosen else "",
+            esc(c.get("model", "")),
+            cell(c.get("parameters") or []),
+            cell(c.get("train_error_percent")),
+            cell(c.get("heldout_error_percent")),
+        ]
+        for c in cands
+    ]
+    headers = ["", "law", "parameters per joint", "training error [%]", "held-out error [%]"]
+    marked = [c.get("model") == chosen for c in cands]
+    return section("candidates", "Candidate laws", table(headers, rows, marked=marked))
