@@ -29,7 +29,6 @@ from pathlib import Path
 
 from ..exceptions import DynidError
 from ..friction.laws import LAWS
-from ..identification.log import DEFAULT_CUTOFF_HZ
 from ..identification.model import IdentifiedModel
 from ..io.friction_json import save_friction_json
 from ..io.model_json import load_model_json
@@ -83,8 +82,9 @@ def register(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParser:
     p.add_argument(
         "--cutoff",
         type=positive_type,
-        default=DEFAULT_CUTOFF_HZ,
-        help=f"low-pass cutoff of the states [Hz] (default {DEFAULT_CUTOFF_HZ:g})",
+        default=None,
+        help="low-pass cutoff of the states [Hz] (default: the one --model was identified "
+        "with, else the one identification reads from the log's motion)",
     )
     add_log_options(p)
     p.add_argument("--no-figures", action="store_true", help="skip the PNG figures")
@@ -120,7 +120,7 @@ def run(args: argparse.Namespace, console: Console) -> int:
     meta = {
         "data": str(args.data.name),
         "model": str(args.model.name) if args.model is not None else args.robot,
-        "cutoff_hz": args.cutoff,
+        "cutoff_hz": result.cutoff_hz,
         "n_samples": fit.n_samples,
         "converged": [bool(x) for x in fit.converged],
     }

@@ -34,7 +34,6 @@ import numpy as np
 
 from ..exceptions import DataError
 from ..friction.validation import own_friction, recorded_cutoff, validate_torques
-from ..identification.log import DEFAULT_CUTOFF_HZ
 from ..identification.model import IdentifiedModel
 from ..io.feasible import load_feasible_drive, load_feasible_linear_friction
 from ..io.friction_json import load_friction_json
@@ -87,7 +86,7 @@ def register(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParser:
         type=positive_type,
         default=None,
         help="low-pass cutoff of the states [Hz] (default: the one --model was identified "
-        f"with, else {DEFAULT_CUTOFF_HZ:g})",
+        "with, else the one identification reads from the log's motion)",
     )
     add_drive_option(p)
     add_log_options(p)
@@ -111,7 +110,7 @@ def run(args: argparse.Namespace, console: Console) -> int:
         friction = own_friction(model)
         if args.params is not None:
             friction = load_feasible_linear_friction(args.params) or friction
-    cutoff = recorded_cutoff(model) if args.cutoff is None else args.cutoff
+    cutoff = recorded_cutoff(model, logs[0]) if args.cutoff is None else args.cutoff
     drive = load_drive_arg(args, robot.n)
     if drive is None and args.params is not None:
         drive = load_feasible_drive(args.params)

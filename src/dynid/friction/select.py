@@ -23,8 +23,9 @@ to:
 The candidates are the laws of the registry (``none``: no extra friction, the rigid model
 alone) and, when the model comes with friction of its own (an identification's classical
 friction, a robot's published sigmoid; :func:`~dynid.friction.validation.own_friction`), that
-friction as it is (``own``, not refitted). Since both are candidates, the kept friction never
-predicts the held-out blocks worse than what the model already has.
+friction (``own``, kept as it is when chosen). Every candidate is judged on the same held-out
+blocks: ``own`` by its law refitted on the other blocks, as the others are (its values were
+fitted to these very samples, and judged on them it would always win).
 """
 
 from __future__ import annotations
@@ -201,7 +202,11 @@ def select_friction(
     if own is not None:
         tf = own.torques(res.dq)
         fits[OWN] = _own_fit(own, res)
-        scores.append(CandidateScore(OWN, own.names, err(tf), err(tf)))
+        # judged as every other candidate: its law refitted on the other blocks predicts
+        # each held-out block (its values on the whole log were fitted to these samples)
+        law = own.kind if own.kind in LAWS else None
+        held = err(tf) if law is None else err(_heldout_torques(res, drive, law, labels))
+        scores.append(CandidateScore(OWN, own.names, err(tf), held))
     for name in names:
         with warnings.catch_warnings():
             if name != names[-1]:  # one warning about still joints is enough

@@ -32,6 +32,7 @@ from ..exceptions import DynidWarning, OptionError, ShapeError
 from ..identification.log import DEFAULT_CUTOFF_HZ, TorqueLog, joint_side_log, prepare_log
 from ..identification.metrics import TorqueErrors, torque_errors
 from ..identification.model import IdentifiedModel
+from ..identification.rate import cutoff_from_motion
 from ..identification.sanity import anticorrelated
 from ..model.drive import Drive
 from ..model.robot import Robot
@@ -117,11 +118,16 @@ class Validation:
 RECORDED: Literal["recorded"] = "recorded"
 
 
-def recorded_cutoff(model: TorqueModel) -> float | None:
+def recorded_cutoff(model: TorqueModel, log: TorqueLog | None = None) -> float | None:
     """The low-pass cut-off [Hz] an identified model's torque log was prepared with
-    (``info.log.cutoff_hz`` of the classical route), else the library default."""
+    (``info.log.cutoff_hz`` of the classical route); for another model the one
+    identification would read from ``log``'s motion
+    (:func:`~dynid.identification.rate.cutoff_from_motion`), so that every model is judged
+    on the samples prepared the same way; the library default without a log."""
     if isinstance(model, IdentifiedModel) and model.info.log is not None:
         return model.info.log.cutoff_hz
+    if log is not None and log.n_samples >= 64:
+        return cutoff_from_motion(log.q, log.dq, log.sample_rate)
     return DEFAULT_CUTOFF_HZ
 
 
@@ -150,7 +156,7 @@ def validate_torques(
     cutoff_hz, trim_s, filter_tau, max_gap_s
         Preparation of the log (:func:`~dynid.friction.fit.friction_residual`);
         ``cutoff_hz="recorded"`` (default): the cut-off an identified model was identified
-        with (:func:`recorded_cutoff`), else the library default.
+        with, else the one read from the log's motion (:func:`recorded_cutoff`).
     drive : Drive, optional
         The drive the log was recorded through (motor side, currents); default: an
         identified model's own (:func:`model_drive`). Its known rotor inertias are added to
@@ -170,8 +176,8 @@ def validate_torques(
     if friction is not None and friction.n != log.n:
         raise ShapeError(f"friction model has {friction.n} joints; the log has {log.n}")
     d = model_drive(model, drive)
-    cut = recorded_cutoff(model) if isinstance(cutoff_hz, str) else cutoff_hz
     jlog = joint_side_log(log, d)
+    cut = recorded_cutoff(model, jlog) if isinstance(cutoff_hz, str) else cutoff_hz
     del log  # a long log's raw signals are freed here when the caller holds no other reference
     p = prepare_log(jlog, cutoff_hz=cut, trim_s=trim_s, filter_tau=filter_tau, max_gap_s=max_gap_s)
     del jlog

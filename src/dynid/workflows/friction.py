@@ -26,8 +26,7 @@ from ..friction.fit import (
 )
 from ..friction.laws import LAWS
 from ..friction.select import FrictionSelection, select_friction
-from ..friction.validation import own_friction
-from ..identification.log import DEFAULT_CUTOFF_HZ
+from ..friction.validation import own_friction, recorded_cutoff
 from ..identification.model import IdentifiedModel
 from ..model.drive import Drive
 from ..model.robot import Robot
@@ -48,11 +47,14 @@ class FrictionFileResult:
         The prepared log and the model's torque residual the friction was fitted to.
     selection : FrictionSelection or None
         Every candidate's training and held-out error (``law="auto"``), else None.
+    cutoff_hz : float or None
+        The low-pass cut-off the log was prepared with [Hz].
     """
 
     fit: FrictionFit
     residual: FrictionResidual
     selection: FrictionSelection | None
+    cutoff_hz: float | None = None
 
 
 def fit_friction_file(
@@ -63,7 +65,7 @@ def fit_friction_file(
     columns: ColumnSpec | None = None,
     drop_invalid: bool = False,
     drive: Drive | None = None,
-    cutoff_hz: float = DEFAULT_CUTOFF_HZ,
+    cutoff_hz: float | None = None,
     max_gap_s: float | None = None,
 ) -> FrictionFileResult:
     """Friction fitted to the torque residual of ``model`` on the log ``path``.
@@ -84,9 +86,10 @@ def fit_friction_file(
         Drop rows with NaN/inf or a repeated timestamp (counted) instead of failing.
     drive : Drive, optional
         The drive the log was recorded through, for a model without one.
-    cutoff_hz : float
-        Zero-phase low-pass cut-off of the states [Hz]; also that of velocities derived
-        from positions through ``columns``.
+    cutoff_hz : float, optional
+        Zero-phase low-pass cut-off of the states [Hz] (and of velocities derived from
+        positions); default: the identification's recorded one, else the one read from the
+        log's motion (:func:`~dynid.friction.validation.recorded_cutoff`).
     max_gap_s : float, optional
         Longest gap bridged by interpolation [s].
 
@@ -117,13 +120,15 @@ def fit_friction_file(
         owner="the model",
     )
     drive = model_drive(model, drive)
+    if cutoff_hz is None:
+        cutoff_hz = recorded_cutoff(model, log)
 
     def fit() -> FrictionFileResult:
         res = friction_residual(model, log, cutoff_hz=cutoff_hz, max_gap_s=max_gap_s, drive=drive)
         if law == "auto":
             sel = select_friction(res, drive, own=own_friction(model))
-            return FrictionFileResult(sel.fit, res, sel)
-        return FrictionFileResult(fit_friction_through(res, drive, law), res, None)
+            return FrictionFileResult(sel.fit, res, sel, cutoff_hz)
+        return FrictionFileResult(fit_friction_through(res, drive, law), res, None, cutoff_hz)
 
     result: FrictionFileResult = in_file(path, fit)
     return result
