@@ -227,9 +227,10 @@ def unexcited_combinations(
     along them leaves every fitted value unchanged. The basis is put in reduced echelon
     form (each direction has coefficient 1 on a label of its own, 0 on the others'), the
     labels chosen by their weight, so that the same null space is named the same way
-    whatever basis the factorisation gave: ``"beta39"`` (a column the data never excite),
+    whatever basis the factorisation gave (in the order of those labels' columns):
+    ``"beta39"`` (a column the data never excite),
     ``"beta40 - 0.31*fc6"`` (two columns the data cannot tell apart). Coefficients are in
-    the coefficients' own units, to 3 significant digits; entries below 1e-3 of a
+    the coefficients' own units, to 4 significant digits; entries below 1e-3 of a
     direction's largest (scaled) weight are left out.
     """
     k = R.shape[1]
@@ -243,14 +244,15 @@ def unexcited_combinations(
     E = np.linalg.solve(B[:, piv], B)  # reduced echelon: E[:, piv] = identity
     names = labels if labels is not None else tuple(f"column {j}" for j in range(k))
     out = []
-    for i, p in enumerate(piv):
+    for i in np.argsort(piv):  # in the order of the columns the directions are named by
+        p = piv[i]
         w = np.abs(E[i] * scale)
         parts = [names[p]]
         for j in np.argsort(-w):
             if j == p or w[j] < 1e-3 * w.max() or j in piv:
                 continue
             c = float(E[i, j])
-            parts.append(f"{'-' if c < 0 else '+'} {abs(c):.3g}*{names[j]}")
+            parts.append(f"{'-' if c < 0 else '+'} {abs(c):.4g}*{names[j]}")
         out.append(" ".join(parts))
     return tuple(out)
 
