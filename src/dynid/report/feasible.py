@@ -170,7 +170,7 @@ def payload_answer(run: RunFiles) -> Answer | None:
     doc = run.doc("payload.json")
     if doc is None or not is_number(doc.get("mass")):
         return None
-    std = doc.get("std") if isinstance(doc.get("std"), dict) else {}
+    std: dict[str, Any] = doc["std"] if isinstance(doc.get("std"), dict) else {}
     m, sm = doc["mass"], std.get("mass")
     rel = abs(sm / m) if is_number(sm) and m else None
     frame = esc(doc.get("frame", ""))
