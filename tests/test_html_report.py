@@ -402,6 +402,7 @@ VERDICTS = {
     "friction": ("Friction law chosen:", True),
     "validate": ("The model predicts the log's torques to", True),
     "retrieve": ("The link parameters are physically consistent", False),
+    "payload": ("The payload weighs 1 kg", False),
 }
 
 

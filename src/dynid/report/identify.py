@@ -192,9 +192,8 @@ def _terms_fact(doc: dict) -> str:
 
 def answer(run: RunFiles) -> Answer | None:
     """The identify page's verdict and parts, or None without identification.json."""
-    rel = next((r for r in ("identification.json",) if r in run.docs), None)
-    doc = run.doc("identification.json")
-    if doc is None or rel is None:
+    doc = run.docs.get("identification.json")  # the run's own, not a stage folder's
+    if not isinstance(doc, dict):
         return None
     held = run.doc("heldout.json")
     if doc.get("route") == "static":
