@@ -221,3 +221,118 @@ def test_every_friction_law_has_a_canonical_form_equal_to_its_torques(name):
                 obs.step(q, dq[k], np.zeros(3), 0.0)
                 f[k] = -obs._S[2 + 3 : 2 + 6] - momentum_terms(robot, q, dq[k])[1]
             np.testing.assert_allclose(f, fr.torques(dq), rtol=0, atol=1e-12)
+
+
+# ---------------------------------------------------------------------- detection
+
+
+def test_detection_delay_of_a_step_contact_is_within_one_sample_of_the_formula():
+    """A step of A on one joint crosses theta after ln(A / (A - theta)) / K_O (one sample)."""
+    from dynid.observer.detection import calibrate, detect
+
+    robot = dynid.panda()
+    traj = panda_trajectory(3.0)
+    K, T = 25.0, 1e-3
+    ext = np.zeros_like(traj.q)
+    on = traj.t >= 1.5
+    A = 8.0
+    ext[on, 3] = A  # a torque step on joint 4 (a wrench whose J^T w is e_4 A)
+    log = simulate_measurement(robot, traj, rng=np.random.default_rng(1), noise=SensorNoise.none())
+    opts = ObserverOptions(gain=K)
+    model = from_robot(robot)
+    quiet = observe(model, log.t, log.q, log.dq, log.tau, opts).r
+    th = calibrate([quiet], opts)
+    th = type(th)(
+        np.full(7, 3.0), np.full(7, 6.0), th.margin, th.quantile, 2.0, opts, th.samples
+    )  # theta = 3 N m on every joint
+    r = observe(model, log.t, log.q, log.dq, log.tau - ext, opts).r
+    events = detect(log.t, r, th)
+    assert len(events) == 1 and events[0].joints == (4,) and events[0].level == "collision"
+    delay = events[0].start - 1.5
+    expected = np.log(A / (A - 3.0)) / K
+    assert abs(delay - expected) <= T
+    assert events[0].peak[3] == pytest.approx(A, abs=1e-3)
+
+
+def test_no_event_on_collision_free_noisy_logs_with_an_identified_model():
+    """Thresholds calibrated on one collision-free noisy log raise no event on two others
+    (other noise, other motion), with a model identified from a fourth; a 15 N push is
+    found."""
+    from dynid.identification.classical import identify_from_log
+    from dynid.observer.detection import calibrate, detect
+    from dynid.simulation.trajectories import random_fourier
+
+    robot = dynid.panda()
+    noise = SensorNoise()
+
+    def log_of(seed, duration=8.0, contacts=()):
+        rng = np.random.default_rng(seed)
+        series = random_fourier(robot, rng, n_harmonics=4, w_f=2 * np.pi * 0.125)
+        traj = series(uniform_times(duration, 1000.0))
+        return simulate_measurement(robot, traj, rng=rng, noise=noise, contacts=contacts)
+
+    model = from_identified(identify_from_log(robot, log_of(10, 16.0)))
+    model = model.with_friction(from_robot(robot).friction)  # the simulated friction
+    opts = ObserverOptions(gain=30.0)
+    cal = log_of(11)
+    th = calibrate([observe(model, cal.t, cal.q, cal.dq, cal.tau, opts).r], opts)
+    for seed in (12, 13):
+        other = log_of(seed)
+        r = observe(model, other.t, other.q, other.dq, other.tau, opts).r
+        assert detect(other.t, r, th) == []
+    push = Contact("link6", (0.0, 0.0, -15.0), 4.0, 4.5)
+    hit = log_of(12, contacts=(push,))
+    r = observe(model, hit.t, hit.q, hit.dq, hit.tau, opts).r
+    events = detect(hit.t, r, th)
+    assert len(events) == 1 and 4.0 <= events[0].start <= 4.2
+
+
+def test_residual_std_is_the_residual_change_of_a_parameter_direction(identified):
+    """With Sigma = e e^T the propagated std equals |r(beta + e) - r(beta)| (the residual
+    is linear in beta): the covariance goes through the momentum regressor exactly."""
+    from dynid.observer.detection import BLOCK, residual_std
+
+    traj = panda_trajectory(0.02 + BLOCK * 1e-3)  # more than one block
+    tau = np.random.default_rng(9).normal(size=traj.q.shape)
+    model = from_identified(identified, friction=None)
+    e = np.zeros(identified.base.rank)
+    e[[3, 10, 20]] = [0.02, -0.01, 0.005]
+    opts = ObserverOptions(gain=20.0)
+    r0 = observe(model, traj.t, traj.q, traj.dq, tau, opts).r
+    moved = IdentifiedModel(
+        robot=identified.robot,
+        base=identified.base,
+        fit=type(identified.fit)(**{**_fields(identified.fit), "beta": identified.fit.beta + e}),
+        drive=identified.drive,
+    )
+    r1 = observe(from_identified(moved, friction=None), traj.t, traj.q, traj.dq, tau, opts).r
+    one = ObserverModel(
+        model.robot, model.rotor_mass, None, model.base, model.beta, np.outer(e, e), model.drive
+    )
+    s = residual_std(one, traj.t, traj.q, traj.dq, opts)
+    np.testing.assert_allclose(s, np.abs(r1 - r0), rtol=0, atol=1e-9)
+
+
+def _fields(obj):
+    import dataclasses
+
+    return {f.name: getattr(obj, f.name) for f in dataclasses.fields(obj)}
+
+
+def test_external_wrench_recovers_the_contact_wrench_and_flags_singular_configurations():
+    """J^T w back to w at the flange on random states (7 joints); the stretched-out arm
+    (a singular configuration) is flagged and damped, and link 3 (3 joints) always is."""
+    from dynid.observer.wrench import external_wrench
+
+    robot = dynid.panda()
+    q, _, _ = random_states(robot, 30, seed=10)
+    w = np.random.default_rng(11).normal(size=(30, 6)) * [10, 10, 10, 1, 1, 1]
+    J = dynid.jacobian(robot, q, "flange")
+    r = (np.swapaxes(J, -1, -2) @ w[..., None])[..., 0]
+    est = external_wrench(robot, q, r, "flange")
+    ok = ~est.damped
+    assert ok.sum() >= 15
+    np.testing.assert_allclose(est.wrench[ok], w[ok], rtol=0, atol=1e-8)
+    straight = np.zeros(7)
+    assert external_wrench(robot, straight, np.ones(7), "flange").damped
+    assert external_wrench(robot, q, r, "link3").damped.all()

@@ -38,6 +38,7 @@ from .terms import momentum_terms
 
 __all__ = [
     "DEFAULT_GAIN",
+    "DEFAULT_OPTIONS",
     "MomentumObserver",
     "ObserverOptions",
     "ObserverResult",
@@ -95,6 +96,10 @@ class ObserverOptions:
         if g.shape != (n,):
             raise ShapeError(f"observer gains must be one or {n} values; got {g.size}")
         return g.copy()
+
+
+#: The default options (a module-level instance: an argument default).
+DEFAULT_OPTIONS = ObserverOptions()
 
 
 @dataclass(frozen=True, slots=True, eq=False)
@@ -158,7 +163,7 @@ class MomentumObserver:
     >>> r = obs.step(q, dq, tau, t)      # every control cycle   # doctest: +SKIP
     """
 
-    def __init__(self, model: ObserverModel, options: ObserverOptions = ObserverOptions()) -> None:
+    def __init__(self, model: ObserverModel, options: ObserverOptions = DEFAULT_OPTIONS) -> None:
         self.model, self.options = model, options
         n = self.n = model.n
         canon = canonical_friction(model.friction, n)
@@ -334,7 +339,7 @@ def observe(
     q: ArrayLike,
     dq: ArrayLike,
     tau: ArrayLike,
-    options: ObserverOptions = ObserverOptions(),
+    options: ObserverOptions = DEFAULT_OPTIONS,
 ) -> ObserverResult:
     """The residual of ``model`` over a log (a fresh :class:`MomentumObserver`).
 
