@@ -12,12 +12,21 @@ from typing import Any
 from ..feasibility.sdp import ConsistentResult
 from ..friction.fit import FrictionFit, FrictionResidual
 from ..friction.validation import Validation
+from ..io.observer_files import observation_names
+from ..observer.detection import threshold_series
+from ..observer.results import ObserveResult
 from ..plots import feasible as feasible_plots
 from ..plots import friction as friction_plots
+from ..plots import observer as observer_plots
 from ..plots import torques as torque_plots
 from .common import save_figure
 
-__all__ = ["save_friction_figure", "save_retrieval_figure", "save_validation_figures"]
+__all__ = [
+    "save_friction_figure",
+    "save_observer_figures",
+    "save_retrieval_figure",
+    "save_validation_figures",
+]
 
 
 def save_retrieval_figure(folder: Path, result: Any) -> list[Path]:
@@ -68,3 +77,21 @@ def save_validation_figures(
         ),
     ]
     return [p for p in paths if p is not None]
+
+
+def save_observer_figures(out: Path, result: ObserveResult, *, names: list[str]) -> list[Path]:
+    """``out/<residuals name>.png`` of every log: residual, thresholds, events, and the true
+    external torques stored beside a simulated log (those skipped are left out)."""
+    paths = []
+    for x, stem in zip(result.logs, observation_names(result.logs), strict=True):
+        contact, collision = threshold_series(result.thresholds, x.t.shape[0], x.std)
+        fig = save_figure(
+            lambda x=x, c=contact, k=collision: observer_plots.plot_residuals(
+                x.t, x.r, c, k, events=x.events, tau_ext=x.tau_ext, joint_names=names,
+                title=f"momentum observer on {x.path.name}: residual, thresholds, events",
+            ),
+            Path(out) / f"{stem}.png",
+        )  # fmt: skip
+        if fig is not None:
+            paths.append(fig)
+    return paths

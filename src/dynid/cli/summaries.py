@@ -14,6 +14,7 @@ from ..feasibility.sdp import ConsistentResult
 from ..friction.validation import NewtonEulerValidation
 from ..identification.info import LogInfo
 from ..identification.model import IdentifiedModel
+from ..observer.results import ObserveResult
 from ..regressors.base import identifiability
 
 __all__ = [
@@ -271,4 +272,29 @@ def format_newton_euler_rms(val: NewtonEulerValidation) -> str:
         rows.append(row)
     fr = "with " + val.friction_kind + " friction" if val.friction_kind else "without friction"
     rows.append(f"(torques {fr}; relative error NE {val.errors.relative_error_percent:.2f} %)")
+    return "\n".join(rows)
+
+
+def format_observation(result: ObserveResult, names: list[str], *, calibrating: bool) -> str:
+    """The thresholds per joint (and the largest residual) and, detecting, every event."""
+    th = result.thresholds
+    peak = np.max([np.max(np.abs(x.r), axis=0) for x in result.logs], axis=0)
+    cols = {"max |r| [N m]": peak, "contact [N m]": th.contact, "collision [N m]": th.collision}
+    rows = [format_rms_table(names, cols)]
+    if th.uses_uncertainty and th.noise is not None:
+        rows.append(
+            f"thresholds grow with the model's uncertainty: {th.k_sigma:g} sigma + noise "
+            f"({', '.join(f'{v:.3g}' for v in th.noise)} N m)"
+        )
+    if calibrating:
+        rows.append(f"calibrated on {th.samples} samples of {len(result.logs)} log(s)")
+        return "\n".join(rows)
+    events = [(x.path.name, e) for x in result.logs for e in x.events]
+    rows.append(f"{len(events)} event(s)")
+    for log, e in events:
+        top = max(e.joints, key=lambda j: abs(e.peak[j - 1]))
+        rows.append(
+            f"  {log}: {e.level:<9} {e.start:9.3f} s .. {e.end:9.3f} s  joints "
+            f"{','.join(map(str, e.joints))}  peak {e.peak[top - 1]:+.2f} N m (joint {top})"
+        )
     return "\n".join(rows)

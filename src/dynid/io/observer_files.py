@@ -32,6 +32,7 @@ from .. import __version__, _checks
 from ..exceptions import DataError
 from ..observer.detection import ContactEvent, Thresholds
 from ..observer.residual import ObserverOptions
+from ..observer.results import LogObservation, ObserveResult
 from .atomic import open_atomic
 from .json_files import load_json, save_json
 
@@ -39,7 +40,9 @@ __all__ = [
     "EVENTS_SCHEMA",
     "THRESHOLDS_SCHEMA",
     "load_thresholds",
+    "observation_names",
     "save_events",
+    "save_observation",
     "save_residuals_csv",
     "save_thresholds",
 ]
@@ -137,9 +140,14 @@ def load_thresholds(path: str | Path) -> Thresholds:
 
 
 def save_events(
-    path: str | Path, events: Sequence[ContactEvent], *, meta: dict[str, Any] | None = None
+    path: str | Path,
+    events: Sequence[ContactEvent],
+    *,
+    meta: dict[str, Any] | None = None,
+    logs: Sequence[str] | None = None,
 ) -> Path:
-    """Write ``events.json`` (schema ``dynid-events/1``); returns the path."""
+    """Write ``events.json`` (schema ``dynid-events/1``; ``logs``: each event's log name,
+    written as its ``log``); returns the path."""
     doc = {
         "dynid_version": __version__,
         "events": [
@@ -149,8 +157,9 @@ def save_events(
                 "joints": list(e.joints),
                 "peak": list(e.peak),
                 "level": e.level,
+                **({} if logs is None else {"log": logs[k]}),
             }
-            for e in events
+            for k, e in enumerate(events)
         ],
         **(meta or {}),
         "units": {"start": "s", "end": "s", "peak": "N m", "joints": "1-based"},
@@ -185,3 +194,72 @@ def save_residuals_csv(
         for a in range(0, table.shape[0], 100_000):
             np.savetxt(fh, table[a : a + 100_000], delimiter=",", fmt="%.17g")
     return path
+
+
+def observation_names(logs: Sequence[LogObservation]) -> list[str]:
+    """The name stem of each log's files: ``residuals`` for one log, ``residuals_<stem>``
+    for several (numbered where two logs share a stem)."""
+    if len(logs) == 1:
+        return ["residuals"]
+    out: list[str] = []
+    for x in logs:
+        name = f"residuals_{Path(x.path).stem}"
+        k, base = 2, name
+        while name in out:
+            name, k = f"{base}_{k}", k + 1
+        out.append(name)
+    return out
+
+
+def save_observation(
+    out: str | Path,
+    result: ObserveResult,
+    *,
+    joints: Sequence[str],
+    calibrating: bool,
+    meta: dict[str, Any] | None = None,
+) -> list[Path]:
+    """The files of ``dynid observe`` in the folder ``out``; returns them.
+
+    Calibrating: ``thresholds.json``. Detecting: ``events.json`` (every log's events, each
+    with its log's name when there are several) and a residual table per log
+    (:func:`observation_names`).
+    """
+    out = Path(out)
+    meta = dict(meta or {})
+    if calibrating:
+        cal = {"data": [Path(x.path).name for x in result.logs], **meta}
+        return [
+            save_thresholds(
+                out / "thresholds.json", result.thresholds, joints=joints, calibration=cal
+            )
+        ]
+    paths = []
+    events: list[ContactEvent] = []
+    logs_of: list[str] = []
+    for x, name in zip(result.logs, observation_names(result.logs), strict=True):
+        w = x.wrench
+        paths.append(
+            save_residuals_csv(
+                out / f"{name}.csv",
+                x.t,
+                x.r,
+                wrench=None if w is None else w.wrench,
+                damped=None if w is None else w.damped,
+                frame=None if w is None else w.frame,
+            )  # fmt: skip
+        )
+        events += x.events
+        logs_of += [Path(x.path).name] * len(x.events)
+    info = {
+        "data": [Path(x.path).name for x in result.logs],
+        "samples": [int(x.t.shape[0]) for x in result.logs],
+        **meta,
+    }
+    paths.insert(
+        0,
+        save_events(
+            out / "events.json", events, meta=info, logs=logs_of if len(result.logs) > 1 else None
+        ),
+    )
+    return paths
