@@ -85,13 +85,14 @@ def save_observer_figures(out: Path, result: ObserveResult, *, names: list[str])
     paths = []
     for x, stem in zip(result.logs, observation_names(result.logs), strict=True):
         contact, collision = threshold_series(result.thresholds, x.t.shape[0], x.std)
-        fig = save_figure(
-            lambda x=x, c=contact, k=collision: observer_plots.plot_residuals(
+
+        def draw(x: Any = x, c: Any = contact, k: Any = collision) -> Any:
+            return observer_plots.plot_residuals(
                 x.t, x.r, c, k, events=x.events, tau_ext=x.tau_ext, joint_names=names,
                 title=f"momentum observer on {x.path.name}: residual, thresholds, events",
-            ),
-            Path(out) / f"{stem}.png",
-        )  # fmt: skip
+            )  # fmt: skip
+
+        fig = save_figure(draw, Path(out) / f"{stem}.png")
         if fig is not None:
             paths.append(fig)
     return paths

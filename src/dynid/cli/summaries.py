@@ -15,6 +15,7 @@ from ..friction.validation import NewtonEulerValidation
 from ..identification.info import LogInfo
 from ..identification.model import IdentifiedModel
 from ..observer.results import ObserveResult
+from ..pipeline.collision import CollisionStageResult
 from ..regressors.base import identifiability
 
 __all__ = [
@@ -297,4 +298,23 @@ def format_observation(result: ObserveResult, names: list[str], *, calibrating: 
             f"  {log}: {e.level:<9} {e.start:9.3f} s .. {e.end:9.3f} s  joints "
             f"{','.join(map(str, e.joints))}  peak {e.peak[top - 1]:+.2f} N m (joint {top})"
         )
+    return "\n".join(rows)
+
+
+def format_collision_stage(res: CollisionStageResult) -> str:
+    """Stage 6: the push, the events found, the delay and the residual's error."""
+    c = res.contact
+    rows = [
+        f"push: {list(c.wrench[:3])} N on {c.frame} from {c.start:g} s to {c.end:g} s; "
+        f"thresholds (contact) [N m]: " + " ".join(f"{x:.2f}" for x in res.thresholds.contact)
+    ]
+    for e in res.events:
+        rows.append(
+            f"  {e.level} {e.start:.3f} s .. {e.end:.3f} s, joints {','.join(map(str, e.joints))}"
+        )
+    found = "not found" if res.delay is None else f"detected {1e3 * res.delay:.0f} ms after it"
+    rows.append(
+        f"{len(res.events)} event(s); the push {found}; residual vs the true external torque "
+        "(first-order lag) RMS [N m]: " + " ".join(f"{x:.3f}" for x in res.residual_error_rms)
+    )
     return "\n".join(rows)

@@ -336,7 +336,9 @@ def detect(
         k = np.argmax(np.abs(seg), axis=0)
         peak = seg[k, np.arange(seg.shape[1])]
         joints = tuple(int(j) + 1 for j in np.flatnonzero(over[a:b].any(axis=0)))
-        level = "collision" if np.any(np.abs(seg) > collision[a:b]) else "contact"
+        level: Literal["contact", "collision"] = (
+            "collision" if np.any(np.abs(seg) > collision[a:b]) else "contact"
+        )
         events.append(
             ContactEvent(
                 float(ta[a]), float(ta[b - 1]), joints, tuple(float(x) for x in peak), level

@@ -162,8 +162,7 @@ def from_robot(
         drive.check(n)
         if drive.rotor_inertia is not None:
             Mr = drive.rotor_mass_matrix(drive.rotor_inertia)
-    if isinstance(friction, str):
-        fr = None if robot.friction is None else SigmoidFriction.from_array(robot.friction)
-    else:
-        fr = friction
+    fr: FrictionModel | None = friction if not isinstance(friction, str) else None
+    if isinstance(friction, str) and robot.friction is not None:
+        fr = SigmoidFriction.from_array(robot.friction)
     return ObserverModel(robot=robot, rotor_mass=Mr, friction=fr, drive=drive, source="robot")

@@ -98,5 +98,5 @@ def external_wrench(
     lam2 = np.where(damped, damping**2 * (1.0 - s2 / epsilon**2), 0.0)
     A = JJ + lam2[..., None, None] * np.eye(6)
     b = (J @ ra[..., None])[..., 0]
-    w = np.linalg.solve(A, b[..., None])[..., 0]
+    w = np.asarray(np.linalg.solve(A, b[..., None])[..., 0], dtype=np.float64)
     return WrenchEstimate(frame, w, smin, damped)

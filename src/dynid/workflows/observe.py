@@ -19,6 +19,7 @@ the command applies, so that the Python API behaves as the command does.
 
 from __future__ import annotations
 
+from collections.abc import Mapping
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -108,7 +109,7 @@ class ObserveOptions:
 
 def load_observer_model(
     model: Path | None, params: str | Path | None, friction: Path | None = None
-) -> tuple[ObserverModel, dict[str, object] | None]:
+) -> tuple[ObserverModel, Mapping[str, str | None] | None]:
     """The observer model of ``--model`` or ``--params`` (and ``--friction``), with the
     column map the model's data were read with (None for a robot).
 
@@ -204,7 +205,7 @@ def observe_files(opts: ObserveOptions) -> ObserveResult:
 def _observe_log(
     path: Path,
     model: ObserverModel,
-    recorded: dict[str, object] | None,
+    recorded: Mapping[str, str | None] | None,
     opts: ObserveOptions,
     options: ObserverOptions,
     wants_std: bool,
