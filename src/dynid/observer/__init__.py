@@ -20,14 +20,29 @@ Albu-Schaeffer, IEEE T-RO 2017), on any model dynid produces.
   model's uncertainty propagated to the residual, contact and collision events.
 """
 
+from .detection import ContactEvent, Thresholds, calibrate, detect, residual_std
 from .model import ObserverModel, from_identified, from_robot
+from .residual import MomentumObserver, ObserverOptions, ObserverResult, first_order_lag, observe
 from .terms import base_momentum_regressor, momentum_regressor, momentum_terms
+from .wrench import WrenchEstimate, external_wrench
 
 __all__ = [
+    "ContactEvent",
+    "MomentumObserver",
     "ObserverModel",
+    "ObserverOptions",
+    "ObserverResult",
+    "Thresholds",
+    "WrenchEstimate",
     "base_momentum_regressor",
+    "calibrate",
+    "detect",
+    "external_wrench",
+    "first_order_lag",
     "from_identified",
     "from_robot",
     "momentum_regressor",
     "momentum_terms",
+    "observe",
+    "residual_std",
 ]
