@@ -126,7 +126,10 @@ def fit_friction_file(
     def fit() -> FrictionFileResult:
         res = friction_residual(model, log, cutoff_hz=cutoff_hz, max_gap_s=max_gap_s, drive=drive)
         if law == "auto":
-            sel = select_friction(res, drive, own=own_friction(model))
+            here = isinstance(model, IdentifiedModel) and path.name in {
+                str(r.get("file")) for r in model.info.recordings
+            }
+            sel = select_friction(res, drive, own=own_friction(model), own_fitted_here=here)
             return FrictionFileResult(sel.fit, res, sel, cutoff_hz)
         return FrictionFileResult(fit_friction_through(res, drive, law), res, None, cutoff_hz)
 
