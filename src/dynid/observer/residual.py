@@ -250,17 +250,8 @@ class MomentumObserver:
         r = np.empty(n)
         if self._entry is not None and self._entry(self._D, self._S, qa, dqa, taua, tf, r):
             return r
-        return self._run_numpy(
-            np.array([tf]),
-            qa[None],
-            dqa[None],
-            self._u(
-                qa[None],
-                dqa[None],
-                taua[None],
-                friction=not self._python_friction and self.model.friction is not None,
-            ),
-        )[0]
+        u = self._u(qa[None], dqa[None], taua[None], friction=not self._python_friction)
+        return self._run_numpy(np.array([tf]), qa[None], dqa[None], u)[0]
 
     # ------------------------------------------------------------------ a block
     def run(self, t: ArrayLike, q: ArrayLike, dq: ArrayLike, tau: ArrayLike) -> NDArray[np.float64]:
