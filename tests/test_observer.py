@@ -336,3 +336,33 @@ def test_external_wrench_recovers_the_contact_wrench_and_flags_singular_configur
     straight = np.zeros(7)
     assert external_wrench(robot, straight, np.ones(7), "flange").damped
     assert external_wrench(robot, q, r, "link3").damped.all()
+
+
+def test_observer_refuses_bad_inputs_with_the_documented_errors():
+    """NaN (NonFiniteError), a time that does not increase (DataError, the state kept), a
+    wrong shape (ShapeError), bad gains and options (OptionError)."""
+    from dynid.exceptions import DataError, NonFiniteError, OptionError, ShapeError
+
+    model = from_robot(dynid.panda())
+    obs = MomentumObserver(model)
+    q = np.full(7, 0.1)
+    obs.step(q, q, q, 0.0)
+    r1 = obs.step(q, q, q, 0.001)
+    with pytest.raises(DataError, match="t must increase"):
+        obs.step(q, q, q, 0.001)
+    with pytest.raises(NonFiniteError):
+        obs.step(np.full(7, np.nan), q, q, 0.002)
+    with pytest.raises(ShapeError):
+        obs.step(q[:6], q, q, 0.002)
+    np.testing.assert_array_equal(obs.residual, r1)  # nothing above moved the state
+    assert obs.step(list(q), q, q, 0.002).shape == (7,)  # a list is validated, then taken
+    with pytest.raises(DataError, match="sample 2"):
+        observe(model, [0.0, 0.1, 0.1], np.zeros((3, 7)), np.zeros((3, 7)), np.zeros((3, 7)))
+    with pytest.raises(OptionError, match="K_O"):
+        ObserverOptions(gain=-1.0)
+    with pytest.raises(OptionError, match="discretisation"):
+        ObserverOptions(discretisation="tustin")
+    with pytest.raises(ShapeError, match="observer gains"):
+        MomentumObserver(model, ObserverOptions(gain=(1.0, 2.0)))
+    with pytest.raises(OptionError, match="contact window"):
+        Contact("link5", (0.0, 0.0, 1.0), 2.0, 1.0)

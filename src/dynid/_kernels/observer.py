@@ -32,8 +32,9 @@ rows ``0..n`` the robot's packed constants ``C``; rows ``n+1..2n`` the rotor mas
 ``M_r``; rows ``2n+1..3n`` the friction transmission ``K_f`` (motor ``m`` a row); rows
 ``3n+1..4n`` each motor's friction parameters (:data:`FRICTION_WIDTH` columns, the
 canonical form of :mod:`dynid.observer.friction`); row ``4n+1`` the gains ``K_O`` [1/s];
-row ``4n+2`` the options ``exact, trapezoid, friction``. State ``S`` (``3 n + 2``):
-started, ``t``, ``p``, ``u`` and ``r`` of the last sample.
+row ``4n+2`` the options ``exact, trapezoid, friction``. State ``S`` (``4 n + 3``):
+started, ``t``, ``p``, ``u`` and ``r`` of the last sample, then the last step ``T`` and its
+``gamma`` per joint (computed again only when the step changes).
 """
 
 from __future__ import annotations
@@ -42,12 +43,15 @@ import math
 
 import numpy as np
 
+from .chain import SINCOS_MAX as _SINCOS_MAX
 from .chain import STACK as _STACK
-from .chain import angles, finite, inline, jit, joint_at, lean, stack
+from .chain import angles, finite, fixed, inline, jit, joint_at, joint_from, lean, stack
+from .chain import sincos as _sincos
 from .dynamics import carry
 from .layout import C_AXIS, C_PHI, C_PRISMATIC
 
 __all__ = [
+    "BLOCK",
     "FRICTION_WIDTH",
     "momentum_terms",
     "momentum_terms_one",
@@ -55,8 +59,9 @@ __all__ = [
     "observer_batch",
 ]
 
-#: columns of a motor's canonical friction parameters
-FRICTION_WIDTH = 13
+#: columns of a motor's canonical friction parameters (the 13 of
+#: :mod:`dynid.observer.friction` and the sigmoid's value at rest)
+FRICTION_WIDTH = 14
 
 
 @inline
@@ -169,8 +174,8 @@ def _law(F, m, v):
         else:
             f += ft * (1.0 if v > 0.0 else (-1.0 if v < 0.0 else 0.0))
     s1, s2, s3 = F[m, 10], F[m, 11], F[m, 12]
-    if s1 != 0.0:
-        f += s1 * (1.0 / (1.0 + math.exp(-s2 * (v + s3))) - 1.0 / (1.0 + math.exp(-s2 * s3)))
+    if s1 != 0.0:  # column 13: the logistic at rest, sigma(phi2 phi3), made once
+        f += s1 * (1.0 / (1.0 + math.exp(-s2 * (v + s3))) - F[m, 13])
     return f
 
 
@@ -208,11 +213,16 @@ def _update(D, n, S, t, p, u, po, uo, r, ro):
     if not T > 0.0:
         return False
     g = 4 * n + 1
-    exact = D[g + 1, 0] != 0.0
     trap = D[g + 1, 1] != 0.0
+    c = 3 * n + 2
+    if S[c] != T:  # the gains of this step (uniform sampling: once)
+        exact = D[g + 1, 0] != 0.0
+        for j in range(n):
+            k = D[g, j]
+            S[c + 1 + j] = -math.expm1(-k * T) if exact else k * T
+        S[c] = T
     for j in range(n):
-        k = D[g, j]
-        gam = -math.expm1(-k * T) if exact else k * T
+        gam = S[c + 1 + j]
         uj = u[uo + j]
         ub = 0.5 * (uj + S[2 + n + j]) if trap else uj
         rj = S[2 + 2 * n + j]
@@ -283,35 +293,222 @@ def observer_step(D, S, q, dq, tau, t, r):
     return _update(D, n, S, t, pk, u, 0, 0, r, 0)
 
 
+# ------------------------------------------------------------------ the batch, in blocks
+#: Samples per block of :func:`observer_batch` (the vectorised inner loop's length).
+BLOCK = 32
+# rows of the block scratch X[link, row, sample]
+_BQ, _BV, _BS, _BC = 0, 1, 2, 3  # q, dq, sin q, cos q
+_BR = 4  # rotation of the link in its parent, R[a][b] at _BR + 3 a + b
+_BP = 13  # origin of the link in its parent
+_BW, _BVO, _BA = 16, 19, 22  # angular velocity, origin velocity, static acceleration -g
+_BH, _BL, _BF, _BN = 25, 28, 31, 34  # subtree momentum (P, L) and gravity wrench (F, N)
+_BOUT_P, _BOUT_B = 37, 38  # p_i and g_i - (C^T dq)_i
+_BROWS = 39
+
+
+@inline
+def _block_scratch(D, n):
+    """``X`` (n + 2, rows, BLOCK): the base (link 0) at rest accelerating at ``-g``, the
+    virtual link ``n + 1`` the identity carrying nothing."""
+    X = np.zeros((n + 2, _BROWS, BLOCK))
+    for k in range(BLOCK):
+        X[0, _BA, k] = -D[n, 0]
+        X[0, _BA + 1, k] = -D[n, 1]
+        X[0, _BA + 2, k] = -D[n, 2]
+        X[n + 1, _BR, k] = 1.0
+        X[n + 1, _BR + 4, k] = 1.0
+        X[n + 1, _BR + 8, k] = 1.0
+    return X
+
+
+@inline
+def _load_block(D, n, q, dq, b0, nb, X):
+    """Samples ``b0 .. b0 + nb`` into ``X``: q, dq, sin q, cos q (exact selectors for a
+    prismatic joint). False for a non-finite input."""
+    big = False
+    for k in range(nb):
+        o = (b0 + k) * n
+        for i in range(n):
+            x, v = q[o + i], dq[o + i]
+            if not (math.isfinite(x) and math.isfinite(v)):
+                return False
+            big = big or abs(x) > _SINCOS_MAX
+            X[i + 1, _BQ, k] = x
+            X[i + 1, _BV, k] = v
+    for l in range(1, n + 1):
+        if D[l - 1, C_PRISMATIC] != 0.0:
+            for k in range(nb):
+                X[l, _BS, k] = 0.0
+                X[l, _BC, k] = 1.0
+        elif big:
+            for k in range(nb):
+                X[l, _BS, k] = math.sin(X[l, _BQ, k])
+                X[l, _BC, k] = math.cos(X[l, _BQ, k])
+        else:
+            for k in range(nb):
+                sn, cs = _sincos(X[l, _BQ, k])
+                X[l, _BS, k] = sn
+                X[l, _BC, k] = cs
+    return True
+
+
+@inline
+def _outward_terms(D, n, nb, X):
+    """Outward pass over a block: each link's pose in its parent, angular velocity, origin
+    velocity and static acceleration, in link coordinates (:func:`_terms_sample`)."""
+    for l in range(1, n + 1):
+        i = l - 1
+        ex, ey, ez = D[i, C_AXIS], D[i, C_AXIS + 1], D[i, C_AXIS + 2]
+        ep = D[i, C_PRISMATIC]
+        er = 1.0 - ep
+        F = fixed(D, i)
+        for k in range(nb):
+            r00, r01, r02, r10, r11, r12, r20, r21, r22, px, py, pz = joint_from(
+                F, X[l, _BS, k], X[l, _BC, k], ep * X[l, _BQ, k]
+            )
+            X[l, _BR, k] = r00
+            X[l, _BR + 1, k] = r01
+            X[l, _BR + 2, k] = r02
+            X[l, _BR + 3, k] = r10
+            X[l, _BR + 4, k] = r11
+            X[l, _BR + 5, k] = r12
+            X[l, _BR + 6, k] = r20
+            X[l, _BR + 7, k] = r21
+            X[l, _BR + 8, k] = r22
+            X[l, _BP, k] = px
+            X[l, _BP + 1, k] = py
+            X[l, _BP + 2, k] = pz
+            wx, wy, wz = X[i, _BW, k], X[i, _BW + 1, k], X[i, _BW + 2, k]
+            bx = X[i, _BVO, k] + (wy * pz - wz * py)
+            by = X[i, _BVO + 1, k] + (wz * px - wx * pz)
+            bz = X[i, _BVO + 2, k] + (wx * py - wy * px)
+            ax, ay, az = X[i, _BA, k], X[i, _BA + 1, k], X[i, _BA + 2, k]
+            d = X[l, _BV, k]
+            X[l, _BW, k] = r00 * wx + r10 * wy + r20 * wz + er * d * ex
+            X[l, _BW + 1, k] = r01 * wx + r11 * wy + r21 * wz + er * d * ey
+            X[l, _BW + 2, k] = r02 * wx + r12 * wy + r22 * wz + er * d * ez
+            X[l, _BVO, k] = r00 * bx + r10 * by + r20 * bz + ep * d * ex
+            X[l, _BVO + 1, k] = r01 * bx + r11 * by + r21 * bz + ep * d * ey
+            X[l, _BVO + 2, k] = r02 * bx + r12 * by + r22 * bz + ep * d * ez
+            X[l, _BA, k] = r00 * ax + r10 * ay + r20 * az
+            X[l, _BA + 1, k] = r01 * ax + r11 * ay + r21 * az
+            X[l, _BA + 2, k] = r02 * ax + r12 * ay + r22 * az
+
+
+@inline
+def _inward_terms(D, n, nb, X):
+    """Inward pass over a block: subtree momenta and gravity wrenches carried from the
+    child, the link's own added, projected into ``p_i`` and ``g_i - (C^T dq)_i``."""
+    for l in range(n, 0, -1):
+        i = l - 1
+        c = l + 1
+        m = D[i, C_PHI]
+        hx, hy, hz = D[i, C_PHI + 1], D[i, C_PHI + 2], D[i, C_PHI + 3]
+        Jxx, Jxy, Jxz = D[i, C_PHI + 4], D[i, C_PHI + 5], D[i, C_PHI + 6]
+        Jyy, Jyz, Jzz = D[i, C_PHI + 7], D[i, C_PHI + 8], D[i, C_PHI + 9]
+        ex, ey, ez = D[i, C_AXIS], D[i, C_AXIS + 1], D[i, C_AXIS + 2]
+        ep = D[i, C_PRISMATIC]
+        er = 1.0 - ep
+        for k in range(nb):
+            Tc = (
+                X[c, _BR, k], X[c, _BR + 1, k], X[c, _BR + 2, k],
+                X[c, _BR + 3, k], X[c, _BR + 4, k], X[c, _BR + 5, k],
+                X[c, _BR + 6, k], X[c, _BR + 7, k], X[c, _BR + 8, k],
+                X[c, _BP, k], X[c, _BP + 1, k], X[c, _BP + 2, k],
+            )  # fmt: skip
+            Px, Py, Pz, Lx, Ly, Lz = carry(
+                Tc,
+                (X[c, _BH, k], X[c, _BH + 1, k], X[c, _BH + 2, k]),
+                (X[c, _BL, k], X[c, _BL + 1, k], X[c, _BL + 2, k]),
+            )
+            Fx, Fy, Fz, Nx, Ny, Nz = carry(
+                Tc,
+                (X[c, _BF, k], X[c, _BF + 1, k], X[c, _BF + 2, k]),
+                (X[c, _BN, k], X[c, _BN + 1, k], X[c, _BN + 2, k]),
+            )
+            wx, wy, wz = X[l, _BW, k], X[l, _BW + 1, k], X[l, _BW + 2, k]
+            vx, vy, vz = X[l, _BVO, k], X[l, _BVO + 1, k], X[l, _BVO + 2, k]
+            ax, ay, az = X[l, _BA, k], X[l, _BA + 1, k], X[l, _BA + 2, k]
+            Px += m * vx + (wy * hz - wz * hy)
+            Py += m * vy + (wz * hx - wx * hz)
+            Pz += m * vz + (wx * hy - wy * hx)
+            Lx += (Jxx * wx + Jxy * wy + Jxz * wz) + (hy * vz - hz * vy)
+            Ly += (Jxy * wx + Jyy * wy + Jyz * wz) + (hz * vx - hx * vz)
+            Lz += (Jxz * wx + Jyz * wy + Jzz * wz) + (hx * vy - hy * vx)
+            Fx += m * ax
+            Fy += m * ay
+            Fz += m * az
+            Nx += hy * az - hz * ay
+            Ny += hz * ax - hx * az
+            Nz += hx * ay - hy * ax
+            X[l, _BH, k] = Px
+            X[l, _BH + 1, k] = Py
+            X[l, _BH + 2, k] = Pz
+            X[l, _BL, k] = Lx
+            X[l, _BL + 1, k] = Ly
+            X[l, _BL + 2, k] = Lz
+            X[l, _BF, k] = Fx
+            X[l, _BF + 1, k] = Fy
+            X[l, _BF + 2, k] = Fz
+            X[l, _BN, k] = Nx
+            X[l, _BN + 1, k] = Ny
+            X[l, _BN + 2, k] = Nz
+            cx, cy, cz = wy * ez - wz * ey, wz * ex - wx * ez, wx * ey - wy * ex
+            sx, sy, sz = vy * ez - vz * ey, vz * ex - vx * ez, vx * ey - vy * ex
+            ePL = Px * ex + Py * ey + Pz * ez
+            eL = Lx * ex + Ly * ey + Lz * ez
+            cP = Px * cx + Py * cy + Pz * cz
+            ct = er * ((Lx * cx + Ly * cy + Lz * cz) + (Px * sx + Py * sy + Pz * sz)) + ep * cP
+            g = er * (Nx * ex + Ny * ey + Nz * ez) + ep * (Fx * ex + Fy * ey + Fz * ez)
+            X[l, _BOUT_P, k] = er * eL + ep * ePL
+            X[l, _BOUT_B, k] = g - ct
+
+
 @jit
 def observer_batch(D, S, t, q, dq, tau, r):
     """The observer over ``B`` samples: ``r`` (B n,) from ``t`` (B,), ``q, dq, tau`` (B n,),
     continuing from the state ``S``; friction as in :func:`observer_step`.
 
+    ``p`` and ``g - C^T dq`` of a block of :data:`BLOCK` samples at a time, the loop over
+    the block's samples innermost (it vectorises); then the update, sample after sample.
     Returns -1, or the first sample that stopped it (a non-finite input, a time that does
     not increase); the state then holds the samples before it.
     """
     B = t.shape[0]
     n = q.shape[0] // B if B > 0 else 0
-    W = np.empty((n, 21))
-    A = np.empty((3, n))
-    X = np.empty((4, n))
-    pk, bk, tf, V = X[0], X[1], X[2], X[3]
+    X = _block_scratch(D, n)
+    Y = np.empty((4, n))
+    pk, bk, tf, V = Y[0], Y[1], Y[2], Y[3]
     friction = D[4 * n + 2, 2] != 0.0
-    for b in range(B):
-        o = b * n
-        if not (angles(D, q, o, A) and finite(dq, o, n) and finite(tau, o, n)):
-            return b
-        if not math.isfinite(t[b]) or (S[0] != 0.0 and not t[b] > S[1]):
-            return b
-        _terms_sample(D, n, A, dq, o, W, pk, bk, 0)
-        _rotor(D, n, dq, o, pk)
-        if friction:
-            _friction(D, n, dq, o, tf, V)
+    for b0 in range(0, B, BLOCK):
+        full = min(BLOCK, B - b0)
+        nb = full
+        for k in range(full):  # up to the first non-finite state (the state reaches it)
+            o = (b0 + k) * n
+            if not (finite(q, o, n) and finite(dq, o, n)):
+                nb = k
+                break
+        _load_block(D, n, q, dq, b0, nb, X)
+        _outward_terms(D, n, nb, X)
+        _inward_terms(D, n, nb, X)
+        for k in range(nb):
+            b = b0 + k
+            o = b * n
+            if not finite(tau, o, n):
+                return b
+            if not math.isfinite(t[b]) or (S[0] != 0.0 and not t[b] > S[1]):
+                return b
             for i in range(n):
-                bk[i] = tau[o + i] - tf[i] - bk[i]
-        else:
-            for i in range(n):
-                bk[i] = tau[o + i] - bk[i]
-        _update(D, n, S, t[b], pk, bk, 0, 0, r, o)
+                pk[i] = X[i + 1, _BOUT_P, k]
+            _rotor(D, n, dq, o, pk)
+            if friction:
+                _friction(D, n, dq, o, tf, V)
+                for i in range(n):
+                    bk[i] = tau[o + i] - tf[i] - X[i + 1, _BOUT_B, k]
+            else:
+                for i in range(n):
+                    bk[i] = tau[o + i] - X[i + 1, _BOUT_B, k]
+            _update(D, n, S, t[b], pk, bk, 0, 0, r, o)
+        if nb < full:
+            return b0 + nb
     return -1

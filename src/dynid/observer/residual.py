@@ -126,13 +126,14 @@ def _packed(
     """The observer's constants ``D`` (:mod:`dynid._kernels.observer`), read-only."""
     n = model.n
     C = _kernels.constants(model.robot)
-    width = max(C.shape[1], n, len(FRICTION_COLUMNS))
+    width = max(C.shape[1], n, len(FRICTION_COLUMNS) + 1)
     D = np.zeros((4 * n + 3, width))
     D[: n + 1, : C.shape[1]] = C
     D[n + 1 : 2 * n + 1, :n] = model.rotor_mass
     if F is not None:
         D[2 * n + 1 : 3 * n + 1, :n] = Kf
         D[3 * n + 1 : 4 * n + 1, : F.shape[1]] = F
+        D[3 * n + 1 : 4 * n + 1, F.shape[1]] = 1.0 / (1.0 + np.exp(-F[:, 11] * F[:, 12]))
     D[4 * n + 1, :n] = options.gains(n)
     D[4 * n + 2, :3] = [
         options.discretisation == "exact",
@@ -171,7 +172,7 @@ class MomentumObserver:
         F, Kf = (None, None) if canon is None else (canon[1], canon[0])
         self._D = _packed(model, options, F, Kf)
         self._D_batch = _packed(model, options, None, None)  # u = tau - tau_f given
-        self._S = np.zeros(3 * n + 2)
+        self._S = np.zeros(4 * n + 3)
         self._shape = (n,)
         self._gains = options.gains(n)
         mod = _kernels.load("observer")
@@ -249,17 +250,8 @@ class MomentumObserver:
         r = np.empty(n)
         if self._entry is not None and self._entry(self._D, self._S, qa, dqa, taua, tf, r):
             return r
-        return self._run_numpy(
-            np.array([tf]),
-            qa[None],
-            dqa[None],
-            self._u(
-                qa[None],
-                dqa[None],
-                taua[None],
-                friction=not self._python_friction and self.model.friction is not None,
-            ),
-        )[0]
+        u = self._u(qa[None], dqa[None], taua[None], friction=not self._python_friction)
+        return self._run_numpy(np.array([tf]), qa[None], dqa[None], u)[0]
 
     # ------------------------------------------------------------------ a block
     def run(self, t: ArrayLike, q: ArrayLike, dq: ArrayLike, tau: ArrayLike) -> NDArray[np.float64]:
@@ -317,15 +309,16 @@ class MomentumObserver:
         for k in range(t.shape[0]):
             if not S[0]:
                 S[0], S[1] = 1.0, t[k]
-                S[2 : 2 + n], S[2 + n : 2 + 2 * n], S[2 + 2 * n :] = p[k], u[k], 0.0
+                S[2 : 2 + n], S[2 + n : 2 + 2 * n], S[2 + 2 * n : 2 + 3 * n] = p[k], u[k], 0.0
                 r[k] = 0.0
                 continue
             T = t[k] - S[1]
             gam = -np.expm1(-K * T) if exact else K * T
             ub = 0.5 * (u[k] + S[2 + n : 2 + 2 * n]) if trap else u[k]
-            rk = S[2 + 2 * n :]
+            rk = S[2 + 2 * n : 2 + 3 * n]
             rk = rk + gam * ((p[k] - S[2 : 2 + n]) / T - ub - rk)
-            S[1], S[2 : 2 + n], S[2 + n : 2 + 2 * n], S[2 + 2 * n :] = t[k], p[k], u[k], rk
+            S[1], S[2 : 2 + n], S[2 + n : 2 + 2 * n] = t[k], p[k], u[k]
+            S[2 + 2 * n : 2 + 3 * n] = rk
             r[k] = rk
         return r
 
