@@ -249,8 +249,7 @@ def _torques_section(run: RunFiles, held: dict | None) -> str:
 
 def _selection(doc: dict) -> Any:
     """The model structure chosen on held-out data (``metadata.selection``), or None."""
-    sel = _get(doc, "metadata", "selection")
-    return sel if sel is not None else doc.get("selection")
+    return _get(doc, "metadata", "selection")
 
 
 def _structure_section(doc: dict) -> str:
