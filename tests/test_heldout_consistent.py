@@ -98,9 +98,10 @@ def test_a_consistent_fit_far_above_least_squares_in_training_is_accepted_held_o
         ls["heldout_error_percent"], rel=1e-9
     )
     # least squares refitted without each block, on rows built here
-    from dynid.identification.classical import friction_regressor
     from dynid.identification.log import prepare_log
+    from dynid.model.drive import Drive
     from dynid.regressors.base import base_parameters
+    from dynid.regressors.terms import LinearFriction
 
     robot = dynid.panda()
     meta = ident["metadata"]
@@ -109,7 +110,10 @@ def test_a_consistent_fit_far_above_least_squares_in_training_is_accepted_held_o
     q, dq, ddq, tau = p.q[s], p.dq[s], p.ddq[s], p.tau[s]
     bp = base_parameters(robot, kind="torque")
     Y = dynid.torque_regressor(robot, q, dq, ddq)[..., bp.independent]
-    W = np.concatenate([Y, friction_regressor(dq)], axis=-1).reshape(-1, bp.rank + 21)
+    # classical friction with the standstill band the identification recorded
+    band = tuple(meta.get("friction_band", ()))
+    F = LinearFriction(Drive.identity(7), band=band).torque_columns(q, dq, ddq)
+    W = np.concatenate([Y, F], axis=-1).reshape(-1, bp.rank + 21)
     y = tau.reshape(-1)
     blocks = np.repeat(np.minimum(np.arange(q.shape[0]) * 5 // q.shape[0], 4), 7)
     sse = ss = 0.0

@@ -300,3 +300,29 @@ def test_identify_command_prints_and_records_the_choice(panda, tmp_path, capsys)
     d = json.loads((tmp_path / "fixed" / "identification.json").read_text())
     assert d["metadata"]["terms"] == ["viscous", "coulomb"]
     assert "recording rec51.csv" in out
+
+
+@pytest.mark.slow
+def test_consistent_fit_of_several_recordings_keeps_the_chosen_armature(panda, tmp_path):
+    """identify --consistent on two recordings with an armature: the armature is chosen on
+    held-out data, kept >= 0 in the convex fit and comes back as simulated; a log cut by a
+    gap is prepared in pieces (--max-gap honoured on this route too)."""
+    fr = ClassicalFriction(VISCOUS, np.zeros(7), np.zeros(7))
+    a = _recording(panda, 71, fr, armature=ARMATURE, duration=6.0)
+    b = _recording(panda, 72, fr, armature=ARMATURE, duration=6.0)
+    b = b.select(np.flatnonzero((b.t < 2.0) | (b.t > 2.4)))  # a 0.4 s gap
+    for name, log in (("a.csv", a), ("b.csv", b)):
+        save_torque_log(tmp_path / name, log)
+    data = ["--data", str(tmp_path / "a.csv"), str(tmp_path / "b.csv")]
+    argv = ["identify", "--robot", "panda", *data, "--consistent", "--prior", "panda"]
+    assert main([*argv, "--no-figures", "--out", str(tmp_path / "c"), "-q"]) == 0
+    d = json.loads((tmp_path / "c" / "feasible.json").read_text())
+    np.testing.assert_allclose(d["drive"]["rotor_inertia"][2:], ARMATURE[2:], rtol=0.05)
+    ident = json.loads((tmp_path / "c" / "identification.json").read_text())["metadata"]
+    assert ident["selection"]["chosen"].startswith("links + armature")
+    assert [r["pieces"] for r in ident["recordings"]] == [1, 2]
+    # the gap bridged instead (--max-gap 1): one piece
+    out = ["--max-gap", "1.0", "--no-figures", "--out", str(tmp_path / "d"), "-q"]
+    assert main([*argv, *out]) == 0
+    ident = json.loads((tmp_path / "d" / "identification.json").read_text())["metadata"]
+    assert [r["pieces"] for r in ident["recordings"]] == [1, 1]

@@ -66,8 +66,10 @@ dominant coefficient, which then goes too (fix the conditioning first).
 
 With --consistent, the link parameters are identified physically consistent in one step
 (convex, every link's pseudo-inertia positive definite, pulled towards --prior; see
-`dynid retrieve --help`): from a torque log with the classical friction (fv, fc >= 0), or
-from static data. Writes next to identification.json (the unconstrained fit) the files of
+`dynid retrieve --help`): from torque logs (one or more, prepared as above) with the
+classical friction (fv, fc >= 0) and the armature when the model structure chosen on
+held-out data has one (rotor inertias >= 0; --terms armature forces it), or from static
+data. Writes next to identification.json (the unconstrained fit) the files of
 `dynid retrieve`: feasible.json (links, and the friction identified with them), robot.urdf,
 robot.toml, report.json, retrieval.png. Exit code 1 when no consistent set satisfies the
 constraints (the closest one is written and reported).
@@ -274,14 +276,11 @@ def _no_consistency_options(args: argparse.Namespace) -> None:
 def run_consistent(args: argparse.Namespace, console: Console, robot, common) -> int:  # noqa: ANN001
     """One-step consistent identification: identification.json plus the retrieve files;
     0 if the parameters are consistent, else 1."""
-    if len(args.data) > 1 or args.terms is not None:
-        raise OptionError(
-            "--consistent takes one --data file and the classical terms (no --terms) for now; "
-            "identify without --consistent to fit several recordings or choose the terms"
-        )
     result = identify_consistent_file(
         robot,
-        args.data[0],
+        args.data,
+        terms=args.terms,
+        max_gap_s=args.max_gap,
         prior=load_prior(args, robot, console),
         total_mass=parse_mass_band(args.total_mass),
         options=sdp_options(args),

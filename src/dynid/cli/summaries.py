@@ -159,7 +159,10 @@ def heldout_line(ho: dict[str, Any]) -> str:
 
 def heldout_table(j: HeldOutJudgement) -> list[str]:
     """Training against held-out errors of least squares and of the consistent fit."""
-    how = "the --validate-on log" if j.scheme == "file" else f"{j.folds} contiguous time blocks"
+    how = {
+        "file": "the --validate-on log",
+        "recordings": f"each of {j.folds} recordings in turn",
+    }.get(j.scheme, f"{j.folds} contiguous time blocks")
     verdict = "accepted" if j.accepted else "NOT accepted"
     return [
         f"torque error [%]      {'training':>9}  {'held-out':>9}   (held out: {how})",

@@ -21,7 +21,12 @@ from pathlib import Path
 from typing import Any, Literal
 
 from ..exceptions import DataError, DynidWarning
-from ..feasibility.convex import ConsistentResult, SDPOptions, identify_consistent
+from ..feasibility.convex import (
+    ConsistentResult,
+    SDPOptions,
+    consistent_from_identified,
+    identify_consistent,
+)
 from ..identification.consistency import fit_mismatch, limit_violations
 from ..identification.estimators import EstimatorName
 from ..identification.least_squares import StdMethod
@@ -222,6 +227,41 @@ def identify_file(
     return _record(model, columns)
 
 
+def _consistent_structure_fit(
+    robot: Robot,
+    logs: list[Any],
+    names: list[str],
+    terms: Structure | Literal["auto"],
+    **kw: Any,
+) -> IdentifiedModel:
+    """The unconstrained fit of the one-step consistent route: the armature chosen on
+    held-out data (or given), the classical friction (``fv, fc, fo``) with it; the choice
+    recorded.
+
+    Raises
+    ------
+    DataError
+        ``terms`` name friction other than the classical parts together.
+    """
+    classical = ("viscous", "coulomb", "offset")
+    if terms != "auto" and terms.friction not in (classical, ()):
+        raise DataError(
+            "--consistent keeps the classical friction (viscous, coulomb, offset) physical: "
+            f"--terms may add armature to it; got {terms.name!r}"
+        )
+    selection = None
+    if terms == "auto":
+        chosen = identify_recordings(robot, logs, names, **kw)
+        selection = chosen.info.selection
+        chosen_terms = str((selection or {}).get("chosen", "")).split(" + ")
+        terms = Structure("armature" in chosen_terms, classical)
+    else:
+        terms = Structure(terms.armature, classical)
+    model = identify_recordings(robot, logs, names, structure=terms, **kw)
+    info = dataclasses.replace(model.info, selection=selection)
+    return dataclasses.replace(model, info=info)
+
+
 def _one_static_file(paths: list[Path], terms: object) -> None:
     """Static data come in one file, and have no terms to choose."""
     if len(paths) > 1:
@@ -234,8 +274,10 @@ def _one_static_file(paths: list[Path], terms: object) -> None:
 
 def identify_consistent_file(
     robot: Robot,
-    path: str | Path,
+    path: str | Path | Sequence[str | Path],
     *,
+    terms: str | Structure | None = None,
+    max_gap_s: float | None = None,
     prior: Robot | None = None,
     total_mass: tuple[float, float] | None = None,
     options: SDPOptions | None = None,
@@ -260,6 +302,11 @@ def identify_consistent_file(
     judgement of the prior weight and of the fit. Other parameters as :func:`identify_file` and
     :func:`~dynid.feasibility.convex.fit.identify_consistent`.
 
+    Torque logs (one or more, prepared as :func:`identify_file` prepares them, ``max_gap_s``
+    honoured): the armature is chosen on held-out data as :func:`identify_file` chooses it
+    (or given by ``terms``), and the friction is the classical ``fv, fc, fo >= 0`` per joint
+    (motor), the terms the convex problem keeps physical.
+
     Returns
     -------
     ConsistentResult
@@ -277,32 +324,47 @@ def identify_consistent_file(
             "--std does not apply to --consistent: its data term is the residual itself "
             "(weighted by --estimator)"
         )
-    path = Path(path)
+    paths = data_files(path)
+    path = paths[0]
     cmap = _columns(columns, cutoff_hz)
     kind = data_kind(path, cmap)
     heldout = _heldout(path, kind, folds, validate_on, robot.n, cmap, drop_invalid)
-    data: Any
+    common: dict[str, Any] = dict(prior=prior, total_mass=total_mass, options=options)
     if kind == "torque_log":
-        data = read_torque_log(
-            path, robot.n, columns=cmap, drop_invalid=drop_invalid, owner=f"robot {robot.name!r}"
-        )
+        logs = [
+            read_torque_log(
+                p, robot.n, columns=cmap, drop_invalid=drop_invalid, owner=f"robot {robot.name!r}"
+            )
+            for p in paths
+        ]
+
+        def fit() -> ConsistentResult:
+            model = _consistent_structure_fit(
+                robot,
+                logs,
+                [p.name for p in paths],
+                _terms(terms),
+                rtol=rtol,
+                drive=drive,
+                estimator=estimator,
+                cutoff_hz="auto" if cutoff_hz is None else cutoff_hz,
+                max_gap_s=max_gap_s,
+                **heldout,
+            )
+            return consistent_from_identified(robot, model, kind="log", **common)
+
+        result = in_file(path, fit) if len(paths) == 1 else fit()
     else:
+        _one_static_file(paths, terms)
+        if max_gap_s is not None:
+            raise DataError(f"{path.name}: --max-gap applies to torque logs, not static data")
         data = read_static_file(path, robot, columns=cmap, drop_invalid=drop_invalid)
-    result = in_file(
-        path,
-        lambda: identify_consistent(
-            robot,
-            data,
-            prior=prior,
-            total_mass=total_mass,
-            options=options,
-            rtol=rtol,
-            drive=drive,
-            estimator=estimator,
-            cutoff_hz="auto" if cutoff_hz is None else cutoff_hz,
-            **heldout,
-        ),
-    )
+        result = in_file(
+            path,
+            lambda: identify_consistent(
+                robot, data, rtol=rtol, drive=drive, estimator=estimator, **common
+            ),
+        )
     if result.identified is None:  # pragma: no cover - identify_consistent always sets it
         raise DataError("the one-step identification returned no unconstrained fit")
     return dataclasses.replace(result, identified=_record(result.identified, columns))

@@ -56,7 +56,7 @@ Modules: :mod:`.options` (:class:`SDPOptions`), :mod:`.data_term` (:class:`DataT
 """
 
 from .data_term import DataTerm, coefficient_term
-from .fit import identify_consistent, retrieve_sdp, with_drive
+from .fit import consistent_from_identified, identify_consistent, retrieve_sdp, with_drive
 from .options import DEFAULT_SDP_MARGIN, SDPOptions
 from .result import ConsistentResult
 from .solve import solve_consistent
@@ -67,6 +67,7 @@ __all__ = [
     "DataTerm",
     "SDPOptions",
     "coefficient_term",
+    "consistent_from_identified",
     "identify_consistent",
     "retrieve_sdp",
     "solve_consistent",

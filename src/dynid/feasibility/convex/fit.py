@@ -37,12 +37,19 @@ from ...model.drive import Drive
 from ...model.robot import Robot
 from ..bounds import Bounds
 from ..prior import Prior
-from .data_term import coefficient_term
+from .data_term import DataTerm, coefficient_term
 from .options import SDPOptions
 from .result import ConsistentResult
 from .solve import solve_consistent
 
-__all__ = ["METHOD", "ConvexMethod", "identify_consistent", "retrieve_sdp", "with_drive"]
+__all__ = [
+    "METHOD",
+    "ConvexMethod",
+    "consistent_from_identified",
+    "identify_consistent",
+    "retrieve_sdp",
+    "with_drive",
+]
 
 
 def retrieve_sdp(
@@ -172,6 +179,51 @@ def identify_consistent(
         raise WrongTypeError(
             f"data must be a TorqueLog or a StaticDataset; got {type(data).__name__}"
         )
+    return consistent_from_identified(
+        robot,
+        model,
+        term,
+        kind=kind,
+        prior=prior,
+        bounds=bounds,
+        total_mass=total_mass,
+        options=options,
+        constraints=constraints,
+    )
+
+
+def consistent_from_identified(
+    robot: Robot,
+    model: IdentifiedModel,
+    term: DataTerm | None = None,
+    *,
+    kind: str = "log",
+    prior: Prior | Robot | None = None,
+    bounds: Bounds | None = None,
+    total_mass: tuple[float, float] | None = None,
+    options: SDPOptions | None = None,
+    constraints: Sequence[Callable[..., Any]] = (),
+) -> ConsistentResult:
+    """The one-step consistent fit of an unconstrained identification: its coefficients
+    (and, from a torque log, its friction ``fv, fc, fo``) with their covariance as the data
+    term, its held-out folds choosing the prior's weight and accepting the result.
+
+    Parameters
+    ----------
+    robot : Robot
+    model : IdentifiedModel
+        The unconstrained fit (:func:`identify_consistent` makes it; several recordings:
+        :func:`~dynid.identification.structure.identify_recordings` with the classical
+        friction); its drive (a drive file's, or the direct drive of an armature) is kept.
+    term : DataTerm, optional
+        Default :func:`~dynid.feasibility.convex.data_term.coefficient_term` of ``model``
+        (with its friction for ``kind="log"``).
+    kind : {"log", "static"}
+    prior, bounds, total_mass, options, constraints
+        As in :func:`~dynid.feasibility.convex.solve.solve_consistent`.
+    """
+    if term is None:
+        term = coefficient_term(model, with_friction=kind == "log")
     res = solve_consistent(
         robot,
         term,
@@ -183,7 +235,7 @@ def identify_consistent(
         kind=kind,
     )
     res = replace(res, identified=model)
-    return res if drive is None else with_drive(res, drive)
+    return res if model.drive is None else with_drive(res, model.drive)
 
 
 class ConvexMethod:
