@@ -129,7 +129,16 @@ def test_friction_then_validate_write_json_and_figures(workdir, capsys):
     sel = doc["selection"]
     assert sel["chosen"] == "sigmoid" and sel["folds"] == 5
     held = {c["model"]: c["heldout_error_percent"] for c in sel["candidates"]}
-    assert set(held) == {"own", "none", "classical", "smooth", "asymmetric", "stribeck", "sigmoid"}
+    assert set(held) == {
+        "own",
+        "none",
+        "classical",
+        "smooth",
+        "quadratic",
+        "asymmetric",
+        "stribeck",
+        "sigmoid",
+    }
     assert held["sigmoid"] == min(held.values()) < held["own"] < held["none"]
 
     val = workdir / "val"

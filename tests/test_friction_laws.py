@@ -38,6 +38,10 @@ REFERENCE = {
         lambda v, p, b: p[0] * v + p[1] * np.tanh(v / b) + p[2],
         [[0.3, 0.8, 0.1], [0.05, 0.4, -0.2]],
     ),
+    "quadratic": (
+        lambda v, p, b: p[0] * v + p[1] * v * np.abs(v) + p[2] * _s(v, b) + p[3],
+        [[0.3, 0.2, 0.8, 0.1], [0.05, 0.1, 0.4, -0.2]],
+    ),
     "asymmetric": (
         lambda v, p, b: (
             np.where(v > 0, p[0] * v, p[1] * v) + p[2] * (_s(v, b) > 0) - p[3] * (_s(v, b) < 0)
@@ -71,8 +75,10 @@ def _friction(name, dq, P, band=BAND):
 
 
 def test_the_registry_names_every_law_and_refuses_others():
-    """The registry holds the five laws and 'none'; an unknown name names the flag."""
-    assert list(LAWS) == ["none", "classical", "smooth", "asymmetric", "stribeck", "sigmoid"]
+    """The registry holds the six laws and 'none'; an unknown name names the flag."""
+    assert list(LAWS) == [
+        "none", "classical", "smooth", "quadratic", "asymmetric", "stribeck", "sigmoid"
+    ]  # fmt: skip
     for law in LAWS.values():
         assert len(law.params) == len(law.units) == len(law.lower) == len(law.upper)
     with pytest.raises(Exception, match="--friction-model must be one of none, classical"):
@@ -82,7 +88,8 @@ def test_the_registry_names_every_law_and_refuses_others():
 @pytest.mark.parametrize("name", sorted(REFERENCE))
 def test_every_law_recovers_its_own_simulated_parameters(name):
     """Torques of the law written out plus 0.02 N m noise: the fit returns the true
-    parameters (to 1 %, 3 % for the Stribeck velocity and the sigmoid's steepness), and the
+    parameters (to 1 %; 3 % for the Stribeck velocity, the sigmoid's steepness and the
+    quadratic law's viscous pair), and the
     RMS after is the noise; the fitted model's torques are the written-out law's."""
     rng = np.random.default_rng(40 + sorted(REFERENCE).index(name))
     _, dq = _sweep()
@@ -94,6 +101,8 @@ def test_every_law_recovers_its_own_simulated_parameters(name):
     rtol = np.full(P.shape, 0.01)
     if name in ("stribeck", "sigmoid"):
         rtol[:, 3 if name == "stribeck" else 1] = 0.03
+    if name == "quadratic":  # v and v |v| are correlated over a sweep: 3 % for fv and fq
+        rtol[:, :2] = 0.03
     assert np.all(np.abs(got - P) <= rtol * scale + 2e-3), (got, P)
     np.testing.assert_allclose(fit.rms_after, TAU_NOISE, rtol=0.05)
     v = np.linspace(-1.2, 1.2, 1001)[:, None] * np.ones(2)

@@ -192,7 +192,24 @@ def test_euler_rectangle_is_de_lucas_integral_form():
     np.testing.assert_allclose(r, ref, rtol=0, atol=1e-9)
 
 
-@pytest.mark.parametrize("name", sorted(LAWS))
+#: Laws the compiled step does not hold (the quadratic viscous term): evaluated in Python.
+PYTHON_LAWS = {"quadratic"}
+
+
+def test_a_law_without_a_canonical_form_is_evaluated_in_python():
+    """The quadratic law has no canonical form: the observer subtracts its own torques."""
+    law = LAWS["quadratic"]
+    model = law.model(np.array([[0.3, 0.2, 0.8, 0.1]] * 3), np.zeros(3))
+    assert canonical_friction(model, 3) is None
+    robot = dynid.Robot.from_mdh(
+        a=[0, 0.3, 0.3], d=[0.3, 0, 0], alpha=[0, np.pi / 2, 0], theta=[0, 0, 0],
+        mass=[1.0, 1.0, 1.0],
+    )  # fmt: skip
+    obs = MomentumObserver(ObserverModel(robot, np.zeros((3, 3)), model))
+    assert obs._python_friction
+
+
+@pytest.mark.parametrize("name", sorted(set(LAWS) - PYTHON_LAWS))
 def test_every_friction_law_has_a_canonical_form_equal_to_its_torques(name):
     """The compiled step's canonical friction equals each law's own torques, with a band,
     and through a coupled drive at the motors."""

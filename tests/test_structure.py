@@ -94,7 +94,7 @@ def test_armature_and_viscous_friction_are_chosen_by_default(panda, armature_log
     assert sel is not None and sel["chosen"] == "links + armature + viscous", sel
     assert sel["validation"].startswith("leave one recording out")
     names = [c["name"] for c in sel["candidates"]]
-    assert "links + viscous + coulomb + offset" in names and len(names) == 30
+    assert "links + viscous + coulomb + offset" in names and len(names) == 32
     rms = np.sqrt(np.mean((test.tau - _predict(model, held)) ** 2, axis=0))
     assert np.all(rms < 1.1 * NOISE), rms  # the held-out recording's noise, nothing more
     # without the armature (the structure of the paper) the same data predict far worse
@@ -153,6 +153,21 @@ def test_stribeck_friction_is_identified_with_the_links_and_its_velocity_chosen(
     assert model.fit.relative_error_percent < 1e-7
     # the model's own friction is the registry's Stribeck law with these parameters
     v = np.linspace(-1.0, 1.0, 41)[:, None] * np.ones(7)
+    np.testing.assert_allclose(_own(model).torques(v), fr.torques(v), atol=1e-7)
+
+
+def test_quadratic_viscous_friction_is_identified_with_the_links(panda):
+    """Exact data of an arm whose viscous friction grows with speed (fq dq |dq|): the
+    quadratic law is chosen and its parameters come back; validate and the observer
+    evaluate it as that law."""
+    P = np.column_stack([VISCOUS, np.full(7, 0.2), np.full(7, 0.3), np.zeros(7)])
+    fr = LawFriction(LAWS["quadratic"], P)
+    logs = [_recording(panda, s, fr, noise=SensorNoise.none(), duration=4.0) for s in (81, 82)]
+    model = identify_recordings(panda, logs, cutoff_hz=None)
+    assert model.info.selection["chosen"] == "links + viscous + quadratic + coulomb + offset"
+    assert model.info.friction.law == "quadratic"
+    np.testing.assert_allclose(model.friction, P, atol=1e-7)
+    v = np.linspace(-2.0, 2.0, 41)[:, None] * np.ones(7)
     np.testing.assert_allclose(_own(model).torques(v), fr.torques(v), atol=1e-7)
 
 

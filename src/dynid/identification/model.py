@@ -120,7 +120,7 @@ class IdentifiedModel:
         n = self.friction.shape[0]
         prefixes = [lab.rstrip("0123456789") for lab in fr.labels[: len(fr.labels) // n]]
         part = {"fv": "viscous", "fc": "smooth" if fr.law == "smooth" else "coulomb"}
-        part |= {"fsp": "stribeck", "fo": "offset"}
+        part |= {"fq": "quadratic", "fsp": "stribeck", "fo": "offset"}
         term = LinearFriction(
             Drive.identity(n),
             parts=tuple(part[p] for p in prefixes),

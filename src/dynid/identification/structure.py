@@ -240,8 +240,9 @@ class Selection:
 def candidate_structures(armature: bool = True) -> tuple[Structure, ...]:
     """The candidates, simplest first: every classical ladder of :data:`FRICTION_LADDER`,
     the smooth Coulomb at each of :data:`SMOOTH_WIDTHS` (with viscous friction, without
-    and with offsets) and the Stribeck law at each of :data:`STRIBECK_VELOCITIES` (with
-    viscous friction and offsets), without and (``armature``) with the armature."""
+    and with offsets), the quadratic viscous law and the Stribeck law at each of
+    :data:`STRIBECK_VELOCITIES` (with viscous friction, Coulomb friction and offsets),
+    without and (``armature``) with the armature."""
     arms = (False, True) if armature else (False,)
     out = []
     for a in arms:
@@ -251,6 +252,7 @@ def candidate_structures(armature: bool = True) -> tuple[Structure, ...]:
             for o in ((), ("offset",))
             for w in SMOOTH_WIDTHS
         ]
+        out.append(Structure(a, ("viscous", "quadratic", "coulomb", "offset")))
         out += [Structure(a, _CLASSICAL + ("stribeck",), vst=v) for v in STRIBECK_VELOCITIES]
     return tuple(out)
 
@@ -311,9 +313,10 @@ def _largest_terms(
     at = Drive.identity(n) if model_drive is None else model_drive
     b = tuple(band) if band else (0.0,) * n
     out: list[tuple[ModelTerm, Any]] = [(t, None) for t in terms]
-    classical = tuple(p for p in _CLASSICAL if any(p in c.friction for c in mine))
+    classical = tuple(p for p in _CLASSICAL + ("quadratic",) if any(p in c.friction for c in mine))
     if classical:
-        out.append((LinearFriction(at, parts=classical, band=b), ("classical", classical)))
+        t = LinearFriction(at, parts=classical, band=b)
+        out.append((t, ("classical", t.parts)))  # the parts in the term's column order
     for w in sorted({c.width for c in mine if "smooth" in c.friction}):
         t = LinearFriction(
             at, ("smooth",), band=b, width=smooth_width(b, w), name=f"friction smooth {w:g}"

@@ -300,7 +300,7 @@ def _route_parts(
 
 
 #: The laws whose parameters an identified model's ``friction`` may hold, with their count.
-_FRICTION_LAWS = {"classical": 3, "smooth": 3, "stribeck": 5}
+_FRICTION_LAWS = {"classical": 3, "smooth": 3, "quadratic": 4, "stribeck": 5}
 
 
 def _friction_law(law: Any) -> str:

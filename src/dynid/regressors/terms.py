@@ -129,13 +129,16 @@ class RotorInertia:
         return C
 
 
-#: The parts of :class:`LinearFriction`, in column order: viscous ``fv v``, Coulomb
+#: The parts of :class:`LinearFriction`, in column order: viscous ``fv v``, quadratic
+#: viscous ``fq v |v|``, Coulomb
 #: ``fc s(v)`` (0 inside the standstill band), smooth Coulomb ``fc tanh(v / w)`` (instead
 #: of ``coulomb``), the Stribeck bump ``(fs - fc) s(v) exp(-(v / v_st)^2)`` (beside
 #: ``coulomb``) and the offset ``fo`` (:mod:`dynid.regressors.friction_columns`).
-FRICTION_PARTS = ("viscous", "coulomb", "smooth", "stribeck", "offset")
-_PART_LABEL = {"viscous": "fv", "coulomb": "fc", "smooth": "fc", "stribeck": "fsp", "offset": "fo"}
-_PART_UNIT = {p: "N m" for p in FRICTION_PARTS} | {"viscous": "N m s/rad"}
+FRICTION_PARTS = ("viscous", "quadratic", "coulomb", "smooth", "stribeck", "offset")
+_PART_LABEL = {"viscous": "fv", "quadratic": "fq", "coulomb": "fc", "smooth": "fc"}
+_PART_LABEL |= {"stribeck": "fsp", "offset": "fo"}
+_PART_UNIT = {p: "N m" for p in FRICTION_PARTS}
+_PART_UNIT |= {"viscous": "N m s/rad", "quadratic": "N m s^2/rad^2"}
 
 
 @dataclass(frozen=True, slots=True, eq=False)
@@ -174,6 +177,10 @@ class LinearFriction:
             raise OptionError(f"friction parts must be among {FRICTION_PARTS}; got {self.parts}")
         if "smooth" in self.parts and "coulomb" in self.parts:
             raise OptionError("friction parts: smooth replaces coulomb; give one of them")
+        if len({"quadratic", "smooth", "stribeck"} & set(self.parts)) > 1:
+            raise OptionError(
+                "friction parts: quadratic, smooth and stribeck are laws of their own; give one"
+            )
         for key, v in (("band", self.band), ("width", self.width)):
             if v and len(v) != self.drive.n:
                 raise OptionError(f"{key} must have {self.drive.n} entries; got {len(v)}")
@@ -187,10 +194,11 @@ class LinearFriction:
     @property
     def law(self) -> str:
         """The registry law the coefficients are parameters of (:meth:`as_array`):
-        ``"stribeck"``, ``"smooth"`` or ``"classical"``."""
-        if "stribeck" in self.parts:
-            return "stribeck"
-        return "smooth" if "smooth" in self.parts else "classical"
+        ``"stribeck"``, ``"smooth"``, ``"quadratic"`` or ``"classical"``."""
+        for law in ("stribeck", "smooth", "quadratic"):
+            if law in self.parts:
+                return law
+        return "classical"
 
     @property
     def law_band(self) -> tuple[float, ...]:
@@ -221,8 +229,8 @@ class LinearFriction:
 
     def as_array(self, params: NDArray[np.float64]) -> NDArray[np.float64]:
         """The coefficients (p,) as the parameters (n, k) of :attr:`law`: ``fv, fc, fo``
-        (classical, smooth) or ``fv, fc, fs, vst, fo`` (Stribeck, ``fs = fc + fsp``); 0 for
-        parts not held."""
+        (classical, smooth), ``fv, fq, fc, fo`` (quadratic) or ``fv, fc, fs, vst, fo``
+        (Stribeck, ``fs = fc + fsp``); 0 for parts not held."""
         n, k = self.drive.n, len(self.parts)
         c = dict(zip(self.parts, np.reshape(params, (n, k)).T, strict=True))
         z = np.zeros(n)
@@ -230,6 +238,8 @@ class LinearFriction:
         if self.law == "stribeck":
             cols = [c.get("viscous", z), fc, fc + c["stribeck"], np.full(n, self.vst)]
             return np.column_stack(cols + [c.get("offset", z)])
+        if self.law == "quadratic":
+            return np.column_stack([c.get("viscous", z), c["quadratic"], fc, c.get("offset", z)])
         return np.column_stack([c.get("viscous", z), fc, c.get("offset", z)])
 
     def torque_columns(
@@ -244,6 +254,7 @@ class LinearFriction:
         band = np.asarray(self.band, dtype=np.float64) if self.band else np.zeros(n)
         col = {
             "viscous": lambda: v,
+            "quadratic": lambda: v * np.abs(v),
             "coulomb": lambda: standstill_sign(v, band),
             "smooth": lambda: smooth_sign(v, np.asarray(self.width)),
             "stribeck": lambda: standstill_sign(v, band) * stribeck_decay(v, self.vst),

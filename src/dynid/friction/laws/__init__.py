@@ -6,6 +6,7 @@ name           law                                                          fit
 ``none``       ``0`` (no extra friction)                                    none
 ``classical``  ``fv dq + fc s(dq) + fo`` (Gaz et al. 2019, eq. 24)          bounded linear
 ``smooth``     ``fv dq + fc tanh(dq / v_s) + fo``, ``v_s`` the noise band   bounded linear
+``quadratic``  ``fv dq + fq dq |dq| + fc s(dq) + fo``                       bounded linear
 ``asymmetric`` ``fv+ dq+ + fv- dq- + fc+ [s > 0] - fc- [s < 0]``            bounded linear
 ``stribeck``   ``fv dq + (fc + (fs - fc) exp(-(dq/vst)^2)) s(dq) + fo``     var. projection
 ``sigmoid``    Gaz et al. 2019, eq. 25                                      Nelder-Mead
@@ -22,7 +23,7 @@ in :data:`LAWS`, and its test.
 from __future__ import annotations
 
 from ...exceptions import OptionError
-from . import asymmetric, classical, none, sigmoid, smooth, stribeck
+from . import asymmetric, classical, none, quadratic, sigmoid, smooth, stribeck
 from .base import FrictionLaw
 
 __all__ = ["LAWS", "FrictionLaw", "law_named"]
@@ -34,6 +35,7 @@ LAWS: dict[str, FrictionLaw] = {
         none.LAW,
         classical.LAW,
         smooth.LAW,
+        quadratic.LAW,
         asymmetric.LAW,
         stribeck.LAW,
         sigmoid.LAW,
