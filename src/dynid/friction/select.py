@@ -9,7 +9,9 @@ to:
    :data:`FOLDS` contiguous blocks of equal length (contiguous, not shuffled: neighbouring
    samples of a filtered log are correlated, and a shuffled split would leak them), the
    blocks of the identification's own held-out judgement
-   (:func:`~dynid.identification.holdout.block_labels`).
+   (:func:`~dynid.identification.holdout.block_labels`); the residual of several
+   recordings (:func:`~dynid.friction.recordings.pieces_residual`) is split by recording
+   instead, one recording left out at a time, as identification does.
 2. For each block, every candidate law is fitted (:func:`~dynid.friction.fit.fit_law_through`,
    so a drive's motors are fitted where its friction acts) on the other blocks and predicts
    the held-out block.
@@ -18,7 +20,8 @@ to:
    (each sample is held out once; :func:`~dynid.identification.metrics.relative_error_percent`);
    the training error is that of the law fitted on the whole log, on the whole log.
 4. The candidate with the lowest held-out error is kept (on a tie, the earlier of
-   :data:`~dynid.friction.laws.LAWS`: the simpler) and fitted on the whole log.
+   :data:`~dynid.friction.laws.LAWS`: the simpler; ``own`` last, since it ties with its
+   own law refitted on these data) and fitted on the whole log.
 
 The candidates are the laws of the registry (``none``: no extra friction, the rigid model
 alone) and, when the model comes with friction of its own (an identification's classical
@@ -88,19 +91,22 @@ class FrictionSelection:
     scores : tuple of CandidateScore
         Every candidate, in registry order (``own`` first when present).
     folds : int
-        Number of blocks.
+        Number of blocks (recordings when one is left out at a time).
+    method : str
+        How the held-out blocks were made.
     """
 
     fit: FrictionFit
     chosen: str
     scores: tuple[CandidateScore, ...]
     folds: int
+    method: str = "contiguous-block cross-validation"
 
     def as_dict(self) -> dict[str, object]:
         """JSON-ready: ``folds``, ``chosen`` and one row per candidate (``model``,
         ``parameters``, ``train_error_percent``, ``heldout_error_percent``)."""
         return {
-            "method": "contiguous-block cross-validation",
+            "method": self.method,
             "folds": self.folds,
             "chosen": self.chosen,
             "candidates": [
@@ -168,7 +174,8 @@ def select_friction(
     own : FrictionModel, optional
         The model's own friction, a candidate as it is (``"own"``).
     folds : int
-        Number of contiguous blocks (>= 2).
+        Number of contiguous blocks (>= 2); not used when ``res`` holds several
+        recordings (one is left out at a time).
 
     Returns
     -------
@@ -190,7 +197,7 @@ def select_friction(
     unknown = [c for c in names if c not in LAWS]
     if unknown:
         raise OptionError(f"--friction-model must be one of {', '.join(LAWS)}; got {unknown[0]!r}")
-    labels = block_labels(res.dq.shape[0], folds)
+    labels, folds, method = _folds(res, folds)
     r = res.residual
     scale = float(np.linalg.norm(res.log.tau)) or 1.0
 
@@ -215,8 +222,20 @@ def select_friction(
         train = err(fits[name].friction.torques(res.dq))
         held = err(_heldout_torques(res, drive, name, labels))
         scores.append(CandidateScore(name, LAWS[name].params, train, held))
-    best = min(scores, key=lambda s: s.heldout_error_percent)  # first of the lowest: simpler
-    return FrictionSelection(fits[best.name], best.name, tuple(scores), folds)
+    # first of the lowest: the simpler law; ``own`` ties with its own law refitted on these
+    # data (judged the same way), and the refitted law is kept
+    best = min(scores, key=lambda s: (s.heldout_error_percent, s.name == OWN))
+    return FrictionSelection(fits[best.name], best.name, tuple(scores), folds, method)
+
+
+def _folds(res: FrictionResidual, folds: int) -> tuple[NDArray[np.intp], int, str]:
+    """Each sample's held-out block, the number of blocks and how they were made."""
+    rec = res.recording
+    if rec is not None and np.unique(rec).size > 1:
+        _, labels = np.unique(rec, return_inverse=True)
+        k = int(labels.max()) + 1
+        return labels.astype(np.intp), k, f"leave one recording out ({k} recordings)"
+    return block_labels(res.dq.shape[0], folds), folds, "contiguous-block cross-validation"
 
 
 def _own_fit(own: FrictionModel, res: FrictionResidual) -> FrictionFit:
