@@ -18,10 +18,12 @@ import dynid
 from dynid.cli.__main__ import main
 from dynid.exceptions import DataError, DynidWarning, OptionError
 from dynid.friction.model import ClassicalFriction
+from dynid.io.static_data import save_static_data
 from dynid.io.torque_log import load_torque_log, save_torque_log
 from dynid.simulation.measurement import SensorNoise, sample_times, simulate_measurement
 from dynid.simulation.trajectories import random_fourier
 from dynid.workflows.friction import fit_friction_file
+from dynid.workflows.payload import identify_payload_files
 from dynid.workflows.validate import ValidateOptions, validate_files
 
 NOISE = 0.05  # N m, the simulated torque sensor noise (SensorNoise's default)
@@ -265,3 +267,57 @@ def test_a_piece_too_short_to_filter_is_named_and_a_recording_without_one_refuse
         warnings.simplefilter("ignore", DynidWarning)
         with pytest.raises(DataError, match="stub.csv: no piece long enough to filter"):
             validate_files(panda, [files / "rec1.csv", tmp_path / "stub.csv"])
+
+
+# --- payload -----------------------------------------------------------------------------
+
+LOAD_MASS = 0.83  # kg
+LOAD_COM = np.array([0.012, -0.021, 0.064])  # m, in the flange frame
+LOAD_INERTIA = np.diag([0.0021, 0.0032, 0.0043])  # kg m^2 about the CoM
+
+
+@pytest.fixture(scope="module")
+def loaded_files(tmp_path_factory):
+    """Two recordings of the Panda carrying a known load (no friction), 200 Hz, each
+    with a 0.5 s gap, and the arm without the load."""
+    arm = dynid.panda().with_friction(None)
+    loaded = arm.with_tool(np.eye(4), LOAD_MASS, LOAD_COM, LOAD_INERTIA, name="load")
+    d = tmp_path_factory.mktemp("payload")
+    for s in (41, 42):
+        traj = random_fourier(arm, np.random.default_rng(s), q0=dynid.PANDA_NEUTRAL_Q)(
+            sample_times(8.0, 200.0)
+        )
+        log = simulate_measurement(loaded, traj, rng=np.random.default_rng(s + 100))
+        save_torque_log(d / f"load{s}.csv", log.select(~((log.t > 3.0) & (log.t < 3.5))))
+    return arm, d
+
+
+def test_a_load_is_identified_from_several_recordings_with_gaps(loaded_files, tmp_path, capsys):
+    """Two recordings of the loaded arm, cut by gaps into four pieces, each filtered on
+    its own: the mass and the CoM come back within four reported standard deviations;
+    dynid payload prints the pieces of each file."""
+    arm, d = loaded_files
+    paths = [d / "load41.csv", d / "load42.csv"]
+    res = identify_payload_files(arm, paths)
+    est = res.estimate
+    assert [r["pieces"] for r in res.recordings] == [2, 2]
+    assert est.route == "4 torque logs"
+    assert abs(est.mass - LOAD_MASS) < 4 * est.std_mass + 1e-3
+    assert np.all(np.abs(est.com - LOAD_COM) < 4 * est.std_com + 1e-3)
+    # the gaps bridged by interpolation (--max-gap 1): the mass is off by several stds
+    bridged = identify_payload_files(arm, paths, max_gap_s=1.0).estimate
+    assert abs(bridged.mass - LOAD_MASS) > 5 * abs(est.mass - LOAD_MASS)
+    argv = ["payload", "--robot", "panda", "--data", *map(str, paths), "--out", str(tmp_path)]
+    assert main(argv) == 0
+    assert "load41.csv: 2 pieces" in capsys.readouterr().out
+
+
+def test_payload_static_data_stay_one_file(tmp_path):
+    """Static data come in one file: two are refused in one line naming the first."""
+    panda = dynid.panda()
+    ctrl = dynid.SimulatedController(panda, rng=np.random.default_rng(5))
+    data = dynid.acquire_static(ctrl, 20, np.random.default_rng(6))
+    for name in ("s1.csv", "s2.csv"):
+        save_static_data(tmp_path / name, data)
+    with pytest.raises(DataError, match=r"s1.csv holds static data: give one static data file"):
+        identify_payload_files(panda, [tmp_path / "s1.csv", tmp_path / "s2.csv"])

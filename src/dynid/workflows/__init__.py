@@ -12,6 +12,8 @@ command applies, so that the Python API and the ``dynid`` commands behave the sa
   or more log files (the law chosen on held-out blocks, or the one asked for).
 * :mod:`~dynid.workflows.validate`: a model validated against one or more log files
   (typed options in, errors pooled and per recording out).
+* :mod:`~dynid.workflows.payload`: a load identified on a known arm from static data or
+  one or more torque logs.
 * :mod:`~dynid.workflows.recordings`: several torque recordings read for a model, each
   problem one line naming the file.
 
