@@ -228,7 +228,7 @@ def test_a_recording_of_another_joint_count_is_named(panda, files, tmp_path):
         validate_files(panda, [files / "rec1.csv", tmp_path / "six.csv"])
 
 
-def test_a_recording_in_other_units_is_named(panda, files, tmp_path):
+def test_a_recording_in_other_units_is_named(panda, files, tmp_path, capsys):
     """A recording in mN m, or with its time in milliseconds, beside recordings in SI
     units: refused, the file named, through the API and the command alike."""
     log = load_torque_log(files / "rec2.csv")
@@ -238,6 +238,12 @@ def test_a_recording_in_other_units_is_named(panda, files, tmp_path):
         validate_files(panda, [files / "rec1.csv", tmp_path / "mnm.csv"])
     with pytest.raises(DataError, match="ms.csv: its velocities against the derivative"):
         fit_friction_file(panda, [files / "rec1.csv", tmp_path / "ms.csv"])
+    with pytest.raises(DataError) as api:
+        validate_files(panda, [files / "rec1.csv", tmp_path / "mnm.csv"])
+    argv = ["validate", "--robot", "panda", "--out", str(tmp_path / "v"), "--data"]
+    assert main([*argv, str(files / "rec1.csv"), str(tmp_path / "mnm.csv")]) == 2
+    err = [s for s in capsys.readouterr().err.splitlines() if s.strip()]
+    assert len(err) == 1 and err[0].endswith(str(api.value))
 
 
 def test_a_recording_of_another_robot_is_named(panda, files, tmp_path):
