@@ -402,6 +402,7 @@ VERDICTS = {
     "friction": ("Friction law chosen:", True),
     "validate": ("The model predicts the log's torques to", True),
     "retrieve": ("The link parameters are physically consistent", False),
+    "payload": ("The payload weighs 1 kg", False),
 }
 
 
@@ -444,10 +445,10 @@ def _identification_doc(runs: Path) -> dict:
 
 @pytest.mark.slow
 def test_model_structure_table_marks_the_chosen_candidate(runs, tmp_path):
-    """An identification record with ``selection`` gets the model-structure table, the
-    chosen candidate's row marked; one without it renders without that table."""
+    """An identification record with ``metadata.selection`` gets the model-structure table,
+    the chosen candidate's row marked; one without it renders without that table."""
     doc = _identification_doc(runs)
-    doc["selection"] = {
+    doc["metadata"]["selection"] = {
         "rule": "lowest held-out error within one standard error",
         "validation": "5 contiguous time blocks",
         "chosen": "classical",
@@ -468,7 +469,7 @@ def test_model_structure_table_marks_the_chosen_candidate(runs, tmp_path):
     assert structure[2][:2] == ["\u2713 chosen", "classical"] and structure[1][0] == ""
     assert '<tr class="marked"><td>&#10003; chosen</td><td>classical' in page_text
     assert "Terms chosen: classical" in " ".join(" ".join(page.text).split())
-    del doc["selection"]
+    del doc["metadata"]["selection"]
     p.write_text(json.dumps(doc))
     page = Page(render_html_report(RunSummary(command="identify"), {p.name: p}, out=tmp_path))
     assert not any("candidate" in t[0] for t in page.tables)

@@ -27,6 +27,7 @@ from dynid.dynamics.terms import gravity_torques_numpy, mass_matrix_numpy
 from dynid.kinematics import forward as forward_module
 from dynid.kinematics.forward import fk_numpy, frame_pose_in_link, link_poses_numpy
 from dynid.kinematics.jacobian import jacobian_numpy
+from dynid.observer.terms import momentum_terms, momentum_terms_numpy
 from dynid.regressors.static import static_regressor_numpy
 from dynid.regressors.torque import torque_regressor, torque_regressor_numpy
 
@@ -113,6 +114,11 @@ PAIRS = {
         dynid.static_regressor,
         static_regressor_numpy,
         lambda r, q, v, a: (r, q),
+    ),
+    "momentum_terms": (
+        lambda r, q, v: np.concatenate(momentum_terms(r, q, v), axis=-1),
+        lambda r, q, v: np.concatenate(momentum_terms_numpy(r, q, v), axis=-1),
+        lambda r, q, v, a: (r, q, v),
     ),
 }
 

@@ -18,6 +18,7 @@ LAYERS = [
     {"friction"},
     {"simulation"},
     {"feasibility"},
+    {"observer"},
     {"pipeline"},
     {"io"},
     {"report"},

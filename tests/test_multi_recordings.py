@@ -23,6 +23,7 @@ from dynid.io.torque_log import load_torque_log, save_torque_log
 from dynid.simulation.measurement import SensorNoise, sample_times, simulate_measurement
 from dynid.simulation.trajectories import random_fourier
 from dynid.workflows.friction import fit_friction_file
+from dynid.workflows.identify import identify_file
 from dynid.workflows.payload import identify_payload_files
 from dynid.workflows.validate import ValidateOptions, validate_files
 
@@ -163,15 +164,23 @@ def test_friction_is_recovered_from_several_recordings(panda, files):
 
 
 def test_the_own_friction_is_judged_on_the_same_recordings(panda, files):
-    """The Panda's own sigmoid friction, the truth of rec1/rec2: judged on the recording
-    left out by its law refitted on the other, it ties with the sigmoid law and the
-    sigmoid law is kept."""
+    """A model identified from rec1 and rec2: on those recordings its friction is judged by
+    its law refitted on the recording left out, exactly as that law is, and a tie keeps the
+    refitted law; the robot's own (true) friction on recordings new to it is judged as it
+    is, and predicts them best."""
+    paths = [files / "rec1.csv", files / "rec2.csv"]
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", DynidWarning)
-        res = fit_friction_file(panda, [files / "rec1.csv", files / "rec2.csv"])
-    held = {s.name: s.heldout_error_percent for s in res.selection.scores}
-    assert held["own"] == held["sigmoid"] == min(held.values())
-    assert res.selection.chosen == "sigmoid"
+        model = identify_file(panda, paths)
+        sel = fit_friction_file(model, paths).selection
+        robot = fit_friction_file(panda, paths).selection
+    held = {s.name: s.heldout_error_percent for s in sel.scores}
+    law = model.info.friction.law
+    assert sel.scores[-1].name == "own" and held["own"] == pytest.approx(held[law], rel=1e-12)
+    assert sel.chosen != "own" and sel.method.startswith("leave one recording out")
+    held_r = {s.name: s.heldout_error_percent for s in robot.scores}
+    assert robot.scores[0].name == "own"
+    assert held_r["own"] <= 1.01 * min(held_r.values())
 
 
 # --- one line naming the file, never a silently dropped recording ----------------------

@@ -37,8 +37,8 @@ def test_friction_stage_refuses_a_truth_without_link_parameters():
 
 
 def test_run_demo_chains_the_stages_and_reports_progress(monkeypatch):
-    """run_demo runs stages 1-5 in order, hands stages 3 and 4 the kinematics-only model and
-    the fitted friction, and brackets every stage with started/finished events."""
+    """run_demo runs stages 1-6 in order, hands stages 3, 4 and 6 the kinematics-only model
+    and the fitted friction, and brackets every stage with started/finished events."""
     import dynid.pipeline.demo as demo
     from dynid.pipeline import StageFinished, StageStarted, run_demo
 
@@ -63,6 +63,7 @@ def test_run_demo_chains_the_stages_and_reports_progress(monkeypatch):
     monkeypatch.setattr(demo, "friction_stage", stage("friction", fric))
     monkeypatch.setattr(demo, "feasible_stage", stage("feasible", "f"))
     monkeypatch.setattr(demo, "consistent_stage", stage("consistent", "c"))
+    monkeypatch.setattr(demo, "collision_stage", stage("collision", "x"))
     events = []
     res = run_demo(robot, 7, progress=events.append)
     assert [c[0] for c in calls] == [
@@ -71,9 +72,10 @@ def test_run_demo_chains_the_stages_and_reports_progress(monkeypatch):
         "friction",
         "feasible",
         "consistent",
+        "collision",
     ]
     assert [(type(e), e.number) for e in events] == [
-        (t, k) for k in range(1, 6) for t in (StageStarted, StageFinished)
+        (t, k) for k in range(1, 7) for t in (StageStarted, StageFinished)
     ]
     np.testing.assert_array_equal(calls[0][1][1], robot.q_neutral)
     handed = calls[2][1][0]
@@ -81,3 +83,18 @@ def test_run_demo_chains_the_stages_and_reports_progress(monkeypatch):
     assert calls[3][1][0] is handed and calls[3][2]["truth"] is robot
     assert calls[3][2]["friction"] == "fitted friction" and calls[3][2]["seed"] == 7
     assert (res.kinematics, res.feasible, res.consistent, res.seed) == ("k", "f", "c", 7)
+    assert res.collision == "x" and calls[5][1][:2] == (handed, "fitted friction")
+    assert calls[5][2]["truth"] is robot
+
+
+def test_collision_stage_finds_the_push_with_the_identified_model():
+    """Stage 6 with the exact model and the true friction: one event, at the push, found
+    within 20 ms, the residual within 0.2 N m (RMS) of the true external torque's lag."""
+    from dynid.friction.model import SigmoidFriction
+    from dynid.pipeline import collision_stage
+
+    robot = dynid.panda()
+    model = kinematics_only(_model(robot))
+    res = collision_stage(model, SigmoidFriction.from_array(robot.friction), 0, truth=robot)
+    assert len(res.events) == 1 and res.delay is not None and 0 <= res.delay < 0.02
+    assert np.all(res.residual_error_rms < 0.2)

@@ -16,7 +16,9 @@ import pytest
 import dynid
 from dynid.cli.__main__ import main
 from dynid.exceptions import DynidWarning, OptionError
-from dynid.friction.model import ClassicalFriction
+from dynid.friction.laws import LAWS
+from dynid.friction.model import ClassicalFriction, LawFriction
+from dynid.friction.validation import own_friction
 from dynid.identification.log import TorqueLog, prepare_log, with_derived_velocities
 from dynid.identification.recordings import prepare_recordings, split_at_gaps, unwrapped
 from dynid.identification.structure import Structure, identify_recordings
@@ -48,10 +50,14 @@ def _recording(robot, seed, friction, *, armature=None, noise=None, duration=8.0
     )
 
 
+def _own(model):
+    """The friction that comes with an identified model."""
+    return own_friction(model)
+
+
 def _predict(model, log):
     """The model's joint torques (friction included) on a log's true states."""
-    own = ClassicalFriction.from_array(model.friction, model.info.friction.band or None)
-    return model.torques(log.q, log.dq, log.ddq) + own.torques(log.dq)
+    return model.torques(log.q, log.dq, log.ddq) + _own(model).torques(log.dq)
 
 
 @pytest.fixture(scope="module")
@@ -88,7 +94,7 @@ def test_armature_and_viscous_friction_are_chosen_by_default(panda, armature_log
     assert sel is not None and sel["chosen"] == "links + armature + viscous", sel
     assert sel["validation"].startswith("leave one recording out")
     names = [c["name"] for c in sel["candidates"]]
-    assert "links + viscous + coulomb + offset" in names and len(names) == 10
+    assert "links + viscous + coulomb + offset" in names and len(names) == 30
     rms = np.sqrt(np.mean((test.tau - _predict(model, held)) ** 2, axis=0))
     assert np.all(rms < 1.1 * NOISE), rms  # the held-out recording's noise, nothing more
     # without the armature (the structure of the paper) the same data predict far worse
@@ -103,15 +109,18 @@ def test_armature_and_viscous_friction_are_chosen_by_default(panda, armature_log
 
 def test_terms_the_data_do_not_support_are_left_out(panda):
     """A rigid arm with viscous and Coulomb friction and no armature: the armature and the
-    offsets are not chosen; Coulomb friction is."""
+    offsets are not chosen; Coulomb friction is (sharp or smooth)."""
     fr = ClassicalFriction(VISCOUS, np.linspace(0.6, 0.2, 7), np.zeros(7))
     logs = [_recording(panda, s, fr) for s in (11, 12)]
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", DynidWarning)
         model = identify_recordings(panda, logs)
-    assert model.info.selection["chosen"] == "links + viscous + coulomb"
+    terms = model.info.selection["chosen"].split(" + ")
+    assert "armature" not in terms and "offset" not in terms, terms
+    assert "coulomb" in terms or any(t.startswith("smooth") for t in terms), terms
     assert model.drive is None and model.rotor_inertia is None
-    np.testing.assert_allclose(model.friction[:, 1], fr.as_array()[:, 1], atol=0.05)
+    # the Coulomb level (sharp or smooth: the filtered torques round its reversals)
+    np.testing.assert_allclose(model.friction[:, 1], fr.as_array()[:, 1], atol=0.06)
 
 
 def test_exact_data_give_the_true_structure_at_round_off(panda):
@@ -129,6 +138,22 @@ def test_exact_data_give_the_true_structure_at_round_off(panda):
     np.testing.assert_allclose(model.friction[:, 0], VISCOUS, atol=1e-8)
     # the rotors of joints 1 and 2 regroup with link parameters; the others stand alone
     np.testing.assert_allclose(model.rotor_inertia[2:], ARMATURE[2:], rtol=1e-6)
+
+
+def test_stribeck_friction_is_identified_with_the_links_and_its_velocity_chosen(panda):
+    """Exact data of an arm with Stribeck friction (v_st = 0.05 rad/s): the Stribeck law at
+    0.05 rad/s is chosen among the candidates' velocities and its parameters come back."""
+    P = np.column_stack([VISCOUS, np.full(7, 0.4), np.full(7, 0.9), np.full(7, 0.05), np.zeros(7)])
+    fr = LawFriction(LAWS["stribeck"], P)
+    logs = [_recording(panda, s, fr, noise=SensorNoise.none(), duration=4.0) for s in (61, 62)]
+    model = identify_recordings(panda, logs, cutoff_hz=None)
+    assert model.info.selection["chosen"] == "links + viscous + coulomb + stribeck:0.05 + offset"
+    assert model.info.friction.law == "stribeck"
+    np.testing.assert_allclose(model.friction, P, atol=1e-7)
+    assert model.fit.relative_error_percent < 1e-7
+    # the model's own friction is the registry's Stribeck law with these parameters
+    v = np.linspace(-1.0, 1.0, 41)[:, None] * np.ones(7)
+    np.testing.assert_allclose(_own(model).torques(v), fr.torques(v), atol=1e-7)
 
 
 def test_a_log_with_gaps_is_cut_into_pieces_never_joined(panda):

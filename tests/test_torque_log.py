@@ -272,3 +272,40 @@ def test_npz_bombs_and_absurd_headers_are_refused_before_reading(tmp_path, monke
     np.savez(tmp_path / "c.npz", q=q, M=np.zeros((5, 2, 2)), g=np.zeros((5, 2)))
     with pytest.raises(DataError, match="array 'q' must be real numbers; got dtype complex128"):
         load_static_npz(tmp_path / "c.npz")
+
+
+def test_extra_columns_are_ignored_with_a_warning_and_read_back_by_name(tmp_path, caplog):
+    """A label column and tau_ext1..n beside the log (as simulate --contact writes them) are
+    ignored by the reader, with a warning naming them; load_joint_columns reads them."""
+    import logging
+
+    from dynid.identification.log import TorqueLog
+    from dynid.io.columns import load_joint_columns
+    from dynid.io.torque_log import load_torque_log, save_torque_log_pieces
+
+    rng = np.random.default_rng(0)
+    N, n = 50, 3
+    log = TorqueLog(
+        t=np.arange(N) * 1e-3, q=rng.normal(size=(N, n)), dq=rng.normal(size=(N, n)),
+        tau=rng.normal(size=(N, n)),
+    )  # fmt: skip
+    ext = rng.normal(size=(N, n))
+    for suffix in (".csv", ".npz"):
+        path = tmp_path / f"log{suffix}"
+        save_torque_log_pieces(
+            path, lambda: (log,), n=n, n_rows=N, extra=("tau_ext", lambda: (ext,))
+        )
+        with caplog.at_level(logging.WARNING):
+            back = load_torque_log(path)
+        assert "tau_ext" in caplog.text and "ignored" in caplog.text
+        np.testing.assert_array_equal(back.tau, log.tau)
+        np.testing.assert_array_equal(load_joint_columns(path, "tau_ext", n), ext)
+        assert load_joint_columns(path, "vendor_tau", n) is None
+        caplog.clear()
+    text = (tmp_path / "log.csv").read_text().splitlines()
+    text[2] += ",label"
+    text[3:] = [row + ",contact" for row in text[3:]]
+    (tmp_path / "labelled.csv").write_text("\n".join(text) + "\n")
+    with caplog.at_level(logging.WARNING):
+        np.testing.assert_array_equal(load_torque_log(tmp_path / "labelled.csv").q, log.q)
+    assert "label" in caplog.text

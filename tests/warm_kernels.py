@@ -8,7 +8,8 @@ before the workers exist; they then load the kernels from the cache. Nothing her
 checked: a kernel left out is compiled by the first test that needs it, as before.
 
 Usage: ``python tests/warm_kernels.py GROUP`` with GROUP 0 (kinematics, inverse kinematics
-included) or 1 (dynamics and regressors); each takes about a minute on one core.
+included, and the momentum observer) or 1 (dynamics and regressors); each takes about a
+minute on one core.
 """
 
 from __future__ import annotations
@@ -40,6 +41,13 @@ def warm(group: int) -> None:
         dynid.forward_dynamics(robot, x, v, v)
         dynid.static_regressor(robot, x)
         dynid.torque_regressor(robot, x, v, v)
+    if group == 0:  # the observer (group 0 is the shorter one)
+        from dynid.observer import MomentumObserver, from_robot, momentum_terms
+
+        momentum_terms(robot, Q, Q)
+        obs = MomentumObserver(from_robot(robot))
+        obs.run(np.arange(3.0), Q, Q, Q)
+        obs.step(q, q, q, 5.0)
 
 
 if __name__ == "__main__":

@@ -260,7 +260,7 @@ __all__ = [
 #: subpackages and modules reachable as attributes (``dynid.spatial``), imported on first use
 _SUBMODULES = frozenset(
     (
-        "cli dynamics feasibility friction identification io kinematics model plots "
+        "cli dynamics feasibility friction identification io kinematics model observer plots "
         "regressors signals simulation spatial"
     ).split()
 )

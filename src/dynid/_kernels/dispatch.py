@@ -133,6 +133,10 @@ KERNELS: dict[str, Kernel] = _kernel_table(
         "dynid.regressors.torque:torque_regressor_numpy",
     ),
     Kernel("ik", "ik", "solve_batch", "dynid.kinematics._ik_numpy:solve_numpy", one="solve_one"),
+    Kernel(
+        "momentum_terms", "observer", "momentum_terms",
+        "dynid.observer.terms:momentum_terms_numpy",
+    ),
 )  # fmt: skip
 
 

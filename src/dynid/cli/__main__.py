@@ -60,6 +60,7 @@ SUBCOMMANDS = (
     "simulate",
     "friction",
     "validate",
+    "observe",
     "retrieve",
     "payload",
     "export",

@@ -60,7 +60,7 @@ from .demo_stages import (
     save_kinematics,
     save_paper_comparison,
 )
-from .summaries import progress_printer
+from .summaries import format_collision_stage, progress_printer
 
 NAME = "demo"
 #: ``--out`` is a folder: its files are one output set (:mod:`dynid.io.run_output`).
@@ -119,6 +119,8 @@ class _Renderer:
         elif number == 5:
             say(format_consistent_stage(res))
             self._record(save_consistent(out / "consistent", res))
+        elif number == 6:
+            say(format_collision_stage(res))
 
 
 def register(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParser:

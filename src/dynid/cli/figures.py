@@ -16,9 +16,13 @@ from ..friction.fit import FrictionFit, FrictionResidual
 from ..friction.validation import Validation
 from ..identification.model import IdentifiedModel
 from ..io.json_files import save_json
+from ..io.observer_files import observation_names
+from ..observer.detection import threshold_series
+from ..observer.results import ObserveResult
 from ..plots import feasible as feasible_plots
 from ..plots import friction as friction_plots
 from ..plots import identification as identification_plots
+from ..plots import observer as observer_plots
 from ..plots import torques as torque_plots
 from ..workflows.data_files import column_map, read_torque_log
 from .common import save_figure
@@ -26,6 +30,7 @@ from .common import save_figure
 __all__ = [
     "save_friction_figure",
     "save_identify_figures",
+    "save_observer_figures",
     "save_retrieval_figure",
     "save_validation_figures",
 ]
@@ -118,3 +123,22 @@ def save_identify_figures(out: Path, model: IdentifiedModel, args: Any) -> list[
         ),
     ]
     return [p for p in paths if p is not None]
+
+
+def save_observer_figures(out: Path, result: ObserveResult, *, names: list[str]) -> list[Path]:
+    """``out/<residuals name>.png`` of every log: residual, thresholds, events, and the true
+    external torques stored beside a simulated log (those skipped are left out)."""
+    paths = []
+    for x, stem in zip(result.logs, observation_names(result.logs), strict=True):
+        contact, collision = threshold_series(result.thresholds, x.t.shape[0], x.std)
+
+        def draw(x: Any = x, c: Any = contact, k: Any = collision) -> Any:
+            return observer_plots.plot_residuals(
+                x.t, x.r, c, k, events=x.events, tau_ext=x.tau_ext, joint_names=names,
+                title=f"momentum observer on {x.path.name}: residual, thresholds, events",
+            )  # fmt: skip
+
+        fig = save_figure(draw, Path(out) / f"{stem}.png")
+        if fig is not None:
+            paths.append(fig)
+    return paths

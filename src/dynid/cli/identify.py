@@ -18,8 +18,10 @@ A log without velocity columns gets its velocities from the positions at that cu
 
 Model structure. Beside the links' base parameters a torque log may need an armature
 (I_a ddq per joint; with a drive file, the rotor inertias at the motors), viscous and
-Coulomb friction (sign(dq) off inside each joint's velocity noise band) and torque
-offsets. By default every combination is fitted and judged on data it was not fitted to
+Coulomb friction (sign(dq) off inside each joint's velocity noise band, or a smooth
+tanh(dq/w) at three widths w), a Stribeck bump exp(-(dq/vst)^2) at four Stribeck
+velocities, and torque offsets, each identified with the links. By default every
+combination is fitted and judged on data it was not fitted to
 (one recording left out at a time when there are several, else --folds contiguous time
 blocks, or --validate-on), and the simplest within one standard error of the lowest
 held-out error is kept. The summary prints the table of candidates and the choice;
@@ -135,8 +137,9 @@ def register(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParser:
         default=None,
         metavar="TERMS",
         help="torque logs: the model's terms beside the links, comma-separated from armature, "
-        "viscous, coulomb, offset ('links' for none); default: chosen on held-out data "
-        "(see Model structure above)",
+        "viscous, coulomb, smooth[:W], stribeck[:V], offset ('links' for none; W the smooth "
+        "Coulomb's width in standstill bands, V the Stribeck velocity [rad/s]); default: "
+        "chosen on held-out data (see Model structure above)",
     )
     add_column_options(p)
     p.add_argument("--out", type=output_path, required=True, help="output folder")

@@ -12,12 +12,19 @@ The measured torques are M ddq + c + g + friction(dq) + noise, with the robot's 
 friction (the published sigmoid for the built-in Panda), or any law of a friction.json
 (--friction FILE, as `dynid friction` writes it), unless --no-friction. With --drive
 the drive's known rotor inertias are added and the log is written on its side (motor
-positions and torques, or currents) with its encoder offsets. Limits are
+positions and torques, or currents) with its encoder offsets. --contact
+FRAME:WRENCH:START,END pushes with a wrench (fx,fy,fz [N] and optionally mx,my,mz [N m],
+base axes) at a frame's origin (a link, flange) over a window [s] (repeatable;
+--contact-ramp rounds the edges): the arm still follows the trajectory, so its torques
+lose tau_ext = J^T w, and the true external joint torques are written beside the log as
+columns tau_ext1..n (every reader of the log ignores them; `dynid observe` plots them).
+Limits are
 checked; by default a trajectory that exceeds them is scaled down in amplitude
 (--scale amplitude), or slowed down (--scale time), or kept (--scale none).
 
 Example:
   dynid simulate --robot panda --trajectory sinusoid --duration 20 --seed 1 --out traj.csv
+  dynid simulate --robot panda --duration 10 --contact link5:0,0,-20:4,4.5 --out hit.csv
 """
 
 from __future__ import annotations
@@ -35,6 +42,7 @@ from ..friction.model import FrictionModel
 from ..io.friction_json import load_friction_json
 from ..io.torque_log import save_torque_log_pieces
 from ..model.robot import Robot
+from ..simulation.contact import Contact
 from ..simulation.measurement import BLOCK_SAMPLES, SensorNoise, measured_blocks, sample_times
 from ..simulation.trajectories import (
     GAZ2019_SINUSOID_AMPLITUDES,
@@ -150,9 +158,41 @@ def register(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParser:
         help="add effects outside the rigid-body model, as real arms have (rotor inertia, "
         "torque-sensor offsets, a 0.3 deg gravity tilt; drawn from --seed and printed)",
     )
+    p.add_argument(
+        "--contact",
+        action="append",
+        default=[],
+        metavar="FRAME:WRENCH:START,END",
+        help="an external wrench fx,fy,fz[,mx,my,mz] [N, N m] (base axes) at FRAME's origin "
+        "from START to END [s], e.g. link5:0,0,-20:4,4.5; repeatable; writes the true "
+        "tau_ext1..n beside the log",
+    )
+    p.add_argument(
+        "--contact-ramp",
+        type=nonnegative_type,
+        default=0.0,
+        help="rise and fall time of the contacts [s] (default 0: steps)",
+    )
     add_seed_option(p)
     p.add_argument("--out", required=True, type=output_path, help="output .csv or .npz")
     return p
+
+
+def _contacts(args: argparse.Namespace, robot: Robot) -> tuple[Contact, ...]:
+    """The contacts of ``--contact FRAME:WRENCH:START,END`` (frames checked)."""
+    out = []
+    for text in args.contact:
+        parts = text.rsplit(":", 2)
+        if len(parts) != 3:
+            raise DynidError(f"--contact must read FRAME:WRENCH:START,END; got {text!r}")
+        frame, wrench, window = parts
+        robot.frame(frame)
+        w = parse_vector(wrench, "--contact WRENCH")
+        if w.size not in (3, 6):
+            raise DynidError(f"--contact WRENCH must be fx,fy,fz or 6 numbers; got {wrench!r}")
+        start, end = parse_vector(window, "--contact START,END", 2)
+        out.append(Contact(frame, tuple(w), float(start), float(end), args.contact_ramp))
+    return tuple(out)
 
 
 def _friction(args: argparse.Namespace) -> FrictionModel | str:
@@ -241,6 +281,7 @@ def run(args: argparse.Namespace, console: Console) -> int:
 
         effects = UnmodelledEffects.typical(n, np.random.default_rng([args.seed, 7]))
         say(f"effects outside the rigid-body model: {effects.describe()}")
+    contacts = _contacts(args, robot)
     measured = measured_blocks(
         robot,
         traj_at,
@@ -252,10 +293,17 @@ def run(args: argparse.Namespace, console: Console) -> int:
         with_ddq=args.with_ddq,
         effects=effects,
         drive=drive,
+        contacts=contacts,
     )
+    extra = None if measured.external is None else ("tau_ext", measured.external)
     save_torque_log_pieces(
-        args.out, measured, n=n, n_rows=measured.n_samples, with_ddq=args.with_ddq
+        args.out, measured, n=n, n_rows=measured.n_samples, with_ddq=args.with_ddq, extra=extra
     )
+    for c in contacts:
+        say(
+            f"contact at {c.frame}: wrench {list(c.wrench)} from {c.start:g} s to {c.end:g} s "
+            f"(true external torques in columns tau_ext1..tau_ext{n})"
+        )
     first, last = traj_at(slice(0, 1)).t[0], traj_at(slice(N - 1, N)).t[0]
     say(
         f"wrote {args.out}: {measured.n_samples} samples, {last - first:.2f} s, "

@@ -14,6 +14,8 @@ from ..feasibility.penalty import RetrievalProgress, RetrievalResult
 from ..friction.validation import NewtonEulerValidation
 from ..identification.info import LogInfo
 from ..identification.model import IdentifiedModel
+from ..observer.results import ObserveResult
+from ..pipeline.collision import CollisionStageResult
 from ..regressors.base import identifiability
 
 __all__ = [
@@ -302,4 +304,48 @@ def format_newton_euler_rms(val: NewtonEulerValidation) -> str:
         rows.append(row)
     fr = "with " + val.friction_kind + " friction" if val.friction_kind else "without friction"
     rows.append(f"(torques {fr}; relative error NE {val.errors.relative_error_percent:.2f} %)")
+    return "\n".join(rows)
+
+
+def format_observation(result: ObserveResult, names: list[str], *, calibrating: bool) -> str:
+    """The thresholds per joint (and the largest residual) and, detecting, every event."""
+    th = result.thresholds
+    peak = np.max([np.max(np.abs(x.r), axis=0) for x in result.logs], axis=0)
+    cols = {"max |r| [N m]": peak, "contact [N m]": th.contact, "collision [N m]": th.collision}
+    rows = [format_rms_table(names, cols)]
+    if th.uses_uncertainty and th.noise is not None:
+        rows.append(
+            f"thresholds grow with the model's uncertainty: {th.k_sigma:g} sigma + noise "
+            f"({', '.join(f'{v:.3g}' for v in th.noise)} N m)"
+        )
+    if calibrating:
+        rows.append(f"calibrated on {th.samples} samples of {len(result.logs)} log(s)")
+        return "\n".join(rows)
+    events = [(x.path.name, e) for x in result.logs for e in x.events]
+    rows.append(f"{len(events)} event(s)")
+    for log, e in events:
+        top = max(e.joints, key=lambda j: abs(e.peak[j - 1]))
+        rows.append(
+            f"  {log}: {e.level:<9} {e.start:9.3f} s .. {e.end:9.3f} s  joints "
+            f"{','.join(map(str, e.joints))}  peak {e.peak[top - 1]:+.2f} N m (joint {top})"
+        )
+    return "\n".join(rows)
+
+
+def format_collision_stage(res: CollisionStageResult) -> str:
+    """Stage 6: the push, the events found, the delay and the residual's error."""
+    c = res.contact
+    rows = [
+        f"push: {list(c.wrench[:3])} N on {c.frame} from {c.start:g} s to {c.end:g} s; "
+        f"thresholds (contact) [N m]: " + " ".join(f"{x:.2f}" for x in res.thresholds.contact)
+    ]
+    for e in res.events:
+        rows.append(
+            f"  {e.level} {e.start:.3f} s .. {e.end:.3f} s, joints {','.join(map(str, e.joints))}"
+        )
+    found = "not found" if res.delay is None else f"detected {1e3 * res.delay:.0f} ms after it"
+    rows.append(
+        f"{len(res.events)} event(s); the push {found}; residual vs the true external torque "
+        "(first-order lag) RMS [N m]: " + " ".join(f"{x:.3f}" for x in res.residual_error_rms)
+    )
     return "\n".join(rows)

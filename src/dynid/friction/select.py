@@ -20,15 +20,16 @@ to:
    (each sample is held out once; :func:`~dynid.identification.metrics.relative_error_percent`);
    the training error is that of the law fitted on the whole log, on the whole log.
 4. The candidate with the lowest held-out error is kept (on a tie, the earlier of
-   :data:`~dynid.friction.laws.LAWS`: the simpler; ``own`` last, since it ties with its
-   own law refitted on these data) and fitted on the whole log.
+   :data:`~dynid.friction.laws.LAWS`: the simpler) and fitted on the whole log.
 
 The candidates are the laws of the registry (``none``: no extra friction, the rigid model
 alone) and, when the model comes with friction of its own (an identification's classical
 friction, a robot's published sigmoid; :func:`~dynid.friction.validation.own_friction`), that
-friction (``own``, kept as it is when chosen). Every candidate is judged on the same held-out
-blocks: ``own`` by its law refitted on the other blocks, as the others are (its values were
-fitted to these very samples, and judged on them it would always win).
+friction (``own``, kept as it is when chosen). Every candidate is judged on held-out data:
+``own`` predicts the log as it is when the log is new to the model, and, when the model was
+identified from this very log (``own_fitted_here``), by its law refitted on the other blocks
+as the others are, a tie going to the registry's law refitted on the whole log (judged on
+the samples its values were fitted to, the model's friction would always win).
 """
 
 from __future__ import annotations
@@ -89,7 +90,8 @@ class FrictionSelection:
     chosen : str
         Its name.
     scores : tuple of CandidateScore
-        Every candidate, in registry order (``own`` first when present).
+        Every candidate, in registry order (``own`` first when present; last when the
+        model was identified from this log).
     folds : int
         Number of blocks (recordings when one is left out at a time).
     method : str
@@ -158,6 +160,7 @@ def select_friction(
     *,
     candidates: Sequence[str] | None = None,
     own: FrictionModel | None = None,
+    own_fitted_here: bool = False,
     folds: int = FOLDS,
 ) -> FrictionSelection:
     """Fit the candidate laws and keep the one with the lowest held-out error.
@@ -173,6 +176,9 @@ def select_friction(
         Laws of the registry to compare (default: all, :data:`~dynid.friction.laws.LAWS`).
     own : FrictionModel, optional
         The model's own friction, a candidate as it is (``"own"``).
+    own_fitted_here : bool
+        The model's friction was identified from this log: it is judged by its law
+        refitted on the other blocks (module docstring).
     folds : int
         Number of contiguous blocks (>= 2); not used when ``res`` holds several
         recordings (one is left out at a time).
@@ -209,11 +215,11 @@ def select_friction(
     if own is not None:
         tf = own.torques(res.dq)
         fits[OWN] = _own_fit(own, res)
-        # judged as every other candidate: its law refitted on the other blocks predicts
-        # each held-out block (its values on the whole log were fitted to these samples)
-        law = own.kind if own.kind in LAWS else None
+        law = own.kind if own_fitted_here and own.kind in LAWS else None
         held = err(tf) if law is None else err(_heldout_torques(res, drive, law, labels))
-        scores.append(CandidateScore(OWN, own.names, err(tf), held))
+        own_score = CandidateScore(OWN, own.names, err(tf), held)
+        if law is None:  # new data to the model: its prediction is held out as it is
+            scores.append(own_score)
     for name in names:
         with warnings.catch_warnings():
             if name != names[-1]:  # one warning about still joints is enough
@@ -222,9 +228,9 @@ def select_friction(
         train = err(fits[name].friction.torques(res.dq))
         held = err(_heldout_torques(res, drive, name, labels))
         scores.append(CandidateScore(name, LAWS[name].params, train, held))
-    # first of the lowest: the simpler law; ``own`` ties with its own law refitted on these
-    # data (judged the same way), and the refitted law is kept
-    best = min(scores, key=lambda s: (s.heldout_error_percent, s.name == OWN))
+    if own is not None and own_fitted_here and own.kind in LAWS:
+        scores.append(own_score)  # last: a tie goes to its law refitted on the whole log
+    best = min(scores, key=lambda s: s.heldout_error_percent)  # first of the lowest: simpler
     return FrictionSelection(fits[best.name], best.name, tuple(scores), folds, method)
 
 

@@ -38,6 +38,7 @@ from ..identification.sanity import anticorrelated
 from ..model.drive import Drive
 from ..model.robot import Robot
 from .fit import TorqueModel, model_drive, rigid_body_torques
+from .laws import LAWS
 from .model import ClassicalFriction, DriveFriction, FrictionModel, LawFriction, SigmoidFriction
 
 __all__ = [
@@ -59,7 +60,12 @@ def own_friction(model: TorqueModel) -> FrictionModel | None:
     if isinstance(model, IdentifiedModel) and model.friction is not None:
         fr = model.info.friction
         band = fr.band if fr is not None and fr.band else None
-        law = ClassicalFriction.from_array(model.friction, band)
+        name = "classical" if fr is None else fr.law
+        law: ClassicalFriction | LawFriction = (
+            ClassicalFriction.from_array(model.friction, band)
+            if name == "classical"
+            else LawFriction(LAWS[name], model.friction, np.asarray(band or ()))
+        )
         if model.drive is not None and model.drive.friction_at == "motor":
             return DriveFriction(law, model.drive)
         return law

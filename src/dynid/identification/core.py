@@ -696,7 +696,8 @@ def _record(
             labels=labels[sl],
             std=tuple(float(x) for x in fit.std[sl]),
             kept=tuple(bool(x) for x in fit.kept[sl]),
-            band=tuple(float(b) for b in getattr(term, "band", ())),
+            band=tuple(float(b) for b in getattr(term, "law_band", ())),
+            law=str(getattr(term, "law", "classical")),
         )
     return dataclasses.replace(
         data.record(stack.n_rows),

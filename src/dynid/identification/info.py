@@ -99,14 +99,20 @@ class FrictionInfo:
     kept : tuple of bool
         False for columns left out (a joint that never moves) or pruned.
     band : tuple of float
-        Standstill band [rad/s] per joint (motor) of the Coulomb columns: ``sign(dq)`` is 0
-        inside it; empty for the plain ``sign``.
+        The band the friction law is evaluated with, per joint (motor): the standstill band
+        [rad/s] of the Coulomb columns (``sign(dq)`` is 0 inside it), or the smooth law's
+        width; empty for the plain ``sign``.
+    law : str
+        The registry law (:mod:`dynid.friction.laws`) whose parameters the model's
+        ``friction`` holds: ``"classical"`` (``fv, fc, fo``), ``"smooth"`` (``fv, fc, fo``,
+        ``tanh(dq / band)``) or ``"stribeck"`` (``fv, fc, fs, vst, fo``).
     """
 
     labels: tuple[str, ...]
     std: tuple[float, ...]
     kept: tuple[bool, ...]
     band: tuple[float, ...] = ()
+    law: str = "classical"
 
 
 @dataclass(frozen=True, slots=True)

@@ -30,6 +30,7 @@ from ..exceptions import ShapeError
 from ..model.drive import Drive
 from ..model.robot import Robot
 from ..regressors.base import BaseParameters
+from ..regressors.terms import LinearFriction
 from .holdout import HeldOut
 from .info import IdentificationInfo
 from .least_squares import LeastSquaresFit
@@ -98,6 +99,35 @@ class IdentifiedModel:
                 f"(the robot's links have {p})"
             )
         object.__setattr__(self, "rotor_inertia", None if ia is None else _checks.frozen(ia))
+
+    def friction_from(self, values: ArrayLike) -> NDArray[np.float64]:
+        """The friction coefficients ``values`` (p,) of this model's friction columns
+        (``info.friction.labels``, e.g. a held-out fold's fit) as the parameters (n, k) of
+        its law, as ``friction`` holds them.
+
+        Raises
+        ------
+        ShapeError
+            The model has no friction columns, or ``values`` another length.
+        """
+        fr = self.info.friction
+        x = np.asarray(values, dtype=np.float64)
+        if fr is None or self.friction is None or x.shape != (len(fr.labels),):
+            raise ShapeError(
+                f"friction values must have the {0 if fr is None else len(fr.labels)} "
+                f"coefficients of the model's friction columns; got {x.shape}"
+            )
+        n = self.friction.shape[0]
+        prefixes = [lab.rstrip("0123456789") for lab in fr.labels[: len(fr.labels) // n]]
+        part = {"fv": "viscous", "fc": "smooth" if fr.law == "smooth" else "coulomb"}
+        part |= {"fsp": "stribeck", "fo": "offset"}
+        term = LinearFriction(
+            Drive.identity(n),
+            parts=tuple(part[p] for p in prefixes),
+            width=fr.band if fr.law == "smooth" else (),
+            vst=float(self.friction[0, 3]) if fr.law == "stribeck" else 0.0,
+        )
+        return term.as_array(x)
 
     def links_only(self) -> IdentifiedModel:
         """The model of the links alone: base parameters that are rotor inertias of their own

@@ -60,7 +60,7 @@ __all__ = [
 #: normal equations, whose round-off on exact data is near 1e-6 %.
 ERROR_FLOOR_PERCENT = 1e-4
 
-#: The friction candidates, simplest first.
+#: The classical friction candidates, simplest first.
 FRICTION_LADDER: tuple[tuple[str, ...], ...] = (
     (),
     ("viscous",),
@@ -68,6 +68,15 @@ FRICTION_LADDER: tuple[tuple[str, ...], ...] = (
     ("viscous", "coulomb"),
     ("viscous", "coulomb", "offset"),
 )
+#: Widths of the smooth Coulomb candidates, in multiples of each joint's standstill band
+#: (at least :data:`MIN_WIDTH`): ``tanh(dq / w)`` reaches 76 % of ``fc`` at ``dq = w``.
+SMOOTH_WIDTHS = (1.0, 3.0, 10.0)
+#: Stribeck velocities [rad/s] of the Stribeck candidates.
+STRIBECK_VELOCITIES = (0.02, 0.05, 0.1, 0.2)
+#: Smallest smooth width [rad/s] (a noise-free log has no standstill band).
+MIN_WIDTH = 1e-3
+
+_CLASSICAL = ("viscous", "coulomb", "offset")
 
 
 @dataclass(frozen=True, slots=True)
@@ -80,12 +89,19 @@ class Structure:
         An inertia ``I_a`` [kg m^2] per joint on the joint's acceleration (``I_a ddq``;
         with a drive, the rotor inertias at the motors: ``K^T diag(I_a) K ddq``).
     friction : tuple of str
-        The parts of the linear friction per joint (motor) held
-        (:data:`~dynid.regressors.terms.FRICTION_PARTS`); empty for none.
+        The parts of the friction per joint (motor) held, linear in their coefficients
+        (:data:`~dynid.regressors.terms.FRICTION_PARTS`: ``viscous``, ``coulomb``,
+        ``smooth``, ``stribeck``, ``offset``); empty for none.
+    width : float
+        With ``smooth``: its width in multiples of each joint's standstill band.
+    vst : float
+        With ``stribeck``: the Stribeck velocity [rad/s].
     """
 
     armature: bool = False
-    friction: tuple[str, ...] = FRICTION_PARTS
+    friction: tuple[str, ...] = _CLASSICAL
+    width: float = 0.0
+    vst: float = 0.0
 
     def __post_init__(self) -> None:
         bad = [p for p in self.friction if p not in FRICTION_PARTS]
@@ -95,12 +111,24 @@ class Structure:
                 + ", ".join(FRICTION_PARTS)
                 + " (or links for none)"
             )
-        object.__setattr__(self, "friction", tuple(p for p in FRICTION_PARTS if p in self.friction))
+        parts = tuple(p for p in FRICTION_PARTS if p in self.friction)
+        if "smooth" in parts and "coulomb" in parts:
+            raise OptionError("--terms: smooth replaces coulomb; give one of them")
+        if "smooth" in parts and not self.width > 0:
+            object.__setattr__(self, "width", 1.0)
+        if "stribeck" in parts and not self.vst > 0:
+            object.__setattr__(self, "vst", 0.05)
+        if "stribeck" in parts and "coulomb" not in parts:
+            parts = tuple(p for p in FRICTION_PARTS if p in parts + ("coulomb",))
+        object.__setattr__(self, "friction", parts)
 
     @property
     def terms(self) -> tuple[str, ...]:
-        """The term names held, e.g. ``("armature", "viscous")``."""
-        return (("armature",) if self.armature else ()) + self.friction
+        """The term names held, e.g. ``("armature", "viscous", "smooth:3")``."""
+        shape = {"smooth": f"smooth:{self.width:g}", "stribeck": f"stribeck:{self.vst:g}"}
+        return (("armature",) if self.armature else ()) + tuple(
+            shape.get(p, p) for p in self.friction
+        )
 
     @property
     def name(self) -> str:
@@ -109,17 +137,34 @@ class Structure:
 
     @classmethod
     def parse(cls, text: str) -> Structure:
-        """From ``"armature,viscous,coulomb"`` (``"links"`` or ``""`` for none).
+        """From ``"armature,viscous,coulomb"`` (``"links"`` or ``""`` for none);
+        ``smooth:W`` gives the smooth Coulomb's width in standstill bands, ``stribeck:V``
+        the Stribeck velocity [rad/s].
 
         Raises
         ------
         OptionError
-            An unknown term name.
+            An unknown term name or a shape that is not a positive number.
         """
         words = [w.strip() for w in text.replace("+", ",").split(",") if w.strip()]
         words = [w for w in words if w != "links"]
+        shapes: dict[str, float] = {}
+        names = []
+        for w in words:
+            name, _, value = w.partition(":")
+            if value:
+                try:
+                    shapes[name] = float(value)
+                except ValueError:
+                    shapes[name] = -1.0
+                if not shapes[name] > 0 or not math.isfinite(shapes[name]):
+                    raise OptionError(f"--terms {w}: the shape must be a positive number")
+            names.append(name)
         return cls(
-            armature="armature" in words, friction=tuple(w for w in words if w != "armature")
+            armature="armature" in names,
+            friction=tuple(w for w in names if w != "armature"),
+            width=shapes.get("smooth", 0.0),
+            vst=shapes.get("stribeck", 0.0),
         )
 
 
@@ -193,10 +238,27 @@ class Selection:
 
 
 def candidate_structures(armature: bool = True) -> tuple[Structure, ...]:
-    """Every friction candidate of :data:`FRICTION_LADDER`, without and (``armature``)
-    with the armature, simplest first."""
+    """The candidates, simplest first: every classical ladder of :data:`FRICTION_LADDER`,
+    the smooth Coulomb at each of :data:`SMOOTH_WIDTHS` (with viscous friction, without
+    and with offsets) and the Stribeck law at each of :data:`STRIBECK_VELOCITIES` (with
+    viscous friction and offsets), without and (``armature``) with the armature."""
     arms = (False, True) if armature else (False,)
-    return tuple(Structure(a, f) for a in arms for f in FRICTION_LADDER)
+    out = []
+    for a in arms:
+        out += [Structure(a, f) for f in FRICTION_LADDER]
+        out += [
+            Structure(a, ("viscous", "smooth") + o, width=w)
+            for o in ((), ("offset",))
+            for w in SMOOTH_WIDTHS
+        ]
+        out += [Structure(a, _CLASSICAL + ("stribeck",), vst=v) for v in STRIBECK_VELOCITIES]
+    return tuple(out)
+
+
+def smooth_width(band: Sequence[float], factor: float) -> tuple[float, ...]:
+    """The smooth Coulomb's width [rad/s] per joint: ``factor`` standstill bands, at least
+    ``factor`` times :data:`MIN_WIDTH`."""
+    return tuple(factor * max(float(b), MIN_WIDTH) for b in band)
 
 
 def structure_terms(
@@ -225,8 +287,62 @@ def structure_terms(
         )
     if structure.friction:
         at = Drive.identity(n) if model_drive is None else model_drive
-        terms.append(LinearFriction(at, parts=structure.friction, band=tuple(band)))
+        b = tuple(band) if band else (0.0,) * n
+        terms.append(
+            LinearFriction(
+                at,
+                parts=structure.friction,
+                band=b,
+                width=smooth_width(b, structure.width) if "smooth" in structure.friction else (),
+                vst=structure.vst,
+            )
+        )
     return model_drive, tuple(terms)
+
+
+def _largest_terms(
+    cands: Sequence[Structure], arm: bool, drive: Drive | None, n: int, band: Sequence[float]
+) -> tuple[Drive | None, list[tuple[ModelTerm, Any]]]:
+    """The terms of every candidate with ``armature == arm`` at once, each with what it
+    stands for: ``("classical", parts)``, ``("smooth", width)`` or ``("stribeck", vst)``;
+    a candidate is a choice of their columns."""
+    mine = [c for c in cands if c.armature == arm]
+    model_drive, terms = structure_terms(Structure(arm, ()), drive, n, band)
+    at = Drive.identity(n) if model_drive is None else model_drive
+    b = tuple(band) if band else (0.0,) * n
+    out: list[tuple[ModelTerm, Any]] = [(t, None) for t in terms]
+    classical = tuple(p for p in _CLASSICAL if any(p in c.friction for c in mine))
+    if classical:
+        out.append((LinearFriction(at, parts=classical, band=b), ("classical", classical)))
+    for w in sorted({c.width for c in mine if "smooth" in c.friction}):
+        t = LinearFriction(
+            at, ("smooth",), band=b, width=smooth_width(b, w), name=f"friction smooth {w:g}"
+        )
+        out.append((t, ("smooth", w)))
+    for v in sorted({c.vst for c in mine if "stribeck" in c.friction}):
+        t = LinearFriction(at, ("stribeck",), band=b, vst=v, name=f"friction stribeck {v:g}")
+        out.append((t, ("stribeck", v)))
+    return model_drive, out
+
+
+def _columns_of(structure: Structure, r: int, terms: list[tuple[ModelTerm, Any]], n: int) -> Any:
+    """The columns (bool, over the base parameters and every appended term) of one
+    candidate among the terms of :func:`_largest_terms`."""
+    use = [np.ones(r, dtype=bool)]
+    for t, what in terms:
+        if t.in_base or what is None:
+            continue
+        kind, shape = what
+        if kind == "classical":
+            mask = np.array([p in structure.friction for p in shape])
+            use.append(np.tile(mask, n))
+        elif kind == "smooth":
+            on = "smooth" in structure.friction and structure.width == shape
+            use.append(np.full(len(t.labels), on))
+        else:
+            on = "stribeck" in structure.friction and structure.vst == shape
+            use.append(np.full(len(t.labels), on))
+    return np.concatenate(use)
 
 
 def _judge(
@@ -299,22 +415,14 @@ def _normals(
 
 def _candidate(
     structure: Structure,
+    use: NDArray[np.bool_],
     model: IdentifiedModel,
     held: HeldOut,
     rtol: float,
 ) -> Candidate:
-    """``structure`` judged on the folds of ``model`` (its columns a subset of the model's)."""
+    """``structure`` (the columns ``use`` of ``model``) judged on the folds of ``model``."""
     fit = model.joint_fit if model.joint_fit is not None else model.fit
-    r = model.base.rank
-    c = len(fit.kept)
-    use = np.zeros(c, dtype=bool)
-    use[:r] = True
-    friction = model.info.friction
-    if friction is not None and structure.friction:
-        prefix = {"viscous": "fv", "coulomb": "fc", "offset": "fo"}
-        want = tuple(prefix[p] for p in structure.friction)
-        use[r:] = [lab.startswith(want) for lab in friction.labels]
-    use &= np.asarray(fit.kept, dtype=bool)
+    use = use & np.asarray(fit.kept, dtype=bool)
     sub = held.restricted(np.flatnonzero(use))
     xs = [t.solve(rtol) for t in sub.train]
     per_fold = [t.relative_error_percent(x) for t, x in zip(sub.test, xs, strict=True)]
@@ -375,9 +483,42 @@ def select_structure(
     judged: list[Candidate] = []
     notes: list[str] = []
     judge, how = _judge(robot, data, est, folds, validation)
+    fit_rtol = 1e-10 if rtol is None else rtol
     for arm in sorted({c.armature for c in cands}):
-        largest = Structure(arm, tuple({p for c in cands if c.armature == arm for p in c.friction}))
-        model_drive, terms = structure_terms(largest, drive, robot.n, tuple(data.band))
+        mine = [c for c in cands if c.armature == arm]
+        fitted = _fit_largest(robot, data, mine, arm, drive, est, rtol, judge, notes)
+        if fitted is None:
+            continue
+        model, terms, mine = fitted
+        if model.holdout is None:
+            return None
+        for c in mine:
+            use = _columns_of(c, model.base.rank, terms, robot.n)
+            judged.append(_candidate(c, use, model, model.holdout, fit_rtol))
+    if not judged:
+        return None
+    return Selection(tuple(judged), _chosen(judged), how, notes=tuple(notes))
+
+
+def _fit_largest(
+    robot: Robot,
+    data: Recordings,
+    mine: list[Structure],
+    arm: bool,
+    drive: Drive | None,
+    est: Estimator,
+    rtol: float | None,
+    judge: Judge,
+    notes: list[str],
+) -> tuple[IdentifiedModel, list[tuple[ModelTerm, Any]], list[Structure]] | None:
+    """The model of every candidate's columns at once (the classical candidates alone when
+    the data cannot tell the shaped laws apart), with its terms and the candidates it
+    holds; None (and a note) when not even those are identifiable."""
+    tries = [mine, [c for c in mine if not ({"smooth", "stribeck"} & set(c.friction))]]
+    for k, group in enumerate(tries):
+        if not group or (k and len(group) == len(mine)):
+            continue
+        model_drive, terms = _largest_terms(group, arm, drive, robot.n, tuple(data.band))
         try:
             with warnings.catch_warnings():  # the candidates' fits: only the chosen one speaks
                 warnings.simplefilter("ignore", DynidWarning)
@@ -385,26 +526,26 @@ def select_structure(
                     robot,
                     data,
                     drive=model_drive,
-                    terms=terms,
+                    terms=tuple(t for t, _ in terms),
                     estimator=est,
                     rtol=rtol,
                     judge=judge,
                 )
         except RankDeficientError as exc:
+            what = "with" if arm else "without"
+            shaped = k == 0 and len(tries[1]) < len(group)
             notes.append(
-                f"{largest.name}: not identifiable from these data ({exc.rank} < "
-                f"{exc.needed} columns)"
+                (
+                    f"the smooth and Stribeck candidates {what} armature: the data do not tell "
+                    "them from Coulomb friction"
+                    if shaped
+                    else f"the candidates {what} armature: not identifiable from these data"
+                )
+                + f" (rank {exc.rank} < {exc.needed})"
             )
             continue
-        if model.holdout is None:
-            return None
-        fit_rtol = 1e-10 if rtol is None else rtol
-        judged += [
-            _candidate(c, model, model.holdout, fit_rtol) for c in cands if c.armature == arm
-        ]
-    if not judged:
-        return None
-    return Selection(tuple(judged), _chosen(judged), how, notes=tuple(notes))
+        return model, terms, group
+    return None
 
 
 def identify_recordings(

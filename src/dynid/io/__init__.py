@@ -46,6 +46,10 @@ _NAMES = {
     "load_mapped_torque_log": "columns",
     "load_mapped_static_data": "columns",
     "load_joint_state_bag": "rosbag",
+    "save_thresholds": "observer_files",
+    "load_thresholds": "observer_files",
+    "save_events": "observer_files",
+    "save_residuals_csv": "observer_files",
 }
 
 __all__ = sorted(_NAMES)

@@ -56,6 +56,7 @@ __all__ = [
     "parse_column_map",
     "load_mapped_static_data",
     "load_mapped_torque_log",
+    "load_joint_columns",
 ]
 
 _DEFAULT = {
@@ -403,6 +404,27 @@ def load_mapped_torque_log(
         raise DataError(f"{path.name}: {exc}") from exc
     notes.append(velocity_note(columns.velocity_cutoff_hz))
     return MappedLog(with_derived_velocities(raw, columns.velocity_cutoff_hz), tuple(notes))
+
+
+def load_joint_columns(path: str | Path, name: str, n: int) -> NDArray[np.float64] | None:
+    """The columns ``name1 .. namen`` (CSV) or the array ``name`` (NPZ) of a log, (N, n), as
+    stored (no unit scaling), or None when the file has none: a signal kept beside the log
+    (the true external torques ``tau_ext`` of ``dynid simulate --contact``, a vendor's
+    estimate).
+
+    Raises
+    ------
+    DataError
+        A malformed file, some but not all of the columns.
+    """
+    cmap = ColumnMap({"tau": name if Path(path).suffix.lower() == ".npz" else name + "{i}"})
+    try:
+        table = _read_table(Path(path), cmap, ("tau",))
+    except DataError as exc:
+        if "no column the map names" in str(exc):
+            return None
+        raise
+    return _vector(table, cmap, "tau", n)
 
 
 @dataclass(frozen=True, slots=True)

@@ -210,6 +210,8 @@ def info_to_dict(info: IdentificationInfo, drive: Drive | None = None) -> dict[s
         out["friction_kept"] = list(info.friction.kept)
         if info.friction.band:
             out["friction_band"] = list(info.friction.band)
+        if info.friction.law != "classical":
+            out["friction_law"] = info.friction.law
     if info.heldout is not None:
         out["heldout"] = dict(info.heldout)
     if info.column_map is not None:
@@ -292,8 +294,23 @@ def _route_parts(
             std=tuple(_float(x, "metadata.friction_std") for x in m.pop("friction_std", ())),
             kept=tuple(bool(x) for x in m.pop("friction_kept", ())),
             band=tuple(_float(x, "metadata.friction_band") for x in m.pop("friction_band", ())),
+            law=_friction_law(m.pop("friction_law", "classical")),
         )
     return static, log, friction
+
+
+#: The laws whose parameters an identified model's ``friction`` may hold, with their count.
+_FRICTION_LAWS = {"classical": 3, "smooth": 3, "stribeck": 5}
+
+
+def _friction_law(law: Any) -> str:
+    """``metadata.friction_law``, checked."""
+    if law not in _FRICTION_LAWS:
+        raise DataError(
+            f"identified model: metadata.friction_law must be one of {list(_FRICTION_LAWS)}; "
+            f"got {law!r}"
+        )
+    return str(law)
 
 
 def _opt_float(x: Any) -> float | None:
@@ -388,10 +405,13 @@ def model_from_dict(d: Mapping[str, Any]) -> IdentifiedModel:
         friction = d.get("friction")
         if friction is not None:
             friction = np.asarray(friction, dtype=np.float64)
-            if friction.shape != (robot.n, 3):
+            meta = d.get("metadata")
+            law = meta.get("friction_law", "classical") if isinstance(meta, dict) else ""
+            k = _FRICTION_LAWS.get(law, 3)
+            if friction.shape != (robot.n, k):
                 raise DataError(
-                    f"identified model: 'friction' must be null or {robot.n} rows of "
-                    f"[fv, fc, fo]; got shape {friction.shape}"
+                    f"identified model: 'friction' must be null or {robot.n} rows of the "
+                    f"{law or 'classical'} law's {k} parameters; got shape {friction.shape}"
                 )
         for name, arr in (("value", fit.beta), ("std", fit.std)):
             if not np.all(np.isfinite(arr)):

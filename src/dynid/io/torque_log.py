@@ -8,11 +8,13 @@ columns, then one row per sample::
     t,q1,...,qn,dq1,...,dqn,tau1,...,taun[,ddq1,...,ddqn]
 
 Columns are found by name, in any order; ``n`` is the number of ``q`` columns
-(``q1..qn``, no gap). A duplicated column, a column of no known name, or an incomplete
-``ddq1..ddqn`` set is an error (a wrong column silently used or ignored is a wrong
-answer). Empty cells and ``nan`` read as NaN. A UTF-8 byte-order mark is accepted. NPZ:
-arrays ``t`` (N,), ``q``, ``dq``, ``tau``, optionally ``ddq`` (N, n) and ``n_rows``, loaded
-with ``allow_pickle=False``; other arrays are an error.
+(``q1..qn``, no gap). A duplicated column, a joint signal's column outside ``1..n``, or an
+incomplete ``ddq1..ddqn`` set is an error (a wrong column silently used is a wrong
+answer); any other column (labels, a vendor's estimates, true external torques
+``tau_ext1..n``) is ignored with a warning. Empty cells and ``nan`` read as NaN. A UTF-8
+byte-order mark is accepted. NPZ: arrays ``t`` (N,), ``q``, ``dq``, ``tau``, optionally
+``ddq`` (N, n) and ``n_rows``, loaded with ``allow_pickle=False``; other arrays are
+ignored with a warning.
 
 Strict by default: a row holding NaN or inf, or repeating the previous timestamp, raises
 :class:`~dynid.exceptions.DataError` naming the first such row and the count. With
@@ -97,6 +99,7 @@ def save_torque_log_pieces(
     n: int,
     n_rows: int,
     with_ddq: bool = False,
+    extra: tuple[str, Callable[[], Iterable[NDArray[np.float64]]]] | None = None,
 ) -> Path:
     """Write a log given in consecutive pieces (never held whole) to ``path`` (``.csv``
     or ``.npz``, by suffix), as :func:`save_torque_log` writes the pieces joined.
@@ -112,6 +115,10 @@ def save_torque_log_pieces(
         Samples over all pieces (recorded in the file).
     with_ddq : bool
         Whether the pieces hold accelerations (written as ``ddq``).
+    extra : (str, callable), optional
+        ``(name, pieces)``: one more (N, n) signal beside the log, ``pieces()`` yielding
+        its rows piece by piece like ``pieces``: columns ``name1..namen`` (the array
+        ``name`` in an NPZ), which readers of the log ignore.
 
     Raises
     ------
@@ -122,6 +129,7 @@ def save_torque_log_pieces(
     suffix = path.suffix.lower()
     if suffix == ".npz":
         names = ["t", "q", "dq", "tau"] + (["ddq"] if with_ddq else [])
+        names += [] if extra is None else [extra[0]]
         with open_atomic(path, "wb") as f, zipfile.ZipFile(f, "w", allowZip64=True) as zf:
             for name in names:
                 shape = (n_rows,) if name == "t" else (n_rows, n)
@@ -129,7 +137,11 @@ def save_torque_log_pieces(
                     header = {"descr": "<f8", "fortran_order": False, "shape": shape}
                     np.lib.format.write_array_header_1_0(member, header)
                     rows = 0
-                    for log in pieces():
+                    if extra is not None and name == extra[0]:
+                        for x in extra[1]():
+                            rows += x.shape[0]
+                            member.write(np.ascontiguousarray(x, dtype="<f8").tobytes())
+                    for log in () if extra is not None and name == extra[0] else pieces():
                         a = np.ascontiguousarray(getattr(log, name), dtype="<f8")
                         rows += _piece_rows(path, log, n)
                         member.write(a.tobytes())
@@ -143,18 +155,24 @@ def save_torque_log_pieces(
         [
             _UNITS,
             f"{_ROWS_PREFIX} {n_rows}",
-            ",".join(torque_log_columns(n, with_ddq=with_ddq)),
+            ",".join(
+                torque_log_columns(n, with_ddq=with_ddq)
+                + ([] if extra is None else [f"{extra[0]}{j}" for j in range(1, n + 1)])
+            ),
         ]
     )
     with open_atomic(path, "w") as fh:
         fh.write(preamble + "\n")
         rows = 0
+        more = iter(()) if extra is None else iter(extra[1]())
         for log in pieces():
             rows += _piece_rows(path, log, n)
             parts = [log.t[:, None], log.q, log.dq, log.tau]
             if with_ddq:
                 assert log.ddq is not None
                 parts.append(log.ddq)
+            if extra is not None:
+                parts.append(next(more))
             step = 100_000  # bounded memory: format the table in blocks of rows
             for start in range(0, log.n_samples, step):
                 block = np.concatenate([x[start : start + step] for x in parts], axis=1)
@@ -198,7 +216,8 @@ def load_torque_log(
     Raises
     ------
     DataError
-        Unknown suffix; a missing, duplicated or unknown column or array; an incomplete
+        Unknown suffix; a missing or duplicated column or array, a joint signal outside
+        ``1..n``; an incomplete
         ``ddq`` set; a non-numeric cell, a row with the wrong number of fields (the line);
         a row count other than the recorded one; NaN/inf or repeated timestamps unless
         ``drop_invalid``; timestamps running backwards.
@@ -310,11 +329,8 @@ def _read_npz(path: Path) -> dict[str, NDArray[np.float64]]:
                     f"dq, derived from q when absent, and ddq); found {sorted(npz.files)}"
                 )
             extra = sorted(set(npz.files) - {"t", "n_rows", *_SIGNALS})
-            if extra:
-                raise DataError(
-                    f"{path.name}: unknown array(s) {extra}; expected t, q, dq, tau "
-                    "(optional ddq, n_rows)"
-                )
+            if extra:  # labels, vendor estimates, true external torques: kept in the file
+                _log.warning("%s: array(s) %s ignored (not read)", path.name, extra)
             n_rows = None
             for k in ("t", "n_rows", *_SIGNALS):
                 if k not in npz.files:
@@ -378,12 +394,15 @@ def _columns(path: Path, names: list[str], line: int) -> tuple[int, bool]:
             f"{where}: accelerations must be all of ddq1..ddq{n} or none; got only {have}"
         )
     unknown = [c for c in names if c not in set(need) | set(ddq)]
-    if unknown:
+    signals = [c for c in unknown if re.fullmatch(r"(q|dq|tau|ddq)\d+", c)]
+    if signals:
         raise DataError(
-            f"{where}: unknown column(s) {unknown}; a torque log has t, q1..q{n}, "
+            f"{where}: unknown column(s) {signals}; a torque log has t, q1..q{n}, "
             f"dq1..dq{n} (optional: derived from q when absent), tau1..tau{n} and optionally "
             f"ddq1..ddq{n}"
         )
+    if unknown:  # labels, vendor estimates, true external torques: kept in the file
+        _log.warning("%s: column(s) %s ignored (not read)", path.name, _checks.short(unknown))
     return n, bool(have)
 
 

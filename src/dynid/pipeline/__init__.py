@@ -5,6 +5,7 @@
 files: the command line renders the results and saves them.
 """
 
+from .collision import CollisionStageResult, collision_stage
 from .consistent import ConsistentSetup, ConsistentStageResult, consistent_stage
 from .demo import STAGE_TITLES, DemoResult, StageFinished, StageStarted, run_demo
 from .stages import (
@@ -27,6 +28,7 @@ __all__ = [
     "DEMO_TOOL_XYZ",
     "DEMO_WORKERS",
     "STAGE_TITLES",
+    "CollisionStageResult",
     "ConsistentSetup",
     "ConsistentStageResult",
     "DemoResult",
@@ -36,6 +38,7 @@ __all__ = [
     "KinematicsStageResult",
     "StageFinished",
     "StageStarted",
+    "collision_stage",
     "consistent_stage",
     "feasible_stage",
     "friction_stage",

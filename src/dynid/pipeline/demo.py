@@ -1,4 +1,4 @@
-"""The whole demonstration: the paper's stages 1-4 and stage 5 on one simulated robot.
+"""The whole demonstration: the paper's stages 1-4 and stages 5-6 on one simulated robot.
 
 :func:`run_demo` chains the stages of :mod:`dynid.pipeline.stages` as ``dynid demo`` does
 and returns a frozen :class:`DemoResult`; ``progress`` receives a :class:`StageStarted`
@@ -15,6 +15,7 @@ import numpy as np
 
 from ..model.panda import panda
 from ..model.robot import Robot
+from .collision import CollisionStageResult, collision_stage
 from .consistent import ConsistentStageResult, consistent_stage
 from .stages import (
     FeasibleStageResult,
@@ -38,6 +39,7 @@ STAGE_TITLES = {
     3: "validation on sinusoids and joint friction (Gaz et al. 2019, Sec. IV-B, VI)",
     4: "feasible link parameters and Newton-Euler validation (Gaz et al. 2019, Sec. V)",
     5: "physically consistent parameters: convex (LMI) against the penalty method",
+    6: "the identified model detects a collision (momentum observer)",
 }
 
 
@@ -73,12 +75,13 @@ class DemoResult:
     friction: FrictionStageResult
     feasible: FeasibleStageResult
     consistent: ConsistentStageResult
+    collision: CollisionStageResult | None = None
 
 
 def run_demo(
     robot: Robot | None = None, seed: int = 0, *, progress: Progress | None = None
 ) -> DemoResult:
-    """Run the five stages on ``robot`` (default: the built-in Panda) with ``seed``.
+    """Run the six stages on ``robot`` (default: the built-in Panda) with ``seed``.
 
     Stage 1 starts at the robot's neutral pose (the Panda's ``PANDA_NEUTRAL_Q``; the middle
     of the limits for a robot without one) and draws its IK goal from
@@ -107,4 +110,5 @@ def run_demo(
         ),
     )
     cons = stage(5, lambda: consistent_stage(robot, seed, progress=progress))
-    return DemoResult(robot, seed, kin, ident, fric, feas, cons)
+    coll = stage(6, lambda: collision_stage(recorded, fric.fit.friction, seed, truth=robot))
+    return DemoResult(robot, seed, kin, ident, fric, feas, cons, coll)

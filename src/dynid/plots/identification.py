@@ -82,19 +82,17 @@ def _fold_model(model: IdentifiedModel, fold: int) -> IdentifiedModel | None:
     parameters followed by ``fv, fc, fo`` per joint)."""
     assert model.holdout is not None
     x = model.holdout.train[fold].solve()
-    r, n = model.fit.beta.size, model.robot.n
+    r = model.fit.beta.size
     labels = () if model.info.friction is None else model.info.friction.labels
     if x.size != r + len(labels):
         return None
-    friction = np.zeros((n, 3))
-    for lab, v in zip(labels, x[r:], strict=True):  # fv1, fc1, fo1, fv2, ...
-        friction[int(lab[2:]) - 1, ("fv", "fc", "fo").index(lab[:2])] = v
+    friction = model.friction_from(x[r:]) if labels else None
     fit = dataclasses.replace(model.fit, beta=x[:r])
     return IdentifiedModel(
         robot=model.robot,
         base=model.base,
         fit=fit,
-        friction=friction if labels else None,
+        friction=friction,
         info=model.info,
         drive=model.drive,
     )

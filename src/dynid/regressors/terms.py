@@ -34,6 +34,7 @@ from numpy.typing import NDArray
 
 from ..exceptions import OptionError
 from ..model.drive import Drive
+from .friction_columns import smooth_sign, standstill_sign, stribeck_decay
 
 __all__ = [
     "FRICTION_PARTS",
@@ -128,42 +129,73 @@ class RotorInertia:
         return C
 
 
-#: The parts of :class:`LinearFriction`, in column order: viscous ``fv dq``, Coulomb
-#: ``fc sign(dq)`` (0 inside the standstill band) and the offset ``fo``.
-FRICTION_PARTS = ("viscous", "coulomb", "offset")
-_PART_LABEL = {"viscous": "fv", "coulomb": "fc", "offset": "fo"}
-_PART_UNIT = {"viscous": "N m s/rad", "coulomb": "N m", "offset": "N m"}
+#: The parts of :class:`LinearFriction`, in column order: viscous ``fv v``, Coulomb
+#: ``fc s(v)`` (0 inside the standstill band), smooth Coulomb ``fc tanh(v / w)`` (instead
+#: of ``coulomb``), the Stribeck bump ``(fs - fc) s(v) exp(-(v / v_st)^2)`` (beside
+#: ``coulomb``) and the offset ``fo`` (:mod:`dynid.regressors.friction_columns`).
+FRICTION_PARTS = ("viscous", "coulomb", "smooth", "stribeck", "offset")
+_PART_LABEL = {"viscous": "fv", "coulomb": "fc", "smooth": "fc", "stribeck": "fsp", "offset": "fo"}
+_PART_UNIT = {p: "N m" for p in FRICTION_PARTS} | {"viscous": "N m s/rad"}
 
 
 @dataclass(frozen=True, slots=True, eq=False)
 class LinearFriction:
-    """Viscous, Coulomb and offset friction where the drive says (motors or joints).
+    """Friction linear in its coefficients, where the drive says (motors or joints).
 
     Attributes
     ----------
     drive : Drive
         Where the friction acts (its motors, or the joints with ``friction_at="joint"``).
     parts : tuple of str
-        Which of :data:`FRICTION_PARTS` the term holds (default all three, eq. 24).
+        Which of :data:`FRICTION_PARTS` the term holds (default viscous, Coulomb and offset:
+        eq. 24 of Gaz et al. 2019); ``smooth`` replaces ``coulomb``, ``stribeck`` goes
+        with it.
     band : tuple of float
-        Standstill band [rad/s] per motor (joint): ``sign(v)`` is 0 where ``|v|`` is inside
-        it, so that the sign of velocity noise at rest does not switch Coulomb friction on;
-        empty for none (the plain ``sign``).
+        Standstill band [rad/s] per motor (joint): ``s(v)`` is 0 where ``|v|`` is inside
+        it; empty for none (the plain ``sign``).
+    width : tuple of float
+        The smooth Coulomb's width ``w`` [rad/s] per motor (joint), with ``smooth``.
+    vst : float
+        The Stribeck velocity [rad/s], with ``stribeck``.
+    name : str
+        The term's name (``"friction"``; another for a second friction term of a model).
     """
 
     drive: Drive
-    parts: tuple[str, ...] = FRICTION_PARTS
+    parts: tuple[str, ...] = ("viscous", "coulomb", "offset")
     band: tuple[float, ...] = ()
+    width: tuple[float, ...] = ()
+    vst: float = 0.0
     name: str = "friction"
     in_base: bool = False
 
     def __post_init__(self) -> None:
         if not self.parts or any(p not in FRICTION_PARTS for p in self.parts):
             raise OptionError(f"friction parts must be among {FRICTION_PARTS}; got {self.parts}")
-        if self.band and len(self.band) != self.drive.n:
-            raise OptionError(f"band must have {self.drive.n} entries; got {len(self.band)}")
+        if "smooth" in self.parts and "coulomb" in self.parts:
+            raise OptionError("friction parts: smooth replaces coulomb; give one of them")
+        for key, v in (("band", self.band), ("width", self.width)):
+            if v and len(v) != self.drive.n:
+                raise OptionError(f"{key} must have {self.drive.n} entries; got {len(v)}")
+        if "smooth" in self.parts and not self.width:
+            raise OptionError("the smooth Coulomb part needs its width (one per joint)")
+        if "stribeck" in self.parts and not self.vst > 0:
+            raise OptionError(f"the Stribeck part needs a Stribeck velocity > 0; got {self.vst}")
         order = tuple(p for p in FRICTION_PARTS if p in self.parts)
         object.__setattr__(self, "parts", order)
+
+    @property
+    def law(self) -> str:
+        """The registry law the coefficients are parameters of (:meth:`as_array`):
+        ``"stribeck"``, ``"smooth"`` or ``"classical"``."""
+        if "stribeck" in self.parts:
+            return "stribeck"
+        return "smooth" if "smooth" in self.parts else "classical"
+
+    @property
+    def law_band(self) -> tuple[float, ...]:
+        """The band the law is evaluated with: the smooth law's width, else the band."""
+        return self.width if "smooth" in self.parts else self.band
 
     @property
     def labels(self) -> tuple[str, ...]:
@@ -172,12 +204,12 @@ class LinearFriction:
 
     @property
     def units(self) -> tuple[str, ...]:
-        """N m s/rad, N m, N m per joint (motor), for the parts held."""
+        """N m s/rad for ``fv``, N m for the others, per joint (motor)."""
         return tuple(_PART_UNIT[p] for p in self.parts) * self.drive.n
 
     @property
     def nonnegative(self) -> NDArray[np.bool_]:
-        """``fv, fc >= 0``; the offset ``fo`` has either sign."""
+        """Every coefficient but the offset ``fo`` is ``>= 0``."""
         return np.tile([p != "offset" for p in self.parts], self.drive.n)
 
     @property
@@ -188,29 +220,37 @@ class LinearFriction:
         return np.where(np.tile([p != "offset" for p in self.parts], self.drive.n), j, -1)
 
     def as_array(self, params: NDArray[np.float64]) -> NDArray[np.float64]:
-        """The parameters (p,) as ``(n, 3)`` columns ``fv, fc, fo`` (0 for parts not held)."""
+        """The coefficients (p,) as the parameters (n, k) of :attr:`law`: ``fv, fc, fo``
+        (classical, smooth) or ``fv, fc, fs, vst, fo`` (Stribeck, ``fs = fc + fsp``); 0 for
+        parts not held."""
         n, k = self.drive.n, len(self.parts)
-        out = np.zeros((n, 3))
-        out[:, [FRICTION_PARTS.index(p) for p in self.parts]] = np.reshape(params, (n, k))
-        return out
+        c = dict(zip(self.parts, np.reshape(params, (n, k)).T, strict=True))
+        z = np.zeros(n)
+        fc = c.get("coulomb", c.get("smooth", z))
+        if self.law == "stribeck":
+            cols = [c.get("viscous", z), fc, fc + c["stribeck"], np.full(n, self.vst)]
+            return np.column_stack(cols + [c.get("offset", z)])
+        return np.column_stack([c.get("viscous", z), fc, c.get("offset", z)])
 
     def torque_columns(
         self, q: NDArray[np.float64], dq: NDArray[np.float64], ddq: NDArray[np.float64]
     ) -> NDArray[np.float64]:
-        """(B, n, k n): motor ``m``'s ``(v, sign v, 1)`` (the parts held) with
-        ``v = (K dq)_m``, mapped by ``K^T`` onto the joints (``K = 1`` at the joints)."""
+        """(B, n, k n): motor ``m``'s columns of the parts held at ``v = (K dq)_m``,
+        mapped by ``K^T`` onto the joints (``K = 1`` at the joints)."""
         v = self.drive.motor_velocities(dq)
         n, k = v.shape[-1], len(self.parts)
         F = np.zeros(v.shape + (k * n,))
         m = np.arange(n)
         band = np.asarray(self.band, dtype=np.float64) if self.band else np.zeros(n)
-        cols = {
-            "viscous": v,
-            "coulomb": np.where(np.abs(v) > band, np.sign(v), 0.0),
-            "offset": np.ones_like(v),
+        col = {
+            "viscous": lambda: v,
+            "coulomb": lambda: standstill_sign(v, band),
+            "smooth": lambda: smooth_sign(v, np.asarray(self.width)),
+            "stribeck": lambda: standstill_sign(v, band) * stribeck_decay(v, self.vst),
+            "offset": lambda: np.ones_like(v),
         }
         for i, p in enumerate(self.parts):
-            F[..., m, k * m + i] = cols[p]
+            F[..., m, k * m + i] = col[p]()
         if self.drive.friction_at == "joint":
             return F
         return np.einsum("mj,...mc->...jc", self.drive.transmission, F)

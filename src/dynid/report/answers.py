@@ -24,6 +24,7 @@ ANSWERS: dict[str, tuple[AnswerFunction, ...]] = {
     "validate": (torques.validate_answer,),
     "friction": (torques.friction_answer,),
     "retrieve": (feasible.answer,),
+    "payload": (feasible.payload_answer,),
     "demo": (demo.answer,),
 }
 

@@ -162,3 +162,41 @@ def _violations(rep: dict) -> str:
         "Constraints not satisfied",
         table(["constraint", "link", "margin", "unit"], rows),
     )
+
+
+def payload_answer(run: RunFiles) -> Answer | None:
+    """payload's verdict (the load's mass, how sure, physically consistent) and its
+    parameters with their standard deviations, or None without payload.json."""
+    doc = run.doc("payload.json")
+    if doc is None or not is_number(doc.get("mass")):
+        return None
+    std: dict[str, Any] = doc["std"] if isinstance(doc.get("std"), dict) else {}
+    m, sm = doc["mass"], std.get("mass")
+    rel = abs(sm / m) if is_number(sm) and m else None
+    frame = esc(doc.get("frame", ""))
+    facts = [
+        f"Mass <b>{number(m)} kg</b>"
+        + (f" &plusmn; {number(sm, 2)} kg (1 std)" if is_number(sm) else "")
+        + f", centre of mass {cell(doc.get('com'))} m in {frame}",
+        f"Physically consistent: pseudo-inertia margin {cell(doc.get('pseudo_inertia_margin'))}"
+        + (
+            "; the constraint is active (the unconstrained fit was not a body)"
+            if doc.get("constraint_active")
+            else ""
+        ),
+        f"From {esc(doc.get('route', ''))}: rank {cell(doc.get('rank'))}, condition number "
+        f"{cell(doc.get('condition_number'))}, residual RMS {cell(doc.get('residual_rms'))}",
+    ]
+    if doc.get("inertia_identified") is False:
+        facts.append("Inertia not identified from these data (mass and CoM only)")
+    sure = rel is not None and rel < 0.05
+    level = "fair" if doc.get("constraint_active") or not sure else "good"
+    head = f"The payload weighs {number(m)} kg" + (
+        f", known to {100 * rel:.2g} %." if rel is not None else "."
+    )
+    rows = []
+    for key, unit in (("mass", "kg"), ("com", "m"), ("inertia", "kg m^2")):
+        rows.append([esc(key), cell(doc.get(key)), cell(std.get(key)), esc(unit)])
+    body = table(["quantity", "value", "std", "unit"], rows)
+    note = f"<p>CoM in {frame}; inertia about the CoM, order xx xy xz yy yz zz.</p>"
+    return Answer(verdict(level, esc(head), facts), (section("payload", "Payload", note, body),))

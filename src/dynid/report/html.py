@@ -130,7 +130,7 @@ def cell(v: Any) -> str:
     if isinstance(v, bool):
         return '<span class="yes">yes</span>' if v else '<span class="no">no</span>'
     if is_number(v):
-        return number(v)
+        return f'<span class="n">{number(v)}</span>'
     if isinstance(v, str):
         return esc(v)
     if is_vector(v) and len(v) <= MAX_VECTOR:

@@ -60,11 +60,10 @@ def _heldout_facts(doc: dict, held: dict | None) -> tuple[list[str], list[str], 
     ho = _get(doc, "metadata", "heldout")
     train, test = _get(ho, "training_error_percent"), _get(ho, "heldout_error_percent")
     if is_number(train) and is_number(test):
-        scheme = (
-            f"over {ho.get('folds')} contiguous time blocks"
-            if ho.get("scheme") == "blocks"
-            else "on the separate log"
-        )
+        scheme = {
+            "blocks": f"over {ho.get('folds')} contiguous time blocks",
+            "recordings": f"leaving out each of {ho.get('folds')} recordings in turn",
+        }.get(str(ho.get("scheme")), "on the separate log")
         ratio = test / train if train > 0 else 1.0
         facts.append(
             f"Held-out error <b>{percent(test)}</b> {esc(scheme)} (filtered torques, as "
@@ -173,7 +172,7 @@ def _short(expression: str, n: int = 28) -> str:
 
 
 def _terms_fact(doc: dict) -> str:
-    sel = doc.get("selection")
+    sel = _selection(doc)
     if isinstance(sel, dict) and sel.get("chosen"):
         chosen = [c for c in sel.get("candidates") or [] if c.get("name") == sel["chosen"]]
         listed = ", ".join(chosen[0].get("terms") or []) if chosen else ""
@@ -183,6 +182,9 @@ def _terms_fact(doc: dict) -> str:
             + f" by {esc(sel.get('rule', 'held-out error'))}"
         )
     terms = [f"rigid body ({len(doc.get('coefficients') or [])} base parameters)"]
+    fixed = _get(doc, "metadata", "terms")
+    if isinstance(fixed, list):  # given with --terms
+        return "Terms given: " + esc(" + ".join(["links", *map(str, fixed)]))
     if _get(doc, "metadata", "friction_labels"):
         terms.append("classical friction fv, fc, fo per joint")
     if doc.get("drive"):
@@ -192,9 +194,8 @@ def _terms_fact(doc: dict) -> str:
 
 def answer(run: RunFiles) -> Answer | None:
     """The identify page's verdict and parts, or None without identification.json."""
-    rel = next((r for r in ("identification.json",) if r in run.docs), None)
-    doc = run.doc("identification.json")
-    if doc is None or rel is None:
+    doc = run.docs.get("identification.json")  # the run's own, not a stage folder's
+    if not isinstance(doc, dict):
         return None
     held = run.doc("heldout.json")
     if doc.get("route") == "static":
@@ -246,8 +247,13 @@ def _torques_section(run: RunFiles, held: dict | None) -> str:
     return section("torques", "Torques on held-out data", *parts)
 
 
+def _selection(doc: dict) -> Any:
+    """The model structure chosen on held-out data (``metadata.selection``), or None."""
+    return _get(doc, "metadata", "selection")
+
+
 def _structure_section(doc: dict) -> str:
-    sel = doc.get("selection")
+    sel = _selection(doc)
     if not isinstance(sel, dict) or not sel.get("candidates"):
         return ""
     chosen = sel.get("chosen")

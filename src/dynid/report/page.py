@@ -401,7 +401,7 @@ border-radius:4px;margin-right:6px;color:#fff;vertical-align:middle}
 tr.marked{background:#e7f3e9!important;font-weight:600}
 .bar{display:inline-block;height:10px;background:#5b8fd5;border-radius:2px;min-width:1px}
 .bar.bad{background:#d9534f}table.coefficients td:nth-child(8){width:180px}
-td{white-space:nowrap}.expr{white-space:normal;font-size:12px;color:#333;
+.n{white-space:nowrap}.expr{font-size:12px;color:#333;
 font-family:ui-monospace,"DejaVu Sans Mono",monospace}
 .figures-left-out{background:#fdeeee;border-color:#e0a0a0}
 """

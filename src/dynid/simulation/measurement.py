@@ -34,6 +34,7 @@ from ..friction.model import FrictionModel, SigmoidFriction
 from ..identification.log import TorqueLog, recorded_side_log
 from ..model.drive import Drive
 from ..model.robot import Robot
+from .contact import Contact, contact_torques
 from .trajectories import Trajectory, uniform_times
 from .unmodelled import UnmodelledEffects
 
@@ -137,6 +138,7 @@ def simulate_measurement(
     with_ddq: bool = False,
     effects: UnmodelledEffects | None = None,
     drive: Drive | None = None,
+    contacts: tuple[Contact, ...] = (),
 ) -> TorqueLog:
     """Simulated torque log of ``robot`` following ``traj``.
 
@@ -167,6 +169,9 @@ def simulate_measurement(
         ``K^T diag(I_a) K ddq`` to the joint torques (none when they are to be identified),
         and the log is written on the drive's side with its effort (motor positions and
         torques or currents, encoder offsets); the noise is added at the joints.
+    contacts : tuple of Contact
+        External wrenches (:mod:`dynid.simulation.contact`): the arm still follows
+        ``traj``, so the torques lose ``tau_ext = J^T w`` over each contact's window.
 
     Returns
     -------
@@ -184,7 +189,7 @@ def simulate_measurement(
     if traj.n != n:
         raise ShapeError(f"trajectory has {traj.n} joints; robot {robot.name!r} has {n}")
     friction = _checked(robot, drop_fraction, friction, effects, drive)
-    tau = _true_torques(robot, traj, friction, effects, drive)
+    tau = _true_torques(robot, traj, friction, effects, drive, contacts)
     N = len(traj)
     sd_tau, sd_q, sd_dq = _stds(noise, n)
     tau = tau + rng.standard_normal((N, n)) * sd_tau
@@ -233,6 +238,7 @@ def _true_torques(
     friction: FrictionModel | None,
     effects: UnmodelledEffects | None,
     drive: Drive | None,
+    contacts: tuple[Contact, ...] = (),
 ) -> NDArray[np.float64]:
     """Joint torques (N, n) [N m] of the robot following ``traj``, before the noise."""
     if effects is not None:
@@ -243,6 +249,8 @@ def _true_torques(
         tau = tau + friction.torques(traj.dq)
     if drive is not None and drive.rotor_inertia is not None:
         tau = tau + drive.rotor_torques(traj.ddq, drive.rotor_inertia)
+    if contacts:
+        tau = tau - contact_torques(robot, contacts, traj.t, traj.q)
     return tau
 
 
@@ -285,12 +293,16 @@ class MeasuredBlocks:
         Samples over all pieces (after dropping).
     with_ddq : bool
         Whether the pieces hold the true accelerations.
+    external : callable or None
+        With contacts: ``external()`` yields, piece by piece, the true external joint
+        torques ``tau_ext`` (rows of the pieces, joint side) [N m]; else None.
     """
 
     n: int
     n_samples: int
     with_ddq: bool
     pieces: Callable[[], Iterator[TorqueLog]]
+    external: Callable[[], Iterator[NDArray[np.float64]]] | None = None
 
     def __call__(self) -> Iterator[TorqueLog]:
         return self.pieces()
@@ -309,6 +321,7 @@ def measured_blocks(
     effects: UnmodelledEffects | None = None,
     drive: Drive | None = None,
     block: int = BLOCK_SAMPLES,
+    contacts: tuple[Contact, ...] = (),
 ) -> MeasuredBlocks:
     """:func:`simulate_measurement` of a long trajectory, a block of samples at a time.
 
@@ -321,7 +334,7 @@ def measured_blocks(
         Samples of the trajectory.
     block : int
         Samples per piece.
-    rng, noise, friction, drop_fraction, with_ddq, effects, drive
+    rng, noise, friction, drop_fraction, with_ddq, effects, drive, contacts
         As :func:`simulate_measurement`; ``rng`` is advanced as that function advances it.
 
     Returns
@@ -354,7 +367,7 @@ def measured_blocks(
             if traj.n != n:
                 raise ShapeError(f"trajectory has {traj.n} joints; robot {robot.name!r} has {n}")
             m = len(traj)
-            tau = _true_torques(robot, traj, fr, effects, drive)
+            tau = _true_torques(robot, traj, fr, effects, drive, contacts)
             tau = tau + gens[0].standard_normal((m, n)) * sds[0]
             q = traj.q + gens[1].standard_normal((m, n)) * sds[1]
             dq = traj.dq + gens[2].standard_normal((m, n)) * sds[2]
@@ -368,4 +381,10 @@ def measured_blocks(
             )
             yield log if drive is None else recorded_side_log(log, drive)
 
-    return MeasuredBlocks(n, int(keep.sum()), with_ddq, pieces)
+    def external() -> Iterator[NDArray[np.float64]]:
+        for a in range(0, N, block):
+            traj = traj_at(slice(a, a + block))
+            rows = np.flatnonzero(keep[a : a + len(traj)])
+            yield contact_torques(robot, contacts, traj.t[rows], traj.q[rows])
+
+    return MeasuredBlocks(n, int(keep.sum()), with_ddq, pieces, external if contacts else None)

@@ -138,7 +138,13 @@ def fit_friction_file(
         res = pieces_residual(model, pieces)
         cut = pieces.cutoff_hz
         if law == "auto":
-            sel = select_friction(res, pieces.drive, own=own_friction(model))
+            # the model identified from one of these recordings: its friction is judged by
+            # its law refitted on the held-out folds' training data
+            here = isinstance(model, IdentifiedModel) and bool(
+                set(rec.names) & {str(r.get("file")) for r in model.info.recordings}
+            )
+            own = own_friction(model)
+            sel = select_friction(res, pieces.drive, own=own, own_fitted_here=here)
             return FrictionFileResult(sel.fit, res, sel, cut, pieces)
         chosen = fit_friction_through(res, pieces.drive, law)
         return FrictionFileResult(chosen, res, None, cut, pieces)

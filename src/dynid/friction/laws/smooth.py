@@ -15,6 +15,7 @@ from __future__ import annotations
 import numpy as np
 from numpy.typing import NDArray
 
+from ...regressors.friction_columns import smooth_sign
 from .base import MjcfTerms, linear_law
 
 __all__ = ["LAW", "columns"]
@@ -22,10 +23,7 @@ __all__ = ["LAW", "columns"]
 
 def columns(dq: NDArray[np.float64], band: NDArray[np.float64]) -> NDArray[np.float64]:
     """Regressor (..., n, 3): ``(dq, tanh(dq / v_s), 1)`` per joint, ``v_s = band``."""
-    vs = np.asarray(band, dtype=np.float64)
-    with np.errstate(divide="ignore", invalid="ignore"):
-        s = np.where(vs > 0, np.tanh(dq / np.where(vs > 0, vs, 1.0)), np.sign(dq))
-    return np.stack([dq, s, np.ones_like(dq)], axis=-1)
+    return np.stack([dq, smooth_sign(dq, band), np.ones_like(dq)], axis=-1)
 
 
 def _mjcf(P: NDArray[np.float64], dq_max: NDArray[np.float64]) -> MjcfTerms:

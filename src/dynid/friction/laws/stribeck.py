@@ -18,7 +18,7 @@ import numpy as np
 import scipy.optimize
 from numpy.typing import NDArray
 
-from ..model import coulomb_sign
+from ...regressors.friction_columns import standstill_sign, stribeck_decay
 from .base import FrictionLaw, JointFit, MjcfTerms, bounded_lstsq
 
 __all__ = ["LAW"]
@@ -31,11 +31,10 @@ _LIN = [0, 1, 2, 4]  # the parameters the law is linear in: fv, fc, fs, fo
 def _columns(
     dq: NDArray[np.float64], band: NDArray[np.float64], vst: NDArray[np.float64]
 ) -> NDArray[np.float64]:
-    s = coulomb_sign(dq, band)
-    # vst = 0 is a joint left unidentified (it never moved; every coefficient 0): the limit
-    # of exp(-(dq / vst)^2) as vst -> 0, without dividing by zero
-    moving = np.asarray(vst) > 0
-    e = np.where(moving, np.exp(-((dq / np.where(moving, vst, 1.0)) ** 2)), 0.0)
+    s = standstill_sign(dq, band)
+    # vst = 0 is a joint left unidentified (it never moved; every coefficient 0): the
+    # limit of exp(-(dq / vst)^2) as vst -> 0 (stribeck_decay gives 0 there)
+    e = stribeck_decay(dq, vst)
     return np.stack([dq, s * (1.0 - e), s * e, np.ones_like(dq)], axis=-1)
 
 

@@ -1,0 +1,112 @@
+"""Detect contacts and collisions with the identified model: the momentum observer.
+
+The generalized-momentum residual of De Luca et al. estimates the external joint torques
+from the measured q, dq and tau, without accelerations: r = K_O (p - p_0 - integral of
+(tau - tau_f + C^T dq - g + r)), p = M(q) dq, a first-order lag K_O / (s + K_O) of the
+true external torque on an exact model. The model is an identification.json (--model: its
+base parameters, rotor inertias, drive and friction) or a robot (--params: a
+feasible.json with its drive and friction, a URDF or TOML robot); --friction replaces the
+friction (a friction.json of `dynid friction`, with its standstill band).
+
+Two steps:
+  --calibrate on collision-free logs writes OUT/thresholds.json: per joint, the largest
+  |r| of the logs (--quantile) times --margin for contact and --collision-factor times
+  that for collision; with an identified model's covariance the thresholds also grow with
+  the model's uncertainty (k sigma + noise, sigma the covariance of the base parameters
+  propagated through the momentum regressor; --no-uncertainty turns it off). --gain,
+  --discretisation and --rule choose the observer, which the thresholds keep.
+  --thresholds thresholds.json on any logs writes OUT/events.json (dynid-events/1: start
+  and end [s], joints (1-based), peak [N m] per joint and level, contact or collision, of
+  every event), OUT/residuals.csv (t, r1..rn and, with --frame, the external wrench at
+  that frame by damped least squares) and OUT/residuals.png (residuals, thresholds,
+  events, and the true tau_ext that `dynid simulate --contact` writes beside a log).
+Several logs: residuals_<name>.csv and .png each, one events.json.
+
+Examples:
+  dynid observe --model id/identification.json --data free.csv --calibrate --out cal
+  dynid observe --model id/identification.json --thresholds cal/thresholds.json \\
+      --data hit.csv --out obs
+"""
+
+from __future__ import annotations
+
+import argparse
+from pathlib import Path
+
+from ..observer.residual import DEFAULT_GAIN
+from ..workflows.observe import ObserveOptions, observe_files
+from .common import (
+    add_column_options,
+    add_drop_invalid,
+    add_subcommand,
+    nonnegative_type,
+    output_path,
+    parse_vector,
+    positive_type,
+)
+from .console import Console
+from .figures import save_observer_figures
+from .summaries import format_observation
+
+NAME = "observe"
+#: ``--out`` is a folder: its files are one output set (:mod:`dynid.io.run_output`).
+OUTPUT = "folder"
+
+
+def register(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParser:
+    """Add the ``observe`` subcommand."""
+    p = add_subcommand(
+        subparsers, NAME, __doc__, help="detect contacts with a momentum observer on the model"
+    )
+    src = p.add_mutually_exclusive_group(required=True)
+    src.add_argument("--model", type=Path, help="identification.json of an identified model")
+    src.add_argument("--params", help="a robot: feasible.json, a .urdf or .toml, or a name")
+    p.add_argument("--friction", type=Path, help="friction.json replacing the model's friction")
+    p.add_argument("--data", type=Path, nargs="+", required=True, help="torque log(s)")
+    mode = p.add_mutually_exclusive_group(required=True)
+    mode.add_argument(
+        "--calibrate", action="store_true", help="thresholds from collision-free logs"
+    )
+    mode.add_argument("--thresholds", type=Path, help="thresholds.json of --calibrate")
+    p.add_argument("--frame", help="also estimate the external wrench at this frame")
+    p.add_argument("--gain", default=str(DEFAULT_GAIN), help="K_O [1/s], one or per joint")
+    p.add_argument("--discretisation", choices=("exact", "euler"), default="exact")
+    p.add_argument("--rule", choices=("trapezoid", "rectangle"), default="trapezoid")
+    p.add_argument("--margin", type=positive_type, default=1.5, help="factor over |r| (1.5)")
+    p.add_argument("--quantile", type=positive_type, default=1.0, help="of |r| (default 1: max)")
+    p.add_argument("--collision-factor", type=positive_type, default=2.0, help="(default 2)")
+    p.add_argument("--k-sigma", type=positive_type, default=3.0, help="uncertainty k (3)")
+    p.add_argument("--no-uncertainty", action="store_true", help="fixed thresholds only")
+    p.add_argument("--merge", type=nonnegative_type, default=0.05, help="join events [s]")
+    add_column_options(p)
+    add_drop_invalid(p)
+    p.add_argument("--no-figures", action="store_true", help="skip the PNG figures")
+    p.add_argument("--out", type=output_path, required=True, help="output directory")
+    return p
+
+
+def run(args: argparse.Namespace, console: Console) -> int:
+    """Calibrate or detect, print the thresholds and events, save the files."""
+    from ..io.observer_files import save_observation
+
+    gain = parse_vector(args.gain, "--gain")
+    opts = ObserveOptions(
+        data=tuple(args.data), model=args.model, params=args.params, friction=args.friction,
+        calibrate=args.calibrate, thresholds=args.thresholds, frame=args.frame,
+        gain=float(gain[0]) if gain.size == 1 else tuple(gain), discretisation=args.discretisation,
+        rule=args.rule, margin=args.margin, quantile=args.quantile,
+        collision_factor=args.collision_factor, k_sigma=args.k_sigma,
+        uncertainty=not args.no_uncertainty, merge_s=args.merge,
+        columns=(args.columns, args.units), drop_invalid=args.drop_invalid,
+    )  # fmt: skip
+    result = observe_files(opts)
+    names = list(result.model.robot.joint_names)
+    console.print(format_observation(result, names, calibrating=args.calibrate))
+    meta = {"model": str(args.model or args.params), "source": result.model.source}
+    for path in save_observation(
+        args.out, result, joints=names, calibrating=args.calibrate, meta=meta
+    ):
+        console.wrote(path)
+    if not args.no_figures:
+        save_observer_figures(args.out, result, names=names)
+    return 0

@@ -1,0 +1,265 @@
+"""The files of ``dynid observe``: ``thresholds.json``, ``events.json`` and ``residuals.csv``.
+
+``thresholds.json`` (schema ``dynid-thresholds/1``)::
+
+    {"schema": "dynid-thresholds/1", "dynid_version": ..., "joints": ["joint1", ...],
+     "contact": [...], "collision": [...],            # N m per joint
+     "rule": {"margin": 1.5, "quantile": 1.0, "collision_factor": 2.0},
+     "uncertainty": null | {"k_sigma": 3.0, "noise": [...]},
+     "observer": {"gain": [...], "discretisation": "exact", "rule": "trapezoid"},
+     "calibration": {"samples": N, "data": [file names], "model": ...},
+     "units": {...}}
+
+``events.json`` (schema ``dynid-events/1``): ``events``, a list of ``{"start", "end"}``
+[s], ``joints`` (1-based), ``peak`` [N m] (one per joint, signed) and ``level``
+(``contact`` or ``collision``), with the data file, the sample count and the units.
+
+``residuals.csv``: a dynid CSV table (comment lines, ``# rows: N``, a header) with ``t``
+[s], ``r1 .. rn`` [N m] and, with a frame, ``fx, fy, fz`` [N], ``mx, my, mz`` [N m] and
+``damped`` (1 near a singular configuration).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+from numpy.typing import NDArray
+
+from .. import __version__, _checks
+from ..exceptions import DataError
+from ..observer.detection import ContactEvent, Thresholds
+from ..observer.residual import ObserverOptions
+from ..observer.results import LogObservation, ObserveResult
+from .atomic import open_atomic
+from .json_files import load_json, save_json
+
+__all__ = [
+    "EVENTS_SCHEMA",
+    "THRESHOLDS_SCHEMA",
+    "load_thresholds",
+    "observation_names",
+    "save_events",
+    "save_observation",
+    "save_residuals_csv",
+    "save_thresholds",
+]
+
+THRESHOLDS_SCHEMA = "dynid-thresholds/1"
+EVENTS_SCHEMA = "dynid-events/1"
+_KEYS = {
+    "schema", "dynid_version", "joints", "contact", "collision", "rule", "uncertainty",
+    "observer", "calibration", "units",
+}  # fmt: skip
+
+
+def save_thresholds(
+    path: str | Path,
+    thresholds: Thresholds,
+    *,
+    joints: Sequence[str],
+    calibration: dict[str, Any] | None = None,
+) -> Path:
+    """Write ``thresholds.json`` (module docstring); returns the path."""
+    th, o = thresholds, thresholds.options
+    doc = {
+        "dynid_version": __version__,
+        "joints": list(joints),
+        "contact": th.contact.tolist(),
+        "collision": th.collision.tolist(),
+        "rule": {
+            "margin": th.margin,
+            "quantile": th.quantile,
+            "collision_factor": th.collision_factor,
+        },
+        "uncertainty": None
+        if not th.uses_uncertainty or th.noise is None
+        else {"k_sigma": th.k_sigma, "noise": th.noise.tolist()},
+        "observer": {
+            "gain": o.gains(th.n).tolist(),
+            "discretisation": o.discretisation,
+            "rule": o.rule,
+        },
+        "calibration": {"samples": th.samples, **(calibration or {})},
+        "units": {"contact": "N m", "collision": "N m", "noise": "N m", "gain": "1/s"},
+    }
+    return save_json(path, doc, schema=THRESHOLDS_SCHEMA)
+
+
+def load_thresholds(path: str | Path) -> Thresholds:
+    """Read ``thresholds.json``.
+
+    Raises
+    ------
+    DataError
+        Not a thresholds file (schema), an unknown key, a missing or malformed entry (named).
+    """
+    path = Path(path)
+    d = load_json(
+        path, schema=THRESHOLDS_SCHEMA, what="thresholds file (dynid observe --calibrate)"
+    )
+    unknown = sorted(set(d) - _KEYS)
+    if unknown:
+        raise DataError(f"{path.name}: unknown key(s) {_checks.short(unknown)}")
+    try:
+        n = len(d["contact"])
+        contact = _checks.numbers(d["contact"], n, f"{path.name}: contact", DataError)
+        collision = _checks.numbers(d["collision"], n, f"{path.name}: collision", DataError)
+        rule, obs = d["rule"], d["observer"]
+        options = ObserverOptions(
+            gain=tuple(_checks.numbers(obs["gain"], n, f"{path.name}: observer gain", DataError)),
+            discretisation=obs["discretisation"],
+            rule=obs["rule"],
+        )
+        unc = d.get("uncertainty")
+        k_sigma = noise = None
+        if unc is not None:
+            k_sigma = _checks.number(unc["k_sigma"], f"{path.name}: k_sigma", DataError)
+            noise = _checks.numbers(unc["noise"], n, f"{path.name}: uncertainty noise", DataError)
+        return Thresholds(
+            contact=contact,
+            collision=collision,
+            margin=_checks.number(rule["margin"], f"{path.name}: margin", DataError),
+            quantile=_checks.number(rule["quantile"], f"{path.name}: quantile", DataError),
+            collision_factor=_checks.number(
+                rule["collision_factor"], f"{path.name}: collision_factor", DataError
+            ),
+            options=options,
+            samples=int(d.get("calibration", {}).get("samples", 0)),
+            k_sigma=k_sigma,
+            noise=noise,
+        )
+    except (KeyError, TypeError) as exc:
+        raise DataError(f"{path.name}: missing or malformed entry {exc}") from None
+    except DataError as exc:
+        if str(exc).startswith(path.name):
+            raise
+        raise DataError(f"{path.name}: {exc}") from None
+
+
+def save_events(
+    path: str | Path,
+    events: Sequence[ContactEvent],
+    *,
+    meta: dict[str, Any] | None = None,
+    logs: Sequence[str] | None = None,
+) -> Path:
+    """Write ``events.json`` (schema ``dynid-events/1``; ``logs``: each event's log name,
+    written as its ``log``); returns the path."""
+    doc = {
+        "dynid_version": __version__,
+        "events": [
+            {
+                "start": e.start,
+                "end": e.end,
+                "joints": list(e.joints),
+                "peak": list(e.peak),
+                "level": e.level,
+                **({} if logs is None else {"log": logs[k]}),
+            }
+            for k, e in enumerate(events)
+        ],
+        **(meta or {}),
+        "units": {"start": "s", "end": "s", "peak": "N m", "joints": "1-based"},
+    }
+    return save_json(path, doc, schema=EVENTS_SCHEMA)
+
+
+def save_residuals_csv(
+    path: str | Path,
+    t: NDArray[np.float64],
+    r: NDArray[np.float64],
+    *,
+    wrench: NDArray[np.float64] | None = None,
+    damped: NDArray[np.bool_] | None = None,
+    frame: str | None = None,
+) -> Path:
+    """Write ``residuals.csv``: ``t, r1..rn`` (and the wrench at ``frame``); returns the path."""
+    n = r.shape[1]
+    names = ["t"] + [f"r{j + 1}" for j in range(n)]
+    parts = [t[:, None], r]
+    units = "t [s], r [N m]"
+    if wrench is not None:
+        names += ["fx", "fy", "fz", "mx", "my", "mz", "damped"]
+        flag = np.zeros(t.shape[0]) if damped is None else damped.astype(float)
+        parts += [wrench, flag[:, None]]
+        units += f"; wrench at {frame}: f [N], m [N m], base axes; damped: 1 near a singularity"
+    path = Path(path)
+    with open_atomic(path, "w") as fh:
+        fh.write(f"# dynid residuals; units: {units}\n# rows: {t.shape[0]}\n")
+        fh.write(",".join(names) + "\n")
+        table = np.concatenate(parts, axis=1)
+        for a in range(0, table.shape[0], 100_000):
+            np.savetxt(fh, table[a : a + 100_000], delimiter=",", fmt="%.17g")
+    return path
+
+
+def observation_names(logs: Sequence[LogObservation]) -> list[str]:
+    """The name stem of each log's files: ``residuals`` for one log, ``residuals_<stem>``
+    for several (numbered where two logs share a stem)."""
+    if len(logs) == 1:
+        return ["residuals"]
+    out: list[str] = []
+    for x in logs:
+        name = f"residuals_{Path(x.path).stem}"
+        k, base = 2, name
+        while name in out:
+            name, k = f"{base}_{k}", k + 1
+        out.append(name)
+    return out
+
+
+def save_observation(
+    out: str | Path,
+    result: ObserveResult,
+    *,
+    joints: Sequence[str],
+    calibrating: bool,
+    meta: dict[str, Any] | None = None,
+) -> list[Path]:
+    """The files of ``dynid observe`` in the folder ``out``; returns them.
+
+    Calibrating: ``thresholds.json``. Detecting: ``events.json`` (every log's events, each
+    with its log's name when there are several) and a residual table per log
+    (:func:`observation_names`).
+    """
+    out = Path(out)
+    meta = dict(meta or {})
+    if calibrating:
+        cal = {"data": [Path(x.path).name for x in result.logs], **meta}
+        return [
+            save_thresholds(
+                out / "thresholds.json", result.thresholds, joints=joints, calibration=cal
+            )
+        ]
+    paths = []
+    events: list[ContactEvent] = []
+    logs_of: list[str] = []
+    for x, name in zip(result.logs, observation_names(result.logs), strict=True):
+        w = x.wrench
+        paths.append(
+            save_residuals_csv(
+                out / f"{name}.csv",
+                x.t,
+                x.r,
+                wrench=None if w is None else w.wrench,
+                damped=None if w is None else w.damped,
+                frame=None if w is None else w.frame,
+            )  # fmt: skip
+        )
+        events += x.events
+        logs_of += [Path(x.path).name] * len(x.events)
+    info = {
+        "data": [Path(x.path).name for x in result.logs],
+        "samples": [int(x.t.shape[0]) for x in result.logs],
+        **meta,
+    }
+    paths.insert(
+        0,
+        save_events(
+            out / "events.json", events, meta=info, logs=logs_of if len(result.logs) > 1 else None
+        ),
+    )
+    return paths

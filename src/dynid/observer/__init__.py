@@ -1,0 +1,48 @@
+"""The identified model at work: external joint torques and collision detection.
+
+The generalized-momentum residual of De Luca et al. estimates the external joint torque
+from the measured ``q, dq, tau`` without accelerations:
+
+.. math:: r = K_O \\Big(p - p_0 - \\int (\\tau - \\tau_f + C^T \\dot q - g + r)\\, dt\\Big),
+          \\qquad \\dot r = K_O (\\tau_{ext} - r)
+
+(De Luca, Albu-Schaeffer, Haddadin, Hirzinger, IROS 2006; Haddadin, De Luca,
+Albu-Schaeffer, IEEE T-RO 2017), on any model dynid produces.
+
+* :mod:`~dynid.observer.model`: :class:`ObserverModel` from an identified model or a robot;
+* :mod:`~dynid.observer.terms`: ``p = M dq`` and ``g - C^T dq`` (compiled pass), the
+  momentum regressor;
+* :mod:`~dynid.observer.friction`: friction laws in the compiled step's canonical form;
+* :mod:`~dynid.observer.residual`: :class:`MomentumObserver` (``step`` for a control loop)
+  and :func:`observe` (a whole log);
+* :mod:`~dynid.observer.wrench`: the external wrench at a frame by damped least squares;
+* :mod:`~dynid.observer.detection`: thresholds calibrated on collision-free data, the
+  model's uncertainty propagated to the residual, contact and collision events.
+"""
+
+from .detection import ContactEvent, Thresholds, calibrate, detect, residual_std
+from .model import ObserverModel, from_identified, from_robot
+from .residual import MomentumObserver, ObserverOptions, ObserverResult, first_order_lag, observe
+from .terms import base_momentum_regressor, momentum_regressor, momentum_terms
+from .wrench import WrenchEstimate, external_wrench
+
+__all__ = [
+    "ContactEvent",
+    "MomentumObserver",
+    "ObserverModel",
+    "ObserverOptions",
+    "ObserverResult",
+    "Thresholds",
+    "WrenchEstimate",
+    "base_momentum_regressor",
+    "calibrate",
+    "detect",
+    "external_wrench",
+    "first_order_lag",
+    "from_identified",
+    "from_robot",
+    "momentum_regressor",
+    "momentum_terms",
+    "observe",
+    "residual_std",
+]

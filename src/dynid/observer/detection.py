@@ -1,0 +1,347 @@
+"""Contact and collision detection on the residual: thresholds, the model's uncertainty,
+events.
+
+**Thresholds** per joint are calibrated on collision-free data (:func:`calibrate`):
+
+* the distribution rule: ``theta_j = margin * Q_q(|r_j|)``, ``Q_q`` the ``q`` quantile of
+  the residual's magnitude over the calibration samples (``q = 1``: its largest value);
+* with the model's uncertainty, a threshold that grows where the model is less certain:
+
+  .. math:: \\theta_j(t) = k \\sqrt{(Z \\Sigma Z^T)_{jj}} + \\nu_j
+
+  with ``Sigma`` the covariance of the identified base parameters and ``Z = dr/dbeta`` the
+  residual's sensitivity to them: the observer's own filter applied to the momentum
+  regressor, ``Z_k = Z_{k-1} + gamma ((Y_{p,k} - Y_{p,k-1}) / T + Y_{beta,k} - Z_{k-1})``
+  (:func:`residual_std`; ``Y_p`` and ``Y_beta`` of
+  :func:`~dynid.observer.terms.base_momentum_regressor`, the rule's mean of ``Y_beta``
+  with the trapezoid rule). The noise floor ``nu_j = margin * Q_q((|r_j| - k sigma_j)^+)``
+  is what the uncertainty leaves unexplained on the calibration data.
+
+Two levels, as robot controllers have them: ``contact`` (the threshold) and ``collision``
+(``collision_factor`` times it).
+
+**Events** (:func:`detect`): the samples where some ``|r_j|`` exceeds its contact
+threshold, runs closer than ``merge_s`` joined; each event has its start and end [s]
+(first and last sample over the threshold), the joints over it (1-based), the peak
+residual of every joint [N m] (signed, at its largest magnitude) and its level
+(``collision`` when some joint passed its collision threshold).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from dataclasses import dataclass, field
+from typing import Literal
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+
+from .. import _checks
+from ..exceptions import DataError, OptionError, ShapeError
+from .model import ObserverModel
+from .residual import DEFAULT_OPTIONS, ObserverOptions
+from .terms import base_momentum_regressor
+
+__all__ = [
+    "ContactEvent",
+    "Thresholds",
+    "calibrate",
+    "detect",
+    "residual_std",
+    "threshold_series",
+]
+
+#: Samples of the momentum regressor held at once by :func:`residual_std`.
+BLOCK = 8192
+
+
+@dataclass(frozen=True, slots=True, eq=False)
+class Thresholds:
+    """Per-joint detection thresholds (module docstring); arrays read-only.
+
+    Attributes
+    ----------
+    contact, collision : ndarray, shape (n,)
+        Fixed thresholds [N m] (the distribution rule).
+    margin, quantile, collision_factor : float
+        The rule's parameters.
+    k_sigma : float or None
+        ``k`` of the uncertainty-grown threshold; None: fixed thresholds only.
+    noise : ndarray, shape (n,), or None
+        Its noise floor ``nu`` [N m] (the contact level's).
+    options : ObserverOptions
+        The observer the thresholds were calibrated with (the residual they apply to).
+    samples : int
+        Calibration samples.
+    """
+
+    contact: NDArray[np.float64]
+    collision: NDArray[np.float64]
+    margin: float
+    quantile: float
+    collision_factor: float
+    options: ObserverOptions
+    samples: int
+    k_sigma: float | None = None
+    noise: NDArray[np.float64] | None = field(default=None)
+
+    def __post_init__(self) -> None:
+        n = np.shape(self.contact)[0]
+        for name in ("contact", "collision") + (("noise",) if self.noise is not None else ()):
+            a = _checks.as_exact(name, getattr(self, name), (n,))
+            if np.any(a < 0):
+                raise DataError(f"thresholds: {name} must be >= 0 [N m]; got {a.tolist()}")
+            object.__setattr__(self, name, _checks.frozen(a))
+
+    @property
+    def n(self) -> int:
+        """Joints."""
+        return int(self.contact.shape[0])
+
+    @property
+    def uses_uncertainty(self) -> bool:
+        """Whether the thresholds grow with the model's uncertainty."""
+        return self.k_sigma is not None and self.noise is not None
+
+
+@dataclass(frozen=True, slots=True)
+class ContactEvent:
+    """A detected contact (module docstring).
+
+    Attributes
+    ----------
+    start, end : float
+        First and last sample over the threshold [s].
+    joints : tuple of int
+        Joints over their threshold during the event, 1-based.
+    peak : tuple of float
+        Every joint's residual at its largest magnitude in the event [N m] (signed).
+    level : {"contact", "collision"}
+    """
+
+    start: float
+    end: float
+    joints: tuple[int, ...]
+    peak: tuple[float, ...]
+    level: Literal["contact", "collision"]
+
+
+def residual_std(
+    model: ObserverModel,
+    t: ArrayLike,
+    q: ArrayLike,
+    dq: ArrayLike,
+    options: ObserverOptions = DEFAULT_OPTIONS,
+) -> NDArray[np.float64]:
+    """Standard deviation (N, n) [N m] of the residual from the base parameters' covariance.
+
+    ``sqrt(diag(Z Sigma Z^T))`` with ``Z = dr/dbeta`` (module docstring), the filter run at
+    the log's median sample time; a block of :data:`BLOCK` samples at a time.
+
+    Raises
+    ------
+    DataError
+        A model without base parameters or covariance (a robot's own parameters).
+    ShapeError, NonFiniteError
+        Bad shapes, NaN.
+    """
+    import scipy.signal
+
+    if model.base is None or model.covariance is None:
+        raise DataError(
+            "the model's uncertainty needs identified base parameters with their covariance "
+            "(an identification.json); a robot's own parameters have none"
+        )
+    n = model.n
+    ta = _checks.as_array("t", t)
+    N = ta.shape[0]
+    qa, dqa = _checks.as_exact("q", q, (N, n)), _checks.as_exact("dq", dq, (N, n))
+    T = float(np.median(np.diff(ta))) if N > 1 else 1.0
+    K = options.gains(n)
+    gam = -np.expm1(-K * T) if options.discretisation == "exact" else K * T
+    trap = options.rule == "trapezoid"
+    w, V = np.linalg.eigh(np.asarray(model.covariance))
+    L = V * np.sqrt(np.clip(w, 0.0, None))  # Sigma = L L^T
+    out = np.zeros((N, n))
+    r = L.shape[0]
+    zi = np.zeros((n, 1, r))
+    prev_p = prev_b = None
+    for a in range(0, N, BLOCK):
+        Yp, Yb = base_momentum_regressor(model, qa[a : a + BLOCK], dqa[a : a + BLOCK])
+        m = Yp.shape[0]
+        dp = np.empty_like(Yp)
+        dp[1:] = np.diff(Yp, axis=0) / T
+        dp[0] = 0.0 if prev_p is None else (Yp[0] - prev_p) / T
+        yb = Yb.copy()
+        if trap:
+            yb[1:] = 0.5 * (Yb[1:] + Yb[:-1])
+            if prev_b is not None:
+                yb[0] = 0.5 * (Yb[0] + prev_b)
+        x = dp + yb
+        if prev_p is None:
+            x[0] = 0.0  # r_0 = 0 whatever the parameters
+        Z = np.empty_like(x)
+        for j in range(n):
+            Z[:, j, :], zf = scipy.signal.lfilter(
+                [gam[j]], [1.0, gam[j] - 1.0], x[:, j, :], axis=0, zi=zi[j]
+            )
+            zi[j] = zf
+        out[a : a + m] = np.sqrt(np.sum((Z @ L) ** 2, axis=-1))
+        prev_p, prev_b = Yp[-1], Yb[-1]
+    return out
+
+
+def calibrate(
+    residuals: Sequence[ArrayLike],
+    options: ObserverOptions,
+    *,
+    std: Sequence[ArrayLike] | None = None,
+    margin: float = 1.5,
+    quantile: float = 1.0,
+    collision_factor: float = 2.0,
+    k_sigma: float = 3.0,
+) -> Thresholds:
+    """Per-joint thresholds from the residuals of collision-free logs (module docstring).
+
+    Parameters
+    ----------
+    residuals : sequence of array_like, shape (N_i, n)
+        Residuals [N m] of collision-free motions.
+    options : ObserverOptions
+        The observer they were computed with (kept with the thresholds).
+    std : sequence of array_like, shape (N_i, n), optional
+        :func:`residual_std` of the same samples: the thresholds then also grow with the
+        model's uncertainty (``k_sigma``).
+    margin : float
+        Factor over the calibration residuals (>= 1).
+    quantile : float
+        Of ``|r|`` over the calibration samples, in (0, 1]; 1: the largest.
+    collision_factor : float
+        Collision over contact level (>= 1).
+    k_sigma : float
+        ``k`` of the uncertainty-grown threshold (> 0).
+
+    Returns
+    -------
+    Thresholds
+
+    Raises
+    ------
+    OptionError
+        A parameter out of its range.
+    ShapeError
+        Residuals of different joint counts, ``std`` not of their shapes, no sample.
+    """
+    if not margin >= 1.0 or not 0.0 < quantile <= 1.0 or not collision_factor >= 1.0:
+        raise OptionError(
+            f"margin >= 1, quantile in (0, 1] and collision factor >= 1 are needed; got "
+            f"{margin}, {quantile}, {collision_factor}"
+        )
+    if not k_sigma > 0:
+        raise OptionError(f"k_sigma must be > 0; got {k_sigma}")
+    R = [_checks.as_array("residual", x) for x in residuals]
+    if not R or any(x.ndim != 2 or x.shape[1] != R[0].shape[1] for x in R):
+        raise ShapeError("residuals must be one or more (N, n) arrays of one joint count")
+    A = np.abs(np.concatenate(R))
+    if A.shape[0] == 0:
+        raise ShapeError("no calibration sample")
+    contact = margin * np.quantile(A, quantile, axis=0)
+    noise = None
+    if std is not None:
+        S = np.concatenate(
+            [_checks.as_exact("std", s, x.shape) for s, x in zip(std, R, strict=True)]
+        )
+        excess = np.clip(A - k_sigma * S, 0.0, None)
+        noise = margin * np.quantile(excess, quantile, axis=0)
+    return Thresholds(
+        contact=contact,
+        collision=collision_factor * contact,
+        margin=margin,
+        quantile=quantile,
+        collision_factor=collision_factor,
+        options=options,
+        samples=int(A.shape[0]),
+        k_sigma=k_sigma if std is not None else None,
+        noise=noise,
+    )
+
+
+def threshold_series(
+    thresholds: Thresholds, N: int, std: ArrayLike | None = None
+) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+    """The contact and collision thresholds at every sample, each (N, n) [N m]: fixed, or
+    ``k sigma + nu`` (and its ``collision_factor`` multiple) when ``std`` (N, n) is given
+    and the thresholds use the model's uncertainty."""
+    n = thresholds.n
+    if std is not None and thresholds.uses_uncertainty:
+        assert thresholds.k_sigma is not None and thresholds.noise is not None
+        s = _checks.as_exact("std", std, (N, n))
+        c = thresholds.k_sigma * s + thresholds.noise
+        return c, thresholds.collision_factor * c
+    return (
+        np.broadcast_to(thresholds.contact, (N, n)).copy(),
+        np.broadcast_to(thresholds.collision, (N, n)).copy(),
+    )
+
+
+def detect(
+    t: ArrayLike,
+    r: ArrayLike,
+    thresholds: Thresholds,
+    *,
+    std: ArrayLike | None = None,
+    merge_s: float = 0.05,
+) -> list[ContactEvent]:
+    """Contact events of a residual (module docstring).
+
+    Parameters
+    ----------
+    t : array_like, shape (N,)
+        Sample times [s].
+    r : array_like, shape (N, n)
+        Residual [N m].
+    thresholds : Thresholds
+    std : array_like, shape (N, n), optional
+        :func:`residual_std` of the samples (for thresholds that use the uncertainty).
+    merge_s : float
+        Runs over the threshold closer than this [s] are one event (>= 0).
+
+    Returns
+    -------
+    list of ContactEvent
+        In time order.
+
+    Raises
+    ------
+    ShapeError
+        Shapes that disagree, thresholds of another joint count.
+    OptionError
+        A negative ``merge_s``.
+    """
+    ta = _checks.as_array("t", t)
+    N = ta.shape[0]
+    ra = _checks.as_exact("r", r, (N, thresholds.n))
+    if not merge_s >= 0:
+        raise OptionError(f"merge_s must be >= 0 [s]; got {merge_s}")
+    contact, collision = threshold_series(thresholds, N, std)
+    over = np.abs(ra) > contact
+    hit = np.flatnonzero(over.any(axis=1))
+    if hit.size == 0:
+        return []
+    cut = np.flatnonzero(ta[hit[1:]] - ta[hit[:-1]] > merge_s) + 1
+    events = []
+    for run in np.split(hit, cut):
+        a, b = int(run[0]), int(run[-1]) + 1
+        seg = ra[a:b]
+        k = np.argmax(np.abs(seg), axis=0)
+        peak = seg[k, np.arange(seg.shape[1])]
+        joints = tuple(int(j) + 1 for j in np.flatnonzero(over[a:b].any(axis=0)))
+        level: Literal["contact", "collision"] = (
+            "collision" if np.any(np.abs(seg) > collision[a:b]) else "contact"
+        )
+        events.append(
+            ContactEvent(
+                float(ta[a]), float(ta[b - 1]), joints, tuple(float(x) for x in peak), level
+            )
+        )
+    return events

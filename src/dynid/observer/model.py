@@ -1,0 +1,168 @@
+"""The dynamic model an observer runs on, from whatever model dynid produced.
+
+:class:`ObserverModel` holds what the residual needs: a robot whose link parameters give
+``M``, ``C^T dq`` and ``g`` by the recursive algorithms (the identified model's *equivalent
+robot*, whose standard parameters map to the identified base parameters, or a consistent
+robot's physical parameters), the constant rotor part of the mass matrix
+``M_r = K^T diag(I_a) K``, the friction ``tau_f(dq)`` and, for an identified model, the base
+parameters with their covariance (the model's uncertainty, :mod:`dynid.observer.detection`).
+
+Two adapters make one: :func:`from_identified` (an
+:class:`~dynid.identification.model.IdentifiedModel`, read through its public attributes
+only, in this one function) and :func:`from_robot` (a consistent robot of ``feasible.json``,
+a URDF, TOML or MJCF robot, with a drive's rotor inertias and a friction model).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+
+from .. import _checks
+from ..exceptions import ShapeError
+from ..friction.model import FrictionModel, SigmoidFriction
+from ..friction.validation import own_friction
+from ..identification.model import IdentifiedModel
+from ..model.drive import Drive
+from ..model.robot import Robot
+from ..regressors.base import BaseParameters
+
+__all__ = ["ObserverModel", "from_identified", "from_robot"]
+
+
+@dataclass(frozen=True, slots=True, eq=False)
+class ObserverModel:
+    """What the momentum observer evaluates (module docstring); arrays read-only.
+
+    Attributes
+    ----------
+    robot : Robot
+        Kinematics, gravity and the link parameters ``M``, ``C`` and ``g`` are computed from.
+    rotor_mass : ndarray, shape (n, n)
+        Constant part of the mass matrix [kg m^2] (rotor inertias, ``K^T diag(I_a) K``).
+    friction : FrictionModel or None
+        ``tau_f(dq)`` [N m], the measured torque's part spent on friction.
+    base : BaseParameters or None
+        The identified base parameters' map (None for a robot's own parameters).
+    beta : ndarray, shape (r,), or None
+        Identified base parameters.
+    covariance : ndarray, shape (r, r), or None
+        Their covariance (None when unknown).
+    drive : Drive or None
+        The drive of the rotor columns of the base parameters (``Ia1 .. Ia_n``).
+    source : str
+        What the model was made from (``"identified"``, ``"robot"``), for reports.
+    """
+
+    robot: Robot
+    rotor_mass: NDArray[np.float64]
+    friction: FrictionModel | None = None
+    base: BaseParameters | None = None
+    beta: NDArray[np.float64] | None = None
+    covariance: NDArray[np.float64] | None = None
+    drive: Drive | None = None
+    source: str = "robot"
+
+    def __post_init__(self) -> None:
+        n = self.robot.n
+        Mr = _checks.as_exact("rotor_mass", self.rotor_mass, (n, n))
+        object.__setattr__(self, "rotor_mass", _checks.frozen(Mr))
+        if self.friction is not None and self.friction.n != n:
+            raise ShapeError(f"friction model has {self.friction.n} joints; the robot has {n}")
+        if self.beta is not None:
+            object.__setattr__(self, "beta", _checks.frozen(np.asarray(self.beta, float)))
+        if self.covariance is not None:
+            object.__setattr__(self, "covariance", _checks.frozen(np.asarray(self.covariance)))
+
+    @property
+    def n(self) -> int:
+        """Joints."""
+        return self.robot.n
+
+    def with_friction(self, friction: FrictionModel | None) -> ObserverModel:
+        """The same model with another friction (None: none)."""
+        return ObserverModel(
+            self.robot, self.rotor_mass, friction, self.base, self.beta, self.covariance,
+            self.drive, self.source,
+        )  # fmt: skip
+
+    def mass_matrix(self, q: ArrayLike) -> NDArray[np.float64]:
+        """``M(q)`` [kg m^2] with the rotor part: (..., n) -> (..., n, n)."""
+        from ..dynamics.terms import mass_matrix
+
+        return mass_matrix(self.robot, q) + self.rotor_mass
+
+
+def from_identified(
+    model: IdentifiedModel, friction: FrictionModel | None | str = "model"
+) -> ObserverModel:
+    """The observer model of an identified model (the one adapter to its attributes).
+
+    Parameters
+    ----------
+    model : IdentifiedModel
+        Base parameters (through ``equivalent_robot``), rotor inertias (``rotor_inertia``
+        with ``drive``), the identified friction and the covariance of ``fit``.
+    friction : FrictionModel, None or "model"
+        ``"model"`` (default): the friction identified with the model (classical, at the
+        motors with a drive whose friction acts there), none if it has none.
+
+    Returns
+    -------
+    ObserverModel
+    """
+    n = model.robot.n
+    Mr = np.zeros((n, n))
+    if model.rotor_inertia is not None and model.drive is not None:
+        Mr = model.drive.rotor_mass_matrix(model.rotor_inertia)
+    fr = own_friction(model) if isinstance(friction, str) else friction
+    fit = model.fit
+    return ObserverModel(
+        robot=model.equivalent_robot,
+        rotor_mass=Mr,
+        friction=fr,
+        base=model.base,
+        beta=np.asarray(fit.beta),
+        covariance=None if fit.covariance is None else np.asarray(fit.covariance),
+        drive=model.drive,
+        source="identified",
+    )
+
+
+def from_robot(
+    robot: Robot,
+    *,
+    friction: FrictionModel | None | str = "robot",
+    drive: Drive | None = None,
+) -> ObserverModel:
+    """The observer model of a robot's own link parameters (a consistent robot, a URDF).
+
+    Parameters
+    ----------
+    robot : Robot
+    friction : FrictionModel, None or "robot"
+        ``"robot"`` (default): the robot's sigmoid friction, none if it has none.
+    drive : Drive, optional
+        Its known rotor inertias add ``K^T diag(I_a) K`` to ``M``.
+
+    Returns
+    -------
+    ObserverModel
+
+    Raises
+    ------
+    ShapeError
+        A drive or friction for another number of joints.
+    """
+    n = robot.n
+    Mr = np.zeros((n, n))
+    if drive is not None:
+        drive.check(n)
+        if drive.rotor_inertia is not None:
+            Mr = drive.rotor_mass_matrix(drive.rotor_inertia)
+    fr: FrictionModel | None = friction if not isinstance(friction, str) else None
+    if isinstance(friction, str) and robot.friction is not None:
+        fr = SigmoidFriction.from_array(robot.friction)
+    return ObserverModel(robot=robot, rotor_mass=Mr, friction=fr, drive=drive, source="robot")

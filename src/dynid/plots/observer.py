@@ -1,0 +1,82 @@
+"""Figures of the momentum observer: residuals, thresholds and detected events.
+
+matplotlib is imported inside the functions; they return a Figure and never show it.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from typing import TYPE_CHECKING
+
+import numpy as np
+from numpy.typing import NDArray
+
+from ..observer.detection import ContactEvent
+
+if TYPE_CHECKING:  # pragma: no cover
+    from matplotlib.figure import Figure
+
+__all__ = ["plot_residuals"]
+
+
+def plot_residuals(
+    t: NDArray[np.float64],
+    r: NDArray[np.float64],
+    contact: NDArray[np.float64],
+    collision: NDArray[np.float64],
+    *,
+    events: Sequence[ContactEvent] = (),
+    tau_ext: NDArray[np.float64] | None = None,
+    joint_names: Sequence[str] | None = None,
+    max_points: int = 20000,
+    title: str | None = None,
+) -> Figure:
+    """One panel per joint: the residual over time with its thresholds and the events.
+
+    Parameters
+    ----------
+    t : ndarray, shape (N,)
+        [s].
+    r : ndarray, shape (N, n)
+        Residual [N m].
+    contact, collision : ndarray, shape (N, n)
+        Thresholds [N m] (drawn at plus and minus).
+    events : sequence of ContactEvent
+        Shaded over their windows (contact orange, collision red).
+    tau_ext : ndarray, shape (N, n), optional
+        The true external torques (a simulated contact), drawn thin.
+    joint_names : sequence of str, optional
+    max_points : int
+        Samples drawn per curve (evenly strided).
+    title : str, optional
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+    """
+    import matplotlib.pyplot as plt
+
+    n = r.shape[1]
+    names = list(joint_names) if joint_names is not None else [f"joint {j + 1}" for j in range(n)]
+    fig, axes = plt.subplots(n, 1, sharex=True, figsize=(10, 1.6 * n + 0.8), squeeze=False)
+    s = slice(None, None, max(1, int(np.ceil(t.size / max_points))))
+    for j in range(n):
+        ax = axes[j, 0]
+        for e in events:
+            ax.axvspan(
+                e.start, max(e.end, e.start + 1e-3),
+                color="tab:red" if e.level == "collision" else "tab:orange", alpha=0.25, lw=0,
+            )  # fmt: skip
+        ax.plot(t[s], r[s, j], color="tab:blue", lw=0.9, label="residual")
+        if tau_ext is not None:
+            ax.plot(t[s], tau_ext[s, j], color="tab:green", lw=0.8, label="true external torque")
+        for th, style, label in ((contact, "--", "contact"), (collision, ":", "collision")):
+            ax.plot(t[s], th[s, j], "k" + style, lw=0.7, label=f"{label} threshold")
+            ax.plot(t[s], -th[s, j], "k" + style, lw=0.7)
+        ax.set_ylabel(f"{names[j]}\n[N m]", fontsize=8)
+        ax.tick_params(labelsize=7)
+    axes[0, 0].legend(fontsize=7, loc="upper right", ncol=4)
+    axes[-1, 0].set_xlabel("t [s]")
+    fig.suptitle(title or "momentum observer: residual, thresholds and events", fontsize=10)
+    fig.tight_layout()
+    return fig

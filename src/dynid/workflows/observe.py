@@ -1,0 +1,238 @@
+"""Collision detection on log files: the entry point of ``dynid observe``, with every policy
+the command applies, so that the Python API behaves as the command does.
+
+* The model: an ``identification.json`` (``--model``; its own friction, drive and rotor
+  inertias, and the covariance of its base parameters) or a robot (``--params``: a
+  ``feasible.json`` with the drive and the friction identified with it, or a URDF/TOML
+  robot); ``--friction friction.json`` replaces the friction (the law ``dynid friction``
+  chose, with its standstill band).
+* Logs are read strictly with the model's joint count (extra columns ignored, with a
+  warning), through the column map the model's data were read with when none is given, and
+  brought to the joint side through the model's drive.
+* ``calibrate``: the residuals of every (collision-free) log give the thresholds; with an
+  identified model that has a covariance, they also grow with the model's uncertainty
+  (``uncertainty``, default on).
+* Otherwise the thresholds (``thresholds.json``) fix the observer (gains, discretisation,
+  rule) and the detection; the true external torques ``tau_ext1..n`` that
+  ``dynid simulate --contact`` writes beside a log are kept for the figure.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+from ..exceptions import OptionError
+from ..friction.model import FrictionModel
+from ..identification.log import joint_side_log
+from ..io.columns import load_joint_columns
+from ..io.feasible import load_feasible_drive, load_feasible_linear_friction
+from ..io.friction_json import load_friction_json
+from ..io.model_json import load_model_json
+from ..io.observer_files import load_thresholds
+from ..io.robot_file import load_robot
+from ..observer.detection import Thresholds, calibrate, detect, residual_std
+from ..observer.model import ObserverModel, from_identified, from_robot
+from ..observer.residual import DEFAULT_GAIN, ObserverOptions, observe
+from ..observer.results import LogObservation, ObserveResult
+from ..observer.wrench import external_wrench
+from .data_files import ColumnSpec, column_map, in_file, read_torque_log, recorded_columns
+
+__all__ = [
+    "LogObservation",
+    "ObserveOptions",
+    "ObserveResult",
+    "load_observer_model",
+    "observe_files",
+]
+
+
+@dataclass(frozen=True, slots=True)
+class ObserveOptions:
+    """What ``dynid observe`` was asked (module docstring).
+
+    Attributes
+    ----------
+    data : tuple of Path
+        Torque logs (``.csv``/``.npz``), or other tools' files read through ``columns``.
+    model : Path, optional
+        ``identification.json`` (exactly one of ``model`` and ``params``).
+    params : str or Path, optional
+        A robot: ``feasible.json``, a ``.urdf``/``.toml`` file or a built-in name.
+    friction : Path, optional
+        ``friction.json`` replacing the model's friction.
+    calibrate : bool
+        Compute thresholds from ``data`` (collision-free logs).
+    thresholds : Path, optional
+        ``thresholds.json`` to detect with (required unless ``calibrate``).
+    frame : str, optional
+        Also estimate the external wrench at this frame.
+    gain : float or tuple of float
+        ``K_O`` [1/s] when calibrating (else the thresholds' own).
+    discretisation, rule : str
+        Of the observer when calibrating (:class:`~dynid.observer.residual.ObserverOptions`).
+    margin, quantile, collision_factor, k_sigma : float
+        The calibration rule (:func:`~dynid.observer.detection.calibrate`).
+    uncertainty : bool
+        Let the thresholds grow with the model's uncertainty when the model has a
+        covariance.
+    merge_s : float
+        Events closer than this [s] are one.
+    columns : (str or None, str or None)
+        ``--columns``/``--units``; default: those the model's data were read with.
+    drop_invalid : bool
+        Drop rows with NaN/inf or a repeated timestamp instead of failing.
+    """
+
+    data: tuple[Path, ...]
+    model: Path | None = None
+    params: str | Path | None = None
+    friction: Path | None = None
+    calibrate: bool = False
+    thresholds: Path | None = None
+    frame: str | None = None
+    gain: float | tuple[float, ...] = DEFAULT_GAIN
+    discretisation: str = "exact"
+    rule: str = "trapezoid"
+    margin: float = 1.5
+    quantile: float = 1.0
+    collision_factor: float = 2.0
+    k_sigma: float = 3.0
+    uncertainty: bool = True
+    merge_s: float = 0.05
+    columns: ColumnSpec = (None, None)
+    drop_invalid: bool = False
+
+
+def load_observer_model(
+    model: Path | None, params: str | Path | None, friction: Path | None = None
+) -> tuple[ObserverModel, Mapping[str, str | None] | None]:
+    """The observer model of ``--model`` or ``--params`` (and ``--friction``), with the
+    column map the model's data were read with (None for a robot).
+
+    Raises
+    ------
+    OptionError
+        Neither or both of ``model`` and ``params``.
+    DataError
+        A file that is not what it should be (named).
+    """
+    if (model is None) == (params is None):
+        raise OptionError("give one of --model identification.json and --params ROBOT")
+    fr: FrictionModel | None | str
+    fr = "model" if friction is None else load_friction_json(friction)
+    if model is not None:
+        ident = load_model_json(model)
+        return from_identified(ident, fr), ident.info.column_map
+    spec = str(params)
+    robot = load_robot(spec, what="--params")
+    drive = None
+    if spec.lower().endswith(".json"):
+        drive = load_feasible_drive(spec)
+        if friction is None:
+            lin = load_feasible_linear_friction(spec)
+            fr = "robot" if lin is None else lin
+    return from_robot(robot, friction="robot" if fr == "model" else fr, drive=drive), None
+
+
+def _observer_options(opts: ObserveOptions, thresholds: Thresholds | None) -> ObserverOptions:
+    if thresholds is not None:
+        return thresholds.options
+    return ObserverOptions(opts.gain, opts.discretisation, opts.rule)  # type: ignore[arg-type]
+
+
+def observe_files(opts: ObserveOptions) -> ObserveResult:
+    """Calibrate thresholds on collision-free logs, or detect contacts in logs (module
+    docstring).
+
+    Returns
+    -------
+    ObserveResult
+
+    Raises
+    ------
+    OptionError
+        No log, neither or both of ``calibrate`` and ``thresholds``, no model or two.
+    DataError
+        A bad file (named), thresholds of another joint count.
+    """
+    if not opts.data:
+        raise OptionError("give one or more --data logs")
+    if opts.calibrate == (opts.thresholds is not None):
+        raise OptionError("give --calibrate (collision-free logs) or --thresholds thresholds.json")
+    model, recorded = load_observer_model(opts.model, opts.params, opts.friction)
+    given = None if opts.thresholds is None else load_thresholds(opts.thresholds)
+    if given is not None and given.n != model.n:
+        raise OptionError(
+            f"{opts.thresholds}: thresholds for {given.n} joints; the model has {model.n}"
+        )
+    options = _observer_options(opts, given)
+    wants_std = (
+        opts.uncertainty and model.covariance is not None
+        if given is None
+        else given.uses_uncertainty and model.covariance is not None
+    )
+    logs = [_observe_log(p, model, recorded, opts, options, wants_std) for p in opts.data]
+    if given is None:
+        th = calibrate(
+            [x.r for x in logs],
+            options,
+            std=[x.std for x in logs] if wants_std else None,  # type: ignore[misc]
+            margin=opts.margin,
+            quantile=opts.quantile,
+            collision_factor=opts.collision_factor,
+            k_sigma=opts.k_sigma,
+        )
+        return ObserveResult(model, th, tuple(logs))
+    found = tuple(
+        LogObservation(
+            x.path,
+            x.t,
+            x.r,
+            x.std,
+            detect(x.t, x.r, given, std=x.std, merge_s=opts.merge_s),
+            x.wrench,
+            x.tau_ext,
+        )  # fmt: skip
+        for x in logs
+    )
+    return ObserveResult(model, given, found)
+
+
+def _observe_log(
+    path: Path,
+    model: ObserverModel,
+    recorded: Mapping[str, str | None] | None,
+    opts: ObserveOptions,
+    options: ObserverOptions,
+    wants_std: bool,
+) -> LogObservation:
+    """The residual (and its std, the wrench, the stored true torques) of one log."""
+    path = Path(path)
+    names, units = recorded_columns(recorded, *opts.columns)
+    log = read_torque_log(
+        path,
+        model.n,
+        columns=column_map(names, units),
+        drop_invalid=opts.drop_invalid,
+        owner="the model",
+    )
+    log = joint_side_log(log, model.drive)
+
+    def run() -> LogObservation:
+        res = observe(model, log.t, log.q, log.dq, log.tau, options)
+        std = residual_std(model, log.t, log.q, log.dq, options) if wants_std else None
+        wrench = None
+        if opts.frame is not None:
+            wrench = external_wrench(model.robot, log.q, res.r, opts.frame)
+        ext = None
+        if path.suffix.lower() in (".csv", ".npz") and names is None:
+            ext = load_joint_columns(path, "tau_ext", model.n)
+            if ext is not None and ext.shape[0] != log.t.shape[0]:
+                ext = None  # rows were dropped: not aligned with the log
+        return LogObservation(path, log.t, np.asarray(res.r), std, [], wrench, ext)
+
+    return in_file(path, run)
