@@ -3,20 +3,24 @@
 The residual tau_measured - (M ddq + c + g) of the model (an identification.json, or a
 robot's own link parameters with --robot) is fitted per joint by a friction law:
 --friction-model auto (default) fits every law of the registry (listed below, with none:
-no extra friction) on 4 of 5 contiguous blocks of the log in turn, predicts the block left out,
-keeps the law with the lowest held-out error (the model's own friction is a candidate too,
-so the result never predicts worse than it) and prints the table; a law's name fits that
-law. Coulomb friction is off where |dq| is inside the velocity noise band. The states are
-low-pass filtered with zero phase (--cutoff) and the accelerations differentiated from the
-filtered velocities. With a drive (--drive, or the
-model's own) the log is read through it and the law is fitted per motor at the motor
-velocities where the drive's friction acts there (tau_f = K^T f(K dq)).
+no extra friction) on 4 of 5 contiguous blocks of the log in turn (with several
+recordings: on all but one recording in turn), predicts the block left out, keeps the law
+with the lowest held-out error (the model's own friction is a candidate too, its law
+refitted and judged on the same blocks) and prints the table; a law's name fits that
+law. --data takes several recordings (or a folder of them): each recording, and each
+piece of one cut at a gap longer than --max-gap, is filtered on its own, and the laws are
+fitted on the residual of all pieces together. Coulomb friction is off where |dq| is
+inside the velocity noise band. The states are low-pass filtered with zero phase
+(--cutoff) and the accelerations differentiated from the filtered velocities. With a
+drive (--drive, or the model's own) the log is read through it and the law is fitted per
+motor at the motor velocities where the drive's friction acts there (tau_f = K^T f(K dq)).
 
 Writes OUT/friction.json (parameters, RMS of the residual before and after, the held-out
 table) and
 OUT/friction.png (residual against velocity with the fitted curve, per joint; skipped,
 with a note, without matplotlib). The log is read strictly: rows with NaN/inf or a
-repeated timestamp are an error unless --drop-invalid; gaps up to --max-gap are bridged.
+repeated timestamp are an error unless --drop-invalid; gaps up to --max-gap are bridged,
+longer ones cut the log into pieces.
 
 Example:
   dynid friction --model out/identification.json --data traj.csv --out out/friction
@@ -67,7 +71,14 @@ def register(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParser:
     src.add_argument("--robot", help="'panda', 'fr3', a .urdf or a .toml: its link parameters")
     p.add_argument("--base", default=None, help="URDF base link (with --robot)")
     p.add_argument("--tip", default=None, help="URDF tip link (with --robot)")
-    p.add_argument("--data", type=Path, required=True, help="torque log (.csv or .npz)")
+    p.add_argument(
+        "--data",
+        type=Path,
+        nargs="+",
+        required=True,
+        help="torque log(s) (.csv or .npz), or a folder of them: each recording, and each "
+        "piece between gaps longer than --max-gap, filtered on its own",
+    )
     add_column_options(p)
     add_drive_option(p)
     p.add_argument("--out", type=output_path, required=True, help="output directory")
@@ -117,8 +128,11 @@ def run(args: argparse.Namespace, console: Console) -> int:
     fit, sel = result.fit, result.selection
     if sel is not None:
         console.print(sel.table())
+    files = [s["file"] for s in result.pieces.summary()] if result.pieces else []
     meta = {
-        "data": str(args.data.name),
+        "data": ", ".join(files),
+        "files": files,
+        "recordings": list(result.pieces.summary()) if result.pieces else [],
         "model": str(args.model.name) if args.model is not None else args.robot,
         "cutoff_hz": result.cutoff_hz,
         "n_samples": fit.n_samples,
@@ -133,12 +147,14 @@ def run(args: argparse.Namespace, console: Console) -> int:
             result.residual,
             fit,
             names=names,
-            title=shown(f"{fit.kind} friction fitted to the torque residual ({args.data.name})"),
+            title=shown(f"{fit.kind} friction fitted to the torque residual ({meta['data']})"),
         )
     console.print(
         format_rms_table(
             names, {"RMS before [N m]": fit.rms_before, "RMS after [N m]": fit.rms_after}
         )
     )
+    if result.pieces is not None:
+        console.print(result.pieces.describe())
     console.wrote(args.out / "friction.json")
     return 0

@@ -3,7 +3,9 @@
 The arm's model is known: --robot (built-in or a description with its parameters),
 --model identification.json (identified) or --params feasible.json (feasible). --data is
 recorded with the load: static data (q, M, g; --gravity-only uses g alone and gives the
-mass and CoM only) or a torque log (classical friction is estimated alongside). With
+mass and CoM only) or torque logs (classical friction is estimated alongside; several
+recordings, or a folder of them: each recording, and each piece of one cut at a gap
+longer than --max-gap, is filtered on its own and never joined to another). With
 --unloaded DATA0 (the same kind of data without the load) the arm is identified from DATA0
 first (difference method). The estimate is physically consistent (pseudo-inertia LMI).
 --columns/--units read files of other tools.
@@ -20,18 +22,21 @@ from __future__ import annotations
 
 import argparse
 from pathlib import Path
-from typing import Any
 
-from ..exceptions import DynidError
-from ..feasibility.payload import identify_payload, robot_with_payload
+from ..feasibility.payload import robot_with_payload
 from ..identification.log import DEFAULT_CUTOFF_HZ
 from ..identification.model import IdentifiedModel
 from ..io.payload_json import save_payload_json
 from ..io.robot.toml import save_toml
 from ..model.inertia import INERTIA_ORDER, inertia6_from_matrix
-from ..model.robot import Robot
-from ..workflows.data_files import column_map, data_kind, read_static_file, read_torque_log
-from .common import add_column_options, add_drop_invalid, add_subcommand, output_path, positive_type
+from ..workflows.payload import identify_payload_files
+from .common import (
+    add_column_options,
+    add_log_options,
+    add_subcommand,
+    output_path,
+    positive_type,
+)
 from .console import Console
 from .sources import load_model_source
 
@@ -51,7 +56,14 @@ def register(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParser:
     src.add_argument("--params", type=Path, help="feasible.json of the arm")
     p.add_argument("--base", default=None, help="URDF base link (with --robot)")
     p.add_argument("--tip", default=None, help="URDF tip link (with --robot)")
-    p.add_argument("--data", type=Path, required=True, help="data with the load (.csv/.npz)")
+    p.add_argument(
+        "--data",
+        type=Path,
+        nargs="+",
+        required=True,
+        help="data with the load (.csv/.npz): static data (one file) or torque logs (one "
+        "or more, or a folder of them)",
+    )
     p.add_argument("--unloaded", type=Path, default=None, help="the same data without the load")
     add_column_options(p)
     p.add_argument("--frame", default="flange", help="frame the load is fixed to")
@@ -59,39 +71,27 @@ def register(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParser:
     p.add_argument(
         "--cutoff", type=positive_type, default=DEFAULT_CUTOFF_HZ, help="torque logs: low-pass [Hz]"
     )
-    add_drop_invalid(p)
+    add_log_options(p)
     p.add_argument("--out", type=output_path, required=True, help="output folder")
     return p
-
-
-def _read(args: argparse.Namespace, path: Path, robot: Robot, kind: str, cmap: Any) -> Any:
-    drop = args.drop_invalid
-    if kind == "torque_log":
-        owner = f"robot {robot.name!r}"
-        return read_torque_log(path, robot.n, columns=cmap, drop_invalid=drop, owner=owner)
-    return read_static_file(
-        path, robot, columns=cmap, drop_invalid=drop, require_M=not args.gravity_only
-    )
 
 
 def run(args: argparse.Namespace, console: Console) -> int:
     """Identify, write payload.json and the robot with the load, print a summary."""
     arm, label = load_model_source(args)
     kin = arm.robot if isinstance(arm, IdentifiedModel) else arm
-    cmap = column_map(args.columns, args.units, cutoff_hz=args.cutoff)
-    kind = data_kind(args.data, cmap)
-    if args.gravity_only and kind != "static":
-        raise DynidError("--gravity-only applies to static data (q, g), not to a torque log")
-    data = _read(args, args.data, kin, kind, cmap)
-    unloaded = None if args.unloaded is None else _read(args, args.unloaded, kin, kind, cmap)
-    est = identify_payload(
+    result = identify_payload_files(
         arm,
-        data,
+        args.data,
+        unloaded=args.unloaded,
         frame=args.frame,
         gravity_only=args.gravity_only,
-        unloaded=unloaded,
-        cutoff_hz=args.cutoff if kind == "torque_log" else None,
+        columns=(args.columns, args.units),
+        drop_invalid=args.drop_invalid,
+        cutoff_hz=args.cutoff,
+        max_gap_s=args.max_gap,
     )
+    est = result.estimate
     base = arm.equivalent_robot if isinstance(arm, IdentifiedModel) else arm
     tool = robot_with_payload(base, est)
     save_toml(args.out / "robot_with_payload.toml", tool)
@@ -108,6 +108,8 @@ def run(args: argparse.Namespace, console: Console) -> int:
             INERTIA_ORDER, inertia6_from_matrix(est.inertia), est.std_inertia, strict=True
         ):
             console.print(f"  I{name}      {v:+.4e} kg m^2  (std {s:.2g})")
+    if result.recordings:
+        console.print(result.describe())
     for note in est.notes:
         console.print(f"note: {note}")
     console.print(f"wrote {path} and {args.out / 'robot_with_payload.toml'}")

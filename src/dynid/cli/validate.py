@@ -15,14 +15,22 @@ measured ones, per joint (RMS, MSE) and overall (relative error). Model sources:
 filtered with zero phase (--cutoff), the accelerations differentiated from the filtered
 velocities; the measured torques are compared unfiltered.
 
+--data takes several recordings (or a folder of them): each recording, and each piece of
+one cut at a gap longer than --max-gap, is filtered on its own and never joined to
+another. The errors are pooled over every sample of every recording (RMS per joint,
+relative error over all), and given per recording; the torque figure shows the longest
+piece of the first recording, the RMS figure the pooled errors.
+
 Writes OUT/validation.json {"rms": [...], "mse": [...], "relative_error_percent": x, ...}
-(for the full model, plus a "without_friction" block) and the figures
+(for the full model, plus a "without_friction" block, and one entry per recording in
+"recordings") and the figures
 OUT/validation_torques.png and OUT/validation_rms.png (skipped, with a note, without
 matplotlib). The log is read strictly: rows with NaN/inf or a repeated timestamp are an
-error unless --drop-invalid; gaps up to --max-gap are bridged.
+error unless --drop-invalid; gaps up to --max-gap are bridged, longer ones cut the log.
 
 Example:
   dynid validate --robot panda --data traj.csv --out out/validation
+  dynid validate --model out/identification.json --data held/ --out out/validation
 """
 
 from __future__ import annotations
@@ -30,16 +38,10 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
-import numpy as np
-
-from ..exceptions import DataError
-from ..friction.validation import own_friction, recorded_cutoff, validate_torques
 from ..identification.model import IdentifiedModel
-from ..io.feasible import load_feasible_drive, load_feasible_linear_friction
-from ..io.friction_json import load_friction_json
 from ..io.validation_json import save_validation_json
+from ..workflows.validate import ValidateOptions, validate_files
 from .common import (
-    about,
     add_column_options,
     add_drive_option,
     add_log_options,
@@ -51,7 +53,7 @@ from .common import (
 )
 from .console import Console
 from .figures import save_validation_figures
-from .sources import load_model_source, read_data_log
+from .sources import load_model_source
 from .summaries import format_rms_table
 
 NAME = "validate"
@@ -78,7 +80,14 @@ def register(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParser:
     fr = p.add_mutually_exclusive_group()
     fr.add_argument("--friction", type=Path, help="friction.json to add to the model")
     fr.add_argument("--no-friction", action="store_true", help="ignore the model's own friction")
-    p.add_argument("--data", type=Path, required=True, help="torque log (.csv or .npz)")
+    p.add_argument(
+        "--data",
+        type=Path,
+        nargs="+",
+        required=True,
+        help="torque log(s) (.csv or .npz), or a folder of them: each recording, and each "
+        "piece between gaps longer than --max-gap, filtered on its own",
+    )
     add_column_options(p)
     p.add_argument("--out", type=output_path, required=True, help="output directory")
     p.add_argument(
@@ -98,60 +107,33 @@ def run(args: argparse.Namespace, console: Console) -> int:
     """Validate, write validation.json and the figures, print the RMS table (unless -q)."""
     model, label = load_model_source(args)
     robot = model.robot if isinstance(model, IdentifiedModel) else model
-    recorded = model.info.column_map if isinstance(model, IdentifiedModel) else None
-    log = read_data_log(args, robot.n, owner=f"the model ({label})", recorded=recorded)
-    logs = [log]  # handed over: validate frees the raw signals once it has filtered them
-    del log
-    if args.friction is not None:
-        friction = load_friction_json(args.friction)
-    elif args.no_friction:
-        friction = None
-    else:
-        friction = own_friction(model)
-        if args.params is not None:
-            friction = load_feasible_linear_friction(args.params) or friction
-    cutoff = recorded_cutoff(model, logs[0]) if args.cutoff is None else args.cutoff
-    drive = load_drive_arg(args, robot.n)
-    if drive is None and args.params is not None:
-        drive = load_feasible_drive(args.params)
-    with about(args.data):
-        val = validate_torques(
-            model,
-            logs.pop(),
-            friction=friction,
-            cutoff_hz=cutoff,
-            max_gap_s=args.max_gap,
-            drive=drive,
-        )
-    errors = val.errors
-    if not np.isfinite(errors.relative_error_percent) or not np.all(np.isfinite(errors.rms)):
-        raise DataError(
-            f"{args.data.name}: the torque errors overflow (relative error "
-            f"{errors.relative_error_percent}); the log holds values far outside a robot's "
-            f"range (largest |tau| {float(np.max(np.abs(val.log.tau))):.3g} N m)"
-        )
-    path = save_validation_json(
-        args.out / "validation.json",
-        val,
-        model=label,
-        friction_source=(
-            str(args.friction.name)
-            if args.friction is not None
-            else ("model" if friction is not None else None)
-        ),
-        data=str(args.data.name),
-        cutoff_hz=cutoff,
+    options = ValidateOptions(
+        friction=args.friction or ("none" if args.no_friction else "own"),
+        columns=(args.columns, args.units),
+        drop_invalid=args.drop_invalid,
+        cutoff_hz=args.cutoff,
+        max_gap_s=args.max_gap,
+        drive=load_drive_arg(args, robot.n),
     )
+    result = validate_files(model, args.data, options, feasible=args.params, label=label)
+    val = result.validation
+    path = save_validation_json(args.out / "validation.json", val, **result.metadata())
     names = list(robot.joint_names)
     if not args.no_figures:
-        save_validation_figures(
-            args.out, val, names=names, title=shown(f"{label} on {args.data.name}")
+        what = result.files[0] + (
+            " (its torques; errors over all)" if len(result.files) > 1 else ""
         )
+        save_validation_figures(args.out, val.shown, names=names, title=shown(f"{label} on {what}"))
     cols = {"RMS no friction [N m]": val.without_friction.rms}
     if val.with_friction is not None:
         cols["RMS + friction [N m]"] = val.with_friction.rms
-    console.print(
-        format_rms_table(names, cols),
-        f"relative error {val.errors.relative_error_percent:.3f} %; wrote {path}",
-    )
+    console.print(format_rms_table(names, cols), val.pieces.describe())
+    if len(val.recordings) > 1:
+        console.print(
+            *(
+                f"  {r.file}: relative error {r.errors.relative_error_percent:.3f} %"
+                for r in val.recordings
+            )
+        )
+    console.print(f"relative error {val.errors.relative_error_percent:.3f} %; wrote {path}")
     return 0

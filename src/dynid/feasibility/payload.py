@@ -41,6 +41,7 @@ When the LMI is active they describe the unconstrained estimate.
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from dataclasses import dataclass
 
 import numpy as np
@@ -208,7 +209,7 @@ def _pseudo_inertia_expr(phi):  # noqa: ANN001, ANN202 (cvxpy expressions)
 
 def identify_payload(
     arm: Robot | IdentifiedModel,
-    data: StaticDataset | TorqueLog,
+    data: StaticDataset | TorqueLog | Sequence[TorqueLog],
     *,
     frame: str = "flange",
     gravity_only: bool = False,
@@ -216,6 +217,7 @@ def identify_payload(
     margin: float = 1e-6,
     cutoff_hz: float | None = DEFAULT_CUTOFF_HZ,
     rtol: float | None = None,
+    max_gap_s: float | None = None,
 ) -> PayloadEstimate:
     """Estimate the load fixed to ``frame`` from data recorded with it on a known arm.
 
@@ -225,8 +227,10 @@ def identify_payload(
         The arm without the load: a robot with its parameters (built-in, feasible), or an
         identified model (its equivalent robot). Ignored for its parameters when
         ``unloaded`` is given (then only its kinematics and gravity are used).
-    data : StaticDataset or TorqueLog
-        Recorded with the load: ``q`` (N, n) [rad], ``M`` [kg m^2], ``g`` [N m]; or a log.
+    data : StaticDataset, TorqueLog or a sequence of TorqueLog
+        Recorded with the load: ``q`` (N, n) [rad], ``M`` [kg m^2], ``g`` [N m]; or a log;
+        or several logs (recordings, or the pieces of one between its gaps), each filtered
+        and differentiated on its own, their rows stacked.
     frame : str
         The frame the load is fixed to; its CoM and inertia are given in it.
     gravity_only : bool
@@ -241,6 +245,9 @@ def identify_payload(
         Relative rank tolerance: of the unloaded arm's identification (None: its default,
         the rank at a clear singular-value gap) and of the load's least squares (None:
         1e-10).
+    max_gap_s : float, optional
+        Torque logs: longest gap bridged by interpolation [s]
+        (:func:`~dynid.identification.log.prepare_log`).
 
     Returns
     -------
@@ -268,8 +275,13 @@ def identify_payload(
     if f.link == 0:
         raise ModelError(f"frame {frame!r} is on the base; a load there does not move")
     n, k = kin.n, f.link
-    if data.q.shape[-1] != n:
-        raise ShapeError(f"data have {data.q.shape[-1]} joints; robot {kin.name!r} has {n}")
+    logs = tuple(data) if isinstance(data, Sequence) else None
+    if logs is not None and not logs:
+        raise DataError("no torque log given")
+    items: tuple[StaticDataset | TorqueLog, ...] = logs if logs is not None else (data,)  # type: ignore[assignment]
+    for one in items:
+        if one.q.shape[-1] != n:
+            raise ShapeError(f"data have {one.q.shape[-1]} joints; robot {kin.name!r} has {n}")
     notes: list[str] = []
     static = isinstance(data, StaticDataset)
     robot = _arm_without_load(arm, kin, unloaded, static, cutoff_hz, rtol, notes)
@@ -279,7 +291,7 @@ def identify_payload(
     if isinstance(data, StaticDataset):
         W, yv, route = _static_rows(robot, data, cols, A, gravity_only, notes)
     else:
-        W, yv, route, kept = _log_rows(robot, data, cols, A, cutoff_hz, notes)
+        W, yv, route, kept = _log_rows(robot, items, cols, A, cutoff_hz, notes, max_gap_s)  # type: ignore[arg-type]
     if unloaded is not None:
         route += ", difference"
     p = 4 if (static and gravity_only) else 10
@@ -447,35 +459,44 @@ def _not_excited(
 
 def _log_rows(
     robot: Robot,
-    data: TorqueLog,
+    logs: Sequence[TorqueLog],
     cols: slice,
     A: NDArray[np.float64],
     cutoff_hz: float | None,
     notes: list[str],
+    max_gap_s: float | None = None,
 ) -> tuple[NDArray[np.float64], NDArray[np.float64], str, NDArray[np.bool_]]:
     """Regressor rows (the load's parameters, then classical friction per joint), targets
-    of a torque log, filtered and decimated, and the columns fitted (the viscous and
-    Coulomb friction of joints that never leave their velocity noise band are not)."""
-    still = ~moving_joints(data.dq)
-    log = prepare_log(data, cutoff_hz=cutoff_hz)
-    ddq = log.ddq
-    assert ddq is not None  # prepare_log always differentiates
-    sl = slice(None, None, auto_decimation(data.sample_rate, cutoff_hz))
-    # a still joint's filtered velocity is noise: it does not move
-    q_, dq_, ddq_ = log.q[sl], log.dq[sl] * ~still, ddq[sl] * ~still
-    Y = torque_regressor(robot, q_, dq_, ddq_)[..., cols] @ A
-    y = np.asarray(log.tau[sl]) - rnea(robot, q_, dq_, ddq_)
-    Y = np.concatenate([Y, friction_regressor(dq_)], axis=-1)
-    kept = np.ones(Y.shape[-1], dtype=bool)
-    kept[10:] = ~(np.repeat(still, 3) & (np.arange(3 * data.n) % 3 != 2))
+    of torque logs, each filtered (gaps up to ``max_gap_s`` bridged) and decimated on its own,
+    and the columns fitted (the viscous and Coulomb friction of joints that never leave
+    their velocity noise band are not)."""
+    still = ~moving_joints(np.concatenate([one.dq for one in logs]))
+    Ws, ys = [], []
+    for data in logs:
+        log = prepare_log(data, cutoff_hz=cutoff_hz, max_gap_s=max_gap_s)
+        ddq = log.ddq
+        assert ddq is not None  # prepare_log always differentiates
+        sl = slice(None, None, auto_decimation(data.sample_rate, cutoff_hz))
+        # a still joint's filtered velocity is noise: it does not move
+        q_, dq_, ddq_ = log.q[sl], log.dq[sl] * ~still, ddq[sl] * ~still
+        Y = torque_regressor(robot, q_, dq_, ddq_)[..., cols] @ A
+        Y = np.concatenate([Y, friction_regressor(dq_)], axis=-1)
+        Ws.append(Y.reshape(-1, Y.shape[-1]))
+        ys.append((np.asarray(log.tau[sl]) - rnea(robot, q_, dq_, ddq_)).reshape(-1))
+    n = logs[0].n
+    kept = np.ones(Ws[0].shape[-1], dtype=bool)
+    kept[10:] = ~(np.repeat(still, 3) & (np.arange(3 * n) % 3 != 2))
     notes.append("classical friction fv, fc, fo per joint estimated alongside")
+    if len(logs) > 1:
+        notes.append(f"{len(logs)} torque logs (recordings or pieces), each filtered on its own")
     if still.any():
         which = ", ".join(str(j + 1) for j in np.flatnonzero(still))
         notes.append(
             f"joint(s) {which} never leave their velocity noise band: taken as still, "
             "their friction fv, fc is not identifiable and is zero (not fitted from noise)"
         )
-    return Y.reshape(-1, Y.shape[-1]), y.reshape(-1), "torque log", kept
+    route = "torque log" if len(logs) == 1 else f"{len(logs)} torque logs"
+    return np.concatenate(Ws), np.concatenate(ys), route, kept
 
 
 def _load_parameters(

@@ -130,12 +130,16 @@ class FrictionResidual:
     dq_noise_std : ndarray, shape (n,), optional
         White-noise std of the measured (unfiltered) velocities [rad/s]
         (:func:`velocity_noise_std` of the log before preparation); None when unknown.
+    recording : ndarray of int, shape (N,), optional
+        The recording of each sample when the residual holds several
+        (:func:`~dynid.friction.recordings.pieces_residual`); None: one recording.
     """
 
     log: TorqueLog
     tau_model: NDArray[np.float64]
     residual: NDArray[np.float64]
     dq_noise_std: NDArray[np.float64] | None = None
+    recording: NDArray[np.intp] | None = None
 
     @property
     def dq(self) -> NDArray[np.float64]:

@@ -9,7 +9,9 @@ to:
    :data:`FOLDS` contiguous blocks of equal length (contiguous, not shuffled: neighbouring
    samples of a filtered log are correlated, and a shuffled split would leak them), the
    blocks of the identification's own held-out judgement
-   (:func:`~dynid.identification.holdout.block_labels`).
+   (:func:`~dynid.identification.holdout.block_labels`); the residual of several
+   recordings (:func:`~dynid.friction.recordings.pieces_residual`) is split by recording
+   instead, one recording left out at a time, as identification does.
 2. For each block, every candidate law is fitted (:func:`~dynid.friction.fit.fit_law_through`,
    so a drive's motors are fitted where its friction acts) on the other blocks and predicts
    the held-out block.
@@ -91,19 +93,22 @@ class FrictionSelection:
         Every candidate, in registry order (``own`` first when present; last when the
         model was identified from this log).
     folds : int
-        Number of blocks.
+        Number of blocks (recordings when one is left out at a time).
+    method : str
+        How the held-out blocks were made.
     """
 
     fit: FrictionFit
     chosen: str
     scores: tuple[CandidateScore, ...]
     folds: int
+    method: str = "contiguous-block cross-validation"
 
     def as_dict(self) -> dict[str, object]:
         """JSON-ready: ``folds``, ``chosen`` and one row per candidate (``model``,
         ``parameters``, ``train_error_percent``, ``heldout_error_percent``)."""
         return {
-            "method": "contiguous-block cross-validation",
+            "method": self.method,
             "folds": self.folds,
             "chosen": self.chosen,
             "candidates": [
@@ -175,7 +180,8 @@ def select_friction(
         The model's friction was identified from this log: it is judged by its law
         refitted on the other blocks (module docstring).
     folds : int
-        Number of contiguous blocks (>= 2).
+        Number of contiguous blocks (>= 2); not used when ``res`` holds several
+        recordings (one is left out at a time).
 
     Returns
     -------
@@ -197,7 +203,7 @@ def select_friction(
     unknown = [c for c in names if c not in LAWS]
     if unknown:
         raise OptionError(f"--friction-model must be one of {', '.join(LAWS)}; got {unknown[0]!r}")
-    labels = block_labels(res.dq.shape[0], folds)
+    labels, folds, method = _folds(res, folds)
     r = res.residual
     scale = float(np.linalg.norm(res.log.tau)) or 1.0
 
@@ -225,7 +231,17 @@ def select_friction(
     if own is not None and own_fitted_here and own.kind in LAWS:
         scores.append(own_score)  # last: a tie goes to its law refitted on the whole log
     best = min(scores, key=lambda s: s.heldout_error_percent)  # first of the lowest: simpler
-    return FrictionSelection(fits[best.name], best.name, tuple(scores), folds)
+    return FrictionSelection(fits[best.name], best.name, tuple(scores), folds, method)
+
+
+def _folds(res: FrictionResidual, folds: int) -> tuple[NDArray[np.intp], int, str]:
+    """Each sample's held-out block, the number of blocks and how they were made."""
+    rec = res.recording
+    if rec is not None and np.unique(rec).size > 1:
+        _, labels = np.unique(rec, return_inverse=True)
+        k = int(labels.max()) + 1
+        return labels.astype(np.intp), k, f"leave one recording out ({k} recordings)"
+    return block_labels(res.dq.shape[0], folds), folds, "contiguous-block cross-validation"
 
 
 def _own_fit(own: FrictionModel, res: FrictionResidual) -> FrictionFit:

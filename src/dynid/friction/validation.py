@@ -20,6 +20,7 @@ correct model equals the sensor noise.
 from __future__ import annotations
 
 import warnings
+from collections.abc import Sequence
 from dataclasses import dataclass
 from typing import Any, Literal
 
@@ -28,7 +29,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from .. import _checks
 from ..dynamics.rnea import rnea
-from ..exceptions import DynidWarning, OptionError, ShapeError
+from ..exceptions import DataError, DynidWarning, OptionError, ShapeError
 from ..identification.log import DEFAULT_CUTOFF_HZ, TorqueLog, joint_side_log, prepare_log
 from ..identification.metrics import TorqueErrors, torque_errors
 from ..identification.model import IdentifiedModel
@@ -44,10 +45,12 @@ __all__ = [
     "RECORDED",
     "NewtonEulerValidation",
     "Validation",
+    "errors_from_sums",
     "own_friction",
     "recorded_cutoff",
     "validate_newton_euler",
     "validate_torques",
+    "validated",
 ]
 
 
@@ -124,17 +127,35 @@ class Validation:
 RECORDED: Literal["recorded"] = "recorded"
 
 
-def recorded_cutoff(model: TorqueModel, log: TorqueLog | None = None) -> float | None:
+def recorded_cutoff(
+    model: TorqueModel, log: TorqueLog | Sequence[TorqueLog] | None = None
+) -> float | None:
     """The low-pass cut-off [Hz] an identified model's torque log was prepared with
     (``info.log.cutoff_hz`` of the classical route); for another model the one
     identification would read from ``log``'s motion
-    (:func:`~dynid.identification.rate.cutoff_from_motion`), so that every model is judged
-    on the samples prepared the same way; the library default without a log."""
+    (:func:`~dynid.identification.rate.cutoff_from_motion`; several logs or pieces: the
+    median of those at least 64 samples long, each weighted by its samples), so that every
+    model is judged on the samples prepared the same way; the library default without a
+    log long enough to read it from."""
     if isinstance(model, IdentifiedModel) and model.info.log is not None:
         return model.info.log.cutoff_hz
-    if log is not None and log.n_samples >= 64:
-        return cutoff_from_motion(log.q, log.dq, log.sample_rate)
-    return DEFAULT_CUTOFF_HZ
+    logs = [] if log is None else [log] if isinstance(log, TorqueLog) else list(log)
+    found, weight = [], []
+    for one in logs:
+        if one.n_samples < 64:
+            continue
+        try:
+            found.append(cutoff_from_motion(one.q, one.dq, one.sample_rate))
+        except DataError:
+            if len(logs) == 1:
+                raise
+            continue
+        weight.append(one.n_samples)
+    if not found:
+        return DEFAULT_CUTOFF_HZ
+    order = np.argsort(found)
+    cum = np.cumsum(np.asarray(weight, dtype=np.float64)[order])
+    return float(np.asarray(found)[order][np.searchsorted(cum, 0.5 * cum[-1])])
 
 
 def validate_torques(
@@ -187,6 +208,23 @@ def validate_torques(
     del log  # a long log's raw signals are freed here when the caller holds no other reference
     p = prepare_log(jlog, cutoff_hz=cut, trim_s=trim_s, filter_tau=filter_tau, max_gap_s=max_gap_s)
     del jlog
+    return validated(model, p, friction, d)
+
+
+def validated(
+    model: TorqueModel, p: TorqueLog, friction: FrictionModel | None, drive: Drive | None
+) -> Validation:
+    """The :class:`Validation` of ``model`` (and ``friction``) on a prepared joint-side log
+    ``p`` (with ``ddq``) read through ``drive`` (its known rotors added to a robot's).
+
+    Raises
+    ------
+    ShapeError
+        The friction model's joint count differs from the log's.
+    """
+    if friction is not None and friction.n != p.n:
+        raise ShapeError(f"friction model has {friction.n} joints; the log has {p.n}")
+    d = drive
     assert p.ddq is not None  # prepare_log always fills ddq
     tau_model = rigid_body_torques(model, p.q, p.dq, p.ddq)
     if d is not None and d.rotor_inertia is not None and not isinstance(model, IdentifiedModel):
@@ -258,6 +296,14 @@ def _errors_of_sum(
         d = tau[k] - hat
         se2 += np.einsum("ij,ij->j", d, d)
         sa2 += np.einsum("ij,ij->j", tau[k], tau[k])
+    return errors_from_sums(se2, sa2, N)
+
+
+def errors_from_sums(se2: NDArray[np.float64], sa2: NDArray[np.float64], N: int) -> TorqueErrors:
+    """:class:`~dynid.identification.metrics.TorqueErrors` from the per-joint sums (n,)
+    over ``N`` samples of the squared errors ``se2`` [N^2 m^2] and of the squared measured
+    torques ``sa2``: ``RMS_j = sqrt(se2_j / N)``, relative error
+    ``100 sqrt(sum se2) / sqrt(sum sa2)`` [%] (infinite where the torques are all zero)."""
     m = se2 / N
     na_all = float(np.sqrt(sa2.sum()))
     na = np.sqrt(sa2)
@@ -270,7 +316,7 @@ def _errors_of_sum(
         if na_all > 0
         else float("inf"),
         relative_error_percent_per_joint=_checks.frozen(per),
-        n_samples=N,
+        n_samples=int(N),
     )
 
 

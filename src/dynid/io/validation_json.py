@@ -7,6 +7,7 @@
      "rms": [...], "mse": [...], "relative_error_percent": x,
      "relative_error_percent_per_joint": [...], "n_samples": N, "friction_model": ...,
      "without_friction": {...}, "with_friction": {...},
+     "recordings": [{"file": ..., "pieces": k, "rms": [...], ...}, ...],  (several recordings)
      ...the caller's keys (model, friction_source, data, cutoff_hz; seed)...,
      "units": {"rms": "N m", "mse": "N^2 m^2", "relative_error_percent": "%"}}
 """
@@ -16,6 +17,7 @@ from __future__ import annotations
 from pathlib import Path
 from typing import Any
 
+from ..friction.recordings import RecordingsValidation
 from ..friction.validation import Validation
 from .json_files import save_json
 
@@ -27,7 +29,9 @@ VALIDATION_SCHEMA = "dynid-validation/1"
 VALIDATION_UNITS = {"rms": "N m", "mse": "N^2 m^2", "relative_error_percent": "%"}
 
 
-def save_validation_json(path: str | Path, validation: Validation, **metadata: Any) -> Path:
+def save_validation_json(
+    path: str | Path, validation: Validation | RecordingsValidation, **metadata: Any
+) -> Path:
     """Write ``validation`` (:meth:`~dynid.friction.validation.Validation.as_dict`), then
     ``metadata`` (the files compared, the cut-off, the seed: JSON values), then ``units``.
 
@@ -35,8 +39,9 @@ def save_validation_json(path: str | Path, validation: Validation, **metadata: A
     ----------
     path : str or Path
         The file to write (atomically).
-    validation : Validation
-        Errors of the model without and with friction.
+    validation : Validation or RecordingsValidation
+        Errors of the model without and with friction (pooled over several recordings,
+        and per recording).
     **metadata
         Extra top-level keys, JSON values (``model``, ``friction_source``, ``data``,
         ``cutoff_hz``, ``seed``).

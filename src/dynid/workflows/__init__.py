@@ -8,8 +8,14 @@ command applies, so that the Python API and the ``dynid`` commands behave the sa
 * :mod:`~dynid.workflows.identify`: identification from a data file (both routes, and
   the one-step consistent fit).
 * :mod:`~dynid.workflows.retrieve`: feasible parameters from a model or static data file.
-* :mod:`~dynid.workflows.friction`: friction fitted to a model's torque residual on a log
-  file (the law chosen on held-out blocks, or the one asked for).
+* :mod:`~dynid.workflows.friction`: friction fitted to a model's torque residual on one
+  or more log files (the law chosen on held-out blocks, or the one asked for).
+* :mod:`~dynid.workflows.validate`: a model validated against one or more log files
+  (typed options in, errors pooled and per recording out).
+* :mod:`~dynid.workflows.payload`: a load identified on a known arm from static data or
+  one or more torque logs.
+* :mod:`~dynid.workflows.recordings`: several torque recordings read for a model, each
+  problem one line naming the file.
 
 The layer sits above :mod:`dynid.io` (it reads files) and below the command line, which
 parses, calls one of these, prints and saves.

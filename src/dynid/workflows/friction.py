@@ -2,35 +2,38 @@
 ``dynid friction``, with every policy the command applies, so that the Python API behaves
 as the command does.
 
-* The log is read strictly with the model's joint count, through the column map the
-  model's data were read with when none is given (:mod:`dynid.workflows.data_files`).
+* The logs (one or more files, or a folder) are read strictly with the model's joint
+  count, through the column map the model's data were read with when none is given
+  (:mod:`dynid.workflows.recordings`).
+* Each recording, and each piece of one cut at a gap longer than ``max_gap_s``, is
+  filtered and differentiated on its own (:func:`~dynid.friction.recordings.prepare_pieces`);
+  the laws are fitted on the residual of every piece together.
 * The drive is the model's own, or the one given when the model has none (another one is
   refused, :func:`~dynid.friction.fit.model_drive`).
-* ``law="auto"`` fits every law of the registry on held-out blocks and keeps the best, the
-  model's own friction a candidate too (:func:`~dynid.friction.select.select_friction`);
+* ``law="auto"`` fits every law of the registry on held-out blocks (one recording left
+  out at a time when there are several, contiguous time blocks otherwise) and keeps the
+  best, the model's own friction a candidate judged on the same blocks
+  (:func:`~dynid.friction.select.select_friction`);
   a law's name fits that law (:func:`~dynid.friction.fit.fit_friction_through`).
 """
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from dataclasses import dataclass
 from pathlib import Path
 
 from ..exceptions import OptionError
-from ..friction.fit import (
-    FrictionFit,
-    FrictionResidual,
-    fit_friction_through,
-    friction_residual,
-    model_drive,
-)
+from ..friction.fit import FrictionFit, FrictionResidual, fit_friction_through
 from ..friction.laws import LAWS
+from ..friction.recordings import Pieces, pieces_residual, prepare_pieces
 from ..friction.select import FrictionSelection, select_friction
-from ..friction.validation import own_friction, recorded_cutoff
+from ..friction.validation import RECORDED, own_friction
 from ..identification.model import IdentifiedModel
 from ..model.drive import Drive
 from ..model.robot import Robot
-from .data_files import ColumnSpec, column_map, in_file, read_torque_log, recorded_columns
+from .data_files import ColumnSpec, in_file
+from .recordings import read_recordings
 
 __all__ = ["FrictionFileResult", "fit_friction_file"]
 
@@ -49,17 +52,20 @@ class FrictionFileResult:
         Every candidate's training and held-out error (``law="auto"``), else None.
     cutoff_hz : float or None
         The low-pass cut-off the log was prepared with [Hz].
+    pieces : Pieces or None
+        The recordings' prepared pieces (how many pieces and samples each file gave).
     """
 
     fit: FrictionFit
     residual: FrictionResidual
     selection: FrictionSelection | None
     cutoff_hz: float | None = None
+    pieces: Pieces | None = None
 
 
 def fit_friction_file(
     model: IdentifiedModel | Robot,
-    path: str | Path,
+    path: str | Path | Sequence[str | Path],
     *,
     law: str = "auto",
     columns: ColumnSpec | None = None,
@@ -74,9 +80,9 @@ def fit_friction_file(
     ----------
     model : IdentifiedModel or Robot
         The rigid-body model (an identified model, or a robot's own link parameters).
-    path : str or Path
-        A torque log (``.csv`` or ``.npz``), or another tool's file read through
-        ``columns``.
+    path : str, Path or a sequence of them
+        One or more torque logs (``.csv`` or ``.npz``; a folder: its data files), or
+        files of another tool read through ``columns``.
     law : str
         ``"auto"`` (the law with the lowest held-out error) or a law of
         :data:`~dynid.friction.laws.LAWS` (``--friction-model``).
@@ -91,7 +97,7 @@ def fit_friction_file(
         positions); default: the identification's recorded one, else the one read from the
         log's motion (:func:`~dynid.friction.validation.recorded_cutoff`).
     max_gap_s : float, optional
-        Longest gap bridged by interpolation [s].
+        Longest gap bridged by interpolation [s]; a longer one cuts a log into pieces.
 
     Returns
     -------
@@ -103,35 +109,45 @@ def fit_friction_file(
         ``law`` neither ``"auto"`` nor a law of the registry.
     DataError
         A bad file, another joint count, invalid rows without ``drop_invalid``, other
-        columns or another drive than the model's, or no joint moving beyond its velocity
-        noise band (the message starts with the file's name).
+        columns or another drive than the model's, a recording in other units or with no
+        piece long enough to filter, or no joint moving beyond its velocity noise band
+        (the message starts with the file's name).
     """
     if law != "auto" and law not in LAWS:
         raise OptionError(f"--friction-model must be auto or one of {', '.join(LAWS)}; got {law!r}")
-    path = Path(path)
     robot = model.robot if isinstance(model, IdentifiedModel) else model
-    recorded = model.info.column_map if isinstance(model, IdentifiedModel) else None
-    names, units = recorded_columns(recorded, *(columns or (None, None)))
-    log = read_torque_log(
+    rec = read_recordings(
         path,
-        robot.n,
-        columns=column_map(names, units, cutoff_hz=cutoff_hz),
+        robot,
+        recorded=model.info.column_map if isinstance(model, IdentifiedModel) else None,
+        columns=columns,
         drop_invalid=drop_invalid,
+        cutoff_hz=cutoff_hz,
         owner="the model",
     )
-    drive = model_drive(model, drive)
-    if cutoff_hz is None:
-        cutoff_hz = recorded_cutoff(model, log)
 
     def fit() -> FrictionFileResult:
-        res = friction_residual(model, log, cutoff_hz=cutoff_hz, max_gap_s=max_gap_s, drive=drive)
+        pieces = prepare_pieces(
+            model,
+            rec.logs,
+            rec.names,
+            cutoff_hz=RECORDED if cutoff_hz is None else cutoff_hz,
+            max_gap_s=max_gap_s,
+            drive=drive,
+        )
+        res = pieces_residual(model, pieces)
+        cut = pieces.cutoff_hz
         if law == "auto":
-            here = isinstance(model, IdentifiedModel) and path.name in {
-                str(r.get("file")) for r in model.info.recordings
-            }
-            sel = select_friction(res, drive, own=own_friction(model), own_fitted_here=here)
-            return FrictionFileResult(sel.fit, res, sel, cutoff_hz)
-        return FrictionFileResult(fit_friction_through(res, drive, law), res, None, cutoff_hz)
+            # the model identified from one of these recordings: its friction is judged by
+            # its law refitted on the held-out folds' training data
+            here = isinstance(model, IdentifiedModel) and bool(
+                set(rec.names) & {str(r.get("file")) for r in model.info.recordings}
+            )
+            own = own_friction(model)
+            sel = select_friction(res, pieces.drive, own=own, own_fitted_here=here)
+            return FrictionFileResult(sel.fit, res, sel, cut, pieces)
+        chosen = fit_friction_through(res, pieces.drive, law)
+        return FrictionFileResult(chosen, res, None, cut, pieces)
 
-    result: FrictionFileResult = in_file(path, fit)
+    result: FrictionFileResult = in_file(rec.paths[0], fit) if len(rec.paths) == 1 else fit()
     return result

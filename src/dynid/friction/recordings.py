@@ -1,0 +1,418 @@
+"""Several recordings for validation and the friction fit: each recording, and each piece
+of one cut at a gap, prepared on its own and never joined to another.
+
+As identification does (:mod:`dynid.identification.recordings`): every log is read at the
+joints (through the model's drive), continuous revolute joints recorded wrapped into
+``[-pi, pi]`` are unwrapped (:func:`~dynid.identification.recordings.unwrapped`), the log is
+cut at each gap longer than ``max_gap_s``
+(:func:`~dynid.identification.recordings.split_at_gaps`), and every piece is filtered and
+differentiated on its own (:func:`~dynid.identification.log.prepare_log`) at one cut-off.
+Unlike identification, the measured torques stay unfiltered and nothing is decimated
+(the RMS of a correct model is the sensor noise). A piece too short to filter is left out
+with a warning naming its file and times; a recording left without any piece, or of
+another joint count, is an error naming the file: no recording is dropped silently.
+
+* :func:`prepare_pieces`: the :class:`Pieces` of a model's recordings;
+* :func:`validate_pieces`: the model's errors pooled over every sample of every piece, and
+  per recording (:class:`RecordingsValidation`);
+* :func:`pieces_residual`: the model's torque residual of every piece, with each sample's
+  recording, for the friction fit and its held-out selection
+  (:func:`~dynid.friction.select.select_friction` leaves one recording out at a time).
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import warnings
+from collections.abc import Sequence
+from dataclasses import dataclass
+from typing import Any, Literal
+
+import numpy as np
+from numpy.typing import NDArray
+
+from .. import _checks
+from ..exceptions import DataError, DynidWarning
+from ..identification.log import TorqueLog, joint_side_log, prepare_log
+from ..identification.metrics import TorqueErrors
+from ..identification.model import IdentifiedModel
+from ..identification.recordings import split_at_gaps, unwrapped
+from ..identification.sanity import velocity_noise_std
+from ..model.drive import Drive
+from ..model.robot import Robot
+from .fit import FrictionResidual, TorqueModel, model_drive, rigid_body_torques
+from .model import FrictionModel
+from .validation import RECORDED, Validation, errors_from_sums, recorded_cutoff, validated
+
+__all__ = [
+    "Pieces",
+    "RecordingErrors",
+    "RecordingsValidation",
+    "pieces_residual",
+    "prepare_pieces",
+    "validate_pieces",
+]
+
+
+@dataclass(frozen=True, slots=True, eq=False)
+class Pieces:
+    """Prepared pieces of one or more recordings (module docstring).
+
+    Attributes
+    ----------
+    logs : tuple of TorqueLog
+        Every piece at the joints, filtered, with ``ddq``, trimmed; recording after
+        recording, in time order.
+    recording : tuple of int
+        The recording (index into ``names``) of each piece.
+    names : tuple of str
+        One name per recording (its file name).
+    cutoff_hz : float or None
+        The one low-pass cut-off of every piece [Hz].
+    dq_noise_std : ndarray, shape (n,)
+        White-noise std of the measured (unfiltered) joint velocities over every piece
+        [rad/s] (:func:`~dynid.identification.sanity.velocity_noise_std`).
+    skipped : tuple of str
+        One line per piece left out (too short to filter), naming its file.
+    unwrapped : tuple of int
+        Joints (0-based) unwrapped in some recording.
+    drive : Drive or None
+        The drive the recordings were read through.
+    """
+
+    logs: tuple[TorqueLog, ...]
+    recording: tuple[int, ...]
+    names: tuple[str, ...]
+    cutoff_hz: float | None
+    dq_noise_std: NDArray[np.float64]
+    skipped: tuple[str, ...] = ()
+    unwrapped: tuple[int, ...] = ()
+    drive: Drive | None = None
+
+    @property
+    def n_samples(self) -> int:
+        """Samples over every piece."""
+        return sum(p.n_samples for p in self.logs)
+
+    def labels(self) -> NDArray[np.intp]:
+        """The recording of every sample (N,), pieces in order."""
+        return np.concatenate(
+            [
+                np.full(p.n_samples, r, np.intp)
+                for p, r in zip(self.logs, self.recording, strict=True)
+            ]
+        )
+
+    def summary(self) -> tuple[dict[str, Any], ...]:
+        """Per recording: ``file``, ``pieces``, ``samples`` and ``duration_s`` used."""
+        out = []
+        for r, name in enumerate(self.names):
+            mine = [p for p, k in zip(self.logs, self.recording, strict=True) if k == r]
+            out.append(
+                {
+                    "file": name,
+                    "pieces": len(mine),
+                    "samples": sum(p.n_samples for p in mine),
+                    "duration_s": float(sum(p.duration for p in mine)),
+                }
+            )
+        return tuple(out)
+
+    def describe(self) -> str:
+        """``"a.csv: 2 pieces, 3000 samples; b.csv: 1 piece, 1500 samples"``."""
+        return "; ".join(
+            f"{s['file']}: {s['pieces']} piece{'s' if s['pieces'] != 1 else ''}, "
+            f"{s['samples']} samples"
+            for s in self.summary()
+        )
+
+
+def prepare_pieces(
+    model: TorqueModel,
+    logs: Sequence[TorqueLog],
+    names: Sequence[str] | None = None,
+    *,
+    cutoff_hz: float | None | Literal["recorded"] = RECORDED,
+    trim_s: float | None = None,
+    max_gap_s: float | None = None,
+    filter_tau: bool = False,
+    drive: Drive | None = None,
+) -> Pieces:
+    """Read every recording at the joints, unwrap, cut at its gaps and prepare each piece.
+
+    Parameters
+    ----------
+    model : TorqueModel
+        The model the recordings are compared with (its drive and recorded cut-off).
+    logs : sequence of TorqueLog
+        The recordings, as read (motor side or currents when the drive says so).
+    names : sequence of str, optional
+        One name per recording (default ``log1, log2, ...``), for messages.
+    cutoff_hz : float, None or "recorded"
+        One low-pass cut-off for every piece [Hz]; ``"recorded"`` (default): the one the
+        model was identified with, else the one identification reads from the pieces'
+        motion (:func:`~dynid.friction.validation.recorded_cutoff`); None: no filter.
+    trim_s, filter_tau
+        As :func:`~dynid.identification.log.prepare_log`.
+    max_gap_s : float, optional
+        Gaps up to this long [s] are bridged; longer ones cut a recording into pieces.
+    drive : Drive, optional
+        The drive the logs were recorded through, for a model without one
+        (:func:`~dynid.friction.fit.model_drive`).
+
+    Returns
+    -------
+    Pieces
+
+    Raises
+    ------
+    DataError
+        No recording; a recording of another joint count than the model's, or with no
+        piece long enough to filter (the file is named); another drive than the model's.
+    """
+    if not logs:
+        raise DataError("no recording given")
+    names = tuple(names) if names is not None else tuple(f"log{k + 1}" for k in range(len(logs)))
+    d = model_drive(model, drive)
+    robot = _robot(model)
+    raw: list[tuple[int, TorqueLog]] = []
+    turned: set[int] = set()
+    for r, (name, log) in enumerate(zip(names, logs, strict=True)):
+        if robot is not None and log.n != robot.n:
+            raise DataError(
+                f"{name}: the log has {log.n} joints; robot {robot.name!r} has {robot.n}; "
+                "hint: a recording of the robot the model describes"
+            )
+        jlog = joint_side_log(log, d)
+        if robot is not None and d is None:
+            jlog, joints = unwrapped(jlog, ~np.asarray(robot.prismatic, dtype=bool))
+            if joints:
+                turned.update(joints)
+                warnings.warn(
+                    f"{name}: joint(s) {', '.join(str(j + 1) for j in joints)} recorded "
+                    "wrapped into [-pi, pi] (jumps of a whole turn): unwrapped",
+                    DynidWarning,
+                    stacklevel=2,
+                )
+        raw += [(r, p) for p in split_at_gaps(jlog, max_gap_s)]
+    cut = recorded_cutoff(model, [p for _, p in raw]) if isinstance(cutoff_hz, str) else cutoff_hz
+    prepared, recording, skipped = [], [], []
+    for r, piece in raw:
+        try:
+            p = prepare_log(
+                piece, cutoff_hz=cut, trim_s=trim_s, filter_tau=filter_tau, max_gap_s=max_gap_s
+            )
+        except DataError as exc:
+            line = (
+                f"{names[r]}: piece {piece.t[0]:.6g}-{piece.t[-1]:.6g} s "
+                f"({piece.n_samples} samples) left out: {exc}"
+            )
+            skipped.append(line)
+            warnings.warn(line, DynidWarning, stacklevel=2)
+            continue
+        prepared.append(p)
+        recording.append(r)
+    lost = [names[r] for r in range(len(names)) if r not in recording]
+    if lost:
+        raise DataError(
+            f"{', '.join(lost)}: no piece long enough to filter at {cut} Hz (gaps longer "
+            "than --max-gap cut a recording into pieces); hint: record longer stretches "
+            "without gaps, or raise --max-gap"
+        )
+    return Pieces(
+        logs=tuple(prepared),
+        recording=tuple(recording),
+        names=names,
+        cutoff_hz=cut,
+        dq_noise_std=_noise_std([p for _, p in raw]),
+        skipped=tuple(skipped),
+        unwrapped=tuple(sorted(turned)),
+        drive=d,
+    )
+
+
+def _robot(model: TorqueModel) -> Robot | None:
+    if isinstance(model, IdentifiedModel):
+        return model.robot
+    return model if isinstance(model, Robot) else None
+
+
+def _noise_std(pieces: list[TorqueLog]) -> NDArray[np.float64]:
+    """The velocity noise std [rad/s] (n,) over the raw pieces: each piece's estimate,
+    their variances averaged with the pieces' samples as weights."""
+    var, w = [], []
+    for p in pieces:
+        if p.n_samples >= 8:
+            var.append(velocity_noise_std(p.dq) ** 2)
+            w.append(p.n_samples)
+    if not var:
+        return _checks.frozen(np.zeros(pieces[0].n))
+    return _checks.frozen(np.sqrt(np.average(np.asarray(var), axis=0, weights=w)))
+
+
+@dataclass(frozen=True, slots=True, eq=False)
+class RecordingErrors:
+    """One recording's errors over its pieces.
+
+    Attributes
+    ----------
+    file : str
+    pieces : int
+    without_friction : TorqueErrors
+    with_friction : TorqueErrors or None
+    """
+
+    file: str
+    pieces: int
+    without_friction: TorqueErrors
+    with_friction: TorqueErrors | None
+
+    @property
+    def errors(self) -> TorqueErrors:
+        """Of the full prediction (with friction when given)."""
+        return self.with_friction if self.with_friction is not None else self.without_friction
+
+    def as_dict(self) -> dict[str, object]:
+        """``file``, ``pieces``, the full prediction's errors and ``without_friction``."""
+        out: dict[str, object] = {"file": self.file, "pieces": self.pieces}
+        out.update(self.errors.as_dict())
+        out["without_friction"] = self.without_friction.as_dict()
+        return out
+
+
+@dataclass(frozen=True, slots=True, eq=False)
+class RecordingsValidation:
+    """A model against several recordings: the errors over every sample of every piece
+    (RMS over all samples, relative error over all), and per recording.
+
+    Attributes
+    ----------
+    parts : tuple of Validation
+        One per piece (``pieces.logs``).
+    pieces : Pieces
+    without_friction, with_friction : TorqueErrors (with_friction None without friction)
+        Pooled over every sample.
+    recordings : tuple of RecordingErrors
+        One per recording.
+    friction : FrictionModel or None
+    """
+
+    parts: tuple[Validation, ...]
+    pieces: Pieces
+    without_friction: TorqueErrors
+    with_friction: TorqueErrors | None
+    recordings: tuple[RecordingErrors, ...]
+    friction: FrictionModel | None
+
+    @property
+    def errors(self) -> TorqueErrors:
+        """Pooled errors of the full prediction (with friction when given)."""
+        return self.with_friction if self.with_friction is not None else self.without_friction
+
+    @property
+    def shown(self) -> Validation:
+        """The longest piece of the first recording, with the pooled errors: its torques
+        are drawn, the errors are every sample's."""
+        first = [v for v, r in zip(self.parts, self.pieces.recording, strict=True) if r == 0]
+        longest = max(first, key=lambda v: v.log.n_samples)
+        return dataclasses.replace(
+            longest, without_friction=self.without_friction, with_friction=self.with_friction
+        )
+
+    def as_dict(self) -> dict[str, object]:
+        """JSON-ready: the pooled errors as :meth:`Validation.as_dict`, then
+        ``recordings`` (one entry per file: pieces, samples, errors), ``skipped`` and
+        ``unwrapped_joints`` (1-based)."""
+        out: dict[str, object] = dict(self.errors.as_dict())
+        out["friction_model"] = None if self.friction is None else self.friction.kind
+        out["without_friction"] = self.without_friction.as_dict()
+        if self.with_friction is not None:
+            out["with_friction"] = self.with_friction.as_dict()
+        out["recordings"] = [r.as_dict() for r in self.recordings]
+        out["skipped"] = list(self.pieces.skipped)
+        out["unwrapped_joints"] = [j + 1 for j in self.pieces.unwrapped]
+        return out
+
+
+def validate_pieces(
+    model: TorqueModel, pieces: Pieces, *, friction: FrictionModel | None = None
+) -> RecordingsValidation:
+    """The model's torques (without and with ``friction``) against every piece.
+
+    Pooled: ``RMS_j = sqrt(sum_pieces sum_k e_kj^2 / N)`` over all ``N`` samples, the
+    relative error ``100 ||E||_F / ||tau||_F`` over all samples; the same per recording.
+
+    Raises
+    ------
+    ShapeError
+        The friction model's joint count differs from the logs'.
+    """
+    parts = tuple(validated(model, p, friction, pieces.drive) for p in pieces.logs)
+    labels = np.asarray(pieces.recording)
+
+    def pooled(sel: NDArray[np.bool_], with_friction: bool) -> TorqueErrors:
+        n = parts[0].log.n
+        se2, sa2, N = np.zeros(n), np.zeros(n), 0
+        for v in (p for p, s in zip(parts, sel, strict=True) if s):
+            hat = v.tau_hat if with_friction else v.tau_model
+            e = v.log.tau - hat
+            se2 += np.einsum("ij,ij->j", e, e)
+            sa2 += np.einsum("ij,ij->j", v.log.tau, v.log.tau)
+            N += v.log.n_samples
+        return errors_from_sums(se2, sa2, N)
+
+    fr = friction is not None
+    every = np.ones(len(parts), bool)
+    recs = tuple(
+        RecordingErrors(
+            name,
+            int(np.sum(labels == r)),
+            pooled(labels == r, False),
+            pooled(labels == r, True) if fr else None,
+        )
+        for r, name in enumerate(pieces.names)
+    )
+    return RecordingsValidation(
+        parts=parts,
+        pieces=pieces,
+        without_friction=pooled(every, False),
+        with_friction=pooled(every, True) if fr else None,
+        recordings=recs,
+        friction=friction,
+    )
+
+
+def pieces_residual(model: TorqueModel, pieces: Pieces) -> FrictionResidual:
+    """The torque residual of ``model`` on every piece, the pieces one after another.
+
+    The returned log holds the pieces' samples in order, their times laid end to end (each
+    piece shifted to start one median step after the previous one ends: a time axis for
+    figures, not a recording; one piece keeps its times); ``recording`` holds each
+    sample's recording, so that the held-out selection leaves one recording out at a time.
+    """
+    if len(pieces.logs) == 1:  # one piece: its own times
+        p = pieces.logs[0]
+        assert p.ddq is not None  # prepare_log always fills ddq
+        tau_m = rigid_body_torques(model, p.q, p.dq, p.ddq)
+        return FrictionResidual(p, tau_m, p.tau - tau_m, pieces.dq_noise_std)
+    cols: dict[str, list[NDArray[np.float64]]] = {k: [] for k in ("t", "q", "dq", "tau", "ddq")}
+    taus = []
+    start = 0.0
+    for p in pieces.logs:
+        assert p.ddq is not None  # prepare_log always fills ddq
+        step = float(np.median(np.diff(p.t)))
+        cols["t"].append(p.t - p.t[0] + start)
+        start = float(cols["t"][-1][-1]) + step
+        for k in ("q", "dq", "tau", "ddq"):
+            cols[k].append(getattr(p, k))
+        taus.append(rigid_body_torques(model, p.q, p.dq, p.ddq))
+    t, q, dq, tau, ddq = (np.concatenate(cols[k]) for k in ("t", "q", "dq", "tau", "ddq"))
+    log = TorqueLog(t, q, dq, tau, ddq)
+    tau_m = np.concatenate(taus)
+    return FrictionResidual(
+        log=log,
+        tau_model=tau_m,
+        residual=log.tau - tau_m,
+        dq_noise_std=pieces.dq_noise_std,
+        recording=_checks.frozen(pieces.labels()),
+    )

@@ -1,0 +1,176 @@
+"""Several torque recordings read for a model: the ``--data a.csv b.csv ...`` (or a
+folder) of ``validate``, ``friction`` and ``payload``.
+
+Every recording is read strictly (:func:`~.data_files.read_torque_log`, through the
+column map the model's data were read with when none is given), and each problem is one
+line naming the file, never a recording dropped silently:
+
+* an empty file, NaN/inf or a repeated timestamp (without ``drop_invalid``), another
+  joint count than the model's: the reader's error, naming the file;
+* a recording in other units than the others (its torques, or its velocities against the
+  derivative of its positions, a power of ten away from the other recordings'): an error
+  naming it;
+* a recording whose positions lie far outside the model's joint limits (of another robot,
+  or in degrees): a warning naming it.
+
+Pieces too short to filter are the preparation's (:mod:`dynid.friction.recordings`).
+"""
+
+from __future__ import annotations
+
+import warnings
+from collections.abc import Sequence
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from ..exceptions import DataError, DynidWarning
+from ..identification.log import TorqueLog
+from ..model.robot import Robot
+from .data_files import ColumnSpec, column_map, in_file, read_torque_log, recorded_columns
+from .identify import data_files
+
+__all__ = ["UNIT_RATIO", "Recorded", "read_recordings"]
+
+#: Ratio of a recording's torque scale (or velocity unit) to the other recordings' median
+#: beyond which it is taken to be in another unit (a power of ten: mN m, ms, degrees).
+UNIT_RATIO = 30.0
+#: Margin [rad or m] beyond the joint limits before positions are called far outside.
+LIMIT_MARGIN = 0.2
+
+
+@dataclass(frozen=True, slots=True, eq=False)
+class Recorded:
+    """The recordings as read.
+
+    Attributes
+    ----------
+    logs : tuple of TorqueLog
+    paths : tuple of Path
+    """
+
+    logs: tuple[TorqueLog, ...]
+    paths: tuple[Path, ...]
+
+    @property
+    def names(self) -> tuple[str, ...]:
+        """The files' names."""
+        return tuple(p.name for p in self.paths)
+
+
+def read_recordings(
+    data: str | Path | Sequence[str | Path],
+    robot: Robot,
+    *,
+    recorded: Any = None,
+    columns: ColumnSpec | None = None,
+    drop_invalid: bool = False,
+    cutoff_hz: float | None = None,
+    owner: str | None = None,
+) -> Recorded:
+    """The torque logs of ``data`` (files, or folders of ``.csv``/``.npz`` files) of
+    ``robot``, read and checked (module docstring).
+
+    Parameters
+    ----------
+    data : str, Path or a sequence of them
+    robot : Robot
+        The model's robot (joint count, limits).
+    recorded : mapping, optional
+        The column map the model's data were read with (``info.column_map``).
+    columns : (str or None, str or None), optional
+        ``--columns`` and ``--units``.
+    drop_invalid : bool
+        Drop invalid rows (counted) instead of failing.
+    cutoff_hz : float, optional
+        Cut-off [Hz] of velocities derived from positions through a column map.
+    owner : str, optional
+        What has ``robot.n`` joints, for messages.
+
+    Returns
+    -------
+    Recorded
+
+    Raises
+    ------
+    DataError
+        No file, a bad file, another joint count, invalid rows without ``drop_invalid``,
+        other columns than the model's, a recording in other units than the others (each
+        names the file).
+    """
+    paths = data_files(data)
+    names, units = recorded_columns(recorded, *(columns or (None, None)))
+    cmap = column_map(names, units, cutoff_hz=cutoff_hz)
+
+    def read(p: Path) -> TorqueLog:
+        return read_torque_log(p, robot.n, columns=cmap, drop_invalid=drop_invalid, owner=owner)
+
+    logs = tuple(in_file(p, lambda p=p: read(p)) for p in paths)  # type: ignore[misc]
+    out = Recorded(logs, tuple(paths))
+    _check_limits(out, robot)
+    _check_units(out)
+    return out
+
+
+def _scales(log: TorqueLog) -> tuple[float, float]:
+    """The RMS torque [N m] and ``k`` of ``d q / dt ~ k dq`` (1 when ``t``, ``q`` and
+    ``dq`` share their units) of a log, on at most 20 000 samples."""
+    step = max(1, log.n_samples // 20_000)
+    t, q, dq, tau = log.t[::step], log.q[::step], log.dq[::step], log.tau[::step]
+    rms = float(np.sqrt(np.mean(tau**2)))
+    if t.size < 5:
+        return rms, float("nan")
+    num = float(np.sum(np.gradient(q, t, axis=0) * dq))
+    den = float(np.sum(dq * dq))
+    return rms, num / den if den > 0 else float("nan")
+
+
+def _check_units(rec: Recorded) -> None:
+    """Refuse a recording whose torque scale or velocity unit is a power of ten away from
+    the median of the other recordings' (several recordings only; of two, the second is
+    named)."""
+    if len(rec.logs) < 2:
+        return
+    scales = np.array([_scales(log) for log in rec.logs])
+    for col, what in (
+        (0, "torques (RMS)"),
+        (1, "velocities against the derivative of the positions"),
+    ):
+        x = np.abs(scales[:, col])
+        worst, ratio, others = -1, 1.0, ""
+        for r in range(len(x)):
+            rest = np.delete(x, r)
+            rest = rest[np.isfinite(rest) & (rest > 0)]
+            if not (np.isfinite(x[r]) and x[r] > 0 and rest.size):
+                continue
+            k = float(x[r] / np.median(rest))
+            if abs(np.log(k)) >= abs(np.log(ratio)) - 1e-6:  # a tie: the later named
+                worst, ratio = r, k
+        if worst >= 0 and not 1 / UNIT_RATIO <= ratio <= UNIT_RATIO:
+            names = [n for i, n in enumerate(rec.names) if i != worst]
+            others = ", ".join(names) if len(names) <= 3 else "the other recordings"
+            raise DataError(
+                f"{rec.names[worst]}: its {what} are {ratio:.3g} times those of {others}: "
+                "recorded in other units? hint: every recording is read with the same "
+                "--units; convert it or leave it out"
+            )
+
+
+def _check_limits(rec: Recorded, robot: Robot) -> None:
+    """Warn about a recording whose positions lie far outside the joint limits."""
+    lo = np.asarray(robot.q_min) - LIMIT_MARGIN
+    hi = np.asarray(robot.q_max) + LIMIT_MARGIN
+    for name, log in zip(rec.names, rec.logs, strict=True):
+        qmin, qmax = np.min(log.q, axis=0), np.max(log.q, axis=0)
+        bad = np.flatnonzero((qmin < lo) | (qmax > hi))
+        if bad.size:
+            j = int(bad[0])
+            warnings.warn(
+                f"{name}: joint {robot.joint_names[j]} spans [{qmin[j]:.4g}, {qmax[j]:.4g}], "
+                f"far outside robot {robot.name!r}'s limits [{robot.q_min[j]:.4g}, "
+                f"{robot.q_max[j]:.4g}]: a recording of another robot, or in other units?",
+                DynidWarning,
+                stacklevel=3,
+            )

@@ -1,0 +1,228 @@
+"""Validate a model against measured torque logs: the entry point of ``dynid validate``,
+with every policy the command applies, so that the Python API behaves as the command does.
+
+* The recordings (one or more files, or a folder) are read strictly with the model's
+  joint count, through the column map the model's data were read with when none is given
+  (:mod:`dynid.workflows.recordings`).
+* The friction added to the model: its own (an identified model's classical friction, a
+  robot's published sigmoid, the friction stored in a ``feasible.json``), none, a
+  friction file, or a friction model (:class:`ValidateOptions` ``friction``).
+* The drive: the model's own (a ``feasible.json``'s), or the one given for a model without
+  one (another one is refused, :func:`~dynid.friction.fit.model_drive`).
+* The cut-off: the identification's recorded one, else the one identification reads from
+  the recordings' motion (:func:`~dynid.friction.validation.recorded_cutoff`).
+* Each recording, and each piece of one cut at a gap longer than ``max_gap_s``, is
+  filtered and differentiated on its own; the errors are pooled over every sample and
+  given per recording (:func:`~dynid.friction.recordings.validate_pieces`).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any, Literal
+
+import numpy as np
+
+from ..exceptions import DataError, OptionError
+from ..friction.model import FrictionModel
+from ..friction.recordings import RecordingsValidation, prepare_pieces, validate_pieces
+from ..friction.validation import RECORDED, own_friction
+from ..identification.model import IdentifiedModel
+from ..io.feasible import load_feasible_drive, load_feasible_linear_friction
+from ..io.friction_json import load_friction_json
+from ..model.drive import Drive
+from ..model.robot import Robot
+from .data_files import ColumnSpec, in_file
+from .recordings import read_recordings
+
+__all__ = ["ValidateOptions", "ValidateResult", "validate_files"]
+
+
+@dataclass(frozen=True, slots=True)
+class ValidateOptions:
+    """How :func:`validate_files` compares a model with its recordings.
+
+    Attributes
+    ----------
+    friction : "own", "none", str, Path or FrictionModel
+        The friction added to the model: its own (default), none, a friction file
+        (``friction.json``) or a friction model.
+    columns : (str or None, str or None), optional
+        Column names and units of another tool's files; default: the model's recorded ones.
+    drop_invalid : bool
+        Drop rows with NaN/inf or a repeated timestamp (counted) instead of failing.
+    cutoff_hz : float, optional
+        Low-pass cut-off of the states [Hz]; default: the identification's recorded one,
+        else the one read from the recordings' motion.
+    max_gap_s : float, optional
+        Longest gap bridged by interpolation [s]; a longer one cuts a recording into
+        pieces.
+    drive : Drive, optional
+        The drive the recordings were recorded through, for a model without one.
+
+    Raises
+    ------
+    OptionError
+        A cut-off or a longest gap that is not a positive number; a friction that is
+        none of the above.
+    """
+
+    friction: Literal["own", "none"] | str | Path | FrictionModel = "own"
+    columns: ColumnSpec | None = None
+    drop_invalid: bool = False
+    cutoff_hz: float | None = None
+    max_gap_s: float | None = None
+    drive: Drive | None = None
+
+    def __post_init__(self) -> None:
+        for name, what in (
+            ("cutoff_hz", "the low-pass cut-off [Hz]"),
+            ("max_gap_s", "the longest gap bridged [s]"),
+        ):
+            v = getattr(self, name)
+            if v is not None and not (isinstance(v, int | float) and np.isfinite(v) and v > 0):
+                raise OptionError(f"{name} ({what}) must be a positive number; got {v!r}")
+        fr = self.friction
+        if not isinstance(fr, str | Path) and not hasattr(fr, "torques"):
+            raise OptionError(
+                "friction (the friction added to the model) must be 'own', 'none', a "
+                f"friction file or a friction model; got {type(fr).__name__}"
+            )
+
+
+@dataclass(frozen=True, slots=True, eq=False)
+class ValidateResult:
+    """Result of :func:`validate_files`.
+
+    Attributes
+    ----------
+    validation : RecordingsValidation
+        The errors pooled and per recording, every piece's prediction.
+    model : str
+        What the model is (its file, or ``robot panda``).
+    friction_source : str or None
+        ``"model"`` (its own), a friction file's name, ``"given"``, or None.
+    files : tuple of str
+        The recordings' file names.
+    cutoff_hz : float or None
+        The low-pass cut-off every piece was filtered at [Hz].
+    """
+
+    validation: RecordingsValidation
+    model: str
+    friction_source: str | None
+    files: tuple[str, ...]
+    cutoff_hz: float | None
+
+    def metadata(self) -> dict[str, Any]:
+        """The keys ``validation.json`` records beside the errors: ``model``,
+        ``friction_source``, ``data`` (the files, comma-separated), ``files`` and
+        ``cutoff_hz``."""
+        return {
+            "model": self.model,
+            "friction_source": self.friction_source,
+            "data": ", ".join(self.files),
+            "files": list(self.files),
+            "cutoff_hz": self.cutoff_hz,
+        }
+
+
+def validate_files(
+    model: IdentifiedModel | Robot,
+    data: str | Path | Sequence[str | Path],
+    options: ValidateOptions | None = None,
+    *,
+    feasible: str | Path | None = None,
+    label: str | None = None,
+) -> ValidateResult:
+    """Compare ``model``'s torques, without and with friction, with the recordings ``data``.
+
+    Parameters
+    ----------
+    model : IdentifiedModel or Robot
+        An identified model, or a robot's own link parameters (RNEA).
+    data : str, Path or a sequence of them
+        One or more torque logs (``.csv``/``.npz``; a folder: its data files).
+    options : ValidateOptions, optional
+    feasible : str or Path, optional
+        The ``feasible.json`` the robot ``model`` was read from: the friction and the drive
+        stored in it are the model's own.
+    label : str, optional
+        What the model is, for the record (default: its robot's name).
+
+    Returns
+    -------
+    ValidateResult
+
+    Raises
+    ------
+    DataError
+        A bad file, another joint count, invalid rows without ``drop_invalid``, a
+        recording in other units, no piece of a recording long enough to filter, another
+        drive than the model's, errors that overflow (each naming the file).
+    ShapeError
+        A friction model of another joint count.
+    """
+    opt = options or ValidateOptions()
+    robot = model.robot if isinstance(model, IdentifiedModel) else model
+    rec = read_recordings(
+        data,
+        robot,
+        recorded=model.info.column_map if isinstance(model, IdentifiedModel) else None,
+        columns=opt.columns,
+        drop_invalid=opt.drop_invalid,
+        cutoff_hz=opt.cutoff_hz,
+        owner=f"the model ({label or robot.name})",
+    )
+    friction, source = _friction(model, opt.friction, feasible)
+    drive = opt.drive
+    if drive is None and feasible is not None:
+        drive = load_feasible_drive(feasible)
+
+    def run() -> RecordingsValidation:
+        pieces = prepare_pieces(
+            model,
+            rec.logs,
+            rec.names,
+            cutoff_hz=RECORDED if opt.cutoff_hz is None else opt.cutoff_hz,
+            max_gap_s=opt.max_gap_s,
+            drive=drive,
+        )
+        return validate_pieces(model, pieces, friction=friction)
+
+    val = in_file(rec.paths[0], run) if len(rec.paths) == 1 else run()
+    errors = val.errors
+    if not np.isfinite(errors.relative_error_percent) or not np.all(np.isfinite(errors.rms)):
+        big = max(float(np.max(np.abs(v.log.tau))) for v in val.parts)
+        raise DataError(
+            f"{', '.join(rec.names)}: the torque errors overflow (relative error "
+            f"{errors.relative_error_percent}); the log holds values far outside a robot's "
+            f"range (largest |tau| {big:.3g} N m)"
+        )
+    return ValidateResult(
+        validation=val,
+        model=label or f"robot {robot.name}",
+        friction_source=source,
+        files=rec.names,
+        cutoff_hz=val.pieces.cutoff_hz,
+    )
+
+
+def _friction(
+    model: IdentifiedModel | Robot,
+    friction: str | Path | FrictionModel,
+    feasible: str | Path | None,
+) -> tuple[FrictionModel | None, str | None]:
+    """The friction added to the model and where it comes from."""
+    if isinstance(friction, str) and friction == "none":
+        return None, None
+    if isinstance(friction, str) and friction == "own":
+        own = own_friction(model)
+        if feasible is not None:
+            own = load_feasible_linear_friction(feasible) or own
+        return own, None if own is None else "model"
+    if isinstance(friction, str | Path):
+        return load_friction_json(friction), Path(friction).name
+    return friction, "given"
