@@ -147,9 +147,10 @@ def _module_name(path: Path) -> str:
     return ".".join(["dynid", *(parts[:-1] if parts[-1] == "__init__" else parts)])
 
 
-def _imports(path: Path, top_level_only: bool) -> list[tuple[str, str]]:
+def _imports(path: Path, top_level_only: bool, type_only: bool = False) -> list[tuple[str, str]]:
     """(module, name) of each ``from dynid... import name`` of ``path``, absolute; only the
-    statements run on import when ``top_level_only`` (not in functions or TYPE_CHECKING)."""
+    statements run on import when ``top_level_only`` (not in functions or TYPE_CHECKING),
+    those under TYPE_CHECKING too with ``type_only``."""
     own = _module_name(path).split(".")
     pkg = own if path.name == "__init__.py" else own[:-1]
     out = []
@@ -157,6 +158,8 @@ def _imports(path: Path, top_level_only: bool) -> list[tuple[str, str]]:
     def visit(body: list[ast.stmt]) -> None:
         for node in body:
             if isinstance(node, ast.If) and "TYPE_CHECKING" in ast.unparse(node.test):
+                if type_only:
+                    visit(node.body)
                 continue
             if isinstance(node, ast.ImportFrom):
                 if node.level:
@@ -218,12 +221,13 @@ def test_no_private_name_is_imported_from_another_package():
 
 
 def test_no_import_circle():
-    """The modules' import-time dependencies form no cycle (depth-first search)."""
+    """The modules' import-time dependencies, type-only ones (under TYPE_CHECKING) included,
+    form no cycle (depth-first search)."""
     modules = {_module_name(p): p for p in SRC.rglob("*.py")}
     graph = {
         name: {
             f"{m}.{n}" if f"{m}.{n}" in modules else m
-            for m, n in _imports(path, top_level_only=True)
+            for m, n in _imports(path, top_level_only=True, type_only=True)
         }
         & (modules.keys() - {name})
         for name, path in modules.items()

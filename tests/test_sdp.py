@@ -122,7 +122,8 @@ def test_generic_prior_of_a_ur5_is_consistent_and_retrieval_runs_without_a_prior
     )
     pr = generic_prior(ur5, total_mass=(15.0, 25.0))
     assert pseudo_inertia_margin(pr.phi).min() > 2e-4
-    assert pr.mass.sum() == pytest.approx(20.0)
+    natural = generic_prior(ur5).mass.sum()  # scaled into the band, to its nearer end
+    assert pr.mass.sum() == pytest.approx(min(max(natural, 15.0), 25.0))
     model = exact_model(ur5, ur5)
     res = retrieve_sdp(model)  # generic prior from the kinematics
     assert res.feasible and res.prior.source == "generic"

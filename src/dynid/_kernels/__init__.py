@@ -13,7 +13,8 @@ Modules:
 * :mod:`~dynid._kernels.dispatch` (no numba): :data:`~dynid._kernels.dispatch.KERNELS`,
   every kernel with its numpy twin; :func:`~dynid._kernels.dispatch.compiled`, the one
   decision "compiled or numpy"; :func:`~dynid._kernels.dispatch.run`, the common path of
-  the public functions; :data:`~dynid._kernels.dispatch.CACHE`, the one cache (kernel
+  the public functions; :func:`~dynid._kernels.dispatch.single_sample`, their one
+  single-sample fast path; :data:`~dynid._kernels.dispatch.CACHE`, the one cache (kernel
   modules, each robot's packed constants held outside the immutable robot, ...);
 * :mod:`~dynid._kernels.chain`: the chain core (joint transform, chaining, motion, sine
   and cosine, compiler settings, stack scratch); :mod:`~dynid._kernels.dense`: Cholesky;
@@ -45,6 +46,7 @@ from .dispatch import (
     loaded,
     packed,
     run,
+    single_sample,
     small_call_uses_kernels,
 )
 from .layout import (
@@ -83,6 +85,7 @@ __all__ = [
     "loaded",
     "packed",
     "run",
+    "single_sample",
     "small_call_uses_kernels",
     "C_AXIS",
     "C_PHI",

@@ -12,6 +12,13 @@ False``) a non-finite input and a chain too long for its stack scratch; the call
 takes the twin or the batch form. :func:`run` is the common path of the public functions
 over joint arrays: check the arrays cheaply, ask :func:`compiled`, call the kernel.
 
+:func:`single_sample` is the one single-sample fast path: a decorator of the public
+functions (``rnea``, ``mass_matrix``, ``gravity_torques``, ``coriolis``, ``forward_dynamics``,
+``fk``, ``jacobian``) that sends float64 ``(n,)`` numpy arrays straight to the kernel's
+compiled single-sample entry point once it is loaded, and everything else to the function
+itself (which validates, and calls :func:`run` or its numpy twin). The wrapper takes the
+function's own parameters, so a fast call costs no more Python frames than the function.
+
 :data:`CACHE` holds everything the kernels memoise, outside the immutable robots: the
 loaded kernel modules, the count of single-sample calls, each robot's packed constants
 (:class:`Packed`, keyed by the robot's identity and dropped when the robot is garbage
@@ -25,18 +32,20 @@ use, by :func:`compiled`.
 
 from __future__ import annotations
 
+import functools
 import importlib
 import os
 import sys
 import weakref
+from collections.abc import Callable
 from types import ModuleType
-from typing import Any
+from typing import Any, TypeVar
 
 import numpy as np
 from numpy.typing import NDArray
 
 from .. import _checks
-from .layout import C_WIDTH, VECTOR, c_float64, flat, pack, pack_frame, readonly
+from .layout import C_WIDTH, F64, VECTOR, c_float64, flat, pack, pack_frame, readonly
 
 __all__ = [
     "Kernel",
@@ -57,6 +66,7 @@ __all__ = [
     "entry",
     "frame_entry",
     "SMALL_CALLS",
+    "single_sample",
 ]
 
 #: single-sample calls that take the numpy path before the kernels are loaded for them
@@ -146,11 +156,11 @@ class Packed:
     ``C``: the constants (:func:`dynid._kernels.layout.pack`); ``C0``: the same without
     gravity (for the Coriolis and centrifugal torques); ``zeros``: a read-only ``(n,)``
     zero vector; ``vector``, ``matrix``, ``jacobian``: the shapes ``(n,)``, ``(n, n)`` and
-    ``(6, n)`` of the single-sample paths; ``frames``: frame name ->
-    ``(link, T_link_frame, CF)`` (:func:`dynid._kernels.layout.pack_frame`), filled as
-    frames are used, and ``flange`` the flange's ``CF`` (the default frame, read without a
-    lookup) once made; ``limits``: the inverse kinematics' limit arrays by ``(m,
-    velocity_limits)``; ``ref``: the weak reference that drops this entry with the robot.
+    ``(6, n)`` of the single-sample paths; ``frames``: frame name -> ``(link, T_link_frame, CF)``
+    (:func:`dynid._kernels.layout.pack_frame`), filled as frames are used, and ``flange``
+    the flange's ``CF`` (the default frame, read without a lookup) once made; ``limits``:
+    the inverse kinematics' limit arrays by ``(m, velocity_limits)``; ``ref``: the weak
+    reference that drops this entry with the robot.
     Robots are immutable, so nothing here goes stale.
     """
 
@@ -427,3 +437,153 @@ def entry(kernel: Any, *args: Any) -> Any:
         return kernel.overloads[sig].entry_point
     except Exception:  # noqa: BLE001 (an internal of numba moved: use the dispatcher)
         return kernel
+
+
+# ----------------------------------------------------------------- the single-sample path
+_ND, _F64 = np.ndarray, F64
+#: a single-sample result's shape: ``(n,)``, ``(n, n)``, ``(6, n)``, ``(4, 4)``
+OUTPUTS = ("vector", "matrix", "jacobian", "pose")
+_F = TypeVar("_F", bound=Callable[..., Any])
+
+
+def single_sample(kernel: Kernel, form: str, output: str) -> Callable[[_F], _F]:
+    """The single-sample fast path of a public function, as a decorator (the only one).
+
+    ``kernel``: the :data:`KERNELS` row whose single-sample entry point (:attr:`Kernel.one`,
+    set once the kernel module is loaded) computes the function; ``output``: the result's
+    shape, one of :data:`OUTPUTS`; ``form``: the function's parameters and the constants
+    the entry point takes:
+
+    * ``"configuration"``: ``f(robot, q)``, constants ``C`` (``mass_matrix``,
+      ``gravity_torques``);
+    * ``"states"``: ``f(robot, q, dq, ddq, *, gravity=None)``, ``C``, fast only without
+      ``gravity`` (``rnea``);
+    * ``"torques"``: ``f(robot, q, dq, tau)``, ``C`` (``forward_dynamics``);
+    * ``"velocities"``: ``f(robot, q, dq)``, ``C0`` (no gravity) and a zero acceleration
+      (``coriolis``, on the RNEA kernel);
+    * ``"frame"``: ``f(robot, q, frame="flange", tool=None)``, the frame's constants ``CF``
+      once made (:func:`frame_entry`), fast only without ``tool`` (``fk``, ``jacobian``).
+
+    A call whose arrays are exactly float64 numpy ``(n,)`` vectors of a robot whose packed
+    arrays exist (:func:`find`) goes to the entry point, which checks finiteness; anything
+    else, a declined input and an object that fakes its class (the entry point raises
+    TypeError) go to the decorated function. The wrapper has the function's name, docstring
+    and signature (:func:`functools.wraps`).
+    """
+    make = _FORMS[form]
+    if output not in OUTPUTS:
+        raise ValueError(f"output must be one of {OUTPUTS}; got {output!r}")
+
+    def decorate(general: _F) -> _F:
+        return functools.wraps(general)(make(kernel, general, output))  # type: ignore[return-value]
+
+    return decorate
+
+
+def _configuration(kernel: Kernel, general: Any, output: str) -> Any:
+    matrix = output == "matrix"  # else a vector
+
+    def one(robot: Any, q: Any) -> Any:
+        e = kernel.one
+        if e is not None and q.__class__ is _ND and q.dtype is _F64:
+            p = CACHE.last if CACHE.robot is robot else find(robot)
+            if p is not None and q.shape == p.vector:
+                out = np.empty(p.matrix if matrix else p.vector)
+                try:  # (an object can fake its class; the entry point then refuses it)
+                    if e(p.C, q, out):
+                        return out
+                except TypeError:
+                    pass
+        return general(robot, q)
+
+    return one
+
+
+def _states(kernel: Kernel, general: Any, output: str) -> Any:
+    def one(robot: Any, q: Any, dq: Any, ddq: Any, *, gravity: Any = None) -> Any:
+        e = kernel.one
+        if (
+            e is not None
+            and gravity is None
+            and q.__class__ is dq.__class__ is ddq.__class__ is _ND
+            and q.dtype is dq.dtype is ddq.dtype is _F64
+        ):
+            p = CACHE.last if CACHE.robot is robot else find(robot)
+            if p is not None and q.shape == dq.shape == ddq.shape == p.vector:
+                out = np.empty(p.vector)  # (their result is a vector)
+                try:
+                    if e(p.C, q, dq, ddq, out):
+                        return out
+                except TypeError:
+                    pass
+        return general(robot, q, dq, ddq, gravity=gravity)
+
+    return one
+
+
+def _torques(kernel: Kernel, general: Any, output: str) -> Any:
+    def one(robot: Any, q: Any, dq: Any, tau: Any) -> Any:
+        e = kernel.one
+        if (
+            e is not None
+            and q.__class__ is dq.__class__ is tau.__class__ is _ND
+            and q.dtype is dq.dtype is tau.dtype is _F64
+        ):
+            p = CACHE.last if CACHE.robot is robot else find(robot)
+            if p is not None and q.shape == dq.shape == tau.shape == p.vector:
+                out = np.empty(p.vector)  # (their result is a vector)
+                try:
+                    if e(p.C, q, dq, tau, out):
+                        return out
+                except TypeError:
+                    pass
+        return general(robot, q, dq, tau)
+
+    return one
+
+
+def _velocities(kernel: Kernel, general: Any, output: str) -> Any:
+    def one(robot: Any, q: Any, dq: Any) -> Any:
+        e = kernel.one
+        if e is not None and q.__class__ is dq.__class__ is _ND and q.dtype is dq.dtype is _F64:
+            p = CACHE.last if CACHE.robot is robot else find(robot)
+            if p is not None and q.shape == dq.shape == p.vector:
+                out = np.empty(p.vector)  # (their result is a vector)
+                try:
+                    if e(p.C0, q, dq, p.zeros, out):
+                        return out
+                except TypeError:
+                    pass
+        return general(robot, q, dq)
+
+    return one
+
+
+def _frame(kernel: Kernel, general: Any, output: str) -> Any:
+    pose = output == "pose"  # else a Jacobian
+
+    def one(robot: Any, q: Any, frame: str = "flange", tool: Any = None) -> Any:
+        e = kernel.one
+        if e is not None and q.__class__ is _ND and tool is None and q.dtype is _F64:
+            p = CACHE.last if CACHE.robot is robot else find(robot)
+            if p is not None and q.shape == p.vector:
+                try:  # (unhashable frames, and objects that fake their class, go the general way)
+                    CF = p.flange if frame == "flange" else p.frames.get(frame, (None,) * 3)[2]
+                    if CF is not None:
+                        out = np.empty((4, 4) if pose else p.jacobian)
+                        if e(CF, q, out):
+                            return out
+                except TypeError:
+                    pass
+        return general(robot, q, frame, tool)
+
+    return one
+
+
+_FORMS = {
+    "configuration": _configuration,
+    "states": _states,
+    "torques": _torques,
+    "velocities": _velocities,
+    "frame": _frame,
+}

@@ -35,9 +35,6 @@ from ..model.robot import Robot
 
 __all__ = ["rnea", "rnea_numpy", "kernels", "LinkMotion", "link_motion"]
 
-_F64, _ND = _kernels.F64, np.ndarray
-#: the kernels' one cache (:data:`dynid._kernels.CACHE`)
-_CACHE = _kernels.CACHE
 _RNEA = _kernels.KERNELS["rnea"]
 #: gravity off (the Coriolis and centrifugal torques, the mass matrix's columns)
 ZERO_GRAVITY = _checks.frozen(np.zeros(3))
@@ -145,6 +142,7 @@ def prepare_states(
     return shape, flat
 
 
+@_kernels.single_sample(_RNEA, "states", "vector")
 def rnea(
     robot: Robot,
     q: ArrayLike,
@@ -183,24 +181,6 @@ def rnea(
     -----
     Uses the compiled kernel when available (see :func:`kernels`), else :func:`rnea_numpy`.
     """
-    # single sample: three float64 (n,) numpy arrays of any strides go straight to the
-    # compiled single-sample kernel (no conversion, no copy, no dispatch; it checks
-    # finiteness)
-    e = _RNEA.one
-    if (
-        e is not None
-        and gravity is None
-        and q.__class__ is dq.__class__ is ddq.__class__ is _ND
-        and q.dtype is dq.dtype is ddq.dtype is _F64
-    ):
-        p = _CACHE.last if _CACHE.robot is robot else _kernels.find(robot)
-        if p is not None and q.shape == dq.shape == ddq.shape == p.vector:
-            tau = np.empty(p.vector)
-            try:  # (an object can fake its class; the entry point then refuses it)
-                if e(p.C, q, dq, ddq, tau):
-                    return tau
-            except TypeError:
-                pass
     if gravity is None:
         # float64 arrays of one shape (..., n) go to the kernel as they are; the kernel
         # checks finiteness, and anything else (or a failure) falls through to the full

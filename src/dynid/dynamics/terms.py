@@ -38,9 +38,6 @@ __all__ = [
 ]
 
 _ZERO_G = ZERO_GRAVITY
-_F64, _ND = _kernels.F64, np.ndarray
-#: the kernels' one cache (:data:`dynid._kernels.CACHE`)
-_CACHE = _kernels.CACHE
 _KERNELS = _kernels.KERNELS
 _RNEA, _MASS = _KERNELS["rnea"], _KERNELS["mass_matrix"]
 _GRAVITY, _FORWARD = _KERNELS["gravity_torques"], _KERNELS["forward_dynamics"]
@@ -66,6 +63,7 @@ def _mass_matrix_numpy(robot: Robot, q2: NDArray[np.float64]) -> NDArray[np.floa
     return 0.5 * (M + np.swapaxes(M, 1, 2))
 
 
+@_kernels.single_sample(_MASS, "configuration", "matrix")
 def mass_matrix(robot: Robot, q: ArrayLike) -> NDArray[np.float64]:
     """Joint-space inertia matrix M(q).
 
@@ -88,19 +86,6 @@ def mass_matrix(robot: Robot, q: ArrayLike) -> NDArray[np.float64]:
     Composite-rigid-body algorithm in the compiled kernel when available; otherwise
     :func:`mass_matrix_numpy`.
     """
-    # single sample: a float64 (n,) numpy array of any strides goes straight to the
-    # compiled single-sample kernel (no conversion, no copy, no dispatch; it checks
-    # finiteness)
-    e = _MASS.one
-    if e is not None and q.__class__ is _ND and q.dtype is _F64:
-        p = _CACHE.last if _CACHE.robot is robot else _kernels.find(robot)
-        if p is not None and q.shape == p.vector:
-            M = np.empty(p.matrix)
-            try:  # (an object can fake its class; the entry point then refuses it)
-                if e(p.C, q, M):
-                    return M
-            except TypeError:
-                pass
     n = len(robot.joint_names)
     out = _kernels.run(_MASS, robot, (q,), (n, n))
     if out is not None:
@@ -115,6 +100,7 @@ def mass_matrix_numpy(robot: Robot, q: ArrayLike) -> NDArray[np.float64]:
     return _mass_matrix_numpy(robot, q.reshape(-1, robot.n)).reshape(q.shape + (robot.n,))
 
 
+@_kernels.single_sample(_GRAVITY, "configuration", "vector")
 def gravity_torques(robot: Robot, q: ArrayLike) -> NDArray[np.float64]:
     """Gravity torques g(q) = rnea(q, 0, 0) [N m], shape (..., n), for ``robot.gravity``.
 
@@ -122,17 +108,6 @@ def gravity_torques(robot: Robot, q: ArrayLike) -> NDArray[np.float64]:
     ------
     ShapeError, NonFiniteError
     """
-    # single sample: as in :func:`mass_matrix`
-    e = _GRAVITY.one
-    if e is not None and q.__class__ is _ND and q.dtype is _F64:
-        p = _CACHE.last if _CACHE.robot is robot else _kernels.find(robot)
-        if p is not None and q.shape == p.vector:
-            tau = np.empty(p.vector)
-            try:
-                if e(p.C, q, tau):
-                    return tau
-            except TypeError:
-                pass
     out = _kernels.run(_GRAVITY, robot, (q,), (len(robot.joint_names),))
     if out is not None:
         return out
@@ -150,6 +125,7 @@ def gravity_torques_numpy(robot: Robot, q: ArrayLike) -> NDArray[np.float64]:
     return _rnea_numpy(robot, robot.phi, q2, z, z, robot.gravity).reshape(q.shape)
 
 
+@_kernels.single_sample(_RNEA, "velocities", "vector")
 def coriolis(robot: Robot, q: ArrayLike, dq: ArrayLike) -> NDArray[np.float64]:
     """Coriolis and centrifugal torques c(q, dq) = rnea(q, dq, 0) without gravity [N m].
 
@@ -162,17 +138,6 @@ def coriolis(robot: Robot, q: ArrayLike, dq: ArrayLike) -> NDArray[np.float64]:
     -------
     c : ndarray, shape (..., n)
     """
-    # single sample: the single-sample RNEA kernel without gravity, at zero acceleration
-    e = _RNEA.one
-    if e is not None and q.__class__ is dq.__class__ is _ND and q.dtype is dq.dtype is _F64:
-        p = _CACHE.last if _CACHE.robot is robot else _kernels.find(robot)
-        if p is not None and q.shape == dq.shape == p.vector:
-            c = np.empty(p.vector)
-            try:  # (an object can fake its class; the entry point then refuses it)
-                if e(p.C0, q, dq, p.zeros, c):
-                    return c
-            except TypeError:
-                pass
     shape, (q2, dq2, _) = prepare_states(robot, q, dq, np.zeros(robot.n))
     if shape == (robot.n,) and _kernels.loaded(_RNEA) is not None:
         _kernels.packed(robot)  # the next single sample takes the thin path
@@ -224,6 +189,7 @@ def coriolis_matrix(robot: Robot, q: ArrayLike, dq: ArrayLike) -> NDArray[np.flo
     return np.einsum("...ijk,...k->...ij", G, dq)
 
 
+@_kernels.single_sample(_FORWARD, "torques", "vector")
 def forward_dynamics(
     robot: Robot, q: ArrayLike, dq: ArrayLike, tau: ArrayLike
 ) -> NDArray[np.float64]:
@@ -246,21 +212,6 @@ def forward_dynamics(
         ``M`` is singular (to rounding: a Cholesky pivot^2 below ``1e-12`` of its diagonal,
         a joint that moves no inertia of its own), so the accelerations are undefined.
     """
-    # single sample: one compiled call (bias, mass matrix and its Cholesky solve)
-    e = _FORWARD.one
-    if (
-        e is not None
-        and q.__class__ is dq.__class__ is tau.__class__ is _ND
-        and q.dtype is dq.dtype is tau.dtype is _F64
-    ):
-        p = _CACHE.last if _CACHE.robot is robot else _kernels.find(robot)
-        if p is not None and q.shape == dq.shape == tau.shape == p.vector:
-            ddq = np.empty(p.vector)
-            try:
-                if e(p.C, q, dq, tau, ddq):
-                    return ddq
-            except TypeError:
-                pass
     shape, (q2, dq2, tau2) = prepare_states(robot, q, dq, tau, ("q", "dq", "tau"))
     if shape == (robot.n,) and _kernels.loaded(_FORWARD) is not None:
         _kernels.packed(robot)  # the next single sample takes the thin path

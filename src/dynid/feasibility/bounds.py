@@ -34,6 +34,7 @@ __all__ = [
     "Bounds",
     "default_bounds",
     "kinematic_bounds",
+    "link_points",
     "panda_bounds",
     "segment_points",
 ]
@@ -251,6 +252,14 @@ def segment_points(robot: Robot, i: int) -> NDArray[np.float64]:
     return np.asarray(pts)
 
 
+def link_points(robot: Robot, i: int) -> NDArray[np.float64]:
+    """:func:`segment_points` of link ``i`` with its centre of mass when it has a mass."""
+    pts = segment_points(robot, i)
+    if robot.mass[i] > 0:
+        pts = np.vstack([pts, robot.com[i]])
+    return pts
+
+
 def kinematic_bounds(
     robot: Robot,
     *,
@@ -262,7 +271,9 @@ def kinematic_bounds(
 
     For link ``i`` let ``S_i`` be the points that bound its segment in its own frame: the
     link origin, the parent link's origin and the next joint's origin (for the last link,
-    the frames fixed to it, such as ``flange``); ``L_i`` the largest extent of ``S_i``.
+    the frames fixed to it, such as ``flange``), and the link's own centre of mass when the
+    robot has one (a link whose mass lies beyond its joints' offsets, a pendulum's bob);
+    ``L_i`` the largest extent of ``S_i`` (from the origin too).
 
     * CoM box: the bounding box of ``S_i`` grown by ``radius`` on every side (default
       ``max(0.05 m, 0.25 * max_i L_i)``; 0.1 m for the Panda).
@@ -290,7 +301,7 @@ def kinematic_bounds(
     Bounds
     """
     n = robot.n
-    pts = [segment_points(robot, i) for i in range(n)]
+    pts = [link_points(robot, i) for i in range(n)]
     ext = np.array([float(np.max(np.ptp(P, axis=0))) if len(P) > 1 else 0.0 for P in pts])
     seg = np.array([float(np.max(np.linalg.norm(P, axis=1))) for P in pts])
     L = np.maximum(ext, seg)

@@ -10,8 +10,8 @@ directions the data cannot see. It comes from
   :data:`GENERIC_RADIUS_FRACTION` of its length (at least :data:`GENERIC_RADIUS_MIN`)
   along the segment that bounds it (from the parent's origin or its own to the next
   joint's origin, or to the frames fixed to the last link); masses in proportion to
-  ``GENERIC_LINK_MASS_BASE + GENERIC_LINK_MASS_PER_M * length``, scaled to the middle of
-  the total-mass band when one is given.
+  ``GENERIC_LINK_MASS_BASE + GENERIC_LINK_MASS_PER_M * length``, scaled to the nearer end
+  of the total-mass band when their total lies outside it.
 
 Every prior is checked before use: a link whose pseudo-inertia is not positive definite
 with the margin ``lambda_min(J) >= margin tr(J)`` (a CAD inertia violating the triangle
@@ -145,7 +145,9 @@ def generic_prior(robot: Robot, total_mass: tuple[float, float] | None = None) -
     ----------
     robot : Robot
     total_mass : (float, float), optional
-        Band on the total mass [kg]: the masses are scaled to its middle.
+        Band on the total mass [kg]: when the cylinders' total lies outside, the masses are
+        scaled to the band's nearer end (a loose band, such as ``0..1e5``, leaves them as
+        they are: the prior does not depend on how wide the band is drawn).
     """
     L = np.maximum(_lengths(robot), GENERIC_LENGTH_MIN)
     m = GENERIC_LINK_MASS_BASE + GENERIC_LINK_MASS_PER_M * L
@@ -153,11 +155,13 @@ def generic_prior(robot: Robot, total_mass: tuple[float, float] | None = None) -
         f"generic prior: solid cylinders along the links, masses {GENERIC_LINK_MASS_BASE:g} kg "
         f"+ {GENERIC_LINK_MASS_PER_M:g} kg/m"
     ]
-    if total_mass is not None:
-        mid = 0.5 * (float(total_mass[0]) + float(total_mass[1]))
-        if mid > 0:
-            m = m * (mid / m.sum())
-            notes[0] += f", scaled to {mid:g} kg in all"
+    if total_mass is not None:  # a total outside the band is scaled to its nearer end
+        lo, hi = (float(x) for x in total_mass)
+        total = float(m.sum())
+        target = min(max(total, lo), hi)
+        if target > 0 and target != total:
+            m = m * (target / total)
+            notes[0] += f", scaled to {target:g} kg in all"
     phi = np.stack([_cylinder(float(m[i]), *_segment(robot, i)) for i in range(robot.n)])
     return Prior(phi=phi, source="generic", notes=tuple(notes))
 

@@ -31,8 +31,9 @@ All evaluate on velocities of shape ``(..., n)`` and return torques of the same 
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass, field
-from typing import TYPE_CHECKING, ClassVar
+from typing import Any, ClassVar, Protocol
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -41,13 +42,11 @@ from .. import _checks
 from ..exceptions import ShapeError
 from ..model.drive import Drive
 
-if TYPE_CHECKING:  # pragma: no cover
-    from .laws.base import FrictionLaw
-
 __all__ = [
     "ClassicalFriction",
     "DriveFriction",
     "FrictionModel",
+    "Law",
     "LawFriction",
     "SigmoidFriction",
     "classical_friction",
@@ -239,6 +238,27 @@ class ClassicalFriction:
         return classical_friction(dq, self.fv, self.fc, self.fo, self.band)
 
 
+class Law(Protocol):
+    """What a :class:`LawFriction` reads of its law, a
+    :class:`~dynid.friction.laws.base.FrictionLaw` (named here by its shape, so that this
+    module imports nothing of the laws, which import it)."""
+
+    @property
+    def name(self) -> str:
+        """The law's registry name."""
+        ...
+
+    @property
+    def params(self) -> tuple[str, ...]:
+        """Its parameter names."""
+        ...
+
+    @property
+    def torques(self) -> Callable[..., Any]:
+        """``torques(dq, params, band)``: friction torques [N m]."""
+        ...
+
+
 @dataclass(frozen=True, slots=True, eq=False)
 class LawFriction:
     """A registry law with parameters per joint; arrays read-only.
@@ -246,13 +266,14 @@ class LawFriction:
     Attributes
     ----------
     law : FrictionLaw
+        The registry law (:class:`Law` is what is read of it).
     params : ndarray, shape (n, k)
         Parameters per joint, columns ``law.params``.
     band : ndarray, shape (n,)
         Standstill band [rad/s] (:func:`coulomb_sign`); zeros when not given.
     """
 
-    law: FrictionLaw
+    law: Law
     params: NDArray[np.float64]
     band: NDArray[np.float64] = field(default_factory=lambda: np.zeros(0))
 

@@ -36,9 +36,6 @@ __all__ = [
     "kernels",
 ]
 
-_F64, _ND = _kernels.F64, np.ndarray
-#: the kernels' one cache (:data:`dynid._kernels.CACHE`)
-_CACHE = _kernels.CACHE
 _KERNELS = _kernels.KERNELS
 _LINK_POSES, _FRAME_POSE = _KERNELS["link_poses"], _KERNELS["frame_pose"]
 
@@ -173,6 +170,7 @@ def frame_pose_in_link(
     return link, T
 
 
+@_kernels.single_sample(_FRAME_POSE, "frame", "pose")
 def fk(
     robot: Robot, q: ArrayLike, frame: str = "flange", tool: ArrayLike | None = None
 ) -> NDArray[np.float64]:
@@ -207,20 +205,6 @@ def fk(
     -----
     Uses the compiled kernel when available (see :func:`kernels`), else :func:`fk_numpy`.
     """
-    # single sample: a float64 (n,) numpy array of any strides goes straight to the
-    # compiled kernel (no conversion, no copy, no dispatch; it checks finiteness)
-    e = _FRAME_POSE.one
-    if e is not None and q.__class__ is _ND and tool is None and q.dtype is _F64:
-        p = _CACHE.last if _CACHE.robot is robot else _kernels.find(robot)
-        if p is not None and q.shape == p.vector:
-            try:  # (unhashable frames, and objects that fake their class, go the general way)
-                CF = p.flange if frame == "flange" else p.frames.get(frame, (None,) * 3)[2]
-                if CF is not None:
-                    T = np.empty((4, 4))
-                    if e(CF, q, T):
-                        return T
-            except TypeError:
-                pass
     link, T_link_frame, CF = frame_constants(robot, frame, tool)
     out = _kernels.run(_FRAME_POSE, robot, (q,), (4, 4), CF)
     if out is not None:

@@ -21,12 +21,10 @@ from .forward import check_q, frame_constants, frame_pose_in_link, link_poses_pr
 
 __all__ = ["jacobian", "jacobian_numpy", "jacobian_to_tool"]
 
-_F64, _ND = _kernels.F64, np.ndarray
-#: the kernels' one cache (:data:`dynid._kernels.CACHE`)
-_CACHE = _kernels.CACHE
 _JACOBIAN = _kernels.KERNELS["jacobian"]
 
 
+@_kernels.single_sample(_JACOBIAN, "frame", "jacobian")
 def jacobian(
     robot: Robot, q: ArrayLike, frame: str = "flange", tool: ArrayLike | None = None
 ) -> NDArray[np.float64]:
@@ -58,19 +56,6 @@ def jacobian(
     Uses the compiled kernel when available (:func:`dynid._kernels.dispatch.compiled`),
     else :func:`jacobian_numpy`.
     """
-    # single sample: as in :func:`dynid.kinematics.forward.fk`
-    e = _JACOBIAN.one
-    if e is not None and q.__class__ is _ND and tool is None and q.dtype is _F64:
-        p = _CACHE.last if _CACHE.robot is robot else _kernels.find(robot)
-        if p is not None and q.shape == p.vector:
-            try:  # (unhashable frames, and objects that fake their class, go the general way)
-                CF = p.flange if frame == "flange" else p.frames.get(frame, (None,) * 3)[2]
-                if CF is not None:
-                    J = np.empty(p.jacobian)
-                    if e(CF, q, J):
-                        return J
-            except TypeError:
-                pass
     link, T_link_frame, CF = frame_constants(robot, frame, tool)
     out = _kernels.run(_JACOBIAN, robot, (q,), (6, len(robot.joint_names)), CF)
     if out is not None:

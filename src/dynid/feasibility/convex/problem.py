@@ -22,12 +22,22 @@ from ..prior import Prior, prior_scales
 from .data_term import DataTerm
 from .options import SDPOptions
 
-__all__ = ["SCS_SIGINT", "ConvexProblem", "Values"]
+__all__ = ["SCS_SIGINT", "ConvexProblem", "Values", "data_scale"]
 
 
-#: Boxes and the band are shrunk by this fraction of their width inside the solver, so
-#: that its tolerance (about 1e-8) cannot put the solution outside them.
+#: Boxes and the band are shrunk by this fraction inside the solver, so that its tolerance
+#: (about 1e-8) cannot put the solution outside them (:func:`_inset`).
 _SHRINK = 1e-6
+
+
+def _inset(lo: float, hi: float, ref: float) -> float:
+    """How far the solver's bounds lie inside ``[lo, hi]``: :data:`_SHRINK` of the width, or
+    of the quantity's own magnitude (``|lo|`` or ``ref``, the prior's) where that is
+    smaller, so that a loose bound (a band ``0..7e6`` kg) does not move its end by the
+    width's share (7 kg)."""
+    return _SHRINK * min(float(hi) - float(lo), max(abs(float(lo)), float(ref)))
+
+
 #: T (10, 16): phi of a link from vec(J) (row-major 4x4): m, h, J_o = tr(S) 1 - S.
 _T = np.zeros((10, 16))
 _T[0, 15] = 1.0
@@ -96,7 +106,10 @@ class ConvexProblem:
 
         n = prior.n
         J0 = prior.pseudo_inertia
-        self.S0 = np.linalg.cholesky(J0)
+        # the variables X_i = S0_i^-1 J_i S0_i^-T / kappa, kappa the data's scale over the
+        # prior's (a power of ten): X_i ~ 1 at the solution, whatever the prior's magnitude
+        kappa = self.kappa = data_scale(term, prior)
+        self.S0 = math.sqrt(kappa) * np.linalg.cholesky(J0)
         self.X = [cp.Variable((4, 4), symmetric=True, name=f"X{i + 1}") for i in range(n)]
         self.J = [self.S0[i] @ self.X[i] @ self.S0[i].T for i in range(n)]
         B = np.stack([_T @ np.kron(self.S0[i], self.S0[i]) for i in range(n)])  # (n, 10, 16)
@@ -115,18 +128,18 @@ class ConvexProblem:
             Ci = 0.5 * (Ci + Ci.T)
             cons.append(self.X[i] - eps * cp.trace(C @ self.X[i]) * Ci >> 0)
             m, h = phis[i][0], phis[i][1:4]
-            dm = _SHRINK * (mass_hi[i] - mass_lo[i])
+            dm = _inset(mass_lo[i], mass_hi[i], prior.mass[i])
             dc = _SHRINK * (bounds.com_max[i] - bounds.com_min[i])
             cons += [m >= mass_lo[i] + dm, m <= mass_hi[i] - dm]
             cons += [h >= m * (bounds.com_min[i] + dc), h <= m * (bounds.com_max[i] - dc)]
         if band is not None:
             M = sum(p[0] for p in phis)
-            db = _SHRINK * (band[1] - band[0])
+            db = _inset(band[0], band[1], float(prior.mass.sum()))
             cons += [M >= band[0] + db, M <= band[1] - db]
-        if options.objective == "logdet":
-            div = sum(-cp.log_det(X) + cp.trace(X) - 4.0 for X in self.X)
+        if options.objective == "logdet":  # (- 4 log kappa dropped: a constant)
+            div = sum(-cp.log_det(X) + kappa * cp.trace(X) - 4.0 for X in self.X)
         else:
-            div = sum(cp.sum_squares(X - np.eye(4)) for X in self.X)
+            div = sum(cp.sum_squares(kappa * X - np.eye(4)) for X in self.X)
         k = term.n_friction
         self.f = cp.Variable(k, name="f") if k else None
         p_links = 10 * n
@@ -218,7 +231,19 @@ class ConvexProblem:
         return _with_margin(phi, self.margin), f, ia
 
 
-#: ``phi`` (n, 10), friction (k,) or None, rotor inertias (n,) or None.
+def data_scale(term: DataTerm, prior: Prior) -> float:
+    """The data's scale over the prior's, a power of ten in ``[1e-8, 1e8]``: the coefficients'
+    norm over that of the prior's coefficients (1 when either is zero). A prior 1e4 times
+    too heavy (other units, a wild guess) would otherwise leave the solver's variables at
+    1e-4 and its tolerances coarser than the bounds."""
+    n10 = 10 * prior.n
+    x0 = term.P[:, :n10] @ np.asarray(prior.phi, dtype=np.float64).reshape(-1)
+    a, b = float(np.linalg.norm(term.x_hat[: term.r])), float(np.linalg.norm(x0))
+    if not (a > 0 and b > 0 and math.isfinite(a / b)):
+        return 1.0
+    return float(10.0 ** min(max(round(math.log10(a / b)), -8), 8))
+
+
 def _scs() -> Any:
     """cvxpy's SCS interface that lets a Ctrl-C through: SCS catches SIGINT itself and
     returns its status -5, which cvxpy reports as a failed solve, so a retry or the rest of

@@ -16,7 +16,7 @@ from numpy.typing import NDArray
 from ...identification.model import IdentifiedModel
 from ...model.inertia import inertial_from_phi
 from ...model.robot import Robot
-from ..bounds import Bounds, segment_points
+from ..bounds import Bounds, link_points
 from ..constraints import Constraint, FeasibilityReport, feasibility_report
 from ..heldout import HeldOutJudgement
 from ..lmi import (
@@ -152,7 +152,7 @@ def _active_and_implausible(
     for i in range(robot.n):
         w = max(bounds.mass_max[i] - bounds.mass_min[i], 1e-12)
         for side, b in (("lower", bounds.mass_min[i]), ("upper", bounds.mass_max[i])):
-            if abs(m[i] - b) <= 1e-4 * w:
+            if abs(m[i] - b) <= 1e-4 * min(w, max(abs(b), m[i], 1e-12)):
                 act.append(f"{names[i]} mass {m[i]:.4g} kg at its {side} bound")
         for k, ax in enumerate("xyz"):
             wc = max(bounds.com_max[i, k] - bounds.com_min[i, k], 1e-12)
@@ -162,14 +162,14 @@ def _active_and_implausible(
     if band is not None:
         M = float(m.sum())
         for side, b in (("lower", band[0]), ("upper", band[1])):
-            if abs(M - b) <= 1e-4 * max(band[1] - band[0], 1e-3):
+            if abs(M - b) <= 1e-4 * max(min(band[1] - band[0], max(abs(b), M)), 1e-3):
                 act.append(f"total mass {M:.4g} kg at the {side} end of its band")
     if act:
         out.append("decided by the bound, not the data: " + "; ".join(act))
     M = float(m.sum())
     lam = np.linalg.eigvalsh(I)
     for i in range(robot.n):
-        ext = max(float(np.linalg.norm(np.ptp(segment_points(robot, i), axis=0))), 0.05)
+        ext = max(float(np.linalg.norm(np.ptp(link_points(robot, i), axis=0))), 0.05)
         rg = math.sqrt(max(float(lam[i].sum()), 0.0) / (2.0 * m[i])) if m[i] > 0 else math.inf
         if m[i] < 0.01 * M:
             out.append(f"implausible: {names[i]} weighs {m[i]:.3g} kg, under 1 % of the total")

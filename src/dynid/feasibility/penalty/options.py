@@ -11,7 +11,13 @@ from .objective import (
     DEFAULT_SCALE_FLOOR,
 )
 
-__all__ = ["RetrievalOptions"]
+__all__ = ["MAX_WEIGHT", "RetrievalOptions"]
+
+#: Largest penalty weight ``xi`` and prior weight: a stage objective's penalty rows then
+#: outweigh its data rows by at most 1e12 in the refinement's normal equations (about what
+#: float64 resolves); a larger weight only loses the data term to rounding, and its powers
+#: overflow. The default schedule stays at this weight once it reaches it.
+MAX_WEIGHT = 1e12
 
 
 @dataclass(frozen=True, slots=True)
@@ -25,10 +31,13 @@ class RetrievalOptions:
     stages : int
         Stages ``kappa`` per run (Gaz et al. used 5).
     xi : tuple of float, optional
-        Penalty weight of every stage (length ``stages``, ``xi[0]`` normally 0). Default
-        ``(0, xi_first, xi_first * xi_growth, ...)``.
+        Penalty weight of every stage (length ``stages``, ``xi[0]`` normally 0, each at
+        most :data:`MAX_WEIGHT`). Default ``(0, xi_first, xi_first * xi_growth, ...)``,
+        each capped at :data:`MAX_WEIGHT` (so any number of stages is valid: the last ones
+        refine at the cap).
     xi_first, xi_growth : float
-        Default schedule: the weight of stage 2 and the factor between later stages.
+        Default schedule: the weight of stage 2 (in ``(0, MAX_WEIGHT]``) and the factor
+        between later stages (``>= 1``).
     anneal_maxiter : int
         Iterations of the simulated annealing per stage (each visits ``2 * 10 n``
         points); 0 skips the annealing.
@@ -79,8 +88,14 @@ class RetrievalOptions:
     def __post_init__(self) -> None:
         if self.residual_tol is not None and not self.residual_tol > 0:
             raise OptionError(f"residual_tol must be positive or None; got {self.residual_tol}")
-        if not (math.isfinite(self.prior_weight) and self.prior_weight >= 0):
-            raise OptionError(f"prior_weight must be finite and >= 0; got {self.prior_weight}")
+        if not (math.isfinite(self.prior_weight) and 0 <= self.prior_weight <= MAX_WEIGHT):
+            raise OptionError(
+                f"prior_weight must be in [0, {MAX_WEIGHT:g}]; got {self.prior_weight}"
+            )
+        if not (math.isfinite(self.xi_first) and 0 < self.xi_first <= MAX_WEIGHT):
+            raise OptionError(f"xi_first must be in (0, {MAX_WEIGHT:g}]; got {self.xi_first}")
+        if not (math.isfinite(self.xi_growth) and self.xi_growth >= 1):
+            raise OptionError(f"xi_growth must be finite and >= 1; got {self.xi_growth}")
         if self.runs < 1 or self.stages < 1:
             raise OptionError(f"runs and stages must be >= 1; got {self.runs}, {self.stages}")
         if self.anneal_maxiter < 0 or self.local_maxiter < 0:
@@ -91,12 +106,16 @@ class RetrievalOptions:
                 raise OptionError(
                     f"xi must have one weight per stage ({self.stages}); got {len(xi)}"
                 )
-            if any(x < 0 or not math.isfinite(x) for x in xi):
-                raise OptionError(f"xi must be finite and >= 0; got {xi}")
+            if any(not 0 <= x <= MAX_WEIGHT for x in xi):  # (NaN fails too)
+                raise OptionError(f"xi must be in [0, {MAX_WEIGHT:g}]; got {xi}")
             object.__setattr__(self, "xi", xi)
 
     def schedule(self) -> tuple[float, ...]:
-        """Penalty weights ``xi_1 .. xi_kappa``."""
+        """Penalty weights ``xi_1 .. xi_kappa`` (each at most :data:`MAX_WEIGHT`)."""
         if self.xi is not None:
             return self.xi
-        return (0.0,) + tuple(self.xi_first * self.xi_growth**k for k in range(self.stages - 1))
+        out, x = [0.0], self.xi_first
+        for _ in range(self.stages - 1):
+            out.append(x)
+            x = min(x * self.xi_growth, MAX_WEIGHT)  # (no power: 100**199 overflows)
+        return tuple(out)
