@@ -36,7 +36,7 @@ from ..exceptions import DataError, DynidWarning
 from ..identification.log import TorqueLog, joint_side_log, prepare_log
 from ..identification.metrics import TorqueErrors
 from ..identification.model import IdentifiedModel
-from ..identification.recordings import split_at_gaps, unwrapped
+from ..identification.recordings import skipped_piece, split_at_gaps, unwrapped
 from ..identification.sanity import velocity_noise_std
 from ..model.drive import Drive
 from ..model.robot import Robot
@@ -203,12 +203,7 @@ def prepare_pieces(
                 piece, cutoff_hz=cut, trim_s=trim_s, filter_tau=filter_tau, max_gap_s=max_gap_s
             )
         except DataError as exc:
-            line = (
-                f"{names[r]}: piece {piece.t[0]:.6g}-{piece.t[-1]:.6g} s "
-                f"({piece.n_samples} samples) left out: {exc}"
-            )
-            skipped.append(line)
-            warnings.warn(line, DynidWarning, stacklevel=2)
+            skipped.append(skipped_piece(names[r], piece, exc))
             continue
         prepared.append(p)
         recording.append(r)

@@ -29,11 +29,11 @@ from numpy.typing import ArrayLike, NDArray
 
 from .. import _checks
 from ..dynamics.rnea import rnea
-from ..exceptions import DataError, DynidWarning, OptionError, ShapeError
+from ..exceptions import DynidWarning, OptionError, ShapeError
 from ..identification.log import DEFAULT_CUTOFF_HZ, TorqueLog, joint_side_log, prepare_log
 from ..identification.metrics import TorqueErrors, torque_errors
 from ..identification.model import IdentifiedModel
-from ..identification.rate import cutoff_from_motion
+from ..identification.recordings import common_cutoff
 from ..identification.sanity import anticorrelated
 from ..model.drive import Drive
 from ..model.robot import Robot
@@ -140,22 +140,8 @@ def recorded_cutoff(
     if isinstance(model, IdentifiedModel) and model.info.log is not None:
         return model.info.log.cutoff_hz
     logs = [] if log is None else [log] if isinstance(log, TorqueLog) else list(log)
-    found, weight = [], []
-    for one in logs:
-        if one.n_samples < 64:
-            continue
-        try:
-            found.append(cutoff_from_motion(one.q, one.dq, one.sample_rate))
-        except DataError:
-            if len(logs) == 1:
-                raise
-            continue
-        weight.append(one.n_samples)
-    if not found:
-        return DEFAULT_CUTOFF_HZ
-    order = np.argsort(found)
-    cum = np.cumsum(np.asarray(weight, dtype=np.float64)[order])
-    return float(np.asarray(found)[order][np.searchsorted(cum, 0.5 * cum[-1])])
+    cut = common_cutoff(logs)
+    return DEFAULT_CUTOFF_HZ if cut is None else cut
 
 
 def validate_torques(

@@ -47,7 +47,14 @@ from .rate import CUTOFF_MULTIPLE, cutoff_from_motion
 from .sanity import noise_band, velocity_noise_std
 from .streaming import streams
 
-__all__ = ["Recordings", "prepare_recordings", "split_at_gaps", "unwrapped"]
+__all__ = [
+    "Recordings",
+    "common_cutoff",
+    "prepare_recordings",
+    "skipped_piece",
+    "split_at_gaps",
+    "unwrapped",
+]
 
 
 def split_at_gaps(log: TorqueLog, max_gap_s: float | None = None) -> list[TorqueLog]:
@@ -318,7 +325,11 @@ def prepare_recordings(
                 stacklevel=2,
             )
         pieces += [(r, p) for p in split_at_gaps(log, max_gap_s)]
-    cutoff = _common_cutoff(pieces, drive) if cutoff_hz == "auto" else cutoff_hz
+    cutoff: float | None = None if cutoff_hz == "auto" else cutoff_hz
+    if cutoff_hz == "auto":
+        cutoff = common_cutoff([joint_side_log(p, drive) for _, p in pieces])
+        if cutoff is None:
+            raise DataError("no piece is long enough to read the motion's frequency from")
     prepared, recording, skipped = [], [], []
     for r, piece in pieces:
         try:
@@ -332,12 +343,7 @@ def prepare_recordings(
                 drive=drive,
             )
         except DataError as exc:
-            line = (
-                f"{names[r]}: piece {piece.t[0]:.6g}-{piece.t[-1]:.6g} s "
-                f"({piece.n_samples} samples) left out: {exc}"
-            )
-            skipped.append(line)
-            warnings.warn(line, DynidWarning, stacklevel=2)
+            skipped.append(skipped_piece(names[r], piece, exc))
             continue
         prepared.append(p)
         recording.append(r)
@@ -363,24 +369,38 @@ def prepare_recordings(
     )
 
 
-def _common_cutoff(pieces: list[tuple[int, TorqueLog]], drive: Drive | None) -> float | None:
-    """The cut-off read from the motion of the pieces long enough to read it: their median,
-    each piece weighted by its samples (a short piece reads its edges as fast motion)."""
+def common_cutoff(pieces: Sequence[TorqueLog]) -> float | None:
+    """The cut-off [Hz] read from the motion of the pieces long enough to read it
+    (:func:`~dynid.identification.rate.cutoff_from_motion`): their median, each piece
+    weighted by its samples (a short piece reads its edges as fast motion); None when no
+    piece is long enough."""
     found, weight = [], []
-    for _, piece in pieces:
-        j = joint_side_log(piece, drive)
-        if j.n_samples < 64:
+    for piece in pieces:
+        if piece.n_samples < 64:
             continue
         try:
-            found.append(cutoff_from_motion(j.q, j.dq, j.sample_rate))
+            found.append(cutoff_from_motion(piece.q, piece.dq, piece.sample_rate))
         except DataError:
+            if len(pieces) == 1:
+                raise
             continue
-        weight.append(j.n_samples)
+        weight.append(piece.n_samples)
     if not found:
-        raise DataError("no piece is long enough to read the motion's frequency from")
+        return None
     order = np.argsort(found)
     cum = np.cumsum(np.asarray(weight, dtype=np.float64)[order])
     return float(np.asarray(found)[order][np.searchsorted(cum, 0.5 * cum[-1])])
+
+
+def skipped_piece(name: str, piece: TorqueLog, exc: Exception, stacklevel: int = 3) -> str:
+    """Warn that a piece of recording ``name`` is left out (too short to filter, the
+    reason ``exc``); returns the line, for the record."""
+    line = (
+        f"{name}: piece {piece.t[0]:.6g}-{piece.t[-1]:.6g} s ({piece.n_samples} samples) "
+        f"left out: {exc}"
+    )
+    warnings.warn(line, DynidWarning, stacklevel=stacklevel)
+    return line
 
 
 def _band(pieces: list[TorqueLog], drive: Drive | None) -> NDArray[np.float64]:

@@ -28,7 +28,7 @@ from ..exceptions import DataError, DynidWarning
 from ..feasibility.payload import PayloadEstimate, identify_payload
 from ..identification.log import DEFAULT_CUTOFF_HZ, TorqueLog, prepare_log
 from ..identification.model import IdentifiedModel
-from ..identification.recordings import split_at_gaps, unwrapped
+from ..identification.recordings import skipped_piece, split_at_gaps, unwrapped
 from ..model.robot import Robot
 from .data_files import ColumnSpec, column_map, data_kind, in_file, read_static_file
 from .identify import data_files
@@ -187,12 +187,7 @@ def _pieces(
             try:
                 prepare_log(piece, cutoff_hz=cutoff_hz, max_gap_s=max_gap_s)  # long enough?
             except DataError as exc:
-                line = (
-                    f"{name}: piece {piece.t[0]:.6g}-{piece.t[-1]:.6g} s "
-                    f"({piece.n_samples} samples) left out: {exc}"
-                )
-                skipped.append(line)
-                warnings.warn(line, DynidWarning, stacklevel=3)
+                skipped.append(skipped_piece(name, piece, exc, stacklevel=4))
                 continue
             mine.append(piece)
         if not mine:
