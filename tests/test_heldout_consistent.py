@@ -112,7 +112,13 @@ def test_a_consistent_fit_far_above_least_squares_in_training_is_accepted_held_o
     Y = dynid.torque_regressor(robot, q, dq, ddq)[..., bp.independent]
     # classical friction with the standstill band the identification recorded
     band = tuple(meta.get("friction_band", ()))
-    F = LinearFriction(Drive.identity(7), band=band).torque_columns(q, dq, ddq)
+    term = LinearFriction(Drive.identity(7), band=band)
+    F = term.torque_columns(q, dq, ddq)
+    # its Coulomb columns through the torques' low-pass (parallel filtering), at this rate
+    step = np.flatnonzero(term.steps)
+    F[..., step] = dynid.signals.lowpass(
+        F[..., step], 1.0 / np.median(np.diff(p.t[s])), meta["cutoff_hz"], axis=0
+    )
     W = np.concatenate([Y, F], axis=-1).reshape(-1, bp.rank + 21)
     y = tau.reshape(-1)
     blocks = np.repeat(np.minimum(np.arange(q.shape[0]) * 5 // q.shape[0], 4), 7)

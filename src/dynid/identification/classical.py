@@ -38,7 +38,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from .. import _checks, signals
-from ..exceptions import DynidWarning, OptionError, ShapeError
+from ..exceptions import DataError, DynidWarning, OptionError, ShapeError
 from ..model.drive import Drive
 from ..model.robot import Robot
 from ..regressors.base import BaseParameters
@@ -77,6 +77,7 @@ from .streaming import BLOCK_ROWS, BlockSource, normals_by_label, streams
 __all__ = [
     "PreparedLog",
     "log_blocks",
+    "parallel_filtered",
     "still_columns",
     "auto_decimation",
     "friction_labels",
@@ -325,6 +326,8 @@ def _validation_rows(
     assert p.ddq is not None
     q, dq, ddq, tau = p.q[sl], p.dq[sl], p.ddq[sl], p.tau[sl]
     Y, _ = term_regressor(robot, columns.base, columns.terms, q, dq, ddq)
+    if cutoff_hz is not None:
+        Y = parallel_filtered(Y, columns.step_columns(), p.t[sl], cutoff_hz)
     if drive is not None and drive.rotor_inertia is not None:
         tau = tau - drive.rotor_torques(ddq, drive.rotor_inertia)
     return Y.reshape(q.shape[0] * robot.n, -1)[:, cols], tau.reshape(-1)
@@ -419,7 +422,7 @@ class PreparedLog:
         """One block (:func:`log_blocks`); several when the log is too long to stack."""
         if columns.drive is not self.drive:
             raise OptionError("the log was prepared for another drive than the model's")
-        yield from log_blocks(robot, self.log, columns)
+        yield from log_blocks(robot, self.log, columns, cutoff_hz=self.cutoff_hz)
 
     def record(self, n_rows: int) -> IdentificationInfo:
         """Filtering, decimation and sample counts."""
@@ -512,12 +515,22 @@ def prepare_torque_log(
 
 
 def log_blocks(
-    robot: Robot, log: TorqueLog, columns: ModelColumns, *, stream: bool | None = None
+    robot: Robot,
+    log: TorqueLog,
+    columns: ModelColumns,
+    *,
+    stream: bool | None = None,
+    cutoff_hz: float | None = None,
 ) -> Iterator[RegressorBlock]:
     """The regressor rows of a prepared log over ``columns``: sample-major (row ``k n + j``
     is sample ``k``, joint ``j``, its noise group ``j``); known rotor torques of
     ``columns.drive`` subtracted. One block, or blocks of :data:`BLOCK_ROWS` rows when
-    ``stream`` (default: when the regressor exceeds ``DYNID_MAX_STACK_BYTES``)."""
+    ``stream`` (default: when the regressor exceeds ``DYNID_MAX_STACK_BYTES``).
+
+    ``cutoff_hz``: the low-pass the log's torques went through. The columns of the
+    appended terms (friction) then go through the same zero-phase low-pass, at the log's
+    rate (:func:`parallel_filtered`): a filtered torque rounds the step of Coulomb friction
+    at a reversal, and ``sign(dq)`` left sharp would bias every friction coefficient."""
     assert log.ddq is not None  # prepare_log always fills ddq
     N, n = log.n_samples, log.n
     drive = columns.drive
@@ -528,12 +541,36 @@ def log_blocks(
         b = slice(a, a + step)
         q, dq, ddq, tau = log.q[b], log.dq[b], log.ddq[b], log.tau[b]
         Y, _ = term_regressor(robot, columns.base, columns.terms, q, dq, ddq)
+        if cutoff_hz is not None:
+            Y = parallel_filtered(Y, columns.step_columns(), log.t[b], cutoff_hz)
         if drive is not None and drive.rotor_inertia is not None:  # known: subtracted
             tau = tau - drive.rotor_torques(ddq, drive.rotor_inertia)
         m = Y.shape[0]
         W = Y.reshape(m * n, -1)
         _checks.finite("regressor", W)
         yield RegressorBlock(W=W, y=tau.reshape(-1), groups=np.tile(np.arange(n), m))
+
+
+def parallel_filtered(
+    Y: NDArray[np.float64], cols: NDArray[np.bool_], t: NDArray[np.float64], cutoff_hz: float
+) -> NDArray[np.float64]:
+    """``Y`` (N, n, c) with its columns ``cols`` (c,) low-passed along time at
+    ``cutoff_hz`` (:func:`dynid.signals.lowpass`, the filter of the torques): the
+    "parallel filtering" of Gautier and Khalil, the regressor and the torques through the
+    same filter, for the columns that step at a reversal (the smooth ones are left as
+    computed from the filtered states). Left as it is where the rate is too low for the
+    cut-off (below 2.2 times it) or the samples too few to filter."""
+    idx = np.flatnonzero(cols)
+    if idx.size == 0 or Y.shape[0] < 2:
+        return Y
+    fs = signals.sample_rate(t)
+    if not cutoff_hz < 0.45 * fs:
+        return Y
+    try:
+        Y[..., idx] = signals.lowpass(Y[..., idx], fs, cutoff_hz, axis=0)
+    except DataError:  # too few samples for the filter's padding
+        pass
+    return Y
 
 
 def still_columns(columns: ModelColumns, still: NDArray[np.bool_]) -> NDArray[np.bool_]:

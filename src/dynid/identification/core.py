@@ -132,6 +132,14 @@ class ModelColumns:
             c += len(t.labels)
         return None
 
+    def step_columns(self) -> NDArray[np.bool_]:
+        """(c,): the columns that step where a velocity reverses (a term's ``steps``)."""
+        out = [np.zeros(self.base.rank, dtype=bool)]
+        for t in self.appended:
+            steps = getattr(t, "steps", None)
+            out.append(np.zeros(len(t.labels), bool) if steps is None else np.asarray(steps))
+        return np.concatenate(out)
+
     def motion_columns(self) -> NDArray[np.intp]:
         """(c,): the joint (motor) whose motion each column needs to be identified, -1 for
         none (a term's ``needs_motion``; the base parameters need none of their own)."""

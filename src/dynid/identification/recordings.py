@@ -189,9 +189,11 @@ class Recordings:
         n = self.n
         if streams(self.n_samples * n, len(columns.labels)):
             for p in self.pieces:
-                yield from log_blocks(robot, p.log, columns, stream=True)
+                yield from log_blocks(robot, p.log, columns, stream=True, cutoff_hz=p.cutoff_hz)
             return
-        parts = [b for p in self.pieces for b in log_blocks(robot, p.log, columns)]
+        parts = [
+            b for p in self.pieces for b in log_blocks(robot, p.log, columns, cutoff_hz=p.cutoff_hz)
+        ]
         if len(parts) == 1:
             yield parts[0]
             return

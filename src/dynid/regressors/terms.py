@@ -227,6 +227,13 @@ class LinearFriction:
         j = np.repeat(np.arange(self.drive.n), k)
         return np.where(np.tile([p != "offset" for p in self.parts], self.drive.n), j, -1)
 
+    @property
+    def steps(self) -> NDArray[np.bool_]:
+        """(p,): the columns that step where the velocity reverses (Coulomb, smooth
+        Coulomb, Stribeck), which a torque filtered at a cut-off sees rounded
+        (:func:`~dynid.identification.classical.parallel_filtered`)."""
+        return np.tile([p in ("coulomb", "smooth", "stribeck") for p in self.parts], self.drive.n)
+
     def as_array(self, params: NDArray[np.float64]) -> NDArray[np.float64]:
         """The coefficients (p,) as the parameters (n, k) of :attr:`law`: ``fv, fc, fo``
         (classical, smooth), ``fv, fq, fc, fo`` (quadratic) or ``fv, fc, fs, vst, fo``
