@@ -30,7 +30,7 @@ from numpy.typing import NDArray
 from .. import _checks
 from ..dynamics.rnea import rnea
 from ..exceptions import OptionError, ShapeError
-from ..friction.model import FrictionModel, SigmoidFriction
+from ..friction.model import DriveFriction, FrictionModel, SigmoidFriction
 from ..identification.log import TorqueLog, recorded_side_log
 from ..model.drive import Drive
 from ..model.robot import Robot
@@ -155,7 +155,10 @@ def simulate_measurement(
         Measurement noise levels.
     friction : FrictionModel, None or "robot"
         Ground-truth friction: a model, None for no friction, or ``"robot"`` (default)
-        for the robot's sigmoid parameters ``robot.friction`` (none if it has none).
+        for the robot's sigmoid parameters ``robot.friction`` (none if it has none). With
+        a ``drive`` whose friction acts at the motors, a law per joint acts per motor
+        (``K^T f(K dq)``, :class:`~dynid.friction.model.DriveFriction`), as identification
+        models it; a ``DriveFriction`` acts as it says.
     drop_fraction : float
         Fraction of samples removed at random (never the first or last), in [0, 0.5).
     with_ddq : bool
@@ -246,6 +249,12 @@ def _true_torques(
     else:
         tau = rnea(robot, traj.q, traj.dq, traj.ddq)
     if friction is not None:
+        if (
+            drive is not None
+            and drive.friction_at == "motor"
+            and not isinstance(friction, DriveFriction)
+        ):  # the law per motor, where the drive says friction acts: K^T f(K dq)
+            friction = DriveFriction(friction, drive)
         tau = tau + friction.torques(traj.dq)
     if drive is not None and drive.rotor_inertia is not None:
         tau = tau + drive.rotor_torques(traj.ddq, drive.rotor_inertia)
