@@ -527,3 +527,21 @@ def test_an_observer_report_shows_residuals_thresholds_and_events(tmp_path):
     assert ["joint2", "2"] in [r for t in page.tables for r in t]
     assert "residuals.csv" in {urllib.parse.unquote(h) for h in page.links}
     check_in_browser(out / REPORT_NAME, tmp_path, verdict=True, torques=True)
+
+
+@pytest.mark.slow
+def test_torques_of_the_opposite_sign_make_the_verdict_poor(runs, tmp_path):
+    """A run that warned that the torques are anti-correlated with the model's gravity
+    torques (a log of the other sign convention fits as well) gets 'not good enough' with the
+    warning in the verdict, whatever its errors (a regression: it said GOOD)."""
+    doc = _identification_doc(runs)
+    p = tmp_path / "identification.json"
+    p.write_text(json.dumps(doc))
+    warning = "torques are anti-correlated with the model's gravity torques (correlation -0.86)"
+    page_text = render_html_report(
+        RunSummary(command="identify", warnings=(warning,)), {p.name: p}, out=tmp_path
+    )
+    assert '<section class="verdict poor"' in page_text
+    assert "anti-correlated" in page_text.split('id="verdict"')[1].split("</section>")[0]
+    good = render_html_report(RunSummary(command="identify"), {p.name: p}, out=tmp_path)
+    assert '<section class="verdict poor"' not in good

@@ -208,6 +208,7 @@ def answer(run: RunFiles) -> Answer | None:
     certainty, _ = _certainty_fact(doc)
     facts += [certainty] if certainty else []
     facts.append(_terms_fact(doc))
+    facts += _warning_facts(run, problems)
     level = "poor" if "poor" in problems else "fair" if problems else "good"
     if not headline:
         headline = "The identification's record holds no error to judge it by"
@@ -220,6 +221,21 @@ def answer(run: RunFiles) -> Answer | None:
         tuple(s for s in sections if s),
         shown,
     )
+
+
+#: Warnings that say the data contradict the model whatever its errors: the verdict is poor.
+_DATA_WARNINGS = ("anti-correlated", "look like degrees")
+
+
+def _warning_facts(run: RunFiles, problems: list[str]) -> list[str]:
+    """Facts (and a poor verdict in ``problems``) from the run's warnings: torques of the
+    opposite sign or positions in degrees fit as well as the right ones, and a model fitted
+    to them predicts the robot's torques wrongly (200 % on a correctly signed log)."""
+    bad = [w for w in run.summary.warnings if any(k in w for k in _DATA_WARNINGS)]
+    if not bad:
+        return []
+    problems.append("poor")
+    return [f"<b>The data contradict the robot</b>: {esc(w)}" for w in bad]
 
 
 def _torques_section(run: RunFiles, held: dict | None) -> str:
