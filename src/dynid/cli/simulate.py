@@ -37,7 +37,7 @@ from typing import Any
 
 import numpy as np
 
-from ..exceptions import DynidError
+from ..exceptions import DynidError, OptionError
 from ..friction.model import FrictionModel
 from ..io.friction_json import load_friction_json
 from ..io.torque_log import save_torque_log_pieces
@@ -156,7 +156,15 @@ def register(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParser:
         "--unmodelled",
         action="store_true",
         help="add effects outside the rigid-body model, as real arms have (rotor inertia, "
-        "torque-sensor offsets, a 0.3 deg gravity tilt; drawn from --seed and printed)",
+        "torque-sensor offsets, a 0.3 deg gravity tilt; drawn from --arm-seed and printed)",
+    )
+    p.add_argument(
+        "--arm-seed",
+        type=number(int, min=0),
+        default=None,
+        metavar="N",
+        help="--unmodelled: the seed of the arm's effects (default 0), apart from --seed so "
+        "that recordings of several --seed are of one arm",
     )
     p.add_argument(
         "--contact",
@@ -276,10 +284,13 @@ def run(args: argparse.Namespace, console: Console) -> int:
     if drive is not None:
         say(f"drive: {drive.describe()}; the log is written on the {drive.side} side")
     effects = None
+    if args.arm_seed is not None and not args.unmodelled:
+        raise OptionError("--arm-seed applies to --unmodelled; add it or leave --arm-seed out")
     if args.unmodelled:
         from ..simulation.unmodelled import UnmodelledEffects
 
-        effects = UnmodelledEffects.typical(n, np.random.default_rng([args.seed, 7]))
+        arm = 0 if args.arm_seed is None else args.arm_seed
+        effects = UnmodelledEffects.typical(n, np.random.default_rng([arm, 7]))
         say(f"effects outside the rigid-body model: {effects.describe()}")
     contacts = _contacts(args, robot)
     measured = measured_blocks(

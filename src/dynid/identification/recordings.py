@@ -317,7 +317,9 @@ def prepare_recordings(
     for r, (name, log) in enumerate(zip(names, logs, strict=True)):
         if log.n != robot.n:
             raise ShapeError(f"{name}: log has {log.n} joints; robot {robot.name!r} has {robot.n}")
-        log, joints = unwrapped(log, revolute if drive is None else np.zeros(robot.n, bool))
+        # a motor-side log: every motor turns (a joint-side one: the robot's revolute joints)
+        turns = revolute if drive is None or drive.side == "joint" else np.ones(robot.n, bool)
+        log, joints = unwrapped(log, turns)
         if joints:
             turned.update(joints)
             warnings.warn(
