@@ -19,15 +19,17 @@ the command applies, so that the Python API behaves as the command does.
 
 from __future__ import annotations
 
+import warnings
 from collections.abc import Mapping
 from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
 
-from ..exceptions import OptionError
+from ..exceptions import DynidWarning, OptionError
 from ..friction.model import FrictionModel
-from ..identification.log import joint_side_log
+from ..identification.log import joint_side_log, with_derived_velocities
+from ..identification.recordings import unwrapped
 from ..io.columns import load_joint_columns
 from ..io.feasible import load_feasible_drive, load_feasible_linear_friction
 from ..io.friction_json import load_friction_json
@@ -221,6 +223,16 @@ def _observe_log(
         owner="the model",
     )
     log = joint_side_log(log, model.drive)
+    log, turned = unwrapped(log, ~np.asarray(model.robot.prismatic, dtype=bool))
+    if turned:  # M(q) is periodic; velocities derived across a wrap are not
+        warnings.warn(
+            f"{path.name}: joint(s) {', '.join(str(j + 1) for j in turned)} recorded wrapped "
+            "into [-pi, pi] (jumps of a whole turn): unwrapped",
+            DynidWarning,
+            stacklevel=3,
+        )
+        if log.dq_derived:
+            log = with_derived_velocities(log)
 
     def run() -> LogObservation:
         res = observe(model, log.t, log.q, log.dq, log.tau, options)
