@@ -296,7 +296,8 @@ def check_row_count(path: Path, recorded: int | None, found: int) -> None:
     if recorded is not None and recorded != found:
         raise DataError(
             f"{path.name}: the file records {recorded} rows but holds {found}; it is "
-            "incomplete or was edited (a write or copy cut short?); regenerate it"
+            "incomplete or was edited (a write or copy cut short?); regenerate it, or, if "
+            "rows were removed on purpose, correct or delete its '# rows:' line"
         )
 
 

@@ -497,7 +497,8 @@ def _check_declared_rows(path: Path, recorded: int | None, width: int, size: int
     if recorded is not None and recorded > size // (2 * width):
         raise DataError(
             f"{path.name}: the file records {recorded} rows but its {size} bytes of data hold "
-            f"at most {size // (2 * width)}; it is incomplete or was edited; regenerate it"
+            f"at most {size // (2 * width)}; it is incomplete or was edited; regenerate it, or, "
+            "if rows were removed on purpose, correct or delete its '# rows:' line"
         )
 
 
