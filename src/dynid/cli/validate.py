@@ -33,7 +33,12 @@ from pathlib import Path
 import numpy as np
 
 from ..exceptions import DataError
-from ..friction.validation import own_friction, recorded_cutoff, validate_torques
+from ..friction.validation import (
+    Validation,
+    own_friction,
+    recorded_cutoff,
+    validate_torques,
+)
 from ..identification.log import DEFAULT_CUTOFF_HZ
 from ..identification.model import IdentifiedModel
 from ..io.feasible import load_feasible_drive, load_feasible_linear_friction
@@ -126,11 +131,7 @@ def run(args: argparse.Namespace, console: Console) -> int:
         )
     errors = val.errors
     if not np.isfinite(errors.relative_error_percent) or not np.all(np.isfinite(errors.rms)):
-        raise DataError(
-            f"{args.data.name}: the torque errors overflow (relative error "
-            f"{errors.relative_error_percent}); the log holds values far outside a robot's "
-            f"range (largest |tau| {float(np.max(np.abs(val.log.tau))):.3g} N m)"
-        )
+        raise DataError(_overflow(args, val, label))
     path = save_validation_json(
         args.out / "validation.json",
         val,
@@ -156,3 +157,29 @@ def run(args: argparse.Namespace, console: Console) -> int:
         f"relative error {val.errors.relative_error_percent:.3f} %; wrote {path}",
     )
     return 0
+
+
+def _overflow(args: argparse.Namespace, val: Validation, label: str) -> str:
+    """Why the torque errors overflow: the largest of the log's torques, the rigid-body
+    model's and the friction's, named with its source."""
+    with np.errstate(over="ignore", invalid="ignore"):
+        peaks = {
+            "log": float(np.max(np.abs(val.log.tau))),
+            "model": float(np.max(np.abs(val.tau_model))),
+            "friction": 0.0
+            if val.tau_friction is None
+            else float(np.max(np.abs(val.tau_friction))),
+        }
+    worst = max(peaks, key=lambda k: peaks[k] if np.isfinite(peaks[k]) else np.inf)
+    where = {
+        "log": "the log holds values far outside a robot's range",
+        "model": f"the model's torques are far outside a robot's range; check {label}'s parameters",
+        "friction": "the friction torques are far outside a robot's range; check the "
+        f"coefficients of {args.friction.name if args.friction is not None else label}",
+    }[worst]
+    return (
+        f"{args.data.name}: the torque errors overflow (relative error "
+        f"{val.errors.relative_error_percent}); {where} (largest |tau| [N m]: log "
+        f"{peaks['log']:.3g}, rigid-body model {peaks['model']:.3g}, "
+        f"friction {peaks['friction']:.3g})"
+    )
