@@ -82,3 +82,12 @@ def test_a_huge_friction_coefficient_is_named_not_the_log(tmp_path):
     assert r.returncode == 2, r.stderr
     assert "friction torques are far outside" in r.stderr and "huge.json" in r.stderr, r.stderr
     assert "the log holds" not in r.stderr
+
+
+def test_payload_refuses_cutoff_with_static_data(one_configuration, tmp_path):
+    """``payload --cutoff`` on static data is refused in one line (it was ignored)."""
+    args = ("payload", "--robot", "panda", "--data", str(one_configuration))
+    r = _main(*args, "--cutoff", "10", "--out", str(tmp_path / "p"))
+    assert r.returncode == 2 and r.stderr.count("\n") == 1, r.stderr
+    assert "--cutoff applies to torque logs" in r.stderr, r.stderr
+    assert not (tmp_path / "p").exists()

@@ -57,7 +57,11 @@ def register(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParser:
     p.add_argument("--frame", default="flange", help="frame the load is fixed to")
     p.add_argument("--gravity-only", action="store_true", help="static data: use g alone")
     p.add_argument(
-        "--cutoff", type=positive_type, default=DEFAULT_CUTOFF_HZ, help="torque logs: low-pass [Hz]"
+        "--cutoff",
+        type=positive_type,
+        default=None,
+        help=f"torque logs: low-pass [Hz] (default {DEFAULT_CUTOFF_HZ:g}; static data are not "
+        "filtered)",
     )
     add_drop_invalid(p)
     p.add_argument("--out", type=output_path, required=True, help="output folder")
@@ -78,10 +82,15 @@ def run(args: argparse.Namespace, console: Console) -> int:
     """Identify, write payload.json and the robot with the load, print a summary."""
     arm, label = load_model_source(args)
     kin = arm.robot if isinstance(arm, IdentifiedModel) else arm
-    cmap = column_map(args.columns, args.units, cutoff_hz=args.cutoff)
+    cutoff = DEFAULT_CUTOFF_HZ if args.cutoff is None else args.cutoff
+    cmap = column_map(args.columns, args.units, cutoff_hz=cutoff)
     kind = data_kind(args.data, cmap)
     if args.gravity_only and kind != "static":
         raise DynidError("--gravity-only applies to static data (q, g), not to a torque log")
+    if args.cutoff is not None and kind == "static":
+        raise DynidError(
+            "--cutoff applies to torque logs (their low-pass); static data are not filtered"
+        )
     data = _read(args, args.data, kin, kind, cmap)
     unloaded = None if args.unloaded is None else _read(args, args.unloaded, kin, kind, cmap)
     est = identify_payload(
@@ -90,7 +99,7 @@ def run(args: argparse.Namespace, console: Console) -> int:
         frame=args.frame,
         gravity_only=args.gravity_only,
         unloaded=unloaded,
-        cutoff_hz=args.cutoff if kind == "torque_log" else None,
+        cutoff_hz=cutoff if kind == "torque_log" else None,
     )
     base = arm.equivalent_robot if isinstance(arm, IdentifiedModel) else arm
     tool = robot_with_payload(base, est)
