@@ -91,3 +91,27 @@ def test_payload_refuses_cutoff_with_static_data(one_configuration, tmp_path):
     assert r.returncode == 2 and r.stderr.count("\n") == 1, r.stderr
     assert "--cutoff applies to torque logs" in r.stderr, r.stderr
     assert not (tmp_path / "p").exists()
+
+
+def test_make_test_says_what_it_installs_beside_python_packages(tmp_path):
+    """`make test` without chromium says it installs Debian's package and whether it could
+    (the install was done, or failed, quietly)."""
+    import shutil
+
+    root = Path(__file__).resolve().parents[1]
+    make = shutil.which("make")
+    if make is None or not (root / "Makefile").exists():
+        pytest.skip("needs make and the repository's Makefile")
+    plan = subprocess.run(
+        [make, "-n", "test"], cwd=root, capture_output=True, text=True, check=True
+    ).stdout.splitlines()
+    line = next(x for x in plan if "chromium" in x and "apt-get" in x)
+    fake = tmp_path / "bin"
+    fake.mkdir()
+    (fake / "apt-get").write_text("#!/bin/sh\nexit 100\n")
+    (fake / "apt-get").chmod(0o755)
+    sh = shutil.which("sh") or "/bin/sh"
+    out = subprocess.run(
+        [sh, "-c", line], env={"PATH": str(fake)}, capture_output=True, text=True
+    ).stdout
+    assert "installing Debian's package" in out and "could not be installed" in out, out
