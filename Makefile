@@ -62,8 +62,11 @@ test: $(TESTS)
 test-fast: $(TESTS)
 	$(TEST_ENV) $(PY) -m pytest -q $(PYTEST_XDIST) -m "not slow"
 
+# BENCH_ARGS=--long adds the long benchmarks (benchmarks/bench_memory.py: peak memory on a
+# 5-million-row log, about ten minutes)
+BENCH_ARGS ?=
 bench: $(TESTS)
-	$(PY) benchmarks/run_all.py
+	$(PY) benchmarks/run_all.py $(BENCH_ARGS)
 
 lint: $(TESTS)
 	$(PY) -m pip install -q "ruff==0.17.6"
