@@ -44,11 +44,15 @@ PYTEST_XDIST := -n $(PYTEST_WORKERS) --dist loadscope --no-loadscope-reorder
 TEST_ENV := MPLBACKEND=Agg OPENBLAS_NUM_THREADS=1 OMP_NUM_THREADS=1 MKL_NUM_THREADS=1
 
 # Chromium renders the HTML reports in tests/test_html_report.py (skipped without it): when
-# it is missing, install Debian's package where apt-get can (root, a Debian system); any
-# failure is ignored, quietly.
+# it is missing, install Debian's package where apt-get can (root, a Debian system), saying
+# so before and after; a failure is printed and the tests that need it are skipped.
 CHROMIUM_INSTALL = command -v chromium >/dev/null 2>&1 || { \
-	(DEBIAN_FRONTEND=noninteractive apt-get update -qq && \
-	 DEBIAN_FRONTEND=noninteractive apt-get install -y -qq chromium) >/dev/null 2>&1 || true; }
+	echo "make test: chromium is missing (tests/test_html_report.py renders with it);" \
+	     "installing Debian's package: apt-get update && apt-get install -y chromium"; \
+	if (DEBIAN_FRONTEND=noninteractive apt-get update -qq && \
+	    DEBIAN_FRONTEND=noninteractive apt-get install -y -qq chromium) >/dev/null 2>&1; then \
+	    echo "make test: installed $$(chromium --version 2>/dev/null || echo chromium)"; \
+	else echo "make test: chromium could not be installed; the tests that render HTML are skipped"; fi; }
 
 test: $(TESTS)
 	@$(CHROMIUM_INSTALL)
@@ -58,8 +62,11 @@ test: $(TESTS)
 test-fast: $(TESTS)
 	$(TEST_ENV) $(PY) -m pytest -q $(PYTEST_XDIST) -m "not slow"
 
+# BENCH_ARGS=--long adds the long benchmarks (benchmarks/bench_memory.py: peak memory on a
+# 5-million-row log, about ten minutes)
+BENCH_ARGS ?=
 bench: $(TESTS)
-	$(PY) benchmarks/run_all.py
+	$(PY) benchmarks/run_all.py $(BENCH_ARGS)
 
 lint: $(TESTS)
 	$(PY) -m pip install -q "ruff==0.17.6"

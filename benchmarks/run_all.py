@@ -14,6 +14,9 @@ the next; their output is shown as it comes.
 ``-- ARGS ...``
     Pass ARGS to every script run (for example ``-- --repeats 7``); the scripts' options
     differ, so combine this with ``--only``.
+``--long``
+    Also run the long scripts of :data:`LONG` (``bench_memory.py``: a 5-million-row log
+    simulated and read, about ten minutes); ``--only`` names them too.
 
 The exit code is non-zero when a script fails, for example because dynid and the
 reference disagree.
@@ -31,6 +34,10 @@ from pathlib import Path
 HERE = Path(__file__).resolve().parent
 
 
+#: Scripts that take many minutes: run with ``--long`` (or named by ``--only``).
+LONG = ("bench_memory.py",)
+
+
 def scripts() -> list[Path]:
     """The benchmark scripts of this folder, sorted by name."""
     return sorted(HERE.glob("bench_*.py"))
@@ -45,11 +52,17 @@ def main(argv: list[str] | None = None) -> int:
     p = argparse.ArgumentParser(description=(__doc__ or "").strip().splitlines()[0])
     p.add_argument("--json", metavar="DIR", help="save each script's JSON as DIR/<script>.json")
     p.add_argument("--only", nargs="+", metavar="NAME", help="run only these scripts")
+    p.add_argument("--long", action="store_true", help=f"also run {', '.join(LONG)}")
     args = p.parse_args(argv)
     found = scripts()
     if args.only:
         want = {n.removeprefix("bench_").removesuffix(".py") for n in args.only}
         found = [s for s in found if s.stem.removeprefix("bench_") in want]
+    elif not args.long:
+        skipped = [s.name for s in found if s.name in LONG]
+        found = [s for s in found if s.name not in LONG]
+        if skipped:
+            print(f"skipped (long; run with --long): {', '.join(skipped)}", flush=True)
     if not found:
         print("no benchmark scripts to run", file=sys.stderr)
         return 1

@@ -11,9 +11,12 @@ import io
 import subprocess
 from pathlib import Path
 
+import numpy as np
 import pytest
 
 from dynid.cli.__main__ import main, out_of_memory
+from dynid.friction.laws import LAWS
+from dynid.io.friction_json import save_friction_json
 
 
 def _main(*args: str) -> subprocess.CompletedProcess:
@@ -61,3 +64,54 @@ def test_out_of_memory_hint_fits_the_command():
     assert "log" not in out_of_memory(MemoryError(), "acquire-static")
     assert "DYNID_MAX_STACK_BYTES" in out_of_memory(MemoryError(), "identify")
     assert out_of_memory(MemoryError(), "retrieve").endswith("machine's memory: raise it")
+
+
+def test_a_huge_friction_coefficient_is_named_not_the_log(tmp_path):
+    """validate with a friction file of fv = 1e300: the overflow names the friction file
+    (it said "the log holds values far outside a robot's range")."""
+    log = tmp_path / "log.csv"
+    assert _main("simulate", "--duration", "1", "--rate", "200", "--out", str(log)).returncode == 0
+    law = LAWS["classical"]
+    params = np.tile([0.1, 0.5, 0.0], (7, 1))
+    params[2, 0] = 1e300
+    save_friction_json(tmp_path / "huge.json", law.model(params, np.zeros(7)))
+    r = _main(
+        *("validate", "--robot", "panda", "--data", str(log), "--out", str(tmp_path / "v")),
+        *("--friction", str(tmp_path / "huge.json"), "--no-figures"),
+    )
+    assert r.returncode == 2, r.stderr
+    assert "friction torques are far outside" in r.stderr and "huge.json" in r.stderr, r.stderr
+    assert "the log holds" not in r.stderr
+
+
+def test_payload_refuses_cutoff_with_static_data(one_configuration, tmp_path):
+    """``payload --cutoff`` on static data is refused in one line (it was ignored)."""
+    args = ("payload", "--robot", "panda", "--data", str(one_configuration))
+    r = _main(*args, "--cutoff", "10", "--out", str(tmp_path / "p"))
+    assert r.returncode == 2 and r.stderr.count("\n") == 1, r.stderr
+    assert "--cutoff applies to torque logs" in r.stderr, r.stderr
+    assert not (tmp_path / "p").exists()
+
+
+def test_make_test_says_what_it_installs_beside_python_packages(tmp_path):
+    """`make test` without chromium says it installs Debian's package and whether it could
+    (the install was done, or failed, quietly)."""
+    import shutil
+
+    root = Path(__file__).resolve().parents[1]
+    make = shutil.which("make")
+    if make is None or not (root / "Makefile").exists():
+        pytest.skip("needs make and the repository's Makefile")
+    plan = subprocess.run(
+        [make, "-n", "test"], cwd=root, capture_output=True, text=True, check=True
+    ).stdout.splitlines()
+    line = next(x for x in plan if "chromium" in x and "apt-get" in x)
+    fake = tmp_path / "bin"
+    fake.mkdir()
+    (fake / "apt-get").write_text("#!/bin/sh\nexit 100\n")
+    (fake / "apt-get").chmod(0o755)
+    sh = shutil.which("sh") or "/bin/sh"
+    out = subprocess.run(
+        [sh, "-c", line], env={"PATH": str(fake)}, capture_output=True, text=True
+    ).stdout
+    assert "installing Debian's package" in out and "could not be installed" in out, out

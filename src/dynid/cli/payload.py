@@ -69,7 +69,11 @@ def register(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParser:
     p.add_argument("--frame", default="flange", help="frame the load is fixed to")
     p.add_argument("--gravity-only", action="store_true", help="static data: use g alone")
     p.add_argument(
-        "--cutoff", type=positive_type, default=DEFAULT_CUTOFF_HZ, help="torque logs: low-pass [Hz]"
+        "--cutoff",
+        type=positive_type,
+        default=None,
+        help=f"torque logs: low-pass [Hz] (default {DEFAULT_CUTOFF_HZ:g}; static data are not "
+        "filtered)",
     )
     add_log_options(p)
     p.add_argument("--out", type=output_path, required=True, help="output folder")

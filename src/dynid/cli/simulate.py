@@ -219,9 +219,15 @@ def _trajectory(
     n = robot.n
     q0 = None if args.q0 is None else parse_vector(args.q0, "--q0", n)
     if args.trajectory not in ("sinusoid", "fourier"):
-        from ..io.excitation import load_trajectory
+        from ..io.excitation import load_exciting_trajectory, load_trajectory
+        from ..simulation.trajectories import uniform_times
 
-        traj = load_trajectory(Path(args.trajectory), n, fs=args.rate)
+        path = Path(args.trajectory)
+        if path.suffix.lower() == ".json":  # the series, evaluated a block at a time
+            exciting = load_exciting_trajectory(path, n)
+            t_file = uniform_times(exciting.total_duration, args.rate)
+            return lambda b: exciting(t_file[b]), t_file.size
+        traj = load_trajectory(path, n, fs=args.rate)
         return lambda b: Trajectory(traj.t[b], traj.q[b], traj.dq[b], traj.ddq[b]), len(traj)
     if args.trajectory == "fourier":
         series = random_fourier(

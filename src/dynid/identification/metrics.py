@@ -99,6 +99,8 @@ def _defined(x: float) -> float | None:
 def torque_errors(tau: ArrayLike, tau_hat: ArrayLike) -> TorqueErrors:
     """All metrics of ``tau_hat`` against ``tau``, both (N, n) [N m].
 
+    Errors beyond the float range are ``inf`` (no warning: the caller says what is far out).
+
     Raises
     ------
     ShapeError
@@ -106,7 +108,11 @@ def torque_errors(tau: ArrayLike, tau_hat: ArrayLike) -> TorqueErrors:
     NonFiniteError
         NaN or inf in an input.
     """
-    a, b = _pair(tau, tau_hat)
+    with np.errstate(over="ignore"):
+        return _torque_errors(*_pair(tau, tau_hat))
+
+
+def _torque_errors(a: NDArray[np.float64], b: NDArray[np.float64]) -> TorqueErrors:
     N = a.shape[0]
     if N <= _BLOCK:
         e2 = (a - b) ** 2

@@ -220,6 +220,9 @@ def _fill(template: str, i: int, j: int | None = None) -> str:
 class _Table:
     name: str
     columns: dict[str, NDArray[np.float64]]  # CSV column or NPZ array by name
+    #: quantity -> (its column names in joint order, their (N, n) array): the columns of a
+    #: CSV read side by side, so that a long log's vectors are not stacked again
+    groups: dict[str, tuple[list[str], NDArray[np.float64]]] = field(default_factory=dict)
 
 
 def _read_table(path: Path, cmap: ColumnMap, quantities: tuple[str, ...]) -> _Table:
@@ -254,10 +257,49 @@ def _read_table(path: Path, cmap: ColumnMap, quantities: tuple[str, ...]) -> _Ta
                 f"{[cmap.template(k) for k in quantities]}); the file has {names[:12]}"
                 f"{'...' if len(names) > 12 else ''}; hint: map them with --columns"
             )
-        return {c: [k] for k, c in enumerate(names) if c in wanted}
+        groups_of.update(_grouped(names, cmap, quantities))
+        grouped = {c for cols in groups_of.values() for c in cols}
+        index = {c: k for k, c in enumerate(names)}
+        out = {key: [index[c] for c in cols] for key, cols in groups_of.items()}
+        return out | {c: [k] for k, c in enumerate(names) if c in wanted and c not in grouped}
+
+    groups_of: dict[str, list[str]] = {}  # layout key -> its columns, filled by layout()
 
     arrays, _ = csv_table(path, layout, "a header naming the columns")
-    return _Table(path.name, {c: a[:, 0] for c, a in arrays.items()})
+    table = _Table(path.name, {})
+    for key, a in arrays.items():
+        if key.startswith(_GROUP):
+            names = groups_of[key]
+            table.groups[key[len(_GROUP) :]] = (names, a)
+            table.columns.update({c: a[:, k] for k, c in enumerate(names)})
+        else:
+            table.columns[key] = a[:, 0]
+    return table
+
+
+#: Prefix of the arrays of :func:`_grouped` (not a column name: CSV names are stripped).
+_GROUP = " group "
+
+
+def _grouped(
+    names: list[str], cmap: ColumnMap, quantities: tuple[str, ...]
+) -> dict[str, list[str]]:
+    """The columns of each joint quantity (``{i}``/``{i0}`` templates, joint order), to be
+    read side by side into one (N, n) array; each column in one group at most."""
+    present = set(names)
+    out: dict[str, list[str]] = {}
+    taken: set[str] = set()
+    for quantity in quantities:
+        tpl = cmap.template(quantity)
+        if "{i" not in tpl or "{j" in tpl:
+            continue
+        cols: list[str] = []
+        while (c := _fill(tpl, len(cols))) in present and c not in taken:
+            cols.append(c)
+        if cols:
+            out[_GROUP + quantity] = cols
+            taken.update(cols)
+    return out
 
 
 def _referenced(names: list[str], cmap: ColumnMap, quantities: tuple[str, ...]) -> set[str]:
@@ -298,6 +340,10 @@ def _vector(table: _Table, cmap: ColumnMap, quantity: str, n: int | None) -> NDA
         return None
     if missing:
         raise DataError(f"{table.name}: missing column(s) {missing} for {quantity!r} ({tpl!r})")
+    group = table.groups.get(quantity)
+    if group is not None and group[0] == names:  # read side by side: no copy when in SI
+        f = cmap.factor(quantity)
+        return group[1] if f == 1.0 else _checks.frozen(group[1] * f)
     return np.stack([table.columns[c] for c in names], axis=1) * cmap.factor(quantity)
 
 
@@ -384,7 +430,7 @@ def load_mapped_torque_log(
             f"{path.name}: no time column {columns.template('t')!r}; "
             f"the file has {list(table.columns)[:12]}; hint: map it with --columns t=NAME"
         )
-    t = t * columns.factor("t")
+    t = t if columns.factor("t") == 1.0 else _checks.frozen(t * columns.factor("t"))
     q = _need(table, columns, "q", n)
     n = q.shape[1]
     tau = _need(table, columns, "tau", n)

@@ -45,6 +45,7 @@ __all__ = [
     "EXCITATION_SCHEMA",
     "OBSTACLES_SCHEMA",
     "load_obstacles",
+    "load_exciting_trajectory",
     "load_trajectory",
     "obstacles_to_dict",
     "save_excitation_json",
@@ -279,34 +280,52 @@ def load_trajectory(path: str | Path, n: int, *, fs: float = 1000.0) -> Trajecto
     path = Path(path)
     suffix = path.suffix.lower()
     if suffix == ".json":
-        d = load_json(path, schema=EXCITATION_SCHEMA, what="trajectory file (dynid excite)")
-        _keys(d, _EXCITATION_KEYS, path.name)
-        tr = d.get("trajectory")
-        if not isinstance(tr, dict):
-            raise DataError(f"{path.name}: 'trajectory' must be an object")
-        _keys(tr, _TRAJECTORY_KEYS, f"{path.name}: trajectory")
-        need = ("w_f_rad_s", "duration_s", "ramp_s", "a_rad_s", "b_rad_s", "q_start_rad")
-        missing = [k for k in need if k not in tr]
-        if missing:
-            raise DataError(f"{path.name}: trajectory: missing key(s) {missing}")
-        num = {k: _numbers(tr[k], f"{path.name}: trajectory.{k}") for k in need}
-        try:
-            traj = ExcitingTrajectory(
-                w_f=float(num["w_f_rad_s"]),
-                a=num["a_rad_s"],
-                b=num["b_rad_s"],
-                q_start=num["q_start_rad"],
-                duration=float(num["duration_s"]),
-                ramp=float(num["ramp_s"]),
-            )
-        except (TypeError, ValueError, DynidError) as exc:
-            raise DataError(f"{path.name}: malformed trajectory ({exc})") from None
-        if traj.n != n:
-            raise DataError(f"{path.name}: trajectory has {traj.n} joints; the robot has {n}")
-        _check_derived(tr, traj, path.name)
-        return traj.sample(fs)
+        return load_exciting_trajectory(path, n).sample(fs)
     if suffix != ".csv":
         raise DataError(f"--trajectory file must be .csv or .json; got {path.name!r}")
+    return _trajectory_csv(path, n)
+
+
+def load_exciting_trajectory(path: str | Path, n: int) -> ExcitingTrajectory:
+    """The Fourier series of ``trajectory.json`` (as :func:`load_trajectory` reads it), to be
+    evaluated at any times (a long log a block of samples at a time).
+
+    Raises
+    ------
+    DataError
+        As :func:`load_trajectory` for a JSON file.
+    """
+    path = Path(path)
+    d = load_json(path, schema=EXCITATION_SCHEMA, what="trajectory file (dynid excite)")
+    _keys(d, _EXCITATION_KEYS, path.name)
+    tr = d.get("trajectory")
+    if not isinstance(tr, dict):
+        raise DataError(f"{path.name}: 'trajectory' must be an object")
+    _keys(tr, _TRAJECTORY_KEYS, f"{path.name}: trajectory")
+    need = ("w_f_rad_s", "duration_s", "ramp_s", "a_rad_s", "b_rad_s", "q_start_rad")
+    missing = [k for k in need if k not in tr]
+    if missing:
+        raise DataError(f"{path.name}: trajectory: missing key(s) {missing}")
+    num = {k: _numbers(tr[k], f"{path.name}: trajectory.{k}") for k in need}
+    try:
+        traj = ExcitingTrajectory(
+            w_f=float(num["w_f_rad_s"]),
+            a=num["a_rad_s"],
+            b=num["b_rad_s"],
+            q_start=num["q_start_rad"],
+            duration=float(num["duration_s"]),
+            ramp=float(num["ramp_s"]),
+        )
+    except (TypeError, ValueError, DynidError) as exc:
+        raise DataError(f"{path.name}: malformed trajectory ({exc})") from None
+    if traj.n != n:
+        raise DataError(f"{path.name}: trajectory has {traj.n} joints; the robot has {n}")
+    _check_derived(tr, traj, path.name)
+    return traj
+
+
+def _trajectory_csv(path: Path, n: int) -> Trajectory:
+    """``trajectory.csv`` read strictly (:func:`load_trajectory`)."""
     want = trajectory_columns(n)
 
     def layout(names: list[str], line: int) -> dict[str, list[int]]:

@@ -30,6 +30,7 @@ from collections.abc import Callable
 from dataclasses import dataclass
 
 import numpy as np
+import scipy.linalg
 from numpy.typing import ArrayLike, NDArray
 
 from .. import _checks
@@ -69,19 +70,33 @@ class StaticSelection:
     pool_condition_number: float
 
 
+#: Bytes of static regressor built at a time by :func:`stacked_condition_numbers` (a long
+#: chain's is large: 5.3 MB per configuration of a 50-joint arm).
+_BLOCK_BYTES = 64 << 20
+
+
 def stacked_condition_numbers(
     robot: Robot, q: NDArray[np.float64], base: BaseParameters | None = None
 ) -> tuple[float, float]:
-    """Unscaled and scaled condition numbers of the stacked ``[tril M; g]`` base regressor."""
+    """Unscaled and scaled condition numbers of the stacked ``[tril M; g]`` base regressor.
+
+    Built a block of configurations at a time: the singular values of the stack ``W`` are
+    those of its triangular factor ``R`` (``W = Q R``), updated block by block, and the
+    column-scaled ones those of ``R D^-1`` (``D``: the column norms, summed by block).
+    """
     base = base_parameters(robot) if base is None else base
-    W = static_regressor(robot, q)[..., base.independent].reshape(-1, base.rank)
-    return _conds(W)
-
-
-def _conds(W: NDArray[np.float64]) -> tuple[float, float]:
-    s = np.linalg.svd(W, compute_uv=False)
-    nrm = np.linalg.norm(W, axis=0)
-    ss = np.linalg.svd(W / np.where(nrm > 0, nrm, 1.0), compute_uv=False)
+    n, r = robot.n, base.rank
+    per = (n * (n + 1) // 2 + n) * 10 * n * 8  # bytes of one configuration's regressor
+    k = max(1, _BLOCK_BYTES // per)
+    R = np.zeros((0, r))
+    sq = np.zeros(r)
+    for a in range(0, q.shape[0], k):
+        W = static_regressor(robot, q[a : a + k])[..., base.independent].reshape(-1, r)
+        sq += np.einsum("ij,ij->j", W, W)
+        R = scipy.linalg.qr(np.concatenate([R, W]), mode="r", check_finite=False)[0][:r]
+    nrm = np.sqrt(sq)
+    s = np.linalg.svd(R, compute_uv=False)
+    ss = np.linalg.svd(R / np.where(nrm > 0, nrm, 1.0), compute_uv=False)
     return float(s[0] / s[-1]), float(ss[0] / ss[-1])
 
 

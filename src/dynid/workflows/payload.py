@@ -76,7 +76,7 @@ def identify_payload_files(
     gravity_only: bool = False,
     columns: ColumnSpec | None = None,
     drop_invalid: bool = False,
-    cutoff_hz: float | None = DEFAULT_CUTOFF_HZ,
+    cutoff_hz: float | None = None,
     max_gap_s: float | None = None,
 ) -> PayloadFileResult:
     """The load fixed to ``frame`` from data recorded with it (module docstring).
@@ -97,7 +97,9 @@ def identify_payload_files(
         Drop invalid rows (counted) instead of failing.
     cutoff_hz : float or None
         Torque logs: zero-phase low-pass cut-off [Hz] (also of velocities derived from
-        positions through ``columns``).
+        positions through ``columns``); default
+        :data:`~dynid.identification.log.DEFAULT_CUTOFF_HZ`. Refused with static data, which
+        are not filtered.
     max_gap_s : float, optional
         Torque logs: longest gap bridged [s]; a longer one cuts a log into pieces.
 
@@ -116,9 +118,15 @@ def identify_payload_files(
     kin = arm.robot if isinstance(arm, IdentifiedModel) else arm
     kin.frame(frame)  # an unknown frame is the option's error, not a file's
     paths = data_files(data)
+    given = cutoff_hz
+    cutoff_hz = DEFAULT_CUTOFF_HZ if cutoff_hz is None else cutoff_hz
     cmap = column_map(*(columns or (None, None)), cutoff_hz=cutoff_hz)
     kind = data_kind(paths[0], cmap)
     if kind != "torque_log":
+        if given is not None:
+            raise DataError(
+                "--cutoff applies to torque logs (their low-pass); static data are not filtered"
+            )
         if len(paths) > 1:
             raise DataError(
                 f"{paths[0].name} holds static data: give one static data file ({len(paths)} given)"

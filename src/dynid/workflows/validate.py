@@ -195,12 +195,7 @@ def validate_files(
     val = in_file(rec.paths[0], run) if len(rec.paths) == 1 else run()
     errors = val.errors
     if not np.isfinite(errors.relative_error_percent) or not np.all(np.isfinite(errors.rms)):
-        big = max(float(np.max(np.abs(v.log.tau))) for v in val.parts)
-        raise DataError(
-            f"{', '.join(rec.names)}: the torque errors overflow (relative error "
-            f"{errors.relative_error_percent}); the log holds values far outside a robot's "
-            f"range (largest |tau| {big:.3g} N m)"
-        )
+        raise DataError(_overflow(rec.names, val, label, opt))
     return ValidateResult(
         validation=val,
         model=label or f"robot {robot.name}",
@@ -226,3 +221,33 @@ def _friction(
     if isinstance(friction, str | Path):
         return load_friction_json(friction), Path(friction).name
     return friction, "given"
+
+
+def _overflow(names: Any, val: Any, label: str | None, opt: ValidateOptions) -> str:
+    """Why the torque errors overflow: the largest of the logs' torques, the rigid-body
+    model's and the friction's, named with its source."""
+    with np.errstate(over="ignore", invalid="ignore"):
+        peaks = {
+            "log": max(float(np.max(np.abs(v.log.tau))) for v in val.parts),
+            "model": max(float(np.max(np.abs(v.tau_model))) for v in val.parts),
+            "friction": max(
+                0.0 if v.tau_friction is None else float(np.max(np.abs(v.tau_friction)))
+                for v in val.parts
+            ),
+        }
+    worst = max(peaks, key=lambda k: peaks[k] if np.isfinite(peaks[k]) else np.inf)
+    model = label or "the model"
+    given = isinstance(opt.friction, str | Path) and opt.friction not in ("own", "none")
+    source = Path(str(opt.friction)).name if given else model
+    where = {
+        "log": "the log holds values far outside a robot's range",
+        "model": f"the model's torques are far outside a robot's range; check {model}'s parameters",
+        "friction": "the friction torques are far outside a robot's range; check the "
+        f"coefficients of {source}",
+    }[worst]
+    return (
+        f"{', '.join(names)}: the torque errors overflow (relative error "
+        f"{val.errors.relative_error_percent}); {where} (largest |tau| [N m]: log "
+        f"{peaks['log']:.3g}, rigid-body model {peaks['model']:.3g}, "
+        f"friction {peaks['friction']:.3g})"
+    )
