@@ -31,7 +31,7 @@ import dynid  # noqa: E402
 from dynid.exceptions import DynidWarning  # noqa: E402
 from dynid.friction.model import ClassicalFriction  # noqa: E402
 from dynid.identification.classical import identify_from_log  # noqa: E402
-from dynid.identification.structure import identify_recordings  # noqa: E402
+from dynid.identification.selection import identify_recordings  # noqa: E402
 from dynid.simulation.measurement import sample_times, simulate_measurement  # noqa: E402
 from dynid.simulation.trajectories import random_fourier  # noqa: E402
 from dynid.simulation.unmodelled import UnmodelledEffects  # noqa: E402

@@ -21,7 +21,8 @@ from dynid.friction.model import ClassicalFriction, LawFriction
 from dynid.friction.validation import own_friction
 from dynid.identification.log import TorqueLog, prepare_log, with_derived_velocities
 from dynid.identification.recordings import prepare_recordings, split_at_gaps, unwrapped
-from dynid.identification.structure import Structure, identify_recordings
+from dynid.identification.selection import identify_recordings
+from dynid.identification.structure import Structure
 from dynid.io.model_json import load_model_json
 from dynid.io.torque_log import save_torque_log
 from dynid.model.drive import Drive

@@ -159,7 +159,7 @@ class IdentificationInfo:
         (``--columns``/``--units``), so that validation reads a log the same way.
     selection : mapping, optional
         The model structure chosen on held-out data
-        (:mod:`dynid.identification.structure`): ``rule``, ``validation``, ``chosen`` and
+        (:mod:`dynid.identification.selection`): ``rule``, ``validation``, ``chosen`` and
         every ``candidates`` entry with its parameters, training and held-out errors.
     recordings : tuple of mapping
         Torque logs: each recording read (``file``, ``pieces``, ``samples``, ``duration_s``).

@@ -31,8 +31,9 @@ from ..identification.consistency import fit_mismatch, limit_violations
 from ..identification.estimators import EstimatorName
 from ..identification.least_squares import StdMethod
 from ..identification.model import IdentifiedModel
+from ..identification.selection import identify_recordings
 from ..identification.static import identify_static
-from ..identification.structure import Structure, identify_recordings
+from ..identification.structure import Structure
 from ..model.drive import Drive
 from ..model.robot import Robot
 from .data_files import (
@@ -145,7 +146,7 @@ def identify_file(
     terms : str or Structure, optional
         Torque logs: the model's terms beside the links (``"armature,viscous"``,
         :class:`~dynid.identification.structure.Structure`); default ``"auto"``: chosen on
-        held-out data (:mod:`dynid.identification.structure`).
+        held-out data (:mod:`dynid.identification.selection`).
     columns : (str or None, str or None), optional
         ``--columns`` and ``--units`` of a file of another tool (recorded in the model).
     drop_invalid : bool

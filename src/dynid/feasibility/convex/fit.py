@@ -213,7 +213,7 @@ def consistent_from_identified(
     robot : Robot
     model : IdentifiedModel
         The unconstrained fit (:func:`identify_consistent` makes it; several recordings:
-        :func:`~dynid.identification.structure.identify_recordings` with the classical
+        :func:`~dynid.identification.selection.identify_recordings` with the classical
         friction); its drive (a drive file's, or the direct drive of an armature) is kept.
     term : DataTerm, optional
         Default :func:`~dynid.feasibility.convex.data_term.coefficient_term` of ``model``

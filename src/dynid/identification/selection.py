@@ -1,0 +1,445 @@
+"""The model's structure chosen on held-out data: which terms beside the links' parameters.
+
+A joint-torque log of a real arm holds more than the rigid links: the rotors' inertia
+(an armature ``I_a ddq`` per joint, or the rotors of a drive), viscous and Coulomb friction,
+torque offsets. Which of them the data support cannot be read from the training error (a
+larger model always fits better); it is read from data the fit did not see.
+
+A :class:`Structure` names the terms: ``armature`` (per joint ``I_a ddq`` without a drive,
+the drive's rotor inertias with one) and the parts of the joint (motor) friction
+(:data:`~dynid.regressors.terms.FRICTION_PARTS`: ``viscous``, ``coulomb`` with the
+standstill band, ``offset``). :func:`select_structure` fits the largest model once per
+armature choice, keeps the normal equations of every held-out fold
+(:mod:`dynid.identification.holdout`), and judges every candidate (a subset of the
+columns) by its pooled held-out error; it keeps the **simplest candidate within one
+standard error of the best** (the one-standard-error rule of cross-validation: Hastie,
+Tibshirani and Friedman, *The Elements of Statistical Learning*, 2nd ed., Sec. 7.10).
+The folds leave one recording out at a time when there are several, contiguous time
+blocks otherwise (:meth:`~dynid.identification.recordings.Recordings.fold_labels`), or
+judge on a separate recording.
+
+:func:`identify_recordings` is the classical route over one or more recordings with the
+structure chosen (or given).
+"""
+
+from __future__ import annotations
+
+import math
+import warnings
+from collections.abc import Sequence
+from dataclasses import dataclass, replace
+from typing import Any, Literal
+
+import numpy as np
+from numpy.typing import NDArray
+
+from ..exceptions import DynidWarning, OptionError, RankDeficientError
+from ..model.drive import Drive
+from ..model.robot import Robot
+from ..regressors.terms import ModelTerm
+from .core import Judge, ModelColumns, RegressorStack, StreamedRows, identify, selected_columns
+from .estimators import Estimator, EstimatorName, estimator_named, row_weights
+from .holdout import DEFAULT_FOLDS, HeldOut, Normals, block_normals
+from .least_squares import StdMethod
+from .log import TorqueLog
+from .model import IdentifiedModel
+from .recordings import Recordings, prepare_recordings
+from .streaming import normals_by_label
+from .structure import (
+    ERROR_FLOOR_PERCENT,
+    Structure,
+    candidate_columns,
+    candidate_structures,
+    largest_terms,
+    structure_terms,
+)
+
+__all__ = ["Candidate", "Selection", "identify_recordings", "select_structure"]
+
+
+@dataclass(frozen=True, slots=True)
+class Candidate:
+    """A structure judged on held-out data.
+
+    Attributes
+    ----------
+    structure : Structure
+    n_params : int
+        Parameters fitted (base parameters and terms; columns the data cannot excite not
+        counted).
+    train_error_percent : float
+        Relative error [%] of the fit on all data, on those data.
+    heldout_error_percent : float
+        Pooled relative error [%] of the folds' fits on their held-out rows.
+    heldout_se_percent : float
+        Standard error [%] of the held-out error over the folds (0 for one fold).
+    """
+
+    structure: Structure
+    n_params: int
+    train_error_percent: float
+    heldout_error_percent: float
+    heldout_se_percent: float
+
+    def as_dict(self) -> dict[str, Any]:
+        """JSON-ready."""
+        return {
+            "name": self.structure.name,
+            "terms": list(self.structure.terms),
+            "n_params": self.n_params,
+            "train_error_percent": self.train_error_percent,
+            "heldout_error_percent": self.heldout_error_percent,
+            "heldout_se_percent": self.heldout_se_percent,
+        }
+
+
+@dataclass(frozen=True, slots=True)
+class Selection:
+    """The candidates judged and the structure kept (module docstring).
+
+    Attributes
+    ----------
+    candidates : tuple of Candidate
+    chosen : Structure
+    validation : str
+        How the data were held out.
+    rule : str
+        How the structure was chosen.
+    notes : tuple of str
+        Candidates that could not be fitted, and why.
+    """
+
+    candidates: tuple[Candidate, ...]
+    chosen: Structure
+    validation: str
+    rule: str = "simplest within one standard error of the lowest held-out error"
+    notes: tuple[str, ...] = ()
+
+    def as_dict(self) -> dict[str, Any]:
+        """JSON-ready (``identification.json``'s ``metadata.selection``)."""
+        return {
+            "rule": self.rule,
+            "validation": self.validation,
+            "chosen": self.chosen.name,
+            "candidates": [c.as_dict() for c in self.candidates],
+            "notes": list(self.notes),
+        }
+
+
+def _judge(
+    robot: Robot,
+    data: Recordings,
+    estimator: Estimator,
+    folds: int,
+    validation: Recordings | None,
+) -> tuple[Judge, str]:
+    """The held-out judgement over the recordings' folds (or a separate recording)."""
+    try:
+        labels, how = data.fold_labels(folds)
+    except OptionError:
+        labels, how = None, "none (too few samples for held-out blocks)"
+    if validation is not None:
+        how = "a separate recording"
+    scheme = "recordings" if len(data.names) > 1 else "blocks"
+
+    def judge(
+        stack: RegressorStack | StreamedRows,
+        columns: ModelColumns,
+        cols: NDArray[np.bool_],
+        beta: NDArray[Any],
+    ) -> HeldOut | None:
+        b = np.asarray(beta)[cols]
+        if isinstance(stack, StreamedRows):
+            source = selected_columns(stack.source, cols)
+            e = np.concatenate([y - W @ b for W, y, _ in source()])
+            rw = estimator.row_weights(e, np.tile(np.arange(data.n), e.size // data.n), b.size)
+            if validation is not None:
+                whole = normals_by_label(source, np.zeros(e.size, np.intp), rw)[0]
+                return HeldOut.separate(
+                    whole, _normals(robot, validation, columns, cols, b, estimator)
+                )
+            if labels is None:
+                return None
+            held = HeldOut.k_fold(normals_by_label(source, labels, rw))
+            return replace(held, scheme=scheme).expanded(cols)
+        W = stack.W if cols.all() else stack.W[:, cols]
+        y = stack.y
+        rw = row_weights(estimator, W, y, stack.groups, b)
+        if validation is not None:
+            whole = block_normals(W * rw[:, None], y * rw, np.zeros(y.size, np.intp))[0]
+            test = _normals(robot, validation, columns, cols, b, estimator)
+            return HeldOut.separate(whole, test).expanded(cols)
+        if labels is None:
+            return None
+        held = HeldOut.k_fold(block_normals(W * rw[:, None], y * rw, labels))
+        return replace(held, scheme=scheme).expanded(cols)
+
+    return judge, how
+
+
+def _normals(
+    robot: Robot,
+    data: Recordings,
+    columns: ModelColumns,
+    cols: NDArray[np.bool_],
+    b: NDArray[np.float64],
+    estimator: Estimator,
+) -> Normals:
+    """The normal equations of a separate recording over the fitted columns."""
+    blocks = list(data.blocks(robot, columns))
+    W = np.concatenate([blk.W for blk in blocks])[:, cols]
+    y = np.concatenate([blk.y for blk in blocks])
+    g = np.concatenate([blk.groups for blk in blocks])
+    rw = row_weights(estimator, W, y, g, b)
+    return block_normals(W * rw[:, None], y * rw, np.zeros(y.size, np.intp))[0]
+
+
+def _candidate(
+    structure: Structure,
+    use: NDArray[np.bool_],
+    model: IdentifiedModel,
+    held: HeldOut,
+    rtol: float,
+) -> Candidate:
+    """``structure`` (the columns ``use`` of ``model``) judged on the folds of ``model``."""
+    fit = model.joint_fit if model.joint_fit is not None else model.fit
+    use = use & np.asarray(fit.kept, dtype=bool)
+    sub = held.restricted(np.flatnonzero(use))
+    xs = [t.solve(rtol) for t in sub.train]
+    per_fold = [t.relative_error_percent(x) for t, x in zip(sub.test, xs, strict=True)]
+    se = float(np.std(per_fold, ddof=1) / math.sqrt(len(per_fold))) if len(per_fold) > 1 else 0.0
+    return Candidate(
+        structure=structure,
+        n_params=int(use.sum()),
+        train_error_percent=sub.whole.relative_error_percent(sub.whole.solve(rtol)),
+        heldout_error_percent=sub.heldout_error_percent(xs),
+        heldout_se_percent=se,
+    )
+
+
+def _chosen(candidates: Sequence[Candidate]) -> Structure:
+    """The simplest candidate within one standard error of the lowest held-out error."""
+    best = min(candidates, key=lambda c: c.heldout_error_percent)
+    limit = best.heldout_error_percent + max(best.heldout_se_percent, ERROR_FLOOR_PERCENT)
+    within = [c for c in candidates if c.heldout_error_percent <= limit]
+    return min(within, key=lambda c: (c.n_params, c.heldout_error_percent)).structure
+
+
+def select_structure(
+    robot: Robot,
+    data: Recordings,
+    *,
+    drive: Drive | None = None,
+    candidates: Sequence[Structure] | None = None,
+    estimator: EstimatorName | Estimator = "ols",
+    folds: int = DEFAULT_FOLDS,
+    validation: Recordings | None = None,
+    rtol: float | None = None,
+) -> Selection | None:
+    """Judge candidate structures on held-out data and choose one (module docstring).
+
+    Parameters
+    ----------
+    robot : Robot
+    data : Recordings
+        The prepared recordings (:func:`~dynid.identification.recordings.prepare_recordings`).
+    drive : Drive, optional
+        The drive the data were read through.
+    candidates : sequence of Structure, optional
+        Default :func:`candidate_structures` (the armature only where the rotor inertias
+        are not known).
+    estimator, folds, rtol
+        As :func:`identify_recordings`.
+    validation : Recordings, optional
+        A separate recording to judge on instead of the folds.
+
+    Returns
+    -------
+    Selection or None
+        None when the data are too short for held-out judgement.
+    """
+    est = estimator_named(estimator)
+    armature_ok = drive is None or drive.identifies_rotor_inertia
+    cands = tuple(candidates) if candidates is not None else candidate_structures(armature_ok)
+    judged: list[Candidate] = []
+    notes: list[str] = []
+    judge, how = _judge(robot, data, est, folds, validation)
+    fit_rtol = 1e-10 if rtol is None else rtol
+    for arm in sorted({c.armature for c in cands}):
+        mine = [c for c in cands if c.armature == arm]
+        fitted = _fit_largest(robot, data, mine, arm, drive, est, rtol, judge, notes)
+        if fitted is None:
+            continue
+        model, terms, mine = fitted
+        if model.holdout is None:
+            return None
+        for c in mine:
+            use = candidate_columns(c, model.base.rank, terms, robot.n)
+            judged.append(_candidate(c, use, model, model.holdout, fit_rtol))
+    if not judged:
+        return None
+    return Selection(tuple(judged), _chosen(judged), how, notes=tuple(notes))
+
+
+def _fit_largest(
+    robot: Robot,
+    data: Recordings,
+    mine: list[Structure],
+    arm: bool,
+    drive: Drive | None,
+    est: Estimator,
+    rtol: float | None,
+    judge: Judge,
+    notes: list[str],
+) -> tuple[IdentifiedModel, list[tuple[ModelTerm, Any]], list[Structure]] | None:
+    """The model of every candidate's columns at once (the classical candidates alone when
+    the data cannot tell the shaped laws apart), with its terms and the candidates it
+    holds; None (and a note) when not even those are identifiable."""
+    tries = [mine, [c for c in mine if not ({"smooth", "stribeck"} & set(c.friction))]]
+    for k, group in enumerate(tries):
+        if not group or (k and len(group) == len(mine)):
+            continue
+        model_drive, terms = largest_terms(group, arm, drive, robot.n, tuple(data.band))
+        try:
+            with warnings.catch_warnings():  # the candidates' fits: only the chosen one speaks
+                warnings.simplefilter("ignore", DynidWarning)
+                model = identify(
+                    robot,
+                    data,
+                    drive=model_drive,
+                    terms=tuple(t for t, _ in terms),
+                    estimator=est,
+                    rtol=rtol,
+                    judge=judge,
+                )
+        except RankDeficientError as exc:
+            what = "with" if arm else "without"
+            shaped = k == 0 and len(tries[1]) < len(group)
+            notes.append(
+                (
+                    f"the smooth and Stribeck candidates {what} armature: the data do not tell "
+                    "them from Coulomb friction"
+                    if shaped
+                    else f"the candidates {what} armature: not identifiable from these data"
+                )
+                + f" (rank {exc.rank} < {exc.needed})"
+            )
+            continue
+        return model, terms, group
+    return None
+
+
+def identify_recordings(
+    robot: Robot,
+    logs: Sequence[TorqueLog],
+    names: Sequence[str] | None = None,
+    *,
+    structure: Structure | Literal["auto"] = "auto",
+    cutoff_hz: float | Literal["auto"] | None = "auto",
+    trim_s: float | None = None,
+    max_gap_s: float | None = None,
+    decimate: int | None = None,
+    drive: Drive | None = None,
+    estimator: EstimatorName | Estimator = "ols",
+    std: StdMethod = "classical",
+    max_std_percent: float | None = None,
+    rtol: float | None = None,
+    folds: int = DEFAULT_FOLDS,
+    validate_on: TorqueLog | None = None,
+) -> IdentifiedModel:
+    """Identify the base parameters and the model's terms from one or more torque logs.
+
+    Each recording (and each piece of one between its gaps) is prepared on its own
+    (:func:`~dynid.identification.recordings.prepare_recordings`); the structure is chosen
+    on held-out data (:func:`select_structure`) unless given; then the chosen model is
+    fitted on all the data.
+
+    Parameters
+    ----------
+    robot : Robot
+        Kinematics and gravity; its inertial parameters are not used.
+    logs : sequence of TorqueLog
+        The recordings.
+    names : sequence of str, optional
+        Their names (file names) for messages and the record.
+    structure : Structure or "auto"
+        The terms beside the links; ``"auto"`` (default) chooses them on held-out data.
+    cutoff_hz, trim_s, decimate, drive, estimator, std, max_std_percent, rtol
+        As :func:`~dynid.identification.classical.identify_from_log`.
+    max_gap_s : float, optional
+        Gaps up to this long [s] are bridged; longer ones cut a log into pieces.
+    folds : int
+        Contiguous time blocks of one recording's held-out judgement (several recordings:
+        one left out at a time).
+    validate_on : TorqueLog, optional
+        Judge on this separate recording instead.
+
+    Returns
+    -------
+    IdentifiedModel
+        With ``info.selection`` (the candidates and the choice) when the structure was
+        chosen, and ``info.recordings``.
+
+    Raises
+    ------
+    DataError, ShapeError
+        From :func:`~dynid.identification.recordings.prepare_recordings`.
+    OptionError
+        An armature asked with known rotor inertias.
+    RankDeficientError
+        The chosen (or given) structure is not identifiable from the data.
+    """
+    data = prepare_recordings(
+        robot,
+        logs,
+        names,
+        cutoff_hz=cutoff_hz,
+        trim_s=trim_s,
+        max_gap_s=max_gap_s,
+        decimate=decimate,
+        drive=drive,
+    )
+    validation = None
+    if validate_on is not None:
+        validation = prepare_recordings(
+            robot,
+            [validate_on],
+            ["validation log"],
+            cutoff_hz=data.cutoff_hz,
+            trim_s=trim_s,
+            max_gap_s=max_gap_s,
+            decimate=data.pieces[0].decimate,
+            drive=drive,
+        )
+    est = estimator_named(estimator)
+    selection = None
+    if structure == "auto":
+        selection = select_structure(
+            robot,
+            data,
+            drive=drive,
+            estimator=est,
+            folds=folds,
+            validation=validation,
+            rtol=rtol,
+        )
+        structure = Structure() if selection is None else selection.chosen
+    model_drive, terms = structure_terms(structure, drive, robot.n, tuple(data.band))
+    judge, _ = _judge(robot, data, est, folds, validation)
+    model = identify(
+        robot,
+        data,
+        drive=model_drive,
+        terms=terms,
+        estimator=est,
+        std=std,
+        max_std_percent=max_std_percent,
+        rtol=rtol,
+        judge=judge,
+    )
+    info = replace(
+        model.info,
+        selection=None if selection is None else selection.as_dict(),
+        extra={**model.info.extra, "terms": list(structure.terms)},
+    )
+    return replace(model, info=info)
