@@ -84,8 +84,10 @@ def _char_references(urdf: str) -> str:
 @settings(max_examples=40, deadline=None, suppress_health_check=list(HealthCheck))
 @given(st.lists(_NAME, min_size=8, max_size=8, unique=True))
 @example(['a "q" <b> & c', "\u00e9 \u94fe\tx", " sp ", "]]>", "&amp;", "--x--", "\U0001f600", "r"])
+@example(["base", "l1", "l2", "tool_joint", "j2", "tool", "other", "r"])
 def test_any_urdf_name_survives_urdf_mjcf_toml_and_json(tmp_path_factory, names):
-    """Link, joint, frame and robot names read back equal from every format (issue 28)."""
+    """Link, joint, frame and robot names read back equal from every format (issue 28); a
+    frame named like a joint without its "_joint" made a URDF with a duplicated joint."""
     if "flange" in names[:3] + names[5:7]:
         return
     r = _named(names)
