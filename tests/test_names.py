@@ -88,8 +88,8 @@ def _char_references(urdf: str) -> str:
 def test_any_urdf_name_survives_urdf_mjcf_toml_and_json(tmp_path_factory, names):
     """Link, joint, frame and robot names read back equal from every format (issue 28); a
     frame named like a joint without its "_joint" made a URDF with a duplicated joint."""
-    if "flange" in names[:3] + names[5:7]:
-        return
+    if "flange" in names[:3] + names[5:7] or "world" in names[1:3]:
+        return  # the mounting frame's name; MuJoCo's world body (their own tests)
     r = _named(names)
     tmp = tmp_path_factory.mktemp("names")
     urdf = urdf_from_robot(r, all_frames=True)
