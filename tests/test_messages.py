@@ -115,3 +115,38 @@ def test_make_test_says_what_it_installs_beside_python_packages(tmp_path):
         [sh, "-c", line], env={"PATH": str(fake)}, capture_output=True, text=True
     ).stdout
     assert "installing Debian's package" in out and "could not be installed" in out, out
+
+
+_ONE_JOINT = """name = "one"
+[[joints]]
+name = "j1"
+type = "revolute"
+parent = "base"
+child = "l1"
+axis = [0.0, 1.0, 0.0]
+limits = { lower = -2.0, upper = 2.0, velocity = 2.0, effort = 50.0 }
+[joints.inertial]
+mass = 2.0
+com = [0.3, 0.0, 0.0]
+inertia = [0.01, 0.0, 0.0, 0.02, 0.0, 0.02]
+"""
+
+
+def test_retrieve_takes_a_none_friction_file_and_names_another_law(tmp_path):
+    """retrieve --friction with a one-joint "none" friction file puts no friction on the
+    robot (it was refused as "a robot holds sigmoid friction"); a classical file is refused
+    naming its law and the sigmoid fit that --friction takes."""
+    robot = tmp_path / "one.toml"
+    robot.write_text(_ONE_JOINT)
+    log, model = tmp_path / "log.csv", tmp_path / "id"
+    sim = ("simulate", "--robot", str(robot), "--duration", "4", "--rate", "250")
+    assert _main(*sim, "--amplitudes", "1", "--periods", "2", "--out", str(log)).returncode == 0
+    fit = ("identify", "--robot", str(robot), "--data", str(log), "--no-figures")
+    assert _main(*fit, "--out", str(model)).returncode == 0
+    for law, params in (("none", np.zeros((1, 0))), ("classical", np.array([[0.1, 0.2, 0.0]]))):
+        save_friction_json(tmp_path / f"{law}.json", LAWS[law].model(params, np.zeros(1)))
+    args = ("retrieve", "--model", str(model / "identification.json"), "--no-figures")
+    r = _main(*args, "--friction", str(tmp_path / "none.json"), "--out", str(tmp_path / "r1"))
+    assert r.returncode in (0, 1) and "sigmoid" not in r.stderr, r.stderr
+    r = _main(*args, "--friction", str(tmp_path / "classical.json"), "--out", str(tmp_path / "r2"))
+    assert r.returncode == 2 and "classical.json holds classical friction" in r.stderr, r.stderr

@@ -30,7 +30,7 @@ from hypothesis import strategies as st
 
 import dynid
 from dynid.cli.__main__ import main
-from dynid.exceptions import DynidWarning
+from dynid.exceptions import DynidWarning, ModelError
 from dynid.feasibility.bounds import default_bounds
 from dynid.io.bounds_file import load_bounds, save_bounds
 from dynid.io.feasible import load_feasible_json, save_feasible_json
@@ -84,10 +84,12 @@ def _char_references(urdf: str) -> str:
 @settings(max_examples=40, deadline=None, suppress_health_check=list(HealthCheck))
 @given(st.lists(_NAME, min_size=8, max_size=8, unique=True))
 @example(['a "q" <b> & c', "\u00e9 \u94fe\tx", " sp ", "]]>", "&amp;", "--x--", "\U0001f600", "r"])
+@example(["base", "l1", "l2", "tool_joint", "j2", "tool", "other", "r"])
 def test_any_urdf_name_survives_urdf_mjcf_toml_and_json(tmp_path_factory, names):
-    """Link, joint, frame and robot names read back equal from every format (issue 28)."""
-    if "flange" in names[:3] + names[5:7]:
-        return
+    """Link, joint, frame and robot names read back equal from every format (issue 28); a
+    frame named like a joint without its "_joint" made a URDF with a duplicated joint."""
+    if "flange" in names[:3] + names[5:7] or "world" in names[1:3]:
+        return  # the mounting frame's name; MuJoCo's world body (their own tests)
     r = _named(names)
     tmp = tmp_path_factory.mktemp("names")
     urdf = urdf_from_robot(r, all_frames=True)
@@ -188,3 +190,16 @@ def test_non_ascii_frame_name_under_c_locale(tmp_path):
     np.testing.assert_allclose(T, dynid.fk(r, np.array([0.1, 0.2]), "w\u00fcrfel"), atol=1e-12)
     c = _run_c_locale([*args, "--frame", "nicht-da-\u00fc"], tmp_path)
     assert c.returncode == 2 and b"Unknown frame 'nicht-da-\\xfc'" in c.stderr
+
+
+def test_a_base_link_named_world_is_mujocos_world_body():
+    """A base link named 'world' (common in URDFs) is MuJoCo's world body: the MJCF compiles
+    and the names read back (it was "repeated name 'world' in body"); a moving link named
+    'world' is refused naming it."""
+    mujoco = pytest.importorskip("mujoco")
+    r = _named(["world", "l1", "l2", "j1", "j2", "a", "b", "r"])
+    m = mujoco.MjModel.from_xml_string(mjcf_from_robot(r)[0])
+    assert [m.body(i).name for i in range(m.nbody)] == list(r.link_names)
+    assert sorted(m.site(i).name for i in range(m.nsite)) == ["a", "b", "flange"]
+    with pytest.raises(ModelError, match="link 1 of robot 'r' is named 'world'"):
+        mjcf_from_robot(_named(["base", "world", "l2", "j1", "j2", "a", "b", "r"]))

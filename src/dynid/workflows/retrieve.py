@@ -51,9 +51,13 @@ def _with_friction(robot: Robot, path: str | Path | None) -> Robot:
     if path is None:
         return robot
     fr = load_friction_json(path)
+    if fr.kind == "none":  # no friction: nothing to put on the robot
+        return robot
     if not isinstance(fr, SigmoidFriction):
         raise DynidError(
-            f"{Path(path).name}: a robot holds sigmoid friction; got a {fr.kind} model"
+            f"{Path(path).name} holds {fr.kind} friction; --friction puts sigmoid friction on "
+            "the robot (the law a robot description holds): give a friction.json of "
+            "`dynid friction --friction-model sigmoid`, or none"
         )
     return robot.with_friction(fr.as_array())
 

@@ -4,10 +4,12 @@
 keeping the robot's link and joint names:
 
 * the base link is a body fixed to the world at the origin (the base frame is MuJoCo's
-  world frame); body ``i`` sits at ``T_parent_joint[i]`` in its parent (``pos`` [m],
-  ``quat`` ``w x y z``) and holds joint ``i``: ``hinge`` (revolute) or ``slide``
-  (prismatic) about/along ``axis`` in the body frame, with ``range`` [rad or m] when both
-  position limits are finite (``<compiler angle="radian" autolimits="true"/>``);
+  world frame); a base link named ``world`` is MuJoCo's world body itself (MuJoCo keeps
+  that name: another link named so is refused); body ``i`` sits at ``T_parent_joint[i]``
+  in its parent (``pos`` [m], ``quat`` ``w x y z``) and holds joint ``i``: ``hinge``
+  (revolute) or ``slide`` (prismatic) about/along ``axis`` in the body frame, with
+  ``range`` [rad or m] when both position limits are finite
+  (``<compiler angle="radian" autolimits="true"/>``);
 * ``<inertial pos="c" mass="m" fullinertia="xx yy zz xy xz yz"/>``: CoM [m] in the link
   frame and the inertia about the CoM in link axes [kg m^2] (MuJoCo's ``fullinertia``
   order); omitted for a link whose parameters are all zero (MuJoCo refuses a zero
@@ -44,7 +46,7 @@ from numpy.typing import NDArray
 from scipy.spatial.transform import Rotation
 
 from ... import __version__
-from ...exceptions import DynidWarning, ShapeError
+from ...exceptions import DynidWarning, ModelError, ShapeError
 from ...friction.model import DriveFriction, FrictionModel, SigmoidFriction
 from ...friction.mujoco import (
     CoulombViscous,
@@ -162,7 +164,13 @@ def _bodies(
             sites.setdefault(fr.link, []).append(
                 f'<site name={quoteattr(name)} {_pose(fr.T_link_frame)} size="0.005"/>'
             )
-    lines = [f'    <body name={quoteattr(robot.link_names[0])} pos="0 0 0">']
+    if "world" in robot.link_names[1:]:
+        raise ModelError(
+            f"link {robot.link_names.index('world')} of robot {robot.name!r} is named 'world', "
+            "which MuJoCo keeps for its world body; only the base link may be named so"
+        )
+    world = robot.link_names[0] == "world"  # the base is MuJoCo's world body itself
+    lines = [] if world else [f'    <body name={quoteattr(robot.link_names[0])} pos="0 0 0">']
     lines += ["      " + s for s in sites.get(0, [])]
     for i in range(n):
         ind = "    " + "  " * (i + 2)
@@ -188,7 +196,7 @@ def _bodies(
         lines += [ind + s for s in sites.get(i + 1, [])]
     for i in reversed(range(n)):
         lines.append("    " + "  " * (i + 1) + "</body>")
-    return lines + ["    </body>"]
+    return lines if world else lines + ["    </body>"]
 
 
 def _actuators(robot: Robot) -> list[str]:
@@ -236,6 +244,11 @@ def mjcf_from_robot(
         The MJCF XML text.
     approximation : CoulombViscous or None
         The fitted friction written to the joints, or None when none was written.
+
+    Raises
+    ------
+    ModelError
+        A link other than the base is named ``world`` (MuJoCo's world body).
     """
     approx, armature, notes = _joint_terms(robot, friction, drive)
     for note in notes:

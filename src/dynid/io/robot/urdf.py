@@ -19,7 +19,8 @@ feasible parameters, say, for simulators) gives one ``<link>`` per link of the r
   a missing (infinite) limit is written as the largest float, ``1.7976931348623157e+308``.
 * the ``flange`` frame (the tip) keeps the source robot's name for it: when the robot
   was read from a URDF whose tip link is fixed to the last moving link (``panda_link8``),
-  that link is written as a ``fixed`` joint ``<tip>_joint`` to a massless link ``<tip>``;
+  that link is written as a ``fixed`` joint ``<tip>_joint`` (``<tip>_joint_2`` when a joint of
+  the robot has that name) to a massless link ``<tip>``;
   when the tip is the last moving link itself nothing is added; otherwise (an MDH robot)
   a massless link ``flange`` is added. The file's only leaf is the tip, so
   :func:`load_urdf` needs no ``tip_link``. With ``all_frames=True`` every other
@@ -76,11 +77,17 @@ def _v(v: np.ndarray) -> str:
     return " ".join(_f(x) for x in v)
 
 
-def _fixed(name: str, parent: str, T: np.ndarray) -> list[str]:
-    """A fixed joint ``<name>_joint`` from ``parent`` to a massless link ``name``."""
+def _fixed(name: str, parent: str, T: np.ndarray, joints: set[str]) -> list[str]:
+    """A fixed joint ``<name>_joint`` (``<name>_joint_2``, ... when ``joints`` holds that
+    name; added to ``joints``) from ``parent`` to a massless link ``name``."""
     rpy = spatial.rpy_from_matrix(T[:3, :3])
+    joint, k = name + "_joint", 1
+    while joint in joints:
+        k += 1
+        joint = f"{name}_joint_{k}"
+    joints.add(joint)
     return [
-        f'  <joint name={quoteattr(name + "_joint")} type="fixed">',
+        f'  <joint name={quoteattr(joint)} type="fixed">',
         f"    <parent link={quoteattr(parent)}/>",
         f"    <child link={quoteattr(name)}/>",
         f'    <origin xyz="{_v(T[:3, 3])}" rpy="{_v(rpy)}"/>',
@@ -200,8 +207,9 @@ def urdf_from_robot(
         frames += [
             (k, f) for k, f in robot.frames.items() if k not in names and k not in ("flange", tip)
         ]
+    joints = set(robot.joint_names)
     for name, f in frames:
-        lines += _fixed(name, robot.link_names[f.link], f.T_link_frame)
+        lines += _fixed(name, robot.link_names[f.link], f.T_link_frame, joints)
     lines.append("</robot>")
     return "\n".join(lines) + "\n"
 
