@@ -506,8 +506,8 @@ def _usable_cutoff(cutoff_hz: float | None, rate: float, n_samples: int) -> floa
         cutoff_hz = rate / 4
     if cutoff_hz is not None and n_samples <= 15:
         raise DataError(
-            f"the log has {n_samples} samples; filtering needs more (a longer log, or "
-            "no filter: cutoff_hz=None)"
+            f"the log has {n_samples} samples; the zero-phase filter needs more than 15: "
+            "record a longer log"
         )
     return cutoff_hz
 
