@@ -669,8 +669,9 @@ def _rank_error(
     what = "the base parameters" + "".join(f" and {t.name}" for t in columns.appended)
     cols = ", ".join(exc.dependent) or "none named"
     combos = "; ".join(exc.combinations) or cols
+    rows = f"{stack.n_rows} rows" if stack.n_rows else "rows read in blocks"
     return RankDeficientError(
-        f"{data.source} ({stack.n_rows} rows) has rank {exc.rank} < {needed} needed for "
+        f"{data.source} ({rows}) has rank {exc.rank} < {needed} needed for "
         f"{what} (rtol={rtol:g}), the model's structural rank; not excited by the data: "
         f"{combos}{columns.base.meaning(exc.combinations)}; nearly dependent columns: "
         f"{cols}; {data.hint}",
