@@ -118,11 +118,6 @@ class ModelColumns:
             out = out + t.labels
         return out
 
-    def term_slice(self, name: str) -> slice | None:
-        """The columns of the appended term named ``name``, or None."""
-        found = self.appended_term(name)
-        return None if found is None else found[1]
-
     def appended_term(self, name: str) -> tuple[ModelTerm, slice] | None:
         """The appended term named ``name`` with its columns, or None."""
         c = self.base.rank
@@ -134,19 +129,20 @@ class ModelColumns:
 
     def step_columns(self) -> NDArray[np.bool_]:
         """(c,): the columns that step where a velocity reverses (a term's ``steps``)."""
-        out = [np.zeros(self.base.rank, dtype=bool)]
-        for t in self.appended:
-            steps = getattr(t, "steps", None)
-            out.append(np.zeros(len(t.labels), bool) if steps is None else np.asarray(steps))
-        return np.concatenate(out)
+        return self._per_column("steps", False).astype(bool)
 
     def motion_columns(self) -> NDArray[np.intp]:
         """(c,): the joint (motor) whose motion each column needs to be identified, -1 for
         none (a term's ``needs_motion``; the base parameters need none of their own)."""
-        out = [np.full(self.base.rank, -1, dtype=np.intp)]
+        return self._per_column("needs_motion", -1).astype(np.intp)
+
+    def _per_column(self, attr: str, fill: bool | int) -> NDArray[Any]:
+        """An optional per-parameter property ``attr`` of the appended terms over every
+        column, ``fill`` for the base parameters and the terms without it."""
+        out = [np.full(self.base.rank, fill)]
         for t in self.appended:
-            need = getattr(t, "needs_motion", None)
-            out.append(np.full(len(t.labels), -1, np.intp) if need is None else np.asarray(need))
+            v = getattr(t, attr, None)
+            out.append(np.full(len(t.labels), fill) if v is None else np.asarray(v))
         return np.concatenate(out)
 
 
