@@ -26,7 +26,7 @@ from __future__ import annotations
 
 import math
 import warnings
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass, replace
 from typing import Any, Literal
 
@@ -149,30 +149,26 @@ def _judge(
         beta: NDArray[Any],
     ) -> HeldOut | None:
         b = np.asarray(beta)[cols]
-        if isinstance(stack, StreamedRows):
+        normals: Callable[[NDArray[np.intp]], tuple[Normals, ...]]
+        if isinstance(stack, StreamedRows):  # rows in blocks: one pass per set of labels
             source = selected_columns(stack.source, cols)
             e = np.concatenate([y - W @ b for W, y, _ in source()])
             rw = estimator.row_weights(e, np.tile(np.arange(data.n), e.size // data.n), b.size)
-            if validation is not None:
-                whole = normals_by_label(source, np.zeros(e.size, np.intp), rw)[0]
-                return HeldOut.separate(
-                    whole, _normals(robot, validation, columns, cols, b, estimator)
-                )
-            if labels is None:
-                return None
-            held = HeldOut.k_fold(normals_by_label(source, labels, rw))
-            return replace(held, scheme=scheme).expanded(cols)
-        W = stack.W if cols.all() else stack.W[:, cols]
-        y = stack.y
-        rw = row_weights(estimator, W, y, stack.groups, b)
+            m = e.size
+            normals = lambda lab: normals_by_label(source, lab, rw)  # noqa: E731
+        else:
+            W = stack.W if cols.all() else stack.W[:, cols]
+            rw = row_weights(estimator, W, stack.y, stack.groups, b)
+            Ww, yw, m = W * rw[:, None], stack.y * rw, stack.y.size
+            normals = lambda lab: block_normals(Ww, yw, lab)  # noqa: E731
         if validation is not None:
-            whole = block_normals(W * rw[:, None], y * rw, np.zeros(y.size, np.intp))[0]
             test = _normals(robot, validation, columns, cols, b, estimator)
-            return HeldOut.separate(whole, test).expanded(cols)
-        if labels is None:
+            held = HeldOut.separate(normals(np.zeros(m, np.intp))[0], test)
+        elif labels is None:
             return None
-        held = HeldOut.k_fold(block_normals(W * rw[:, None], y * rw, labels))
-        return replace(held, scheme=scheme).expanded(cols)
+        else:
+            held = replace(HeldOut.k_fold(normals(labels)), scheme=scheme)
+        return held.expanded(cols)
 
     return judge, how
 
