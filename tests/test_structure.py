@@ -7,6 +7,7 @@ against the noise level of that recording, and exact data against round-off.
 
 from __future__ import annotations
 
+import dataclasses
 import json
 import warnings
 
@@ -342,3 +343,43 @@ def test_consistent_fit_of_several_recordings_keeps_the_chosen_armature(panda, t
     assert main([*argv, *out]) == 0
     ident = json.loads((tmp_path / "d" / "identification.json").read_text())["metadata"]
     assert [r["pieces"] for r in ident["recordings"]] == [1, 1]
+
+
+@pytest.mark.parametrize("truth", ["joint", "motor"])
+def test_friction_of_a_coupled_drive_is_placed_where_the_data_say(panda, truth):
+    """A coupled drive (motor 7 turns with joints 6 and 7): friction acting at the joints,
+    ``f(dq)``, and at the motors, ``K^T f(K dq)``, are different models. Exact data of
+    either: the default identification judges both placements and keeps the true one, whose
+    parameters come back; the drive file's own placement (the motors) does not decide."""
+    truth_drive = Drive.from_gears(np.ones(7), [(7, 6, 0.8)], rotor_inertia=np.zeros(7))
+    truth_drive = dataclasses.replace(truth_drive, friction_at=truth)
+    fr = ClassicalFriction(VISCOUS, np.linspace(0.6, 0.2, 7), np.zeros(7))
+    t = sample_times(4.0, 500.0)
+    logs = [
+        simulate_measurement(
+            panda,
+            random_fourier(panda, np.random.default_rng(s))(t),
+            rng=np.random.default_rng(s),
+            noise=SensorNoise.none(),
+            friction=fr,
+            drive=truth_drive,
+            with_ddq=True,
+        )
+        for s in (91, 92)
+    ]
+    given = Drive.from_gears(np.ones(7), [(7, 6, 0.8)], rotor_inertia=np.zeros(7))
+    assert given.friction_at == "motor"
+    model = identify_recordings(panda, logs, cutoff_hz=None, drive=given)
+    sel = model.info.selection
+    names = [c["name"] for c in sel["candidates"]]
+    assert "links + viscous + at:joint" in names and "links + viscous + at:motor" in names
+    assert len(names) == 31  # 15 per placement, the model without friction once
+    assert sel["chosen"] == f"links + viscous + coulomb + at:{truth}", sel["chosen"]
+    assert model.drive.friction_at == truth
+    np.testing.assert_allclose(model.friction[:, :2], fr.as_array()[:, :2], atol=1e-7)
+    assert model.fit.relative_error_percent < 1e-7
+    # the model's own friction acts where it was placed
+    v = np.random.default_rng(5).uniform(-1, 1, (20, 7))
+    ref = fr.torques(v) if truth == "joint" else fr.torques(v @ given.transmission.T)
+    ref = ref if truth == "joint" else ref @ given.transmission
+    np.testing.assert_allclose(_own(model).torques(v), ref, atol=1e-7)

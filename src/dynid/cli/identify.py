@@ -139,8 +139,9 @@ def register(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParser:
         default=None,
         metavar="TERMS",
         help="torque logs: the model's terms beside the links, comma-separated from armature, "
-        "viscous, coulomb, smooth[:W], stribeck[:V], offset ('links' for none; W the smooth "
-        "Coulomb's width in standstill bands, V the Stribeck velocity [rad/s]); default: "
+        "viscous, quadratic, coulomb, smooth[:W], stribeck[:V], offset, at:motor|at:joint "
+        "('links' for none; W the smooth Coulomb's width in standstill bands, V the Stribeck "
+        "velocity [rad/s]; at: where a coupled drive's friction acts); default: "
         "chosen on held-out data (see Model structure above)",
     )
     add_column_options(p)

@@ -28,7 +28,7 @@ from __future__ import annotations
 
 import dataclasses
 import warnings
-from collections.abc import Iterator, Sequence
+from collections.abc import Iterator, Mapping, Sequence
 from dataclasses import dataclass
 from typing import Any, Literal
 
@@ -110,6 +110,10 @@ class Recordings:
         One line per piece left out (too short to filter).
     unwrapped : tuple of int
         Joints (0-based) unwrapped in some recording.
+    bands : dict
+        With a drive: the standstill band at its motors (``"motor"``) and at the joints
+        (``"joint"``), for a friction placed where the drive does not say
+        (:attr:`~dynid.identification.structure.Structure.at`); empty without one.
     """
 
     pieces: tuple[PreparedLog, ...]
@@ -118,6 +122,7 @@ class Recordings:
     band: NDArray[np.float64]
     skipped: tuple[str, ...] = ()
     unwrapped: tuple[int, ...] = ()
+    bands: Mapping[str, NDArray[np.float64]] = dataclasses.field(default_factory=dict)
 
     @property
     def route(self) -> Literal["classical"]:
@@ -370,6 +375,7 @@ def prepare_recordings(
         band=_band([piece for _, piece in pieces], drive),
         skipped=tuple(skipped),
         unwrapped=tuple(sorted(turned)),
+        bands=_bands([piece for _, piece in pieces], drive),
     )
 
 
@@ -405,6 +411,14 @@ def skipped_piece(name: str, piece: TorqueLog, exc: Exception, stacklevel: int =
     )
     warnings.warn(line, DynidWarning, stacklevel=stacklevel)
     return line
+
+
+def _bands(pieces: list[TorqueLog], drive: Drive | None) -> dict[str, NDArray[np.float64]]:
+    """The standstill bands at a drive's motors and at the joints (none without a drive)."""
+    if drive is None:
+        return {}
+    places: tuple[Literal["motor", "joint"], ...] = ("motor", "joint")
+    return {at: _band(pieces, dataclasses.replace(drive, friction_at=at)) for at in places}
 
 
 def _band(pieces: list[TorqueLog], drive: Drive | None) -> NDArray[np.float64]:

@@ -50,6 +50,7 @@ from .structure import (
     Structure,
     candidate_columns,
     candidate_structures,
+    friction_placements,
     largest_terms,
     structure_terms,
 )
@@ -190,6 +191,11 @@ def _normals(
     return block_normals(W * rw[:, None], y * rw, np.zeros(y.size, np.intp))[0]
 
 
+def _bands(data: Recordings) -> dict[str, tuple[float, ...]]:
+    """The standstill bands at a drive's motors and joints, as tuples."""
+    return {at: tuple(float(x) for x in b) for at, b in data.bands.items()}
+
+
 def _candidate(
     structure: Structure,
     use: NDArray[np.bool_],
@@ -243,7 +249,8 @@ def select_structure(
         The drive the data were read through.
     candidates : sequence of Structure, optional
         Default :func:`candidate_structures` (the armature only where the rotor inertias
-        are not known).
+        are not known; the friction at the motors and at the joints of a coupled drive,
+        :func:`~dynid.identification.structure.friction_placements`).
     estimator, folds, rtol
         As :func:`identify_recordings`.
     validation : Recordings, optional
@@ -256,13 +263,19 @@ def select_structure(
     """
     est = estimator_named(estimator)
     armature_ok = drive is None or drive.identifies_rotor_inertia
-    cands = tuple(candidates) if candidates is not None else candidate_structures(armature_ok)
+    cands = (
+        tuple(candidates)
+        if candidates is not None
+        else candidate_structures(armature_ok, friction_placements(drive))
+    )
     judged: list[Candidate] = []
     notes: list[str] = []
     judge, how = _judge(robot, data, est, folds, validation)
     fit_rtol = 1e-10 if rtol is None else rtol
-    for arm in sorted({c.armature for c in cands}):
-        mine = [c for c in cands if c.armature == arm]
+    # one regressor per armature choice and friction placement (friction at the motors and
+    # at the joints of a coupled drive, together, would be dependent columns)
+    for arm, at in sorted({(c.armature, c.at) for c in cands}):
+        mine = [c for c in cands if c.armature == arm and c.at == at]
         fitted = _fit_largest(robot, data, mine, arm, drive, est, rtol, judge, notes)
         if fitted is None:
             continue
@@ -295,7 +308,9 @@ def _fit_largest(
     for k, group in enumerate(tries):
         if not group or (k and len(group) == len(mine)):
             continue
-        model_drive, terms = largest_terms(group, arm, drive, robot.n, tuple(data.band))
+        model_drive, terms = largest_terms(
+            group, arm, drive, robot.n, tuple(data.band), _bands(data)
+        )
         try:
             with warnings.catch_warnings():  # the candidates' fits: only the chosen one speaks
                 warnings.simplefilter("ignore", DynidWarning)
@@ -309,14 +324,16 @@ def _fit_largest(
                     judge=judge,
                 )
         except RankDeficientError as exc:
-            what = "with" if arm else "without"
+            what = ("with" if arm else "without") + " armature"
+            where = {c.at for c in group if c.at}
+            what += "".join(f", friction at the {at}s" for at in where)
             shaped = k == 0 and len(tries[1]) < len(group)
             notes.append(
                 (
-                    f"the smooth and Stribeck candidates {what} armature: the data do not tell "
+                    f"the smooth and Stribeck candidates {what}: the data do not tell "
                     "them from Coulomb friction"
                     if shaped
-                    else f"the candidates {what} armature: not identifiable from these data"
+                    else f"the candidates {what}: not identifiable from these data"
                 )
                 + f" (rank {exc.rank} < {exc.needed})"
             )
@@ -420,7 +437,7 @@ def identify_recordings(
             rtol=rtol,
         )
         structure = Structure() if selection is None else selection.chosen
-    model_drive, terms = structure_terms(structure, drive, robot.n, tuple(data.band))
+    model_drive, terms = structure_terms(structure, drive, robot.n, tuple(data.band), _bands(data))
     judge, _ = _judge(robot, data, est, folds, validation)
     model = identify(
         robot,

@@ -15,8 +15,8 @@ each candidate's columns in it.
 from __future__ import annotations
 
 import math
-from collections.abc import Sequence
-from dataclasses import dataclass
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass, replace
 from typing import Any
 
 import numpy as np
@@ -34,6 +34,7 @@ __all__ = [
     "Structure",
     "candidate_columns",
     "candidate_structures",
+    "friction_placements",
     "largest_terms",
     "smooth_width",
     "structure_terms",
@@ -60,6 +61,7 @@ STRIBECK_VELOCITIES = (0.02, 0.05, 0.1, 0.2)
 MIN_WIDTH = 1e-3
 
 _CLASSICAL = ("viscous", "coulomb", "offset")
+_PLACEMENTS = ("", "motor", "joint")
 
 
 @dataclass(frozen=True, slots=True)
@@ -79,14 +81,21 @@ class Structure:
         With ``smooth``: its width in multiples of each joint's standstill band.
     vst : float
         With ``stribeck``: the Stribeck velocity [rad/s].
+    at : {"", "motor", "joint"}
+        Where the friction acts: ``""`` where the drive says (the joints without a drive),
+        else at the drive's motors (``K^T f(K dq)``) or at the joints (``f(dq)``). The two
+        differ only through a coupled transmission (:func:`friction_placements`).
     """
 
     armature: bool = False
     friction: tuple[str, ...] = _CLASSICAL
     width: float = 0.0
     vst: float = 0.0
+    at: str = ""
 
     def __post_init__(self) -> None:
+        if self.at not in _PLACEMENTS:
+            raise OptionError(f"--terms at:{self.at}: friction acts at 'motor' or 'joint'")
         bad = [p for p in self.friction if p not in FRICTION_PARTS]
         if bad:
             raise OptionError(
@@ -104,13 +113,18 @@ class Structure:
         if "stribeck" in parts and "coulomb" not in parts:
             parts = tuple(p for p in FRICTION_PARTS if p in parts + ("coulomb",))
         object.__setattr__(self, "friction", parts)
+        if not parts:
+            object.__setattr__(self, "at", "")
 
     @property
     def terms(self) -> tuple[str, ...]:
         """The term names held, e.g. ``("armature", "viscous", "smooth:3")``."""
         shape = {"smooth": f"smooth:{self.width:g}", "stribeck": f"stribeck:{self.vst:g}"}
-        return (("armature",) if self.armature else ()) + tuple(
-            shape.get(p, p) for p in self.friction
+        where = (f"at:{self.at}",) if self.at and self.friction else ()
+        return (
+            (("armature",) if self.armature else ())
+            + tuple(shape.get(p, p) for p in self.friction)
+            + where
         )
 
     @property
@@ -122,7 +136,7 @@ class Structure:
     def parse(cls, text: str) -> Structure:
         """From ``"armature,viscous,coulomb"`` (``"links"`` or ``""`` for none);
         ``smooth:W`` gives the smooth Coulomb's width in standstill bands, ``stribeck:V``
-        the Stribeck velocity [rad/s].
+        the Stribeck velocity [rad/s], ``at:joint`` or ``at:motor`` where the friction acts.
 
         Raises
         ------
@@ -133,8 +147,12 @@ class Structure:
         words = [w for w in words if w != "links"]
         shapes: dict[str, float] = {}
         names = []
+        at = ""
         for w in words:
             name, _, value = w.partition(":")
+            if name == "at":
+                at = value
+                continue
             if value:
                 try:
                     shapes[name] = float(value)
@@ -148,26 +166,46 @@ class Structure:
             friction=tuple(w for w in names if w != "armature"),
             width=shapes.get("smooth", 0.0),
             vst=shapes.get("stribeck", 0.0),
+            at=at,
         )
 
 
-def candidate_structures(armature: bool = True) -> tuple[Structure, ...]:
+def friction_placements(drive: Drive | None) -> tuple[str, ...]:
+    """Where the candidates' friction may act: at the motors or at the joints for a drive
+    whose transmission couples joints (a coupled wrist: one motor turns with two joints,
+    so ``K^T f(K dq)`` and ``f(dq)`` are different models); ``("",)``, where the drive
+    says, otherwise (through a diagonal ``K`` both are the same model up to the units of
+    the coefficients)."""
+    if drive is None:
+        return ("",)
+    K = np.asarray(drive.transmission)
+    coupled = bool(np.any(K[~np.eye(drive.n, dtype=bool)] != 0))
+    return ("motor", "joint") if coupled else ("",)
+
+
+def candidate_structures(
+    armature: bool = True, placements: Sequence[str] = ("",)
+) -> tuple[Structure, ...]:
     """The candidates, simplest first: every classical ladder of :data:`FRICTION_LADDER`,
     the smooth Coulomb at each of :data:`SMOOTH_WIDTHS` (with viscous friction, without
     and with offsets), the quadratic viscous law and the Stribeck law at each of
     :data:`STRIBECK_VELOCITIES` (with viscous friction, Coulomb friction and offsets),
-    without and (``armature``) with the armature."""
+    without and (``armature``) with the armature, the friction at each of ``placements``
+    (:func:`friction_placements`; the model without friction once)."""
     arms = (False, True) if armature else (False,)
     out = []
     for a in arms:
-        out += [Structure(a, f) for f in FRICTION_LADDER]
-        out += [
-            Structure(a, ("viscous", "smooth") + o, width=w)
-            for o in ((), ("offset",))
-            for w in SMOOTH_WIDTHS
-        ]
-        out.append(Structure(a, ("viscous", "quadratic", "coulomb", "offset")))
-        out += [Structure(a, _CLASSICAL + ("stribeck",), vst=v) for v in STRIBECK_VELOCITIES]
+        for i, at in enumerate(placements):
+            out += [Structure(a, f, at=at if f else "") for f in FRICTION_LADDER if f or not i]
+            out += [
+                Structure(a, ("viscous", "smooth") + o, width=w, at=at)
+                for o in ((), ("offset",))
+                for w in SMOOTH_WIDTHS
+            ]
+            out.append(Structure(a, ("viscous", "quadratic", "coulomb", "offset"), at=at))
+            out += [
+                Structure(a, _CLASSICAL + ("stribeck",), vst=v, at=at) for v in STRIBECK_VELOCITIES
+            ]
     return tuple(out)
 
 
@@ -178,32 +216,26 @@ def smooth_width(band: Sequence[float], factor: float) -> tuple[float, ...]:
 
 
 def structure_terms(
-    structure: Structure, drive: Drive | None, n: int, band: Sequence[float] = ()
+    structure: Structure,
+    drive: Drive | None,
+    n: int,
+    band: Sequence[float] = (),
+    bands: Mapping[str, Sequence[float]] | None = None,
 ) -> tuple[Drive | None, tuple[ModelTerm, ...]]:
     """The model's drive and terms of ``structure``: without a drive, an armature is the
-    rotor inertia of a direct drive (``K = 1``); friction acts where the drive says, with the
-    standstill ``band`` [rad/s] per joint (motor).
+    rotor inertia of a direct drive (``K = 1``); friction acts where the structure says
+    (:attr:`Structure.at`: the drive's ``friction_at`` is set to it), with the standstill
+    band [rad/s] per motor (joint) where it acts: ``bands["motor"]`` or ``bands["joint"]``,
+    else ``band``.
 
     Raises
     ------
     OptionError
         An armature asked of a drive whose rotor inertias are known (given in its file).
     """
-    model_drive = drive
-    if structure.armature and drive is None:
-        model_drive = Drive.identity(n)
-    terms: list[ModelTerm] = []
-    if model_drive is not None and model_drive.identifies_rotor_inertia:
-        if structure.armature:
-            terms.append(RotorInertia(model_drive))
-    elif structure.armature:
-        raise OptionError(
-            "the armature term identifies the rotor inertias, which the drive file gives; "
-            "drop 'armature' from --terms or set rotor_inertia = \"identify\""
-        )
+    model_drive, terms = _rotor_terms(structure.armature, drive, n)
     if structure.friction:
-        at = Drive.identity(n) if model_drive is None else model_drive
-        b = tuple(band) if band else (0.0,) * n
+        model_drive, at, b = _placed(structure.at, model_drive, n, band, bands)
         terms.append(
             LinearFriction(
                 at,
@@ -216,16 +248,57 @@ def structure_terms(
     return model_drive, tuple(terms)
 
 
-def largest_terms(
-    cands: Sequence[Structure], arm: bool, drive: Drive | None, n: int, band: Sequence[float]
-) -> tuple[Drive | None, list[tuple[ModelTerm, Any]]]:
-    """The terms of every candidate with ``armature == arm`` at once, each with what it
-    stands for: ``("classical", parts)``, ``("smooth", width)`` or ``("stribeck", vst)``;
-    a candidate is a choice of their columns."""
-    mine = [c for c in cands if c.armature == arm]
-    model_drive, terms = structure_terms(Structure(arm, ()), drive, n, band)
+def _rotor_terms(armature: bool, drive: Drive | None, n: int) -> tuple[Drive | None, list[Any]]:
+    """The model's drive and its rotor term (an armature without a drive: ``K = 1``)."""
+    model_drive = drive
+    if armature and drive is None:
+        model_drive = Drive.identity(n)
+    terms: list[ModelTerm] = []
+    if model_drive is not None and model_drive.identifies_rotor_inertia:
+        if armature:
+            terms.append(RotorInertia(model_drive))
+    elif armature:
+        raise OptionError(
+            "the armature term identifies the rotor inertias, which the drive file gives; "
+            "drop 'armature' from --terms or set rotor_inertia = \"identify\""
+        )
+    return model_drive, terms
+
+
+def _placed(
+    where: str,
+    model_drive: Drive | None,
+    n: int,
+    band: Sequence[float],
+    bands: Mapping[str, Sequence[float]] | None,
+) -> tuple[Drive | None, Drive, tuple[float, ...]]:
+    """The model's drive with its friction placed ``where``, the drive the friction term
+    acts through, and the standstill band there."""
     at = Drive.identity(n) if model_drive is None else model_drive
-    b = tuple(band) if band else (0.0,) * n
+    if where and model_drive is not None and where != model_drive.friction_at:
+        model_drive = at = replace(model_drive, friction_at=where)  # type: ignore[arg-type]
+    b = tuple((bands or {}).get(str(at.friction_at), band))
+    return model_drive, at, b or (0.0,) * n
+
+
+def largest_terms(
+    cands: Sequence[Structure],
+    arm: bool,
+    drive: Drive | None,
+    n: int,
+    band: Sequence[float],
+    bands: Mapping[str, Sequence[float]] | None = None,
+) -> tuple[Drive | None, list[tuple[ModelTerm, Any]]]:
+    """The terms of every candidate with ``armature == arm`` at once (their friction at
+    one place: :attr:`Structure.at`), each with what it stands for:
+    ``("classical", parts)``, ``("smooth", width)`` or ``("stribeck", vst)``; a candidate
+    is a choice of their columns."""
+    mine = [c for c in cands if c.armature == arm]
+    places = {c.at for c in mine if c.friction}
+    if len(places) > 1:
+        raise OptionError(f"largest_terms: one friction placement at a time; got {places}")
+    model_drive, terms = _rotor_terms(arm, drive, n)
+    model_drive, at, b = _placed(places.pop() if places else "", model_drive, n, band, bands)
     out: list[tuple[ModelTerm, Any]] = [(t, None) for t in terms]
     classical = tuple(p for p in _CLASSICAL + ("quadratic",) if any(p in c.friction for c in mine))
     if classical:
