@@ -10,14 +10,17 @@ terms written out here, independently of dynid:
 
 from __future__ import annotations
 
+import warnings
+
 import numpy as np
 import pytest
 
 import dynid
-from dynid.exceptions import DataError, ModelError
+from dynid.exceptions import DataError, DynidWarning, ModelError
 from dynid.identification.classical import identify_from_log
 from dynid.identification.log import TorqueLog
 from dynid.io.drive_file import drive_from_mapping, load_drive
+from dynid.io.torque_log import save_torque_log
 from dynid.model.drive import Drive
 from dynid.regressors.terms import RotorInertia
 
@@ -537,3 +540,23 @@ def test_gear_ratio_1_in_a_drive_file_identifies_a_joint_side_armature(tmp_path)
     tau_hat = m.torques(held.q, held.dq, held.ddq)
     tau_hat = tau_hat + dynid.friction.validation.own_friction(m).torques(held.dq)
     assert np.linalg.norm(tau_hat - tau_held) / np.linalg.norm(tau_held) < 1e-6
+
+
+def test_validate_checks_the_joint_limits_of_a_motor_side_log_at_the_joints(tmp_path):
+    """A motor-side log holds motor angles (the gear ratio times the joint's): validating
+    the model identified through the drive checks the limits on the joint-side positions,
+    so the log raises no "far outside the limits" warning, and the held-out torques come
+    back to round-off."""
+    from dynid.workflows.validate import ValidateOptions, validate_files
+
+    robot, model, data = _ur5()
+    train, _ = _motor_log(model, data, seed=1)
+    held, _ = _motor_log(model, data, seed=2)
+    assert np.max(np.abs(held.q)) > 10 * np.max(np.abs(robot.q_max))  # motor angles
+    m = identify_from_log(robot, train, cutoff_hz=None, decimate=1, drive=_drive())
+    path = tmp_path / "held.csv"
+    save_torque_log(path, held)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", DynidWarning)
+        res = validate_files(m, path, ValidateOptions(friction="own", cutoff_hz=20.0))
+    assert res.validation.errors.relative_error_percent < 1.0

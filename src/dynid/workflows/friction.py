@@ -124,6 +124,7 @@ def fit_friction_file(
         drop_invalid=drop_invalid,
         cutoff_hz=cutoff_hz,
         owner="the model",
+        drive=(model.drive if isinstance(model, IdentifiedModel) else None) or drive,
     )
 
     def fit() -> FrictionFileResult:

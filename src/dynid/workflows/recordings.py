@@ -27,7 +27,8 @@ from typing import Any
 import numpy as np
 
 from ..exceptions import DataError, DynidWarning
-from ..identification.log import TorqueLog
+from ..identification.log import TorqueLog, joint_side_log
+from ..model.drive import Drive
 from ..model.robot import Robot
 from .data_files import ColumnSpec, column_map, in_file, read_torque_log, recorded_columns
 from .identify import data_files
@@ -69,6 +70,7 @@ def read_recordings(
     drop_invalid: bool = False,
     cutoff_hz: float | None = None,
     owner: str | None = None,
+    drive: Drive | None = None,
 ) -> Recorded:
     """The torque logs of ``data`` (files, or folders of ``.csv``/``.npz`` files) of
     ``robot``, read and checked (module docstring).
@@ -88,6 +90,9 @@ def read_recordings(
         Cut-off [Hz] of velocities derived from positions through a column map.
     owner : str, optional
         What has ``robot.n`` joints, for messages.
+    drive : Drive, optional
+        The drive the recordings were recorded through: the joint limits are checked on
+        their joint-side positions (a motor-side log holds motor angles).
 
     Returns
     -------
@@ -109,7 +114,7 @@ def read_recordings(
 
     logs = tuple(in_file(p, lambda p=p: read(p)) for p in paths)  # type: ignore[misc]
     out = Recorded(logs, tuple(paths))
-    _check_limits(out, robot)
+    _check_limits(out, robot, drive)
     _check_units(out)
     return out
 
@@ -158,12 +163,14 @@ def _check_units(rec: Recorded) -> None:
             )
 
 
-def _check_limits(rec: Recorded, robot: Robot) -> None:
-    """Warn about a recording whose positions lie far outside the joint limits."""
+def _check_limits(rec: Recorded, robot: Robot, drive: Drive | None) -> None:
+    """Warn about a recording whose (joint-side) positions lie far outside the joint
+    limits."""
     lo = np.asarray(robot.q_min) - LIMIT_MARGIN
     hi = np.asarray(robot.q_max) + LIMIT_MARGIN
     for name, log in zip(rec.names, rec.logs, strict=True):
-        qmin, qmax = np.min(log.q, axis=0), np.max(log.q, axis=0)
+        q = log.q if drive is None or drive.n != log.n else joint_side_log(log, drive).q
+        qmin, qmax = np.min(q, axis=0), np.max(q, axis=0)
         bad = np.flatnonzero((qmin < lo) | (qmax > hi))
         if bad.size:
             j = int(bad[0])

@@ -167,6 +167,10 @@ def validate_files(
     """
     opt = options or ValidateOptions()
     robot = model.robot if isinstance(model, IdentifiedModel) else model
+    drive = opt.drive
+    if drive is None and feasible is not None:
+        drive = load_feasible_drive(feasible)
+    own = model.drive if isinstance(model, IdentifiedModel) else None
     rec = read_recordings(
         data,
         robot,
@@ -175,11 +179,9 @@ def validate_files(
         drop_invalid=opt.drop_invalid,
         cutoff_hz=opt.cutoff_hz,
         owner=f"the model ({label or robot.name})",
+        drive=own if drive is None else drive,
     )
     friction, source = _friction(model, opt.friction, feasible)
-    drive = opt.drive
-    if drive is None and feasible is not None:
-        drive = load_feasible_drive(feasible)
 
     def run() -> RecordingsValidation:
         pieces = prepare_pieces(
