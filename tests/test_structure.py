@@ -252,6 +252,13 @@ def test_structure_names_are_checked():
     with known rotor inertias is refused."""
     assert Structure.parse("offset, viscous,armature").name == "links + armature + viscous + offset"
     assert Structure.parse("links").terms == ()
+    # a chosen structure's name reads back as the structure (the consistent route's use)
+    s = Structure.parse("links + armature + viscous + smooth:3 + at:joint")
+    assert (s.armature, s.friction, s.width, s.at) == (True, ("viscous", "smooth"), 3.0, "joint")
+    assert Structure.parse(s.name) == s
+    assert Structure.parse("links,at:joint").at == ""  # no friction: nowhere to act
+    with pytest.raises(OptionError, match="at:knee"):
+        Structure.parse("viscous,at:knee")
     with pytest.raises(OptionError, match="stiction"):
         Structure.parse("viscous,stiction")
     from dynid.identification.structure import structure_terms

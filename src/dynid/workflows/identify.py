@@ -254,10 +254,10 @@ def _consistent_structure_fit(
     if terms == "auto":
         chosen = identify_recordings(robot, logs, names, **kw)
         selection = chosen.info.selection
-        chosen_terms = str((selection or {}).get("chosen", "")).split(" + ")
-        terms = Structure("armature" in chosen_terms, classical)
+        chosen = Structure.parse(str((selection or {}).get("chosen", "")))
+        terms = Structure(chosen.armature, classical, at=chosen.at)
     else:
-        terms = Structure(terms.armature, classical)
+        terms = Structure(terms.armature, classical, at=terms.at)
     model = identify_recordings(robot, logs, names, structure=terms, **kw)
     info = dataclasses.replace(model.info, selection=selection)
     return dataclasses.replace(model, info=info)
