@@ -149,7 +149,8 @@ def test_stribeck_friction_is_identified_with_the_links_and_its_velocity_chosen(
     fr = LawFriction(LAWS["stribeck"], P)
     logs = [_recording(panda, s, fr, noise=SensorNoise.none(), duration=4.0) for s in (61, 62)]
     model = identify_recordings(panda, logs, cutoff_hz=None)
-    assert model.info.selection["chosen"] == "links + viscous + coulomb + stribeck:0.05 + offset"
+    # the offsets, zero in the truth, are left out joint by joint
+    assert model.info.selection["chosen"] == "links + viscous + coulomb + stribeck:0.05"
     assert model.info.friction.law == "stribeck"
     np.testing.assert_allclose(model.friction, P, atol=1e-7)
     assert model.fit.relative_error_percent < 1e-7
@@ -166,7 +167,7 @@ def test_quadratic_viscous_friction_is_identified_with_the_links(panda):
     fr = LawFriction(LAWS["quadratic"], P)
     logs = [_recording(panda, s, fr, noise=SensorNoise.none(), duration=4.0) for s in (81, 82)]
     model = identify_recordings(panda, logs, cutoff_hz=None)
-    assert model.info.selection["chosen"] == "links + viscous + quadratic + coulomb + offset"
+    assert model.info.selection["chosen"] == "links + viscous + quadratic + coulomb"
     assert model.info.friction.law == "quadratic"
     np.testing.assert_allclose(model.friction, P, atol=1e-7)
     v = np.linspace(-2.0, 2.0, 41)[:, None] * np.ones(7)
@@ -390,3 +391,34 @@ def test_friction_of_a_coupled_drive_is_placed_where_the_data_say(panda, truth):
     ref = fr.torques(v) if truth == "joint" else fr.torques(v @ given.transmission.T)
     ref = ref if truth == "joint" else ref @ given.transmission
     np.testing.assert_allclose(_own(model).torques(v), ref, atol=1e-7)
+
+
+def test_friction_structure_is_chosen_per_joint(panda):
+    """Exact data of an arm whose joints differ: Coulomb friction on joints 1-3 only, a
+    torque offset on joint 2 only. The structure chosen holds exactly those coefficients
+    (the others left out joint by joint), they come back to 1e-7, and `--terms` names the
+    same structure."""
+    fc = np.array([0.6, 0.5, 0.4, 0.0, 0.0, 0.0, 0.0])
+    fo = np.array([0.0, 0.3, 0.0, 0.0, 0.0, 0.0, 0.0])
+    fr = ClassicalFriction(VISCOUS, fc, fo)
+    logs = [_recording(panda, s, fr, noise=SensorNoise.none(), duration=4.0) for s in (71, 72)]
+    model = identify_recordings(panda, logs, cutoff_hz=None)
+    want = (
+        "links + viscous + coulomb + offset"
+        " - fc4 - fc5 - fc6 - fc7 - fo1 - fo3 - fo4 - fo5 - fo6 - fo7"
+    )
+    chosen = model.info.selection["chosen"]
+    assert Structure.parse(chosen) == Structure.parse(want), chosen
+    assert model.info.friction.labels == (
+        "fv1", "fc1", "fv2", "fc2", "fo2", "fv3", "fc3", "fv4", "fv5", "fv6", "fv7"
+    )  # fmt: skip
+    np.testing.assert_allclose(model.friction, fr.as_array(), atol=1e-7)
+    assert model.fit.relative_error_percent < 1e-7
+    v = np.linspace(-1.0, 1.0, 41)[:, None] * np.ones(7)
+    np.testing.assert_allclose(_own(model).torques(v), fr.torques(v), atol=1e-7)
+    # the friction columns' coefficients read back as the law's table
+    r = model.base.rank
+    np.testing.assert_array_equal(model.friction_from(model.joint_fit.beta[r:]), model.friction)
+    # the same structure given by hand
+    given = identify_recordings(panda, logs, cutoff_hz=None, structure=Structure.parse(want))
+    np.testing.assert_allclose(given.friction, model.friction, atol=1e-9)

@@ -30,7 +30,7 @@ from ..exceptions import ShapeError
 from ..model.drive import Drive
 from ..model.robot import Robot
 from ..regressors.base import BaseParameters
-from ..regressors.terms import LinearFriction
+from ..regressors.terms import FRICTION_PARTS, LinearFriction
 from .holdout import HeldOut
 from .info import IdentificationInfo
 from .least_squares import LeastSquaresFit
@@ -118,14 +118,20 @@ class IdentifiedModel:
                 f"coefficients of the model's friction columns; got {x.shape}"
             )
         n = self.friction.shape[0]
-        prefixes = [lab.rstrip("0123456789") for lab in fr.labels[: len(fr.labels) // n]]
         part = {"fv": "viscous", "fc": "smooth" if fr.law == "smooth" else "coulomb"}
         part |= {"fq": "quadratic", "fsp": "stribeck", "fo": "offset"}
+        held = []  # (part, joint) of each label: "fo3" -> ("offset", 2)
+        for lab in fr.labels:
+            prefix = lab.rstrip("0123456789")
+            held.append((part[prefix], int(lab[len(prefix) :]) - 1))
+        parts = tuple(p for p in FRICTION_PARTS if any(h[0] == p for h in held))
+        mask = tuple((p, j) in held for j in range(n) for p in parts)
         term = LinearFriction(
             Drive.identity(n),
-            parts=tuple(part[p] for p in prefixes),
+            parts=parts,
             width=fr.band if fr.law == "smooth" else (),
-            vst=float(self.friction[0, 3]) if fr.law == "stribeck" else 0.0,
+            vst=float(np.max(self.friction[:, 3])) if fr.law == "stribeck" else 0.0,
+            mask=() if all(mask) else mask,
         )
         return term.as_array(x)
 

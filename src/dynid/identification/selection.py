@@ -50,6 +50,7 @@ from .structure import (
     Structure,
     candidate_columns,
     candidate_structures,
+    coefficient_labels,
     friction_placements,
     largest_terms,
     structure_terms,
@@ -237,6 +238,7 @@ def select_structure(
     folds: int = DEFAULT_FOLDS,
     validation: Recordings | None = None,
     rtol: float | None = None,
+    per_joint: bool = True,
 ) -> Selection | None:
     """Judge candidate structures on held-out data and choose one (module docstring).
 
@@ -255,6 +257,10 @@ def select_structure(
         As :func:`identify_recordings`.
     validation : Recordings, optional
         A separate recording to judge on instead of the folds.
+    per_joint : bool
+        Also judge per-joint structures: friction coefficients of single joints left out
+        while the held-out error stays within one standard error of the lowest
+        (:attr:`~dynid.identification.structure.Structure.drop`).
 
     Returns
     -------
@@ -272,6 +278,7 @@ def select_structure(
     notes: list[str] = []
     judge, how = _judge(robot, data, est, folds, validation)
     fit_rtol = 1e-10 if rtol is None else rtol
+    groups: dict[tuple[bool, str], tuple[IdentifiedModel, list[tuple[ModelTerm, Any]]]] = {}
     # one regressor per armature choice and friction placement (friction at the motors and
     # at the joints of a coupled drive, together, would be dependent columns)
     for arm, at in sorted({(c.armature, c.at) for c in cands}):
@@ -282,12 +289,54 @@ def select_structure(
         model, terms, mine = fitted
         if model.holdout is None:
             return None
+        groups[(arm, at)] = (model, terms)
         for c in mine:
             use = candidate_columns(c, model.base.rank, terms, robot.n)
             judged.append(_candidate(c, use, model, model.holdout, fit_rtol))
     if not judged:
         return None
+    if per_joint:
+        judged += _per_joint(judged, groups, robot.n, fit_rtol)
     return Selection(tuple(judged), _chosen(judged), how, notes=tuple(notes))
+
+
+def _per_joint(
+    judged: Sequence[Candidate],
+    groups: dict[tuple[bool, str], tuple[IdentifiedModel, list[tuple[ModelTerm, Any]]]],
+    n: int,
+    rtol: float,
+) -> list[Candidate]:
+    """Per-joint structures: from the candidate with the lowest held-out error and from
+    the one chosen, friction coefficients of single joints left out one at a time (the one
+    whose absence the held-out data miss least first) while the held-out error stays
+    within one standard error of the lowest; the candidates reached, when they hold
+    fewer coefficients than where they started."""
+    best = min(judged, key=lambda c: c.heldout_error_percent)
+    limit = best.heldout_error_percent + max(best.heldout_se_percent, ERROR_FLOOR_PERCENT)
+    out: list[Candidate] = []
+    for start in dict.fromkeys((best.structure, _chosen(judged))):
+        if not start.friction:
+            continue
+        model, terms = groups[(start.armature, start.at)]
+        held, r = model.holdout, model.base.rank
+        assert held is not None  # groups hold models judged on held-out data
+        here = next(c for c in judged if c.structure == start)
+        while True:
+            trials = [
+                _candidate(s, candidate_columns(s, r, terms, n), model, held, rtol)
+                for s in (
+                    replace(here.structure, drop=here.structure.drop + (lab,))
+                    for lab in coefficient_labels(here.structure, n)
+                )
+            ]
+            step = min(trials, key=lambda c: c.heldout_error_percent, default=None)
+            if step is None or step.heldout_error_percent > limit:
+                break
+            here = step
+        reached = here.structure.collapsed(n)
+        if reached not in [c.structure for c in (*judged, *out)]:
+            out.append(replace(here, structure=reached))
+    return out
 
 
 def _fit_largest(

@@ -23,7 +23,13 @@ import numpy as np
 
 from ..exceptions import OptionError
 from ..model.drive import Drive
-from ..regressors.terms import FRICTION_PARTS, LinearFriction, ModelTerm, RotorInertia
+from ..regressors.terms import (
+    FRICTION_PARTS,
+    PART_LABELS,
+    LinearFriction,
+    ModelTerm,
+    RotorInertia,
+)
 
 __all__ = [
     "ERROR_FLOOR_PERCENT",
@@ -34,6 +40,7 @@ __all__ = [
     "Structure",
     "candidate_columns",
     "candidate_structures",
+    "coefficient_labels",
     "friction_placements",
     "largest_terms",
     "smooth_width",
@@ -64,6 +71,12 @@ _CLASSICAL = ("viscous", "coulomb", "offset")
 _PLACEMENTS = ("", "motor", "joint")
 
 
+def _label_order(label: str) -> tuple[int, str]:
+    """Joint first, then the label: ``fv2 < fo2 < fv3``."""
+    prefix = label.rstrip("0123456789")
+    return int(label[len(prefix) :]), prefix
+
+
 @dataclass(frozen=True, slots=True)
 class Structure:
     """The terms of a model beside the links' parameters.
@@ -85,6 +98,10 @@ class Structure:
         Where the friction acts: ``""`` where the drive says (the joints without a drive),
         else at the drive's motors (``K^T f(K dq)``) or at the joints (``f(dq)``). The two
         differ only through a coupled transmission (:func:`friction_placements`).
+    drop : tuple of str
+        Friction coefficients left out on single joints (motors), by label: ``"fo3"`` is
+        joint 3 without an offset, ``"fc5"`` joint 5 without Coulomb friction (``fv``,
+        ``fq``, ``fc``, ``fsp``, ``fo``; 1-based); every other joint holds every part.
     """
 
     armature: bool = False
@@ -92,6 +109,7 @@ class Structure:
     width: float = 0.0
     vst: float = 0.0
     at: str = ""
+    drop: tuple[str, ...] = ()
 
     def __post_init__(self) -> None:
         if self.at not in _PLACEMENTS:
@@ -115,6 +133,48 @@ class Structure:
         object.__setattr__(self, "friction", parts)
         if not parts:
             object.__setattr__(self, "at", "")
+        held = {PART_LABELS[p] for p in parts}
+        for lab in self.drop:
+            prefix = lab.rstrip("0123456789")
+            if prefix not in held or prefix == lab or not int(lab[len(prefix) :]) >= 1:
+                raise OptionError(
+                    f"--terms -{lab}: a coefficient to leave out is a label of a part held "
+                    f"and a joint number from 1 ({', '.join(sorted(held)) or 'no friction'})"
+                )
+        object.__setattr__(self, "drop", tuple(sorted(set(self.drop), key=_label_order)))
+
+    def collapsed(self, n: int) -> Structure:
+        """The same model with a part whose coefficients :attr:`drop` leaves out on every
+        one of ``n`` joints removed from :attr:`friction` (``viscous + offset - fo1 - fo2``
+        on two joints is ``viscous``); Coulomb friction stays with a Stribeck part."""
+        drop, parts = set(self.drop), list(self.friction)
+        for p in self.friction:
+            labels = {f"{PART_LABELS[p]}{j + 1}" for j in range(n)}
+            if labels <= drop and not (p == "coulomb" and "stribeck" in parts):
+                parts.remove(p)
+                drop -= labels
+        if len(parts) == len(self.friction):
+            return self
+        width = self.width if "smooth" in parts else 0.0
+        vst = self.vst if "stribeck" in parts else 0.0
+        return replace(self, friction=tuple(parts), drop=tuple(drop), width=width, vst=vst)
+
+    def mask(self, n: int) -> tuple[bool, ...]:
+        """Which of the ``len(friction) n`` coefficients (joint by joint, the parts in
+        order) are held: all but :attr:`drop`; empty when every one is.
+
+        Raises
+        ------
+        OptionError
+            A coefficient of :attr:`drop` on a joint beyond ``n``.
+        """
+        if not self.drop:
+            return ()
+        labels = [f"{PART_LABELS[p]}{j + 1}" for j in range(n) for p in self.friction]
+        beyond = [lab for lab in self.drop if lab not in labels]
+        if beyond:
+            raise OptionError(f"--terms -{beyond[0]}: the arm has {n} joints")
+        return tuple(lab not in self.drop for lab in labels)
 
     @property
     def terms(self) -> tuple[str, ...]:
@@ -125,12 +185,15 @@ class Structure:
             (("armature",) if self.armature else ())
             + tuple(shape.get(p, p) for p in self.friction)
             + where
+            + tuple(f"-{lab}" for lab in self.drop)
         )
 
     @property
     def name(self) -> str:
-        """``"links + armature + viscous"``."""
-        return " + ".join(("links",) + self.terms)
+        """``"links + armature + viscous"``; ``"links + viscous + offset - fo3"`` with a
+        coefficient left out."""
+        kept = [t for t in self.terms if not t.startswith("-")]
+        return " + ".join(["links", *kept]) + "".join(f" - {lab}" for lab in self.drop)
 
     @classmethod
     def parse(cls, text: str) -> Structure:
@@ -143,15 +206,20 @@ class Structure:
         OptionError
             An unknown term name or a shape that is not a positive number.
         """
-        words = [w.strip() for w in text.replace("+", ",").split(",") if w.strip()]
+        text = text.replace(" - ", ",-").replace("+", ",")
+        words = [w.strip() for w in text.split(",") if w.strip()]
         words = [w for w in words if w != "links"]
         shapes: dict[str, float] = {}
         names = []
         at = ""
+        drop = []
         for w in words:
             name, _, value = w.partition(":")
             if name == "at":
                 at = value
+                continue
+            if name.startswith("-"):
+                drop.append(name[1:].strip())
                 continue
             if value:
                 try:
@@ -167,6 +235,7 @@ class Structure:
             width=shapes.get("smooth", 0.0),
             vst=shapes.get("stribeck", 0.0),
             at=at,
+            drop=tuple(drop),
         )
 
 
@@ -243,6 +312,7 @@ def structure_terms(
                 band=b,
                 width=smooth_width(b, structure.width) if "smooth" in structure.friction else (),
                 vst=structure.vst,
+                mask=structure.mask(n),
             )
         )
     return model_drive, tuple(terms)
@@ -326,12 +396,20 @@ def candidate_columns(
             continue
         kind, shape = what
         if kind == "classical":
-            mask = np.array([p in structure.friction for p in shape])
-            use.append(np.tile(mask, n))
+            on = np.tile(np.array([p in structure.friction for p in shape]), n)
         elif kind == "smooth":
-            on = "smooth" in structure.friction and structure.width == shape
-            use.append(np.full(len(t.labels), on))
+            on = np.full(len(t.labels), "smooth" in structure.friction and structure.width == shape)
         else:
-            on = "stribeck" in structure.friction and structure.vst == shape
-            use.append(np.full(len(t.labels), on))
+            on = np.full(len(t.labels), "stribeck" in structure.friction and structure.vst == shape)
+        if structure.drop:
+            on &= np.array([lab not in structure.drop for lab in t.labels])
+        use.append(on)
     return np.concatenate(use)
+
+
+def coefficient_labels(structure: Structure, n: int) -> tuple[str, ...]:
+    """The labels of the friction coefficients ``structure`` holds on ``n`` joints
+    (motors), joint by joint: ``fv1, fc1, fv2, ...``, those of :attr:`Structure.drop`
+    left out."""
+    every = [f"{PART_LABELS[p]}{j + 1}" for j in range(n) for p in structure.friction]
+    return tuple(lab for lab in every if lab not in structure.drop)

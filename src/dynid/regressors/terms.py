@@ -40,6 +40,7 @@ __all__ = [
     "FRICTION_PARTS",
     "LinearFriction",
     "ModelTerm",
+    "PART_LABELS",
     "RotorInertia",
     "base_term_columns",
     "drive_terms",
@@ -135,8 +136,9 @@ class RotorInertia:
 #: of ``coulomb``), the Stribeck bump ``(fs - fc) s(v) exp(-(v / v_st)^2)`` (beside
 #: ``coulomb``) and the offset ``fo`` (:mod:`dynid.regressors.friction_columns`).
 FRICTION_PARTS = ("viscous", "quadratic", "coulomb", "smooth", "stribeck", "offset")
-_PART_LABEL = {"viscous": "fv", "quadratic": "fq", "coulomb": "fc", "smooth": "fc"}
-_PART_LABEL |= {"stribeck": "fsp", "offset": "fo"}
+#: The label of each part's coefficients (``fv3``: joint 3's viscous friction).
+PART_LABELS = {"viscous": "fv", "quadratic": "fq", "coulomb": "fc", "smooth": "fc"}
+PART_LABELS |= {"stribeck": "fsp", "offset": "fo"}
 _PART_UNIT = {p: "N m" for p in FRICTION_PARTS}
 _PART_UNIT |= {"viscous": "N m s/rad", "quadratic": "N m s^2/rad^2"}
 
@@ -162,6 +164,10 @@ class LinearFriction:
         The Stribeck velocity [rad/s], with ``stribeck``.
     name : str
         The term's name (``"friction"``; another for a second friction term of a model).
+    mask : tuple of bool
+        Which of the ``k n`` coefficients (motor by motor, the parts in order) the term
+        holds, when a motor (joint) holds fewer parts than ``parts``; empty: all. The
+        coefficients left out are 0 in :meth:`as_array`.
     """
 
     drive: Drive
@@ -171,6 +177,7 @@ class LinearFriction:
     vst: float = 0.0
     name: str = "friction"
     in_base: bool = False
+    mask: tuple[bool, ...] = ()
 
     def __post_init__(self) -> None:
         if not self.parts or any(p not in FRICTION_PARTS for p in self.parts):
@@ -189,7 +196,22 @@ class LinearFriction:
         if "stribeck" in self.parts and not self.vst > 0:
             raise OptionError(f"the Stribeck part needs a Stribeck velocity > 0; got {self.vst}")
         order = tuple(p for p in FRICTION_PARTS if p in self.parts)
+        if self.mask:
+            if len(self.mask) != len(self.parts) * self.drive.n:
+                raise OptionError(
+                    f"mask must have {len(self.parts) * self.drive.n} entries; got {len(self.mask)}"
+                )
+            grid = np.reshape(np.asarray(self.mask, dtype=bool), (self.drive.n, -1))
+            index = [self.parts.index(p) for p in order]  # the mask in the parts' order
+            object.__setattr__(self, "mask", tuple(bool(x) for x in grid[:, index].ravel()))
         object.__setattr__(self, "parts", order)
+
+    @property
+    def _held(self) -> NDArray[np.bool_]:
+        """(k n,): the coefficients held (:attr:`mask`, or all)."""
+        if self.mask:
+            return np.asarray(self.mask, dtype=bool)
+        return np.ones(len(self.parts) * self.drive.n, dtype=bool)
 
     @property
     def law(self) -> str:
@@ -208,38 +230,44 @@ class LinearFriction:
     @property
     def labels(self) -> tuple[str, ...]:
         """``fv1, fc1, fo1, fv2, ...`` (the parts held, per joint or motor)."""
-        return tuple(f"{_PART_LABEL[p]}{j + 1}" for j in range(self.drive.n) for p in self.parts)
+        every = [f"{PART_LABELS[p]}{j + 1}" for j in range(self.drive.n) for p in self.parts]
+        return tuple(lab for lab, h in zip(every, self._held, strict=True) if h)
 
     @property
     def units(self) -> tuple[str, ...]:
         """N m s/rad for ``fv``, N m for the others, per joint (motor)."""
-        return tuple(_PART_UNIT[p] for p in self.parts) * self.drive.n
+        every = tuple(_PART_UNIT[p] for p in self.parts) * self.drive.n
+        return tuple(u for u, h in zip(every, self._held, strict=True) if h)
 
     @property
     def nonnegative(self) -> NDArray[np.bool_]:
         """Every coefficient but the offset ``fo`` is ``>= 0``."""
-        return np.tile([p != "offset" for p in self.parts], self.drive.n)
+        return np.tile([p != "offset" for p in self.parts], self.drive.n)[self._held]
 
     @property
     def needs_motion(self) -> NDArray[np.intp]:
         """(p,): the motor (joint) whose motion each column needs, -1 for none (the offset)."""
         k = len(self.parts)
         j = np.repeat(np.arange(self.drive.n), k)
-        return np.where(np.tile([p != "offset" for p in self.parts], self.drive.n), j, -1)
+        every = np.where(np.tile([p != "offset" for p in self.parts], self.drive.n), j, -1)
+        return every[self._held]
 
     @property
     def steps(self) -> NDArray[np.bool_]:
         """(p,): the columns that step where the velocity reverses (Coulomb, smooth
         Coulomb, Stribeck), which a torque filtered at a cut-off sees rounded
         (:func:`~dynid.identification.classical.parallel_filtered`)."""
-        return np.tile([p in ("coulomb", "smooth", "stribeck") for p in self.parts], self.drive.n)
+        steps = np.tile([p in ("coulomb", "smooth", "stribeck") for p in self.parts], self.drive.n)
+        return steps[self._held]
 
     def as_array(self, params: NDArray[np.float64]) -> NDArray[np.float64]:
         """The coefficients (p,) as the parameters (n, k) of :attr:`law`: ``fv, fc, fo``
         (classical, smooth), ``fv, fq, fc, fo`` (quadratic) or ``fv, fc, fs, vst, fo``
         (Stribeck, ``fs = fc + fsp``); 0 for parts not held."""
         n, k = self.drive.n, len(self.parts)
-        c = dict(zip(self.parts, np.reshape(params, (n, k)).T, strict=True))
+        every = np.zeros(n * k)
+        every[self._held] = params
+        c = dict(zip(self.parts, np.reshape(every, (n, k)).T, strict=True))
         z = np.zeros(n)
         fc = c.get("coulomb", c.get("smooth", z))
         if self.law == "stribeck":
@@ -269,6 +297,8 @@ class LinearFriction:
         }
         for i, p in enumerate(self.parts):
             F[..., m, k * m + i] = col[p]()
+        if self.mask:
+            F = F[..., self._held]
         if self.drive.friction_at == "joint":
             return F
         return np.einsum("mj,...mc->...jc", self.drive.transmission, F)

@@ -252,8 +252,7 @@ def _consistent_structure_fit(
         )
     selection = None
     if terms == "auto":
-        chosen = identify_recordings(robot, logs, names, **kw)
-        selection = chosen.info.selection
+        selection = identify_recordings(robot, logs, names, **kw).info.selection
         chosen = Structure.parse(str((selection or {}).get("chosen", "")))
         terms = Structure(chosen.armature, classical, at=chosen.at)
     else:
