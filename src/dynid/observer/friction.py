@@ -15,6 +15,17 @@ friction transmission (the identity at the joints). The 13 columns per motor, in
 :func:`canonical_friction` maps a friction model to that form, or returns None for a law it
 does not know (a law added to the registry later): the observer's step then evaluates the
 model's own ``torques`` in Python.
+
+:func:`standstill_margin` bounds what such a model cannot know about its friction near rest:
+inside the standstill band the law's Coulomb term is off (or, for ``tanh(v / v_s)``, not yet
+at its level), while the true friction of a slow reversal or a standstill lies anywhere in
+``[-f_c, f_c]``. Its bound per motor is
+
+.. math:: w(v) = \\big(\\max(|f_{c+}|, |f_{c-}|) + |f_s - f_c|\\big) [|v| \\le b]
+          + |f_t| \\big(1 - \\tanh(|v| / v_s)\\big)
+
+(``b`` the band; the Stribeck bump is off inside it as well), ``|K_f|^T w(K_f dq)`` at the
+joints; 0 for the sigmoid law (no Coulomb level) and for laws without a canonical form.
 """
 
 from __future__ import annotations
@@ -30,7 +41,7 @@ from ..friction.model import (
     SigmoidFriction,
 )
 
-__all__ = ["FRICTION_COLUMNS", "canonical_friction"]
+__all__ = ["FRICTION_COLUMNS", "canonical_friction", "standstill_margin"]
 
 #: The canonical parameters per motor (module docstring).
 FRICTION_COLUMNS = (
@@ -92,3 +103,27 @@ def canonical_friction(
     else:
         return None
     return None if F is None else (K, F)
+
+
+def standstill_margin(
+    friction: FrictionModel | None, dq: NDArray[np.float64]
+) -> NDArray[np.float64]:
+    """Bound [N m] (..., n) of the friction the model cannot know at velocities ``dq``
+    [rad/s] (..., n): its Coulomb level where the law's Coulomb term is off or not at its
+    level (module docstring); zeros without friction or for a law without a canonical form.
+    """
+    v = np.asarray(dq, dtype=np.float64)
+    n = v.shape[-1]
+    canon = canonical_friction(friction, n)
+    if friction is None or canon is None:
+        return np.zeros_like(v)
+    K, F = canon
+    vm = v @ K.T  # motor velocities
+    level = np.maximum(np.abs(F[:, 2]), np.abs(F[:, 3])) + np.abs(F[:, 6])
+    w = np.where(np.abs(vm) <= F[:, 5], level, 0.0)
+    ft, vs = np.abs(F[:, 8]), F[:, 9]
+    with np.errstate(divide="ignore", invalid="ignore"):
+        x = np.where(vs > 0, np.abs(vm) / np.where(vs > 0, vs, 1.0), np.inf)
+    w = w + ft * np.where(vs > 0, 1.0 - np.tanh(x), np.where(vm == 0.0, 1.0, 0.0))
+    out: NDArray[np.float64] = w @ np.abs(K)
+    return out

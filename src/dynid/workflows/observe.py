@@ -11,7 +11,10 @@ the command applies, so that the Python API behaves as the command does.
   brought to the joint side through the model's drive.
 * ``calibrate``: the residuals of every (collision-free) log give the thresholds; with an
   identified model that has a covariance, they also grow with the model's uncertainty
-  (``uncertainty``, default on).
+  (``uncertainty``, default on); the standstill margin of the model's friction (its
+  Coulomb level where the law's Coulomb term is off, through the observer's lag) is left
+  out of the residuals they read and added to the thresholds (``standstill``, default on;
+  :mod:`dynid.observer.detection`).
 * Otherwise the thresholds (``thresholds.json``) fix the observer (gains, discretisation,
   rule) and the detection; the true external torques ``tau_ext1..n`` that
   ``dynid simulate --contact`` writes beside a log are kept for the figure.
@@ -36,7 +39,13 @@ from ..io.friction_json import load_friction_json
 from ..io.model_json import load_model_json
 from ..io.observer_files import load_thresholds
 from ..io.robot_file import load_robot
-from ..observer.detection import Thresholds, calibrate, detect, residual_std
+from ..observer.detection import (
+    Thresholds,
+    calibrate,
+    detect,
+    residual_std,
+    standstill_series,
+)
 from ..observer.model import ObserverModel, from_identified, from_robot
 from ..observer.residual import DEFAULT_GAIN, ObserverOptions, observe
 from ..observer.results import LogObservation, ObserveResult
@@ -81,6 +90,9 @@ class ObserveOptions:
     uncertainty : bool
         Let the thresholds grow with the model's uncertainty when the model has a
         covariance.
+    standstill : bool
+        When calibrating: add the standstill margin of the model's friction to the
+        thresholds (the thresholds keep the choice).
     merge_s : float
         Events closer than this [s] are one.
     columns : (str or None, str or None)
@@ -104,6 +116,7 @@ class ObserveOptions:
     collision_factor: float = 2.0
     k_sigma: float = 3.0
     uncertainty: bool = True
+    standstill: bool = True
     merge_s: float = 0.05
     columns: ColumnSpec = (None, None)
     drop_invalid: bool = False
@@ -177,12 +190,16 @@ def observe_files(opts: ObserveOptions) -> ObserveResult:
         if given is None
         else given.uses_uncertainty and model.covariance is not None
     )
-    logs = [_observe_log(p, model, recorded, opts, options, wants_std) for p in opts.data]
+    wants_margin = opts.standstill if given is None else given.standstill
+    logs = [
+        _observe_log(p, model, recorded, opts, options, wants_std, wants_margin) for p in opts.data
+    ]
     if given is None:
         th = calibrate(
             [x.r for x in logs],
             options,
             std=[x.std for x in logs] if wants_std else None,  # type: ignore[misc]
+            standstill=[x.standstill for x in logs] if wants_margin else None,  # type: ignore[misc]
             margin=opts.margin,
             quantile=opts.quantile,
             collision_factor=opts.collision_factor,
@@ -195,9 +212,10 @@ def observe_files(opts: ObserveOptions) -> ObserveResult:
             x.t,
             x.r,
             x.std,
-            detect(x.t, x.r, given, std=x.std, merge_s=opts.merge_s),
+            detect(x.t, x.r, given, std=x.std, standstill=x.standstill, merge_s=opts.merge_s),
             x.wrench,
             x.tau_ext,
+            x.standstill,
         )  # fmt: skip
         for x in logs
     )
@@ -211,6 +229,7 @@ def _observe_log(
     opts: ObserveOptions,
     options: ObserverOptions,
     wants_std: bool,
+    wants_margin: bool = False,
 ) -> LogObservation:
     """The residual (and its std, the wrench, the stored true torques) of one log."""
     path = Path(path)
@@ -237,6 +256,7 @@ def _observe_log(
     def run() -> LogObservation:
         res = observe(model, log.t, log.q, log.dq, log.tau, options)
         std = residual_std(model, log.t, log.q, log.dq, options) if wants_std else None
+        margin = standstill_series(model, log.t, log.dq, options) if wants_margin else None
         wrench = None
         if opts.frame is not None:
             wrench = external_wrench(model.robot, log.q, res.r, opts.frame)
@@ -245,6 +265,6 @@ def _observe_log(
             ext = load_joint_columns(path, "tau_ext", model.n)
             if ext is not None and ext.shape[0] != log.t.shape[0]:
                 ext = None  # rows were dropped: not aligned with the log
-        return LogObservation(path, log.t, np.asarray(res.r), std, [], wrench, ext)
+        return LogObservation(path, log.t, np.asarray(res.r), std, [], wrench, ext, margin)
 
     return in_file(path, run)
