@@ -89,6 +89,14 @@ def register(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParser:
     p.add_argument("--merge", type=nonnegative_type, default=0.05, help="join events [s]")
     add_column_options(p)
     add_drop_invalid(p)
+    p.add_argument(
+        "--max-gap",
+        type=positive_type,
+        default=None,
+        metavar="SECONDS",
+        help="longest step the observer integrates over [s]; the log is cut at longer "
+        "ones and the observer starts again (default: 2.5 median steps, at least 0.02 s)",
+    )
     p.add_argument("--no-figures", action="store_true", help="skip the PNG figures")
     p.add_argument("--out", type=output_path, required=True, help="output directory")
     return p
@@ -108,6 +116,7 @@ def run(args: argparse.Namespace, console: Console) -> int:
         uncertainty=not args.no_uncertainty, standstill=not args.no_standstill_margin,
         merge_s=args.merge,
         columns=(args.columns, args.units), drop_invalid=args.drop_invalid,
+        max_gap=args.max_gap,
     )  # fmt: skip
     result = observe_files(opts)
     names = list(result.model.robot.joint_names)

@@ -348,6 +348,7 @@ def detect(
     std: ArrayLike | None = None,
     standstill: ArrayLike | None = None,
     merge_s: float = 0.05,
+    restarts: ArrayLike | None = None,
 ) -> list[ContactEvent]:
     """Contact events of a residual (module docstring).
 
@@ -364,6 +365,9 @@ def detect(
         :func:`standstill_series` of the samples (for thresholds that use it).
     merge_s : float
         Runs over the threshold closer than this [s] are one event (>= 0).
+    restarts : array_like of int, optional
+        Samples where the observer started again (the first of each piece of a log cut
+        at its gaps): no event spans one.
 
     Returns
     -------
@@ -387,7 +391,11 @@ def detect(
     hit = np.flatnonzero(over.any(axis=1))
     if hit.size == 0:
         return []
-    cut = np.flatnonzero(ta[hit[1:]] - ta[hit[:-1]] > merge_s) + 1
+    split = ta[hit[1:]] - ta[hit[:-1]] > merge_s
+    if restarts is not None:
+        piece = np.searchsorted(np.asarray(restarts, dtype=np.int64), hit, side="right")
+        split |= piece[1:] != piece[:-1]
+    cut = np.flatnonzero(split) + 1
     events = []
     for run in np.split(hit, cut):
         a, b = int(run[0]), int(run[-1]) + 1

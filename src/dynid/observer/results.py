@@ -40,6 +40,8 @@ class LogObservation:
     standstill : ndarray, shape (N, n), or None
         The lagged standstill margin of the model's friction
         (:func:`~dynid.observer.detection.standstill_series`), when the thresholds use it.
+    restarts : tuple of int
+        First sample of each piece the observer ran on (the log cut at its gaps).
     """
 
     path: Path
@@ -50,6 +52,7 @@ class LogObservation:
     wrench: WrenchEstimate | None
     tau_ext: NDArray[np.float64] | None
     standstill: NDArray[np.float64] | None = None
+    restarts: tuple[int, ...] = (0,)
 
 
 @dataclass(frozen=True, slots=True, eq=False)

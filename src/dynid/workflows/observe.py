@@ -8,7 +8,12 @@ the command applies, so that the Python API behaves as the command does.
   chose, with its standstill band).
 * Logs are read strictly with the model's joint count (extra columns ignored, with a
   warning), through the column map the model's data were read with when none is given, and
-  brought to the joint side through the model's drive.
+  brought to the joint side through the model's drive. A log is cut at its gaps (steps
+  longer than ``max_gap``, default :func:`~dynid.identification.log.default_max_gap`, as
+  ``identify`` cuts) and after rows dropped for NaN or inf (``drop_invalid``; refused
+  otherwise, the row named): the observer starts again on each piece and no event spans a
+  cut (one warning names the file and the times); a position that jumps more than its
+  velocity explains is warned about (:mod:`dynid.observer.pieces`).
 * ``calibrate``: the residuals of every (collision-free) log give the thresholds; with an
   identified model that has a covariance, they also grow with the model's uncertainty
   (``uncertainty``, default on); the standstill margin of the model's friction (its
@@ -31,7 +36,7 @@ import numpy as np
 
 from ..exceptions import DynidWarning, OptionError
 from ..friction.model import FrictionModel
-from ..identification.log import joint_side_log, with_derived_velocities
+from ..identification.log import TorqueLog, default_max_gap, joint_side_log, with_derived_velocities
 from ..identification.recordings import unwrapped
 from ..io.columns import load_joint_columns
 from ..io.feasible import load_feasible_drive, load_feasible_linear_friction
@@ -47,6 +52,7 @@ from ..observer.detection import (
     standstill_series,
 )
 from ..observer.model import ObserverModel, from_identified, from_robot
+from ..observer.pieces import pieces, position_jumps
 from ..observer.residual import DEFAULT_GAIN, ObserverOptions, observe
 from ..observer.results import LogObservation, ObserveResult
 from ..observer.wrench import external_wrench
@@ -98,7 +104,10 @@ class ObserveOptions:
     columns : (str or None, str or None)
         ``--columns``/``--units``; default: those the model's data were read with.
     drop_invalid : bool
-        Drop rows with NaN/inf or a repeated timestamp instead of failing.
+        Drop rows with NaN/inf or a repeated timestamp instead of failing (the observer
+        starts again after rows dropped for NaN/inf).
+    max_gap : float, optional
+        Longest step [s] the observer integrates over; the log is cut at longer ones.
     """
 
     data: tuple[Path, ...]
@@ -120,6 +129,7 @@ class ObserveOptions:
     merge_s: float = 0.05
     columns: ColumnSpec = (None, None)
     drop_invalid: bool = False
+    max_gap: float | None = None
 
 
 def load_observer_model(
@@ -212,10 +222,19 @@ def observe_files(opts: ObserveOptions) -> ObserveResult:
             x.t,
             x.r,
             x.std,
-            detect(x.t, x.r, given, std=x.std, standstill=x.standstill, merge_s=opts.merge_s),
+            detect(
+                x.t,
+                x.r,
+                given,
+                std=x.std,
+                standstill=x.standstill,
+                merge_s=opts.merge_s,
+                restarts=x.restarts,
+            ),
             x.wrench,
             x.tau_ext,
             x.standstill,
+            x.restarts,
         )  # fmt: skip
         for x in logs
     )
@@ -253,18 +272,65 @@ def _observe_log(
         if log.dq_derived:
             log = with_derived_velocities(log)
 
+    starts = _pieces(path, log, opts)
+
     def run() -> LogObservation:
-        res = observe(model, log.t, log.q, log.dq, log.tau, options)
-        std = residual_std(model, log.t, log.q, log.dq, options) if wants_std else None
-        margin = standstill_series(model, log.t, log.dq, options) if wants_margin else None
+        t, q, dq, tau, n = log.t, log.q, log.dq, log.tau, model.n
+        r = np.empty((t.shape[0], n))
+        std = np.empty_like(r) if wants_std else None
+        margin = np.empty_like(r) if wants_margin else None
+        for a, b in zip(starts, [*starts[1:], t.shape[0]], strict=True):
+            r[a:b] = observe(model, t[a:b], q[a:b], dq[a:b], tau[a:b], options).r
+            if std is not None:
+                std[a:b] = residual_std(model, t[a:b], q[a:b], dq[a:b], options)
+            if margin is not None:
+                margin[a:b] = standstill_series(model, t[a:b], dq[a:b], options)
         wrench = None
         if opts.frame is not None:
-            wrench = external_wrench(model.robot, log.q, res.r, opts.frame)
+            wrench = external_wrench(model.robot, log.q, r, opts.frame)
         ext = None
         if path.suffix.lower() in (".csv", ".npz") and names is None:
             ext = load_joint_columns(path, "tau_ext", model.n)
             if ext is not None and ext.shape[0] != log.t.shape[0]:
                 ext = None  # rows were dropped: not aligned with the log
-        return LogObservation(path, log.t, np.asarray(res.r), std, [], wrench, ext, margin)
+        return LogObservation(
+            path, log.t, r, std, [], wrench, ext, margin, tuple(int(k) for k in starts)
+        )
 
     return in_file(path, run)
+
+
+def _pieces(path: Path, log: TorqueLog, opts: ObserveOptions) -> list[int]:
+    """First sample of each piece the observer runs on (module docstring), with the
+    warnings: the cuts (file and times) and the positions that jump."""
+    c = log.cleaning
+    dt = np.diff(log.t)
+    limit = opts.max_gap
+    if limit is None:
+        limit = default_max_gap(float(np.median(dt)) if dt.size else 1.0)
+    starts = [int(k) for k in pieces(log.t, limit, c.invalid_after)]
+    if len(starts) > 1:
+        at = ", ".join(f"{log.t[k]:.6g}" for k in starts[1:6])
+        more = f" and {len(starts) - 6} more" if len(starts) > 6 else ""
+        why = f"gaps longer than {limit:.3g} s" + (
+            f" or after {c.n_nan_rows} row(s) dropped for NaN/inf" if c.invalid_after else ""
+        )
+        warnings.warn(
+            f"{path.name}: cut at {why}: the observer starts again at t = {at}{more} s "
+            "(no event spans a cut)",
+            DynidWarning,
+            stacklevel=4,
+        )
+    jumps = position_jumps(log.t, log.q, log.dq, starts)
+    if jumps:
+        listed = ", ".join(
+            f"joint {x.joint + 1} by {x.size:+.3g} at t = {x.t:.6g} s" for x in jumps[:3]
+        )
+        more = f" and {len(jumps) - 3} more" if len(jumps) > 3 else ""
+        warnings.warn(
+            f"{path.name}: position jumps more than the recorded velocity explains "
+            f"({listed}{more}): the residual after a jump is not to be trusted",
+            DynidWarning,
+            stacklevel=4,
+        )
+    return starts
