@@ -59,9 +59,9 @@ __all__ = [
     "observer_batch",
 ]
 
-#: columns of a motor's canonical friction parameters (the 13 of
+#: columns of a motor's canonical friction parameters (the 14 of
 #: :mod:`dynid.observer.friction` and the sigmoid's value at rest)
-FRICTION_WIDTH = 14
+FRICTION_WIDTH = 15
 
 
 @inline
@@ -174,8 +174,9 @@ def _law(F, m, v):
         else:
             f += ft * (1.0 if v > 0.0 else (-1.0 if v < 0.0 else 0.0))
     s1, s2, s3 = F[m, 10], F[m, 11], F[m, 12]
-    if s1 != 0.0:  # column 13: the logistic at rest, sigma(phi2 phi3), made once
-        f += s1 * (1.0 / (1.0 + math.exp(-s2 * (v + s3))) - F[m, 13])
+    if s1 != 0.0:  # column 14: the logistic at rest, sigma(phi2 phi3), made once
+        f += s1 * (1.0 / (1.0 + math.exp(-s2 * (v + s3))) - F[m, 14])
+    f += F[m, 13] * v * abs(v)  # quadratic viscous
     return f
 
 

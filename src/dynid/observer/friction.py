@@ -5,12 +5,12 @@ Every law of the registry (:mod:`dynid.friction.laws`) is a special case of, per
 .. math:: f(v) = f_{v+} v^+ + f_{v-} v^- + f_{c+} [s > 0] - f_{c-} [s < 0] + f_o
           + \\Delta_s e^{-(v / v_{st})^2} s + f_t \\tanh(v / v_s)
           + \\varphi_1 \\big(\\sigma(\\varphi_2 (v + \\varphi_3))
-          - \\sigma(\\varphi_2 \\varphi_3)\\big)
+          - \\sigma(\\varphi_2 \\varphi_3)\\big) + f_q v |v|
 
 with ``s`` the sign outside the standstill band (:func:`~dynid.friction.model.coulomb_sign`)
 and ``sigma`` the logistic function; ``tau_f = K_f^T f(K_f dq)`` with ``K_f`` the drive's
-friction transmission (the identity at the joints). The 13 columns per motor, in order:
-``fv+, fv-, fc+, fc-, fo, band, fs - fc, vst, ft, vs, phi1, phi2, phi3``.
+friction transmission (the identity at the joints). The 14 columns per motor, in order:
+``fv+, fv-, fc+, fc-, fo, band, fs - fc, vst, ft, vs, phi1, phi2, phi3, fq``.
 
 :func:`canonical_friction` maps a friction model to that form, or returns None for a law it
 does not know (a law added to the registry later): the observer's step then evaluates the
@@ -46,12 +46,12 @@ __all__ = ["FRICTION_COLUMNS", "canonical_friction", "standstill_margin"]
 #: The canonical parameters per motor (module docstring).
 FRICTION_COLUMNS = (
     "fv_pos", "fv_neg", "fc_pos", "fc_neg", "fo", "band", "fs_minus_fc", "vst", "ft", "vs",
-    "phi1", "phi2", "phi3",
+    "phi1", "phi2", "phi3", "fq",
 )  # fmt: skip
 
 
 def _law_rows(kind: str, P: NDArray[np.float64], band: NDArray[np.float64]) -> NDArray | None:
-    """The canonical rows (n, 13) of a registry law's parameters (n, k), or None."""
+    """The canonical rows (n, 14) of a registry law's parameters (n, k), or None."""
     n = P.shape[0]
     F = np.zeros((n, len(FRICTION_COLUMNS)))
     F[:, 5] = band
@@ -73,6 +73,12 @@ def _law_rows(kind: str, P: NDArray[np.float64], band: NDArray[np.float64]) -> N
             F[:, 6] = P[:, 2] - fc
             F[:, 7] = P[:, 3]
         return F
+    if kind == "quadratic":  # fv, fq, fc, fo
+        F[:, 0] = F[:, 1] = P[:, 0]
+        F[:, 13] = P[:, 1]
+        F[:, 2] = F[:, 3] = P[:, 2]
+        F[:, 4] = P[:, 3]
+        return F
     if kind == "asymmetric":  # fv+, fv-, fc+, fc-
         F[:, :4] = P[:, :4]
         return F
@@ -85,7 +91,7 @@ def _law_rows(kind: str, P: NDArray[np.float64], band: NDArray[np.float64]) -> N
 def canonical_friction(
     friction: FrictionModel | None, n: int
 ) -> tuple[NDArray[np.float64], NDArray[np.float64]] | None:
-    """``(K_f, F)``: the friction transmission (n, n) and the canonical parameters (n, 13)
+    """``(K_f, F)``: the friction transmission (n, n) and the canonical parameters (n, 14)
     of ``friction`` (zeros for None), or None for a law without a canonical form."""
     K = np.eye(n)
     if friction is None:
