@@ -65,6 +65,8 @@ def register(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParser:
     src = p.add_mutually_exclusive_group(required=True)
     src.add_argument("--model", type=Path, help="identification.json of an identified model")
     src.add_argument("--params", help="a robot: feasible.json, a .urdf or .toml, or a name")
+    p.add_argument("--base", help="--params URDF: base link of the chain (default: the root)")
+    p.add_argument("--tip", help="--params URDF: tip link of the chain (default: the only leaf)")
     p.add_argument("--friction", type=Path, help="friction.json replacing the model's friction")
     p.add_argument("--data", type=Path, nargs="+", required=True, help="torque log(s)")
     mode = p.add_mutually_exclusive_group(required=True)
@@ -116,7 +118,7 @@ def run(args: argparse.Namespace, console: Console) -> int:
         uncertainty=not args.no_uncertainty, standstill=not args.no_standstill_margin,
         merge_s=args.merge,
         columns=(args.columns, args.units), drop_invalid=args.drop_invalid,
-        max_gap=args.max_gap,
+        max_gap=args.max_gap, base=args.base, tip=args.tip,
     )  # fmt: skip
     result = observe_files(opts)
     names = list(result.model.robot.joint_names)

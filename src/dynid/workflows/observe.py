@@ -108,6 +108,9 @@ class ObserveOptions:
         starts again after rows dropped for NaN/inf).
     max_gap : float, optional
         Longest step [s] the observer integrates over; the log is cut at longer ones.
+    base, tip : str, optional
+        The chain of a ``params`` URDF with several leaves (its root and only leaf by
+        default).
     """
 
     data: tuple[Path, ...]
@@ -130,30 +133,44 @@ class ObserveOptions:
     columns: ColumnSpec = (None, None)
     drop_invalid: bool = False
     max_gap: float | None = None
+    base: str | None = None
+    tip: str | None = None
 
 
 def load_observer_model(
-    model: Path | None, params: str | Path | None, friction: Path | None = None
+    model: Path | None,
+    params: str | Path | None,
+    friction: Path | None = None,
+    *,
+    base: str | None = None,
+    tip: str | None = None,
 ) -> tuple[ObserverModel, Mapping[str, str | None] | None]:
     """The observer model of ``--model`` or ``--params`` (and ``--friction``), with the
-    column map the model's data were read with (None for a robot).
+    column map the model's data were read with (None for a robot); ``base`` and ``tip``
+    choose the chain of a ``params`` URDF.
 
     Raises
     ------
     OptionError
-        Neither or both of ``model`` and ``params``.
+        Neither or both of ``model`` and ``params``; ``base`` or ``tip`` with another
+        model than a URDF.
     DataError
         A file that is not what it should be (named).
     """
     if (model is None) == (params is None):
         raise OptionError("give one of --model identification.json and --params ROBOT")
+    if (base is not None or tip is not None) and not str(params).lower().endswith(".urdf"):
+        given = "--model" if model is not None else f"--params {params}"
+        raise OptionError(
+            f"--base/--tip choose the chain of a --params URDF; {given} holds its own chain"
+        )
     fr: FrictionModel | None | str
     fr = "model" if friction is None else load_friction_json(friction)
     if model is not None:
         ident = load_model_json(model)
         return from_identified(ident, fr), ident.info.column_map
     spec = str(params)
-    robot = load_robot(spec, what="--params")
+    robot = load_robot(spec, base=base, tip=tip, what="--params")
     drive = None
     if spec.lower().endswith(".json"):
         drive = load_feasible_drive(spec)
@@ -188,7 +205,9 @@ def observe_files(opts: ObserveOptions) -> ObserveResult:
         raise OptionError("give one or more --data logs")
     if opts.calibrate == (opts.thresholds is not None):
         raise OptionError("give --calibrate (collision-free logs) or --thresholds thresholds.json")
-    model, recorded = load_observer_model(opts.model, opts.params, opts.friction)
+    model, recorded = load_observer_model(
+        opts.model, opts.params, opts.friction, base=opts.base, tip=opts.tip
+    )
     given = None if opts.thresholds is None else load_thresholds(opts.thresholds)
     if given is not None and given.n != model.n:
         raise OptionError(
