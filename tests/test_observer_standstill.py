@@ -96,3 +96,17 @@ def test_no_event_at_slow_reversals_and_a_push_within_the_delay_bound(case):
     delay = events[0].start - free.t[k0]
     low, high = (np.log(A / (A - theta + s * e)) / K for s in (1, -1))
     assert low - 1e-3 <= delay <= high + 1e-3
+
+
+def test_the_lag_is_the_closed_form_step_response_at_any_sample_times():
+    """A step of A (rectangle rule: held over each step at its new value) from sample k0
+    on: A (1 - exp(-K (t - t_{k0-1}))) per joint gain, on jittered sample times."""
+    rng = np.random.default_rng(4)
+    t = np.cumsum(rng.uniform(0.5e-3, 1.5e-3, 3000))
+    x = np.zeros((3000, 2))
+    x[1000:] = [2.0, -3.0]
+    gains = np.array([20.0, 60.0])
+    y = first_order_lag(t, x, gains, "rectangle")
+    expected = np.zeros_like(x)
+    expected[1000:] = [2.0, -3.0] * -np.expm1(-gains * (t[1000:, None] - t[999]))
+    np.testing.assert_allclose(y, expected, rtol=0, atol=1e-12)

@@ -53,6 +53,7 @@ from .layout import C_AXIS, C_PHI, C_PRISMATIC
 __all__ = [
     "BLOCK",
     "FRICTION_WIDTH",
+    "first_order_lag",
     "momentum_terms",
     "momentum_terms_one",
     "observer_step",
@@ -234,6 +235,24 @@ def _update(D, n, S, t, p, u, po, uo, r, ro):
         r[ro + j] = rj
     S[1] = t
     return True
+
+
+@jit
+def first_order_lag(t, x, K, trapezoid, out):
+    """``x`` (N, n) at the times ``t`` (N,) through ``K/(s + K)`` (``K`` (n,) [1/s]) from 0
+    into ``out`` (N, n): exact for ``x`` held over each step at its new value or, with
+    ``trapezoid``, at the mean of both ends (:func:`dynid.observer.residual.first_order_lag`)."""
+    N, n = x.shape
+    if N == 0:
+        return
+    for j in range(n):
+        out[0, j] = 0.0
+    for k in range(1, N):
+        T = t[k] - t[k - 1]
+        for j in range(n):
+            a = -math.expm1(-K[j] * T)
+            xk = 0.5 * (x[k, j] + x[k - 1, j]) if trapezoid else x[k, j]
+            out[k, j] = out[k - 1, j] + a * (xk - out[k - 1, j])
 
 
 @jit

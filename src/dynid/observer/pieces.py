@@ -71,16 +71,19 @@ def position_jumps(
     qa, dqa = _checks.as_array("q", q), _checks.as_array("dq", dq)
     if N < 3:
         return []
-    d = np.diff(qa, axis=0) - 0.5 * np.diff(ta)[:, None] * (dqa[1:] + dqa[:-1])
+    half = 0.5 * np.diff(ta)
     across = np.asarray(starts, dtype=np.int64) - 1
-    d[across[across >= 0]] = 0.0  # no step across a cut
-    mad = np.median(np.abs(d - np.median(d, axis=0)), axis=0)
-    limit = np.maximum(JUMP_FACTOR * 1.4826 * mad, JUMP_FLOOR)
-    out = []
+    across = across[across >= 0]
     bounds = np.concatenate([np.asarray(starts, dtype=np.int64), [N]])
-    for a, b in zip(bounds[:-1], bounds[1:], strict=True):
-        seg = np.abs(d[a : b - 1])
-        for j in np.flatnonzero(np.any(seg > limit, axis=0)):
-            k = int(np.argmax(seg[:, j]))
-            out.append(PositionJump(float(ta[a + k + 1]), int(j), float(d[a + k, j])))
+    out = []
+    for j in range(qa.shape[1]):  # one joint at a time: a few (N,) arrays on long logs
+        d = np.diff(qa[:, j]) - half * (dqa[1:, j] + dqa[:-1, j])
+        d[across] = 0.0  # no step across a cut
+        mad = np.median(np.abs(d - np.median(d)))
+        limit = max(JUMP_FACTOR * 1.4826 * float(mad), JUMP_FLOOR)
+        for a, b in zip(bounds[:-1], bounds[1:], strict=True):
+            seg = np.abs(d[a : b - 1])
+            if seg.size and seg.max() > limit:
+                k = int(np.argmax(seg))
+                out.append(PositionJump(float(ta[a + k + 1]), j, float(d[a + k])))
     return sorted(out, key=lambda x: (x.t, x.joint))
