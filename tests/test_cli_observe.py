@@ -110,3 +110,52 @@ def test_observe_refuses_thresholds_of_another_joint_count(logs, capsys):
     args = ["observe", "--params", "panda", "--thresholds", str(d / "six.json")]
     assert main([*args, "--data", str(d / "hit.csv"), "--out", str(d / "bad")]) == 2
     assert "thresholds for 6 joints" in capsys.readouterr().err
+
+
+TWO_LEAVES = """<robot name="two_leaves">
+  <link name="world"/>
+  <link name="upper"><inertial><origin xyz="0 0 0.15"/><mass value="2.0"/>
+    <inertia ixx="0.02" ixy="0" ixz="0" iyy="0.02" iyz="0" izz="0.004"/></inertial></link>
+  <link name="lower"><inertial><origin xyz="0.1 0 0"/><mass value="1.0"/>
+    <inertia ixx="0.002" ixy="0" ixz="0" iyy="0.01" iyz="0" izz="0.01"/></inertial></link>
+  <link name="camera"><inertial><mass value="0.3"/>
+    <inertia ixx="0.001" ixy="0" ixz="0" iyy="0.001" iyz="0" izz="0.001"/></inertial></link>
+  <joint name="shoulder" type="revolute"><parent link="world"/><child link="upper"/>
+    <axis xyz="0 0 1"/><limit lower="-3" upper="3" effort="50" velocity="3"/></joint>
+  <joint name="elbow" type="revolute"><parent link="upper"/><child link="lower"/>
+    <origin xyz="0 0 0.3"/><axis xyz="0 1 0"/>
+    <limit lower="-2" upper="2" effort="30" velocity="3"/></joint>
+  <joint name="pan" type="revolute"><parent link="world"/><child link="camera"/>
+    <origin xyz="0.2 0 0.05"/><axis xyz="0 0 1"/>
+    <limit lower="-3" upper="3" effort="5" velocity="3"/></joint>
+</robot>
+"""
+
+
+def test_observe_params_urdf_with_two_leaves_takes_the_chain_of_tip(tmp_path, capsys):
+    """--params URDF with two leaves: refused naming --tip without it; with --tip the
+    chain's two joints (a log of that chain calibrates, a push on it is found); --tip with
+    --model or a built-in robot is refused in one line."""
+    urdf = tmp_path / "two.urdf"
+    urdf.write_text(TWO_LEAVES)
+    sim = ["simulate", "--robot", str(urdf), "--tip", "lower", "--trajectory", "fourier", "-q"]
+    sim += ["--duration", "4", "--no-friction"]
+    assert main([*sim, "--seed", "1", "--out", str(tmp_path / "free.csv")]) == 0
+    hit = ["--contact", "lower:0,0,0,0,0,5:2,2.3"]  # 5 N m about the shoulder
+    assert main([*sim, "--seed", "2", *hit, "--out", str(tmp_path / "hit.csv")]) == 0
+    obs = ["observe", "--params", str(urdf), "-q", "--no-figures"]
+    cal = [*obs, "--data", str(tmp_path / "free.csv"), "--calibrate"]
+    assert main([*cal, "--out", str(tmp_path / "c0")]) != 0
+    err = capsys.readouterr().err
+    assert "several leaf links" in err and "--tip" in err
+    assert main([*cal, "--tip", "lower", "--out", str(tmp_path / "cal")]) == 0
+    assert load_thresholds(tmp_path / "cal" / "thresholds.json").n == 2
+    th = ["--thresholds", str(tmp_path / "cal" / "thresholds.json"), "--tip", "lower"]
+    assert main([*obs, *th, "--data", str(tmp_path / "hit.csv"), "--out", str(tmp_path / "o")]) == 0
+    events = json.loads((tmp_path / "o" / "events.json").read_text())["events"]
+    assert len(events) == 1 and 2.0 <= events[0]["start"] < 2.1
+    capsys.readouterr()
+    other = ["observe", "--params", "panda", "--tip", "link7", *cal[4:]]
+    assert main([*other, "--out", str(tmp_path / "c1")]) != 0
+    (line,) = capsys.readouterr().err.strip().splitlines()
+    assert "--base/--tip choose the chain of a --params URDF" in line

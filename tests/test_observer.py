@@ -192,14 +192,22 @@ def test_euler_rectangle_is_de_lucas_integral_form():
     np.testing.assert_allclose(r, ref, rtol=0, atol=1e-9)
 
 
-#: Laws the compiled step does not hold (the quadratic viscous term): evaluated in Python.
-PYTHON_LAWS = {"quadratic"}
+class _CubicLaw:
+    """A law outside the registry (no canonical form): ``tau_f = fk dq^3``."""
+
+    name, params, units, formula = "cubic", ("fk",), ("N m s^3/rad^3",), "fk dq^3"
+
+    @staticmethod
+    def torques(dq, P, band):
+        return P[:, 0] * np.asarray(dq) ** 3
 
 
 def test_a_law_without_a_canonical_form_is_evaluated_in_python():
-    """The quadratic law has no canonical form: the observer subtracts its own torques."""
-    law = LAWS["quadratic"]
-    model = law.model(np.array([[0.3, 0.2, 0.8, 0.1]] * 3), np.zeros(3))
+    """A law the canonical form does not know: the observer subtracts its own torques, and
+    its residual equals that of the same torques subtracted from the measured ones first."""
+    from dynid.friction.model import LawFriction
+
+    model = LawFriction(_CubicLaw(), np.array([[0.3], [0.2], [0.8]]), np.zeros(3))
     assert canonical_friction(model, 3) is None
     robot = dynid.Robot.from_mdh(
         a=[0, 0.3, 0.3], d=[0.3, 0, 0], alpha=[0, np.pi / 2, 0], theta=[0, 0, 0],
@@ -207,9 +215,15 @@ def test_a_law_without_a_canonical_form_is_evaluated_in_python():
     )  # fmt: skip
     obs = MomentumObserver(ObserverModel(robot, np.zeros((3, 3)), model))
     assert obs._python_friction
+    rng = np.random.default_rng(3)
+    t = np.arange(50) * 1e-3
+    q, dq, tau = rng.normal(size=(3, 50, 3))
+    bare = MomentumObserver(ObserverModel(robot, np.zeros((3, 3)), None))
+    expected = bare.run(t, q, dq, tau - model.torques(dq))
+    np.testing.assert_allclose(obs.run(t, q, dq, tau), expected, rtol=0, atol=1e-12)
 
 
-@pytest.mark.parametrize("name", sorted(set(LAWS) - PYTHON_LAWS))
+@pytest.mark.parametrize("name", sorted(LAWS))
 def test_every_friction_law_has_a_canonical_form_equal_to_its_torques(name):
     """The compiled step's canonical friction equals each law's own torques, with a band,
     and through a coupled drive at the motors."""
@@ -237,7 +251,7 @@ def test_every_friction_law_has_a_canonical_form_equal_to_its_torques(name):
                 obs.reset()
                 obs.step(q, dq[k], np.zeros(3), 0.0)
                 f[k] = -obs._S[2 + 3 : 2 + 6] - momentum_terms(robot, q, dq[k])[1]
-            np.testing.assert_allclose(f, fr.torques(dq), rtol=0, atol=1e-12)
+            np.testing.assert_allclose(f, fr.torques(dq), rtol=1e-15, atol=1e-12)
 
 
 # ---------------------------------------------------------------------- detection

@@ -53,15 +53,16 @@ from .layout import C_AXIS, C_PHI, C_PRISMATIC
 __all__ = [
     "BLOCK",
     "FRICTION_WIDTH",
+    "first_order_lag",
     "momentum_terms",
     "momentum_terms_one",
     "observer_step",
     "observer_batch",
 ]
 
-#: columns of a motor's canonical friction parameters (the 13 of
+#: columns of a motor's canonical friction parameters (the 14 of
 #: :mod:`dynid.observer.friction` and the sigmoid's value at rest)
-FRICTION_WIDTH = 14
+FRICTION_WIDTH = 15
 
 
 @inline
@@ -174,8 +175,9 @@ def _law(F, m, v):
         else:
             f += ft * (1.0 if v > 0.0 else (-1.0 if v < 0.0 else 0.0))
     s1, s2, s3 = F[m, 10], F[m, 11], F[m, 12]
-    if s1 != 0.0:  # column 13: the logistic at rest, sigma(phi2 phi3), made once
-        f += s1 * (1.0 / (1.0 + math.exp(-s2 * (v + s3))) - F[m, 13])
+    if s1 != 0.0:  # column 14: the logistic at rest, sigma(phi2 phi3), made once
+        f += s1 * (1.0 / (1.0 + math.exp(-s2 * (v + s3))) - F[m, 14])
+    f += F[m, 13] * v * abs(v)  # quadratic viscous
     return f
 
 
@@ -233,6 +235,24 @@ def _update(D, n, S, t, p, u, po, uo, r, ro):
         r[ro + j] = rj
     S[1] = t
     return True
+
+
+@jit
+def first_order_lag(t, x, K, trapezoid, out):
+    """``x`` (N, n) at the times ``t`` (N,) through ``K/(s + K)`` (``K`` (n,) [1/s]) from 0
+    into ``out`` (N, n): exact for ``x`` held over each step at its new value or, with
+    ``trapezoid``, at the mean of both ends (:func:`dynid.observer.residual.first_order_lag`)."""
+    N, n = x.shape
+    if N == 0:
+        return
+    for j in range(n):
+        out[0, j] = 0.0
+    for k in range(1, N):
+        T = t[k] - t[k - 1]
+        for j in range(n):
+            a = -math.expm1(-K[j] * T)
+            xk = 0.5 * (x[k, j] + x[k - 1, j]) if trapezoid else x[k, j]
+            out[k, j] = out[k - 1, j] + a * (xk - out[k - 1, j])
 
 
 @jit

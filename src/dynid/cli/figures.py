@@ -130,7 +130,7 @@ def save_observer_figures(out: Path, result: ObserveResult, *, names: list[str])
     external torques stored beside a simulated log (those skipped are left out)."""
     paths = []
     for x, stem in zip(result.logs, observation_names(result.logs), strict=True):
-        contact, collision = threshold_series(result.thresholds, x.t.shape[0], x.std)
+        contact, collision = threshold_series(result.thresholds, x.t.shape[0], x.std, x.standstill)
 
         def draw(x: Any = x, c: Any = contact, k: Any = collision) -> Any:
             return observer_plots.plot_residuals(

@@ -13,7 +13,11 @@ Two steps:
   |r| of the logs (--quantile) times --margin for contact and --collision-factor times
   that for collision; with an identified model's covariance the thresholds also grow with
   the model's uncertainty (k sigma + noise, sigma the covariance of the base parameters
-  propagated through the momentum regressor; --no-uncertainty turns it off). --gain,
+  propagated through the momentum regressor; --no-uncertainty turns it off). Inside a
+  friction law's standstill band the model's Coulomb term is off while the true friction
+  of a slow reversal lies anywhere within its Coulomb level: that level, through the
+  observer's lag, is left out of the calibration and added to the thresholds (the
+  standstill margin; --no-standstill-margin turns it off). --gain,
   --discretisation and --rule choose the observer, which the thresholds keep.
   --thresholds thresholds.json on any logs writes OUT/events.json (dynid-events/1: start
   and end [s], joints (1-based), peak [N m] per joint and level, contact or collision, of
@@ -61,6 +65,8 @@ def register(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParser:
     src = p.add_mutually_exclusive_group(required=True)
     src.add_argument("--model", type=Path, help="identification.json of an identified model")
     src.add_argument("--params", help="a robot: feasible.json, a .urdf or .toml, or a name")
+    p.add_argument("--base", help="--params URDF: base link of the chain (default: the root)")
+    p.add_argument("--tip", help="--params URDF: tip link of the chain (default: the only leaf)")
     p.add_argument("--friction", type=Path, help="friction.json replacing the model's friction")
     p.add_argument("--data", type=Path, nargs="+", required=True, help="torque log(s)")
     mode = p.add_mutually_exclusive_group(required=True)
@@ -77,9 +83,22 @@ def register(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParser:
     p.add_argument("--collision-factor", type=positive_type, default=2.0, help="(default 2)")
     p.add_argument("--k-sigma", type=positive_type, default=3.0, help="uncertainty k (3)")
     p.add_argument("--no-uncertainty", action="store_true", help="fixed thresholds only")
+    p.add_argument(
+        "--no-standstill-margin",
+        action="store_true",
+        help="calibrating: no margin for the friction inside the standstill band",
+    )
     p.add_argument("--merge", type=nonnegative_type, default=0.05, help="join events [s]")
     add_column_options(p)
     add_drop_invalid(p)
+    p.add_argument(
+        "--max-gap",
+        type=positive_type,
+        default=None,
+        metavar="SECONDS",
+        help="longest step the observer integrates over [s]; the log is cut at longer "
+        "ones and the observer starts again (default: 2.5 median steps, at least 0.02 s)",
+    )
     p.add_argument("--no-figures", action="store_true", help="skip the PNG figures")
     p.add_argument("--out", type=output_path, required=True, help="output directory")
     return p
@@ -96,8 +115,10 @@ def run(args: argparse.Namespace, console: Console) -> int:
         gain=float(gain[0]) if gain.size == 1 else tuple(gain), discretisation=args.discretisation,
         rule=args.rule, margin=args.margin, quantile=args.quantile,
         collision_factor=args.collision_factor, k_sigma=args.k_sigma,
-        uncertainty=not args.no_uncertainty, merge_s=args.merge,
+        uncertainty=not args.no_uncertainty, standstill=not args.no_standstill_margin,
+        merge_s=args.merge,
         columns=(args.columns, args.units), drop_invalid=args.drop_invalid,
+        max_gap=args.max_gap, base=args.base, tip=args.tip,
     )  # fmt: skip
     result = observe_files(opts)
     names = list(result.model.robot.joint_names)

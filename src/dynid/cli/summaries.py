@@ -321,6 +321,13 @@ def format_observation(result: ObserveResult, names: list[str], *, calibrating: 
             f"thresholds grow with the model's uncertainty: {th.k_sigma:g} sigma + noise "
             f"({', '.join(f'{v:.3g}' for v in th.noise)} N m)"
         )
+    margins = [x.standstill for x in result.logs if x.standstill is not None]
+    if th.standstill and margins and np.any([np.any(m) for m in margins]):
+        top = np.max([np.max(m, axis=0) for m in margins], axis=0)
+        rows.append(
+            "plus the standstill margin of the friction (Coulomb level inside its band, "
+            f"lagged; up to {', '.join(f'{v:.3g}' for v in top)} N m)"
+        )
     if calibrating:
         rows.append(f"calibrated on {th.samples} samples of {len(result.logs)} log(s)")
         return "\n".join(rows)

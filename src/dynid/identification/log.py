@@ -92,6 +92,9 @@ class LogCleaning:
         Median time step [s].
     dt_jitter : float
         Standard deviation of the steps (gaps excluded) over the median step.
+    invalid_after : tuple of float
+        Time [s] of the kept row before each run of rows dropped for NaN or inf (where a
+        reader that must not bridge them cuts the log).
     """
 
     n_input_rows: int = 0
@@ -100,6 +103,7 @@ class LogCleaning:
     gaps: tuple[tuple[float, float], ...] = ()
     dt_median: float = float("nan")
     dt_jitter: float = 0.0
+    invalid_after: tuple[float, ...] = ()
 
 
 @dataclass(frozen=True, slots=True, eq=False)
@@ -261,6 +265,7 @@ class TorqueLog:
             finite &= np.all(np.isfinite(a), axis=1)
         rows = np.flatnonzero(finite)
         n_nan = N - rows.size
+        skipped = rows[np.flatnonzero(np.diff(rows) > 1)]  # a kept row, then invalid ones
         if rows.size == 0:  # every row invalid (the duplicate mask below needs one)
             raise DataError(f"fewer than 2 valid rows left of {N} ({n_nan} with NaN/inf)")
         tt = t[rows]
@@ -291,6 +296,7 @@ class TorqueLog:
             gaps=gaps,
             dt_median=h,
             dt_jitter=jitter,
+            invalid_after=tuple(float(t[i]) for i in skipped),
         )
         if rows.size == N:  # nothing dropped: no copy of a large log
             tt, pick = t, (lambda a: a)

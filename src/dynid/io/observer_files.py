@@ -4,7 +4,8 @@
 
     {"schema": "dynid-thresholds/1", "dynid_version": ..., "joints": ["joint1", ...],
      "contact": [...], "collision": [...],            # N m per joint
-     "rule": {"margin": 1.5, "quantile": 1.0, "collision_factor": 2.0},
+     "rule": {"margin": 1.5, "quantile": 1.0, "collision_factor": 2.0,
+              "standstill_margin": true},     # false or absent: fixed levels only
      "uncertainty": null | {"k_sigma": 3.0, "noise": [...]},
      "observer": {"gain": [...], "discretisation": "exact", "rule": "trapezoid"},
      "calibration": {"samples": N, "data": [file names], "model": ...},
@@ -73,6 +74,7 @@ def save_thresholds(
             "margin": th.margin,
             "quantile": th.quantile,
             "collision_factor": th.collision_factor,
+            "standstill_margin": th.standstill,
         },
         "uncertainty": None
         if not th.uses_uncertainty or th.noise is None
@@ -130,6 +132,7 @@ def load_thresholds(path: str | Path) -> Thresholds:
             samples=int(d.get("calibration", {}).get("samples", 0)),
             k_sigma=k_sigma,
             noise=noise,
+            standstill=bool(rule.get("standstill_margin", False)),
         )
     except (KeyError, TypeError) as exc:
         raise DataError(f"{path.name}: missing or malformed entry {exc}") from None

@@ -15,6 +15,8 @@ Albu-Schaeffer, IEEE T-RO 2017), on any model dynid produces.
 * :mod:`~dynid.observer.friction`: friction laws in the compiled step's canonical form;
 * :mod:`~dynid.observer.residual`: :class:`MomentumObserver` (``step`` for a control loop)
   and :func:`observe` (a whole log);
+* :mod:`~dynid.observer.pieces`: a log cut at its gaps (the observer starts again on
+  each piece), positions that jump;
 * :mod:`~dynid.observer.wrench`: the external wrench at a frame by damped least squares;
 * :mod:`~dynid.observer.detection`: thresholds calibrated on collision-free data, the
   model's uncertainty propagated to the residual, contact and collision events.

@@ -17,6 +17,16 @@ events.
   with the trapezoid rule). The noise floor ``nu_j = margin * Q_q((|r_j| - k sigma_j)^+)``
   is what the uncertainty leaves unexplained on the calibration data.
 
+**The standstill margin** (``standstill``): inside a friction law's standstill band its
+Coulomb term is off, while the true friction of a slow reversal lies anywhere in
+``[-f_c, f_c]`` (:func:`~dynid.observer.friction.standstill_margin`): a torque the model
+cannot know, which the residual passes through its lag ``K_O/(s + K_O)``. That lagged bound
+``m_j(t)`` (:func:`standstill_series`, a bound because the lag's impulse response is
+positive) is added to both levels of the joint's threshold; the calibration leaves it out
+of the residual it reads (``(|r_j| - m_j)^+``), so one reversal does not raise the
+threshold everywhere. Without it, a model with a band raises contacts at the slow
+reversals of a collision-free motion.
+
 Two levels, as robot controllers have them: ``contact`` (the threshold) and ``collision``
 (``collision_factor`` times it).
 
@@ -38,8 +48,9 @@ from numpy.typing import ArrayLike, NDArray
 
 from .. import _checks
 from ..exceptions import DataError, OptionError, ShapeError
+from .friction import standstill_margin
 from .model import ObserverModel
-from .residual import DEFAULT_OPTIONS, ObserverOptions
+from .residual import DEFAULT_OPTIONS, ObserverOptions, first_order_lag
 from .terms import base_momentum_regressor
 
 __all__ = [
@@ -48,6 +59,7 @@ __all__ = [
     "calibrate",
     "detect",
     "residual_std",
+    "standstill_series",
     "threshold_series",
 ]
 
@@ -69,6 +81,9 @@ class Thresholds:
         ``k`` of the uncertainty-grown threshold; None: fixed thresholds only.
     noise : ndarray, shape (n,), or None
         Its noise floor ``nu`` [N m] (the contact level's).
+    standstill : bool
+        The lagged standstill margin of the model's friction is added to both levels
+        (calibrated without it).
     options : ObserverOptions
         The observer the thresholds were calibrated with (the residual they apply to).
     samples : int
@@ -84,6 +99,7 @@ class Thresholds:
     samples: int
     k_sigma: float | None = None
     noise: NDArray[np.float64] | None = field(default=None)
+    standstill: bool = False
 
     def __post_init__(self) -> None:
         n = np.shape(self.contact)[0]
@@ -191,11 +207,37 @@ def residual_std(
     return out
 
 
+def standstill_series(
+    model: ObserverModel,
+    t: ArrayLike,
+    dq: ArrayLike,
+    options: ObserverOptions = DEFAULT_OPTIONS,
+) -> NDArray[np.float64]:
+    """The standstill margin (N, n) [N m] of the model's friction at the velocities ``dq``
+    (N, n) [rad/s], through the observer's lag ``K_O/(s + K_O)`` over the times ``t`` (N,)
+    [s] (module docstring): a bound of the residual that friction the model cannot know
+    inside its standstill band leaves; zeros for a friction without a band.
+
+    Raises
+    ------
+    ShapeError, NonFiniteError
+        Bad shapes, NaN.
+    """
+    n = model.n
+    ta = _checks.as_array("t", t)
+    dqa = _checks.as_exact("dq", dq, (ta.shape[0], n))
+    w = standstill_margin(model.friction, dqa)
+    if not np.any(w):
+        return w
+    return first_order_lag(ta, w, options.gains(n), options.rule)
+
+
 def calibrate(
     residuals: Sequence[ArrayLike],
     options: ObserverOptions,
     *,
     std: Sequence[ArrayLike] | None = None,
+    standstill: Sequence[ArrayLike] | None = None,
     margin: float = 1.5,
     quantile: float = 1.0,
     collision_factor: float = 2.0,
@@ -212,6 +254,9 @@ def calibrate(
     std : sequence of array_like, shape (N_i, n), optional
         :func:`residual_std` of the same samples: the thresholds then also grow with the
         model's uncertainty (``k_sigma``).
+    standstill : sequence of array_like, shape (N_i, n), optional
+        :func:`standstill_series` of the same samples: left out of the residual read here
+        and added to the thresholds at detection.
     margin : float
         Factor over the calibration residuals (>= 1).
     quantile : float
@@ -245,6 +290,9 @@ def calibrate(
     A = np.abs(np.concatenate(R))
     if A.shape[0] == 0:
         raise ShapeError("no calibration sample")
+    if standstill is not None:
+        W = [_checks.as_exact("standstill", w, x.shape) for w, x in zip(standstill, R, strict=True)]
+        A = np.clip(A - np.concatenate(W), 0.0, None)
     contact = margin * np.quantile(A, quantile, axis=0)
     noise = None
     if std is not None:
@@ -263,25 +311,33 @@ def calibrate(
         samples=int(A.shape[0]),
         k_sigma=k_sigma if std is not None else None,
         noise=noise,
+        standstill=standstill is not None,
     )
 
 
 def threshold_series(
-    thresholds: Thresholds, N: int, std: ArrayLike | None = None
+    thresholds: Thresholds,
+    N: int,
+    std: ArrayLike | None = None,
+    standstill: ArrayLike | None = None,
 ) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
     """The contact and collision thresholds at every sample, each (N, n) [N m]: fixed, or
     ``k sigma + nu`` (and its ``collision_factor`` multiple) when ``std`` (N, n) is given
-    and the thresholds use the model's uncertainty."""
+    and the thresholds use the model's uncertainty; plus the standstill margin
+    ``standstill`` (N, n) when given and the thresholds use it."""
     n = thresholds.n
     if std is not None and thresholds.uses_uncertainty:
         assert thresholds.k_sigma is not None and thresholds.noise is not None
         s = _checks.as_exact("std", std, (N, n))
         c = thresholds.k_sigma * s + thresholds.noise
-        return c, thresholds.collision_factor * c
-    return (
-        np.broadcast_to(thresholds.contact, (N, n)).copy(),
-        np.broadcast_to(thresholds.collision, (N, n)).copy(),
-    )
+        k = thresholds.collision_factor * c
+    else:
+        c = np.broadcast_to(thresholds.contact, (N, n)).copy()
+        k = np.broadcast_to(thresholds.collision, (N, n)).copy()
+    if standstill is not None and thresholds.standstill:
+        w = _checks.as_exact("standstill", standstill, (N, n))
+        c, k = c + w, k + w
+    return c, k
 
 
 def detect(
@@ -290,7 +346,9 @@ def detect(
     thresholds: Thresholds,
     *,
     std: ArrayLike | None = None,
+    standstill: ArrayLike | None = None,
     merge_s: float = 0.05,
+    restarts: ArrayLike | None = None,
 ) -> list[ContactEvent]:
     """Contact events of a residual (module docstring).
 
@@ -303,8 +361,13 @@ def detect(
     thresholds : Thresholds
     std : array_like, shape (N, n), optional
         :func:`residual_std` of the samples (for thresholds that use the uncertainty).
+    standstill : array_like, shape (N, n), optional
+        :func:`standstill_series` of the samples (for thresholds that use it).
     merge_s : float
         Runs over the threshold closer than this [s] are one event (>= 0).
+    restarts : array_like of int, optional
+        Samples where the observer started again (the first of each piece of a log cut
+        at its gaps): no event spans one.
 
     Returns
     -------
@@ -323,12 +386,16 @@ def detect(
     ra = _checks.as_exact("r", r, (N, thresholds.n))
     if not merge_s >= 0:
         raise OptionError(f"merge_s must be >= 0 [s]; got {merge_s}")
-    contact, collision = threshold_series(thresholds, N, std)
+    contact, collision = threshold_series(thresholds, N, std, standstill)
     over = np.abs(ra) > contact
     hit = np.flatnonzero(over.any(axis=1))
     if hit.size == 0:
         return []
-    cut = np.flatnonzero(ta[hit[1:]] - ta[hit[:-1]] > merge_s) + 1
+    split = ta[hit[1:]] - ta[hit[:-1]] > merge_s
+    if restarts is not None:
+        piece = np.searchsorted(np.asarray(restarts, dtype=np.int64), hit, side="right")
+        split |= piece[1:] != piece[:-1]
+    cut = np.flatnonzero(split) + 1
     events = []
     for run in np.split(hit, cut):
         a, b = int(run[0]), int(run[-1]) + 1

@@ -5,16 +5,27 @@ Every law of the registry (:mod:`dynid.friction.laws`) is a special case of, per
 .. math:: f(v) = f_{v+} v^+ + f_{v-} v^- + f_{c+} [s > 0] - f_{c-} [s < 0] + f_o
           + \\Delta_s e^{-(v / v_{st})^2} s + f_t \\tanh(v / v_s)
           + \\varphi_1 \\big(\\sigma(\\varphi_2 (v + \\varphi_3))
-          - \\sigma(\\varphi_2 \\varphi_3)\\big)
+          - \\sigma(\\varphi_2 \\varphi_3)\\big) + f_q v |v|
 
 with ``s`` the sign outside the standstill band (:func:`~dynid.friction.model.coulomb_sign`)
 and ``sigma`` the logistic function; ``tau_f = K_f^T f(K_f dq)`` with ``K_f`` the drive's
-friction transmission (the identity at the joints). The 13 columns per motor, in order:
-``fv+, fv-, fc+, fc-, fo, band, fs - fc, vst, ft, vs, phi1, phi2, phi3``.
+friction transmission (the identity at the joints). The 14 columns per motor, in order:
+``fv+, fv-, fc+, fc-, fo, band, fs - fc, vst, ft, vs, phi1, phi2, phi3, fq``.
 
 :func:`canonical_friction` maps a friction model to that form, or returns None for a law it
 does not know (a law added to the registry later): the observer's step then evaluates the
 model's own ``torques`` in Python.
+
+:func:`standstill_margin` bounds what such a model cannot know about its friction near rest:
+inside the standstill band the law's Coulomb term is off (or, for ``tanh(v / v_s)``, not yet
+at its level), while the true friction of a slow reversal or a standstill lies anywhere in
+``[-f_c, f_c]``. Its bound per motor is
+
+.. math:: w(v) = \\big(\\max(|f_{c+}|, |f_{c-}|) + |f_s - f_c|\\big) [|v| \\le b]
+          + |f_t| \\big(1 - \\tanh(|v| / v_s)\\big)
+
+(``b`` the band; the Stribeck bump is off inside it as well), ``|K_f|^T w(K_f dq)`` at the
+joints; 0 for the sigmoid law (no Coulomb level) and for laws without a canonical form.
 """
 
 from __future__ import annotations
@@ -30,17 +41,17 @@ from ..friction.model import (
     SigmoidFriction,
 )
 
-__all__ = ["FRICTION_COLUMNS", "canonical_friction"]
+__all__ = ["FRICTION_COLUMNS", "canonical_friction", "standstill_margin"]
 
 #: The canonical parameters per motor (module docstring).
 FRICTION_COLUMNS = (
     "fv_pos", "fv_neg", "fc_pos", "fc_neg", "fo", "band", "fs_minus_fc", "vst", "ft", "vs",
-    "phi1", "phi2", "phi3",
+    "phi1", "phi2", "phi3", "fq",
 )  # fmt: skip
 
 
 def _law_rows(kind: str, P: NDArray[np.float64], band: NDArray[np.float64]) -> NDArray | None:
-    """The canonical rows (n, 13) of a registry law's parameters (n, k), or None."""
+    """The canonical rows (n, 14) of a registry law's parameters (n, k), or None."""
     n = P.shape[0]
     F = np.zeros((n, len(FRICTION_COLUMNS)))
     F[:, 5] = band
@@ -62,6 +73,12 @@ def _law_rows(kind: str, P: NDArray[np.float64], band: NDArray[np.float64]) -> N
             F[:, 6] = P[:, 2] - fc
             F[:, 7] = P[:, 3]
         return F
+    if kind == "quadratic":  # fv, fq, fc, fo
+        F[:, 0] = F[:, 1] = P[:, 0]
+        F[:, 13] = P[:, 1]
+        F[:, 2] = F[:, 3] = P[:, 2]
+        F[:, 4] = P[:, 3]
+        return F
     if kind == "asymmetric":  # fv+, fv-, fc+, fc-
         F[:, :4] = P[:, :4]
         return F
@@ -74,7 +91,7 @@ def _law_rows(kind: str, P: NDArray[np.float64], band: NDArray[np.float64]) -> N
 def canonical_friction(
     friction: FrictionModel | None, n: int
 ) -> tuple[NDArray[np.float64], NDArray[np.float64]] | None:
-    """``(K_f, F)``: the friction transmission (n, n) and the canonical parameters (n, 13)
+    """``(K_f, F)``: the friction transmission (n, n) and the canonical parameters (n, 14)
     of ``friction`` (zeros for None), or None for a law without a canonical form."""
     K = np.eye(n)
     if friction is None:
@@ -92,3 +109,27 @@ def canonical_friction(
     else:
         return None
     return None if F is None else (K, F)
+
+
+def standstill_margin(
+    friction: FrictionModel | None, dq: NDArray[np.float64]
+) -> NDArray[np.float64]:
+    """Bound [N m] (..., n) of the friction the model cannot know at velocities ``dq``
+    [rad/s] (..., n): its Coulomb level where the law's Coulomb term is off or not at its
+    level (module docstring); zeros without friction or for a law without a canonical form.
+    """
+    v = np.asarray(dq, dtype=np.float64)
+    n = v.shape[-1]
+    canon = canonical_friction(friction, n)
+    if friction is None or canon is None:
+        return np.zeros_like(v)
+    K, F = canon
+    vm = v @ K.T  # motor velocities
+    level = np.maximum(np.abs(F[:, 2]), np.abs(F[:, 3])) + np.abs(F[:, 6])
+    w = np.where(np.abs(vm) <= F[:, 5], level, 0.0)
+    ft, vs = np.abs(F[:, 8]), F[:, 9]
+    with np.errstate(divide="ignore", invalid="ignore"):
+        x = np.where(vs > 0, np.abs(vm) / np.where(vs > 0, vs, 1.0), np.inf)
+    w = w + ft * np.where(vs > 0, 1.0 - np.tanh(x), np.where(vm == 0.0, 1.0, 0.0))
+    out: NDArray[np.float64] = w @ np.abs(K)
+    return out

@@ -370,12 +370,19 @@ def first_order_lag(
 
     Exact for an input held over each step at its new value (``"rectangle"``) or at the
     mean of both ends (``"trapezoid"``, second-order accurate for a smooth input): what the
-    residual of an exact model gives for an external torque ``x`` (a test's truth).
+    residual of an exact model gives for an external torque ``x`` (a test's truth). One
+    compiled pass (:func:`dynid._kernels.observer.first_order_lag`) for ``x`` of shape
+    (N, n); a loop over the samples otherwise.
     """
     ta = np.asarray(t, dtype=np.float64)
     xa = np.asarray(x, dtype=np.float64)
     K = np.asarray(gain, dtype=np.float64)
     out = np.zeros_like(xa)
+    mod = _kernels.load("observer")
+    if mod is not None and xa.ndim == 2 and ta.shape == xa.shape[:1]:
+        Kn = np.ascontiguousarray(np.broadcast_to(K, xa.shape[1:]), dtype=np.float64)
+        mod.first_order_lag(ta, np.ascontiguousarray(xa), Kn, rule == "trapezoid", out)
+        return out
     for k in range(1, ta.shape[0]):
         a = -np.expm1(-K * (ta[k] - ta[k - 1]))
         xk = 0.5 * (xa[k] + xa[k - 1]) if rule == "trapezoid" else xa[k]

@@ -37,6 +37,11 @@ class LogObservation:
         At ``frame``, when one was given.
     tau_ext : ndarray, shape (N, n), or None
         The true external torques stored beside the log (a simulated contact).
+    standstill : ndarray, shape (N, n), or None
+        The lagged standstill margin of the model's friction
+        (:func:`~dynid.observer.detection.standstill_series`), when the thresholds use it.
+    restarts : tuple of int
+        First sample of each piece the observer ran on (the log cut at its gaps).
     """
 
     path: Path
@@ -46,6 +51,8 @@ class LogObservation:
     events: list[ContactEvent]
     wrench: WrenchEstimate | None
     tau_ext: NDArray[np.float64] | None
+    standstill: NDArray[np.float64] | None = None
+    restarts: tuple[int, ...] = (0,)
 
 
 @dataclass(frozen=True, slots=True, eq=False)

@@ -17,7 +17,14 @@ from numpy.typing import NDArray
 from ..friction.model import FrictionModel
 from ..identification.model import IdentifiedModel
 from ..model.robot import Robot
-from ..observer.detection import ContactEvent, Thresholds, calibrate, detect, residual_std
+from ..observer.detection import (
+    ContactEvent,
+    Thresholds,
+    calibrate,
+    detect,
+    residual_std,
+    standstill_series,
+)
 from ..observer.model import from_identified
 from ..observer.residual import ObserverOptions, first_order_lag, observe
 from ..simulation.contact import Contact, contact_torques
@@ -89,10 +96,12 @@ def collision_stage(
     std = None
     if obs.covariance is not None:
         std = [residual_std(obs, free.t, free.q, free.dq, opts)]
-    th = calibrate([r_free], opts, std=std)
+    w_free = standstill_series(obs, free.t, free.dq, opts)
+    th = calibrate([r_free], opts, std=std, standstill=[w_free])
     r = observe(obs, hit.t, hit.q, hit.dq, hit.tau, opts).r
     s_hit = None if std is None else residual_std(obs, hit.t, hit.q, hit.dq, opts)
-    events = detect(hit.t, r, th, std=s_hit)
+    w_hit = standstill_series(obs, hit.t, hit.dq, opts)
+    events = detect(hit.t, r, th, std=s_hit, standstill=w_hit)
     ext = contact_torques(truth, (contact,), traj.t, traj.q)
     lag = first_order_lag(hit.t, ext, opts.gains(truth.n), opts.rule)
     on = (hit.t >= contact.start) & (hit.t < contact.end)

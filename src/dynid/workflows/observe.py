@@ -8,10 +8,18 @@ the command applies, so that the Python API behaves as the command does.
   chose, with its standstill band).
 * Logs are read strictly with the model's joint count (extra columns ignored, with a
   warning), through the column map the model's data were read with when none is given, and
-  brought to the joint side through the model's drive.
+  brought to the joint side through the model's drive. A log is cut at its gaps (steps
+  longer than ``max_gap``, default :func:`~dynid.identification.log.default_max_gap`, as
+  ``identify`` cuts) and after rows dropped for NaN or inf (``drop_invalid``; refused
+  otherwise, the row named): the observer starts again on each piece and no event spans a
+  cut (one warning names the file and the times); a position that jumps more than its
+  velocity explains is warned about (:mod:`dynid.observer.pieces`).
 * ``calibrate``: the residuals of every (collision-free) log give the thresholds; with an
   identified model that has a covariance, they also grow with the model's uncertainty
-  (``uncertainty``, default on).
+  (``uncertainty``, default on); the standstill margin of the model's friction (its
+  Coulomb level where the law's Coulomb term is off, through the observer's lag) is left
+  out of the residuals they read and added to the thresholds (``standstill``, default on;
+  :mod:`dynid.observer.detection`).
 * Otherwise the thresholds (``thresholds.json``) fix the observer (gains, discretisation,
   rule) and the detection; the true external torques ``tau_ext1..n`` that
   ``dynid simulate --contact`` writes beside a log are kept for the figure.
@@ -28,7 +36,7 @@ import numpy as np
 
 from ..exceptions import DynidWarning, OptionError
 from ..friction.model import FrictionModel
-from ..identification.log import joint_side_log, with_derived_velocities
+from ..identification.log import TorqueLog, default_max_gap, joint_side_log, with_derived_velocities
 from ..identification.recordings import unwrapped
 from ..io.columns import load_joint_columns
 from ..io.feasible import load_feasible_drive, load_feasible_linear_friction
@@ -36,8 +44,15 @@ from ..io.friction_json import load_friction_json
 from ..io.model_json import load_model_json
 from ..io.observer_files import load_thresholds
 from ..io.robot_file import load_robot
-from ..observer.detection import Thresholds, calibrate, detect, residual_std
+from ..observer.detection import (
+    Thresholds,
+    calibrate,
+    detect,
+    residual_std,
+    standstill_series,
+)
 from ..observer.model import ObserverModel, from_identified, from_robot
+from ..observer.pieces import pieces, position_jumps
 from ..observer.residual import DEFAULT_GAIN, ObserverOptions, observe
 from ..observer.results import LogObservation, ObserveResult
 from ..observer.wrench import external_wrench
@@ -81,12 +96,21 @@ class ObserveOptions:
     uncertainty : bool
         Let the thresholds grow with the model's uncertainty when the model has a
         covariance.
+    standstill : bool
+        When calibrating: add the standstill margin of the model's friction to the
+        thresholds (the thresholds keep the choice).
     merge_s : float
         Events closer than this [s] are one.
     columns : (str or None, str or None)
         ``--columns``/``--units``; default: those the model's data were read with.
     drop_invalid : bool
-        Drop rows with NaN/inf or a repeated timestamp instead of failing.
+        Drop rows with NaN/inf or a repeated timestamp instead of failing (the observer
+        starts again after rows dropped for NaN/inf).
+    max_gap : float, optional
+        Longest step [s] the observer integrates over; the log is cut at longer ones.
+    base, tip : str, optional
+        The chain of a ``params`` URDF with several leaves (its root and only leaf by
+        default).
     """
 
     data: tuple[Path, ...]
@@ -104,33 +128,49 @@ class ObserveOptions:
     collision_factor: float = 2.0
     k_sigma: float = 3.0
     uncertainty: bool = True
+    standstill: bool = True
     merge_s: float = 0.05
     columns: ColumnSpec = (None, None)
     drop_invalid: bool = False
+    max_gap: float | None = None
+    base: str | None = None
+    tip: str | None = None
 
 
 def load_observer_model(
-    model: Path | None, params: str | Path | None, friction: Path | None = None
+    model: Path | None,
+    params: str | Path | None,
+    friction: Path | None = None,
+    *,
+    base: str | None = None,
+    tip: str | None = None,
 ) -> tuple[ObserverModel, Mapping[str, str | None] | None]:
     """The observer model of ``--model`` or ``--params`` (and ``--friction``), with the
-    column map the model's data were read with (None for a robot).
+    column map the model's data were read with (None for a robot); ``base`` and ``tip``
+    choose the chain of a ``params`` URDF.
 
     Raises
     ------
     OptionError
-        Neither or both of ``model`` and ``params``.
+        Neither or both of ``model`` and ``params``; ``base`` or ``tip`` with another
+        model than a URDF.
     DataError
         A file that is not what it should be (named).
     """
     if (model is None) == (params is None):
         raise OptionError("give one of --model identification.json and --params ROBOT")
+    if (base is not None or tip is not None) and not str(params).lower().endswith(".urdf"):
+        given = "--model" if model is not None else f"--params {params}"
+        raise OptionError(
+            f"--base/--tip choose the chain of a --params URDF; {given} holds its own chain"
+        )
     fr: FrictionModel | None | str
     fr = "model" if friction is None else load_friction_json(friction)
     if model is not None:
         ident = load_model_json(model)
         return from_identified(ident, fr), ident.info.column_map
     spec = str(params)
-    robot = load_robot(spec, what="--params")
+    robot = load_robot(spec, base=base, tip=tip, what="--params")
     drive = None
     if spec.lower().endswith(".json"):
         drive = load_feasible_drive(spec)
@@ -165,7 +205,9 @@ def observe_files(opts: ObserveOptions) -> ObserveResult:
         raise OptionError("give one or more --data logs")
     if opts.calibrate == (opts.thresholds is not None):
         raise OptionError("give --calibrate (collision-free logs) or --thresholds thresholds.json")
-    model, recorded = load_observer_model(opts.model, opts.params, opts.friction)
+    model, recorded = load_observer_model(
+        opts.model, opts.params, opts.friction, base=opts.base, tip=opts.tip
+    )
     given = None if opts.thresholds is None else load_thresholds(opts.thresholds)
     if given is not None and given.n != model.n:
         raise OptionError(
@@ -177,12 +219,16 @@ def observe_files(opts: ObserveOptions) -> ObserveResult:
         if given is None
         else given.uses_uncertainty and model.covariance is not None
     )
-    logs = [_observe_log(p, model, recorded, opts, options, wants_std) for p in opts.data]
+    wants_margin = opts.standstill if given is None else given.standstill
+    logs = [
+        _observe_log(p, model, recorded, opts, options, wants_std, wants_margin) for p in opts.data
+    ]
     if given is None:
         th = calibrate(
             [x.r for x in logs],
             options,
             std=[x.std for x in logs] if wants_std else None,  # type: ignore[misc]
+            standstill=[x.standstill for x in logs] if wants_margin else None,  # type: ignore[misc]
             margin=opts.margin,
             quantile=opts.quantile,
             collision_factor=opts.collision_factor,
@@ -195,9 +241,19 @@ def observe_files(opts: ObserveOptions) -> ObserveResult:
             x.t,
             x.r,
             x.std,
-            detect(x.t, x.r, given, std=x.std, merge_s=opts.merge_s),
+            detect(
+                x.t,
+                x.r,
+                given,
+                std=x.std,
+                standstill=x.standstill,
+                merge_s=opts.merge_s,
+                restarts=x.restarts,
+            ),
             x.wrench,
             x.tau_ext,
+            x.standstill,
+            x.restarts,
         )  # fmt: skip
         for x in logs
     )
@@ -211,6 +267,7 @@ def _observe_log(
     opts: ObserveOptions,
     options: ObserverOptions,
     wants_std: bool,
+    wants_margin: bool = False,
 ) -> LogObservation:
     """The residual (and its std, the wrench, the stored true torques) of one log."""
     path = Path(path)
@@ -234,17 +291,65 @@ def _observe_log(
         if log.dq_derived:
             log = with_derived_velocities(log)
 
+    starts = _pieces(path, log, opts)
+
     def run() -> LogObservation:
-        res = observe(model, log.t, log.q, log.dq, log.tau, options)
-        std = residual_std(model, log.t, log.q, log.dq, options) if wants_std else None
+        t, q, dq, tau, n = log.t, log.q, log.dq, log.tau, model.n
+        r = np.empty((t.shape[0], n))
+        std = np.empty_like(r) if wants_std else None
+        margin = np.empty_like(r) if wants_margin else None
+        for a, b in zip(starts, [*starts[1:], t.shape[0]], strict=True):
+            r[a:b] = observe(model, t[a:b], q[a:b], dq[a:b], tau[a:b], options).r
+            if std is not None:
+                std[a:b] = residual_std(model, t[a:b], q[a:b], dq[a:b], options)
+            if margin is not None:
+                margin[a:b] = standstill_series(model, t[a:b], dq[a:b], options)
         wrench = None
         if opts.frame is not None:
-            wrench = external_wrench(model.robot, log.q, res.r, opts.frame)
+            wrench = external_wrench(model.robot, log.q, r, opts.frame)
         ext = None
         if path.suffix.lower() in (".csv", ".npz") and names is None:
             ext = load_joint_columns(path, "tau_ext", model.n)
             if ext is not None and ext.shape[0] != log.t.shape[0]:
                 ext = None  # rows were dropped: not aligned with the log
-        return LogObservation(path, log.t, np.asarray(res.r), std, [], wrench, ext)
+        return LogObservation(
+            path, log.t, r, std, [], wrench, ext, margin, tuple(int(k) for k in starts)
+        )
 
     return in_file(path, run)
+
+
+def _pieces(path: Path, log: TorqueLog, opts: ObserveOptions) -> list[int]:
+    """First sample of each piece the observer runs on (module docstring), with the
+    warnings: the cuts (file and times) and the positions that jump."""
+    c = log.cleaning
+    dt = np.diff(log.t)
+    limit = opts.max_gap
+    if limit is None:
+        limit = default_max_gap(float(np.median(dt)) if dt.size else 1.0)
+    starts = [int(k) for k in pieces(log.t, limit, c.invalid_after)]
+    if len(starts) > 1:
+        at = ", ".join(f"{log.t[k]:.6g}" for k in starts[1:6])
+        more = f" and {len(starts) - 6} more" if len(starts) > 6 else ""
+        why = f"gaps longer than {limit:.3g} s" + (
+            f" or after {c.n_nan_rows} row(s) dropped for NaN/inf" if c.invalid_after else ""
+        )
+        warnings.warn(
+            f"{path.name}: cut at {why}: the observer starts again at t = {at}{more} s "
+            "(no event spans a cut)",
+            DynidWarning,
+            stacklevel=4,
+        )
+    jumps = position_jumps(log.t, log.q, log.dq, starts)
+    if jumps:
+        listed = ", ".join(
+            f"joint {x.joint + 1} by {x.size:+.3g} at t = {x.t:.6g} s" for x in jumps[:3]
+        )
+        more = f" and {len(jumps) - 3} more" if len(jumps) > 3 else ""
+        warnings.warn(
+            f"{path.name}: position jumps more than the recorded velocity explains "
+            f"({listed}{more}): the residual after a jump is not to be trusted",
+            DynidWarning,
+            stacklevel=4,
+        )
+    return starts

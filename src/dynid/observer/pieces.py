@@ -1,0 +1,89 @@
+"""A log as the observer may read it: pieces between its gaps, and positions that jump.
+
+The residual integrates the measured torques from the momentum at its first sample: across
+a gap (a stop of the recording longer than the longest step, or rows dropped for NaN or
+inf) the momentum and the torques of the missing time are unknown, so the observer starts
+again after it (:func:`pieces`; the residual is 0 at each piece's first sample and no event
+spans a cut, :func:`~dynid.observer.detection.detect`'s ``restarts``). Inside a piece, a
+position that moves more than its recorded velocity allows over one step (an encoder
+glitch, a re-homing) changes ``M(q)`` and ``g(q)`` at once: :func:`position_jumps` finds it
+for a warning.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from dataclasses import dataclass
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+
+from .. import _checks
+
+__all__ = ["JUMP_FACTOR", "JUMP_FLOOR", "PositionJump", "pieces", "position_jumps"]
+
+#: A position step is a jump when it departs from the step of the recorded velocity by more
+#: than this many robust standard deviations of that departure ...
+JUMP_FACTOR = 20.0
+#: ... and by more than this [rad or m] (encoder quantisation is far below).
+JUMP_FLOOR = 1e-3
+
+
+def pieces(t: ArrayLike, max_gap_s: float, cut_after: Sequence[float] = ()) -> NDArray[np.int64]:
+    """First sample of every piece (K,) of the times ``t`` (N,) [s]: 0, every sample after a
+    step longer than ``max_gap_s`` [s], and every sample after a time of ``cut_after`` [s]
+    (rows dropped there)."""
+    ta = _checks.as_array("t", t)
+    starts = np.flatnonzero(np.diff(ta) > max_gap_s) + 1
+    after = np.searchsorted(ta, np.asarray(cut_after, dtype=np.float64), side="right")
+    cuts = np.union1d(np.concatenate([[0], starts]), after[after < ta.shape[0]])
+    return cuts.astype(np.int64)
+
+
+@dataclass(frozen=True, slots=True)
+class PositionJump:
+    """A position step inconsistent with the recorded velocity.
+
+    Attributes
+    ----------
+    t : float
+        Time of the sample after the step [s].
+    joint : int
+        0-based.
+    size : float
+        The step less what the velocity explains [rad or m].
+    """
+
+    t: float
+    joint: int
+    size: float
+
+
+def position_jumps(
+    t: ArrayLike, q: ArrayLike, dq: ArrayLike, starts: ArrayLike = (0,)
+) -> list[PositionJump]:
+    """Steps of ``q`` (N, n) that the velocity ``dq`` (N, n) does not explain, inside the
+    pieces beginning at ``starts``: ``d = q_k - q_{k-1} - T_k (dq_k + dq_{k-1}) / 2``
+    (trapezoid) beyond :data:`JUMP_FACTOR` times its robust standard deviation (1.4826 the
+    median absolute deviation) and :data:`JUMP_FLOOR`; the largest per joint and piece."""
+    ta = _checks.as_array("t", t)
+    N = ta.shape[0]
+    qa, dqa = _checks.as_array("q", q), _checks.as_array("dq", dq)
+    if N < 3:
+        return []
+    half = 0.5 * np.diff(ta)
+    across = np.asarray(starts, dtype=np.int64) - 1
+    across = across[across >= 0]
+    bounds = np.concatenate([np.asarray(starts, dtype=np.int64), [N]])
+    out = []
+    for j in range(qa.shape[1]):  # one joint at a time: a few (N,) arrays on long logs
+        d = np.diff(qa[:, j]) - half * (dqa[1:, j] + dqa[:-1, j])
+        d[across] = 0.0  # no step across a cut
+        mad = np.median(np.abs(d - np.median(d)))
+        limit = max(JUMP_FACTOR * 1.4826 * float(mad), JUMP_FLOOR)
+        for a, b in zip(bounds[:-1], bounds[1:], strict=True):
+            seg = np.abs(d[a : b - 1])
+            if seg.size and seg.max() > limit:
+                k = int(np.argmax(seg))
+                out.append(PositionJump(float(ta[a + k + 1]), j, float(d[a + k])))
+    return sorted(out, key=lambda x: (x.t, x.joint))

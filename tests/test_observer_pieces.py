@@ -1,0 +1,190 @@
+"""The observer on logs that stop, jump or hold NaN: cut at gaps and after dropped rows
+(the observer starts again, no event spans a cut, never an event invented from a gap),
+invalid rows refused unless dropped, position jumps warned about, a long standstill
+quiet; through the library and ``dynid observe``."""
+
+from __future__ import annotations
+
+import json
+
+import numpy as np
+import pytest
+
+import dynid
+from dynid.cli.__main__ import main
+from dynid.identification.log import TorqueLog
+from dynid.io.torque_log import save_torque_log
+from dynid.observer.detection import Thresholds, detect
+from dynid.observer.pieces import pieces, position_jumps
+from dynid.observer.residual import ObserverOptions
+from dynid.simulation.measurement import SensorNoise, simulate_measurement
+from dynid.simulation.trajectories import Trajectory, random_fourier, uniform_times
+
+
+def test_pieces_start_after_every_long_step_and_every_dropped_row():
+    t = np.array([0.0, 0.001, 0.002, 0.5, 0.501, 0.502, 0.504, 0.505])
+    assert pieces(t, 0.02).tolist() == [0, 3]
+    assert pieces(t, 0.02, cut_after=(0.502,)).tolist() == [0, 3, 6]
+    assert pieces(t, 1.0, cut_after=(0.505,)).tolist() == [0]  # nothing after the last
+
+
+def test_position_jumps_find_a_step_the_velocity_does_not_explain():
+    """q = sin(t) recorded with its derivative: no jump; 0.05 rad added from t = 1 s on
+    joint 2: found there, of that size; a long standstill (q constant, dq = 0): none."""
+    t = np.arange(0.0, 2.0, 1e-3)
+    q = np.stack([np.sin(t), np.cos(2 * t)], axis=1)
+    dq = np.stack([np.cos(t), -2 * np.sin(2 * t)], axis=1)
+    assert position_jumps(t, q, dq) == []
+    q2 = q.copy()
+    q2[t >= 1.0, 1] += 0.05
+    (jump,) = position_jumps(t, q2, dq)
+    assert (
+        jump.joint == 1
+        and jump.t == pytest.approx(1.0)
+        and jump.size == pytest.approx(0.05, abs=1e-5)
+    )
+    assert position_jumps(t, q2, dq, starts=(0, int(np.argmax(t >= 1.0)))) == []  # a cut there
+    assert position_jumps(t, np.ones_like(q), np.zeros_like(dq)) == []
+
+
+def test_no_event_spans_a_restart():
+    t = np.arange(10) * 1e-3
+    r = np.zeros((10, 1))
+    r[3:7] = 2.0
+    th = Thresholds(np.ones(1), np.full(1, 3.0), 1.5, 1.0, 3.0, ObserverOptions(), 1)
+    assert [(e.start, e.end) for e in detect(t, r, th)] == [(0.003, 0.006)]
+    cut = detect(t, r, th, restarts=[0, 5])
+    assert [(e.start, e.end) for e in cut] == [(0.003, 0.004), (0.005, 0.006)]
+
+
+def _log(seed: int, duration: float = 6.0) -> TorqueLog:
+    robot = dynid.panda()
+    rng = np.random.default_rng(seed)
+    traj = random_fourier(robot, rng, n_harmonics=4, w_f=2 * np.pi * 0.125)(
+        uniform_times(duration, 1000.0)
+    )
+    return simulate_measurement(robot, traj, rng=rng, noise=SensorNoise())
+
+
+def _rows(log: TorqueLog, keep) -> TorqueLog:
+    return TorqueLog(log.t[keep], log.q[keep], log.dq[keep], log.tau[keep])
+
+
+def _standstill_log(seed: int) -> TorqueLog:
+    """Rest, a smooth move, 3 s of standstill holding gravity, a move back."""
+    robot = dynid.panda()
+    t = uniform_times(7.0, 1000.0)
+    q0, dqmax = np.array([0.0, -0.5, 0.0, -2.0, 0.0, 1.6, 0.8]), np.full(7, 0.4)
+
+    def smooth(x):  # 0 -> 1 with zero rate and curvature at both ends
+        x = np.clip(x, 0.0, 1.0)
+        return (
+            x**3 * (10 - 15 * x + 6 * x**2),
+            30 * x**2 * (1 - x) ** 2,
+            60 * x * (1 - x) * (1 - 2 * x),
+        )
+
+    up, dup, ddup = smooth(t / 2.0)
+    dn, ddn, dddn = smooth((t - 5.0) / 2.0)
+    s, ds, dds = up - dn, dup / 2.0 - ddn / 2.0, ddup / 4.0 - dddn / 4.0
+    traj = Trajectory(t, q0 + s[:, None] * dqmax, ds[:, None] * dqmax, dds[:, None] * dqmax)
+    return simulate_measurement(robot, traj, rng=np.random.default_rng(seed), noise=SensorNoise())
+
+
+@pytest.fixture(scope="module")
+def folder(tmp_path_factory):
+    d = tmp_path_factory.mktemp("pieces")
+    free = _log(1)
+    save_torque_log(d / "free.csv", free)
+    cal = ["observe", "--params", "panda", "-q", "--no-figures"]
+    assert main([*cal, "--data", str(d / "free.csv"), "--calibrate", "--out", str(d / "cal")]) == 0
+    other = _log(2)
+    gap = (other.t < 2.0) | (other.t >= 3.0)  # the recording stopped for 1 s, the arm moved on
+    save_torque_log(d / "gap.csv", _rows(other, gap))
+    save_torque_log(d / "still.csv", _standstill_log(3))
+    return d
+
+
+def _observe(d, name, *extra):
+    th = ["--thresholds", str(d / "cal" / "thresholds.json")]
+    args = ["observe", "--params", "panda", *th, "--no-figures", "--data", str(d / name)]
+    rc = main([*args, "--out", str(d / f"obs_{name}"), "--force", *extra])
+    events = None
+    if rc == 0:
+        events = json.loads((d / f"obs_{name}" / "events.json").read_text())["events"]
+    return rc, events
+
+
+def test_a_gap_cuts_the_log_and_invents_no_event(folder, capsys):
+    """Integrated across the 1 s gap (--max-gap 2) the residual makes a collision of it;
+    cut there (default), no event and one warning naming the file and the restart time."""
+    rc, events = _observe(folder, "gap.csv", "--max-gap", "2")
+    assert rc == 0 and len(events) >= 1 and events[0]["start"] == pytest.approx(3.0)
+    capsys.readouterr()
+    rc, events = _observe(folder, "gap.csv")
+    assert rc == 0 and events == []
+    (line,) = [x for x in capsys.readouterr().err.splitlines() if "warning" in x]
+    assert "gap.csv: cut at gaps longer than 0.02 s" in line and "at t = 3 s" in line
+
+
+def test_nan_rows_are_refused_naming_the_row_or_dropped_and_cut(folder, capsys, caplog):
+    d = folder
+    text = (d / "free.csv").read_text().splitlines()
+    head = sum(1 for line in text if not line[:1].isdigit() and not line[:1] == "-")
+    for row in (1500, 4000):
+        cells = text[head + row].split(",")
+        cells[9] = "nan"
+        text[head + row] = ",".join(cells)
+    (d / "nan.csv").write_text("\n".join(text) + "\n")
+    rc, _ = _observe(d, "nan.csv")
+    err = capsys.readouterr().err
+    assert rc != 0 and "nan.csv" in err and "row 1500" in err and "--drop-invalid" in err
+    rc, events = _observe(d, "nan.csv", "--drop-invalid")
+    assert rc == 0 and events == []
+    err = capsys.readouterr().err
+    assert "dropped 2 row(s)" in caplog.text and "row 4000" in caplog.text  # counted
+    assert (
+        "after 2 row(s) dropped for NaN/inf: the observer starts again at t = 1.501, 4.001 s" in err
+    )
+
+
+def test_a_position_jump_is_warned_about(folder, capsys):
+    d = folder
+    log = _log(2)
+    q = np.array(log.q)
+    q[log.t >= 4.0, 1] += 0.05  # an encoder glitch on joint 2
+    save_torque_log(d / "jump.csv", TorqueLog(log.t, q, log.dq, log.tau))
+    assert _observe(d, "jump.csv")[0] == 0
+    err = capsys.readouterr().err
+    assert (
+        "jump.csv: position jumps more than the recorded velocity explains (joint 2 by +0.05" in err
+    )
+    assert "at t = 4 s" in err
+
+
+def test_a_long_standstill_raises_nothing(folder, capsys):
+    rc, events = _observe(folder, "still.csv")
+    assert rc == 0 and events == []
+    assert "warning" not in capsys.readouterr().err
+
+
+def test_the_library_runs_the_observer_again_on_each_piece(folder):
+    """observe_files: the piece after the gap starts at its first sample with r = 0, as a
+    fresh observer on that piece alone gives (the state of the first piece forgotten)."""
+    from dynid.observer import from_robot, observe
+    from dynid.workflows.observe import ObserveOptions, observe_files
+
+    d = folder
+    opts = ObserveOptions(
+        data=(d / "gap.csv",), params="panda", thresholds=d / "cal" / "thresholds.json"
+    )
+    with pytest.warns(UserWarning, match="cut at gaps"):
+        (x,) = observe_files(opts).logs
+    k = int(np.argmax(x.t >= 3.0))
+    assert x.restarts == (0, k) and not np.any(x.r[k])
+    log = _rows(_log(2), slice(None))
+    after = log.t >= 3.0
+    alone = observe(
+        from_robot(dynid.panda()), log.t[after], log.q[after], log.dq[after], log.tau[after]
+    )
+    assert x.r[k:] == pytest.approx(np.asarray(alone.r), abs=1e-9)
