@@ -188,3 +188,46 @@ def test_the_library_runs_the_observer_again_on_each_piece(folder):
         from_robot(dynid.panda()), log.t[after], log.q[after], log.dq[after], log.tau[after]
     )
     assert x.r[k:] == pytest.approx(np.asarray(alone.r), abs=1e-9)
+
+
+def _positions_only(path, log: TorqueLog) -> None:
+    """A CSV of t, q, tau (no velocity column)."""
+    n = log.q.shape[1]
+    head = ",".join(["t", *(f"q{j + 1}" for j in range(n)), *(f"tau{j + 1}" for j in range(n))])
+    np.savetxt(
+        path, np.column_stack([log.t, log.q, log.tau]), delimiter=",", header=head, comments=""
+    )
+
+
+def test_positions_only_logs_get_velocities_per_piece_and_unobserved_edges(folder, capsys):
+    """A log without velocities, cut by a 1 s gap: derived across the gap, the velocities
+    made collisions of its edges (24 N m); derived per piece, with the low-pass's
+    transient at each piece's ends left unobserved (NaN), no event on free motion, while a
+    20 N push inside a piece is still found where it starts."""
+    from dynid.simulation.contact import Contact
+
+    d = folder
+    _positions_only(d / "free_q.csv", _log(1))
+    other = _log(2)
+    _positions_only(d / "gap_q.csv", _rows(other, (other.t < 2.0) | (other.t >= 3.0)))
+    robot = dynid.panda()
+    rng = np.random.default_rng(4)
+    traj = random_fourier(robot, rng, n_harmonics=4, w_f=2 * np.pi * 0.125)(
+        uniform_times(6.0, 1000.0)
+    )
+    push = Contact("link6", (0.0, 0.0, -20.0), 4.0, 4.5)
+    hit = simulate_measurement(robot, traj, rng=rng, noise=SensorNoise(), contacts=(push,))
+    _positions_only(d / "hit_q.csv", _rows(hit, (hit.t < 2.0) | (hit.t >= 2.5)))
+    cal = ["observe", "--params", "panda", "--no-figures", "--force"]
+    args = [*cal, "--data", str(d / "free_q.csv"), "--calibrate", "--out", str(d / "cal_q")]
+    assert main(args) == 0
+    assert "velocities derived from the positions of each piece" in capsys.readouterr().err
+    th = ["--thresholds", str(d / "cal_q" / "thresholds.json")]
+    for name, want in (("gap_q.csv", []), ("hit_q.csv", [4.0])):
+        out = d / f"obs_{name}"
+        assert main([*cal, *th, "--data", str(d / name), "--out", str(out)]) == 0
+        events = json.loads((out / "events.json").read_text())["events"]
+        assert [round(e["start"], 1) for e in events] == want, events
+        r = np.loadtxt(out / "residuals.csv", delimiter=",", skiprows=3)  # t, r1 .. r7
+        unseen = np.isnan(r[:, 1])
+        assert unseen[0] and unseen[-1] and 0.1 < unseen.mean() < 0.5  # the pieces' edges

@@ -313,7 +313,7 @@ def format_newton_euler_rms(val: NewtonEulerValidation) -> str:
 def format_observation(result: ObserveResult, names: list[str], *, calibrating: bool) -> str:
     """The thresholds per joint (and the largest residual) and, detecting, every event."""
     th = result.thresholds
-    peak = np.max([np.max(np.abs(x.r), axis=0) for x in result.logs], axis=0)
+    peak = np.nanmax([np.nanmax(np.abs(x.r), axis=0) for x in result.logs], axis=0)
     cols = {"max |r| [N m]": peak, "contact [N m]": th.contact, "collision [N m]": th.collision}
     rows = [format_rms_table(names, cols)]
     if th.uses_uncertainty and th.noise is not None:

@@ -357,7 +357,7 @@ def detect(
     t : array_like, shape (N,)
         Sample times [s].
     r : array_like, shape (N, n)
-        Residual [N m].
+        Residual [N m]; NaN where the observer did not run (never an event there).
     thresholds : Thresholds
     std : array_like, shape (N, n), optional
         :func:`residual_std` of the samples (for thresholds that use the uncertainty).
@@ -383,9 +383,15 @@ def detect(
     """
     ta = _checks.as_array("t", t)
     N = ta.shape[0]
-    ra = _checks.as_exact("r", r, (N, thresholds.n))
+    ra = _checks.as_exact("r", r, (N, thresholds.n), allow_nonfinite=True)
+    if np.any(np.isinf(ra)):
+        raise ShapeError("r must be finite or NaN (not observed); got inf")
     if not merge_s >= 0:
         raise OptionError(f"merge_s must be >= 0 [s]; got {merge_s}")
+    seen: NDArray[np.bool_] = np.all(np.isfinite(ra), axis=1)
+    if std is not None:  # NaN where not observed, as r
+        std = np.where(seen[:, None], np.asarray(std, dtype=np.float64), 0.0)
+    ra = np.where(seen[:, None], ra, 0.0)
     contact, collision = threshold_series(thresholds, N, std, standstill)
     over = np.abs(ra) > contact
     hit = np.flatnonzero(over.any(axis=1))

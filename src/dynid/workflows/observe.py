@@ -33,10 +33,17 @@ from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
+from numpy.typing import NDArray
 
-from ..exceptions import DynidWarning, OptionError
+from ..exceptions import DataError, DynidWarning, OptionError
 from ..friction.model import FrictionModel
-from ..identification.log import TorqueLog, default_max_gap, joint_side_log, with_derived_velocities
+from ..identification.log import (
+    DEFAULT_CUTOFF_HZ,
+    TorqueLog,
+    default_max_gap,
+    joint_side_log,
+    with_derived_velocities,
+)
 from ..identification.recordings import unwrapped
 from ..io.columns import load_joint_columns
 from ..io.feasible import load_feasible_drive, load_feasible_linear_friction
@@ -56,6 +63,7 @@ from ..observer.pieces import pieces, position_jumps
 from ..observer.residual import DEFAULT_GAIN, ObserverOptions, observe
 from ..observer.results import LogObservation, ObserveResult
 from ..observer.wrench import external_wrench
+from ..signals import edge_seconds, filtered_derivative
 from .data_files import ColumnSpec, column_map, in_file, read_torque_log, recorded_columns
 
 __all__ = [
@@ -224,11 +232,16 @@ def observe_files(opts: ObserveOptions) -> ObserveResult:
         _observe_log(p, model, recorded, opts, options, wants_std, wants_margin) for p in opts.data
     ]
     if given is None:
+        seen = [np.all(np.isfinite(x.r), axis=1) for x in logs]  # observed samples only
         th = calibrate(
-            [x.r for x in logs],
+            [x.r[k] for x, k in zip(logs, seen, strict=True)],
             options,
-            std=[x.std for x in logs] if wants_std else None,  # type: ignore[misc]
-            standstill=[x.standstill for x in logs] if wants_margin else None,  # type: ignore[misc]
+            std=[x.std[k] for x, k in zip(logs, seen, strict=True)] if wants_std else None,  # type: ignore[index]
+            standstill=(
+                [x.standstill[k] for x, k in zip(logs, seen, strict=True)]  # type: ignore[index]
+                if wants_margin
+                else None
+            ),
             margin=opts.margin,
             quantile=opts.quantile,
             collision_factor=opts.collision_factor,
@@ -292,13 +305,15 @@ def _observe_log(
             log = with_derived_velocities(log)
 
     starts = _pieces(path, log, opts)
+    spans = _observed_spans(path, log, starts)
 
     def run() -> LogObservation:
-        t, q, dq, tau, n = log.t, log.q, log.dq, log.tau, model.n
-        r = np.empty((t.shape[0], n))
-        std = np.empty_like(r) if wants_std else None
-        margin = np.empty_like(r) if wants_margin else None
-        for a, b in zip(starts, [*starts[1:], t.shape[0]], strict=True):
+        t, q, tau, n = log.t, log.q, log.tau, model.n
+        dq = _piece_velocities(log, starts)
+        r = np.full((t.shape[0], n), np.nan)
+        std = np.full_like(r, np.nan) if wants_std else None
+        margin = np.zeros_like(r) if wants_margin else None
+        for a, b in spans:
             r[a:b] = observe(model, t[a:b], q[a:b], dq[a:b], tau[a:b], options).r
             if std is not None:
                 std[a:b] = residual_std(model, t[a:b], q[a:b], dq[a:b], options)
@@ -313,10 +328,48 @@ def _observe_log(
             if ext is not None and ext.shape[0] != log.t.shape[0]:
                 ext = None  # rows were dropped: not aligned with the log
         return LogObservation(
-            path, log.t, r, std, [], wrench, ext, margin, tuple(int(k) for k in starts)
+            path, log.t, r, std, [], wrench, ext, margin, tuple(a for a, _ in spans)
         )
 
     return in_file(path, run)
+
+
+def _piece_velocities(log: TorqueLog, starts: list[int]) -> NDArray[np.float64]:
+    """The velocities the observer runs on: the log's, or, for a log of positions only,
+    derived from the positions of each piece on its own (never across a gap)."""
+    if not log.dq_derived:
+        return np.asarray(log.dq)
+    dq = np.array(log.dq)
+    for a, b in zip(starts, [*starts[1:], log.t.shape[0]], strict=True):
+        try:
+            dq[a:b] = filtered_derivative(log.t[a:b], log.q[a:b], DEFAULT_CUTOFF_HZ)
+        except DataError:  # too short to filter: its span is not observed
+            dq[a:b] = np.nan
+    return dq
+
+
+def _observed_spans(path: Path, log: TorqueLog, starts: list[int]) -> list[tuple[int, int]]:
+    """The samples ``[a, b)`` the observer runs on: every piece; for a log of positions
+    only, each piece without the first and last ``2 / cut-off`` seconds, where the derived
+    velocities carry the low-pass's transient (a note says so; their residual is NaN)."""
+    ends = [*starts[1:], log.t.shape[0]]
+    if not log.dq_derived:
+        return list(zip(starts, ends, strict=True))
+    edge = edge_seconds(DEFAULT_CUTOFF_HZ)
+    spans = []
+    for a, b in zip(starts, ends, strict=True):
+        t = log.t[a:b]
+        inside = np.flatnonzero((t >= t[0] + edge) & (t <= t[-1] - edge))
+        if inside.size > 1:
+            spans.append((a + int(inside[0]), a + int(inside[-1]) + 1))
+    warnings.warn(
+        f"{path.name}: velocities derived from the positions of each piece: the first and "
+        f"last {edge:g} s of each piece (the low-pass's transient) are not observed (NaN "
+        "residuals)" + ("" if spans else "; no piece is long enough: nothing is observed"),
+        DynidWarning,
+        stacklevel=4,
+    )
+    return spans
 
 
 def _pieces(path: Path, log: TorqueLog, opts: ObserveOptions) -> list[int]:
