@@ -330,7 +330,7 @@ def test_robot_json_round_trip_keeps_the_kinematics(panda_data):
     np.testing.assert_array_equal(back.phi, 0.0)
     unlimited = robot_from_dict(robot_to_dict(planar_2r()))
     assert np.all(np.isneginf(unlimited.q_min)) and np.all(np.isposinf(unlimited.tau_max))
-    with pytest.raises(DataError, match="missing field 'axes'"):
+    with pytest.raises(DataError, match="key 'axes': missing; expected a 7 x 3 nested list"):
         robot_from_dict({k: v for k, v in robot_to_dict(robot).items() if k != "axes"})
 
 

@@ -31,7 +31,17 @@ from .json_files import jsonable, load_json, save_json
 __all__ = ["Field", "Format", "Record", "check", "describe", "fault", "read_json", "write_json"]
 
 Kind = Literal[
-    "number", "integer", "bool", "string", "strings", "numbers", "object", "objects", "named", "any"
+    "number",
+    "integer",
+    "bool",
+    "string",
+    "strings",
+    "bools",
+    "numbers",
+    "object",
+    "objects",
+    "named",
+    "any",
 ]
 
 
@@ -43,7 +53,8 @@ class Field:
     ----------
     kind : str
         ``number`` (finite, never a boolean or a string), ``integer``, ``bool``, ``string``,
-        ``strings`` (a list of them), ``numbers`` (nested lists of numbers of ``shape``),
+        ``strings`` and ``bools`` (lists of them, of ``shape[0]`` entries when given),
+        ``numbers`` (nested lists of numbers of ``shape``),
         ``object`` (the keys of ``record``), ``objects`` (a list of such objects, of
         ``shape[0]`` entries when given), ``named`` (an object of names, each value an
         object of ``record``) or ``any`` (not checked: metadata).
@@ -140,8 +151,12 @@ def describe(f: Field, sizes: Mapping[str, int] | None = None) -> str:
         text = "true or false"
     elif f.kind == "string":
         text = "a string"
-    elif f.kind == "strings":
-        text = "a list of strings"
+    elif f.kind in ("strings", "bools"):
+        count = _size(f.shape[0], sizes) if f.shape else ""
+        item = "strings" if f.kind == "strings" else "true or false values"
+        text = (
+            f"a {'non-empty ' if f.non_empty else ''}list of {count + ' ' if count else ''}{item}"
+        )
     elif f.kind == "numbers":
         dims = [_size(s, sizes) for s in f.shape] or [""]
         if len(dims) == 1:
@@ -237,9 +252,10 @@ def _value(v: Any, f: Field, source: str, at: str, sizes: dict[str, int]) -> Non
         ok = isinstance(v, bool)
     elif f.kind == "string":
         ok = isinstance(v, str)
-    elif f.kind == "strings":
-        ok = isinstance(v, list) and all(isinstance(x, str) for x in v)
-        ok = ok and (len(v) > 0 or not f.non_empty)
+    elif f.kind in ("strings", "bools"):
+        item = str if f.kind == "strings" else bool
+        ok = isinstance(v, list) and all(isinstance(x, item) for x in v)
+        ok = ok and _count(v, f, sizes)
     elif f.kind == "numbers":
         _numbers(v, f, 0, source, at, sizes)
     elif f.kind == "object":
@@ -250,6 +266,16 @@ def _value(v: Any, f: Field, source: str, at: str, sizes: dict[str, int]) -> Non
         raise fault(source, at, f"expected {describe(f, sizes)}; got {_got(v)}")
     if f.choices and v not in f.choices:
         raise fault(source, at, f"expected {describe(f, sizes)}; got {_got(v)}")
+
+
+def _count(v: list[Any], f: Field, sizes: dict[str, int]) -> bool:
+    """Whether the list ``v`` has the length ``f.shape[0]`` says (a name bound here)."""
+    if f.non_empty and not v:
+        return False
+    s = f.shape[0] if f.shape else None
+    if isinstance(s, str):
+        s = sizes.setdefault(s, len(v))
+    return s is None or len(v) == s
 
 
 def _within(x: float, f: Field) -> bool:
@@ -304,14 +330,8 @@ def _objects(v: Any, f: Field, source: str, at: str, sizes: dict[str, int]) -> N
         for name, item in v.items():
             check(item, record, source, at=f"{at}.{name}", sizes=sizes)
         return
-    if not isinstance(v, list) or (f.non_empty and not v):
+    if not isinstance(v, list) or not _count(v, f, sizes):
         raise fault(source, at, f"expected {describe(f, sizes)}; got {_got(v)}")
-    s = f.shape[0] if f.shape else None
-    if isinstance(s, str) and s not in sizes:
-        sizes[s] = len(v)
-    want = sizes[s] if isinstance(s, str) else s
-    if want is not None and len(v) != want:
-        raise fault(source, at, f"expected {describe(f, sizes)}; got {len(v)} entries")
     for i, item in enumerate(v):
         check(item, record, source, at=f"{at}[{i}]", sizes=sizes)
 
