@@ -948,8 +948,8 @@ CASES = [
     C("toml-mass-true", toml_boolean_mass, "fk --robot {d}/bad.toml --q 0.1,0.2", 2, "key 'inertial.mass' must be a number; got True"),
     C("toml-long-string", toml_long_name, "fk --robot {d}/bad.toml --q 0.1,0.2", 2, "... (1000000 characters)"),
     # bounds files: numbers only where numbers belong
-    C("bounds-mass-true", bounds_boolean_mass, f"retrieve --model {{d}}/res/identification.json --bounds {{d}}/bounds.json --out {OUT}", 2, "bounds.json: links[0] mass[0] must be a number; got True"),
-    C("bounds-mass-string", bounds_string_mass, f"retrieve --model {{d}}/res/identification.json --bounds {{d}}/bounds.toml --out {OUT}", 2, "bounds.toml: links[0] mass[0] must be a number; got '1'"),
+    C("bounds-mass-true", bounds_boolean_mass, f"retrieve --model {{d}}/res/identification.json --bounds {{d}}/bounds.json --out {OUT}", 2, "bounds.json: key 'links[0].mass[0]': expected a number [kg]; got True"),
+    C("bounds-mass-string", bounds_string_mass, f"retrieve --model {{d}}/res/identification.json --bounds {{d}}/bounds.toml --out {OUT}", 2, "bounds.toml: key 'links[0].mass[0]': expected a number [kg]; got '1'"),
     C("bounds-nested-deep", bounds_deep, f"retrieve --model {{d}}/res/identification.json --bounds {{d}}/bounds.toml --out {OUT}", 2, "bounds.toml is not valid TOML (arrays or tables nested too deeply)"),
     # one-joint and prismatic-only arms (issue 20: excite failed on a zero-size minimum)
     C("excite-one-joint", small_arms, f"excite --robot {{d}}/one.toml --duration 3 --harmonics 2 --max-iter 3 --no-figure --out {OUT}", 0, ""),
@@ -1019,8 +1019,8 @@ CASES = [
     C("bounds-mass-1e300", bounds_mass_1e300, f"retrieve --model {{d}}/res/identification.json --bounds {{d}}/bounds.json --out {OUT}", 2, "bounds.json: mass_max must be at most 1e+06 kg per link; got [1e+300,"),
     C("total-mass-1e300", None, f"retrieve --model {{d}}/res/identification.json --total-mass 0,1e300 --out {OUT}", 2, "total_mass max must be at most 7e+06 kg (7 links of at most 1e+06 kg); got 1e+300"),
     C("penalty-total-mass-1e300", None, f"retrieve --model {{d}}/res/identification.json --method penalty --total-mass 0,1e300 --out {OUT}", 2, "total_mass max must be at most 7e+06 kg"),
-    C("bounds-link-twice", bounds_link_twice, f"retrieve --model {{d}}/res/identification.json --bounds {{d}}/twice.json --out {OUT}", 2, "twice.json: links[1]: link 'link1' is listed twice"),
-    C("bounds-units-pounds", bounds_link_twice, f"retrieve --model {{d}}/res/identification.json --bounds {{d}}/lb.json --out {OUT}", 2, "lb.json: units.mass must be 'kg' (bounds are in SI units); got 'lb'"),
+    C("bounds-link-twice", bounds_link_twice, f"retrieve --model {{d}}/res/identification.json --bounds {{d}}/twice.json --out {OUT}", 2, "twice.json: key 'links[1].name': expected each link once; got 'link1' again"),
+    C("bounds-units-pounds", bounds_link_twice, f"retrieve --model {{d}}/res/identification.json --bounds {{d}}/lb.json --out {OUT}", 2, "lb.json: key 'units.mass': expected 'kg' (bounds are in SI units); got 'lb'"),
     C("trajectory-json-unknown-key", trajectory_json_edited, f"simulate --trajectory {{d}}/extra.json --out {OUT}/x.csv", 2, "extra.json: unknown key(s) ['note']"),
     C("trajectory-json-harmonics-string", trajectory_json_edited, f"simulate --trajectory {{d}}/five.json --out {OUT}/x.csv", 2, "five.json: trajectory.harmonics must be a number; got 'five'"),
     C("trajectory-json-duration-edited", trajectory_json_edited, f"simulate --trajectory {{d}}/longer.json --out {OUT}/x.csv", 2, "longer.json: trajectory.total_duration_s = 3 disagrees with the coefficients (21)"),

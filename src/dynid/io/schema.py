@@ -310,7 +310,7 @@ def _numbers(v: Any, f: Field, depth: int, source: str, at: str, sizes: dict[str
         sizes[s] = len(v)
     want = sizes[s] if isinstance(s, str) else s
     if (want is not None and len(v) != want) or (f.non_empty and not v):
-        raise fault(source, at, f"expected {_level(f, depth, sizes)}; got {len(v)} entries")
+        raise fault(source, at, f"expected {_level(f, depth, sizes)}; got {_got(v)}")
     for i, x in enumerate(v):
         _numbers(x, f, depth + 1, source, f"{at}[{i}]", sizes)
 
