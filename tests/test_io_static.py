@@ -295,11 +295,11 @@ def test_model_json_errors_name_the_problem(tmp_path, panda_model):
     """Wrong schema, a missing field and invalid JSON raise DataError."""
     _, model = panda_model
     d = model_to_dict(model)
-    with pytest.raises(DataError, match="schema must be"):
+    with pytest.raises(DataError, match="key 'schema': expected 'dynid-identified-model/1'"):
         model_from_dict({**d, "schema": "something-else"})
     broken = dict(d)
     del broken["base"]
-    with pytest.raises(DataError, match="missing field 'base'"):
+    with pytest.raises(DataError, match="key 'base': missing; expected an object"):
         model_from_dict(broken)
     path = tmp_path / "identification.json"
     path.write_text("{not json")

@@ -238,7 +238,7 @@ def _join(at: str, key: str) -> str:
 
 def _value(v: Any, f: Field, source: str, at: str, sizes: dict[str, int]) -> None:
     if v is None:
-        if not f.nullable:
+        if not f.nullable and f.kind != "any":
             raise fault(source, at, f"expected {describe(f, sizes)}; got null")
         return
     if f.kind == "any":
