@@ -1009,7 +1009,7 @@ CASES = [
     C("acquire-n-1e20", None, f"acquire-static --n {10**20} --out {OUT}/x.csv", 2, "configurations of 7 joints are more than any memory holds"),
     C("obstacles-point-1e300", obstacles_far, f"excite --obstacles {{d}}/far.json --out {OUT}", 2, "far.json: key 'planes[0]': plane point must be at most 1e+06 m in absolute value; got [0.0, 0.0, 1e+300]"),
     C("obstacles-box-1e200", obstacles_far, f"excite --obstacles {{d}}/huge.json --out {OUT}", 2, "huge.json: key 'boxes[0]': box size must be at most 1e+06 m"),
-    C("drive-coupling-twice", drive_coupling_twice, f"identify --data {{d}}/log.csv --drive {{d}}/drive.toml --out {OUT}", 2, "drive.toml: coupling[1]: motor 1 on joint 2 is given twice"),
+    C("drive-coupling-twice", drive_coupling_twice, f"identify --data {{d}}/log.csv --drive {{d}}/drive.toml --out {OUT}", 2, "drive.toml: key 'coupling[1]': expected each entry of K once; got motor 1 on joint 2 again"),
     # column maps: a quantity once, a column for one quantity only
     C("columns-one-column-two-quantities", None, f"validate --robot panda --data {{d}}/log.csv --columns tau=q{{i}} --out {OUT}", 2, "log.csv: column 'q1' is named by the templates of both 'q' and 'tau'"),
     C("static-columns-one-column-two-quantities", None, f"identify --data {{d}}/s.csv --columns g=q{{i}} --out {OUT}", 2, "s.csv: column 'q1' is named by the templates of both 'q' and 'g'"),

@@ -313,7 +313,4 @@ def load_feasible_drive(path: str | Path) -> Drive | None:
     d = read_json(path, FEASIBLE)
     if d.get("drive") is None:
         return None
-    try:
-        return drive_from_record(d["drive"], len(d["links"]))
-    except DataError as exc:
-        raise DataError(f"{Path(path).name}: {exc}") from exc
+    return drive_from_record(d["drive"], len(d["links"]), source=Path(path).name, at="drive")

@@ -137,10 +137,9 @@ def load_friction_json(path: str | Path) -> FrictionModel:
         raise DataError(f"{path.name}: {exc}") from exc
     if doc.get("drive") is None:
         return fr
-    try:
-        return DriveFriction(fr, drive_from_record(doc["drive"], len(joints)))
-    except DataError as exc:
-        raise DataError(f"{path.name}: {exc}") from exc
+    return DriveFriction(
+        fr, drive_from_record(doc["drive"], len(joints), source=path.name, at="drive")
+    )
 
 
 _WHAT = "friction file (dynid friction)"

@@ -50,7 +50,6 @@ import numpy as np
 from numpy.typing import NDArray
 
 from .. import __version__, _checks
-from ..exceptions import DataError
 from ..identification.info import FrictionInfo, IdentificationInfo, LogInfo, StaticInfo
 from ..identification.least_squares import LeastSquaresFit
 from ..identification.model import IdentifiedModel
@@ -404,10 +403,9 @@ def model_from_dict(d: Mapping[str, Any], *, source: str = "identified model") -
     if len(coefs) != r:
         want = f"one per base parameter ({r}, base.rank)"
         raise fault(source, "coefficients", f"expected {want}; got {len(coefs)}")
-    try:
-        drive = None if d.get("drive") is None else drive_from_record(d["drive"], robot.n)
-    except DataError as exc:
-        raise DataError(f"{source}: {exc}") from exc
+    drive = d.get("drive")
+    if drive is not None:
+        drive = drive_from_record(drive, robot.n, source=source, at="drive")
     p = 10 * robot.n
     if drive is not None and drive.identifies_rotor_inertia:
         p += robot.n
