@@ -989,7 +989,7 @@ CASES = [
     C("urdf-two-masses", urdf_two_masses, "fk --robot {d}/bad.urdf --base base --tip l1 --q 0.1", 2, "bad.urdf: <inertial> holds 2 <mass> elements; URDF allows one"),
     C("urdf-two-inertials", urdf_two_inertials, "fk --robot {d}/bad.urdf --base base --tip l1 --q 0.1", 2, "<link name='l1'> holds 2 <inertial> elements"),
     C("npz-duplicated-array", npz_duplicated_member, f"identify --data {{d}}/bad.npz --out {OUT}", 2, "bad.npz: duplicated array(s) ['q.npy']; an array may appear once"),
-    C("model-is-friction", friction_as_model, "predict --model {d}/bad.json --q " + NEUTRAL, 2, "bad.json: not an identified model (dynid identify): 'schema' must be"),
+    C("model-is-friction", friction_as_model, "predict --model {d}/bad.json --q " + NEUTRAL, 2, "bad.json: key 'schema': expected 'dynid-identified-model/1' (an identified model (dynid identify)); got 'dynid-friction/1'"),
     C("identify-prior-without-consistent", None, f"identify --data {{d}}/s.csv --prior panda --total-mass 16,20 --out {OUT}", 2, "--prior, --total-mass apply to --consistent only; add --consistent or leave them out"),
     C("acquire-obstacles-without-pool", floor_only, "acquire-static --n 5 --obstacles {d}/floor.json --out {d}/out.csv", 2, "--obstacles needs --pool"),
     C("bounds-total-inverted", bounds_total_inverted, f"retrieve --model {{d}}/res/identification.json --bounds {{d}}/bounds.json --out {OUT}", 2, "total_mass must be (min, max) with 0 <= min <= max; got (20, 16)"),

@@ -213,7 +213,10 @@ def test_obstacles_file_is_read_and_errors_name_the_problem(tmp_path):
     ):
         load_obstacles(p)
     p.write_text(json.dumps({"schema": "other"}))
-    with pytest.raises(DataError, match="'schema' must be"):
+    with pytest.raises(
+        DataError,
+        match=r"obs.json: key 'schema': expected 'dynid-obstacles/1' \(an obstacles file\); got",
+    ):
         load_obstacles(p)
     assert main(["excite", "--obstacles", str(p), "--out", str(tmp_path / "x")]) == 2
 
