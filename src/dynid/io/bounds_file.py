@@ -31,8 +31,8 @@ from ..model.inertia import INERTIA_ORDER
 from ..model.robot import Robot
 from .atomic import write_text
 from .input_files import file_text
-from .json_files import load_json, save_json
-from .schema import Field, Record, check, fault
+from .json_files import load_json
+from .schema import Field, Format, Record, check, fault, write_json
 
 __all__ = [
     "BOUNDS_RECORD",
@@ -196,4 +196,4 @@ def save_bounds(path: str | Path, bounds: Bounds) -> Path:
         return write_text(path, "\n".join(lines) + "\n")
     if path.suffix.lower() != ".json":
         raise DataError(f"{path.name}: bounds files are .json or .toml; got {path.suffix!r}")
-    return save_json(path, d)
+    return write_json(path, Format(BOUNDS_SCHEMA, BOUNDS_RECORD, "bounds file"), d)

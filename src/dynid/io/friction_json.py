@@ -35,8 +35,8 @@ from ..friction.fit import FrictionFit
 from ..friction.laws import LAWS
 from ..friction.model import DriveFriction, FrictionModel
 from .drive_file import drive_from_record
-from .json_files import load_json, save_json
-from .schema import Field, Record, check, describe, fault
+from .json_files import load_json
+from .schema import Field, Format, Record, check, describe, fault, write_json
 
 __all__ = ["FORMAT", "load_friction_json", "save_friction_json"]
 
@@ -100,7 +100,7 @@ def save_friction_json(
     }
     if selection is not None:
         doc["selection"] = selection
-    return save_json(path, doc)
+    return write_json(path, Format(FORMAT, _record(model.kind), _WHAT), doc)
 
 
 def load_friction_json(path: str | Path) -> FrictionModel:
