@@ -30,7 +30,7 @@ from dynid.io.friction_json import FORMAT, _record, load_friction_json, save_fri
 from dynid.io.model_json import MODEL
 from dynid.io.observer_files import THRESHOLDS, load_thresholds, save_thresholds
 from dynid.io.robot_json import ROBOT_RECORD, ROBOT_SCHEMA
-from dynid.io.schema import Field, Format, Record, check, read_json, write_json
+from dynid.io.schema import Field, Format, Record, check, load_document, save_document
 from dynid.model.drive import DRIVE_SCHEMA
 from dynid.observer.detection import Thresholds
 from dynid.observer.residual import ObserverOptions
@@ -128,7 +128,7 @@ def _file(draw: Any, fmt: Format) -> dict[str, Any]:
 
 @pytest.mark.parametrize("name", sorted(FORMATS))
 def test_any_document_a_format_admits_reads_back_equal(name):
-    """write_json then read_json gives back the very document, every key of the format
+    """save_document then load_document gives back the very document, every key of the format
     drawn (floats exactly: shortest round-trip representation)."""
     fmt = FORMATS[name]
 
@@ -136,8 +136,8 @@ def test_any_document_a_format_admits_reads_back_equal(name):
     @given(doc=_file(fmt))
     def round_trip(doc: dict[str, Any]) -> None:
         with tempfile.TemporaryDirectory() as d:
-            path = write_json(Path(d) / "f.json", fmt, doc)
-            back = read_json(path, fmt)
+            path = save_document(Path(d) / "f.json", fmt, doc)
+            back = load_document(path, fmt)
         assert back == doc
         assert json.dumps(back, sort_keys=True) == json.dumps(doc, sort_keys=True)
 
@@ -337,7 +337,7 @@ def test_check_names_sizes_once_for_the_whole_file():
 
 
 def test_a_writer_never_writes_what_its_reader_refuses(tmp_path):
-    """write_json checks before writing: a document its format refuses leaves no file."""
+    """save_document checks before writing: a document its format refuses leaves no file."""
     with pytest.raises(DataError, match=r"^t.json: key 'contact': missing"):
-        write_json(tmp_path / "t.json", THRESHOLDS, {"collision": [1.0]})
+        save_document(tmp_path / "t.json", THRESHOLDS, {"collision": [1.0]})
     assert not (tmp_path / "t.json").exists()

@@ -32,7 +32,7 @@ from ..model.robot import Robot
 from .atomic import write_text
 from .input_files import file_text
 from .json_files import load_json
-from .schema import Field, Format, Record, check, fault, write_json
+from .schema import Field, Format, Record, check, fault, save_document
 
 __all__ = [
     "BOUNDS_RECORD",
@@ -196,4 +196,4 @@ def save_bounds(path: str | Path, bounds: Bounds) -> Path:
         return write_text(path, "\n".join(lines) + "\n")
     if path.suffix.lower() != ".json":
         raise DataError(f"{path.name}: bounds files are .json or .toml; got {path.suffix!r}")
-    return write_json(path, Format(BOUNDS_SCHEMA, BOUNDS_RECORD, "bounds file"), d)
+    return save_document(path, Format(BOUNDS_SCHEMA, BOUNDS_RECORD, "bounds file"), d)

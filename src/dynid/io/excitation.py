@@ -39,7 +39,7 @@ from ..simulation.excitation import ExcitationResult, ExcitingTrajectory
 from ..simulation.trajectories import Trajectory
 from .atomic import open_atomic
 from .json_files import finite_or_none
-from .schema import Field, Format, Record, fault, read_json, write_json
+from .schema import Field, Format, Record, fault, load_document, save_document
 from .torque_log import csv_table
 
 __all__ = [
@@ -139,7 +139,7 @@ def save_excitation_json(
         "history": list(result.history),
     }
     # limits, margins and condition numbers may be infinite (no limit, no obstacle): null
-    return write_json(path, EXCITATION, finite_or_none(d))
+    return save_document(path, EXCITATION, finite_or_none(d))
 
 
 _V3 = Field("numbers", required=True, shape=(3,), unit="m")
@@ -219,7 +219,7 @@ def load_obstacles(path: str | Path) -> Obstacles:
         The file cannot be read.
     """
     path = Path(path)
-    return obstacles_from_dict(read_json(path, OBSTACLES), path.name)
+    return obstacles_from_dict(load_document(path, OBSTACLES), path.name)
 
 
 def obstacles_from_dict(d: Mapping[str, Any], source: str) -> Obstacles:
@@ -290,7 +290,7 @@ def load_exciting_trajectory(path: str | Path, n: int) -> ExcitingTrajectory:
         As :func:`load_trajectory` for a JSON file.
     """
     path = Path(path)
-    tr = read_json(path, EXCITATION)["trajectory"]
+    tr = load_document(path, EXCITATION)["trajectory"]
     try:
         traj = ExcitingTrajectory.from_dict(tr)
     except (TypeError, ValueError) as exc:

@@ -41,7 +41,7 @@ from ..model.robot import MAX_LINK_MASS, MAX_LINK_OFFSET, Robot
 from .drive_file import drive_from_record
 from .json_files import finite_or_none, load_json
 from .robot_json import ROBOT_RECORD, robot_from_dict, robot_to_dict
-from .schema import Field, Format, Record, check, fault, read_json, write_json
+from .schema import Field, Format, Record, check, fault, load_document, save_document
 
 __all__ = [
     "FEASIBLE",
@@ -195,7 +195,7 @@ def save_feasible_json(path: str | Path, source: FeasibleResult | Robot) -> Path
     NonFiniteError
         A NaN or infinite number in the parameters (named).
     """
-    return write_json(path, FEASIBLE, feasible_to_dict(source))
+    return save_document(path, FEASIBLE, feasible_to_dict(source))
 
 
 def robot_from_feasible_dict(
@@ -299,7 +299,7 @@ def load_feasible_linear_friction(path: str | Path) -> ClassicalFriction | Drive
     uses it unless another friction is given. With a drive whose friction acts at the
     motors, the law per motor mapped through the transmission (:class:`DriveFriction`).
     """
-    lin = read_json(path, FEASIBLE).get("linear_friction")
+    lin = load_document(path, FEASIBLE).get("linear_friction")
     if lin is None:
         return None
     law = ClassicalFriction(*(np.array(lin[k], dtype=float) for k in ("fv", "fc", "fo")))
@@ -310,7 +310,7 @@ def load_feasible_linear_friction(path: str | Path) -> ClassicalFriction | Drive
 def load_feasible_drive(path: str | Path) -> Drive | None:
     """The drive train held by ``feasible.json`` (its rotor inertias the identified ones), or
     None."""
-    d = read_json(path, FEASIBLE)
+    d = load_document(path, FEASIBLE)
     if d.get("drive") is None:
         return None
     return drive_from_record(d["drive"], len(d["links"]), source=Path(path).name, at="drive")

@@ -36,7 +36,7 @@ from ..friction.laws import LAWS
 from ..friction.model import DriveFriction, FrictionModel
 from .drive_file import drive_from_record
 from .json_files import load_json
-from .schema import Field, Format, Record, check, describe, fault, write_json
+from .schema import Field, Format, Record, check, describe, fault, save_document
 
 __all__ = ["FORMAT", "load_friction_json", "save_friction_json"]
 
@@ -100,7 +100,7 @@ def save_friction_json(
     }
     if selection is not None:
         doc["selection"] = selection
-    return write_json(path, Format(FORMAT, _record(model.kind), _WHAT), doc)
+    return save_document(path, Format(FORMAT, _record(model.kind), _WHAT), doc)
 
 
 def load_friction_json(path: str | Path) -> FrictionModel:

@@ -58,7 +58,7 @@ from ..regressors.base import BaseParameters
 from .drive_file import drive_from_record
 from .json_files import finite_or_none, load_json
 from .robot_json import ROBOT_RECORD, robot_from_dict, robot_to_dict
-from .schema import Field, Format, Record, check, fault, write_json
+from .schema import Field, Format, Record, check, fault, save_document
 
 __all__ = [
     "MODEL",
@@ -466,7 +466,7 @@ def save_model_json(path: str | Path, model: IdentifiedModel, *, seed: int | Non
     NonFiniteError
         A NaN or infinite number (named).
     """
-    return write_json(path, MODEL, model_to_dict(model, seed=seed))
+    return save_document(path, MODEL, model_to_dict(model, seed=seed))
 
 
 def load_model_json(path: str | Path) -> IdentifiedModel:

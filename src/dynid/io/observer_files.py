@@ -35,7 +35,7 @@ from ..observer.residual import ObserverOptions
 from ..observer.results import LogObservation, ObserveResult
 from .atomic import open_atomic
 from .json_files import save_json
-from .schema import Field, Format, Record, read_json, write_json
+from .schema import Field, Format, Record, load_document, save_document
 
 __all__ = [
     "EVENTS_SCHEMA",
@@ -132,7 +132,7 @@ def save_thresholds(
         "calibration": {"samples": th.samples, **(calibration or {})},
         "units": {"contact": "N m", "collision": "N m", "noise": "N m", "gain": "1/s"},
     }
-    return write_json(path, THRESHOLDS, doc)
+    return save_document(path, THRESHOLDS, doc)
 
 
 def load_thresholds(path: str | Path) -> Thresholds:
@@ -144,7 +144,7 @@ def load_thresholds(path: str | Path) -> Thresholds:
         Not a thresholds file (schema), an unknown key, a missing or malformed entry (named).
     """
     path = Path(path)
-    d = read_json(path, THRESHOLDS)
+    d = load_document(path, THRESHOLDS)
     rule, obs, unc = d["rule"], d["observer"], d.get("uncertainty")
     try:
         return Thresholds(

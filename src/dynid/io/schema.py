@@ -3,7 +3,7 @@
 A :class:`Format` names a JSON file's ``schema`` tag and its :class:`Record`: each key a
 :class:`Field` declaring its kind, the sizes of a list of numbers (a name such as ``"n"``
 is bound by its first use, so that every per-joint list must have the same length), its
-unit and its limits. :func:`read_json` and :func:`write_json` are the reader and writer of
+unit and its limits. :func:`load_document` and :func:`save_document` are the reader and writer of
 such a file; :func:`check` checks any parsed mapping (a TOML table included) against a
 record. Every fault is a :class:`~dynid.exceptions.DataError` in one wording, naming the
 file (or source) and the key path::
@@ -28,7 +28,16 @@ from .. import _checks
 from ..exceptions import DataError, NonFiniteError
 from .json_files import jsonable, load_json, save_json
 
-__all__ = ["Field", "Format", "Record", "check", "describe", "fault", "read_json", "write_json"]
+__all__ = [
+    "Field",
+    "Format",
+    "Record",
+    "check",
+    "describe",
+    "fault",
+    "load_document",
+    "save_document",
+]
 
 Kind = Literal[
     "number",
@@ -336,7 +345,7 @@ def _objects(v: Any, f: Field, source: str, at: str, sizes: dict[str, int]) -> N
         check(item, record, source, at=f"{at}[{i}]", sizes=sizes)
 
 
-def read_json(
+def load_document(
     path: str | Path, fmt: Format, *, sizes: dict[str, int] | None = None
 ) -> dict[str, Any]:
     """Read a strict JSON file of format ``fmt`` and check it (:func:`check`).
@@ -355,9 +364,9 @@ def read_json(
     return d
 
 
-def write_json(path: str | Path, fmt: Format, doc: Mapping[str, Any]) -> Path:
+def save_document(path: str | Path, fmt: Format, doc: Mapping[str, Any]) -> Path:
     """Write ``doc`` as a file of format ``fmt`` (``schema`` first), atomically, after
-    checking it as :func:`read_json` will: a writer never writes what its reader refuses.
+    checking it as :func:`load_document` will: a writer never writes what its reader refuses.
 
     Raises
     ------
