@@ -155,12 +155,15 @@ def test_without_the_coupling_the_fit_is_worse():
     [
         ({"gear_ratio": [1, 2]}, "list of 3 numbers"),
         ({"gear_ratio": [1, 0, 1]}, "singular"),
-        ({"coupling": [[4, 1, 2.0]]}, "1..3"),
+        (
+            {"coupling": [[4, 1, 2.0]]},
+            r"key 'coupling\[0\].motor': expected an integer in \[1, 3\]; got 4",
+        ),
         ({"coupling": [[1, 1, 2.0]]}, "gear_ratio"),
         ({"effort": "current"}, "torque_constant"),
-        ({"side": "motors"}, "'side' must be one of"),
-        ({"gear": [1, 2, 3]}, "unknown key 'gear'"),
-        ({"offset": [0, True, 0]}, "must be a number"),
+        ({"side": "motors"}, "key 'side': expected one of 'joint', 'motor'; got 'motors'"),
+        ({"gear": [1, 2, 3]}, "key 'gear': unknown key; allowed: coupling, effort"),
+        ({"offset": [0, True, 0]}, r"key 'offset\[1\]': expected a number; got True"),
         ({"rotor_inertia": [0.1, -0.1, 0.0]}, "rotor_inertia must be >= 0"),
         ({"rotor_inertia": "fit"}, "'identify', a number or a list"),
         ({"schema": "dynid-drive/9"}, "schema"),
@@ -190,7 +193,9 @@ def test_drive_file_and_robot_toml_drive_table(tmp_path):
     )
     d2 = load_drive(r, 2)
     np.testing.assert_array_equal(d2.transmission, d.transmission)
-    with pytest.raises(DataError, match="missing key 'schema'"):
+    with pytest.raises(
+        DataError, match="bad.toml: key 'schema': missing; expected 'dynid-drive/1'"
+    ):
         (tmp_path / "bad.toml").write_text(text)
         load_drive(tmp_path / "bad.toml", 2)
 

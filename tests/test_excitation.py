@@ -207,10 +207,16 @@ def test_obstacles_file_is_read_and_errors_name_the_problem(tmp_path):
     obs = load_obstacles(p)
     assert obs.names == ("table", "fixture") and obs.planes[0].normal == (0.0, 0.0, 1.0)
     p.write_text(json.dumps({"schema": "dynid-obstacles/1", "boxes": [{"center": [0, 0, 0]}]}))
-    with pytest.raises(DataError, match=r"boxes\[0\] \('box1'\): missing key 'size'"):
+    with pytest.raises(
+        DataError,
+        match=r"obs.json: key 'boxes\[0\].size': missing; expected a list of 3 numbers \[m\]",
+    ):
         load_obstacles(p)
     p.write_text(json.dumps({"schema": "other"}))
-    with pytest.raises(DataError, match="'schema' must be"):
+    with pytest.raises(
+        DataError,
+        match=r"obs.json: key 'schema': expected 'dynid-obstacles/1' \(an obstacles file\); got",
+    ):
         load_obstacles(p)
     assert main(["excite", "--obstacles", str(p), "--out", str(tmp_path / "x")]) == 2
 
@@ -221,23 +227,24 @@ _BAD_OBSTACLES = [
     ("duplicated-planes", f'{{"schema": "dynid-obstacles/1", "planes": [{_PLANE}], "planes": []}}',
      "duplicated key 'planes'"),
     ("unknown-top-key", f'{{"schema": "dynid-obstacles/1", "plane": [{_PLANE}]}}',
-     "unknown key(s) ['plane']"),
+     "key 'plane': unknown key; allowed: boxes, planes, schema"),
     ("unknown-plane-key", '{"schema": "dynid-obstacles/1", "planes": [{"point": [0, 0, 0], '
-     '"normal": [0, 0, 1], "offset": 0.1}]}', "planes[0] ('plane1'): unknown key(s) ['offset']"),
+     '"normal": [0, 0, 1], "offset": 0.1}]}',
+     "key 'planes[0].offset': unknown key; allowed: name, normal, point"),
     ("boolean-coordinate", '{"schema": "dynid-obstacles/1", "planes": [{"point": [0, 0, true], '
-     '"normal": [0, 0, 1]}]}', "point[2] must be a number; got True"),
+     '"normal": [0, 0, 1]}]}', "key 'planes[0].point[2]': expected a number [m]; got True"),
     ("string-coordinate", '{"schema": "dynid-obstacles/1", "boxes": [{"center": [0, 0, "0.1"], '
-     '"size": [1, 1, 1]}]}', "center[2] must be a number; got '0.1'"),
+     '"size": [1, 1, 1]}]}', "key 'boxes[0].center[2]': expected a number [m]; got '0.1'"),
     ("two-coordinates", '{"schema": "dynid-obstacles/1", "boxes": [{"center": [0, 0], '
-     '"size": [1, 1, 1]}]}', "center must be a list of shape (3,)"),
+     '"size": [1, 1, 1]}]}', "key 'boxes[0].center': expected a list of 3 numbers [m]; got [0, 0]"),
     ("zero-normal", '{"schema": "dynid-obstacles/1", "planes": [{"point": [0, 0, 0], '
      '"normal": [0, 0, 0]}]}', "plane normal must be non-zero"),
     ("flat-box", '{"schema": "dynid-obstacles/1", "boxes": [{"center": [0, 0, 0], '
      '"size": [1, 0, 1]}]}', "box size must be positive"),
     ("repeated-name", f'{{"schema": "dynid-obstacles/1", "planes": [{_PLANE}, {_PLANE}]}}',
-     "planes[1] ('floor'): the name is used by another obstacle"),
+     "key 'planes[1].name': expected a name of one obstacle; got 'floor' again"),
     ("planes-not-a-list", '{"schema": "dynid-obstacles/1", "planes": {"point": [0, 0, 0]}}',
-     "'planes' must be a list"),
+     "key 'planes': expected a list of objects; got {'point': [0, 0, 0]}"),
     ("integer-of-400-digits", '{"schema": "dynid-obstacles/1", "planes": [{"point": [0, 0, 1'
      + "0" * 400 + '], "normal": [0, 0, 1]}]}', "an integer of 401 digits overflows a float"),
     ("nested-10000-deep", '{"schema": "dynid-obstacles/1", "planes": ' + "[" * 10000
@@ -344,10 +351,22 @@ def test_trajectory_json_is_read_strictly(tmp_path):
     p.write_text(json.dumps(doc))
     np.testing.assert_allclose(load_trajectory(p, 2, fs=100.0).q, tr.sample(100.0).q)
     for edit, message in [
-        (lambda d: d["trajectory"].update(extra=1), r"trajectory: unknown key\(s\) \['extra'\]"),
-        (lambda d: d["trajectory"].update(ramp_s=True), "ramp_s must be a number; got True"),
-        (lambda d: d["trajectory"]["a_rad_s"][0].__setitem__(1, "0.1"), r"a_rad_s\[0\]\[1\]"),
-        (lambda d: d["trajectory"].pop("b_rad_s"), r"missing key\(s\) \['b_rad_s'\]"),
+        (
+            lambda d: d["trajectory"].update(extra=1),
+            r"t.json: key 'trajectory.extra': unknown key; allowed: a_rad_s",
+        ),
+        (
+            lambda d: d["trajectory"].update(ramp_s=True),
+            "key 'trajectory.ramp_s': expected a number \\[s\\]; got True",
+        ),
+        (
+            lambda d: d["trajectory"]["a_rad_s"][0].__setitem__(1, "0.1"),
+            r"key 'trajectory.a_rad_s\[0\]\[1\]': expected a number; got '0.1'",
+        ),
+        (
+            lambda d: d["trajectory"].pop("b_rad_s"),
+            r"key 'trajectory.b_rad_s': missing; expected a 2 x 2 nested list of numbers",
+        ),
     ]:
         bad = json.loads(json.dumps(doc))
         edit(bad)

@@ -152,12 +152,12 @@ def test_friction_json_round_trip(tmp_path, panda):
     assert doc["model"] == "sigmoid" and set(doc["joints"][0]) == {"phi1", "phi2", "phi3"}
     del doc["joints"][2]["phi2"]
     (tmp_path / "bad.json").write_text(json.dumps(doc))
-    with pytest.raises(DataError, match="joint 3 has no 'phi2'"):
+    with pytest.raises(DataError, match=r"key 'joints\[2\].phi2': missing; expected a number"):
         load_friction_json(tmp_path / "bad.json")
     (tmp_path / "bad2.json").write_text(
         '{"schema": "dynid-friction/1", "model": "stribek", "joints": []}'
     )
-    with pytest.raises(DataError, match="'model' must be"):
+    with pytest.raises(DataError, match="key 'model': expected one of"):
         load_friction_json(tmp_path / "bad2.json")
 
 

@@ -24,7 +24,7 @@ import pytest
 import dynid
 from dynid.cli.__main__ import main
 from dynid.io.robot.toml import save_toml
-from dynid.io.run_output import MANIFEST
+from dynid.outputs.run_output import MANIFEST
 from dynid.report import (
     REPORT_NAME,
     ReportTable,

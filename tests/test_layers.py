@@ -21,6 +21,7 @@ LAYERS = [
     {"observer"},
     {"pipeline"},
     {"io"},
+    {"outputs"},
     {"report"},
     {"workflows"},
     {"plots"},

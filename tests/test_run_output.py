@@ -23,7 +23,7 @@ from pathlib import Path
 import pytest
 
 from dynid.cli.__main__ import main
-from dynid.io.run_output import MANIFEST
+from dynid.outputs.run_output import MANIFEST
 
 pytestmark = pytest.mark.skipif(sys.platform == "win32", reason="POSIX locks and signals")
 
@@ -350,7 +350,7 @@ def test_run_output_stages_and_names_the_staged_location(tmp_path):
     """Inside run_output, a file under --out is written in the staging folder beside it
     and current_location says where; it appears under --out when the block ends."""
     from dynid.io.atomic import current_location, write_text
-    from dynid.io.run_output import run_output
+    from dynid.outputs.run_output import run_output
 
     out = tmp_path / "o"
     with run_output(out, command="test") as run:
@@ -372,7 +372,7 @@ def test_the_record_is_strict_json_and_outlives_a_signal_after_the_move(tmp_path
     removes it: the set stays recorded, so a rerun does not call its files foreign."""
     from dynid.io.atomic import output_transaction, write_text
     from dynid.io.json_files import load_json
-    from dynid.io.run_output import run_output
+    from dynid.outputs.run_output import run_output
 
     out = tmp_path / "o"
     out.mkdir()
@@ -393,7 +393,7 @@ def test_a_record_with_a_duplicated_key_is_not_trusted(tmp_path):
     set: the file it names is the user's and is not replaced without force."""
     from dynid.exceptions import OutputError
     from dynid.io.atomic import write_text
-    from dynid.io.run_output import run_output
+    from dynid.outputs.run_output import run_output
 
     out = tmp_path / "o"
     out.mkdir()

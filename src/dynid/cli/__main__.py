@@ -38,7 +38,7 @@ from .. import __version__
 from .._checks import one_line
 from ..exceptions import DynidError
 from ..io.atomic import output_transaction
-from ..io.run_output import RunOutput, run_output
+from ..outputs.run_output import RunOutput, run_output
 from .console import Console
 from .run_report import RunRecord, save_run_report
 
@@ -216,7 +216,7 @@ def decode_text_options(args: argparse.Namespace) -> None:
 
 @contextlib.contextmanager
 def _output_set(args: argparse.Namespace, argv: Sequence[str]) -> Iterator[RunOutput | None]:
-    """The run's output set under ``--out`` (:func:`dynid.io.run_output.run_output`)."""
+    """The run's output set under ``--out`` (:func:`dynid.outputs.run_output.run_output`)."""
     kind, out = getattr(args, "_output", None), getattr(args, "out", None)
     if kind is None or out is None:
         yield None

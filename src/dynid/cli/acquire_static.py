@@ -48,7 +48,7 @@ from .common import (
 from .console import Console
 
 NAME = "acquire-static"
-#: ``--out`` is the one file written (:mod:`dynid.io.run_output`).
+#: ``--out`` is the one file written (:mod:`dynid.outputs.run_output`).
 OUTPUT = "file"
 
 

@@ -63,7 +63,7 @@ from .demo_stages import (
 from .summaries import format_collision_stage, progress_printer
 
 NAME = "demo"
-#: ``--out`` is a folder: its files are one output set (:mod:`dynid.io.run_output`).
+#: ``--out`` is a folder: its files are one output set (:mod:`dynid.outputs.run_output`).
 OUTPUT = "folder"
 
 

@@ -41,7 +41,7 @@ from .common import add_robot_options, add_subcommand, load_robot, output_path, 
 from .console import Console
 
 NAME = "excite"
-#: ``--out`` is a folder: its files are one output set (:mod:`dynid.io.run_output`).
+#: ``--out`` is a folder: its files are one output set (:mod:`dynid.outputs.run_output`).
 OUTPUT = "folder"
 
 

@@ -43,7 +43,7 @@ from .common import add_drive_option, add_subcommand, load_drive_arg, output_pat
 from .console import Console
 
 NAME = "export"
-#: ``--out`` is the one file written (:mod:`dynid.io.run_output`).
+#: ``--out`` is the one file written (:mod:`dynid.outputs.run_output`).
 OUTPUT = "file"
 
 

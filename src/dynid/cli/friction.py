@@ -54,7 +54,7 @@ from .figures import save_friction_figure
 from .summaries import format_rms_table
 
 NAME = "friction"
-#: ``--out`` is a folder: its files are one output set (:mod:`dynid.io.run_output`).
+#: ``--out`` is a folder: its files are one output set (:mod:`dynid.outputs.run_output`).
 OUTPUT = "folder"
 
 

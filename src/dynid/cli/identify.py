@@ -111,7 +111,7 @@ from .figures import save_identify_figures, save_retrieval_figure
 from .summaries import format_consistent, format_identification
 
 NAME = "identify"
-#: ``--out`` is a folder: its files are one output set (:mod:`dynid.io.run_output`).
+#: ``--out`` is a folder: its files are one output set (:mod:`dynid.outputs.run_output`).
 OUTPUT = "folder"
 
 

@@ -27,7 +27,7 @@ from .common import add_robot_options, add_subcommand, load_robot, output_path, 
 from .console import Console
 
 NAME = "import"
-#: ``--out`` is the one file written (:mod:`dynid.io.run_output`).
+#: ``--out`` is the one file written (:mod:`dynid.outputs.run_output`).
 OUTPUT = "file"
 
 

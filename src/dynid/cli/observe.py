@@ -53,7 +53,7 @@ from .figures import save_observer_figures
 from .summaries import format_observation
 
 NAME = "observe"
-#: ``--out`` is a folder: its files are one output set (:mod:`dynid.io.run_output`).
+#: ``--out`` is a folder: its files are one output set (:mod:`dynid.outputs.run_output`).
 OUTPUT = "folder"
 
 

@@ -41,7 +41,7 @@ from .console import Console
 from .sources import load_model_source
 
 NAME = "payload"
-#: ``--out`` is a folder: its files are one output set (:mod:`dynid.io.run_output`).
+#: ``--out`` is a folder: its files are one output set (:mod:`dynid.outputs.run_output`).
 OUTPUT = "folder"
 
 

@@ -73,7 +73,7 @@ from .figures import save_retrieval_figure
 from .summaries import format_consistent, format_retrieval, progress_printer
 
 NAME = "retrieve"
-#: ``--out`` is a folder: its files are one output set (:mod:`dynid.io.run_output`).
+#: ``--out`` is a folder: its files are one output set (:mod:`dynid.outputs.run_output`).
 OUTPUT = "folder"
 
 

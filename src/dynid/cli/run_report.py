@@ -19,7 +19,7 @@ import time
 from collections.abc import Sequence
 from typing import Any, TextIO
 
-from ..io.run_output import RunOutput
+from ..outputs.run_output import RunOutput
 from ..report import REPORT_NAME, ReportTable, RunSummary, save_html_report
 
 __all__ = ["RunRecord", "save_run_report"]

@@ -71,7 +71,7 @@ from .common import (
 from .console import Console
 
 NAME = "simulate"
-#: ``--out`` is the one file written (:mod:`dynid.io.run_output`).
+#: ``--out`` is the one file written (:mod:`dynid.outputs.run_output`).
 OUTPUT = "file"
 log = logging.getLogger(__name__)
 

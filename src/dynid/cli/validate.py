@@ -57,7 +57,7 @@ from .sources import load_model_source
 from .summaries import format_rms_table
 
 NAME = "validate"
-#: ``--out`` is a folder: its files are one output set (:mod:`dynid.io.run_output`).
+#: ``--out`` is a folder: its files are one output set (:mod:`dynid.outputs.run_output`).
 OUTPUT = "folder"
 
 

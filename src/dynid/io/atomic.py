@@ -10,7 +10,7 @@ Every writer of dynid goes through this module:
 * :func:`open_atomic`, :func:`write_text` and :func:`write_bytes` are the same for a file
   object, a string and bytes.
 * The destination folder is created only when a file is written into it.
-* Inside :func:`dynid.io.run_output.run_output` (every command that writes into
+* Inside :func:`dynid.outputs.run_output.run_output` (every command that writes into
   ``--out``), a path under ``--out`` is written into that run's staging folder instead;
   :func:`current_location` says where a file written in the run is now.
 * :func:`output_transaction` groups the files of one command: on failure, the files and
@@ -41,7 +41,7 @@ __all__ = [
 
 #: Stack of active transactions; each records (created files, created folders).
 _TRANSACTIONS: list[tuple[list[Path], list[Path]]] = []
-#: Active run outputs (:class:`dynid.io.run_output.RunOutput`): each has ``stage(path)``
+#: Active run outputs (:class:`dynid.outputs.run_output.RunOutput`): each has ``stage(path)``
 #: (the staged path of a file under its ``--out``, or None), ``location(path)`` and
 #: ``manages(path)`` (its own record, which it puts back or removes itself).
 _REDIRECTS: list[Any] = []

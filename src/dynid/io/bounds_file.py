@@ -31,9 +31,17 @@ from ..model.inertia import INERTIA_ORDER
 from ..model.robot import Robot
 from .atomic import write_text
 from .input_files import file_text
-from .json_files import load_json, save_json
+from .json_files import load_json
+from .schema import Field, Format, Record, check, fault, save_document
 
-__all__ = ["BOUNDS_SCHEMA", "bounds_from_dict", "bounds_to_dict", "load_bounds", "save_bounds"]
+__all__ = [
+    "BOUNDS_RECORD",
+    "BOUNDS_SCHEMA",
+    "bounds_from_dict",
+    "bounds_to_dict",
+    "load_bounds",
+    "save_bounds",
+]
 
 BOUNDS_SCHEMA = "dynid-feasibility-bounds/1"
 
@@ -68,26 +76,25 @@ def bounds_to_dict(bounds: Bounds) -> dict[str, Any]:
 
 #: The unit each ``units`` entry must start with (what follows describes the frame).
 _UNITS = {"mass": "kg", "com": "m", "inertia": "kg m^2", "total_mass": "kg"}
-
-
-def _check_units(units: Any, source: str) -> None:
-    """Refuse a ``units`` table that is not the one dynid writes (``mass = "lb"`` was
-    ignored: the numbers were read as kg)."""
-    if units is None:
-        return
-    if not isinstance(units, Mapping):
-        raise DataError(f"{source}: 'units' must be a table/object; got {_checks.short(units)}")
-    for key, value in units.items():
-        if key not in _UNITS:
-            raise DataError(
-                f"{source}: units: unknown key {_checks.short(key)}; allowed: {sorted(_UNITS)}"
-            )
-        unit = value.split(",")[0].strip() if isinstance(value, str) else None
-        if unit != _UNITS[key]:
-            raise DataError(
-                f"{source}: units.{key} must be {_UNITS[key]!r} (bounds are in SI units); "
-                f"got {_checks.short(value)}"
-            )
+_LINK = Record(
+    {
+        "name": Field("string", required=True),
+        "mass": Field("numbers", shape=(2,), unit="kg"),
+        "com_min": Field("numbers", shape=(3,), unit="m"),
+        "com_max": Field("numbers", shape=(3,), unit="m"),
+        "inertia_min": Field("numbers", shape=(6,), unit="kg m^2"),
+        "inertia_max": Field("numbers", shape=(6,), unit="kg m^2"),
+    }
+)
+#: a bounds file, JSON or TOML (module docstring)
+BOUNDS_RECORD = Record(
+    {
+        "schema": Field("string", choices=(BOUNDS_SCHEMA,)),
+        "total_mass": Field("numbers", nullable=True, unit="kg"),
+        "links": Field("objects", nullable=True, record=_LINK),
+        "units": Field("object", record=Record({k: Field("string") for k in _UNITS})),
+    }
+)
 
 
 def bounds_from_dict(d: Mapping[str, Any], robot: Robot, *, source: str = "bounds") -> Bounds:
@@ -99,54 +106,47 @@ def bounds_from_dict(d: Mapping[str, Any], robot: Robot, *, source: str = "bound
         Unknown keys, a link name the robot does not have or listed twice, units other
         than SI, malformed or inconsistent values (lower above upper, negative mass).
     """
-    unknown = sorted(set(d) - {"schema", "total_mass", "links", "units"})
-    if unknown:
-        raise DataError(f"{source}: unknown keys {_checks.short(unknown)}")
-    schema = d.get("schema", BOUNDS_SCHEMA)
-    if schema != BOUNDS_SCHEMA:
-        raise DataError(f"{source}: schema {schema!r}, expected {BOUNDS_SCHEMA!r}")
+    check(d, BOUNDS_RECORD, source)
+    for key, value in (d.get("units") or {}).items():
+        if value.split(",")[0].strip() != _UNITS[key]:  # "lb" was read as kg
+            raise fault(
+                source,
+                f"units.{key}",
+                f"expected {_UNITS[key]!r} (bounds are in SI units); got {_checks.short(value)}",
+            )
     base = default_bounds(robot)
     lo, hi = base.lower.copy(), base.upper.copy()
     names = list(robot.link_names[1:])
-    links = d.get("links", []) or []
-    if not isinstance(links, list):
-        raise DataError(f"{source}: 'links' must be a list of tables/objects")
-    _check_units(d.get("units"), source)
     seen: set[str] = set()
-    for k, link in enumerate(links):
-        where = f"{source}: links[{k}]"
-        if not isinstance(link, Mapping):
-            raise DataError(f"{where} must be a table/object")
-        bad = sorted(set(link) - _BOUND_KEYS)
-        if bad:
-            raise DataError(
-                f"{where}: unknown keys {_checks.short(bad)}; allowed: {sorted(_BOUND_KEYS)}"
-            )
-        name = link.get("name")
+    for k, link in enumerate(d.get("links") or []):
+        name = link["name"]
         if name not in names:
-            raise DataError(f"{where}: unknown link {_checks.short(name)}; available: {names}")
+            want = f"a link of the robot ({', '.join(names)})"
+            raise fault(source, f"links[{k}].name", f"expected {want}; got {_checks.short(name)}")
         if name in seen:
-            raise DataError(f"{where}: link {name!r} is listed twice; give each link once")
+            raise fault(source, f"links[{k}].name", f"expected each link once; got {name!r} again")
         seen.add(name)
         i = names.index(name)
         if "mass" in link:
-            lo[i, 0], hi[i, 0] = _checks.numbers(link["mass"], 2, f"{where} mass", DataError)
-        for key, arr, sl, size in (
-            ("com_min", lo, slice(1, 4), 3),
-            ("com_max", hi, slice(1, 4), 3),
-            ("inertia_min", lo, slice(4, 10), 6),
-            ("inertia_max", hi, slice(4, 10), 6),
+            lo[i, 0], hi[i, 0] = link["mass"]
+        for key, arr, sl in (
+            ("com_min", lo, slice(1, 4)),
+            ("com_max", hi, slice(1, 4)),
+            ("inertia_min", lo, slice(4, 10)),
+            ("inertia_max", hi, slice(4, 10)),
         ):
             if key in link:
-                arr[i, sl] = _checks.numbers(link[key], size, f"{where} {key}", DataError)
+                arr[i, sl] = link[key]
     band: Any = base.total_mass
     if "total_mass" in d:
         tm = d["total_mass"]
-        band = (
-            None
-            if tm is None or (isinstance(tm, list) and not tm)
-            else tuple(_checks.numbers(tm, 2, f"{source}: total_mass", DataError))
-        )
+        if tm is not None and len(tm) not in (0, 2):
+            raise fault(
+                source,
+                "total_mass",
+                f"expected [min, max] [kg], [] or null; got {_checks.short(tm)}",
+            )
+        band = tuple(float(x) for x in tm) if tm else None
     try:
         return Bounds.from_arrays(lo, hi, band, names)
     except (ValueError, ShapeError) as exc:
@@ -196,4 +196,4 @@ def save_bounds(path: str | Path, bounds: Bounds) -> Path:
         return write_text(path, "\n".join(lines) + "\n")
     if path.suffix.lower() != ".json":
         raise DataError(f"{path.name}: bounds files are .json or .toml; got {path.suffix!r}")
-    return save_json(path, d)
+    return save_document(path, Format(BOUNDS_SCHEMA, BOUNDS_RECORD, "bounds file"), d)

@@ -34,8 +34,11 @@ from .. import _checks
 from ..exceptions import DataError, DynidError
 from ..model.drive import DRIVE_SCHEMA, Drive
 from .input_files import file_text
+from .schema import Field, Record, check, fault
 
 __all__ = [
+    "DRIVE_JSON",
+    "DRIVE_RECORD",
     "drive_from_mapping",
     "drive_from_record",
     "drive_of_robot_file",
@@ -43,40 +46,47 @@ __all__ = [
     "load_drive",
 ]
 
-_KEYS = {
-    "schema",
-    "side",
-    "gear_ratio",
-    "coupling",
-    "offset",
-    "effort",
-    "torque_constant",
-    "rotor_inertia",
-    "friction_at",
-}
 _CHOICES = {
     "side": ("joint", "motor"),
     "effort": ("torque", "current"),
     "friction_at": ("motor", "joint"),
 }
+_PER_JOINT = Field("any")  # one number for every joint, or one per joint (_vector)
+#: a drive description in TOML (module docstring)
+DRIVE_RECORD = Record(
+    {
+        "schema": Field("string", choices=(DRIVE_SCHEMA,)),
+        **{k: Field("string", choices=v) for k, v in _CHOICES.items()},
+        "gear_ratio": _PER_JOINT,
+        "coupling": Field("any"),
+        "offset": _PER_JOINT,
+        "torque_constant": _PER_JOINT,
+        "rotor_inertia": _PER_JOINT,
+    }
+)
+#: the JSON record of a drive (:meth:`~dynid.model.drive.Drive.as_dict`)
+DRIVE_JSON = Record(
+    {
+        "schema": Field("string", required=True, choices=(DRIVE_SCHEMA,)),
+        **{k: Field("string", choices=v) for k, v in _CHOICES.items()},
+        "transmission": Field("numbers", required=True, shape=("n", "n")),
+        "offset": Field("any", nullable=True),
+        "torque_constant": Field("any", nullable=True),
+        "rotor_inertia": _PER_JOINT,
+    }
+)
 
 
-def _number(value: Any, where: str) -> float:
-    return _checks.number(value, where, DataError)
-
-
-def _vector(table: Mapping[str, Any], key: str, n: int, where: str) -> NDArray[np.float64]:
-    """A list of ``n`` numbers, or one number for every joint (``gear_ratio = 1``)."""
+def _vector(
+    table: Mapping[str, Any], key: str, n: int, source: str, at: str = ""
+) -> NDArray[np.float64]:
+    """A list of ``n`` numbers, or one number for every joint (``gear_ratio = 1``); ``at``:
+    the key path of ``table`` in ``source``."""
     value = table[key]
-    if isinstance(value, int | float) and not isinstance(value, bool):
-        return np.full(n, _number(value, f"{where}: {key}"))
-    if not isinstance(value, list) or len(value) != n:
-        got = f"{len(value)} entries" if isinstance(value, list) else _checks.short(value)
-        raise DataError(
-            f"{where}: key {key!r} must be a number or a list of {n} numbers (one per "
-            f"joint); got {got}"
-        )
-    return np.array([_number(v, f"{where}: {key}[{k}]") for k, v in enumerate(value)])
+    unit = "kg m^2" if key == "rotor_inertia" else ""
+    one = Field("numbers", shape=(n,), unit=unit) if isinstance(value, list) else Field("number")
+    check({key: value}, Record({key: one}), source, at=at)
+    return np.array(value, dtype=float) if isinstance(value, list) else np.full(n, float(value))
 
 
 def drive_from_mapping(table: Mapping[str, Any], n: int, *, source: str = "drive") -> Drive:
@@ -85,64 +95,53 @@ def drive_from_mapping(table: Mapping[str, Any], n: int, *, source: str = "drive
     Raises
     ------
     DataError
-        An unknown key, a wrong type, length or choice, or an invalid drive (singular ``K``,
-        currents without torque constants, ...): the message names ``source`` and the key.
+        An unknown key, a wrong type, length or choice (:mod:`dynid.io.schema`), or an
+        invalid drive (singular ``K``, currents without torque constants, ...): the message
+        names ``source`` and the key.
     """
-    if not isinstance(table, Mapping):
-        raise DataError(f"{source} must be a table; got {type(table).__name__}")
-    unknown = sorted(set(table) - _KEYS)
-    if unknown:
-        raise DataError(f"{source}: unknown key {unknown[0]!r}; allowed: {sorted(_KEYS)}")
-    schema = table.get("schema", DRIVE_SCHEMA)
-    if schema != DRIVE_SCHEMA:
-        raise DataError(
-            f"{source}: key 'schema' must be {DRIVE_SCHEMA!r}; got {_checks.short(schema)}"
-        )
-    kw: dict[str, Any] = {}
-    for key, allowed in _CHOICES.items():
-        if key in table:
-            if table[key] not in allowed:
-                got = _checks.short(table[key])
-                raise DataError(f"{source}: key {key!r} must be one of {list(allowed)}; got {got}")
-            kw[key] = table[key]
+    check(table, DRIVE_RECORD, source)
+    kw: dict[str, Any] = {k: table[k] for k in _CHOICES if k in table}
     gear = _vector(table, "gear_ratio", n, source) if "gear_ratio" in table else np.ones(n)
-    coupling = table.get("coupling", [])
-    if not isinstance(coupling, list):
-        raise DataError(f"{source}: key 'coupling' must be a list of [motor, joint, value]")
-    entries: list[tuple[int, int, float]] = []
-    for k, entry in enumerate(coupling):
-        where = f"{source}: coupling[{k}]"
-        if not isinstance(entry, list) or len(entry) != 3:
-            raise DataError(f"{where} must be [motor, joint, value]; got {_checks.short(entry)}")
-        m, j = entry[0], entry[1]
-        for what, idx in (("motor", m), ("joint", j)):
-            if isinstance(idx, bool) or not isinstance(idx, int) or not 1 <= idx <= n:
-                raise DataError(
-                    f"{where}: {what} must be an integer in 1..{n} (1-based, the robot has "
-                    f"{n} joints); got {_checks.short(idx)}"
-                )
-        if m == j:
-            raise DataError(f"{where}: motor {m} on joint {j} is the gear ratio; use gear_ratio")
-        if any(e[:2] == (m, j) for e in entries):
-            raise DataError(
-                f"{where}: motor {m} on joint {j} is given twice; give each entry of K once"
-            )
-        entries.append((m, j, _number(entry[2], f"{where}: value")))
+    entries = _coupling(table.get("coupling", []), n, source)
     for key in ("offset", "torque_constant"):
         if key in table:
             kw[key] = _vector(table, key, n, source)
     ia = table.get("rotor_inertia", "identify")
     if ia != "identify":
         if isinstance(ia, str):
-            raise DataError(
-                f"{source}: key 'rotor_inertia' must be 'identify', a number or a list of {n} "
-                f"numbers [kg m^2]; got {_checks.short(ia)}"
-            )
+            want = f"'identify', a number or a list of {n} numbers [kg m^2]"
+            raise fault(source, "rotor_inertia", f"expected {want}; got {_checks.short(ia)}")
         kw["rotor_inertia"] = _vector(table, "rotor_inertia", n, source)
     try:
         return Drive.from_gears(gear, entries, **kw)
     except DynidError as exc:
         raise DataError(f"{source}: {exc}") from exc
+
+
+def _coupling(coupling: Any, n: int, source: str) -> list[tuple[int, int, float]]:
+    """The entries of K off the diagonal: ``[motor, joint, value]``, 1-based, each once."""
+    want = "a list of [motor, joint, value]"
+    if not isinstance(coupling, list):
+        raise fault(source, "coupling", f"expected {want}; got {_checks.short(coupling)}")
+    entries: list[tuple[int, int, float]] = []
+    index = Field("integer", required=True, low=1, high=n)
+    entry = Record({"motor": index, "joint": index, "value": Field("number", required=True)})
+    for k, e in enumerate(coupling):
+        at = f"coupling[{k}]"
+        if not isinstance(e, list) or len(e) != 3:
+            raise fault(source, at, f"expected [motor, joint, value]; got {_checks.short(e)}")
+        check(dict(zip(("motor", "joint", "value"), e, strict=True)), entry, source, at=at)
+        m, j = e[0], e[1]
+        if m == j:
+            raise fault(
+                source, at, f"expected motor and joint apart; got {m} and {j}: use gear_ratio"
+            )
+        if any(x[:2] == (m, j) for x in entries):
+            raise fault(
+                source, at, f"expected each entry of K once; got motor {m} on joint {j} again"
+            )
+        entries.append((m, j, float(e[2])))
+    return entries
 
 
 def load_drive(path: str | Path, n: int) -> Drive:
@@ -175,45 +174,36 @@ def load_drive(path: str | Path, n: int) -> Drive:
             raise DataError(f"{p.name}: a robot TOML without a [drive] table")
         return drive_from_mapping(doc["drive"], n, source=f"{p.name} [drive]")
     if "schema" not in doc:
-        raise DataError(f"{p.name}: missing key 'schema' (expected {DRIVE_SCHEMA!r})")
+        raise fault(p.name, "schema", f"missing; expected {DRIVE_SCHEMA!r}")
     return drive_from_mapping(doc, n, source=p.name)
 
 
-def drive_from_record(record: Mapping[str, Any], n: int) -> Drive:
+def drive_from_record(
+    record: Mapping[str, Any], n: int, *, source: str = "drive", at: str = ""
+) -> Drive:
     """The drive of a JSON record (:meth:`~dynid.model.drive.Drive.as_dict`: the
-    transmission as rows), as identification.json and feasible.json hold it.
+    transmission as rows), as identification.json and feasible.json hold it; ``at``: its
+    key path in ``source`` (``"drive"``).
 
     Raises
     ------
     DataError
-        A malformed record (the field is named).
+        A malformed record (the key named, :mod:`dynid.io.schema`).
     """
-    if not isinstance(record, Mapping) or record.get("schema") != DRIVE_SCHEMA:
-        raise DataError(f"drive: must be an object with schema {DRIVE_SCHEMA!r}")
-    K = record.get("transmission")
-    if (
-        not isinstance(K, list)
-        or len(K) != n
-        or any(not isinstance(row, list) or len(row) != n for row in K)
-    ):
-        raise DataError(f"drive: 'transmission' must be {n} rows of {n} numbers")
-    rows = [
-        [_number(x, f"drive: transmission[{i}][{j}]") for j, x in enumerate(row)]
-        for i, row in enumerate(K)
-    ]
-    table = {k: record[k] for k in ("offset", "torque_constant") if record.get(k) is not None}
-    kw: dict[str, Any] = {k: _vector(table, k, n, "drive") for k in table}
-    ia = record.get("rotor_inertia", "identify")
-    if ia != "identify":
-        kw["rotor_inertia"] = _vector({"rotor_inertia": ia}, "rotor_inertia", n, "drive")
-    for key in _CHOICES:
-        if key in record:
-            kw[key] = record[key]
+    check(record, DRIVE_JSON, source, at=at, sizes={"n": n})
+    kw: dict[str, Any] = {
+        k: _vector(record, k, n, source, at)
+        for k in ("offset", "torque_constant")
+        if record.get(k) is not None
+    }
+    if record.get("rotor_inertia", "identify") != "identify":
+        kw["rotor_inertia"] = _vector(record, "rotor_inertia", n, source, at)
+    kw.update({k: record[k] for k in _CHOICES if k in record})
     kw.setdefault("offset", np.zeros(n))
     try:
-        return Drive(transmission=np.array(rows), **kw)
+        return Drive(transmission=np.array(record["transmission"], dtype=float), **kw)
     except DynidError as exc:
-        raise DataError(f"drive: {exc}") from exc
+        raise fault(source, at, str(exc)) if at else DataError(f"{source}: {exc}") from exc
 
 
 def drive_of_robot_file(spec: str | Path, n: int) -> Drive | None:

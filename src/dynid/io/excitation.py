@@ -25,11 +25,11 @@ from __future__ import annotations
 
 import math
 import re
+from collections.abc import Mapping
 from pathlib import Path
 from typing import Any
 
 import numpy as np
-from numpy.typing import NDArray
 
 from .. import __version__, _checks
 from ..exceptions import DataError, DynidError
@@ -38,15 +38,19 @@ from ..simulation.collision import Box, Obstacles, Plane, capsule_model
 from ..simulation.excitation import ExcitationResult, ExcitingTrajectory
 from ..simulation.trajectories import Trajectory
 from .atomic import open_atomic
-from .json_files import finite_or_none, load_json, save_json
+from .json_files import finite_or_none
+from .schema import Field, Format, Record, fault, load_document, save_document
 from .torque_log import csv_table
 
 __all__ = [
+    "EXCITATION",
     "EXCITATION_SCHEMA",
+    "OBSTACLES",
     "OBSTACLES_SCHEMA",
     "load_obstacles",
     "load_exciting_trajectory",
     "load_trajectory",
+    "obstacles_from_dict",
     "obstacles_to_dict",
     "save_excitation_json",
     "save_trajectory_csv",
@@ -135,70 +139,69 @@ def save_excitation_json(
         "history": list(result.history),
     }
     # limits, margins and condition numbers may be infinite (no limit, no obstacle): null
-    return save_json(path, finite_or_none(d))
+    return save_document(path, EXCITATION, finite_or_none(d))
 
 
-_OBSTACLE_KEYS = {"schema", "planes", "boxes"}
+_V3 = Field("numbers", required=True, shape=(3,), unit="m")
 _SHAPE_KEYS = {"planes": ("plane", "point", "normal"), "boxes": ("box", "center", "size")}
-_TRAJECTORY_KEYS = {
-    "form",
-    "w_f_rad_s",
-    "base_frequency_hz",
-    "harmonics",
-    "duration_s",
-    "ramp_s",
-    "total_duration_s",
-    "a_rad_s",
-    "b_rad_s",
-    "q_start_rad",
-}
-
-
-#: the top-level keys of ``trajectory.json`` (:func:`save_excitation_json`)
-_EXCITATION_KEYS = {
-    "schema",
-    "dynid_version",
-    "robot",
-    "joint_names",
-    "seed",
-    "trajectory",
-    "condition_number",
-    "scaled_condition_number",
-    "initial_condition_number",
-    "criterion",
-    "condition_number_of",
-    "status",
-    "iterations",
-    "evaluations",
-    "limits",
-    "margins_required",
-    "capsule_radii_m",
-    "obstacles",
-    "smallest_margins_at_1khz",
-    "history",
-}
-
-
-def _keys(d: dict[str, Any], allowed: set[str], where: str) -> None:
-    unknown = sorted(set(d) - allowed)
-    if unknown:
-        raise DataError(
-            f"{where}: unknown key(s) {_checks.short(unknown)}; allowed: {sorted(allowed)}"
-        )
-
-
-def _numbers(value: Any, where: str, shape: tuple[int, ...] | None = None) -> NDArray[np.float64]:
-    """A nested list of finite JSON numbers (no booleans, no strings) as an array."""
-
-    def walk(v: Any, at: str) -> Any:
-        if isinstance(v, list):
-            return [walk(x, f"{at}[{i}]") for i, x in enumerate(v)]
-        return _checks.number(v, at, DataError)
-
-    a = np.array(walk(value, where), dtype=np.float64)
-    if shape is not None and a.shape != shape:
-        raise DataError(f"{where} must be a list of shape {shape}; got {_checks.short(value)}")
-    return a
+#: an obstacles file (module docstring)
+OBSTACLES = Format(
+    OBSTACLES_SCHEMA,
+    Record(
+        {
+            kind: Field("objects", record=Record({"name": Field("string"), k1: _V3, k2: _V3}))
+            for kind, (_, k1, k2) in _SHAPE_KEYS.items()
+        }
+    ),
+    "obstacles file",
+)
+_NUMBER = Field("number")
+_OPTIONAL = Field("number", nullable=True)
+#: ``trajectory.json`` (:func:`save_excitation_json`; n joints, L harmonics)
+EXCITATION = Format(
+    EXCITATION_SCHEMA,
+    Record(
+        {
+            "dynid_version": Field("string"),
+            "robot": Field("string"),
+            "joint_names": Field("strings"),
+            "seed": Field("integer", nullable=True),
+            "trajectory": Field(
+                "object",
+                required=True,
+                record=Record(
+                    {
+                        "form": Field("string"),
+                        "w_f_rad_s": Field("number", required=True, unit="rad/s"),
+                        "base_frequency_hz": _NUMBER,
+                        "harmonics": _NUMBER,
+                        "duration_s": Field("number", required=True, unit="s"),
+                        "ramp_s": Field("number", required=True, unit="s"),
+                        "total_duration_s": _NUMBER,
+                        "a_rad_s": Field("numbers", required=True, shape=("n", "L")),
+                        "b_rad_s": Field("numbers", required=True, shape=("n", "L")),
+                        "q_start_rad": Field("numbers", required=True, shape=("n",)),
+                    }
+                ),
+            ),
+            "condition_number": _OPTIONAL,
+            "scaled_condition_number": _OPTIONAL,
+            "initial_condition_number": _OPTIONAL,
+            "criterion": Field("string"),
+            "condition_number_of": Field("string"),
+            "status": Field("any"),
+            "iterations": Field("any"),
+            "evaluations": Field("any"),
+            "limits": Field("any"),
+            "margins_required": Field("any"),
+            "capsule_radii_m": Field("any"),
+            "obstacles": Field("object", record=OBSTACLES.top),
+            "smallest_margins_at_1khz": Field("any"),
+            "history": Field("any"),
+        }
+    ),
+    "trajectory file (dynid excite)",
+)
 
 
 def load_obstacles(path: str | Path) -> Obstacles:
@@ -211,44 +214,35 @@ def load_obstacles(path: str | Path) -> Obstacles:
         first), wrong schema, an unknown key, a plane or box that is not an object of a
         name (without control characters) and three finite numbers per vector, a zero
         normal or a box without volume, or two obstacles of one name (each message names
-        the file and the obstacle).
+        the file and the key, :mod:`dynid.io.schema`).
     OSError
         The file cannot be read.
     """
     path = Path(path)
-    d = load_json(path, schema=OBSTACLES_SCHEMA, what="obstacles file")
-    _keys(d, _OBSTACLE_KEYS, path.name)
+    return obstacles_from_dict(load_document(path, OBSTACLES), path.name)
+
+
+def obstacles_from_dict(d: Mapping[str, Any], source: str) -> Obstacles:
+    """The obstacles of an obstacles record checked against :data:`OBSTACLES`."""
     shapes: dict[str, list[Plane | Box]] = {"planes": [], "boxes": []}
     names: list[str] = []
     for kind, (one, k1, k2) in _SHAPE_KEYS.items():
-        items = d.get(kind, [])
-        if not isinstance(items, list):
-            raise DataError(f"{path.name}: {kind!r} must be a list of objects")
-        for k, item in enumerate(items):
-            where = f"{path.name}: {kind}[{k}]"
-            if not isinstance(item, dict):
-                raise DataError(f"{where} must be an object; got {_checks.short(item)}")
+        for k, item in enumerate(d.get(kind) or []):
+            where = f"{kind}[{k}]"
             name = item.get("name", f"{one}{k + 1}")
-            if not isinstance(name, str) or not name:
-                raise DataError(f"{where}: 'name' must be a non-empty string")
             bad = _checks.control_character(name)
-            if bad is not None:  # as robot names: it was printed raw to the terminal
-                raise DataError(
-                    f"{where}: name {_checks.short(name)} holds the character {ascii(bad)}; "
-                    "give a name without control characters"
-                )
-            where = f"{path.name}: {kind}[{k}] ({_checks.short(name)})"
-            _keys(item, {"name", k1, k2}, where)
+            if not name or bad is not None:  # as robot names: it was printed raw
+                got = _checks.short(name) + (f" (holds {ascii(bad)})" if bad else "")
+                want = "a non-empty name without control characters"
+                raise fault(source, f"{where}.name", f"expected {want}; got {got}")
             if name in names:
-                raise DataError(f"{where}: the name is used by another obstacle")
-            missing = [key for key in (k1, k2) if key not in item]
-            if missing:
-                raise DataError(f"{where}: missing key {missing[0]!r}")
-            v1, v2 = (tuple(_numbers(item[key], f"{where}: {key}", (3,))) for key in (k1, k2))
+                want = "a name of one obstacle"
+                raise fault(source, f"{where}.name", f"expected {want}; got {name!r} again")
+            v1, v2 = tuple(item[k1]), tuple(item[k2])
             try:
                 shapes[kind].append(Plane(v1, v2) if kind == "planes" else Box(v1, v2))
             except DynidError as exc:
-                raise DataError(f"{where}: {exc}") from None
+                raise fault(source, where, str(exc)) from None
             names.append(name)
     return Obstacles(
         planes=tuple(x for x in shapes["planes"] if isinstance(x, Plane)),
@@ -296,30 +290,15 @@ def load_exciting_trajectory(path: str | Path, n: int) -> ExcitingTrajectory:
         As :func:`load_trajectory` for a JSON file.
     """
     path = Path(path)
-    d = load_json(path, schema=EXCITATION_SCHEMA, what="trajectory file (dynid excite)")
-    _keys(d, _EXCITATION_KEYS, path.name)
-    tr = d.get("trajectory")
-    if not isinstance(tr, dict):
-        raise DataError(f"{path.name}: 'trajectory' must be an object")
-    _keys(tr, _TRAJECTORY_KEYS, f"{path.name}: trajectory")
-    need = ("w_f_rad_s", "duration_s", "ramp_s", "a_rad_s", "b_rad_s", "q_start_rad")
-    missing = [k for k in need if k not in tr]
-    if missing:
-        raise DataError(f"{path.name}: trajectory: missing key(s) {missing}")
-    num = {k: _numbers(tr[k], f"{path.name}: trajectory.{k}") for k in need}
+    tr = load_document(path, EXCITATION)["trajectory"]
     try:
-        traj = ExcitingTrajectory(
-            w_f=float(num["w_f_rad_s"]),
-            a=num["a_rad_s"],
-            b=num["b_rad_s"],
-            q_start=num["q_start_rad"],
-            duration=float(num["duration_s"]),
-            ramp=float(num["ramp_s"]),
-        )
-    except (TypeError, ValueError, DynidError) as exc:
-        raise DataError(f"{path.name}: malformed trajectory ({exc})") from None
+        traj = ExcitingTrajectory.from_dict(tr)
+    except (TypeError, ValueError) as exc:
+        raise fault(path.name, "trajectory", str(exc)) from None
     if traj.n != n:
-        raise DataError(f"{path.name}: trajectory has {traj.n} joints; the robot has {n}")
+        raise fault(
+            path.name, "trajectory.q_start_rad", f"expected {n} joints (the robot's); got {traj.n}"
+        )
     _check_derived(tr, traj, path.name)
     return traj
 
@@ -372,11 +351,13 @@ def _check_derived(tr: dict[str, Any], traj: ExcitingTrajectory, name: str) -> N
     }
     for key, want in derived.items():
         if key in tr:
-            got = float(_numbers(tr[key], f"{name}: trajectory.{key}"))
+            got = float(tr[key])
             if not math.isclose(got, want, rel_tol=1e-9):
-                raise DataError(
-                    f"{name}: trajectory.{key} = {got:.10g} disagrees with the coefficients "
-                    f"({want:.10g}); the file was edited: regenerate it with dynid excite"
+                raise fault(
+                    name,
+                    f"trajectory.{key}",
+                    f"expected {want:.10g} (from the coefficients; the file was edited: "
+                    f"regenerate it with dynid excite); got {got:.10g}",
                 )
 
 

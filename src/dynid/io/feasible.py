@@ -39,10 +39,12 @@ from ..model.inertia import (
 )
 from ..model.robot import MAX_LINK_MASS, MAX_LINK_OFFSET, Robot
 from .drive_file import drive_from_record
-from .json_files import finite_or_none, load_json, save_json
-from .robot_json import robot_from_dict, robot_to_dict
+from .json_files import finite_or_none, load_json
+from .robot_json import ROBOT_RECORD, robot_from_dict, robot_to_dict
+from .schema import Field, Format, Record, check, fault, load_document, save_document
 
 __all__ = [
+    "FEASIBLE",
     "FEASIBLE_SCHEMA",
     "feasible_to_dict",
     "load_feasible_drive",
@@ -61,32 +63,63 @@ _CONVENTIONS = {
     "friction": "tau_f = phi1/(1+exp(-phi2 (dq+phi3))) - phi1/(1+exp(-phi2 phi3)) "
     "[phi1 N m, phi2 s/rad, phi3 rad/s] (Gaz et al. 2019, eq. 25)",
 }
-_LINK_KEYS = {"name", "mass", "com", "inertia"}
-#: the keys :func:`feasible_to_dict` writes
-_KEYS = {
-    "schema",
-    "dynid_version",
-    "name",
-    "links",
-    "friction",
-    "linear_friction",
-    "kinematics",
-    "units",
-    "conventions",
-    "drive",
-    "method",
-    "feasible",
-    "relative_residual",
-    "seed",
-    "heldout",
-}
 #: the farthest a link's centre of mass may lie from its frame [m], as in the robot
 #: readers (1e300 overflowed the parallel-axis inertia into NaN)
 MAX_COM_DISTANCE = MAX_LINK_OFFSET
-
-
-def _numbers(v: Any, size: int, where: str) -> NDArray[np.float64]:
-    return _checks.numbers(v, size, where, DataError)
+_M = MAX_LINK_MASS
+_LINK = Record(
+    {
+        "name": Field("string"),
+        "mass": Field("number", required=True, low=-_M, high=_M, unit="kg"),
+        "com": Field(
+            "numbers",
+            required=True,
+            shape=(3,),
+            low=-MAX_COM_DISTANCE,
+            high=MAX_COM_DISTANCE,
+            unit="m",
+        ),
+        "inertia": Field("numbers", required=True, shape=(6,), unit="kg m^2"),
+    }
+)
+_PER_JOINT = Field("numbers", required=True, shape=("n",))
+#: ``feasible.json`` (module docstring; n: the joint count)
+FEASIBLE = Format(
+    FEASIBLE_SCHEMA,
+    Record(
+        {
+            "dynid_version": Field("string"),
+            "name": Field("string"),
+            "links": Field("objects", required=True, record=_LINK),
+            "friction": Field(
+                "object",
+                nullable=True,
+                record=Record(
+                    {"model": Field("string", choices=("sigmoid",))}
+                    | {f"phi{k}": _PER_JOINT for k in (1, 2, 3)}
+                ),
+            ),
+            "linear_friction": Field(
+                "object",
+                nullable=True,
+                record=Record(
+                    {"model": Field("string", choices=("classical",))}
+                    | {k: _PER_JOINT for k in ("fv", "fc", "fo")}
+                ),
+            ),
+            "kinematics": Field("object", record=ROBOT_RECORD),
+            "units": Field("any"),
+            "conventions": Field("any"),
+            "drive": Field("object", nullable=True),
+            "method": Field("string"),
+            "feasible": Field("bool"),
+            "relative_residual": Field("number", nullable=True),
+            "seed": Field("integer", nullable=True),
+            "heldout": Field("object", nullable=True),
+        }
+    ),
+    "feasible-parameter file",
+)
 
 
 def feasible_to_dict(source: FeasibleResult | Robot, *, seed: int | None = None) -> dict[str, Any]:
@@ -162,10 +195,12 @@ def save_feasible_json(path: str | Path, source: FeasibleResult | Robot) -> Path
     NonFiniteError
         A NaN or infinite number in the parameters (named).
     """
-    return save_json(path, feasible_to_dict(source))
+    return save_document(path, FEASIBLE, feasible_to_dict(source))
 
 
-def robot_from_feasible_dict(d: Mapping[str, Any], robot: Robot | None = None) -> Robot:
+def robot_from_feasible_dict(
+    d: Mapping[str, Any], robot: Robot | None = None, *, source: str = "feasible parameters"
+) -> Robot:
     """A robot with the link parameters of a :func:`feasible_to_dict` dictionary.
 
     Parameters
@@ -174,94 +209,65 @@ def robot_from_feasible_dict(d: Mapping[str, Any], robot: Robot | None = None) -
     robot : Robot, optional
         Kinematics to put the parameters on (its link names must match the file's);
         default the kinematics and friction held in the file.
+    source : str
+        The file named in messages.
 
     Raises
     ------
     DataError
         Wrong schema, an unknown key, a missing or malformed field, a mass beyond
-        ``MAX_LINK_MASS`` or a CoM beyond :data:`MAX_COM_DISTANCE`, link names that do not
-        match ``robot``.
+        ``MAX_LINK_MASS`` or a CoM beyond :data:`MAX_COM_DISTANCE` (:mod:`dynid.io.schema`),
+        link names that do not match ``robot``.
 
     Warns
     -----
     DynidWarning
         A link whose parameters are not physically consistent (kept as given).
     """
-    if d.get("schema") != FEASIBLE_SCHEMA:
-        raise DataError(
-            f"not a feasible-parameter file (schema {d.get('schema')!r}, "
-            f"expected {FEASIBLE_SCHEMA!r})"
-        )
-    unknown = sorted(set(d) - _KEYS)
-    if unknown:
-        raise DataError(f"feasible parameters: unknown key(s) {_checks.short(unknown)}")
-    if not isinstance(d.get("feasible", False), bool):
-        raise DataError(
-            f"feasible parameters: 'feasible' must be true or false; got "
-            f"{_checks.short(d['feasible'])}"
-        )
-    try:
-        links = list(d["links"])
-    except (KeyError, TypeError):
-        raise DataError("feasible parameters: missing field 'links'") from None
+    if not isinstance(d, Mapping) or d.get("schema") != FEASIBLE_SCHEMA:
+        got = _checks.short(d.get("schema")) if isinstance(d, Mapping) else "no object"
+        raise fault(source, "schema", f"expected {FEASIBLE_SCHEMA!r} ({FEASIBLE.what}); got {got}")
+    check(d, FEASIBLE.top, source)
+    links = d["links"]
     if robot is None:
         if "kinematics" not in d:
-            raise DataError("feasible parameters: no 'kinematics'; pass the robot")
-        robot = robot_from_dict(d["kinematics"])
+            raise fault(source, "kinematics", "missing; pass the robot the parameters are of")
+        robot = robot_from_dict(d["kinematics"], source=source, at="kinematics")
         fr = d.get("friction")
         if fr is not None:
+            F = np.array([fr[f"phi{k}"] for k in (1, 2, 3)], dtype=float).T
             try:
-                F = np.stack(
-                    [_numbers(fr[f"phi{k}"], robot.n, f"friction phi{k}") for k in (1, 2, 3)],
-                    axis=1,
-                )
-            except (KeyError, TypeError):
-                raise DataError("feasible parameters: friction needs phi1, phi2, phi3") from None
-            robot = robot.with_friction(F)
+                robot = robot.with_friction(F)
+            except (ModelError, ShapeError) as exc:
+                raise fault(source, "friction", str(exc)) from exc
     if len(links) != robot.n:
-        raise DataError(
-            f"feasible parameters for {len(links)} links; robot {robot.name!r} has {robot.n}"
+        raise fault(
+            source,
+            "links",
+            f"expected one per link of robot {robot.name!r} ({robot.n}); got {len(links)} links",
         )
     mass = np.empty(robot.n)
     com = np.empty((robot.n, 3))
     I6 = np.empty((robot.n, 6))
     for i, link in enumerate(links):
-        where = f"feasible parameters, link {i + 1}"
-        if not isinstance(link, Mapping):
-            raise DataError(f"{where}: expected an object")
-        unknown = sorted(set(link) - _LINK_KEYS)
-        if unknown:
-            raise DataError(f"{where}: unknown keys {unknown}")
         name = link.get("name")
         if name is not None and name != robot.link_names[i + 1]:
-            raise DataError(
-                f"{where} is named {name!r}; robot {robot.name!r} has "
-                f"{robot.link_names[i + 1]!r} there"
+            raise fault(
+                source,
+                f"links[{i}].name",
+                f"expected {robot.link_names[i + 1]!r} (robot {robot.name!r}); got {name!r}",
             )
-        try:
-            mass[i] = _numbers([link["mass"]], 1, f"{where} mass")[0]
-            com[i] = _numbers(link["com"], 3, f"{where} com")
-            I6[i] = _numbers(link["inertia"], 6, f"{where} inertia")
-        except KeyError as exc:
-            raise DataError(f"{where}: missing {exc.args[0]!r}") from None
-        _check_link(where, mass[i], com[i], I6[i])
+        mass[i], com[i], I6[i] = link["mass"], link["com"], link["inertia"]
+        _check_link(f"{source}: links[{i}]", mass[i], I6[i])
     try:
         return robot.with_inertials(mass, com, I6)
     except (ModelError, ShapeError) as exc:
-        raise DataError(f"feasible parameters: {exc}") from exc
+        raise DataError(f"{source}: {exc}") from exc
 
 
-def _check_link(where: str, mass: float, com: NDArray[np.float64], I6: NDArray[np.float64]) -> None:
-    """Refuse a mass or a CoM no robot description holds; warn, as the URDF reader does, on
-    parameters that are not physically consistent, a negative mass included (kept: those of
-    an infeasible result are not consistent)."""
-    if not abs(mass) <= MAX_LINK_MASS:
-        raise DataError(f"{where}: mass must be at most {MAX_LINK_MASS:g} kg; got {float(mass)!r}")
-    if not float(np.max(np.abs(com))) <= MAX_COM_DISTANCE:
-        raise DataError(
-            f"{where}: com must lie within {MAX_COM_DISTANCE:g} m of the link frame; got "
-            f"{com.tolist()}"
-        )
+def _check_link(where: str, mass: float, I6: NDArray[np.float64]) -> None:
+    """Warn, as the URDF reader does, on parameters that are not physically consistent, a
+    negative mass included (kept: those of an infeasible result are not consistent)."""
     problems = inertial_problems(mass, matrix_from_inertia6(I6))
     if problems:
         warnings.warn(
@@ -283,13 +289,7 @@ def load_feasible_json(path: str | Path, robot: Robot | None = None) -> Robot:
     DataError
         Not JSON, or not a feasible-parameter file (see :func:`robot_from_feasible_dict`).
     """
-    try:
-        return robot_from_feasible_dict(load_json(path), robot)
-    except DataError as exc:
-        name = Path(path).name
-        if str(exc).startswith(name):
-            raise
-        raise DataError(f"{name}: {exc}") from exc
+    return robot_from_feasible_dict(load_json(path), robot, source=Path(path).name)
 
 
 def load_feasible_linear_friction(path: str | Path) -> ClassicalFriction | DriveFriction | None:
@@ -299,18 +299,10 @@ def load_feasible_linear_friction(path: str | Path) -> ClassicalFriction | Drive
     uses it unless another friction is given. With a drive whose friction acts at the
     motors, the law per motor mapped through the transmission (:class:`DriveFriction`).
     """
-    d = load_json(path)
-    lin = d.get("linear_friction")
+    lin = load_document(path, FEASIBLE).get("linear_friction")
     if lin is None:
         return None
-    name = Path(path).name
-    try:
-        n = len(d["links"])
-        law = ClassicalFriction(
-            *(_numbers(lin[k], n, f"{name}: linear_friction {k}") for k in ("fv", "fc", "fo"))
-        )
-    except (KeyError, TypeError):
-        raise DataError(f"{name}: linear_friction needs fv, fc, fo per joint") from None
+    law = ClassicalFriction(*(np.array(lin[k], dtype=float) for k in ("fv", "fc", "fo")))
     drive = load_feasible_drive(path)
     return DriveFriction(law, drive) if drive is not None and drive.friction_at == "motor" else law
 
@@ -318,14 +310,7 @@ def load_feasible_linear_friction(path: str | Path) -> ClassicalFriction | Drive
 def load_feasible_drive(path: str | Path) -> Drive | None:
     """The drive train held by ``feasible.json`` (its rotor inertias the identified ones), or
     None."""
-    d = load_json(path)
+    d = load_document(path, FEASIBLE)
     if d.get("drive") is None:
         return None
-    try:
-        n = len(d["links"])
-    except (KeyError, TypeError):
-        raise DataError(f"{Path(path).name}: 'links' must be a list") from None
-    try:
-        return drive_from_record(d["drive"], n)
-    except DataError as exc:
-        raise DataError(f"{Path(path).name}: {exc}") from exc
+    return drive_from_record(d["drive"], len(d["links"]), source=Path(path).name, at="drive")

@@ -30,12 +30,13 @@ from typing import Any
 import numpy as np
 
 from .. import _checks
-from ..exceptions import DataError
+from ..exceptions import DataError, DynidError
 from ..friction.fit import FrictionFit
 from ..friction.laws import LAWS
 from ..friction.model import DriveFriction, FrictionModel
 from .drive_file import drive_from_record
-from .json_files import load_json, save_json
+from .json_files import load_json
+from .schema import Field, Format, Record, check, describe, fault, save_document
 
 __all__ = ["FORMAT", "load_friction_json", "save_friction_json"]
 
@@ -99,7 +100,7 @@ def save_friction_json(
     }
     if selection is not None:
         doc["selection"] = selection
-    return save_json(path, doc)
+    return save_document(path, Format(FORMAT, _record(model.kind), _WHAT), doc)
 
 
 def load_friction_json(path: str | Path) -> FrictionModel:
@@ -115,62 +116,59 @@ def load_friction_json(path: str | Path) -> FrictionModel:
         The file cannot be read.
     """
     path = Path(path)
-    doc = load_json(path, what="friction file (dynid friction)")
+    doc = load_json(path, what=_WHAT)
     tag = doc.get("schema", doc.get("format"))  # "format": files of dynid 0.1
     if tag != FORMAT:
-        raise DataError(
-            f"{path.name}: not a friction file: 'schema' must be {FORMAT!r}; got {tag!r}"
-        )
+        raise fault(path.name, "schema", f"expected {FORMAT!r} ({_WHAT}); got {_checks.short(tag)}")
     kind = doc.get("model")
     if kind not in LAWS:
-        raise DataError(f"{path.name}: 'model' must be one of {', '.join(LAWS)}; got {kind!r}")
-    unknown = sorted(set(doc) - _KEYS)
-    if unknown:
-        raise DataError(f"{path.name}: unknown key(s) {_checks.short(unknown)}")
-    joints = doc.get("joints")
-    if not isinstance(joints, list) or not joints:
-        raise DataError(f"{path.name}: 'joints' must be a non-empty list of objects")
+        raise fault(path.name, "model", f"expected {describe(_MODEL)}; got {_checks.short(kind)}")
+    check(doc, _record(kind), path.name)
+    joints = doc["joints"]
     law = LAWS[kind]
-    names = law.params + ("standstill_band",)
-    P = np.zeros((len(joints), len(names)))
+    P = np.zeros((len(joints), len(law.params)))
     for j, d in enumerate(joints):
-        if isinstance(d, dict):
-            _check_joint(d, set(names), f"{path.name}: joint {j + 1}")
-        for i, k in enumerate(names):
-            if k == "standstill_band" and isinstance(d, dict) and k not in d:
-                continue  # files of earlier versions: the plain sign
-            if not isinstance(d, dict) or k not in d:
-                raise DataError(f"{path.name}: joint {j + 1} has no {k!r} (model {kind!r})")
-            P[j, i] = _checks.number(d[k], f"{path.name}: joint {j + 1}, {k!r}", DataError)
-    if not np.all(np.isfinite(P)):
-        raise DataError(f"{path.name}: non-finite friction parameters")
-    if np.any(P[:, -1] < 0):
-        raise DataError(f"{path.name}: 'standstill_band' must be >= 0")
-    fr = law.model(P[:, :-1], P[:, -1])
+        P[j] = [d[k] for k in law.params]
+    # no standstill_band: files of earlier versions, the plain sign(dq)
+    band = np.array([d.get("standstill_band", 0.0) for d in joints], dtype=float)
+    try:
+        fr = law.model(P, band)
+    except DynidError as exc:
+        raise DataError(f"{path.name}: {exc}") from exc
     if doc.get("drive") is None:
         return fr
-    try:
-        return DriveFriction(fr, drive_from_record(doc["drive"], len(joints)))
-    except DataError as exc:
-        raise DataError(f"{path.name}: {exc}") from exc
+    return DriveFriction(
+        fr, drive_from_record(doc["drive"], len(joints), source=path.name, at="drive")
+    )
 
 
-#: the keys :func:`save_friction_json` writes (``format``: files of dynid 0.1)
-_KEYS = {"schema", "format", "dynid_version", "model", "convention", "units", "joints"}
-_KEYS |= {"drive", "metadata", "selection"}
-#: the keys of a joint beside its law's parameters and ``standstill_band``
-_FIT_KEYS = {"rms_before", "rms_after", "identified"}
+_WHAT = "friction file (dynid friction)"
+_MODEL = Field("string", required=True, choices=tuple(LAWS))
 
 
-def _check_joint(d: dict[str, Any], params: set[str], where: str) -> None:
-    """Refuse a joint's unknown key or a record of the fit of the wrong type."""
-    unknown = sorted(set(d) - params - _FIT_KEYS)
-    if unknown:
-        raise DataError(f"{where}: unknown key(s) {_checks.short(unknown)}")
-    for k in ("rms_before", "rms_after"):
-        if k in d:
-            _checks.number(d[k], f"{where}, {k!r}", DataError)
-    if "identified" in d and not isinstance(d["identified"], bool):
-        raise DataError(
-            f"{where}, 'identified' must be true or false; got {_checks.short(d['identified'])}"
-        )
+def _record(kind: str) -> Record:
+    """The fields of a friction file of the law ``kind`` (module docstring)."""
+    law = LAWS[kind]
+    joint = {
+        p: Field("number", required=True, unit=u)
+        for p, u in zip(law.params, law.units, strict=True)
+    }
+    joint |= {
+        "standstill_band": Field("number", low=0.0, unit="rad/s"),
+        "rms_before": Field("number", unit="N m"),
+        "rms_after": Field("number", unit="N m"),
+        "identified": Field("bool"),
+    }
+    top = {
+        "schema": Field("string"),
+        "format": Field("string"),  # files of dynid 0.1
+        "dynid_version": Field("string"),
+        "model": _MODEL,
+        "convention": Field("string"),
+        "units": Field("any"),
+        "joints": Field("objects", required=True, non_empty=True, record=Record(joint)),
+        "drive": Field("object", nullable=True),
+        "metadata": Field("any"),
+        "selection": Field("any"),
+    }
+    return Record(top)

@@ -193,9 +193,8 @@ def load_json(
         ok = (schema,) if isinstance(schema, str) else tuple(schema)
         got = d.get("schema")
         if got not in ok:
-            raise DataError(
-                f"{path.name}: not {'an' if what[:1] in 'aeiou' else 'a'} {what}: 'schema' must "
-                f"be {' or '.join(map(repr, ok))}; "
-                f"got {got!r}"
+            raise DataError(  # the wording of dynid.io.schema
+                f"{path.name}: key 'schema': expected {' or '.join(map(repr, ok))} "
+                f"({'an' if what[:1] in 'aeiou' else 'a'} {what}); got {_checks.short(got)}"
             )
     return d

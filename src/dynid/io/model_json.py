@@ -50,17 +50,18 @@ import numpy as np
 from numpy.typing import NDArray
 
 from .. import __version__, _checks
-from ..exceptions import DataError
 from ..identification.info import FrictionInfo, IdentificationInfo, LogInfo, StaticInfo
 from ..identification.least_squares import LeastSquaresFit
 from ..identification.model import IdentifiedModel
 from ..model.drive import Drive
 from ..regressors.base import BaseParameters
 from .drive_file import drive_from_record
-from .json_files import finite_or_none, load_json, save_json
-from .robot_json import robot_from_dict, robot_to_dict
+from .json_files import finite_or_none, load_json
+from .robot_json import ROBOT_RECORD, robot_from_dict, robot_to_dict
+from .schema import Field, Format, Record, check, fault, save_document
 
 __all__ = [
+    "MODEL",
     "MODEL_SCHEMA",
     "info_from_dict",
     "info_to_dict",
@@ -227,7 +228,9 @@ def info_to_dict(info: IdentificationInfo, drive: Drive | None = None) -> dict[s
     return _jsonable(out)
 
 
-def info_from_dict(meta: Mapping[str, Any]) -> IdentificationInfo:
+def info_from_dict(
+    meta: Mapping[str, Any], *, source: str = "identified model"
+) -> IdentificationInfo:
     """The :class:`IdentificationInfo` of a file's ``metadata`` object (any version).
 
     Raises
@@ -235,16 +238,9 @@ def info_from_dict(meta: Mapping[str, Any]) -> IdentificationInfo:
     DataError
         A known entry of the wrong type or value (named).
     """
+    check(meta, _META, source, at="metadata")
     m = dict(meta)
     route, std = m.pop("route", None), m.pop("std_estimator", None)
-    if route not in (None, "static", "classical"):
-        raise DataError(
-            f"identified model: metadata.route must be 'static' or 'classical'; got {route!r}"
-        )
-    if std not in (None, "classical", "robust"):
-        raise DataError(
-            f"identified model: metadata.std_estimator must be 'classical' or 'robust'; got {std!r}"
-        )
     try:
         static, log, friction = _route_parts(m)
         gap = m.pop("rank_gap", None)
@@ -274,7 +270,7 @@ def info_from_dict(meta: Mapping[str, Any]) -> IdentificationInfo:
             extra={k: v for k, v in m.items() if k not in _DERIVED_KEYS},
         )
     except (TypeError, ValueError, IndexError) as exc:
-        raise DataError(f"identified model: malformed metadata ({exc})") from exc
+        raise fault(source, "metadata", f"malformed ({exc})") from exc
 
 
 def _route_parts(
@@ -291,164 +287,186 @@ def _route_parts(
     if "friction_labels" in m:
         friction = FrictionInfo(
             labels=tuple(str(x) for x in m.pop("friction_labels")),
-            std=tuple(_float(x, "metadata.friction_std") for x in m.pop("friction_std", ())),
+            std=tuple(_float(x) for x in m.pop("friction_std", ())),
             kept=tuple(bool(x) for x in m.pop("friction_kept", ())),
-            band=tuple(_float(x, "metadata.friction_band") for x in m.pop("friction_band", ())),
-            law=_friction_law(m.pop("friction_law", "classical")),
+            band=tuple(_float(x) for x in m.pop("friction_band", ())),
+            law=str(m.pop("friction_law", "classical")),
         )
     return static, log, friction
-
-
-#: The laws whose parameters an identified model's ``friction`` may hold, with their count.
-_FRICTION_LAWS = {"classical": 3, "smooth": 3, "quadratic": 4, "stribeck": 5}
-
-
-def _friction_law(law: Any) -> str:
-    """``metadata.friction_law``, checked."""
-    if law not in _FRICTION_LAWS:
-        raise DataError(
-            f"identified model: metadata.friction_law must be one of {list(_FRICTION_LAWS)}; "
-            f"got {law!r}"
-        )
-    return str(law)
 
 
 def _opt_float(x: Any) -> float | None:
     return None if x is None else float(x)
 
 
-def _covariance(c: Any, r: int) -> NDArray[np.float64] | None:
+def _covariance(c: Any, r: int, source: str) -> NDArray[np.float64] | None:
     """The (r, r) covariance of a file, or None when the file has none (older files)."""
     if c is None:
         return None
     a = np.asarray(c, dtype=np.float64)
-    if a.shape != (r, r) or not np.all(np.isfinite(a)):
-        raise DataError(f"identified model: covariance must be a finite {r}x{r} matrix")
+    if a.shape != (r, r):
+        raise fault(
+            source, "covariance", f"expected an {r} x {r} matrix (base.rank); got {a.shape}"
+        )
     return _frozen(0.5 * (a + a.T))
 
 
-def model_from_dict(d: Mapping[str, Any]) -> IdentifiedModel:
+_NUMBER = Field("number", required=True, nullable=True)
+_COEFFICIENT = Record(
+    {
+        "name": Field("string", required=True),
+        "expression": Field("string", required=True),
+        "value": Field("number", required=True),
+        "std": Field("number", required=True, low=0.0),
+        "std_percent": Field("number", required=True, nullable=True, unit="%"),
+        "kept": Field("bool", required=True),
+    }
+)
+_BASE = Record(
+    {
+        "std_labels": Field("strings", required=True),
+        "independent": Field("any", required=True),  # indices: checked by _base_indices
+        "dependent": Field("any", required=True),
+        "K_d": Field("numbers", required=True, shape=(None, None)),
+        "rank": Field("integer", required=True, low=0),
+        "rtol": Field("number", required=True),
+        "gap": Field("numbers", nullable=True, shape=(2,)),
+    }
+)
+_FRICTION_LAWS = {"classical": 3, "smooth": 3, "quadratic": 4, "stribeck": 5}
+#: the typed keys of ``metadata`` (others are kept as they are)
+_META = Record(
+    {
+        "route": Field("string", nullable=True, choices=("static", "classical")),
+        "std_estimator": Field("string", nullable=True, choices=("classical", "robust")),
+        "friction_law": Field("string", choices=tuple(_FRICTION_LAWS)),
+        "friction_std": Field("numbers", null_items=True),
+        "friction_band": Field("numbers", null_items=True),
+        "friction_kept": Field("bools"),
+        "rank_gap": Field("numbers", nullable=True, shape=(2,)),
+    },
+    open=True,
+)
+#: ``identification.json`` (module docstring; n joints)
+MODEL = Format(
+    MODEL_SCHEMA,
+    Record(
+        {
+            "robot": Field("object", required=True, record=ROBOT_RECORD),
+            "dynid_version": Field("string"),
+            "route": Field("string", nullable=True),
+            "seed": Field("any"),
+            "rank": Field("integer", required=True, low=0),
+            "condition_number": _NUMBER,
+            "relative_error_percent": _NUMBER,
+            "residual_rms": _NUMBER,
+            "sigma": _NUMBER,
+            "n_rows": Field("integer", required=True, low=0),
+            "rtol": _NUMBER,
+            "scaled_condition_number": Field("number", nullable=True),
+            "dropped_rows": Field("any"),
+            "pruned": Field("any"),
+            "std_estimator": Field("any"),
+            "coefficients": Field("objects", required=True, record=_COEFFICIENT),
+            "covariance": Field("numbers", nullable=True, shape=(None, None)),
+            "base": Field("object", required=True, record=_BASE),
+            "friction": Field("numbers", nullable=True, shape=("n", None)),
+            "drive": Field("object", nullable=True),
+            "metadata": Field("object", nullable=True, record=_META),
+            "units": Field("any"),
+            "conventions": Field("any"),
+        }
+    ),
+    "identified model (dynid identify)",
+)
+
+
+def model_from_dict(d: Mapping[str, Any], *, source: str = "identified model") -> IdentifiedModel:
     """Rebuild an :class:`IdentifiedModel` from :func:`model_to_dict` output.
+
+    ``source``: the file named in messages.
 
     Raises
     ------
     DataError
         Wrong schema, an unknown key (at the top or in a coefficient; the metadata keep
-        theirs), or a field missing, of the wrong type or inconsistent (named).
+        theirs), or a field missing, of the wrong type or inconsistent (the key named,
+        :mod:`dynid.io.schema`).
     """
-    if d.get("schema") != MODEL_SCHEMA:
-        raise DataError(
-            f"identified model: schema must be {MODEL_SCHEMA!r}; got {d.get('schema')!r}"
-        )
-    _known_keys(d, _MODEL_KEYS, "identified model")
-    try:
-        robot = robot_from_dict(d["robot"])
-        b = d["base"]
-        coefs = d["coefficients"]
-        r = _int(b["rank"], "base.rank")
-        if not isinstance(coefs, list) or len(coefs) != r:
-            raise DataError(
-                f"identified model: 'coefficients' must list {r} coefficients (base rank); "
-                f"got {len(coefs) if isinstance(coefs, list) else type(coefs).__name__}"
-            )
-        for k, c in enumerate(coefs):
-            if not isinstance(c, Mapping):
-                raise DataError(f"identified model: coefficients[{k}] must be an object")
-            _known_keys(c, _COEFFICIENT_KEYS, f"identified model: coefficients[{k}]")
-            if not isinstance(c["kept"], bool):
-                raise DataError(
-                    f"identified model: coefficients[{k}].kept must be true or false; got "
-                    f"{_checks.short(c['kept'])}"
-                )
-        drive = None if d.get("drive") is None else drive_from_record(d["drive"], robot.n)
-        p = 10 * robot.n
-        if drive is not None and drive.identifies_rotor_inertia:
-            p += robot.n
-        independent, dependent, K_d = _base_indices(b, r, p)
-        base = BaseParameters(
-            std_labels=tuple(b["std_labels"]),
-            independent=_frozen(independent),
-            dependent=_frozen(dependent),
-            K_d=_frozen(K_d),
-            rank=r,
-            rtol=float(b["rtol"]),
-            labels=tuple(c["name"] for c in coefs),
-            expressions=tuple(c["expression"] for c in coefs),
-            gap=None if b.get("gap") is None else (float(b["gap"][0]), float(b["gap"][1])),
-        )
-        kept = np.array([bool(c["kept"]) for c in coefs])
-        pct = np.array(
-            [
-                _float(c["std_percent"], "coefficients[].std_percent")
-                if c["std_percent"] is not None
-                else (np.inf if c["kept"] else np.nan)
-                for c in coefs
-            ]
-        )
-        fit = LeastSquaresFit(
-            beta=_frozen(np.array([_float(c["value"], "coefficients[].value") for c in coefs])),
-            std=_frozen(np.array([_float(c["std"], "coefficients[].std") for c in coefs])),
-            std_percent=_frozen(pct),
-            kept=_frozen(kept),
-            rank=_int(d["rank"], "rank"),
-            condition_number=_float(d["condition_number"], "condition_number"),
-            relative_error_percent=_float(d["relative_error_percent"], "relative_error_percent"),
-            residual_rms=_float(d["residual_rms"], "residual_rms"),
-            sigma=_float(d["sigma"], "sigma"),
-            n_rows=_int(d["n_rows"], "n_rows"),
-            rtol=_float(d["rtol"], "rtol"),
-            covariance=_covariance(d.get("covariance"), r),
-            scaled_condition_number=_float(
-                d.get("scaled_condition_number"), "scaled_condition_number"
-            ),
-        )
-        friction = d.get("friction")
-        if friction is not None:
-            friction = np.asarray(friction, dtype=np.float64)
-            meta = d.get("metadata")
-            law = meta.get("friction_law", "classical") if isinstance(meta, dict) else ""
-            k = _FRICTION_LAWS.get(law, 3)
-            if friction.shape != (robot.n, k):
-                raise DataError(
-                    f"identified model: 'friction' must be null or {robot.n} rows of the "
-                    f"{law or 'classical'} law's {k} parameters; got shape {friction.shape}"
-                )
-        for name, arr in (("value", fit.beta), ("std", fit.std)):
-            if not np.all(np.isfinite(arr)):
-                k = int(np.flatnonzero(~np.isfinite(arr))[0])
-                raise DataError(f"identified model: coefficient {k + 1} {name!r} is not finite")
-        if np.any(fit.std < 0):
-            k = int(np.flatnonzero(fit.std < 0)[0])
-            raise DataError(f"identified model: coefficient {k + 1} has a negative 'std'")
-        metadata = d.get("metadata") or {}
-        if not isinstance(metadata, dict):
-            raise DataError("identified model: 'metadata' must be an object")
-        info = info_from_dict(metadata)
-    except KeyError as exc:
-        raise DataError(f"identified model: missing field {exc.args[0]!r}") from None
-    except (TypeError, ValueError) as exc:
-        if isinstance(exc, DataError):
-            raise
-        raise DataError(f"identified model: malformed field ({exc})") from exc
-    if base.n_std != p:
-        raise DataError(
-            f"identified model: base.std_labels has {base.n_std} labels; the robot has "
-            f"{robot.n} joints ({p} parameters"
-            + (" with the rotor inertias)" if p > 10 * robot.n else ")")
-        )
+    if not isinstance(d, Mapping) or d.get("schema") != MODEL_SCHEMA:
+        got = _checks.short(d.get("schema")) if isinstance(d, Mapping) else "no object"
+        raise fault(source, "schema", f"expected {MODEL_SCHEMA!r} ({MODEL.what}); got {got}")
+    check(d, MODEL.top, source)
+    robot = robot_from_dict(d["robot"], source=source, at="robot")
+    b, coefs = d["base"], d["coefficients"]
+    r = b["rank"]
+    if len(coefs) != r:
+        want = f"one per base parameter ({r}, base.rank)"
+        raise fault(source, "coefficients", f"expected {want}; got {len(coefs)}")
+    drive = d.get("drive")
+    if drive is not None:
+        drive = drive_from_record(drive, robot.n, source=source, at="drive")
+    p = 10 * robot.n
+    if drive is not None and drive.identifies_rotor_inertia:
+        p += robot.n
+    independent, dependent, K_d = _base_indices(b, r, p, source)
+    if len(b["std_labels"]) != p:
+        rotor = " with the rotor inertias" if p > 10 * robot.n else ""
+        want = f"{p} labels (the robot's {robot.n} joints{rotor})"
+        raise fault(source, "base.std_labels", f"expected {want}; got {len(b['std_labels'])}")
+    base = BaseParameters(
+        std_labels=tuple(b["std_labels"]),
+        independent=_frozen(independent),
+        dependent=_frozen(dependent),
+        K_d=_frozen(K_d),
+        rank=r,
+        rtol=float(b["rtol"]),
+        labels=tuple(c["name"] for c in coefs),
+        expressions=tuple(c["expression"] for c in coefs),
+        gap=None if b.get("gap") is None else (float(b["gap"][0]), float(b["gap"][1])),
+    )
+    kept = np.array([c["kept"] for c in coefs], dtype=bool)
+    pct = [c["std_percent"] if c["std_percent"] is not None else (np.inf if c["kept"] else np.nan)
+           for c in coefs]  # fmt: skip
+    fit = LeastSquaresFit(
+        beta=_frozen(np.array([c["value"] for c in coefs], dtype=float)),
+        std=_frozen(np.array([c["std"] for c in coefs], dtype=float)),
+        std_percent=_frozen(np.array(pct, dtype=float)),
+        kept=_frozen(kept),
+        rank=d["rank"],
+        condition_number=_float(d["condition_number"]),
+        relative_error_percent=_float(d["relative_error_percent"]),
+        residual_rms=_float(d["residual_rms"]),
+        sigma=_float(d["sigma"]),
+        n_rows=d["n_rows"],
+        rtol=_float(d["rtol"]),
+        covariance=_covariance(d.get("covariance"), r, source),
+        scaled_condition_number=_float(d.get("scaled_condition_number")),
+    )
+    metadata = d.get("metadata") or {}
+    friction = d.get("friction")
+    if friction is not None:
+        law = metadata.get("friction_law", "classical")
+        k = _FRICTION_LAWS[law]
+        if any(len(row) != k for row in friction):
+            want = f"null or {robot.n} rows of the {law} law's {k} parameters"
+            raise fault(source, "friction", f"expected {want}; got {_checks.short(friction)}")
+        friction = _frozen(np.array(friction, dtype=np.float64).reshape(robot.n, k))
+    info = info_from_dict(metadata, source=source)
     return IdentifiedModel(
-        robot=robot,
-        base=base,
-        fit=fit,
-        friction=None if friction is None else _frozen(np.asarray(friction, dtype=np.float64)),
-        info=info,
-        drive=drive,
+        robot=robot, base=base, fit=fit, friction=friction, info=info, drive=drive
     )
 
 
 def save_model_json(path: str | Path, model: IdentifiedModel, *, seed: int | None = None) -> Path:
-    """Write an identified model as strict JSON (indented, UTF-8, atomic); returns the path."""
-    return save_json(path, model_to_dict(model, seed=seed))
+    """Write an identified model as strict JSON (indented, UTF-8, atomic); returns the path.
+
+    Raises
+    ------
+    NonFiniteError
+        A NaN or infinite number (named).
+    """
+    return save_document(path, MODEL, model_to_dict(model, seed=seed))
 
 
 def load_model_json(path: str | Path) -> IdentifiedModel:
@@ -460,74 +478,39 @@ def load_model_json(path: str | Path) -> IdentifiedModel:
         Not JSON, or not an identified model (see :func:`model_from_dict`).
     """
     path = Path(path)
-    d = load_json(path, schema=MODEL_SCHEMA, what="identified model (dynid identify)")
-    try:
-        return model_from_dict(d)
-    except DataError as exc:
-        raise DataError(f"{path.name}: {exc}") from exc
-
-
-#: the keys :func:`model_to_dict` writes, at the top and per coefficient
-_MODEL_KEYS = {"schema", "dynid_version", "route", "seed", *_FIT_SCALARS, "dropped_rows"}
-_MODEL_KEYS |= {"pruned", "std_estimator", "coefficients", "covariance", "base", "friction"}
-_MODEL_KEYS |= {"drive", "robot", "metadata", "units", "conventions"}
-_COEFFICIENT_KEYS = {"name", "expression", "value", "std", "std_percent", "kept"}
-
-
-def _known_keys(d: Mapping[str, Any], allowed: set[str], where: str) -> None:
-    unknown = sorted(set(d) - allowed)
-    if unknown:
-        raise DataError(f"{where}: unknown key(s) {_checks.short(unknown)}")
-
-
-def _int(x: Any, where: str) -> int:
-    if isinstance(x, bool) or not isinstance(x, int):
-        raise DataError(f"identified model: {where!r} must be an integer; got {x!r}")
-    return x
+    d = load_json(path, schema=MODEL_SCHEMA, what=MODEL.what)
+    return model_from_dict(d, source=path.name)
 
 
 def _base_indices(
-    b: Mapping[str, Any], r: int, p: int
+    b: Mapping[str, Any], r: int, p: int, source: str
 ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """``independent`` (r,), ``dependent`` (p - r,) and ``K_d`` (r, p - r), checked: integer
-    indices of the p standard parameters, each exactly once, finite K_d of that shape."""
+    indices of the p standard parameters, each exactly once, K_d of that shape."""
     ind, dep = b["independent"], b["dependent"]
+    want = f"an index in 0..{p - 1} (the robot has {p} standard parameters)"
     for name, v in (("base.independent", ind), ("base.dependent", dep)):
         if not isinstance(v, list):
-            raise DataError(f"identified model: {name!r} must be a list of indices")
+            raise fault(source, name, f"expected a list of indices; got {_checks.short(v)}")
         for k, x in enumerate(v):
             if isinstance(x, bool) or not isinstance(x, int) or not 0 <= x < p:
-                raise DataError(
-                    f"identified model: {name}[{k}] = {x!r} is not an index in 0..{p - 1} "
-                    f"(the robot has {p} standard parameters)"
-                )
+                raise fault(source, f"{name}[{k}]", f"expected {want}; got {_checks.short(x)}")
     if len(ind) != r:
-        raise DataError(
-            f"identified model: 'base.independent' has {len(ind)} indices for base rank {r}"
-        )
+        raise fault(source, "base.independent", f"expected {r} indices (base.rank); got {len(ind)}")
     if sorted(ind + dep) != list(range(p)):
-        raise DataError(
-            f"identified model: 'base.independent' and 'base.dependent' must hold each of the "
-            f"{p} parameter indices exactly once"
-        )
+        want = f"with base.dependent each of the {p} parameter indices exactly once"
+        raise fault(source, "base.independent", f"expected {want}; got {_checks.short(ind)}")
     K_d = np.asarray(b["K_d"], dtype=np.float64)
     if K_d.size == 0 and len(dep) == 0:
         K_d = K_d.reshape(r, 0)
     if K_d.shape != (r, len(dep)):
-        raise DataError(
-            f"identified model: 'base.K_d' must have shape {(r, len(dep))}; got {K_d.shape}"
-        )
-    if not np.all(np.isfinite(K_d)):
-        raise DataError("identified model: 'base.K_d' holds a non-finite number")
+        raise fault(source, "base.K_d", f"expected shape {(r, len(dep))}; got {K_d.shape}")
     return np.asarray(ind, dtype=np.intp), np.asarray(dep, dtype=np.intp), K_d
 
 
-def _float(x: Any, where: str) -> float:
-    """``null`` as NaN (a value the fit has none of); otherwise a finite number, strictly
-    (a boolean or a string where a number belongs is refused, not cast)."""
-    return (
-        float("nan") if x is None else _checks.number(x, f"identified model: {where!r}", DataError)
-    )
+def _float(x: Any) -> float:
+    """A checked number; ``null`` as NaN (a value the fit has none of)."""
+    return float("nan") if x is None else float(x)
 
 
 def _frozen(a: np.ndarray) -> np.ndarray:

@@ -29,16 +29,18 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
-from .. import __version__, _checks
-from ..exceptions import DataError
+from .. import __version__
+from ..exceptions import DataError, DynidError
 from ..observer.detection import ContactEvent, Thresholds
 from ..observer.residual import ObserverOptions
 from ..observer.results import LogObservation, ObserveResult
 from .atomic import open_atomic
-from .json_files import load_json, save_json
+from .json_files import save_json
+from .schema import Field, Format, Record, load_document, save_document
 
 __all__ = [
     "EVENTS_SCHEMA",
+    "THRESHOLDS",
     "THRESHOLDS_SCHEMA",
     "load_thresholds",
     "observation_names",
@@ -50,10 +52,60 @@ __all__ = [
 
 THRESHOLDS_SCHEMA = "dynid-thresholds/1"
 EVENTS_SCHEMA = "dynid-events/1"
-_KEYS = {
-    "schema", "dynid_version", "joints", "contact", "collision", "rule", "uncertainty",
-    "observer", "calibration", "units",
-}  # fmt: skip
+_N, _NM = ("n",), "N m"
+_NUMBER = Field("number", required=True)
+#: ``thresholds.json``: every per-joint list of the same length n
+THRESHOLDS = Format(
+    THRESHOLDS_SCHEMA,
+    Record(
+        {
+            "dynid_version": Field("string"),
+            "joints": Field("strings"),
+            "contact": Field("numbers", required=True, shape=_N, low=0.0, unit=_NM),
+            "collision": Field("numbers", required=True, shape=_N, low=0.0, unit=_NM),
+            "rule": Field(
+                "object",
+                required=True,
+                record=Record(
+                    {
+                        "margin": _NUMBER,
+                        "quantile": _NUMBER,
+                        "collision_factor": _NUMBER,
+                        "standstill_margin": Field("bool"),
+                    }
+                ),
+            ),
+            "uncertainty": Field(
+                "object",
+                nullable=True,
+                record=Record(
+                    {
+                        "k_sigma": _NUMBER,
+                        "noise": Field("numbers", required=True, shape=_N, low=0.0, unit=_NM),
+                    }
+                ),
+            ),
+            "observer": Field(
+                "object",
+                required=True,
+                record=Record(
+                    {
+                        "gain": Field("numbers", required=True, shape=_N, unit="1/s"),
+                        "discretisation": Field(
+                            "string", required=True, choices=("exact", "euler")
+                        ),
+                        "rule": Field("string", required=True, choices=("rectangle", "trapezoid")),
+                    }
+                ),
+            ),
+            "calibration": Field(
+                "object", record=Record({"samples": Field("integer", low=0)}, open=True)
+            ),
+            "units": Field("any"),
+        }
+    ),
+    "thresholds file (dynid observe --calibrate)",
+)
 
 
 def save_thresholds(
@@ -87,7 +139,7 @@ def save_thresholds(
         "calibration": {"samples": th.samples, **(calibration or {})},
         "units": {"contact": "N m", "collision": "N m", "noise": "N m", "gain": "1/s"},
     }
-    return save_json(path, doc, schema=THRESHOLDS_SCHEMA)
+    return save_document(path, THRESHOLDS, doc)
 
 
 def load_thresholds(path: str | Path) -> Thresholds:
@@ -99,46 +151,26 @@ def load_thresholds(path: str | Path) -> Thresholds:
         Not a thresholds file (schema), an unknown key, a missing or malformed entry (named).
     """
     path = Path(path)
-    d = load_json(
-        path, schema=THRESHOLDS_SCHEMA, what="thresholds file (dynid observe --calibrate)"
-    )
-    unknown = sorted(set(d) - _KEYS)
-    if unknown:
-        raise DataError(f"{path.name}: unknown key(s) {_checks.short(unknown)}")
+    d = load_document(path, THRESHOLDS)
+    rule, obs, unc = d["rule"], d["observer"], d.get("uncertainty")
     try:
-        n = len(d["contact"])
-        contact = _checks.numbers(d["contact"], n, f"{path.name}: contact", DataError)
-        collision = _checks.numbers(d["collision"], n, f"{path.name}: collision", DataError)
-        rule, obs = d["rule"], d["observer"]
-        options = ObserverOptions(
-            gain=tuple(_checks.numbers(obs["gain"], n, f"{path.name}: observer gain", DataError)),
-            discretisation=obs["discretisation"],
-            rule=obs["rule"],
-        )
-        unc = d.get("uncertainty")
-        k_sigma = noise = None
-        if unc is not None:
-            k_sigma = _checks.number(unc["k_sigma"], f"{path.name}: k_sigma", DataError)
-            noise = _checks.numbers(unc["noise"], n, f"{path.name}: uncertainty noise", DataError)
         return Thresholds(
-            contact=contact,
-            collision=collision,
-            margin=_checks.number(rule["margin"], f"{path.name}: margin", DataError),
-            quantile=_checks.number(rule["quantile"], f"{path.name}: quantile", DataError),
-            collision_factor=_checks.number(
-                rule["collision_factor"], f"{path.name}: collision_factor", DataError
+            contact=np.array(d["contact"], dtype=float),
+            collision=np.array(d["collision"], dtype=float),
+            margin=float(rule["margin"]),
+            quantile=float(rule["quantile"]),
+            collision_factor=float(rule["collision_factor"]),
+            options=ObserverOptions(
+                gain=tuple(float(g) for g in obs["gain"]),
+                discretisation=obs["discretisation"],
+                rule=obs["rule"],
             ),
-            options=options,
             samples=int(d.get("calibration", {}).get("samples", 0)),
-            k_sigma=k_sigma,
-            noise=noise,
+            k_sigma=None if unc is None else float(unc["k_sigma"]),
+            noise=None if unc is None else np.array(unc["noise"], dtype=float),
             standstill=bool(rule.get("standstill_margin", False)),
         )
-    except (KeyError, TypeError) as exc:
-        raise DataError(f"{path.name}: missing or malformed entry {exc}") from None
-    except DataError as exc:
-        if str(exc).startswith(path.name):
-            raise
+    except DynidError as exc:
         raise DataError(f"{path.name}: {exc}") from None
 
 

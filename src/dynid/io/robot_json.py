@@ -19,20 +19,48 @@ from collections.abc import Mapping
 from typing import Any
 
 import numpy as np
-from numpy.typing import NDArray
 
-from .. import _checks
 from ..exceptions import DataError, ModelError, ShapeError
 from ..model.robot import Frame, Robot
 from .json_files import finite_or_none
+from .schema import Field, Record, check
 
-__all__ = ["robot_to_dict", "robot_from_dict", "ROBOT_SCHEMA"]
+__all__ = ["ROBOT_RECORD", "ROBOT_SCHEMA", "robot_from_dict", "robot_to_dict"]
 
 ROBOT_SCHEMA = "dynid-robot-kinematics/1"
 _LIMITS = ("q_min", "q_max", "dq_max", "ddq_max", "tau_max")
-#: the keys :func:`robot_to_dict` writes
-_KEYS = {"schema", "name", "joint_names", "link_names", "T_parent_joint", "axes", "prismatic"}
-_KEYS |= {"limits", "gravity", "frames", "units"}
+_N = "n"
+#: the fields :func:`robot_to_dict` writes (n: the joint count)
+ROBOT_RECORD = Record(
+    {
+        "schema": Field("string", choices=(ROBOT_SCHEMA,)),
+        "name": Field("string", required=True),
+        "joint_names": Field("strings", required=True, shape=(_N,)),
+        "link_names": Field("strings", required=True),
+        "T_parent_joint": Field("numbers", required=True, shape=(_N, 4, 4), unit="m"),
+        "axes": Field("numbers", required=True, shape=(_N, 3)),
+        "prismatic": Field("bools", required=True, shape=(_N,)),
+        "limits": Field(
+            "object",
+            required=True,
+            record=Record(
+                {k: Field("numbers", required=True, shape=(_N,), null_items=True) for k in _LIMITS}
+            ),
+        ),
+        "gravity": Field("numbers", required=True, shape=(3,), unit="m/s^2"),
+        "frames": Field(
+            "named",
+            required=True,
+            record=Record(
+                {
+                    "link": Field("integer", required=True, low=0),
+                    "T_link_frame": Field("numbers", required=True, shape=(4, 4)),
+                }
+            ),
+        ),
+        "units": Field("any"),
+    }
+)
 
 
 def robot_to_dict(robot: Robot) -> dict[str, Any]:
@@ -62,80 +90,43 @@ def robot_to_dict(robot: Robot) -> dict[str, Any]:
     }
 
 
-def robot_from_dict(d: Mapping[str, Any]) -> Robot:
+def robot_from_dict(
+    d: Mapping[str, Any], *, source: str = "robot description", at: str = ""
+) -> Robot:
     """A robot (zero inertial parameters, no friction) from :func:`robot_to_dict` output.
+
+    ``source`` and ``at``: the file and the key path of ``d`` in it, for messages.
 
     Raises
     ------
     DataError
         An unknown key, a missing or malformed field (a boolean or a string where a number
-        belongs included; named in the message).
+        belongs included; named in the message, :mod:`dynid.io.schema`), or kinematics the
+        robot refuses.
     """
-    unknown = sorted(set(d) - _KEYS)
-    if unknown:
-        raise DataError(f"robot description: unknown key(s) {_checks.short(unknown)}")
+    check(d, ROBOT_RECORD, source, at=at)
+    n = len(d["joint_names"])
+    inf = {k: (-np.inf if k == "q_min" else np.inf) for k in _LIMITS}
+    lim = {
+        k: np.array([inf[k] if v is None else float(v) for v in d["limits"][k]], dtype=float)
+        for k in _LIMITS
+    }
     try:
-        n = len(d["joint_names"])
-        limits = d["limits"]
-        sign = {"q_min": -1.0}
-        lim = {
-            k: np.array(
-                [
-                    sign.get(k, 1.0) * np.inf if v is None else _number(v, f"limits.{k}")
-                    for v in limits[k]
-                ]
-            )
-            for k in _LIMITS
-        }
-        frames = {
-            str(name): Frame(_index(f["link"]), _numbers(f["T_link_frame"], f"frames.{name}"))
-            for name, f in d["frames"].items()
-        }
-        prismatic = d["prismatic"]
-        if not isinstance(prismatic, list) or not all(isinstance(p, bool) for p in prismatic):
-            raise DataError(
-                f"robot description: 'prismatic' must be a list of true or false; got "
-                f"{_checks.short(prismatic)}"
-            )
         return Robot(
-            name=str(d["name"]),
+            name=d["name"],
             joint_names=tuple(d["joint_names"]),
             link_names=tuple(d["link_names"]),
-            T_parent_joint=_numbers(d["T_parent_joint"], "T_parent_joint"),
-            axes=_numbers(d["axes"], "axes"),
-            prismatic=np.asarray(prismatic, dtype=bool),
+            T_parent_joint=np.array(d["T_parent_joint"], dtype=float).reshape(n, 4, 4),
+            axes=np.array(d["axes"], dtype=float).reshape(n, 3),
+            prismatic=np.array(d["prismatic"], dtype=bool).reshape(n),
             phi=np.zeros((n, 10)),
-            gravity=_numbers(d["gravity"], "gravity"),
-            frames=frames,
+            gravity=np.array(d["gravity"], dtype=float),
+            frames={
+                str(name): Frame(f["link"], np.array(f["T_link_frame"], dtype=float))
+                for name, f in d["frames"].items()
+            },
             **lim,
         )
-    except KeyError as exc:
-        raise DataError(f"robot description: missing field {exc.args[0]!r}") from None
-    except DataError:
-        raise
-    except (TypeError, ValueError, AttributeError) as exc:
-        if isinstance(exc, (ModelError, ShapeError)):
-            raise DataError(f"robot description: {exc}") from exc
-        raise DataError(f"robot description: malformed field ({exc})") from exc
-
-
-def _number(value: Any, where: str) -> float:
-    """A JSON number, strictly: not a boolean or a string (``float`` took both)."""
-    return _checks.number(value, f"robot description: {where}", DataError)
-
-
-def _numbers(value: Any, where: str) -> NDArray[np.float64]:
-    """A nested list of JSON numbers as an array (no booleans, no strings)."""
-
-    def walk(v: Any, at: str) -> Any:
-        if isinstance(v, list):
-            return [walk(x, f"{at}[{i}]") for i, x in enumerate(v)]
-        return _number(v, at)
-
-    return np.array(walk(value, where), dtype=np.float64)
-
-
-def _index(value: Any) -> int:
-    if isinstance(value, bool) or not isinstance(value, int):
-        raise DataError(f"robot description: a frame's link must be an integer; got {value!r}")
-    return value
+    except (ModelError, ShapeError, ValueError) as exc:
+        where = f"{source}: key {at!r}" if at else source
+        raise DataError(f"{where}: {exc}") from exc

@@ -47,8 +47,8 @@ from collections.abc import Iterator, Sequence
 from pathlib import Path
 
 from ..exceptions import DataError, OutputError
-from . import atomic
-from .json_files import load_json, save_json
+from ..io import atomic
+from ..io.json_files import load_json, save_json
 
 try:
     import fcntl
