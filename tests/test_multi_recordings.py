@@ -23,7 +23,7 @@ from dynid.io.torque_log import load_torque_log, save_torque_log
 from dynid.simulation.measurement import SensorNoise, sample_times, simulate_measurement
 from dynid.simulation.trajectories import random_fourier
 from dynid.workflows.friction import fit_friction_file
-from dynid.workflows.identify import identify_file
+from dynid.workflows.identify import identify_files
 from dynid.workflows.payload import identify_payload_files
 from dynid.workflows.validate import ValidateOptions, validate_files
 
@@ -171,7 +171,7 @@ def test_the_own_friction_is_judged_on_the_same_recordings(panda, files):
     paths = [files / "rec1.csv", files / "rec2.csv"]
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", DynidWarning)
-        model = identify_file(panda, paths)
+        model = identify_files(panda, paths).model
         sel = fit_friction_file(model, paths).selection
         robot = fit_friction_file(panda, paths).selection
     held = {s.name: s.heldout_error_percent for s in sel.scores}

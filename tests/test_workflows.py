@@ -12,13 +12,14 @@ import pytest
 
 import dynid
 from dynid.cli.__main__ import main
+from dynid.cli.common import option_message
 from dynid.exceptions import DataError, DynidError, OptionError
 from dynid.io.feasible_bundle import FEASIBLE_BUNDLE
 from dynid.io.robot.toml import save_toml
 from dynid.io.static_data import load_static_data
 from dynid.workflows.data_files import column_map, read_torque_log
 from dynid.workflows.friction import fit_friction_file
-from dynid.workflows.identify import identify_consistent_file, identify_file
+from dynid.workflows.identify import IdentifyOptions, identify_files
 from dynid.workflows.prior import load_prior
 from dynid.workflows.retrieve import retrieve_file
 
@@ -72,8 +73,8 @@ def test_static_data_of_another_robot_is_refused_by_the_api_and_every_command(
         load_static_data(files / "s.csv", other)
     assert str(api.value).startswith(OTHER)
     for call in (
-        lambda: identify_file(other, files / "s.csv"),
-        lambda: identify_consistent_file(other, files / "s.csv"),
+        lambda: identify_files(other, files / "s.csv"),
+        lambda: identify_files(other, files / "s.csv", IdentifyOptions(consistent=True)),
         lambda: retrieve_file(files / "s.csv", kind="static", robot=other),
         lambda: retrieve_file(files / "s.csv", kind="static", robot=other, method="penalty"),
     ):
@@ -113,7 +114,7 @@ def test_a_log_of_another_joint_count_is_refused_alike(files, tmp_path, capsys, 
     with pytest.raises(DataError, match="the log has 7 joints; the robot has 2"):
         read_torque_log(files / "log.csv", 2)
     with pytest.raises(DataError, match="the log has 7 joints; robot 'planar2r' has 2"):
-        identify_file(planar_2r(), files / "log.csv")
+        identify_files(planar_2r(), files / "log.csv")
     line = _refusal(
         capsys,
         [*argv, str(files / "two.toml"), "--data", str(files / "log.csv"), "--out", str(tmp_path)],
@@ -161,7 +162,7 @@ def test_std_is_honoured_on_every_route_or_refused(files, tmp_path, capsys):
     panda = dynid.panda()
     for data in ("s.csv", "log.csv"):
         for std in ("robust", "classical"):
-            model = identify_file(panda, files / data, std=std)
+            model = identify_files(panda, files / data, IdentifyOptions(std=std)).model
             assert model.info.std == std
             out = tmp_path / f"{data}-{std}"
             argv = ["identify", "--data", str(files / data), "--std", std, "--out", str(out)]
@@ -170,12 +171,13 @@ def test_std_is_honoured_on_every_route_or_refused(files, tmp_path, capsys):
             assert doc["std_estimator"] == std
             got = [c["std"] for c in doc["coefficients"]]
             np.testing.assert_allclose(got, model.fit.std[: len(got)], rtol=1e-9, atol=0)
-    with pytest.raises(DataError, match="--std does not apply to --consistent") as api:
-        identify_consistent_file(panda, files / "s.csv", std="robust")
+    with pytest.raises(OptionError, match="std does not apply to consistent") as api:
+        identify_files(panda, files / "s.csv", IdentifyOptions(consistent=True, std="robust"))
+    assert api.value.field == "std"
     argv = ["identify", "--consistent", "--std", "robust", "--data", str(files / "s.csv")]
-    assert _refusal(capsys, [*argv, "--out", str(tmp_path / "c")]) == (
-        f"dynid identify: error: {api.value}"
-    )
+    line = _refusal(capsys, [*argv, "--out", str(tmp_path / "c")])
+    assert line == f"dynid identify: error: {option_message(api.value)}"
+    assert line.startswith("dynid identify: error: --std does not apply to --consistent")
 
 
 def test_the_output_bundle_of_a_consistent_fit_is_the_same_for_identify_and_retrieve(
