@@ -4,15 +4,27 @@ which the command names by its flag) and give the same result."""
 
 from __future__ import annotations
 
+import re
+import warnings
 from pathlib import Path
 
+import numpy as np
 import pytest
 
 import dynid
 from dynid.cli.__main__ import main
 from dynid.cli.common import flag, option_message
-from dynid.exceptions import OptionError
+from dynid.exceptions import DynidWarning, ModelError, OptionError
+from dynid.io.robot.toml import save_toml
+from dynid.io.robot_file import load_robot
+from dynid.io.static_data import load_static_data
+from dynid.io.torque_log import save_torque_log_pieces
+from dynid.workflows.acquire_static import AcquireStaticOptions, acquire_static_data
+from dynid.workflows.export import ExportRobotOptions, export_robot
 from dynid.workflows.identify import IdentifyOptions, identify_files
+from dynid.workflows.simulate import SimulateOptions, simulate_log
+
+from conftest import pinocchio_panda_urdf, planar_2r
 
 
 @pytest.fixture(scope="module")
@@ -86,3 +98,133 @@ def test_identify_gives_the_same_model_through_both(static, tmp_path):
     got = [(c["value"], c["kept"]) for c in doc["coefficients"]]
     want = [(float(b), bool(k)) for b, k in zip(model.fit.beta, model.fit.kept, strict=False)]
     assert got == want[: len(got)] and len(got) == model.base.rank
+
+
+# ---------------------------------------------------------------------- simulate
+@pytest.mark.parametrize(
+    ("options", "argv", "field"),
+    [
+        ({"arm_seed": 3}, ["--arm-seed", "3"], "arm_seed"),
+        ({"q0": (0.0, 0.1)}, ["--q0", "0,0.1"], "q0"),
+        (
+            {"amplitudes": (0.1,) * 7, "periods": (5.0,) * 6},
+            ["--amplitudes", ",".join(["0.1"] * 7), "--periods", ",".join(["5"] * 6)],
+            "periods",
+        ),
+    ],
+    ids=["arm-seed-alone", "q0-count", "periods-count"],
+)
+def test_simulate_refuses_alike(tmp_path, capsys, options, argv, field):
+    with pytest.raises(OptionError) as api:
+        simulate_log(dynid.panda(), SimulateOptions(duration_s=1.0, **options))
+    assert api.value.field == field
+    out = tmp_path / "x.csv"
+    line = _refusal(capsys, ["simulate", "--duration", "1", *argv, "--out", str(out)])
+    assert line == option_message(api.value) and line.startswith(flag(field))
+    assert not out.exists()
+
+
+def test_simulate_needs_sinusoids_for_a_robot_without_seven_joints(tmp_path, capsys):
+    """Table I's sinusoids are for 7 joints: another robot needs its own, in both."""
+    save_toml(tmp_path / "two.toml", planar_2r())
+    with pytest.raises(OptionError, match="default sinusoids are for 7 joints") as api:
+        simulate_log(planar_2r(), SimulateOptions(duration_s=1.0))
+    argv = ["simulate", "--robot", str(tmp_path / "two.toml"), "--duration", "1"]
+    line = _refusal(capsys, [*argv, "--out", str(tmp_path / "x.csv")])
+    assert line.startswith("--amplitudes are needed") and "give --periods too" in line
+    assert line == option_message(api.value)
+
+
+def test_simulate_writes_the_log_of_the_api(tmp_path):
+    """dynid simulate writes, byte for byte, the log simulate_log gives (with options that
+    change it: fourier, unmodelled effects of another arm seed, jitter, dropped samples)."""
+    options = SimulateOptions(
+        trajectory="fourier",
+        duration_s=1.0,
+        rate_hz=200.0,
+        jitter_s=1e-4,
+        drop_fraction=0.1,
+        unmodelled=True,
+        arm_seed=4,
+        seed=9,
+        with_ddq=True,
+    )
+    res = simulate_log(dynid.panda(), options)
+    api = save_torque_log_pieces(
+        tmp_path / "api.csv", res.log, n=7, n_rows=res.log.n_samples, with_ddq=True
+    )
+    argv = ["simulate", "--trajectory", "fourier", "--duration", "1", "--rate", "200"]
+    argv += ["--jitter", "1e-4", "--drop", "0.1", "--unmodelled", "--arm-seed", "4"]
+    argv += ["--seed", "9", "--with-ddq", "--out", str(tmp_path / "cli.csv"), "-q"]
+    assert main(argv) == 0
+    assert (tmp_path / "cli.csv").read_bytes() == api.read_bytes()
+    assert res.log.n_samples < 200  # samples were dropped
+
+
+# ---------------------------------------------------------------------- export
+def test_export_chooses_the_chain_of_a_urdf_with_several_leaves(tmp_path, capsys):
+    """A URDF with a hand and two fingers has several leaves: export --params refuses it
+    without --tip (naming the leaves), and --tip panda_hand exports the arm's seven
+    revolute joints as the file names them, through the API and the command alike."""
+    urdf = Path(pinocchio_panda_urdf())
+    text = urdf.read_text()
+    revolute = re.findall(r'<joint\s+name="([^"]+)"\s+type="revolute"', text)
+    assert len(revolute) == 7
+    out = tmp_path / "arm.toml"
+    with pytest.raises(ModelError, match="several leaf links") as api:
+        export_robot(urdf, out)
+    line = _refusal(capsys, ["export", "--params", str(urdf), "--out", str(out)])
+    assert line == str(api.value) and "--tip" in line and not out.exists()
+    res = export_robot(urdf, out, ExportRobotOptions(tip="panda_hand"))
+    assert res.robot.joint_names == tuple(revolute) and res.format == "toml"
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", DynidWarning)
+        assert (
+            main(["export", "--params", str(urdf), "--tip", "panda_hand", "--out", str(out), "-q"])
+            == 0
+        )
+    saved = load_robot(out)
+    assert saved.joint_names == tuple(revolute)
+    np.testing.assert_allclose(saved.phi, res.robot.phi, rtol=1e-12, atol=1e-15)
+
+
+def test_export_refuses_a_chain_without_a_urdf(tmp_path, capsys):
+    """--base/--tip choose the chain of a URDF --params or template: with panda they would
+    do nothing; a template for MJCF is refused; both alike through the API."""
+    for options, argv, field, out in (
+        ({"tip": "link7"}, ["--tip", "link7"], "tip", "x.toml"),
+        ({"urdf_template": "t.urdf"}, ["--urdf-template", "t.urdf"], "urdf_template", "x.xml"),
+    ):
+        with pytest.raises(OptionError) as api:
+            export_robot("panda", tmp_path / out, ExportRobotOptions(**options))
+        assert api.value.field == field
+        line = _refusal(
+            capsys, ["export", "--params", "panda", *argv, "--out", str(tmp_path / out)]
+        )
+        assert line == option_message(api.value) and line.startswith(flag(field))
+
+
+# ---------------------------------------------------------------------- acquire-static
+def test_acquire_static_refuses_obstacles_without_a_pool_alike(tmp_path, capsys):
+    with pytest.raises(OptionError, match="obstacles needs pool") as api:
+        AcquireStaticOptions(n=5, obstacles="floor.json")
+    assert api.value.field == "obstacles"
+    argv = ["acquire-static", "--n", "5", "--obstacles", "floor.json"]
+    line = _refusal(capsys, [*argv, "--out", str(tmp_path / "s.csv")])
+    assert line == option_message(api.value) and line.startswith("--obstacles needs --pool")
+
+
+def test_acquire_static_writes_the_data_of_the_api(tmp_path):
+    """dynid acquire-static writes the configurations and readings acquire_static_data
+    gives (noisy, with the effects outside the model, which both record); the noise-free
+    readings equal M(q) and g(q) of the robot (the controller's reference)."""
+    options = AcquireStaticOptions(n=12, noise=1e-3, seed=5, unmodelled=True)
+    res = acquire_static_data(dynid.panda(), options)
+    argv = ["acquire-static", "--n", "12", "--noise", "1e-3", "--seed", "5", "--unmodelled"]
+    assert main([*argv, "--out", str(tmp_path / "s.npz"), "-q"]) == 0
+    got, _ = load_static_data(tmp_path / "s.npz", dynid.panda())
+    np.testing.assert_array_equal(got.q, res.data.q)
+    np.testing.assert_array_equal(got.g, res.data.g)
+    assert got.metadata["unmodelled"] == res.data.metadata["unmodelled"]
+    clean = acquire_static_data(dynid.panda(), AcquireStaticOptions(n=4, seed=5)).data
+    np.testing.assert_allclose(clean.g, dynid.gravity_torques(dynid.panda(), clean.q), atol=1e-12)

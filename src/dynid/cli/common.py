@@ -37,22 +37,12 @@ _O = TypeVar("_O")
 FLAGS: dict[str, str] = {
     "cutoff_hz": "--cutoff",
     "max_gap_s": "--max-gap",
-    "data": "--data",
-    "friction_model": "--friction-model",
     "duration_s": "--duration",
     "rate_hz": "--rate",
-    "noise": "--noise",
-    "q_noise": "--q-noise",
-    "dq_noise": "--dq-noise",
     "jitter_s": "--jitter",
     "drop_fraction": "--drop",
     "base_freq_hz": "--base-freq",
-    "contact_ramp_s": "--contact-ramp",
-    "urdf_template": "--urdf-template",
-    "n_configurations": "--n",
-    "pool_factor": "--pool",
-    "margin_rad": "--margin",
-    "consistent": "--consistent",
+    "contacts": "--contact",
 }
 
 
