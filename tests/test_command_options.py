@@ -15,6 +15,7 @@ import dynid
 from dynid.cli.__main__ import main
 from dynid.cli.common import flag, option_message
 from dynid.exceptions import DynidWarning, ModelError, OptionError
+from dynid.io.model_json import save_model_json
 from dynid.io.robot.toml import save_toml
 from dynid.io.robot_file import load_robot
 from dynid.io.static_data import load_static_data
@@ -22,9 +23,10 @@ from dynid.io.torque_log import save_torque_log_pieces
 from dynid.workflows.acquire_static import AcquireStaticOptions, acquire_static_data
 from dynid.workflows.export import ExportRobotOptions, export_robot
 from dynid.workflows.identify import IdentifyOptions, identify_files
+from dynid.workflows.retrieve import RetrieveOptions, retrieve_files
 from dynid.workflows.simulate import SimulateOptions, simulate_log
 
-from conftest import pinocchio_panda_urdf, planar_2r
+from conftest import exact_model, pinocchio_panda_urdf, planar_2r
 
 
 @pytest.fixture(scope="module")
@@ -228,3 +230,37 @@ def test_acquire_static_writes_the_data_of_the_api(tmp_path):
     assert got.metadata["unmodelled"] == res.data.metadata["unmodelled"]
     clean = acquire_static_data(dynid.panda(), AcquireStaticOptions(n=4, seed=5)).data
     np.testing.assert_allclose(clean.g, dynid.gravity_torques(dynid.panda(), clean.q), atol=1e-12)
+
+
+# ---------------------------------------------------------------------- retrieve
+@pytest.mark.parametrize(
+    ("options", "argv", "field"),
+    [
+        ({"workers": 2}, ["--workers", "2"], "workers"),
+        ({"runs": 3}, ["--runs", "3"], "runs"),
+        (
+            {"method": "penalty", "margin": 0.01},
+            ["--method", "penalty", "--margin", "0.01"],
+            "margin",
+        ),
+        (
+            {"method": "penalty", "prior_weight": 1e300},
+            ["--method", "penalty", "--prior-weight", "1e300"],
+            "prior_weight",
+        ),
+    ],
+    ids=["workers-convex", "runs-convex", "margin-penalty", "weight-penalty"],
+)
+def test_retrieve_refuses_an_option_of_the_other_method_alike(
+    tmp_path, capsys, options, argv, field
+):
+    """Options of one consistent method given to the other are refused by RetrieveOptions,
+    through the API and the command, in one line naming the flag."""
+    arm = planar_2r()
+    path = save_model_json(tmp_path / "identification.json", exact_model(arm, arm))
+    with pytest.raises(OptionError) as api:
+        retrieve_files(path, RetrieveOptions(**options))
+    assert api.value.field == field
+    line = _refusal(capsys, ["retrieve", "--model", str(path), *argv, "--out", str(tmp_path / "o")])
+    assert line == option_message(api.value) and line.startswith(flag(field))
+    assert not (tmp_path / "o").exists()

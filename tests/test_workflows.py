@@ -18,10 +18,10 @@ from dynid.io.feasible_bundle import FEASIBLE_BUNDLE
 from dynid.io.robot.toml import save_toml
 from dynid.io.static_data import load_static_data
 from dynid.workflows.data_files import column_map, read_torque_log
-from dynid.workflows.friction import fit_friction_file
+from dynid.workflows.friction import FrictionOptions, fit_friction_files
 from dynid.workflows.identify import IdentifyOptions, identify_files
 from dynid.workflows.prior import load_prior
-from dynid.workflows.retrieve import retrieve_file
+from dynid.workflows.retrieve import RetrieveOptions, retrieve_files
 
 from conftest import planar_2r
 
@@ -75,8 +75,10 @@ def test_static_data_of_another_robot_is_refused_by_the_api_and_every_command(
     for call in (
         lambda: identify_files(other, files / "s.csv"),
         lambda: identify_files(other, files / "s.csv", IdentifyOptions(consistent=True)),
-        lambda: retrieve_file(files / "s.csv", kind="static", robot=other),
-        lambda: retrieve_file(files / "s.csv", kind="static", robot=other, method="penalty"),
+        lambda: retrieve_files(files / "s.csv", kind="static", robot=other),
+        lambda: retrieve_files(
+            files / "s.csv", RetrieveOptions(method="penalty"), kind="static", robot=other
+        ),
     ):
         with pytest.raises(DataError, match="recorded with robot 'panda'") as exc:
             call()
@@ -192,7 +194,7 @@ def test_the_output_bundle_of_a_consistent_fit_is_the_same_for_identify_and_retr
     for folder in (a, b):
         names = {p.name for p in folder.iterdir() if not p.name.startswith(".")}
         assert set(FEASIBLE_BUNDLE) <= names
-    api = retrieve_file(files / "s.csv", kind="static", robot=dynid.panda())
+    api = retrieve_files(files / "s.csv", kind="static", robot=dynid.panda()).result
     doc = json.loads((b / "feasible.json").read_text())
     got = np.array([link["mass"] for link in doc["links"]])
     np.testing.assert_allclose(got, api.mass, rtol=1e-6)
@@ -248,19 +250,20 @@ def test_quiet_keeps_a_json_result(capsys):
 
 
 def test_the_friction_law_policy_is_the_library_s(files, tmp_path, capsys):
-    """fit_friction_file applies dynid friction's policy: auto compares every law on
+    """fit_friction_files applies dynid friction's policy: auto compares every law on
     held-out blocks (the model's own friction too) and keeps the lowest held-out error, a
     named law is fitted as asked, an unknown one is refused; the command writes what the
     API returns."""
     panda = dynid.panda()
-    auto = fit_friction_file(panda, files / "log.csv")
+    auto = fit_friction_files(panda, files / "log.csv")
     assert auto.selection is not None and auto.fit is auto.selection.fit
     held = {s.name: s.heldout_error_percent for s in auto.selection.scores}
     assert held[auto.selection.chosen] == min(held.values()) and "own" in held
-    named = fit_friction_file(panda, files / "log.csv", law="classical")
+    named = fit_friction_files(panda, files / "log.csv", FrictionOptions(law="classical"))
     assert named.selection is None and named.fit.kind == "classical"
-    with pytest.raises(OptionError, match="--friction-model must be auto or one of none"):
-        fit_friction_file(panda, files / "log.csv", law="coulomb")
+    with pytest.raises(OptionError, match="law must be one of auto, none") as api:
+        FrictionOptions(law="coulomb")
+    assert option_message(api.value).startswith("--friction-model must be one of auto, none")
 
     out = tmp_path / "fr"
     argv = ["friction", "--robot", "panda", "--data", str(files / "log.csv"), "--out", str(out)]

@@ -43,6 +43,7 @@ FLAGS: dict[str, str] = {
     "drop_fraction": "--drop",
     "base_freq_hz": "--base-freq",
     "contacts": "--contact",
+    "law": "--friction-model",
 }
 
 
@@ -314,17 +315,6 @@ def parse_mass_band(text: str | None) -> tuple[float, float] | None:
     if not 0.0 <= v[0] <= v[1]:
         raise DataError(f"--total-mass must be MIN,MAX, 0 <= MIN <= MAX; got {text}")
     return float(v[0]), float(v[1])
-
-
-def sdp_options(args: argparse.Namespace) -> Any:
-    """:class:`~dynid.feasibility.convex.options.SDPOptions` from the consistency options."""
-    from ..feasibility.convex import DEFAULT_SDP_MARGIN, SDPOptions  # scipy: kept off fk's start-up
-
-    return SDPOptions(
-        objective=args.objective or "logdet",
-        prior_weight=args.prior_weight,
-        margin=DEFAULT_SDP_MARGIN if args.margin is None else args.margin,
-    )
 
 
 def parse_vector(
