@@ -155,7 +155,8 @@ def test_a_prior_with_other_joints_is_refused_alike(files, tmp_path, capsys):
         load_prior(files / "two.toml", panda)
     argv = ["identify", "--consistent", "--data", str(files / "s.csv")]
     line = _refusal(capsys, [*argv, "--prior", str(files / "two.toml"), "--out", str(tmp_path)])
-    assert line == f"dynid identify: error: {api.value}"
+    assert line == f"dynid identify: error: {option_message(api.value)}"
+    assert line.startswith("dynid identify: error: --prior ")
 
 
 def test_std_is_honoured_on_every_route_or_refused(files, tmp_path, capsys):

@@ -181,6 +181,8 @@ def about(path: Path) -> Iterator[None]:
     try:
         yield
     except DynidError as exc:
+        if isinstance(exc, OptionError) and exc.field is not None:
+            raise  # about an option, not the file
         if str(exc).startswith(path.name):
             raise
         raise type(exc)(f"{path.name}: {exc}") from exc
