@@ -201,7 +201,8 @@ def read_torque_log(
             )
             if not drop_invalid:
                 raise DataError(
-                    f"{path.name}: {what}; hint: fix the file or pass --drop-invalid to drop them"
+                    f"{path.name}: {what}; hint: fix the file or pass --drop-invalid "
+                    "(drop_invalid=True) to drop them"
                 )
             _log.warning("%s: dropped: %s", path.name, what)
         log = mapped.log

@@ -66,10 +66,11 @@ def _with_friction(robot: Robot, path: str | Path | None) -> Robot:
     if fr.kind == "none":  # no friction: nothing to put on the robot
         return robot
     if not isinstance(fr, SigmoidFriction):
-        raise DynidError(
-            f"{Path(path).name} holds {fr.kind} friction; --friction puts sigmoid friction on "
-            "the robot (the law a robot description holds): give a friction.json of "
-            "`dynid friction --friction-model sigmoid`, or none"
+        raise OptionError(
+            f"{Path(path).name} holds {fr.kind} friction; sigmoid friction goes on the robot "
+            "(the law a robot description holds): give a friction.json of the sigmoid law "
+            "(`dynid friction --friction-model sigmoid`), or none",
+            field="friction",
         )
     return robot.with_friction(fr.as_array())
 
