@@ -20,7 +20,9 @@ from dynid.io.robot.toml import save_toml
 from dynid.io.robot_file import load_robot
 from dynid.io.static_data import load_static_data
 from dynid.io.torque_log import save_torque_log_pieces
+from dynid.simulation.excitation import ExcitationOptions
 from dynid.workflows.acquire_static import AcquireStaticOptions, acquire_static_data
+from dynid.workflows.excite import design_excitation
 from dynid.workflows.export import ExportRobotOptions, export_robot
 from dynid.workflows.identify import IdentifyOptions, identify_files
 from dynid.workflows.retrieve import RetrieveOptions, retrieve_files
@@ -264,3 +266,14 @@ def test_retrieve_refuses_an_option_of_the_other_method_alike(
     line = _refusal(capsys, ["retrieve", "--model", str(path), *argv, "--out", str(tmp_path / "o")])
     assert line == option_message(api.value) and line.startswith(flag(field))
     assert not (tmp_path / "o").exists()
+
+
+# ---------------------------------------------------------------------- excite
+def test_excite_refuses_aliased_harmonics_alike(tmp_path, capsys):
+    """A highest harmonic above half the rate the regressor is optimised at is refused by
+    ExcitationOptions, which design_excitation and dynid excite take alike."""
+    with pytest.raises(OptionError, match="highest harmonic") as api:
+        design_excitation(dynid.panda(), ExcitationOptions(harmonics=20, base_frequency=1.0))
+    argv = ["excite", "--harmonics", "20", "--base-frequency", "1", "--out", str(tmp_path / "e")]
+    assert _refusal(capsys, argv) == option_message(api.value)
+    assert not (tmp_path / "e").exists()
