@@ -12,7 +12,7 @@ import numpy as np
 import pytest
 
 import dynid
-from dynid.cli.__main__ import main
+from dynid.cli.__main__ import build_parser, main
 from dynid.cli.common import flag, option_message
 from dynid.exceptions import DynidWarning, ModelError, OptionError
 from dynid.io.model_json import save_model_json
@@ -24,6 +24,7 @@ from dynid.simulation.excitation import ExcitationOptions
 from dynid.workflows.acquire_static import AcquireStaticOptions, acquire_static_data
 from dynid.workflows.excite import design_excitation
 from dynid.workflows.export import ExportRobotOptions, export_robot
+from dynid.workflows.friction import FrictionOptions
 from dynid.workflows.identify import IdentifyOptions, identify_files
 from dynid.workflows.retrieve import RetrieveOptions, retrieve_files
 from dynid.workflows.simulate import SimulateOptions, simulate_log
@@ -277,3 +278,31 @@ def test_excite_refuses_aliased_harmonics_alike(tmp_path, capsys):
     argv = ["excite", "--harmonics", "20", "--base-frequency", "1", "--out", str(tmp_path / "e")]
     assert _refusal(capsys, argv) == option_message(api.value)
     assert not (tmp_path / "e").exists()
+
+
+@pytest.mark.parametrize(
+    ("command", "cls", "given"),
+    [
+        ("identify", IdentifyOptions, {"columns", "drive", "total_mass"}),
+        (
+            "simulate",
+            SimulateOptions,
+            {"friction", "amplitudes", "periods", "q0", "contacts", "drive"},
+        ),
+        ("export", ExportRobotOptions, {"friction"}),
+        ("acquire-static", AcquireStaticOptions, set()),
+        ("friction", FrictionOptions, {"columns", "drive"}),
+        ("retrieve", RetrieveOptions, {"total_mass_band", "total_mass"}),
+    ],
+)
+def test_every_option_field_has_its_flag(command, cls, given):
+    """Each field of a command's options class is given by the command (parsed first) or
+    read from the flag cli.common.flag names, which the command's parser has: the table of
+    flags and the parsers agree, so that every refusal names a flag the user can type."""
+    import dataclasses
+
+    parser = build_parser((command.replace("-", "_"),))
+    sub = next(a for a in parser._actions if a.dest == "command").choices[command]
+    flags = {s for a in sub._actions for s in a.option_strings}
+    for f in dataclasses.fields(cls):
+        assert f.name in given or flag(f.name) in flags, (command, f.name, flag(f.name))
