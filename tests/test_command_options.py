@@ -26,6 +26,7 @@ from dynid.workflows.excite import design_excitation
 from dynid.workflows.export import ExportRobotOptions, export_robot
 from dynid.workflows.friction import FrictionOptions
 from dynid.workflows.identify import IdentifyOptions, identify_files
+from dynid.workflows.kinematics import goal_pose
 from dynid.workflows.retrieve import RetrieveOptions, retrieve_files
 from dynid.workflows.simulate import SimulateOptions, simulate_log
 
@@ -306,3 +307,21 @@ def test_every_option_field_has_its_flag(command, cls, given):
     flags = {s for a in sub._actions for s in a.option_strings}
     for f in dataclasses.fields(cls):
         assert f.name in given or flag(f.name) in flags, (command, f.name, flag(f.name))
+
+
+# ---------------------------------------------------------------------- ik
+def test_an_ik_goal_by_position_keeps_the_start_orientation_through_both(capsys):
+    """goal_pose without rpy keeps the frame's orientation at q0 (fk at q0, the reference);
+    dynid ik --goal-xyz solves for that goal: the same configuration as ik on goal_pose."""
+    import json
+
+    robot, q0 = dynid.panda(), dynid.PANDA_NEUTRAL_Q
+    T = goal_pose(robot, q0, (0.35, 0.1, 0.45))
+    np.testing.assert_array_equal(T[:3, :3], dynid.fk(robot, q0)[:3, :3])
+    np.testing.assert_array_equal(T[:3, 3], [0.35, 0.1, 0.45])
+    ref = dynid.ik(robot, T, q0, rng=np.random.default_rng(0))
+    assert main(["ik", "--goal-xyz", "0.35,0.1,0.45", "--json"]) == 0
+    np.testing.assert_array_equal(json.loads(capsys.readouterr().out)["q"], ref.q)
+    with pytest.raises(OptionError) as api:
+        goal_pose(robot, q0, (0.3, 0.1))
+    assert api.value.field == "goal_xyz"
