@@ -22,8 +22,8 @@ from dynid.io.static_data import save_static_data
 from dynid.io.torque_log import load_torque_log, save_torque_log
 from dynid.simulation.measurement import SensorNoise, sample_times, simulate_measurement
 from dynid.simulation.trajectories import random_fourier
-from dynid.workflows.friction import fit_friction_file
-from dynid.workflows.identify import identify_file
+from dynid.workflows.friction import FrictionOptions, fit_friction_files
+from dynid.workflows.identify import identify_files
 from dynid.workflows.payload import identify_payload_files
 from dynid.workflows.validate import ValidateOptions, validate_files
 
@@ -147,8 +147,8 @@ def test_friction_is_recovered_from_several_recordings(panda, files):
     paths = [files / "cl3.csv", files / "cl4.csv"]
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", DynidWarning)
-        fixed = fit_friction_file(rigid, paths, law="classical")
-        auto = fit_friction_file(rigid, paths)
+        fixed = fit_friction_files(rigid, paths, FrictionOptions(law="classical"))
+        auto = fit_friction_files(rigid, paths)
     fr = fixed.fit.friction.as_array()
     np.testing.assert_allclose(fr[:, 0], VISCOUS, atol=0.05)
     np.testing.assert_allclose(fr[:, 1], COULOMB, atol=0.05)
@@ -171,9 +171,9 @@ def test_the_own_friction_is_judged_on_the_same_recordings(panda, files):
     paths = [files / "rec1.csv", files / "rec2.csv"]
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", DynidWarning)
-        model = identify_file(panda, paths)
-        sel = fit_friction_file(model, paths).selection
-        robot = fit_friction_file(panda, paths).selection
+        model = identify_files(panda, paths).model
+        sel = fit_friction_files(model, paths).selection
+        robot = fit_friction_files(panda, paths).selection
     held = {s.name: s.heldout_error_percent for s in sel.scores}
     law = model.info.friction.law
     assert sel.scores[-1].name == "own" and held["own"] == pytest.approx(held[law], rel=1e-12)
@@ -223,7 +223,7 @@ def test_a_bad_recording_among_several_is_named(panda, files, tmp_path, edit, me
     """An empty recording, one with NaN or a repeated time stamp: one error naming it, on
     validate and friction alike."""
     bad = _copy(files / "rec2.csv", tmp_path / "bad.csv", edit)
-    for call in (validate_files, fit_friction_file):
+    for call in (validate_files, fit_friction_files):
         with pytest.raises(DataError, match=message):
             call(panda, [files / "rec1.csv", bad])
 
@@ -246,7 +246,7 @@ def test_a_recording_in_other_units_is_named(panda, files, tmp_path, capsys):
     with pytest.raises(DataError, match=r"mnm.csv: its torques \(RMS\) are 1\.\d+e\+03 times tho"):
         validate_files(panda, [files / "rec1.csv", tmp_path / "mnm.csv"])
     with pytest.raises(DataError, match="ms.csv: its velocities against the derivative"):
-        fit_friction_file(panda, [files / "rec1.csv", tmp_path / "ms.csv"])
+        fit_friction_files(panda, [files / "rec1.csv", tmp_path / "ms.csv"])
     with pytest.raises(DataError) as api:
         validate_files(panda, [files / "rec1.csv", tmp_path / "mnm.csv"])
     argv = ["validate", "--robot", "panda", "--out", str(tmp_path / "v"), "--data"]

@@ -12,15 +12,16 @@ import pytest
 
 import dynid
 from dynid.cli.__main__ import main
+from dynid.cli.common import option_message
 from dynid.exceptions import DataError, DynidError, OptionError
 from dynid.io.feasible_bundle import FEASIBLE_BUNDLE
 from dynid.io.robot.toml import save_toml
 from dynid.io.static_data import load_static_data
 from dynid.workflows.data_files import column_map, read_torque_log
-from dynid.workflows.friction import fit_friction_file
-from dynid.workflows.identify import identify_consistent_file, identify_file
+from dynid.workflows.friction import FrictionOptions, fit_friction_files
+from dynid.workflows.identify import IdentifyOptions, identify_files
 from dynid.workflows.prior import load_prior
-from dynid.workflows.retrieve import retrieve_file
+from dynid.workflows.retrieve import RetrieveOptions, retrieve_files
 
 from conftest import planar_2r
 
@@ -72,10 +73,12 @@ def test_static_data_of_another_robot_is_refused_by_the_api_and_every_command(
         load_static_data(files / "s.csv", other)
     assert str(api.value).startswith(OTHER)
     for call in (
-        lambda: identify_file(other, files / "s.csv"),
-        lambda: identify_consistent_file(other, files / "s.csv"),
-        lambda: retrieve_file(files / "s.csv", kind="static", robot=other),
-        lambda: retrieve_file(files / "s.csv", kind="static", robot=other, method="penalty"),
+        lambda: identify_files(other, files / "s.csv"),
+        lambda: identify_files(other, files / "s.csv", IdentifyOptions(consistent=True)),
+        lambda: retrieve_files(files / "s.csv", kind="static", robot=other),
+        lambda: retrieve_files(
+            files / "s.csv", RetrieveOptions(method="penalty"), kind="static", robot=other
+        ),
     ):
         with pytest.raises(DataError, match="recorded with robot 'panda'") as exc:
             call()
@@ -113,7 +116,7 @@ def test_a_log_of_another_joint_count_is_refused_alike(files, tmp_path, capsys, 
     with pytest.raises(DataError, match="the log has 7 joints; the robot has 2"):
         read_torque_log(files / "log.csv", 2)
     with pytest.raises(DataError, match="the log has 7 joints; robot 'planar2r' has 2"):
-        identify_file(planar_2r(), files / "log.csv")
+        identify_files(planar_2r(), files / "log.csv")
     line = _refusal(
         capsys,
         [*argv, str(files / "two.toml"), "--data", str(files / "log.csv"), "--out", str(tmp_path)],
@@ -152,7 +155,8 @@ def test_a_prior_with_other_joints_is_refused_alike(files, tmp_path, capsys):
         load_prior(files / "two.toml", panda)
     argv = ["identify", "--consistent", "--data", str(files / "s.csv")]
     line = _refusal(capsys, [*argv, "--prior", str(files / "two.toml"), "--out", str(tmp_path)])
-    assert line == f"dynid identify: error: {api.value}"
+    assert line == f"dynid identify: error: {option_message(api.value)}"
+    assert line.startswith("dynid identify: error: --prior ")
 
 
 def test_std_is_honoured_on_every_route_or_refused(files, tmp_path, capsys):
@@ -161,7 +165,7 @@ def test_std_is_honoured_on_every_route_or_refused(files, tmp_path, capsys):
     panda = dynid.panda()
     for data in ("s.csv", "log.csv"):
         for std in ("robust", "classical"):
-            model = identify_file(panda, files / data, std=std)
+            model = identify_files(panda, files / data, IdentifyOptions(std=std)).model
             assert model.info.std == std
             out = tmp_path / f"{data}-{std}"
             argv = ["identify", "--data", str(files / data), "--std", std, "--out", str(out)]
@@ -170,12 +174,13 @@ def test_std_is_honoured_on_every_route_or_refused(files, tmp_path, capsys):
             assert doc["std_estimator"] == std
             got = [c["std"] for c in doc["coefficients"]]
             np.testing.assert_allclose(got, model.fit.std[: len(got)], rtol=1e-9, atol=0)
-    with pytest.raises(DataError, match="--std does not apply to --consistent") as api:
-        identify_consistent_file(panda, files / "s.csv", std="robust")
+    with pytest.raises(OptionError, match="std does not apply to consistent") as api:
+        identify_files(panda, files / "s.csv", IdentifyOptions(consistent=True, std="robust"))
+    assert api.value.field == "std"
     argv = ["identify", "--consistent", "--std", "robust", "--data", str(files / "s.csv")]
-    assert _refusal(capsys, [*argv, "--out", str(tmp_path / "c")]) == (
-        f"dynid identify: error: {api.value}"
-    )
+    line = _refusal(capsys, [*argv, "--out", str(tmp_path / "c")])
+    assert line == f"dynid identify: error: {option_message(api.value)}"
+    assert line.startswith("dynid identify: error: --std does not apply to --consistent")
 
 
 def test_the_output_bundle_of_a_consistent_fit_is_the_same_for_identify_and_retrieve(
@@ -190,7 +195,7 @@ def test_the_output_bundle_of_a_consistent_fit_is_the_same_for_identify_and_retr
     for folder in (a, b):
         names = {p.name for p in folder.iterdir() if not p.name.startswith(".")}
         assert set(FEASIBLE_BUNDLE) <= names
-    api = retrieve_file(files / "s.csv", kind="static", robot=dynid.panda())
+    api = retrieve_files(files / "s.csv", kind="static", robot=dynid.panda()).result
     doc = json.loads((b / "feasible.json").read_text())
     got = np.array([link["mass"] for link in doc["links"]])
     np.testing.assert_allclose(got, api.mass, rtol=1e-6)
@@ -246,19 +251,20 @@ def test_quiet_keeps_a_json_result(capsys):
 
 
 def test_the_friction_law_policy_is_the_library_s(files, tmp_path, capsys):
-    """fit_friction_file applies dynid friction's policy: auto compares every law on
+    """fit_friction_files applies dynid friction's policy: auto compares every law on
     held-out blocks (the model's own friction too) and keeps the lowest held-out error, a
     named law is fitted as asked, an unknown one is refused; the command writes what the
     API returns."""
     panda = dynid.panda()
-    auto = fit_friction_file(panda, files / "log.csv")
+    auto = fit_friction_files(panda, files / "log.csv")
     assert auto.selection is not None and auto.fit is auto.selection.fit
     held = {s.name: s.heldout_error_percent for s in auto.selection.scores}
     assert held[auto.selection.chosen] == min(held.values()) and "own" in held
-    named = fit_friction_file(panda, files / "log.csv", law="classical")
+    named = fit_friction_files(panda, files / "log.csv", FrictionOptions(law="classical"))
     assert named.selection is None and named.fit.kind == "classical"
-    with pytest.raises(OptionError, match="--friction-model must be auto or one of none"):
-        fit_friction_file(panda, files / "log.csv", law="coulomb")
+    with pytest.raises(OptionError, match="law must be one of auto, none") as api:
+        FrictionOptions(law="coulomb")
+    assert option_message(api.value).startswith("--friction-model must be one of auto, none")
 
     out = tmp_path / "fr"
     argv = ["friction", "--robot", "panda", "--data", str(files / "log.csv"), "--out", str(out)]

@@ -6,6 +6,8 @@ builtin (``ValueError``, ``KeyError``, ...) so generic handlers keep working.
 
 from __future__ import annotations
 
+from collections.abc import Callable
+
 
 class DynidError(Exception):
     """Base class of every error raised by dynid."""
@@ -27,7 +29,41 @@ class UnknownNameError(DynidError, KeyError):
 
 
 class OptionError(DynidError, ValueError):
-    """An option or argument has a value outside its range (the message names it)."""
+    """An option or argument has a value outside its range, or options that do not go
+    together (the message names them).
+
+    Attributes
+    ----------
+    field : str or None
+        The option at fault as the Python API names it (an options class's field or a
+        function's parameter: ``cutoff_hz``), when one is; the message starts with it.
+        The command line names it by its flag instead (``--cutoff``).
+    others : tuple of str
+        Other options the message names, written ``{name}`` in ``reason``.
+    reason : str
+        The message after the field's name, with ``{name}`` for each of ``others``.
+
+    Examples
+    --------
+    >>> str(OptionError("applies with {unmodelled} only", field="arm_seed", others=("unmodelled",)))
+    'arm_seed applies with unmodelled only'
+    """
+
+    def __init__(
+        self, message: str, *, field: str | None = None, others: tuple[str, ...] = ()
+    ) -> None:
+        super().__init__(message if field is None else self.named(message, field, others, str))
+        self.field = field
+        self.others = tuple(others)
+        self.reason = message
+
+    @staticmethod
+    def named(reason: str, field: str, others: tuple[str, ...], name: Callable[[str], str]) -> str:
+        """The message with each option named by ``name`` (``str``: as the Python API
+        names it; the command line gives its flags)."""
+        for other in others:
+            reason = reason.replace("{" + other + "}", name(other))
+        return name(field) + ("" if reason[:1] in (",", ":", ";") else " ") + reason
 
 
 class WrongTypeError(DynidError, TypeError):

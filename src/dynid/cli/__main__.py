@@ -36,7 +36,7 @@ from typing import TextIO
 
 from .. import __version__
 from .._checks import one_line
-from ..exceptions import DynidError
+from ..exceptions import DynidError, OptionError
 from ..io.atomic import output_transaction
 from ..outputs.run_output import RunOutput, run_output
 from .console import Console
@@ -280,7 +280,7 @@ def main(argv: Sequence[str] | None = None) -> int:
     except (DynidError, OSError) as exc:
         if args.debug:
             raise
-        print(f"{say}: error: {one_line(str(exc), ERROR_LINE_LIMIT)}", file=_stderr())
+        print(f"{say}: error: {one_line(_message(exc), ERROR_LINE_LIMIT)}", file=_stderr())
         return 2
     except MemoryError as exc:
         if args.debug:
@@ -296,6 +296,15 @@ def main(argv: Sequence[str] | None = None) -> int:
             file=_stderr(),
         )
         return 2
+
+
+def _message(exc: BaseException) -> str:
+    """An error's line: an option named by its flag (:func:`dynid.cli.common.flag`)."""
+    if isinstance(exc, OptionError):
+        from .common import option_message
+
+        return option_message(exc)
+    return str(exc)
 
 
 #: What makes each command's memory smaller, for the out-of-memory hint (the commands that

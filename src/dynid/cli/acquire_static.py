@@ -25,17 +25,9 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
-import numpy as np
-
-from ..exceptions import OptionError
-from ..identification.consistency import kinematics_record
 from ..io.static_data import save_static_data
-from ..simulation.controller import (
-    DEFAULT_MARGIN,
-    SimulatedController,
-    acquire_static,
-    acquire_static_at,
-)
+from ..simulation.controller import DEFAULT_MARGIN
+from ..workflows.acquire_static import AcquireStaticOptions, acquire_static_data
 from .common import (
     add_robot_options,
     add_seed_option,
@@ -43,6 +35,7 @@ from .common import (
     count_type,
     load_robot,
     nonnegative_type,
+    options_from,
     output_path,
 )
 from .console import Console
@@ -98,56 +91,17 @@ def register(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParser:
     return p
 
 
-def streams(seed: int) -> tuple[np.random.Generator, np.random.Generator]:
-    """Two independent generators from one seed: configurations, then noise."""
-    a, b = np.random.SeedSequence(seed).spawn(2)
-    return np.random.default_rng(a), np.random.default_rng(b)
-
-
 def run(args: argparse.Namespace, console: Console) -> int:
     """Acquire and write the data set; returns the exit code."""
-    if args.obstacles is not None and args.pool is None:
-        raise OptionError(
-            "--obstacles needs --pool: only the chosen configurations are kept clear of "
-            "obstacles, random ones are not checked (give --pool 5, say)"
-        )
+    options = options_from(args, AcquireStaticOptions)
     robot = load_robot(args)
-    rng_q, rng_noise = streams(args.seed)
-    effects = None
-    if args.unmodelled:
-        from ..simulation.unmodelled import UnmodelledEffects
-
-        effects = UnmodelledEffects.typical(robot.n, np.random.default_rng([args.seed, 7]))
-    controller = SimulatedController(robot, args.noise, rng=rng_noise, effects=effects)
-    if args.pool is None:
-        data = acquire_static(controller, args.n, rng_q, margin=args.margin)
-        data = data.with_metadata(seed=args.seed, kinematics=kinematics_record(robot))
-        if effects is not None:
-            data = data.with_metadata(unmodelled=effects.as_dict())
-    else:
-        from ..io.excitation import load_obstacles
-        from ..simulation.static_selection import select_static_configurations
-
-        obstacles = None if args.obstacles is None else load_obstacles(args.obstacles)
-        sel = select_static_configurations(
-            robot, args.n, rng_q, pool_factor=args.pool, margin=args.margin, obstacles=obstacles
-        )
-        data = acquire_static_at(controller, sel.q, margin=args.margin)
-        data = data.with_metadata(
-            seed=args.seed,
-            kinematics=kinematics_record(robot),
-            pool_factor=args.pool,
-            condition_number=sel.condition_number,
-            random_condition_number=sel.pool_condition_number,
-        )
-        console.print(
-            f"chose {args.n} of {sel.pool_size} configurations: condition number "
-            f"{sel.condition_number:.4g} (unscaled; {sel.pool_condition_number:.4g} for "
-            f"{args.n} random ones of the pool), scaled {sel.scaled_condition_number:.4g}"
-        )
-    path = save_static_data(args.out, data)
+    result = acquire_static_data(robot, options)
+    chosen = result.describe()
+    if chosen is not None:
+        console.print(chosen)
+    path = save_static_data(args.out, result.data)
     console.print(
-        f"wrote {data.n_configurations} configurations of {robot.name} "
+        f"wrote {result.data.n_configurations} configurations of {robot.name} "
         f"(noise {args.noise:g}, seed {args.seed}) to {path}"
     )
     return 0

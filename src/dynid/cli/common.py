@@ -5,12 +5,13 @@ from __future__ import annotations
 
 import argparse
 import contextlib
+import dataclasses
 import logging
 import math
 import sys
 from collections.abc import Callable, Iterator
 from pathlib import Path
-from typing import Any
+from typing import Any, TypeVar
 
 import numpy as np
 
@@ -26,6 +27,51 @@ from ..workflows.prior import load_prior as workflow_prior
 from .console import Console
 
 _log = logging.getLogger(__name__)
+_O = TypeVar("_O")
+
+
+# ---------------------------------------------------------------------- options' flags
+#: The flag of each option field of the library's entry points whose flag is not the
+#: field's name with dashes (``drop_invalid`` -> ``--drop-invalid``): the one place where
+#: an :class:`~dynid.exceptions.OptionError`'s ``field`` becomes what the user typed.
+FLAGS: dict[str, str] = {
+    "cutoff_hz": "--cutoff",
+    "max_gap_s": "--max-gap",
+    "duration_s": "--duration",
+    "rate_hz": "--rate",
+    "jitter_s": "--jitter",
+    "drop_fraction": "--drop",
+    "base_freq_hz": "--base-freq",
+    "contacts": "--contact",
+    "law": "--friction-model",
+}
+
+
+def flag(field: str) -> str:
+    """The command-line flag of the option field ``field`` (:data:`FLAGS`)."""
+    return FLAGS.get(field, "--" + field.replace("_", "-"))
+
+
+def options_from(args: argparse.Namespace, cls: type[_O], **given: Any) -> _O:
+    """The typed options ``cls`` (a dataclass of a library entry point) from the parsed
+    command line: each field from its flag's value (:func:`flag`), or from ``given``
+    (values the command parses or loads first); fields without a flag keep their default."""
+    kw = {}
+    for f in dataclasses.fields(cls):  # type: ignore[arg-type]
+        dest = flag(f.name)[2:].replace("-", "_")
+        if f.name in given:
+            kw[f.name] = given[f.name]
+        elif hasattr(args, dest):
+            kw[f.name] = getattr(args, dest)
+    return cls(**kw)
+
+
+def option_message(exc: OptionError) -> str:
+    """An :class:`~dynid.exceptions.OptionError`'s message with its options named by their
+    flags (``cutoff_hz must be ...`` -> ``--cutoff must be ...``)."""
+    if exc.field is None:
+        return str(exc)
+    return OptionError.named(exc.reason, exc.field, exc.others, flag)
 
 
 # ---------------------------------------------------------------------- option value types
@@ -135,6 +181,8 @@ def about(path: Path) -> Iterator[None]:
     try:
         yield
     except DynidError as exc:
+        if isinstance(exc, OptionError) and exc.field is not None:
+            raise  # about an option, not the file
         if str(exc).startswith(path.name):
             raise
         raise type(exc)(f"{path.name}: {exc}") from exc
@@ -269,17 +317,6 @@ def parse_mass_band(text: str | None) -> tuple[float, float] | None:
     if not 0.0 <= v[0] <= v[1]:
         raise DataError(f"--total-mass must be MIN,MAX, 0 <= MIN <= MAX; got {text}")
     return float(v[0]), float(v[1])
-
-
-def sdp_options(args: argparse.Namespace) -> Any:
-    """:class:`~dynid.feasibility.convex.options.SDPOptions` from the consistency options."""
-    from ..feasibility.convex import DEFAULT_SDP_MARGIN, SDPOptions  # scipy: kept off fk's start-up
-
-    return SDPOptions(
-        objective=args.objective or "logdet",
-        prior_weight=args.prior_weight,
-        margin=DEFAULT_SDP_MARGIN if args.margin is None else args.margin,
-    )
 
 
 def parse_vector(

@@ -32,11 +32,13 @@ from __future__ import annotations
 import argparse
 import sys
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 
-from ..io.excitation import load_obstacles, save_excitation_json, save_trajectory_csv
-from ..simulation.excitation import ExcitationOptions, optimise_excitation
+from ..io.excitation import save_excitation_json, save_trajectory_csv
+from ..simulation.excitation import ExcitationOptions
+from ..workflows.excite import design_excitation
 from .common import add_robot_options, add_subcommand, load_robot, output_path, save_figure
 from .console import Console
 
@@ -88,10 +90,20 @@ def register(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParser:
     return p
 
 
+def _progress(show: bool) -> Any:
+    """A bar of the iterations on stderr when ``show`` (a terminal, without -q)."""
+
+    def progress(k: int, total: int, cond: float) -> None:
+        if show:
+            bar = "#" * int(30 * k / max(total, 1))
+            print(f"\r[{bar:<30}] iteration {k}/{total}, cond {cond:.4g}", end="", file=sys.stderr)
+
+    return progress
+
+
 def run(args: argparse.Namespace, console: Console) -> int:
     """Optimise, write the trajectory files and the figure; returns the exit code."""
     robot = load_robot(args)
-    obstacles = None if args.obstacles is None else load_obstacles(args.obstacles)
     opts = ExcitationOptions(
         duration=args.duration,
         harmonics=args.harmonics,
@@ -103,47 +115,18 @@ def run(args: argparse.Namespace, console: Console) -> int:
         max_iter=args.max_iter,
     )
     show = not console.quiet and sys.stderr.isatty()
-
-    def progress(k: int, total: int, cond: float) -> None:
-        if show:
-            bar = "#" * int(30 * k / max(total, 1))
-            print(f"\r[{bar:<30}] iteration {k}/{total}, cond {cond:.4g}", end="", file=sys.stderr)
-
-    res = optimise_excitation(
-        robot, np.random.default_rng(args.seed), opts, obstacles=obstacles, progress=progress
+    progress = _progress(show)
+    design = design_excitation(
+        robot, opts, obstacles=args.obstacles, seed=args.seed, progress=progress
     )
-    if show:
-        print(file=sys.stderr)
-    samples = res.trajectory.sample(1000.0)
-    csv = save_trajectory_csv(args.out / "trajectory.csv", samples)
-    js = save_excitation_json(args.out / "trajectory.json", res, robot, seed=args.seed)
-    written = [csv, js]
+    print(end="\n" if show else "", file=sys.stderr)
+    res, samples = design.result, design.samples
+    written = [save_trajectory_csv(args.out / "trajectory.csv", samples)]
+    written.append(save_excitation_json(args.out / "trajectory.json", res, robot, seed=args.seed))
     if not args.no_figure:
-        from ..plots.excitation import plot_excitation
-
-        png = save_figure(
-            lambda: plot_excitation(robot, samples, obstacles=res.obstacles),
-            args.out / "excitation.png",
-            dpi=110,
-        )
-        written += [png] if png is not None else []
-    m = res.margins
-    console.print(
-        f"exciting trajectory for {robot.name}: {res.trajectory.total_duration:g} s, "
-        f"condition number {res.condition_number:.4g} (unscaled; start "
-        f"{res.initial_condition_number:.4g}), scaled {res.scaled_condition_number:.4g}, "
-        f"{res.iterations} iterations, status {res.status}"
-    )
-    console.print(
-        "smallest margins at 1 kHz: position "
-        f"{min(m['position']):.3g} rad, velocity {min(m['velocity']):.3g} rad/s, "
-        f"acceleration {min(m['acceleration']):.3g} rad/s^2, torque "
-        f"{min(m['torque']):.3g} N m, self-collision {m['self_collision']:.3g} m"
-        + "".join(f", {k} {v:.3g} m" for k, v in m["obstacles"].items())
-    )
-    for p in written:
-        console.print(f"wrote {p}")
-    if res.status == "infeasible":  # a negative result, as retrieve's: exit 1, files kept
+        written += save_excitation_figure(args.out, robot, design)
+    console.print(*design.describe(robot), *(f"wrote {p}" for p in written))
+    if not design.admissible:  # a negative result, as retrieve's: exit 1, files kept
         print(
             f"dynid {NAME}: no admissible trajectory found (files written for inspection); "
             "hint: fewer or smaller obstacles, smaller --radius or another --seed",
@@ -151,3 +134,16 @@ def run(args: argparse.Namespace, console: Console) -> int:
         )
         return 1
     return 0
+
+
+def save_excitation_figure(out: Path, robot: Any, design: Any) -> list[Path]:
+    """``excitation.png`` (skipped without matplotlib)."""
+    from ..plots.excitation import plot_excitation
+
+    samples, obstacles = design.samples, design.result.obstacles
+    png = save_figure(
+        lambda: plot_excitation(robot, samples, obstacles=obstacles),
+        out / "excitation.png",
+        dpi=110,
+    )
+    return [] if png is None else [png]

@@ -1,7 +1,8 @@
 """Write a robot with its (identified, feasible) parameters as URDF, MJCF or TOML.
 
---params takes feasible.json (from `dynid retrieve`), a robot .toml, 'panda' or 'fr3'. The
-format comes from --format or the suffix of --out (.urdf, .xml/.mjcf, .toml).
+--params takes feasible.json (from `dynid retrieve`), a robot .toml, a .urdf (the chain
+from --base to --tip; by default its only root and leaf), 'panda' or 'fr3'. The format
+comes from --format or the suffix of --out (.urdf, .xml/.mjcf, .toml).
 
 URDF without a template: the chain with the source robot's link and joint names. With
 --urdf-template ORIGINAL.urdf (and --base/--tip for its chain): the original file written
@@ -31,15 +32,11 @@ from __future__ import annotations
 
 import argparse
 from pathlib import Path
-from typing import Any
 
-from ..exceptions import DynidError
-from ..friction.model import DriveFriction
-from ..friction.mujoco import coulomb_viscous_from_sigmoid
-from ..io.export import EXPORT_FORMATS, export_format, model_terms_of, save_robot
+from ..io.export import EXPORT_FORMATS
 from ..io.robot.urdf_patch import MERGED_POLICIES
-from ..model.robot import Robot
-from .common import add_drive_option, add_subcommand, load_drive_arg, output_path
+from ..workflows.export import ExportRobotOptions, export_robot, save_export
+from .common import add_drive_option, add_subcommand, options_from, output_path
 from .console import Console
 
 NAME = "export"
@@ -55,12 +52,23 @@ def register(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParser:
         __doc__,
         help="write a robot as URDF (optionally patching the original), MJCF or TOML",
     )
-    p.add_argument("--params", required=True, help="feasible.json, a robot .toml, 'panda' or 'fr3'")
+    p.add_argument(
+        "--params",
+        required=True,
+        help="feasible.json, a robot .toml or .urdf (--base/--tip: its chain), 'panda' or 'fr3'",
+    )
     p.add_argument("--format", choices=EXPORT_FORMATS, default=None, help="default: by suffix")
     p.add_argument("--out", type=output_path, required=True, help="output file")
     p.add_argument("--urdf-template", type=Path, default=None, help="the original URDF file")
-    p.add_argument("--base", default=None, help="base link of the template's chain")
-    p.add_argument("--tip", default=None, help="tip link of the template's chain")
+    p.add_argument(
+        "--base", default=None, help="base link of the chain of a URDF --params and the template"
+    )
+    p.add_argument(
+        "--tip",
+        default=None,
+        help="tip link of the chain of a URDF --params and the template (default: the only "
+        "leaf; a URDF with several leaves, such as an arm with a two-finger hand, needs it)",
+    )
     p.add_argument(
         "--merged",
         choices=MERGED_POLICIES,
@@ -75,57 +83,23 @@ def register(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParser:
     return p
 
 
-def load_params(spec: str) -> Robot:
-    """The robot of ``--params``: feasible.json, a robot .toml, ``panda`` or ``fr3``."""
-    from ..io.robot_file import load_robot
-
-    if Path(spec).suffix.lower() == ".urdf":
-        raise DynidError(
-            f"--params must be feasible.json, a robot .toml, 'panda' or 'fr3'; got {spec!r}"
-        )
-    return load_robot(spec, what="--params")
-
-
 def run(args: argparse.Namespace, console: Console) -> int:
-    """Load, write, print a summary; returns the exit code."""
-    robot = load_params(args.params)
-    if args.urdf_template is None and (args.base or args.tip):
-        raise DynidError("--base/--tip choose the chain of --urdf-template; give the template")
-    linear, drive = model_terms_of(args.params, robot.n)
-    if args.drive is not None:
-        drive = load_drive_arg(args, robot.n)
-    friction: Any = False if args.no_friction else True
-    if linear is not None and not args.no_friction:
-        friction = linear
-        if (
-            drive is not None
-            and drive.friction_at == "motor"
-            and not isinstance(linear, DriveFriction)
-        ):
-            friction = DriveFriction(linear, drive)
-    path = save_robot(
-        args.out,
-        robot,
-        format=args.format,
-        template=args.urdf_template,
-        base=args.base,
-        tip=args.tip,
-        merged=args.merged,
-        friction=friction,
-        all_frames=args.all_frames,
-        drive=drive,
-    )
+    """Read, write, print a summary; returns the exit code."""
+    options = options_from(args, ExportRobotOptions, friction=not args.no_friction)
+    result = export_robot(args.params, args.out, options)
+    path = save_export(args.out, result)
     console.print(f"wrote {path}")
-    if drive is not None:
-        console.print(f"drive: {drive.describe()}")
-    mjcf = export_format(path, args.format) == "mjcf"
-    if mjcf and friction is True and robot.friction is not None:
-        approx = coulomb_viscous_from_sigmoid(robot.friction, robot.dq_max)
+    if result.options.drive is not None:
+        console.print(f"drive: {result.options.drive.describe()}")
+    approx = result.mujoco_friction
+    if approx is not None:
         console.print("friction as MuJoCo holds it (odd part of the sigmoid, fitted up to dq_max):")
-        for j, name in enumerate(robot.joint_names):
-            console.print(
+        console.print(
+            *(
                 f"  {name}: frictionloss {approx.coulomb[j]:.4g} N m, damping "
                 f"{approx.viscous[j]:.4g} N m s/rad, dropped offset {approx.offset[j]:+.3g} "
                 f"N m, fit RMS {approx.rms_error[j]:.3g} N m"
+                for j, name in enumerate(result.robot.joint_names)
             )
+        )
     return 0

@@ -37,7 +37,7 @@ from ..identification.model import IdentifiedModel
 from ..io.friction_json import save_friction_json
 from ..io.model_json import load_model_json
 from ..model.robot import Robot
-from ..workflows.friction import fit_friction_file
+from ..workflows.friction import FrictionOptions, fit_friction_files
 from .common import (
     add_column_options,
     add_drive_option,
@@ -45,6 +45,7 @@ from .common import (
     add_subcommand,
     load_drive_arg,
     load_robot,
+    options_from,
     output_path,
     positive_type,
     shown,
@@ -115,45 +116,27 @@ def run(args: argparse.Namespace, console: Console) -> int:
     """Fit friction, write friction.json and the figure, print the RMS table (unless -q)."""
     model = load_torque_model(args)
     robot = model.robot if isinstance(model, IdentifiedModel) else model
-    result = fit_friction_file(
-        model,
-        args.data,
-        law=args.friction_model,
+    options = options_from(
+        args,
+        FrictionOptions,
         columns=(args.columns, args.units),
-        drop_invalid=args.drop_invalid,
         drive=load_drive_arg(args, robot.n),
-        cutoff_hz=args.cutoff,
-        max_gap_s=args.max_gap,
     )
+    result = fit_friction_files(model, args.data, options)
     fit, sel = result.fit, result.selection
-    if sel is not None:
-        console.print(sel.table())
-    files = [s["file"] for s in result.pieces.summary()] if result.pieces else []
-    meta = {
-        "data": ", ".join(files),
-        "files": files,
-        "recordings": list(result.pieces.summary()) if result.pieces else [],
-        "model": str(args.model.name) if args.model is not None else args.robot,
-        "cutoff_hz": result.cutoff_hz,
-        "n_samples": fit.n_samples,
-        "converged": [bool(x) for x in fit.converged],
-    }
+    meta = result.metadata(str(args.model.name) if args.model is not None else args.robot)
     selection = None if sel is None else sel.as_dict()
     save_friction_json(args.out / "friction.json", fit, metadata=meta, selection=selection)
     names = list(robot.joint_names)
     if not args.no_figures:
+        title = shown(f"{fit.kind} friction fitted to the torque residual ({meta['data']})")
         save_friction_figure(
-            args.out / "friction.png",
-            result.residual,
-            fit,
-            names=names,
-            title=shown(f"{fit.kind} friction fitted to the torque residual ({meta['data']})"),
+            args.out / "friction.png", result.residual, fit, names=names, title=title
         )
-    console.print(
-        format_rms_table(
-            names, {"RMS before [N m]": fit.rms_before, "RMS after [N m]": fit.rms_after}
-        )
-    )
+    if sel is not None:
+        console.print(sel.table())
+    cols = {"RMS before [N m]": fit.rms_before, "RMS after [N m]": fit.rms_after}
+    console.print(format_rms_table(names, cols))
     if result.pieces is not None:
         console.print(result.pieces.describe())
     console.wrote(args.out / "friction.json")

@@ -84,12 +84,11 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
-from ..exceptions import OptionError
 from ..identification.estimators import ESTIMATORS
 from ..identification.least_squares import STD_METHODS
 from ..io.feasible_bundle import save_feasible_bundle
 from ..io.model_json import save_model_json
-from ..workflows.identify import identify_consistent_file, identify_file
+from ..workflows.identify import IdentifyOptions, identify_files
 from .common import (
     add_column_options,
     add_consistency_options,
@@ -98,13 +97,13 @@ from .common import (
     add_robot_options,
     add_subcommand,
     load_drive_arg,
-    load_prior,
     load_robot,
+    note_prior,
     number,
+    options_from,
     output_path,
     parse_mass_band,
     positive_type,
-    sdp_options,
 )
 from .console import Console
 from .figures import save_identify_figures, save_retrieval_figure
@@ -229,71 +228,25 @@ def register(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParser:
 
 
 def run(args: argparse.Namespace, console: Console) -> int:
-    """Identify, write DIR/identification.json and print the summary; returns the exit code."""
-    if not args.consistent:
-        _no_consistency_options(args)
+    """Identify, write identification.json (and, with --consistent, the retrieve files),
+    print the summary; 0, or 1 when no consistent set satisfies the constraints."""
     robot = load_robot(args)
-    common = dict(
+    options = options_from(
+        args,
+        IdentifyOptions,
         columns=(args.columns, args.units),
-        drop_invalid=args.drop_invalid,
-        rtol=args.rtol,
-        estimator=args.estimator,
         drive=load_drive_arg(args, robot.n),
-        cutoff_hz=args.cutoff,
-        max_std_percent=args.max_std_percent,
-        std=args.std,
-        folds=args.folds,
-        validate_on=args.validate_on,
-    )
-    if args.consistent:
-        return run_consistent(args, console, robot, common)
-    model = identify_file(robot, args.data, terms=args.terms, max_gap_s=args.max_gap, **common)
-    path = save_model_json(args.out / "identification.json", model)
-    figures = [] if args.no_figures else save_identify_figures(args.out, model, args)
-    console.print(format_identification(model))
-    console.wrote(path, *figures)
-    return 0
-
-
-#: Options of the one-step consistent fit only: given without --consistent they would do
-#: nothing (a prior or a mass band silently ignored).
-_CONSISTENT_ONLY = (
-    "prior",
-    "prior_base",
-    "prior_tip",
-    "prior_weight",
-    "objective",
-    "margin",
-    "total_mass",
-)
-
-
-def _no_consistency_options(args: argparse.Namespace) -> None:
-    given = [k for k in _CONSISTENT_ONLY if getattr(args, k, None) is not None]
-    if given:
-        flags = ", ".join("--" + k.replace("_", "-") for k in given)
-        raise OptionError(f"{flags} apply to --consistent only; add --consistent or leave them out")
-
-
-def run_consistent(args: argparse.Namespace, console: Console, robot, common) -> int:  # noqa: ANN001
-    """One-step consistent identification: identification.json plus the retrieve files;
-    0 if the parameters are consistent, else 1."""
-    result = identify_consistent_file(
-        robot,
-        args.data,
-        terms=args.terms,
-        max_gap_s=args.max_gap,
-        prior=load_prior(args, robot, console),
         total_mass=parse_mass_band(args.total_mass),
-        options=sdp_options(args),
-        **common,
     )
-    assert result.identified is not None  # identify_consistent_file says so
-    files = [save_model_json(args.out / "identification.json", result.identified)]
-    if not args.no_figures:
-        files += save_identify_figures(args.out, result.identified, args)
-    files += save_feasible_bundle(args.out, result, source=str(args.data[0]))
-    files += [] if args.no_figures else save_retrieval_figure(args.out, result)
-    console.print(format_identification(result.identified), "", format_consistent(result))
+    note_prior(args, console)
+    result = identify_files(robot, args.data, options)
+    files = [save_model_json(args.out / "identification.json", result.model)]
+    files += [] if args.no_figures else save_identify_figures(args.out, result.model, args)
+    text = [format_identification(result.model)]
+    if result.consistent is not None:
+        files += save_feasible_bundle(args.out, result.consistent, source=str(args.data[0]))
+        files += [] if args.no_figures else save_retrieval_figure(args.out, result.consistent)
+        text += ["", format_consistent(result.consistent)]
+    console.print(*text)
     console.wrote(*files)
-    return 0 if result.feasible else 1
+    return 1 if result.consistent is not None and not result.consistent.feasible else 0

@@ -25,9 +25,9 @@ import argparse
 import numpy as np
 
 from ..exceptions import DynidError
-from ..kinematics.forward import fk
 from ..kinematics.inverse import IKOptions, default_q0, ik
-from ..spatial import matrix_from_rpy, transform
+from ..model.robot import Robot
+from ..workflows.kinematics import goal_pose
 from .common import (
     add_frame_tool_options,
     add_robot_options,
@@ -102,8 +102,11 @@ def register(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParser:
     return p
 
 
-def goal_pose(args: argparse.Namespace, robot, q0: np.ndarray, tool) -> np.ndarray:
-    """``T_base_goal`` (4, 4) from ``--goal`` or ``--goal-xyz``/``--goal-rpy``."""
+def _goal(
+    args: argparse.Namespace, robot: Robot, q0: np.ndarray, tool: np.ndarray | None
+) -> np.ndarray:
+    """``T_base_goal`` (4, 4) from ``--goal`` or ``--goal-xyz``/``--goal-rpy``
+    (:func:`dynid.workflows.kinematics.goal_pose`)."""
     if (args.goal is None) == (args.goal_xyz is None):
         raise DynidError("give the goal as either --goal (16 numbers) or --goal-xyz [--goal-rpy]")
     if args.goal is not None:
@@ -111,11 +114,8 @@ def goal_pose(args: argparse.Namespace, robot, q0: np.ndarray, tool) -> np.ndarr
             raise DynidError("--goal-rpy goes with --goal-xyz, not with --goal")
         return parse_vector(args.goal, "--goal", 16).reshape(4, 4)
     xyz = parse_vector(args.goal_xyz, "--goal-xyz", 3)
-    if args.goal_rpy is None:
-        R = fk(robot, q0, args.frame, tool)[:3, :3]
-    else:
-        R = matrix_from_rpy(parse_vector(args.goal_rpy, "--goal-rpy", 3))
-    return transform(R, xyz)
+    rpy = None if args.goal_rpy is None else parse_vector(args.goal_rpy, "--goal-rpy", 3)
+    return goal_pose(robot, q0, xyz, rpy, frame=args.frame, tool=tool)
 
 
 def run(args: argparse.Namespace, console: Console) -> int:
@@ -123,7 +123,7 @@ def run(args: argparse.Namespace, console: Console) -> int:
     robot = load_robot(args)
     tool = parse_tool(args.tool)
     q0 = default_q0(robot) if args.q0 is None else parse_q(args.q0, robot, "--q0")
-    T_goal = goal_pose(args, robot, q0, tool)
+    T_goal = _goal(args, robot, q0, tool)
     options = IKOptions(
         position_tolerance=args.position_tolerance,
         orientation_tolerance=args.orientation_tolerance,

@@ -49,24 +49,22 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
-from .._parallel import available_cores
-from ..exceptions import DynidError
-from ..feasibility.convex import ConsistentResult
 from ..feasibility.methods import METHODS
 from ..feasibility.penalty import RetrievalOptions, RetrievalResult
 from ..io.feasible_bundle import save_feasible_bundle
-from ..workflows.retrieve import retrieve_file
+from ..workflows.retrieve import RetrieveOptions, retrieve_files
 from .common import (
     add_consistency_options,
     add_robot_options,
     add_seed_option,
     add_subcommand,
     count_type,
+    flag,
     load_robot,
     note_prior,
+    options_from,
     output_path,
     parse_mass_band,
-    sdp_options,
 )
 from .console import Console
 from .figures import save_retrieval_figure
@@ -132,67 +130,30 @@ def register(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParser:
     return p
 
 
-def _refuse(args: argparse.Namespace, flags: tuple[str, ...], method: str) -> None:
-    """One line naming the first of ``flags`` given, which apply to ``method`` only."""
-    for flag in flags:
-        if getattr(args, flag.removeprefix("--").replace("-", "_")) is not None:
-            raise DynidError(f"{flag} applies to --method {method} only")
-
-
-def _penalty_options(args: argparse.Namespace, console: Console) -> RetrievalOptions:
-    """The penalty method's options; --margin and --objective are the convex method's;
-    --workers above min(cores, runs) is capped, with a note."""
-    _refuse(args, ("--margin", "--objective"), "sdp")
-    d = RetrievalOptions()
-    runs = d.runs if args.runs is None else args.runs
-    stages = d.stages if args.stages is None else args.stages
-    try:
-        extra = {} if args.prior_weight is None else {"prior_weight": args.prior_weight}
-        options = RetrievalOptions(runs=runs, stages=stages, **extra)
-    except ValueError as exc:
-        raise DynidError(f"--runs/--stages/--prior-weight: {exc}") from None
-    if args.workers is not None:
-        cores = available_cores()
-        cap = min(cores, runs)
-        if args.workers > cap:
-            console.notice(
-                f"note: --workers {args.workers}: using {cap} ({cores} cores, {runs} runs)"
-            )
-            args.workers = cap
-    return options
-
-
 def run(args: argparse.Namespace, console: Console) -> int:
     """Retrieve, write the outputs, print the summary; 0 if feasible, 1 if not."""
-    penalty = args.method == "penalty"
-    if not penalty:  # the convex method solves one problem in this process
-        _refuse(args, ("--workers", "--runs", "--stages"), "penalty")
-    options = _penalty_options(args, console) if penalty else sdp_options(args)
     static = args.static is not None
     source = args.static if static else args.model
-    note_prior(args, console)
-    result = retrieve_file(
-        source,
-        kind="static" if static else "model",
-        robot=load_robot(args) if static else None,
-        method=args.method,
-        prior=args.prior,
-        prior_base=args.prior_base,
-        prior_tip=args.prior_tip,
-        bounds=args.bounds,
+    options = options_from(
+        args,
+        RetrieveOptions,
         total_mass_band=not args.no_total_mass,
         total_mass=parse_mass_band(args.total_mass),
-        friction=args.friction,
-        options=options,
-        workers=args.workers,
-        seed=args.seed,
+    )
+    note_prior(args, console)
+    retrieval = retrieve_files(
+        source,
+        options,
+        kind="static" if static else "model",
+        robot=load_robot(args) if static else None,
         progress=None if console.quiet else progress_printer(header=f"retrieving from {source}:"),
     )
+    for field, what in retrieval.notes:
+        console.notice(f"note: {flag(field)} {what}")
+    result = retrieval.result
     files = save_feasible_bundle(args.out, result, source=str(source))
     files += [] if args.no_figures else save_retrieval_figure(args.out, result)
-    if isinstance(result, RetrievalResult):
-        console.print(format_retrieval(result))
-    elif isinstance(result, ConsistentResult):
-        console.print(format_consistent(result))
+    summary = format_retrieval if isinstance(result, RetrievalResult) else format_consistent
+    console.print(summary(result))  # type: ignore[arg-type]
     console.wrote(*files)
     return 0 if result.feasible else 1

@@ -30,30 +30,12 @@ Example:
 from __future__ import annotations
 
 import argparse
-import logging
-from collections.abc import Callable, Iterator
 from pathlib import Path
-from typing import Any
 
-import numpy as np
-
-from ..exceptions import DynidError, OptionError
-from ..friction.model import FrictionModel
-from ..io.friction_json import load_friction_json
+from ..exceptions import OptionError
 from ..io.torque_log import save_torque_log_pieces
-from ..model.robot import Robot
 from ..simulation.contact import Contact
-from ..simulation.measurement import BLOCK_SAMPLES, SensorNoise, measured_blocks, sample_times
-from ..simulation.trajectories import (
-    GAZ2019_SINUSOID_AMPLITUDES,
-    GAZ2019_SINUSOID_PERIODS,
-    Trajectory,
-    centered_start,
-    check_limits_blocks,
-    limit_scaling,
-    random_fourier,
-    sinusoid_trajectory,
-)
+from ..workflows.simulate import SimulateOptions, simulate_log
 from .common import (
     add_drive_option,
     add_robot_options,
@@ -64,6 +46,7 @@ from .common import (
     load_robot,
     nonnegative_type,
     number,
+    options_from,
     output_path,
     parse_vector,
     positive_type,
@@ -73,7 +56,6 @@ from .console import Console
 NAME = "simulate"
 #: ``--out`` is the one file written (:mod:`dynid.outputs.run_output`).
 OUTPUT = "file"
-log = logging.getLogger(__name__)
 
 
 def register(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParser:
@@ -186,144 +168,47 @@ def register(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParser:
     return p
 
 
-def _contacts(args: argparse.Namespace, robot: Robot) -> tuple[Contact, ...]:
-    """The contacts of ``--contact FRAME:WRENCH:START,END`` (frames checked)."""
+def _contacts(args: argparse.Namespace) -> tuple[Contact, ...]:
+    """The contacts of ``--contact FRAME:WRENCH:START,END`` (parsed; the library checks
+    the frames)."""
     out = []
     for text in args.contact:
         parts = text.rsplit(":", 2)
         if len(parts) != 3:
-            raise DynidError(f"--contact must read FRAME:WRENCH:START,END; got {text!r}")
+            raise OptionError(f"--contact must read FRAME:WRENCH:START,END; got {text!r}")
         frame, wrench, window = parts
-        robot.frame(frame)
         w = parse_vector(wrench, "--contact WRENCH")
         if w.size not in (3, 6):
-            raise DynidError(f"--contact WRENCH must be fx,fy,fz or 6 numbers; got {wrench!r}")
+            raise OptionError(f"--contact WRENCH must be fx,fy,fz or 6 numbers; got {wrench!r}")
         start, end = parse_vector(window, "--contact START,END", 2)
         out.append(Contact(frame, tuple(w), float(start), float(end), args.contact_ramp))
     return tuple(out)
 
 
-def _friction(args: argparse.Namespace) -> FrictionModel | str:
-    """The ground-truth friction: a friction.json's law (--friction), else the robot's."""
-    if args.friction is None:
-        return "robot"
-    return load_friction_json(args.friction)
-
-
-def _trajectory(
-    args: argparse.Namespace, robot: Robot, t: np.ndarray, rng: np.random.Generator
-) -> tuple[Callable[[slice], Trajectory], int]:
-    """The true trajectory, a slice of the sample times ``t`` at a time (a file's
-    trajectory is held; the sinusoids and the Fourier series are evaluated per slice),
-    and its number of samples."""
-    n = robot.n
-    q0 = None if args.q0 is None else parse_vector(args.q0, "--q0", n)
-    if args.trajectory not in ("sinusoid", "fourier"):
-        from ..io.excitation import load_exciting_trajectory, load_trajectory
-        from ..simulation.trajectories import uniform_times
-
-        path = Path(args.trajectory)
-        if path.suffix.lower() == ".json":  # the series, evaluated a block at a time
-            exciting = load_exciting_trajectory(path, n)
-            t_file = uniform_times(exciting.total_duration, args.rate)
-            return lambda b: exciting(t_file[b]), t_file.size
-        traj = load_trajectory(path, n, fs=args.rate)
-        return lambda b: Trajectory(traj.t[b], traj.q[b], traj.dq[b], traj.ddq[b]), len(traj)
-    if args.trajectory == "fourier":
-        series = random_fourier(
-            robot, rng, n_harmonics=args.harmonics, w_f=2 * np.pi * args.base_freq, q0=q0
-        )
-        return lambda b: series(t[b]), t.size
-    if n != len(GAZ2019_SINUSOID_AMPLITUDES) and (args.amplitudes is None or args.periods is None):
-        raise DynidError(
-            f"the default sinusoids are for 7 joints; robot {robot.name!r} has {n}: "
-            "give --amplitudes and --periods"
-        )
-    A = (
-        GAZ2019_SINUSOID_AMPLITUDES
-        if args.amplitudes is None
-        else parse_vector(args.amplitudes, "--amplitudes", n)
-    )
-    T = (
-        GAZ2019_SINUSOID_PERIODS
-        if args.periods is None
-        else parse_vector(args.periods, "--periods", n)
-    )
-    start = centered_start(robot, A, T) if q0 is None else q0
-    return lambda b: sinusoid_trajectory(t[b], start, A, T), t.size
-
-
-def _in_limits(
-    args: argparse.Namespace, robot: Robot, traj_at: Callable[[slice], Trajectory], N: int, say: Any
-) -> Callable[[slice], Trajectory]:
-    """The trajectory checked against the limits (a pass over its blocks) and, unless
-    ``--scale none``, scaled into them (one more pass)."""
-
-    def blocks(at: Callable[[slice], Trajectory]) -> Iterator[Trajectory]:
-        return (at(slice(a, a + BLOCK_SAMPLES)) for a in range(0, N, BLOCK_SAMPLES))
-
-    report = check_limits_blocks(robot, blocks(traj_at))
-    if report.ok or args.scale == "none":
-        if not report.ok:
-            say(f"limits exceeded by the {args.trajectory} trajectory:\n{report}")
-        return traj_at
-    say(f"limits exceeded by the {args.trajectory} trajectory:\n{report}")
-    scaling = limit_scaling(robot, lambda: blocks(traj_at), method=args.scale)
-    scaled = lambda b: scaling.apply(traj_at(b))  # noqa: E731
-    what = "amplitude scaled by" if args.scale == "amplitude" else "time stretched by"
-    say(f"{what} {scaling.factor:.4f}; now: {check_limits_blocks(robot, blocks(scaled))}")
-    return scaled
+def _vector(text: str | None, name: str) -> tuple[float, ...] | None:
+    return None if text is None else tuple(parse_vector(text, name).tolist())
 
 
 def run(args: argparse.Namespace, console: Console) -> int:
     """Simulate and write the log, a block of samples at a time; prints the limit report
     and a summary (unless -q)."""
-    say = console.print
     robot = load_robot(args)
-    n = robot.n
-    rng = np.random.default_rng(args.seed)
-    t = sample_times(args.duration, args.rate, jitter_std=args.jitter, rng=rng)
-    traj_at, N = _trajectory(args, robot, t, rng)
-    traj_at = _in_limits(args, robot, traj_at, N, say)
-    noise = SensorNoise(tau_std=args.noise, q_std=args.q_noise, dq_std=args.dq_noise)
-    drive = load_drive_arg(args, n)
-    if drive is not None:
-        say(f"drive: {drive.describe()}; the log is written on the {drive.side} side")
-    effects = None
-    if args.arm_seed is not None and not args.unmodelled:
-        raise OptionError("--arm-seed applies to --unmodelled; add it or leave --arm-seed out")
-    if args.unmodelled:
-        from ..simulation.unmodelled import UnmodelledEffects
-
-        arm = 0 if args.arm_seed is None else args.arm_seed
-        effects = UnmodelledEffects.typical(n, np.random.default_rng([arm, 7]))
-        say(f"effects outside the rigid-body model: {effects.describe()}")
-    contacts = _contacts(args, robot)
-    measured = measured_blocks(
-        robot,
-        traj_at,
-        N,
-        rng=rng,
-        noise=noise,
-        friction=None if args.no_friction else _friction(args),
-        drop_fraction=args.drop,
-        with_ddq=args.with_ddq,
-        effects=effects,
-        drive=drive,
-        contacts=contacts,
+    options = options_from(
+        args,
+        SimulateOptions,
+        friction="none" if args.no_friction else (args.friction or "robot"),
+        amplitudes=_vector(args.amplitudes, "--amplitudes"),
+        periods=_vector(args.periods, "--periods"),
+        q0=_vector(args.q0, "--q0"),
+        contacts=_contacts(args),
+        drive=load_drive_arg(args, robot.n),
     )
-    extra = None if measured.external is None else ("tau_ext", measured.external)
+    result = simulate_log(robot, options)
+    console.print(*result.notes)
+    log = result.log
+    extra = None if log.external is None else ("tau_ext", log.external)
     save_torque_log_pieces(
-        args.out, measured, n=n, n_rows=measured.n_samples, with_ddq=args.with_ddq, extra=extra
+        args.out, log, n=log.n, n_rows=log.n_samples, with_ddq=log.with_ddq, extra=extra
     )
-    for c in contacts:
-        say(
-            f"contact at {c.frame}: wrench {list(c.wrench)} from {c.start:g} s to {c.end:g} s "
-            f"(true external torques in columns tau_ext1..tau_ext{n})"
-        )
-    first, last = traj_at(slice(0, 1)).t[0], traj_at(slice(N - 1, N)).t[0]
-    say(
-        f"wrote {args.out}: {measured.n_samples} samples, {last - first:.2f} s, "
-        f"{n} joints, torque noise {args.noise:g} N m, seed {args.seed}"
-    )
+    console.print(f"wrote {args.out}: {result.describe(options)}")
     return 0

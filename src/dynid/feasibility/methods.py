@@ -10,7 +10,7 @@ A method answers two questions, with one signature for every method
 
 Both return a :class:`~dynid.feasibility.result.FeasibleResult`, which files, reports,
 figures and the comparison of methods read. ``dynid retrieve --method NAME`` and
-:func:`dynid.workflows.retrieve.retrieve_file` take any name of :data:`METHODS`.
+:func:`dynid.workflows.retrieve.retrieve_files` take any name of :data:`METHODS`.
 
 * ``sdp``, the convex method (:mod:`dynid.feasibility.convex`): from coefficients
   :func:`~dynid.feasibility.convex.fit.retrieve_sdp`, from a torque log or static data

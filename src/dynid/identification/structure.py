@@ -117,13 +117,14 @@ class Structure:
         bad = [p for p in self.friction if p not in FRICTION_PARTS]
         if bad:
             raise OptionError(
-                f"unknown model term(s) {bad}; terms are armature, "
+                f"names unknown model term(s) {bad}; terms are armature, "
                 + ", ".join(FRICTION_PARTS)
-                + " (or links for none)"
+                + " (or links for none)",
+                field="terms",
             )
         parts = tuple(p for p in FRICTION_PARTS if p in self.friction)
         if "smooth" in parts and "coulomb" in parts:
-            raise OptionError("--terms: smooth replaces coulomb; give one of them")
+            raise OptionError(": smooth replaces coulomb; give one of them", field="terms")
         if "smooth" in parts and not self.width > 0:
             object.__setattr__(self, "width", 1.0)
         if "stribeck" in parts and not self.vst > 0:
@@ -227,7 +228,7 @@ class Structure:
                 except ValueError:
                     shapes[name] = -1.0
                 if not shapes[name] > 0 or not math.isfinite(shapes[name]):
-                    raise OptionError(f"--terms {w}: the shape must be a positive number")
+                    raise OptionError(f"{w}: the shape must be a positive number", field="terms")
             names.append(name)
         return cls(
             armature="armature" in names,

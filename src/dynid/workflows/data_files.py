@@ -22,7 +22,7 @@ from typing import Any, Literal, TypeVar
 
 import numpy as np
 
-from ..exceptions import DataError, DynidError
+from ..exceptions import DataError, DynidError, OptionError
 from ..identification.data import StaticDataset
 from ..identification.log import TorqueLog
 from ..io.columns import (
@@ -71,6 +71,8 @@ def in_file(path: Path, fit: Callable[[], _T]) -> _T:
     try:
         return fit()
     except DynidError as exc:
+        if isinstance(exc, OptionError) and exc.field is not None:
+            raise  # about an option, not the file; the command names it by its flag
         if str(exc).startswith(path.name):
             raise
         raise type(exc)(f"{path.name}: {exc}") from exc
@@ -148,7 +150,7 @@ def data_kind(path: str | Path, columns: ColumnMap | None = None) -> DataKind:
         except (AttributeError, TypeError):  # a single .npy array: np.load gives an array
             raise DataError(f"{path.name}: a single array, not an NPZ archive") from None
         return "torque_log" if "t" in keys or "tau" in keys else "static"
-    raise DataError(f"--data must be a .csv or .npz file; got {path.name!r}")
+    raise DataError(f"{path.name}: a data file must be .csv or .npz")
 
 
 def read_torque_log(
@@ -199,7 +201,8 @@ def read_torque_log(
             )
             if not drop_invalid:
                 raise DataError(
-                    f"{path.name}: {what}; hint: fix the file or pass --drop-invalid to drop them"
+                    f"{path.name}: {what}; hint: fix the file or pass --drop-invalid "
+                    "(drop_invalid=True) to drop them"
                 )
             _log.warning("%s: dropped: %s", path.name, what)
         log = mapped.log
@@ -259,14 +262,16 @@ def recorded_columns(
     if (columns, units) == (None, None):
         columns, units = rec.get("columns"), rec.get("units")
         _log.warning(
-            "reading --data as the model's data were read: --columns %r --units %r",
+            "reading the data as the model's data were read: columns %r, units %r",
             columns,
             units,
         )
     elif (columns, units) != (rec.get("columns"), rec.get("units")):
-        raise DataError(
-            f"--columns {columns!r} --units {units!r} differ from those the model was "
-            f"identified with ({rec.get('columns')!r}, {rec.get('units')!r}); hint: leave "
-            "them out to use the model's"
+        raise OptionError(
+            f"{columns!r} {{units}} {units!r} differ from those the model was identified "
+            f"with ({rec.get('columns')!r}, {rec.get('units')!r}); hint: leave them out to "
+            "use the model's",
+            field="columns",
+            others=("units",),
         )
     return columns, units

@@ -22,8 +22,8 @@ from __future__ import annotations
 from collections.abc import Sequence
 from dataclasses import dataclass
 from pathlib import Path
+from typing import Any
 
-from ..exceptions import OptionError
 from ..friction.fit import FrictionFit, FrictionResidual, fit_friction_through
 from ..friction.laws import LAWS
 from ..friction.recordings import Pieces, pieces_residual, prepare_pieces
@@ -33,14 +33,58 @@ from ..identification.model import IdentifiedModel
 from ..model.drive import Drive
 from ..model.robot import Robot
 from .data_files import ColumnSpec, in_file
+from .options import check_choice, check_number
 from .recordings import read_recordings
 
-__all__ = ["FrictionFileResult", "fit_friction_file"]
+__all__ = ["FrictionFileResult", "FrictionOptions", "fit_friction_files"]
+
+
+@dataclass(frozen=True, slots=True)
+class FrictionOptions:
+    """How :func:`fit_friction_files` fits friction to a model's torque residual.
+
+    Attributes
+    ----------
+    law : str
+        ``"auto"`` (the law with the lowest held-out error) or a law of
+        :data:`~dynid.friction.laws.LAWS`.
+    columns : (str or None, str or None), optional
+        Column names and units of another tool's files; default: those the model's data
+        were read with.
+    drop_invalid : bool
+        Drop rows with NaN/inf or a repeated timestamp (counted) instead of failing.
+    drive : Drive, optional
+        The drive the log was recorded through, for a model without one.
+    cutoff_hz : float, optional
+        Zero-phase low-pass cut-off of the states [Hz] (and of velocities derived from
+        positions); default: the identification's recorded one, else the one read from the
+        log's motion (:func:`~dynid.friction.validation.recorded_cutoff`).
+    max_gap_s : float, optional
+        Longest gap bridged by interpolation [s]; a longer one cuts a log into pieces.
+
+    Raises
+    ------
+    OptionError
+        ``law`` neither ``"auto"`` nor a law of the registry; a cut-off or gap that is not
+        a positive number (``field`` names it).
+    """
+
+    law: str = "auto"
+    columns: ColumnSpec | None = None
+    drop_invalid: bool = False
+    drive: Drive | None = None
+    cutoff_hz: float | None = None
+    max_gap_s: float | None = None
+
+    def __post_init__(self) -> None:
+        check_choice(self, "law", ("auto", *LAWS), optional=False)
+        check_number(self, "cutoff_hz")
+        check_number(self, "max_gap_s")
 
 
 @dataclass(frozen=True, slots=True, eq=False)
 class FrictionFileResult:
-    """Result of :func:`fit_friction_file`.
+    """Result of :func:`fit_friction_files`.
 
     Attributes
     ----------
@@ -62,42 +106,36 @@ class FrictionFileResult:
     cutoff_hz: float | None = None
     pieces: Pieces | None = None
 
+    def metadata(self, model: str) -> dict[str, Any]:
+        """The keys ``friction.json`` records beside the fit: the recordings, ``model``
+        (what the rigid-body model is), the cut-off, the samples and the convergence."""
+        files = [s["file"] for s in self.pieces.summary()] if self.pieces else []
+        return {
+            "data": ", ".join(files),
+            "files": files,
+            "recordings": list(self.pieces.summary()) if self.pieces else [],
+            "model": model,
+            "cutoff_hz": self.cutoff_hz,
+            "n_samples": self.fit.n_samples,
+            "converged": [bool(x) for x in self.fit.converged],
+        }
 
-def fit_friction_file(
+
+def fit_friction_files(
     model: IdentifiedModel | Robot,
-    path: str | Path | Sequence[str | Path],
-    *,
-    law: str = "auto",
-    columns: ColumnSpec | None = None,
-    drop_invalid: bool = False,
-    drive: Drive | None = None,
-    cutoff_hz: float | None = None,
-    max_gap_s: float | None = None,
+    data: str | Path | Sequence[str | Path],
+    options: FrictionOptions | None = None,
 ) -> FrictionFileResult:
-    """Friction fitted to the torque residual of ``model`` on the log ``path``.
+    """Friction fitted to the torque residual of ``model`` on the logs ``data``.
 
     Parameters
     ----------
     model : IdentifiedModel or Robot
         The rigid-body model (an identified model, or a robot's own link parameters).
-    path : str, Path or a sequence of them
+    data : str, Path or a sequence of them
         One or more torque logs (``.csv`` or ``.npz``; a folder: its data files), or
-        files of another tool read through ``columns``.
-    law : str
-        ``"auto"`` (the law with the lowest held-out error) or a law of
-        :data:`~dynid.friction.laws.LAWS` (``--friction-model``).
-    columns : (str or None, str or None), optional
-        ``--columns`` and ``--units``; default: those the model's data were read with.
-    drop_invalid : bool
-        Drop rows with NaN/inf or a repeated timestamp (counted) instead of failing.
-    drive : Drive, optional
-        The drive the log was recorded through, for a model without one.
-    cutoff_hz : float, optional
-        Zero-phase low-pass cut-off of the states [Hz] (and of velocities derived from
-        positions); default: the identification's recorded one, else the one read from the
-        log's motion (:func:`~dynid.friction.validation.recorded_cutoff`).
-    max_gap_s : float, optional
-        Longest gap bridged by interpolation [s]; a longer one cuts a log into pieces.
+        files of another tool read through ``options.columns``.
+    options : FrictionOptions, optional
 
     Returns
     -------
@@ -105,16 +143,16 @@ def fit_friction_file(
 
     Raises
     ------
-    OptionError
-        ``law`` neither ``"auto"`` nor a law of the registry.
     DataError
         A bad file, another joint count, invalid rows without ``drop_invalid``, other
         columns or another drive than the model's, a recording in other units or with no
         piece long enough to filter, or no joint moving beyond its velocity noise band
         (the message starts with the file's name).
     """
-    if law != "auto" and law not in LAWS:
-        raise OptionError(f"--friction-model must be auto or one of {', '.join(LAWS)}; got {law!r}")
+    opt = options or FrictionOptions()
+    law, columns, drop_invalid = opt.law, opt.columns, opt.drop_invalid
+    drive, cutoff_hz, max_gap_s = opt.drive, opt.cutoff_hz, opt.max_gap_s
+    path = data
     robot = model.robot if isinstance(model, IdentifiedModel) else model
     rec = read_recordings(
         path,

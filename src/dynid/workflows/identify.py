@@ -6,10 +6,14 @@ command applies, so that the Python API behaves as the command does.
   (:mod:`dynid.workflows.data_files`: joint count, recorded robot, log cleaning).
 * Static data: configurations outside the joint limits and a relative error far above
   the recorded noise level are :class:`~dynid.exceptions.DynidWarning` warnings.
-* ``std`` (standard deviations, ``--std``) is honoured on both routes (default: robust
-  for static data, classical for torque logs); the consistent fit refuses it and
-  ``max_std_percent``, which do not apply to it.
+* ``std`` (standard deviations) is honoured on both routes (default: robust for static
+  data, classical for torque logs); the consistent fit refuses it and ``max_std_percent``,
+  which do not apply to it, and the prior, its weight, objective, margin and mass band
+  apply to the consistent fit only (:class:`IdentifyOptions`).
 * The column map the data were read with is recorded in the model (``info.column_map``).
+
+Every refusal of an option is an :class:`~dynid.exceptions.OptionError` carrying the
+option's field; the command line names it by its flag.
 """
 
 from __future__ import annotations
@@ -17,19 +21,23 @@ from __future__ import annotations
 import dataclasses
 import warnings
 from collections.abc import Sequence
+from dataclasses import dataclass
 from pathlib import Path
 from typing import Any, Literal
 
-from ..exceptions import DataError, DynidWarning
+import numpy as np
+
+from ..exceptions import DataError, DynidWarning, OptionError
 from ..feasibility.convex import (
+    DEFAULT_SDP_MARGIN,
     ConsistentResult,
     SDPOptions,
     consistent_from_identified,
     identify_consistent,
 )
 from ..identification.consistency import fit_mismatch, limit_violations
-from ..identification.estimators import EstimatorName
-from ..identification.least_squares import StdMethod
+from ..identification.estimators import ESTIMATORS, EstimatorName
+from ..identification.least_squares import STD_METHODS, StdMethod
 from ..identification.model import IdentifiedModel
 from ..identification.selection import identify_recordings
 from ..identification.static import identify_static
@@ -44,8 +52,10 @@ from .data_files import (
     read_static_file,
     read_torque_log,
 )
+from .options import check_choice, check_count, check_number, only_with, refused_with
+from .prior import load_prior
 
-__all__ = ["ColumnSpec", "data_files", "identify_consistent_file", "identify_file"]
+__all__ = ["ColumnSpec", "IdentifyOptions", "IdentifyResult", "data_files", "identify_files"]
 
 
 def _columns(spec: ColumnSpec | None, cutoff_hz: float | None) -> Any:
@@ -66,8 +76,9 @@ def _heldout(
     if folds is None and validate_on is None:
         return {}
     if kind != "torque_log":
-        raise DataError(
-            f"{path.name}: --folds and --validate-on apply to torque logs, not static data"
+        raise OptionError(
+            f"applies to torque logs, not static data ({path.name})",
+            field="folds" if folds is not None else "validate_on",
         )
     kw: dict[str, Any] = {} if folds is None else {"folds": folds}
     if validate_on is not None:
@@ -111,121 +122,254 @@ def data_files(paths: str | Path | Sequence[str | Path]) -> list[Path]:
 
 
 def _terms(terms: str | Structure | None) -> Structure | Literal["auto"]:
-    """``--terms``: ``"auto"``/None (chosen on held-out data) or the terms named."""
+    """``terms``: ``"auto"``/None (chosen on held-out data) or the terms named."""
     if terms is None or terms == "auto":
         return "auto"
     return terms if isinstance(terms, Structure) else Structure.parse(terms)
 
 
-def identify_file(
+#: Options of the one-step consistent fit only (refused without ``consistent``).
+CONSISTENT_ONLY = (
+    "prior",
+    "prior_base",
+    "prior_tip",
+    "prior_weight",
+    "objective",
+    "margin",
+    "total_mass",
+)
+
+
+@dataclass(frozen=True, slots=True)
+class IdentifyOptions:
+    """How :func:`identify_files` identifies a robot from its data.
+
+    Attributes
+    ----------
+    terms : str or Structure, optional
+        Torque logs: the model's terms beside the links (``"armature,viscous"``,
+        :class:`~dynid.identification.structure.Structure`); default ``"auto"``: chosen
+        on held-out data (:mod:`dynid.identification.selection`).
+    columns : (str or None, str or None), optional
+        Column names and units of a file of another tool (recorded in the model).
+    drop_invalid : bool
+        Drop invalid rows (counted, named) instead of failing.
+    max_std_percent : float, optional
+        Remove the coefficients above this relative standard deviation [%] and re-fit.
+    rtol : float, optional
+        Fixed relative rank tolerance, 0 < rtol < 1 (default: the first clear gap).
+    std : {"robust", "classical"}, optional
+        Standard deviations (default robust for static data, classical for a log).
+    estimator : {"ols", "wls", "irls"}
+        Least squares: ordinary, weighted by the noise level, or Huber-reweighted.
+    drive : Drive, optional
+        The drive train the data were recorded through.
+    cutoff_hz : float, optional
+        Torque logs: zero-phase low-pass cut-off [Hz] (default: read from the log); also
+        the cut-off of velocities derived from positions through ``columns``.
+    max_gap_s : float, optional
+        Torque logs: longest gap bridged by interpolation [s]; a longer one cuts the log.
+    folds : int, optional
+        Torque logs: contiguous time blocks of the held-out judgement (>= 2).
+    validate_on : str or Path, optional
+        Torque logs: judge on this separate log (read as the data) instead of time blocks.
+    consistent : bool
+        Also identify physically consistent link parameters in one step (convex).
+    prior : str, Path or Robot, optional
+        ``consistent``: the prior link parameters (``"panda"``, ``"fr3"``, a robot file or
+        a ``feasible.json``, :func:`~dynid.workflows.prior.load_prior`); default generic.
+    prior_base, prior_tip : str, optional
+        ``consistent``: the chain of a URDF prior.
+    prior_weight : float, optional
+        ``consistent``: weight of the distance to the prior (>= 0; default automatic).
+    objective : {"logdet", "euclidean"}, optional
+        ``consistent``: distance to the prior (default log-det).
+    margin : float, optional
+        ``consistent``: every link's lambda_min(J) >= margin tr(J), 0 <= margin < 0.25.
+    total_mass : (float, float), optional
+        ``consistent``: band [kg] on the total mass, 0 <= min <= max.
+
+    Raises
+    ------
+    OptionError
+        A value out of its range or choices; a consistent-only option without
+        ``consistent``; ``max_std_percent`` or ``std`` with it (``field`` names it).
+    """
+
+    terms: str | Structure | None = None
+    columns: ColumnSpec | None = None
+    drop_invalid: bool = False
+    max_std_percent: float | None = None
+    rtol: float | None = None
+    std: StdMethod | None = None
+    estimator: EstimatorName = "ols"
+    drive: Drive | None = None
+    cutoff_hz: float | None = None
+    max_gap_s: float | None = None
+    folds: int | None = None
+    validate_on: str | Path | None = None
+    consistent: bool = False
+    prior: str | Path | Robot | None = None
+    prior_base: str | None = None
+    prior_tip: str | None = None
+    prior_weight: float | None = None
+    objective: str | None = None
+    margin: float | None = None
+    total_mass: tuple[float, float] | None = None
+
+    def __post_init__(self) -> None:
+        for name in ("max_std_percent", "cutoff_hz", "max_gap_s"):
+            check_number(self, name)
+        check_number(self, "rtol", high=1.0, high_open=True)
+        check_number(self, "prior_weight", low_open=False)
+        check_number(self, "margin", low_open=False, high=0.25, high_open=True)
+        check_count(self, "folds", low=2)
+        check_choice(self, "estimator", ESTIMATORS, optional=False)
+        check_choice(self, "std", STD_METHODS)
+        check_choice(self, "objective", ("logdet", "euclidean"))
+        band = self.total_mass
+        if band is not None and not (
+            len(band) == 2 and all(np.isfinite(band)) and 0.0 <= band[0] <= band[1]
+        ):
+            raise OptionError(
+                f"must be MIN,MAX with 0 <= MIN <= MAX; got {band}", field="total_mass"
+            )
+        only_with(self, CONSISTENT_ONLY, "consistent")
+        refused_with(
+            self,
+            ("max_std_percent", "std"),
+            "consistent",
+            "nothing is pruned; its data term is the residual itself, weighted by the estimator",
+        )
+        if self.terms is not None and not isinstance(self.terms, Structure):
+            _terms(self.terms)  # parsed now: a misspelt term is refused before any file is read
+
+    def sdp(self) -> SDPOptions:
+        """The settings of the convex fit (``consistent``)."""
+        return SDPOptions(
+            objective=self.objective or "logdet",
+            prior_weight=self.prior_weight,
+            margin=DEFAULT_SDP_MARGIN if self.margin is None else self.margin,
+        )
+
+
+@dataclass(frozen=True, slots=True, eq=False)
+class IdentifyResult:
+    """Result of :func:`identify_files`.
+
+    Attributes
+    ----------
+    model : IdentifiedModel
+        The unconstrained fit (with the column map its data were read with).
+    consistent : ConsistentResult or None
+        With ``consistent``: the physically consistent link parameters (``feasible``
+        says whether they satisfy every constraint).
+    files : tuple of Path
+        The data files read, in order.
+    """
+
+    model: IdentifiedModel
+    consistent: ConsistentResult | None
+    files: tuple[Path, ...]
+
+
+def identify_files(
     robot: Robot,
-    path: str | Path | Sequence[str | Path],
-    *,
-    terms: str | Structure | None = None,
-    columns: ColumnSpec | None = None,
-    drop_invalid: bool = False,
-    max_std_percent: float | None = None,
-    rtol: float | None = None,
-    std: StdMethod | None = None,
-    estimator: EstimatorName = "ols",
-    drive: Drive | None = None,
-    cutoff_hz: float | None = None,
-    max_gap_s: float | None = None,
-    folds: int | None = None,
-    validate_on: str | Path | None = None,
-) -> IdentifiedModel:
-    """The base parameters (and, from a torque log, friction) of ``robot`` from ``path``.
+    data: str | Path | Sequence[str | Path],
+    options: IdentifyOptions | None = None,
+) -> IdentifyResult:
+    """The base parameters (and, from a torque log, the model's terms) of ``robot`` from
+    ``data``; with ``options.consistent`` also physically consistent link parameters.
 
     Parameters
     ----------
     robot : Robot
         The robot the data belong to.
-    path : str, Path or a sequence of them
+    data : str, Path or a sequence of them
         Static data (``q, M, g``), or one or more torque logs (a folder: its ``.csv``
         and ``.npz`` files), each ``.csv`` or ``.npz``.
-    terms : str or Structure, optional
-        Torque logs: the model's terms beside the links (``"armature,viscous"``,
-        :class:`~dynid.identification.structure.Structure`); default ``"auto"``: chosen on
-        held-out data (:mod:`dynid.identification.selection`).
-    columns : (str or None, str or None), optional
-        ``--columns`` and ``--units`` of a file of another tool (recorded in the model).
-    drop_invalid : bool
-        Drop invalid rows (counted, named) instead of failing.
-    max_std_percent, rtol, estimator, drive
-        As :func:`~dynid.identification.static.identify_static`.
-    std : {"robust", "classical"}, optional
-        Standard deviations (default robust for static data, classical for a log).
-    cutoff_hz : float, optional
-        Torque logs: zero-phase low-pass cutoff [Hz] (default: read from the log,
-        :mod:`dynid.identification.rate`); also the
-        cutoff of velocities derived from positions through ``columns``.
-    max_gap_s : float, optional
-        Torque logs: longest gap bridged by interpolation [s]; a longer one cuts the log
-        into pieces prepared on their own.
-    folds : int, optional
-        Torque logs: contiguous time blocks of the held-out judgement (``--folds``).
-    validate_on : str or Path, optional
-        Torque logs: judge on this separate log (read as ``path``) instead of time blocks.
+    options : IdentifyOptions, optional
 
     Returns
     -------
-    IdentifiedModel
+    IdentifyResult
 
     Raises
     ------
     DataError
         A bad file, data of another robot or joint count, invalid rows without
-        ``drop_invalid``; ``folds`` or ``validate_on`` with static data.
+        ``drop_invalid``.
+    OptionError
+        ``folds``, ``validate_on`` or ``terms`` with static data, ``max_gap_s`` with
+        static data and ``consistent``; an unreadable prior (``field`` names it).
     """
-    paths = data_files(path)
+    opt = options or IdentifyOptions()
+    paths = data_files(data)
+    if opt.consistent:
+        prior = opt.prior
+        if not isinstance(prior, Robot) and prior is not None:
+            prior = load_prior(prior, robot, base=opt.prior_base, tip=opt.prior_tip)
+        result = _identify_consistent(robot, paths, opt, prior)
+        assert result.identified is not None  # _identify_consistent sets it
+        return IdentifyResult(result.identified, result, tuple(paths))
+    return IdentifyResult(_identify(robot, paths, opt), None, tuple(paths))
+
+
+def _identify(robot: Robot, paths: list[Path], opt: IdentifyOptions) -> IdentifiedModel:
+    """The unconstrained fit of :func:`identify_files`."""
     path = paths[0]
-    cmap = _columns(columns, cutoff_hz)
+    cmap = _columns(opt.columns, opt.cutoff_hz)
     kind = data_kind(path, cmap)
-    heldout = _heldout(path, kind, folds, validate_on, robot.n, cmap, drop_invalid)
+    heldout = _heldout(path, kind, opt.folds, opt.validate_on, robot.n, cmap, opt.drop_invalid)
     if kind == "torque_log":
-        logs = [
-            read_torque_log(
-                p, robot.n, columns=cmap, drop_invalid=drop_invalid, owner=f"robot {robot.name!r}"
-            )
-            for p in paths
-        ]
+        logs = _read_logs(robot, paths, cmap, opt.drop_invalid)
         fit = lambda: identify_recordings(  # noqa: E731
             robot,
             logs,
             [p.name for p in paths],
-            structure=_terms(terms),
-            max_std_percent=max_std_percent,
-            rtol=rtol,
-            max_gap_s=max_gap_s,
-            drive=drive,
-            estimator=estimator,
-            std=std or "classical",
-            cutoff_hz="auto" if cutoff_hz is None else cutoff_hz,
+            structure=_terms(opt.terms),
+            max_std_percent=opt.max_std_percent,
+            rtol=opt.rtol,
+            max_gap_s=opt.max_gap_s,
+            drive=opt.drive,
+            estimator=opt.estimator,
+            std=opt.std or "classical",
+            cutoff_hz="auto" if opt.cutoff_hz is None else opt.cutoff_hz,
             **heldout,
         )
         model = in_file(path, fit) if len(paths) == 1 else fit()
     else:
-        _one_static_file(paths, terms)
-        data = read_static_file(path, robot, columns=cmap, drop_invalid=drop_invalid)
+        _one_static_file(paths, opt.terms)
+        data = read_static_file(path, robot, columns=cmap, drop_invalid=opt.drop_invalid)
         outside = limit_violations(robot, data.q)
         if outside is not None:
-            warnings.warn(f"{path.name}: {outside}", DynidWarning, stacklevel=2)
+            warnings.warn(f"{path.name}: {outside}", DynidWarning, stacklevel=3)
         model = in_file(
             path,
             lambda: identify_static(
                 robot,
                 data,
-                max_std_percent=max_std_percent,
-                rtol=rtol,
-                std=std or "robust",
-                drive=drive,
-                estimator=estimator,
+                max_std_percent=opt.max_std_percent,
+                rtol=opt.rtol,
+                std=opt.std or "robust",
+                drive=opt.drive,
+                estimator=opt.estimator,
             ),
         )
         misfit = fit_mismatch(model.fit.relative_error_percent, data.metadata)
         if misfit is not None:
-            warnings.warn(f"{path.name}: {misfit}", DynidWarning, stacklevel=2)
-    return _record(model, columns)
+            warnings.warn(f"{path.name}: {misfit}", DynidWarning, stacklevel=3)
+    return _record(model, opt.columns)
+
+
+def _read_logs(robot: Robot, paths: list[Path], cmap: Any, drop_invalid: bool) -> list[Any]:
+    """The torque logs ``paths``, read strictly for ``robot``."""
+    return [
+        read_torque_log(
+            p, robot.n, columns=cmap, drop_invalid=drop_invalid, owner=f"robot {robot.name!r}"
+        )
+        for p in paths
+    ]
 
 
 def _consistent_structure_fit(
@@ -246,9 +390,11 @@ def _consistent_structure_fit(
     """
     classical = ("viscous", "coulomb", "offset")
     if terms != "auto" and terms.friction not in (classical, ()):
-        raise DataError(
-            "--consistent keeps the classical friction (viscous, coulomb, offset) physical: "
-            f"--terms may add armature to it; got {terms.name!r}"
+        raise OptionError(
+            "may add armature to the classical friction (viscous, coulomb, offset) that "
+            f"{{consistent}} keeps physical; got {terms.name!r}",
+            field="terms",
+            others=("consistent",),
         )
     selection = None
     if terms == "auto":
@@ -269,102 +415,61 @@ def _one_static_file(paths: list[Path], terms: object) -> None:
             f"{paths[0].name} holds static data: give one static data file ({len(paths)} given)"
         )
     if terms is not None and terms != "auto":
-        raise DataError(f"{paths[0].name}: --terms applies to torque logs, not static data")
-
-
-def identify_consistent_file(
-    robot: Robot,
-    path: str | Path | Sequence[str | Path],
-    *,
-    terms: str | Structure | None = None,
-    max_gap_s: float | None = None,
-    prior: Robot | None = None,
-    total_mass: tuple[float, float] | None = None,
-    options: SDPOptions | None = None,
-    columns: ColumnSpec | None = None,
-    drop_invalid: bool = False,
-    rtol: float | None = None,
-    estimator: EstimatorName = "ols",
-    drive: Drive | None = None,
-    cutoff_hz: float | None = None,
-    max_std_percent: float | None = None,
-    std: str | None = None,
-    folds: int | None = None,
-    validate_on: str | Path | None = None,
-) -> ConsistentResult:
-    """Physically consistent link parameters of ``robot`` identified in one step from
-    ``path`` (:func:`~dynid.feasibility.convex.fit.identify_consistent`), the data read and
-    checked as by :func:`identify_file`.
-
-    ``max_std_percent`` and ``std`` are refused (nothing is pruned; the data term is the
-    residual itself, weighted by ``estimator``); they are parameters so that a caller
-    passing them learns it. ``folds``/``validate_on`` (torque logs) choose the held-out
-    judgement of the prior weight and of the fit. Other parameters as :func:`identify_file` and
-    :func:`~dynid.feasibility.convex.fit.identify_consistent`.
-
-    Torque logs (one or more, prepared as :func:`identify_file` prepares them, ``max_gap_s``
-    honoured): the armature is chosen on held-out data as :func:`identify_file` chooses it
-    (or given by ``terms``), and the friction is the classical ``fv, fc, fo >= 0`` per joint
-    (motor), the terms the convex problem keeps physical.
-
-    Returns
-    -------
-    ConsistentResult
-        ``identified`` holds the unconstrained fit (with the column map recorded).
-
-    Raises
-    ------
-    DataError
-        ``max_std_percent`` or ``std`` given; a bad file or data of another robot.
-    """
-    if max_std_percent is not None:
-        raise DataError("--max-std-percent does not apply to --consistent (nothing is pruned)")
-    if std is not None:
-        raise DataError(
-            "--std does not apply to --consistent: its data term is the residual itself "
-            "(weighted by --estimator)"
+        raise OptionError(
+            f"applies to torque logs, not static data ({paths[0].name})", field="terms"
         )
-    paths = data_files(path)
+
+
+def _identify_consistent(
+    robot: Robot, paths: list[Path], opt: IdentifyOptions, prior: Robot | None
+) -> ConsistentResult:
+    """The one-step consistent fit of :func:`identify_files`
+    (:func:`~dynid.feasibility.convex.fit.identify_consistent`), the data read and checked
+    as for the unconstrained fit.
+
+    Torque logs (one or more, ``max_gap_s`` honoured): the armature is chosen on held-out
+    data as the unconstrained fit chooses it (or given by ``terms``), and the friction is
+    the classical ``fv, fc, fo >= 0`` per joint (motor), the terms the convex problem keeps
+    physical; ``folds``/``validate_on`` choose the held-out judgement of the prior weight
+    and of the fit. ``identified`` of the result holds the unconstrained fit.
+    """
     path = paths[0]
-    cmap = _columns(columns, cutoff_hz)
+    cmap = _columns(opt.columns, opt.cutoff_hz)
     kind = data_kind(path, cmap)
-    heldout = _heldout(path, kind, folds, validate_on, robot.n, cmap, drop_invalid)
-    common: dict[str, Any] = dict(prior=prior, total_mass=total_mass, options=options)
+    heldout = _heldout(path, kind, opt.folds, opt.validate_on, robot.n, cmap, opt.drop_invalid)
+    common: dict[str, Any] = dict(prior=prior, total_mass=opt.total_mass, options=opt.sdp())
     if kind == "torque_log":
-        logs = [
-            read_torque_log(
-                p, robot.n, columns=cmap, drop_invalid=drop_invalid, owner=f"robot {robot.name!r}"
-            )
-            for p in paths
-        ]
+        logs = _read_logs(robot, paths, cmap, opt.drop_invalid)
 
         def fit() -> ConsistentResult:
             model = _consistent_structure_fit(
                 robot,
                 logs,
                 [p.name for p in paths],
-                _terms(terms),
-                rtol=rtol,
-                drive=drive,
-                estimator=estimator,
-                cutoff_hz="auto" if cutoff_hz is None else cutoff_hz,
-                max_gap_s=max_gap_s,
+                _terms(opt.terms),
+                rtol=opt.rtol,
+                drive=opt.drive,
+                estimator=opt.estimator,
+                cutoff_hz="auto" if opt.cutoff_hz is None else opt.cutoff_hz,
+                max_gap_s=opt.max_gap_s,
                 **heldout,
             )
             return consistent_from_identified(robot, model, kind="log", **common)
 
         result = in_file(path, fit) if len(paths) == 1 else fit()
     else:
-        _one_static_file(paths, terms)
-        if max_gap_s is not None:
-            raise DataError(f"{path.name}: --max-gap applies to torque logs, not static data")
-        data = read_static_file(path, robot, columns=cmap, drop_invalid=drop_invalid)
+        _one_static_file(paths, opt.terms)
+        if opt.max_gap_s is not None:
+            raise OptionError(
+                f"applies to torque logs, not static data ({path.name})", field="max_gap_s"
+            )
+        data = read_static_file(path, robot, columns=cmap, drop_invalid=opt.drop_invalid)
         result = in_file(
             path,
             lambda: identify_consistent(
-                robot, data, rtol=rtol, drive=drive, estimator=estimator, **common
+                robot, data, rtol=opt.rtol, drive=opt.drive, estimator=opt.estimator, **common
             ),
         )
     if result.identified is None:  # pragma: no cover - identify_consistent always sets it
         raise DataError("the one-step identification returned no unconstrained fit")
-    return dataclasses.replace(result, identified=_record(result.identified, columns))
+    return dataclasses.replace(result, identified=_record(result.identified, opt.columns))

@@ -1,4 +1,5 @@
-"""The prior of a consistent fit, named as on the command line, checked against the robot."""
+"""The prior of a consistent fit, named by a built-in robot or a file, checked against the
+robot; every refusal an :class:`~dynid.exceptions.OptionError` of the field ``prior``."""
 
 from __future__ import annotations
 
@@ -7,8 +8,8 @@ from pathlib import Path
 
 import numpy as np
 
-from ..exceptions import DynidError
-from ..io.robot_file import load_robot
+from ..exceptions import DynidError, OptionError
+from ..io.robot_file import ROBOT_FILE_SUFFIXES, load_robot
 from ..model.builtin import BUILTIN_ROBOTS, builtin_robot
 from ..model.robot import Robot
 
@@ -20,7 +21,7 @@ _log = logging.getLogger(__name__)
 def load_prior(
     spec: str | Path | None, robot: Robot, *, base: str | None = None, tip: str | None = None
 ) -> Robot | None:
-    """The prior robot ``spec`` (``--prior``) for ``robot``, or None (the generic prior).
+    """The prior robot ``spec`` for ``robot``, or None (the generic prior).
 
     Parameters
     ----------
@@ -30,7 +31,7 @@ def load_prior(
     robot : Robot
         The robot being identified.
     base, tip : str, optional
-        ``--prior-base``/``--prior-tip``: the URDF chain.
+        The URDF prior's chain (fields ``prior_base``, ``prior_tip`` of the options).
 
     Returns
     -------
@@ -41,9 +42,9 @@ def load_prior(
 
     Raises
     ------
-    DynidError
-        An unreadable prior (the message starts with ``--prior``) or joint types other
-        than the robot's.
+    OptionError
+        A prior of another kind, missing or unreadable, or with joint types other than
+        the robot's (``field`` is ``"prior"``).
     """
     if spec is None:
         return None
@@ -52,26 +53,33 @@ def load_prior(
         prior = builtin_robot(spec)
     else:
         path = Path(spec)
+        if path.suffix.lower() not in ROBOT_FILE_SUFFIXES:
+            raise OptionError(
+                f"must be {' or '.join(map(repr, BUILTIN_ROBOTS))} or a .urdf, .toml or .json "
+                f"(feasible.json) file; got {spec!r}",
+                field="prior",
+            )
+        if not path.exists():
+            raise OptionError(f"{path.name}: {path} does not exist", field="prior")
+        urdf = path.suffix.lower() == ".urdf"
         try:
             prior = load_robot(
-                path,
-                base=base or robot.link_names[0],
-                tip=tip or robot.link_names[-1],
-                what="--prior",
+                path, base=base or robot.link_names[0], tip=tip or robot.link_names[-1]
             )
         except DynidError as exc:
-            hint = (
-                " (name the chain with --prior-base/--prior-tip)" if path.suffix == ".urdf" else ""
-            )
-            msg = str(exc) if str(exc).startswith("--prior") else f"--prior {path.name}: {exc}"
-            raise DynidError(msg + hint) from None
+            hint = " (name the chain with {prior_base}/{prior_tip})" if urdf else ""
+            raise OptionError(
+                f"{path.name}: {exc}{hint}",
+                field="prior",
+                others=("prior_base", "prior_tip") if urdf else (),
+            ) from None
         prior = prior.replace(name=path.name)
     pk, rk = ("".join("P" if x else "R" for x in r.prismatic) for r in (prior, robot))
     if pk != rk:
-        raise DynidError(f"--prior {spec}: joints {pk}; the robot's are {rk}")
+        raise OptionError(f"{spec}: joints {pk}; the robot's are {rk}", field="prior")
     if not np.allclose(prior.T_parent_joint, robot.T_parent_joint, atol=1e-3):
         _log.warning(
-            "--prior %s: its joint frames differ from the robot's by up to %.3g m; its link "
+            "the prior %s: its joint frames differ from the robot's by up to %.3g m; its link "
             "parameters are used in the robot's link frames as they are",
             spec,
             float(np.max(np.abs(prior.T_parent_joint - robot.T_parent_joint))),

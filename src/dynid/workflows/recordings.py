@@ -159,7 +159,7 @@ def _check_units(rec: Recorded) -> None:
             raise DataError(
                 f"{rec.names[worst]}: its {what} are {ratio:.3g} times those of {others}: "
                 "recorded in other units? hint: every recording is read with the same "
-                "--units; convert it or leave it out"
+                "units; convert it or leave it out"
             )
 
 

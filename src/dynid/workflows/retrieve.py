@@ -3,7 +3,7 @@
 Every method of :data:`~dynid.feasibility.methods.METHODS` (``sdp``, the convex retrieval;
 ``penalty``, Gaz et al.'s Algorithm 1) and both sources (an identified model's
 ``identification.json``, the method's "from coefficients"; static data, its "from data")
-go through :func:`retrieve_file`, which applies the command's checks for the Python API
+go through :func:`retrieve_files`, which applies the command's checks for the Python API
 too: static data must be of the robot (joint count, recorded robot), the prior's joints
 must be the robot's, a friction file on the robot must be sigmoid friction.
 """
@@ -11,12 +11,17 @@ must be the robot's, a friction file on the robot must be sigmoid friction.
 from __future__ import annotations
 
 from collections.abc import Callable
+from dataclasses import dataclass
 from pathlib import Path
 from typing import Any, Literal
 
-from ..exceptions import DynidError
+import numpy as np
+
+from .._parallel import available_cores
+from ..exceptions import DynidError, OptionError
 from ..feasibility.bounds import Bounds, default_bounds
-from ..feasibility.convex import SDPOptions
+from ..feasibility.convex import DEFAULT_SDP_MARGIN, SDPOptions
+from ..feasibility.methods import METHODS
 from ..feasibility.methods import method as consistent_method
 from ..feasibility.penalty import RetrievalOptions, RetrievalProgress
 from ..feasibility.result import FeasibleResult
@@ -27,9 +32,16 @@ from ..io.friction_json import load_friction_json
 from ..io.model_json import load_model_json
 from ..model.robot import Robot
 from .data_files import read_static_file
+from .options import check_choice, check_count, check_number
 from .prior import load_prior
 
-__all__ = ["load_bounds_for", "load_model_with_friction", "retrieve_file"]
+__all__ = [
+    "Retrieval",
+    "RetrieveOptions",
+    "load_bounds_for",
+    "load_model_with_friction",
+    "retrieve_files",
+]
 
 
 def load_bounds_for(
@@ -54,10 +66,11 @@ def _with_friction(robot: Robot, path: str | Path | None) -> Robot:
     if fr.kind == "none":  # no friction: nothing to put on the robot
         return robot
     if not isinstance(fr, SigmoidFriction):
-        raise DynidError(
-            f"{Path(path).name} holds {fr.kind} friction; --friction puts sigmoid friction on "
-            "the robot (the law a robot description holds): give a friction.json of "
-            "`dynid friction --friction-model sigmoid`, or none"
+        raise OptionError(
+            f"{Path(path).name} holds {fr.kind} friction; sigmoid friction goes on the robot "
+            "(the law a robot description holds): give a friction.json of the sigmoid law "
+            "(`dynid friction --friction-model sigmoid`), or none",
+            field="friction",
         )
     return robot.with_friction(fr.as_array())
 
@@ -82,25 +95,150 @@ def load_model_with_friction(
     )
 
 
-def retrieve_file(
+#: Options of the penalty method only, and of the convex method only.
+PENALTY_ONLY = ("runs", "stages", "workers")
+CONVEX_ONLY = ("margin", "objective")
+
+
+@dataclass(frozen=True, slots=True)
+class RetrieveOptions:
+    """How :func:`retrieve_files` retrieves feasible link parameters.
+
+    Attributes
+    ----------
+    method : str
+        A name of :data:`~dynid.feasibility.methods.METHODS`: ``"sdp"``, the convex
+        retrieval with a prior, or ``"penalty"``, the penalty method (Algorithm 1).
+    prior : str, Path or Robot, optional
+        The prior link parameters (:func:`~dynid.workflows.prior.load_prior`); default
+        generic.
+    prior_base, prior_tip : str, optional
+        The chain of a URDF prior.
+    prior_weight : float, optional
+        Weight of the distance to the prior (>= 0; default: the method's).
+    objective : {"logdet", "euclidean"}, optional
+        Convex method: distance to the prior (default log-det).
+    margin : float, optional
+        Convex method: lambda_min(J) >= margin tr(J), 0 <= margin < 0.25.
+    bounds : str or Path, optional
+        Bounds file (default: :func:`~dynid.feasibility.bounds.default_bounds`).
+    total_mass_band : bool
+        False drops the bounds' total-mass band.
+    total_mass : (float, float), optional
+        Band on the total mass [kg], 0 <= min <= max.
+    friction : str or Path, optional
+        friction.json (sigmoid) put on the robot (exported with it).
+    runs, stages : int, optional
+        Penalty method: independent runs and stages per run (default: its own).
+    workers : int, optional
+        Penalty method: worker processes (capped at the cores and the runs, with a note).
+    seed : int or None
+        Penalty method: the seed of the runs.
+
+    Raises
+    ------
+    OptionError
+        An unknown method; an option of the other method; a value out of its range
+        (``field`` names it).
+    """
+
+    method: str = "sdp"
+    prior: str | Path | Robot | None = None
+    prior_base: str | None = None
+    prior_tip: str | None = None
+    prior_weight: float | None = None
+    objective: str | None = None
+    margin: float | None = None
+    bounds: str | Path | None = None
+    total_mass_band: bool = True
+    total_mass: tuple[float, float] | None = None
+    friction: str | Path | None = None
+    runs: int | None = None
+    stages: int | None = None
+    workers: int | None = None
+    seed: int | None = 0
+
+    def __post_init__(self) -> None:
+        check_choice(self, "method", METHODS, optional=False)
+        for name in ("runs", "stages", "workers"):
+            check_count(self, name)
+        check_count(self, "seed", low=0)
+        check_number(self, "prior_weight", low_open=False)
+        check_number(self, "margin", low_open=False, high=0.25, high_open=True)
+        check_choice(self, "objective", ("logdet", "euclidean"))
+        band = self.total_mass
+        if band is not None and not (
+            len(band) == 2 and all(np.isfinite(band)) and 0.0 <= band[0] <= band[1]
+        ):
+            raise OptionError(
+                f"must be MIN,MAX with 0 <= MIN <= MAX; got {band}", field="total_mass"
+            )
+        other = {"sdp": PENALTY_ONLY, "penalty": CONVEX_ONLY}.get(self.method, ())
+        method = "penalty" if self.method == "sdp" else "sdp"
+        for name in other:
+            if getattr(self, name) is not None:
+                raise OptionError(
+                    f"applies to {{method}} {method} only", field=name, others=("method",)
+                )
+
+    def method_options(self) -> SDPOptions | RetrievalOptions:
+        """The settings of the method (its ``options_type``).
+
+        Raises
+        ------
+        OptionError
+            Runs, stages or a prior weight the penalty method refuses.
+        """
+        if self.method != "penalty":
+            return SDPOptions(
+                objective=self.objective or "logdet",
+                prior_weight=self.prior_weight,
+                margin=DEFAULT_SDP_MARGIN if self.margin is None else self.margin,
+            )
+        every = {"runs": self.runs, "stages": self.stages, "prior_weight": self.prior_weight}
+        given: dict[str, Any] = {k: v for k, v in every.items() if v is not None}
+        try:
+            return RetrievalOptions(**given)
+        except ValueError as exc:
+            raise OptionError(f"(penalty method): {exc}", field=_refused(given)) from None
+
+
+def _refused(given: dict[str, Any]) -> str:
+    """The first of the penalty method's ``given`` settings it refuses on its own (else
+    the first given)."""
+    for k, v in given.items():
+        try:
+            RetrievalOptions(**{k: v})
+        except ValueError:
+            return k
+    return next(iter(given))
+
+
+@dataclass(frozen=True, slots=True, eq=False)
+class Retrieval:
+    """Result of :func:`retrieve_files`.
+
+    Attributes
+    ----------
+    result : FeasibleResult
+        The method's: ConsistentResult (sdp) or RetrievalResult (penalty).
+    notes : tuple of (str, str)
+        What was adjusted, as (field, what): the worker processes capped at the cores
+        and the runs (``("workers", "64: using 2 (2 cores, 10 runs)")``).
+    """
+
+    result: FeasibleResult
+    notes: tuple[tuple[str, str], ...] = ()
+
+
+def retrieve_files(
     source: str | Path,
+    options: RetrieveOptions | None = None,
     *,
     kind: Literal["model", "static"] = "model",
     robot: Robot | None = None,
-    method: str = "sdp",
-    prior: str | Path | None = None,
-    prior_base: str | None = None,
-    prior_tip: str | None = None,
-    bounds: str | Path | None = None,
-    total_mass_band: bool = True,
-    total_mass: tuple[float, float] | None = None,
-    friction: str | Path | None = None,
-    sdp_options: SDPOptions | None = None,
-    options: SDPOptions | RetrievalOptions | None = None,
-    workers: int | None = None,
-    seed: int | None = 0,
     progress: Callable[[RetrievalProgress], None] | None = None,
-) -> FeasibleResult:
+) -> Retrieval:
     """Feasible link parameters from an identified model or from static data.
 
     Parameters
@@ -108,64 +246,58 @@ def retrieve_file(
     source : str or Path
         ``identification.json`` (``kind="model"``) or static data ``.csv``/``.npz``
         (``kind="static"``, the single-step variant).
+    options : RetrieveOptions, optional
     kind : {"model", "static"}
         What ``source`` is.
     robot : Robot, optional
         Static data: the robot the data were recorded with (required).
-    method : str
-        A name of :data:`~dynid.feasibility.methods.METHODS`: ``"sdp"``, the convex
-        retrieval with a prior, or ``"penalty"``, the penalty method (Algorithm 1).
-    prior, prior_base, prior_tip
-        ``--prior`` and its URDF chain (:func:`~dynid.workflows.prior.load_prior`).
-    bounds : str or Path, optional
-        Bounds file (default: :func:`~dynid.feasibility.bounds.default_bounds`).
-    total_mass_band : bool
-        False drops the bounds' total-mass band (``--no-total-mass``).
-    total_mass : (float, float), optional
-        Band on the total mass [kg].
-    friction : str or Path, optional
-        friction.json (sigmoid) put on the robot (exported with it).
-    sdp_options : SDPOptions, optional
-        The convex method's options (as ``options``).
-    options : SDPOptions or RetrievalOptions, optional
-        The method's options (its ``options_type``).
-    workers, seed, progress
-        The penalty method's processes, seed and per-run callback; ``workers`` is refused
-        by a method that runs in this process (the convex one).
+    progress : callable, optional
+        Penalty method: called with each finished run.
 
     Returns
     -------
-    FeasibleResult
-        The method's: ConsistentResult (sdp) or RetrievalResult (penalty).
+    Retrieval
 
     Raises
     ------
     DynidError
         A bad file; static data without a robot or of another robot; a prior whose
-        joints differ from the robot's; an unknown method, options of another method,
-        ``workers`` for the convex method.
+        joints differ from the robot's.
+    OptionError
+        Options the method refuses (``field`` names them).
     """
-    m = consistent_method(method)
-    if sdp_options is not None and (m.name != "sdp" or options is not None):
-        raise DynidError("sdp_options are the convex method's options; pass one set, as options")
+    opt = options or RetrieveOptions()
+    m = consistent_method(opt.method)
+    method_options = opt.method_options()
     if kind == "model":
-        model = load_model_with_friction(source, friction)
+        model = load_model_with_friction(source, opt.friction)
         robot = model.robot
     elif robot is None:
         raise DynidError("retrieving from static data needs the robot that recorded them")
     else:
-        robot = _with_friction(robot, friction)
+        robot = _with_friction(robot, opt.friction)
         data = read_static_file(source, robot)
-    prior_robot = load_prior(prior, robot, base=prior_base, tip=prior_tip)
+    prior = opt.prior
+    if not isinstance(prior, Robot):
+        prior = load_prior(prior, robot, base=opt.prior_base, tip=opt.prior_tip)
+    workers, notes = opt.workers, []
+    if workers is not None and isinstance(method_options, RetrievalOptions):
+        cores = available_cores()
+        cap = min(cores, method_options.runs)
+        if workers > cap:
+            notes.append(
+                ("workers", f"{workers}: using {cap} ({cores} cores, {method_options.runs} runs)")
+            )
+            workers = cap
     common: dict[str, Any] = {
-        "prior": prior_robot,
-        "bounds": load_bounds_for(robot, bounds, total_mass_band=total_mass_band),
-        "total_mass": total_mass,
-        "options": sdp_options if options is None and m.name == "sdp" else options,
+        "prior": prior,
+        "bounds": load_bounds_for(robot, opt.bounds, total_mass_band=opt.total_mass_band),
+        "total_mass": opt.total_mass,
+        "options": method_options,
         "workers": workers,
-        "seed": seed,
+        "seed": opt.seed,
         "progress": progress,
     }
     if kind == "model":
-        return m.from_coefficients(model, **common)
-    return m.from_data(robot, data, **common)
+        return Retrieval(m.from_coefficients(model, **common), tuple(notes))
+    return Retrieval(m.from_data(robot, data, **common), tuple(notes))

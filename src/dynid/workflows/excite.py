@@ -1,0 +1,112 @@
+"""Design an exciting trajectory: the entry point of ``dynid excite``, with every policy the
+command applies, so that the Python API behaves as the command does.
+
+* The obstacles: a file's (``obstacles.json``), else the floor
+  (:func:`~dynid.simulation.excitation.optimise_excitation`).
+* The trajectory is optimised from one seed and checked, and given sampled at 1 kHz (the
+  rate of the checks and of ``trajectory.csv``).
+* A trajectory that is not admissible is a result, not an error (``admissible`` is False;
+  the command writes it for inspection and exits 1).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from ..io.excitation import load_obstacles
+from ..model.robot import Robot
+from ..simulation.excitation import ExcitationOptions, ExcitationResult, optimise_excitation
+
+__all__ = ["EXCITE_RATE_HZ", "ExcitationDesign", "design_excitation"]
+
+#: Rate of the sampled trajectory and of its checks [Hz].
+EXCITE_RATE_HZ = 1000.0
+
+
+@dataclass(frozen=True, slots=True, eq=False)
+class ExcitationDesign:
+    """Result of :func:`design_excitation`.
+
+    Attributes
+    ----------
+    result : ExcitationResult
+        The optimised trajectory, its condition numbers and its margins to every limit.
+    samples : Trajectory
+        The trajectory sampled at :data:`EXCITE_RATE_HZ`.
+    seed : int
+        The seed it was optimised from.
+    """
+
+    result: ExcitationResult
+    samples: Any
+    seed: int = field(default=0)
+
+    @property
+    def admissible(self) -> bool:
+        """Whether the trajectory keeps every limit and clearance."""
+        return self.result.status != "infeasible"
+
+    def describe(self, robot: Robot) -> tuple[str, str]:
+        """Two lines: the condition numbers and iterations; the smallest margins."""
+        res, m = self.result, self.result.margins
+        first = (
+            f"exciting trajectory for {robot.name}: {res.trajectory.total_duration:g} s, "
+            f"condition number {res.condition_number:.4g} (unscaled; start "
+            f"{res.initial_condition_number:.4g}), scaled {res.scaled_condition_number:.4g}, "
+            f"{res.iterations} iterations, status {res.status}"
+        )
+        second = (
+            "smallest margins at 1 kHz: position "
+            f"{min(m['position']):.3g} rad, velocity {min(m['velocity']):.3g} rad/s, "
+            f"acceleration {min(m['acceleration']):.3g} rad/s^2, torque "
+            f"{min(m['torque']):.3g} N m, self-collision {m['self_collision']:.3g} m"
+            + "".join(f", {k} {v:.3g} m" for k, v in m["obstacles"].items())
+        )
+        return first, second
+
+
+def design_excitation(
+    robot: Robot,
+    options: ExcitationOptions | None = None,
+    *,
+    obstacles: str | Path | None = None,
+    seed: int = 0,
+    progress: Callable[[int, int, float], None] | None = None,
+) -> ExcitationDesign:
+    """An exciting trajectory for ``robot``, optimised and checked
+    (:func:`~dynid.simulation.excitation.optimise_excitation`).
+
+    Parameters
+    ----------
+    robot : Robot
+    options : ExcitationOptions, optional
+    obstacles : str or Path, optional
+        An obstacles JSON (default: the floor).
+    seed : int
+        Seed of the starts of the optimisation.
+    progress : callable, optional
+        ``progress(iteration, total, condition_number)`` after each iteration.
+
+    Returns
+    -------
+    ExcitationDesign
+
+    Raises
+    ------
+    DataError
+        An unreadable obstacles file.
+    """
+    obs = None if obstacles is None else load_obstacles(obstacles)
+    res = optimise_excitation(
+        robot,
+        np.random.default_rng(seed),
+        options or ExcitationOptions(),
+        obstacles=obs,
+        progress=progress,
+    )
+    return ExcitationDesign(res, res.trajectory.sample(EXCITE_RATE_HZ), seed)

@@ -1,0 +1,193 @@
+"""Export a robot's parameters: the entry point of ``dynid export``, with every policy the
+command applies, so that the Python API behaves as the command does.
+
+* The robot: a ``feasible.json``, a robot ``.toml``, a ``.urdf`` (the chain from ``base``
+  to ``tip``; default the file's only root and leaf) or a built-in name.
+* ``base``/``tip`` choose the chain of a URDF robot and of the URDF template; given with
+  neither they would do nothing, and are refused.
+* The friction written: the linear friction identified with the links (a
+  ``feasible.json``'s; reflected from the motors when its drive has friction there), else
+  the robot's own; none on request. The drive: the file's own, or the one given.
+* MJCF holds friction as ``frictionloss`` and ``damping``: the robot's sigmoid is
+  approximated and the fit is part of the result
+  (:func:`~dynid.friction.mujoco.coulomb_viscous_from_sigmoid`).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+from ..exceptions import OptionError
+from ..friction.model import DriveFriction
+from ..friction.mujoco import CoulombViscous, coulomb_viscous_from_sigmoid
+from ..io.drive_file import load_drive
+from ..io.export import EXPORT_FORMATS, ROBOT_FORMATS, export_format, model_terms_of
+from ..io.robot.export_options import ExportOptions
+from ..io.robot.urdf_patch import MERGED_POLICIES
+from ..io.robot_file import ROBOT_FILE_SUFFIXES, load_robot
+from ..model.builtin import BUILTIN_ROBOTS
+from ..model.drive import Drive
+from ..model.robot import Robot
+from .options import check_choice
+
+__all__ = ["ExportRobotOptions", "RobotExport", "export_robot"]
+
+
+@dataclass(frozen=True, slots=True)
+class ExportRobotOptions:
+    """How :func:`export_robot` exports a robot.
+
+    Attributes
+    ----------
+    format : {"urdf", "mjcf", "toml"}, optional
+        Default: from the output's suffix.
+    urdf_template : str or Path, optional
+        URDF: the original file, written back with only the chain's inertials replaced.
+    base, tip : str, optional
+        The chain's base and tip links in a URDF robot and in the template (default: the
+        file's only root and leaf).
+    merged : {"subtract", "keep", "move"}
+        Template: how a body is split over its moving link and the links fixed to it.
+    friction : bool
+        Write friction (the identified linear friction, else the robot's own).
+    all_frames : bool
+        URDF chain: every named frame as a fixed, massless link.
+    drive : Drive, str or Path, optional
+        The drive train (or its ``.toml`` file), in place of the robot file's own.
+
+    Raises
+    ------
+    OptionError
+        An unknown format or merge policy (``field`` names it).
+    """
+
+    format: str | None = None
+    urdf_template: str | Path | None = None
+    base: str | None = None
+    tip: str | None = None
+    merged: str = "subtract"
+    friction: bool = True
+    all_frames: bool = False
+    drive: Drive | str | Path | None = None
+
+    def __post_init__(self) -> None:
+        check_choice(self, "format", EXPORT_FORMATS)
+        check_choice(self, "merged", MERGED_POLICIES, optional=False)
+
+
+@dataclass(frozen=True, slots=True, eq=False)
+class RobotExport:
+    """Result of :func:`export_robot`: what the writer of ``format`` writes.
+
+    Attributes
+    ----------
+    robot : Robot
+        The robot with its parameters.
+    format : str
+        The name of its format in :data:`~dynid.io.export.ROBOT_FORMATS`.
+    options : ExportOptions
+        What the writer writes beside the robot (template, chain, friction, drive).
+    mujoco_friction : CoulombViscous or None
+        MJCF with the robot's own (sigmoid) friction: the ``frictionloss`` and
+        ``damping`` that approximate it, per joint.
+    """
+
+    robot: Robot
+    format: str
+    options: ExportOptions
+    mujoco_friction: CoulombViscous | None
+
+
+def export_robot(
+    params: str | Path, out: str | Path, options: ExportRobotOptions | None = None
+) -> RobotExport:
+    """Read the robot ``params`` and decide how it is written to ``out``.
+
+    Parameters
+    ----------
+    params : str or Path
+        ``feasible.json``, a robot ``.toml`` or ``.urdf``, ``"panda"`` or ``"fr3"``.
+    out : str or Path
+        The file to write (its suffix chooses the format unless ``options.format``).
+    options : ExportRobotOptions, optional
+
+    Returns
+    -------
+    RobotExport
+        :func:`save_export` writes it.
+
+    Raises
+    ------
+    OptionError
+        ``params`` of another kind or missing; ``base``/``tip`` with neither a URDF robot
+        nor a template; a template for another format (``field`` names it).
+    DataError, ModelError
+        An unreadable robot file; a URDF with several leaves and no ``tip``.
+    """
+    opt = options or ExportRobotOptions()
+    urdf = _check_params(params)
+    for name in ("base", "tip"):
+        if getattr(opt, name) is not None and not urdf and opt.urdf_template is None:
+            raise OptionError(
+                "chooses the chain of a URDF {params} or of {urdf_template}; give one",
+                field=name,
+                others=("params", "urdf_template"),
+            )
+    fmt = export_format(out, opt.format)
+    if opt.urdf_template is not None and not ROBOT_FORMATS[fmt].template:
+        raise OptionError(f"applies to the urdf format only; got {fmt}", field="urdf_template")
+    robot = load_robot(params, base=opt.base, tip=opt.tip)
+    linear, drive = model_terms_of(params, robot.n)
+    if opt.drive is not None:
+        drive = opt.drive if isinstance(opt.drive, Drive) else load_drive(opt.drive, robot.n)
+    friction: Any = opt.friction
+    if linear is not None and opt.friction:
+        friction = linear
+        if (
+            drive is not None
+            and drive.friction_at == "motor"
+            and not isinstance(linear, DriveFriction)
+        ):
+            friction = DriveFriction(linear, drive)
+    written = ExportOptions(
+        template=None if opt.urdf_template is None else Path(opt.urdf_template),
+        base=opt.base,
+        tip=opt.tip,
+        merged=opt.merged,
+        friction=friction,
+        all_frames=opt.all_frames,
+        drive=drive,
+    )
+    approx = None
+    if fmt == "mjcf" and friction is True and robot.friction is not None:
+        approx = coulomb_viscous_from_sigmoid(robot.friction, robot.dq_max)
+    return RobotExport(robot, fmt, written, approx)
+
+
+def save_export(path: str | Path, export: RobotExport) -> Path:
+    """Write ``export`` to ``path`` with its format's writer; returns the path."""
+    return ROBOT_FORMATS[export.format].save(path, export.robot, export.options)
+
+
+def _check_params(params: str | Path) -> bool:
+    """Whether ``params`` is a URDF; a built-in name or an existing robot file.
+
+    Raises
+    ------
+    OptionError
+        Another suffix, or a file that does not exist.
+    """
+    if str(params) in BUILTIN_ROBOTS:
+        return False
+    path = Path(params)
+    if path.suffix.lower() not in ROBOT_FILE_SUFFIXES:
+        raise OptionError(
+            f"must be feasible.json, a robot .toml or .urdf, or "
+            f"{' or '.join(map(repr, BUILTIN_ROBOTS))}; got {str(params)!r}",
+            field="params",
+        )
+    if not path.exists():
+        raise OptionError(f": {path} does not exist", field="params")
+    return path.suffix.lower() == ".urdf"
