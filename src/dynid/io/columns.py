@@ -44,9 +44,9 @@ from ..identification.log import (
     with_derived_velocities,
 )
 from ..model.robot import Robot
+from .csv_tables import csv_table
 from .input_files import file_text, regular_file
 from .npz_files import check_npz
-from .torque_log import csv_table
 
 __all__ = [
     "ColumnMap",
@@ -228,7 +228,7 @@ class _Table:
 def _read_table(path: Path, cmap: ColumnMap, quantities: tuple[str, ...]) -> _Table:
     """The columns (CSV) or arrays (NPZ) of a file; of a CSV only those that the map's
     templates of ``quantities`` name, read by the strict reader of torque logs
-    (:func:`~dynid.io.torque_log.csv_table`: one pass, a chunk of text at a time)."""
+    (:func:`~dynid.io.csv_tables.csv_table`: one pass, a chunk of text at a time)."""
     regular_file(path)  # not a device that never ends
     suffix = path.suffix.lower()
     if suffix == ".npz":

@@ -38,8 +38,8 @@ from ..simulation.collision import Box, Obstacles, Plane, capsule_model
 from ..simulation.excitation import ExcitationResult, ExcitingTrajectory
 from ..simulation.trajectories import Trajectory
 from .atomic import open_atomic
+from .csv_tables import csv_table
 from .json_files import finite_or_none, load_json, save_json
-from .torque_log import csv_table
 
 __all__ = [
     "EXCITATION_SCHEMA",
