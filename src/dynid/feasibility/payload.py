@@ -60,7 +60,7 @@ from ..identification.static import identify_static
 from ..model.inertia import inertia6_from_matrix, inertial_from_phi
 from ..model.robot import Robot
 from ..regressors.base import RANK_FLOOR
-from ..regressors.static import static_regressor, static_vector
+from ..regressors.static import static_regressor_columns, static_rows, static_vector
 from ..regressors.terms import friction_labels
 from ..regressors.torque import torque_regressor
 from .lmi import phi_from_pseudo_inertia, pseudo_inertia, pseudo_inertia_margin
@@ -359,9 +359,22 @@ def _static_rows(
     gravity_only: bool,
     notes: list[str],
 ) -> tuple[NDArray[np.float64], NDArray[np.float64], str]:
-    """Regressor rows (in the load's frame parameters) and targets of static data."""
+    """Regressor rows (in the load's frame parameters) and targets of static data.
+
+    Only the load link's 10 columns of the static regressor are computed, a block of
+    configurations at a time (a 50-joint arm's full regressor is 5.3 MB a configuration);
+    the fit of the load takes its rows whole, ``(N rows, <= 10)``: a tenth of one link's
+    share of the full regressor.
+    """
     n, q = robot.n, data.q
-    Y = static_regressor(robot, q)[..., cols] @ A
+    idx = np.arange(10 * n)[cols]
+    step = max(1, (64 << 20) // (8 * static_rows(n) * 10))
+    Y = np.concatenate(
+        [
+            static_regressor_columns(robot, q[a : a + step], idx).transpose(2, 1, 0) @ A
+            for a in range(0, q.shape[0], step)
+        ]
+    )
     y = static_vector(data.M, data.g) - static_vector(
         mass_matrix(robot, q), gravity_torques(robot, q)
     )

@@ -35,19 +35,19 @@ reasons are in ``docs/feasible-retrieval-penalty.md``.
 from __future__ import annotations
 
 import dataclasses
-from collections.abc import Sequence
+from collections.abc import Iterator, Sequence
 from dataclasses import dataclass
-from typing import Any
+from typing import Any, cast
 
 import numpy as np
-import scipy.linalg
 from numpy.typing import ArrayLike, NDArray
 
 from ... import _checks
 from ...exceptions import DataError, OptionError, ShapeError
+from ...identification.streaming import max_stack_bytes
 from ...model.robot import Robot
 from ...regressors.base import BaseParameters, base_parameters
-from ...regressors.static import static_regressor, static_vector
+from ...regressors.static import static_regressor_columns, static_rows, static_vector
 from ..bounds import Bounds, default_bounds
 from ..constraints import UserConstraint, user_constraints
 from ..prior import prior_scales
@@ -476,6 +476,43 @@ def coefficient_problem(
     )
 
 
+class _StaticBlocks:
+    """The base static regressor ``(B, rows, r)`` of consecutive blocks of configurations,
+    each at most :func:`~dynid.identification.streaming.max_stack_bytes` (only the base
+    columns computed); iterated once per pass, one block held at a time (a single block
+    is computed once)."""
+
+    def __init__(self, robot: Robot, q: NDArray[np.float64], base: BaseParameters) -> None:
+        self.robot, self.q, self.ind = robot, q, np.asarray(base.independent)
+        per = 8 * static_rows(robot.n) * (base.rank + 1) * 4  # the block, weighted, stacked
+        self.step = max(1, max_stack_bytes() // per)
+        self._whole: NDArray[np.float64] | None = None
+
+    def __iter__(self) -> Iterator[tuple[slice, NDArray[np.float64]]]:
+        N = self.q.shape[0]
+        if N <= self.step:
+            if self._whole is None:
+                self._whole = self._rows(slice(0, N))
+            yield slice(0, N), self._whole
+            return
+        for a in range(0, N, self.step):
+            sl = slice(a, min(a + self.step, N))
+            yield sl, self._rows(sl)
+
+    def _rows(self, sl: slice) -> NDArray[np.float64]:
+        Y = static_regressor_columns(self.robot, self.q[sl], self.ind)  # (r, rows, B)
+        return np.ascontiguousarray(Y.transpose(2, 1, 0))
+
+
+def _r_factor(
+    R: NDArray[np.float64] | None, W: NDArray[np.float64], y: NDArray[np.float64]
+) -> NDArray[np.float64]:
+    """R (at most r + 1 rows) of the rows ``[W, y]`` stacked under the factor ``R`` so far."""
+    X = np.column_stack([W, y])
+    X = X if R is None else np.vstack([R, X])
+    return cast("NDArray[np.float64]", np.linalg.qr(X, mode="r"))  # (min(rows, r + 1), r + 1)
+
+
 def static_problem(
     robot: Robot,
     q: ArrayLike,
@@ -529,27 +566,33 @@ def static_problem(
     M = _checks.as_exact("M", M, (N, n, n))
     g = _checks.as_exact("g", g, (N, n))
     base = base_parameters(robot) if base is None else base
+    r = base.rank
     y = static_vector(M, g)  # (N, rows)
-    Yb = base.reduce(static_regressor(robot, q))  # (N, rows, r)
+    if y.size < r:
+        raise DataError(f"{y.size} stacked rows < {r} coefficients; add configurations")
+    blocks = _StaticBlocks(robot, q, base)
+    ss = np.zeros(y.shape[1])  # per row of s: the sum of squares of its regressor rows
+    for _, Yb in blocks:
+        ss += np.einsum("bkc,bkc->k", Yb, Yb)
     rms = np.sqrt(np.mean(y**2, axis=0))
-    rms_reg = np.sqrt(np.mean(np.sum(Yb**2, axis=2), axis=0))
+    rms_reg = np.sqrt(ss / N)
     informative = rms_reg > 1e-12 * max(float(rms_reg.max(initial=0.0)), 1e-300)
     floor = 1e-6 * float(rms.max(initial=0.0)) or 1.0
     w = np.where(informative, 1.0 / np.maximum(rms, floor), 0.0)
-    W = (Yb * w[None, :, None]).reshape(-1, base.rank)
-    yw = (y * w[None, :]).reshape(-1)
-    if W.shape[0] < base.rank:
-        raise DataError(f"{W.shape[0]} stacked rows < {base.rank} coefficients; add configurations")
+    # R of [W, y] accumulated block by block (weighted, and unweighted for the report):
+    # its first r columns are R of W, its last Q^T y and, below, the residual's norm
+    Ra = Ru_a = None
+    for sl, Yb in blocks:
+        Ra = _r_factor(Ra, (Yb * w[None, :, None]).reshape(-1, r), (y[sl] * w).reshape(-1))
+        Ru_a = _r_factor(Ru_a, Yb.reshape(-1, r), y[sl].reshape(-1))
+    assert Ra is not None and Ru_a is not None
+    yw = y * w[None, :]
+    R, qy = Ra[:r, :r], Ra[:r, r]
+    Ru, qyu = Ru_a[:r, :r], Ru_a[:r, r]
+    ny2 = float(np.sum(yw * yw))
+    k = np.sqrt(r / ny2) if ny2 > 0 else 1.0
+    yu2 = float(np.sum(y * y))
     P = base.projection
-    Q, R = scipy.linalg.qr(W, mode="economic")
-    qy = Q.T @ yw
-    ny2 = float(yw @ yw)
-    k = np.sqrt(base.rank / ny2) if ny2 > 0 else 1.0
-    # unweighted copy for the reported residual
-    Wu = Yb.reshape(-1, base.rank)
-    yu = y.reshape(-1)
-    Qu, Ru = scipy.linalg.qr(Wu, mode="economic")
-    qyu = Qu.T @ yu
     b, band, ucs = _common(robot, bounds, total_mass, extra, margin)
     lo, hi = _box(b, margin)
     return PenaltyProblem(
@@ -565,7 +608,7 @@ def static_problem(
         margin=float(margin),
         report_A=_checks.frozen(Ru @ P),
         report_b=_checks.frozen(qyu),
-        report_offset=max(float(yu @ yu) - float(qyu @ qyu), 0.0),
-        report_norm=float(np.linalg.norm(yu)),
+        report_offset=max(yu2 - float(qyu @ qyu), 0.0),
+        report_norm=float(np.sqrt(yu2)),
         kind="static",
     )
