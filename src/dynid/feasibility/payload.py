@@ -470,6 +470,25 @@ def _not_excited(
     )
 
 
+def _load_columns(
+    robot: Robot,
+    q: NDArray[np.float64],
+    dq: NDArray[np.float64],
+    ddq: NDArray[np.float64],
+    cols: slice,
+    A: NDArray[np.float64],
+) -> NDArray[np.float64]:
+    """The torque regressor's columns ``cols`` mapped by ``A``, (N, n, p), computed a block
+    of samples at a time (the full regressor of one block held, 64 MB at most)."""
+    n = robot.n
+    step = max(1, (64 << 20) // (8 * n * 10 * n))
+    parts = []
+    for k in range(0, q.shape[0], step):
+        b = slice(k, k + step)
+        parts.append(torque_regressor(robot, q[b], dq[b], ddq[b])[..., cols] @ A)
+    return np.concatenate(parts)
+
+
 def _log_rows(
     robot: Robot,
     logs: Sequence[TorqueLog],
@@ -482,7 +501,10 @@ def _log_rows(
     """Regressor rows (the load's parameters, then classical friction per joint), targets
     of torque logs, each filtered (gaps up to ``max_gap_s`` bridged) and decimated on its own,
     and the columns fitted (the viscous and Coulomb friction of joints that never leave
-    their velocity noise band are not)."""
+    their velocity noise band are not). The torque regressor is computed a block of
+    samples at a time, its load link's columns kept: the rows fitted are held whole
+    (``N n`` rows of ``10 + 3 n`` columns; the fit of the load needs them), not the
+    ``10 n`` columns of every link."""
     still = ~moving_joints(np.concatenate([one.dq for one in logs]))
     Ws, ys = [], []
     for data in logs:
@@ -492,7 +514,7 @@ def _log_rows(
         sl = slice(None, None, auto_decimation(data.sample_rate, cutoff_hz))
         # a still joint's filtered velocity is noise: it does not move
         q_, dq_, ddq_ = log.q[sl], log.dq[sl] * ~still, ddq[sl] * ~still
-        Y = torque_regressor(robot, q_, dq_, ddq_)[..., cols] @ A
+        Y = _load_columns(robot, q_, dq_, ddq_, cols, A)
         Y = np.concatenate([Y, friction_regressor(dq_)], axis=-1)
         Ws.append(Y.reshape(-1, Y.shape[-1]))
         ys.append((np.asarray(log.tau[sl]) - rnea(robot, q_, dq_, ddq_)).reshape(-1))
