@@ -239,3 +239,31 @@ def test_a_log_without_a_row_count_is_read_into_arrays_allocated_once(tmp_path, 
         np.testing.assert_array_equal(getattr(got, k), x)
     arrays = 8 * N * (1 + 3 * n)
     assert peak < arrays + 8 * N * n + 3 * (1 << 20) * 3, (peak, arrays)
+
+
+def test_a_log_in_other_units_is_scaled_in_place_as_it_is_read(tmp_path, monkeypatch):
+    """ms, degrees and mN m: each signal scaled to SI in place while read (issue 28: a
+    scaled copy of each array beside the one read), one immutable copy at a time; the
+    values are the SI ones."""
+    import tracemalloc
+
+    log = _log(9, N=60_000)
+    path = tmp_path / "other.csv"
+    _write_renamed(path, log)
+    cmap = parse_column_map(
+        "t=time_ms,q=position_{i0},dq=velocity_{i0},tau=effort_{i0}",
+        "t=ms,q=deg,dq=deg/s,tau=mNm",
+    )
+    from dynid.io import csv_tables
+
+    monkeypatch.setattr(csv_tables, "_CHUNK_BYTES", 1 << 18)
+    tracemalloc.start()
+    got = load_mapped_torque_log(path, cmap).log
+    peak = tracemalloc.get_traced_memory()[1]
+    tracemalloc.stop()
+    np.testing.assert_allclose(got.t, log.t, rtol=1e-15, atol=1e-18)
+    for k in ("q", "dq", "tau"):
+        np.testing.assert_allclose(getattr(got, k), getattr(log, k), rtol=1e-14, atol=1e-15)
+    N, n = 60_000, 3
+    arrays, one = 8 * N * (1 + 3 * n), 8 * N * n
+    assert peak < arrays + one + (2 << 20), (peak, arrays)  # the arrays, a copy, a chunk

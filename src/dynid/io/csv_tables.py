@@ -39,6 +39,8 @@ def csv_table(
     path: Path,
     layout_of: Callable[[list[str], int], dict[str, list[int]]],
     expected: str,
+    *,
+    freeze: bool = True,
 ) -> tuple[dict[str, NDArray[np.float64]], tuple[int, int] | None]:
     """Read a dynid CSV table: comment lines (``# rows: N`` checked), a header, numbers.
 
@@ -51,10 +53,14 @@ def csv_table(
         parsed; the others may hold anything but a comma).
     expected : str
         The header expected, for the message when there is none.
+    freeze : bool
+        Return the arrays immutable (:func:`dynid._checks.frozen`, one copy at a time);
+        False: writable, for a caller that changes them in place (units) and then
+        freezes them itself.
 
     Returns
     -------
-    arrays : dict of str to ndarray, shape (N, k) each, read-only
+    arrays : dict of str to ndarray, shape (N, k) each, read-only unless not ``freeze``
     lines : (int, int) or None
         Line number of data row 0 and the row count, when rows map to lines one to one.
 
@@ -102,6 +108,8 @@ def csv_table(
     if N == 0:
         raise DataError(f"{path.name}: no data rows after the header")
     check_row_count(path, recorded, N)
+    if not freeze:
+        return arrays, ((first, N) if one_to_one else None)
     for k in list(arrays):  # immutable one at a time (TorqueLog keeps them without a copy):
         arrays[k] = _checks.frozen(arrays.pop(k))  # the copy of one array at a time only
     return arrays, ((first, N) if one_to_one else None)
