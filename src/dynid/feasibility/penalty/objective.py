@@ -35,22 +35,22 @@ reasons are in ``docs/feasible-retrieval-penalty.md``.
 from __future__ import annotations
 
 import dataclasses
-from collections.abc import Iterator, Sequence
+from collections.abc import Sequence
 from dataclasses import dataclass
-from typing import Any, cast
+from typing import Any
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from ... import _checks
 from ...exceptions import DataError, OptionError, ShapeError
-from ...identification.streaming import max_stack_bytes
 from ...model.robot import Robot
 from ...regressors.base import BaseParameters, base_parameters
-from ...regressors.static import static_regressor_columns, static_rows, static_vector
+from ...regressors.static import static_vector
 from ..bounds import Bounds, default_bounds
 from ..constraints import UserConstraint, user_constraints
 from ..prior import prior_scales
+from .static_blocks import StaticBlocks, r_factor
 
 __all__ = [
     "DEFAULT_MARGIN",
@@ -476,43 +476,6 @@ def coefficient_problem(
     )
 
 
-class _StaticBlocks:
-    """The base static regressor ``(B, rows, r)`` of consecutive blocks of configurations,
-    each at most :func:`~dynid.identification.streaming.max_stack_bytes` (only the base
-    columns computed); iterated once per pass, one block held at a time (a single block
-    is computed once)."""
-
-    def __init__(self, robot: Robot, q: NDArray[np.float64], base: BaseParameters) -> None:
-        self.robot, self.q, self.ind = robot, q, np.asarray(base.independent)
-        per = 8 * static_rows(robot.n) * (base.rank + 1) * 4  # the block, weighted, stacked
-        self.step = max(1, max_stack_bytes() // per)
-        self._whole: NDArray[np.float64] | None = None
-
-    def __iter__(self) -> Iterator[tuple[slice, NDArray[np.float64]]]:
-        N = self.q.shape[0]
-        if N <= self.step:
-            if self._whole is None:
-                self._whole = self._rows(slice(0, N))
-            yield slice(0, N), self._whole
-            return
-        for a in range(0, N, self.step):
-            sl = slice(a, min(a + self.step, N))
-            yield sl, self._rows(sl)
-
-    def _rows(self, sl: slice) -> NDArray[np.float64]:
-        Y = static_regressor_columns(self.robot, self.q[sl], self.ind)  # (r, rows, B)
-        return np.ascontiguousarray(Y.transpose(2, 1, 0))
-
-
-def _r_factor(
-    R: NDArray[np.float64] | None, W: NDArray[np.float64], y: NDArray[np.float64]
-) -> NDArray[np.float64]:
-    """R (at most r + 1 rows) of the rows ``[W, y]`` stacked under the factor ``R`` so far."""
-    X = np.column_stack([W, y])
-    X = X if R is None else np.vstack([R, X])
-    return cast("NDArray[np.float64]", np.linalg.qr(X, mode="r"))  # (min(rows, r + 1), r + 1)
-
-
 def static_problem(
     robot: Robot,
     q: ArrayLike,
@@ -570,7 +533,7 @@ def static_problem(
     y = static_vector(M, g)  # (N, rows)
     if y.size < r:
         raise DataError(f"{y.size} stacked rows < {r} coefficients; add configurations")
-    blocks = _StaticBlocks(robot, q, base)
+    blocks = StaticBlocks(robot, q, base)
     ss = np.zeros(y.shape[1])  # per row of s: the sum of squares of its regressor rows
     for _, Yb in blocks:
         ss += np.einsum("bkc,bkc->k", Yb, Yb)
@@ -583,8 +546,8 @@ def static_problem(
     # its first r columns are R of W, its last Q^T y and, below, the residual's norm
     Ra = Ru_a = None
     for sl, Yb in blocks:
-        Ra = _r_factor(Ra, (Yb * w[None, :, None]).reshape(-1, r), (y[sl] * w).reshape(-1))
-        Ru_a = _r_factor(Ru_a, Yb.reshape(-1, r), y[sl].reshape(-1))
+        Ra = r_factor(Ra, (Yb * w[None, :, None]).reshape(-1, r), (y[sl] * w).reshape(-1))
+        Ru_a = r_factor(Ru_a, Yb.reshape(-1, r), y[sl].reshape(-1))
     assert Ra is not None and Ru_a is not None
     yw = y * w[None, :]
     R, qy = Ra[:r, :r], Ra[:r, r]
