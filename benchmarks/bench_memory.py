@@ -10,7 +10,11 @@ size"). The cases:
 * reading the Fourier log as a ``--columns`` CSV (``dynid.io.columns``), its columns
   renamed as another tool writes them (``time_s, pos_0.., vel_0.., eff_0..``, a text
   column the map does not name, no ``# rows:`` line), and, for comparison, dynid's own CSV
-  of it (``dynid.io.torque_log.load_torque_log``).
+  of it (``dynid.io.torque_log.load_torque_log``);
+* static data of a long chain (``--static-joints`` 50, ``--static-n`` 200 configurations
+  written by ``acquire-static``): the single-step problem of ``retrieve --static
+  --method penalty`` (``static_problem``, the base static regressor accumulated a block of
+  configurations at a time; its residual on the arm's own exact data must be rounding).
 
 Target (issue 28): each case under ``--target-gb`` (1.5 GB). The check: the ``--columns``
 read gives the same log as dynid's own CSV (sums of every signal equal). The commands that
@@ -19,7 +23,7 @@ fit the log are measured by ``bench_io.py``.
 Long (several minutes on two cores): ``run_all.py`` runs it only with ``--long``.
 
 ``python benchmarks/bench_memory.py [--rows N] [--dir DIR] [--keep] [--target-gb G]
-[--json [PATH]]``
+[--static-joints J] [--static-n N] [--json [PATH]]``
 """
 
 from __future__ import annotations
@@ -35,6 +39,7 @@ import time
 from pathlib import Path
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))  # this folder
+from bench_io import _arm_toml  # noqa: E402
 from common import environment, format_environment  # noqa: E402
 
 #: Peak memory allowed on the 5-million-row log [GB] (issue 28).
@@ -76,6 +81,21 @@ print(json.dumps({k: float(getattr(log, k).sum()) for k in ("t", "q", "dq", "tau
 """
 
 
+#: A process that builds the single-step penalty problem of static data and prints its
+#: relative residual (the arm's own exact data: rounding) and its rows (the base parameters).
+STATIC = """
+import json, sys
+import dynid
+from dynid.feasibility.penalty.objective import static_problem
+from dynid.io.static_data import load_static_data
+robot = dynid.Robot.from_toml(sys.argv[1])
+data = load_static_data(sys.argv[2], robot)[0]
+p = static_problem(robot, data.q, data.M, data.g)
+res = (p.report_offset ** 0.5) / p.report_norm
+print(json.dumps({"rows": int(p.A.shape[0]), "relative_residual": res}))
+"""
+
+
 def renamed(log: Path, out: Path) -> None:
     """``log`` (dynid's CSV) with the header of another tool and an extra text column,
     rewritten a line at a time (the benchmark itself holds no log in memory)."""
@@ -97,12 +117,31 @@ def renamed(log: Path, out: Path) -> None:
             dst.write(line.rstrip("\n") + ",ok\n")
 
 
+def _static(work: Path, dynid: list[str], joints: int, n_conf: int) -> dict:
+    """acquire-static of a long arm, then the penalty problem of its static data."""
+    arm, data = work / f"arm{joints}.toml", work / f"static{joints}.csv"
+    _arm_toml(arm, joints)
+    out = {}
+    cmd = ["acquire-static", "--robot", str(arm), "--n", str(n_conf), "--seed", "1"]
+    out[f"acquire-static {joints} joints"] = run(dynid + cmd + ["--out", str(data)])
+    if out[f"acquire-static {joints} joints"]["exit_code"] == 0:
+        key = f"retrieve --static problem {joints} j."
+        out[key] = r = run([sys.executable, "-c", STATIC, str(arm), str(data)])
+        if r["exit_code"] == 0:
+            res = json.loads(r["stdout"])["relative_residual"]
+            if not res < 1e-9:
+                r["exit_code"], r["stderr"] = -1, f"relative residual {res} on exact data"
+    return out
+
+
 def main(argv: list[str] | None = None) -> int:
     p = argparse.ArgumentParser(description=(__doc__ or "").strip().splitlines()[0])
     p.add_argument("--rows", type=int, default=5_000_001, help="samples of the log")
     p.add_argument("--dir", type=Path, default=None, help="work folder (default: temporary)")
     p.add_argument("--keep", action="store_true", help="keep the logs and the results")
     p.add_argument("--target-gb", type=float, default=TARGET_GB, help="peak allowed [GB]")
+    p.add_argument("--static-joints", type=int, default=50, help="joints of the arm (0: skip)")
+    p.add_argument("--static-n", type=int, default=200, help="static configurations")
     p.add_argument("--json", nargs="?", const="-", default=None, metavar="PATH")
     args = p.parse_args(argv)
     work = Path(tempfile.mkdtemp(prefix="dynid-bench-mem-")) if args.dir is None else args.dir
@@ -123,10 +162,12 @@ def main(argv: list[str] | None = None) -> int:
             read = [sys.executable, "-c", READ]
             results["read --columns log"] = run(read + [str(other), COLUMNS])
             results["read the log"] = run(read + [str(log), "-"])
+        if args.static_joints:
+            results.update(_static(work, dynid, args.static_joints, args.static_n))
         failed = [k for k, r in results.items() if r["exit_code"] != 0]
         for k in failed:
             print(f"{k} failed: {results[k]['stderr']}", file=sys.stderr)
-        if failed or len(results) < 4:
+        if failed or len(results) < 4 + 2 * bool(args.static_joints):
             return 1
         a = json.loads(results["read --columns log"]["stdout"])
         b = json.loads(results["read the log"]["stdout"])
@@ -157,9 +198,10 @@ def main(argv: list[str] | None = None) -> int:
     print(format_environment(record["environment"]))
     print(f"log: {args.rows:,} rows at 1 kHz; the --columns CSV {size_mb:.0f} MB")
     print(f"load average at the end {record['load_average']:.2f} (a busy machine: wall > CPU)")
-    print(f"{'command':<22} {'wall [s]':>9} {'CPU [s]':>8} {'peak [MB]':>10}")
+    w = max(len(k) for k in record["commands"])
+    print(f"{'command':<{w}} {'wall [s]':>9} {'CPU [s]':>8} {'peak [MB]':>10}")
     for name, r in record["commands"].items():
-        print(f"{name:<22} {r['seconds']:>9.1f} {r['cpu_seconds']:>8.1f} {r['peak_mb']:>10.0f}")
+        print(f"{name:<{w}} {r['seconds']:>9.1f} {r['cpu_seconds']:>8.1f} {r['peak_mb']:>10.0f}")
     print(
         f"--columns log = the log; largest peak {worst:.2f} GB, target < {args.target_gb:g} GB: "
         f"{'met' if record['meets_target'] else 'NOT met'}"

@@ -545,3 +545,56 @@ def test_torques_of_the_opposite_sign_make_the_verdict_poor(runs, tmp_path):
     assert "anti-correlated" in page_text.split('id="verdict"')[1].split("</section>")[0]
     good = render_html_report(RunSummary(command="identify"), {p.name: p}, out=tmp_path)
     assert '<section class="verdict poor"' not in good
+
+
+def _verdict_of(page_text: str) -> tuple[str, str]:
+    """The level (class) and the text of a page's verdict box."""
+    m = re.search(r'<section class="verdict (\w+)" id="verdict">(.*?)</section>', page_text, re.S)
+    assert m is not None
+    return m.group(1), re.sub(r"<[^>]+>", "", m.group(2))
+
+
+def test_validate_is_not_good_while_a_joint_errs_by_15_percent(tmp_path):
+    """validate's verdict judges the worst joint too: 3 % over the log but 15-19 % on the
+    wrist joints is usable, not good (it said GOOD), and names the worst joint."""
+    per = [2.0, 2.5, 3.0, 4.0, 15.0, 19.0, 17.0]
+    doc = {
+        "schema": "dynid-validation/1",
+        "relative_error_percent": 3.0,
+        "joint_names": [f"panda_joint{j}" for j in range(1, 8)],
+        "n_samples": 1000,
+        "without_friction": {
+            "rms": [1.0] * 7,
+            "relative_error_percent": 3.0,
+            "relative_error_percent_per_joint": per,
+        },
+    }
+    p = tmp_path / "validation.json"
+    p.write_text(json.dumps(doc))
+    level, text = _verdict_of(render_html_report(RunSummary(command="validate"), {p.name: p}))
+    assert level == "fair", text
+    assert "Worst joint panda_joint6" in text and "19" in text
+    doc["without_friction"]["relative_error_percent_per_joint"] = [2.0] * 7
+    p.write_text(json.dumps(doc))
+    assert _verdict_of(render_html_report(RunSummary(command="validate"), {p.name: p}))[0] == (
+        "good"
+    )
+
+
+def test_a_consistent_set_with_an_implausible_link_is_not_good(tmp_path):
+    """identify --consistent / retrieve: a consistent set that reproduces the coefficients
+    but carries an 'implausible' note (a link under 1 % of the mass) is usable with
+    reservations, the note in the verdict (it said GOOD)."""
+    links = [{"name": f"link{k}", "mass": m} for k, m in enumerate((5.0, 3.0, 0.01), 1)]
+    feas = {"schema": "dynid-feasible/1", "feasible": True, "relative_residual": 0.001}
+    note = "implausible: link3 weighs 0.01 kg, under 1 % of the total"
+    rep = {"schema": "dynid-report/1", "on_bound": [], "notes": ["generic prior", note]}
+    p, r = tmp_path / "feasible.json", tmp_path / "report.json"
+    p.write_text(json.dumps(feas | {"links": links}))
+    r.write_text(json.dumps(rep))
+    files = {p.name: p, r.name: r}
+    level, text = _verdict_of(render_html_report(RunSummary(command="retrieve"), files))
+    assert level == "fair", text
+    assert "link3 weighs 0.01 kg" in text and "implausible" in text
+    r.write_text(json.dumps(rep | {"notes": ["generic prior"]}))
+    assert _verdict_of(render_html_report(RunSummary(command="retrieve"), files))[0] == "good"

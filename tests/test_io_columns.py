@@ -161,7 +161,7 @@ def test_mapped_csv_is_read_strictly_and_frugally(tmp_path, monkeypatch):
     than twice the arrays (numpy.genfromtxt held a Python object per cell)."""
     import tracemalloc
 
-    from dynid.io import torque_log
+    from dynid.io import csv_tables
 
     log = _log(5, N=100_000)
     path = tmp_path / "other.csv"
@@ -170,7 +170,7 @@ def test_mapped_csv_is_read_strictly_and_frugally(tmp_path, monkeypatch):
         "t=time_ms,q=position_{i0},dq=velocity_{i0},tau=effort_{i0}",
         "t=ms,q=deg,dq=deg/s,tau=mNm",
     )
-    monkeypatch.setattr(torque_log, "_CHUNK_BYTES", 1 << 20)
+    monkeypatch.setattr(csv_tables, "_CHUNK_BYTES", 1 << 20)
     tracemalloc.start()
     got = load_mapped_torque_log(path, cmap)
     peak = tracemalloc.get_traced_memory()[1]
@@ -202,3 +202,68 @@ def test_mapped_csv_is_read_strictly_and_frugally(tmp_path, monkeypatch):
     word.write_text("\n".join(lines[:3] + [",".join(bad)] + lines[4:6]) + "\n")
     with pytest.raises(DataError, match=r"line 4, column 'effort_1': not a number"):
         load_mapped_torque_log(word, cmap)
+
+
+def test_a_log_without_a_row_count_is_read_into_arrays_allocated_once(tmp_path, monkeypatch):
+    """A log of another tool (no '# rows:' line, a text column the map does not name) is
+    read by numpy's C reader, only the mapped columns, into arrays allocated once: the
+    peak is the arrays, one copy of the largest and a chunk of text, not the chunks kept
+    and joined (issue 28: 1.85 GB on 5 million rows), and the values equal the file's."""
+    import tracemalloc
+
+    from dynid.io import csv_tables
+
+    N, n = 60_000, 3
+    rng = np.random.default_rng(71)
+    t = np.arange(N) * 1e-3
+    q, dq, tau = (rng.normal(size=(N, n)) for _ in range(3))
+    names = ["time_s", *(f"{k}_{i}" for k in ("pos", "vel", "eff") for i in range(n)), "status"]
+    with open(tmp_path / "other.csv", "w") as fh:
+        fh.write(",".join(names) + "\n")
+        for r in range(N):
+            cells = [t[r], *q[r], *dq[r], *tau[r]]
+            fh.write(",".join(repr(float(x)) for x in cells) + ",ok é\n")
+
+    def refuse(*args, **kw):
+        raise AssertionError("the slow reader was used")
+
+    monkeypatch.setattr(csv_tables, "_slow_table", refuse)
+    monkeypatch.setattr(csv_tables, "_CHUNK_BYTES", 1 << 20)
+    cmap = parse_column_map("t=time_s,q=pos_{i0},dq=vel_{i0},tau=eff_{i0}")
+    tracemalloc.start()
+    got = load_mapped_torque_log(tmp_path / "other.csv", cmap).log
+    peak = tracemalloc.get_traced_memory()[1]
+    tracemalloc.stop()
+    np.testing.assert_array_equal(got.t, t)
+    for k, x in (("q", q), ("dq", dq), ("tau", tau)):
+        np.testing.assert_array_equal(getattr(got, k), x)
+    arrays = 8 * N * (1 + 3 * n)
+    assert peak < arrays + 8 * N * n + 3 * (1 << 20) * 3, (peak, arrays)
+
+
+def test_a_log_in_other_units_is_scaled_in_place_as_it_is_read(tmp_path, monkeypatch):
+    """ms, degrees and mN m: each signal scaled to SI in place while read (issue 28: a
+    scaled copy of each array beside the one read), one immutable copy at a time; the
+    values are the SI ones."""
+    import tracemalloc
+
+    log = _log(9, N=60_000)
+    path = tmp_path / "other.csv"
+    _write_renamed(path, log)
+    cmap = parse_column_map(
+        "t=time_ms,q=position_{i0},dq=velocity_{i0},tau=effort_{i0}",
+        "t=ms,q=deg,dq=deg/s,tau=mNm",
+    )
+    from dynid.io import csv_tables
+
+    monkeypatch.setattr(csv_tables, "_CHUNK_BYTES", 1 << 18)
+    tracemalloc.start()
+    got = load_mapped_torque_log(path, cmap).log
+    peak = tracemalloc.get_traced_memory()[1]
+    tracemalloc.stop()
+    np.testing.assert_allclose(got.t, log.t, rtol=1e-15, atol=1e-18)
+    for k in ("q", "dq", "tau"):
+        np.testing.assert_allclose(getattr(got, k), getattr(log, k), rtol=1e-14, atol=1e-15)
+    N, n = 60_000, 3
+    arrays, one = 8 * N * (1 + 3 * n), 8 * N * n
+    assert peak < arrays + one + (2 << 20), (peak, arrays)  # the arrays, a copy, a chunk

@@ -405,3 +405,79 @@ def test_a_record_with_a_duplicated_key_is_not_trusted(tmp_path):
         with run_output(out, command="test"):
             write_text(out / "a.txt", "b")
     assert (out / "a.txt").read_text() == "mine"
+
+
+@pytest.mark.parametrize("existing", [False, True], ids=["new folder", "existing folder"])
+def test_ctrl_c_during_the_move_completes_the_run(tmp_path, monkeypatch, caplog, existing):
+    """Ctrl-C that arrives while the set moves into place (held back then) does not turn
+    the complete set into an interrupted run: the block ends normally, the folder holds
+    the whole set, and a warning says the signal came late (before the fix the signal was
+    delivered right after the move: a complete folder, and an exit as interrupted)."""
+    from dynid.io import run_output as ro
+    from dynid.io.atomic import write_text
+
+    out = tmp_path / "o"
+    if existing:
+        with ro.run_output(out, command="test"):
+            write_text(out / "a.txt", "old")
+    real = ro._write_manifest
+
+    def interrupted(folder, doc):
+        os.kill(os.getpid(), signal.SIGINT)  # Ctrl-C during the move
+        real(folder, doc)
+
+    monkeypatch.setattr(ro, "_write_manifest", interrupted)
+    with ro.run_output(out, command="test"):
+        write_text(out / "a.txt", "a")
+        write_text(out / "b.txt", "b")
+    assert (out / "a.txt").read_text() == "a" and (out / "b.txt").read_text() == "b"
+    assert json.loads((out / MANIFEST).read_text())["files"] == ["a.txt", "b.txt"]
+    assert "SIGINT arrived once the outputs" in caplog.text
+    assert signal.getsignal(signal.SIGINT) is signal.default_int_handler
+
+
+def test_ctrl_c_during_a_move_that_fails_is_an_interrupt_and_moves_nothing(tmp_path, monkeypatch):
+    """Ctrl-C held back during a move that then fails: the folder is put back as it was
+    and the interrupt is delivered (nothing published, exit as interrupted)."""
+    from dynid.io import run_output as ro
+    from dynid.io.atomic import write_text
+
+    out = tmp_path / "o"
+    with ro.run_output(out, command="test"):
+        write_text(out / "a.txt", "old")
+    real = os.replace
+
+    def failing(src, dst):
+        if Path(dst) == out / "b.txt":  # the move, not the staged write
+            os.kill(os.getpid(), signal.SIGINT)
+            raise OSError(28, "No space left on device")
+        real(src, dst)
+
+    monkeypatch.setattr(ro.os, "replace", failing)
+    with pytest.raises(KeyboardInterrupt), ro.run_output(out, command="test"):
+        write_text(out / "a.txt", "a")
+        write_text(out / "b.txt", "b")
+    monkeypatch.setattr(ro.os, "replace", real)
+    assert (out / "a.txt").read_text() == "old" and not (out / "b.txt").exists()
+    assert json.loads((out / MANIFEST).read_text())["files"] == ["a.txt"]
+
+
+def test_ctrl_c_once_the_program_ran_does_not_turn_its_exit_into_an_interrupt(tmp_path):
+    """Ctrl-C that arrives after the command finished, while the interpreter exits (its
+    handlers reset as it does): the complete output stays and the exit code is the run's,
+    0 (before the fix: killed by SIGINT, exit 130 beside a complete folder)."""
+    out = tmp_path / "s.csv"
+    code = (
+        "import os, signal, sys\n"
+        "from dynid.cli.__main__ import main\n"
+        f"sys.argv = ['dynid', 'acquire-static', '--n', '5', '--out', {str(out)!r}, '-q']\n"
+        "code = main()\n"
+        "os.kill(os.getpid(), signal.SIGINT)  # Ctrl-C as the program exits\n"
+        "sys.exit(code)\n"
+    )
+    r = subprocess.run(
+        [sys.executable, "-c", code], capture_output=True, text=True, env=_env(), timeout=120
+    )
+    assert r.returncode == 0, r.stderr
+    assert "KeyboardInterrupt" not in r.stderr
+    assert out.read_text().count("\n") > 5

@@ -117,3 +117,28 @@ def test_unwrapped_continuous_joints_are_not_taken_for_degrees():
     both = TorqueLog(log.t, np.degrees(log.q), np.degrees(log.dq), log.tau)
     found = [f for f in check_torque_log(robot, both) if "degrees" in f]
     assert len(found) == 1 and "--units q=deg,dq=deg/s" in found[0]
+
+
+def test_torque_spikes_are_found_where_they_were_put_and_named_with_the_file(panda_log):
+    """Spikes of 30 noise levels put on joint 6 (three samples) and joint 2 (one) are found
+    there and counted, and preparing the recording warns with the file, the joints and the
+    counts (issue 28: spikes were fitted silently); the clean log has none."""
+    from dynid.identification.recordings import prepare_recordings
+    from dynid.identification.sanity import torque_spikes
+
+    robot = dynid.panda()
+    assert torque_spikes(panda_log.tau) == []
+    d = np.diff(panda_log.tau, axis=0)
+    noise = 1.4826 * np.median(np.abs(d - np.median(d, axis=0)), axis=0) / np.sqrt(2)
+    tau = np.array(panda_log.tau)
+    rows = {5: [300, 1200, 2000], 1: [900]}
+    for j, rs in rows.items():
+        tau[rs, j] += 30 * noise[j] * np.array([1, -1, 1][: len(rs)])
+    found = torque_spikes(tau)
+    assert [(j, c, r) for j, c, r, _ in found] == [(1, 1, 900), (5, 3, 300)]
+    assert all(25 < h < 35 for *_, h in found)
+    spiked = TorqueLog(panda_log.t, panda_log.q, panda_log.dq, tau)
+    with pytest.warns(DynidWarning, match=r"arm\.csv: 4 torque sample\(s\)") as got:
+        prepare_recordings(robot, [spiked], names=["arm.csv"])
+    text = " ".join(str(w.message) for w in got)
+    assert f"{robot.joint_names[5]} 3" in text and f"{robot.joint_names[1]} 1" in text

@@ -187,7 +187,7 @@ def test_blank_lines_keep_the_fast_reader_and_the_same_arrays(tmp_path, monkeypa
     """A log with blank lines (one after the header, one inside, two at a block's end) is
     read by the fast reader, not the slow per-cell one, into the same arrays (issue 20: one
     blank line in 2 million rows took 38 s and 2.3 GB instead of 23 s and 1.2 GB)."""
-    from dynid.io import torque_log
+    from dynid.io import csv_tables
 
     log = _log(np.random.default_rng(47), N=300)
     lines = save_torque_log(tmp_path / "log.csv", log).read_text().splitlines()
@@ -198,11 +198,11 @@ def test_blank_lines_keep_the_fast_reader_and_the_same_arrays(tmp_path, monkeypa
     def refuse(*args, **kw):
         raise AssertionError("the slow reader was used")
 
-    monkeypatch.setattr(torque_log, "_slow_table", refuse)
+    monkeypatch.setattr(csv_tables, "_slow_table", refuse)
     back = load_torque_log(tmp_path / "blank.csv")
     for k in ("t", "q", "dq", "tau"):
         np.testing.assert_array_equal(getattr(back, k), getattr(log, k))
-    monkeypatch.setattr(torque_log, "_CHUNK_BYTES", 1000)  # blank lines across block ends
+    monkeypatch.setattr(csv_tables, "_CHUNK_BYTES", 1000)  # blank lines across block ends
     back = load_torque_log(tmp_path / "blank.csv")
     np.testing.assert_array_equal(back.tau, log.tau)
 

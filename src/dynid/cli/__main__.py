@@ -228,7 +228,21 @@ def _output_set(args: argparse.Namespace, argv: Sequence[str]) -> Iterator[RunOu
 
 
 def main(argv: Sequence[str] | None = None) -> int:
-    """Entry point of the ``dynid`` console script; returns the exit code."""
+    """Entry point of the ``dynid`` console script; returns the exit code.
+
+    Run as the program (``argv`` None), the stop signals are ignored once the run is over:
+    the interpreter resets their handlers as it exits, and a late Ctrl-C would kill it
+    after a complete run, reported as interrupted (exit 130 beside a complete ``--out``).
+    """
+    try:
+        return _main(argv)
+    finally:
+        if argv is None:
+            for sig in (signal.SIGINT, *TERMINATING):
+                signal.signal(sig, signal.SIG_IGN)
+
+
+def _main(argv: Sequence[str] | None) -> int:
     _printable_streams()
     argv = join_negative_values(sys.argv[1:] if argv is None else list(argv))
     command = _command(argv)

@@ -30,6 +30,11 @@ __all__ = [
 ]
 
 
+def _width(header: str, cells: Any, least: int = 0) -> int:
+    """The width of a left-aligned column: its header's, its longest cell's, or ``least``."""
+    return max([least, len(header), *(len(str(c)) for c in cells)])
+
+
 def format_identification(model: IdentifiedModel, *, width: int = 60) -> str:
     """A readable summary: metrics, then one line per coefficient (expressions shortened)."""
     fit, info = model.fit, model.info
@@ -76,14 +81,15 @@ def format_identification(model: IdentifiedModel, *, width: int = 60) -> str:
         + (f" ({', '.join(groups['unidentifiable'])})" if groups["unidentifiable"] else "")
     )
     head += recordings_lines(info.recordings) + selection_lines(info.selection)
-    head.append(f"{'#':>3}  {'name':<7} {'value':>13} {'std %':>9}  kept  expression")
+    lw = _width("name", model.base.labels[: model.base.rank], 7)
+    head.append(f"{'#':>3}  {'name':<{lw}} {'value':>13} {'std %':>9}  kept  expression")
     rows = []
     for k in range(model.base.rank):
         e = model.base.expressions[k]
         e = e if len(e) <= width else e[: width - 3] + "..."
         pct = fit.std_percent[k]
         rows.append(
-            f"{k + 1:>3}  {model.base.labels[k]:<7} {fit.beta[k]:>+13.6g} "
+            f"{k + 1:>3}  {model.base.labels[k]:<{lw}} {fit.beta[k]:>+13.6g} "
             f"{'-' if not np.isfinite(pct) else f'{pct:.3g}':>9}  "
             f"{'yes' if fit.kept[k] else 'no':<4}  {e}"
         )
@@ -106,15 +112,16 @@ def selection_lines(selection: Any) -> list[str]:
     """The model structures judged on held-out data, the one kept marked ``*``."""
     if not selection:
         return []
+    w = _width("structure", [str(c["name"]) for c in selection["candidates"]], 46)
     out = [
         f"model structure chosen on held-out data ({selection['validation']}): "
         f"{selection['chosen']} ({selection['rule']})",
-        f"    {'structure':<46} {'params':>6} {'train %':>9} {'held-out %':>11} {'+- se':>7}",
+        f"    {'structure':<{w}} {'params':>6} {'train %':>9} {'held-out %':>11} {'+- se':>7}",
     ]
     for c in selection["candidates"]:
         mark = "*" if c["name"] == selection["chosen"] else " "
         out.append(
-            f"  {mark} {c['name']:<46} {c['n_params']:>6} {c['train_error_percent']:>9.4g} "
+            f"  {mark} {c['name']:<{w}} {c['n_params']:>6} {c['train_error_percent']:>9.4g} "
             f"{c['heldout_error_percent']:>11.4g} {c['heldout_se_percent']:>7.2g}"
         )
     out += [f"  note: {line}" for line in selection.get("notes", ())]
@@ -202,7 +209,7 @@ def format_retrieval(result: RetrievalResult) -> str:
     lam = principal_moments(r.inertia)
     tri = {c.link: c.margin for c in r.report.select("triangle_inequality")}
     names = r.robot.link_names[1:]
-    w = max(len(s) for s in names)
+    w = _width("link", names)
     lines = [
         f"{'link':<{w}}  {'mass [kg]':>9}  {'CoM [m]':^26}  "
         f"{'principal moments [kg m^2]':^30}  {'triangle':>9}",
@@ -241,7 +248,7 @@ def format_consistent(result: ConsistentResult) -> str:
     """Readable summary of a convex retrieval: per link mass, CoM, margin; fit; notes."""
     r = result
     names = r.robot.link_names[1:]
-    w = max(len(s) for s in names)
+    w = _width("link", names)
     lines = [
         f"{'link':<{w}}  {'mass [kg]':>9}  {'prior [kg]':>10}  {'CoM [m]':^26}  "
         f"{'lambda_min(J)/tr(J)':>19}",
@@ -283,11 +290,15 @@ def format_consistent(result: ConsistentResult) -> str:
 
 
 def format_rms_table(names: list[str], columns: dict[str, np.ndarray]) -> str:
-    """A per-joint table of RMS values [N m]."""
-    head = f"{'joint':<10}" + "".join(f"{k:>22}" for k in columns)
+    """A per-joint table of RMS values [N m]: columns as wide as their longest name."""
+    w = _width("joint", names, 9) + 1
+    cw = {k: max(22, len(k) + 2) for k in columns}
+    head = f"{'joint':<{w}}" + "".join(f"{k:>{cw[k]}}" for k in columns)
     rows = [head]
     for j, name in enumerate(names):
-        rows.append(f"{name:<10}" + "".join(f"{float(v[j]):>22.4f}" for v in columns.values()))
+        rows.append(
+            f"{name:<{w}}" + "".join(f"{float(v[j]):>{cw[k]}.4f}" for k, v in columns.items())
+        )
     return "\n".join(rows)
 
 
@@ -295,9 +306,9 @@ def format_newton_euler_rms(val: NewtonEulerValidation) -> str:
     """Per-joint RMS of the Newton-Euler torques with retrieved parameters [N m] (and of
     the identified model, when compared)."""
     names = val.joint_names
-    w = max(len(s) for s in names)
+    w = _width("joint", names)
     head = f"{'joint':<{w}}  {'RMS NE [N m]':>12}" + (
-        "  {:>18}".format("RMS identified [N m]") if val.errors_reference is not None else ""
+        "  {:>20}".format("RMS identified [N m]") if val.errors_reference is not None else ""
     )
     rows = [head]
     for j, name in enumerate(names):

@@ -60,7 +60,7 @@ from ..identification.static import identify_static
 from ..model.inertia import inertia6_from_matrix, inertial_from_phi
 from ..model.robot import Robot
 from ..regressors.base import RANK_FLOOR
-from ..regressors.static import static_regressor, static_vector
+from ..regressors.static import static_regressor_columns, static_rows, static_vector
 from ..regressors.terms import friction_labels
 from ..regressors.torque import torque_regressor
 from .lmi import phi_from_pseudo_inertia, pseudo_inertia, pseudo_inertia_margin
@@ -359,9 +359,22 @@ def _static_rows(
     gravity_only: bool,
     notes: list[str],
 ) -> tuple[NDArray[np.float64], NDArray[np.float64], str]:
-    """Regressor rows (in the load's frame parameters) and targets of static data."""
+    """Regressor rows (in the load's frame parameters) and targets of static data.
+
+    Only the load link's 10 columns of the static regressor are computed, a block of
+    configurations at a time (a 50-joint arm's full regressor is 5.3 MB a configuration);
+    the fit of the load takes its rows whole, ``(N rows, <= 10)``: a tenth of one link's
+    share of the full regressor.
+    """
     n, q = robot.n, data.q
-    Y = static_regressor(robot, q)[..., cols] @ A
+    idx = np.arange(10 * n)[cols]
+    step = max(1, (64 << 20) // (8 * static_rows(n) * 10))
+    Y = np.concatenate(
+        [
+            static_regressor_columns(robot, q[a : a + step], idx).transpose(2, 1, 0) @ A
+            for a in range(0, q.shape[0], step)
+        ]
+    )
     y = static_vector(data.M, data.g) - static_vector(
         mass_matrix(robot, q), gravity_torques(robot, q)
     )
@@ -457,6 +470,25 @@ def _not_excited(
     )
 
 
+def _load_columns(
+    robot: Robot,
+    q: NDArray[np.float64],
+    dq: NDArray[np.float64],
+    ddq: NDArray[np.float64],
+    cols: slice,
+    A: NDArray[np.float64],
+) -> NDArray[np.float64]:
+    """The torque regressor's columns ``cols`` mapped by ``A``, (N, n, p), computed a block
+    of samples at a time (the full regressor of one block held, 64 MB at most)."""
+    n = robot.n
+    step = max(1, (64 << 20) // (8 * n * 10 * n))
+    parts = []
+    for k in range(0, q.shape[0], step):
+        b = slice(k, k + step)
+        parts.append(torque_regressor(robot, q[b], dq[b], ddq[b])[..., cols] @ A)
+    return np.concatenate(parts)
+
+
 def _log_rows(
     robot: Robot,
     logs: Sequence[TorqueLog],
@@ -469,7 +501,10 @@ def _log_rows(
     """Regressor rows (the load's parameters, then classical friction per joint), targets
     of torque logs, each filtered (gaps up to ``max_gap_s`` bridged) and decimated on its own,
     and the columns fitted (the viscous and Coulomb friction of joints that never leave
-    their velocity noise band are not)."""
+    their velocity noise band are not). The torque regressor is computed a block of
+    samples at a time, its load link's columns kept: the rows fitted are held whole
+    (``N n`` rows of ``10 + 3 n`` columns; the fit of the load needs them), not the
+    ``10 n`` columns of every link."""
     still = ~moving_joints(np.concatenate([one.dq for one in logs]))
     Ws, ys = [], []
     for data in logs:
@@ -479,7 +514,7 @@ def _log_rows(
         sl = slice(None, None, auto_decimation(data.sample_rate, cutoff_hz))
         # a still joint's filtered velocity is noise: it does not move
         q_, dq_, ddq_ = log.q[sl], log.dq[sl] * ~still, ddq[sl] * ~still
-        Y = torque_regressor(robot, q_, dq_, ddq_)[..., cols] @ A
+        Y = _load_columns(robot, q_, dq_, ddq_, cols, A)
         Y = np.concatenate([Y, friction_regressor(dq_)], axis=-1)
         Ws.append(Y.reshape(-1, Y.shape[-1]))
         ys.append((np.asarray(log.tau[sl]) - rnea(robot, q_, dq_, ddq_)).reshape(-1))

@@ -44,7 +44,7 @@ from .holdout import DEFAULT_FOLDS, block_labels
 from .info import IdentificationInfo, LogInfo
 from .log import TorqueLog, default_max_gap, joint_side_log
 from .rate import CUTOFF_MULTIPLE, cutoff_from_motion
-from .sanity import noise_band, velocity_noise_std
+from .sanity import noise_band, spike_finding, velocity_noise_std
 from .streaming import streams
 
 __all__ = [
@@ -325,6 +325,8 @@ def prepare_recordings(
         # a motor-side log: every motor turns (a joint-side one: the robot's revolute joints)
         turns = revolute if drive is None or drive.side == "joint" else np.ones(robot.n, bool)
         log, joints = unwrapped(log, turns)
+        if (spikes := spike_finding(name, log, robot.joint_names)) is not None:
+            warnings.warn(spikes, DynidWarning, stacklevel=2)
         if joints:
             turned.update(joints)
             warnings.warn(

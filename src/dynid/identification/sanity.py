@@ -25,6 +25,10 @@ with them before fitting (:func:`log_findings`). None of them changes the data.
 * **Frozen joints**: a joint whose velocity never leaves its noise band (fewer than 1 % of
   the samples beyond 5 times the robust noise level, :func:`velocity_noise_std`, and
   :data:`MIN_MOTION`); its friction cannot be identified (:func:`moving_joints`).
+* **Torque spikes**: samples that stand off both neighbours, on the same side, by more
+  than :data:`SPIKE_SIGMAS` robust noise levels (:func:`torque_spikes`); a sensor or
+  logging fault that least squares weighs by its square (:func:`spike_finding` names the
+  file, the joints and the counts).
 """
 
 from __future__ import annotations
@@ -48,6 +52,9 @@ __all__ = [
     "check_torque_log",
     "moving_joints",
     "noise_band",
+    "SPIKE_SIGMAS",
+    "spike_finding",
+    "torque_spikes",
     "velocity_noise_std",
 ]
 
@@ -60,6 +67,8 @@ NOISE_BAND_STD = 5.0
 MIN_MOTION = 1e-3
 #: Fraction of the samples that must lie outside the noise band for a joint to move.
 MOVING_FRACTION = 0.01
+#: A torque sample this many robust noise levels off both its neighbours is a spike.
+SPIKE_SIGMAS = 20.0
 
 
 def velocity_noise_std(dq: ArrayLike) -> NDArray[np.float64]:
@@ -329,3 +338,105 @@ def _milliseconds(log: TorqueLog) -> list[str]:
                 "time column looks like milliseconds; hint: --units t=ms"
             ]
     return []
+
+
+#: Samples of a column handled at a time by :func:`torque_spikes` (bounded temporaries).
+_SPIKE_BLOCK = 1 << 20
+
+
+def torque_spikes(
+    tau: ArrayLike, dq: ArrayLike | None = None, *, sigmas: float = SPIKE_SIGMAS
+) -> list[tuple[int, int, int, float]]:
+    """The spikes of each column of ``tau`` (N, n): samples off both neighbours, on the
+    same side, by more than ``sigmas`` robust noise levels, away from slow motion.
+
+    A sample's height is ``min(|x_k - x_{k-1}|, |x_k - x_{k+1}|)`` when both differences
+    have one sign (0 otherwise: a step is not a spike). The noise level is the first
+    differences' median absolute deviation, scaled to a Gaussian std over ``sqrt(2)``, at
+    least the data's resolution (the smallest step between samples) and ``1e-9`` of the
+    column's largest magnitude (noise-free data); a height must also exceed ``1e-3`` of
+    the column's range (p1 to p99). With the velocities ``dq``, samples where the joint
+    moves slowly are not judged (``|dq|`` at the sample or a neighbour under a tenth of
+    its 99th percentile, or of another sign): friction changes abruptly there (Coulomb
+    and Stribeck friction at a reversal or a near stop) without any fault.
+
+    Parameters
+    ----------
+    tau : array_like, shape (N, n)
+        Torques [N m] (or any signal sampled in time).
+    dq : array_like, shape (N, n), optional
+        Velocities [rad/s] of the same samples.
+    sigmas : float
+        The threshold in noise levels.
+
+    Returns
+    -------
+    list of (joint, count, first, largest)
+        Per column with spikes: its index, their count, the row of the first and the
+        largest height in noise levels.
+
+    Raises
+    ------
+    ShapeError
+        ``tau`` not (N, n), or ``dq`` of another shape.
+    """
+    a = _checks.as_array("tau", tau)
+    if a.ndim != 2:
+        raise ShapeError(f"tau must have shape (N, n); got {a.shape}")
+    v = None if dq is None else _checks.as_array("dq", dq)
+    if v is not None and v.shape != a.shape:
+        raise ShapeError(f"dq must have the shape of tau {a.shape}; got {v.shape}")
+    N = a.shape[0]
+    if N < 5:
+        return []
+    k = max(1, N // 200_000)  # the noise level from 200,000 differences spread over the log
+    m = (N - 1) // k
+    out = []
+    for j in range(a.shape[1]):
+        x = a[:, j]
+        d = x[1::k][:m] - x[0::k][:m]  # consecutive samples, spread over the log
+        ad = np.abs(d)
+        step = float(np.min(ad[ad > 0])) if np.any(ad > 0) else 0.0
+        s = 1.4826 * float(np.median(np.abs(d - np.median(d)))) / math.sqrt(2.0)
+        lo, hi = np.quantile(x[::k], [0.01, 0.99])
+        level = max(s, step, 1e-9 * float(np.max(np.abs(x[::k]))), 1e-300)
+        least = max(sigmas * level, 1e-3 * float(hi - lo))
+        slow = 0.1 * float(np.quantile(np.abs(v[::k, j]), 0.99)) if v is not None else 0.0
+        count, first, top = 0, -1, 0.0
+        for start in range(1, N - 1, _SPIKE_BLOCK):
+            stop = min(start + _SPIKE_BLOCK, N - 1)
+            d1 = x[start:stop] - x[start - 1 : stop - 1]
+            d2 = x[start:stop] - x[start + 1 : stop + 1]
+            h = np.where(np.sign(d1) == np.sign(d2), np.minimum(np.abs(d1), np.abs(d2)), 0.0)
+            if v is not None:
+                w = v[start - 1 : stop + 1, j]
+                fast = (np.abs(w) > slow) & (w > 0)
+                up = fast[:-2] & fast[1:-1] & fast[2:]
+                fast = (np.abs(w) > slow) & (w < 0)
+                h[~(up | (fast[:-2] & fast[1:-1] & fast[2:]))] = 0.0
+            hit = np.flatnonzero(h > least)
+            if hit.size:
+                count += int(hit.size)
+                first = first if first >= 0 else start + int(hit[0])
+                top = max(top, float(h[hit].max()) / level)
+        if count:
+            out.append((j, count, first, top))
+    return out
+
+
+def spike_finding(name: str, log: TorqueLog, joint_names: tuple[str, ...]) -> str | None:
+    """One line naming the file ``name``, the joints and the counts of the torque spikes
+    of ``log`` (:func:`torque_spikes`), or None without spikes."""
+    found = torque_spikes(log.tau, log.dq)
+    if not found:
+        return None
+    total = sum(c for _, c, _, _ in found)
+    parts = ", ".join(
+        f"{joint_names[j]} {c} (first at t = {float(log.t[r]):.6g} s, largest {h:.3g} sigma)"
+        for j, c, r, h in found
+    )
+    return (
+        f"{name}: {total} torque sample(s) stand off both neighbours by more than "
+        f"{SPIKE_SIGMAS:g} times the noise: {parts}; spikes (a sensor or logging fault) bias "
+        "the fit by their square; hint: remove those rows from the log"
+    )

@@ -44,9 +44,9 @@ from ..identification.log import (
     with_derived_velocities,
 )
 from ..model.robot import Robot
+from .csv_tables import csv_table
 from .input_files import file_text, regular_file
 from .npz_files import check_npz
-from .torque_log import csv_table
 
 __all__ = [
     "ColumnMap",
@@ -223,12 +223,14 @@ class _Table:
     #: quantity -> (its column names in joint order, their (N, n) array): the columns of a
     #: CSV read side by side, so that a long log's vectors are not stacked again
     groups: dict[str, tuple[list[str], NDArray[np.float64]]] = field(default_factory=dict)
+    #: the quantities whose groups were scaled to SI as they were read (in place)
+    scaled: set[str] = field(default_factory=set)
 
 
 def _read_table(path: Path, cmap: ColumnMap, quantities: tuple[str, ...]) -> _Table:
     """The columns (CSV) or arrays (NPZ) of a file; of a CSV only those that the map's
     templates of ``quantities`` name, read by the strict reader of torque logs
-    (:func:`~dynid.io.torque_log.csv_table`: one pass, a chunk of text at a time)."""
+    (:func:`~dynid.io.csv_tables.csv_table`: one pass, a chunk of text at a time)."""
     regular_file(path)  # not a device that never ends
     suffix = path.suffix.lower()
     if suffix == ".npz":
@@ -265,15 +267,20 @@ def _read_table(path: Path, cmap: ColumnMap, quantities: tuple[str, ...]) -> _Ta
 
     groups_of: dict[str, list[str]] = {}  # layout key -> its columns, filled by layout()
 
-    arrays, _ = csv_table(path, layout, "a header naming the columns")
+    arrays, _ = csv_table(path, layout, "a header naming the columns", freeze=False)
     table = _Table(path.name, {})
-    for key, a in arrays.items():
+    for key in list(arrays):  # one at a time: scaled in place, then its immutable copy
+        a = arrays.pop(key)
         if key.startswith(_GROUP):
-            names = groups_of[key]
-            table.groups[key[len(_GROUP) :]] = (names, a)
+            names, quantity = groups_of[key], key[len(_GROUP) :]
+            if cmap.factor(quantity) != 1.0:
+                a *= cmap.factor(quantity)
+                table.scaled.add(quantity)
+            a = _checks.frozen(a)
+            table.groups[quantity] = (names, a)
             table.columns.update({c: a[:, k] for k, c in enumerate(names)})
         else:
-            table.columns[key] = a[:, 0]
+            table.columns[key] = _checks.frozen(a)[:, 0]
     return table
 
 
@@ -341,10 +348,11 @@ def _vector(table: _Table, cmap: ColumnMap, quantity: str, n: int | None) -> NDA
     if missing:
         raise DataError(f"{table.name}: missing column(s) {missing} for {quantity!r} ({tpl!r})")
     group = table.groups.get(quantity)
+    # the columns of a group scaled as read are in SI (the first n of the group: names)
+    f = 1.0 if quantity in table.scaled else cmap.factor(quantity)
     if group is not None and group[0] == names:  # read side by side: no copy when in SI
-        f = cmap.factor(quantity)
         return group[1] if f == 1.0 else _checks.frozen(group[1] * f)
-    return np.stack([table.columns[c] for c in names], axis=1) * cmap.factor(quantity)
+    return np.stack([table.columns[c] for c in names], axis=1) * f
 
 
 def _check_distinct(table: _Table, cmap: ColumnMap, quantities: tuple[str, ...], n: int) -> None:

@@ -38,9 +38,9 @@ from ..simulation.collision import Box, Obstacles, Plane, capsule_model
 from ..simulation.excitation import ExcitationResult, ExcitingTrajectory
 from ..simulation.trajectories import Trajectory
 from .atomic import open_atomic
+from .csv_tables import csv_table
 from .json_files import finite_or_none
 from .schema import Field, Format, Record, fault, load_document, save_document
-from .torque_log import csv_table
 
 __all__ = [
     "EXCITATION",

@@ -25,20 +25,17 @@ the file records its row count (``# rows:``, ``n_rows``), a different count is a
 the file, the column and the line.
 
 Writing is atomic (:mod:`dynid.io.atomic`) with 17 significant digits, so a round trip is
-exact. The CSV reader parses the body in one pass with numpy's C reader straight from the
-file (no copy of the text), so a 2-million-row log needs about the memory of its arrays.
+exact. The CSV body is read by :func:`dynid.io.csv_tables.csv_table` (numpy's C reader,
+straight into arrays allocated once), so a long log needs about the memory of its arrays.
 """
 
 from __future__ import annotations
 
-import io
 import logging
 import re
-import warnings
 import zipfile
 from collections.abc import Callable, Iterable
 from pathlib import Path
-from typing import IO
 
 import numpy as np
 from numpy.typing import NDArray
@@ -52,13 +49,12 @@ from ..identification.log import (
     with_derived_velocities,
 )
 from .atomic import open_atomic
-from .input_files import regular_file
+from .csv_tables import ROWS_PREFIX, csv_table
 from .npz_files import check_npz
 from .static_data import check_row_count
 
 __all__ = [
     "load_torque_log",
-    "csv_table",
     "save_torque_log",
     "save_torque_log_pieces",
     "torque_log_columns",
@@ -67,7 +63,6 @@ __all__ = [
 _log = logging.getLogger(__name__)
 
 _UNITS = "# dynid torque log; units: t [s], q [rad], dq [rad/s], tau [N m], ddq [rad/s^2]"
-_ROWS_PREFIX = "# rows:"
 _SIGNALS = ("q", "dq", "tau", "ddq")
 
 
@@ -154,7 +149,7 @@ def save_torque_log_pieces(
     preamble = "\n".join(
         [
             _UNITS,
-            f"{_ROWS_PREFIX} {n_rows}",
+            f"{ROWS_PREFIX} {n_rows}",
             ",".join(
                 torque_log_columns(n, with_ddq=with_ddq)
                 + ([] if extra is None else [f"{extra[0]}{j}" for j in range(1, n + 1)])
@@ -421,229 +416,3 @@ def _read_csv(path: Path) -> tuple[dict[str, NDArray[np.float64]], tuple[int, in
     arrays, lines = csv_table(path, layout, "t,q1,...,dq1,...,tau1,...")
     arrays["t"] = arrays["t"].reshape(-1)
     return arrays, lines
-
-
-def csv_table(
-    path: Path,
-    layout_of: Callable[[list[str], int], dict[str, list[int]]],
-    expected: str,
-) -> tuple[dict[str, NDArray[np.float64]], tuple[int, int] | None]:
-    """Read a dynid CSV table: comment lines (``# rows: N`` checked), a header, numbers.
-
-    Parameters
-    ----------
-    path : Path
-    layout_of : callable
-        ``layout_of(names, line)`` checks the header's column names (found on ``line``)
-        and returns, per output array, the indices of its columns.
-    expected : str
-        The header expected, for the message when there is none.
-
-    Returns
-    -------
-    arrays : dict of str to ndarray, shape (N, k) each, read-only
-    lines : (int, int) or None
-        Line number of data row 0 and the row count, when rows map to lines one to one.
-
-    Raises
-    ------
-    DataError
-        No header, a refused header, no row, a malformed row (its line), a declared row
-        count the file cannot hold (refused before anything is allocated) or other than
-        the rows found.
-    """
-    regular_file(path)
-    with open(path, "rb") as fb:
-        recorded = None
-        lineno = 0
-        names: list[str] | None = None
-        while raw := fb.readline():
-            lineno += 1
-            try:
-                s = raw.decode("utf-8-sig" if lineno == 1 else "utf-8").strip()
-            except UnicodeDecodeError as exc:
-                raise DataError(
-                    f"{path.name}, line {lineno}: not UTF-8 text ({exc.reason})"
-                ) from None
-            if not s:
-                continue
-            if s.startswith("#"):
-                if s.startswith(_ROWS_PREFIX):
-                    recorded = _rows(path, lineno, s[len(_ROWS_PREFIX) :])
-                continue
-            names = [c.strip() for c in s.split(",")]
-            break
-        if names is None:
-            raise DataError(f"{path.name}: no header line ({expected}) found")
-        layout = layout_of(names, lineno)
-        first = lineno + 1
-        start = fb.tell()
-        _check_declared_rows(path, recorded, len(names), fb.seek(0, io.SEEK_END) - start)
-        fb.seek(start)
-        arrays, one_to_one = _parse(path, fb, names, layout, recorded, first)
-    N = next(iter(arrays.values())).shape[0]
-    if N == 0:
-        raise DataError(f"{path.name}: no data rows after the header")
-    check_row_count(path, recorded, N)
-    for k in list(arrays):  # immutable one at a time (TorqueLog keeps them without a copy):
-        arrays[k] = _checks.frozen(arrays.pop(k))  # the copy of one array at a time only
-    return arrays, ((first, N) if one_to_one else None)
-
-
-def _check_declared_rows(path: Path, recorded: int | None, width: int, size: int) -> None:
-    """Refuse a ``# rows:`` count that ``size`` bytes of rows of ``width`` cells cannot
-    hold (each row is at least one character and a separator per cell), before the
-    arrays for that count are allocated."""
-    if recorded is not None and recorded > size // (2 * width):
-        raise DataError(
-            f"{path.name}: the file records {recorded} rows but its {size} bytes of data hold "
-            f"at most {size // (2 * width)}; it is incomplete or was edited; regenerate it, or, "
-            "if rows were removed on purpose, correct or delete its '# rows:' line"
-        )
-
-
-#: Bytes of CSV text parsed at a time (bounded memory whatever the file size).
-_CHUNK_BYTES = 32 << 20
-
-
-def _parse(
-    path: Path,
-    fb: IO[bytes],
-    names: list[str],
-    layout: dict[str, list[int]],
-    n_rows: int | None,
-    first: int,
-) -> tuple[dict[str, NDArray[np.float64]], bool]:
-    """Parse the data rows a chunk of text at a time straight into the per-signal arrays,
-    and say whether rows map to lines one to one (no blank or comment line skipped).
-
-    Each chunk is read by numpy's C number reader; a chunk that is not a clean table of
-    numbers (an empty cell, a comment line, a short row, a word) is read line by line, to
-    NaN for an empty cell or a column no array takes, or to an error naming the line.
-    Memory: the arrays and one chunk, whatever the file.
-    """
-    width = len(names)
-    used = sorted({c for cols in layout.values() for c in cols})
-    blocks: dict[str, list[NDArray[np.float64]]] = {k: [] for k in layout}
-    out: dict[str, NDArray[np.float64]] | None = None
-    if n_rows is not None and n_rows > 0:
-        out = {k: np.empty((n_rows, len(c))) for k, c in layout.items()}
-    row, line = 0, first
-    tail = b""
-    one_to_one = True
-    while True:
-        chunk = fb.read(_CHUNK_BYTES)
-        last = not chunk
-        buf = tail + chunk
-        if last:
-            buf, tail = buf.rstrip() + b"\n", b""
-            if buf == b"\n":
-                break
-        else:
-            cut = buf.rfind(b"\n") + 1
-            buf, tail = buf[:cut], buf[cut:]
-            if not buf:
-                continue
-        lines = buf.count(b"\n")
-        fast = _fast_table(buf, width)
-        if fast is None:
-            table, skipped = _slow_table(path, buf, line, names, used)
-        else:
-            table, skipped = fast
-        one_to_one = one_to_one and not skipped
-        del buf
-        line += lines
-        rows = table.shape[0]
-        if out is not None and n_rows is not None and row + rows <= n_rows:
-            for k, cols in layout.items():
-                out[k][row : row + rows] = table[:, cols]
-        else:
-            if out is not None:  # more rows than recorded: keep going, report later
-                for k in layout:
-                    blocks[k].append(out[k][:row])
-                out = None
-            for k, cols in layout.items():
-                blocks[k].append(table[:, cols])
-        row += rows
-        if last:
-            break
-    if out is not None:
-        return {k: a[:row] if row < a.shape[0] else a for k, a in out.items()}, one_to_one
-    arrays = {
-        k: np.concatenate(b) if b else np.empty((0, len(layout[k]))) for k, b in blocks.items()
-    }
-    return arrays, one_to_one
-
-
-def _fast_table(buf: bytes, width: int) -> tuple[NDArray[np.float64], bool] | None:
-    """The rows of ``buf`` (whole lines) as a table (rows, width) by numpy's C reader,
-    and whether blank lines were skipped; None unless it is a clean table of numbers."""
-    skipped = False
-    if b"\r" in buf:
-        buf = buf.replace(b"\r\n", b"\n")
-    if buf.startswith(b"\n") or b"\n\n" in buf:  # blank lines: skipped
-        skipped = True
-        while b"\n\n" in buf:
-            buf = buf.replace(b"\n\n", b"\n")
-        buf = buf.lstrip(b"\n")
-        if not buf:
-            return np.empty((0, width)), skipped
-    rows = buf.count(b"\n")
-    if b"#" in buf or b",," in buf:
-        return None
-    with warnings.catch_warnings():
-        warnings.simplefilter("error")
-        try:
-            flat = np.fromstring(buf.replace(b"\n", b","), dtype=np.float64, sep=",")
-        except (ValueError, DeprecationWarning):
-            return None
-    if flat.size != rows * width:
-        return None
-    return flat.reshape(rows, width), skipped
-
-
-def _slow_table(
-    path: Path, buf: bytes, first: int, names: list[str], used: list[int]
-) -> tuple[NDArray[np.float64], bool]:
-    """The rows of ``buf`` read line by line (the first is line ``first``): blank and
-    comment lines skipped (said by the flag), an empty cell and a column not in ``used``
-    NaN, anything else in a used column a number or an error naming the line."""
-    width = len(names)
-    try:
-        text = buf.decode("utf-8")
-    except UnicodeDecodeError as exc:
-        line = first + buf[: exc.start].count(b"\n")
-        raise DataError(f"{path.name}, line {line}: not UTF-8 text ({exc.reason})") from None
-    lines = text.split("\n")[:-1]
-    del text
-    table = np.full((len(lines), width), np.nan)  # 8 bytes a cell, not a Python float
-    rows = 0
-    skipped = False
-    for i, raw in enumerate(lines, start=first):
-        s = raw.strip()
-        if not s or s.startswith("#"):
-            skipped = True
-            continue
-        cells = s.split(",")
-        if len(cells) != width:
-            raise DataError(
-                f"{path.name}, line {i}: expected {width} fields like the header; got {len(cells)}"
-            )
-        for k in used:
-            c = cells[k].strip()
-            if c:
-                try:
-                    table[rows, k] = _checks.decimal(c)
-                except ValueError:
-                    raise DataError(
-                        f"{path.name}, line {i}, column {names[k]!r}: not a number: {c[:40]!r}"
-                    ) from None
-        rows += 1
-    return table[:rows], skipped
-
-
-def _rows(path: Path, lineno: int, text: str) -> int:
-    try:
-        return _checks.integer(text)
-    except ValueError:
-        raise DataError(f"{path.name}, line {lineno}: '# rows:' must give an integer") from None

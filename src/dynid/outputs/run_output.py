@@ -13,7 +13,8 @@
 * **Success.** The complete set moves into place: onto a new ``--out`` by one rename;
   into an existing folder file by file (each a rename, with the previous version kept
   aside until the whole set is in place, and put back if a move fails). Termination
-  signals are held back during those milliseconds.
+  signals are held back from the move to the run's end: one that arrives once the set
+  is in place is reported as late and the run completes; one before, nothing moved.
 * **Ownership.** A folder records the set of its last run in ``.dynid-run.json`` (command,
   files, time). A run of the same command replaces that set as a whole: files of the old
   set that the new run does not write are removed once the new set is complete. Files
@@ -38,10 +39,12 @@ Without ``fcntl`` (not POSIX) runs are not locked against each other; the rest h
 from __future__ import annotations
 
 import contextlib
+import logging
 import os
 import shutil
 import signal
 import tempfile
+import threading
 import time
 from collections.abc import Iterator, Sequence
 from pathlib import Path
@@ -61,6 +64,7 @@ __all__ = ["MANIFEST", "RunOutput", "run_output"]
 MANIFEST = ".dynid-run.json"
 _SCHEMA = "dynid-run/1"
 _STAGING = ".dynid-"
+_log = logging.getLogger(__name__)
 #: Signals held back while a set moves into place (the command line turns them into exits).
 _HELD = tuple(
     getattr(signal, s) for s in ("SIGINT", "SIGTERM", "SIGHUP", "SIGQUIT") if hasattr(signal, s)
@@ -94,16 +98,42 @@ def _folder_lock(folder: Path) -> Iterator[None]:
 
 
 @contextlib.contextmanager
-def _signals_held() -> Iterator[None]:
-    """Block the termination signals inside the block; pending ones arrive after it."""
-    if not hasattr(signal, "pthread_sigmask"):  # pragma: no cover - not POSIX
-        yield
-        return
-    old = signal.pthread_sigmask(signal.SIG_BLOCK, _HELD)
+def _signals_held() -> Iterator[list[int]]:
+    """Hold the termination signals back inside the block; yields the list of those that
+    arrived meanwhile (filled when the block ends), which are not delivered when the block
+    ends normally and are delivered again when it raises.
+
+    Blocked in this thread, and, in the main thread, their handlers replaced by a record
+    of their arrival: a signal that another thread takes still runs its handler in the
+    main thread, and one left pending would arrive right after the block, both when the
+    set is already in place (a complete folder, and an exit as interrupted).
+    """
+    arrived: list[int] = []
+    handlers = {}
+    if threading.current_thread() is threading.main_thread():
+        for s in _HELD:
+            h = signal.getsignal(s)
+            if h is not None:  # a handler Python can put back
+                handlers[s] = h
+                signal.signal(s, lambda signum, frame: arrived.append(signum))
+    blocking = hasattr(signal, "pthread_sigmask")
+    old = signal.pthread_sigmask(signal.SIG_BLOCK, _HELD) if blocking else set()
+    ok = False
     try:
-        yield
+        yield arrived
+        ok = True
     finally:
-        signal.pthread_sigmask(signal.SIG_SETMASK, old)
+        if blocking:
+            for s in sorted(signal.sigpending() & set(_HELD)):  # taken here, not after
+                with contextlib.suppress(OSError):
+                    if signal.sigtimedwait([s], 0) is not None:
+                        arrived.append(s)
+            signal.pthread_sigmask(signal.SIG_SETMASK, old)
+        for s, h in handlers.items():
+            signal.signal(s, h)
+        if not ok:
+            for s in dict.fromkeys(arrived):  # the set did not move: stop as asked
+                signal.raise_signal(s)
 
 
 def _is_temporary(name: str, targets: set[str]) -> bool:
@@ -216,7 +246,27 @@ class RunOutput:
         atomic._REDIRECTS.append(self)
 
     def close(self, ok: bool) -> None:
-        """Move the set into place (``ok``) or drop it; the staging folder goes either way."""
+        """Move the set into place (``ok``) or drop it; the staging folder goes either way.
+
+        With ``ok`` the termination signals are held back from the move to the end (the
+        staging folder's removal included): a signal that arrives once the set is in place
+        does not turn a complete run into an interrupted one (a warning says it came late);
+        one that arrives before is delivered when nothing has moved.
+        """
+        if not ok:
+            self._close(ok)
+            return
+        with _signals_held() as arrived:
+            self._close(ok)
+        if arrived and self.committed:
+            names = ", ".join(signal.Signals(s).name for s in dict.fromkeys(arrived))
+            _log.warning(
+                "%s arrived once the outputs of %s were in place; the run completed",
+                names,
+                self.given,
+            )
+
+    def _close(self, ok: bool) -> None:
         try:
             if ok:
                 self._commit()
@@ -376,9 +426,8 @@ class RunOutput:
             return
         self._check_targets(names, set())
         assert self.staging is not None
-        with _signals_held():
-            os.replace(self.staging / names[0], self.out)
-            self._remove_stale_temporaries(self.out.parent, {self.out.name})
+        os.replace(self.staging / names[0], self.out)
+        self._remove_stale_temporaries(self.out.parent, {self.out.name})
 
     def _commit_folder(self, names: list[str]) -> None:
         assert self.staging is not None
@@ -388,15 +437,14 @@ class RunOutput:
             self._check_other_command(old)
         owned = self._owned()
         self._check_targets(names, owned)
-        with _signals_held():
-            if not os.path.lexists(out):
-                # a new folder: the whole set appears at once
-                _write_manifest(self.staging, self._record(names, "complete"))
-                os.chmod(self.staging, 0o777 & ~_umask())
-                os.rename(self.staging, out)
-                self.staging = None
-                return
-            self._move_into(out, names, owned)
+        if not os.path.lexists(out):
+            # a new folder: the whole set appears at once
+            _write_manifest(self.staging, self._record(names, "complete"))
+            os.chmod(self.staging, 0o777 & ~_umask())
+            os.rename(self.staging, out)
+            self.staging = None
+            return
+        self._move_into(out, names, owned)
 
     def _move_into(self, out: Path, names: list[str], owned: set[str]) -> None:
         """Move the staged ``names`` into the existing ``out``; put everything back on error."""

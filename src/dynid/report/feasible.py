@@ -3,7 +3,8 @@ are the link parameters physically consistent, how close to the coefficients, ho
 the prior.
 
 The verdict: consistent or not, the residual on the coefficients, the smallest margin of
-the constraints, the total mass against its band, the bounds the result sits on. Below it:
+the constraints, the total mass against its band, the bounds the result sits on, the links
+found implausible (either of the last two: not good, usable with reservations). Below it:
 per link the mass with its bounds, the prior's mass and the difference, the centre of mass
 with its box, the pseudo-inertia margin; the constraints that are not satisfied; the
 figures (``retrieval.png``, ``comparison.png``).
@@ -70,11 +71,17 @@ def answer(run: RunFiles) -> Answer | None:
         facts.append(
             "Held-out: " + cell({k: v for k, v in held.items() if not isinstance(v, (list, dict))})
         )
+    implausible = [
+        n for n in rep.get("notes") or [] if isinstance(n, str) and n.startswith("implausible")
+    ]
+    facts += [esc(n[0].upper() + n[1:]) for n in implausible]
     good = ok and is_number(res) and res < RESIDUAL_GOOD
-    level = "poor" if not ok else "good" if good and not rep.get("on_bound") else "fair"
+    plain = good and not rep.get("on_bound") and not implausible
+    level = "poor" if not ok else "good" if plain else "fair"
     head = (
         "The link parameters are physically consistent"
-        + (" and reproduce the identified coefficients." if good else ".")
+        + (" and reproduce the identified coefficients" if good else "")
+        + ("; some links are implausible." if implausible else ".")
         if ok
         else "No physically consistent set satisfies the constraints: the closest one is shown."
     )

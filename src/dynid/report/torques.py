@@ -1,10 +1,10 @@
 """The answers of ``dynid validate`` and ``dynid friction``: how well the model predicts the
 log's torques, without and with friction, and which friction law the data chose.
 
-validate: the relative error with and without friction, the errors per joint, the
-measured against the predicted torques. friction: per joint the law chosen and its
-parameters with their units, every candidate law's training and held-out error (the
-chosen one marked), the friction curve over the data.
+validate: the relative error with and without friction (the verdict also judges the worst
+joint's), the errors per joint, the measured against the predicted torques. friction: per
+joint the law chosen and its parameters with their units, every candidate law's training
+and held-out error (the chosen one marked), the friction curve over the data.
 """
 
 from __future__ import annotations
@@ -19,6 +19,11 @@ __all__ = ["friction_answer", "validate_answer"]
 #: Relative validation error [%]: good below GOOD, usable below FAIR (this page's rule of
 #: thumb: the sensor noise is not known to validate, so the error is judged on its own).
 GOOD, FAIR = 5.0, 15.0
+#: Relative error [%] of the worst joint: good below JOINT_GOOD, usable below JOINT_FAIR
+#: (a joint of small torques, a wrist, errs more in relative terms than the log as a
+#: whole, whose error the large torques of the shoulder dominate).
+JOINT_GOOD, JOINT_FAIR = 10.0, 25.0
+_LEVELS = ("good", "fair", "poor")
 
 
 def _names(doc: dict, n: int) -> list[str]:
@@ -58,6 +63,16 @@ def validate_answer(run: RunFiles) -> Answer | None:
         f"{FAIR:g} % (the sensor noise is not known here: compare with identify's "
         "held-out error against its noise floor)",
     ]
+    per = (with_ if isinstance(with_, dict) else without).get("relative_error_percent_per_joint")
+    if isinstance(per, list) and per and all(is_number(p) for p in per):
+        j = max(range(len(per)), key=lambda k: per[k])
+        joint = "good" if per[j] < JOINT_GOOD else "fair" if per[j] < JOINT_FAIR else "poor"
+        level = max(level, joint, key=_LEVELS.index)
+        facts.append(
+            f"Worst joint {esc(_names(doc, len(per))[j])}: relative error "
+            f"<b>{percent(per[j])}</b> (per joint judged good below {JOINT_GOOD:g} %, usable "
+            f"below {JOINT_FAIR:g} %)"
+        )
     rms = doc.get("rms")
     if isinstance(rms, list) and rms:
         worst = max(range(len(rms)), key=lambda j: rms[j])

@@ -40,17 +40,17 @@ from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
-import scipy.linalg
 from numpy.typing import ArrayLike, NDArray
 
 from ... import _checks
 from ...exceptions import DataError, OptionError, ShapeError
 from ...model.robot import Robot
 from ...regressors.base import BaseParameters, base_parameters
-from ...regressors.static import static_regressor, static_vector
+from ...regressors.static import static_vector
 from ..bounds import Bounds, default_bounds
 from ..constraints import UserConstraint, user_constraints
 from ..prior import prior_scales
+from .static_blocks import StaticBlocks, r_factor
 
 __all__ = [
     "DEFAULT_MARGIN",
@@ -529,27 +529,33 @@ def static_problem(
     M = _checks.as_exact("M", M, (N, n, n))
     g = _checks.as_exact("g", g, (N, n))
     base = base_parameters(robot) if base is None else base
+    r = base.rank
     y = static_vector(M, g)  # (N, rows)
-    Yb = base.reduce(static_regressor(robot, q))  # (N, rows, r)
+    if y.size < r:
+        raise DataError(f"{y.size} stacked rows < {r} coefficients; add configurations")
+    blocks = StaticBlocks(robot, q, base)
+    ss = np.zeros(y.shape[1])  # per row of s: the sum of squares of its regressor rows
+    for _, Yb in blocks:
+        ss += np.einsum("bkc,bkc->k", Yb, Yb)
     rms = np.sqrt(np.mean(y**2, axis=0))
-    rms_reg = np.sqrt(np.mean(np.sum(Yb**2, axis=2), axis=0))
+    rms_reg = np.sqrt(ss / N)
     informative = rms_reg > 1e-12 * max(float(rms_reg.max(initial=0.0)), 1e-300)
     floor = 1e-6 * float(rms.max(initial=0.0)) or 1.0
     w = np.where(informative, 1.0 / np.maximum(rms, floor), 0.0)
-    W = (Yb * w[None, :, None]).reshape(-1, base.rank)
-    yw = (y * w[None, :]).reshape(-1)
-    if W.shape[0] < base.rank:
-        raise DataError(f"{W.shape[0]} stacked rows < {base.rank} coefficients; add configurations")
+    # R of [W, y] accumulated block by block (weighted, and unweighted for the report):
+    # its first r columns are R of W, its last Q^T y and, below, the residual's norm
+    Ra = Ru_a = None
+    for sl, Yb in blocks:
+        Ra = r_factor(Ra, (Yb * w[None, :, None]).reshape(-1, r), (y[sl] * w).reshape(-1))
+        Ru_a = r_factor(Ru_a, Yb.reshape(-1, r), y[sl].reshape(-1))
+    assert Ra is not None and Ru_a is not None
+    yw = y * w[None, :]
+    R, qy = Ra[:r, :r], Ra[:r, r]
+    Ru, qyu = Ru_a[:r, :r], Ru_a[:r, r]
+    ny2 = float(np.sum(yw * yw))
+    k = np.sqrt(r / ny2) if ny2 > 0 else 1.0
+    yu2 = float(np.sum(y * y))
     P = base.projection
-    Q, R = scipy.linalg.qr(W, mode="economic")
-    qy = Q.T @ yw
-    ny2 = float(yw @ yw)
-    k = np.sqrt(base.rank / ny2) if ny2 > 0 else 1.0
-    # unweighted copy for the reported residual
-    Wu = Yb.reshape(-1, base.rank)
-    yu = y.reshape(-1)
-    Qu, Ru = scipy.linalg.qr(Wu, mode="economic")
-    qyu = Qu.T @ yu
     b, band, ucs = _common(robot, bounds, total_mass, extra, margin)
     lo, hi = _box(b, margin)
     return PenaltyProblem(
@@ -565,7 +571,7 @@ def static_problem(
         margin=float(margin),
         report_A=_checks.frozen(Ru @ P),
         report_b=_checks.frozen(qyu),
-        report_offset=max(float(yu @ yu) - float(qyu @ qyu), 0.0),
-        report_norm=float(np.linalg.norm(yu)),
+        report_offset=max(yu2 - float(qyu @ qyu), 0.0),
+        report_norm=float(np.sqrt(yu2)),
         kind="static",
     )

@@ -1,0 +1,61 @@
+"""The tables the commands print: columns aligned whatever the names' lengths."""
+
+from __future__ import annotations
+
+from types import SimpleNamespace
+
+import numpy as np
+
+from dynid.cli.summaries import format_newton_euler_rms, format_rms_table, selection_lines
+
+
+def _column_ends(line: str) -> list[int]:
+    """Where each run of non-blank characters ends (the right edges of right-aligned cells)."""
+    ends, inside = [], False
+    for k, ch in enumerate(line + " "):
+        if ch != " " and not inside:
+            inside = True
+        elif ch == " " and inside:
+            inside = False
+            ends.append(k)
+    return ends
+
+
+def test_the_rms_table_stays_aligned_with_long_joint_names():
+    """Joint names longer than the first column (and a short one) keep every value's right
+    edge under its header's (a long name pushed its row's values right)."""
+    names = ["j1", "a_very_long_joint_name_of_a_wrist", "elbow"]
+    cols = {"RMS[Nm]": np.array([0.1, 22.5, 3.0]), "a_long_column_title_[Nm]_of_a_tool": np.ones(3)}
+    lines = format_rms_table(names, cols).splitlines()
+    assert len({len(s) for s in lines}) == 1, lines
+    ends = _column_ends(lines[0])[-2:]  # the two value columns (the header's words end there)
+    for line in lines[1:]:
+        assert _column_ends(line)[-2:] == ends, lines
+
+
+def test_the_newton_euler_table_stays_aligned_with_short_and_long_names():
+    """The Newton-Euler table: names shorter than 'joint' align too."""
+    errors = SimpleNamespace(rms=np.array([0.5, 1.25]), relative_error_percent=3.0)
+    reference = SimpleNamespace(rms=np.array([0.4, 1.0]))
+    val = SimpleNamespace(
+        joint_names=("j1", "j2"),
+        errors=errors,
+        errors_reference=reference,
+        friction_kind="",
+    )
+    lines = format_newton_euler_rms(val).splitlines()[:-1]
+    assert len({len(s) for s in lines}) == 1, lines
+    assert _column_ends(lines[1])[-2:] == _column_ends(lines[2])[-2:]
+    assert _column_ends(lines[0])[-1] == _column_ends(lines[1])[-1]
+
+
+def test_the_structure_table_stays_aligned_with_a_long_structure_name():
+    """A structure name over the usual width keeps the numbers of every row aligned."""
+    cands = [
+        {"name": n, "n_params": 40, "train_error_percent": 1.5, "heldout_error_percent": 2.0}
+        | {"heldout_se_percent": 0.1}
+        for n in ("base", "base + armature + viscous + coulomb on every joint of the arm")
+    ]
+    sel = {"validation": "5 folds", "chosen": "base", "rule": "lowest", "candidates": cands}
+    lines = selection_lines(sel)[1:]
+    assert len({len(s) for s in lines}) == 1, lines
