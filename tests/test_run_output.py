@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import contextlib
 import fcntl
+import importlib
 import io
 import json
 import os
@@ -413,7 +414,7 @@ def test_ctrl_c_during_the_move_completes_the_run(tmp_path, monkeypatch, caplog,
     the complete set into an interrupted run: the block ends normally, the folder holds
     the whole set, and a warning says the signal came late (before the fix the signal was
     delivered right after the move: a complete folder, and an exit as interrupted)."""
-    from dynid.io import run_output as ro
+    ro = importlib.import_module("dynid.outputs.run_output")
     from dynid.io.atomic import write_text
 
     out = tmp_path / "o"
@@ -439,7 +440,7 @@ def test_ctrl_c_during_the_move_completes_the_run(tmp_path, monkeypatch, caplog,
 def test_ctrl_c_during_a_move_that_fails_is_an_interrupt_and_moves_nothing(tmp_path, monkeypatch):
     """Ctrl-C held back during a move that then fails: the folder is put back as it was
     and the interrupt is delivered (nothing published, exit as interrupted)."""
-    from dynid.io import run_output as ro
+    ro = importlib.import_module("dynid.outputs.run_output")
     from dynid.io.atomic import write_text
 
     out = tmp_path / "o"
