@@ -34,7 +34,6 @@ from pathlib import Path
 from typing import Any
 
 from ..exceptions import DynidError
-from ..friction.model import DriveFriction
 from ..friction.mujoco import coulomb_viscous_from_sigmoid
 from ..io.export import EXPORT_FORMATS, export_format, model_terms_of, save_robot
 from ..io.robot.urdf_patch import MERGED_POLICIES
@@ -97,12 +96,8 @@ def run(args: argparse.Namespace, console: Console) -> int:
     friction: Any = False if args.no_friction else True
     if linear is not None and not args.no_friction:
         friction = linear
-        if (
-            drive is not None
-            and drive.friction_at == "motor"
-            and not isinstance(linear, DriveFriction)
-        ):
-            friction = DriveFriction(linear, drive)
+        if drive is not None and drive.friction_at == "motor" and linear.drive is None:
+            friction = linear.at(drive)
     path = save_robot(
         args.out,
         robot,

@@ -29,7 +29,7 @@ from numpy.typing import NDArray
 from .. import __version__, _checks
 from ..exceptions import DataError, DynidWarning, ModelError, ShapeError
 from ..feasibility.result import FeasibleResult
-from ..friction.model import ClassicalFriction, DriveFriction
+from ..friction.model import ClassicalFriction, Friction
 from ..model.drive import Drive
 from ..model.inertia import (
     INERTIA_ORDER,
@@ -292,12 +292,13 @@ def load_feasible_json(path: str | Path, robot: Robot | None = None) -> Robot:
         raise DataError(f"{name}: {exc}") from exc
 
 
-def load_feasible_linear_friction(path: str | Path) -> ClassicalFriction | DriveFriction | None:
+def load_feasible_linear_friction(path: str | Path) -> Friction | None:
     """The classical friction (``fv, fc, fo`` per joint) held by ``feasible.json``, or None.
 
     Written by a consistent identification from a torque log; ``dynid validate --params``
     uses it unless another friction is given. With a drive whose friction acts at the
-    motors, the law per motor mapped through the transmission (:class:`DriveFriction`).
+    motors, the law per motor mapped through the transmission (a
+    :class:`~dynid.friction.model.Friction` with the drive).
     """
     d = load_json(path)
     lin = d.get("linear_friction")
@@ -312,7 +313,7 @@ def load_feasible_linear_friction(path: str | Path) -> ClassicalFriction | Drive
     except (KeyError, TypeError):
         raise DataError(f"{name}: linear_friction needs fv, fc, fo per joint") from None
     drive = load_feasible_drive(path)
-    return DriveFriction(law, drive) if drive is not None and drive.friction_at == "motor" else law
+    return law.at(drive) if drive is not None and drive.friction_at == "motor" else law
 
 
 def load_feasible_drive(path: str | Path) -> Drive | None:

@@ -78,7 +78,7 @@ def robot_from_dict(d: Mapping[str, Any]) -> Robot:
         n = len(d["joint_names"])
         limits = d["limits"]
         sign = {"q_min": -1.0}
-        lim = {
+        lim: dict[str, Any] = {
             k: np.array(
                 [
                     sign.get(k, 1.0) * np.inf if v is None else _number(v, f"limits.{k}")
