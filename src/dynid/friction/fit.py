@@ -511,7 +511,7 @@ def fit_law_through(
     At the motors the joint residual ``r`` becomes motor torques ``K^-T r`` at the motor
     velocities ``K dq`` (exact: ``K`` is invertible), each motor is fitted on its own
     (:func:`fit_law`, the motor velocity noise ``sqrt(K^2 sigma^2)`` setting the standstill
-    band), and the result is a :class:`~dynid.friction.model.DriveFriction` whose RMS
+    band), and the result is a :class:`~dynid.friction.model.Friction` at the drive whose RMS
     before and after are those of the joint torques. Without a drive (or with friction at
     the joints) the joints are fitted.
 
