@@ -119,6 +119,17 @@ def test_a_robot_holds_any_law():
         r.replace(friction=PARAMS["sigmoid"])
 
 
+@pytest.mark.parametrize("name", sorted(LAWS))
+def test_a_robot_with_any_law_pickles(name):
+    """Robots go to worker processes: each law, with its drive, pickles and evaluates the same."""
+    import pickle
+
+    fr = LAWS[name].model(PARAMS[name], BAND, Drive(K, np.zeros(2)))
+    back = pickle.loads(pickle.dumps(_two_joints().with_friction(fr))).friction_model
+    dq = _velocities()
+    np.testing.assert_array_equal(back.torques(dq), fr.torques(dq))
+
+
 def test_a_simulation_applies_the_robots_own_law():
     """``friction="robot"`` with a classical law on the robot: tau = rnea + eq. 24."""
     from dynid.simulation.measurement import SensorNoise, simulate_measurement
@@ -171,6 +182,15 @@ def test_urdf_writes_any_law_and_says_in_one_line_what_it_drops(tmp_path):
         plain = ClassicalFriction(P[:, 0], P[:, 2], np.zeros(2))
         save_robot(tmp_path / "own.urdf", robot.with_friction(plain), friction=True)
     np.testing.assert_allclose(_dynamics(tmp_path / "own.urdf"), P[:, [0, 2]], rtol=1e-15)
+
+
+def test_a_robot_description_says_it_does_not_hold_another_law(tmp_path):
+    from dynid.io.robot.toml import robot_from_toml_string, toml_from_robot
+
+    robot = _two_joints().with_friction(ClassicalFriction.from_array(PARAMS["classical"]))
+    with pytest.warns(DynidWarning, match="classical friction is not part of a robot desc"):
+        text = toml_from_robot(robot)
+    assert robot_from_toml_string(text).friction is None
 
 
 def test_friction_json_of_the_sigmoid_has_no_band_and_reads_back(tmp_path):

@@ -259,18 +259,36 @@ class Friction:
         return self.drive.joint_friction(f)
 
 
-def _columns_fit(
-    columns: Callable[[NDArray[np.float64], NDArray[np.float64]], NDArray[np.float64]],
-    lower: tuple[float, ...],
-    upper: tuple[float, ...],
-) -> Fit:
-    lo, hi = np.asarray(lower, dtype=np.float64), np.asarray(upper, dtype=np.float64)
+#: ``columns(dq (..., n), band (n,)) -> (..., n, k)``: a linear law's regressor.
+Columns = Callable[[NDArray[np.float64], NDArray[np.float64]], NDArray[np.float64]]
 
-    def fit(dq: NDArray[np.float64], r: NDArray[np.float64], band: float) -> JointFit:
-        A = columns(dq[:, None], np.array([band]))[:, 0, :]
+
+@dataclass(frozen=True, slots=True)
+class _LinearTorques:
+    """``torques`` of a linear law (a module-level class: the law pickles)."""
+
+    columns: Columns
+
+    def __call__(
+        self, dq: NDArray[np.float64], P: NDArray[np.float64], band: NDArray[np.float64]
+    ) -> NDArray[np.float64]:
+        out: NDArray[np.float64] = np.einsum("...jk,jk->...j", self.columns(dq, band), P)
+        return out
+
+
+@dataclass(frozen=True, slots=True)
+class _LinearFit:
+    """``fit`` of a linear law: bounded linear least squares on its columns."""
+
+    columns: Columns
+    lower: tuple[float, ...]
+    upper: tuple[float, ...]
+
+    def __call__(self, dq: NDArray[np.float64], r: NDArray[np.float64], band: float) -> JointFit:
+        A = self.columns(dq[:, None], np.array([band]))[:, 0, :]
+        lo = np.asarray(self.lower, dtype=np.float64)
+        hi = np.asarray(self.upper, dtype=np.float64)
         return JointFit(bounded_lstsq(A, r, lo, hi))
-
-    return fit
 
 
 def bounded_lstsq(
@@ -299,7 +317,7 @@ def linear_law(
     params: tuple[str, ...],
     units: tuple[str, ...],
     formula: str,
-    columns: Callable[[NDArray[np.float64], NDArray[np.float64]], NDArray[np.float64]],
+    columns: Columns,
     lower: tuple[float, ...],
     upper: tuple[float, ...],
     mjcf: Mjcf,
@@ -311,12 +329,5 @@ def linear_law(
     bounded linear least squares of :func:`bounded_lstsq`; ``canonical`` as in
     :class:`FrictionLaw`.
     """
-
-    def torques(
-        dq: NDArray[np.float64], P: NDArray[np.float64], band: NDArray[np.float64]
-    ) -> NDArray[np.float64]:
-        out: NDArray[np.float64] = np.einsum("...jk,jk->...j", columns(dq, band), P)
-        return out
-
-    fit = _columns_fit(columns, lower, upper)
+    torques, fit = _LinearTorques(columns), _LinearFit(columns, lower, upper)
     return FrictionLaw(name, params, units, formula, torques, fit, lower, upper, mjcf, canonical)
