@@ -3,6 +3,7 @@ the joints and through a coupled drive; the constructors; a robot holding any la
 
 from __future__ import annotations
 
+import importlib
 import json
 import warnings
 
@@ -53,6 +54,10 @@ def test_each_law_evaluates_as_its_registry_module_at_the_joints(name):
     assert isinstance(fr, Friction) and fr.kind == name and fr.drive is None
     np.testing.assert_array_equal(fr.band, band)
     np.testing.assert_allclose(fr.torques(dq), law.torques(dq, P, band), rtol=0, atol=1e-15)
+    module = importlib.import_module(f"dynid.friction.laws.{name}")
+    if hasattr(module, "columns"):  # a linear law: its regressor times its parameters
+        C = module.columns(dq, band)
+        np.testing.assert_allclose(fr.torques(dq), np.einsum("sjk,jk->sj", C, P), atol=1e-15)
     # a single sample: (n,) in, (n,) out
     np.testing.assert_allclose(fr.torques(dq[0]), law.torques(dq[:1], P, band)[0], atol=1e-15)
 

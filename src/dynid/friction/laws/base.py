@@ -322,12 +322,15 @@ def linear_law(
     upper: tuple[float, ...],
     mjcf: Mjcf,
     canonical: Canonical | None = None,
+    torques: Torques | None = None,
 ) -> FrictionLaw:
     """A law linear in its parameters, ``tau_f,j = columns(dq, band)[..., j, :] @ p_j``.
 
     ``columns(dq (..., n), band (n,))`` gives the regressor (..., n, k); the fit is the
     bounded linear least squares of :func:`bounded_lstsq`; ``canonical`` as in
-    :class:`FrictionLaw`.
+    :class:`FrictionLaw`; ``torques``, when given, the same torques in closed form (faster
+    than the columns' product; default that product).
     """
-    torques, fit = _LinearTorques(columns), _LinearFit(columns, lower, upper)
-    return FrictionLaw(name, params, units, formula, torques, fit, lower, upper, mjcf, canonical)
+    tau = _LinearTorques(columns) if torques is None else torques
+    fit = _LinearFit(columns, lower, upper)
+    return FrictionLaw(name, params, units, formula, tau, fit, lower, upper, mjcf, canonical)

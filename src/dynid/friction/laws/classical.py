@@ -15,7 +15,7 @@ from __future__ import annotations
 import numpy as np
 from numpy.typing import NDArray
 
-from ..torques import coulomb_sign
+from ..torques import classical_friction, coulomb_sign
 from .base import MjcfTerms, canonical_rows, linear_law
 
 __all__ = ["LAW", "columns"]
@@ -35,6 +35,13 @@ def _canonical(P: NDArray[np.float64], band: NDArray[np.float64]) -> NDArray[np.
     return canonical_rows(band, fv_pos=fv, fv_neg=fv, fc_pos=fc, fc_neg=fc, fo=fo)
 
 
+def _torques(
+    dq: NDArray[np.float64], P: NDArray[np.float64], band: NDArray[np.float64]
+) -> NDArray[np.float64]:
+    """``fv dq + fc s(dq) + fo`` in closed form (the columns' product, faster)."""
+    return classical_friction(dq, P[:, 0], P[:, 1], P[:, 2], band)
+
+
 LAW = linear_law(
     "classical",
     ("fv", "fc", "fo"),
@@ -46,4 +53,5 @@ LAW = linear_law(
     (np.inf, np.inf, np.inf),
     _mjcf,
     _canonical,
+    _torques,
 )
