@@ -422,7 +422,7 @@ def test_friction_fitted_per_motor_through_the_coupled_drive(tmp_path):
     res = friction_residual(m, held, cutoff_hz=None)  # read through the model's drive
     fit = fit_friction_through(res, m.drive, "classical")
     assert isinstance(fit.friction, DriveFriction)
-    law = fit.friction.law
+    law = fit.friction
     np.testing.assert_allclose(law.fv, FV, rtol=1e-6)
     np.testing.assert_allclose(law.fc, FC, rtol=1e-6)
     np.testing.assert_allclose(law.fo, FO, rtol=1e-5, atol=1e-9)

@@ -252,7 +252,7 @@ def test_a_law_at_the_motors_is_fitted_per_motor():
     tau = np.stack([REFERENCE["asymmetric"][0](vm[:, m], P[m], band[m]) for m in range(2)], 1)
     tau = tau @ K + rng.normal(0.0, TAU_NOISE, dq.shape)
     fit = fit_law_through("asymmetric", dq, tau, drive, dq_noise_std=np.full(2, DQ_NOISE))
-    assert isinstance(fit.friction, DriveFriction) and isinstance(fit.friction.law, LawFriction)
+    assert isinstance(fit.friction, DriveFriction) and isinstance(fit.friction, LawFriction)
     np.testing.assert_allclose(fit.friction.as_array(), P, rtol=0.02, atol=0.01)
 
 

@@ -59,6 +59,7 @@ if TYPE_CHECKING:  # the names as static imports, for type checkers and editors
     from .friction.fit import FrictionFit, fit_friction
     from .friction.model import (
         ClassicalFriction,
+        Friction,
         SigmoidFriction,
         classical_friction,
         sigmoid_friction,
@@ -114,6 +115,7 @@ _LAZY: dict[str, tuple[str, str]] = {
     "ExcitationResult": ("simulation.excitation", "ExcitationResult"),
     "ExcitingTrajectory": ("simulation.excitation", "ExcitingTrajectory"),
     "Frame": ("model.robot", "Frame"),
+    "Friction": ("friction.model", "Friction"),
     "FrictionFit": ("friction.fit", "FrictionFit"),
     "IKOptions": ("kinematics.inverse", "IKOptions"),
     "IKResult": ("kinematics.inverse", "IKResult"),
@@ -186,6 +188,7 @@ __all__ = [
     "ExcitationResult",
     "ExcitingTrajectory",
     "Frame",
+    "Friction",
     "FrictionFit",
     "IKOptions",
     "IKResult",

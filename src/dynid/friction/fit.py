@@ -50,7 +50,7 @@ from ..identification.sanity import moving_joints, noise_band, velocity_noise_st
 from ..model.drive import Drive
 from ..model.robot import Robot
 from .laws import FrictionLaw, law_named
-from .model import DriveFriction, FrictionModel
+from .model import FrictionModel
 
 __all__ = [
     "FrictionFit",
@@ -230,8 +230,8 @@ class FrictionFit:
 
     Attributes
     ----------
-    friction : SigmoidFriction or ClassicalFriction
-        Fitted parameters per joint.
+    friction : Friction
+        The fitted law with its parameters per joint (per motor at the motors of a drive).
     rms_before : ndarray, shape (n,)
         RMS of the residual without friction compensation [N m].
     rms_after : ndarray, shape (n,)
@@ -511,7 +511,7 @@ def fit_law_through(
     At the motors the joint residual ``r`` becomes motor torques ``K^-T r`` at the motor
     velocities ``K dq`` (exact: ``K`` is invertible), each motor is fitted on its own
     (:func:`fit_law`, the motor velocity noise ``sqrt(K^2 sigma^2)`` setting the standstill
-    band), and the result is a :class:`~dynid.friction.model.DriveFriction` whose RMS
+    band), and the result is a :class:`~dynid.friction.model.Friction` at the drive whose RMS
     before and after are those of the joint torques. Without a drive (or with friction at
     the joints) the joints are fitted.
 
@@ -548,7 +548,7 @@ def fit_law_through(
     r = np.asarray(np.linalg.solve(K.T, residual.T).T, dtype=np.float64)
     noise = None if dq_noise_std is None else np.sqrt((K**2) @ np.asarray(dq_noise_std) ** 2)
     fit = fit_law(law, v, r, dq_noise_std=noise, warn=warn)
-    fr = DriveFriction(fit.friction, drive)  # type: ignore[arg-type]  # a law per motor
+    fr = fit.friction.at(drive)  # the law per motor
     after = residual - fr.torques(dq)
     return replace(
         fit,

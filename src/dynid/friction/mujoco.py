@@ -25,9 +25,8 @@ from numpy.typing import ArrayLike, NDArray
 
 from .. import _checks
 from ..exceptions import ShapeError
-from .laws import LAWS
 from .laws.sigmoid import odd_part
-from .model import DriveFriction, FrictionModel
+from .model import FrictionModel
 
 __all__ = [
     "CoulombViscous",
@@ -195,14 +194,13 @@ def joint_coulomb_viscous(
     -------
     DriveJointTerms
     """
-    law = friction.law if isinstance(friction, DriveFriction) else friction
-    n = law.n
+    n = friction.n
     vmax = np.full(n, 2.0) if dq_max is None else _checks.as_exact("dq_max", dq_max, (n,))
-    terms = LAWS[law.kind].mjcf(law.as_array(), vmax)
-    notes = (f"{law.kind} friction: {terms.dropped} is not expressible in MJCF",) * bool(
+    terms = friction.law.mjcf(friction.as_array(), vmax)
+    notes = (f"{friction.kind} friction: {terms.dropped} is not expressible in MJCF",) * bool(
         terms.dropped
     )
-    if isinstance(friction, DriveFriction):
+    if friction.drive is not None:
         d = friction.drive
         jt = drive_joint_terms(
             d.transmission,

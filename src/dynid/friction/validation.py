@@ -39,7 +39,7 @@ from ..model.drive import Drive
 from ..model.robot import Robot
 from .fit import TorqueModel, model_drive, rigid_body_torques
 from .laws import LAWS
-from .model import ClassicalFriction, DriveFriction, FrictionModel, LawFriction, SigmoidFriction
+from .model import FrictionModel, friction_from_array, robot_friction
 
 __all__ = [
     "RECORDED",
@@ -55,22 +55,16 @@ __all__ = [
 
 
 def own_friction(model: TorqueModel) -> FrictionModel | None:
-    """The friction that comes with a model: an IdentifiedModel's classical ``friction``,
-    a Robot's sigmoid ``friction``, or None."""
+    """The friction that comes with a model: an IdentifiedModel's ``friction`` (its law,
+    band and drive), a Robot's own (:func:`~dynid.friction.model.robot_friction`), or None."""
     if isinstance(model, IdentifiedModel) and model.friction is not None:
         fr = model.info.friction
         band = fr.band if fr is not None and fr.band else None
         name = "classical" if fr is None else fr.law
-        law: ClassicalFriction | LawFriction = (
-            ClassicalFriction.from_array(model.friction, band)
-            if name == "classical"
-            else LawFriction(LAWS[name], model.friction, np.asarray(band or ()))
-        )
-        if model.drive is not None and model.drive.friction_at == "motor":
-            return DriveFriction(law, model.drive)
-        return law
-    if isinstance(model, Robot) and model.friction is not None:
-        return SigmoidFriction.from_array(model.friction)
+        at_motors = model.drive is not None and model.drive.friction_at == "motor"
+        return LAWS[name].model(model.friction, band, model.drive if at_motors else None)
+    if isinstance(model, Robot):
+        return robot_friction(model)
     return None
 
 
@@ -377,13 +371,8 @@ def _friction_model(robot: Robot, friction: Any) -> FrictionModel | None:
                 "friction must be 'robot', None, a friction model or an (n, 3) array; "
                 f"got {friction!r}"
             )
-        return None if robot.friction is None else SigmoidFriction.from_array(robot.friction)
-    if friction is None or isinstance(
-        friction, (SigmoidFriction, ClassicalFriction, LawFriction, DriveFriction)
-    ):
-        model = friction
-    else:
-        model = SigmoidFriction.from_array(friction)
+        return robot_friction(robot)
+    model = friction_from_array(friction)
     if model is not None and model.n != robot.n:
         raise ShapeError(f"friction model has {model.n} joints; robot {robot.name!r} has {robot.n}")
     return model

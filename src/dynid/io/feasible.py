@@ -29,7 +29,7 @@ from numpy.typing import NDArray
 from .. import __version__, _checks
 from ..exceptions import DataError, DynidWarning, ModelError, ShapeError
 from ..feasibility.result import FeasibleResult
-from ..friction.model import ClassicalFriction, DriveFriction
+from ..friction.model import ClassicalFriction, Friction
 from ..model.drive import Drive
 from ..model.inertia import (
     INERTIA_ORDER,
@@ -292,19 +292,20 @@ def load_feasible_json(path: str | Path, robot: Robot | None = None) -> Robot:
     return robot_from_feasible_dict(load_json(path), robot, source=Path(path).name)
 
 
-def load_feasible_linear_friction(path: str | Path) -> ClassicalFriction | DriveFriction | None:
+def load_feasible_linear_friction(path: str | Path) -> Friction | None:
     """The classical friction (``fv, fc, fo`` per joint) held by ``feasible.json``, or None.
 
     Written by a consistent identification from a torque log; ``dynid validate --params``
     uses it unless another friction is given. With a drive whose friction acts at the
-    motors, the law per motor mapped through the transmission (:class:`DriveFriction`).
+    motors, the law per motor mapped through the transmission (a
+    :class:`~dynid.friction.model.Friction` with the drive).
     """
     lin = load_document(path, FEASIBLE).get("linear_friction")
     if lin is None:
         return None
     law = ClassicalFriction(*(np.array(lin[k], dtype=float) for k in ("fv", "fc", "fo")))
     drive = load_feasible_drive(path)
-    return DriveFriction(law, drive) if drive is not None and drive.friction_at == "motor" else law
+    return law.at(drive) if drive is not None and drive.friction_at == "motor" else law
 
 
 def load_feasible_drive(path: str | Path) -> Drive | None:

@@ -13,7 +13,7 @@ from pathlib import Path
 from typing import Any
 
 from ..feasibility.result import FeasibleResult
-from ..friction.model import ClassicalFriction, DriveFriction
+from ..friction.model import ClassicalFriction
 from .export import ROBOT_FORMATS, ExportOptions, save_robot_files
 from .feasible import save_feasible_json
 from .report_json import save_report_json
@@ -63,7 +63,7 @@ def save_feasible_bundle(
     if fr is not None:
         law = ClassicalFriction.from_array(fr)
         at_motors = drive is not None and drive.friction_at == "motor"
-        friction = DriveFriction(law, drive) if drive is not None and at_motors else law
+        friction = law.at(drive) if drive is not None and at_motors else law
     files += save_robot_files(folder, result.robot, ExportOptions(friction=friction, drive=drive))
     files.append(save_report_json(folder / "report.json", result, **report_extra))
     return files

@@ -33,7 +33,7 @@ from .. import _checks
 from ..exceptions import DataError, DynidError
 from ..friction.fit import FrictionFit
 from ..friction.laws import LAWS
-from ..friction.model import DriveFriction, FrictionModel
+from ..friction.model import FrictionModel
 from .drive_file import drive_from_record
 from .json_files import load_json
 from .schema import Field, Format, Record, check, describe, fault, save_document
@@ -69,10 +69,8 @@ def save_friction_json(
         fit, model = friction, friction.friction
     else:
         fit, model = None, friction
-    drive = model.drive if isinstance(model, DriveFriction) else None
-    law = LAWS[model.kind]
-    P = model.as_array()
-    band = getattr(model.law if isinstance(model, DriveFriction) else model, "band", None)
+    drive, law, P = model.drive, model.law, model.as_array()
+    band = model.band if law.standstill else None
     joints = []
     for j in range(model.n):
         d: dict[str, float | bool] = {k: float(P[j, i]) for i, k in enumerate(model.names)}
@@ -137,9 +135,7 @@ def load_friction_json(path: str | Path) -> FrictionModel:
         raise DataError(f"{path.name}: {exc}") from exc
     if doc.get("drive") is None:
         return fr
-    return DriveFriction(
-        fr, drive_from_record(doc["drive"], len(joints), source=path.name, at="drive")
-    )
+    return fr.at(drive_from_record(doc["drive"], len(joints), source=path.name, at="drive"))
 
 
 _WHAT = "friction file (dynid friction)"

@@ -107,7 +107,7 @@ def robot_from_dict(
     check(d, ROBOT_RECORD, source, at=at)
     n = len(d["joint_names"])
     inf = {k: (-np.inf if k == "q_min" else np.inf) for k in _LIMITS}
-    lim = {
+    lim: dict[str, Any] = {
         k: np.array([inf[k] if v is None else float(v) for v in d["limits"][k]], dtype=float)
         for k in _LIMITS
     }

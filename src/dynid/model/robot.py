@@ -24,7 +24,7 @@ from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 from types import MappingProxyType
-from typing import Any
+from typing import Any, Protocol
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -125,6 +125,30 @@ def _restore_robot(state: dict[str, Any]) -> Robot:
     return robot
 
 
+class FrictionLike(Protocol):
+    """What a robot reads of a friction model it holds (the one friction type,
+    :class:`~dynid.friction.model.Friction`, of a later layer)."""
+
+    @property
+    def n(self) -> int:
+        """Number of joints."""
+        ...
+
+    @property
+    def kind(self) -> str:
+        """The law's registry name."""
+        ...
+
+    @property
+    def drive(self) -> Any:
+        """Where the law acts (None: the joints)."""
+        ...
+
+    def as_array(self) -> NDArray[np.float64]:
+        """The parameters (n, k)."""
+        ...
+
+
 @dataclass(frozen=True, slots=True, eq=False, weakref_slot=True)
 class Robot:
     """Immutable serial-chain robot: kinematics, inertial parameters, limits, friction.
@@ -155,7 +179,13 @@ class Robot:
         Named frames; includes every link name and ``flange``.
     friction : ndarray, shape (n, 3), or None
         Sigmoid friction parameters ``phi1 [N m], phi2 [s/rad], phi3 [rad/s]`` per joint
-        (Gaz et al. 2019 eq. 25), or None for no friction model.
+        (Gaz et al. 2019 eq. 25), as the description files hold them; None for none, or
+        when the robot's friction is another law (``friction_model``).
+    friction_model : Friction or None
+        The robot's friction when it is not the sigmoid at the joints: a
+        :class:`~dynid.friction.model.Friction` of any law, standstill band and drive
+        (:meth:`with_friction`); None otherwise. Exclusive with ``friction``;
+        :func:`dynid.friction.model.robot_friction` returns either as a ``Friction``.
     q_neutral : ndarray, shape (n,), or None
         A documented neutral pose (start of IK, demos); None: the middle of the limits.
 
@@ -184,6 +214,7 @@ class Robot:
     frames: Mapping[str, Frame] = field(default_factory=dict)
     friction: NDArray[np.float64] | None = None
     q_neutral: NDArray[np.float64] | None = None
+    friction_model: FrictionLike | None = None
 
     def __post_init__(self) -> None:
         n = len(self.joint_names)
@@ -259,6 +290,15 @@ class Robot:
         )
         if self.friction is not None:
             put("friction", _checks.frozen(_checks.as_exact("friction", self.friction, (n, 3))))
+        if self.friction_model is not None:
+            if self.friction is not None:
+                raise ModelError(
+                    "a robot holds friction (sigmoid parameters) or friction_model (a friction "
+                    "model of any law), not both; use with_friction to replace it"
+                )
+            if self.friction_model.n != n:
+                m = self.friction_model.n
+                raise ShapeError(f"friction_model has {m} joints; robot has {n}")
         if self.q_neutral is not None:
             qn = _checks.as_exact("q_neutral", self.q_neutral, (n,))
             if np.any((qn < self.q_min) | (qn > self.q_max)):
@@ -325,9 +365,18 @@ class Robot:
         """A copy with masses [kg] (n,), CoMs [m] (n, 3), CoM inertias (n, 3, 3) or (n, 6)."""
         return self.replace(phi=phi_from_inertial(mass, com, inertia))
 
-    def with_friction(self, friction: ArrayLike | None) -> Robot:
-        """A copy with sigmoid friction parameters (n, 3), or None."""
-        return self.replace(friction=friction)
+    def with_friction(self, friction: ArrayLike | FrictionLike | None) -> Robot:
+        """A copy with friction: sigmoid parameters (n, 3), a friction model of any law
+        (:class:`~dynid.friction.model.Friction`; the sigmoid at the joints is kept as its
+        parameters, as the description files hold it), or None."""
+        if friction is None:
+            return self.replace(friction=None, friction_model=None)
+        if hasattr(friction, "kind") and hasattr(friction, "as_array"):
+            fr: Any = friction
+            if fr.kind == "sigmoid" and fr.drive is None:
+                return self.replace(friction=fr.as_array(), friction_model=None)
+            return self.replace(friction=None, friction_model=fr)
+        return self.replace(friction=friction, friction_model=None)
 
     def with_gravity(self, gravity: ArrayLike) -> Robot:
         """A copy with the gravity vector (3,) [m/s^2] in the base frame."""

@@ -10,11 +10,12 @@ Every law of the registry (:mod:`dynid.friction.laws`) is a special case of, per
 with ``s`` the sign outside the standstill band (:func:`~dynid.friction.model.coulomb_sign`)
 and ``sigma`` the logistic function; ``tau_f = K_f^T f(K_f dq)`` with ``K_f`` the drive's
 friction transmission (the identity at the joints). The 14 columns per motor, in order:
-``fv+, fv-, fc+, fc-, fo, band, fs - fc, vst, ft, vs, phi1, phi2, phi3, fq``.
+``fv+, fv-, fc+, fc-, fo, band, fs - fc, vst, ft, vs, phi1, phi2, phi3, fq``
+(:data:`~dynid.friction.laws.base.CANONICAL_COLUMNS`).
 
-:func:`canonical_friction` maps a friction model to that form, or returns None for a law it
-does not know (a law added to the registry later): the observer's step then evaluates the
-model's own ``torques`` in Python.
+:func:`canonical_friction` asks the model's law for that form
+(:attr:`~dynid.friction.laws.base.FrictionLaw.canonical`); a law without one (None) has the
+observer's step evaluate the model's own ``torques`` in Python.
 
 :func:`standstill_margin` bounds what such a model cannot know about its friction near rest:
 inside the standstill band the law's Coulomb term is off (or, for ``tanh(v / v_s)``, not yet
@@ -33,59 +34,13 @@ from __future__ import annotations
 import numpy as np
 from numpy.typing import NDArray
 
-from ..friction.model import (
-    ClassicalFriction,
-    DriveFriction,
-    FrictionModel,
-    LawFriction,
-    SigmoidFriction,
-)
+from ..friction.laws.base import CANONICAL_COLUMNS
+from ..friction.model import FrictionModel
 
 __all__ = ["FRICTION_COLUMNS", "canonical_friction", "standstill_margin"]
 
 #: The canonical parameters per motor (module docstring).
-FRICTION_COLUMNS = (
-    "fv_pos", "fv_neg", "fc_pos", "fc_neg", "fo", "band", "fs_minus_fc", "vst", "ft", "vs",
-    "phi1", "phi2", "phi3", "fq",
-)  # fmt: skip
-
-
-def _law_rows(kind: str, P: NDArray[np.float64], band: NDArray[np.float64]) -> NDArray | None:
-    """The canonical rows (n, 14) of a registry law's parameters (n, k), or None."""
-    n = P.shape[0]
-    F = np.zeros((n, len(FRICTION_COLUMNS)))
-    F[:, 5] = band
-    if kind == "none":
-        return F
-    if kind in ("classical", "smooth", "stribeck"):
-        fv, fc, fo = P[:, 0], P[:, 1], P[:, -1]
-        F[:, 0] = F[:, 1] = fv
-        F[:, 4] = fo
-        if kind == "smooth":  # fc tanh(dq / band), the plain sign where band = 0
-            tanh = band > 0
-            F[:, 8] = np.where(tanh, fc, 0.0)
-            F[:, 9] = band
-            F[:, 2] = F[:, 3] = np.where(tanh, 0.0, fc)
-            F[:, 5] = 0.0
-        else:
-            F[:, 2] = F[:, 3] = fc
-        if kind == "stribeck":  # fv, fc, fs, vst, fo
-            F[:, 6] = P[:, 2] - fc
-            F[:, 7] = P[:, 3]
-        return F
-    if kind == "quadratic":  # fv, fq, fc, fo
-        F[:, 0] = F[:, 1] = P[:, 0]
-        F[:, 13] = P[:, 1]
-        F[:, 2] = F[:, 3] = P[:, 2]
-        F[:, 4] = P[:, 3]
-        return F
-    if kind == "asymmetric":  # fv+, fv-, fc+, fc-
-        F[:, :4] = P[:, :4]
-        return F
-    if kind == "sigmoid":
-        F[:, 10:13] = P[:, :3]
-        return F
-    return None
+FRICTION_COLUMNS = CANONICAL_COLUMNS
 
 
 def canonical_friction(
@@ -93,22 +48,12 @@ def canonical_friction(
 ) -> tuple[NDArray[np.float64], NDArray[np.float64]] | None:
     """``(K_f, F)``: the friction transmission (n, n) and the canonical parameters (n, 14)
     of ``friction`` (zeros for None), or None for a law without a canonical form."""
-    K = np.eye(n)
     if friction is None:
-        return K, np.zeros((n, len(FRICTION_COLUMNS)))
-    law: object = friction
-    if isinstance(friction, DriveFriction):
-        K = np.array(friction.drive.friction_transmission, dtype=np.float64)
-        law = friction.law
-    if isinstance(law, SigmoidFriction):
-        F = _law_rows("sigmoid", law.as_array(), np.zeros(n))
-    elif isinstance(law, ClassicalFriction):
-        F = _law_rows("classical", law.as_array(), np.asarray(law.band))
-    elif isinstance(law, LawFriction):
-        F = _law_rows(law.kind, np.asarray(law.params), np.asarray(law.band))
-    else:
+        return np.eye(n), np.zeros((n, len(FRICTION_COLUMNS)))
+    canonical = getattr(friction.law, "canonical", None)  # a law outside the registry: none
+    if canonical is None:
         return None
-    return None if F is None else (K, F)
+    return friction.transmission, canonical(np.asarray(friction.params), np.asarray(friction.band))
 
 
 def standstill_margin(

@@ -22,7 +22,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from .. import _checks
 from ..exceptions import ShapeError
-from ..friction.model import FrictionModel, SigmoidFriction
+from ..friction.model import FrictionModel, robot_friction
 from ..friction.validation import own_friction
 from ..identification.model import IdentifiedModel
 from ..model.drive import Drive
@@ -163,6 +163,6 @@ def from_robot(
         if drive.rotor_inertia is not None:
             Mr = drive.rotor_mass_matrix(drive.rotor_inertia)
     fr: FrictionModel | None = friction if not isinstance(friction, str) else None
-    if isinstance(friction, str) and robot.friction is not None:
-        fr = SigmoidFriction.from_array(robot.friction)
+    if isinstance(friction, str):
+        fr = robot_friction(robot)
     return ObserverModel(robot=robot, rotor_mass=Mr, friction=fr, drive=drive, source="robot")

@@ -31,7 +31,7 @@ from numpy.typing import ArrayLike, NDArray
 from ..exceptions import DynidError
 from ..feasibility.penalty import RetrievalResult, retrieve
 from ..friction.fit import FrictionFit, FrictionResidual, fit_sigmoid, friction_residual
-from ..friction.model import SigmoidFriction
+from ..friction.model import Friction, SigmoidFriction
 from ..friction.validation import (
     NewtonEulerValidation,
     Validation,
@@ -276,7 +276,7 @@ class FrictionStageResult:
     seed: int
 
     @property
-    def reference_friction(self) -> SigmoidFriction | None:
+    def reference_friction(self) -> Friction | None:
         """The truth's friction, or None."""
         f = self.truth.friction
         return None if f is None else SigmoidFriction.from_array(f)
@@ -416,7 +416,7 @@ def feasible_stage(
         with :func:`dynid.identification.log.prepare_log` (zero-phase filtered states,
         ``ddq`` differentiated, torques kept unfiltered). Default: a 10 s random Fourier
         trajectory simulated on ``truth`` with sensor noise.
-    friction : SigmoidFriction, ClassicalFriction, array_like (n, 3) or None
+    friction : Friction, array_like (n, 3) (sigmoid) or None
         Friction added to the Newton-Euler torques (e.g. the fitted sigmoid of stage 3).
     seed : int
     truth : Robot, optional

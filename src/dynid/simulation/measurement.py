@@ -30,7 +30,7 @@ from numpy.typing import NDArray
 from .. import _checks
 from ..dynamics.rnea import rnea
 from ..exceptions import OptionError, ShapeError
-from ..friction.model import DriveFriction, FrictionModel, SigmoidFriction
+from ..friction.model import FrictionModel, robot_friction
 from ..identification.log import TorqueLog, recorded_side_log
 from ..model.drive import Drive
 from ..model.robot import Robot
@@ -155,10 +155,10 @@ def simulate_measurement(
         Measurement noise levels.
     friction : FrictionModel, None or "robot"
         Ground-truth friction: a model, None for no friction, or ``"robot"`` (default)
-        for the robot's sigmoid parameters ``robot.friction`` (none if it has none). With
-        a ``drive`` whose friction acts at the motors, a law per joint acts per motor
-        (``K^T f(K dq)``, :class:`~dynid.friction.model.DriveFriction`), as identification
-        models it; a ``DriveFriction`` acts as it says.
+        for the robot's own friction (:func:`~dynid.friction.model.robot_friction`; none if
+        it has none). With a ``drive`` whose friction acts at the motors, a law at the
+        joints acts per motor (``K^T f(K dq)``), as identification models it; a model with
+        its own drive acts as it says.
     drop_fraction : float
         Fraction of samples removed at random (never the first or last), in [0, 0.5).
     with_ddq : bool
@@ -225,7 +225,7 @@ def _checked(
             raise OptionError(
                 f"friction must be a friction model, None or 'robot'; got {friction!r}"
             )
-        friction = None if robot.friction is None else SigmoidFriction.from_array(robot.friction)
+        friction = robot_friction(robot)
     if friction is not None and friction.n != n:
         raise ShapeError(f"friction model has {friction.n} joints; robot has {n}")
     if effects is not None:
@@ -249,12 +249,8 @@ def _true_torques(
     else:
         tau = rnea(robot, traj.q, traj.dq, traj.ddq)
     if friction is not None:
-        if (
-            drive is not None
-            and drive.friction_at == "motor"
-            and not isinstance(friction, DriveFriction)
-        ):  # the law per motor, where the drive says friction acts: K^T f(K dq)
-            friction = DriveFriction(friction, drive)
+        if drive is not None and drive.friction_at == "motor" and friction.drive is None:
+            friction = friction.at(drive)  # the law per motor, where the drive says: K^T f(K dq)
         tau = tau + friction.torques(traj.dq)
     if drive is not None and drive.rotor_inertia is not None:
         tau = tau + drive.rotor_torques(traj.ddq, drive.rotor_inertia)

@@ -20,7 +20,6 @@ from pathlib import Path
 from typing import Any
 
 from ..exceptions import OptionError
-from ..friction.model import DriveFriction
 from ..friction.mujoco import CoulombViscous, coulomb_viscous_from_sigmoid
 from ..io.drive_file import load_drive
 from ..io.export import EXPORT_FORMATS, ROBOT_FORMATS, export_format, model_terms_of
@@ -145,12 +144,8 @@ def export_robot(
     friction: Any = opt.friction
     if linear is not None and opt.friction:
         friction = linear
-        if (
-            drive is not None
-            and drive.friction_at == "motor"
-            and not isinstance(linear, DriveFriction)
-        ):
-            friction = DriveFriction(linear, drive)
+        if drive is not None and drive.friction_at == "motor" and linear.drive is None:
+            friction = linear.at(drive)
     written = ExportOptions(
         template=None if opt.urdf_template is None else Path(opt.urdf_template),
         base=opt.base,

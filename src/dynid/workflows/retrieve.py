@@ -25,7 +25,6 @@ from ..feasibility.methods import METHODS
 from ..feasibility.methods import method as consistent_method
 from ..feasibility.penalty import RetrievalOptions, RetrievalProgress
 from ..feasibility.result import FeasibleResult
-from ..friction.model import SigmoidFriction
 from ..identification.model import IdentifiedModel
 from ..io.bounds_file import load_bounds
 from ..io.friction_json import load_friction_json
@@ -65,7 +64,7 @@ def _with_friction(robot: Robot, path: str | Path | None) -> Robot:
     fr = load_friction_json(path)
     if fr.kind == "none":  # no friction: nothing to put on the robot
         return robot
-    if not isinstance(fr, SigmoidFriction):
+    if fr.kind != "sigmoid" or fr.drive is not None:  # what the robot files hold
         raise OptionError(
             f"{Path(path).name} holds {fr.kind} friction; sigmoid friction goes on the robot "
             "(the law a robot description holds): give a friction.json of the sigmoid law "

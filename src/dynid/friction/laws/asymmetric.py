@@ -16,8 +16,8 @@ from __future__ import annotations
 import numpy as np
 from numpy.typing import NDArray
 
-from ..model import coulomb_sign
-from .base import MjcfTerms, linear_law
+from ..torques import coulomb_sign
+from .base import MjcfTerms, canonical_rows, linear_law
 
 __all__ = ["LAW", "columns"]
 
@@ -41,6 +41,11 @@ def _mjcf(P: NDArray[np.float64], dq_max: NDArray[np.float64]) -> MjcfTerms:
     )
 
 
+def _canonical(P: NDArray[np.float64], band: NDArray[np.float64]) -> NDArray[np.float64]:
+    fvp, fvn, fcp, fcn = P.T
+    return canonical_rows(band, fv_pos=fvp, fv_neg=fvn, fc_pos=fcp, fc_neg=fcn)
+
+
 LAW = linear_law(
     "asymmetric",
     ("fv_pos", "fv_neg", "fc_pos", "fc_neg"),
@@ -51,4 +56,5 @@ LAW = linear_law(
     (0.0, 0.0, -np.inf, -np.inf),
     (np.inf, np.inf, np.inf, np.inf),
     _mjcf,
+    _canonical,
 )

@@ -2,9 +2,10 @@
 
 A law (:class:`FrictionLaw`) is a record of plain functions: its name, parameter names
 and units, the torques of per-joint parameters, a per-joint fit to a torque residual,
-bounds, and its MuJoCo mapping. Linear-in-parameter laws are built from their regressor
-columns by :func:`linear_law` (bounded linear least squares); the others give their own
-fit.
+bounds, its MuJoCo mapping and its compiled form in the observer. :class:`Friction`, the
+one friction type, is a law with its parameters, standstill band and where it acts.
+Linear-in-parameter laws are built from their regressor columns by :func:`linear_law`
+(bounded linear least squares); the others give their own fit.
 
 **Standstill.** A Coulomb term switches on with the sign of the velocity, and where a joint
 stands still the measured velocity is encoder noise: ``sign(dq)`` of noise would put the
@@ -27,18 +28,42 @@ import numpy as np
 import scipy.optimize
 from numpy.typing import ArrayLike, NDArray
 
+from ... import _checks
 from ...exceptions import ShapeError
-from ..model import LawFriction, coulomb_sign
+from ...model.drive import Drive
+from ..torques import coulomb_sign
 
 __all__ = [
+    "CANONICAL_COLUMNS",
+    "Friction",
     "FrictionLaw",
     "JointFit",
-    "LawFriction",
     "MjcfTerms",
     "bounded_lstsq",
+    "canonical_rows",
     "coulomb_sign",
     "linear_law",
 ]
+
+#: The canonical friction parameters per motor that the observer's compiled step evaluates
+#: (:mod:`dynid.observer.friction`, which writes the form out):
+#: ``f(v) = fv+ v+ + fv- v- + fc+ [s > 0] - fc- [s < 0] + fo + (fs - fc) exp(-(v/vst)^2) s
+#: + ft tanh(v / vs) + phi1 (sigma(phi2 (v + phi3)) - sigma(phi2 phi3)) + fq v |v|``.
+CANONICAL_COLUMNS = (
+    "fv_pos", "fv_neg", "fc_pos", "fc_neg", "fo", "band", "fs_minus_fc", "vst", "ft", "vs",
+    "phi1", "phi2", "phi3", "fq",
+)  # fmt: skip
+
+
+def canonical_rows(band: NDArray[np.float64], **columns: ArrayLike) -> NDArray[np.float64]:
+    """Canonical rows (n, 14) with the standstill ``band`` (n,) and the named columns of
+    :data:`CANONICAL_COLUMNS` set (each (n,)), the others zero."""
+    b = np.asarray(band, dtype=np.float64)
+    F = np.zeros((b.shape[0], len(CANONICAL_COLUMNS)))
+    F[:, CANONICAL_COLUMNS.index("band")] = b
+    for name, value in columns.items():
+        F[:, CANONICAL_COLUMNS.index(name)] = value
+    return F
 
 
 @dataclass(frozen=True, slots=True)
@@ -69,8 +94,8 @@ Torques = Callable[[NDArray[np.float64], NDArray[np.float64], NDArray[np.float64
 Fit = Callable[[NDArray[np.float64], NDArray[np.float64], float], JointFit]
 #: ``mjcf(params (n, k), dq_max (n,)) -> MjcfTerms``.
 Mjcf = Callable[[NDArray[np.float64], NDArray[np.float64]], MjcfTerms]
-#: ``make(params (n, k), band (n,) or None) -> FrictionModel``.
-Make = Callable[[NDArray[np.float64], Any], Any]
+#: ``canonical(params (n, k), band (n,)) -> (n, 14)`` (:data:`CANONICAL_COLUMNS`).
+Canonical = Callable[[NDArray[np.float64], NDArray[np.float64]], NDArray[np.float64]]
 
 
 @dataclass(frozen=True, slots=True)
@@ -94,10 +119,15 @@ class FrictionLaw:
     lower, upper : tuple of float
         Bounds of each parameter in the fit.
     mjcf : callable
-        ``mjcf(params (n, k), dq_max (n,))`` -> :class:`MjcfTerms`.
-    make : callable, optional
-        ``make(params (n, k), band)``: the law's own model class; default
-        :class:`~dynid.friction.model.LawFriction`.
+        ``mjcf(params (n, k), dq_max (n,))`` -> :class:`MjcfTerms`: what MuJoCo's joints
+        (and URDF's ``<dynamics>``) hold of the law, and what they drop.
+    canonical : callable or None
+        ``canonical(params (n, k), band (n,))`` -> (n, 14): the law in the observer's
+        compiled form (:data:`CANONICAL_COLUMNS`); None: the observer evaluates
+        ``torques`` in Python.
+    standstill : bool
+        Whether the law has a standstill band (the sigmoid, smooth and zero at rest, has
+        none: its band is always zero and ``friction.json`` writes none).
     """
 
     name: str
@@ -109,41 +139,156 @@ class FrictionLaw:
     lower: tuple[float, ...]
     upper: tuple[float, ...]
     mjcf: Mjcf = field(repr=False)
-    make: Make | None = field(repr=False, default=None)
+    canonical: Canonical | None = field(repr=False, default=None)
+    standstill: bool = True
 
-    def model(self, params: ArrayLike, band: ArrayLike | None = None) -> Any:
-        """The law with parameters (n, k) and standstill band (n,) [rad/s] (default 0):
-        ``make(params, band)`` when the law has its own class (the classical and sigmoid
-        laws, :mod:`dynid.friction.model`), else a :class:`LawFriction`."""
-        if self.make is not None:
-            return self.make(_as_params(self, params), band)
-        p = _as_params(self, params)
-        if band is None:
-            return LawFriction(self, p)
-        return LawFriction(self, p, np.asarray(band, dtype=np.float64))
+    def model(
+        self, params: ArrayLike, band: ArrayLike | None = None, drive: Drive | None = None
+    ) -> Friction:
+        """The law with parameters (n, k), standstill band (n,) [rad/s] (default 0) and
+        where it acts (``drive``, default the joints): a :class:`Friction`."""
+        b = np.zeros(0) if band is None else np.asarray(band, dtype=np.float64)
+        return Friction(self, np.asarray(params, dtype=np.float64), b, drive)
 
 
-def _as_params(law: FrictionLaw, params: ArrayLike) -> NDArray[np.float64]:
-    p = np.asarray(params, dtype=np.float64)
-    if p.ndim != 2 or p.shape[1] != len(law.params):
-        raise ShapeError(
-            f"params of the {law.name} law must have shape (n, {len(law.params)}); got {p.shape}"
-        )
-    return p
+@dataclass(frozen=True, slots=True, eq=False)
+class Friction:
+    """Friction of a robot: a registry law, its parameters, standstill band and where it
+    acts; arrays read-only.
+
+    ``tau_f(dq) = f(dq)`` at the joints (``drive`` None, or a drive with
+    ``friction_at="joint"``), ``tau_f(dq) = K^T f(K dq)`` at the motors of a drive
+    (:mod:`dynid.model.drive`). The law's parameters read by name as attributes
+    (``fr.fv``, ``fr.phi1``: column (n,) of ``params``).
+
+    Attributes
+    ----------
+    law : FrictionLaw
+        The registry law (:mod:`dynid.friction.laws`).
+    params : ndarray, shape (n, k)
+        Parameters per joint (per motor at the motors), columns ``law.params``, in the
+        law's units.
+    band : ndarray, shape (n,)
+        Standstill band [rad/s] (:func:`coulomb_sign`); zeros when not given, and always
+        for a law without one (:attr:`FrictionLaw.standstill`).
+    drive : Drive or None
+        Where the law acts: None (the joints) or a drive, whose ``friction_at`` says the
+        motors (velocities and torques at the motor) or the joints.
+
+    Raises
+    ------
+    ShapeError
+        Parameters not (n, k), a band not (n,), a drive of another number of joints.
+    """
+
+    law: FrictionLaw
+    params: NDArray[np.float64]
+    band: NDArray[np.float64] = field(default_factory=lambda: np.zeros(0))
+    drive: Drive | None = None
+
+    def __post_init__(self) -> None:
+        p = _checks.as_array("params", self.params)
+        k = len(self.law.params)
+        if p.ndim != 2 or p.shape[1] != k:
+            raise ShapeError(
+                f"params of the {self.law.name} law must have shape (n, {k}); got {p.shape}"
+            )
+        n = p.shape[0]
+        no_band = np.size(self.band) == 0 or not getattr(self.law, "standstill", True)
+        b = np.zeros(n) if no_band else _checks.as_exact("band", self.band, (n,))
+        if self.drive is not None:
+            self.drive.check(n)
+        object.__setattr__(self, "params", _checks.frozen(p))
+        object.__setattr__(self, "band", _checks.frozen(b))
+
+    def __getattr__(self, name: str) -> NDArray[np.float64]:
+        """A parameter by name: its column (n,) of ``params``."""
+        if name.startswith("_") or name in ("law", "params", "band", "drive"):
+            raise AttributeError(name)  # not set yet (copying, unpickling)
+        try:
+            i = self.law.params.index(name)
+        except (ValueError, AttributeError):
+            raise AttributeError(
+                f"{type(self).__name__} of the {self.law.name} law has no attribute {name!r}"
+            ) from None
+        return self.params[:, i]
+
+    @property
+    def kind(self) -> str:
+        """The law's registry name."""
+        return self.law.name
+
+    @property
+    def names(self) -> tuple[str, ...]:
+        """The parameter names."""
+        return self.law.params
+
+    @property
+    def n(self) -> int:
+        """Number of joints."""
+        return int(self.params.shape[0])
+
+    @property
+    def at_motors(self) -> bool:
+        """Whether the law acts at the motors of a drive (``K^T f(K dq)``)."""
+        return self.drive is not None and self.drive.friction_at == "motor"
+
+    @property
+    def transmission(self) -> NDArray[np.float64]:
+        """``K_f`` (n, n): motor velocities per joint velocity where the law acts (the
+        identity at the joints)."""
+        if self.drive is None:
+            return np.eye(self.n)
+        return np.array(self.drive.friction_transmission, dtype=np.float64)
+
+    def as_array(self) -> NDArray[np.float64]:
+        """The parameters (n, k) (a copy)."""
+        return np.array(self.params)
+
+    def at(self, drive: Drive | None) -> Friction:
+        """The same law acting where ``drive`` says (None: at the joints)."""
+        return Friction(self.law, self.params, self.band, drive)
+
+    def torques(self, dq: ArrayLike) -> NDArray[np.float64]:
+        """Joint friction torques [N m] (..., n) at joint velocities ``dq`` [rad/s] (..., n)."""
+        v = _checks.as_batch("dq", dq, (self.n,))
+        if self.drive is None:
+            out: NDArray[np.float64] = np.asarray(self.law.torques(v, self.params, self.band))
+            return out
+        f = np.asarray(self.law.torques(self.drive.motor_velocities(v), self.params, self.band))
+        return self.drive.joint_friction(f)
 
 
-def _columns_fit(
-    columns: Callable[[NDArray[np.float64], NDArray[np.float64]], NDArray[np.float64]],
-    lower: tuple[float, ...],
-    upper: tuple[float, ...],
-) -> Fit:
-    lo, hi = np.asarray(lower, dtype=np.float64), np.asarray(upper, dtype=np.float64)
+#: ``columns(dq (..., n), band (n,)) -> (..., n, k)``: a linear law's regressor.
+Columns = Callable[[NDArray[np.float64], NDArray[np.float64]], NDArray[np.float64]]
 
-    def fit(dq: NDArray[np.float64], r: NDArray[np.float64], band: float) -> JointFit:
-        A = columns(dq[:, None], np.array([band]))[:, 0, :]
+
+@dataclass(frozen=True, slots=True)
+class _LinearTorques:
+    """``torques`` of a linear law (a module-level class: the law pickles)."""
+
+    columns: Columns
+
+    def __call__(
+        self, dq: NDArray[np.float64], P: NDArray[np.float64], band: NDArray[np.float64]
+    ) -> NDArray[np.float64]:
+        out: NDArray[np.float64] = np.einsum("...jk,jk->...j", self.columns(dq, band), P)
+        return out
+
+
+@dataclass(frozen=True, slots=True)
+class _LinearFit:
+    """``fit`` of a linear law: bounded linear least squares on its columns."""
+
+    columns: Columns
+    lower: tuple[float, ...]
+    upper: tuple[float, ...]
+
+    def __call__(self, dq: NDArray[np.float64], r: NDArray[np.float64], band: float) -> JointFit:
+        A = self.columns(dq[:, None], np.array([band]))[:, 0, :]
+        lo = np.asarray(self.lower, dtype=np.float64)
+        hi = np.asarray(self.upper, dtype=np.float64)
         return JointFit(bounded_lstsq(A, r, lo, hi))
-
-    return fit
 
 
 def bounded_lstsq(
@@ -172,25 +317,20 @@ def linear_law(
     params: tuple[str, ...],
     units: tuple[str, ...],
     formula: str,
-    columns: Callable[[NDArray[np.float64], NDArray[np.float64]], NDArray[np.float64]],
+    columns: Columns,
     lower: tuple[float, ...],
     upper: tuple[float, ...],
     mjcf: Mjcf,
-    *,
-    make: Make | None = None,
+    canonical: Canonical | None = None,
+    torques: Torques | None = None,
 ) -> FrictionLaw:
     """A law linear in its parameters, ``tau_f,j = columns(dq, band)[..., j, :] @ p_j``.
 
     ``columns(dq (..., n), band (n,))`` gives the regressor (..., n, k); the fit is the
-    bounded linear least squares of :func:`bounded_lstsq`; ``make`` as in
-    :class:`FrictionLaw`.
+    bounded linear least squares of :func:`bounded_lstsq`; ``canonical`` as in
+    :class:`FrictionLaw`; ``torques``, when given, the same torques in closed form (faster
+    than the columns' product; default that product).
     """
-
-    def torques(
-        dq: NDArray[np.float64], P: NDArray[np.float64], band: NDArray[np.float64]
-    ) -> NDArray[np.float64]:
-        out: NDArray[np.float64] = np.einsum("...jk,jk->...j", columns(dq, band), P)
-        return out
-
-    fit = _columns_fit(columns, lower, upper)
-    return FrictionLaw(name, params, units, formula, torques, fit, lower, upper, mjcf, make)
+    tau = _LinearTorques(columns) if torques is None else torques
+    fit = _LinearFit(columns, lower, upper)
+    return FrictionLaw(name, params, units, formula, tau, fit, lower, upper, mjcf, canonical)

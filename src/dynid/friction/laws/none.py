@@ -9,7 +9,7 @@ from __future__ import annotations
 import numpy as np
 from numpy.typing import NDArray
 
-from .base import FrictionLaw, JointFit, MjcfTerms
+from .base import FrictionLaw, JointFit, MjcfTerms, canonical_rows
 
 __all__ = ["LAW"]
 
@@ -29,4 +29,8 @@ def _mjcf(P: NDArray[np.float64], dq_max: NDArray[np.float64]) -> MjcfTerms:
     return MjcfTerms(z, z, z)
 
 
-LAW = FrictionLaw("none", (), (), "tau_f = 0", _torques, _fit, (), (), _mjcf)
+def _canonical(P: NDArray[np.float64], band: NDArray[np.float64]) -> NDArray[np.float64]:
+    return canonical_rows(band)
+
+
+LAW = FrictionLaw("none", (), (), "tau_f = 0", _torques, _fit, (), (), _mjcf, _canonical)

@@ -16,7 +16,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from ...regressors.friction_columns import standstill_sign
-from .base import MjcfTerms, linear_law
+from .base import MjcfTerms, canonical_rows, linear_law
 
 __all__ = ["LAW", "columns"]
 
@@ -31,6 +31,11 @@ def _mjcf(P: NDArray[np.float64], dq_max: NDArray[np.float64]) -> MjcfTerms:
     return MjcfTerms(P[:, 0].copy(), P[:, 2].copy(), P[:, 3].copy(), dropped)
 
 
+def _canonical(P: NDArray[np.float64], band: NDArray[np.float64]) -> NDArray[np.float64]:
+    fv, fq, fc, fo = P.T
+    return canonical_rows(band, fv_pos=fv, fv_neg=fv, fc_pos=fc, fc_neg=fc, fo=fo, fq=fq)
+
+
 LAW = linear_law(
     "quadratic",
     ("fv", "fq", "fc", "fo"),
@@ -41,4 +46,5 @@ LAW = linear_law(
     (0.0, 0.0, 0.0, -np.inf),
     (np.inf, np.inf, np.inf, np.inf),
     _mjcf,
+    _canonical,
 )

@@ -20,8 +20,8 @@ import scipy.optimize
 import scipy.special
 from numpy.typing import NDArray
 
-from ..model import SigmoidFriction, sigmoid_friction
-from .base import FrictionLaw, JointFit, MjcfTerms
+from ..torques import sigmoid_friction
+from .base import FrictionLaw, JointFit, MjcfTerms, canonical_rows
 
 __all__ = ["LAW", "odd_part"]
 
@@ -106,8 +106,8 @@ def _mjcf(P: NDArray[np.float64], dq_max: NDArray[np.float64]) -> MjcfTerms:
     return MjcfTerms(fv, fc, offset, "the even part of the sigmoid (an offset at large speed)")
 
 
-def _make(P: NDArray[np.float64], band: object) -> SigmoidFriction:
-    return SigmoidFriction.from_array(P)
+def _canonical(P: NDArray[np.float64], band: NDArray[np.float64]) -> NDArray[np.float64]:
+    return canonical_rows(np.zeros(P.shape[0]), phi1=P[:, 0], phi2=P[:, 1], phi3=P[:, 2])
 
 
 LAW = FrictionLaw(
@@ -120,5 +120,6 @@ LAW = FrictionLaw(
     (-np.inf, 0.0, -np.inf),
     (np.inf, np.inf, np.inf),
     _mjcf,
-    _make,
+    _canonical,
+    standstill=False,
 )

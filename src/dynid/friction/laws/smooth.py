@@ -16,7 +16,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from ...regressors.friction_columns import smooth_sign
-from .base import MjcfTerms, linear_law
+from .base import MjcfTerms, canonical_rows, linear_law
 
 __all__ = ["LAW", "columns"]
 
@@ -30,6 +30,17 @@ def _mjcf(P: NDArray[np.float64], dq_max: NDArray[np.float64]) -> MjcfTerms:
     return MjcfTerms(P[:, 0].copy(), P[:, 1].copy(), P[:, 2].copy())
 
 
+def _canonical(P: NDArray[np.float64], band: NDArray[np.float64]) -> NDArray[np.float64]:
+    # fc tanh(dq / band), the plain sign where band = 0
+    fv, fc, fo = P.T
+    tanh = band > 0
+    sign = np.where(tanh, 0.0, fc)
+    return canonical_rows(
+        np.zeros_like(band), fv_pos=fv, fv_neg=fv, fc_pos=sign, fc_neg=sign, fo=fo,
+        ft=np.where(tanh, fc, 0.0), vs=band,
+    )  # fmt: skip
+
+
 LAW = linear_law(
     "smooth",
     ("fv", "fc", "fo"),
@@ -39,4 +50,5 @@ LAW = linear_law(
     (0.0, 0.0, -np.inf),
     (np.inf, np.inf, np.inf),
     _mjcf,
+    _canonical,
 )

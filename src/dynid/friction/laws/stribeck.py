@@ -19,7 +19,7 @@ import scipy.optimize
 from numpy.typing import NDArray
 
 from ...regressors.friction_columns import standstill_sign, stribeck_decay
-from .base import FrictionLaw, JointFit, MjcfTerms, bounded_lstsq
+from .base import FrictionLaw, JointFit, MjcfTerms, bounded_lstsq, canonical_rows
 
 __all__ = ["LAW"]
 
@@ -79,6 +79,13 @@ def _mjcf(P: NDArray[np.float64], dq_max: NDArray[np.float64]) -> MjcfTerms:
     return MjcfTerms(P[:, 0].copy(), P[:, 1].copy(), P[:, 4].copy(), dropped)
 
 
+def _canonical(P: NDArray[np.float64], band: NDArray[np.float64]) -> NDArray[np.float64]:
+    fv, fc, fs, vst, fo = P.T
+    return canonical_rows(
+        band, fv_pos=fv, fv_neg=fv, fc_pos=fc, fc_neg=fc, fo=fo, fs_minus_fc=fs - fc, vst=vst
+    )
+
+
 LAW = FrictionLaw(
     "stribeck",
     ("fv", "fc", "fs", "vst", "fo"),
@@ -90,4 +97,5 @@ LAW = FrictionLaw(
     _LOWER,
     _UPPER,
     _mjcf,
+    _canonical,
 )

@@ -14,7 +14,7 @@ from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
 
-from ...friction.model import ClassicalFriction, DriveFriction
+from ...friction.model import Friction
 from ...model.drive import Drive
 from ...model.robot import Robot
 
@@ -33,9 +33,9 @@ class ExportOptions:
         URDF template: the chain's base and tip links.
     merged : {"subtract", "move"}
         URDF template: how a body is split over its moving and fixed links.
-    friction : bool, ClassicalFriction or DriveFriction
-        True: the robot's own (sigmoid) friction where the format holds it; identified
-        classical friction (at the joints, or at the motors of a drive); False: none.
+    friction : bool or Friction
+        True: the robot's own friction where the format holds it; a friction model of any
+        law (at the joints, or at the motors of a drive); False: none.
     all_frames : bool
         URDF chain: every named frame as a fixed, massless link.
     drive : Drive or None
@@ -46,7 +46,7 @@ class ExportOptions:
     base: str | None = None
     tip: str | None = None
     merged: str = "subtract"
-    friction: bool | ClassicalFriction | DriveFriction = True
+    friction: bool | Friction = True
     all_frames: bool = False
     drive: Drive | None = None
 

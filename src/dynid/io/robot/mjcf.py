@@ -25,10 +25,11 @@ keeping the robot's link and joint names:
   as ``frictionloss`` [N m] + ``damping`` [N m s/rad]
   (:func:`dynid.friction.mujoco.coulomb_viscous_from_sigmoid`; an approximation: MuJoCo
   cannot hold the sigmoid's offset and curvature). ``friction=`` a
-  :class:`~dynid.friction.model.ClassicalFriction` (identified ``fv, fc, fo``) is written
-  as it is, ``frictionloss = fc``, ``damping = fv``; only the offset ``fo`` is dropped. Any
-  other law of the registry (:mod:`dynid.friction.laws`) maps itself (the asymmetric law's
-  means, the Stribeck law's ``fv`` and ``fc``), what MJCF cannot hold named in a warning.
+  :class:`~dynid.friction.model.Friction` of any law of the registry
+  (:mod:`dynid.friction.laws`) is written as its law maps itself
+  (:attr:`~dynid.friction.laws.base.FrictionLaw.mjcf`: the classical law's ``fc`` and
+  ``fv`` as they are, the asymmetric law's means, the Stribeck law's ``fv`` and ``fc``),
+  what MJCF cannot hold (an offset, an asymmetry, coupled terms) named in one warning line.
   With ``friction=False`` the joints are frictionless, and ``mj_inverse`` equals
   :func:`dynid.rnea`.
 
@@ -47,7 +48,7 @@ from scipy.spatial.transform import Rotation
 
 from ... import __version__
 from ...exceptions import DynidWarning, ModelError, ShapeError
-from ...friction.model import DriveFriction, FrictionModel, SigmoidFriction
+from ...friction.model import FrictionModel, robot_friction
 from ...friction.mujoco import (
     CoulombViscous,
     coulomb_viscous_from_sigmoid,
@@ -82,9 +83,6 @@ def _law_terms(
     friction: FrictionModel, dq_max: NDArray[np.float64]
 ) -> tuple[CoulombViscous, tuple[str, ...]]:
     """A friction model as MuJoCo holds it, and what it drops (one line each)."""
-    law = friction.law if isinstance(friction, DriveFriction) else friction
-    if isinstance(law, SigmoidFriction) and not isinstance(friction, DriveFriction):
-        return coulomb_viscous_from_sigmoid(law.as_array(), dq_max), ()
     jt = joint_coulomb_viscous(friction, np.where(np.isfinite(dq_max), dq_max, 2.0))
     z = np.zeros(friction.n)
     offset = z if jt.offset is None else jt.offset
@@ -99,34 +97,30 @@ def _joint_terms(
     Returns ``(approximation, armature, notes)``: the Coulomb and viscous terms per joint
     (None: frictionless), the armature (n,) [kg m^2] (None: no drive with rotor inertias)
     and one note per thing dropped (:func:`dynid.friction.mujoco.drive_joint_terms`,
-    :func:`_law_terms`).
+    :func:`_law_terms`). ``friction=True`` is the robot's own friction: its sigmoid
+    (``Robot.friction``) by the fit of its odd part up to ``dq_max``, another law as that
+    law maps itself.
     """
     n = robot.n
-    if isinstance(friction, DriveFriction) or drive is not None:
-        d = friction.drive if isinstance(friction, DriveFriction) else drive
-        assert d is not None
+    model = robot_friction(robot) if friction is True else friction or None
+    if model is not None and model.n != n:
+        raise ShapeError(f"friction has {model.n} joints; robot {robot.name!r} has {n}")
+    d = model.drive if model is not None and model.drive is not None else drive
+    notes: tuple[str, ...] = ()
+    armature = None
+    if d is not None:
         d.check(n)
         jt = drive_joint_terms(
             d.transmission, d.rotor_inertia, None, None, friction_at_motor=d.friction_at == "motor"
         )
         notes = jt.notes
         armature = jt.armature if d.rotor_inertia is not None else None
-        approx = None
-        if isinstance(friction, DriveFriction):
-            d.check(friction.n)
-            approx, more = _law_terms(friction, robot.dq_max)
-            notes += more
-        elif friction is True and robot.friction is not None:
-            approx = coulomb_viscous_from_sigmoid(robot.friction, robot.dq_max)
-        return approx, armature, notes
-    if not isinstance(friction, bool):
-        if friction.n != n:
-            raise ShapeError(f"friction has {friction.n} joints; robot {robot.name!r} has {n}")
-        approx, notes = _law_terms(friction, robot.dq_max)
-        return approx, None, notes
-    if friction and robot.friction is not None:
-        return coulomb_viscous_from_sigmoid(robot.friction, robot.dq_max), None, ()
-    return None, None, ()
+    if friction is True and robot.friction is not None:  # the description's sigmoid
+        return coulomb_viscous_from_sigmoid(robot.friction, robot.dq_max), armature, notes
+    if model is None:
+        return None, armature, notes
+    approx, more = _law_terms(model, robot.dq_max)
+    return approx, armature, notes + more
 
 
 def _comment(
@@ -143,7 +137,7 @@ def _comment(
         text += "; friction: Coulomb as frictionloss, viscous as damping"
         if isinstance(friction, bool):
             text += " (fit of the sigmoid)"
-        elif isinstance(friction, DriveFriction):
+        elif friction.at_motors:
             text += " (reflected from the motors)"
     if armature is not None:
         text += "; rotor inertia as armature"
@@ -251,8 +245,8 @@ def mjcf_from_robot(
         A link other than the base is named ``world`` (MuJoCo's world body).
     """
     approx, armature, notes = _joint_terms(robot, friction, drive)
-    for note in notes:
-        warnings.warn(f"MJCF export: {note}", DynidWarning, stacklevel=2)
+    if notes:  # one line: what MJCF cannot hold
+        warnings.warn(f"MJCF export: {'; '.join(notes)}", DynidWarning, stacklevel=2)
     text = comment or _comment(friction, approx, armature, notes)
     lines = [
         '<?xml version="1.0"?>',

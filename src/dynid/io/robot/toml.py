@@ -447,7 +447,22 @@ def toml_from_robot(robot: Robot) -> str:
     -------
     text : str
         The TOML document.
+
+    Warns
+    -----
+    DynidWarning
+        The robot holds friction of another law than the sigmoid
+        (``Robot.friction_model``), which a description does not hold: it is not written
+        (``friction.json`` holds any law).
     """
+    if robot.friction_model is not None:
+        warnings.warn(
+            f"TOML export: the robot's {robot.friction_model.kind} friction is not part of a "
+            "robot description (which holds the sigmoid) and is not written; save it as "
+            "friction.json",
+            DynidWarning,
+            stacklevel=2,
+        )
     out = [
         "# dynid robot description; schema: dynid.io.robot.toml",
         "# units: m, rad, kg, kg m^2, s; inertia about the CoM, in link axes",

@@ -28,14 +28,16 @@ feasible parameters, say, for simulators) gives one ``<link>`` per link of the r
 * with ``template=`` the original URDF is written back with only the chain's
   ``<inertial>`` elements replaced (:func:`dynid.io.robot.urdf_patch.patch_urdf_inertials`).
 
-Gravity is not part of URDF; identified linear friction (``dynamics=``) is written as
-``<dynamics damping friction>`` per joint, the sigmoid is not. Numbers use Python's
+Gravity is not part of URDF; a friction model (``dynamics=``, :func:`export_urdf`) is
+written as ``<dynamics damping friction>`` per joint, the description's sigmoid is not.
+Numbers use Python's
 shortest round-trip representation, so the parameters read back exactly.
 """
 
 from __future__ import annotations
 
 import sys
+import warnings
 from pathlib import Path
 from xml.sax.saxutils import quoteattr
 
@@ -43,8 +45,8 @@ import numpy as np
 from numpy.typing import NDArray
 
 from ... import __version__, spatial
-from ...exceptions import ModelError
-from ...friction.model import ClassicalFriction, DriveFriction
+from ...exceptions import DynidWarning, ModelError, ShapeError
+from ...friction.model import robot_friction
 from ...friction.mujoco import joint_coulomb_viscous
 from ...model.inertia import inertia6_from_matrix
 from ...model.robot import Robot
@@ -271,19 +273,36 @@ def save_urdf(
 def export_urdf(path: str | Path, robot: Robot, options: ExportOptions) -> Path:
     """:func:`save_urdf` with the export options (the entry of ``urdf`` in the exports).
 
-    Identified classical friction (``options.friction``, at the joints or reflected from
-    the motors of a drive) is written as ``<dynamics damping friction>``; the sigmoid and
-    the drive are not part of URDF.
+    A friction model (``options.friction``, any law of the registry, at the joints or
+    reflected from the motors of a drive) is written as ``<dynamics damping friction>``,
+    what its law maps to viscous and dry friction
+    (:func:`dynid.friction.mujoco.joint_coulomb_viscous`); what URDF cannot hold (an offset,
+    an asymmetry, a Stribeck peak, coupled terms) is named in one warning line.
+    ``friction=True`` writes the robot's own friction when it is a law other than the
+    description's sigmoid (``Robot.friction``, which URDF does not hold); the drive is not
+    part of URDF.
 
     Raises
     ------
     ModelError
         As :func:`save_urdf` (a template that cannot be read or does not match).
+    ShapeError
+        A friction model of another number of joints.
     """
     dynamics = None
-    if isinstance(options.friction, ClassicalFriction | DriveFriction):
-        jt = joint_coulomb_viscous(options.friction)
+    model = None if isinstance(options.friction, bool) else options.friction
+    if options.friction is True and robot.friction is None:  # the description's sigmoid: none
+        model = robot_friction(robot)
+    if model is not None:
+        if model.n != robot.n:
+            raise ShapeError(f"friction has {model.n} joints; robot {robot.name!r} has {robot.n}")
+        jt = joint_coulomb_viscous(model, np.where(np.isfinite(robot.dq_max), robot.dq_max, 2.0))
         dynamics = (jt.damping, jt.frictionloss)
+        notes = jt.notes
+        if jt.offset is not None and np.any(jt.offset != 0):
+            notes += (f"{model.kind} friction: the velocity-independent offset is not expressible",)
+        if notes:  # one line: what URDF cannot hold
+            warnings.warn(f"URDF export: {'; '.join(notes)}", DynidWarning, stacklevel=2)
     return save_urdf(
         path,
         robot,
