@@ -35,13 +35,13 @@ from typing import Any, Literal, Protocol
 import numpy as np
 from numpy.typing import NDArray
 
-from .. import _checks
 from ..exceptions import DynidWarning, OptionError, RankDeficientError, ShapeError
 from ..model.drive import Drive
 from ..model.robot import Robot
 from ..regressors.base import BaseParameters, base_parameters, identifiability
 from ..regressors.terms import ModelTerm, drive_terms
-from .estimators import OLS, Estimator, EstimatorName, estimator_named
+from .engine import HeldRows, Rows, fit_rows
+from .estimators import Estimator, EstimatorName, estimator_named
 from .holdout import HeldOut, cross_validate
 from .info import FrictionInfo, IdentificationInfo, Route
 from .least_squares import (
@@ -50,10 +50,9 @@ from .least_squares import (
     block_grams,
     checked_std,
     conditioning_advice,
-    fit_blocks,
 )
 from .model import IdentifiedModel
-from .streaming import BlockSource, fit_streamed
+from .streaming import BlockRows, BlockSource
 
 __all__ = [
     "DEFAULT_FIT_RTOL",
@@ -473,8 +472,10 @@ def fit_stack(
 ) -> LeastSquaresFit:
     """Fit the stacked rows with an estimator; ``frozen`` columns are left out (0, not kept).
 
-    Ordinary least squares takes the blocked path (Gram matrices of the blocks, columns
-    known to be zero skipped); other estimators get the rows used and their groups.
+    The one engine (:func:`~dynid.identification.engine.fit_rows`) on the rows held
+    (:class:`~dynid.identification.engine.HeldRows`, the blocks' Gram matrices reused and
+    their zero columns skipped) or read in blocks
+    (:class:`~dynid.identification.streaming.BlockRows`).
 
     Raises
     ------
@@ -486,16 +487,24 @@ def fit_stack(
     est = estimator_named(estimator)
     cols = np.ones(len(labels), dtype=bool) if frozen is None else ~np.asarray(frozen, bool)
     kept_labels = tuple(lab for lab, c in zip(labels, cols, strict=True) if c)
+    fit = fit_rows(
+        _rows(stack, cols, est),
+        est,
+        rtol=rtol,
+        std=std,
+        max_std_percent=max_std_percent,
+        labels=kept_labels,
+    )
+    return fit if cols.all() else _expanded(fit, cols)
+
+
+def _rows(
+    stack: RegressorStack | StreamedRows, cols: NDArray[np.bool_], est: Estimator
+) -> Rows:
+    """The stack's rows over the columns ``cols`` (c,), as the engine takes them."""
     if isinstance(stack, StreamedRows):
-        fit = fit_streamed(
-            selected_columns(stack.source, cols),
-            est,
-            rtol=rtol,
-            std=std,
-            max_std_percent=max_std_percent,
-            labels=kept_labels,
-        )
-        return fit if cols.all() else _expanded(fit, cols)
+        source = selected_columns(stack.source, cols)
+        return BlockRows(source, by_group=est.weighted, per_row=est.per_row)
     W, rows = stack.W, stack.used_rows
     grams = None if stack.grams is None else stack.grams[stack.kept]
     if not cols.all():
@@ -503,34 +512,8 @@ def fit_stack(
         rows = rows.copy()
         rows[:, 2] = 0
         grams = None if grams is None else grams[:, cols][:, :, cols]
-    if isinstance(est, OLS):
-        fit = fit_blocks(
-            W,
-            stack.y,
-            rows=rows,
-            gram=None if grams is None else grams.sum(axis=0),
-            std=std,
-            max_std_percent=max_std_percent,
-            rtol=rtol,
-            labels=kept_labels,
-        )
-    else:
-        used = stack.used()
-        if used.size != stack.y.size:
-            Wu, yu, gu = W[used], stack.y[used], stack.groups[used]
-        else:
-            Wu, yu, gu = W, stack.y, stack.groups
-        _checks.finite("regressor", Wu)
-        fit = est.fit(
-            Wu,
-            yu,
-            gu,
-            rtol=rtol,
-            std=std,
-            max_std_percent=max_std_percent,
-            labels=kept_labels,
-        )
-    return fit if cols.all() else _expanded(fit, cols)
+    gram = None if grams is None else grams.sum(axis=0)
+    return HeldRows(W, stack.y, stack.groups, rows, gram)
 
 
 def selected_columns(source: BlockSource, cols: NDArray[np.bool_]) -> BlockSource:

@@ -49,12 +49,12 @@ from ..exceptions import NonFiniteError, OptionError, RankDeficientError, ShapeE
 
 __all__ = [
     "LeastSquaresFit",
+    "assembled",
     "STD_METHODS",
     "StdMethod",
     "block_grams",
     "checked_std",
     "conditioning_advice",
-    "fit_blocks",
     "fit_least_squares",
     "fit_with_pruning",
     "unexcited_combinations",
@@ -388,7 +388,34 @@ def _fit(
             f"(y[{k}]) and the regressor up to {float(np.max(np.abs(Wk))):.3g}; values this "
             "large are not measurements: check the data"
         )
-    ss = float(e @ e)
+    ny = float(np.linalg.norm(yu))
+    return assembled(keep, bk, cov_s, scale, float(e @ e), ny, m, rank, cond, cond_u, vmin, rtol)
+
+
+def assembled(
+    keep: NDArray[np.bool_],
+    bk: NDArray[np.float64],
+    cov_s: NDArray[np.float64],
+    scale: NDArray[np.float64],
+    ss: float,
+    ny: float,
+    m: int,
+    rank: int,
+    cond: float,
+    cond_u: float,
+    vmin: NDArray[np.float64],
+    rtol: float,
+) -> LeastSquaresFit:
+    """The statistics of a fit, assembled in one place for every solver.
+
+    ``keep`` (r,) the columns fitted; over them ``bk`` (k,) the estimates, ``cov_s`` (k, k)
+    the covariance of the column-scaled coefficients (divided by ``outer(scale, scale)``
+    for ``bk``'s), ``vmin`` (k,) the weakest direction; ``ss`` the residual sum of squares
+    and ``ny`` the norm of the targets of the ``m`` rows; ``rank``, ``cond`` (scaled) and
+    ``cond_u`` (unscaled) of the regressor.
+    """
+    r = keep.size
+    rk = bk.size
     sigma = np.sqrt(ss / max(m - rk, 1))
     cov_k = cov_s / np.outer(scale, scale)
     cov_k = 0.5 * (cov_k + cov_k.T)
@@ -398,7 +425,6 @@ def _fit(
     cov = np.zeros((r, r))
     beta[keep], sd[keep] = bk, sk
     cov[np.ix_(keep, keep)] = cov_k
-    ny = float(np.linalg.norm(yu))
     effect = np.zeros(r)
     effect[keep] = 100.0 * sk * scale / ny if ny > 0 else 0.0
     weakest = np.zeros(r)
@@ -410,11 +436,11 @@ def _fit(
         beta=_checks.frozen(beta),
         std=_checks.frozen(sd),
         std_percent=_checks.frozen(pct),
-        kept=_checks.frozen(keep),
+        kept=_checks.frozen(keep.copy()),
         rank=rank,
         condition_number=cond_u,
         relative_error_percent=100.0 * np.sqrt(ss) / ny if ny > 0 else 0.0,
-        residual_rms=float(np.sqrt(ss / m)),
+        residual_rms=float(np.sqrt(ss / max(m, 1))),
         sigma=float(sigma),
         n_rows=m,
         rtol=rtol,
@@ -703,43 +729,6 @@ def fit_with_pruning(
     W, y = _validated(W, y, std)
     return _fit_with_pruning(
         W, y, max_std_percent=max_std_percent, rtol=rtol, std=std, labels=labels
-    )
-
-
-def fit_blocks(
-    W: NDArray[np.float64],
-    y: NDArray[np.float64],
-    *,
-    rows: NDArray[np.intp],
-    gram: NDArray[np.float64] | None = None,
-    std: StdMethod = "classical",
-    max_std_percent: float | None = None,
-    rtol: float = 1e-10,
-    labels: tuple[str, ...] | None = None,
-) -> LeastSquaresFit:
-    """:func:`fit_with_pruning` over row blocks of ``W`` (M, r) and ``y`` (M,).
-
-    ``rows`` (k, 3) holds ``(start, stop, first)`` of each block used (``W[start:stop,
-    :first]`` exactly zero, so the products skip it); ``gram`` ``W^T W`` over those rows
-    when known (:func:`block_grams` summed).
-
-    Raises
-    ------
-    RankDeficientError
-        Rank below the column count (``rank``, ``needed``, ``dependent`` set).
-    NonFiniteError
-        NaN or inf in ``W`` or ``y``.
-    """
-    W, y = _validated(W, y, std)
-    return _fit_with_pruning(
-        W,
-        y,
-        max_std_percent=max_std_percent,
-        rtol=rtol,
-        std=std,
-        blocks=rows,
-        gram=gram,
-        labels=labels,
     )
 
 

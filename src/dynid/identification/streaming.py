@@ -46,13 +46,14 @@ from numpy.typing import NDArray
 
 from .. import _checks
 from ..exceptions import DataError, NonFiniteError, OptionError, RankDeficientError, ShapeError
-from .estimators import IRLS, OLS, WLS, Estimator, huber_weights
+from .engine import fit_rows
+from .estimators import Estimator, Weights
 from .holdout import Normals
 from .least_squares import (
     LeastSquaresFit,
     StdMethod,
     _conditioning,
-    checked_std,
+    assembled,
     unexcited_combinations,
 )
 
@@ -230,7 +231,9 @@ def _blocks(source: BlockSource) -> Iterable[Block]:
         yield W, y, g
 
 
-def group_factors(source: BlockSource, *, keep_groups: bool = False) -> GroupFactors:
+def group_factors(
+    source: BlockSource, *, keep_groups: bool = False, by_group: bool = True
+) -> GroupFactors:
     """One pass over the blocks: the triangular factor of ``[W_g y_g]`` of every group (or,
     past :data:`GROUP_FACTOR_BYTES`, of all rows with the groups' counts and targets).
 
@@ -239,6 +242,9 @@ def group_factors(source: BlockSource, *, keep_groups: bool = False) -> GroupFac
     source : BlockSource
     keep_groups : bool
         Also return the group of every row (IRLS).
+    by_group : bool
+        A factor per group; False keeps the factor of all rows only (an estimator that
+        does not weigh).
 
     Raises
     ------
@@ -262,8 +268,10 @@ def group_factors(source: BlockSource, *, keep_groups: bool = False) -> GroupFac
         count = np.bincount(g, minlength=k) + np.pad(count, (0, k - count.size))
         squares = np.asarray(np.bincount(g, y * y, minlength=k), dtype=np.float64)
         target = squares + np.pad(target, (0, k - target.size))
+        if total is None and not by_group:
+            total = np.zeros((c + 1, c + 1))
         if total is None and 8 * k * (c + 1) ** 2 > GROUP_FACTOR_BYTES:  # too many groups
-            total = _triangular(np.vstack([np.zeros((0, c + 1)), *R.values()]))
+            total = _triangular(np.vstack([np.zeros((c + 1, c + 1)), *R.values()]))
             R.clear()
         if total is not None:
             total = _triangular(_on_top(total, X))
@@ -422,36 +430,9 @@ def _fit_factor(
             "least squares overflowed: the data or the regressor hold values too large to be "
             "measurements; check the data"
         )
-    cov_k = cov_s / np.outer(s.scale, s.scale)
-    cov_k = 0.5 * (cov_k + cov_k.T)
-    sk = np.sqrt(np.maximum(np.diag(cov_k), 0.0))
-    beta, sd, cov = np.zeros(c), np.zeros(c), np.zeros((c, c))
-    beta[keep], sd[keep] = s.beta, sk
-    cov[np.ix_(keep, keep)] = cov_k
     ny = float(np.linalg.norm(Raug[:, c]))
-    effect = np.zeros(c)
-    effect[keep] = 100.0 * sk * s.scale / ny if ny > 0 else 0.0
-    weakest = np.zeros(c)
-    weakest[keep] = s.vmin
-    with np.errstate(divide="ignore", invalid="ignore"):
-        pct = np.where(keep, 100.0 * sd / np.abs(beta), np.nan)
-    pct = np.where(keep & (sd == 0.0), 0.0, pct)
-    return LeastSquaresFit(
-        beta=_checks.frozen(beta),
-        std=_checks.frozen(sd),
-        std_percent=_checks.frozen(pct),
-        kept=_checks.frozen(keep.copy()),
-        rank=s.rank,
-        condition_number=s.cond_u,
-        relative_error_percent=100.0 * np.sqrt(s.ss) / ny if ny > 0 else 0.0,
-        residual_rms=float(np.sqrt(s.ss / m)),
-        sigma=float(np.sqrt(s.ss / dof)),
-        n_rows=m,
-        rtol=rtol,
-        covariance=_checks.frozen(cov),
-        scaled_condition_number=s.cond,
-        weakest=_checks.frozen(weakest),
-        effect_percent=_checks.frozen(effect),
+    return assembled(
+        keep, s.beta, cov_s, s.scale, s.ss, ny, m, s.rank, s.cond, s.cond_u, s.vmin, rtol
     )
 
 
@@ -478,7 +459,7 @@ def _fit_pruned(
 
 
 def _unweighted(fit: LeastSquaresFit, F: GroupFactors) -> LeastSquaresFit:
-    """The fit with the residual statistics of the unweighted rows (as the estimators)."""
+    """The fit with the residual statistics of the unweighted rows (as every estimator)."""
     ss = float(F.residual_ss(np.asarray(fit.beta)).sum())
     ny = float(np.sqrt(F.target_ss().sum()))
     return dataclasses.replace(
@@ -488,16 +469,92 @@ def _unweighted(fit: LeastSquaresFit, F: GroupFactors) -> LeastSquaresFit:
     )
 
 
-def _noise(F: GroupFactors, rtol: float) -> NDArray[np.float64]:
-    """WLS's noise std per group from the residual of a first OLS fit
-    (:func:`~dynid.identification.estimators.group_noise`)."""
-    m, c = F.n_rows, F.n_columns
-    first = _solve(F.combined(), m, np.ones(c, dtype=bool), rtol, None)
-    ss = F.residual_ss(first.beta)
-    s = np.sqrt(ss / np.maximum(F.rows * (1.0 - c / max(m, 1)), 1.0))
-    pos = s[s > 0]
-    floor = float(pos.min()) if pos.size else 1.0
-    return np.where(s > 0, s, floor)
+class BlockRows:
+    """Rows read in blocks from a :data:`BlockSource`, for the least-squares engine
+    (:class:`~dynid.identification.engine.Rows`; module docstring).
+
+    The first fit reads the blocks once into the triangular factors of every noise group
+    (``by_group``) or of all rows; the group-weighted fits and the groups' residuals come
+    from the factors, per-row weights and residuals take a pass each.
+
+    Parameters
+    ----------
+    source : BlockSource
+    by_group : bool
+        Keep a factor per noise group (an estimator that weighs); False keeps one.
+    per_row : bool
+        Keep the group of every row (an estimator that weighs rows one by one).
+    """
+
+    def __init__(self, source: BlockSource, *, by_group: bool, per_row: bool) -> None:
+        self.source = source
+        self._by_group = by_group
+        self._per_row = per_row
+        self._factors: GroupFactors | None = None
+
+    @property
+    def factors(self) -> GroupFactors:
+        """The groups' factors (one pass over the blocks, the first time)."""
+        if self._factors is None:
+            self._factors = group_factors(
+                self.source, keep_groups=self._per_row, by_group=self._by_group
+            )
+        return self._factors
+
+    @property
+    def n_columns(self) -> int:
+        """Columns c of the regressor."""
+        return self.factors.n_columns
+
+    def fit(
+        self,
+        weights: Weights | None,
+        *,
+        rtol: float,
+        std: StdMethod,
+        max_std_percent: float | None,
+        labels: tuple[str, ...] | None,
+    ) -> LeastSquaresFit:
+        """The fit of the weighted rows, unweighted residual statistics (the engine's)."""
+        F = self.factors
+        kw = {"rtol": rtol, "std": std, "max_std_percent": max_std_percent, "labels": labels}
+        if weights is None:
+            meat = lambda b, k: _meat(self.source, b, k, None)  # noqa: E731
+            return _fit_pruned(F.combined(), F.n_rows, meat=meat, **kw)  # type: ignore[arg-type]
+        w = weights
+        if w.group is not None:
+            factor = F.combined(w.group)
+        else:
+            factor = _weighted_factor(self.source, lambda o, g: w.of_rows(g, o), F.n_columns)
+        meat = lambda b, k: _meat(self.source, b, k, lambda o, g: w.of_rows(g, o))  # noqa: E731
+        fit = _fit_pruned(factor, F.n_rows, meat=meat, **kw)  # type: ignore[arg-type]
+        return _unweighted(fit, F)
+
+    def residuals(self, beta: NDArray[np.float64], per_row: bool) -> tuple[
+        NDArray[np.float64],
+        NDArray[np.intp],
+        NDArray[np.float64] | None,
+        NDArray[np.intp] | None,
+    ]:
+        """The groups' residual sums of squares (from the factors), and every row's residual
+        when ``per_row`` (one pass)."""
+        F = self.factors
+        if not per_row:
+            return F.residual_ss(beta), F.rows, None, None
+        assert F.groups is not None, "BlockRows(per_row=True) keeps the groups"
+        m = F.n_rows
+        e = np.empty(m)
+        o = 0
+        for W, y, _g in _blocks(self.source):
+            if o + y.size > m:
+                break
+            np.subtract(y, W @ beta, out=e[o : o + y.size])
+            o += y.size
+        if o != m:
+            raise DataError(f"the regressor blocks changed between passes ({m} rows, then {o})")
+        k = F.rows.size
+        squares = np.asarray(np.bincount(F.groups, e * e, minlength=k)[:k], dtype=np.float64)
+        return squares, F.rows, e, F.groups
 
 
 def fit_streamed(
@@ -509,31 +566,16 @@ def fit_streamed(
     max_std_percent: float | None = None,
     labels: tuple[str, ...] | None = None,
 ) -> LeastSquaresFit:
-    """Fit ``W beta = y`` with an estimator over the blocks of ``source`` (module docstring).
+    """Fit ``W beta = y`` with an estimator over the blocks of ``source``: the engine
+    (:func:`~dynid.identification.engine.fit_rows`) on :class:`BlockRows`.
 
-    The estimates and statistics are those of ``estimator.fit`` on the stacked rows
-    (:mod:`dynid.identification.estimators`), to rounding.
-
-    Parameters
-    ----------
-    source : BlockSource
-        Blocks ``(W_b (m_b, c), y_b (m_b,), groups_b (m_b,))``, the same at every call.
-    estimator : Estimator
-        OLS, WLS and IRLS fit block by block; any other estimator's ``fit`` gets the rows
-        stacked, when they fit within :func:`max_stack_bytes`.
-    rtol : float
-        Relative rank tolerance on the diagonal of R of the column-scaled regressor.
-    std : {"classical", "robust"}
-    max_std_percent : float, optional
-        Remove the coefficients above this relative standard deviation and re-fit once.
-    labels : tuple of str, length c, optional
-        Column names for a rank-deficiency message.
+    The estimates and statistics are those of the same estimator on the rows stacked, to
+    rounding.
 
     Raises
     ------
     OptionError
-        An estimator other than OLS, WLS, IRLS (its ``fit`` takes the stacked rows) on rows
-        beyond :func:`max_stack_bytes`, or an unknown ``std``.
+        An unknown ``std``.
     ShapeError
         Inconsistent blocks.
     NonFiniteError
@@ -541,115 +583,10 @@ def fit_streamed(
     RankDeficientError
         Rank below the column count.
     """
-    checked_std(std)
-    if not isinstance(estimator, OLS | WLS | IRLS):
-        W, y, g = _stacked(source, estimator.name)
-        return estimator.fit(
-            W, y, g, rtol=rtol, std=std, max_std_percent=max_std_percent, labels=labels
-        )
-    F = group_factors(source, keep_groups=isinstance(estimator, IRLS))
-    m = F.n_rows
-    kw = {"rtol": rtol, "max_std_percent": max_std_percent, "labels": labels}
-    if isinstance(estimator, OLS):
-        return _fit_pruned(
-            F.combined(),
-            m,
-            std=std,
-            meat=lambda b, k: _meat(source, b, k, None),
-            **kw,  # type: ignore[arg-type]
-        )
-    s0 = _noise(F, rtol)
-    if isinstance(estimator, WLS):
-        wg = 1.0 / s0
-        fit = _fit_pruned(
-            F.combined(wg),
-            m,
-            std=std,
-            meat=lambda b, k: _meat(source, b, k, lambda o, g: wg[g]),
-            **kw,  # type: ignore[arg-type]
-        )
-        return _unweighted(fit, F)
-    return _irls(source, estimator, F, s0, std=std, **kw)  # type: ignore[arg-type]
-
-
-def _stacked(source: BlockSource, name: str) -> Block:
-    """The blocks of ``source`` stacked, for an estimator that needs every row at once.
-
-    Raises
-    ------
-    OptionError
-        The rows exceed :func:`max_stack_bytes`.
-    ShapeError
-        No rows, or inconsistent blocks.
-    NonFiniteError
-        NaN or inf in a block.
-    """
-    parts: list[Block] = []
-    size, limit = 0, max_stack_bytes()
-    for W, y, g in _blocks(source):
-        size += 8 * y.size * (W.shape[1] + 1)
-        if size > limit:
-            raise OptionError(
-                f"estimator {name!r} needs the whole regressor, which is too large here to "
-                f"hold; use ols, wls or irls, or raise {_ENV}"
-            )
-        parts.append((W, y, g))
-    if not parts:
-        raise ShapeError("the block source gave no rows")
-    W = np.concatenate([b[0] for b in parts])
-    return W, np.concatenate([b[1] for b in parts]), np.concatenate([b[2] for b in parts])
-
-
-def _irls(
-    source: BlockSource,
-    est: IRLS,
-    F: GroupFactors,
-    s0: NDArray[np.float64],
-    *,
-    rtol: float,
-    std: StdMethod,
-    max_std_percent: float | None,
-    labels: tuple[str, ...] | None,
-) -> LeastSquaresFit:
-    """Huber IRLS as :class:`~dynid.identification.estimators.IRLS`, two passes an
-    iteration (the weighted factor, the residuals)."""
-    assert F.groups is not None
-    groups = F.groups
-    m, c = F.n_rows, F.n_columns
-    w = 1.0 / s0[groups]
-    e = np.empty(m)
-    beta = None
-
-    def row_weights(o: int, g: NDArray[np.intp]) -> NDArray[np.float64]:
-        return w[o : o + g.size]
-
-    for _ in range(est.max_iter):
-        Rw = _weighted_factor(source, row_weights, c)
-        fb = _solve(Rw, m, np.ones(c, dtype=bool), rtol, labels).beta
-        o = 0
-        for W, y, _g in _blocks(source):
-            np.subtract(y, W @ fb, out=e[o : o + y.size])
-            o += y.size
-        if o != m:
-            raise DataError(f"the regressor blocks changed between passes ({o} rows, then {m})")
-        w = huber_weights(e, groups, s0, est.c)
-        done = beta is not None and np.linalg.norm(fb - beta) <= est.tol * max(
-            float(np.linalg.norm(fb)), 1e-300
-        )
-        beta = fb
-        if done:
-            break
-    del e
-    fit = _fit_pruned(
-        _weighted_factor(source, row_weights, c),
-        m,
-        rtol=rtol,
-        std=std,
-        max_std_percent=max_std_percent,
-        labels=labels,
-        meat=lambda b, k: _meat(source, b, k, lambda o, g: w[o : o + g.size]),
+    rows = BlockRows(source, by_group=estimator.weighted, per_row=estimator.per_row)
+    return fit_rows(
+        rows, estimator, rtol=rtol, std=std, max_std_percent=max_std_percent, labels=labels
     )
-    return _unweighted(fit, F)
 
 
 def _weighted_factor(
