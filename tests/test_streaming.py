@@ -13,8 +13,8 @@ import pytest
 from dynid.exceptions import NonFiniteError, OptionError, RankDeficientError, ShapeError
 from dynid.identification.engine import fit_stacked
 from dynid.identification.estimators import IRLS, OLS, WLS, Residuals, Weights
+from dynid.identification.streamed import fit_streamed
 from dynid.identification.streaming import (
-    fit_streamed,
     group_factors,
     max_stack_bytes,
     streams,

@@ -68,7 +68,9 @@ class Rows(Protocol):
         ``max_std_percent``, with the residual statistics of the unweighted rows."""
         ...
 
-    def residuals(self, beta: NDArray[np.float64], per_row: bool) -> tuple[
+    def residuals(
+        self, beta: NDArray[np.float64], per_row: bool
+    ) -> tuple[
         NDArray[np.float64],
         NDArray[np.intp],
         NDArray[np.float64] | None,
@@ -161,7 +163,9 @@ def fit_stacked(
     y = _checks.as_array("y", y)
     g = np.asarray(groups, dtype=np.intp)
     if W.ndim != 2 or y.shape != (W.shape[0],) or g.shape != y.shape:
-        raise ShapeError(f"W must be (m, c), y and groups (m,); got {W.shape}, {y.shape}, {g.shape}")
+        raise ShapeError(
+            f"W must be (m, c), y and groups (m,); got {W.shape}, {y.shape}, {g.shape}"
+        )
     if g.size and g.min() < 0:
         raise ShapeError("noise groups must be non-negative integers")
     return fit_rows(
@@ -236,7 +240,9 @@ class HeldRows:
         _checks.finite("regressor", W)
         return _weighted(W, y, weights.of_rows(g), rtol, std, max_std_percent, labels)
 
-    def residuals(self, beta: NDArray[np.float64], per_row: bool) -> tuple[
+    def residuals(
+        self, beta: NDArray[np.float64], per_row: bool
+    ) -> tuple[
         NDArray[np.float64],
         NDArray[np.intp],
         NDArray[np.float64] | None,
