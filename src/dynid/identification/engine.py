@@ -55,6 +55,11 @@ class Rows(Protocol):
         """Columns c of the regressor."""
         ...
 
+    @property
+    def cheap(self) -> bool:
+        """True when a pass over the rows costs little against a solve (rows in memory)."""
+        ...
+
     def fit(
         self,
         weights: Weights | None,
@@ -118,7 +123,9 @@ def fit_rows(
     checked_std(std)
     if not estimator.weighted:
         return rows.fit(None, rtol=rtol, std=std, max_std_percent=max_std_percent, labels=labels)
-    fit = rows.fit(None, rtol=rtol, std="classical", max_std_percent=None, labels=labels)
+    # the weighted fits' own standard deviations where a pass over the rows is cheap
+    each = std if rows.cheap else "classical"
+    fit = rows.fit(None, rtol=rtol, std=each, max_std_percent=None, labels=labels)
     beta, previous = np.asarray(fit.beta), None
     noise = None
     weights = None
@@ -131,9 +138,9 @@ def fit_rows(
         if nxt is None:
             break
         weights = nxt
-        fit = rows.fit(weights, rtol=rtol, std="classical", max_std_percent=None, labels=labels)
+        fit = rows.fit(weights, rtol=rtol, std=each, max_std_percent=None, labels=labels)
         previous, beta = beta, np.asarray(fit.beta)
-    if std == "classical" and max_std_percent is None:
+    if std == each and max_std_percent is None:
         return fit
     return rows.fit(weights, rtol=rtol, std=std, max_std_percent=max_std_percent, labels=labels)
 
@@ -178,11 +185,10 @@ def fit_stacked(
     )
 
 
-@dataclasses.dataclass(frozen=True, slots=True, eq=False)
 class HeldRows:
     """Rows held in memory: ``W`` (M, c), ``y`` (M,), ``groups`` (M,) and the blocks used.
 
-    Attributes
+    Parameters
     ----------
     W, y, groups : ndarray
         Every row of the stack.
@@ -193,11 +199,20 @@ class HeldRows:
         ``W^T W`` over the rows used, when known.
     """
 
-    W: NDArray[np.float64]
-    y: NDArray[np.float64]
-    groups: NDArray[np.intp]
-    blocks: NDArray[np.intp] | None = None
-    gram: NDArray[np.float64] | None = None
+    def __init__(
+        self,
+        W: NDArray[np.float64],
+        y: NDArray[np.float64],
+        groups: NDArray[np.intp],
+        blocks: NDArray[np.intp] | None = None,
+        gram: NDArray[np.float64] | None = None,
+    ) -> None:
+        self.W, self.y, self.groups, self.blocks, self.gram = W, y, groups, blocks, gram
+        self._rows: tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.intp]] | None
+        self._rows = None
+
+    #: Passes over rows in memory are cheap.
+    cheap = True
 
     @property
     def n_columns(self) -> int:
@@ -205,15 +220,28 @@ class HeldRows:
         return int(self.W.shape[1])
 
     def _used(self) -> tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.intp]]:
-        """The rows used, in block order."""
-        if self.blocks is None:
-            return self.W, self.y, self.groups
-        idx = np.concatenate(
-            [np.arange(a, b) for a, b, _ in self.blocks] + [np.zeros(0, dtype=np.intp)]
-        )
-        if idx.size == self.y.size and np.all(idx == np.arange(idx.size)):
-            return self.W, self.y, self.groups
-        return self.W[idx], self.y[idx], self.groups[idx]
+        """The rows used, in block order (copied once, when not all rows in order)."""
+        if self._rows is None:
+            blk = self.blocks
+            M = self.y.size
+            if blk is None or (
+                blk.size
+                and blk[0, 0] == 0
+                and blk[-1, 1] == M
+                and np.all(blk[1:, 0] == blk[:-1, 1])
+            ):
+                self._rows = self.W, self.y, self.groups
+            else:
+                idx = np.concatenate(
+                    [np.arange(a, b) for a, b, _ in blk] + [np.zeros(0, dtype=np.intp)]
+                )
+                W = np.empty((idx.size, self.W.shape[1]), order="F")
+                o = 0
+                for a, b, _ in blk:
+                    W[o : o + b - a] = self.W[a:b]
+                    o += b - a
+                self._rows = W, self.y[idx], self.groups[idx]
+        return self._rows
 
     def fit(
         self,

@@ -223,6 +223,9 @@ class BlockRows:
         Keep the group of every row (an estimator that weighs rows one by one).
     """
 
+    #: A pass computes the rows again.
+    cheap = False
+
     def __init__(self, source: BlockSource, *, by_group: bool, per_row: bool) -> None:
         self.source = source
         self._by_group = by_group
