@@ -61,7 +61,7 @@ from .estimators import (
     estimator_named,
     row_weights,
 )
-from .holdout import DEFAULT_FOLDS, HeldOut, block_labels, block_normals
+from .holdout import DEFAULT_FOLDS, HeldOut, Normals, block_labels, block_normals
 from .info import IdentificationInfo, LogInfo
 from .least_squares import StdMethod
 from .log import LogCleaning, TorqueLog, joint_side_log, prepare_log
@@ -214,7 +214,17 @@ def identify_from_log(
         max_std_percent=max_std_percent,
         rtol=rtol,
         judge=_judge(robot, prepared, estimator, folds, validate_on, prepared.cutoff_hz, trim_s),
+        fold_labels=_fold_labels(prepared, folds) if validate_on is None else None,
     )
+
+
+def _fold_labels(prepared: PreparedLog, folds: int) -> NDArray[np.intp] | None:
+    """The fold of every row of the prepared log (contiguous time blocks), or None when the
+    log is too short for them."""
+    try:
+        return np.repeat(block_labels(prepared.log.n_samples, folds), prepared.n)
+    except OptionError:
+        return None
 
 
 def _judge(
@@ -240,7 +250,8 @@ def _judge(
     ) -> HeldOut | None:
         b = np.asarray(beta)[cols]
         if isinstance(stack, StreamedRows):
-            return _held_out_streamed(selected_columns(stack.source, cols), b, cols, columns)
+            source = selected_columns(stack.source, cols)
+            return _held_out_streamed(source, b, cols, columns, stack.normals)
         W, y = (stack.W if cols.all() else stack.W[:, cols]), stack.y
         rw = row_weights(est, W, y, stack.groups, b)
         if validate_on is None:
@@ -258,8 +269,12 @@ def _judge(
         b: NDArray[np.float64],
         cols: NDArray[np.bool_],
         columns: ModelColumns,
+        stack_normals: tuple[Normals, ...] | None,
     ) -> HeldOut | None:
-        """The judgement of rows left in blocks (a long log), from their normal equations."""
+        """The judgement of rows left in blocks (a long log), from their normal equations
+        (those of the folds gathered by the fit's pass when it was given them)."""
+        if validate_on is None and stack_normals is not None:
+            return HeldOut.k_fold(stack_normals).expanded(cols)
         e = np.concatenate([y - W @ b for W, y, _ in source()])
         N = e.size // n
         rw = est.row_weights(e, np.tile(np.arange(n, dtype=np.intp), N), b.size)

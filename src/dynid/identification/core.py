@@ -129,25 +129,45 @@ def fit_stack(
     NonFiniteError
         NaN or inf in the regressor.
     """
-    est = estimator_named(estimator)
+    return _fitted(stack, labels, estimator_named(estimator), std, max_std_percent, rtol, frozen)[0]
+
+
+def _fitted(
+    stack: RegressorStack | StreamedRows,
+    labels: tuple[str, ...],
+    est: Estimator,
+    std: StdMethod,
+    max_std_percent: float | None,
+    rtol: float,
+    frozen: NDArray[np.bool_] | None,
+    fold_labels: NDArray[np.intp] | None = None,
+) -> tuple[LeastSquaresFit, RegressorStack | StreamedRows]:
+    """:func:`fit_stack`, and the stack with what the fit's pass learnt of rows read in
+    blocks (their count; the normal equations of the ``fold_labels`` when the estimator
+    does not weigh)."""
     cols = np.ones(len(labels), dtype=bool) if frozen is None else ~np.asarray(frozen, bool)
     kept_labels = tuple(lab for lab, c in zip(labels, cols, strict=True) if c)
+    rows = _rows(stack, cols, est, None if est.weighted else fold_labels)
     fit = fit_rows(
-        _rows(stack, cols, est),
-        est,
-        rtol=rtol,
-        std=std,
-        max_std_percent=max_std_percent,
-        labels=kept_labels,
+        rows, est, rtol=rtol, std=std, max_std_percent=max_std_percent, labels=kept_labels
     )
-    return fit if cols.all() else _expanded(fit, cols)
+    if isinstance(rows, BlockRows):
+        assert isinstance(stack, StreamedRows)
+        normals = rows.factors.normals
+        stack = dataclasses.replace(stack, n_rows=fit.n_rows, normals=normals)
+    return (fit if cols.all() else _expanded(fit, cols)), stack
 
 
-def _rows(stack: RegressorStack | StreamedRows, cols: NDArray[np.bool_], est: Estimator) -> Rows:
+def _rows(
+    stack: RegressorStack | StreamedRows,
+    cols: NDArray[np.bool_],
+    est: Estimator,
+    fold_labels: NDArray[np.intp] | None = None,
+) -> Rows:
     """The stack's rows over the columns ``cols`` (c,), as the engine takes them."""
     if isinstance(stack, StreamedRows):
         source = selected_columns(stack.source, cols)
-        return BlockRows(source, by_group=est.weighted, per_row=est.per_row)
+        return BlockRows(source, by_group=est.weighted, per_row=est.per_row, labels=fold_labels)
     W, rows = stack.W, stack.used_rows
     grams = None if stack.grams is None else stack.grams[stack.kept]
     if not cols.all():
@@ -171,6 +191,7 @@ def identify(
     max_std_percent: float | None = None,
     rtol: float | None = None,
     judge: Judge | None = None,
+    fold_labels: NDArray[np.intp] | None = None,
 ) -> IdentifiedModel:
     """Identify the base parameters (and the appended terms: friction) from a data set.
 
@@ -203,6 +224,11 @@ def identify(
     judge : callable, optional
         Held-out judgement (:data:`Judge`): its folds are kept (``holdout``) and their
         errors recorded (``heldout``).
+    fold_labels : ndarray of int, shape (m,), optional
+        The judge's label of every row (its folds), in block order: on rows read in blocks
+        with an estimator that does not weigh, the fit's pass gathers their normal
+        equations (``StreamedRows.normals``, handed to the judge) so that the judgement
+        needs no pass of its own.
 
     Returns
     -------
@@ -238,19 +264,11 @@ def identify(
     est = estimator_named(estimator)
     frozen = data.frozen_columns(columns)
     try:
-        fit = fit_stack(
-            stack,
-            labels,
-            estimator=est,
-            std=std,
-            max_std_percent=max_std_percent,
-            rtol=fit_rtol,
-            frozen=frozen,
+        fit, stack = _fitted(
+            stack, labels, est, std, max_std_percent, fit_rtol, frozen, fold_labels
         )
     except RankDeficientError as exc:
         raise _rank_error(exc, data, columns, stack, fit_rtol) from exc
-    if isinstance(stack, StreamedRows):
-        stack = dataclasses.replace(stack, n_rows=fit.n_rows)
     held = None if judge is None else judge(stack, columns, ~frozen, fit.beta)
     for msg in conditioning_advice(fit, labels, what=_what(data)):
         warnings.warn(msg, DynidWarning, stacklevel=2)

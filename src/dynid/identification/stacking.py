@@ -21,7 +21,7 @@ from numpy.typing import NDArray
 from ..exceptions import DynidWarning, ShapeError
 from ..model.robot import Robot
 from .dataset import Dataset, ModelColumns, RegressorBlock
-from .holdout import HeldOut
+from .holdout import HeldOut, Normals
 from .solvers import block_grams
 from .streaming import BlockSource
 
@@ -117,11 +117,15 @@ class StreamedRows:
     dropped : tuple of str
         Labels of the noise groups dropped (no information); empty for a torque log,
         whose blocks are not judged.
+    normals : tuple of Normals, optional
+        The unweighted normal equations of the rows of each fold, gathered by the fit's
+        pass (:func:`~dynid.identification.core.identify`'s ``fold_labels``).
     """
 
     source: BlockSource
     n_rows: int = 0
     dropped: tuple[str, ...] = ()
+    normals: tuple[Normals, ...] | None = None
 
 
 Judge = Callable[

@@ -221,15 +221,26 @@ class BlockRows:
         Keep a factor per noise group (an estimator that weighs); False keeps one.
     per_row : bool
         Keep the group of every row (an estimator that weighs rows one by one).
+    labels : ndarray of int, shape (m,), optional
+        Labels of the rows whose unweighted normal equations the first pass gathers too
+        (``factors.normals``: the folds of a held-out judgement, no pass of their own).
     """
 
     #: A pass computes the rows again.
     cheap = False
 
-    def __init__(self, source: BlockSource, *, by_group: bool, per_row: bool) -> None:
+    def __init__(
+        self,
+        source: BlockSource,
+        *,
+        by_group: bool,
+        per_row: bool,
+        labels: NDArray[np.intp] | None = None,
+    ) -> None:
         self.source = source
         self._by_group = by_group
         self._per_row = per_row
+        self._labels = labels
         self._factors: GroupFactors | None = None
 
     @property
@@ -237,7 +248,10 @@ class BlockRows:
         """The groups' factors (one pass over the blocks, the first time)."""
         if self._factors is None:
             self._factors = group_factors(
-                self.source, keep_groups=self._per_row, by_group=self._by_group
+                self.source,
+                keep_groups=self._per_row,
+                by_group=self._by_group,
+                labels=self._labels,
             )
         return self._factors
 

@@ -128,6 +128,9 @@ class GroupFactors:
         ``||y_g||^2`` of each group, when ``R`` is None.
     source : BlockSource or None
         The blocks again, for the passes that replace ``R`` when it is None.
+    normals : tuple of Normals, optional
+        The normal equations of the rows of each label, when :func:`group_factors` was
+        given labels.
     """
 
     R: NDArray[np.float64] | None
@@ -136,6 +139,7 @@ class GroupFactors:
     total: NDArray[np.float64] | None = None
     target: NDArray[np.float64] | None = None
     source: BlockSource | None = None
+    normals: tuple[Normals, ...] | None = None
 
     @property
     def n_rows(self) -> int:
@@ -198,6 +202,16 @@ def _triangular(X: NDArray[np.float64]) -> NDArray[np.float64]:
     return R
 
 
+def _stacked_r(buf: NDArray[np.float64]) -> NDArray[np.float64]:
+    """The upper triangular factor (k, k) of ``buf`` (M, k), M >= k, column-major,
+    overwritten (LAPACK ``dgeqrf`` in place: no copy of the block)."""
+    k = buf.shape[1]
+    qr, _, _, info = scipy.linalg.lapack.dgeqrf(buf, overwrite_a=1)
+    if info != 0:  # pragma: no cover - LAPACK argument error
+        raise ShapeError(f"LAPACK dgeqrf failed with info={info}")
+    return np.triu(qr[:k])
+
+
 def _blocks(source: BlockSource) -> Iterable[Block]:
     """The source's blocks checked: shapes, finite values, integer groups."""
     c = None
@@ -221,7 +235,11 @@ def _blocks(source: BlockSource) -> Iterable[Block]:
 
 
 def group_factors(
-    source: BlockSource, *, keep_groups: bool = False, by_group: bool = True
+    source: BlockSource,
+    *,
+    keep_groups: bool = False,
+    by_group: bool = True,
+    labels: NDArray[np.intp] | None = None,
 ) -> GroupFactors:
     """One pass over the blocks: the triangular factor of ``[W_g y_g]`` of every group (or,
     past :data:`GROUP_FACTOR_BYTES`, of all rows with the groups' counts and targets).
@@ -234,6 +252,10 @@ def group_factors(
     by_group : bool
         A factor per group; False keeps the factor of all rows only (an estimator that
         does not weigh).
+    labels : ndarray of int, shape (m,), optional
+        A label ``0 .. k-1`` of every row in block order (the folds of a held-out
+        judgement): the normal equations of each label's rows are gathered in the same pass
+        (``normals``).
 
     Raises
     ------
@@ -247,12 +269,20 @@ def group_factors(
     seen: list[NDArray[np.intp]] = []
     total: NDArray[np.float64] | None = None
     count, target = np.zeros(0, dtype=np.intp), np.zeros(0)
-    c = 0
+    c = o = 0
+    L = int(labels.max()) + 1 if labels is not None and labels.size else 0
+    LG: NDArray[np.float64] | None = None
     for W, y, g in _blocks(source):
         c = W.shape[1]
-        X = np.empty((W.shape[0], c + 1), order="F")
+        buf = np.empty((c + 1 + W.shape[0], c + 1), order="F")  # [R; W y] for the QR below
+        X = buf[c + 1 :]
         X[:, :c] = W
         X[:, c] = y
+        if labels is not None:
+            if LG is None:
+                LG = np.zeros((L, c + 1, c + 1))
+            _label_grams(LG, X, labels, o)
+        o += y.size
         k = max(count.size, int(g.max(initial=-1)) + 1)
         count = np.bincount(g, minlength=k) + np.pad(count, (0, k - count.size))
         squares = np.asarray(np.bincount(g, y * y, minlength=k), dtype=np.float64)
@@ -263,27 +293,54 @@ def group_factors(
             total = _triangular(np.vstack([np.zeros((c + 1, c + 1)), *R.values()]))
             R.clear()
         if total is not None:
-            total = _triangular(_on_top(total, X))
+            buf[: c + 1] = total
+            total = _stacked_r(buf)
         else:
             for gv in np.unique(g):
                 sel = X[g == gv]
                 prev = R.get(int(gv))
                 R[int(gv)] = _triangular(sel if prev is None else np.vstack([prev, sel]))
                 rows[int(gv)] = rows.get(int(gv), 0) + sel.shape[0]
-        del X
+        del X, buf
         if keep_groups:
             seen.append(g.copy())
     if not R and total is None:
         raise ShapeError("no regressor rows: the data hold no block")
     groups = np.concatenate(seen) if keep_groups else None
+    normals = None
+    if labels is not None:
+        if o != labels.size or LG is None:
+            raise ShapeError(f"labels hold {labels.size} rows; the blocks {o}")
+        cnt_l = np.bincount(labels, minlength=L)
+        normals = tuple(
+            Normals(LG[j, :c, :c], LG[j, :c, c], float(LG[j, c, c]), int(cnt_l[j]))
+            for j in range(L)
+        )
     if total is not None:
-        return GroupFactors(None, count, groups, total=total, target=target, source=source)
+        return GroupFactors(
+            None, count, groups, total=total, target=target, source=source, normals=normals
+        )
     k = max(R) + 1
     out = np.zeros((k, c + 1, c + 1))
     cnt = np.zeros(k, dtype=np.intp)
     for gv, Rg in R.items():
         out[gv], cnt[gv] = Rg, rows[gv]
-    return GroupFactors(R=out, rows=cnt, groups=groups)
+    return GroupFactors(R=out, rows=cnt, groups=groups, normals=normals)
+
+
+def _label_grams(
+    LG: NDArray[np.float64], X: NDArray[np.float64], labels: NDArray[np.intp], o: int
+) -> None:
+    """Add ``X_j^T X_j`` of the rows of each label to ``LG[j]``; ``X`` (m_b, c+1) holds the
+    rows ``o .. o + m_b`` (labels in runs, as time folds: one product per run)."""
+    lab = labels[o : o + X.shape[0]]
+    if lab.size != X.shape[0]:
+        raise ShapeError(f"labels hold {labels.size} rows; the blocks more")
+    cuts = np.concatenate([[0], np.flatnonzero(np.diff(lab)) + 1, [lab.size]])
+    for a, b in zip(cuts[:-1], cuts[1:], strict=True):
+        if b > a:
+            Xr = X[a:b]
+            LG[lab[a]] += Xr.T @ Xr
 
 
 def _weighted_factor(
