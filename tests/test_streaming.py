@@ -156,3 +156,25 @@ def test_stack_limit_from_the_environment(monkeypatch):
     monkeypatch.setenv("DYNID_MAX_STACK_BYTES", "lots")
     with pytest.raises(OptionError, match="DYNID_MAX_STACK_BYTES"):
         max_stack_bytes()
+
+
+def test_a_filtered_log_read_in_blocks_equals_the_log_stacked(monkeypatch):
+    """A log read in several blocks whose friction columns go through the torques' low-pass
+    (parallel filtering) gives the stacked fit's estimates to 1e-9: each block is filtered
+    with enough of its neighbours' samples that its edges are the whole log's."""
+    import dynid
+    from dynid.identification.classical import identify_from_log
+    from dynid.simulation.measurement import sample_times, simulate_measurement
+    from dynid.simulation.trajectories import random_fourier
+
+    robot = dynid.panda()
+    traj = random_fourier(robot, np.random.default_rng(3))(sample_times(12.0, 1000.0))
+    log = simulate_measurement(robot, traj, rng=np.random.default_rng(4))
+    kw = {"decimate": 1, "cutoff_hz": 20.0}
+    ref = identify_from_log(robot, log, **kw)
+    monkeypatch.setenv("DYNID_MAX_STACK_BYTES", "0")  # 12 000 samples: 3 blocks of rows
+    got = identify_from_log(robot, log, **kw)
+    np.testing.assert_allclose(got.fit.beta, ref.fit.beta, rtol=1e-9, atol=1e-12)
+    np.testing.assert_allclose(got.friction, ref.friction, rtol=1e-9, atol=1e-12)
+    h, hr = got.info.heldout, ref.info.heldout
+    assert h["heldout_error_percent"] == pytest.approx(hr["heldout_error_percent"], rel=1e-9)

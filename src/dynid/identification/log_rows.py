@@ -24,6 +24,11 @@ from .log import TorqueLog
 from .sanity import moving_joints
 from .streaming import BLOCK_ROWS, streams
 
+#: Cycles of the cut-off frequency after which the zero-phase Butterworth low-pass has
+#: forgotten a block's edge (its slowest pole decays as ``exp(-0.38 * 2 pi f_c t)``: 1e-14
+#: after 13.5 cycles): each block is computed this much beyond its ends, filtered, trimmed.
+_SETTLE_CYCLES = 14.0
+
 __all__ = [
     "friction_regressor",
     "log_blocks",
@@ -59,19 +64,32 @@ def log_blocks(
     ``cutoff_hz``: the low-pass the log's torques went through. The columns of the
     appended terms (friction) then go through the same zero-phase low-pass, at the log's
     rate (:func:`parallel_filtered`): a filtered torque rounds the step of Coulomb friction
-    at a reversal, and ``sign(dq)`` left sharp would bias every friction coefficient."""
+    at a reversal, and ``sign(dq)`` left sharp would bias every friction coefficient. In
+    blocks, each block's rows are computed with the samples of :data:`_SETTLE_CYCLES` periods
+    of the cut-off on either side, so that they equal the rows of the log filtered whole."""
     assert log.ddq is not None  # prepare_log always fills ddq
     N, n = log.n_samples, log.n
     drive = columns.drive
     if stream is None:
         stream = streams(N * n, len(columns.labels))
     step = max(1, BLOCK_ROWS // n) if stream else N
+    steps = columns.step_columns()
+    pad = 0  # samples computed beyond each block so that its filtered columns are the whole log's
+    if cutoff_hz is not None and step < N and steps.any():
+        pad = int(np.ceil(_SETTLE_CYCLES * signals.sample_rate(log.t) / cutoff_hz))
     for a in range(0, N, step):
         b = slice(a, a + step)
         q, dq, ddq, tau = log.q[b], log.dq[b], log.ddq[b], log.tau[b]
-        Y, _ = term_regressor(robot, columns.base, columns.terms, q, dq, ddq)
-        if cutoff_hz is not None:
-            Y = parallel_filtered(Y, columns.step_columns(), log.t[b], cutoff_hz)
+        if cutoff_hz is None:
+            Y, _ = term_regressor(robot, columns.base, columns.terms, q, dq, ddq)
+        else:
+            lo, hi = max(0, a - pad), min(N, a + step + pad)
+            w = slice(lo, hi)
+            Y, _ = term_regressor(
+                robot, columns.base, columns.terms, log.q[w], log.dq[w], log.ddq[w]
+            )
+            Y = parallel_filtered(Y, steps, log.t[w], cutoff_hz)
+            Y = Y[a - lo : a - lo + q.shape[0]]
         if drive is not None and drive.rotor_inertia is not None:  # known: subtracted
             tau = tau - drive.rotor_torques(ddq, drive.rotor_inertia)
         m = Y.shape[0]
