@@ -7,7 +7,8 @@ a callable that returns a fresh iterable of ``(W_b, y_b, groups_b)`` (rows of th
 regressor, their targets, their noise groups) each time it is called, always in the same
 order; only small triangular factors are kept between blocks.
 
-**Factors by groups (one pass).** For every noise group ``g`` (a joint of a torque log,
+**Factors by groups (one pass).** An estimator that weighs (WLS, IRLS) gets, for every
+noise group ``g`` (a joint of a torque log,
 a row of ``[tril M; g]`` of static data) the triangular factor ``R_g`` (c+1, c+1) of
 ``[W_g y_g]`` is updated block by block, ``R_g <- qr([R_g; W_gb y_gb])`` (a tall-skinny
 QR, TSQR; Demmel et al. 2012): the same factor as the QR of the whole stack, better
@@ -21,16 +22,23 @@ From these factors alone:
   per-group noise, the unweighted residual of a weighted fit);
 * the factor of a subset of the columns is the QR of those columns of ``R`` (pruning).
 
+An estimator that does not weigh (OLS) gets the factor of all rows only, each block put
+under it in place (one ``dgeqrf`` a block), and, when given the folds of a held-out
+judgement, the normal equations of each fold from the same pass.
+
 The fit on a factor is the one of :func:`~dynid.identification.least_squares.fit_least_squares`
 (column-scaled Householder QR with column pivoting, its rank guard and statistics); the
 estimates and standard deviations agree with the stacked fit to about 1e-12 relative.
+
+The engine (:func:`~dynid.identification.engine.fit_rows`) fits these rows through
+:class:`~dynid.identification.streamed.BlockRows`, any estimator alike.
 
 **Passes over the data.** OLS and WLS with classical standard deviations take one pass;
 the heteroscedasticity-consistent covariance (``"robust"``) needs ``W^T diag(e^2) W`` of
 the final residual: one pass more (two with pruning). Huber IRLS reweights every row from
 the median of its group's residuals: two passes per iteration (the weighted factor, then
 the residuals), holding the residuals, weights and groups of every row (24 bytes a row,
-not ``8 c``).
+not ``8 c``); so does any estimator that weighs rows one by one (``per_row``).
 """
 
 from __future__ import annotations
