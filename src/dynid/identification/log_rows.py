@@ -80,16 +80,19 @@ def log_blocks(
     for a in range(0, N, step):
         b = slice(a, a + step)
         q, dq, ddq, tau = log.q[b], log.dq[b], log.ddq[b], log.tau[b]
-        if cutoff_hz is None:
-            Y, _ = term_regressor(robot, columns.base, columns.terms, q, dq, ddq)
-        else:
+        Y, _ = term_regressor(robot, columns.base, columns.terms, q, dq, ddq)
+        if cutoff_hz is not None and pad == 0:
+            Y = parallel_filtered(Y, steps, log.t[b], cutoff_hz)
+        elif cutoff_hz is not None:  # the appended terms' columns (all that step) with margins
             lo, hi = max(0, a - pad), min(N, a + step + pad)
             w = slice(lo, hi)
-            Y, _ = term_regressor(
-                robot, columns.base, columns.terms, log.q[w], log.dq[w], log.ddq[w]
+            A = np.concatenate(
+                [t.torque_columns(log.q[w], log.dq[w], log.ddq[w]) for t in columns.appended],
+                axis=-1,
             )
-            Y = parallel_filtered(Y, steps, log.t[w], cutoff_hz)
-            Y = Y[a - lo : a - lo + q.shape[0]]
+            r0 = Y.shape[-1] - A.shape[-1]
+            A = parallel_filtered(A, steps[r0:], log.t[w], cutoff_hz)
+            Y[..., r0:] = A[a - lo : a - lo + q.shape[0]]
         if drive is not None and drive.rotor_inertia is not None:  # known: subtracted
             tau = tau - drive.rotor_torques(ddq, drive.rotor_inertia)
         m = Y.shape[0]
