@@ -197,3 +197,30 @@ def test_cli_std_and_estimator_are_honoured_on_both_routes(tmp_path):
         )
         == 2
     )
+
+
+def test_weights_of_groups_or_rows_give_numpys_weighted_solution_and_bad_ones_are_refused():
+    """The engine fits group weights and the same weights given row by row alike, both equal
+    to numpy's lstsq of the weighted rows; weights that are neither, both, 2-D or negative
+    are refused."""
+    from dynid.exceptions import DataError, ShapeError
+    from dynid.identification.engine import HeldRows
+    from dynid.identification.estimators import Weights
+
+    W, y, groups, _ = _linear_problem(3)
+    wg = np.array([2.0, 0.5, 1.0])
+    rows = HeldRows(W, y, groups)
+    kw = {"rtol": 1e-10, "std": "classical", "max_std_percent": None, "labels": None}
+    by_group = rows.fit(Weights(group=wg), **kw)
+    by_row = rows.fit(Weights(row=wg[groups]), **kw)
+    ref = np.linalg.lstsq(W * wg[groups][:, None], y * wg[groups], rcond=None)[0]
+    np.testing.assert_allclose(by_group.beta, ref, rtol=1e-12)
+    np.testing.assert_allclose(by_row.beta, ref, rtol=1e-12)
+    with pytest.raises(ShapeError):
+        Weights()
+    with pytest.raises(ShapeError):
+        Weights(group=wg, row=wg[groups])
+    with pytest.raises(ShapeError):
+        Weights(row=np.ones((2, 2)))
+    with pytest.raises(DataError):
+        Weights(group=-wg)

@@ -16,7 +16,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from ... import _checks
-from ...exceptions import ShapeError
+from ...exceptions import DataError, ShapeError
 
 __all__ = [
     "Estimator",
@@ -53,8 +53,10 @@ class Weights:
             v = getattr(self, name)
             if v is not None:
                 v = _checks.as_array(f"weights.{name}", v)
-                if v.ndim != 1 or not np.all(v > 0):
-                    raise ShapeError(f"weights.{name} must be positive and 1-D")
+                if v.ndim != 1:
+                    raise ShapeError(f"weights.{name} must be 1-D; got shape {v.shape}")
+                if not np.all(v >= 0):
+                    raise DataError(f"weights.{name} must be non-negative")
                 object.__setattr__(self, name, v)
 
     def of_rows(self, groups: NDArray[np.intp], start: int = 0) -> NDArray[np.float64]:
