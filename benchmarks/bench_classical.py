@@ -8,6 +8,10 @@
   Target: under 1 s.
 * dynid, the same on every sample (``decimate=1``, the (N, 7, 70) regressor of ~19 600
   samples).
+* dynid, the same on every sample with the regressor read in blocks of rows
+  (``DYNID_MAX_STACK_BYTES=0``, as a log too long to stack is fitted); reference: the same
+  fit stacked (target, issue 28: within 1.2 times its time; one process, one core, so
+  time is CPU time).
 * dynid, the torque regressor alone on the prepared samples.
 * dynid with drive terms: the same log recorded on the motor side of a drive train (gear
   ratios 100, motor 7 coupled to joint 6, rotor inertias and friction at the motors
@@ -30,8 +34,10 @@ usage: python benchmarks/bench_classical.py [--duration 20] [--rate 1000] [--rep
 from __future__ import annotations
 
 import dataclasses
+import os
 import sys
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 
@@ -108,7 +114,24 @@ def main(argv: list[str] | None = None) -> int:
     ref = measure(lambda: pinocchio_torque_regressor(pin, model, data, q, dq, ddq), **kw)
     end_to_end = measure(lambda: identify_from_log(robot, log), **kw)
     every = measure(lambda: identify_from_log(robot, log, decimate=1), **kw)
+    every_model = identify_from_log(robot, log, decimate=1)
     regressor = measure(lambda: torque_regressor(robot, q, dq, ddq), **kw)
+
+    def in_blocks() -> Any:
+        old = os.environ.get("DYNID_MAX_STACK_BYTES")
+        os.environ["DYNID_MAX_STACK_BYTES"] = "0"
+        try:
+            return identify_from_log(robot, log, decimate=1)
+        finally:
+            if old is None:
+                del os.environ["DYNID_MAX_STACK_BYTES"]
+            else:
+                os.environ["DYNID_MAX_STACK_BYTES"] = old
+
+    streamed = in_blocks()
+    scale = float(np.max(np.abs(every_model.beta)))
+    check_close("read in blocks vs stacked", streamed.beta, every_model.beta, atol=1e-9 * scale)
+    blocks = measure(in_blocks, **kw)
     truth = Drive.from_gears(
         np.full(7, 100.0), [(7, 6, 20.0)], side="motor", rotor_inertia=np.full(7, 3e-5)
     )
@@ -121,6 +144,14 @@ def main(argv: list[str] | None = None) -> int:
     cases = [
         Case(f"identify_from_log, {args.duration:g} s log", N, end_to_end, ref, note=note),
         Case("identify_from_log, decimate=1", N, every, ref, note=note),
+        Case(
+            "identify_from_log, decimate=1, read in blocks",
+            N,
+            blocks,
+            every,
+            ref_name="stacked",
+            note="reference: the same fit with the regressor stacked (target: ref/dynid >= 1/1.2)",
+        ),
         Case("torque regressor only", len(q), regressor, ref, note=note),
         Case(
             "identify_from_log with a coupled drive (motor side, rotors)",
@@ -139,6 +170,7 @@ def main(argv: list[str] | None = None) -> int:
         "meets_target": bool(end_to_end.median < 1.0),
         "with_drive_median_s": round(with_drive.median, 4),
         "with_drive_meets_target": bool(with_drive.median < 1.0),
+        "blocks_over_stacked": round(blocks.median / every.median, 3),
         "decimation": ident.info.log.decimate if ident.info.log else None,
         "rows_in_least_squares": ident.info.n_rows,
         "condition_number": round(ident.fit.condition_number, 2),

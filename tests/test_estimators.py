@@ -12,6 +12,7 @@ import pytest
 import dynid
 from dynid.exceptions import OptionError
 from dynid.identification.classical import identify_from_log
+from dynid.identification.engine import fit_stacked
 from dynid.identification.estimators import IRLS, OLS, WLS, estimator_named
 from dynid.identification.log import TorqueLog
 from dynid.regressors.base import base_parameters
@@ -33,8 +34,8 @@ def test_wls_equals_the_closed_form_weighted_solution():
     """WLS with the residual noise of each group equals (W^T S^-1 W)^-1 W^T S^-1 y with those
     noise levels, and beats OLS when one group is 100 times noisier."""
     W, y, groups, beta = _linear_problem(0)
-    ols = OLS().fit(W, y, groups, rtol=1e-10, std="classical")
-    wls = WLS().fit(W, y, groups, rtol=1e-10, std="classical")
+    ols = fit_stacked(W, y, groups, OLS(), rtol=1e-10, std="classical")
+    wls = fit_stacked(W, y, groups, WLS(), rtol=1e-10, std="classical")
     e = y - W @ ols.beta
     s = np.array(
         [
@@ -59,11 +60,11 @@ def test_irls_resists_outliers_and_its_std_holds():
     bad = rng.choice(y.size, y.size // 20, replace=False)
     yb = y.copy()
     yb[bad] += rng.choice([-1, 1], bad.size) * rng.uniform(5, 20, bad.size)
-    ols = OLS().fit(W, yb, groups, rtol=1e-10, std="classical")
-    irls = IRLS().fit(W, yb, groups, rtol=1e-10, std="classical")
+    ols = fit_stacked(W, yb, groups, OLS(), rtol=1e-10, std="classical")
+    irls = fit_stacked(W, yb, groups, IRLS(), rtol=1e-10, std="classical")
     assert np.max(np.abs(irls.beta - beta) / irls.std) < 5
     assert np.linalg.norm(irls.beta - beta) < 0.1 * np.linalg.norm(ols.beta - beta)
-    clean = IRLS().fit(W, y, groups, rtol=1e-10, std="classical")
+    clean = fit_stacked(W, y, groups, IRLS(), rtol=1e-10, std="classical")
     assert np.max(np.abs(clean.beta - beta) / clean.std) < 5
 
 
@@ -196,3 +197,30 @@ def test_cli_std_and_estimator_are_honoured_on_both_routes(tmp_path):
         )
         == 2
     )
+
+
+def test_weights_of_groups_or_rows_give_numpys_weighted_solution_and_bad_ones_are_refused():
+    """The engine fits group weights and the same weights given row by row alike, both equal
+    to numpy's lstsq of the weighted rows; weights that are neither, both, 2-D or negative
+    are refused."""
+    from dynid.exceptions import DataError, ShapeError
+    from dynid.identification.engine import HeldRows
+    from dynid.identification.estimators import Weights
+
+    W, y, groups, _ = _linear_problem(3)
+    wg = np.array([2.0, 0.5, 1.0])
+    rows = HeldRows(W, y, groups)
+    kw = {"rtol": 1e-10, "std": "classical", "max_std_percent": None, "labels": None}
+    by_group = rows.fit(Weights(group=wg), **kw)
+    by_row = rows.fit(Weights(row=wg[groups]), **kw)
+    ref = np.linalg.lstsq(W * wg[groups][:, None], y * wg[groups], rcond=None)[0]
+    np.testing.assert_allclose(by_group.beta, ref, rtol=1e-12)
+    np.testing.assert_allclose(by_row.beta, ref, rtol=1e-12)
+    with pytest.raises(ShapeError):
+        Weights()
+    with pytest.raises(ShapeError):
+        Weights(group=wg, row=wg[groups])
+    with pytest.raises(ShapeError):
+        Weights(row=np.ones((2, 2)))
+    with pytest.raises(DataError):
+        Weights(group=-wg)

@@ -21,7 +21,7 @@ from dynid.identification.core import (
     stack_dataset,
 )
 from dynid.identification.data import StaticDataset
-from dynid.identification.estimators import row_weights, weighted_fit
+from dynid.identification.estimators import Residuals, Weights, row_weights
 from dynid.identification.info import IdentificationInfo
 from dynid.io.model_json import info_from_dict, load_model_json, model_to_dict
 from dynid.regressors.base import base_parameters
@@ -141,28 +141,22 @@ def test_identification_files_of_the_previous_version_load_with_their_record(nam
 
 @dataclasses.dataclass(frozen=True)
 class _Huber:
-    """A user's estimator: Huber's M-estimator with a fixed threshold ``k`` [N m], fitted by
-    reweighting (the protocol of dynid.identification.estimators, defined outside it)."""
+    """A user's estimator: Huber's M-estimator with a fixed threshold ``k`` [N m], a
+    row-weighting policy reweighted until the estimate stops moving (the protocol of
+    dynid.identification.estimators, defined outside it)."""
 
     k: float
     name: str = "huber"
+    weighted: bool = True
+    per_row: bool = True
 
     def row_weights(self, e: np.ndarray, groups: np.ndarray, n_columns: int) -> np.ndarray:
         return np.sqrt(np.minimum(1.0, self.k / np.maximum(np.abs(e), 1e-300)))
 
-    def fit(self, W, y, groups, *, rtol, std, max_std_percent=None, labels=None):
-        w = np.ones(y.size)
-        beta = np.zeros(W.shape[1])
-        for _ in range(500):
-            fit = weighted_fit(W, y, w, rtol=rtol, std=std, labels=labels)
-            done = np.linalg.norm(fit.beta - beta) <= 1e-14 * np.linalg.norm(fit.beta)
-            beta = np.asarray(fit.beta)
-            if done:
-                break
-            w = self.row_weights(y - W @ beta, groups, W.shape[1])
-        return weighted_fit(
-            W, y, w, rtol=rtol, std=std, max_std_percent=max_std_percent, labels=labels
-        )
+    def reweight(self, res: Residuals) -> Weights | None:
+        if res.step >= 500 or (res.step > 0 and not res.moved(1e-14)):
+            return None
+        return Weights(row=self.row_weights(res.e, res.groups, res.n_columns))
 
 
 @pytest.mark.filterwarnings("ignore:.*indistinguishable from zero")  # OLS: a zero coefficient

@@ -469,13 +469,13 @@ def _tall_problem(seed, m=3000, r=12, cond=10.0):
 @pytest.mark.parametrize("std", ["classical", "robust"])
 def test_semi_normal_route_equals_the_qr_route_on_a_well_conditioned_problem(monkeypatch, std):
     """Issue 3: CSNE (tall, cond <= 100) and pivoted QR give the same fit to 1e-10."""
-    from dynid.identification import least_squares as ls
+    from dynid.identification import solvers
 
     W, y = _tall_problem(120)
     calls = _spy_qr(monkeypatch)
     fast = fit_least_squares(W, y, std=std)
     assert calls == []  # the semi-normal route was taken
-    monkeypatch.setattr(ls, "_CSNE_MAX_COND", 0.0)  # force the QR route
+    monkeypatch.setattr(solvers, "_CSNE_MAX_COND", 0.0)  # force the QR route
     qr = fit_least_squares(W, y, std=std)
     assert len(calls) == 1
     assert fast.rank == qr.rank == 12 and fast.n_rows == qr.n_rows == 3000

@@ -1,6 +1,6 @@
 """Least squares over blocks of rows (identification/streaming.py, issue 20 item 5).
 
-References: the stacked estimators of identification/estimators.py on the same rows
+References: the engine on the same rows stacked (identification/engine.py, HeldRows:
 (a different algorithm: the whole regressor, semi-normal equations or one QR) and
 numpy's lstsq (SVD) for the ordinary and weighted estimates.
 """
@@ -11,9 +11,10 @@ import numpy as np
 import pytest
 
 from dynid.exceptions import NonFiniteError, OptionError, RankDeficientError, ShapeError
-from dynid.identification.estimators import IRLS, OLS, WLS
+from dynid.identification.engine import fit_stacked
+from dynid.identification.estimators import IRLS, OLS, WLS, Residuals, Weights
+from dynid.identification.streamed import fit_streamed
 from dynid.identification.streaming import (
-    fit_streamed,
     group_factors,
     max_stack_bytes,
     streams,
@@ -57,7 +58,7 @@ def test_streamed_fit_equals_the_stacked_fit(est, cov):
     """Blocks of 700 rows (groups split unevenly across them) give the stacked estimator's
     estimates, standard deviations and statistics to 1e-10 relative."""
     W, y, g = _problem(3)
-    ref = est.fit(W, y, g, rtol=1e-10, std=cov)
+    ref = fit_stacked(W, y, g, est, rtol=1e-10, std=cov)
     got = fit_streamed(_source(W, y, g, 700), est, rtol=1e-10, std=cov)
     _same(got, ref)
 
@@ -66,7 +67,7 @@ def test_streamed_fit_equals_the_stacked_fit(est, cov):
 def test_streamed_pruning_equals_the_stacked_pruning(est):
     """With --max-std-percent the same coefficients are removed and the re-fit agrees."""
     W, y, g = _problem(4, weak=1e-4)  # column 2's coefficient is lost in the noise
-    ref = est.fit(W, y, g, rtol=1e-10, std="robust", max_std_percent=30.0)
+    ref = fit_stacked(W, y, g, est, rtol=1e-10, std="robust", max_std_percent=30.0)
     assert not np.all(ref.kept)
     got = fit_streamed(_source(W, y, g, 999), est, rtol=1e-10, std="robust", max_std_percent=30.0)
     _same(got, ref)
@@ -92,9 +93,8 @@ def test_ordinary_and_weighted_estimates_equal_lstsq():
     assert F.n_rows == y.size and list(F.rows) == [np.sum(g == j) for j in range(4)]
 
 
-def test_rank_deficiency_and_bad_blocks_are_named(monkeypatch):
-    """A dependent column is named; NaN, ragged blocks and another estimator beyond the
-    stack limit are refused."""
+def test_rank_deficiency_and_bad_blocks_are_named():
+    """A dependent column is named; NaN and ragged blocks are refused."""
     rng = np.random.default_rng(6)
     W = rng.normal(size=(400, 3))
     W[:, 2] = 2 * W[:, 0]
@@ -108,38 +108,44 @@ def test_rank_deficiency_and_bad_blocks_are_named(monkeypatch):
     with pytest.raises(ShapeError):
         fit_streamed(lambda: iter([(W[:10], y[:9], g[:10])]), OLS(), rtol=1e-10)
 
-    class Other:
-        name = "other"
 
-    monkeypatch.setenv("DYNID_MAX_STACK_BYTES", str(8 * 150 * 4))  # 150 rows of 3 columns
-    with pytest.raises(OptionError, match="'other' needs the whole regressor.*STACK_BYTES"):
-        fit_streamed(_source(W[6:], y[6:], g[6:], 100), Other(), rtol=1e-10)  # type: ignore[arg-type]
+class _Cauchy:
+    """A user's estimator, not built in: Cauchy weights ``1 / sqrt(1 + (e / k)^2)`` of
+    every row with a fixed scale ``k``, reweighted until the estimate moves less than 1e-13."""
+
+    name = "cauchy"
+    weighted = True
+    per_row = True
+    k = 0.5
+
+    def reweight(self, res: Residuals) -> Weights | None:
+        if res.step > 0 and not res.moved(1e-13):
+            return None
+        return Weights(row=self.row_weights(res.e, res.groups, res.n_columns))
+
+    def row_weights(self, e, groups, n_columns):
+        return 1.0 / np.sqrt(1.0 + (e / self.k) ** 2)
 
 
-def test_another_estimator_gets_the_blocks_stacked_within_the_limit():
-    """An estimator other than OLS, WLS, IRLS is handed the rows of every block, in order,
-    with their groups, and its fit is returned as it is."""
-    rng = np.random.default_rng(8)
-    W, y = rng.normal(size=(250, 3)), rng.normal(size=250)
-    g = np.arange(250, dtype=np.intp) % 2
-    seen = {}
+def test_a_users_estimator_fits_on_rows_read_in_blocks():
+    """An estimator written outside the package fits on blocks as on the stacked rows; the
+    estimate is a stationary point of the Cauchy loss (its gradient vanishes to rounding)
+    and scipy's least_squares(loss="cauchy") minimiser to its own tolerance."""
+    from scipy.optimize import least_squares
 
-    class Recorder:
-        name = "recorder"
-
-        def fit(self, W, y, groups, **kw):
-            seen.update(W=W, y=y, groups=groups, kw=kw)
-            return OLS().fit(W, y, groups, **kw)
-
-        def row_weights(self, e, groups, n_columns):
-            return np.ones(e.size)
-
-    fit = fit_streamed(_source(W, y, g, 100), Recorder(), rtol=1e-10, std="robust")
-    np.testing.assert_array_equal(seen["W"], W)
-    np.testing.assert_array_equal(seen["y"], y)
-    np.testing.assert_array_equal(seen["groups"], g)
-    assert seen["kw"]["std"] == "robust"
-    np.testing.assert_allclose(fit.beta, np.linalg.lstsq(W, y, rcond=None)[0], rtol=1e-12)
+    W, y, g = _problem(8, m=1500, c=4)
+    est = _Cauchy()
+    stacked = fit_stacked(W, y, g, est, rtol=1e-10, std="robust")
+    got = fit_streamed(_source(W, y, g, 100), est, rtol=1e-10, std="robust")
+    _same(got, stacked, rtol=1e-8)
+    x0 = np.linalg.lstsq(W, y, rcond=None)[0]
+    ref = least_squares(
+        lambda b: W @ b - y, x0, loss="cauchy", f_scale=est.k, xtol=1e-15, ftol=1e-15, gtol=1e-15
+    ).x
+    e = y - W @ np.asarray(got.beta)
+    grad = W.T @ (e / (1.0 + (e / est.k) ** 2))
+    assert np.linalg.norm(grad) < 1e-10 * np.linalg.norm(W.T @ e)
+    np.testing.assert_allclose(got.beta, ref, rtol=1e-5)
 
 
 def test_stack_limit_from_the_environment(monkeypatch):
@@ -150,3 +156,25 @@ def test_stack_limit_from_the_environment(monkeypatch):
     monkeypatch.setenv("DYNID_MAX_STACK_BYTES", "lots")
     with pytest.raises(OptionError, match="DYNID_MAX_STACK_BYTES"):
         max_stack_bytes()
+
+
+def test_a_filtered_log_read_in_blocks_equals_the_log_stacked(monkeypatch):
+    """A log read in several blocks whose friction columns go through the torques' low-pass
+    (parallel filtering) gives the stacked fit's estimates to 1e-9: each block is filtered
+    with enough of its neighbours' samples that its edges are the whole log's."""
+    import dynid
+    from dynid.identification.classical import identify_from_log
+    from dynid.simulation.measurement import sample_times, simulate_measurement
+    from dynid.simulation.trajectories import random_fourier
+
+    robot = dynid.panda()
+    traj = random_fourier(robot, np.random.default_rng(3))(sample_times(12.0, 1000.0))
+    log = simulate_measurement(robot, traj, rng=np.random.default_rng(4))
+    kw = {"decimate": 1, "cutoff_hz": 20.0}
+    ref = identify_from_log(robot, log, **kw)
+    monkeypatch.setenv("DYNID_MAX_STACK_BYTES", "0")  # 12 000 samples: 3 blocks of rows
+    got = identify_from_log(robot, log, **kw)
+    np.testing.assert_allclose(got.fit.beta, ref.fit.beta, rtol=1e-9, atol=1e-12)
+    np.testing.assert_allclose(got.friction, ref.friction, rtol=1e-9, atol=1e-12)
+    h, hr = got.info.heldout, ref.info.heldout
+    assert h["heldout_error_percent"] == pytest.approx(hr["heldout_error_percent"], rel=1e-9)

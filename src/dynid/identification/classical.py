@@ -37,19 +37,15 @@ from typing import Any, Literal
 import numpy as np
 from numpy.typing import NDArray
 
-from .. import _checks, signals
-from ..exceptions import DataError, DynidWarning, OptionError, ShapeError
+from .. import signals
+from ..exceptions import DynidWarning, OptionError, ShapeError
 from ..model.drive import Drive
 from ..model.robot import Robot
 from ..regressors.base import BaseParameters
 from ..regressors.terms import (
-    LinearFriction,
-    ModelTerm,
-    base_term_columns,
     drive_terms,
     friction_labels,
 )
-from ..regressors.torque import torque_regressor_prepared
 from .core import (
     Judge,
     ModelColumns,
@@ -65,14 +61,22 @@ from .estimators import (
     estimator_named,
     row_weights,
 )
-from .holdout import DEFAULT_FOLDS, HeldOut, block_labels, block_normals
+from .holdout import DEFAULT_FOLDS, HeldOut, Normals, block_labels, block_normals
 from .info import IdentificationInfo, LogInfo
 from .least_squares import StdMethod
 from .log import LogCleaning, TorqueLog, joint_side_log, prepare_log
+from .log_rows import (
+    friction_regressor,
+    log_blocks,
+    parallel_filtered,
+    still_columns,
+    still_friction,
+    term_regressor,
+)
 from .model import IdentifiedModel
 from .rate import cutoff_from_motion, decimation, motion_frequency
 from .sanity import check_torque_log, moving_joints
-from .streaming import BLOCK_ROWS, BlockSource, normals_by_label, streams
+from .streaming import BlockSource, normals_by_label
 
 __all__ = [
     "PreparedLog",
@@ -88,15 +92,6 @@ __all__ = [
 ]
 
 _ = friction_labels  # re-exported: the labels of friction_regressor
-
-
-def friction_regressor(dq: NDArray[np.float64]) -> NDArray[np.float64]:
-    """Regressor ``F`` (..., n, 3 n) of the classical friction at the joints, columns
-    :func:`~dynid.regressors.terms.friction_labels`.
-
-    ``F[..., j, 3 j : 3 j + 3] = (dq_j, sign(dq_j), 1)``; zero elsewhere.
-    """
-    return LinearFriction(Drive.identity(dq.shape[-1])).torque_columns(dq, dq, dq)
 
 
 def auto_decimation(fs: float, cutoff_hz: float | None) -> int:
@@ -219,7 +214,17 @@ def identify_from_log(
         max_std_percent=max_std_percent,
         rtol=rtol,
         judge=_judge(robot, prepared, estimator, folds, validate_on, prepared.cutoff_hz, trim_s),
+        fold_labels=_fold_labels(prepared, folds) if validate_on is None else None,
     )
+
+
+def _fold_labels(prepared: PreparedLog, folds: int) -> NDArray[np.intp] | None:
+    """The fold of every row of the prepared log (contiguous time blocks), or None when the
+    log is too short for them."""
+    try:
+        return np.repeat(block_labels(prepared.log.n_samples, folds), prepared.n)
+    except OptionError:
+        return None
 
 
 def _judge(
@@ -245,7 +250,8 @@ def _judge(
     ) -> HeldOut | None:
         b = np.asarray(beta)[cols]
         if isinstance(stack, StreamedRows):
-            return _held_out_streamed(selected_columns(stack.source, cols), b, cols, columns)
+            source = selected_columns(stack.source, cols)
+            return _held_out_streamed(source, b, cols, columns, stack.normals)
         W, y = (stack.W if cols.all() else stack.W[:, cols]), stack.y
         rw = row_weights(est, W, y, stack.groups, b)
         if validate_on is None:
@@ -263,8 +269,12 @@ def _judge(
         b: NDArray[np.float64],
         cols: NDArray[np.bool_],
         columns: ModelColumns,
+        stack_normals: tuple[Normals, ...] | None,
     ) -> HeldOut | None:
-        """The judgement of rows left in blocks (a long log), from their normal equations."""
+        """The judgement of rows left in blocks (a long log), from their normal equations
+        (those of the folds gathered by the fit's pass when it was given them)."""
+        if validate_on is None and stack_normals is not None:
+            return HeldOut.k_fold(stack_normals).expanded(cols)
         e = np.concatenate([y - W @ b for W, y, _ in source()])
         N = e.size // n
         rw = est.row_weights(e, np.tile(np.arange(n, dtype=np.intp), N), b.size)
@@ -486,7 +496,7 @@ def prepare_torque_log(
     jlog = joint_side_log(log, drive)
     for finding in check_torque_log(robot, jlog):  # sign, units, frozen joints: said first
         warnings.warn(finding, DynidWarning, stacklevel=3)
-    still = _still_friction(jlog, drive)
+    still = still_friction(jlog, drive)
     f_q = None
     if cutoff_hz == "auto":
         f_q = motion_frequency(jlog.q, fs, moving_joints(jlog.dq))
@@ -512,108 +522,3 @@ def prepare_torque_log(
         motion_frequency_hz=f_q,
         resampled=not signals.is_uniform(log.t),
     )
-
-
-def log_blocks(
-    robot: Robot,
-    log: TorqueLog,
-    columns: ModelColumns,
-    *,
-    stream: bool | None = None,
-    cutoff_hz: float | None = None,
-) -> Iterator[RegressorBlock]:
-    """The regressor rows of a prepared log over ``columns``: sample-major (row ``k n + j``
-    is sample ``k``, joint ``j``, its noise group ``j``); known rotor torques of
-    ``columns.drive`` subtracted. One block, or blocks of :data:`BLOCK_ROWS` rows when
-    ``stream`` (default: when the regressor exceeds ``DYNID_MAX_STACK_BYTES``).
-
-    ``cutoff_hz``: the low-pass the log's torques went through. The columns of the
-    appended terms (friction) then go through the same zero-phase low-pass, at the log's
-    rate (:func:`parallel_filtered`): a filtered torque rounds the step of Coulomb friction
-    at a reversal, and ``sign(dq)`` left sharp would bias every friction coefficient."""
-    assert log.ddq is not None  # prepare_log always fills ddq
-    N, n = log.n_samples, log.n
-    drive = columns.drive
-    if stream is None:
-        stream = streams(N * n, len(columns.labels))
-    step = max(1, BLOCK_ROWS // n) if stream else N
-    for a in range(0, N, step):
-        b = slice(a, a + step)
-        q, dq, ddq, tau = log.q[b], log.dq[b], log.ddq[b], log.tau[b]
-        Y, _ = term_regressor(robot, columns.base, columns.terms, q, dq, ddq)
-        if cutoff_hz is not None:
-            Y = parallel_filtered(Y, columns.step_columns(), log.t[b], cutoff_hz)
-        if drive is not None and drive.rotor_inertia is not None:  # known: subtracted
-            tau = tau - drive.rotor_torques(ddq, drive.rotor_inertia)
-        m = Y.shape[0]
-        W = Y.reshape(m * n, -1)
-        _checks.finite("regressor", W)
-        yield RegressorBlock(W=W, y=tau.reshape(-1), groups=np.tile(np.arange(n), m))
-
-
-def parallel_filtered(
-    Y: NDArray[np.float64], cols: NDArray[np.bool_], t: NDArray[np.float64], cutoff_hz: float
-) -> NDArray[np.float64]:
-    """``Y`` (N, n, c) with its columns ``cols`` (c,) low-passed along time at
-    ``cutoff_hz`` (:func:`dynid.signals.lowpass`, the filter of the torques): the
-    "parallel filtering" of Gautier and Khalil, the regressor and the torques through the
-    same filter, for the columns that step at a reversal (the smooth ones are left as
-    computed from the filtered states). Left as it is where the rate is too low for the
-    cut-off (below 2.2 times it) or the samples too few to filter."""
-    idx = np.flatnonzero(cols)
-    if idx.size == 0 or Y.shape[0] < 2:
-        return Y
-    fs = signals.sample_rate(t)
-    if not cutoff_hz < 0.45 * fs:
-        return Y
-    try:
-        Y[..., idx] = signals.lowpass(Y[..., idx], fs, cutoff_hz, axis=0)
-    except DataError:  # too few samples for the filter's padding
-        pass
-    return Y
-
-
-def still_columns(columns: ModelColumns, still: NDArray[np.bool_]) -> NDArray[np.bool_]:
-    """Columns (c,) that need the motion of a joint (motor) flagged in ``still`` (n,)."""
-    need = columns.motion_columns()
-    return (need >= 0) & np.asarray(still, dtype=bool)[np.maximum(need, 0)]
-
-
-def _still_friction(log: TorqueLog, drive: Drive | None) -> NDArray[np.bool_]:
-    """Joints (motors, where the drive's friction acts there) whose velocity never leaves
-    its noise band: their viscous and Coulomb friction is not fitted from noise."""
-    if drive is None:
-        return ~moving_joints(log.dq)
-    return ~moving_joints(log.dq @ drive.friction_transmission.T)
-
-
-def term_regressor(
-    robot: Robot,
-    base: BaseParameters,
-    terms: tuple[ModelTerm, ...],
-    q: NDArray[np.float64],
-    dq: NDArray[np.float64],
-    ddq: NDArray[np.float64],
-) -> tuple[NDArray[np.float64], tuple[str, ...]]:
-    """The regressor (N, n, r + p_t) of the base parameters and the appended terms.
-
-    Columns: the independent base columns in ``base.independent`` order (link parameters
-    from the compiled regressor, then those of the ``in_base`` terms), then every column of
-    each term that is not ``in_base`` (friction). Returns it with its labels.
-    """
-    ind = np.asarray(base.independent)
-    rigid = ind[ind < 10 * robot.n]
-    appended = [t for t in terms if not t.in_base]
-    width = ind.size + sum(len(t.labels) for t in appended)
-    Y = torque_regressor_prepared(robot, q, dq, ddq, robot.gravity, columns=rigid, width=width)
-    c = rigid.size
-    for t, sel in base_term_columns(terms, ind, robot.n):
-        if sel.size:
-            Y[..., c : c + sel.size] = t.torque_columns(q, dq, ddq)[..., sel]
-            c += sel.size
-    labels = base.labels
-    for t in appended:
-        Y[..., c : c + len(t.labels)] = t.torque_columns(q, dq, ddq)
-        c += len(t.labels)
-        labels = labels + t.labels
-    return Y, labels

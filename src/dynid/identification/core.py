@@ -25,35 +25,35 @@ that a long log can be read in pieces; they are concatenated here.
 from __future__ import annotations
 
 import dataclasses
-import itertools
 import logging
 import warnings
-from collections.abc import Callable, Iterable, Iterator
-from dataclasses import dataclass
-from typing import Any, Literal, Protocol
+from typing import Any
 
 import numpy as np
 from numpy.typing import NDArray
 
-from .. import _checks
 from ..exceptions import DynidWarning, OptionError, RankDeficientError, ShapeError
 from ..model.drive import Drive
 from ..model.robot import Robot
 from ..regressors.base import BaseParameters, base_parameters, identifiability
 from ..regressors.terms import ModelTerm, drive_terms
-from .estimators import OLS, Estimator, EstimatorName, estimator_named
+from .dataset import Dataset, ModelColumns, RegressorBlock, RegressorKind
+from .engine import HeldRows, Rows, fit_rows
+from .estimators import Estimator, EstimatorName, estimator_named
 from .holdout import HeldOut, cross_validate
 from .info import FrictionInfo, IdentificationInfo, Route
-from .least_squares import (
-    LeastSquaresFit,
-    StdMethod,
-    block_grams,
-    checked_std,
-    conditioning_advice,
-    fit_blocks,
-)
+from .least_squares import LeastSquaresFit, StdMethod, checked_std, conditioning_advice
 from .model import IdentifiedModel
-from .streaming import BlockSource, fit_streamed
+from .stacking import (
+    DEFAULT_FIT_RTOL,
+    Judge,
+    RegressorStack,
+    StreamedRows,
+    informative_blocks,
+    selected_columns,
+    stack_dataset,
+)
+from .streamed import BlockRows
 
 __all__ = [
     "DEFAULT_FIT_RTOL",
@@ -73,249 +73,6 @@ __all__ = [
 ]
 
 _log = logging.getLogger(__name__)
-
-#: Which regressor a data set stacks (the kind of :func:`~dynid.regressors.base.
-#: base_parameters`).
-RegressorKind = Literal["static", "torque"]
-
-#: Rank tolerance of the fit (diagonal of R, column-scaled) when none is given: the base
-#: parameters' columns are independent by construction, so only degenerate data fall below.
-DEFAULT_FIT_RTOL = 1e-10
-
-#: A dropped block whose data exceed this fraction of the largest |y| triggers a warning:
-#: the robot says the rows are identically zero, the data say otherwise.
-_DROPPED_DATA_RTOL = 1e-6
-
-
-@dataclass(frozen=True, slots=True, eq=False)
-class ModelColumns:
-    """The columns of a model: base parameters, then the appended terms' parameters.
-
-    Attributes
-    ----------
-    base : BaseParameters
-        Over the link parameters and the ``in_base`` terms (rotor inertias).
-    terms : tuple of ModelTerm
-        Every term; those not ``in_base`` (friction) append their columns after ``beta``.
-    drive : Drive, optional
-        The drive the data are read through (known rotor inertias are subtracted).
-    """
-
-    base: BaseParameters
-    terms: tuple[ModelTerm, ...] = ()
-    drive: Drive | None = None
-
-    @property
-    def appended(self) -> tuple[ModelTerm, ...]:
-        """The terms whose columns follow the base parameters."""
-        return tuple(t for t in self.terms if not t.in_base)
-
-    @property
-    def labels(self) -> tuple[str, ...]:
-        """One label per column: ``base.labels`` then the appended terms' labels."""
-        out = self.base.labels
-        for t in self.appended:
-            out = out + t.labels
-        return out
-
-    def appended_term(self, name: str) -> tuple[ModelTerm, slice] | None:
-        """The appended term named ``name`` with its columns, or None."""
-        c = self.base.rank
-        for t in self.appended:
-            if t.name == name:
-                return t, slice(c, c + len(t.labels))
-            c += len(t.labels)
-        return None
-
-    def step_columns(self) -> NDArray[np.bool_]:
-        """(c,): the columns that step where a velocity reverses (a term's ``steps``)."""
-        return self._per_column("steps", False).astype(bool)
-
-    def motion_columns(self) -> NDArray[np.intp]:
-        """(c,): the joint (motor) whose motion each column needs to be identified, -1 for
-        none (a term's ``needs_motion``; the base parameters need none of their own)."""
-        return self._per_column("needs_motion", -1).astype(np.intp)
-
-    def _per_column(self, attr: str, fill: bool | int) -> NDArray[Any]:
-        """An optional per-parameter property ``attr`` of the appended terms over every
-        column, ``fill`` for the base parameters and the terms without it."""
-        out = [np.full(self.base.rank, fill)]
-        for t in self.appended:
-            v = getattr(t, attr, None)
-            out.append(np.full(len(t.labels), fill) if v is None else np.asarray(v))
-        return np.concatenate(out)
-
-
-@dataclass(frozen=True, slots=True, eq=False)
-class RegressorBlock:
-    """Rows of the stacked regressor of one kind, with their targets and noise groups.
-
-    Attributes
-    ----------
-    W : ndarray, shape (m, c)
-        Regressor rows over the model's columns (:class:`ModelColumns` order).
-    y : ndarray, shape (m,)
-        Measured targets (SI: N m, kg m^2).
-    groups : ndarray of int, shape (m,)
-        Noise group of each row (joint of a torque log, row of ``[tril M; g]``).
-    label : str
-        What the rows are (``"g1"``); names a dropped block.
-    first : int
-        ``W[:, :first]`` is exactly zero (products over the rows skip those columns).
-    group_labels : tuple of str
-        Set on a block of rows of many groups that is one of several pieces of data too
-        large to stack (static data of a long chain): the name of every group. The core
-        then fits the pieces in passes (:class:`StreamedRows`), never concatenated, and
-        drops the groups without information by these names.
-    """
-
-    W: NDArray[np.float64]
-    y: NDArray[np.float64]
-    groups: NDArray[np.intp]
-    label: str = ""
-    first: int = 0
-    group_labels: tuple[str, ...] = ()
-
-
-class Dataset(Protocol):
-    """What the core needs of data (module docstring)."""
-
-    @property
-    def route(self) -> Route:
-        """``"static"`` or ``"classical"``: recorded in the model."""
-        ...
-
-    @property
-    def regressor_kind(self) -> RegressorKind:
-        """The regressor it stacks: ``"static"`` or ``"torque"``."""
-        ...
-
-    @property
-    def moving(self) -> bool:
-        """True when the data move (friction acts and can be identified)."""
-        ...
-
-    @property
-    def source(self) -> str:
-        """The data in a few words, for messages (``"static regressor of 5 configuration(s)"``)."""
-        ...
-
-    @property
-    def hint(self) -> str:
-        """What to do when the data do not excite every column (ends a rank error)."""
-        ...
-
-    def check_robot(self, robot: Robot) -> None:
-        """Raise unless the data belong to a robot with ``robot.n`` joints."""
-        ...
-
-    def frozen_columns(self, columns: ModelColumns) -> NDArray[np.bool_]:
-        """Columns (c,) the data cannot excite (left out of the fit)."""
-        ...
-
-    def blocks(self, robot: Robot, columns: ModelColumns) -> Iterator[RegressorBlock]:
-        """The regressor blocks over ``columns`` with their targets."""
-        ...
-
-    def record(self, n_rows: int) -> IdentificationInfo:
-        """The data's part of the model's record (reference, counts, preparation), given
-        the rows used; the core fills in the rest."""
-        ...
-
-
-@dataclass(frozen=True, slots=True, eq=False)
-class RegressorStack:
-    """Blocks concatenated: ``W`` (m, c) column-major, ``y`` (m,), ``groups`` (m,).
-
-    Attributes
-    ----------
-    W, y, groups : ndarray
-        Every block's rows, in block order.
-    rows : ndarray of int, shape (k, 3)
-        ``(start, stop, first)`` of each block.
-    labels : tuple of str
-        Each block's label.
-    kept : ndarray of bool, shape (k,)
-        False for the blocks dropped (no information).
-    grams : ndarray, shape (k, c, c), optional
-        Each block's Gram matrix ``W_b^T W_b`` (None for a single block).
-    """
-
-    W: NDArray[np.float64]
-    y: NDArray[np.float64]
-    groups: NDArray[np.intp]
-    rows: NDArray[np.intp]
-    labels: tuple[str, ...]
-    kept: NDArray[np.bool_]
-    grams: NDArray[np.float64] | None = None
-
-    @property
-    def dropped(self) -> tuple[str, ...]:
-        """Labels of the blocks dropped."""
-        return tuple(self.labels[k] for k in np.flatnonzero(~self.kept))
-
-    @property
-    def used_rows(self) -> NDArray[np.intp]:
-        """``(start, stop, first)`` of the blocks kept."""
-        return self.rows[self.kept]
-
-    @property
-    def n_rows(self) -> int:
-        """Rows used (in the kept blocks)."""
-        r = self.used_rows
-        return int(np.sum(r[:, 1] - r[:, 0]))
-
-    def used(self) -> NDArray[np.intp]:
-        """Indices of the rows used, block after block."""
-        return np.concatenate(
-            [np.arange(a, b) for a, b, _ in self.used_rows] + [np.zeros(0, dtype=np.intp)]
-        )
-
-    def select(self, blocks: NDArray[np.bool_]) -> RegressorStack:
-        """The stack with only the kept blocks among ``blocks`` (k,) used (held-out fits)."""
-        return dataclasses.replace(self, kept=self.kept & np.asarray(blocks, dtype=bool))
-
-
-#: Held-out judgement of a fit (:mod:`dynid.identification.holdout`): called with the stack,
-#: the model's columns, the columns fitted (c,) and the estimates over every column (c,);
-#: returns the folds' normal equations over every column, or None when the data are too
-#: short to judge.
-@dataclass(frozen=True, slots=True, eq=False)
-class StreamedRows:
-    """A data set's rows left in blocks, too many to stack (a long torque log): ``source``
-    yields ``(W, y, groups)`` again for every pass of the fit
-    (:mod:`dynid.identification.streaming`).
-
-    Attributes
-    ----------
-    source : BlockSource
-    n_rows : int
-        Rows over all blocks (0 until the fit has counted them).
-    dropped : tuple of str
-        Labels of the noise groups dropped (no information); empty for a torque log,
-        whose blocks are not judged.
-    """
-
-    source: BlockSource
-    n_rows: int = 0
-    dropped: tuple[str, ...] = ()
-
-
-Judge = Callable[
-    [RegressorStack | StreamedRows, ModelColumns, NDArray[np.bool_], NDArray[np.float64]],
-    HeldOut | None,
-]
-
-
-def informative_blocks(ss: NDArray[np.float64], rtol: float) -> NDArray[np.bool_]:
-    """Blocks with information, from the sums of squares ``ss[j, k]`` of column j, block k.
-
-    A block is uninformative when the norm of its column-scaled regressor is at most
-    ``rtol`` times the largest block's.
-    """
-    col = ss.sum(axis=1)
-    block = np.sqrt(np.sum(ss / np.where(col > 0, col, 1.0)[:, None], axis=0))
-    return block > rtol * float(np.max(block, initial=0.0))
 
 
 def model_columns(
@@ -348,119 +105,6 @@ def model_columns(
     return ModelColumns(base=base, terms=tuple(terms), drive=drive)
 
 
-def stack_dataset(
-    robot: Robot, data: Dataset, columns: ModelColumns, *, rtol: float = DEFAULT_FIT_RTOL
-) -> RegressorStack | StreamedRows:
-    """Concatenate the data's blocks and drop those without information; a torque log
-    that comes in several blocks (too long to stack) is left in them (:class:`StreamedRows`).
-
-    A seam for held-out judgement: :meth:`RegressorStack.select` keeps some blocks for
-    :func:`fit_stack`.
-
-    Warns
-    -----
-    DynidWarning
-        A dropped block holds non-zero data (gravity or kinematics differ from the source's).
-    """
-    blocks = iter(data.blocks(robot, columns))
-    head = list(itertools.islice(blocks, 2))
-    source: BlockSource = lambda: ((b.W, b.y, b.groups) for b in data.blocks(robot, columns))  # noqa: E731
-    if head and head[0].group_labels:  # pieces of many groups: streamed, groups judged
-        labels = head[0].group_labels
-        del head, blocks
-        return _streamed_groups(robot, source, labels, rtol)
-    if data.route == "classical" and len(head) > 1:  # a long log: blocks of rows, streamed
-        del head, blocks
-        return StreamedRows(source)
-    stack = _concatenated(itertools.chain(head, blocks), len(columns.labels))
-    if stack.rows.shape[0] < 2:
-        return stack
-    grams = block_grams(stack.W, stack.rows)
-    info = informative_blocks(np.einsum("kjj->jk", grams), rtol)
-    stack = dataclasses.replace(stack, kept=info, grams=grams)
-    if info.all():
-        return stack
-    y_out = np.concatenate([stack.y[a:b] for a, b, _ in stack.rows[~info]])
-    _warn_dropped(robot, stack.dropped, np.max(np.abs(y_out)), np.max(np.abs(stack.y)), 5)
-    return stack
-
-
-def _warn_dropped(
-    robot: Robot, dropped: tuple[str, ...], big: float, top: float, level: int
-) -> None:
-    """Warn when rows without information hold data (``big`` of the largest ``top``),
-    ``level`` frames above (at the caller of :func:`identify`)."""
-    if big > _DROPPED_DATA_RTOL * top:
-        warnings.warn(
-            f"rows {list(dropped)} carry no information for robot {robot.name!r} (its "
-            f"regressor is zero there) but the data reach |{big:.3g}|; hint: check the "
-            "gravity vector and the kinematics against the source of the data",
-            DynidWarning,
-            stacklevel=level,
-        )
-    _log.info("dropping rows without information: %s", ", ".join(dropped))
-
-
-def _streamed_groups(
-    robot: Robot, source: BlockSource, labels: tuple[str, ...], rtol: float
-) -> StreamedRows:
-    """Rows of many noise groups left in blocks, the groups without information dropped
-    as the stacked route drops its blocks (:func:`informative_blocks` on each group's
-    column sums of squares, one pass)."""
-    k = len(labels)
-    ss: NDArray[np.float64] | None = None
-    ymax = np.zeros(k)
-    for W, y, g in source():
-        if ss is None:
-            ss = np.zeros((W.shape[1], k))
-        for j in range(W.shape[1]):  # one column at a time: no squared copy of the block
-            ss[j] += np.bincount(g, W[:, j] ** 2, minlength=k)
-        np.maximum.at(ymax, g, np.abs(y))
-    if ss is None:
-        raise ShapeError("no regressor rows: the data hold no block")
-    info = informative_blocks(ss, rtol)
-    if info.all():
-        return StreamedRows(source)
-    dropped = tuple(lab for lab, ok in zip(labels, info, strict=True) if not ok)
-    _warn_dropped(robot, dropped, float(ymax[~info].max()), float(ymax.max()), 6)
-
-    def kept() -> Iterator[tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.intp]]]:
-        for W, y, g in source():
-            sel = info[g]
-            yield W[sel], y[sel], g[sel]
-
-    return StreamedRows(kept, dropped=dropped)
-
-
-def _concatenated(blocks: Iterable[RegressorBlock], c: int) -> RegressorStack:
-    """One stack of the blocks, every block kept."""
-    blks = list(blocks)
-    for b in blks:
-        if b.W.ndim != 2 or b.W.shape[1] != c or b.y.shape != (b.W.shape[0],):
-            raise ShapeError(
-                f"a regressor block must be (m, {c}) with y (m,); got {b.W.shape}, {b.y.shape}"
-            )
-    sizes = np.array([b.W.shape[0] for b in blks], dtype=np.intp)
-    stops = np.cumsum(sizes)
-    rows = np.column_stack([stops - sizes, stops, [b.first for b in blks]]).astype(np.intp)
-    if len(blks) == 1:
-        W, y, groups = blks[0].W, blks[0].y, blks[0].groups
-    else:
-        W = np.empty((int(stops[-1]) if blks else 0, c), order="F")
-        for b, (a, e, _) in zip(blks, rows, strict=True):
-            W[a:e] = b.W
-        y = np.concatenate([b.y for b in blks] + [np.zeros(0)])
-        groups = np.concatenate([b.groups for b in blks] + [np.zeros(0, np.intp)])
-    return RegressorStack(
-        W,
-        y,
-        np.asarray(groups, dtype=np.intp),
-        rows,
-        tuple(b.label for b in blks),
-        np.ones(len(blks), dtype=bool),
-    )
-
-
 def fit_stack(
     stack: RegressorStack | StreamedRows,
     labels: tuple[str, ...],
@@ -473,8 +117,10 @@ def fit_stack(
 ) -> LeastSquaresFit:
     """Fit the stacked rows with an estimator; ``frozen`` columns are left out (0, not kept).
 
-    Ordinary least squares takes the blocked path (Gram matrices of the blocks, columns
-    known to be zero skipped); other estimators get the rows used and their groups.
+    The one engine (:func:`~dynid.identification.engine.fit_rows`) on the rows held
+    (:class:`~dynid.identification.engine.HeldRows`, the blocks' Gram matrices reused and
+    their zero columns skipped) or read in blocks
+    (:class:`~dynid.identification.streaming.BlockRows`).
 
     Raises
     ------
@@ -483,19 +129,45 @@ def fit_stack(
     NonFiniteError
         NaN or inf in the regressor.
     """
-    est = estimator_named(estimator)
+    return _fitted(stack, labels, estimator_named(estimator), std, max_std_percent, rtol, frozen)[0]
+
+
+def _fitted(
+    stack: RegressorStack | StreamedRows,
+    labels: tuple[str, ...],
+    est: Estimator,
+    std: StdMethod,
+    max_std_percent: float | None,
+    rtol: float,
+    frozen: NDArray[np.bool_] | None,
+    fold_labels: NDArray[np.intp] | None = None,
+) -> tuple[LeastSquaresFit, RegressorStack | StreamedRows]:
+    """:func:`fit_stack`, and the stack with what the fit's pass learnt of rows read in
+    blocks (their count; the normal equations of the ``fold_labels`` when the estimator
+    does not weigh)."""
     cols = np.ones(len(labels), dtype=bool) if frozen is None else ~np.asarray(frozen, bool)
     kept_labels = tuple(lab for lab, c in zip(labels, cols, strict=True) if c)
+    rows = _rows(stack, cols, est, None if est.weighted else fold_labels)
+    fit = fit_rows(
+        rows, est, rtol=rtol, std=std, max_std_percent=max_std_percent, labels=kept_labels
+    )
+    if isinstance(rows, BlockRows):
+        assert isinstance(stack, StreamedRows)
+        normals = rows.factors.normals
+        stack = dataclasses.replace(stack, n_rows=fit.n_rows, normals=normals)
+    return (fit if cols.all() else _expanded(fit, cols)), stack
+
+
+def _rows(
+    stack: RegressorStack | StreamedRows,
+    cols: NDArray[np.bool_],
+    est: Estimator,
+    fold_labels: NDArray[np.intp] | None = None,
+) -> Rows:
+    """The stack's rows over the columns ``cols`` (c,), as the engine takes them."""
     if isinstance(stack, StreamedRows):
-        fit = fit_streamed(
-            selected_columns(stack.source, cols),
-            est,
-            rtol=rtol,
-            std=std,
-            max_std_percent=max_std_percent,
-            labels=kept_labels,
-        )
-        return fit if cols.all() else _expanded(fit, cols)
+        source = selected_columns(stack.source, cols)
+        return BlockRows(source, by_group=est.weighted, per_row=est.per_row, labels=fold_labels)
     W, rows = stack.W, stack.used_rows
     grams = None if stack.grams is None else stack.grams[stack.kept]
     if not cols.all():
@@ -503,41 +175,8 @@ def fit_stack(
         rows = rows.copy()
         rows[:, 2] = 0
         grams = None if grams is None else grams[:, cols][:, :, cols]
-    if isinstance(est, OLS):
-        fit = fit_blocks(
-            W,
-            stack.y,
-            rows=rows,
-            gram=None if grams is None else grams.sum(axis=0),
-            std=std,
-            max_std_percent=max_std_percent,
-            rtol=rtol,
-            labels=kept_labels,
-        )
-    else:
-        used = stack.used()
-        if used.size != stack.y.size:
-            Wu, yu, gu = W[used], stack.y[used], stack.groups[used]
-        else:
-            Wu, yu, gu = W, stack.y, stack.groups
-        _checks.finite("regressor", Wu)
-        fit = est.fit(
-            Wu,
-            yu,
-            gu,
-            rtol=rtol,
-            std=std,
-            max_std_percent=max_std_percent,
-            labels=kept_labels,
-        )
-    return fit if cols.all() else _expanded(fit, cols)
-
-
-def selected_columns(source: BlockSource, cols: NDArray[np.bool_]) -> BlockSource:
-    """The blocks of ``source`` with only the columns ``cols`` (c,) bool."""
-    if np.all(cols):
-        return source
-    return lambda: ((W[:, cols], y, g) for W, y, g in source())
+    gram = None if grams is None else grams.sum(axis=0)
+    return HeldRows(W, stack.y, stack.groups, rows, gram)
 
 
 def identify(
@@ -552,6 +191,7 @@ def identify(
     max_std_percent: float | None = None,
     rtol: float | None = None,
     judge: Judge | None = None,
+    fold_labels: NDArray[np.intp] | None = None,
 ) -> IdentifiedModel:
     """Identify the base parameters (and the appended terms: friction) from a data set.
 
@@ -584,6 +224,11 @@ def identify(
     judge : callable, optional
         Held-out judgement (:data:`Judge`): its folds are kept (``holdout``) and their
         errors recorded (``heldout``).
+    fold_labels : ndarray of int, shape (m,), optional
+        The judge's label of every row (its folds), in block order: on rows read in blocks
+        with an estimator that does not weigh, the fit's pass gathers their normal
+        equations (``StreamedRows.normals``, handed to the judge) so that the judgement
+        needs no pass of its own.
 
     Returns
     -------
@@ -619,19 +264,11 @@ def identify(
     est = estimator_named(estimator)
     frozen = data.frozen_columns(columns)
     try:
-        fit = fit_stack(
-            stack,
-            labels,
-            estimator=est,
-            std=std,
-            max_std_percent=max_std_percent,
-            rtol=fit_rtol,
-            frozen=frozen,
+        fit, stack = _fitted(
+            stack, labels, est, std, max_std_percent, fit_rtol, frozen, fold_labels
         )
     except RankDeficientError as exc:
         raise _rank_error(exc, data, columns, stack, fit_rtol) from exc
-    if isinstance(stack, StreamedRows):
-        stack = dataclasses.replace(stack, n_rows=fit.n_rows)
     held = None if judge is None else judge(stack, columns, ~frozen, fit.beta)
     for msg in conditioning_advice(fit, labels, what=_what(data)):
         warnings.warn(msg, DynidWarning, stacklevel=2)

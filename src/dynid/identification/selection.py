@@ -134,8 +134,9 @@ def _judge(
     estimator: Estimator,
     folds: int,
     validation: Recordings | None,
-) -> tuple[Judge, str]:
-    """The held-out judgement over the recordings' folds (or a separate recording)."""
+) -> tuple[Judge, str, NDArray[np.intp] | None]:
+    """The held-out judgement over the recordings' folds (or a separate recording), how,
+    and the fold of every row (None with a separate recording or too few samples)."""
     try:
         labels, how = data.fold_labels(folds)
     except OptionError:
@@ -152,6 +153,8 @@ def _judge(
     ) -> HeldOut | None:
         b = np.asarray(beta)[cols]
         normals: Callable[[NDArray[np.intp]], tuple[Normals, ...]]
+        if isinstance(stack, StreamedRows) and stack.normals is not None and validation is None:
+            return replace(HeldOut.k_fold(stack.normals), scheme=scheme).expanded(cols)
         if isinstance(stack, StreamedRows):  # rows in blocks: one pass per set of labels
             source = selected_columns(stack.source, cols)
             e = np.concatenate([y - W @ b for W, y, _ in source()])
@@ -172,7 +175,7 @@ def _judge(
             held = replace(HeldOut.k_fold(normals(labels)), scheme=scheme)
         return held.expanded(cols)
 
-    return judge, how
+    return judge, how, (labels if validation is None else None)
 
 
 def _normals(
@@ -276,14 +279,14 @@ def select_structure(
     )
     judged: list[Candidate] = []
     notes: list[str] = []
-    judge, how = _judge(robot, data, est, folds, validation)
+    judge, how, fold_labels = _judge(robot, data, est, folds, validation)
     fit_rtol = 1e-10 if rtol is None else rtol
     groups: dict[tuple[bool, str], tuple[IdentifiedModel, list[tuple[ModelTerm, Any]]]] = {}
     # one regressor per armature choice and friction placement (friction at the motors and
     # at the joints of a coupled drive, together, would be dependent columns)
     for arm, at in sorted({(c.armature, c.at) for c in cands}):
         mine = [c for c in cands if c.armature == arm and c.at == at]
-        fitted = _fit_largest(robot, data, mine, arm, drive, est, rtol, judge, notes)
+        fitted = _fit_largest(robot, data, mine, arm, drive, est, rtol, judge, notes, fold_labels)
         if fitted is None:
             continue
         model, terms, mine = fitted
@@ -349,6 +352,7 @@ def _fit_largest(
     rtol: float | None,
     judge: Judge,
     notes: list[str],
+    fold_labels: NDArray[np.intp] | None = None,
 ) -> tuple[IdentifiedModel, list[tuple[ModelTerm, Any]], list[Structure]] | None:
     """The model of every candidate's columns at once (the classical candidates alone when
     the data cannot tell the shaped laws apart), with its terms and the candidates it
@@ -371,6 +375,7 @@ def _fit_largest(
                     estimator=est,
                     rtol=rtol,
                     judge=judge,
+                    fold_labels=fold_labels,
                 )
         except RankDeficientError as exc:
             what = ("with" if arm else "without") + " armature"
@@ -487,7 +492,7 @@ def identify_recordings(
         )
         structure = Structure() if selection is None else selection.chosen
     model_drive, terms = structure_terms(structure, drive, robot.n, tuple(data.band), _bands(data))
-    judge, _ = _judge(robot, data, est, folds, validation)
+    judge, _, fold_labels = _judge(robot, data, est, folds, validation)
     model = identify(
         robot,
         data,
@@ -498,6 +503,7 @@ def identify_recordings(
         max_std_percent=max_std_percent,
         rtol=rtol,
         judge=judge,
+        fold_labels=fold_labels,
     )
     info = replace(
         model.info,

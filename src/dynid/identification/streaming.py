@@ -7,7 +7,8 @@ a callable that returns a fresh iterable of ``(W_b, y_b, groups_b)`` (rows of th
 regressor, their targets, their noise groups) each time it is called, always in the same
 order; only small triangular factors are kept between blocks.
 
-**Factors by groups (one pass).** For every noise group ``g`` (a joint of a torque log,
+**Factors by groups (one pass).** An estimator that weighs (WLS, IRLS) gets, for every
+noise group ``g`` (a joint of a torque log,
 a row of ``[tril M; g]`` of static data) the triangular factor ``R_g`` (c+1, c+1) of
 ``[W_g y_g]`` is updated block by block, ``R_g <- qr([R_g; W_gb y_gb])`` (a tall-skinny
 QR, TSQR; Demmel et al. 2012): the same factor as the QR of the whole stack, better
@@ -21,21 +22,27 @@ From these factors alone:
   per-group noise, the unweighted residual of a weighted fit);
 * the factor of a subset of the columns is the QR of those columns of ``R`` (pruning).
 
+An estimator that does not weigh (OLS) gets the factor of all rows only, each block put
+under it in place (one ``dgeqrf`` a block), and, when given the folds of a held-out
+judgement, the normal equations of each fold from the same pass.
+
 The fit on a factor is the one of :func:`~dynid.identification.least_squares.fit_least_squares`
 (column-scaled Householder QR with column pivoting, its rank guard and statistics); the
 estimates and standard deviations agree with the stacked fit to about 1e-12 relative.
+
+The engine (:func:`~dynid.identification.engine.fit_rows`) fits these rows through
+:class:`~dynid.identification.streamed.BlockRows`, any estimator alike.
 
 **Passes over the data.** OLS and WLS with classical standard deviations take one pass;
 the heteroscedasticity-consistent covariance (``"robust"``) needs ``W^T diag(e^2) W`` of
 the final residual: one pass more (two with pruning). Huber IRLS reweights every row from
 the median of its group's residuals: two passes per iteration (the weighted factor, then
 the residuals), holding the residuals, weights and groups of every row (24 bytes a row,
-not ``8 c``).
+not ``8 c``); so does any estimator that weighs rows one by one (``per_row``).
 """
 
 from __future__ import annotations
 
-import dataclasses
 import os
 from collections.abc import Callable, Iterable
 from dataclasses import dataclass
@@ -45,16 +52,8 @@ import scipy.linalg
 from numpy.typing import NDArray
 
 from .. import _checks
-from ..exceptions import DataError, NonFiniteError, OptionError, RankDeficientError, ShapeError
-from .estimators import IRLS, OLS, WLS, Estimator, huber_weights
+from ..exceptions import OptionError, ShapeError
 from .holdout import Normals
-from .least_squares import (
-    LeastSquaresFit,
-    StdMethod,
-    _conditioning,
-    checked_std,
-    unexcited_combinations,
-)
 
 __all__ = [
     "BLOCK_ROWS",
@@ -63,7 +62,6 @@ __all__ = [
     "GROUP_FACTOR_BYTES",
     "GroupFactors",
     "MAX_STACK_BYTES",
-    "fit_streamed",
     "group_factors",
     "max_stack_bytes",
     "normals_by_label",
@@ -138,6 +136,9 @@ class GroupFactors:
         ``||y_g||^2`` of each group, when ``R`` is None.
     source : BlockSource or None
         The blocks again, for the passes that replace ``R`` when it is None.
+    normals : tuple of Normals, optional
+        The normal equations of the rows of each label, when :func:`group_factors` was
+        given labels.
     """
 
     R: NDArray[np.float64] | None
@@ -146,6 +147,7 @@ class GroupFactors:
     total: NDArray[np.float64] | None = None
     target: NDArray[np.float64] | None = None
     source: BlockSource | None = None
+    normals: tuple[Normals, ...] | None = None
 
     @property
     def n_rows(self) -> int:
@@ -208,6 +210,16 @@ def _triangular(X: NDArray[np.float64]) -> NDArray[np.float64]:
     return R
 
 
+def _stacked_r(buf: NDArray[np.float64]) -> NDArray[np.float64]:
+    """The upper triangular factor (k, k) of ``buf`` (M, k), M >= k, column-major,
+    overwritten (LAPACK ``dgeqrf`` in place: no copy of the block)."""
+    k = buf.shape[1]
+    qr, _, _, info = scipy.linalg.lapack.dgeqrf(buf, overwrite_a=1)
+    if info != 0:  # pragma: no cover - LAPACK argument error
+        raise ShapeError(f"LAPACK dgeqrf failed with info={info}")
+    return np.triu(qr[:k])
+
+
 def _blocks(source: BlockSource) -> Iterable[Block]:
     """The source's blocks checked: shapes, finite values, integer groups."""
     c = None
@@ -230,7 +242,13 @@ def _blocks(source: BlockSource) -> Iterable[Block]:
         yield W, y, g
 
 
-def group_factors(source: BlockSource, *, keep_groups: bool = False) -> GroupFactors:
+def group_factors(
+    source: BlockSource,
+    *,
+    keep_groups: bool = False,
+    by_group: bool = True,
+    labels: NDArray[np.intp] | None = None,
+) -> GroupFactors:
     """One pass over the blocks: the triangular factor of ``[W_g y_g]`` of every group (or,
     past :data:`GROUP_FACTOR_BYTES`, of all rows with the groups' counts and targets).
 
@@ -239,6 +257,13 @@ def group_factors(source: BlockSource, *, keep_groups: bool = False) -> GroupFac
     source : BlockSource
     keep_groups : bool
         Also return the group of every row (IRLS).
+    by_group : bool
+        A factor per group; False keeps the factor of all rows only (an estimator that
+        does not weigh).
+    labels : ndarray of int, shape (m,), optional
+        A label ``0 .. k-1`` of every row in block order (the folds of a held-out
+        judgement): the normal equations of each label's rows are gathered in the same pass
+        (``normals``).
 
     Raises
     ------
@@ -252,404 +277,78 @@ def group_factors(source: BlockSource, *, keep_groups: bool = False) -> GroupFac
     seen: list[NDArray[np.intp]] = []
     total: NDArray[np.float64] | None = None
     count, target = np.zeros(0, dtype=np.intp), np.zeros(0)
-    c = 0
+    c = o = 0
+    L = int(labels.max()) + 1 if labels is not None and labels.size else 0
+    LG: NDArray[np.float64] | None = None
     for W, y, g in _blocks(source):
         c = W.shape[1]
-        X = np.empty((W.shape[0], c + 1), order="F")
+        buf = np.empty((c + 1 + W.shape[0], c + 1), order="F")  # [R; W y] for the QR below
+        X = buf[c + 1 :]
         X[:, :c] = W
         X[:, c] = y
+        if labels is not None:
+            if LG is None:
+                LG = np.zeros((L, c + 1, c + 1))
+            _label_grams(LG, X, labels, o)
+        o += y.size
         k = max(count.size, int(g.max(initial=-1)) + 1)
         count = np.bincount(g, minlength=k) + np.pad(count, (0, k - count.size))
         squares = np.asarray(np.bincount(g, y * y, minlength=k), dtype=np.float64)
         target = squares + np.pad(target, (0, k - target.size))
+        if total is None and not by_group:
+            total = np.zeros((c + 1, c + 1))
         if total is None and 8 * k * (c + 1) ** 2 > GROUP_FACTOR_BYTES:  # too many groups
-            total = _triangular(np.vstack([np.zeros((0, c + 1)), *R.values()]))
+            total = _triangular(np.vstack([np.zeros((c + 1, c + 1)), *R.values()]))
             R.clear()
         if total is not None:
-            total = _triangular(_on_top(total, X))
+            buf[: c + 1] = total
+            total = _stacked_r(buf)
         else:
             for gv in np.unique(g):
                 sel = X[g == gv]
                 prev = R.get(int(gv))
                 R[int(gv)] = _triangular(sel if prev is None else np.vstack([prev, sel]))
                 rows[int(gv)] = rows.get(int(gv), 0) + sel.shape[0]
-        del X
+        del X, buf
         if keep_groups:
             seen.append(g.copy())
     if not R and total is None:
         raise ShapeError("no regressor rows: the data hold no block")
     groups = np.concatenate(seen) if keep_groups else None
+    normals = None
+    if labels is not None:
+        if o != labels.size or LG is None:
+            raise ShapeError(f"labels hold {labels.size} rows; the blocks {o}")
+        cnt_l = np.bincount(labels, minlength=L)
+        normals = tuple(
+            Normals(LG[j, :c, :c], LG[j, :c, c], float(LG[j, c, c]), int(cnt_l[j]))
+            for j in range(L)
+        )
     if total is not None:
-        return GroupFactors(None, count, groups, total=total, target=target, source=source)
+        return GroupFactors(
+            None, count, groups, total=total, target=target, source=source, normals=normals
+        )
     k = max(R) + 1
     out = np.zeros((k, c + 1, c + 1))
     cnt = np.zeros(k, dtype=np.intp)
     for gv, Rg in R.items():
         out[gv], cnt[gv] = Rg, rows[gv]
-    return GroupFactors(R=out, rows=cnt, groups=groups)
+    return GroupFactors(R=out, rows=cnt, groups=groups, normals=normals)
 
 
-@dataclass(frozen=True, slots=True)
-class _Solved:
-    """A fit on a triangular factor, over the kept columns."""
-
-    rank: int
-    cond: float
-    cond_u: float
-    vmin: NDArray[np.float64]
-    beta: NDArray[np.float64]
-    ss: float
-    gi: NDArray[np.float64]  # (R^T R)^-1 of the column-scaled kept columns
-    scale: NDArray[np.float64]
-
-
-def _solve(
-    Raug: NDArray[np.float64],
-    m: int,
-    keep: NDArray[np.bool_],
-    rtol: float,
-    labels: tuple[str, ...] | None,
-) -> _Solved:
-    """The least-squares fit of the kept columns from the factor ``Raug`` of ``[W y]``."""
-    c = Raug.shape[1] - 1
-    idx = np.flatnonzero(keep)
-    rk = idx.size
-    T = Raug[:, np.append(idx, c)]
-    if rk < c:
-        T = _triangular(np.array(T))
-    A, b, rres = T[:rk, :rk], T[:rk, rk], float(T[rk, rk])
-    norms = np.sqrt(np.einsum("ij,ij->j", A, A))
-    scale = np.where(norms > 0, norms, 1.0)
-    Q, R, piv = scipy.linalg.qr(A / scale, mode="economic", pivoting=True)
-    d = np.abs(np.diag(R))
-    rank = int(np.sum(d > rtol * d[0])) if d.size and d[0] > 0 else 0
-    cond, cond_u, vp = _conditioning(R, scale[piv])
-    vmin = np.empty(rk)
-    vmin[piv] = vp
-    if m < rk or rank < rk:
-        names = _names(labels, vmin, idx)
-        combos: tuple[str, ...] = ()
-        if rank < rk and m >= rk:
-            kl = tuple(labels[k] if labels is not None else f"column {k}" for k in idx)
-            combos = unexcited_combinations(R[:, np.argsort(piv)], scale, rank, kl)
-        why = (
-            f"{m} rows for {rk} coefficients; add configurations"
-            if m < rk
-            else (
-                f"at rtol={rtol:g} (scaled cond {cond:.3g}); add configurations or excite the "
-                "trajectory more, or drop unidentifiable parameters"
-            )
-        )
-        raise RankDeficientError(
-            f"Regressor rank {rank} < {rk} {why}; nearly dependent columns: "
-            f"{', '.join(names) or 'none named'}"
-            + (f"; not excited by the data: {'; '.join(combos)}" if combos else ""),
-            rank=rank,
-            needed=rk,
-            dependent=names,
-            combinations=combos,
-        )
-    z = scipy.linalg.solve_triangular(R, Q.T @ b)
-    bs = np.empty(rk)
-    bs[piv] = z
-    beta = bs / scale
-    r = A @ beta - b
-    Rinv = scipy.linalg.solve_triangular(R, np.eye(rk))
-    gi = np.empty((rk, rk))
-    gi[np.ix_(piv, piv)] = Rinv @ Rinv.T
-    ss = float(r @ r) + rres * rres
-    return _Solved(rank, cond, cond_u, vmin, beta, ss, gi, scale)
-
-
-def _names(
-    labels: tuple[str, ...] | None, v: NDArray[np.float64], idx: NDArray[np.intp]
-) -> tuple[str, ...]:
-    """The kept columns with large weight in ``v``, named (largest first, at most 8)."""
-    a = np.abs(v)
-    if not a.size or not a.max() > 0:
-        return ()
-    big = np.flatnonzero(a >= 0.1 * a.max())
-    cols = idx[big[np.argsort(-a[big])][:8]]
-    return tuple(labels[k] if labels is not None else f"column {k}" for k in cols)
-
-
-def _meat(
-    source: BlockSource,
-    beta: NDArray[np.float64],
-    keep: NDArray[np.bool_],
-    weights: Callable[[int, NDArray[np.intp]], NDArray[np.float64]] | None,
-) -> NDArray[np.float64]:
-    """``Ww^T diag(ew^2) Ww`` over the kept columns, ``Ww`` the weighted rows and ``ew``
-    the weighted residual of ``beta`` (one pass; HC1's middle factor)."""
-    rk = int(keep.sum())
-    meat = np.zeros((rk, rk))
-    o = 0
-    for W, y, g in _blocks(source):
-        Wk = W[:, keep]
-        e = y - Wk @ beta
-        if weights is not None:
-            w = weights(o, g)
-            Wk, e = Wk * w[:, None], e * w
-        We = Wk * e[:, None]
-        meat += We.T @ We
-        o += y.size
-    return meat
-
-
-def _fit_factor(
-    Raug: NDArray[np.float64],
-    m: int,
-    *,
-    keep: NDArray[np.bool_],
-    rtol: float,
-    std: StdMethod,
-    labels: tuple[str, ...] | None,
-    meat: Callable[[NDArray[np.float64], NDArray[np.bool_]], NDArray[np.float64]],
-) -> LeastSquaresFit:
-    """:func:`~dynid.identification.least_squares.fit_least_squares` from the factor of
-    ``[W y]`` (m rows); ``meat(beta, keep)`` gives HC1's middle factor by a pass."""
-    c = Raug.shape[1] - 1
-    s = _solve(Raug, m, keep, rtol, labels)
-    rk = s.beta.size
-    dof = max(m - rk, 1)
-    if std == "classical":
-        cov_s = s.gi * (s.ss / dof)
-    else:
-        mt = meat(s.beta, keep) / np.outer(s.scale, s.scale)
-        cov_s = s.gi @ mt @ s.gi * (m / dof)
-    if not (np.all(np.isfinite(s.beta)) and np.all(np.isfinite(cov_s)) and np.isfinite(s.ss)):
-        raise NonFiniteError(
-            "least squares overflowed: the data or the regressor hold values too large to be "
-            "measurements; check the data"
-        )
-    cov_k = cov_s / np.outer(s.scale, s.scale)
-    cov_k = 0.5 * (cov_k + cov_k.T)
-    sk = np.sqrt(np.maximum(np.diag(cov_k), 0.0))
-    beta, sd, cov = np.zeros(c), np.zeros(c), np.zeros((c, c))
-    beta[keep], sd[keep] = s.beta, sk
-    cov[np.ix_(keep, keep)] = cov_k
-    ny = float(np.linalg.norm(Raug[:, c]))
-    effect = np.zeros(c)
-    effect[keep] = 100.0 * sk * s.scale / ny if ny > 0 else 0.0
-    weakest = np.zeros(c)
-    weakest[keep] = s.vmin
-    with np.errstate(divide="ignore", invalid="ignore"):
-        pct = np.where(keep, 100.0 * sd / np.abs(beta), np.nan)
-    pct = np.where(keep & (sd == 0.0), 0.0, pct)
-    return LeastSquaresFit(
-        beta=_checks.frozen(beta),
-        std=_checks.frozen(sd),
-        std_percent=_checks.frozen(pct),
-        kept=_checks.frozen(keep.copy()),
-        rank=s.rank,
-        condition_number=s.cond_u,
-        relative_error_percent=100.0 * np.sqrt(s.ss) / ny if ny > 0 else 0.0,
-        residual_rms=float(np.sqrt(s.ss / m)),
-        sigma=float(np.sqrt(s.ss / dof)),
-        n_rows=m,
-        rtol=rtol,
-        covariance=_checks.frozen(cov),
-        scaled_condition_number=s.cond,
-        weakest=_checks.frozen(weakest),
-        effect_percent=_checks.frozen(effect),
-    )
-
-
-def _fit_pruned(
-    Raug: NDArray[np.float64],
-    m: int,
-    *,
-    rtol: float,
-    std: StdMethod,
-    max_std_percent: float | None,
-    labels: tuple[str, ...] | None,
-    meat: Callable[[NDArray[np.float64], NDArray[np.bool_]], NDArray[np.float64]],
-) -> LeastSquaresFit:
-    """Fit, then (``max_std_percent``) remove the coefficients above it and re-fit once."""
-    keep = np.ones(Raug.shape[1] - 1, dtype=bool)
-    kw = {"rtol": rtol, "std": std, "labels": labels, "meat": meat}
-    fit = _fit_factor(Raug, m, keep=keep, **kw)  # type: ignore[arg-type]
-    if max_std_percent is None:
-        return fit
-    keep = ~(np.asarray(fit.std_percent) > max_std_percent)
-    if keep.all():
-        return fit
-    return _fit_factor(Raug, m, keep=keep, **kw)  # type: ignore[arg-type]
-
-
-def _unweighted(fit: LeastSquaresFit, F: GroupFactors) -> LeastSquaresFit:
-    """The fit with the residual statistics of the unweighted rows (as the estimators)."""
-    ss = float(F.residual_ss(np.asarray(fit.beta)).sum())
-    ny = float(np.sqrt(F.target_ss().sum()))
-    return dataclasses.replace(
-        fit,
-        relative_error_percent=100.0 * np.sqrt(ss) / ny if ny > 0 else 0.0,
-        residual_rms=float(np.sqrt(ss / max(F.n_rows, 1))),
-    )
-
-
-def _noise(F: GroupFactors, rtol: float) -> NDArray[np.float64]:
-    """WLS's noise std per group from the residual of a first OLS fit
-    (:func:`~dynid.identification.estimators.group_noise`)."""
-    m, c = F.n_rows, F.n_columns
-    first = _solve(F.combined(), m, np.ones(c, dtype=bool), rtol, None)
-    ss = F.residual_ss(first.beta)
-    s = np.sqrt(ss / np.maximum(F.rows * (1.0 - c / max(m, 1)), 1.0))
-    pos = s[s > 0]
-    floor = float(pos.min()) if pos.size else 1.0
-    return np.where(s > 0, s, floor)
-
-
-def fit_streamed(
-    source: BlockSource,
-    estimator: Estimator,
-    *,
-    rtol: float,
-    std: StdMethod = "classical",
-    max_std_percent: float | None = None,
-    labels: tuple[str, ...] | None = None,
-) -> LeastSquaresFit:
-    """Fit ``W beta = y`` with an estimator over the blocks of ``source`` (module docstring).
-
-    The estimates and statistics are those of ``estimator.fit`` on the stacked rows
-    (:mod:`dynid.identification.estimators`), to rounding.
-
-    Parameters
-    ----------
-    source : BlockSource
-        Blocks ``(W_b (m_b, c), y_b (m_b,), groups_b (m_b,))``, the same at every call.
-    estimator : Estimator
-        OLS, WLS and IRLS fit block by block; any other estimator's ``fit`` gets the rows
-        stacked, when they fit within :func:`max_stack_bytes`.
-    rtol : float
-        Relative rank tolerance on the diagonal of R of the column-scaled regressor.
-    std : {"classical", "robust"}
-    max_std_percent : float, optional
-        Remove the coefficients above this relative standard deviation and re-fit once.
-    labels : tuple of str, length c, optional
-        Column names for a rank-deficiency message.
-
-    Raises
-    ------
-    OptionError
-        An estimator other than OLS, WLS, IRLS (its ``fit`` takes the stacked rows) on rows
-        beyond :func:`max_stack_bytes`, or an unknown ``std``.
-    ShapeError
-        Inconsistent blocks.
-    NonFiniteError
-        NaN or inf in a block.
-    RankDeficientError
-        Rank below the column count.
-    """
-    checked_std(std)
-    if not isinstance(estimator, OLS | WLS | IRLS):
-        W, y, g = _stacked(source, estimator.name)
-        return estimator.fit(
-            W, y, g, rtol=rtol, std=std, max_std_percent=max_std_percent, labels=labels
-        )
-    F = group_factors(source, keep_groups=isinstance(estimator, IRLS))
-    m = F.n_rows
-    kw = {"rtol": rtol, "max_std_percent": max_std_percent, "labels": labels}
-    if isinstance(estimator, OLS):
-        return _fit_pruned(
-            F.combined(),
-            m,
-            std=std,
-            meat=lambda b, k: _meat(source, b, k, None),
-            **kw,  # type: ignore[arg-type]
-        )
-    s0 = _noise(F, rtol)
-    if isinstance(estimator, WLS):
-        wg = 1.0 / s0
-        fit = _fit_pruned(
-            F.combined(wg),
-            m,
-            std=std,
-            meat=lambda b, k: _meat(source, b, k, lambda o, g: wg[g]),
-            **kw,  # type: ignore[arg-type]
-        )
-        return _unweighted(fit, F)
-    return _irls(source, estimator, F, s0, std=std, **kw)  # type: ignore[arg-type]
-
-
-def _stacked(source: BlockSource, name: str) -> Block:
-    """The blocks of ``source`` stacked, for an estimator that needs every row at once.
-
-    Raises
-    ------
-    OptionError
-        The rows exceed :func:`max_stack_bytes`.
-    ShapeError
-        No rows, or inconsistent blocks.
-    NonFiniteError
-        NaN or inf in a block.
-    """
-    parts: list[Block] = []
-    size, limit = 0, max_stack_bytes()
-    for W, y, g in _blocks(source):
-        size += 8 * y.size * (W.shape[1] + 1)
-        if size > limit:
-            raise OptionError(
-                f"estimator {name!r} needs the whole regressor, which is too large here to "
-                f"hold; use ols, wls or irls, or raise {_ENV}"
-            )
-        parts.append((W, y, g))
-    if not parts:
-        raise ShapeError("the block source gave no rows")
-    W = np.concatenate([b[0] for b in parts])
-    return W, np.concatenate([b[1] for b in parts]), np.concatenate([b[2] for b in parts])
-
-
-def _irls(
-    source: BlockSource,
-    est: IRLS,
-    F: GroupFactors,
-    s0: NDArray[np.float64],
-    *,
-    rtol: float,
-    std: StdMethod,
-    max_std_percent: float | None,
-    labels: tuple[str, ...] | None,
-) -> LeastSquaresFit:
-    """Huber IRLS as :class:`~dynid.identification.estimators.IRLS`, two passes an
-    iteration (the weighted factor, the residuals)."""
-    assert F.groups is not None
-    groups = F.groups
-    m, c = F.n_rows, F.n_columns
-    w = 1.0 / s0[groups]
-    e = np.empty(m)
-    beta = None
-
-    def row_weights(o: int, g: NDArray[np.intp]) -> NDArray[np.float64]:
-        return w[o : o + g.size]
-
-    for _ in range(est.max_iter):
-        Rw = _weighted_factor(source, row_weights, c)
-        fb = _solve(Rw, m, np.ones(c, dtype=bool), rtol, labels).beta
-        o = 0
-        for W, y, _g in _blocks(source):
-            np.subtract(y, W @ fb, out=e[o : o + y.size])
-            o += y.size
-        if o != m:
-            raise DataError(f"the regressor blocks changed between passes ({o} rows, then {m})")
-        w = huber_weights(e, groups, s0, est.c)
-        done = beta is not None and np.linalg.norm(fb - beta) <= est.tol * max(
-            float(np.linalg.norm(fb)), 1e-300
-        )
-        beta = fb
-        if done:
-            break
-    del e
-    fit = _fit_pruned(
-        _weighted_factor(source, row_weights, c),
-        m,
-        rtol=rtol,
-        std=std,
-        max_std_percent=max_std_percent,
-        labels=labels,
-        meat=lambda b, k: _meat(source, b, k, lambda o, g: w[o : o + g.size]),
-    )
-    return _unweighted(fit, F)
+def _label_grams(
+    LG: NDArray[np.float64], X: NDArray[np.float64], labels: NDArray[np.intp], o: int
+) -> None:
+    """Add ``X_j^T X_j`` of the rows of each label to ``LG[j]``; ``X`` (m_b, c+1) holds the
+    rows ``o .. o + m_b`` (labels in runs, as time folds: one product per run)."""
+    lab = labels[o : o + X.shape[0]]
+    if lab.size != X.shape[0]:
+        raise ShapeError(f"labels hold {labels.size} rows; the blocks more")
+    cuts = np.concatenate([[0], np.flatnonzero(np.diff(lab)) + 1, [lab.size]])
+    for a, b in zip(cuts[:-1], cuts[1:], strict=True):
+        if b > a:
+            Xr = X[a:b]
+            LG[lab[a]] += Xr.T @ Xr
 
 
 def _weighted_factor(
