@@ -159,3 +159,39 @@ def test_observe_params_urdf_with_two_leaves_takes_the_chain_of_tip(tmp_path, ca
     assert main([*other, "--out", str(tmp_path / "c1")]) != 0
     (line,) = capsys.readouterr().err.strip().splitlines()
     assert "--base/--tip choose the chain of a --params URDF" in line
+
+
+@pytest.mark.parametrize(
+    "extra, flag",
+    [
+        (["--gain", "80"], "--gain"),
+        (["--discretisation", "euler"], "--discretisation"),
+        (["--rule", "rectangle"], "--rule"),
+        (["--margin", "2"], "--margin"),
+        (["--quantile", "0.99"], "--quantile"),
+        (["--collision-factor", "3"], "--collision-factor"),
+        (["--k-sigma", "4"], "--k-sigma"),
+        (["--no-uncertainty"], "--no-uncertainty"),
+        (["--no-standstill-margin"], "--no-standstill-margin"),
+    ],
+)
+def test_observe_thresholds_refuses_each_calibration_option_in_one_line(
+    tmp_path, capsys, extra, flag
+):
+    """With --thresholds the file fixes the calibration: each of its options is refused,
+    named by its flag, rather than silently ignored."""
+    args = ["observe", "--params", "panda", "--thresholds", str(tmp_path / "t.json")]
+    assert main([*args, *extra, "--data", str(tmp_path / "x.csv"), "--out", str(tmp_path)]) == 2
+    (line,) = capsys.readouterr().err.strip().splitlines()
+    assert f"{flag} is a calibration option; t.json fixes it" in line
+
+
+@pytest.mark.parametrize(
+    "extra, flag", [(["--frame", "flange"], "--frame"), (["--merge", "1"], "--merge")]
+)
+def test_observe_calibrate_refuses_the_detection_options(tmp_path, capsys, extra, flag):
+    """--frame and --merge act on detection only: refused when calibrating."""
+    args = ["observe", "--params", "panda", "--calibrate", *extra]
+    assert main([*args, "--data", str(tmp_path / "x.csv"), "--out", str(tmp_path)]) == 2
+    (line,) = capsys.readouterr().err.strip().splitlines()
+    assert f"error: {flag} applies when detecting" in line
