@@ -14,6 +14,7 @@ from ..feasibility.penalty import RetrievalProgress, RetrievalResult
 from ..friction.validation import NewtonEulerValidation
 from ..identification.info import LogInfo
 from ..identification.model import IdentifiedModel
+from ..io.observer_files import log_labels
 from ..observer.detection import undetected_at_rest
 from ..observer.results import ObserveResult
 from ..pipeline.collision import CollisionStageResult
@@ -364,7 +365,8 @@ def format_observation(result: ObserveResult, names: list[str], *, calibrating: 
     if calibrating:
         rows.append(f"calibrated on {th.samples} samples of {len(result.logs)} log(s)")
         return "\n".join(rows)
-    events = [(x.path.name, e) for x in result.logs for e in x.events]
+    labels = log_labels([x.path for x in result.logs])
+    events = [(label, e) for x, label in zip(result.logs, labels, strict=True) for e in x.events]
     rows.append(f"{len(events)} event(s)")
     for log, e in events:
         top = max(e.joints, key=lambda j: abs(e.peak[j - 1]))

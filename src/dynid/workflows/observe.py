@@ -65,6 +65,7 @@ from ..observer.results import LogObservation, ObserveResult
 from ..observer.wrench import external_wrench
 from ..signals import edge_seconds, filtered_derivative
 from .data_files import ColumnSpec, column_map, in_file, read_torque_log, recorded_columns
+from .identify import data_files
 
 __all__ = [
     "LogObservation",
@@ -82,7 +83,8 @@ class ObserveOptions:
     Attributes
     ----------
     data : tuple of Path
-        Torque logs (``.csv``/``.npz``), or other tools' files read through ``columns``.
+        Torque logs (``.csv``/``.npz``), or other tools' files read through ``columns``; a
+        folder stands for its ``.csv`` and ``.npz`` files in name order.
     model : Path, optional
         ``identification.json`` (exactly one of ``model`` and ``params``).
     params : str or Path, optional
@@ -268,7 +270,8 @@ def observe_files(opts: ObserveOptions) -> ObserveResult:
     )
     wants_margin = opts.standstill if given is None else given.standstill
     logs = [
-        _observe_log(p, model, recorded, opts, options, wants_std, wants_margin) for p in opts.data
+        _observe_log(p, model, recorded, opts, options, wants_std, wants_margin)
+        for p in data_files(opts.data)
     ]
     if given is None:
         seen = [np.all(np.isfinite(x.r), axis=1) for x in logs]  # observed samples only
