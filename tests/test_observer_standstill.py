@@ -165,3 +165,19 @@ def test_the_calibration_summary_prints_the_residual_the_rule_read_and_the_level
     np.testing.assert_allclose(printed[:, 0], read, atol=6e-5)
     np.testing.assert_allclose(printed[:, 3], FC + 1.5 * read, atol=6e-5)
     assert "contact = 1.5 x the largest |r| of the calibration after the standstill margin" in text
+
+
+def test_the_margin_of_a_coupled_drive_is_taken_at_the_motors():
+    """Friction at the motors of a coupled drive (K = [[100, 0], [50, 50]], motor 2 turns
+    with both joints): each motor's Coulomb level where its own velocity K dq is inside
+    its band, brought to the joints by |K|^T (hand-computed)."""
+    from dynid.model.drive import Drive
+
+    K2 = np.array([[100.0, 0.0], [50.0, 50.0]])
+    drive = Drive(K2, np.zeros(2), side="motor", friction_at="motor")
+    fr = ClassicalFriction(np.zeros(2), np.array([2.0, 1.0]), np.zeros(2), np.full(2, 0.05)).at(
+        drive
+    )
+    dq = np.array([[0.0, 0.0], [0.001, -0.001], [0.0, 0.01]])  # motors (0, 0), (0.1, 0), (0, 0.5)
+    expected = np.array([[250.0, 50.0], [50.0, 50.0], [200.0, 0.0]])
+    assert standstill_margin(fr, dq) == pytest.approx(expected, abs=1e-12)
