@@ -159,3 +159,60 @@ def test_observe_params_urdf_with_two_leaves_takes_the_chain_of_tip(tmp_path, ca
     assert main([*other, "--out", str(tmp_path / "c1")]) != 0
     (line,) = capsys.readouterr().err.strip().splitlines()
     assert "--base/--tip choose the chain of a --params URDF" in line
+
+
+@pytest.mark.parametrize(
+    "extra, flag",
+    [
+        (["--gain", "80"], "--gain"),
+        (["--discretisation", "euler"], "--discretisation"),
+        (["--rule", "rectangle"], "--rule"),
+        (["--margin", "2"], "--margin"),
+        (["--quantile", "0.99"], "--quantile"),
+        (["--collision-factor", "3"], "--collision-factor"),
+        (["--k-sigma", "4"], "--k-sigma"),
+        (["--no-uncertainty"], "--no-uncertainty"),
+        (["--no-standstill-margin"], "--no-standstill-margin"),
+    ],
+)
+def test_observe_thresholds_refuses_each_calibration_option_in_one_line(
+    tmp_path, capsys, extra, flag
+):
+    """With --thresholds the file fixes the calibration: each of its options is refused,
+    named by its flag, rather than silently ignored."""
+    args = ["observe", "--params", "panda", "--thresholds", str(tmp_path / "t.json")]
+    assert main([*args, *extra, "--data", str(tmp_path / "x.csv"), "--out", str(tmp_path)]) == 2
+    (line,) = capsys.readouterr().err.strip().splitlines()
+    assert f"{flag} is a calibration option; t.json fixes it" in line
+
+
+@pytest.mark.parametrize(
+    "extra, flag", [(["--frame", "flange"], "--frame"), (["--merge", "1"], "--merge")]
+)
+def test_observe_calibrate_refuses_the_detection_options(tmp_path, capsys, extra, flag):
+    """--frame and --merge act on detection only: refused when calibrating."""
+    args = ["observe", "--params", "panda", "--calibrate", *extra]
+    assert main([*args, "--data", str(tmp_path / "x.csv"), "--out", str(tmp_path)]) == 2
+    (line,) = capsys.readouterr().err.strip().splitlines()
+    assert f"error: {flag} applies when detecting" in line
+
+
+def test_observe_takes_folders_and_names_logs_of_one_name_by_their_folder(logs, capsys):
+    """--data FOLDER stands for its logs, as on identify; two logs named log.csv in folders
+    a and b are told apart: events.json's log, the residual files and the printed events."""
+    import shutil
+
+    d = logs
+    for sub, src in (("c", "free.csv"), ("a", "hit.csv"), ("b", "free.csv")):
+        (d / sub).mkdir()
+        shutil.copy(d / src, d / sub / "log.csv")
+    p = ["observe", "--params", "panda", "--no-figures"]
+    assert main([*p, "--data", str(d / "c"), "--calibrate", "--out", str(d / "calc")]) == 0
+    th = ["--thresholds", str(d / "calc" / "thresholds.json")]
+    capsys.readouterr()
+    out = d / "obsab"
+    assert main([*p, *th, "--data", str(d / "a"), str(d / "b"), "--out", str(out)]) == 0
+    doc = json.loads((out / "events.json").read_text())
+    assert len(doc["events"]) == 2 and {e["log"] for e in doc["events"]} == {"a/log.csv"}
+    assert (out / "residuals_a_log.csv").exists() and (out / "residuals_b_log.csv").exists()
+    assert capsys.readouterr().out.count("  a/log.csv: ") == 2

@@ -47,6 +47,28 @@ def test_position_jumps_find_a_step_the_velocity_does_not_explain():
     assert position_jumps(t, np.ones_like(q), np.zeros_like(dq)) == []
 
 
+def test_an_encoder_glitch_is_named_at_its_jump_not_at_its_jump_back():
+    """One sample read 0.05 rad off (at t = 1 s) and the next a little short of the way
+    back: the glitch is at t = 1 s, of +0.05, though the step back is the larger."""
+    t = np.arange(0.0, 2.0, 1e-3)
+    q = np.sin(t)[:, None]
+    dq = np.cos(t)[:, None]
+    k = int(np.argmax(t >= 1.0))
+    q[k] += 0.05
+    q[k + 1] -= 0.002
+    (jump,) = position_jumps(t, q, dq)
+    assert jump.t == pytest.approx(1.0) and jump.size == pytest.approx(0.05, abs=1e-5)
+
+
+def test_log_labels_tell_logs_of_one_name_apart_by_their_folders():
+    """A file name when it is unique; the folder too for two free.csv."""
+    from dynid.io.observer_files import log_labels
+
+    paths = ["x/a/free.csv", "x/b/free.csv", "x/a/hit.csv"]
+    assert log_labels(paths) == ["a/free.csv", "b/free.csv", "hit.csv"]
+    assert log_labels(["a/b/c.csv", "d/b/c.csv"]) == ["a/b/c.csv", "d/b/c.csv"]
+
+
 def test_no_event_spans_a_restart():
     t = np.arange(10) * 1e-3
     r = np.zeros((10, 1))

@@ -110,3 +110,74 @@ def test_the_lag_is_the_closed_form_step_response_at_any_sample_times():
     expected = np.zeros_like(x)
     expected[1000:] = [2.0, -3.0] * -np.expm1(-gains * (t[1000:, None] - t[999]))
     np.testing.assert_allclose(y, expected, rtol=0, atol=1e-12)
+
+
+def test_calibrating_on_a_log_at_rest_is_refused_naming_the_joints(case):
+    """At rest every sample is inside the band: the margin covers the whole residual and
+    the thresholds would be 0 N m (a moving free log then flags everything). Refused, the
+    joints named; a log moving every joint calibrates."""
+    from dynid.exceptions import DataError
+    from dynid.simulation.trajectories import Trajectory
+
+    model, opts, cal, _ = case
+    t = uniform_times(2.0, 1000.0)
+    q = np.tile(cal.q[0], (t.shape[0], 1))
+    rest = Trajectory(t, q, np.zeros_like(q), np.zeros_like(q))
+    log = simulate_measurement(dynid.panda(), rest, rng=np.random.default_rng(5))
+    r = _residual(model, opts, log)
+    w = standstill_series(model, log.t, log.dq, opts)
+    with pytest.raises(DataError, match=r"joint\(s\) 1, 2, 3, 4, 5, 6, 7: .*moves every joint"):
+        calibrate([r], opts, standstill=[w])
+    assert calibrate([r], opts).contact.min() > 0  # without the margin: the noise's level
+    # a joint at rest beside moving ones is named alone
+    r_cal = _residual(model, opts, cal)
+    w_cal = np.array(standstill_series(model, cal.t, cal.dq, opts))
+    w_cal[:, 4] = np.abs(r_cal[:, 4]) + 1.0  # joint 5 covered everywhere
+    with pytest.raises(DataError, match=r"joint\(s\) 5: only 0 of"):
+        calibrate([r_cal], opts, standstill=[w_cal])
+
+
+def test_the_calibration_summary_prints_the_residual_the_rule_read_and_the_level_at_rest(case):
+    """The table's residual is the one the rule used, max (|r| - margin)^+ (so contact =
+    margin x it), not the raw max |r|; the level below which a contact at rest goes
+    undetected is the Coulomb level plus the contact threshold."""
+    from pathlib import Path
+
+    from dynid.cli.summaries import format_observation
+    from dynid.observer.detection import undetected_at_rest
+    from dynid.observer.results import LogObservation, ObserveResult
+
+    model, opts, cal, _ = case
+    r = _residual(model, opts, cal)
+    w = standstill_series(model, cal.t, cal.dq, opts)
+    th = calibrate([r], opts, standstill=[w])
+    np.testing.assert_allclose(undetected_at_rest(model, th), FC + th.contact, rtol=1e-12)
+    log = LogObservation(Path("cal.csv"), cal.t, r, None, [], None, None, w)
+    text = format_observation(
+        ObserveResult(model, th, (log,)), [f"j{k}" for k in range(1, 8)], calibrating=True
+    )
+    head, *rows = text.splitlines()[:8]
+    assert head.split()[1:4] == ["|r|", "read", "[N"] and "at rest [N m]" in head
+    read = np.max(np.clip(np.abs(r) - w, 0.0, None), axis=0)
+    raw = np.max(np.abs(r), axis=0)
+    assert np.any(raw - read > 1e-3)  # the margin left samples out: the two differ
+    printed = np.array([[float(v) for v in row.split()[1:]] for row in rows])
+    np.testing.assert_allclose(printed[:, 0], read, atol=6e-5)
+    np.testing.assert_allclose(printed[:, 3], FC + 1.5 * read, atol=6e-5)
+    assert "contact = 1.5 x the largest |r| of the calibration after the standstill margin" in text
+
+
+def test_the_margin_of_a_coupled_drive_is_taken_at_the_motors():
+    """Friction at the motors of a coupled drive (K = [[100, 0], [50, 50]], motor 2 turns
+    with both joints): each motor's Coulomb level where its own velocity K dq is inside
+    its band, brought to the joints by |K|^T (hand-computed)."""
+    from dynid.model.drive import Drive
+
+    K2 = np.array([[100.0, 0.0], [50.0, 50.0]])
+    drive = Drive(K2, np.zeros(2), side="motor", friction_at="motor")
+    fr = ClassicalFriction(np.zeros(2), np.array([2.0, 1.0]), np.zeros(2), np.full(2, 0.05)).at(
+        drive
+    )
+    dq = np.array([[0.0, 0.0], [0.001, -0.001], [0.0, 0.01]])  # motors (0, 0), (0.1, 0), (0, 0.5)
+    expected = np.array([[250.0, 50.0], [50.0, 50.0], [200.0, 0.0]])
+    assert standstill_margin(fr, dq) == pytest.approx(expected, abs=1e-12)

@@ -44,6 +44,9 @@ FLAGS: dict[str, str] = {
     "base_freq_hz": "--base-freq",
     "contacts": "--contact",
     "law": "--friction-model",
+    "merge_s": "--merge",
+    "uncertainty": "--no-uncertainty",
+    "standstill": "--no-standstill-margin",
 }
 
 

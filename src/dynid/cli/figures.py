@@ -16,7 +16,7 @@ from ..friction.fit import FrictionFit, FrictionResidual
 from ..friction.validation import Validation
 from ..identification.model import IdentifiedModel
 from ..io.json_files import save_json
-from ..io.observer_files import observation_names
+from ..io.observer_files import log_labels, observation_names
 from ..observer.detection import threshold_series
 from ..observer.results import ObserveResult
 from ..plots import feasible as feasible_plots
@@ -129,13 +129,14 @@ def save_observer_figures(out: Path, result: ObserveResult, *, names: list[str])
     """``out/<residuals name>.png`` of every log: residual, thresholds, events, and the true
     external torques stored beside a simulated log (those skipped are left out)."""
     paths = []
-    for x, stem in zip(result.logs, observation_names(result.logs), strict=True):
+    labels = log_labels([x.path for x in result.logs])
+    for x, stem, label in zip(result.logs, observation_names(result.logs), labels, strict=True):
         contact, collision = threshold_series(result.thresholds, x.t.shape[0], x.std, x.standstill)
 
-        def draw(x: Any = x, c: Any = contact, k: Any = collision) -> Any:
+        def draw(x: Any = x, c: Any = contact, k: Any = collision, lab: str = label) -> Any:
             return observer_plots.plot_residuals(
                 x.t, x.r, c, k, events=x.events, tau_ext=x.tau_ext, joint_names=names,
-                title=f"momentum observer on {x.path.name}: residual, thresholds, events",
+                title=f"momentum observer on {lab}: residual, thresholds, events",
             )  # fmt: skip
 
         fig = save_figure(draw, Path(out) / f"{stem}.png")

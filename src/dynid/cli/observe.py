@@ -24,7 +24,11 @@ Two steps:
   every event), OUT/residuals.csv (t, r1..rn and, with --frame, the external wrench at
   that frame by damped least squares) and OUT/residuals.png (residuals, thresholds,
   events, and the true tau_ext that `dynid simulate --contact` writes beside a log).
-Several logs: residuals_<name>.csv and .png each, one events.json.
+Several logs (or a folder of them): residuals_<name>.csv and .png each, one events.json;
+logs of one name in different folders are named by their folder. With --thresholds the
+calibration's options (--gain, --discretisation, --rule, --margin, --quantile,
+--collision-factor, --k-sigma, --no-uncertainty, --no-standstill-margin) are refused:
+the file fixes them; --frame and --merge apply to detection only.
 
 Examples:
   dynid observe --model id/identification.json --data free.csv --calibrate --out cal
@@ -68,7 +72,7 @@ def register(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParser:
     p.add_argument("--base", help="--params URDF: base link of the chain (default: the root)")
     p.add_argument("--tip", help="--params URDF: tip link of the chain (default: the only leaf)")
     p.add_argument("--friction", type=Path, help="friction.json replacing the model's friction")
-    p.add_argument("--data", type=Path, nargs="+", required=True, help="torque log(s)")
+    p.add_argument("--data", type=Path, nargs="+", required=True, help="torque log(s) or folder(s)")
     mode = p.add_mutually_exclusive_group(required=True)
     mode.add_argument(
         "--calibrate", action="store_true", help="thresholds from collision-free logs"

@@ -14,6 +14,8 @@ from ..feasibility.penalty import RetrievalProgress, RetrievalResult
 from ..friction.validation import NewtonEulerValidation
 from ..identification.info import LogInfo
 from ..identification.model import IdentifiedModel
+from ..io.observer_files import log_labels
+from ..observer.detection import undetected_at_rest
 from ..observer.results import ObserveResult
 from ..pipeline.collision import CollisionStageResult
 from ..regressors.base import identifiability
@@ -324,9 +326,30 @@ def format_newton_euler_rms(val: NewtonEulerValidation) -> str:
 def format_observation(result: ObserveResult, names: list[str], *, calibrating: bool) -> str:
     """The thresholds per joint (and the largest residual) and, detecting, every event."""
     th = result.thresholds
-    peak = np.nanmax([np.nanmax(np.abs(x.r), axis=0) for x in result.logs], axis=0)
-    cols = {"max |r| [N m]": peak, "contact [N m]": th.contact, "collision [N m]": th.collision}
+    if calibrating:  # the residual the rule read: after the standstill margin
+        read = "|r| read" if th.quantile == 1.0 else f"|r| q{th.quantile:g}"
+        cols = {f"{read} [N m]": th.contact / th.margin}
+    else:
+        peak = np.nanmax([np.nanmax(np.abs(x.r), axis=0) for x in result.logs], axis=0)
+        cols = {"max |r| [N m]": peak}
+    cols |= {"contact [N m]": th.contact, "collision [N m]": th.collision}
+    rest = undetected_at_rest(result.model, th)
+    at_rest = calibrating and th.standstill and np.any(rest > th.contact)
+    if at_rest:
+        cols["at rest [N m]"] = rest
     rows = [format_rms_table(names, cols)]
+    if calibrating:
+        what = "largest" if th.quantile == 1.0 else f"{th.quantile:g} quantile of the"
+        rows.append(
+            f"contact = {th.margin:g} x the {what} |r| of the calibration"
+            + (" after the standstill margin (left out)" if th.standstill else "")
+        )
+    if at_rest:
+        rows.append(
+            "at rest: a contact on a joint standing still inside its standstill band "
+            "goes undetected below this (its Coulomb level, which friction may hold, "
+            "plus the contact threshold)"
+        )
     if th.uses_uncertainty and th.noise is not None:
         rows.append(
             f"thresholds grow with the model's uncertainty: {th.k_sigma:g} sigma + noise "
@@ -342,7 +365,8 @@ def format_observation(result: ObserveResult, names: list[str], *, calibrating: 
     if calibrating:
         rows.append(f"calibrated on {th.samples} samples of {len(result.logs)} log(s)")
         return "\n".join(rows)
-    events = [(x.path.name, e) for x in result.logs for e in x.events]
+    labels = log_labels([x.path for x in result.logs])
+    events = [(label, e) for x, label in zip(result.logs, labels, strict=True) for e in x.events]
     rows.append(f"{len(events)} event(s)")
     for log, e in events:
         top = max(e.joints, key=lambda j: abs(e.peak[j - 1]))

@@ -43,6 +43,7 @@ __all__ = [
     "THRESHOLDS",
     "THRESHOLDS_SCHEMA",
     "load_thresholds",
+    "log_labels",
     "observation_names",
     "save_events",
     "save_observation",
@@ -231,14 +232,31 @@ def save_residuals_csv(
     return path
 
 
+def log_labels(paths: Sequence[str | Path]) -> list[str]:
+    """How each log is named to the user: its file name, or, for logs of one file name in
+    different folders, the shortest end of its path that tells them apart
+    (``a/free.csv``, ``b/free.csv``)."""
+    parts = [Path(p).parts for p in paths]
+    out = []
+    for k, mine in enumerate(parts):
+        depth = 1
+        while depth < len(mine) and any(
+            o[-depth:] == mine[-depth:] for i, o in enumerate(parts) if i != k
+        ):
+            depth += 1
+        out.append("/".join(mine[-depth:]))
+    return out
+
+
 def observation_names(logs: Sequence[LogObservation]) -> list[str]:
     """The name stem of each log's files: ``residuals`` for one log, ``residuals_<stem>``
-    for several (numbered where two logs share a stem)."""
+    for several, the stem of :func:`log_labels` (``residuals_a_free`` for ``a/free.csv``
+    beside ``b/free.csv``; numbered where two still agree)."""
     if len(logs) == 1:
         return ["residuals"]
     out: list[str] = []
-    for x in logs:
-        name = f"residuals_{Path(x.path).stem}"
+    for label in log_labels([x.path for x in logs]):
+        name = "residuals_" + str(Path(label).with_suffix("")).replace("/", "_")
         k, base = 2, name
         while name in out:
             name, k = f"{base}_{k}", k + 1
@@ -263,7 +281,7 @@ def save_observation(
     out = Path(out)
     meta = dict(meta or {})
     if calibrating:
-        cal = {"data": [Path(x.path).name for x in result.logs], **meta}
+        cal = {"data": log_labels([x.path for x in result.logs]), **meta}
         return [
             save_thresholds(
                 out / "thresholds.json", result.thresholds, joints=joints, calibration=cal
@@ -284,10 +302,12 @@ def save_observation(
                 frame=None if w is None else w.frame,
             )  # fmt: skip
         )
+    labels = log_labels([x.path for x in result.logs])
+    for x, label in zip(result.logs, labels, strict=True):
         events += x.events
-        logs_of += [Path(x.path).name] * len(x.events)
+        logs_of += [label] * len(x.events)
     info = {
-        "data": [Path(x.path).name for x in result.logs],
+        "data": labels,
         "samples": [int(x.t.shape[0]) for x in result.logs],
         **meta,
     }

@@ -325,7 +325,9 @@ def _read_npz(path: Path) -> dict[str, NDArray[np.float64]]:
                 )
             extra = sorted(set(npz.files) - {"t", "n_rows", *_SIGNALS})
             if extra:  # labels, vendor estimates, true external torques: kept in the file
-                _log.warning("%s: array(s) %s ignored (not read)", path.name, extra)
+                _log.warning(
+                    "%s: array(s) %s are not torque-log signals: ignored as data", path.name, extra
+                )
             n_rows = None
             for k in ("t", "n_rows", *_SIGNALS):
                 if k not in npz.files:
@@ -397,7 +399,11 @@ def _columns(path: Path, names: list[str], line: int) -> tuple[int, bool]:
             f"ddq1..ddq{n}"
         )
     if unknown:  # labels, vendor estimates, true external torques: kept in the file
-        _log.warning("%s: column(s) %s ignored (not read)", path.name, _checks.short(unknown))
+        _log.warning(
+            "%s: column(s) %s are not torque-log signals: ignored as data",
+            path.name,
+            _checks.short(unknown),
+        )
     return n, bool(have)
 
 

@@ -61,10 +61,15 @@ __all__ = [
     "residual_std",
     "standstill_series",
     "threshold_series",
+    "undetected_at_rest",
 ]
 
 #: Samples of the momentum regressor held at once by :func:`residual_std`.
 BLOCK = 8192
+#: Calibration samples per joint that the standstill margin must leave over (a residual
+#: above it) at least, and the fraction of the samples: fewer is refused (:func:`calibrate`).
+MIN_OUTSIDE = 200
+MIN_OUTSIDE_FRACTION = 0.01
 
 
 @dataclass(frozen=True, slots=True, eq=False)
@@ -276,6 +281,10 @@ def calibrate(
         A parameter out of its range.
     ShapeError
         Residuals of different joint counts, ``std`` not of their shapes, no sample.
+    DataError
+        With ``standstill``: a joint whose residual the margin covers at all but fewer than
+        :data:`MIN_OUTSIDE` samples (or 1 % of them), as on a log at rest: inside its
+        standstill band the calibration learns nothing (a threshold of about 0 N m).
     """
     if not margin >= 1.0 or not 0.0 < quantile <= 1.0 or not collision_factor >= 1.0:
         raise OptionError(
@@ -293,6 +302,7 @@ def calibrate(
     if standstill is not None:
         W = [_checks.as_exact("standstill", w, x.shape) for w, x in zip(standstill, R, strict=True)]
         A = np.clip(A - np.concatenate(W), 0.0, None)
+        _check_outside_band(A)
     contact = margin * np.quantile(A, quantile, axis=0)
     noise = None
     if std is not None:
@@ -313,6 +323,36 @@ def calibrate(
         noise=noise,
         standstill=standstill is not None,
     )
+
+
+def _check_outside_band(read: NDArray[np.float64]) -> None:
+    """Refuse joints whose calibration residual the standstill margin covers (almost)
+    everywhere: fewer than :data:`MIN_OUTSIDE` samples (or 1 % of them) left over, as on a
+    log at rest, would calibrate a threshold of about 0 N m."""
+    N = read.shape[0]
+    need = max(MIN_OUTSIDE_FRACTION * N, min(MIN_OUTSIDE, N))
+    left = np.count_nonzero(read > 0.0, axis=0)
+    bad = np.flatnonzero(left < need)
+    if bad.size:
+        joints = ", ".join(str(j + 1) for j in bad)
+        counts = ", ".join(str(int(left[j])) for j in bad)
+        raise DataError(
+            f"joint(s) {joints}: only {counts} of {N} calibration samples outside the "
+            "friction's standstill band (inside it the standstill margin covers the "
+            "residual, leaving a threshold of about 0 N m); calibrate on collision-free "
+            "motion that moves every joint"
+        )
+
+
+def undetected_at_rest(model: ObserverModel, thresholds: Thresholds) -> NDArray[np.float64]:
+    """Per joint (n,) [N m]: the contact torque below which a contact on a joint at rest
+    inside its standstill band goes undetected, its standstill margin at rest (the
+    friction's Coulomb level, which may hold any torque up to it without a motion) plus
+    its contact threshold; the threshold alone for thresholds without the margin."""
+    if not thresholds.standstill:
+        return np.array(thresholds.contact)
+    rest = standstill_margin(model.friction, np.zeros((1, model.n)))[0]
+    return np.asarray(thresholds.contact + rest)
 
 
 def threshold_series(

@@ -65,7 +65,8 @@ def position_jumps(
     """Steps of ``q`` (N, n) that the velocity ``dq`` (N, n) does not explain, inside the
     pieces beginning at ``starts``: ``d = q_k - q_{k-1} - T_k (dq_k + dq_{k-1}) / 2``
     (trapezoid) beyond :data:`JUMP_FACTOR` times its robust standard deviation (1.4826 the
-    median absolute deviation) and :data:`JUMP_FLOOR`; the largest per joint and piece."""
+    median absolute deviation) and :data:`JUMP_FLOOR`; the first per joint and piece (of
+    a glitch, the jump rather than the jump back)."""
     ta = _checks.as_array("t", t)
     N = ta.shape[0]
     qa, dqa = _checks.as_array("q", q), _checks.as_array("dq", dq)
@@ -82,8 +83,8 @@ def position_jumps(
         mad = np.median(np.abs(d - np.median(d)))
         limit = max(JUMP_FACTOR * 1.4826 * float(mad), JUMP_FLOOR)
         for a, b in zip(bounds[:-1], bounds[1:], strict=True):
-            seg = np.abs(d[a : b - 1])
-            if seg.size and seg.max() > limit:
-                k = int(np.argmax(seg))
+            over = np.flatnonzero(np.abs(d[a : b - 1]) > limit)
+            if over.size:  # the first: a glitch's jump, not its jump back
+                k = int(over[0])
                 out.append(PositionJump(float(ta[a + k + 1]), j, float(d[a + k])))
     return sorted(out, key=lambda x: (x.t, x.joint))

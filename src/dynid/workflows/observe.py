@@ -65,6 +65,7 @@ from ..observer.results import LogObservation, ObserveResult
 from ..observer.wrench import external_wrench
 from ..signals import edge_seconds, filtered_derivative
 from .data_files import ColumnSpec, column_map, in_file, read_torque_log, recorded_columns
+from .identify import data_files
 
 __all__ = [
     "LogObservation",
@@ -82,7 +83,8 @@ class ObserveOptions:
     Attributes
     ----------
     data : tuple of Path
-        Torque logs (``.csv``/``.npz``), or other tools' files read through ``columns``.
+        Torque logs (``.csv``/``.npz``), or other tools' files read through ``columns``; a
+        folder stands for its ``.csv`` and ``.npz`` files in name order.
     model : Path, optional
         ``identification.json`` (exactly one of ``model`` and ``params``).
     params : str or Path, optional
@@ -188,6 +190,44 @@ def load_observer_model(
     return from_robot(robot, friction="robot" if fr == "model" else fr, drive=drive), None
 
 
+#: The calibration's options, which a thresholds file fixes (with their defaults).
+_CALIBRATION_FIELDS = (
+    "gain",
+    "discretisation",
+    "rule",
+    "margin",
+    "quantile",
+    "collision_factor",
+    "k_sigma",
+    "uncertainty",
+    "standstill",
+)
+
+
+def _refuse_unused(opts: ObserveOptions) -> None:
+    """Options that do not apply: the calibration's with ``thresholds`` (the file fixes
+    them), ``frame`` and ``merge_s`` when calibrating (no wrench or event is computed)."""
+    default = ObserveOptions(data=())
+    if opts.thresholds is not None:
+        for name in _CALIBRATION_FIELDS:
+            if getattr(opts, name) != getattr(default, name):
+                raise OptionError(
+                    f"is a calibration option; {opts.thresholds.name} fixes it (calibrate "
+                    "again to change it)",
+                    field=name,
+                )
+    elif opts.frame is not None:
+        raise OptionError(
+            "applies when detecting (the wrench of residuals.csv); calibrating writes "
+            "thresholds only",
+            field="frame",
+        )
+    elif opts.merge_s != default.merge_s:
+        raise OptionError(
+            "applies when detecting (joins events); calibrating finds none", field="merge_s"
+        )
+
+
 def _observer_options(opts: ObserveOptions, thresholds: Thresholds | None) -> ObserverOptions:
     if thresholds is not None:
         return thresholds.options
@@ -213,6 +253,7 @@ def observe_files(opts: ObserveOptions) -> ObserveResult:
         raise OptionError("give one or more --data logs")
     if opts.calibrate == (opts.thresholds is not None):
         raise OptionError("give --calibrate (collision-free logs) or --thresholds thresholds.json")
+    _refuse_unused(opts)
     model, recorded = load_observer_model(
         opts.model, opts.params, opts.friction, base=opts.base, tip=opts.tip
     )
@@ -229,7 +270,8 @@ def observe_files(opts: ObserveOptions) -> ObserveResult:
     )
     wants_margin = opts.standstill if given is None else given.standstill
     logs = [
-        _observe_log(p, model, recorded, opts, options, wants_std, wants_margin) for p in opts.data
+        _observe_log(p, model, recorded, opts, options, wants_std, wants_margin)
+        for p in data_files(opts.data)
     ]
     if given is None:
         seen = [np.all(np.isfinite(x.r), axis=1) for x in logs]  # observed samples only
