@@ -25,8 +25,6 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any, Literal
 
-import numpy as np
-
 from ..exceptions import DataError, DynidWarning, OptionError
 from ..feasibility.convex import (
     DEFAULT_SDP_MARGIN,
@@ -52,7 +50,7 @@ from .data_files import (
     read_static_file,
     read_torque_log,
 )
-from .options import check_choice, check_count, check_number, only_with, refused_with
+from .options import check_band, check_choice, check_count, check_number, only_with, refused_with
 from .prior import load_prior
 
 __all__ = ["ColumnSpec", "IdentifyOptions", "IdentifyResult", "data_files", "identify_files"]
@@ -227,13 +225,7 @@ class IdentifyOptions:
         check_choice(self, "estimator", ESTIMATORS, optional=False)
         check_choice(self, "std", STD_METHODS)
         check_choice(self, "objective", ("logdet", "euclidean"))
-        band = self.total_mass
-        if band is not None and not (
-            len(band) == 2 and all(np.isfinite(band)) and 0.0 <= band[0] <= band[1]
-        ):
-            raise OptionError(
-                f"must be MIN,MAX with 0 <= MIN <= MAX; got {band}", field="total_mass"
-            )
+        check_band(self, "total_mass")
         only_with(self, CONSISTENT_ONLY, "consistent")
         refused_with(
             self,

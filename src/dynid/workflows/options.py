@@ -10,7 +10,14 @@ from typing import Any
 
 from ..exceptions import OptionError
 
-__all__ = ["check_choice", "check_count", "check_number", "only_with", "refused_with"]
+__all__ = [
+    "check_band",
+    "check_choice",
+    "check_count",
+    "check_number",
+    "only_with",
+    "refused_with",
+]
 
 
 def check_number(
@@ -39,6 +46,22 @@ def check_number(
         lo = f"{'>' if low_open else '>='} {low:g}"
         hi = "" if math.isinf(high) else f" and {'<' if high_open else '<='} {high:g}"
         raise OptionError(f"must be a finite number {lo}{hi}; got {v!r}", field=field)
+
+
+def check_band(options: Any, field: str) -> None:
+    """``options.field`` is None or ``(MIN, MAX)`` with ``0 <= MIN <= MAX``, finite (a
+    total-mass band [kg]).
+
+    Raises
+    ------
+    OptionError
+        Anything else; ``field`` set.
+    """
+    band = getattr(options, field)
+    if band is not None and not (
+        len(band) == 2 and all(math.isfinite(float(b)) for b in band) and 0.0 <= band[0] <= band[1]
+    ):
+        raise OptionError(f"must be MIN,MAX with 0 <= MIN <= MAX; got {band}", field=field)
 
 
 def check_count(options: Any, field: str, *, low: int = 1, optional: bool = True) -> None:

@@ -15,8 +15,6 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any, Literal
 
-import numpy as np
-
 from .._parallel import available_cores
 from ..exceptions import DynidError, OptionError
 from ..feasibility.bounds import Bounds, default_bounds
@@ -31,7 +29,7 @@ from ..io.friction_json import load_friction_json
 from ..io.model_json import load_model_json
 from ..model.robot import Robot
 from .data_files import read_static_file
-from .options import check_choice, check_count, check_number
+from .options import check_band, check_choice, check_count, check_number
 from .prior import load_prior
 
 __all__ = [
@@ -165,13 +163,7 @@ class RetrieveOptions:
         check_number(self, "prior_weight", low_open=False)
         check_number(self, "margin", low_open=False, high=0.25, high_open=True)
         check_choice(self, "objective", ("logdet", "euclidean"))
-        band = self.total_mass
-        if band is not None and not (
-            len(band) == 2 and all(np.isfinite(band)) and 0.0 <= band[0] <= band[1]
-        ):
-            raise OptionError(
-                f"must be MIN,MAX with 0 <= MIN <= MAX; got {band}", field="total_mass"
-            )
+        check_band(self, "total_mass")
         other = {"sdp": PENALTY_ONLY, "penalty": CONVEX_ONLY}.get(self.method, ())
         method = "penalty" if self.method == "sdp" else "sdp"
         for name in other:
