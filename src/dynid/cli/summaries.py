@@ -124,6 +124,17 @@ def selection_lines(selection: Any) -> list[str]:
             f"  {mark} {c['name']:<{w}} {c['n_params']:>6} {c['train_error_percent']:>9.4g} "
             f"{c['heldout_error_percent']:>11.4g} {c['heldout_se_percent']:>7.2g}"
         )
+    per = selection.get("heldout_per_recording") or ()
+    if per:
+        odd = set(selection.get("outlying_recordings") or ())
+        out.append(
+            "  held-out error of the chosen structure per recording (fitted on the others): "
+            + ", ".join(
+                f"{r['file']} {r['heldout_error_percent']:.3g} %"
+                + (" (outlying)" if r["file"] in odd else "")
+                for r in per
+            )
+        )
     out += [f"  note: {line}" for line in selection.get("notes", ())]
     return out
 

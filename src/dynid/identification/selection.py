@@ -56,7 +56,13 @@ from .structure import (
     structure_terms,
 )
 
-__all__ = ["Candidate", "Selection", "identify_recordings", "select_structure"]
+__all__ = [
+    "OUTLIER_RATIO",
+    "Candidate",
+    "Selection",
+    "identify_recordings",
+    "select_structure",
+]
 
 
 @dataclass(frozen=True, slots=True)
@@ -75,6 +81,9 @@ class Candidate:
         Pooled relative error [%] of the folds' fits on their held-out rows.
     heldout_se_percent : float
         Standard error [%] of the held-out error over the folds (0 for one fold).
+    fold_errors_percent : tuple of float
+        Relative held-out error [%] of every fold judged (each recording left out, when
+        the folds are recordings).
     """
 
     structure: Structure
@@ -82,6 +91,7 @@ class Candidate:
     train_error_percent: float
     heldout_error_percent: float
     heldout_se_percent: float
+    fold_errors_percent: tuple[float, ...] = ()
 
     def as_dict(self) -> dict[str, Any]:
         """JSON-ready."""
@@ -92,6 +102,7 @@ class Candidate:
             "train_error_percent": self.train_error_percent,
             "heldout_error_percent": self.heldout_error_percent,
             "heldout_se_percent": self.heldout_se_percent,
+            "heldout_per_fold_percent": list(self.fold_errors_percent),
         }
 
 
@@ -109,6 +120,14 @@ class Selection:
         How the structure was chosen.
     notes : tuple of str
         Candidates that could not be fitted, and why.
+    per_recording : tuple of (str, float)
+        With several recordings: each recording's name and the chosen structure's
+        held-out error [%] on it (fitted on the others).
+    outlying : tuple of str
+        Recordings whose held-out error is more than :data:`OUTLIER_RATIO` times the
+        others' median (the others fitted without it); the structure is judged on the
+        other recordings alone (the table's held-out errors), the final fit still uses
+        every recording.
     """
 
     candidates: tuple[Candidate, ...]
@@ -116,6 +135,8 @@ class Selection:
     validation: str
     rule: str = "simplest within one standard error of the lowest held-out error"
     notes: tuple[str, ...] = ()
+    per_recording: tuple[tuple[str, float], ...] = ()
+    outlying: tuple[str, ...] = ()
 
     def as_dict(self) -> dict[str, Any]:
         """JSON-ready (``identification.json``'s ``metadata.selection``)."""
@@ -125,7 +146,17 @@ class Selection:
             "chosen": self.chosen.name,
             "candidates": [c.as_dict() for c in self.candidates],
             "notes": list(self.notes),
+            "heldout_per_recording": [
+                {"file": f, "heldout_error_percent": e} for f, e in self.per_recording
+            ],
+            "outlying_recordings": list(self.outlying),
         }
+
+
+#: A recording whose held-out error exceeds this multiple of the other recordings' median
+#: (each fitted without it) is named in a warning and left out of the structure's
+#: judgement.
+OUTLIER_RATIO = 3.0
 
 
 def _judge(
@@ -204,7 +235,7 @@ def _candidate(
     held: HeldOut,
     rtol: float,
 ) -> Candidate:
-    """``structure`` (the columns ``use`` of ``model``) judged on the folds of ``model``."""
+    """``structure`` (the columns ``use`` of ``model``) judged on the folds ``held``."""
     fit = model.joint_fit if model.joint_fit is not None else model.fit
     use = use & np.asarray(fit.kept, dtype=bool)
     sub = held.restricted(np.flatnonzero(use))
@@ -217,6 +248,7 @@ def _candidate(
         train_error_percent=sub.whole.relative_error_percent(sub.whole.solve(rtol)),
         heldout_error_percent=sub.heldout_error_percent(xs),
         heldout_se_percent=se,
+        fold_errors_percent=tuple(per_fold),
     )
 
 
@@ -279,6 +311,7 @@ def select_structure(
     judge, how = _judge(robot, data, est, folds, validation)
     fit_rtol = 1e-10 if rtol is None else rtol
     groups: dict[tuple[bool, str], tuple[IdentifiedModel, list[tuple[ModelTerm, Any]]]] = {}
+    columns: list[tuple[Structure, NDArray[np.bool_], tuple[bool, str]]] = []
     # one regressor per armature choice and friction placement (friction at the motors and
     # at the joints of a coupled drive, together, would be dependent columns)
     for arm, at in sorted({(c.armature, c.at) for c in cands}):
@@ -292,17 +325,108 @@ def select_structure(
         groups[(arm, at)] = (model, terms)
         for c in mine:
             use = candidate_columns(c, model.base.rank, terms, robot.n)
+            columns.append((c, use, (arm, at)))
             judged.append(_candidate(c, use, model, model.holdout, fit_rtol))
     if not judged:
         return None
+    skip: tuple[int, ...] = ()
+    full = list(judged)
+    if len(data.names) > 2 and validation is None:
+        # a recording that holds what no candidate models (contacts, a payload) spoils
+        # the fits of every other fold: found, named, and left out of the judgement
+        ref = min(judged, key=lambda c: c.heldout_error_percent)
+        k = next(i for i, c in enumerate(judged) if c is ref)
+        _, use0, g0 = columns[k]
+        scores = _oddness(use0, groups[g0][0], fit_rtol)
+        skip = tuple(i for i, x in enumerate(scores) if x > OUTLIER_RATIO)
+        if skip and len(data.names) - len(skip) >= 2:
+            judged = [
+                _candidate(c, use, groups[g][0], _without(groups[g][0], skip), fit_rtol)
+                for c, use, g in columns
+            ]
+            notes += [
+                f"{data.names[i]}: held-out error {ref.fold_errors_percent[i]:.3g} %, "
+                f"{scores[i]:.3g} x the other recordings' median when it is left out of "
+                "their fits too: it holds torques the model does not (contacts, a payload, "
+                "another set-up?); the structure is chosen on the other recordings, the "
+                "final fit uses every recording"
+                for i in skip
+            ]
+        else:
+            skip = ()
     if per_joint:
-        judged += _per_joint(judged, groups, robot.n, fit_rtol)
-    return Selection(tuple(judged), _chosen(judged), how, notes=tuple(notes))
+        judged += _per_joint(
+            judged,
+            {g: (m, t, _without(m, skip) if skip else _holdout(m)) for g, (m, t) in groups.items()},
+            robot.n,
+            fit_rtol,
+        )
+    chosen = _chosen(judged)
+    per: tuple[tuple[str, float], ...] = ()
+    if len(data.names) > 1 and validation is None:
+        here = next((c for c in full if c.structure == chosen), None)
+        if here is None:  # a per-joint structure: judged again on every recording
+            m, t = groups[(chosen.armature, chosen.at)]
+            use = candidate_columns(chosen, m.base.rank, t, robot.n)
+            here = _candidate(chosen, use, m, _holdout(m), fit_rtol)
+        per = tuple(zip(data.names, here.fold_errors_percent, strict=True))
+    for i in skip:
+        warnings.warn(
+            f"{data.names[i]}: held-out error {per[i][1]:.3g} % with the chosen structure, far "
+            "above the other recordings' (metadata.selection.heldout_per_recording): it holds "
+            "torques the model does not (contacts, a payload?); the structure is chosen on "
+            "the other recordings",
+            DynidWarning,
+            stacklevel=2,
+        )
+    return Selection(
+        tuple(judged),
+        chosen,
+        how + (f", judged without {', '.join(data.names[i] for i in skip)}" if skip else ""),
+        notes=tuple(notes),
+        per_recording=per,
+        outlying=tuple(data.names[i] for i in skip),
+    )
+
+
+def _holdout(model: IdentifiedModel) -> HeldOut:
+    assert model.holdout is not None  # models of the candidates are judged on held-out data
+    return model.holdout
+
+
+def _without(model: IdentifiedModel, skip: tuple[int, ...]) -> HeldOut:
+    """The held-out folds of ``model`` with the recordings ``skip`` left out of every fit
+    and every judgement."""
+    held = _holdout(model)
+    kept = [t for j, t in enumerate(held.test) if j not in skip]
+    return replace(HeldOut.k_fold(kept), scheme=held.scheme, noise=held.noise)
+
+
+def _oddness(use: NDArray[np.bool_], model: IdentifiedModel, rtol: float) -> list[float]:
+    """Per recording (fold): its held-out error over the median held-out error of the
+    other recordings when it is left out of their fits too (about 1 for recordings
+    alike; large for one holding torques no candidate models, which also spoils the
+    others' fits while it is among them)."""
+    fit = model.joint_fit if model.joint_fit is not None else model.fit
+    idx = np.flatnonzero(use & np.asarray(fit.kept, dtype=bool))
+    held = _holdout(model).restricted(idx)
+    tests = held.test
+    out = []
+    for r, (train, test) in enumerate(zip(held.train, tests, strict=True)):
+        rest = HeldOut.k_fold([t for j, t in enumerate(tests) if j != r])
+        others = [
+            t.relative_error_percent(f.solve(rtol))
+            for f, t in zip(rest.train, rest.test, strict=True)
+        ]
+        med = float(np.median(others))
+        e = test.relative_error_percent(train.solve(rtol))
+        out.append(e / med if med > 0 else (math.inf if e > 0 else 1.0))
+    return out
 
 
 def _per_joint(
     judged: Sequence[Candidate],
-    groups: dict[tuple[bool, str], tuple[IdentifiedModel, list[tuple[ModelTerm, Any]]]],
+    groups: dict[tuple[bool, str], tuple[IdentifiedModel, list[tuple[ModelTerm, Any]], HeldOut]],
     n: int,
     rtol: float,
 ) -> list[Candidate]:
@@ -317,9 +441,8 @@ def _per_joint(
     for start in dict.fromkeys((best.structure, _chosen(judged))):
         if not start.friction:
             continue
-        model, terms = groups[(start.armature, start.at)]
-        held, r = model.holdout, model.base.rank
-        assert held is not None  # groups hold models judged on held-out data
+        model, terms, held = groups[(start.armature, start.at)]
+        r = model.base.rank
         here = next(c for c in judged if c.structure == start)
         while True:
             trials = [
