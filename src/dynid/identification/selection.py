@@ -310,7 +310,7 @@ def select_structure(
     notes: list[str] = []
     judge, how = _judge(robot, data, est, folds, validation)
     fit_rtol = 1e-10 if rtol is None else rtol
-    groups: dict[tuple[bool, str], tuple[IdentifiedModel, list[tuple[ModelTerm, Any]]]] = {}
+    groups: _Groups = {}
     columns: list[tuple[Structure, NDArray[np.bool_], tuple[bool, str]]] = []
     # one regressor per armature choice and friction placement (friction at the motors and
     # at the joints of a coupled drive, together, would be dependent columns)
@@ -329,31 +329,10 @@ def select_structure(
             judged.append(_candidate(c, use, model, model.holdout, fit_rtol))
     if not judged:
         return None
-    skip: tuple[int, ...] = ()
     full = list(judged)
+    skip: tuple[int, ...] = ()
     if len(data.names) > 2 and validation is None:
-        # a recording that holds what no candidate models (contacts, a payload) spoils
-        # the fits of every other fold: found, named, and left out of the judgement
-        ref = min(judged, key=lambda c: c.heldout_error_percent)
-        k = next(i for i, c in enumerate(judged) if c is ref)
-        _, use0, g0 = columns[k]
-        scores = _oddness(use0, groups[g0][0], fit_rtol)
-        skip = tuple(i for i, x in enumerate(scores) if x > OUTLIER_RATIO)
-        if skip and len(data.names) - len(skip) >= 2:
-            judged = [
-                _candidate(c, use, groups[g][0], _without(groups[g][0], skip), fit_rtol)
-                for c, use, g in columns
-            ]
-            notes += [
-                f"{data.names[i]}: held-out error {ref.fold_errors_percent[i]:.3g} %, "
-                f"{scores[i]:.3g} x the other recordings' median when it is left out of "
-                "their fits too: it holds torques the model does not (contacts, a payload, "
-                "another set-up?); the structure is chosen on the other recordings, the "
-                "final fit uses every recording"
-                for i in skip
-            ]
-        else:
-            skip = ()
+        judged, skip = _without_odd(judged, columns, groups, data.names, fit_rtol, notes)
     if per_joint:
         judged += _per_joint(
             judged,
@@ -364,12 +343,7 @@ def select_structure(
     chosen = _chosen(judged)
     per: tuple[tuple[str, float], ...] = ()
     if len(data.names) > 1 and validation is None:
-        here = next((c for c in full if c.structure == chosen), None)
-        if here is None:  # a per-joint structure: judged again on every recording
-            m, t = groups[(chosen.armature, chosen.at)]
-            use = candidate_columns(chosen, m.base.rank, t, robot.n)
-            here = _candidate(chosen, use, m, _holdout(m), fit_rtol)
-        per = tuple(zip(data.names, here.fold_errors_percent, strict=True))
+        per = _per_recording(chosen, full, groups, data.names, robot.n, fit_rtol)
     for i in skip:
         warnings.warn(
             f"{data.names[i]}: held-out error {per[i][1]:.3g} % with the chosen structure, far "
@@ -387,6 +361,60 @@ def select_structure(
         per_recording=per,
         outlying=tuple(data.names[i] for i in skip),
     )
+
+
+_Groups = dict[tuple[bool, str], tuple[IdentifiedModel, list[tuple[ModelTerm, Any]]]]
+
+
+def _without_odd(
+    judged: list[Candidate],
+    columns: list[tuple[Structure, NDArray[np.bool_], tuple[bool, str]]],
+    groups: _Groups,
+    names: Sequence[str],
+    rtol: float,
+    notes: list[str],
+) -> tuple[list[Candidate], tuple[int, ...]]:
+    """The candidates judged without the recordings that hold what no candidate models
+    (contacts, a payload), which spoil the fit of every other fold while among them
+    (:func:`_oddness` above :data:`OUTLIER_RATIO`), with those recordings; the candidates
+    as they were and none when none is odd or fewer than two would be left."""
+    ref = min(judged, key=lambda c: c.heldout_error_percent)
+    _, use0, g0 = columns[next(i for i, c in enumerate(judged) if c is ref)]
+    scores = _oddness(use0, groups[g0][0], rtol)
+    skip = tuple(i for i, x in enumerate(scores) if x > OUTLIER_RATIO)
+    if not skip or len(names) - len(skip) < 2:
+        return judged, ()
+    notes += [
+        f"{names[i]}: held-out error {ref.fold_errors_percent[i]:.3g} %, "
+        f"{scores[i]:.3g} x the other recordings' median when it is left out of "
+        "their fits too: it holds torques the model does not (contacts, a payload, "
+        "another set-up?); the structure is chosen on the other recordings, the "
+        "final fit uses every recording"
+        for i in skip
+    ]
+    return [
+        _candidate(c, use, groups[g][0], _without(groups[g][0], skip), rtol)
+        for c, use, g in columns
+    ], skip
+
+
+def _per_recording(
+    chosen: Structure,
+    judged: Sequence[Candidate],
+    groups: _Groups,
+    names: Sequence[str],
+    n: int,
+    rtol: float,
+) -> tuple[tuple[str, float], ...]:
+    """Each recording's name and the held-out error [%] of ``chosen`` on it, fitted on
+    every other recording."""
+    here = next((c for c in judged if c.structure == chosen), None)
+    if here is None:  # a per-joint structure: judged again on every recording
+        m, t = groups[(chosen.armature, chosen.at)]
+        here = _candidate(
+            chosen, candidate_columns(chosen, m.base.rank, t, n), m, _holdout(m), rtol
+        )
+    return tuple(zip(names, here.fold_errors_percent, strict=True))
 
 
 def _holdout(model: IdentifiedModel) -> HeldOut:
