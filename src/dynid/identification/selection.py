@@ -24,10 +24,9 @@ structure chosen (or given).
 
 from __future__ import annotations
 
-import math
 import warnings
 from collections.abc import Callable, Sequence
-from dataclasses import dataclass, replace
+from dataclasses import replace
 from typing import Any, Literal
 
 import numpy as np
@@ -37,6 +36,15 @@ from ..exceptions import DynidWarning, OptionError, RankDeficientError
 from ..model.drive import Drive
 from ..model.robot import Robot
 from ..regressors.terms import ModelTerm
+from .candidates import (
+    OUTLIER_RATIO,
+    Candidate,
+    Selection,
+    candidate_judged,
+    heldout_of,
+    recording_oddness,
+    without_recordings,
+)
 from .core import Judge, ModelColumns, RegressorStack, StreamedRows, identify, selected_columns
 from .estimators import Estimator, EstimatorName, estimator_named, row_weights
 from .holdout import DEFAULT_FOLDS, HeldOut, Normals, block_normals
@@ -63,100 +71,6 @@ __all__ = [
     "identify_recordings",
     "select_structure",
 ]
-
-
-@dataclass(frozen=True, slots=True)
-class Candidate:
-    """A structure judged on held-out data.
-
-    Attributes
-    ----------
-    structure : Structure
-    n_params : int
-        Parameters fitted (base parameters and terms; columns the data cannot excite not
-        counted).
-    train_error_percent : float
-        Relative error [%] of the fit on all data, on those data.
-    heldout_error_percent : float
-        Pooled relative error [%] of the folds' fits on their held-out rows.
-    heldout_se_percent : float
-        Standard error [%] of the held-out error over the folds (0 for one fold).
-    fold_errors_percent : tuple of float
-        Relative held-out error [%] of every fold judged (each recording left out, when
-        the folds are recordings).
-    """
-
-    structure: Structure
-    n_params: int
-    train_error_percent: float
-    heldout_error_percent: float
-    heldout_se_percent: float
-    fold_errors_percent: tuple[float, ...] = ()
-
-    def as_dict(self) -> dict[str, Any]:
-        """JSON-ready."""
-        return {
-            "name": self.structure.name,
-            "terms": list(self.structure.terms),
-            "n_params": self.n_params,
-            "train_error_percent": self.train_error_percent,
-            "heldout_error_percent": self.heldout_error_percent,
-            "heldout_se_percent": self.heldout_se_percent,
-            "heldout_per_fold_percent": list(self.fold_errors_percent),
-        }
-
-
-@dataclass(frozen=True, slots=True)
-class Selection:
-    """The candidates judged and the structure kept (module docstring).
-
-    Attributes
-    ----------
-    candidates : tuple of Candidate
-    chosen : Structure
-    validation : str
-        How the data were held out.
-    rule : str
-        How the structure was chosen.
-    notes : tuple of str
-        Candidates that could not be fitted, and why.
-    per_recording : tuple of (str, float)
-        With several recordings: each recording's name and the chosen structure's
-        held-out error [%] on it (fitted on the others).
-    outlying : tuple of str
-        Recordings whose held-out error is more than :data:`OUTLIER_RATIO` times the
-        others' median (the others fitted without it); the structure is judged on the
-        other recordings alone (the table's held-out errors), the final fit still uses
-        every recording.
-    """
-
-    candidates: tuple[Candidate, ...]
-    chosen: Structure
-    validation: str
-    rule: str = "simplest within one standard error of the lowest held-out error"
-    notes: tuple[str, ...] = ()
-    per_recording: tuple[tuple[str, float], ...] = ()
-    outlying: tuple[str, ...] = ()
-
-    def as_dict(self) -> dict[str, Any]:
-        """JSON-ready (``identification.json``'s ``metadata.selection``)."""
-        return {
-            "rule": self.rule,
-            "validation": self.validation,
-            "chosen": self.chosen.name,
-            "candidates": [c.as_dict() for c in self.candidates],
-            "notes": list(self.notes),
-            "heldout_per_recording": [
-                {"file": f, "heldout_error_percent": e} for f, e in self.per_recording
-            ],
-            "outlying_recordings": list(self.outlying),
-        }
-
-
-#: A recording whose held-out error exceeds this multiple of the other recordings' median
-#: (each fitted without it) is named in a warning and left out of the structure's
-#: judgement.
-OUTLIER_RATIO = 3.0
 
 
 def _judge(
@@ -226,30 +140,6 @@ def _normals(
 def _bands(data: Recordings) -> dict[str, tuple[float, ...]]:
     """The standstill bands at a drive's motors and joints, as tuples."""
     return {at: tuple(float(x) for x in b) for at, b in data.bands.items()}
-
-
-def _candidate(
-    structure: Structure,
-    use: NDArray[np.bool_],
-    model: IdentifiedModel,
-    held: HeldOut,
-    rtol: float,
-) -> Candidate:
-    """``structure`` (the columns ``use`` of ``model``) judged on the folds ``held``."""
-    fit = model.joint_fit if model.joint_fit is not None else model.fit
-    use = use & np.asarray(fit.kept, dtype=bool)
-    sub = held.restricted(np.flatnonzero(use))
-    xs = [t.solve(rtol) for t in sub.train]
-    per_fold = [t.relative_error_percent(x) for t, x in zip(sub.test, xs, strict=True)]
-    se = float(np.std(per_fold, ddof=1) / math.sqrt(len(per_fold))) if len(per_fold) > 1 else 0.0
-    return Candidate(
-        structure=structure,
-        n_params=int(use.sum()),
-        train_error_percent=sub.whole.relative_error_percent(sub.whole.solve(rtol)),
-        heldout_error_percent=sub.heldout_error_percent(xs),
-        heldout_se_percent=se,
-        fold_errors_percent=tuple(per_fold),
-    )
 
 
 def _chosen(candidates: Sequence[Candidate]) -> Structure:
@@ -326,7 +216,7 @@ def select_structure(
         for c in mine:
             use = candidate_columns(c, model.base.rank, terms, robot.n)
             columns.append((c, use, (arm, at)))
-            judged.append(_candidate(c, use, model, model.holdout, fit_rtol))
+            judged.append(candidate_judged(c, use, model, model.holdout, fit_rtol))
     if not judged:
         return None
     full = list(judged)
@@ -336,7 +226,10 @@ def select_structure(
     if per_joint:
         judged += _per_joint(
             judged,
-            {g: (m, t, _without(m, skip) if skip else _holdout(m)) for g, (m, t) in groups.items()},
+            {
+                g: (m, t, without_recordings(m, skip) if skip else heldout_of(m))
+                for g, (m, t) in groups.items()
+            },
             robot.n,
             fit_rtol,
         )
@@ -380,7 +273,7 @@ def _without_odd(
     as they were and none when none is odd or fewer than two would be left."""
     ref = min(judged, key=lambda c: c.heldout_error_percent)
     _, use0, g0 = columns[next(i for i, c in enumerate(judged) if c is ref)]
-    scores = _oddness(use0, groups[g0][0], rtol)
+    scores = recording_oddness(use0, groups[g0][0], rtol)
     skip = tuple(i for i, x in enumerate(scores) if x > OUTLIER_RATIO)
     if not skip or len(names) - len(skip) < 2:
         return judged, ()
@@ -393,7 +286,7 @@ def _without_odd(
         for i in skip
     ]
     return [
-        _candidate(c, use, groups[g][0], _without(groups[g][0], skip), rtol)
+        candidate_judged(c, use, groups[g][0], without_recordings(groups[g][0], skip), rtol)
         for c, use, g in columns
     ], skip
 
@@ -411,45 +304,10 @@ def _per_recording(
     here = next((c for c in judged if c.structure == chosen), None)
     if here is None:  # a per-joint structure: judged again on every recording
         m, t = groups[(chosen.armature, chosen.at)]
-        here = _candidate(
-            chosen, candidate_columns(chosen, m.base.rank, t, n), m, _holdout(m), rtol
+        here = candidate_judged(
+            chosen, candidate_columns(chosen, m.base.rank, t, n), m, heldout_of(m), rtol
         )
     return tuple(zip(names, here.fold_errors_percent, strict=True))
-
-
-def _holdout(model: IdentifiedModel) -> HeldOut:
-    assert model.holdout is not None  # models of the candidates are judged on held-out data
-    return model.holdout
-
-
-def _without(model: IdentifiedModel, skip: tuple[int, ...]) -> HeldOut:
-    """The held-out folds of ``model`` with the recordings ``skip`` left out of every fit
-    and every judgement."""
-    held = _holdout(model)
-    kept = [t for j, t in enumerate(held.test) if j not in skip]
-    return replace(HeldOut.k_fold(kept), scheme=held.scheme, noise=held.noise)
-
-
-def _oddness(use: NDArray[np.bool_], model: IdentifiedModel, rtol: float) -> list[float]:
-    """Per recording (fold): its held-out error over the median held-out error of the
-    other recordings when it is left out of their fits too (about 1 for recordings
-    alike; large for one holding torques no candidate models, which also spoils the
-    others' fits while it is among them)."""
-    fit = model.joint_fit if model.joint_fit is not None else model.fit
-    idx = np.flatnonzero(use & np.asarray(fit.kept, dtype=bool))
-    held = _holdout(model).restricted(idx)
-    tests = held.test
-    out = []
-    for r, (train, test) in enumerate(zip(held.train, tests, strict=True)):
-        rest = HeldOut.k_fold([t for j, t in enumerate(tests) if j != r])
-        others = [
-            t.relative_error_percent(f.solve(rtol))
-            for f, t in zip(rest.train, rest.test, strict=True)
-        ]
-        med = float(np.median(others))
-        e = test.relative_error_percent(train.solve(rtol))
-        out.append(e / med if med > 0 else (math.inf if e > 0 else 1.0))
-    return out
 
 
 def _per_joint(
@@ -474,7 +332,7 @@ def _per_joint(
         here = next(c for c in judged if c.structure == start)
         while True:
             trials = [
-                _candidate(s, candidate_columns(s, r, terms, n), model, held, rtol)
+                candidate_judged(s, candidate_columns(s, r, terms, n), model, held, rtol)
                 for s in (
                     replace(here.structure, drop=here.structure.drop + (lab,))
                     for lab in coefficient_labels(here.structure, n)
