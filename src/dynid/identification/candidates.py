@@ -14,6 +14,7 @@ it.
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
 from dataclasses import dataclass, replace
 from typing import Any
 
@@ -62,6 +63,7 @@ class Candidate:
     heldout_error_percent: float
     heldout_se_percent: float
     fold_errors_percent: tuple[float, ...] = ()
+    unphysical: tuple[str, ...] = ()
 
     def as_dict(self) -> dict[str, Any]:
         """JSON-ready."""
@@ -73,6 +75,7 @@ class Candidate:
             "heldout_error_percent": self.heldout_error_percent,
             "heldout_se_percent": self.heldout_se_percent,
             "heldout_per_fold_percent": list(self.fold_errors_percent),
+            "not_dissipative": list(self.unphysical),
         }
 
 
@@ -135,21 +138,32 @@ def candidate_judged(
     model: IdentifiedModel,
     held: HeldOut,
     rtol: float,
+    check: Callable[[NDArray[np.float64]], tuple[str, ...]] | None = None,
 ) -> Candidate:
-    """``structure`` (the columns ``use`` of ``model``) judged on the folds ``held``."""
+    """``structure`` (the columns ``use`` of ``model``) judged on the folds ``held``;
+    ``check`` (of every column's coefficients fitted on all data, 0 where not used) says
+    where its friction is not dissipative."""
     fit = model.joint_fit if model.joint_fit is not None else model.fit
     use = use & np.asarray(fit.kept, dtype=bool)
-    sub = held.restricted(np.flatnonzero(use))
+    idx = np.flatnonzero(use)
+    sub = held.restricted(idx)
     xs = [t.solve(rtol) for t in sub.train]
     per_fold = [t.relative_error_percent(x) for t, x in zip(sub.test, xs, strict=True)]
     se = float(np.std(per_fold, ddof=1) / math.sqrt(len(per_fold))) if len(per_fold) > 1 else 0.0
+    whole = sub.whole.solve(rtol)
+    unphysical: tuple[str, ...] = ()
+    if check is not None:
+        x = np.zeros(use.size)
+        x[idx] = whole
+        unphysical = check(x)
     return Candidate(
         structure=structure,
         n_params=int(use.sum()),
-        train_error_percent=sub.whole.relative_error_percent(sub.whole.solve(rtol)),
+        train_error_percent=sub.whole.relative_error_percent(whole),
         heldout_error_percent=sub.heldout_error_percent(xs),
         heldout_se_percent=se,
         fold_errors_percent=tuple(per_fold),
+        unphysical=unphysical,
     )
 
 

@@ -35,7 +35,7 @@ from numpy.typing import NDArray
 from ..exceptions import DynidWarning, OptionError, RankDeficientError
 from ..model.drive import Drive
 from ..model.robot import Robot
-from ..regressors.terms import ModelTerm
+from ..regressors.terms import LinearFriction, ModelTerm
 from .candidates import (
     OUTLIER_RATIO,
     Candidate,
@@ -46,6 +46,7 @@ from .candidates import (
     without_recordings,
 )
 from .core import Judge, ModelColumns, RegressorStack, StreamedRows, identify, selected_columns
+from .dissipation import friction_violations
 from .estimators import Estimator, EstimatorName, estimator_named, row_weights
 from .holdout import DEFAULT_FOLDS, HeldOut, Normals, block_normals
 from .least_squares import StdMethod
@@ -142,8 +143,16 @@ def _bands(data: Recordings) -> dict[str, tuple[float, ...]]:
     return {at: tuple(float(x) for x in b) for at, b in data.bands.items()}
 
 
+def _physical(candidates: Sequence[Candidate]) -> list[Candidate]:
+    """The candidates whose friction is dissipative within the velocity limits (all of
+    them when none is)."""
+    return [c for c in candidates if not c.unphysical] or list(candidates)
+
+
 def _chosen(candidates: Sequence[Candidate]) -> Structure:
-    """The simplest candidate within one standard error of the lowest held-out error."""
+    """The simplest candidate within one standard error of the lowest held-out error,
+    among those whose friction is dissipative within the velocity limits."""
+    candidates = _physical(candidates)
     best = min(candidates, key=lambda c: c.heldout_error_percent)
     limit = best.heldout_error_percent + max(best.heldout_se_percent, ERROR_FLOOR_PERCENT)
     within = [c for c in candidates if c.heldout_error_percent <= limit]
@@ -216,7 +225,7 @@ def select_structure(
         for c in mine:
             use = candidate_columns(c, model.base.rank, terms, robot.n)
             columns.append((c, use, (arm, at)))
-            judged.append(candidate_judged(c, use, model, model.holdout, fit_rtol))
+            judged.append(_judged(c, use, model, terms, model.holdout, fit_rtol))
     if not judged:
         return None
     full = list(judged)
@@ -234,6 +243,12 @@ def select_structure(
             fit_rtol,
         )
     chosen = _chosen(judged)
+    notes += [
+        f"{c.structure.name}: skipped, its friction is not dissipative within the velocity "
+        f"limits ({', '.join(v.split(' (')[0] for v in c.unphysical)})"
+        for c in judged
+        if c.unphysical and len(_physical(judged)) < len(judged)
+    ]
     per: tuple[tuple[str, float], ...] = ()
     if len(data.names) > 1 and validation is None:
         per = _per_recording(chosen, full, groups, data.names, robot.n, fit_rtol)
@@ -286,9 +301,46 @@ def _without_odd(
         for i in skip
     ]
     return [
-        candidate_judged(c, use, groups[g][0], without_recordings(groups[g][0], skip), rtol)
+        _judged(c, use, groups[g][0], groups[g][1], without_recordings(groups[g][0], skip), rtol)
         for c, use, g in columns
     ], skip
+
+
+def _judged(
+    structure: Structure,
+    use: NDArray[np.bool_],
+    model: IdentifiedModel,
+    terms: list[tuple[ModelTerm, Any]],
+    held: HeldOut | None,
+    rtol: float,
+) -> Candidate:
+    """``structure`` judged (:func:`~.candidates.candidate_judged`), its friction fitted
+    on all data checked for dissipation within the robot's velocity limits."""
+    assert held is not None  # models of the candidates are judged on held-out data
+    columns = _friction_columns(terms, model.base.rank)
+    dq_max = model.robot.dq_max
+
+    def check(x: NDArray[np.float64]) -> tuple[str, ...]:
+        return friction_violations([(t, x[sl]) for t, sl in columns], dq_max)
+
+    return candidate_judged(structure, use, model, held, rtol, check)
+
+
+def _friction_columns(
+    terms: Sequence[tuple[ModelTerm, Any]] | Sequence[ModelTerm], r: int
+) -> list[tuple[LinearFriction, slice]]:
+    """The friction terms among ``terms`` (those not in the base, appended after the
+    ``r`` base parameters in order) with their columns."""
+    out, k = [], r
+    for item in terms:
+        t = item[0] if isinstance(item, tuple) else item
+        if t.in_base:
+            continue
+        m = len(t.labels)
+        if isinstance(t, LinearFriction):
+            out.append((t, slice(k, k + m)))
+        k += m
+    return out
 
 
 def _per_recording(
@@ -304,9 +356,8 @@ def _per_recording(
     here = next((c for c in judged if c.structure == chosen), None)
     if here is None:  # a per-joint structure: judged again on every recording
         m, t = groups[(chosen.armature, chosen.at)]
-        here = candidate_judged(
-            chosen, candidate_columns(chosen, m.base.rank, t, n), m, heldout_of(m), rtol
-        )
+        use = candidate_columns(chosen, m.base.rank, t, n)
+        here = _judged(chosen, use, m, t, heldout_of(m), rtol)
     return tuple(zip(names, here.fold_errors_percent, strict=True))
 
 
@@ -321,7 +372,7 @@ def _per_joint(
     whose absence the held-out data miss least first) while the held-out error stays
     within one standard error of the lowest; the candidates reached, when they hold
     fewer coefficients than where they started."""
-    best = min(judged, key=lambda c: c.heldout_error_percent)
+    best = min(_physical(judged), key=lambda c: c.heldout_error_percent)
     limit = best.heldout_error_percent + max(best.heldout_se_percent, ERROR_FLOOR_PERCENT)
     out: list[Candidate] = []
     for start in dict.fromkeys((best.structure, _chosen(judged))):
@@ -332,12 +383,13 @@ def _per_joint(
         here = next(c for c in judged if c.structure == start)
         while True:
             trials = [
-                candidate_judged(s, candidate_columns(s, r, terms, n), model, held, rtol)
+                _judged(s, candidate_columns(s, r, terms, n), model, terms, held, rtol)
                 for s in (
                     replace(here.structure, drop=here.structure.drop + (lab,))
                     for lab in coefficient_labels(here.structure, n)
                 )
             ]
+            trials = [c for c in trials if not c.unphysical or here.unphysical]
             step = min(trials, key=lambda c: c.heldout_error_percent, default=None)
             if step is None or step.heldout_error_percent > limit:
                 break
@@ -508,9 +560,28 @@ def identify_recordings(
         rtol=rtol,
         judge=judge,
     )
+    _warn_unphysical(model, terms)
     info = replace(
         model.info,
         selection=None if selection is None else selection.as_dict(),
         extra={**model.info.extra, "terms": list(structure.terms)},
     )
     return replace(model, info=info)
+
+
+def _warn_unphysical(model: IdentifiedModel, terms: Sequence[ModelTerm]) -> None:
+    """A warning, one line per joint (motor), where the identified friction is not
+    dissipative within the robot's velocity limits."""
+    fit = model.joint_fit
+    if fit is None:
+        return
+    beta = np.where(np.asarray(fit.kept, dtype=bool), np.asarray(fit.beta, dtype=float), 0.0)
+    columns = _friction_columns(terms, model.base.rank)
+    for line in friction_violations([(t, beta[sl]) for t, sl in columns], model.robot.dq_max):
+        warnings.warn(
+            f"identified friction not dissipative within the velocity limits: {line}; "
+            "the friction pushes the arm there (--terms without that part, or with "
+            "the part left out on that joint: -LABEL)",
+            DynidWarning,
+            stacklevel=3,
+        )
