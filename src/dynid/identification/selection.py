@@ -508,10 +508,22 @@ def identify_recordings(
     DataError, ShapeError
         From :func:`~dynid.identification.recordings.prepare_recordings`.
     OptionError
-        An armature asked with known rotor inertias.
+        An armature asked with known rotor inertias; a friction placement (``at:``)
+        without a drive that couples joints.
     RankDeficientError
         The chosen (or given) structure is not identifiable from the data.
     """
+    if (
+        isinstance(structure, Structure)
+        and structure.at
+        and (drive is None or not drive.is_coupled)
+    ):
+        raise OptionError(
+            f"at:{structure.at}: friction at the motors and at the joints differ only through "
+            "a drive that couples joints; "
+            + ("no drive given" if drive is None else "this drive couples none"),
+            field="terms",
+        )
     data = prepare_recordings(
         robot,
         logs,
