@@ -70,9 +70,7 @@ def test_the_api_names_the_field(static):
     assert err.value.field == "cutoff_hz"
 
 
-def test_simulate_refuses_a_ramp_without_contact_and_a_contact_outside_the_log(
-    tmp_path, capsys
-):
+def test_simulate_refuses_a_ramp_without_contact_and_a_contact_outside_the_log(tmp_path, capsys):
     base = ["simulate", "--robot", "panda", "--duration", "2", "--out", str(tmp_path / "x.csv")]
     line = _refused([*base, "--contact-ramp", "0.1"], capsys)
     assert "--contact-ramp applies with --contact only" in line

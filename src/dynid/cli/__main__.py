@@ -270,6 +270,9 @@ def _main(argv: Sequence[str] | None) -> int:
             output_transaction(),
             _output_set(args, argv) as run,
         ):
+            from .common import check_inputs  # numpy and the library: after parsing
+
+            check_inputs(args)
             code = int(args._run(args, console) or 0)
             if run is not None and run.kind == "folder":
                 save_run_report(run, record, args, argv, code)
@@ -318,7 +321,9 @@ def _message(exc: BaseException) -> str:
         from .common import option_message
 
         return option_message(exc)
-    return str(exc)
+    from .common import cli_text
+
+    return cli_text(str(exc))
 
 
 #: What makes each command's memory smaller, for the out-of-memory hint (the commands that

@@ -8,6 +8,7 @@ import contextlib
 import dataclasses
 import logging
 import math
+import re
 import sys
 from collections.abc import Callable, Iterator
 from pathlib import Path
@@ -45,6 +46,34 @@ FLAGS: dict[str, str] = {
     "contacts": "--contact",
     "law": "--friction-model",
 }
+
+
+#: The options that name input files, checked before a command runs (:func:`check_inputs`).
+INPUT_FILES = ("data", "model", "thresholds", "validate_on")
+
+
+def check_inputs(args: argparse.Namespace) -> None:
+    """Every input file named by :data:`INPUT_FILES` exists, else one line naming the
+    file and its option (``nope.csv: --data: nope.csv does not exist``, as ``--robot``).
+
+    Raises
+    ------
+    DataError
+        The first file that does not exist.
+    """
+    for name in INPUT_FILES:
+        value = getattr(args, name, None)
+        for p in value if isinstance(value, list | tuple) else [value]:
+            if isinstance(p, str | Path) and not Path(p).exists():
+                raise DataError(f"{Path(p).name}: {flag(name)}: {p} does not exist")
+
+
+def cli_text(message: str) -> str:
+    """A library message as the command line says it: a Python option in a hint,
+    ``(drop_invalid=True)``, becomes its flag, and a flag the message already names is
+    not repeated (``pass --drop-invalid (drop_invalid=True)`` -> ``pass --drop-invalid``)."""
+    out = re.sub(r"\((\w+)=True\)", lambda m: f"({flag(m.group(1))})", message)
+    return re.sub(r"(--[\w-]+) \(\1\)", r"\1", out)
 
 
 def flag(field: str) -> str:

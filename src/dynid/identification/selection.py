@@ -59,6 +59,7 @@ from .structure import (
     Structure,
     candidate_columns,
     candidate_structures,
+    check_placement,
     coefficient_labels,
     friction_placements,
     largest_terms,
@@ -513,17 +514,8 @@ def identify_recordings(
     RankDeficientError
         The chosen (or given) structure is not identifiable from the data.
     """
-    if (
-        isinstance(structure, Structure)
-        and structure.at
-        and (drive is None or not drive.is_coupled)
-    ):
-        raise OptionError(
-            f"at:{structure.at}: friction at the motors and at the joints differ only through "
-            "a drive that couples joints; "
-            + ("no drive given" if drive is None else "this drive couples none"),
-            field="terms",
-        )
+    if isinstance(structure, Structure):
+        check_placement(structure, drive)
     data = prepare_recordings(
         robot,
         logs,
