@@ -16,7 +16,10 @@ standard error of the best** (the one-standard-error rule of cross-validation: H
 Tibshirani and Friedman, *The Elements of Statistical Learning*, 2nd ed., Sec. 7.10).
 The folds leave one recording out at a time when there are several, contiguous time
 blocks otherwise (:meth:`~dynid.identification.recordings.Recordings.fold_labels`), or
-judge on a separate recording.
+judge on a separate recording. A recording that holds what no candidate models is left
+out of the judgement and named (:mod:`dynid.identification.candidates`); a candidate
+whose friction is not dissipative within the velocity limits is not chosen
+(:mod:`dynid.identification.dissipation`).
 
 :func:`identify_recordings` is the classical route over one or more recordings with the
 structure chosen (or given).
@@ -285,8 +288,9 @@ def _without_odd(
 ) -> tuple[list[Candidate], tuple[int, ...]]:
     """The candidates judged without the recordings that hold what no candidate models
     (contacts, a payload), which spoil the fit of every other fold while among them
-    (:func:`_oddness` above :data:`OUTLIER_RATIO`), with those recordings; the candidates
-    as they were and none when none is odd or fewer than two would be left."""
+    (:func:`~.candidates.recording_oddness` above :data:`OUTLIER_RATIO`), with those
+    recordings; the candidates as they were and none when none is odd or fewer than two
+    would be left."""
     ref = min(judged, key=lambda c: c.heldout_error_percent)
     _, use0, g0 = columns[next(i for i, c in enumerate(judged) if c is ref)]
     scores = recording_oddness(use0, groups[g0][0], rtol)
