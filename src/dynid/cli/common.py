@@ -48,24 +48,20 @@ FLAGS: dict[str, str] = {
 }
 
 
-#: The options that name input files, checked before a command runs (:func:`check_inputs`).
+#: The options that name input files (:func:`missing_input`).
 INPUT_FILES = ("data", "model", "thresholds", "validate_on")
 
 
-def check_inputs(args: argparse.Namespace) -> None:
-    """Every input file named by :data:`INPUT_FILES` exists, else one line naming the
-    file and its option (``nope.csv: --data: nope.csv does not exist``, as ``--robot``).
-
-    Raises
-    ------
-    DataError
-        The first file that does not exist.
-    """
+def missing_input(args: argparse.Namespace, filename: str | Path) -> str | None:
+    """The line for an input file that does not exist, named with its option as
+    ``--robot`` is (``nope.csv: --data: nope.csv does not exist``); None when ``filename``
+    is none of the files of :data:`INPUT_FILES`."""
     for name in INPUT_FILES:
         value = getattr(args, name, None)
         for p in value if isinstance(value, list | tuple) else [value]:
-            if isinstance(p, str | Path) and not Path(p).exists():
-                raise DataError(f"{Path(p).name}: {flag(name)}: {p} does not exist")
+            if isinstance(p, str | Path) and Path(p) == Path(filename) and not Path(p).exists():
+                return f"{Path(p).name}: {flag(name)}: {p} does not exist"
+    return None
 
 
 def cli_text(message: str) -> str:
