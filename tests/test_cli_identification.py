@@ -170,7 +170,8 @@ def test_bad_inputs_exit_non_zero_with_one_stderr_line(tmp_path, identified, cap
     text[5] = text[5].replace(text[5].split(",")[3], "nan", 1)
     bad.write_text("\n".join(text) + "\n")
     assert main(["identify", "--data", str(bad), "--out", str(tmp_path)]) == 2
-    assert "drop_invalid=True" in _one_error_line(capsys)
+    line = _one_error_line(capsys)
+    assert "pass --drop-invalid to drop" in line and "drop_invalid=True" not in line
     assert (
         main(["identify", "--data", str(bad), "--out", str(tmp_path / "ok"), "--drop-invalid"]) == 0
     )

@@ -469,6 +469,16 @@ def test_model_structure_table_marks_the_chosen_candidate(runs, tmp_path):
     assert structure[2][:2] == ["\u2713 chosen", "classical"] and structure[1][0] == ""
     assert '<tr class="marked"><td>&#10003; chosen</td><td>classical' in page_text
     assert "Terms chosen: classical" in " ".join(" ".join(page.text).split())
+    doc["metadata"]["selection"]["heldout_per_recording"] = [
+        {"file": "a.csv", "heldout_error_percent": 0.41},
+        {"file": "hit.csv", "heldout_error_percent": 7.5},
+    ]
+    doc["metadata"]["selection"]["outlying_recordings"] = ["hit.csv"]
+    p.write_text(json.dumps(doc))
+    page = Page(render_html_report(RunSummary(command="identify"), {p.name: p}, out=tmp_path))
+    per = next(t for t in page.tables if t[0][0] == "recording")
+    assert per[1][0] == "a.csv" and per[1][2] == ""
+    assert per[2][0] == "hit.csv" and per[2][2].startswith("outlying")
     del doc["metadata"]["selection"]
     p.write_text(json.dumps(doc))
     page = Page(render_html_report(RunSummary(command="identify"), {p.name: p}, out=tmp_path))

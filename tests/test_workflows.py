@@ -12,7 +12,7 @@ import pytest
 
 import dynid
 from dynid.cli.__main__ import main
-from dynid.cli.common import option_message
+from dynid.cli.common import cli_text, option_message
 from dynid.exceptions import DataError, DynidError, OptionError
 from dynid.io.feasible_bundle import FEASIBLE_BUNDLE
 from dynid.io.robot.toml import save_toml
@@ -144,7 +144,10 @@ def test_log_cleaning_through_a_column_map_is_strict_alike(files, tmp_path, caps
         capsys,
         ["identify", "--data", str(path), "--columns", spec[0], "--out", str(tmp_path / "o")],
     )
-    assert line == f"dynid identify: error: {api.value}"
+    # the same message, the Python option of the library's hint named by its flag
+    assert "(drop_invalid=True)" in str(api.value)
+    assert line == f"dynid identify: error: {cli_text(str(api.value))}"
+    assert "drop_invalid=True" not in line and "--drop-invalid to drop" in line
 
 
 def test_a_prior_with_other_joints_is_refused_alike(files, tmp_path, capsys):

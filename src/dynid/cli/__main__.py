@@ -294,7 +294,7 @@ def _main(argv: Sequence[str] | None) -> int:
     except (DynidError, OSError) as exc:
         if args.debug:
             raise
-        print(f"{say}: error: {one_line(_message(exc), ERROR_LINE_LIMIT)}", file=_stderr())
+        print(f"{say}: error: {one_line(_message(exc, args), ERROR_LINE_LIMIT)}", file=_stderr())
         return 2
     except MemoryError as exc:
         if args.debug:
@@ -312,13 +312,20 @@ def _main(argv: Sequence[str] | None) -> int:
         return 2
 
 
-def _message(exc: BaseException) -> str:
-    """An error's line: an option named by its flag (:func:`dynid.cli.common.flag`)."""
+def _message(exc: BaseException, args: argparse.Namespace | None = None) -> str:
+    """An error's line: an option named by its flag (:func:`dynid.cli.common.flag`); a
+    missing input file named with its option (:func:`dynid.cli.common.missing_input`)."""
     if isinstance(exc, OptionError):
         from .common import option_message
 
         return option_message(exc)
-    return str(exc)
+    from .common import cli_text, missing_input
+
+    if isinstance(exc, FileNotFoundError) and exc.filename is not None and args is not None:
+        said = missing_input(args, exc.filename)
+        if said is not None:
+            return said
+    return cli_text(str(exc))
 
 
 #: What makes each command's memory smaller, for the out-of-memory hint (the commands that

@@ -8,6 +8,7 @@ import contextlib
 import dataclasses
 import logging
 import math
+import re
 import sys
 from collections.abc import Callable, Iterator
 from pathlib import Path
@@ -48,6 +49,30 @@ FLAGS: dict[str, str] = {
     "uncertainty": "--no-uncertainty",
     "standstill": "--no-standstill-margin",
 }
+
+
+#: The options that name input files (:func:`missing_input`).
+INPUT_FILES = ("data", "model", "thresholds", "validate_on")
+
+
+def missing_input(args: argparse.Namespace, filename: str | Path) -> str | None:
+    """The line for an input file that does not exist, named with its option as
+    ``--robot`` is (``nope.csv: --data: nope.csv does not exist``); None when ``filename``
+    is none of the files of :data:`INPUT_FILES`."""
+    for name in INPUT_FILES:
+        value = getattr(args, name, None)
+        for p in value if isinstance(value, list | tuple) else [value]:
+            if isinstance(p, str | Path) and Path(p) == Path(filename) and not Path(p).exists():
+                return f"{Path(p).name}: {flag(name)}: {p} does not exist"
+    return None
+
+
+def cli_text(message: str) -> str:
+    """A library message as the command line says it: a Python option in a hint,
+    ``(drop_invalid=True)``, becomes its flag, and a flag the message already names is
+    not repeated (``pass --drop-invalid (drop_invalid=True)`` -> ``pass --drop-invalid``)."""
+    out = re.sub(r"\((\w+)=True\)", lambda m: f"({flag(m.group(1))})", message)
+    return re.sub(r"(--[\w-]+) \(\1\)", r"\1", out)
 
 
 def flag(field: str) -> str:

@@ -25,6 +25,7 @@ from ..plots import identification as identification_plots
 from ..plots import observer as observer_plots
 from ..plots import torques as torque_plots
 from ..workflows.data_files import column_map, read_torque_log
+from ..workflows.identify import data_files
 from .common import save_figure
 
 __all__ = [
@@ -86,12 +87,16 @@ def save_validation_figures(
     return [p for p in paths if p is not None]
 
 
-def save_identify_figures(out: Path, model: IdentifiedModel, args: Any) -> list[Path]:
+def save_identify_figures(
+    out: Path, model: IdentifiedModel, args: Any, *, figures: bool = True
+) -> list[Path]:
     """A torque log's identification on held-out data, under ``out``: ``heldout.json``
-    (errors per joint against the sensor noise), ``heldout_torques.png`` (measured and
-    predicted torques) and ``heldout_residuals.png`` (residual histograms). Nothing for
-    static data or a model without held-out folds; a log that cannot be read back is
-    noted and skipped (the identification's own files are written)."""
+    (errors per joint against the sensor noise; data, written without ``figures`` too),
+    ``heldout_torques.png`` (measured and predicted torques) and ``heldout_residuals.png``
+    (residual histograms). The held-out recording is the last data file (a folder given
+    to ``--data`` stands for its files). Nothing for static data or a model without
+    held-out folds; a log that cannot be read back is noted and skipped (the
+    identification's own files are written)."""
     if model.info.log is None or model.holdout is None:
         return []
     try:
@@ -100,7 +105,7 @@ def save_identify_figures(out: Path, model: IdentifiedModel, args: Any) -> list[
             p, model.robot.n, columns=cmap, drop_invalid=args.drop_invalid
         )
         separate = None if args.validate_on is None else read(args.validate_on)
-        data = args.data if isinstance(args.data, Path) else args.data[-1]
+        data = data_files(args.data)[-1]
         held = identification_plots.heldout_torques(model, read(data), separate=separate)
     except Exception as exc:  # a figure never fails the command
         print(f"note: skipped the held-out torque figures: {exc}", file=sys.stderr)
@@ -108,8 +113,13 @@ def save_identify_figures(out: Path, model: IdentifiedModel, args: Any) -> list[
     if held is None:
         return []
     names = list(held.joint_names)
+    data_file = save_json(
+        Path(out) / "heldout.json", held.as_dict(), schema="dynid-heldout-torques/1"
+    )
+    if not figures:
+        return [data_file]
     paths = [
-        save_json(Path(out) / "heldout.json", held.as_dict(), schema="dynid-heldout-torques/1"),
+        data_file,
         save_figure(
             lambda: torque_plots.plot_torque_validation(
                 held.validation, joint_names=names, title=f"Held-out: {held.block}"

@@ -199,7 +199,8 @@ def register(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParser:
     p.add_argument(
         "--no-figures",
         action="store_true",
-        help="skip the figures (held-out torques of a log; --consistent: retrieval.png)",
+        help="skip the figures (held-out torques of a log; --consistent: retrieval.png); "
+        "heldout.json, data, is written all the same",
     )
     p.add_argument(
         "--cutoff",
@@ -241,7 +242,7 @@ def run(args: argparse.Namespace, console: Console) -> int:
     note_prior(args, console)
     result = identify_files(robot, args.data, options)
     files = [save_model_json(args.out / "identification.json", result.model)]
-    files += [] if args.no_figures else save_identify_figures(args.out, result.model, args)
+    files += save_identify_figures(args.out, result.model, args, figures=not args.no_figures)
     text = [format_identification(result.model)]
     if result.consistent is not None:
         files += save_feasible_bundle(args.out, result.consistent, source=str(args.data[0]))

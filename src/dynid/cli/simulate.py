@@ -85,10 +85,16 @@ def register(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParser:
         help="torque sensor noise std [N m] (default 0.05)",
     )
     p.add_argument(
-        "--q-noise", type=nonnegative_type, default=1e-4, help="position noise std [rad]"
+        "--q-noise",
+        type=nonnegative_type,
+        default=1e-4,
+        help="position noise std [rad] (default 1e-4)",
     )
     p.add_argument(
-        "--dq-noise", type=nonnegative_type, default=1e-3, help="velocity noise std [rad/s]"
+        "--dq-noise",
+        type=nonnegative_type,
+        default=1e-3,
+        help="velocity noise std [rad/s] (default 1e-3)",
     )
     p.add_argument(
         "--jitter", type=nonnegative_type, default=0.0, help="timestamp jitter std [s] (default 0)"
@@ -161,7 +167,7 @@ def register(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParser:
         "--contact-ramp",
         type=nonnegative_type,
         default=0.0,
-        help="rise and fall time of the contacts [s] (default 0: steps)",
+        help="rise and fall time of the contacts [s] (default 0: steps); with --contact only",
     )
     add_seed_option(p)
     p.add_argument("--out", required=True, type=output_path, help="output .csv or .npz")
@@ -171,6 +177,10 @@ def register(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParser:
 def _contacts(args: argparse.Namespace) -> tuple[Contact, ...]:
     """The contacts of ``--contact FRAME:WRENCH:START,END`` (parsed; the library checks
     the frames)."""
+    if args.contact_ramp and not args.contact:
+        raise OptionError(
+            "applies with {contacts} only", field="contact_ramp", others=("contacts",)
+        )
     out = []
     for text in args.contact:
         parts = text.rsplit(":", 2)

@@ -126,6 +126,17 @@ def selection_lines(selection: Any) -> list[str]:
             f"  {mark} {c['name']:<{w}} {c['n_params']:>6} {c['train_error_percent']:>9.4g} "
             f"{c['heldout_error_percent']:>11.4g} {c['heldout_se_percent']:>7.2g}"
         )
+    per = selection.get("heldout_per_recording") or ()
+    if per:
+        odd = set(selection.get("outlying_recordings") or ())
+        out.append(
+            "  held-out error of the chosen structure per recording (fitted on the others): "
+            + ", ".join(
+                f"{r['file']} {r['heldout_error_percent']:.3g} %"
+                + (" (outlying)" if r["file"] in odd else "")
+                for r in per
+            )
+        )
     out += [f"  note: {line}" for line in selection.get("notes", ())]
     return out
 
@@ -246,6 +257,38 @@ def format_retrieval(result: RetrievalResult) -> str:
     return "\n".join(lines)
 
 
+def consistent_structure_lines(result: ConsistentResult) -> list[str]:
+    """Which structure the one-step consistent fit of a torque log uses (the classical
+    friction on every joint, whatever was chosen) and the held-out errors of least
+    squares of that structure and of the chosen one."""
+    model = result.identified
+    if model is None or result.kind != "log":
+        return []
+    terms = [str(t) for t in model.info.extra.get("terms", ())]
+    used = " + ".join(["links", *terms])
+    out = [
+        f"structure of the consistent fit: {used} (the classical friction fv, fc, fo on "
+        "every joint, the friction it keeps physical; the least squares below have this "
+        "structure)"
+    ]
+    sel = model.info.selection
+    if sel:
+        held = {c["name"]: c["heldout_error_percent"] for c in sel.get("candidates", ())}
+        chosen = str(sel.get("chosen"))
+        mine = held.get(used)
+        out.append(
+            f"structure chosen on held-out data: {chosen}, held-out error "
+            f"{held.get(chosen, float('nan')):.4g} %"
+            + (
+                ""
+                if chosen == used or mine is None
+                else f"; least squares of the consistent fit's structure: {mine:.4g} %"
+            )
+            + f" ({sel.get('validation')})"
+        )
+    return out
+
+
 def format_consistent(result: ConsistentResult) -> str:
     """Readable summary of a convex retrieval: per link mass, CoM, margin; fit; notes."""
     r = result
@@ -270,6 +313,7 @@ def format_consistent(result: ConsistentResult) -> str:
         f"{100 * (r.residual_ratio - 1):.3f} % above the unconstrained fit",
         f"solver {r.solver}: {r.status}, {r.run_time:.2f} s",
     ]
+    lines += consistent_structure_lines(r)
     if r.heldout is not None:
         lines += heldout_table(r.heldout)
     if r.friction is not None:
@@ -279,6 +323,8 @@ def format_consistent(result: ConsistentResult) -> str:
             + " ".join(f"{x:.4g}" for x in r.friction[:, 0])
             + "; fc [N m]: "
             + " ".join(f"{x:.4g}" for x in r.friction[:, 1])
+            + "; fo [N m]: "
+            + " ".join(f"{x:.4g}" for x in r.friction[:, 2])
         )
     if r.rotor_inertia is not None:
         lines.append(

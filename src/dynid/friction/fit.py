@@ -147,6 +147,12 @@ class FrictionResidual:
         return self.log.dq
 
 
+def _short(value: object, limit: int = 40) -> str:
+    """``repr(value)``, cut to ``limit`` characters."""
+    text = repr(value)
+    return text if len(text) <= limit else text[: limit - 3] + "..."
+
+
 def model_drive(model: TorqueModel, drive: Drive | None) -> Drive | None:
     """The drive a log is read through: an identified model's own, or ``drive``.
 
@@ -158,10 +164,15 @@ def model_drive(model: TorqueModel, drive: Drive | None) -> Drive | None:
     own = model.drive if isinstance(model, IdentifiedModel) else None
     if drive is None or own is None:
         return own if drive is None else drive
-    if drive.as_dict() != own.as_dict():
+    mine, theirs = drive.as_dict(), own.as_dict()
+    if mine != theirs:
+        keys = sorted(k for k in {*mine, *theirs} if mine.get(k) != theirs.get(k))
+        given = ", ".join(
+            f"{k} = {_short(mine.get(k))} (the model's {_short(theirs.get(k))})" for k in keys
+        )
         raise DataError(
-            "the drive given differs from the one the model was identified with "
-            f"({own.describe()}); hint: leave out --drive to use the model's"
+            f"the drive given differs from the one the model was identified with: {given}; "
+            "hint: leave out --drive to use the model's"
         )
     return own
 

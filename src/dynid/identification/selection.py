@@ -16,7 +16,10 @@ standard error of the best** (the one-standard-error rule of cross-validation: H
 Tibshirani and Friedman, *The Elements of Statistical Learning*, 2nd ed., Sec. 7.10).
 The folds leave one recording out at a time when there are several, contiguous time
 blocks otherwise (:meth:`~dynid.identification.recordings.Recordings.fold_labels`), or
-judge on a separate recording.
+judge on a separate recording. A recording that holds what no candidate models is left
+out of the judgement and named (:mod:`dynid.identification.candidates`); a candidate
+whose friction is not dissipative within the velocity limits is not chosen
+(:mod:`dynid.identification.dissipation`).
 
 :func:`identify_recordings` is the classical route over one or more recordings with the
 structure chosen (or given).
@@ -24,10 +27,9 @@ structure chosen (or given).
 
 from __future__ import annotations
 
-import math
 import warnings
 from collections.abc import Callable, Sequence
-from dataclasses import dataclass, replace
+from dataclasses import replace
 from typing import Any, Literal
 
 import numpy as np
@@ -36,8 +38,18 @@ from numpy.typing import NDArray
 from ..exceptions import DynidWarning, OptionError, RankDeficientError
 from ..model.drive import Drive
 from ..model.robot import Robot
-from ..regressors.terms import ModelTerm
+from ..regressors.terms import LinearFriction, ModelTerm
+from .candidates import (
+    OUTLIER_RATIO,
+    Candidate,
+    Selection,
+    candidate_judged,
+    heldout_of,
+    recording_oddness,
+    without_recordings,
+)
 from .core import Judge, ModelColumns, RegressorStack, StreamedRows, identify, selected_columns
+from .dissipation import friction_violations
 from .estimators import Estimator, EstimatorName, estimator_named, row_weights
 from .holdout import DEFAULT_FOLDS, HeldOut, Normals, block_normals
 from .least_squares import StdMethod
@@ -50,82 +62,20 @@ from .structure import (
     Structure,
     candidate_columns,
     candidate_structures,
+    check_placement,
     coefficient_labels,
     friction_placements,
     largest_terms,
     structure_terms,
 )
 
-__all__ = ["Candidate", "Selection", "identify_recordings", "select_structure"]
-
-
-@dataclass(frozen=True, slots=True)
-class Candidate:
-    """A structure judged on held-out data.
-
-    Attributes
-    ----------
-    structure : Structure
-    n_params : int
-        Parameters fitted (base parameters and terms; columns the data cannot excite not
-        counted).
-    train_error_percent : float
-        Relative error [%] of the fit on all data, on those data.
-    heldout_error_percent : float
-        Pooled relative error [%] of the folds' fits on their held-out rows.
-    heldout_se_percent : float
-        Standard error [%] of the held-out error over the folds (0 for one fold).
-    """
-
-    structure: Structure
-    n_params: int
-    train_error_percent: float
-    heldout_error_percent: float
-    heldout_se_percent: float
-
-    def as_dict(self) -> dict[str, Any]:
-        """JSON-ready."""
-        return {
-            "name": self.structure.name,
-            "terms": list(self.structure.terms),
-            "n_params": self.n_params,
-            "train_error_percent": self.train_error_percent,
-            "heldout_error_percent": self.heldout_error_percent,
-            "heldout_se_percent": self.heldout_se_percent,
-        }
-
-
-@dataclass(frozen=True, slots=True)
-class Selection:
-    """The candidates judged and the structure kept (module docstring).
-
-    Attributes
-    ----------
-    candidates : tuple of Candidate
-    chosen : Structure
-    validation : str
-        How the data were held out.
-    rule : str
-        How the structure was chosen.
-    notes : tuple of str
-        Candidates that could not be fitted, and why.
-    """
-
-    candidates: tuple[Candidate, ...]
-    chosen: Structure
-    validation: str
-    rule: str = "simplest within one standard error of the lowest held-out error"
-    notes: tuple[str, ...] = ()
-
-    def as_dict(self) -> dict[str, Any]:
-        """JSON-ready (``identification.json``'s ``metadata.selection``)."""
-        return {
-            "rule": self.rule,
-            "validation": self.validation,
-            "chosen": self.chosen.name,
-            "candidates": [c.as_dict() for c in self.candidates],
-            "notes": list(self.notes),
-        }
+__all__ = [
+    "OUTLIER_RATIO",
+    "Candidate",
+    "Selection",
+    "identify_recordings",
+    "select_structure",
+]
 
 
 def _judge(
@@ -200,31 +150,16 @@ def _bands(data: Recordings) -> dict[str, tuple[float, ...]]:
     return {at: tuple(float(x) for x in b) for at, b in data.bands.items()}
 
 
-def _candidate(
-    structure: Structure,
-    use: NDArray[np.bool_],
-    model: IdentifiedModel,
-    held: HeldOut,
-    rtol: float,
-) -> Candidate:
-    """``structure`` (the columns ``use`` of ``model``) judged on the folds of ``model``."""
-    fit = model.joint_fit if model.joint_fit is not None else model.fit
-    use = use & np.asarray(fit.kept, dtype=bool)
-    sub = held.restricted(np.flatnonzero(use))
-    xs = [t.solve(rtol) for t in sub.train]
-    per_fold = [t.relative_error_percent(x) for t, x in zip(sub.test, xs, strict=True)]
-    se = float(np.std(per_fold, ddof=1) / math.sqrt(len(per_fold))) if len(per_fold) > 1 else 0.0
-    return Candidate(
-        structure=structure,
-        n_params=int(use.sum()),
-        train_error_percent=sub.whole.relative_error_percent(sub.whole.solve(rtol)),
-        heldout_error_percent=sub.heldout_error_percent(xs),
-        heldout_se_percent=se,
-    )
+def _physical(candidates: Sequence[Candidate]) -> list[Candidate]:
+    """The candidates whose friction is dissipative within the velocity limits (all of
+    them when none is)."""
+    return [c for c in candidates if not c.unphysical] or list(candidates)
 
 
 def _chosen(candidates: Sequence[Candidate]) -> Structure:
-    """The simplest candidate within one standard error of the lowest held-out error."""
+    """The simplest candidate within one standard error of the lowest held-out error,
+    among those whose friction is dissipative within the velocity limits."""
+    candidates = _physical(candidates)
     best = min(candidates, key=lambda c: c.heldout_error_percent)
     limit = best.heldout_error_percent + max(best.heldout_se_percent, ERROR_FLOOR_PERCENT)
     within = [c for c in candidates if c.heldout_error_percent <= limit]
@@ -281,7 +216,8 @@ def select_structure(
     notes: list[str] = []
     judge, how, fold_labels = _judge(robot, data, est, folds, validation)
     fit_rtol = 1e-10 if rtol is None else rtol
-    groups: dict[tuple[bool, str], tuple[IdentifiedModel, list[tuple[ModelTerm, Any]]]] = {}
+    groups: _Groups = {}
+    columns: list[tuple[Structure, NDArray[np.bool_], tuple[bool, str]]] = []
     # one regressor per armature choice and friction placement (friction at the motors and
     # at the joints of a coupled drive, together, would be dependent columns)
     for arm, at in sorted({(c.armature, c.at) for c in cands}):
@@ -295,17 +231,147 @@ def select_structure(
         groups[(arm, at)] = (model, terms)
         for c in mine:
             use = candidate_columns(c, model.base.rank, terms, robot.n)
-            judged.append(_candidate(c, use, model, model.holdout, fit_rtol))
+            columns.append((c, use, (arm, at)))
+            judged.append(_judged(c, use, model, terms, model.holdout, fit_rtol))
     if not judged:
         return None
+    full = list(judged)
+    skip: tuple[int, ...] = ()
+    if len(data.names) > 2 and validation is None:
+        judged, skip = _without_odd(judged, columns, groups, data.names, fit_rtol, notes)
     if per_joint:
-        judged += _per_joint(judged, groups, robot.n, fit_rtol)
-    return Selection(tuple(judged), _chosen(judged), how, notes=tuple(notes))
+        judged += _per_joint(
+            judged,
+            {
+                g: (m, t, without_recordings(m, skip) if skip else heldout_of(m))
+                for g, (m, t) in groups.items()
+            },
+            robot.n,
+            fit_rtol,
+        )
+    chosen = _chosen(judged)
+    notes += [
+        f"{c.structure.name}: skipped, its friction is not dissipative within the velocity "
+        f"limits ({', '.join(v.split(' (')[0] for v in c.unphysical)})"
+        for c in judged
+        if c.unphysical and len(_physical(judged)) < len(judged)
+    ]
+    per: tuple[tuple[str, float], ...] = ()
+    if len(data.names) > 1 and validation is None:
+        per = _per_recording(chosen, full, groups, data.names, robot.n, fit_rtol)
+    for i in skip:
+        warnings.warn(
+            f"{data.names[i]}: held-out error {per[i][1]:.3g} % with the chosen structure, far "
+            "above the other recordings' (metadata.selection.heldout_per_recording): it holds "
+            "torques the model does not (contacts, a payload?); the structure is chosen on "
+            "the other recordings",
+            DynidWarning,
+            stacklevel=2,
+        )
+    return Selection(
+        tuple(judged),
+        chosen,
+        how + (f", judged without {', '.join(data.names[i] for i in skip)}" if skip else ""),
+        notes=tuple(notes),
+        per_recording=per,
+        outlying=tuple(data.names[i] for i in skip),
+    )
+
+
+_Groups = dict[tuple[bool, str], tuple[IdentifiedModel, list[tuple[ModelTerm, Any]]]]
+
+
+def _without_odd(
+    judged: list[Candidate],
+    columns: list[tuple[Structure, NDArray[np.bool_], tuple[bool, str]]],
+    groups: _Groups,
+    names: Sequence[str],
+    rtol: float,
+    notes: list[str],
+) -> tuple[list[Candidate], tuple[int, ...]]:
+    """The candidates judged without the recordings that hold what no candidate models
+    (contacts, a payload), which spoil the fit of every other fold while among them
+    (:func:`~.candidates.recording_oddness` above :data:`OUTLIER_RATIO`), with those
+    recordings; the candidates as they were and none when none is odd or fewer than two
+    would be left."""
+    ref = min(judged, key=lambda c: c.heldout_error_percent)
+    _, use0, g0 = columns[next(i for i, c in enumerate(judged) if c is ref)]
+    scores = recording_oddness(use0, groups[g0][0], rtol)
+    skip = tuple(i for i, x in enumerate(scores) if x > OUTLIER_RATIO)
+    if not skip or len(names) - len(skip) < 2:
+        return judged, ()
+    notes += [
+        f"{names[i]}: held-out error {ref.fold_errors_percent[i]:.3g} %, "
+        f"{scores[i]:.3g} x the other recordings' median when it is left out of "
+        "their fits too: it holds torques the model does not (contacts, a payload, "
+        "another set-up?); the structure is chosen on the other recordings, the "
+        "final fit uses every recording"
+        for i in skip
+    ]
+    return [
+        _judged(c, use, groups[g][0], groups[g][1], without_recordings(groups[g][0], skip), rtol)
+        for c, use, g in columns
+    ], skip
+
+
+def _judged(
+    structure: Structure,
+    use: NDArray[np.bool_],
+    model: IdentifiedModel,
+    terms: list[tuple[ModelTerm, Any]],
+    held: HeldOut | None,
+    rtol: float,
+) -> Candidate:
+    """``structure`` judged (:func:`~.candidates.candidate_judged`), its friction fitted
+    on all data checked for dissipation within the robot's velocity limits."""
+    assert held is not None  # models of the candidates are judged on held-out data
+    columns = _friction_columns(terms, model.base.rank)
+    dq_max = model.robot.dq_max
+
+    def check(x: NDArray[np.float64]) -> tuple[str, ...]:
+        return friction_violations([(t, x[sl]) for t, sl in columns], dq_max)
+
+    return candidate_judged(structure, use, model, held, rtol, check)
+
+
+def _friction_columns(
+    terms: Sequence[tuple[ModelTerm, Any]] | Sequence[ModelTerm], r: int
+) -> list[tuple[LinearFriction, slice]]:
+    """The friction terms among ``terms`` (those not in the base, appended after the
+    ``r`` base parameters in order) with their columns."""
+    out, k = [], r
+    for item in terms:
+        t = item[0] if isinstance(item, tuple) else item
+        if t.in_base:
+            continue
+        m = len(t.labels)
+        if isinstance(t, LinearFriction):
+            out.append((t, slice(k, k + m)))
+        k += m
+    return out
+
+
+def _per_recording(
+    chosen: Structure,
+    judged: Sequence[Candidate],
+    groups: _Groups,
+    names: Sequence[str],
+    n: int,
+    rtol: float,
+) -> tuple[tuple[str, float], ...]:
+    """Each recording's name and the held-out error [%] of ``chosen`` on it, fitted on
+    every other recording."""
+    here = next((c for c in judged if c.structure == chosen), None)
+    if here is None:  # a per-joint structure: judged again on every recording
+        m, t = groups[(chosen.armature, chosen.at)]
+        use = candidate_columns(chosen, m.base.rank, t, n)
+        here = _judged(chosen, use, m, t, heldout_of(m), rtol)
+    return tuple(zip(names, here.fold_errors_percent, strict=True))
 
 
 def _per_joint(
     judged: Sequence[Candidate],
-    groups: dict[tuple[bool, str], tuple[IdentifiedModel, list[tuple[ModelTerm, Any]]]],
+    groups: dict[tuple[bool, str], tuple[IdentifiedModel, list[tuple[ModelTerm, Any]], HeldOut]],
     n: int,
     rtol: float,
 ) -> list[Candidate]:
@@ -314,24 +380,24 @@ def _per_joint(
     whose absence the held-out data miss least first) while the held-out error stays
     within one standard error of the lowest; the candidates reached, when they hold
     fewer coefficients than where they started."""
-    best = min(judged, key=lambda c: c.heldout_error_percent)
+    best = min(_physical(judged), key=lambda c: c.heldout_error_percent)
     limit = best.heldout_error_percent + max(best.heldout_se_percent, ERROR_FLOOR_PERCENT)
     out: list[Candidate] = []
     for start in dict.fromkeys((best.structure, _chosen(judged))):
         if not start.friction:
             continue
-        model, terms = groups[(start.armature, start.at)]
-        held, r = model.holdout, model.base.rank
-        assert held is not None  # groups hold models judged on held-out data
+        model, terms, held = groups[(start.armature, start.at)]
+        r = model.base.rank
         here = next(c for c in judged if c.structure == start)
         while True:
             trials = [
-                _candidate(s, candidate_columns(s, r, terms, n), model, held, rtol)
+                _judged(s, candidate_columns(s, r, terms, n), model, terms, held, rtol)
                 for s in (
                     replace(here.structure, drop=here.structure.drop + (lab,))
                     for lab in coefficient_labels(here.structure, n)
                 )
             ]
+            trials = [c for c in trials if not c.unphysical or here.unphysical]
             step = min(trials, key=lambda c: c.heldout_error_percent, default=None)
             if step is None or step.heldout_error_percent > limit:
                 break
@@ -452,10 +518,13 @@ def identify_recordings(
     DataError, ShapeError
         From :func:`~dynid.identification.recordings.prepare_recordings`.
     OptionError
-        An armature asked with known rotor inertias.
+        An armature asked with known rotor inertias; a friction placement (``at:``)
+        without a drive that couples joints.
     RankDeficientError
         The chosen (or given) structure is not identifiable from the data.
     """
+    if isinstance(structure, Structure):
+        check_placement(structure, drive)
     data = prepare_recordings(
         robot,
         logs,
@@ -505,9 +574,28 @@ def identify_recordings(
         judge=judge,
         fold_labels=fold_labels,
     )
+    _warn_unphysical(model, terms)
     info = replace(
         model.info,
         selection=None if selection is None else selection.as_dict(),
         extra={**model.info.extra, "terms": list(structure.terms)},
     )
     return replace(model, info=info)
+
+
+def _warn_unphysical(model: IdentifiedModel, terms: Sequence[ModelTerm]) -> None:
+    """A warning, one line per joint (motor), where the identified friction is not
+    dissipative within the robot's velocity limits."""
+    fit = model.joint_fit
+    if fit is None:
+        return
+    beta = np.where(np.asarray(fit.kept, dtype=bool), np.asarray(fit.beta, dtype=float), 0.0)
+    columns = _friction_columns(terms, model.base.rank)
+    for line in friction_violations([(t, beta[sl]) for t, sl in columns], model.robot.dq_max):
+        warnings.warn(
+            f"identified friction not dissipative within the velocity limits: {line}; "
+            "the friction pushes the arm there (--terms without that part, or with "
+            "the part left out on that joint: -LABEL)",
+            DynidWarning,
+            stacklevel=3,
+        )

@@ -40,6 +40,7 @@ __all__ = [
     "Structure",
     "candidate_columns",
     "candidate_structures",
+    "check_placement",
     "coefficient_labels",
     "friction_placements",
     "largest_terms",
@@ -137,10 +138,21 @@ class Structure:
         held = {PART_LABELS[p] for p in parts}
         for lab in self.drop:
             prefix = lab.rstrip("0123456789")
-            if prefix not in held or prefix == lab or not int(lab[len(prefix) :]) >= 1:
+            if prefix not in held:
+                some = sorted(held)[0] if held else ""
                 raise OptionError(
-                    f"--terms -{lab}: a coefficient to leave out is a label of a part held "
-                    f"and a joint number from 1 ({', '.join(sorted(held)) or 'no friction'})"
+                    f"--terms -{lab}: {prefix or lab!r} is none of the coefficients of the "
+                    + (
+                        f"terms given ({', '.join(sorted(held))}); e.g. -{some}3 leaves out "
+                        f"joint 3's {some}"
+                        if held
+                        else "terms given: they hold no friction"
+                    )
+                )
+            if prefix == lab or not int(lab[len(prefix) :]) >= 1:
+                raise OptionError(
+                    f"--terms -{lab}: give the joint number from 1 after the label "
+                    f"(-{prefix}3 leaves out joint 3's {prefix})"
                 )
         object.__setattr__(self, "drop", tuple(sorted(set(self.drop), key=_label_order)))
 
@@ -251,6 +263,24 @@ def friction_placements(drive: Drive | None) -> tuple[str, ...]:
     K = np.asarray(drive.transmission)
     coupled = bool(np.any(K[~np.eye(drive.n, dtype=bool)] != 0))
     return ("motor", "joint") if coupled else ("",)
+
+
+def check_placement(structure: Structure, drive: Drive | None) -> None:
+    """A friction placement (:attr:`Structure.at`) given by hand needs a drive that
+    couples joints, the one case where friction at the motors and at the joints differ.
+
+    Raises
+    ------
+    OptionError
+        ``at`` without such a drive (``field`` ``terms``).
+    """
+    if structure.at and (drive is None or not drive.is_coupled):
+        raise OptionError(
+            f"at:{structure.at}: friction at the motors and at the joints differ only through "
+            "a drive that couples joints; "
+            + ("no drive given" if drive is None else "this drive couples none"),
+            field="terms",
+        )
 
 
 def candidate_structures(

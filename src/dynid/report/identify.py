@@ -298,9 +298,25 @@ def _structure_section(doc: dict) -> str:
         "held-out std. error [%]",
     ]
     rule = f"Rule: {esc(sel.get('rule', ''))}; validation: {esc(sel.get('validation', ''))}."
-    return section(
-        "structure", "Model structure", f"<p>{rule}</p>", table(headers, rows, marked=marked)
-    )
+    parts = [f"<p>{rule}</p>", table(headers, rows, marked=marked)]
+    per = [r for r in sel.get("heldout_per_recording") or () if isinstance(r, dict)]
+    if per:
+        odd = set(sel.get("outlying_recordings") or ())
+        parts.append(
+            "<p>Held-out error of the chosen structure per recording (fitted on the others).</p>"
+            + table(
+                ["recording", "held-out error [%]", ""],
+                [
+                    [
+                        esc(r.get("file", "")),
+                        cell(r.get("heldout_error_percent")),
+                        "outlying: left out of the judgement" if r.get("file") in odd else "",
+                    ]
+                    for r in per
+                ],
+            )
+        )
+    return section("structure", "Model structure", *parts)
 
 
 def _coefficients_section(doc: dict) -> str:

@@ -15,6 +15,7 @@ command applies, so that the Python API behaves as the command does.
 
 from __future__ import annotations
 
+import json
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
@@ -185,4 +186,20 @@ def _check_params(params: str | Path) -> bool:
         )
     if not path.exists():
         raise OptionError(f": {path} does not exist", field="params")
+    if path.suffix.lower() == ".json" and _schema(path) == "dynid-identified-model/1":
+        raise OptionError(
+            f": {path.name} holds base parameters (combinations of the links' parameters), "
+            "not the links' own; run `dynid retrieve --model` on it or `dynid identify "
+            "--consistent` first and export their feasible.json",
+            field="params",
+        )
     return path.suffix.lower() == ".urdf"
+
+
+def _schema(path: Path) -> str | None:
+    """The ``schema`` of a JSON file, None when it cannot be read (its reader says why)."""
+    try:
+        doc = json.loads(path.read_text(encoding="utf-8"))
+    except (OSError, ValueError):
+        return None
+    return str(doc.get("schema")) if isinstance(doc, dict) else None

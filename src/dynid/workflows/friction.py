@@ -19,11 +19,15 @@ as the command does.
 
 from __future__ import annotations
 
+import warnings
 from collections.abc import Sequence
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
+import numpy as np
+
+from ..exceptions import DynidWarning
 from ..friction.fit import FrictionFit, FrictionResidual, fit_friction_through
 from ..friction.laws import LAWS
 from ..friction.recordings import Pieces, pieces_residual, prepare_pieces
@@ -186,7 +190,27 @@ def fit_friction_files(
             sel = select_friction(res, pieces.drive, own=own, own_fitted_here=here)
             return FrictionFileResult(sel.fit, res, sel, cut, pieces)
         chosen = fit_friction_through(res, pieces.drive, law)
+        if law == "quadratic":
+            _quadratic_at_bound(chosen)
         return FrictionFileResult(chosen, res, None, cut, pieces)
 
     result: FrictionFileResult = in_file(rec.paths[0], fit) if len(rec.paths) == 1 else fit()
     return result
+
+
+def _quadratic_at_bound(fit: FrictionFit) -> None:
+    """A warning when the quadratic law's ``fq`` sits on its bound 0 on joints it was
+    identified on: the friction of the data grows slower than linearly with speed (it
+    saturates), which ``fq >= 0`` (dissipative at every speed) cannot follow, so the law
+    is the classical one there."""
+    fq = np.asarray(fit.friction.params)[:, 1]
+    held = [j + 1 for j in range(fq.size) if fit.identified[j] and fq[j] == 0.0]
+    if held:
+        warnings.warn(
+            f"quadratic friction: fq held at its bound 0 on joint(s) "
+            f"{', '.join(map(str, held))}: the friction of these data grows slower than "
+            "linearly with speed (it saturates), which fq >= 0 cannot follow; there the law "
+            "is the classical one (a saturating law follows it: sigmoid, smooth, stribeck)",
+            DynidWarning,
+            stacklevel=3,
+        )

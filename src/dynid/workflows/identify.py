@@ -61,7 +61,7 @@ def _columns(spec: ColumnSpec | None, cutoff_hz: float | None) -> Any:
 
 
 def _heldout(
-    path: Path,
+    paths: Sequence[Path],
     kind: str,
     folds: int | None,
     validate_on: str | Path | None,
@@ -69,14 +69,22 @@ def _heldout(
     cmap: Any,
     drop_invalid: bool,
 ) -> dict[str, Any]:
-    """``folds``/``validate_on`` of the torque-log routes (the log read as ``path`` is);
-    refused for static data."""
+    """``folds``/``validate_on`` of the torque-log routes (the log read as ``paths[0]``
+    is); refused for static data, ``folds`` with several recordings (each recording is
+    a fold)."""
     if folds is None and validate_on is None:
         return {}
+    path = paths[0]
     if kind != "torque_log":
         raise OptionError(
             f"applies to torque logs, not static data ({path.name})",
             field="folds" if folds is not None else "validate_on",
+        )
+    if folds is not None and len(paths) > 1:
+        raise OptionError(
+            f"sets time blocks of one recording; with {len(paths)} recordings each one is "
+            "left out in turn (the folds are the recordings)",
+            field="folds",
         )
     kw: dict[str, Any] = {} if folds is None else {"folds": folds}
     if validate_on is not None:
@@ -123,7 +131,18 @@ def _terms(terms: str | Structure | None) -> Structure | Literal["auto"]:
     """``terms``: ``"auto"``/None (chosen on held-out data) or the terms named."""
     if terms is None or terms == "auto":
         return "auto"
-    return terms if isinstance(terms, Structure) else Structure.parse(terms)
+    if isinstance(terms, Structure):
+        return terms
+    words = [w.strip() for w in terms.replace("+", ",").split(",")]
+    if not any(words):
+        raise OptionError(
+            "is empty: name the terms (viscous,coulomb), links for none, or auto", field="terms"
+        )
+    names = [w.partition(":")[0] for w in words if w]
+    twice = sorted({w for w in names if names.count(w) > 1})
+    if twice:
+        raise OptionError(f"names {', '.join(twice)} twice", field="terms")
+    return Structure.parse(terms)
 
 
 #: Options of the one-step consistent fit only (refused without ``consistent``).
@@ -312,7 +331,7 @@ def _identify(robot: Robot, paths: list[Path], opt: IdentifyOptions) -> Identifi
     path = paths[0]
     cmap = _columns(opt.columns, opt.cutoff_hz)
     kind = data_kind(path, cmap)
-    heldout = _heldout(path, kind, opt.folds, opt.validate_on, robot.n, cmap, opt.drop_invalid)
+    heldout = _heldout(paths, kind, opt.folds, opt.validate_on, robot.n, cmap, opt.drop_invalid)
     if kind == "torque_log":
         logs = _read_logs(robot, paths, cmap, opt.drop_invalid)
         fit = lambda: identify_recordings(  # noqa: E731
@@ -331,7 +350,7 @@ def _identify(robot: Robot, paths: list[Path], opt: IdentifyOptions) -> Identifi
         )
         model = in_file(path, fit) if len(paths) == 1 else fit()
     else:
-        _one_static_file(paths, opt.terms)
+        _one_static_file(paths, opt)
         data = read_static_file(path, robot, columns=cmap, drop_invalid=opt.drop_invalid)
         outside = limit_violations(robot, data.q)
         if outside is not None:
@@ -400,16 +419,21 @@ def _consistent_structure_fit(
     return dataclasses.replace(model, info=info)
 
 
-def _one_static_file(paths: list[Path], terms: object) -> None:
-    """Static data come in one file, and have no terms to choose."""
+def _one_static_file(paths: list[Path], opt: IdentifyOptions) -> None:
+    """Static data come in one file, and have no terms to choose, no filter and no gaps."""
     if len(paths) > 1:
         raise DataError(
             f"{paths[0].name} holds static data: give one static data file ({len(paths)} given)"
         )
-    if terms is not None and terms != "auto":
+    if opt.terms is not None and opt.terms != "auto":
         raise OptionError(
             f"applies to torque logs, not static data ({paths[0].name})", field="terms"
         )
+    for name in ("cutoff_hz", "max_gap_s"):
+        if getattr(opt, name) is not None:
+            raise OptionError(
+                f"applies to torque logs, not static data ({paths[0].name})", field=name
+            )
 
 
 def _identify_consistent(
@@ -428,7 +452,7 @@ def _identify_consistent(
     path = paths[0]
     cmap = _columns(opt.columns, opt.cutoff_hz)
     kind = data_kind(path, cmap)
-    heldout = _heldout(path, kind, opt.folds, opt.validate_on, robot.n, cmap, opt.drop_invalid)
+    heldout = _heldout(paths, kind, opt.folds, opt.validate_on, robot.n, cmap, opt.drop_invalid)
     common: dict[str, Any] = dict(prior=prior, total_mass=opt.total_mass, options=opt.sdp())
     if kind == "torque_log":
         logs = _read_logs(robot, paths, cmap, opt.drop_invalid)
@@ -450,11 +474,7 @@ def _identify_consistent(
 
         result = in_file(path, fit) if len(paths) == 1 else fit()
     else:
-        _one_static_file(paths, opt.terms)
-        if opt.max_gap_s is not None:
-            raise OptionError(
-                f"applies to torque logs, not static data ({path.name})", field="max_gap_s"
-            )
+        _one_static_file(paths, opt)
         data = read_static_file(path, robot, columns=cmap, drop_invalid=opt.drop_invalid)
         result = in_file(
             path,

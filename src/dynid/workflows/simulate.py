@@ -196,6 +196,8 @@ def simulate_log(robot: Robot, options: SimulateOptions | None = None) -> Simula
         names it).
     UnknownNameError
         A contact at a frame the robot lacks.
+    OptionError
+        A contact whose window lies outside the log (``field`` ``contacts``).
     DataError
         An unreadable trajectory or friction file.
     """
@@ -207,6 +209,14 @@ def simulate_log(robot: Robot, options: SimulateOptions | None = None) -> Simula
     traj_at, N = _trajectory(opt, robot, t, rng)
     notes: list[str] = []
     traj_at = _in_limits(opt, robot, traj_at, N, notes)
+    first, last = traj_at(slice(0, 1)).t[0], traj_at(slice(N - 1, N)).t[0]
+    for c in opt.contacts:
+        if c.end <= first or c.start >= last:
+            raise OptionError(
+                f"{c.frame}: the window {c.start:g} to {c.end:g} s lies outside the log "
+                f"({first:g} to {last:g} s)",
+                field="contacts",
+            )
     if opt.drive is not None:
         notes.append(
             f"drive: {opt.drive.describe()}; the log is written on the {opt.drive.side} side"
@@ -236,7 +246,6 @@ def simulate_log(robot: Robot, options: SimulateOptions | None = None) -> Simula
         f"(true external torques in columns tau_ext1..tau_ext{robot.n})"
         for c in opt.contacts
     ]
-    first, last = traj_at(slice(0, 1)).t[0], traj_at(slice(N - 1, N)).t[0]
     return SimulatedLog(log, tuple(notes), float(first), float(last))
 
 

@@ -1,0 +1,203 @@
+"""The candidates of the model's structure judged on held-out data, and the recordings
+that hold what no candidate models.
+
+A :class:`Candidate` is a structure with its training and held-out errors (every fold's
+too); a :class:`Selection` the candidates judged, the one kept and, with several
+recordings, the chosen one's held-out error on each. A recording that holds torques no
+candidate models (contacts, a payload) spoils the fit of every fold it is trained in, so
+that every recording's held-out error rises and the structure collapses to the links;
+:func:`recording_oddness` finds it by comparing its held-out error with the others' when
+it is left out of their fits too, and :func:`without_recordings` gives the folds without
+it.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Callable
+from dataclasses import dataclass, replace
+from typing import Any
+
+import numpy as np
+from numpy.typing import NDArray
+
+from .holdout import HeldOut
+from .model import IdentifiedModel
+from .structure import Structure
+
+__all__ = [
+    "OUTLIER_RATIO",
+    "Candidate",
+    "Selection",
+    "candidate_judged",
+    "heldout_of",
+    "recording_oddness",
+    "without_recordings",
+]
+
+
+@dataclass(frozen=True, slots=True)
+class Candidate:
+    """A structure judged on held-out data.
+
+    Attributes
+    ----------
+    structure : Structure
+    n_params : int
+        Parameters fitted (base parameters and terms; columns the data cannot excite not
+        counted).
+    train_error_percent : float
+        Relative error [%] of the fit on all data, on those data.
+    heldout_error_percent : float
+        Pooled relative error [%] of the folds' fits on their held-out rows.
+    heldout_se_percent : float
+        Standard error [%] of the held-out error over the folds (0 for one fold).
+    fold_errors_percent : tuple of float
+        Relative held-out error [%] of every fold judged (each recording left out, when
+        the folds are recordings).
+    """
+
+    structure: Structure
+    n_params: int
+    train_error_percent: float
+    heldout_error_percent: float
+    heldout_se_percent: float
+    fold_errors_percent: tuple[float, ...] = ()
+    unphysical: tuple[str, ...] = ()
+
+    def as_dict(self) -> dict[str, Any]:
+        """JSON-ready."""
+        return {
+            "name": self.structure.name,
+            "terms": list(self.structure.terms),
+            "n_params": self.n_params,
+            "train_error_percent": self.train_error_percent,
+            "heldout_error_percent": self.heldout_error_percent,
+            "heldout_se_percent": self.heldout_se_percent,
+            "heldout_per_fold_percent": list(self.fold_errors_percent),
+            "not_dissipative": list(self.unphysical),
+        }
+
+
+@dataclass(frozen=True, slots=True)
+class Selection:
+    """The candidates judged and the structure kept (module docstring).
+
+    Attributes
+    ----------
+    candidates : tuple of Candidate
+    chosen : Structure
+    validation : str
+        How the data were held out.
+    rule : str
+        How the structure was chosen.
+    notes : tuple of str
+        Candidates that could not be fitted, and why.
+    per_recording : tuple of (str, float)
+        With several recordings: each recording's name and the chosen structure's
+        held-out error [%] on it (fitted on the others).
+    outlying : tuple of str
+        Recordings whose held-out error is more than :data:`OUTLIER_RATIO` times the
+        others' median (the others fitted without it); the structure is judged on the
+        other recordings alone (the table's held-out errors), the final fit still uses
+        every recording.
+    """
+
+    candidates: tuple[Candidate, ...]
+    chosen: Structure
+    validation: str
+    rule: str = "simplest within one standard error of the lowest held-out error"
+    notes: tuple[str, ...] = ()
+    per_recording: tuple[tuple[str, float], ...] = ()
+    outlying: tuple[str, ...] = ()
+
+    def as_dict(self) -> dict[str, Any]:
+        """JSON-ready (``identification.json``'s ``metadata.selection``)."""
+        return {
+            "rule": self.rule,
+            "validation": self.validation,
+            "chosen": self.chosen.name,
+            "candidates": [c.as_dict() for c in self.candidates],
+            "notes": list(self.notes),
+            "heldout_per_recording": [
+                {"file": f, "heldout_error_percent": e} for f, e in self.per_recording
+            ],
+            "outlying_recordings": list(self.outlying),
+        }
+
+
+#: A recording whose held-out error exceeds this multiple of the other recordings' median
+#: (each fitted without it) is named in a warning and left out of the structure's
+#: judgement.
+OUTLIER_RATIO = 3.0
+
+
+def candidate_judged(
+    structure: Structure,
+    use: NDArray[np.bool_],
+    model: IdentifiedModel,
+    held: HeldOut,
+    rtol: float,
+    check: Callable[[NDArray[np.float64]], tuple[str, ...]] | None = None,
+) -> Candidate:
+    """``structure`` (the columns ``use`` of ``model``) judged on the folds ``held``;
+    ``check`` (of every column's coefficients fitted on all data, 0 where not used) says
+    where its friction is not dissipative."""
+    fit = model.joint_fit if model.joint_fit is not None else model.fit
+    use = use & np.asarray(fit.kept, dtype=bool)
+    idx = np.flatnonzero(use)
+    sub = held.restricted(idx)
+    xs = [t.solve(rtol) for t in sub.train]
+    per_fold = [t.relative_error_percent(x) for t, x in zip(sub.test, xs, strict=True)]
+    se = float(np.std(per_fold, ddof=1) / math.sqrt(len(per_fold))) if len(per_fold) > 1 else 0.0
+    whole = sub.whole.solve(rtol)
+    unphysical: tuple[str, ...] = ()
+    if check is not None:
+        x = np.zeros(use.size)
+        x[idx] = whole
+        unphysical = check(x)
+    return Candidate(
+        structure=structure,
+        n_params=int(use.sum()),
+        train_error_percent=sub.whole.relative_error_percent(whole),
+        heldout_error_percent=sub.heldout_error_percent(xs),
+        heldout_se_percent=se,
+        fold_errors_percent=tuple(per_fold),
+        unphysical=unphysical,
+    )
+
+
+def heldout_of(model: IdentifiedModel) -> HeldOut:
+    """The held-out folds of a candidates' model (fitted with a judge)."""
+    assert model.holdout is not None  # models of the candidates are judged on held-out data
+    return model.holdout
+
+
+def without_recordings(model: IdentifiedModel, skip: tuple[int, ...]) -> HeldOut:
+    """The held-out folds of ``model`` with the recordings ``skip`` left out of every fit
+    and every judgement."""
+    held = heldout_of(model)
+    kept = [t for j, t in enumerate(held.test) if j not in skip]
+    return replace(HeldOut.k_fold(kept), scheme=held.scheme, noise=held.noise)
+
+
+def recording_oddness(use: NDArray[np.bool_], model: IdentifiedModel, rtol: float) -> list[float]:
+    """Per recording (fold): its held-out error over the median held-out error of the
+    other recordings when it is left out of their fits too (about 1 for recordings
+    alike; large for one holding torques no candidate models, which also spoils the
+    others' fits while it is among them)."""
+    fit = model.joint_fit if model.joint_fit is not None else model.fit
+    idx = np.flatnonzero(use & np.asarray(fit.kept, dtype=bool))
+    held = heldout_of(model).restricted(idx)
+    tests = held.test
+    out = []
+    for r, (train, test) in enumerate(zip(held.train, tests, strict=True)):
+        rest = HeldOut.k_fold([t for j, t in enumerate(tests) if j != r])
+        others = [
+            t.relative_error_percent(f.solve(rtol))
+            for f, t in zip(rest.train, rest.test, strict=True)
+        ]
+        med = float(np.median(others))
+        e = test.relative_error_percent(train.solve(rtol))
+        out.append(e / med if med > 0 else (math.inf if e > 0 else 1.0))
+    return out

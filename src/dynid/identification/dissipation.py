@@ -1,0 +1,108 @@
+"""Friction that dissipates: identified friction laws checked within the velocity limits.
+
+A friction torque opposes the motion: ``f(v) v >= 0`` at every velocity ``v`` the joint
+(motor) reaches, the offset ``fo`` left aside (a constant torque, not friction of the
+motion). Friction identified together with the links is a least-squares fit without
+bounds, and a law with a term that grows faster than the others (``fq v |v|``) or a
+Stribeck bump (``fsp``) can turn negative inside the limits: a model whose friction pushes
+the arm. :func:`friction_violations` names every joint (motor) where it does, with its
+coefficients below zero, for the structure selection to skip such a candidate and for
+``identify`` to warn.
+
+The velocity limit of a motor is ``sum_j |K_mj| dq_max_j`` (``K`` the drive's friction
+transmission, the identity at the joints); joints without a limit are not checked.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from typing import Any
+
+import numpy as np
+from numpy.typing import NDArray
+
+from ..regressors.friction_columns import smooth_sign, standstill_sign, stribeck_decay
+from ..regressors.terms import PART_LABELS, LinearFriction
+
+__all__ = ["GRID", "friction_violations"]
+
+#: Velocities checked per joint (motor), evenly over ``[-v_max, v_max]``.
+GRID = 401
+
+
+def _part_columns(term: LinearFriction, v: NDArray[np.float64]) -> dict[str, Any]:
+    """Each part's column at the velocities ``v`` (s, n) of the term's motors."""
+    n = v.shape[-1]
+    band = np.asarray(term.band, dtype=np.float64) if term.band else np.zeros(n)
+    return {
+        "viscous": v,
+        "quadratic": v * np.abs(v),
+        "coulomb": standstill_sign(v, band),
+        "smooth": smooth_sign(v, np.asarray(term.width)) if "smooth" in term.parts else None,
+        "stribeck": standstill_sign(v, band) * stribeck_decay(v, term.vst)
+        if "stribeck" in term.parts
+        else None,
+    }
+
+
+def friction_violations(
+    terms: Sequence[tuple[LinearFriction, NDArray[np.float64]]],
+    dq_max: NDArray[np.float64],
+) -> tuple[str, ...]:
+    """Where identified friction is not dissipative within the velocity limits.
+
+    Parameters
+    ----------
+    terms : sequence of (LinearFriction, ndarray)
+        The friction terms of one model (acting at one place) with their coefficients
+        (in the order of the term's ``labels``); their torques add up.
+    dq_max : ndarray, shape (n,)
+        Joint velocity limits [rad/s] (``inf``: none).
+
+    Returns
+    -------
+    tuple of str
+        One entry per joint (motor) where ``f(v) v < 0`` for some ``|v| <= v_max``:
+        ``"fq3 = -0.12 (joint 3: f(v) v < 0 at |v| = 2.1 rad/s, limit 2.18 rad/s)"``,
+        naming the coefficients below zero (else every coefficient of the joint).
+    """
+    if not terms:
+        return ()
+    drive = terms[0][0].drive
+    n = drive.n
+    K = np.abs(np.asarray(drive.friction_transmission, dtype=np.float64))
+    limit = np.broadcast_to(np.asarray(dq_max, dtype=np.float64), (n,))
+    vmax = np.array([float(np.sum(K[m, K[m] != 0] * limit[K[m] != 0])) for m in range(n)])
+    where = "motor" if drive.friction_at == "motor" else "joint"
+    grid = np.linspace(-1.0, 1.0, GRID)
+    v = grid[:, None] * np.where(np.isfinite(vmax), vmax, 0.0)[None, :]
+    f = np.zeros_like(v)
+    coefficients: list[dict[str, float]] = [{} for _ in range(n)]
+    for term, values in terms:
+        cols = _part_columns(term, v)
+        every = [(j, p) for j in range(n) for p in term.parts]
+        mask = term.mask or (True,) * len(every)
+        held = [jp for jp, h in zip(every, mask, strict=True) if h]
+        for (j, p), x in zip(held, np.asarray(values, dtype=np.float64), strict=True):
+            if p == "offset" or x == 0.0:
+                continue
+            f[:, j] += x * cols[p][:, j]
+            lab = f"{PART_LABELS[p]}{j + 1}"
+            coefficients[j][lab] = coefficients[j].get(lab, 0.0) + float(x)
+    power = f * v
+    scale = np.max(np.abs(power), axis=0)
+    out = []
+    for j in range(n):
+        if not np.isfinite(vmax[j]) or scale[j] == 0.0:
+            continue
+        bad = power[:, j] < -1e-9 * scale[j]
+        if not bad.any():
+            continue
+        at = float(np.max(np.abs(v[bad, j])))
+        neg = {k: x for k, x in coefficients[j].items() if x < 0} or coefficients[j]
+        named = ", ".join(f"{k} = {x:.3g}" for k, x in neg.items())
+        out.append(
+            f"{named} ({where} {j + 1}: f(v) v < 0 at |v| = {at:.3g} rad/s, "
+            f"limit {vmax[j]:.3g} rad/s)"
+        )
+    return tuple(out)

@@ -1,0 +1,42 @@
+"""``heldout.json`` (data, not a figure) is written when ``--data`` is a folder and with
+``--no-figures``; a folder stands for its files in name order.
+
+Reference: the same command with the files named one by one and figures drawn.
+"""
+
+from __future__ import annotations
+
+import json
+
+import pytest
+
+from dynid.cli.__main__ import main
+
+
+@pytest.fixture(scope="module")
+def folder(tmp_path_factory):
+    d = tmp_path_factory.mktemp("heldout") / "logs"
+    d.mkdir()
+    for s in (1, 2):
+        args = ["simulate", "--robot", "panda", "--trajectory", "fourier", "--duration", "4"]
+        assert main([*args, "--rate", "250", "--seed", str(s), "--out", str(d / f"r{s}.csv")]) == 0
+    return d
+
+
+def _heldout(out):
+    doc = json.loads((out / "heldout.json").read_text())
+    doc.pop("created", None)
+    return doc
+
+
+@pytest.mark.filterwarnings("ignore::dynid.exceptions.DynidWarning")
+def test_heldout_json_from_a_folder_and_without_figures(folder, tmp_path):
+    files = [str(folder / "r1.csv"), str(folder / "r2.csv")]
+    base = ["identify", "--robot", "panda", "--terms", "viscous", "-q"]
+    assert main([*base, "--data", *files, "--out", str(tmp_path / "a")]) == 0
+    assert main([*base, "--data", str(folder), "--out", str(tmp_path / "b")]) == 0
+    assert main([*base, "--data", str(folder), "--no-figures", "--out", str(tmp_path / "c")]) == 0
+    assert (tmp_path / "b" / "heldout_torques.png").is_file()
+    assert not (tmp_path / "c" / "heldout_torques.png").exists()
+    assert _heldout(tmp_path / "b") == _heldout(tmp_path / "a")
+    assert _heldout(tmp_path / "c") == _heldout(tmp_path / "a")

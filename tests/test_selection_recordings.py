@@ -1,0 +1,76 @@
+"""The structure chosen over several recordings when one of them holds torques the model
+does not (a contact): the held-out error of each recording recorded, the odd one named,
+and the choice made on the others.
+
+References: simulated Panda logs with the Panda's own (sigmoid) friction, which every
+friction candidate approximates better than no friction; a contact wrench (J^T w) that no
+candidate models; the structure chosen from the clean recordings alone.
+"""
+
+from __future__ import annotations
+
+import warnings
+
+import numpy as np
+import pytest
+
+import dynid
+from dynid.exceptions import DynidWarning
+from dynid.identification.selection import identify_recordings
+from dynid.simulation.contact import Contact
+from dynid.simulation.measurement import SensorNoise, sample_times, simulate_measurement
+from dynid.simulation.trajectories import random_fourier
+
+
+def _log(robot, seed, contacts=()):
+    traj = random_fourier(robot, np.random.default_rng(seed))(sample_times(6.0, 500.0))
+    return simulate_measurement(
+        robot, traj, rng=np.random.default_rng(seed + 100), noise=SensorNoise(), contacts=contacts
+    )
+
+
+@pytest.fixture(scope="module")
+def panda():
+    return dynid.panda()
+
+
+@pytest.fixture(scope="module")
+def logs(panda):
+    clean = [_log(panda, s) for s in (1, 2, 3)]
+    hit = _log(panda, 4, (Contact("link5", (0.0, 0.0, -20.0), 2.0, 3.0),))
+    return clean, hit
+
+
+def _selection(panda, logs, names):
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always", DynidWarning)
+        model = identify_recordings(panda, logs, names)
+    return model.info.selection, [str(w.message) for w in caught]
+
+
+def test_a_recording_with_a_contact_is_named_and_does_not_decide_the_structure(panda, logs):
+    clean, hit = logs
+    ref, _ = _selection(panda, clean, ["a.csv", "b.csv", "c.csv"])
+    sel, said = _selection(panda, [*clean, hit], ["a.csv", "b.csv", "c.csv", "hit.csv"])
+    assert sel["outlying_recordings"] == ["hit.csv"]
+    assert any(m.startswith("hit.csv: held-out error") for m in said)
+    # the friction the clean recordings hold is kept: the choice of the clean recordings
+    assert sel["chosen"] == ref["chosen"]
+    assert "viscous" in sel["chosen"]
+    per = {r["file"]: r["heldout_error_percent"] for r in sel["heldout_per_recording"]}
+    assert list(per) == ["a.csv", "b.csv", "c.csv", "hit.csv"]
+    assert per["hit.csv"] > max(per[f] for f in ("a.csv", "b.csv", "c.csv"))
+
+
+def test_alike_recordings_each_get_their_held_out_error_and_no_warning(panda, logs):
+    clean, _ = logs
+    sel, said = _selection(panda, clean, ["a.csv", "b.csv", "c.csv"])
+    assert sel["outlying_recordings"] == [] and not said
+    chosen = next(c for c in sel["candidates"] if c["name"] == sel["chosen"])
+    per = [r["heldout_error_percent"] for r in sel["heldout_per_recording"]]
+    # the pooled held-out error is the root of the recordings' mean squares, weighted by
+    # their torque energy; recordings of equal length and alike: close to the plain RMS
+    assert per == chosen["heldout_per_fold_percent"]
+    assert np.sqrt(np.mean(np.square(per))) == pytest.approx(
+        chosen["heldout_error_percent"], rel=0.2
+    )
