@@ -608,3 +608,30 @@ def test_a_consistent_set_with_an_implausible_link_is_not_good(tmp_path):
     assert "link3 weighs 0.01 kg" in text and "implausible" in text
     r.write_text(json.dumps(rep | {"notes": ["generic prior"]}))
     assert _verdict_of(render_html_report(RunSummary(command="retrieve"), files))[0] == "good"
+
+
+def test_a_fit_at_the_noise_floor_is_not_called_over_fitted(tmp_path):
+    """Held-out error 1.41 x the training error, and 1.22 x the sensor-noise floor on
+    unfiltered held-out torques: the fit follows some noise yet predicts as well as the
+    noise allows, which is no reservation (the page said "usable ... the fit over-fits"
+    beside "only noise is left"); 2.4 x the floor with the same ratio is one."""
+    ident = {
+        "schema": "dynid-identification/1",
+        "route": "classical",
+        "rank": 43,
+        "metadata": {"heldout": {"training_error_percent": 1.0, "heldout_error_percent": 1.41,
+                                 "scheme": "blocks", "folds": 5}},
+    }  # fmt: skip
+    held = {"schema": "dynid-heldout/1", "relative_error_percent": 1.22,
+            "noise_floor_percent": 1.0, "block": "the last block"}  # fmt: skip
+    p, h = tmp_path / "identification.json", tmp_path / "heldout.json"
+    p.write_text(json.dumps(ident))
+    files = {p.name: p, h.name: h}
+    h.write_text(json.dumps(held))
+    level, text = _verdict_of(render_html_report(RunSummary(command="identify"), files))
+    assert "over-fits" not in text and "predicts to the noise floor" in text, text
+    assert "ratio 1.41" in text
+    h.write_text(json.dumps(held | {"relative_error_percent": 2.4}))
+    level2, text2 = _verdict_of(render_html_report(RunSummary(command="identify"), files))
+    assert "the fit over-fits" in text2 and level2 in ("fair", "poor"), text2
+    assert level == "good", text  # the ratio alone is no reservation at the floor

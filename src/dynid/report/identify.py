@@ -59,21 +59,30 @@ def _heldout_facts(doc: dict, held: dict | None) -> tuple[list[str], list[str], 
     facts, problems, headline = [], [], ""
     ho = _get(doc, "metadata", "heldout")
     train, test = _get(ho, "training_error_percent"), _get(ho, "heldout_error_percent")
+    at_floor = False  # the unfiltered held-out error at the sensor-noise floor
+    if held is not None and is_number(held.get("relative_error_percent")):
+        floor = held.get("noise_floor_percent")
+        at_floor = is_number(floor) and floor > 0
+        at_floor = at_floor and held["relative_error_percent"] / floor <= FLOOR_GOOD
     if is_number(train) and is_number(test):
         scheme = {
             "blocks": f"over {ho.get('folds')} contiguous time blocks",
             "recordings": f"leaving out each of {ho.get('folds')} recordings in turn",
         }.get(str(ho.get("scheme")), "on the separate log")
         ratio = test / train if train > 0 else 1.0
+        if ratio <= OVERFIT_GOOD:
+            why = "no sign of over-fitting"
+        elif at_floor:  # the fit follows some noise, and predicts as well as noise allows
+            why = "the fit follows some of the noise, yet predicts to the noise floor below"
+        else:
+            why = "the fit over-fits"
         facts.append(
             f"Held-out error <b>{percent(test)}</b> {esc(scheme)} (filtered torques, as "
-            f"fitted), training error "
-            f"{percent(train)} (ratio {ratio:.2f}: "
-            + ("no sign of over-fitting)" if ratio <= OVERFIT_GOOD else "the fit over-fits)")
+            f"fitted), training error {percent(train)} (ratio {ratio:.2f}: {why})"
         )
-        if ratio > OVERFIT_FAIR:
+        if ratio > OVERFIT_FAIR and not at_floor:
             problems.append("poor")
-        elif ratio > OVERFIT_GOOD:
+        elif ratio > OVERFIT_GOOD and not at_floor:
             problems.append("fair")
         headline = f"The model predicts held-out torques to {percent(test)}"
     if held is not None and is_number(held.get("relative_error_percent")):
