@@ -136,8 +136,9 @@ def _again(step: Callable[[], object]) -> None:
 
 
 def _stop(ex: ProcessPoolExecutor) -> None:
-    """Cancel the pending tasks, terminate and join the workers of ``ex``, each step done
-    again when a second signal interrupts it (the caller is already stopping)."""
+    """Cancel the pending tasks, terminate and join the workers of ``ex`` and its manager
+    thread, each step done again when a second signal interrupts it (the caller is already
+    stopping)."""
     procs: list[Any] = []
     _again(lambda: procs.extend(p for p in _workers(ex) if p not in procs))
     _again(lambda: ex.shutdown(wait=False, cancel_futures=True))
@@ -145,6 +146,12 @@ def _stop(ex: ProcessPoolExecutor) -> None:
         _again(p.terminate)
     for p in procs:
         _again(functools.partial(p.join, timeout=5.0))
+    # the executor's manager thread closes its wake-up pipe when it ends; the interpreter's
+    # exit hook writes to that pipe if the thread has not ended, and a close between its
+    # check and its write prints a traceback (Python 3.11): let the thread end first
+    manager = getattr(ex, "_executor_manager_thread", None)
+    if manager is not None:
+        _again(functools.partial(manager.join, timeout=5.0))
 
 
 @contextlib.contextmanager
