@@ -136,3 +136,32 @@ def test_quadratic_friction_at_its_bound_is_explained_and_a_true_one_recovered(t
         assert bool(said) == expect_warning
         if not expect_warning:
             np.testing.assert_allclose(res.fit.friction.params[:, 1], truth[:, 1], rtol=0.1)
+
+
+def test_a_coefficient_below_zero_within_its_uncertainty_is_no_violation():
+    """A joint without Coulomb friction gets an estimate of -0.002 N m from noisy data:
+    within 3 of its 0.01 N m standard deviations it is zero, not friction that pushes the
+    arm (the selection skipped the true structure for it); 10 standard deviations below
+    zero it is a violation."""
+    term = LinearFriction(Drive.identity(2), parts=("viscous", "coulomb"))
+    x = np.array([0.3, 0.5, 0.0005, -0.002])  # fv1, fc1, fv2, fc2: f2(v) v < 0 below 4 rad/s
+    vmax = np.array([2.0, 2.0])
+    assert friction_violations([(term, x)], vmax)  # without its uncertainty: fc2 < 0
+    assert friction_violations([(term, x)], vmax, [np.full(4, 0.01)]) == ()
+    assert friction_violations([(term, x)], vmax, [np.full(4, 0.0002)])
+
+
+def test_normal_equations_give_the_classical_standard_deviations():
+    """``Normals.std``: sqrt(diag(sigma^2 (W^T W)^-1)), sigma^2 = RSS / (rows - p), as
+    numpy's least squares and inverse give them, on columns of very different scales."""
+    from dynid.identification.holdout import block_normals
+
+    rng = np.random.default_rng(0)
+    W = rng.normal(size=(400, 5)) * np.array([1e-3, 1.0, 1e2, 1.0, 10.0])
+    y = W @ rng.normal(size=5) + 0.1 * rng.normal(size=400)
+    (N,) = block_normals(W, y, np.zeros(400, np.intp))
+    x = N.solve()
+    ref_x, rss, *_ = np.linalg.lstsq(W, y, rcond=None)
+    ref = np.sqrt(rss[0] / (400 - 5) * np.diag(np.linalg.inv(W.T @ W)))
+    np.testing.assert_allclose(x, ref_x, rtol=1e-9)
+    np.testing.assert_allclose(N.std(x), ref, rtol=1e-8)

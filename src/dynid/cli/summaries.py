@@ -114,17 +114,23 @@ def selection_lines(selection: Any) -> list[str]:
     """The model structures judged on held-out data, the one kept marked ``*``."""
     if not selection:
         return []
-    w = _width("structure", [str(c["name"]) for c in selection["candidates"]], 46)
+    # a per-joint structure's coefficients left out go last ("- fo1 - fc4"), so that the
+    # table is as wide as the structures' names without them
+    split = [str(c["name"]).partition(" - ") for c in selection["candidates"]]
+    w = _width("structure", [name for name, _, _ in split], 46)
+    left = any(dropped for _, _, dropped in split)
     out = [
         f"model structure chosen on held-out data ({selection['validation']}): "
         f"{selection['chosen']} ({selection['rule']})",
-        f"    {'structure':<{w}} {'params':>6} {'train %':>9} {'held-out %':>11} {'+- se':>7}",
+        f"    {'structure':<{w}} {'params':>6} {'train %':>9} {'held-out %':>11} {'+- se':>7}"
+        + ("  left out (coefficient and joint)" if left else ""),
     ]
-    for c in selection["candidates"]:
+    for c, (name, _, dropped) in zip(selection["candidates"], split, strict=True):
         mark = "*" if c["name"] == selection["chosen"] else " "
         out.append(
-            f"  {mark} {c['name']:<{w}} {c['n_params']:>6} {c['train_error_percent']:>9.4g} "
+            f"  {mark} {name:<{w}} {c['n_params']:>6} {c['train_error_percent']:>9.4g} "
             f"{c['heldout_error_percent']:>11.4g} {c['heldout_se_percent']:>7.2g}"
+            + (f"  {dropped.replace(' - ', ' ')}" if dropped else "")
         )
     per = selection.get("heldout_per_recording") or ()
     if per:

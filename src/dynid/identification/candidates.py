@@ -138,11 +138,11 @@ def candidate_judged(
     model: IdentifiedModel,
     held: HeldOut,
     rtol: float,
-    check: Callable[[NDArray[np.float64]], tuple[str, ...]] | None = None,
+    check: Callable[[NDArray[np.float64], NDArray[np.float64]], tuple[str, ...]] | None = None,
 ) -> Candidate:
     """``structure`` (the columns ``use`` of ``model``) judged on the folds ``held``;
-    ``check`` (of every column's coefficients fitted on all data, 0 where not used) says
-    where its friction is not dissipative."""
+    ``check`` (of every column's coefficients fitted on all data and their standard
+    deviations, 0 where not used) says where its friction is not dissipative."""
     fit = model.joint_fit if model.joint_fit is not None else model.fit
     use = use & np.asarray(fit.kept, dtype=bool)
     idx = np.flatnonzero(use)
@@ -153,9 +153,10 @@ def candidate_judged(
     whole = sub.whole.solve(rtol)
     unphysical: tuple[str, ...] = ()
     if check is not None:
-        x = np.zeros(use.size)
+        x, sd = np.zeros(use.size), np.zeros(use.size)
         x[idx] = whole
-        unphysical = check(x)
+        sd[idx] = sub.whole.std(whole, rtol)
+        unphysical = check(x, sd)
     return Candidate(
         structure=structure,
         n_params=int(use.sum()),

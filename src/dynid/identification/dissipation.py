@@ -24,7 +24,7 @@ from numpy.typing import NDArray
 from ..regressors.friction_columns import smooth_sign, standstill_sign, stribeck_decay
 from ..regressors.terms import PART_LABELS, LinearFriction
 
-__all__ = ["GRID", "friction_violations"]
+__all__ = ["GRID", "SIGNIFICANCE", "friction_violations"]
 
 #: Velocities checked per joint (motor), evenly over ``[-v_max, v_max]``.
 GRID = 401
@@ -45,11 +45,19 @@ def _part_columns(term: LinearFriction, v: NDArray[np.float64]) -> dict[str, Any
     }
 
 
+#: Standard deviations by which each coefficient is moved towards zero before the check:
+#: friction that pushes the arm only within the fit's uncertainty (a Coulomb level of
+#: -0.002 N m on a joint without Coulomb friction) is not a violation.
+SIGNIFICANCE = 3.0
+
+
 def friction_violations(
     terms: Sequence[tuple[LinearFriction, NDArray[np.float64]]],
     dq_max: NDArray[np.float64],
+    std: Sequence[NDArray[np.float64]] | None = None,
 ) -> tuple[str, ...]:
-    """Where identified friction is not dissipative within the velocity limits.
+    """Where identified friction is not dissipative within the velocity limits, beyond
+    its uncertainty.
 
     Parameters
     ----------
@@ -58,6 +66,9 @@ def friction_violations(
         (in the order of the term's ``labels``); their torques add up.
     dq_max : ndarray, shape (n,)
         Joint velocity limits [rad/s] (``inf``: none).
+    std : sequence of ndarray, optional
+        The coefficients' standard deviations, one array per term: each coefficient is
+        moved :data:`SIGNIFICANCE` of them towards zero (not past it) before the check.
 
     Returns
     -------
@@ -78,12 +89,16 @@ def friction_violations(
     v = grid[:, None] * np.where(np.isfinite(vmax), vmax, 0.0)[None, :]
     f = np.zeros_like(v)
     coefficients: list[dict[str, float]] = [{} for _ in range(n)]
-    for term, values in terms:
+    for k, (term, values) in enumerate(terms):
         cols = _part_columns(term, v)
         every = [(j, p) for j in range(n) for p in term.parts]
         mask = term.mask or (True,) * len(every)
         held = [jp for jp, h in zip(every, mask, strict=True) if h]
-        for (j, p), x in zip(held, np.asarray(values, dtype=np.float64), strict=True):
+        x_all = np.asarray(values, dtype=np.float64)
+        if std is not None:
+            shrink = SIGNIFICANCE * np.abs(np.asarray(std[k], dtype=np.float64))
+            x_all = np.sign(x_all) * np.maximum(np.abs(x_all) - shrink, 0.0)
+        for (j, p), x in zip(held, x_all, strict=True):
             if p == "offset" or x == 0.0:
                 continue
             f[:, j] += x * cols[p][:, j]

@@ -100,6 +100,19 @@ class Normals:
         z = U[:, keep] @ ((U[:, keep].T @ (self.b / d)) / s[keep])
         return np.asarray(z / d, dtype=np.float64)
 
+    def std(self, x: NDArray[np.float64], rtol: float = 1e-10) -> NDArray[np.float64]:
+        """Classical standard deviations (p,) of the least-squares ``x``:
+        ``sqrt(diag(sigma^2 G^+))`` with ``sigma^2 = ||W x - y||^2 / (rows - p)`` and the
+        pseudo-inverse of :meth:`solve` (0 for a direction left out)."""
+        d = np.sqrt(np.maximum(np.diag(self.G), 0.0))
+        d = np.where(d > 0, d, 1.0)
+        Gs = self.G / np.outer(d, d)
+        s, U = np.linalg.eigh(0.5 * (Gs + Gs.T))
+        keep = s > (rtol**2) * max(float(s[-1]), 0.0) if s.size else s > 0
+        var = np.sum(U[:, keep] ** 2 / s[keep], axis=1) / d**2
+        s2 = self.sse(x) / max(self.rows - self.p, 1)
+        return np.asarray(np.sqrt(s2 * var), dtype=np.float64)
+
     def sqrt(self) -> NDArray[np.float64]:
         """``A`` (s, p) with ``A^T A = G`` (directions of zero eigenvalue dropped)."""
         s, U = np.linalg.eigh(0.5 * (self.G + self.G.T))

@@ -328,8 +328,10 @@ def _judged(
     columns = _friction_columns(terms, model.base.rank)
     dq_max = model.robot.dq_max
 
-    def check(x: NDArray[np.float64]) -> tuple[str, ...]:
-        return friction_violations([(t, x[sl]) for t, sl in columns], dq_max)
+    def check(x: NDArray[np.float64], sd: NDArray[np.float64]) -> tuple[str, ...]:
+        return friction_violations(
+            [(t, x[sl]) for t, sl in columns], dq_max, [sd[sl] for _, sl in columns]
+        )
 
     return candidate_judged(structure, use, model, held, rtol, check)
 
@@ -590,8 +592,10 @@ def _warn_unphysical(model: IdentifiedModel, terms: Sequence[ModelTerm]) -> None
     if fit is None:
         return
     beta = np.where(np.asarray(fit.kept, dtype=bool), np.asarray(fit.beta, dtype=float), 0.0)
+    sd = np.nan_to_num(np.asarray(fit.std, dtype=float))
     columns = _friction_columns(terms, model.base.rank)
-    for line in friction_violations([(t, beta[sl]) for t, sl in columns], model.robot.dq_max):
+    terms_x = [(t, beta[sl]) for t, sl in columns]
+    for line in friction_violations(terms_x, model.robot.dq_max, [sd[sl] for _, sl in columns]):
         warnings.warn(
             f"identified friction not dissipative within the velocity limits: {line}; "
             "the friction pushes the arm there (--terms without that part, or with "
