@@ -27,7 +27,8 @@ from .. import _checks, _kernels
 from ..dynamics.rnea import cross
 from ..kinematics.forward import link_poses
 from ..model.robot import Robot
-from ..regressors.torque import torque_regressor
+from ..regressors.torque import inertia_operator, torque_regressor
+from ..spatial import skew
 from .model import ObserverModel
 
 __all__ = [
@@ -140,12 +141,12 @@ def _regressor(
     wl, vl = (Rt @ Wb[..., None])[..., 0], (Rt @ Vb[..., None])[..., 0]
     K = np.zeros((B, n, 6, 10))  # (P; L) of the link about its origin, link axes
     K[..., :3, 0] = vl
-    K[..., :3, 1:4] = _skew(wl)
-    K[..., 3:, 1:4] = -_skew(vl)
-    K[..., 3:, 4:] = _inertia_operator(wl)
+    K[..., :3, 1:4] = skew(wl)
+    K[..., 3:, 1:4] = -skew(vl)
+    K[..., 3:, 4:] = inertia_operator(wl)
     H = np.empty_like(K)  # about the base origin, base axes
     H[..., :3, :] = R0 @ K[..., :3, :]
-    H[..., 3:, :] = R0 @ K[..., 3:, :] + _skew(o) @ H[..., :3, :]
+    H[..., 3:, :] = R0 @ K[..., 3:, :] + skew(o) @ H[..., :3, :]
     pri = robot.prismatic[:, None]
     s0 = cross(o, z)
     A = np.concatenate([np.where(pri, z, s0), np.where(pri, 0.0, z)], axis=-1)
@@ -160,22 +161,6 @@ def _regressor(
     Hs = H.transpose(0, 2, 1, 3).reshape(B, 6, 10 * n)
     mask = np.repeat(np.triu(np.ones((n, n))), 10, axis=1)
     return (A @ Hs) * mask, (Ac @ Hs) * mask
-
-
-def _skew(v: NDArray[np.float64]) -> NDArray[np.float64]:
-    S = np.zeros(v.shape[:-1] + (3, 3))
-    S[..., 0, 1], S[..., 0, 2], S[..., 1, 2] = -v[..., 2], v[..., 1], -v[..., 0]
-    return S - np.swapaxes(S, -1, -2)
-
-
-def _inertia_operator(v: NDArray[np.float64]) -> NDArray[np.float64]:
-    """``J v = L(v) [Jxx, Jxy, Jxz, Jyy, Jyz, Jzz]``: (..., 3, 6)."""
-    L = np.zeros(v.shape[:-1] + (3, 6))
-    x, y, zz = v[..., 0], v[..., 1], v[..., 2]
-    L[..., 0, 0], L[..., 0, 1], L[..., 0, 2] = x, y, zz
-    L[..., 1, 1], L[..., 1, 3], L[..., 1, 4] = x, y, zz
-    L[..., 2, 2], L[..., 2, 4], L[..., 2, 5] = x, y, zz
-    return L
 
 
 def momentum_regressor(

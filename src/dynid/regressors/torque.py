@@ -32,20 +32,20 @@ from numpy.typing import ArrayLike, NDArray
 from .. import _checks, _kernels
 from ..dynamics.rnea import link_motion, prepare_states
 from ..model.robot import Robot
+from ..spatial import skew
 
-__all__ = ["torque_regressor", "torque_regressor_numpy", "link_wrench_regressor"]
+__all__ = [
+    "inertia_operator",
+    "link_wrench_regressor",
+    "torque_regressor",
+    "torque_regressor_numpy",
+]
 
 _TORQUE = _kernels.KERNELS["torque_regressor"]
 
 
-def _skew(v: NDArray[np.float64]) -> NDArray[np.float64]:
-    S = np.zeros(v.shape[:-1] + (3, 3))
-    S[..., 0, 1], S[..., 0, 2], S[..., 1, 2] = -v[..., 2], v[..., 1], -v[..., 0]
-    return S - np.swapaxes(S, -1, -2)
-
-
-def _inertia_operator(v: NDArray[np.float64]) -> NDArray[np.float64]:
-    """L(v), (B, 3, 6), with ``J v = L(v) [Jxx, Jxy, Jxz, Jyy, Jyz, Jzz]``."""
+def inertia_operator(v: NDArray[np.float64]) -> NDArray[np.float64]:
+    """L(v), (..., 3, 6), with ``J v = L(v) [Jxx, Jxy, Jxz, Jyy, Jyz, Jzz]``."""
     L = np.zeros(v.shape[:-1] + (3, 6))
     x, y, z = v[..., 0], v[..., 1], v[..., 2]
     L[..., 0, 0], L[..., 0, 1], L[..., 0, 2] = x, y, z
@@ -64,11 +64,11 @@ def link_wrench_regressor(
     """
     B = w.shape[0]
     K = np.zeros((B, 6, 10))
-    Sw, Sdw, Sa = _skew(w), _skew(dw), _skew(a)
+    Sw, Sdw, Sa = skew(w), skew(dw), skew(a)
     K[:, :3, 0] = a
     K[:, :3, 1:4] = Sdw + Sw @ Sw
     K[:, 3:, 1:4] = -Sa
-    K[:, 3:, 4:] = _inertia_operator(dw) + Sw @ _inertia_operator(w)
+    K[:, 3:, 4:] = inertia_operator(dw) + Sw @ inertia_operator(w)
     return K
 
 
@@ -138,7 +138,7 @@ def _torque_regressor_numpy(
         R0[:, i], p0[:, i] = Rc, pc
     W = np.empty((B, n, 6, 10))
     W[:, :, :3] = R0 @ K[:, :, :3]
-    W[:, :, 3:] = R0 @ K[:, :, 3:] + _skew(p0) @ W[:, :, :3]
+    W[:, :, 3:] = R0 @ K[:, :, 3:] + skew(p0) @ W[:, :, :3]
     z = (R0 @ robot.axes[:, :, None])[..., 0]  # (B, n, 3)
     A = np.empty((B, n, 6))
     pri = robot.prismatic
