@@ -455,6 +455,18 @@ def format_joint_table(robot: Robot, q: np.ndarray) -> str:
 
 
 # ---------------------------------------------------------------------- data files
+def add_recordings_option(p: argparse.ArgumentParser) -> None:
+    """``--data``: one or more torque logs, or folders of them, each filtered on its own."""
+    p.add_argument(
+        "--data",
+        type=Path,
+        nargs="+",
+        required=True,
+        help="torque log(s) (.csv or .npz), or a folder of them: each recording, and each "
+        "piece between gaps longer than --max-gap, filtered on its own",
+    )
+
+
 def add_column_options(p: argparse.ArgumentParser) -> None:
     """``--columns`` (text or a .toml file) and ``--units`` for files of other tools."""
     p.add_argument(

@@ -42,6 +42,7 @@ from .common import (
     add_column_options,
     add_drive_option,
     add_log_options,
+    add_recordings_option,
     add_subcommand,
     load_drive_arg,
     load_robot,
@@ -72,14 +73,7 @@ def register(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParser:
     src.add_argument("--robot", help="'panda', 'fr3', a .urdf or a .toml: its link parameters")
     p.add_argument("--base", default=None, help="URDF base link (with --robot)")
     p.add_argument("--tip", default=None, help="URDF tip link (with --robot)")
-    p.add_argument(
-        "--data",
-        type=Path,
-        nargs="+",
-        required=True,
-        help="torque log(s) (.csv or .npz), or a folder of them: each recording, and each "
-        "piece between gaps longer than --max-gap, filtered on its own",
-    )
+    add_recordings_option(p)
     add_column_options(p)
     add_drive_option(p)
     p.add_argument("--out", type=output_path, required=True, help="output directory")

@@ -45,6 +45,7 @@ from .common import (
     add_column_options,
     add_drive_option,
     add_log_options,
+    add_recordings_option,
     add_subcommand,
     load_drive_arg,
     output_path,
@@ -80,14 +81,7 @@ def register(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParser:
     fr = p.add_mutually_exclusive_group()
     fr.add_argument("--friction", type=Path, help="friction.json to add to the model")
     fr.add_argument("--no-friction", action="store_true", help="ignore the model's own friction")
-    p.add_argument(
-        "--data",
-        type=Path,
-        nargs="+",
-        required=True,
-        help="torque log(s) (.csv or .npz), or a folder of them: each recording, and each "
-        "piece between gaps longer than --max-gap, filtered on its own",
-    )
+    add_recordings_option(p)
     add_column_options(p)
     p.add_argument("--out", type=output_path, required=True, help="output directory")
     p.add_argument(
