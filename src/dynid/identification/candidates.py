@@ -150,12 +150,11 @@ def candidate_judged(
     xs = [t.solve(rtol) for t in sub.train]
     per_fold = [t.relative_error_percent(x) for t, x in zip(sub.test, xs, strict=True)]
     se = float(np.std(per_fold, ddof=1) / math.sqrt(len(per_fold))) if len(per_fold) > 1 else 0.0
-    whole = sub.whole.solve(rtol)
+    whole, whole_std = sub.whole.solve_with_std(rtol, std=check is not None)
     unphysical: tuple[str, ...] = ()
     if check is not None:
         x, sd = np.zeros(use.size), np.zeros(use.size)
-        x[idx] = whole
-        sd[idx] = sub.whole.std(whole, rtol)
+        x[idx], sd[idx] = whole, whole_std
         unphysical = check(x, sd)
     return Candidate(
         structure=structure,

@@ -89,27 +89,47 @@ class Normals:
         """``100 ||W x - y|| / ||y||``."""
         return 100.0 * math.sqrt(self.sse(x) / self.c) if self.c > 0 else 0.0
 
-    def solve(self, rtol: float = 1e-10) -> NDArray[np.float64]:
-        """Least-squares ``x`` (p,): minimum norm in the column-scaled coordinates,
-        directions with a scaled eigenvalue below ``rtol^2`` times the largest left out."""
+    def _scaled_eigen(
+        self, rtol: float
+    ) -> tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.float64]]:
+        """The column scales ``d`` and the eigenpairs ``s, U`` of the column-scaled ``G``
+        kept (a scaled eigenvalue below ``rtol^2`` times the largest left out)."""
         d = np.sqrt(np.maximum(np.diag(self.G), 0.0))
         d = np.where(d > 0, d, 1.0)
         Gs = self.G / np.outer(d, d)
         s, U = np.linalg.eigh(0.5 * (Gs + Gs.T))
         keep = s > (rtol**2) * max(float(s[-1]), 0.0) if s.size else s > 0
-        z = U[:, keep] @ ((U[:, keep].T @ (self.b / d)) / s[keep])
-        return np.asarray(z / d, dtype=np.float64)
+        return d, s[keep], U[:, keep]
+
+    def solve(self, rtol: float = 1e-10) -> NDArray[np.float64]:
+        """Least-squares ``x`` (p,): minimum norm in the column-scaled coordinates,
+        directions with a scaled eigenvalue below ``rtol^2`` times the largest left out."""
+        return self.solve_with_std(rtol, std=False)[0]
 
     def std(self, x: NDArray[np.float64], rtol: float = 1e-10) -> NDArray[np.float64]:
         """Classical standard deviations (p,) of the least-squares ``x``:
         ``sqrt(diag(sigma^2 G^+))`` with ``sigma^2 = ||W x - y||^2 / (rows - p)`` and the
         pseudo-inverse of :meth:`solve` (0 for a direction left out)."""
-        d = np.sqrt(np.maximum(np.diag(self.G), 0.0))
-        d = np.where(d > 0, d, 1.0)
-        Gs = self.G / np.outer(d, d)
-        s, U = np.linalg.eigh(0.5 * (Gs + Gs.T))
-        keep = s > (rtol**2) * max(float(s[-1]), 0.0) if s.size else s > 0
-        var = np.sum(U[:, keep] ** 2 / s[keep], axis=1) / d**2
+        d, s, U = self._scaled_eigen(rtol)
+        return self._std(x, d, s, U)
+
+    def solve_with_std(
+        self, rtol: float = 1e-10, *, std: bool = True
+    ) -> tuple[NDArray[np.float64], NDArray[np.float64] | None]:
+        """:meth:`solve` and (``std``) :meth:`std` of its solution from one
+        eigendecomposition."""
+        d, s, U = self._scaled_eigen(rtol)
+        x = np.asarray((U @ ((U.T @ (self.b / d)) / s)) / d, dtype=np.float64)
+        return x, self._std(x, d, s, U) if std else None
+
+    def _std(
+        self,
+        x: NDArray[np.float64],
+        d: NDArray[np.float64],
+        s: NDArray[np.float64],
+        U: NDArray[np.float64],
+    ) -> NDArray[np.float64]:
+        var = np.sum(U**2 / s, axis=1) / d**2
         s2 = self.sse(x) / max(self.rows - self.p, 1)
         return np.asarray(np.sqrt(s2 * var), dtype=np.float64)
 
