@@ -42,7 +42,6 @@ from ..identification.log import (
     TorqueLog,
     default_max_gap,
     joint_side_log,
-    with_derived_velocities,
 )
 from ..identification.recordings import unwrapped
 from ..io.columns import load_joint_columns
@@ -343,15 +342,13 @@ def _observe_log(
             DynidWarning,
             stacklevel=3,
         )
-        if log.dq_derived:
-            log = with_derived_velocities(log)
-
     starts = _pieces(path, log, opts)
+    dq = _piece_velocities(log, starts)  # of a log of positions: from the unwrapped ones
+    _warn_jumps(path, log, dq, starts)
     spans = _observed_spans(path, log, starts)
 
     def run() -> LogObservation:
         t, q, tau, n = log.t, log.q, log.tau, model.n
-        dq = _piece_velocities(log, starts)
         r = np.full((t.shape[0], n), np.nan)
         std = np.full_like(r, np.nan) if wants_std else None
         margin = np.zeros_like(r) if wants_margin else None
@@ -415,8 +412,8 @@ def _observed_spans(path: Path, log: TorqueLog, starts: list[int]) -> list[tuple
 
 
 def _pieces(path: Path, log: TorqueLog, opts: ObserveOptions) -> list[int]:
-    """First sample of each piece the observer runs on (module docstring), with the
-    warnings: the cuts (file and times) and the positions that jump."""
+    """First sample of each piece the observer runs on (module docstring), with a
+    warning of the cuts (file and times)."""
     c = log.cleaning
     dt = np.diff(log.t)
     limit = opts.max_gap
@@ -435,7 +432,12 @@ def _pieces(path: Path, log: TorqueLog, opts: ObserveOptions) -> list[int]:
             DynidWarning,
             stacklevel=4,
         )
-    jumps = position_jumps(log.t, log.q, log.dq, starts)
+    return starts
+
+
+def _warn_jumps(path: Path, log: TorqueLog, dq: NDArray[np.float64], starts: list[int]) -> None:
+    """Warn about positions that jump more than the velocities ``dq`` explain."""
+    jumps = position_jumps(log.t, log.q, dq, starts)
     if jumps:
         listed = ", ".join(
             f"joint {x.joint + 1} by {x.size:+.3g} at t = {x.t:.6g} s" for x in jumps[:3]
@@ -447,4 +449,3 @@ def _pieces(path: Path, log: TorqueLog, opts: ObserveOptions) -> list[int]:
             DynidWarning,
             stacklevel=4,
         )
-    return starts
