@@ -422,3 +422,20 @@ def test_friction_structure_is_chosen_per_joint(panda):
     # the same structure given by hand
     given = identify_recordings(panda, logs, cutoff_hz=None, structure=Structure.parse(want))
     np.testing.assert_allclose(given.friction, model.friction, atol=1e-9)
+
+
+def test_a_fast_motor_is_not_taken_for_a_wrapped_joint():
+    """A motor at 800 rad/s logged at 200 Hz turns 4 rad between samples, its recorded
+    velocity explaining every step: left as it is (it was "unwrapped", corrupting the
+    log); the same motion wrapped into [-pi, pi] comes back to the motion exactly."""
+    t = np.arange(400) / 200.0
+    q = np.stack([800.0 * np.sin(t), 0.1 * t], axis=1)
+    dq = np.stack([800.0 * np.cos(t), np.full_like(t, 0.1)], axis=1)
+    fast = TorqueLog(t, q, dq, np.zeros_like(q))
+    assert np.max(np.abs(np.diff(q[:, 0]))) > np.pi
+    out, joints = unwrapped(fast, np.array([True, True]))
+    assert joints == () and out is fast
+    wrapped = TorqueLog(t, np.angle(np.exp(1j * q)), dq, np.zeros_like(q))
+    back, joints = unwrapped(wrapped, np.array([True, True]))
+    assert joints == (0,)
+    np.testing.assert_allclose(back.q[:, 0] - back.q[0, 0], q[:, 0] - q[0, 0], atol=1e-9)

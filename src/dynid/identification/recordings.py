@@ -69,11 +69,16 @@ def split_at_gaps(log: TorqueLog, max_gap_s: float | None = None) -> list[Torque
 def unwrapped(log: TorqueLog, revolute: NDArray[np.bool_]) -> tuple[TorqueLog, tuple[int, ...]]:
     """The log with revolute joints recorded wrapped into ``[-pi, pi]`` unwrapped.
 
-    A joint is wrapped when its position jumps by nearly ``2 pi`` between two samples while
-    the jump less a whole turn is as small as its other steps; returns the log and the
-    joints unwrapped (0-based; the log itself when none).
+    A joint is wrapped when its position jumps by nearly a whole turn more than its
+    recorded velocity explains (``dq dt``, the mean of the two samples'; the raw step for
+    velocities derived from the positions) while the rest of the jump is as small as its
+    other unexplained steps: a fast motor turning more than half a turn between two samples
+    is motion, not a wrap. Returns the log with those turns taken out and the joints
+    unwrapped (0-based; the log itself when none).
     """
     d = np.diff(log.q, axis=0)
+    if not log.dq_derived:
+        d = d - 0.5 * (log.dq[:-1] + log.dq[1:]) * np.diff(log.t)[:, None]
     turns = np.round(d / (2 * np.pi))
     rest = np.abs(d - 2 * np.pi * turns)
     typical = np.max(np.abs(np.where(turns == 0, d, 0.0)), axis=0, initial=0.0)
@@ -84,7 +89,7 @@ def unwrapped(log: TorqueLog, revolute: NDArray[np.bool_]) -> tuple[TorqueLog, t
     if not joints:
         return log, ()
     q = np.array(log.q)
-    q[:, joints] = np.unwrap(q[:, joints], axis=0)
+    q[1:, joints] -= 2 * np.pi * np.cumsum(turns[:, joints], axis=0)
     out = TorqueLog(log.t, q, log.dq, log.tau, log.ddq, log.cleaning, log.dq_derived)
     return out, joints
 
