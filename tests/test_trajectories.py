@@ -94,6 +94,22 @@ def test_random_fourier_stays_inside_the_limits(panda):
         np.testing.assert_allclose(use, 0.9, rtol=1e-9)
 
 
+def test_random_fourier_starts_a_continuous_joint_at_zero_without_a_warning(panda):
+    """A joint without position limits starts at 0, the others in the middle of their
+    range; no numpy warning (``inf + -inf`` was computed and discarded)."""
+    import dataclasses
+    import warnings
+
+    lo, hi = np.array(panda.q_min), np.array(panda.q_max)
+    lo[6], hi[6] = -np.inf, np.inf
+    robot = dataclasses.replace(panda, q_min=lo, q_max=hi)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        series = random_fourier(robot, np.random.default_rng(0))
+    np.testing.assert_allclose(series.q0[:6], 0.5 * (lo[:6] + hi[:6]))
+    assert series.q0[6] == 0.0
+
+
 def test_random_fourier_rejects_start_outside_limits(panda):
     """A q0 on or outside a position limit raises LimitError naming the joint."""
     q0 = 0.5 * (panda.q_min + panda.q_max)

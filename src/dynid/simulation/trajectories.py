@@ -339,7 +339,8 @@ def random_fourier(
         raise OptionError(f"margin must be in (0, 1]; got {margin}")
     lo, hi = robot.q_min, robot.q_max
     if q0 is None:
-        q0 = np.where(np.isfinite(lo) & np.isfinite(hi), 0.5 * (lo + hi), 0.0)
+        bounded = np.isfinite(lo) & np.isfinite(hi)  # a continuous joint starts at 0
+        q0 = 0.5 * (np.where(bounded, lo, 0.0) + np.where(bounded, hi, 0.0))
     q0 = _checks.as_exact("q0", q0, (robot.n,))
     room = np.minimum(q0 - lo, hi - q0)
     if np.any(room <= 0):
