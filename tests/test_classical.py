@@ -44,11 +44,10 @@ def test_noise_free_identification_recovers_base_parameters_and_friction(panda, 
     model = identify_from_log(panda, log, cutoff_hz=None, base=torque_base)
     beta = torque_base.beta_from_phi(panda.phi)
     np.testing.assert_allclose(model.beta, beta, rtol=1e-6, atol=1e-9 * np.max(np.abs(beta)))
-    np.testing.assert_allclose(model.friction, truth.as_array(), atol=1e-9)
+    np.testing.assert_allclose(model.friction.params, truth.as_array(), atol=1e-9)
     assert model.fit.relative_error_percent < 1e-7
     assert model.info.route == "classical"
-    assert model.info.friction is not None
-    assert model.info.friction.labels[:4] == ("fv1", "fc1", "fo1", "fv2")
+    assert model.terms["friction"].labels[:4] == ("fv1", "fc1", "fo1", "fv2")
     assert np.isfinite(model.fit.condition_number) and model.fit.rank == torque_base.rank + 21
 
 
@@ -83,12 +82,12 @@ def test_noisy_identification_predicts_held_out_torques_to_the_noise_level(panda
     held = random_fourier(panda, np.random.default_rng(37))(t)
     test = simulate_measurement(panda, held, rng=np.random.default_rng(38), friction=None)
     pred = model.torques(held.q, held.dq, held.ddq)
-    pred = pred + ClassicalFriction.from_array(model.friction).torques(held.dq)
+    pred = pred + ClassicalFriction.from_array(model.friction.params).torques(held.dq)
     r = rms(test.tau, pred)
     assert np.all(r < 1.1 * NOISE), r
     assert np.all(r > 0.9 * NOISE), r  # the noise itself
     # no friction in the data: identified friction is small
-    assert np.max(np.abs(model.friction)) < 0.02
+    assert np.max(np.abs(model.friction.params)) < 0.02
     # the estimated sigma of the fit reflects the filtered noise, well below the raw noise
     assert model.fit.sigma < NOISE
 

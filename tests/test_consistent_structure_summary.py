@@ -57,4 +57,4 @@ def test_the_consistent_summary_prints_the_offsets(consistent):
     text = format_consistent(consistent)
     line = next(x for x in text.splitlines() if x.startswith("friction at the joints"))
     fo = [float(x) for x in line.split("fo [N m]:")[1].split()]
-    np.testing.assert_allclose(fo, consistent.friction[:, 2], rtol=1e-3, atol=1e-9)
+    np.testing.assert_allclose(fo, consistent.friction.fo, rtol=1e-3, atol=1e-9)

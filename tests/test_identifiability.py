@@ -198,7 +198,7 @@ def test_torque_log_leaves_out_the_friction_columns_of_a_still_joint():
     r = model.base.rank
     kept = np.asarray(model.joint_fit.kept[r:]).reshape(7, 3)
     assert not kept[6, 0] and not kept[6, 1]
-    np.testing.assert_array_equal(model.friction[6, :2], 0.0)
+    np.testing.assert_array_equal(model.friction.params[6, :2], 0.0)
 
 
 def test_condition_number_on_the_papers_1010_configurations_is_the_papers_48_9():

@@ -175,7 +175,7 @@ def test_the_own_friction_is_judged_on_the_same_recordings(panda, files):
         sel = fit_friction_files(model, paths).selection
         robot = fit_friction_files(panda, paths).selection
     held = {s.name: s.heldout_error_percent for s in sel.scores}
-    law = model.info.friction.law
+    law = model.friction.law
     assert sel.scores[-1].name == "own" and held["own"] == pytest.approx(held[law], rel=1e-12)
     assert sel.chosen != "own" and sel.method.startswith("leave one recording out")
     held_r = {s.name: s.heldout_error_percent for s in robot.scores}

@@ -74,7 +74,7 @@ def test_a_frozen_joint_gets_no_friction_fitted_from_noise():
     r = m.base.rank
     kept = np.asarray(m.joint_fit.kept[r:]).reshape(7, 3)
     assert not kept[3, 0] and not kept[3, 1] and kept[3, 2]
-    np.testing.assert_array_equal(m.friction[3, :2], 0.0)
+    np.testing.assert_array_equal(m.friction.params[3, :2], 0.0)
     assert kept[[0, 1, 2, 4, 5, 6], :2].all()
 
 

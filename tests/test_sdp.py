@@ -84,17 +84,15 @@ def test_one_step_on_a_log_with_model_error_predicts_held_out_torques_like_least
 
     res = identify_consistent(robot, log(5, 20.0), prior=robot)
     assert res.kind == "log" and res.feasible and res.friction is not None
-    assert np.all(res.friction[:, :2] >= -1e-9)
+    assert res.friction.kind == "classical" and np.all(res.friction.params[:, :2] >= -1e-9)
     assert pseudo_inertia_margin(res.phi).min() >= 1e-4 * (1 - 1e-9)
     p = prepare_log(log(15, 10.0), filter_tau=False)
     ols = res.identified
     assert ols is not None and ols.friction is not None
     tau_ols = ols.torques(p.q, p.dq, p.ddq) + dynid.ClassicalFriction.from_array(
-        ols.friction
+        ols.friction.params
     ).torques(p.dq)
-    tau_c = dynid.rnea(res.robot, p.q, p.dq, p.ddq) + dynid.ClassicalFriction.from_array(
-        res.friction
-    ).torques(p.dq)
+    tau_c = dynid.rnea(res.robot, p.q, p.dq, p.ddq) + res.friction.torques(p.dq)
     rms_ols = np.sqrt(np.mean((tau_ols - p.tau) ** 2))
     rms_c = np.sqrt(np.mean((tau_c - p.tau) ** 2))
     assert rms_c <= 1.1 * rms_ols

@@ -122,7 +122,7 @@ def test_terms_the_data_do_not_support_are_left_out(panda):
     assert "coulomb" in terms or any(t.startswith("smooth") for t in terms), terms
     assert model.drive is None and model.rotor_inertia is None
     # the Coulomb level (sharp or smooth: the filtered torques round its reversals)
-    np.testing.assert_allclose(model.friction[:, 1], fr.as_array()[:, 1], atol=0.06)
+    np.testing.assert_allclose(model.friction.params[:, 1], fr.as_array()[:, 1], atol=0.06)
 
 
 def test_exact_data_give_the_true_structure_at_round_off(panda):
@@ -137,7 +137,7 @@ def test_exact_data_give_the_true_structure_at_round_off(panda):
     assert model.info.selection["chosen"] == "links + armature + viscous"
     assert model.fit.relative_error_percent < 1e-7  # the final fit (QR)
     assert model.info.heldout["heldout_error_percent"] < 1e-4  # normal equations' round-off
-    np.testing.assert_allclose(model.friction[:, 0], VISCOUS, atol=1e-8)
+    np.testing.assert_allclose(model.friction.params[:, 0], VISCOUS, atol=1e-8)
     # the rotors of joints 1 and 2 regroup with link parameters; the others stand alone
     np.testing.assert_allclose(model.rotor_inertia[2:], ARMATURE[2:], rtol=1e-6)
 
@@ -151,8 +151,8 @@ def test_stribeck_friction_is_identified_with_the_links_and_its_velocity_chosen(
     model = identify_recordings(panda, logs, cutoff_hz=None)
     # the offsets, zero in the truth, are left out joint by joint
     assert model.info.selection["chosen"] == "links + viscous + coulomb + stribeck:0.05"
-    assert model.info.friction.law == "stribeck"
-    np.testing.assert_allclose(model.friction, P, atol=1e-7)
+    assert model.friction.law == "stribeck"
+    np.testing.assert_allclose(model.friction.params, P, atol=1e-7)
     assert model.fit.relative_error_percent < 1e-7
     # the model's own friction is the registry's Stribeck law with these parameters
     v = np.linspace(-1.0, 1.0, 41)[:, None] * np.ones(7)
@@ -168,8 +168,8 @@ def test_quadratic_viscous_friction_is_identified_with_the_links(panda):
     logs = [_recording(panda, s, fr, noise=SensorNoise.none(), duration=4.0) for s in (81, 82)]
     model = identify_recordings(panda, logs, cutoff_hz=None)
     assert model.info.selection["chosen"] == "links + viscous + quadratic + coulomb"
-    assert model.info.friction.law == "quadratic"
-    np.testing.assert_allclose(model.friction, P, atol=1e-7)
+    assert model.friction.law == "quadratic"
+    np.testing.assert_allclose(model.friction.params, P, atol=1e-7)
     v = np.linspace(-2.0, 2.0, 41)[:, None] * np.ones(7)
     np.testing.assert_allclose(_own(model).torques(v), fr.torques(v), atol=1e-7)
 
@@ -305,7 +305,7 @@ def test_identify_command_prints_and_records_the_choice(panda, tmp_path, capsys)
     assert [r["file"] for r in d["metadata"]["recordings"]] == ["rec51.csv", "rec52.csv"]
     model = load_model_json(tmp_path / "auto" / "identification.json")
     assert model.info.selection["chosen"] == "links + armature + viscous"
-    assert model.info.friction.band and len(model.info.friction.band) == 7
+    assert np.any(model.friction.band) and len(model.friction.band) == 7
     capsys.readouterr()
     code = main(
         [
@@ -384,7 +384,7 @@ def test_friction_of_a_coupled_drive_is_placed_where_the_data_say(panda, truth):
     assert len(names) == 31  # 15 per placement, the model without friction once
     assert sel["chosen"] == f"links + viscous + coulomb + at:{truth}", sel["chosen"]
     assert model.drive.friction_at == truth
-    np.testing.assert_allclose(model.friction[:, :2], fr.as_array()[:, :2], atol=1e-7)
+    np.testing.assert_allclose(model.friction.params[:, :2], fr.as_array()[:, :2], atol=1e-7)
     assert model.fit.relative_error_percent < 1e-7
     # the model's own friction acts where it was placed
     v = np.random.default_rng(5).uniform(-1, 1, (20, 7))
@@ -409,19 +409,19 @@ def test_friction_structure_is_chosen_per_joint(panda):
     )
     chosen = model.info.selection["chosen"]
     assert Structure.parse(chosen) == Structure.parse(want), chosen
-    assert model.info.friction.labels == (
+    assert model.terms["friction"].labels == (
         "fv1", "fc1", "fv2", "fc2", "fo2", "fv3", "fc3", "fv4", "fv5", "fv6", "fv7"
     )  # fmt: skip
-    np.testing.assert_allclose(model.friction, fr.as_array(), atol=1e-7)
+    np.testing.assert_allclose(model.friction.params, fr.as_array(), atol=1e-7)
     assert model.fit.relative_error_percent < 1e-7
     v = np.linspace(-1.0, 1.0, 41)[:, None] * np.ones(7)
     np.testing.assert_allclose(_own(model).torques(v), fr.torques(v), atol=1e-7)
     # the friction columns' coefficients read back as the law's table
-    r = model.base.rank
-    np.testing.assert_array_equal(model.friction_from(model.joint_fit.beta[r:]), model.friction)
+    refit = model.with_coefficients(model.joint_fit.beta)
+    np.testing.assert_array_equal(refit.friction.params, model.friction.params)
     # the same structure given by hand
     given = identify_recordings(panda, logs, cutoff_hz=None, structure=Structure.parse(want))
-    np.testing.assert_allclose(given.friction, model.friction, atol=1e-9)
+    np.testing.assert_allclose(given.friction.params, model.friction.params, atol=1e-9)
 
 
 def test_a_fast_motor_is_not_taken_for_a_wrapped_joint():

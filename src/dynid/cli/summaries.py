@@ -11,6 +11,7 @@ from ..feasibility.constraints import principal_moments
 from ..feasibility.convex import ConsistentResult
 from ..feasibility.heldout import HeldOutJudgement
 from ..feasibility.penalty import RetrievalProgress, RetrievalResult
+from ..friction.model import friction_parts
 from ..friction.validation import NewtonEulerValidation
 from ..identification.info import LogInfo
 from ..identification.model import IdentifiedModel
@@ -322,15 +323,14 @@ def format_consistent(result: ConsistentResult) -> str:
     lines += consistent_structure_lines(r)
     if r.heldout is not None:
         lines += heldout_table(r.heldout)
-    if r.friction is not None:
-        at = "motors" if r.drive is not None and r.drive.friction_at == "motor" else "joints"
+    for fr in friction_parts(r.friction):
+        at = "motors" if fr.at_motors else "joints"
         lines.append(
-            f"friction at the {at}: fv [N m s/rad]: "
-            + " ".join(f"{x:.4g}" for x in r.friction[:, 0])
-            + "; fc [N m]: "
-            + " ".join(f"{x:.4g}" for x in r.friction[:, 1])
-            + "; fo [N m]: "
-            + " ".join(f"{x:.4g}" for x in r.friction[:, 2])
+            f"friction at the {at}: "
+            + "; ".join(
+                f"{name} [{unit}]: " + " ".join(f"{x:.4g}" for x in fr.params[:, j])
+                for j, (name, unit) in enumerate(zip(fr.names, fr.law.units, strict=True))
+            )
         )
     if r.rotor_inertia is not None:
         lines.append(

@@ -25,6 +25,7 @@ from typing import Any, ClassVar
 import numpy as np
 from numpy.typing import NDArray
 
+from ..friction.model import Friction, FrictionSum
 from ..model.drive import Drive
 from ..model.inertia import params_from_inertial
 from ..model.robot import Robot
@@ -68,9 +69,12 @@ class FeasibleResult:
         The penalty method's seed (recorded for files; the convex method uses none).
     notes : tuple of str
         What the user should know (one line each).
-    friction : ndarray, shape (n, 3), or None
-        Classical friction ``fv, fc, fo`` per joint identified with the links
-        [N m s/rad, N m, N m]; None when the method fits the links alone.
+    friction : Friction, FrictionSum or None
+        The friction identified with the links (:mod:`dynid.friction.model`: its law,
+        parameters, band and where it acts; the classical ``fv, fc, fo`` of the one-step
+        fit on a torque log, at the motors with a drive whose friction acts there; a
+        :class:`~dynid.friction.model.FrictionSum` of friction at the motors and at the
+        joints of a coupled drive); None when the method fits the links alone.
     rotor_inertia : ndarray, shape (n,), or None
         Rotor inertias at the motors identified with the links [kg m^2]; None otherwise.
     drive : Drive or None
@@ -98,7 +102,7 @@ class FeasibleResult:
     kind: str
     seed: int | None = None
     notes: tuple[str, ...] = ()
-    friction: NDArray[np.float64] | None = None
+    friction: Friction | FrictionSum | None = None
     rotor_inertia: NDArray[np.float64] | None = None
     drive: Drive | None = None
     heldout: HeldOutJudgement | None = None

@@ -31,21 +31,27 @@ is asked of the law, never of a class. The constructors below build the common o
 
 * :func:`DriveFriction`: a friction acting at the motors of a drive.
 
+* :class:`FrictionSum`: frictions acting together in different places (a coupled wrist
+  with friction at its motors and at its joints), ``tau_f = sum_i tau_f,i``; it has no
+  single law (``law`` None), so the observer evaluates it in Python.
+
 Any other law: ``LAWS[name].model(params, band, drive)`` or ``Friction(law, params, ...)``.
 All evaluate on velocities of shape ``(..., n)`` and return torques of the same shape.
 """
 
 from __future__ import annotations
 
+from dataclasses import dataclass
 from typing import cast
 
 import numpy as np
-from numpy.typing import ArrayLike
+from numpy.typing import ArrayLike, NDArray
 
 from .. import _checks
 from ..exceptions import ShapeError
 from ..model.drive import Drive
 from ..model.robot import Robot
+from ..regressors.terms import FrictionValues
 from .laws import LAWS
 from .laws.base import Friction
 from .torques import classical_friction, coulomb_sign, sigmoid_friction
@@ -55,11 +61,15 @@ __all__ = [
     "DriveFriction",
     "Friction",
     "FrictionModel",
+    "FrictionSum",
     "LawFriction",
     "SigmoidFriction",
     "classical_friction",
+    "combined",
+    "friction_parts",
     "coulomb_sign",
     "friction_from_array",
+    "friction_of",
     "robot_friction",
     "sigmoid_friction",
 ]
@@ -165,6 +175,92 @@ def friction_from_array(params: ArrayLike | Friction | None) -> Friction | None:
     if params is None or isinstance(params, Friction):
         return params
     return SigmoidFriction.from_array(params)
+
+
+def friction_of(values: FrictionValues) -> Friction:
+    """The friction type of a model term's identified law and parameters
+    (:meth:`~dynid.regressors.terms.ModelTerm.friction`; ``IdentifiedModel.frictions``)."""
+    return LAWS[values.law].model(values.params, values.band, values.drive)
+
+
+@dataclass(frozen=True, slots=True, eq=False)
+class FrictionSum:
+    """Frictions acting together where each says (module docstring).
+
+    Attributes
+    ----------
+    parts : tuple of Friction
+        Two or more, of the same number of joints.
+
+    Raises
+    ------
+    ShapeError
+        Fewer than two parts, or parts of different numbers of joints.
+    """
+
+    parts: tuple[Friction, ...]
+
+    def __post_init__(self) -> None:
+        if len(self.parts) < 2 or len({p.n for p in self.parts}) != 1:
+            raise ShapeError(
+                "a friction sum needs two or more frictions of the same number of joints; got "
+                + str([p.n for p in self.parts])
+            )
+
+    @property
+    def law(self) -> None:
+        """None: no single law (the observer evaluates :meth:`torques` in Python)."""
+        return None
+
+    @property
+    def kind(self) -> str:
+        """The parts' laws and places: ``"classical at the motors + classical"``."""
+        return " + ".join(p.kind + (" at the motors" if p.at_motors else "") for p in self.parts)
+
+    @property
+    def n(self) -> int:
+        """Number of joints."""
+        return self.parts[0].n
+
+    @property
+    def drive(self) -> Drive | None:
+        """The drive of the part at the motors (None: every part acts at the joints)."""
+        return next((p.drive for p in self.parts if p.at_motors), None)
+
+    @property
+    def at_motors(self) -> bool:
+        """Whether a part acts at the motors of a drive."""
+        return any(p.at_motors for p in self.parts)
+
+    @property
+    def names(self) -> tuple[str, ...]:
+        """The parts' parameter names in order, each part's after its index
+        (``fv@1, fc@1, ..., fv@2, ...``)."""
+        return tuple(f"{name}@{i + 1}" for i, p in enumerate(self.parts) for name in p.names)
+
+    def torques(self, dq: ArrayLike) -> NDArray[np.float64]:
+        """Joint friction torques [N m] (..., n): the sum of the parts'."""
+        out = self.parts[0].torques(dq)
+        for p in self.parts[1:]:
+            out = out + p.torques(dq)
+        return out
+
+
+def friction_parts(friction: Friction | FrictionSum | None) -> tuple[Friction, ...]:
+    """The frictions of a model: none, the one, or a sum's parts."""
+    if friction is None:
+        return ()
+    return friction.parts if isinstance(friction, FrictionSum) else (friction,)
+
+
+def combined(frictions: tuple[FrictionValues, ...]) -> Friction | FrictionSum | None:
+    """The friction of a model's friction terms: None for none, the one friction type for
+    one, their :class:`FrictionSum` for several."""
+    if not frictions:
+        return None
+    if len(frictions) == 1:
+        return friction_of(frictions[0])
+    return FrictionSum(tuple(friction_of(f) for f in frictions))
 
 
 def robot_friction(robot: Robot) -> Friction | None:

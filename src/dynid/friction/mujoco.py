@@ -26,7 +26,7 @@ from numpy.typing import ArrayLike, NDArray
 from .. import _checks
 from ..exceptions import ShapeError
 from .laws.sigmoid import odd_part
-from .model import FrictionModel
+from .model import FrictionModel, FrictionSum
 
 __all__ = [
     "CoulombViscous",
@@ -174,7 +174,7 @@ def drive_joint_terms(
 
 
 def joint_coulomb_viscous(
-    friction: FrictionModel, dq_max: ArrayLike | None = None
+    friction: FrictionModel | FrictionSum, dq_max: ArrayLike | None = None
 ) -> DriveJointTerms:
     """Per-joint Coulomb (``frictionloss``, URDF ``friction``) and viscous (``damping``)
     coefficients of a friction model, at the joints or reflected from the motors of a drive
@@ -193,7 +193,19 @@ def joint_coulomb_viscous(
     Returns
     -------
     DriveJointTerms
+        Of a :class:`~dynid.friction.model.FrictionSum`: the sum of its parts' (each
+        reflected from where it acts).
     """
+    if isinstance(friction, FrictionSum):
+        each = [joint_coulomb_viscous(p, dq_max) for p in friction.parts]
+        z = np.zeros(friction.n)
+        return DriveJointTerms(
+            np.sum([t.armature for t in each], axis=0),
+            np.sum([t.damping for t in each], axis=0),
+            np.sum([t.frictionloss for t in each], axis=0),
+            tuple(x for t in each for x in t.notes),
+            np.sum([z if t.offset is None else t.offset for t in each], axis=0),
+        )
     n = friction.n
     vmax = np.full(n, 2.0) if dq_max is None else _checks.as_exact("dq_max", dq_max, (n,))
     terms = friction.law.mjcf(friction.as_array(), vmax)

@@ -41,7 +41,7 @@ from ..identification.sanity import velocity_noise_std
 from ..model.drive import Drive
 from ..model.robot import Robot
 from .fit import FrictionResidual, TorqueModel, model_drive, rigid_body_torques
-from .model import FrictionModel
+from .model import FrictionModel, FrictionSum
 from .validation import RECORDED, Validation, errors_from_sums, recorded_cutoff, validated
 
 __all__ = [
@@ -297,7 +297,7 @@ class RecordingsValidation:
     without_friction: TorqueErrors
     with_friction: TorqueErrors | None
     recordings: tuple[RecordingErrors, ...]
-    friction: FrictionModel | None
+    friction: FrictionModel | FrictionSum | None
 
     @property
     def errors(self) -> TorqueErrors:
@@ -330,7 +330,7 @@ class RecordingsValidation:
 
 
 def validate_pieces(
-    model: TorqueModel, pieces: Pieces, *, friction: FrictionModel | None = None
+    model: TorqueModel, pieces: Pieces, *, friction: FrictionModel | FrictionSum | None = None
 ) -> RecordingsValidation:
     """The model's torques (without and with ``friction``) against every piece.
 

@@ -38,8 +38,7 @@ from ..identification.sanity import anticorrelated
 from ..model.drive import Drive
 from ..model.robot import Robot
 from .fit import TorqueModel, model_drive, rigid_body_torques
-from .laws import LAWS
-from .model import FrictionModel, friction_from_array, robot_friction
+from .model import FrictionModel, FrictionSum, combined, friction_from_array, robot_friction
 
 __all__ = [
     "RECORDED",
@@ -54,15 +53,13 @@ __all__ = [
 ]
 
 
-def own_friction(model: TorqueModel) -> FrictionModel | None:
-    """The friction that comes with a model: an IdentifiedModel's ``friction`` (its law,
-    band and drive), a Robot's own (:func:`~dynid.friction.model.robot_friction`), or None."""
-    if isinstance(model, IdentifiedModel) and model.friction is not None:
-        fr = model.info.friction
-        band = fr.band if fr is not None and fr.band else None
-        name = "classical" if fr is None else fr.law
-        at_motors = model.drive is not None and model.drive.friction_at == "motor"
-        return LAWS[name].model(model.friction, band, model.drive if at_motors else None)
+def own_friction(model: TorqueModel) -> FrictionModel | FrictionSum | None:
+    """The friction that comes with a model: an IdentifiedModel's friction terms (each its
+    law, band and where it acts; a :class:`~dynid.friction.model.FrictionSum` of friction
+    at the motors and at the joints), a Robot's own
+    (:func:`~dynid.friction.model.robot_friction`), or None."""
+    if isinstance(model, IdentifiedModel):
+        return combined(model.frictions)
     if isinstance(model, Robot):
         return robot_friction(model)
     return None
@@ -92,7 +89,7 @@ class Validation:
     tau_friction: NDArray[np.float64] | None
     without_friction: TorqueErrors
     with_friction: TorqueErrors | None
-    friction: FrictionModel | None
+    friction: FrictionModel | FrictionSum | None
 
     @property
     def tau_hat(self) -> NDArray[np.float64]:
@@ -142,7 +139,7 @@ def validate_torques(
     model: TorqueModel,
     log: TorqueLog,
     *,
-    friction: FrictionModel | None = None,
+    friction: FrictionModel | FrictionSum | None = None,
     cutoff_hz: float | None | Literal["recorded"] = RECORDED,
     trim_s: float | None = None,
     filter_tau: bool = False,
@@ -192,7 +189,10 @@ def validate_torques(
 
 
 def validated(
-    model: TorqueModel, p: TorqueLog, friction: FrictionModel | None, drive: Drive | None
+    model: TorqueModel,
+    p: TorqueLog,
+    friction: FrictionModel | FrictionSum | None,
+    drive: Drive | None,
 ) -> Validation:
     """The :class:`Validation` of ``model`` (and ``friction``) on a prepared joint-side log
     ``p`` (with ``ddq``) read through ``drive`` (its known rotors added to a robot's).

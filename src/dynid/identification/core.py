@@ -13,7 +13,7 @@ Every route is the same steps over a :class:`Dataset`:
 3. **fit** (:func:`fit_stack`): an estimator (:mod:`dynid.identification.estimators`)
    solves ``W x = y``; columns the data cannot excite (the friction of a joint that never
    moves) are left out and reported as not kept;
-4. **model**: the fit, the friction and the record of what was done, as an
+4. **model**: the fit, the terms with their coefficients and the record of what was done, as an
    :class:`~dynid.identification.model.IdentifiedModel`.
 
 A data set is anything with the :class:`Dataset` protocol: static data
@@ -41,9 +41,9 @@ from .dataset import Dataset, ModelColumns, RegressorBlock, RegressorKind
 from .engine import HeldRows, Rows, fit_rows
 from .estimators import Estimator, EstimatorName, estimator_named
 from .holdout import HeldOut, cross_validate
-from .info import FrictionInfo, IdentificationInfo, Route
+from .info import IdentificationInfo, Route
 from .least_squares import LeastSquaresFit, StdMethod, checked_std, conditioning_advice
-from .model import IdentifiedModel
+from .model import IdentifiedModel, IdentifiedTerm
 from .stacking import (
     DEFAULT_FIT_RTOL,
     Judge,
@@ -234,7 +234,8 @@ def identify(
     -------
     IdentifiedModel
         ``fit`` over the ``r`` base parameters (global statistics of the whole fit);
-        ``joint_fit`` over every column and ``friction`` (n, 3) when friction is appended.
+        ``terms`` every model term with its coefficients; ``joint_fit`` over every column
+        when terms are appended (friction).
 
     Raises
     ------
@@ -330,17 +331,6 @@ def _record(
     pruned = tuple(labels[k] for k in np.flatnonzero(~np.asarray(fit.kept)))
     if pruned:
         _log.info("pruned %d coefficient(s): %s", len(pruned), pruned)
-    found = columns.appended_term("friction")
-    friction = None
-    if found is not None:
-        term, sl = found
-        friction = FrictionInfo(
-            labels=labels[sl],
-            std=tuple(float(x) for x in fit.std[sl]),
-            kept=tuple(bool(x) for x in fit.kept[sl]),
-            band=tuple(float(b) for b in getattr(term, "law_band", ())),
-            law=str(getattr(term, "law", "classical")),
-        )
     return dataclasses.replace(
         data.record(stack.n_rows),
         route=data.route,
@@ -353,7 +343,6 @@ def _record(
         rtol=rtol,
         rank_gap=base.gap,
         identifiability=dict(zip(base.std_labels, identifiability(base), strict=True)),
-        friction=friction,
     )
 
 
@@ -364,21 +353,27 @@ def _model(
     info: IdentificationInfo,
     held: HeldOut | None,
 ) -> IdentifiedModel:
-    """The identified model: the base parameters' fit, friction and the full fit."""
+    """The identified model: the base parameters' fit, the terms with their coefficients
+    (those in the base derived by the model from its fit) and the full fit."""
     r = columns.base.rank
-    found = columns.appended_term("friction")
-    friction = None
-    if found is not None:
-        term, sl = found
-        as_array = getattr(term, "as_array", None)
-        beta = np.asarray(fit.beta[sl])
-        friction = beta.reshape(robot.n, 3) if as_array is None else as_array(beta)
+    terms, c = {}, r
+    for t in columns.terms:
+        if t.name in terms:
+            raise OptionError(f"two model terms are named {t.name!r}; each needs its own name")
+        k = len(t.labels)
+        if t.in_base:  # the model derives its values from the fit
+            terms[t.name] = IdentifiedTerm(t, np.zeros(k), np.zeros(k), np.zeros(k, dtype=bool))
+            continue
+        terms[t.name] = IdentifiedTerm(
+            t, fit.beta[c : c + k], fit.std[c : c + k], fit.kept[c : c + k]
+        )
+        c += k
     appended = bool(columns.appended)
     return IdentifiedModel(
         robot=robot,
         base=columns.base,
         fit=_split_fit(fit, r) if appended else fit,
-        friction=friction,
+        terms=terms,
         info=info,
         joint_fit=fit if appended else None,
         drive=columns.drive,

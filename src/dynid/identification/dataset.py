@@ -60,15 +60,6 @@ class ModelColumns:
             out = out + t.labels
         return out
 
-    def appended_term(self, name: str) -> tuple[ModelTerm, slice] | None:
-        """The appended term named ``name`` with its columns, or None."""
-        c = self.base.rank
-        for t in self.appended:
-            if t.name == name:
-                return t, slice(c, c + len(t.labels))
-            c += len(t.labels)
-        return None
-
     def step_columns(self) -> NDArray[np.bool_]:
         """(c,): the columns that step where a velocity reverses (a term's ``steps``)."""
         return self._per_column("steps", False).astype(bool)

@@ -4,8 +4,8 @@
 used and dropped, the coefficients pruned, the estimator and how the standard deviations
 were estimated, the rank tolerance and gap, the identifiability of every standard
 parameter, and the route's own part: :class:`StaticInfo` (configurations) or
-:class:`LogInfo` (filtering, decimation, sample counts), :class:`FrictionInfo` (the
-appended friction columns' labels, standard deviations and which were kept). It is
+:class:`LogInfo` (filtering, decimation, sample counts). The model terms' coefficients
+(friction) are the model's own (:class:`~dynid.identification.model.IdentifiedTerm`). It is
 written to and read from the ``metadata`` object of ``identification.json`` with the keys
 that file has always used (:mod:`dynid.io.model_json`); keys this version does not know are
 kept in ``extra``.
@@ -19,7 +19,7 @@ from typing import Any, Literal
 
 from .least_squares import StdMethod
 
-__all__ = ["FrictionInfo", "IdentificationInfo", "LogInfo", "Route", "StaticInfo"]
+__all__ = ["IdentificationInfo", "LogInfo", "Route", "StaticInfo"]
 
 #: The identification routes: static data (Gaz et al. 2019, Sec. IV-A) or a torque log
 #: (Sec. IV-B).
@@ -87,35 +87,6 @@ class LogInfo:
 
 
 @dataclass(frozen=True, slots=True)
-class FrictionInfo:
-    """The friction columns fitted after the base parameters.
-
-    Attributes
-    ----------
-    labels : tuple of str
-        ``fv1, fc1, fo1, fv2, ...``.
-    std : tuple of float
-        Their standard deviations (units of each parameter).
-    kept : tuple of bool
-        False for columns left out (a joint that never moves) or pruned.
-    band : tuple of float
-        The band the friction law is evaluated with, per joint (motor): the standstill band
-        [rad/s] of the Coulomb columns (``sign(dq)`` is 0 inside it), or the smooth law's
-        width; empty for the plain ``sign``.
-    law : str
-        The registry law (:mod:`dynid.friction.laws`) whose parameters the model's
-        ``friction`` holds: ``"classical"`` (``fv, fc, fo``), ``"smooth"`` (``fv, fc, fo``,
-        ``tanh(dq / band)``) or ``"stribeck"`` (``fv, fc, fs, vst, fo``).
-    """
-
-    labels: tuple[str, ...]
-    std: tuple[float, ...]
-    kept: tuple[bool, ...]
-    band: tuple[float, ...] = ()
-    law: str = "classical"
-
-
-@dataclass(frozen=True, slots=True)
 class IdentificationInfo:
     """What an identification did (module docstring).
 
@@ -149,8 +120,6 @@ class IdentificationInfo:
         The static data set's own metadata (source, noise, seed, robot).
     static, log : StaticInfo or LogInfo, optional
         The route's own part.
-    friction : FrictionInfo, optional
-        The appended friction columns.
     heldout : mapping, optional
         Training and held-out errors of least squares
         (:meth:`~dynid.identification.holdout.HeldOutErrors.as_dict`).
@@ -184,7 +153,6 @@ class IdentificationInfo:
     data: Mapping[str, Any] = field(default_factory=dict)
     static: StaticInfo | None = None
     log: LogInfo | None = None
-    friction: FrictionInfo | None = None
     heldout: Mapping[str, Any] | None = None
     column_map: Mapping[str, str | None] | None = None
     notes: tuple[str, ...] = ()

@@ -17,8 +17,9 @@ given); ``g`` and ``c`` are those of the links.
 from __future__ import annotations
 
 import dataclasses
-import re
+from collections.abc import Mapping
 from dataclasses import dataclass, field
+from types import MappingProxyType
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -26,16 +27,84 @@ from numpy.typing import ArrayLike, NDArray
 from .. import _checks
 from ..dynamics.rnea import rnea
 from ..dynamics.terms import coriolis, gravity_torques, mass_matrix
-from ..exceptions import ShapeError
+from ..exceptions import ModelError, ShapeError
 from ..model.drive import Drive
 from ..model.robot import Robot
 from ..regressors.base import BaseParameters
-from ..regressors.terms import FRICTION_PARTS, LinearFriction
+from ..regressors.terms import FrictionValues, ModelTerm, RotorInertia
 from .holdout import HeldOut
 from .info import IdentificationInfo
 from .least_squares import LeastSquaresFit
 
-__all__ = ["IdentifiedModel"]
+__all__ = ["IdentifiedModel", "IdentifiedTerm"]
+
+
+@dataclass(frozen=True, slots=True, eq=False)
+class IdentifiedTerm:
+    """A model term (:mod:`dynid.regressors.terms`) with its identified coefficients.
+
+    Attributes
+    ----------
+    term : ModelTerm
+        What the coefficients are (labels, units, columns; friction or rotor inertias).
+    values : ndarray, shape (p,)
+        The coefficients, in the units of ``term.units`` (0 where not kept). For a term in
+        the base (a rotor inertia): the equivalent standard parameters, whose regrouped
+        entries are carried by their base combination (``J1zz + Ia1``) and are 0 here.
+    std : ndarray, shape (p,)
+        Their standard deviations (NaN for a term in the base's regrouped entries).
+    kept : ndarray of bool, shape (p,)
+        False for coefficients left out (a joint that never moves), pruned or regrouped.
+    """
+
+    term: ModelTerm
+    values: NDArray[np.float64]
+    std: NDArray[np.float64]
+    kept: NDArray[np.bool_]
+
+    def __post_init__(self) -> None:
+        p = len(self.term.labels)
+        for key in ("values", "std", "kept"):
+            a = np.asarray(getattr(self, key), dtype=bool if key == "kept" else np.float64)
+            if a.shape != (p,):
+                raise ShapeError(
+                    f"term {self.term.name!r}: {key} must have its {p} coefficients; got {a.shape}"
+                )
+            object.__setattr__(self, key, _checks.frozen(a))
+
+    @property
+    def labels(self) -> tuple[str, ...]:
+        """The term's labels."""
+        return self.term.labels
+
+    @property
+    def friction(self) -> FrictionValues | None:
+        """The term as a friction law's parameters (None: not friction)."""
+        return self.term.friction(self.values)
+
+    @property
+    def inertia(self) -> NDArray[np.float64] | None:
+        """The term as rotor inertias [kg m^2] (None: not rotor inertias)."""
+        return self.term.inertia(self.values)
+
+    def torques(self, q: ArrayLike, dq: ArrayLike, ddq: ArrayLike) -> NDArray[np.float64]:
+        """The term's joint torques [N m] (..., n) at joint states (..., n)."""
+        a = [np.asarray(x, dtype=np.float64) for x in (q, dq, ddq)]
+        Y = self.term.torque_columns(a[0], a[1], a[2])
+        out: NDArray[np.float64] = Y @ self.values
+        return out
+
+    def with_values(self, values: ArrayLike) -> IdentifiedTerm:
+        """The same term with other coefficients (p,) (a held-out fold's fit)."""
+        return dataclasses.replace(self, values=np.asarray(values, dtype=np.float64))
+
+
+def _terms_mapping(terms: Mapping[str, IdentifiedTerm]) -> Mapping[str, IdentifiedTerm]:
+    """A read-only copy, keys checked against the terms' names."""
+    for key, t in terms.items():
+        if key != t.term.name:
+            raise ShapeError(f"terms: key {key!r} holds the term named {t.term.name!r}")
+    return MappingProxyType(dict(terms))
 
 
 @dataclass(frozen=True, slots=True, eq=False)
@@ -51,9 +120,13 @@ class IdentifiedModel:
         Labels, expressions and the map from standard parameters.
     fit : LeastSquaresFit
         Estimates ``fit.beta`` and statistics.
-    friction : ndarray, shape (n, 3), optional
-        Linear friction ``fv [N m s/rad], fc [N m], fo [N m]`` per joint, identified with
-        the classical route; None otherwise.
+    terms : mapping of str to IdentifiedTerm
+        The model terms beside the links (:mod:`dynid.regressors.terms`), by name, in the
+        order stacked: those in the base (rotor inertias; their values the equivalent
+        standard parameters, derived from ``fit`` here), then those appended after the
+        base parameters (friction), with their coefficients. A drive that identifies
+        rotor inertias over a base that holds them gets its rotor term when none is given
+        (a model built by hand, an older file).
     info : IdentificationInfo
         What the identification did: route, data, rows used and dropped, estimator,
         standard deviations, filtering (:mod:`dynid.identification.info`).
@@ -61,8 +134,8 @@ class IdentifiedModel:
         The drive train the model includes (rotor inertia, friction at the motors); None
         for link-side torques of a direct drive.
     joint_fit : LeastSquaresFit, optional
-        Classical route with friction: the fit of every column (the ``r`` base parameters,
-        then ``fv, fc, fo`` per joint), whose covariance couples both (consistent
+        With appended terms: the fit of every column (the ``r`` base parameters, then the
+        appended terms' coefficients in order), whose covariance couples both (consistent
         identification uses it); not saved to files.
     holdout : HeldOut, optional
         Classical route: the normal equations of the contiguous time blocks (or of the
@@ -73,7 +146,7 @@ class IdentifiedModel:
     robot: Robot
     base: BaseParameters
     fit: LeastSquaresFit
-    friction: NDArray[np.float64] | None = None
+    terms: Mapping[str, IdentifiedTerm] = field(default_factory=dict)
     info: IdentificationInfo = field(default_factory=IdentificationInfo)
     joint_fit: LeastSquaresFit | None = None
     drive: Drive | None = None
@@ -86,64 +159,117 @@ class IdentifiedModel:
         phi[self.base.independent] = self.fit.beta
         p = 10 * self.robot.n
         object.__setattr__(self, "equivalent_robot", self.robot.with_params(phi[:p]))
-        ia = None
         if self.drive is not None:
             self.drive.check(self.robot.n)
-            if self.drive.rotor_inertia is not None:
-                ia = np.array(self.drive.rotor_inertia)
-            elif self.base.n_std == p + self.robot.n:
-                ia = phi[p:]
-        elif self.base.n_std != p:
+        terms = dict(self.terms)
+        given = [t.term for t in terms.values() if t.term.in_base]
+        if not given and self.base.n_std == p + self.robot.n:
+            if self.drive is None or not self.drive.identifies_rotor_inertia:
+                raise ShapeError(
+                    f"base parameters over {self.base.n_std} standard parameters need a drive "
+                    f"that identifies rotor inertias (the robot's links have {p})"
+                )
+            given = [RotorInertia(self.drive)]
+        if p + sum(len(t.labels) for t in given) != self.base.n_std:
             raise ShapeError(
-                f"base parameters over {self.base.n_std} standard parameters need a drive "
-                f"(the robot's links have {p})"
+                f"base parameters over {self.base.n_std} standard parameters need terms in the "
+                f"base for those beyond the robot's links ({p})"
             )
+        in_base = self._in_base(given, phi)
+        appended = {k: t for k, t in terms.items() if not t.term.in_base}
+        object.__setattr__(self, "terms", _terms_mapping(in_base | appended))
+        ia = None
+        if self.drive is not None and self.drive.rotor_inertia is not None:
+            ia = np.array(self.drive.rotor_inertia)
+        else:
+            found = [x for x in (t.inertia for t in self.terms.values()) if x is not None]
+            ia = found[0] if found else None
         object.__setattr__(self, "rotor_inertia", None if ia is None else _checks.frozen(ia))
 
-    def friction_from(self, values: ArrayLike) -> NDArray[np.float64]:
-        """The friction coefficients ``values`` (p,) of this model's friction columns
-        (``info.friction.labels``, e.g. a held-out fold's fit) as the parameters (n, k) of
-        its law, as ``friction`` holds them.
+    def _in_base(
+        self, terms: list[ModelTerm], phi: NDArray[np.float64]
+    ) -> dict[str, IdentifiedTerm]:
+        """The terms in the base with their equivalent standard parameters (``phi``), the
+        standard deviation and kept flag of the base parameter where one is its own."""
+        ind = list(np.asarray(self.base.independent))
+        out, start = {}, 10 * self.robot.n
+        for t in terms:
+            k = len(t.labels)
+            std, kept = np.full(k, np.nan), np.zeros(k, dtype=bool)
+            for i in range(k):
+                if start + i in ind:
+                    j = ind.index(start + i)
+                    std[i], kept[i] = self.fit.std[j], bool(self.fit.kept[j])
+            out[t.name] = IdentifiedTerm(t, phi[start : start + k], std, kept)
+            start += k
+        return out
+
+    @property
+    def appended(self) -> tuple[IdentifiedTerm, ...]:
+        """The terms whose coefficients follow the base parameters (``joint_fit``'s
+        columns after ``r``), in order."""
+        return tuple(t for t in self.terms.values() if not t.term.in_base)
+
+    @property
+    def frictions(self) -> tuple[FrictionValues, ...]:
+        """Every friction term's law and parameters, in order (a view of :attr:`terms`):
+        one, or two for friction at the motors and at the joints of a coupled drive."""
+        return tuple(f for f in (t.friction for t in self.terms.values()) if f is not None)
+
+    @property
+    def friction(self) -> FrictionValues | None:
+        """The friction term's law and parameters (a read-only view of :attr:`terms`;
+        ``dynid.friction.model.friction_of`` makes the friction type of it); None without
+        friction.
+
+        Raises
+        ------
+        ModelError
+            The model holds several friction terms (:attr:`frictions`).
+        """
+        fr = self.frictions
+        if len(fr) > 1:
+            raise ModelError(
+                f"the model holds {len(fr)} friction terms (at the motors and at the joints); "
+                "take them all from frictions"
+            )
+        return fr[0] if fr else None
+
+    def with_coefficients(self, x: ArrayLike) -> IdentifiedModel:
+        """The same model with every coefficient replaced: ``x`` (c,) holds the base
+        parameters then the appended terms' coefficients in order (a held-out fold's fit
+        over ``joint_fit``'s columns).
 
         Raises
         ------
         ShapeError
-            The model has no friction columns, or ``values`` another length.
+            ``x`` of another length.
         """
-        fr = self.info.friction
-        x = np.asarray(values, dtype=np.float64)
-        if fr is None or self.friction is None or x.shape != (len(fr.labels),):
+        v = np.asarray(x, dtype=np.float64)
+        r = self.base.rank
+        sizes = [len(t.labels) for t in self.appended]
+        if v.shape != (r + sum(sizes),):
             raise ShapeError(
-                f"friction values must have the {0 if fr is None else len(fr.labels)} "
-                f"coefficients of the model's friction columns; got {x.shape}"
+                f"coefficients must be the {r} base parameters and the {sum(sizes)} of the "
+                f"appended terms; got {v.shape}"
             )
-        n = self.friction.shape[0]
-        part = {"fv": "viscous", "fc": "smooth" if fr.law == "smooth" else "coulomb"}
-        part |= {"fq": "quadratic", "fsp": "stribeck", "fo": "offset"}
-        held = []  # (part, joint) of each label: "fo3" -> ("offset", 2)
-        for lab in fr.labels:
-            prefix = lab.rstrip("0123456789")
-            held.append((part[prefix], int(lab[len(prefix) :]) - 1))
-        parts = tuple(p for p in FRICTION_PARTS if any(h[0] == p for h in held))
-        mask = tuple((p, j) in held for j in range(n) for p in parts)
-        term = LinearFriction(
-            Drive.identity(n),
-            parts=parts,
-            width=fr.band if fr.law == "smooth" else (),
-            vst=float(np.max(self.friction[:, 3])) if fr.law == "stribeck" else 0.0,
-            mask=() if all(mask) else mask,
-        )
-        return term.as_array(x)
+        terms, c = dict(self.terms), r
+        for t, k in zip(self.appended, sizes, strict=True):
+            terms[t.term.name] = t.with_values(v[c : c + k])
+            c += k
+        fit = dataclasses.replace(self.fit, beta=_checks.frozen(v[:r]))
+        return dataclasses.replace(self, fit=fit, terms=terms, joint_fit=None, holdout=None)
 
     def links_only(self) -> IdentifiedModel:
-        """The model of the links alone: base parameters that are rotor inertias of their own
-        (``beta_k = Ia_k``) are removed; a rotor that regroups with link parameters
-        (``J1zz + Ia1``) stays in that combination, which the links then carry. ``self`` when
-        the model has no rotor parameters. For methods that know only link parameters (the
-        penalty method)."""
+        """The model of the links alone: base parameters that are parameters of the terms
+        in the base of their own (``beta_k = Ia_k``) are removed; a rotor that regroups with
+        link parameters (``J1zz + Ia1``) stays in that combination, which the links then
+        carry. ``self`` when the model has no terms in the base. For methods that know only
+        link parameters (the penalty method)."""
         p = 10 * self.robot.n
         if self.base.n_std == p:
             return self
+        own = {lab for t in self.terms.values() if t.term.in_base for lab in t.labels}
         base, fit = self.base, self.fit
         keep = np.flatnonzero(np.asarray(base.independent) < p)
         dep = np.asarray(base.dependent)
@@ -156,7 +282,7 @@ class IdentifiedModel:
             rank=int(keep.size),
             rtol=base.rtol,
             labels=tuple(base.labels[k] for k in keep),
-            expressions=tuple(_without_rotor_terms(base.expressions[k]) for k in keep),
+            expressions=tuple(_without_symbols(base.expressions[k], own) for k in keep),
             gap=base.gap,
         )
         cov = None if fit.covariance is None else np.asarray(fit.covariance)[np.ix_(keep, keep)]
@@ -173,7 +299,7 @@ class IdentifiedModel:
             robot=self.robot,
             base=sub,
             fit=sub_fit,
-            friction=self.friction,
+            terms={k: t for k, t in self.terms.items() if not t.term.in_base},
             info=self.info,
         )
 
@@ -207,8 +333,9 @@ class IdentifiedModel:
         return tau
 
 
-def _without_rotor_terms(expression: str) -> str:
-    """A base parameter's expression without its ``Ia`` terms (``J1zz + Ia1`` -> ``J1zz``)."""
+def _without_symbols(expression: str, symbols: set[str]) -> str:
+    """A base parameter's expression without its terms in ``symbols`` (``J1zz + Ia1`` ->
+    ``J1zz`` for ``{"Ia1"}``; a term is ``[-][coefficient*]symbol``)."""
     terms = expression.replace(" - ", " + -").split(" + ")
-    kept = [t for t in terms if not re.fullmatch(r"-?([0-9.e+-]+\*)?Ia\d+", t)]
+    kept = [t for t in terms if t.lstrip("-").rpartition("*")[2] not in symbols]
     return " + ".join(kept).replace(" + -", " - ")

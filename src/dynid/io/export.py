@@ -22,7 +22,7 @@ from dataclasses import replace
 from pathlib import Path
 
 from ..exceptions import DataError
-from ..friction.model import Friction
+from ..friction.model import Friction, FrictionSum
 from ..model.drive import Drive
 from ..model.robot import Robot
 from .robot.export_options import ExportOptions, RobotFormat
@@ -88,7 +88,7 @@ def save_robot(
     base: str | None = None,
     tip: str | None = None,
     merged: str = "subtract",
-    friction: bool | Friction = True,
+    friction: bool | Friction | FrictionSum = True,
     all_frames: bool = False,
     drive: Drive | None = None,
 ) -> Path:
@@ -151,7 +151,7 @@ def save_robot_files(
     return [f.save(folder / f"{stem}{f.suffixes[0]}", robot, plain) for f in ROBOT_FORMATS.values()]
 
 
-def model_terms_of(spec: str | Path, n: int) -> tuple[Friction | None, Drive | None]:
+def model_terms_of(spec: str | Path, n: int) -> tuple[Friction | FrictionSum | None, Drive | None]:
     """The model terms a robot file holds beside its links, for an export: the linear
     friction identified with the links and the drive of a ``feasible.json`` (its rotor
     inertias the identified ones), or the ``[drive]`` table of a robot TOML; ``(None, None)``

@@ -11,6 +11,8 @@ link, in the schema of the robot description's inertials (:mod:`dynid.io.robot.t
      "links": [{"name": "link1", "mass": 4.97, "com": [...], "inertia": [...]}, ...],
      "friction": null | {"model": "sigmoid", "phi1": [...], "phi2": [...], "phi3": [...]},
      "linear_friction": null | {"model": "classical", "fv": [...], "fc": [...], "fo": [...]},
+     "joint_friction": {"model": "classical", "fv": [...], ...} (with friction at the motors
+         and at the joints of a coupled drive: the part at the joints),
      "drive": null | {dynid-drive/1 record, rotor_inertia: the identified values},
      "kinematics": {...}, "feasible": true, "relative_residual": ..., "seed": ...,
      "units": {...}, "conventions": {...}}
@@ -29,7 +31,8 @@ from numpy.typing import NDArray
 from .. import __version__, _checks
 from ..exceptions import DataError, DynidWarning, ModelError, ShapeError
 from ..feasibility.result import FeasibleResult
-from ..friction.model import ClassicalFriction, Friction
+from ..friction.laws import LAWS
+from ..friction.model import Friction, FrictionSum, friction_parts
 from ..model.drive import Drive
 from ..model.inertia import (
     INERTIA_ORDER,
@@ -83,6 +86,12 @@ _LINK = Record(
     }
 )
 _PER_JOINT = Field("numbers", required=True, shape=("n",))
+#: friction of a registry law identified with the links: ``model`` and one list per parameter
+_LAW_FRICTION = Field(
+    "object",
+    nullable=True,
+    record=Record({"model": Field("string", required=True, choices=tuple(LAWS))}, open=True),
+)
 #: ``feasible.json`` (module docstring; n: the joint count)
 FEASIBLE = Format(
     FEASIBLE_SCHEMA,
@@ -99,14 +108,8 @@ FEASIBLE = Format(
                     | {f"phi{k}": _PER_JOINT for k in (1, 2, 3)}
                 ),
             ),
-            "linear_friction": Field(
-                "object",
-                nullable=True,
-                record=Record(
-                    {"model": Field("string", choices=("classical",))}
-                    | {k: _PER_JOINT for k in ("fv", "fc", "fo")}
-                ),
-            ),
+            "linear_friction": _LAW_FRICTION,
+            "joint_friction": _LAW_FRICTION,
             "kinematics": Field("object", record=ROBOT_RECORD),
             "units": Field("any"),
             "conventions": Field("any"),
@@ -159,7 +162,7 @@ def feasible_to_dict(source: FeasibleResult | Robot, *, seed: int | None = None)
         fr = {"model": "sigmoid"} | {
             f"phi{k + 1}": [float(x) for x in robot.friction[:, k]] for k in range(3)
         }
-    lin = None if result is None else result.friction
+    parts = friction_parts(None if result is None else result.friction)
     drive = None if result is None else result.drive
     d: dict[str, Any] = {
         "schema": FEASIBLE_SCHEMA,
@@ -167,15 +170,14 @@ def feasible_to_dict(source: FeasibleResult | Robot, *, seed: int | None = None)
         "name": robot.name,
         "links": links,
         "friction": fr,
-        "linear_friction": None
-        if lin is None
-        else {"model": "classical"}
-        | {k: [float(x) for x in lin[:, j]] for j, k in enumerate(("fv", "fc", "fo"))},
+        "linear_friction": _law_record(parts[0]) if parts else None,
         "kinematics": robot_to_dict(robot),
         "units": _UNITS,
         "conventions": _CONVENTIONS,
         "drive": None if drive is None else drive.as_dict(),
     }
+    if len(parts) > 1:
+        d["joint_friction"] = _law_record(parts[1])
     if result is None:
         return d if seed is None else d | {"seed": seed}
     d["method"] = result.method
@@ -185,6 +187,12 @@ def feasible_to_dict(source: FeasibleResult | Robot, *, seed: int | None = None)
     if result.heldout is not None:
         d["heldout"] = result.heldout.as_dict()
     return d
+
+
+def _law_record(friction: Friction) -> dict[str, Any]:
+    """``{"model": law, name: per-joint values, ...}`` of a friction."""
+    cols = {k: [float(x) for x in friction.params[:, j]] for j, k in enumerate(friction.names)}
+    return {"model": friction.kind} | cols
 
 
 def save_feasible_json(path: str | Path, source: FeasibleResult | Robot) -> Path:
@@ -292,20 +300,48 @@ def load_feasible_json(path: str | Path, robot: Robot | None = None) -> Robot:
     return robot_from_feasible_dict(load_json(path), robot, source=Path(path).name)
 
 
-def load_feasible_linear_friction(path: str | Path) -> Friction | None:
-    """The classical friction (``fv, fc, fo`` per joint) held by ``feasible.json``, or None.
+def load_feasible_linear_friction(path: str | Path) -> Friction | FrictionSum | None:
+    """The friction identified with the links held by ``feasible.json`` (the classical
+    ``fv, fc, fo`` per joint of a consistent identification), or None.
 
-    Written by a consistent identification from a torque log; ``dynid validate --params``
-    uses it unless another friction is given. With a drive whose friction acts at the
-    motors, the law per motor mapped through the transmission (a
-    :class:`~dynid.friction.model.Friction` with the drive).
+    ``dynid validate --params`` uses it unless another friction is given. With a drive whose
+    friction acts at the motors, the law per motor mapped through the transmission (a
+    :class:`~dynid.friction.model.Friction` with the drive); with ``joint_friction`` too,
+    the sum of both (:class:`~dynid.friction.model.FrictionSum`).
+
+    Raises
+    ------
+    DataError
+        A law's parameter missing or not one per joint.
     """
-    lin = load_document(path, FEASIBLE).get("linear_friction")
-    if lin is None:
+    d = load_document(path, FEASIBLE)
+    if d.get("linear_friction") is None:
         return None
-    law = ClassicalFriction(*(np.array(lin[k], dtype=float) for k in ("fv", "fc", "fo")))
     drive = load_feasible_drive(path)
-    return law.at(drive) if drive is not None and drive.friction_at == "motor" else law
+    at = drive if drive is not None and drive.friction_at == "motor" else None
+    parts = [_law_friction(d["linear_friction"], at, len(d["links"]), path, "linear_friction")]
+    if d.get("joint_friction") is not None:
+        parts.append(
+            _law_friction(d["joint_friction"], None, len(d["links"]), path, "joint_friction")
+        )
+    return parts[0] if len(parts) == 1 else FrictionSum(tuple(parts))
+
+
+def _law_friction(
+    rec: Mapping[str, Any], drive: Drive | None, n: int, path: str | Path, key: str
+) -> Friction:
+    """A law's friction from its record (:func:`_law_record`), acting through ``drive``."""
+    law = LAWS[rec["model"]]
+    cols = []
+    for name in law.params:
+        v = rec.get(name)
+        if not isinstance(v, list) or len(v) != n:
+            want = f"{n} numbers (one per joint) for the {law.name} law's {name}"
+            raise fault(
+                Path(path).name, f"{key}.{name}", f"expected {want}; got {_checks.short(v)}"
+            )
+        cols.append(np.array(v, dtype=float))
+    return law.model(np.column_stack(cols), None, drive)
 
 
 def load_feasible_drive(path: str | Path) -> Drive | None:

@@ -13,7 +13,6 @@ from pathlib import Path
 from typing import Any
 
 from ..feasibility.result import FeasibleResult
-from ..friction.model import ClassicalFriction
 from .export import ROBOT_FORMATS, ExportOptions, save_robot_files
 from .feasible import save_feasible_json
 from .report_json import save_report_json
@@ -58,12 +57,8 @@ def save_feasible_bundle(
     """
     folder = Path(folder)
     files = [save_feasible_json(folder / "feasible.json", result)]
-    fr, drive = result.friction, result.drive  # one-step on a log: classical fv, fc, fo
-    friction: Any = True
-    if fr is not None:
-        law = ClassicalFriction.from_array(fr)
-        at_motors = drive is not None and drive.friction_at == "motor"
-        friction = law.at(drive) if drive is not None and at_motors else law
+    drive = result.drive
+    friction: Any = True if result.friction is None else result.friction
     files += save_robot_files(folder, result.robot, ExportOptions(friction=friction, drive=drive))
     files.append(save_report_json(folder / "report.json", result, **report_extra))
     return files

@@ -8,8 +8,14 @@ Layout of the file (top-level keys)::
     coefficients: [{"name", "expression", "value", "std", "std_percent", "kept"}, ...],
     covariance: (r x r) covariance of the values, or null,
     base: {"std_labels", "independent", "dependent", "K_d", "rank", "rtol", "gap"},
-    friction: null or (n, 3) linear friction [fv N m s/rad, fc N m, fo N m] (per motor with a
-        drive whose friction acts at the motors),
+    terms: the model terms beside the links, in the order stacked (:mod:`dynid.regressors.
+        terms`): [{"name", "kind" (a key of TERM_KINDS), "definition" (the term's own
+        record), "labels", "values", "std", "kept"}, ...]; older files have none (their
+        friction and rotor inertias are read into terms),
+    friction: null or the parameters (n, k) of the one friction term's law (metadata
+        friction_law, default classical: fv N m s/rad, fc N m, fo N m; per motor with a
+        drive whose friction acts at the motors); null with two friction terms (a copy of
+        terms for readers of the friction alone),
     drive: null or the drive train (dynid-drive/1: side, effort, transmission rows, offset,
         torque_constant, rotor_inertia "identify" or values, friction_at); with identified
         rotor inertias base.std_labels continue with Ia1 .. Ia_n after the links' 10 n,
@@ -19,7 +25,9 @@ Layout of the file (top-level keys)::
         rank_gap, identifiability, [seed], static: n_configurations,
         rows_per_configuration, data; classical: cutoff_hz, trim_s, decimate,
         sample_rate_hz, n_samples_log, n_samples_used, duration_s, n_nan_rows,
-        n_duplicates, n_gaps, friction_labels, friction_std, friction_kept, [heldout];
+        n_duplicates, n_gaps, friction_labels, friction_std, friction_kept (the appended
+        terms' coefficients, as in terms), [friction_band, friction_law] (with one friction
+        term), [heldout];
         [column_map], [notes], drive; unknown keys are kept,
     units, conventions
 
@@ -50,11 +58,13 @@ import numpy as np
 from numpy.typing import NDArray
 
 from .. import __version__, _checks
-from ..identification.info import FrictionInfo, IdentificationInfo, LogInfo, StaticInfo
+from ..exceptions import DynidError
+from ..identification.info import IdentificationInfo, LogInfo, StaticInfo
 from ..identification.least_squares import LeastSquaresFit
-from ..identification.model import IdentifiedModel
+from ..identification.model import IdentifiedModel, IdentifiedTerm
 from ..model.drive import Drive
 from ..regressors.base import BaseParameters
+from ..regressors.terms import FRICTION_PARTS, TERM_KINDS, LinearFriction, term_from_definition
 from .drive_file import drive_from_record
 from .json_files import finite_or_none, load_json
 from .robot_json import ROBOT_RECORD, robot_from_dict, robot_to_dict
@@ -143,10 +153,23 @@ def model_to_dict(model: IdentifiedModel, *, seed: int | None = None) -> dict[st
         "rtol": base.rtol,
         "gap": None if base.gap is None else list(base.gap),
     }
-    out["friction"] = None if model.friction is None else model.friction.tolist()
+    out["terms"] = [
+        {
+            "name": t.term.name,
+            "kind": t.term.kind,
+            "definition": _jsonable(t.term.definition()),
+            "labels": list(t.labels),
+            "values": [float(x) for x in t.values],
+            "std": [finite_or_none(x) for x in t.std],
+            "kept": [bool(x) for x in t.kept],
+        }
+        for t in model.terms.values()
+    ]
+    frictions = model.frictions
+    out["friction"] = frictions[0].params.tolist() if len(frictions) == 1 else None
     out["drive"] = None if model.drive is None else model.drive.as_dict()
     out["robot"] = robot_to_dict(model.robot)
-    out["metadata"] = info_to_dict(info, model.drive)
+    out["metadata"] = info_to_dict(info, model.drive) | _friction_metadata(model)
     out["units"] = {
         "value": "SI of each expression: m kg, mc kg m, J kg m^2",
         "std": "as value",
@@ -172,6 +195,27 @@ _DERIVED_KEYS = (
     "scaled_condition_number",
     "relative_error_percent",
 )
+
+
+def _friction_metadata(model: IdentifiedModel) -> dict[str, Any]:
+    """The ``metadata`` keys of the appended terms' coefficients that earlier files wrote:
+    ``friction_labels``, ``friction_std``, ``friction_kept``, and with one friction term its
+    ``friction_band`` and ``friction_law``."""
+    app = model.appended
+    if not app:
+        return {}
+    out: dict[str, Any] = {
+        "friction_labels": [lab for t in app for lab in t.labels],
+        "friction_std": [finite_or_none(x) for t in app for x in t.std],
+        "friction_kept": [bool(x) for t in app for x in t.kept],
+    }
+    fr = model.frictions
+    if len(fr) == 1:
+        if np.any(fr[0].band):
+            out["friction_band"] = [float(x) for x in fr[0].band]
+        if fr[0].law != "classical":
+            out["friction_law"] = fr[0].law
+    return out
 
 
 def info_to_dict(info: IdentificationInfo, drive: Drive | None = None) -> dict[str, Any]:
@@ -205,14 +249,6 @@ def info_to_dict(info: IdentificationInfo, drive: Drive | None = None) -> dict[s
         out["data"] = dict(info.data)
     if info.log is not None:
         out.update({k: getattr(info.log, k) for k in _LOG_KEYS})
-    if info.friction is not None:
-        out["friction_labels"] = list(info.friction.labels)
-        out["friction_std"] = list(info.friction.std)
-        out["friction_kept"] = list(info.friction.kept)
-        if info.friction.band:
-            out["friction_band"] = list(info.friction.band)
-        if info.friction.law != "classical":
-            out["friction_law"] = info.friction.law
     if info.heldout is not None:
         out["heldout"] = dict(info.heldout)
     if info.column_map is not None:
@@ -242,7 +278,7 @@ def info_from_dict(
     m = dict(meta)
     route, std = m.pop("route", None), m.pop("std_estimator", None)
     try:
-        static, log, friction = _route_parts(m)
+        static, log = _route_parts(m)
         gap = m.pop("rank_gap", None)
         seed = m.pop("seed", None)
         return IdentificationInfo(
@@ -261,38 +297,37 @@ def info_from_dict(
             data=dict(m.pop("data", {})),
             static=static,
             log=log,
-            friction=friction,
             heldout=None if m.get("heldout") is None else dict(m.pop("heldout")),
             column_map=None if m.get("column_map") is None else dict(m.pop("column_map")),
             notes=tuple(str(x) for x in m.pop("notes", ())),
             selection=None if m.get("selection") is None else dict(m.pop("selection")),
             recordings=tuple(dict(r) for r in m.pop("recordings", ())),
-            extra={k: v for k, v in m.items() if k not in _DERIVED_KEYS},
+            extra={k: v for k, v in m.items() if k not in _DERIVED_KEYS + _FRICTION_KEYS},
         )
     except (TypeError, ValueError, IndexError) as exc:
         raise fault(source, "metadata", f"malformed ({exc})") from exc
 
 
-def _route_parts(
-    m: dict[str, Any],
-) -> tuple[StaticInfo | None, LogInfo | None, FrictionInfo | None]:
-    """The static, log and friction parts of a ``metadata`` object (their keys removed)."""
-    static = log = friction = None
+#: The keys of ``metadata`` that describe the appended terms (read with the terms).
+_FRICTION_KEYS = (
+    "friction_labels",
+    "friction_std",
+    "friction_kept",
+    "friction_band",
+    "friction_law",
+)
+
+
+def _route_parts(m: dict[str, Any]) -> tuple[StaticInfo | None, LogInfo | None]:
+    """The static and log parts of a ``metadata`` object (their keys removed)."""
+    static = log = None
     if "n_configurations" in m:
         n_conf = int(m.pop("n_configurations"))
         static = StaticInfo(n_conf, int(m.pop("rows_per_configuration", 0)))
     if "decimate" in m:
         vals = {k: m.pop(k) for k in _LOG_KEYS if k in m}
         log = LogInfo(**vals)
-    if "friction_labels" in m:
-        friction = FrictionInfo(
-            labels=tuple(str(x) for x in m.pop("friction_labels")),
-            std=tuple(_float(x) for x in m.pop("friction_std", ())),
-            kept=tuple(bool(x) for x in m.pop("friction_kept", ())),
-            band=tuple(_float(x) for x in m.pop("friction_band", ())),
-            law=str(m.pop("friction_law", "classical")),
-        )
-    return static, log, friction
+    return static, log
 
 
 def _opt_float(x: Any) -> float | None:
@@ -334,6 +369,17 @@ _BASE = Record(
     }
 )
 _FRICTION_LAWS = {"classical": 3, "smooth": 3, "quadratic": 4, "stribeck": 5}
+_TERM = Record(
+    {
+        "name": Field("string", required=True),
+        "kind": Field("string", required=True, choices=tuple(TERM_KINDS)),
+        "definition": Field("object", required=True),
+        "labels": Field("strings", required=True),
+        "values": Field("numbers", required=True),
+        "std": Field("numbers", required=True, null_items=True),
+        "kept": Field("bools", required=True),
+    }
+)
 #: the typed keys of ``metadata`` (others are kept as they are)
 _META = Record(
     {
@@ -370,6 +416,7 @@ MODEL = Format(
             "coefficients": Field("objects", required=True, record=_COEFFICIENT),
             "covariance": Field("numbers", nullable=True, shape=(None, None)),
             "base": Field("object", required=True, record=_BASE),
+            "terms": Field("objects", record=_TERM),
             "friction": Field("numbers", nullable=True, shape=("n", None)),
             "drive": Field("object", nullable=True),
             "metadata": Field("object", nullable=True, record=_META),
@@ -444,18 +491,84 @@ def model_from_dict(d: Mapping[str, Any], *, source: str = "identified model") -
         scaled_condition_number=_float(d.get("scaled_condition_number")),
     )
     metadata = d.get("metadata") or {}
-    friction = d.get("friction")
-    if friction is not None:
-        law = metadata.get("friction_law", "classical")
-        k = _FRICTION_LAWS[law]
-        if any(len(row) != k for row in friction):
-            want = f"null or {robot.n} rows of the {law} law's {k} parameters"
-            raise fault(source, "friction", f"expected {want}; got {_checks.short(friction)}")
-        friction = _frozen(np.array(friction, dtype=np.float64).reshape(robot.n, k))
+    if d.get("terms") is not None:
+        terms = _terms(d["terms"], drive, robot.n, source)
+    else:
+        terms = _older_terms(d.get("friction"), metadata, drive, robot.n, source)
     info = info_from_dict(metadata, source=source)
-    return IdentifiedModel(
-        robot=robot, base=base, fit=fit, friction=friction, info=info, drive=drive
+    return IdentifiedModel(robot=robot, base=base, fit=fit, terms=terms, info=info, drive=drive)
+
+
+def _terms(
+    records: list[Mapping[str, Any]], drive: Drive | None, n: int, source: str
+) -> dict[str, IdentifiedTerm]:
+    """The ``terms`` of a file, each rebuilt by its kind (:data:`~dynid.regressors.terms.
+    TERM_KINDS`) and checked against its labels."""
+    out = {}
+    for k, rec in enumerate(records):
+        at = f"terms[{k}]"
+        try:
+            term = term_from_definition(rec["kind"], rec["name"], rec["definition"], drive, n)
+        except (DynidError, TypeError, ValueError, KeyError) as exc:
+            raise fault(source, f"{at}.definition", f"malformed ({exc})") from exc
+        if tuple(rec["labels"]) != term.labels:
+            want = f"the labels of its definition {list(term.labels)}"
+            raise fault(
+                source, f"{at}.labels", f"expected {want}; got {_checks.short(rec['labels'])}"
+            )
+        p = len(term.labels)
+        for key in ("values", "std", "kept"):
+            if len(rec[key]) != p:
+                raise fault(
+                    source, f"{at}.{key}", f"expected {p} entries (labels); got {len(rec[key])}"
+                )
+        std = np.array([_float(x) for x in rec["std"]])
+        out[term.name] = IdentifiedTerm(
+            term, np.array(rec["values"], float), std, np.array(rec["kept"], bool)
+        )
+    return out
+
+
+def _older_terms(
+    friction: Any, metadata: Mapping[str, Any], drive: Drive | None, n: int, source: str
+) -> dict[str, IdentifiedTerm]:
+    """The friction term of a file without ``terms``: its law's parameters (n, k) in
+    ``friction`` and its coefficients' labels, std and kept flags in ``metadata``."""
+    if friction is None:
+        return {}
+    law = metadata.get("friction_law", "classical")
+    k = _FRICTION_LAWS[law]
+    if any(len(row) != k for row in friction):
+        want = f"null or {n} rows of the {law} law's {k} parameters"
+        raise fault(source, "friction", f"expected {want}; got {_checks.short(friction)}")
+    P = np.array(friction, dtype=np.float64).reshape(n, k)
+    labels = [str(x) for x in metadata.get("friction_labels") or ()]
+    if not labels:
+        labels = [f"{c}{j + 1}" for j in range(n) for c in ("fv", "fc", "fo")]
+    part = {"fv": "viscous", "fc": "smooth" if law == "smooth" else "coulomb"}
+    part |= {"fq": "quadratic", "fsp": "stribeck", "fo": "offset"}
+    try:
+        held = [(part[lab.rstrip("0123456789")], int(lab.lstrip("fvcqspo")) - 1) for lab in labels]
+    except (KeyError, ValueError) as exc:
+        raise fault(source, "metadata.friction_labels", f"malformed ({exc})") from exc
+    parts = tuple(p for p in FRICTION_PARTS if any(h[0] == p for h in held))
+    mask = tuple((p, j) in held for j in range(n) for p in parts)
+    band = tuple(_float(x) for x in metadata.get("friction_band") or ())
+    at = Drive.identity(n) if drive is None else drive
+    term = LinearFriction(
+        at,
+        parts=parts,
+        band=() if law == "smooth" else band,
+        width=band if law == "smooth" else (),
+        vst=float(np.max(P[:, 3])) if law == "stribeck" else 0.0,
+        mask=() if all(mask) else mask,
     )
+    p = len(term.labels)
+    std = [_float(x) for x in metadata.get("friction_std") or ()] or [np.nan] * p
+    kept = [bool(x) for x in metadata.get("friction_kept") or ()] or [True] * p
+    if len(std) != p or len(kept) != p:
+        raise fault(source, "metadata.friction_std", f"expected {p} entries (friction_labels)")
+    return {term.name: IdentifiedTerm(term, term.values_of(P), np.array(std), np.array(kept))}
 
 
 def save_model_json(path: str | Path, model: IdentifiedModel, *, seed: int | None = None) -> Path:

@@ -18,6 +18,7 @@ from typing import Any
 from .. import __version__
 from ..feasibility.constraints import FeasibilityReport
 from ..feasibility.result import FeasibleResult
+from ..friction.model import Friction, FrictionSum, friction_parts
 from .bounds_file import bounds_to_dict
 from .json_files import finite_or_none, save_json
 
@@ -81,9 +82,7 @@ def report_to_dict(result: FeasibleResult) -> dict[str, Any]:
         "min_margin": {name: finite_or_none(rep.min_margin(name)) for name in rep.names},
         "constraints": _report_constraints(rep),
         "pseudo_inertia_margin": finite_or_none(result.pseudo_inertia_margin),
-        "friction": None
-        if fr is None
-        else {k: [float(x) for x in fr[:, j]] for j, k in enumerate(("fv", "fc", "fo"))},
+        "friction": None if fr is None else _friction_record(fr),
         "heldout": None if result.heldout is None else result.heldout.as_dict(),
         "run_time_s": float(result.run_time),
         "seed": result.seed,
@@ -107,3 +106,17 @@ def save_report_json(path: str | Path, result: FeasibleResult, **extra: Any) -> 
         A NaN or infinite number where the report admits none (named).
     """
     return save_json(path, report_to_dict(result) | extra)
+
+
+def _friction_record(fr: Friction | FrictionSum) -> dict[str, Any]:
+    """``{name: per-joint values}`` of the law's parameters (``fv, fc, fo``: classical); of
+    friction at the motors and at the joints, the part at the joints under ``"joints"``."""
+    parts = friction_parts(fr)
+    out: dict[str, Any] = {
+        k: [float(x) for x in parts[0].params[:, j]] for j, k in enumerate(parts[0].names)
+    }
+    if len(parts) > 1:
+        out["joints"] = {
+            k: [float(x) for x in parts[1].params[:, j]] for j, k in enumerate(parts[1].names)
+        }
+    return out

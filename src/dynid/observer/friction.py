@@ -35,7 +35,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from ..friction.laws.base import CANONICAL_COLUMNS
-from ..friction.model import FrictionModel
+from ..friction.model import FrictionModel, FrictionSum
 
 __all__ = ["FRICTION_COLUMNS", "canonical_friction", "standstill_margin"]
 
@@ -44,12 +44,15 @@ FRICTION_COLUMNS = CANONICAL_COLUMNS
 
 
 def canonical_friction(
-    friction: FrictionModel | None, n: int
+    friction: FrictionModel | FrictionSum | None, n: int
 ) -> tuple[NDArray[np.float64], NDArray[np.float64]] | None:
     """``(K_f, F)``: the friction transmission (n, n) and the canonical parameters (n, 14)
-    of ``friction`` (zeros for None), or None for a law without a canonical form."""
+    of ``friction`` (zeros for None), or None for a law without a canonical form and for a
+    sum of frictions in different places (evaluated in Python)."""
     if friction is None:
         return np.eye(n), np.zeros((n, len(FRICTION_COLUMNS)))
+    if isinstance(friction, FrictionSum):
+        return None
     canonical = getattr(friction.law, "canonical", None)  # a law outside the registry: none
     if canonical is None:
         return None
@@ -57,7 +60,7 @@ def canonical_friction(
 
 
 def standstill_margin(
-    friction: FrictionModel | None, dq: NDArray[np.float64]
+    friction: FrictionModel | FrictionSum | None, dq: NDArray[np.float64]
 ) -> NDArray[np.float64]:
     """Bound [N m] (..., n) of the friction the model cannot know at velocities ``dq``
     [rad/s] (..., n): its Coulomb level where the law's Coulomb term is off or not at its

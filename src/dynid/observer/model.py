@@ -22,7 +22,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from .. import _checks
 from ..exceptions import ShapeError
-from ..friction.model import FrictionModel, robot_friction
+from ..friction.model import FrictionModel, FrictionSum, robot_friction
 from ..friction.validation import own_friction
 from ..identification.model import IdentifiedModel
 from ..model.drive import Drive
@@ -42,8 +42,9 @@ class ObserverModel:
         Kinematics, gravity and the link parameters ``M``, ``C`` and ``g`` are computed from.
     rotor_mass : ndarray, shape (n, n)
         Constant part of the mass matrix [kg m^2] (rotor inertias, ``K^T diag(I_a) K``).
-    friction : FrictionModel or None
-        ``tau_f(dq)`` [N m], the measured torque's part spent on friction.
+    friction : FrictionModel, FrictionSum or None
+        ``tau_f(dq)`` [N m], the measured torque's part spent on friction (a sum: friction
+        at the motors and at the joints of a coupled drive, evaluated in Python).
     base : BaseParameters or None
         The identified base parameters' map (None for a robot's own parameters).
     beta : ndarray, shape (r,), or None
@@ -58,7 +59,7 @@ class ObserverModel:
 
     robot: Robot
     rotor_mass: NDArray[np.float64]
-    friction: FrictionModel | None = None
+    friction: FrictionModel | FrictionSum | None = None
     base: BaseParameters | None = None
     beta: NDArray[np.float64] | None = None
     covariance: NDArray[np.float64] | None = None
@@ -81,7 +82,7 @@ class ObserverModel:
         """Joints."""
         return self.robot.n
 
-    def with_friction(self, friction: FrictionModel | None) -> ObserverModel:
+    def with_friction(self, friction: FrictionModel | FrictionSum | None) -> ObserverModel:
         """The same model with another friction (None: none)."""
         return ObserverModel(
             self.robot, self.rotor_mass, friction, self.base, self.beta, self.covariance,
@@ -96,7 +97,7 @@ class ObserverModel:
 
 
 def from_identified(
-    model: IdentifiedModel, friction: FrictionModel | None | str = "model"
+    model: IdentifiedModel, friction: FrictionModel | FrictionSum | None | str = "model"
 ) -> ObserverModel:
     """The observer model of an identified model (the one adapter to its attributes).
 
@@ -106,8 +107,8 @@ def from_identified(
         Base parameters (through ``equivalent_robot``), rotor inertias (``rotor_inertia``
         with ``drive``), the identified friction and the covariance of ``fit``.
     friction : FrictionModel, None or "model"
-        ``"model"`` (default): the friction identified with the model (classical, at the
-        motors with a drive whose friction acts there), none if it has none.
+        ``"model"`` (default): the friction identified with the model (each friction term
+        where it acts: :func:`~dynid.friction.validation.own_friction`), none if it has none.
 
     Returns
     -------
@@ -134,7 +135,7 @@ def from_identified(
 def from_robot(
     robot: Robot,
     *,
-    friction: FrictionModel | None | str = "robot",
+    friction: FrictionModel | FrictionSum | None | str = "robot",
     drive: Drive | None = None,
 ) -> ObserverModel:
     """The observer model of a robot's own link parameters (a consistent robot, a URDF).
@@ -162,7 +163,7 @@ def from_robot(
         drive.check(n)
         if drive.rotor_inertia is not None:
             Mr = drive.rotor_mass_matrix(drive.rotor_inertia)
-    fr: FrictionModel | None = friction if not isinstance(friction, str) else None
+    fr: FrictionModel | FrictionSum | None = friction if not isinstance(friction, str) else None
     if isinstance(friction, str):
         fr = robot_friction(robot)
     return ObserverModel(robot=robot, rotor_mass=Mr, friction=fr, drive=drive, source="robot")

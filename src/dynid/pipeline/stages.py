@@ -101,9 +101,7 @@ def kinematics_only(model: IdentifiedModel) -> IdentifiedModel:
     """``model`` with a robot that keeps only its kinematics (no link parameters, friction
     or neutral pose): what an identification file records, and all later stages may use."""
     robot = model.robot.replace(phi=np.zeros((model.robot.n, 10)), friction=None, q_neutral=None)
-    return IdentifiedModel(
-        robot, model.base, model.fit, model.friction, model.info, model.joint_fit
-    )
+    return IdentifiedModel(robot, model.base, model.fit, model.terms, model.info, model.joint_fit)
 
 
 # ----------------------------------------------------------------------------- stage 1

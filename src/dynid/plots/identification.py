@@ -15,7 +15,6 @@ matplotlib is imported inside the plotting functions (never by ``import dynid``)
 
 from __future__ import annotations
 
-import dataclasses
 from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any
 
@@ -82,20 +81,9 @@ def _fold_model(model: IdentifiedModel, fold: int) -> IdentifiedModel | None:
     parameters followed by ``fv, fc, fo`` per joint)."""
     assert model.holdout is not None
     x = model.holdout.train[fold].solve()
-    r = model.fit.beta.size
-    labels = () if model.info.friction is None else model.info.friction.labels
-    if x.size != r + len(labels):
+    if x.size != model.base.rank + sum(len(t.labels) for t in model.appended):
         return None
-    friction = model.friction_from(x[r:]) if labels else None
-    fit = dataclasses.replace(model.fit, beta=x[:r])
-    return IdentifiedModel(
-        robot=model.robot,
-        base=model.base,
-        fit=fit,
-        friction=friction,
-        info=model.info,
-        drive=model.drive,
-    )
+    return model.with_coefficients(x)
 
 
 def heldout_torques(

@@ -10,8 +10,11 @@ and units, its torque columns, its columns of the static regressor ``[tril M; g]
 it does not act at rest), whether it regroups with the link parameters (``in_base``: its
 columns join the rigid-body ones before the base parameters are found, as a rotor inertia
 regroups with its link's ``Izz``) and which of its parameters a physically consistent model
-keeps non-negative. Adding a term (a spring, a payload) is one class here and its entry in
-:func:`drive_terms`.
+keeps non-negative, what it is (:meth:`ModelTerm.friction`: a friction law's parameters;
+:meth:`ModelTerm.inertia`: rotor inertias; None for neither) and its place in files
+(:attr:`ModelTerm.kind`, the key of :data:`TERM_KINDS`, and :meth:`ModelTerm.definition`).
+Adding a term (a spring, a payload) is one class and its line in :data:`TERM_KINDS`
+(``ARCHITECTURE.md``, "Adding a model term").
 
 Terms of a :class:`~dynid.model.drive.Drive`:
 
@@ -26,8 +29,9 @@ Rows are sample-major as everywhere (row ``k n + j`` of a stack is sample ``k``,
 
 from __future__ import annotations
 
-from dataclasses import dataclass
-from typing import Protocol
+from collections.abc import Callable, Mapping
+from dataclasses import dataclass, replace
+from typing import Any, Protocol
 
 import numpy as np
 from numpy.typing import NDArray
@@ -38,6 +42,8 @@ from .friction_columns import smooth_sign, standstill_sign, stribeck_decay
 
 __all__ = [
     "FRICTION_PARTS",
+    "TERM_KINDS",
+    "FrictionValues",
     "LinearFriction",
     "ModelTerm",
     "PART_LABELS",
@@ -45,7 +51,36 @@ __all__ = [
     "base_term_columns",
     "drive_terms",
     "friction_labels",
+    "term_from_definition",
 ]
+
+
+@dataclass(frozen=True, slots=True, eq=False)
+class FrictionValues:
+    """A friction term's identified coefficients as the parameters of a registry law.
+
+    The identification layer names the law; the friction layer makes the one friction type
+    of it (:func:`dynid.friction.model.friction_of`).
+
+    Attributes
+    ----------
+    law : str
+        The registry law (:mod:`dynid.friction.laws`): ``"classical"`` (``fv, fc, fo``),
+        ``"smooth"`` (``fv, fc, fo``, ``tanh(v / band)``), ``"quadratic"``
+        (``fv, fq, fc, fo``) or ``"stribeck"`` (``fv, fc, fs, vst, fo``).
+    params : ndarray, shape (n, k)
+        The law's parameters per motor (joint), in its units.
+    band : ndarray, shape (n,)
+        The standstill band [rad/s] the law is evaluated with (the smooth law's width);
+        zeros for the plain ``sign``.
+    drive : Drive or None
+        Where the law acts: None at the joints, a drive at its motors (``K^T f(K dq)``).
+    """
+
+    law: str
+    params: NDArray[np.float64]
+    band: NDArray[np.float64]
+    drive: Drive | None = None
 
 
 class ModelTerm(Protocol):
@@ -53,7 +88,12 @@ class ModelTerm(Protocol):
 
     @property
     def name(self) -> str:
-        """Short name, used in files and summaries."""
+        """Short name, unique in a model: its key in the model's terms, files and summaries."""
+        ...
+
+    @property
+    def kind(self) -> str:
+        """Its key in :data:`TERM_KINDS` (how a file names the class that reads it back)."""
         ...
 
     @property
@@ -86,6 +126,19 @@ class ModelTerm(Protocol):
         """Columns (p, n (n + 1) / 2 + n, N) of the static regressor, or None."""
         ...
 
+    def friction(self, values: NDArray[np.float64]) -> FrictionValues | None:
+        """The coefficients (p,) as a friction law's parameters; None: not friction."""
+        ...
+
+    def inertia(self, values: NDArray[np.float64]) -> NDArray[np.float64] | None:
+        """The coefficients (p,) as rotor inertias [kg m^2] at the motors of the model's
+        drive; None: not rotor inertias."""
+        ...
+
+    def definition(self) -> dict[str, Any]:
+        """JSON-ready: what :data:`TERM_KINDS` needs beside the model's drive to rebuild it."""
+        ...
+
 
 def friction_labels(n: int) -> tuple[str, ...]:
     """``fv1, fc1, fo1, fv2, ...`` for ``n`` joints (or motors)."""
@@ -99,6 +152,7 @@ class RotorInertia:
     drive: Drive
     name: str = "rotor_inertia"
     in_base: bool = True
+    kind: str = "rotor_inertia"
 
     @property
     def labels(self) -> tuple[str, ...]:
@@ -128,6 +182,25 @@ class RotorInertia:
         C = np.zeros((n, i.size + n, n_samples))
         C[:, : i.size, :] = self.drive.rotor_mass_columns()[:, i, j][:, :, None]
         return C
+
+    def friction(self, values: NDArray[np.float64]) -> None:
+        """None: not friction."""
+        return None
+
+    def inertia(self, values: NDArray[np.float64]) -> NDArray[np.float64]:
+        """The rotor inertias ``I_a`` (n,) [kg m^2]: the values themselves."""
+        return np.asarray(values, dtype=np.float64)
+
+    def definition(self) -> dict[str, Any]:
+        """Empty: the model's drive is all it needs."""
+        return {}
+
+    @classmethod
+    def from_definition(
+        cls, name: str, definition: Mapping[str, Any], drive: Drive | None, n: int
+    ) -> RotorInertia:
+        """Rebuilt for the model's ``drive`` (a direct drive of ``n`` joints when None)."""
+        return cls(Drive.identity(n) if drive is None else drive, name=name)
 
 
 #: The parts of :class:`LinearFriction`, in column order: viscous ``fv v``, quadratic
@@ -168,6 +241,9 @@ class LinearFriction:
         Which of the ``k n`` coefficients (motor by motor, the parts in order) the term
         holds, when a motor (joint) holds fewer parts than ``parts``; empty: all. The
         coefficients left out are 0 in :meth:`as_array`.
+    prefix : str
+        Put before every label (``"j"``: ``jfv7``), for a second friction term of a model
+        (friction at the joints beside friction at the motors).
     """
 
     drive: Drive
@@ -178,6 +254,8 @@ class LinearFriction:
     name: str = "friction"
     in_base: bool = False
     mask: tuple[bool, ...] = ()
+    kind: str = "linear_friction"
+    prefix: str = ""
 
     def __post_init__(self) -> None:
         if not self.parts or any(p not in FRICTION_PARTS for p in self.parts):
@@ -230,7 +308,9 @@ class LinearFriction:
     @property
     def labels(self) -> tuple[str, ...]:
         """``fv1, fc1, fo1, fv2, ...`` (the parts held, per joint or motor)."""
-        every = [f"{PART_LABELS[p]}{j + 1}" for j in range(self.drive.n) for p in self.parts]
+        every = [
+            f"{self.prefix}{PART_LABELS[p]}{j + 1}" for j in range(self.drive.n) for p in self.parts
+        ]
         return tuple(lab for lab, h in zip(every, self._held, strict=True) if h)
 
     @property
@@ -307,6 +387,69 @@ class LinearFriction:
         """None: friction does not act at rest."""
         return None
 
+    def friction(self, values: NDArray[np.float64]) -> FrictionValues:
+        """The coefficients (p,) as the parameters of :attr:`law` (:meth:`as_array`), with
+        its band and where it acts."""
+        n = self.drive.n
+        band = np.asarray(self.law_band, dtype=np.float64) if self.law_band else np.zeros(n)
+        at_motors = self.drive.friction_at == "motor"
+        return FrictionValues(
+            self.law, self.as_array(np.asarray(values)), band, self.drive if at_motors else None
+        )
+
+    def inertia(self, values: NDArray[np.float64]) -> None:
+        """None: not rotor inertias."""
+        return None
+
+    def values_of(self, params: NDArray[np.float64]) -> NDArray[np.float64]:
+        """The coefficients (p,) of the law's parameters (n, k): the inverse of
+        :meth:`as_array` (``fsp = fs - fc``)."""
+        P = np.asarray(params, dtype=np.float64)
+        names: dict[str, tuple[str, ...]] = {"classical": ("fv", "fc", "fo")}
+        names |= {"smooth": ("fv", "fc", "fo"), "quadratic": ("fv", "fq", "fc", "fo")}
+        names["stribeck"] = ("fv", "fc", "fs", "vst", "fo")
+        col = dict(zip(names[self.law], P.T, strict=True))
+        part = {"viscous": col["fv"], "coulomb": col["fc"], "smooth": col["fc"]}
+        part |= {"offset": col["fo"], "quadratic": col.get("fq"), "stribeck": None}
+        if "stribeck" in self.parts:
+            part["stribeck"] = col["fs"] - col["fc"]
+        every = np.column_stack([part[p] for p in self.parts]).ravel()
+        return every[self._held]
+
+    def definition(self) -> dict[str, Any]:
+        """``parts``, ``band``, ``width``, ``vst``, ``mask``, ``at`` (``"motor"`` or
+        ``"joint"``: where it acts) and ``prefix``."""
+        return {
+            "parts": list(self.parts),
+            "band": list(self.band),
+            "width": list(self.width),
+            "vst": self.vst,
+            "mask": list(self.mask),
+            "at": self.drive.friction_at,
+            "prefix": self.prefix,
+        }
+
+    @classmethod
+    def from_definition(
+        cls, name: str, definition: Mapping[str, Any], drive: Drive | None, n: int
+    ) -> LinearFriction:
+        """Rebuilt acting where ``definition["at"]`` says, through the model's ``drive`` (a
+        direct drive of ``n`` joints when None)."""
+        d = dict(definition)
+        at = Drive.identity(n) if drive is None else drive
+        if d.get("at", at.friction_at) != at.friction_at:
+            at = replace(at, friction_at=d["at"])
+        return cls(
+            at,
+            parts=tuple(str(p) for p in d.get("parts", ("viscous", "coulomb", "offset"))),
+            band=tuple(float(x) for x in d.get("band", ())),
+            width=tuple(float(x) for x in d.get("width", ())),
+            vst=float(d.get("vst", 0.0)),
+            name=name,
+            mask=tuple(bool(x) for x in d.get("mask", ())),
+            prefix=str(d.get("prefix", "")),
+        )
+
 
 def drive_terms(drive: Drive | None, n: int, *, friction: bool = True) -> tuple[ModelTerm, ...]:
     """The extra terms of an arm of ``n`` joints: the rotor inertia of a drive (when it is
@@ -338,3 +481,28 @@ def base_term_columns(
             out.append((t, ind[(ind >= start) & (ind < start + k)] - start))
             start += k
     return out
+
+
+#: Reads a term back from a file: ``(name, definition, the model's drive, n joints)``.
+TermReader = Callable[[str, Mapping[str, Any], Drive | None, int], ModelTerm]
+
+#: Every kind of model term, by :attr:`ModelTerm.kind`: its reader from files.
+TERM_KINDS: dict[str, TermReader] = {
+    "rotor_inertia": RotorInertia.from_definition,
+    "linear_friction": LinearFriction.from_definition,
+}
+
+
+def term_from_definition(
+    kind: str, name: str, definition: Mapping[str, Any], drive: Drive | None, n: int
+) -> ModelTerm:
+    """The term of ``kind`` (:data:`TERM_KINDS`) rebuilt from its :meth:`~ModelTerm.definition`.
+
+    Raises
+    ------
+    OptionError
+        An unknown kind.
+    """
+    if kind not in TERM_KINDS:
+        raise OptionError(f"unknown model term kind {kind!r}; known: {sorted(TERM_KINDS)}")
+    return TERM_KINDS[kind](name, definition, drive, n)

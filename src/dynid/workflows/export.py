@@ -21,6 +21,7 @@ from pathlib import Path
 from typing import Any
 
 from ..exceptions import OptionError
+from ..friction.model import Friction
 from ..friction.mujoco import CoulombViscous, coulomb_viscous_from_sigmoid
 from ..io.drive_file import load_drive
 from ..io.export import EXPORT_FORMATS, ROBOT_FORMATS, export_format, model_terms_of
@@ -145,8 +146,9 @@ def export_robot(
     friction: Any = opt.friction
     if linear is not None and opt.friction:
         friction = linear
-        if drive is not None and drive.friction_at == "motor" and linear.drive is None:
-            friction = linear.at(drive)
+        at_joints = isinstance(linear, Friction) and linear.drive is None
+        if isinstance(linear, Friction) and at_joints and drive is not None:
+            friction = linear.at(drive) if drive.friction_at == "motor" else linear
     written = ExportOptions(
         template=None if opt.urdf_template is None else Path(opt.urdf_template),
         base=opt.base,

@@ -36,7 +36,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from ..exceptions import DataError, DynidWarning, OptionError
-from ..friction.model import FrictionModel
+from ..friction.model import FrictionModel, FrictionSum
 from ..identification.log import (
     DEFAULT_CUTOFF_HZ,
     TorqueLog,
@@ -173,7 +173,7 @@ def load_observer_model(
         raise OptionError(
             f"--base/--tip choose the chain of a --params URDF; {given} holds its own chain"
         )
-    fr: FrictionModel | None | str
+    fr: FrictionModel | FrictionSum | None | str
     fr = "model" if friction is None else load_friction_json(friction)
     if model is not None:
         ident = load_model_json(model)

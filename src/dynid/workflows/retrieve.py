@@ -87,9 +87,7 @@ def load_model_with_friction(
     robot = _with_friction(model.robot, friction)
     if robot is model.robot:
         return model
-    return IdentifiedModel(
-        robot, model.base, model.fit, model.friction, model.info, drive=model.drive
-    )
+    return IdentifiedModel(robot, model.base, model.fit, model.terms, model.info, drive=model.drive)
 
 
 #: Options of the penalty method only, and of the convex method only.

@@ -26,7 +26,7 @@ from typing import Any, Literal
 import numpy as np
 
 from ..exceptions import DataError, OptionError
-from ..friction.model import FrictionModel
+from ..friction.model import FrictionModel, FrictionSum
 from ..friction.recordings import RecordingsValidation, prepare_pieces, validate_pieces
 from ..friction.validation import RECORDED, own_friction
 from ..identification.model import IdentifiedModel
@@ -211,7 +211,7 @@ def _friction(
     model: IdentifiedModel | Robot,
     friction: str | Path | FrictionModel,
     feasible: str | Path | None,
-) -> tuple[FrictionModel | None, str | None]:
+) -> tuple[FrictionModel | FrictionSum | None, str | None]:
     """The friction added to the model and where it comes from."""
     if isinstance(friction, str) and friction == "none":
         return None, None

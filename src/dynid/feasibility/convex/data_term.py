@@ -12,6 +12,7 @@ from ...exceptions import DataError, ModelError
 from ...identification.holdout import HeldOut
 from ...identification.least_squares import LeastSquaresFit
 from ...identification.model import IdentifiedModel
+from ...regressors.terms import FrictionValues, ModelTerm
 from .options import EXACT_RTOL
 
 __all__ = ["DataTerm", "coefficient_term"]
@@ -36,11 +37,14 @@ class DataTerm:
     exact : bool
         The estimate is exact (noise-free): the equality ``P phi = beta`` applies.
     n_friction : int
-        ``k``: 0, or the classical friction coefficients fitted (``fv, fc, fo`` per joint,
-        less those of joints that never moved).
+        ``k``: 0, or the coefficients of the model's appended terms fitted (friction, less
+        the coefficients of joints that never moved).
     friction_index : ndarray of int, shape (k,), optional
-        Where each friction unknown sits in the ``(n, 3)`` layout ``fv, fc, fo`` per joint
-        (flattened); None: all ``3 n`` in order.
+        Where each such unknown sits among every coefficient of :attr:`terms`, in order;
+        None: all of them in order.
+    terms : tuple of ModelTerm
+        The appended terms the unknowns are coefficients of (:mod:`dynid.regressors.terms`):
+        they say which are kept ``>= 0`` and what friction they are.
     labels : tuple of str
         Names of the entries of ``x``.
     notes : tuple of str
@@ -58,6 +62,7 @@ class DataTerm:
     exact: bool
     n_friction: int = 0
     friction_index: NDArray[np.intp] | None = None
+    terms: tuple[ModelTerm, ...] = ()
     labels: tuple[str, ...] = ()
     notes: tuple[str, ...] = ()
     holdout: HeldOut | None = None
@@ -73,12 +78,27 @@ class DataTerm:
             return np.arange(self.n_friction)
         return np.asarray(self.friction_index)
 
-    def friction_table(self, f: NDArray[np.float64], n: int) -> NDArray[np.float64]:
-        """The fitted friction unknowns ``f`` (k,) as the (n, 3) table ``fv, fc, fo`` (zero
-        for the coefficients not fitted)."""
-        out = np.zeros(3 * n)
-        out[self.friction_layout()] = f
-        return out.reshape(n, 3)
+    def nonnegative(self) -> NDArray[np.bool_]:
+        """(k,): the unknowns a physically consistent model keeps ``>= 0`` (the terms'
+        ``nonnegative``: viscous and Coulomb friction, not an offset)."""
+        if not self.terms:
+            return np.zeros(self.n_friction, dtype=bool)
+        every = np.concatenate([np.asarray(t.nonnegative, dtype=bool) for t in self.terms])
+        return every[self.friction_layout()]
+
+    def frictions(self, f: NDArray[np.float64]) -> tuple[FrictionValues, ...]:
+        """The unknowns ``f`` (k,) as the friction of each friction term (its law's
+        parameters; zero for the coefficients not fitted), in order."""
+        every = np.zeros(sum(len(t.labels) for t in self.terms))
+        every[self.friction_layout()] = f
+        out, c = [], 0
+        for t in self.terms:
+            k = len(t.labels)
+            fr = t.friction(every[c : c + k])
+            c += k
+            if fr is not None:
+                out.append(fr)
+        return tuple(out)
 
     def chi2(self, x: NDArray[np.float64]) -> float:
         """``||A (x - x_hat)||^2``: the increase of the residual sum of squares / sigma^2."""
@@ -151,6 +171,7 @@ def coefficient_term(model: IdentifiedModel, *, with_friction: bool = False) -> 
         exact=exact,
         n_friction=int(kept[r_all:].sum()) if k else 0,
         friction_index=np.flatnonzero(kept[r_all:]) if k else None,
+        terms=tuple(t.term for t in model.appended) if k else (),
         labels=labels,
         notes=notes,
         holdout=None if held is None else held.restricted(np.flatnonzero(kept)),
@@ -158,6 +179,5 @@ def coefficient_term(model: IdentifiedModel, *, with_friction: bool = False) -> 
 
 
 def _friction_labels(model: IdentifiedModel) -> tuple[str, ...]:
-    """The labels of the model's friction columns (empty without friction)."""
-    fr = model.info.friction
-    return () if fr is None else fr.labels
+    """The labels of the model's appended terms' columns (friction), in order."""
+    return tuple(lab for t in model.appended for lab in t.labels)

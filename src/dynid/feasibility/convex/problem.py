@@ -154,7 +154,7 @@ class ConvexProblem:
         if self.f is not None:
             x = cp.hstack([x, self.f])
             if friction_nonneg:  # fv, fc >= 0 (every joint's fo is free)
-                pos = np.flatnonzero(term.friction_layout() % 3 != 2)  # fv, fc (not fo)
+                pos = np.flatnonzero(term.nonnegative())  # the terms say which
                 sel = np.zeros((pos.size, k))
                 sel[np.arange(pos.size), pos] = 1.0
                 cons.append(sel @ self.f >= 0)

@@ -13,6 +13,7 @@ from typing import Any, ClassVar
 import numpy as np
 from numpy.typing import NDArray
 
+from ...friction.model import combined
 from ...identification.model import IdentifiedModel
 from ...model.inertia import inertial_from_phi
 from ...model.robot import Robot
@@ -203,7 +204,7 @@ def build_result(
 ) -> ConsistentResult:
     if f is not None and term.n_friction:
         f = f.copy()
-        nonneg = term.friction_layout() % 3 != 2
+        nonneg = term.nonnegative()
         f[nonneg] = np.maximum(f[nonneg], 0.0)  # fv, fc >= 0 held to the solver's tolerance
     m, c, I = inertial_from_phi(phi)
     out = robot.with_params(phi)
@@ -249,7 +250,7 @@ def build_result(
     div = log_det_divergence(pseudo_inertia(phi), prior.pseudo_inertia)
     return ConsistentResult(
         robot=out,
-        friction=None if f is None else term.friction_table(f, robot.n),
+        friction=None if f is None else combined(term.frictions(f)),
         rotor_inertia=ia,
         relative_residual=rel,
         residual_ratio=ratio,

@@ -14,7 +14,7 @@ from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
 
-from ...friction.model import Friction
+from ...friction.model import Friction, FrictionSum
 from ...model.drive import Drive
 from ...model.robot import Robot
 
@@ -33,7 +33,7 @@ class ExportOptions:
         URDF template: the chain's base and tip links.
     merged : {"subtract", "move"}
         URDF template: how a body is split over its moving and fixed links.
-    friction : bool or Friction
+    friction : bool, Friction or FrictionSum
         True: the robot's own friction where the format holds it; a friction model of any
         law (at the joints, or at the motors of a drive); False: none.
     all_frames : bool
@@ -46,7 +46,7 @@ class ExportOptions:
     base: str | None = None
     tip: str | None = None
     merged: str = "subtract"
-    friction: bool | Friction = True
+    friction: bool | Friction | FrictionSum = True
     all_frames: bool = False
     drive: Drive | None = None
 

@@ -48,7 +48,7 @@ from scipy.spatial.transform import Rotation
 
 from ... import __version__
 from ...exceptions import DynidWarning, ModelError, ShapeError
-from ...friction.model import FrictionModel, robot_friction
+from ...friction.model import FrictionModel, FrictionSum, robot_friction
 from ...friction.mujoco import (
     CoulombViscous,
     coulomb_viscous_from_sigmoid,
@@ -80,7 +80,7 @@ def _pose(T: np.ndarray) -> str:
 
 
 def _law_terms(
-    friction: FrictionModel, dq_max: NDArray[np.float64]
+    friction: FrictionModel | FrictionSum, dq_max: NDArray[np.float64]
 ) -> tuple[CoulombViscous, tuple[str, ...]]:
     """A friction model as MuJoCo holds it, and what it drops (one line each)."""
     jt = joint_coulomb_viscous(friction, np.where(np.isfinite(dq_max), dq_max, 2.0))
@@ -90,7 +90,7 @@ def _law_terms(
 
 
 def _joint_terms(
-    robot: Robot, friction: bool | FrictionModel, drive: Drive | None
+    robot: Robot, friction: bool | FrictionModel | FrictionSum, drive: Drive | None
 ) -> tuple[CoulombViscous | None, NDArray[np.float64] | None, tuple[str, ...]]:
     """The friction written to the joints, the rotor ``armature`` and what MJCF cannot hold.
 
@@ -124,7 +124,7 @@ def _joint_terms(
 
 
 def _comment(
-    friction: bool | FrictionModel,
+    friction: bool | FrictionModel | FrictionSum,
     approx: CoulombViscous | None,
     armature: NDArray[np.float64] | None,
     notes: tuple[str, ...],
@@ -209,7 +209,7 @@ def _actuators(robot: Robot) -> list[str]:
 def mjcf_from_robot(
     robot: Robot,
     *,
-    friction: bool | FrictionModel = True,
+    friction: bool | FrictionModel | FrictionSum = True,
     comment: str | None = None,
     drive: Drive | None = None,
 ) -> tuple[str, CoulombViscous | None]:
@@ -269,7 +269,7 @@ def save_mjcf(
     path: str | Path,
     robot: Robot,
     *,
-    friction: bool | FrictionModel = True,
+    friction: bool | FrictionModel | FrictionSum = True,
     drive: Drive | None = None,
 ) -> Path:
     """Write :func:`mjcf_from_robot` to ``path``; returns the path."""
