@@ -6,15 +6,21 @@ terms' coefficients against those values, and a file (current and older layout) 
 
 from __future__ import annotations
 
+import dataclasses
+
 import numpy as np
 import pytest
 
 import dynid
 from dynid.exceptions import DataError
 from dynid.friction.model import ClassicalFriction, friction_of
+from dynid.identification.core import identify
+from dynid.identification.recordings import prepare_recordings
 from dynid.identification.selection import identify_recordings
 from dynid.identification.structure import Structure
 from dynid.io.model_json import model_from_dict, model_to_dict
+from dynid.model.drive import Drive
+from dynid.regressors.spring import JointSpring
 from dynid.regressors.terms import TERM_KINDS, LinearFriction, RotorInertia
 from dynid.simulation.measurement import SensorNoise, sample_times, simulate_measurement
 from dynid.simulation.trajectories import random_fourier
@@ -128,3 +134,39 @@ def test_a_term_whose_labels_disagree_with_its_definition_is_refused(model):
     d["terms"][1]["kind"] = "spring?"
     with pytest.raises(DataError, match="kind"):
         model_from_dict(d)
+
+
+def test_a_joint_spring_is_one_module_and_one_registry_line():
+    """The worked example of ARCHITECTURE.md: exact torques with a spring
+    ``k_j (q_j - q0_j)`` and viscous friction; the spring term identified with the links
+    gives the true stiffnesses, its torques are ``k (q - q0)``, and the file reads it back
+    by its kind."""
+    panda = dynid.panda()
+    k = np.array([2.0, 0.0, 1.5, 3.0, 0.5, 1.0, 0.25])  # N m/rad
+    q0 = np.array([0.1, -0.2, 0.0, -1.5, 0.0, 1.6, 0.7])  # rad
+    t = sample_times(3.0, 500.0)
+    logs = []
+    for s in (21, 22):
+        log = simulate_measurement(
+            panda,
+            random_fourier(panda, np.random.default_rng(s))(t),
+            rng=np.random.default_rng(s),
+            noise=SensorNoise.none(),
+            friction=ClassicalFriction(FV, np.zeros(7), np.zeros(7)),
+            with_ddq=True,
+        )
+        logs.append(dataclasses.replace(log, tau=log.tau + k * (log.q - q0)))
+    data = prepare_recordings(panda, logs, cutoff_hz=None)
+    spring = JointSpring(tuple(q0))
+    friction = LinearFriction(Drive.identity(7), parts=("viscous",))
+    model = identify(panda, data, terms=(spring, friction))
+    assert list(model.terms) == ["spring", "friction"] and "joint_spring" in TERM_KINDS
+    np.testing.assert_allclose(model.terms["spring"].values, k, atol=1e-6)
+    np.testing.assert_allclose(model.terms["friction"].values, FV, atol=1e-6)
+    q = np.random.default_rng(8).uniform(-1, 1, (4, 7))
+    np.testing.assert_allclose(model.terms["spring"].torques(q, q, q), k * (q - q0), atol=1e-6)
+    assert model.friction is not None  # the spring is not friction
+    back = model_from_dict(model_to_dict(model))
+    assert isinstance(back.terms["spring"].term, JointSpring)
+    np.testing.assert_array_equal(back.terms["spring"].term.q0, q0)
+    np.testing.assert_array_equal(back.terms["spring"].values, model.terms["spring"].values)

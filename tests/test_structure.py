@@ -381,7 +381,7 @@ def test_friction_of_a_coupled_drive_is_placed_where_the_data_say(panda, truth):
     sel = model.info.selection
     names = [c["name"] for c in sel["candidates"]]
     assert "links + viscous + at:joint" in names and "links + viscous + at:motor" in names
-    assert len(names) == 31  # 15 per placement, the model without friction once
+    assert len(names) == 35  # 15 per placement, 4 at both, the model without friction once
     assert sel["chosen"] == f"links + viscous + coulomb + at:{truth}", sel["chosen"]
     assert model.drive.friction_at == truth
     np.testing.assert_allclose(model.friction.params[:, :2], fr.as_array()[:, :2], atol=1e-7)

@@ -138,9 +138,10 @@ def register(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParser:
         default=None,
         metavar="TERMS",
         help="torque logs: the model's terms beside the links, comma-separated from armature, "
-        "viscous, quadratic, coulomb, smooth[:W], stribeck[:V], offset, at:motor|at:joint, "
-        "-LABEL ('links' for none; W the smooth Coulomb's width in standstill bands, V the "
-        "Stribeck velocity [rad/s]; at: where a coupled drive's friction acts; -fo3 leaves "
+        "viscous, quadratic, coulomb, smooth[:W], stribeck[:V], offset, "
+        "at:motor|at:joint|at:both, -LABEL ('links' for none; W the smooth Coulomb's width in "
+        "standstill bands, V the Stribeck velocity [rad/s]; at: where a coupled drive's "
+        "friction acts, both: at the motors and at the joints no motor turns alone; -fo3 leaves "
         "joint 3's offset out, -fc5 joint 5's Coulomb friction); default: chosen on held-out "
         "data (see Model structure above)",
     )

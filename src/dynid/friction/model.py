@@ -67,6 +67,7 @@ __all__ = [
     "classical_friction",
     "combined",
     "friction_parts",
+    "through_drive",
     "coulomb_sign",
     "friction_from_array",
     "friction_of",
@@ -251,6 +252,17 @@ def friction_parts(friction: Friction | FrictionSum | None) -> tuple[Friction, .
     if friction is None:
         return ()
     return friction.parts if isinstance(friction, FrictionSum) else (friction,)
+
+
+def through_drive(
+    friction: Friction | FrictionSum | None, drive: Drive
+) -> Friction | FrictionSum | None:
+    """``friction`` with its parts at the motors acting through ``drive`` (the same
+    transmission, its rotor inertias now known); the parts at the joints as they are."""
+    parts = tuple(p.at(drive) if p.at_motors else p for p in friction_parts(friction))
+    if not parts:
+        return None
+    return parts[0] if len(parts) == 1 else FrictionSum(parts)
 
 
 def combined(frictions: tuple[FrictionValues, ...]) -> Friction | FrictionSum | None:

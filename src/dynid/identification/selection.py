@@ -448,7 +448,8 @@ def _fit_largest(
         except RankDeficientError as exc:
             what = ("with" if arm else "without") + " armature"
             where = {c.at for c in group if c.at}
-            what += "".join(f", friction at the {at}s" for at in where)
+            place = {"both": "motors and the joints"}
+            what += "".join(f", friction at the {place.get(at, at + 's')}" for at in where)
             shaped = k == 0 and len(tries[1]) < len(group)
             notes.append(
                 (

@@ -34,6 +34,7 @@ from ..regressors.terms import (
 __all__ = [
     "ERROR_FLOOR_PERCENT",
     "FRICTION_LADDER",
+    "JOINT_PREFIX",
     "MIN_WIDTH",
     "SMOOTH_WIDTHS",
     "STRIBECK_VELOCITIES",
@@ -43,6 +44,7 @@ __all__ = [
     "check_placement",
     "coefficient_labels",
     "friction_placements",
+    "joint_side_joints",
     "largest_terms",
     "smooth_width",
     "structure_terms",
@@ -69,7 +71,9 @@ STRIBECK_VELOCITIES = (0.02, 0.05, 0.1, 0.2)
 MIN_WIDTH = 1e-3
 
 _CLASSICAL = ("viscous", "coulomb", "offset")
-_PLACEMENTS = ("", "motor", "joint")
+_PLACEMENTS = ("", "motor", "joint", "both")
+#: The prefix of the labels of the friction at the joints beside that at the motors.
+JOINT_PREFIX = "j"
 
 
 def _label_order(label: str) -> tuple[int, str]:
@@ -95,14 +99,19 @@ class Structure:
         With ``smooth``: its width in multiples of each joint's standstill band.
     vst : float
         With ``stribeck``: the Stribeck velocity [rad/s].
-    at : {"", "motor", "joint"}
+    at : {"", "motor", "joint", "both"}
         Where the friction acts: ``""`` where the drive says (the joints without a drive),
-        else at the drive's motors (``K^T f(K dq)``) or at the joints (``f(dq)``). The two
-        differ only through a coupled transmission (:func:`friction_placements`).
+        else at the drive's motors (``K^T f(K dq)``), at the joints (``f(dq)``), or
+        ``"both"``: at the motors and, with the same parts but the offset (the motors'
+        offsets ``K^T f_o`` span every constant torque already), at the joints that no
+        motor turns alone (:func:`joint_side_joints`; labels ``jfv7, ...``), a coupled
+        wrist with bearings on both sides. They differ only through a coupled transmission
+        (:func:`friction_placements`).
     drop : tuple of str
         Friction coefficients left out on single joints (motors), by label: ``"fo3"`` is
         joint 3 without an offset, ``"fc5"`` joint 5 without Coulomb friction (``fv``,
-        ``fq``, ``fc``, ``fsp``, ``fo``; 1-based); every other joint holds every part.
+        ``fq``, ``fc``, ``fsp``, ``fo``; 1-based; ``jfo7``: joint 7's offset at the joint
+        with ``at="both"``); every other joint holds every part.
     """
 
     armature: bool = False
@@ -114,7 +123,7 @@ class Structure:
 
     def __post_init__(self) -> None:
         if self.at not in _PLACEMENTS:
-            raise OptionError(f"--terms at:{self.at}: friction acts at 'motor' or 'joint'")
+            raise OptionError(f"--terms at:{self.at}: friction acts at 'motor', 'joint' or 'both'")
         bad = [p for p in self.friction if p not in FRICTION_PARTS]
         if bad:
             raise OptionError(
@@ -136,6 +145,8 @@ class Structure:
         if not parts:
             object.__setattr__(self, "at", "")
         held = {PART_LABELS[p] for p in parts}
+        if self.at == "both":
+            held |= {JOINT_PREFIX + PART_LABELS[p] for p in self.joint_parts}
         for lab in self.drop:
             prefix = lab.rstrip("0123456789")
             if prefix not in held:
@@ -181,13 +192,44 @@ class Structure:
         OptionError
             A coefficient of :attr:`drop` on a joint beyond ``n``.
         """
-        if not self.drop:
+        return self._mask(n, "", range(n), self.friction)
+
+    @property
+    def joint_parts(self) -> tuple[str, ...]:
+        """With ``at="both"``: the parts of the friction at the joints (all but the offset)."""
+        return tuple(p for p in self.friction if p != "offset")
+
+    def joint_mask(self, n: int, joints: Sequence[int]) -> tuple[bool, ...]:
+        """With ``at="both"``: which coefficients the friction at the joints holds, the
+        ``joints`` (0-based, :func:`joint_side_joints`) but :attr:`drop` (``jfc7``).
+
+        Raises
+        ------
+        OptionError
+            A coefficient of :attr:`drop` at the joints on a joint beyond ``n`` or on a
+            joint that has no friction at the joint.
+        """
+        parts = self.joint_parts
+        return self._mask(n, JOINT_PREFIX, joints, parts) or (True,) * (len(parts) * n)
+
+    def _mask(
+        self, n: int, prefix: str, joints: Sequence[int], parts: Sequence[str]
+    ) -> tuple[bool, ...]:
+        """The mask of the coefficients labelled ``prefix...`` on ``joints``, empty when
+        every one of the ``n`` joints holds every part."""
+        mine = [lab for lab in self.drop if lab.startswith(prefix + "f")]
+        if not mine and len(joints) == n:
             return ()
-        labels = [f"{PART_LABELS[p]}{j + 1}" for j in range(n) for p in self.friction]
-        beyond = [lab for lab in self.drop if lab not in labels]
+        every = [f"{prefix}{PART_LABELS[p]}{j + 1}" for j in range(n) for p in parts]
+        held = [f"{prefix}{PART_LABELS[p]}{j + 1}" for j in joints for p in parts]
+        beyond = [lab for lab in mine if lab not in held]
         if beyond:
-            raise OptionError(f"--terms -{beyond[0]}: the arm has {n} joints")
-        return tuple(lab not in self.drop for lab in labels)
+            where = " at the joints" if prefix else ""
+            raise OptionError(
+                f"--terms -{beyond[0]}: no such coefficient{where} (the arm has {n} joints"
+                + (f"; friction at the joints on {[j + 1 for j in joints]})" if prefix else ")")
+            )
+        return tuple(lab in held and lab not in mine for lab in every)
 
     @property
     def terms(self) -> tuple[str, ...]:
@@ -262,7 +304,17 @@ def friction_placements(drive: Drive | None) -> tuple[str, ...]:
         return ("",)
     K = np.asarray(drive.transmission)
     coupled = bool(np.any(K[~np.eye(drive.n, dtype=bool)] != 0))
-    return ("motor", "joint") if coupled else ("",)
+    return ("motor", "joint", "both") if coupled else ("",)
+
+
+def joint_side_joints(drive: Drive) -> tuple[int, ...]:
+    """The joints (0-based) that friction at the joints adds to friction at the motors:
+    those that no motor turns alone. A motor whose row of ``K`` is ``k e_j`` puts
+    ``k f(k dq_j)`` on joint ``j`` alone, the same columns as friction at joint ``j``, so
+    such a joint's friction at the joint would repeat them."""
+    K = np.asarray(drive.transmission)
+    alone = {int(np.flatnonzero(row)[0]) for row in K if np.count_nonzero(row) == 1}
+    return tuple(j for j in range(drive.n) if j not in alone)
 
 
 def check_placement(structure: Structure, drive: Drive | None) -> None:
@@ -291,12 +343,15 @@ def candidate_structures(
     and with offsets), the quadratic viscous law and the Stribeck law at each of
     :data:`STRIBECK_VELOCITIES` (with viscous friction, Coulomb friction and offsets),
     without and (``armature``) with the armature, the friction at each of ``placements``
-    (:func:`friction_placements`; the model without friction once)."""
+    (:func:`friction_placements`; the model without friction once; at ``"both"`` the
+    classical ladder alone)."""
     arms = (False, True) if armature else (False,)
     out = []
     for a in arms:
         for i, at in enumerate(placements):
             out += [Structure(a, f, at=at if f else "") for f in FRICTION_LADDER if f or not i]
+            if at == "both":
+                continue
             out += [
                 Structure(a, ("viscous", "smooth") + o, width=w, at=at)
                 for o in ((), ("offset",))
@@ -346,7 +401,32 @@ def structure_terms(
                 mask=structure.mask(n),
             )
         )
+        if structure.at == "both" and structure.joint_parts:
+            jt, jb = _at_joints(at, n, band, bands)
+            terms.append(
+                LinearFriction(
+                    jt,
+                    parts=structure.joint_parts,
+                    band=jb,
+                    width=smooth_width(jb, structure.width)
+                    if "smooth" in structure.friction
+                    else (),
+                    vst=structure.vst,
+                    name="joint friction",
+                    mask=structure.joint_mask(n, joint_side_joints(at)),
+                    prefix=JOINT_PREFIX,
+                )
+            )
     return model_drive, tuple(terms)
+
+
+def _at_joints(
+    at: Drive, n: int, band: Sequence[float], bands: Mapping[str, Sequence[float]] | None
+) -> tuple[Drive, tuple[float, ...]]:
+    """The drive of the friction at the joints beside that at the motors of ``at``, and
+    the standstill band at the joints."""
+    b = tuple((bands or {}).get("joint", band))
+    return replace(at, friction_at="joint"), b or (0.0,) * n
 
 
 def _rotor_terms(armature: bool, drive: Drive | None, n: int) -> tuple[Drive | None, list[Any]]:
@@ -376,6 +456,7 @@ def _placed(
     """The model's drive with its friction placed ``where``, the drive the friction term
     acts through, and the standstill band there."""
     at = Drive.identity(n) if model_drive is None else model_drive
+    where = "motor" if where == "both" else where  # the friction at the joints beside it
     if where and model_drive is not None and where != model_drive.friction_at:
         model_drive = at = replace(model_drive, friction_at=where)  # type: ignore[arg-type]
     b = tuple((bands or {}).get(str(at.friction_at), band))
@@ -405,6 +486,15 @@ def largest_terms(
     if classical:
         t = LinearFriction(at, parts=classical, band=b)
         out.append((t, ("classical", t.parts)))  # the parts in the term's column order
+    if classical and any(c.at == "both" for c in mine):
+        jt, jb = _at_joints(at, n, band, bands)
+        joints = joint_side_joints(at)
+        parts = tuple(p for p in classical if p != "offset")
+        mask = tuple(j in joints for j in range(n) for _ in parts)
+        t = LinearFriction(
+            jt, parts=parts, band=jb, name="joint friction", mask=mask, prefix=JOINT_PREFIX
+        )
+        out.append((t, ("classical", t.parts)))
     for w in sorted({c.width for c in mine if "smooth" in c.friction}):
         t = LinearFriction(
             at, ("smooth",), band=b, width=smooth_width(b, w), name=f"friction smooth {w:g}"
@@ -427,7 +517,8 @@ def candidate_columns(
             continue
         kind, shape = what
         if kind == "classical":
-            on = np.tile(np.array([p in structure.friction for p in shape]), n)
+            part = {PART_LABELS[p]: p for p in shape}
+            on = np.array([part[_stem(lab)] in structure.friction for lab in t.labels])
         elif kind == "smooth":
             on = np.full(len(t.labels), "smooth" in structure.friction and structure.width == shape)
         else:
@@ -436,6 +527,11 @@ def candidate_columns(
             on &= np.array([lab not in structure.drop for lab in t.labels])
         use.append(on)
     return np.concatenate(use)
+
+
+def _stem(label: str) -> str:
+    """``jfv7`` -> ``fv``: a friction label without its prefix and joint."""
+    return label.rstrip("0123456789").removeprefix(JOINT_PREFIX)
 
 
 def coefficient_labels(structure: Structure, n: int) -> tuple[str, ...]:

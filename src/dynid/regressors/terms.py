@@ -39,6 +39,7 @@ from numpy.typing import NDArray
 from ..exceptions import OptionError
 from ..model.drive import Drive
 from .friction_columns import smooth_sign, standstill_sign, stribeck_decay
+from .spring import JointSpring
 
 __all__ = [
     "FRICTION_PARTS",
@@ -490,6 +491,7 @@ TermReader = Callable[[str, Mapping[str, Any], Drive | None, int], ModelTerm]
 TERM_KINDS: dict[str, TermReader] = {
     "rotor_inertia": RotorInertia.from_definition,
     "linear_friction": LinearFriction.from_definition,
+    "joint_spring": JointSpring.from_definition,
 }
 
 

@@ -26,6 +26,7 @@ from dataclasses import replace
 from typing import Any, Literal
 
 from ...exceptions import OptionError, WrongTypeError
+from ...friction.model import through_drive
 from ...identification.classical import identify_from_log
 from ...identification.data import StaticDataset
 from ...identification.estimators import Estimator, EstimatorName
@@ -90,11 +91,12 @@ def retrieve_sdp(
 
 def with_drive(res: ConsistentResult, drive: Drive) -> ConsistentResult:
     """The result with its drive, whose rotor inertias are the identified ones (known from
-    then on: a simulator or a validation takes them as given)."""
+    then on: a simulator or a validation takes them as given), its friction at the motors
+    acting through it."""
     ia = res.rotor_inertia if drive.rotor_inertia is None else drive.rotor_inertia
-    if ia is None:
-        return dataclasses.replace(res, drive=drive)
-    return dataclasses.replace(res, drive=dataclasses.replace(drive, rotor_inertia=ia))
+    if ia is not None:
+        drive = dataclasses.replace(drive, rotor_inertia=ia)
+    return dataclasses.replace(res, drive=drive, friction=through_drive(res.friction, drive))
 
 
 def identify_consistent(

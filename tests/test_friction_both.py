@@ -1,0 +1,189 @@
+"""Friction at the motors and at the joints of a coupled drive at once (``at:both``).
+
+References: exact simulated torques of a Panda whose wrist is coupled (motor 7 turns with
+joints 6 and 7) and whose friction acts at its motors, ``K^T f_m(K dq)``, and at joint 7,
+``f_j(dq_7)`` (the joint no motor turns alone), with known coefficients; the model chosen on
+held-out data and its coefficients against those values.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import json
+import re
+
+import numpy as np
+import pytest
+
+import dynid
+from dynid.feasibility.convex.data_term import coefficient_term
+from dynid.feasibility.convex.fit import consistent_from_identified
+from dynid.friction.model import ClassicalFriction, FrictionSum, friction_of
+from dynid.friction.validation import own_friction
+from dynid.identification.selection import identify_recordings
+from dynid.identification.structure import Structure, joint_side_joints
+from dynid.io.feasible import load_feasible_linear_friction
+from dynid.io.feasible_bundle import save_feasible_bundle
+from dynid.io.model_json import model_from_dict, model_to_dict
+from dynid.model.drive import Drive
+from dynid.observer.model import from_identified
+from dynid.observer.residual import ObserverOptions, observe
+from dynid.simulation.measurement import SensorNoise, sample_times, simulate_measurement
+from dynid.simulation.trajectories import random_fourier
+
+FV = np.linspace(0.3, 0.1, 7)  # N m s/rad, at the motors
+FC = np.linspace(0.6, 0.2, 7)  # N m
+JFV, JFC = 0.15, 0.25  # joint 7's own bearing, at the joint
+
+
+def _drive() -> Drive:
+    return Drive.from_gears(np.ones(7), [(7, 6, 0.8)], rotor_inertia=np.zeros(7))
+
+
+def _logs(panda, joint_side: bool):
+    """Two exact recordings: classical friction at the motors, and (``joint_side``) viscous
+    and Coulomb friction at joint 7."""
+    drive = _drive()
+    motor = ClassicalFriction(FV, FC, np.zeros(7)).at(drive)
+    z = np.zeros(7)
+    joint = ClassicalFriction(z + np.eye(7)[6] * JFV, z + np.eye(7)[6] * JFC, z)
+    t = sample_times(4.0, 500.0)
+    logs = []
+    for s in (91, 92):
+        log = simulate_measurement(
+            panda,
+            random_fourier(panda, np.random.default_rng(s))(t),
+            rng=np.random.default_rng(s),
+            noise=SensorNoise.none(),
+            friction=motor,
+            drive=drive,
+            with_ddq=True,
+        )
+        if joint_side:
+            log = dataclasses.replace(log, tau=log.tau + joint.torques(log.dq))
+        logs.append(log)
+    return logs, motor, joint
+
+
+@pytest.fixture(scope="module")
+def panda():
+    return dynid.panda()
+
+
+@pytest.fixture(scope="module")
+def both(panda):
+    logs, motor, joint = _logs(panda, joint_side=True)
+    return identify_recordings(panda, logs, cutoff_hz=None, drive=_drive()), motor, joint
+
+
+def test_the_joints_no_motor_turns_alone_get_friction_at_the_joint():
+    """Motor 6 turns joint 6 alone (its friction at the motor is joint 6's at the joint);
+    motor 7 turns joints 6 and 7: only joint 7 gets friction at the joint."""
+    assert joint_side_joints(_drive()) == (6,)
+    diff = Drive(transmission=np.array([[1.0, 1.0], [1.0, -1.0]]), offset=np.zeros(2))
+    assert joint_side_joints(diff) == (0, 1)
+
+
+def test_friction_on_both_sides_is_chosen_and_comes_back(both):
+    """Exact data with friction at the motors and at joint 7: the default judges the three
+    placements and keeps both, the coefficients back to 1e-6."""
+    model, motor, joint = both
+    sel = model.info.selection
+    names = [c["name"] for c in sel["candidates"]]
+    assert "links + viscous + coulomb + at:both" in names
+    assert Structure.parse(sel["chosen"]).at == "both", sel["chosen"]
+    assert list(model.terms) == ["friction", "joint friction"]
+    m, j = model.terms["friction"], model.terms["joint friction"]
+    assert j.labels[:2] == ("jfv7", "jfc7") and not any(lab.startswith("jfo") for lab in j.labels)
+    np.testing.assert_allclose(m.friction.params[:, :2], motor.params[:, :2], atol=1e-6)
+    np.testing.assert_allclose(j.friction.params[6, :2], [JFV, JFC], atol=1e-6)
+    assert j.friction.drive is None and m.friction.drive is not None
+    assert model.fit.relative_error_percent < 1e-6
+    # every consumer takes both: the model's own friction is their sum
+    own = own_friction(model)
+    assert isinstance(own, FrictionSum) and len(own.parts) == 2
+    v = np.random.default_rng(5).uniform(-1, 1, (20, 7))
+    np.testing.assert_allclose(own.torques(v), motor.torques(v) + joint.torques(v), atol=1e-6)
+    np.testing.assert_allclose(
+        own.torques(v), friction_of(m.friction).torques(v) + friction_of(j.friction).torques(v)
+    )
+
+
+def test_both_frictions_are_written_and_read_back(both):
+    model, _, _ = both
+    d = model_to_dict(model)
+    assert d["friction"] is None and [t["name"] for t in d["terms"]] == list(model.terms)
+    back = model_from_dict(d)
+    for name, t in model.terms.items():
+        assert back.terms[name].labels == t.labels
+        np.testing.assert_array_equal(back.terms[name].values, t.values)
+    v = np.random.default_rng(6).uniform(-1, 1, (5, 7))
+    np.testing.assert_array_equal(own_friction(back).torques(v), own_friction(model).torques(v))
+
+
+def test_the_consistent_fit_keeps_both_dissipative(both):
+    """The data term of the consistent fit holds both terms' coefficients and keeps every
+    viscous and Coulomb coefficient ``>= 0``."""
+    model, _, _ = both
+    term = coefficient_term(model, with_friction=True)
+    labels = term.labels[term.r :]
+    assert labels == model.terms["friction"].labels + ("jfv7", "jfc7")
+    assert labels[:4] == ("fv1", "fc1", "fv2", "fc2") and term.nonnegative().all()
+    fr = term.frictions(term.x_hat[term.r :])
+    assert [f.drive is None for f in fr] == [False, True]
+
+
+def test_motor_friction_alone_does_not_choose_both(panda):
+    """Exact data with friction at the motors only: the friction at the joints adds nothing
+    within one standard error, and the simpler placement is kept."""
+    logs, motor, _ = _logs(panda, joint_side=False)
+    model = identify_recordings(panda, logs, cutoff_hz=None, drive=_drive())
+    chosen = Structure.parse(model.info.selection["chosen"])
+    assert chosen.at == "motor", model.info.selection["chosen"]
+    assert list(model.terms) == ["friction"]
+    np.testing.assert_allclose(model.friction.params[:, :2], motor.params[:, :2], atol=1e-6)
+
+
+def test_the_consistent_result_holds_both_and_exports_them(panda, tmp_path):
+    """The one-step consistent fit of exact data with friction on both sides: its friction
+    is the sum of both (the truth, to round-off), feasible.json holds the part at the joints
+    as ``joint_friction`` and reads back the same sum, and URDF and MJCF add both to each
+    joint's damping and dry friction."""
+    logs, motor, joint = _logs(panda, joint_side=True)
+    terms = Structure.parse("viscous, coulomb, offset, at:both")
+    model = identify_recordings(panda, logs, cutoff_hz=None, drive=_drive(), structure=terms)
+    res = consistent_from_identified(panda, model, prior=panda)
+    assert isinstance(res.friction, FrictionSum) and res.feasible
+    v = np.random.default_rng(7).uniform(-1, 1, (20, 7))
+    np.testing.assert_allclose(
+        res.friction.torques(v), motor.torques(v) + joint.torques(v), atol=1e-6
+    )
+    files = save_feasible_bundle(tmp_path, res)
+    doc = json.loads((tmp_path / "feasible.json").read_text())
+    np.testing.assert_allclose(doc["joint_friction"]["fv"], np.eye(7)[6] * JFV, atol=1e-6)
+    back = load_feasible_linear_friction(tmp_path / "feasible.json")
+    np.testing.assert_allclose(back.torques(v), res.friction.torques(v), atol=1e-12)
+    urdf = next(p for p in files if p.suffix == ".urdf").read_text()
+    # diag(K^T diag(fv) K) of the motors plus the joint's own: joint 6 feels motor 7 too
+    assert _damping(urdf, 5) == pytest.approx(FV[5] + 0.8**2 * FV[6], abs=1e-6)
+    assert _damping(urdf, 6) == pytest.approx(FV[6] + JFV, abs=1e-6)
+
+
+def _damping(urdf: str, j: int) -> float:
+    """The ``damping`` of the ``j``-th ``<dynamics>`` of a URDF text (0-based)."""
+    return float(re.findall(r'<dynamics damping="([^"]+)"', urdf)[j])
+
+
+def test_the_observer_takes_both(both, panda):
+    """The momentum observer of the model (its friction the sum, evaluated in Python) sees
+    no external torque on exact data of the truth; with the motors' friction alone it sees
+    the joint's own friction."""
+    model, _, _ = both
+    log = _logs(panda, joint_side=True)[0][0]
+    obs = from_identified(model)
+    assert isinstance(obs.friction, FrictionSum)
+    opts = ObserverOptions(gain=40.0)
+    r = observe(obs, log.t, log.q, log.dq, log.tau, opts).r[200:]
+    motor_only = obs.with_friction(friction_of(model.terms["friction"].friction))
+    r_motor = observe(motor_only, log.t, log.q, log.dq, log.tau, opts).r[200:]
+    assert np.abs(r).max() < 1e-3 < 0.1 < np.abs(r_motor[:, 6]).max()
