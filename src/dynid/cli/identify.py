@@ -142,7 +142,8 @@ def register(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParser:
         "at:motor|at:joint|at:both, -LABEL ('links' for none; W the smooth Coulomb's width in "
         "standstill bands, V the Stribeck velocity [rad/s]; at: where a coupled drive's "
         "friction acts, both: at the motors and at the joints no motor turns alone; -fo3 leaves "
-        "joint 3's offset out, -fc5 joint 5's Coulomb friction); default: chosen on held-out "
+        "joint 3's offset out, -fc5 joint 5's Coulomb friction, -Ia2 joint 2's armature); "
+        "default: chosen on held-out "
         "data (see Model structure above)",
     )
     add_column_options(p)

@@ -15,16 +15,27 @@ transmission, the identity at the joints); joints without a limit are not checke
 
 from __future__ import annotations
 
+import warnings
 from collections.abc import Sequence
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 from numpy.typing import NDArray
 
+from ..exceptions import DynidWarning
 from ..regressors.friction_columns import smooth_sign, standstill_sign, stribeck_decay
-from ..regressors.terms import PART_LABELS, LinearFriction
+from ..regressors.terms import PART_LABELS, LinearFriction, ModelTerm
 
-__all__ = ["GRID", "SIGNIFICANCE", "friction_violations"]
+if TYPE_CHECKING:
+    from .model import IdentifiedModel
+
+__all__ = [
+    "GRID",
+    "SIGNIFICANCE",
+    "friction_columns",
+    "friction_violations",
+    "warn_unphysical",
+]
 
 #: Velocities checked per joint (motor), evenly over ``[-v_max, v_max]``.
 GRID = 401
@@ -121,3 +132,40 @@ def friction_violations(
             f"limit {vmax[j]:.3g} rad/s)"
         )
     return tuple(out)
+
+
+def friction_columns(
+    terms: Sequence[tuple[ModelTerm, Any]] | Sequence[ModelTerm], r: int
+) -> list[tuple[LinearFriction, slice]]:
+    """The friction terms among ``terms`` (those not in the base, appended after the
+    ``r`` base parameters in order) with their columns."""
+    out, k = [], r
+    for item in terms:
+        t = item[0] if isinstance(item, tuple) else item
+        if t.in_base:
+            continue
+        m = len(t.labels)
+        if isinstance(t, LinearFriction):
+            out.append((t, slice(k, k + m)))
+        k += m
+    return out
+
+
+def warn_unphysical(model: IdentifiedModel, terms: Sequence[ModelTerm]) -> None:
+    """A warning, one line per joint (motor), where the identified friction is not
+    dissipative within the robot's velocity limits."""
+    fit = model.joint_fit
+    if fit is None:
+        return
+    beta = np.where(np.asarray(fit.kept, dtype=bool), np.asarray(fit.beta, dtype=float), 0.0)
+    sd = np.nan_to_num(np.asarray(fit.std, dtype=float))
+    columns = friction_columns(terms, model.base.rank)
+    terms_x = [(t, beta[sl]) for t, sl in columns]
+    for line in friction_violations(terms_x, model.robot.dq_max, [sd[sl] for _, sl in columns]):
+        warnings.warn(
+            f"identified friction not dissipative within the velocity limits: {line}; "
+            "the friction pushes the arm there (--terms without that part, or with "
+            "the part left out on that joint: -LABEL)",
+            DynidWarning,
+            stacklevel=3,
+        )

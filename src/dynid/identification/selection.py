@@ -38,7 +38,7 @@ from numpy.typing import NDArray
 from ..exceptions import DynidWarning, OptionError, RankDeficientError
 from ..model.drive import Drive
 from ..model.robot import Robot
-from ..regressors.terms import LinearFriction, ModelTerm
+from ..regressors.terms import ModelTerm
 from .candidates import (
     OUTLIER_RATIO,
     Candidate,
@@ -49,7 +49,7 @@ from .candidates import (
     without_recordings,
 )
 from .core import Judge, ModelColumns, RegressorStack, StreamedRows, identify, selected_columns
-from .dissipation import friction_violations
+from .dissipation import friction_columns, friction_violations, warn_unphysical
 from .estimators import Estimator, EstimatorName, estimator_named, row_weights
 from .holdout import DEFAULT_FOLDS, HeldOut, Normals, block_normals
 from .least_squares import StdMethod
@@ -66,6 +66,7 @@ from .structure import (
     coefficient_labels,
     friction_placements,
     largest_terms,
+    own_rotors,
     structure_terms,
 )
 
@@ -230,7 +231,7 @@ def select_structure(
             return None
         groups[(arm, at)] = (model, terms)
         for c in mine:
-            use = candidate_columns(c, model.base.rank, terms, robot.n)
+            use = candidate_columns(c, model, terms)
             columns.append((c, use, (arm, at)))
             judged.append(_judged(c, use, model, terms, model.holdout, fit_rtol))
     if not judged:
@@ -325,7 +326,7 @@ def _judged(
     """``structure`` judged (:func:`~.candidates.candidate_judged`), its friction fitted
     on all data checked for dissipation within the robot's velocity limits."""
     assert held is not None  # models of the candidates are judged on held-out data
-    columns = _friction_columns(terms, model.base.rank)
+    columns = friction_columns(terms, model.base.rank)
     dq_max = model.robot.dq_max
 
     def check(x: NDArray[np.float64], sd: NDArray[np.float64]) -> tuple[str, ...]:
@@ -334,23 +335,6 @@ def _judged(
         )
 
     return candidate_judged(structure, use, model, held, rtol, check)
-
-
-def _friction_columns(
-    terms: Sequence[tuple[ModelTerm, Any]] | Sequence[ModelTerm], r: int
-) -> list[tuple[LinearFriction, slice]]:
-    """The friction terms among ``terms`` (those not in the base, appended after the
-    ``r`` base parameters in order) with their columns."""
-    out, k = [], r
-    for item in terms:
-        t = item[0] if isinstance(item, tuple) else item
-        if t.in_base:
-            continue
-        m = len(t.labels)
-        if isinstance(t, LinearFriction):
-            out.append((t, slice(k, k + m)))
-        k += m
-    return out
 
 
 def _per_recording(
@@ -366,7 +350,7 @@ def _per_recording(
     here = next((c for c in judged if c.structure == chosen), None)
     if here is None:  # a per-joint structure: judged again on every recording
         m, t = groups[(chosen.armature, chosen.at)]
-        use = candidate_columns(chosen, m.base.rank, t, n)
+        use = candidate_columns(chosen, m, t)
         here = _judged(chosen, use, m, t, heldout_of(m), rtol)
     return tuple(zip(names, here.fold_errors_percent, strict=True))
 
@@ -378,25 +362,26 @@ def _per_joint(
     rtol: float,
 ) -> list[Candidate]:
     """Per-joint structures: from the candidate with the lowest held-out error and from
-    the one chosen, friction coefficients of single joints left out one at a time (the one
-    whose absence the held-out data miss least first) while the held-out error stays
-    within one standard error of the lowest; the candidates reached, when they hold
-    fewer coefficients than where they started."""
+    the one chosen, friction coefficients and armatures (rotors that are base parameters
+    of their own) of single joints left out one at a time (the one whose absence the
+    held-out data miss least first) while the held-out error stays within one standard
+    error of the lowest; the candidates reached, when they hold fewer coefficients than
+    where they started."""
     best = min(_physical(judged), key=lambda c: c.heldout_error_percent)
     limit = best.heldout_error_percent + max(best.heldout_se_percent, ERROR_FLOOR_PERCENT)
     out: list[Candidate] = []
     for start in dict.fromkeys((best.structure, _chosen(judged))):
-        if not start.friction:
+        if not start.friction and not start.armature:
             continue
         model, terms, held = groups[(start.armature, start.at)]
-        r = model.base.rank
+        rotors = tuple(own_rotors(model.base, n))
         here = next(c for c in judged if c.structure == start)
         while True:
             trials = [
-                _judged(s, candidate_columns(s, r, terms, n), model, terms, held, rtol)
+                _judged(s, candidate_columns(s, model, terms), model, terms, held, rtol)
                 for s in (
                     replace(here.structure, drop=here.structure.drop + (lab,))
-                    for lab in coefficient_labels(here.structure, n)
+                    for lab in coefficient_labels(here.structure, n, rotors)
                 )
             ]
             trials = [c for c in trials if not c.unphysical or here.unphysical]
@@ -577,30 +562,10 @@ def identify_recordings(
         judge=judge,
         fold_labels=fold_labels,
     )
-    _warn_unphysical(model, terms)
+    warn_unphysical(model, terms)
     info = replace(
         model.info,
         selection=None if selection is None else selection.as_dict(),
         extra={**model.info.extra, "terms": list(structure.terms)},
     )
     return replace(model, info=info)
-
-
-def _warn_unphysical(model: IdentifiedModel, terms: Sequence[ModelTerm]) -> None:
-    """A warning, one line per joint (motor), where the identified friction is not
-    dissipative within the robot's velocity limits."""
-    fit = model.joint_fit
-    if fit is None:
-        return
-    beta = np.where(np.asarray(fit.kept, dtype=bool), np.asarray(fit.beta, dtype=float), 0.0)
-    sd = np.nan_to_num(np.asarray(fit.std, dtype=float))
-    columns = _friction_columns(terms, model.base.rank)
-    terms_x = [(t, beta[sl]) for t, sl in columns]
-    for line in friction_violations(terms_x, model.robot.dq_max, [sd[sl] for _, sl in columns]):
-        warnings.warn(
-            f"identified friction not dissipative within the velocity limits: {line}; "
-            "the friction pushes the arm there (--terms without that part, or with "
-            "the part left out on that joint: -LABEL)",
-            DynidWarning,
-            stacklevel=3,
-        )

@@ -45,6 +45,7 @@ __all__ = [
     "coefficient_labels",
     "friction_placements",
     "joint_side_joints",
+    "own_rotors",
     "largest_terms",
     "smooth_width",
     "structure_terms",
@@ -74,6 +75,8 @@ _CLASSICAL = ("viscous", "coulomb", "offset")
 _PLACEMENTS = ("", "motor", "joint", "both")
 #: The prefix of the labels of the friction at the joints beside that at the motors.
 JOINT_PREFIX = "j"
+#: The label of a joint's armature (rotor inertia): ``Ia3``.
+ARMATURE_LABEL = "Ia"
 
 
 def _label_order(label: str) -> tuple[int, str]:
@@ -108,10 +111,11 @@ class Structure:
         wrist with bearings on both sides. They differ only through a coupled transmission
         (:func:`friction_placements`).
     drop : tuple of str
-        Friction coefficients left out on single joints (motors), by label: ``"fo3"`` is
-        joint 3 without an offset, ``"fc5"`` joint 5 without Coulomb friction (``fv``,
-        ``fq``, ``fc``, ``fsp``, ``fo``; 1-based; ``jfo7``: joint 7's offset at the joint
-        with ``at="both"``); every other joint holds every part.
+        Coefficients left out on single joints (motors), by label: ``"fo3"`` is joint 3
+        without an offset, ``"fc5"`` joint 5 without Coulomb friction (``fv``, ``fq``,
+        ``fc``, ``fsp``, ``fo``; 1-based; ``jfc7``: joint 7's Coulomb friction at the joint
+        with ``at="both"``), ``"Ia3"`` (or ``ia3``) joint 3 (motor 3) without armature;
+        every other joint holds every term.
     """
 
     armature: bool = False
@@ -147,6 +151,10 @@ class Structure:
         held = {PART_LABELS[p] for p in parts}
         if self.at == "both":
             held |= {JOINT_PREFIX + PART_LABELS[p] for p in self.joint_parts}
+        if self.armature:
+            held.add(ARMATURE_LABEL)
+        drops = [ARMATURE_LABEL + d[2:] if d.lower().startswith("ia") else d for d in self.drop]
+        object.__setattr__(self, "drop", tuple(drops))
         for lab in self.drop:
             prefix = lab.rstrip("0123456789")
             if prefix not in held:
@@ -157,7 +165,7 @@ class Structure:
                         f"terms given ({', '.join(sorted(held))}); e.g. -{some}3 leaves out "
                         f"joint 3's {some}"
                         if held
-                        else "terms given: they hold no friction"
+                        else "terms given: they hold no friction and no armature"
                     )
                 )
             if prefix == lab or not int(lab[len(prefix) :]) >= 1:
@@ -172,16 +180,39 @@ class Structure:
         one of ``n`` joints removed from :attr:`friction` (``viscous + offset - fo1 - fo2``
         on two joints is ``viscous``); Coulomb friction stays with a Stribeck part."""
         drop, parts = set(self.drop), list(self.friction)
-        for p in self.friction:
+        for p in reversed(self.friction):  # a Stribeck part before the Coulomb it goes with
             labels = {f"{PART_LABELS[p]}{j + 1}" for j in range(n)}
             if labels <= drop and not (p == "coulomb" and "stribeck" in parts):
                 parts.remove(p)
                 drop -= labels
-        if len(parts) == len(self.friction):
+        rotors = {f"{ARMATURE_LABEL}{j + 1}" for j in range(n)}
+        armature = self.armature and not rotors <= drop
+        drop -= set() if armature else rotors
+        if len(parts) == len(self.friction) and armature == self.armature:
             return self
         width = self.width if "smooth" in parts else 0.0
         vst = self.vst if "stribeck" in parts else 0.0
-        return replace(self, friction=tuple(parts), drop=tuple(drop), width=width, vst=vst)
+        return replace(
+            self, armature=armature, friction=tuple(parts), drop=tuple(drop), width=width, vst=vst
+        )
+
+    def armature_mask(self, n: int) -> tuple[bool, ...]:
+        """Which of the ``n`` rotor inertias the armature holds: all but :attr:`drop`
+        (``Ia3``); empty when every one is.
+
+        Raises
+        ------
+        OptionError
+            A rotor of :attr:`drop` beyond ``n``.
+        """
+        mine = [lab for lab in self.drop if lab.startswith(ARMATURE_LABEL)]
+        if not mine:
+            return ()
+        every = [f"{ARMATURE_LABEL}{j + 1}" for j in range(n)]
+        beyond = [lab for lab in mine if lab not in every]
+        if beyond:
+            raise OptionError(f"--terms -{beyond[0]}: the arm has {n} joints")
+        return tuple(lab not in mine for lab in every)
 
     def mask(self, n: int) -> tuple[bool, ...]:
         """Which of the ``len(friction) n`` coefficients (joint by joint, the parts in
@@ -388,7 +419,7 @@ def structure_terms(
     OptionError
         An armature asked of a drive whose rotor inertias are known (given in its file).
     """
-    model_drive, terms = _rotor_terms(structure.armature, drive, n)
+    model_drive, terms = _rotor_terms(structure.armature, drive, n, structure.armature_mask(n))
     if structure.friction:
         model_drive, at, b = _placed(structure.at, model_drive, n, band, bands)
         terms.append(
@@ -429,15 +460,18 @@ def _at_joints(
     return replace(at, friction_at="joint"), b or (0.0,) * n
 
 
-def _rotor_terms(armature: bool, drive: Drive | None, n: int) -> tuple[Drive | None, list[Any]]:
-    """The model's drive and its rotor term (an armature without a drive: ``K = 1``)."""
+def _rotor_terms(
+    armature: bool, drive: Drive | None, n: int, mask: tuple[bool, ...] = ()
+) -> tuple[Drive | None, list[Any]]:
+    """The model's drive and its rotor term (an armature without a drive: ``K = 1``), the
+    rotors of ``mask`` (default all)."""
     model_drive = drive
     if armature and drive is None:
         model_drive = Drive.identity(n)
     terms: list[ModelTerm] = []
     if model_drive is not None and model_drive.identifies_rotor_inertia:
         if armature:
-            terms.append(RotorInertia(model_drive))
+            terms.append(RotorInertia(model_drive, mask=mask))
     elif armature:
         raise OptionError(
             "the armature term identifies the rotor inertias, which the drive file gives; "
@@ -506,12 +540,15 @@ def largest_terms(
     return model_drive, out
 
 
-def candidate_columns(
-    structure: Structure, r: int, terms: list[tuple[ModelTerm, Any]], n: int
-) -> Any:
+def candidate_columns(structure: Structure, model: Any, terms: list[tuple[ModelTerm, Any]]) -> Any:
     """The columns (bool, over the base parameters and every appended term) of one
-    candidate among the terms of :func:`largest_terms`."""
-    use = [np.ones(r, dtype=bool)]
+    candidate among the terms of :func:`largest_terms` of ``model`` (an identified model
+    over them): the base parameters but the armature's rotors that :attr:`Structure.drop`
+    leaves out (:func:`own_rotors`), the appended terms' columns the structure holds."""
+    rotors = own_rotors(model.base, model.robot.n)
+    base = np.ones(model.base.rank, dtype=bool)
+    base[[rotors[lab] for lab in structure.drop if lab in rotors]] = False
+    use = [base]
     for t, what in terms:
         if t.in_base or what is None:
             continue
@@ -529,14 +566,29 @@ def candidate_columns(
     return np.concatenate(use)
 
 
+def own_rotors(base: Any, n_links: int) -> dict[str, int]:
+    """The armature's rotors that are base parameters of their own (``beta_k = Ia_j``, not
+    regrouped with a link's ``Jzz``): label to base column. Only those a candidate can
+    leave out."""
+    p = 10 * n_links
+    K_d = np.asarray(base.K_d)
+    out = {}
+    for k, idx in enumerate(np.asarray(base.independent)):
+        if idx >= p and not np.any(K_d[k]):
+            out[str(base.std_labels[idx])] = k
+    return out
+
+
 def _stem(label: str) -> str:
     """``jfv7`` -> ``fv``: a friction label without its prefix and joint."""
     return label.rstrip("0123456789").removeprefix(JOINT_PREFIX)
 
 
-def coefficient_labels(structure: Structure, n: int) -> tuple[str, ...]:
-    """The labels of the friction coefficients ``structure`` holds on ``n`` joints
-    (motors), joint by joint: ``fv1, fc1, fv2, ...``, those of :attr:`Structure.drop`
+def coefficient_labels(structure: Structure, n: int, rotors: Sequence[str] = ()) -> tuple[str, ...]:
+    """The labels of the coefficients ``structure`` holds on ``n`` joints (motors) that a
+    per-joint structure may leave out, joint by joint: ``fv1, fc1, fv2, ...`` and, with the
+    armature, its ``rotors`` (:func:`own_rotors`: ``Ia3``), those of :attr:`Structure.drop`
     left out."""
     every = [f"{PART_LABELS[p]}{j + 1}" for j in range(n) for p in structure.friction]
+    every += list(rotors) if structure.armature else []
     return tuple(lab for lab in every if lab not in structure.drop)

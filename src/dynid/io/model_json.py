@@ -58,15 +58,21 @@ import numpy as np
 from numpy.typing import NDArray
 
 from .. import __version__, _checks
-from ..exceptions import DynidError
 from ..identification.info import IdentificationInfo, LogInfo, StaticInfo
 from ..identification.least_squares import LeastSquaresFit
-from ..identification.model import IdentifiedModel, IdentifiedTerm
+from ..identification.model import IdentifiedModel
 from ..model.drive import Drive
 from ..regressors.base import BaseParameters
-from ..regressors.terms import FRICTION_PARTS, TERM_KINDS, LinearFriction, term_from_definition
 from .drive_file import drive_from_record
 from .json_files import finite_or_none, load_json
+from .model_terms import (
+    FRICTION_LAWS,
+    TERM_RECORD,
+    friction_metadata,
+    older_terms,
+    terms_from_list,
+    terms_to_list,
+)
 from .robot_json import ROBOT_RECORD, robot_from_dict, robot_to_dict
 from .schema import Field, Format, Record, check, fault, save_document
 
@@ -153,23 +159,12 @@ def model_to_dict(model: IdentifiedModel, *, seed: int | None = None) -> dict[st
         "rtol": base.rtol,
         "gap": None if base.gap is None else list(base.gap),
     }
-    out["terms"] = [
-        {
-            "name": t.term.name,
-            "kind": t.term.kind,
-            "definition": _jsonable(t.term.definition()),
-            "labels": list(t.labels),
-            "values": [float(x) for x in t.values],
-            "std": [finite_or_none(x) for x in t.std],
-            "kept": [bool(x) for x in t.kept],
-        }
-        for t in model.terms.values()
-    ]
+    out["terms"] = terms_to_list(model)
     frictions = model.frictions
     out["friction"] = frictions[0].params.tolist() if len(frictions) == 1 else None
     out["drive"] = None if model.drive is None else model.drive.as_dict()
     out["robot"] = robot_to_dict(model.robot)
-    out["metadata"] = info_to_dict(info, model.drive) | _friction_metadata(model)
+    out["metadata"] = info_to_dict(info, model.drive) | friction_metadata(model)
     out["units"] = {
         "value": "SI of each expression: m kg, mc kg m, J kg m^2",
         "std": "as value",
@@ -195,27 +190,6 @@ _DERIVED_KEYS = (
     "scaled_condition_number",
     "relative_error_percent",
 )
-
-
-def _friction_metadata(model: IdentifiedModel) -> dict[str, Any]:
-    """The ``metadata`` keys of the appended terms' coefficients that earlier files wrote:
-    ``friction_labels``, ``friction_std``, ``friction_kept``, and with one friction term its
-    ``friction_band`` and ``friction_law``."""
-    app = model.appended
-    if not app:
-        return {}
-    out: dict[str, Any] = {
-        "friction_labels": [lab for t in app for lab in t.labels],
-        "friction_std": [finite_or_none(x) for t in app for x in t.std],
-        "friction_kept": [bool(x) for t in app for x in t.kept],
-    }
-    fr = model.frictions
-    if len(fr) == 1:
-        if np.any(fr[0].band):
-            out["friction_band"] = [float(x) for x in fr[0].band]
-        if fr[0].law != "classical":
-            out["friction_law"] = fr[0].law
-    return out
 
 
 def info_to_dict(info: IdentificationInfo, drive: Drive | None = None) -> dict[str, Any]:
@@ -368,24 +342,12 @@ _BASE = Record(
         "gap": Field("numbers", nullable=True, shape=(2,)),
     }
 )
-_FRICTION_LAWS = {"classical": 3, "smooth": 3, "quadratic": 4, "stribeck": 5}
-_TERM = Record(
-    {
-        "name": Field("string", required=True),
-        "kind": Field("string", required=True, choices=tuple(TERM_KINDS)),
-        "definition": Field("object", required=True),
-        "labels": Field("strings", required=True),
-        "values": Field("numbers", required=True),
-        "std": Field("numbers", required=True, null_items=True),
-        "kept": Field("bools", required=True),
-    }
-)
 #: the typed keys of ``metadata`` (others are kept as they are)
 _META = Record(
     {
         "route": Field("string", nullable=True, choices=("static", "classical")),
         "std_estimator": Field("string", nullable=True, choices=("classical", "robust")),
-        "friction_law": Field("string", choices=tuple(_FRICTION_LAWS)),
+        "friction_law": Field("string", choices=tuple(FRICTION_LAWS)),
         "friction_std": Field("numbers", null_items=True),
         "friction_band": Field("numbers", null_items=True),
         "friction_kept": Field("bools"),
@@ -416,7 +378,7 @@ MODEL = Format(
             "coefficients": Field("objects", required=True, record=_COEFFICIENT),
             "covariance": Field("numbers", nullable=True, shape=(None, None)),
             "base": Field("object", required=True, record=_BASE),
-            "terms": Field("objects", record=_TERM),
+            "terms": Field("objects", record=TERM_RECORD),
             "friction": Field("numbers", nullable=True, shape=("n", None)),
             "drive": Field("object", nullable=True),
             "metadata": Field("object", nullable=True, record=_META),
@@ -453,9 +415,13 @@ def model_from_dict(d: Mapping[str, Any], *, source: str = "identified model") -
     drive = d.get("drive")
     if drive is not None:
         drive = drive_from_record(drive, robot.n, source=source, at="drive")
-    p = 10 * robot.n
-    if drive is not None and drive.identifies_rotor_inertia:
-        p += robot.n
+    metadata = d.get("metadata") or {}
+    if d.get("terms") is not None:
+        terms = terms_from_list(d["terms"], drive, robot.n, source)
+        p = 10 * robot.n + sum(len(t.labels) for t in terms.values() if t.term.in_base)
+    else:
+        terms = older_terms(d.get("friction"), metadata, drive, robot.n, source)
+        p = 10 * robot.n + (robot.n if drive is not None and drive.identifies_rotor_inertia else 0)
     independent, dependent, K_d = _base_indices(b, r, p, source)
     if len(b["std_labels"]) != p:
         rotor = " with the rotor inertias" if p > 10 * robot.n else ""
@@ -490,85 +456,8 @@ def model_from_dict(d: Mapping[str, Any], *, source: str = "identified model") -
         covariance=_covariance(d.get("covariance"), r, source),
         scaled_condition_number=_float(d.get("scaled_condition_number")),
     )
-    metadata = d.get("metadata") or {}
-    if d.get("terms") is not None:
-        terms = _terms(d["terms"], drive, robot.n, source)
-    else:
-        terms = _older_terms(d.get("friction"), metadata, drive, robot.n, source)
     info = info_from_dict(metadata, source=source)
     return IdentifiedModel(robot=robot, base=base, fit=fit, terms=terms, info=info, drive=drive)
-
-
-def _terms(
-    records: list[Mapping[str, Any]], drive: Drive | None, n: int, source: str
-) -> dict[str, IdentifiedTerm]:
-    """The ``terms`` of a file, each rebuilt by its kind (:data:`~dynid.regressors.terms.
-    TERM_KINDS`) and checked against its labels."""
-    out = {}
-    for k, rec in enumerate(records):
-        at = f"terms[{k}]"
-        try:
-            term = term_from_definition(rec["kind"], rec["name"], rec["definition"], drive, n)
-        except (DynidError, TypeError, ValueError, KeyError) as exc:
-            raise fault(source, f"{at}.definition", f"malformed ({exc})") from exc
-        if tuple(rec["labels"]) != term.labels:
-            want = f"the labels of its definition {list(term.labels)}"
-            raise fault(
-                source, f"{at}.labels", f"expected {want}; got {_checks.short(rec['labels'])}"
-            )
-        p = len(term.labels)
-        for key in ("values", "std", "kept"):
-            if len(rec[key]) != p:
-                raise fault(
-                    source, f"{at}.{key}", f"expected {p} entries (labels); got {len(rec[key])}"
-                )
-        std = np.array([_float(x) for x in rec["std"]])
-        out[term.name] = IdentifiedTerm(
-            term, np.array(rec["values"], float), std, np.array(rec["kept"], bool)
-        )
-    return out
-
-
-def _older_terms(
-    friction: Any, metadata: Mapping[str, Any], drive: Drive | None, n: int, source: str
-) -> dict[str, IdentifiedTerm]:
-    """The friction term of a file without ``terms``: its law's parameters (n, k) in
-    ``friction`` and its coefficients' labels, std and kept flags in ``metadata``."""
-    if friction is None:
-        return {}
-    law = metadata.get("friction_law", "classical")
-    k = _FRICTION_LAWS[law]
-    if any(len(row) != k for row in friction):
-        want = f"null or {n} rows of the {law} law's {k} parameters"
-        raise fault(source, "friction", f"expected {want}; got {_checks.short(friction)}")
-    P = np.array(friction, dtype=np.float64).reshape(n, k)
-    labels = [str(x) for x in metadata.get("friction_labels") or ()]
-    if not labels:
-        labels = [f"{c}{j + 1}" for j in range(n) for c in ("fv", "fc", "fo")]
-    part = {"fv": "viscous", "fc": "smooth" if law == "smooth" else "coulomb"}
-    part |= {"fq": "quadratic", "fsp": "stribeck", "fo": "offset"}
-    try:
-        held = [(part[lab.rstrip("0123456789")], int(lab.lstrip("fvcqspo")) - 1) for lab in labels]
-    except (KeyError, ValueError) as exc:
-        raise fault(source, "metadata.friction_labels", f"malformed ({exc})") from exc
-    parts = tuple(p for p in FRICTION_PARTS if any(h[0] == p for h in held))
-    mask = tuple((p, j) in held for j in range(n) for p in parts)
-    band = tuple(_float(x) for x in metadata.get("friction_band") or ())
-    at = Drive.identity(n) if drive is None else drive
-    term = LinearFriction(
-        at,
-        parts=parts,
-        band=() if law == "smooth" else band,
-        width=band if law == "smooth" else (),
-        vst=float(np.max(P[:, 3])) if law == "stribeck" else 0.0,
-        mask=() if all(mask) else mask,
-    )
-    p = len(term.labels)
-    std = [_float(x) for x in metadata.get("friction_std") or ()] or [np.nan] * p
-    kept = [bool(x) for x in metadata.get("friction_kept") or ()] or [True] * p
-    if len(std) != p or len(kept) != p:
-        raise fault(source, "metadata.friction_std", f"expected {p} entries (friction_labels)")
-    return {term.name: IdentifiedTerm(term, term.values_of(P), np.array(std), np.array(kept))}
 
 
 def save_model_json(path: str | Path, model: IdentifiedModel, *, seed: int | None = None) -> Path:

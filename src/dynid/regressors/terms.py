@@ -148,60 +148,82 @@ def friction_labels(n: int) -> tuple[str, ...]:
 
 @dataclass(frozen=True, slots=True, eq=False)
 class RotorInertia:
-    """Rotor inertias ``I_a`` [kg m^2] at the motors: ``K^T diag(I_a) K ddq``."""
+    """Rotor inertias ``I_a`` [kg m^2] at the motors: ``K^T diag(I_a) K ddq``.
+
+    Attributes
+    ----------
+    drive : Drive
+        The transmission ``K`` (a direct drive for an armature ``I_a ddq`` per joint).
+    mask : tuple of bool
+        Which of the ``n`` rotors the term holds (a joint without armature: False, its
+        inertia 0); empty: all.
+    """
 
     drive: Drive
     name: str = "rotor_inertia"
     in_base: bool = True
     kind: str = "rotor_inertia"
+    mask: tuple[bool, ...] = ()
+
+    def __post_init__(self) -> None:
+        if self.mask and len(self.mask) != self.drive.n:
+            raise OptionError(f"mask must have {self.drive.n} entries; got {len(self.mask)}")
+
+    @property
+    def _held(self) -> NDArray[np.bool_]:
+        """(n,): the rotors held."""
+        return np.asarray(self.mask, dtype=bool) if self.mask else np.ones(self.drive.n, bool)
 
     @property
     def labels(self) -> tuple[str, ...]:
-        """``Ia1 .. Ia_n``."""
-        return self.drive.rotor_labels
+        """``Ia1 .. Ia_n`` (the rotors held)."""
+        return tuple(lab for lab, h in zip(self.drive.rotor_labels, self._held, strict=True) if h)
 
     @property
     def units(self) -> tuple[str, ...]:
         """kg m^2 each."""
-        return ("kg m^2",) * self.drive.n
+        return ("kg m^2",) * len(self.labels)
 
     @property
     def nonnegative(self) -> NDArray[np.bool_]:
         """Every rotor inertia is ``>= 0``."""
-        return np.ones(self.drive.n, dtype=bool)
+        return np.ones(len(self.labels), dtype=bool)
 
     def torque_columns(
         self, q: NDArray[np.float64], dq: NDArray[np.float64], ddq: NDArray[np.float64]
     ) -> NDArray[np.float64]:
-        """(B, n, n): column ``k`` is ``K[k]^T (K[k] . ddq)``."""
-        return self.drive.rotor_columns(ddq)
+        """(B, n, p): column ``k`` is ``K[k]^T (K[k] . ddq)`` (the rotors held)."""
+        return self.drive.rotor_columns(ddq)[..., self._held]
 
     def static_columns(self, n_samples: int) -> NDArray[np.float64]:
-        """(n, s, N): ``tril(K[k] K[k]^T)`` in the rows of ``M``, zero in those of ``g``."""
+        """(p, s, N): ``tril(K[k] K[k]^T)`` in the rows of ``M``, zero in those of ``g``."""
         n = self.drive.n
         i, j = np.tril_indices(n)
         C = np.zeros((n, i.size + n, n_samples))
         C[:, : i.size, :] = self.drive.rotor_mass_columns()[:, i, j][:, :, None]
-        return C
+        return C[self._held]
 
     def friction(self, values: NDArray[np.float64]) -> None:
         """None: not friction."""
         return None
 
     def inertia(self, values: NDArray[np.float64]) -> NDArray[np.float64]:
-        """The rotor inertias ``I_a`` (n,) [kg m^2]: the values themselves."""
-        return np.asarray(values, dtype=np.float64)
+        """The rotor inertias ``I_a`` (n,) [kg m^2]: the values, 0 for the rotors not held."""
+        out = np.zeros(self.drive.n)
+        out[self._held] = values
+        return out
 
     def definition(self) -> dict[str, Any]:
-        """Empty: the model's drive is all it needs."""
-        return {}
+        """``mask`` (the model's drive is all it needs beside it)."""
+        return {"mask": list(self.mask)}
 
     @classmethod
     def from_definition(
         cls, name: str, definition: Mapping[str, Any], drive: Drive | None, n: int
     ) -> RotorInertia:
         """Rebuilt for the model's ``drive`` (a direct drive of ``n`` joints when None)."""
-        return cls(Drive.identity(n) if drive is None else drive, name=name)
+        mask = tuple(bool(x) for x in definition.get("mask", ()))
+        return cls(Drive.identity(n) if drive is None else drive, name=name, mask=mask)
 
 
 #: The parts of :class:`LinearFriction`, in column order: viscous ``fv v``, quadratic
