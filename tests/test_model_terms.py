@@ -7,14 +7,15 @@ terms' coefficients against those values, and a file (current and older layout) 
 from __future__ import annotations
 
 import dataclasses
+from types import SimpleNamespace
 
 import numpy as np
 import pytest
 
 import dynid
-from dynid.exceptions import DataError
+from dynid.exceptions import DataError, OptionError
 from dynid.friction.model import ClassicalFriction, friction_of
-from dynid.identification.core import identify
+from dynid.identification.core import identify, model_columns
 from dynid.identification.recordings import prepare_recordings
 from dynid.identification.selection import identify_recordings
 from dynid.identification.structure import Structure
@@ -165,8 +166,20 @@ def test_a_joint_spring_is_one_module_and_one_registry_line():
     np.testing.assert_allclose(model.terms["friction"].values, FV, atol=1e-6)
     q = np.random.default_rng(8).uniform(-1, 1, (4, 7))
     np.testing.assert_allclose(model.terms["spring"].torques(q, q, q), k * (q - q0), atol=1e-6)
+    # the model's torques hold the spring (not the friction): those of the truth
+    truth = dynid.rnea(panda, q, q, q) + k * (q - q0)
+    np.testing.assert_allclose(model.torques(q, q, q), truth, atol=1e-5)
     assert model.friction is not None  # the spring is not friction
     back = model_from_dict(model_to_dict(model))
     assert isinstance(back.terms["spring"].term, JointSpring)
     np.testing.assert_array_equal(back.terms["spring"].term.q0, q0)
     np.testing.assert_array_equal(back.terms["spring"].values, model.terms["spring"].values)
+
+
+def test_two_terms_of_one_name_are_refused():
+    """Terms are keyed by name in the model and its file: two of one name are refused
+    before anything is fitted."""
+    data = SimpleNamespace(moving=True, regressor_kind="torque")
+    twice = (LinearFriction(Drive.identity(7)), LinearFriction(Drive.identity(7), ("viscous",)))
+    with pytest.raises(OptionError, match="friction"):
+        model_columns(dynid.panda(), data, terms=twice)

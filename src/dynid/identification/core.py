@@ -92,9 +92,15 @@ def model_columns(
     ------
     ShapeError
         ``base`` was built for another number of standard parameters.
+    OptionError
+        Two terms of the same name.
     """
     if terms is None:
         terms = drive_terms(drive, robot.n, friction=data.moving)
+    names = [t.name for t in terms]
+    twice = sorted({x for x in names if names.count(x) > 1})
+    if twice:
+        raise OptionError(f"model terms named {twice} twice; each term needs its own name")
     p = 10 * robot.n + sum(len(t.labels) for t in terms if t.in_base)
     if base is None:
         base = base_parameters(robot, kind=data.regressor_kind, rtol=rtol, terms=terms)
@@ -358,8 +364,6 @@ def _model(
     r = columns.base.rank
     terms, c = {}, r
     for t in columns.terms:
-        if t.name in terms:
-            raise OptionError(f"two model terms are named {t.name!r}; each needs its own name")
         k = len(t.labels)
         if t.in_base:  # the model derives its values from the fit
             terms[t.name] = IdentifiedTerm(t, np.zeros(k), np.zeros(k), np.zeros(k, dtype=bool))

@@ -153,6 +153,7 @@ class IdentifiedModel:
     holdout: HeldOut | None = None
     equivalent_robot: Robot = field(init=False)
     rotor_inertia: NDArray[np.float64] | None = field(init=False)
+    _other: tuple[IdentifiedTerm, ...] = field(init=False, repr=False)
 
     def __post_init__(self) -> None:
         phi = np.zeros(self.base.n_std)
@@ -185,6 +186,8 @@ class IdentifiedModel:
             found = [x for x in (t.inertia for t in self.terms.values()) if x is not None]
             ia = found[0] if found else None
         object.__setattr__(self, "rotor_inertia", None if ia is None else _checks.frozen(ia))
+        other = tuple(t for t in self.appended if t.friction is None)
+        object.__setattr__(self, "_other", other)
 
     def _in_base(
         self, terms: list[ModelTerm], phi: NDArray[np.float64]
@@ -324,12 +327,15 @@ class IdentifiedModel:
         return coriolis(self.equivalent_robot, q, dq)
 
     def torques(self, q: ArrayLike, dq: ArrayLike, ddq: ArrayLike) -> NDArray[np.float64]:
-        """Identified ``M ddq + c + g`` [N m] (rotor inertia included), friction not
-        included: (..., n)."""
+        """Identified ``M ddq + c + g`` [N m] (rotor inertia included) and the appended
+        terms that are not friction (a spring), friction not included (it comes with
+        ``dynid.friction.validation.own_friction``): (..., n)."""
         tau = rnea(self.equivalent_robot, q, dq, ddq)
         if self.rotor_inertia is not None and self.drive is not None:
             a = _checks.as_batch("ddq", ddq, (self.robot.n,))
             tau = tau + self.drive.rotor_torques(a, self.rotor_inertia)
+        for t in self._other:
+            tau = tau + t.torques(q, dq, ddq)
         return tau
 
 
