@@ -11,7 +11,7 @@ import numpy as np
 import pytest
 
 import dynid
-from dynid.exceptions import DynidWarning, ModelError
+from dynid.exceptions import DynidWarning, ShapeError, WrongTypeError
 from dynid.friction.laws import LAWS
 from dynid.friction.model import (
     ClassicalFriction,
@@ -111,17 +111,20 @@ def test_a_robot_holds_any_law():
     robot = _two_joints()
     classical = ClassicalFriction.from_array(PARAMS["classical"], BAND)
     r = robot.with_friction(classical)
-    assert r.friction is None and r.friction_model is classical
-    assert robot_friction(r) is classical
-    # a variant keeps it; the sigmoid at the joints is kept as the description's parameters
-    assert r.with_gravity([0, 0, -1.0]).friction_model is classical
-    s = r.with_friction(SigmoidFriction.from_array(PARAMS["sigmoid"]))
-    assert s.friction_model is None
-    np.testing.assert_array_equal(s.friction, PARAMS["sigmoid"])
-    np.testing.assert_array_equal(robot_friction(s).params, PARAMS["sigmoid"])
-    assert r.with_friction(None).friction_model is None
-    with pytest.raises(ModelError, match="not both"):
+    assert r.friction is classical and robot_friction(r) is classical
+    # a variant keeps it; the sigmoid is held the same way, as the one type
+    assert r.with_gravity([0, 0, -1.0]).friction is classical
+    sigmoid = SigmoidFriction.from_array(PARAMS["sigmoid"])
+    s = r.with_friction(sigmoid)
+    assert s.friction is sigmoid
+    assert r.with_friction(None).friction is None
+    # a bare array names no law: refused, with the constructor to call
+    with pytest.raises(WrongTypeError, match=r"not an array of shape \(2, 3\).*from_array"):
         r.replace(friction=PARAMS["sigmoid"])
+    with pytest.raises(WrongTypeError, match="not an array"):
+        robot.with_friction(PARAMS["sigmoid"])
+    with pytest.raises(ShapeError, match="friction has 7 joints; robot has 2"):
+        robot.with_friction(dynid.panda().friction)
 
 
 @pytest.mark.parametrize("name", sorted(LAWS))
@@ -130,7 +133,7 @@ def test_a_robot_with_any_law_pickles(name):
     import pickle
 
     fr = LAWS[name].model(PARAMS[name], BAND, Drive(K, np.zeros(2)))
-    back = pickle.loads(pickle.dumps(_two_joints().with_friction(fr))).friction_model
+    back = pickle.loads(pickle.dumps(_two_joints().with_friction(fr))).friction
     dq = _velocities()
     np.testing.assert_array_equal(back.torques(dq), fr.torques(dq))
 

@@ -90,11 +90,10 @@ def test_run_demo_chains_the_stages_and_reports_progress(monkeypatch):
 def test_collision_stage_finds_the_push_with_the_identified_model():
     """Stage 6 with the exact model and the true friction: one event, at the push, found
     within 20 ms, the residual within 0.2 N m (RMS) of the true external torque's lag."""
-    from dynid.friction.model import SigmoidFriction
     from dynid.pipeline import collision_stage
 
     robot = dynid.panda()
     model = kinematics_only(_model(robot))
-    res = collision_stage(model, SigmoidFriction.from_array(robot.friction), 0, truth=robot)
+    res = collision_stage(model, robot.friction, 0, truth=robot)
     assert len(res.events) == 1 and res.delay is not None and 0 <= res.delay < 0.02
     assert np.all(res.residual_error_rms < 0.2)

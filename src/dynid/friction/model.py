@@ -40,7 +40,7 @@ from __future__ import annotations
 from typing import cast
 
 import numpy as np
-from numpy.typing import ArrayLike
+from numpy.typing import ArrayLike, NDArray
 
 from .. import _checks
 from ..exceptions import ShapeError
@@ -59,9 +59,9 @@ __all__ = [
     "SigmoidFriction",
     "classical_friction",
     "coulomb_sign",
-    "friction_from_array",
     "robot_friction",
     "sigmoid_friction",
+    "sigmoid_parameters",
 ]
 
 #: A friction model (the one type; the name kept for annotations).
@@ -98,7 +98,8 @@ class _Sigmoid:
 
     @staticmethod
     def from_array(params: ArrayLike) -> Friction:
-        """From an (n, 3) array with columns ``phi1, phi2, phi3`` (as ``Robot.friction``)."""
+        """From an (n, 3) array with columns ``phi1, phi2, phi3`` (as description files and
+        the Panda's published data hold them)."""
         return _from_array("sigmoid", params)
 
     def __instancecheck__(self, obj: object) -> bool:
@@ -159,17 +160,16 @@ ClassicalFriction = _Classical()
 DriveFriction = _Drive()
 
 
-def friction_from_array(params: ArrayLike | Friction | None) -> Friction | None:
-    """A friction model from a :class:`Friction` (itself), None, or a bare (n, 3) array,
-    which is sigmoid parameters (``Robot.friction``, the description files' ``friction``)."""
-    if params is None or isinstance(params, Friction):
-        return params
-    return SigmoidFriction.from_array(params)
-
-
 def robot_friction(robot: Robot) -> Friction | None:
-    """A robot's own friction as a :class:`Friction`: its ``friction_model`` (any law), its
-    sigmoid parameters ``friction``, or None."""
-    if robot.friction_model is not None:
-        return cast(Friction, robot.friction_model)  # what with_friction puts there
-    return None if robot.friction is None else SigmoidFriction.from_array(robot.friction)
+    """A robot's friction, ``robot.friction``, typed as the :class:`Friction` it is (the
+    model layer names it by a protocol), or None."""
+    return cast(Friction | None, robot.friction)
+
+
+def sigmoid_parameters(friction: object) -> NDArray[np.float64] | None:
+    """The (n, 3) parameters ``phi1, phi2, phi3`` of ``friction`` when it is the sigmoid law
+    at the joints (what robot description files hold), else None (another law, a drive,
+    no friction)."""
+    if isinstance(friction, Friction) and friction.kind == "sigmoid" and friction.drive is None:
+        return friction.as_array()
+    return None

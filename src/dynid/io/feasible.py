@@ -29,7 +29,7 @@ from numpy.typing import NDArray
 from .. import __version__, _checks
 from ..exceptions import DataError, DynidWarning, ModelError, ShapeError
 from ..feasibility.result import FeasibleResult
-from ..friction.model import ClassicalFriction, Friction
+from ..friction.model import ClassicalFriction, Friction, SigmoidFriction, sigmoid_parameters
 from ..model.drive import Drive
 from ..model.inertia import (
     INERTIA_ORDER,
@@ -155,10 +155,9 @@ def feasible_to_dict(source: FeasibleResult | Robot, *, seed: int | None = None)
         for i in range(robot.n)
     ]
     fr = None
-    if robot.friction is not None:
-        fr = {"model": "sigmoid"} | {
-            f"phi{k + 1}": [float(x) for x in robot.friction[:, k]] for k in range(3)
-        }
+    P = sigmoid_parameters(robot.friction)
+    if P is not None:  # what the format holds (module docstring)
+        fr = {"model": "sigmoid"} | {f"phi{k + 1}": [float(x) for x in P[:, k]] for k in range(3)}
     lin = None if result is None else result.friction
     drive = None if result is None else result.drive
     d: dict[str, Any] = {
@@ -237,7 +236,7 @@ def robot_from_feasible_dict(
         if fr is not None:
             F = np.array([fr[f"phi{k}"] for k in (1, 2, 3)], dtype=float).T
             try:
-                robot = robot.with_friction(F)
+                robot = robot.with_friction(SigmoidFriction.from_array(F))
             except (ModelError, ShapeError) as exc:
                 raise fault(source, "friction", str(exc)) from exc
     if len(links) != robot.n:

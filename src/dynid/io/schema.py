@@ -86,6 +86,9 @@ class Field:
         ``objects``, ``strings``, ``numbers``: an empty list is refused.
     unit : str
         The SI unit, for messages and the format's documentation.
+    infinite : bool
+        ``number``: ``inf`` and ``-inf`` are accepted (no limit: a TOML file's ``inf``);
+        NaN never is.
     """
 
     kind: Kind
@@ -99,6 +102,7 @@ class Field:
     null_items: bool = False
     non_empty: bool = False
     unit: str = ""
+    infinite: bool = False
 
 
 @dataclass(frozen=True)
@@ -153,7 +157,7 @@ def describe(f: Field, sizes: Mapping[str, int] | None = None) -> str:
     if f.choices:
         text = "one of " + ", ".join(map(repr, f.choices))
     elif f.kind == "number":
-        text = f"a number{_limits(f)}{unit}"
+        text = f"a {'number or inf' if f.infinite else 'number'}{_limits(f)}{unit}"
     elif f.kind == "integer":
         text = f"an integer{_limits(f)}"
     elif f.kind == "bool":
@@ -293,14 +297,14 @@ def _within(x: float, f: Field) -> bool:
 
 def _number(v: Any, f: Field, source: str, at: str) -> None:
     unit = f" [{f.unit}]" if f.unit else ""
-    want = f"a number{_limits(f)}{unit}"
+    want = f"a {'number or inf' if f.infinite else 'number'}{_limits(f)}{unit}"
     if isinstance(v, bool) or not isinstance(v, int | float):
         raise fault(source, at, f"expected {want}; got {_got(v)}")
     try:
         x = float(v)
     except OverflowError:
         raise fault(source, at, f"expected a finite number; got {_got(v)}") from None
-    if not math.isfinite(x):
+    if math.isnan(x) or (math.isinf(x) and not f.infinite):
         raise fault(source, at, f"expected a finite number; got {_got(v)}")
     if not _within(x, f):
         raise fault(source, at, f"expected {want}; got {_got(v)}")
