@@ -130,8 +130,8 @@ class Format:
 
 
 def fault(source: str, at: str, text: str) -> DataError:
-    """The one wording: ``"<source>: key '<at>': <text>"``."""
-    return DataError(f"{source}: key {at!r}: {text}")
+    """The one wording: ``"<source>: key '<at>': <text>"`` (the error's ``file``: ``source``)."""
+    return DataError(f"key {at!r}: {text}", file=source)
 
 
 def _limits(f: Field) -> str:
@@ -383,6 +383,6 @@ def save_document(path: str | Path, fmt: Format, doc: Mapping[str, Any]) -> Path
     try:
         plain = jsonable({"schema": fmt.tag, **{k: v for k, v in doc.items() if k != "schema"}})
     except (DataError, NonFiniteError) as exc:
-        raise type(exc)(f"{path.name}: {exc}") from None
+        raise type(exc)(str(exc), file=path.name) from None
     check(plain, fmt.top, path.name)
     return save_json(path, plain)
