@@ -256,3 +256,17 @@ def test_a_robot_with_quadratic_friction_goes_through_simulate_identify_observe(
         assert np.max(np.abs(r)) < 1e-3, np.max(np.abs(r))
     rigid = observe(from_robot(robot, friction=None), log.t, log.q, log.dq, log.tau).r
     assert np.max(np.abs(rigid)) > 0.1
+
+
+def test_feasible_json_says_it_does_not_hold_another_law():
+    from dynid.io.feasible import feasible_to_dict
+
+    robot = _two_joints().with_friction(ClassicalFriction.from_array(PARAMS["classical"]))
+    with pytest.warns(DynidWarning, match="classical friction is not part of the file"):
+        d = feasible_to_dict(robot)
+    assert d["friction"] is None
+    sigmoid = SigmoidFriction.from_array(PARAMS["sigmoid"])
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        d = feasible_to_dict(robot.with_friction(sigmoid))
+    assert d["friction"]["phi2"] == list(PARAMS["sigmoid"][:, 1])

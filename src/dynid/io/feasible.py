@@ -141,6 +141,12 @@ def feasible_to_dict(source: FeasibleResult | Robot, *, seed: int | None = None)
     -------
     dict
         JSON-ready (module docstring).
+
+    Warns
+    -----
+    DynidWarning
+        The robot's friction is another law than the sigmoid at the joints, which the file
+        does not hold (``friction.json`` does): it is left out.
     """
     result = None if isinstance(source, Robot) else source
     robot = source if isinstance(source, Robot) else source.robot
@@ -158,6 +164,13 @@ def feasible_to_dict(source: FeasibleResult | Robot, *, seed: int | None = None)
     P = sigmoid_parameters(robot.friction)
     if P is not None:  # what the format holds (module docstring)
         fr = {"model": "sigmoid"} | {f"phi{k + 1}": [float(x) for x in P[:, k]] for k in range(3)}
+    elif robot.friction is not None:
+        warnings.warn(
+            f"feasible.json: the robot's {robot.friction.kind} friction is not part of the file "
+            "(which holds the sigmoid at the joints) and is not written; save it as friction.json",
+            DynidWarning,
+            stacklevel=2,
+        )
     lin = None if result is None else result.friction
     drive = None if result is None else result.drive
     d: dict[str, Any] = {
