@@ -150,7 +150,7 @@ def bounds_from_dict(d: Mapping[str, Any], robot: Robot, *, source: str = "bound
     try:
         return Bounds.from_arrays(lo, hi, band, names)
     except (ValueError, ShapeError) as exc:
-        raise DataError(f"{exc}", file=source) from exc
+        raise DataError(str(exc), file=source) from exc
 
 
 def load_bounds(path: str | Path, robot: Robot) -> Bounds:

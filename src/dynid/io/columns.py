@@ -199,7 +199,7 @@ def load_column_map(path: str | Path, **kw: Any) -> ColumnMap:
             {k: str(v) for k, v in d.get("columns", {}).items()}, d.get("units", {}), **kw
         )
     except DataError as exc:
-        raise DataError(f"{exc}", file=path.name) from exc
+        raise DataError(str(exc), file=path.name) from exc
 
 
 # ------------------------------------------------------------------------------ tables
@@ -462,7 +462,7 @@ def load_mapped_torque_log(
             )
         raw = TorqueLog.from_raw(t, q, np.zeros_like(q), tau, ddq, gap_factor=gap_factor)
     except DataError as exc:
-        raise DataError(f"{exc}", file=path.name) from exc
+        raise DataError(str(exc), file=path.name) from exc
     notes.append(velocity_note(columns.velocity_cutoff_hz))
     return MappedLog(with_derived_velocities(raw, columns.velocity_cutoff_hz), tuple(notes))
 

@@ -115,7 +115,7 @@ def drive_from_mapping(table: Mapping[str, Any], n: int, *, source: str = "drive
     try:
         return Drive.from_gears(gear, entries, **kw)
     except DynidError as exc:
-        raise DataError(f"{exc}", file=source) from exc
+        raise DataError(str(exc), file=source) from exc
 
 
 def _coupling(coupling: Any, n: int, source: str) -> list[tuple[int, int, float]]:
@@ -203,7 +203,7 @@ def drive_from_record(
     try:
         return Drive(transmission=np.array(record["transmission"], dtype=float), **kw)
     except DynidError as exc:
-        raise fault(source, at, str(exc)) if at else DataError(f"{exc}", file=source) from exc
+        raise fault(source, at, str(exc)) if at else DataError(str(exc), file=source) from exc
 
 
 def drive_of_robot_file(spec: str | Path, n: int) -> Drive | None:

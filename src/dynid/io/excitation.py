@@ -346,7 +346,7 @@ def _trajectory_csv(path: Path, n: int) -> Trajectory:
             t=a[:, 0], q=a[:, 1 : n + 1], dq=a[:, n + 1 : 2 * n + 1], ddq=a[:, 2 * n + 1 :]
         )
     except DynidError as exc:
-        raise DataError(f"{exc}", file=path.name) from None
+        raise DataError(str(exc), file=path.name) from None
 
 
 def _check_derived(tr: dict[str, Any], traj: ExcitingTrajectory, name: str) -> None:

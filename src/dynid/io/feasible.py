@@ -274,7 +274,7 @@ def robot_from_feasible_dict(
     try:
         return robot.with_inertials(mass, com, I6)
     except (ModelError, ShapeError) as exc:
-        raise DataError(f"{exc}", file=source) from exc
+        raise DataError(str(exc), file=source) from exc
 
 
 def _check_link(where: str, mass: float, I6: NDArray[np.float64]) -> None:

@@ -224,7 +224,7 @@ def load_joint_state_bag(
     except DataError as exc:
         if str(exc).startswith(f"{path.name}:"):
             raise
-        raise DataError(f"{exc}", file=path.name) from None
+        raise DataError(str(exc), file=path.name) from None
     except Exception as exc:
         raise DataError(
             f"cannot read the bag ({_checks.one_line(str(exc))})", file=path.name
@@ -409,7 +409,7 @@ def _assemble(
                 f"{cutoff_hz:g} Hz, then central differences)"
             )
     except DataError as exc:
-        raise DataError(f"{exc}", file=name) from exc
+        raise DataError(str(exc), file=name) from exc
     for count, what in (
         (n_total - n_msg, "message(s) on other topics skipped"),
         (n_missing, "message(s) missing a joint or field dropped"),

@@ -238,7 +238,7 @@ def load_torque_log(
             log = with_derived_velocities(log, DEFAULT_CUTOFF_HZ)
         return log
     except DataError as exc:
-        raise DataError(f"{exc}", file=path.name) from exc
+        raise DataError(str(exc), file=path.name) from exc
 
 
 def _where(rows: NDArray[np.intp], lines: tuple[int, int] | None) -> str:

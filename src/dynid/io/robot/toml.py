@@ -363,7 +363,7 @@ def robot_from_toml_string(text: str, *, source: str = "TOML text") -> Robot:
             q_neutral=_vector(doc["q_neutral"], ()) if "q_neutral" in doc else None,
         )
     except DynidError as exc:
-        raise DataError(f"{exc}", file=source) from exc
+        raise DataError(str(exc), file=source) from exc
 
 
 def load_toml(path: str | Path) -> Robot:
