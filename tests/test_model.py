@@ -19,7 +19,7 @@ def test_panda_matches_published_tables(panda):
     np.testing.assert_allclose(panda.q_max[3], -0.0698)
     assert panda.friction.kind == "sigmoid" and panda.friction.drive is None
     np.testing.assert_array_equal(panda.friction.params, dynid.model.panda.PANDA_FRICTION)
-    # Gaz et al. 2019, Table IV: joint 1's phi1, phi2, phi3
+    # Gaz et al. 2019, supplementary Table I: joint 1's phi1, phi2, phi3
     np.testing.assert_array_equal(panda.friction.params[0], [0.54615, 5.1181, 0.039533])
 
 

@@ -63,8 +63,8 @@ _INERTIA = [  # xx, xy, xz, yy, yz, zz about the CoM
     [0.001964, 0.000109, -0.001158, 0.004354, 0.000341, 0.005433],
     [0.012516, -0.000428, -0.001196, 0.010027, -0.000741, 0.004815],
 ]
-#: The Panda's published sigmoid friction parameters (Gaz et al. 2019, Table IV), (7, 3):
-#: columns ``phi1 [N m], phi2 [s/rad], phi3 [rad/s]``; :func:`panda` holds them as a
+#: The Panda's published sigmoid friction parameters (module docstring), (7, 3): columns
+#: ``phi1 [N m], phi2 [s/rad], phi3 [rad/s]``; :func:`panda` holds them as a
 #: ``dynid.SigmoidFriction``.
 PANDA_FRICTION = np.array(
     [
