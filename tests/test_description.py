@@ -211,13 +211,13 @@ def test_good_reference_file_loads():
 
 #: (edit of GOOD, the key path named, the rest of the one-line message)
 _FAULTS = [
-    ('name = "j1"\n', "", "joints[0].name", "missing; expected a string"),
+    ('name = "j1"\n', "", "joints[0].name", "missing; expected a non-empty string"),
     ('type = "revolute"\nparent = "base"', 'parent = "base"', "joints[0].type", "missing; "),
-    ('parent = "l1"\n', "", "joints[1].parent", "missing; expected a string"),
-    ('child = "l2"\n', "", "joints[1].child", "missing; expected a string"),
+    ('parent = "l1"\n', "", "joints[1].parent", "missing; expected a non-empty string"),
+    ('child = "l2"\n', "", "joints[1].child", "missing; expected a non-empty string"),
     ("mass = 1.0\n", "", "joints[0].inertial.mass", "missing; expected a number in [0, "),
     ("com = [0.0, 0.0, 0.1]\n", "", "joints[0].inertial.com", "missing; expected a list of 3"),
-    ('name = "tool"\n', "", "frames[0].name", "missing; expected a string"),
+    ('name = "tool"\n', "", "frames[0].name", "missing; expected a non-empty string"),
     ("com = [0.0, 0.0, 0.1]", "com = [0.0, 0.1]", "joints[0].inertial.com",
      "expected a list of 3 numbers in [-10000, 10000] [m]; got [0.0, 0.1]"),
     ("inertia = [0.1, 0.0, 0.0, 0.1, 0.0, 0.1]", "inertia = [0.1, 0.1, 0.1]",
@@ -230,6 +230,7 @@ _FAULTS = [
     ('child = "l2"', 'child = "l2"\nfriction = [1.0, 2.0]', "joints[1].friction",
      "expected a list of 3 numbers"),
     ('parent = "l1"', 'parent = "l9"', "joints[1].parent", "unknown parent 'l9'"),
+    ('parent = "l1"', 'parent = ""', "joints[1].parent", "expected a non-empty string; got ''"),
     ('parent = "l2"', 'parent = "nowhere"', "frames[0].parent", "unknown parent 'nowhere'"),
     ('type = "revolute"\nparent = "l1"', 'type = "spherical"\nparent = "l1"', "joints[1].type",
      "expected one of 'revolute', 'prismatic'; got 'spherical'"),

@@ -85,7 +85,7 @@ def _value(draw: Any, f: Field, sizes: dict[str, int]) -> Any:
     if f.kind == "bool":
         return draw(st.booleans())
     if f.kind == "string":
-        return draw(st.text(max_size=6))
+        return draw(st.text(min_size=int(f.non_empty), max_size=6))
     if f.kind in ("strings", "bools"):
         item = st.text(max_size=4) if f.kind == "strings" else st.booleans()
         k = draw(_count(shape[0], sizes))

@@ -83,7 +83,8 @@ class Field:
     null_items : bool
         ``numbers``: an entry may be ``null`` (no limit).
     non_empty : bool
-        ``objects``, ``strings``, ``numbers``: an empty list is refused.
+        ``objects``, ``strings``, ``numbers``: an empty list is refused; ``string``: an
+        empty string.
     unit : str
         The SI unit, for messages and the format's documentation.
     infinite : bool
@@ -163,7 +164,7 @@ def describe(f: Field, sizes: Mapping[str, int] | None = None) -> str:
     elif f.kind == "bool":
         text = "true or false"
     elif f.kind == "string":
-        text = "a string"
+        text = "a non-empty string" if f.non_empty else "a string"
     elif f.kind in ("strings", "bools"):
         count = _size(f.shape[0], sizes) if f.shape else ""
         item = "strings" if f.kind == "strings" else "true or false values"
@@ -264,7 +265,7 @@ def _value(v: Any, f: Field, source: str, at: str, sizes: dict[str, int]) -> Non
     elif f.kind == "bool":
         ok = isinstance(v, bool)
     elif f.kind == "string":
-        ok = isinstance(v, str)
+        ok = isinstance(v, str) and bool(v or not f.non_empty)
     elif f.kind in ("strings", "bools"):
         item = str if f.kind == "strings" else bool
         ok = isinstance(v, list) and all(isinstance(x, item) for x in v)

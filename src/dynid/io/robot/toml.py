@@ -104,10 +104,10 @@ _INERTIAL = Record(
 _TYPES = {"revolute": False, "prismatic": True}
 _JOINT = Record(
     {
-        "name": Field("string", required=True),
+        "name": Field("string", required=True, non_empty=True),
         "type": Field("string", required=True, choices=tuple(_TYPES)),
-        "parent": Field("string", required=True),
-        "child": Field("string", required=True),
+        "parent": Field("string", required=True, non_empty=True),
+        "child": Field("string", required=True, non_empty=True),
         "origin": Field("object", record=Record({"xyz": _XYZ, "rpy": _RPY})),
         "mdh": Field("object", record=_MDH),
         "axis": Field("numbers", shape=(3,)),
@@ -118,8 +118,8 @@ _JOINT = Record(
 )
 _FRAME = Record(
     {
-        "name": Field("string", required=True),
-        "parent": Field("string", required=True),
+        "name": Field("string", required=True, non_empty=True),
+        "parent": Field("string", required=True, non_empty=True),
         "xyz": _XYZ,
         "rpy": _RPY,
         "mdh": Field("object", record=_MDH),
