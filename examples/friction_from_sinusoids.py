@@ -19,7 +19,7 @@ log = dynid.simulate_measurement(robot, traj, rng=np.random.default_rng(0))
 rigid = robot.with_friction(None)  # the rigid-body model only
 fit = dynid.fit_friction(rigid, log)
 print(f"amplitudes scaled by {scale:.3f} into the limits")
-true = robot.friction
+true = robot.friction.as_array()  # the sigmoid the simulation used
 print(
     "joint  phi1 [N m]  phi2 [s/rad]  phi3 [rad/s]   RMS before -> after [N m]"
     "   (true phi1, phi2, phi3)"

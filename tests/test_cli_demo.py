@@ -120,3 +120,21 @@ def test_the_shipped_table_iii_is_the_papers():
     A = table_iii_matrix(tuple(robot.param_labels))
     recomputed = [c["pi_of_p_hat_recomputed_from_printed_p_hat"] for c in ref["coefficients"]]
     np.testing.assert_allclose(A @ robot.phi.ravel(), recomputed, rtol=0, atol=0.5e-6 + 1e-12)
+
+
+def test_the_demo_renders_a_stage_by_what_it_is_not_by_its_place(tmp_path, monkeypatch):
+    """The renderer reads the stage's kind: a collision stage announced as number 1 is
+    rendered as a collision, and every kind of stage has its rendering."""
+    from typing import get_args
+
+    import dynid.cli.demo as demo
+    from dynid.cli.console import Console
+    from dynid.pipeline import Stage, StageFinished, StageKind
+
+    assert set(demo._RENDER) == set(get_args(StageKind))
+    shown = []
+    monkeypatch.setattr(demo, "format_collision_stage", lambda res: f"collision of {res}")
+    render = demo._Renderer(tmp_path, None, Console("demo"))
+    render.console.print = shown.append  # type: ignore[method-assign]
+    render(StageFinished(Stage("collision", 1, "first"), "result"))
+    assert shown == ["collision of result"] and render.files == []

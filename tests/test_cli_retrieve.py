@@ -16,7 +16,6 @@ import pytest
 import dynid
 from dynid.cli.__main__ import main
 from dynid.feasibility.bounds import panda_bounds
-from dynid.friction.model import SigmoidFriction
 from dynid.identification.data import StaticDataset
 from dynid.identification.log import TorqueLog
 from dynid.identification.model import IdentifiedModel
@@ -180,7 +179,6 @@ def test_demo_feasible_stage_retrieves_validates_and_writes_its_files(tmp_path, 
     import dynid.pipeline.stages as stages
     from dynid.cli.demo_stages import format_feasible_stage, save_feasible_stage
     from dynid.feasibility.penalty import RetrievalOptions
-    from dynid.friction.model import SigmoidFriction
     from dynid.pipeline import feasible_stage
 
     short = RetrievalOptions(runs=2)
@@ -193,7 +191,7 @@ def test_demo_feasible_stage_retrieves_validates_and_writes_its_files(tmp_path, 
     q = q + 0.2 * np.sin(2 * np.pi * t)[:, None]
     dq = np.broadcast_to(0.2 * 2 * np.pi * np.cos(2 * np.pi * t)[:, None], q.shape).copy()
     ddq = np.broadcast_to(-0.2 * (2 * np.pi) ** 2 * np.sin(2 * np.pi * t)[:, None], q.shape).copy()
-    fr = SigmoidFriction.from_array(panda.friction)
+    fr = panda.friction
     tau = dynid.rnea(panda, q, dq, ddq) + fr.torques(dq) + rng.normal(0, 0.01, q.shape)
     log = TorqueLog(t, q, dq, tau, ddq)
     runs = []
@@ -253,7 +251,7 @@ def test_validate_with_retrieved_parameters_uses_rnea(retrieved, tmp_path):
     assert max(d["rms"]) > 0.1  # the log carries friction that this model lacks
     # with the published sigmoid friction the residual falls to the sensor noise (0.05 N m)
     fr = tmp_path / "friction.json"
-    save_friction_json(fr, SigmoidFriction.from_array(dynid.panda().friction))
+    save_friction_json(fr, dynid.panda().friction)
     assert (
         main(
             [

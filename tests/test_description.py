@@ -6,6 +6,7 @@ import numpy as np
 import pytest
 
 import dynid
+from dynid.exceptions import DataError
 from dynid.io.export import save_robot
 from dynid.io.robot.toml import load_toml, robot_from_toml_string, toml_from_robot
 
@@ -21,7 +22,8 @@ def assert_same_robot(a: dynid.Robot, b: dynid.Robot, seed: int) -> None:
     if a.friction is None:
         assert b.friction is None
     else:
-        np.testing.assert_array_equal(a.friction, b.friction)
+        assert a.friction.kind == b.friction.kind
+        np.testing.assert_array_equal(a.friction.params, b.friction.params)
     assert set(a.frames) == set(b.frames)
     for k, f in a.frames.items():
         assert f.link == b.frames[k].link, k
@@ -52,7 +54,9 @@ def test_ur5_round_trip_keeps_the_robot():
     ur5 = dynid.Robot.from_urdf(
         robot_data_urdf("ur_description/urdf/ur5_robot.urdf"), tip_link="tool0"
     )
-    ur5 = ur5.with_friction(rng.uniform(0.1, 5.0, (6, 3))).with_gravity(rng.normal(size=3))
+    ur5 = ur5.with_friction(
+        dynid.SigmoidFriction.from_array(rng.uniform(0.1, 5.0, (6, 3)))
+    ).with_gravity(rng.normal(size=3))
     ur5 = ur5.with_tool(
         dynid.spatial.transform_from_xyz_rpy(rng.normal(size=3), rng.normal(size=3)),
         1.5,
@@ -205,114 +209,101 @@ def test_good_reference_file_loads():
     assert robot.n == 2 and robot.frames["tool"].link == 2
 
 
-@pytest.mark.parametrize(
-    ("old", "new", "message"),
-    [
-        ('name = "j1"\n', "", r"joints\[0\]: missing key 'name'"),
-        ('type = "revolute"\nparent = "base"', 'parent = "base"', r"\('j1'\): missing key 'type'"),
-        ('parent = "l1"\n', "", r"\('j2'\): missing key 'parent'"),
-        ('child = "l2"\n', "", r"\('j2'\): missing key 'child'"),
-        ("mass = 1.0\n", "", r"\('j1'\): inertial: missing key 'mass'"),
-        ("com = [0.0, 0.0, 0.1]\n", "", r"\('j1'\): inertial: missing key 'com'"),
-        ('name = "tool"\n', "", r"frames\[0\]: missing key 'name'"),
-        (
-            "com = [0.0, 0.0, 0.1]",
-            "com = [0.0, 0.1]",
-            r"\('j1'\): key 'inertial.com' must be a list of 3 numbers; got 2",
-        ),
-        (
-            "inertia = [0.1, 0.0, 0.0, 0.1, 0.0, 0.1]",
-            "inertia = [0.1, 0.1, 0.1]",
-            r"key 'inertial.inertia' must be a list of 6",
-        ),
-        (
-            "xyz = [0.0, 0.0, 0.1]",
-            "xyz = [0.0, 0.1]",
-            r"\('j1'\): key 'origin.xyz' must be a list of 3",
-        ),
-        (
-            'child = "l2"',
-            'child = "l2"\naxis = [1, 0]',
-            r"\('j2'\): key 'axis' must be a list of 3",
-        ),
-        (
-            'child = "l2"',
-            'child = "l2"\naxis = [0, 0, 0]',
-            r"\('j2'\): key 'axis' must not be zero",
-        ),
-        (
-            'child = "l2"',
-            'child = "l2"\nfriction = [1.0, 2.0]',
-            r"\('j2'\): key 'friction' must be a list of 3",
-        ),
-        ('parent = "l1"', 'parent = "l9"', r"\('j2'\): unknown parent 'l9'"),
-        (
-            'parent = "l2"',
-            'parent = "nowhere"',
-            r"frames\[0\] \('tool'\): unknown parent 'nowhere'",
-        ),
-        (
-            'type = "revolute"\nparent = "l1"',
-            'type = "spherical"\nparent = "l1"',
-            r"key 'type' must be one of",
-        ),
-        ('child = "l1"', 'child = "l1"\ninertal = 3', r"\('j1'\): unknown key 'inertal'"),
-        ('name = "r"', 'name = "r"\ngravty = [0, 0, -9.81]', r"unknown key 'gravty'"),
-        ('name = "r"', 'name = "r"\ngravity = [0, -9.81]', r"key 'gravity' must be a list of 3"),
-        (
-            "lower = -1.0",
-            "lower = 1.0",
-            r"\('j1'\): key 'limits.lower' must be below 'limits.upper'",
-        ),
-        (
-            "lower = -1.0",
-            "lower = -1.0, velocity = 0.0",
-            r"\('j1'\): key 'limits.velocity' must be positive",
-        ),
-        ("lower = -1.0", "lowr = -1.0", r"\('j1'\): limits: unknown key 'lowr'"),
-        ("lower = -1.0", 'lower = "a"', r"\('j1'\): key 'limits.lower' must be a number"),
-        ("mass = 1.0", "mass = nan", r"key 'inertial.mass' must be finite"),
-        (
-            'child = "l1"',
-            'child = "l1"\nfriction = [1.0, 2.0, 3.0]',
-            r"friction' is given for some joints but not for joint 'j2'",
-        ),
-        (
-            "origin = { xyz = [0.0, 0.0, 0.1] }",
-            "origin = { xyz = [0.0, 0.0, 0.1] }\nmdh = { a = 0.0, d = 0.1, alpha = 0.0 }",
-            r"give either 'origin' or 'mdh'",
-        ),
-        (
-            "origin = { xyz = [0.0, 0.0, 0.1] }",
-            "mdh = { a = 0.0, alpha = 0.0 }",
-            r"\('j1'\): mdh: missing key 'd'",
-        ),
-        ('name = "r"', 'name = "r"\nformat_version = 2', r"key 'format_version' must be 1"),
-        ('name = "j2"', 'name = "j1"', r"duplicate joint names: \['j1'\]"),
-        (
-            'name = "tool"',
-            'name = "tool"\nmdh = { a = 0.0, d = 0.1, alpha = 0.0 }',
-            r"give either 'xyz' or 'mdh'",
-        ),
-    ],
-)
-def test_malformed_description_raises_model_error_naming_the_key(old, new, message):
-    """Missing, unknown, mistyped and wrong-length keys raise ModelError naming joint and key."""
+#: (edit of GOOD, the key path named, the rest of the one-line message)
+_FAULTS = [
+    ('name = "j1"\n', "", "joints[0].name", "missing; expected a non-empty string"),
+    ('type = "revolute"\nparent = "base"', 'parent = "base"', "joints[0].type", "missing; "),
+    ('parent = "l1"\n', "", "joints[1].parent", "missing; expected a non-empty string"),
+    ('child = "l2"\n', "", "joints[1].child", "missing; expected a non-empty string"),
+    ("mass = 1.0\n", "", "joints[0].inertial.mass", "missing; expected a number in [0, "),
+    ("com = [0.0, 0.0, 0.1]\n", "", "joints[0].inertial.com", "missing; expected a list of 3"),
+    ('name = "tool"\n', "", "frames[0].name", "missing; expected a non-empty string"),
+    ("com = [0.0, 0.0, 0.1]", "com = [0.0, 0.1]", "joints[0].inertial.com",
+     "expected a list of 3 numbers in [-10000, 10000] [m]; got [0.0, 0.1]"),
+    ("inertia = [0.1, 0.0, 0.0, 0.1, 0.0, 0.1]", "inertia = [0.1, 0.1, 0.1]",
+     "joints[0].inertial.inertia", "expected a list of 6 numbers [kg m^2]"),
+    ("xyz = [0.0, 0.0, 0.1]", "xyz = [0.0, 0.1]", "joints[0].origin.xyz",
+     "expected a list of 3 numbers"),
+    ('child = "l2"', 'child = "l2"\naxis = [1, 0]', "joints[1].axis", "expected a list of 3"),
+    ('child = "l2"', 'child = "l2"\naxis = [0, 0, 0]', "joints[1].axis",
+     "expected a non-zero axis; got [0.0, 0.0, 0.0]"),
+    ('child = "l2"', 'child = "l2"\nfriction = [1.0, 2.0]', "joints[1].friction",
+     "expected a list of 3 numbers"),
+    ('parent = "l1"', 'parent = "l9"', "joints[1].parent", "unknown parent 'l9'"),
+    ('parent = "l1"', 'parent = ""', "joints[1].parent", "expected a non-empty string; got ''"),
+    ('parent = "l2"', 'parent = "nowhere"', "frames[0].parent", "unknown parent 'nowhere'"),
+    ('type = "revolute"\nparent = "l1"', 'type = "spherical"\nparent = "l1"', "joints[1].type",
+     "expected one of 'revolute', 'prismatic'; got 'spherical'"),
+    ('child = "l1"', 'child = "l1"\ninertal = 3', "joints[0].inertal", "unknown key; allowed: "),
+    ('name = "r"', 'name = "r"\ngravty = [0, 0, -9.81]', "gravty", "unknown key; allowed: "),
+    ('name = "r"', 'name = "r"\ngravity = [0, -9.81]', "gravity",
+     "expected a list of 3 numbers [m/s^2]"),
+    ("lower = -1.0", "lower = 1.0", "joints[0].limits.lower",
+     "expected a number below 'limits.upper'; got 1.0 >= 1.0"),
+    ("lower = -1.0", "lower = -1.0, velocity = 0.0", "joints[0].limits.velocity",
+     "expected a number > 0; got 0.0"),
+    ("lower = -1.0", "lower = -1.0, velocity = -1.0", "joints[0].limits.velocity",
+     "expected a number or inf >= 0; got -1.0"),
+    ("lower = -1.0", "lowr = -1.0", "joints[0].limits.lowr", "unknown key; allowed: "),
+    ("lower = -1.0", 'lower = "a"', "joints[0].limits.lower",
+     "expected a number or inf [rad or m]; got 'a'"),
+    ("lower = -1.0", "lower = true", "joints[0].limits.lower", "expected a number or inf"),
+    ("mass = 1.0", "mass = nan", "joints[0].inertial.mass", "expected a finite number; got nan"),
+    ("mass = 1.0", "mass = -1.0", "joints[0].inertial.mass", "expected a number in [0, "),
+    ('child = "l1"', 'child = "l1"\nfriction = [1.0, 2.0, 3.0]', "joints[1].friction",
+     "missing; it is given for joint 'j1'"),
+    ("origin = { xyz = [0.0, 0.0, 0.1] }",
+     "origin = { xyz = [0.0, 0.0, 0.1] }\nmdh = { a = 0.0, d = 0.1, alpha = 0.0 }",
+     "joints[0].mdh", "give either 'origin' or 'mdh', not both"),
+    ("origin = { xyz = [0.0, 0.0, 0.1] }", "mdh = { a = 0.0, alpha = 0.0 }", "joints[0].mdh.d",
+     "missing; expected a number"),
+    ('name = "r"', 'name = "r"\nformat_version = 2', "format_version",
+     "expected one of 1; got 2"),
+    ('name = "tool"', 'name = "tool"\nmdh = { a = 0.0, d = 0.1, alpha = 0.0 }', "frames[0].mdh",
+     "give either 'xyz' or 'mdh', not both"),
+]  # fmt: skip
+
+
+@pytest.mark.parametrize(("old", "new", "key", "text"), _FAULTS)
+def test_malformed_description_is_refused_in_the_codecs_wording(old, new, key, text):
+    """Missing, unknown, mistyped, wrong-length and out-of-limit keys, and keys that do not
+    fit together: one DataError line ``SOURCE: key 'PATH': ...`` naming the key path, the
+    wording of every file format (:mod:`dynid.io.schema`)."""
     assert old in GOOD
-    with pytest.raises(dynid.ModelError, match=message):
-        robot_from_toml_string(GOOD.replace(old, new, 1))
+    with pytest.raises(DataError) as info:
+        robot_from_toml_string(GOOD.replace(old, new, 1), source="arm.toml")
+    msg = str(info.value)
+    assert msg.startswith(f"arm.toml: key {key!r}: {text}"), msg
+    assert "\n" not in msg
 
 
-def test_description_without_joints_or_bad_toml_raises_model_error(tmp_path):
-    """No [[joints]], invalid TOML and a missing file raise ModelError."""
-    with pytest.raises(dynid.ModelError, match="missing key 'joints'"):
+def test_a_description_the_robot_refuses_names_the_file():
+    """What only the Robot checks (names that repeat) is refused naming the file."""
+    with pytest.raises(DataError, match=r"^arm.toml: duplicate joint names: \['j1'\]$"):
+        robot_from_toml_string(GOOD.replace('name = "j2"', 'name = "j1"', 1), source="arm.toml")
+
+
+def test_description_without_joints_or_bad_toml_is_refused(tmp_path):
+    """No [[joints]] and invalid TOML raise DataError naming the file; a missing file a
+    ModelError."""
+    with pytest.raises(DataError, match="^TOML text: key 'joints': missing; expected a non-emp"):
         robot_from_toml_string('name = "r"\n')
-    with pytest.raises(dynid.ModelError, match="not valid TOML"):
+    with pytest.raises(DataError, match="not valid TOML"):
         robot_from_toml_string("name = \n")
+    bad = tmp_path / "arm.toml"
+    bad.write_text(GOOD.replace('name = "r"', 'name = "r"\ngravty = 1', 1))
+    with pytest.raises(DataError, match=r"^arm.toml: key 'gravty': unknown key; allowed: drive, "):
+        dynid.Robot.from_toml(bad)
     with pytest.raises(dynid.ModelError, match="TOML description not found.*none.toml"):
         load_toml(tmp_path / "none.toml")
     with pytest.raises(dynid.ModelError, match="TOML description not found"):
         dynid.Robot.from_toml(tmp_path / "none.toml")
+
+
+def test_infinite_limits_are_no_limits():
+    """``inf`` is accepted for a limit (none), as the writer leaves them out."""
+    robot = robot_from_toml_string(GOOD.replace("lower = -1.0", "lower = -inf, effort = inf", 1))
+    assert robot.q_min[0] == -np.inf and robot.tau_max[0] == np.inf and robot.q_max[0] == 1.0
 
 
 def test_neutral_pose_round_trips_and_is_checked():
@@ -320,5 +311,5 @@ def test_neutral_pose_round_trips_and_is_checked():
     panda = dynid.panda()
     text = toml_from_robot(panda)
     np.testing.assert_array_equal(robot_from_toml_string(text).q_neutral, panda.q_neutral)
-    with pytest.raises(dynid.ModelError, match="'q_neutral' must be a list of 7 numbers"):
+    with pytest.raises(DataError, match=r"key 'q_neutral': expected a list of 7 numbers \[rad"):
         robot_from_toml_string(text.replace("q_neutral = [", "q_neutral = [1.0, "))

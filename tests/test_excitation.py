@@ -92,7 +92,7 @@ def _check_admissible(robot, traj, opts, obstacles):
     assert np.all(q >= robot.q_min + opts.position_margin - 1e-12)
     assert np.all(np.abs(dq) <= robot.dq_max - opts.velocity_margin + 1e-12)
     assert np.all(np.abs(ddq) <= (1 - opts.acceleration_margin) * robot.ddq_max + 1e-12)
-    f = np.asarray(robot.friction)
+    f = robot.friction.as_array()
     tau = dynid.rnea(robot, q, dq, ddq) + sigmoid_friction(dq, f[:, 0], f[:, 1], f[:, 2])
     assert np.all(np.abs(tau) <= (1 - opts.torque_margin) * robot.tau_max + 1e-9)
     caps = capsule_model(robot, opts.radii)

@@ -147,7 +147,8 @@ def test_feasible_json_round_trip(retrieved, tmp_path):
     back = load_feasible_json(path)
     np.testing.assert_allclose(back.phi, res.robot.phi, atol=1e-15)
     np.testing.assert_array_equal(back.T_parent_joint, res.robot.T_parent_joint)
-    np.testing.assert_array_equal(back.friction, res.robot.friction)
+    np.testing.assert_array_equal(back.friction.params, res.robot.friction.params)
+    assert back.friction.kind == res.robot.friction.kind == "sigmoid"
     on = load_feasible_json(path, robot=dynid.panda().with_friction(None))
     np.testing.assert_allclose(on.phi, res.robot.phi, atol=1e-15)
     assert on.friction is None
@@ -184,7 +185,7 @@ def test_toml_round_trip(retrieved, tmp_path):
     back = dynid.Robot.from_toml(path)
     np.testing.assert_allclose(back.phi, res.robot.phi, atol=1e-14)
     np.testing.assert_allclose(back.T_parent_joint, res.robot.T_parent_joint, atol=1e-15)
-    np.testing.assert_allclose(back.friction, res.robot.friction)
+    np.testing.assert_allclose(back.friction.params, res.robot.friction.params)
 
 
 def test_report_json_lists_every_constraint(retrieved, tmp_path):

@@ -16,7 +16,7 @@ import numpy as np
 import pytest
 
 import dynid
-from dynid.exceptions import DataError, InfeasibleError, ShapeError
+from dynid.exceptions import DataError, InfeasibleError, ShapeError, WrongTypeError
 from dynid.feasibility.bounds import Bounds, default_bounds, kinematic_bounds, panda_bounds
 from dynid.feasibility.constraints import (
     UserConstraint,
@@ -33,7 +33,6 @@ from dynid.feasibility.penalty import (
     retrieve_from_coefficients,
     retrieve_from_static,
 )
-from dynid.friction.model import SigmoidFriction
 from dynid.friction.validation import validate_newton_euler
 from dynid.identification.model import IdentifiedModel
 from dynid.regressors.base import base_parameters
@@ -409,7 +408,7 @@ def test_newton_euler_validation_of_exact_data():
     panda = dynid.panda()
     q, dq, ddq = random_states(panda, 300, 7)
     t = np.arange(300) * 1e-3
-    fr = SigmoidFriction.from_array(panda.friction)
+    fr = panda.friction
     tau = dynid.rnea(panda, q, dq, ddq) + fr.torques(dq)
     val = validate_newton_euler(panda, t, q, dq, ddq, tau, reference=_noise_free_model(panda))
     assert val.friction_kind == "sigmoid"
@@ -429,8 +428,11 @@ def test_newton_euler_validation_shape_errors():
     t = np.arange(10) * 1e-3
     with pytest.raises(ShapeError, match="tau must have shape"):
         validate_newton_euler(panda, t, q, dq, ddq, np.zeros((10, 6)))
+    two = dynid.SigmoidFriction.from_array(np.ones((2, 3)))
     with pytest.raises(ShapeError, match="friction model has 2 joints"):
-        validate_newton_euler(panda, t, q, dq, ddq, np.zeros((10, 7)), friction=np.ones((2, 3)))
+        validate_newton_euler(panda, t, q, dq, ddq, np.zeros((10, 7)), friction=two)
+    with pytest.raises(WrongTypeError, match="SigmoidFriction.from_array"):  # a bare array
+        validate_newton_euler(panda, t, q, dq, ddq, np.zeros((10, 7)), friction=np.ones((7, 3)))
 
 
 def test_feasible_figures_render(panda_retrieval):

@@ -61,7 +61,8 @@ def test_fr3_has_the_pandas_kinematics_flange_and_parameters():
     T_link7_flange = fr3.frame("flange").T_link_frame
     np.testing.assert_allclose(T_link7_flange[:3, 3], [0.0, 0.0, 0.107], atol=1e-15)
     np.testing.assert_array_equal(fr3.phi, panda.phi)
-    np.testing.assert_array_equal(fr3.friction, panda.friction)
+    np.testing.assert_array_equal(fr3.friction.params, panda.friction.params)
+    assert fr3.friction.kind == panda.friction.kind
     np.testing.assert_array_equal(fr3.gravity, panda.gravity)
     np.testing.assert_array_equal(dynid.rnea(fr3, q, dq, ddq), dynid.rnea(panda, q, dq, ddq))
     assert fr3.name == "fr3" and fr3.joint_names == panda.joint_names

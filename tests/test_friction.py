@@ -43,7 +43,7 @@ def _reference_sigmoid(dq, P):
 def test_sigmoid_friction_matches_the_published_formula(panda):
     """The sigmoid equals eq. 25, is zero at rest, and saturates at its two levels."""
     rng = np.random.default_rng(22)
-    P = panda.friction
+    P = panda.friction.as_array()
     dq = rng.uniform(-3, 3, (4, 5, 7))
     fr = SigmoidFriction.from_array(P)
     tau = fr.torques(dq)
@@ -76,7 +76,7 @@ def test_sigmoid_fit_reproduces_the_true_friction_curve(panda, sinusoid_log):
     compensation is the noise level."""
     traj, log = sinusoid_log
     fit = fit_friction(panda, log, kind="sigmoid")
-    truth = SigmoidFriction.from_array(panda.friction)
+    truth = panda.friction
     v = np.linspace(-1, 1, 2001)[:, None] * np.max(np.abs(traj.dq), axis=0)
     curve_rms = np.sqrt(np.mean((fit.friction.torques(v) - truth.torques(v)) ** 2, axis=0))
     assert np.all(curve_rms < 0.05 * NOISE), curve_rms
@@ -84,7 +84,7 @@ def test_sigmoid_fit_reproduces_the_true_friction_curve(panda, sinusoid_log):
     np.testing.assert_allclose(fit.rms_after, NOISE, rtol=0.03)
     assert np.all(fit.rms_before > 2.5 * NOISE)
     assert fit.converged.all() and fit.kind == "sigmoid"
-    np.testing.assert_allclose(fit.friction.phi1, panda.friction[:, 0], rtol=0.02)
+    np.testing.assert_allclose(fit.friction.phi1, panda.friction.phi1, rtol=0.02)
 
 
 def test_classical_fit_recovers_linear_friction(panda, sinusoid_log):
@@ -141,7 +141,7 @@ def test_validate_accepts_a_callable_model(panda, sinusoid_log):
 
 def test_friction_json_round_trip(tmp_path, panda):
     """Sigmoid and classical parameters survive write/read; bad files raise DataError."""
-    sig = SigmoidFriction.from_array(panda.friction)
+    sig = panda.friction
     cls = ClassicalFriction([0.1, 0.2], [0.3, 0.4], [0.0, -0.1])
     for fr in (sig, cls):
         p = save_friction_json(tmp_path / f"{fr.kind}.json", fr)
@@ -203,7 +203,7 @@ def test_a_joint_that_never_moves_gets_no_friction_and_the_others_are_recovered(
     held = simulate_measurement(
         panda, traj, rng=np.random.default_rng(2002), noise=SensorNoise(tau_std=NOISE)
     )
-    truth = SigmoidFriction.from_array(panda.friction)
+    truth = panda.friction
     tau_fit, tau_true = fit.friction.torques(held.dq), truth.torques(held.dq)
     np.testing.assert_array_equal(tau_fit[:, 3], 0.0)
     err = np.sqrt(np.mean((tau_fit - tau_true) ** 2, axis=0))
@@ -214,7 +214,7 @@ def test_a_joint_that_never_moves_gets_no_friction_and_the_others_are_recovered(
     assert np.all(err[others] < np.broadcast_to(limit, (7,))[others]), err
     # validation with the fitted friction: joint 4 misses only its own friction (< phi1)
     val = validate_torques(panda, held, friction=fit.friction)
-    assert val.with_friction.rms[3] < panda.friction[3, 0], val.with_friction.rms
+    assert val.with_friction.rms[3] < panda.friction.phi1[3], val.with_friction.rms
 
 
 def test_friction_from_a_log_where_no_joint_moves_is_refused(panda):

@@ -11,7 +11,7 @@ import numpy as np
 import pytest
 
 import dynid
-from dynid.exceptions import DynidWarning, ModelError
+from dynid.exceptions import DynidWarning, ShapeError, WrongTypeError
 from dynid.friction.laws import LAWS
 from dynid.friction.model import (
     ClassicalFriction,
@@ -111,17 +111,20 @@ def test_a_robot_holds_any_law():
     robot = _two_joints()
     classical = ClassicalFriction.from_array(PARAMS["classical"], BAND)
     r = robot.with_friction(classical)
-    assert r.friction is None and r.friction_model is classical
-    assert robot_friction(r) is classical
-    # a variant keeps it; the sigmoid at the joints is kept as the description's parameters
-    assert r.with_gravity([0, 0, -1.0]).friction_model is classical
-    s = r.with_friction(SigmoidFriction.from_array(PARAMS["sigmoid"]))
-    assert s.friction_model is None
-    np.testing.assert_array_equal(s.friction, PARAMS["sigmoid"])
-    np.testing.assert_array_equal(robot_friction(s).params, PARAMS["sigmoid"])
-    assert r.with_friction(None).friction_model is None
-    with pytest.raises(ModelError, match="not both"):
+    assert r.friction is classical and robot_friction(r) is classical
+    # a variant keeps it; the sigmoid is held the same way, as the one type
+    assert r.with_gravity([0, 0, -1.0]).friction is classical
+    sigmoid = SigmoidFriction.from_array(PARAMS["sigmoid"])
+    s = r.with_friction(sigmoid)
+    assert s.friction is sigmoid
+    assert r.with_friction(None).friction is None
+    # a bare array names no law: refused, with the constructor to call
+    with pytest.raises(WrongTypeError, match=r"not an array of shape \(2, 3\).*from_array"):
         r.replace(friction=PARAMS["sigmoid"])
+    with pytest.raises(WrongTypeError, match="not an array"):
+        robot.with_friction(PARAMS["sigmoid"])
+    with pytest.raises(ShapeError, match="friction has 7 joints; robot has 2"):
+        robot.with_friction(dynid.panda().friction)
 
 
 @pytest.mark.parametrize("name", sorted(LAWS))
@@ -130,7 +133,7 @@ def test_a_robot_with_any_law_pickles(name):
     import pickle
 
     fr = LAWS[name].model(PARAMS[name], BAND, Drive(K, np.zeros(2)))
-    back = pickle.loads(pickle.dumps(_two_joints().with_friction(fr))).friction_model
+    back = pickle.loads(pickle.dumps(_two_joints().with_friction(fr))).friction
     dq = _velocities()
     np.testing.assert_array_equal(back.torques(dq), fr.torques(dq))
 
@@ -212,3 +215,58 @@ def test_friction_json_of_the_sigmoid_has_no_band_and_reads_back(tmp_path):
     np.testing.assert_allclose(back.torques(dq), cl.torques(dq), rtol=0, atol=1e-15)
     np.testing.assert_array_equal(back.band, BAND)
     np.testing.assert_array_equal(back.drive.transmission, K)
+
+
+def test_a_robot_with_quadratic_friction_goes_through_simulate_identify_observe():
+    """A robot holding the quadratic law (not the sigmoid): the simulation adds the law's
+    closed form (fv dq + fq dq |dq| + fc sign(dq) + fo), identification recovers its
+    coefficients from the noise-free log, and the momentum observer of the robot and of the
+    identified model both explain the log (no external torque), which without the friction
+    they do not."""
+    from dynid.friction.validation import own_friction
+    from dynid.identification.selection import identify_recordings
+    from dynid.identification.structure import Structure
+    from dynid.observer.model import from_identified, from_robot
+    from dynid.observer.residual import observe
+    from dynid.simulation.measurement import SensorNoise, sample_times, simulate_measurement
+    from dynid.simulation.trajectories import random_fourier
+
+    from conftest import planar_2r
+
+    P = np.array([[0.3, 0.2, 0.5, 0.05], [0.2, 0.1, 0.3, -0.02]])  # fv, fq, fc, fo
+    robot = planar_2r().with_friction(LAWS["quadratic"].model(P))
+    traj = random_fourier(robot, np.random.default_rng(3))(sample_times(4.0, 200.0))
+    exact = SensorNoise(tau_std=0.0, q_std=0.0, dq_std=0.0)
+    log = simulate_measurement(
+        robot, traj, rng=np.random.default_rng(4), noise=exact, with_ddq=True
+    )
+    q, dq, ddq = (np.asarray(x) for x in (traj.q, traj.dq, traj.ddq))
+    fv, fq, fc, fo = P.T
+    closed = fv * dq + fq * dq * np.abs(dq) + fc * np.sign(dq) + fo
+    np.testing.assert_allclose(log.tau, dynid.rnea(robot, q, dq, ddq) + closed, atol=1e-12)
+
+    parts = Structure.parse("viscous,quadratic,coulomb,offset")
+    model = identify_recordings(robot, [log], structure=parts, cutoff_hz=None)
+    identified = own_friction(model)
+    assert identified is not None and identified.kind == "quadratic"
+    np.testing.assert_allclose(identified.params, P, atol=1e-9)
+
+    for observer in (from_robot(robot), from_identified(model)):
+        r = observe(observer, log.t, log.q, log.dq, log.tau).r
+        assert np.max(np.abs(r)) < 1e-3, np.max(np.abs(r))
+    rigid = observe(from_robot(robot, friction=None), log.t, log.q, log.dq, log.tau).r
+    assert np.max(np.abs(rigid)) > 0.1
+
+
+def test_feasible_json_says_it_does_not_hold_another_law():
+    from dynid.io.feasible import feasible_to_dict
+
+    robot = _two_joints().with_friction(ClassicalFriction.from_array(PARAMS["classical"]))
+    with pytest.warns(DynidWarning, match="classical friction is not part of the file"):
+        d = feasible_to_dict(robot)
+    assert d["friction"] is None
+    sigmoid = SigmoidFriction.from_array(PARAMS["sigmoid"])
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        d = feasible_to_dict(robot.with_friction(sigmoid))
+    assert d["friction"]["phi2"] == list(PARAMS["sigmoid"][:, 1])

@@ -29,6 +29,7 @@ from dynid.io.feasible import FEASIBLE, load_feasible_json, save_feasible_json
 from dynid.io.friction_json import FORMAT, _record, load_friction_json, save_friction_json
 from dynid.io.model_json import MODEL
 from dynid.io.observer_files import THRESHOLDS, load_thresholds, save_thresholds
+from dynid.io.robot.toml import ROBOT_TOML, robot_from_toml_string
 from dynid.io.robot_json import ROBOT_RECORD, ROBOT_SCHEMA
 from dynid.io.schema import Field, Format, Record, check, load_document, save_document
 from dynid.model.drive import DRIVE_SCHEMA
@@ -45,6 +46,7 @@ FORMATS = {
     "excitation": EXCITATION,
     "model": MODEL,
     "robot": Format(ROBOT_SCHEMA, ROBOT_RECORD, "robot description"),
+    "robot-toml": Format("dynid-robot-toml", ROBOT_TOML, "robot description (TOML)"),
     "bounds": Format(BOUNDS_SCHEMA, BOUNDS_RECORD, "bounds file"),
     "drive": Format(DRIVE_SCHEMA, DRIVE_JSON, "drive record"),
     **{f"friction-{k}": Format(FORMAT, _record(k), "friction file") for k in LAWS},
@@ -83,7 +85,7 @@ def _value(draw: Any, f: Field, sizes: dict[str, int]) -> Any:
     if f.kind == "bool":
         return draw(st.booleans())
     if f.kind == "string":
-        return draw(st.text(max_size=6))
+        return draw(st.text(min_size=int(f.non_empty), max_size=6))
     if f.kind in ("strings", "bools"):
         item = st.text(max_size=4) if f.kind == "strings" else st.booleans()
         k = draw(_count(shape[0], sizes))
@@ -303,6 +305,33 @@ def test_every_format_refuses_in_one_wording(tmp_path, fmt, make, edit, key, fau
     if fault == "limit":
         assert re.search(r"expected a number (>=|<=|in) ", msg), msg
     assert "\n" not in msg
+
+
+@pytest.mark.parametrize(
+    ("edit", "key", "fault"),
+    [
+        (("velocity = 2.0", "velocty = 2.0"), "joints[0].limits.velocty", "unknown"),
+        (("mass = 1.5", 'mass = "1.5"'), "joints[0].inertial.mass", "type"),
+        (("mass = 1.5", "mass = 1e12"), "joints[0].inertial.mass", "limit"),
+    ],
+)
+def test_a_robot_description_is_refused_in_the_same_wording(edit, key, fault):
+    """The TOML robot description goes through the same codec: an unknown key, a wrong type
+    and a value out of its limits in the one wording."""
+    text = (
+        '[[joints]]\nname = "j"\ntype = "revolute"\nparent = "a"\nchild = "b"\n'
+        "limits = { velocity = 2.0 }\n"
+        "inertial = { mass = 1.5, com = [0, 0, 0], inertia = [1, 0, 0, 1, 0, 1] }\n"
+    )
+    assert robot_from_toml_string(text).mass[0] == 1.5
+    with pytest.raises(DataError) as info:
+        robot_from_toml_string(text.replace(*edit), source="arm.toml")
+    msg = str(info.value)
+    m = _ONE.match(msg)
+    assert m is not None and (m["file"], m["key"]) == ("arm.toml", key), msg
+    assert ("unknown key" in msg) == (fault == "unknown"), msg
+    if fault == "limit":
+        assert re.search(r"expected a number (>=|<=|in) ", msg), msg
 
 
 def test_a_drive_table_is_refused_in_the_same_wording():

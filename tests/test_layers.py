@@ -66,10 +66,13 @@ def _imported_parts(path: Path) -> list[str]:
 #: The only imports of a later layer, each inside one function (imported when called):
 #: ``Robot.from_urdf`` and ``Robot.from_toml`` are facades over the readers of io/robot, so
 #: that ``dynid.Robot.from_urdf(path)`` keeps working while the model layer holds no file
-#: format and importing it loads no reader. (module, function) -> the later package.
+#: format and importing it loads no reader. ``panda`` builds its published sigmoid friction
+#: as the one friction type, whose laws are a later layer's registry (importing the model
+#: layer loads no law). (module, function) -> the later package.
 FACADES = {
     ("model/robot.py", "from_urdf"): "io",
     ("model/robot.py", "from_toml"): "io",
+    ("model/panda.py", "panda"): "friction",
 }
 
 

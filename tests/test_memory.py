@@ -106,7 +106,7 @@ def test_classical_route_streamed_equals_stacked(monkeypatch, estimator):
     got = identify_from_log(robot, log, estimator=estimator)
     np.testing.assert_allclose(got.fit.beta, ref.fit.beta, rtol=1e-9, atol=1e-12)
     np.testing.assert_allclose(got.fit.std, ref.fit.std, rtol=1e-9, atol=1e-14)
-    np.testing.assert_allclose(got.friction, ref.friction, rtol=1e-9, atol=1e-12)
+    np.testing.assert_allclose(got.friction.params, ref.friction.params, rtol=1e-9, atol=1e-12)
     assert got.fit.relative_error_percent == pytest.approx(ref.fit.relative_error_percent, rel=1e-9)
     h, hr = got.info.heldout, ref.info.heldout
     assert h["heldout_error_percent"] == pytest.approx(hr["heldout_error_percent"], rel=1e-9)

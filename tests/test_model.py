@@ -17,7 +17,10 @@ def test_panda_matches_published_tables(panda):
     np.testing.assert_allclose(panda.mass.sum(), 16.062132, rtol=1e-12)
     np.testing.assert_allclose(panda.frame("flange").T_link_frame[:3, 3], [0, 0, 0.107])
     np.testing.assert_allclose(panda.q_max[3], -0.0698)
-    assert panda.friction.shape == (7, 3)
+    assert panda.friction.kind == "sigmoid" and panda.friction.drive is None
+    np.testing.assert_array_equal(panda.friction.params, dynid.model.panda.PANDA_FRICTION)
+    # Gaz et al. 2019, supplementary Table I: joint 1's phi1, phi2, phi3
+    np.testing.assert_array_equal(panda.friction.params[0], [0.54615, 5.1181, 0.039533])
 
 
 def test_mdh_transform_is_the_product_of_elementary_transforms():
@@ -97,18 +100,21 @@ def test_a_robot_pickles_and_copies_bit_for_bit(panda):
 
     from dynid import _kernels
 
-    robot = panda.with_friction(np.tile([0.5, 30.0, 0.01], (7, 1))).with_frame(
-        "tcp", np.diag([1.0, -1.0, -1.0, 1.0])
-    )
+    robot = panda.with_friction(
+        dynid.SigmoidFriction.from_array(np.tile([0.5, 30.0, 0.01], (7, 1)))
+    ).with_frame("tcp", np.diag([1.0, -1.0, -1.0, 1.0]))
     q = np.linspace(-1.0, 1.0, 7)
     dynid.rnea(robot, q, q, q)  # the packed arrays exist and must not travel
     for other in (pickle.loads(pickle.dumps(robot)), copy.deepcopy(robot)):
         assert _kernels.cached(other) is None and other.frames.keys() == robot.frames.keys()
         for name in ("T_parent_joint", "axes", "prismatic", "phi", "q_min", "q_max", "dq_max",
-                     "ddq_max", "tau_max", "gravity", "friction", "q_neutral"):  # fmt: skip
+                     "ddq_max", "tau_max", "gravity", "q_neutral"):  # fmt: skip
             a, b = getattr(robot, name), getattr(other, name)
             np.testing.assert_array_equal(a, b)
             assert not b.flags.writeable
+        assert other.friction.kind == robot.friction.kind
+        np.testing.assert_array_equal(other.friction.params, robot.friction.params)
+        assert not other.friction.params.flags.writeable
         tcp = (r.frame("tcp").T_link_frame for r in (other, robot))
         np.testing.assert_array_equal(*tcp)
         np.testing.assert_array_equal(dynid.rnea(other, q, q, q), dynid.rnea(robot, q, q, q))

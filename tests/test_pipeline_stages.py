@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+from typing import get_args
+
 import numpy as np
 import pytest
 
@@ -40,7 +42,7 @@ def test_run_demo_chains_the_stages_and_reports_progress(monkeypatch):
     """run_demo runs stages 1-6 in order, hands stages 3, 4 and 6 the kinematics-only model
     and the fitted friction, and brackets every stage with started/finished events."""
     import dynid.pipeline.demo as demo
-    from dynid.pipeline import StageFinished, StageStarted, run_demo
+    from dynid.pipeline import STAGES, StageFinished, StageKind, StageStarted, run_demo
 
     robot = dynid.panda()
     model = _model(robot)
@@ -77,6 +79,12 @@ def test_run_demo_chains_the_stages_and_reports_progress(monkeypatch):
     assert [(type(e), e.number) for e in events] == [
         (t, k) for k in range(1, 7) for t in (StageStarted, StageFinished)
     ]
+    # every event says which stage it is; a finished stage's result is the field of its kind
+    kinds = [e.stage.kind for e in events[::2]]
+    assert kinds == [c[0] for c in calls] == [s.kind for s in STAGES]
+    assert set(kinds) == set(get_args(StageKind))
+    for e in events[1::2]:
+        assert e.result is getattr(res, e.stage.kind)
     np.testing.assert_array_equal(calls[0][1][1], robot.q_neutral)
     handed = calls[2][1][0]
     assert not np.any(handed.robot.phi) and calls[2][2]["truth"] is robot
@@ -90,11 +98,10 @@ def test_run_demo_chains_the_stages_and_reports_progress(monkeypatch):
 def test_collision_stage_finds_the_push_with_the_identified_model():
     """Stage 6 with the exact model and the true friction: one event, at the push, found
     within 20 ms, the residual within 0.2 N m (RMS) of the true external torque's lag."""
-    from dynid.friction.model import SigmoidFriction
     from dynid.pipeline import collision_stage
 
     robot = dynid.panda()
     model = kinematics_only(_model(robot))
-    res = collision_stage(model, SigmoidFriction.from_array(robot.friction), 0, truth=robot)
+    res = collision_stage(model, robot.friction, 0, truth=robot)
     assert len(res.events) == 1 and res.delay is not None and 0 <= res.delay < 0.02
     assert np.all(res.residual_error_rms < 0.2)

@@ -175,6 +175,6 @@ def test_a_filtered_log_read_in_blocks_equals_the_log_stacked(monkeypatch):
     monkeypatch.setenv("DYNID_MAX_STACK_BYTES", "0")  # 12 000 samples: 3 blocks of rows
     got = identify_from_log(robot, log, **kw)
     np.testing.assert_allclose(got.fit.beta, ref.fit.beta, rtol=1e-9, atol=1e-12)
-    np.testing.assert_allclose(got.friction, ref.friction, rtol=1e-9, atol=1e-12)
+    np.testing.assert_allclose(got.friction.params, ref.friction.params, rtol=1e-9, atol=1e-12)
     h, hr = got.info.heldout, ref.info.heldout
     assert h["heldout_error_percent"] == pytest.approx(hr["heldout_error_percent"], rel=1e-9)

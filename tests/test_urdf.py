@@ -495,9 +495,10 @@ def test_urdf_link_named_flange_off_the_tip_warns():
 
 def test_absurd_axes_and_masses_are_refused_by_every_reader():
     """An axis [0, 0, 1e300] (its norm overflows, so it became a zero axis) and a link of
-    1e12 kg are ModelErrors naming the joint or link, from the URDF reader, the TOML reader
-    and the Robot itself (issue 20); an axis of 1e150 still normalises to [0, 0, 1]."""
-    from dynid.exceptions import ModelError
+    1e12 kg are refused naming the joint or link, by the URDF reader (ModelError), the TOML
+    reader (DataError, the key path in the schema codec's wording) and the Robot itself
+    (issue 20); an axis of 1e150 still normalises to [0, 0, 1]."""
+    from dynid.exceptions import DataError, ModelError
     from dynid.io.robot.toml import robot_from_toml_string
 
     urdf = """<robot name="r"><link name="a"/><link name="b"><inertial><mass value="{m}"/>
@@ -514,9 +515,17 @@ def test_absurd_axes_and_masses_are_refused_by_every_reader():
         robot_from_urdf_string(urdf.format(m=1e12, ax="0 0 1"))
     toml = '[[joints]]\nname = "j"\ntype = "revolute"\nparent = "a"\nchild = "b"\naxis = {ax}\n'
     with pytest.raises(
-        ModelError, match=r"key 'axis' = \[0.0, 1e\+300, 0.0\] is too large to normalise"
+        DataError,
+        match=r"^TOML text: key 'joints\[0\].axis': \[0.0, 1e\+300, 0.0\] is too large to norm",
     ):
         robot_from_toml_string(toml.format(ax="[0, 1e300, 0]"))
+    with pytest.raises(
+        DataError, match=r"key 'joints\[0\].inertial.mass': expected a number in \[0, 1e\+06\]"
+    ):
+        robot_from_toml_string(
+            toml.format(ax="[0, 0, 1]") + "inertial = { mass = 1e12, com = [0, 0, 0], "
+            "inertia = [1, 0, 0, 1, 0, 1] }\n"
+        )
     with pytest.raises(ModelError, match="joint axis of j, .* is too large to normalise"):
         dynid.Robot(
             name="r", joint_names=("j",), link_names=("a", "b"), T_parent_joint=np.eye(4)[None],

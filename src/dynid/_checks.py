@@ -15,7 +15,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from .exceptions import NonFiniteError, ShapeError
+from .exceptions import DynidError, NonFiniteError, ShapeError
 
 #: arrays up to this size are checked element by element in Python (a numpy reduction
 #: costs about 2 us whatever the size, the Python loop 40 ns an element)
@@ -210,16 +210,17 @@ def toml_string(text: str) -> str:
     return json.dumps(text, ensure_ascii=False).replace("\x7f", "\\u007f")
 
 
-def parse_toml(text: str, where: str, error: type[Exception]) -> dict[str, Any]:
-    """``tomllib.loads(text)``, every parse failure one ``error`` naming ``where``: invalid
-    TOML, nesting too deep for the parser, integers of more than 4300 digits."""
+def parse_toml(text: str, file: str, error: type[DynidError]) -> dict[str, Any]:
+    """``tomllib.loads(text)``, every parse failure one ``error`` about ``file`` (its
+    ``file``): invalid TOML, nesting too deep for the parser, integers of more than 4300
+    digits."""
     import tomllib
 
     try:
         return tomllib.loads(text)
     except tomllib.TOMLDecodeError as exc:
-        raise error(f"{where} is not valid TOML ({one_line(str(exc))})") from None
+        raise error(f"not valid TOML ({one_line(str(exc))})", file=file) from None
     except RecursionError:
-        raise error(f"{where} is not valid TOML (arrays or tables nested too deeply)") from None
+        raise error("not valid TOML (arrays or tables nested too deeply)", file=file) from None
     except ValueError:  # int() refusing a literal of more than 4300 digits
-        raise error(f"{where} is not valid TOML (an integer of more than 4300 digits)") from None
+        raise error("not valid TOML (an integer of more than 4300 digits)", file=file) from None

@@ -2,15 +2,48 @@
 
 Every error derives from :class:`DynidError`; each subclass also inherits the matching
 builtin (``ValueError``, ``KeyError``, ...) so generic handlers keep working.
+
+An error about a file (or a recording) names it first, ``"log.csv: ..."``, and says so in
+its ``file`` attribute: the prefix is written in one place, ``DynidError(text, file=name)``,
+and :func:`in_file` names the file in an error raised while a file is processed that does
+not name one yet (it reads ``file``, never the message).
 """
 
 from __future__ import annotations
 
-from collections.abc import Callable
+import contextlib
+import copy
+from collections.abc import Callable, Iterator
 
 
 class DynidError(Exception):
-    """Base class of every error raised by dynid."""
+    """Base class of every error raised by dynid.
+
+    Parameters
+    ----------
+    *args
+        The message (and any other arguments of the builtin).
+    file : str, optional
+        The file (or recording) the error is about: the message becomes
+        ``"{file}: {message}"`` (``"{file}, {at}: {message}"`` with ``at``).
+    at : str, optional
+        Where in the file (``"line 5, column 'tau1'"``).
+
+    Attributes
+    ----------
+    file : str or None
+        The file (or recording) the message names first; None when it names none.
+    """
+
+    file: str | None = None
+
+    def __init__(self, *args: object, file: str | None = None, at: str | None = None) -> None:
+        if file is not None:
+            where = file if at is None else f"{file}, {at}"
+            args = (f"{where}: {args[0]}" if args else where, *args[1:])
+        super().__init__(*args)
+        if file is not None:
+            self.file = file
 
 
 class ShapeError(DynidError, ValueError):
@@ -133,3 +166,37 @@ class DynidWarning(UserWarning):
 
 class SolverError(DynidError, RuntimeError):
     """A numerical solver failed (its status is named in the message)."""
+
+
+def named_file(exc: DynidError, name: str) -> DynidError:
+    """``exc`` naming the file (or recording) ``name``: itself when it names one already
+    (``exc.file``) or is about an option (an :class:`OptionError` with a ``field``, which the
+    command line names by its flag), else a copy of the same class and attributes whose
+    message starts with ``"{name}: "``."""
+    if exc.file is not None or (isinstance(exc, OptionError) and exc.field is not None):
+        return exc
+    out = copy.copy(exc)
+    out.args = (f"{name}: {exc.args[0]}" if exc.args else name, *exc.args[1:])
+    out.file = name
+    return out
+
+
+@contextlib.contextmanager
+def in_file(name: str) -> Iterator[None]:
+    """Run the ``with`` block naming the file ``name`` in a :class:`DynidError` raised
+    inside that names none (:func:`named_file`): the one place where an error is given
+    the name of the file being processed.
+
+    Raises
+    ------
+    DynidError
+        What the block raises, its message starting with a file's name (``name`` unless
+        the error named its own, or is about an option).
+    """
+    try:
+        yield
+    except DynidError as exc:
+        out = named_file(exc, name)
+        if out is exc:
+            raise
+        raise out from exc

@@ -4,20 +4,19 @@ for checked option values, figures that are skipped without matplotlib."""
 from __future__ import annotations
 
 import argparse
-import contextlib
 import dataclasses
 import logging
 import math
 import re
 import sys
-from collections.abc import Callable, Iterator
+from collections.abc import Callable
 from pathlib import Path
 from typing import Any, TypeVar
 
 import numpy as np
 
 from .. import _checks, spatial
-from ..exceptions import DataError, DynidError, OptionError, ShapeError
+from ..exceptions import DataError, OptionError, ShapeError, in_file
 from ..io.drive_file import drive_of_robot_file, load_drive
 from ..io.robot_file import load_robot as load_robot_file
 from ..kinematics.inverse import default_q0
@@ -203,19 +202,6 @@ def add_drop_invalid(p: argparse.ArgumentParser) -> None:
     )
 
 
-@contextlib.contextmanager
-def about(path: Path) -> Iterator[None]:
-    """Prefix the file's name to a :class:`DynidError` raised inside, if it lacks it."""
-    try:
-        yield
-    except DynidError as exc:
-        if isinstance(exc, OptionError) and exc.field is not None:
-            raise  # about an option, not the file
-        if str(exc).startswith(path.name):
-            raise
-        raise type(exc)(f"{path.name}: {exc}") from exc
-
-
 def shown(text: str) -> str:
     """``text`` as it can be drawn: a file name given under an ASCII locale (its UTF-8
     bytes escaped as surrogates, ``l\\udcc3\\udcb6g.csv``) back to its characters
@@ -282,7 +268,7 @@ def load_robot(args: argparse.Namespace) -> Robot:
     if spec in BUILTIN_ROBOTS:
         return builtin_robot(spec)
     path = Path(spec)
-    with about(path):
+    with in_file(path.name):
         return load_robot_file(path, base=args.base, tip=args.tip, what="--robot", snap_angles=snap)
 
 

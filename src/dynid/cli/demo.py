@@ -37,13 +37,14 @@ from __future__ import annotations
 import argparse
 import sys
 import time
+from collections.abc import Callable
 from pathlib import Path
 from typing import Any
 
 from ..feasibility.penalty import RetrievalProgress
 from ..model.panda import panda
 from ..model.robot import Robot
-from ..pipeline import ConsistentSetup, StageFinished, StageStarted, run_demo
+from ..pipeline import ConsistentSetup, StageFinished, StageKind, StageStarted, run_demo
 from .common import add_seed_option, add_subcommand, output_path
 from .console import Console
 from .demo_stages import (
@@ -94,33 +95,50 @@ class _Renderer:
         elif isinstance(event, ConsistentSetup):
             self.console.print(format_consistent_setup(event))
         elif isinstance(event, StageFinished):
-            self.finished(event.number, event.result)
+            self.finished(event.stage.kind, event.result)
 
-    def finished(self, number: int, res: Any) -> None:
-        """Print stage ``number``'s result and write its files."""
-        out, say = self.out, self.console.print
-        if number == 1:
-            say(format_kinematics(self.robot, res))
-            self._record(save_kinematics(out, self.robot, res))
-        elif number == 2:
-            self.files += save_identification_stage(out / "identification", res)
-            say(format_identification_stage(res))
-        elif number == 3:
-            self.files += save_friction_stage(out / "friction", res)
-            say(format_friction_stage(res))
-        elif number == 4:
-            files = save_feasible_stage(out / "feasible", res)
-            self.files += files
-            say(format_feasible_stage(res))
-            say(
-                f"retrieval stage: {time.perf_counter() - self.started:.1f} s; wrote "
-                f"{len(files)} files in {out / 'feasible'}"
-            )
-        elif number == 5:
-            say(format_consistent_stage(res))
-            self._record(save_consistent(out / "consistent", res))
-        elif number == 6:
-            say(format_collision_stage(res))
+    def finished(self, kind: StageKind, res: Any) -> None:
+        """Print the result of the stage of ``kind`` and write its files."""
+        _RENDER[kind](self, res)
+
+    def kinematics(self, res: Any) -> None:
+        self.console.print(format_kinematics(self.robot, res))
+        self._record(save_kinematics(self.out, self.robot, res))
+
+    def identification(self, res: Any) -> None:
+        self.files += save_identification_stage(self.out / "identification", res)
+        self.console.print(format_identification_stage(res))
+
+    def friction(self, res: Any) -> None:
+        self.files += save_friction_stage(self.out / "friction", res)
+        self.console.print(format_friction_stage(res))
+
+    def feasible(self, res: Any) -> None:
+        files = save_feasible_stage(self.out / "feasible", res)
+        self.files += files
+        self.console.print(format_feasible_stage(res))
+        self.console.print(
+            f"retrieval stage: {time.perf_counter() - self.started:.1f} s; wrote "
+            f"{len(files)} files in {self.out / 'feasible'}"
+        )
+
+    def consistent(self, res: Any) -> None:
+        self.console.print(format_consistent_stage(res))
+        self._record(save_consistent(self.out / "consistent", res))
+
+    def collision(self, res: Any) -> None:
+        self.console.print(format_collision_stage(res))
+
+
+#: What the demo prints and writes of each kind of stage.
+_RENDER: dict[StageKind, Callable[[_Renderer, Any], None]] = {
+    "kinematics": _Renderer.kinematics,
+    "identification": _Renderer.identification,
+    "friction": _Renderer.friction,
+    "feasible": _Renderer.feasible,
+    "consistent": _Renderer.consistent,
+    "collision": _Renderer.collision,
+}
 
 
 def register(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParser:

@@ -69,10 +69,10 @@ __all__ = [
     "friction_parts",
     "through_drive",
     "coulomb_sign",
-    "friction_from_array",
     "friction_of",
     "robot_friction",
     "sigmoid_friction",
+    "sigmoid_parameters",
 ]
 
 #: A friction model (the one type; the name kept for annotations).
@@ -109,7 +109,8 @@ class _Sigmoid:
 
     @staticmethod
     def from_array(params: ArrayLike) -> Friction:
-        """From an (n, 3) array with columns ``phi1, phi2, phi3`` (as ``Robot.friction``)."""
+        """From an (n, 3) array with columns ``phi1, phi2, phi3`` (as description files and
+        the Panda's published data hold them)."""
         return _from_array("sigmoid", params)
 
     def __instancecheck__(self, obj: object) -> bool:
@@ -168,14 +169,6 @@ SigmoidFriction = _Sigmoid()
 ClassicalFriction = _Classical()
 #: ``DriveFriction(law, drive)``: the :class:`Friction` ``law`` acting where ``drive`` says.
 DriveFriction = _Drive()
-
-
-def friction_from_array(params: ArrayLike | Friction | None) -> Friction | None:
-    """A friction model from a :class:`Friction` (itself), None, or a bare (n, 3) array,
-    which is sigmoid parameters (``Robot.friction``, the description files' ``friction``)."""
-    if params is None or isinstance(params, Friction):
-        return params
-    return SigmoidFriction.from_array(params)
 
 
 def friction_of(values: FrictionValues) -> Friction:
@@ -276,8 +269,15 @@ def combined(frictions: tuple[FrictionValues, ...]) -> Friction | FrictionSum | 
 
 
 def robot_friction(robot: Robot) -> Friction | None:
-    """A robot's own friction as a :class:`Friction`: its ``friction_model`` (any law), its
-    sigmoid parameters ``friction``, or None."""
-    if robot.friction_model is not None:
-        return cast(Friction, robot.friction_model)  # what with_friction puts there
-    return None if robot.friction is None else SigmoidFriction.from_array(robot.friction)
+    """A robot's friction, ``robot.friction``, typed as the :class:`Friction` it is (the
+    model layer names it by a protocol), or None."""
+    return cast(Friction | None, robot.friction)
+
+
+def sigmoid_parameters(friction: object) -> NDArray[np.float64] | None:
+    """The (n, 3) parameters ``phi1, phi2, phi3`` of ``friction`` when it is the sigmoid law
+    at the joints (what robot description files hold), else None (another law, a drive,
+    no friction)."""
+    if isinstance(friction, Friction) and friction.kind == "sigmoid" and friction.drive is None:
+        return friction.as_array()
+    return None

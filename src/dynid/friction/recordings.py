@@ -180,8 +180,9 @@ def prepare_pieces(
     for r, (name, log) in enumerate(zip(names, logs, strict=True)):
         if robot is not None and log.n != robot.n:
             raise DataError(
-                f"{name}: the log has {log.n} joints; robot {robot.name!r} has {robot.n}; "
-                "hint: a recording of the robot the model describes"
+                f"the log has {log.n} joints; robot {robot.name!r} has {robot.n}; "
+                "hint: a recording of the robot the model describes",
+                file=name,
             )
         jlog = joint_side_log(log, d)
         if robot is not None and d is None:

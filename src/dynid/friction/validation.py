@@ -29,7 +29,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from .. import _checks
 from ..dynamics.rnea import rnea
-from ..exceptions import DynidWarning, OptionError, ShapeError
+from ..exceptions import DynidWarning, OptionError, ShapeError, WrongTypeError
 from ..identification.log import DEFAULT_CUTOFF_HZ, TorqueLog, joint_side_log, prepare_log
 from ..identification.metrics import TorqueErrors, torque_errors
 from ..identification.model import IdentifiedModel
@@ -38,7 +38,7 @@ from ..identification.sanity import anticorrelated
 from ..model.drive import Drive
 from ..model.robot import Robot
 from .fit import TorqueModel, model_drive, rigid_body_torques
-from .model import FrictionModel, FrictionSum, combined, friction_from_array, robot_friction
+from .model import Friction, FrictionModel, FrictionSum, combined, robot_friction
 
 __all__ = [
     "RECORDED",
@@ -368,11 +368,15 @@ def _friction_model(robot: Robot, friction: Any) -> FrictionModel | None:
     if isinstance(friction, str):
         if friction != "robot":
             raise OptionError(
-                "friction must be 'robot', None, a friction model or an (n, 3) array; "
-                f"got {friction!r}"
+                f"must be 'robot', None or a Friction; got {friction!r}", field="friction"
             )
         return robot_friction(robot)
-    model = friction_from_array(friction)
+    if friction is not None and not isinstance(friction, Friction):
+        raise WrongTypeError(
+            f"friction must be 'robot', None or a Friction, not a {type(friction).__name__} "
+            "(sigmoid parameters (n, 3): dynid.SigmoidFriction.from_array(P))"
+        )
+    model = friction
     if model is not None and model.n != robot.n:
         raise ShapeError(f"friction model has {model.n} joints; robot {robot.name!r} has {robot.n}")
     return model
@@ -406,9 +410,8 @@ def validate_newton_euler(
         Joint positions [rad], velocities [rad/s], accelerations [rad/s^2].
     tau : array_like, shape (N, n)
         Measured joint torques [N m] (friction included).
-    friction : "robot", None, FrictionModel or array_like (n, 3)
-        ``"robot"`` (default) uses ``robot.friction`` (sigmoid; none if the robot has
-        none); an (n, 3) array is sigmoid ``phi1, phi2, phi3`` per joint.
+    friction : "robot", None or Friction
+        ``"robot"`` (default) uses ``robot.friction`` (none if the robot has none).
     reference : IdentifiedModel, optional
         An identified model evaluated on the same states (with the same friction), for
         comparison.

@@ -326,7 +326,9 @@ def prepare_recordings(
     turned: set[int] = set()
     for r, (name, log) in enumerate(zip(names, logs, strict=True)):
         if log.n != robot.n:
-            raise ShapeError(f"{name}: log has {log.n} joints; robot {robot.name!r} has {robot.n}")
+            raise ShapeError(
+                f"log has {log.n} joints; robot {robot.name!r} has {robot.n}", file=name
+            )
         # a motor-side log: every motor turns (a joint-side one: the robot's revolute joints)
         turns = revolute if drive is None or drive.side == "joint" else np.ones(robot.n, bool)
         log, joints = unwrapped(log, turns)

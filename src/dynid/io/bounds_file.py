@@ -150,7 +150,7 @@ def bounds_from_dict(d: Mapping[str, Any], robot: Robot, *, source: str = "bound
     try:
         return Bounds.from_arrays(lo, hi, band, names)
     except (ValueError, ShapeError) as exc:
-        raise DataError(f"{source}: {exc}") from exc
+        raise DataError(str(exc), file=source) from exc
 
 
 def load_bounds(path: str | Path, robot: Robot) -> Bounds:
@@ -169,10 +169,10 @@ def load_bounds(path: str | Path, robot: Robot) -> Bounds:
         try:
             text = file_text(path)
         except UnicodeDecodeError as exc:
-            raise DataError(f"{path.name}: not a UTF-8 text file ({exc.reason})") from None
+            raise DataError(f"not a UTF-8 text file ({exc.reason})", file=path.name) from None
         d = _checks.parse_toml(text, path.name, DataError)
     else:
-        raise DataError(f"{path.name}: bounds files are .json or .toml; got {suffix!r}")
+        raise DataError(f"bounds files are .json or .toml; got {suffix!r}", file=path.name)
     return bounds_from_dict(d, robot, source=path.name)
 
 
@@ -195,5 +195,5 @@ def save_bounds(path: str | Path, bounds: Bounds) -> Path:
             lines += ["", "[[links]]"] + [f"{k} = {_toml_value(v)}" for k, v in link.items()]
         return write_text(path, "\n".join(lines) + "\n")
     if path.suffix.lower() != ".json":
-        raise DataError(f"{path.name}: bounds files are .json or .toml; got {path.suffix!r}")
+        raise DataError(f"bounds files are .json or .toml; got {path.suffix!r}", file=path.name)
     return save_document(path, Format(BOUNDS_SCHEMA, BOUNDS_RECORD, "bounds file"), d)

@@ -191,7 +191,7 @@ def load_column_map(path: str | Path, **kw: Any) -> ColumnMap:
     d = _checks.parse_toml(file_text(path), path.name, DataError)
     extra = sorted(set(d) - {"columns", "units", "velocity_cutoff_hz"})
     if extra:
-        raise DataError(f"{path.name}: unknown key(s) {extra}; expected [columns], [units]")
+        raise DataError(f"unknown key(s) {extra}; expected [columns], [units]", file=path.name)
     if "velocity_cutoff_hz" in d:
         kw.setdefault("velocity_cutoff_hz", float(d["velocity_cutoff_hz"]))
     try:
@@ -199,7 +199,7 @@ def load_column_map(path: str | Path, **kw: Any) -> ColumnMap:
             {k: str(v) for k, v in d.get("columns", {}).items()}, d.get("units", {}), **kw
         )
     except DataError as exc:
-        raise DataError(f"{path.name}: {exc}") from exc
+        raise DataError(str(exc), file=path.name) from exc
 
 
 # ------------------------------------------------------------------------------ tables
@@ -241,23 +241,27 @@ def _read_table(path: Path, cmap: ColumnMap, quantities: tuple[str, ...]) -> _Ta
             complex_ = [k for k, a in raw.items() if np.iscomplexobj(a)]
             arrays = {k: a.astype(np.float64) for k, a in raw.items() if k not in complex_}
         except ValueError as exc:
-            raise DataError(f"{path.name}: not a numeric NPZ file without pickles ({exc})") from exc
+            raise DataError(
+                f"not a numeric NPZ file without pickles ({exc})", file=path.name
+            ) from exc
         if complex_:
-            raise DataError(f"{path.name}: array {complex_[0]!r} holds complex numbers")
+            raise DataError(f"array {complex_[0]!r} holds complex numbers", file=path.name)
         return _Table(path.name, arrays)
     if suffix != ".csv":
-        raise DataError(f"{path.name}: expected a .csv or .npz file")
+        raise DataError("expected a .csv or .npz file", file=path.name)
 
     def layout(names: list[str], line: int) -> dict[str, list[int]]:
         dup = sorted({c for c in names if names.count(c) > 1})
         if dup:
-            raise DataError(f"{path.name}, line {line}: duplicate column(s) {dup}")
+            raise DataError(f"duplicate column(s) {dup}", file=path.name, at=f"line {line}")
         wanted = _referenced(names, cmap, quantities)
         if not wanted:
             raise DataError(
-                f"{path.name}, line {line}: no column the map names (templates "
+                f"no column the map names (templates "
                 f"{[cmap.template(k) for k in quantities]}); the file has {names[:12]}"
-                f"{'...' if len(names) > 12 else ''}; hint: map them with --columns"
+                f"{'...' if len(names) > 12 else ''}; hint: map them with --columns",
+                file=path.name,
+                at=f"line {line}",
             )
         groups_of.update(_grouped(names, cmap, quantities))
         grouped = {c for cols in groups_of.values() for c in cols}
@@ -333,7 +337,7 @@ def _vector(table: _Table, cmap: ColumnMap, quantity: str, n: int | None) -> NDA
         a = table.columns[tpl]
         a = a[:, None] if a.ndim == 1 else a
         if n is not None and a.shape[1] != n:
-            raise DataError(f"{table.name}: {tpl!r} has {a.shape[1]} joints; expected {n}")
+            raise DataError(f"{tpl!r} has {a.shape[1]} joints; expected {n}", file=table.name)
         return a * cmap.factor(quantity)
     if n is None:
         n = 0
@@ -346,7 +350,7 @@ def _vector(table: _Table, cmap: ColumnMap, quantity: str, n: int | None) -> NDA
     if len(missing) == n:
         return None
     if missing:
-        raise DataError(f"{table.name}: missing column(s) {missing} for {quantity!r} ({tpl!r})")
+        raise DataError(f"missing column(s) {missing} for {quantity!r} ({tpl!r})", file=table.name)
     group = table.groups.get(quantity)
     # the columns of a group scaled as read are in SI (the first n of the group: names)
     f = 1.0 if quantity in table.scaled else cmap.factor(quantity)
@@ -370,8 +374,9 @@ def _check_distinct(table: _Table, cmap: ColumnMap, quantities: tuple[str, ...],
         for c in names:
             if c in table.columns and owner.setdefault(c, quantity) != quantity:
                 raise DataError(
-                    f"{table.name}: column {c!r} is named by the templates of both "
-                    f"{owner[c]!r} and {quantity!r}; each column holds one quantity: fix --columns"
+                    f"column {c!r} is named by the templates of both "
+                    f"{owner[c]!r} and {quantity!r}; each column holds one quantity: fix --columns",
+                    file=table.name,
                 )
 
 
@@ -382,9 +387,10 @@ def _need(table: _Table, cmap: ColumnMap, quantity: str, n: int | None) -> NDArr
         first = _fill(tpl, 0) if "{" in tpl else tpl
         have = list(table.columns)[:12]
         raise DataError(
-            f"{table.name}: no column {first!r} for {quantity!r} (template {tpl!r}); "
+            f"no column {first!r} for {quantity!r} (template {tpl!r}); "
             f"the file has {have}{'...' if len(table.columns) > 12 else ''}; "
-            "hint: map it with --columns"
+            "hint: map it with --columns",
+            file=table.name,
         )
     return a
 
@@ -435,8 +441,9 @@ def load_mapped_torque_log(
     t = table.columns.get(columns.template("t"))
     if t is None:
         raise DataError(
-            f"{path.name}: no time column {columns.template('t')!r}; "
-            f"the file has {list(table.columns)[:12]}; hint: map it with --columns t=NAME"
+            f"no time column {columns.template('t')!r}; "
+            f"the file has {list(table.columns)[:12]}; hint: map it with --columns t=NAME",
+            file=path.name,
         )
     t = t if columns.factor("t") == 1.0 else _checks.frozen(t * columns.factor("t"))
     q = _need(table, columns, "q", n)
@@ -455,7 +462,7 @@ def load_mapped_torque_log(
             )
         raw = TorqueLog.from_raw(t, q, np.zeros_like(q), tau, ddq, gap_factor=gap_factor)
     except DataError as exc:
-        raise DataError(f"{path.name}: {exc}") from exc
+        raise DataError(str(exc), file=path.name) from exc
     notes.append(velocity_note(columns.velocity_cutoff_hz))
     return MappedLog(with_derived_velocities(raw, columns.velocity_cutoff_hz), tuple(notes))
 
@@ -514,8 +521,9 @@ def load_mapped_static_data(
         while _fill(tpl_q, k) in table.columns:
             k += 1
         raise DataError(
-            f"{path.name}: data for {k} joints (columns {_fill(tpl_q, 0)}..{_fill(tpl_q, k - 1)}); "
-            f"robot {robot.name!r} has {robot.n}; hint: pass the robot the data were recorded with"
+            f"data for {k} joints (columns {_fill(tpl_q, 0)}..{_fill(tpl_q, k - 1)}); "
+            f"robot {robot.name!r} has {robot.n}; hint: pass the robot the data were recorded with",
+            file=path.name,
         )
     q = _need(table, columns, "q", n)
     n = q.shape[1]
@@ -529,7 +537,7 @@ def load_mapped_static_data(
         extra = ("no M columns: M set to zero (gravity torques only)",)
     elif "{" not in tpl:
         if tpl not in table.columns:
-            raise DataError(f"{path.name}: no array {tpl!r} for 'M'")
+            raise DataError(f"no array {tpl!r} for 'M'", file=path.name)
         M = table.columns[tpl] * columns.factor("M")
     else:
         M = np.zeros((q.shape[0], n, n))
@@ -540,12 +548,12 @@ def load_mapped_static_data(
                     name = _fill(tpl, j, i)
                 if name not in table.columns:
                     raise DataError(
-                        f"{path.name}: no column {_fill(tpl, i, j)!r} for M (template {tpl!r})"
+                        f"no column {_fill(tpl, i, j)!r} for M (template {tpl!r})", file=path.name
                     )
                 M[:, i, j] = M[:, j, i] = table.columns[name] * columns.factor("M")
     bad = ~(np.all(np.isfinite(q), 1) & np.all(np.isfinite(g), 1))
     bad |= ~np.all(np.isfinite(M.reshape(len(M), -1)), 1)
     if bad.any():
-        raise DataError(f"{path.name}: row {int(np.argmax(bad))} holds NaN or inf")
+        raise DataError(f"row {int(np.argmax(bad))} holds NaN or inf", file=path.name)
     notes = extra + tuple(f"{k} scaled by {columns.factor(k):.17g} to SI" for k in columns.factors)
     return MappedStatic(StaticDataset(q, M, g, {"file": path.name}), notes)

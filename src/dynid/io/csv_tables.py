@@ -82,7 +82,7 @@ def csv_table(
                 s = raw.decode("utf-8-sig" if lineno == 1 else "utf-8").strip()
             except UnicodeDecodeError as exc:
                 raise DataError(
-                    f"{path.name}, line {lineno}: not UTF-8 text ({exc.reason})"
+                    f"not UTF-8 text ({exc.reason})", file=path.name, at=f"line {lineno}"
                 ) from None
             if not s:
                 continue
@@ -93,7 +93,7 @@ def csv_table(
             names = [c.strip() for c in s.split(",")]
             break
         if names is None:
-            raise DataError(f"{path.name}: no header line ({expected}) found")
+            raise DataError(f"no header line ({expected}) found", file=path.name)
         layout = layout_of(names, lineno)
         first = lineno + 1
         start = fb.tell()
@@ -106,7 +106,7 @@ def csv_table(
         arrays, one_to_one = _parse(path, fb, names, layout, capacity, first)
     N = next(iter(arrays.values())).shape[0]
     if N == 0:
-        raise DataError(f"{path.name}: no data rows after the header")
+        raise DataError("no data rows after the header", file=path.name)
     check_row_count(path, recorded, N)
     if not freeze:
         return arrays, ((first, N) if one_to_one else None)
@@ -131,9 +131,10 @@ def _check_declared_rows(path: Path, recorded: int | None, width: int, size: int
     arrays for that count are allocated."""
     if recorded is not None and recorded > size // (2 * width):
         raise DataError(
-            f"{path.name}: the file records {recorded} rows but its {size} bytes of data hold "
+            f"the file records {recorded} rows but its {size} bytes of data hold "
             f"at most {size // (2 * width)}; it is incomplete or was edited; regenerate it, or, "
-            "if rows were removed on purpose, correct or delete its '# rows:' line"
+            "if rows were removed on purpose, correct or delete its '# rows:' line",
+            file=path.name,
         )
 
 
@@ -186,7 +187,7 @@ def _parse(
         line += lines
         rows = table.shape[0]
         if row + rows > capacity:
-            raise DataError(f"{path.name}: the file grew while it was read; read it again")
+            raise DataError("the file grew while it was read; read it again", file=path.name)
         for k, cols in take.items():
             out[k][row : row + rows] = table[:, cols]
         row += rows
@@ -251,7 +252,9 @@ def _slow_table(
         text = buf.decode("utf-8")
     except UnicodeDecodeError as exc:
         line = first + buf[: exc.start].count(b"\n")
-        raise DataError(f"{path.name}, line {line}: not UTF-8 text ({exc.reason})") from None
+        raise DataError(
+            f"not UTF-8 text ({exc.reason})", file=path.name, at=f"line {line}"
+        ) from None
     lines = text.split("\n")[:-1]
     del text
     table = np.full((len(lines), len(used)), np.nan)  # 8 bytes a cell, not a Python float
@@ -265,7 +268,9 @@ def _slow_table(
         cells = s.split(",")
         if len(cells) != width:
             raise DataError(
-                f"{path.name}, line {i}: expected {width} fields like the header; got {len(cells)}"
+                f"expected {width} fields like the header; got {len(cells)}",
+                file=path.name,
+                at=f"line {i}",
             )
         for m, k in enumerate(used):
             c = cells[k].strip()
@@ -274,7 +279,9 @@ def _slow_table(
                     table[rows, m] = _checks.decimal(c)
                 except ValueError:
                     raise DataError(
-                        f"{path.name}, line {i}, column {names[k]!r}: not a number: {c[:40]!r}"
+                        f"not a number: {c[:40]!r}",
+                        file=path.name,
+                        at=f"line {i}, column {names[k]!r}",
                     ) from None
         rows += 1
     return table[:rows], skipped
@@ -284,4 +291,6 @@ def _rows(path: Path, lineno: int, text: str) -> int:
     try:
         return _checks.integer(text)
     except ValueError:
-        raise DataError(f"{path.name}, line {lineno}: '# rows:' must give an integer") from None
+        raise DataError(
+            "'# rows:' must give an integer", file=path.name, at=f"line {lineno}"
+        ) from None

@@ -115,7 +115,7 @@ def drive_from_mapping(table: Mapping[str, Any], n: int, *, source: str = "drive
     try:
         return Drive.from_gears(gear, entries, **kw)
     except DynidError as exc:
-        raise DataError(f"{source}: {exc}") from exc
+        raise DataError(str(exc), file=source) from exc
 
 
 def _coupling(coupling: Any, n: int, source: str) -> list[tuple[int, int, float]]:
@@ -171,7 +171,7 @@ def load_drive(path: str | Path, n: int) -> Drive:
         raise DataError(f"drive file {p.name} is not valid TOML: {str(exc)[:200]}") from None
     if "joints" in doc:  # a robot description
         if "drive" not in doc:
-            raise DataError(f"{p.name}: a robot TOML without a [drive] table")
+            raise DataError("a robot TOML without a [drive] table", file=p.name)
         return drive_from_mapping(doc["drive"], n, source=f"{p.name} [drive]")
     if "schema" not in doc:
         raise fault(p.name, "schema", f"missing; expected {DRIVE_SCHEMA!r}")
@@ -203,7 +203,7 @@ def drive_from_record(
     try:
         return Drive(transmission=np.array(record["transmission"], dtype=float), **kw)
     except DynidError as exc:
-        raise fault(source, at, str(exc)) if at else DataError(f"{source}: {exc}") from exc
+        raise fault(source, at, str(exc)) if at else DataError(str(exc), file=source) from exc
 
 
 def drive_of_robot_file(spec: str | Path, n: int) -> Drive | None:

@@ -308,23 +308,31 @@ def _trajectory_csv(path: Path, n: int) -> Trajectory:
     want = trajectory_columns(n)
 
     def layout(names: list[str], line: int) -> dict[str, list[int]]:
-        where = f"{path.name}, line {line}"
+        at = f"line {line}"
         dup = sorted({c for c in names if names.count(c) > 1})
         if dup:
             raise DataError(
-                f"{where}: duplicated column(s) {_checks.short(dup)}; each column must appear once"
+                f"duplicated column(s) {_checks.short(dup)}; each column must appear once",
+                file=path.name,
+                at=at,
             )
         k = sum(1 for c in names if re.fullmatch(r"q[1-9]\d*", c))
         if k != n and f"q{k}" in names:
-            raise DataError(f"{where}: trajectory has {k} joints (q1..q{k}); the robot has {n}")
+            raise DataError(
+                f"trajectory has {k} joints (q1..q{k}); the robot has {n}", file=path.name, at=at
+            )
         missing = [c for c in want if c not in names]
         if missing:
-            raise DataError(f"{where}: missing column(s) {_checks.short(missing)} for {n} joints")
+            raise DataError(
+                f"missing column(s) {_checks.short(missing)} for {n} joints", file=path.name, at=at
+            )
         unknown = [c for c in names if c not in want]
         if unknown:
             raise DataError(
-                f"{where}: unknown column(s) {_checks.short(unknown)}; a trajectory of {n} "
-                f"joints has t, q1..q{n}, dq1..dq{n}, ddq1..ddq{n}"
+                f"unknown column(s) {_checks.short(unknown)}; a trajectory of {n} "
+                f"joints has t, q1..q{n}, dq1..dq{n}, ddq1..ddq{n}",
+                file=path.name,
+                at=at,
             )
         return {"a": [names.index(c) for c in want]}
 
@@ -332,13 +340,13 @@ def _trajectory_csv(path: Path, n: int) -> Trajectory:
     a = arrays["a"]
     if not np.all(np.isfinite(a)):
         r = int(np.flatnonzero(~np.isfinite(a).all(axis=1))[0])
-        raise DataError(f"{path.name}: data row {r} holds NaN, inf or an empty cell")
+        raise DataError(f"data row {r} holds NaN, inf or an empty cell", file=path.name)
     try:
         return Trajectory(
             t=a[:, 0], q=a[:, 1 : n + 1], dq=a[:, n + 1 : 2 * n + 1], ddq=a[:, 2 * n + 1 :]
         )
     except DynidError as exc:
-        raise DataError(f"{path.name}: {exc}") from None
+        raise DataError(str(exc), file=path.name) from None
 
 
 def _check_derived(tr: dict[str, Any], traj: ExcitingTrajectory, name: str) -> None:

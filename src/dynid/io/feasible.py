@@ -32,7 +32,13 @@ from .. import __version__, _checks
 from ..exceptions import DataError, DynidWarning, ModelError, ShapeError
 from ..feasibility.result import FeasibleResult
 from ..friction.laws import LAWS
-from ..friction.model import Friction, FrictionSum, friction_parts
+from ..friction.model import (
+    Friction,
+    FrictionSum,
+    SigmoidFriction,
+    friction_parts,
+    sigmoid_parameters,
+)
 from ..model.drive import Drive
 from ..model.inertia import (
     INERTIA_ORDER,
@@ -144,6 +150,12 @@ def feasible_to_dict(source: FeasibleResult | Robot, *, seed: int | None = None)
     -------
     dict
         JSON-ready (module docstring).
+
+    Warns
+    -----
+    DynidWarning
+        The robot's friction is another law than the sigmoid at the joints, which the file
+        does not hold (``friction.json`` does): it is left out.
     """
     result = None if isinstance(source, Robot) else source
     robot = source if isinstance(source, Robot) else source.robot
@@ -158,10 +170,16 @@ def feasible_to_dict(source: FeasibleResult | Robot, *, seed: int | None = None)
         for i in range(robot.n)
     ]
     fr = None
-    if robot.friction is not None:
-        fr = {"model": "sigmoid"} | {
-            f"phi{k + 1}": [float(x) for x in robot.friction[:, k]] for k in range(3)
-        }
+    P = sigmoid_parameters(robot.friction)
+    if P is not None:  # what the format holds (module docstring)
+        fr = {"model": "sigmoid"} | {f"phi{k + 1}": [float(x) for x in P[:, k]] for k in range(3)}
+    elif robot.friction is not None:
+        warnings.warn(
+            f"feasible.json: the robot's {robot.friction.kind} friction is not part of the file "
+            "(which holds the sigmoid at the joints) and is not written; save it as friction.json",
+            DynidWarning,
+            stacklevel=2,
+        )
     parts = friction_parts(None if result is None else result.friction)
     drive = None if result is None else result.drive
     d: dict[str, Any] = {
@@ -245,7 +263,7 @@ def robot_from_feasible_dict(
         if fr is not None:
             F = np.array([fr[f"phi{k}"] for k in (1, 2, 3)], dtype=float).T
             try:
-                robot = robot.with_friction(F)
+                robot = robot.with_friction(SigmoidFriction.from_array(F))
             except (ModelError, ShapeError) as exc:
                 raise fault(source, "friction", str(exc)) from exc
     if len(links) != robot.n:
@@ -270,7 +288,7 @@ def robot_from_feasible_dict(
     try:
         return robot.with_inertials(mass, com, I6)
     except (ModelError, ShapeError) as exc:
-        raise DataError(f"{source}: {exc}") from exc
+        raise DataError(str(exc), file=source) from exc
 
 
 def _check_link(where: str, mass: float, I6: NDArray[np.float64]) -> None:

@@ -132,7 +132,7 @@ def load_friction_json(path: str | Path) -> FrictionModel:
     try:
         fr = law.model(P, band)
     except DynidError as exc:
-        raise DataError(f"{path.name}: {exc}") from exc
+        raise DataError(str(exc), file=path.name) from exc
     if doc.get("drive") is None:
         return fr
     return fr.at(drive_from_record(doc["drive"], len(joints), source=path.name, at="drive"))

@@ -53,8 +53,8 @@ def regular_file(path: str | Path) -> int:
         raise IsADirectoryError(errno.EISDIR, "is a folder; give a file", str(p))
     if not stat.S_ISREG(st.st_mode):
         raise DataError(
-            f"{p.name}: not a regular file (a device, a pipe or a socket, which may never "
-            "end); give a file"
+            "not a regular file (a device, a pipe or a socket, which may never end); give a file",
+            file=p.name,
         )
     return int(st.st_size)
 
@@ -76,8 +76,9 @@ def file_bytes(path: str | Path) -> bytes:
         data = fh.read(limit + 1) if size <= limit else b""
     if size > limit or len(data) > limit:
         raise DataError(
-            f"{p.name}: {max(size, len(data))} bytes, above the {limit} bytes a JSON, TOML "
-            f"or URDF file may have; hint: set the environment variable {_ENV} to raise it"
+            f"{max(size, len(data))} bytes, above the {limit} bytes a JSON, TOML "
+            f"or URDF file may have; hint: set the environment variable {_ENV} to raise it",
+            file=p.name,
         )
     return data
 

@@ -101,7 +101,7 @@ def save_json(path: str | Path, obj: Mapping[str, Any], *, schema: str | None = 
     try:
         text = dumps(doc)
     except (DataError, NonFiniteError) as exc:
-        raise type(exc)(f"{path.name}: {exc}") from None
+        raise type(exc)(str(exc), file=path.name) from None
     return write_text(path, text + "\n")
 
 
@@ -178,23 +178,24 @@ def load_json(
     try:
         text = raw.decode("utf-8-sig")
     except UnicodeDecodeError as exc:
-        raise DataError(f"{path.name}: not a UTF-8 text file ({exc.reason})") from None
+        raise DataError(f"not a UTF-8 text file ({exc.reason})", file=path.name) from None
     try:
         d = loads(text)
     except json.JSONDecodeError as exc:
         raise DataError(
-            f"{path.name}: not a JSON file ({exc.msg} at line {exc.lineno}, column {exc.colno})"
+            f"not a JSON file ({exc.msg} at line {exc.lineno}, column {exc.colno})", file=path.name
         ) from None
     except ValueError as exc:
-        raise DataError(f"{path.name}: not strict JSON ({_checks.one_line(str(exc))})") from None
+        raise DataError(f"not strict JSON ({_checks.one_line(str(exc))})", file=path.name) from None
     if not isinstance(d, dict):
-        raise DataError(f"{path.name}: expected a JSON object ({what}); got {type(d).__name__}")
+        raise DataError(f"expected a JSON object ({what}); got {type(d).__name__}", file=path.name)
     if schema is not None:
         ok = (schema,) if isinstance(schema, str) else tuple(schema)
         got = d.get("schema")
         if got not in ok:
             raise DataError(  # the wording of dynid.io.schema
-                f"{path.name}: key 'schema': expected {' or '.join(map(repr, ok))} "
-                f"({'an' if what[:1] in 'aeiou' else 'a'} {what}); got {_checks.short(got)}"
+                f"key 'schema': expected {' or '.join(map(repr, ok))} "
+                f"({'an' if what[:1] in 'aeiou' else 'a'} {what}); got {_checks.short(got)}",
+                file=path.name,
             )
     return d

@@ -72,21 +72,22 @@ def check_npz(path: str | Path) -> None:
             dup = sorted({n for n in names if names.count(n) > 1})
             if dup:  # numpy reads the last one of a name silently
                 raise DataError(
-                    f"{path.name}: duplicated array(s) {_checks.short(dup)}; an array may "
-                    "appear once"
+                    f"duplicated array(s) {_checks.short(dup)}; an array may appear once",
+                    file=path.name,
                 )
             total = sum(i.file_size for i in infos)
             limit = _limit()
             if total > limit:
                 raise DataError(
-                    f"{path.name}: its arrays would take {total / 2**30:.3g} GiB uncompressed, "
+                    f"its arrays would take {total / 2**30:.3g} GiB uncompressed, "
                     f"above the limit of {limit / 2**30:.3g} GiB; hint: set the environment "
-                    f"variable {_ENV} (bytes) to read it"
+                    f"variable {_ENV} (bytes) to read it",
+                    file=path.name,
                 )
             for info in infos:
                 _check_member(path, zf, info)
     except (zipfile.BadZipFile, OSError, EOFError) as exc:
-        raise DataError(f"{path.name}: not a readable NPZ file ({exc})") from None
+        raise DataError(f"not a readable NPZ file ({exc})", file=path.name) from None
 
 
 def _check_member(path: Path, zf: zipfile.ZipFile, info: zipfile.ZipInfo) -> None:
@@ -94,9 +95,10 @@ def _check_member(path: Path, zf: zipfile.ZipFile, info: zipfile.ZipInfo) -> Non
     ratio = info.file_size / max(info.compress_size, 1)
     if info.file_size > _RATIO_FLOOR and ratio > MAX_COMPRESSION_RATIO:
         raise DataError(
-            f"{path.name}: member {name!r} inflates {ratio:.0f} times ({info.file_size} bytes "
+            f"member {name!r} inflates {ratio:.0f} times ({info.file_size} bytes "
             f"from {info.compress_size}), above {MAX_COMPRESSION_RATIO:g}: not measured data "
-            "(a zip bomb?)"
+            "(a zip bomb?)",
+            file=path.name,
         )
     if not name.endswith(".npy"):
         return
@@ -108,13 +110,18 @@ def _check_member(path: Path, zf: zipfile.ZipFile, info: zipfile.ZipInfo) -> Non
             else:
                 shape, _, dtype = np.lib.format.read_array_header_2_0(fh)
         except (ValueError, EOFError, SyntaxError) as exc:
-            raise DataError(f"{path.name}: member {name!r} is not a .npy array ({exc})") from None
+            raise DataError(
+                f"member {name!r} is not a .npy array ({exc})", file=path.name
+            ) from None
         header = fh.tell()
     if dtype.hasobject:
-        raise DataError(f"{path.name}: array {name[:-4]!r} holds Python objects (pickles refused)")
+        raise DataError(
+            f"array {name[:-4]!r} holds Python objects (pickles refused)", file=path.name
+        )
     need = int(np.prod(shape, dtype=object)) * dtype.itemsize
     if need > info.file_size - header:
         raise DataError(
-            f"{path.name}: array {name[:-4]!r} declares shape {shape} ({need} bytes) but holds "
-            f"{info.file_size - header} bytes; the file is incomplete or was edited"
+            f"array {name[:-4]!r} declares shape {shape} ({need} bytes) but holds "
+            f"{info.file_size - header} bytes; the file is incomplete or was edited",
+            file=path.name,
         )

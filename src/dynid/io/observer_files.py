@@ -172,7 +172,7 @@ def load_thresholds(path: str | Path) -> Thresholds:
             standstill=bool(rule.get("standstill_margin", False)),
         )
     except DynidError as exc:
-        raise DataError(f"{path.name}: {exc}") from None
+        raise DataError(str(exc), file=path.name) from None
 
 
 def save_events(

@@ -128,5 +128,4 @@ def robot_from_dict(
             **lim,
         )
     except (ModelError, ShapeError, ValueError) as exc:
-        where = f"{source}: key {at!r}" if at else source
-        raise DataError(f"{where}: {exc}") from exc
+        raise DataError(f"key {at!r}: {exc}" if at else str(exc), file=source) from exc

@@ -153,11 +153,11 @@ def _open(path: Path):  # noqa: ANN202 (a rosbags reader)
     if not path.exists():
         raise DataError(f"bag not found: {str(path)!r}")
     if path.is_dir() and not (path / "metadata.yaml").exists():
-        raise DataError(f"{path.name}: a ROS 2 bag folder needs metadata.yaml")
+        raise DataError("a ROS 2 bag folder needs metadata.yaml", file=path.name)
     if not path.is_dir():
         regular_file(path)  # not a device (/dev/zero) that rosbags fails on unexpectedly
     if not path.is_dir() and path.suffix != ".bag":
-        raise DataError(f"{path.name}: give a ROS 1 .bag file or a ROS 2 bag folder")
+        raise DataError("give a ROS 1 .bag file or a ROS 2 bag folder", file=path.name)
     store = Stores.ROS1_NOETIC if path.suffix == ".bag" else Stores.ROS2_HUMBLE
     return AnyReader([path], default_typestore=get_typestore(store))
 
@@ -204,15 +204,19 @@ def load_joint_state_bag(
     try:
         reader.open()
     except Exception as exc:  # rosbags raises its own error classes
-        raise DataError(f"{path.name}: cannot read the bag ({_checks.one_line(str(exc))})") from exc
+        raise DataError(
+            f"cannot read the bag ({_checks.one_line(str(exc))})", file=path.name
+        ) from exc
     try:
         conns = [c for c in reader.connections if c.topic == topic]
         if not conns:
             topics = sorted({c.topic for c in reader.connections})
-            raise DataError(f"{path.name}: no topic {topic!r}; the bag has {_checks.short(topics)}")
+            raise DataError(
+                f"no topic {topic!r}; the bag has {_checks.short(topics)}", file=path.name
+            )
         bad = [c.msgtype for c in conns if c.msgtype not in JOINT_STATE_TYPES]
         if bad:
-            raise DataError(f"{path.name}: topic {topic!r} holds {bad[0]}, not JointState")
+            raise DataError(f"topic {topic!r} holds {bad[0]}, not JointState", file=path.name)
         n_total = int(reader.message_count)
         msgs = _Messages(sum(int(getattr(c, "msgcount", 0) or 0) for c in conns))
         for conn, recv_ns, raw in reader.messages(connections=conns):
@@ -220,9 +224,11 @@ def load_joint_state_bag(
     except DataError as exc:
         if str(exc).startswith(f"{path.name}:"):
             raise
-        raise DataError(f"{path.name}: {exc}") from None
+        raise DataError(str(exc), file=path.name) from None
     except Exception as exc:
-        raise DataError(f"{path.name}: cannot read the bag ({_checks.one_line(str(exc))})") from exc
+        raise DataError(
+            f"cannot read the bag ({_checks.one_line(str(exc))})", file=path.name
+        ) from exc
     finally:
         reader.close()
     return _assemble(
@@ -343,7 +349,7 @@ def _assemble(
 ) -> BagImport:
     n_msg = msgs.n
     if n_msg == 0:
-        raise DataError(f"{name}: topic {topic!r} holds no message")
+        raise DataError(f"topic {topic!r} holds no message", file=name)
     mapping = match_joints(robot_joints, msgs.names(), joints)
     stamps = msgs.stamp[:n_msg]
     notes = []
@@ -356,7 +362,8 @@ def _assemble(
     has_vel = msgs.any_velocity
     if not msgs.any_effort:
         raise DataError(
-            f"{name}: no JointState message on {topic!r} holds effort; a torque log needs torques"
+            f"no JointState message on {topic!r} holds effort; a torque log needs torques",
+            file=name,
         )
     q, dq, tau, keep = msgs.arrays(mapping)
     keep &= ~msgs.short[:n_msg]
@@ -384,8 +391,9 @@ def _assemble(
                 "messages at distinct times"
             )
         raise DataError(
-            f"{name}: fewer than 2 usable JointState messages on {topic!r} "
-            f"({n_missing} missing a joint or field, {n_nonfinite} with NaN{same})"
+            f"fewer than 2 usable JointState messages on {topic!r} "
+            f"({n_missing} missing a joint or field, {n_nonfinite} with NaN{same})",
+            file=name,
         )
     t0 = int(stamps[0])
     t = (stamps - t0).astype(np.float64) * 1e-9
@@ -401,7 +409,7 @@ def _assemble(
                 f"{cutoff_hz:g} Hz, then central differences)"
             )
     except DataError as exc:
-        raise DataError(f"{name}: {exc}") from exc
+        raise DataError(str(exc), file=name) from exc
     for count, what in (
         (n_total - n_msg, "message(s) on other topics skipped"),
         (n_missing, "message(s) missing a joint or field dropped"),

@@ -83,9 +83,13 @@ class Field:
     null_items : bool
         ``numbers``: an entry may be ``null`` (no limit).
     non_empty : bool
-        ``objects``, ``strings``, ``numbers``: an empty list is refused.
+        ``objects``, ``strings``, ``numbers``: an empty list is refused; ``string``: an
+        empty string.
     unit : str
         The SI unit, for messages and the format's documentation.
+    infinite : bool
+        ``number``: ``inf`` and ``-inf`` are accepted (no limit: a TOML file's ``inf``);
+        NaN never is.
     """
 
     kind: Kind
@@ -99,6 +103,7 @@ class Field:
     null_items: bool = False
     non_empty: bool = False
     unit: str = ""
+    infinite: bool = False
 
 
 @dataclass(frozen=True)
@@ -126,8 +131,8 @@ class Format:
 
 
 def fault(source: str, at: str, text: str) -> DataError:
-    """The one wording: ``"<source>: key '<at>': <text>"``."""
-    return DataError(f"{source}: key {at!r}: {text}")
+    """The one wording: ``"<source>: key '<at>': <text>"`` (the error's ``file``: ``source``)."""
+    return DataError(f"key {at!r}: {text}", file=source)
 
 
 def _limits(f: Field) -> str:
@@ -153,13 +158,13 @@ def describe(f: Field, sizes: Mapping[str, int] | None = None) -> str:
     if f.choices:
         text = "one of " + ", ".join(map(repr, f.choices))
     elif f.kind == "number":
-        text = f"a number{_limits(f)}{unit}"
+        text = f"a {'number or inf' if f.infinite else 'number'}{_limits(f)}{unit}"
     elif f.kind == "integer":
         text = f"an integer{_limits(f)}"
     elif f.kind == "bool":
         text = "true or false"
     elif f.kind == "string":
-        text = "a string"
+        text = "a non-empty string" if f.non_empty else "a string"
     elif f.kind in ("strings", "bools"):
         count = _size(f.shape[0], sizes) if f.shape else ""
         item = "strings" if f.kind == "strings" else "true or false values"
@@ -260,7 +265,7 @@ def _value(v: Any, f: Field, source: str, at: str, sizes: dict[str, int]) -> Non
     elif f.kind == "bool":
         ok = isinstance(v, bool)
     elif f.kind == "string":
-        ok = isinstance(v, str)
+        ok = isinstance(v, str) and bool(v or not f.non_empty)
     elif f.kind in ("strings", "bools"):
         item = str if f.kind == "strings" else bool
         ok = isinstance(v, list) and all(isinstance(x, item) for x in v)
@@ -293,14 +298,14 @@ def _within(x: float, f: Field) -> bool:
 
 def _number(v: Any, f: Field, source: str, at: str) -> None:
     unit = f" [{f.unit}]" if f.unit else ""
-    want = f"a number{_limits(f)}{unit}"
+    want = f"a {'number or inf' if f.infinite else 'number'}{_limits(f)}{unit}"
     if isinstance(v, bool) or not isinstance(v, int | float):
         raise fault(source, at, f"expected {want}; got {_got(v)}")
     try:
         x = float(v)
     except OverflowError:
         raise fault(source, at, f"expected a finite number; got {_got(v)}") from None
-    if not math.isfinite(x):
+    if math.isnan(x) or (math.isinf(x) and not f.infinite):
         raise fault(source, at, f"expected a finite number; got {_got(v)}")
     if not _within(x, f):
         raise fault(source, at, f"expected {want}; got {_got(v)}")
@@ -379,6 +384,6 @@ def save_document(path: str | Path, fmt: Format, doc: Mapping[str, Any]) -> Path
     try:
         plain = jsonable({"schema": fmt.tag, **{k: v for k, v in doc.items() if k != "schema"}})
     except (DataError, NonFiniteError) as exc:
-        raise type(exc)(f"{path.name}: {exc}") from None
+        raise type(exc)(str(exc), file=path.name) from None
     check(plain, fmt.top, path.name)
     return save_json(path, plain)

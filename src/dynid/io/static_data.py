@@ -129,7 +129,7 @@ def load_static_data(
     mismatch = None if robot is None else recorded_robot_mismatch(robot, data.metadata)
     if mismatch is not None:
         raise DataError(
-            f"{path.name}: {mismatch}; hint: pass --robot for the arm that recorded the data"
+            f"{mismatch}; hint: pass --robot for the arm that recorded the data", file=path.name
         )
     return data, n_dropped
 
@@ -185,7 +185,7 @@ def load_static_csv(
     try:
         text = path.read_text(encoding="utf-8-sig")
     except UnicodeDecodeError as exc:
-        raise DataError(f"{path.name}: not a UTF-8 text file ({exc.reason})") from exc
+        raise DataError(f"not a UTF-8 text file ({exc.reason})", file=path.name) from exc
     meta: dict[str, Any] = {}
     n_recorded: int | None = None
     header: list[str] | None = None
@@ -207,7 +207,7 @@ def load_static_csv(
         else:
             rows.append((lineno, cells))
     if header is None:
-        raise DataError(f"{path.name}: no header line; expected columns {_expected_hint(robot)}")
+        raise DataError(f"no header line; expected columns {_expected_hint(robot)}", file=path.name)
     check_row_count(path, n_recorded, len(rows))
     n = _check_columns(path, header, header_line, robot)
     cols = static_columns(n)
@@ -236,8 +236,9 @@ def load_static_csv(
             msg = f"line {lineno} (row {len(good) + len(bad)}) {reason}"
             if not drop_invalid:
                 raise DataError(
-                    f"{path.name}: {msg}; hint: fix the file or pass --drop-invalid "
-                    "(drop_invalid=True) to drop such rows"
+                    f"{msg}; hint: fix the file or pass --drop-invalid "
+                    "(drop_invalid=True) to drop such rows",
+                    file=path.name,
                 )
             bad.append(msg)
             continue
@@ -251,32 +252,36 @@ def _check_columns(path: Path, header: list[str], line: int, robot: Robot | None
     """Validate the header; return the joint count."""
     dup = sorted({c for c in header if header.count(c) > 1})
     if dup:
-        raise DataError(f"{path.name}: line {line}: duplicated columns {dup}")
+        raise DataError(f"line {line}: duplicated columns {dup}", file=path.name)
     qcols = [c for c in header if re.fullmatch(r"q[1-9]\d*", c)]
     if not qcols:
         raise DataError(
-            f"{path.name}: line {line}: no joint position columns q1..qn; got columns "
-            f"{header[:8]}{' ...' if len(header) > 8 else ''}"
+            f"line {line}: no joint position columns q1..qn; got columns "
+            f"{header[:8]}{' ...' if len(header) > 8 else ''}",
+            file=path.name,
         )
     n_file = max(int(c[1:]) for c in qcols)
     n = robot.n if robot is not None else n_file
     if robot is not None and n_file != robot.n:
         raise DataError(
-            f"{path.name}: data for {n_file} joints (columns q1..q{n_file}); robot "
-            f"{robot.name!r} has {robot.n}; hint: pass the robot the data were recorded with"
+            f"data for {n_file} joints (columns q1..q{n_file}); robot "
+            f"{robot.name!r} has {robot.n}; hint: pass the robot the data were recorded with",
+            file=path.name,
         )
     expected = static_columns(n)
     missing = [c for c in expected if c not in header]
     extra = [c for c in header if c not in expected]
     if missing:
         raise DataError(
-            f"{path.name}: line {line}: missing columns {missing}; expected q1..q{n}, "
-            f"M<i>_<j> (i >= j) and g1..g{n}"
+            f"line {line}: missing columns {missing}; expected q1..q{n}, "
+            f"M<i>_<j> (i >= j) and g1..g{n}",
+            file=path.name,
         )
     if extra:
         raise DataError(
-            f"{path.name}: line {line}: unexpected columns {extra}; expected q1..q{n}, "
-            f"M<i>_<j> (i >= j) and g1..g{n} only"
+            f"line {line}: unexpected columns {extra}; expected q1..q{n}, "
+            f"M<i>_<j> (i >= j) and g1..g{n} only",
+            file=path.name,
         )
     return n
 
@@ -285,9 +290,9 @@ def _parse_rows(path: Path, lineno: int, text: str) -> int:
     try:
         n = _checks.integer(text)
     except ValueError:
-        raise DataError(f"{path.name}: line {lineno}: '# rows:' must give an integer") from None
+        raise DataError(f"line {lineno}: '# rows:' must give an integer", file=path.name) from None
     if n < 0:
-        raise DataError(f"{path.name}: line {lineno}: '# rows:' must be >= 0; got {n}")
+        raise DataError(f"line {lineno}: '# rows:' must be >= 0; got {n}", file=path.name)
     return n
 
 
@@ -295,9 +300,10 @@ def check_row_count(path: Path, recorded: int | None, found: int) -> None:
     """Raise :class:`DataError` when a file holds fewer or more rows than it recorded."""
     if recorded is not None and recorded != found:
         raise DataError(
-            f"{path.name}: the file records {recorded} rows but holds {found}; it is "
+            f"the file records {recorded} rows but holds {found}; it is "
             "incomplete or was edited (a write or copy cut short?); regenerate it, or, if "
-            "rows were removed on purpose, correct or delete its '# rows:' line"
+            "rows were removed on purpose, correct or delete its '# rows:' line",
+            file=path.name,
         )
 
 
@@ -305,9 +311,9 @@ def _parse_meta(path: Path, where: str, text: str) -> dict[str, Any]:
     try:
         meta = loads(text)
     except ValueError as exc:
-        raise DataError(f"{path.name}: {where}: metadata is not strict JSON ({exc})") from exc
+        raise DataError(f"{where}: metadata is not strict JSON ({exc})", file=path.name) from exc
     if not isinstance(meta, dict):
-        raise DataError(f"{path.name}: {where}: metadata must be a JSON object")
+        raise DataError(f"{where}: metadata must be a JSON object", file=path.name)
     return meta
 
 
@@ -350,37 +356,40 @@ def load_static_npz(
             missing = [k for k in _NPZ_KEYS if k not in keys]
             extra = sorted(keys - set(_NPZ_KEYS) - {"metadata", "n_rows"})
             if missing:
-                raise DataError(f"{path.name}: missing arrays {missing}; expected q, M, g")
+                raise DataError(f"missing arrays {missing}; expected q, M, g", file=path.name)
             if extra:
                 raise DataError(
-                    f"{path.name}: unexpected arrays {extra}; expected q, M, g (and metadata)"
+                    f"unexpected arrays {extra}; expected q, M, g (and metadata)", file=path.name
                 )
             arrays = {k: np.asarray(z[k]) for k in _NPZ_KEYS}
             meta_text = str(z["metadata"]) if "metadata" in keys else "{}"
             n_recorded = _npz_rows(path, z) if "n_rows" in keys else None
     except (AttributeError, TypeError):  # a single .npy array: np.load gives an array
-        raise DataError(f"{path.name}: a single array, not an NPZ archive of q, M, g") from None
+        raise DataError("a single array, not an NPZ archive of q, M, g", file=path.name) from None
     except (zipfile.BadZipFile, OSError, ValueError, EOFError, KeyError) as exc:
         if isinstance(exc, DataError):
             raise
-        raise DataError(f"{path.name}: not a readable NPZ file of arrays ({exc})") from exc
+        raise DataError(f"not a readable NPZ file of arrays ({exc})", file=path.name) from exc
     for k, a in arrays.items():
         if not np.issubdtype(a.dtype, np.number) or np.iscomplexobj(a):
-            raise DataError(f"{path.name}: array {k!r} must be real numbers; got dtype {a.dtype}")
+            raise DataError(
+                f"array {k!r} must be real numbers; got dtype {a.dtype}", file=path.name
+            )
     q, M, g = (arrays[k].astype(np.float64) for k in _NPZ_KEYS)
     if q.ndim != 2 or q.shape[0] < 1:
-        raise DataError(f"{path.name}: array 'q' must have shape (N, n); got {q.shape}")
+        raise DataError(f"array 'q' must have shape (N, n); got {q.shape}", file=path.name)
     N, n = q.shape
     check_row_count(path, n_recorded, N)
     if robot is not None and n != robot.n:
         raise DataError(
-            f"{path.name}: data for {n} joints (q of shape {q.shape}); robot {robot.name!r} "
-            f"has {robot.n}; hint: pass the robot the data were recorded with"
+            f"data for {n} joints (q of shape {q.shape}); robot {robot.name!r} "
+            f"has {robot.n}; hint: pass the robot the data were recorded with",
+            file=path.name,
         )
     if M.shape != (N, n, n):
-        raise DataError(f"{path.name}: array 'M' must have shape {(N, n, n)}; got {M.shape}")
+        raise DataError(f"array 'M' must have shape {(N, n, n)}; got {M.shape}", file=path.name)
     if g.shape != (N, n):
-        raise DataError(f"{path.name}: array 'g' must have shape {(N, n)}; got {g.shape}")
+        raise DataError(f"array 'g' must have shape {(N, n)}; got {g.shape}", file=path.name)
     meta = _parse_meta(path, "array 'metadata'", meta_text)
     i, j = np.tril_indices(n)
     bad: list[str] = []
@@ -399,8 +408,9 @@ def load_static_npz(
     if bad and not drop_invalid:
         first = min(bad, key=lambda b: int(b.split(":")[0].split()[1]))
         raise DataError(
-            f"{path.name}: {first} ({len(bad)} bad row(s) in all); hint: fix the file or load "
-            "with drop_invalid=True"
+            f"{first} ({len(bad)} bad row(s) in all); hint: fix the file or load "
+            "with drop_invalid=True",
+            file=path.name,
         )
     table = np.concatenate([q, M[:, i, j], g], axis=1)[ok]
     return _finish(path, table, n, meta, bad)
@@ -421,7 +431,7 @@ def _finish(
             "; ..." if len(bad) > 5 else "",
         )
     if len(table) == 0:
-        raise DataError(f"{path.name}: no valid configuration ({len(bad)} invalid row(s))")
+        raise DataError(f"no valid configuration ({len(bad)} invalid row(s))", file=path.name)
     i, j = np.tril_indices(n)
     q = table[:, :n]
     M = np.zeros((len(table), n, n))
@@ -437,5 +447,5 @@ def _finish(
 def _npz_rows(path: Path, z: Any) -> int:
     a = np.asarray(z["n_rows"])
     if a.shape != () or not np.issubdtype(a.dtype, np.integer) or int(a) < 0:
-        raise DataError(f"{path.name}: array 'n_rows' must be one integer >= 0; got {a!r}")
+        raise DataError(f"array 'n_rows' must be one integer >= 0; got {a!r}", file=path.name)
     return int(a)

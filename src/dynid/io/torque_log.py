@@ -179,14 +179,14 @@ def save_torque_log_pieces(
 def _piece_rows(path: Path, log: TorqueLog, n: int) -> int:
     """The samples of a piece of a log of ``n`` joints written to ``path``."""
     if log.n != n:
-        raise DataError(f"{path.name}: a piece of the log has {log.n} joints; expected {n}")
+        raise DataError(f"a piece of the log has {log.n} joints; expected {n}", file=path.name)
     return log.n_samples
 
 
 def _check_written(path: Path, rows: int, n_rows: int) -> None:
     """Refuse a written log whose pieces hold another number of rows than recorded."""
     if rows != n_rows:
-        raise DataError(f"{path.name}: the pieces held {rows} rows; {n_rows} were recorded")
+        raise DataError(f"the pieces held {rows} rows; {n_rows} were recorded", file=path.name)
 
 
 def load_torque_log(
@@ -238,7 +238,7 @@ def load_torque_log(
             log = with_derived_velocities(log, DEFAULT_CUTOFF_HZ)
         return log
     except DataError as exc:
-        raise DataError(f"{path.name}: {exc}") from exc
+        raise DataError(str(exc), file=path.name) from exc
 
 
 def _where(rows: NDArray[np.intp], lines: tuple[int, int] | None) -> str:
@@ -280,13 +280,15 @@ def _check_rows(
                 col = f"{k}{int(j[0]) + 1}"
                 break
         raise DataError(
-            f"{path.name}: {bad.size} row(s) hold NaN, inf or an empty cell; first "
-            f"{_where(bad[:1], lines)} in {col!r}; hint: {hint}"
+            f"{bad.size} row(s) hold NaN, inf or an empty cell; first "
+            f"{_where(bad[:1], lines)} in {col!r}; hint: {hint}",
+            file=path.name,
         )
     if dup.size and not drop_invalid:
         raise DataError(
-            f"{path.name}: {dup.size} row(s) repeat the previous timestamp; first "
-            f"{_where(dup[:1], lines)} (t = {float(t[dup[0]])!r}); hint: {hint}"
+            f"{dup.size} row(s) repeat the previous timestamp; first "
+            f"{_where(dup[:1], lines)} (t = {float(t[dup[0]])!r}); hint: {hint}",
+            file=path.name,
         )
     if bad.size:
         _log.warning(
@@ -311,17 +313,18 @@ def _read_npz(path: Path) -> dict[str, NDArray[np.float64]]:
     try:
         npz = np.load(path, allow_pickle=False)
     except (ValueError, OSError, EOFError, zipfile.BadZipFile) as exc:
-        raise DataError(f"{path.name}: not a readable NPZ file without pickles ({exc})") from exc
+        raise DataError(f"not a readable NPZ file without pickles ({exc})", file=path.name) from exc
     if not hasattr(npz, "files"):
-        raise DataError(f"{path.name}: a single .npy array, not an NPZ archive of arrays")
+        raise DataError("a single .npy array, not an NPZ archive of arrays", file=path.name)
     arrays = {}
     try:
         with npz:
             missing = [k for k in ("t", "q", "tau") if k not in npz.files]
             if missing:
                 raise DataError(
-                    f"{path.name}: missing array(s) {missing}; expected t, q, tau (optional "
-                    f"dq, derived from q when absent, and ddq); found {sorted(npz.files)}"
+                    f"missing array(s) {missing}; expected t, q, tau (optional "
+                    f"dq, derived from q when absent, and ddq); found {sorted(npz.files)}",
+                    file=path.name,
                 )
             extra = sorted(set(npz.files) - {"t", "n_rows", *_SIGNALS})
             if extra:  # labels, vendor estimates, true external torques: kept in the file
@@ -335,68 +338,78 @@ def _read_npz(path: Path) -> dict[str, NDArray[np.float64]]:
                 try:
                     a = np.asarray(npz[k])
                 except ValueError as exc:  # object arrays need pickles, which are refused
-                    raise DataError(f"{path.name}: array {k!r} cannot be read ({exc})") from exc
+                    raise DataError(f"array {k!r} cannot be read ({exc})", file=path.name) from exc
                 if k == "n_rows":
                     if a.shape != () or not np.issubdtype(a.dtype, np.integer):
-                        raise DataError(f"{path.name}: array 'n_rows' must be one integer")
+                        raise DataError("array 'n_rows' must be one integer", file=path.name)
                     n_rows = int(a)
                     continue
                 if not np.issubdtype(a.dtype, np.number) or np.iscomplexobj(a):
                     raise DataError(
-                        f"{path.name}: array {k!r} must be real numbers; got dtype {a.dtype}"
+                        f"array {k!r} must be real numbers; got dtype {a.dtype}", file=path.name
                     )
                 arrays[k] = _checks.frozen(a.astype(np.float64, copy=False))  # kept as is
                 del a
     except (zipfile.BadZipFile, EOFError, OSError) as exc:
-        raise DataError(f"{path.name}: not a readable NPZ file ({exc})") from exc
+        raise DataError(f"not a readable NPZ file ({exc})", file=path.name) from exc
     t = arrays["t"]
     if t.ndim != 1:
-        raise DataError(f"{path.name}: array 't' must have shape (N,); got {t.shape}")
+        raise DataError(f"array 't' must have shape (N,); got {t.shape}", file=path.name)
     check_row_count(path, n_rows, t.shape[0])
     for k in _SIGNALS:
         if k in arrays and (arrays[k].ndim != 2 or arrays[k].shape[0] != t.shape[0]):
             raise DataError(
-                f"{path.name}: array {k!r} must have shape ({t.shape[0]}, n) like t; "
-                f"got {arrays[k].shape}"
+                f"array {k!r} must have shape ({t.shape[0]}, n) like t; got {arrays[k].shape}",
+                file=path.name,
             )
     return arrays
 
 
 def _columns(path: Path, names: list[str], line: int) -> tuple[int, bool]:
     """Check the header; return the joint count n and whether ddq columns are present."""
-    where = f"{path.name}, line {line}"
+    at = f"line {line}"
     dup = sorted({c for c in names if names.count(c) > 1})
     if dup:
-        raise DataError(f"{where}: duplicated column(s) {dup}; each column must appear once")
+        raise DataError(
+            f"duplicated column(s) {dup}; each column must appear once", file=path.name, at=at
+        )
     qs = sorted(int(c[1:]) for c in names if re.fullmatch(r"q[1-9]\d*", c))
     n = len(qs)
     if "t" not in names or n == 0:
         raise DataError(
-            f"{where}: header must name columns t, q1..qn, dq1..dqn, tau1..taun; "
-            f"got {names[:8]}{' ...' if len(names) > 8 else ''}"
+            f"header must name columns t, q1..qn, dq1..dqn, tau1..taun; "
+            f"got {names[:8]}{' ...' if len(names) > 8 else ''}",
+            file=path.name,
+            at=at,
         )
     if qs != list(range(1, n + 1)):
         gap = sorted(set(range(1, max(qs) + 1)) - set(qs))
-        raise DataError(f"{where}: joint position columns must be q1..qn; missing q{gap[0]}")
+        raise DataError(
+            f"joint position columns must be q1..qn; missing q{gap[0]}", file=path.name, at=at
+        )
     need = torque_log_columns(n)
     if not any(f"dq{j}" in names for j in range(1, n + 1)):  # positions only
         need = [c for c in need if not c.startswith("dq")]
     missing = [c for c in need if c not in names]
     if missing:
-        raise DataError(f"{path.name}: missing column(s) {missing} (n = {n} from q1..q{n})")
+        raise DataError(f"missing column(s) {missing} (n = {n} from q1..q{n})", file=path.name)
     ddq = [f"ddq{j}" for j in range(1, n + 1)]
     have = [c for c in ddq if c in names]
     if have and len(have) != n:
         raise DataError(
-            f"{where}: accelerations must be all of ddq1..ddq{n} or none; got only {have}"
+            f"accelerations must be all of ddq1..ddq{n} or none; got only {have}",
+            file=path.name,
+            at=at,
         )
     unknown = [c for c in names if c not in set(need) | set(ddq)]
     signals = [c for c in unknown if re.fullmatch(r"(q|dq|tau|ddq)\d+", c)]
     if signals:
         raise DataError(
-            f"{where}: unknown column(s) {signals}; a torque log has t, q1..q{n}, "
+            f"unknown column(s) {signals}; a torque log has t, q1..q{n}, "
             f"dq1..dq{n} (optional: derived from q when absent), tau1..tau{n} and optionally "
-            f"ddq1..ddq{n}"
+            f"ddq1..ddq{n}",
+            file=path.name,
+            at=at,
         )
     if unknown:  # labels, vendor estimates, true external torques: kept in the file
         _log.warning(

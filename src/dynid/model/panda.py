@@ -25,6 +25,7 @@ from .robot import Robot
 
 __all__ = [
     "panda",
+    "PANDA_FRICTION",
     "PANDA_NEUTRAL_Q",
     "GAZ2019_EXCITING_A",
     "GAZ2019_EXCITING_B",
@@ -62,7 +63,10 @@ _INERTIA = [  # xx, xy, xz, yy, yz, zz about the CoM
     [0.001964, 0.000109, -0.001158, 0.004354, 0.000341, 0.005433],
     [0.012516, -0.000428, -0.001196, 0.010027, -0.000741, 0.004815],
 ]
-_FRICTION = np.array(
+#: The Panda's published sigmoid friction parameters (module docstring), (7, 3): columns
+#: ``phi1 [N m], phi2 [s/rad], phi3 [rad/s]``; :func:`panda` holds them as a
+#: ``dynid.SigmoidFriction``.
+PANDA_FRICTION = np.array(
     [
         [0.54615, 0.87224, 0.64068, 1.2794, 0.83904, 0.30301, 0.56489],  # phi1 [N m]
         [5.1181, 9.0657, 10.136, 5.5903, 8.3469, 17.133, 10.336],  # phi2 [s/rad]
@@ -122,8 +126,13 @@ def panda() -> Robot:
     -------
     Robot
         7 revolute joints ``joint1..joint7``, links ``link0..link7``, frame ``flange``
-        0.107 m along z7; gravity 9.80665 m/s^2 along -z of ``link0``.
+        0.107 m along z7; gravity 9.80665 m/s^2 along -z of ``link0``; friction the
+        published sigmoid (:data:`PANDA_FRICTION`).
     """
+    # The one friction type is built from the law registry of a later layer, imported when
+    # called (tests/test_layers.py lists this facade): the published data is an array.
+    from ..friction.model import SigmoidFriction
+
     robot = Robot.from_mdh(
         _A,
         _D,
@@ -137,7 +146,7 @@ def panda() -> Robot:
         dq_max=_DQ_MAX,
         ddq_max=_DDQ_MAX,
         tau_max=_TAU_MAX,
-        friction=_FRICTION,
+        friction=SigmoidFriction.from_array(PANDA_FRICTION),
         name="panda",
     )
     return robot.replace(q_neutral=PANDA_NEUTRAL_Q)

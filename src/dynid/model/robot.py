@@ -24,13 +24,13 @@ from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 from types import MappingProxyType
-from typing import Any, Protocol
+from typing import Any, Protocol, runtime_checkable
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from .. import _checks
-from ..exceptions import ModelError, ShapeError, UnknownNameError
+from ..exceptions import ModelError, ShapeError, UnknownNameError, WrongTypeError
 from .inertia import inertial_from_phi, param_labels, phi_from_inertial
 
 __all__ = ["Frame", "MAX_LINK_MASS", "MAX_LINK_OFFSET", "Robot", "STANDARD_GRAVITY"]
@@ -125,9 +125,10 @@ def _restore_robot(state: dict[str, Any]) -> Robot:
     return robot
 
 
+@runtime_checkable
 class FrictionLike(Protocol):
-    """What a robot reads of a friction model it holds (the one friction type,
-    :class:`~dynid.friction.model.Friction`, of a later layer)."""
+    """What a robot reads of the friction it holds: the one friction type,
+    :class:`~dynid.friction.model.Friction`, of a later layer (this layer cannot name it)."""
 
     @property
     def n(self) -> int:
@@ -147,6 +148,27 @@ class FrictionLike(Protocol):
     def as_array(self) -> NDArray[np.float64]:
         """The parameters (n, k)."""
         ...
+
+    def torques(self, dq: ArrayLike) -> NDArray[np.float64]:
+        """Joint friction torques [N m] (..., n) at joint velocities (..., n) [rad/s]."""
+        ...
+
+
+def _check_friction(friction: object, n: int) -> None:
+    """Refuse what is not a friction model of ``n`` joints: a bare array says no law (it was
+    once read as sigmoid parameters), so it is refused with the constructor to call."""
+    if not isinstance(friction, FrictionLike):
+        what = (
+            f"an array of shape {np.shape(friction)}"
+            if isinstance(friction, np.ndarray | list | tuple)
+            else f"a {type(friction).__name__}"
+        )
+        raise WrongTypeError(
+            f"a robot's friction must be a Friction (dynid.Friction, of any law), not {what}; "
+            "sigmoid parameters (n, 3) make one with dynid.SigmoidFriction.from_array(P)"
+        )
+    if friction.n != n:
+        raise ShapeError(f"friction has {friction.n} joints; robot has {n}")
 
 
 @dataclass(frozen=True, slots=True, eq=False, weakref_slot=True)
@@ -177,15 +199,12 @@ class Robot:
         Gravity acceleration in the base frame [m/s^2].
     frames : mapping of str to Frame
         Named frames; includes every link name and ``flange``.
-    friction : ndarray, shape (n, 3), or None
-        Sigmoid friction parameters ``phi1 [N m], phi2 [s/rad], phi3 [rad/s]`` per joint
-        (Gaz et al. 2019 eq. 25), as the description files hold them; None for none, or
-        when the robot's friction is another law (``friction_model``).
-    friction_model : Friction or None
-        The robot's friction when it is not the sigmoid at the joints: a
-        :class:`~dynid.friction.model.Friction` of any law, standstill band and drive
-        (:meth:`with_friction`); None otherwise. Exclusive with ``friction``;
-        :func:`dynid.friction.model.robot_friction` returns either as a ``Friction``.
+    friction : Friction or None
+        The robot's friction: a :class:`~dynid.friction.model.Friction` (a law of the
+        registry, its parameters, standstill band and where it acts), None for none. The
+        Panda's is the sigmoid of Gaz et al. 2019 (eq. 25); sigmoid parameters ``(n, 3)``
+        (``phi1 [N m], phi2 [s/rad], phi3 [rad/s]``, as description files hold them) make
+        one with ``dynid.SigmoidFriction.from_array(P)``; a bare array is refused.
     q_neutral : ndarray, shape (n,), or None
         A documented neutral pose (start of IK, demos); None: the middle of the limits.
 
@@ -212,9 +231,8 @@ class Robot:
         default_factory=lambda: np.array([0.0, 0.0, -STANDARD_GRAVITY])
     )
     frames: Mapping[str, Frame] = field(default_factory=dict)
-    friction: NDArray[np.float64] | None = None
+    friction: FrictionLike | None = None
     q_neutral: NDArray[np.float64] | None = None
-    friction_model: FrictionLike | None = None
 
     def __post_init__(self) -> None:
         n = len(self.joint_names)
@@ -289,16 +307,7 @@ class Robot:
             "frame", list(self.frames), np.array([f.T_link_frame for f in self.frames.values()])
         )
         if self.friction is not None:
-            put("friction", _checks.frozen(_checks.as_exact("friction", self.friction, (n, 3))))
-        if self.friction_model is not None:
-            if self.friction is not None:
-                raise ModelError(
-                    "a robot holds friction (sigmoid parameters) or friction_model (a friction "
-                    "model of any law), not both; use with_friction to replace it"
-                )
-            if self.friction_model.n != n:
-                m = self.friction_model.n
-                raise ShapeError(f"friction_model has {m} joints; robot has {n}")
+            _check_friction(self.friction, n)
         if self.q_neutral is not None:
             qn = _checks.as_exact("q_neutral", self.q_neutral, (n,))
             if np.any((qn < self.q_min) | (qn > self.q_max)):
@@ -365,18 +374,11 @@ class Robot:
         """A copy with masses [kg] (n,), CoMs [m] (n, 3), CoM inertias (n, 3, 3) or (n, 6)."""
         return self.replace(phi=phi_from_inertial(mass, com, inertia))
 
-    def with_friction(self, friction: ArrayLike | FrictionLike | None) -> Robot:
-        """A copy with friction: sigmoid parameters (n, 3), a friction model of any law
-        (:class:`~dynid.friction.model.Friction`; the sigmoid at the joints is kept as its
-        parameters, as the description files hold it), or None."""
-        if friction is None:
-            return self.replace(friction=None, friction_model=None)
-        if hasattr(friction, "kind") and hasattr(friction, "as_array"):
-            fr: Any = friction
-            if fr.kind == "sigmoid" and fr.drive is None:
-                return self.replace(friction=fr.as_array(), friction_model=None)
-            return self.replace(friction=None, friction_model=fr)
-        return self.replace(friction=friction, friction_model=None)
+    def with_friction(self, friction: FrictionLike | None) -> Robot:
+        """A copy with ``friction``: a :class:`~dynid.friction.model.Friction` of any law,
+        standstill band and drive, or None (sigmoid parameters (n, 3):
+        ``dynid.SigmoidFriction.from_array(P)``)."""
+        return self.replace(friction=friction)
 
     def with_gravity(self, gravity: ArrayLike) -> Robot:
         """A copy with the gravity vector (3,) [m/s^2] in the base frame."""
@@ -456,7 +458,7 @@ class Robot:
         ddq_max: ArrayLike | None = None,
         tau_max: ArrayLike | None = None,
         gravity: ArrayLike = (0.0, 0.0, -STANDARD_GRAVITY),
-        friction: ArrayLike | None = None,
+        friction: FrictionLike | None = None,
         name: str = "robot",
         link_names: Sequence[str] | None = None,
         joint_names: Sequence[str] | None = None,
@@ -483,6 +485,8 @@ class Robot:
             (n, 6) [kg m^2]. Default zero.
         q_min, q_max, dq_max, ddq_max, tau_max : array_like, optional
             Joint limits (n,); default unbounded.
+        friction : Friction, optional
+            The robot's friction (:class:`~dynid.friction.model.Friction`); default none.
         """
         a_, d_, al = (np.asarray(x, dtype=np.float64) for x in (a, d, alpha))
         n = a_.shape[0]
@@ -536,7 +540,7 @@ class Robot:
             tau_max=limit("tau_max", tau_max, inf),
             gravity=np.asarray(gravity, dtype=np.float64),
             frames=frames,
-            friction=None if friction is None else np.asarray(friction, dtype=np.float64),
+            friction=friction,
         )
 
     # The two file constructors are facades over dynid.io.robot, imported when called: the

@@ -144,7 +144,7 @@ def from_robot(
     ----------
     robot : Robot
     friction : FrictionModel, None or "robot"
-        ``"robot"`` (default): the robot's sigmoid friction, none if it has none.
+        ``"robot"`` (default): the robot's own friction (any law), none if it has none.
     drive : Drive, optional
         Its known rotor inertias add ``K^T diag(I_a) K`` to ``M``.
 

@@ -222,7 +222,9 @@ def base_momentum_regressor(
     Fp, Fb = np.zeros((B, n, p_std)), np.zeros((B, n, p_std))
     Fp[..., : 10 * n], Fb[..., : 10 * n] = Yp, Yg - Yc
     if p_std > 10 * n and model.drive is not None:
-        Fp[..., 10 * n : 11 * n] = model.drive.rotor_columns(dq2)
+        # the rotors that are standard parameters (a rotor term may hold some only)
+        held = np.isin(model.drive.rotor_labels, model.base.std_labels[10 * n :])
+        Fp[..., 10 * n :] = model.drive.rotor_columns(dq2)[..., held]
     idx = np.asarray(model.base.independent)
     r = idx.size
     return Fp[..., idx].reshape(shape + (n, r)), Fb[..., idx].reshape(shape + (n, r))

@@ -7,7 +7,16 @@ files: the command line renders the results and saves them.
 
 from .collision import CollisionStageResult, collision_stage
 from .consistent import ConsistentSetup, ConsistentStageResult, consistent_stage
-from .demo import STAGE_TITLES, DemoResult, StageFinished, StageStarted, run_demo
+from .demo import (
+    STAGE_TITLES,
+    STAGES,
+    DemoResult,
+    Stage,
+    StageFinished,
+    StageKind,
+    StageStarted,
+    run_demo,
+)
 from .stages import (
     DEMO_RELATIVE_NOISE,
     DEMO_TOOL_XYZ,
@@ -27,6 +36,7 @@ __all__ = [
     "DEMO_RELATIVE_NOISE",
     "DEMO_TOOL_XYZ",
     "DEMO_WORKERS",
+    "STAGES",
     "STAGE_TITLES",
     "CollisionStageResult",
     "ConsistentSetup",
@@ -36,7 +46,9 @@ __all__ = [
     "FrictionStageResult",
     "IdentificationStageResult",
     "KinematicsStageResult",
+    "Stage",
     "StageFinished",
+    "StageKind",
     "StageStarted",
     "collision_stage",
     "consistent_stage",

@@ -27,6 +27,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
+from ..friction.model import sigmoid_parameters
 from ..identification.static import basis_transform
 from ..model.robot import Robot
 from .demo import DemoResult
@@ -182,8 +183,8 @@ def _table_iii(demo: DemoResult) -> list[dict[str, Any]]:
 
 
 def _friction(demo: DemoResult) -> list[dict[str, Any]]:
-    published = demo.robot.friction
     fitted = demo.friction.fit.friction
+    published = sigmoid_parameters(demo.robot.friction)
     if published is None or not hasattr(fitted, "phi1"):
         return []
     units = {"phi1": "N m", "phi2": "s/rad", "phi3": "rad/s"}

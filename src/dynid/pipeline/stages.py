@@ -31,7 +31,7 @@ from numpy.typing import ArrayLike, NDArray
 from ..exceptions import DynidError
 from ..feasibility.penalty import RetrievalResult, retrieve
 from ..friction.fit import FrictionFit, FrictionResidual, fit_sigmoid, friction_residual
-from ..friction.model import Friction, SigmoidFriction
+from ..friction.model import Friction, robot_friction
 from ..friction.validation import (
     NewtonEulerValidation,
     Validation,
@@ -276,8 +276,7 @@ class FrictionStageResult:
     @property
     def reference_friction(self) -> Friction | None:
         """The truth's friction, or None."""
-        f = self.truth.friction
-        return None if f is None else SigmoidFriction.from_array(f)
+        return robot_friction(self.truth)
 
     @property
     def rms_without_friction(self) -> FloatArray:
@@ -333,9 +332,9 @@ def friction_stage(
     val = validate_torques(model, val_log, friction=fit.friction)
     assert val.with_friction is not None
     curve = None
-    if truth.friction is not None:
+    true_f = robot_friction(truth)
+    if true_f is not None:
         v = np.linspace(-1.0, 1.0, 801)[:, None] * np.max(np.abs(traj.dq), axis=0)
-        true_f = SigmoidFriction.from_array(truth.friction)
         curve = np.sqrt(np.mean((fit.friction.torques(v) - true_f.torques(v)) ** 2, axis=0))
     return FrictionStageResult(truth, limits, float(scale), noise, res, fit, val, curve, seed)
 

@@ -50,7 +50,6 @@ from numpy.typing import ArrayLike, NDArray
 from .. import _checks
 from ..dynamics.rnea import rnea
 from ..exceptions import OptionError, ShapeError
-from ..friction.model import sigmoid_friction
 from ..identification.classical import friction_regressor
 from ..model.robot import Robot
 from ..regressors.base import BaseParameters, base_parameters
@@ -382,8 +381,7 @@ def excitation_condition_number(
 def _motor_torques(robot: Robot, tr: Trajectory) -> NDArray[np.float64]:
     tau = rnea(robot, tr.q, tr.dq, tr.ddq)
     if robot.friction is not None:
-        f = np.asarray(robot.friction)
-        tau = tau + sigmoid_friction(tr.dq, f[:, 0], f[:, 1], f[:, 2])
+        tau = tau + robot.friction.torques(tr.dq)
     return tau
 
 

@@ -22,7 +22,8 @@ from typing import Any, Literal, TypeVar
 
 import numpy as np
 
-from ..exceptions import DataError, DynidError, OptionError
+from ..exceptions import DataError, OptionError
+from ..exceptions import in_file as about_file
 from ..identification.data import StaticDataset
 from ..identification.log import TorqueLog
 from ..io.columns import (
@@ -60,22 +61,17 @@ _T = TypeVar("_T")
 
 
 def in_file(path: Path, fit: Callable[[], _T]) -> _T:
-    """``fit()``, a :class:`~dynid.exceptions.DynidError` it raises prefixed with the
-    file's name when it lacks it (the same error, of the same class).
+    """``fit()``, a :class:`~dynid.exceptions.DynidError` it raises naming the file when it
+    names none (:func:`dynid.exceptions.in_file`: the same error, of the same class).
 
     Raises
     ------
     DynidError
-        Whatever ``fit`` raises, its message starting with ``path.name``.
+        Whatever ``fit`` raises, its message starting with a file's name (``path.name``
+        unless the error names its own; an option's error is left to name its flag).
     """
-    try:
+    with about_file(path.name):
         return fit()
-    except DynidError as exc:
-        if isinstance(exc, OptionError) and exc.field is not None:
-            raise  # about an option, not the file; the command names it by its flag
-        if str(exc).startswith(path.name):
-            raise
-        raise type(exc)(f"{path.name}: {exc}") from exc
 
 
 def column_map(
@@ -140,17 +136,17 @@ def data_kind(path: str | Path, columns: ColumnMap | None = None) -> DataKind:
                 if s and not s.startswith("#"):
                     cols = [c.strip() for c in s.split(",")]
                     return "torque_log" if "t" in cols else "static"
-        raise DataError(f"{path.name}: no header line")
+        raise DataError("no header line", file=path.name)
     if suffix == ".npz":
         try:
             with np.load(path, allow_pickle=False) as z:
                 keys = set(z.files)
         except (ValueError, EOFError, zipfile.BadZipFile) as exc:
-            raise DataError(f"{path.name}: not a readable NPZ file ({exc})") from exc
+            raise DataError(f"not a readable NPZ file ({exc})", file=path.name) from exc
         except (AttributeError, TypeError):  # a single .npy array: np.load gives an array
-            raise DataError(f"{path.name}: a single array, not an NPZ archive") from None
+            raise DataError("a single array, not an NPZ archive", file=path.name) from None
         return "torque_log" if "t" in keys or "tau" in keys else "static"
-    raise DataError(f"{path.name}: a data file must be .csv or .npz")
+    raise DataError("a data file must be .csv or .npz", file=path.name)
 
 
 def read_torque_log(
@@ -201,15 +197,17 @@ def read_torque_log(
             )
             if not drop_invalid:
                 raise DataError(
-                    f"{path.name}: {what}; hint: fix the file or pass --drop-invalid "
-                    "(drop_invalid=True) to drop them"
+                    f"{what}; hint: fix the file or pass --drop-invalid "
+                    "(drop_invalid=True) to drop them",
+                    file=path.name,
                 )
             _log.warning("%s: dropped: %s", path.name, what)
         log = mapped.log
     if n is not None and log.n != n:
         raise DataError(
-            f"{path.name}: the log has {log.n} joints; {owner or 'the robot'} has {n}; "
-            "hint: pass the robot the log was recorded with"
+            f"the log has {log.n} joints; {owner or 'the robot'} has {n}; "
+            "hint: pass the robot the log was recorded with",
+            file=path.name,
         )
     return log
 

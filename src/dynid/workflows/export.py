@@ -21,7 +21,7 @@ from pathlib import Path
 from typing import Any
 
 from ..exceptions import OptionError
-from ..friction.model import Friction
+from ..friction.model import Friction, sigmoid_parameters
 from ..friction.mujoco import CoulombViscous, coulomb_viscous_from_sigmoid
 from ..io.drive_file import load_drive
 from ..io.export import EXPORT_FORMATS, ROBOT_FORMATS, export_format, model_terms_of
@@ -159,8 +159,9 @@ def export_robot(
         drive=drive,
     )
     approx = None
-    if fmt == "mjcf" and friction is True and robot.friction is not None:
-        approx = coulomb_viscous_from_sigmoid(robot.friction, robot.dq_max)
+    sigmoid = sigmoid_parameters(robot.friction)
+    if fmt == "mjcf" and friction is True and sigmoid is not None:
+        approx = coulomb_viscous_from_sigmoid(sigmoid, robot.dq_max)
     return RobotExport(robot, fmt, written, approx)
 
 

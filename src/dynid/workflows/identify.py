@@ -115,7 +115,7 @@ def data_files(paths: str | Path | Sequence[str | Path]) -> list[Path]:
         if p.is_dir():
             found = sorted(f for f in p.iterdir() if f.suffix.lower() in (".csv", ".npz"))
             if not found:
-                raise DataError(f"{p.name}: the folder holds no .csv or .npz data file")
+                raise DataError("the folder holds no .csv or .npz data file", file=p.name)
             out += found
         else:
             out.append(p)

@@ -132,7 +132,7 @@ def identify_payload_files(
                 f"{paths[0].name} holds static data: give one static data file ({len(paths)} given)"
             )
         if unloaded is not None and data_kind(unloaded, cmap) != "static":
-            raise DataError(f"{Path(unloaded).name}: --unloaded must be static data like --data")
+            raise DataError("--unloaded must be static data like --data", file=Path(unloaded).name)
         static = read_static_file(
             paths[0], kin, columns=cmap, drop_invalid=drop_invalid, require_M=not gravity_only
         )
@@ -200,9 +200,10 @@ def _pieces(
             mine.append(piece)
         if not mine:
             raise DataError(
-                f"{name}: no piece long enough to filter at {cutoff_hz} Hz (gaps longer than "
+                f"no piece long enough to filter at {cutoff_hz} Hz (gaps longer than "
                 "--max-gap cut a recording into pieces); hint: record longer stretches "
-                "without gaps, or raise --max-gap"
+                "without gaps, or raise --max-gap",
+                file=name,
             )
         kept += mine
         summary.append(

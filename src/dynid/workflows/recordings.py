@@ -157,9 +157,10 @@ def _check_units(rec: Recorded) -> None:
             names = [n for i, n in enumerate(rec.names) if i != worst]
             others = ", ".join(names) if len(names) <= 3 else "the other recordings"
             raise DataError(
-                f"{rec.names[worst]}: its {what} are {ratio:.3g} times those of {others}: "
+                f"its {what} are {ratio:.3g} times those of {others}: "
                 "recorded in other units? hint: every recording is read with the same "
-                "units; convert it or leave it out"
+                "units; convert it or leave it out",
+                file=rec.names[worst],
             )
 
 

@@ -69,7 +69,7 @@ def _with_friction(robot: Robot, path: str | Path | None) -> Robot:
             "(`dynid friction --friction-model sigmoid`), or none",
             field="friction",
         )
-    return robot.with_friction(fr.as_array())
+    return robot.with_friction(fr)
 
 
 def load_model_with_friction(

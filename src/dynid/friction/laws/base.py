@@ -25,7 +25,6 @@ from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
-import scipy.optimize
 from numpy.typing import ArrayLike, NDArray
 
 from ... import _checks
@@ -201,6 +200,10 @@ class Friction:
         object.__setattr__(self, "params", _checks.frozen(p))
         object.__setattr__(self, "band", _checks.frozen(b))
 
+    def __reduce__(self) -> tuple[Any, tuple[Any, ...]]:
+        """Pickle (and copy) through the constructor: the arrays come back read-only."""
+        return Friction, (self.law, self.params, self.band, self.drive)
+
     def __getattr__(self, name: str) -> NDArray[np.float64]:
         """A parameter by name: its column (n,) of ``params``."""
         if name.startswith("_") or name in ("law", "params", "band", "drive"):
@@ -308,6 +311,8 @@ def bounded_lstsq(
     if np.all((free >= lo) & (free <= hi)):
         x[used] = free  # the unconstrained minimum is feasible: it is the bounded one
     else:
+        import scipy.optimize  # here: a robot holding a law loads no solver
+
         x[used] = scipy.optimize.lsq_linear(A[:, used], b, bounds=(lo, hi), method="bvls").x
     return x
 

@@ -16,8 +16,6 @@ MuJoCo holds the odd part of the sigmoid, ``(tau_f(dq) - tau_f(-dq)) / 2``, fitt
 from __future__ import annotations
 
 import numpy as np
-import scipy.optimize
-import scipy.special
 from numpy.typing import NDArray
 
 from ..torques import sigmoid_friction
@@ -30,9 +28,9 @@ MAXITER = 4000
 
 
 def _basis(dq: NDArray[np.float64], phi2: float, phi3: float) -> NDArray[np.float64]:
-    out: NDArray[np.float64] = scipy.special.expit(phi2 * (dq + phi3)) - scipy.special.expit(
-        phi2 * phi3
-    )
+    from scipy.special import expit  # here: a robot holding the law loads no scipy
+
+    out: NDArray[np.float64] = expit(phi2 * (dq + phi3)) - expit(phi2 * phi3)
     return out
 
 
@@ -63,6 +61,8 @@ def fit_joint(dq: NDArray[np.float64], r: NDArray[np.float64], band: float = 0.0
         e = rs - z[0] * s1 * _basis(dq, s2 * np.exp(z[1]), z[2] * s3)
         return float(np.mean(e**2))
 
+    import scipy.optimize  # here: a robot holding the law loads no solver
+
     z0 = np.array([1.0, 0.0, p30 / s3])
     res = scipy.optimize.minimize(
         cost, z0, method="Nelder-Mead", options={"xatol": 1e-7, "fatol": 1e-12, "maxiter": MAXITER}
@@ -79,6 +79,8 @@ def odd_part(
     velocities in ``(0, dq_max]`` (n,) [rad/s]: ``(fc, fv, offset, rms)``, each (n,), with
     ``fc, fv >= 0``, ``offset`` the even part at ``dq_max`` [N m] and ``rms`` the fit's RMS
     error [N m]."""
+    import scipy.optimize  # here: a robot holding the law loads no solver
+
     n = P.shape[0]
     coulomb, viscous, offset, rms = (np.zeros(n) for _ in range(4))
     for j in range(n):

@@ -15,7 +15,6 @@ as ``frictionloss``; the peak ``fs - fc`` at low speed and the offset are droppe
 from __future__ import annotations
 
 import numpy as np
-import scipy.optimize
 from numpy.typing import NDArray
 
 from ...regressors.friction_columns import standstill_sign, stribeck_decay
@@ -64,6 +63,8 @@ def _fit(dq: NDArray[np.float64], r: NDArray[np.float64], band: float) -> JointF
     costs = [solve(g, dqs, rs)[1] for g in grid]
     k = int(np.argmin(costs))
     a, b = grid[max(k - 1, 0)], grid[min(k + 1, grid.size - 1)]
+    import scipy.optimize  # here: a robot holding the law loads no solver
+
     res = scipy.optimize.minimize_scalar(
         lambda g: solve(g, dqs, rs)[1], bounds=(a, b), method="bounded", options={"xatol": 1e-4}
     )

@@ -48,7 +48,7 @@ from scipy.spatial.transform import Rotation
 
 from ... import __version__
 from ...exceptions import DynidWarning, ModelError, ShapeError
-from ...friction.model import FrictionModel, FrictionSum, robot_friction
+from ...friction.model import FrictionModel, FrictionSum, robot_friction, sigmoid_parameters
 from ...friction.mujoco import (
     CoulombViscous,
     coulomb_viscous_from_sigmoid,
@@ -115,8 +115,9 @@ def _joint_terms(
         )
         notes = jt.notes
         armature = jt.armature if d.rotor_inertia is not None else None
-    if friction is True and robot.friction is not None:  # the description's sigmoid
-        return coulomb_viscous_from_sigmoid(robot.friction, robot.dq_max), armature, notes
+    sigmoid = sigmoid_parameters(model) if friction is True else None
+    if sigmoid is not None:  # the description's sigmoid
+        return coulomb_viscous_from_sigmoid(sigmoid, robot.dq_max), armature, notes
     if model is None:
         return None, armature, notes
     approx, more = _law_terms(model, robot.dq_max)

@@ -14,10 +14,13 @@ Layout: optional top-level ``format_version = 1``, ``name``, ``gravity`` and
 ``mass``, ``com`` and ``inertia`` about the CoM); optional ``[[frames]]``. The full schema,
 with an annotated example, is in ``docs/robot-description.md``.
 
-Unknown keys are rejected, so that a misspelt key does not silently fall back to a
-default; numbers must be finite TOML numbers (never booleans or strings), an axis of a
-squared length beyond the float range and a mass outside ``[0, MAX_LINK_MASS]`` are refused.
-Every error names the joint or frame and the key.
+The keys are declared once (:data:`ROBOT_TOML`) and checked by the one strict codec of
+dynid's files (:mod:`dynid.io.schema`): unknown keys are rejected, so that a misspelt key
+does not silently fall back to a default; numbers must be finite TOML numbers (never booleans
+or strings; ``inf`` only for a limit), a mass outside ``[0, MAX_LINK_MASS]`` and an offset
+beyond ``MAX_LINK_OFFSET`` are refused; so is an axis of a squared length beyond the float
+range. Every error is one line in the codec's wording naming the file and the key path:
+``robot.toml: key 'joints[1].limits.velocity': expected a number > 0; got 0.0``.
 """
 
 from __future__ import annotations
@@ -33,7 +36,8 @@ import numpy as np
 from numpy.typing import NDArray
 
 from ... import _checks, spatial
-from ...exceptions import DynidError, DynidWarning, ModelError
+from ...exceptions import DataError, DynidError, DynidWarning, ModelError
+from ...friction.model import SigmoidFriction, sigmoid_parameters
 from ...model.drive import Drive
 from ...model.inertia import (
     inertia6_from_matrix,
@@ -52,10 +56,12 @@ from ...model.robot import (
 from ..atomic import write_text
 from ..drive_file import drive_toml
 from ..input_files import file_text
+from ..schema import Field, Record, check, fault
 from .export_options import ExportOptions
 
 __all__ = [
     "FORMAT_VERSION",
+    "ROBOT_TOML",
     "export_toml",
     "load_toml",
     "robot_from_toml_string",
@@ -66,92 +72,96 @@ __all__ = [
 #: Version of the schema written by :func:`toml_from_robot`.
 FORMAT_VERSION = 1
 
-_TOP_KEYS = {"format_version", "name", "gravity", "q_neutral", "joints", "frames", "drive"}
-#: ``[drive]`` (a drive train) is read by :func:`dynid.io.drive_file.load_drive`, not here.
-_JOINT_KEYS = {
-    "name",
-    "type",
-    "parent",
-    "child",
-    "origin",
-    "mdh",
-    "axis",
-    "limits",
-    "friction",
-    "inertial",
-}
-_ORIGIN_KEYS = {"xyz", "rpy"}
-_MDH_KEYS = {"a", "d", "alpha", "theta"}
-_LIMIT_KEYS = ("lower", "upper", "velocity", "acceleration", "effort")
-_INERTIAL_KEYS = {"mass", "com", "inertia"}
-_FRAME_KEYS = {"name", "parent", "xyz", "rpy", "mdh"}
+_L = MAX_LINK_OFFSET
+_XYZ = Field("numbers", shape=(3,), low=-_L, high=_L, unit="m")
+_RPY = Field("numbers", shape=(3,), unit="rad")
+_MDH = Record(
+    {
+        "a": Field("number", required=True, low=-_L, high=_L, unit="m"),
+        "d": Field("number", required=True, low=-_L, high=_L, unit="m"),
+        "alpha": Field("number", required=True, unit="rad"),
+        "theta": Field("number", unit="rad"),
+    }
+)
+_LIMIT = Field("number", infinite=True, unit="rad or m")
+_RATE = Field("number", infinite=True, low=0.0)
+_LIMITS = Record(
+    {
+        "lower": _LIMIT,
+        "upper": _LIMIT,
+        "velocity": _RATE,
+        "acceleration": _RATE,
+        "effort": _RATE,
+    }
+)
+_INERTIAL = Record(
+    {
+        "mass": Field("number", required=True, low=0.0, high=MAX_LINK_MASS, unit="kg"),
+        "com": Field("numbers", required=True, shape=(3,), low=-_L, high=_L, unit="m"),
+        "inertia": Field("numbers", required=True, shape=(6,), unit="kg m^2"),
+    }
+)
 _TYPES = {"revolute": False, "prismatic": True}
+_JOINT = Record(
+    {
+        "name": Field("string", required=True, non_empty=True),
+        "type": Field("string", required=True, choices=tuple(_TYPES)),
+        "parent": Field("string", required=True, non_empty=True),
+        "child": Field("string", required=True, non_empty=True),
+        "origin": Field("object", record=Record({"xyz": _XYZ, "rpy": _RPY})),
+        "mdh": Field("object", record=_MDH),
+        "axis": Field("numbers", shape=(3,)),
+        "limits": Field("object", record=_LIMITS),
+        "friction": Field("numbers", shape=(3,)),
+        "inertial": Field("object", record=_INERTIAL),
+    }
+)
+_FRAME = Record(
+    {
+        "name": Field("string", required=True, non_empty=True),
+        "parent": Field("string", required=True, non_empty=True),
+        "xyz": _XYZ,
+        "rpy": _RPY,
+        "mdh": Field("object", record=_MDH),
+    }
+)
+#: The robot description's keys (module docstring; ``n`` the joint count), checked by the
+#: one strict codec (:func:`dynid.io.schema.check`). ``[drive]`` is read by
+#: :func:`dynid.io.drive_file.load_drive`, not here.
+ROBOT_TOML = Record(
+    {
+        "format_version": Field("integer", choices=(FORMAT_VERSION,)),
+        "name": Field("string"),
+        "gravity": Field("numbers", shape=(3,), unit="m/s^2"),
+        "q_neutral": Field("numbers", shape=("n",), unit="rad or m"),
+        "joints": Field("objects", required=True, non_empty=True, shape=("n",), record=_JOINT),
+        "frames": Field("objects", record=_FRAME),
+        "drive": Field("any"),
+    }
+)
+#: Rate limits: ``limits.velocity`` [rad/s or m/s], ``acceleration``, ``effort`` [N m or N].
+_RATES = ("velocity", "acceleration", "effort")
 
 
 # ---------------------------------------------------------------------- reading helpers
-def _check_keys(table: Mapping[str, Any], allowed: set[str], where: str) -> None:
-    unknown = sorted(set(table) - allowed)
-    if unknown:
-        raise ModelError(
-            f"{where}: unknown key {_checks.short(unknown[0])}; allowed: {sorted(allowed)}"
-        )
+def _vector(value: Any, default: Sequence[float]) -> NDArray[np.float64]:
+    return np.array(default if value is None else value, dtype=np.float64)
 
 
-def _table(value: Any, where: str) -> Mapping[str, Any]:
-    if not isinstance(value, Mapping):
-        raise ModelError(f"{where} must be a table; got {type(value).__name__}")
-    return value
-
-
-def _require(table: Mapping[str, Any], key: str, where: str) -> Any:
-    if key not in table:
-        raise ModelError(f"{where}: missing key {_checks.short(key)}")
-    return table[key]
-
-
-def _string(table: Mapping[str, Any], key: str, where: str) -> str:
-    value = _require(table, key, where)
-    if not isinstance(value, str) or not value:
-        raise ModelError(
-            f"{where}: key {key!r} must be a non-empty string; got {_checks.short(value)}"
-        )
-    return value
-
-
-def _number(value: Any, where: str, key: str, *, finite: bool = True) -> float:
-    if not finite and isinstance(value, float) and math.isinf(value):
-        return value  # limits may be inf (none)
-    return _checks.number(value, f"{where}: key {key!r}", ModelError)
-
-
-def _vector(value: Any, size: int, where: str, key: str) -> NDArray[np.float64]:
-    if not isinstance(value, list) or len(value) != size:
-        got = f"{len(value)} entries" if isinstance(value, list) else _checks.short(value)
-        raise ModelError(f"{where}: key {key!r} must be a list of {size} numbers; got {got}")
-    return np.array([_number(v, where, key) for v in value])
-
-
-def _pose(table: Mapping[str, Any], where: str, *, nested: bool) -> NDArray[np.float64]:
-    """Pose (4, 4) from ``xyz``/``rpy`` (in ``origin = {...}`` when ``nested``) or ``mdh``."""
+def _pose(table: Mapping[str, Any], source: str, at: str, *, nested: bool) -> NDArray[np.float64]:
+    """Pose (4, 4) from ``xyz``/``rpy`` (in ``origin = {...}`` when ``nested``) or ``mdh``
+    (the table checked already)."""
     origin_keys = ("origin",) if nested else ("xyz", "rpy")
     if "mdh" in table:
-        if any(k in table for k in origin_keys):
-            what = " and ".join(repr(k) for k in origin_keys if k in table)
-            raise ModelError(f"{where}: give either {what} or 'mdh', not both")
-        mdh = _table(table["mdh"], f"{where}: key 'mdh'")
-        _check_keys(mdh, _MDH_KEYS, f"{where}: mdh")
-        a, d, alpha = (
-            _number(_require(mdh, k, f"{where}: mdh"), where, f"mdh.{k}")
-            for k in ("a", "d", "alpha")
-        )
-        theta = _number(mdh.get("theta", 0.0), where, "mdh.theta")
-        return mdh_transform(a, d, alpha, theta)
-    origin, prefix = table, ""
-    if nested:
-        origin, prefix = _table(table.get("origin", {}), f"{where}: key 'origin'"), "origin."
-        _check_keys(origin, _ORIGIN_KEYS, f"{where}: origin")
-    xyz = _vector(origin.get("xyz", [0.0, 0.0, 0.0]), 3, where, f"{prefix}xyz")
-    rpy = _vector(origin.get("rpy", [0.0, 0.0, 0.0]), 3, where, f"{prefix}rpy")
+        given = [k for k in origin_keys if k in table]
+        if given:
+            what = " and ".join(repr(k) for k in given)
+            raise fault(source, f"{at}.mdh", f"give either {what} or 'mdh', not both")
+        mdh = table["mdh"]
+        return mdh_transform(mdh["a"], mdh["d"], mdh["alpha"], mdh.get("theta", 0.0))
+    origin = table.get("origin", {}) if nested else table
+    xyz = _vector(origin.get("xyz"), (0.0, 0.0, 0.0))
+    rpy = _vector(origin.get("rpy"), (0.0, 0.0, 0.0))
     return spatial.transform_from_xyz_rpy(xyz, rpy)
 
 
@@ -172,108 +182,104 @@ class _JointRow:
     friction: NDArray[np.float64] | None
 
 
-def _axis(jt: Mapping[str, Any], where: str) -> NDArray[np.float64]:
+def _axis(jt: Mapping[str, Any], source: str, at: str) -> NDArray[np.float64]:
     """The joint axis (3,) as given (the robot normalises it); zero or overflowing refused."""
-    axis = _vector(jt.get("axis", [0.0, 0.0, 1.0]), 3, where, "axis")
+    axis = _vector(jt.get("axis"), (0.0, 0.0, 1.0))
     with np.errstate(over="ignore"):
         norm = float(np.linalg.norm(axis))
     if norm < 1e-12:
-        raise ModelError(f"{where}: key 'axis' must not be zero")
+        raise fault(source, f"{at}.axis", f"expected a non-zero axis; got {axis.tolist()}")
     if not math.isfinite(norm):
-        raise ModelError(
-            f"{where}: key 'axis' = {axis.tolist()} is too large to normalise "
-            "(its squared length overflows a float); give the axis as a unit vector"
+        raise fault(
+            source,
+            f"{at}.axis",
+            f"{axis.tolist()} is too large to normalise (its squared length overflows a "
+            "float); give the axis as a unit vector",
         )
     return axis
 
 
-def _limits(jt: Mapping[str, Any], where: str) -> dict[str, float]:
+def _limits(jt: Mapping[str, Any], source: str, at: str) -> dict[str, float]:
     """``lower``, ``upper``, ``velocity``, ``acceleration``, ``effort`` (inf where none)."""
-    lim = dict.fromkeys(_LIMIT_KEYS, math.inf)
-    lim["lower"] = -math.inf
-    table = _table(jt.get("limits", {}), f"{where}: key 'limits'")
-    _check_keys(table, set(_LIMIT_KEYS), f"{where}: limits")
-    for k, v in table.items():
-        lim[k] = _number(v, where, f"limits.{k}", finite=False)
-        if k not in ("lower", "upper") and not lim[k] > 0.0:
-            raise ModelError(f"{where}: key 'limits.{k}' must be positive; got {_checks.short(v)}")
+    lim = {"lower": -math.inf, "upper": math.inf} | dict.fromkeys(_RATES, math.inf)
+    lim |= {k: float(v) for k, v in jt.get("limits", {}).items()}
+    for k in _RATES:
+        if not lim[k] > 0.0:
+            raise fault(source, f"{at}.limits.{k}", f"expected a number > 0; got {lim[k]!r}")
     if not lim["lower"] < lim["upper"]:
-        raise ModelError(
-            f"{where}: key 'limits.lower' must be below 'limits.upper'; "
-            f"got {lim['lower']!r} >= {lim['upper']!r}"
+        raise fault(
+            source,
+            f"{at}.limits.lower",
+            f"expected a number below 'limits.upper'; got {lim['lower']!r} >= {lim['upper']!r}",
         )
     return lim
 
 
 def _inertial(
-    jt: Mapping[str, Any], where: str
+    jt: Mapping[str, Any], source: str, at: str
 ) -> tuple[float, NDArray[np.float64], NDArray[np.float64]]:
     """Mass [kg], CoM [m] (3,) and inertia about the CoM (6,) of ``[joints.inertial]``."""
     if "inertial" not in jt:
         return 0.0, np.zeros(3), np.zeros(6)
-    inertial = _table(jt["inertial"], f"{where}: key 'inertial'")
-    _check_keys(inertial, _INERTIAL_KEYS, f"{where}: inertial")
-    inside = f"{where}: inertial"
-    mass = _number(_require(inertial, "mass", inside), where, "inertial.mass")
-    if not 0.0 <= mass <= MAX_LINK_MASS:
-        raise ModelError(
-            f"{where}: key 'inertial.mass' must lie in [0, {MAX_LINK_MASS:g}] kg; got {mass!r}"
-        )
-    com = _vector(_require(inertial, "com", inside), 3, where, "inertial.com")
-    if not float(np.max(np.abs(com))) <= MAX_LINK_OFFSET:  # 1e300: the inertia became NaN
-        raise ModelError(
-            f"{where}: key 'inertial.com' must lie within {MAX_LINK_OFFSET:g} m of the link "
-            f"frame; got {com.tolist()}"
-        )
-    inertia = _vector(_require(inertial, "inertia", inside), 6, where, "inertial.inertia")
+    inertial = jt["inertial"]
+    mass = float(inertial["mass"])
+    com, inertia = _vector(inertial["com"], ()), _vector(inertial["inertia"], ())
     problems = inertial_problems(mass, matrix_from_inertia6(inertia))
     if problems:  # as the URDF reader: kept, as a real description may round its numbers
         warnings.warn(
-            f"{where}: the inertial is physically inconsistent: {'; '.join(problems)}; "
-            "kept as given",
+            f"{source}: key '{at}.inertial': the inertial is physically inconsistent: "
+            f"{'; '.join(problems)}; kept as given",
             DynidWarning,
             stacklevel=2,
         )
     return mass, com, inertia
 
 
-def _joint_row(i: int, raw: Any) -> _JointRow:
-    """Joint ``i`` (0-based) of the ``[[joints]]`` array, every key checked."""
-    jt = _table(raw, f"joints[{i}]")
-    jname = _string(jt, "name", f"joints[{i}]")
-    where = f"joints[{i}] ({jname!r})"
-    _check_keys(jt, _JOINT_KEYS, where)
-    kind = _string(jt, "type", where)
-    if kind not in _TYPES:
-        raise ModelError(
-            f"{where}: key 'type' must be one of {sorted(_TYPES)}; got {_checks.short(kind)}"
-        )
-    parent, child = _string(jt, "parent", where), _string(jt, "child", where)
-    T, axis, limits = _pose(jt, where, nested=True), _axis(jt, where), _limits(jt, where)
-    mass, com, inertia = _inertial(jt, where)
-    friction = _vector(jt["friction"], 3, where, "friction") if "friction" in jt else None
+def _joint_row(jt: Mapping[str, Any], source: str, at: str) -> _JointRow:
+    """The joint table at ``at`` (checked by the codec) as a row."""
+    T, axis, limits = (
+        _pose(jt, source, at, nested=True),
+        _axis(jt, source, at),
+        _limits(jt, source, at),
+    )
+    mass, com, inertia = _inertial(jt, source, at)
+    friction = _vector(jt["friction"], ()) if "friction" in jt else None
     return _JointRow(
-        jname, parent, child, T, axis, _TYPES[kind], limits, mass, com, inertia, friction
+        jt["name"],
+        jt["parent"],
+        jt["child"],
+        T,
+        axis,
+        _TYPES[jt["type"]],
+        limits,
+        mass,
+        com,
+        inertia,
+        friction,
     )
 
 
 def _joint_rows(joints: list[Any], source: str) -> list[_JointRow]:
     """Every joint, checked to form a chain and to give friction for all joints or none."""
     rows: list[_JointRow] = []
-    for i, raw in enumerate(joints):
-        row = _joint_row(i, raw)
+    for i, jt in enumerate(joints):
+        row = _joint_row(jt, source, f"joints[{i}]")
         if rows and row.parent != rows[-1].child:
-            raise ModelError(
-                f"joints[{i}] ({row.name!r}): unknown parent {row.parent!r}; joints must form "
-                f"a chain, so the parent must be the previous joint's child {rows[-1].child!r}"
+            raise fault(
+                source,
+                f"joints[{i}].parent",
+                f"unknown parent {row.parent!r}; joints must form a chain, so the parent must "
+                f"be the previous joint's child {rows[-1].child!r}",
             )
         rows.append(row)
     given = [r.friction is not None for r in rows]
     if any(given) and not all(given):
-        missing = rows[given.index(False)].name
-        raise ModelError(
-            f"{source}: key 'friction' is given for some joints but not for joint {missing!r}; "
-            "give it for every joint or for none"
+        i = given.index(False)
+        raise fault(
+            source,
+            f"joints[{i}].friction",
+            f"missing; it is given for joint {rows[given.index(True)].name!r}: give it for "
+            "every joint or for none",
         )
     return rows
 
@@ -281,27 +287,22 @@ def _joint_rows(joints: list[Any], source: str) -> list[_JointRow]:
 def _frames(doc: Mapping[str, Any], source: str, link_names: list[str]) -> dict[str, Frame]:
     """The ``[[frames]]``, each fixed to a link or to an earlier frame."""
     frames: dict[str, Frame] = {}
-    raw_frames = doc.get("frames", [])
-    if not isinstance(raw_frames, list):
-        raise ModelError(f"{source}: 'frames' must be an array of tables ([[frames]])")
-    for i, raw in enumerate(raw_frames):
-        ft = _table(raw, f"frames[{i}]")
-        fname = _string(ft, "name", f"frames[{i}]")
-        where = f"frames[{i}] ({fname!r})"
-        _check_keys(ft, _FRAME_KEYS, where)
+    for i, ft in enumerate(doc.get("frames", [])):
+        at, fname, parent = f"frames[{i}]", ft["name"], ft["parent"]
         if fname in frames:
-            raise ModelError(f"{where}: duplicate frame name {fname!r}")
-        parent = _string(ft, "parent", where)
+            raise fault(source, f"{at}.name", f"duplicate frame name {fname!r}")
         if parent in link_names:
             link, T_link_parent = link_names.index(parent), np.eye(4)
         elif parent in frames:
             link, T_link_parent = frames[parent].link, frames[parent].T_link_frame
         else:
-            raise ModelError(
-                f"{where}: unknown parent {parent!r}; available: links {link_names} "
-                f"and earlier frames {list(frames)}"
+            raise fault(
+                source,
+                f"{at}.parent",
+                f"unknown parent {parent!r}; available: links {link_names} and earlier "
+                f"frames {list(frames)}",
             )
-        frames[fname] = Frame(link, T_link_parent @ _pose(ft, where, nested=False))
+        frames[fname] = Frame(link, T_link_parent @ _pose(ft, source, at, nested=False))
     return frames
 
 
@@ -313,47 +314,34 @@ def robot_from_toml_string(text: str, *, source: str = "TOML text") -> Robot:
     text : str
         The TOML document.
     source : str
-        Name of the document used in error messages (a file path, say).
+        Name of the document used in error messages (a file name, say).
 
     Returns
     -------
     Robot
+        With the joints' sigmoid ``friction`` as a ``dynid.SigmoidFriction`` (none when
+        the description gives none).
 
     Raises
     ------
-    ModelError
-        The text is not valid TOML, or a key is missing, unknown, of the wrong type or
-        length, a joint's parent is not the previous joint's child, a frame's parent is
-        unknown, names repeat, or the robot is otherwise invalid (limits, axes); the
-        message names the joint or frame and the key.
+    DataError
+        The text is not valid TOML, or a key is missing, unknown, of the wrong type, length
+        or out of its limits (:data:`ROBOT_TOML`, checked by :func:`dynid.io.schema.check`),
+        a joint's parent is not the previous joint's child, a frame's parent is unknown,
+        names repeat, or the robot is otherwise invalid (limits, axes); one line
+        ``SOURCE: key 'joints[0].limits.lower': ...`` naming the key.
     """
-    doc = _checks.parse_toml(text, source, ModelError)
-    _check_keys(doc, _TOP_KEYS, source)
-    version = doc.get("format_version", FORMAT_VERSION)
-    if version != FORMAT_VERSION:
-        raise ModelError(
-            f"{source}: key 'format_version' must be {FORMAT_VERSION}; got {_checks.short(version)}"
-        )
-    name = doc.get("name", "robot")
-    if not isinstance(name, str):
-        raise ModelError(f"{source}: key 'name' must be a string; got {_checks.short(name)}")
-    gravity = _vector(doc.get("gravity", [0.0, 0.0, -STANDARD_GRAVITY]), 3, source, "gravity")
-    q_neutral = (
-        _vector(doc["q_neutral"], len(doc.get("joints", [])), source, "q_neutral")
-        if "q_neutral" in doc
-        else None
-    )
-    joints = _require(doc, "joints", source)
-    if not isinstance(joints, list) or not joints:
-        raise ModelError(f"{source}: 'joints' must be a non-empty array of tables ([[joints]])")
-    rows = _joint_rows(joints, source)
+    doc = _checks.parse_toml(text, source, DataError)
+    joints = doc.get("joints")
+    check(doc, ROBOT_TOML, source, sizes={"n": len(joints)} if isinstance(joints, list) else {})
+    rows = _joint_rows(doc["joints"], source)
     link_names = [rows[0].parent] + [r.child for r in rows]
     frames = _frames(doc, source, link_names)
-    lim = {k: np.array([r.limits[k] for r in rows]) for k in _LIMIT_KEYS}
-    friction = [r.friction for r in rows if r.friction is not None]
+    lim = {k: np.array([r.limits[k] for r in rows]) for k in ("lower", "upper", *_RATES)}
+    sigmoid = [r.friction for r in rows if r.friction is not None]
     try:
         return Robot(
-            name=name,
+            name=doc.get("name", "robot"),
             joint_names=tuple(r.name for r in rows),
             link_names=tuple(link_names),
             T_parent_joint=np.stack([r.T_parent_joint for r in rows]),
@@ -369,13 +357,13 @@ def robot_from_toml_string(text: str, *, source: str = "TOML text") -> Robot:
             dq_max=lim["velocity"],
             ddq_max=lim["acceleration"],
             tau_max=lim["effort"],
-            gravity=gravity,
+            gravity=_vector(doc.get("gravity"), (0.0, 0.0, -STANDARD_GRAVITY)),
             frames=frames,
-            friction=np.stack(friction) if len(friction) == len(rows) else None,
-            q_neutral=q_neutral,
+            friction=SigmoidFriction.from_array(np.stack(sigmoid)) if sigmoid else None,
+            q_neutral=_vector(doc["q_neutral"], ()) if "q_neutral" in doc else None,
         )
     except DynidError as exc:
-        raise ModelError(f"{source}: {exc}") from exc
+        raise DataError(str(exc), file=source) from exc
 
 
 def load_toml(path: str | Path) -> Robot:
@@ -393,8 +381,10 @@ def load_toml(path: str | Path) -> Robot:
     Raises
     ------
     ModelError
-        The file does not exist or cannot be read, is not valid TOML, or does not follow
-        the schema (the message names the joint or frame and the key).
+        The file does not exist or cannot be read.
+    DataError
+        The file is not valid TOML or does not follow the schema
+        (:func:`robot_from_toml_string`; the message starts with the file's name).
     """
     p = Path(path)
     try:
@@ -403,7 +393,7 @@ def load_toml(path: str | Path) -> Robot:
         raise ModelError(f"TOML description not found: {str(p)!r}") from exc
     except (OSError, UnicodeDecodeError) as exc:
         raise ModelError(f"cannot read TOML description {str(p)!r}: {exc}") from exc
-    return robot_from_toml_string(text, source=f"TOML file {str(p)!r}")
+    return robot_from_toml_string(text, source=p.name)
 
 
 # ---------------------------------------------------------------------- writing
@@ -451,15 +441,16 @@ def toml_from_robot(robot: Robot) -> str:
     Warns
     -----
     DynidWarning
-        The robot holds friction of another law than the sigmoid
-        (``Robot.friction_model``), which a description does not hold: it is not written
-        (``friction.json`` holds any law).
+        The robot's friction is another law than the sigmoid at the joints, which a
+        description does not hold: it is not written (``friction.json`` holds any law).
     """
-    if robot.friction_model is not None:
+    sigmoid = sigmoid_parameters(robot.friction)
+    if robot.friction is not None and sigmoid is None:
+        where = " at the motors of a drive" if robot.friction.drive is not None else ""
         warnings.warn(
-            f"TOML export: the robot's {robot.friction_model.kind} friction is not part of a "
-            "robot description (which holds the sigmoid) and is not written; save it as "
-            "friction.json",
+            f"TOML export: the robot's {robot.friction.kind} friction{where} is not part of "
+            "a robot description (which holds the sigmoid at the joints) and is not written; "
+            "save it as friction.json",
             DynidWarning,
             stacklevel=2,
         )
@@ -495,8 +486,8 @@ def toml_from_robot(robot: Robot) -> str:
         ]
         if finite:
             out.append("limits = { " + ", ".join(finite) + " }")
-        if robot.friction is not None:
-            out.append(f"friction = {_arr(robot.friction[i])}")
+        if sigmoid is not None:
+            out.append(f"friction = {_arr(sigmoid[i])}")
         out += [
             "",
             "[joints.inertial]",

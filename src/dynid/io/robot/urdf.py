@@ -46,7 +46,7 @@ from numpy.typing import NDArray
 
 from ... import __version__, spatial
 from ...exceptions import DynidWarning, ModelError, ShapeError
-from ...friction.model import robot_friction
+from ...friction.model import robot_friction, sigmoid_parameters
 from ...friction.mujoco import joint_coulomb_viscous
 from ...model.inertia import inertia6_from_matrix
 from ...model.robot import Robot
@@ -279,7 +279,7 @@ def export_urdf(path: str | Path, robot: Robot, options: ExportOptions) -> Path:
     (:func:`dynid.friction.mujoco.joint_coulomb_viscous`); what URDF cannot hold (an offset,
     an asymmetry, a Stribeck peak, coupled terms) is named in one warning line.
     ``friction=True`` writes the robot's own friction when it is a law other than the
-    description's sigmoid (``Robot.friction``, which URDF does not hold); the drive is not
+    description's sigmoid at the joints (which URDF does not hold); the drive is not
     part of URDF.
 
     Raises
@@ -291,8 +291,8 @@ def export_urdf(path: str | Path, robot: Robot, options: ExportOptions) -> Path:
     """
     dynamics = None
     model = None if isinstance(options.friction, bool) else options.friction
-    if options.friction is True and robot.friction is None:  # the description's sigmoid: none
-        model = robot_friction(robot)
+    if options.friction is True and sigmoid_parameters(robot.friction) is None:
+        model = robot_friction(robot)  # the description's sigmoid: none
     if model is not None:
         if model.n != robot.n:
             raise ShapeError(f"friction has {model.n} joints; robot {robot.name!r} has {robot.n}")

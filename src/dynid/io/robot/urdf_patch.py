@@ -124,8 +124,9 @@ def _link_spans(text: str, names: list[str]) -> dict[str, tuple[int, int, int, b
 def _check_same_chain(robot: Robot, chain: Robot, source: str) -> None:
     if robot.n != chain.n:
         raise ModelError(
-            f"{source}: the chain has {chain.n} moving joints, the robot {robot.n}; "
-            "choose --base/--tip so that the chains match"
+            f"the chain has {chain.n} moving joints, the robot {robot.n}; "
+            "choose --base/--tip so that the chains match",
+            file=source,
         )
     for i in range(robot.n):
         same = np.allclose(robot.T_parent_joint[i], chain.T_parent_joint[i], atol=1e-9) and (
@@ -134,9 +135,10 @@ def _check_same_chain(robot: Robot, chain: Robot, source: str) -> None:
         )
         if not same:
             raise ModelError(
-                f"{source}: joint {chain.joint_names[i]!r} has another frame, axis or type "
+                f"joint {chain.joint_names[i]!r} has another frame, axis or type "
                 f"than the robot's joint {robot.joint_names[i]!r}; the inertials would be in "
-                "different link frames"
+                "different link frames",
+                file=source,
             )
 
 
@@ -249,7 +251,7 @@ def patch_urdf_inertials(
         back = robot_from_urdf_string(out, base, tip, source=source)
     scale = max(float(np.max(np.abs(expected))), 1e-300)
     if not np.allclose(back.phi, expected, rtol=1e-9, atol=1e-12 * scale):
-        raise ModelError(f"{source}: the patched inertials do not read back as the robot's")
+        raise ModelError("the patched inertials do not read back as the robot's", file=source)
     return out
 
 
@@ -265,13 +267,14 @@ def _check_consistent(link: str, phi: NDArray[np.float64], fixed: list[str], sou
     if m > 0 and lam[0] >= 0 and lam[0] + lam[1] >= lam[2]:
         return
     raise ModelError(
-        f"{source}: link {_checks.short(link)}: the identified body minus the template's "
+        f"link {_checks.short(link)}: the identified body minus the template's "
         f"fixed links {_checks.short(fixed)} is not physically consistent (mass "
         f"{float(m):.6g} kg, principal moments {[float(f'{x:.4g}') for x in lam]} kg m^2), "
         "so --merged subtract cannot split it: if the identified data did not include those "
         "bodies, export with --merged keep (the template's fixed links stay as they are, the "
         "identified body goes on the moving link); with --merged move the whole body goes on "
-        "the moving link and the fixed links lose their inertials"
+        "the moving link and the fixed links lose their inertials",
+        file=source,
     )
 
 
@@ -281,6 +284,7 @@ def _check_masses(fixed: list[str], elems: dict, source: str) -> None:
         m = float(_own_phi(elems[name])[0])
         if m < 0:
             raise ModelError(
-                f"{source}: link {_checks.short(name)} has a negative mass ({m:.6g} kg); "
-                "correct its <inertial> in the template"
+                f"link {_checks.short(name)} has a negative mass ({m:.6g} kg); "
+                "correct its <inertial> in the template",
+                file=source,
             )
