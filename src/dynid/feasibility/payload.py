@@ -77,7 +77,7 @@ from ..model.robot import Robot
 from .lmi import phi_from_pseudo_inertia, pseudo_inertia
 from .payload_arm import ArmFriction, ArmModel, arm_model, model_structure, unloaded_arm
 from .payload_doubts import doubts_about
-from .payload_fit import fit_load, load_parameters, summary
+from .payload_fit import fit_load, load_parameters, serial_correlation_factor, summary
 from .payload_rows import log_preparation, log_rows, static_load_rows, still_joints
 
 __all__ = [
@@ -133,8 +133,11 @@ class PayloadEstimate:
         Why the estimate is not a load to trust (module docstring); empty when none.
     preprocessing : mapping
         Torque logs: ``cutoff_hz`` [Hz], ``cutoff_source`` (``"given"``, ``"model"``: the
-        identification's, ``"motion"``: read from the recordings), ``decimate`` and
-        ``max_gap_s`` [s] (None: the default rule); empty for static data.
+        identification's, ``"motion"``: read from the recordings), ``decimate``,
+        ``max_gap_s`` [s] (None: the default rule) and ``sample_rate_hz`` of the raw
+        recordings; empty for static data. The standard deviations of filtered rows are
+        widened for their serial correlation
+        (:func:`~dynid.feasibility.payload_fit.serial_correlation_factor`).
     recordings : tuple of mapping
         Torque logs: per recording ``file``, ``pieces``, ``samples`` and ``duration_s``.
     skipped : tuple of str
@@ -321,6 +324,17 @@ def _estimate(
     fit = fit_load(W, yv, kept, rtol, p, static)
     est = np.asarray(fit.beta)
     cov = np.asarray(fit.covariance)[:p, :p]
+    prep = record.get("preprocessing") or {}
+    if prep.get("cutoff_hz"):  # filtered rows: their noise is serially correlated
+        cols = np.ones(W.shape[1], bool) if kept is None else kept
+        rate = prep["sample_rate_hz"] / prep["decimate"]
+        resid = yv - W[:, cols] @ est[cols]
+        factor, lags = serial_correlation_factor(resid, n, int(np.ceil(rate / prep["cutoff_hz"])))
+        cov = cov * factor
+        notes.append(
+            f"standard deviations widened x{np.sqrt(factor):.2f} for the serial correlation "
+            f"of the filtered samples (Newey-West, {lags} lags)"
+        )
     phi, active, marg = load_parameters(est[:p], float(np.sqrt(cov[0, 0])), W, margin, notes)
     m, c, I, sm, sc, si = summary(phi, cov, p == 10)
     doubts = doubts_about(kin, frame, m, sm, c)
@@ -374,7 +388,8 @@ def _log_route(
     gap = opt["max_gap_s"]
     rec = prepare_recordings(kin, logs, names, cutoff_hz=cut, max_gap_s=gap, decimate=dec, drive=d)
     used = max(p.decimate for p in rec.pieces)
-    prep = {"cutoff_hz": rec.cutoff_hz, "cutoff_source": source, "decimate": used, "max_gap_s": gap}
+    prep = {"cutoff_hz": rec.cutoff_hz, "cutoff_source": source, "decimate": used}
+    prep |= {"max_gap_s": gap, "sample_rate_hz": rec.pieces[0].sample_rate_hz}
     if base is None:
         the_arm = arm_model(arm, drive=d, friction=opt["friction"])
     else:

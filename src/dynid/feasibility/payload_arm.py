@@ -84,10 +84,16 @@ class ArmModel:
         return np.asarray(d.rotor_inertia)
 
     def torques(
-        self, q: NDArray[np.float64], dq: NDArray[np.float64], ddq: NDArray[np.float64]
+        self,
+        q: NDArray[np.float64],
+        dq: NDArray[np.float64],
+        ddq: NDArray[np.float64],
+        *,
+        with_friction: bool = True,
     ) -> NDArray[np.float64]:
         """Joint torques [N m] (N, n) of the arm at joint positions [rad], velocities
-        [rad/s] and accelerations [rad/s^2] (N, n): rigid body, rotors and friction."""
+        [rad/s] and accelerations [rad/s^2] (N, n): rigid body, rotors and (unless
+        ``with_friction`` is False) friction."""
         if isinstance(self.model, IdentifiedModel):
             tau = self.model.torques(q, dq, ddq)
         else:
@@ -95,7 +101,7 @@ class ArmModel:
         ia = self._known_rotors()
         if ia is not None and self.drive is not None:
             tau = tau + self.drive.rotor_torques(ddq, ia)
-        if self.friction is not None:
+        if self.friction is not None and with_friction:
             tau = tau + self.friction.torques(dq)
         return np.asarray(tau, dtype=np.float64)
 

@@ -6,7 +6,9 @@
 * :func:`load_parameters`: the estimate checked for a positive mass and, for the full 10,
   moved into the physically consistent set by the pseudo-inertia LMI when it is not in it
   (the closest point in the metric of the data; Wensing, Kim, Slotine, RA-L 2018);
-* :func:`summary`: mass, CoM, inertia about the CoM and their standard deviations.
+* :func:`summary`: mass, CoM, inertia about the CoM and their standard deviations;
+* :func:`serial_correlation_factor`: how much the variances of a fit to low-pass filtered
+  samples exceed those of independent rows.
 """
 
 from __future__ import annotations
@@ -21,7 +23,7 @@ from ..regressors.base import RANK_FLOOR
 from ..regressors.terms import friction_labels
 from .lmi import pseudo_inertia, pseudo_inertia_margin
 
-__all__ = ["fit_load", "load_parameters", "summary"]
+__all__ = ["fit_load", "load_parameters", "serial_correlation_factor", "summary"]
 
 
 def summary(phi: NDArray[np.float64], cov: NDArray[np.float64], full: bool):
@@ -193,3 +195,30 @@ def load_parameters(
             f"(margin {margin:g}) moved it; standard deviations are the unconstrained ones"
         )
     return phi, active, float(pseudo_inertia_margin(phi))
+
+
+def serial_correlation_factor(
+    residual: NDArray[np.float64], n: int, max_lag: int
+) -> tuple[float, int]:
+    """The variance inflation of a least squares whose residual is serially correlated,
+    and the lags used.
+
+    Rows of filtered recordings (sample-major, ``n`` joints a sample) are not independent:
+    a zero-phase low-pass at ``f_c`` correlates the noise over about ``f_s / f_c``
+    samples, so the covariance of independent rows is too small by about that factor
+    (the standard deviations by its square root). With the residual's autocorrelation
+    ``rho_l`` pooled over the joints, the factor is the Newey-West long-run variance
+    ratio with Bartlett weights, ``1 + 2 sum_l (1 - l / (L + 1)) rho_l`` for
+    ``l = 1 .. L = max_lag`` (Newey and West, Econometrica 55, 1987), at least 1.
+    """
+    R = np.asarray(residual, dtype=np.float64).reshape(-1, n)
+    R = R - R.mean(axis=0)
+    var = float(np.sum(R * R))
+    L = int(min(max(max_lag, 0), R.shape[0] // 4))
+    if var <= 0 or L < 1:
+        return 1.0, 0
+    f = 1.0
+    for lag in range(1, L + 1):
+        rho = float(np.sum(R[lag:] * R[:-lag])) / var
+        f += 2.0 * (1.0 - lag / (L + 1)) * rho
+    return max(f, 1.0), L

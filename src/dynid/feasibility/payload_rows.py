@@ -130,9 +130,15 @@ def log_rows(
     (measured torques minus the arm's) of prepared recordings, and the columns fitted
     (the viscous and Coulomb friction of ``still`` joints are not: their velocity is
     noise, taken as zero). The rows are held whole (``N n`` rows of ``10 + 3 n``
-    columns), not the ``10 n`` columns of every link."""
+    columns), not the ``10 n`` columns of every link.
+
+    The arm's own friction is kept in its torques when the rows explain the targets with
+    it better than without it (a smaller least-squares residual, the same columns
+    fitted): a friction law the loaded data do not follow (a robot file's published
+    sigmoid on an arm with viscous friction only) would otherwise bias the load; without
+    it, the classical friction fitted alongside is the arm's whole friction."""
     robot = arm.robot
-    Ws, ys = [], []
+    Ws, ys, fs = [], [], []
     for piece in data.pieces:
         log = piece.log
         assert log.ddq is not None  # prepared logs are differentiated
@@ -140,16 +146,20 @@ def log_rows(
         Y = _load_columns(robot, q, dq, ddq, cols, A)
         Y = np.concatenate([Y, friction_regressor(dq)], axis=-1)
         Ws.append(Y.reshape(-1, Y.shape[-1]))
-        ys.append((np.asarray(log.tau) - arm.torques(q, dq, ddq)).reshape(-1))
+        ys.append((np.asarray(log.tau) - arm.torques(q, dq, ddq, with_friction=False)).ravel())
+        if arm.friction is not None:
+            fs.append(np.asarray(arm.friction.torques(dq)).ravel())
     n = robot.n
     kept = np.ones(Ws[0].shape[-1], dtype=bool)
     kept[10:] = ~(np.repeat(still, 3) & (np.arange(3 * n) % 3 != 2))
-    own = (
-        "beyond the arm's own friction"
-        if arm.friction is not None
-        else "(the arm's model has none)"
-    )
-    notes.append(f"classical friction fv, fc, fo per joint estimated alongside, {own}")
+    W, y = np.concatenate(Ws), np.concatenate(ys)
+    if fs:
+        y = _with_own_friction(W[:, kept], y, np.concatenate(fs), arm, notes)
+    else:
+        notes.append(
+            "classical friction fv, fc, fo per joint estimated alongside (the arm's model "
+            "has no friction)"
+        )
     if len(data.pieces) > 1:
         notes.append(
             f"{data.source}: each recording and each piece between gaps filtered on its own"
@@ -162,4 +172,37 @@ def log_rows(
         )
     k = len(data.names)
     route = "torque log" if k == 1 else f"{k} torque logs"
-    return np.concatenate(Ws), np.concatenate(ys), route, kept
+    return W, y, route, kept
+
+
+def _with_own_friction(
+    W: NDArray[np.float64],
+    y: NDArray[np.float64],
+    f: NDArray[np.float64],
+    arm: ArmModel,
+    notes: list[str],
+) -> NDArray[np.float64]:
+    """The targets ``y`` [N m] less the arm's own friction ``f`` when that explains the
+    rows ``W`` better (:func:`log_rows`), else ``y``; the choice noted."""
+    scale = np.linalg.norm(W, axis=0)
+    Ws = W / np.where(scale > 0, scale, 1.0)
+
+    def rms(t: NDArray[np.float64]) -> float:
+        x = np.linalg.lstsq(Ws, t, rcond=None)[0]
+        return float(np.sqrt(np.mean((t - Ws @ x) ** 2)))
+
+    law = arm.friction.kind if arm.friction is not None else "?"
+    own, bare = rms(y - f), rms(y)
+    if own <= bare:
+        notes.append(
+            f"the arm's own friction ({law}) subtracted, classical friction fv, fc, fo per "
+            f"joint estimated alongside as its correction (residual RMS {own:.3g} N m; "
+            f"{bare:.3g} without the arm's friction)"
+        )
+        return y - f
+    notes.append(
+        f"the arm's own friction ({law}) left out: the loaded data follow the classical "
+        f"friction fv, fc, fo estimated alongside better (residual RMS {bare:.3g} N m; "
+        f"{own:.3g} with the arm's friction)"
+    )
+    return y
