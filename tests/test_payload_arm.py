@@ -170,7 +170,7 @@ def test_a_robot_whose_rotor_inertias_are_to_be_identified_is_refused():
 
 def test_cli_model_preprocessing_recorded_and_several_unloaded_files(logs, tmp_path):
     """--model: its cut-off reused and recorded in payload.json; --unloaded takes several
-    files."""
+    files, the arm identified from them with the model's terms."""
     loaded, unloaded = logs
     for k, log in enumerate(loaded):
         save_torque_log(tmp_path / f"l{k}.csv", log)
@@ -192,3 +192,4 @@ def test_cli_model_preprocessing_recorded_and_several_unloaded_files(logs, tmp_p
     assert main(argv + ["--out", str(tmp_path / "q")]) == 0
     d = json.loads((tmp_path / "q" / "payload.json").read_text())
     assert "difference" in d["route"] and abs(d["mass"] - MASS) < 0.01 * MASS
+    assert any("links + armature + viscous (given)" in note for note in d["notes"])
