@@ -26,7 +26,7 @@ from __future__ import annotations
 
 from collections.abc import Sequence
 from dataclasses import dataclass
-from typing import Literal
+from typing import Literal, Protocol
 
 import numpy as np
 from numpy.typing import NDArray
@@ -35,7 +35,7 @@ from ..dynamics.rnea import rnea
 from ..dynamics.terms import gravity_torques, mass_matrix
 from ..exceptions import ModelError
 from ..friction.fit import model_drive
-from ..friction.model import FrictionModel, robot_friction
+from ..friction.model import robot_friction
 from ..friction.validation import own_friction
 from ..identification.data import StaticDataset
 from ..identification.log import TorqueLog
@@ -46,10 +46,32 @@ from ..identification.structure import Structure
 from ..model.drive import Drive
 from ..model.robot import Robot
 
-__all__ = ["ArmModel", "arm_model", "model_structure", "unloaded_arm"]
+__all__ = [
+    "ArmFriction",
+    "ArmModel",
+    "FrictionTorques",
+    "arm_model",
+    "model_structure",
+    "unloaded_arm",
+]
+
+
+class FrictionTorques(Protocol):
+    """A friction model as the arm's prediction uses it (a
+    :class:`~dynid.friction.model.Friction`, or a sum of them)."""
+
+    @property
+    def kind(self) -> str:
+        """The law's name."""
+        ...
+
+    def torques(self, v: NDArray[np.float64]) -> NDArray[np.float64]:
+        """Joint torques [N m] (N, n) at joint velocities ``v`` [rad/s] (N, n)."""
+        ...
+
 
 #: The friction of :func:`arm_model`: the model's own, none, or a friction model.
-ArmFriction = Literal["own"] | FrictionModel | None
+ArmFriction = Literal["own"] | FrictionTorques | None
 
 
 @dataclass(frozen=True, slots=True, eq=False)
@@ -63,13 +85,13 @@ class ArmModel:
     drive : Drive or None
         The drive the logs are read through (an identified model's own); its known rotor
         inertias are added to a robot's torques.
-    friction : FrictionModel or None
+    friction : FrictionTorques or None
         The arm's friction, added to its torques.
     """
 
     model: IdentifiedModel | Robot
     drive: Drive | None
-    friction: FrictionModel | None
+    friction: FrictionTorques | None
 
     @property
     def robot(self) -> Robot:
@@ -137,7 +159,7 @@ def arm_model(
     drive : Drive, optional
         The drive the data were recorded through: an identified model's own by default
         (another one is refused); a robot's known rotor inertias come from it.
-    friction : "own", None or FrictionModel
+    friction : "own", None or a friction model
         The arm's friction: its own (default), none, or this one.
 
     Raises
@@ -157,6 +179,7 @@ def arm_model(
             "so the arm's are unknown; hint: --model identification.json of the arm, "
             "--unloaded data of the arm without the load, or the rotor inertias in the drive"
         )
+    fr: FrictionTorques | None
     if isinstance(friction, str):
         fr = own_friction(arm) if isinstance(arm, IdentifiedModel) else robot_friction(arm)
     else:
