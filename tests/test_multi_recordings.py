@@ -316,7 +316,7 @@ def test_a_load_is_identified_from_several_recordings_with_gaps(loaded_files, tm
     res = identify_payload_files(arm, paths)
     est = res.estimate
     assert [r["pieces"] for r in res.recordings] == [2, 2]
-    assert est.route == "4 torque logs"
+    assert est.route == "2 torque logs"  # recordings; their pieces in res.recordings
     assert abs(est.mass - LOAD_MASS) < 4 * est.std_mass + 1e-3
     assert np.all(np.abs(est.com - LOAD_COM) < 4 * est.std_com + 1e-3)
     # the gaps bridged by interpolation (--max-gap 1): the mass is off by several stds

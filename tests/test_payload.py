@@ -311,11 +311,12 @@ def test_a_load_that_rotates_about_one_axis_is_refused_not_fitted_from_noise():
 
 def test_a_joint_that_never_moves_gets_no_friction_from_a_payload_log():
     """Joint 4 stays inside its velocity noise band: its fv, fc are zero (not fitted from
-    noise) and said so; the moving joints' Coulomb friction is the arm's (0.3 N m,
+    noise) and said so; with the arm's friction left out of its model (``friction=None``)
+    the moving joints' Coulomb friction estimated alongside is the arm's (0.3 N m,
     published sigmoid near its plateau), and the load is still found."""
     amplitudes = [2.21, -2.21, 1.2, 0.0, -2.3, 2.1, -2.5]
     arm, log = _sinusoid_log(amplitudes, 23)
-    est = identify_payload(arm, log)
+    est = identify_payload(arm, log, friction=None)
     assert np.all(est.friction[3, :2] == 0.0)
     assert np.all(est.friction[[0, 1, 2, 4, 5, 6], 1] > 0.1)
     assert any("joint(s) 4 never leave" in note for note in est.notes)

@@ -5,14 +5,21 @@ The arm's model is known: --robot (built-in or a description with its parameters
 recorded with the load: static data (q, M, g; --gravity-only uses g alone and gives the
 mass and CoM only) or torque logs (classical friction is estimated alongside; several
 recordings, or a folder of them: each recording, and each piece of one cut at a gap
-longer than --max-gap, is filtered on its own and never joined to another). With
---unloaded DATA0 (the same kind of data without the load) the arm is identified from DATA0
-first (difference method). The estimate is physically consistent (pseudo-inertia LMI).
---columns/--units read files of other tools.
+longer than --max-gap, is filtered on its own and never joined to another; --model's
+recorded cut-off and decimation are reused unless --cutoff is given). The arm's torques
+are its model's whole prediction: an identified model's armature (or rotor inertias) and
+friction, a robot's drive (--drive, or the [drive] table of a --robot TOML) and friction,
+a feasible.json's drive and friction. With --unloaded DATA0 ... (the same kind of data
+without the load) the arm is identified from DATA0 first (difference method), with the
+structure identify chooses (or --model's). The estimate is physically consistent
+(pseudo-inertia LMI). --columns/--units read files of other tools.
 
-Writes DIR/payload.json (mass, com [m] in --frame, inertia about the CoM, their std, and
-libfranka's setLoad values load_mass, F_x_Cload, load_inertia) and
-DIR/robot_with_payload.toml (the robot carrying the load).
+A mass less than 3 standard deviations above zero, or a CoM farther from --frame than
+the arm is long, is warned about and no setLoad values are written.
+
+Writes DIR/payload.json (mass, com [m] in --frame, inertia about the CoM, their std, the
+preprocessing used, and libfranka's setLoad values load_mass, F_x_Cload, load_inertia)
+and DIR/robot_with_payload.toml (the robot carrying the load).
 
 example:
   dynid payload --robot panda --data static_with_gripper.csv --out payload
@@ -24,7 +31,6 @@ import argparse
 from pathlib import Path
 
 from ..feasibility.payload import robot_with_payload
-from ..identification.log import DEFAULT_CUTOFF_HZ
 from ..identification.model import IdentifiedModel
 from ..io.payload_json import save_payload_json
 from ..io.robot.toml import save_toml
@@ -32,8 +38,10 @@ from ..model.inertia import INERTIA_ORDER, inertia6_from_matrix
 from ..workflows.payload import identify_payload_files
 from .common import (
     add_column_options,
+    add_drive_option,
     add_log_options,
     add_subcommand,
+    load_drive_arg,
     output_path,
     positive_type,
 )
@@ -64,7 +72,14 @@ def register(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParser:
         help="data with the load (.csv/.npz): static data (one file) or torque logs (one "
         "or more, or a folder of them)",
     )
-    p.add_argument("--unloaded", type=Path, default=None, help="the same data without the load")
+    p.add_argument(
+        "--unloaded",
+        type=Path,
+        nargs="+",
+        default=None,
+        help="the same kind of data without the load (difference method): one static data "
+        "file, or torque logs (one or more, or a folder of them)",
+    )
     add_column_options(p)
     p.add_argument("--frame", default="flange", help="frame the load is fixed to")
     p.add_argument("--gravity-only", action="store_true", help="static data: use g alone")
@@ -72,9 +87,11 @@ def register(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParser:
         "--cutoff",
         type=positive_type,
         default=None,
-        help=f"torque logs: low-pass [Hz] (default {DEFAULT_CUTOFF_HZ:g}; static data are not "
-        "filtered)",
+        help="torque logs: low-pass [Hz] (default: the one --model was identified with, and "
+        "its decimation, else the one identification reads from the logs' motion; static "
+        "data are not filtered)",
     )
+    add_drive_option(p)
     add_log_options(p)
     p.add_argument("--out", type=output_path, required=True, help="output folder")
     return p
@@ -94,6 +111,8 @@ def run(args: argparse.Namespace, console: Console) -> int:
         drop_invalid=args.drop_invalid,
         cutoff_hz=args.cutoff,
         max_gap_s=args.max_gap,
+        drive=load_drive_arg(args, kin.n),
+        feasible=args.params,
     )
     est = result.estimate
     base = arm.equivalent_robot if isinstance(arm, IdentifiedModel) else arm
@@ -114,7 +133,18 @@ def run(args: argparse.Namespace, console: Console) -> int:
             console.print(f"  I{name}      {v:+.4e} kg m^2  (std {s:.2g})")
     if result.recordings:
         console.print(result.describe())
+    prep = est.preprocessing
+    if prep:
+        source = {"given": "given", "model": "the model's", "motion": "read from the motion"}
+        cut = prep["cutoff_hz"]
+        console.print(
+            f"preprocessing: cut-off {'none' if cut is None else f'{cut:.4g} Hz'} "
+            f"({source.get(prep['cutoff_source'], prep['cutoff_source'])}), "
+            f"decimation {prep['decimate']}"
+        )
     for note in est.notes:
         console.print(f"note: {note}")
+    if est.doubts:
+        console.print("not a load to trust: no setLoad values written (see the warnings)")
     console.print(f"wrote {path} and {args.out / 'robot_with_payload.toml'}")
     return 0

@@ -8,24 +8,28 @@ linear in the load's parameters ``phi_F = [m, m c, J_F]`` (about ``F``'s origin,
 
 .. math:: y - y_{arm}(q) = Y_k(q) \\, A \\, \\phi_F \\; (+ F(\\dot q) f)
 
+``y_arm`` is the arm's whole model (:mod:`dynid.feasibility.payload_arm`): an identified
+model's own prediction with its armature or rotor inertias and its friction as identified,
+or a robot's links with its drive's known rotor inertias and its own friction.
+
 * **static M and g** (:func:`identify_payload` with a
   :class:`~dynid.identification.data.StaticDataset`): ``y = [tril M; g]`` and ``Y`` the
   static regressor (Gaz et al. 2019, eq. 20); all 10 parameters;
 * **static g only** (``gravity_only=True``): ``g`` depends on ``m`` and ``m c`` only, so
   the mass and the CoM are estimated and the inertia is not (``inertia_identified`` False);
-* **a torque log** (:class:`~dynid.identification.log.TorqueLog`): zero-phase filtered and
-  differentiated (:func:`~dynid.identification.log.prepare_log`), decimated to about ten
-  samples per cutoff period (as :func:`~dynid.identification.classical.identify_from_log`),
-  ``Y`` the torque regressor, and the classical friction ``fv, fc, fo`` per joint
-  estimated alongside; a joint whose measured velocity never leaves its noise band
+* **torque logs** (one or more :class:`~dynid.identification.log.TorqueLog`): prepared as
+  identification prepares them (:mod:`dynid.feasibility.payload_rows`: through the drive,
+  each recording and each piece between gaps on its own; an identified model's recorded
+  cut-off and decimation by default), ``Y`` the torque regressor, and the classical
+  friction ``fv, fc, fo`` per joint estimated alongside (what the arm's own friction
+  leaves); a joint whose measured velocity never leaves its noise band
   (:func:`~dynid.identification.sanity.moving_joints`) does not move: its velocity and
-  acceleration are zero in the regressor and its ``fv, fc`` are not fitted (zero), so
-  nothing is fitted from noise;
+  acceleration are zero in the regressor and its ``fv, fc`` are not fitted (zero);
 * **difference method** (``unloaded=`` data of the same kind recorded without the load):
-  the arm is first identified from the unloaded data (base parameters,
-  :func:`~dynid.identification.static.identify_static` or
-  :func:`~dynid.identification.classical.identify_from_log`) and its identified model is
-  the arm; model errors common to both recordings cancel.
+  the arm is first identified from the unloaded data with identification's structure
+  selection, or the structure of the identified model given
+  (:func:`~dynid.feasibility.payload_arm.unloaded_arm`), at the loaded data's cut-off and
+  decimation; model errors common to both recordings cancel.
 
 Physical consistency: the least-squares estimate is kept when its pseudo-inertia is
 positive definite with ``lambda_min(J) >= margin tr(J)``; otherwise the estimate closest to
@@ -37,35 +41,51 @@ Standard deviations: the heteroscedasticity-consistent (HC1) covariance of the l
 squares (relative, multiplicative sensor noise gives rows of unequal variance), carried to
 mass, CoM and inertia about the CoM through the Jacobian of that map (central differences).
 When the LMI is active they describe the unconstrained estimate.
+
+Doubts (:attr:`PayloadEstimate.doubts`, each also a :class:`~dynid.exceptions.DynidWarning`):
+a mass less than :data:`MIN_MASS_SIGMAS` standard deviations above zero (no load the data
+can tell from none: unloaded data, or a load too light for them), or a CoM farther from
+the frame than the arm is long (no load the arm carries reaches past its own base; such
+a CoM is the first moment ``m c`` divided by a mass near zero). A doubtful estimate is
+not a load to hand to a controller.
 """
 
 from __future__ import annotations
 
-from collections.abc import Sequence
-from dataclasses import dataclass
+import warnings
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass, field
+from typing import Any, Literal, cast
 
 import numpy as np
 from numpy.typing import NDArray
 
-from ..dynamics.rnea import rnea
-from ..dynamics.terms import gravity_torques, mass_matrix
-from ..exceptions import DataError, ModelError, RankDeficientError, ShapeError, SolverError
-from ..identification.classical import auto_decimation, friction_regressor, identify_from_log
+from ..exceptions import (
+    DataError,
+    DynidWarning,
+    ModelError,
+    ShapeError,
+)
+from ..friction.fit import model_drive
 from ..identification.data import StaticDataset
-from ..identification.least_squares import LeastSquaresFit, fit_least_squares
-from ..identification.log import DEFAULT_CUTOFF_HZ, TorqueLog, prepare_log
+from ..identification.log import TorqueLog
 from ..identification.model import IdentifiedModel
-from ..identification.sanity import moving_joints
-from ..identification.static import identify_static
-from ..model.inertia import inertia6_from_matrix, inertial_from_phi
+from ..identification.recordings import prepare_recordings
+from ..identification.structure import Structure
+from ..model.drive import Drive
 from ..model.robot import Robot
-from ..regressors.base import RANK_FLOOR
-from ..regressors.static import static_regressor_columns, static_rows, static_vector
-from ..regressors.terms import friction_labels
-from ..regressors.torque import torque_regressor
-from .lmi import phi_from_pseudo_inertia, pseudo_inertia, pseudo_inertia_margin
+from .lmi import phi_from_pseudo_inertia, pseudo_inertia
+from .payload_arm import ArmFriction, ArmModel, arm_model, model_structure, unloaded_arm
+from .payload_doubts import doubts_about
+from .payload_fit import fit_load, load_parameters, serial_correlation_factor, summary
+from .payload_rows import log_preparation, log_rows, static_load_rows, still_joints
 
-__all__ = ["PayloadEstimate", "identify_payload", "link_params_from_frame", "robot_with_payload"]
+__all__ = [
+    "PayloadEstimate",
+    "identify_payload",
+    "link_params_from_frame",
+    "robot_with_payload",
+]
 
 
 @dataclass(frozen=True, slots=True, eq=False)
@@ -106,8 +126,22 @@ class PayloadEstimate:
         RMS of the fit's residual [SI of the rows].
     n_rows : int
     friction : ndarray, shape (n, 3), or None
-        ``fv, fc, fo`` per joint estimated alongside (torque logs).
+        ``fv, fc, fo`` per joint estimated alongside (torque logs): the friction beyond
+        the arm's own model's.
     notes : tuple of str
+    doubts : tuple of str
+        Why the estimate is not a load to trust (module docstring); empty when none.
+    preprocessing : mapping
+        Torque logs: ``cutoff_hz`` [Hz], ``cutoff_source`` (``"given"``, ``"model"``: the
+        identification's, ``"motion"``: read from the recordings), ``decimate``,
+        ``max_gap_s`` [s] (None: the default rule) and ``sample_rate_hz`` of the raw
+        recordings; empty for static data. The standard deviations of filtered rows are
+        widened for their serial correlation
+        (:func:`~dynid.feasibility.payload_fit.serial_correlation_factor`).
+    recordings : tuple of mapping
+        Torque logs: per recording ``file``, ``pieces``, ``samples`` and ``duration_s``.
+    skipped : tuple of str
+        One line per piece left out (too short to filter).
     """
 
     frame: str
@@ -130,6 +164,15 @@ class PayloadEstimate:
     n_rows: int
     friction: NDArray[np.float64] | None
     notes: tuple[str, ...]
+    doubts: tuple[str, ...] = ()
+    preprocessing: Mapping[str, Any] = field(default_factory=dict)
+    recordings: tuple[Mapping[str, Any], ...] = ()
+    skipped: tuple[str, ...] = ()
+
+    @property
+    def plausible(self) -> bool:
+        """No doubt about the estimate (:attr:`doubts` empty)."""
+        return not self.doubts
 
 
 def link_params_from_frame(T_link_frame: NDArray[np.float64]) -> NDArray[np.float64]:
@@ -142,80 +185,21 @@ def link_params_from_frame(T_link_frame: NDArray[np.float64]) -> NDArray[np.floa
     return np.stack([phi_from_pseudo_inertia(T @ pseudo_inertia(E[i]) @ T.T) for i in range(10)], 1)
 
 
-def _arm(arm: Robot | IdentifiedModel) -> Robot:
-    return arm.equivalent_robot if isinstance(arm, IdentifiedModel) else arm
-
-
-def _kinematics(arm: Robot | IdentifiedModel) -> Robot:
-    return arm.robot if isinstance(arm, IdentifiedModel) else arm
-
-
-def _summary(phi: NDArray[np.float64], cov: NDArray[np.float64], full: bool):
-    """Mass, CoM, inertia (about CoM) and their standard deviations from phi and its cov."""
-
-    def f(p: NDArray[np.float64]) -> NDArray[np.float64]:
-        m, c, I = inertial_from_phi(p)
-        return np.concatenate([[m], c, inertia6_from_matrix(I)])
-
-    p = phi.copy()
-    k = cov.shape[0]
-    scale = np.maximum(np.abs(p[:k]), 1e-6 * max(float(np.max(np.abs(p[:k]))), 1e-12))
-    Jac = np.empty((10, k))
-    for i in range(k):
-        h = 1e-6 * scale[i]
-        a, b = p.copy(), p.copy()
-        a[i] += h
-        b[i] -= h
-        Jac[:, i] = (f(a) - f(b)) / (2 * h)
-    C = Jac @ cov @ Jac.T
-    std = np.sqrt(np.maximum(np.diag(C), 0.0))
-    m, c, I = inertial_from_phi(p)
-    if not full:
-        std[4:] = np.nan
-        I = np.zeros((3, 3))
-    return float(m), c, I, float(std[0]), std[1:4], std[4:]
-
-
-def _consistent(
-    phi_ls: NDArray[np.float64], R: NDArray[np.float64], margin: float
-) -> tuple[NDArray[np.float64], bool]:
-    """The LMI-constrained estimate closest to ``phi_ls`` in ``||R (phi - phi_ls)||``."""
-    if pseudo_inertia_margin(phi_ls) >= margin:
-        return phi_ls, False
-    import cvxpy as cp
-
-    s = np.maximum(np.abs(phi_ls), 1e-9 * max(float(np.max(np.abs(phi_ls))), 1e-12))
-    x = cp.Variable(10)  # phi = s * x, so the variables are of order one
-    phi = cp.multiply(s, x)
-    J = _pseudo_inertia_expr(phi)
-    Rs = R * s[None, :]
-    obj = cp.sum_squares(Rs @ x - R @ phi_ls)
-    cons = [J - margin * cp.trace(J) * np.eye(4) >> 0]
-    prob = cp.Problem(cp.Minimize(obj), cons)
-    try:
-        prob.solve(solver="CLARABEL")
-    except (cp.error.SolverError, ArithmeticError, ValueError) as exc:
-        raise SolverError(f"payload: the consistent estimate was not found ({exc})") from exc
-    if prob.status not in ("optimal", "optimal_inaccurate") or x.value is None:
-        raise SolverError(f"payload: the consistent estimate was not found (status {prob.status})")
-    return s * np.asarray(x.value), True
-
-
-def _pseudo_inertia_expr(phi):  # noqa: ANN001, ANN202 (cvxpy expressions)
-    """cvxpy expression of :func:`~dynid.feasibility.lmi.pseudo_inertia` (linear in phi)."""
-    E = np.eye(10)
-    return sum(phi[i] * pseudo_inertia(E[i]) for i in range(10))
-
-
 def identify_payload(
-    arm: Robot | IdentifiedModel,
+    arm: Robot | IdentifiedModel | ArmModel,
     data: StaticDataset | TorqueLog | Sequence[TorqueLog],
     *,
+    names: Sequence[str] | None = None,
     frame: str = "flange",
     gravity_only: bool = False,
-    unloaded: StaticDataset | TorqueLog | None = None,
+    unloaded: StaticDataset | TorqueLog | Sequence[TorqueLog] | None = None,
+    unloaded_names: Sequence[str] | None = None,
+    structure: Structure | Literal["auto"] | None = None,
+    drive: Drive | None = None,
+    friction: ArmFriction = "own",
     margin: float = 1e-6,
-    cutoff_hz: float | None = DEFAULT_CUTOFF_HZ,
+    cutoff_hz: float | None | Literal["recorded"] = "recorded",
+    decimate: int | None = None,
     rtol: float | None = None,
     max_gap_s: float | None = None,
 ) -> PayloadEstimate:
@@ -223,31 +207,40 @@ def identify_payload(
 
     Parameters
     ----------
-    arm : Robot or IdentifiedModel
-        The arm without the load: a robot with its parameters (built-in, feasible), or an
-        identified model (its equivalent robot). Ignored for its parameters when
-        ``unloaded`` is given (then only its kinematics and gravity are used).
+    arm : Robot, IdentifiedModel or ArmModel
+        The arm without the load, its whole model
+        (:func:`~dynid.feasibility.payload_arm.arm_model`); only its kinematics, gravity
+        and drive when ``unloaded`` is given.
     data : StaticDataset, TorqueLog or a sequence of TorqueLog
-        Recorded with the load: ``q`` (N, n) [rad], ``M`` [kg m^2], ``g`` [N m]; or a log;
-        or several logs (recordings, or the pieces of one between its gaps), each filtered
-        and differentiated on its own, their rows stacked.
+        Recorded with the load: ``q`` (N, n) [rad], ``M`` [kg m^2], ``g`` [N m]; or one or
+        more recordings (on the drive's side), every piece between gaps on its own.
+    names, unloaded_names : sequence of str, optional
+        The recordings' names (file names), for messages and the record.
     frame : str
         The frame the load is fixed to; its CoM and inertia are given in it.
     gravity_only : bool
         Static data: use ``g`` only (mass and CoM; the inertia is not identified).
-    unloaded : StaticDataset or TorqueLog, optional
+    unloaded : StaticDataset, TorqueLog or a sequence of TorqueLog, optional
         The same kind of data without the load (difference method).
+    structure : Structure or "auto", optional
+        Difference method on recordings: the terms of the arm identified from
+        ``unloaded``; default: an identified model's own, else chosen on held-out data.
+    drive, friction
+        As :func:`~dynid.feasibility.payload_arm.arm_model`.
     margin : float
         LMI margin: ``lambda_min(J) >= margin tr(J)``.
-    cutoff_hz : float or None
-        Torque logs: zero-phase low-pass cutoff [Hz] (None: no filtering).
+    cutoff_hz : float, None or "recorded"
+        Torque logs: zero-phase low-pass cut-off [Hz] (None: no filtering); ``"recorded"``
+        (default): an identified model's (with its decimation), else the one read from
+        the recordings' motion as identification reads it.
+    decimate : int, optional
+        Torque logs: keep every ``decimate``-th sample (default: the model's for
+        recordings at its rate, else about ten samples per cut-off period).
     rtol : float, optional
-        Relative rank tolerance: of the unloaded arm's identification (None: its default,
-        the rank at a clear singular-value gap) and of the load's least squares (None:
-        1e-10).
+        Relative rank tolerance of the unloaded arm's identification and of the load's
+        least squares (None: their defaults; every direction of the load excited).
     max_gap_s : float, optional
-        Torque logs: longest gap bridged by interpolation [s]
-        (:func:`~dynid.identification.log.prepare_log`).
+        Torque logs: longest gap bridged [s]; a longer one cuts a log.
 
     Returns
     -------
@@ -258,49 +251,95 @@ def identify_payload(
     UnknownNameError
         ``frame`` is not a frame of the robot.
     ModelError
-        The frame is on the base (a load there does not move).
+        The frame is on the base; a robot whose drive's rotor inertias are unknown.
     ShapeError
         Data of another joint count; ``unloaded`` of another kind than ``data``.
     RankDeficientError
-        The data do not excite the load's parameters (configurations too alike, a load
-        that never rotates, a log in which no joint moves); the message names them.
+        The data do not excite the load's parameters (named: a load that never rotates).
     DataError
-        The least-squares estimate of the mass is not positive (no load in the data, or a
-        wrong model of the arm).
+        The least-squares mass is not positive (no load, or a wrong model of the arm); a
+        drive other than the model's; a recording without a piece long enough to filter.
     SolverError
         The constrained problem failed.
+
+    Each of :attr:`PayloadEstimate.doubts` is also a :class:`DynidWarning`.
     """
-    kin = _kinematics(arm)
+    inner = arm.model if isinstance(arm, ArmModel) else arm
+    kin = inner.robot if isinstance(inner, IdentifiedModel) else inner
+    d = arm.drive if isinstance(arm, ArmModel) else model_drive(inner, drive)
     f = kin.frame(frame)
     if f.link == 0:
         raise ModelError(f"frame {frame!r} is on the base; a load there does not move")
     n, k = kin.n, f.link
-    logs = tuple(data) if isinstance(data, Sequence) else None
-    if logs is not None and not logs:
-        raise DataError("no torque log given")
-    items: tuple[StaticDataset | TorqueLog, ...] = logs if logs is not None else (data,)  # type: ignore[assignment]
+    static = isinstance(data, StaticDataset)
+    items = _items(data, "data")
     for one in items:
         if one.q.shape[-1] != n:
             raise ShapeError(f"data have {one.q.shape[-1]} joints; robot {kin.name!r} has {n}")
+    base = None if unloaded is None else _items(unloaded, "unloaded")
+    if base is not None and isinstance(unloaded, StaticDataset) != static:
+        raise ShapeError("unloaded must be the same kind of data as data (static or log)")
     notes: list[str] = []
-    static = isinstance(data, StaticDataset)
-    robot = _arm_without_load(arm, kin, unloaded, static, cutoff_hz, rtol, notes)
     A = link_params_from_frame(f.T_link_frame)
     cols = slice(10 * (k - 1), 10 * k)
-    kept = None
+    kept: NDArray[np.bool_] | None = None
+    record: dict[str, Any] = {}
     if isinstance(data, StaticDataset):
-        W, yv, route = _static_rows(robot, data, cols, A, gravity_only, notes)
+        if base is None:
+            the_arm = arm_model(arm, drive=d, friction=friction)
+        else:
+            the_arm, note = unloaded_arm(kin, base[0], rtol=rtol, drive=d)  # type: ignore[arg-type]
+            notes.append(note)
+        W, yv, route = static_load_rows(the_arm, data, cols, A, gravity_only, notes)
     else:
-        W, yv, route, kept = _log_rows(robot, items, cols, A, cutoff_hz, notes, max_gap_s)  # type: ignore[arg-type]
-    if unloaded is not None:
+        opt = dict(structure=structure, drive=d, friction=friction, cutoff_hz=cutoff_hz)
+        opt |= dict(decimate=decimate, max_gap_s=max_gap_s, rtol=rtol)
+        logs = cast(list[TorqueLog], list(items))
+        without = None if base is None else cast(list[TorqueLog], list(base))
+        W, yv, route, kept, record = _log_route(
+            arm, logs, names, without, unloaded_names, cols, A, notes, opt
+        )
+    if base is not None:
         route += ", difference"
     p = 4 if (static and gravity_only) else 10
-    fit = _fit_load(W, yv, kept, rtol, p, static)
+    return _estimate(W, yv, kept, p, static, rtol, margin, kin, frame, route, notes, record)
+
+
+def _estimate(
+    W: NDArray[np.float64],
+    yv: NDArray[np.float64],
+    kept: NDArray[np.bool_] | None,
+    p: int,
+    static: bool,
+    rtol: float | None,
+    margin: float,
+    kin: Robot,
+    frame: str,
+    route: str,
+    notes: list[str],
+    record: dict[str, Any],
+) -> PayloadEstimate:
+    """The load's estimate from its rows: least squares, consistency, doubts (warned)."""
+    n, k = kin.n, kin.frame(frame).link
+    fit = fit_load(W, yv, kept, rtol, p, static)
     est = np.asarray(fit.beta)
     cov = np.asarray(fit.covariance)[:p, :p]
-    friction = None if static else est[10:].reshape(n, 3)
-    phi, active, marg = _load_parameters(est[:p], W, margin, notes)
-    m, c, I, sm, sc, si = _summary(phi, cov, p == 10)
+    prep = record.get("preprocessing") or {}
+    if prep.get("cutoff_hz"):  # filtered rows: their noise is serially correlated
+        cols = np.ones(W.shape[1], bool) if kept is None else kept
+        rate = prep["sample_rate_hz"] / prep["decimate"]
+        resid = yv - W[:, cols] @ est[cols]
+        factor, lags = serial_correlation_factor(resid, n, int(np.ceil(rate / prep["cutoff_hz"])))
+        cov = cov * factor
+        notes.append(
+            f"standard deviations widened x{np.sqrt(factor):.2f} for the serial correlation "
+            f"of the filtered samples (Newey-West, {lags} lags)"
+        )
+    phi, active, marg = load_parameters(est[:p], float(np.sqrt(cov[0, 0])), W, margin, notes)
+    m, c, I, sm, sc, si = summary(phi, cov, p == 10)
+    doubts = doubts_about(kin, frame, m, sm, c)
+    for line in doubts:
+        warnings.warn(line, DynidWarning, stacklevel=3)
     return PayloadEstimate(
         frame=frame,
         link=k,
@@ -320,244 +359,71 @@ def identify_payload(
         condition_number=fit.condition_number,
         residual_rms=fit.residual_rms,
         n_rows=fit.n_rows,
-        friction=friction,
+        friction=None if static else est[10:].reshape(n, 3),
         notes=tuple(notes),
+        doubts=doubts,
+        **record,
     )
 
 
-def _arm_without_load(
-    arm: Robot | IdentifiedModel,
-    kin: Robot,
-    unloaded: StaticDataset | TorqueLog | None,
-    static: bool,
-    cutoff_hz: float | None,
-    rtol: float | None,
+def _log_route(
+    arm: Robot | IdentifiedModel | ArmModel,
+    logs: list[TorqueLog],
+    names: Sequence[str] | None,
+    base: Sequence[TorqueLog] | None,
+    base_names: Sequence[str] | None,
+    cols: slice,
+    A: NDArray[np.float64],
     notes: list[str],
-) -> Robot:
-    """The arm's robot: ``arm``'s own parameters, or identified from ``unloaded``."""
-    if unloaded is None:
-        return _arm(arm)
-    if isinstance(unloaded, StaticDataset) != static:
-        raise ShapeError("unloaded must be the same kind of data as data (static or log)")
-    if isinstance(unloaded, StaticDataset):
-        model = identify_static(kin, unloaded, rtol=rtol)
+    opt: dict[str, Any],
+) -> tuple[NDArray[np.float64], NDArray[np.float64], str, NDArray[np.bool_], dict[str, Any]]:
+    """The rows of recordings (:func:`~dynid.feasibility.payload_rows.log_rows`) with the
+    arm given or identified from ``base``; the preprocessing, recordings and pieces left
+    out, for the record (:class:`PayloadEstimate`'s fields). ``opt``: the options of
+    :func:`identify_payload`."""
+    inner = arm.model if isinstance(arm, ArmModel) else arm
+    kin = inner.robot if isinstance(inner, IdentifiedModel) else inner
+    d = opt["drive"]
+    cut, dec, source = log_preparation(inner, logs, opt["cutoff_hz"], opt["decimate"])
+    gap = opt["max_gap_s"]
+    rec = prepare_recordings(kin, logs, names, cutoff_hz=cut, max_gap_s=gap, decimate=dec, drive=d)
+    used = max(p.decimate for p in rec.pieces)
+    prep = {"cutoff_hz": rec.cutoff_hz, "cutoff_source": source, "decimate": used}
+    prep |= {"max_gap_s": gap, "sample_rate_hz": rec.pieces[0].sample_rate_hz}
+    if base is None:
+        the_arm = arm_model(arm, drive=d, friction=opt["friction"])
     else:
-        model = identify_from_log(kin, unloaded, cutoff_hz=cutoff_hz, rtol=rtol)
-    notes.append(
-        f"difference method: arm identified from the unloaded data "
-        f"({model.base.rank} base parameters); the standard deviations leave out "
-        "the uncertainty of that fit"
-    )
-    return model.equivalent_robot
-
-
-def _static_rows(
-    robot: Robot,
-    data: StaticDataset,
-    cols: slice,
-    A: NDArray[np.float64],
-    gravity_only: bool,
-    notes: list[str],
-) -> tuple[NDArray[np.float64], NDArray[np.float64], str]:
-    """Regressor rows (in the load's frame parameters) and targets of static data.
-
-    Only the load link's 10 columns of the static regressor are computed, a block of
-    configurations at a time (a 50-joint arm's full regressor is 5.3 MB a configuration);
-    the fit of the load takes its rows whole, ``(N rows, <= 10)``: a tenth of one link's
-    share of the full regressor.
-    """
-    n, q = robot.n, data.q
-    idx = np.arange(10 * n)[cols]
-    step = max(1, (64 << 20) // (8 * static_rows(n) * 10))
-    Y = np.concatenate(
-        [
-            static_regressor_columns(robot, q[a : a + step], idx).transpose(2, 1, 0) @ A
-            for a in range(0, q.shape[0], step)
-        ]
-    )
-    y = static_vector(data.M, data.g) - static_vector(
-        mass_matrix(robot, q), gravity_torques(robot, q)
-    )
-    route = "static M and g"
-    if gravity_only:
-        rows = n * (n + 1) // 2
-        Y, y = Y[:, rows:, :4], y[:, rows:]
-        route = "static g"
-        notes.append("g only: mass and CoM identified, the inertia is not")
-    return Y.reshape(-1, Y.shape[-1]), y.reshape(-1), route
-
-
-_LOAD_LABELS = ("m", "mcx", "mcy", "mcz", "Jxx", "Jxy", "Jxz", "Jyy", "Jyz", "Jzz")
-
-
-def _fit_load(
-    W: NDArray[np.float64],
-    y: NDArray[np.float64],
-    kept: NDArray[np.bool_] | None,
-    rtol: float | None,
-    p: int,
-    static: bool,
-) -> LeastSquaresFit:
-    """The least squares of the load (and friction) columns.
-
-    Without ``rtol``, every direction of the load's ``p`` parameters must be excited
-    (:func:`_excited`): a load rotated about one axis only excites some of its 10
-    parameters, and the noise of the measured positions would otherwise fill the others.
-
-    Raises
-    ------
-    RankDeficientError
-        Naming the load's parameters the data do not excite, and what would excite them.
-    """
-    labels = _LOAD_LABELS[:p] + friction_labels((W.shape[1] - p) // 3)
-    if rtol is None:
-        r, names = _excited(W, p, kept, labels)
-        if r < p:
-            raise _not_excited(r, p, names, static)
-    try:
-        return fit_least_squares(
-            W, y, kept=kept, rtol=1e-10 if rtol is None else rtol, std="robust"
+        structure = opt["structure"]
+        if structure is None:
+            own = model_structure(inner) if isinstance(inner, IdentifiedModel) else None
+            structure = "auto" if own is None else own
+        the_arm, note = unloaded_arm(
+            kin,
+            base,
+            base_names,
+            structure=structure,
+            cutoff_hz=rec.cutoff_hz,
+            decimate=used,
+            max_gap_s=gap,
+            drive=d,
+            rtol=opt["rtol"],
         )
-    except RankDeficientError as exc:
-        by_column = {f"column {i}": label for i, label in enumerate(labels)}
-        shown = tuple(by_column.get(d, d) for d in exc.dependent)
-        raise _not_excited(exc.rank, exc.needed, shown, static) from None
+        notes.append(note)
+    W, yv, route, kept = log_rows(the_arm, rec, still_joints(logs, d), cols, A, notes)
+    record = {"preprocessing": prep, "recordings": rec.summary(), "skipped": rec.skipped}
+    return W, yv, route, kept, record
 
 
-def _excited(
-    W: NDArray[np.float64], p: int, kept: NDArray[np.bool_] | None, labels: tuple[str, ...]
-) -> tuple[int, tuple[str, ...]]:
-    """How many directions of the load's parameters (the first ``p`` columns) the data
-    excite, and the labels of the others' large entries.
-
-    Every column is scaled to unit norm; the load's columns are then freed of what the
-    other fitted columns (friction, offsets) explain, and a direction whose singular
-    value stays below :data:`~dynid.regressors.base.RANK_FLOOR` (a 1e-3 part of a unit
-    column) is not excited: its estimate would be noise amplified a thousandfold.
-    """
-    import scipy.linalg  # as the rest of the module: scipy on first use
-
-    cols = np.arange(W.shape[1]) if kept is None else np.flatnonzero(kept)
-    other = cols[cols >= p]
-    M = np.concatenate([W[:, other], W[:, :p]], axis=1)
-    if M.shape[0] < M.shape[1]:
-        return p, ()  # fewer rows than columns: the least squares says so
-    norms = np.linalg.norm(M, axis=0)
-    M /= np.where(norms > 0, norms, 1.0)
-    R = scipy.linalg.qr(M, mode="r")[0]
-    _, sv, Vt = np.linalg.svd(R[other.size : other.size + p, other.size :])
-    r = int(np.sum(sv > RANK_FLOOR))
-    null = np.abs(Vt[r:])
-    names = tuple(labels[i] for i in np.flatnonzero(null.max(axis=0, initial=0.0) > 0.3))
-    return r, names
-
-
-def _not_excited(
-    rank: int | None, needed: int | None, names: tuple[str, ...], static: bool
-) -> RankDeficientError:
-    hint = (
-        "static data at more varied configurations (with --gravity-only: mass and CoM only)"
-        if static
-        else "a log that moves the joints carrying the load, its wrist included, so that "
-        "the load rotates about several axes (or static data)"
-    )
-    return RankDeficientError(
-        f"the data do not excite the load's parameters (rank {rank} of {needed}; "
-        f"unexcited combinations of {', '.join(names) or '?'}); hint: {hint}",
-        rank=rank,
-        needed=needed,
-        dependent=names,
-    )
-
-
-def _load_columns(
-    robot: Robot,
-    q: NDArray[np.float64],
-    dq: NDArray[np.float64],
-    ddq: NDArray[np.float64],
-    cols: slice,
-    A: NDArray[np.float64],
-) -> NDArray[np.float64]:
-    """The torque regressor's columns ``cols`` mapped by ``A``, (N, n, p), computed a block
-    of samples at a time (the full regressor of one block held, 64 MB at most)."""
-    n = robot.n
-    step = max(1, (64 << 20) // (8 * n * 10 * n))
-    parts = []
-    for k in range(0, q.shape[0], step):
-        b = slice(k, k + step)
-        parts.append(torque_regressor(robot, q[b], dq[b], ddq[b])[..., cols] @ A)
-    return np.concatenate(parts)
-
-
-def _log_rows(
-    robot: Robot,
-    logs: Sequence[TorqueLog],
-    cols: slice,
-    A: NDArray[np.float64],
-    cutoff_hz: float | None,
-    notes: list[str],
-    max_gap_s: float | None = None,
-) -> tuple[NDArray[np.float64], NDArray[np.float64], str, NDArray[np.bool_]]:
-    """Regressor rows (the load's parameters, then classical friction per joint), targets
-    of torque logs, each filtered (gaps up to ``max_gap_s`` bridged) and decimated on its own,
-    and the columns fitted (the viscous and Coulomb friction of joints that never leave
-    their velocity noise band are not). The torque regressor is computed a block of
-    samples at a time, its load link's columns kept: the rows fitted are held whole
-    (``N n`` rows of ``10 + 3 n`` columns; the fit of the load needs them), not the
-    ``10 n`` columns of every link."""
-    still = ~moving_joints(np.concatenate([one.dq for one in logs]))
-    Ws, ys = [], []
-    for data in logs:
-        log = prepare_log(data, cutoff_hz=cutoff_hz, max_gap_s=max_gap_s)
-        ddq = log.ddq
-        assert ddq is not None  # prepare_log always differentiates
-        sl = slice(None, None, auto_decimation(data.sample_rate, cutoff_hz))
-        # a still joint's filtered velocity is noise: it does not move
-        q_, dq_, ddq_ = log.q[sl], log.dq[sl] * ~still, ddq[sl] * ~still
-        Y = _load_columns(robot, q_, dq_, ddq_, cols, A)
-        Y = np.concatenate([Y, friction_regressor(dq_)], axis=-1)
-        Ws.append(Y.reshape(-1, Y.shape[-1]))
-        ys.append((np.asarray(log.tau[sl]) - rnea(robot, q_, dq_, ddq_)).reshape(-1))
-    n = logs[0].n
-    kept = np.ones(Ws[0].shape[-1], dtype=bool)
-    kept[10:] = ~(np.repeat(still, 3) & (np.arange(3 * n) % 3 != 2))
-    notes.append("classical friction fv, fc, fo per joint estimated alongside")
-    if len(logs) > 1:
-        notes.append(f"{len(logs)} torque logs (recordings or pieces), each filtered on its own")
-    if still.any():
-        which = ", ".join(str(j + 1) for j in np.flatnonzero(still))
-        notes.append(
-            f"joint(s) {which} never leave their velocity noise band: taken as still, "
-            "their friction fv, fc is not identifiable and is zero (not fitted from noise)"
-        )
-    route = "torque log" if len(logs) == 1 else f"{len(logs)} torque logs"
-    return np.concatenate(Ws), np.concatenate(ys), route, kept
-
-
-def _load_parameters(
-    est: NDArray[np.float64], W: NDArray[np.float64], margin: float, notes: list[str]
-) -> tuple[NDArray[np.float64], bool, float]:
-    """The load's 10 parameters from the least-squares ``est`` (checked for a positive
-    mass; 4: mass and first moments; 10: moved into the consistent set by the LMI)."""
-    phi_ls = np.zeros(10)
-    phi_ls[: est.size] = est
-    if phi_ls[0] <= 0:  # both routes: the LMI would turn no load into 1e-22 kg, silently
-        raise DataError(
-            f"the estimated load mass is {phi_ls[0]:.6g} kg (not positive); "
-            "is a load mounted, and is the arm's model right?"
-        )
-    if est.size == 4:
-        return phi_ls, False, float("nan")
-    import scipy.linalg  # as the rest of the module: scipy on first use
-
-    R = scipy.linalg.qr(W[:, :10], mode="r")[0][:10]
-    phi, active = _consistent(phi_ls, R, margin)
-    if active:
-        notes.append(
-            "the least-squares estimate was not physically consistent; the LMI "
-            f"(margin {margin:g}) moved it; standard deviations are the unconstrained ones"
-        )
-    return phi, active, float(pseudo_inertia_margin(phi))
+def _items(
+    data: StaticDataset | TorqueLog | Sequence[TorqueLog], what: str
+) -> tuple[StaticDataset | TorqueLog, ...]:
+    """``data`` as a tuple of data sets (one static data set, or the recordings)."""
+    if isinstance(data, StaticDataset | TorqueLog):
+        return (data,)
+    out = tuple(data)
+    if not out:
+        raise DataError(f"no torque log given ({what})")
+    return out
 
 
 def robot_with_payload(robot: Robot, est: PayloadEstimate, *, name: str = "payload") -> Robot:

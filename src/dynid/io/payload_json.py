@@ -10,14 +10,24 @@
      "with_tool": "robot_with_payload.toml", "inertia_identified": true,
      "constraint_active": false, "pseudo_inertia_margin": ..., "rank": 10,
      "condition_number": ..., "residual_rms": ..., "n_rows": ..., "notes": [...],
+     "plausible": true, "doubts": [...],
+     "preprocessing": {"cutoff_hz": ..., "cutoff_source": "model", "decimate": ...,
+                       "max_gap_s": null} | null,
+     "recordings": [{"file": ..., "pieces": ..., "samples": ..., "duration_s": ...}],
      "units": {...}, "conventions": {...}}
 
 ``mass`` [kg]; ``com`` [m] in the given frame; ``inertia`` about the CoM in the frame's axes
 [kg m^2]. ``load_mass``, ``F_x_Cload`` (CoM in the flange frame [m]) and ``load_inertia``
 (inertia about the CoM in flange axes, 3x3 column-major) are libfranka's
 ``Robot::setLoad`` arguments: the load carried into the flange frame when the frame is on
-the flange's link; null otherwise (and ``load_inertia`` null when the inertia was not
-identified). Floats use Python's shortest round-trip representation.
+the flange's link and the estimate is plausible; null otherwise (and ``load_inertia``
+null when the inertia was not identified). ``doubts`` says why an estimate is not
+plausible (:mod:`dynid.feasibility.payload_doubts`: a mass not significantly above zero,
+a CoM farther than the arm is long): such a load is not handed to a controller.
+``preprocessing`` is how torque logs were prepared (cut-off [Hz] and where it came from:
+``given``, ``model`` (the identification's) or ``motion``; decimation; longest gap
+bridged [s], null for the default rule); null for static data. Floats use Python's
+shortest round-trip representation.
 """
 
 from __future__ import annotations
@@ -67,7 +77,7 @@ def payload_to_dict(
         },
     }
     fl, fr = robot.frame("flange"), robot.frame(est.frame)
-    if fl.link == fr.link:
+    if fl.link == fr.link and est.plausible:
         T_flange_frame = spatial.inverse_transform(fl.T_link_frame) @ fr.T_link_frame
         R, p = T_flange_frame[:3, :3], T_flange_frame[:3, 3]
         I_fl = R @ est.inertia @ R.T
@@ -87,12 +97,18 @@ def payload_to_dict(
             "residual_rms": _num(est.residual_rms),
             "n_rows": int(est.n_rows),
             "notes": list(est.notes),
+            "plausible": est.plausible,
+            "doubts": list(est.doubts),
+            "preprocessing": dict(est.preprocessing) or None,
+            "recordings": [dict(r) for r in est.recordings],
             "units": {"mass": "kg", "com": "m", "inertia": "kg m^2"},
             "conventions": {
                 "com": f"centre of mass in frame {est.frame!r}",
                 "inertia": "about the CoM, frame axes, order " + " ".join(INERTIA_ORDER),
                 "load_inertia": "libfranka setLoad: about the CoM, flange axes, column-major",
                 "F_x_Cload": "libfranka setLoad: CoM in the flange frame",
+                "setLoad": "null when the frame is not on the flange's link or the estimate "
+                "is not plausible (doubts)",
             },
         }
     )

@@ -4,31 +4,31 @@ every policy the command applies, so that the Python API behaves as the command 
 * The data's kind (static data or torque logs, :func:`~.data_files.data_kind`) picks the
   route; static data come in one file, torque logs in one or more (a folder: its data
   files), read as :mod:`dynid.workflows.recordings` reads them (each problem one line
-  naming the file).
-* Each torque recording, and each piece of one cut at a gap longer than ``max_gap_s``
-  (continuous joints recorded wrapped unwrapped first), is filtered and differentiated on
-  its own (:func:`~dynid.feasibility.payload.identify_payload` with the pieces); a piece
-  too short to filter is left out with a warning naming its file, a recording without
-  one is an error naming it.
+  naming the file; an identified model's recorded column map unless one is given).
+* The arm is its model's whole prediction (:mod:`dynid.feasibility.payload_arm`): an
+  identified model's armature or rotor inertias and friction, a robot's drive (the one
+  given, or the ``[drive]`` table of its TOML) and own friction, or the drive and friction
+  stored in a ``feasible.json``.
+* Torque logs are prepared as identification prepared the model's (its recorded cut-off
+  and decimation unless ``cutoff_hz`` is given; each recording, and each piece of one cut
+  at a gap longer than ``max_gap_s``, on its own); what was used is recorded.
 * ``gravity_only`` applies to static data; ``unloaded`` (the difference method) is data
-  of the same kind, one file.
+  of the same kind: one static file, or one or more torque logs.
 """
 
 from __future__ import annotations
 
-import warnings
 from collections.abc import Sequence
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
-import numpy as np
-
-from ..exceptions import DataError, DynidWarning
+from ..exceptions import DataError
 from ..feasibility.payload import PayloadEstimate, identify_payload
-from ..identification.log import DEFAULT_CUTOFF_HZ, TorqueLog, prepare_log
+from ..feasibility.payload_arm import ArmFriction
 from ..identification.model import IdentifiedModel
-from ..identification.recordings import skipped_piece, split_at_gaps, unwrapped
+from ..io.feasible import load_feasible_drive, load_feasible_linear_friction
+from ..model.drive import Drive
 from ..model.robot import Robot
 from .data_files import ColumnSpec, column_map, data_kind, in_file, read_static_file
 from .identify import data_files
@@ -46,17 +46,21 @@ class PayloadFileResult:
     estimate : PayloadEstimate
     kind : str
         ``"static"`` or ``"torque_log"``.
-    recordings : tuple of dict
-        Torque logs: per file, ``file``, ``pieces`` and ``samples`` used; static data:
-        empty.
-    skipped : tuple of str
-        One line per piece left out (too short to filter).
     """
 
     estimate: PayloadEstimate
     kind: str
-    recordings: tuple[dict[str, Any], ...] = ()
-    skipped: tuple[str, ...] = ()
+
+    @property
+    def recordings(self) -> tuple[Any, ...]:
+        """Torque logs: per file, ``file``, ``pieces``, ``samples`` and ``duration_s``
+        used; static data: empty."""
+        return tuple(self.estimate.recordings)
+
+    @property
+    def skipped(self) -> tuple[str, ...]:
+        """One line per piece left out (too short to filter)."""
+        return self.estimate.skipped
 
     def describe(self) -> str:
         """``"a.csv: 2 pieces, 3000 samples; ..."`` (empty for static data)."""
@@ -71,13 +75,15 @@ def identify_payload_files(
     arm: Robot | IdentifiedModel,
     data: str | Path | Sequence[str | Path],
     *,
-    unloaded: str | Path | None = None,
+    unloaded: str | Path | Sequence[str | Path] | None = None,
     frame: str = "flange",
     gravity_only: bool = False,
     columns: ColumnSpec | None = None,
     drop_invalid: bool = False,
     cutoff_hz: float | None = None,
     max_gap_s: float | None = None,
+    drive: Drive | None = None,
+    feasible: str | Path | None = None,
 ) -> PayloadFileResult:
     """The load fixed to ``frame`` from data recorded with it (module docstring).
 
@@ -87,21 +93,28 @@ def identify_payload_files(
         The arm without the load.
     data : str, Path or a sequence of them
         Static data (one file) or one or more torque logs (a folder: its data files).
-    unloaded : str or Path, optional
-        The same kind of data without the load (difference method), one file.
+    unloaded : str, Path or a sequence of them, optional
+        The same kind of data without the load (difference method): one static file, or
+        one or more torque logs.
     frame, gravity_only
         As :func:`~dynid.feasibility.payload.identify_payload`.
     columns : (str or None, str or None), optional
-        ``--columns`` and ``--units`` of files of another tool.
+        ``--columns`` and ``--units`` of files of another tool (default: an identified
+        model's recorded ones).
     drop_invalid : bool
         Drop invalid rows (counted) instead of failing.
-    cutoff_hz : float or None
-        Torque logs: zero-phase low-pass cut-off [Hz] (also of velocities derived from
-        positions through ``columns``); default
-        :data:`~dynid.identification.log.DEFAULT_CUTOFF_HZ`. Refused with static data, which
-        are not filtered.
+    cutoff_hz : float, optional
+        Torque logs: zero-phase low-pass cut-off [Hz]; default: the identification's
+        recorded one (with its decimation), else the one read from the recordings' motion.
+        Refused with static data, which are not filtered.
     max_gap_s : float, optional
         Torque logs: longest gap bridged [s]; a longer one cuts a log into pieces.
+    drive : Drive, optional
+        The drive the data were recorded through, for an arm without one (a robot's known
+        rotor inertias come from it).
+    feasible : str or Path, optional
+        The ``feasible.json`` the robot ``arm`` was read from: its drive and friction are
+        the arm's.
 
     Returns
     -------
@@ -118,95 +131,80 @@ def identify_payload_files(
     kin = arm.robot if isinstance(arm, IdentifiedModel) else arm
     kin.frame(frame)  # an unknown frame is the option's error, not a file's
     paths = data_files(data)
-    given = cutoff_hz
-    cutoff_hz = DEFAULT_CUTOFF_HZ if cutoff_hz is None else cutoff_hz
-    cmap = column_map(*(columns or (None, None)), cutoff_hz=cutoff_hz)
+    base = None if unloaded is None else data_files(unloaded)
+    friction: ArmFriction = "own"
+    if feasible is not None:
+        drive = drive or load_feasible_drive(feasible)
+        friction = load_feasible_linear_friction(feasible) or "own"
+    recorded = arm.info.log if isinstance(arm, IdentifiedModel) else None
+    known = cutoff_hz if cutoff_hz is not None or recorded is None else recorded.cutoff_hz
+    cmap = column_map(*(columns or (None, None)), cutoff_hz=known)
     kind = data_kind(paths[0], cmap)
+    common: dict[str, Any] = dict(frame=frame, drive=drive, friction=friction)
     if kind != "torque_log":
-        if given is not None:
+        if cutoff_hz is not None:
             raise DataError(
                 "--cutoff applies to torque logs (their low-pass); static data are not filtered"
             )
-        if len(paths) > 1:
-            raise DataError(
-                f"{paths[0].name} holds static data: give one static data file ({len(paths)} given)"
-            )
-        if unloaded is not None and data_kind(unloaded, cmap) != "static":
-            raise DataError("--unloaded must be static data like --data", file=Path(unloaded).name)
-        static = read_static_file(
-            paths[0], kin, columns=cmap, drop_invalid=drop_invalid, require_M=not gravity_only
-        )
-        base = (
-            None
-            if unloaded is None
-            else read_static_file(
-                unloaded, kin, columns=cmap, drop_invalid=drop_invalid, require_M=not gravity_only
-            )
-        )
-        est = in_file(
-            paths[0],
-            lambda: identify_payload(
-                arm, static, frame=frame, gravity_only=gravity_only, unloaded=base, cutoff_hz=None
-            ),
-        )
-        return PayloadFileResult(est, "static")
+        return _static(arm, kin, paths, base, cmap, drop_invalid, gravity_only, common)
     if gravity_only:
         raise DataError("--gravity-only applies to static data (q, g), not to a torque log")
-    owner = f"robot {kin.name!r}"
-    rec = read_recordings(
-        paths, kin, columns=columns, drop_invalid=drop_invalid, cutoff_hz=cutoff_hz, owner=owner
+    read_as: dict[str, Any] = dict(
+        recorded=arm.info.column_map if isinstance(arm, IdentifiedModel) else None,
+        columns=columns,
+        drop_invalid=drop_invalid,
+        cutoff_hz=known,
+        drive=arm.drive if isinstance(arm, IdentifiedModel) and drive is None else drive,
     )
-    pieces, summary, skipped = _pieces(kin, rec.logs, rec.names, cutoff_hz, max_gap_s)
-    without = None
-    if unloaded is not None:
-        without = read_recordings(
-            unloaded, kin, columns=columns, drop_invalid=drop_invalid, cutoff_hz=cutoff_hz
-        ).logs[0]
+    rec = read_recordings(paths, kin, owner=f"robot {kin.name!r}", **read_as)
+    without_rec = None
+    if base is not None:
+        without_rec = read_recordings(base, kin, owner=f"robot {kin.name!r}", **read_as)
     fit = lambda: identify_payload(  # noqa: E731
-        arm, pieces, frame=frame, unloaded=without, cutoff_hz=cutoff_hz, max_gap_s=max_gap_s
+        arm,
+        rec.logs,
+        names=rec.names,
+        unloaded=None if without_rec is None else without_rec.logs,
+        unloaded_names=None if without_rec is None else without_rec.names,
+        cutoff_hz="recorded" if cutoff_hz is None else cutoff_hz,
+        max_gap_s=max_gap_s,
+        **common,
     )
     est = in_file(paths[0], fit) if len(paths) == 1 else fit()
-    return PayloadFileResult(est, "torque_log", summary, skipped)
+    return PayloadFileResult(est, "torque_log")
 
 
-def _pieces(
-    robot: Robot,
-    logs: Sequence[TorqueLog],
-    names: Sequence[str],
-    cutoff_hz: float | None,
-    max_gap_s: float | None,
-) -> tuple[list[TorqueLog], tuple[dict[str, Any], ...], tuple[str, ...]]:
-    """Every recording unwrapped and cut at its gaps; the pieces long enough to filter,
-    the pieces and samples per file, and a line per piece left out."""
-    revolute = ~np.asarray(robot.prismatic, dtype=bool)
-    kept: list[TorqueLog] = []
-    summary, skipped = [], []
-    for name, log in zip(names, logs, strict=True):
-        log, joints = unwrapped(log, revolute)
-        if joints:
-            warnings.warn(
-                f"{name}: joint(s) {', '.join(str(j + 1) for j in joints)} recorded wrapped "
-                "into [-pi, pi] (jumps of a whole turn): unwrapped",
-                DynidWarning,
-                stacklevel=3,
-            )
-        mine = []
-        for piece in split_at_gaps(log, max_gap_s):
-            try:
-                prepare_log(piece, cutoff_hz=cutoff_hz, max_gap_s=max_gap_s)  # long enough?
-            except DataError as exc:
-                skipped.append(skipped_piece(name, piece, exc, stacklevel=4))
-                continue
-            mine.append(piece)
-        if not mine:
+def _static(
+    arm: Robot | IdentifiedModel,
+    kin: Robot,
+    paths: list[Path],
+    base: list[Path] | None,
+    cmap: Any,
+    drop_invalid: bool,
+    gravity_only: bool,
+    common: dict[str, Any],
+) -> PayloadFileResult:
+    """The static route of :func:`identify_payload_files`: one file with the load, and at
+    most one without."""
+    for given in (paths, base or []):
+        if len(given) > 1:
             raise DataError(
-                f"no piece long enough to filter at {cutoff_hz} Hz (gaps longer than "
-                "--max-gap cut a recording into pieces); hint: record longer stretches "
-                "without gaps, or raise --max-gap",
-                file=name,
+                f"{given[0].name} holds static data: give one static data file ({len(given)} given)"
             )
-        kept += mine
-        summary.append(
-            {"file": name, "pieces": len(mine), "samples": sum(p.n_samples for p in mine)}
+    if base is not None and data_kind(base[0], cmap) != "static":
+        raise DataError("--unloaded must be static data like --data", file=base[0].name)
+
+    def read(p: Path) -> Any:
+        return read_static_file(
+            p, kin, columns=cmap, drop_invalid=drop_invalid, require_M=not gravity_only
         )
-    return kept, tuple(summary), tuple(skipped)
+
+    static = read(paths[0])
+    without = None if base is None else read(base[0])
+    est = in_file(
+        paths[0],
+        lambda: identify_payload(
+            arm, static, gravity_only=gravity_only, unloaded=without, **common
+        ),
+    )
+    return PayloadFileResult(est, "static")

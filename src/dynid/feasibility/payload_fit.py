@@ -1,0 +1,224 @@
+"""The least squares of a load's parameters and their physical consistency.
+
+* :func:`fit_load`: the least squares of the load's ``p`` parameters (and the friction
+  beside them), refused when the data do not excite every direction of the load's
+  parameters (a load rotated about one axis only), the unexcited ones named;
+* :func:`load_parameters`: the estimate checked for a positive mass and, for the full 10,
+  moved into the physically consistent set by the pseudo-inertia LMI when it is not in it
+  (the closest point in the metric of the data; Wensing, Kim, Slotine, RA-L 2018);
+* :func:`summary`: mass, CoM, inertia about the CoM and their standard deviations;
+* :func:`serial_correlation_factor`: how much the variances of a fit to low-pass filtered
+  samples exceed those of independent rows.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from numpy.typing import NDArray
+
+from ..exceptions import DataError, RankDeficientError, SolverError
+from ..identification.least_squares import LeastSquaresFit, fit_least_squares
+from ..model.inertia import inertia6_from_matrix, inertial_from_phi
+from ..regressors.base import RANK_FLOOR
+from ..regressors.terms import friction_labels
+from .lmi import pseudo_inertia, pseudo_inertia_margin
+
+__all__ = ["fit_load", "load_parameters", "serial_correlation_factor", "summary"]
+
+
+def summary(phi: NDArray[np.float64], cov: NDArray[np.float64], full: bool):
+    """Mass, CoM, inertia (about CoM) and their standard deviations from phi and its cov."""
+
+    def f(p: NDArray[np.float64]) -> NDArray[np.float64]:
+        m, c, I = inertial_from_phi(p)
+        return np.concatenate([[m], c, inertia6_from_matrix(I)])
+
+    p = phi.copy()
+    k = cov.shape[0]
+    scale = np.maximum(np.abs(p[:k]), 1e-6 * max(float(np.max(np.abs(p[:k]))), 1e-12))
+    Jac = np.empty((10, k))
+    for i in range(k):
+        h = 1e-6 * scale[i]
+        a, b = p.copy(), p.copy()
+        a[i] += h
+        b[i] -= h
+        Jac[:, i] = (f(a) - f(b)) / (2 * h)
+    C = Jac @ cov @ Jac.T
+    std = np.sqrt(np.maximum(np.diag(C), 0.0))
+    m, c, I = inertial_from_phi(p)
+    if not full:
+        std[4:] = np.nan
+        I = np.zeros((3, 3))
+    return float(m), c, I, float(std[0]), std[1:4], std[4:]
+
+
+def _consistent(
+    phi_ls: NDArray[np.float64], R: NDArray[np.float64], margin: float
+) -> tuple[NDArray[np.float64], bool]:
+    """The LMI-constrained estimate closest to ``phi_ls`` in ``||R (phi - phi_ls)||``."""
+    if pseudo_inertia_margin(phi_ls) >= margin:
+        return phi_ls, False
+    import cvxpy as cp
+
+    s = np.maximum(np.abs(phi_ls), 1e-9 * max(float(np.max(np.abs(phi_ls))), 1e-12))
+    x = cp.Variable(10)  # phi = s * x, so the variables are of order one
+    phi = cp.multiply(s, x)
+    J = _pseudo_inertia_expr(phi)
+    Rs = R * s[None, :]
+    obj = cp.sum_squares(Rs @ x - R @ phi_ls)
+    cons = [J - margin * cp.trace(J) * np.eye(4) >> 0]
+    prob = cp.Problem(cp.Minimize(obj), cons)
+    try:
+        prob.solve(solver="CLARABEL")
+    except (cp.error.SolverError, ArithmeticError, ValueError) as exc:
+        raise SolverError(f"payload: the consistent estimate was not found ({exc})") from exc
+    if prob.status not in ("optimal", "optimal_inaccurate") or x.value is None:
+        raise SolverError(f"payload: the consistent estimate was not found (status {prob.status})")
+    return s * np.asarray(x.value), True
+
+
+def _pseudo_inertia_expr(phi):  # noqa: ANN001, ANN202 (cvxpy expressions)
+    """cvxpy expression of :func:`~dynid.feasibility.lmi.pseudo_inertia` (linear in phi)."""
+    E = np.eye(10)
+    return sum(phi[i] * pseudo_inertia(E[i]) for i in range(10))
+
+
+_LOAD_LABELS = ("m", "mcx", "mcy", "mcz", "Jxx", "Jxy", "Jxz", "Jyy", "Jyz", "Jzz")
+
+
+def fit_load(
+    W: NDArray[np.float64],
+    y: NDArray[np.float64],
+    kept: NDArray[np.bool_] | None,
+    rtol: float | None,
+    p: int,
+    static: bool,
+) -> LeastSquaresFit:
+    """The least squares of the load (and friction) columns.
+
+    Without ``rtol``, every direction of the load's ``p`` parameters must be excited
+    (:func:`_excited`): a load rotated about one axis only excites some of its 10
+    parameters, and the noise of the measured positions would otherwise fill the others.
+
+    Raises
+    ------
+    RankDeficientError
+        Naming the load's parameters the data do not excite, and what would excite them.
+    """
+    labels = _LOAD_LABELS[:p] + friction_labels((W.shape[1] - p) // 3)
+    if rtol is None:
+        r, names = _excited(W, p, kept, labels)
+        if r < p:
+            raise _not_excited(r, p, names, static)
+    try:
+        return fit_least_squares(
+            W, y, kept=kept, rtol=1e-10 if rtol is None else rtol, std="robust"
+        )
+    except RankDeficientError as exc:
+        by_column = {f"column {i}": label for i, label in enumerate(labels)}
+        shown = tuple(by_column.get(d, d) for d in exc.dependent)
+        raise _not_excited(exc.rank, exc.needed, shown, static) from None
+
+
+def _excited(
+    W: NDArray[np.float64], p: int, kept: NDArray[np.bool_] | None, labels: tuple[str, ...]
+) -> tuple[int, tuple[str, ...]]:
+    """How many directions of the load's parameters (the first ``p`` columns) the data
+    excite, and the labels of the others' large entries.
+
+    Every column is scaled to unit norm; the load's columns are then freed of what the
+    other fitted columns (friction, offsets) explain, and a direction whose singular
+    value stays below :data:`~dynid.regressors.base.RANK_FLOOR` (a 1e-3 part of a unit
+    column) is not excited: its estimate would be noise amplified a thousandfold.
+    """
+    import scipy.linalg  # as the rest of the module: scipy on first use
+
+    cols = np.arange(W.shape[1]) if kept is None else np.flatnonzero(kept)
+    other = cols[cols >= p]
+    M = np.concatenate([W[:, other], W[:, :p]], axis=1)
+    if M.shape[0] < M.shape[1]:
+        return p, ()  # fewer rows than columns: the least squares says so
+    norms = np.linalg.norm(M, axis=0)
+    M /= np.where(norms > 0, norms, 1.0)
+    R = scipy.linalg.qr(M, mode="r")[0]
+    _, sv, Vt = np.linalg.svd(R[other.size : other.size + p, other.size :])
+    r = int(np.sum(sv > RANK_FLOOR))
+    null = np.abs(Vt[r:])
+    names = tuple(labels[i] for i in np.flatnonzero(null.max(axis=0, initial=0.0) > 0.3))
+    return r, names
+
+
+def _not_excited(
+    rank: int | None, needed: int | None, names: tuple[str, ...], static: bool
+) -> RankDeficientError:
+    hint = (
+        "static data at more varied configurations (with --gravity-only: mass and CoM only)"
+        if static
+        else "a log that moves the joints carrying the load, its wrist included, so that "
+        "the load rotates about several axes (or static data)"
+    )
+    return RankDeficientError(
+        f"the data do not excite the load's parameters (rank {rank} of {needed}; "
+        f"unexcited combinations of {', '.join(names) or '?'}); hint: {hint}",
+        rank=rank,
+        needed=needed,
+        dependent=names,
+    )
+
+
+def load_parameters(
+    est: NDArray[np.float64],
+    std_mass: float,
+    W: NDArray[np.float64],
+    margin: float,
+    notes: list[str],
+) -> tuple[NDArray[np.float64], bool, float]:
+    """The load's 10 parameters from the least-squares ``est`` (checked for a positive
+    mass; 4: mass and first moments; 10: moved into the consistent set by the LMI)."""
+    phi_ls = np.zeros(10)
+    phi_ls[: est.size] = est
+    if phi_ls[0] <= 0:  # both routes: the LMI would turn no load into 1e-22 kg, silently
+        raise DataError(
+            f"the estimated load mass is {phi_ls[0]:.6g} kg (std {std_mass:.2g} kg; not "
+            "positive); is a load mounted, and is the arm's model right (its armature, "
+            "rotor inertias and friction included)?"
+        )
+    if est.size == 4:
+        return phi_ls, False, float("nan")
+    import scipy.linalg  # as the rest of the module: scipy on first use
+
+    R = scipy.linalg.qr(W[:, :10], mode="r")[0][:10]
+    phi, active = _consistent(phi_ls, R, margin)
+    if active:
+        notes.append(
+            "the least-squares estimate was not physically consistent; the LMI "
+            f"(margin {margin:g}) moved it; standard deviations are the unconstrained ones"
+        )
+    return phi, active, float(pseudo_inertia_margin(phi))
+
+
+def serial_correlation_factor(
+    residual: NDArray[np.float64], n: int, max_lag: int
+) -> tuple[float, int]:
+    """The variance inflation of a least squares whose residual is serially correlated,
+    and the lags used.
+
+    Rows of filtered recordings (sample-major, ``n`` joints a sample) are not independent:
+    a zero-phase low-pass at ``f_c`` correlates the noise over about ``f_s / f_c``
+    samples, so the covariance of independent rows is too small by about that factor
+    (the standard deviations by its square root). With the residual's autocorrelation
+    ``rho_l`` pooled over the joints, the factor is the Newey-West long-run variance
+    ratio with Bartlett weights, ``1 + 2 sum_l (1 - l / (L + 1)) rho_l`` for
+    ``l = 1 .. L = max_lag`` (Newey and West, Econometrica 55, 1987), at least 1.
+    """
+    R = np.asarray(residual, dtype=np.float64).reshape(-1, n)
+    R = R - R.mean(axis=0)
+    var = float(np.sum(R * R))
+    L = int(min(max(max_lag, 0), R.shape[0] // 4))
+    if var <= 0 or L < 1:
+        return 1.0, 0
+    f = 1.0
+    for lag in range(1, L + 1):
+        rho = float(np.sum(R[lag:] * R[:-lag])) / var
+        f += 2.0 * (1.0 - lag / (L + 1)) * rho
+    return max(f, 1.0), L

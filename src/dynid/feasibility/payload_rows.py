@@ -1,0 +1,208 @@
+"""The rows of a payload fit: the load's regressor columns and what the arm leaves of the data.
+
+The load fixed to a frame on link ``k`` adds ``Y_k A phi_F`` to the arm's torques
+(:mod:`dynid.feasibility.payload`); the targets are the measured quantities minus the
+arm's whole prediction (:class:`~dynid.feasibility.payload_arm.ArmModel`).
+
+* :func:`static_load_rows`: ``[tril M; g]`` of static data;
+* :func:`log_rows`: recordings prepared as identification prepares them
+  (:func:`~dynid.identification.recordings.prepare_recordings`: read through the drive,
+  unwrapped, cut at gaps longer than ``max_gap_s``, each piece filtered, differentiated
+  and decimated on its own at one cut-off), with the classical friction ``fv, fc, fo`` per
+  joint beside the load's columns: what the arm's own friction leaves (the load presses
+  the bearings harder), or all of it for an arm modelled without friction;
+* :func:`log_preparation`: the cut-off and decimation: given, else the identified model's
+  recorded ones, else read from the recordings' motion as identification reads them.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from typing import Any, Literal
+
+import numpy as np
+from numpy.typing import NDArray
+
+from ..identification.classical import friction_regressor
+from ..identification.data import StaticDataset
+from ..identification.log import TorqueLog, joint_side_log
+from ..identification.model import IdentifiedModel
+from ..identification.recordings import Recordings
+from ..identification.sanity import moving_joints
+from ..model.drive import Drive
+from ..regressors.static import static_regressor_columns, static_rows, static_vector
+from ..regressors.torque import torque_regressor
+from .payload_arm import ArmModel
+
+__all__ = ["log_preparation", "log_rows", "static_load_rows", "still_joints"]
+
+
+def static_load_rows(
+    arm: ArmModel,
+    data: StaticDataset,
+    cols: slice,
+    A: NDArray[np.float64],
+    gravity_only: bool,
+    notes: list[str],
+) -> tuple[NDArray[np.float64], NDArray[np.float64], str]:
+    """Regressor rows (in the load's frame parameters) and targets of static data.
+
+    Only the load link's 10 columns of the static regressor are computed, a block of
+    configurations at a time (a 50-joint arm's full regressor is 5.3 MB a configuration);
+    the fit of the load takes its rows whole, ``(N rows, <= 10)``.
+    """
+    robot = arm.robot
+    n, q = robot.n, data.q
+    idx = np.arange(10 * n)[cols]
+    step = max(1, (64 << 20) // (8 * static_rows(n) * 10))
+    Y = np.concatenate(
+        [
+            static_regressor_columns(robot, q[a : a + step], idx).transpose(2, 1, 0) @ A
+            for a in range(0, q.shape[0], step)
+        ]
+    )
+    y = static_vector(data.M, data.g) - static_vector(arm.mass_matrix(q), arm.gravity_torques(q))
+    route = "static M and g"
+    if gravity_only:
+        rows = n * (n + 1) // 2
+        Y, y = Y[:, rows:, :4], y[:, rows:]
+        route = "static g"
+        notes.append("g only: mass and CoM identified, the inertia is not")
+    return Y.reshape(-1, Y.shape[-1]), y.reshape(-1), route
+
+
+def log_preparation(
+    arm: IdentifiedModel | Any,
+    logs: Sequence[TorqueLog],
+    cutoff_hz: float | None | Literal["recorded"],
+    decimate: int | None,
+) -> tuple[float | None | Literal["auto"], int | None, str]:
+    """The cut-off [Hz] (``"auto"``: read from the motion), the decimation (None: the
+    default for the cut-off) and where they come from (``"given"``, ``"model"`` or
+    ``"motion"``). The model's decimation is reused for recordings at the rate it was
+    identified from (within 1 %)."""
+    if not isinstance(cutoff_hz, str):
+        return cutoff_hz, decimate, "given"
+    info = arm.info.log if isinstance(arm, IdentifiedModel) else None
+    if info is None:
+        return "auto", decimate, "motion"
+    if decimate is None and logs:
+        rate = float(np.median([log.sample_rate for log in logs]))
+        if abs(rate - info.sample_rate_hz) <= 0.01 * info.sample_rate_hz:
+            decimate = int(info.decimate)
+    return info.cutoff_hz, decimate, "model"
+
+
+def still_joints(logs: Sequence[TorqueLog], drive: Drive | None) -> NDArray[np.bool_]:
+    """Joints whose measured velocity (joint side) never leaves its noise band in any
+    recording (:func:`~dynid.identification.sanity.moving_joints`)."""
+    return ~moving_joints(np.concatenate([joint_side_log(log, drive).dq for log in logs]))
+
+
+def _load_columns(
+    robot: Any,
+    q: NDArray[np.float64],
+    dq: NDArray[np.float64],
+    ddq: NDArray[np.float64],
+    cols: slice,
+    A: NDArray[np.float64],
+) -> NDArray[np.float64]:
+    """The torque regressor's columns ``cols`` mapped by ``A``, (N, n, p), computed a block
+    of samples at a time (the full regressor of one block held, 64 MB at most)."""
+    n = robot.n
+    step = max(1, (64 << 20) // (8 * n * 10 * n))
+    parts = []
+    for k in range(0, q.shape[0], step):
+        b = slice(k, k + step)
+        parts.append(torque_regressor(robot, q[b], dq[b], ddq[b])[..., cols] @ A)
+    return np.concatenate(parts)
+
+
+def log_rows(
+    arm: ArmModel,
+    data: Recordings,
+    still: NDArray[np.bool_],
+    cols: slice,
+    A: NDArray[np.float64],
+    notes: list[str],
+) -> tuple[NDArray[np.float64], NDArray[np.float64], str, NDArray[np.bool_]]:
+    """Regressor rows (the load's parameters, then classical friction per joint), targets
+    (measured torques minus the arm's) of prepared recordings, and the columns fitted
+    (the viscous and Coulomb friction of ``still`` joints are not: their velocity is
+    noise, taken as zero). The rows are held whole (``N n`` rows of ``10 + 3 n``
+    columns), not the ``10 n`` columns of every link.
+
+    The arm's own friction is kept in its torques when the rows explain the targets with
+    it better than without it (a smaller least-squares residual, the same columns
+    fitted): a friction law the loaded data do not follow (a robot file's published
+    sigmoid on an arm with viscous friction only) would otherwise bias the load; without
+    it, the classical friction fitted alongside is the arm's whole friction."""
+    robot = arm.robot
+    Ws, ys, fs = [], [], []
+    for piece in data.pieces:
+        log = piece.log
+        assert log.ddq is not None  # prepared logs are differentiated
+        q, dq, ddq = log.q, log.dq * ~still, log.ddq * ~still
+        Y = _load_columns(robot, q, dq, ddq, cols, A)
+        Y = np.concatenate([Y, friction_regressor(dq)], axis=-1)
+        Ws.append(Y.reshape(-1, Y.shape[-1]))
+        ys.append((np.asarray(log.tau) - arm.torques(q, dq, ddq, with_friction=False)).ravel())
+        if arm.friction is not None:
+            fs.append(np.asarray(arm.friction.torques(dq)).ravel())
+    n = robot.n
+    kept = np.ones(Ws[0].shape[-1], dtype=bool)
+    kept[10:] = ~(np.repeat(still, 3) & (np.arange(3 * n) % 3 != 2))
+    W, y = np.concatenate(Ws), np.concatenate(ys)
+    if fs:
+        y = _with_own_friction(W[:, kept], y, np.concatenate(fs), arm, notes)
+    else:
+        notes.append(
+            "classical friction fv, fc, fo per joint estimated alongside (the arm's model "
+            "has no friction)"
+        )
+    if len(data.pieces) > 1:
+        notes.append(
+            f"{data.source}: each recording and each piece between gaps filtered on its own"
+        )
+    if still.any():
+        which = ", ".join(str(j + 1) for j in np.flatnonzero(still))
+        notes.append(
+            f"joint(s) {which} never leave their velocity noise band: taken as still, "
+            "their friction fv, fc is not identifiable and is zero (not fitted from noise)"
+        )
+    k = len(data.names)
+    route = "torque log" if k == 1 else f"{k} torque logs"
+    return W, y, route, kept
+
+
+def _with_own_friction(
+    W: NDArray[np.float64],
+    y: NDArray[np.float64],
+    f: NDArray[np.float64],
+    arm: ArmModel,
+    notes: list[str],
+) -> NDArray[np.float64]:
+    """The targets ``y`` [N m] less the arm's own friction ``f`` when that explains the
+    rows ``W`` better (:func:`log_rows`), else ``y``; the choice noted."""
+    scale = np.linalg.norm(W, axis=0)
+    Ws = W / np.where(scale > 0, scale, 1.0)
+
+    def rms(t: NDArray[np.float64]) -> float:
+        x = np.linalg.lstsq(Ws, t, rcond=None)[0]
+        return float(np.sqrt(np.mean((t - Ws @ x) ** 2)))
+
+    law = arm.friction.kind if arm.friction is not None else "?"
+    own, bare = rms(y - f), rms(y)
+    if own <= bare:
+        notes.append(
+            f"the arm's own friction ({law}) subtracted, classical friction fv, fc, fo per "
+            f"joint estimated alongside as its correction (residual RMS {own:.3g} N m; "
+            f"{bare:.3g} without the arm's friction)"
+        )
+        return y - f
+    notes.append(
+        f"the arm's own friction ({law}) left out: the loaded data follow the classical "
+        f"friction fv, fc, fo estimated alongside better (residual RMS {bare:.3g} N m; "
+        f"{own:.3g} with the arm's friction)"
+    )
+    return y
