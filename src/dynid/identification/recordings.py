@@ -7,11 +7,14 @@ filter and the derivatives run across the joins, where positions jump: the accel
 there are artefacts, and the cut-off read from the motion sees the joins as fast motion.
 Here:
 
-1. every log is cut at each gap longer than ``max_gap_s`` (default
-   :func:`~dynid.identification.log.default_max_gap`: one or two lost samples are
-   bridged, longer gaps cut) into **pieces**;
-2. continuous revolute joints recorded wrapped into ``[-pi, pi]`` are unwrapped first
-   (:func:`unwrapped`, a warning names them);
+1. every log's time column is checked against its recorded velocities (a time column in
+   ms, us or ns is refused with the remedy,
+   :func:`~dynid.identification.sanity.time_unit_finding`), then cut at each gap longer
+   than ``max_gap_s`` (default :func:`~dynid.identification.log.default_max_gap`: one or
+   two lost samples are bridged, longer gaps cut) into **pieces**;
+2. in each piece, the joints that can wrap (:func:`wrappable`: a continuous joint, a
+   motor of a motor-side log) and were recorded wrapped into ``[-pi, pi]`` are unwrapped
+   (:func:`unwrapped`, a warning names them; a jump across a cut-out stretch is no wrap);
 3. one cut-off serves every piece: the median of the pieces'
    :func:`~dynid.identification.rate.cutoff_from_motion`, each weighted by its samples
    (or the one given);
@@ -35,7 +38,7 @@ from typing import Any, Literal
 import numpy as np
 from numpy.typing import NDArray
 
-from ..exceptions import DataError, DynidWarning, ShapeError
+from ..exceptions import DataError, DynidWarning, OptionError, ShapeError
 from ..model.drive import Drive
 from ..model.robot import Robot
 from .classical import PreparedLog, log_blocks, prepare_torque_log, still_columns
@@ -44,46 +47,90 @@ from .holdout import DEFAULT_FOLDS, block_labels
 from .info import IdentificationInfo, LogInfo
 from .log import TorqueLog, default_max_gap, joint_side_log
 from .rate import CUTOFF_MULTIPLE, cutoff_from_motion
-from .sanity import noise_band, spike_finding, velocity_noise_std
+from .sanity import noise_band, spike_finding, time_unit_finding, velocity_noise_std
 from .streaming import streams
 
 __all__ = [
     "Recordings",
     "common_cutoff",
     "prepare_recordings",
+    "recording_pieces",
     "skipped_piece",
     "split_at_gaps",
     "unwrapped",
+    "wrappable",
 ]
 
 
-def split_at_gaps(log: TorqueLog, max_gap_s: float | None = None) -> list[TorqueLog]:
+def split_at_gaps(
+    log: TorqueLog, max_gap_s: float | None = None, name: str = "the log"
+) -> list[TorqueLog]:
     """The pieces of ``log`` between its gaps longer than ``max_gap_s`` [s] (default
-    :func:`~dynid.identification.log.default_max_gap` of the median step)."""
+    :func:`~dynid.identification.log.default_max_gap` of the median step); a sample
+    isolated between two gaps is no piece (:func:`recording_pieces` counts it).
+
+    Raises
+    ------
+    OptionError
+        ``max_gap_s`` below the median sample step of ``log`` (named ``name``): every
+        sample would be a piece of its own.
+    """
     dt = np.diff(log.t)
-    limit = default_max_gap(float(np.median(dt))) if max_gap_s is None else float(max_gap_s)
+    step = float(np.median(dt)) if dt.size else 0.0
+    if max_gap_s is not None and dt.size and float(max_gap_s) < step:
+        raise OptionError(
+            f"--max-gap {float(max_gap_s):g} s is below the sample step {step:g} s of {name}: "
+            "every sample would be cut from the next; hint: --max-gap of at least the sample "
+            "step (a gap is a step longer than it), or leave it out for 2.5 steps"
+        )
+    limit = default_max_gap(step) if max_gap_s is None else float(max_gap_s)
     cuts = np.concatenate([[0], np.flatnonzero(dt > limit) + 1, [log.n_samples]])
-    return [log.select(np.arange(a, b)) for a, b in zip(cuts[:-1], cuts[1:], strict=True)]
+    return [
+        log.select(np.arange(a, b)) for a, b in zip(cuts[:-1], cuts[1:], strict=True) if b - a > 1
+    ]
+
+
+def wrappable(robot: Robot, drive: Drive | None = None) -> NDArray[np.bool_]:
+    """The recorded position columns that can hold a wrap into ``[-pi, pi]``.
+
+    Without a drive, or with one whose log is joint side (an identity drive, the armature
+    of ``rotor_inertia = "identify"`` included): the revolute joints whose limits span at
+    least a whole turn (unbounded ones included); a joint whose limits span less cannot
+    wrap. On a motor-side log: the motors whose angle spans at least a turn over the
+    joints' limits (``|K| (q_max - q_min)``, ``K`` the transmission; any unbounded joint
+    they drive included), prismatic joints' motors too (a ball screw turns).
+    """
+    span = np.asarray(robot.q_max, dtype=np.float64) - np.asarray(robot.q_min, dtype=np.float64)
+    turn = 2 * np.pi * (1.0 - 1e-9)
+    if drive is None or drive.side == "joint":
+        return ~np.asarray(robot.prismatic, dtype=bool) & (span >= turn)
+    K = np.abs(np.asarray(drive.transmission, dtype=np.float64))
+    motor = np.array([float(np.sum(span[row > 0] * row[row > 0])) for row in K])
+    return np.asarray(motor >= turn, dtype=bool)
 
 
 def unwrapped(log: TorqueLog, revolute: NDArray[np.bool_]) -> tuple[TorqueLog, tuple[int, ...]]:
-    """The log with revolute joints recorded wrapped into ``[-pi, pi]`` unwrapped.
+    """The log with the columns ``revolute`` (:func:`wrappable`) recorded wrapped into
+    ``[-pi, pi]`` unwrapped; a log without gaps (a piece, :func:`split_at_gaps`).
 
-    A joint is wrapped when its position jumps by nearly a whole turn more than its
-    recorded velocity explains (``dq dt``, the mean of the two samples'; the raw step for
+    A column is wrapped when its positions stay within one turn, jump somewhere by more
+    than half a turn, and every such jump is nearly a whole turn more than its recorded
+    velocity explains (``dq dt``, the mean of the two samples'; the raw step for
     velocities derived from the positions) while the rest of the jump is as small as its
     other unexplained steps: a fast motor turning more than half a turn between two samples
-    is motion, not a wrap. Returns the log with those turns taken out and the joints
-    unwrapped (0-based; the log itself when none).
+    is motion, not a wrap, and smooth positions whose velocities disagree with them (a
+    time column in ms) are not wrapped. Returns the log with those turns taken out and the
+    columns unwrapped (0-based; the log itself when none).
     """
-    d = np.diff(log.q, axis=0)
-    if not log.dq_derived:
-        d = d - 0.5 * (log.dq[:-1] + log.dq[1:]) * np.diff(log.t)[:, None]
+    raw = np.diff(log.q, axis=0)
+    d = raw if log.dq_derived else raw - 0.5 * (log.dq[:-1] + log.dq[1:]) * np.diff(log.t)[:, None]
     turns = np.round(d / (2 * np.pi))
     rest = np.abs(d - 2 * np.pi * turns)
     typical = np.max(np.abs(np.where(turns == 0, d, 0.0)), axis=0, initial=0.0)
-    wrapped = np.any(turns != 0, axis=0) & np.all(
-        (turns == 0) | (rest <= np.maximum(2 * typical, 1e-9)), axis=0
+    within = np.ptp(log.q, axis=0) <= 2 * np.pi * (1.0 + 1e-9) + 1e-9
+    jumps = np.any((turns != 0) & (np.abs(raw) > np.pi), axis=0)
+    wrapped = (
+        within & jumps & np.all((turns == 0) | (rest <= np.maximum(2 * typical, 1e-9)), axis=0)
     )
     joints = tuple(int(j) for j in np.flatnonzero(wrapped & np.asarray(revolute, dtype=bool)))
     if not joints:
@@ -92,6 +139,62 @@ def unwrapped(log: TorqueLog, revolute: NDArray[np.bool_]) -> tuple[TorqueLog, t
     q[1:, joints] -= 2 * np.pi * np.cumsum(turns[:, joints], axis=0)
     out = TorqueLog(log.t, q, log.dq, log.tau, log.ddq, log.cleaning, log.dq_derived)
     return out, joints
+
+
+def recording_pieces(
+    name: str,
+    log: TorqueLog,
+    turns: NDArray[np.bool_],
+    max_gap_s: float | None = None,
+    *,
+    stacklevel: int = 3,
+) -> tuple[list[TorqueLog], tuple[int, ...]]:
+    """One recording checked, cut at its gaps and unwrapped piece by piece.
+
+    The time column is checked against the recorded velocities first
+    (:func:`~dynid.identification.sanity.time_unit_finding`); the log is cut at its gaps
+    longer than ``max_gap_s`` (:func:`split_at_gaps`) and each piece's columns ``turns``
+    (:func:`wrappable`) are unwrapped on their own (:func:`unwrapped`): a jump across a
+    cut-out stretch is no wrap and does not keep the other wraps in. A warning names the
+    file and the joints unwrapped.
+
+    Returns
+    -------
+    pieces : list of TorqueLog
+    joints : tuple of int
+        The columns (0-based) unwrapped in some piece.
+
+    Raises
+    ------
+    DataError
+        The time column looks like ms, us or ns (the file and the factor are named).
+    OptionError
+        ``max_gap_s`` below the sample step.
+    """
+    if (unit := time_unit_finding(name, log)) is not None:
+        raise DataError(unit)
+    pieces: list[TorqueLog] = []
+    turned: set[int] = set()
+    for piece in split_at_gaps(log, max_gap_s, name):
+        piece, joints = unwrapped(piece, turns)
+        turned.update(joints)
+        pieces.append(piece)
+    if (alone := log.n_samples - sum(p.n_samples for p in pieces)) > 0:
+        warnings.warn(
+            f"{name}: {alone} sample(s) isolated between gaps longer than the longest gap "
+            "bridged left out",
+            DynidWarning,
+            stacklevel=stacklevel,
+        )
+    joints = tuple(sorted(turned))
+    if joints:
+        warnings.warn(
+            f"{name}: joint(s) {', '.join(str(j + 1) for j in joints)} recorded wrapped "
+            "into [-pi, pi] (jumps of a whole turn): unwrapped",
+            DynidWarning,
+            stacklevel=stacklevel,
+        )
+    return pieces, joints
 
 
 @dataclass(frozen=True, slots=True, eq=False)
@@ -119,6 +222,11 @@ class Recordings:
         With a drive: the standstill band at its motors (``"motor"``) and at the joints
         (``"joint"``), for a friction placed where the drive does not say
         (:attr:`~dynid.identification.structure.Structure.at`); empty without one.
+    max_gap_s : float or None
+        The longest gap bridged, as given [s] (None: the default rule,
+        :func:`~dynid.identification.log.default_max_gap` of each recording's step).
+    cuts : tuple of int
+        Per recording, the gaps longer than ``max_gap_s`` it was cut at.
     """
 
     pieces: tuple[PreparedLog, ...]
@@ -128,6 +236,8 @@ class Recordings:
     skipped: tuple[str, ...] = ()
     unwrapped: tuple[int, ...] = ()
     bands: Mapping[str, NDArray[np.float64]] = dataclasses.field(default_factory=dict)
+    max_gap_s: float | None = None
+    cuts: tuple[int, ...] = ()
 
     @property
     def route(self) -> Literal["classical"]:
@@ -251,9 +361,13 @@ class Recordings:
         return tuple(out)
 
     def record(self, n_rows: int) -> IdentificationInfo:
-        """Filtering, decimation and sample counts over every piece, and each recording."""
+        """Filtering, decimation, the gap rule and sample counts over every piece; what
+        cleaning found counted once per recording (every piece carries its recording's),
+        gaps bridged apart from the gaps cut at; and each recording."""
         ps = self.pieces
         first = ps[0]
+        found = {r: p.cleaning for p, r in zip(ps, self.recording, strict=True)}
+        cuts = self.cuts or (0,) * len(self.names)
         log = LogInfo(
             cutoff_hz=first.cutoff_hz,
             trim_s=first.trim_s,
@@ -262,12 +376,14 @@ class Recordings:
             n_samples_log=sum(p.n_samples_log for p in ps),
             n_samples_used=self.n_samples,
             duration_s=float(sum(p.duration_s for p in ps)),
-            n_nan_rows=sum(p.cleaning.n_nan_rows for p in ps),
-            n_duplicates=sum(p.cleaning.n_duplicates for p in ps),
-            n_gaps=sum(len(p.cleaning.gaps) for p in ps),
+            n_nan_rows=sum(c.n_nan_rows for c in found.values()),
+            n_duplicates=sum(c.n_duplicates for c in found.values()),
+            n_gaps=sum(max(0, len(c.gaps) - cuts[r]) for r, c in found.items()),
             cutoff_source="given" if first.motion_frequency_hz is None else "motion",
             motion_frequency_hz=first.motion_frequency_hz,
             resampled=any(p.resampled for p in ps),
+            n_cuts=sum(cuts),
+            max_gap_s=self.max_gap_s,
         )
         notes = tuple(self.skipped)
         if self.unwrapped:
@@ -321,26 +437,20 @@ def prepare_recordings(
     names = tuple(names) if names is not None else tuple(f"log{k + 1}" for k in range(len(logs)))
     if len(names) != len(logs):
         raise ShapeError(f"{len(names)} names for {len(logs)} recordings")
-    revolute = ~np.asarray(robot.prismatic, dtype=bool)
+    # a motor-side log: its motors turn (a joint-side one: joints whose limits span a turn)
+    turns = wrappable(robot, drive)
     pieces: list[tuple[int, TorqueLog]] = []
     turned: set[int] = set()
+    cuts: list[int] = []
     for r, (name, log) in enumerate(zip(names, logs, strict=True)):
         if log.n != robot.n:
             raise ShapeError(f"{name}: log has {log.n} joints; robot {robot.name!r} has {robot.n}")
-        # a motor-side log: every motor turns (a joint-side one: the robot's revolute joints)
-        turns = revolute if drive is None or drive.side == "joint" else np.ones(robot.n, bool)
-        log, joints = unwrapped(log, turns)
         if (spikes := spike_finding(name, log, robot.joint_names)) is not None:
             warnings.warn(spikes, DynidWarning, stacklevel=2)
-        if joints:
-            turned.update(joints)
-            warnings.warn(
-                f"{name}: joint(s) {', '.join(str(j + 1) for j in joints)} recorded wrapped "
-                "into [-pi, pi] (jumps of a whole turn): unwrapped",
-                DynidWarning,
-                stacklevel=2,
-            )
-        pieces += [(r, p) for p in split_at_gaps(log, max_gap_s)]
+        mine, joints = recording_pieces(name, log, turns, max_gap_s)
+        turned.update(joints)
+        cuts.append(max(0, len(mine) - 1))
+        pieces += [(r, p) for p in mine]
     cutoff: float | None = None if cutoff_hz == "auto" else cutoff_hz
     if cutoff_hz == "auto":
         cutoff = common_cutoff([joint_side_log(p, drive) for _, p in pieces])
@@ -383,6 +493,8 @@ def prepare_recordings(
         skipped=tuple(skipped),
         unwrapped=tuple(sorted(turned)),
         bands=_bands([piece for _, piece in pieces], drive),
+        max_gap_s=None if max_gap_s is None else float(max_gap_s),
+        cuts=tuple(cuts),
     )
 
 

@@ -1,0 +1,178 @@
+"""Preparation of several recordings that tells the truth (issue 26 items 2 and 5, issue 28
+item 6): wraps found only where a joint can wrap and its positions jump by a turn, a time
+column in milliseconds refused with its remedy, wraps taken out per piece, gap counts per
+recording, and a ``--max-gap`` below the sample step refused in one line.
+
+References: simulated Panda logs (the same motion wrapped into ``[-pi, pi]`` by
+``angle(exp(i q))``, its time column multiplied by 1000), the joints' limits, and the
+counts of the stretches cut out by hand.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import warnings
+
+import numpy as np
+import pytest
+
+import dynid
+from dynid.exceptions import DataError, DynidWarning, OptionError
+from dynid.friction.recordings import prepare_pieces
+from dynid.identification.log import TorqueLog
+from dynid.identification.recordings import (
+    prepare_recordings,
+    recording_pieces,
+    unwrapped,
+    wrappable,
+)
+from dynid.model.drive import Drive
+from dynid.simulation.measurement import sample_times, simulate_measurement
+from dynid.simulation.trajectories import random_fourier
+
+
+@pytest.fixture(scope="module")
+def panda():
+    return dynid.panda()
+
+
+def _continuous(robot, joints):
+    """``robot`` with the given joints (0-based) continuous: no position limits."""
+    lo, hi = np.array(robot.q_min), np.array(robot.q_max)
+    lo[list(joints)], hi[list(joints)] = -np.inf, np.inf
+    return dataclasses.replace(robot, q_min=lo, q_max=hi)
+
+
+@pytest.fixture(scope="module")
+def log(panda):
+    """A 6 s, 200 Hz Panda log whose joints 1 and 7 cross +-pi (moved by a constant)."""
+    traj = random_fourier(panda, np.random.default_rng(3))(sample_times(6.0, 200.0))
+    g = simulate_measurement(panda, traj, rng=np.random.default_rng(4))
+    q = np.array(g.q)
+    for j in (0, 6):
+        q[:, j] += np.pi - 0.5 * (q[:, j].min() + q[:, j].max())  # centred on +pi
+    return TorqueLog(g.t, q, g.dq, g.tau)
+
+
+def _wrap(log, joints):
+    q = np.array(log.q)
+    q[:, joints] = np.angle(np.exp(1j * q[:, joints]))
+    return TorqueLog(log.t, q, log.dq, log.tau)
+
+
+def test_only_joints_whose_limits_span_a_turn_can_wrap(panda):
+    """The Panda's joints span less than a turn: none can wrap; continuous joints can;
+    a motor-side log's motor of a 50:1 gear turns over joint limits of 0.2 rad (10 rad),
+    a 20:1 one does not (4 rad); an identity drive is the joint side."""
+    assert not np.any(wrappable(panda))
+    arm = _continuous(panda, [0, 6])
+    np.testing.assert_array_equal(wrappable(arm), np.arange(7) % 6 == 0)
+    np.testing.assert_array_equal(wrappable(arm, Drive.identity(7)), wrappable(arm))
+    narrow = dataclasses.replace(
+        panda, q_min=np.full(7, -0.1), q_max=np.full(7, 0.1), q_neutral=np.zeros(7)
+    )
+    gears = Drive.from_gears([50, 20, 50, 20, 50, 20, 50], side="motor")
+    np.testing.assert_array_equal(wrappable(narrow, gears), np.arange(7) % 2 == 0)
+
+
+def test_a_time_column_in_ms_is_refused_naming_the_file_and_the_factor(panda, log):
+    """t x 1000: every continuous joint was 'unwrapped' and the cut-off fell to 0.05 Hz;
+    now the file, the factor 1000 and --units t=ms are named and nothing is prepared, on
+    identification and on validation alike; wrap detection alone finds no wrap in smooth
+    positions whose velocities disagree with their time column."""
+    arm = _continuous(panda, range(7))
+    ms = TorqueLog(1e3 * log.t, log.q, log.dq, log.tau)
+    assert unwrapped(ms, np.ones(7, bool))[1] == ()
+    with pytest.raises(DataError, match=r"ms\.csv: .*1000 times.*--units t=ms"):
+        prepare_recordings(arm, [log, ms], ["good.csv", "ms.csv"], cutoff_hz=10.0)
+    with pytest.raises(DataError, match=r"ms\.csv: .*--units t=ms"):
+        prepare_pieces(arm, [ms], ["ms.csv"], cutoff_hz=10.0)
+    us = TorqueLog(1e6 * log.t, log.q, log.dq, log.tau)
+    with pytest.raises(DataError, match="--units t=us"):
+        prepare_recordings(arm, [us], ["us.csv"], cutoff_hz=10.0)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", DynidWarning)
+        prepare_recordings(arm, [log], ["good.csv"], cutoff_hz=10.0)  # seconds: no word
+
+
+def test_validation_with_an_identity_drive_unwraps_like_identification(panda, log):
+    """An armature model is stored with an identity drive: validation skipped unwrapping
+    then. Joint-side pieces with the drive now come back to the motion exactly, as
+    without a drive, with the joints named."""
+    arm = _continuous(panda, [0, 6])
+    wrapped = _wrap(log, [0, 6])
+    for drive in (None, Drive.identity(7)):
+        with pytest.warns(DynidWarning, match=r"joint\(s\) 1, 7 recorded wrapped"):
+            p = prepare_pieces(arm, [wrapped], ["w.csv"], cutoff_hz=None, drive=drive)
+        assert p.unwrapped == (0, 6)
+        back = p.logs[0].q
+        np.testing.assert_allclose(back - back[0], log.q - log.q[0], atol=1e-9)
+
+
+def test_a_motor_side_log_is_unwrapped_at_its_motors(panda, log):
+    """A geared motor-side log wraps the motor angles: unwrapped before the drive maps
+    them to the joints (mapped first, the joint angles came out wrong by 2 pi / 50)."""
+    arm = _continuous(panda, [0, 6])
+    drive = Drive.from_gears(np.full(7, 50.0), side="motor")
+    qm = log.q * 50.0
+    motor = TorqueLog(log.t, np.angle(np.exp(1j * qm)), log.dq * 50.0, log.tau / 50.0)
+    with pytest.warns(DynidWarning, match="recorded wrapped"):
+        p = prepare_pieces(arm, [motor], ["m.csv"], cutoff_hz=None, drive=drive)
+    back = p.logs[0].q
+    np.testing.assert_allclose(back - back[0], log.q - log.q[0], atol=1e-9)
+
+
+def test_a_wrap_inside_a_cut_out_stretch_keeps_the_other_wraps(panda, log):
+    """Joint 7 wraps several times and a stretch is cut out where it also wraps: the jump
+    across the cut is no wrap, every piece comes back to the motion (the joint was left
+    wrapped entirely)."""
+    arm = _continuous(panda, [6])
+    t = log.t
+    q = np.array(log.q)
+    q[:, 6] = 3.0 * t + np.pi  # turns a half turn a second: wraps at every turn
+    dq = np.array(log.dq)
+    dq[:, 6] = 3.0
+    keep = ~((t > 2.0) & (t < 3.2))  # wrap at t = 2.09 s cut out
+    cut = TorqueLog(t, q, dq, log.tau).select(np.flatnonzero(keep))
+    wrapped = _wrap(cut, [6])
+    with pytest.warns(DynidWarning, match=r"c\.csv: joint\(s\) 7 recorded wrapped"):
+        pieces, joints = recording_pieces("c.csv", wrapped, wrappable(arm))
+    assert joints == (6,) and len(pieces) == 2
+    for piece, rows in zip(pieces, (t[keep] <= 2.0, t[keep] >= 3.2), strict=True):
+        truth = cut.q[rows, 6]
+        np.testing.assert_allclose(piece.q[:, 6] - piece.q[0, 6], truth - truth[0], atol=1e-9)
+
+
+def test_cleaning_is_counted_once_per_recording_and_cuts_as_cuts(panda, log):
+    """Two cut-out stretches and one dropped sample: 1 gap bridged and 2 cuts, however
+    many pieces (the counts were multiplied by the pieces, the cuts called bridged)."""
+    t = log.t
+    drop = np.ones(t.size, bool)
+    drop[(t > 1.5) & (t < 2.0)] = False
+    drop[(t > 4.0) & (t < 4.5)] = False
+    drop[100] = False  # one lost sample: bridged
+    g = TorqueLog.from_raw(t[drop], log.q[drop], log.dq[drop], log.tau[drop])
+    rec = prepare_recordings(panda, [g, g], ["a.csv", "b.csv"], cutoff_hz=10.0)
+    assert len(rec.pieces) == 6
+    info = rec.record(0).log
+    assert (info.n_gaps, info.n_cuts) == (2, 4)
+
+
+def test_a_max_gap_below_the_sample_step_is_refused_in_one_line(panda, log):
+    """--max-gap 1 ms on a 200 Hz log ended in 't must have shape (N,) with N >= 2'."""
+    with pytest.raises(OptionError, match=r"--max-gap 0\.001 s is below the sample step 0\.005"):
+        prepare_recordings(panda, [log], ["a.csv"], max_gap_s=1e-3)
+    with pytest.raises(OptionError, match="--max-gap"):
+        prepare_pieces(panda, [log], ["a.csv"], max_gap_s=1e-3)
+
+
+def test_a_sample_isolated_between_two_gaps_is_left_out_with_a_word(panda, log):
+    """One sample between two cut-out stretches ended in 't must have shape (N,) with
+    N >= 2'; it is left out, counted, and the rest prepared."""
+    t = log.t
+    keep = ~(((t > 2.0) & (t < 2.5)) | ((t > 2.51) & (t < 3.0)))
+    assert np.sum((t >= 2.5) & (t <= 2.51)) == 1
+    g = log.select(np.flatnonzero(keep))
+    with pytest.warns(DynidWarning, match=r"g\.csv: 1 sample\(s\) isolated between gaps"):
+        rec = prepare_recordings(panda, [g], ["g.csv"], cutoff_hz=10.0)
+    assert len(rec.pieces) == 2
