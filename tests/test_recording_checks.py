@@ -176,3 +176,48 @@ def test_a_sample_isolated_between_two_gaps_is_left_out_with_a_word(panda, log):
     with pytest.warns(DynidWarning, match=r"g\.csv: 1 sample\(s\) isolated between gaps"):
         rec = prepare_recordings(panda, [g], ["g.csv"], cutoff_hz=10.0)
     assert len(rec.pieces) == 2
+
+
+def _sines(f_hz, duration=8.0, fs=100.0):
+    """Joints moving as sines of the given frequencies [Hz] (exact velocities), 7 joints."""
+    t = np.arange(int(duration * fs) + 1) / fs
+    f = np.resize(np.asarray(f_hz, dtype=float), 7)
+    phase = np.arange(7)
+    q = 0.5 * np.sin(2 * np.pi * f * t[:, None] + phase)
+    dq = 0.5 * 2 * np.pi * f * np.cos(2 * np.pi * f * t[:, None] + phase)
+    return TorqueLog(t, q, dq, np.zeros_like(q))
+
+
+def test_the_cut_off_of_a_log_cut_into_pieces_is_read_over_its_time_axis():
+    """Sines of at most 0.5 Hz over 8 s, four 0.2 s stretches cut out: the cut-off is
+    10 x 0.5 Hz up to the whole log's resolution (2 bins of 1/8 s), as for the whole log;
+    read piece by piece (1.6 s each) it was 2-4 times that."""
+    from dynid.identification.recordings import common_cutoff, split_at_gaps
+
+    g = _sines([0.5, 0.3, 0.2])
+    whole = common_cutoff([g])
+    keep = ~np.any([(g.t > a) & (g.t < a + 0.2) for a in (1.5, 3.1, 4.7, 6.3)], axis=0)
+    pieces = split_at_gaps(g.select(np.flatnonzero(keep)))
+    assert len(pieces) == 5
+    cut = common_cutoff(pieces, [0] * 5)
+    for c in (whole, cut):
+        assert 5.0 <= c <= 10 * (0.5 + 2 / 8.0)
+    # two recordings of other motions: the median by samples, each read on its own axis
+    slow = split_at_gaps(_sines([0.2]).select(np.flatnonzero(keep)))
+    both = common_cutoff(pieces + slow + slow, [0] * 5 + [1] * 5 + [2] * 5)
+    assert 2.0 <= both <= 10 * (0.2 + 2 / 8.0)
+
+
+def test_pieces_of_three_samples_leave_no_numpy_warning(panda):
+    """A log cut into many pieces, some of three samples: left out with a word, no
+    'Mean of empty slice' from the noise estimate of a piece too short for it."""
+    g = _sines([0.5, 0.3])
+    keep = np.ones(g.n_samples, bool)
+    for a in range(100, 700, 100):
+        keep[a : a + 10] = False
+        keep[a + 13 : a + 20] = False  # leaves three samples a+10..a+12 alone
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", RuntimeWarning)
+        with pytest.warns(DynidWarning, match="3 samples"):
+            rec = prepare_recordings(panda, [g.select(np.flatnonzero(keep))], ["p.csv"])
+    assert len(rec.pieces) == 7

@@ -198,7 +198,11 @@ def prepare_pieces(
         mine, joints = recording_pieces(name, log, turns, max_gap_s)
         turned.update(joints)
         raw += [(r, joint_side_log(p, d)) for p in mine]
-    cut = recorded_cutoff(model, [p for _, p in raw]) if isinstance(cutoff_hz, str) else cutoff_hz
+    cut = (
+        recorded_cutoff(model, [p for _, p in raw], [r for r, _ in raw])
+        if isinstance(cutoff_hz, str)
+        else cutoff_hz
+    )
     prepared, recording, skipped = [], [], []
     for r, piece in raw:
         try:

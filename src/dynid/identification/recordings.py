@@ -15,9 +15,9 @@ Here:
 2. in each piece, the joints that can wrap (:func:`wrappable`: a continuous joint, a
    motor of a motor-side log) and were recorded wrapped into ``[-pi, pi]`` are unwrapped
    (:func:`unwrapped`, a warning names them; a jump across a cut-out stretch is no wrap);
-3. one cut-off serves every piece: the median of the pieces'
-   :func:`~dynid.identification.rate.cutoff_from_motion`, each weighted by its samples
-   (or the one given);
+3. one cut-off serves every piece (or the one given): the median of the recordings'
+   :func:`~dynid.identification.rate.cutoff_from_motion`, each weighted by its samples,
+   each read from its pieces on its own time axis (:func:`common_cutoff`);
 4. each piece is read through the drive, filtered, differentiated and decimated on its own
    (:func:`~dynid.identification.classical.prepare_torque_log`); a piece too short for
    the filter is left out with a warning naming its file and times, never silently;
@@ -46,7 +46,7 @@ from .core import ModelColumns, RegressorBlock
 from .holdout import DEFAULT_FOLDS, block_labels
 from .info import IdentificationInfo, LogInfo
 from .log import TorqueLog, default_max_gap, joint_side_log
-from .rate import CUTOFF_MULTIPLE, cutoff_from_motion
+from .rate import CUTOFF_MULTIPLE, bridged, cutoff_from_motion
 from .sanity import noise_band, spike_finding, time_unit_finding, velocity_noise_std
 from .streaming import streams
 
@@ -453,7 +453,11 @@ def prepare_recordings(
         pieces += [(r, p) for p in mine]
     cutoff: float | None = None if cutoff_hz == "auto" else cutoff_hz
     if cutoff_hz == "auto":
-        cutoff = common_cutoff([joint_side_log(p, drive) for _, p in pieces])
+        # joint-side pieces of a motor-side log differ by turns of the motors, not joints
+        jturns = None if drive is not None and drive.side == "motor" else turns
+        cutoff = common_cutoff(
+            [joint_side_log(p, drive) for _, p in pieces], [r for r, _ in pieces], jturns
+        )
         if cutoff is None:
             raise DataError("no piece is long enough to read the motion's frequency from")
     prepared, recording, skipped = [], [], []
@@ -498,22 +502,44 @@ def prepare_recordings(
     )
 
 
-def common_cutoff(pieces: Sequence[TorqueLog]) -> float | None:
-    """The cut-off [Hz] read from the motion of the pieces long enough to read it
-    (:func:`~dynid.identification.rate.cutoff_from_motion`): their median, each piece
-    weighted by its samples (a short piece reads its edges as fast motion); None when no
-    piece is long enough."""
-    found, weight = [], []
-    for piece in pieces:
-        if piece.n_samples < 64:
+def common_cutoff(
+    pieces: Sequence[TorqueLog],
+    recording: Sequence[int] | None = None,
+    turns: NDArray[np.bool_] | None = None,
+) -> float | None:
+    """The cut-off [Hz] read from the motion of the recordings
+    (:func:`~dynid.identification.rate.cutoff_from_motion`): each recording's read from
+    its pieces on its own time axis (:func:`~dynid.identification.rate.bridged`, the
+    columns ``turns`` moved by whole turns across its gaps), the median over the
+    recordings, each weighted by its samples; None when no recording holds 64 samples.
+
+    ``recording`` gives each piece's recording (default: every piece its own, read alone).
+    A recording whose cut-out stretches are longer than what was kept is read from its
+    pieces of at least 64 samples, each on its own, weighted by its samples.
+    """
+    labels = list(range(len(pieces))) if recording is None else [int(r) for r in recording]
+    found: list[float] = []
+    weight: list[int] = []
+    for r in dict.fromkeys(labels):
+        mine = [p for p, k in zip(pieces, labels, strict=True) if k == r]
+        grid = None
+        if len(mine) > 1 and sum(p.n_samples for p in mine) >= 64:
+            grid = bridged([p.t for p in mine], [p.q for p in mine], [p.dq for p in mine], turns)
+        if grid is not None:
+            dq = np.concatenate([p.dq for p in mine])
+            found.append(cutoff_from_motion(grid[0], dq, grid[1]))
+            weight.append(sum(p.n_samples for p in mine))
             continue
-        try:
-            found.append(cutoff_from_motion(piece.q, piece.dq, piece.sample_rate))
-        except DataError:
-            if len(pieces) == 1:
-                raise
-            continue
-        weight.append(piece.n_samples)
+        for piece in mine:
+            if piece.n_samples < 64:
+                continue
+            try:
+                found.append(cutoff_from_motion(piece.q, piece.dq, piece.sample_rate))
+            except DataError:
+                if len(pieces) == 1:
+                    raise
+                continue
+            weight.append(piece.n_samples)
     if not found:
         return None
     order = np.argsort(found)

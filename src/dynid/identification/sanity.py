@@ -105,13 +105,15 @@ def velocity_noise_std(dq: ArrayLike) -> NDArray[np.float64]:
         raise ShapeError(f"dq must have shape (N, n), N >= 3; got {a.shape}")
     est = []
     for order, var in ((2, 6.0), (3, 20.0)):
+        if a.shape[0] <= order:  # three samples: no third difference
+            continue
         mad = np.empty(a.shape[1])
         for j in range(a.shape[1]):  # one joint at a time: temporaries of one column
             d = np.diff(a[:, j], n=order)
             d -= np.median(d)
             mad[j] = np.median(np.abs(d, out=d))
         est.append(1.4826 * mad / np.sqrt(var))
-    out: NDArray[np.float64] = np.minimum(*est)
+    out: NDArray[np.float64] = np.minimum.reduce(est)
     return out
 
 
