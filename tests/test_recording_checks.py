@@ -221,3 +221,43 @@ def test_pieces_of_three_samples_leave_no_numpy_warning(panda):
         with pytest.warns(DynidWarning, match="3 samples"):
             rec = prepare_recordings(panda, [g.select(np.flatnonzero(keep))], ["p.csv"])
     assert len(rec.pieces) == 7
+
+
+def test_validation_cuts_and_decimates_as_the_model_was_identified(panda, log, tmp_path):
+    """--max-gap 0.05 at identification bridges two 30 ms gaps (one piece); validate and
+    friction re-cut at the default 20 ms rule (three pieces) and compared every sample.
+    The rule is recorded in identification.json and reused, with the decimation, unless
+    given: the pieces then hold the samples identification used."""
+    from dynid.identification.selection import identify_recordings
+    from dynid.identification.structure import Structure
+    from dynid.io.model_json import load_model_json, save_model_json
+
+    keep = np.ones(log.n_samples, bool)
+    keep[300:306] = keep[800:806] = False  # 35 ms steps
+    g = log.select(np.flatnonzero(keep))
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", DynidWarning)
+        model = identify_recordings(panda, [g], structure=Structure(False, ()), max_gap_s=0.05)
+    assert model.info.log.max_gap_s == 0.05 and model.info.recordings[0]["pieces"] == 1
+    back = load_model_json(save_model_json(tmp_path / "identification.json", model))
+    assert back.info.log.max_gap_s == 0.05
+    k = back.info.log.decimate
+    assert k > 1
+    p = prepare_pieces(back, [g], ["g.csv"])
+    every = prepare_pieces(back, [g], ["g.csv"], decimate=1)
+    default = prepare_pieces(back, [g], ["g.csv"], max_gap_s=0.02, decimate=1)
+    assert len(p.logs) == len(every.logs) == 1 and len(default.logs) == 3
+    assert p.n_samples == -(-every.n_samples // k)
+    np.testing.assert_array_equal(p.logs[0].t, every.logs[0].t[::k])
+
+
+def test_a_time_column_in_ms_among_good_recordings_is_named_for_its_time(panda, log, tmp_path):
+    """Mixed with a good recording, the ms file was refused as 'velocities 0.001 times
+    those of the other recording: other units?'; its time column is now named."""
+    from dynid.io.torque_log import save_torque_log
+    from dynid.workflows.validate import validate_files
+
+    save_torque_log(tmp_path / "good.csv", log)
+    save_torque_log(tmp_path / "ms.csv", TorqueLog(1e3 * log.t, log.q, log.dq, log.tau))
+    with pytest.raises(DataError, match=r"ms\.csv: .*time column looks like ms.*--units t=ms"):
+        validate_files(_continuous(panda, [0, 6]), [tmp_path / "good.csv", tmp_path / "ms.csv"])
