@@ -16,19 +16,16 @@ every policy the command applies, so that the Python API behaves as the command 
 
 from __future__ import annotations
 
-import warnings
 from collections.abc import Sequence
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
-import numpy as np
-
-from ..exceptions import DataError, DynidWarning
+from ..exceptions import DataError
 from ..feasibility.payload import PayloadEstimate, identify_payload
 from ..identification.log import DEFAULT_CUTOFF_HZ, TorqueLog, prepare_log
 from ..identification.model import IdentifiedModel
-from ..identification.recordings import skipped_piece, split_at_gaps, unwrapped
+from ..identification.recordings import recording_pieces, skipped_piece, wrappable
 from ..model.robot import Robot
 from .data_files import ColumnSpec, column_map, data_kind, in_file, read_static_file
 from .identify import data_files
@@ -176,22 +173,16 @@ def _pieces(
     cutoff_hz: float | None,
     max_gap_s: float | None,
 ) -> tuple[list[TorqueLog], tuple[dict[str, Any], ...], tuple[str, ...]]:
-    """Every recording unwrapped and cut at its gaps; the pieces long enough to filter,
+    """Every recording cut at its gaps and unwrapped piece by piece
+    (:func:`~dynid.identification.recordings.recording_pieces`); the pieces long enough to filter,
     the pieces and samples per file, and a line per piece left out."""
-    revolute = ~np.asarray(robot.prismatic, dtype=bool)
+    turns = wrappable(robot)
     kept: list[TorqueLog] = []
     summary, skipped = [], []
     for name, log in zip(names, logs, strict=True):
-        log, joints = unwrapped(log, revolute)
-        if joints:
-            warnings.warn(
-                f"{name}: joint(s) {', '.join(str(j + 1) for j in joints)} recorded wrapped "
-                "into [-pi, pi] (jumps of a whole turn): unwrapped",
-                DynidWarning,
-                stacklevel=3,
-            )
+        pieces, _ = recording_pieces(name, log, turns, max_gap_s, stacklevel=4)
         mine = []
-        for piece in split_at_gaps(log, max_gap_s):
+        for piece in pieces:
             try:
                 prepare_log(piece, cutoff_hz=cutoff_hz, max_gap_s=max_gap_s)  # long enough?
             except DataError as exc:
