@@ -51,6 +51,7 @@ from .sanity import noise_band, spike_finding, time_unit_finding, velocity_noise
 from .streaming import streams
 
 __all__ = [
+    "WRAP_SPAN",
     "Recordings",
     "common_cutoff",
     "prepare_recordings",
@@ -60,6 +61,11 @@ __all__ = [
     "unwrapped",
     "wrappable",
 ]
+
+
+#: Positions recorded wrapped span at most this many turns (one, and the noise or offset
+#: a logger may add after wrapping).
+WRAP_SPAN = 1.05
 
 
 def split_at_gaps(
@@ -113,9 +119,9 @@ def unwrapped(log: TorqueLog, revolute: NDArray[np.bool_]) -> tuple[TorqueLog, t
     """The log with the columns ``revolute`` (:func:`wrappable`) recorded wrapped into
     ``[-pi, pi]`` unwrapped; a log without gaps (a piece, :func:`split_at_gaps`).
 
-    A column is wrapped when its positions stay within one turn, jump somewhere by more
-    than half a turn, and every such jump is nearly a whole turn more than its recorded
-    velocity explains (``dq dt``, the mean of the two samples'; the raw step for
+    A column is wrapped when its positions stay within one turn (:data:`WRAP_SPAN`), jump
+    somewhere by more than half a turn, and every such jump is nearly a whole turn more
+    than its recorded velocity explains (``dq dt``, the mean of the two samples'; the raw step for
     velocities derived from the positions) while the rest of the jump is as small as its
     other unexplained steps: a fast motor turning more than half a turn between two samples
     is motion, not a wrap, and smooth positions whose velocities disagree with them (a
@@ -127,7 +133,7 @@ def unwrapped(log: TorqueLog, revolute: NDArray[np.bool_]) -> tuple[TorqueLog, t
     turns = np.round(d / (2 * np.pi))
     rest = np.abs(d - 2 * np.pi * turns)
     typical = np.max(np.abs(np.where(turns == 0, d, 0.0)), axis=0, initial=0.0)
-    within = np.ptp(log.q, axis=0) <= 2 * np.pi * (1.0 + 1e-9) + 1e-9
+    within = np.ptp(log.q, axis=0) <= 2 * np.pi * WRAP_SPAN
     jumps = np.any((turns != 0) & (np.abs(raw) > np.pi), axis=0)
     wrapped = (
         within & jumps & np.all((turns == 0) | (rest <= np.maximum(2 * typical, 1e-9)), axis=0)
