@@ -47,7 +47,13 @@ from .holdout import DEFAULT_FOLDS, block_labels
 from .info import IdentificationInfo, LogInfo
 from .log import TorqueLog, default_max_gap, joint_side_log
 from .rate import CUTOFF_MULTIPLE, bridged, cutoff_from_motion
-from .sanity import noise_band, spike_finding, time_unit_finding, velocity_noise_std
+from .sanity import (
+    check_torque_log,
+    noise_band,
+    spike_finding,
+    time_unit_finding,
+    velocity_noise_std,
+)
 from .streaming import streams
 
 __all__ = [
@@ -456,6 +462,11 @@ def prepare_recordings(
         mine, joints = recording_pieces(name, log, turns, max_gap_s)
         turned.update(joints)
         cuts.append(max(0, len(mine) - 1))
+        if mine:  # sign, units, frozen joints: on the whole recording, said once
+            for finding in check_torque_log(
+                robot, _joined([joint_side_log(p, drive) for p in mine])
+            ):
+                warnings.warn(finding, DynidWarning, stacklevel=2)
         pieces += [(r, p) for p in mine]
     cutoff: float | None = None if cutoff_hz == "auto" else cutoff_hz
     if cutoff_hz == "auto":
@@ -477,6 +488,7 @@ def prepare_recordings(
                 max_gap_s=max_gap_s,
                 decimate=decimate,
                 drive=drive,
+                check=False,
             )
         except DataError as exc:
             skipped.append(skipped_piece(names[r], piece, exc))
@@ -551,6 +563,34 @@ def common_cutoff(
     order = np.argsort(found)
     cum = np.cumsum(np.asarray(weight, dtype=np.float64)[order])
     return float(np.asarray(found)[order][np.searchsorted(cum, 0.5 * cum[-1])])
+
+
+#: The checks of a recording cut into pieces read at most about this many of its samples.
+_CHECKED_SAMPLES = 200_000
+
+
+def _joined(pieces: list[TorqueLog]) -> TorqueLog:
+    """The pieces of one recording as one log for its checks (statistics over its samples,
+    every k-th sample of a long one; never prepared)."""
+    if len(pieces) == 1:
+        return pieces[0]
+    k = max(1, sum(p.n_samples for p in pieces) // _CHECKED_SAMPLES)
+    ps = [p if k == 1 else p.select(_every(p.n_samples, k)) for p in pieces]
+    return TorqueLog(
+        np.concatenate([p.t for p in ps]),
+        np.concatenate([p.q for p in ps]),
+        np.concatenate([p.dq for p in ps]),
+        np.concatenate([p.tau for p in ps]),
+        None,
+        ps[0].cleaning,
+        ps[0].dq_derived,
+    )
+
+
+def _every(n: int, k: int) -> NDArray[np.intp]:
+    """Every ``k``-th of ``n >= 2`` rows, the last too when that leaves one."""
+    rows = np.arange(0, n, k)
+    return rows if rows.size > 1 else np.array([0, n - 1])
 
 
 def skipped_piece(name: str, piece: TorqueLog, exc: Exception, stacklevel: int = 3) -> str:
