@@ -2,7 +2,7 @@
 of one cut at a gap, prepared on its own and never joined to another.
 
 As identification does (:mod:`dynid.identification.recordings`,
-:func:`~dynid.identification.recordings.recording_pieces`): a time column in ms is refused,
+:func:`~dynid.identification.pieces.recording_pieces`): a time column in ms is refused,
 every log is cut at each gap longer than ``max_gap_s`` (by default the rule the model was
 identified with), the joints (motors, on a motor-side log) that can wrap and were recorded
 wrapped into ``[-pi, pi]`` are unwrapped piece by piece, whatever the drive, each piece is
@@ -37,7 +37,7 @@ from ..exceptions import DataError, OptionError
 from ..identification.log import TorqueLog, joint_side_log, prepare_log
 from ..identification.metrics import TorqueErrors
 from ..identification.model import IdentifiedModel
-from ..identification.recordings import recording_pieces, skipped_piece, wrappable
+from ..identification.pieces import recording_pieces, skipped_piece, wrappable
 from ..identification.sanity import velocity_noise_std
 from ..model.drive import Drive
 from ..model.robot import Robot

@@ -43,7 +43,7 @@ from ..identification.log import (
     default_max_gap,
     joint_side_log,
 )
-from ..identification.recordings import unwrapped, wrappable
+from ..identification.pieces import unwrapped, wrappable
 from ..io.columns import load_joint_columns
 from ..io.feasible import load_feasible_drive, load_feasible_linear_friction
 from ..io.friction_json import load_friction_json

@@ -25,7 +25,7 @@ from ..exceptions import DataError
 from ..feasibility.payload import PayloadEstimate, identify_payload
 from ..identification.log import DEFAULT_CUTOFF_HZ, TorqueLog, prepare_log
 from ..identification.model import IdentifiedModel
-from ..identification.recordings import recording_pieces, skipped_piece, wrappable
+from ..identification.pieces import recording_pieces, skipped_piece, wrappable
 from ..model.robot import Robot
 from .data_files import ColumnSpec, column_map, data_kind, in_file, read_static_file
 from .identify import data_files
@@ -174,7 +174,7 @@ def _pieces(
     max_gap_s: float | None,
 ) -> tuple[list[TorqueLog], tuple[dict[str, Any], ...], tuple[str, ...]]:
     """Every recording cut at its gaps and unwrapped piece by piece
-    (:func:`~dynid.identification.recordings.recording_pieces`); the pieces long enough to filter,
+    (:func:`~dynid.identification.pieces.recording_pieces`); the pieces long enough to filter,
     the pieces and samples per file, and a line per piece left out."""
     turns = wrappable(robot)
     kept: list[TorqueLog] = []
