@@ -156,6 +156,7 @@ def test_cleaning_is_counted_once_per_recording_and_cuts_as_cuts(panda, log):
     assert len(rec.pieces) == 6
     info = rec.record(0).log
     assert (info.n_gaps, info.n_cuts) == (2, 4)
+    assert info.n_samples_log == 2 * g.n_samples
 
 
 def test_a_max_gap_below_the_sample_step_is_refused_in_one_line(panda, log):
@@ -210,17 +211,20 @@ def test_the_cut_off_of_a_log_cut_into_pieces_is_read_over_its_time_axis():
 
 def test_pieces_of_three_samples_leave_no_numpy_warning(panda):
     """A log cut into many pieces, some of three samples: left out with a word, no
-    'Mean of empty slice' from the noise estimate of a piece too short for it."""
+    'Mean of empty slice' from the noise estimate of a piece too short for it, and the
+    samples recorded counted with them (the pieces used only were counted)."""
     g = _sines([0.5, 0.3])
     keep = np.ones(g.n_samples, bool)
     for a in range(100, 700, 100):
         keep[a : a + 10] = False
         keep[a + 13 : a + 20] = False  # leaves three samples a+10..a+12 alone
+    cut = g.select(np.flatnonzero(keep))
     with warnings.catch_warnings():
         warnings.simplefilter("error", RuntimeWarning)
         with pytest.warns(DynidWarning, match="3 samples"):
-            rec = prepare_recordings(panda, [g.select(np.flatnonzero(keep))], ["p.csv"])
+            rec = prepare_recordings(panda, [cut], ["p.csv"])
     assert len(rec.pieces) == 7
+    assert rec.record(0).log.n_samples_log == cut.n_samples  # the pieces left out too
 
 
 def test_validation_cuts_and_decimates_as_the_model_was_identified(panda, log, tmp_path):

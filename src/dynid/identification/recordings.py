@@ -103,6 +103,8 @@ class Recordings:
         :func:`~dynid.identification.log.default_max_gap` of each recording's step).
     cuts : tuple of int
         Per recording, the gaps longer than ``max_gap_s`` it was cut at.
+    n_recorded : int
+        Samples of every recording as read (pieces left out included); 0: the pieces'.
     """
 
     pieces: tuple[PreparedLog, ...]
@@ -114,6 +116,7 @@ class Recordings:
     bands: Mapping[str, NDArray[np.float64]] = dataclasses.field(default_factory=dict)
     max_gap_s: float | None = None
     cuts: tuple[int, ...] = ()
+    n_recorded: int = 0
 
     @property
     def route(self) -> Literal["classical"]:
@@ -249,7 +252,7 @@ class Recordings:
             trim_s=first.trim_s,
             decimate=max(p.decimate for p in ps),
             sample_rate_hz=first.sample_rate_hz,
-            n_samples_log=sum(p.n_samples_log for p in ps),
+            n_samples_log=self.n_recorded or sum(p.n_samples_log for p in ps),
             n_samples_used=self.n_samples,
             duration_s=float(sum(p.duration_s for p in ps)),
             n_nan_rows=sum(c.n_nan_rows for c in found.values()),
@@ -381,6 +384,7 @@ def prepare_recordings(
         bands=_bands([piece for _, piece in pieces], drive),
         max_gap_s=None if max_gap_s is None else float(max_gap_s),
         cuts=tuple(cuts),
+        n_recorded=sum(log.n_samples for log in logs),
     )
 
 
