@@ -9,8 +9,8 @@ wrapped into ``[-pi, pi]`` are unwrapped piece by piece, whatever the drive, eac
 read at the joints (through the model's drive) and filtered and differentiated on its own
 (:func:`~dynid.identification.log.prepare_log`) at one cut-off, and decimated as the model
 was identified.
-Unlike identification, the measured torques stay unfiltered and nothing is decimated
-(the RMS of a correct model is the sensor noise). A piece too short to filter is left out
+Unlike identification, the measured torques stay unfiltered (the RMS of a correct model
+is the sensor noise). A piece too short to filter is left out
 with a warning naming its file and times; a recording left without any piece, or of
 another joint count, is an error naming the file: no recording is dropped silently.
 
