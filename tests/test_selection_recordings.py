@@ -74,3 +74,31 @@ def test_alike_recordings_each_get_their_held_out_error_and_no_warning(panda, lo
     assert np.sqrt(np.mean(np.square(per))) == pytest.approx(
         chosen["heldout_error_percent"], rel=0.2
     )
+
+
+def test_exact_recordings_are_never_called_outlying(panda):
+    """Noise-free recordings with their true accelerations: held-out errors of round-off
+    (1e-6 %) whose ratios exceeded 3 named a recording 'outlying'; below the floor no
+    recording is odd."""
+    from dynid.identification.candidates import ODD_FLOOR_PERCENT
+    from dynid.simulation.measurement import SensorNoise
+
+    logs = []
+    for s in (1, 2, 3, 4):
+        traj = random_fourier(panda, np.random.default_rng(s))(sample_times(4.0, 200.0))
+        logs.append(
+            simulate_measurement(
+                panda,
+                traj,
+                rng=np.random.default_rng(s),
+                noise=SensorNoise.none(),
+                with_ddq=True,
+                friction=None,
+            )
+        )
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always", DynidWarning)
+        sel = identify_recordings(panda, logs, ["a", "b", "c", "d"], cutoff_hz=None).info.selection
+    assert all(r["heldout_error_percent"] < ODD_FLOOR_PERCENT for r in sel["heldout_per_recording"])
+    assert sel["outlying_recordings"] == []
+    assert not any("held-out error" in str(w.message) for w in caught)

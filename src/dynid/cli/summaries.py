@@ -161,6 +161,8 @@ def samples_text(log: LogInfo) -> str:
     )
     if log.resampled:
         text += f", resampled onto a uniform grid, {log.n_gaps} gap(s) bridged"
+    if log.n_cuts:
+        text += f", cut into pieces at {log.n_cuts} longer gap(s)"
     return text + ")"
 
 

@@ -1,14 +1,16 @@
 """Several recordings for validation and the friction fit: each recording, and each piece
 of one cut at a gap, prepared on its own and never joined to another.
 
-As identification does (:mod:`dynid.identification.recordings`): every log is read at the
-joints (through the model's drive), continuous revolute joints recorded wrapped into
-``[-pi, pi]`` are unwrapped (:func:`~dynid.identification.recordings.unwrapped`), the log is
-cut at each gap longer than ``max_gap_s``
-(:func:`~dynid.identification.recordings.split_at_gaps`), and every piece is filtered and
-differentiated on its own (:func:`~dynid.identification.log.prepare_log`) at one cut-off.
-Unlike identification, the measured torques stay unfiltered and nothing is decimated
-(the RMS of a correct model is the sensor noise). A piece too short to filter is left out
+As identification does (:mod:`dynid.identification.recordings`,
+:func:`~dynid.identification.pieces.recording_pieces`): a time column in ms is refused,
+every log is cut at each gap longer than ``max_gap_s`` (by default the rule the model was
+identified with), the joints (motors, on a motor-side log) that can wrap and were recorded
+wrapped into ``[-pi, pi]`` are unwrapped piece by piece, whatever the drive, each piece is
+read at the joints (through the model's drive) and filtered and differentiated on its own
+(:func:`~dynid.identification.log.prepare_log`) at one cut-off, and decimated as the model
+was identified.
+Unlike identification, the measured torques stay unfiltered (the RMS of a correct model
+is the sensor noise). A piece too short to filter is left out
 with a warning naming its file and times; a recording left without any piece, or of
 another joint count, is an error naming the file: no recording is dropped silently.
 
@@ -23,7 +25,6 @@ another joint count, is an error naming the file: no recording is dropped silent
 from __future__ import annotations
 
 import dataclasses
-import warnings
 from collections.abc import Sequence
 from dataclasses import dataclass
 from typing import Any, Literal
@@ -32,11 +33,11 @@ import numpy as np
 from numpy.typing import NDArray
 
 from .. import _checks
-from ..exceptions import DataError, DynidWarning
+from ..exceptions import DataError, OptionError
 from ..identification.log import TorqueLog, joint_side_log, prepare_log
 from ..identification.metrics import TorqueErrors
 from ..identification.model import IdentifiedModel
-from ..identification.recordings import skipped_piece, split_at_gaps, unwrapped
+from ..identification.pieces import recording_pieces, skipped_piece, wrappable
 from ..identification.sanity import velocity_noise_std
 from ..model.drive import Drive
 from ..model.robot import Robot
@@ -134,9 +135,10 @@ def prepare_pieces(
     *,
     cutoff_hz: float | None | Literal["recorded"] = RECORDED,
     trim_s: float | None = None,
-    max_gap_s: float | None = None,
+    max_gap_s: float | None | Literal["recorded"] = RECORDED,
     filter_tau: bool = False,
     drive: Drive | None = None,
+    decimate: int | Literal["recorded"] = RECORDED,
 ) -> Pieces:
     """Read every recording at the joints, unwrap, cut at its gaps and prepare each piece.
 
@@ -154,8 +156,15 @@ def prepare_pieces(
         motion (:func:`~dynid.friction.validation.recorded_cutoff`); None: no filter.
     trim_s, filter_tau
         As :func:`~dynid.identification.log.prepare_log`.
-    max_gap_s : float, optional
+    max_gap_s : float, None or "recorded"
         Gaps up to this long [s] are bridged; longer ones cut a recording into pieces.
+        ``"recorded"`` (default) and None: the rule the model was identified with
+        (``info.log.max_gap_s``), else the default
+        (:func:`~dynid.identification.log.default_max_gap`).
+    decimate : int or "recorded"
+        Every ``decimate``-th sample of each prepared piece is compared; ``"recorded"``
+        (default): the model's identification's decimation (1 for another model), so that
+        the model is judged on the samples it was identified on.
     drive : Drive, optional
         The drive the logs were recorded through, for a model without one
         (:func:`~dynid.friction.fit.model_drive`).
@@ -175,6 +184,7 @@ def prepare_pieces(
     names = tuple(names) if names is not None else tuple(f"log{k + 1}" for k in range(len(logs)))
     d = model_drive(model, drive)
     robot = _robot(model)
+    max_gap_s, k = _recorded_preparation(model, max_gap_s, decimate)
     raw: list[tuple[int, TorqueLog]] = []
     turned: set[int] = set()
     for r, (name, log) in enumerate(zip(names, logs, strict=True)):
@@ -184,19 +194,16 @@ def prepare_pieces(
                 "hint: a recording of the robot the model describes",
                 file=name,
             )
-        jlog = joint_side_log(log, d)
-        if robot is not None and d is None:
-            jlog, joints = unwrapped(jlog, ~np.asarray(robot.prismatic, dtype=bool))
-            if joints:
-                turned.update(joints)
-                warnings.warn(
-                    f"{name}: joint(s) {', '.join(str(j + 1) for j in joints)} recorded "
-                    "wrapped into [-pi, pi] (jumps of a whole turn): unwrapped",
-                    DynidWarning,
-                    stacklevel=2,
-                )
-        raw += [(r, p) for p in split_at_gaps(jlog, max_gap_s)]
-    cut = recorded_cutoff(model, [p for _, p in raw]) if isinstance(cutoff_hz, str) else cutoff_hz
+        # unwrapped where recorded (motor angles on a motor-side log), as identification
+        turns = wrappable(robot, d) if robot is not None else np.zeros(log.n, bool)
+        mine, joints = recording_pieces(name, log, turns, max_gap_s)
+        turned.update(joints)
+        raw += [(r, joint_side_log(p, d)) for p in mine]
+    cut = (
+        recorded_cutoff(model, [p for _, p in raw], [r for r, _ in raw])
+        if isinstance(cutoff_hz, str)
+        else cutoff_hz
+    )
     prepared, recording, skipped = [], [], []
     for r, piece in raw:
         try:
@@ -206,7 +213,7 @@ def prepare_pieces(
         except DataError as exc:
             skipped.append(skipped_piece(names[r], piece, exc))
             continue
-        prepared.append(p)
+        prepared.append(p if k == 1 else p.select(np.arange(0, p.n_samples, k)))
         recording.append(r)
     lost = [names[r] for r in range(len(names)) if r not in recording]
     if lost:
@@ -225,6 +232,29 @@ def prepare_pieces(
         unwrapped=tuple(sorted(turned)),
         drive=d,
     )
+
+
+def _recorded_preparation(
+    model: TorqueModel,
+    max_gap_s: float | None | Literal["recorded"],
+    decimate: int | Literal["recorded"],
+) -> tuple[float | None, int]:
+    """The gap rule and the decimation: as given, or as the model was identified with
+    (the library defaults for another model).
+
+    Raises
+    ------
+    OptionError
+        ``decimate`` below 1.
+    """
+    log = model.info.log if isinstance(model, IdentifiedModel) else None
+    if max_gap_s is None or isinstance(max_gap_s, str):
+        max_gap_s = None if log is None else log.max_gap_s
+    if isinstance(decimate, str):
+        decimate = 1 if log is None else int(log.decimate)
+    if int(decimate) < 1:
+        raise OptionError(f"decimate must be at least 1; got {decimate}")
+    return max_gap_s, int(decimate)
 
 
 def _robot(model: TorqueModel) -> Robot | None:

@@ -119,19 +119,22 @@ RECORDED: Literal["recorded"] = "recorded"
 
 
 def recorded_cutoff(
-    model: TorqueModel, log: TorqueLog | Sequence[TorqueLog] | None = None
+    model: TorqueModel,
+    log: TorqueLog | Sequence[TorqueLog] | None = None,
+    recording: Sequence[int] | None = None,
 ) -> float | None:
     """The low-pass cut-off [Hz] an identified model's torque log was prepared with
     (``info.log.cutoff_hz`` of the classical route); for another model the one
     identification would read from ``log``'s motion
-    (:func:`~dynid.identification.rate.cutoff_from_motion`; several logs or pieces: the
-    median of those at least 64 samples long, each weighted by its samples), so that every
+    (:func:`~dynid.identification.recordings.common_cutoff`: pieces of one recording,
+    as ``recording`` says, read together on its time axis; the median over the
+    recordings, each weighted by its samples), so that every
     model is judged on the samples prepared the same way; the library default without a
     log long enough to read it from."""
     if isinstance(model, IdentifiedModel) and model.info.log is not None:
         return model.info.log.cutoff_hz
     logs = [] if log is None else [log] if isinstance(log, TorqueLog) else list(log)
-    cut = common_cutoff(logs)
+    cut = common_cutoff(logs, recording)
     return DEFAULT_CUTOFF_HZ if cut is None else cut
 
 

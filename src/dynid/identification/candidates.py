@@ -26,6 +26,7 @@ from .model import IdentifiedModel
 from .structure import Structure
 
 __all__ = [
+    "ODD_FLOOR_PERCENT",
     "OUTLIER_RATIO",
     "Candidate",
     "Selection",
@@ -130,6 +131,11 @@ class Selection:
 #: (each fitted without it) is named in a warning and left out of the structure's
 #: judgement.
 OUTLIER_RATIO = 3.0
+#: A recording predicted within this relative error [%] is never odd, whatever the ratio:
+#: exact data leave round-off errors (1e-6 %) whose ratios mean nothing, and torques no
+#: candidate models large enough to spoil the others' fits (a contact, a payload) are far
+#: above it.
+ODD_FLOOR_PERCENT = 0.5
 
 
 def candidate_judged(
@@ -185,7 +191,8 @@ def recording_oddness(use: NDArray[np.bool_], model: IdentifiedModel, rtol: floa
     """Per recording (fold): its held-out error over the median held-out error of the
     other recordings when it is left out of their fits too (about 1 for recordings
     alike; large for one holding torques no candidate models, which also spoils the
-    others' fits while it is among them)."""
+    others' fits while it is among them); 0 for a recording whose held-out error is below
+    :data:`ODD_FLOOR_PERCENT` (never odd)."""
     fit = model.joint_fit if model.joint_fit is not None else model.fit
     idx = np.flatnonzero(use & np.asarray(fit.kept, dtype=bool))
     held = heldout_of(model).restricted(idx)
@@ -199,5 +206,8 @@ def recording_oddness(use: NDArray[np.bool_], model: IdentifiedModel, rtol: floa
         ]
         med = float(np.median(others))
         e = test.relative_error_percent(train.solve(rtol))
+        if e < ODD_FLOOR_PERCENT:
+            out.append(0.0)
+            continue
         out.append(e / med if med > 0 else (math.inf if e > 0 else 1.0))
     return out

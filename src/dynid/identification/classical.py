@@ -465,11 +465,13 @@ def prepare_torque_log(
     max_gap_s: float | None = None,
     decimate: int | None = None,
     drive: Drive | None = None,
+    check: bool = True,
 ) -> PreparedLog:
     """Read a torque log through the drive, check it, filter and decimate it.
 
     The checks of :func:`~dynid.identification.sanity.check_torque_log` (sign, units,
-    frozen joints) are warned first; then :func:`~dynid.identification.log.prepare_log`
+    frozen joints) are warned first (unless ``check`` is False: a piece of a recording
+    checked whole); then :func:`~dynid.identification.log.prepare_log`
     and every ``decimate``-th sample (default :func:`~dynid.identification.rate.decimation`;
     the cut-off ``"auto"``: :func:`~dynid.identification.rate.cutoff_from_motion`).
     Parameters as in
@@ -494,7 +496,7 @@ def prepare_torque_log(
         drive.check(n)
     fs = log.sample_rate
     jlog = joint_side_log(log, drive)
-    for finding in check_torque_log(robot, jlog):  # sign, units, frozen joints: said first
+    for finding in check_torque_log(robot, jlog) if check else ():  # said first
         warnings.warn(finding, DynidWarning, stacklevel=3)
     still = still_friction(jlog, drive)
     f_q = None

@@ -69,6 +69,13 @@ class LogInfo:
         The motion's highest significant frequency [Hz] when the cut-off was read from it.
     resampled : bool
         The timestamps were not uniform: the log was resampled onto a uniform grid.
+    n_cuts : int
+        Gaps longer than the longest gap bridged: the logs were cut into pieces there
+        (``n_gaps`` counts the gaps bridged).
+    max_gap_s : float or None
+        The longest gap bridged, as given [s]; None: the default rule
+        (:func:`~dynid.identification.log.default_max_gap`). ``validate`` and ``friction``
+        cut their recordings with it unless told otherwise.
     """
 
     cutoff_hz: float | None
@@ -84,6 +91,8 @@ class LogInfo:
     cutoff_source: str = "given"
     motion_frequency_hz: float | None = None
     resampled: bool = False
+    n_cuts: int = 0
+    max_gap_s: float | None = None
 
 
 @dataclass(frozen=True, slots=True)

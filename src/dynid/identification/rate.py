@@ -16,6 +16,15 @@ hundred. The classical route therefore reads both from the data by default:
   hold nothing above a few times the cut-off), but keeping at least ``MIN_KEPT_SHARE``
   (10 %) of the samples: ``k <= 10``.
 
+A recording cut into pieces at its gaps (:mod:`dynid.identification.recordings`) keeps
+its time axis: the motion went on through a cut-out stretch. Its motion frequency is read
+from its pieces on that axis (:func:`bridged`: one uniform grid, each cut-out stretch
+bridged by the cubic that meets its ends' positions and velocities, for this reading
+only), with the frequency resolution of the
+whole recording: a piece of 1.6 s cannot tell 0.6 Hz from 1.5 Hz on its own, and the
+pieces' own readings, read at their coarse resolution, put the cut-off at 2-4 times the
+whole log's.
+
 Both are printed by ``identify`` and recorded in ``identification.json``
 (``metadata.cutoff_hz``, ``cutoff_source``, ``motion_frequency_hz``, ``decimate``);
 ``validate`` reuses the recorded cut-off.
@@ -24,6 +33,7 @@ Both are printed by ``identify`` and recorded in ``identification.json``
 from __future__ import annotations
 
 import math
+from collections.abc import Sequence
 
 import numpy as np
 from numpy.typing import NDArray
@@ -32,10 +42,12 @@ from .log import DEFAULT_CUTOFF_HZ
 from .sanity import moving_joints
 
 __all__ = [
+    "BRIDGE_GROWTH",
     "CUTOFF_MULTIPLE",
     "MIN_CUTOFF_HZ",
     "MIN_KEPT_SHARE",
     "SIGNIFICANT_POWER",
+    "bridged",
     "cutoff_from_motion",
     "decimation",
     "motion_frequency",
@@ -49,6 +61,9 @@ SIGNIFICANT_POWER = 0.999
 MIN_CUTOFF_HZ = 1.0
 #: Decimation keeps at least this share of the samples.
 MIN_KEPT_SHARE = 0.1
+#: A recording's pieces are bridged (:func:`bridged`) while the grid holds at most this
+#: many times their samples (cut-out stretches at most as long as what was kept).
+BRIDGE_GROWTH = 2.0
 
 
 def motion_frequency(
@@ -112,3 +127,72 @@ def decimation(fs: float, cutoff_hz: float | None) -> int:
     if cutoff_hz is None:
         return 1
     return max(1, min(int(math.floor(fs / (10.0 * cutoff_hz))), int(round(1 / MIN_KEPT_SHARE))))
+
+
+def bridged(
+    t: Sequence[NDArray[np.float64]],
+    q: Sequence[NDArray[np.float64]],
+    dq: Sequence[NDArray[np.float64]],
+    turns: NDArray[np.bool_] | None = None,
+) -> tuple[NDArray[np.float64], float] | None:
+    """The positions of the pieces of one recording on one uniform grid, for reading the
+    motion's frequency over the recording's whole time axis (module docstring).
+
+    Parameters
+    ----------
+    t : sequence of ndarray, shape (N_k,)
+        Each piece's timestamps [s], pieces in time order.
+    q, dq : sequence of ndarray, shape (N_k, n)
+        Each piece's positions [rad or m] and velocities [rad/s or m/s].
+    turns : ndarray of bool, shape (n,), optional
+        Columns that may have been unwrapped piece by piece: each piece is moved by the
+        whole turns that make its first sample nearest to the previous piece's last.
+
+    Returns
+    -------
+    (ndarray, shape (M, n), float) or None
+        The positions at the median step from the first sample to the last: linear
+        between the samples of a piece, and over each cut-out stretch the cubic that meets
+        the positions and velocities at both of its ends (a straight line there would put
+        kinks, fast motion, into the spectrum); and the grid's rate [Hz]. None when the
+        grid would hold more than :data:`BRIDGE_GROWTH` times the samples (the stretches
+        cut out are longer than what was kept).
+    """
+    n_kept = sum(int(a.size) for a in t)
+    step = float(np.median(np.concatenate([np.diff(a) for a in t])))
+    if not step > 0:
+        return None
+    m = int(math.floor((float(t[-1][-1]) - float(t[0][0])) / step)) + 1
+    if m > BRIDGE_GROWTH * n_kept:
+        return None
+    grid = float(t[0][0]) + step * np.arange(m)
+    tt = np.concatenate(list(t))
+    n = q[0].shape[1]
+    turn = np.zeros(n, bool) if turns is None else np.asarray(turns, dtype=bool)
+    spans = [  # each cut-out stretch: (grid rows inside it, t_a, t_b, s in [0, 1])
+        (rows, float(a[-1]), float(b[0]), (grid[rows] - float(a[-1])) / float(b[0] - a[-1]))
+        for a, b in zip(t[:-1], t[1:], strict=True)
+        for rows in [np.flatnonzero((grid > a[-1]) & (grid < b[0]))]
+    ]
+    out = np.empty((m, n))
+    for j in range(n):  # one joint at a time: a long log's columns never copied whole
+        parts: list[NDArray[np.float64]] = []
+        shift = 0.0
+        for k, a in enumerate(q):
+            col = a[:, j]
+            if k and turn[j]:
+                gap = float(col[0]) + shift - float(parts[-1][-1])
+                shift -= 2 * np.pi * round(gap / (2 * np.pi))
+            parts.append(col + shift if shift else col)
+        out[:, j] = np.interp(grid, tt, np.concatenate(parts))
+        for k, (rows, ta, tb, x) in enumerate(spans):  # cubic Hermite over the stretch
+            h = tb - ta
+            qa, qb = float(parts[k][-1]), float(parts[k + 1][0])
+            va, vb = float(dq[k][-1, j]), float(dq[k + 1][0, j])
+            out[rows, j] = (
+                (2 * x**3 - 3 * x**2 + 1) * qa
+                + (x**3 - 2 * x**2 + x) * h * va
+                + (-2 * x**3 + 3 * x**2) * qb
+                + (x**3 - x**2) * h * vb
+            )
+    return out, 1.0 / step

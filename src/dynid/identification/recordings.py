@@ -7,14 +7,18 @@ filter and the derivatives run across the joins, where positions jump: the accel
 there are artefacts, and the cut-off read from the motion sees the joins as fast motion.
 Here:
 
-1. every log is cut at each gap longer than ``max_gap_s`` (default
-   :func:`~dynid.identification.log.default_max_gap`: one or two lost samples are
-   bridged, longer gaps cut) into **pieces**;
-2. continuous revolute joints recorded wrapped into ``[-pi, pi]`` are unwrapped first
-   (:func:`unwrapped`, a warning names them);
-3. one cut-off serves every piece: the median of the pieces'
-   :func:`~dynid.identification.rate.cutoff_from_motion`, each weighted by its samples
-   (or the one given);
+1. every log's time column is checked against its recorded velocities (a time column in
+   ms, us or ns is refused with the remedy,
+   :func:`~dynid.identification.sanity.time_unit_finding`), then cut at each gap longer
+   than ``max_gap_s`` (default :func:`~dynid.identification.log.default_max_gap`: one or
+   two lost samples are bridged, longer gaps cut) into **pieces**;
+2. in each piece, the joints that can wrap (a continuous joint, a motor of a motor-side
+   log: :func:`~dynid.identification.pieces.wrappable`) and were recorded wrapped into
+   ``[-pi, pi]`` are unwrapped (:func:`~dynid.identification.pieces.unwrapped`, a warning
+   names them; a jump across a cut-out stretch is no wrap);
+3. one cut-off serves every piece (or the one given): the median of the recordings'
+   :func:`~dynid.identification.rate.cutoff_from_motion`, each weighted by its samples,
+   each read from its pieces on its own time axis (:func:`common_cutoff`);
 4. each piece is read through the drive, filtered, differentiated and decimated on its own
    (:func:`~dynid.identification.classical.prepare_torque_log`); a piece too short for
    the filter is left out with a warning naming its file and times, never silently;
@@ -42,56 +46,31 @@ from .classical import PreparedLog, log_blocks, prepare_torque_log, still_column
 from .core import ModelColumns, RegressorBlock
 from .holdout import DEFAULT_FOLDS, block_labels
 from .info import IdentificationInfo, LogInfo
-from .log import TorqueLog, default_max_gap, joint_side_log
-from .rate import CUTOFF_MULTIPLE, cutoff_from_motion
-from .sanity import noise_band, spike_finding, velocity_noise_std
+from .log import TorqueLog, joint_side_log
+from .pieces import (
+    WRAP_SPAN,
+    joined,
+    recording_pieces,
+    skipped_piece,
+    split_at_gaps,
+    unwrapped,
+    wrappable,
+)
+from .rate import CUTOFF_MULTIPLE, bridged, cutoff_from_motion
+from .sanity import check_torque_log, noise_band, spike_finding, velocity_noise_std
 from .streaming import streams
 
 __all__ = [
+    "WRAP_SPAN",
     "Recordings",
     "common_cutoff",
     "prepare_recordings",
+    "recording_pieces",
     "skipped_piece",
     "split_at_gaps",
     "unwrapped",
+    "wrappable",
 ]
-
-
-def split_at_gaps(log: TorqueLog, max_gap_s: float | None = None) -> list[TorqueLog]:
-    """The pieces of ``log`` between its gaps longer than ``max_gap_s`` [s] (default
-    :func:`~dynid.identification.log.default_max_gap` of the median step)."""
-    dt = np.diff(log.t)
-    limit = default_max_gap(float(np.median(dt))) if max_gap_s is None else float(max_gap_s)
-    cuts = np.concatenate([[0], np.flatnonzero(dt > limit) + 1, [log.n_samples]])
-    return [log.select(np.arange(a, b)) for a, b in zip(cuts[:-1], cuts[1:], strict=True)]
-
-
-def unwrapped(log: TorqueLog, revolute: NDArray[np.bool_]) -> tuple[TorqueLog, tuple[int, ...]]:
-    """The log with revolute joints recorded wrapped into ``[-pi, pi]`` unwrapped.
-
-    A joint is wrapped when its position jumps by nearly a whole turn more than its
-    recorded velocity explains (``dq dt``, the mean of the two samples'; the raw step for
-    velocities derived from the positions) while the rest of the jump is as small as its
-    other unexplained steps: a fast motor turning more than half a turn between two samples
-    is motion, not a wrap. Returns the log with those turns taken out and the joints
-    unwrapped (0-based; the log itself when none).
-    """
-    d = np.diff(log.q, axis=0)
-    if not log.dq_derived:
-        d = d - 0.5 * (log.dq[:-1] + log.dq[1:]) * np.diff(log.t)[:, None]
-    turns = np.round(d / (2 * np.pi))
-    rest = np.abs(d - 2 * np.pi * turns)
-    typical = np.max(np.abs(np.where(turns == 0, d, 0.0)), axis=0, initial=0.0)
-    wrapped = np.any(turns != 0, axis=0) & np.all(
-        (turns == 0) | (rest <= np.maximum(2 * typical, 1e-9)), axis=0
-    )
-    joints = tuple(int(j) for j in np.flatnonzero(wrapped & np.asarray(revolute, dtype=bool)))
-    if not joints:
-        return log, ()
-    q = np.array(log.q)
-    q[1:, joints] -= 2 * np.pi * np.cumsum(turns[:, joints], axis=0)
-    out = TorqueLog(log.t, q, log.dq, log.tau, log.ddq, log.cleaning, log.dq_derived)
-    return out, joints
 
 
 @dataclass(frozen=True, slots=True, eq=False)
@@ -119,6 +98,13 @@ class Recordings:
         With a drive: the standstill band at its motors (``"motor"``) and at the joints
         (``"joint"``), for a friction placed where the drive does not say
         (:attr:`~dynid.identification.structure.Structure.at`); empty without one.
+    max_gap_s : float or None
+        The longest gap bridged, as given [s] (None: the default rule,
+        :func:`~dynid.identification.log.default_max_gap` of each recording's step).
+    cuts : tuple of int
+        Per recording, the gaps longer than ``max_gap_s`` it was cut at.
+    n_recorded : int
+        Samples of every recording as read (pieces left out included); 0: the pieces'.
     """
 
     pieces: tuple[PreparedLog, ...]
@@ -128,6 +114,9 @@ class Recordings:
     skipped: tuple[str, ...] = ()
     unwrapped: tuple[int, ...] = ()
     bands: Mapping[str, NDArray[np.float64]] = dataclasses.field(default_factory=dict)
+    max_gap_s: float | None = None
+    cuts: tuple[int, ...] = ()
+    n_recorded: int = 0
 
     @property
     def route(self) -> Literal["classical"]:
@@ -251,23 +240,29 @@ class Recordings:
         return tuple(out)
 
     def record(self, n_rows: int) -> IdentificationInfo:
-        """Filtering, decimation and sample counts over every piece, and each recording."""
+        """Filtering, decimation, the gap rule and sample counts over every piece; what
+        cleaning found counted once per recording (every piece carries its recording's),
+        gaps bridged apart from the gaps cut at; and each recording."""
         ps = self.pieces
         first = ps[0]
+        found = {r: p.cleaning for p, r in zip(ps, self.recording, strict=True)}
+        cuts = self.cuts or (0,) * len(self.names)
         log = LogInfo(
             cutoff_hz=first.cutoff_hz,
             trim_s=first.trim_s,
             decimate=max(p.decimate for p in ps),
             sample_rate_hz=first.sample_rate_hz,
-            n_samples_log=sum(p.n_samples_log for p in ps),
+            n_samples_log=self.n_recorded or sum(p.n_samples_log for p in ps),
             n_samples_used=self.n_samples,
             duration_s=float(sum(p.duration_s for p in ps)),
-            n_nan_rows=sum(p.cleaning.n_nan_rows for p in ps),
-            n_duplicates=sum(p.cleaning.n_duplicates for p in ps),
-            n_gaps=sum(len(p.cleaning.gaps) for p in ps),
+            n_nan_rows=sum(c.n_nan_rows for c in found.values()),
+            n_duplicates=sum(c.n_duplicates for c in found.values()),
+            n_gaps=sum(max(0, len(c.gaps) - cuts[r]) for r, c in found.items()),
             cutoff_source="given" if first.motion_frequency_hz is None else "motion",
             motion_frequency_hz=first.motion_frequency_hz,
             resampled=any(p.resampled for p in ps),
+            n_cuts=sum(cuts),
+            max_gap_s=self.max_gap_s,
         )
         notes = tuple(self.skipped)
         if self.unwrapped:
@@ -321,31 +316,34 @@ def prepare_recordings(
     names = tuple(names) if names is not None else tuple(f"log{k + 1}" for k in range(len(logs)))
     if len(names) != len(logs):
         raise ShapeError(f"{len(names)} names for {len(logs)} recordings")
-    revolute = ~np.asarray(robot.prismatic, dtype=bool)
+    # a motor-side log: its motors turn (a joint-side one: joints whose limits span a turn)
+    turns = wrappable(robot, drive)
     pieces: list[tuple[int, TorqueLog]] = []
     turned: set[int] = set()
+    cuts: list[int] = []
     for r, (name, log) in enumerate(zip(names, logs, strict=True)):
         if log.n != robot.n:
             raise ShapeError(
                 f"log has {log.n} joints; robot {robot.name!r} has {robot.n}", file=name
             )
-        # a motor-side log: every motor turns (a joint-side one: the robot's revolute joints)
-        turns = revolute if drive is None or drive.side == "joint" else np.ones(robot.n, bool)
-        log, joints = unwrapped(log, turns)
         if (spikes := spike_finding(name, log, robot.joint_names)) is not None:
             warnings.warn(spikes, DynidWarning, stacklevel=2)
-        if joints:
-            turned.update(joints)
-            warnings.warn(
-                f"{name}: joint(s) {', '.join(str(j + 1) for j in joints)} recorded wrapped "
-                "into [-pi, pi] (jumps of a whole turn): unwrapped",
-                DynidWarning,
-                stacklevel=2,
-            )
-        pieces += [(r, p) for p in split_at_gaps(log, max_gap_s)]
+        mine, joints = recording_pieces(name, log, turns, max_gap_s)
+        turned.update(joints)
+        cuts.append(max(0, len(mine) - 1))
+        if mine:  # sign, units, frozen joints: on the whole recording, said once
+            for finding in check_torque_log(
+                robot, joined([joint_side_log(p, drive) for p in mine])
+            ):
+                warnings.warn(finding, DynidWarning, stacklevel=2)
+        pieces += [(r, p) for p in mine]
     cutoff: float | None = None if cutoff_hz == "auto" else cutoff_hz
     if cutoff_hz == "auto":
-        cutoff = common_cutoff([joint_side_log(p, drive) for _, p in pieces])
+        # joint-side pieces of a motor-side log differ by turns of the motors, not joints
+        jturns = None if drive is not None and drive.side == "motor" else turns
+        cutoff = common_cutoff(
+            [joint_side_log(p, drive) for _, p in pieces], [r for r, _ in pieces], jturns
+        )
         if cutoff is None:
             raise DataError("no piece is long enough to read the motion's frequency from")
     prepared, recording, skipped = [], [], []
@@ -359,6 +357,7 @@ def prepare_recordings(
                 max_gap_s=max_gap_s,
                 decimate=decimate,
                 drive=drive,
+                check=False,
             )
         except DataError as exc:
             skipped.append(skipped_piece(names[r], piece, exc))
@@ -385,41 +384,55 @@ def prepare_recordings(
         skipped=tuple(skipped),
         unwrapped=tuple(sorted(turned)),
         bands=_bands([piece for _, piece in pieces], drive),
+        max_gap_s=None if max_gap_s is None else float(max_gap_s),
+        cuts=tuple(cuts),
+        n_recorded=sum(log.n_samples for log in logs),
     )
 
 
-def common_cutoff(pieces: Sequence[TorqueLog]) -> float | None:
-    """The cut-off [Hz] read from the motion of the pieces long enough to read it
-    (:func:`~dynid.identification.rate.cutoff_from_motion`): their median, each piece
-    weighted by its samples (a short piece reads its edges as fast motion); None when no
-    piece is long enough."""
-    found, weight = [], []
-    for piece in pieces:
-        if piece.n_samples < 64:
+def common_cutoff(
+    pieces: Sequence[TorqueLog],
+    recording: Sequence[int] | None = None,
+    turns: NDArray[np.bool_] | None = None,
+) -> float | None:
+    """The cut-off [Hz] read from the motion of the recordings
+    (:func:`~dynid.identification.rate.cutoff_from_motion`): each recording's read from
+    its pieces on its own time axis (:func:`~dynid.identification.rate.bridged`, the
+    columns ``turns`` moved by whole turns across its gaps), the median over the
+    recordings, each weighted by its samples; None when no recording holds 64 samples.
+
+    ``recording`` gives each piece's recording (default: every piece its own, read alone).
+    A recording whose cut-out stretches are longer than what was kept is read from its
+    pieces of at least 64 samples, each on its own, weighted by its samples.
+    """
+    labels = list(range(len(pieces))) if recording is None else [int(r) for r in recording]
+    found: list[float] = []
+    weight: list[int] = []
+    for r in dict.fromkeys(labels):
+        mine = [p for p, k in zip(pieces, labels, strict=True) if k == r]
+        grid = None
+        if len(mine) > 1 and sum(p.n_samples for p in mine) >= 64:
+            grid = bridged([p.t for p in mine], [p.q for p in mine], [p.dq for p in mine], turns)
+        if grid is not None:
+            dq = np.concatenate([p.dq for p in mine])
+            found.append(cutoff_from_motion(grid[0], dq, grid[1]))
+            weight.append(sum(p.n_samples for p in mine))
             continue
-        try:
-            found.append(cutoff_from_motion(piece.q, piece.dq, piece.sample_rate))
-        except DataError:
-            if len(pieces) == 1:
-                raise
-            continue
-        weight.append(piece.n_samples)
+        for piece in mine:
+            if piece.n_samples < 64:
+                continue
+            try:
+                found.append(cutoff_from_motion(piece.q, piece.dq, piece.sample_rate))
+            except DataError:
+                if len(pieces) == 1:
+                    raise
+                continue
+            weight.append(piece.n_samples)
     if not found:
         return None
     order = np.argsort(found)
     cum = np.cumsum(np.asarray(weight, dtype=np.float64)[order])
     return float(np.asarray(found)[order][np.searchsorted(cum, 0.5 * cum[-1])])
-
-
-def skipped_piece(name: str, piece: TorqueLog, exc: Exception, stacklevel: int = 3) -> str:
-    """Warn that a piece of recording ``name`` is left out (too short to filter, the
-    reason ``exc``); returns the line, for the record."""
-    line = (
-        f"{name}: piece {piece.t[0]:.6g}-{piece.t[-1]:.6g} s ({piece.n_samples} samples) "
-        f"left out: {exc}"
-    )
-    warnings.warn(line, DynidWarning, stacklevel=stacklevel)
-    return line
 
 
 def _bands(pieces: list[TorqueLog], drive: Drive | None) -> dict[str, NDArray[np.float64]]:

@@ -54,8 +54,10 @@ __all__ = [
     "noise_band",
     "SPIKE_SIGMAS",
     "spike_finding",
+    "time_unit_finding",
     "torque_spikes",
     "velocity_noise_std",
+    "velocity_rate_factor",
 ]
 
 _MAX_SAMPLES = 4000  # samples used by the checks (evenly spaced): they are statistics
@@ -103,13 +105,15 @@ def velocity_noise_std(dq: ArrayLike) -> NDArray[np.float64]:
         raise ShapeError(f"dq must have shape (N, n), N >= 3; got {a.shape}")
     est = []
     for order, var in ((2, 6.0), (3, 20.0)):
+        if a.shape[0] <= order:  # three samples: no third difference
+            continue
         mad = np.empty(a.shape[1])
         for j in range(a.shape[1]):  # one joint at a time: temporaries of one column
             d = np.diff(a[:, j], n=order)
             d -= np.median(d)
             mad[j] = np.median(np.abs(d, out=d))
         est.append(1.4826 * mad / np.sqrt(var))
-    out: NDArray[np.float64] = np.minimum(*est)
+    out: NDArray[np.float64] = np.minimum.reduce(est)
     return out
 
 
@@ -440,3 +444,50 @@ def spike_finding(name: str, log: TorqueLog, joint_names: tuple[str, ...]) -> st
         f"{SPIKE_SIGMAS:g} times the noise: {parts}; spikes (a sensor or logging fault) bias "
         "the fit by their square; hint: remove those rows from the log"
     )
+
+
+#: Time units a time column may be recorded in instead of seconds: the ``--units t=``
+#: spelling and its length [s].
+_TIME_UNITS = (("ms", 1e-3), ("us", 1e-6), ("ns", 1e-9))
+
+
+def velocity_rate_factor(log: TorqueLog) -> float:
+    """``k`` of ``d q / dt ~ k dq`` [1]: 1 when ``t``, ``q`` and ``dq`` share their units.
+
+    The positions' differences over their time steps against the mean of the two samples'
+    recorded velocities, pooled over every joint by least squares; a step where a position
+    jumps by more than half a turn (a wrap) or the time by more than 1.5 median steps (a
+    gap) is left out. NaN for velocities derived from the positions, fewer than 5 samples
+    or a log that does not move.
+    """
+    if log.dq_derived or log.n_samples < 5:
+        return float("nan")
+    dt = np.diff(log.t)
+    ok = dt <= 1.5 * float(np.median(dt))
+    num = den = 0.0
+    for j in range(log.n):  # one joint at a time: temporaries of one column (long logs)
+        dqj = np.diff(log.q[:, j])
+        v = 0.5 * (log.dq[1:, j] + log.dq[:-1, j])
+        keep = ok & (np.abs(dqj) <= np.pi)
+        num += float(np.sum(dqj[keep] / dt[keep] * v[keep]))
+        den += float(np.sum(v[keep] * v[keep]))
+    return num / den if den > 0 else float("nan")
+
+
+def time_unit_finding(name: str, log: TorqueLog) -> str | None:
+    """One line naming the file ``name`` when its recorded velocities are a power of ten
+    (1e3, 1e6, 1e9, within 25 %) times the rate of change of its positions per unit of its
+    time column: the time column is then in ms, us or ns, not seconds
+    (:func:`velocity_rate_factor`); None otherwise."""
+    k = velocity_rate_factor(log)
+    if not np.isfinite(k) or k <= 0:
+        return None
+    for unit, size in _TIME_UNITS:
+        if abs(k / size - 1.0) < _RATE_AGREES:
+            return (
+                f"{name}: its recorded velocities are {1 / k:.4g} times the rate of change of "
+                f"its positions per unit of its time column: the time column looks like "
+                f"{unit}, not seconds (t x {1 / size:g}); every filter, derivative and "
+                f"frequency read from it would be off by that factor; hint: --units t={unit}"
+            )
+    return None

@@ -43,7 +43,7 @@ from ..identification.log import (
     default_max_gap,
     joint_side_log,
 )
-from ..identification.recordings import unwrapped
+from ..identification.pieces import unwrapped, wrappable
 from ..io.columns import load_joint_columns
 from ..io.feasible import load_feasible_drive, load_feasible_linear_friction
 from ..io.friction_json import load_friction_json
@@ -334,7 +334,7 @@ def _observe_log(
         owner="the model",
     )
     log = joint_side_log(log, model.drive)
-    log, turned = unwrapped(log, ~np.asarray(model.robot.prismatic, dtype=bool))
+    log, turned = unwrapped(log, wrappable(model.robot))  # joints whose limits span a turn
     if turned:  # M(q) is periodic; velocities derived across a wrap are not
         warnings.warn(
             f"{path.name}: joint(s) {', '.join(str(j + 1) for j in turned)} recorded wrapped "

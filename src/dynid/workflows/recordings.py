@@ -7,6 +7,8 @@ line naming the file, never a recording dropped silently:
 
 * an empty file, NaN/inf or a repeated timestamp (without ``drop_invalid``), another
   joint count than the model's: the reader's error, naming the file;
+* a time column in ms, us or ns (:func:`~dynid.identification.sanity.time_unit_finding`):
+  an error naming the file and ``--units t=ms``;
 * a recording in other units than the others (its torques, or its velocities against the
   derivative of its positions, a power of ten away from the other recordings'): an error
   naming it;
@@ -28,6 +30,7 @@ import numpy as np
 
 from ..exceptions import DataError, DynidWarning
 from ..identification.log import TorqueLog, joint_side_log
+from ..identification.sanity import time_unit_finding
 from ..model.drive import Drive
 from ..model.robot import Robot
 from .data_files import ColumnSpec, column_map, in_file, read_torque_log, recorded_columns
@@ -115,6 +118,9 @@ def read_recordings(
     logs = tuple(in_file(p, lambda p=p: read(p)) for p in paths)  # type: ignore[misc]
     out = Recorded(logs, tuple(paths))
     _check_limits(out, robot, drive)
+    for name, log in zip(out.names, out.logs, strict=True):  # the time unit named first
+        if (unit := time_unit_finding(name, log)) is not None:
+            raise DataError(unit)
     _check_units(out)
     return out
 
