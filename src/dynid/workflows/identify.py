@@ -407,16 +407,10 @@ def _consistent_structure_fit(
             field="terms",
             others=("consistent",),
         )
-    selection = None
-    if terms == "auto":
-        selection = identify_recordings(robot, logs, names, **kw).info.selection
-        chosen = Structure.parse(str((selection or {}).get("chosen", "")))
-        terms = Structure(chosen.armature, classical, at=chosen.at)
-    else:
-        terms = Structure(terms.armature, classical, at=terms.at)
-    model = identify_recordings(robot, logs, names, structure=terms, **kw)
-    info = dataclasses.replace(model.info, selection=selection)
-    return dataclasses.replace(model, info=info)
+    if terms == "auto":  # the armature chosen, the classical friction fitted with it
+        return identify_recordings(robot, logs, names, friction=classical, **kw)
+    terms = Structure(terms.armature, classical, at=terms.at)
+    return identify_recordings(robot, logs, names, structure=terms, **kw)
 
 
 def _one_static_file(paths: list[Path], opt: IdentifyOptions) -> None:
