@@ -16,7 +16,7 @@ from __future__ import annotations
 
 import logging
 import zipfile
-from collections.abc import Callable, Mapping
+from collections.abc import Callable, Mapping, Sequence
 from pathlib import Path
 from typing import Any, Literal, TypeVar
 
@@ -41,6 +41,7 @@ __all__ = [
     "ColumnSpec",
     "DataKind",
     "column_map",
+    "data_files",
     "data_kind",
     "in_file",
     "read_static_file",
@@ -275,3 +276,30 @@ def recorded_columns(
             others=("units",),
         )
     return columns, units
+
+
+def data_files(paths: str | Path | Sequence[str | Path]) -> list[Path]:
+    """The data files of ``--data``: the paths given, a folder standing for its ``.csv``
+    and ``.npz`` files in name order.
+
+    Raises
+    ------
+    DataError
+        No path, a folder without data files, or a file named twice.
+    """
+    given = [paths] if isinstance(paths, str | Path) else list(paths)
+    out: list[Path] = []
+    for p in map(Path, given):
+        if p.is_dir():
+            found = sorted(f for f in p.iterdir() if f.suffix.lower() in (".csv", ".npz"))
+            if not found:
+                raise DataError(f"{p.name}: the folder holds no .csv or .npz data file")
+            out += found
+        else:
+            out.append(p)
+    if not out:
+        raise DataError("no data file given")
+    twice = sorted({p.name for p in out if out.count(p) > 1})
+    if twice:
+        raise DataError(f"{', '.join(twice)}: data file given twice")
+    return out

@@ -45,6 +45,7 @@ from ..model.robot import Robot
 from .data_files import (
     ColumnSpec,
     column_map,
+    data_files,
     data_kind,
     in_file,
     read_static_file,
@@ -52,6 +53,7 @@ from .data_files import (
 )
 from .options import check_band, check_choice, check_count, check_number, only_with, refused_with
 from .prior import load_prior
+from .recordings import Recorded, check_units
 
 __all__ = ["ColumnSpec", "IdentifyOptions", "IdentifyResult", "data_files", "identify_files"]
 
@@ -98,33 +100,6 @@ def _record(model: IdentifiedModel, spec: ColumnSpec | None) -> IdentifiedModel:
         return model
     info = dataclasses.replace(model.info, column_map={"columns": spec[0], "units": spec[1]})
     return dataclasses.replace(model, info=info)
-
-
-def data_files(paths: str | Path | Sequence[str | Path]) -> list[Path]:
-    """The data files of ``--data``: the paths given, a folder standing for its ``.csv``
-    and ``.npz`` files in name order.
-
-    Raises
-    ------
-    DataError
-        No path, a folder without data files, or a file named twice.
-    """
-    given = [paths] if isinstance(paths, str | Path) else list(paths)
-    out: list[Path] = []
-    for p in map(Path, given):
-        if p.is_dir():
-            found = sorted(f for f in p.iterdir() if f.suffix.lower() in (".csv", ".npz"))
-            if not found:
-                raise DataError(f"{p.name}: the folder holds no .csv or .npz data file")
-            out += found
-        else:
-            out.append(p)
-    if not out:
-        raise DataError("no data file given")
-    twice = sorted({p.name for p in out if out.count(p) > 1})
-    if twice:
-        raise DataError(f"{', '.join(twice)}: data file given twice")
-    return out
 
 
 def _terms(terms: str | Structure | None) -> Structure | Literal["auto"]:
@@ -374,13 +349,16 @@ def _identify(robot: Robot, paths: list[Path], opt: IdentifyOptions) -> Identifi
 
 
 def _read_logs(robot: Robot, paths: list[Path], cmap: Any, drop_invalid: bool) -> list[Any]:
-    """The torque logs ``paths``, read strictly for ``robot``."""
-    return [
+    """The torque logs ``paths``, read strictly for ``robot``; a recording in other units
+    than the others refused, naming it (:func:`~dynid.workflows.recordings.check_units`)."""
+    logs = [
         read_torque_log(
             p, robot.n, columns=cmap, drop_invalid=drop_invalid, owner=f"robot {robot.name!r}"
         )
         for p in paths
     ]
+    check_units(Recorded(tuple(logs), tuple(paths)))
+    return logs
 
 
 def _consistent_structure_fit(

@@ -63,8 +63,15 @@ from ..observer.residual import DEFAULT_GAIN, ObserverOptions, observe
 from ..observer.results import LogObservation, ObserveResult
 from ..observer.wrench import external_wrench
 from ..signals import edge_seconds, filtered_derivative
-from .data_files import ColumnSpec, column_map, in_file, read_torque_log, recorded_columns
-from .identify import data_files
+from .data_files import (
+    ColumnSpec,
+    column_map,
+    data_files,
+    in_file,
+    read_torque_log,
+    recorded_columns,
+)
+from .recordings import Recorded, check_limits, check_units
 
 __all__ = [
     "LogObservation",
@@ -268,9 +275,11 @@ def observe_files(opts: ObserveOptions) -> ObserveResult:
         else given.uses_uncertainty and model.covariance is not None
     )
     wants_margin = opts.standstill if given is None else given.standstill
+    columns = recorded_columns(recorded, *opts.columns)  # (names, units), said once
+    read = _read_logs(data_files(opts.data), model, columns, opts)
     logs = [
-        _observe_log(p, model, recorded, opts, options, wants_std, wants_margin)
-        for p in data_files(opts.data)
+        _observe_log(p, log, model, columns[0] is not None, opts, options, wants_std, wants_margin)
+        for p, log in zip(read.paths, read.logs, strict=True)
     ]
     if given is None:
         seen = [np.all(np.isfinite(x.r), axis=1) for x in logs]  # observed samples only
@@ -314,25 +323,39 @@ def observe_files(opts: ObserveOptions) -> ObserveResult:
     return ObserveResult(model, given, found)
 
 
+def _read_logs(
+    paths: list[Path],
+    model: ObserverModel,
+    columns: tuple[str | None, str | None],
+    opts: ObserveOptions,
+) -> Recorded:
+    """The logs ``paths`` read strictly for the model; a log in other units than the others
+    refused and one far outside the joint limits warned about, each naming the file
+    (:mod:`dynid.workflows.recordings`)."""
+    cmap = column_map(*columns)
+    logs = [
+        read_torque_log(p, model.n, columns=cmap, drop_invalid=opts.drop_invalid, owner="the model")
+        for p in map(Path, paths)
+    ]
+    read = Recorded(tuple(logs), tuple(map(Path, paths)))
+    check_limits(read, model.robot, model.drive)
+    check_units(read)
+    return read
+
+
 def _observe_log(
     path: Path,
+    log: TorqueLog,
     model: ObserverModel,
-    recorded: Mapping[str, str | None] | None,
+    mapped: bool,
     opts: ObserveOptions,
     options: ObserverOptions,
     wants_std: bool,
     wants_margin: bool = False,
 ) -> LogObservation:
-    """The residual (and its std, the wrench, the stored true torques) of one log."""
+    """The residual (and its std, the wrench, the stored true torques) of one log, as
+    read (``mapped``: through a column map)."""
     path = Path(path)
-    names, units = recorded_columns(recorded, *opts.columns)
-    log = read_torque_log(
-        path,
-        model.n,
-        columns=column_map(names, units),
-        drop_invalid=opts.drop_invalid,
-        owner="the model",
-    )
     log = joint_side_log(log, model.drive)
     log, turned = unwrapped(log, ~np.asarray(model.robot.prismatic, dtype=bool))
     if turned:  # M(q) is periodic; velocities derived across a wrap are not
@@ -362,7 +385,7 @@ def _observe_log(
         if opts.frame is not None:
             wrench = external_wrench(model.robot, log.q, r, opts.frame)
         ext = None
-        if path.suffix.lower() in (".csv", ".npz") and names is None:
+        if path.suffix.lower() in (".csv", ".npz") and not mapped:
             ext = load_joint_columns(path, "tau_ext", model.n)
             if ext is not None and ext.shape[0] != log.t.shape[0]:
                 ext = None  # rows were dropped: not aligned with the log

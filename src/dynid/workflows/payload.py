@@ -200,7 +200,7 @@ def _pieces(
             mine.append(piece)
         if not mine:
             raise DataError(
-                f"{name}: no piece long enough to filter at {cutoff_hz} Hz (gaps longer than "
+                f"{name}: no piece long enough to filter at {cutoff_hz:.4g} Hz (gaps longer than "
                 "--max-gap cut a recording into pieces); hint: record longer stretches "
                 "without gaps, or raise --max-gap"
             )
