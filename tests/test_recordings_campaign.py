@@ -26,6 +26,7 @@ from dynid.io.torque_log import load_torque_log, save_torque_log
 from dynid.simulation.measurement import sample_times, simulate_measurement
 from dynid.simulation.trajectories import random_fourier
 from dynid.workflows import identify as identify_workflow
+from dynid.workflows.data_files import data_files
 from dynid.workflows.identify import IdentifyOptions, identify_files
 from dynid.workflows.observe import ObserveOptions, observe_files
 from dynid.workflows.validate import validate_files
@@ -272,3 +273,17 @@ def test_extra_columns_are_noted_once_per_read(panda, logs, tmp_path, caplog):
     assert notes == [
         "extra.csv: column(s) ['temp', 'label'] are not torque-log signals: ignored as data"
     ]
+
+
+def test_a_folder_names_the_files_it_leaves_out(logs, tmp_path, caplog):
+    """A folder given to --data stands for its .csv and .npz files; a recording saved as
+    .txt beside them was left out without a word, now in one note naming it."""
+    d = tmp_path / "folder"
+    (d / "sub").mkdir(parents=True)
+    for name in ("a.csv", "b.txt"):
+        (d / name).write_text((logs / "rec1.csv").read_text())
+    (d / ".hidden").write_text("")
+    with caplog.at_level(logging.WARNING, logger="dynid"):
+        assert data_files(d) == [d / "a.csv"]
+    notes = [r.getMessage() for r in caplog.records]
+    assert notes == ["folder: 1 file(s) neither .csv nor .npz left out: b.txt"]

@@ -127,7 +127,8 @@ def save_identify_figures(
                 )
 
         separate = None if args.validate_on is None else read(args.validate_on)
-        data = data_files(args.data)[-1]
+        with _said_before():
+            data = data_files(args.data)[-1]
         held = identification_plots.heldout_torques(model, read(data), separate=separate)
     except Exception as exc:  # a figure never fails the command
         print(f"note: skipped the held-out torque figures: {exc}", file=sys.stderr)

@@ -280,7 +280,8 @@ def recorded_columns(
 
 def data_files(paths: str | Path | Sequence[str | Path]) -> list[Path]:
     """The data files of ``--data``: the paths given, a folder standing for its ``.csv``
-    and ``.npz`` files in name order.
+    and ``.npz`` files in name order (its other files, hidden ones and folders apart,
+    named in a logged note).
 
     Raises
     ------
@@ -294,6 +295,18 @@ def data_files(paths: str | Path | Sequence[str | Path]) -> list[Path]:
             found = sorted(f for f in p.iterdir() if f.suffix.lower() in (".csv", ".npz"))
             if not found:
                 raise DataError(f"{p.name}: the folder holds no .csv or .npz data file")
+            other = sorted(
+                f.name
+                for f in p.iterdir()
+                if f not in found and not f.name.startswith(".") and not f.is_dir()
+            )
+            if other:  # a recording of another extension is never left out unsaid
+                _log.warning(
+                    "%s: %d file(s) neither .csv nor .npz left out: %s",
+                    p.name,
+                    len(other),
+                    ", ".join(other[:5]) + (", ..." if len(other) > 5 else ""),
+                )
             out += found
         else:
             out.append(p)
