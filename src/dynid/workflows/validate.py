@@ -28,11 +28,13 @@ from pathlib import Path
 from typing import Any, Literal
 
 import numpy as np
+from numpy.typing import NDArray
 
 from ..exceptions import DataError, OptionError
 from ..friction.model import FrictionModel
 from ..friction.recordings import RecordingsValidation, prepare_pieces, validate_pieces
 from ..friction.validation import RECORDED, own_friction
+from ..identification.metrics import TorqueErrors
 from ..identification.model import IdentifiedModel
 from ..identification.sanity import anticorrelated, velocity_noise_std
 from ..identification.verdict import LEVELS, Verdict, judge_prediction
@@ -130,7 +132,7 @@ class ValidateResult:
     files: tuple[str, ...]
     cutoff_hz: float | None
     verdict: Verdict
-    noise_rms: np.ndarray
+    noise_rms: NDArray[np.float64]
     noise_floor_percent: float
 
     def metadata(self) -> dict[str, Any]:
@@ -244,8 +246,8 @@ def validate_files(
 
 
 def _judged(
-    val: RecordingsValidation, sel: np.ndarray, errors: Any
-) -> tuple[Verdict, np.ndarray, float]:
+    val: RecordingsValidation, sel: NDArray[np.bool_], errors: TorqueErrors
+) -> tuple[Verdict, NDArray[np.float64], float]:
     """The verdict, the sensor noise per joint [N m] and the noise floor [%] of the pieces
     ``sel`` (bool per piece), whose pooled errors are ``errors``: the noise read from each
     piece's measured torques (:func:`~dynid.identification.sanity.velocity_noise_std`),
