@@ -287,3 +287,32 @@ def test_a_folder_names_the_files_it_leaves_out(logs, tmp_path, caplog):
         assert data_files(d) == [d / "a.csv"]
     notes = [r.getMessage() for r in caplog.records]
     assert notes == ["folder: 1 file(s) neither .csv nor .npz left out: b.txt"]
+
+
+def test_one_recording_given_twice_is_refused_however_it_is_named(logs, tmp_path, monkeypatch):
+    """The same file named two ways (relative and absolute), or a copy under another name:
+    used twice, it counted double in the fit and judged itself when one recording was left
+    out; now refused naming it."""
+    monkeypatch.chdir(logs)
+    with pytest.raises(DataError, match="rec1.csv: data file given twice"):
+        data_files(["rec1.csv", logs / "rec1.csv"])
+    (tmp_path / "copy.csv").write_bytes((logs / "rec1.csv").read_bytes())
+    with pytest.raises(DataError, match="copy.csv: the same content as rec1.csv"):
+        data_files([logs / "rec1.csv", logs / "rec2.csv", tmp_path / "copy.csv"])
+    assert data_files([logs / "rec1.csv", logs / "rec2.csv"]) == [
+        logs / "rec1.csv",
+        logs / "rec2.csv",
+    ]
+
+
+def test_validate_on_one_of_the_recordings_fitted_is_refused(panda, logs, tmp_path, capsys):
+    """--validate-on a recording the fit also saw (the same file, or a copy): its held-out
+    error was the training error and chose the structure on it; now one line names the
+    option and the file."""
+    (tmp_path / "copy.csv").write_bytes((logs / "rec1.csv").read_bytes())
+    argv = ["identify", "--robot", "panda", "--out", str(tmp_path / "i"), "--data"]
+    for other in (logs / "rec1.csv", tmp_path / "copy.csv"):
+        assert main([*argv, str(logs / "rec1.csv"), "--validate-on", str(other)]) == 2
+        err = [s for s in capsys.readouterr().err.splitlines() if s.strip()]
+        assert len(err) == 1, err
+        assert f"error: --validate-on {other.name} is one of the recordings fitted" in err[0]

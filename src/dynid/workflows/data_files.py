@@ -14,6 +14,8 @@ The policies, the same for the Python API and every command:
 
 from __future__ import annotations
 
+import contextlib
+import hashlib
 import logging
 import zipfile
 from collections.abc import Callable, Mapping, Sequence
@@ -286,7 +288,8 @@ def data_files(paths: str | Path | Sequence[str | Path]) -> list[Path]:
     Raises
     ------
     DataError
-        No path, a folder without data files, or a file named twice.
+        No path, a folder without data files, a file named twice (however written), or
+        two files of identical content.
     """
     given = [paths] if isinstance(paths, str | Path) else list(paths)
     out: list[Path] = []
@@ -312,7 +315,33 @@ def data_files(paths: str | Path | Sequence[str | Path]) -> list[Path]:
             out.append(p)
     if not out:
         raise DataError("no data file given")
-    twice = sorted({p.name for p in out if out.count(p) > 1})
+    real = [p.resolve() for p in out]  # one file named two ways (a.csv, ./d/../a.csv)
+    twice = sorted({p.name for p, r in zip(out, real, strict=True) if real.count(r) > 1})
     if twice:
         raise DataError(f"{', '.join(twice)}: data file given twice")
+    _refuse_copies(out)
     return out
+
+
+def _refuse_copies(paths: list[Path]) -> None:
+    """Refuse two files of identical content (a recording copied under another name): it
+    would count twice in the fit, and judge itself when one recording is left out.
+    Only files of equal size are read (hashed in blocks)."""
+    sizes: dict[int, list[Path]] = {}
+    for p in paths:
+        with contextlib.suppress(OSError):  # missing or unreadable: its reader says so
+            if p.is_file() and (n := p.stat().st_size) > 0:
+                sizes.setdefault(n, []).append(p)
+    for group in (g for g in sizes.values() if len(g) > 1):
+        first: dict[str, Path] = {}
+        for p in group:
+            h = hashlib.sha1()
+            with contextlib.suppress(OSError), p.open("rb") as fh:
+                while block := fh.read(1 << 20):
+                    h.update(block)
+            if (seen := first.setdefault(h.hexdigest(), p)) is not p:
+                raise DataError(
+                    f"{p.name}: the same content as {seen.name} (a copy of one recording); "
+                    "it would count twice and judge itself when one recording is left out; "
+                    "hint: give it once"
+                )

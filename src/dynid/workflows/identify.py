@@ -73,7 +73,7 @@ def _heldout(
 ) -> dict[str, Any]:
     """``folds``/``validate_on`` of the torque-log routes (the log read as ``paths[0]``
     is); refused for static data, ``folds`` with several recordings (each recording is
-    a fold)."""
+    a fold), ``validate_on`` one of the recordings (or a copy)."""
     if folds is None and validate_on is None:
         return {}
     path = paths[0]
@@ -90,6 +90,15 @@ def _heldout(
         )
     kw: dict[str, Any] = {} if folds is None else {"folds": folds}
     if validate_on is not None:
+        try:  # the same file, however named, or a copy of one of the recordings
+            data_files([*paths, Path(validate_on)])
+        except DataError:
+            raise OptionError(
+                f"{Path(validate_on).name} is one of the recordings fitted (or a copy of one): "
+                "judged on it, the held-out error is the training error; hint: a recording "
+                "the fit does not see",
+                field="validate_on",
+            ) from None
         kw["validate_on"] = read_torque_log(validate_on, n, columns=cmap, drop_invalid=drop_invalid)
     return kw
 
