@@ -316,3 +316,27 @@ def test_validate_on_one_of_the_recordings_fitted_is_refused(panda, logs, tmp_pa
         err = [s for s in capsys.readouterr().err.splitlines() if s.strip()]
         assert len(err) == 1, err
         assert f"error: --validate-on {other.name} is one of the recordings fitted" in err[0]
+
+
+def test_a_stretch_lost_without_a_gap_in_the_stamps_makes_no_event(logs, tmp_path, capsys):
+    """The observer on a log whose logger lost 0.2 s of samples but stamped on evenly (the
+    positions jump): it reported a 'collision' on every joint at the jump; now it starts
+    again there, with a warning naming the file and the time, and finds no event."""
+    log = load_torque_log(logs / "rec2.csv")
+    keep = np.ones(log.n_samples, bool)
+    keep[400:440] = False  # 2.0-2.2 s lost
+    g = log.select(keep)
+    save_torque_log(tmp_path / "lost.csv", type(g)(log.t[: g.n_samples], g.q, g.dq, g.tau))
+    p = ["observe", "--params", "panda", "--no-figures"]
+    cal = tmp_path / "cal"
+    assert main([*p, "--calibrate", "--data", str(logs / "rec1.csv"), "--out", str(cal)]) == 0
+    out = tmp_path / "det"
+    th = ["--thresholds", str(cal / "thresholds.json")]
+    capsys.readouterr()
+    with warnings.catch_warnings():
+        warnings.simplefilter("default", DynidWarning)
+        assert main([*p, *th, "--data", str(tmp_path / "lost.csv"), "--out", str(out)]) == 0
+    err = capsys.readouterr().err
+    assert "lost.csv: position jumps more than the recorded velocity explains" in err
+    assert "at t = 2 s" in err and "the observer starts again after each jump" in err
+    assert json.loads((out / "events.json").read_text())["events"] == []

@@ -13,7 +13,10 @@ the command applies, so that the Python API behaves as the command does.
   ``identify`` cuts) and after rows dropped for NaN or inf (``drop_invalid``; refused
   otherwise, the row named): the observer starts again on each piece and no event spans a
   cut (one warning names the file and the times); a position that jumps more than its
-  velocity explains is warned about (:mod:`dynid.observer.pieces`).
+  velocity explains over a regular time step (samples lost without a gap in the stamps, an
+  encoder glitch) cuts the log there too, with a warning (:mod:`dynid.observer.pieces`).
+  Several logs are checked together: one in other units than the others is refused, one
+  far outside the joint limits warned about (:mod:`dynid.workflows.recordings`).
 * ``calibrate``: the residuals of every (collision-free) log give the thresholds; with an
   identified model that has a covariance, they also grow with the model's uncertainty
   (``uncertainty``, default on); the standstill margin of the model's friction (its
@@ -58,7 +61,7 @@ from ..observer.detection import (
     standstill_series,
 )
 from ..observer.model import ObserverModel, from_identified, from_robot
-from ..observer.pieces import pieces, position_jumps
+from ..observer.pieces import PositionJump, pieces, position_jumps
 from ..observer.residual import DEFAULT_GAIN, ObserverOptions, observe
 from ..observer.results import LogObservation, ObserveResult
 from ..observer.wrench import external_wrench
@@ -367,7 +370,10 @@ def _observe_log(
         )
     starts = _pieces(path, log, opts)
     dq = _piece_velocities(log, starts)  # of a log of positions: from the unwrapped ones
-    _warn_jumps(path, log, dq, starts)
+    cut = _cut_at_jumps(path, log, dq, starts)
+    if cut != starts and log.dq_derived:  # derived again, never across a jump
+        dq = _piece_velocities(log, cut)
+    starts = cut
     spans = _observed_spans(path, log, starts)
 
     def run() -> LogObservation:
@@ -458,17 +464,53 @@ def _pieces(path: Path, log: TorqueLog, opts: ObserveOptions) -> list[int]:
     return starts
 
 
-def _warn_jumps(path: Path, log: TorqueLog, dq: NDArray[np.float64], starts: list[int]) -> None:
-    """Warn about positions that jump more than the velocities ``dq`` explain."""
-    jumps = position_jumps(log.t, log.q, dq, starts)
-    if jumps:
+def _cut_at_jumps(
+    path: Path, log: TorqueLog, dq: NDArray[np.float64], starts: list[int]
+) -> list[int]:
+    """The pieces cut again where positions jump more than the velocities ``dq`` explain
+    (:func:`~dynid.observer.pieces.position_jumps`) over one regular time step (a stretch
+    of samples lost without a gap in the stamps, an encoder glitch), with a warning naming
+    the file, the joints and the times: the observer starts again there, so that no event
+    is made of the jump (a lost stretch of 0.2 s was a 'collision' on every joint). A
+    glitch's jump back is found in the next pass (at most three). A jump across a gap
+    bridged by ``--max-gap`` is warned about only (bridging was asked for)."""
+    dt = np.diff(log.t)
+    regular = 1.5 * float(np.median(dt)) if dt.size else np.inf
+    found: list[PositionJump] = []
+    bridged: list[PositionJump] = []
+    cut = list(starts)
+    for _ in range(3):
+        jumps = [x for x in position_jumps(log.t, log.q, dq, cut) if x not in found + bridged]
+        at: set[int] = set()
+        for x in jumps:
+            k = int(np.searchsorted(log.t, x.t))
+            if k > 0 and log.t[k] - log.t[k - 1] > regular:
+                bridged.append(x)
+            elif k not in cut:
+                found.append(x)
+                at.add(k)
+        if not at:
+            break
+        cut = sorted(set(cut) | at)
+    for jumps, what in (
+        (
+            found,
+            "samples lost without a gap in the time stamps, or an encoder glitch; the "
+            "observer starts again after each jump (no event spans one)",
+        ),
+        (bridged, "across a gap bridged by --max-gap: the residual after it is not to be trusted"),
+    ):
+        if not jumps:
+            continue
+        jumps.sort(key=lambda x: (x.t, x.joint))
         listed = ", ".join(
             f"joint {x.joint + 1} by {x.size:+.3g} at t = {x.t:.6g} s" for x in jumps[:3]
         )
         more = f" and {len(jumps) - 3} more" if len(jumps) > 3 else ""
         warnings.warn(
             f"{path.name}: position jumps more than the recorded velocity explains "
-            f"({listed}{more}): the residual after a jump is not to be trusted",
+            f"({listed}{more}): {what}",
             DynidWarning,
             stacklevel=4,
         )
+    return cut
