@@ -293,21 +293,17 @@ def test_ctrl_c_during_the_clarabel_solve_ends_it_and_the_run(tmp_path):
     a termination callback drops the interrupt raised in it). The convex fit's solver
     records the signal, ends the solve at its next iteration and delivers it: the run
     exits 130 with no output folder, its solve cut short (status CallbackTerminated)."""
+    import numpy as np
+
+    import dynid
+    from dynid.io.torque_log import save_torque_log
+    from dynid.simulation.measurement import sample_times, simulate_measurement
+    from dynid.simulation.trajectories import random_fourier
+
+    panda = dynid.panda()
+    traj = random_fourier(panda, np.random.default_rng(3))(sample_times(5.0, 200.0))
     log = tmp_path / "log.csv"
-    sim = _dynid(
-        "simulate",
-        "--duration",
-        "5",
-        "--rate",
-        "200",
-        "--trajectory",
-        "fourier",
-        "--seed",
-        "3",
-        "--out",
-        str(log),
-    )
-    assert sim.wait(timeout=120) == 0
+    save_torque_log(log, simulate_measurement(panda, traj, rng=np.random.default_rng(4)))
     out = tmp_path / "out"
     p = subprocess.Popen(
         [
