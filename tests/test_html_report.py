@@ -540,10 +540,11 @@ def test_an_observer_report_shows_residuals_thresholds_and_events(tmp_path):
 
 
 @pytest.mark.slow
-def test_torques_of_the_opposite_sign_make_the_verdict_poor(runs, tmp_path):
+def test_torques_of_the_opposite_sign_make_the_verdict_unusable(runs, tmp_path):
     """A run that warned that the torques are anti-correlated with the model's gravity
-    torques (a log of the other sign convention fits as well) gets 'not good enough' with the
-    warning in the verdict, whatever its errors (a regression: it said GOOD)."""
+    torques (a log of the other sign convention fits as well) gets 'unusable: check the
+    data' with the warning in the verdict, whatever its errors (a regression: it said GOOD;
+    then 'not good enough', as a model 3.9 x the noise floor)."""
     doc = _identification_doc(runs)
     p = tmp_path / "identification.json"
     p.write_text(json.dumps(doc))
@@ -551,10 +552,11 @@ def test_torques_of_the_opposite_sign_make_the_verdict_poor(runs, tmp_path):
     page_text = render_html_report(
         RunSummary(command="identify", warnings=(warning,)), {p.name: p}, out=tmp_path
     )
-    assert '<section class="verdict poor"' in page_text
-    assert "anti-correlated" in page_text.split('id="verdict"')[1].split("</section>")[0]
+    assert '<section class="verdict unusable"' in page_text
+    box = page_text.split('id="verdict"')[1].split("</section>")[0]
+    assert "anti-correlated" in box and "unusable: check the data" in box
     good = render_html_report(RunSummary(command="identify"), {p.name: p}, out=tmp_path)
-    assert '<section class="verdict poor"' not in good
+    assert '<section class="verdict unusable"' not in good
 
 
 def _verdict_of(page_text: str) -> tuple[str, str]:
@@ -635,3 +637,47 @@ def test_a_fit_at_the_noise_floor_is_not_called_over_fitted(tmp_path):
     level2, text2 = _verdict_of(render_html_report(RunSummary(command="identify"), files))
     assert "the fit over-fits" in text2 and level2 in ("fair", "poor"), text2
     assert level == "good", text  # the ratio alone is no reservation at the floor
+
+
+@pytest.mark.parametrize(
+    "error, floor, level, label",
+    [
+        (0.5, 0.4, "good", "at the noise floor"),  # 1.25 x the floor
+        (1.56, 0.4, "fair", "usable, with reservations"),  # 3.9 x the floor, 1.56 %
+        (39.0, 0.4, "poor", "poor: improve the model"),
+        (60.0, 0.4, "unusable", "unusable: check the data"),
+    ],
+)
+def test_the_held_out_verdict_has_levels_a_person_can_act_on(tmp_path, error, floor, level, label):
+    """identify's verdict grades the held-out error against the noise floor: at the floor,
+    usable, poor, unusable (3.9 x the floor at 1.56 % and torques of the wrong sign were
+    both 'not good enough')."""
+    ident = {
+        "schema": "dynid-identification/1",
+        "route": "classical",
+        "rank": 2,
+        "base": {"rank": 2},
+        "coefficients": [
+            {"name": "beta1", "expression": "m1"},
+            {"name": "beta2", "expression": "m2"},
+        ],
+        "metadata": {
+            "heldout": {
+                "training_error_percent": error,
+                "heldout_error_percent": error,
+                "scheme": "blocks",
+                "folds": 5,
+            }
+        },
+    }
+    held = {
+        "relative_error_percent": error,
+        "noise_floor_percent": floor,
+        "block": "the last block",
+    }
+    (tmp_path / "identification.json").write_text(json.dumps(ident))
+    (tmp_path / "heldout.json").write_text(json.dumps(held))
+    files = {p.name: p for p in tmp_path.glob("*.json")}
+    got, text = _verdict_of(render_html_report(RunSummary(command="identify"), files))
+    assert got == level, text
+    assert text.strip().lower().startswith(label), text

@@ -331,8 +331,9 @@ def test_payload_static_data_stay_one_file(tmp_path):
     """Static data come in one file: two are refused in one line naming the first."""
     panda = dynid.panda()
     ctrl = dynid.SimulatedController(panda, rng=np.random.default_rng(5))
-    data = dynid.acquire_static(ctrl, 20, np.random.default_rng(6))
-    for name in ("s1.csv", "s2.csv"):
-        save_static_data(tmp_path / name, data)
+    for seed, name in ((6, "s1.csv"), (7, "s2.csv")):  # two acquisitions (a copy is refused)
+        save_static_data(
+            tmp_path / name, dynid.acquire_static(ctrl, 20, np.random.default_rng(seed))
+        )
     with pytest.raises(DataError, match=r"s1.csv holds static data: give one static data file"):
         identify_payload_files(panda, [tmp_path / "s1.csv", tmp_path / "s2.csv"])

@@ -233,7 +233,7 @@ def test_a_failing_figure_is_skipped_with_a_note(model, tmp_path, monkeypatch, c
 
 _SCS_RUN = """
 import numpy as np, cvxpy as cp
-from dynid.feasibility.convex.problem import _scs
+from dynid.feasibility.convex.solvers import scs as _scs
 rng = np.random.default_rng(0); n = 120
 C = rng.normal(size=(n, n)); C = C + C.T
 X = cp.Variable((n, n), PSD=True)
@@ -264,3 +264,69 @@ def test_ctrl_c_during_the_scs_fallback_stops_the_run():
     out, err = p.communicate(timeout=120)
     assert "KeyboardInterrupt" in err and "finished" not in out and "solver error" not in out
     assert p.returncode != 0
+
+
+_CLARABEL_RUN = """
+import os, signal, sys
+import clarabel
+real = clarabel.DefaultSolver
+
+class Solver:  # Clarabel's solver; a Ctrl-C arrives as its first solve starts
+    def __init__(self, *args):
+        self.real = real(*args)
+    def __getattr__(self, name):
+        return getattr(self.real, name)
+    def solve(self):
+        os.kill(os.getpid(), signal.SIGINT)
+        result = self.real.solve()
+        print("solver status", result.status, file=sys.stderr, flush=True)
+        return result
+
+clarabel.DefaultSolver = Solver
+from dynid.cli.__main__ import main
+sys.exit(main())
+"""
+
+
+def test_ctrl_c_during_the_clarabel_solve_ends_it_and_the_run(tmp_path):
+    """Clarabel never looks at Python's signals: a Ctrl-C waited for the whole solve (and
+    a termination callback drops the interrupt raised in it). The convex fit's solver
+    records the signal, ends the solve at its next iteration and delivers it: the run
+    exits 130 with no output folder, its solve cut short (status CallbackTerminated)."""
+    import numpy as np
+
+    import dynid
+    from dynid.io.torque_log import save_torque_log
+    from dynid.simulation.measurement import sample_times, simulate_measurement
+    from dynid.simulation.trajectories import random_fourier
+
+    panda = dynid.panda()
+    traj = random_fourier(panda, np.random.default_rng(3))(sample_times(5.0, 200.0))
+    log = tmp_path / "log.csv"
+    save_torque_log(log, simulate_measurement(panda, traj, rng=np.random.default_rng(4)))
+    out = tmp_path / "out"
+    p = subprocess.Popen(
+        [
+            sys.executable,
+            "-c",
+            _CLARABEL_RUN,
+            "identify",
+            "--robot",
+            "panda",
+            "--data",
+            str(log),
+            "--consistent",
+            "--out",
+            str(out),
+        ],
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        text=True,
+        env=_env(),
+        preexec_fn=lambda: signal.signal(signal.SIGINT, signal.SIG_DFL),
+    )
+    _, err = p.communicate(timeout=300)
+    assert p.returncode == 130, err
+    assert "solver status CallbackTerminated" in err
+    assert "interrupted; no partial output left" in err
+    assert not out.exists()

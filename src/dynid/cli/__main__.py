@@ -3,7 +3,8 @@
 Run ``dynid <command> --help`` for the options of one command.
 
 Exit status: 0 success; 1 a command's documented negative result, its files written
-(retrieve: no feasible set; excite: no admissible trajectory); 2 an error (one line on
+(retrieve: no feasible set; excite: no admissible trajectory; validate: a model that
+does not explain the log); 2 an error (one line on
 stderr; --debug shows the traceback); 130 interrupted (Ctrl-C); 129, 131, 143
 terminated by SIGHUP, SIGQUIT, SIGTERM; 141 stdout was closed
 before everything was printed (`dynid fk ... | head -1`: the run completes quietly, its

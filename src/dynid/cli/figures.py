@@ -7,10 +7,15 @@ so that a test can replace a plotting function."""
 
 from __future__ import annotations
 
+import contextlib
+import logging
 import sys
+import warnings
+from collections.abc import Iterator
 from pathlib import Path
 from typing import Any
 
+from ..exceptions import DynidWarning
 from ..feasibility.convex import ConsistentResult
 from ..friction.fit import FrictionFit, FrictionResidual
 from ..friction.validation import Validation
@@ -87,6 +92,19 @@ def save_validation_figures(
     return [p for p in paths if p is not None]
 
 
+@contextlib.contextmanager
+def _said_before() -> Iterator[None]:
+    """A log read again for its figures: what its reading warns or logs (ignored columns,
+    dropped rows) was said when the identification read it, and is not said twice."""
+    logging.disable(logging.WARNING)
+    try:
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore", DynidWarning)
+            yield
+    finally:
+        logging.disable(logging.NOTSET)
+
+
 def save_identify_figures(
     out: Path, model: IdentifiedModel, args: Any, *, figures: bool = True
 ) -> list[Path]:
@@ -94,18 +112,23 @@ def save_identify_figures(
     (errors per joint against the sensor noise; data, written without ``figures`` too),
     ``heldout_torques.png`` (measured and predicted torques) and ``heldout_residuals.png``
     (residual histograms). The held-out recording is the last data file (a folder given
-    to ``--data`` stands for its files). Nothing for static data or a model without
-    held-out folds; a log that cannot be read back is noted and skipped (the
-    identification's own files are written)."""
+    to ``--data`` stands for its files), its reading's warnings not said again. Nothing
+    for static data or a model without held-out folds; a log that cannot be read back is
+    noted and skipped (the identification's own files are written)."""
     if model.info.log is None or model.holdout is None:
         return []
     try:
         cmap = column_map(args.columns, args.units, cutoff_hz=args.cutoff)
-        read = lambda p: read_torque_log(  # noqa: E731
-            p, model.robot.n, columns=cmap, drop_invalid=args.drop_invalid
-        )
+
+        def read(p: Any) -> Any:
+            with _said_before():
+                return read_torque_log(
+                    p, model.robot.n, columns=cmap, drop_invalid=args.drop_invalid
+                )
+
         separate = None if args.validate_on is None else read(args.validate_on)
-        data = data_files(args.data)[-1]
+        with _said_before():
+            data = data_files(args.data)[-1]
         held = identification_plots.heldout_torques(model, read(data), separate=separate)
     except Exception as exc:  # a figure never fails the command
         print(f"note: skipped the held-out torque figures: {exc}", file=sys.stderr)

@@ -21,9 +21,20 @@ another. The errors are pooled over every sample of every recording (RMS per joi
 relative error over all), and given per recording; the torque figure shows the longest
 piece of the first recording, the RMS figure the pooled errors.
 
+The verdict weighs the relative error against the sensor-noise floor read from the
+measured torques (the smallest error a model can reach on them): "at the noise floor"
+(at most 1.5 x the floor), "usable" (at most 3 x, or below 15 %), "poor" (below 50 %: the
+model misses effects the data show), "unusable" (50 % or more, or torques anti-correlated
+with the model's: a log of another robot, in other units or of the other sign). With
+several recordings, a recording worse than the whole is named.
+
+Exit status: 0 when the model explains the log (at the noise floor, usable or poor); 1
+when it is unusable, its files written all the same (the verdict line says why); 2 an
+error (a bad file, another joint count: one line naming the file).
+
 Writes OUT/validation.json {"rms": [...], "mse": [...], "relative_error_percent": x, ...}
-(for the full model, plus a "without_friction" block, and one entry per recording in
-"recordings") and the figures
+(for the full model, plus a "without_friction" block, one entry per recording in
+"recordings", the noise floor and the verdict) and the figures
 OUT/validation_torques.png and OUT/validation_rms.png (skipped, with a note, without
 matplotlib). The log is read strictly: rows with NaN/inf or a repeated timestamp are an
 error unless --drop-invalid; gaps up to --max-gap are bridged, longer ones cut the log.
@@ -130,4 +141,6 @@ def run(args: argparse.Namespace, console: Console) -> int:
             )
         )
     console.print(f"relative error {val.errors.relative_error_percent:.3f} %; wrote {path}")
-    return 0
+    v = result.verdict
+    console.print(f"verdict: {v.label}: {v.reason}")
+    return 1 if v.unusable else 0

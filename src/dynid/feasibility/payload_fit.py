@@ -60,6 +60,8 @@ def _consistent(
         return phi_ls, False
     import cvxpy as cp
 
+    from .convex.solvers import clarabel
+
     s = np.maximum(np.abs(phi_ls), 1e-9 * max(float(np.max(np.abs(phi_ls))), 1e-12))
     x = cp.Variable(10)  # phi = s * x, so the variables are of order one
     phi = cp.multiply(s, x)
@@ -69,7 +71,7 @@ def _consistent(
     cons = [J - margin * cp.trace(J) * np.eye(4) >> 0]
     prob = cp.Problem(cp.Minimize(obj), cons)
     try:
-        prob.solve(solver="CLARABEL")
+        prob.solve(solver=clarabel())
     except (cp.error.SolverError, ArithmeticError, ValueError) as exc:
         raise SolverError(f"payload: the consistent estimate was not found ({exc})") from exc
     if prob.status not in ("optimal", "optimal_inaccurate") or x.value is None:

@@ -218,7 +218,7 @@ def prepare_pieces(
     lost = [names[r] for r in range(len(names)) if r not in recording]
     if lost:
         raise DataError(
-            f"{', '.join(lost)}: no piece long enough to filter at {cut} Hz (gaps longer "
+            f"{', '.join(lost)}: no piece long enough to filter at {cut or 0:.4g} Hz (gaps longer "
             "than --max-gap cut a recording into pieces); hint: record longer stretches "
             "without gaps, or raise --max-gap"
         )

@@ -30,6 +30,7 @@ Here:
 
 from __future__ import annotations
 
+import contextlib
 import dataclasses
 import warnings
 from collections.abc import Iterator, Mapping, Sequence
@@ -279,6 +280,27 @@ class Recordings:
         )
 
 
+def _at(cutoff_hz: float | None) -> str:
+    """`` at 11.25 Hz`` (empty without a cut-off)."""
+    return "" if cutoff_hz is None else f" at {cutoff_hz:.4g} Hz"
+
+
+@contextlib.contextmanager
+def _named_findings(name: str | None, r: int, said: set[tuple[int, str]]) -> Iterator[None]:
+    """The findings a piece's preparation warns (a torque sign, degrees, a unit), once per
+    recording and, of several recordings, named with the recording's file."""
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        yield
+    for w in caught:
+        text = str(w.message)
+        if (r, text) in said:
+            continue
+        said.add((r, text))
+        shown = text if name is None or text.startswith(name) else f"{name}: {text}"
+        warnings.warn_explicit(shown, w.category, w.filename, w.lineno)
+
+
 def prepare_recordings(
     robot: Robot,
     logs: Sequence[TorqueLog],
@@ -335,7 +357,8 @@ def prepare_recordings(
             for finding in check_torque_log(
                 robot, joined([joint_side_log(p, drive) for p in mine])
             ):
-                warnings.warn(finding, DynidWarning, stacklevel=2)
+                shown = finding if len(names) == 1 else f"{name}: {finding}"
+                warnings.warn(shown, DynidWarning, stacklevel=2)
         pieces += [(r, p) for p in mine]
     cutoff: float | None = None if cutoff_hz == "auto" else cutoff_hz
     if cutoff_hz == "auto":
@@ -347,18 +370,20 @@ def prepare_recordings(
         if cutoff is None:
             raise DataError("no piece is long enough to read the motion's frequency from")
     prepared, recording, skipped = [], [], []
+    said: set[tuple[int, str]] = set()
     for r, piece in pieces:
         try:
-            p = prepare_torque_log(
-                robot,
-                piece,
-                cutoff_hz=cutoff,
-                trim_s=trim_s,
-                max_gap_s=max_gap_s,
-                decimate=decimate,
-                drive=drive,
-                check=False,
-            )
+            with _named_findings(names[r] if len(names) > 1 else None, r, said):
+                p = prepare_torque_log(
+                    robot,
+                    piece,
+                    cutoff_hz=cutoff,
+                    trim_s=trim_s,
+                    max_gap_s=max_gap_s,
+                    decimate=decimate,
+                    drive=drive,
+                    check=False,
+                )
         except DataError as exc:
             skipped.append(skipped_piece(names[r], piece, exc))
             continue
@@ -366,13 +391,13 @@ def prepare_recordings(
         recording.append(r)
     if not prepared:
         raise DataError(
-            f"no piece of {', '.join(names)} is long enough to filter at {cutoff} Hz; "
+            f"no piece of {', '.join(names)} is long enough to filter{_at(cutoff)}; "
             "hint: record longer stretches without gaps, or raise --max-gap"
         )
     used = sorted(set(recording))
     if len(used) < len(names):
         lost = [names[r] for r in range(len(names)) if r not in used]
-        raise DataError(f"{', '.join(lost)}: no piece long enough to filter at {cutoff} Hz")
+        raise DataError(f"{', '.join(lost)}: no piece long enough to filter{_at(cutoff)}")
     if cutoff_hz == "auto" and cutoff is not None:  # read from the motion: recorded so
         f_q = cutoff / CUTOFF_MULTIPLE
         prepared = [dataclasses.replace(p, motion_frequency_hz=f_q) for p in prepared]

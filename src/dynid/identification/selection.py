@@ -467,6 +467,7 @@ def identify_recordings(
     rtol: float | None = None,
     folds: int = DEFAULT_FOLDS,
     validate_on: TorqueLog | None = None,
+    friction: tuple[str, ...] | None = None,
 ) -> IdentifiedModel:
     """Identify the base parameters and the model's terms from one or more torque logs.
 
@@ -494,6 +495,9 @@ def identify_recordings(
         one left out at a time).
     validate_on : TorqueLog, optional
         Judge on this separate recording instead.
+    friction : tuple of str, optional
+        The friction parts fitted whatever the chosen structure holds (its armature and
+        placement kept; the consistent fit's classical parts): the data prepared once.
 
     Returns
     -------
@@ -539,15 +543,12 @@ def identify_recordings(
     selection = None
     if structure == "auto":
         selection = select_structure(
-            robot,
-            data,
-            drive=drive,
-            estimator=est,
-            folds=folds,
-            validation=validation,
-            rtol=rtol,
+            robot, data, drive=drive, estimator=est, folds=folds, validation=validation, rtol=rtol
         )
-        structure = Structure() if selection is None else selection.chosen
+        chosen = Structure() if selection is None else selection.chosen
+        structure = (
+            chosen if friction is None else Structure(chosen.armature, friction, at=chosen.at)
+        )
     model_drive, terms = structure_terms(structure, drive, robot.n, tuple(data.band), _bands(data))
     judge, _, fold_labels = _judge(robot, data, est, folds, validation)
     model = identify(

@@ -200,18 +200,22 @@ def section(anchor: str, title: str, *parts: str) -> str:
     return f'<h2 id="{esc(anchor)}">{esc(title)}</h2>' + "".join(parts)
 
 
-def verdict(level: str, headline: str, facts: Sequence[str]) -> str:
-    """The answer box at the top of a page: ``level`` good, fair or poor (a judgement), or
-    info (a finding, such as events detected); ``headline`` and ``facts`` are HTML."""
+def verdict(level: str, headline: str, facts: Sequence[str], label: str | None = None) -> str:
+    """The answer box at the top of a page: ``level`` good, fair, poor or unusable (a
+    judgement, :mod:`dynid.identification.verdict`), or info (a finding, such as events
+    detected); ``label`` the level in words (default: the level's own: "good", "usable,
+    with reservations", "poor: improve the model", "unusable: check the data");
+    ``headline`` and ``facts`` are HTML."""
     items = "".join(f"<li>{f}</li>" for f in facts)
-    label = {
+    labels = {
         "good": "good",
         "fair": "usable, with reservations",
-        "poor": "not good enough",
+        "poor": "poor: improve the model",
+        "unusable": "unusable: check the data",
         "info": "found",
     }
     return (
         f'<section class="verdict {esc(level)}" id="verdict"><p class="headline">'
-        f'<span class="level">{esc(label.get(level, level))}</span> {headline}</p>'
+        f'<span class="level">{esc(label or labels.get(level, level))}</span> {headline}</p>'
         f"<ul>{items}</ul></section>"
     )

@@ -1,6 +1,7 @@
 """The answer of ``dynid identify``: is the model good enough, and how sure are we.
 
-The verdict weighs the held-out error against the sensor-noise floor (``heldout.json``:
+The verdict (at the noise floor, usable, poor, unusable: :mod:`dynid.identification.verdict`)
+weighs the held-out error against the sensor-noise floor (``heldout.json``:
 the last time block predicted by the fit of the others, unfiltered torques, against the
 noise read from the log above the motion's band), the training against the held-out error
 (over-fitting), the rank against the columns of the model (the base parameters are the
@@ -15,6 +16,7 @@ from __future__ import annotations
 import re
 from typing import Any
 
+from ..identification.verdict import FLOOR_GOOD, judge_prediction, worst
 from .html import bar, cell, esc, figure, is_number, number, percent, section, table, verdict
 from .run import Answer, RunFiles
 
@@ -23,8 +25,6 @@ __all__ = ["answer", "coefficient_unit"]
 #: Relative standard deviation [%] above which a coefficient counts as poorly identified
 #: (the threshold Gaz et al. 2019 pruned at).
 UNCERTAIN_PERCENT = 30.0
-#: Held-out error / noise floor: at the floor up to FLOOR_GOOD, usable up to FLOOR_FAIR.
-FLOOR_GOOD, FLOOR_FAIR = 1.5, 3.0
 #: Held-out / training error above which the model over-fits (usable up to OVERFIT_FAIR).
 OVERFIT_GOOD, OVERFIT_FAIR = 1.1, 1.5
 #: Figures of the identification (written by the command when it has torques).
@@ -88,25 +88,32 @@ def _heldout_facts(doc: dict, held: dict | None) -> tuple[list[str], list[str], 
     if held is not None and is_number(held.get("relative_error_percent")):
         err, floor = held["relative_error_percent"], held.get("noise_floor_percent")
         where = esc(held.get("block", "held-out data"))
-        if is_number(floor) and floor > 0:
-            r = err / floor
+        v = judge_prediction(err, floor if is_number(floor) else None)
+        if v.level != "good":
+            problems.append(v.level)
+        if v.ratio is not None:
+            r = v.ratio
             facts.append(
                 f"On {where}, unfiltered: error {percent(err)} against a sensor-noise floor "
-                f"of {percent(floor)} (<b>{r:.2f} x the floor</b>"
+                f"of {percent(floor)} (<b>{r:.2f} x the floor</b>: {esc(v.label)}"
                 + (
-                    ": only noise is left)"
+                    ", only noise is left)"
                     if r <= FLOOR_GOOD
-                    else ": effects outside the model remain, see the residuals)"
+                    else ", effects outside the model remain, see the residuals)"
                 )
             )
-            problems += ["poor"] if r > FLOOR_FAIR else ["fair"] if r > FLOOR_GOOD else []
             level = "at" if r <= FLOOR_GOOD else f"{r:.1f} times"
             headline = (
                 f"The model predicts held-out torques to {percent(err)}, {level} the "
                 f"sensor-noise floor of {percent(floor)} (unfiltered torques)"
             )
         else:
-            facts.append(f"On {where}, unfiltered: error {percent(err)} (noise floor unknown)")
+            facts.append(
+                f"On {where}, unfiltered: error {percent(err)} (noise floor unknown: "
+                f"{esc(v.label)})"
+            )
+        if v.unusable:
+            headline = f"The model does not explain held-out torques: error {percent(err)}"
     elif headline:
         facts.append(
             "Sensor-noise floor not measured (heldout.json absent: the run was made with "
@@ -218,7 +225,10 @@ def answer(run: RunFiles) -> Answer | None:
     facts += [certainty] if certainty else []
     facts.append(_terms_fact(doc))
     facts += _warning_facts(run, problems)
-    level = "poor" if "poor" in problems else "fair" if problems else "good"
+    level = worst(*problems)  # type: ignore[arg-type]
+    label = None
+    if level == "good" and headline and "at the sensor-noise floor" in headline:
+        label = "at the noise floor"
     if not headline:
         headline = "The identification's record holds no error to judge it by"
         level = "fair"
@@ -226,24 +236,25 @@ def answer(run: RunFiles) -> Answer | None:
     sections = [_torques_section(run, held), _structure_section(doc)]
     sections += [_coefficients_section(doc), _friction_section(doc)]
     return Answer(
-        verdict(level, esc(headline) + ".", facts),
+        verdict(level, esc(headline) + ".", facts, label),
         tuple(s for s in sections if s),
         shown,
     )
 
 
-#: Warnings that say the data contradict the model whatever its errors: the verdict is poor.
+#: Warnings that say the data contradict the model whatever its errors: the verdict is
+#: unusable (check the data before the model).
 _DATA_WARNINGS = ("anti-correlated", "look like degrees")
 
 
 def _warning_facts(run: RunFiles, problems: list[str]) -> list[str]:
-    """Facts (and a poor verdict in ``problems``) from the run's warnings: torques of the
+    """Facts (and an unusable verdict in ``problems``) from the run's warnings: torques of the
     opposite sign or positions in degrees fit as well as the right ones, and a model fitted
     to them predicts the robot's torques wrongly (200 % on a correctly signed log)."""
     bad = [w for w in run.summary.warnings if any(k in w for k in _DATA_WARNINGS)]
     if not bad:
         return []
-    problems.append("poor")
+    problems.append("unusable")
     return [f"<b>The data contradict the robot</b>: {esc(w)}" for w in bad]
 
 

@@ -396,7 +396,9 @@ border-color:#c0392b}.verdict .headline{font-size:19px;font-weight:600;margin:4p
 .verdict .level{text-transform:uppercase;font-size:13px;letter-spacing:.04em;padding:2px 8px;
 border-radius:4px;margin-right:6px;color:#fff;vertical-align:middle}
 .verdict.info{background:#eef5ff;border-color:#3b73b9}.info .level{background:#3b73b9}
+.verdict.unusable{background:#f6e0e0;border-color:#7b1111}
 .good .level{background:#2e8540}.fair .level{background:#b07d00}.poor .level{background:#c0392b}
+.unusable .level{background:#7b1111}
 .verdict ul{margin:4px 0;padding-left:20px}.verdict li{margin:2px 0}
 tr.marked{background:#e7f3e9!important;font-weight:600}
 .bar{display:inline-block;height:10px;background:#5b8fd5;border-radius:2px;min-width:1px}

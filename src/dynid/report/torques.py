@@ -1,8 +1,11 @@
 """The answers of ``dynid validate`` and ``dynid friction``: how well the model predicts the
 log's torques, without and with friction, and which friction law the data chose.
 
-validate: the relative error with and without friction (the verdict also judges the worst
-joint's), the errors per joint, the measured against the predicted torques. friction: per
+validate: the verdict the command printed (validation.json ``verdict``: the error against
+the sensor-noise floor, at the floor / usable / poor / unusable,
+:mod:`dynid.identification.verdict`; the worst joint's error can lower a good one), the
+relative error with and without friction, the errors per joint, the measured against the
+predicted torques. friction: per
 joint the law chosen and its parameters with their units, every candidate law's training
 and held-out error (the chosen one marked), the friction curve over the data.
 """
@@ -11,19 +14,24 @@ from __future__ import annotations
 
 from typing import Any
 
+from ..identification.verdict import (
+    FAIR_PERCENT,
+    FLOOR_FAIR,
+    FLOOR_GOOD,
+    GOOD_PERCENT,
+    LEVELS,
+    UNUSABLE_PERCENT,
+    judge_prediction,
+)
 from .html import cell, esc, figure, is_number, percent, section, table, verdict
 from .run import Answer, RunFiles
 
 __all__ = ["friction_answer", "validate_answer"]
 
-#: Relative validation error [%]: good below GOOD, usable below FAIR (this page's rule of
-#: thumb: the sensor noise is not known to validate, so the error is judged on its own).
-GOOD, FAIR = 5.0, 15.0
 #: Relative error [%] of the worst joint: good below JOINT_GOOD, usable below JOINT_FAIR
 #: (a joint of small torques, a wrist, errs more in relative terms than the log as a
 #: whole, whose error the large torques of the shoulder dominate).
 JOINT_GOOD, JOINT_FAIR = 10.0, 25.0
-_LEVELS = ("good", "fair", "poor")
 
 
 def _names(doc: dict, n: int) -> list[str]:
@@ -49,8 +57,21 @@ def validate_answer(run: RunFiles) -> Answer | None:
     best = doc.get("relative_error_percent")
     if not is_number(best):
         return None
-    level = "good" if best < GOOD else "fair" if best < FAIR else "poor"
+    judged: dict[str, Any] = doc["verdict"] if isinstance(doc.get("verdict"), dict) else {}
+    floor = doc.get("noise_floor_percent")
+    if judged.get("level") in LEVELS:  # the command's own verdict
+        level, label = str(judged["level"]), str(judged.get("label") or judged["level"])
+        reason = str(judged.get("reason", ""))
+    else:  # a file without one (older, or the demo's): judged on its errors alone
+        v = judge_prediction(best, floor if is_number(floor) else None)
+        level, label, reason = v.level, v.label, v.reason
+    judged_level = level
+    if level in ("good", "fair"):  # the words of the level: "at the noise floor", "usable"
+        label = label if level == "good" else "usable, with reservations"
+    else:
+        label = {"poor": "poor: improve the model", "unusable": "unusable: check the data"}[level]
     facts = [
+        f"<b>{esc(label[0].upper() + label[1:])}</b>: {esc(reason)}",
         f"Relative error without friction {percent(without.get('relative_error_percent'))}"
         + (
             f", with friction ({esc(doc.get('friction_model'))}) "
@@ -59,19 +80,35 @@ def validate_answer(run: RunFiles) -> Answer | None:
             else " (no friction model given)"
         ),
         f"Judged on {cell(doc.get('n_samples'))} samples of {esc(doc.get('data', 'the log'))}, "
-        f"model {esc(doc.get('model', ''))}; judged good below {GOOD:g} %, usable below "
-        f"{FAIR:g} % (the sensor noise is not known here: compare with identify's "
-        "held-out error against its noise floor)",
+        f"model {esc(doc.get('model', ''))}: at the noise floor up to {FLOOR_GOOD:g} x the "
+        f"sensor-noise floor"
+        + (
+            f" ({percent(floor)})"
+            if is_number(floor)
+            else f" (not measured: below {GOOD_PERCENT:g} % is good)"
+        )
+        + f", usable up to {FLOOR_FAIR:g} x or below {FAIR_PERCENT:g} %, poor below "
+        f"{UNUSABLE_PERCENT:g} %, unusable from {UNUSABLE_PERCENT:g} % or with torques of "
+        "the opposite sign",
     ]
     per = (with_ if isinstance(with_, dict) else without).get("relative_error_percent_per_joint")
     if isinstance(per, list) and per and all(is_number(p) for p in per):
-        j = max(range(len(per)), key=lambda k: per[k])
-        joint = "good" if per[j] < JOINT_GOOD else "fair" if per[j] < JOINT_FAIR else "poor"
-        level = max(level, joint, key=_LEVELS.index)
+        ratio = _noise_ratios(doc, len(per))
+        j = max(range(len(per)), key=lambda k: (ratio[k], per[k]))
+        joint = (
+            "good"
+            if per[j] < JOINT_GOOD or ratio[j] <= FLOOR_GOOD
+            else "fair"
+            if per[j] < JOINT_FAIR or ratio[j] <= FLOOR_FAIR
+            else "poor"
+        )
+        if LEVELS.index(joint) > LEVELS.index(level) and level != "unusable":
+            level = joint
+        noise = f", {ratio[j]:.2f} x its sensor noise" if ratio[j] < float("inf") else ""
         facts.append(
             f"Worst joint {esc(_names(doc, len(per))[j])}: relative error "
-            f"<b>{percent(per[j])}</b> (per joint judged good below {JOINT_GOOD:g} %, usable "
-            f"below {JOINT_FAIR:g} %)"
+            f"<b>{percent(per[j])}</b>{noise} (per joint judged good below {JOINT_GOOD:g} % or "
+            f"at its noise, usable below {JOINT_FAIR:g} % or {FLOOR_FAIR:g} x its noise)"
         )
     rms = doc.get("rms")
     if isinstance(rms, list) and rms:
@@ -79,7 +116,11 @@ def validate_answer(run: RunFiles) -> Answer | None:
         facts.append(
             f"Largest RMS error {cell(rms[worst])} N m on {esc(_names(doc, len(rms))[worst])}"
         )
-    head = f"The model predicts the log's torques to {percent(best)}."
+    head = (
+        f"The model does not explain the log's torques: error {percent(best)}."
+        if level == "unusable"
+        else f"The model predicts the log's torques to {percent(best)}."
+    )
     figs, shown = _figures(
         run,
         (
@@ -87,7 +128,20 @@ def validate_answer(run: RunFiles) -> Answer | None:
             ("validation_rms.png", "RMS error per joint, without and with friction"),
         ),
     )
-    return Answer(verdict(level, head, facts), (_joint_errors(doc), figs), shown)
+    shown_label = label if level == judged_level else None  # a worse joint: the level's own
+    return Answer(verdict(level, head, facts, shown_label), (_joint_errors(doc), figs), shown)
+
+
+def _noise_ratios(doc: dict, n: int) -> list[float]:
+    """Per joint, the RMS error over the sensor noise (validation.json ``rms`` and
+    ``noise_rms``); inf where either is missing."""
+    rms, noise = doc.get("rms"), doc.get("noise_rms")
+    if not (isinstance(rms, list) and isinstance(noise, list) and len(rms) == len(noise) == n):
+        return [float("inf")] * n
+    return [
+        r / s if is_number(r) and is_number(s) and s > 0 else float("inf")
+        for r, s in zip(rms, noise, strict=True)
+    ]
 
 
 def _joint_errors(doc: dict) -> str:

@@ -14,9 +14,11 @@ The policies, the same for the Python API and every command:
 
 from __future__ import annotations
 
+import contextlib
+import hashlib
 import logging
 import zipfile
-from collections.abc import Callable, Mapping
+from collections.abc import Callable, Mapping, Sequence
 from pathlib import Path
 from typing import Any, Literal, TypeVar
 
@@ -42,6 +44,7 @@ __all__ = [
     "ColumnSpec",
     "DataKind",
     "column_map",
+    "data_files",
     "data_kind",
     "in_file",
     "read_static_file",
@@ -273,3 +276,70 @@ def recorded_columns(
             others=("units",),
         )
     return columns, units
+
+
+def data_files(paths: str | Path | Sequence[str | Path]) -> list[Path]:
+    """The data files of ``--data``: the paths given, a folder standing for its ``.csv``
+    and ``.npz`` files in name order (its other files, hidden ones and folders apart,
+    named in a logged note).
+
+    Raises
+    ------
+    DataError
+        No path, a folder without data files, a file named twice (however written), or
+        two files of identical content.
+    """
+    given = [paths] if isinstance(paths, str | Path) else list(paths)
+    out: list[Path] = []
+    for p in map(Path, given):
+        if p.is_dir():
+            found = sorted(f for f in p.iterdir() if f.suffix.lower() in (".csv", ".npz"))
+            if not found:
+                raise DataError(f"{p.name}: the folder holds no .csv or .npz data file")
+            other = sorted(
+                f.name
+                for f in p.iterdir()
+                if f not in found and not f.name.startswith(".") and not f.is_dir()
+            )
+            if other:  # a recording of another extension is never left out unsaid
+                _log.warning(
+                    "%s: %d file(s) neither .csv nor .npz left out: %s",
+                    p.name,
+                    len(other),
+                    ", ".join(other[:5]) + (", ..." if len(other) > 5 else ""),
+                )
+            out += found
+        else:
+            out.append(p)
+    if not out:
+        raise DataError("no data file given")
+    real = [p.resolve() for p in out]  # one file named two ways (a.csv, ./d/../a.csv)
+    twice = sorted({p.name for p, r in zip(out, real, strict=True) if real.count(r) > 1})
+    if twice:
+        raise DataError(f"{', '.join(twice)}: data file given twice")
+    _refuse_copies(out)
+    return out
+
+
+def _refuse_copies(paths: list[Path]) -> None:
+    """Refuse two files of identical content (a recording copied under another name): it
+    would count twice in the fit, and judge itself when one recording is left out.
+    Only files of equal size are read (hashed in blocks)."""
+    sizes: dict[int, list[Path]] = {}
+    for p in paths:
+        with contextlib.suppress(OSError):  # missing or unreadable: its reader says so
+            if p.is_file() and (n := p.stat().st_size) > 0:
+                sizes.setdefault(n, []).append(p)
+    for group in (g for g in sizes.values() if len(g) > 1):
+        first: dict[str, Path] = {}
+        for p in group:
+            h = hashlib.sha1()
+            with contextlib.suppress(OSError), p.open("rb") as fh:
+                while block := fh.read(1 << 20):
+                    h.update(block)
+            if (seen := first.setdefault(h.hexdigest(), p)) is not p:
+                raise DataError(
+                    f"{p.name}: the same content as {seen.name} (a copy of one recording); "
+                    "it would count twice and judge itself when one recording is left out; "
+                    "hint: give it once"
+                )

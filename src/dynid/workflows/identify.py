@@ -45,6 +45,7 @@ from ..model.robot import Robot
 from .data_files import (
     ColumnSpec,
     column_map,
+    data_files,
     data_kind,
     in_file,
     read_static_file,
@@ -52,6 +53,7 @@ from .data_files import (
 )
 from .options import check_band, check_choice, check_count, check_number, only_with, refused_with
 from .prior import load_prior
+from .recordings import Recorded, check_units
 
 __all__ = ["ColumnSpec", "IdentifyOptions", "IdentifyResult", "data_files", "identify_files"]
 
@@ -71,7 +73,7 @@ def _heldout(
 ) -> dict[str, Any]:
     """``folds``/``validate_on`` of the torque-log routes (the log read as ``paths[0]``
     is); refused for static data, ``folds`` with several recordings (each recording is
-    a fold)."""
+    a fold), ``validate_on`` one of the recordings (or a copy)."""
     if folds is None and validate_on is None:
         return {}
     path = paths[0]
@@ -88,6 +90,15 @@ def _heldout(
         )
     kw: dict[str, Any] = {} if folds is None else {"folds": folds}
     if validate_on is not None:
+        try:  # the same file, however named, or a copy of one of the recordings
+            data_files([*paths, Path(validate_on)])
+        except DataError:
+            raise OptionError(
+                f"{Path(validate_on).name} is one of the recordings fitted (or a copy of one): "
+                "judged on it, the held-out error is the training error; hint: a recording "
+                "the fit does not see",
+                field="validate_on",
+            ) from None
         kw["validate_on"] = read_torque_log(validate_on, n, columns=cmap, drop_invalid=drop_invalid)
     return kw
 
@@ -98,33 +109,6 @@ def _record(model: IdentifiedModel, spec: ColumnSpec | None) -> IdentifiedModel:
         return model
     info = dataclasses.replace(model.info, column_map={"columns": spec[0], "units": spec[1]})
     return dataclasses.replace(model, info=info)
-
-
-def data_files(paths: str | Path | Sequence[str | Path]) -> list[Path]:
-    """The data files of ``--data``: the paths given, a folder standing for its ``.csv``
-    and ``.npz`` files in name order.
-
-    Raises
-    ------
-    DataError
-        No path, a folder without data files, or a file named twice.
-    """
-    given = [paths] if isinstance(paths, str | Path) else list(paths)
-    out: list[Path] = []
-    for p in map(Path, given):
-        if p.is_dir():
-            found = sorted(f for f in p.iterdir() if f.suffix.lower() in (".csv", ".npz"))
-            if not found:
-                raise DataError("the folder holds no .csv or .npz data file", file=p.name)
-            out += found
-        else:
-            out.append(p)
-    if not out:
-        raise DataError("no data file given")
-    twice = sorted({p.name for p in out if out.count(p) > 1})
-    if twice:
-        raise DataError(f"{', '.join(twice)}: data file given twice")
-    return out
 
 
 def _terms(terms: str | Structure | None) -> Structure | Literal["auto"]:
@@ -374,13 +358,16 @@ def _identify(robot: Robot, paths: list[Path], opt: IdentifyOptions) -> Identifi
 
 
 def _read_logs(robot: Robot, paths: list[Path], cmap: Any, drop_invalid: bool) -> list[Any]:
-    """The torque logs ``paths``, read strictly for ``robot``."""
-    return [
+    """The torque logs ``paths``, read strictly for ``robot``; a recording in other units
+    than the others refused, naming it (:func:`~dynid.workflows.recordings.check_units`)."""
+    logs = [
         read_torque_log(
             p, robot.n, columns=cmap, drop_invalid=drop_invalid, owner=f"robot {robot.name!r}"
         )
         for p in paths
     ]
+    check_units(Recorded(tuple(logs), tuple(paths)))
+    return logs
 
 
 def _consistent_structure_fit(
@@ -407,16 +394,10 @@ def _consistent_structure_fit(
             field="terms",
             others=("consistent",),
         )
-    selection = None
-    if terms == "auto":
-        selection = identify_recordings(robot, logs, names, **kw).info.selection
-        chosen = Structure.parse(str((selection or {}).get("chosen", "")))
-        terms = Structure(chosen.armature, classical, at=chosen.at)
-    else:
-        terms = Structure(terms.armature, classical, at=terms.at)
-    model = identify_recordings(robot, logs, names, structure=terms, **kw)
-    info = dataclasses.replace(model.info, selection=selection)
-    return dataclasses.replace(model, info=info)
+    if terms == "auto":  # the armature chosen, the classical friction fitted with it
+        return identify_recordings(robot, logs, names, friction=classical, **kw)
+    terms = Structure(terms.armature, classical, at=terms.at)
+    return identify_recordings(robot, logs, names, structure=terms, **kw)
 
 
 def _one_static_file(paths: list[Path], opt: IdentifyOptions) -> None:

@@ -13,7 +13,10 @@ the command applies, so that the Python API behaves as the command does.
   ``identify`` cuts) and after rows dropped for NaN or inf (``drop_invalid``; refused
   otherwise, the row named): the observer starts again on each piece and no event spans a
   cut (one warning names the file and the times); a position that jumps more than its
-  velocity explains is warned about (:mod:`dynid.observer.pieces`).
+  velocity explains over a regular time step (samples lost without a gap in the stamps, an
+  encoder glitch) cuts the log there too, with a warning (:mod:`dynid.observer.pieces`).
+  Several logs are checked together: one in other units than the others is refused, one
+  far outside the joint limits warned about (:mod:`dynid.workflows.recordings`).
 * ``calibrate``: the residuals of every (collision-free) log give the thresholds; with an
   identified model that has a covariance, they also grow with the model's uncertainty
   (``uncertainty``, default on); the standstill margin of the model's friction (its
@@ -58,13 +61,20 @@ from ..observer.detection import (
     standstill_series,
 )
 from ..observer.model import ObserverModel, from_identified, from_robot
-from ..observer.pieces import pieces, position_jumps
+from ..observer.pieces import PositionJump, pieces, position_jumps
 from ..observer.residual import DEFAULT_GAIN, ObserverOptions, observe
 from ..observer.results import LogObservation, ObserveResult
 from ..observer.wrench import external_wrench
 from ..signals import edge_seconds, filtered_derivative
-from .data_files import ColumnSpec, column_map, in_file, read_torque_log, recorded_columns
-from .identify import data_files
+from .data_files import (
+    ColumnSpec,
+    column_map,
+    data_files,
+    in_file,
+    read_torque_log,
+    recorded_columns,
+)
+from .recordings import Recorded, check_limits, check_units
 
 __all__ = [
     "LogObservation",
@@ -268,9 +278,11 @@ def observe_files(opts: ObserveOptions) -> ObserveResult:
         else given.uses_uncertainty and model.covariance is not None
     )
     wants_margin = opts.standstill if given is None else given.standstill
+    columns = recorded_columns(recorded, *opts.columns)  # (names, units), said once
+    read = _read_logs(data_files(opts.data), model, columns, opts)
     logs = [
-        _observe_log(p, model, recorded, opts, options, wants_std, wants_margin)
-        for p in data_files(opts.data)
+        _observe_log(p, log, model, columns[0] is not None, opts, options, wants_std, wants_margin)
+        for p, log in zip(read.paths, read.logs, strict=True)
     ]
     if given is None:
         seen = [np.all(np.isfinite(x.r), axis=1) for x in logs]  # observed samples only
@@ -314,25 +326,39 @@ def observe_files(opts: ObserveOptions) -> ObserveResult:
     return ObserveResult(model, given, found)
 
 
+def _read_logs(
+    paths: list[Path],
+    model: ObserverModel,
+    columns: tuple[str | None, str | None],
+    opts: ObserveOptions,
+) -> Recorded:
+    """The logs ``paths`` read strictly for the model; a log in other units than the others
+    refused and one far outside the joint limits warned about, each naming the file
+    (:mod:`dynid.workflows.recordings`)."""
+    cmap = column_map(*columns)
+    logs = [
+        read_torque_log(p, model.n, columns=cmap, drop_invalid=opts.drop_invalid, owner="the model")
+        for p in map(Path, paths)
+    ]
+    read = Recorded(tuple(logs), tuple(map(Path, paths)))
+    check_limits(read, model.robot, model.drive)
+    check_units(read)
+    return read
+
+
 def _observe_log(
     path: Path,
+    log: TorqueLog,
     model: ObserverModel,
-    recorded: Mapping[str, str | None] | None,
+    mapped: bool,
     opts: ObserveOptions,
     options: ObserverOptions,
     wants_std: bool,
     wants_margin: bool = False,
 ) -> LogObservation:
-    """The residual (and its std, the wrench, the stored true torques) of one log."""
+    """The residual (and its std, the wrench, the stored true torques) of one log, as
+    read (``mapped``: through a column map)."""
     path = Path(path)
-    names, units = recorded_columns(recorded, *opts.columns)
-    log = read_torque_log(
-        path,
-        model.n,
-        columns=column_map(names, units),
-        drop_invalid=opts.drop_invalid,
-        owner="the model",
-    )
     log = joint_side_log(log, model.drive)
     log, turned = unwrapped(log, wrappable(model.robot))  # joints whose limits span a turn
     if turned:  # M(q) is periodic; velocities derived across a wrap are not
@@ -344,7 +370,10 @@ def _observe_log(
         )
     starts = _pieces(path, log, opts)
     dq = _piece_velocities(log, starts)  # of a log of positions: from the unwrapped ones
-    _warn_jumps(path, log, dq, starts)
+    cut = _cut_at_jumps(path, log, dq, starts)
+    if cut != starts and log.dq_derived:  # derived again, never across a jump
+        dq = _piece_velocities(log, cut)
+    starts = cut
     spans = _observed_spans(path, log, starts)
 
     def run() -> LogObservation:
@@ -362,7 +391,7 @@ def _observe_log(
         if opts.frame is not None:
             wrench = external_wrench(model.robot, log.q, r, opts.frame)
         ext = None
-        if path.suffix.lower() in (".csv", ".npz") and names is None:
+        if path.suffix.lower() in (".csv", ".npz") and not mapped:
             ext = load_joint_columns(path, "tau_ext", model.n)
             if ext is not None and ext.shape[0] != log.t.shape[0]:
                 ext = None  # rows were dropped: not aligned with the log
@@ -435,17 +464,53 @@ def _pieces(path: Path, log: TorqueLog, opts: ObserveOptions) -> list[int]:
     return starts
 
 
-def _warn_jumps(path: Path, log: TorqueLog, dq: NDArray[np.float64], starts: list[int]) -> None:
-    """Warn about positions that jump more than the velocities ``dq`` explain."""
-    jumps = position_jumps(log.t, log.q, dq, starts)
-    if jumps:
+def _cut_at_jumps(
+    path: Path, log: TorqueLog, dq: NDArray[np.float64], starts: list[int]
+) -> list[int]:
+    """The pieces cut again where positions jump more than the velocities ``dq`` explain
+    (:func:`~dynid.observer.pieces.position_jumps`) over one regular time step (a stretch
+    of samples lost without a gap in the stamps, an encoder glitch), with a warning naming
+    the file, the joints and the times: the observer starts again there, so that no event
+    is made of the jump (a lost stretch of 0.2 s was a 'collision' on every joint). A
+    glitch's jump back is found in the next pass (at most three). A jump across a gap
+    bridged by ``--max-gap`` is warned about only (bridging was asked for)."""
+    dt = np.diff(log.t)
+    regular = 1.5 * float(np.median(dt)) if dt.size else np.inf
+    found: list[PositionJump] = []
+    bridged: list[PositionJump] = []
+    cut = list(starts)
+    for _ in range(3):
+        jumps = [x for x in position_jumps(log.t, log.q, dq, cut) if x not in found + bridged]
+        at: set[int] = set()
+        for x in jumps:
+            k = int(np.searchsorted(log.t, x.t))
+            if k > 0 and log.t[k] - log.t[k - 1] > regular:
+                bridged.append(x)
+            elif k not in cut:
+                found.append(x)
+                at.add(k)
+        if not at:
+            break
+        cut = sorted(set(cut) | at)
+    for jumps, what in (
+        (
+            found,
+            "samples lost without a gap in the time stamps, or an encoder glitch; the "
+            "observer starts again after each jump (no event spans one)",
+        ),
+        (bridged, "across a gap bridged by --max-gap: the residual after it is not to be trusted"),
+    ):
+        if not jumps:
+            continue
+        jumps.sort(key=lambda x: (x.t, x.joint))
         listed = ", ".join(
             f"joint {x.joint + 1} by {x.size:+.3g} at t = {x.t:.6g} s" for x in jumps[:3]
         )
         more = f" and {len(jumps) - 3} more" if len(jumps) > 3 else ""
         warnings.warn(
             f"{path.name}: position jumps more than the recorded velocity explains "
-            f"({listed}{more}): the residual after a jump is not to be trusted",
+            f"({listed}{more}): {what}",
             DynidWarning,
             stacklevel=4,
         )
+    return cut

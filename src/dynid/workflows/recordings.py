@@ -1,5 +1,6 @@
 """Several torque recordings read for a model: the ``--data a.csv b.csv ...`` (or a
-folder) of ``validate``, ``friction`` and ``payload``.
+folder) of ``validate``, ``friction`` and ``payload`` (``identify`` applies the units
+check, :func:`check_units`; ``observe`` both checks).
 
 Every recording is read strictly (:func:`~.data_files.read_torque_log`, through the
 column map the model's data were read with when none is given), and each problem is one
@@ -33,10 +34,16 @@ from ..identification.log import TorqueLog, joint_side_log
 from ..identification.sanity import time_unit_finding
 from ..model.drive import Drive
 from ..model.robot import Robot
-from .data_files import ColumnSpec, column_map, in_file, read_torque_log, recorded_columns
-from .identify import data_files
+from .data_files import (
+    ColumnSpec,
+    column_map,
+    data_files,
+    in_file,
+    read_torque_log,
+    recorded_columns,
+)
 
-__all__ = ["UNIT_RATIO", "Recorded", "read_recordings"]
+__all__ = ["UNIT_RATIO", "Recorded", "check_limits", "check_units", "read_recordings"]
 
 #: Ratio of a recording's torque scale (or velocity unit) to the other recordings' median
 #: beyond which it is taken to be in another unit (a power of ten: mN m, ms, degrees).
@@ -117,11 +124,11 @@ def read_recordings(
 
     logs = tuple(in_file(p, lambda p=p: read(p)) for p in paths)  # type: ignore[misc]
     out = Recorded(logs, tuple(paths))
-    _check_limits(out, robot, drive)
+    check_limits(out, robot, drive)
     for name, log in zip(out.names, out.logs, strict=True):  # the time unit named first
         if (unit := time_unit_finding(name, log)) is not None:
             raise DataError(unit)
-    _check_units(out)
+    check_units(out)
     return out
 
 
@@ -138,10 +145,16 @@ def _scales(log: TorqueLog) -> tuple[float, float]:
     return rms, num / den if den > 0 else float("nan")
 
 
-def _check_units(rec: Recorded) -> None:
+def check_units(rec: Recorded) -> None:
     """Refuse a recording whose torque scale or velocity unit is a power of ten away from
     the median of the other recordings' (several recordings only; of two, the second is
-    named)."""
+    named).
+
+    Raises
+    ------
+    DataError
+        Naming the recording, the ratio and the recordings it was compared with.
+    """
     if len(rec.logs) < 2:
         return
     scales = np.array([_scales(log) for log in rec.logs])
@@ -170,9 +183,9 @@ def _check_units(rec: Recorded) -> None:
             )
 
 
-def _check_limits(rec: Recorded, robot: Robot, drive: Drive | None) -> None:
+def check_limits(rec: Recorded, robot: Robot, drive: Drive | None) -> None:
     """Warn about a recording whose (joint-side) positions lie far outside the joint
-    limits."""
+    limits (:data:`LIMIT_MARGIN` beyond them), naming it."""
     lo = np.asarray(robot.q_min) - LIMIT_MARGIN
     hi = np.asarray(robot.q_max) + LIMIT_MARGIN
     for name, log in zip(rec.names, rec.logs, strict=True):

@@ -14,6 +14,10 @@ with every policy the command applies, so that the Python API behaves as the com
 * Each recording, and each piece of one cut at a gap longer than ``max_gap_s``, is
   filtered and differentiated on its own; the errors are pooled over every sample and
   given per recording (:func:`~dynid.friction.recordings.validate_pieces`).
+* The verdict (:func:`~dynid.identification.verdict.judge_prediction`): the error against
+  the sensor-noise floor read from the measured torques, and whether they are
+  anti-correlated with the model's; over all recordings and per recording, the worst
+  recording named when the recordings differ.
 """
 
 from __future__ import annotations
@@ -24,12 +28,16 @@ from pathlib import Path
 from typing import Any, Literal
 
 import numpy as np
+from numpy.typing import NDArray
 
 from ..exceptions import DataError, OptionError
 from ..friction.model import FrictionModel, FrictionSum
 from ..friction.recordings import RecordingsValidation, prepare_pieces, validate_pieces
 from ..friction.validation import RECORDED, own_friction
+from ..identification.metrics import TorqueErrors
 from ..identification.model import IdentifiedModel
+from ..identification.sanity import anticorrelated, velocity_noise_std
+from ..identification.verdict import LEVELS, Verdict, judge_prediction
 from ..io.feasible import load_feasible_drive, load_feasible_linear_friction
 from ..io.friction_json import load_friction_json
 from ..model.drive import Drive
@@ -108,6 +116,14 @@ class ValidateResult:
         The recordings' file names.
     cutoff_hz : float or None
         The low-pass cut-off every piece was filtered at [Hz].
+    verdict : Verdict
+        Over every recording, or, when the recordings differ, the worst one's (its ``reason``
+        names the file).
+    noise_rms : ndarray, shape (n,)
+        Sensor noise of the measured torques per joint, over every piece [N m].
+    noise_floor_percent : float
+        The noise relative to the measured torques' norm [%]: the smallest relative error
+        a model can reach on them.
     """
 
     validation: RecordingsValidation
@@ -115,17 +131,25 @@ class ValidateResult:
     friction_source: str | None
     files: tuple[str, ...]
     cutoff_hz: float | None
+    verdict: Verdict
+    noise_rms: NDArray[np.float64]
+    noise_floor_percent: float
 
     def metadata(self) -> dict[str, Any]:
         """The keys ``validation.json`` records beside the errors: ``model``,
-        ``friction_source``, ``data`` (the files, comma-separated), ``files`` and
-        ``cutoff_hz``."""
+        ``friction_source``, ``data`` (the files, comma-separated), ``files``,
+        ``cutoff_hz``, ``noise_rms``, ``noise_floor_percent`` and ``verdict`` (``level``,
+        ``label``, ``reason``)."""
+        v = self.verdict
         return {
             "model": self.model,
             "friction_source": self.friction_source,
             "data": ", ".join(self.files),
             "files": list(self.files),
             "cutoff_hz": self.cutoff_hz,
+            "noise_rms": [float(x) for x in self.noise_rms],
+            "noise_floor_percent": self.noise_floor_percent,
+            "verdict": {"level": v.level, "label": v.label, "reason": v.reason},
         }
 
 
@@ -198,13 +222,56 @@ def validate_files(
     errors = val.errors
     if not np.isfinite(errors.relative_error_percent) or not np.all(np.isfinite(errors.rms)):
         raise DataError(_overflow(rec.names, val, label, opt))
+    verdict, noise, floor = _judged(val, np.ones(len(val.parts), bool), errors)
+    labels = np.asarray(val.pieces.recording)
+    if len(rec.names) > 1:  # recordings judged apart: the worst named, when they differ
+        each = [
+            _judged(val, labels == r, val.recordings[r].errors)[0] for r in range(len(rec.names))
+        ]
+        rank = [LEVELS.index(v.level) for v in each]
+        r = int(np.argmax(rank))
+        if min(rank) < rank[r] and rank[r] >= LEVELS.index(verdict.level):
+            v = each[r]
+            verdict = Verdict(v.level, v.label, f"{rec.names[r]}: {v.reason}", v.ratio)
     return ValidateResult(
         validation=val,
         model=label or f"robot {robot.name}",
         friction_source=source,
         files=rec.names,
         cutoff_hz=val.pieces.cutoff_hz,
+        verdict=verdict,
+        noise_rms=noise,
+        noise_floor_percent=floor,
     )
+
+
+def _judged(
+    val: RecordingsValidation, sel: NDArray[np.bool_], errors: TorqueErrors
+) -> tuple[Verdict, NDArray[np.float64], float]:
+    """The verdict, the sensor noise per joint [N m] and the noise floor [%] of the pieces
+    ``sel`` (bool per piece), whose pooled errors are ``errors``: the noise read from each
+    piece's measured torques (:func:`~dynid.identification.sanity.velocity_noise_std`),
+    the model's torques checked for the opposite sign (on at most 20 000 samples)."""
+    parts = [v for v, s in zip(val.parts, sel, strict=True) if s]
+    n = parts[0].log.n
+    var, norm2, N = np.zeros(n), 0.0, 0
+    for v in parts:
+        if v.log.n_samples >= 3:
+            var += v.log.n_samples * velocity_noise_std(v.log.tau) ** 2
+        norm2 += float(np.sum(v.log.tau**2))
+        N += v.log.n_samples
+    noise = np.sqrt(var / max(N, 1))
+    floor = 100.0 * float(np.sqrt(var.sum() / norm2)) if norm2 > 0 else 0.0
+    step = max(1, N // 20_000)
+    tau = np.concatenate([v.log.tau[::step] for v in parts])
+    model = np.concatenate([v.tau_model[::step] for v in parts])
+    spread = np.std(model, axis=0)
+    loaded = spread > 0.05 * max(float(spread.max(initial=0.0)), 1e-300)
+    opposite = anticorrelated(model - model.mean(axis=0), tau - tau.mean(axis=0), loaded)
+    verdict = judge_prediction(
+        errors.relative_error_percent, floor, opposite_sign=opposite is not None
+    )
+    return verdict, noise, floor
 
 
 def _friction(

@@ -1,6 +1,7 @@
 """The convex problem in cvxpy (:class:`ConvexProblem`), built once per data term and
 re-solved at each prior weight, with the solver fallback (Clarabel, Clarabel with
-regularisation, SCS) and the solution's read-out (margins enforced, exact fits polished)."""
+regularisation, SCS; each lets a Ctrl-C end its solve, :mod:`.solvers`) and the solution's
+read-out (margins enforced, exact fits polished)."""
 
 from __future__ import annotations
 
@@ -21,6 +22,7 @@ from ..lmi import (
 from ..prior import Prior, prior_scales
 from .data_term import DataTerm
 from .options import SDPOptions
+from .solvers import SCS_SIGINT, clarabel, scs
 
 __all__ = ["SCS_SIGINT", "ConvexProblem", "Values", "data_scale"]
 
@@ -197,7 +199,7 @@ class ConvexProblem:
             try:
                 with warnings.catch_warnings():  # the status says it; retried below
                     warnings.simplefilter("ignore", UserWarning)
-                    self.problem.solve(solver=_scs() if solver == "SCS" else solver, **kw)
+                    self.problem.solve(solver=scs() if solver == "SCS" else clarabel(), **kw)
             except (cp.error.SolverError, ArithmeticError, ValueError) as exc:
                 seen.append(f"{solver}: {exc}")
                 continue
@@ -242,28 +244,6 @@ def data_scale(term: DataTerm, prior: Prior) -> float:
     if not (a > 0 and b > 0 and math.isfinite(a / b)):
         return 1.0
     return float(10.0 ** min(max(round(math.log10(a / b)), -8), 8))
-
-
-def _scs() -> Any:
-    """cvxpy's SCS interface that lets a Ctrl-C through: SCS catches SIGINT itself and
-    returns its status -5, which cvxpy reports as a failed solve, so a retry or the rest of
-    the run would go on as if nothing were asked; here it is a :class:`KeyboardInterrupt`."""
-    from cvxpy.reductions.solvers.conic_solvers.scs_conif import SCS
-
-    class InterruptibleSCS(SCS):
-        def name(self) -> str:
-            return "DYNID_SCS"  # (cvxpy refuses a custom solver under a built-in name)
-
-        def invert(self, solution: Any, inverse_data: Any) -> Any:
-            if solution["info"]["status_val"] == SCS_SIGINT:
-                raise KeyboardInterrupt
-            return super().invert(solution, inverse_data)
-
-    return InterruptibleSCS()
-
-
-#: SCS's status after it caught SIGINT
-SCS_SIGINT = -5
 
 
 Values = tuple[NDArray[np.float64], NDArray[np.float64] | None, NDArray[np.float64] | None]
