@@ -71,7 +71,7 @@ def test_the_consistent_route_warns_each_finding_of_the_data_once(panda, tmp_pat
     assert len(said) == len(set(said)), said
     model = kept["model"]
     assert model.info.selection is not None  # the structure was chosen, and recorded
-    assert model.friction.shape == (7, 3)  # fv, fc, fo per joint: the classical friction
+    assert model.friction.params.shape == (7, 3)  # fv, fc, fo per joint: the classical friction
     # the friction warnings are of the model kept: one per joint whose kept friction
     # has a negative viscous or Coulomb coefficient (the selection's fit warned its own)
     quoted = [s for s in said if s.startswith("identified friction not dissipative")]
