@@ -76,7 +76,7 @@ def test_the_consistent_route_warns_each_finding_of_the_data_once(panda, tmp_pat
     # has a negative viscous or Coulomb coefficient (the selection's fit warned its own)
     quoted = [s for s in said if s.startswith("identified friction not dissipative")]
     named = sorted(int(s.split("(joint ")[1].split(":")[0]) for s in quoted)
-    negative = np.flatnonzero(np.any(model.friction[:, :2] < 0, axis=1)) + 1
+    negative = np.flatnonzero(np.any(model.friction.params[:, :2] < 0, axis=1)) + 1
     assert named and set(named) <= set(negative.tolist()) and len(named) == len(set(named))
 
 
