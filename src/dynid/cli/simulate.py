@@ -82,19 +82,20 @@ def register(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParser:
         "--noise",
         type=nonnegative_type,
         default=0.05,
-        help="torque sensor noise std [N m] (default 0.05)",
+        help="torque sensor noise std [N m] (default 0.05); with --drive added at the joints "
+        "before the log is written on the drive's side (a motor sees it through the gear)",
     )
     p.add_argument(
         "--q-noise",
         type=nonnegative_type,
         default=1e-4,
-        help="position noise std [rad] (default 1e-4)",
+        help="position noise std [rad] (default 1e-4; at the joints, as --noise)",
     )
     p.add_argument(
         "--dq-noise",
         type=nonnegative_type,
         default=1e-3,
-        help="velocity noise std [rad/s] (default 1e-3)",
+        help="velocity noise std [rad/s] (default 1e-3; at the joints, as --noise)",
     )
     p.add_argument(
         "--jitter", type=nonnegative_type, default=0.0, help="timestamp jitter std [s] (default 0)"
