@@ -89,13 +89,13 @@ def register(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParser:
         "--q-noise",
         type=nonnegative_type,
         default=1e-4,
-        help="position noise std [rad] (default 1e-4; at the joints, as --noise)",
+        help="position noise std [rad] (default 1e-4), at the joints as --noise",
     )
     p.add_argument(
         "--dq-noise",
         type=nonnegative_type,
         default=1e-3,
-        help="velocity noise std [rad/s] (default 1e-3; at the joints, as --noise)",
+        help="velocity noise std [rad/s] (default 1e-3), at the joints as --noise",
     )
     p.add_argument(
         "--jitter", type=nonnegative_type, default=0.0, help="timestamp jitter std [s] (default 0)"
