@@ -6,15 +6,14 @@ import numpy as np
 import pytest
 
 from dynid.exceptions import DataError, LimitError, OptionError, ShapeError
+from dynid.simulation.limits import check_limits, scale_into_limits
 from dynid.simulation.trajectories import (
     GAZ2019_SINUSOID_AMPLITUDES,
     GAZ2019_SINUSOID_PERIODS,
     FourierSeries,
     Trajectory,
     centered_start,
-    check_limits,
     random_fourier,
-    scale_into_limits,
     sinusoid_trajectory,
     uniform_times,
 )

@@ -95,15 +95,10 @@ if TYPE_CHECKING:  # the names as static imports, for type checkers and editors
         excitation_condition_number,
         optimise_excitation,
     )
+    from .simulation.limits import check_limits, scale_into_limits
     from .simulation.measurement import SensorNoise, simulate_measurement
     from .simulation.static_selection import StaticSelection, select_static_configurations
-    from .simulation.trajectories import (
-        Trajectory,
-        check_limits,
-        random_fourier,
-        scale_into_limits,
-        sinusoid_trajectory,
-    )
+    from .simulation.trajectories import Trajectory, random_fourier, sinusoid_trajectory
 
 #: public name -> (module under dynid, attribute): imported on first use (PEP 562), so that
 #: ``import dynid`` (and every command line call) loads only what it uses
@@ -136,7 +131,7 @@ _LAZY: dict[str, tuple[str, str]] = {
     "acquire_static": ("simulation.controller", "acquire_static"),
     "acquire_static_at": ("simulation.controller", "acquire_static_at"),
     "base_parameters": ("regressors.base", "base_parameters"),
-    "check_limits": ("simulation.trajectories", "check_limits"),
+    "check_limits": ("simulation.limits", "check_limits"),
     "classical_friction": ("friction.model", "classical_friction"),
     "coriolis": ("dynamics.terms", "coriolis"),
     "coriolis_matrix": ("dynamics.terms", "coriolis_matrix"),
@@ -164,7 +159,7 @@ _LAZY: dict[str, tuple[str, str]] = {
     "random_fourier": ("simulation.trajectories", "random_fourier"),
     "rnea": ("dynamics.rnea", "rnea"),
     "sample_configurations": ("simulation.controller", "sample_configurations"),
-    "scale_into_limits": ("simulation.trajectories", "scale_into_limits"),
+    "scale_into_limits": ("simulation.limits", "scale_into_limits"),
     "select_static_configurations": ("simulation.static_selection", "select_static_configurations"),
     "sigmoid_friction": ("friction.model", "sigmoid_friction"),
     "simulate_measurement": ("simulation.measurement", "simulate_measurement"),

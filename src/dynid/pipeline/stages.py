@@ -47,15 +47,9 @@ from ..kinematics.inverse import IKOptions, IKResult, ik
 from ..kinematics.jacobian import jacobian
 from ..model.robot import Robot
 from ..simulation.controller import SimulatedController, acquire_static
+from ..simulation.limits import LimitReport, check_limits, scale_into_limits
 from ..simulation.measurement import SensorNoise, sample_times, simulate_measurement
-from ..simulation.trajectories import (
-    LimitReport,
-    centered_start,
-    check_limits,
-    random_fourier,
-    scale_into_limits,
-    sinusoid_trajectory,
-)
+from ..simulation.trajectories import centered_start, random_fourier, sinusoid_trajectory
 from ..spatial import rpy_from_matrix, transform_from_xyz_rpy
 
 __all__ = [

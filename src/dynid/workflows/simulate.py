@@ -31,6 +31,7 @@ from ..io.friction_json import load_friction_json
 from ..model.drive import Drive
 from ..model.robot import Robot
 from ..simulation.contact import Contact
+from ..simulation.limits import check_limits_blocks, limit_scaling
 from ..simulation.measurement import (
     BLOCK_SAMPLES,
     MeasuredBlocks,
@@ -43,8 +44,6 @@ from ..simulation.trajectories import (
     GAZ2019_SINUSOID_PERIODS,
     Trajectory,
     centered_start,
-    check_limits_blocks,
-    limit_scaling,
     random_fourier,
     sinusoid_trajectory,
     uniform_times,
