@@ -37,8 +37,9 @@ from typing import Any
 import numpy as np
 
 from ..io.excitation import save_excitation_json, save_trajectory_csv
+from ..model.robot import Robot
 from ..simulation.excitation import ExcitationOptions
-from ..workflows.excite import design_excitation
+from ..workflows.excite import ExcitationDesign, design_excitation
 from .common import add_robot_options, add_subcommand, load_robot, output_path, save_figure
 from .console import Console
 
@@ -104,27 +105,14 @@ def _progress(show: bool) -> Any:
 def run(args: argparse.Namespace, console: Console) -> int:
     """Optimise, write the trajectory files and the figure; returns the exit code."""
     robot = load_robot(args)
-    opts = ExcitationOptions(
-        duration=args.duration,
-        harmonics=args.harmonics,
-        base_frequency=args.base_frequency,
-        position_margin=float(np.deg2rad(args.position_margin)),
-        velocity_margin=float(np.deg2rad(args.velocity_margin)),
-        radii=args.radius,
-        criterion=args.criterion,
-        max_iter=args.max_iter,
-    )
+    opts = _options(args)
     show = not console.quiet and sys.stderr.isatty()
     progress = _progress(show)
     design = design_excitation(
         robot, opts, obstacles=args.obstacles, seed=args.seed, progress=progress
     )
     print(end="\n" if show else "", file=sys.stderr)
-    res, samples = design.result, design.samples
-    written = [save_trajectory_csv(args.out / "trajectory.csv", samples)]
-    written.append(save_excitation_json(args.out / "trajectory.json", res, robot, seed=args.seed))
-    if not args.no_figure:
-        written += save_excitation_figure(args.out, robot, design)
+    written = _save(args, robot, design)
     console.print(*design.describe(robot), *(f"wrote {p}" for p in written))
     if not design.admissible:  # a negative result, as retrieve's: exit 1, files kept
         print(
@@ -134,6 +122,30 @@ def run(args: argparse.Namespace, console: Console) -> int:
         )
         return 1
     return 0
+
+
+def _options(args: argparse.Namespace) -> ExcitationOptions:
+    """The design's options from the flags (margins given in degrees)."""
+    return ExcitationOptions(
+        duration=args.duration,
+        harmonics=args.harmonics,
+        base_frequency=args.base_frequency,
+        position_margin=float(np.deg2rad(args.position_margin)),
+        velocity_margin=float(np.deg2rad(args.velocity_margin)),
+        radii=args.radius,
+        criterion=args.criterion,
+        max_iter=args.max_iter,
+    )
+
+
+def _save(args: argparse.Namespace, robot: Robot, design: ExcitationDesign) -> list[Path]:
+    """trajectory.csv, trajectory.json and (unless --no-figure) excitation.png."""
+    res, samples = design.result, design.samples
+    written = [save_trajectory_csv(args.out / "trajectory.csv", samples)]
+    written.append(save_excitation_json(args.out / "trajectory.json", res, robot, seed=args.seed))
+    if not args.no_figure:
+        written += save_excitation_figure(args.out, robot, design)
+    return written
 
 
 def save_excitation_figure(out: Path, robot: Any, design: Any) -> list[Path]:

@@ -21,11 +21,13 @@ Example:
 from __future__ import annotations
 
 import argparse
+from typing import Any
 
 import numpy as np
+from numpy.typing import NDArray
 
 from ..exceptions import DynidError
-from ..kinematics.inverse import IKOptions, default_q0, ik
+from ..kinematics.inverse import IKOptions, IKResult, default_q0, ik
 from ..model.robot import Robot
 from ..workflows.kinematics import goal_pose
 from .common import (
@@ -131,16 +133,31 @@ def run(args: argparse.Namespace, console: Console) -> int:
     )
     res = ik(robot, T_goal, q0, args.frame, tool, options, rng=np.random.default_rng(args.seed))
     if args.json:
-        console.json(
-            {
-                "q": res.q,
-                "converged": res.converged,
-                "iterations": res.iterations,
-                "position_error": res.position_error,
-                "orientation_error": res.orientation_error,
-            }
-        )
-        return 0 if res.converged else 1
+        console.json(_summary(res))
+    else:
+        print_ik(console, args, robot, T_goal, res)
+    return 0 if res.converged else 1
+
+
+def _summary(res: IKResult) -> dict[str, Any]:
+    """What ``--json`` prints: the configuration, convergence and the errors."""
+    return {
+        "q": res.q,
+        "converged": res.converged,
+        "iterations": res.iterations,
+        "position_error": res.position_error,
+        "orientation_error": res.orientation_error,
+    }
+
+
+def print_ik(
+    console: Console,
+    args: argparse.Namespace,
+    robot: Robot,
+    T_goal: NDArray[np.float64],
+    res: IKResult,
+) -> None:
+    """The goal pose, convergence, the position and orientation errors and the joint table."""
     what = f"tool on frame {args.frame!r}" if args.tool else f"frame {args.frame!r}"
     console.print(f"{robot.name}: inverse kinematics of the {what}")
     console.print(
@@ -151,4 +168,3 @@ def run(args: argparse.Namespace, console: Console) -> int:
     console.print(f"position error:    {res.position_error:.3e} m")
     console.print(f"orientation error: {res.orientation_error:.3e} rad")
     console.print(f"q:\n{format_joint_table(robot, res.q)}")
-    return 0 if res.converged else 1

@@ -18,10 +18,12 @@ example:
 from __future__ import annotations
 
 import argparse
+from collections.abc import Sequence
 from pathlib import Path
+from typing import Any
 
 from ..identification.log import DEFAULT_CUTOFF_HZ
-from ..io.rosbag import load_joint_state_bag
+from ..io.rosbag import BagImport, load_joint_state_bag
 from ..io.torque_log import save_torque_log
 from .common import add_robot_options, add_subcommand, load_robot, output_path, positive_type
 from .console import Console
@@ -67,14 +69,23 @@ def run(args: argparse.Namespace, console: Console) -> int:
         args.bag, robot.joint_names, topic=args.topic, joints=joints, velocity_cutoff_hz=args.cutoff
     )
     path = save_torque_log(args.out, res.log)
-    summary = {
-        "bag": str(args.bag.name),
+    if args.json:
+        console.json(_summary(args.bag, res, robot.joint_names, path))
+        return 0
+    print_import(console, res, robot.joint_names, path)
+    return 0
+
+
+def _summary(bag: Path, res: BagImport, names: Sequence[str], path: Path) -> dict[str, Any]:
+    """What ``--json`` prints: the bag, the topic, the log written and what the reading found."""
+    return {
+        "bag": str(bag.name),
         "topic": res.topic,
         "out": str(path),
         "samples": res.log.n_samples,
         "duration_s": res.log.duration,
         "sample_rate_hz": res.log.sample_rate,
-        "joints": dict(zip(robot.joint_names, res.joints, strict=True)),
+        "joints": dict(zip(names, res.joints, strict=True)),
         "time_source": res.time_source,
         "t0_ns": res.t0_ns,
         "messages": res.n_messages,
@@ -86,17 +97,17 @@ def run(args: argparse.Namespace, console: Console) -> int:
         "velocity_derived": res.velocity_derived,
         "notes": list(res.notes),
     }
-    if args.json:
-        console.json(summary)
-        return 0
+
+
+def print_import(console: Console, res: BagImport, names: Sequence[str], path: Path) -> None:
+    """Samples, duration and rate, the time source, the joint map, the notes, the file."""
     console.print(
         f"{res.log.n_samples} samples, {res.log.duration:.3f} s at "
         f"{res.log.sample_rate:.1f} Hz from {res.n_messages} messages on {res.topic}; "
         f"time from {res.time_source} stamps, t = 0 at {res.t0_ns} ns"
     )
-    for rj, bj in zip(robot.joint_names, res.joints, strict=True):
+    for rj, bj in zip(names, res.joints, strict=True):
         console.print(f"  {rj} <- {bj}")
     for note in res.notes:
         console.print(f"note: {note}")
     console.print(f"wrote {path}")
-    return 0

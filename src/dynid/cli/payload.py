@@ -29,13 +29,13 @@ from __future__ import annotations
 
 import argparse
 from pathlib import Path
+from typing import Any
 
-from ..feasibility.payload import robot_with_payload
 from ..identification.model import IdentifiedModel
 from ..io.payload_json import save_payload_json
 from ..io.robot.toml import save_toml
 from ..model.inertia import INERTIA_ORDER, inertia6_from_matrix
-from ..workflows.payload import identify_payload_files
+from ..workflows.payload import PayloadFileResult, identify_payload_files
 from .common import (
     add_column_options,
     add_drive_option,
@@ -101,9 +101,19 @@ def run(args: argparse.Namespace, console: Console) -> int:
     """Identify, write payload.json and the robot with the load, print a summary."""
     arm, label = load_model_source(args)
     kin = arm.robot if isinstance(arm, IdentifiedModel) else arm
-    result = identify_payload_files(
-        arm,
-        args.data,
+    result = identify_payload_files(arm, args.data, **_options(args, kin.n))
+    save_toml(args.out / "robot_with_payload.toml", result.robot_with_load(arm))
+    path = save_payload_json(
+        args.out / "payload.json", result.estimate, kin, with_tool="robot_with_payload.toml"
+    )
+    print_payload(console, result, label)
+    console.print(f"wrote {path} and {args.out / 'robot_with_payload.toml'}")
+    return 0
+
+
+def _options(args: argparse.Namespace, n: int) -> dict[str, Any]:
+    """The keyword arguments of :func:`~dynid.workflows.payload.identify_payload_files`."""
+    return dict(
         unloaded=args.unloaded,
         frame=args.frame,
         gravity_only=args.gravity_only,
@@ -111,16 +121,15 @@ def run(args: argparse.Namespace, console: Console) -> int:
         drop_invalid=args.drop_invalid,
         cutoff_hz=args.cutoff,
         max_gap_s=args.max_gap,
-        drive=load_drive_arg(args, kin.n),
+        drive=load_drive_arg(args, n),
         feasible=args.params,
     )
+
+
+def print_payload(console: Console, result: PayloadFileResult, label: str) -> None:
+    """The estimate (mass, CoM, inertia with their std), the recordings, the preprocessing,
+    the notes and whether setLoad values were written."""
     est = result.estimate
-    base = arm.equivalent_robot if isinstance(arm, IdentifiedModel) else arm
-    tool = robot_with_payload(base, est)
-    save_toml(args.out / "robot_with_payload.toml", tool)
-    path = save_payload_json(
-        args.out / "payload.json", est, kin, with_tool="robot_with_payload.toml"
-    )
     console.print(f"payload on frame {est.frame!r} ({est.route}; arm: {label})")
     console.print(f"  mass     {est.mass:.6g} kg  (std {est.std_mass:.2g})")
     com = ", ".join(f"{x:+.5f}" for x in est.com)
@@ -146,5 +155,3 @@ def run(args: argparse.Namespace, console: Console) -> int:
         console.print(f"note: {note}")
     if est.doubts:
         console.print("not a load to trust: no setLoad values written (see the warnings)")
-    console.print(f"wrote {path} and {args.out / 'robot_with_payload.toml'}")
-    return 0

@@ -51,7 +51,7 @@ from pathlib import Path
 
 from ..identification.model import IdentifiedModel
 from ..io.validation_json import save_validation_json
-from ..workflows.validate import ValidateOptions, validate_files
+from ..workflows.validate import ValidateOptions, ValidateResult, validate_files
 from .common import (
     add_column_options,
     add_drive_option,
@@ -121,14 +121,28 @@ def run(args: argparse.Namespace, console: Console) -> int:
         drive=load_drive_arg(args, robot.n),
     )
     result = validate_files(model, args.data, options, feasible=args.params, label=label)
-    val = result.validation
-    path = save_validation_json(args.out / "validation.json", val, **result.metadata())
-    names = list(robot.joint_names)
+    path = save_validation_json(
+        args.out / "validation.json", result.validation, **result.metadata()
+    )
     if not args.no_figures:
-        what = result.files[0] + (
-            " (its torques; errors over all)" if len(result.files) > 1 else ""
-        )
-        save_validation_figures(args.out, val.shown, names=names, title=shown(f"{label} on {what}"))
+        _save_figures(args.out, result, list(robot.joint_names), label)
+    print_validation(console, result, list(robot.joint_names), path)
+    return 1 if result.verdict.unusable else 0
+
+
+def _save_figures(out: Path, result: ValidateResult, names: list[str], label: str) -> None:
+    """The validation figures of the shown recording, titled with the model and the file."""
+    what = result.files[0] + (" (its torques; errors over all)" if len(result.files) > 1 else "")
+    save_validation_figures(
+        out, result.validation.shown, names=names, title=shown(f"{label} on {what}")
+    )
+
+
+def print_validation(
+    console: Console, result: ValidateResult, names: list[str], path: Path
+) -> None:
+    """The RMS table, the pieces, the error per recording and overall, the verdict."""
+    val = result.validation
     cols = {"RMS no friction [N m]": val.without_friction.rms}
     if val.with_friction is not None:
         cols["RMS + friction [N m]"] = val.with_friction.rms
@@ -143,4 +157,3 @@ def run(args: argparse.Namespace, console: Console) -> int:
     console.print(f"relative error {val.errors.relative_error_percent:.3f} %; wrote {path}")
     v = result.verdict
     console.print(f"verdict: {v.label}: {v.reason}")
-    return 1 if v.unusable else 0

@@ -24,7 +24,7 @@ from pathlib import Path
 from typing import Any
 
 from ..exceptions import DataError
-from ..feasibility.payload import PayloadEstimate, identify_payload
+from ..feasibility.payload import PayloadEstimate, identify_payload, robot_with_payload
 from ..feasibility.payload_arm import ArmFriction
 from ..identification.model import IdentifiedModel
 from ..io.feasible import load_feasible_drive, load_feasible_linear_friction
@@ -61,6 +61,12 @@ class PayloadFileResult:
     def skipped(self) -> tuple[str, ...]:
         """One line per piece left out (too short to filter)."""
         return self.estimate.skipped
+
+    def robot_with_load(self, arm: Robot | IdentifiedModel) -> Robot:
+        """The arm carrying the load: ``arm`` (an identified model's equivalent robot) with
+        the estimated load added to the link of its frame."""
+        base = arm.equivalent_robot if isinstance(arm, IdentifiedModel) else arm
+        return robot_with_payload(base, self.estimate)
 
     def describe(self) -> str:
         """``"a.csv: 2 pieces, 3000 samples; ..."`` (empty for static data)."""
