@@ -305,13 +305,9 @@ def _log_still(d: Path, name: str, joints: list[int]) -> None:
     their measured velocities are only the sensor noise."""
     import dynid
     from dynid.io.torque_log import save_torque_log
+    from dynid.simulation.limits import scale_into_limits
     from dynid.simulation.measurement import sample_times, simulate_measurement
-    from dynid.simulation.trajectories import (
-        Trajectory,
-        centered_start,
-        scale_into_limits,
-        sinusoid_trajectory,
-    )
+    from dynid.simulation.trajectories import Trajectory, centered_start, sinusoid_trajectory
 
     robot = dynid.panda()
     q0 = centered_start(robot)

@@ -17,8 +17,9 @@ from dynid.friction.model import (
 )
 from dynid.friction.validation import own_friction, validate_torques
 from dynid.io.friction_json import load_friction_json, save_friction_json
+from dynid.simulation.limits import scale_into_limits
 from dynid.simulation.measurement import SensorNoise, sample_times, simulate_measurement
-from dynid.simulation.trajectories import centered_start, scale_into_limits, sinusoid_trajectory
+from dynid.simulation.trajectories import centered_start, sinusoid_trajectory
 
 NOISE = 0.05  # torque sensor noise [N m]
 

@@ -306,13 +306,13 @@ def test_limits_over_blocks_equal_those_of_the_whole_trajectory(panda):
     """check_limits_blocks and limit_scaling over pieces of a trajectory that exceeds its
     limits give the report and the factors of check_limits and scale_into_limits on the
     whole (each written out on the joined arrays)."""
-    from dynid.simulation.trajectories import (
+    from dynid.simulation.limits import (
         check_limits,
         check_limits_blocks,
         limit_scaling,
         scale_into_limits,
-        sinusoid_trajectory,
     )
+    from dynid.simulation.trajectories import sinusoid_trajectory
 
     t = sample_times(12.0, 500.0)
     A = 1.6 * np.array([1.0, 1.0, 1.0, 1.0, 1.0, 2.0, 2.0])

@@ -351,25 +351,3 @@ def random_fourier(
         )
     s = np.where(np.isfinite(s), s, 1.0 / vb)
     return FourierSeries(w_f, a * s[:, None], b * s[:, None], q0)
-
-
-_MOVED_TO_LIMITS = frozenset(
-    {
-        "LimitReport",
-        "LimitScaling",
-        "LimitViolation",
-        "check_limits",
-        "check_limits_blocks",
-        "limit_scaling",
-        "scale_into_limits",
-    }
-)
-
-
-def __getattr__(name: str) -> object:
-    """The limit checks moved to :mod:`dynid.simulation.limits`; their old import path works."""
-    if name in _MOVED_TO_LIMITS:
-        from . import limits
-
-        return getattr(limits, name)
-    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
