@@ -63,7 +63,9 @@ def split_at_gaps(log: TorqueLog, max_gap_s: float | None = None) -> list[Torque
     dt = np.diff(log.t)
     limit = default_max_gap(float(np.median(dt))) if max_gap_s is None else float(max_gap_s)
     cuts = np.concatenate([[0], np.flatnonzero(dt > limit) + 1, [log.n_samples]])
-    return [log.select(np.arange(a, b)) for a, b in zip(cuts[:-1], cuts[1:], strict=True)]
+    if cuts.size == 2:  # no gap: the log itself, not a copy
+        return [log]
+    return [log.select(slice(a, b)) for a, b in zip(cuts[:-1], cuts[1:], strict=True)]
 
 
 def unwrapped(log: TorqueLog, revolute: NDArray[np.bool_]) -> tuple[TorqueLog, tuple[int, ...]]:
@@ -76,22 +78,27 @@ def unwrapped(log: TorqueLog, revolute: NDArray[np.bool_]) -> tuple[TorqueLog, t
     is motion, not a wrap. Returns the log with those turns taken out and the joints
     unwrapped (0-based; the log itself when none).
     """
-    d = np.diff(log.q, axis=0)
-    if not log.dq_derived:
-        d = d - 0.5 * (log.dq[:-1] + log.dq[1:]) * np.diff(log.t)[:, None]
-    turns = np.round(d / (2 * np.pi))
-    rest = np.abs(d - 2 * np.pi * turns)
-    typical = np.max(np.abs(np.where(turns == 0, d, 0.0)), axis=0, initial=0.0)
-    wrapped = np.any(turns != 0, axis=0) & np.all(
-        (turns == 0) | (rest <= np.maximum(2 * typical, 1e-9)), axis=0
-    )
-    joints = tuple(int(j) for j in np.flatnonzero(wrapped & np.asarray(revolute, dtype=bool)))
-    if not joints:
+    h = np.diff(log.t)
+    found: dict[int, NDArray[np.float64]] = {}
+    for j in np.flatnonzero(np.asarray(revolute, dtype=bool)).tolist():  # a joint at a time
+        d = np.diff(log.q[:, j])
+        if not log.dq_derived:
+            d -= 0.5 * (log.dq[:-1, j] + log.dq[1:, j]) * h
+        turns = np.round(d / (2 * np.pi))
+        moved = turns != 0
+        if not moved.any():
+            continue
+        typical = float(np.max(np.abs(d[~moved]), initial=0.0))
+        rest = np.abs(d[moved] - 2 * np.pi * turns[moved])
+        if np.all(rest <= max(2 * typical, 1e-9)):
+            found[j] = turns
+    if not found:
         return log, ()
     q = np.array(log.q)
-    q[1:, joints] -= 2 * np.pi * np.cumsum(turns[:, joints], axis=0)
+    for j, turns in found.items():
+        q[1:, j] -= 2 * np.pi * np.cumsum(turns)
     out = TorqueLog(log.t, q, log.dq, log.tau, log.ddq, log.cleaning, log.dq_derived)
-    return out, joints
+    return out, tuple(sorted(found))
 
 
 @dataclass(frozen=True, slots=True, eq=False)
@@ -431,7 +438,10 @@ def _bands(pieces: list[TorqueLog], drive: Drive | None) -> dict[str, NDArray[np
 def _band(pieces: list[TorqueLog], drive: Drive | None) -> NDArray[np.float64]:
     """The standstill band [rad/s] from the raw velocities of every piece (at the motors
     where the drive's friction acts there)."""
-    dq = np.concatenate([joint_side_log(p, drive).dq for p in pieces])
+    if len(pieces) == 1:  # one piece: its velocities as they are, not a copy
+        dq = joint_side_log(pieces[0], drive).dq
+    else:
+        dq = np.concatenate([joint_side_log(p, drive).dq for p in pieces])
     if drive is not None:
         dq = dq @ drive.friction_transmission.T
     if dq.shape[0] < 8:

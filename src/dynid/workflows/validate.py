@@ -13,7 +13,8 @@ with every policy the command applies, so that the Python API behaves as the com
   the recordings' motion (:func:`~dynid.friction.validation.recorded_cutoff`).
 * Each recording, and each piece of one cut at a gap longer than ``max_gap_s``, is
   filtered and differentiated on its own; the errors are pooled over every sample and
-  given per recording (:func:`~dynid.friction.recordings.validate_pieces`).
+  given per recording (:func:`~dynid.friction.recordings.validate_recordings`: a long
+  piece prepared and predicted a block at a time).
 """
 
 from __future__ import annotations
@@ -27,7 +28,7 @@ import numpy as np
 
 from ..exceptions import DataError, OptionError
 from ..friction.model import FrictionModel
-from ..friction.recordings import RecordingsValidation, prepare_pieces, validate_pieces
+from ..friction.recordings import RecordingsValidation, validate_recordings
 from ..friction.validation import RECORDED, own_friction
 from ..identification.model import IdentifiedModel
 from ..io.feasible import load_feasible_drive, load_feasible_linear_friction
@@ -184,15 +185,15 @@ def validate_files(
     friction, source = _friction(model, opt.friction, feasible)
 
     def run() -> RecordingsValidation:
-        pieces = prepare_pieces(
+        return validate_recordings(
             model,
             rec.logs,
             rec.names,
+            friction=friction,
             cutoff_hz=RECORDED if opt.cutoff_hz is None else opt.cutoff_hz,
             max_gap_s=opt.max_gap_s,
             drive=drive,
         )
-        return validate_pieces(model, pieces, friction=friction)
 
     val = in_file(rec.paths[0], run) if len(rec.paths) == 1 else run()
     errors = val.errors
