@@ -154,3 +154,17 @@ def test_a_read_log_is_immutable_without_a_copy(tmp_path):
     for x in (back.t, back.q, back.dq, back.tau):
         with pytest.raises(ValueError):
             x.setflags(write=True)
+
+
+@pytest.mark.parametrize("N", [40, 41, 43])
+def test_a_long_signal_is_differentiated_in_blocks_as_numpy_whole(monkeypatch, N):
+    """derivative in blocks of 7 samples (one of overlap) is numpy's second-order gradient
+    of the whole signal on a non-uniform grid, bit for bit (a last block of one sample
+    included)."""
+    from dynid import signals
+
+    rng = np.random.default_rng(N)
+    t = np.cumsum(rng.uniform(0.5, 1.5, N))
+    x = rng.normal(size=(N, 2))
+    monkeypatch.setattr(signals, "_GRADIENT_BLOCK", 7)
+    np.testing.assert_array_equal(signals.derivative(t, x), np.gradient(x, t, axis=0, edge_order=2))

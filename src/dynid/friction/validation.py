@@ -218,7 +218,7 @@ def validate_torques(
 #: Prepared samples a :class:`Validation` keeps (for its figures): of a longer log it keeps
 #: every k-th sample, the errors being summed over every sample block by block, so that
 #: neither the prepared log nor the predictions are ever held whole.
-KEPT_SAMPLES = 1 << 19
+KEPT_SAMPLES = 1 << 17
 
 
 def validated_log(

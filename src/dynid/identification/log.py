@@ -267,29 +267,35 @@ class TorqueLog:
                 raise ShapeError(f"{k} must have shape ({N}, {n}) like q; got {a.shape}")
         finite = np.isfinite(t)
         for a in arrays.values():
-            finite &= np.all(np.isfinite(a), axis=1)
-        rows = np.flatnonzero(finite)
-        n_nan = N - rows.size
-        skipped = rows[np.flatnonzero(np.diff(rows) > 1)]  # a kept row, then invalid ones
-        if rows.size == 0:  # every row invalid (the duplicate mask below needs one)
+            for j in range(a.shape[1]):  # a column at a time: no (N, n) temporary
+                finite &= np.isfinite(a[:, j])
+        # a log without invalid rows or duplicates (the usual one) takes no index arrays
+        rows: NDArray[np.intp] | None = None if finite.all() else np.flatnonzero(finite)
+        del finite
+        n_nan = 0 if rows is None else N - rows.size
+        skipped = (  # a kept row, then invalid ones
+            np.zeros(0, np.intp) if rows is None else rows[np.flatnonzero(np.diff(rows) > 1)]
+        )
+        if rows is not None and rows.size == 0:  # every row invalid
             raise DataError(f"fewer than 2 valid rows left of {N} ({n_nan} with NaN/inf)")
-        tt = t[rows]
+        tt = t if rows is None else t[rows]
         dt = np.diff(tt)
         back = np.flatnonzero(dt < 0)
         if back.size:
             i = int(back[0])
             raise DataError(
-                f"timestamps run backwards at row {int(rows[i + 1])}: "
+                f"timestamps run backwards at row {i + 1 if rows is None else int(rows[i + 1])}: "
                 f"t = {float(tt[i + 1])!r} after t = {float(tt[i])!r}; the log is out of order "
                 "and cannot be repaired safely"
             )
-        keep = np.concatenate([[True], dt > 0])
-        n_dup = int(np.sum(~keep))
-        rows = rows[keep]
-        if rows.size < 2:
+        n_dup = int(np.count_nonzero(dt == 0))
+        if n_dup:
+            keep = np.concatenate([[True], dt > 0])
+            rows = np.flatnonzero(keep) if rows is None else rows[keep]
+            tt = t[rows]
+            dt = np.diff(tt)
+        if tt.shape[0] < 2:
             raise DataError(f"fewer than 2 valid rows left of {N} ({n_nan} with NaN/inf)")
-        tt = t[rows]
-        dt = np.diff(tt)
         h = float(np.median(dt))
         gap = dt > gap_factor * h
         gaps = tuple((float(tt[i]), float(tt[i + 1])) for i in np.flatnonzero(gap))
@@ -303,7 +309,7 @@ class TorqueLog:
             dt_jitter=jitter,
             invalid_after=tuple(float(t[i]) for i in skipped),
         )
-        if rows.size == N:  # nothing dropped: no copy of a large log
+        if rows is None:  # nothing dropped: no copy of a large log
             tt, pick = t, (lambda a: a)
         else:
             pick = lambda a: a[rows]  # noqa: E731
