@@ -168,3 +168,32 @@ def test_a_long_signal_is_differentiated_in_blocks_as_numpy_whole(monkeypatch, N
     x = rng.normal(size=(N, 2))
     monkeypatch.setattr(signals, "_GRADIENT_BLOCK", 7)
     np.testing.assert_array_equal(signals.derivative(t, x), np.gradient(x, t, axis=0, edge_order=2))
+
+
+def test_the_observer_run_block_by_block_equals_one_run_and_the_numpy_path():
+    """A long log's residual is computed a block at a time, the observer's state carried
+    (observe's batch path): the same residual as one run and as the numpy loop over every
+    sample."""
+    import dynid
+    from dynid.observer import MomentumObserver, ObserverOptions, from_robot
+
+    robot = dynid.panda()
+    rng = np.random.default_rng(9)
+    N = 1_000
+    t = np.arange(N) * 1e-3 + np.r_[0.0, rng.uniform(-3e-4, 3e-4, N - 1)]
+    q = 0.3 * np.sin(np.outer(t, np.arange(1, 8)))
+    dq = 0.3 * np.arange(1, 8) * np.cos(np.outer(t, np.arange(1, 8)))
+    tau = rng.normal(size=q.shape)
+    model, opts = from_robot(robot), ObserverOptions(gain=50.0)
+    whole = MomentumObserver(model, opts).run(t, q, dq, tau)
+    obs = MomentumObserver(model, opts)
+    blocks = np.concatenate(
+        [
+            obs.run(t[a : a + 97], q[a : a + 97], dq[a : a + 97], tau[a : a + 97])
+            for a in range(0, N, 97)
+        ]
+    )
+    slow = MomentumObserver(model, opts)
+    ref = slow._run_numpy(t, q, dq, slow._u(q, dq, tau, friction=True))
+    np.testing.assert_allclose(blocks, ref, rtol=0, atol=1e-9)
+    np.testing.assert_array_equal(blocks, whole)

@@ -535,7 +535,7 @@ def prepared_blocks(
 
 
 #: Prepared samples per block of :func:`prepare_log` and :func:`prepared_blocks`.
-PREPARE_BLOCK_SAMPLES = 1 << 18
+PREPARE_BLOCK_SAMPLES = 1 << 16
 
 #: Periods of the cut-off by which a block's window reaches beyond the block: the slowest
 #: pole of the order-4 Butterworth decays as ``exp(-0.38 * 2 pi f_c t)``, to 1e-14 after 13.5

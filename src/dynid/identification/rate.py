@@ -83,14 +83,17 @@ def motion_frequency(
     import scipy.fft  # imported here: it costs most of ``import dynid`` otherwise
 
     N = int(scipy.fft.prev_fast_len(q.shape[0], real=True))  # no Bluestein transform
-    A = np.stack([np.ones(N), np.linspace(-1.0, 1.0, N)], axis=1)
+    s = np.linspace(-1.0, 1.0, N)  # the trend's slope column (the other one: the mean)
+    ss = float(s @ s)
     window = np.hanning(N)
     f = np.fft.rfftfreq(N, 1.0 / fs)
     total = np.zeros(cols.size)
     found = np.zeros(cols.size)
     for k, j in enumerate(cols):  # one joint at a time: a long log's spectra never held whole
         y = q[:N, j]
-        x = y - A @ np.linalg.lstsq(A, y, rcond=None)[0]  # mean and linear trend removed
+        # mean and linear trend removed: least squares on the orthogonal columns 1 and s
+        x = y - float(np.mean(y))
+        x -= (float(s @ y) / ss) * s
         p = np.abs(scipy.fft.rfft(x * window)) ** 2
         del x
         cum = np.cumsum(p)
