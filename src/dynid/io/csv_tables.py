@@ -203,9 +203,9 @@ def _parse(
         return {k: a[:row] for k, a in out.items()}, one_to_one
     out.clear()  # the writable views gone: the buffers are reached read-only only
     return {
-        k: np.frombuffer(memoryview(buffers[k]).toreadonly(), np.float64).reshape(
-            capacity, len(c)
-        )[:row]
+        k: np.frombuffer(memoryview(buffers[k]).toreadonly(), np.float64).reshape(capacity, len(c))[
+            :row
+        ]
         for k, c in layout.items()
     }, one_to_one
 
