@@ -62,7 +62,7 @@ def _reference(
     ("filter_tau", "k", "jitter"), [(True, 1, False), (False, 7, False), (True, 3, True)]
 )
 def test_blocks_equal_the_whole_array_steps(monkeypatch, filter_tau, k, jitter):
-    """prepare_log forced into blocks of 500 samples (a window of 14 cut-off periods beyond
+    """prepare_log forced into blocks of 500 samples (a window of 20 cut-off periods beyond
     each) equals scipy and numpy on the whole arrays to rounding; so does the
     concatenation of prepared_blocks."""
     log = _log(1, 9_000, jitter=jitter)

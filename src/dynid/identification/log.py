@@ -538,9 +538,10 @@ def prepared_blocks(
 PREPARE_BLOCK_SAMPLES = 1 << 16
 
 #: Periods of the cut-off by which a block's window reaches beyond the block: the slowest
-#: pole of the order-4 Butterworth decays as ``exp(-0.38 * 2 pi f_c t)``, to 1e-14 after 13.5
-#: periods, so the zero-phase filter of the window equals the whole log's there to rounding.
-SETTLE_CYCLES = 14.0
+#: pole of the order-4 Butterworth decays as ``exp(-0.38 * 2 pi f_c t)``, so that the
+#: zero-phase filter of the window equals the whole log's there to rounding (as the
+#: parallel filtering of the regressor's blocks, :mod:`dynid.identification.log_rows`).
+SETTLE_CYCLES = 20.0
 
 
 @dataclass(frozen=True, slots=True)
@@ -582,11 +583,14 @@ def _plan(
     cutoff_hz = _usable_cutoff(cutoff_hz, rate, log.n_samples)
     if trim_s is None:
         trim_s = signals.edge_seconds(cutoff_hz) if cutoff_hz is not None else 0.0
-    keep = signals.trim_edges(t, trim_s)
-    if keep.sum() < 2:
+    if trim_s < 0:
+        raise DataError(f"seconds must be >= 0; got {trim_s}")
+    # the samples of signals.trim_edges (t increases): its first and last, no mask of them
+    first = int(np.searchsorted(t, t[0] + trim_s, side="left"))
+    last = int(np.searchsorted(t, t[-1] - trim_s, side="right")) - 1
+    if last - first + 1 < 2:
         raise DataError(f"fewer than 2 samples left after trimming {trim_s:g} s at each end")
-    kept = np.flatnonzero(keep)
-    out = range(int(kept[0]), int(kept[-1]) + 1, int(decimate))
+    out = range(first, last + 1, int(decimate))
     derived = log.dq_derived and cutoff_hz is not None
     pad = 2  # the central differences' neighbours
     if cutoff_hz is not None:
