@@ -81,7 +81,7 @@ def main(argv: list[str] | None = None) -> int:
         "--seconds",
         type=float,
         nargs="+",
-        default=[60.0, 300.0, 700.0, 1500.0],
+        default=[60.0, 300.0, 700.0, 1200.0],
         help="durations of the logs [s] at 1 kHz",
     )
     p.add_argument("--repeats", type=int, default=2, help="runs of each fit (best kept)")

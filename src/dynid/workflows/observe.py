@@ -351,7 +351,7 @@ def _observe_log(
         t, q, tau, n = log.t, log.q, log.tau, model.n
         r = np.full((t.shape[0], n), np.nan)
         std = np.full_like(r, np.nan) if wants_std else None
-        margin = np.zeros_like(r) if wants_margin else None
+        margin = np.zeros(r.shape) if wants_margin else None  # untouched where it stays 0
         for a, b in spans:
             obs = MomentumObserver(model, options)  # one per piece, run a block at a time:
             for c in range(a, b, _OBSERVE_BLOCK):  # no full-length copies of the residual
@@ -360,7 +360,10 @@ def _observe_log(
             if std is not None:
                 std[a:b] = residual_std(model, t[a:b], q[a:b], dq[a:b], options)
             if margin is not None:
-                margin[a:b] = standstill_series(model, t[a:b], dq[a:b], options)
+                m = standstill_series(model, t[a:b], dq[a:b], options)
+                if np.any(m):  # a friction without a band: its zeros not written (no memory)
+                    margin[a:b] = m
+                del m
         wrench = None
         if opts.frame is not None:
             wrench = external_wrench(model.robot, log.q, r, opts.frame)
