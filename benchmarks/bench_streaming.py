@@ -22,6 +22,7 @@ import json
 import os
 import sys
 import time
+import warnings
 from pathlib import Path
 
 import numpy as np
@@ -30,6 +31,7 @@ sys.path.insert(0, str(Path(__file__).resolve().parent))  # this folder
 from common import environment, format_environment  # noqa: E402
 
 import dynid  # noqa: E402
+from dynid.exceptions import DynidWarning  # noqa: E402
 from dynid.identification import log_rows, recordings, streaming  # noqa: E402
 from dynid.identification.classical import identify_from_log  # noqa: E402
 from dynid.identification.streaming import MAX_STACK_BYTES  # noqa: E402
@@ -87,6 +89,7 @@ def main(argv: list[str] | None = None) -> int:
     p.add_argument("--repeats", type=int, default=2, help="runs of each fit (best kept)")
     p.add_argument("--json", nargs="?", const="-", default=None, metavar="PATH")
     args = p.parse_args(argv)
+    warnings.simplefilter("ignore", DynidWarning)  # the logs' findings: not this benchmark's
     robot = dynid.panda()
     series = random_fourier(robot, np.random.default_rng(7))
     warm = simulate_measurement(  # compiles the kernels: not timed
