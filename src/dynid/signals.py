@@ -76,15 +76,22 @@ def sample_rate(t: ArrayLike) -> float:
     within ``(0.5, 1.5) h0`` instead. For uniform ``t`` both give ``1 / dt``.
     """
     t = _time(t)
-    dt = np.diff(t)
-    h0 = float(np.median(dt))
-    m = dt / h0
+    m = np.diff(t)
+    h0 = float(np.median(m))
+    m /= h0  # in place (and below): a long log's temporaries are a few columns, not seven
     whole = np.round(m)
-    if np.all(np.abs(m - whole) <= 0.4) and np.all(whole >= 1):
-        k = np.concatenate([[0.0], np.cumsum(whole)])
-        kc = k - k.mean()
+    np.subtract(m, whole, out=m)
+    counted = bool(np.all(np.abs(m, out=m) <= 0.4) and np.all(whole >= 1))
+    del m
+    if counted:
+        kc = np.empty(t.shape[0])
+        kc[0] = 0.0
+        np.cumsum(whole, out=kc[1:])
+        del whole
+        kc -= kc.mean()
         h = float(kc @ (t - t.mean()) / (kc @ kc))
     else:
+        dt = np.diff(t)
         h = float(np.median(dt[(dt > 0.5 * h0) & (dt < 1.5 * h0)]))
     return 1.0 / h
 
@@ -253,12 +260,33 @@ def derivative(t: ArrayLike, x: ArrayLike) -> NDArray[np.float64]:
             f"derivative needs t (N,) with N >= 3 and x (N, ...); got {t.shape} and {x.shape}"
         )
     if x.ndim < 2:
-        return np.gradient(x, t, edge_order=2)
+        return _gradient(x, t)
     # one signal at a time: np.gradient's temporaries stay the size of one column
     out = np.empty(x.shape)
     flat, fout = x.reshape(x.shape[0], -1), out.reshape(x.shape[0], -1)
     for k in range(flat.shape[1]):
-        fout[:, k] = np.gradient(flat[:, k], t, edge_order=2)
+        fout[:, k] = _gradient(flat[:, k], t)
+    return out
+
+
+#: Samples of a signal differentiated at a time by :func:`derivative` (np.gradient on a
+#: non-uniform grid takes about ten temporaries of its input's size).
+_GRADIENT_BLOCK = 1 << 18
+
+
+def _gradient(x: NDArray[np.float64], t: NDArray[np.float64]) -> NDArray[np.float64]:
+    """``np.gradient(x, t, edge_order=2)`` of a 1-D signal, a block of samples at a time
+    with one sample of overlap: each value is the same formula on the same samples."""
+    N = x.shape[0]
+    if N <= 2 * _GRADIENT_BLOCK:
+        return np.gradient(x, t, edge_order=2)
+    out = np.empty(N)
+    for a in range(0, N, _GRADIENT_BLOCK):
+        b = min(a + _GRADIENT_BLOCK, N)
+        lo, hi = max(a - 1, 0), min(b + 1, N)
+        if hi - lo < 3:  # a last sample alone: with the two before it
+            lo = hi - 3
+        out[a:b] = np.gradient(x[lo:hi], t[lo:hi], edge_order=2)[a - lo : b - lo]
     return out
 
 

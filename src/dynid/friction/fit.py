@@ -94,7 +94,7 @@ def rigid_body_torques(
 
 
 #: Samples per block in :func:`rigid_body_torques`.
-BLOCK_SAMPLES = 50_000
+BLOCK_SAMPLES = 16_384
 
 
 def _rigid_body_torques(

@@ -43,7 +43,14 @@ from ..model.drive import Drive
 from ..model.robot import Robot
 from .fit import FrictionResidual, TorqueModel, model_drive, rigid_body_torques
 from .model import FrictionModel, FrictionSum
-from .validation import RECORDED, Validation, errors_from_sums, recorded_cutoff, validated
+from .validation import (
+    RECORDED,
+    Validation,
+    errors_from_sums,
+    recorded_cutoff,
+    validated,
+    validated_log,
+)
 
 __all__ = [
     "Pieces",
@@ -52,6 +59,7 @@ __all__ = [
     "pieces_residual",
     "prepare_pieces",
     "validate_pieces",
+    "validate_recordings",
 ]
 
 
@@ -79,6 +87,9 @@ class Pieces:
         Joints (0-based) unwrapped in some recording.
     drive : Drive or None
         The drive the recordings were read through.
+    samples, durations : tuple, optional
+        Prepared samples and duration [s] of each piece, when ``logs`` keep only every
+        k-th sample of long pieces (:func:`validate_recordings`); default: the logs' own.
     """
 
     logs: tuple[TorqueLog, ...]
@@ -89,11 +100,19 @@ class Pieces:
     skipped: tuple[str, ...] = ()
     unwrapped: tuple[int, ...] = ()
     drive: Drive | None = None
+    samples: tuple[int, ...] | None = None
+    durations: tuple[float, ...] | None = None
+
+    def __post_init__(self) -> None:
+        if self.samples is None:  # the logs hold every prepared sample
+            object.__setattr__(self, "samples", tuple(p.n_samples for p in self.logs))
+            object.__setattr__(self, "durations", tuple(p.duration for p in self.logs))
 
     @property
     def n_samples(self) -> int:
         """Samples over every piece."""
-        return sum(p.n_samples for p in self.logs)
+        assert self.samples is not None
+        return sum(self.samples)
 
     def labels(self) -> NDArray[np.intp]:
         """The recording of every sample (N,), pieces in order."""
@@ -107,14 +126,15 @@ class Pieces:
     def summary(self) -> tuple[dict[str, Any], ...]:
         """Per recording: ``file``, ``pieces``, ``samples`` and ``duration_s`` used."""
         out = []
+        assert self.samples is not None and self.durations is not None
         for r, name in enumerate(self.names):
-            mine = [p for p, k in zip(self.logs, self.recording, strict=True) if k == r]
+            mine = [i for i, k in enumerate(self.recording) if k == r]
             out.append(
                 {
                     "file": name,
                     "pieces": len(mine),
-                    "samples": sum(p.n_samples for p in mine),
-                    "duration_s": float(sum(p.duration for p in mine)),
+                    "samples": sum(self.samples[i] for i in mine),
+                    "duration_s": float(sum(self.durations[i] for i in mine)),
                 }
             )
         return tuple(out)
@@ -179,12 +199,57 @@ def prepare_pieces(
         No recording; a recording of another joint count than the model's, or with no
         piece long enough to filter (the file is named); another drive than the model's.
     """
+    gap, k = _recorded_preparation(model, max_gap_s, decimate)
+    raw = _raw_pieces(model, logs, names, cutoff_hz, gap, drive)
+    prepared, recording, skipped = [], [], []
+    for r, piece in raw.pieces:
+        try:
+            p = prepare_log(
+                piece, cutoff_hz=raw.cutoff_hz, trim_s=trim_s, filter_tau=filter_tau, max_gap_s=gap
+            )
+        except DataError as exc:
+            skipped.append(skipped_piece(raw.names[r], piece, exc))
+            continue
+        prepared.append(p if k == 1 else p.select(np.arange(0, p.n_samples, k)))
+        recording.append(r)
+    _check_kept(raw, recording)
+    return Pieces(
+        logs=tuple(prepared),
+        recording=tuple(recording),
+        names=raw.names,
+        cutoff_hz=raw.cutoff_hz,
+        dq_noise_std=_noise_std([p for _, p in raw.pieces]),
+        skipped=tuple(skipped),
+        unwrapped=raw.unwrapped,
+        drive=raw.drive,
+    )
+
+
+@dataclass(frozen=True, slots=True, eq=False)
+class _Raw:
+    """The pieces of the recordings before preparation, and what holds for all of them."""
+
+    pieces: list[tuple[int, TorqueLog]]
+    names: tuple[str, ...]
+    cutoff_hz: float | None
+    unwrapped: tuple[int, ...]
+    drive: Drive | None
+
+
+def _raw_pieces(
+    model: TorqueModel,
+    logs: Sequence[TorqueLog],
+    names: Sequence[str] | None,
+    cutoff_hz: float | None | Literal["recorded"],
+    max_gap_s: float | None,
+    drive: Drive | None,
+) -> _Raw:
+    """Every recording at the joints, unwrapped, cut at its gaps; the one cut-off."""
     if not logs:
         raise DataError("no recording given")
     names = tuple(names) if names is not None else tuple(f"log{k + 1}" for k in range(len(logs)))
     d = model_drive(model, drive)
     robot = _robot(model)
-    max_gap_s, k = _recorded_preparation(model, max_gap_s, decimate)
     raw: list[tuple[int, TorqueLog]] = []
     turned: set[int] = set()
     for r, (name, log) in enumerate(zip(names, logs, strict=True)):
@@ -204,34 +269,71 @@ def prepare_pieces(
         if isinstance(cutoff_hz, str)
         else cutoff_hz
     )
-    prepared, recording, skipped = [], [], []
-    for r, piece in raw:
-        try:
-            p = prepare_log(
-                piece, cutoff_hz=cut, trim_s=trim_s, filter_tau=filter_tau, max_gap_s=max_gap_s
-            )
-        except DataError as exc:
-            skipped.append(skipped_piece(names[r], piece, exc))
-            continue
-        prepared.append(p if k == 1 else p.select(np.arange(0, p.n_samples, k)))
-        recording.append(r)
-    lost = [names[r] for r in range(len(names)) if r not in recording]
+    return _Raw(raw, names, cut, tuple(sorted(turned)), d)
+
+
+def _check_kept(raw: _Raw, recording: list[int]) -> None:
+    """Refuse a recording left without any piece long enough to filter (named)."""
+    lost = [raw.names[r] for r in range(len(raw.names)) if r not in recording]
     if lost:
         raise DataError(
-            f"{', '.join(lost)}: no piece long enough to filter at {cut or 0:.4g} Hz (gaps longer "
-            "than --max-gap cut a recording into pieces); hint: record longer stretches "
-            "without gaps, or raise --max-gap"
+            f"{', '.join(lost)}: no piece long enough to filter at {raw.cutoff_hz or 0:.4g} Hz "
+            "(gaps longer than --max-gap cut a recording into pieces); hint: record longer "
+            "stretches without gaps, or raise --max-gap"
         )
-    return Pieces(
-        logs=tuple(prepared),
+
+
+def validate_recordings(
+    model: TorqueModel,
+    logs: Sequence[TorqueLog],
+    names: Sequence[str] | None = None,
+    *,
+    friction: FrictionModel | FrictionSum | None = None,
+    cutoff_hz: float | None | Literal["recorded"] = RECORDED,
+    trim_s: float | None = None,
+    max_gap_s: float | None | Literal["recorded"] = RECORDED,
+    filter_tau: bool = False,
+    drive: Drive | None = None,
+) -> RecordingsValidation:
+    """:func:`validate_pieces` of :func:`prepare_pieces`, each piece prepared and predicted
+    a block at a time when it is long (:func:`~dynid.friction.validation.validated_log`):
+    the errors over every sample, the prepared logs and predictions of a long piece kept
+    at every k-th sample only (``Validation.step``), so that a long recording is never
+    held prepared whole. Parameters and errors as the two."""
+    gap, _ = _recorded_preparation(model, max_gap_s, RECORDED)  # every sample judged
+    raw = _raw_pieces(model, logs, names, cutoff_hz, gap, drive)
+    parts, recording, skipped = [], [], []
+    for r, piece in raw.pieces:
+        try:
+            v = validated_log(
+                model,
+                piece,
+                friction,
+                raw.drive,
+                cutoff_hz=raw.cutoff_hz,
+                trim_s=trim_s,
+                filter_tau=filter_tau,
+                max_gap_s=gap,
+            )
+        except DataError as exc:
+            skipped.append(skipped_piece(raw.names[r], piece, exc))
+            continue
+        parts.append(v)
+        recording.append(r)
+    _check_kept(raw, recording)
+    pieces = Pieces(
+        logs=tuple(v.log for v in parts),
         recording=tuple(recording),
-        names=names,
-        cutoff_hz=cut,
-        dq_noise_std=_noise_std([p for _, p in raw]),
+        names=raw.names,
+        cutoff_hz=raw.cutoff_hz,
+        dq_noise_std=_noise_std([p for _, p in raw.pieces]),
         skipped=tuple(skipped),
-        unwrapped=tuple(sorted(turned)),
-        drive=d,
+        unwrapped=raw.unwrapped,
+        drive=raw.drive,
+        samples=tuple(v.errors.n_samples for v in parts),
+        durations=tuple(v.log.duration for v in parts),
     )
+    return _pooled(tuple(parts), pieces, friction)
 
 
 def _recorded_preparation(
@@ -374,12 +476,27 @@ def validate_pieces(
         The friction model's joint count differs from the logs'.
     """
     parts = tuple(validated(model, p, friction, pieces.drive) for p in pieces.logs)
+    return _pooled(parts, pieces, friction)
+
+
+def _pooled(
+    parts: tuple[Validation, ...], pieces: Pieces, friction: FrictionModel | FrictionSum | None
+) -> RecordingsValidation:
+    """The errors of the pieces' validations pooled over all and per recording."""
     labels = np.asarray(pieces.recording)
 
     def pooled(sel: NDArray[np.bool_], with_friction: bool) -> TorqueErrors:
         n = parts[0].log.n
         se2, sa2, N = np.zeros(n), np.zeros(n), 0
         for v in (p for p, s in zip(parts, sel, strict=True) if s):
+            if v.step > 1:  # every k-th sample kept: the sums over all of them
+                assert v.tau_ss is not None
+                err = v.with_friction if with_friction else v.without_friction
+                assert err is not None
+                se2 += np.asarray(err.mse) * err.n_samples
+                sa2 += v.tau_ss
+                N += err.n_samples
+                continue
             hat = v.tau_hat if with_friction else v.tau_model
             e = v.log.tau - hat
             se2 += np.einsum("ij,ij->j", e, e)

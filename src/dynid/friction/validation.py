@@ -20,7 +20,7 @@ correct model equals the sensor noise.
 from __future__ import annotations
 
 import warnings
-from collections.abc import Sequence
+from collections.abc import Iterator, Sequence
 from dataclasses import dataclass
 from typing import Any, Literal
 
@@ -30,7 +30,13 @@ from numpy.typing import ArrayLike, NDArray
 from .. import _checks
 from ..dynamics.rnea import rnea
 from ..exceptions import DynidWarning, OptionError, ShapeError, WrongTypeError
-from ..identification.log import DEFAULT_CUTOFF_HZ, TorqueLog, joint_side_log, prepare_log
+from ..identification.log import (
+    DEFAULT_CUTOFF_HZ,
+    TorqueLog,
+    joint_side_log,
+    prepare_log,
+    prepared_blocks,
+)
 from ..identification.metrics import TorqueErrors, torque_errors
 from ..identification.model import IdentifiedModel
 from ..identification.recordings import common_cutoff
@@ -41,6 +47,7 @@ from .fit import TorqueModel, model_drive, rigid_body_torques
 from .model import Friction, FrictionModel, FrictionSum, combined, robot_friction
 
 __all__ = [
+    "KEPT_SAMPLES",
     "RECORDED",
     "NewtonEulerValidation",
     "Validation",
@@ -50,6 +57,7 @@ __all__ = [
     "validate_newton_euler",
     "validate_torques",
     "validated",
+    "validated_log",
 ]
 
 
@@ -72,16 +80,23 @@ class Validation:
     Attributes
     ----------
     log : TorqueLog
-        Prepared log (filtered states, ``ddq``, trimmed).
+        Prepared log (filtered states, ``ddq``, trimmed); of a log longer than
+        :data:`KEPT_SAMPLES`, every ``step``-th prepared sample (the errors are over every
+        sample).
     tau_model : ndarray, shape (N, n)
-        Rigid-body prediction [N m].
+        Rigid-body prediction [N m] at the samples of ``log``.
     tau_friction : ndarray, shape (N, n), or None
-        Friction prediction [N m].
+        Friction prediction [N m] at the samples of ``log``.
     without_friction : TorqueErrors
-        Errors of ``tau_model``.
+        Errors of ``tau_model`` over every prepared sample.
     with_friction : TorqueErrors or None
-        Errors of ``tau_model + tau_friction``.
+        Errors of ``tau_model + tau_friction`` over every prepared sample.
     friction : FrictionModel or None
+    step : int
+        ``log`` holds every ``step``-th prepared sample (1: all of them).
+    tau_ss : ndarray, shape (n,), or None
+        Sum over every prepared sample of the squared measured torques [N^2 m^2] (when
+        ``step`` > 1: the errors of several logs are pooled from it).
     """
 
     log: TorqueLog
@@ -90,6 +105,8 @@ class Validation:
     without_friction: TorqueErrors
     with_friction: TorqueErrors | None
     friction: FrictionModel | FrictionSum | None
+    step: int = 1
+    tau_ss: NDArray[np.float64] | None = None
 
     @property
     def tau_hat(self) -> NDArray[np.float64]:
@@ -186,9 +203,120 @@ def validate_torques(
     jlog = joint_side_log(log, d)
     cut = recorded_cutoff(model, jlog) if isinstance(cutoff_hz, str) else cutoff_hz
     del log  # a long log's raw signals are freed here when the caller holds no other reference
-    p = prepare_log(jlog, cutoff_hz=cut, trim_s=trim_s, filter_tau=filter_tau, max_gap_s=max_gap_s)
-    del jlog
-    return validated(model, p, friction, d)
+    return validated_log(
+        model,
+        jlog,
+        friction,
+        d,
+        cutoff_hz=cut,
+        trim_s=trim_s,
+        filter_tau=filter_tau,
+        max_gap_s=max_gap_s,
+    )
+
+
+#: Prepared samples a :class:`Validation` keeps (for its figures): of a longer log it keeps
+#: every k-th sample, the errors being summed over every sample block by block, so that
+#: neither the prepared log nor the predictions are ever held whole.
+KEPT_SAMPLES = 1 << 17
+
+
+def validated_log(
+    model: TorqueModel,
+    jlog: TorqueLog,
+    friction: FrictionModel | FrictionSum | None,
+    drive: Drive | None,
+    *,
+    cutoff_hz: float | None,
+    trim_s: float | None = None,
+    filter_tau: bool = False,
+    max_gap_s: float | None = None,
+) -> Validation:
+    """:func:`validated` on the joint-side log ``jlog`` prepared
+    (:func:`~dynid.identification.log.prepare_log` with these settings); a log longer than
+    :data:`KEPT_SAMPLES` is prepared and predicted a block at a time
+    (:func:`~dynid.identification.log.prepared_blocks`): the errors over every sample, the
+    Validation keeping every k-th sample (``step``).
+
+    Raises
+    ------
+    DataError
+        From the preparation of the log.
+    ShapeError
+        The friction model's joint count differs from the log's.
+    """
+    kw = {"cutoff_hz": cutoff_hz, "trim_s": trim_s, "filter_tau": filter_tau}
+    step = -(-jlog.n_samples // KEPT_SAMPLES)
+    if step <= 1:
+        p = prepare_log(jlog, max_gap_s=max_gap_s, **kw)  # type: ignore[arg-type]
+        return validated(model, p, friction, drive)
+    if friction is not None and friction.n != jlog.n:
+        raise ShapeError(f"friction model has {friction.n} joints; the log has {jlog.n}")
+    blocks = prepared_blocks(jlog, max_gap_s=max_gap_s, **kw)  # type: ignore[arg-type]
+    return _validated_blocks(model, blocks, friction, drive, step)
+
+
+def _validated_blocks(
+    model: TorqueModel,
+    blocks: Iterator[TorqueLog],
+    friction: FrictionModel | FrictionSum | None,
+    drive: Drive | None,
+    step: int,
+) -> Validation:
+    """:func:`validated` over consecutive prepared blocks: the errors summed over every
+    sample, every ``step``-th sample (counted over all blocks) kept."""
+    n = 0
+    sums: dict[str, NDArray[np.float64]] = {}
+    kept: dict[str, list[NDArray[np.float64]]] = {}
+    N = 0
+    rotors = drive is not None and drive.rotor_inertia is not None
+    for p in blocks:
+        assert p.ddq is not None  # prepare_log always fills ddq
+        if not sums:
+            n = p.n
+            sums = {k: np.zeros(n) for k in ("tau", "model", "sum")}
+        tau_model = np.array(rigid_body_torques(model, p.q, p.dq, p.ddq))
+        if rotors and not isinstance(model, IdentifiedModel):  # a robot's links: add rotors
+            assert drive is not None and drive.rotor_inertia is not None
+            tau_model += drive.rotor_torques(p.ddq, drive.rotor_inertia)
+        _checks.finite("tau_model", tau_model)
+        with np.errstate(over="ignore"):
+            e = p.tau - tau_model
+            sums["tau"] += np.einsum("ij,ij->j", p.tau, p.tau)
+            sums["model"] += np.einsum("ij,ij->j", e, e)
+            tf = None
+            if friction is not None:
+                tf = friction.torques(p.dq)
+                e -= tf
+                sums["sum"] += np.einsum("ij,ij->j", e, e)
+        rows = slice((-N) % step, None, step)
+        for name, x in (
+            ("t", p.t),
+            ("q", p.q),
+            ("dq", p.dq),
+            ("tau", p.tau),
+            ("ddq", p.ddq),
+            ("tau_model", tau_model),
+            ("tau_friction", tf),
+        ):
+            if x is not None:
+                kept.setdefault(name, []).append(np.array(x[rows]))
+        N += p.n_samples
+    joined = {k: np.concatenate(v) for k, v in kept.items()}
+    log = TorqueLog(joined["t"], joined["q"], joined["dq"], joined["tau"], joined["ddq"])
+    _warn_opposite_sign(log.tau, joined["tau_model"])
+    return Validation(
+        log=log,
+        tau_model=_checks.frozen(joined["tau_model"]),
+        tau_friction=_checks.frozen(joined["tau_friction"]) if friction is not None else None,
+        without_friction=errors_from_sums(sums["model"], sums["tau"], N),
+        with_friction=(
+            errors_from_sums(sums["sum"], sums["tau"], N) if friction is not None else None
+        ),
+        friction=friction,
+        step=step,
+        tau_ss=_checks.frozen(sums["tau"]),
+    )
 
 
 def validated(

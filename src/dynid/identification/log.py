@@ -32,6 +32,7 @@ zero-phase filter adds no delay, so the signals stay aligned in time.
 from __future__ import annotations
 
 import warnings
+from collections.abc import Iterator
 from dataclasses import dataclass, field
 from typing import Any
 
@@ -48,7 +49,10 @@ __all__ = [
     "TorqueLog",
     "default_max_gap",
     "joint_side_log",
+    "PREPARE_BLOCK_SAMPLES",
+    "SETTLE_CYCLES",
     "prepare_log",
+    "prepared_blocks",
     "recorded_side_log",
     "velocity_note",
     "with_derived_velocities",
@@ -195,9 +199,10 @@ class TorqueLog:
     def __len__(self) -> int:
         return self.n_samples
 
-    def select(self, rows: ArrayLike) -> TorqueLog:
-        """A log of the given rows (bool mask or increasing indices), ``cleaning`` kept."""
-        r = np.asarray(rows)
+    def select(self, rows: ArrayLike | slice) -> TorqueLog:
+        """A log of the given rows (bool mask, increasing indices, or a slice: views of
+        this log's arrays, no copy), ``cleaning`` kept."""
+        r = rows if isinstance(rows, slice) else np.asarray(rows)
         pick = lambda x: None if x is None else x[r]  # noqa: E731
         return TorqueLog(
             self.t[r],
@@ -262,29 +267,35 @@ class TorqueLog:
                 raise ShapeError(f"{k} must have shape ({N}, {n}) like q; got {a.shape}")
         finite = np.isfinite(t)
         for a in arrays.values():
-            finite &= np.all(np.isfinite(a), axis=1)
-        rows = np.flatnonzero(finite)
-        n_nan = N - rows.size
-        skipped = rows[np.flatnonzero(np.diff(rows) > 1)]  # a kept row, then invalid ones
-        if rows.size == 0:  # every row invalid (the duplicate mask below needs one)
+            for j in range(a.shape[1]):  # a column at a time: no (N, n) temporary
+                finite &= np.isfinite(a[:, j])
+        # a log without invalid rows or duplicates (the usual one) takes no index arrays
+        rows: NDArray[np.intp] | None = None if finite.all() else np.flatnonzero(finite)
+        del finite
+        n_nan = 0 if rows is None else N - rows.size
+        skipped = (  # a kept row, then invalid ones
+            np.zeros(0, np.intp) if rows is None else rows[np.flatnonzero(np.diff(rows) > 1)]
+        )
+        if rows is not None and rows.size == 0:  # every row invalid
             raise DataError(f"fewer than 2 valid rows left of {N} ({n_nan} with NaN/inf)")
-        tt = t[rows]
+        tt = t if rows is None else t[rows]
         dt = np.diff(tt)
         back = np.flatnonzero(dt < 0)
         if back.size:
             i = int(back[0])
             raise DataError(
-                f"timestamps run backwards at row {int(rows[i + 1])}: "
+                f"timestamps run backwards at row {i + 1 if rows is None else int(rows[i + 1])}: "
                 f"t = {float(tt[i + 1])!r} after t = {float(tt[i])!r}; the log is out of order "
                 "and cannot be repaired safely"
             )
-        keep = np.concatenate([[True], dt > 0])
-        n_dup = int(np.sum(~keep))
-        rows = rows[keep]
-        if rows.size < 2:
+        n_dup = int(np.count_nonzero(dt == 0))
+        if n_dup:
+            keep = np.concatenate([[True], dt > 0])
+            rows = np.flatnonzero(keep) if rows is None else rows[keep]
+            tt = t[rows]
+            dt = np.diff(tt)
+        if tt.shape[0] < 2:
             raise DataError(f"fewer than 2 valid rows left of {N} ({n_nan} with NaN/inf)")
-        tt = t[rows]
-        dt = np.diff(tt)
         h = float(np.median(dt))
         gap = dt > gap_factor * h
         gaps = tuple((float(tt[i]), float(tt[i + 1])) for i in np.flatnonzero(gap))
@@ -298,7 +309,7 @@ class TorqueLog:
             dt_jitter=jitter,
             invalid_after=tuple(float(t[i]) for i in skipped),
         )
-        if rows.size == N:  # nothing dropped: no copy of a large log
+        if rows is None:  # nothing dropped: no copy of a large log
             tt, pick = t, (lambda a: a)
         else:
             pick = lambda a: a[rows]  # noqa: E731
@@ -444,35 +455,29 @@ def prepare_log(
         The default cutoff :data:`DEFAULT_CUTOFF_HZ` is not below the log's Nyquist
         frequency (a log slower than 10 Hz): a quarter of the rate is used instead.
     """
-    t = log.t
-    dt = np.diff(t)
-    _check_gaps(t, dt, max_gap_s)
-    if int(decimate) != decimate or decimate < 1:
-        raise ShapeError(f"decimate must be an integer >= 1; got {decimate}")
-    rate = signals.sample_rate(t) if fs is None else float(fs)
-    data = {k: getattr(log, k) for k in _SIGNALS if getattr(log, k) is not None}
-    uniform = signals.is_uniform(t, rtol=jitter_rtol) and abs(rate * np.median(dt) - 1.0) < 1e-9
-    if not uniform:  # one signal at a time: no stacked copy of the whole log
-        tu = t
-        for name in list(data):
-            tu, data[name] = signals.resample_uniform(t, data[name], rate)
-        t = tu
-    cutoff_hz = _usable_cutoff(cutoff_hz, rate, log.n_samples)
-    if log.dq_derived and cutoff_hz is not None:  # positions only: dq at this cut-off
-        data["dq"] = signals.filtered_derivative(t, data["q"], cutoff_hz)
-    if trim_s is None:
-        trim_s = signals.edge_seconds(cutoff_hz) if cutoff_hz is not None else 0.0
-    keep = signals.trim_edges(t, trim_s)
-    if keep.sum() < 2:
-        raise DataError(f"fewer than 2 samples left after trimming {trim_s:g} s at each end")
-    kept = np.flatnonzero(keep)
-    rows = slice(int(kept[0]), int(kept[-1]) + 1, int(decimate))  # one contiguous block
-    out = _conditioned(t, data, rows, rate, cutoff_hz, filter_tau)
-    if out["t"].shape[0] < 2:
+    plan = _plan(log, cutoff_hz, trim_s, fs, max_gap_s, jitter_rtol, decimate)
+    n_out = len(plan.out)
+    if n_out < 2:
         raise DataError(
-            f"fewer than 2 samples left after trimming {trim_s:g} s at each end and keeping "
+            f"fewer than 2 samples left after trimming {plan.trim_s:g} s at each end and keeping "
             f"every {decimate}-th"
         )
+    parts = _windows(plan, PREPARE_BLOCK_SAMPLES)
+    if len(parts) == 1:  # short: the whole log at once
+        out = _prepared_window(log, plan, *parts[0], filter_tau)
+    else:  # long: block by block into the result (one block's temporaries at a time)
+        out = {}
+        o = 0
+        for w in parts:
+            piece = _prepared_window(log, plan, *w, filter_tau)
+            m = piece["t"].shape[0]
+            for k, v in piece.items():
+                if k not in out:
+                    out[k] = np.empty((n_out,) + v.shape[1:])
+                out[k][o : o + m] = v
+            o += m
+        for v in out.values():
+            v.setflags(write=False)  # kept by TorqueLog without a copy
     return TorqueLog(
         t=out["t"],
         q=out["q"],
@@ -481,6 +486,155 @@ def prepare_log(
         ddq=out["ddq"],
         cleaning=log.cleaning,
     )
+
+
+def prepared_blocks(
+    log: TorqueLog,
+    *,
+    cutoff_hz: float | None = DEFAULT_CUTOFF_HZ,
+    trim_s: float | None = None,
+    fs: float | None = None,
+    max_gap_s: float | None = None,
+    jitter_rtol: float = 1e-6,
+    filter_tau: bool = True,
+    decimate: int = 1,
+    block_samples: int | None = None,
+) -> Iterator[TorqueLog]:
+    """:func:`prepare_log` in consecutive blocks of at most ``block_samples`` prepared
+    samples (default :data:`PREPARE_BLOCK_SAMPLES`): their concatenation is
+    :func:`prepare_log`'s log (to about 1e-14 of each signal's scale), and only one block's
+    samples and temporaries are held at a time (a long log validated without its prepared
+    copy).
+
+    Each block is resampled, filtered and differentiated over a window that reaches
+    :data:`SETTLE_CYCLES` periods of the cut-off beyond its ends (twice that for velocities
+    derived from positions, which are filtered twice), where the zero-phase filter's
+    response to the window's edges has decayed to rounding, then cut to the block.
+
+    Parameters and errors as :func:`prepare_log`; ``block_samples`` must be >= 1.
+    """
+    if block_samples is not None and block_samples < 1:
+        raise ShapeError(f"block_samples must be >= 1; got {block_samples}")
+    plan = _plan(log, cutoff_hz, trim_s, fs, max_gap_s, jitter_rtol, decimate)
+    if len(plan.out) < 2:
+        raise DataError(
+            f"fewer than 2 samples left after trimming {plan.trim_s:g} s at each end and keeping "
+            f"every {decimate}-th"
+        )
+    size = PREPARE_BLOCK_SAMPLES if block_samples is None else int(block_samples)
+    for w in _windows(plan, size):
+        out = _prepared_window(log, plan, *w, filter_tau)
+        yield TorqueLog(
+            t=out["t"],
+            q=out["q"],
+            dq=out["dq"],
+            tau=out["tau"],
+            ddq=out["ddq"],
+            cleaning=log.cleaning,
+        )
+
+
+#: Prepared samples per block of :func:`prepare_log` and :func:`prepared_blocks`.
+PREPARE_BLOCK_SAMPLES = 1 << 16
+
+#: Periods of the cut-off by which a block's window reaches beyond the block: the slowest
+#: pole of the order-4 Butterworth decays as ``exp(-0.38 * 2 pi f_c t)``, so that the
+#: zero-phase filter of the window equals the whole log's there to rounding (as the
+#: parallel filtering of the regressor's blocks, :mod:`dynid.identification.log_rows`).
+SETTLE_CYCLES = 20.0
+
+
+@dataclass(frozen=True, slots=True)
+class _Plan:
+    """What :func:`prepare_log` does to a log: the uniform grid, the cut-off, the samples
+    kept (``out``, indices into the grid) and the margin of a block's window."""
+
+    t: NDArray[np.float64]  # the uniform grid (the log's own times when uniform)
+    uniform: bool
+    rate: float
+    cutoff_hz: float | None
+    trim_s: float
+    out: range
+    pad: int
+    derived: bool  # dq derived again from q at the cut-off
+
+
+def _plan(
+    log: TorqueLog,
+    cutoff_hz: float | None,
+    trim_s: float | None,
+    fs: float | None,
+    max_gap_s: float | None,
+    jitter_rtol: float,
+    decimate: int,
+) -> _Plan:
+    """Steps 1 and 4-5 of :func:`prepare_log` decided: the checks, the grid, the rows."""
+    t = log.t
+    dt = np.diff(t)
+    _check_gaps(t, dt, max_gap_s)
+    if int(decimate) != decimate or decimate < 1:
+        raise ShapeError(f"decimate must be an integer >= 1; got {decimate}")
+    rate = signals.sample_rate(t) if fs is None else float(fs)
+    uniform = signals.is_uniform(t, rtol=jitter_rtol) and abs(rate * np.median(dt) - 1.0) < 1e-9
+    del dt
+    if not uniform:  # the grid of signals.resample_uniform
+        m = int(np.floor((t[-1] - t[0]) * rate * (1.0 + 1e-12))) + 1
+        t = t[0] + np.arange(m) / rate
+    cutoff_hz = _usable_cutoff(cutoff_hz, rate, log.n_samples)
+    if trim_s is None:
+        trim_s = signals.edge_seconds(cutoff_hz) if cutoff_hz is not None else 0.0
+    if trim_s < 0:
+        raise DataError(f"seconds must be >= 0; got {trim_s}")
+    # the samples of signals.trim_edges (t increases): its first and last, no mask of them
+    first = int(np.searchsorted(t, t[0] + trim_s, side="left"))
+    last = int(np.searchsorted(t, t[-1] - trim_s, side="right")) - 1
+    if last - first + 1 < 2:
+        raise DataError(f"fewer than 2 samples left after trimming {trim_s:g} s at each end")
+    out = range(first, last + 1, int(decimate))
+    derived = log.dq_derived and cutoff_hz is not None
+    pad = 2  # the central differences' neighbours
+    if cutoff_hz is not None:
+        pad += int(np.ceil(SETTLE_CYCLES * rate / cutoff_hz)) * (2 if derived else 1)
+    return _Plan(t, bool(uniform), rate, cutoff_hz, float(trim_s), out, pad, derived)
+
+
+def _windows(plan: _Plan, size: int) -> list[tuple[int, int, slice]]:
+    """``(lo, hi, rows)`` per block of at most ``size`` kept samples: the window
+    ``lo:hi`` of the grid to prepare and the block's rows in it; one window of the whole
+    grid when the blocks would not save its length."""
+    out, M = plan.out, plan.t.shape[0]
+    if len(out) <= size or M <= 4 * plan.pad + size * out.step:
+        return [(0, M, slice(out.start, out.stop, out.step))]
+    found = []
+    for i in range(0, len(out), size):
+        a, b = out[i], out[min(i + size, len(out)) - 1] + 1
+        lo, hi = max(0, a - plan.pad), min(M, b + plan.pad)
+        found.append((lo, hi, slice(a - lo, b - lo, out.step)))
+    return found
+
+
+def _prepared_window(
+    log: TorqueLog, plan: _Plan, lo: int, hi: int, rows: slice, filter_tau: bool
+) -> dict[str, NDArray[np.float64]]:
+    """Steps 1-5 of :func:`prepare_log` on the window ``lo:hi`` of the grid, the rows
+    ``rows`` of it kept."""
+    tw = plan.t[lo:hi]
+    data = {}
+    for name in _SIGNALS:
+        x = getattr(log, name)
+        if x is None:
+            continue
+        if plan.uniform:
+            data[name] = x[lo:hi]
+        else:  # linear interpolation from the samples around the window only
+            a = max(int(np.searchsorted(log.t, tw[0], side="right")) - 1, 0)
+            b = min(int(np.searchsorted(log.t, tw[-1], side="left")) + 1, log.n_samples)
+            ts = log.t[a:b]
+            data[name] = np.stack([np.interp(tw, ts, x[a:b, j]) for j in range(x.shape[1])], 1)
+    if plan.derived:  # positions only: dq at this cut-off
+        assert plan.cutoff_hz is not None
+        data["dq"] = signals.filtered_derivative(tw, data["q"], plan.cutoff_hz)
+    return _conditioned(tw, data, rows, plan.rate, plan.cutoff_hz, filter_tau)
 
 
 def _check_gaps(t: NDArray[np.float64], dt: NDArray[np.float64], max_gap_s: float | None) -> None:
@@ -499,7 +653,8 @@ def _check_gaps(t: NDArray[np.float64], dt: NDArray[np.float64], max_gap_s: floa
 
 def _usable_cutoff(cutoff_hz: float | None, rate: float, n_samples: int) -> float | None:
     """The cut-off [Hz] to filter at: the default one moved below the Nyquist frequency of a
-    slow log (with a warning pointing at :func:`prepare_log`'s caller); refused for a log too
+    slow log (with a warning pointing at the caller of :func:`prepare_log`, through
+    :func:`_plan`); refused for a log too
     short to filter."""
     if cutoff_hz is not None and cutoff_hz == DEFAULT_CUTOFF_HZ and cutoff_hz >= rate / 2:
         warnings.warn(
@@ -507,7 +662,7 @@ def _usable_cutoff(cutoff_hz: float | None, rate: float, n_samples: int) -> floa
             f"of this {rate:.4g} Hz log; filtering at {rate / 4:.4g} Hz instead (choose with "
             "cutoff_hz / --cutoff)",
             DynidWarning,
-            stacklevel=3,
+            stacklevel=4,
         )
         cutoff_hz = rate / 4
     if cutoff_hz is not None and n_samples <= 15:

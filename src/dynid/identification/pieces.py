@@ -64,6 +64,8 @@ def split_at_gaps(
         )
     limit = default_max_gap(step) if max_gap_s is None else float(max_gap_s)
     cuts = np.concatenate([[0], np.flatnonzero(dt > limit) + 1, [log.n_samples]])
+    if cuts.size == 2 and log.n_samples > 1:  # no gap: the log itself, not a copy
+        return [log]
     return [
         log.select(np.arange(a, b)) for a, b in zip(cuts[:-1], cuts[1:], strict=True) if b - a > 1
     ]
@@ -101,22 +103,28 @@ def unwrapped(log: TorqueLog, revolute: NDArray[np.bool_]) -> tuple[TorqueLog, t
     time column in ms) are not wrapped. Returns the log with those turns taken out and the
     columns unwrapped (0-based; the log itself when none).
     """
-    raw = np.diff(log.q, axis=0)
-    d = raw if log.dq_derived else raw - 0.5 * (log.dq[:-1] + log.dq[1:]) * np.diff(log.t)[:, None]
-    turns = np.round(d / (2 * np.pi))
-    rest = np.abs(d - 2 * np.pi * turns)
-    typical = np.max(np.abs(np.where(turns == 0, d, 0.0)), axis=0, initial=0.0)
-    within = np.ptp(log.q, axis=0) <= 2 * np.pi * WRAP_SPAN
-    jumps = np.any((turns != 0) & (np.abs(raw) > np.pi), axis=0)
-    wrapped = (
-        within & jumps & np.all((turns == 0) | (rest <= np.maximum(2 * typical, 1e-9)), axis=0)
-    )
-    joints = tuple(int(j) for j in np.flatnonzero(wrapped & np.asarray(revolute, dtype=bool)))
-    if not joints:
+    h = np.diff(log.t)
+    found: dict[int, NDArray[np.float64]] = {}
+    for j in np.flatnonzero(np.asarray(revolute, dtype=bool)).tolist():  # a column at a time
+        q_j = log.q[:, j]
+        if q_j.size < 2 or np.ptp(q_j) > 2 * np.pi * WRAP_SPAN:
+            continue
+        raw = np.diff(q_j)
+        d = raw if log.dq_derived else raw - 0.5 * (log.dq[:-1, j] + log.dq[1:, j]) * h
+        turns = np.round(d / (2 * np.pi))
+        moved = turns != 0
+        if not np.any(moved & (np.abs(raw) > np.pi)):
+            continue
+        typical = float(np.max(np.abs(d[~moved]), initial=0.0))
+        if np.all(np.abs(d[moved] - 2 * np.pi * turns[moved]) <= max(2 * typical, 1e-9)):
+            found[j] = turns
+    if not found:
         return log, ()
     q = np.array(log.q)
-    q[1:, joints] -= 2 * np.pi * np.cumsum(turns[:, joints], axis=0)
+    for j, turns in found.items():
+        q[1:, j] -= 2 * np.pi * np.cumsum(turns)
     out = TorqueLog(log.t, q, log.dq, log.tau, log.ddq, log.cleaning, log.dq_derived)
+    joints = tuple(sorted(found))
     return out, joints
 
 

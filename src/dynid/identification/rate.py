@@ -80,6 +80,11 @@ def motion_frequency(
     moving : ndarray of bool, shape (n,), optional
         Joints to look at; default all.
 
+    The spectrum is that of the first ``N'`` samples, ``N'`` the longest length up to the
+    log's own whose transform is fast (:func:`scipy.fft.prev_fast_len`; a length with a
+    large prime factor, 5,000,001 = 3 x 47 x 35461, would take Bluestein's transform,
+    about 16 times the signal's memory): a few samples of a long log at most are left out.
+
     Returns
     -------
     float
@@ -87,19 +92,24 @@ def motion_frequency(
         Joints whose motion is a linear trend alone (power below 1e-6 of the largest
         joint's once the trend is removed) are not looked at.
     """
-    N = q.shape[0]
     cols = np.arange(q.shape[1]) if moving is None else np.flatnonzero(moving)
-    if N < 8 or cols.size == 0:
+    if q.shape[0] < 8 or cols.size == 0:
         return 0.0
-    A = np.stack([np.ones(N), np.linspace(-1.0, 1.0, N)], axis=1)
+    import scipy.fft  # imported here: it costs most of ``import dynid`` otherwise
+
+    N = int(scipy.fft.prev_fast_len(q.shape[0], real=True))  # no Bluestein transform
+    s = np.linspace(-1.0, 1.0, N)  # the trend's slope column (the other one: the mean)
+    ss = float(s @ s)
     window = np.hanning(N)
     f = np.fft.rfftfreq(N, 1.0 / fs)
     total = np.zeros(cols.size)
     found = np.zeros(cols.size)
     for k, j in enumerate(cols):  # one joint at a time: a long log's spectra never held whole
-        y = q[:, j]
-        x = y - A @ np.linalg.lstsq(A, y, rcond=None)[0]  # mean and linear trend removed
-        p = np.abs(np.fft.rfft(x * window)) ** 2
+        y = q[:N, j]
+        # mean and linear trend removed: least squares on the orthogonal columns 1 and s
+        x = y - float(np.mean(y))
+        x -= (float(s @ y) / ss) * s
+        p = np.abs(scipy.fft.rfft(x * window)) ** 2
         del x
         cum = np.cumsum(p)
         total[k] = cum[-1]

@@ -471,7 +471,10 @@ def _bands(pieces: list[TorqueLog], drive: Drive | None) -> dict[str, NDArray[np
 def _band(pieces: list[TorqueLog], drive: Drive | None) -> NDArray[np.float64]:
     """The standstill band [rad/s] from the raw velocities of every piece (at the motors
     where the drive's friction acts there)."""
-    dq = np.concatenate([joint_side_log(p, drive).dq for p in pieces])
+    if len(pieces) == 1:  # one piece: its velocities as they are, not a copy
+        dq = joint_side_log(pieces[0], drive).dq
+    else:
+        dq = np.concatenate([joint_side_log(p, drive).dq for p in pieces])
     if drive is not None:
         dq = dq @ drive.friction_transmission.T
     if dq.shape[0] < 8:

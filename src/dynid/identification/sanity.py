@@ -38,7 +38,7 @@ import math
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from .. import _checks
+from .. import _checks, signals
 from ..dynamics.terms import gravity_torques
 from ..exceptions import ShapeError
 from ..model.robot import Robot
@@ -303,7 +303,7 @@ def _rate_verdict(robot: Robot, log: TorqueLog, j: int) -> tuple[str, str] | Non
     den = float(v @ v)
     if t.size < 5 or not den > 0:
         return "", "--units q=deg"
-    k = float(np.gradient(q, t) @ v) / den
+    k = float(signals.derivative(t, q) @ v) / den  # in blocks: a long log's column
     deg = 180.0 / np.pi
     if abs(k / deg - 1.0) < _RATE_AGREES:
         return (
@@ -332,7 +332,7 @@ def _milliseconds(log: TorqueLog) -> list[str]:
     num = den = 0.0
     for j in range(q.shape[1]):  # one joint at a time: temporaries of one column (long logs)
         v = np.ascontiguousarray(dq[:, j])
-        num += float(np.gradient(q[:, j], t) @ v)
+        num += float(signals.derivative(t, q[:, j]) @ v)  # in blocks: a long log's column
         den += float(v @ v)
     if den > 0:
         k = num / den

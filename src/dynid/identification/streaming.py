@@ -73,8 +73,10 @@ __all__ = [
 Block = tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.intp]]
 BlockSource = Callable[[], Iterable[Block]]
 
-#: Rows per block a source should aim at (about 17 MB of a 65-column regressor).
-BLOCK_ROWS = 32_768
+#: Rows per block a source should aim at (about 9 MB of a 65-column regressor; the
+#: kinematics and the QR's copy of a block come on top, so that a long log's fit holds a
+#: few tens of MB beside its data).
+BLOCK_ROWS = 16_384
 
 #: Largest stacked regressor [bytes] a route holds whole before it streams its rows
 #: (``DYNID_MAX_STACK_BYTES`` overrides): below it the stacked fit is the faster one.

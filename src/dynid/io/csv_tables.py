@@ -5,9 +5,8 @@ naming the columns, then one row of numbers per line. The reader makes two passe
 file in binary blocks: the first counts the lines (an upper bound of the rows), so that the
 output arrays are allocated once at their final size; the second parses the rows a block
 at a time with numpy's C number reader, only the columns some output array takes, straight
-into those arrays. Memory: the output arrays, one block of text and its table of numbers,
-and, while each array is made immutable, one copy of that array, whatever the file's size
-and whether it records its row count.
+into those arrays. Memory: the output arrays (immutable without a copy), one block of text
+and its table of numbers, whatever the file's size and whether it records its row count.
 """
 
 from __future__ import annotations
@@ -54,7 +53,7 @@ def csv_table(
     expected : str
         The header expected, for the message when there is none.
     freeze : bool
-        Return the arrays immutable (:func:`dynid._checks.frozen`, one copy at a time);
+        Return the arrays immutable (as :func:`dynid._checks.frozen` wants them, no copy);
         False: writable, for a caller that changes them in place (units) and then
         freezes them itself.
 
@@ -103,15 +102,11 @@ def csv_table(
         # rows <= lines, and a row holds at least a separator per cell (or its newline)
         capacity = min(_count_lines(fb), size // len(names) + 1)
         fb.seek(start)
-        arrays, one_to_one = _parse(path, fb, names, layout, capacity, first)
+        arrays, one_to_one = _parse(path, fb, names, layout, capacity, first, freeze)
     N = next(iter(arrays.values())).shape[0]
     if N == 0:
         raise DataError("no data rows after the header", file=path.name)
     check_row_count(path, recorded, N)
-    if not freeze:
-        return arrays, ((first, N) if one_to_one else None)
-    for k in list(arrays):  # immutable one at a time (TorqueLog keeps them without a copy):
-        arrays[k] = _checks.frozen(arrays.pop(k))  # the copy of one array at a time only
     return arrays, ((first, N) if one_to_one else None)
 
 
@@ -145,10 +140,16 @@ def _parse(
     layout: dict[str, list[int]],
     capacity: int,
     first: int,
+    freeze: bool,
 ) -> tuple[dict[str, NDArray[np.float64]], bool]:
     """Parse the data rows a chunk of text at a time straight into the per-signal arrays
-    (allocated for ``capacity`` rows, returned cut to the rows found), and say whether rows
-    map to lines one to one (no blank or comment line skipped).
+    (allocated for ``capacity`` rows, returned cut to the rows found; read-only when
+    ``freeze``), and say whether rows map to lines one to one (no blank or comment line
+    skipped).
+
+    Frozen arrays are filled in buffers that only they hold and then seen through read-only
+    views of those buffers (:func:`dynid._checks.frozen` keeps them as they are): never
+    copied, so that a long log is held once.
 
     Each chunk is read by numpy's C number reader, only the columns ``layout`` takes; a
     chunk that is not a clean table of numbers there (an empty cell, a comment line, a
@@ -159,7 +160,13 @@ def _parse(
     used = sorted({c for cols in layout.values() for c in cols})
     at = {c: i for i, c in enumerate(used)}
     take = {k: [at[c] for c in cols] for k, cols in layout.items()}
-    out = {k: np.empty((capacity, len(c))) for k, c in layout.items()}
+    buffers = {k: bytearray(8 * capacity * len(c)) for k, c in layout.items()} if freeze else {}
+    out = {
+        k: np.frombuffer(buffers[k], np.float64).reshape(capacity, len(c))
+        if freeze
+        else np.empty((capacity, len(c)))
+        for k, c in layout.items()
+    }
     row, line = 0, first
     tail = b""
     one_to_one = True
@@ -193,7 +200,15 @@ def _parse(
         row += rows
         if last:
             break
-    return {k: a[:row] for k, a in out.items()}, one_to_one
+    if not freeze:
+        return {k: a[:row] for k, a in out.items()}, one_to_one
+    out.clear()  # the writable views gone: the buffers are reached read-only only
+    return {
+        k: np.frombuffer(memoryview(buffers[k]).toreadonly(), np.float64).reshape(capacity, len(c))[
+            :row
+        ]
+        for k, c in layout.items()
+    }, one_to_one
 
 
 def _fast_table(buf: bytes, width: int, used: list[int]) -> tuple[NDArray[np.float64], bool] | None:

@@ -265,11 +265,15 @@ def _check_rows(
     ok = np.isfinite(t)
     for k in _SIGNALS:
         if k in arrays:
-            ok &= np.isfinite(arrays[k]).all(axis=1)
+            for c in range(arrays[k].shape[1]):  # a column at a time: no (N, n) temporary
+                ok &= np.isfinite(arrays[k][:, c])
     bad = np.flatnonzero(~ok)
-    good = np.flatnonzero(ok)
-    tg = t[good]
-    dup = good[1:][tg[1:] == tg[:-1]]
+    if bad.size:
+        good = np.flatnonzero(ok)
+        tg = t[good]
+        dup = good[1:][tg[1:] == tg[:-1]]
+    else:  # every row valid (the usual log): no index of them
+        dup = np.flatnonzero(t[1:] == t[:-1]) + 1
     hint = "fix the file or pass --drop-invalid (drop_invalid=True) to drop such rows"
     if bad.size and not drop_invalid:
         r = int(bad[0])

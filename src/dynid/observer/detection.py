@@ -231,10 +231,17 @@ def standstill_series(
     n = model.n
     ta = _checks.as_array("t", t)
     dqa = _checks.as_exact("dq", dq, (ta.shape[0], n))
-    w = standstill_margin(model.friction, dqa)
+    N = ta.shape[0]
+    w = np.empty((N, n))
+    for a in range(0, N, _MARGIN_BLOCK):  # pointwise: a block's temporaries only
+        w[a : a + _MARGIN_BLOCK] = standstill_margin(model.friction, dqa[a : a + _MARGIN_BLOCK])
     if not np.any(w):
         return w
     return first_order_lag(ta, w, options.gains(n), options.rule)
+
+
+#: Samples of the standstill margin computed at a time (about ten temporaries of a block).
+_MARGIN_BLOCK = 1 << 16
 
 
 def calibrate(

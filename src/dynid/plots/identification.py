@@ -118,7 +118,8 @@ def heldout_torques(
         trim = model.info.log.trim_s
         t0, t1 = float(log.t[0]) + trim, float(log.t[-1]) - trim
         start = t0 + (k - 1) / k * (t1 - t0)
-        fitted, held = fold, log.select(log.t >= start - trim)
+        first = int(np.searchsorted(log.t, start - trim))  # the block's rows: a view
+        fitted, held = fold, log.select(slice(first, None))
         block = (
             f"the last of {k} time blocks, {start:.1f}-{float(log.t[-1]):.1f} s, predicted by "
             f"the fit of the other {k - 1}"

@@ -62,7 +62,7 @@ from ..observer.detection import (
 )
 from ..observer.model import ObserverModel, from_identified, from_robot
 from ..observer.pieces import PositionJump, pieces, position_jumps
-from ..observer.residual import DEFAULT_GAIN, ObserverOptions, observe
+from ..observer.residual import DEFAULT_GAIN, MomentumObserver, ObserverOptions
 from ..observer.results import LogObservation, ObserveResult
 from ..observer.wrench import external_wrench
 from ..signals import edge_seconds, filtered_derivative
@@ -380,13 +380,19 @@ def _observe_log(
         t, q, tau, n = log.t, log.q, log.tau, model.n
         r = np.full((t.shape[0], n), np.nan)
         std = np.full_like(r, np.nan) if wants_std else None
-        margin = np.zeros_like(r) if wants_margin else None
+        margin = np.zeros(r.shape) if wants_margin else None  # untouched where it stays 0
         for a, b in spans:
-            r[a:b] = observe(model, t[a:b], q[a:b], dq[a:b], tau[a:b], options).r
+            obs = MomentumObserver(model, options)  # one per piece, run a block at a time:
+            for c in range(a, b, _OBSERVE_BLOCK):  # no full-length copies of the residual
+                d = min(c + _OBSERVE_BLOCK, b)
+                r[c:d] = obs.run(t[c:d], q[c:d], dq[c:d], tau[c:d])
             if std is not None:
                 std[a:b] = residual_std(model, t[a:b], q[a:b], dq[a:b], options)
             if margin is not None:
-                margin[a:b] = standstill_series(model, t[a:b], dq[a:b], options)
+                m = standstill_series(model, t[a:b], dq[a:b], options)
+                if np.any(m):  # a friction without a band: its zeros not written (no memory)
+                    margin[a:b] = m
+                del m
         wrench = None
         if opts.frame is not None:
             wrench = external_wrench(model.robot, log.q, r, opts.frame)
@@ -400,6 +406,10 @@ def _observe_log(
         )
 
     return in_file(path, run)
+
+
+#: Samples the observer runs on at a time (its state carried from block to block).
+_OBSERVE_BLOCK = 1 << 16
 
 
 def _piece_velocities(log: TorqueLog, starts: list[int]) -> NDArray[np.float64]:

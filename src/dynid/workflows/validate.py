@@ -13,7 +13,8 @@ with every policy the command applies, so that the Python API behaves as the com
   the recordings' motion (:func:`~dynid.friction.validation.recorded_cutoff`).
 * Each recording, and each piece of one cut at a gap longer than ``max_gap_s``, is
   filtered and differentiated on its own; the errors are pooled over every sample and
-  given per recording (:func:`~dynid.friction.recordings.validate_pieces`).
+  given per recording (:func:`~dynid.friction.recordings.validate_recordings`: a long
+  piece prepared and predicted a block at a time).
 * The verdict (:func:`~dynid.identification.verdict.judge_prediction`): the error against
   the sensor-noise floor read from the measured torques, and whether they are
   anti-correlated with the model's; over all recordings and per recording, the worst
@@ -32,7 +33,7 @@ from numpy.typing import NDArray
 
 from ..exceptions import DataError, OptionError
 from ..friction.model import FrictionModel, FrictionSum
-from ..friction.recordings import RecordingsValidation, prepare_pieces, validate_pieces
+from ..friction.recordings import RecordingsValidation, validate_recordings
 from ..friction.validation import RECORDED, own_friction
 from ..identification.metrics import TorqueErrors
 from ..identification.model import IdentifiedModel
@@ -208,15 +209,15 @@ def validate_files(
     friction, source = _friction(model, opt.friction, feasible)
 
     def run() -> RecordingsValidation:
-        pieces = prepare_pieces(
+        return validate_recordings(
             model,
             rec.logs,
             rec.names,
+            friction=friction,
             cutoff_hz=RECORDED if opt.cutoff_hz is None else opt.cutoff_hz,
             max_gap_s=opt.max_gap_s,
             drive=drive,
         )
-        return validate_pieces(model, pieces, friction=friction)
 
     val = in_file(rec.paths[0], run) if len(rec.paths) == 1 else run()
     errors = val.errors
