@@ -187,3 +187,52 @@ def test_the_observer_takes_both(both, panda):
     motor_only = obs.with_friction(friction_of(model.terms["friction"].friction))
     r_motor = observe(motor_only, log.t, log.q, log.dq, log.tau, opts).r[200:]
     assert np.abs(r).max() < 1e-3 < 0.1 < np.abs(r_motor[:, 6]).max()
+
+
+def test_the_report_shows_both_frictions(both, tmp_path):
+    """identification.json of an ``at:both`` model has no top-level ``friction`` (null): the
+    HTML report reads its ``terms`` and shows a table for the friction at the motors and one
+    for the friction at the joints, each value that of the model with its std."""
+    from html.parser import HTMLParser
+
+    from dynid.io.model_json import save_model_json
+    from dynid.report import RunSummary, render_html_report
+
+    model, _, _ = both
+    p = save_model_json(tmp_path / "identification.json", model)
+    page = render_html_report(RunSummary(command="identify"), {p.name: p}, out=tmp_path)
+
+    class Tables(HTMLParser):
+        def __init__(self) -> None:
+            super().__init__(convert_charrefs=True)
+            self.rows: list[list[str]] = []
+            self.headings: list[str] = []
+            self._h2 = False
+
+        def handle_starttag(self, tag, attrs):
+            self._h2 = tag == "h2"
+            if tag == "tr":
+                self.rows.append([])
+            elif tag in ("td", "th"):
+                self.rows[-1].append("")
+
+        def handle_data(self, data):
+            if self._h2:
+                self.headings.append(data)
+            elif self.rows and self.rows[-1]:
+                self.rows[-1][-1] += data
+
+        def handle_endtag(self, tag):
+            self._h2 = False if tag == "h2" else self._h2
+
+    t = Tables()
+    t.feed(page)
+    assert any("at the motors" in h for h in t.headings), t.headings
+    assert any("at the joints" in h for h in t.headings), t.headings
+    joint = model.terms["joint friction"]
+    header = next(r for r in t.rows if r and r[0] == "joint" and "jfv [N m s/rad]" in r)
+    row7 = next(r for r in t.rows if len(r) == len(header) and r[0].endswith("joint7"))
+    fv = float(row7[header.index("jfv [N m s/rad]")].split("\u00b1")[0])
+    assert fv == pytest.approx(joint.values[0], rel=1e-3) and fv == pytest.approx(JFV, abs=1e-3)
+    motors = [r for r in t.rows if r and r[0].startswith("motor ")]
+    assert len(motors) == 7  # fv, fc at each motor
