@@ -236,3 +236,27 @@ def test_the_report_shows_both_frictions(both, tmp_path):
     assert fv == pytest.approx(joint.values[0], rel=1e-3) and fv == pytest.approx(JFV, abs=1e-3)
     motors = [r for r in t.rows if r and r[0].startswith("motor ")]
     assert len(motors) == 7  # fv, fc at each motor
+
+
+def test_friction_selection_judges_the_sum_on_held_out_data(both, panda):
+    """``dynid friction`` on the recordings the at:both model was identified from: its own
+    friction (the sum) is a candidate, refitted part by part on the other recording (exact
+    data: held-out error at round-off, below every single law, which cannot hold friction
+    at the motors and at joint 7 at once); friction.json holds one law, so the best law is
+    kept and a warning says the model's own predicts best."""
+    from dynid.exceptions import DynidWarning
+    from dynid.friction.recordings import pieces_residual, prepare_pieces
+    from dynid.friction.select import OWN, select_friction
+
+    model, _, _ = both
+    logs = _logs(panda, joint_side=True)[0]
+    pieces = prepare_pieces(model, logs, ["a.csv", "b.csv"], cutoff_hz=None, max_gap_s=None)
+    res = pieces_residual(model, pieces)
+    own = own_friction(model)
+    with pytest.warns(DynidWarning, match="own friction .* predicts the held-out data best"):
+        sel = select_friction(res, pieces.drive, own=own, own_fitted_here=True)
+    scores = {s.name: s for s in sel.scores}
+    assert sel.chosen == OWN and sel.scores[-1].name == OWN
+    assert scores[OWN].heldout_error_percent < 1e-6
+    assert min(s.heldout_error_percent for s in sel.scores if s.name != OWN) > 1e-3
+    assert sel.fit.friction.kind in scores and sel.fit.friction.kind != OWN
