@@ -112,7 +112,8 @@ def recordings_lines(recordings: Any) -> list[str]:
 
 
 def selection_lines(selection: Any) -> list[str]:
-    """The model structures judged on held-out data, the one kept marked ``*``."""
+    """The model structures judged on held-out data, the one kept marked ``*``, those
+    skipped because their friction is not dissipative ``x`` (one note says why)."""
     if not selection:
         return []
     # a per-joint structure's coefficients left out go last ("- fo1 - fc4"), so that the
@@ -126,8 +127,12 @@ def selection_lines(selection: Any) -> list[str]:
         f"    {'structure':<{w}} {'params':>6} {'train %':>9} {'held-out %':>11} {'+- se':>7}"
         + ("  left out (coefficient and joint)" if left else ""),
     ]
-    for c, (name, _, dropped) in zip(selection["candidates"], split, strict=True):
+    cands = selection["candidates"]
+    # skipped (not dissipative within the velocity limits) unless every candidate is
+    skip = not all(c.get("not_dissipative") for c in cands)
+    for c, (name, _, dropped) in zip(cands, split, strict=True):
         mark = "*" if c["name"] == selection["chosen"] else " "
+        mark = "x" if skip and c.get("not_dissipative") else mark
         out.append(
             f"  {mark} {name:<{w}} {c['n_params']:>6} {c['train_error_percent']:>9.4g} "
             f"{c['heldout_error_percent']:>11.4g} {c['heldout_se_percent']:>7.2g}"

@@ -251,12 +251,12 @@ def select_structure(
             fit_rtol,
         )
     chosen = _chosen(judged)
-    notes += [
-        f"{c.structure.name}: skipped, its friction is not dissipative within the velocity "
-        f"limits ({', '.join(v.split(' (')[0] for v in c.unphysical)})"
-        for c in judged
-        if c.unphysical and len(_physical(judged)) < len(judged)
-    ]
+    skipped = [c for c in judged if c.unphysical] if len(_physical(judged)) < len(judged) else []
+    if skipped:  # one line: the table marks each (metadata.selection names the joints)
+        notes.append(
+            f"{len(skipped)} candidate(s) marked x skipped: their friction is not dissipative "
+            "within the velocity limits (where: metadata.selection.candidates[].not_dissipative)"
+        )
     per: tuple[tuple[str, float], ...] = ()
     if len(data.names) > 1 and validation is None:
         per = _per_recording(chosen, full, groups, data.names, robot.n, fit_rtol)

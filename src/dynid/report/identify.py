@@ -300,11 +300,13 @@ def _structure_section(doc: dict) -> str:
         return ""
     chosen = sel.get("chosen")
     rows, marked = [], []
+    skip = not all(c.get("not_dissipative") for c in sel["candidates"])
     for c in sel["candidates"]:
         mark = c.get("name") == chosen
+        skipped = skip and bool(c.get("not_dissipative"))
         rows.append(
             [
-                "&#10003; chosen" if mark else "",
+                "&#10003; chosen" if mark else "skipped: not dissipative" if skipped else "",
                 esc(c.get("name", "")),
                 cell(c.get("terms") or []),
                 cell(c.get("n_params")),
