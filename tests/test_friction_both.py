@@ -260,3 +260,18 @@ def test_friction_selection_judges_the_sum_on_held_out_data(both, panda):
     assert scores[OWN].heldout_error_percent < 1e-6
     assert min(s.heldout_error_percent for s in sel.scores if s.name != OWN) > 1e-3
     assert sel.fit.friction.kind in scores and sel.fit.friction.kind != OWN
+
+
+def test_a_part_left_out_at_the_motors_stays_named_while_the_joints_hold_it():
+    """The per-joint search leaving out viscous friction at every motor of an ``at:both``
+    model: the joints still hold ``jfv7``, so the name keeps ``viscous`` and its left-out
+    coefficients (it read ``links + coulomb + offset + at:both``, which drops ``jfv7``);
+    left out at joint 7 as well, viscous goes from the name."""
+    motors = "".join(f", -fv{j}" for j in range(1, 8))
+    s = Structure.parse("viscous, coulomb, offset, at:both" + motors)
+    kept = s.collapsed(7, joint_side_joints(_drive()))
+    assert kept == s and "viscous" in kept.name and " - fv7" in kept.name
+    assert kept.joint_mask(7, (6,))[2 * 6]  # jfv7 held (joint by joint: jfv, jfc)
+    assert s.collapsed(7) == s  # the joints unknown: nothing at both places is removed
+    gone = Structure.parse("viscous, coulomb, offset, at:both, -jfv7" + motors)
+    assert gone.collapsed(7, (6,)) == Structure.parse("coulomb, offset, at:both")

@@ -65,6 +65,7 @@ from .structure import (
     check_placement,
     coefficient_labels,
     friction_placements,
+    joint_side_joints,
     largest_terms,
     own_rotors,
     structure_terms,
@@ -389,9 +390,11 @@ def _per_joint(
             if step is None or step.heldout_error_percent > limit:
                 break
             here = step
-        reached = here.structure.collapsed(n)
+        drive = model.drive if start.at == "both" else None
+        reached = here.structure.collapsed(n, () if drive is None else joint_side_joints(drive))
         if reached not in [c.structure for c in (*judged, *out)]:
-            out.append(replace(here, structure=reached))
+            left = tuple(lab for lab in here.structure.drop if lab not in start.drop)
+            out.append(replace(here, structure=reached, left_out=left))
     return out
 
 

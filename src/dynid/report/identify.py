@@ -301,6 +301,7 @@ def _structure_section(doc: dict) -> str:
     chosen = sel.get("chosen")
     rows, marked = [], []
     skip = not all(c.get("not_dissipative") for c in sel["candidates"])
+    left = any(c.get("left_out") for c in sel["candidates"])
     for c in sel["candidates"]:
         mark = c.get("name") == chosen
         skipped = skip and bool(c.get("not_dissipative"))
@@ -314,6 +315,7 @@ def _structure_section(doc: dict) -> str:
                 cell(c.get("heldout_error_percent")),
                 cell(c.get("heldout_se_percent")),
             ]
+            + ([esc(" ".join(c.get("left_out") or ()))] if left else [])
         )
         marked.append(mark)
     headers = [
@@ -324,7 +326,7 @@ def _structure_section(doc: dict) -> str:
         "training error [%]",
         "held-out error [%]",
         "held-out std. error [%]",
-    ]
+    ] + (["left out per joint"] if left else [])
     rule = f"Rule: {esc(sel.get('rule', ''))}; validation: {esc(sel.get('validation', ''))}."
     parts = [f"<p>{rule}</p>", table(headers, rows, marked=marked)]
     per = [r for r in sel.get("heldout_per_recording") or () if isinstance(r, dict)]
