@@ -428,7 +428,15 @@ def format_observation(result: ObserveResult, names: list[str], *, calibrating: 
     at_rest = calibrating and th.standstill and np.any(rest > th.contact)
     if at_rest:
         cols["at rest [N m]"] = rest
+    truth = [err for x in result.logs if (err := x.truth_error()) is not None]
+    if truth:
+        cols["RMS r - tau_ext [N m]"] = np.sqrt(np.mean(np.square(truth), axis=0))
     rows = [format_rms_table(names, cols)]
+    if truth:
+        rows.append(
+            f"r - tau_ext: the residual against the true external torques of {len(truth)} "
+            "log(s) (columns tau_ext, a simulation's ground truth), the observer's lag included"
+        )
     if calibrating:
         what = "largest" if th.quantile == 1.0 else f"{th.quantile:g} quantile of the"
         rows.append(
