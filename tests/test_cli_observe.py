@@ -80,7 +80,10 @@ def test_observe_calibrates_then_finds_both_simulated_contacts(logs, capsys):
     assert np.median(table[during, 8]) == pytest.approx(10.0, abs=1.0)  # fx of the push
     assert (out / "residuals.png").stat().st_size > 10_000
     assert "residuals.png" in (out / "report.html").read_text()
-    assert "2 event(s)" in capsys.readouterr().out
+    said = capsys.readouterr()
+    assert "2 event(s)" in said.out
+    # the true external torques simulate wrote: compared with, not called ignored
+    assert "RMS r - tau_ext [N m]" in said.out and "ground truth" in said.out
 
 
 def test_observe_with_a_consistent_robot_raises_no_event_on_a_free_log(logs):

@@ -59,3 +59,22 @@ def test_the_structure_table_stays_aligned_with_a_long_structure_name():
     sel = {"validation": "5 folds", "chosen": "base", "rule": "lowest", "candidates": cands}
     lines = selection_lines(sel)[1:]
     assert len({len(s) for s in lines}) == 1, lines
+
+
+def test_the_structure_table_lists_every_coefficient_the_per_joint_search_left_out():
+    """A per-joint structure whose search left viscous friction out on every joint: the
+    name no longer holds ``viscous`` and its ``- fo2`` alone would hide that; the left-out
+    column lists every coefficient left out from where the search started (``fv1-7``)."""
+    row = {"n_params": 40, "train_error_percent": 1.5, "heldout_error_percent": 2.0}
+    row |= {"heldout_se_percent": 0.1}
+    left = [f"fv{j}" for j in range(1, 8)] + ["fo2"]
+    cands = [
+        row | {"name": "links + viscous + coulomb + offset"},
+        row | {"name": "links + coulomb + offset - fo2", "left_out": left},
+    ]
+    chosen = cands[1]["name"]
+    sel = {"validation": "5 folds", "chosen": chosen, "rule": "lowest", "candidates": cands}
+    lines = selection_lines(sel)
+    assert lines[1].endswith("left out per joint (coefficient and joint)")
+    assert lines[3].startswith("  * links + coulomb + offset ") and lines[3].endswith("  fv1-7 fo2")
+    assert lines[2].rstrip() == lines[2] and not lines[2].endswith("fo2")

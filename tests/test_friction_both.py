@@ -187,3 +187,91 @@ def test_the_observer_takes_both(both, panda):
     motor_only = obs.with_friction(friction_of(model.terms["friction"].friction))
     r_motor = observe(motor_only, log.t, log.q, log.dq, log.tau, opts).r[200:]
     assert np.abs(r).max() < 1e-3 < 0.1 < np.abs(r_motor[:, 6]).max()
+
+
+def test_the_report_shows_both_frictions(both, tmp_path):
+    """identification.json of an ``at:both`` model has no top-level ``friction`` (null): the
+    HTML report reads its ``terms`` and shows a table for the friction at the motors and one
+    for the friction at the joints, each value that of the model with its std."""
+    from html.parser import HTMLParser
+
+    from dynid.io.model_json import save_model_json
+    from dynid.report import RunSummary, render_html_report
+
+    model, _, _ = both
+    p = save_model_json(tmp_path / "identification.json", model)
+    page = render_html_report(RunSummary(command="identify"), {p.name: p}, out=tmp_path)
+
+    class Tables(HTMLParser):
+        def __init__(self) -> None:
+            super().__init__(convert_charrefs=True)
+            self.rows: list[list[str]] = []
+            self.headings: list[str] = []
+            self._h2 = False
+
+        def handle_starttag(self, tag, attrs):
+            self._h2 = tag == "h2"
+            if tag == "tr":
+                self.rows.append([])
+            elif tag in ("td", "th"):
+                self.rows[-1].append("")
+
+        def handle_data(self, data):
+            if self._h2:
+                self.headings.append(data)
+            elif self.rows and self.rows[-1]:
+                self.rows[-1][-1] += data
+
+        def handle_endtag(self, tag):
+            self._h2 = False if tag == "h2" else self._h2
+
+    t = Tables()
+    t.feed(page)
+    assert any("at the motors" in h for h in t.headings), t.headings
+    assert any("at the joints" in h for h in t.headings), t.headings
+    joint = model.terms["joint friction"]
+    header = next(r for r in t.rows if r and r[0] == "joint" and "jfv [N m s/rad]" in r)
+    row7 = next(r for r in t.rows if len(r) == len(header) and r[0].endswith("joint7"))
+    fv = float(row7[header.index("jfv [N m s/rad]")].split("\u00b1")[0])
+    assert fv == pytest.approx(joint.values[0], rel=1e-3) and fv == pytest.approx(JFV, abs=1e-3)
+    motors = [r for r in t.rows if r and r[0].startswith("motor ")]
+    assert len(motors) == 7  # fv, fc at each motor
+
+
+def test_friction_selection_judges_the_sum_on_held_out_data(both, panda):
+    """``dynid friction`` on the recordings the at:both model was identified from: its own
+    friction (the sum) is a candidate, refitted part by part on the other recording (exact
+    data: held-out error at round-off, below every single law, which cannot hold friction
+    at the motors and at joint 7 at once); friction.json holds one law, so the best law is
+    kept and a warning says the model's own predicts best."""
+    from dynid.exceptions import DynidWarning
+    from dynid.friction.recordings import pieces_residual, prepare_pieces
+    from dynid.friction.select import OWN, select_friction
+
+    model, _, _ = both
+    logs = _logs(panda, joint_side=True)[0]
+    pieces = prepare_pieces(model, logs, ["a.csv", "b.csv"], cutoff_hz=None, max_gap_s=None)
+    res = pieces_residual(model, pieces)
+    own = own_friction(model)
+    with pytest.warns(DynidWarning, match="own friction .* predicts the held-out data best"):
+        sel = select_friction(res, pieces.drive, own=own, own_fitted_here=True)
+    scores = {s.name: s for s in sel.scores}
+    assert sel.chosen == OWN and sel.scores[-1].name == OWN
+    assert scores[OWN].heldout_error_percent < 1e-6
+    assert min(s.heldout_error_percent for s in sel.scores if s.name != OWN) > 1e-3
+    assert sel.fit.friction.kind in scores and sel.fit.friction.kind != OWN
+
+
+def test_a_part_left_out_at_the_motors_stays_named_while_the_joints_hold_it():
+    """The per-joint search leaving out viscous friction at every motor of an ``at:both``
+    model: the joints still hold ``jfv7``, so the name keeps ``viscous`` and its left-out
+    coefficients (it read ``links + coulomb + offset + at:both``, which drops ``jfv7``);
+    left out at joint 7 as well, viscous goes from the name."""
+    motors = "".join(f", -fv{j}" for j in range(1, 8))
+    s = Structure.parse("viscous, coulomb, offset, at:both" + motors)
+    kept = s.collapsed(7, joint_side_joints(_drive()))
+    assert kept == s and "viscous" in kept.name and " - fv7" in kept.name
+    assert kept.joint_mask(7, (6,))[2 * 6]  # jfv7 held (joint by joint: jfv, jfc)
+    assert s.collapsed(7) == s  # the joints unknown: nothing at both places is removed
+    gone = Structure.parse("viscous, coulomb, offset, at:both, -jfv7" + motors)
+    assert gone.collapsed(7, (6,)) == Structure.parse("coulomb, offset, at:both")

@@ -83,7 +83,14 @@ def test_the_selection_skips_a_law_that_pushes_the_arm(panda_data):
     assert judged[quadratic].heldout_error_percent < judged[cands[0]].heldout_error_percent
     assert any(v.startswith("fq") for v in judged[quadratic].unphysical)
     assert sel.chosen == cands[0]
-    assert any("skipped" in note and quadratic.name in note for note in sel.notes)
+    # the printed table marks the skipped candidate (x) and one line says why
+    from dynid.cli.summaries import selection_lines
+
+    lines = selection_lines(sel.as_dict())
+    marks = {line[4:].split("  ")[0].strip(): line[2] for line in lines[2:] if line[2] in "*x "}
+    assert marks[sel.chosen.name] == "*" and marks[quadratic.name] == "x", marks
+    said = [line for line in lines if "not dissipative" in line]
+    assert len(said) == 1 and said[0].startswith("  note: 1 candidate(s) marked x skipped")
 
 
 def test_identify_warns_of_a_given_law_that_pushes_the_arm(panda_data):

@@ -458,6 +458,12 @@ def test_model_structure_table_marks_the_chosen_candidate(runs, tmp_path):
             {"name": "classical", "terms": ["fv", "fc", "fo"], "n_params": 64,
              "train_error_percent": 0.38, "heldout_error_percent": 0.40,
              "heldout_se_percent": 0.02},
+            {"name": "quadratic", "terms": ["fv", "fq", "fc", "fo"], "n_params": 71,
+             "train_error_percent": 0.30, "heldout_error_percent": 0.35,
+             "heldout_se_percent": 0.02, "not_dissipative": ["fq3 < 0 (joint 3)"]},
+            {"name": "coulomb - fo2", "terms": ["fc", "fo", "-fo2"], "n_params": 56,
+             "train_error_percent": 0.39, "heldout_error_percent": 0.40,
+             "heldout_se_percent": 0.02, "left_out": ["fv1", "fv2", "fo2"]},
         ],
     }  # fmt: skip
     p = tmp_path / "identification.json"
@@ -467,6 +473,8 @@ def test_model_structure_table_marks_the_chosen_candidate(runs, tmp_path):
     structure = next(t for t in page.tables if "candidate" in t[0])
     assert structure[0][:2] == ["", "candidate"] and "held-out error [%]" in structure[0]
     assert structure[2][:2] == ["\u2713 chosen", "classical"] and structure[1][0] == ""
+    assert structure[3][:2] == ["skipped: not dissipative", "quadratic"]
+    assert structure[0][-1] == "left out per joint" and structure[4][-1] == "fv1 fv2 fo2"
     assert '<tr class="marked"><td>&#10003; chosen</td><td>classical' in page_text
     assert "Terms chosen: classical" in " ".join(" ".join(page.text).split())
     doc["metadata"]["selection"]["heldout_per_recording"] = [

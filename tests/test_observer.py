@@ -153,6 +153,15 @@ def test_residual_of_a_simulated_contact_converges_to_the_true_external_torque()
     res = observe(from_robot(robot), log.t, log.q, log.dq, log.tau, ObserverOptions(gain=40.0))
     truth = first_order_lag(log.t, tau_ext, 40.0)
     assert np.abs(res.r - truth).max() < 1e-3
+    # the residual against the truth the log stores: the lag's own error, per joint
+    from pathlib import Path
+
+    from dynid.observer.results import LogObservation
+
+    seen = LogObservation(Path("x.csv"), log.t, res.r, None, [], None, tau_ext)
+    lag_rms = np.sqrt(np.mean((truth - tau_ext) ** 2, axis=0))
+    np.testing.assert_allclose(seen.truth_error(), lag_rms, atol=1e-3)
+    assert np.max(lag_rms) > 0.1  # the lag is what is left: the comparison is not trivial
 
 
 def test_step_equals_batch_and_the_numpy_path_with_variable_sample_times(identified):

@@ -181,3 +181,21 @@ def test_the_margin_of_a_coupled_drive_is_taken_at_the_motors():
     dq = np.array([[0.0, 0.0], [0.001, -0.001], [0.0, 0.01]])  # motors (0, 0), (0.1, 0), (0, 0.5)
     expected = np.array([[250.0, 50.0], [50.0, 50.0], [200.0, 0.0]])
     assert standstill_margin(fr, dq) == pytest.approx(expected, abs=1e-12)
+
+
+def test_the_margin_of_friction_at_the_motors_and_the_joints_adds_both():
+    """A friction sum (``at:both``): the motors' Coulomb levels through ``|K|^T`` where each
+    motor's velocity is inside its band, plus the joints' own where each joint's is
+    (hand-computed; it was zero)."""
+    from dynid.friction.model import FrictionSum
+    from dynid.model.drive import Drive
+
+    K2 = np.array([[100.0, 0.0], [50.0, 50.0]])
+    drive = Drive(K2, np.zeros(2), side="motor", friction_at="motor")
+    z = np.zeros(2)
+    motor = ClassicalFriction(z, np.array([2.0, 1.0]), z, np.full(2, 0.05)).at(drive)
+    joint = ClassicalFriction(z, np.array([0.0, 0.3]), z, np.full(2, 0.002))
+    dq = np.array([[0.0, 0.0], [0.001, -0.001], [0.0, 0.01]])
+    # motors as in the coupled test; joint 2's own 0.3 where |dq_2| <= 0.002
+    expected = np.array([[250.0, 50.3], [50.0, 50.3], [200.0, 0.0]])
+    assert standstill_margin(FrictionSum((motor, joint)), dq) == pytest.approx(expected, abs=1e-12)

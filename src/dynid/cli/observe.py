@@ -23,7 +23,8 @@ Two steps:
   and end [s], joints (1-based), peak [N m] per joint and level, contact or collision, of
   every event), OUT/residuals.csv (t, r1..rn and, with --frame, the external wrench at
   that frame by damped least squares) and OUT/residuals.png (residuals, thresholds,
-  events, and the true tau_ext that `dynid simulate --contact` writes beside a log).
+  events, and the true tau_ext that `dynid simulate --contact` writes beside a log; the
+  summary then gives the RMS of the residual against it per joint).
 Several logs (or a folder of them): residuals_<name>.csv and .png each, one events.json;
 logs of one name in different folders are named by their folder. With --thresholds the
 calibration's options (--gain, --discretisation, --rule, --margin, --quantile,

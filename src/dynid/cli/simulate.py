@@ -17,7 +17,8 @@ FRAME:WRENCH:START,END pushes with a wrench (fx,fy,fz [N] and optionally mx,my,m
 base axes) at a frame's origin (a link, flange) over a window [s] (repeatable;
 --contact-ramp rounds the edges): the arm still follows the trajectory, so its torques
 lose tau_ext = J^T w, and the true external joint torques are written beside the log as
-columns tau_ext1..n (every reader of the log ignores them; `dynid observe` plots them).
+columns tau_ext1..n (ground truth: no reader takes them as data; `dynid observe` plots
+them and reports its residual against them).
 Limits are
 checked; by default a trajectory that exceeds them is scaled down in amplitude
 (--scale amplitude), or slowed down (--scale time), or kept (--scale none).

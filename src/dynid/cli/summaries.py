@@ -112,26 +112,37 @@ def recordings_lines(recordings: Any) -> list[str]:
 
 
 def selection_lines(selection: Any) -> list[str]:
-    """The model structures judged on held-out data, the one kept marked ``*``."""
+    """The model structures judged on held-out data, the one kept marked ``*``, those
+    skipped because their friction is not dissipative ``x`` (one note says why)."""
     if not selection:
         return []
     # a per-joint structure's coefficients left out go last ("- fo1 - fc4"), so that the
     # table is as wide as the structures' names without them
     split = [str(c["name"]).partition(" - ") for c in selection["candidates"]]
+    # the per-joint search's every coefficient left out: a part left out on every joint
+    # is gone from the name (``viscous``) and listed here (``fv1-7``)
+    split = [
+        (name, _, " - ".join(c.get("left_out") or ()) or dropped)
+        for c, (name, _, dropped) in zip(selection["candidates"], split, strict=True)
+    ]
     w = _width("structure", [name for name, _, _ in split], 46)
     left = any(dropped for _, _, dropped in split)
     out = [
         f"model structure chosen on held-out data ({selection['validation']}): "
         f"{selection['chosen']} ({selection['rule']})",
         f"    {'structure':<{w}} {'params':>6} {'train %':>9} {'held-out %':>11} {'+- se':>7}"
-        + ("  left out (coefficient and joint)" if left else ""),
+        + ("  left out per joint (coefficient and joint)" if left else ""),
     ]
-    for c, (name, _, dropped) in zip(selection["candidates"], split, strict=True):
+    cands = selection["candidates"]
+    # skipped (not dissipative within the velocity limits) unless every candidate is
+    skip = not all(c.get("not_dissipative") for c in cands)
+    for c, (name, _, dropped) in zip(cands, split, strict=True):
         mark = "*" if c["name"] == selection["chosen"] else " "
+        mark = "x" if skip and c.get("not_dissipative") else mark
         out.append(
             f"  {mark} {name:<{w}} {c['n_params']:>6} {c['train_error_percent']:>9.4g} "
             f"{c['heldout_error_percent']:>11.4g} {c['heldout_se_percent']:>7.2g}"
-            + (f"  {dropped.replace(' - ', ' ')}" if dropped else "")
+            + (f"  {_compact(dropped.split(' - '))}" if dropped else "")
         )
     per = selection.get("heldout_per_recording") or ()
     if per:
@@ -146,6 +157,32 @@ def selection_lines(selection: Any) -> list[str]:
         )
     out += [f"  note: {line}" for line in selection.get("notes", ())]
     return out
+
+
+def _compact(labels: list[str]) -> str:
+    """``fv1 fv2 fv3 fo2`` as ``fv1-3 fo2``: each coefficient's joints, runs joined."""
+    joints: dict[str, list[int]] = {}
+    for lab in labels:
+        stem = lab.rstrip("0123456789")
+        if stem == lab:
+            joints.setdefault(lab, [])
+            continue
+        joints.setdefault(stem, []).append(int(lab[len(stem) :]))
+    out = []
+    for stem, js in joints.items():
+        if not js:
+            out.append(stem)
+            continue
+        js = sorted(set(js))
+        runs: list[list[int]] = [[js[0]]]
+        for j in js[1:]:
+            if j == runs[-1][-1] + 1:
+                runs[-1].append(j)
+            else:
+                runs.append([j])
+        for r in runs:
+            out += [f"{stem}{r[0]}-{r[-1]}"] if len(r) > 2 else [f"{stem}{j}" for j in r]
+    return " ".join(out)
 
 
 def samples_text(log: LogInfo) -> str:
@@ -391,7 +428,15 @@ def format_observation(result: ObserveResult, names: list[str], *, calibrating: 
     at_rest = calibrating and th.standstill and np.any(rest > th.contact)
     if at_rest:
         cols["at rest [N m]"] = rest
+    truth = [err for x in result.logs if (err := x.truth_error()) is not None]
+    if truth:
+        cols["RMS r - tau_ext [N m]"] = np.sqrt(np.mean(np.square(truth), axis=0))
     rows = [format_rms_table(names, cols)]
+    if truth:
+        rows.append(
+            f"r - tau_ext: the residual against the true external torques of {len(truth)} "
+            "log(s) (columns tau_ext, a simulation's ground truth), the observer's lag included"
+        )
     if calibrating:
         what = "largest" if th.quantile == 1.0 else f"{th.quantile:g} quantile of the"
         rows.append(

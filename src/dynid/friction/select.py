@@ -30,6 +30,14 @@ friction (``own``, kept as it is when chosen). Every candidate is judged on held
 identified from this very log (``own_fitted_here``), by its law refitted on the other blocks
 as the others are, a tie going to the registry's law refitted on the whole log (judged on
 the samples its values were fitted to, the model's friction would always win).
+
+A model with friction at its motors and at its joints (a coupled drive's ``at:both``:
+:class:`~dynid.friction.model.FrictionSum`) has no one law of the registry to refit; its
+parts, linear in their coefficients, are refitted together on the other blocks (the
+coefficients the model holds, the others left at 0: the same structure). ``friction.json``
+holds one law of the registry: when the sum predicts best it is ``chosen`` (``own``), the
+kept fit is the best law of the registry and a warning says so (the model's own friction
+stays in its identification file).
 """
 
 from __future__ import annotations
@@ -46,7 +54,8 @@ from ..identification.holdout import DEFAULT_FOLDS, block_labels
 from ..model.drive import Drive
 from .fit import FrictionFit, FrictionResidual, fit_friction_through, fit_law_through
 from .laws import LAWS
-from .model import FrictionModel
+from .laws.base import _LinearFit, bounded_lstsq
+from .model import FrictionModel, FrictionSum
 
 __all__ = ["FOLDS", "OWN", "CandidateScore", "FrictionSelection", "select_friction"]
 
@@ -159,7 +168,7 @@ def select_friction(
     drive: Drive | None = None,
     *,
     candidates: Sequence[str] | None = None,
-    own: FrictionModel | None = None,
+    own: FrictionModel | FrictionSum | None = None,
     own_fitted_here: bool = False,
     folds: int = FOLDS,
 ) -> FrictionSelection:
@@ -174,8 +183,9 @@ def select_friction(
         The drive whose motors the friction acts at (:func:`~dynid.friction.fit.fit_law_through`).
     candidates : sequence of str, optional
         Laws of the registry to compare (default: all, :data:`~dynid.friction.laws.LAWS`).
-    own : FrictionModel, optional
-        The model's own friction, a candidate as it is (``"own"``).
+    own : FrictionModel or FrictionSum, optional
+        The model's own friction, a candidate as it is (``"own"``); a sum is refitted
+        part by part together (module docstring).
     own_fitted_here : bool
         The model's friction was identified from this log: it is judged by its law
         refitted on the other blocks (module docstring).
@@ -212,13 +222,20 @@ def select_friction(
 
     fits: dict[str, FrictionFit] = {}
     scores: list[CandidateScore] = []
+    own_score: CandidateScore | None = None
+    last = False  # the own friction judged by a refit goes last: a tie goes to a law
     if own is not None:
         tf = own.torques(res.dq)
-        fits[OWN] = _own_fit(own, res)
-        law = own.kind if own_fitted_here and own.kind in LAWS else None
-        held = err(tf) if law is None else err(_heldout_torques(res, drive, law, labels))
+        if isinstance(own, FrictionSum):
+            last = own_fitted_here
+            held = err(_heldout_sum(res, own, labels) if last else tf)
+        else:
+            fits[OWN] = _own_fit(own, res)
+            law = own.kind if own_fitted_here and own.kind in LAWS else None
+            held = err(tf) if law is None else err(_heldout_torques(res, drive, law, labels))
+            last = law is not None
         own_score = CandidateScore(OWN, own.names, err(tf), held)
-        if law is None:  # new data to the model: its prediction is held out as it is
+        if not last:  # new data to the model: its prediction is held out as it is
             scores.append(own_score)
     for name in names:
         with warnings.catch_warnings():
@@ -228,10 +245,63 @@ def select_friction(
         train = err(fits[name].friction.torques(res.dq))
         held = err(_heldout_torques(res, drive, name, labels))
         scores.append(CandidateScore(name, LAWS[name].params, train, held))
-    if own is not None and own_fitted_here and own.kind in LAWS:
-        scores.append(own_score)  # last: a tie goes to its law refitted on the whole log
+    if own_score is not None and last:
+        scores.append(own_score)
     best = min(scores, key=lambda s: s.heldout_error_percent)  # first of the lowest: simpler
+    if best.name == OWN and isinstance(own, FrictionSum):
+        kept = min((s for s in scores if s.name != OWN), key=lambda s: s.heldout_error_percent)
+        warnings.warn(
+            f"the model's own friction ({own.kind}) predicts the held-out data best "
+            f"({best.heldout_error_percent:.3g} % against {kept.heldout_error_percent:.3g} % "
+            f"for {kept.name}); friction.json holds one law of the registry, {kept.name}: "
+            "keep the model's own friction from its identification file",
+            DynidWarning,
+            stacklevel=2,
+        )
+        return FrictionSelection(fits[kept.name], OWN, tuple(scores), folds, method)
     return FrictionSelection(fits[best.name], best.name, tuple(scores), folds, method)
+
+
+def _heldout_sum(
+    res: FrictionResidual, own: FrictionSum, labels: NDArray[np.intp]
+) -> NDArray[np.float64]:
+    """Each block's friction torques (N, n) predicted by the parts of ``own`` refitted
+    together on the other blocks: the coefficients ``own`` holds (nonzero) by bounded
+    linear least squares within their laws' bounds (a part's torques at one coefficient set
+    to 1 are its column; a law not linear in its parameters gets one gain >= 0 per row,
+    its shape kept)."""
+    dq = res.dq
+    cols: list[NDArray[np.float64]] = []
+    lo: list[float] = []
+    hi: list[float] = []
+    for part in own.parts:
+        P = part.as_array()
+        units: list[tuple[NDArray[np.float64], float, float]] = []
+        if isinstance(part.law.fit, _LinearFit):
+            for m, i in zip(*np.nonzero(P), strict=True):
+                unit = np.zeros_like(P)
+                unit[m, i] = 1.0
+                units.append((unit, part.law.lower[i], part.law.upper[i]))
+        else:  # not linear in its parameters: one gain per row, its shape kept
+            for m in np.flatnonzero(np.any(P != 0, axis=1)):
+                unit = np.zeros_like(P)
+                unit[m] = P[m]
+                units.append((unit, 0.0, np.inf))
+        for unit, low, high in units:
+            cols.append(part.law.model(unit, part.band, part.drive).torques(dq).ravel())
+            lo.append(low)
+            hi.append(high)
+    out = np.zeros(dq.shape)
+    if not cols:
+        return out
+    A = np.column_stack(cols)
+    rows = np.repeat(labels, dq.shape[1])
+    r = res.residual.ravel()
+    for k in range(int(labels.max()) + 1):
+        b = rows == k
+        x = bounded_lstsq(A[~b], r[~b], np.array(lo), np.array(hi))
+        out.reshape(-1)[b] = A[b] @ x
+    return out
 
 
 def _folds(res: FrictionResidual, folds: int) -> tuple[NDArray[np.intp], int, str]:

@@ -56,6 +56,12 @@ class Candidate:
     fold_errors_percent : tuple of float
         Relative held-out error [%] of every fold judged (each recording left out, when
         the folds are recordings).
+    unphysical : tuple of str
+        Where its friction is not dissipative within the velocity limits.
+    left_out : tuple of str
+        A per-joint structure's coefficients left out from the candidate its search
+        started at, every one (``fv1 .. fv7`` too when the name no longer holds
+        ``viscous``).
     """
 
     structure: Structure
@@ -65,6 +71,7 @@ class Candidate:
     heldout_se_percent: float
     fold_errors_percent: tuple[float, ...] = ()
     unphysical: tuple[str, ...] = ()
+    left_out: tuple[str, ...] = ()
 
     def as_dict(self) -> dict[str, Any]:
         """JSON-ready."""
@@ -77,6 +84,7 @@ class Candidate:
             "heldout_se_percent": self.heldout_se_percent,
             "heldout_per_fold_percent": list(self.fold_errors_percent),
             "not_dissipative": list(self.unphysical),
+            "left_out": list(self.left_out),
         }
 
 

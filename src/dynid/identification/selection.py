@@ -65,6 +65,7 @@ from .structure import (
     check_placement,
     coefficient_labels,
     friction_placements,
+    joint_side_joints,
     largest_terms,
     own_rotors,
     structure_terms,
@@ -251,12 +252,12 @@ def select_structure(
             fit_rtol,
         )
     chosen = _chosen(judged)
-    notes += [
-        f"{c.structure.name}: skipped, its friction is not dissipative within the velocity "
-        f"limits ({', '.join(v.split(' (')[0] for v in c.unphysical)})"
-        for c in judged
-        if c.unphysical and len(_physical(judged)) < len(judged)
-    ]
+    skipped = [c for c in judged if c.unphysical] if len(_physical(judged)) < len(judged) else []
+    if skipped:  # one line: the table marks each (metadata.selection names the joints)
+        notes.append(
+            f"{len(skipped)} candidate(s) marked x skipped: their friction is not dissipative "
+            "within the velocity limits (where: metadata.selection.candidates[].not_dissipative)"
+        )
     per: tuple[tuple[str, float], ...] = ()
     if len(data.names) > 1 and validation is None:
         per = _per_recording(chosen, full, groups, data.names, robot.n, fit_rtol)
@@ -389,9 +390,11 @@ def _per_joint(
             if step is None or step.heldout_error_percent > limit:
                 break
             here = step
-        reached = here.structure.collapsed(n)
+        drive = model.drive if start.at == "both" else None
+        reached = here.structure.collapsed(n, () if drive is None else joint_side_joints(drive))
         if reached not in [c.structure for c in (*judged, *out)]:
-            out.append(replace(here, structure=reached))
+            left = tuple(lab for lab in here.structure.drop if lab not in start.drop)
+            out.append(replace(here, structure=reached, left_out=left))
     return out
 
 

@@ -175,13 +175,18 @@ class Structure:
                 )
         object.__setattr__(self, "drop", tuple(sorted(set(self.drop), key=_label_order)))
 
-    def collapsed(self, n: int) -> Structure:
+    def collapsed(self, n: int, joints: Sequence[int] = ()) -> Structure:
         """The same model with a part whose coefficients :attr:`drop` leaves out on every
         one of ``n`` joints removed from :attr:`friction` (``viscous + offset - fo1 - fo2``
-        on two joints is ``viscous``); Coulomb friction stays with a Stribeck part."""
+        on two joints is ``viscous``); Coulomb friction stays with a Stribeck part. With
+        ``at="both"`` a part held at the joints too goes only when also left out there on
+        every one of ``joints`` (0-based, :func:`joint_side_joints`; none given: it stays)."""
         drop, parts = set(self.drop), list(self.friction)
         for p in reversed(self.friction):  # a Stribeck part before the Coulomb it goes with
             labels = {f"{PART_LABELS[p]}{j + 1}" for j in range(n)}
+            if self.at == "both" and p in self.joint_parts:  # removed at both places
+                labels |= {f"{JOINT_PREFIX}{PART_LABELS[p]}{j + 1}" for j in joints}
+                labels |= set() if joints else {"the joints unknown"}
             if labels <= drop and not (p == "coulomb" and "stribeck" in parts):
                 parts.remove(p)
                 drop -= labels

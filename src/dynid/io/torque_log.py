@@ -10,11 +10,13 @@ columns, then one row per sample::
 Columns are found by name, in any order; ``n`` is the number of ``q`` columns
 (``q1..qn``, no gap). A duplicated column, a joint signal's column outside ``1..n``, or an
 incomplete ``ddq1..ddqn`` set is an error (a wrong column silently used is a wrong
-answer); any other column (labels, a vendor's estimates, true external torques
-``tau_ext1..n``) is ignored with a warning. Empty cells and ``nan`` read as NaN. A UTF-8
-byte-order mark is accepted. NPZ: arrays ``t`` (N,), ``q``, ``dq``, ``tau``, optionally
-``ddq`` (N, n) and ``n_rows``, loaded with ``allow_pickle=False``; other arrays are
-ignored with a warning.
+answer); any other column (labels, a vendor's estimates) is ignored with a warning; the
+true external torques ``tau_ext1..n`` that ``dynid simulate --contact`` writes are named
+once as ground truth (not read as data; ``dynid observe`` compares its residual with
+them). Empty cells and ``nan`` read as NaN. A UTF-8 byte-order mark is accepted. NPZ:
+arrays ``t`` (N,), ``q``, ``dq``, ``tau``, optionally ``ddq`` (N, n) and ``n_rows``,
+loaded with ``allow_pickle=False``; other arrays are ignored with a warning (``tau_ext``
+named as ground truth).
 
 Strict by default: a row holding NaN or inf, or repeating the previous timestamp, raises
 :class:`~dynid.exceptions.DataError` naming the first such row and the count. With
@@ -331,10 +333,7 @@ def _read_npz(path: Path) -> dict[str, NDArray[np.float64]]:
                     file=path.name,
                 )
             extra = sorted(set(npz.files) - {"t", "n_rows", *_SIGNALS})
-            if extra:  # labels, vendor estimates, true external torques: kept in the file
-                _log.warning(
-                    "%s: array(s) %s are not torque-log signals: ignored as data", path.name, extra
-                )
+            _say_unread(path.name, "array(s)", extra)
             n_rows = None
             for k in ("t", "n_rows", *_SIGNALS):
                 if k not in npz.files:
@@ -415,13 +414,29 @@ def _columns(path: Path, names: list[str], line: int) -> tuple[int, bool]:
             file=path.name,
             at=at,
         )
-    if unknown:  # labels, vendor estimates, true external torques: kept in the file
-        _log.warning(
-            "%s: column(s) %s are not torque-log signals: ignored as data",
-            path.name,
-            _checks.short(unknown),
-        )
+    _say_unread(path.name, "column(s)", unknown)
     return n, bool(have)
+
+
+def _say_unread(name: str, kind: str, extra: list[str]) -> None:
+    """One warning for the true external torques a simulation writes (``tau_ext``: ground
+    truth, which ``dynid observe`` compares its residual with), one for other columns
+    (labels, vendor estimates): kept in the file, not read as data."""
+    truth = [c for c in extra if re.fullmatch(r"tau_ext\d*", c)]
+    rest = [c for c in extra if c not in truth]
+    if truth:
+        span = truth[0] if len(truth) == 1 else f"{truth[0]}..{truth[-1]}"
+        _log.warning(
+            "%s: %s %s hold the true external torques of a simulation: ground truth, never "
+            "read as data (dynid observe reports its residual against them)",
+            name,
+            kind,
+            span,
+        )
+    if rest:
+        _log.warning(
+            "%s: %s %s are not torque-log signals: ignored as data", name, kind, _checks.short(rest)
+        )
 
 
 def _read_csv(path: Path) -> tuple[dict[str, NDArray[np.float64]], tuple[int, int] | None]:

@@ -27,6 +27,8 @@ at its level), while the true friction of a slow reversal or a standstill lies a
 
 (``b`` the band; the Stribeck bump is off inside it as well), ``|K_f|^T w(K_f dq)`` at the
 joints; 0 for the sigmoid law (no Coulomb level) and for laws without a canonical form.
+A :class:`~dynid.friction.model.FrictionSum` (friction at the motors and at the joints)
+gets the sum of its parts' bounds, each seen at the joints through its own transmission.
 """
 
 from __future__ import annotations
@@ -64,9 +66,14 @@ def standstill_margin(
 ) -> NDArray[np.float64]:
     """Bound [N m] (..., n) of the friction the model cannot know at velocities ``dq``
     [rad/s] (..., n): its Coulomb level where the law's Coulomb term is off or not at its
-    level (module docstring); zeros without friction or for a law without a canonical form.
+    level (module docstring); zeros without friction or for a law without a canonical form;
+    the sum of the parts' for a :class:`~dynid.friction.model.FrictionSum`.
     """
     v = np.asarray(dq, dtype=np.float64)
+    if isinstance(friction, FrictionSum):
+        parts = [standstill_margin(p, v) for p in friction.parts]
+        total: NDArray[np.float64] = np.sum(parts, axis=0)
+        return total
     n = v.shape[-1]
     canon = canonical_friction(friction, n)
     if friction is None or canon is None:

@@ -54,6 +54,19 @@ class LogObservation:
     standstill: NDArray[np.float64] | None = None
     restarts: tuple[int, ...] = (0,)
 
+    def truth_error(self) -> NDArray[np.float64] | None:
+        """RMS [N m] (n,) per joint of the residual against the true external torques
+        ``r - tau_ext`` (the observer's first-order lag included), over the samples the
+        observer ran on; None without ``tau_ext``."""
+        if self.tau_ext is None:
+            return None
+        e = self.r - self.tau_ext
+        ran = np.all(np.isfinite(e), axis=1)
+        if not ran.any():
+            return None
+        out: NDArray[np.float64] = np.sqrt(np.mean(e[ran] ** 2, axis=0))
+        return out
+
 
 @dataclass(frozen=True, slots=True, eq=False)
 class ObserveResult:

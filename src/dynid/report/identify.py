@@ -8,7 +8,8 @@ noise read from the log above the motion's band), the training against the held-
 structural rank of the kinematics), and the relative standard deviations (the paper pruned
 above 30 %). Below it: the measured against the predicted torques on held-out data, the
 residuals, the model structure (``selection``, when the identification chose terms), the
-coefficients with their standard deviations as bars, and the friction.
+coefficients with their standard deviations as bars, and each appended term (friction at
+the motors and at the joints, armature: :mod:`.model_terms`).
 """
 
 from __future__ import annotations
@@ -18,6 +19,7 @@ from typing import Any
 
 from ..identification.verdict import FLOOR_GOOD, judge_prediction, worst
 from .html import bar, cell, esc, figure, is_number, number, percent, section, table, verdict
+from .model_terms import terms_sections
 from .run import Answer, RunFiles
 
 __all__ = ["answer", "coefficient_unit"]
@@ -201,10 +203,14 @@ def _terms_fact(doc: dict) -> str:
     fixed = _get(doc, "metadata", "terms")
     if isinstance(fixed, list):  # given with --terms
         return "Terms given: " + esc(" + ".join(["links", *map(str, fixed)]))
-    if _get(doc, "metadata", "friction_labels"):
-        terms.append("classical friction fv, fc, fo per joint")
-    if doc.get("drive"):
-        terms.append("drive train (rotor inertia)")
+    appended = doc.get("terms")
+    if isinstance(appended, list) and appended:
+        terms += [str(t.get("name")) for t in appended if isinstance(t, dict)]
+    else:
+        if _get(doc, "metadata", "friction_labels"):
+            terms.append("classical friction fv, fc, fo per joint")
+        if doc.get("drive"):
+            terms.append("drive train (rotor inertia)")
     return "Terms: " + esc(" + ".join(terms))
 
 
@@ -234,7 +240,7 @@ def answer(run: RunFiles) -> Answer | None:
         level = "fair"
     shown = frozenset(f for f, _ in FIGURES if f in run.files)
     sections = [_torques_section(run, held), _structure_section(doc)]
-    sections += [_coefficients_section(doc), _friction_section(doc)]
+    sections += [_coefficients_section(doc), *terms_sections(doc)]
     return Answer(
         verdict(level, esc(headline) + ".", facts, label),
         tuple(s for s in sections if s),
@@ -294,11 +300,14 @@ def _structure_section(doc: dict) -> str:
         return ""
     chosen = sel.get("chosen")
     rows, marked = [], []
+    skip = not all(c.get("not_dissipative") for c in sel["candidates"])
+    left = any(c.get("left_out") for c in sel["candidates"])
     for c in sel["candidates"]:
         mark = c.get("name") == chosen
+        skipped = skip and bool(c.get("not_dissipative"))
         rows.append(
             [
-                "&#10003; chosen" if mark else "",
+                "&#10003; chosen" if mark else "skipped: not dissipative" if skipped else "",
                 esc(c.get("name", "")),
                 cell(c.get("terms") or []),
                 cell(c.get("n_params")),
@@ -306,6 +315,7 @@ def _structure_section(doc: dict) -> str:
                 cell(c.get("heldout_error_percent")),
                 cell(c.get("heldout_se_percent")),
             ]
+            + ([esc(" ".join(c.get("left_out") or ()))] if left else [])
         )
         marked.append(mark)
     headers = [
@@ -316,7 +326,7 @@ def _structure_section(doc: dict) -> str:
         "training error [%]",
         "held-out error [%]",
         "held-out std. error [%]",
-    ]
+    ] + (["left out per joint"] if left else [])
     rule = f"Rule: {esc(sel.get('rule', ''))}; validation: {esc(sel.get('validation', ''))}."
     parts = [f"<p>{rule}</p>", table(headers, rows, marked=marked)]
     per = [r for r in sel.get("heldout_per_recording") or () if isinstance(r, dict)]
@@ -375,25 +385,4 @@ def _coefficients_section(doc: dict) -> str:
         "coefficients",
         "Coefficients and their standard deviations",
         table(headers, rows, cls="coefficients"),
-    )
-
-
-def _friction_section(doc: dict) -> str:
-    fr = doc.get("friction")
-    if not isinstance(fr, list) or not fr:
-        return ""
-    names = _get(doc, "robot", "joint_names") or [f"joint {j + 1}" for j in range(len(fr))]
-    std = _get(doc, "metadata", "friction_std") or []
-    rows = []
-    for j, row in enumerate(fr):
-        cells = [esc(names[j] if j < len(names) else j + 1)]
-        for k, v in enumerate(row):
-            s = std[3 * j + k] if 3 * j + k < len(std) else None
-            cells.append(cell(v) + (f" &plusmn; {number(s, 2)}" if is_number(s) else ""))
-        rows.append(cells)
-    headers = ["joint", "fv [N m s/rad]", "fc [N m]", "fo [N m]"]
-    return section(
-        "friction",
-        "Friction identified with the coefficients (value ± std)",
-        table(headers, rows),
     )

@@ -30,7 +30,6 @@ import numpy as np
 from ..exceptions import DynidWarning
 from ..friction.fit import FrictionFit, FrictionResidual, fit_friction_through
 from ..friction.laws import LAWS
-from ..friction.model import FrictionSum
 from ..friction.recordings import Pieces, pieces_residual, prepare_pieces
 from ..friction.select import FrictionSelection, select_friction
 from ..friction.validation import RECORDED, own_friction
@@ -187,9 +186,7 @@ def fit_friction_files(
             here = isinstance(model, IdentifiedModel) and bool(
                 set(rec.names) & {str(r.get("file")) for r in model.info.recordings}
             )
-            own = own_friction(model)
-            if isinstance(own, FrictionSum):  # friction at the motors and the joints: no
-                own = None  # one law of the registry to refit or write to friction.json
+            own = own_friction(model)  # a sum (at the motors and the joints) judged too
             sel = select_friction(res, pieces.drive, own=own, own_fitted_here=here)
             return FrictionFileResult(sel.fit, res, sel, cut, pieces)
         chosen = fit_friction_through(res, pieces.drive, law)

@@ -1,0 +1,113 @@
+"""The identified model's appended terms (``terms`` of identification.json) as tables.
+
+Every term the model holds beside the base parameters gets its table: friction at the
+motors, friction at the joints (a coupled drive's ``at:both`` model holds both), the
+armature or rotor inertia and a joint spring. Each row is a motor (the term acts at the
+motors) or a joint; each column one kind of coefficient (``fv``, ``fc``, ``Ia``, ...) with
+its unit, the value ``± std`` in each cell. Files without ``terms`` (written before it) show
+the top-level ``friction`` matrix: ``fv, fc, fo`` per joint.
+"""
+
+from __future__ import annotations
+
+import re
+from typing import Any
+
+from .html import cell, esc, is_number, number, section, table
+
+__all__ = ["terms_sections"]
+
+#: The unit of each coefficient kind (the label without its joint number and prefix).
+_UNITS = {
+    "fv": "N m s/rad",
+    "fq": "N m s^2/rad^2",
+    "fc": "N m",
+    "fsp": "N m",
+    "fo": "N m",
+    "Ia": "kg m^2",
+}
+_LABEL = re.compile(r"^(?P<code>[A-Za-z_]+?)(?P<index>\d+)$")
+
+
+def _heading(term: dict[str, Any]) -> str:
+    name = str(term.get("name", ""))
+    definition = term.get("definition") or {}
+    if term.get("kind") == "linear_friction":
+        where = "the motors" if definition.get("at") == "motor" else "the joints"
+        return f"{name.capitalize()} at {where} (value \u00b1 std)"
+    if term.get("kind") == "rotor_inertia":
+        return f"{name.capitalize()}: armature or rotor inertia at the motors (value \u00b1 std)"
+    return f"{name.capitalize()} (value \u00b1 std)"
+
+
+def _unit(code: str) -> str:
+    unit = _UNITS.get(code) or _UNITS.get(code[1:], "")  # "jfv": friction at the joints
+    return f" [{unit}]" if unit else ""
+
+
+def _term_table(term: dict[str, Any], joint_names: list[str]) -> str:
+    labels, values = term.get("labels") or [], term.get("values") or []
+    std = term.get("std") or []
+    at_motors = term.get("kind") == "rotor_inertia" or (
+        (term.get("definition") or {}).get("at") == "motor"
+    )
+    codes: list[str] = []
+    rows: dict[int, dict[str, str]] = {}
+    for k, lab in enumerate(labels):
+        m = _LABEL.match(str(lab))
+        code, index = (m["code"], int(m["index"])) if m else (str(lab), 0)
+        if code not in codes:
+            codes.append(code)
+        s = std[k] if k < len(std) else None
+        v = values[k] if k < len(values) else None
+        text = cell(v) + (f" &plusmn; {number(s, 2)}" if is_number(s) else "")
+        rows.setdefault(index, {})[code] = text
+    body = []
+    for index in sorted(rows):
+        if at_motors:
+            who = f"motor {index}"
+        elif 0 < index <= len(joint_names):
+            who = joint_names[index - 1]
+        else:
+            who = f"joint {index}"
+        body.append([esc(who), *(rows[index].get(c, "") for c in codes)])
+    headers = ["motor" if at_motors else "joint", *(f"{c}{_unit(c)}" for c in codes)]
+    return table(headers, body)
+
+
+def _classical(doc: dict[str, Any], joint_names: list[str]) -> str:
+    fr = doc.get("friction")
+    if not isinstance(fr, list) or not fr:
+        return ""
+    std = (doc.get("metadata") or {}).get("friction_std") or []
+    rows = []
+    for j, row in enumerate(fr):
+        cells = [esc(joint_names[j] if j < len(joint_names) else f"joint {j + 1}")]
+        for k, v in enumerate(row):
+            s = std[3 * j + k] if 3 * j + k < len(std) else None
+            cells.append(cell(v) + (f" &plusmn; {number(s, 2)}" if is_number(s) else ""))
+        rows.append(cells)
+    headers = ["joint", "fv [N m s/rad]", "fc [N m]", "fo [N m]"]
+    return section(
+        "friction",
+        "Friction identified with the coefficients (value \u00b1 std)",
+        table(headers, rows),
+    )
+
+
+def terms_sections(doc: dict[str, Any]) -> list[str]:
+    """One section per appended term of the identification record ``doc`` (its ``terms``),
+    or the classical friction table of a record without them; empty without either."""
+    robot = doc.get("robot") or {}
+    names = [str(x) for x in robot.get("joint_names") or []] if isinstance(robot, dict) else []
+    terms = doc.get("terms")
+    if not isinstance(terms, list) or not terms:
+        classical = _classical(doc, names)
+        return [classical] if classical else []
+    out: list[str] = []
+    for k, term in enumerate(terms):
+        if not isinstance(term, dict) or not term.get("labels"):
+            continue
+        anchor = "friction" if k == 0 and term.get("kind") == "linear_friction" else f"term-{k}"
+        out.append(section(anchor, _heading(term), _term_table(term, names)))
+    return out
