@@ -44,7 +44,7 @@ def log_file(tmp_path_factory):
 
 @pytest.fixture(scope="module")
 def consistent(log_file):
-    opt = IdentifyOptions(terms=TERMS, consistent=True, prior="panda")
+    opt = IdentifyOptions(terms=TERMS, consistent=True, prior="panda", prior_weight=1.0)
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", DynidWarning)
         return identify_files(dynid.panda(), log_file, opt).consistent
@@ -82,8 +82,15 @@ def test_dissipation_rows_allow_a_rising_friction_and_refuse_a_pushing_one():
 
 def test_leave_outs_given_with_terms_are_honoured(log_file, tmp_path):
     argv = ["identify", "--robot", "panda", "--data", str(log_file), "--consistent"]
-    argv += ["--terms", TERMS, "--prior", "panda", "--no-figures", "-q"]
+    argv += ["--terms", f"armature,{TERMS},-ia3", "--prior", "panda", "--prior-weight", "1"]
+    argv += ["--no-figures", "-q"]  # a given weight: no search (the test is of the structure)
     assert main([*argv, "--out", str(tmp_path / "c")]) == 0
-    fr = json.loads((tmp_path / "c" / "feasible.json").read_text())["linear_friction"]
+    d = json.loads((tmp_path / "c" / "feasible.json").read_text())
+    fr = d["linear_friction"]
     assert fr["model"] == "stribeck" and fr["vst"] == [0.2] * 7
     assert fr["fo"][2] == 0.0 and all(x != 0.0 for x in fr["fo"][:2] + fr["fo"][3:])
+    ia = d["drive"]["rotor_inertia"]  # the armature held on every joint but joint 3
+    assert len(ia) == 7 and ia[2] == 0.0 and min(ia) >= 0.0
+    ident = json.loads((tmp_path / "c" / "identification.json").read_text())
+    labels = [lab for t in ident["terms"] for lab in t["labels"]]
+    assert "Ia1" in labels and "fo1" in labels and "Ia3" not in labels and "fo3" not in labels

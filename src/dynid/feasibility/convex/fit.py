@@ -90,6 +90,7 @@ def retrieve_sdp(
         constraints=constraints,
         kind="coefficients",
     )
+    res = replace(res, rotor_inertia=_rotor_inertia(model, res.rotor_inertia))
     return res if model.drive is None else with_drive(res, model.drive)
 
 
