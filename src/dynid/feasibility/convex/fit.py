@@ -212,7 +212,7 @@ def consistent_from_identified(
     constraints: Sequence[Callable[..., Any]] = (),
 ) -> ConsistentResult:
     """The one-step consistent fit of an unconstrained identification: its coefficients
-    (and, from a torque log, its friction ``fv, fc, fo``) with their covariance as the data
+    (and, from a torque log, its friction, of the law fitted) with their covariance as the data
     term, its held-out folds choosing the prior's weight and accepting the result.
 
     Parameters

@@ -63,7 +63,8 @@ def solve_consistent(
     kind : str
         Recorded in the result (``"coefficients"``, ``"log"``, ``"static"``).
     friction_nonneg : bool
-        ``fv, fc >= 0`` for the friction unknowns of the data term.
+        The friction unknowns physical as their terms declare (``nonnegative`` and the
+        data term's ``dissipation`` rows).
 
     Raises
     ------
