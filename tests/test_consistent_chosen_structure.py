@@ -94,3 +94,12 @@ def test_leave_outs_given_with_terms_are_honoured(log_file, tmp_path):
     ident = json.loads((tmp_path / "c" / "identification.json").read_text())
     labels = [lab for t in ident["terms"] for lab in t["labels"]]
     assert "Ia1" in labels and "fo1" in labels and "Ia3" not in labels and "fo3" not in labels
+
+
+def test_dissipation_rows_bound_a_saturating_quadratic_viscous_at_the_limit():
+    """``fv v + fq v |v| >= 0`` up to ``v_max = 2`` rad/s holds iff ``fv + 2 fq >= 0``."""
+    term = LinearFriction(Drive.identity(1), parts=("viscous", "quadratic"))
+    G = term.dissipation_rows(np.array([2.0]))
+    assert np.all(G @ np.array([1.0, -0.45]) >= 0)  # 1 - 0.9 >= 0
+    assert np.any(G @ np.array([1.0, -0.55]) < 0)  # 1 - 1.1 < 0 at the limit
+    assert not term.nonnegative[1] and term.nonnegative[0]
