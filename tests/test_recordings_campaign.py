@@ -50,7 +50,7 @@ class _Stop(Exception):
 
 def test_the_consistent_route_warns_each_finding_of_the_data_once(panda, tmp_path, monkeypatch):
     """Torques of the opposite sign: the consistent route's unconstrained fit (structure
-    chosen on held-out data, then the classical friction fitted with it) prepares the log
+    chosen on held-out data and fitted as chosen) prepares the log
     once, so its finding is warned once (it was warned by the selection's fit and again
     by the final one), and the friction warnings are those of the model kept."""
     log = _log(panda, 3)
@@ -71,11 +71,18 @@ def test_the_consistent_route_warns_each_finding_of_the_data_once(panda, tmp_pat
     assert len(said) == len(set(said)), said
     model = kept["model"]
     assert model.info.selection is not None  # the structure was chosen, and recorded
-    assert model.friction.params.shape == (7, 3)  # fv, fc, fo per joint: the classical friction
+    terms = model.info.extra["terms"]  # the structure chosen, fitted as it was chosen
+    name = " + ".join(["links", *(t for t in terms if t[:1] != "-")])
+    assert model.info.selection["chosen"] == name + "".join(
+        f" - {t[1:]}" for t in terms if t[:1] == "-"
+    )
     # the friction warnings are of the model kept: one per joint whose kept friction
     # has a negative viscous or Coulomb coefficient (the selection's fit warned its own)
     quoted = [s for s in said if s.startswith("identified friction not dissipative")]
     named = sorted(int(s.split("(joint ")[1].split(":")[0]) for s in quoted)
+    if model.friction is None:  # no friction candidate was dissipative: none kept, none warned
+        assert not named
+        return
     negative = np.flatnonzero(np.any(model.friction.params[:, :2] < 0, axis=1)) + 1
     assert named and set(named) <= set(negative.tolist()) and len(named) == len(set(named))
 

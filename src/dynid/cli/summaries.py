@@ -304,18 +304,19 @@ def format_retrieval(result: RetrievalResult) -> str:
 
 
 def consistent_structure_lines(result: ConsistentResult) -> list[str]:
-    """Which structure the one-step consistent fit of a torque log uses (the classical
-    friction on every joint, whatever was chosen) and the held-out errors of least
-    squares of that structure and of the chosen one."""
+    """Which structure the one-step consistent fit of a torque log uses (the one chosen on
+    held-out data, or given, its terms kept physical as each declares) and the held-out
+    error of least squares of it."""
     model = result.identified
     if model is None or result.kind != "log":
         return []
     terms = [str(t) for t in model.info.extra.get("terms", ())]
-    used = " + ".join(["links", *terms])
+    kept = [t for t in terms if not t.startswith("-")]
+    used = " + ".join(["links", *kept]) + "".join(f" - {t[1:]}" for t in terms if t[:1] == "-")
     out = [
-        f"structure of the consistent fit: {used} (the classical friction fv, fc, fo on "
-        "every joint, the friction it keeps physical; the least squares below have this "
-        "structure)"
+        f"structure of the consistent fit: {used} (its friction law, leave-outs and armature "
+        "as fitted by least squares; kept physical: fv, fc, rotor inertias >= 0 and the "
+        "friction opposing the motion within the velocity limits, the offset free)"
     ]
     sel = model.info.selection
     if sel:

@@ -71,12 +71,13 @@ class FeasibleResult:
         What the user should know (one line each).
     friction : Friction, FrictionSum or None
         The friction identified with the links (:mod:`dynid.friction.model`: its law,
-        parameters, band and where it acts; the classical ``fv, fc, fo`` of the one-step
-        fit on a torque log, at the motors with a drive whose friction acts there; a
+        parameters, band and where it acts; the law of the structure of the one-step fit
+        on a torque log, at the motors with a drive whose friction acts there; a
         :class:`~dynid.friction.model.FrictionSum` of friction at the motors and at the
         joints of a coupled drive); None when the method fits the links alone.
     rotor_inertia : ndarray, shape (n,), or None
-        Rotor inertias at the motors identified with the links [kg m^2]; None otherwise.
+        Rotor inertias at the motors identified with the links [kg m^2] (0 for a rotor the
+        model's armature leaves out); None otherwise.
     drive : Drive or None
         The drive train of the data, its rotor inertias the identified ones.
     heldout : HeldOutJudgement or None

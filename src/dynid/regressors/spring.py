@@ -73,6 +73,10 @@ class JointSpring:
         """None: not friction."""
         return None
 
+    def dissipation_rows(self, dq_max: NDArray[np.float64]) -> NDArray[np.float64]:
+        """(0, p): nothing beside :attr:`nonnegative`."""
+        return np.zeros((0, len(self.q0)))
+
     def inertia(self, values: NDArray[np.float64]) -> None:
         """None: not rotor inertias."""
         return None

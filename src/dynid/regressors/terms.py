@@ -117,6 +117,13 @@ class ModelTerm(Protocol):
         """Parameters a physically consistent model keeps ``>= 0``."""
         ...
 
+    def dissipation_rows(self, dq_max: NDArray[np.float64]) -> NDArray[np.float64]:
+        """Rows ``G`` (m, p): a physically consistent model keeps ``G values >= 0`` beside
+        :attr:`nonnegative` (friction that opposes the motion at the velocities the joints
+        reach, ``dq_max`` (n,) [rad/s]); (0, p) for none. Linear in the coefficients, so
+        a convex fit keeps them."""
+        ...
+
     def torque_columns(
         self, q: NDArray[np.float64], dq: NDArray[np.float64], ddq: NDArray[np.float64]
     ) -> NDArray[np.float64]:
@@ -189,6 +196,10 @@ class RotorInertia:
         """Every rotor inertia is ``>= 0``."""
         return np.ones(len(self.labels), dtype=bool)
 
+    def dissipation_rows(self, dq_max: NDArray[np.float64]) -> NDArray[np.float64]:
+        """(0, p): nothing beside :attr:`nonnegative`."""
+        return np.zeros((0, len(self.labels)))
+
     def torque_columns(
         self, q: NDArray[np.float64], dq: NDArray[np.float64], ddq: NDArray[np.float64]
     ) -> NDArray[np.float64]:
@@ -236,6 +247,11 @@ FRICTION_PARTS = ("viscous", "quadratic", "coulomb", "smooth", "stribeck", "offs
 PART_LABELS = {"viscous": "fv", "quadratic": "fq", "coulomb": "fc", "smooth": "fc"}
 PART_LABELS |= {"stribeck": "fsp", "offset": "fo"}
 _PART_UNIT = {p: "N m" for p in FRICTION_PARTS}
+#: Velocities checked evenly (and as many geometrically) by
+#: :meth:`LinearFriction.dissipation_rows`, and the velocity limit [rad/s] it assumes for a
+#: joint without one.
+DISSIPATION_GRID = 16
+DISSIPATION_VMAX = 10.0
 _PART_UNIT |= {"viscous": "N m s/rad", "quadratic": "N m s^2/rad^2"}
 
 
@@ -344,8 +360,60 @@ class LinearFriction:
 
     @property
     def nonnegative(self) -> NDArray[np.bool_]:
-        """Every coefficient but the offset ``fo`` is ``>= 0``."""
-        return np.tile([p != "offset" for p in self.parts], self.drive.n)[self._held]
+        """The viscous ``fv`` and the Coulomb level ``fc`` (plain or smooth) are ``>= 0``.
+
+        Not sign-constrained: the offset ``fo`` (a constant torque, not friction of the
+        motion), the Stribeck excess ``fsp = fs - fc`` (friction that rises from its
+        standstill level, ``fs < fc``, is physical as well as a breakaway peak) and the
+        quadratic viscous ``fq`` (a viscous friction that saturates within the limits):
+        what keeps these physical is :meth:`dissipation_rows`.
+        """
+        free = ("offset", "stribeck", "quadratic")
+        return np.tile([p not in free for p in self.parts], self.drive.n)[self._held]
+
+    def dissipation_rows(self, dq_max: NDArray[np.float64]) -> NDArray[np.float64]:
+        """Rows ``G`` (m, p): ``G values >= 0`` says the friction opposes the motion,
+        ``f(v) >= 0`` for ``0 < v <= v_max`` of every motor (joint) (the offset left aside;
+        every part is odd in ``v``, so the negative velocities follow).
+
+        ``v_max`` of a motor is ``sum_j |K_mj| dq_max_j`` (:data:`DISSIPATION_VMAX` [rad/s]
+        where a joint has no limit); the velocities checked: :data:`DISSIPATION_GRID` evenly
+        up to ``v_max`` and as many spaced geometrically from ``1e-4 v_max`` (the Stribeck
+        bump near standstill), those inside the standstill band left out (``f = 0`` there).
+        """
+        n, k = self.drive.n, len(self.parts)
+        K = np.abs(np.asarray(self.drive.friction_transmission, dtype=np.float64))
+        limit = np.broadcast_to(np.asarray(dq_max, dtype=np.float64), (K.shape[1],))
+        limit = np.where(np.isfinite(limit), limit, DISSIPATION_VMAX)
+        vmax = np.array([float(np.sum(K[m] * limit)) for m in range(n)])
+        g = DISSIPATION_GRID
+        unit = np.concatenate([np.linspace(1.0 / g, 1.0, g), np.geomspace(1e-4, 1.0, g)])
+        v = unit[:, None] * vmax[None, :]  # (s, n)
+        band = np.asarray(self.band, dtype=np.float64) if self.band else np.zeros(n)
+        F = self._part_columns(v, band)  # (s, n, k)
+        rows = []
+        for m in range(n):
+            moving = v[:, m] > band[m]
+            G = np.zeros((int(moving.sum()), n * k))
+            G[:, m * k : (m + 1) * k] = F[moving, m, :]
+            rows.append(G)
+        every = np.concatenate(rows) if rows else np.zeros((0, n * k))
+        G = every[:, self._held]
+        return _distinct_rows(G[np.any(G != 0.0, axis=1)])
+
+    def _part_columns(
+        self, v: NDArray[np.float64], band: NDArray[np.float64]
+    ) -> NDArray[np.float64]:
+        """(..., n, k): each part's column at the motor (joint) velocities ``v`` (..., n)."""
+        col = {
+            "viscous": lambda: v,
+            "quadratic": lambda: v * np.abs(v),
+            "coulomb": lambda: standstill_sign(v, band),
+            "smooth": lambda: smooth_sign(v, np.asarray(self.width)),
+            "stribeck": lambda: standstill_sign(v, band) * stribeck_decay(v, self.vst),
+            "offset": lambda: np.ones_like(v),
+        }
+        return np.stack([col[p]() for p in self.parts], axis=-1)
 
     @property
     def needs_motion(self) -> NDArray[np.intp]:
@@ -390,16 +458,9 @@ class LinearFriction:
         F = np.zeros(v.shape + (k * n,))
         m = np.arange(n)
         band = np.asarray(self.band, dtype=np.float64) if self.band else np.zeros(n)
-        col = {
-            "viscous": lambda: v,
-            "quadratic": lambda: v * np.abs(v),
-            "coulomb": lambda: standstill_sign(v, band),
-            "smooth": lambda: smooth_sign(v, np.asarray(self.width)),
-            "stribeck": lambda: standstill_sign(v, band) * stribeck_decay(v, self.vst),
-            "offset": lambda: np.ones_like(v),
-        }
-        for i, p in enumerate(self.parts):
-            F[..., m, k * m + i] = col[p]()
+        parts = self._part_columns(v, band)
+        for i in range(k):
+            F[..., m, k * m + i] = parts[..., i]
         if self.mask:
             F = F[..., self._held]
         if self.drive.friction_at == "joint":
@@ -472,6 +533,16 @@ class LinearFriction:
             mask=tuple(bool(x) for x in d.get("mask", ())),
             prefix=str(d.get("prefix", "")),
         )
+
+
+def _distinct_rows(G: NDArray[np.float64]) -> NDArray[np.float64]:
+    """The rows of ``G``, each scaled to a largest entry of 1, without repeats (a joint
+    with Coulomb friction alone gives one row, ``fc >= 0``, not one per velocity)."""
+    if not G.shape[0]:
+        return G
+    G = G / np.max(np.abs(G), axis=1, keepdims=True)
+    _, first = np.unique(np.round(G, 12), axis=0, return_index=True)
+    return G[np.sort(first)]
 
 
 def drive_terms(drive: Drive | None, n: int, *, friction: bool = True) -> tuple[ModelTerm, ...]:

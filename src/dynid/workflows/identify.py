@@ -377,26 +377,12 @@ def _consistent_structure_fit(
     terms: Structure | Literal["auto"],
     **kw: Any,
 ) -> IdentifiedModel:
-    """The unconstrained fit of the one-step consistent route: the armature chosen on
-    held-out data (or given), the classical friction (``fv, fc, fo``) with it; the choice
-    recorded.
-
-    Raises
-    ------
-    DataError
-        ``terms`` name friction other than the classical parts together.
-    """
-    classical = ("viscous", "coulomb", "offset")
-    if terms != "auto" and terms.friction not in (classical, ()):
-        raise OptionError(
-            "may add armature to the classical friction (viscous, coulomb, offset) that "
-            f"{{consistent}} keeps physical; got {terms.name!r}",
-            field="terms",
-            others=("consistent",),
-        )
-    if terms == "auto":  # the armature chosen, the classical friction fitted with it
-        return identify_recordings(robot, logs, names, friction=classical, **kw)
-    terms = Structure(terms.armature, classical, at=terms.at)
+    """The unconstrained fit of the one-step consistent route: the structure chosen on
+    held-out data (or given by ``terms``, its leave-outs honoured) as the plain route
+    chooses it, the choice recorded. Its terms are the consistent fit's as they are: the
+    friction law with its fixed shape parameters, the per-joint leave-outs and the
+    armature mask; each term says which coefficients a physical model keeps ``>= 0``
+    (:attr:`~dynid.regressors.terms.ModelTerm.nonnegative`)."""
     return identify_recordings(robot, logs, names, structure=terms, **kw)
 
 
@@ -424,11 +410,12 @@ def _identify_consistent(
     (:func:`~dynid.feasibility.convex.fit.identify_consistent`), the data read and checked
     as for the unconstrained fit.
 
-    Torque logs (one or more, ``max_gap_s`` honoured): the armature is chosen on held-out
-    data as the unconstrained fit chooses it (or given by ``terms``), and the friction is
-    the classical ``fv, fc, fo >= 0`` per joint (motor), the terms the convex problem keeps
-    physical; ``folds``/``validate_on`` choose the held-out judgement of the prior weight
-    and of the fit. ``identified`` of the result holds the unconstrained fit.
+    Torque logs (one or more, ``max_gap_s`` honoured): the model's structure is chosen on
+    held-out data as the unconstrained fit chooses it (or given by ``terms``), and the
+    convex problem keeps each of its terms physical as the term declares
+    (:func:`_consistent_structure_fit`); ``folds``/``validate_on`` choose the held-out
+    judgement of the prior weight and of the fit. ``identified`` of the result holds the
+    unconstrained fit.
     """
     path = paths[0]
     cmap = _columns(opt.columns, opt.cutoff_hz)

@@ -19,9 +19,12 @@ residual sum of squares in units of its noise variance (``Delta chi^2``).
   coefficients with their full covariance. When the coefficients are exact (a residual below
   1e-9 relative), the data term becomes the equality ``P phi = beta`` and the result is
   polished by a minimum-norm correction so that it holds to round-off.
-* **One-step** (:func:`identify_consistent`): the same problem on data, with the classical
-  friction ``f = (fv, fc, fo)`` per joint as extra unknowns, ``fv, fc >= 0`` (torque logs),
-  or on static ``[tril M; g]`` data. The data term is then exactly
+* **One-step** (:func:`identify_consistent`, :func:`consistent_from_identified`): the same
+  problem on data, with the coefficients of the model's appended terms as extra unknowns
+  (torque logs: the friction of the structure fitted, the classical ``fv, fc, fo`` per joint
+  by default), each kept physical as its term declares (``nonnegative``: ``fv, fc >= 0``;
+  ``dissipation_rows``: the friction opposing the motion within the velocity limits), or
+  on static ``[tril M; g]`` data. The data term is then exactly
   ``||W x - y||^2 / sigma^2`` up to a constant, ``W`` the stacked regressor.
 
 **The prior's weight** ``w``: when the data term holds held-out folds (torque logs: k-fold

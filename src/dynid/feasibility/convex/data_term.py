@@ -53,6 +53,10 @@ class DataTerm:
         Normal equations of the held-out folds over the entries of ``x``
         (:mod:`dynid.identification.holdout`): the weight and the acceptance are then
         judged on held-out data.
+    dissipation : ndarray, shape (m, k), optional
+        Rows ``G`` with ``G f >= 0`` for friction that opposes the motion within the
+        velocity limits (each term's :meth:`~dynid.regressors.terms.ModelTerm.
+        dissipation_rows`, over the unknowns fitted); None: none.
     """
 
     P: NDArray[np.float64]
@@ -66,6 +70,7 @@ class DataTerm:
     labels: tuple[str, ...] = ()
     notes: tuple[str, ...] = ()
     holdout: HeldOut | None = None
+    dissipation: NDArray[np.float64] | None = None
 
     @property
     def r(self) -> int:
@@ -160,6 +165,8 @@ def coefficient_term(model: IdentifiedModel, *, with_friction: bool = False) -> 
         )
         if kk
     )
+    terms = tuple(t.term for t in model.appended) if k else ()
+    index = np.flatnonzero(kept[r_all:])
     held = model.holdout
     if held is not None and held.whole.p != kept.size:
         held = None  # folds over other columns (friction left out of the term)
@@ -170,12 +177,33 @@ def coefficient_term(model: IdentifiedModel, *, with_friction: bool = False) -> 
         dof=max(int(fit.n_rows) - int(fit.rank), 1),
         exact=exact,
         n_friction=int(kept[r_all:].sum()) if k else 0,
-        friction_index=np.flatnonzero(kept[r_all:]) if k else None,
-        terms=tuple(t.term for t in model.appended) if k else (),
+        friction_index=index if k else None,
+        terms=terms,
+        dissipation=_dissipation(terms, index, model.robot.dq_max) if k else None,
         labels=labels,
         notes=notes,
         holdout=None if held is None else held.restricted(np.flatnonzero(kept)),
     )
+
+
+def _dissipation(
+    terms: tuple[ModelTerm, ...], index: NDArray[np.intp], dq_max: NDArray[np.float64]
+) -> NDArray[np.float64] | None:
+    """The terms' dissipation rows over the unknowns ``index`` (of every coefficient of
+    ``terms``, in order); rows that only touch coefficients not fitted (0) dropped."""
+    blocks = [np.asarray(t.dissipation_rows(dq_max), dtype=np.float64) for t in terms]
+    width = sum(len(t.labels) for t in terms)
+    rows, c = [], 0
+    for t, G in zip(terms, blocks, strict=True):
+        full = np.zeros((G.shape[0], width))
+        full[:, c : c + len(t.labels)] = G
+        rows.append(full)
+        c += len(t.labels)
+    if not rows:
+        return None
+    G = np.concatenate(rows)[:, index]
+    G = G[np.any(G != 0.0, axis=1)]
+    return G if G.shape[0] else None
 
 
 def _friction_labels(model: IdentifiedModel) -> tuple[str, ...]:

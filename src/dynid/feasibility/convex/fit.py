@@ -12,8 +12,10 @@ ordinary least squares,
 so the classical covariance ``sigma^2 (W^T W)^{-1}`` of the unconstrained fit ``x_hat`` gives
 the data term exactly (up to the constant ``RSS / sigma^2``). Torque logs go through the
 classical route (:func:`~dynid.identification.classical.identify_from_log`: filtering,
-decimation, base regressor plus viscous, Coulomb and offset friction per joint), with
-``fv, fc >= 0`` in the consistent problem; static data through
+decimation, base regressor plus viscous, Coulomb and offset friction per joint); a model of
+another structure (:func:`consistent_from_identified`: the one chosen on held-out data) keeps
+its terms as they are, each physical as it declares (``nonnegative`` and
+``dissipation_rows`` of :mod:`dynid.regressors.terms`); static data through
 :func:`~dynid.identification.static.identify_static` (``[tril M; g]``). The unconstrained
 fit is returned with the result (``result.identified``) for comparison.
 """
@@ -24,6 +26,8 @@ import dataclasses
 from collections.abc import Callable, Sequence
 from dataclasses import replace
 from typing import Any, Literal
+
+import numpy as np
 
 from ...exceptions import OptionError, WrongTypeError
 from ...friction.model import through_drive
@@ -86,6 +90,7 @@ def retrieve_sdp(
         constraints=constraints,
         kind="coefficients",
     )
+    res = replace(res, rotor_inertia=_rotor_inertia(model, res.rotor_inertia))
     return res if model.drive is None else with_drive(res, model.drive)
 
 
@@ -207,7 +212,7 @@ def consistent_from_identified(
     constraints: Sequence[Callable[..., Any]] = (),
 ) -> ConsistentResult:
     """The one-step consistent fit of an unconstrained identification: its coefficients
-    (and, from a torque log, its friction ``fv, fc, fo``) with their covariance as the data
+    (and, from a torque log, its friction, of the law fitted) with their covariance as the data
     term, its held-out folds choosing the prior's weight and accepting the result.
 
     Parameters
@@ -224,8 +229,8 @@ def consistent_from_identified(
     prior, bounds, total_mass, options, constraints
         As in :func:`~dynid.feasibility.convex.solve.solve_consistent`.
     """
-    if term is None:
-        term = coefficient_term(model, with_friction=kind == "log")
+    if term is None:  # a structure without friction (links, armature) has no joint fit
+        term = coefficient_term(model, with_friction=kind == "log" and model.joint_fit is not None)
     res = solve_consistent(
         robot,
         term,
@@ -236,8 +241,26 @@ def consistent_from_identified(
         constraints=constraints,
         kind=kind,
     )
-    res = replace(res, identified=model)
+    res = replace(res, identified=model, rotor_inertia=_rotor_inertia(model, res.rotor_inertia))
     return res if model.drive is None else with_drive(res, model.drive)
+
+
+def _rotor_inertia(model: IdentifiedModel, ia: Any) -> Any:
+    """The solved values of the model's terms in the base (``ia``, in order) as rotor
+    inertias (n,) at the motors: each term maps its own (a masked armature: 0 for the
+    rotors it does not hold); None when none is an inertia."""
+    if ia is None:
+        return None
+    vals, start, out = np.asarray(ia, dtype=np.float64), 0, None
+    for t in model.terms.values():
+        if not t.term.in_base:
+            continue
+        k = len(t.term.labels)
+        got = t.term.inertia(vals[start : start + k])
+        start += k
+        if got is not None:
+            out = got if out is None else out + got
+    return vals if start != vals.size else out
 
 
 class ConvexMethod:

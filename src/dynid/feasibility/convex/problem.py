@@ -155,11 +155,16 @@ class ConvexProblem:
             x = x + term.P[:, p_links:] @ self.ia
         if self.f is not None:
             x = cp.hstack([x, self.f])
-            if friction_nonneg:  # fv, fc >= 0 (every joint's fo is free)
+            if friction_nonneg:  # the terms' non-negative coefficients, their dissipation
                 pos = np.flatnonzero(term.nonnegative())  # the terms say which
                 sel = np.zeros((pos.size, k))
                 sel[np.arange(pos.size), pos] = 1.0
                 cons.append(sel @ self.f >= 0)
+                if term.dissipation is not None:  # f(v) >= 0 within the velocity limits
+                    G = term.dissipation / np.maximum(
+                        np.max(np.abs(term.dissipation), axis=1, keepdims=True), 1e-300
+                    )
+                    cons.append(G @ self.f >= 0)
         for make in constraints:
             cons += list(make(phis, self.J))
         if equality:

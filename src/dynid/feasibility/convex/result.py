@@ -72,8 +72,8 @@ class ConsistentResult(FeasibleResult):
     ``report`` holds the physical constraints, the bounds, the total mass,
     ``pseudo_inertia`` (margin ``lambda_min(J)/tr(J)``) and ``data_fit``; ``bounds`` are
     the masses narrowed by the prior; ``kind`` is ``"coefficients"`` (two-step), ``"log"``
-    or ``"static"`` (one-step); ``friction`` (one-step on a torque log) holds ``fv, fc >= 0``;
-    ``drive`` is the data's drive train with the identified rotor inertias
+    or ``"static"`` (one-step); ``friction`` (one-step on a torque log) is physical as its
+    terms declare; ``drive`` is the data's drive train with the identified rotor inertias
     (:func:`with_drive`); ``notes`` the prior's repairs and the weight's choice.
     """
 
@@ -205,7 +205,7 @@ def build_result(
     if f is not None and term.n_friction:
         f = f.copy()
         nonneg = term.nonnegative()
-        f[nonneg] = np.maximum(f[nonneg], 0.0)  # fv, fc >= 0 held to the solver's tolerance
+        f[nonneg] = np.maximum(f[nonneg], 0.0)  # >= 0 held to the solver's tolerance
     m, c, I = inertial_from_phi(phi)
     out = robot.with_params(phi)
     found, act = _active_and_implausible(robot, m, c, I, bounds, band)

@@ -63,7 +63,8 @@ def solve_consistent(
     kind : str
         Recorded in the result (``"coefficients"``, ``"log"``, ``"static"``).
     friction_nonneg : bool
-        ``fv, fc >= 0`` for the friction unknowns of the data term.
+        The friction unknowns physical as their terms declare (``nonnegative`` and the
+        data term's ``dissipation`` rows).
 
     Raises
     ------
@@ -152,7 +153,7 @@ def _checked_bounds(
     band [kg] (``total_mass`` over the bounds' own), both checked against the robot and the
     data term's number of links."""
     n = robot.n
-    if term.P.shape[1] not in (10 * n, 11 * n):
+    if not 10 * n <= term.P.shape[1] <= 11 * n:  # the links, then rotor inertias held
         raise ShapeError(f"data term is for {term.P.shape[1] // 10} links; robot has {n}")
     b = default_bounds(robot) if bounds is None else bounds
     if b.n != n:
