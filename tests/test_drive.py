@@ -565,3 +565,41 @@ def test_validate_checks_the_joint_limits_of_a_motor_side_log_at_the_joints(tmp_
         warnings.simplefilter("error", DynidWarning)
         res = validate_files(m, path, ValidateOptions(friction="own", cutoff_hz=20.0))
     assert res.validation.errors.relative_error_percent < 1.0
+
+
+def test_a_robots_own_friction_acts_where_its_drive_puts_it_in_every_comparison():
+    """Simulation puts a robot's own friction, given per joint, at the motors when its
+    drive's friction acts there (``K^T f(K dq)``); validating that robot on its own log, and
+    its observer at rest of contacts, must place it the same: the torques come back exactly
+    (before, validation added the law at the joints and the error was that of the friction)."""
+    from dynid.friction.model import ClassicalFriction
+    from dynid.friction.validation import own_friction, validate_torques
+    from dynid.observer.model import from_robot
+    from dynid.simulation.measurement import SensorNoise, sample_times, simulate_measurement
+    from dynid.simulation.trajectories import centered_start, sinusoid_trajectory
+
+    robot, _, _ = _ur5()
+    n = robot.n
+    fr = ClassicalFriction(np.full(n, 0.02), np.full(n, 0.05), np.zeros(n))
+    robot = robot.with_friction(fr)
+    drive = Drive.from_gears(GEAR, COUPLING, side="motor", friction_at="motor")
+    t = sample_times(3.0, 250.0)
+    periods = np.array([3.1, 2.3, 2.9, 1.7, 2.1, 1.3])
+    A = np.full(n, 0.4)
+    traj = sinusoid_trajectory(t, centered_start(robot, A, periods), A, periods)
+    log = simulate_measurement(
+        robot,
+        traj,
+        rng=np.random.default_rng(0),
+        noise=SensorNoise.none(),
+        with_ddq=True,
+        drive=drive,
+    )
+    v = validate_torques(robot, log, friction=own_friction(robot), cutoff_hz=None, drive=drive)
+    assert v.with_friction is not None
+    assert v.with_friction.relative_error_percent < 1e-8
+    # the law at the joints instead differs by the motors' friction seen through the gears
+    at_joints = validate_torques(robot, log, friction=fr, cutoff_hz=None, drive=None)
+    assert at_joints.errors.relative_error_percent > 1.0
+    obs = from_robot(robot, drive=drive)
+    assert obs.friction is not None and obs.friction.drive is drive

@@ -181,7 +181,11 @@ def arm_model(
         )
     fr: FrictionTorques | None
     if isinstance(friction, str):
-        fr = own_friction(arm) if isinstance(arm, IdentifiedModel) else robot_friction(arm)
+        if isinstance(arm, IdentifiedModel):
+            fr = own_friction(arm)
+        else:  # the robot's own, where its drive puts it (as simulation does)
+            own = robot_friction(arm)
+            fr = None if own is None else own.placed(d)
     else:
         fr = friction
     return ArmModel(arm, d, fr)

@@ -252,6 +252,8 @@ def validated_log(
         return validated(model, p, friction, drive)
     if friction is not None and friction.n != jlog.n:
         raise ShapeError(f"friction model has {friction.n} joints; the log has {jlog.n}")
+    if isinstance(friction, Friction) and isinstance(model, Robot):  # as in validated
+        friction = friction.placed(drive)
     blocks = prepared_blocks(jlog, max_gap_s=max_gap_s, **kw)  # type: ignore[arg-type]
     return _validated_blocks(model, blocks, friction, drive, step)
 
@@ -336,6 +338,8 @@ def validated(
     if friction is not None and friction.n != p.n:
         raise ShapeError(f"friction model has {friction.n} joints; the log has {p.n}")
     d = drive
+    if isinstance(friction, Friction) and isinstance(model, Robot):  # as simulation puts it
+        friction = friction.placed(d)
     assert p.ddq is not None  # prepare_log always fills ddq
     tau_model = rigid_body_torques(model, p.q, p.dq, p.ddq)
     if d is not None and d.rotor_inertia is not None and not isinstance(model, IdentifiedModel):

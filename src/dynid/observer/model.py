@@ -164,6 +164,7 @@ def from_robot(
         if drive.rotor_inertia is not None:
             Mr = drive.rotor_mass_matrix(drive.rotor_inertia)
     fr: FrictionModel | FrictionSum | None = friction if not isinstance(friction, str) else None
-    if isinstance(friction, str):
-        fr = robot_friction(robot)
+    if isinstance(friction, str):  # the robot's own, where its drive puts it
+        own = robot_friction(robot)
+        fr = None if own is None else own.placed(drive)
     return ObserverModel(robot=robot, rotor_mass=Mr, friction=fr, drive=drive, source="robot")

@@ -249,8 +249,7 @@ def _true_torques(
     else:
         tau = rnea(robot, traj.q, traj.dq, traj.ddq)
     if friction is not None:
-        if drive is not None and drive.friction_at == "motor" and friction.drive is None:
-            friction = friction.at(drive)  # the law per motor, where the drive says: K^T f(K dq)
+        friction = friction.placed(drive)  # the law per motor where the drive says: K^T f(K dq)
         tau = tau + friction.torques(traj.dq)
     if drive is not None and drive.rotor_inertia is not None:
         tau = tau + drive.rotor_torques(traj.ddq, drive.rotor_inertia)

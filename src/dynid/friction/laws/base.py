@@ -252,6 +252,15 @@ class Friction:
         """The same law acting where ``drive`` says (None: at the joints)."""
         return Friction(self.law, self.params, self.band, drive)
 
+    def placed(self, drive: Drive | None) -> Friction:
+        """A robot's friction, given per joint without a drive, where ``drive`` puts it:
+        per motor (``K^T f(K dq)``, :meth:`at`) when its friction acts at the motors
+        (``friction_at = "motor"``), else itself. Simulation and every comparison with a
+        robot's own friction place it so."""
+        if drive is None or self.drive is not None or drive.friction_at != "motor":
+            return self
+        return self.at(drive)
+
     def torques(self, dq: ArrayLike) -> NDArray[np.float64]:
         """Joint friction torques [N m] (..., n) at joint velocities ``dq`` [rad/s] (..., n)."""
         v = _checks.as_batch("dq", dq, (self.n,))
