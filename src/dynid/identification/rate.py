@@ -80,17 +80,19 @@ def motion_frequency(
     moving : ndarray of bool, shape (n,), optional
         Joints to look at; default all.
 
-    The spectrum is that of the first ``N'`` samples, ``N'`` the longest length up to the
-    log's own whose transform is fast (:func:`scipy.fft.prev_fast_len`; a length with a
-    large prime factor, 5,000,001 = 3 x 47 x 35461, would take Bluestein's transform,
-    about 16 times the signal's memory): a few samples of a long log at most are left out.
-
     Returns
     -------
     float
         0 when no joint is looked at or the log is too short (fewer than 8 samples).
         Joints whose motion is a linear trend alone (power below 1e-6 of the largest
         joint's once the trend is removed) are not looked at.
+
+    Notes
+    -----
+    The spectrum is that of the first ``N'`` samples, ``N'`` the longest length up to the
+    log's own whose transform is fast (:func:`scipy.fft.prev_fast_len`; a length with a
+    large prime factor, 5,000,001 = 3 x 47 x 35461, would take Bluestein's transform,
+    about 16 times the signal's memory): a few samples of a long log at most are left out.
     """
     cols = np.arange(q.shape[1]) if moving is None else np.flatnonzero(moving)
     if q.shape[0] < 8 or cols.size == 0:
