@@ -212,17 +212,7 @@ def prepare_pieces(
             continue
         prepared.append(p if k == 1 else p.select(np.arange(0, p.n_samples, k)))
         recording.append(r)
-    _check_kept(raw, recording)
-    return Pieces(
-        logs=tuple(prepared),
-        recording=tuple(recording),
-        names=raw.names,
-        cutoff_hz=raw.cutoff_hz,
-        dq_noise_std=_noise_std([p for _, p in raw.pieces]),
-        skipped=tuple(skipped),
-        unwrapped=raw.unwrapped,
-        drive=raw.drive,
-    )
+    return _kept(raw, prepared, recording, skipped)
 
 
 @dataclass(frozen=True, slots=True, eq=False)
@@ -270,6 +260,28 @@ def _raw_pieces(
         else cutoff_hz
     )
     return _Raw(raw, names, cut, tuple(sorted(turned)), d)
+
+
+def _kept(
+    raw: _Raw,
+    logs: list[TorqueLog],
+    recording: list[int],
+    skipped: list[str],
+    **counts: tuple[Any, ...],
+) -> Pieces:
+    """The :class:`Pieces` of the pieces kept (every recording holding one: checked)."""
+    _check_kept(raw, recording)
+    return Pieces(
+        logs=tuple(logs),
+        recording=tuple(recording),
+        names=raw.names,
+        cutoff_hz=raw.cutoff_hz,
+        dq_noise_std=_noise_std([p for _, p in raw.pieces]),
+        skipped=tuple(skipped),
+        unwrapped=raw.unwrapped,
+        drive=raw.drive,
+        **counts,
+    )
 
 
 def _check_kept(raw: _Raw, recording: list[int]) -> None:
@@ -320,16 +332,11 @@ def validate_recordings(
             continue
         parts.append(v)
         recording.append(r)
-    _check_kept(raw, recording)
-    pieces = Pieces(
-        logs=tuple(v.log for v in parts),
-        recording=tuple(recording),
-        names=raw.names,
-        cutoff_hz=raw.cutoff_hz,
-        dq_noise_std=_noise_std([p for _, p in raw.pieces]),
-        skipped=tuple(skipped),
-        unwrapped=raw.unwrapped,
-        drive=raw.drive,
+    pieces = _kept(
+        raw,
+        [v.log for v in parts],
+        recording,
+        skipped,
         samples=tuple(v.errors.n_samples for v in parts),
         durations=tuple(v.log.duration for v in parts),
     )
