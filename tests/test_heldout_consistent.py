@@ -99,7 +99,7 @@ def test_a_consistent_fit_far_above_least_squares_in_training_is_accepted_held_o
         ls["heldout_error_percent"], rel=1e-9
     )
     # least squares refitted without each block, on rows built here
-    from dynid.identification.log import prepare_log
+    from dynid.identification.prepare import prepare_log
     from dynid.model.drive import Drive
     from dynid.regressors.base import base_parameters
     from dynid.regressors.terms import LinearFriction

@@ -12,8 +12,9 @@ import pytest
 import scipy.signal
 
 from dynid.exceptions import ShapeError
-from dynid.identification import log as log_module
-from dynid.identification.log import TorqueLog, prepare_log, prepared_blocks
+from dynid.identification import prepare as log_module
+from dynid.identification.log import TorqueLog
+from dynid.identification.prepare import prepare_log, prepared_blocks
 
 
 def _log(seed: int, N: int, n: int = 3, *, jitter: bool = False) -> TorqueLog:

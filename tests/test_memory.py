@@ -20,7 +20,8 @@ from dynid.exceptions import ShapeError
 from dynid.friction.model import ClassicalFriction
 from dynid.friction.validation import BLOCK_SAMPLES, validate_torques
 from dynid.identification.classical import identify_from_log
-from dynid.identification.log import TorqueLog, prepare_log
+from dynid.identification.log import TorqueLog
+from dynid.identification.prepare import prepare_log
 from dynid.io.torque_log import load_torque_log, save_torque_log
 from dynid.simulation.measurement import sample_times, simulate_measurement
 from dynid.simulation.trajectories import random_fourier

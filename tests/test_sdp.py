@@ -16,7 +16,7 @@ from dynid.feasibility.bounds import panda_bounds
 from dynid.feasibility.convex import SDPOptions, identify_consistent, retrieve_sdp
 from dynid.feasibility.lmi import pseudo_inertia_margin
 from dynid.feasibility.prior import generic_prior, prior_from_robot
-from dynid.identification.log import prepare_log
+from dynid.identification.prepare import prepare_log
 from dynid.simulation.measurement import SensorNoise, sample_times, simulate_measurement
 from dynid.simulation.trajectories import random_fourier
 from dynid.simulation.unmodelled import UnmodelledEffects

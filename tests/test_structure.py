@@ -20,7 +20,8 @@ from dynid.exceptions import DynidWarning, OptionError
 from dynid.friction.laws import LAWS
 from dynid.friction.model import ClassicalFriction, LawFriction
 from dynid.friction.validation import own_friction
-from dynid.identification.log import TorqueLog, prepare_log, with_derived_velocities
+from dynid.identification.log import TorqueLog, with_derived_velocities
+from dynid.identification.prepare import prepare_log
 from dynid.identification.recordings import prepare_recordings, split_at_gaps, unwrapped
 from dynid.identification.selection import identify_recordings
 from dynid.identification.structure import Structure

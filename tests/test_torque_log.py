@@ -6,7 +6,8 @@ import numpy as np
 import pytest
 
 from dynid.exceptions import DataError, NonFiniteError, ShapeError
-from dynid.identification.log import TorqueLog, prepare_log
+from dynid.identification.log import TorqueLog
+from dynid.identification.prepare import prepare_log
 from dynid.io.torque_log import load_torque_log, save_torque_log, torque_log_columns
 from dynid.simulation.measurement import SensorNoise, sample_times, simulate_measurement
 from dynid.simulation.trajectories import sinusoid_trajectory

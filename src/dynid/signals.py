@@ -138,7 +138,7 @@ def resample_uniform(
     Linear interpolation attenuates a sinusoid of frequency ``f`` by at most
     ``(pi f / fs)^2 / 2`` (relative): 5e-5 at 3 Hz and 1 kHz. Gaps (dropped samples) are
     bridged by straight lines; callers bound the gap length (``max_gap_s`` of
-    :func:`dynid.identification.log.prepare_log`).
+    :func:`dynid.identification.prepare.prepare_log`).
     """
     t = _time(t)
     x = _checks.as_array("x", x)

@@ -7,7 +7,7 @@ The friction torque is what the rigid-body model leaves unexplained,
 where ``tau_hat`` is an identified model (:class:`~dynid.identification.model.IdentifiedModel`
 ``.torques``), a :class:`~dynid.model.robot.Robot` (its own link parameters through RNEA)
 or any callable ``f(q, dq, ddq) -> tau`` on (N, n) arrays. The log is first prepared
-(:func:`~dynid.identification.log.prepare_log`): the states are low-pass filtered with
+(:func:`~dynid.identification.prepare.prepare_log`): the states are low-pass filtered with
 zero phase and ``ddq`` is the derivative of the filtered ``dq``; the measured torques are
 kept unfiltered by default (``filter_tau=False``), because filtering them would smear the
 fast friction reversals that the friction model, evaluated on the velocity, keeps sharp.
@@ -44,8 +44,9 @@ from numpy.typing import ArrayLike, NDArray
 from .. import _checks
 from ..dynamics.rnea import rnea
 from ..exceptions import ConvergenceError, DataError, DynidWarning, ShapeError, WrongTypeError
-from ..identification.log import DEFAULT_CUTOFF_HZ, TorqueLog, joint_side_log, prepare_log
+from ..identification.log import DEFAULT_CUTOFF_HZ, TorqueLog, joint_side_log
 from ..identification.model import IdentifiedModel
+from ..identification.prepare import prepare_log
 from ..identification.sanity import moving_joints, noise_band, velocity_noise_std
 from ..model.drive import Drive
 from ..model.robot import Robot
@@ -194,7 +195,7 @@ def friction_residual(
     model : TorqueModel
     log : TorqueLog
     cutoff_hz, trim_s, filter_tau, max_gap_s
-        Passed to :func:`~dynid.identification.log.prepare_log` (``cutoff_hz=None``: no
+        Passed to :func:`~dynid.identification.prepare.prepare_log` (``cutoff_hz=None``: no
         filtering).
     drive : Drive, optional
         The drive the log was recorded through; default: an identified model's own

@@ -7,7 +7,7 @@ every log is cut at each gap longer than ``max_gap_s`` (by default the rule the 
 identified with), the joints (motors, on a motor-side log) that can wrap and were recorded
 wrapped into ``[-pi, pi]`` are unwrapped piece by piece, whatever the drive, each piece is
 read at the joints (through the model's drive) and filtered and differentiated on its own
-(:func:`~dynid.identification.log.prepare_log`) at one cut-off, and decimated as the model
+(:func:`~dynid.identification.prepare.prepare_log`) at one cut-off, and decimated as the model
 was identified.
 Unlike identification, the measured torques stay unfiltered (the RMS of a correct model
 is the sensor noise). A piece too short to filter is left out
@@ -34,10 +34,11 @@ from numpy.typing import NDArray
 
 from .. import _checks
 from ..exceptions import DataError, OptionError
-from ..identification.log import TorqueLog, joint_side_log, prepare_log
+from ..identification.log import TorqueLog, joint_side_log
 from ..identification.metrics import TorqueErrors
 from ..identification.model import IdentifiedModel
 from ..identification.pieces import recording_pieces, skipped_piece, wrappable
+from ..identification.prepare import prepare_log
 from ..identification.sanity import velocity_noise_std
 from ..model.drive import Drive
 from ..model.robot import Robot
@@ -175,7 +176,7 @@ def prepare_pieces(
         model was identified with, else the one identification reads from the pieces'
         motion (:func:`~dynid.friction.validation.recorded_cutoff`); None: no filter.
     trim_s, filter_tau
-        As :func:`~dynid.identification.log.prepare_log`.
+        As :func:`~dynid.identification.prepare.prepare_log`.
     max_gap_s : float, None or "recorded"
         Gaps up to this long [s] are bridged; longer ones cut a recording into pieces.
         ``"recorded"`` (default) and None: the rule the model was identified with

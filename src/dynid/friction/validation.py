@@ -30,15 +30,10 @@ from numpy.typing import ArrayLike, NDArray
 from .. import _checks
 from ..dynamics.rnea import rnea
 from ..exceptions import DynidWarning, OptionError, ShapeError, WrongTypeError
-from ..identification.log import (
-    DEFAULT_CUTOFF_HZ,
-    TorqueLog,
-    joint_side_log,
-    prepare_log,
-    prepared_blocks,
-)
+from ..identification.log import DEFAULT_CUTOFF_HZ, TorqueLog, joint_side_log
 from ..identification.metrics import TorqueErrors, torque_errors
 from ..identification.model import IdentifiedModel
+from ..identification.prepare import prepare_log, prepared_blocks
 from ..identification.recordings import common_cutoff
 from ..identification.sanity import anticorrelated
 from ..model.drive import Drive
@@ -233,9 +228,9 @@ def validated_log(
     max_gap_s: float | None = None,
 ) -> Validation:
     """:func:`validated` on the joint-side log ``jlog`` prepared
-    (:func:`~dynid.identification.log.prepare_log` with these settings); a log longer than
+    (:func:`~dynid.identification.prepare.prepare_log` with these settings); a log longer than
     :data:`KEPT_SAMPLES` is prepared and predicted a block at a time
-    (:func:`~dynid.identification.log.prepared_blocks`): the errors over every sample, the
+    (:func:`~dynid.identification.prepare.prepared_blocks`): the errors over every sample, the
     Validation keeping every k-th sample (``step``).
 
     Raises

@@ -13,7 +13,7 @@ friction of each joint (eq. 24), ``fv dq_j + fc sign(dq_j) + fo`` in the row of 
 ``j`` only. Columns are ordered ``beta1 .. beta_r`` then ``fv1, fc1, fo1, fv2, ...``;
 rows sample-major (row ``k n + j`` is sample ``k``, joint ``j``).
 
-Pipeline: :func:`~dynid.identification.log.prepare_log` (resample if needed, zero-phase
+Pipeline: :func:`~dynid.identification.prepare.prepare_log` (resample if needed, zero-phase
 low-pass of ``q``, ``dq``, ``tau``, ``ddq`` from the filtered ``dq``, trim the edges), then
 **decimation**: after the low-pass at ``cutoff_hz`` the signals hold nothing above a few
 times the cutoff, so keeping every ``k``-th sample with ``fs / k >= 10 cutoff_hz`` loses no
@@ -64,7 +64,7 @@ from .estimators import (
 from .holdout import DEFAULT_FOLDS, HeldOut, Normals, block_labels, block_normals
 from .info import IdentificationInfo, LogInfo
 from .least_squares import StdMethod
-from .log import LogCleaning, TorqueLog, joint_side_log, prepare_log
+from .log import LogCleaning, TorqueLog, joint_side_log
 from .log_rows import (
     friction_regressor,
     log_blocks,
@@ -74,6 +74,7 @@ from .log_rows import (
     term_regressor,
 )
 from .model import IdentifiedModel
+from .prepare import prepare_log
 from .rate import cutoff_from_motion, decimation, motion_frequency
 from .sanity import check_torque_log, moving_joints
 from .streaming import BlockSource, normals_by_label
@@ -128,14 +129,14 @@ def identify_from_log(
     log : TorqueLog
         Measured ``t``, ``q``, ``dq``, ``tau`` (``ddq`` optional) of an exciting trajectory.
     cutoff_hz : float, "auto" or None
-        Zero-phase low-pass cutoff [Hz] (:func:`~dynid.identification.log.prepare_log`);
+        Zero-phase low-pass cutoff [Hz] (:func:`~dynid.identification.prepare.prepare_log`);
         ``"auto"`` (default) reads it from the motion
         (:func:`~dynid.identification.rate.cutoff_from_motion`); None for noise-free data
         (then ``ddq`` of the log is used if present, else differentiated).
     trim_s : float, optional
         Seconds dropped at each end after filtering (default ``2 / cutoff_hz``).
     max_gap_s : float, optional
-        Longest gap bridged [s] (:func:`~dynid.identification.log.prepare_log`).
+        Longest gap bridged [s] (:func:`~dynid.identification.prepare.prepare_log`).
     decimate : int, optional
         Keep every ``decimate``-th sample after filtering; default
         :func:`~dynid.identification.rate.decimation` (at least 10 % of the samples).
@@ -471,7 +472,7 @@ def prepare_torque_log(
 
     The checks of :func:`~dynid.identification.sanity.check_torque_log` (sign, units,
     frozen joints) are warned first (unless ``check`` is False: a piece of a recording
-    checked whole); then :func:`~dynid.identification.log.prepare_log`
+    checked whole); then :func:`~dynid.identification.prepare.prepare_log`
     and every ``decimate``-th sample (default :func:`~dynid.identification.rate.decimation`;
     the cut-off ``"auto"``: :func:`~dynid.identification.rate.cutoff_from_motion`).
     Parameters as in
@@ -482,7 +483,7 @@ def prepare_torque_log(
     ShapeError
         ``log.n != robot.n`` or ``decimate < 1``.
     DataError
-        From :func:`~dynid.identification.log.prepare_log`.
+        From :func:`~dynid.identification.prepare.prepare_log`.
 
     Warns
     -----

@@ -39,8 +39,9 @@ from ..friction.validation import (
     validate_torques,
 )
 from ..identification.data import StaticDataset
-from ..identification.log import TorqueLog, prepare_log
+from ..identification.log import TorqueLog
 from ..identification.model import IdentifiedModel
+from ..identification.prepare import prepare_log
 from ..identification.static import identify_static
 from ..kinematics.forward import fk
 from ..kinematics.inverse import IKOptions, IKResult, ik
@@ -404,7 +405,7 @@ def feasible_stage(
         Identified static coefficients (e.g. from :func:`identification_stage`).
     validation_log : TorqueLog, optional
         Measured validation trajectory, used as it is when it has ``ddq``, else prepared
-        with :func:`dynid.identification.log.prepare_log` (zero-phase filtered states,
+        with :func:`dynid.identification.prepare.prepare_log` (zero-phase filtered states,
         ``ddq`` differentiated, torques kept unfiltered). Default: a 10 s random Fourier
         trajectory simulated on ``truth`` with sensor noise.
     friction : Friction, array_like (n, 3) (sigmoid) or None

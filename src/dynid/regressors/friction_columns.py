@@ -19,7 +19,7 @@ from __future__ import annotations
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-__all__ = ["smooth_sign", "standstill_sign", "stribeck_decay"]
+__all__ = ["distinct_rows", "smooth_sign", "standstill_sign", "stribeck_decay"]
 
 
 def standstill_sign(v: ArrayLike, band: ArrayLike = 0.0) -> NDArray[np.float64]:
@@ -47,3 +47,14 @@ def stribeck_decay(v: ArrayLike, vst: ArrayLike) -> NDArray[np.float64]:
     ok = s > 0
     out: NDArray[np.float64] = np.where(ok, np.exp(-((x / np.where(ok, s, 1.0)) ** 2)), 0.0)
     return out
+
+
+def distinct_rows(G: NDArray[np.float64]) -> NDArray[np.float64]:
+    """The rows of ``G`` (constraints ``G f >= 0`` on friction coefficients), each scaled to
+    a largest entry of 1, without repeats (a joint with Coulomb friction alone gives one
+    row, ``fc >= 0``, not one per velocity)."""
+    if not G.shape[0]:
+        return G
+    G = G / np.max(np.abs(G), axis=1, keepdims=True)
+    _, first = np.unique(np.round(G, 12), axis=0, return_index=True)
+    return G[np.sort(first)]

@@ -38,7 +38,7 @@ from numpy.typing import NDArray
 
 from ..exceptions import OptionError
 from ..model.drive import Drive
-from .friction_columns import smooth_sign, standstill_sign, stribeck_decay
+from .friction_columns import distinct_rows, smooth_sign, standstill_sign, stribeck_decay
 from .spring import JointSpring
 
 __all__ = [
@@ -399,7 +399,7 @@ class LinearFriction:
             rows.append(G)
         every = np.concatenate(rows) if rows else np.zeros((0, n * k))
         G = every[:, self._held]
-        return _distinct_rows(G[np.any(G != 0.0, axis=1)])
+        return distinct_rows(G[np.any(G != 0.0, axis=1)])
 
     def _part_columns(
         self, v: NDArray[np.float64], band: NDArray[np.float64]
@@ -533,16 +533,6 @@ class LinearFriction:
             mask=tuple(bool(x) for x in d.get("mask", ())),
             prefix=str(d.get("prefix", "")),
         )
-
-
-def _distinct_rows(G: NDArray[np.float64]) -> NDArray[np.float64]:
-    """The rows of ``G``, each scaled to a largest entry of 1, without repeats (a joint
-    with Coulomb friction alone gives one row, ``fc >= 0``, not one per velocity)."""
-    if not G.shape[0]:
-        return G
-    G = G / np.max(np.abs(G), axis=1, keepdims=True)
-    _, first = np.unique(np.round(G, 12), axis=0, return_index=True)
-    return G[np.sort(first)]
 
 
 def drive_terms(drive: Drive | None, n: int, *, friction: bool = True) -> tuple[ModelTerm, ...]:
