@@ -12,7 +12,7 @@ import pytest
 import scipy.signal
 
 from dynid.exceptions import ShapeError
-from dynid.identification import prepare as log_module
+from dynid.identification import prepare as prepare_module
 from dynid.identification.log import TorqueLog
 from dynid.identification.prepare import prepare_log, prepared_blocks
 
@@ -69,7 +69,7 @@ def test_blocks_equal_the_whole_array_steps(monkeypatch, filter_tau, k, jitter):
     log = _log(1, 9_000, jitter=jitter)
     fs, cut = 1000.0, 20.0
     ref = _reference(log, fs, cut, filter_tau, k, jitter)
-    monkeypatch.setattr(log_module, "PREPARE_BLOCK_SAMPLES", 500)
+    monkeypatch.setattr(prepare_module, "PREPARE_BLOCK_SAMPLES", 500)
     p = prepare_log(log, cutoff_hz=cut, filter_tau=filter_tau, decimate=k, fs=fs)
     blocks = list(prepared_blocks(log, cutoff_hz=cut, filter_tau=filter_tau, decimate=k, fs=fs))
     assert len(blocks) > 2
@@ -94,7 +94,7 @@ def test_blocks_of_derived_velocities_equal_the_whole_log(monkeypatch):
     dq = lp(np.gradient(lp(log.q), log.t, axis=0, edge_order=2))
     ddq = np.gradient(dq, log.t, axis=0, edge_order=2)
     keep = (log.t >= 2 / cut) & (log.t <= log.t[-1] - 2 / cut)
-    monkeypatch.setattr(log_module, "PREPARE_BLOCK_SAMPLES", 600)
+    monkeypatch.setattr(prepare_module, "PREPARE_BLOCK_SAMPLES", 600)
     p = prepare_log(log, cutoff_hz=cut)
     for got, want in ((p.dq, dq[keep]), (p.ddq, ddq[keep])):
         np.testing.assert_allclose(got, want, rtol=0, atol=1e-12 * float(np.max(np.abs(want))))
@@ -122,7 +122,7 @@ def test_a_long_recording_is_validated_in_blocks_with_every_samples_errors(monke
     whole = prepare_pieces(model, [log], cutoff_hz=20.0).logs[0]  # one block: the reference
     e0 = whole.tau - (0.1 * whole.q + 0.01 * whole.ddq)
     e1 = e0 - fr.torques(whole.dq)
-    monkeypatch.setattr(log_module, "PREPARE_BLOCK_SAMPLES", 700)
+    monkeypatch.setattr(prepare_module, "PREPARE_BLOCK_SAMPLES", 700)
     monkeypatch.setattr(validation, "KEPT_SAMPLES", 2_000)
     val = validate_recordings(model, [log], friction=fr, cutoff_hz=20.0)
     (part,) = val.parts
