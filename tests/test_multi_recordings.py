@@ -247,6 +247,10 @@ def test_a_recording_in_other_units_is_named(panda, files, tmp_path, capsys):
         validate_files(panda, [files / "rec1.csv", tmp_path / "mnm.csv"])
     with pytest.raises(DataError, match=r"ms\.csv: .*time column looks like ms.*--units t=ms"):
         fit_friction_files(panda, [files / "rec1.csv", tmp_path / "ms.csv"])
+    code = main(["identify", "--robot", "panda", "--data", str(tmp_path / "ms.csv"), "--out",
+                 str(tmp_path / "i"), "--no-figures"])  # fmt: skip
+    err = capsys.readouterr().err
+    assert code == 2 and err.count("ms.csv") == 1, err  # one recording: its name said once
     with pytest.raises(DataError) as api:
         validate_files(panda, [files / "rec1.csv", tmp_path / "mnm.csv"])
     argv = ["validate", "--robot", "panda", "--out", str(tmp_path / "v"), "--data"]
@@ -260,7 +264,7 @@ def test_a_recording_of_another_robot_is_named(panda, files, tmp_path):
     warning naming the file."""
     log = load_torque_log(files / "rec2.csv")
     save_torque_log(tmp_path / "deg.csv", type(log)(log.t, np.degrees(log.q), log.dq, log.tau))
-    with pytest.warns(DynidWarning, match="deg.csv: joint .* far outside robot 'panda'"):
+    with pytest.warns(DynidWarning, match="deg.csv: joint .* far outside the limits of robot"):
         with pytest.raises(DataError):  # its velocities disagree with its positions too
             validate_files(panda, [files / "rec1.csv", tmp_path / "deg.csv"])
 

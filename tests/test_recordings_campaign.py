@@ -242,7 +242,7 @@ def test_observe_checks_its_recordings_as_the_other_commands(panda, logs, tmp_pa
     assert main([*run, str(mnm)]) == 2
     err = [s for s in capsys.readouterr().err.splitlines() if s.strip()]
     assert len(err) == 1 and "error: mnm.csv: its torques (RMS) are 1" in err[0], err
-    with pytest.warns(DynidWarning, match="deg.csv: joint .* far outside robot 'panda'"):
+    with pytest.warns(DynidWarning, match="deg.csv: joint .* far outside the limits of robot"):
         observe_files(
             ObserveOptions(
                 data=(logs / "rec1.csv", deg),

@@ -158,8 +158,8 @@ def recording_pieces(
     OptionError
         ``max_gap_s`` below the sample step.
     """
-    if (unit := time_unit_finding(name, log)) is not None:
-        raise DataError(unit)
+    if (unit := time_unit_finding(name, log)) is not None:  # it names the file
+        raise DataError(unit.removeprefix(f"{name}: "), file=name)
     pieces: list[TorqueLog] = []
     turned: set[int] = set()
     for piece in split_at_gaps(log, max_gap_s, name):

@@ -126,8 +126,8 @@ def read_recordings(
     out = Recorded(logs, tuple(paths))
     check_limits(out, robot, drive)
     for name, log in zip(out.names, out.logs, strict=True):  # the time unit named first
-        if (unit := time_unit_finding(name, log)) is not None:
-            raise DataError(unit)
+        if (unit := time_unit_finding(name, log)) is not None:  # it names the file
+            raise DataError(unit.removeprefix(f"{name}: "), file=name)
     check_units(out)
     return out
 
@@ -196,7 +196,7 @@ def check_limits(rec: Recorded, robot: Robot, drive: Drive | None) -> None:
             j = int(bad[0])
             warnings.warn(
                 f"{name}: joint {robot.joint_names[j]} spans [{qmin[j]:.4g}, {qmax[j]:.4g}], "
-                f"far outside robot {robot.name!r}'s limits [{robot.q_min[j]:.4g}, "
+                f"far outside the limits of robot {robot.name!r} [{robot.q_min[j]:.4g}, "
                 f"{robot.q_max[j]:.4g}]: a recording of another robot, or in other units?",
                 DynidWarning,
                 stacklevel=3,
