@@ -16,6 +16,7 @@ import numpy as np
 import pytest
 
 import dynid
+from dynid.cli.__main__ import main
 from dynid.feasibility.convex.data_term import coefficient_term
 from dynid.feasibility.convex.fit import consistent_from_identified
 from dynid.friction.model import ClassicalFriction, FrictionSum, friction_of
@@ -25,6 +26,7 @@ from dynid.identification.structure import Structure, joint_side_joints
 from dynid.io.feasible import load_feasible_linear_friction
 from dynid.io.feasible_bundle import save_feasible_bundle
 from dynid.io.model_json import model_from_dict, model_to_dict
+from dynid.io.torque_log import save_torque_log
 from dynid.model.drive import Drive
 from dynid.observer.model import from_identified
 from dynid.observer.residual import ObserverOptions, observe
@@ -275,3 +277,25 @@ def test_a_part_left_out_at_the_motors_stays_named_while_the_joints_hold_it():
     assert s.collapsed(7) == s  # the joints unknown: nothing at both places is removed
     gone = Structure.parse("viscous, coulomb, offset, at:both, -jfv7" + motors)
     assert gone.collapsed(7, (6,)) == Structure.parse("coulomb, offset, at:both")
+
+
+def test_a_feasible_json_as_robot_brings_its_drive_and_identified_friction(panda, tmp_path):
+    """``validate --robot feasible.json`` reads the file's drive (its rotor inertias) and
+    the friction identified with the links, as ``--params feasible.json`` does: both give
+    the same errors on a recording (before, the robot kept the input's sigmoid and no
+    drive, so motor-side data were read as joint angles)."""
+    logs, _, _ = _logs(panda, joint_side=False)
+    terms = Structure.parse("viscous, coulomb, offset")
+    model = identify_recordings(panda, logs, cutoff_hz=None, drive=_drive(), structure=terms)
+    res = consistent_from_identified(panda, model, prior=panda)
+    save_feasible_bundle(tmp_path, res)
+    save_torque_log(tmp_path / "rec.csv", logs[1])
+    got = {}
+    for how in ("--robot", "--params"):
+        out = tmp_path / how.strip("-")
+        argv = ["validate", how, str(tmp_path / "feasible.json"), "--data"]
+        argv += [str(tmp_path / "rec.csv"), "--out", str(out), "--no-figures", "-q"]
+        assert main(argv) == 0
+        got[how] = json.loads((out / "validation.json").read_text())["relative_error_percent"]
+    assert got["--robot"] == pytest.approx(got["--params"], rel=1e-9)
+    assert got["--robot"] < 0.5

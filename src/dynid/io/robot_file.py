@@ -8,9 +8,11 @@ it needs, so a command on a built-in robot loads no file reader at all.
 
 from __future__ import annotations
 
+import warnings
 from pathlib import Path
 
-from ..exceptions import DataError
+from ..exceptions import DataError, DynidWarning
+from ..friction.model import FrictionSum
 from ..model.builtin import BUILTIN_ROBOTS, builtin_robot
 from ..model.robot import Robot
 
@@ -34,7 +36,9 @@ def load_robot(
     ``.urdf`` (the chain from ``base`` to ``tip``, rounded angles snapped with
     ``snap_angles``: :func:`dynid.io.robot.urdf.load_urdf`),
     ``.toml`` (:func:`dynid.io.robot.toml.load_toml`) or ``.json`` (a ``feasible.json``,
-    :func:`dynid.io.feasible.load_feasible_json`). ``what`` names the option in errors.
+    :func:`dynid.io.feasible.load_feasible_json`, with the friction identified with the links
+    when the file holds it, acting where it was identified). ``what`` names the option in
+    errors.
 
     Raises
     ------
@@ -60,9 +64,22 @@ def load_robot(
         from .robot.toml import load_toml
 
         return load_toml(path)
-    from .feasible import load_feasible_json
+    from .feasible import load_feasible_json, load_feasible_linear_friction
 
-    return load_feasible_json(path)
+    robot = load_feasible_json(path)
+    identified = load_feasible_linear_friction(path)
+    if identified is None:
+        return robot
+    if isinstance(identified, FrictionSum):  # at the motors and at the joints: no one law
+        warnings.warn(
+            f"{path.name}: its friction acts at the motors and at the joints, which a robot "
+            "does not hold; the robot keeps the file's sigmoid; hint: --params "
+            f"{path.name} uses both",
+            DynidWarning,
+            stacklevel=2,
+        )
+        return robot
+    return robot.with_friction(identified)  # the friction identified with the links
 
 
 def _names() -> str:
