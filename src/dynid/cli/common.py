@@ -18,7 +18,6 @@ import numpy as np
 from .. import _checks, spatial
 from ..exceptions import DataError, OptionError, ShapeError, in_file
 from ..io.drive_file import drive_of_robot_file, load_drive
-from ..io.feasible import load_feasible_drive
 from ..io.robot_file import load_robot as load_robot_file
 from ..kinematics.inverse import default_q0
 from ..model.builtin import BUILTIN_ROBOTS, builtin_robot
@@ -251,6 +250,8 @@ def load_drive_arg(args: argparse.Namespace, n: int) -> Any:
         return load_drive(args.drive, n)
     spec = getattr(args, "robot", None)
     if spec is not None and str(spec).lower().endswith(".json") and Path(spec).is_file():
+        from ..io.feasible import load_feasible_drive  # here: one-shot commands skip scipy
+
         return load_feasible_drive(spec)  # a feasible.json's drive, if it holds one
     return None if spec is None else drive_of_robot_file(spec, n)
 

@@ -12,7 +12,6 @@ import warnings
 from pathlib import Path
 
 from ..exceptions import DataError, DynidWarning
-from ..friction.model import FrictionSum
 from ..model.builtin import BUILTIN_ROBOTS, builtin_robot
 from ..model.robot import Robot
 
@@ -64,6 +63,7 @@ def load_robot(
         from .robot.toml import load_toml
 
         return load_toml(path)
+    from ..friction.model import FrictionSum
     from .feasible import load_feasible_json, load_feasible_linear_friction
 
     robot = load_feasible_json(path)
