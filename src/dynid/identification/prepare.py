@@ -100,11 +100,6 @@ def prepare_log(
     """
     plan = _plan(log, cutoff_hz, trim_s, fs, max_gap_s, jitter_rtol, decimate)
     n_out = len(plan.out)
-    if n_out < 2:
-        raise DataError(
-            f"fewer than 2 samples left after trimming {plan.trim_s:g} s at each end and keeping "
-            f"every {decimate}-th"
-        )
     parts = _windows(plan, PREPARE_BLOCK_SAMPLES)
     if len(parts) == 1:  # short: the whole log at once
         out = _prepared_window(log, plan, *parts[0], filter_tau)
@@ -121,14 +116,7 @@ def prepare_log(
             o += m
         for v in out.values():
             v.setflags(write=False)  # kept by TorqueLog without a copy
-    return TorqueLog(
-        t=out["t"],
-        q=out["q"],
-        dq=out["dq"],
-        tau=out["tau"],
-        ddq=out["ddq"],
-        cleaning=log.cleaning,
-    )
+    return _as_log(out, log)
 
 
 def prepared_blocks(
@@ -159,22 +147,17 @@ def prepared_blocks(
     if block_samples is not None and block_samples < 1:
         raise ShapeError(f"block_samples must be >= 1; got {block_samples}")
     plan = _plan(log, cutoff_hz, trim_s, fs, max_gap_s, jitter_rtol, decimate)
-    if len(plan.out) < 2:
-        raise DataError(
-            f"fewer than 2 samples left after trimming {plan.trim_s:g} s at each end and keeping "
-            f"every {decimate}-th"
-        )
     size = PREPARE_BLOCK_SAMPLES if block_samples is None else int(block_samples)
     for w in _windows(plan, size):
         out = _prepared_window(log, plan, *w, filter_tau)
-        yield TorqueLog(
-            t=out["t"],
-            q=out["q"],
-            dq=out["dq"],
-            tau=out["tau"],
-            ddq=out["ddq"],
-            cleaning=log.cleaning,
-        )
+        yield _as_log(out, log)
+
+
+def _as_log(out: dict[str, NDArray[np.float64]], log: TorqueLog) -> TorqueLog:
+    """The prepared signals ``out`` as a log, with ``log``'s cleaning record."""
+    return TorqueLog(
+        t=out["t"], q=out["q"], dq=out["dq"], tau=out["tau"], ddq=out["ddq"], cleaning=log.cleaning
+    )
 
 
 #: Prepared samples per block of :func:`prepare_log` and :func:`prepared_blocks`.
@@ -234,6 +217,11 @@ def _plan(
     if last - first + 1 < 2:
         raise DataError(f"fewer than 2 samples left after trimming {trim_s:g} s at each end")
     out = range(first, last + 1, int(decimate))
+    if len(out) < 2:
+        raise DataError(
+            f"fewer than 2 samples left after trimming {trim_s:g} s at each end and keeping "
+            f"every {decimate}-th"
+        )
     derived = log.dq_derived and cutoff_hz is not None
     pad = 2  # the central differences' neighbours
     if cutoff_hz is not None:
