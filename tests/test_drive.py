@@ -595,7 +595,9 @@ def test_a_robots_own_friction_acts_where_its_drive_puts_it_in_every_comparison(
         with_ddq=True,
         drive=drive,
     )
-    v = validate_torques(robot, log, friction=own_friction(robot), cutoff_hz=None, drive=drive)
+    v = validate_torques(
+        robot, log, friction=own_friction(robot, drive), cutoff_hz=None, drive=drive
+    )
     assert v.with_friction is not None
     assert v.with_friction.relative_error_percent < 1e-8
     # the law at the joints instead differs by the motors' friction seen through the gears
@@ -603,3 +605,38 @@ def test_a_robots_own_friction_acts_where_its_drive_puts_it_in_every_comparison(
     assert at_joints.errors.relative_error_percent > 1.0
     obs = from_robot(robot, drive=drive)
     assert obs.friction is not None and obs.friction.drive is drive
+
+
+def test_a_robots_own_friction_is_placed_in_one_place_as_written_out():
+    """``own_friction(robot, drive)`` is the robot's per-joint law acting where the drive
+    puts it, against the torques written out here with ``K`` built from the gears and the
+    coupling: ``K^T (fv dqm + fc sign(dqm) + fo)``, ``dqm = K dq``, with friction at the
+    motors; ``fv dq + fc sign(dq) + fo`` with it at the joints or without a drive. The
+    observer and payload identification read that same friction."""
+    from dynid.feasibility.payload_arm import arm_model
+    from dynid.friction.model import ClassicalFriction
+    from dynid.friction.validation import own_friction
+    from dynid.observer.model import from_robot
+
+    robot, _, _ = _ur5()
+    robot = robot.with_friction(ClassicalFriction(FV, FC, FO))
+    K = np.diag(GEAR)
+    K[5, 4] = 30.0  # qm6 = 51 q6 + 30 q5
+    dq = np.random.default_rng(3).uniform(-1.0, 1.0, (40, robot.n))
+    dqm = dq @ K.T
+    at_motors = (FV * dqm + FC * np.sign(dqm) + FO) @ K
+    at_joints = FV * dq + FC * np.sign(dq) + FO
+    motor = _drive(friction_at="motor", rotor_inertia=IA)
+    joint = _drive(friction_at="joint", rotor_inertia=IA)
+    for drive, want in ((motor, at_motors), (joint, at_joints), (None, at_joints)):
+        own = own_friction(robot, drive)
+        assert own is not None
+        np.testing.assert_allclose(own.torques(dq), want, rtol=1e-12, atol=1e-15)
+        obs = from_robot(robot, drive=drive).friction
+        assert obs is not None
+        np.testing.assert_allclose(obs.torques(dq), want, rtol=1e-12, atol=1e-15)
+        arm = arm_model(robot, drive=drive).friction
+        assert arm is not None
+        np.testing.assert_allclose(arm.torques(dq), want, rtol=1e-12, atol=1e-15)
+    # the robot description holds the law per joint: without a drive it is returned as held
+    assert own_friction(robot) is robot.friction

@@ -35,7 +35,6 @@ from ..dynamics.rnea import rnea
 from ..dynamics.terms import gravity_torques, mass_matrix
 from ..exceptions import ModelError
 from ..friction.fit import model_drive
-from ..friction.model import robot_friction
 from ..friction.validation import own_friction
 from ..identification.data import StaticDataset
 from ..identification.log import TorqueLog
@@ -180,12 +179,8 @@ def arm_model(
             "--unloaded data of the arm without the load, or the rotor inertias in the drive"
         )
     fr: FrictionTorques | None
-    if isinstance(friction, str):
-        if isinstance(arm, IdentifiedModel):
-            fr = own_friction(arm)
-        else:  # the robot's own, where its drive puts it (as simulation does)
-            own = robot_friction(arm)
-            fr = None if own is None else own.placed(d)
+    if isinstance(friction, str):  # its own, where its drive puts it (as simulation does)
+        fr = own_friction(arm, d)
     else:
         fr = friction
     return ArmModel(arm, d, fr)

@@ -268,10 +268,18 @@ def combined(frictions: tuple[FrictionValues, ...]) -> Friction | FrictionSum | 
     return FrictionSum(tuple(friction_of(f) for f in frictions))
 
 
-def robot_friction(robot: Robot) -> Friction | None:
+def robot_friction(robot: Robot, drive: Drive | None = None) -> Friction | None:
     """A robot's friction, ``robot.friction``, typed as the :class:`Friction` it is (the
-    model layer names it by a protocol), or None."""
-    return cast(Friction | None, robot.friction)
+    model layer names it by a protocol), or None.
+
+    A robot holds its friction per joint, without a drive; with ``drive`` it is returned
+    where that drive puts it: per motor (``tau_f = K^T f(K dq)``) when the drive's friction
+    acts at the motors (``friction_at = "motor"``), else as held (a friction that names its
+    own drive acts as it says). This is the one place a robot's own friction is placed:
+    simulation, validation, payload identification and the observer all read it here.
+    Without ``drive``: as held (what a robot description file writes)."""
+    own = cast(Friction | None, robot.friction)
+    return None if own is None else own.placed(drive)
 
 
 def sigmoid_parameters(friction: object) -> NDArray[np.float64] | None:

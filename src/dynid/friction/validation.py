@@ -56,15 +56,35 @@ __all__ = [
 ]
 
 
-def own_friction(model: TorqueModel) -> FrictionModel | FrictionSum | None:
-    """The friction that comes with a model: an IdentifiedModel's friction terms (each its
-    law, band and where it acts; a :class:`~dynid.friction.model.FrictionSum` of friction
-    at the motors and at the joints), a Robot's own
-    (:func:`~dynid.friction.model.robot_friction`), or None."""
+def own_friction(
+    model: TorqueModel, drive: Drive | None = None
+) -> FrictionModel | FrictionSum | None:
+    """The friction that comes with a model, acting where it acts: an IdentifiedModel's
+    friction terms (each its law, band and place; a
+    :class:`~dynid.friction.model.FrictionSum` of friction at the motors and at the
+    joints), a Robot's own where ``drive`` puts it
+    (:func:`~dynid.friction.model.robot_friction`), or None.
+
+    Parameters
+    ----------
+    model : TorqueModel
+        An identified model, a robot or a callable (which has none).
+    drive : Drive, optional
+        The drive the robot's torques are read through: with its friction at the motors a
+        robot's per-joint law acts per motor (``K^T f(K dq)``), as simulation puts it. An
+        identified model's terms already hold their place; a drive given with one must be
+        the one it was identified with.
+
+    Raises
+    ------
+    DataError
+        ``drive`` differs from the one the identified model was identified with.
+    """
     if isinstance(model, IdentifiedModel):
+        model_drive(model, drive)  # another drive than the model's is refused
         return combined(model.frictions)
     if isinstance(model, Robot):
-        return robot_friction(model)
+        return robot_friction(model, drive)
     return None
 
 
@@ -170,8 +190,8 @@ def validate_torques(
     log : TorqueLog
         Measured log (e.g. the validation sinusoids, Gaz et al. 2019 eq. 31).
     friction : FrictionModel, optional
-        Friction added to the prediction (e.g. :func:`own_friction` of the model, or a
-        fitted sigmoid).
+        Friction added to the prediction as it is (e.g. a fitted sigmoid, or the model's
+        own where the drive puts it: :func:`own_friction` ``(model, drive)``).
     cutoff_hz, trim_s, filter_tau, max_gap_s
         Preparation of the log (:func:`~dynid.friction.fit.friction_residual`);
         ``cutoff_hz="recorded"`` (default): the cut-off an identified model was identified
@@ -247,8 +267,6 @@ def validated_log(
         return validated(model, p, friction, drive)
     if friction is not None and friction.n != jlog.n:
         raise ShapeError(f"friction model has {friction.n} joints; the log has {jlog.n}")
-    if isinstance(friction, Friction) and isinstance(model, Robot):  # as in validated
-        friction = friction.placed(drive)
     blocks = prepared_blocks(jlog, max_gap_s=max_gap_s, **kw)  # type: ignore[arg-type]
     return _validated_blocks(model, blocks, friction, drive, step)
 
@@ -323,7 +341,8 @@ def validated(
     drive: Drive | None,
 ) -> Validation:
     """The :class:`Validation` of ``model`` (and ``friction``) on a prepared joint-side log
-    ``p`` (with ``ddq``) read through ``drive`` (its known rotors added to a robot's).
+    ``p`` (with ``ddq``) read through ``drive`` (its known rotors added to a robot's),
+    ``friction`` added as it is (a robot's own placed by :func:`own_friction`).
 
     Raises
     ------
@@ -333,8 +352,6 @@ def validated(
     if friction is not None and friction.n != p.n:
         raise ShapeError(f"friction model has {friction.n} joints; the log has {p.n}")
     d = drive
-    if isinstance(friction, Friction) and isinstance(model, Robot):  # as simulation puts it
-        friction = friction.placed(d)
     assert p.ddq is not None  # prepare_log always fills ddq
     tau_model = rigid_body_torques(model, p.q, p.dq, p.ddq)
     if d is not None and d.rotor_inertia is not None and not isinstance(model, IdentifiedModel):

@@ -22,7 +22,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from .. import _checks
 from ..exceptions import ShapeError
-from ..friction.model import FrictionModel, FrictionSum, robot_friction
+from ..friction.model import FrictionModel, FrictionSum
 from ..friction.validation import own_friction
 from ..identification.model import IdentifiedModel
 from ..model.drive import Drive
@@ -144,7 +144,8 @@ def from_robot(
     ----------
     robot : Robot
     friction : FrictionModel, None or "robot"
-        ``"robot"`` (default): the robot's own friction (any law), none if it has none.
+        ``"robot"`` (default): the robot's own friction (any law) where ``drive`` puts it
+        (:func:`~dynid.friction.validation.own_friction`), none if it has none.
     drive : Drive, optional
         Its known rotor inertias add ``K^T diag(I_a) K`` to ``M``.
 
@@ -163,8 +164,5 @@ def from_robot(
         drive.check(n)
         if drive.rotor_inertia is not None:
             Mr = drive.rotor_mass_matrix(drive.rotor_inertia)
-    fr: FrictionModel | FrictionSum | None = friction if not isinstance(friction, str) else None
-    if isinstance(friction, str):  # the robot's own, where its drive puts it
-        own = robot_friction(robot)
-        fr = None if own is None else own.placed(drive)
+    fr = own_friction(robot, drive) if isinstance(friction, str) else friction
     return ObserverModel(robot=robot, rotor_mass=Mr, friction=fr, drive=drive, source="robot")

@@ -220,19 +220,17 @@ def _checked(
     n = robot.n
     if not 0.0 <= drop_fraction < 0.5:
         raise OptionError(f"drop_fraction must be in [0, 0.5); got {drop_fraction}")
-    if isinstance(friction, str):
-        if friction != "robot":
-            raise OptionError(
-                f"friction must be a friction model, None or 'robot'; got {friction!r}"
-            )
-        friction = robot_friction(robot)
-    if friction is not None and friction.n != n:
+    if isinstance(friction, str) and friction != "robot":
+        raise OptionError(f"friction must be a friction model, None or 'robot'; got {friction!r}")
+    if friction is not None and not isinstance(friction, str) and friction.n != n:
         raise ShapeError(f"friction model has {friction.n} joints; robot has {n}")
     if effects is not None:
         effects.check(robot)
     if drive is not None:
         drive.check(n)
-    return friction
+    # a ground truth given stands for the robot's own: both act where the drive puts it
+    truth = robot if isinstance(friction, str) else robot.with_friction(friction)
+    return robot_friction(truth, drive)
 
 
 def _true_torques(
@@ -248,8 +246,7 @@ def _true_torques(
         tau = rnea(effects.true_robot(robot), traj.q, traj.dq, traj.ddq) + effects.torques(traj.ddq)
     else:
         tau = rnea(robot, traj.q, traj.dq, traj.ddq)
-    if friction is not None:
-        friction = friction.placed(drive)  # the law per motor where the drive says: K^T f(K dq)
+    if friction is not None:  # placed where the drive puts it (_checked)
         tau = tau + friction.torques(traj.dq)
     if drive is not None and drive.rotor_inertia is not None:
         tau = tau + drive.rotor_torques(traj.ddq, drive.rotor_inertia)

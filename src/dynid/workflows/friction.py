@@ -186,7 +186,8 @@ def fit_friction_files(
             here = isinstance(model, IdentifiedModel) and bool(
                 set(rec.names) & {str(r.get("file")) for r in model.info.recordings}
             )
-            own = own_friction(model)  # a sum (at the motors and the joints) judged too
+            # where it acts (a robot's where the drive puts it); a sum judged too
+            own = own_friction(model, pieces.drive)
             sel = select_friction(res, pieces.drive, own=own, own_fitted_here=here)
             return FrictionFileResult(sel.fit, res, sel, cut, pieces)
         chosen = fit_friction_through(res, pieces.drive, law)

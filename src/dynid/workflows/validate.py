@@ -206,7 +206,7 @@ def validate_files(
         owner=f"the model ({label or robot.name})",
         drive=own if drive is None else drive,
     )
-    friction, source = _friction(model, opt.friction, feasible)
+    friction, source = _friction(model, opt.friction, feasible, drive)
 
     def run() -> RecordingsValidation:
         return validate_recordings(
@@ -279,12 +279,14 @@ def _friction(
     model: IdentifiedModel | Robot,
     friction: str | Path | FrictionModel,
     feasible: str | Path | None,
+    drive: Drive | None,
 ) -> tuple[FrictionModel | FrictionSum | None, str | None]:
-    """The friction added to the model and where it comes from."""
+    """The friction added to the model (its own where ``drive`` puts it) and where it comes
+    from."""
     if isinstance(friction, str) and friction == "none":
         return None, None
     if isinstance(friction, str) and friction == "own":
-        own = own_friction(model)
+        own = own_friction(model, drive)
         if feasible is not None:
             own = load_feasible_linear_friction(feasible) or own
         return own, None if own is None else "model"

@@ -255,8 +255,9 @@ class Friction:
     def placed(self, drive: Drive | None) -> Friction:
         """A robot's friction, given per joint without a drive, where ``drive`` puts it:
         per motor (``K^T f(K dq)``, :meth:`at`) when its friction acts at the motors
-        (``friction_at = "motor"``), else itself. Simulation and every comparison with a
-        robot's own friction place it so."""
+        (``friction_at = "motor"``), else itself. Called in one place,
+        :func:`~dynid.friction.model.robot_friction`, which simulation and every
+        comparison with a robot's own friction read."""
         if drive is None or self.drive is not None or drive.friction_at != "motor":
             return self
         return self.at(drive)
