@@ -1,20 +1,30 @@
-"""Shared fixtures: the built-in Panda, a planar 2R arm with closed forms, seeded states."""
+"""Shared fixtures: the built-in Panda, a planar 2R arm with closed forms, seeded states,
+simulated recordings of an arm with known terms."""
 
 from __future__ import annotations
 
+import dataclasses
 import os
 import subprocess
 import sys
+from collections.abc import Callable, Sequence
 from pathlib import Path
 
 import numpy as np
 import pytest
+from numpy.typing import ArrayLike
 
 import dynid
 from dynid.feasibility.compare import perturbed_robot  # noqa: F401 (shared with the tests)
+from dynid.friction.model import Friction
 from dynid.identification.least_squares import LeastSquaresFit
+from dynid.identification.log import TorqueLog
 from dynid.identification.model import IdentifiedModel
+from dynid.model.drive import Drive
 from dynid.regressors.base import base_parameters
+from dynid.simulation.measurement import SensorNoise, sample_times, simulate_measurement
+from dynid.simulation.trajectories import random_fourier
+from dynid.simulation.unmodelled import UnmodelledEffects
 
 
 def pytest_sessionstart(session: pytest.Session) -> None:
@@ -141,3 +151,47 @@ def exact_model(
         rtol=1e-10,
     )
     return IdentifiedModel(robot=robot, base=base, fit=fit)
+
+
+def recordings(
+    robot: dynid.Robot,
+    seeds: Sequence[int],
+    *,
+    friction: Friction | None,
+    duration: float,
+    armature: ArrayLike | None = None,
+    drive: Drive | None = None,
+    added: Callable[[TorqueLog], np.ndarray] | None = None,
+    noise: SensorNoise | None = None,
+    fs: float = 500.0,
+) -> list[TorqueLog]:
+    """Recordings of ``robot`` whose torques hold known terms, one per seed.
+
+    Each follows the random Fourier trajectory of its seed, ``duration`` s sampled at
+    ``fs`` Hz; its torques are the rigid body's plus the ground-truth ``friction`` (None:
+    none; a law per joint acts where ``drive`` puts it), the rotor inertias ``armature``
+    (n,) [kg m^2] at the joints, and ``added(log)`` (N, n) [N m] on the log's states (a
+    term the simulation does not hold: a spring, friction at a joint). Exact without
+    ``noise`` (no sensor noise, the true accelerations kept); with ``noise``, drawn from
+    ``default_rng(seed + 100)``, and no accelerations (they are derived).
+    """
+    effects = None
+    if armature is not None:
+        effects = UnmodelledEffects(rotor_inertia=armature, torque_offset=np.zeros(robot.n))
+    t = sample_times(duration, fs)
+    logs = []
+    for seed in seeds:
+        log = simulate_measurement(
+            robot,
+            random_fourier(robot, np.random.default_rng(seed))(t),
+            rng=np.random.default_rng(seed + 100),
+            noise=SensorNoise.none() if noise is None else noise,
+            friction=friction,
+            effects=effects,
+            drive=drive,
+            with_ddq=noise is None,
+        )
+        if added is not None:
+            log = dataclasses.replace(log, tau=log.tau + added(log))
+        logs.append(log)
+    return logs

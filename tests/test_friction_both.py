@@ -8,14 +8,12 @@ held-out data and its coefficients against those values.
 
 from __future__ import annotations
 
-import dataclasses
 import json
 import re
 
 import numpy as np
 import pytest
 
-import dynid
 from dynid.cli.__main__ import main
 from dynid.feasibility.convex.data_term import coefficient_term
 from dynid.feasibility.convex.fit import consistent_from_identified
@@ -30,8 +28,8 @@ from dynid.io.torque_log import save_torque_log
 from dynid.model.drive import Drive
 from dynid.observer.model import from_identified
 from dynid.observer.residual import ObserverOptions, observe
-from dynid.simulation.measurement import SensorNoise, sample_times, simulate_measurement
-from dynid.simulation.trajectories import random_fourier
+
+from conftest import recordings
 
 FV = np.linspace(0.3, 0.1, 7)  # N m s/rad, at the motors
 FC = np.linspace(0.6, 0.2, 7)  # N m
@@ -49,27 +47,9 @@ def _logs(panda, joint_side: bool):
     motor = ClassicalFriction(FV, FC, np.zeros(7)).at(drive)
     z = np.zeros(7)
     joint = ClassicalFriction(z + np.eye(7)[6] * JFV, z + np.eye(7)[6] * JFC, z)
-    t = sample_times(4.0, 500.0)
-    logs = []
-    for s in (91, 92):
-        log = simulate_measurement(
-            panda,
-            random_fourier(panda, np.random.default_rng(s))(t),
-            rng=np.random.default_rng(s),
-            noise=SensorNoise.none(),
-            friction=motor,
-            drive=drive,
-            with_ddq=True,
-        )
-        if joint_side:
-            log = dataclasses.replace(log, tau=log.tau + joint.torques(log.dq))
-        logs.append(log)
+    added = (lambda log: joint.torques(log.dq)) if joint_side else None
+    logs = recordings(panda, (91, 92), friction=motor, drive=drive, duration=4.0, added=added)
     return logs, motor, joint
-
-
-@pytest.fixture(scope="module")
-def panda():
-    return dynid.panda()
 
 
 @pytest.fixture(scope="module")

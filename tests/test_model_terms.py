@@ -6,7 +6,6 @@ terms' coefficients against those values, and a file (current and older layout) 
 
 from __future__ import annotations
 
-import dataclasses
 from types import SimpleNamespace
 
 import numpy as np
@@ -23,9 +22,8 @@ from dynid.io.model_json import model_from_dict, model_to_dict
 from dynid.model.drive import Drive
 from dynid.regressors.spring import JointSpring
 from dynid.regressors.terms import TERM_KINDS, LinearFriction, RotorInertia
-from dynid.simulation.measurement import SensorNoise, sample_times, simulate_measurement
-from dynid.simulation.trajectories import random_fourier
-from dynid.simulation.unmodelled import UnmodelledEffects
+
+from conftest import recordings
 
 ARMATURE = np.array([0.30, 0.25, 0.20, 0.15, 0.10, 0.08, 0.05])  # kg m^2
 FV = np.linspace(0.3, 0.1, 7)  # N m s/rad
@@ -34,23 +32,10 @@ FO = np.array([0.0, 0.0, 0.0, 0.1, 0.0, -0.2, 0.0])  # N m
 
 
 @pytest.fixture(scope="module")
-def model():
+def model(panda):
     """Armature and classical friction (no offset on joints 1-3, 5, 7) from exact data."""
-    panda = dynid.panda()
     fr = ClassicalFriction(FV, FC, FO)
-    t = sample_times(3.0, 500.0)
-    logs = [
-        simulate_measurement(
-            panda,
-            random_fourier(panda, np.random.default_rng(s))(t),
-            rng=np.random.default_rng(s),
-            noise=SensorNoise.none(),
-            friction=fr,
-            effects=UnmodelledEffects(rotor_inertia=ARMATURE, torque_offset=np.zeros(7)),
-            with_ddq=True,
-        )
-        for s in (11, 12)
-    ]
+    logs = recordings(panda, (11, 12), friction=fr, armature=ARMATURE, duration=3.0)
     terms = Structure.parse("armature, viscous, coulomb, offset - fo1 - fo2 - fo3 - fo5 - fo7")
     return identify_recordings(panda, logs, cutoff_hz=None, structure=terms)
 
@@ -137,26 +122,20 @@ def test_a_term_whose_labels_disagree_with_its_definition_is_refused(model):
         model_from_dict(d)
 
 
-def test_a_joint_spring_is_one_module_and_one_registry_line():
+def test_a_joint_spring_is_one_module_and_one_registry_line(panda):
     """The worked example of ARCHITECTURE.md: exact torques with a spring
     ``k_j (q_j - q0_j)`` and viscous friction; the spring term identified with the links
     gives the true stiffnesses, its torques are ``k (q - q0)``, and the file reads it back
     by its kind."""
-    panda = dynid.panda()
     k = np.array([2.0, 0.0, 1.5, 3.0, 0.5, 1.0, 0.25])  # N m/rad
     q0 = np.array([0.1, -0.2, 0.0, -1.5, 0.0, 1.6, 0.7])  # rad
-    t = sample_times(3.0, 500.0)
-    logs = []
-    for s in (21, 22):
-        log = simulate_measurement(
-            panda,
-            random_fourier(panda, np.random.default_rng(s))(t),
-            rng=np.random.default_rng(s),
-            noise=SensorNoise.none(),
-            friction=ClassicalFriction(FV, np.zeros(7), np.zeros(7)),
-            with_ddq=True,
-        )
-        logs.append(dataclasses.replace(log, tau=log.tau + k * (log.q - q0)))
+    logs = recordings(
+        panda,
+        (21, 22),
+        friction=ClassicalFriction(FV, np.zeros(7), np.zeros(7)),
+        duration=3.0,
+        added=lambda log: k * (log.q - q0),
+    )
     data = prepare_recordings(panda, logs, cutoff_hz=None)
     spring = JointSpring(tuple(q0))
     friction = LinearFriction(Drive.identity(7), parts=("viscous",))

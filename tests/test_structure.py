@@ -28,29 +28,14 @@ from dynid.identification.structure import Structure
 from dynid.io.model_json import load_model_json
 from dynid.io.torque_log import save_torque_log
 from dynid.model.drive import Drive
-from dynid.simulation.measurement import SensorNoise, sample_times, simulate_measurement
+from dynid.simulation.measurement import SensorNoise, sample_times
 from dynid.simulation.trajectories import random_fourier
-from dynid.simulation.unmodelled import UnmodelledEffects
+
+from conftest import recordings
 
 NOISE = 0.05  # N m, the simulated torque sensor noise
 ARMATURE = np.array([0.30, 0.25, 0.20, 0.15, 0.10, 0.08, 0.05])  # kg m^2
 VISCOUS = np.linspace(0.3, 0.1, 7)  # N m s/rad
-
-
-def _recording(robot, seed, friction, *, armature=None, noise=None, duration=8.0, fs=500.0):
-    """A simulated torque log of a random Fourier trajectory."""
-    effects = None
-    if armature is not None:
-        effects = UnmodelledEffects(rotor_inertia=armature, torque_offset=np.zeros(robot.n))
-    return simulate_measurement(
-        robot,
-        random_fourier(robot, np.random.default_rng(seed))(sample_times(duration, fs)),
-        rng=np.random.default_rng(seed + 100),
-        noise=SensorNoise() if noise is None else noise,
-        friction=friction,
-        effects=effects,
-        with_ddq=noise is not None,
-    )
 
 
 def _own(model):
@@ -64,26 +49,16 @@ def _predict(model, log):
 
 
 @pytest.fixture(scope="module")
-def panda():
-    return dynid.panda()
-
-
-@pytest.fixture(scope="module")
 def armature_logs(panda):
     """Three training recordings and one held out of a Panda with armature and viscous
     friction, noise 0.05 N m; the held-out one with its true accelerations."""
     fr = ClassicalFriction(VISCOUS, np.zeros(7), np.zeros(7))
-    logs = [_recording(panda, s, fr, armature=ARMATURE) for s in (1, 2, 3)]
-    t = sample_times(8.0, 500.0)
-    held = random_fourier(panda, np.random.default_rng(4))(t)
-    test = simulate_measurement(
-        panda,
-        held,
-        rng=np.random.default_rng(104),
-        friction=fr,
-        effects=UnmodelledEffects(rotor_inertia=ARMATURE, torque_offset=np.zeros(7)),
+    noisy = SensorNoise(tau_std=NOISE)
+    logs = recordings(
+        panda, (1, 2, 3, 4), friction=fr, armature=ARMATURE, duration=8.0, noise=noisy
     )
-    return logs, held, test
+    held = random_fourier(panda, np.random.default_rng(4))(sample_times(8.0, 500.0))
+    return logs[:3], held, logs[3]  # the held-out recording: trajectory 4's
 
 
 def test_armature_and_viscous_friction_are_chosen_by_default(panda, armature_logs):
@@ -114,7 +89,7 @@ def test_terms_the_data_do_not_support_are_left_out(panda):
     """A rigid arm with viscous and Coulomb friction and no armature: the armature and the
     offsets are not chosen; Coulomb friction is (sharp or smooth)."""
     fr = ClassicalFriction(VISCOUS, np.linspace(0.6, 0.2, 7), np.zeros(7))
-    logs = [_recording(panda, s, fr) for s in (11, 12)]
+    logs = recordings(panda, (11, 12), friction=fr, duration=8.0, noise=SensorNoise())
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", DynidWarning)
         model = identify_recordings(panda, logs)
@@ -130,10 +105,7 @@ def test_exact_data_give_the_true_structure_at_round_off(panda):
     """Noise-free data with exact accelerations: the true structure (armature, viscous) is
     chosen and fits to round-off; the armature comes back as simulated."""
     fr = ClassicalFriction(VISCOUS, np.zeros(7), np.zeros(7))
-    logs = [
-        _recording(panda, s, fr, armature=ARMATURE, noise=SensorNoise.none(), duration=4.0)
-        for s in (21, 22)
-    ]
+    logs = recordings(panda, (21, 22), friction=fr, armature=ARMATURE, duration=4.0)
     model = identify_recordings(panda, logs, cutoff_hz=None)
     assert model.info.selection["chosen"] == "links + armature + viscous"
     assert model.fit.relative_error_percent < 1e-7  # the final fit (QR)
@@ -148,7 +120,7 @@ def test_stribeck_friction_is_identified_with_the_links_and_its_velocity_chosen(
     0.05 rad/s is chosen among the candidates' velocities and its parameters come back."""
     P = np.column_stack([VISCOUS, np.full(7, 0.4), np.full(7, 0.9), np.full(7, 0.05), np.zeros(7)])
     fr = LawFriction(LAWS["stribeck"], P)
-    logs = [_recording(panda, s, fr, noise=SensorNoise.none(), duration=4.0) for s in (61, 62)]
+    logs = recordings(panda, (61, 62), friction=fr, duration=4.0)
     model = identify_recordings(panda, logs, cutoff_hz=None)
     # the offsets, zero in the truth, are left out joint by joint
     assert model.info.selection["chosen"] == "links + viscous + coulomb + stribeck:0.05"
@@ -166,7 +138,7 @@ def test_quadratic_viscous_friction_is_identified_with_the_links(panda):
     evaluate it as that law."""
     P = np.column_stack([VISCOUS, np.full(7, 0.2), np.full(7, 0.3), np.zeros(7)])
     fr = LawFriction(LAWS["quadratic"], P)
-    logs = [_recording(panda, s, fr, noise=SensorNoise.none(), duration=4.0) for s in (81, 82)]
+    logs = recordings(panda, (81, 82), friction=fr, duration=4.0)
     model = identify_recordings(panda, logs, cutoff_hz=None)
     assert model.info.selection["chosen"] == "links + viscous + quadratic + coulomb"
     assert model.friction.law == "quadratic"
@@ -179,7 +151,7 @@ def test_a_log_with_gaps_is_cut_into_pieces_never_joined(panda):
     """Two cut-out stretches of 0.5 s: the log is prepared in three pieces, and predicts a
     clean recording as well as the whole log does; bridging the gaps ruins the fit."""
     fr = ClassicalFriction(VISCOUS, np.zeros(7), np.zeros(7))
-    whole = _recording(panda, 31, fr, duration=12.0)
+    (whole,) = recordings(panda, (31,), friction=fr, duration=12.0, noise=SensorNoise())
     t = whole.t
     keep = ~(((t > 3.0) & (t < 3.5)) | ((t > 7.0) & (t < 7.5)))
     cut = whole.select(np.flatnonzero(keep))
@@ -211,7 +183,7 @@ def test_wrapped_joint_is_unwrapped_with_a_warning(panda):
     log; on the Panda itself, whose joint 7 spans less than a turn, it cannot wrap."""
     arm = _continuous(panda, [6])
     fr = ClassicalFriction(VISCOUS, np.zeros(7), np.zeros(7))
-    log = _recording(panda, 41, fr, duration=6.0)
+    (log,) = recordings(panda, (41,), friction=fr, duration=6.0, noise=SensorNoise())
     q = np.array(log.q)
     q[:, 6] += np.pi - np.min(q[:, 6]) - 0.3  # joint 7 crosses +pi
     turned = TorqueLog(log.t, q, log.dq, log.tau)
@@ -290,10 +262,11 @@ def test_identify_command_prints_and_records_the_choice(panda, tmp_path, capsys)
     """dynid identify with two logs prints the candidates, records the choice and the
     recordings in identification.json; --terms fixes the structure."""
     fr = ClassicalFriction(VISCOUS, np.zeros(7), np.zeros(7))
-    for s in (51, 52):
-        save_torque_log(
-            tmp_path / f"rec{s}.csv", _recording(panda, s, fr, armature=ARMATURE, duration=5.0)
-        )
+    logs = recordings(
+        panda, (51, 52), friction=fr, armature=ARMATURE, duration=5.0, noise=SensorNoise()
+    )
+    for s, log in zip((51, 52), logs, strict=True):
+        save_torque_log(tmp_path / f"rec{s}.csv", log)
     code = main(
         [
             "identify",
@@ -341,8 +314,9 @@ def test_consistent_fit_of_several_recordings_keeps_the_chosen_armature(panda, t
     held-out data, kept >= 0 in the convex fit and comes back as simulated; a log cut by a
     gap is prepared in pieces (--max-gap honoured on this route too)."""
     fr = ClassicalFriction(VISCOUS, np.zeros(7), np.zeros(7))
-    a = _recording(panda, 71, fr, armature=ARMATURE, duration=6.0)
-    b = _recording(panda, 72, fr, armature=ARMATURE, duration=6.0)
+    a, b = recordings(
+        panda, (71, 72), friction=fr, armature=ARMATURE, duration=6.0, noise=SensorNoise()
+    )
     b = b.select(np.flatnonzero((b.t < 2.0) | (b.t > 2.4)))  # a 0.4 s gap
     for name, log in (("a.csv", a), ("b.csv", b)):
         save_torque_log(tmp_path / name, log)
@@ -370,19 +344,7 @@ def test_friction_of_a_coupled_drive_is_placed_where_the_data_say(panda, truth):
     truth_drive = Drive.from_gears(np.ones(7), [(7, 6, 0.8)], rotor_inertia=np.zeros(7))
     truth_drive = dataclasses.replace(truth_drive, friction_at=truth)
     fr = ClassicalFriction(VISCOUS, np.linspace(0.6, 0.2, 7), np.zeros(7))
-    t = sample_times(4.0, 500.0)
-    logs = [
-        simulate_measurement(
-            panda,
-            random_fourier(panda, np.random.default_rng(s))(t),
-            rng=np.random.default_rng(s),
-            noise=SensorNoise.none(),
-            friction=fr,
-            drive=truth_drive,
-            with_ddq=True,
-        )
-        for s in (91, 92)
-    ]
+    logs = recordings(panda, (91, 92), friction=fr, drive=truth_drive, duration=4.0)
     given = Drive.from_gears(np.ones(7), [(7, 6, 0.8)], rotor_inertia=np.zeros(7))
     assert given.friction_at == "motor"
     model = identify_recordings(panda, logs, cutoff_hz=None, drive=given)
@@ -409,7 +371,7 @@ def test_friction_structure_is_chosen_per_joint(panda):
     fc = np.array([0.6, 0.5, 0.4, 0.0, 0.0, 0.0, 0.0])
     fo = np.array([0.0, 0.3, 0.0, 0.0, 0.0, 0.0, 0.0])
     fr = ClassicalFriction(VISCOUS, fc, fo)
-    logs = [_recording(panda, s, fr, noise=SensorNoise.none(), duration=4.0) for s in (71, 72)]
+    logs = recordings(panda, (71, 72), friction=fr, duration=4.0)
     model = identify_recordings(panda, logs, cutoff_hz=None)
     want = (
         "links + viscous + coulomb + offset"
