@@ -58,6 +58,7 @@ ERROR_FLOOR_PERCENT = 1e-4
 #: The classical friction candidates, simplest first.
 FRICTION_LADDER: tuple[tuple[str, ...], ...] = (
     (),
+    ("offset",),
     ("viscous",),
     ("viscous", "offset"),
     ("viscous", "coulomb"),
