@@ -471,7 +471,7 @@ def _fit_largest(
         if not group or (k and len(group) == len(mine)):
             continue
         model_drive, terms = largest_terms(
-            group, arm, drive, robot.n, tuple(data.band), _bands(data)
+            group, arm, drive, robot.n, tuple(data.band), _bands(data), data.band_gain
         )
         try:
             with warnings.catch_warnings():  # the candidates' fits: only the chosen one speaks
@@ -605,7 +605,9 @@ def identify_recordings(
         structure = (
             chosen if friction is None else Structure(chosen.armature, friction, at=chosen.at)
         )
-    model_drive, terms = structure_terms(structure, drive, robot.n, tuple(data.band), _bands(data))
+    model_drive, terms = structure_terms(
+        structure, drive, robot.n, tuple(data.band), _bands(data), data.band_gain
+    )
     judge, _, fold_labels = _judge(robot, data, est, folds, validation)
     model = identify(
         robot,
