@@ -166,7 +166,16 @@ def _chosen(candidates: Sequence[Candidate]) -> Structure:
     best = min(candidates, key=lambda c: c.heldout_error_percent)
     limit = best.heldout_error_percent + max(best.heldout_se_percent, ERROR_FLOOR_PERCENT)
     within = [c for c in candidates if c.heldout_error_percent <= limit]
-    return min(within, key=lambda c: (c.n_params, c.heldout_error_percent)).structure
+    # of as many parameters, the one with fewer terms: an armature whose every own rotor
+    # is left out holds only rotors that regroup with the links (the same columns)
+    return min(
+        within,
+        key=lambda c: (
+            c.n_params,
+            c.structure.armature + len(c.structure.friction),
+            c.heldout_error_percent,
+        ),
+    ).structure
 
 
 def select_structure(
