@@ -40,6 +40,7 @@ __all__ = [
     "filtered_derivative",
     "is_uniform",
     "lowpass",
+    "lowpass_noise_gain",
     "resample_uniform",
     "sample_rate",
     "trim_edges",
@@ -226,6 +227,43 @@ def lowpass(
     for idx in np.ndindex(*xt.shape[:-1]):
         yt[idx] = scipy.signal.sosfiltfilt(sos, xt[idx], padtype="odd", padlen=padlen)
     return y
+
+
+def lowpass_noise_gain(
+    fs: float, cutoff_hz: float | None, *, order: int = BUTTERWORTH_ORDER
+) -> float:
+    """The std of white noise after :func:`lowpass`, per unit std before it.
+
+    .. math:: g = \\Big(\\sum_k h_k^2\\Big)^{1/2}
+
+    with ``h`` the impulse response of the zero-phase filter (forward and backward), far
+    from the ends of the signal; for ``cutoff_hz << fs`` it tends to
+    ``sqrt((2 cutoff_hz / fs) int_0^inf dx / (1 + x^(2 order))^2)``.
+
+    Parameters
+    ----------
+    fs : float
+        Sample rate [Hz].
+    cutoff_hz : float or None
+        Cutoff of :func:`lowpass` [Hz]; None (no filter): 1.
+    order : int
+        Designed Butterworth order.
+
+    Returns
+    -------
+    float
+        In (0, 1].
+    """
+    if cutoff_hz is None or not 0 < cutoff_hz < fs / 2:
+        return 1.0
+    import scipy.signal
+
+    sos = scipy.signal.butter(order, float(cutoff_hz), btype="low", fs=float(fs), output="sos")
+    half = max(64, int(np.ceil(40.0 * fs / cutoff_hz)))
+    impulse = np.zeros(2 * half + 1)
+    impulse[half] = 1.0
+    h = scipy.signal.sosfiltfilt(sos, impulse, padtype=None)
+    return float(min(1.0, np.sqrt(np.sum(h * h))))
 
 
 def derivative(t: ArrayLike, x: ArrayLike) -> NDArray[np.float64]:

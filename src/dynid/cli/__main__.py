@@ -40,7 +40,7 @@ from .._checks import one_line
 from ..exceptions import DynidError, OptionError
 from ..io.atomic import output_transaction
 from ..outputs.run_output import RunOutput, run_output
-from .console import Console
+from .console import Console, log_to_stderr
 from .run_report import RunRecord, save_run_report
 
 #: Longest error line printed [characters]: a message echoing megabytes of input keeps
@@ -260,7 +260,7 @@ def _main(argv: Sequence[str] | None) -> int:
             logging.DEBUG if args.verbose > 1 else logging.INFO if args.verbose else logging.WARNING
         )
     )
-    logging.basicConfig(level=level, format="%(levelname)s %(name)s: %(message)s")
+    log_to_stderr(args.command, level)
     say = f"dynid {args.command}"
     record = RunRecord()
     console = Console(args.command, quiet=args.quiet, verbose=args.verbose, record=record)

@@ -13,6 +13,7 @@ warnings either way.
 
 from __future__ import annotations
 
+import logging
 import sys
 from collections.abc import Mapping
 from typing import Any
@@ -20,7 +21,7 @@ from typing import Any
 from ..io.json_files import dumps
 from .run_report import RunRecord
 
-__all__ = ["Console"]
+__all__ = ["Console", "LogFormat", "log_to_stderr"]
 
 
 class Console:
@@ -91,3 +92,35 @@ class Console:
         """One strict JSON object on stdout (a NaN or infinity is an error), also with
         ``-q``: it is the result asked for."""
         sys.stdout.write(dumps(obj, indent=None) + "\n")
+
+
+class LogFormat(logging.Formatter):
+    """Log lines as the command's own: a warning or error logged by the library reads
+    ``dynid identify: warning: r1.csv: ...`` like :meth:`Console.warn`; the informational
+    and debug lines of ``-v`` keep their level and logger (``INFO dynid.identification.core:
+    ...``)."""
+
+    def __init__(self, command: str) -> None:
+        super().__init__()
+        self.command = command
+
+    def format(self, record: logging.LogRecord) -> str:
+        """One line of ``record``."""
+        if record.levelno >= logging.WARNING:
+            return f"dynid {self.command}: {record.levelname.lower()}: {record.getMessage()}"
+        return f"{record.levelname} {record.name}: {record.getMessage()}"
+
+
+def log_to_stderr(command: str, level: int) -> None:
+    """Print the library's log records of ``level`` and above on stderr as ``command``'s
+    own lines (:class:`LogFormat`), as :func:`logging.basicConfig` does: only when the
+    process has no logging set up of its own (a handler of an earlier run replaced)."""
+    root = logging.getLogger()
+    for h in [h for h in root.handlers if isinstance(h.formatter, LogFormat)]:
+        root.removeHandler(h)
+    if root.handlers:
+        return
+    handler = logging.StreamHandler()
+    handler.setFormatter(LogFormat(command))
+    root.addHandler(handler)
+    root.setLevel(level)

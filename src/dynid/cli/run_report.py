@@ -95,14 +95,15 @@ class RunRecord:
 
     def lines(self, prefix: str) -> list[str]:
         """Lines of stdout and stderr that hold ``prefix`` (``"warning: "``, ``"note: "``),
-        from the prefix on; logged warnings count as warnings."""
+        from the prefix on; logged warnings count as warnings (once, printed or not)."""
         found = []
         for text in ("".join(self.err_parts), self.printed):
             for line in text.splitlines():
                 s = line.strip()
-                if prefix in s and not s.startswith("WARNING "):
+                if prefix in s:
                     found.append(s[s.index(prefix) + len(prefix) :])
-        return found + (self.logged if prefix == "warning: " else [])
+        logged = self.logged if prefix == "warning: " else []
+        return found + [m for m in logged if m not in found]
 
 
 class _Collect(logging.Handler):

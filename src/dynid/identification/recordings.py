@@ -43,6 +43,7 @@ from numpy.typing import NDArray
 from ..exceptions import DataError, DynidWarning, ShapeError
 from ..model.drive import Drive
 from ..model.robot import Robot
+from ..signals import lowpass_noise_gain
 from .classical import PreparedLog, log_blocks, prepare_torque_log, still_columns
 from .core import ModelColumns, RegressorBlock
 from .holdout import DEFAULT_FOLDS, block_labels
@@ -106,6 +107,11 @@ class Recordings:
         Per recording, the gaps longer than ``max_gap_s`` it was cut at.
     n_recorded : int
         Samples of every recording as read (pieces left out included); 0: the pieces'.
+    band_gain : float
+        The velocity noise left by the low-pass, per unit of the raw noise
+        (:func:`~dynid.signals.lowpass_noise_gain` at the cut-off; 1 without one): a
+        Coulomb sign is switched off within ``band_gain * band`` of the velocities as
+        prepared, the noise they still hold; a smooth Coulomb's width counts in ``band``.
     """
 
     pieces: tuple[PreparedLog, ...]
@@ -118,6 +124,7 @@ class Recordings:
     max_gap_s: float | None = None
     cuts: tuple[int, ...] = ()
     n_recorded: int = 0
+    band_gain: float = 1.0
 
     @property
     def route(self) -> Literal["classical"]:
@@ -409,6 +416,7 @@ def prepare_recordings(
         skipped=tuple(skipped),
         unwrapped=tuple(sorted(turned)),
         bands=_bands([piece for _, piece in pieces], drive),
+        band_gain=lowpass_noise_gain(float(np.median([p.sample_rate for _, p in pieces])), cutoff),
         max_gap_s=None if max_gap_s is None else float(max_gap_s),
         cuts=tuple(cuts),
         n_recorded=sum(log.n_samples for log in logs),

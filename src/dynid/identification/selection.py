@@ -19,7 +19,8 @@ blocks otherwise (:meth:`~dynid.identification.recordings.Recordings.fold_labels
 judge on a separate recording. A recording that holds what no candidate models is left
 out of the judgement and named (:mod:`dynid.identification.candidates`); a candidate
 whose friction is not dissipative within the velocity limits is not chosen
-(:mod:`dynid.identification.dissipation`).
+(:mod:`dynid.identification.dissipation`); when it predicts best, its offending
+coefficients are left out joint by joint and the candidate reached is judged instead.
 
 :func:`identify_recordings` is the classical route over one or more recordings with the
 structure chosen (or given).
@@ -165,7 +166,16 @@ def _chosen(candidates: Sequence[Candidate]) -> Structure:
     best = min(candidates, key=lambda c: c.heldout_error_percent)
     limit = best.heldout_error_percent + max(best.heldout_se_percent, ERROR_FLOOR_PERCENT)
     within = [c for c in candidates if c.heldout_error_percent <= limit]
-    return min(within, key=lambda c: (c.n_params, c.heldout_error_percent)).structure
+    # of as many parameters, the one with fewer terms: an armature whose every own rotor
+    # is left out holds only rotors that regroup with the links (the same columns)
+    return min(
+        within,
+        key=lambda c: (
+            c.n_params,
+            c.structure.armature + len(c.structure.friction),
+            c.heldout_error_percent,
+        ),
+    ).structure
 
 
 def select_structure(
@@ -367,35 +377,87 @@ def _per_joint(
     of their own) of single joints left out one at a time (the one whose absence the
     held-out data miss least first) while the held-out error stays within one standard
     error of the lowest; the candidates reached, when they hold fewer coefficients than
-    where they started."""
+    where they started.
+
+    When the lowest held-out error is a candidate whose friction is not dissipative, its
+    offending coefficients are left out first (:func:`_repaired`): a joint's small
+    negative viscous coefficient does not cost the whole candidate its place."""
+    best_any = min(judged, key=lambda c: c.heldout_error_percent)
     best = min(_physical(judged), key=lambda c: c.heldout_error_percent)
+    repaired = None
+    if best_any.unphysical and not best.unphysical:
+        group = groups[(best_any.structure.armature, best_any.structure.at)]
+        repaired = _repaired(best_any, *group, n, rtol)
+    starts = [best, *([] if repaired is None else [repaired])]
+    best = min(starts, key=lambda c: c.heldout_error_percent)
     limit = best.heldout_error_percent + max(best.heldout_se_percent, ERROR_FLOOR_PERCENT)
+    chosen = _chosen(judged)
+    starts += [c for c in judged if c.structure == chosen][:1]
     out: list[Candidate] = []
-    for start in dict.fromkeys((best.structure, _chosen(judged))):
-        if not start.friction and not start.armature:
+    for start in dict.fromkeys(starts):
+        if not start.structure.friction and not start.structure.armature:
             continue
-        model, terms, held = groups[(start.armature, start.at)]
-        rotors = tuple(own_rotors(model.base, n))
-        here = next(c for c in judged if c.structure == start)
+        model, terms, held = groups[(start.structure.armature, start.structure.at)]
+        here = start
         while True:
             trials = [
-                _judged(s, candidate_columns(s, model, terms), model, terms, held, rtol)
-                for s in (
-                    replace(here.structure, drop=here.structure.drop + (lab,))
-                    for lab in coefficient_labels(here.structure, n, rotors)
-                )
+                c
+                for c in _dropped(here, model, terms, held, n, rtol)
+                if not c.unphysical or here.unphysical
             ]
-            trials = [c for c in trials if not c.unphysical or here.unphysical]
             step = min(trials, key=lambda c: c.heldout_error_percent, default=None)
             if step is None or step.heldout_error_percent > limit:
                 break
             here = step
-        drive = model.drive if start.at == "both" else None
+        drive = model.drive if start.structure.at == "both" else None
         reached = here.structure.collapsed(n, () if drive is None else joint_side_joints(drive))
         if reached not in [c.structure for c in (*judged, *out)]:
-            left = tuple(lab for lab in here.structure.drop if lab not in start.drop)
+            origin = best_any.structure if start is repaired else start.structure
+            left = tuple(lab for lab in here.structure.drop if lab not in origin.drop)
             out.append(replace(here, structure=reached, left_out=left))
     return out
+
+
+def _dropped(
+    here: Candidate,
+    model: IdentifiedModel,
+    terms: list[tuple[ModelTerm, Any]],
+    held: HeldOut,
+    n: int,
+    rtol: float,
+) -> list[Candidate]:
+    """``here`` with one more coefficient left out, every way, judged."""
+    rotors = tuple(own_rotors(model.base, n))
+    return [
+        _judged(s, candidate_columns(s, model, terms), model, terms, held, rtol)
+        for s in (
+            replace(here.structure, drop=here.structure.drop + (lab,))
+            for lab in coefficient_labels(here.structure, n, rotors)
+        )
+    ]
+
+
+def _repaired(
+    here: Candidate,
+    model: IdentifiedModel,
+    terms: list[tuple[ModelTerm, Any]],
+    held: HeldOut,
+    n: int,
+    rtol: float,
+) -> Candidate | None:
+    """``here`` (friction not dissipative somewhere) with coefficients left out one at a
+    time, each step the one that leaves the fewest joints not dissipative at the lowest
+    held-out error, until its friction is dissipative; None when a step helps no joint."""
+    while here.unphysical:
+        step = min(
+            _dropped(here, model, terms, held, n, rtol),
+            key=lambda c: (len(c.unphysical), c.heldout_error_percent),
+            default=None,
+        )
+        if step is None or len(step.unphysical) >= len(here.unphysical):
+            return None
+        here = step
+    return here
 
 
 def _fit_largest(
@@ -418,7 +480,7 @@ def _fit_largest(
         if not group or (k and len(group) == len(mine)):
             continue
         model_drive, terms = largest_terms(
-            group, arm, drive, robot.n, tuple(data.band), _bands(data)
+            group, arm, drive, robot.n, tuple(data.band), _bands(data), data.band_gain
         )
         try:
             with warnings.catch_warnings():  # the candidates' fits: only the chosen one speaks
@@ -552,7 +614,9 @@ def identify_recordings(
         structure = (
             chosen if friction is None else Structure(chosen.armature, friction, at=chosen.at)
         )
-    model_drive, terms = structure_terms(structure, drive, robot.n, tuple(data.band), _bands(data))
+    model_drive, terms = structure_terms(
+        structure, drive, robot.n, tuple(data.band), _bands(data), data.band_gain
+    )
     judge, _, fold_labels = _judge(robot, data, est, folds, validation)
     model = identify(
         robot,

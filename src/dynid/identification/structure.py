@@ -58,6 +58,7 @@ ERROR_FLOOR_PERCENT = 1e-4
 #: The classical friction candidates, simplest first.
 FRICTION_LADDER: tuple[tuple[str, ...], ...] = (
     (),
+    ("offset",),
     ("viscous",),
     ("viscous", "offset"),
     ("viscous", "coulomb"),
@@ -412,12 +413,16 @@ def structure_terms(
     n: int,
     band: Sequence[float] = (),
     bands: Mapping[str, Sequence[float]] | None = None,
+    gain: float = 1.0,
 ) -> tuple[Drive | None, tuple[ModelTerm, ...]]:
     """The model's drive and terms of ``structure``: without a drive, an armature is the
     rotor inertia of a direct drive (``K = 1``); friction acts where the structure says
-    (:attr:`Structure.at`: the drive's ``friction_at`` is set to it), with the standstill
-    band [rad/s] per motor (joint) where it acts: ``bands["motor"]`` or ``bands["joint"]``,
-    else ``band``.
+    (:attr:`Structure.at`: the drive's ``friction_at`` is set to it), with the velocity
+    noise band [rad/s] of the raw velocities per motor (joint) where it acts:
+    ``bands["motor"]`` or ``bands["joint"]``, else ``band``. The Coulomb sign's standstill
+    band is ``gain`` times it (the noise the filtered velocities keep:
+    :attr:`~dynid.identification.recordings.Recordings.band_gain`), a smooth Coulomb's
+    width counts in it.
 
     Raises
     ------
@@ -431,7 +436,7 @@ def structure_terms(
             LinearFriction(
                 at,
                 parts=structure.friction,
-                band=b,
+                band=_times(b, gain),
                 width=smooth_width(b, structure.width) if "smooth" in structure.friction else (),
                 vst=structure.vst,
                 mask=structure.mask(n),
@@ -443,7 +448,7 @@ def structure_terms(
                 LinearFriction(
                     jt,
                     parts=structure.joint_parts,
-                    band=jb,
+                    band=_times(jb, gain),
                     width=smooth_width(jb, structure.width)
                     if "smooth" in structure.friction
                     else (),
@@ -454,6 +459,11 @@ def structure_terms(
                 )
             )
     return model_drive, tuple(terms)
+
+
+def _times(band: Sequence[float], gain: float) -> tuple[float, ...]:
+    """``gain * band``, per joint."""
+    return tuple(gain * float(b) for b in band)
 
 
 def _at_joints(
@@ -509,9 +519,11 @@ def largest_terms(
     n: int,
     band: Sequence[float],
     bands: Mapping[str, Sequence[float]] | None = None,
+    gain: float = 1.0,
 ) -> tuple[Drive | None, list[tuple[ModelTerm, Any]]]:
     """The terms of every candidate with ``armature == arm`` at once (their friction at
-    one place: :attr:`Structure.at`), each with what it stands for:
+    one place: :attr:`Structure.at`; bands as :func:`structure_terms`), each with what it
+    stands for:
     ``("classical", parts)``, ``("smooth", width)`` or ``("stribeck", vst)``; a candidate
     is a choice of their columns."""
     mine = [c for c in cands if c.armature == arm]
@@ -523,7 +535,7 @@ def largest_terms(
     out: list[tuple[ModelTerm, Any]] = [(t, None) for t in terms]
     classical = tuple(p for p in _CLASSICAL + ("quadratic",) if any(p in c.friction for c in mine))
     if classical:
-        t = LinearFriction(at, parts=classical, band=b)
+        t = LinearFriction(at, parts=classical, band=_times(b, gain))
         out.append((t, ("classical", t.parts)))  # the parts in the term's column order
     if classical and any(c.at == "both" for c in mine):
         jt, jb = _at_joints(at, n, band, bands)
@@ -531,16 +543,27 @@ def largest_terms(
         parts = tuple(p for p in classical if p != "offset")
         mask = tuple(j in joints for j in range(n) for _ in parts)
         t = LinearFriction(
-            jt, parts=parts, band=jb, name="joint friction", mask=mask, prefix=JOINT_PREFIX
+            jt,
+            parts=parts,
+            band=_times(jb, gain),
+            name="joint friction",
+            mask=mask,
+            prefix=JOINT_PREFIX,
         )
         out.append((t, ("classical", t.parts)))
     for w in sorted({c.width for c in mine if "smooth" in c.friction}):
         t = LinearFriction(
-            at, ("smooth",), band=b, width=smooth_width(b, w), name=f"friction smooth {w:g}"
+            at,
+            ("smooth",),
+            band=_times(b, gain),
+            width=smooth_width(b, w),
+            name=f"friction smooth {w:g}",
         )
         out.append((t, ("smooth", w)))
     for v in sorted({c.vst for c in mine if "stribeck" in c.friction}):
-        t = LinearFriction(at, ("stribeck",), band=b, vst=v, name=f"friction stribeck {v:g}")
+        t = LinearFriction(
+            at, ("stribeck",), band=_times(b, gain), vst=v, name=f"friction stribeck {v:g}"
+        )
         out.append((t, ("stribeck", v)))
     return model_drive, out
 

@@ -134,14 +134,19 @@ def read_recordings(
 
 def _scales(log: TorqueLog) -> tuple[float, float]:
     """The RMS torque [N m] and ``k`` of ``d q / dt ~ k dq`` (1 when ``t``, ``q`` and
-    ``dq`` share their units) of a log, on at most 20 000 samples."""
+    ``dq`` share their units) of a log, on at most 20 000 samples. The positions'
+    differences of half a turn or more (a continuous joint recorded wrapped into
+    [-pi, pi), a jump) are left out: they are not motion."""
     step = max(1, log.n_samples // 20_000)
     t, q, dq, tau = log.t[::step], log.q[::step], log.dq[::step], log.tau[::step]
     rms = float(np.sqrt(np.mean(tau**2)))
     if t.size < 5:
         return rms, float("nan")
-    num = float(np.sum(np.gradient(q, t, axis=0) * dq))
-    den = float(np.sum(dq * dq))
+    dqdt = np.diff(q, axis=0) / np.diff(t)[:, None]
+    mid = 0.5 * (dq[1:] + dq[:-1])
+    keep = np.abs(np.diff(q, axis=0)) < np.pi
+    num = float(np.sum(np.where(keep, dqdt * mid, 0.0)))
+    den = float(np.sum(np.where(keep, mid * mid, 0.0)))
     return rms, num / den if den > 0 else float("nan")
 
 
