@@ -94,7 +94,14 @@ def test_a_joint_whose_friction_is_not_dissipative_loses_that_coefficient_alone(
     fv = VISCOUS.copy()
     fv[1] = -0.05
     fr = ClassicalFriction(fv, np.zeros(7), np.zeros(7))
-    logs = [_recording(panda, s, fr, armature=ARMATURE) for s in (1, 2, 3)]
+    *logs, test = recordings(
+        panda,
+        (1, 2, 3, 4),
+        friction=fr,
+        armature=ARMATURE,
+        duration=8.0,
+        noise=SensorNoise(),
+    )
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", DynidWarning)
         model = identify_recordings(panda, logs)
@@ -107,13 +114,6 @@ def test_a_joint_whose_friction_is_not_dissipative_loses_that_coefficient_alone(
         model.friction.params[[0, 2, 3, 4, 5, 6], 0], np.delete(fv, 1), atol=0.03
     )
     held = random_fourier(panda, np.random.default_rng(4))(sample_times(8.0, 500.0))
-    test = simulate_measurement(
-        panda,
-        held,
-        rng=np.random.default_rng(104),
-        friction=fr,
-        effects=UnmodelledEffects(rotor_inertia=ARMATURE, torque_offset=np.zeros(7)),
-    )
     rms = np.sqrt(np.mean((test.tau - _predict(model, held)) ** 2, axis=0))
     assert np.all(np.delete(rms, 1) < 1.1 * NOISE), rms  # joint 2 misses -0.05 dq2 only
 
@@ -124,20 +124,20 @@ def test_armature_and_offsets_without_friction_are_offered_and_chosen(panda):
     is predicted to its noise."""
     offsets = np.array([0.4, -0.3, 0.2, 0.0, 0.1, -0.2, 0.15])
     fr = ClassicalFriction(np.zeros(7), np.zeros(7), offsets)
-    logs = [_recording(panda, s, fr, armature=ARMATURE) for s in (21, 22, 23)]
+    *logs, test = recordings(
+        panda,
+        (21, 22, 23, 24),
+        friction=fr,
+        armature=ARMATURE,
+        duration=8.0,
+        noise=SensorNoise(),
+    )
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", DynidWarning)
         model = identify_recordings(panda, logs)
     chosen = Structure.parse(model.info.selection["chosen"])
     assert chosen.armature and chosen.friction == ("offset",), chosen
     held = random_fourier(panda, np.random.default_rng(24))(sample_times(8.0, 500.0))
-    test = simulate_measurement(
-        panda,
-        held,
-        rng=np.random.default_rng(124),
-        friction=fr,
-        effects=UnmodelledEffects(rotor_inertia=ARMATURE, torque_offset=np.zeros(7)),
-    )
     rms = np.sqrt(np.mean((test.tau - _predict(model, held)) ** 2, axis=0))
     assert np.all(rms < 1.1 * NOISE), rms
 
