@@ -153,6 +153,13 @@ def _bands(data: Recordings) -> dict[str, tuple[float, ...]]:
     return {at: tuple(float(x) for x in b) for at, b in data.bands.items()}
 
 
+def _terms_of(
+    structure: Structure, drive: Drive | None, n: int, data: Recordings
+) -> tuple[Drive | None, tuple[ModelTerm, ...]]:
+    """:func:`~dynid.identification.structure.structure_terms` with the recordings' bands."""
+    return structure_terms(structure, drive, n, tuple(data.band), _bands(data), data.band_gain)
+
+
 def _physical(candidates: Sequence[Candidate]) -> list[Candidate]:
     """The candidates whose friction is dissipative within the velocity limits (all of
     them when none is)."""
@@ -614,9 +621,7 @@ def identify_recordings(
         structure = (
             chosen if friction is None else Structure(chosen.armature, friction, at=chosen.at)
         )
-    model_drive, terms = structure_terms(
-        structure, drive, robot.n, tuple(data.band), _bands(data), data.band_gain
-    )
+    model_drive, terms = _terms_of(structure, drive, robot.n, data)
     judge, _, fold_labels = _judge(robot, data, est, folds, validation)
     model = identify(
         robot,
