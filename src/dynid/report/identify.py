@@ -17,6 +17,8 @@ from __future__ import annotations
 import re
 from typing import Any
 
+from ..exceptions import DynidError
+from ..identification.structure import Structure
 from ..identification.verdict import FLOOR_GOOD, judge_prediction, worst
 from .html import bar, cell, esc, figure, is_number, number, percent, section, table, verdict
 from .model_terms import terms_sections
@@ -189,8 +191,28 @@ def _short(expression: str, n: int = 28) -> str:
     return expression if len(expression) <= n else expression[: n - 3] + "..."
 
 
+def used_structure(doc: Any) -> str | None:
+    """The structure the identified model holds (``metadata.terms``, its name as the
+    candidates are named: ``"links + viscous + coulomb - fc5"``), which the one-step
+    consistent fit uses too; None when the record does not say."""
+    terms = _get(doc, "metadata", "terms")
+    if not isinstance(terms, list) or not all(isinstance(t, str) for t in terms):
+        return None
+    try:
+        return Structure.parse(",".join(terms) or "links").name
+    except DynidError:
+        return None
+
+
 def _terms_fact(doc: dict) -> str:
     sel = _selection(doc)
+    used = used_structure(doc)
+    if isinstance(sel, dict) and sel.get("chosen") and used not in (None, sel["chosen"]):
+        return (
+            f"Terms used: <b>{esc(used)}</b> (the model's, and a consistent fit's); the "
+            f"structure chosen on held-out data was {esc(sel['chosen'])} by "
+            f"{esc(sel.get('rule', 'held-out error'))}"
+        )
     if isinstance(sel, dict) and sel.get("chosen"):
         chosen = [c for c in sel.get("candidates") or [] if c.get("name") == sel["chosen"]]
         listed = ", ".join(chosen[0].get("terms") or []) if chosen else ""
