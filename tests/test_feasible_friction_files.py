@@ -11,6 +11,7 @@ band of the identified law).
 from __future__ import annotations
 
 import dataclasses
+import json
 import warnings
 
 import numpy as np
@@ -30,6 +31,7 @@ from dynid.io.feasible import (
     load_feasible_linear_friction,
 )
 from dynid.io.feasible_bundle import save_feasible_bundle
+from dynid.io.model_json import model_to_dict
 from dynid.io.robot.toml import load_toml, robot_from_toml_string, save_toml
 from dynid.io.robot_file import load_robot
 from dynid.model.drive import Drive
@@ -63,6 +65,7 @@ def bundle(panda, tmp_path_factory):
     res = consistent_from_identified(panda, model, prior=panda)
     folder = tmp_path_factory.mktemp("consistent")
     save_feasible_bundle(folder, res)
+    folder.joinpath("identification.json").write_text(json.dumps(model_to_dict(model)))
     return res, folder
 
 
@@ -97,6 +100,18 @@ def test_the_files_predict_the_fitted_models_torques(panda, bundle):
     # and the fit itself recovered the simulated friction (exact data)
     np.testing.assert_allclose(res.friction.params[:, 0], FV, rtol=0.02)
     np.testing.assert_allclose(res.friction.params[:, 1], FC, rtol=0.02)
+
+
+def test_report_json_names_the_law_and_identification_json_its_units(bundle):
+    """report.json's friction says which law its fv, fc, fo are of; identification.json's
+    residual RMS and sigma have their unit (N m for a torque log)."""
+    res, folder = bundle
+    rep = json.loads((folder / "report.json").read_text())
+    assert rep["friction"]["model"] == "classical"
+    np.testing.assert_array_equal(rep["friction"]["fc"], res.friction.params[:, 1])
+    units = json.loads((folder / "identification.json").read_text())["units"]
+    assert units["residual_rms"] == "N m" and units["sigma"] == "as residual_rms"
+    assert units["friction"] == "fv N m s/rad, fc N m, fo N m"
 
 
 def test_a_fit_without_friction_writes_none(panda, bundle):
