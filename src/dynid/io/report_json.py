@@ -65,7 +65,8 @@ def report_to_dict(result: FeasibleResult) -> dict[str, Any]:
         margin, unit, satisfied), ``pseudo_inertia_margin`` (``lambda_min(J)/tr(J)`` per
         link [1]), ``friction`` (the friction identified with the links: ``model``, its law,
         and the law's parameters, ``fv, fc, fo`` of the classical law; or None), ``heldout``
-        (the held-out judgement, or None), ``run_time_s`` [s], ``seed``, ``notes``, ``total_mass`` [kg], ``bounds`` (a bounds file's content) and ``units``;
+        (the held-out judgement, or None), ``run_time_s`` [s], ``seed``, ``notes``,
+        ``total_mass`` [kg], ``bounds`` (a bounds file's content) and ``units``;
         then the method's own (:meth:`~dynid.feasibility.result.FeasibleResult.report_fields`),
         their numbers that may have no value written None."""
     rep = result.report
