@@ -63,6 +63,16 @@ def test_the_terms_and_the_consistent_fit_name_the_same_structure(tmp_path):
         "schema": "dynid-identified-model/1",
         "route": "classical",
         "coefficients": [],
+        "terms": [
+            {
+                "name": "friction",
+                "kind": "linear_friction",
+                "labels": ["fv1", "fc1"],
+                "values": [0.5, 0.8],
+                "std": [0.01, 0.01],
+                "definition": {"parts": ["viscous", "smooth"], "at": "joint"},
+            },
+        ],  # fmt: skip
         "metadata": {
             "terms": ["viscous", "coulomb", "-fc5"],
             "selection": {"rule": "lowest held-out error", "chosen": "links + viscous + coulomb"},
@@ -79,6 +89,7 @@ def test_the_terms_and_the_consistent_fit_name_the_same_structure(tmp_path):
     assert "chosen on held-out data was links + viscous + coulomb" in text
     said = f"Structure of the consistent fit: {used}; friction identified with the links: "
     assert said + "smooth law at the joints" in text
+    assert "Friction at the joints: viscous + smooth (value \u00b1 std)" in text
     ident["metadata"]["selection"]["chosen"] = used
     (tmp_path / "identification.json").write_text(json.dumps(ident))
     text = " ".join("".join(Page(render_html_report(RunSummary("identify"), files)).text).split())
