@@ -75,7 +75,12 @@ def test_the_terms_and_the_consistent_fit_name_the_same_structure(tmp_path):
         ],  # fmt: skip
         "metadata": {
             "terms": ["viscous", "coulomb", "-fc5"],
-            "selection": {"rule": "lowest held-out error", "chosen": "links + viscous + coulomb"},
+            "selection": {
+                "rule": "lowest held-out error",
+                "chosen": "links + viscous + coulomb",
+                "candidates": [{"name": "links + viscous + coulomb", "terms": ["viscous"]}],
+                "heldout_per_recording": [{"file": "a.csv", "heldout_error_percent": 0.1}],
+            },
         },
     }
     smooth = {"model": "smooth", "fv": [1.0], "fc": [1.0], "fo": [0.0]}
@@ -90,6 +95,8 @@ def test_the_terms_and_the_consistent_fit_name_the_same_structure(tmp_path):
     said = f"Structure of the consistent fit: {used}; friction identified with the links: "
     assert said + "smooth law at the joints" in text
     assert "Friction at the joints: viscous + smooth (value \u00b1 std)" in text
+    page = Page(render_html_report(RunSummary("identify"), files))
+    assert _table(page, "recording") == [["recording", "held-out error [%]"], ["a.csv", "0.1"]]
     ident["metadata"]["selection"]["chosen"] = used
     (tmp_path / "identification.json").write_text(json.dumps(ident))
     text = " ".join("".join(Page(render_html_report(RunSummary("identify"), files)).text).split())

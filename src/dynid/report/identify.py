@@ -354,19 +354,16 @@ def _structure_section(doc: dict) -> str:
     per = [r for r in sel.get("heldout_per_recording") or () if isinstance(r, dict)]
     if per:
         odd = set(sel.get("outlying_recordings") or ())
+        said = "outlying: left out of the judgement"
+        rows = [
+            [esc(r.get("file", "")), cell(r.get("heldout_error_percent"))]
+            + ([said if r.get("file") in odd else ""] if odd else [])
+            for r in per
+        ]
+        head = ["recording", "held-out error [%]"] + (["judgement"] if odd else [])
         parts.append(
             "<p>Held-out error of the chosen structure per recording (fitted on the others).</p>"
-            + table(
-                ["recording", "held-out error [%]", ""],
-                [
-                    [
-                        esc(r.get("file", "")),
-                        cell(r.get("heldout_error_percent")),
-                        "outlying: left out of the judgement" if r.get("file") in odd else "",
-                    ]
-                    for r in per
-                ],
-            )
+            + table(head, rows)
         )
     return section("structure", "Model structure", *parts)
 
