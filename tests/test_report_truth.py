@@ -135,3 +135,21 @@ def test_the_comparison_figure_draws_what_its_legend_says(margins):
     import matplotlib.pyplot as plt
 
     plt.close(fig)
+
+
+def test_the_headline_and_its_fact_give_the_same_ratio_to_the_noise_floor(tmp_path):
+    """The held-out error over the noise floor, 897355.81: one number in the headline and
+    in the fact behind it (897355.8 and 897355.81 before)."""
+    err, floor = 0.2123, 0.2123 / 897355.81
+    ident = {
+        "route": "classical",
+        "coefficients": [],
+        "metadata": {"heldout": {"training_error_percent": 0.05, "heldout_error_percent": 0.15}},
+    }
+    held = {"relative_error_percent": err, "noise_floor_percent": floor, "block": "b.csv"}
+    (tmp_path / "identification.json").write_text(json.dumps(ident))
+    (tmp_path / "heldout.json").write_text(json.dumps(held))
+    files = {p.name: p for p in tmp_path.iterdir()}
+    text = " ".join("".join(Page(render_html_report(RunSummary("identify"), files)).text).split())
+    said = f"{err / floor:.3g}"
+    assert f"{said} times the sensor-noise floor" in text and f"{said} x the floor" in text

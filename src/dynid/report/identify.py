@@ -99,14 +99,14 @@ def _heldout_facts(doc: dict, held: dict | None) -> tuple[list[str], list[str], 
             r = v.ratio
             facts.append(
                 f"On {where}, unfiltered: error {percent(err)} against a sensor-noise floor "
-                f"of {percent(floor)} (<b>{r:.2f} x the floor</b>: {esc(v.label)}"
+                f"of {percent(floor)} (<b>{r:.3g} x the floor</b>: {esc(v.label)}"
                 + (
                     ", only noise is left)"
                     if r <= FLOOR_GOOD
                     else ", effects outside the model remain, see the residuals)"
                 )
             )
-            level = "at" if r <= FLOOR_GOOD else f"{r:.1f} times"
+            level = "at" if r <= FLOOR_GOOD else f"{r:.3g} times"  # as in the fact
             headline = (
                 f"The model predicts held-out torques to {percent(err)}, {level} the "
                 f"sensor-noise floor of {percent(floor)} (unfiltered torques)"
