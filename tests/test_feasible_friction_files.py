@@ -136,6 +136,7 @@ def test_toml_holds_friction_at_the_motors_and_at_the_joints(panda, tmp_path):
     path = save_toml(tmp_path / "r.toml", panda, friction=FrictionSum((motor, joint)))
     text = path.read_text()
     assert '[friction]\nmodel = "classical"\nat = "motor"' in text and "[joint_friction]" in text
+    assert "\nfv = [" in text and text.count("]  # N m s/rad\n") == 2  # each table's fv
     with pytest.warns(DynidWarning, match=r"\[joint_friction\]"):
         back = load_toml(path)
     dq = np.random.default_rng(1).normal(0, 1, (5, 7))

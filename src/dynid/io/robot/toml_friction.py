@@ -56,7 +56,11 @@ def friction_tables(friction: Friction | FrictionSum | None) -> str:
         at = "motor" if part.drive is not None and part.drive.friction_at == "motor" else "joint"
         rec = law_record(part)
         lines = [f"[{key}]", f'model = "{rec.pop("model")}"', f'at = "{at}"']
-        lines += [f"{k} = [{', '.join(repr(float(x)) for x in v)}]" for k, v in rec.items()]
+        units = dict(zip(part.law.params, part.law.units, strict=True))
+        units["standstill_band"] = "rad/s"
+        lines += [
+            f"{k} = [{', '.join(repr(float(x)) for x in v)}]  # {units[k]}" for k, v in rec.items()
+        ]
         out.append("\n".join(lines))
     return "\n\n".join(out) + "\n"
 
