@@ -274,3 +274,45 @@ def test_mjcf_coupled_rotor_says_what_it_drops(tmp_path):
     model = mujoco.MjModel.from_xml_path(str(path))
     # joint 5 carries its own rotor and motor 6's reflected through the coupling: 101^2 + 30^2
     assert model.dof_armature[4] == pytest.approx(2e-5 * (101.0**2 + 30.0**2), rel=1e-12)
+
+
+def test_urdf_export_names_what_it_drops_and_mjcf_holds_it(tmp_path):
+    """A coupled drive with rotor inertias and friction at its motors: the URDF export
+    warns once, in URDF's words, that the armature has no URDF element (naming the MJCF
+    export, which holds it) and what of the coupled friction it drops; the URDF holds the
+    reflected diagonal friction and no armature; MuJoCo reads the MJCF's armature as
+    diag(K^T diag(I_a) K) and the same diagonal friction."""
+    import warnings
+    import xml.etree.ElementTree as ET
+
+    from dynid.exceptions import DynidWarning
+    from dynid.friction.model import ClassicalFriction
+    from dynid.model.drive import Drive
+
+    robot = _ur5_from_urdf()
+    ia = np.full(6, 2e-5)
+    drive = Drive.from_gears([101.0] * 6, [(6, 5, 30.0)], rotor_inertia=ia, side="motor")
+    fv, fc = np.linspace(1e-3, 2e-3, 6), np.linspace(1e-2, 2e-2, 6)
+    motor = ClassicalFriction(fv, fc, np.zeros(6)).at(drive)
+    with warnings.catch_warnings(record=True) as got:
+        warnings.simplefilter("always")
+        urdf = save_robot(tmp_path / "r.urdf", robot, friction=motor, drive=drive)
+    lines = [str(w.message) for w in got if issubclass(w.category, DynidWarning)]
+    assert len(lines) == 1 and lines[0].startswith("URDF export: "), lines
+    assert "MJCF" not in lines[0].split("MJCF export holds")[0], lines[0]
+    assert "rotor inertias (armature per joint" in lines[0]
+    assert "the MJCF export holds them as armature" in lines[0]
+    assert "Coulomb friction of coupled motors" in lines[0]
+    K = drive.transmission
+    arm = np.diag(K.T @ np.diag(ia) @ K)
+    damping = np.diag(K.T @ np.diag(fv) @ K)
+    joints = ET.parse(urdf).getroot().findall("joint")
+    dyn = [j.find("dynamics") for j in joints if j.get("type") != "fixed"]
+    assert [float(d.get("damping")) for d in dyn] == pytest.approx(damping, rel=1e-12)
+    assert "armature" not in urdf.read_text()
+    with pytest.warns(DynidWarning, match="MJCF export: "):
+        xml = save_robot(tmp_path / "r.xml", robot, friction=motor, drive=drive)
+    model = mujoco.MjModel.from_xml_path(str(xml))
+    np.testing.assert_allclose(model.dof_armature, arm, rtol=1e-12)
+    np.testing.assert_allclose(model.dof_damping, damping, rtol=1e-12)
+    np.testing.assert_allclose(model.dof_frictionloss, np.abs(np.diag(K)) * fc, rtol=1e-12)

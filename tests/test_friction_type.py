@@ -192,13 +192,20 @@ def test_urdf_writes_any_law_and_says_in_one_line_what_it_drops(tmp_path):
     np.testing.assert_allclose(_dynamics(tmp_path / "own.urdf"), P[:, [0, 2]], rtol=1e-15)
 
 
-def test_a_robot_description_says_it_does_not_hold_another_law(tmp_path):
+def test_a_robot_description_holds_another_law_as_a_friction_table(tmp_path):
+    """Another law than the sigmoid is the description's ``[friction]`` table, its band and
+    (at the motors) its drive with it; it reads back to the same torques."""
     from dynid.io.robot.toml import robot_from_toml_string, toml_from_robot
 
-    robot = _two_joints().with_friction(ClassicalFriction.from_array(PARAMS["classical"]))
-    with pytest.warns(DynidWarning, match="classical friction is not part of a robot desc"):
-        text = toml_from_robot(robot)
-    assert robot_from_toml_string(text).friction is None
+    dq = _velocities()
+    for fr in (
+        LAWS["classical"].model(PARAMS["classical"], BAND),
+        LAWS["classical"].model(PARAMS["classical"], BAND, Drive(K, np.zeros(2))),
+    ):
+        with warnings.catch_warnings():
+            warnings.simplefilter("error")
+            back = robot_from_toml_string(toml_from_robot(_two_joints().with_friction(fr)))
+        np.testing.assert_allclose(back.friction.torques(dq), fr.torques(dq), rtol=0, atol=1e-15)
 
 
 def test_friction_json_of_the_sigmoid_has_no_band_and_reads_back(tmp_path):

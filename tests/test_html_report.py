@@ -448,6 +448,7 @@ def test_model_structure_table_marks_the_chosen_candidate(runs, tmp_path):
     """An identification record with ``metadata.selection`` gets the model-structure table,
     the chosen candidate's row marked; one without it renders without that table."""
     doc = _identification_doc(runs)
+    doc["metadata"].pop("terms", None)  # the structure held: the chosen one's (not said)
     doc["metadata"]["selection"] = {
         "rule": "lowest held-out error within one standard error",
         "validation": "5 contiguous time blocks",

@@ -20,7 +20,10 @@ stored in feasible.json, else the sigmoid approximated (its odd part fitted over
 velocity range); --no-friction for frictionless joints. A drive (feasible.json's, a robot
 TOML's [drive] table, or --drive) adds its rotor inertias as armature and reflects friction
 at the motors to the joints; what MJCF cannot hold (a coupled rotor's off-diagonal inertia)
-is named in a warning. TOML keeps the drive as a [drive] table.
+is named in a warning. TOML keeps the drive as a [drive] table and the identified friction
+as a [friction] table. URDF holds per joint damping and friction (<dynamics>, the chain
+export only); what it cannot hold (the rotor inertias, an offset, a coupled drive's
+off-diagonal terms) is named in one warning.
 
 examples:
   dynid export --params feasible/feasible.json --out panda.xml

@@ -14,6 +14,7 @@ from __future__ import annotations
 import argparse
 import contextlib
 import logging
+import os
 import sys
 import time
 from collections.abc import Sequence
@@ -118,6 +119,18 @@ class _Collect(logging.Handler):
             self._into.append(record.getMessage())
 
 
+def option_text(value: object) -> str:
+    """An option's value as the user gave it: a path as the path, several values
+    space-separated, none as ""."""
+    if value is None:
+        return ""
+    if isinstance(value, list | tuple):
+        return " ".join(option_text(v) for v in value)
+    if isinstance(value, os.PathLike):
+        return os.fspath(value)
+    return str(value)
+
+
 def save_run_report(
     run: RunOutput,
     record: RunRecord,
@@ -146,7 +159,7 @@ def save_run_report(
         The report cannot be written.
     """
     options = tuple(
-        (f"--{k.replace('_', '-')}", "" if v is None else str(v))
+        (f"--{k.replace('_', '-')}", option_text(v))
         for k, v in sorted(vars(args).items())
         if not k.startswith("_") and k != "command"
     )

@@ -152,8 +152,8 @@ def drive_joint_terms(
         if np.any(np.abs(off) > 1e-12 * max(float(np.abs(A).max()), 1e-300)):
             i, j = np.unravel_index(int(np.argmax(np.abs(off))), off.shape)
             notes.append(
-                f"{what}: the coupling's off-diagonal terms are not expressible in MJCF and "
-                f"are dropped (largest: joints {i + 1}-{j + 1}, {A[i, j]:.4g})"
+                f"{what}: the coupling's off-diagonal terms have no per-joint term and are "
+                f"dropped (largest: joints {i + 1}-{j + 1}, {A[i, j]:.4g})"
             )
         return np.diag(A).copy()
 
@@ -167,8 +167,8 @@ def drive_joint_terms(
         off = Kf - np.diag(np.diag(Kf))
         if np.any(off * fcv[:, None]):
             notes.append(
-                "Coulomb friction of coupled motors on other joints is not expressible in MJCF "
-                "and is dropped (frictionloss holds each joint's own motor)"
+                "Coulomb friction of coupled motors on other joints has no per-joint term and "
+                "is dropped (the joint's dry friction holds its own motor's)"
             )
     return DriveJointTerms(arm, damp, loss, tuple(notes))
 
@@ -209,7 +209,7 @@ def joint_coulomb_viscous(
     n = friction.n
     vmax = np.full(n, 2.0) if dq_max is None else _checks.as_exact("dq_max", dq_max, (n,))
     terms = friction.law.mjcf(friction.as_array(), vmax)
-    notes = (f"{friction.kind} friction: {terms.dropped} is not expressible in MJCF",) * bool(
+    notes = (f"{friction.kind} friction: {terms.dropped} has no per-joint term",) * bool(
         terms.dropped
     )
     if friction.drive is not None:

@@ -4,13 +4,17 @@
 link, in the schema of the robot description's inertials (:mod:`dynid.io.robot.toml`):
 ``mass`` [kg], ``com`` [m] in the link frame, ``inertia`` ``[xx, xy, xz, yy, yz, zz]``
 [kg m^2] **about the CoM**, link-frame axes. It also holds the robot's kinematics
-(:mod:`dynid.io.robot_json`) and its sigmoid friction, so that it loads back as a complete
+(:mod:`dynid.io.robot_json`) and the friction of the fitted model
+(:func:`fitted_robot`: the input robot's sigmoid only when the fit identified no friction
+and was not on a torque log; the friction identified with the links in ``linear_friction``,
+:mod:`dynid.io.law_friction`), so that it loads back as a complete
 :class:`~dynid.model.robot.Robot`::
 
     {"schema": "dynid-feasible-parameters/1", "dynid_version": ..., "name": ...,
      "links": [{"name": "link1", "mass": 4.97, "com": [...], "inertia": [...]}, ...],
      "friction": null | {"model": "sigmoid", "phi1": [...], "phi2": [...], "phi3": [...]},
-     "linear_friction": null | {"model": "classical", "fv": [...], "fc": [...], "fo": [...]},
+     "linear_friction": null | {"model": "classical", "fv": [...], "fc": [...], "fo": [...],
+         "standstill_band": [...]},
      "joint_friction": {"model": "classical", "fv": [...], ...} (with friction at the motors
          and at the joints of a coupled drive: the part at the joints),
      "drive": null | {dynid-drive/1 record, rotor_inertia: the identified values},
@@ -49,6 +53,7 @@ from ..model.inertia import (
 from ..model.robot import MAX_LINK_MASS, MAX_LINK_OFFSET, Robot
 from .drive_file import drive_from_record
 from .json_files import finite_or_none, load_json
+from .law_friction import law_friction, law_record
 from .robot_json import ROBOT_RECORD, robot_from_dict, robot_to_dict
 from .schema import Field, Format, Record, check, fault, load_document, save_document
 
@@ -58,6 +63,7 @@ __all__ = [
     "feasible_to_dict",
     "load_feasible_drive",
     "load_feasible_json",
+    "fitted_robot",
     "load_feasible_linear_friction",
     "robot_from_feasible_dict",
     "save_feasible_json",
@@ -157,8 +163,11 @@ def feasible_to_dict(source: FeasibleResult | Robot, *, seed: int | None = None)
         The robot's friction is another law than the sigmoid at the joints, which the file
         does not hold (``friction.json`` does): it is left out.
     """
-    result = None if isinstance(source, Robot) else source
-    robot = source if isinstance(source, Robot) else source.robot
+    result: FeasibleResult | None = None
+    if isinstance(source, Robot):
+        robot = source
+    else:
+        result, robot = source, fitted_robot(source)
     I6 = inertia6_from_matrix(robot.inertia)
     links = [
         {
@@ -173,7 +182,7 @@ def feasible_to_dict(source: FeasibleResult | Robot, *, seed: int | None = None)
     P = sigmoid_parameters(robot.friction)
     if P is not None:  # what the format holds (module docstring)
         fr = {"model": "sigmoid"} | {f"phi{k + 1}": [float(x) for x in P[:, k]] for k in range(3)}
-    elif robot.friction is not None:
+    elif robot.friction is not None and result is None:  # a result's is linear_friction
         warnings.warn(
             f"feasible.json: the robot's {robot.friction.kind} friction is not part of the file "
             "(which holds the sigmoid at the joints) and is not written; save it as friction.json",
@@ -182,20 +191,25 @@ def feasible_to_dict(source: FeasibleResult | Robot, *, seed: int | None = None)
         )
     parts = friction_parts(None if result is None else result.friction)
     drive = None if result is None else result.drive
+    conventions = {k: v for k, v in _CONVENTIONS.items() if k != "friction" or fr is not None}
+    for key, part in zip(("linear_friction", "joint_friction"), parts, strict=False):
+        conventions[key] = part.law.formula + (
+            " (at the motors: K^T f(K dq))" if _at_motors(part) else ""
+        )
     d: dict[str, Any] = {
         "schema": FEASIBLE_SCHEMA,
         "dynid_version": __version__,
         "name": robot.name,
         "links": links,
         "friction": fr,
-        "linear_friction": _law_record(parts[0]) if parts else None,
+        "linear_friction": law_record(parts[0]) if parts else None,
         "kinematics": robot_to_dict(robot),
         "units": _UNITS,
-        "conventions": _CONVENTIONS,
+        "conventions": conventions,
         "drive": None if drive is None else drive.as_dict(),
     }
     if len(parts) > 1:
-        d["joint_friction"] = _law_record(parts[1])
+        d["joint_friction"] = law_record(parts[1])
     if result is None:
         return d if seed is None else d | {"seed": seed}
     d["method"] = result.method
@@ -207,10 +221,23 @@ def feasible_to_dict(source: FeasibleResult | Robot, *, seed: int | None = None)
     return d
 
 
-def _law_record(friction: Friction) -> dict[str, Any]:
-    """``{"model": law, name: per-joint values, ...}`` of a friction."""
-    cols = {k: [float(x) for x in friction.params[:, j]] for j, k in enumerate(friction.names)}
-    return {"model": friction.kind} | cols
+def fitted_robot(result: FeasibleResult) -> Robot:
+    """The result's robot with the friction of the fitted model, as the files hold it.
+
+    The friction identified with the links (``result.friction``; none when it acts at the
+    motors and at the joints, which a robot does not hold: ``feasible.json`` keeps both
+    parts); none after a one-step fit of a torque log whose structure had no friction (the
+    input robot's friction was not part of the fit); the input robot's own friction for a
+    retrieval or a fit of static data, which identify none.
+    """
+    f = result.friction
+    if f is not None:
+        return result.robot.with_friction(None if isinstance(f, FrictionSum) else f)
+    return result.robot.with_friction(None) if result.kind == "log" else result.robot
+
+
+def _at_motors(friction: Friction) -> bool:
+    return friction.drive is not None and friction.drive.friction_at == "motor"
 
 
 def save_feasible_json(path: str | Path, source: FeasibleResult | Robot) -> Path:
@@ -337,29 +364,11 @@ def load_feasible_linear_friction(path: str | Path) -> Friction | FrictionSum | 
         return None
     drive = load_feasible_drive(path)
     at = drive if drive is not None and drive.friction_at == "motor" else None
-    parts = [_law_friction(d["linear_friction"], at, len(d["links"]), path, "linear_friction")]
+    n, name = len(d["links"]), Path(path).name
+    parts = [law_friction(d["linear_friction"], at, n, name, "linear_friction")]
     if d.get("joint_friction") is not None:
-        parts.append(
-            _law_friction(d["joint_friction"], None, len(d["links"]), path, "joint_friction")
-        )
+        parts.append(law_friction(d["joint_friction"], None, n, name, "joint_friction"))
     return parts[0] if len(parts) == 1 else FrictionSum(tuple(parts))
-
-
-def _law_friction(
-    rec: Mapping[str, Any], drive: Drive | None, n: int, path: str | Path, key: str
-) -> Friction:
-    """A law's friction from its record (:func:`_law_record`), acting through ``drive``."""
-    law = LAWS[rec["model"]]
-    cols = []
-    for name in law.params:
-        v = rec.get(name)
-        if not isinstance(v, list) or len(v) != n:
-            want = f"{n} numbers (one per joint) for the {law.name} law's {name}"
-            raise fault(
-                Path(path).name, f"{key}.{name}", f"expected {want}; got {_checks.short(v)}"
-            )
-        cols.append(np.array(v, dtype=float))
-    return law.model(np.column_stack(cols), None, drive)
 
 
 def load_feasible_drive(path: str | Path) -> Drive | None:

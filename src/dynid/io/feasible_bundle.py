@@ -2,9 +2,10 @@
 ``robot.xml`` (MJCF), ``robot.toml`` and ``report.json`` in one folder.
 
 Written alike by ``dynid retrieve``, ``dynid identify --consistent`` and the demo's
-feasible stage. The friction a one-step fit identified with the links (classical ``fv``,
-``fc``, ``fo`` per joint, at the joints or, with a drive whose friction acts there, at the
-motors) goes on the exported robots.
+feasible stage. The robots carry the friction of the fitted model
+(:func:`~dynid.io.feasible.fitted_robot`): the one a one-step fit identified with the links
+(the law of its structure, at the joints or, with a drive whose friction acts there, at the
+motors, or both), none when it fitted a torque log without friction, else the input robot's.
 """
 
 from __future__ import annotations
@@ -14,7 +15,7 @@ from typing import Any
 
 from ..feasibility.result import FeasibleResult
 from .export import ROBOT_FORMATS, ExportOptions, save_robot_files
-from .feasible import save_feasible_json
+from .feasible import fitted_robot, save_feasible_json
 from .report_json import save_report_json
 
 __all__ = ["FEASIBLE_BUNDLE", "save_feasible_bundle"]
@@ -57,8 +58,8 @@ def save_feasible_bundle(
     """
     folder = Path(folder)
     files = [save_feasible_json(folder / "feasible.json", result)]
-    drive = result.drive
     friction: Any = True if result.friction is None else result.friction
-    files += save_robot_files(folder, result.robot, ExportOptions(friction=friction, drive=drive))
+    options = ExportOptions(friction=friction, drive=result.drive)
+    files += save_robot_files(folder, fitted_robot(result), options)
     files.append(save_report_json(folder / "report.json", result, **report_extra))
     return files

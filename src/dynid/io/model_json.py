@@ -58,6 +58,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from .. import __version__, _checks
+from ..friction.laws import LAWS
 from ..identification.info import IdentificationInfo, LogInfo, StaticInfo
 from ..identification.least_squares import LeastSquaresFit
 from ..identification.model import IdentifiedModel
@@ -165,12 +166,15 @@ def model_to_dict(model: IdentifiedModel, *, seed: int | None = None) -> dict[st
     out["drive"] = None if model.drive is None else model.drive.as_dict()
     out["robot"] = robot_to_dict(model.robot)
     out["metadata"] = info_to_dict(info, model.drive) | friction_metadata(model)
+    law = LAWS[frictions[0].law if len(frictions) == 1 else "classical"]
     out["units"] = {
         "value": "SI of each expression: m kg, mc kg m, J kg m^2",
         "std": "as value",
         "std_percent": "%",
         "relative_error_percent": "%",
-        "friction": "fv N m s/rad, fc N m, fo N m",
+        "residual_rms": "N m, kg m^2 for M rows" if info.route == "static" else "N m",
+        "sigma": "as residual_rms",
+        "friction": ", ".join(f"{p} {u}" for p, u in zip(law.params, law.units, strict=True)),
     }
     out["conventions"] = {
         "standard_parameters": "per link m, mcx, mcy, mcz, Jxx, Jxy, Jxz, Jyy, Jyz, Jzz; J about "

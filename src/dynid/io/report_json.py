@@ -63,9 +63,10 @@ def report_to_dict(result: FeasibleResult) -> dict[str, Any]:
         ``"penalty"``), ``kind``, ``robot``, ``link_names``, ``relative_residual`` [1],
         ``feasible``, ``min_margin`` (per constraint name), ``constraints`` (name, link,
         margin, unit, satisfied), ``pseudo_inertia_margin`` (``lambda_min(J)/tr(J)`` per
-        link [1]), ``friction`` (classical ``fv, fc, fo`` identified with the links, or
-        None), ``heldout`` (the held-out judgement, or None), ``run_time_s`` [s], ``seed``,
-        ``notes``, ``total_mass`` [kg], ``bounds`` (a bounds file's content) and ``units``;
+        link [1]), ``friction`` (the friction identified with the links: ``model``, its law,
+        and the law's parameters, ``fv, fc, fo`` of the classical law; or None), ``heldout``
+        (the held-out judgement, or None), ``run_time_s`` [s], ``seed``, ``notes``,
+        ``total_mass`` [kg], ``bounds`` (a bounds file's content) and ``units``;
         then the method's own (:meth:`~dynid.feasibility.result.FeasibleResult.report_fields`),
         their numbers that may have no value written None."""
     rep = result.report
@@ -109,14 +110,16 @@ def save_report_json(path: str | Path, result: FeasibleResult, **extra: Any) -> 
 
 
 def _friction_record(fr: Friction | FrictionSum) -> dict[str, Any]:
-    """``{name: per-joint values}`` of the law's parameters (``fv, fc, fo``: classical); of
-    friction at the motors and at the joints, the part at the joints under ``"joints"``."""
+    """``{"model": law, name: per-joint values}`` of the law's parameters (``fv, fc, fo``
+    of the classical or the smooth law, ...); of friction at the motors and at the joints,
+    the part at the joints under ``"joints"``."""
     parts = friction_parts(fr)
-    out: dict[str, Any] = {
-        k: [float(x) for x in parts[0].params[:, j]] for j, k in enumerate(parts[0].names)
-    }
+
+    def record(f: Friction) -> dict[str, Any]:
+        cols = {k: [float(x) for x in f.params[:, j]] for j, k in enumerate(f.names)}
+        return {"model": f.kind} | cols
+
+    out = record(parts[0])
     if len(parts) > 1:
-        out["joints"] = {
-            k: [float(x) for x in parts[1].params[:, j]] for j, k in enumerate(parts[1].names)
-        }
+        out["joints"] = record(parts[1])
     return out

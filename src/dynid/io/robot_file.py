@@ -73,7 +73,7 @@ def load_robot(
     if isinstance(identified, FrictionSum):  # at the motors and at the joints: no one law
         warnings.warn(
             f"{path.name}: its friction acts at the motors and at the joints, which a robot "
-            "does not hold; the robot keeps the file's sigmoid; hint: --params "
+            "does not hold; the robot gets neither; hint: --params "
             f"{path.name} uses both",
             DynidWarning,
             stacklevel=2,

@@ -219,8 +219,10 @@ def plot_consistent(
 
     Left: link masses [kg] of each result (bars), the prior's (of the first convex result,
     open markers) and ``truth``'s (a Robot, crosses) when given. Right: the margin
-    ``lambda_min(J)/tr(J)`` of each link's pseudo-inertia (log scale; non-positive margins
-    drawn at the bottom, red), with the convex method's margin as a dashed line.
+    ``lambda_min(J)/tr(J)`` of each link's pseudo-inertia (log scale), with the convex
+    method's margin as a dashed line; a link whose margin is not positive (not physically
+    consistent), which a log scale cannot show, is a hatched red bar over the whole height,
+    named in the legend and the title only when there is one.
 
     Parameters
     ----------
@@ -241,13 +243,27 @@ def plot_consistent(
     x = np.arange(1, n + 1)
     w = 0.8 / len(results)
     floor = 1e-7
+    inconsistent = False
     for k, (res, name) in enumerate(zip(results, names, strict=True)):
         off = (k - (len(results) - 1) / 2) * w
-        ax1.bar(x + off, res.robot.mass, width=w, label=name)
-        mg = res.pseudo_inertia_margin
+        colour = f"C{k}" if k < 3 else f"C{k + 1}"  # C3 is red: kept for the inconsistent
+        ax1.bar(x + off, res.robot.mass, width=w, label=name, color=colour)
+        mg = np.asarray(res.pseudo_inertia_margin, dtype=float)
         ok = mg > 0
-        ax2.bar(x[ok] + off, mg[ok], width=w, label=name)
-        ax2.bar(x[~ok] + off, np.full((~ok).sum(), floor), width=w, color="tab:red")
+        ax2.bar(x[ok] + off, mg[ok], width=w, label=name, color=colour)
+        if np.any(~ok):  # the whole height: a log scale has no place for margins <= 0
+            ax2.bar(
+                x[~ok] + off,
+                np.full(int((~ok).sum()), 1.0 - floor / 2),
+                bottom=floor / 2,
+                width=w,
+                color="tab:red",
+                alpha=0.5,
+                hatch="//",
+                edgecolor=colour,
+                label=None if inconsistent else "not physically consistent (margin <= 0)",
+            )
+            inconsistent = True
     convex = [r for r in results if isinstance(r, ConsistentResult)]  # a prior, a margin
     prior = convex[0].prior if convex else None
     if prior is not None:
@@ -268,6 +284,7 @@ def plot_consistent(
     ax2.set_ylabel("lambda_min(J) / tr(J)")
     ax2.set_xticks(x)
     ax2.legend(fontsize=8, loc="upper right", ncol=2)
-    ax2.set_title("pseudo-inertia margin (red: not physically consistent)", fontsize=9)
+    title = "pseudo-inertia margin per link"
+    ax2.set_title(title + (" (red: not physically consistent)" if inconsistent else ""), fontsize=9)
     fig.tight_layout()
     return fig

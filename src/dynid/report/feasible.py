@@ -15,6 +15,7 @@ from __future__ import annotations
 from typing import Any
 
 from .html import cell, esc, figure, is_number, number, section, table, verdict
+from .identify import used_structure
 from .run import Answer, RunFiles
 
 __all__ = ["answer"]
@@ -64,6 +65,7 @@ def answer(run: RunFiles) -> Answer | None:
         f"Total mass {number(sum(masses))} kg"
         + (f" (band {cell(band)} kg)" if isinstance(band, list) else "")
     )
+    facts += _structure_fact(run, feas)
     for note in rep.get("on_bound") or []:
         facts.append("On a bound: " + esc(note))
     held = rep.get("heldout")
@@ -97,6 +99,31 @@ def answer(run: RunFiles) -> Answer | None:
         f'<div class="figures">{fig_html}</div>' if fig_html else "",
     )
     return Answer(verdict(level, head, facts), sections, shown)
+
+
+def _structure_fact(run: RunFiles, feas: dict) -> list[str]:
+    """The one-step fit of a torque log: the structure it used (the identified model's,
+    as the identify part of the page names it) and the friction identified with the links
+    (its law and where it acts, as ``feasible.json`` holds it)."""
+    used = used_structure(run.docs.get("identification.json"))
+    laws = [
+        (feas[k], "the joints" if k == "joint_friction" else _where(feas))
+        for k in ("linear_friction", "joint_friction")
+        if isinstance(feas.get(k), dict)
+    ]
+    if used is None and not laws:
+        return []
+    friction = " + ".join(f"{esc(rec.get('model'))} law at {w}" for rec, w in laws) or "none"
+    said = f"friction identified with the links: {friction}"
+    if used is None:
+        return [said[0].upper() + said[1:]]
+    return [f"Structure of the consistent fit: <b>{esc(used)}</b>; {said}"]
+
+
+def _where(feas: dict) -> str:
+    drive = feas.get("drive")
+    at = drive.get("friction_at") if isinstance(drive, dict) else None
+    return "the motors" if at == "motor" else "the joints"
 
 
 def _links_table(feas: dict, rep: dict) -> str:

@@ -17,6 +17,8 @@ from __future__ import annotations
 import re
 from typing import Any
 
+from ..exceptions import DynidError
+from ..identification.structure import Structure
 from ..identification.verdict import FLOOR_GOOD, judge_prediction, worst
 from .html import bar, cell, esc, figure, is_number, number, percent, section, table, verdict
 from .model_terms import terms_sections
@@ -97,14 +99,14 @@ def _heldout_facts(doc: dict, held: dict | None) -> tuple[list[str], list[str], 
             r = v.ratio
             facts.append(
                 f"On {where}, unfiltered: error {percent(err)} against a sensor-noise floor "
-                f"of {percent(floor)} (<b>{r:.2f} x the floor</b>: {esc(v.label)}"
+                f"of {percent(floor)} (<b>{r:.3g} x the floor</b>: {esc(v.label)}"
                 + (
                     ", only noise is left)"
                     if r <= FLOOR_GOOD
                     else ", effects outside the model remain, see the residuals)"
                 )
             )
-            level = "at" if r <= FLOOR_GOOD else f"{r:.1f} times"
+            level = "at" if r <= FLOOR_GOOD else f"{r:.3g} times"  # as in the fact
             headline = (
                 f"The model predicts held-out torques to {percent(err)}, {level} the "
                 f"sensor-noise floor of {percent(floor)} (unfiltered torques)"
@@ -189,8 +191,28 @@ def _short(expression: str, n: int = 28) -> str:
     return expression if len(expression) <= n else expression[: n - 3] + "..."
 
 
+def used_structure(doc: Any) -> str | None:
+    """The structure the identified model holds (``metadata.terms``, its name as the
+    candidates are named: ``"links + viscous + coulomb - fc5"``), which the one-step
+    consistent fit uses too; None when the record does not say."""
+    terms = _get(doc, "metadata", "terms")
+    if not isinstance(terms, list) or not all(isinstance(t, str) for t in terms):
+        return None
+    try:
+        return Structure.parse(",".join(terms) or "links").name
+    except DynidError:
+        return None
+
+
 def _terms_fact(doc: dict) -> str:
     sel = _selection(doc)
+    used = used_structure(doc)
+    if isinstance(sel, dict) and sel.get("chosen") and used not in (None, sel["chosen"]):
+        return (
+            f"Terms used: <b>{esc(used)}</b> (the model's, and a consistent fit's); the "
+            f"structure chosen on held-out data was {esc(sel['chosen'])} by "
+            f"{esc(sel.get('rule', 'held-out error'))}"
+        )
     if isinstance(sel, dict) and sel.get("chosen"):
         chosen = [c for c in sel.get("candidates") or [] if c.get("name") == sel["chosen"]]
         listed = ", ".join(chosen[0].get("terms") or []) if chosen else ""
@@ -332,19 +354,16 @@ def _structure_section(doc: dict) -> str:
     per = [r for r in sel.get("heldout_per_recording") or () if isinstance(r, dict)]
     if per:
         odd = set(sel.get("outlying_recordings") or ())
+        said = "outlying: left out of the judgement"
+        rows = [
+            [esc(r.get("file", "")), cell(r.get("heldout_error_percent"))]
+            + ([said if r.get("file") in odd else ""] if odd else [])
+            for r in per
+        ]
+        head = ["recording", "held-out error [%]"] + (["judgement"] if odd else [])
         parts.append(
             "<p>Held-out error of the chosen structure per recording (fitted on the others).</p>"
-            + table(
-                ["recording", "held-out error [%]", ""],
-                [
-                    [
-                        esc(r.get("file", "")),
-                        cell(r.get("heldout_error_percent")),
-                        "outlying: left out of the judgement" if r.get("file") in odd else "",
-                    ]
-                    for r in per
-                ],
-            )
+            + table(head, rows)
         )
     return section("structure", "Model structure", *parts)
 

@@ -34,7 +34,9 @@ def _heading(term: dict[str, Any]) -> str:
     definition = term.get("definition") or {}
     if term.get("kind") == "linear_friction":
         where = "the motors" if definition.get("at") == "motor" else "the joints"
-        return f"{name.capitalize()} at {where} (value \u00b1 std)"
+        parts = definition.get("parts")
+        law = ": " + " + ".join(map(str, parts)) if isinstance(parts, list) and parts else ""
+        return f"{name.capitalize()} at {where}{esc(law)} (value \u00b1 std)"
     if term.get("kind") == "rotor_inertia":
         return f"{name.capitalize()}: armature or rotor inertia at the motors (value \u00b1 std)"
     return f"{name.capitalize()} (value \u00b1 std)"

@@ -58,7 +58,8 @@ LONG_PRINTOUT = 60
 # ---------------------------------------------------------------------- page parts
 def input_files(argv: Sequence[str], out: str | Path | None = None) -> list[tuple[str, Path]]:
     """The files named on a command line: (option, path) of each argument that is an
-    existing file outside the output folder ``out``.
+    existing file outside the output folder ``out``, and of each data file (``.csv``,
+    ``.npz``, in name order) of an argument that is a folder (``--data folder/``).
 
     Parameters
     ----------
@@ -89,10 +90,59 @@ def input_files(argv: Sequence[str], out: str | Path | None = None) -> list[tupl
         except (OSError, ValueError):
             is_file = False
         ap = Path(os.path.abspath(p))
-        if is_file and (outdir is None or outdir not in ap.parents):
+        outside = outdir is None or (outdir != ap and outdir not in ap.parents)
+        if is_file and outside:
             found.append((flag, p))
+        elif outside and _is_dir(p):
+            found += [(flag, f) for f in sorted(p.iterdir()) if f.suffix.lower() in _DATA]
         flag = ""
     return found
+
+
+#: the suffixes of the data files a folder given as data stands for
+_DATA = (".csv", ".npz")
+
+
+def _is_dir(p: Path) -> bool:
+    try:
+        return p.is_dir()
+    except (OSError, ValueError):
+        return False
+
+
+def _recordings(docs: Mapping[str, Any]) -> dict[str, dict[str, Any]]:
+    """What the run's files say of each recording read, by file name: ``pieces`` and
+    ``samples`` used (``recordings`` of ``identification.json``'s metadata, of
+    ``validation.json``, ``payload.json``, ...)."""
+    out: dict[str, dict[str, Any]] = {}
+    for doc in docs.values():
+        if not isinstance(doc, dict):
+            continue
+        meta = doc.get("metadata")
+        for recs in (
+            doc.get("recordings"),
+            meta.get("recordings") if isinstance(meta, dict) else None,
+        ):
+            for r in recs if isinstance(recs, list) else ():
+                if isinstance(r, dict) and isinstance(r.get("file"), str):
+                    out.setdefault(r["file"], r)
+    return out
+
+
+def _rows(path: Path) -> str:
+    """The data rows of a recording: a CSV's lines after its header (comments and blank
+    lines apart), an NPZ's length of ``t``; "" when it cannot tell."""
+    try:
+        if path.suffix.lower() == ".npz":
+            import numpy as np
+
+            with np.load(path) as z:
+                return str(len(z["t"])) if "t" in z.files else ""
+        with open(path, encoding="utf-8", errors="replace") as fh:
+            lines = sum(1 for line in fh if line.strip() and not line.startswith("#"))
+        return str(max(lines - 1, 0))
+    except (OSError, ValueError, KeyError):
+        return ""
 
 
 def _looks_numeric(arg: str) -> bool:
@@ -111,27 +161,38 @@ def _sha256(path: Path) -> str:
     return h.hexdigest()
 
 
-def _inputs_html(summary: RunSummary, out: Path | None) -> str:
+def _inputs_html(
+    summary: RunSummary, out: Path | None, docs: Mapping[str, Any] | None = None
+) -> str:
     line = " ".join(_quote_arg(a) for a in summary.argv) or summary.command
     parts = [f'<pre class="cmd">{esc(line)}</pre>']
     rows = []
-    for flag, p in input_files(summary.argv[1:], out):
+    recs = _recordings(docs or {})
+    inputs = input_files(summary.argv[1:], out)
+    read = any(p.name in recs for _, p in inputs)
+    for flag, p in inputs:
         try:
             st, digest = p.stat(), _sha256(p)
         except OSError:
             continue
         ap = os.path.abspath(p)
         rel = os.path.relpath(ap, out) if out is not None else ap
+        rec = recs.get(p.name)
+        counts = [] if not read else ["", "", ""]
+        if rec is not None:
+            counts = [_rows(p), esc(rec.get("pieces", "")), esc(rec.get("samples", ""))]
         rows.append(
             [
                 f"<code>{esc(flag)}</code>",
                 f'<a href="{href(rel)}">{esc(p)}</a>',
+                *counts,
                 esc(size(st.st_size)),
                 f'<code title="sha256 {esc(digest)}">{esc(digest[:12])}</code>',
             ]
         )
     if rows:
-        parts.append(table(["option", "input file", "size", "sha256"], rows))
+        counted = ["rows in the file", "pieces", "samples used"] if read else []
+        parts.append(table(["option", "input file", *counted, "size", "sha256"], rows))
     if summary.options:
         opts = [[f"<code>{esc(k)}</code>", esc(v)] for k, v in summary.options]
         parts.append(
@@ -230,7 +291,7 @@ def render_html_report(
         body += answer.sections
     else:
         body.append(_key_numbers_html(list(docs.items())))
-    body.append(f'<h2 id="inputs">Run</h2>{_inputs_html(summary, outdir)}')
+    body.append(f'<h2 id="inputs">Run</h2>{_inputs_html(summary, outdir, docs)}')
     for t in summary.tables:
         rows = [[esc(c) for c in r] for r in t.rows]
         body.append(f"<h2>{esc(t.title)}</h2>" + table(t.headers, rows))

@@ -37,7 +37,13 @@ from numpy.typing import NDArray
 
 from ... import _checks, spatial
 from ...exceptions import DataError, DynidError, DynidWarning, ModelError
-from ...friction.model import SigmoidFriction, sigmoid_parameters
+from ...friction.model import (
+    Friction,
+    FrictionSum,
+    SigmoidFriction,
+    robot_friction,
+    sigmoid_parameters,
+)
 from ...model.drive import Drive
 from ...model.inertia import (
     inertia6_from_matrix,
@@ -58,6 +64,7 @@ from ..drive_file import drive_toml
 from ..input_files import file_text
 from ..schema import Field, Record, check, fault
 from .export_options import ExportOptions
+from .toml_friction import FRICTION_TABLE, friction_tables, table_friction
 
 __all__ = [
     "FORMAT_VERSION",
@@ -137,6 +144,8 @@ ROBOT_TOML = Record(
         "joints": Field("objects", required=True, non_empty=True, shape=("n",), record=_JOINT),
         "frames": Field("objects", record=_FRAME),
         "drive": Field("any"),
+        "friction": FRICTION_TABLE,
+        "joint_friction": FRICTION_TABLE,
     }
 )
 #: Rate limits: ``limits.velocity`` [rad/s or m/s], ``acceleration``, ``effort`` [N m or N].
@@ -339,6 +348,7 @@ def robot_from_toml_string(text: str, *, source: str = "TOML text") -> Robot:
     frames = _frames(doc, source, link_names)
     lim = {k: np.array([r.limits[k] for r in rows]) for k in ("lower", "upper", *_RATES)}
     sigmoid = [r.friction for r in rows if r.friction is not None]
+    law = table_friction(doc, len(rows), source)
     try:
         return Robot(
             name=doc.get("name", "robot"),
@@ -359,7 +369,7 @@ def robot_from_toml_string(text: str, *, source: str = "TOML text") -> Robot:
             tau_max=lim["effort"],
             gravity=_vector(doc.get("gravity"), (0.0, 0.0, -STANDARD_GRAVITY)),
             frames=frames,
-            friction=SigmoidFriction.from_array(np.stack(sigmoid)) if sigmoid else None,
+            friction=SigmoidFriction.from_array(np.stack(sigmoid)) if sigmoid else law,
             q_neutral=_vector(doc["q_neutral"], ()) if "q_neutral" in doc else None,
         )
     except DynidError as exc:
@@ -420,7 +430,9 @@ def _xyz_rpy(T: NDArray[np.float64]) -> tuple[str, str]:
     return _arr(T[:3, 3]), _arr(spatial.rpy_from_matrix(T[:3, :3]))
 
 
-def toml_from_robot(robot: Robot) -> str:
+def toml_from_robot(
+    robot: Robot, *, drive: Drive | None = None, friction: Friction | FrictionSum | None = None
+) -> str:
     """The dynid TOML description of a robot (schema: see the module docstring).
 
     Joint origins are written as ``origin = {xyz, rpy}``, inertials as mass, CoM and
@@ -432,28 +444,30 @@ def toml_from_robot(robot: Robot) -> str:
     Parameters
     ----------
     robot : Robot
+    drive : Drive, optional
+        A drive train, written as a ``[drive]`` table
+        (:func:`dynid.io.drive_file.drive_toml`); default: the drive a friction at the
+        motors acts through, if any.
+    friction : Friction or FrictionSum, optional
+        Written instead of the robot's own (the friction identified with the links; a sum
+        of friction at the motors and at the joints as ``[friction]`` and
+        ``[joint_friction]``, :mod:`dynid.io.robot.toml_friction`).
 
     Returns
     -------
     text : str
         The TOML document.
 
-    Warns
-    -----
-    DynidWarning
-        The robot's friction is another law than the sigmoid at the joints, which a
-        description does not hold: it is not written (``friction.json`` holds any law).
+    Another law than the sigmoid at the joints (the friction identified with the links,
+    say) is the ``[friction]`` table (:mod:`dynid.io.robot.toml_friction`); with friction
+    at the motors, the drive it acts through is needed beside it (:func:`save_toml`).
     """
-    sigmoid = sigmoid_parameters(robot.friction)
-    if robot.friction is not None and sigmoid is None:
-        where = " at the motors of a drive" if robot.friction.drive is not None else ""
-        warnings.warn(
-            f"TOML export: the robot's {robot.friction.kind} friction{where} is not part of "
-            "a robot description (which holds the sigmoid at the joints) and is not written; "
-            "save it as friction.json",
-            DynidWarning,
-            stacklevel=2,
-        )
+    held = robot_friction(robot) if friction is None else friction
+    if isinstance(held, FrictionSum) or held is not robot.friction:
+        robot = robot.with_friction(None if isinstance(held, FrictionSum) else held)
+    sigmoid = sigmoid_parameters(held)
+    if drive is None and held is not None and held.drive is not None:
+        drive = held.drive  # the drive the friction at the motors acts through
     out = [
         "# dynid robot description; schema: dynid.io.robot.toml",
         "# units: m, rad, kg, kg m^2, s; inertia about the CoM, in link axes",
@@ -509,32 +523,44 @@ def toml_from_robot(robot: Robot) -> str:
             f"xyz = {xyz}",
             f"rpy = {rpy}",
         ]
-    return "\n".join(out) + "\n"
+    text = "\n".join(out) + "\n"
+    tables = friction_tables(held)
+    text = text if not tables else text + "\n" + tables
+    return text if drive is None else text + "\n" + drive_toml(drive)
 
 
-def save_toml(path: str | Path, robot: Robot, *, drive: Drive | None = None) -> Path:
+def save_toml(
+    path: str | Path,
+    robot: Robot,
+    *,
+    drive: Drive | None = None,
+    friction: Friction | FrictionSum | None = None,
+) -> Path:
     """Write the TOML description of ``robot`` (:func:`toml_from_robot`) to ``path``.
 
     Parameters
     ----------
     path : str or Path
     robot : Robot
-    drive : Drive, optional
-        A drive train, written with the robot as a ``[drive]`` table
-        (:func:`dynid.io.drive_file.drive_toml`).
+    drive, friction
+        As :func:`toml_from_robot`.
 
     Returns
     -------
     Path
         The path written.
     """
-    text = toml_from_robot(robot)
-    if drive is not None:
-        text = text.rstrip("\n") + "\n\n" + drive_toml(drive)
+    text = toml_from_robot(robot, drive=drive, friction=friction)
     return write_text(path, text)
 
 
 def export_toml(path: str | Path, robot: Robot, options: ExportOptions) -> Path:
-    """:func:`save_toml` with the export options' ``drive`` (the entry of ``toml`` in the
-    exports; the robot's own sigmoid friction is part of the description)."""
-    return save_toml(path, robot, drive=options.drive)
+    """:func:`save_toml` with the export options' ``drive`` and ``friction`` (the entry of
+    ``toml`` in the exports): ``True`` the robot's own friction, ``False`` none, a friction
+    model (the one identified with the links) written in its place."""
+    f = options.friction
+    if f is True:
+        return save_toml(path, robot, drive=options.drive)
+    return save_toml(
+        path, robot if f else robot.with_friction(None), drive=options.drive, friction=f or None
+    )

@@ -47,7 +47,8 @@ from numpy.typing import NDArray
 from ... import __version__, spatial
 from ...exceptions import DynidWarning, ModelError, ShapeError
 from ...friction.model import robot_friction, sigmoid_parameters
-from ...friction.mujoco import joint_coulomb_viscous
+from ...friction.mujoco import drive_joint_terms, joint_coulomb_viscous
+from ...model.drive import Drive
 from ...model.inertia import inertia6_from_matrix
 from ...model.robot import Robot
 from ..atomic import write_text
@@ -270,6 +271,20 @@ def save_urdf(
     return path
 
 
+def _rotor_note(drive: Drive | None) -> tuple[str, ...]:
+    """What URDF cannot hold of a drive: its rotor inertias (the armature per joint,
+    ``diag(K^T diag(I_a) K)`` [kg m^2]), which the MJCF export writes as ``armature``."""
+    if drive is None or drive.rotor_inertia is None or not np.any(drive.rotor_inertia != 0):
+        return ()
+    arm = drive_joint_terms(drive.transmission, drive.rotor_inertia, None, None).armature
+    j = int(np.argmax(arm))
+    return (
+        f"the drive's rotor inertias (armature per joint, up to {arm[j]:.4g} kg m^2 at joint "
+        f"{j + 1}) have no URDF element and are left out: the MJCF export holds them as "
+        "armature, the TOML export as its [drive] table",
+    )
+
+
 def export_urdf(path: str | Path, robot: Robot, options: ExportOptions) -> Path:
     """:func:`save_urdf` with the export options (the entry of ``urdf`` in the exports).
 
@@ -277,10 +292,11 @@ def export_urdf(path: str | Path, robot: Robot, options: ExportOptions) -> Path:
     reflected from the motors of a drive) is written as ``<dynamics damping friction>``,
     what its law maps to viscous and dry friction
     (:func:`dynid.friction.mujoco.joint_coulomb_viscous`); what URDF cannot hold (an offset,
-    an asymmetry, a Stribeck peak, coupled terms) is named in one warning line.
-    ``friction=True`` writes the robot's own friction when it is a law other than the
-    description's sigmoid at the joints (which URDF does not hold); the drive is not
-    part of URDF.
+    an asymmetry, a Stribeck peak, a coupled drive's off-diagonal terms, the rotor inertias
+    of a drive, friction with a template) is named in one warning line, with the export
+    that holds it. ``friction=True`` writes the robot's own friction when it is a law other
+    than the description's sigmoid at the joints (which URDF does not hold); the drive is
+    not part of URDF.
 
     Raises
     ------
@@ -293,6 +309,7 @@ def export_urdf(path: str | Path, robot: Robot, options: ExportOptions) -> Path:
     model = None if isinstance(options.friction, bool) else options.friction
     if options.friction is True and sigmoid_parameters(robot.friction) is None:
         model = robot_friction(robot)  # the description's sigmoid: none
+    notes: tuple[str, ...] = ()
     if model is not None:
         if model.n != robot.n:
             raise ShapeError(f"friction has {model.n} joints; robot {robot.name!r} has {robot.n}")
@@ -300,9 +317,16 @@ def export_urdf(path: str | Path, robot: Robot, options: ExportOptions) -> Path:
         dynamics = (jt.damping, jt.frictionloss)
         notes = jt.notes
         if jt.offset is not None and np.any(jt.offset != 0):
-            notes += (f"{model.kind} friction: the velocity-independent offset is not expressible",)
-        if notes:  # one line: what URDF cannot hold
-            warnings.warn(f"URDF export: {'; '.join(notes)}", DynidWarning, stacklevel=2)
+            notes += (f"{model.kind} friction: the velocity-independent offset has no URDF term",)
+        if options.template is not None:
+            notes = (
+                f"the {model.kind} friction is not written (a template's inertials alone are "
+                "replaced; its <dynamics> are kept as they are)",
+            )
+    drive = options.drive if options.drive is not None else getattr(model, "drive", None)
+    notes += _rotor_note(drive)
+    if notes:  # one line: what URDF cannot hold
+        warnings.warn(f"URDF export: {'; '.join(notes)}", DynidWarning, stacklevel=2)
     return save_urdf(
         path,
         robot,

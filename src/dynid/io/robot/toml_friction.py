@@ -1,0 +1,103 @@
+"""The robot TOML's friction of any law: a ``[friction]`` table (and ``[joint_friction]``).
+
+A description holds the Gaz et al. sigmoid per joint (``joints[i].friction``); any other
+law of the registry (:mod:`dynid.friction.laws`), such as the friction identified with the
+links by ``identify --consistent``, is one top-level table with the law's parameters per
+joint (:mod:`dynid.io.law_friction`)::
+
+    [friction]
+    model = "classical"
+    at = "joint"            # or "motor": tau_f = K^T f(K dq) through the [drive] table
+    fv = [0.5, ...]         # N m s/rad
+    fc = [0.8, ...]         # N m
+    fo = [0.0, ...]         # N m
+    standstill_band = [...] # rad/s, optional
+
+With friction at the motors and at the joints of a coupled drive (``at:both``), the joint
+part is ``[joint_friction]`` (same keys, ``at = "joint"``); a robot holds one friction, so
+reading such a file keeps ``[friction]`` and names the other in a warning.
+"""
+
+from __future__ import annotations
+
+import warnings
+from collections.abc import Mapping
+from typing import Any
+
+from ...exceptions import DynidWarning
+from ...friction.laws import LAWS
+from ...friction.model import Friction, FrictionSum, friction_parts, sigmoid_parameters
+from ..drive_file import drive_from_mapping
+from ..law_friction import law_friction, law_record
+from ..schema import Field, Record, fault
+
+__all__ = ["FRICTION_TABLE", "friction_tables", "table_friction"]
+
+#: ``[friction]`` and ``[joint_friction]``: the law, where it acts, its parameters (open)
+FRICTION_TABLE = Field(
+    "object",
+    record=Record(
+        {
+            "model": Field("string", required=True, choices=tuple(LAWS)),
+            "at": Field("string", choices=("joint", "motor")),
+        },
+        open=True,
+    ),
+)
+
+
+def friction_tables(friction: Friction | FrictionSum | None) -> str:
+    """The TOML tables of a friction that is not the sigmoid at the joints ("" for none,
+    or for the sigmoid, which the joints hold)."""
+    if friction is None or sigmoid_parameters(friction) is not None:
+        return ""
+    out = []
+    for key, part in zip(("friction", "joint_friction"), friction_parts(friction), strict=False):
+        at = "motor" if part.drive is not None and part.drive.friction_at == "motor" else "joint"
+        rec = law_record(part)
+        lines = [f"[{key}]", f'model = "{rec.pop("model")}"', f'at = "{at}"']
+        units = dict(zip(part.law.params, part.law.units, strict=True))
+        units["standstill_band"] = "rad/s"
+        lines += [
+            f"{k} = [{', '.join(repr(float(x)) for x in v)}]  # {units[k]}" for k, v in rec.items()
+        ]
+        out.append("\n".join(lines))
+    return "\n\n".join(out) + "\n"
+
+
+def table_friction(doc: Mapping[str, Any], n: int, source: str) -> Friction | None:
+    """The friction of a description's ``[friction]`` table (through its ``[drive]`` table
+    when ``at = "motor"``), or None.
+
+    Raises
+    ------
+    DataError
+        A malformed table; ``at = "motor"`` without a ``[drive]`` table; a ``[friction]``
+        table beside a sigmoid per joint.
+
+    Warns
+    -----
+    DynidWarning
+        A ``[joint_friction]`` table, which a robot does not hold beside ``[friction]``.
+    """
+    rec = doc.get("friction")
+    if rec is None:
+        return None
+    if any("friction" in jt for jt in doc.get("joints", [])):
+        raise fault(
+            source, "friction", "give the sigmoid per joint or a [friction] table, not both"
+        )
+    drive = None
+    if rec.get("at", "joint") == "motor":
+        if "drive" not in doc:
+            raise fault(source, "friction.at", '"motor" needs the [drive] table it acts through')
+        drive = drive_from_mapping(doc["drive"], n, source=f"{source} [drive]")
+    friction = law_friction(rec, drive, n, source, "friction")
+    if "joint_friction" in doc:
+        warnings.warn(
+            f"{source}: its friction acts at the motors ([friction]) and at the joints "
+            "([joint_friction]), which a robot does not hold; the robot keeps [friction]",
+            DynidWarning,
+            stacklevel=3,
+        )
+    return friction

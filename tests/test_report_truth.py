@@ -1,0 +1,155 @@
+"""The HTML report of a run says what the run did: the options as given, each recording a
+folder stood for, the structure a consistent fit used, and a figure whose legend names only
+what it draws.
+
+References: the recordings themselves (their rows counted with the csv module), the
+command line, the identification record's structure, and the bars matplotlib drew.
+"""
+
+from __future__ import annotations
+
+import csv
+import json
+from types import SimpleNamespace
+
+import numpy as np
+import pytest
+from test_html_report import Page
+
+import dynid
+from dynid.cli.__main__ import main
+from dynid.report import RunSummary, render_html_report
+
+
+def _rows(path) -> int:
+    with open(path, newline="") as fh:
+        lines = [r for r in csv.reader(fh) if r and not r[0].startswith("#")]
+    return len(lines) - 1  # the header
+
+
+def _table(page: Page, *head: str) -> list[list[str]]:
+    return next(t for t in page.tables if t and t[0][: len(head)] == list(head))
+
+
+def test_a_data_folder_lists_each_recording_and_options_show_plain_paths(tmp_path):
+    logs = tmp_path / "logs"
+    logs.mkdir()
+    sim = ["simulate", "--trajectory", "sinusoid", "--duration", "1.5", "--rate", "200", "-q"]
+    for seed in (1, 2):
+        assert main([*sim, "--seed", str(seed), "--out", str(logs / f"r{seed}.csv")]) == 0
+    out = tmp_path / "run"
+    argv = ["identify", "--data", f"{logs}/", "--terms", "viscous,coulomb", "--no-figures"]
+    assert main([*argv, "--out", str(out), "-q"]) == 0
+    page = Page((out / "report.html").read_text())
+    inputs = _table(page, "option", "input file")
+    assert inputs[0][2:5] == ["rows in the file", "pieces", "samples used"]
+    listed = {r[1]: r for r in inputs[1:]}
+    recs = json.loads((out / "identification.json").read_text())["metadata"]["recordings"]
+    assert sorted(listed) == [str(logs / "r1.csv"), str(logs / "r2.csv")]
+    for rec in recs:
+        row = listed[str(logs / rec["file"])]
+        assert row[0] == "--data" and int(row[2]) == _rows(logs / rec["file"]) == 301
+        assert int(row[3]) == rec["pieces"] == 1 and int(row[4]) == rec["samples"]
+    options = dict(_table(page, "option", "value")[1:])
+    assert options["--data"] == str(logs) and "PosixPath" not in " ".join(page.text)
+    assert options["--out"] == str(out)
+
+
+def test_the_terms_and_the_consistent_fit_name_the_same_structure(tmp_path):
+    """The model holds (and the consistent fit uses) ``metadata.terms``; a record whose
+    selection named another structure says both, and the consistent part names the one
+    used and the law feasible.json holds."""
+    ident = {
+        "schema": "dynid-identified-model/1",
+        "route": "classical",
+        "coefficients": [],
+        "terms": [
+            {
+                "name": "friction",
+                "kind": "linear_friction",
+                "labels": ["fv1", "fc1"],
+                "values": [0.5, 0.8],
+                "std": [0.01, 0.01],
+                "definition": {"parts": ["viscous", "smooth"], "at": "joint"},
+            },
+        ],  # fmt: skip
+        "metadata": {
+            "terms": ["viscous", "coulomb", "-fc5"],
+            "selection": {
+                "rule": "lowest held-out error",
+                "chosen": "links + viscous + coulomb",
+                "candidates": [{"name": "links + viscous + coulomb", "terms": ["viscous"]}],
+                "heldout_per_recording": [{"file": "a.csv", "heldout_error_percent": 0.1}],
+            },
+        },
+    }
+    smooth = {"model": "smooth", "fv": [1.0], "fc": [1.0], "fo": [0.0]}
+    feas = {"links": [{"name": "l1", "mass": 1.0}], "feasible": True, "linear_friction": smooth}
+    (tmp_path / "identification.json").write_text(json.dumps(ident))
+    (tmp_path / "feasible.json").write_text(json.dumps(feas))
+    files = {p.name: p for p in tmp_path.iterdir()}
+    text = " ".join("".join(Page(render_html_report(RunSummary("identify"), files)).text).split())
+    used = "links + viscous + coulomb - fc5"
+    assert f"Terms used: {used}" in text
+    assert "chosen on held-out data was links + viscous + coulomb" in text
+    said = f"Structure of the consistent fit: {used}; friction identified with the links: "
+    assert said + "smooth law at the joints" in text
+    assert "Friction at the joints: viscous + smooth (value \u00b1 std)" in text
+    page = Page(render_html_report(RunSummary("identify"), files))
+    assert _table(page, "recording") == [["recording", "held-out error [%]"], ["a.csv", "0.1"]]
+    ident["metadata"]["selection"]["chosen"] = used
+    (tmp_path / "identification.json").write_text(json.dumps(ident))
+    text = " ".join("".join(Page(render_html_report(RunSummary("identify"), files)).text).split())
+    assert f"Terms chosen: {used}" in text and "Terms used" not in text
+
+
+@pytest.mark.parametrize("margins", [[0.01, -0.002, 0.003], [0.01, 0.002, 0.003]])
+def test_the_comparison_figure_draws_what_its_legend_says(margins):
+    """A link whose pseudo-inertia margin is not positive is a red bar a reader can see
+    (over the log axis' height), named in the legend and the title; without one, neither
+    speaks of red."""
+    pytest.importorskip("matplotlib")
+    import matplotlib
+
+    matplotlib.use("Agg")
+    from matplotlib.colors import to_rgb
+
+    from dynid.plots.feasible import plot_consistent
+
+    robot = dynid.panda()
+    res = [
+        SimpleNamespace(robot=robot, pseudo_inertia_margin=np.array(margins + [0.01] * 4)),
+        SimpleNamespace(robot=robot, pseudo_inertia_margin=np.full(7, 0.02)),
+    ]
+    fig = plot_consistent(res, labels=["penalty", "sdp"])
+    ax = fig.axes[1]
+    red = [p for p in ax.patches if np.allclose(to_rgb(p.get_facecolor()), to_rgb("tab:red"))]
+    legend = [t.get_text() for t in ax.get_legend().get_texts()]
+    bad = int(np.sum(np.array(margins) <= 0))
+    assert len(red) == bad
+    lo, hi = ax.get_ylim()
+    for p in red:  # visible: from the bottom of the axis to its top
+        assert p.get_y() <= lo * 1.01 and p.get_y() + p.get_height() >= hi * 0.99
+    named = any("not physically consistent" in t for t in legend)
+    assert named == bool(bad) and ("red" in ax.get_title()) == bool(bad)
+    import matplotlib.pyplot as plt
+
+    plt.close(fig)
+
+
+def test_the_headline_and_its_fact_give_the_same_ratio_to_the_noise_floor(tmp_path):
+    """The held-out error over the noise floor, 897355.81: one number in the headline and
+    in the fact behind it (897355.8 and 897355.81 before)."""
+    err, floor = 0.2123, 0.2123 / 897355.81
+    ident = {
+        "route": "classical",
+        "coefficients": [],
+        "metadata": {"heldout": {"training_error_percent": 0.05, "heldout_error_percent": 0.15}},
+    }
+    held = {"relative_error_percent": err, "noise_floor_percent": floor, "block": "b.csv"}
+    (tmp_path / "identification.json").write_text(json.dumps(ident))
+    (tmp_path / "heldout.json").write_text(json.dumps(held))
+    files = {p.name: p for p in tmp_path.iterdir()}
+    text = " ".join("".join(Page(render_html_report(RunSummary("identify"), files)).text).split())
+    said = f"{err / floor:.3g}"
+    assert f"{said} times the sensor-noise floor" in text and f"{said} x the floor" in text
