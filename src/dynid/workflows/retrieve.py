@@ -11,7 +11,7 @@ must be the robot's, a friction file on the robot must be sigmoid friction.
 from __future__ import annotations
 
 from collections.abc import Callable
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from pathlib import Path
 from typing import Any, Literal
 
@@ -23,6 +23,7 @@ from ..feasibility.methods import METHODS
 from ..feasibility.methods import method as consistent_method
 from ..feasibility.penalty import RetrievalOptions, RetrievalProgress
 from ..feasibility.result import FeasibleResult
+from ..friction.model import combined
 from ..identification.model import IdentifiedModel
 from ..io.bounds_file import load_bounds
 from ..io.friction_json import load_friction_json
@@ -37,6 +38,7 @@ __all__ = [
     "RetrieveOptions",
     "load_bounds_for",
     "load_model_with_friction",
+    "with_model_friction",
     "retrieve_files",
 ]
 
@@ -70,6 +72,17 @@ def _with_friction(robot: Robot, path: str | Path | None) -> Robot:
             field="friction",
         )
     return robot.with_friction(fr)
+
+
+def with_model_friction(result: FeasibleResult, model: IdentifiedModel) -> FeasibleResult:
+    """``result`` (links retrieved from ``model``'s coefficients) with the friction
+    identified with the links beside them, unchanged (the retrieval fits the links alone),
+    and the model's drive, so that its files predict the model's torques: a torque-log
+    identification's friction was left out of ``feasible.json`` and ``robot.toml``."""
+    fr = combined(model.frictions)
+    if result.friction is not None or fr is None:
+        return result
+    return replace(result, friction=fr, drive=result.drive or model.drive)
 
 
 def load_model_with_friction(
@@ -288,5 +301,7 @@ def retrieve_files(
         "progress": progress,
     }
     if kind == "model":
-        return Retrieval(m.from_coefficients(model, **common), tuple(notes))
+        return Retrieval(
+            with_model_friction(m.from_coefficients(model, **common), model), tuple(notes)
+        )
     return Retrieval(m.from_data(robot, data, **common), tuple(notes))
