@@ -17,6 +17,7 @@ import dynid
 from dynid.cli.__main__ import main
 from dynid.feasibility.bounds import default_bounds
 from dynid.feasibility.convex import identify_consistent
+from dynid.identification.structure import Structure
 from dynid.model.drive import Drive
 from dynid.simulation.measurement import SensorNoise, sample_times, simulate_measurement
 from dynid.simulation.trajectories import random_fourier
@@ -54,7 +55,10 @@ def test_consistent_fit_with_rotors_offsets_outliers_and_noise_is_judged_held_ou
     k = rng.choice(tau.shape[0], tau.shape[0] // 500, replace=False)  # 0.2 % spikes of 30 N m
     tau[k, rng.integers(0, 7, k.size)] += rng.choice([-1.0, 1.0], k.size) * 30.0
     log = dynid.TorqueLog(t=log.t, q=log.q, dq=log.dq, tau=tau)
-    res = identify_consistent(robot, log, prior=robot, drive=Drive.identity(7), estimator="irls")
+    given = Structure.parse("armature,viscous,coulomb,offset")  # classical friction, rotors
+    res = identify_consistent(
+        robot, log, prior=robot, drive=Drive.identity(7), estimator="irls", structure=given
+    )
     j = res.heldout
     assert j is not None and j.scheme == "blocks" and j.folds == 5
     assert j.heldout_percent <= (1 + j.tolerance) * j.ls_heldout_percent

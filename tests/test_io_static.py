@@ -122,14 +122,14 @@ def test_csv_nan_non_number_and_short_row_name_line_row_and_column(tmp_path, pan
         _write_csv(path, comments, header, bad)
         with pytest.raises(
             DataError,
-            match=rf"line {first_line + 4} \(row 4\) column 'g2':? {what}",
+            match=rf"static.csv, line {first_line + 4}: row 4 column 'g2':? {what}",
         ):
             load_static_csv(path, robot)
     bad = [list(r) for r in rows]
     bad[7] = bad[7][:-1]
     _write_csv(path, comments, header, bad)
     with pytest.raises(
-        DataError, match=rf"line {first_line + 7} \(row 7\) has 41 cells, the header 42"
+        DataError, match=rf"static.csv, line {first_line + 7}: row 7 has 41 cells, the header 42"
     ):
         load_static_csv(path, robot)
 

@@ -1,8 +1,9 @@
 """A long log prepared in blocks (issue 28 item 5): each block filtered over a window that
 reaches beyond it, so that the blocks together equal the whole-array steps.
 
-References: scipy's zero-phase Butterworth and numpy's gradient and interpolation on the
-whole arrays.
+References: scipy's zero-phase Butterworth (each end continued by numpy's cubic fitted to
+its last period of the cut-off, as :func:`dynid.signals.lowpass` does) and numpy's gradient
+and interpolation on the whole arrays.
 """
 
 from __future__ import annotations
@@ -33,24 +34,39 @@ def _log(seed: int, N: int, n: int = 3, *, jitter: bool = False) -> TorqueLog:
     return TorqueLog(t, q, dq + rng.normal(0, 1e-2, (N, n)), rng.normal(size=(N, n)))
 
 
+def _lowpass(x: np.ndarray, fs: float, cut: float) -> np.ndarray:
+    """scipy's forward-backward Butterworth of each column of ``x`` (N, n), continued at each
+    end over three periods of the cut-off by numpy's cubic fitted to one period."""
+    sos = scipy.signal.butter(4, cut, fs=fs, output="sos")
+    period = fs / cut
+    N = x.shape[0]
+    m, L = min(N, max(4, int(np.ceil(period)))), int(np.ceil(3 * period))
+    k = np.arange(m)
+    out = np.empty_like(x)
+    for j in range(x.shape[1]):
+        left = np.polyval(np.polyfit(k, x[:m, j], 3), np.arange(-L, 0))
+        right = np.polyval(np.polyfit(k, x[-m:, j], 3), m - 1 + np.arange(1, L + 1))
+        ext = np.concatenate([left, x[:, j], right])
+        y = scipy.signal.sosfiltfilt(sos, ext, padtype="odd", padlen=int(np.ceil(period)))
+        out[:, j] = y[L : L + N]
+    return out
+
+
 def _reference(
     log: TorqueLog, fs: float, cut: float, filter_tau: bool, k: int, jitter: bool
 ) -> dict:
     """The steps of prepare_log on the whole arrays: resample a jittered log (numpy's
-    interp on the grid t0 + i / fs), scipy's sosfiltfilt, numpy's gradient, trim 2 / cut,
-    every k-th."""
+    interp on the grid t0 + i / fs), scipy's sosfiltfilt (:func:`_lowpass`), numpy's
+    gradient, trim 2 / cut, every k-th."""
     m = int(np.floor((log.t[-1] - log.t[0]) * fs * (1 + 1e-12))) + 1
     t = log.t[0] + np.arange(m) / fs if jitter else log.t
     raw = {
         name: np.stack([np.interp(t, log.t, x[:, j]) for j in range(x.shape[1])], 1)
         for name, x in (("q", log.q), ("dq", log.dq), ("tau", log.tau))
     }
-    sos = scipy.signal.butter(4, cut, fs=fs, output="sos")
 
     def lp(x):
-        return scipy.signal.sosfiltfilt(
-            sos, x, axis=0, padtype="odd", padlen=int(np.ceil(fs / cut))
-        )
+        return _lowpass(x, fs, cut)
 
     dq = lp(raw["dq"])
     ref = {"t": t, "q": lp(raw["q"]), "dq": dq, "ddq": np.gradient(dq, t, axis=0, edge_order=2)}
@@ -86,10 +102,9 @@ def test_blocks_of_derived_velocities_equal_the_whole_log(monkeypatch):
     base = _log(2, 8_000)
     log = TorqueLog(base.t, base.q, np.zeros_like(base.q), base.tau, dq_derived=True)
     fs, cut = 1000.0, 25.0
-    sos = scipy.signal.butter(4, cut, fs=fs, output="sos")
 
     def lp(x):
-        return scipy.signal.sosfiltfilt(sos, x, axis=0, padtype="odd", padlen=int(fs / cut))
+        return _lowpass(x, fs, cut)
 
     dq = lp(np.gradient(lp(log.q), log.t, axis=0, edge_order=2))
     ddq = np.gradient(dq, log.t, axis=0, edge_order=2)

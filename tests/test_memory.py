@@ -13,7 +13,7 @@ import sys
 
 import numpy as np
 import pytest
-import scipy.signal
+from test_log_blocks import _lowpass as continued_lowpass
 
 import dynid
 from dynid.exceptions import ShapeError
@@ -37,15 +37,13 @@ def _log(seed: int, N: int, n: int = 3) -> TorqueLog:
 @pytest.mark.parametrize("filter_tau", [True, False])
 def test_decimated_preparation_equals_the_whole_array_steps(filter_tau):
     """prepare_log(decimate=k), which works column by column, equals the zero-phase
-    Butterworth of scipy on whole arrays, numpy's gradient of the filtered dq, trimmed
-    and every k-th sample taken."""
+    Butterworth of scipy on whole arrays (their ends continued by numpy's cubic), numpy's
+    gradient of the filtered dq, trimmed and every k-th sample taken."""
     log = _log(1, 12_000)
     fs, cut, k = 1000.0, 5.0, 20
-    sos = scipy.signal.butter(4, cut, fs=fs, output="sos")
-    pad = int(np.ceil(fs / cut))
 
-    def lp(x):
-        return scipy.signal.sosfiltfilt(sos, x, axis=0, padtype="odd", padlen=pad)
+    def lp(x):  # scipy's filter of the ends continued by numpy's cubic (test_log_blocks)
+        return continued_lowpass(x, fs, cut)
 
     dq = lp(log.dq)
     ref = {"q": lp(log.q), "dq": dq, "ddq": np.gradient(dq, log.t, axis=0, edge_order=2)}

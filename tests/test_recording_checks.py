@@ -27,8 +27,8 @@ from dynid.identification.recordings import (
     wrappable,
 )
 from dynid.model.drive import Drive
-from dynid.simulation.measurement import sample_times, simulate_measurement
-from dynid.simulation.trajectories import random_fourier
+from dynid.simulation.measurement import SensorNoise, sample_times, simulate_measurement
+from dynid.simulation.trajectories import Trajectory, random_fourier
 
 
 @pytest.fixture(scope="module")
@@ -111,15 +111,80 @@ def test_validation_with_an_identity_drive_unwraps_like_identification(panda, lo
 
 def test_a_motor_side_log_is_unwrapped_at_its_motors(panda, log):
     """A geared motor-side log wraps the motor angles: unwrapped before the drive maps
-    them to the joints (mapped first, the joint angles came out wrong by 2 pi / 50)."""
+    them to the joints (mapped first, the joint angles came out wrong by 2 pi / 50); the
+    whole turns each motor had at the start are lost, and the Panda's limits leave many
+    counts of them at a 50:1 gear: refused naming the file and the motors (the fit was
+    made with joint angles off by up to 20 turns' worth, with an "unwrapped" note)."""
     arm = _continuous(panda, [0, 6])
     drive = Drive.from_gears(np.full(7, 50.0), side="motor")
     qm = log.q * 50.0
     motor = TorqueLog(log.t, np.angle(np.exp(1j * qm)), log.dq * 50.0, log.tau / 50.0)
-    with pytest.warns(DynidWarning, match="recorded wrapped"):
-        p = prepare_pieces(arm, [motor], ["m.csv"], cutoff_hz=None, drive=drive)
-    back = p.logs[0].q
+    pieces, motors = recording_pieces("m.csv", motor, wrappable(arm, drive))  # no limits
+    assert motors == tuple(range(7))
+    back = pieces[0].q / 50.0
     np.testing.assert_allclose(back - back[0], log.q - log.q[0], atol=1e-9)
+    with pytest.raises(DataError, match=r"m\.csv: motor\(s\) 1, 2, .*7 recorded wrapped.*turns"):
+        prepare_pieces(arm, [motor], ["m.csv"], cutoff_hz=None, drive=drive)
+
+
+def _narrow_motor_log(jitter: float = 0.0, drop: tuple[int, ...] = ()):
+    """A Panda whose joints move within +-0.1 rad (sinusoids of 0.08 rad), read at
+    motors of 50:1 gears (encoder offsets 0.01 rad at the joints) wrapped into [-pi, pi]
+    as single-turn encoders give them; the joint-side truth and the drive."""
+    panda = dynid.panda()
+    arm = dataclasses.replace(
+        panda, q_min=np.full(7, -0.1), q_max=np.full(7, 0.1), q_neutral=np.zeros(7)
+    )
+    drive = Drive.from_gears(np.full(7, 50.0), side="motor", offset=np.full(7, 0.01))
+    t = np.arange(0.0, 4.0, 0.005)
+    t = t + jitter * np.random.default_rng(8).standard_normal(t.size)
+    t = np.delete(t, list(drop))
+    w = 2 * np.pi * np.linspace(0.4, 0.9, 7)
+    ph = np.linspace(0.3, 2.8, 7)  # several joints start more than pi / 50 from zero
+    s = np.sin(w * t[:, None] + ph)
+    c = np.cos(w * t[:, None] + ph)
+    traj = Trajectory(t, 0.08 * s, 0.08 * w * c, -0.08 * w**2 * s)
+    true = simulate_measurement(
+        arm, traj, rng=np.random.default_rng(0), noise=SensorNoise.none(), drive=drive
+    )
+    wrapped = TorqueLog(true.t, np.angle(np.exp(1j * true.q)), true.dq, true.tau)
+    return arm, drive, traj, true, wrapped
+
+
+def test_a_motor_sides_lost_turns_are_found_from_the_joint_limits():
+    """The joints' limits leave one count of turns per motor: the wrapped log comes back
+    to the joint positions exactly (absolute, not up to a constant), and identification
+    prepares the very samples of the log recorded with multi-turn encoders."""
+    arm, drive, traj, true, wrapped = _narrow_motor_log()
+    assert np.any(np.abs(true.q[0]) > np.pi)  # turns lost at the start
+    with pytest.warns(DynidWarning, match=r"w\.csv: motor\(s\) 1, 2, 3, 4, 5, 6, 7 recorded"):
+        pieces, _ = recording_pieces(
+            "w.csv", wrapped, wrappable(arm, drive), robot=arm, drive=drive
+        )
+    q = drive.joint_states(pieces[0].q)[0]
+    np.testing.assert_allclose(q, traj.q, atol=1e-9)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", DynidWarning)
+        a = prepare_recordings(arm, [wrapped], ["w.csv"], cutoff_hz=5.0, drive=drive)
+        b = prepare_recordings(arm, [true], ["t.csv"], cutoff_hz=5.0, drive=drive)
+    for x, y in zip(a.pieces, b.pieces, strict=True):
+        for k in ("q", "dq", "ddq", "tau"):
+            np.testing.assert_allclose(getattr(x.log, k), getattr(y.log, k), atol=1e-9)
+
+
+def test_jitter_and_dropped_samples_near_wraps_make_no_false_turn():
+    """Timestamps jittered by 0.2 ms and samples dropped right at motor wraps (a jump of
+    more than pi between two kept samples, which the recorded velocities explain): the
+    positions come back exactly, no turn added or lost."""
+    _, drive, _, true, _ = _narrow_motor_log()
+    wraps = np.flatnonzero(np.abs(np.diff(np.angle(np.exp(1j * true.q[:, 2])))) > np.pi)
+    drop = tuple(int(k) + d for k in wraps[:3] for d in (0, 1))  # both sides of 3 wraps
+    arm, drive, traj, true, wrapped = _narrow_motor_log(jitter=2e-4, drop=drop)
+    back, motors = unwrapped(wrapped, wrappable(arm, drive))
+    assert 2 in motors
+    np.testing.assert_allclose(back.q - back.q[0], true.q - true.q[0], atol=1e-9)
+    pieces, _ = recording_pieces("j.csv", wrapped, wrappable(arm, drive), robot=arm, drive=drive)
+    np.testing.assert_allclose(drive.joint_states(pieces[0].q)[0], traj.q, atol=1e-9)
 
 
 def test_a_wrap_inside_a_cut_out_stretch_keeps_the_other_wraps(panda, log):

@@ -21,11 +21,11 @@ import pytest
 import dynid
 from dynid.cli.__main__ import main
 from dynid.exceptions import DataError, DynidWarning
+from dynid.feasibility.convex import fit as convex_fit
 from dynid.identification.verdict import judge_prediction
 from dynid.io.torque_log import load_torque_log, save_torque_log
 from dynid.simulation.measurement import sample_times, simulate_measurement
 from dynid.simulation.trajectories import random_fourier
-from dynid.workflows import identify as identify_workflow
 from dynid.workflows.data_files import data_files
 from dynid.workflows.identify import IdentifyOptions, identify_files
 from dynid.workflows.observe import ObserveOptions, observe_files
@@ -57,11 +57,11 @@ def test_the_consistent_route_warns_each_finding_of_the_data_once(panda, tmp_pat
     save_torque_log(tmp_path / "neg.csv", type(log)(log.t, log.q, log.dq, -log.tau))
     kept = {}
 
-    def stop(robot, model, **kw):
+    def stop(robot, model, *args, **kw):
         kept["model"] = model
         raise _Stop
 
-    monkeypatch.setattr(identify_workflow, "consistent_from_identified", stop)
+    monkeypatch.setattr(convex_fit, "consistent_from_identified", stop)
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")
         with pytest.raises(_Stop):

@@ -106,9 +106,27 @@ def recordings_lines(recordings: Any) -> list[str]:
         return []
     return [
         f"recording {r['file']}: {r['pieces']} piece(s), {r['samples']} samples used "
-        f"({r['duration_s']:.4g} s)"
+        f"({r['duration_s']:.4g} s){_lost(r)}"
         for r in recs
     ]
+
+
+#: The causes a recording's samples are not used for, as a recording's record counts them
+_LOST = (
+    ("trimmed", "trimmed at the pieces' ends (the filter's edge transient)"),
+    ("decimated", "between the decimated samples"),
+    ("too_short", "in pieces too short to filter"),
+    ("isolated", "alone between gaps"),
+)
+
+
+def _lost(rec: Any) -> str:
+    """`` of 820 recorded: 274 trimmed at the pieces' ends (...), ...`` (empty when the
+    record does not count them)."""
+    if "recorded" not in rec:
+        return ""
+    parts = [f"{rec[k]} {why}" for k, why in _LOST if rec.get(k)]
+    return f" of {rec['recorded']} recorded" + (": " + ", ".join(parts) if parts else "")
 
 
 def selection_lines(selection: Any) -> list[str]:

@@ -252,7 +252,7 @@ def _raw_pieces(
             )
         # unwrapped where recorded (motor angles on a motor-side log), as identification
         turns = wrappable(robot, d) if robot is not None else np.zeros(log.n, bool)
-        mine, joints = recording_pieces(name, log, turns, max_gap_s)
+        mine, joints = recording_pieces(name, log, turns, max_gap_s, robot=robot, drive=d)
         turned.update(joints)
         raw += [(r, joint_side_log(p, d)) for p in mine]
     cut = (

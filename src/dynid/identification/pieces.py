@@ -4,7 +4,9 @@
 * :func:`wrappable`: the recorded position columns that can hold a wrap into
   ``[-pi, pi]`` (joints whose limits span a turn; a motor-side log's motors);
 * :func:`unwrapped`: the wraps of a piece taken out;
-* :func:`recording_pieces`: all three for one recording, its time column checked first
+* :func:`start_turns`: the whole turns a motor recorded wrapped had at a piece's start,
+  from the joints' limits (refused when they leave several);
+* :func:`recording_pieces`: all four for one recording, its time column checked first
   (:func:`~dynid.identification.sanity.time_unit_finding`);
 * :func:`joined`: the pieces of one recording as one log for its checks;
 * :func:`skipped_piece`: the line (and warning) of a piece left out.
@@ -32,6 +34,7 @@ __all__ = [
     "recording_pieces",
     "skipped_piece",
     "split_at_gaps",
+    "start_turns",
     "unwrapped",
     "wrappable",
 ]
@@ -98,10 +101,11 @@ def unwrapped(log: TorqueLog, revolute: NDArray[np.bool_]) -> tuple[TorqueLog, t
     somewhere by more than half a turn, and every such jump is nearly a whole turn more
     than its recorded velocity explains (``dq dt``, the mean of the two samples'; the raw step for
     velocities derived from the positions) while the rest of the jump is as small as its
-    other unexplained steps: a fast motor turning more than half a turn between two samples
-    is motion, not a wrap, and smooth positions whose velocities disagree with them (a
-    time column in ms) are not wrapped. Returns the log with those turns taken out and the
-    columns unwrapped (0-based; the log itself when none).
+    other unexplained steps (scaled by the cube of the step's length, the trapezoid's
+    error: a sample dropped at a wrap): a fast motor turning more than half a turn
+    between two samples is motion, not a wrap, and smooth positions whose velocities
+    disagree with them (a time column in ms) are not wrapped. Returns the log with those
+    turns taken out and the columns unwrapped (0-based; the log itself when none).
     """
     h = np.diff(log.t)
     found: dict[int, NDArray[np.float64]] = {}
@@ -115,8 +119,12 @@ def unwrapped(log: TorqueLog, revolute: NDArray[np.bool_]) -> tuple[TorqueLog, t
         moved = turns != 0
         if not np.any(moved & (np.abs(raw) > np.pi)):
             continue
-        typical = float(np.max(np.abs(d[~moved]), initial=0.0))
-        if np.all(np.abs(d[moved] - 2 * np.pi * turns[moved]) <= max(2 * typical, 1e-9)):
+        # the velocities' trapezoid misses a step by about h^3 (a sample dropped at a wrap
+        # makes its step 2-3 times as long): each step's allowance grows so
+        long = np.maximum(1.0, h / float(np.median(h))) ** 3
+        typical = float(np.max(np.abs(d[~moved]) / long[~moved], initial=0.0))
+        allowed = np.maximum(2 * typical * long[moved], 1e-9)
+        if np.all(np.abs(d[moved] - 2 * np.pi * turns[moved]) <= allowed):
             found[j] = turns
     if not found:
         return log, ()
@@ -135,6 +143,8 @@ def recording_pieces(
     max_gap_s: float | None = None,
     *,
     stacklevel: int = 3,
+    robot: Robot | None = None,
+    drive: Drive | None = None,
 ) -> tuple[list[TorqueLog], tuple[int, ...]]:
     """One recording checked, cut at its gaps and unwrapped piece by piece.
 
@@ -142,8 +152,11 @@ def recording_pieces(
     (:func:`~dynid.identification.sanity.time_unit_finding`); the log is cut at its gaps
     longer than ``max_gap_s`` (:func:`split_at_gaps`) and each piece's columns ``turns``
     (:func:`wrappable`) are unwrapped on their own (:func:`unwrapped`): a jump across a
-    cut-out stretch is no wrap and does not keep the other wraps in. A warning names the
-    file and the joints unwrapped.
+    cut-out stretch is no wrap and does not keep the other wraps in. On a motor-side log
+    (``drive``), the motors found wrapped lost their whole turns at each piece's start,
+    which set the joint positions (``2 pi / K`` each): they are found from the joints'
+    limits (:func:`start_turns`, ``robot``). A warning names the file and the joints
+    (motors) unwrapped.
 
     Returns
     -------
@@ -154,7 +167,9 @@ def recording_pieces(
     Raises
     ------
     DataError
-        The time column looks like ms, us or ns (the file and the factor are named).
+        The time column looks like ms, us or ns (the file and the factor are named); a
+        motor-side log's motors recorded wrapped whose turns the joints' limits do not
+        tell (:func:`start_turns`).
     OptionError
         ``max_gap_s`` below the sample step.
     """
@@ -166,6 +181,10 @@ def recording_pieces(
         piece, joints = unwrapped(piece, turns)
         turned.update(joints)
         pieces.append(piece)
+    motors = drive is not None and drive.side == "motor"
+    if turned and motors and robot is not None:
+        assert drive is not None
+        pieces = [start_turns(name, p, sorted(turned), robot, drive) for p in pieces]
     if (alone := log.n_samples - sum(p.n_samples for p in pieces)) > 0:
         warnings.warn(
             f"{name}: {alone} sample(s) isolated between gaps longer than the longest gap "
@@ -175,13 +194,77 @@ def recording_pieces(
         )
     joints = tuple(sorted(turned))
     if joints:
+        what = "motor(s)" if motors else "joint(s)"
         warnings.warn(
-            f"{name}: joint(s) {', '.join(str(j + 1) for j in joints)} recorded wrapped "
+            f"{name}: {what} {', '.join(str(j + 1) for j in joints)} recorded wrapped "
             "into [-pi, pi] (jumps of a whole turn): unwrapped",
             DynidWarning,
             stacklevel=stacklevel,
         )
     return pieces, joints
+
+
+def start_turns(
+    name: str, piece: TorqueLog, motors: list[int], robot: Robot, drive: Drive
+) -> TorqueLog:
+    """The motor-side ``piece`` with its ``motors`` (0-based, recorded wrapped and
+    unwrapped, :func:`unwrapped`) given the whole turns they had at its start.
+
+    A wrapped motor angle keeps no count of whole turns: unwrapped, it starts within
+    ``[-pi, pi]``, and each turn it lost moves the joints by ``2 pi K^-1 e_j`` (a gear of
+    100 turns 0.063 rad at the joint). The turns ``n`` are those that put every sample's
+    joint positions ``q = K^-1 (q_m + 2 pi n) + q_0`` within the joints' limits: a joint
+    that one motor turns (beside motors already counted) bounds that motor's turns, motor
+    after motor; found when each motor is left one count (the joint's limits spanning
+    less than its motion plus one turn of the motor), then checked on every joint.
+
+    Raises
+    ------
+    DataError
+        The limits leave several counts (or none) for some motor: the joint positions are
+        unknown by whole turns of the motors (the file, the motors and the counts named).
+    """
+    q = drive.joint_states(np.asarray(piece.q, dtype=np.float64))[0]
+    lo = np.asarray(robot.q_min, dtype=np.float64) - q.min(axis=0)
+    hi = np.asarray(robot.q_max, dtype=np.float64) - q.max(axis=0)
+    A = 2 * np.pi * np.linalg.inv(np.asarray(drive.transmission, dtype=np.float64))[:, motors]
+    acts = np.abs(A) > 1e-12 * np.abs(A).max()
+    n = np.zeros(len(motors))
+    counts = np.full(len(motors), np.inf)  # the counts the limits leave; inf: unbounded
+    done = np.zeros(len(motors), dtype=bool)
+    while not done.all():
+        progress = False
+        for k in np.flatnonzero(~done):
+            others = acts & ~done & (np.arange(len(motors)) != k)
+            rows = np.flatnonzero(acts[:, k] & ~others.any(axis=1))
+            if rows.size == 0:
+                continue
+            rest = A[rows][:, done] @ n[done]  # the motors already counted
+            ends = np.sort(np.stack([lo[rows] - rest, hi[rows] - rest]) / A[rows, k], axis=0)
+            a, b = float(np.max(ends[0])), float(np.min(ends[1]))
+            first = np.ceil(a - 1e-9) if np.isfinite(a) else 0.0
+            counts[k] = np.floor(b + 1e-9) - first + 1 if np.isfinite(a + b) else np.inf
+            n[k], done[k], progress = first, True, True
+        if not progress:
+            break
+    shift = A @ n
+    if np.any(counts != 1) or np.any(shift < lo - 1e-9) or np.any(shift > hi + 1e-9):
+        told = [
+            f"{m + 1}: {'unbounded' if not np.isfinite(c) else int(max(c, 0))}"
+            for m, c in zip(motors, counts, strict=True)
+            if c != 1
+        ]
+        raise DataError(
+            f"motor(s) {', '.join(str(m + 1) for m in motors)} recorded wrapped into "
+            "[-pi, pi] lost the whole turns that set the joint positions, and the joints' "
+            f"limits leave several counts of them at t = {piece.t[0]:.6g} s (motor "
+            f"{'; motor '.join(told) or 'none fits every joint'}); hint: log the motors' "
+            "multi-turn angles, or the joint positions (a joint-side log)",
+            file=name,
+        )
+    qm = np.array(piece.q)
+    qm[:, motors] += 2 * np.pi * n
+    return TorqueLog(piece.t, qm, piece.dq, piece.tau, piece.ddq, piece.cleaning, piece.dq_derived)
 
 
 #: The checks of a recording cut into pieces read at most about this many of its samples.

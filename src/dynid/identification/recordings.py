@@ -20,8 +20,11 @@ Here:
    :func:`~dynid.identification.rate.cutoff_from_motion`, each weighted by its samples,
    each read from its pieces on its own time axis (:func:`common_cutoff`);
 4. each piece is read through the drive, filtered, differentiated and decimated on its own
-   (:func:`~dynid.identification.classical.prepare_torque_log`); a piece too short for
-   the filter is left out with a warning naming its file and times, never silently;
+   (:func:`~dynid.identification.classical.prepare_torque_log`), the filter's edges
+   trimmed at both of its ends (:func:`~dynid.signals.edge_seconds`, half a period of the
+   cut-off); a piece too short for the filter is left out with a warning naming its file
+   and times, never silently; each recording's samples not used are counted by cause
+   (:class:`SampleCounts`);
 5. the pieces' regressor rows are stacked (:class:`Recordings`, a
    :class:`~dynid.identification.core.Dataset`); held-out judgement leaves one recording
    out at a time when there are several (:meth:`Recordings.fold_labels`), contiguous time
@@ -40,6 +43,7 @@ from typing import Any, Literal
 import numpy as np
 from numpy.typing import NDArray
 
+from .. import signals
 from ..exceptions import DataError, DynidWarning, ShapeError
 from ..model.drive import Drive
 from ..model.robot import Robot
@@ -65,6 +69,7 @@ from .streaming import streams
 __all__ = [
     "WRAP_SPAN",
     "Recordings",
+    "SampleCounts",
     "common_cutoff",
     "prepare_recordings",
     "recording_pieces",
@@ -73,6 +78,49 @@ __all__ = [
     "unwrapped",
     "wrappable",
 ]
+
+
+@dataclass(frozen=True, slots=True)
+class SampleCounts:
+    """Where one recording's samples went.
+
+    Attributes
+    ----------
+    recorded : int
+        Samples as read.
+    isolated : int
+        Samples alone between two gaps longer than the longest gap bridged (no piece).
+    too_short : int
+        Samples of pieces too short to filter, left out.
+    trimmed : int
+        Samples within the filter's edge transient at the pieces' ends, trimmed
+        (:func:`~dynid.signals.edge_seconds`).
+    decimated : int
+        Samples between the decimated samples kept.
+    used : int
+        Samples used: ``recorded`` less the others.
+    """
+
+    recorded: int
+    isolated: int = 0
+    too_short: int = 0
+    trimmed: int = 0
+    decimated: int = 0
+
+    @property
+    def used(self) -> int:
+        """Samples used."""
+        return self.recorded - self.isolated - self.too_short - self.trimmed - self.decimated
+
+    def as_dict(self) -> dict[str, int]:
+        """``recorded``, ``isolated``, ``too_short``, ``trimmed``, ``decimated``."""
+        return {
+            "recorded": self.recorded,
+            "isolated": self.isolated,
+            "too_short": self.too_short,
+            "trimmed": self.trimmed,
+            "decimated": self.decimated,
+        }
 
 
 @dataclass(frozen=True, slots=True, eq=False)
@@ -112,6 +160,8 @@ class Recordings:
         (:func:`~dynid.signals.lowpass_noise_gain` at the cut-off; 1 without one): a
         Coulomb sign is switched off within ``band_gain * band`` of the velocities as
         prepared, the noise they still hold; a smooth Coulomb's width counts in ``band``.
+    counts : tuple of SampleCounts
+        Per recording, where its samples went (empty: not counted).
     """
 
     pieces: tuple[PreparedLog, ...]
@@ -125,6 +175,7 @@ class Recordings:
     cuts: tuple[int, ...] = ()
     n_recorded: int = 0
     band_gain: float = 1.0
+    counts: tuple[SampleCounts, ...] = ()
 
     @property
     def route(self) -> Literal["classical"]:
@@ -233,18 +284,20 @@ class Recordings:
         return labels, f"{folds} contiguous time blocks"
 
     def summary(self) -> tuple[dict[str, Any], ...]:
-        """Per recording: ``file``, ``pieces``, ``samples`` used and ``duration_s`` used."""
+        """Per recording: ``file``, ``pieces``, ``samples`` used and ``duration_s`` used,
+        and where the others went (:meth:`SampleCounts.as_dict`) when counted."""
         out = []
         for r, name in enumerate(self.names):
             mine = [p for p, k in zip(self.pieces, self.recording, strict=True) if k == r]
-            out.append(
-                {
-                    "file": name,
-                    "pieces": len(mine),
-                    "samples": sum(p.log.n_samples for p in mine),
-                    "duration_s": float(sum(p.log.duration for p in mine)),
-                }
-            )
+            rec: dict[str, Any] = {
+                "file": name,
+                "pieces": len(mine),
+                "samples": sum(p.log.n_samples for p in mine),
+                "duration_s": float(sum(p.log.duration for p in mine)),
+            }
+            if self.counts:
+                rec.update(self.counts[r].as_dict())
+            out.append(rec)
         return tuple(out)
 
     def record(self, n_rows: int) -> IdentificationInfo:
@@ -274,8 +327,9 @@ class Recordings:
         )
         notes = tuple(self.skipped)
         if self.unwrapped:
+            motors = self.drive is not None and self.drive.side == "motor"
             notes += (
-                "joint(s) "
+                ("motor(s) " if motors else "joint(s) ")
                 + ", ".join(str(j + 1) for j in self.unwrapped)
                 + " recorded wrapped into [-pi, pi]: unwrapped",
             )
@@ -357,7 +411,7 @@ def prepare_recordings(
             )
         if (spikes := spike_finding(name, log, robot.joint_names)) is not None:
             warnings.warn(spikes, DynidWarning, stacklevel=2)
-        mine, joints = recording_pieces(name, log, turns, max_gap_s)
+        mine, joints = recording_pieces(name, log, turns, max_gap_s, robot=robot, drive=drive)
         turned.update(joints)
         cuts.append(max(0, len(mine) - 1))
         if mine:  # sign, units, frozen joints: on the whole recording, said once
@@ -368,34 +422,17 @@ def prepare_recordings(
                 warnings.warn(shown, DynidWarning, stacklevel=2)
         pieces += [(r, p) for p in mine]
     cutoff: float | None = None if cutoff_hz == "auto" else cutoff_hz
+    # joint-side pieces of a motor-side log differ by turns of the motors, not joints
+    jturns = None if drive is not None and drive.side == "motor" else turns
     if cutoff_hz == "auto":
-        # joint-side pieces of a motor-side log differ by turns of the motors, not joints
-        jturns = None if drive is not None and drive.side == "motor" else turns
         cutoff = common_cutoff(
             [joint_side_log(p, drive) for _, p in pieces], [r for r, _ in pieces], jturns
         )
         if cutoff is None:
             raise DataError("no piece is long enough to read the motion's frequency from")
-    prepared, recording, skipped = [], [], []
-    said: set[tuple[int, str]] = set()
-    for r, piece in pieces:
-        try:
-            with _named_findings(names[r] if len(names) > 1 else None, r, said):
-                p = prepare_torque_log(
-                    robot,
-                    piece,
-                    cutoff_hz=cutoff,
-                    trim_s=trim_s,
-                    max_gap_s=max_gap_s,
-                    decimate=decimate,
-                    drive=drive,
-                    check=False,
-                )
-        except DataError as exc:
-            skipped.append(skipped_piece(names[r], piece, exc))
-            continue
-        prepared.append(p)
-        recording.append(r)
+    edge = trim_s if trim_s is not None else _edge(pieces, cutoff, cutoff_hz, drive, jturns)
+    kw = dict(cutoff_hz=cutoff, trim_s=edge, max_gap_s=max_gap_s, decimate=decimate)
+    prepared, recording, skipped, gone = _prepared(robot, pieces, names, drive, **kw)
     if not prepared:
         raise DataError(
             f"no piece of {', '.join(names)} is long enough to filter{_at(cutoff)}; "
@@ -420,7 +457,86 @@ def prepare_recordings(
         max_gap_s=None if max_gap_s is None else float(max_gap_s),
         cuts=tuple(cuts),
         n_recorded=sum(log.n_samples for log in logs),
+        counts=tuple(
+            SampleCounts(
+                recorded=log.n_samples,
+                isolated=log.n_samples - sum(p.n_samples for k, p in pieces if k == r),
+                **gone[r],
+            )
+            for r, log in enumerate(logs)
+        ),
     )
+
+
+def _prepared(
+    robot: Robot,
+    pieces: list[tuple[int, TorqueLog]],
+    names: tuple[str, ...],
+    drive: Drive | None,
+    **kw: Any,
+) -> tuple[list[PreparedLog], list[int], list[str], dict[int, dict[str, int]]]:
+    """Each piece prepared (:func:`~dynid.identification.classical.prepare_torque_log`
+    with ``kw``), a piece too short to filter left out with a warning; per recording, the
+    samples left out, trimmed and decimated away."""
+    prepared, recording, skipped = [], [], []
+    gone = {r: dict.fromkeys(("too_short", "trimmed", "decimated"), 0) for r in range(len(names))}
+    said: set[tuple[int, str]] = set()
+    for r, piece in pieces:
+        try:
+            with _named_findings(names[r] if len(names) > 1 else None, r, said):
+                p = prepare_torque_log(robot, piece, drive=drive, check=False, **kw)
+        except DataError as exc:
+            skipped.append(skipped_piece(names[r], piece, exc, stacklevel=4))
+            gone[r]["too_short"] += piece.n_samples
+            continue
+        prepared.append(p)
+        recording.append(r)
+        kept = _within_edges(piece.t, kw["trim_s"] or 0.0)
+        gone[r]["trimmed"] += piece.n_samples - kept
+        gone[r]["decimated"] += kept - p.log.n_samples
+    return prepared, recording, skipped, gone
+
+
+def _edge(
+    pieces: list[tuple[int, TorqueLog]],
+    cutoff: float | None,
+    cutoff_hz: float | Literal["auto"] | None,
+    drive: Drive | None,
+    jturns: NDArray[np.bool_] | None,
+) -> float | None:
+    """The seconds trimmed at each end of every piece filtered at ``cutoff`` [Hz]
+    (:func:`~dynid.signals.edge_seconds`): half a period when the motion lies a decade
+    below the cut-off (read from it, or read here for a cut-off given); two periods for
+    velocities derived from positions, filtered twice; None without filtering."""
+    if cutoff is None:
+        return None
+    if any(p.dq_derived for _, p in pieces):
+        return signals.edge_seconds(cutoff)
+    motion = cutoff / CUTOFF_MULTIPLE if cutoff_hz == "auto" else _motion_hz(pieces, drive, jturns)
+    return signals.edge_seconds(cutoff, motion)
+
+
+def _motion_hz(
+    pieces: list[tuple[int, TorqueLog]], drive: Drive | None, jturns: NDArray[np.bool_] | None
+) -> float | None:
+    """The motion's highest significant frequency [Hz] of the recordings' pieces (as a
+    cut-off read from the motion reads it, :func:`common_cutoff`), None when no piece
+    tells it."""
+    try:
+        found = common_cutoff(
+            [joint_side_log(p, drive) for _, p in pieces], [r for r, _ in pieces], jturns
+        )
+    except DataError:
+        return None
+    return None if found is None else found / CUTOFF_MULTIPLE
+
+
+def _within_edges(t: NDArray[np.float64], trim_s: float) -> int:
+    """Samples of ``t`` more than ``trim_s`` [s] from both of its ends (as
+    :func:`~dynid.signals.trim_edges` keeps them)."""
+    lo = np.searchsorted(t, t[0] + trim_s, side="left")
+    hi = np.searchsorted(t, t[-1] - trim_s, side="right")
+    return int(max(0, hi - lo))
 
 
 def common_cutoff(

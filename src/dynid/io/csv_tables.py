@@ -92,7 +92,7 @@ def csv_table(
             names = [c.strip() for c in s.split(",")]
             break
         if names is None:
-            raise DataError(f"no header line ({expected}) found", file=path.name)
+            raise DataError(f"no header line found; expected columns {expected}", file=path.name)
         layout = layout_of(names, lineno)
         first = lineno + 1
         start = fb.tell()

@@ -207,7 +207,9 @@ def load_static_csv(
         else:
             rows.append((lineno, cells))
     if header is None:
-        raise DataError(f"no header line; expected columns {_expected_hint(robot)}", file=path.name)
+        raise DataError(
+            f"no header line found; expected columns {_expected_hint(robot)}", file=path.name
+        )
     check_row_count(path, n_recorded, len(rows))
     n = _check_columns(path, header, header_line, robot)
     cols = static_columns(n)
@@ -236,9 +238,10 @@ def load_static_csv(
             msg = f"line {lineno} (row {len(good) + len(bad)}) {reason}"
             if not drop_invalid:
                 raise DataError(
-                    f"{msg}; hint: fix the file or pass --drop-invalid "
-                    "(drop_invalid=True) to drop such rows",
+                    f"row {len(good) + len(bad)} {reason}; hint: fix the file or pass "
+                    "--drop-invalid (drop_invalid=True) to drop such rows",
                     file=path.name,
+                    at=f"line {lineno}",
                 )
             bad.append(msg)
             continue
@@ -252,13 +255,14 @@ def _check_columns(path: Path, header: list[str], line: int, robot: Robot | None
     """Validate the header; return the joint count."""
     dup = sorted({c for c in header if header.count(c) > 1})
     if dup:
-        raise DataError(f"line {line}: duplicated columns {dup}", file=path.name)
+        raise DataError(f"duplicated columns {dup}", file=path.name, at=f"line {line}")
     qcols = [c for c in header if re.fullmatch(r"q[1-9]\d*", c)]
     if not qcols:
         raise DataError(
-            f"line {line}: no joint position columns q1..qn; got columns "
+            f"no joint position columns q1..qn; got columns "
             f"{header[:8]}{' ...' if len(header) > 8 else ''}",
             file=path.name,
+            at=f"line {line}",
         )
     n_file = max(int(c[1:]) for c in qcols)
     n = robot.n if robot is not None else n_file
@@ -273,15 +277,15 @@ def _check_columns(path: Path, header: list[str], line: int, robot: Robot | None
     extra = [c for c in header if c not in expected]
     if missing:
         raise DataError(
-            f"line {line}: missing columns {missing}; expected q1..q{n}, "
-            f"M<i>_<j> (i >= j) and g1..g{n}",
+            f"missing columns {missing}; expected q1..q{n}, M<i>_<j> (i >= j) and g1..g{n}",
             file=path.name,
+            at=f"line {line}",
         )
     if extra:
         raise DataError(
-            f"line {line}: unexpected columns {extra}; expected q1..q{n}, "
-            f"M<i>_<j> (i >= j) and g1..g{n} only",
+            f"unexpected columns {extra}; expected q1..q{n}, M<i>_<j> (i >= j) and g1..g{n} only",
             file=path.name,
+            at=f"line {line}",
         )
     return n
 
@@ -290,9 +294,11 @@ def _parse_rows(path: Path, lineno: int, text: str) -> int:
     try:
         n = _checks.integer(text)
     except ValueError:
-        raise DataError(f"line {lineno}: '# rows:' must give an integer", file=path.name) from None
+        raise DataError(
+            "'# rows:' must give an integer", file=path.name, at=f"line {lineno}"
+        ) from None
     if n < 0:
-        raise DataError(f"line {lineno}: '# rows:' must be >= 0; got {n}", file=path.name)
+        raise DataError(f"'# rows:' must be >= 0; got {n}", file=path.name, at=f"line {lineno}")
     return n
 
 
@@ -311,9 +317,9 @@ def _parse_meta(path: Path, where: str, text: str) -> dict[str, Any]:
     try:
         meta = loads(text)
     except ValueError as exc:
-        raise DataError(f"{where}: metadata is not strict JSON ({exc})", file=path.name) from exc
+        raise DataError(f"metadata is not strict JSON ({exc})", file=path.name, at=where) from exc
     if not isinstance(meta, dict):
-        raise DataError(f"{where}: metadata must be a JSON object", file=path.name)
+        raise DataError("metadata must be a JSON object", file=path.name, at=where)
     return meta
 
 

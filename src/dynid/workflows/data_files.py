@@ -17,6 +17,7 @@ from __future__ import annotations
 import contextlib
 import hashlib
 import logging
+import re
 import zipfile
 from collections.abc import Callable, Mapping, Sequence
 from pathlib import Path
@@ -61,6 +62,9 @@ DataKind = Literal["static", "torque_log"]
 ColumnSpec = tuple[str | None, str | None]
 
 _T = TypeVar("_T")
+
+#: A column only static data hold: ``M<i>_<j>`` or ``g<i>``.
+_STATIC_COLUMN = re.compile(r"M[1-9]\d*_[1-9]\d*|g[1-9]\d*")
 
 
 def in_file(path: Path, fit: Callable[[], _T]) -> _T:
@@ -112,15 +116,18 @@ def column_map(
 def data_kind(path: str | Path, columns: ColumnMap | None = None) -> DataKind:
     """``"static"`` or ``"torque_log"``.
 
-    A CSV with a ``t`` column or an NPZ with ``t``/``tau`` is a torque log; with a column
-    map, mapping ``t``, ``dq``, ``ddq`` or ``tau`` makes a torque log and mapping ``M`` or
-    ``g`` static data.
+    A CSV whose header names static data's columns (``M<i>_<j>`` or ``g<i>``) and no
+    ``t`` is static data, any other CSV (one without a header line or whose header names
+    neither kind included) a torque log, whose reader names what is wrong in the words it
+    uses whatever the other files given; an NPZ with ``t``/``tau`` is a torque log; with a
+    column map, mapping ``t``, ``dq``, ``ddq`` or ``tau`` makes a torque log and mapping
+    ``M`` or ``g`` static data.
 
     Raises
     ------
     DataError
-        Neither ``.csv`` nor ``.npz``, a CSV without a header line, an unreadable NPZ, not
-        a regular file (a device, a pipe).
+        Neither ``.csv`` nor ``.npz``, an unreadable NPZ, not a regular file (a device, a
+        pipe).
     OSError
         Missing, unreadable, a folder.
     """
@@ -138,8 +145,9 @@ def data_kind(path: str | Path, columns: ColumnMap | None = None) -> DataKind:
                 s = line.strip()
                 if s and not s.startswith("#"):
                     cols = [c.strip() for c in s.split(",")]
-                    return "torque_log" if "t" in cols else "static"
-        raise DataError("no header line", file=path.name)
+                    static = any(_STATIC_COLUMN.fullmatch(c) for c in cols)
+                    return "static" if static and "t" not in cols else "torque_log"
+        return "torque_log"  # no header line: its reader says so
     if suffix == ".npz":
         try:
             with np.load(path, allow_pickle=False) as z:

@@ -30,7 +30,6 @@ from ..feasibility.convex import (
     DEFAULT_SDP_MARGIN,
     ConsistentResult,
     SDPOptions,
-    consistent_from_identified,
     identify_consistent,
 )
 from ..identification.consistency import fit_mismatch, limit_violations
@@ -370,22 +369,6 @@ def _read_logs(robot: Robot, paths: list[Path], cmap: Any, drop_invalid: bool) -
     return logs
 
 
-def _consistent_structure_fit(
-    robot: Robot,
-    logs: list[Any],
-    names: list[str],
-    terms: Structure | Literal["auto"],
-    **kw: Any,
-) -> IdentifiedModel:
-    """The unconstrained fit of the one-step consistent route: the structure chosen on
-    held-out data (or given by ``terms``, its leave-outs honoured) as the plain route
-    chooses it, the choice recorded. Its terms are the consistent fit's as they are: the
-    friction law with its fixed shape parameters, the per-joint leave-outs and the
-    armature mask; each term says which coefficients a physical model keeps ``>= 0``
-    (:attr:`~dynid.regressors.terms.ModelTerm.nonnegative`)."""
-    return identify_recordings(robot, logs, names, structure=terms, **kw)
-
-
 def _one_static_file(paths: list[Path], opt: IdentifyOptions) -> None:
     """Static data come in one file, and have no terms to choose, no filter and no gaps."""
     if len(paths) > 1:
@@ -412,10 +395,10 @@ def _identify_consistent(
 
     Torque logs (one or more, ``max_gap_s`` honoured): the model's structure is chosen on
     held-out data as the unconstrained fit chooses it (or given by ``terms``), and the
-    convex problem keeps each of its terms physical as the term declares
-    (:func:`_consistent_structure_fit`); ``folds``/``validate_on`` choose the held-out
-    judgement of the prior weight and of the fit. ``identified`` of the result holds the
-    unconstrained fit.
+    convex problem keeps each of its terms physical as the term declares (the Python
+    API's call, so that both give the same parameters); ``folds``/``validate_on`` choose
+    the held-out judgement of the prior weight and of the fit. ``identified`` of the
+    result holds the unconstrained fit.
     """
     path = paths[0]
     cmap = _columns(opt.columns, opt.cutoff_hz)
@@ -426,19 +409,19 @@ def _identify_consistent(
         logs = _read_logs(robot, paths, cmap, opt.drop_invalid)
 
         def fit() -> ConsistentResult:
-            model = _consistent_structure_fit(
+            return identify_consistent(
                 robot,
                 logs,
-                [p.name for p in paths],
-                _terms(opt.terms),
+                names=[p.name for p in paths],
+                structure=_terms(opt.terms),
                 rtol=opt.rtol,
                 drive=opt.drive,
                 estimator=opt.estimator,
                 cutoff_hz="auto" if opt.cutoff_hz is None else opt.cutoff_hz,
                 max_gap_s=opt.max_gap_s,
                 **heldout,
+                **common,
             )
-            return consistent_from_identified(robot, model, kind="log", **common)
 
         result = in_file(path, fit) if len(paths) == 1 else fit()
     else:

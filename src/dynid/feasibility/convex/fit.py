@@ -10,12 +10,13 @@ ordinary least squares,
 .. math:: \\|W x - y\\|^2 = \\|W \\hat x - y\\|^2 + (x - \\hat x)^T W^T W (x - \\hat x),
 
 so the classical covariance ``sigma^2 (W^T W)^{-1}`` of the unconstrained fit ``x_hat`` gives
-the data term exactly (up to the constant ``RSS / sigma^2``). Torque logs go through the
-classical route (:func:`~dynid.identification.classical.identify_from_log`: filtering,
-decimation, base regressor plus viscous, Coulomb and offset friction per joint); a model of
-another structure (:func:`consistent_from_identified`: the one chosen on held-out data) keeps
-its terms as they are, each physical as it declares (``nonnegative`` and
-``dissipation_rows`` of :mod:`dynid.regressors.terms`); static data through
+the data term exactly (up to the constant ``RSS / sigma^2``). Torque logs (one or several
+recordings) go through the route of ``dynid identify``
+(:func:`~dynid.identification.selection.identify_recordings`: each recording and each piece
+between its gaps filtered, differentiated and decimated on its own, the model's structure
+chosen on held-out data or given); the model keeps its terms as they are, each physical as
+it declares (``nonnegative`` and ``dissipation_rows`` of :mod:`dynid.regressors.terms`,
+:func:`consistent_from_identified`); static data through
 :func:`~dynid.identification.static.identify_static` (``[tril M; g]``). The unconstrained
 fit is returned with the result (``result.identified``) for comparison.
 """
@@ -31,13 +32,14 @@ import numpy as np
 
 from ...exceptions import OptionError, WrongTypeError
 from ...friction.model import through_drive
-from ...identification.classical import identify_from_log
 from ...identification.data import StaticDataset
 from ...identification.estimators import Estimator, EstimatorName
 from ...identification.holdout import DEFAULT_FOLDS
 from ...identification.log import TorqueLog
 from ...identification.model import IdentifiedModel
+from ...identification.selection import identify_recordings
 from ...identification.static import identify_static
+from ...identification.structure import Structure
 from ...model.drive import Drive
 from ...model.robot import Robot
 from ..bounds import Bounds
@@ -106,7 +108,7 @@ def with_drive(res: ConsistentResult, drive: Drive) -> ConsistentResult:
 
 def identify_consistent(
     robot: Robot,
-    data: TorqueLog | StaticDataset,
+    data: TorqueLog | Sequence[TorqueLog] | StaticDataset,
     *,
     prior: Prior | Robot | None = None,
     bounds: Bounds | None = None,
@@ -120,6 +122,9 @@ def identify_consistent(
     estimator: EstimatorName | Estimator = "ols",
     folds: int = DEFAULT_FOLDS,
     validate_on: TorqueLog | None = None,
+    structure: Structure | Literal["auto"] = "auto",
+    max_gap_s: float | None = None,
+    names: Sequence[str] | None = None,
 ) -> ConsistentResult:
     """Physically consistent link parameters (and friction) identified from data.
 
@@ -127,8 +132,9 @@ def identify_consistent(
     ----------
     robot : Robot
         Kinematics and gravity of the data.
-    data : TorqueLog or StaticDataset
-        A torque log of an exciting trajectory, or static ``q, M, g`` data.
+    data : TorqueLog, sequence of TorqueLog, or StaticDataset
+        A torque log of an exciting trajectory (or several recordings of one arm), or
+        static ``q, M, g`` data.
     prior, bounds, total_mass, options, constraints
         As in :func:`~dynid.feasibility.convex.solve.solve_consistent`.
     cutoff_hz, decimate
@@ -144,15 +150,25 @@ def identify_consistent(
         The unconstrained fit's estimator; its weighted covariance is the consistent fit's
         data term (:mod:`dynid.identification.estimators`).
     folds, validate_on
-        Torque logs: the held-out judgement (contiguous time blocks, or a separate log) that
-        chooses the prior's weight and accepts the result
+        Torque logs: the held-out judgement (contiguous time blocks of one recording, one
+        recording left out at a time of several, or a separate log) that chooses the
+        model's structure and the prior's weight and accepts the result
         (:mod:`dynid.feasibility.heldout`).
+    structure : Structure or "auto"
+        Torque logs: the terms beside the links; ``"auto"`` (default) chooses them on
+        held-out data as ``dynid identify --consistent`` does
+        (:func:`~dynid.identification.selection.identify_recordings`).
+    max_gap_s : float, optional
+        Torque logs: gaps up to this long [s] are bridged, longer ones cut a recording
+        into pieces prepared on their own.
+    names : sequence of str, optional
+        Torque logs: one name per recording (file names), for messages and the record.
 
     Returns
     -------
     ConsistentResult
-        ``kind`` ``"log"`` (with ``friction`` (n, 3) ``fv, fc, fo``) or ``"static"``;
-        ``identified`` the unconstrained identification.
+        ``kind`` ``"log"`` (with ``friction``, of the law of the structure, physical as its
+        terms declare) or ``"static"``; ``identified`` the unconstrained identification.
 
     Raises
     ------
@@ -161,30 +177,34 @@ def identify_consistent(
     WrongTypeError
         ``data`` is neither a torque log nor static data.
     """
-    if isinstance(data, TorqueLog):
-        model = identify_from_log(
-            robot,
-            data,
-            cutoff_hz=cutoff_hz,
-            decimate=decimate,
-            friction=True,
-            rtol=rtol,
-            drive=drive,
-            estimator=estimator,
-            folds=folds,
-            validate_on=validate_on,
-        )
-        term = coefficient_term(model, with_friction=True)
-        kind = "log"
-    elif isinstance(data, StaticDataset):
+    logs = [data] if isinstance(data, TorqueLog) else data
+    term: DataTerm | None = None
+    if isinstance(data, StaticDataset):
         model = identify_static(
             robot, data, rtol=rtol, std="classical", drive=drive, estimator=estimator
         )
         term = coefficient_term(model)
         kind = "static"
+    elif isinstance(logs, Sequence) and all(isinstance(g, TorqueLog) for g in logs):
+        model = identify_recordings(
+            robot,
+            list(logs),
+            names,
+            structure=structure,
+            cutoff_hz=cutoff_hz,
+            max_gap_s=max_gap_s,
+            decimate=decimate,
+            drive=drive,
+            estimator=estimator,
+            rtol=rtol,
+            folds=folds,
+            validate_on=validate_on,
+        )
+        kind = "log"
     else:
         raise WrongTypeError(
-            f"data must be a TorqueLog or a StaticDataset; got {type(data).__name__}"
+            "data must be a TorqueLog, a sequence of them or a StaticDataset; got "
+            f"{type(data).__name__}"
         )
     return consistent_from_identified(
         robot,
