@@ -30,8 +30,10 @@ the command applies, so that the Python API behaves as the command does.
 
 from __future__ import annotations
 
+import dataclasses
+import itertools
 import warnings
-from collections.abc import Mapping
+from collections.abc import Iterator, Mapping
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -39,6 +41,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from ..exceptions import DataError, DynidWarning, OptionError
+from ..exceptions import in_file as about_file
 from ..friction.model import FrictionModel, FrictionSum
 from ..identification.log import (
     DEFAULT_CUTOFF_HZ,
@@ -58,7 +61,7 @@ from ..observer.detection import (
     calibrate,
     detect,
     residual_std,
-    standstill_series,
+    standstill_blocks,
 )
 from ..observer.model import ObserverModel, from_identified, from_robot
 from ..observer.pieces import PositionJump, pieces, position_jumps
@@ -130,6 +133,11 @@ class ObserveOptions:
     base, tip : str, optional
         The chain of a ``params`` URDF with several leaves (its root and only leaf by
         default).
+    keep_series : bool
+        When calibrating: keep every log's residual (and its std and margin) in the
+        result, for figures. False: only the calibration's running statistics, a block of
+        samples at a time (bounded memory on a long log); the result's logs then hold no
+        series. Detecting always keeps them (events, ``residuals.csv``).
     """
 
     data: tuple[Path, ...]
@@ -154,6 +162,7 @@ class ObserveOptions:
     max_gap: float | None = None
     base: str | None = None
     tip: str | None = None
+    keep_series: bool = True
 
 
 def load_observer_model(
@@ -280,47 +289,27 @@ def observe_files(opts: ObserveOptions) -> ObserveResult:
     wants_margin = opts.standstill if given is None else given.standstill
     columns = recorded_columns(recorded, *opts.columns)  # (names, units), said once
     read = _read_logs(data_files(opts.data), model, columns, opts)
+    if given is None:
+        return _calibrated(
+            read, model, columns[0] is not None, opts, options, wants_std, wants_margin
+        )
     logs = [
         _observe_log(p, log, model, columns[0] is not None, opts, options, wants_std, wants_margin)
         for p, log in zip(read.paths, read.logs, strict=True)
     ]
-    if given is None:
-        seen = [np.all(np.isfinite(x.r), axis=1) for x in logs]  # observed samples only
-        th = calibrate(
-            [x.r[k] for x, k in zip(logs, seen, strict=True)],
-            options,
-            std=[x.std[k] for x, k in zip(logs, seen, strict=True)] if wants_std else None,  # type: ignore[index]
-            standstill=(
-                [x.standstill[k] for x, k in zip(logs, seen, strict=True)]  # type: ignore[index]
-                if wants_margin
-                else None
-            ),
-            margin=opts.margin,
-            quantile=opts.quantile,
-            collision_factor=opts.collision_factor,
-            k_sigma=opts.k_sigma,
-        )
-        return ObserveResult(model, th, tuple(logs))
     found = tuple(
-        LogObservation(
-            x.path,
-            x.t,
-            x.r,
-            x.std,
-            detect(
+        dataclasses.replace(
+            x,
+            events=detect(
                 x.t,
-                x.r,
+                x.series,
                 given,
                 std=x.std,
                 standstill=x.standstill,
                 merge_s=opts.merge_s,
                 restarts=x.restarts,
             ),
-            x.wrench,
-            x.tau_ext,
-            x.standstill,
-            x.restarts,
-        )  # fmt: skip
+        )
         for x in logs
     )
     return ObserveResult(model, given, found)
@@ -346,6 +335,101 @@ def _read_logs(
     return read
 
 
+def _calibrated(
+    read: Recorded,
+    model: ObserverModel,
+    mapped: bool,
+    opts: ObserveOptions,
+    options: ObserverOptions,
+    wants_std: bool,
+    wants_margin: bool,
+) -> ObserveResult:
+    """The thresholds of the collision-free logs ``read``: their residuals a block at a
+    time into :func:`~dynid.observer.detection.calibrate` (running maxima), each log's
+    series kept only with ``opts.keep_series``."""
+    logs: list[LogObservation] = []
+    peaks: list[NDArray[np.float64]] = []
+
+    def blocks() -> Iterator[_Block]:
+        for path, log in zip(read.paths, read.logs, strict=True):
+            prep = _prepared(Path(path), log, model, opts)
+            keep = _Series.new(prep, model.n, wants_std, wants_margin) if opts.keep_series else None
+            peak = np.zeros(model.n)
+            for blk in _blocks(prep, model, options, wants_std, wants_margin):
+                if blk.margin is not None:
+                    np.maximum(peak, blk.margin.max(axis=0), out=peak)
+                if keep is not None:
+                    keep.put(blk)
+                yield blk
+            peaks.append(peak)
+            logs.append(_observation(prep, model, mapped, opts, keep, peak))
+
+    a, b, c = itertools.tee(blocks(), 3)  # read in step: one block held
+    th = calibrate(
+        (x.r for x in a),
+        options,
+        std=(x.std for x in b) if wants_std else None,  # type: ignore[misc]
+        standstill=(_margin(x, model.n) for x in c) if wants_margin else None,
+        margin=opts.margin,
+        quantile=opts.quantile,
+        collision_factor=opts.collision_factor,
+        k_sigma=opts.k_sigma,
+    )
+    return ObserveResult(model, th, tuple(logs))
+
+
+def _margin(x: _Block, n: int) -> NDArray[np.float64]:
+    return np.zeros((x.r.shape[0], n)) if x.margin is None else x.margin
+
+
+@dataclass(frozen=True, slots=True)
+class _Prepared:
+    """A log brought to the joints, with the velocities and the spans the observer runs
+    on (:func:`_prepared`)."""
+
+    path: Path
+    log: TorqueLog
+    dq: NDArray[np.float64]
+    spans: list[tuple[int, int]]
+
+
+@dataclass(frozen=True, slots=True)
+class _Block:
+    """The residual of samples ``[a, a + len(r))`` of a log, their std and margin."""
+
+    a: int
+    r: NDArray[np.float64]
+    std: NDArray[np.float64] | None
+    margin: NDArray[np.float64] | None
+
+
+@dataclass(frozen=True, slots=True)
+class _Series:
+    """Full-length series of a log filled block by block (NaN where not observed)."""
+
+    r: NDArray[np.float64]
+    std: NDArray[np.float64] | None
+    margin: NDArray[np.float64] | None
+
+    @staticmethod
+    def new(prep: _Prepared, n: int, wants_std: bool, wants_margin: bool) -> _Series:
+        N = prep.log.t.shape[0]
+        r = np.full((N, n), np.nan)
+        return _Series(
+            r,
+            np.full_like(r, np.nan) if wants_std else None,
+            np.zeros(r.shape) if wants_margin else None,  # untouched where it stays 0
+        )
+
+    def put(self, blk: _Block) -> None:
+        k = slice(blk.a, blk.a + blk.r.shape[0])
+        self.r[k] = blk.r
+        if self.std is not None and blk.std is not None:
+            self.std[k] = blk.std
+        if self.margin is not None and blk.margin is not None:
+            self.margin[k] = blk.margin
+
+
 def _observe_log(
     path: Path,
     log: TorqueLog,
@@ -358,7 +442,19 @@ def _observe_log(
 ) -> LogObservation:
     """The residual (and its std, the wrench, the stored true torques) of one log, as
     read (``mapped``: through a column map)."""
-    path = Path(path)
+    prep = _prepared(Path(path), log, model, opts)
+    keep = _Series.new(prep, model.n, wants_std, wants_margin)
+    peak = np.zeros(model.n)
+    for blk in _blocks(prep, model, options, wants_std, wants_margin):
+        keep.put(blk)
+        if blk.margin is not None:
+            np.maximum(peak, blk.margin.max(axis=0), out=peak)
+    return _observation(prep, model, mapped, opts, keep, peak)
+
+
+def _prepared(path: Path, log: TorqueLog, model: ObserverModel, opts: ObserveOptions) -> _Prepared:
+    """The log at the joints, unwrapped, cut at its gaps and jumps, with the velocities
+    and the spans the observer runs on (warnings name the file)."""
     log = joint_side_log(log, model.drive)
     log, turned = unwrapped(log, wrappable(model.robot))  # joints whose limits span a turn
     if turned:  # M(q) is periodic; velocities derived across a wrap are not
@@ -366,43 +462,82 @@ def _observe_log(
             f"{path.name}: joint(s) {', '.join(str(j + 1) for j in turned)} recorded wrapped "
             "into [-pi, pi] (jumps of a whole turn): unwrapped",
             DynidWarning,
-            stacklevel=3,
+            stacklevel=4,
         )
     starts = _pieces(path, log, opts)
     dq = _piece_velocities(log, starts)  # of a log of positions: from the unwrapped ones
     cut = _cut_at_jumps(path, log, dq, starts)
     if cut != starts and log.dq_derived:  # derived again, never across a jump
         dq = _piece_velocities(log, cut)
-    starts = cut
-    spans = _observed_spans(path, log, starts)
+    return _Prepared(path, log, dq, _observed_spans(path, log, cut))
+
+
+def _blocks(
+    prep: _Prepared,
+    model: ObserverModel,
+    options: ObserverOptions,
+    wants_std: bool,
+    wants_margin: bool,
+) -> Iterator[_Block]:
+    """The residual of every observed span, :data:`_OBSERVE_BLOCK` samples at a time (one
+    observer per piece, its state carried from block to block), with the std and the
+    standstill margin of the same samples (errors name the file)."""
+    t, q, tau, dq = prep.log.t, prep.log.q, prep.log.tau, prep.dq
+    with about_file(prep.path.name):
+        for a, b in prep.spans:
+            obs = MomentumObserver(model, options)
+            std = residual_std(model, t[a:b], q[a:b], dq[a:b], options) if wants_std else None
+            margins = (
+                standstill_blocks(model, t[a:b], dq[a:b], options, _OBSERVE_BLOCK)
+                if wants_margin
+                else iter(())
+            )
+            pending = next(margins, None)
+            for c in range(a, b, _OBSERVE_BLOCK):
+                d = min(c + _OBSERVE_BLOCK, b)
+                m = None
+                if pending is not None and pending[0] == c - a:
+                    m, pending = pending[1], next(margins, None)
+                yield _Block(
+                    c,
+                    obs.run(t[c:d], q[c:d], dq[c:d], tau[c:d]),
+                    None if std is None else std[c - a : d - a],
+                    m,
+                )
+            del std
+
+
+def _observation(
+    prep: _Prepared,
+    model: ObserverModel,
+    mapped: bool,
+    opts: ObserveOptions,
+    keep: _Series | None,
+    peak: NDArray[np.float64],
+) -> LogObservation:
+    """A log's observation from its series (None: not kept) and its margin's peak."""
+    path, log = prep.path, prep.log
 
     def run() -> LogObservation:
-        t, q, tau, n = log.t, log.q, log.tau, model.n
-        r = np.full((t.shape[0], n), np.nan)
-        std = np.full_like(r, np.nan) if wants_std else None
-        margin = np.zeros(r.shape) if wants_margin else None  # untouched where it stays 0
-        for a, b in spans:
-            obs = MomentumObserver(model, options)  # one per piece, run a block at a time:
-            for c in range(a, b, _OBSERVE_BLOCK):  # no full-length copies of the residual
-                d = min(c + _OBSERVE_BLOCK, b)
-                r[c:d] = obs.run(t[c:d], q[c:d], dq[c:d], tau[c:d])
-            if std is not None:
-                std[a:b] = residual_std(model, t[a:b], q[a:b], dq[a:b], options)
-            if margin is not None:
-                m = standstill_series(model, t[a:b], dq[a:b], options)
-                if np.any(m):  # a friction without a band: its zeros not written (no memory)
-                    margin[a:b] = m
-                del m
         wrench = None
-        if opts.frame is not None:
-            wrench = external_wrench(model.robot, log.q, r, opts.frame)
+        if opts.frame is not None and keep is not None:
+            wrench = external_wrench(model.robot, log.q, keep.r, opts.frame)
         ext = None
-        if path.suffix.lower() in (".csv", ".npz") and not mapped:
+        if keep is not None and path.suffix.lower() in (".csv", ".npz") and not mapped:
             ext = load_joint_columns(path, "tau_ext", model.n)
             if ext is not None and ext.shape[0] != log.t.shape[0]:
                 ext = None  # rows were dropped: not aligned with the log
         return LogObservation(
-            path, log.t, r, std, [], wrench, ext, margin, tuple(a for a, _ in spans)
+            path,
+            log.t,
+            None if keep is None else keep.r,
+            None if keep is None else keep.std,
+            [],
+            wrench,
+            ext,
+            None if keep is None else keep.margin,
+            tuple(a for a, _ in prep.spans),
+            peak,
         )
 
     return in_file(path, run)
