@@ -13,7 +13,7 @@ from dynid.friction.laws import LAWS
 from dynid.friction.model import LawFriction
 from dynid.identification.log import TorqueLog, joint_side_log
 from dynid.model.drive import Drive
-from dynid.observer import from_robot, observe
+from dynid.observer import from_identified, from_robot, observe
 from dynid.observer.detection import calibrate, detect, standstill_series
 from dynid.observer.friction import standstill_margin
 from dynid.observer.residual import ObserverOptions, first_order_lag
@@ -122,3 +122,42 @@ def test_the_noise_bound_of_a_sigmoid_is_its_change_across_the_band():
     got = standstill_margin(fr, vm[:, None] / 100.0, (np.array([b]),))[:, 0]
     np.testing.assert_allclose(got, want, rtol=1e-12, atol=1e-12)
     assert not np.any(standstill_margin(fr, vm[:, None] / 100.0))
+
+
+def test_rotor_terms_give_their_own_momentum_columns():
+    """An identified model whose rotor term carries its drive (a coupled wrist, rotor 7
+    not held) while the model has none: the observer asks the term, so ``p`` and the
+    momentum regressor over the base parameters both equal ``M_links dq + K^T diag(I_a) K
+    dq`` (the closed form; the drive's labels are not the model's to match)."""
+    from dynid.dynamics.terms import mass_matrix
+    from dynid.identification.least_squares import LeastSquaresFit
+    from dynid.identification.model import IdentifiedModel, IdentifiedTerm
+    from dynid.observer.terms import base_momentum_regressor, momentum_terms
+    from dynid.regressors.base import base_parameters
+    from dynid.regressors.terms import RotorInertia
+
+    robot, drive = dynid.panda(), Drive.from_gears(GEARS, [(7, 6, 50.0)])
+    held = (True,) * 6 + (False,)
+    term = RotorInertia(drive, mask=held)
+    base = base_parameters(robot, kind="torque", terms=(term,))
+    ia = np.array(ROTORS)
+    beta = base.beta_from_phi(np.concatenate([robot.phi.reshape(-1), ia[:6]]))
+    r = base.rank
+    fit = LeastSquaresFit(
+        beta=beta, std=np.ones(r), std_percent=np.ones(r), kept=np.ones(r, bool), rank=r,
+        condition_number=1.0, relative_error_percent=0.0, residual_rms=0.0, sigma=0.0,
+        n_rows=0, rtol=1e-10, covariance=np.eye(r),
+    )  # fmt: skip
+    blank = IdentifiedTerm(term, np.zeros(6), np.zeros(6), np.zeros(6, bool))
+    ident = IdentifiedModel(robot=robot, base=base, fit=fit, terms={term.name: blank})
+    assert ident.drive is None  # the term carries the drive
+    obs = from_identified(ident)
+    rng = np.random.default_rng(5)
+    q, dq = rng.uniform(-1.0, 1.0, (6, 7)), rng.uniform(-1.0, 1.0, (6, 7))
+    K = drive.transmission
+    Mr = K.T @ np.diag(np.where(held, ia, 0.0)) @ K
+    want = np.einsum("bij,bj->bi", mass_matrix(robot, q), dq) + dq @ Mr.T
+    p, _ = momentum_terms(obs, q, dq)
+    np.testing.assert_allclose(p, want, rtol=1e-10, atol=1e-12)
+    Yp, _ = base_momentum_regressor(obs, q, dq)
+    np.testing.assert_allclose(Yp @ beta, want, rtol=1e-10, atol=1e-12)

@@ -76,6 +76,11 @@ def canonical_friction(
     return friction.transmission, canonical(np.asarray(friction.params), np.asarray(friction.band))
 
 
+#: Consecutive samples per estimate of the velocity noise (:func:`velocity_bands` takes
+#: the median of the windows' estimates: a long log in bounded memory).
+_NOISE_WINDOW = 1 << 16
+
+
 def velocity_bands(
     friction: FrictionModel | FrictionSum | None, dq: NDArray[np.float64]
 ) -> tuple[NDArray[np.float64], ...]:
@@ -83,7 +88,8 @@ def velocity_bands(
     (n,) array per part; none without friction), estimated on the velocities ``dq`` (N, n)
     [rad/s] seen through the part's transmission
     (:func:`~dynid.identification.sanity.velocity_noise_std` times
-    :data:`~dynid.identification.sanity.NOISE_BAND_STD`); zeros for fewer than 4 samples.
+    :data:`~dynid.identification.sanity.NOISE_BAND_STD`, the median of its estimates over
+    windows of :data:`_NOISE_WINDOW` samples); zeros for fewer than 4 samples.
     """
     from ..identification.sanity import noise_band, velocity_noise_std
 
@@ -94,8 +100,16 @@ def velocity_bands(
         if v.shape[0] < 4:
             out.append(np.zeros(part.n))
             continue
-        vm = v @ np.asarray(part.transmission).T
-        out.append(np.asarray(noise_band(velocity_noise_std(vm)), dtype=np.float64))
+        K = np.asarray(part.transmission)
+        sd = np.zeros(part.n)
+        for k in range(part.n):  # a motor at a time, over windows: bounded temporaries
+            est = [
+                velocity_noise_std((v[a : a + _NOISE_WINDOW] @ K[k])[:, None])[0]
+                for a in range(0, v.shape[0], _NOISE_WINDOW)
+                if v.shape[0] - a >= 4
+            ]
+            sd[k] = np.median(est)
+        out.append(np.asarray(noise_band(sd), dtype=np.float64))
     return tuple(out)
 
 

@@ -31,9 +31,8 @@ the command applies, so that the Python API behaves as the command does.
 from __future__ import annotations
 
 import dataclasses
-import itertools
 import warnings
-from collections.abc import Iterator, Mapping
+from collections.abc import Callable, Iterator, Mapping
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -348,7 +347,6 @@ def _calibrated(
     time into :func:`~dynid.observer.detection.calibrate` (running maxima), each log's
     series kept only with ``opts.keep_series``."""
     logs: list[LogObservation] = []
-    peaks: list[NDArray[np.float64]] = []
 
     def blocks() -> Iterator[_Block]:
         for path, log in zip(read.paths, read.logs, strict=True):
@@ -361,21 +359,41 @@ def _calibrated(
                 if keep is not None:
                     keep.put(blk)
                 yield blk
-            peaks.append(peak)
             logs.append(_observation(prep, model, mapped, opts, keep, peak))
 
-    a, b, c = itertools.tee(blocks(), 3)  # read in step: one block held
+    # calibrate reads a block's residual, then its margin and std: these two come from the
+    # block the residual was last read from (one block held; itertools.tee would keep up
+    # to 57 blocks, its links' size)
+    current: list[_Block] = []
+
+    def residuals() -> Iterator[NDArray[np.float64]]:
+        for x in blocks():
+            current[:] = [x]
+            yield x.r
+
+    def beside(what: Callable[[_Block], NDArray[np.float64]]) -> Iterator[NDArray[np.float64]]:
+        while current:
+            yield what(current[0])
+
+    std = beside(_std) if wants_std else None
+    margins = beside(lambda x: _margin(x, model.n)) if wants_margin else None
+    r = residuals()
     th = calibrate(
-        (x.r for x in a),
+        r,
         options,
-        std=(x.std for x in b) if wants_std else None,  # type: ignore[misc]
-        standstill=(_margin(x, model.n) for x in c) if wants_margin else None,
+        std=std,
+        standstill=margins,
         margin=opts.margin,
         quantile=opts.quantile,
         collision_factor=opts.collision_factor,
         k_sigma=opts.k_sigma,
     )
     return ObserveResult(model, th, tuple(logs))
+
+
+def _std(x: _Block) -> NDArray[np.float64]:
+    assert x.std is not None
+    return x.std
 
 
 def _margin(x: _Block, n: int) -> NDArray[np.float64]:
