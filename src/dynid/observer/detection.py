@@ -59,6 +59,8 @@ __all__ = [
     "calibrate",
     "detect",
     "residual_std",
+    "residual_std_blocks",
+    "standstill_blocks",
     "standstill_series",
     "threshold_series",
     "undetected_at_rest",
@@ -166,8 +168,6 @@ def residual_std(
     ShapeError, NonFiniteError
         Bad shapes, NaN.
     """
-    import scipy.signal
-
     if model.base is None or model.covariance is None:
         raise DataError(
             "the model's uncertainty needs identified base parameters with their covariance "
@@ -177,19 +177,40 @@ def residual_std(
     ta = _checks.as_array("t", t)
     N = ta.shape[0]
     qa, dqa = _checks.as_exact("q", q, (N, n)), _checks.as_exact("dq", dq, (N, n))
+    out = np.zeros((N, n))
+    for a, s in residual_std_blocks(model, ta, qa, dqa, options):
+        out[a : a + s.shape[0]] = s
+    return out
+
+
+def residual_std_blocks(
+    model: ObserverModel,
+    t: NDArray[np.float64],
+    q: NDArray[np.float64],
+    dq: NDArray[np.float64],
+    options: ObserverOptions = DEFAULT_OPTIONS,
+) -> Iterator[tuple[int, NDArray[np.float64]]]:
+    """:func:`residual_std` of validated ``t`` (N,), ``q, dq`` (N, n), a block of
+    :data:`BLOCK` samples at a time: ``(first sample, std (m, n) [N m])`` (the filter's
+    state carried; only a block's regressor held)."""
+    import scipy.signal
+
+    if model.base is None or model.covariance is None:
+        raise DataError("the model's uncertainty needs its base parameters' covariance")
+    n = model.n
+    ta, qa, dqa = t, q, dq
+    N = ta.shape[0]
     T = float(np.median(np.diff(ta))) if N > 1 else 1.0
     K = options.gains(n)
     gam = -np.expm1(-K * T) if options.discretisation == "exact" else K * T
     trap = options.rule == "trapezoid"
     w, V = np.linalg.eigh(np.asarray(model.covariance))
     L = V * np.sqrt(np.clip(w, 0.0, None))  # Sigma = L L^T
-    out = np.zeros((N, n))
     r = L.shape[0]
     zi = np.zeros((n, 1, r))
     prev_p = prev_b = None
     for a in range(0, N, BLOCK):
         Yp, Yb = base_momentum_regressor(model, qa[a : a + BLOCK], dqa[a : a + BLOCK])
-        m = Yp.shape[0]
         dp = np.empty_like(Yp)
         dp[1:] = np.diff(Yp, axis=0) / T
         dp[0] = 0.0 if prev_p is None else (Yp[0] - prev_p) / T
@@ -207,9 +228,8 @@ def residual_std(
                 [gam[j]], [1.0, gam[j] - 1.0], x[:, j, :], axis=0, zi=zi[j]
             )
             zi[j] = zf
-        out[a : a + m] = np.sqrt(np.sum((Z @ L) ** 2, axis=-1))
         prev_p, prev_b = Yp[-1], Yb[-1]
-    return out
+        yield a, np.sqrt(np.sum((Z @ L) ** 2, axis=-1))
 
 
 def standstill_series(

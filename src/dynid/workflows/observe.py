@@ -59,7 +59,7 @@ from ..observer.detection import (
     Thresholds,
     calibrate,
     detect,
-    residual_std,
+    residual_std_blocks,
     standstill_blocks,
 )
 from ..observer.model import ObserverModel, from_identified, from_robot
@@ -504,7 +504,12 @@ def _blocks(
     with about_file(prep.path.name):
         for a, b in prep.spans:
             obs = MomentumObserver(model, options)
-            std = residual_std(model, t[a:b], q[a:b], dq[a:b], options) if wants_std else None
+            stds = _rechunked(
+                residual_std_blocks(model, t[a:b], q[a:b], dq[a:b], options)
+                if wants_std
+                else iter(()),
+                _OBSERVE_BLOCK,
+            )
             margins = (
                 standstill_blocks(model, t[a:b], dq[a:b], options, _OBSERVE_BLOCK)
                 if wants_margin
@@ -519,10 +524,27 @@ def _blocks(
                 yield _Block(
                     c,
                     obs.run(t[c:d], q[c:d], dq[c:d], tau[c:d]),
-                    None if std is None else std[c - a : d - a],
+                    next(stds) if wants_std else None,
                     m,
                 )
-            del std
+
+
+def _rechunked(
+    blocks: Iterator[tuple[int, NDArray[np.float64]]], size: int
+) -> Iterator[NDArray[np.float64]]:
+    """Consecutive blocks ``(first sample, array)`` cut again into arrays of ``size``
+    samples (the last shorter): the std's blocks as the observer's."""
+    pending: list[NDArray[np.float64]] = []
+    have = 0
+    for _, x in blocks:
+        pending.append(x)
+        have += x.shape[0]
+        while have >= size:
+            cat = np.concatenate(pending)
+            yield cat[:size]
+            pending, have = [cat[size:]], cat.shape[0] - size
+    if have:
+        yield np.concatenate(pending)
 
 
 def _observation(
