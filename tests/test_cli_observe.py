@@ -234,7 +234,7 @@ def test_calibrating_an_identified_model_in_blocks_keeps_no_series(logs, monkeyp
     from dynid.observer.detection import residual_std, standstill_series
     from dynid.workflows.observe import ObserveOptions, load_observer_model, observe_files
 
-    monkeypatch.setattr("dynid.workflows.observe._OBSERVE_BLOCK", 700)
+    monkeypatch.setattr("dynid.workflows.observe_logs.OBSERVE_BLOCK", 700)
     path = logs / "id" / "identification.json"
     opts = ObserveOptions(data=(logs / "free.csv",), model=path, calibrate=True, keep_series=False)
     lean = observe_files(opts)

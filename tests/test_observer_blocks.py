@@ -77,7 +77,7 @@ def test_calibrating_without_series_gives_the_same_thresholds(case, tmp_path: Pa
     """observe_files a block of 700 samples at a time, with keep_series=False (the command
     with --no-figures): no residual kept, the thresholds of the residual kept whole, which
     is the observer's over the whole log at once to 1e-12, and the rule on it."""
-    monkeypatch.setattr("dynid.workflows.observe._OBSERVE_BLOCK", 700)
+    monkeypatch.setattr("dynid.workflows.observe_logs.OBSERVE_BLOCK", 700)
     model, opts, log = case
     path = tmp_path / "free.csv"
     save_torque_log(path, log)
