@@ -468,7 +468,8 @@ def format_observation(result: ObserveResult, names: list[str], *, calibrating: 
         top = np.max(margins, axis=0)
         rows.append(
             "plus the standstill margin of the friction (Coulomb level inside its band, "
-            f"lagged; up to {', '.join(f'{v:.3g}' for v in top)} N m)"
+            "smooth steps within the velocity noise, lagged; "
+            f"up to {', '.join(f'{v:.3g}' for v in top)} N m)"
         )
     if calibrating:
         rows.append(f"calibrated on {th.samples} samples of {len(result.logs)} log(s)")
