@@ -15,7 +15,8 @@ Panda on a seeded Fourier series with sensor noise:
   figures' data), ``identify --consistent`` and ``validate --robot panda`` (the log
   prepared and predicted a block at a time);
 * ``observe --calibrate`` of the Panda's own parameters (the momentum observer's batch
-  path over the whole log);
+  path a block at a time, the thresholds from running maxima; with ``--no-figures`` no
+  full-length residual is kept);
 * static data of a long chain (``--static-joints`` 50, ``--static-n`` 200 configurations
   written by ``acquire-static``): the single-step problem of ``retrieve --static
   --method penalty`` (``static_problem``; its residual on the arm's own exact data must be

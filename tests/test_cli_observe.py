@@ -219,3 +219,32 @@ def test_observe_takes_folders_and_names_logs_of_one_name_by_their_folder(logs, 
     assert len(doc["events"]) == 2 and {e["log"] for e in doc["events"]} == {"a/log.csv"}
     assert (out / "residuals_a_log.csv").exists() and (out / "residuals_b_log.csv").exists()
     assert capsys.readouterr().out.count("  a/log.csv: ") == 2
+
+
+def test_calibrating_an_identified_model_in_blocks_keeps_no_series(logs, monkeypatch):
+    """An identified model with its covariance, the log a block of 700 samples at a time
+    (the std filtered in blocks of 8192, cut again) without its series: the thresholds,
+    noise floor included, are the rule on the whole log's residual, std and margin
+    (residual_std and standstill_series of the whole log at once)."""
+    import numpy as np
+
+    from dynid.identification.log import joint_side_log
+    from dynid.io.torque_log import load_torque_log
+    from dynid.observer import observe
+    from dynid.observer.detection import residual_std, standstill_series
+    from dynid.workflows.observe import ObserveOptions, load_observer_model, observe_files
+
+    monkeypatch.setattr("dynid.workflows.observe_logs.OBSERVE_BLOCK", 700)
+    path = logs / "id" / "identification.json"
+    opts = ObserveOptions(data=(logs / "free.csv",), model=path, calibrate=True, keep_series=False)
+    lean = observe_files(opts)
+    assert lean.logs[0].r is None and lean.thresholds.uses_uncertainty
+    model, _ = load_observer_model(path, None)
+    log = joint_side_log(load_torque_log(logs / "free.csv"), model.drive)
+    o = lean.thresholds.options
+    r = observe(model, log.t, log.q, log.dq, log.tau, o).r
+    s = residual_std(model, log.t, log.q, log.dq, o)
+    A = np.clip(np.abs(r) - standstill_series(model, log.t, log.dq, o), 0.0, None)
+    np.testing.assert_allclose(lean.thresholds.contact, 1.5 * A.max(axis=0), rtol=1e-9)
+    noise = 1.5 * np.clip(A - 3.0 * s, 0.0, None).max(axis=0)
+    np.testing.assert_allclose(lean.thresholds.noise, noise, rtol=1e-9, atol=1e-12)

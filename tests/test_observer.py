@@ -3,6 +3,8 @@ simulated contact's external torque, the first-order lag and the friction laws."
 
 from __future__ import annotations
 
+import dataclasses
+
 import numpy as np
 import pytest
 
@@ -346,9 +348,7 @@ def test_residual_std_is_the_residual_change_of_a_parameter_direction(identified
         drive=identified.drive,
     )
     r1 = observe(from_identified(moved, friction=None), traj.t, traj.q, traj.dq, tau, opts).r
-    one = ObserverModel(
-        model.robot, model.rotor_mass, None, model.base, model.beta, np.outer(e, e), model.drive
-    )
+    one = dataclasses.replace(model, covariance=np.outer(e, e))
     s = residual_std(one, traj.t, traj.q, traj.dq, opts)
     np.testing.assert_allclose(s, np.abs(r1 - r0), rtol=0, atol=1e-9)
 

@@ -164,6 +164,8 @@ def save_observer_figures(out: Path, result: ObserveResult, *, names: list[str])
     paths = []
     labels = log_labels([x.path for x in result.logs])
     for x, stem, label in zip(result.logs, observation_names(result.logs), labels, strict=True):
+        if x.r is None:  # a calibration that kept no series
+            continue
         contact, collision = threshold_series(result.thresholds, x.t.shape[0], x.std, x.standstill)
 
         def draw(x: Any = x, c: Any = contact, k: Any = collision, lab: str = label) -> Any:

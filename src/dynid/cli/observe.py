@@ -124,6 +124,7 @@ def run(args: argparse.Namespace, console: Console) -> int:
         merge_s=args.merge,
         columns=(args.columns, args.units), drop_invalid=args.drop_invalid,
         max_gap=args.max_gap, base=args.base, tip=args.tip,
+        keep_series=not args.no_figures,  # a calibration's series serve its figures only
     )  # fmt: skip
     result = observe_files(opts)
     names = list(result.model.robot.joint_names)

@@ -6,6 +6,7 @@ import sys
 from typing import Any
 
 import numpy as np
+from numpy.typing import NDArray
 
 from ..feasibility.constraints import principal_moments
 from ..feasibility.convex import ConsistentResult
@@ -17,7 +18,7 @@ from ..identification.info import LogInfo
 from ..identification.model import IdentifiedModel
 from ..io.observer_files import log_labels
 from ..observer.detection import undetected_at_rest
-from ..observer.results import ObserveResult
+from ..observer.results import LogObservation, ObserveResult
 from ..pipeline.collision import CollisionStageResult
 from ..regressors.base import identifiability
 
@@ -433,6 +434,13 @@ def format_newton_euler_rms(val: NewtonEulerValidation) -> str:
     return "\n".join(rows)
 
 
+def _margin_peak(x: LogObservation) -> NDArray[np.float64] | None:
+    """A log's largest standstill margin per joint [N m] (its own, or of its series)."""
+    if x.standstill_peak is not None:
+        return x.standstill_peak
+    return None if x.standstill is None else np.max(x.standstill, axis=0)
+
+
 def format_observation(result: ObserveResult, names: list[str], *, calibrating: bool) -> str:
     """The thresholds per joint (and the largest residual) and, detecting, every event."""
     th = result.thresholds
@@ -440,7 +448,7 @@ def format_observation(result: ObserveResult, names: list[str], *, calibrating: 
         read = "|r| read" if th.quantile == 1.0 else f"|r| q{th.quantile:g}"
         cols = {f"{read} [N m]": th.contact / th.margin}
     else:
-        peak = np.nanmax([np.nanmax(np.abs(x.r), axis=0) for x in result.logs], axis=0)
+        peak = np.nanmax([np.nanmax(np.abs(x.series), axis=0) for x in result.logs], axis=0)
         cols = {"max |r| [N m]": peak}
     cols |= {"contact [N m]": th.contact, "collision [N m]": th.collision}
     rest = undetected_at_rest(result.model, th)
@@ -473,12 +481,13 @@ def format_observation(result: ObserveResult, names: list[str], *, calibrating: 
             f"thresholds grow with the model's uncertainty: {th.k_sigma:g} sigma + noise "
             f"({', '.join(f'{v:.3g}' for v in th.noise)} N m)"
         )
-    margins = [x.standstill for x in result.logs if x.standstill is not None]
-    if th.standstill and margins and np.any([np.any(m) for m in margins]):
-        top = np.max([np.max(m, axis=0) for m in margins], axis=0)
+    margins = [m for x in result.logs if (m := _margin_peak(x)) is not None]
+    if th.standstill and margins and np.any(margins):
+        top = np.max(margins, axis=0)
         rows.append(
             "plus the standstill margin of the friction (Coulomb level inside its band, "
-            f"lagged; up to {', '.join(f'{v:.3g}' for v in top)} N m)"
+            "smooth steps within the velocity noise, lagged; "
+            f"up to {', '.join(f'{v:.3g}' for v in top)} N m)"
         )
     if calibrating:
         rows.append(f"calibrated on {th.samples} samples of {len(result.logs)} log(s)")

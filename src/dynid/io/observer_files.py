@@ -296,7 +296,7 @@ def save_observation(
             save_residuals_csv(
                 out / f"{name}.csv",
                 x.t,
-                x.r,
+                x.series,
                 wrench=None if w is None else w.wrench,
                 damped=None if w is None else w.damped,
                 frame=None if w is None else w.frame,

@@ -39,7 +39,7 @@ residual of every joint [N m] (signed, at its largest magnitude) and its level
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+from collections.abc import Iterable, Iterator
 from dataclasses import dataclass, field
 from typing import Literal
 
@@ -48,7 +48,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from .. import _checks
 from ..exceptions import DataError, OptionError, ShapeError
-from .friction import standstill_margin
+from .friction import standstill_margin, velocity_bands
 from .model import ObserverModel
 from .residual import DEFAULT_OPTIONS, ObserverOptions, first_order_lag
 from .terms import base_momentum_regressor
@@ -59,6 +59,8 @@ __all__ = [
     "calibrate",
     "detect",
     "residual_std",
+    "residual_std_blocks",
+    "standstill_blocks",
     "standstill_series",
     "threshold_series",
     "undetected_at_rest",
@@ -166,8 +168,6 @@ def residual_std(
     ShapeError, NonFiniteError
         Bad shapes, NaN.
     """
-    import scipy.signal
-
     if model.base is None or model.covariance is None:
         raise DataError(
             "the model's uncertainty needs identified base parameters with their covariance "
@@ -177,19 +177,40 @@ def residual_std(
     ta = _checks.as_array("t", t)
     N = ta.shape[0]
     qa, dqa = _checks.as_exact("q", q, (N, n)), _checks.as_exact("dq", dq, (N, n))
+    out = np.zeros((N, n))
+    for a, s in residual_std_blocks(model, ta, qa, dqa, options):
+        out[a : a + s.shape[0]] = s
+    return out
+
+
+def residual_std_blocks(
+    model: ObserverModel,
+    t: NDArray[np.float64],
+    q: NDArray[np.float64],
+    dq: NDArray[np.float64],
+    options: ObserverOptions = DEFAULT_OPTIONS,
+) -> Iterator[tuple[int, NDArray[np.float64]]]:
+    """:func:`residual_std` of validated ``t`` (N,), ``q, dq`` (N, n), a block of
+    :data:`BLOCK` samples at a time: ``(first sample, std (m, n) [N m])`` (the filter's
+    state carried; only a block's regressor held)."""
+    import scipy.signal
+
+    if model.base is None or model.covariance is None:
+        raise DataError("the model's uncertainty needs its base parameters' covariance")
+    n = model.n
+    ta, qa, dqa = t, q, dq
+    N = ta.shape[0]
     T = float(np.median(np.diff(ta))) if N > 1 else 1.0
     K = options.gains(n)
     gam = -np.expm1(-K * T) if options.discretisation == "exact" else K * T
     trap = options.rule == "trapezoid"
     w, V = np.linalg.eigh(np.asarray(model.covariance))
     L = V * np.sqrt(np.clip(w, 0.0, None))  # Sigma = L L^T
-    out = np.zeros((N, n))
     r = L.shape[0]
     zi = np.zeros((n, 1, r))
     prev_p = prev_b = None
     for a in range(0, N, BLOCK):
         Yp, Yb = base_momentum_regressor(model, qa[a : a + BLOCK], dqa[a : a + BLOCK])
-        m = Yp.shape[0]
         dp = np.empty_like(Yp)
         dp[1:] = np.diff(Yp, axis=0) / T
         dp[0] = 0.0 if prev_p is None else (Yp[0] - prev_p) / T
@@ -207,9 +228,8 @@ def residual_std(
                 [gam[j]], [1.0, gam[j] - 1.0], x[:, j, :], axis=0, zi=zi[j]
             )
             zi[j] = zf
-        out[a : a + m] = np.sqrt(np.sum((Z @ L) ** 2, axis=-1))
         prev_p, prev_b = Yp[-1], Yb[-1]
-    return out
+        yield a, np.sqrt(np.sum((Z @ L) ** 2, axis=-1))
 
 
 def standstill_series(
@@ -221,7 +241,9 @@ def standstill_series(
     """The standstill margin (N, n) [N m] of the model's friction at the velocities ``dq``
     (N, n) [rad/s], through the observer's lag ``K_O/(s + K_O)`` over the times ``t`` (N,)
     [s] (module docstring): a bound of the residual that friction the model cannot know
-    inside its standstill band leaves; zeros for a friction without a band.
+    (inside its standstill band, within the velocity noise band of its smooth Coulomb
+    steps: :func:`~dynid.observer.friction.standstill_margin`) leaves; zeros for a friction
+    without either. The noise band is estimated on ``dq`` (one piece of a log).
 
     Raises
     ------
@@ -231,13 +253,45 @@ def standstill_series(
     n = model.n
     ta = _checks.as_array("t", t)
     dqa = _checks.as_exact("dq", dq, (ta.shape[0], n))
-    N = ta.shape[0]
-    w = np.empty((N, n))
-    for a in range(0, N, _MARGIN_BLOCK):  # pointwise: a block's temporaries only
-        w[a : a + _MARGIN_BLOCK] = standstill_margin(model.friction, dqa[a : a + _MARGIN_BLOCK])
-    if not np.any(w):
-        return w
-    return first_order_lag(ta, w, options.gains(n), options.rule)
+    out = np.zeros((ta.shape[0], n))
+    for a, m in standstill_blocks(model, ta, dqa, options):
+        out[a : a + m.shape[0]] = m
+    return out
+
+
+def standstill_blocks(
+    model: ObserverModel,
+    t: NDArray[np.float64],
+    dq: NDArray[np.float64],
+    options: ObserverOptions = DEFAULT_OPTIONS,
+    block: int | None = None,
+) -> Iterator[tuple[int, NDArray[np.float64]]]:
+    """:func:`standstill_series` of one piece ``t`` (N,), ``dq`` (N, n) (validated) a block
+    of ``block`` samples (default :data:`_MARGIN_BLOCK`) at a time: ``(first sample, margin
+    (m, n) [N m])``, only one block's temporaries held (a long log). The lag continues from
+    block to block (its free response ``exp(-K_O (t - t_prev))`` added), as the whole
+    piece's to rounding; a margin that is zero everywhere yields nothing."""
+    N, n = dq.shape
+    size = _MARGIN_BLOCK if block is None else int(block)
+    bands = velocity_bands(model.friction, dq) if model.friction is not None else None
+    gains = options.gains(n)
+    prev: tuple[float, NDArray[np.float64], NDArray[np.float64]] | None = None
+    for a in range(0, N, size):
+        b = min(a + size, N)
+        w = standstill_margin(model.friction, dq[a:b], bands)
+        if prev is None and not np.any(w):
+            continue  # zero so far: its lag is zero too
+        if prev is None:  # the first nonzero block: the lag of zeros before it is zero
+            c = max(a - 1, 0)
+            x = np.concatenate([np.zeros((a - c, n)), w])
+            y = first_order_lag(t[c:b], x, gains, options.rule)[a - c :]
+        else:
+            t0, x0, y0 = prev
+            y = first_order_lag(np.concatenate([[t0], t[a:b]]), np.concatenate([x0[None], w]),
+                                gains, options.rule)[1:]  # fmt: skip
+            y += y0 * np.exp(-gains * (t[a:b, None] - t0))
+        prev = (float(t[b - 1]), w[-1].copy(), y[-1].copy())
+        yield a, y
 
 
 #: Samples of the standstill margin computed at a time (about ten temporaries of a block).
@@ -245,11 +299,11 @@ _MARGIN_BLOCK = 1 << 16
 
 
 def calibrate(
-    residuals: Sequence[ArrayLike],
+    residuals: Iterable[ArrayLike],
     options: ObserverOptions,
     *,
-    std: Sequence[ArrayLike] | None = None,
-    standstill: Sequence[ArrayLike] | None = None,
+    std: Iterable[ArrayLike] | None = None,
+    standstill: Iterable[ArrayLike] | None = None,
     margin: float = 1.5,
     quantile: float = 1.0,
     collision_factor: float = 2.0,
@@ -259,14 +313,16 @@ def calibrate(
 
     Parameters
     ----------
-    residuals : sequence of array_like, shape (N_i, n)
-        Residuals [N m] of collision-free motions.
+    residuals : iterable of array_like, shape (N_i, n)
+        Residuals [N m] of collision-free motions: whole logs or consecutive blocks of
+        them (a generator: each block is read once and dropped; with ``quantile`` 1 only
+        running maxima and counts are kept, so a long log is calibrated in bounded memory).
     options : ObserverOptions
         The observer they were computed with (kept with the thresholds).
-    std : sequence of array_like, shape (N_i, n), optional
+    std : iterable of array_like, shape (N_i, n), optional
         :func:`residual_std` of the same samples: the thresholds then also grow with the
         model's uncertainty (``k_sigma``).
-    standstill : sequence of array_like, shape (N_i, n), optional
+    standstill : iterable of array_like, shape (N_i, n), optional
         :func:`standstill_series` of the same samples: left out of the residual read here
         and added to the thresholds at detection.
     margin : float
@@ -300,24 +356,52 @@ def calibrate(
         )
     if not k_sigma > 0:
         raise OptionError(f"k_sigma must be > 0; got {k_sigma}")
-    R = [_checks.as_array("residual", x) for x in residuals]
-    if not R or any(x.ndim != 2 or x.shape[1] != R[0].shape[1] for x in R):
+    n_joints: int | None = None
+    count, top, top_excess = 0, None, None
+    outside = None
+    kept: list[NDArray[np.float64]] = []  # quantile < 1: every sample's |r| (and excess)
+    kept_excess: list[NDArray[np.float64]] = []
+    stds = iter(std) if std is not None else None
+    margins = iter(standstill) if standstill is not None else None
+    for x in residuals:
+        R = _checks.as_array("residual", x)
+        if R.ndim != 2 or (n_joints is not None and R.shape[1] != n_joints):
+            raise ShapeError("residuals must be one or more (N, n) arrays of one joint count")
+        n_joints = R.shape[1]
+        A = np.abs(R)
+        if margins is not None:
+            W = _checks.as_exact("standstill", _next(margins, "standstill"), R.shape)
+            A = np.clip(A - W, 0.0, None)
+            left = np.count_nonzero(A > 0.0, axis=0)
+            outside = left if outside is None else outside + left
+        excess = None
+        if stds is not None:
+            S = _checks.as_exact("std", _next(stds, "std"), R.shape)
+            excess = np.clip(A - k_sigma * S, 0.0, None)
+        count += A.shape[0]
+        if quantile < 1.0:
+            kept.append(A)
+            if excess is not None:
+                kept_excess.append(excess)
+        elif A.shape[0]:
+            top = _running_max(top, A)
+            if excess is not None:
+                top_excess = _running_max(top_excess, excess)
+    if n_joints is None:
         raise ShapeError("residuals must be one or more (N, n) arrays of one joint count")
-    A = np.abs(np.concatenate(R))
-    if A.shape[0] == 0:
+    if count == 0:
         raise ShapeError("no calibration sample")
-    if standstill is not None:
-        W = [_checks.as_exact("standstill", w, x.shape) for w, x in zip(standstill, R, strict=True)]
-        A = np.clip(A - np.concatenate(W), 0.0, None)
-        _check_outside_band(A)
-    contact = margin * np.quantile(A, quantile, axis=0)
-    noise = None
-    if std is not None:
-        S = np.concatenate(
-            [_checks.as_exact("std", s, x.shape) for s, x in zip(std, R, strict=True)]
-        )
-        excess = np.clip(A - k_sigma * S, 0.0, None)
-        noise = margin * np.quantile(excess, quantile, axis=0)
+    if outside is not None:
+        _check_outside_band(outside, count)
+    if quantile < 1.0:
+        contact = margin * np.quantile(np.concatenate(kept), quantile, axis=0)
+        noise = None
+        if stds is not None:
+            noise = margin * np.quantile(np.concatenate(kept_excess), quantile, axis=0)
+    else:
+        assert top is not None
+        contact = margin * top
+        noise = None if top_excess is None else margin * top_excess
     return Thresholds(
         contact=contact,
         collision=collision_factor * contact,
@@ -325,20 +409,32 @@ def calibrate(
         quantile=quantile,
         collision_factor=collision_factor,
         options=options,
-        samples=int(A.shape[0]),
+        samples=int(count),
         k_sigma=k_sigma if std is not None else None,
         noise=noise,
         standstill=standstill is not None,
     )
 
 
-def _check_outside_band(read: NDArray[np.float64]) -> None:
+def _next(it: Iterator[ArrayLike], name: str) -> ArrayLike:
+    """The next block of ``std`` or ``standstill`` beside a residual block."""
+    try:
+        return next(it)
+    except StopIteration:
+        raise ShapeError(f"{name} must have one array per residual array") from None
+
+
+def _running_max(top: NDArray[np.float64] | None, A: NDArray[np.float64]) -> NDArray:
+    m = np.max(A, axis=0)
+    return m if top is None else np.maximum(top, m)
+
+
+def _check_outside_band(left: NDArray[np.int64], N: int) -> None:
     """Refuse joints whose calibration residual the standstill margin covers (almost)
-    everywhere: fewer than :data:`MIN_OUTSIDE` samples (or 1 % of them) left over, as on a
-    log at rest, would calibrate a threshold of about 0 N m."""
-    N = read.shape[0]
+    everywhere: fewer than :data:`MIN_OUTSIDE` samples (or 1 % of them) of the ``N`` left
+    over (``left`` (n,) per joint), as on a log at rest, would calibrate a threshold of
+    about 0 N m."""
     need = max(MIN_OUTSIDE_FRACTION * N, min(MIN_OUTSIDE, N))
-    left = np.count_nonzero(read > 0.0, axis=0)
     bad = np.flatnonzero(left < need)
     if bad.size:
         joints = ", ".join(str(j + 1) for j in bad)

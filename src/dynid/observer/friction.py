@@ -26,9 +26,24 @@ at its level), while the true friction of a slow reversal or a standstill lies a
           + |f_t| \\big(1 - \\tanh(|v| / v_s)\\big)
 
 (``b`` the band; the Stribeck bump is off inside it as well), ``|K_f|^T w(K_f dq)`` at the
-joints; 0 for the sigmoid law (no Coulomb level) and for laws without a canonical form.
+joints; 0 for the sigmoid law (no Coulomb level) and for laws without a canonical form
+(before the noise band's term below).
 A :class:`~dynid.friction.model.FrictionSum` (friction at the motors and at the joints)
 gets the sum of its parts' bounds, each seen at the joints through its own transmission.
+
+The friction is evaluated at the *measured* velocities, which lie within their noise band
+``b`` (:func:`velocity_bands`: :data:`~dynid.identification.sanity.NOISE_BAND_STD` robust
+standard deviations of the velocity noise, per motor) of the true ones. A smooth Coulomb
+step (the sigmoid ``phi1 sigma(phi2 (v + phi3))``, the term ``f_t tanh(v / v_s)``) narrower
+than that band changes by up to its whole height between the two: per motor, each step's
+
+.. math:: s(v) = \\max\\big(|h(v + b) - h(v)|,\\; |h(v - b) - h(v)|\\big)
+
+(``h`` monotone: the largest change within the band is at one of its ends) is added to
+``w``. Through a gear of ratio ``K`` a motor's velocity noise and its friction both grow
+with ``K``: a motor sigmoid of 8 N m and ``phi2 = 30`` s/rad behind a ratio of 120 moves
+the joint torque by up to 960 N m within the noise of a reversal, which a calibration
+without this bound reads as the collision-free residual.
 """
 
 from __future__ import annotations
@@ -37,9 +52,9 @@ import numpy as np
 from numpy.typing import NDArray
 
 from ..friction.laws.base import CANONICAL_COLUMNS
-from ..friction.model import FrictionModel, FrictionSum
+from ..friction.model import FrictionModel, FrictionSum, friction_parts
 
-__all__ = ["FRICTION_COLUMNS", "canonical_friction", "standstill_margin"]
+__all__ = ["FRICTION_COLUMNS", "canonical_friction", "standstill_margin", "velocity_bands"]
 
 #: The canonical parameters per motor (module docstring).
 FRICTION_COLUMNS = CANONICAL_COLUMNS
@@ -61,17 +76,62 @@ def canonical_friction(
     return friction.transmission, canonical(np.asarray(friction.params), np.asarray(friction.band))
 
 
-def standstill_margin(
+#: Consecutive samples per estimate of the velocity noise (:func:`velocity_bands` takes
+#: the median of the windows' estimates: a long log in bounded memory).
+_NOISE_WINDOW = 1 << 16
+
+
+def velocity_bands(
     friction: FrictionModel | FrictionSum | None, dq: NDArray[np.float64]
+) -> tuple[NDArray[np.float64], ...]:
+    """The velocity noise band [rad/s] of the motors of every part of ``friction`` (one
+    (n,) array per part; none without friction), estimated on the velocities ``dq`` (N, n)
+    [rad/s] seen through the part's transmission
+    (:func:`~dynid.identification.sanity.velocity_noise_std` times
+    :data:`~dynid.identification.sanity.NOISE_BAND_STD`, the median of its estimates over
+    windows of :data:`_NOISE_WINDOW` samples); zeros for fewer than 4 samples.
+    """
+    from ..identification.sanity import noise_band, velocity_noise_std
+
+    v = np.asarray(dq, dtype=np.float64)
+    parts = friction_parts(friction)
+    out = []
+    for part in parts:
+        if v.shape[0] < 4:
+            out.append(np.zeros(part.n))
+            continue
+        K = np.asarray(part.transmission)
+        sd = np.zeros(part.n)
+        for k in range(part.n):  # a motor at a time, over windows: bounded temporaries
+            est = [
+                velocity_noise_std((v[a : a + _NOISE_WINDOW] @ K[k])[:, None])[0]
+                for a in range(0, v.shape[0], _NOISE_WINDOW)
+                if v.shape[0] - a >= 4
+            ]
+            sd[k] = np.median(est)
+        out.append(np.asarray(noise_band(sd), dtype=np.float64))
+    return tuple(out)
+
+
+def standstill_margin(
+    friction: FrictionModel | FrictionSum | None,
+    dq: NDArray[np.float64],
+    bands: tuple[NDArray[np.float64], ...] | None = None,
 ) -> NDArray[np.float64]:
     """Bound [N m] (..., n) of the friction the model cannot know at velocities ``dq``
     [rad/s] (..., n): its Coulomb level where the law's Coulomb term is off or not at its
-    level (module docstring); zeros without friction or for a law without a canonical form;
-    the sum of the parts' for a :class:`~dynid.friction.model.FrictionSum`.
+    level and, with ``bands`` (:func:`velocity_bands`, one per part), what its smooth
+    Coulomb steps change within the velocity noise band (module docstring); zeros without
+    friction or for a law without a canonical form; the sum of the parts' for a
+    :class:`~dynid.friction.model.FrictionSum`.
     """
     v = np.asarray(dq, dtype=np.float64)
     if isinstance(friction, FrictionSum):
-        parts = [standstill_margin(p, v) for p in friction.parts]
+        each = bands if bands is not None else (None,) * len(friction.parts)
+        parts = [
+            standstill_margin(p, v, None if b is None else (b,))
+            for p, b in zip(friction.parts, each, strict=True)
+        ]
         total: NDArray[np.float64] = np.sum(parts, axis=0)
         return total
     n = v.shape[-1]
@@ -86,5 +146,28 @@ def standstill_margin(
     with np.errstate(divide="ignore", invalid="ignore"):
         x = np.where(vs > 0, np.abs(vm) / np.where(vs > 0, vs, 1.0), np.inf)
     w = w + ft * np.where(vs > 0, 1.0 - np.tanh(x), np.where(vm == 0.0, 1.0, 0.0))
+    if bands is not None and bands[0] is not None:
+        w = w + _step_spread(F, vm, np.asarray(bands[0], dtype=np.float64))
     out: NDArray[np.float64] = w @ np.abs(K)
+    return out
+
+
+def _step_spread(
+    F: NDArray[np.float64], vm: NDArray[np.float64], b: NDArray[np.float64]
+) -> NDArray[np.float64]:
+    """Per motor (..., n) [N m]: the largest change of the smooth Coulomb steps (sigmoid,
+    tanh) within ``b`` (n,) [rad/s] of the motor velocities ``vm`` (module docstring)."""
+
+    def steps(v: NDArray[np.float64]) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+        with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
+            # phi1 sigma(phi2 (v + phi3)) less its constant phi1 / 2
+            sig = F[:, 10] * (0.5 * np.tanh(0.5 * F[:, 11] * (v + F[:, 12])))
+            vs = F[:, 9]
+            th = np.where(vs > 0, F[:, 8] * np.tanh(v / np.where(vs > 0, vs, 1.0)), 0.0)
+        return sig, th
+
+    mid, lo, hi = steps(vm), steps(vm - b), steps(vm + b)
+    out: NDArray[np.float64] = np.zeros_like(vm)
+    for k in range(2):  # each step monotone: its largest change at an end of the band
+        out = out + np.maximum(np.abs(hi[k] - mid[k]), np.abs(lo[k] - mid[k]))
     return out

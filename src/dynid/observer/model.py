@@ -28,8 +28,9 @@ from ..identification.model import IdentifiedModel
 from ..model.drive import Drive
 from ..model.robot import Robot
 from ..regressors.base import BaseParameters
+from ..regressors.terms import ModelTerm
 
-__all__ = ["ObserverModel", "from_identified", "from_robot"]
+__all__ = ["ObserverModel", "from_identified", "from_robot", "term_mass"]
 
 
 @dataclass(frozen=True, slots=True, eq=False)
@@ -52,7 +53,11 @@ class ObserverModel:
     covariance : ndarray, shape (r, r), or None
         Their covariance (None when unknown).
     drive : Drive or None
-        The drive of the rotor columns of the base parameters (``Ia1 .. Ia_n``).
+        The drive the logs are read through (motor-side logs brought to the joints).
+    base_terms : tuple of ModelTerm
+        The identified model's terms in the base (a rotor inertia), in the order of their
+        standard parameters after the links': each gives its momentum columns
+        (:meth:`~dynid.regressors.terms.ModelTerm.momentum_columns`).
     source : str
         What the model was made from (``"identified"``, ``"robot"``), for reports.
     """
@@ -65,6 +70,7 @@ class ObserverModel:
     covariance: NDArray[np.float64] | None = None
     drive: Drive | None = None
     source: str = "robot"
+    base_terms: tuple[ModelTerm, ...] = ()
 
     def __post_init__(self) -> None:
         n = self.robot.n
@@ -86,7 +92,7 @@ class ObserverModel:
         """The same model with another friction (None: none)."""
         return ObserverModel(
             self.robot, self.rotor_mass, friction, self.base, self.beta, self.covariance,
-            self.drive, self.source,
+            self.drive, self.source, self.base_terms,
         )  # fmt: skip
 
     def mass_matrix(self, q: ArrayLike) -> NDArray[np.float64]:
@@ -104,8 +110,9 @@ def from_identified(
     Parameters
     ----------
     model : IdentifiedModel
-        Base parameters (through ``equivalent_robot``), rotor inertias (``rotor_inertia``
-        with ``drive``), the identified friction and the covariance of ``fit``.
+        Base parameters (through ``equivalent_robot``), the rotor inertias (the drive's
+        known ones, and the terms in the base, each its own mass through its momentum
+        columns: :func:`term_mass`), the identified friction and the covariance of ``fit``.
     friction : FrictionModel, None or "model"
         ``"model"`` (default): the friction identified with the model (each friction term
         where it acts: :func:`~dynid.friction.validation.own_friction`), none if it has none.
@@ -116,8 +123,11 @@ def from_identified(
     """
     n = model.robot.n
     Mr = np.zeros((n, n))
-    if model.rotor_inertia is not None and model.drive is not None:
-        Mr = model.drive.rotor_mass_matrix(model.rotor_inertia)
+    if model.drive is not None and model.drive.rotor_inertia is not None:  # known ones
+        Mr = model.drive.rotor_mass_matrix(model.drive.rotor_inertia)
+    in_base = [t for t in model.terms.values() if t.term.in_base]
+    for t in in_base:  # identified ones: each term's momentum per unit velocity
+        Mr = Mr + term_mass(t.term, t.values, n)
     fr = own_friction(model) if isinstance(friction, str) else friction
     fit = model.fit
     return ObserverModel(
@@ -129,7 +139,18 @@ def from_identified(
         covariance=None if fit.covariance is None else np.asarray(fit.covariance),
         drive=model.drive,
         source="identified",
+        base_terms=tuple(t.term for t in in_base),
     )
+
+
+def term_mass(term: ModelTerm, values: ArrayLike, n: int) -> NDArray[np.float64]:
+    """The constant mass matrix (n, n) [kg m^2] of a term of constant inertia (a rotor's
+    ``K^T diag(I_a) K``) with its coefficients ``values`` (p,): its momentum columns at
+    unit joint velocities, ``M[:, j] = Y_p(e_j) values``; zeros for a term without
+    inertia."""
+    cols = term.momentum_columns(np.zeros((n, n)), np.eye(n))  # (j, i, k)
+    out: NDArray[np.float64] = (cols @ np.asarray(values, dtype=np.float64)).T
+    return out
 
 
 def from_robot(

@@ -12,6 +12,7 @@ from pathlib import Path
 import numpy as np
 from numpy.typing import NDArray
 
+from ..exceptions import DataError
 from .detection import ContactEvent, Thresholds
 from .model import ObserverModel
 from .wrench import WrenchEstimate
@@ -27,8 +28,10 @@ class LogObservation:
     ----------
     path : Path
     t : ndarray, shape (N,)
-    r : ndarray, shape (N, n)
-        Residual [N m].
+    r : ndarray, shape (N, n), or None
+        Residual [N m]; None when a calibration kept no series (a long log's thresholds
+        from running statistics: ``keep_series`` of
+        :class:`~dynid.workflows.observe.ObserveOptions`).
     std : ndarray, shape (N, n), or None
         Its standard deviation from the model's uncertainty (when used).
     events : list of ContactEvent
@@ -42,23 +45,40 @@ class LogObservation:
         (:func:`~dynid.observer.detection.standstill_series`), when the thresholds use it.
     restarts : tuple of int
         First sample of each piece the observer ran on (the log cut at its gaps).
+    standstill_peak : ndarray, shape (n,), or None
+        The largest standstill margin of each joint over the log [N m] (kept without the
+        series).
     """
 
     path: Path
     t: NDArray[np.float64]
-    r: NDArray[np.float64]
+    r: NDArray[np.float64] | None
     std: NDArray[np.float64] | None
     events: list[ContactEvent]
     wrench: WrenchEstimate | None
     tau_ext: NDArray[np.float64] | None
     standstill: NDArray[np.float64] | None = None
     restarts: tuple[int, ...] = (0,)
+    standstill_peak: NDArray[np.float64] | None = None
+
+    @property
+    def series(self) -> NDArray[np.float64]:
+        """The residual ``r`` (N, n) [N m].
+
+        Raises
+        ------
+        DataError
+            A calibration that kept no series.
+        """
+        if self.r is None:
+            raise DataError(f"{self.path.name}: the calibration kept no residual series")
+        return self.r
 
     def truth_error(self) -> NDArray[np.float64] | None:
         """RMS [N m] (n,) per joint of the residual against the true external torques
         ``r - tau_ext`` (the observer's first-order lag included), over the samples the
         observer ran on; None without ``tau_ext``."""
-        if self.tau_ext is None:
+        if self.tau_ext is None or self.r is None:
             return None
         e = self.r - self.tau_ext
         ran = np.all(np.isfinite(e), axis=1)

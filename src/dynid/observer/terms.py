@@ -197,8 +197,10 @@ def base_momentum_regressor(
     """:func:`momentum_regressor` over an identified model's base parameters.
 
     ``p = Y_p beta (+ M_r dq for rotor inertias known, not identified)`` and
-    ``g - C^T dq = Y_beta beta``; identified rotor inertias (``Ia1 .. Ia_n``, standard
-    parameters after the links') have momentum columns ``K_k^T (K_k dq)``.
+    ``g - C^T dq = Y_beta beta``; the model's terms in the base (identified rotor
+    inertias, standard parameters after the links') give their own momentum columns
+    (:meth:`~dynid.regressors.terms.ModelTerm.momentum_columns`: ``K_k^T (K_k dq)`` for
+    rotor ``k``).
 
     Returns
     -------
@@ -207,7 +209,8 @@ def base_momentum_regressor(
     Raises
     ------
     ShapeError
-        A model without base parameters (a robot's own parameters), bad shapes.
+        A model without base parameters (a robot's own parameters), base parameters over
+        other terms than the model's, bad shapes.
     """
     from ..exceptions import ShapeError
 
@@ -221,10 +224,20 @@ def base_momentum_regressor(
     p_std = model.base.n_std
     Fp, Fb = np.zeros((B, n, p_std)), np.zeros((B, n, p_std))
     Fp[..., : 10 * n], Fb[..., : 10 * n] = Yp, Yg - Yc
-    if p_std > 10 * n and model.drive is not None:
-        # the rotors that are standard parameters (a rotor term may hold some only)
-        held = np.isin(model.drive.rotor_labels, model.base.std_labels[10 * n :])
-        Fp[..., 10 * n :] = model.drive.rotor_columns(dq2)[..., held]
+    start = 10 * n
+    for term in model.base_terms:  # each term's own columns, in the base's order
+        k = len(term.labels)
+        if start + k > p_std:
+            break
+        Fp[..., start : start + k] = term.momentum_columns(q2, dq2)
+        # constant inertia: its torque without acceleration is all it adds to g - C^T dq
+        Fb[..., start : start + k] = term.torque_columns(q2, dq2, np.zeros_like(q2))
+        start += k
+    if start != p_std:
+        raise ShapeError(
+            f"the base's {p_std} standard parameters are not the links' {10 * n} and those "
+            f"of the model's terms in the base ({start - 10 * n})"
+        )
     idx = np.asarray(model.base.independent)
     r = idx.size
     return Fp[..., idx].reshape(shape + (n, r)), Fb[..., idx].reshape(shape + (n, r))

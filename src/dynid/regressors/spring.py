@@ -69,6 +69,12 @@ class JointSpring:
         """None: taken without the configuration (module docstring)."""
         return None
 
+    def momentum_columns(
+        self, q: NDArray[np.float64], dq: NDArray[np.float64]
+    ) -> NDArray[np.float64]:
+        """(B, n, n) zeros: a spring holds no momentum."""
+        return np.zeros(np.shape(dq) + (len(self.q0),))
+
     def friction(self, values: NDArray[np.float64]) -> None:
         """None: not friction."""
         return None

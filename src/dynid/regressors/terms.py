@@ -134,6 +134,14 @@ class ModelTerm(Protocol):
         """Columns (p, n (n + 1) / 2 + n, N) of the static regressor, or None."""
         ...
 
+    def momentum_columns(
+        self, q: NDArray[np.float64], dq: NDArray[np.float64]
+    ) -> NDArray[np.float64]:
+        """Columns (B, n, p) of the term's part of the generalized momentum ``M dq`` of
+        (B, n) joint states, per unit coefficient (the momentum observer's regressor);
+        zeros for a term without inertia."""
+        ...
+
     def friction(self, values: NDArray[np.float64]) -> FrictionValues | None:
         """The coefficients (p,) as a friction law's parameters; None: not friction."""
         ...
@@ -205,6 +213,13 @@ class RotorInertia:
     ) -> NDArray[np.float64]:
         """(B, n, p): column ``k`` is ``K[k]^T (K[k] . ddq)`` (the rotors held)."""
         return self.drive.rotor_columns(ddq)[..., self._held]
+
+    def momentum_columns(
+        self, q: NDArray[np.float64], dq: NDArray[np.float64]
+    ) -> NDArray[np.float64]:
+        """(B, n, p): column ``k`` is ``K[k]^T (K[k] . dq)``, rotor ``k``'s momentum at
+        the joints (the rotors held); constant inertia, so the torque is its derivative."""
+        return self.drive.rotor_columns(dq)[..., self._held]
 
     def static_columns(self, n_samples: int) -> NDArray[np.float64]:
         """(p, s, N): ``tril(K[k] K[k]^T)`` in the rows of ``M``, zero in those of ``g``."""
@@ -466,6 +481,12 @@ class LinearFriction:
         if self.drive.friction_at == "joint":
             return F
         return np.einsum("mj,...mc->...jc", self.drive.transmission, F)
+
+    def momentum_columns(
+        self, q: NDArray[np.float64], dq: NDArray[np.float64]
+    ) -> NDArray[np.float64]:
+        """(B, n, p) zeros: friction holds no momentum."""
+        return np.zeros(np.shape(dq) + (len(self.labels),))
 
     def static_columns(self, n_samples: int) -> None:
         """None: friction does not act at rest."""

@@ -30,42 +30,30 @@ the command applies, so that the Python API behaves as the command does.
 
 from __future__ import annotations
 
-import warnings
-from collections.abc import Mapping
+import dataclasses
+from collections.abc import Callable, Iterator, Mapping
 from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
 from numpy.typing import NDArray
 
-from ..exceptions import DataError, DynidWarning, OptionError
+from ..exceptions import OptionError
 from ..friction.model import FrictionModel, FrictionSum
 from ..identification.log import (
-    DEFAULT_CUTOFF_HZ,
     TorqueLog,
-    default_max_gap,
-    joint_side_log,
 )
-from ..identification.pieces import unwrapped, wrappable
 from ..io.columns import load_joint_columns
 from ..io.feasible import load_feasible_drive, load_feasible_linear_friction
 from ..io.friction_json import load_friction_json
 from ..io.model_json import load_model_json
 from ..io.observer_files import load_thresholds
 from ..io.robot_file import load_robot
-from ..observer.detection import (
-    Thresholds,
-    calibrate,
-    detect,
-    residual_std,
-    standstill_series,
-)
+from ..observer.detection import Thresholds, calibrate, detect
 from ..observer.model import ObserverModel, from_identified, from_robot
-from ..observer.pieces import PositionJump, pieces, position_jumps
-from ..observer.residual import DEFAULT_GAIN, MomentumObserver, ObserverOptions
+from ..observer.residual import DEFAULT_GAIN, ObserverOptions
 from ..observer.results import LogObservation, ObserveResult
 from ..observer.wrench import external_wrench
-from ..signals import edge_seconds, filtered_derivative
 from .data_files import (
     ColumnSpec,
     column_map,
@@ -74,6 +62,7 @@ from .data_files import (
     read_torque_log,
     recorded_columns,
 )
+from .observe_logs import ObservedBlock, PreparedLog, Series, observed_blocks, prepared_log
 from .recordings import Recorded, check_limits, check_units
 
 __all__ = [
@@ -130,6 +119,11 @@ class ObserveOptions:
     base, tip : str, optional
         The chain of a ``params`` URDF with several leaves (its root and only leaf by
         default).
+    keep_series : bool
+        When calibrating: keep every log's residual (and its std and margin) in the
+        result, for figures. False: only the calibration's running statistics, a block of
+        samples at a time (bounded memory on a long log); the result's logs then hold no
+        series. Detecting always keeps them (events, ``residuals.csv``).
     """
 
     data: tuple[Path, ...]
@@ -154,6 +148,7 @@ class ObserveOptions:
     max_gap: float | None = None
     base: str | None = None
     tip: str | None = None
+    keep_series: bool = True
 
 
 def load_observer_model(
@@ -280,47 +275,27 @@ def observe_files(opts: ObserveOptions) -> ObserveResult:
     wants_margin = opts.standstill if given is None else given.standstill
     columns = recorded_columns(recorded, *opts.columns)  # (names, units), said once
     read = _read_logs(data_files(opts.data), model, columns, opts)
+    if given is None:
+        return _calibrated(
+            read, model, columns[0] is not None, opts, options, wants_std, wants_margin
+        )
     logs = [
         _observe_log(p, log, model, columns[0] is not None, opts, options, wants_std, wants_margin)
         for p, log in zip(read.paths, read.logs, strict=True)
     ]
-    if given is None:
-        seen = [np.all(np.isfinite(x.r), axis=1) for x in logs]  # observed samples only
-        th = calibrate(
-            [x.r[k] for x, k in zip(logs, seen, strict=True)],
-            options,
-            std=[x.std[k] for x, k in zip(logs, seen, strict=True)] if wants_std else None,  # type: ignore[index]
-            standstill=(
-                [x.standstill[k] for x, k in zip(logs, seen, strict=True)]  # type: ignore[index]
-                if wants_margin
-                else None
-            ),
-            margin=opts.margin,
-            quantile=opts.quantile,
-            collision_factor=opts.collision_factor,
-            k_sigma=opts.k_sigma,
-        )
-        return ObserveResult(model, th, tuple(logs))
     found = tuple(
-        LogObservation(
-            x.path,
-            x.t,
-            x.r,
-            x.std,
-            detect(
+        dataclasses.replace(
+            x,
+            events=detect(
                 x.t,
-                x.r,
+                x.series,
                 given,
                 std=x.std,
                 standstill=x.standstill,
                 merge_s=opts.merge_s,
                 restarts=x.restarts,
             ),
-            x.wrench,
-            x.tau_ext,
-            x.standstill,
-            x.restarts,
-        )  # fmt: skip
+        )
         for x in logs
     )
     return ObserveResult(model, given, found)
@@ -346,6 +321,74 @@ def _read_logs(
     return read
 
 
+def _calibrated(
+    read: Recorded,
+    model: ObserverModel,
+    mapped: bool,
+    opts: ObserveOptions,
+    options: ObserverOptions,
+    wants_std: bool,
+    wants_margin: bool,
+) -> ObserveResult:
+    """The thresholds of the collision-free logs ``read``: their residuals a block at a
+    time into :func:`~dynid.observer.detection.calibrate` (running maxima), each log's
+    series kept only with ``opts.keep_series``."""
+    logs: list[LogObservation] = []
+
+    def blocks() -> Iterator[ObservedBlock]:
+        for path, log in zip(read.paths, read.logs, strict=True):
+            prep = prepared_log(Path(path), log, model, opts.max_gap)
+            keep = Series.new(prep, model.n, wants_std, wants_margin) if opts.keep_series else None
+            peak = np.zeros(model.n)
+            for blk in observed_blocks(prep, model, options, wants_std, wants_margin):
+                if blk.margin is not None:
+                    np.maximum(peak, blk.margin.max(axis=0), out=peak)
+                if keep is not None:
+                    keep.put(blk)
+                yield blk
+            logs.append(_observation(prep, model, mapped, opts, keep, peak))
+
+    # calibrate reads a block's residual, then its margin and std: these two come from the
+    # block the residual was last read from (one block held; itertools.tee would keep up
+    # to 57 blocks, its links' size)
+    current: list[ObservedBlock] = []
+
+    def residuals() -> Iterator[NDArray[np.float64]]:
+        for x in blocks():
+            current[:] = [x]
+            yield x.r
+
+    def beside(
+        what: Callable[[ObservedBlock], NDArray[np.float64]],
+    ) -> Iterator[NDArray[np.float64]]:
+        while current:
+            yield what(current[0])
+
+    std = beside(_std) if wants_std else None
+    margins = beside(lambda x: _margin(x, model.n)) if wants_margin else None
+    r = residuals()
+    th = calibrate(
+        r,
+        options,
+        std=std,
+        standstill=margins,
+        margin=opts.margin,
+        quantile=opts.quantile,
+        collision_factor=opts.collision_factor,
+        k_sigma=opts.k_sigma,
+    )
+    return ObserveResult(model, th, tuple(logs))
+
+
+def _std(x: ObservedBlock) -> NDArray[np.float64]:
+    assert x.std is not None
+    return x.std
+
+
+def _margin(x: ObservedBlock, n: int) -> NDArray[np.float64]:
+    return np.zeros((x.r.shape[0], n)) if x.margin is None else x.margin
+
+
 def _observe_log(
     path: Path,
     log: TorqueLog,
@@ -358,169 +401,47 @@ def _observe_log(
 ) -> LogObservation:
     """The residual (and its std, the wrench, the stored true torques) of one log, as
     read (``mapped``: through a column map)."""
-    path = Path(path)
-    log = joint_side_log(log, model.drive)
-    log, turned = unwrapped(log, wrappable(model.robot))  # joints whose limits span a turn
-    if turned:  # M(q) is periodic; velocities derived across a wrap are not
-        warnings.warn(
-            f"{path.name}: joint(s) {', '.join(str(j + 1) for j in turned)} recorded wrapped "
-            "into [-pi, pi] (jumps of a whole turn): unwrapped",
-            DynidWarning,
-            stacklevel=3,
-        )
-    starts = _pieces(path, log, opts)
-    dq = _piece_velocities(log, starts)  # of a log of positions: from the unwrapped ones
-    cut = _cut_at_jumps(path, log, dq, starts)
-    if cut != starts and log.dq_derived:  # derived again, never across a jump
-        dq = _piece_velocities(log, cut)
-    starts = cut
-    spans = _observed_spans(path, log, starts)
+    prep = prepared_log(Path(path), log, model, opts.max_gap)
+    keep = Series.new(prep, model.n, wants_std, wants_margin)
+    peak = np.zeros(model.n)
+    for blk in observed_blocks(prep, model, options, wants_std, wants_margin):
+        keep.put(blk)
+        if blk.margin is not None:
+            np.maximum(peak, blk.margin.max(axis=0), out=peak)
+    return _observation(prep, model, mapped, opts, keep, peak)
+
+
+def _observation(
+    prep: PreparedLog,
+    model: ObserverModel,
+    mapped: bool,
+    opts: ObserveOptions,
+    keep: Series | None,
+    peak: NDArray[np.float64],
+) -> LogObservation:
+    """A log's observation from its series (None: not kept) and its margin's peak."""
+    path, log = prep.path, prep.log
 
     def run() -> LogObservation:
-        t, q, tau, n = log.t, log.q, log.tau, model.n
-        r = np.full((t.shape[0], n), np.nan)
-        std = np.full_like(r, np.nan) if wants_std else None
-        margin = np.zeros(r.shape) if wants_margin else None  # untouched where it stays 0
-        for a, b in spans:
-            obs = MomentumObserver(model, options)  # one per piece, run a block at a time:
-            for c in range(a, b, _OBSERVE_BLOCK):  # no full-length copies of the residual
-                d = min(c + _OBSERVE_BLOCK, b)
-                r[c:d] = obs.run(t[c:d], q[c:d], dq[c:d], tau[c:d])
-            if std is not None:
-                std[a:b] = residual_std(model, t[a:b], q[a:b], dq[a:b], options)
-            if margin is not None:
-                m = standstill_series(model, t[a:b], dq[a:b], options)
-                if np.any(m):  # a friction without a band: its zeros not written (no memory)
-                    margin[a:b] = m
-                del m
         wrench = None
-        if opts.frame is not None:
-            wrench = external_wrench(model.robot, log.q, r, opts.frame)
+        if opts.frame is not None and keep is not None:
+            wrench = external_wrench(model.robot, log.q, keep.r, opts.frame)
         ext = None
-        if path.suffix.lower() in (".csv", ".npz") and not mapped:
+        if keep is not None and path.suffix.lower() in (".csv", ".npz") and not mapped:
             ext = load_joint_columns(path, "tau_ext", model.n)
             if ext is not None and ext.shape[0] != log.t.shape[0]:
                 ext = None  # rows were dropped: not aligned with the log
         return LogObservation(
-            path, log.t, r, std, [], wrench, ext, margin, tuple(a for a, _ in spans)
+            path,
+            log.t,
+            None if keep is None else keep.r,
+            None if keep is None else keep.std,
+            [],
+            wrench,
+            ext,
+            None if keep is None else keep.margin,
+            tuple(a for a, _ in prep.spans),
+            peak,
         )
 
     return in_file(path, run)
-
-
-#: Samples the observer runs on at a time (its state carried from block to block).
-_OBSERVE_BLOCK = 1 << 16
-
-
-def _piece_velocities(log: TorqueLog, starts: list[int]) -> NDArray[np.float64]:
-    """The velocities the observer runs on: the log's, or, for a log of positions only,
-    derived from the positions of each piece on its own (never across a gap)."""
-    if not log.dq_derived:
-        return np.asarray(log.dq)
-    dq = np.array(log.dq)
-    for a, b in zip(starts, [*starts[1:], log.t.shape[0]], strict=True):
-        try:
-            dq[a:b] = filtered_derivative(log.t[a:b], log.q[a:b], DEFAULT_CUTOFF_HZ)
-        except DataError:  # too short to filter: its span is not observed
-            dq[a:b] = np.nan
-    return dq
-
-
-def _observed_spans(path: Path, log: TorqueLog, starts: list[int]) -> list[tuple[int, int]]:
-    """The samples ``[a, b)`` the observer runs on: every piece; for a log of positions
-    only, each piece without the first and last ``2 / cut-off`` seconds, where the derived
-    velocities carry the low-pass's transient (a note says so; their residual is NaN)."""
-    ends = [*starts[1:], log.t.shape[0]]
-    if not log.dq_derived:
-        return list(zip(starts, ends, strict=True))
-    edge = edge_seconds(DEFAULT_CUTOFF_HZ)
-    spans = []
-    for a, b in zip(starts, ends, strict=True):
-        t = log.t[a:b]
-        inside = np.flatnonzero((t >= t[0] + edge) & (t <= t[-1] - edge))
-        if inside.size > 1:
-            spans.append((a + int(inside[0]), a + int(inside[-1]) + 1))
-    warnings.warn(
-        f"{path.name}: velocities derived from the positions of each piece: the first and "
-        f"last {edge:g} s of each piece (the low-pass's transient) are not observed (NaN "
-        "residuals)" + ("" if spans else "; no piece is long enough: nothing is observed"),
-        DynidWarning,
-        stacklevel=4,
-    )
-    return spans
-
-
-def _pieces(path: Path, log: TorqueLog, opts: ObserveOptions) -> list[int]:
-    """First sample of each piece the observer runs on (module docstring), with a
-    warning of the cuts (file and times)."""
-    c = log.cleaning
-    dt = np.diff(log.t)
-    limit = opts.max_gap
-    if limit is None:
-        limit = default_max_gap(float(np.median(dt)) if dt.size else 1.0)
-    starts = [int(k) for k in pieces(log.t, limit, c.invalid_after)]
-    if len(starts) > 1:
-        at = ", ".join(f"{log.t[k]:.6g}" for k in starts[1:6])
-        more = f" and {len(starts) - 6} more" if len(starts) > 6 else ""
-        why = f"gaps longer than {limit:.3g} s" + (
-            f" or after {c.n_nan_rows} row(s) dropped for NaN/inf" if c.invalid_after else ""
-        )
-        warnings.warn(
-            f"{path.name}: cut at {why}: the observer starts again at t = {at}{more} s "
-            "(no event spans a cut)",
-            DynidWarning,
-            stacklevel=4,
-        )
-    return starts
-
-
-def _cut_at_jumps(
-    path: Path, log: TorqueLog, dq: NDArray[np.float64], starts: list[int]
-) -> list[int]:
-    """The pieces cut again where positions jump more than the velocities ``dq`` explain
-    (:func:`~dynid.observer.pieces.position_jumps`) over one regular time step (a stretch
-    of samples lost without a gap in the stamps, an encoder glitch), with a warning naming
-    the file, the joints and the times: the observer starts again there, so that no event
-    is made of the jump (a lost stretch of 0.2 s was a 'collision' on every joint). A
-    glitch's jump back is found in the next pass (at most three). A jump across a gap
-    bridged by ``--max-gap`` is warned about only (bridging was asked for)."""
-    dt = np.diff(log.t)
-    regular = 1.5 * float(np.median(dt)) if dt.size else np.inf
-    found: list[PositionJump] = []
-    bridged: list[PositionJump] = []
-    cut = list(starts)
-    for _ in range(3):
-        jumps = [x for x in position_jumps(log.t, log.q, dq, cut) if x not in found + bridged]
-        at: set[int] = set()
-        for x in jumps:
-            k = int(np.searchsorted(log.t, x.t))
-            if k > 0 and log.t[k] - log.t[k - 1] > regular:
-                bridged.append(x)
-            elif k not in cut:
-                found.append(x)
-                at.add(k)
-        if not at:
-            break
-        cut = sorted(set(cut) | at)
-    for jumps, what in (
-        (
-            found,
-            "samples lost without a gap in the time stamps, or an encoder glitch; the "
-            "observer starts again after each jump (no event spans one)",
-        ),
-        (bridged, "across a gap bridged by --max-gap: the residual after it is not to be trusted"),
-    ):
-        if not jumps:
-            continue
-        jumps.sort(key=lambda x: (x.t, x.joint))
-        listed = ", ".join(
-            f"joint {x.joint + 1} by {x.size:+.3g} at t = {x.t:.6g} s" for x in jumps[:3]
-        )
-        more = f" and {len(jumps) - 3} more" if len(jumps) > 3 else ""
-        warnings.warn(
-            f"{path.name}: position jumps more than the recorded velocity explains "
-            f"({listed}{more}): {what}",
-            DynidWarning,
-            stacklevel=4,
-        )
-    return cut

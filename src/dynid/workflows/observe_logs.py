@@ -1,0 +1,285 @@
+"""A log as ``dynid observe`` runs the momentum observer on it (:mod:`dynid.workflows.observe`).
+
+:func:`prepared_log` brings it to the joints through the model's drive, unwraps joints
+recorded in ``[-pi, pi]``, cuts it at its gaps and after rows dropped for NaN or inf, and
+again where positions jump more than the velocities explain (each with a warning naming the
+file), and keeps the spans the observer runs on. :func:`observed_blocks` then runs one
+observer per piece a block of :data:`OBSERVE_BLOCK` samples at a time, with the residual's
+std from the model's covariance and the standstill margin of the same samples: a long log
+is observed with one block's temporaries (a calibration keeps only running statistics;
+:class:`Series` fills full-length series when they are wanted).
+"""
+
+from __future__ import annotations
+
+import warnings
+from collections.abc import Iterator
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+from numpy.typing import NDArray
+
+from ..exceptions import DataError, DynidWarning
+from ..exceptions import in_file as about_file
+from ..identification.log import DEFAULT_CUTOFF_HZ, TorqueLog, default_max_gap, joint_side_log
+from ..identification.pieces import unwrapped, wrappable
+from ..observer.detection import residual_std_blocks, standstill_blocks
+from ..observer.model import ObserverModel
+from ..observer.pieces import PositionJump, pieces, position_jumps
+from ..observer.residual import MomentumObserver, ObserverOptions
+from ..signals import edge_seconds, filtered_derivative
+
+__all__ = [
+    "OBSERVE_BLOCK",
+    "ObservedBlock",
+    "PreparedLog",
+    "Series",
+    "observed_blocks",
+    "prepared_log",
+]
+
+
+@dataclass(frozen=True, slots=True)
+class PreparedLog:
+    """A log brought to the joints, with the velocities and the spans the observer runs
+    on (:func:`_prepared`)."""
+
+    path: Path
+    log: TorqueLog
+    dq: NDArray[np.float64]
+    spans: list[tuple[int, int]]
+
+
+@dataclass(frozen=True, slots=True)
+class ObservedBlock:
+    """The residual of samples ``[a, a + len(r))`` of a log, their std and margin."""
+
+    a: int
+    r: NDArray[np.float64]
+    std: NDArray[np.float64] | None
+    margin: NDArray[np.float64] | None
+
+
+@dataclass(frozen=True, slots=True)
+class Series:
+    """Full-length series of a log filled block by block (NaN where not observed)."""
+
+    r: NDArray[np.float64]
+    std: NDArray[np.float64] | None
+    margin: NDArray[np.float64] | None
+
+    @staticmethod
+    def new(prep: PreparedLog, n: int, wants_std: bool, wants_margin: bool) -> Series:
+        N = prep.log.t.shape[0]
+        r = np.full((N, n), np.nan)
+        return Series(
+            r,
+            np.full_like(r, np.nan) if wants_std else None,
+            np.zeros(r.shape) if wants_margin else None,  # untouched where it stays 0
+        )
+
+    def put(self, blk: ObservedBlock) -> None:
+        k = slice(blk.a, blk.a + blk.r.shape[0])
+        self.r[k] = blk.r
+        if self.std is not None and blk.std is not None:
+            self.std[k] = blk.std
+        if self.margin is not None and blk.margin is not None:
+            self.margin[k] = blk.margin
+
+
+def prepared_log(
+    path: Path, log: TorqueLog, model: ObserverModel, max_gap: float | None
+) -> PreparedLog:
+    """The log at the joints, unwrapped, cut at its gaps and jumps, with the velocities
+    and the spans the observer runs on (warnings name the file)."""
+    log = joint_side_log(log, model.drive)
+    log, turned = unwrapped(log, wrappable(model.robot))  # joints whose limits span a turn
+    if turned:  # M(q) is periodic; velocities derived across a wrap are not
+        warnings.warn(
+            f"{path.name}: joint(s) {', '.join(str(j + 1) for j in turned)} recorded wrapped "
+            "into [-pi, pi] (jumps of a whole turn): unwrapped",
+            DynidWarning,
+            stacklevel=4,
+        )
+    starts = _pieces(path, log, max_gap)
+    dq = _piece_velocities(log, starts)  # of a log of positions: from the unwrapped ones
+    cut = _cut_at_jumps(path, log, dq, starts)
+    if cut != starts and log.dq_derived:  # derived again, never across a jump
+        dq = _piece_velocities(log, cut)
+    return PreparedLog(path, log, dq, _observed_spans(path, log, cut))
+
+
+def observed_blocks(
+    prep: PreparedLog,
+    model: ObserverModel,
+    options: ObserverOptions,
+    wants_std: bool,
+    wants_margin: bool,
+) -> Iterator[ObservedBlock]:
+    """The residual of every observed span, :data:`OBSERVE_BLOCK` samples at a time (one
+    observer per piece, its state carried from block to block), with the std and the
+    standstill margin of the same samples (errors name the file)."""
+    t, q, tau, dq = prep.log.t, prep.log.q, prep.log.tau, prep.dq
+    with about_file(prep.path.name):
+        for a, b in prep.spans:
+            obs = MomentumObserver(model, options)
+            stds = _rechunked(
+                residual_std_blocks(model, t[a:b], q[a:b], dq[a:b], options)
+                if wants_std
+                else iter(()),
+                OBSERVE_BLOCK,
+            )
+            margins = (
+                standstill_blocks(model, t[a:b], dq[a:b], options, OBSERVE_BLOCK)
+                if wants_margin
+                else iter(())
+            )
+            pending = next(margins, None)
+            for c in range(a, b, OBSERVE_BLOCK):
+                d = min(c + OBSERVE_BLOCK, b)
+                m = None
+                if pending is not None and pending[0] == c - a:
+                    m, pending = pending[1], next(margins, None)
+                yield ObservedBlock(
+                    c,
+                    obs.run(t[c:d], q[c:d], dq[c:d], tau[c:d]),
+                    next(stds) if wants_std else None,
+                    m,
+                )
+
+
+def _rechunked(
+    blocks: Iterator[tuple[int, NDArray[np.float64]]], size: int
+) -> Iterator[NDArray[np.float64]]:
+    """Consecutive blocks ``(first sample, array)`` cut again into arrays of ``size``
+    samples (the last shorter): the std's blocks as the observer's."""
+    pending: list[NDArray[np.float64]] = []
+    have = 0
+    for _, x in blocks:
+        pending.append(x)
+        have += x.shape[0]
+        while have >= size:
+            cat = np.concatenate(pending)
+            yield cat[:size]
+            pending, have = [cat[size:]], cat.shape[0] - size
+    if have:
+        yield np.concatenate(pending)
+
+
+#: Samples the observer runs on at a time (its state carried from block to block).
+OBSERVE_BLOCK = 1 << 16
+
+
+def _piece_velocities(log: TorqueLog, starts: list[int]) -> NDArray[np.float64]:
+    """The velocities the observer runs on: the log's, or, for a log of positions only,
+    derived from the positions of each piece on its own (never across a gap)."""
+    if not log.dq_derived:
+        return np.asarray(log.dq)
+    dq = np.array(log.dq)
+    for a, b in zip(starts, [*starts[1:], log.t.shape[0]], strict=True):
+        try:
+            dq[a:b] = filtered_derivative(log.t[a:b], log.q[a:b], DEFAULT_CUTOFF_HZ)
+        except DataError:  # too short to filter: its span is not observed
+            dq[a:b] = np.nan
+    return dq
+
+
+def _observed_spans(path: Path, log: TorqueLog, starts: list[int]) -> list[tuple[int, int]]:
+    """The samples ``[a, b)`` the observer runs on: every piece; for a log of positions
+    only, each piece without the first and last ``2 / cut-off`` seconds, where the derived
+    velocities carry the low-pass's transient (a note says so; their residual is NaN)."""
+    ends = [*starts[1:], log.t.shape[0]]
+    if not log.dq_derived:
+        return list(zip(starts, ends, strict=True))
+    edge = edge_seconds(DEFAULT_CUTOFF_HZ)
+    spans = []
+    for a, b in zip(starts, ends, strict=True):
+        t = log.t[a:b]
+        inside = np.flatnonzero((t >= t[0] + edge) & (t <= t[-1] - edge))
+        if inside.size > 1:
+            spans.append((a + int(inside[0]), a + int(inside[-1]) + 1))
+    warnings.warn(
+        f"{path.name}: velocities derived from the positions of each piece: the first and "
+        f"last {edge:g} s of each piece (the low-pass's transient) are not observed (NaN "
+        "residuals)" + ("" if spans else "; no piece is long enough: nothing is observed"),
+        DynidWarning,
+        stacklevel=4,
+    )
+    return spans
+
+
+def _pieces(path: Path, log: TorqueLog, max_gap: float | None) -> list[int]:
+    """First sample of each piece the observer runs on (module docstring), with a
+    warning of the cuts (file and times)."""
+    c = log.cleaning
+    dt = np.diff(log.t)
+    limit = max_gap
+    if limit is None:
+        limit = default_max_gap(float(np.median(dt)) if dt.size else 1.0)
+    starts = [int(k) for k in pieces(log.t, limit, c.invalid_after)]
+    if len(starts) > 1:
+        at = ", ".join(f"{log.t[k]:.6g}" for k in starts[1:6])
+        more = f" and {len(starts) - 6} more" if len(starts) > 6 else ""
+        why = f"gaps longer than {limit:.3g} s" + (
+            f" or after {c.n_nan_rows} row(s) dropped for NaN/inf" if c.invalid_after else ""
+        )
+        warnings.warn(
+            f"{path.name}: cut at {why}: the observer starts again at t = {at}{more} s "
+            "(no event spans a cut)",
+            DynidWarning,
+            stacklevel=4,
+        )
+    return starts
+
+
+def _cut_at_jumps(
+    path: Path, log: TorqueLog, dq: NDArray[np.float64], starts: list[int]
+) -> list[int]:
+    """The pieces cut again where positions jump more than the velocities ``dq`` explain
+    (:func:`~dynid.observer.pieces.position_jumps`) over one regular time step (a stretch
+    of samples lost without a gap in the stamps, an encoder glitch), with a warning naming
+    the file, the joints and the times: the observer starts again there, so that no event
+    is made of the jump (a lost stretch of 0.2 s was a 'collision' on every joint). A
+    glitch's jump back is found in the next pass (at most three). A jump across a gap
+    bridged by ``--max-gap`` is warned about only (bridging was asked for)."""
+    dt = np.diff(log.t)
+    regular = 1.5 * float(np.median(dt)) if dt.size else np.inf
+    found: list[PositionJump] = []
+    bridged: list[PositionJump] = []
+    cut = list(starts)
+    for _ in range(3):
+        jumps = [x for x in position_jumps(log.t, log.q, dq, cut) if x not in found + bridged]
+        at: set[int] = set()
+        for x in jumps:
+            k = int(np.searchsorted(log.t, x.t))
+            if k > 0 and log.t[k] - log.t[k - 1] > regular:
+                bridged.append(x)
+            elif k not in cut:
+                found.append(x)
+                at.add(k)
+        if not at:
+            break
+        cut = sorted(set(cut) | at)
+    for jumps, what in (
+        (
+            found,
+            "samples lost without a gap in the time stamps, or an encoder glitch; the "
+            "observer starts again after each jump (no event spans one)",
+        ),
+        (bridged, "across a gap bridged by --max-gap: the residual after it is not to be trusted"),
+    ):
+        if not jumps:
+            continue
+        jumps.sort(key=lambda x: (x.t, x.joint))
+        listed = ", ".join(
+            f"joint {x.joint + 1} by {x.size:+.3g} at t = {x.t:.6g} s" for x in jumps[:3]
+        )
+        more = f" and {len(jumps) - 3} more" if len(jumps) > 3 else ""
+        warnings.warn(
+            f"{path.name}: position jumps more than the recorded velocity explains "
+            f"({listed}{more}): {what}",
+            DynidWarning,
+            stacklevel=4,
+        )
+    return cut
