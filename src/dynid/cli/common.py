@@ -451,6 +451,7 @@ def add_recordings_option(p: argparse.ArgumentParser) -> None:
         "--data",
         type=Path,
         nargs="+",
+        action="extend",
         required=True,
         help="torque log(s) (.csv or .npz), or a folder of them: each recording, and each "
         "piece between gaps longer than --max-gap, filtered on its own",

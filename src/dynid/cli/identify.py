@@ -128,6 +128,7 @@ def register(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParser:
         "--data",
         type=Path,
         nargs="+",
+        action="extend",
         required=True,
         metavar="FILE",
         help="data: one static data file, or one or more torque logs (a folder: its .csv and "

@@ -73,7 +73,14 @@ def register(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParser:
     p.add_argument("--base", help="--params URDF: base link of the chain (default: the root)")
     p.add_argument("--tip", help="--params URDF: tip link of the chain (default: the only leaf)")
     p.add_argument("--friction", type=Path, help="friction.json replacing the model's friction")
-    p.add_argument("--data", type=Path, nargs="+", required=True, help="torque log(s) or folder(s)")
+    p.add_argument(
+        "--data",
+        type=Path,
+        nargs="+",
+        action="extend",
+        required=True,
+        help="torque log(s) or folder(s)",
+    )
     mode = p.add_mutually_exclusive_group(required=True)
     mode.add_argument(
         "--calibrate", action="store_true", help="thresholds from collision-free logs"

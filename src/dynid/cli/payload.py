@@ -68,6 +68,7 @@ def register(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParser:
         "--data",
         type=Path,
         nargs="+",
+        action="extend",
         required=True,
         help="data with the load (.csv/.npz): static data (one file) or torque logs (one "
         "or more, or a folder of them)",
@@ -76,6 +77,7 @@ def register(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParser:
         "--unloaded",
         type=Path,
         nargs="+",
+        action="extend",
         default=None,
         help="the same kind of data without the load (difference method): one static data "
         "file, or torque logs (one or more, or a folder of them)",

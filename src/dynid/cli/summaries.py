@@ -236,9 +236,18 @@ def heldout_line(ho: dict[str, Any]) -> str:
         "file": "on the --validate-on log",
         "recordings": f"leaving out each of {ho.get('folds')} recordings in turn",
     }.get(str(ho.get("scheme")), f"over {ho.get('folds')} contiguous time blocks")
+    floor = ho.get("noise_floor_percent")
+    said = (
+        ""
+        if floor is None
+        else f"; the filtered torques' noise floor {floor:.3g} % "
+        f"({ho['heldout_error_percent'] / floor:.3g} x)"
+        if floor > 0
+        else ""
+    )
     return (
         f"least squares: training error {ho['training_error_percent']:.4g} %, held-out "
-        f"error {ho['heldout_error_percent']:.4g} % ({how})"
+        f"error {ho['heldout_error_percent']:.4g} % ({how}){said}"
     )
 
 

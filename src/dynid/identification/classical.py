@@ -76,7 +76,7 @@ from .log_rows import (
 from .model import IdentifiedModel
 from .prepare import prepare_log
 from .rate import cutoff_from_motion, decimation, motion_frequency
-from .sanity import check_torque_log, moving_joints
+from .sanity import check_torque_log, moving_joints, velocity_noise_std
 from .streaming import BlockSource, normals_by_label
 
 __all__ = [
@@ -371,6 +371,9 @@ class PreparedLog:
         Of the raw log.
     raw : TorqueLog
         The raw log's counts (``n_samples``, ``duration``, ``cleaning``).
+    torque_noise_std : ndarray, shape (n,), or None
+        White-noise std [N m] per joint of the raw log's joint-side torques
+        (:func:`~dynid.identification.sanity.velocity_noise_std`, which reads any signal's).
     """
 
     log: TorqueLog
@@ -385,6 +388,7 @@ class PreparedLog:
     cleaning: LogCleaning
     motion_frequency_hz: float | None = None
     resampled: bool = False
+    torque_noise_std: NDArray[np.float64] | None = None
 
     @property
     def route(self) -> Literal["classical"]:
@@ -510,6 +514,7 @@ def prepare_torque_log(
     prepared = prepare_log(
         jlog, cutoff_hz=cutoff_hz, trim_s=trim_s, max_gap_s=max_gap_s, decimate=k
     )
+    noise = velocity_noise_std(jlog.tau) if jlog.n_samples >= 3 else None
     del jlog
     return PreparedLog(
         log=prepared,
@@ -524,4 +529,5 @@ def prepare_torque_log(
         cleaning=log.cleaning,
         motion_frequency_hz=f_q,
         resampled=not signals.is_uniform(log.t),
+        torque_noise_std=noise,
     )

@@ -10,6 +10,7 @@ For measured ``tau`` and predicted ``tau_hat`` (N, n) [N m], with ``e = tau - ta
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from dataclasses import dataclass
 
 import numpy as np
@@ -18,7 +19,14 @@ from numpy.typing import ArrayLike, NDArray
 from .. import _checks
 from ..exceptions import ShapeError
 
-__all__ = ["TorqueErrors", "torque_errors", "rms", "mse", "relative_error_percent"]
+__all__ = [
+    "TorqueErrors",
+    "mse",
+    "noise_floor_percent",
+    "relative_error_percent",
+    "rms",
+    "torque_errors",
+]
 
 
 def _pair(tau: ArrayLike, tau_hat: ArrayLike) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
@@ -138,3 +146,36 @@ def _torque_errors(a: NDArray[np.float64], b: NDArray[np.float64]) -> TorqueErro
         relative_error_percent_per_joint=_checks.frozen(per),
         n_samples=a.shape[0],
     )
+
+
+def noise_floor_percent(
+    tau: Sequence[ArrayLike], noise_std: Sequence[ArrayLike], gains: Sequence[float]
+) -> float | None:
+    """The relative error [%] a perfect model leaves on filtered torques: their noise.
+
+    .. math:: 100 \\sqrt{\\sum_p N_p g_p^2 \\sum_j \\sigma_{pj}^2} \\Big/ \\|\\tau\\|
+
+    over pieces ``p`` of ``N_p`` samples whose raw torques held white noise of std
+    ``sigma_pj`` [N m] on joint ``j`` and went through a low-pass of noise gain ``g_p``
+    (:func:`~dynid.signals.lowpass_noise_gain`).
+
+    Parameters
+    ----------
+    tau : sequence of array_like, shape (N_p, n)
+        Each piece's filtered torques [N m], the samples used.
+    noise_std : sequence of array_like, shape (n,)
+        Each piece's raw noise std [N m].
+    gains : sequence of float
+        Each piece's noise gain.
+
+    Returns
+    -------
+    float or None
+        None for torques of zero norm.
+    """
+    noise = sum(
+        np.shape(t)[0] * g * g * float(np.sum(np.square(s)))
+        for t, s, g in zip(tau, noise_std, gains, strict=True)
+    )
+    norm = sum(float(np.sum(np.square(t))) for t in tau)
+    return None if norm == 0.0 else 100.0 * float(np.sqrt(noise / norm))

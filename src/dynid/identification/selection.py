@@ -40,6 +40,7 @@ from ..exceptions import DynidWarning, OptionError, RankDeficientError
 from ..model.drive import Drive
 from ..model.robot import Robot
 from ..regressors.terms import ModelTerm
+from ..signals import lowpass_noise_gain
 from .candidates import (
     OUTLIER_RATIO,
     Candidate,
@@ -55,6 +56,7 @@ from .estimators import Estimator, EstimatorName, estimator_named, row_weights
 from .holdout import DEFAULT_FOLDS, HeldOut, Normals, block_normals
 from .least_squares import StdMethod
 from .log import TorqueLog
+from .metrics import noise_floor_percent
 from .model import IdentifiedModel
 from .recordings import Recordings, prepare_recordings
 from .streaming import normals_by_label
@@ -158,6 +160,20 @@ def _terms_of(
 ) -> tuple[Drive | None, tuple[ModelTerm, ...]]:
     """:func:`~dynid.identification.structure.structure_terms` with the recordings' bands."""
     return structure_terms(structure, drive, n, tuple(data.band), _bands(data), data.band_gain)
+
+
+def _with_floor(heldout: Any, data: Recordings) -> Any:
+    """The held-out record with the noise floor of the filtered torques
+    (:func:`~dynid.identification.metrics.noise_floor_percent`), when both are known."""
+    pieces = data.pieces
+    if heldout is None or any(p.torque_noise_std is None for p in pieces):
+        return heldout
+    floor = noise_floor_percent(
+        [p.log.tau for p in pieces],
+        [p.torque_noise_std for p in pieces],  # type: ignore[misc]
+        [lowpass_noise_gain(p.sample_rate_hz, p.cutoff_hz) for p in pieces],
+    )
+    return heldout if floor is None else {**heldout, "noise_floor_percent": floor}
 
 
 def _physical(candidates: Sequence[Candidate]) -> list[Candidate]:
@@ -638,6 +654,7 @@ def identify_recordings(
     warn_unphysical(model, terms)
     info = replace(
         model.info,
+        heldout=_with_floor(model.info.heldout, data),
         selection=None if selection is None else selection.as_dict(),
         extra={**model.info.extra, "terms": list(structure.terms)},
     )

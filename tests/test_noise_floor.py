@@ -1,0 +1,38 @@
+"""The noise floor of the filtered torques printed beside the held-out error: what a
+perfect model leaves on them (the raw torque noise through the low-pass)."""
+
+from __future__ import annotations
+
+import warnings
+
+import numpy as np
+import pytest
+
+from dynid.cli.summaries import heldout_line
+from dynid.exceptions import DynidWarning
+from dynid.friction.model import ClassicalFriction
+from dynid.identification.selection import identify_recordings
+from dynid.identification.structure import Structure
+from dynid.simulation.measurement import SensorNoise
+
+from conftest import recordings
+
+
+def test_a_true_model_meets_the_noise_floor_it_is_given(panda):
+    """Torques with white noise of 0.05 N m and the true structure fitted: the held-out
+    error on the filtered torques is the predicted floor (within the fit's own error), and
+    the line says so."""
+    fr = ClassicalFriction(np.linspace(0.3, 0.1, 7), np.zeros(7), np.zeros(7))
+    logs = recordings(
+        panda,
+        (41, 42, 43),
+        friction=fr,
+        duration=8.0,
+        noise=SensorNoise(tau_std=0.05, q_std=0.0, dq_std=0.0),
+    )
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", DynidWarning)
+        model = identify_recordings(panda, logs, structure=Structure(False, ("viscous",)))
+    ho = model.info.heldout
+    assert ho["heldout_error_percent"] == pytest.approx(ho["noise_floor_percent"], rel=0.15)
+    assert "noise floor" in heldout_line(ho)
