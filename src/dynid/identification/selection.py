@@ -616,17 +616,11 @@ def identify_recordings(
         drive=drive,
     )
     validation = None
-    if validate_on is not None:
+    if validate_on is not None:  # prepared as the recordings
         validation = prepare_recordings(
-            robot,
-            [validate_on],
-            ["validation log"],
-            cutoff_hz=data.cutoff_hz,
-            trim_s=trim_s,
-            max_gap_s=max_gap_s,
-            decimate=data.pieces[0].decimate,
-            drive=drive,
-        )
+            robot, [validate_on], ["validation log"], cutoff_hz=data.cutoff_hz, trim_s=trim_s,
+            max_gap_s=max_gap_s, decimate=data.pieces[0].decimate, drive=drive,
+        )  # fmt: skip
     est = estimator_named(estimator)
     selection = None
     if structure == "auto":
