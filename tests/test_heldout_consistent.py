@@ -110,7 +110,7 @@ def test_a_consistent_fit_far_above_least_squares_in_training_is_accepted_held_o
 
     robot = dynid.panda()
     meta = ident["metadata"]
-    p = prepare_log(log, cutoff_hz=meta["cutoff_hz"])
+    p = prepare_log(log, cutoff_hz=meta["cutoff_hz"], trim_s=meta["trim_s"])
     s = slice(None, None, meta["decimate"])
     q, dq, ddq, tau = p.q[s], p.dq[s], p.ddq[s], p.tau[s]
     bp = base_parameters(robot, kind="torque")
