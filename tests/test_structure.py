@@ -85,6 +85,19 @@ def test_armature_and_viscous_friction_are_chosen_by_default(panda, armature_log
     assert [r["file"] for r in model.info.recordings] == ["a.csv", "b.csv", "c.csv"]
 
 
+def _fitted_with_held_out(panda, seeds, fr):
+    """The default identification of the first recordings of an arm with ``fr`` and the
+    armature (noise as the sensors'), the last recording held out and its true states."""
+    *logs, test = recordings(
+        panda, seeds, friction=fr, armature=ARMATURE, duration=8.0, noise=SensorNoise()
+    )
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", DynidWarning)
+        model = identify_recordings(panda, logs)
+    held = random_fourier(panda, np.random.default_rng(seeds[-1]))(sample_times(8.0, 500.0))
+    return model, test, held
+
+
 def test_a_joint_whose_friction_is_not_dissipative_loses_that_coefficient_alone(panda):
     """Every joint has viscous friction but joint 2's torque holds ``-0.05 dq2`` (an
     effect no dissipative law holds, as a controller's compensation would). Every
@@ -94,17 +107,7 @@ def test_a_joint_whose_friction_is_not_dissipative_loses_that_coefficient_alone(
     fv = VISCOUS.copy()
     fv[1] = -0.05
     fr = ClassicalFriction(fv, np.zeros(7), np.zeros(7))
-    *logs, test = recordings(
-        panda,
-        (1, 2, 3, 4),
-        friction=fr,
-        armature=ARMATURE,
-        duration=8.0,
-        noise=SensorNoise(),
-    )
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore", DynidWarning)
-        model = identify_recordings(panda, logs)
+    model, test, held = _fitted_with_held_out(panda, (1, 2, 3, 4), fr)
     sel = model.info.selection
     assert sel["chosen"] == "links + armature + viscous - fv2", sel["chosen"]
     chosen = next(c for c in sel["candidates"] if c["name"] == sel["chosen"])
@@ -113,7 +116,6 @@ def test_a_joint_whose_friction_is_not_dissipative_loses_that_coefficient_alone(
     np.testing.assert_allclose(
         model.friction.params[[0, 2, 3, 4, 5, 6], 0], np.delete(fv, 1), atol=0.03
     )
-    held = random_fourier(panda, np.random.default_rng(4))(sample_times(8.0, 500.0))
     rms = np.sqrt(np.mean((test.tau - _predict(model, held)) ** 2, axis=0))
     assert np.all(np.delete(rms, 1) < 1.1 * NOISE), rms  # joint 2 misses -0.05 dq2 only
 
@@ -124,20 +126,9 @@ def test_armature_and_offsets_without_friction_are_offered_and_chosen(panda):
     is predicted to its noise."""
     offsets = np.array([0.4, -0.3, 0.2, 0.0, 0.1, -0.2, 0.15])
     fr = ClassicalFriction(np.zeros(7), np.zeros(7), offsets)
-    *logs, test = recordings(
-        panda,
-        (21, 22, 23, 24),
-        friction=fr,
-        armature=ARMATURE,
-        duration=8.0,
-        noise=SensorNoise(),
-    )
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore", DynidWarning)
-        model = identify_recordings(panda, logs)
+    model, test, held = _fitted_with_held_out(panda, (21, 22, 23, 24), fr)
     chosen = Structure.parse(model.info.selection["chosen"])
     assert chosen.armature and chosen.friction == ("offset",), chosen
-    held = random_fourier(panda, np.random.default_rng(24))(sample_times(8.0, 500.0))
     rms = np.sqrt(np.mean((test.tau - _predict(model, held)) ** 2, axis=0))
     assert np.all(rms < 1.1 * NOISE), rms
 
