@@ -16,7 +16,9 @@ Panda on a seeded Fourier series with sensor noise:
   prepared and predicted a block at a time);
 * ``observe --calibrate`` of the Panda's own parameters (the momentum observer's batch
   path a block at a time, the thresholds from running maxima; with ``--no-figures`` no
-  full-length residual is kept);
+  full-length residual is kept) and ``observe --thresholds`` with those thresholds
+  (detection still keeps the residual, its std and margin whole for the events and
+  ``residuals.csv``: 3.0 GB on the 5-million-row log, not met);
 * static data of a long chain (``--static-joints`` 50, ``--static-n`` 200 configurations
   written by ``acquire-static``): the single-step problem of ``retrieve --static
   --method penalty`` (``static_problem``; its residual on the arm's own exact data must be
@@ -143,7 +145,8 @@ def _static(work: Path, dynid: list[str], joints: int, n_conf: int) -> dict:
 
 
 def _commands(work: Path, dynid: list[str], log: Path) -> dict[str, dict]:
-    """identify, identify --consistent, validate and observe --calibrate of the log."""
+    """identify, identify --consistent, validate, observe --calibrate and observe
+    --thresholds (detection with the thresholds just calibrated) of the log."""
     data = ["--data", str(log), "--no-figures"]
     out: dict[str, dict] = {}
     ident = ["identify", "--robot", "panda", *data]
@@ -154,6 +157,10 @@ def _commands(work: Path, dynid: list[str], log: Path) -> dict[str, dict]:
     )
     out["observe --calibrate"] = run(
         dynid + ["observe", "--params", "panda", "--calibrate", *data, "--out", str(work / "obs")]
+    )
+    thresholds = ["--thresholds", str(work / "obs" / "thresholds.json")]
+    out["observe --thresholds"] = run(
+        dynid + ["observe", "--params", "panda", *thresholds, *data, "--out", str(work / "det")]
     )
     return out
 
