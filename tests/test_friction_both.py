@@ -8,6 +8,8 @@ held-out data and its coefficients against those values.
 
 from __future__ import annotations
 
+import contextlib
+import io
 import json
 import re
 
@@ -279,3 +281,26 @@ def test_a_feasible_json_as_robot_brings_its_drive_and_identified_friction(panda
         got[how] = json.loads((out / "validation.json").read_text())["relative_error_percent"]
     assert got["--robot"] == pytest.approx(got["--params"], rel=1e-9)
     assert got["--robot"] < 0.5
+
+
+def test_validate_refuses_a_drive_other_than_the_one_feasible_json_holds(panda, tmp_path):
+    """``validate --params feasible.json --drive other.toml``: the file's drive (its rotor
+    inertias identified with the links) was replaced silently by the one given (a trial:
+    0.705 % -> 4.94 % without a word); now one line names the file and what differs."""
+    logs, _, _ = _logs(panda, joint_side=False)
+    terms = Structure.parse("viscous, coulomb, offset")
+    model = identify_recordings(panda, logs, cutoff_hz=None, drive=_drive(), structure=terms)
+    save_feasible_bundle(tmp_path, consistent_from_identified(panda, model, prior=panda))
+    save_torque_log(tmp_path / "rec.csv", logs[1])
+    (tmp_path / "other.toml").write_text(
+        'schema = "dynid-drive/1"\nside = "joint"\ngear_ratio = [1, 1, 1, 1, 1, 1, 1]\n'
+    )
+    argv = ["validate", "--params", str(tmp_path / "feasible.json"), "--data"]
+    argv += [str(tmp_path / "rec.csv"), "--drive", str(tmp_path / "other.toml")]
+    err = io.StringIO()
+    with contextlib.redirect_stderr(err):
+        code = main([*argv, "--out", str(tmp_path / "v"), "--no-figures"])
+    lines = [s for s in err.getvalue().splitlines() if s.strip()]
+    assert code == 2 and len(lines) == 1, lines
+    assert "differs from the one feasible.json holds: friction_at" in lines[0]
+    assert not (tmp_path / "v").exists()

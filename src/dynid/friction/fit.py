@@ -65,6 +65,7 @@ __all__ = [
     "fit_law_through",
     "friction_residual",
     "model_drive",
+    "same_drive",
     "moving_joints",
     "rigid_body_torques",
     "velocity_noise_std",
@@ -163,17 +164,30 @@ def model_drive(model: TorqueModel, drive: Drive | None) -> Drive | None:
         ``drive`` differs from the one the model was identified with.
     """
     own = model.drive if isinstance(model, IdentifiedModel) else None
+    return same_drive(drive, own, "the model", "the one the model was identified with")
+
+
+def same_drive(drive: Drive | None, own: Drive | None, whose: str, what: str) -> Drive | None:
+    """``own`` (a model's or a file's drive), the same as ``drive`` when both are given,
+    else the one given.
+
+    Raises
+    ------
+    DataError
+        ``drive`` differs from ``own``: each differing field named with ``whose`` value
+        (``what`` names the drive: "the one the model was identified with").
+    """
     if drive is None or own is None:
         return own if drive is None else drive
     mine, theirs = drive.as_dict(), own.as_dict()
     if mine != theirs:
         keys = sorted(k for k in {*mine, *theirs} if mine.get(k) != theirs.get(k))
         given = ", ".join(
-            f"{k} = {_short(mine.get(k))} (the model's {_short(theirs.get(k))})" for k in keys
+            f"{k} = {_short(mine.get(k))} ({whose}'s {_short(theirs.get(k))})" for k in keys
         )
         raise DataError(
-            f"the drive given differs from the one the model was identified with: {given}; "
-            "hint: leave out --drive to use the model's"
+            f"the drive given differs from {what}: {given}; "
+            f"hint: leave out --drive to use {whose}'s"
         )
     return own
 

@@ -32,6 +32,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from ..exceptions import DataError, OptionError
+from ..friction.fit import same_drive
 from ..friction.model import FrictionModel, FrictionSum
 from ..friction.recordings import RecordingsValidation, validate_recordings
 from ..friction.validation import RECORDED, own_friction
@@ -193,8 +194,9 @@ def validate_files(
     opt = options or ValidateOptions()
     robot = model.robot if isinstance(model, IdentifiedModel) else model
     drive = opt.drive
-    if drive is None and feasible is not None:
-        drive = load_feasible_drive(feasible)
+    if feasible is not None:  # the file's drive holds the rotor inertias identified
+        held = load_feasible_drive(feasible)
+        drive = same_drive(drive, held, Path(feasible).name, f"the one {Path(feasible).name} holds")
     own = model.drive if isinstance(model, IdentifiedModel) else None
     rec = read_recordings(
         data,
