@@ -240,8 +240,8 @@ def heldout_line(ho: dict[str, Any]) -> str:
     said = (
         ""
         if floor is None
-        else f"; {ho['heldout_error_percent'] / floor:.3g} x the noise floor of the filtered "
-        f"torques ({floor:.3g} %: sensor noise only; validate judges the raw torques)"
+        else f"; {ho['heldout_error_percent'] / floor:.3g} x the torque sensors' noise floor "
+        f"({floor:.3g} %)"
         if floor > 0
         else ""
     )

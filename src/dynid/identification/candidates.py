@@ -173,7 +173,7 @@ def candidate_judged(
     return Candidate(
         structure=structure,
         n_params=int(use.sum()),
-        train_error_percent=sub.whole.relative_error_percent(whole),
+        train_error_percent=sub.judged_whole.relative_error_percent(whole),
         heldout_error_percent=sub.heldout_error_percent(xs),
         heldout_se_percent=se,
         fold_errors_percent=tuple(per_fold),

@@ -374,6 +374,10 @@ class PreparedLog:
     torque_noise_std : ndarray, shape (n,), or None
         White-noise std [N m] per joint of the raw log's joint-side torques
         (:func:`~dynid.identification.sanity.velocity_noise_std`, which reads any signal's).
+    tau_raw : ndarray, shape like ``log.tau``, or None
+        The joint-side torques at the prepared samples as measured, not low-passed (None
+        when the log was not filtered): the held-out judgement predicts them, as
+        ``dynid validate`` does.
     """
 
     log: TorqueLog
@@ -389,6 +393,7 @@ class PreparedLog:
     motion_frequency_hz: float | None = None
     resampled: bool = False
     torque_noise_std: NDArray[np.float64] | None = None
+    tau_raw: NDArray[np.float64] | None = None
 
     @property
     def route(self) -> Literal["classical"]:
@@ -511,9 +516,11 @@ def prepare_torque_log(
     k = decimation(fs, cutoff_hz) if decimate is None else int(decimate)
     if k < 1:
         raise ShapeError(f"decimate must be >= 1; got {decimate}")
-    prepared = prepare_log(
-        jlog, cutoff_hz=cutoff_hz, trim_s=trim_s, max_gap_s=max_gap_s, decimate=k
-    )
+    same = dict(cutoff_hz=cutoff_hz, trim_s=trim_s, max_gap_s=max_gap_s, decimate=k)
+    prepared = prepare_log(jlog, **same)  # type: ignore[arg-type]
+    raw = None
+    if cutoff_hz is not None:  # the torques as measured at the same samples
+        raw = prepare_log(jlog, filter_tau=False, **same).tau  # type: ignore[arg-type]
     noise = velocity_noise_std(jlog.tau) if jlog.n_samples >= 3 else None
     del jlog
     return PreparedLog(
@@ -530,4 +537,5 @@ def prepare_torque_log(
         motion_frequency_hz=f_q,
         resampled=not signals.is_uniform(log.t),
         torque_noise_std=noise,
+        tau_raw=None if raw is None or raw.shape != prepared.tau.shape else raw,
     )

@@ -237,12 +237,15 @@ class HeldOut:
     noise: float = 1.0
 
     @classmethod
-    def k_fold(cls, blocks: Sequence[Normals]) -> HeldOut:
-        """Fold ``j`` fitted on every block but ``j``, predicting block ``j``."""
+    def k_fold(cls, blocks: Sequence[Normals], test: Sequence[Normals] | None = None) -> HeldOut:
+        """Fold ``j`` fitted on every block but ``j``, predicting block ``j`` (its rows'
+        targets as ``test[j]`` holds them when given: the measured torques beside the
+        low-passed ones fitted)."""
         whole = blocks[0]
         for blk in blocks[1:]:
             whole = whole + blk
-        return cls(tuple(whole - b for b in blocks), tuple(blocks), whole, "blocks", _noise(whole))
+        judged = tuple(blocks) if test is None else tuple(test)
+        return cls(tuple(whole - b for b in blocks), judged, whole, "blocks", _noise(whole))
 
     @classmethod
     def separate(cls, whole: Normals, test: Normals) -> HeldOut:
@@ -253,6 +256,18 @@ class HeldOut:
     def folds(self) -> int:
         """Number of folds."""
         return len(self.test)
+
+    @property
+    def judged_whole(self) -> Normals:
+        """All of the data with the targets the folds are judged on (the measured torques
+        when :meth:`k_fold` was given them; ``whole`` for a separate log): the training
+        error is read on it, so that it compares with the held-out error."""
+        if self.scheme == "file":
+            return self.whole
+        out = self.test[0]
+        for t in self.test[1:]:
+            out = out + t
+        return out
 
     @property
     def training_share(self) -> float:
@@ -341,6 +356,6 @@ def cross_validate(held: HeldOut, rtol: float = 1e-10) -> HeldOutErrors:
     return HeldOutErrors(
         held.scheme,
         held.folds,
-        held.whole.relative_error_percent(held.whole.solve(rtol)),
+        held.judged_whole.relative_error_percent(held.whole.solve(rtol)),
         held.heldout_error_percent(xs),
     )

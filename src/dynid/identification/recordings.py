@@ -241,6 +241,16 @@ class Recordings:
         """The friction columns of the joints (motors) that never move in any piece."""
         return still_columns(columns, self.still)
 
+    def raw_offsets(self) -> NDArray[np.float64] | None:
+        """Per row of :meth:`blocks` (sample-major within each piece), the measured torque
+        minus the low-passed one [N m]: ``y + raw_offsets()`` are the targets as measured;
+        None when a piece was not filtered."""
+        if any(p.tau_raw is None for p in self.pieces):
+            return None
+        return np.concatenate(
+            [(np.asarray(p.tau_raw) - p.log.tau).reshape(-1) for p in self.pieces]
+        )
+
     def blocks(self, robot: Robot, columns: ModelColumns) -> Iterator[RegressorBlock]:
         """The pieces' rows stacked in one block (sample-major within each piece), or the
         pieces' blocks one after another when they are too many to stack."""

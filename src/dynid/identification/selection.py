@@ -99,6 +99,7 @@ def _judge(
     if validation is not None:
         how = "a separate recording"
     scheme = "recordings" if len(data.names) > 1 else "blocks"
+    raw = data.raw_offsets()
 
     def judge(
         stack: RegressorStack | StreamedRows,
@@ -108,6 +109,7 @@ def _judge(
     ) -> HeldOut | None:
         b = np.asarray(beta)[cols]
         normals: Callable[[NDArray[np.intp]], tuple[Normals, ...]]
+        measured: Callable[[NDArray[np.intp]], tuple[Normals, ...]] | None = None
         if isinstance(stack, StreamedRows) and stack.normals is not None and validation is None:
             return replace(HeldOut.k_fold(stack.normals), scheme=scheme).expanded(cols)
         if isinstance(stack, StreamedRows):  # rows in blocks: one pass per set of labels
@@ -121,16 +123,49 @@ def _judge(
             rw = row_weights(estimator, W, stack.y, stack.groups, b)
             Ww, yw, m = W * rw[:, None], stack.y * rw, stack.y.size
             normals = lambda lab: block_normals(Ww, yw, lab)  # noqa: E731
+            if raw is not None and raw.size == m:  # judged on the torques as measured
+                Wm = _measured_rows(data, columns, stack.W)
+                Wm = (Wm if cols.all() else Wm[:, cols]) * rw[:, None]
+                measured = lambda lab: block_normals(Wm, (stack.y + raw) * rw, lab)  # noqa: E731
         if validation is not None:
             test = _normals(robot, validation, columns, cols, b, estimator)
             held = HeldOut.separate(normals(np.zeros(m, np.intp))[0], test)
         elif labels is None:
             return None
         else:
-            held = replace(HeldOut.k_fold(normals(labels)), scheme=scheme)
+            held = HeldOut.k_fold(normals(labels), None if measured is None else measured(labels))
+            held = replace(held, scheme=scheme)
         return held.expanded(cols)
 
     return judge, how, (labels if validation is None else None)
+
+
+def _measured_rows(
+    data: Recordings, columns: ModelColumns, W: NDArray[np.float64]
+) -> NDArray[np.float64]:
+    """``W`` (rows of :meth:`~dynid.identification.recordings.Recordings.blocks`, every
+    column of ``columns``) with the columns that step at a reversal (Coulomb, smooth,
+    Stribeck) as they act on the measured torques: not through the torques' low-pass
+    (the parallel filtering of the fit), as the model predicts a recording."""
+    steps = columns.step_columns()
+    if not steps.any():
+        return W
+    r = W.shape[1] - int(sum(len(t.labels) for t in columns.appended))
+    sharp = np.concatenate(
+        [
+            np.concatenate(
+                [
+                    t.torque_columns(p.log.q, p.log.dq, np.asarray(p.log.ddq))
+                    for t in columns.appended
+                ],
+                axis=-1,
+            ).reshape(p.log.n_samples * p.log.n, -1)
+            for p in data.pieces
+        ]
+    )
+    out = W.copy()
+    out[:, r:][:, steps[r:]] = sharp[:, steps[r:]]
+    return out
 
 
 def _normals(
@@ -145,6 +180,10 @@ def _normals(
     blocks = list(data.blocks(robot, columns))
     W = np.concatenate([blk.W for blk in blocks])[:, cols]
     y = np.concatenate([blk.y for blk in blocks])
+    raw = data.raw_offsets()
+    if raw is not None and raw.size == y.size:  # the torques as measured
+        W = _measured_rows(data, columns, np.concatenate([blk.W for blk in blocks]))[:, cols]
+        y = y + raw
     g = np.concatenate([blk.groups for blk in blocks])
     rw = row_weights(estimator, W, y, g, b)
     return block_normals(W * rw[:, None], y * rw, np.zeros(y.size, np.intp))[0]
@@ -163,15 +202,17 @@ def _terms_of(
 
 
 def _with_floor(heldout: Any, data: Recordings) -> Any:
-    """The held-out record with the noise floor of the filtered torques
+    """The held-out record with the noise floor of the torques it was judged on (as
+    measured, or filtered when the recordings were not)
     (:func:`~dynid.identification.metrics.noise_floor_percent`), when both are known."""
     pieces = data.pieces
     if heldout is None or any(p.torque_noise_std is None for p in pieces):
         return heldout
+    measured = data.raw_offsets() is not None  # judged on the torques as measured
     floor = noise_floor_percent(
-        [p.log.tau for p in pieces],
+        [p.tau_raw if measured else p.log.tau for p in pieces],  # type: ignore[misc]
         [p.torque_noise_std for p in pieces],  # type: ignore[misc]
-        [lowpass_noise_gain(p.sample_rate_hz, p.cutoff_hz) for p in pieces],
+        [1.0 if measured else lowpass_noise_gain(p.sample_rate_hz, p.cutoff_hz) for p in pieces],
     )
     return heldout if floor is None else {**heldout, "noise_floor_percent": floor}
 

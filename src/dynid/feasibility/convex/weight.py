@@ -110,7 +110,8 @@ def with_training(
     judgement: HeldOutJudgement, held: HeldOut, x: NDArray[np.float64]
 ) -> HeldOutJudgement:
     """The judgement with the training error of the fit ``x`` on all data."""
-    return dataclasses.replace(judgement, training_percent=held.whole.relative_error_percent(x))
+    training = held.judged_whole.relative_error_percent(x)
+    return dataclasses.replace(judgement, training_percent=training)
 
 
 def auto_weight(
