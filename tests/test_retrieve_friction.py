@@ -3,7 +3,9 @@ the links: the links are retrieved, the friction is the model's (its files hold 
 
 from __future__ import annotations
 
+import json
 import warnings
+import xml.etree.ElementTree as ET
 
 import numpy as np
 
@@ -14,6 +16,7 @@ from dynid.identification.selection import identify_recordings
 from dynid.identification.structure import Structure
 from dynid.io.feasible import load_feasible_linear_friction
 from dynid.io.model_json import save_model_json
+from dynid.model.drive import Drive
 
 from conftest import recordings
 
@@ -36,3 +39,30 @@ def test_retrieve_keeps_the_friction_identified_with_the_links(panda, tmp_path):
     assert got is not None
     v = np.random.default_rng(0).uniform(-2.0, 2.0, (50, 7))
     np.testing.assert_allclose(got.torques(v), fr.torques(v), atol=1e-6)
+
+
+def test_retrieve_of_a_geared_model_writes_its_rotor_inertias_as_armature(panda, tmp_path):
+    """A coupled drive whose rotor inertias were identified with friction at the motors:
+    the retrieval's MJCF had no armature (the friction's drive, without the identified
+    inertias, was taken for the file's); now ``armature = diag(K^T diag(I_a) K)`` of the
+    drive feasible.json holds."""
+    gears = np.array([50.0, 50.0, 40.0, 40.0, 30.0, 30.0, 30.0])
+    ia = np.array([5e-5, 5e-5, 4e-5, 4e-5, 2e-5, 2e-5, 2e-5])
+    truth = Drive.from_gears(gears, [(7, 6, 20.0)], rotor_inertia=ia)
+    fr = ClassicalFriction(np.full(7, 1e-3), np.zeros(7), np.zeros(7)).at(truth)
+    logs = recordings(panda, (7, 8), friction=fr, drive=truth, duration=4.0)
+    given = Drive.from_gears(gears, [(7, 6, 20.0)], rotor_inertia=None)
+    model = identify_recordings(
+        panda, logs, cutoff_hz=None, drive=given, structure=Structure(True, ("viscous",))
+    )
+    path = save_model_json(tmp_path / "identification.json", model)
+    out = tmp_path / "ret"
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", DynidWarning)
+        assert main(["retrieve", "--model", str(path), "--out", str(out), "-q"]) in (0, 1)
+    drive = json.loads((out / "feasible.json").read_text())["drive"]
+    K = np.asarray(given.transmission)
+    want = np.diag(K.T @ np.diag(drive["rotor_inertia"]) @ K)
+    xml = ET.parse(out / "robot.xml")
+    got = [float(j.get("armature")) for j in xml.iter("joint") if j.get("armature")]
+    np.testing.assert_allclose(got, want, rtol=1e-6)

@@ -23,7 +23,7 @@ from ..feasibility.methods import METHODS
 from ..feasibility.methods import method as consistent_method
 from ..feasibility.penalty import RetrievalOptions, RetrievalProgress
 from ..feasibility.result import FeasibleResult
-from ..friction.model import combined
+from ..friction.model import combined, through_drive
 from ..identification.model import IdentifiedModel
 from ..io.bounds_file import load_bounds
 from ..io.friction_json import load_friction_json
@@ -82,7 +82,9 @@ def with_model_friction(result: FeasibleResult, model: IdentifiedModel) -> Feasi
     fr = combined(model.frictions)
     if result.friction is not None or fr is None:
         return result
-    return replace(result, friction=fr, drive=result.drive or model.drive)
+    drive = result.drive or model.drive
+    # at the motors, through the result's drive: its rotor inertias the identified ones
+    return replace(result, friction=fr if drive is None else through_drive(fr, drive), drive=drive)
 
 
 def load_model_with_friction(
