@@ -74,7 +74,7 @@ from .log_rows import (
     term_regressor,
 )
 from .model import IdentifiedModel
-from .prepare import prepare_log
+from .prepare import measured_torques, prepare_log
 from .rate import cutoff_from_motion, decimation, motion_frequency
 from .sanity import check_torque_log, moving_joints, velocity_noise_std
 from .streaming import BlockSource, normals_by_label
@@ -520,7 +520,7 @@ def prepare_torque_log(
     prepared = prepare_log(jlog, **same)  # type: ignore[arg-type]
     raw = None
     if cutoff_hz is not None:  # the torques as measured at the same samples
-        raw = prepare_log(jlog, filter_tau=False, **same).tau  # type: ignore[arg-type]
+        raw = measured_torques(jlog, **same)  # type: ignore[arg-type]
     noise = velocity_noise_std(jlog.tau) if jlog.n_samples >= 3 else None
     del jlog
     return PreparedLog(

@@ -20,7 +20,13 @@ from .. import signals
 from ..exceptions import DataError, DynidWarning, ShapeError
 from .log import _SIGNALS, DEFAULT_CUTOFF_HZ, TorqueLog, default_max_gap
 
-__all__ = ["PREPARE_BLOCK_SAMPLES", "SETTLE_CYCLES", "prepare_log", "prepared_blocks"]
+__all__ = [
+    "PREPARE_BLOCK_SAMPLES",
+    "SETTLE_CYCLES",
+    "measured_torques",
+    "prepare_log",
+    "prepared_blocks",
+]
 
 
 def prepare_log(
@@ -151,6 +157,27 @@ def prepared_blocks(
     for w in _windows(plan, size):
         out = _prepared_window(log, plan, *w, filter_tau)
         yield _as_log(out, log)
+
+
+def measured_torques(
+    log: TorqueLog,
+    *,
+    cutoff_hz: float | None = DEFAULT_CUTOFF_HZ,
+    trim_s: float | None = None,
+    fs: float | None = None,
+    max_gap_s: float | None = None,
+    jitter_rtol: float = 1e-6,
+    decimate: int = 1,
+) -> NDArray[np.float64]:
+    """The torques [N m] (M, n) at the samples of :func:`prepare_log` (same parameters)
+    as measured: resampled as it resamples a log that is not uniform, not low-passed,
+    ``prepare_log(log, filter_tau=False, ...).tau`` without preparing the other signals."""
+    plan = _plan(log, cutoff_hz, trim_s, fs, max_gap_s, jitter_rtol, decimate)
+    idx = np.asarray(plan.out)
+    if plan.uniform:
+        return np.array(log.tau[idx])
+    ts = plan.t[idx]
+    return np.stack([np.interp(ts, log.t, log.tau[:, j]) for j in range(log.n)], axis=1)
 
 
 def _as_log(out: dict[str, NDArray[np.float64]], log: TorqueLog) -> TorqueLog:

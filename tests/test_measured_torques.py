@@ -1,0 +1,26 @@
+"""The torques as measured at the prepared samples: what ``prepare_log`` gives with
+``filter_tau=False``, without preparing the other signals."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+import dynid
+from dynid.identification.log import TorqueLog
+from dynid.identification.prepare import measured_torques, prepare_log
+from dynid.simulation.measurement import sample_times, simulate_measurement
+from dynid.simulation.trajectories import random_fourier
+
+
+@pytest.mark.parametrize("jitter", [0.0, 2e-5], ids=["uniform", "jittered"])
+def test_measured_torques_are_prepare_logs_unfiltered_ones(jitter):
+    panda = dynid.panda()
+    rng = np.random.default_rng(3)
+    t = sample_times(3.0, 500.0) + rng.normal(0.0, jitter, 1501) * (np.arange(1501) > 0)
+    t = np.sort(t)
+    log = simulate_measurement(panda, random_fourier(panda, rng)(t), rng=rng)
+    log = TorqueLog(log.t, log.q, log.dq, log.tau)
+    same = dict(cutoff_hz=6.0, trim_s=0.2, decimate=4)
+    want = prepare_log(log, filter_tau=False, **same).tau
+    np.testing.assert_array_equal(measured_torques(log, **same), want)
