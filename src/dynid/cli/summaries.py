@@ -149,7 +149,7 @@ def selection_lines(selection: Any) -> list[str]:
     out = [
         f"model structure chosen on held-out data ({selection['validation']}): "
         f"{selection['chosen']} ({selection['rule']})",
-        f"    {'structure':<{w}} {'params':>6} {'train %':>9} {'held-out %':>11} {'+- se':>7}"
+        f"    {'structure':<{w}} {'params':>6} {'train %':>9} {'held-out %':>11} {'se vs best':>10}"
         + ("  left out per joint (coefficient and joint)" if left else ""),
     ]
     cands = selection["candidates"]
@@ -160,7 +160,7 @@ def selection_lines(selection: Any) -> list[str]:
         mark = "x" if skip and c.get("not_dissipative") else mark
         out.append(
             f"  {mark} {name:<{w}} {c['n_params']:>6} {c['train_error_percent']:>9.4g} "
-            f"{c['heldout_error_percent']:>11.4g} {c['heldout_se_percent']:>7.2g}"
+            f"{c['heldout_error_percent']:>11.4g} {_se_vs_best(c):>10}"
             + (f"  {_compact(dropped.split(' - '))}" if dropped else "")
         )
     per = selection.get("heldout_per_recording") or ()
@@ -176,6 +176,14 @@ def selection_lines(selection: Any) -> list[str]:
         )
     out += [f"  note: {line}" for line in selection.get("notes", ())]
     return out
+
+
+def _se_vs_best(c: dict[str, Any]) -> str:
+    """The standard error of a candidate's held-out error's difference from the lowest
+    (paired over the folds), blank where there is none (the best, one fold); files
+    written before it was recorded give each candidate's own standard error."""
+    se = c.get("heldout_se_vs_best_percent", c.get("heldout_se_percent"))
+    return f"{se:.2g}" if se else ""
 
 
 def _compact(labels: list[str]) -> str:

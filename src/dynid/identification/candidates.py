@@ -28,13 +28,23 @@ from .structure import Structure
 __all__ = [
     "ODD_FLOOR_PERCENT",
     "OUTLIER_RATIO",
+    "RELATIVE_TIE",
+    "RULE",
     "Candidate",
     "Selection",
     "candidate_judged",
     "heldout_of",
+    "paired_se",
     "recording_oddness",
     "without_recordings",
 ]
+
+
+#: How the structure is chosen (:func:`paired_se`).
+RULE = "simplest within one standard error of the lowest held-out error, paired over the folds"
+#: Held-out errors closer than this fraction of the lowest one count as equal: a model
+#: that predicts 1 % better (relative) is not worth a term.
+RELATIVE_TIE = 0.01
 
 
 @dataclass(frozen=True, slots=True)
@@ -53,6 +63,10 @@ class Candidate:
         Pooled relative error [%] of the folds' fits on their held-out rows.
     heldout_se_percent : float
         Standard error [%] of the held-out error over the folds (0 for one fold).
+    se_vs_best_percent : float
+        Standard error [%] of its held-out error's difference from the lowest one, paired
+        over the folds (:func:`paired_se`); set once every candidate is judged (0 before,
+        and for the best).
     fold_errors_percent : tuple of float
         Relative held-out error [%] of every fold judged (each recording left out, when
         the folds are recordings).
@@ -70,6 +84,7 @@ class Candidate:
     heldout_error_percent: float
     heldout_se_percent: float
     fold_errors_percent: tuple[float, ...] = ()
+    se_vs_best_percent: float = 0.0
     unphysical: tuple[str, ...] = ()
     left_out: tuple[str, ...] = ()
 
@@ -82,10 +97,28 @@ class Candidate:
             "train_error_percent": self.train_error_percent,
             "heldout_error_percent": self.heldout_error_percent,
             "heldout_se_percent": self.heldout_se_percent,
+            "heldout_se_vs_best_percent": self.se_vs_best_percent,
             "heldout_per_fold_percent": list(self.fold_errors_percent),
             "not_dissipative": list(self.unphysical),
             "left_out": list(self.left_out),
         }
+
+
+def paired_se(c: Candidate, best: Candidate) -> float:
+    """Standard error [%] of ``c``'s held-out error minus ``best``'s, paired over the
+    folds both were judged on.
+
+    Every candidate is judged on the same folds, and the folds differ far more among
+    themselves (one recording is harder to predict than another) than two candidates do
+    on one fold; the spread of each candidate's fold errors (``heldout_se_percent``) would
+    call a consistently worse candidate as good as the best. The one-standard-error rule
+    reads the spread of the differences instead. 0 for one fold (the folds of two
+    candidates always match: the same held-out data)."""
+    a, b = c.fold_errors_percent, best.fold_errors_percent
+    if len(a) < 2 or len(a) != len(b):
+        return 0.0
+    d = np.subtract(a, b)
+    return float(np.std(d, ddof=1) / math.sqrt(d.size))
 
 
 @dataclass(frozen=True, slots=True)
@@ -115,7 +148,7 @@ class Selection:
     candidates: tuple[Candidate, ...]
     chosen: Structure
     validation: str
-    rule: str = "simplest within one standard error of the lowest held-out error"
+    rule: str = RULE
     notes: tuple[str, ...] = ()
     per_recording: tuple[tuple[str, float], ...] = ()
     outlying: tuple[str, ...] = ()

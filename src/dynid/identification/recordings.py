@@ -159,7 +159,8 @@ class Recordings:
         The velocity noise left by the low-pass, per unit of the raw noise
         (:func:`~dynid.signals.lowpass_noise_gain` at the cut-off; 1 without one): a
         Coulomb sign is switched off within ``band_gain * band`` of the velocities as
-        prepared, the noise they still hold; a smooth Coulomb's width counts in ``band``.
+        prepared, the noise they still hold; a smooth Coulomb's width counts in
+        ``band_gain * band`` too.
     counts : tuple of SampleCounts
         Per recording, where its samples went (empty: not counted).
     """

@@ -13,7 +13,10 @@ armature choice, keeps the normal equations of every held-out fold
 (:mod:`dynid.identification.holdout`), and judges every candidate (a subset of the
 columns) by its pooled held-out error; it keeps the **simplest candidate within one
 standard error of the best** (the one-standard-error rule of cross-validation: Hastie,
-Tibshirani and Friedman, *The Elements of Statistical Learning*, 2nd ed., Sec. 7.10).
+Tibshirani and Friedman, *The Elements of Statistical Learning*, 2nd ed., Sec. 7.10),
+the standard error being that of the difference of the two candidates' errors paired
+over the folds (:func:`~dynid.identification.candidates.paired_se`), and differences
+under 1 % of the lowest error counting as ties.
 The folds leave one recording out at a time when there are several, contiguous time
 blocks otherwise (:meth:`~dynid.identification.recordings.Recordings.fold_labels`), or
 judge on a separate recording. A recording that holds what no candidate models is left
@@ -43,10 +46,12 @@ from ..regressors.terms import ModelTerm
 from ..signals import lowpass_noise_gain
 from .candidates import (
     OUTLIER_RATIO,
+    RELATIVE_TIE,
     Candidate,
     Selection,
     candidate_judged,
     heldout_of,
+    paired_se,
     recording_oddness,
     without_recordings,
 )
@@ -223,13 +228,23 @@ def _physical(candidates: Sequence[Candidate]) -> list[Candidate]:
     return [c for c in candidates if not c.unphysical] or list(candidates)
 
 
+def _within(c: Candidate, best: Candidate) -> bool:
+    """Whether ``c`` predicts as well as ``best``: its held-out error above the lowest by
+    at most one standard error of the difference, paired over the folds
+    (:func:`~.candidates.paired_se`), or by less than :data:`~.candidates.RELATIVE_TIE` of
+    the lowest (or :data:`~.structure.ERROR_FLOOR_PERCENT`)."""
+    low = best.heldout_error_percent
+    tie = max(paired_se(c, best), RELATIVE_TIE * low, ERROR_FLOOR_PERCENT)
+    return c.heldout_error_percent <= low + tie
+
+
 def _chosen(candidates: Sequence[Candidate]) -> Structure:
-    """The simplest candidate within one standard error of the lowest held-out error,
-    among those whose friction is dissipative within the velocity limits."""
+    """The simplest candidate within one standard error of the lowest held-out error
+    (:func:`_within`), among those whose friction is dissipative within the velocity
+    limits."""
     candidates = _physical(candidates)
     best = min(candidates, key=lambda c: c.heldout_error_percent)
-    limit = best.heldout_error_percent + max(best.heldout_se_percent, ERROR_FLOOR_PERCENT)
-    within = [c for c in candidates if c.heldout_error_percent <= limit]
+    within = [c for c in candidates if _within(c, best)]
     # of as many parameters, the one with fewer terms: an armature whose every own rotor
     # is left out holds only rotors that regroup with the links (the same columns)
     return min(
@@ -326,6 +341,16 @@ def select_structure(
             fit_rtol,
         )
     chosen = _chosen(judged)
+    best = min(_physical(judged), key=lambda c: c.heldout_error_percent)
+    judged = [replace(c, se_vs_best_percent=paired_se(c, best)) for c in judged]
+    wild = [c for c in judged if c.heldout_error_percent > max(100.0, 10 * c.train_error_percent)]
+    if wild:
+        notes.append(
+            f"{len(wild)} candidate(s) predict held-out data far worse than they fit (up to "
+            f"{max(c.heldout_error_percent for c in wild):.3g} %): some folds' training data "
+            "hardly excite their columns (a Stribeck term whose velocities the held-out data "
+            "reach and the others seldom do), so their fits on those folds extrapolate"
+        )
     skipped = [c for c in judged if c.unphysical] if len(_physical(judged)) < len(judged) else []
     if skipped:  # one line: the table marks each (metadata.selection names the joints)
         notes.append(
@@ -454,7 +479,6 @@ def _per_joint(
         repaired = _repaired(best_any, *group, n, rtol)
     starts = [best, *([] if repaired is None else [repaired])]
     best = min(starts, key=lambda c: c.heldout_error_percent)
-    limit = best.heldout_error_percent + max(best.heldout_se_percent, ERROR_FLOOR_PERCENT)
     chosen = _chosen(judged)
     starts += [c for c in judged if c.structure == chosen][:1]
     out: list[Candidate] = []
@@ -470,7 +494,7 @@ def _per_joint(
                 if not c.unphysical or here.unphysical
             ]
             step = min(trials, key=lambda c: c.heldout_error_percent, default=None)
-            if step is None or step.heldout_error_percent > limit:
+            if step is None or not _within(step, best):
                 break
             here = step
         drive = model.drive if start.structure.at == "both" else None

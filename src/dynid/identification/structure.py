@@ -65,8 +65,12 @@ FRICTION_LADDER: tuple[tuple[str, ...], ...] = (
     ("viscous", "coulomb", "offset"),
 )
 #: Widths of the smooth Coulomb candidates, in multiples of each joint's standstill band
-#: (at least :data:`MIN_WIDTH`): ``tanh(dq / w)`` reaches 76 % of ``fc`` at ``dq = w``.
-SMOOTH_WIDTHS = (1.0, 3.0, 10.0)
+#: (the band of the velocities as prepared, at least :data:`MIN_WIDTH`): ``tanh(dq / w)``
+#: reaches 76 % of ``fc`` at ``dq = w``. The narrowest (0.3 bands: about the velocity
+#: noise's standard deviation) predicts a sharp Coulomb law best where the velocity
+#: crosses zero in motion (the expected sign given the noise); the standstill band of
+#: ``coulomb`` best at rest; the held-out data choose.
+SMOOTH_WIDTHS = (0.3, 1.0, 3.0, 10.0)
 #: Stribeck velocities [rad/s] of the Stribeck candidates.
 STRIBECK_VELOCITIES = (0.02, 0.05, 0.1, 0.2)
 #: Smallest smooth width [rad/s] (a noise-free log has no standstill band).
@@ -421,8 +425,8 @@ def structure_terms(
     noise band [rad/s] of the raw velocities per motor (joint) where it acts:
     ``bands["motor"]`` or ``bands["joint"]``, else ``band``. The Coulomb sign's standstill
     band is ``gain`` times it (the noise the filtered velocities keep:
-    :attr:`~dynid.identification.recordings.Recordings.band_gain`), a smooth Coulomb's
-    width counts in it.
+    :attr:`~dynid.identification.recordings.Recordings.band_gain`), and so does a smooth
+    Coulomb's width.
 
     Raises
     ------
@@ -437,7 +441,9 @@ def structure_terms(
                 at,
                 parts=structure.friction,
                 band=_times(b, gain),
-                width=smooth_width(b, structure.width) if "smooth" in structure.friction else (),
+                width=smooth_width(_times(b, gain), structure.width)
+                if "smooth" in structure.friction
+                else (),
                 vst=structure.vst,
                 mask=structure.mask(n),
             )
@@ -449,7 +455,7 @@ def structure_terms(
                     jt,
                     parts=structure.joint_parts,
                     band=_times(jb, gain),
-                    width=smooth_width(jb, structure.width)
+                    width=smooth_width(_times(jb, gain), structure.width)
                     if "smooth" in structure.friction
                     else (),
                     vst=structure.vst,
@@ -556,7 +562,7 @@ def largest_terms(
             at,
             ("smooth",),
             band=_times(b, gain),
-            width=smooth_width(b, w),
+            width=smooth_width(_times(b, gain), w),
             name=f"friction smooth {w:g}",
         )
         out.append((t, ("smooth", w)))

@@ -335,7 +335,7 @@ def _structure_section(doc: dict) -> str:
                 cell(c.get("n_params")),
                 cell(c.get("train_error_percent")),
                 cell(c.get("heldout_error_percent")),
-                cell(c.get("heldout_se_percent")),
+                cell(c.get("heldout_se_vs_best_percent", c.get("heldout_se_percent"))),
             ]
             + ([esc(" ".join(c.get("left_out") or ()))] if left else [])
         )
@@ -347,7 +347,7 @@ def _structure_section(doc: dict) -> str:
         "parameters",
         "training error [%]",
         "held-out error [%]",
-        "held-out std. error [%]",
+        "std. error of the difference from the best [%]",
     ] + (["left out per joint"] if left else [])
     rule = f"Rule: {esc(sel.get('rule', ''))}; validation: {esc(sel.get('validation', ''))}."
     parts = [f"<p>{rule}</p>", table(headers, rows, marked=marked)]
