@@ -49,12 +49,12 @@ class _Stop(Exception):
 
 
 def test_the_consistent_route_warns_each_finding_of_the_data_once(panda, tmp_path, monkeypatch):
-    """Torques of the opposite sign: the consistent route's unconstrained fit (structure
-    chosen on held-out data and fitted as chosen) prepares the log
-    once, so its finding is warned once (it was warned by the selection's fit and again
-    by the final one), and the friction warnings are those of the model kept."""
+    """Torques in mN m: the consistent route's unconstrained fit (structure chosen on
+    held-out data and fitted as chosen) prepares the log once, so its finding is warned
+    once (it was warned by the selection's fit and again by the final one), and the
+    friction warnings are those of the model kept."""
     log = _log(panda, 3)
-    save_torque_log(tmp_path / "neg.csv", type(log)(log.t, log.q, log.dq, -log.tau))
+    save_torque_log(tmp_path / "neg.csv", type(log)(log.t, log.q, log.dq, 1e3 * log.tau))
     kept = {}
 
     def stop(robot, model, *args, **kw):
@@ -67,7 +67,7 @@ def test_the_consistent_route_warns_each_finding_of_the_data_once(panda, tmp_pat
         with pytest.raises(_Stop):
             identify_files(panda, [tmp_path / "neg.csv"], IdentifyOptions(consistent=True))
     said = [str(w.message) for w in caught if issubclass(w.category, DynidWarning)]
-    assert sum("anti-correlated" in s for s in said) == 1
+    assert sum("times the model's gravity torques" in s for s in said) == 1
     assert len(said) == len(set(said)), said
     model = kept["model"]
     assert model.info.selection is not None  # the structure was chosen, and recorded
@@ -84,7 +84,8 @@ def test_the_consistent_route_warns_each_finding_of_the_data_once(panda, tmp_pat
         assert not named
         return
     negative = np.flatnonzero(np.any(model.friction.params[:, :2] < 0, axis=1)) + 1
-    assert named and set(named) <= set(negative.tolist()) and len(named) == len(set(named))
+    assert set(named) <= set(negative.tolist()) and len(named) == len(set(named))
+    assert bool(named) == bool(negative.size)
 
 
 # --- validate: a verdict a person can act on, and its exit status ----------------------
@@ -217,11 +218,9 @@ def test_identify_names_the_recording_its_findings_are_about(panda, logs, tmp_pa
     """Findings of the data (torques of the opposite sign, positions in degrees) on one of
     several recordings name it, once (the finding was said without a file, as if of all)."""
     neg = _rewritten(load_torque_log(logs / "rec2.csv"), tmp_path / "neg.csv", tau=-1.0)
-    with warnings.catch_warnings(record=True) as caught:
-        warnings.simplefilter("always")
+    with pytest.raises(DataError) as refused:  # a fit would negate the masses
         identify_files(panda, [logs / "rec1.csv", neg])
-    said = [str(w.message) for w in caught if "anti-correlated" in str(w.message)]
-    assert len(said) == 1 and said[0].startswith("neg.csv: the measured torques"), said
+    assert str(refused.value).startswith("neg.csv: the measured torques are anti-correlated")
 
 
 def test_observe_checks_its_recordings_as_the_other_commands(panda, logs, tmp_path, capsys):

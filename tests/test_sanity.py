@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 
 import dynid
-from dynid.exceptions import DynidWarning
+from dynid.exceptions import DataError, DynidWarning
 from dynid.identification.classical import identify_from_log
 from dynid.identification.log import TorqueLog
 from dynid.identification.sanity import check_torque_log
@@ -45,10 +45,11 @@ def test_unit_and_sign_faults_are_named_with_their_remedy(panda_log, change, mat
 
 
 @pytest.mark.filterwarnings("ignore:.*indistinguishable from zero")  # expected: weak coefficients
-def test_identification_warns_about_a_flipped_sign_before_fitting(panda_log):
-    """identify_from_log names the sign in a DynidWarning (the fit itself would succeed)."""
+def test_identification_refuses_a_flipped_sign_before_fitting(panda_log):
+    """identify_from_log refuses torques of the opposite sign, with the hint: the fit
+    itself would succeed, with negated masses (it warned and returned that model)."""
     flipped = TorqueLog(panda_log.t, panda_log.q, panda_log.dq, -panda_log.tau)
-    with pytest.warns(DynidWarning, match="anti-correlated"):
+    with pytest.raises(DataError, match=r"anti-correlated.*--units tau=-1"):
         identify_from_log(dynid.panda(), flipped)
 
 

@@ -38,7 +38,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from .. import signals
-from ..exceptions import DynidWarning, OptionError, ShapeError
+from ..exceptions import DataError, DynidWarning, OptionError, ShapeError
 from ..model.drive import Drive
 from ..model.robot import Robot
 from ..regressors.base import BaseParameters
@@ -76,7 +76,7 @@ from .log_rows import (
 from .model import IdentifiedModel
 from .prepare import measured_torques, prepare_log
 from .rate import cutoff_from_motion, decimation, motion_frequency
-from .sanity import check_torque_log, moving_joints, velocity_noise_std
+from .sanity import check_torque_log, moving_joints, opposite_sign, velocity_noise_std
 from .streaming import BlockSource, normals_by_label
 
 __all__ = [
@@ -506,6 +506,8 @@ def prepare_torque_log(
         drive.check(n)
     fs = log.sample_rate
     jlog = joint_side_log(log, drive)
+    if check and (opposite := opposite_sign(robot, jlog)) is not None:
+        raise DataError(opposite)  # a fit would negate the masses
     for finding in check_torque_log(robot, jlog) if check else ():  # said first
         warnings.warn(finding, DynidWarning, stacklevel=3)
     still = still_friction(jlog, drive)

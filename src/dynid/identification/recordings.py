@@ -63,7 +63,13 @@ from .pieces import (
     wrappable,
 )
 from .rate import CUTOFF_MULTIPLE, bridged, cutoff_from_motion
-from .sanity import check_torque_log, noise_band, spike_finding, velocity_noise_std
+from .sanity import (
+    check_torque_log,
+    noise_band,
+    opposite_sign,
+    spike_finding,
+    velocity_noise_std,
+)
 from .streaming import streams
 
 __all__ = [
@@ -401,7 +407,9 @@ def prepare_recordings(
     Raises
     ------
     DataError
-        No recording, or no piece long enough to filter (the files are named).
+        No recording, or no piece long enough to filter (the files are named); a
+        recording whose torques have the opposite sign to the robot's
+        (:func:`~dynid.identification.sanity.opposite_sign`, named).
     ShapeError
         A recording with another number of joints than the robot (named).
     """
@@ -426,9 +434,10 @@ def prepare_recordings(
         turned.update(joints)
         cuts.append(max(0, len(mine) - 1))
         if mine:  # sign, units, frozen joints: on the whole recording, said once
-            for finding in check_torque_log(
-                robot, joined([joint_side_log(p, drive) for p in mine])
-            ):
+            whole = joined([joint_side_log(p, drive) for p in mine])
+            if (opposite := opposite_sign(robot, whole)) is not None:
+                raise DataError(opposite, file=name)  # a fit would negate the masses
+            for finding in check_torque_log(robot, whole):
                 shown = finding if len(names) == 1 else f"{name}: {finding}"
                 warnings.warn(shown, DynidWarning, stacklevel=2)
         pieces += [(r, p) for p in mine]

@@ -50,6 +50,7 @@ __all__ = [
     "MOVING_FRACTION",
     "NOISE_BAND_STD",
     "check_torque_log",
+    "opposite_sign",
     "moving_joints",
     "noise_band",
     "SPIKE_SIGMAS",
@@ -220,27 +221,58 @@ def anticorrelated(
     return j, float(corr[j])
 
 
-def _sign_and_scale(
-    robot: Robot, q: NDArray[np.float64], tau: NDArray[np.float64], names: tuple[str, ...]
-) -> list[str]:
+def _gravity_spread(
+    robot: Robot, q: NDArray[np.float64], tau: NDArray[np.float64]
+) -> tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.bool_]] | None:
+    """The robot's gravity torques and ``tau`` with their means removed, and the joints
+    gravity loads (None when it loads none)."""
     g = gravity_torques(robot, q)
     spread = np.std(g, axis=0)
     loaded = spread > 0.05 * max(float(spread.max()), 1e-300)
     if not np.any(loaded) or not np.any(spread > 0):
+        return None
+    return g - g.mean(axis=0), tau - tau.mean(axis=0), loaded
+
+
+def opposite_sign(robot: Robot, log: TorqueLog) -> str | None:
+    """The finding that a joint-side log's torques have the opposite sign to ``robot``'s
+    (anti-correlated with its gravity torques: :func:`anticorrelated`), or None; None
+    too for a robot without inertial parameters to compare with.
+
+    ``identify`` refuses such a log: a fit of the negated torques returns negated
+    masses, and friction that pushes the arm."""
+    if not np.any(robot.phi):
+        return None
+    step = max(1, log.n_samples // _MAX_SAMPLES)
+    return _opposite(robot, log.q[::step], log.tau[::step], robot.joint_names)
+
+
+def _opposite(
+    robot: Robot, q: NDArray[np.float64], tau: NDArray[np.float64], names: tuple[str, ...]
+) -> str | None:
+    centred = _gravity_spread(robot, q, tau)
+    found = None if centred is None else anticorrelated(*centred)
+    if found is None:
+        return None
+    j, c = found
+    return (
+        f"the measured torques are anti-correlated with the model's gravity torques "
+        f"(correlation {c:+.2f} on {names[j]}): the torque sign is probably opposite "
+        "to the model's; hint: --units tau=-1 (or a drive file whose transmission has "
+        "the sign)"
+    )
+
+
+def _sign_and_scale(
+    robot: Robot, q: NDArray[np.float64], tau: NDArray[np.float64], names: tuple[str, ...]
+) -> list[str]:
+    if (opposite := _opposite(robot, q, tau, names)) is not None:
+        return [opposite]
+    centred = _gravity_spread(robot, q, tau)
+    if centred is None:
         return []
-    gc = g - g.mean(axis=0)
-    tc = tau - tau.mean(axis=0)
+    gc, tc, loaded = centred
     out = []
-    found = anticorrelated(gc, tc, loaded)
-    if found is not None:
-        j, c = found
-        out.append(
-            f"the measured torques are anti-correlated with the model's gravity torques "
-            f"(correlation {c:+.2f} on {names[j]}): the torque sign is probably opposite "
-            "to the model's; hint: --units tau=-1 (or a drive file whose transmission has "
-            "the sign)"
-        )
-        return out
     a = float(np.sum(gc[:, loaded] * tc[:, loaded]) / np.sum(gc[:, loaded] ** 2))
     if abs(a) > 30 or 0 < abs(a) < 1 / 30:
         p = round(math.log10(abs(a)))
