@@ -75,6 +75,6 @@ def test_the_structure_table_lists_every_coefficient_the_per_joint_search_left_o
     chosen = cands[1]["name"]
     sel = {"validation": "5 folds", "chosen": chosen, "rule": "lowest", "candidates": cands}
     lines = selection_lines(sel)
-    assert lines[1].endswith("left out per joint (coefficient and joint)")
+    assert lines[1].endswith("left out of the candidate its per-joint search began at")
     assert lines[3].startswith("  * links + coulomb + offset ") and lines[3].endswith("  fv1-7 fo2")
     assert lines[2].rstrip() == lines[2] and not lines[2].endswith("fo2")

@@ -74,4 +74,5 @@ def test_a_sharp_coulomb_law_is_predicted_through_noisy_velocities_by_a_narrow_s
     rel = errors[0].relative_error_percent / truth.with_friction.relative_error_percent
     assert rel < 1.05, rel
 
+
 _SHARP = ("viscous", "coulomb")

@@ -19,13 +19,14 @@ A log without velocity columns gets its velocities from the positions at that cu
 Model structure. Beside the links' base parameters a torque log may need an armature
 (I_a ddq per joint; with a drive file, the rotor inertias at the motors), viscous and
 Coulomb friction (sign(dq) off inside each joint's velocity noise band, or a smooth
-tanh(dq/w) at four widths w, the narrowest about the velocity noise), a Stribeck bump exp(-(dq/vst)^2) at four Stribeck
-velocities, and torque offsets, each identified with the links. By default every
-combination is fitted and judged on data it was not fitted to
-(one recording left out at a time when there are several, else --folds contiguous time
-blocks, or --validate-on), and the simplest within one standard error of the lowest
-held-out error (of the difference, paired over the folds) is kept. The summary prints the table of candidates and the choice;
-identification.json records it. --terms fixes the structure by hand
+tanh(dq/w) at four widths w, the narrowest about the velocity noise), a Stribeck bump
+exp(-(dq/vst)^2) at four Stribeck velocities, and torque offsets, each identified with
+the links. By default every combination is fitted and judged on data it was not fitted
+to (one recording left out at a time when there are several, else --folds contiguous
+time blocks, or --validate-on), and the simplest within one standard error of the lowest
+held-out error (of the difference, paired over the folds) is kept. The summary prints
+the table of candidates and the choice, and the terms' coefficients per joint;
+identification.json records them. --terms fixes the structure by hand
 (e.g. --terms armature,viscous,coulomb,offset).
 
 Checks that the data belong to --robot: a static data file that records another robot

@@ -30,6 +30,7 @@ __all__ = [
     "format_rms_table",
     "heldout_line",
     "heldout_table",
+    "term_lines",
     "progress_printer",
 ]
 
@@ -97,7 +98,53 @@ def format_identification(model: IdentifiedModel, *, width: int = 60) -> str:
             f"{'-' if not np.isfinite(pct) else f'{pct:.3g}':>9}  "
             f"{'yes' if fit.kept[k] else 'no':<4}  {e}"
         )
-    return "\n".join(head + rows)
+    return "\n".join(head + rows + term_lines(model))
+
+
+def term_lines(model: IdentifiedModel) -> list[str]:
+    """The terms identified with the links (friction, armature), one table each: a row per
+    joint (motor, where the term acts at the motors), a column per coefficient, each
+    value with its standard deviation in %; ``in beta`` where the coefficient is regrouped
+    into a base parameter (a rotor with a link's inertia), ``-`` where left out."""
+    out: list[str] = []
+    for name, t in model.terms.items():
+        if not t.labels:
+            continue
+        stems = list(dict.fromkeys(lab.rstrip("0123456789") for lab in t.labels))
+        cells: dict[tuple[str, int], str] = {}
+        units: dict[str, str] = {}
+        for k, lab in enumerate(t.labels):
+            stem = lab.rstrip("0123456789")
+            units[stem] = t.term.units[k] if k < len(t.term.units) else ""
+            cells[(stem, int(lab[len(stem) :]))] = _coefficient(
+                float(t.values[k]), float(t.std[k]), bool(t.kept[k]), t.term.in_base
+            )
+        drive = getattr(t.term, "drive", None)
+        row = "motor" if drive is not None and drive.friction_at == "motor" else "joint"
+        n = getattr(drive, "n", None) or max(j for _, j in cells)
+        heads = [f"{stem} [{units[stem]}]" if units[stem] else stem for stem in stems]
+        widths = [
+            max(len(h), *(len(cells.get((stem, j), "-")) for j in range(1, n + 1)))
+            for h, stem in zip(heads, stems, strict=True)
+        ]
+        out.append(f"{name} identified with the links (value, std %; - left out):")
+        titles = [f"{h:<{w}}" for h, w in zip(heads, widths, strict=True)]
+        out.append(f"  {row:<5}  " + "  ".join(titles).rstrip())
+        for j in range(1, n + 1):
+            cols = [
+                f"{cells.get((stem, j), '-'):<{w}}" for stem, w in zip(stems, widths, strict=True)
+            ]
+            out.append(f"  {j:<5}  " + "  ".join(cols).rstrip())
+    return out
+
+
+def _coefficient(value: float, std: float, kept: bool, in_base: bool) -> str:
+    """One coefficient of a term's table (:func:`term_lines`)."""
+    if not kept:
+        return "in beta" if in_base and not np.isfinite(std) else "-"
+    if not np.isfinite(std) or not value:
+        return f"{value:+.4g}"
+    return f"{value:+.4g} ({abs(100.0 * std / value):.2g} %)"
 
 
 def recordings_lines(recordings: Any) -> list[str]:
@@ -150,7 +197,7 @@ def selection_lines(selection: Any) -> list[str]:
         f"model structure chosen on held-out data ({selection['validation']}): "
         f"{selection['chosen']} ({selection['rule']})",
         f"    {'structure':<{w}} {'params':>6} {'train %':>9} {'held-out %':>11} {'se vs best':>10}"
-        + ("  left out per joint (coefficient and joint)" if left else ""),
+        + ("  left out of the candidate its per-joint search began at" if left else ""),
     ]
     cands = selection["candidates"]
     # skipped (not dissipative within the velocity limits) unless every candidate is
