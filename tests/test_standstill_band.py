@@ -17,6 +17,7 @@ from dynid.friction.model import ClassicalFriction
 from dynid.friction.validation import own_friction
 from dynid.identification.recordings import prepare_recordings
 from dynid.identification.selection import identify_recordings
+from dynid.identification.structure import Structure
 from dynid.signals import lowpass, lowpass_noise_gain
 from dynid.simulation.measurement import SensorNoise, sample_times, simulate_measurement
 from dynid.simulation.trajectories import random_fourier
@@ -68,8 +69,13 @@ def test_the_band_is_the_filtered_noise_band(slow_arm):
     np.testing.assert_allclose(data.band, 5 * 2e-3, rtol=0.1)  # the raw noise band
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", DynidWarning)
-        model = identify_recordings(panda, logs)
+        model = identify_recordings(panda, logs, structure=Structure(False, ("viscous", "coulomb")))
     np.testing.assert_allclose(model.friction.band, gain * data.band, rtol=1e-12)
+    # a smooth Coulomb's width counts in the same band
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", DynidWarning)
+        smooth = identify_recordings(panda, logs, structure=Structure.parse("viscous + smooth:3"))
+    np.testing.assert_allclose(smooth.friction.band, 3 * gain * data.band, rtol=1e-12)
 
 
 def test_a_slow_arm_keeps_its_coulomb_friction_through_reversals(slow_arm):

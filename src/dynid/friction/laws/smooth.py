@@ -2,10 +2,12 @@
 
 .. math:: \\tau_f(\\dot q) = f_v \\dot q + f_c \\tanh(\\dot q / v_s) + f_o
 
-``v_s`` [rad/s] is not fitted: it is the joint's standstill band (the velocity noise band,
-:mod:`dynid.friction.laws.base`), so the Coulomb torque reaches 76 % of ``fc`` where the
-velocity leaves the noise and is near zero where encoder noise alone moves ``dq``
-(without a band, ``v_s = 0``: the plain sign). Linear in ``fv`` [N m s/rad] ``>= 0``,
+``v_s`` [rad/s] is not fitted: it is the law's band (:mod:`dynid.friction.laws.base`),
+the Coulomb torque reaching 76 % of ``fc`` at ``dq = v_s`` (without a band, ``v_s = 0``:
+the plain sign). ``dynid friction`` takes the joint's velocity noise band; ``identify``
+chooses it on held-out data among multiples of that band, the narrowest (0.3 bands,
+about the noise's standard deviation) the expected sign of a sharp Coulomb law given
+the noise. Linear in ``fv`` [N m s/rad] ``>= 0``,
 ``fc`` [N m] ``>= 0`` and ``fo`` [N m]. MuJoCo holds ``fv`` as ``damping`` and ``fc`` as
 ``frictionloss`` (its dry friction is itself a smoothed constraint); the offset is dropped.
 """
