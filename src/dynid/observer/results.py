@@ -48,6 +48,11 @@ class LogObservation:
     standstill_peak : ndarray, shape (n,), or None
         The largest standstill margin of each joint over the log [N m] (kept without the
         series).
+    peak : ndarray, shape (n,), or None
+        The largest ``|r|`` of each joint over the log [N m] (NaN: never observed), kept
+        without the series.
+    truth_rms : ndarray, shape (n,), or None
+        :meth:`truth_error` computed while observing (kept without the series).
     """
 
     path: Path
@@ -60,6 +65,8 @@ class LogObservation:
     standstill: NDArray[np.float64] | None = None
     restarts: tuple[int, ...] = (0,)
     standstill_peak: NDArray[np.float64] | None = None
+    peak: NDArray[np.float64] | None = None
+    truth_rms: NDArray[np.float64] | None = None
 
     @property
     def series(self) -> NDArray[np.float64]:
@@ -74,10 +81,29 @@ class LogObservation:
             raise DataError(f"{self.path.name}: the calibration kept no residual series")
         return self.r
 
+    def largest(self) -> NDArray[np.float64]:
+        """The largest ``|r|`` of each joint (n,) [N m] (NaN: never observed).
+
+        Raises
+        ------
+        DataError
+            Neither the series nor its peak kept.
+        """
+        if self.peak is not None:
+            return self.peak
+        r = self.series
+        ran = np.all(np.isfinite(r), axis=1)
+        if not ran.any():
+            return np.full(r.shape[1], np.nan)
+        out: NDArray[np.float64] = np.max(np.abs(r[ran]), axis=0)
+        return out
+
     def truth_error(self) -> NDArray[np.float64] | None:
         """RMS [N m] (n,) per joint of the residual against the true external torques
         ``r - tau_ext`` (the observer's first-order lag included), over the samples the
         observer ran on; None without ``tau_ext``."""
+        if self.truth_rms is not None:
+            return self.truth_rms
         if self.tau_ext is None or self.r is None:
             return None
         e = self.r - self.tau_ext

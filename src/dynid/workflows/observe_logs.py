@@ -36,6 +36,7 @@ __all__ = [
     "PreparedLog",
     "Series",
     "observed_blocks",
+    "observed_rows",
     "prepared_log",
 ]
 
@@ -147,6 +148,31 @@ def observed_blocks(
                     next(stds) if wants_std else None,
                     m,
                 )
+
+
+def observed_rows(
+    prep: PreparedLog,
+    model: ObserverModel,
+    options: ObserverOptions,
+    wants_std: bool,
+    wants_margin: bool,
+) -> Iterator[ObservedBlock]:
+    """:func:`observed_blocks` with the samples the observer does not run on between them
+    (NaN residual and std, no margin), at most :data:`OBSERVE_BLOCK` at a time: blocks that
+    cover every sample of the log in order (a residual table, the detection)."""
+    N, n = prep.log.t.shape[0], prep.log.q.shape[1]
+    done = 0
+    for blk in observed_blocks(prep, model, options, wants_std, wants_margin):
+        yield from _unobserved(done, blk.a, n, wants_std)
+        yield blk
+        done = blk.a + blk.r.shape[0]
+    yield from _unobserved(done, N, n, wants_std)
+
+
+def _unobserved(a: int, b: int, n: int, wants_std: bool) -> Iterator[ObservedBlock]:
+    for c in range(a, b, OBSERVE_BLOCK):
+        r = np.full((min(c + OBSERVE_BLOCK, b) - c, n), np.nan)
+        yield ObservedBlock(c, r, r if wants_std else None, None)
 
 
 def _rechunked(
