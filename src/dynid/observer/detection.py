@@ -191,20 +191,28 @@ def standstill_blocks(
     dq: NDArray[np.float64],
     options: ObserverOptions = DEFAULT_OPTIONS,
     block: int | None = None,
+    *,
+    bands: tuple[NDArray[np.float64], ...] | None = None,
+    derived: bool = False,
 ) -> Iterator[tuple[int, NDArray[np.float64]]]:
     """:func:`standstill_series` of one piece ``t`` (N,), ``dq`` (N, n) (validated) a block
     of ``block`` samples (default :data:`_MARGIN_BLOCK`) at a time: ``(first sample, margin
     (m, n) [N m])``, only one block's temporaries held (a long log). The lag continues from
     block to block (its free response ``exp(-K_O (t - t_prev))`` added), as the whole
-    piece's to rounding; a margin that is zero everywhere yields nothing."""
+    piece's to rounding; a margin that is zero everywhere yields nothing. ``bands``: the
+    velocity bands of the friction's parts (default :func:`~dynid.observer.friction.
+    velocity_bands` of ``dq``); ``derived``: ``dq`` derived from the positions, ``bands``
+    of :func:`~dynid.observer.friction.derived_velocity_bands`
+    (:func:`~dynid.observer.friction.standstill_margin`)."""
     N, n = dq.shape
     size = _MARGIN_BLOCK if block is None else int(block)
-    bands = velocity_bands(model.friction, dq) if model.friction is not None else None
+    if bands is None and model.friction is not None:
+        bands = velocity_bands(model.friction, dq)
     gains = options.gains(n)
     prev: tuple[float, NDArray[np.float64], NDArray[np.float64]] | None = None
     for a in range(0, N, size):
         b = min(a + size, N)
-        w = standstill_margin(model.friction, dq[a:b], bands)
+        w = standstill_margin(model.friction, dq[a:b], bands, derived=derived)
         if prev is None and not np.any(w):
             continue  # zero so far: its lag is zero too
         if prev is None:  # the first nonzero block: the lag of zeros before it is zero
