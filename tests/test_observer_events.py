@@ -167,3 +167,31 @@ def test_observe_command_writes_the_table_a_block_at_a_time(contact_log, monkeyp
     r = observe(model, log.t, log.q, log.dq, log.tau, ObserverOptions()).r  # the whole log
     np.testing.assert_array_equal(table[:, 0], log.t)
     np.testing.assert_array_equal(table[:, 1:], r)
+
+
+def test_a_detection_figure_keeps_every_kth_sample_of_the_series(contact_log, monkeypatch):
+    """figure_points 50 over blocks of 97 samples: the figure's series are every
+    ceil(N / 50)-th sample of the whole series, with the thresholds at those samples;
+    the command draws residuals.png from them."""
+    from dynid.observer.detection import threshold_series
+    from dynid.workflows.observe import ObserveOptions, observe_files
+
+    d = contact_log
+    monkeypatch.setattr("dynid.workflows.observe_logs.OBSERVE_BLOCK", 97)
+    opts = ObserveOptions(
+        data=(d / "gap.csv",), params="panda", thresholds=d / "cal" / "thresholds.json",
+        figure_points=50,
+    )  # fmt: skip
+    result = observe_files(opts)
+    x = result.logs[0]
+    f = x.figure
+    assert f is not None and x.tau_ext is not None
+    step = int(np.ceil(x.t.shape[0] / 50))
+    assert f.step == step and f.t.shape[0] <= 50
+    c, k = threshold_series(result.thresholds, x.t.shape[0], x.std, x.standstill)
+    for got, whole in ((f.t, x.t), (f.r, x.r), (f.contact, c), (f.collision, k)):
+        np.testing.assert_array_equal(got, whole[::step])
+    np.testing.assert_array_equal(f.tau_ext, x.tau_ext[::step])
+    p = ["observe", "--params", "panda", "--thresholds", str(d / "cal" / "thresholds.json")]
+    assert main([*p, "--data", str(d / "hit.csv"), "--out", str(d / "fig")]) == 0
+    assert (d / "fig" / "residuals.png").stat().st_size > 0

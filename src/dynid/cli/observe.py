@@ -58,6 +58,8 @@ from .figures import save_observer_figures
 from .summaries import format_observation
 
 NAME = "observe"
+#: Samples drawn per curve of a detection's figure (every k-th of a long log).
+FIGURE_POINTS = 20000
 #: ``--out`` is a folder: its files are one output set (:mod:`dynid.outputs.run_output`).
 OUTPUT = "folder"
 
@@ -131,7 +133,9 @@ def run(args: argparse.Namespace, console: Console) -> int:
         merge_s=args.merge,
         columns=(args.columns, args.units), drop_invalid=args.drop_invalid,
         max_gap=args.max_gap, base=args.base, tip=args.tip,
-        keep_series=not args.no_figures,  # the series serve the figures only
+        # the series serve the figures only: a calibration's whole, a detection's strided
+        keep_series=args.calibrate and not args.no_figures,
+        figure_points=None if args.no_figures else FIGURE_POINTS,
     )  # fmt: skip
     tables = ResidualTables(args.out)  # written a block at a time while detecting
     result = observe_files(opts, tables)

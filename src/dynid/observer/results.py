@@ -17,7 +17,34 @@ from .detection import ContactEvent, Thresholds
 from .model import ObserverModel
 from .wrench import WrenchEstimate
 
-__all__ = ["LogObservation", "ObserveResult"]
+__all__ = ["FigureSeries", "LogObservation", "ObserveResult"]
+
+
+@dataclass(frozen=True, slots=True, eq=False)
+class FigureSeries:
+    """Every ``step``-th sample of a log's residual, thresholds and true torques, kept
+    for its figure when the series are not (detection a block at a time).
+
+    Attributes
+    ----------
+    step : int
+        Samples between two kept ones.
+    t : ndarray, shape (M,)
+        [s].
+    r : ndarray, shape (M, n)
+        Residual [N m] (NaN where not observed).
+    contact, collision : ndarray, shape (M, n)
+        The thresholds at those samples [N m] (NaN where not observed).
+    tau_ext : ndarray, shape (M, n), or None
+        The true external torques stored beside a simulated log.
+    """
+
+    step: int
+    t: NDArray[np.float64]
+    r: NDArray[np.float64]
+    contact: NDArray[np.float64]
+    collision: NDArray[np.float64]
+    tau_ext: NDArray[np.float64] | None
 
 
 @dataclass(frozen=True, slots=True, eq=False)
@@ -53,6 +80,8 @@ class LogObservation:
         without the series.
     truth_rms : ndarray, shape (n,), or None
         :meth:`truth_error` computed while observing (kept without the series).
+    figure : FigureSeries or None
+        Every few samples of the series for a figure (kept without the series).
     """
 
     path: Path
@@ -67,6 +96,7 @@ class LogObservation:
     standstill_peak: NDArray[np.float64] | None = None
     peak: NDArray[np.float64] | None = None
     truth_rms: NDArray[np.float64] | None = None
+    figure: FigureSeries | None = None
 
     @property
     def series(self) -> NDArray[np.float64]:

@@ -121,6 +121,9 @@ class ObserveOptions:
         samples at a time (bounded memory on a long log); the result's logs then hold no
         series. Detecting: False keeps no series (the events, the residual tables of the
         ``sink`` and the summaries a block at a time); True keeps them too.
+    figure_points : int, optional
+        Detecting: keep every k-th sample of the residual, its thresholds and the true
+        torques, at most this many, for a figure (``LogObservation.figure``).
     """
 
     data: tuple[Path, ...]
@@ -146,6 +149,7 @@ class ObserveOptions:
     base: str | None = None
     tip: str | None = None
     keep_series: bool = True
+    figure_points: int | None = None
 
 
 def load_observer_model(
@@ -299,6 +303,7 @@ def observe_files(opts: ObserveOptions, sink: ResidualSink | None = None) -> Obs
                 merge_s=opts.merge_s,
                 frame=opts.frame,
                 keep_series=opts.keep_series,
+                figure_points=opts.figure_points,
                 table=table,
             )  # fmt: skip
         )

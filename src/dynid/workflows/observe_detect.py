@@ -7,7 +7,9 @@ carried), to the residual table of a ``sink`` (written a block at a time), to th
 wrench at ``frame`` and to running statistics (the largest residual, the error against
 the true external torques ``tau_ext`` of a simulated log, the largest standstill margin):
 a long log is detected with one block's temporaries. The full-length series are kept
-only when asked (``keep_series``: figures, the Python API).
+only when asked (``keep_series``, the Python API); a figure gets every k-th sample of the
+residual, its thresholds and the true torques (``figure_points``: the samples the figure
+draws).
 """
 
 from __future__ import annotations
@@ -25,11 +27,11 @@ from ..io.columns import load_joint_columns
 from ..observer.events import ContactEvent, EventDetector
 from ..observer.model import ObserverModel
 from ..observer.residual import ObserverOptions
-from ..observer.results import LogObservation
-from ..observer.thresholds import Thresholds
+from ..observer.results import FigureSeries, LogObservation
+from ..observer.thresholds import Thresholds, threshold_series
 from ..observer.wrench import WrenchEstimate, external_wrench
 from .data_files import in_file
-from .observe_logs import PreparedLog, Series, observed_rows
+from .observe_logs import ObservedBlock, PreparedLog, Series, observed_rows
 
 __all__ = ["ResidualSink", "detected_log", "true_torques"]
 
@@ -69,16 +71,19 @@ def detected_log(
     merge_s: float,
     frame: str | None,
     keep_series: bool,
+    figure_points: int | None = None,
     table: AbstractContextManager[Callable[..., None] | None] | None = None,
 ) -> LogObservation:
     """The events of one prepared log (module docstring), ``wants`` the residual's std and
-    the standstill margin, ``table`` the sink's writer of its residual table (or none)."""
+    the standstill margin, ``table`` the sink's writer of its residual table (or none);
+    ``figure_points``: keep every k-th sample (at most that many) for a figure."""
     log, n = prep.log, model.n
     starts = tuple(a for a, _ in prep.spans)
     det = EventDetector(thresholds, merge_s=merge_s, restarts=starts)
     keep = Series.new(prep, n, *wants) if keep_series else None
     ext = in_file(prep.path, lambda: true_torques(prep, model, mapped))
     stats = _Running(n)
+    strided = None if not figure_points else _Strided(log.t.shape[0], figure_points, thresholds)
     events: list[ContactEvent] = []
     wrenches: list[WrenchEstimate] = []
     with about_file(prep.path.name), table or nullcontext(None) as put:
@@ -93,6 +98,8 @@ def detected_log(
             stats.add(blk.r, blk.margin, None if ext is None else ext[a:b])
             if keep is not None:
                 keep.put(blk)
+            if strided is not None:
+                strided.add(log.t, blk, None if ext is None else ext[a:b])
         events += det.finish()
     return LogObservation(
         prep.path,
@@ -107,6 +114,7 @@ def detected_log(
         stats.margin,
         peak=stats.peak,
         truth_rms=stats.truth(),
+        figure=None if strided is None else strided.series(),
     )
 
 
@@ -147,3 +155,36 @@ class _Running:
     def truth(self) -> Any:
         """RMS of the error against the true torques (n,) [N m], or None."""
         return np.sqrt(self.square / self.count) if self.count else None
+
+
+class _Strided:
+    """Every ``step``-th sample of a log of ``N`` (``step = ceil(N / points)``, the stride
+    of :func:`~dynid.plots.observer.plot_residuals`) with its thresholds, a block at a
+    time."""
+
+    def __init__(self, N: int, points: int, thresholds: Thresholds) -> None:
+        self.step = max(1, int(np.ceil(N / points)))
+        self.thresholds = thresholds
+        self.parts: list[tuple[NDArray, ...]] = []
+        self.ext: list[NDArray] = []
+
+    def add(self, t: NDArray, blk: ObservedBlock, ext: NDArray | None) -> None:
+        a, m = blk.a, blk.r.shape[0]
+        rows = np.arange(-a % self.step, m, self.step)  # the block's samples k*step
+        r = blk.r[rows]
+        seen = np.all(np.isfinite(r), axis=1)
+        std = None if blk.std is None else np.where(seen[:, None], blk.std[rows], 0.0)
+        margin = None if blk.margin is None else blk.margin[rows]
+        c, k = threshold_series(self.thresholds, rows.size, std, margin)
+        c[~seen], k[~seen] = np.nan, np.nan
+        self.parts.append((t[a + rows], r, c, k))
+        if ext is not None:
+            self.ext.append(ext[rows])
+
+    def series(self) -> FigureSeries:
+        if not self.parts:  # no sample
+            e = np.zeros((0, self.thresholds.n))
+            return FigureSeries(self.step, np.zeros(0), e, e, e, None)
+        t, r, c, k = (np.concatenate(x) for x in zip(*self.parts, strict=True))
+        ext = np.concatenate(self.ext) if self.ext else None
+        return FigureSeries(self.step, t, r, c, k, ext)
