@@ -40,14 +40,16 @@ end, the joints over the threshold, every joint's peak and its level
 from __future__ import annotations
 
 from collections.abc import Iterable, Iterator
+from typing import Any
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from .. import _checks
 from ..exceptions import DataError, OptionError, ShapeError
+from ..identification.log import DEFAULT_CUTOFF_HZ
 from .events import ContactEvent, EventDetector, detect
-from .friction import standstill_margin, velocity_bands
+from .friction import derived_velocity_bands, standstill_margin, velocity_bands
 from .model import ObserverModel
 from .residual import DEFAULT_OPTIONS, ObserverOptions, first_order_lag
 from .terms import base_momentum_regressor
@@ -163,13 +165,19 @@ def standstill_series(
     t: ArrayLike,
     dq: ArrayLike,
     options: ObserverOptions = DEFAULT_OPTIONS,
+    *,
+    q: ArrayLike | None = None,
+    cutoff_hz: float = DEFAULT_CUTOFF_HZ,
 ) -> NDArray[np.float64]:
     """The standstill margin (N, n) [N m] of the model's friction at the velocities ``dq``
     (N, n) [rad/s], through the observer's lag ``K_O/(s + K_O)`` over the times ``t`` (N,)
     [s] (module docstring): a bound of the residual that friction the model cannot know
     (inside its standstill band, within the velocity noise band of its smooth Coulomb
     steps: :func:`~dynid.observer.friction.standstill_margin`) leaves; zeros for a friction
-    without either. The noise band is estimated on ``dq`` (one piece of a log).
+    without either. The noise band is estimated on ``dq`` (one piece of a log), or, for
+    velocities derived from the positions ``q`` (N, n) [rad] at ``cutoff_hz`` [Hz], it is
+    their noise through the derivative filter
+    (:func:`~dynid.observer.friction.derived_velocity_bands`).
 
     Raises
     ------
@@ -180,7 +188,11 @@ def standstill_series(
     ta = _checks.as_array("t", t)
     dqa = _checks.as_exact("dq", dq, (ta.shape[0], n))
     out = np.zeros((ta.shape[0], n))
-    for a, m in standstill_blocks(model, ta, dqa, options):
+    kw: dict[str, Any] = {}
+    if q is not None and model.friction is not None:
+        qa = _checks.as_exact("q", q, dqa.shape)
+        kw = {"bands": derived_velocity_bands(model.friction, ta, qa, cutoff_hz), "derived": True}
+    for a, m in standstill_blocks(model, ta, dqa, options, **kw):
         out[a : a + m.shape[0]] = m
     return out
 
@@ -200,9 +212,10 @@ def standstill_blocks(
     (m, n) [N m])``, only one block's temporaries held (a long log). The lag continues from
     block to block (its free response ``exp(-K_O (t - t_prev))`` added), as the whole
     piece's to rounding; a margin that is zero everywhere yields nothing. ``bands``: the
-    velocity bands of the friction's parts (default :func:`~dynid.observer.friction.
-    velocity_bands` of ``dq``); ``derived``: ``dq`` derived from the positions, ``bands``
-    of :func:`~dynid.observer.friction.derived_velocity_bands`
+    velocity bands of the friction's parts (default
+    :func:`~dynid.observer.friction.velocity_bands` of ``dq``); ``derived``: ``dq``
+    derived from the positions, ``bands`` of
+    :func:`~dynid.observer.friction.derived_velocity_bands`
     (:func:`~dynid.observer.friction.standstill_margin`)."""
     N, n = dq.shape
     size = _MARGIN_BLOCK if block is None else int(block)

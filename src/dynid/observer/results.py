@@ -56,9 +56,8 @@ class LogObservation:
     path : Path
     t : ndarray, shape (N,)
     r : ndarray, shape (N, n), or None
-        Residual [N m]; None when a calibration kept no series (a long log's thresholds
-        from running statistics: ``keep_series`` of
-        :class:`~dynid.workflows.observe.ObserveOptions`).
+        Residual [N m]; None when no series was kept (a long log a block at a time:
+        ``keep_series`` of :class:`~dynid.workflows.observe.ObserveOptions`).
     std : ndarray, shape (N, n), or None
         Its standard deviation from the model's uncertainty (when used).
     events : list of ContactEvent
@@ -105,10 +104,10 @@ class LogObservation:
         Raises
         ------
         DataError
-            A calibration that kept no series.
+            An observation that kept no series (``keep_series`` off).
         """
         if self.r is None:
-            raise DataError(f"{self.path.name}: the calibration kept no residual series")
+            raise DataError(f"{self.path.name}: no residual series kept (keep_series off)")
         return self.r
 
     def largest(self) -> NDArray[np.float64]:

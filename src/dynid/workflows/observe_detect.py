@@ -1,15 +1,15 @@
 """Detection on one log a block of samples at a time (``dynid observe --thresholds``).
 
-The observer runs over the log's pieces a block at a time (:func:`~dynid.workflows.
-observe_logs.observed_rows`, its state carried), and each block goes at once to the
-events (:class:`~dynid.observer.events.EventDetector`, the event open at a block's end
-carried), to the residual table of a ``sink`` (written a block at a time), to the
-wrench at ``frame`` and to running statistics (the largest residual, the error against
-the true external torques ``tau_ext`` of a simulated log, the largest standstill margin):
-a long log is detected with one block's temporaries. The full-length series are kept
-only when asked (``keep_series``, the Python API); a figure gets every k-th sample of the
-residual, its thresholds and the true torques (``figure_points``: the samples the figure
-draws).
+The observer runs over the log's pieces a block at a time
+(:func:`~dynid.workflows.observe_logs.observed_rows`, its state carried), and each block
+goes at once to the events (:class:`~dynid.observer.events.EventDetector`, the event open
+at a block's end carried), to the residual table of a ``sink`` (written a block at a
+time), to the wrench at ``frame`` and to running statistics (the largest residual, the
+error against the true external torques ``tau_ext`` of a simulated log, the largest
+standstill margin): a long log is detected with one block's temporaries. The
+full-length series are kept only when asked (``keep_series``, the Python API); a figure
+gets every k-th sample of the residual, its thresholds and the true torques
+(``figure_points``: the samples the figure draws).
 """
 
 from __future__ import annotations
