@@ -164,13 +164,28 @@ def save_observer_figures(out: Path, result: ObserveResult, *, names: list[str])
     paths = []
     labels = log_labels([x.path for x in result.logs])
     for x, stem, label in zip(result.logs, observation_names(result.logs), labels, strict=True):
-        if x.r is None:  # a calibration that kept no series
+        if x.figure is not None:  # a detection's every k-th sample
+            f = x.figure
+            t, r, contact, collision, ext = f.t, f.r, f.contact, f.collision, f.tau_ext
+        elif x.r is not None:
+            t, r, ext = x.t, x.r, x.tau_ext
+            contact, collision = threshold_series(
+                result.thresholds, t.shape[0], x.std, x.standstill
+            )
+        else:  # a calibration that kept no series
             continue
-        contact, collision = threshold_series(result.thresholds, x.t.shape[0], x.std, x.standstill)
 
-        def draw(x: Any = x, c: Any = contact, k: Any = collision, lab: str = label) -> Any:
+        def draw(
+            t: Any = t,
+            r: Any = r,
+            c: Any = contact,
+            k: Any = collision,
+            ext: Any = ext,
+            events: Any = x.events,
+            lab: str = label,
+        ) -> Any:
             return observer_plots.plot_residuals(
-                x.t, x.r, c, k, events=x.events, tau_ext=x.tau_ext, joint_names=names,
+                t, r, c, k, events=events, tau_ext=ext, joint_names=names,
                 title=f"momentum observer on {lab}: residual, thresholds, events",
             )  # fmt: skip
 

@@ -58,6 +58,8 @@ from .figures import save_observer_figures
 from .summaries import format_observation
 
 NAME = "observe"
+#: Samples drawn per curve of a detection's figure (every k-th of a long log).
+FIGURE_POINTS = 20000
 #: ``--out`` is a folder: its files are one output set (:mod:`dynid.outputs.run_output`).
 OUTPUT = "folder"
 
@@ -118,7 +120,7 @@ def register(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParser:
 
 def run(args: argparse.Namespace, console: Console) -> int:
     """Calibrate or detect, print the thresholds and events, save the files."""
-    from ..io.observer_files import save_observation
+    from ..io.observer_files import ResidualTables, save_observation
 
     gain = parse_vector(args.gain, "--gain")
     opts = ObserveOptions(
@@ -131,15 +133,19 @@ def run(args: argparse.Namespace, console: Console) -> int:
         merge_s=args.merge,
         columns=(args.columns, args.units), drop_invalid=args.drop_invalid,
         max_gap=args.max_gap, base=args.base, tip=args.tip,
-        keep_series=not args.no_figures,  # a calibration's series serve its figures only
+        # the series serve the figures only: a calibration's whole, a detection's strided
+        keep_series=args.calibrate and not args.no_figures,
+        figure_points=None if args.no_figures else FIGURE_POINTS,
     )  # fmt: skip
-    result = observe_files(opts)
+    tables = ResidualTables(args.out)  # written a block at a time while detecting
+    result = observe_files(opts, tables)
     names = list(result.model.robot.joint_names)
     console.print(format_observation(result, names, calibrating=args.calibrate))
     meta = {"model": str(args.model or args.params), "source": result.model.source}
-    for path in save_observation(
-        args.out, result, joints=names, calibrating=args.calibrate, meta=meta
-    ):
+    saved = save_observation(
+        args.out, result, joints=names, calibrating=args.calibrate, meta=meta, residuals=False
+    )
+    for path in saved + tables.written:
         console.wrote(path)
     if not args.no_figures:
         save_observer_figures(args.out, result, names=names)

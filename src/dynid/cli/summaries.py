@@ -512,7 +512,7 @@ def format_observation(result: ObserveResult, names: list[str], *, calibrating: 
         read = "|r| read" if th.quantile == 1.0 else f"|r| q{th.quantile:g}"
         cols = {f"{read} [N m]": th.contact / th.margin}
     else:
-        peak = np.nanmax([np.nanmax(np.abs(x.series), axis=0) for x in result.logs], axis=0)
+        peak = np.nanmax([x.largest() for x in result.logs], axis=0)
         cols = {"max |r| [N m]": peak}
     cols |= {"contact [N m]": th.contact, "collision [N m]": th.collision}
     rest = undetected_at_rest(result.model, th)

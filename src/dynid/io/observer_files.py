@@ -22,7 +22,8 @@
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+import contextlib
+from collections.abc import Callable, Iterator, Sequence
 from pathlib import Path
 from typing import Any
 
@@ -40,11 +41,14 @@ from .schema import Field, Format, Record, load_document, save_document
 
 __all__ = [
     "EVENTS_SCHEMA",
+    "ResidualTables",
     "THRESHOLDS",
     "THRESHOLDS_SCHEMA",
     "load_thresholds",
     "log_labels",
     "observation_names",
+    "residual_names",
+    "residuals_csv",
     "save_events",
     "save_observation",
     "save_residuals_csv",
@@ -213,23 +217,71 @@ def save_residuals_csv(
     frame: str | None = None,
 ) -> Path:
     """Write ``residuals.csv``: ``t, r1..rn`` (and the wrench at ``frame``); returns the path."""
-    n = r.shape[1]
+    with residuals_csv(
+        path, t.shape[0], r.shape[1], frame=frame if wrench is not None else None
+    ) as put:
+        put(t, r, wrench, damped)
+    return Path(path)
+
+
+@contextlib.contextmanager
+def residuals_csv(
+    path: str | Path, rows: int, n: int, *, frame: str | None = None
+) -> Iterator[Callable[..., None]]:
+    """``residuals.csv`` written a block of rows at a time: yields ``put(t, r, wrench=None,
+    damped=None)`` for consecutive blocks ``t`` (m,), ``r`` (m, n) and, with ``frame``,
+    the wrench (m, 6) and its flag (m,); the file (``rows`` in its header) appears when the
+    block ends normally (atomic), the bytes of :func:`save_residuals_csv` of the whole."""
     names = ["t"] + [f"r{j + 1}" for j in range(n)]
-    parts = [t[:, None], r]
     units = "t [s], r [N m]"
-    if wrench is not None:
+    if frame is not None:
         names += ["fx", "fy", "fz", "mx", "my", "mz", "damped"]
-        flag = np.zeros(t.shape[0]) if damped is None else damped.astype(float)
-        parts += [wrench, flag[:, None]]
         units += f"; wrench at {frame}: f [N], m [N m], base axes; damped: 1 near a singularity"
-    path = Path(path)
-    with open_atomic(path, "w") as fh:
-        fh.write(f"# dynid residuals; units: {units}\n# rows: {t.shape[0]}\n")
+    with open_atomic(Path(path), "w") as fh:
+        fh.write(f"# dynid residuals; units: {units}\n# rows: {rows}\n")
         fh.write(",".join(names) + "\n")
-        table = np.concatenate(parts, axis=1)
-        for a in range(0, table.shape[0], 100_000):
-            np.savetxt(fh, table[a : a + 100_000], delimiter=",", fmt="%.17g")
-    return path
+
+        def put(
+            t: NDArray[np.float64],
+            r: NDArray[np.float64],
+            wrench: NDArray[np.float64] | None = None,
+            damped: NDArray[np.bool_] | None = None,
+        ) -> None:
+            parts = [t[:, None], r]
+            if frame is not None:
+                assert wrench is not None
+                flag = np.zeros(t.shape[0]) if damped is None else damped.astype(float)
+                parts += [wrench, flag[:, None]]
+            table = np.concatenate(parts, axis=1)
+            for a in range(0, table.shape[0], _CSV_ROWS):
+                np.savetxt(fh, table[a : a + _CSV_ROWS], delimiter=",", fmt="%.17g")
+
+        yield put
+
+
+#: Rows of ``residuals.csv`` formatted at a time.
+_CSV_ROWS = 100_000
+
+
+class ResidualTables:
+    """The residual tables of ``dynid observe`` in the folder ``out``, each written a block
+    at a time while the log is observed (:func:`dynid.workflows.observe.observe_files`'s
+    ``sink``): ``residuals.csv`` for one log, ``residuals_<name>.csv`` for several
+    (:func:`residual_names`). ``written`` lists the files in order."""
+
+    def __init__(self, out: str | Path) -> None:
+        self.out = Path(out)
+        self.written: list[Path] = []
+
+    @contextlib.contextmanager
+    def table(
+        self, paths: Sequence[str | Path], index: int, rows: int, n: int, frame: str | None
+    ) -> Iterator[Callable[..., None]]:
+        """The writer of log ``index`` of ``paths`` (:func:`residuals_csv`)."""
+        path = self.out / f"{residual_names(paths)[index]}.csv"
+        with residuals_csv(path, rows, n, frame=frame) as put:
+            yield put
+        self.written.append(path)
 
 
 def log_labels(paths: Sequence[str | Path]) -> list[str]:
@@ -249,13 +301,18 @@ def log_labels(paths: Sequence[str | Path]) -> list[str]:
 
 
 def observation_names(logs: Sequence[LogObservation]) -> list[str]:
-    """The name stem of each log's files: ``residuals`` for one log, ``residuals_<stem>``
-    for several, the stem of :func:`log_labels` (``residuals_a_free`` for ``a/free.csv``
-    beside ``b/free.csv``; numbered where two still agree)."""
-    if len(logs) == 1:
+    """The name stem of each log's files (:func:`residual_names` of their paths)."""
+    return residual_names([x.path for x in logs])
+
+
+def residual_names(paths: Sequence[str | Path]) -> list[str]:
+    """The name stem of the files of the logs ``paths``: ``residuals`` for one log,
+    ``residuals_<stem>`` for several, the stem of :func:`log_labels` (``residuals_a_free``
+    for ``a/free.csv`` beside ``b/free.csv``; numbered where two still agree)."""
+    if len(paths) == 1:
         return ["residuals"]
     out: list[str] = []
-    for label in log_labels([x.path for x in logs]):
+    for label in log_labels(paths):
         name = "residuals_" + str(Path(label).with_suffix("")).replace("/", "_")
         k, base = 2, name
         while name in out:
@@ -271,12 +328,14 @@ def save_observation(
     joints: Sequence[str],
     calibrating: bool,
     meta: dict[str, Any] | None = None,
+    residuals: bool = True,
 ) -> list[Path]:
     """The files of ``dynid observe`` in the folder ``out``; returns them.
 
     Calibrating: ``thresholds.json``. Detecting: ``events.json`` (every log's events, each
-    with its log's name when there are several) and a residual table per log
-    (:func:`observation_names`).
+    with its log's name when there are several) and, with ``residuals``, a residual table
+    per log from its series (:func:`observation_names`; False: written while observing,
+    :class:`ResidualTables`).
     """
     out = Path(out)
     meta = dict(meta or {})
@@ -291,6 +350,8 @@ def save_observation(
     events: list[ContactEvent] = []
     logs_of: list[str] = []
     for x, name in zip(result.logs, observation_names(result.logs), strict=True):
+        if not residuals:
+            break
         w = x.wrench
         paths.append(
             save_residuals_csv(

@@ -19,17 +19,23 @@ Albu-Schaeffer, IEEE T-RO 2017), on any model dynid produces.
   each piece), positions that jump;
 * :mod:`~dynid.observer.wrench`: the external wrench at a frame by damped least squares;
 * :mod:`~dynid.observer.detection`: thresholds calibrated on collision-free data, the
-  model's uncertainty propagated to the residual, contact and collision events.
+  model's uncertainty propagated to the residual, the standstill margin;
+* :mod:`~dynid.observer.thresholds`: the thresholds and their value at every sample;
+* :mod:`~dynid.observer.events`: contact and collision events, from a whole log or a
+  block of samples at a time (:class:`EventDetector`).
 """
 
-from .detection import ContactEvent, Thresholds, calibrate, detect, residual_std
+from .detection import calibrate, residual_std
+from .events import ContactEvent, EventDetector, detect
 from .model import ObserverModel, from_identified, from_robot
 from .residual import MomentumObserver, ObserverOptions, ObserverResult, first_order_lag, observe
 from .terms import base_momentum_regressor, momentum_regressor, momentum_terms
+from .thresholds import Thresholds
 from .wrench import WrenchEstimate, external_wrench
 
 __all__ = [
     "ContactEvent",
+    "EventDetector",
     "MomentumObserver",
     "ObserverModel",
     "ObserverOptions",

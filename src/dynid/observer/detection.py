@@ -30,31 +30,34 @@ reversals of a collision-free motion.
 Two levels, as robot controllers have them: ``contact`` (the threshold) and ``collision``
 (``collision_factor`` times it).
 
-**Events** (:func:`detect`): the samples where some ``|r_j|`` exceeds its contact
-threshold, runs closer than ``merge_s`` joined; each event has its start and end [s]
-(first and last sample over the threshold), the joints over it (1-based), the peak
-residual of every joint [N m] (signed, at its largest magnitude) and its level
-(``collision`` when some joint passed its collision threshold).
+**Events** (:func:`~dynid.observer.events.detect`, a block of samples at a time with
+:class:`~dynid.observer.events.EventDetector`): the samples where some ``|r_j|`` exceeds
+its contact threshold, runs closer than ``merge_s`` joined; each event has its start and
+end, the joints over the threshold, every joint's peak and its level
+(:mod:`dynid.observer.events`).
 """
 
 from __future__ import annotations
 
 from collections.abc import Iterable, Iterator
-from dataclasses import dataclass, field
-from typing import Literal
+from typing import Any
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from .. import _checks
 from ..exceptions import DataError, OptionError, ShapeError
-from .friction import standstill_margin, velocity_bands
+from ..identification.log import DEFAULT_CUTOFF_HZ
+from .events import ContactEvent, EventDetector, detect
+from .friction import derived_velocity_bands, standstill_margin, velocity_bands
 from .model import ObserverModel
 from .residual import DEFAULT_OPTIONS, ObserverOptions, first_order_lag
 from .terms import base_momentum_regressor
+from .thresholds import Thresholds, threshold_series
 
 __all__ = [
     "ContactEvent",
+    "EventDetector",
     "Thresholds",
     "calibrate",
     "detect",
@@ -72,81 +75,6 @@ BLOCK = 8192
 #: above it) at least, and the fraction of the samples: fewer is refused (:func:`calibrate`).
 MIN_OUTSIDE = 200
 MIN_OUTSIDE_FRACTION = 0.01
-
-
-@dataclass(frozen=True, slots=True, eq=False)
-class Thresholds:
-    """Per-joint detection thresholds (module docstring); arrays read-only.
-
-    Attributes
-    ----------
-    contact, collision : ndarray, shape (n,)
-        Fixed thresholds [N m] (the distribution rule).
-    margin, quantile, collision_factor : float
-        The rule's parameters.
-    k_sigma : float or None
-        ``k`` of the uncertainty-grown threshold; None: fixed thresholds only.
-    noise : ndarray, shape (n,), or None
-        Its noise floor ``nu`` [N m] (the contact level's).
-    standstill : bool
-        The lagged standstill margin of the model's friction is added to both levels
-        (calibrated without it).
-    options : ObserverOptions
-        The observer the thresholds were calibrated with (the residual they apply to).
-    samples : int
-        Calibration samples.
-    """
-
-    contact: NDArray[np.float64]
-    collision: NDArray[np.float64]
-    margin: float
-    quantile: float
-    collision_factor: float
-    options: ObserverOptions
-    samples: int
-    k_sigma: float | None = None
-    noise: NDArray[np.float64] | None = field(default=None)
-    standstill: bool = False
-
-    def __post_init__(self) -> None:
-        n = np.shape(self.contact)[0]
-        for name in ("contact", "collision") + (("noise",) if self.noise is not None else ()):
-            a = _checks.as_exact(name, getattr(self, name), (n,))
-            if np.any(a < 0):
-                raise DataError(f"thresholds: {name} must be >= 0 [N m]; got {a.tolist()}")
-            object.__setattr__(self, name, _checks.frozen(a))
-
-    @property
-    def n(self) -> int:
-        """Joints."""
-        return int(self.contact.shape[0])
-
-    @property
-    def uses_uncertainty(self) -> bool:
-        """Whether the thresholds grow with the model's uncertainty."""
-        return self.k_sigma is not None and self.noise is not None
-
-
-@dataclass(frozen=True, slots=True)
-class ContactEvent:
-    """A detected contact (module docstring).
-
-    Attributes
-    ----------
-    start, end : float
-        First and last sample over the threshold [s].
-    joints : tuple of int
-        Joints over their threshold during the event, 1-based.
-    peak : tuple of float
-        Every joint's residual at its largest magnitude in the event [N m] (signed).
-    level : {"contact", "collision"}
-    """
-
-    start: float
-    end: float
-    joints: tuple[int, ...]
-    peak: tuple[float, ...]
-    level: Literal["contact", "collision"]
 
 
 def residual_std(
@@ -237,13 +165,19 @@ def standstill_series(
     t: ArrayLike,
     dq: ArrayLike,
     options: ObserverOptions = DEFAULT_OPTIONS,
+    *,
+    q: ArrayLike | None = None,
+    cutoff_hz: float = DEFAULT_CUTOFF_HZ,
 ) -> NDArray[np.float64]:
     """The standstill margin (N, n) [N m] of the model's friction at the velocities ``dq``
     (N, n) [rad/s], through the observer's lag ``K_O/(s + K_O)`` over the times ``t`` (N,)
     [s] (module docstring): a bound of the residual that friction the model cannot know
     (inside its standstill band, within the velocity noise band of its smooth Coulomb
     steps: :func:`~dynid.observer.friction.standstill_margin`) leaves; zeros for a friction
-    without either. The noise band is estimated on ``dq`` (one piece of a log).
+    without either. The noise band is estimated on ``dq`` (one piece of a log), or, for
+    velocities derived from the positions ``q`` (N, n) [rad] at ``cutoff_hz`` [Hz], it is
+    their noise through the derivative filter
+    (:func:`~dynid.observer.friction.derived_velocity_bands`).
 
     Raises
     ------
@@ -254,7 +188,11 @@ def standstill_series(
     ta = _checks.as_array("t", t)
     dqa = _checks.as_exact("dq", dq, (ta.shape[0], n))
     out = np.zeros((ta.shape[0], n))
-    for a, m in standstill_blocks(model, ta, dqa, options):
+    kw: dict[str, Any] = {}
+    if q is not None and model.friction is not None:
+        qa = _checks.as_exact("q", q, dqa.shape)
+        kw = {"bands": derived_velocity_bands(model.friction, ta, qa, cutoff_hz), "derived": True}
+    for a, m in standstill_blocks(model, ta, dqa, options, **kw):
         out[a : a + m.shape[0]] = m
     return out
 
@@ -265,20 +203,29 @@ def standstill_blocks(
     dq: NDArray[np.float64],
     options: ObserverOptions = DEFAULT_OPTIONS,
     block: int | None = None,
+    *,
+    bands: tuple[NDArray[np.float64], ...] | None = None,
+    derived: bool = False,
 ) -> Iterator[tuple[int, NDArray[np.float64]]]:
     """:func:`standstill_series` of one piece ``t`` (N,), ``dq`` (N, n) (validated) a block
     of ``block`` samples (default :data:`_MARGIN_BLOCK`) at a time: ``(first sample, margin
     (m, n) [N m])``, only one block's temporaries held (a long log). The lag continues from
     block to block (its free response ``exp(-K_O (t - t_prev))`` added), as the whole
-    piece's to rounding; a margin that is zero everywhere yields nothing."""
+    piece's to rounding; a margin that is zero everywhere yields nothing. ``bands``: the
+    velocity bands of the friction's parts (default
+    :func:`~dynid.observer.friction.velocity_bands` of ``dq``); ``derived``: ``dq``
+    derived from the positions, ``bands`` of
+    :func:`~dynid.observer.friction.derived_velocity_bands`
+    (:func:`~dynid.observer.friction.standstill_margin`)."""
     N, n = dq.shape
     size = _MARGIN_BLOCK if block is None else int(block)
-    bands = velocity_bands(model.friction, dq) if model.friction is not None else None
+    if bands is None and model.friction is not None:
+        bands = velocity_bands(model.friction, dq)
     gains = options.gains(n)
     prev: tuple[float, NDArray[np.float64], NDArray[np.float64]] | None = None
     for a in range(0, N, size):
         b = min(a + size, N)
-        w = standstill_margin(model.friction, dq[a:b], bands)
+        w = standstill_margin(model.friction, dq[a:b], bands, derived=derived)
         if prev is None and not np.any(w):
             continue  # zero so far: its lag is zero too
         if prev is None:  # the first nonzero block: the lag of zeros before it is zero
@@ -456,108 +403,3 @@ def undetected_at_rest(model: ObserverModel, thresholds: Thresholds) -> NDArray[
         return np.array(thresholds.contact)
     rest = standstill_margin(model.friction, np.zeros((1, model.n)))[0]
     return np.asarray(thresholds.contact + rest)
-
-
-def threshold_series(
-    thresholds: Thresholds,
-    N: int,
-    std: ArrayLike | None = None,
-    standstill: ArrayLike | None = None,
-) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
-    """The contact and collision thresholds at every sample, each (N, n) [N m]: fixed, or
-    ``k sigma + nu`` (and its ``collision_factor`` multiple) when ``std`` (N, n) is given
-    and the thresholds use the model's uncertainty; plus the standstill margin
-    ``standstill`` (N, n) when given and the thresholds use it."""
-    n = thresholds.n
-    if std is not None and thresholds.uses_uncertainty:
-        assert thresholds.k_sigma is not None and thresholds.noise is not None
-        s = _checks.as_exact("std", std, (N, n))
-        c = thresholds.k_sigma * s + thresholds.noise
-        k = thresholds.collision_factor * c
-    else:
-        c = np.broadcast_to(thresholds.contact, (N, n)).copy()
-        k = np.broadcast_to(thresholds.collision, (N, n)).copy()
-    if standstill is not None and thresholds.standstill:
-        w = _checks.as_exact("standstill", standstill, (N, n))
-        c, k = c + w, k + w
-    return c, k
-
-
-def detect(
-    t: ArrayLike,
-    r: ArrayLike,
-    thresholds: Thresholds,
-    *,
-    std: ArrayLike | None = None,
-    standstill: ArrayLike | None = None,
-    merge_s: float = 0.05,
-    restarts: ArrayLike | None = None,
-) -> list[ContactEvent]:
-    """Contact events of a residual (module docstring).
-
-    Parameters
-    ----------
-    t : array_like, shape (N,)
-        Sample times [s].
-    r : array_like, shape (N, n)
-        Residual [N m]; NaN where the observer did not run (never an event there).
-    thresholds : Thresholds
-    std : array_like, shape (N, n), optional
-        :func:`residual_std` of the samples (for thresholds that use the uncertainty).
-    standstill : array_like, shape (N, n), optional
-        :func:`standstill_series` of the samples (for thresholds that use it).
-    merge_s : float
-        Runs over the threshold closer than this [s] are one event (>= 0).
-    restarts : array_like of int, optional
-        Samples where the observer started again (the first of each piece of a log cut
-        at its gaps): no event spans one.
-
-    Returns
-    -------
-    list of ContactEvent
-        In time order.
-
-    Raises
-    ------
-    ShapeError
-        Shapes that disagree, thresholds of another joint count.
-    OptionError
-        A negative ``merge_s``.
-    """
-    ta = _checks.as_array("t", t)
-    N = ta.shape[0]
-    ra = _checks.as_exact("r", r, (N, thresholds.n), allow_nonfinite=True)
-    if np.any(np.isinf(ra)):
-        raise ShapeError("r must be finite or NaN (not observed); got inf")
-    if not merge_s >= 0:
-        raise OptionError(f"merge_s must be >= 0 [s]; got {merge_s}")
-    seen: NDArray[np.bool_] = np.all(np.isfinite(ra), axis=1)
-    if std is not None:  # NaN where not observed, as r
-        std = np.where(seen[:, None], np.asarray(std, dtype=np.float64), 0.0)
-    ra = np.where(seen[:, None], ra, 0.0)
-    contact, collision = threshold_series(thresholds, N, std, standstill)
-    over = np.abs(ra) > contact
-    hit = np.flatnonzero(over.any(axis=1))
-    if hit.size == 0:
-        return []
-    split = ta[hit[1:]] - ta[hit[:-1]] > merge_s
-    if restarts is not None:
-        piece = np.searchsorted(np.asarray(restarts, dtype=np.int64), hit, side="right")
-        split |= piece[1:] != piece[:-1]
-    cut = np.flatnonzero(split) + 1
-    events = []
-    for run in np.split(hit, cut):
-        a, b = int(run[0]), int(run[-1]) + 1
-        seg = ra[a:b]
-        k = np.argmax(np.abs(seg), axis=0)
-        peak = seg[k, np.arange(seg.shape[1])]
-        joints = tuple(int(j) + 1 for j in np.flatnonzero(over[a:b].any(axis=0)))
-        level: Literal["contact", "collision"] = (
-            "collision" if np.any(np.abs(seg) > collision[a:b]) else "contact"
-        )
-        events.append(
-            ContactEvent(
-                float(ta[a]), float(ta[b - 1]), joints, tuple(float(x) for x in peak), level
-            )
-        )
-    return events

@@ -44,6 +44,17 @@ than that band changes by up to its whole height between the two: per motor, eac
 with ``K``: a motor sigmoid of 8 N m and ``phi2 = 30`` s/rad behind a ratio of 120 moves
 the joint torque by up to 960 N m within the noise of a reversal, which a calibration
 without this bound reads as the collision-free residual.
+
+Velocities *derived* from the positions (a log without velocity columns) are smooth: the
+noise estimate above finds next to nothing, and an identification on them a standstill
+band of next to zero, while the derived velocity still departs from the true one by the
+position noise passed through the derivative filter. Their band
+(:func:`derived_velocity_bands`) is that noise: ``NOISE_BAND_STD`` times the std of the
+motor positions' noise times the filter's noise gain ``sqrt(sum h_k^2)`` (``h`` the
+derivative filter's impulse response). Within it the model's sharp Coulomb step may sit on
+the wrong side of zero: ``w`` then also holds the step's change within the band, up to
+``2 f_c`` where the band reaches across zero (``derived=True`` of
+:func:`standstill_margin`).
 """
 
 from __future__ import annotations
@@ -54,7 +65,13 @@ from numpy.typing import NDArray
 from ..friction.laws.base import CANONICAL_COLUMNS
 from ..friction.model import FrictionModel, FrictionSum, friction_parts
 
-__all__ = ["FRICTION_COLUMNS", "canonical_friction", "standstill_margin", "velocity_bands"]
+__all__ = [
+    "FRICTION_COLUMNS",
+    "canonical_friction",
+    "derived_velocity_bands",
+    "standstill_margin",
+    "velocity_bands",
+]
 
 #: The canonical parameters per motor (module docstring).
 FRICTION_COLUMNS = CANONICAL_COLUMNS
@@ -113,23 +130,74 @@ def velocity_bands(
     return tuple(out)
 
 
+def derived_velocity_bands(
+    friction: FrictionModel | FrictionSum | None,
+    t: NDArray[np.float64],
+    q: NDArray[np.float64],
+    cutoff_hz: float,
+) -> tuple[NDArray[np.float64], ...]:
+    """The velocity band [rad/s] of the motors of every part of ``friction`` (one (n,)
+    array per part) for velocities derived from the positions ``q`` (N, n) [rad] sampled
+    at ``t`` (N,) [s] by :func:`~dynid.signals.filtered_derivative` at ``cutoff_hz``
+    (module docstring): :data:`~dynid.identification.sanity.NOISE_BAND_STD` times the
+    position noise of each motor (:func:`~dynid.identification.sanity.velocity_noise_std`
+    of its positions, the median over windows) times the filter's noise gain; zeros for
+    fewer than 4 samples."""
+    from ..identification.sanity import noise_band, velocity_noise_std
+
+    parts = friction_parts(friction)
+    N = q.shape[0]
+    if N < 4:
+        return tuple(np.zeros(p.n) for p in parts)
+    gain = _derivative_noise_gain(float(np.median(np.diff(t))), cutoff_hz)
+    out = []
+    for part in parts:
+        K = np.asarray(part.transmission)
+        sd = np.zeros(part.n)
+        for k in range(part.n):
+            est = [
+                velocity_noise_std((q[a : a + _NOISE_WINDOW] @ K[k])[:, None])[0]
+                for a in range(0, N, _NOISE_WINDOW)
+                if N - a >= 4
+            ]
+            sd[k] = np.median(est)
+        out.append(np.asarray(noise_band(gain * sd), dtype=np.float64))
+    return tuple(out)
+
+
+def _derivative_noise_gain(dt: float, cutoff_hz: float) -> float:
+    """``sqrt(sum h_k^2)`` [1/s] of the impulse response ``h`` of
+    :func:`~dynid.signals.filtered_derivative` at the step ``dt`` [s]: the std of its
+    output for white input noise of std 1."""
+    from ..signals import edge_seconds, filtered_derivative
+
+    half = int(np.ceil(4.0 * edge_seconds(cutoff_hz) / dt)) + 8
+    x = np.zeros((2 * half + 1, 1))
+    x[half] = 1.0
+    h = filtered_derivative(dt * np.arange(2 * half + 1), x, cutoff_hz)[:, 0]
+    return float(np.sqrt(np.sum(h**2)))
+
+
 def standstill_margin(
     friction: FrictionModel | FrictionSum | None,
     dq: NDArray[np.float64],
     bands: tuple[NDArray[np.float64], ...] | None = None,
+    *,
+    derived: bool = False,
 ) -> NDArray[np.float64]:
     """Bound [N m] (..., n) of the friction the model cannot know at velocities ``dq``
     [rad/s] (..., n): its Coulomb level where the law's Coulomb term is off or not at its
     level and, with ``bands`` (:func:`velocity_bands`, one per part), what its smooth
-    Coulomb steps change within the velocity noise band (module docstring); zeros without
-    friction or for a law without a canonical form; the sum of the parts' for a
-    :class:`~dynid.friction.model.FrictionSum`.
+    Coulomb steps change within the velocity noise band (module docstring); with
+    ``derived`` (``bands`` of :func:`derived_velocity_bands`) what its sharp Coulomb step
+    changes within the band as well; zeros without friction or for a law without a
+    canonical form; the sum of the parts' for a :class:`~dynid.friction.model.FrictionSum`.
     """
     v = np.asarray(dq, dtype=np.float64)
     if isinstance(friction, FrictionSum):
         each = bands if bands is not None else (None,) * len(friction.parts)
         parts = [
-            standstill_margin(p, v, None if b is None else (b,))
+            standstill_margin(p, v, None if b is None else (b,), derived=derived)
             for p, b in zip(friction.parts, each, strict=True)
         ]
         total: NDArray[np.float64] = np.sum(parts, axis=0)
@@ -147,7 +215,11 @@ def standstill_margin(
         x = np.where(vs > 0, np.abs(vm) / np.where(vs > 0, vs, 1.0), np.inf)
     w = w + ft * np.where(vs > 0, 1.0 - np.tanh(x), np.where(vm == 0.0, 1.0, 0.0))
     if bands is not None and bands[0] is not None:
-        w = w + _step_spread(F, vm, np.asarray(bands[0], dtype=np.float64))
+        b = np.asarray(bands[0], dtype=np.float64)
+        w = w + _step_spread(F, vm, b)
+        if derived:  # the sharp step: off inside |v| <= band, its sign beyond
+            a, band = np.abs(vm), F[:, 5]
+            w = w + level * ((a > band) & (a <= band + b)) + level * (a < b - band)
     out: NDArray[np.float64] = w @ np.abs(K)
     return out
 

@@ -17,7 +17,34 @@ from .detection import ContactEvent, Thresholds
 from .model import ObserverModel
 from .wrench import WrenchEstimate
 
-__all__ = ["LogObservation", "ObserveResult"]
+__all__ = ["FigureSeries", "LogObservation", "ObserveResult"]
+
+
+@dataclass(frozen=True, slots=True, eq=False)
+class FigureSeries:
+    """Every ``step``-th sample of a log's residual, thresholds and true torques, kept
+    for its figure when the series are not (detection a block at a time).
+
+    Attributes
+    ----------
+    step : int
+        Samples between two kept ones.
+    t : ndarray, shape (M,)
+        [s].
+    r : ndarray, shape (M, n)
+        Residual [N m] (NaN where not observed).
+    contact, collision : ndarray, shape (M, n)
+        The thresholds at those samples [N m] (NaN where not observed).
+    tau_ext : ndarray, shape (M, n), or None
+        The true external torques stored beside a simulated log.
+    """
+
+    step: int
+    t: NDArray[np.float64]
+    r: NDArray[np.float64]
+    contact: NDArray[np.float64]
+    collision: NDArray[np.float64]
+    tau_ext: NDArray[np.float64] | None
 
 
 @dataclass(frozen=True, slots=True, eq=False)
@@ -29,9 +56,8 @@ class LogObservation:
     path : Path
     t : ndarray, shape (N,)
     r : ndarray, shape (N, n), or None
-        Residual [N m]; None when a calibration kept no series (a long log's thresholds
-        from running statistics: ``keep_series`` of
-        :class:`~dynid.workflows.observe.ObserveOptions`).
+        Residual [N m]; None when no series was kept (a long log a block at a time:
+        ``keep_series`` of :class:`~dynid.workflows.observe.ObserveOptions`).
     std : ndarray, shape (N, n), or None
         Its standard deviation from the model's uncertainty (when used).
     events : list of ContactEvent
@@ -48,6 +74,13 @@ class LogObservation:
     standstill_peak : ndarray, shape (n,), or None
         The largest standstill margin of each joint over the log [N m] (kept without the
         series).
+    peak : ndarray, shape (n,), or None
+        The largest ``|r|`` of each joint over the log [N m] (NaN: never observed), kept
+        without the series.
+    truth_rms : ndarray, shape (n,), or None
+        :meth:`truth_error` computed while observing (kept without the series).
+    figure : FigureSeries or None
+        Every few samples of the series for a figure (kept without the series).
     """
 
     path: Path
@@ -60,6 +93,9 @@ class LogObservation:
     standstill: NDArray[np.float64] | None = None
     restarts: tuple[int, ...] = (0,)
     standstill_peak: NDArray[np.float64] | None = None
+    peak: NDArray[np.float64] | None = None
+    truth_rms: NDArray[np.float64] | None = None
+    figure: FigureSeries | None = None
 
     @property
     def series(self) -> NDArray[np.float64]:
@@ -68,16 +104,35 @@ class LogObservation:
         Raises
         ------
         DataError
-            A calibration that kept no series.
+            An observation that kept no series (``keep_series`` off).
         """
         if self.r is None:
-            raise DataError(f"{self.path.name}: the calibration kept no residual series")
+            raise DataError(f"{self.path.name}: no residual series kept (keep_series off)")
         return self.r
+
+    def largest(self) -> NDArray[np.float64]:
+        """The largest ``|r|`` of each joint (n,) [N m] (NaN: never observed).
+
+        Raises
+        ------
+        DataError
+            Neither the series nor its peak kept.
+        """
+        if self.peak is not None:
+            return self.peak
+        r = self.series
+        ran = np.all(np.isfinite(r), axis=1)
+        if not ran.any():
+            return np.full(r.shape[1], np.nan)
+        out: NDArray[np.float64] = np.max(np.abs(r[ran]), axis=0)
+        return out
 
     def truth_error(self) -> NDArray[np.float64] | None:
         """RMS [N m] (n,) per joint of the residual against the true external torques
         ``r - tau_ext`` (the observer's first-order lag included), over the samples the
         observer ran on; None without ``tau_ext``."""
+        if self.truth_rms is not None:
+            return self.truth_rms
         if self.tau_ext is None or self.r is None:
             return None
         e = self.r - self.tau_ext

@@ -30,7 +30,6 @@ the command applies, so that the Python API behaves as the command does.
 
 from __future__ import annotations
 
-import dataclasses
 from collections.abc import Callable, Iterator, Mapping
 from dataclasses import dataclass
 from pathlib import Path
@@ -39,21 +38,17 @@ import numpy as np
 from numpy.typing import NDArray
 
 from ..exceptions import OptionError
+from ..exceptions import in_file as about_file
 from ..friction.model import FrictionModel, FrictionSum
-from ..identification.log import (
-    TorqueLog,
-)
-from ..io.columns import load_joint_columns
 from ..io.feasible import load_feasible_drive, load_feasible_linear_friction
 from ..io.friction_json import load_friction_json
 from ..io.model_json import load_model_json
 from ..io.observer_files import load_thresholds
 from ..io.robot_file import load_robot
-from ..observer.detection import Thresholds, calibrate, detect
+from ..observer.detection import Thresholds, calibrate
 from ..observer.model import ObserverModel, from_identified, from_robot
 from ..observer.residual import DEFAULT_GAIN, ObserverOptions
 from ..observer.results import LogObservation, ObserveResult
-from ..observer.wrench import external_wrench
 from .data_files import (
     ColumnSpec,
     column_map,
@@ -62,6 +57,7 @@ from .data_files import (
     read_torque_log,
     recorded_columns,
 )
+from .observe_detect import ResidualSink, detected_log, true_torques
 from .observe_logs import ObservedBlock, PreparedLog, Series, observed_blocks, prepared_log
 from .recordings import Recorded, check_limits, check_units
 
@@ -123,7 +119,11 @@ class ObserveOptions:
         When calibrating: keep every log's residual (and its std and margin) in the
         result, for figures. False: only the calibration's running statistics, a block of
         samples at a time (bounded memory on a long log); the result's logs then hold no
-        series. Detecting always keeps them (events, ``residuals.csv``).
+        series. Detecting: False keeps no series (the events, the residual tables of the
+        ``sink`` and the summaries a block at a time); True keeps them too.
+    figure_points : int, optional
+        Detecting: keep every k-th sample of the residual, its thresholds and the true
+        torques, at most this many, for a figure (``LogObservation.figure``).
     """
 
     data: tuple[Path, ...]
@@ -149,6 +149,7 @@ class ObserveOptions:
     base: str | None = None
     tip: str | None = None
     keep_series: bool = True
+    figure_points: int | None = None
 
 
 def load_observer_model(
@@ -238,9 +239,14 @@ def _observer_options(opts: ObserveOptions, thresholds: Thresholds | None) -> Ob
     return ObserverOptions(opts.gain, opts.discretisation, opts.rule)  # type: ignore[arg-type]
 
 
-def observe_files(opts: ObserveOptions) -> ObserveResult:
+def observe_files(opts: ObserveOptions, sink: ResidualSink | None = None) -> ObserveResult:
     """Calibrate thresholds on collision-free logs, or detect contacts in logs (module
     docstring).
+
+    Detecting runs a block of samples at a time (:mod:`dynid.workflows.observe_detect`):
+    ``sink`` (:class:`~dynid.io.observer_files.ResidualTables`) receives every log's
+    residual table as it is computed; the series themselves are kept with
+    ``opts.keep_series`` only.
 
     Returns
     -------
@@ -279,26 +285,29 @@ def observe_files(opts: ObserveOptions) -> ObserveResult:
         return _calibrated(
             read, model, columns[0] is not None, opts, options, wants_std, wants_margin
         )
-    logs = [
-        _observe_log(p, log, model, columns[0] is not None, opts, options, wants_std, wants_margin)
-        for p, log in zip(read.paths, read.logs, strict=True)
-    ]
-    found = tuple(
-        dataclasses.replace(
-            x,
-            events=detect(
-                x.t,
-                x.series,
+    paths = tuple(map(Path, read.paths))
+    logs = []
+    for k, (path, log) in enumerate(zip(paths, read.logs, strict=True)):
+        rows = log.t.shape[0]
+        table = None if sink is None else sink.table(paths, k, rows, model.n, opts.frame)
+        with about_file(path.name):
+            prep = prepared_log(path, log, model, opts.max_gap)
+        logs.append(
+            detected_log(
+                prep,
+                model,
+                columns[0] is not None,
                 given,
-                std=x.std,
-                standstill=x.standstill,
+                options,
+                wants=(wants_std, wants_margin),
                 merge_s=opts.merge_s,
-                restarts=x.restarts,
-            ),
+                frame=opts.frame,
+                keep_series=opts.keep_series,
+                figure_points=opts.figure_points,
+                table=table,
+            )  # fmt: skip
         )
-        for x in logs
-    )
-    return ObserveResult(model, given, found)
+    return ObserveResult(model, given, tuple(logs))
 
 
 def _read_logs(
@@ -389,28 +398,6 @@ def _margin(x: ObservedBlock, n: int) -> NDArray[np.float64]:
     return np.zeros((x.r.shape[0], n)) if x.margin is None else x.margin
 
 
-def _observe_log(
-    path: Path,
-    log: TorqueLog,
-    model: ObserverModel,
-    mapped: bool,
-    opts: ObserveOptions,
-    options: ObserverOptions,
-    wants_std: bool,
-    wants_margin: bool = False,
-) -> LogObservation:
-    """The residual (and its std, the wrench, the stored true torques) of one log, as
-    read (``mapped``: through a column map)."""
-    prep = prepared_log(Path(path), log, model, opts.max_gap)
-    keep = Series.new(prep, model.n, wants_std, wants_margin)
-    peak = np.zeros(model.n)
-    for blk in observed_blocks(prep, model, options, wants_std, wants_margin):
-        keep.put(blk)
-        if blk.margin is not None:
-            np.maximum(peak, blk.margin.max(axis=0), out=peak)
-    return _observation(prep, model, mapped, opts, keep, peak)
-
-
 def _observation(
     prep: PreparedLog,
     model: ObserverModel,
@@ -423,21 +410,14 @@ def _observation(
     path, log = prep.path, prep.log
 
     def run() -> LogObservation:
-        wrench = None
-        if opts.frame is not None and keep is not None:
-            wrench = external_wrench(model.robot, log.q, keep.r, opts.frame)
-        ext = None
-        if keep is not None and path.suffix.lower() in (".csv", ".npz") and not mapped:
-            ext = load_joint_columns(path, "tau_ext", model.n)
-            if ext is not None and ext.shape[0] != log.t.shape[0]:
-                ext = None  # rows were dropped: not aligned with the log
+        ext = None if keep is None else true_torques(prep, model, mapped)
         return LogObservation(
             path,
             log.t,
             None if keep is None else keep.r,
             None if keep is None else keep.std,
             [],
-            wrench,
+            None,
             ext,
             None if keep is None else keep.margin,
             tuple(a for a, _ in prep.spans),

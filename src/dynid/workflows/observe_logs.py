@@ -16,6 +16,7 @@ import warnings
 from collections.abc import Iterator
 from dataclasses import dataclass
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 from numpy.typing import NDArray
@@ -25,6 +26,7 @@ from ..exceptions import in_file as about_file
 from ..identification.log import DEFAULT_CUTOFF_HZ, TorqueLog, default_max_gap, joint_side_log
 from ..identification.pieces import unwrapped, wrappable
 from ..observer.detection import residual_std_blocks, standstill_blocks
+from ..observer.friction import derived_velocity_bands
 from ..observer.model import ObserverModel
 from ..observer.pieces import PositionJump, pieces, position_jumps
 from ..observer.residual import MomentumObserver, ObserverOptions
@@ -36,6 +38,7 @@ __all__ = [
     "PreparedLog",
     "Series",
     "observed_blocks",
+    "observed_rows",
     "prepared_log",
 ]
 
@@ -131,7 +134,9 @@ def observed_blocks(
                 OBSERVE_BLOCK,
             )
             margins = (
-                standstill_blocks(model, t[a:b], dq[a:b], options, OBSERVE_BLOCK)
+                standstill_blocks(
+                    model, t[a:b], dq[a:b], options, OBSERVE_BLOCK, **_bands(prep, model, a, b)
+                )
                 if wants_margin
                 else iter(())
             )
@@ -147,6 +152,45 @@ def observed_blocks(
                     next(stds) if wants_std else None,
                     m,
                 )
+
+
+def observed_rows(
+    prep: PreparedLog,
+    model: ObserverModel,
+    options: ObserverOptions,
+    wants_std: bool,
+    wants_margin: bool,
+) -> Iterator[ObservedBlock]:
+    """:func:`observed_blocks` with the samples the observer does not run on between them
+    (NaN residual and std, no margin), at most :data:`OBSERVE_BLOCK` at a time: blocks that
+    cover every sample of the log in order (a residual table, the detection)."""
+    N, n = prep.log.t.shape[0], prep.log.q.shape[1]
+    done = 0
+    for blk in observed_blocks(prep, model, options, wants_std, wants_margin):
+        yield from _unobserved(done, blk.a, n, wants_std)
+        yield blk
+        done = blk.a + blk.r.shape[0]
+    yield from _unobserved(done, N, n, wants_std)
+
+
+def _unobserved(a: int, b: int, n: int, wants_std: bool) -> Iterator[ObservedBlock]:
+    for c in range(a, b, OBSERVE_BLOCK):
+        r = np.full((min(c + OBSERVE_BLOCK, b) - c, n), np.nan)
+        yield ObservedBlock(c, r, r if wants_std else None, None)
+
+
+def _bands(prep: PreparedLog, model: ObserverModel, a: int, b: int) -> dict[str, Any]:
+    """The velocity bands of the standstill margin of samples ``[a, b)``: for velocities
+    derived from the positions, the position noise through the derivative filter
+    (:func:`~dynid.observer.friction.derived_velocity_bands`); none otherwise (estimated
+    on the velocities)."""
+    if not prep.log.dq_derived or model.friction is None:
+        return {}
+    t, q = prep.log.t[a:b], prep.log.q[a:b]
+    return {
+        "bands": derived_velocity_bands(model.friction, t, q, DEFAULT_CUTOFF_HZ),
+        "derived": True,
+    }
 
 
 def _rechunked(

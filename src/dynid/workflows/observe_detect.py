@@ -1,0 +1,190 @@
+"""Detection on one log a block of samples at a time (``dynid observe --thresholds``).
+
+The observer runs over the log's pieces a block at a time
+(:func:`~dynid.workflows.observe_logs.observed_rows`, its state carried), and each block
+goes at once to the events (:class:`~dynid.observer.events.EventDetector`, the event open
+at a block's end carried), to the residual table of a ``sink`` (written a block at a
+time), to the wrench at ``frame`` and to running statistics (the largest residual, the
+error against the true external torques ``tau_ext`` of a simulated log, the largest
+standstill margin): a long log is detected with one block's temporaries. The
+full-length series are kept only when asked (``keep_series``, the Python API); a figure
+gets every k-th sample of the residual, its thresholds and the true torques
+(``figure_points``: the samples the figure draws).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable, Sequence
+from contextlib import AbstractContextManager, nullcontext
+from pathlib import Path
+from typing import Any, Protocol
+
+import numpy as np
+from numpy.typing import NDArray
+
+from ..exceptions import in_file as about_file
+from ..io.columns import load_joint_columns
+from ..observer.events import ContactEvent, EventDetector
+from ..observer.model import ObserverModel
+from ..observer.residual import ObserverOptions
+from ..observer.results import FigureSeries, LogObservation
+from ..observer.thresholds import Thresholds, threshold_series
+from ..observer.wrench import WrenchEstimate, external_wrench
+from .data_files import in_file
+from .observe_logs import ObservedBlock, PreparedLog, Series, observed_rows
+
+__all__ = ["ResidualSink", "detected_log", "true_torques"]
+
+
+class ResidualSink(Protocol):
+    """Where the residual tables go while the logs are observed
+    (:class:`dynid.io.observer_files.ResidualTables`)."""
+
+    def table(
+        self, paths: Sequence[Path], index: int, rows: int, n: int, frame: str | None
+    ) -> AbstractContextManager[Callable[..., None]]:
+        """A writer ``put(t, r, wrench, damped)`` of log ``index`` of ``paths`` (``rows``
+        samples, ``n`` joints, the wrench at ``frame`` or none), called for consecutive
+        blocks of samples."""
+        ...
+
+
+def true_torques(prep: PreparedLog, model: ObserverModel, mapped: bool) -> NDArray | None:
+    """The true external torques ``tau_ext`` (N, n) [N m] stored beside a log of dynid's
+    (``dynid simulate --contact``), or None (none, a log read through a column map, rows
+    dropped so that they no longer align)."""
+    path, N = prep.path, prep.log.t.shape[0]
+    if mapped or path.suffix.lower() not in (".csv", ".npz"):
+        return None
+    ext = load_joint_columns(path, "tau_ext", model.n)
+    return None if ext is None or ext.shape[0] != N else ext
+
+
+def detected_log(
+    prep: PreparedLog,
+    model: ObserverModel,
+    mapped: bool,
+    thresholds: Thresholds,
+    options: ObserverOptions,
+    *,
+    wants: tuple[bool, bool],
+    merge_s: float,
+    frame: str | None,
+    keep_series: bool,
+    figure_points: int | None = None,
+    table: AbstractContextManager[Callable[..., None] | None] | None = None,
+) -> LogObservation:
+    """The events of one prepared log (module docstring), ``wants`` the residual's std and
+    the standstill margin, ``table`` the sink's writer of its residual table (or none);
+    ``figure_points``: keep every k-th sample (at most that many) for a figure."""
+    log, n = prep.log, model.n
+    starts = tuple(a for a, _ in prep.spans)
+    det = EventDetector(thresholds, merge_s=merge_s, restarts=starts)
+    keep = Series.new(prep, n, *wants) if keep_series else None
+    ext = in_file(prep.path, lambda: true_torques(prep, model, mapped))
+    stats = _Running(n)
+    strided = None if not figure_points else _Strided(log.t.shape[0], figure_points, thresholds)
+    events: list[ContactEvent] = []
+    wrenches: list[WrenchEstimate] = []
+    with about_file(prep.path.name), table or nullcontext(None) as put:
+        for blk in observed_rows(prep, model, options, *wants):
+            a, b = blk.a, blk.a + blk.r.shape[0]
+            events += det.feed(log.t[a:b], blk.r, std=blk.std, standstill=blk.margin)
+            w = None if frame is None else external_wrench(model.robot, log.q[a:b], blk.r, frame)
+            if put is not None:
+                put(log.t[a:b], blk.r, *((None, None) if w is None else (w.wrench, w.damped)))
+            if w is not None and keep is not None:
+                wrenches.append(w)
+            stats.add(blk.r, blk.margin, None if ext is None else ext[a:b])
+            if keep is not None:
+                keep.put(blk)
+            if strided is not None:
+                strided.add(log.t, blk, None if ext is None else ext[a:b])
+        events += det.finish()
+    return LogObservation(
+        prep.path,
+        log.t,
+        None if keep is None else keep.r,
+        None if keep is None else keep.std,
+        events,
+        _joined(wrenches, frame) if keep is not None else None,
+        ext if keep is not None else None,
+        None if keep is None else keep.margin,
+        starts,
+        stats.margin,
+        peak=stats.peak,
+        truth_rms=stats.truth(),
+        figure=None if strided is None else strided.series(),
+    )
+
+
+def _joined(blocks: list[WrenchEstimate], frame: str | None) -> WrenchEstimate | None:
+    """The wrench of every block as one estimate."""
+    if frame is None or not blocks:
+        return None
+    return WrenchEstimate(
+        frame,
+        np.concatenate([w.wrench for w in blocks]),
+        np.concatenate([w.sigma_min for w in blocks]),
+        np.concatenate([w.damped for w in blocks]),
+    )
+
+
+class _Running:
+    """Per joint over the blocks of a log: the largest ``|r|`` (NaN where never observed),
+    the largest standstill margin, and the squared error against the true torques over
+    the observed samples."""
+
+    def __init__(self, n: int) -> None:
+        self.peak = np.full(n, np.nan)
+        self.margin = np.zeros(n)
+        self.square, self.count = np.zeros(n), 0
+
+    def add(self, r: NDArray, margin: NDArray | None, ext: NDArray | None) -> None:
+        ran = np.all(np.isfinite(r), axis=1)
+        if ran.any():
+            self.peak = np.fmax(self.peak, np.max(np.abs(r[ran]), axis=0))
+        if margin is not None and margin.shape[0]:
+            np.maximum(self.margin, margin.max(axis=0), out=self.margin)
+        if ext is not None:
+            e = r - ext
+            ok = np.all(np.isfinite(e), axis=1)
+            self.square += np.sum(e[ok] ** 2, axis=0)
+            self.count += int(ok.sum())
+
+    def truth(self) -> Any:
+        """RMS of the error against the true torques (n,) [N m], or None."""
+        return np.sqrt(self.square / self.count) if self.count else None
+
+
+class _Strided:
+    """Every ``step``-th sample of a log of ``N`` (``step = ceil(N / points)``, the stride
+    of :func:`~dynid.plots.observer.plot_residuals`) with its thresholds, a block at a
+    time."""
+
+    def __init__(self, N: int, points: int, thresholds: Thresholds) -> None:
+        self.step = max(1, int(np.ceil(N / points)))
+        self.thresholds = thresholds
+        self.parts: list[tuple[NDArray, ...]] = []
+        self.ext: list[NDArray] = []
+
+    def add(self, t: NDArray, blk: ObservedBlock, ext: NDArray | None) -> None:
+        a, m = blk.a, blk.r.shape[0]
+        rows = np.arange(-a % self.step, m, self.step)  # the block's samples k*step
+        r = blk.r[rows]
+        seen = np.all(np.isfinite(r), axis=1)
+        std = None if blk.std is None else np.where(seen[:, None], blk.std[rows], 0.0)
+        margin = None if blk.margin is None else blk.margin[rows]
+        c, k = threshold_series(self.thresholds, rows.size, std, margin)
+        c[~seen], k[~seen] = np.nan, np.nan
+        self.parts.append((t[a + rows], r, c, k))
+        if ext is not None:
+            self.ext.append(ext[rows])
+
+    def series(self) -> FigureSeries:
+        if not self.parts:  # no sample
+            e = np.zeros((0, self.thresholds.n))
+            return FigureSeries(self.step, np.zeros(0), e, e, e, None)
+        t, r, c, k = (np.concatenate(x) for x in zip(*self.parts, strict=True))
+        ext = np.concatenate(self.ext) if self.ext else None
+        return FigureSeries(self.step, t, r, c, k, ext)

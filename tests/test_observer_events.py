@@ -1,0 +1,197 @@
+"""Detection a block of samples at a time: the events of :class:`EventDetector` fed any
+blocks equal those of a per-sample reference written from the definition (runs over the
+threshold, joined within merge_s, never across a restart; peaks at the first largest
+magnitude); ``dynid observe --thresholds`` in blocks that cut a contact gives the events
+and the residual table of one block, and finds a simulated contact at its time."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from dynid.cli.__main__ import main
+from dynid.observer.detection import Thresholds, detect
+from dynid.observer.events import EventDetector
+from dynid.observer.residual import ObserverOptions
+
+
+def _reference(t, r, contact, collision, merge_s, restarts):
+    """Events sample by sample: (start, end, joints, peak, level)."""
+    r = np.where(np.isfinite(r), r, 0.0)
+    events, cur = [], None
+    for k in range(t.shape[0]):
+        over = np.abs(r[k]) > contact[k]
+        if not over.any():
+            continue
+        new_piece = cur is not None and any(cur["last"] < s <= k for s in restarts)
+        if cur is None or t[k] - t[cur["last"]] > merge_s or new_piece:
+            if cur is not None:
+                events.append(cur)
+            cur = {"first": k, "last": k, "joints": set()}
+        cur["last"] = k
+        cur["joints"] |= {j + 1 for j in np.flatnonzero(over)}
+    if cur is not None:
+        events.append(cur)
+    out = []
+    for e in events:
+        a, b = e["first"], e["last"] + 1
+        peak = []
+        for j in range(r.shape[1]):
+            best = 0
+            for k in range(a, b):  # the first of the largest magnitudes
+                if abs(r[k, j]) > abs(r[best + a, j]):
+                    best = k - a
+            peak.append(float(r[a + best, j]))
+        hit = np.any(np.abs(r[a:b]) > collision[a:b])
+        out.append((float(t[a]), float(t[b - 1]), tuple(sorted(e["joints"])), tuple(peak),
+                    "collision" if hit else "contact"))  # fmt: skip
+    return out
+
+
+def _as_tuples(events):
+    return [(e.start, e.end, e.joints, e.peak, e.level) for e in events]
+
+
+@pytest.mark.parametrize("block", [1, 3, 17, 64, 1000])
+def test_events_fed_in_blocks_are_those_of_the_definition(block):
+    """A noisy residual with bursts (some closer than merge_s, one across a restart, NaN
+    samples, the uncertainty's std and a standstill margin): every block size gives the
+    reference's events, as the whole log in one block (detect) does."""
+    rng = np.random.default_rng(4)
+    N, n = 1000, 3
+    t = np.cumsum(rng.uniform(0.8e-3, 1.2e-3, N))
+    r = 0.05 * rng.standard_normal((N, n))
+    for a, size, j in ((100, 30, 0), (160, 5, 1), (400, 80, 2), (590, 30, 0), (700, 3, 1)):
+        r[a : a + size, j] += rng.choice([-1, 1]) * rng.uniform(0.3, 1.2, size)
+    r[450:470] = np.nan  # the observer did not run
+    std = np.abs(0.02 * rng.standard_normal((N, n)))
+    std[450:470] = np.nan
+    margin = np.where(np.arange(N)[:, None] % 200 < 20, 0.1, 0.0) * np.ones(n)
+    th = Thresholds(
+        contact=np.full(n, 0.2), collision=np.full(n, 0.6), margin=1.5, quantile=1.0,
+        collision_factor=3.0, options=ObserverOptions(), samples=1, k_sigma=3.0,
+        noise=np.full(n, 0.15), standstill=True,
+    )  # fmt: skip
+    restarts = [0, 610]
+    c = 3.0 * np.nan_to_num(std) + 0.15 + margin
+    want = _reference(t, r, c, 3.0 * (3.0 * np.nan_to_num(std) + 0.15) + margin, 0.05, restarts)
+    assert len(want) >= 5 and {e[4] for e in want} == {"contact", "collision"}
+    det = EventDetector(th, merge_s=0.05, restarts=restarts)
+    got = []
+    for a in range(0, N, block):
+        k = slice(a, a + block)
+        got += det.feed(t[k], r[k], std=std[k], standstill=margin[k])
+    got += det.finish()
+    assert _as_tuples(got) == want
+    whole = detect(t, r, th, std=std, standstill=margin, merge_s=0.05, restarts=restarts)
+    assert _as_tuples(whole) == want
+
+
+@pytest.fixture(scope="module")
+def contact_log(tmp_path_factory):
+    """A Panda log with a contact from 1.0 to 1.4 s (tau_ext written beside it), its
+    thresholds from a free log, and the same contact log with 50 ms of rows removed at
+    2 s (a gap: two pieces)."""
+    d = tmp_path_factory.mktemp("events")
+    sim = ["simulate", "--robot", "panda", "--trajectory", "fourier", "-q", "--duration", "3"]
+    assert main([*sim, "--seed", "2", "--out", str(d / "free.csv")]) == 0
+    hit = ["--contact", "link6:0,0,-15:1,1.4", "--contact", "flange:0,0,0,0,0,2:2.3,2.6"]
+    assert main([*sim, "--seed", "3", *hit, "--out", str(d / "hit.csv")]) == 0
+    p = ["observe", "--params", "panda", "--no-figures"]
+    assert main([*p, "--data", str(d / "free.csv"), "--calibrate", "--out", str(d / "cal")]) == 0
+    lines = (d / "hit.csv").read_text().splitlines(keepends=True)
+    head, rows = lines[:3], lines[3:]
+    kept = [x for x in rows if not 2.0 <= float(x.split(",", 1)[0]) < 2.05]
+    head[1] = f"# rows: {len(kept)}\n"
+    (d / "gap.csv").write_text("".join(head + kept))
+    return d
+
+
+@pytest.mark.parametrize("name", ["hit.csv", "gap.csv"])
+def test_observe_in_blocks_that_cut_the_events_equals_one_block(contact_log, monkeypatch, name):
+    """Blocks of 97 samples (both contacts span several; the gap cuts the log in two)
+    against one block of the whole log: the same events, the same residual table bytes;
+    the contacts start within 15 ms of the true torques' first sample (K_O = 50/s); the
+    summaries kept without the series (largest |r|, r - tau_ext) agree with those of the
+    series."""
+    from dynid.io.observer_files import ResidualTables
+    from dynid.workflows.observe import ObserveOptions, observe_files
+
+    d = contact_log
+    opts = ObserveOptions(
+        data=(d / name,), params="panda", thresholds=d / "cal" / "thresholds.json"
+    )
+    monkeypatch.setattr("dynid.workflows.observe_logs.OBSERVE_BLOCK", 1 << 20)
+    whole_tables = ResidualTables(d / f"whole_{name}")
+    whole = observe_files(opts, whole_tables).logs[0]
+    monkeypatch.setattr("dynid.workflows.observe_logs.OBSERVE_BLOCK", 97)
+    tables = ResidualTables(d / f"blocks_{name}")
+    lean = observe_files(
+        ObserveOptions(data=opts.data, params="panda", thresholds=opts.thresholds,
+                       keep_series=False), tables,
+    ).logs[0]  # fmt: skip
+    assert lean.r is None and len(whole.restarts) == (2 if name == "gap.csv" else 1)
+    assert _as_tuples(lean.events) == _as_tuples(whole.events)
+    assert tables.written[0].read_bytes() == whole_tables.written[0].read_bytes()
+    ext = whole.tau_ext
+    assert ext is not None
+    on = np.flatnonzero(np.any(ext != 0, axis=1))
+    onsets = [whole.t[on[0]], whole.t[on[np.argmax(np.diff(on) > 1) + 1]]]
+    assert len(whole.events) == 2
+    for e, t0 in zip(whole.events, onsets, strict=True):
+        assert t0 <= e.start <= t0 + 0.015  # the lag: 20 ms time constant
+    np.testing.assert_allclose(lean.largest(), np.nanmax(np.abs(whole.series), axis=0))
+    e = whole.series - ext
+    ran = np.all(np.isfinite(e), axis=1)
+    np.testing.assert_allclose(lean.truth_error(), np.sqrt(np.mean(e[ran] ** 2, axis=0)))
+
+
+def test_observe_command_writes_the_table_a_block_at_a_time(contact_log, monkeypatch):
+    """``dynid observe --thresholds --no-figures`` in blocks of 97 samples: residuals.csv
+    holds the residual of the observer run over the whole log at once (rows, header,
+    values to the last digit)."""
+    d = contact_log
+    monkeypatch.setattr("dynid.workflows.observe_logs.OBSERVE_BLOCK", 97)
+    p = ["observe", "--params", "panda", "--no-figures"]
+    th = ["--thresholds", str(d / "cal" / "thresholds.json")]
+    assert main([*p, *th, "--data", str(d / "hit.csv"), "--out", str(d / "cmd")]) == 0
+    lines = (d / "cmd" / "residuals.csv").read_text().splitlines()
+    assert lines[1] == "# rows: 3001" and lines[2] == "t,r1,r2,r3,r4,r5,r6,r7"
+    table = np.loadtxt(d / "cmd" / "residuals.csv", delimiter=",", comments="#", skiprows=3)
+    from dynid.io.torque_log import load_torque_log
+    from dynid.observer import observe
+    from dynid.workflows.observe import load_observer_model
+
+    log = load_torque_log(d / "hit.csv")
+    model, _ = load_observer_model(None, "panda")
+    r = observe(model, log.t, log.q, log.dq, log.tau, ObserverOptions()).r  # the whole log
+    np.testing.assert_array_equal(table[:, 0], log.t)
+    np.testing.assert_array_equal(table[:, 1:], r)
+
+
+def test_a_detection_figure_keeps_every_kth_sample_of_the_series(contact_log, monkeypatch):
+    """figure_points 50 over blocks of 97 samples: the figure's series are every
+    ceil(N / 50)-th sample of the whole series, with the thresholds at those samples;
+    the command draws residuals.png from them."""
+    from dynid.observer.detection import threshold_series
+    from dynid.workflows.observe import ObserveOptions, observe_files
+
+    d = contact_log
+    monkeypatch.setattr("dynid.workflows.observe_logs.OBSERVE_BLOCK", 97)
+    opts = ObserveOptions(
+        data=(d / "gap.csv",), params="panda", thresholds=d / "cal" / "thresholds.json",
+        figure_points=50,
+    )  # fmt: skip
+    result = observe_files(opts)
+    x = result.logs[0]
+    f = x.figure
+    assert f is not None and x.tau_ext is not None
+    step = int(np.ceil(x.t.shape[0] / 50))
+    assert f.step == step and f.t.shape[0] <= 50
+    c, k = threshold_series(result.thresholds, x.t.shape[0], x.std, x.standstill)
+    for got, whole in ((f.t, x.t), (f.r, x.r), (f.contact, c), (f.collision, k)):
+        np.testing.assert_array_equal(got, whole[::step])
+    np.testing.assert_array_equal(f.tau_ext, x.tau_ext[::step])
+    p = ["observe", "--params", "panda", "--thresholds", str(d / "cal" / "thresholds.json")]
+    assert main([*p, "--data", str(d / "hit.csv"), "--out", str(d / "fig")]) == 0
+    assert (d / "fig" / "residuals.png").stat().st_size > 0
