@@ -146,3 +146,23 @@ def test_the_library_names_the_field():
     with pytest.raises(OptionError, match=r"^q_start gives the whole turns") as exc:
         with_start_turns("x.csv", log, robot, None, np.zeros(7))
     assert exc.value.field == "q_start"
+
+
+@pytest.mark.parametrize(
+    "command",
+    [
+        "identify --robot panda",
+        "payload --robot panda",
+        "observe --params panda --calibrate",
+        "validate --robot panda",
+    ],
+)
+def test_every_command_reading_logs_through_a_drive_takes_q_start(arm, capsys, command):
+    """The one option on each command: without a motor-side drive it is refused in one
+    line naming it (the robot's drive is none)."""
+    d = arm[-1]
+    argv = [*command.split(), "--data", str(d / "w.csv"), "--out", str(d / "o")]
+    capsys.readouterr()
+    assert main([*argv, "--q-start", ",".join(["0"] * 7)]) == 2
+    err = capsys.readouterr().err.strip()
+    assert "--q-start gives the whole turns" in err and "\n" not in err, err
