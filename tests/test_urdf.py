@@ -104,7 +104,9 @@ def test_panda_urdf_structure_names_limits_and_frames(panda_urdf):
     assert np.all(np.isinf(robot.ddq_max))
     np.testing.assert_array_equal(robot.gravity, [0.0, 0.0, -9.80665])
     assert not np.any(robot.prismatic)
-    assert robot.friction is None
+    # <dynamics damping="0.003" friction="0.0"/> on every arm joint: viscous friction only
+    assert robot.friction.kind == "classical"
+    np.testing.assert_array_equal(robot.friction.params, [[0.003, 0.0, 0.0]] * 7)
     assert set(robot.frames) == {f"panda_link{i}" for i in range(9)} | {
         "panda_hand",
         "panda_hand_tcp",

@@ -243,6 +243,33 @@ def add_drive_option(p: argparse.ArgumentParser) -> None:
     )
 
 
+def numbers_type(text: str) -> tuple[float, ...]:
+    """An argparse ``type``: comma-separated finite numbers (``-0.1,0.2``), else a one-line
+    error; the count is checked where the robot is known."""
+    try:
+        v = tuple(float(x) for x in text.replace(" ", "").split(",") if x != "")
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"must be comma-separated numbers; got {text!r}") from None
+    if not v or not all(math.isfinite(x) for x in v):
+        raise argparse.ArgumentTypeError(f"must be comma-separated finite numbers; got {text!r}")
+    return v
+
+
+def add_q_start_option(p: argparse.ArgumentParser) -> None:
+    """``--q-start Q1,...,QN``: the joint positions at a motor-side log's first sample,
+    which tell the whole turns of motors recorded wrapped (one definition for every
+    command that reads logs through a drive)."""
+    p.add_argument(
+        "--q-start",
+        type=numbers_type,
+        default=None,
+        metavar="Q1,...,QN",
+        help="joint positions [rad] at the first sample of a motor-side log (one log) whose "
+        "motor encoders wrap every turn: the motors' whole turns are those that put the "
+        "joints nearest them (needed when the joint limits leave several)",
+    )
+
+
 def load_drive_arg(args: argparse.Namespace, n: int) -> Any:
     """The :class:`~dynid.model.drive.Drive` of ``--drive`` (or of a --robot TOML's
     ``[drive]`` table, or the one a --robot feasible.json holds), or None."""

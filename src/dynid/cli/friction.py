@@ -42,6 +42,7 @@ from .common import (
     add_column_options,
     add_drive_option,
     add_log_options,
+    add_q_start_option,
     add_recordings_option,
     add_subcommand,
     load_drive_arg,
@@ -76,6 +77,7 @@ def register(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParser:
     add_recordings_option(p)
     add_column_options(p)
     add_drive_option(p)
+    add_q_start_option(p)
     p.add_argument("--out", type=output_path, required=True, help="output directory")
     p.add_argument(
         "--friction-model",

@@ -95,6 +95,7 @@ from .common import (
     add_consistency_options,
     add_drive_option,
     add_log_options,
+    add_q_start_option,
     add_robot_options,
     add_subcommand,
     load_drive_arg,
@@ -125,6 +126,7 @@ def register(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParser:
     )
     add_robot_options(p)
     add_drive_option(p)
+    add_q_start_option(p)
     p.add_argument(
         "--data",
         type=Path,

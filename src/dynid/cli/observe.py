@@ -47,6 +47,7 @@ from ..workflows.observe import ObserveOptions, observe_files
 from .common import (
     add_column_options,
     add_drop_invalid,
+    add_q_start_option,
     add_subcommand,
     nonnegative_type,
     output_path,
@@ -75,6 +76,7 @@ def register(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParser:
     p.add_argument("--base", help="--params URDF: base link of the chain (default: the root)")
     p.add_argument("--tip", help="--params URDF: tip link of the chain (default: the only leaf)")
     p.add_argument("--friction", type=Path, help="friction.json replacing the model's friction")
+    add_q_start_option(p)
     p.add_argument(
         "--data",
         type=Path,
@@ -132,7 +134,7 @@ def run(args: argparse.Namespace, console: Console) -> int:
         uncertainty=not args.no_uncertainty, standstill=not args.no_standstill_margin,
         merge_s=args.merge,
         columns=(args.columns, args.units), drop_invalid=args.drop_invalid,
-        max_gap=args.max_gap, base=args.base, tip=args.tip,
+        max_gap=args.max_gap, base=args.base, tip=args.tip, q_start=args.q_start,
         # the series serve the figures only: a calibration's whole, a detection's strided
         keep_series=args.calibrate and not args.no_figures,
         figure_points=None if args.no_figures else FIGURE_POINTS,

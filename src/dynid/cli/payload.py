@@ -40,6 +40,7 @@ from .common import (
     add_column_options,
     add_drive_option,
     add_log_options,
+    add_q_start_option,
     add_subcommand,
     load_drive_arg,
     output_path,
@@ -94,6 +95,7 @@ def register(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParser:
         "data are not filtered)",
     )
     add_drive_option(p)
+    add_q_start_option(p)
     add_log_options(p)
     p.add_argument("--out", type=output_path, required=True, help="output folder")
     return p
@@ -125,6 +127,7 @@ def _options(args: argparse.Namespace, n: int) -> dict[str, Any]:
         max_gap_s=args.max_gap,
         drive=load_drive_arg(args, n),
         feasible=args.params,
+        q_start=args.q_start,
     )
 
 

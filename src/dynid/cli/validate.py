@@ -56,6 +56,7 @@ from .common import (
     add_column_options,
     add_drive_option,
     add_log_options,
+    add_q_start_option,
     add_recordings_option,
     add_subcommand,
     load_drive_arg,
@@ -103,6 +104,7 @@ def register(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParser:
         "with, else the one identification reads from the log's motion)",
     )
     add_drive_option(p)
+    add_q_start_option(p)
     add_log_options(p)
     p.add_argument("--no-figures", action="store_true", help="skip the PNG figures")
     return p
@@ -119,6 +121,7 @@ def run(args: argparse.Namespace, console: Console) -> int:
         cutoff_hz=args.cutoff,
         max_gap_s=args.max_gap,
         drive=load_drive_arg(args, robot.n),
+        q_start=args.q_start,
     )
     result = validate_files(model, args.data, options, feasible=args.params, label=label)
     path = save_validation_json(

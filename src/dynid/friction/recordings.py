@@ -7,8 +7,11 @@ every log is cut at each gap longer than ``max_gap_s`` (by default the rule the 
 identified with), the joints (motors, on a motor-side log) that can wrap and were recorded
 wrapped into ``[-pi, pi]`` are unwrapped piece by piece, whatever the drive, each piece is
 read at the joints (through the model's drive) and filtered and differentiated on its own
-(:func:`~dynid.identification.prepare.prepare_log`) at one cut-off, and decimated as the model
-was identified.
+(:func:`~dynid.identification.prepare.prepare_log`) at one cut-off, its ends trimmed by the
+rule identification applies (:func:`~dynid.identification.trim.edge_seconds`: half a period
+of the cut-off when the motion lies a decade below it), and decimated as the model was
+identified: a model is judged on the samples identification prepared from the same
+recording.
 Unlike identification, the measured torques stay unfiltered (the RMS of a correct model
 is the sensor noise). A piece too short to filter is left out
 with a warning naming its file and times; a recording left without any piece, or of
@@ -40,6 +43,7 @@ from ..identification.model import IdentifiedModel
 from ..identification.pieces import recording_pieces, skipped_piece, wrappable
 from ..identification.prepare import prepare_log
 from ..identification.sanity import velocity_noise_std
+from ..identification.trim import common_cutoff, edge_seconds
 from ..model.drive import Drive
 from ..model.robot import Robot
 from .fit import FrictionResidual, TorqueModel, model_drive, rigid_body_torques
@@ -201,12 +205,16 @@ def prepare_pieces(
         piece long enough to filter (the file is named); another drive than the model's.
     """
     gap, k = _recorded_preparation(model, max_gap_s, decimate)
-    raw = _raw_pieces(model, logs, names, cutoff_hz, gap, drive)
+    raw = _raw_pieces(model, logs, names, cutoff_hz, gap, drive, trim_s)
     prepared, recording, skipped = [], [], []
     for r, piece in raw.pieces:
         try:
             p = prepare_log(
-                piece, cutoff_hz=raw.cutoff_hz, trim_s=trim_s, filter_tau=filter_tau, max_gap_s=gap
+                piece,
+                cutoff_hz=raw.cutoff_hz,
+                trim_s=raw.trim_s,
+                filter_tau=filter_tau,
+                max_gap_s=gap,
             )
         except DataError as exc:
             skipped.append(skipped_piece(raw.names[r], piece, exc))
@@ -223,6 +231,7 @@ class _Raw:
     pieces: list[tuple[int, TorqueLog]]
     names: tuple[str, ...]
     cutoff_hz: float | None
+    trim_s: float | None
     unwrapped: tuple[int, ...]
     drive: Drive | None
 
@@ -234,8 +243,11 @@ def _raw_pieces(
     cutoff_hz: float | None | Literal["recorded"],
     max_gap_s: float | None,
     drive: Drive | None,
+    trim_s: float | None = None,
 ) -> _Raw:
-    """Every recording at the joints, unwrapped, cut at its gaps; the one cut-off."""
+    """Every recording at the joints, unwrapped, cut at its gaps; the one cut-off and the
+    seconds trimmed at each piece's ends (``trim_s``, else identification's rule,
+    :func:`~dynid.identification.trim.edge_seconds`)."""
     if not logs:
         raise DataError("no recording given")
     names = tuple(names) if names is not None else tuple(f"log{k + 1}" for k in range(len(logs)))
@@ -255,12 +267,23 @@ def _raw_pieces(
         mine, joints = recording_pieces(name, log, turns, max_gap_s, robot=robot, drive=d)
         turned.update(joints)
         raw += [(r, joint_side_log(p, d)) for p in mine]
-    cut = (
-        recorded_cutoff(model, [p for _, p in raw], [r for r, _ in raw])
-        if isinstance(cutoff_hz, str)
-        else cutoff_hz
-    )
-    return _Raw(raw, names, cut, tuple(sorted(turned)), d)
+    jpieces, labels = [p for _, p in raw], [r for r, _ in raw]
+    # joint-side pieces of a motor-side log differ by turns of the motors, not joints
+    jturns = None if robot is None or (d is not None and d.side == "motor") else wrappable(robot)
+    read = isinstance(cutoff_hz, str) and _no_recorded_cutoff(model)
+    cut = common_cutoff(jpieces, labels, jturns) if read else None
+    from_motion = cut is not None
+    if cut is None:
+        cut = recorded_cutoff(model, jpieces, labels) if isinstance(cutoff_hz, str) else cutoff_hz
+    if trim_s is None:
+        trim_s = edge_seconds(jpieces, labels, cut, from_motion=from_motion, turns=jturns)
+    return _Raw(raw, names, cut, trim_s, tuple(sorted(turned)), d)
+
+
+def _no_recorded_cutoff(model: TorqueModel) -> bool:
+    """Whether ``model`` holds no cut-off of its own (not a model identified from logs):
+    identification's would be read from the recordings' motion."""
+    return not (isinstance(model, IdentifiedModel) and model.info.log is not None)
 
 
 def _kept(
@@ -314,7 +337,7 @@ def validate_recordings(
     at every k-th sample only (``Validation.step``), so that a long recording is never
     held prepared whole. Parameters and errors as the two."""
     gap, _ = _recorded_preparation(model, max_gap_s, RECORDED)  # every sample judged
-    raw = _raw_pieces(model, logs, names, cutoff_hz, gap, drive)
+    raw = _raw_pieces(model, logs, names, cutoff_hz, gap, drive, trim_s)
     parts, recording, skipped = [], [], []
     for r, piece in raw.pieces:
         try:
@@ -324,7 +347,7 @@ def validate_recordings(
                 friction,
                 raw.drive,
                 cutoff_hz=raw.cutoff_hz,
-                trim_s=trim_s,
+                trim_s=raw.trim_s,
                 filter_tau=filter_tau,
                 max_gap_s=gap,
             )

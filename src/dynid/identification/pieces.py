@@ -5,7 +5,10 @@
   ``[-pi, pi]`` (joints whose limits span a turn; a motor-side log's motors);
 * :func:`unwrapped`: the wraps of a piece taken out;
 * :func:`start_turns`: the whole turns a motor recorded wrapped had at a piece's start,
-  from the joints' limits (refused when they leave several);
+  from the joints' limits (refused when they leave several), or, at the log's first
+  sample, the turns that put the joints nearest the positions given there (``--q-start``);
+* :func:`with_start_turns`: a motor-side log with its wrapped motors unwrapped and given
+  their whole turns, the first piece's from the joint positions given at its start;
 * :func:`recording_pieces`: all four for one recording, its time column checked first
   (:func:`~dynid.identification.sanity.time_unit_finding`);
 * :func:`joined`: the pieces of one recording as one log for its checks;
@@ -17,6 +20,7 @@ friction fit (:mod:`dynid.friction.recordings`) and the payload.
 
 from __future__ import annotations
 
+import itertools
 import warnings
 
 import numpy as np
@@ -31,11 +35,13 @@ from .sanity import time_unit_finding
 __all__ = [
     "WRAP_SPAN",
     "joined",
+    "nearest_turns",
     "recording_pieces",
     "skipped_piece",
     "split_at_gaps",
     "start_turns",
     "unwrapped",
+    "with_start_turns",
     "wrappable",
 ]
 
@@ -184,7 +190,10 @@ def recording_pieces(
     motors = drive is not None and drive.side == "motor"
     if turned and motors and robot is not None:
         assert drive is not None
-        pieces = [start_turns(name, p, sorted(turned), robot, drive) for p in pieces]
+        pieces = [
+            start_turns(name, p, sorted(turned), robot, drive, log_start=k == 0)
+            for k, p in enumerate(pieces)
+        ]
     if (alone := log.n_samples - sum(p.n_samples for p in pieces)) > 0:
         warnings.warn(
             f"{name}: {alone} sample(s) isolated between gaps longer than the longest gap "
@@ -205,7 +214,14 @@ def recording_pieces(
 
 
 def start_turns(
-    name: str, piece: TorqueLog, motors: list[int], robot: Robot, drive: Drive
+    name: str,
+    piece: TorqueLog,
+    motors: list[int],
+    robot: Robot,
+    drive: Drive,
+    q_start: NDArray[np.float64] | None = None,
+    *,
+    log_start: bool = True,
 ) -> TorqueLog:
     """The motor-side ``piece`` with its ``motors`` (0-based, recorded wrapped and
     unwrapped, :func:`unwrapped`) given the whole turns they had at its start.
@@ -218,12 +234,25 @@ def start_turns(
     after motor; found when each motor is left one count (the joint's limits spanning
     less than its motion plus one turn of the motor), then checked on every joint.
 
+    With ``q_start`` (n,) [rad or m], the joint positions at the piece's first sample (the
+    log's, ``--q-start``), the turns are those that put the first sample's joint positions
+    nearest to it (:func:`nearest_turns`), whatever the limits say. ``log_start``: the
+    piece starts the log (False: it follows a gap, said in the error).
+
     Raises
     ------
     DataError
         The limits leave several counts (or none) for some motor: the joint positions are
-        unknown by whole turns of the motors (the file, the motors and the counts named).
+        unknown by whole turns of the motors (the file, the motors and the counts named;
+        the hint names ``--q-start``); ``q_start`` nearly as near to two counts.
     """
+    if q_start is not None:
+        n = nearest_turns(name, piece, motors, drive, q_start)
+        qm = np.array(piece.q)
+        qm[:, motors] += 2 * np.pi * n
+        return TorqueLog(
+            piece.t, qm, piece.dq, piece.tau, piece.ddq, piece.cleaning, piece.dq_derived
+        )
     q = drive.joint_states(np.asarray(piece.q, dtype=np.float64))[0]
     lo = np.asarray(robot.q_min, dtype=np.float64) - q.min(axis=0)
     hi = np.asarray(robot.q_max, dtype=np.float64) - q.max(axis=0)
@@ -258,13 +287,147 @@ def start_turns(
             f"motor(s) {', '.join(str(m + 1) for m in motors)} recorded wrapped into "
             "[-pi, pi] lost the whole turns that set the joint positions, and the joints' "
             f"limits leave several counts of them at t = {piece.t[0]:.6g} s (motor "
-            f"{'; motor '.join(told) or 'none fits every joint'}); hint: log the motors' "
-            "multi-turn angles, or the joint positions (a joint-side log)",
+            f"{'; motor '.join(told) or 'none fits every joint'}); hint: "
+            + (
+                "give the joint positions at the log's first sample with --q-start "
+                "(comma list, rad), log the motors' multi-turn angles, or the joint "
+                "positions (a joint-side log)"
+                if log_start
+                else "this piece follows a gap, across which the turns are lost: "
+                "--q-start gives those of the log's first sample only; log the motors' "
+                "multi-turn angles, or record without gaps"
+            ),
             file=name,
         )
     qm = np.array(piece.q)
     qm[:, motors] += 2 * np.pi * n
     return TorqueLog(piece.t, qm, piece.dq, piece.tau, piece.ddq, piece.cleaning, piece.dq_derived)
+
+
+def nearest_turns(
+    name: str,
+    piece: TorqueLog,
+    motors: list[int],
+    drive: Drive,
+    q_start: NDArray[np.float64],
+) -> NDArray[np.float64]:
+    """The whole turns ``n`` (len(motors),) of the ``motors`` (recorded wrapped) that put
+    the joint positions of the piece's first sample, ``K^-1 (q_m + 2 pi n) + q_0``,
+    nearest to ``q_start`` (n,) [rad] (Euclidean; the nearest point of the lattice of
+    joint shifts ``2 pi K^-1 e_m``, searched around the rounded least-squares counts).
+
+    Raises
+    ------
+    DataError
+        The second-nearest count lies less than twice as far from ``q_start`` as the
+        nearest: the positions given do not tell the turns (the gap to close is named).
+    """
+    q0 = drive.joint_states(np.asarray(piece.q[:1], dtype=np.float64))[0][0]
+    A = 2 * np.pi * np.linalg.inv(np.asarray(drive.transmission, dtype=np.float64))[:, motors]
+    d = np.asarray(q_start, dtype=np.float64) - q0
+    m = len(motors)
+    base = np.round(np.linalg.lstsq(A, d, rcond=None)[0])
+    steps = (
+        np.array(list(itertools.product((-1.0, 0.0, 1.0), repeat=m)))
+        if m <= 7
+        else np.vstack([np.zeros(m), np.eye(m), -np.eye(m)])
+    )
+    counts = base + steps
+    dist = np.linalg.norm(counts @ A.T - d, axis=1)
+    order = np.argsort(dist, kind="stable")
+    best, second = counts[order[0]], counts[order[1]]
+    d1, d2 = float(dist[order[0]]), float(dist[order[1]])
+    if not d2 >= 2.0 * d1:
+        apart = float(np.linalg.norm(A @ (best - second)))
+        raise DataError(
+            f"--q-start lies {d1:.3g} rad from the joint positions of one count of the "
+            f"turns of motor(s) {', '.join(str(k + 1) for k in motors)} recorded wrapped and "
+            f"{d2:.3g} rad from another's ({apart:.3g} rad apart): it does not tell them; "
+            f"hint: give the joint positions at the log's first sample (t = "
+            f"{piece.t[0]:.6g} s) to within {apart / 3:.3g} rad",
+            file=name,
+        )
+    return best
+
+
+def with_start_turns(
+    name: str,
+    log: TorqueLog,
+    robot: Robot,
+    drive: Drive | None,
+    q_start: NDArray[np.float64] | None = None,
+    max_gap_s: float | None = None,
+) -> TorqueLog:
+    """A motor-side ``log`` with its motors recorded wrapped into ``[-pi, pi]`` unwrapped
+    and given their whole turns: with ``q_start`` (``--q-start``) the log's first piece
+    (up to its first gap longer than ``max_gap_s``) the turns that put its first sample's
+    joint positions nearest to ``q_start`` (n,) [rad] (:func:`nearest_turns`); every other
+    piece those its joints' limits tell (:func:`start_turns`). The log then holds
+    multi-turn motor angles, as :func:`recording_pieces` reads them; its samples isolated
+    between gaps are kept as recorded (no piece holds them). A warning names the file and
+    the motors. Without ``q_start``, a log that is not motor side or whose motors did not
+    wrap is returned as it is.
+
+    Raises
+    ------
+    OptionError
+        ``q_start`` not ``n`` finite numbers; a drive whose log is not motor side; no motor
+        of the log recorded wrapped (its angles tell the turns: ``--q-start`` does not
+        apply).
+    DataError
+        As :func:`start_turns` (a later piece whose turns the limits do not tell) and
+        :func:`nearest_turns`.
+    """
+    if q_start is None and (drive is None or drive.side != "motor"):
+        return log
+    if q_start is not None:
+        _check_q_start(np.asarray(q_start, dtype=np.float64), robot, drive)
+    assert drive is not None
+    dt = np.diff(log.t)
+    limit = default_max_gap(float(np.median(dt))) if max_gap_s is None else float(max_gap_s)
+    cuts = np.concatenate([[0], np.flatnonzero(dt > limit) + 1, [log.n_samples]])
+    spans = [(a, b) for a, b in zip(cuts[:-1], cuts[1:], strict=True) if b - a > 1]
+    turns = wrappable(robot, drive)
+    done = [unwrapped(log.select(slice(a, b)), turns) for a, b in spans]
+    motors = sorted({j for _, js in done for j in js})
+    if not motors and q_start is None:
+        return log
+    if not motors:
+        raise OptionError(
+            f"does not apply to {name}: none of its motors was recorded wrapped into "
+            "[-pi, pi] (its angles tell the turns); leave it out",
+            field="q_start",
+        )
+    q = np.array(log.q)
+    for k, ((a, b), (piece, _)) in enumerate(zip(spans, done, strict=True)):
+        given = q_start if k == 0 else None
+        q[a:b] = start_turns(name, piece, motors, robot, drive, given, log_start=k == 0).q
+    source = "from --q-start" if q_start is not None else "from the joints' limits"
+    warnings.warn(
+        f"{name}: motor(s) {', '.join(str(j + 1) for j in motors)} recorded wrapped into "
+        f"[-pi, pi]: unwrapped, their whole turns at the first sample {source}",
+        DynidWarning,
+        stacklevel=2,
+    )
+    return TorqueLog(log.t, q, log.dq, log.tau, log.ddq, log.cleaning, log.dq_derived)
+
+
+def _check_q_start(q_start: NDArray[np.float64], robot: Robot, drive: Drive | None) -> None:
+    """Refuse joint positions at the first sample that are not ``robot.n`` finite numbers,
+    or given without a motor-side drive (:func:`with_start_turns`)."""
+    if q_start.shape != (robot.n,) or not np.all(np.isfinite(q_start)):
+        raise OptionError(
+            f"must hold {robot.n} finite joint positions [rad] (one per joint of robot "
+            f"{robot.name!r}); got {np.size(q_start)} number(s)",
+            field="q_start",
+        )
+    if drive is None or drive.side != "motor":
+        raise OptionError(
+            "gives the whole turns of motors recorded wrapped into [-pi, pi] on a motor-side "
+            'log; it does not apply without a {drive} of side = "motor"',
+            field="q_start",
+            others=("drive",),
+        )
 
 
 #: The checks of a recording cut into pieces read at most about this many of its samples.

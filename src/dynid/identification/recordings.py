@@ -18,13 +18,14 @@ Here:
    names them; a jump across a cut-out stretch is no wrap);
 3. one cut-off serves every piece (or the one given): the median of the recordings'
    :func:`~dynid.identification.rate.cutoff_from_motion`, each weighted by its samples,
-   each read from its pieces on its own time axis (:func:`common_cutoff`);
+   each read from its pieces on its own time axis
+   (:func:`~dynid.identification.trim.common_cutoff`);
 4. each piece is read through the drive, filtered, differentiated and decimated on its own
    (:func:`~dynid.identification.classical.prepare_torque_log`), the filter's edges
-   trimmed at both of its ends (:func:`~dynid.signals.edge_seconds`, half a period of the
-   cut-off); a piece too short for the filter is left out with a warning naming its file
-   and times, never silently; each recording's samples not used are counted by cause
-   (:class:`SampleCounts`);
+   trimmed at both of its ends (:func:`~dynid.identification.trim.edge_seconds`, half a
+   period of the cut-off; the rule validation and the friction fit apply too); a piece
+   too short for the filter is left out with a warning naming its file and times, never
+   silently; each recording's samples not used are counted by cause (:class:`SampleCounts`);
 5. the pieces' regressor rows are stacked (:class:`Recordings`, a
    :class:`~dynid.identification.core.Dataset`); held-out judgement leaves one recording
    out at a time when there are several (:meth:`Recordings.fold_labels`), contiguous time
@@ -43,7 +44,6 @@ from typing import Any, Literal
 import numpy as np
 from numpy.typing import NDArray
 
-from .. import signals
 from ..exceptions import DataError, DynidWarning, ShapeError
 from ..model.drive import Drive
 from ..model.robot import Robot
@@ -62,7 +62,7 @@ from .pieces import (
     unwrapped,
     wrappable,
 )
-from .rate import CUTOFF_MULTIPLE, bridged, cutoff_from_motion
+from .rate import CUTOFF_MULTIPLE
 from .sanity import (
     check_torque_log,
     noise_band,
@@ -71,6 +71,7 @@ from .sanity import (
     velocity_noise_std,
 )
 from .streaming import streams
+from .trim import common_cutoff, edge_seconds, within_edges
 
 __all__ = [
     "WRAP_SPAN",
@@ -450,7 +451,16 @@ def prepare_recordings(
         )
         if cutoff is None:
             raise DataError("no piece is long enough to read the motion's frequency from")
-    edge = trim_s if trim_s is not None else _edge(pieces, cutoff, cutoff_hz, drive, jturns)
+    if trim_s is not None:
+        edge: float | None = trim_s
+    else:
+        edge = edge_seconds(
+            [joint_side_log(p, drive) for _, p in pieces],
+            [r for r, _ in pieces],
+            cutoff,
+            from_motion=cutoff_hz == "auto",
+            turns=jturns,
+        )
     kw = dict(cutoff_hz=cutoff, trim_s=edge, max_gap_s=max_gap_s, decimate=decimate)
     prepared, recording, skipped, gone = _prepared(robot, pieces, names, drive, **kw)
     if not prepared:
@@ -511,97 +521,10 @@ def _prepared(
             continue
         prepared.append(p)
         recording.append(r)
-        kept = _within_edges(piece.t, kw["trim_s"] or 0.0)
+        kept = within_edges(piece.t, kw["trim_s"] or 0.0)
         gone[r]["trimmed"] += piece.n_samples - kept
         gone[r]["decimated"] += kept - p.log.n_samples
     return prepared, recording, skipped, gone
-
-
-def _edge(
-    pieces: list[tuple[int, TorqueLog]],
-    cutoff: float | None,
-    cutoff_hz: float | Literal["auto"] | None,
-    drive: Drive | None,
-    jturns: NDArray[np.bool_] | None,
-) -> float | None:
-    """The seconds trimmed at each end of every piece filtered at ``cutoff`` [Hz]
-    (:func:`~dynid.signals.edge_seconds`): half a period when the motion lies a decade
-    below the cut-off (read from it, or read here for a cut-off given); two periods for
-    velocities derived from positions, filtered twice; None without filtering."""
-    if cutoff is None:
-        return None
-    if any(p.dq_derived for _, p in pieces):
-        return signals.edge_seconds(cutoff)
-    motion = cutoff / CUTOFF_MULTIPLE if cutoff_hz == "auto" else _motion_hz(pieces, drive, jturns)
-    return signals.edge_seconds(cutoff, motion)
-
-
-def _motion_hz(
-    pieces: list[tuple[int, TorqueLog]], drive: Drive | None, jturns: NDArray[np.bool_] | None
-) -> float | None:
-    """The motion's highest significant frequency [Hz] of the recordings' pieces (as a
-    cut-off read from the motion reads it, :func:`common_cutoff`), None when no piece
-    tells it."""
-    try:
-        found = common_cutoff(
-            [joint_side_log(p, drive) for _, p in pieces], [r for r, _ in pieces], jturns
-        )
-    except DataError:
-        return None
-    return None if found is None else found / CUTOFF_MULTIPLE
-
-
-def _within_edges(t: NDArray[np.float64], trim_s: float) -> int:
-    """Samples of ``t`` more than ``trim_s`` [s] from both of its ends (as
-    :func:`~dynid.signals.trim_edges` keeps them)."""
-    lo = np.searchsorted(t, t[0] + trim_s, side="left")
-    hi = np.searchsorted(t, t[-1] - trim_s, side="right")
-    return int(max(0, hi - lo))
-
-
-def common_cutoff(
-    pieces: Sequence[TorqueLog],
-    recording: Sequence[int] | None = None,
-    turns: NDArray[np.bool_] | None = None,
-) -> float | None:
-    """The cut-off [Hz] read from the motion of the recordings
-    (:func:`~dynid.identification.rate.cutoff_from_motion`): each recording's read from
-    its pieces on its own time axis (:func:`~dynid.identification.rate.bridged`, the
-    columns ``turns`` moved by whole turns across its gaps), the median over the
-    recordings, each weighted by its samples; None when no recording holds 64 samples.
-
-    ``recording`` gives each piece's recording (default: every piece its own, read alone).
-    A recording whose cut-out stretches are longer than what was kept is read from its
-    pieces of at least 64 samples, each on its own, weighted by its samples.
-    """
-    labels = list(range(len(pieces))) if recording is None else [int(r) for r in recording]
-    found: list[float] = []
-    weight: list[int] = []
-    for r in dict.fromkeys(labels):
-        mine = [p for p, k in zip(pieces, labels, strict=True) if k == r]
-        grid = None
-        if len(mine) > 1 and sum(p.n_samples for p in mine) >= 64:
-            grid = bridged([p.t for p in mine], [p.q for p in mine], [p.dq for p in mine], turns)
-        if grid is not None:
-            dq = np.concatenate([p.dq for p in mine])
-            found.append(cutoff_from_motion(grid[0], dq, grid[1]))
-            weight.append(sum(p.n_samples for p in mine))
-            continue
-        for piece in mine:
-            if piece.n_samples < 64:
-                continue
-            try:
-                found.append(cutoff_from_motion(piece.q, piece.dq, piece.sample_rate))
-            except DataError:
-                if len(pieces) == 1:
-                    raise
-                continue
-            weight.append(piece.n_samples)
-    if not found:
-        return None
-    order = np.argsort(found)
-    cum = np.cumsum(np.asarray(weight, dtype=np.float64)[order])
-    return float(np.asarray(found)[order][np.searchsorted(cum, 0.5 * cum[-1])])
 
 
 def _bands(pieces: list[TorqueLog], drive: Drive | None) -> dict[str, NDArray[np.float64]]:

@@ -65,6 +65,10 @@ class FrictionOptions:
         log's motion (:func:`~dynid.friction.validation.recorded_cutoff`).
     max_gap_s : float, optional
         Longest gap bridged by interpolation [s]; a longer one cuts a log into pieces.
+    q_start : tuple of float, optional
+        Joint positions [rad] at the first sample of one motor-side recording whose motor
+        encoders wrap every turn: the motors' whole turns are those that put the joints
+        nearest them (:func:`~dynid.workflows.recordings.given_start`).
 
     Raises
     ------
@@ -79,6 +83,7 @@ class FrictionOptions:
     drive: Drive | None = None
     cutoff_hz: float | None = None
     max_gap_s: float | None = None
+    q_start: tuple[float, ...] | None = None
 
     def __post_init__(self) -> None:
         check_choice(self, "law", ("auto", *LAWS), optional=False)
@@ -167,6 +172,8 @@ def fit_friction_files(
         cutoff_hz=cutoff_hz,
         owner="the model",
         drive=(model.drive if isinstance(model, IdentifiedModel) else None) or drive,
+        q_start=opt.q_start,
+        max_gap_s=max_gap_s,
     )
 
     def fit() -> FrictionFileResult:

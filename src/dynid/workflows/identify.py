@@ -52,7 +52,7 @@ from .data_files import (
 )
 from .options import check_band, check_choice, check_count, check_number, only_with, refused_with
 from .prior import load_prior
-from .recordings import Recorded, check_units
+from .recordings import Recorded, check_units, given_start
 
 __all__ = ["ColumnSpec", "IdentifyOptions", "IdentifyResult", "data_files", "identify_files"]
 
@@ -169,6 +169,10 @@ class IdentifyOptions:
         the cut-off of velocities derived from positions through ``columns``.
     max_gap_s : float, optional
         Torque logs: longest gap bridged by interpolation [s]; a longer one cuts the log.
+    q_start : tuple of float, optional
+        Torque logs: the joint positions [rad] at the first sample of one motor-side log
+        whose motor encoders wrap every turn: the motors' whole turns are those that put
+        the joints nearest them (:func:`~dynid.workflows.recordings.given_start`).
     folds : int, optional
         Torque logs: contiguous time blocks of the held-out judgement (>= 2).
     validate_on : str or Path, optional
@@ -206,6 +210,7 @@ class IdentifyOptions:
     drive: Drive | None = None
     cutoff_hz: float | None = None
     max_gap_s: float | None = None
+    q_start: tuple[float, ...] | None = None
     folds: int | None = None
     validate_on: str | Path | None = None
     consistent: bool = False
@@ -316,7 +321,7 @@ def _identify(robot: Robot, paths: list[Path], opt: IdentifyOptions) -> Identifi
     kind = data_kind(path, cmap)
     heldout = _heldout(paths, kind, opt.folds, opt.validate_on, robot.n, cmap, opt.drop_invalid)
     if kind == "torque_log":
-        logs = _read_logs(robot, paths, cmap, opt.drop_invalid)
+        logs = _read_logs(robot, paths, cmap, opt)
         fit = lambda: identify_recordings(  # noqa: E731
             robot,
             logs,
@@ -356,15 +361,18 @@ def _identify(robot: Robot, paths: list[Path], opt: IdentifyOptions) -> Identifi
     return _record(model, opt.columns)
 
 
-def _read_logs(robot: Robot, paths: list[Path], cmap: Any, drop_invalid: bool) -> list[Any]:
+def _read_logs(robot: Robot, paths: list[Path], cmap: Any, opt: IdentifyOptions) -> list[Any]:
     """The torque logs ``paths``, read strictly for ``robot``; a recording in other units
-    than the others refused, naming it (:func:`~dynid.workflows.recordings.check_units`)."""
+    than the others refused, naming it (:func:`~dynid.workflows.recordings.check_units`);
+    the whole turns of wrapped motors from ``q_start`` (:func:`given_start`)."""
     logs = [
         read_torque_log(
-            p, robot.n, columns=cmap, drop_invalid=drop_invalid, owner=f"robot {robot.name!r}"
+            p, robot.n, columns=cmap, drop_invalid=opt.drop_invalid, owner=f"robot {robot.name!r}"
         )
         for p in paths
     ]
+    names = [p.name for p in paths]
+    logs = list(given_start(logs, names, robot, opt.drive, opt.q_start, opt.max_gap_s))
     check_units(Recorded(tuple(logs), tuple(paths)))
     return logs
 
@@ -379,7 +387,7 @@ def _one_static_file(paths: list[Path], opt: IdentifyOptions) -> None:
         raise OptionError(
             f"applies to torque logs, not static data ({paths[0].name})", field="terms"
         )
-    for name in ("cutoff_hz", "max_gap_s"):
+    for name in ("cutoff_hz", "max_gap_s", "q_start"):
         if getattr(opt, name) is not None:
             raise OptionError(
                 f"applies to torque logs, not static data ({paths[0].name})", field=name
@@ -406,7 +414,7 @@ def _identify_consistent(
     heldout = _heldout(paths, kind, opt.folds, opt.validate_on, robot.n, cmap, opt.drop_invalid)
     common: dict[str, Any] = dict(prior=prior, total_mass=opt.total_mass, options=opt.sdp())
     if kind == "torque_log":
-        logs = _read_logs(robot, paths, cmap, opt.drop_invalid)
+        logs = _read_logs(robot, paths, cmap, opt)
 
         def fit() -> ConsistentResult:
             return identify_consistent(

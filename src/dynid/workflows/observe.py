@@ -59,7 +59,7 @@ from .data_files import (
 )
 from .observe_detect import ResidualSink, detected_log, true_torques
 from .observe_logs import ObservedBlock, PreparedLog, Series, observed_blocks, prepared_log
-from .recordings import Recorded, check_limits, check_units
+from .recordings import Recorded, check_limits, check_units, given_start
 
 __all__ = [
     "LogObservation",
@@ -115,6 +115,9 @@ class ObserveOptions:
     base, tip : str, optional
         The chain of a ``params`` URDF with several leaves (its root and only leaf by
         default).
+    q_start : tuple of float, optional
+        The joint positions [rad] at the first sample of one motor-side log whose motor
+        encoders wrap every turn (:func:`~dynid.workflows.recordings.given_start`).
     keep_series : bool
         When calibrating: keep every log's residual (and its std and margin) in the
         result, for figures. False: only the calibration's running statistics, a block of
@@ -148,6 +151,7 @@ class ObserveOptions:
     max_gap: float | None = None
     base: str | None = None
     tip: str | None = None
+    q_start: tuple[float, ...] | None = None
     keep_series: bool = True
     figure_points: int | None = None
 
@@ -324,6 +328,8 @@ def _read_logs(
         read_torque_log(p, model.n, columns=cmap, drop_invalid=opts.drop_invalid, owner="the model")
         for p in map(Path, paths)
     ]
+    names = [Path(p).name for p in paths]
+    logs = list(given_start(logs, names, model.robot, model.drive, opts.q_start, opts.max_gap))
     read = Recorded(tuple(logs), tuple(map(Path, paths)))
     check_limits(read, model.robot, model.drive)
     check_units(read)

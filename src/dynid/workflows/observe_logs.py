@@ -24,7 +24,7 @@ from numpy.typing import NDArray
 from ..exceptions import DataError, DynidWarning
 from ..exceptions import in_file as about_file
 from ..identification.log import DEFAULT_CUTOFF_HZ, TorqueLog, default_max_gap, joint_side_log
-from ..identification.pieces import unwrapped, wrappable
+from ..identification.pieces import unwrapped, with_start_turns, wrappable
 from ..observer.detection import residual_std_blocks, standstill_blocks
 from ..observer.friction import derived_velocity_bands
 from ..observer.model import ObserverModel
@@ -96,6 +96,8 @@ def prepared_log(
 ) -> PreparedLog:
     """The log at the joints, unwrapped, cut at its gaps and jumps, with the velocities
     and the spans the observer runs on (warnings name the file)."""
+    # motors recorded wrapped given their whole turns (refused when the limits leave several)
+    log = with_start_turns(path.name, log, model.robot, model.drive, max_gap_s=max_gap)
     log = joint_side_log(log, model.drive)
     log, turned = unwrapped(log, wrappable(model.robot))  # joints whose limits span a turn
     if turned:  # M(q) is periodic; velocities derived across a wrap are not

@@ -23,7 +23,7 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
-from ..exceptions import DataError
+from ..exceptions import DataError, OptionError
 from ..feasibility.payload import PayloadEstimate, identify_payload, robot_with_payload
 from ..feasibility.payload_arm import ArmFriction
 from ..identification.model import IdentifiedModel
@@ -90,6 +90,7 @@ def identify_payload_files(
     max_gap_s: float | None = None,
     drive: Drive | None = None,
     feasible: str | Path | None = None,
+    q_start: tuple[float, ...] | None = None,
 ) -> PayloadFileResult:
     """The load fixed to ``frame`` from data recorded with it (module docstring).
 
@@ -121,6 +122,10 @@ def identify_payload_files(
     feasible : str or Path, optional
         The ``feasible.json`` the robot ``arm`` was read from: its drive and friction are
         the arm's.
+    q_start : tuple of float, optional
+        Torque logs: the joint positions [rad] at the first sample of the one motor-side
+        log ``data`` whose motor encoders wrap every turn
+        (:func:`~dynid.workflows.recordings.given_start`).
 
     Returns
     -------
@@ -148,6 +153,8 @@ def identify_payload_files(
     kind = data_kind(paths[0], cmap)
     common: dict[str, Any] = dict(frame=frame, drive=drive, friction=friction)
     if kind != "torque_log":
+        if q_start is not None:
+            raise OptionError("applies to torque logs, not static data", field="q_start")
         if cutoff_hz is not None:
             raise DataError(
                 "--cutoff applies to torque logs (their low-pass); static data are not filtered"
@@ -162,7 +169,9 @@ def identify_payload_files(
         cutoff_hz=known,
         drive=arm.drive if isinstance(arm, IdentifiedModel) and drive is None else drive,
     )
-    rec = read_recordings(paths, kin, owner=f"robot {kin.name!r}", **read_as)
+    rec = read_recordings(
+        paths, kin, owner=f"robot {kin.name!r}", q_start=q_start, max_gap_s=max_gap_s, **read_as
+    )
     without_rec = None
     if base is not None:
         without_rec = read_recordings(base, kin, owner=f"robot {kin.name!r}", **read_as)

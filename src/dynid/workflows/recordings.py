@@ -29,8 +29,9 @@ from typing import Any
 
 import numpy as np
 
-from ..exceptions import DataError, DynidWarning
+from ..exceptions import DataError, DynidWarning, OptionError
 from ..identification.log import TorqueLog, joint_side_log
+from ..identification.pieces import with_start_turns
 from ..identification.sanity import time_unit_finding
 from ..model.drive import Drive
 from ..model.robot import Robot
@@ -43,7 +44,14 @@ from .data_files import (
     recorded_columns,
 )
 
-__all__ = ["UNIT_RATIO", "Recorded", "check_limits", "check_units", "read_recordings"]
+__all__ = [
+    "UNIT_RATIO",
+    "Recorded",
+    "check_limits",
+    "check_units",
+    "given_start",
+    "read_recordings",
+]
 
 #: Ratio of a recording's torque scale (or velocity unit) to the other recordings' median
 #: beyond which it is taken to be in another unit (a power of ten: mN m, ms, degrees).
@@ -81,6 +89,8 @@ def read_recordings(
     cutoff_hz: float | None = None,
     owner: str | None = None,
     drive: Drive | None = None,
+    q_start: Sequence[float] | None = None,
+    max_gap_s: float | None = None,
 ) -> Recorded:
     """The torque logs of ``data`` (files, or folders of ``.csv``/``.npz`` files) of
     ``robot``, read and checked (module docstring).
@@ -103,6 +113,9 @@ def read_recordings(
     drive : Drive, optional
         The drive the recordings were recorded through: the joint limits are checked on
         their joint-side positions (a motor-side log holds motor angles).
+    q_start, max_gap_s : optional
+        The joint positions [rad] at the first sample of one motor-side recording whose
+        motors were recorded wrapped, and the gap rule cutting it (:func:`given_start`).
 
     Returns
     -------
@@ -123,6 +136,7 @@ def read_recordings(
         return read_torque_log(p, robot.n, columns=cmap, drop_invalid=drop_invalid, owner=owner)
 
     logs = tuple(in_file(p, lambda p=p: read(p)) for p in paths)  # type: ignore[misc]
+    logs = given_start(logs, [p.name for p in paths], robot, drive, q_start, max_gap_s)
     out = Recorded(logs, tuple(paths))
     check_limits(out, robot, drive)
     for name, log in zip(out.names, out.logs, strict=True):  # the time unit named first
@@ -130,6 +144,39 @@ def read_recordings(
             raise DataError(unit.removeprefix(f"{name}: "), file=name)
     check_units(out)
     return out
+
+
+def given_start(
+    logs: Sequence[TorqueLog],
+    names: Sequence[str],
+    robot: Robot,
+    drive: Drive | None,
+    q_start: Sequence[float] | None,
+    max_gap_s: float | None = None,
+) -> tuple[TorqueLog, ...]:
+    """The recordings with the whole turns of motors recorded wrapped set from the joint
+    positions ``q_start`` (n,) [rad] at the first sample (``--q-start``,
+    :func:`~dynid.identification.pieces.with_start_turns`; the pieces after a gap longer
+    than ``max_gap_s`` from the joints' limits); the recordings as they are without it.
+
+    Raises
+    ------
+    OptionError
+        ``q_start`` with several recordings (it is one log's first sample), without a
+        motor-side drive, of another joint count, or for a log whose motors did not wrap.
+    DataError
+        The turns are not told (:func:`~dynid.identification.pieces.start_turns`; the
+        file named).
+    """
+    if q_start is None:
+        return tuple(logs)
+    if len(logs) != 1:
+        raise OptionError(
+            f"gives the joint positions at the first sample of one recording; got {len(logs)} "
+            f"({', '.join(names)})",
+            field="q_start",
+        )
+    return (with_start_turns(names[0], logs[0], robot, drive, np.asarray(q_start), max_gap_s),)
 
 
 def _scales(log: TorqueLog) -> tuple[float, float]:

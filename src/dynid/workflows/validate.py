@@ -71,6 +71,10 @@ class ValidateOptions:
         pieces.
     drive : Drive, optional
         The drive the recordings were recorded through, for a model without one.
+    q_start : tuple of float, optional
+        Joint positions [rad] at the first sample of one motor-side recording whose motor
+        encoders wrap every turn: the motors' whole turns are those that put the joints
+        nearest them (:func:`~dynid.workflows.recordings.given_start`).
 
     Raises
     ------
@@ -85,6 +89,7 @@ class ValidateOptions:
     cutoff_hz: float | None = None
     max_gap_s: float | None = None
     drive: Drive | None = None
+    q_start: tuple[float, ...] | None = None
 
     def __post_init__(self) -> None:
         for name, what in (
@@ -207,6 +212,8 @@ def validate_files(
         cutoff_hz=opt.cutoff_hz,
         owner=f"the model ({label or robot.name})",
         drive=own if drive is None else drive,
+        q_start=opt.q_start,
+        max_gap_s=opt.max_gap_s,
     )
     friction, source = _friction(model, opt.friction, feasible, drive)
 

@@ -29,7 +29,8 @@ feasible parameters, say, for simulators) gives one ``<link>`` per link of the r
   ``<inertial>`` elements replaced (:func:`dynid.io.robot.urdf_patch.patch_urdf_inertials`).
 
 Gravity is not part of URDF; a friction model (``dynamics=``, :func:`export_urdf`) is
-written as ``<dynamics damping friction>`` per joint, the description's sigmoid is not.
+written as ``<dynamics damping friction>`` per joint, the description's sigmoid is not;
+reading takes it back as the robot's classical friction (:mod:`dynid.io.robot.urdf_parse`).
 Numbers use Python's
 shortest round-trip representation, so the parameters read back exactly.
 """
@@ -46,7 +47,7 @@ from numpy.typing import NDArray
 
 from ... import __version__, spatial
 from ...exceptions import DynidWarning, ModelError, ShapeError
-from ...friction.model import robot_friction, sigmoid_parameters
+from ...friction.model import Friction, robot_friction, sigmoid_parameters
 from ...friction.mujoco import drive_joint_terms, joint_coulomb_viscous
 from ...model.drive import Drive
 from ...model.inertia import inertia6_from_matrix
@@ -320,14 +321,16 @@ def export_urdf(path: str | Path, robot: Robot, options: ExportOptions) -> Path:
             notes += (f"{model.kind} friction: the velocity-independent offset has no URDF term",)
         if options.template is not None:
             notes = (
-                f"the {model.kind} friction is not written (a template's inertials alone are "
-                "replaced; its <dynamics> are kept as they are)",
+                ()
+                if _template_holds(options, dynamics)
+                else (
+                    f"the {model.kind} friction is not written (a template's inertials alone are "
+                    "replaced; its <dynamics> are kept as they are)",
+                )
             )
     drive = options.drive if options.drive is not None else getattr(model, "drive", None)
     notes += _rotor_note(drive)
-    if notes:  # one line: what URDF cannot hold
-        warnings.warn(f"URDF export: {'; '.join(notes)}", DynidWarning, stacklevel=2)
-    return save_urdf(
+    out = save_urdf(
         path,
         robot,
         all_frames=options.all_frames,
@@ -336,4 +339,29 @@ def export_urdf(path: str | Path, robot: Robot, options: ExportOptions) -> Path:
         tip=options.tip,
         merged=options.merged,
         dynamics=dynamics,
+    )
+    if notes:  # one line, once written: what URDF cannot hold
+        warnings.warn(f"URDF export: {'; '.join(notes)}", DynidWarning, stacklevel=2)
+    return out
+
+
+def _template_holds(
+    options: ExportOptions, dynamics: tuple[NDArray[np.float64], NDArray[np.float64]]
+) -> bool:
+    """Whether the template's chain already holds ``dynamics`` (damping, friction) in its
+    ``<dynamics>`` (a robot read from that template, say): then nothing is lost."""
+    assert options.template is not None
+    try:
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore", DynidWarning)
+            held = load_urdf(options.template, options.base, options.tip).friction
+    except ModelError:  # save_urdf names what is wrong with the template
+        return False
+    if held is None:
+        return not np.any(dynamics[0]) and not np.any(dynamics[1])
+    P = np.asarray(held.as_array() if isinstance(held, Friction) else 0.0)
+    return bool(
+        P.shape == (len(dynamics[0]), 3)
+        and np.array_equal(P[:, 0], dynamics[0])
+        and np.array_equal(P[:, 1], dynamics[1])
     )

@@ -29,9 +29,19 @@ Conventions
   attribute, gives ``-inf``/``inf``), ``velocity`` [rad/s or m/s] and ``effort``
   [N m or N] (missing or non-positive: ``inf``); URDF holds no acceleration limit, so
   ``ddq_max`` is ``inf``.
+* Joint friction: ``<dynamics damping friction>`` of a moving joint on the chain is read
+  as Pinocchio reads it (``model.damping``, ``model.friction``): ``damping`` the viscous
+  coefficient ``fv`` [N m s/rad or N s/m], ``friction`` the Coulomb level ``fc`` [N m or
+  N] (a missing attribute is 0). When some joint holds a non-zero value the robot's own
+  friction is the classical law at the joints, ``tau_f = fv dq + fc sign(dq)``
+  (:func:`~dynid.friction.model.ClassicalFriction`, no offset, no standstill band), and one
+  log line names those joints; zeros everywhere mean no friction. dynid's export writes
+  its friction there (:func:`~dynid.io.robot.urdf.export_urdf`), so it reads back. A
+  negative coefficient is refused.
 * Ignored: what is off the chain (other branches through moving joints, mimic joints off
-  the chain, transmissions, gazebo tags), visual and collision geometry, ``<dynamics>``,
-  ``<safety_controller>``.
+  the chain, transmissions, gazebo tags), visual and collision geometry, ``<dynamics>`` of
+  fixed joints, the other attributes of ``<dynamics>`` (Gazebo's ``K``, ``D``,
+  ``mu_coulomb``, ...), ``<safety_controller>``.
 """
 
 from __future__ import annotations
@@ -46,6 +56,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from ...exceptions import DynidWarning, ModelError, UnknownNameError
+from ...friction.model import ClassicalFriction, Friction
 from ...model.inertia import inertial_problems, phi_from_inertial
 from ...model.robot import MAX_LINK_MASS, MAX_LINK_OFFSET, Frame, Robot
 from ..input_files import file_bytes
@@ -146,6 +157,35 @@ def _limits(joint: _Joint) -> tuple[float, float, float, float]:
             v = None
         out.append(np.inf if v is None else v)
     return lo, hi, out[0], out[1]
+
+
+def _dynamics(joint: _Joint) -> tuple[float, float]:
+    """Viscous ``damping`` [N m s/rad or N s/m] and Coulomb ``friction`` [N m or N] of a
+    moving joint's ``<dynamics>`` (0 where absent), as Pinocchio reads them."""
+    el = _child(joint.elem, "dynamics")
+    if el is None:
+        return 0.0, 0.0
+    what = f"joint {joint.name!r} <dynamics>"
+    out = []
+    for attr in ("damping", "friction"):
+        v = _float(el, attr, what)
+        v = 0.0 if v is None else v
+        if not (np.isfinite(v) and v >= 0.0):
+            raise ModelError(
+                f"{what} attribute {attr!r} must be a finite number >= 0 (a dissipative "
+                f"joint); got {v!r}"
+            )
+        out.append(v)
+    return out[0], out[1]
+
+
+def _friction(w: _Walk) -> Friction | None:
+    """The chain's joint friction of ``<dynamics>`` (module docstring), None when every
+    coefficient is zero."""
+    fv_fc = np.array(w.dynamics, dtype=np.float64).reshape(-1, 2)
+    if not np.any(fv_fc != 0.0):
+        return None
+    return ClassicalFriction(fv_fc[:, 0], fv_fc[:, 1], np.zeros(len(fv_fc)))
 
 
 def robot_from_urdf_string(
@@ -297,13 +337,14 @@ class _Walk:
     axes: list[NDArray[np.float64]]
     prismatic: list[bool]
     limits: list[tuple[float, float, float, float]]
+    dynamics: list[tuple[float, float]]
     placed: dict[str, tuple[int, NDArray[np.float64]]]
     order: list[str]
 
 
 def _walk(path: list[_Joint], base_link: str, angles: AngleRounding) -> _Walk:
     """Walk the chain: fixed joints fold into the next joint's pose or the current body."""
-    w = _Walk([base_link], [], [], [], [], [], {base_link: (0, np.eye(4))}, [base_link])
+    w = _Walk([base_link], [], [], [], [], [], [], {base_link: (0, np.eye(4))}, [base_link])
     k, T_k_cur = 0, np.eye(4)
     for joint in path:
         T = T_k_cur @ _origin(joint.elem, f"joint {joint.name!r}", angles, joint.name)
@@ -315,6 +356,7 @@ def _walk(path: list[_Joint], base_link: str, angles: AngleRounding) -> _Walk:
             w.T_fix.append(T)
             w.prismatic.append(_MOVING[joint.type])
             w.limits.append(_limits(joint))
+            w.dynamics.append(_dynamics(joint))
             w.link_names.append(joint.child)
             k, T_k_cur = k + 1, np.eye(4)
         w.placed[joint.child] = (k, T_k_cur)
@@ -374,6 +416,19 @@ def _robot_from_text(
             warnings.warn(msg, DynidWarning, stacklevel=3)
         else:
             _log.info("%s", msg)
+    fr = robot.friction
+    if isinstance(fr, Friction):
+        held = [
+            name
+            for name, fv, fc in zip(robot.joint_names, fr.fv, fr.fc, strict=True)
+            if fv != 0.0 or fc != 0.0
+        ]
+        _log.info(
+            "%s: joint friction read from <dynamics> of joints %s (damping as viscous "
+            "N m s/rad, friction as Coulomb N m)",
+            source,
+            ", ".join(held),
+        )
     return robot
 
 
@@ -424,6 +479,7 @@ def _read_chain(
         ddq_max=np.full(n, np.inf),
         tau_max=lim[:, 3],
         frames=frames,
+        friction=_friction(w),
     )
 
 
