@@ -6,6 +6,7 @@ from __future__ import annotations
 import warnings
 
 import numpy as np
+import pytest
 
 from dynid.exceptions import DynidWarning
 from dynid.friction.model import ClassicalFriction
@@ -131,3 +132,23 @@ def test_with_rests_the_banded_coulomb_law_is_kept(panda):
     assert "coulomb" in chosen.info.selection["chosen"].split(" + ")
     assert errors[0] is not None and errors[1] is not None
     assert errors[0].relative_error_percent < 0.6 * errors[1].relative_error_percent
+
+
+@pytest.mark.parametrize("estimator", ["ols", "wls"])
+def test_a_streamed_log_is_judged_on_the_torques_as_measured_too(panda, monkeypatch, estimator):
+    """Recordings too long to stack (``DYNID_MAX_STACK_BYTES=0``: the regressor in blocks)
+    were judged on the low-passed torques, while stacked ones were judged as measured: the
+    same data chose by other errors. Streamed, every candidate's training and held-out
+    errors equal the stacked ones to 1e-9, and the same structure is chosen."""
+    fr = ClassicalFriction(np.linspace(0.6, 0.2, 7), np.linspace(3.0, 1.0, 7), np.zeros(7))
+    logs = recordings(panda, (61, 62), friction=fr, duration=6.0, noise=SensorNoise(dq_std=2e-3))
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", DynidWarning)
+        stacked = identify_recordings(panda, logs, estimator=estimator).info.selection
+        monkeypatch.setenv("DYNID_MAX_STACK_BYTES", "0")
+        streamed = identify_recordings(panda, logs, estimator=estimator).info.selection
+    assert streamed["chosen"] == stacked["chosen"]
+    for a, b in zip(streamed["candidates"], stacked["candidates"], strict=True):
+        assert a["name"] == b["name"]
+        for key in ("train_error_percent", "heldout_error_percent"):
+            assert a[key] == pytest.approx(b[key], rel=1e-9), (a["name"], key)

@@ -279,6 +279,15 @@ class Recordings:
             groups=np.concatenate([b.groups for b in parts]),
         )
 
+    def measured_blocks(self, robot: Robot, columns: ModelColumns) -> Iterator[RegressorBlock]:
+        """The rows of :meth:`blocks` in the same order, in blocks, with the torques as
+        measured and the columns that step at a reversal (Coulomb, smooth, Stribeck) as the
+        model applies them, not through the torques' low-pass: what a held-out recording
+        is judged on (a piece whose torques were not filtered: its own)."""
+        for p in self.pieces:
+            log = p.log if p.tau_raw is None else dataclasses.replace(p.log, tau=p.tau_raw)
+            yield from log_blocks(robot, log, columns, stream=True, cutoff_hz=None)
+
     def fold_labels(self, folds: int = DEFAULT_FOLDS) -> tuple[NDArray[np.intp], str]:
         """The held-out fold of every row (rows of :meth:`blocks`, in order) and how they
         were made: one recording left out at a time when there are several, else

@@ -64,7 +64,7 @@ from .log import TorqueLog
 from .metrics import noise_floor_percent
 from .model import IdentifiedModel
 from .recordings import Recordings, prepare_recordings
-from .streaming import normals_by_label
+from .streaming import BlockSource, normals_by_label
 from .structure import (
     ERROR_FLOOR_PERCENT,
     Structure,
@@ -104,7 +104,7 @@ def _judge(
     if validation is not None:
         how = "a separate recording"
     scheme = "recordings" if len(data.names) > 1 else "blocks"
-    raw = data.raw_offsets()
+    measured_ok = all(p.tau_raw is not None for p in data.pieces)
 
     def judge(
         stack: RegressorStack | StreamedRows,
@@ -116,19 +116,30 @@ def _judge(
         normals: Callable[[NDArray[np.intp]], tuple[Normals, ...]]
         measured: Callable[[NDArray[np.intp]], tuple[Normals, ...]] | None = None
         if isinstance(stack, StreamedRows) and stack.normals is not None and validation is None:
-            return replace(HeldOut.k_fold(stack.normals), scheme=scheme).expanded(cols)
+            assert labels is not None  # the fit gathered the folds' normals by these labels
+            judged = None
+            if measured_ok:  # judged on the torques as measured: one more pass
+                rows = selected_columns(_rows(data, robot, columns), cols)
+                judged = normals_by_label(rows, labels)
+            return replace(HeldOut.k_fold(stack.normals, judged), scheme=scheme).expanded(cols)
         if isinstance(stack, StreamedRows):  # rows in blocks: one pass per set of labels
             source = selected_columns(stack.source, cols)
             e = np.concatenate([y - W @ b for W, y, _ in source()])
             rw = estimator.row_weights(e, np.tile(np.arange(data.n), e.size // data.n), b.size)
             m = e.size
             normals = lambda lab: normals_by_label(source, lab, rw)  # noqa: E731
+            if measured_ok:  # judged on the torques as measured
+                rows = selected_columns(_rows(data, robot, columns), cols)
+                measured = lambda lab: normals_by_label(rows, lab, rw)  # noqa: E731
         else:
             W = stack.W if cols.all() else stack.W[:, cols]
             rw = row_weights(estimator, W, stack.y, stack.groups, b)
             Ww, yw, m = W * rw[:, None], stack.y * rw, stack.y.size
             normals = lambda lab: block_normals(Ww, yw, lab)  # noqa: E731
-            if raw is not None and raw.size == m:  # judged on the torques as measured
+            raw = data.raw_offsets() if measured_ok else None
+            if raw is not None:  # judged on the torques as measured
+                if raw.size != m:
+                    raise AssertionError(f"{raw.size} measured targets for {m} rows")
                 Wm = _measured_rows(data, columns, stack.W)
                 Wm = (Wm if cols.all() else Wm[:, cols]) * rw[:, None]
                 measured = lambda lab: block_normals(Wm, (stack.y + raw) * rw, lab)  # noqa: E731
@@ -143,6 +154,12 @@ def _judge(
         return held.expanded(cols)
 
     return judge, how, (labels if validation is None else None)
+
+
+def _rows(data: Recordings, robot: Robot, columns: ModelColumns) -> BlockSource:
+    """The recordings' rows as measured (:meth:`~.recordings.Recordings.measured_blocks`),
+    a source of blocks for a pass."""
+    return lambda: ((b.W, b.y, b.groups) for b in data.measured_blocks(robot, columns))
 
 
 def _measured_rows(
@@ -186,7 +203,9 @@ def _normals(
     W = np.concatenate([blk.W for blk in blocks])[:, cols]
     y = np.concatenate([blk.y for blk in blocks])
     raw = data.raw_offsets()
-    if raw is not None and raw.size == y.size:  # the torques as measured
+    if raw is not None:  # the torques as measured
+        if raw.size != y.size:
+            raise AssertionError(f"{raw.size} measured targets for {y.size} rows")
         W = _measured_rows(data, columns, np.concatenate([blk.W for blk in blocks]))[:, cols]
         y = y + raw
     g = np.concatenate([blk.groups for blk in blocks])
