@@ -18,7 +18,9 @@ with them before fitting (:func:`log_findings`). None of them changes the data.
   radians unless the velocities are too fast for radians (above the joint's ``dq_max``,
   or ``2 pi`` rad/s without one); an unwrapped continuous joint that turns several times
   is not degrees. Velocities ``180 / pi`` times slower than the derivative of ``q`` are
-  (``--units q=deg``; both in degrees: ``--units q=deg,dq=deg/s``).
+  (``--units q=deg``; both in degrees: ``--units q=deg,dq=deg/s``). Said first, and
+  instead of the sign and scale findings: the gravity torques at positions in degrees
+  say nothing of the torques' units.
 * **Milliseconds**: logged velocities ``1e3`` times the derivative of the positions (or a
   median time step of at least 0.5 s with integer steps when no velocities were logged):
   ``--units t=ms``.
@@ -183,9 +185,9 @@ def check_torque_log(robot: Robot, log: TorqueLog) -> list[str]:
     q, dq, tau, t = log.q[::step], log.dq[::step], log.tau[::step], log.t[::step]
     out: list[str] = []
     names = robot.joint_names
-    if np.any(robot.phi):  # the robot's own parameters: a model to compare with
+    out += _degrees(robot, log)  # first: the gravity torques at such positions say nothing
+    if np.any(robot.phi) and not out:  # the robot's own parameters: a model to compare with
         out += _sign_and_scale(robot, q, tau, names)
-    out += _degrees(robot, log)
     out += _milliseconds(log)
     frozen = ~moving_joints(log.dq)
     if np.any(frozen) and not np.all(frozen):
