@@ -137,8 +137,17 @@ def test_simulate_needs_sinusoids_for_a_robot_without_seven_joints(tmp_path, cap
         simulate_log(planar_2r(), SimulateOptions(duration_s=1.0))
     argv = ["simulate", "--robot", str(tmp_path / "two.toml"), "--duration", "1"]
     line = _refusal(capsys, [*argv, "--out", str(tmp_path / "x.csv")])
-    assert line.startswith("--amplitudes are needed") and "give --periods too" in line
+    assert line.startswith("--amplitudes and --periods are needed: the default sinusoids")
     assert line == option_message(api.value)
+    # one of the two given: the other is named as missing (it said "--amplitudes are
+    # needed" with --amplitudes given)
+    for given, missing in (("amplitudes", "periods"), ("periods", "amplitudes")):
+        with pytest.raises(OptionError) as api:
+            simulate_log(planar_2r(), SimulateOptions(duration_s=1.0, **{given: (1.0, 1.0)}))
+        assert api.value.field == missing
+        line = _refusal(capsys, [*argv, f"--{given}", "1,1", "--out", str(tmp_path / "x.csv")])
+        assert line.startswith(f"--{missing} is needed beside --{given}: the default")
+        assert line == option_message(api.value)
 
 
 def test_simulate_writes_the_log_of_the_api(tmp_path):

@@ -291,3 +291,40 @@ def test_a_message_naming_a_joint_twice_is_refused(tmp_path):
     path = write_bag(tmp_path / "bag", "mcap", msgs)
     with pytest.raises(DataError, match=r"bag: message 0 names joint\(s\) \['joint7'\] more"):
         load_joint_state_bag(path, robot.joint_names)
+
+
+def test_franka_ros_names_with_finger_joints_match_without_joints_option(tmp_path, capsys):
+    """franka_ros's ``panda_joint1..7`` and ``panda_finger_joint1/2``: the finger joints
+    also end in ``_joint1``/``_joint2`` and the import was refused as ambiguous ("--joints
+    NAME,..."); the prefix that matches every robot joint wins, the fingers are left out
+    with a note, and the log is the CSV's."""
+    robot = dynid.panda()
+    log = _small(robot)
+    names = [*_bag_names(robot), "panda_finger_joint1", "panda_finger_joint2"]
+    assert match_joints(robot.joint_names, names) == _bag_names(robot)
+    messages = [
+        (s, s, names, [*log.q[k], 0.02, 0.02], [*log.dq[k], 0.0, 0.0], [*log.tau[k], 0.0, 0.0])
+        for k, s in enumerate(T0_NS + int(round(x * 1e9)) for x in log.t)
+    ]
+    write_bag(tmp_path / "b", "sqlite3", messages)
+    res = load_joint_state_bag(tmp_path / "b", robot.joint_names)
+    for k in ("q", "dq", "tau"):
+        np.testing.assert_array_equal(getattr(res.log, k), getattr(log, k))
+    assert any(
+        "panda_finger_joint1, panda_finger_joint2 match no robot joint" in s for s in res.notes
+    )
+    out = tmp_path / "log.csv"
+    assert main(["import", str(tmp_path / "b"), "--robot", "panda", "--out", str(out)]) == 0
+    np.testing.assert_array_equal(load_torque_log(out).q, log.q)
+
+
+def test_an_ambiguous_or_missing_match_says_what_to_pass():
+    """The hint names the robot's joints in order and a --joints value to start from."""
+    with pytest.raises(
+        DataError,
+        match=r"--joints with the bag's name of each robot joint "
+        r"\(joint1, joint2\), in that order, e.g. --joints a_joint1,joint2",
+    ):
+        match_joints(("joint1", "joint2"), ["a_joint1", "b_joint1", "joint2"])
+    with pytest.raises(DataError, match=r"e.g. --joints A,B$"):
+        match_joints(("shoulder", "elbow"), ["A", "B", "C"])

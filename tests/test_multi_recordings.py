@@ -25,6 +25,7 @@ from dynid.simulation.trajectories import random_fourier
 from dynid.workflows.friction import FrictionOptions, fit_friction_files
 from dynid.workflows.identify import identify_files
 from dynid.workflows.payload import identify_payload_files
+from dynid.workflows.recordings import Recorded, check_limits
 from dynid.workflows.validate import ValidateOptions, validate_files
 
 NOISE = 0.05  # N m, the simulated torque sensor noise (SensorNoise's default)
@@ -260,13 +261,16 @@ def test_a_recording_in_other_units_is_named(panda, files, tmp_path, capsys):
 
 
 def test_a_recording_of_another_robot_is_named(panda, files, tmp_path):
-    """Positions far outside the Panda's joint limits (degrees, or another arm): a
-    warning naming the file."""
+    """Positions far outside the Panda's joint limits (another arm: shifted by 3 rad): a
+    warning naming the file; positions in degrees beside radians: refused, naming it."""
     log = load_torque_log(files / "rec2.csv")
+    far = type(log)(log.t, log.q + 3.0, log.dq, log.tau)
+    rec = Recorded((log, far), (files / "rec2.csv", tmp_path / "far.csv"))
+    with pytest.warns(DynidWarning, match="far.csv: joint .* far outside the limits of robot"):
+        check_limits(rec, panda, None)
     save_torque_log(tmp_path / "deg.csv", type(log)(log.t, np.degrees(log.q), log.dq, log.tau))
-    with pytest.warns(DynidWarning, match="deg.csv: joint .* far outside the limits of robot"):
-        with pytest.raises(DataError):  # its velocities disagree with its positions too
-            validate_files(panda, [files / "rec1.csv", tmp_path / "deg.csv"])
+    with pytest.raises(DataError, match="deg.csv: its positions look like degrees"):
+        validate_files(panda, [files / "rec1.csv", tmp_path / "deg.csv"])
 
 
 def test_a_piece_too_short_to_filter_is_named_and_a_recording_without_one_refused(

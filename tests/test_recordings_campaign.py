@@ -225,8 +225,8 @@ def test_identify_names_the_recording_its_findings_are_about(panda, logs, tmp_pa
 
 def test_observe_checks_its_recordings_as_the_other_commands(panda, logs, tmp_path, capsys):
     """observe calibrated its thresholds on a recording in mN m or in degrees beside good
-    ones without a word (thresholds 1000 times too large); now the one in other units is
-    refused and the one in degrees warned about, each naming the file."""
+    ones without a word (thresholds 1000 times too large); now each is refused, naming the
+    file."""
     model = tmp_path / "model"
     argv = ["identify", "--robot", "panda", "--no-figures", "--out", str(model), "--data"]
     with warnings.catch_warnings():
@@ -241,7 +241,7 @@ def test_observe_checks_its_recordings_as_the_other_commands(panda, logs, tmp_pa
     assert main([*run, str(mnm)]) == 2
     err = [s for s in capsys.readouterr().err.splitlines() if s.strip()]
     assert len(err) == 1 and "error: mnm.csv: its torques (RMS) are 1" in err[0], err
-    with pytest.warns(DynidWarning, match="deg.csv: joint .* far outside the limits of robot"):
+    with pytest.raises(DataError, match="deg.csv: its positions and velocities look like deg"):
         observe_files(
             ObserveOptions(
                 data=(logs / "rec1.csv", deg),

@@ -8,6 +8,7 @@ import numpy as np
 import pytest
 
 import dynid
+from dynid.dynamics.terms import gravity_torques
 from dynid.exceptions import DataError, DynidWarning
 from dynid.identification.classical import identify_from_log
 from dynid.identification.log import TorqueLog
@@ -143,3 +144,19 @@ def test_torque_spikes_are_found_where_they_were_put_and_named_with_the_file(pan
         prepare_recordings(robot, [spiked], names=["arm.csv"])
     text = " ".join(str(w.message) for w in got)
     assert f"{robot.joint_names[5]} 3" in text and f"{robot.joint_names[1]} 1" in text
+
+
+def test_a_log_at_rest_has_no_sign_or_scale_finding():
+    """The arm held at one pose (encoder and torque noise), pushed once (a contact of
+    5 N m on joint 2 for 0.5 s): the gravity torques vary by the encoder noise only, and
+    the scale finding said "3.31e+03 times the model's gravity torques ... currents logged
+    as torques" for such a UR10 log."""
+    robot = dynid.panda()
+    rng = np.random.default_rng(5)
+    N, q0 = 4000, np.asarray(robot.q_neutral if robot.q_neutral is not None else np.zeros(7))
+    q = q0 + rng.normal(0.0, 1e-8, (N, 7))  # a fine encoder: the gravity torques barely vary
+    tau = gravity_torques(robot, q0[None])[0] + rng.normal(0.0, 0.05, (N, 7))
+    t = np.arange(N) * 2e-3
+    tau[:, 1] += np.where((t > 3.0) & (t < 3.5), 5.0, 0.0)
+    log = TorqueLog(t, q, rng.normal(0.0, 2e-3, (N, 7)), tau)
+    assert check_torque_log(robot, log) == []

@@ -3,7 +3,9 @@
 BAG is a ROS 1 .bag file or a ROS 2 bag folder (sqlite3 or MCAP); reading needs the
 optional package rosbags (pip install 'dynid[ros]'). Joints are matched by name to the
 robot's: equal names, or one name preceded by a prefix ending in '_' (panda_joint1 matches
-joint1); otherwise give --joints with the bag's names in the robot's joint order. Times
+joint1; of several, the prefix matching the most robot joints, so panda_finger_joint1 is
+not taken for joint1); bag joints matching none (a gripper's) are left out, said in a
+note; otherwise give --joints with the bag's names in the robot's joint order. Times
 are header stamps (receive times when stamps are unset, said so), in seconds from the
 first message. Messages on other topics, missing joints or fields, NaN, out-of-order and
 repeated stamps are handled and counted. Without velocities in the bag they come from the

@@ -67,7 +67,8 @@ def format_identification(model: IdentifiedModel, *, width: int = 60) -> str:
         head.append("the residual is zero to rounding (exact data): standard deviations are 0")
     ho = info.heldout
     if ho:
-        head.append(heldout_line(dict(ho)))
+        effort = "torque" if model.drive is None else model.drive.effort
+        head.append(heldout_line(dict(ho), effort))
     if model.base.gap is not None:
         hi, lo = model.base.gap
         head.append(
@@ -285,8 +286,11 @@ def columns_text(model: IdentifiedModel) -> str:
     return f"columns: {cols}, rank {model.fit.rank} of {r + k}"
 
 
-def heldout_line(ho: dict[str, Any]) -> str:
-    """The training and held-out errors of least squares (``info.heldout``)."""
+def heldout_line(ho: dict[str, Any], effort: str = "torque") -> str:
+    """The training and held-out errors of least squares (``info.heldout``), and how many
+    times the noise floor of the measured torques (``effort="current"``: of the motor
+    currents the torques were read from) the held-out error is."""
+    measured = "motor currents'" if effort == "current" else "measured torques'"
     how = {
         "file": "on the --validate-on log",
         "recordings": f"leaving out each of {ho.get('folds')} recordings in turn",
@@ -295,7 +299,7 @@ def heldout_line(ho: dict[str, Any]) -> str:
     said = (
         ""
         if floor is None
-        else f"; {ho['heldout_error_percent'] / floor:.3g} x the torque sensors' noise floor "
+        else f"; {ho['heldout_error_percent'] / floor:.3g} x the {measured} noise floor "
         f"({floor:.3g} %)"
         if floor > 0
         else ""

@@ -11,14 +11,17 @@ with them before fitting (:func:`log_findings`). None of them changes the data.
 * **Scale**: the least-squares factor ``a`` in ``tau ~ a g(q)`` over the gravity-loaded
   joints; ``a`` near 1e3 or 1e-3 is a unit off by a power of ten (mN m against N m), and
   currents logged as torques show as a factor far from 1 (a drive file with
-  ``torque_constant``).
+  ``torque_constant``). Sign and scale compare variations: not made on a log at rest
+  (every joint frozen), whose variations are noise.
 * **Degrees**: positions whose range exceeds ``2 pi`` on a revolute joint while the range
   divided by ``180 / pi`` fits in the joint's limits, unless the velocities say otherwise:
   where ``dq`` agrees with the derivative of ``q`` (one unit for both) the positions are
   radians unless the velocities are too fast for radians (above the joint's ``dq_max``,
   or ``2 pi`` rad/s without one); an unwrapped continuous joint that turns several times
   is not degrees. Velocities ``180 / pi`` times slower than the derivative of ``q`` are
-  (``--units q=deg``; both in degrees: ``--units q=deg,dq=deg/s``).
+  (``--units q=deg``; both in degrees: ``--units q=deg,dq=deg/s``). Said first, and
+  instead of the sign and scale findings: the gravity torques at positions in degrees
+  say nothing of the torques' units.
 * **Milliseconds**: logged velocities ``1e3`` times the derivative of the positions (or a
   median time step of at least 0.5 s with integer steps when no velocities were logged):
   ``--units t=ms``.
@@ -183,11 +186,13 @@ def check_torque_log(robot: Robot, log: TorqueLog) -> list[str]:
     q, dq, tau, t = log.q[::step], log.dq[::step], log.tau[::step], log.t[::step]
     out: list[str] = []
     names = robot.joint_names
-    if np.any(robot.phi):  # the robot's own parameters: a model to compare with
-        out += _sign_and_scale(robot, q, tau, names)
-    out += _degrees(robot, log)
-    out += _milliseconds(log)
+    out += _degrees(robot, log)  # first: the gravity torques at such positions say nothing
     frozen = ~moving_joints(log.dq)
+    # the robot's own parameters: a model to compare with; at rest the torques' and the
+    # gravity torques' variations are noise, whose ratio says nothing of the units
+    if np.any(robot.phi) and not out and not np.all(frozen):
+        out += _sign_and_scale(robot, q, tau, names)
+    out += _milliseconds(log)
     if np.any(frozen) and not np.all(frozen):
         which = ", ".join(names[j] for j in np.flatnonzero(frozen))
         out.append(

@@ -6,9 +6,12 @@
 
 * **Joints by name.** Each message's ``name`` list may come in any order. A bag name
   matches a robot joint when the names are equal, or when one is the other preceded by a
-  prefix ending in ``_`` (``panda_joint1`` matches ``joint1``; see :func:`match_joints`).
-  A missing or ambiguous match is an error unless ``joints=`` names the bag's joints in
-  the robot's joint order.
+  prefix ending in ``_`` (``panda_joint1`` matches ``joint1``); of several, the equal
+  name, else the one whose prefix matches the most robot joints (franka_ros's
+  ``panda_finger_joint1`` does not take ``joint1`` from ``panda_joint1``; see
+  :func:`match_joints`). Bag joints that match no robot joint (fingers) are left out,
+  said in ``notes``. A missing or ambiguous match is an error unless ``joints=`` names the
+  bag's joints in the robot's joint order (the message gives the value to pass).
 * **Signals.** ``position`` -> ``q`` [rad or m], ``velocity`` -> ``dq``, ``effort`` ->
   ``tau`` [N m or N]. When no message carries velocities they come from the zero-phase
   filtered derivative of the positions (:func:`dynid.signals.filtered_derivative`), said
@@ -37,19 +40,41 @@ from ..exceptions import DataError
 from ..identification.log import DEFAULT_CUTOFF_HZ, TorqueLog
 from .input_files import regular_file
 
-__all__ = ["JOINT_STATE_TYPES", "BagImport", "match_joints", "load_joint_state_bag"]
+__all__ = [
+    "JOINT_STATE_TYPES",
+    "BagImport",
+    "load_joint_state_bag",
+    "match_joints",
+    "unused_joints",
+]
 
 JOINT_STATE_TYPES = ("sensor_msgs/msg/JointState", "sensor_msgs/JointState")
 
 
-def _same(a: str, b: str) -> bool:
-    return a == b or a.endswith("_" + b) or b.endswith("_" + a)
+def _prefix(bag: str, name: str) -> tuple[str, str] | None:
+    """How bag name ``bag`` matches robot joint ``name``: ``("", "")`` equal names,
+    ``("bag", p)`` the bag's name is ``p + name`` (``p`` ending in ``_``), ``("robot", p)``
+    the robot's is ``p + bag``; None: no match (whole ``_``-separated tokens only)."""
+    if bag == name:
+        return ("", "")
+    if bag.endswith("_" + name):
+        return ("bag", bag[: -len(name)])
+    if name.endswith("_" + bag):
+        return ("robot", name[: -len(bag)])
+    return None
 
 
 def match_joints(
     robot_joints: Sequence[str], bag_joints: Sequence[str], joints: Sequence[str] | None = None
 ) -> list[str]:
     """The bag's joint name for each robot joint, in the robot's order.
+
+    A bag name matches a robot joint when the names are equal, or when one is the other
+    preceded by a prefix ending in ``_`` (``panda_joint1`` matches ``joint1``). Where
+    several match (``panda_joint1`` and ``panda_finger_joint1`` for ``joint1``), the equal
+    name wins, else the one of the prefix that matches the most robot joints
+    (``panda_``: all seven; ``panda_finger_``: two). Bag joints that match no robot joint
+    (a gripper's) are left out (:func:`unused_joints`).
 
     Parameters
     ----------
@@ -68,7 +93,8 @@ def match_joints(
     ------
     DataError
         ``joints`` of the wrong length or naming a joint not in the bag; a robot joint
-        with no or several matching bag names (the message lists them; hint ``--joints``).
+        with no matching bag name, or several that the rule does not tell apart (the
+        message lists them and the ``--joints`` value to pass).
     """
     bag = list(dict.fromkeys(bag_joints))
     if joints is not None:
@@ -81,18 +107,45 @@ def match_joints(
         if unknown:
             raise DataError(f"joint(s) {unknown} not in the bag; the bag has {bag}")
         return joints
+    cands = {
+        name: {b: k for b in bag if (k := _prefix(b, name)) is not None} for name in robot_joints
+    }
+    reach: dict[tuple[str, str], int] = {}  # robot joints each prefix matches
+    for found in cands.values():
+        for k in set(found.values()):
+            reach[k] = reach.get(k, 0) + 1
     out = []
     for name in robot_joints:
-        exact = [b for b in bag if b == name]
-        cands = exact or [b for b in bag if _same(b, name)]
-        if len(cands) != 1:
-            what = "no" if not cands else f"several ({cands})"
+        found = cands[name]
+        best = [b for b, k in found.items() if k == ("", "")]
+        if not best and found:
+            top = max(reach[k] for k in found.values())
+            best = [b for b, k in found.items() if reach[k] == top]
+        if len(best) != 1:
+            what = "no" if not found else f"several ({list(found)})"
             raise DataError(
-                f"{what} bag joint(s) match robot joint {name!r}; the bag has {bag}; "
-                "hint: --joints NAME,... in the robot's joint order"
+                f"{what} bag joint(s) match robot joint {name!r}; the bag has {bag}; hint: "
+                f"--joints with the bag's name of each robot joint ({', '.join(robot_joints)}), "
+                f"in that order, e.g. --joints {_guess(robot_joints, bag, cands)}"
             )
-        out.append(cands[0])
+        out.append(best[0])
     return out
+
+
+def _guess(
+    robot_joints: Sequence[str], bag: list[str], cands: dict[str, dict[str, tuple[str, str]]]
+) -> str:
+    """A ``--joints`` value to start from: each robot joint's first match, else the bag's
+    name at its place."""
+    names = [
+        next(iter(cands[r]), bag[i] if i < len(bag) else r) for i, r in enumerate(robot_joints)
+    ]
+    return ",".join(names)
+
+
+def unused_joints(bag_joints: Sequence[str], used: Sequence[str]) -> list[str]:
+    """The bag's joints that no robot joint reads (a gripper's fingers), in bag order."""
+    return [b for b in dict.fromkeys(bag_joints) if b not in set(used)]
 
 
 @dataclass(frozen=True, slots=True)
@@ -353,6 +406,9 @@ def _assemble(
     mapping = match_joints(robot_joints, msgs.names(), joints)
     stamps = msgs.stamp[:n_msg]
     notes = []
+    extra = unused_joints(msgs.names(), mapping)
+    if extra:
+        notes.append(f"bag joint(s) {', '.join(extra)} match no robot joint: left out")
     if np.any(stamps == 0):
         stamps = msgs.recv[:n_msg]
         source = "receive"

@@ -171,6 +171,12 @@ class Drive:
         return int(self.transmission.shape[0])
 
     @property
+    def is_bare(self) -> bool:
+        """True for :meth:`identity`: ``K = 1``, no offsets, joint-side torques, no torque
+        constants or rotor inertias (a drive with nothing to write or to add)."""
+        return self.as_dict() == Drive.identity(self.n).as_dict()
+
+    @property
     def identifies_rotor_inertia(self) -> bool:
         """True when the rotor inertias are unknown (identified with the links)."""
         return self.rotor_inertia is None

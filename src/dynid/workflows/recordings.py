@@ -11,8 +11,11 @@ line naming the file, never a recording dropped silently:
 * a time column in ms, us or ns (:func:`~dynid.identification.sanity.time_unit_finding`):
   an error naming the file and ``--units t=ms``;
 * a recording in other units than the others (its torques, or its velocities against the
-  derivative of its positions, a power of ten away from the other recordings'): an error
-  naming it;
+  derivative of its positions on the joints that move, a power of ten away from the other
+  recordings'): an error naming it (a recording at rest has no velocity ratio to compare);
+* a recording in degrees among recordings in radians (positions and velocities both in
+  degrees pass the check above): an error naming it and the columns to convert
+  (:mod:`~dynid.identification.unit_mix`);
 * a recording whose positions lie far outside the model's joint limits (of another robot,
   or in degrees): a warning naming it.
 
@@ -32,7 +35,8 @@ import numpy as np
 from ..exceptions import DataError, DynidWarning, OptionError
 from ..identification.log import TorqueLog, joint_side_log
 from ..identification.pieces import with_start_turns
-from ..identification.sanity import time_unit_finding
+from ..identification.sanity import moving_joints, time_unit_finding
+from ..identification.unit_mix import degrees_among_radians
 from ..model.drive import Drive
 from ..model.robot import Robot
 from .data_files import (
@@ -47,6 +51,7 @@ from .data_files import (
 __all__ = [
     "UNIT_RATIO",
     "Recorded",
+    "check_degrees",
     "check_limits",
     "check_units",
     "given_start",
@@ -125,8 +130,8 @@ def read_recordings(
     ------
     DataError
         No file, a bad file, another joint count, invalid rows without ``drop_invalid``,
-        other columns than the model's, a recording in other units than the others (each
-        names the file).
+        other columns than the model's, a recording in other units than the others or in
+        degrees among recordings in radians (each names the file).
     """
     paths = data_files(data)
     names, units = recorded_columns(recorded, *(columns or (None, None)))
@@ -183,7 +188,9 @@ def _scales(log: TorqueLog) -> tuple[float, float]:
     """The RMS torque [N m] and ``k`` of ``d q / dt ~ k dq`` (1 when ``t``, ``q`` and
     ``dq`` share their units) of a log, on at most 20 000 samples. The positions'
     differences of half a turn or more (a continuous joint recorded wrapped into
-    [-pi, pi), a jump) are left out: they are not motion."""
+    [-pi, pi), a jump) are left out: they are not motion; so are the joints whose
+    velocities are their noise (a joint at rest: ``k`` of noise against noise, any
+    number); ``k`` is NaN when no joint moves."""
     step = max(1, log.n_samples // 20_000)
     t, q, dq, tau = log.t[::step], log.q[::step], log.dq[::step], log.tau[::step]
     rms = float(np.sqrt(np.mean(tau**2)))
@@ -191,7 +198,7 @@ def _scales(log: TorqueLog) -> tuple[float, float]:
         return rms, float("nan")
     dqdt = np.diff(q, axis=0) / np.diff(t)[:, None]
     mid = 0.5 * (dq[1:] + dq[:-1])
-    keep = np.abs(np.diff(q, axis=0)) < np.pi
+    keep = (np.abs(np.diff(q, axis=0)) < np.pi) & moving_joints(dq)
     num = float(np.sum(np.where(keep, dqdt * mid, 0.0)))
     den = float(np.sum(np.where(keep, mid * mid, 0.0)))
     return rms, num / den if den > 0 else float("nan")
@@ -235,13 +242,40 @@ def check_units(rec: Recorded) -> None:
             )
 
 
+def check_degrees(rec: Recorded, robot: Robot, drive: Drive | None) -> None:
+    """Refuse a recording in degrees among recordings in radians
+    (:func:`~dynid.identification.unit_mix.degrees_among_radians`), naming it.
+
+    Raises
+    ------
+    DataError
+        Naming the recording, the scales and the columns to convert.
+    """
+    logs = [_joint_side(log, drive) for log in rec.logs]
+    found = degrees_among_radians(robot, logs, rec.names, LIMIT_MARGIN)
+    if found is not None:
+        raise DataError(found[1], file=rec.names[found[0]])
+
+
+def _joint_side(log: TorqueLog, drive: Drive | None) -> TorqueLog:
+    return log if drive is None or drive.n != log.n else joint_side_log(log, drive)
+
+
 def check_limits(rec: Recorded, robot: Robot, drive: Drive | None) -> None:
-    """Warn about a recording whose (joint-side) positions lie far outside the joint
-    limits (:data:`LIMIT_MARGIN` beyond them), naming it."""
+    """Refuse a recording in degrees among recordings in radians (:func:`check_degrees`);
+    warn about a recording whose (joint-side) positions lie far outside the joint limits
+    (:data:`LIMIT_MARGIN` beyond them), naming it.
+
+    Raises
+    ------
+    DataError
+        A recording in degrees among recordings in radians.
+    """
+    check_degrees(rec, robot, drive)
     lo = np.asarray(robot.q_min) - LIMIT_MARGIN
     hi = np.asarray(robot.q_max) + LIMIT_MARGIN
     for name, log in zip(rec.names, rec.logs, strict=True):
-        q = log.q if drive is None or drive.n != log.n else joint_side_log(log, drive).q
+        q = _joint_side(log, drive).q
         qmin, qmax = np.min(q, axis=0), np.max(q, axis=0)
         bad = np.flatnonzero((qmin < lo) | (qmax > hi))
         if bad.size:

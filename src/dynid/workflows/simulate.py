@@ -294,11 +294,15 @@ def _trajectory(
         return lambda b: series(t[b]), t.size
     A, T = _per_joint(opt, "amplitudes", n), _per_joint(opt, "periods", n)
     if n != len(GAZ2019_SINUSOID_AMPLITUDES) and (A is None or T is None):
+        if A is None and T is None:
+            field, said, others = "amplitudes", "and {periods} are needed", ("periods",)
+        else:  # the one given needs the other
+            field, given = ("periods", "amplitudes") if T is None else ("amplitudes", "periods")
+            said, others = f"is needed beside {{{given}}}", (given,)
         raise OptionError(
-            f"are needed: the default sinusoids are for 7 joints; robot {robot.name!r} has "
-            f"{n} (give {{periods}} too)",
-            field="amplitudes",
-            others=("periods",),
+            f"{said}: the default sinusoids are for 7 joints; robot {robot.name!r} has {n}",
+            field=field,
+            others=others,
         )
     amp = np.asarray(GAZ2019_SINUSOID_AMPLITUDES if A is None else A, dtype=np.float64)
     per = np.asarray(GAZ2019_SINUSOID_PERIODS if T is None else T, dtype=np.float64)

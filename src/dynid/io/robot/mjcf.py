@@ -105,7 +105,8 @@ def _joint_terms(
     model = robot_friction(robot) if friction is True else friction or None
     if model is not None and model.n != n:
         raise ShapeError(f"friction has {model.n} joints; robot {robot.name!r} has {n}")
-    d = model.drive if model is not None and model.drive is not None else drive
+    own = None if model is None else model.drive  # a friction's own drive, if not bare
+    d = own if own is not None and not own.is_bare else drive
     notes: tuple[str, ...] = ()
     armature = None
     if d is not None:

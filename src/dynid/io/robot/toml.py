@@ -467,7 +467,9 @@ def toml_from_robot(
         robot = robot.with_friction(None if isinstance(held, FrictionSum) else held)
     sigmoid = sigmoid_parameters(held)
     if drive is None and held is not None and held.drive is not None:
-        drive = held.drive  # the drive the friction at the motors acts through
+        # the drive the friction acts through (none for a friction that only holds its
+        # place at the joints: the identity drive, which a description leaves out)
+        drive = None if held.drive.is_bare else held.drive
     out = [
         "# dynid robot description; schema: dynid.io.robot.toml",
         "# units: m, rad, kg, kg m^2, s; inertia about the CoM, in link axes",

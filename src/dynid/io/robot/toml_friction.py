@@ -13,6 +13,12 @@ joint (:mod:`dynid.io.law_friction`)::
     fo = [0.0, ...]         # N m
     standstill_band = [...] # rad/s, optional
 
+The place written is the one every command uses, whatever drive the torques are read
+through (the description's ``[drive]`` or another one given with the robot): the friction
+holds its place (a drive whose ``friction_at`` is ``at``), unlike the sigmoid per joint,
+which a drive places. Without ``at``: the ``[drive]`` table's ``friction_at`` when it
+writes one, else the joints.
+
 With friction at the motors and at the joints of a coupled drive (``at:both``), the joint
 part is ``[joint_friction]`` (same keys, ``at = "joint"``); a robot holds one friction, so
 reading such a file keeps ``[friction]`` and names the other in a warning.
@@ -20,6 +26,7 @@ reading such a file keeps ``[friction]`` and names the other in a warning.
 
 from __future__ import annotations
 
+import dataclasses
 import warnings
 from collections.abc import Mapping
 from typing import Any
@@ -27,6 +34,7 @@ from typing import Any
 from ...exceptions import DynidWarning
 from ...friction.laws import LAWS
 from ...friction.model import Friction, FrictionSum, friction_parts, sigmoid_parameters
+from ...model.drive import Drive
 from ..drive_file import drive_from_mapping
 from ..law_friction import law_friction, law_record
 from ..schema import Field, Record, fault
@@ -66,8 +74,9 @@ def friction_tables(friction: Friction | FrictionSum | None) -> str:
 
 
 def table_friction(doc: Mapping[str, Any], n: int, source: str) -> Friction | None:
-    """The friction of a description's ``[friction]`` table (through its ``[drive]`` table
-    when ``at = "motor"``), or None.
+    """The friction of a description's ``[friction]`` table where its ``at`` says (module
+    docstring): through its ``[drive]`` table at the motors, at the joints whatever drive
+    the robot is later used with; or None.
 
     Raises
     ------
@@ -87,11 +96,19 @@ def table_friction(doc: Mapping[str, Any], n: int, source: str) -> Friction | No
         raise fault(
             source, "friction", "give the sigmoid per joint or a [friction] table, not both"
         )
-    drive = None
-    if rec.get("at", "joint") == "motor":
-        if "drive" not in doc:
-            raise fault(source, "friction.at", '"motor" needs the [drive] table it acts through')
-        drive = drive_from_mapping(doc["drive"], n, source=f"{source} [drive]")
+    table = doc.get("drive")
+    at = rec.get("at")
+    if at is None:  # the [drive] table's place, else the joints
+        at = table.get("friction_at", "joint") if isinstance(table, Mapping) else "joint"
+    if at == "motor" and table is None:
+        raise fault(source, "friction.at", '"motor" needs the [drive] table it acts through')
+    # the friction holds its place: no other drive moves a friction written at the joints
+    drive = (
+        Drive.identity(n)
+        if table is None
+        else drive_from_mapping(table, n, source=f"{source} [drive]")
+    )
+    drive = dataclasses.replace(drive, friction_at=at)
     friction = law_friction(rec, drive, n, source, "friction")
     if "joint_friction" in doc:
         warnings.warn(

@@ -1,0 +1,106 @@
+"""A recording in degrees among recordings in radians, found before any fit.
+
+A recording whose positions and velocities are both in degrees passes the check of
+velocities against the derivative of the positions (one unit for both), and its torques
+are those of the others: alone among the checks across recordings, nothing says it is
+wrong, and the fit ends in a model that explains no recording (76 % training error on a
+Panda, exit 0). What gives it away is the scale of its positions against the others' and
+against the joint limits:
+
+* its positions lie outside the joint limits (beyond a margin) while divided by
+  ``180 / pi`` they fit them;
+* the other recordings' positions fit the limits as they are;
+* the RMS of its positions (revolute joints, about zero) is ``180 / pi`` times the others'
+  median, within a factor :data:`DEGREE_TOLERANCE` (one pose differs from another; a
+  recording of another robot or of a continuous joint that turns many times does not
+  scale so).
+
+The finding names which columns to convert: the positions, and the velocities when their
+RMS is also ``180 / pi`` times the others' (a velocity in radians beside positions in
+degrees also shows in :func:`dynid.workflows.recordings.check_units`).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+
+import numpy as np
+from numpy.typing import NDArray
+
+from ..model.robot import Robot
+from .log import TorqueLog
+
+__all__ = ["DEGREE_TOLERANCE", "degrees_among_radians"]
+
+#: A scale ratio within this factor of ``180 / pi`` reads as degrees against radians.
+DEGREE_TOLERANCE = 2.0
+_DEG = 180.0 / np.pi
+_MAX_SAMPLES = 20_000  # statistics: evenly spaced samples
+
+
+def _inside(q: NDArray[np.float64], robot: Robot, margin: float) -> bool:
+    """Whether positions (N, n) fit the joint limits within ``margin`` [rad or m]."""
+    lo = np.asarray(robot.q_min) - margin
+    hi = np.asarray(robot.q_max) + margin
+    return bool(np.all(q.min(axis=0) >= lo) and np.all(q.max(axis=0) <= hi))
+
+
+def _rms(x: NDArray[np.float64]) -> float:
+    return float(np.sqrt(np.mean(x**2))) if x.size else float("nan")
+
+
+def degrees_among_radians(
+    robot: Robot, logs: Sequence[TorqueLog], names: Sequence[str], margin: float
+) -> tuple[int, str] | None:
+    """The first recording that reads as degrees among recordings in radians (module
+    docstring), and the finding (one line, without the file's name); or None.
+
+    Parameters
+    ----------
+    robot : Robot
+        The model's robot (its joint limits [rad or m]).
+    logs : sequence of TorqueLog
+        Joint-side logs (motor angles turned into joint angles by the drive).
+    names : sequence of str
+        The recordings' names, for the finding.
+    margin : float
+        Margin [rad or m] beyond the joint limits before positions are outside them.
+    """
+    if len(logs) < 2:
+        return None
+    rev = ~np.asarray(robot.prismatic, dtype=bool)
+    if not np.any(rev):
+        return None
+    qs = [log.q[:: max(1, log.n_samples // _MAX_SAMPLES)] for log in logs]
+    dqs = [log.dq[:: max(1, log.n_samples // _MAX_SAMPLES)] for log in logs]
+    fits = [_inside(q, robot, margin) for q in qs]
+    q_rms = np.array([_rms(q[:, rev]) for q in qs])
+    dq_rms = np.array([_rms(dq[:, rev]) for dq in dqs])
+    for r, q in enumerate(qs):
+        others = [i for i in range(len(qs)) if i != r and fits[i]]
+        if fits[r] or not others:
+            continue
+        in_degrees = np.where(rev, q / _DEG, q)
+        if not _inside(in_degrees, robot, margin):
+            continue
+        k = q_rms[r] / float(np.median(q_rms[others]))
+        if not abs(np.log(k / _DEG)) <= np.log(DEGREE_TOLERANCE):
+            continue
+        kv = dq_rms[r] / float(np.median(dq_rms[others]))
+        both = abs(np.log(kv / _DEG)) <= np.log(DEGREE_TOLERANCE)
+        lo, hi = q.min(axis=0), q.max(axis=0)
+        j = int(np.argmax(np.maximum(robot.q_min - lo, hi - robot.q_max)))
+        who = [names[i] for i in others]
+        said = ", ".join(who) if len(who) <= 3 else "the other recordings"
+        what = "positions and velocities" if both else "positions"
+        cols = "q and dq" if both else "q"
+        return r, (
+            f"its {what} look like degrees among recordings in radians: positions "
+            f"{k:.3g} times those of {said}"
+            + (f" (velocities {kv:.3g} times)" if both else "")
+            + f", and joint {robot.joint_names[j]} spans [{lo[j]:.4g}, {hi[j]:.4g}], outside "
+            f"its limits [{robot.q_min[j]:.4g}, {robot.q_max[j]:.4g}] unless read in "
+            f"degrees; hint: convert its {cols} to radians (x pi/180) or leave it out "
+            "(--units applies to every file)"
+        )
+    return None
