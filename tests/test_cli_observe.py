@@ -190,10 +190,16 @@ def test_observe_thresholds_refuses_each_calibration_option_in_one_line(
 
 
 @pytest.mark.parametrize(
-    "extra, flag", [(["--frame", "flange"], "--frame"), (["--merge", "1"], "--merge")]
+    "extra, flag",
+    [
+        (["--frame", "flange"], "--frame"),
+        (["--merge", "1"], "--merge"),
+        (["--min-duration", "0"], "--min-duration"),
+    ],
 )
 def test_observe_calibrate_refuses_the_detection_options(tmp_path, capsys, extra, flag):
-    """--frame and --merge act on detection only: refused when calibrating."""
+    """--frame, --merge and --min-duration act on detection only: refused when
+    calibrating."""
     args = ["observe", "--params", "panda", "--calibrate", *extra]
     assert main([*args, "--data", str(tmp_path / "x.csv"), "--out", str(tmp_path)]) == 2
     (line,) = capsys.readouterr().err.strip().splitlines()

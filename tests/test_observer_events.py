@@ -15,8 +15,9 @@ from dynid.observer.events import EventDetector
 from dynid.observer.residual import ObserverOptions
 
 
-def _reference(t, r, contact, collision, merge_s, restarts):
-    """Events sample by sample: (start, end, joints, peak, level)."""
+def _reference(t, r, contact, collision, merge_s, restarts, min_duration_s=0.0):
+    """Events sample by sample: (start, end, joints, peak, level); those shorter than
+    ``min_duration_s`` at the contact level left out."""
     r = np.where(np.isfinite(r), r, 0.0)
     events, cur = [], None
     for k in range(t.shape[0]):
@@ -43,6 +44,8 @@ def _reference(t, r, contact, collision, merge_s, restarts):
                     best = k - a
             peak.append(float(r[a + best, j]))
         hit = np.any(np.abs(r[a:b]) > collision[a:b])
+        if t[b - 1] - t[a] < min_duration_s and not hit:
+            continue
         out.append((float(t[a]), float(t[b - 1]), tuple(sorted(e["joints"])), tuple(peak),
                     "collision" if hit else "contact"))  # fmt: skip
     return out
@@ -63,6 +66,7 @@ def test_events_fed_in_blocks_are_those_of_the_definition(block):
     r = 0.05 * rng.standard_normal((N, n))
     for a, size, j in ((100, 30, 0), (160, 5, 1), (400, 80, 2), (590, 30, 0), (700, 3, 1)):
         r[a : a + size, j] += rng.choice([-1, 1]) * rng.uniform(0.3, 1.2, size)
+    r[850:870, 2] += 0.35  # a contact-level burst
     r[450:470] = np.nan  # the observer did not run
     std = np.abs(0.02 * rng.standard_normal((N, n)))
     std[450:470] = np.nan
@@ -74,17 +78,62 @@ def test_events_fed_in_blocks_are_those_of_the_definition(block):
     )  # fmt: skip
     restarts = [0, 610]
     c = 3.0 * np.nan_to_num(std) + 0.15 + margin
-    want = _reference(t, r, c, 3.0 * (3.0 * np.nan_to_num(std) + 0.15) + margin, 0.05, restarts)
+    k = 3.0 * (3.0 * np.nan_to_num(std) + 0.15) + margin
+    want = _reference(t, r, c, k, 0.05, restarts, 0.01)
     assert len(want) >= 5 and {e[4] for e in want} == {"contact", "collision"}
-    det = EventDetector(th, merge_s=0.05, restarts=restarts)
+    raw = _reference(t, r, c, k, 0.05, restarts)
+    assert any(e[1] - e[0] < 0.01 for e in raw)  # some dropped
+    det = EventDetector(th, merge_s=0.05, min_duration_s=0.01, restarts=restarts)
     got = []
     for a in range(0, N, block):
         k = slice(a, a + block)
         got += det.feed(t[k], r[k], std=std[k], standstill=margin[k])
     got += det.finish()
     assert _as_tuples(got) == want
-    whole = detect(t, r, th, std=std, standstill=margin, merge_s=0.05, restarts=restarts)
+    whole = detect(
+        t, r, th, std=std, standstill=margin, merge_s=0.05, min_duration_s=0.01,
+        restarts=restarts,
+    )  # fmt: skip
     assert _as_tuples(whole) == want
+
+
+def test_one_push_near_a_flickering_threshold_is_one_event_starting_at_its_first_crossing():
+    """A 1 s step push of 1.2 N m on a joint at rest, through the observer's lag
+    K_O / (s + K_O) (closed form), with a threshold that jumps between 0.8 and 1.4 N m as
+    the standstill margin follows the velocity noise: raw (merge 0, no minimum) it is many
+    events; by default one, from the first crossing, which is the raw first event's start
+    (neither rule delays it) and the closed form's crossing of the threshold. One-sample noise
+    crossings are dropped, a one-sample crossing of the collision level kept."""
+    rng = np.random.default_rng(7)
+    fs, K, A, t0 = 500.0, 50.0, 1.2, 2.0
+    t = np.arange(0.0, 5.0, 1 / fs)
+    r = np.zeros((t.size, 2))
+    on = t >= t0
+    r[on, 0] = A * -np.expm1(-K * (t[on] - t0)) * (t[on] < t0 + 1.0)
+    off = t >= t0 + 1.0
+    r[off, 0] = r[off, 0] + A * -np.expm1(-K * 1.0) * np.exp(-K * (t[off] - t0 - 1.0))
+    r += 0.02 * rng.standard_normal(r.shape)
+    r[[200, 1900], 1] = 0.9  # one-sample noise crossings of joint 2 (contact level)
+    r[2300, 1] = 3.0  # one sample over its collision level
+    held = np.repeat(rng.random(t.size // 10) < 0.5, 10)[: t.size]  # 20 ms segments
+    margin = np.where(held, 0.6, 0.0)[:, None] * np.array([1.0, 0.0])
+    th = Thresholds(
+        contact=np.full(2, 0.8), collision=np.full(2, 2.0), margin=1.5, quantile=1.0,
+        collision_factor=2.5, options=ObserverOptions(), samples=1, standstill=True,
+    )  # fmt: skip
+    margin = np.broadcast_to(margin, r.shape)
+    raw = detect(t, r, th, standstill=margin, merge_s=0.0, min_duration_s=0.0)
+    default = detect(t, r, th, standstill=margin)
+    in_push = [e for e in default if t0 <= e.start <= t0 + 1.1]
+    assert len([e for e in raw if t0 <= e.start <= t0 + 1.1]) > 3
+    assert len(in_push) == 1 and in_push[0].start == min(e.start for e in raw if e.start >= t0)
+    lag = A * -np.expm1(-K * np.clip(t - t0, 0.0, None))  # the closed form, noise-free
+    crossing = t[np.argmax(lag > 0.8 + margin[:, 0])]  # of the threshold at each sample
+    assert abs(in_push[0].start - crossing) < 3 / fs
+    assert in_push[0].end > t0 + 0.9
+    others = [(e.start, e.level) for e in default if e not in in_push]
+    assert others == [(t[2300], "collision")]
+    assert {t[200], t[1900]} <= {e.start for e in raw}
 
 
 @pytest.fixture(scope="module")

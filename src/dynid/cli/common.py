@@ -45,6 +45,7 @@ FLAGS: dict[str, str] = {
     "contacts": "--contact",
     "law": "--friction-model",
     "merge_s": "--merge",
+    "min_duration_s": "--min-duration",
     "uncertainty": "--no-uncertainty",
     "standstill": "--no-standstill-margin",
 }
@@ -239,7 +240,7 @@ def add_drive_option(p: argparse.ArgumentParser) -> None:
         metavar="FILE.toml",
         help="drive train (schema dynid-drive/1: side, gear_ratio, coupling, offset, effort, "
         "torque_constant, rotor_inertia, friction_at; see the README); default: the [drive] "
-        "table of a --robot TOML, else link-side torques of a direct drive",
+        "table of a robot TOML (--robot, --params), else link-side torques of a direct drive",
     )
 
 

@@ -5,7 +5,9 @@ from the measured q, dq and tau, without accelerations: r = K_O (p - p_0 - integ
 (tau - tau_f + C^T dq - g + r)), p = M(q) dq, a first-order lag K_O / (s + K_O) of the
 true external torque on an exact model. The model is an identification.json (--model: its
 base parameters, rotor inertias, drive and friction) or a robot (--params: a
-feasible.json with its drive and friction, a URDF or TOML robot); --friction replaces the
+feasible.json with its drive and friction, a URDF, or a TOML robot with its [drive]
+table); --drive gives the drive of a robot without one (as validate takes it; another
+drive than the model's or the feasible.json's is refused); --friction replaces the
 friction (a friction.json of `dynid friction`, with its standstill band).
 
 Two steps:
@@ -20,16 +22,23 @@ Two steps:
   standstill margin; --no-standstill-margin turns it off). --gain,
   --discretisation and --rule choose the observer, which the thresholds keep.
   --thresholds thresholds.json on any logs writes OUT/events.json (dynid-events/1: start
-  and end [s], joints (1-based), peak [N m] per joint and level, contact or collision, of
-  every event), OUT/residuals.csv (t, r1..rn and, with --frame, the external wrench at
-  that frame by damped least squares) and OUT/residuals.png (residuals, thresholds,
-  events, and the true tau_ext that `dynid simulate --contact` writes beside a log; the
-  summary then gives the RMS of the residual against it per joint).
+  and end [s], joints (1-based) and joint_names, peak [N m] per joint and level, contact
+  or collision, and the log of every event), OUT/residuals.csv (t, r1..rn and, with
+  --frame, the external wrench at that frame by damped least squares, NaN where the
+  residual is) and OUT/residuals.png (residuals, thresholds, events, and the true
+  tau_ext that `dynid simulate --contact` writes beside a log; the summary then gives
+  the RMS of the residual against it per joint), and prints the largest |r| of each log.
+One contact is one event: runs over the threshold closer than --merge (0.2 s) are joined
+(a push near the threshold on a joint at rest crosses it again and again as the
+standstill margin follows the velocity noise), and an event shorter than --min-duration
+(0.01 s) that stays at the contact level is dropped (the velocity noise crosses for a
+few samples); neither delays an event's start. --merge 0 --min-duration 0: every run
+over the threshold.
 Several logs (or a folder of them): residuals_<name>.csv and .png each, one events.json;
 logs of one name in different folders are named by their folder. With --thresholds the
 calibration's options (--gain, --discretisation, --rule, --margin, --quantile,
 --collision-factor, --k-sigma, --no-uncertainty, --no-standstill-margin) are refused:
-the file fixes them; --frame and --merge apply to detection only.
+the file fixes them; --frame, --merge and --min-duration apply to detection only.
 
 Examples:
   dynid observe --model id/identification.json --data free.csv --calibrate --out cal
@@ -42,10 +51,12 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
+from ..observer.events import DEFAULT_MERGE_S, DEFAULT_MIN_DURATION_S
 from ..observer.residual import DEFAULT_GAIN
 from ..workflows.observe import ObserveOptions, observe_files
 from .common import (
     add_column_options,
+    add_drive_option,
     add_drop_invalid,
     add_q_start_option,
     add_subcommand,
@@ -76,6 +87,7 @@ def register(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParser:
     p.add_argument("--base", help="--params URDF: base link of the chain (default: the root)")
     p.add_argument("--tip", help="--params URDF: tip link of the chain (default: the only leaf)")
     p.add_argument("--friction", type=Path, help="friction.json replacing the model's friction")
+    add_drive_option(p)
     add_q_start_option(p)
     p.add_argument(
         "--data",
@@ -104,7 +116,21 @@ def register(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParser:
         action="store_true",
         help="calibrating: no margin for the friction inside the standstill band",
     )
-    p.add_argument("--merge", type=nonnegative_type, default=0.05, help="join events [s]")
+    p.add_argument(
+        "--merge",
+        type=nonnegative_type,
+        default=DEFAULT_MERGE_S,
+        metavar="SECONDS",
+        help=f"join runs over the threshold closer than this (default {DEFAULT_MERGE_S:g} s)",
+    )
+    p.add_argument(
+        "--min-duration",
+        type=nonnegative_type,
+        default=DEFAULT_MIN_DURATION_S,
+        metavar="SECONDS",
+        help="drop contact-level events shorter than this (default "
+        f"{DEFAULT_MIN_DURATION_S:g} s; 0 with --merge 0: every run over the threshold)",
+    )
     add_column_options(p)
     add_drop_invalid(p)
     p.add_argument(
@@ -127,12 +153,13 @@ def run(args: argparse.Namespace, console: Console) -> int:
     gain = parse_vector(args.gain, "--gain")
     opts = ObserveOptions(
         data=tuple(args.data), model=args.model, params=args.params, friction=args.friction,
+        drive=args.drive,
         calibrate=args.calibrate, thresholds=args.thresholds, frame=args.frame,
         gain=float(gain[0]) if gain.size == 1 else tuple(gain), discretisation=args.discretisation,
         rule=args.rule, margin=args.margin, quantile=args.quantile,
         collision_factor=args.collision_factor, k_sigma=args.k_sigma,
         uncertainty=not args.no_uncertainty, standstill=not args.no_standstill_margin,
-        merge_s=args.merge,
+        merge_s=args.merge, min_duration_s=args.min_duration,
         columns=(args.columns, args.units), drop_invalid=args.drop_invalid,
         max_gap=args.max_gap, base=args.base, tip=args.tip, q_start=args.q_start,
         # the series serve the figures only: a calibration's whole, a detection's strided

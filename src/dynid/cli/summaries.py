@@ -516,8 +516,9 @@ def format_observation(result: ObserveResult, names: list[str], *, calibrating: 
         read = "|r| read" if th.quantile == 1.0 else f"|r| q{th.quantile:g}"
         cols = {f"{read} [N m]": th.contact / th.margin}
     else:
-        peak = np.nanmax([x.largest() for x in result.logs], axis=0)
-        cols = {"max |r| [N m]": peak}
+        peaks = [x.largest() for x in result.logs]
+        one = len(peaks) == 1
+        cols = {("max |r| [N m]" if one else "max |r| all logs [N m]"): np.nanmax(peaks, axis=0)}
     cols |= {"contact [N m]": th.contact, "collision [N m]": th.collision}
     rest = undetected_at_rest(result.model, th)
     at_rest = calibrating and th.standstill and np.any(rest > th.contact)
@@ -561,6 +562,11 @@ def format_observation(result: ObserveResult, names: list[str], *, calibrating: 
         rows.append(f"calibrated on {th.samples} samples of {len(result.logs)} log(s)")
         return "\n".join(rows)
     labels = log_labels([x.path for x in result.logs])
+    if len(result.logs) > 1:  # the pooled column holds the contacts of every log
+        rows.append("max |r| per log [N m], joints in the table's order:")
+        width = max(map(len, labels))
+        for label, x in zip(labels, result.logs, strict=True):
+            rows.append(f"  {label:<{width}}  " + "  ".join(f"{v:8.4g}" for v in x.largest()))
     events = [(label, e) for x, label in zip(result.logs, labels, strict=True) for e in x.events]
     rows.append(f"{len(events)} event(s)")
     for log, e in events:

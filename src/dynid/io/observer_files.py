@@ -12,8 +12,10 @@
      "units": {...}}
 
 ``events.json`` (schema ``dynid-events/1``): ``events``, a list of ``{"start", "end"}``
-[s], ``joints`` (1-based), ``peak`` [N m] (one per joint, signed) and ``level``
-(``contact`` or ``collision``), with the data file, the sample count and the units.
+[s], ``joints`` (1-based) and ``joint_names`` (the same joints by name), ``peak`` [N m]
+(one per joint, signed), ``level`` (``contact`` or ``collision``) and ``log`` (the name
+of the event's log, one log or several), with the model's ``joints`` (names), the data
+files, their sample counts and the units.
 
 ``residuals.csv``: a dynid CSV table (comment lines, ``# rows: N``, a header) with ``t``
 [s], ``r1 .. rn`` [N m] and, with a frame, ``fx, fy, fz`` [N], ``mx, my, mz`` [N m] and
@@ -185,16 +187,20 @@ def save_events(
     *,
     meta: dict[str, Any] | None = None,
     logs: Sequence[str] | None = None,
+    joints: Sequence[str] | None = None,
 ) -> Path:
     """Write ``events.json`` (schema ``dynid-events/1``; ``logs``: each event's log name,
-    written as its ``log``); returns the path."""
+    written as its ``log``; ``joints``: the model's joint names, written beside the
+    model's and each event's 1-based joints); returns the path."""
     doc = {
         "dynid_version": __version__,
+        **({} if joints is None else {"joints": list(joints)}),
         "events": [
             {
                 "start": e.start,
                 "end": e.end,
                 "joints": list(e.joints),
+                **({} if joints is None else {"joint_names": [joints[j - 1] for j in e.joints]}),
                 "peak": list(e.peak),
                 "level": e.level,
                 **({} if logs is None else {"log": logs[k]}),
@@ -333,7 +339,7 @@ def save_observation(
     """The files of ``dynid observe`` in the folder ``out``; returns them.
 
     Calibrating: ``thresholds.json``. Detecting: ``events.json`` (every log's events, each
-    with its log's name when there are several) and, with ``residuals``, a residual table
+    with its log's name and its joints' names) and, with ``residuals``, a residual table
     per log from its series (:func:`observation_names`; False: written while observing,
     :class:`ResidualTables`).
     """
@@ -374,8 +380,6 @@ def save_observation(
     }
     paths.insert(
         0,
-        save_events(
-            out / "events.json", events, meta=info, logs=logs_of if len(result.logs) > 1 else None
-        ),
+        save_events(out / "events.json", events, meta=info, logs=logs_of, joints=joints),
     )
     return paths

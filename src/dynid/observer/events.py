@@ -8,6 +8,16 @@ threshold), the joints over it (1-based), the peak residual of every joint [N m]
 at its first largest magnitude between its start and end) and its level (``collision``
 when some joint passed its collision threshold).
 
+One contact is one event by default. A push near the threshold (a joint at rest, whose
+threshold rises and falls with the standstill margin as the velocity noise crosses the
+band) crosses it again and again: runs closer than :data:`DEFAULT_MERGE_S` (0.2 s) are
+one event. A crossing of a few samples is the velocity noise, which the residual passes
+unfiltered through ``M(q) dq``: an event shorter than :data:`DEFAULT_MIN_DURATION_S`
+(0.01 s from its first to its last sample over the threshold) is dropped unless it
+reached the collision level. Neither moves an event's start: it is the first sample over
+the threshold (a dropped run only goes unreported). ``merge_s = 0`` and
+``min_duration_s = 0`` give every run over the threshold as its own event.
+
 :class:`EventDetector` finds them a block of samples at a time: the event still open at
 the end of a block (its start, last sample over the threshold, peaks, joints and level)
 and the largest residual since its last sample over the threshold are carried to the
@@ -27,7 +37,13 @@ from .. import _checks
 from ..exceptions import OptionError, ShapeError
 from .thresholds import Thresholds, threshold_series
 
-__all__ = ["ContactEvent", "EventDetector", "detect"]
+__all__ = ["DEFAULT_MERGE_S", "DEFAULT_MIN_DURATION_S", "ContactEvent", "EventDetector", "detect"]
+
+#: Runs over the threshold closer than this [s] are one event (module docstring).
+DEFAULT_MERGE_S = 0.2
+#: Events shorter than this [s] (first to last sample over the threshold) are dropped
+#: unless they reached the collision level (module docstring).
+DEFAULT_MIN_DURATION_S = 0.01
 
 
 @dataclass(frozen=True, slots=True)
@@ -121,6 +137,8 @@ class EventDetector:
     thresholds : Thresholds
     merge_s : float
         Runs over the threshold closer than this [s] are one event (>= 0).
+    min_duration_s : float
+        Events shorter than this [s] at the contact level are dropped (>= 0).
     restarts : array_like of int, optional
         Samples of the log (counted from its first, over every block) where the observer
         started again (the first of each piece of a log cut at its gaps): no event spans
@@ -129,7 +147,7 @@ class EventDetector:
     Raises
     ------
     OptionError
-        A negative ``merge_s``.
+        A negative ``merge_s`` or ``min_duration_s``.
 
     Examples
     --------
@@ -139,11 +157,19 @@ class EventDetector:
     """
 
     def __init__(
-        self, thresholds: Thresholds, *, merge_s: float = 0.05, restarts: ArrayLike | None = None
+        self,
+        thresholds: Thresholds,
+        *,
+        merge_s: float = DEFAULT_MERGE_S,
+        min_duration_s: float = DEFAULT_MIN_DURATION_S,
+        restarts: ArrayLike | None = None,
     ) -> None:
         if not merge_s >= 0:
             raise OptionError(f"merge_s must be >= 0 [s]; got {merge_s}")
+        if not min_duration_s >= 0:
+            raise OptionError(f"min_duration_s must be >= 0 [s]; got {min_duration_s}")
         self.thresholds, self.merge_s = thresholds, float(merge_s)
+        self.min_duration_s = float(min_duration_s)
         self._restarts = np.sort(np.asarray([] if restarts is None else restarts, dtype=np.int64))
         self._next = 0  # the log's sample the next block starts at
         self._open: _Open | None = None
@@ -213,7 +239,7 @@ class EventDetector:
                 self._open.held = held
             else:
                 if self._open is not None:
-                    out.append(self._open.closed())
+                    out += self._closed(self._open)
                 self._open = _Open(
                     float(ta[a]), 0.0, 0, _Stretch.of(ra[a:b], over[a:b], beyond[a:b]),
                     _Stretch.empty(ra.shape[1]),
@@ -221,7 +247,7 @@ class EventDetector:
             self._open.last, self._open.piece = float(ta[b - 1]), int(piece[run[-1]])
             self._open.after = _Stretch.empty(ra.shape[1])
             if i < len(runs) - 1:
-                out.append(self._open.closed())
+                out += self._closed(self._open)
                 self._open = None
         assert self._open is not None
         b = int(hit[-1]) + 1
@@ -231,7 +257,14 @@ class EventDetector:
     def finish(self) -> list[ContactEvent]:
         """The event still open after the last block (none or one)."""
         done, self._open = self._open, None
-        return [] if done is None else [done.closed()]
+        return [] if done is None else self._closed(done)
+
+    def _closed(self, event: _Open) -> list[ContactEvent]:
+        """The event closed, or none when it is shorter than ``min_duration_s`` and
+        stayed at the contact level."""
+        if event.last - event.start < self.min_duration_s and not event.held.collision:
+            return []
+        return [event.closed()]
 
 
 def detect(
@@ -241,7 +274,8 @@ def detect(
     *,
     std: ArrayLike | None = None,
     standstill: ArrayLike | None = None,
-    merge_s: float = 0.05,
+    merge_s: float = DEFAULT_MERGE_S,
+    min_duration_s: float = DEFAULT_MIN_DURATION_S,
     restarts: ArrayLike | None = None,
 ) -> list[ContactEvent]:
     """Contact events of a whole residual (module docstring): :class:`EventDetector` fed
@@ -262,6 +296,8 @@ def detect(
         thresholds that use it).
     merge_s : float
         Runs over the threshold closer than this [s] are one event (>= 0).
+    min_duration_s : float
+        Events shorter than this [s] at the contact level are dropped (>= 0).
     restarts : array_like of int, optional
         Samples where the observer started again (the first of each piece of a log cut
         at its gaps): no event spans one.
@@ -276,7 +312,9 @@ def detect(
     ShapeError
         Shapes that disagree, thresholds of another joint count.
     OptionError
-        A negative ``merge_s``.
+        A negative ``merge_s`` or ``min_duration_s``.
     """
-    det = EventDetector(thresholds, merge_s=merge_s, restarts=restarts)
+    det = EventDetector(
+        thresholds, merge_s=merge_s, min_duration_s=min_duration_s, restarts=restarts
+    )
     return det.feed(t, r, std=std, standstill=standstill) + det.finish()

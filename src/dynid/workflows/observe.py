@@ -4,8 +4,11 @@ the command applies, so that the Python API behaves as the command does.
 * The model: an ``identification.json`` (``--model``; its own friction, drive and rotor
   inertias, and the covariance of its base parameters) or a robot (``--params``: a
   ``feasible.json`` with the drive and the friction identified with it, or a URDF/TOML
-  robot); ``--friction friction.json`` replaces the friction (the law ``dynid friction``
-  chose, with its standstill band).
+  robot, a TOML with the drive of its ``[drive]`` table); ``--friction friction.json``
+  replaces the friction (the law ``dynid friction`` chose, with its standstill band).
+  The drive is read as ``validate`` reads it: ``--drive`` for a robot without one (and
+  in place of a TOML's ``[drive]`` table), refused when it differs from the one an
+  identified model or a ``feasible.json`` holds (:func:`observer_drive`).
 * Logs are read strictly with the model's joint count (extra columns ignored, with a
   warning), through the column map the model's data were read with when none is given, and
   brought to the joint side through the model's drive. A log is cut at its gaps (steps
@@ -24,12 +27,15 @@ the command applies, so that the Python API behaves as the command does.
   out of the residuals they read and added to the thresholds (``standstill``, default on;
   :mod:`dynid.observer.detection`).
 * Otherwise the thresholds (``thresholds.json``) fix the observer (gains, discretisation,
-  rule) and the detection; the true external torques ``tau_ext1..n`` that
+  rule) and the detection; runs over the threshold closer than ``merge_s`` are one event
+  and contact-level events shorter than ``min_duration_s`` are dropped
+  (:mod:`dynid.observer.events`); the true external torques ``tau_ext1..n`` that
   ``dynid simulate --contact`` writes beside a log are kept for the figure.
 """
 
 from __future__ import annotations
 
+import dataclasses
 from collections.abc import Callable, Iterator, Mapping
 from dataclasses import dataclass
 from pathlib import Path
@@ -39,13 +45,17 @@ from numpy.typing import NDArray
 
 from ..exceptions import OptionError
 from ..exceptions import in_file as about_file
+from ..friction.fit import same_drive
 from ..friction.model import FrictionModel, FrictionSum
+from ..io.drive_file import drive_of_robot_file, load_drive
 from ..io.feasible import load_feasible_drive, load_feasible_linear_friction
 from ..io.friction_json import load_friction_json
 from ..io.model_json import load_model_json
 from ..io.observer_files import load_thresholds
 from ..io.robot_file import load_robot
+from ..model.drive import Drive
 from ..observer.detection import Thresholds, calibrate
+from ..observer.events import DEFAULT_MERGE_S, DEFAULT_MIN_DURATION_S
 from ..observer.model import ObserverModel, from_identified, from_robot
 from ..observer.residual import DEFAULT_GAIN, ObserverOptions
 from ..observer.results import LogObservation, ObserveResult
@@ -67,6 +77,7 @@ __all__ = [
     "ObserveResult",
     "load_observer_model",
     "observe_files",
+    "observer_drive",
 ]
 
 
@@ -85,6 +96,9 @@ class ObserveOptions:
         A robot: ``feasible.json``, a ``.urdf``/``.toml`` file or a built-in name.
     friction : Path, optional
         ``friction.json`` replacing the model's friction.
+    drive : Drive or Path, optional
+        The drive the logs were recorded through (a drive TOML, or a robot TOML with a
+        ``[drive]`` table), as ``validate`` takes it (:func:`observer_drive`).
     calibrate : bool
         Compute thresholds from ``data`` (collision-free logs).
     thresholds : Path, optional
@@ -104,7 +118,12 @@ class ObserveOptions:
         When calibrating: add the standstill margin of the model's friction to the
         thresholds (the thresholds keep the choice).
     merge_s : float
-        Events closer than this [s] are one.
+        Runs over the threshold closer than this [s] are one event
+        (:data:`~dynid.observer.events.DEFAULT_MERGE_S`).
+    min_duration_s : float
+        Contact-level events shorter than this [s] are dropped
+        (:data:`~dynid.observer.events.DEFAULT_MIN_DURATION_S`); ``merge_s = 0`` and
+        ``min_duration_s = 0``: every run over the threshold is an event.
     columns : (str or None, str or None)
         ``--columns``/``--units``; default: those the model's data were read with.
     drop_invalid : bool
@@ -133,6 +152,7 @@ class ObserveOptions:
     model: Path | None = None
     params: str | Path | None = None
     friction: Path | None = None
+    drive: Drive | Path | None = None
     calibrate: bool = False
     thresholds: Path | None = None
     frame: str | None = None
@@ -145,7 +165,8 @@ class ObserveOptions:
     k_sigma: float = 3.0
     uncertainty: bool = True
     standstill: bool = True
-    merge_s: float = 0.05
+    merge_s: float = DEFAULT_MERGE_S
+    min_duration_s: float = DEFAULT_MIN_DURATION_S
     columns: ColumnSpec = (None, None)
     drop_invalid: bool = False
     max_gap: float | None = None
@@ -163,10 +184,12 @@ def load_observer_model(
     *,
     base: str | None = None,
     tip: str | None = None,
+    drive: Drive | Path | None = None,
 ) -> tuple[ObserverModel, Mapping[str, str | None] | None]:
     """The observer model of ``--model`` or ``--params`` (and ``--friction``), with the
     column map the model's data were read with (None for a robot); ``base`` and ``tip``
-    choose the chain of a ``params`` URDF.
+    choose the chain of a ``params`` URDF; ``drive`` the one given (``--drive``,
+    :func:`observer_drive`).
 
     Raises
     ------
@@ -174,7 +197,8 @@ def load_observer_model(
         Neither or both of ``model`` and ``params``; ``base`` or ``tip`` with another
         model than a URDF.
     DataError
-        A file that is not what it should be (named).
+        A file that is not what it should be (named), a ``drive`` other than the one the
+        model or the ``feasible.json`` holds.
     """
     if (model is None) == (params is None):
         raise OptionError("give one of --model identification.json and --params ROBOT")
@@ -187,16 +211,46 @@ def load_observer_model(
     fr = "model" if friction is None else load_friction_json(friction)
     if model is not None:
         ident = load_model_json(model)
-        return from_identified(ident, fr), ident.info.column_map
+        held = ident.drive
+        own = same_drive(
+            _drive(drive, ident.robot.n), held, "the model", "the one the model was identified with"
+        )
+        obs = from_identified(ident, fr)
+        if own is not held:  # a model without one: its logs are read through it
+            obs = dataclasses.replace(obs, drive=own)
+        return obs, ident.info.column_map
     spec = str(params)
     robot = load_robot(spec, base=base, tip=tip, what="--params")
-    drive = None
+    if spec.lower().endswith(".json") and friction is None:
+        lin = load_feasible_linear_friction(spec)
+        fr = "robot" if lin is None else lin
+    own = observer_drive(spec, robot.n, drive)
+    return from_robot(robot, friction="robot" if fr == "model" else fr, drive=own), None
+
+
+def observer_drive(params: str | Path, n: int, drive: Drive | Path | None = None) -> Drive | None:
+    """The drive a ``--params`` robot's logs are read through, by ``validate``'s rule:
+    the one a ``feasible.json`` holds (``drive`` must then be the same), else ``drive``
+    (a :class:`~dynid.model.drive.Drive` or a TOML file of one), else the ``[drive]``
+    table of a robot TOML (its gear ratios, currents and rotor inertias), else none.
+
+    Raises
+    ------
+    DataError
+        An unreadable drive file, a ``drive`` that differs from the ``feasible.json``'s
+        (each field named).
+    """
+    given = _drive(drive, n)
+    spec = str(params)
     if spec.lower().endswith(".json"):
-        drive = load_feasible_drive(spec)
-        if friction is None:
-            lin = load_feasible_linear_friction(spec)
-            fr = "robot" if lin is None else lin
-    return from_robot(robot, friction="robot" if fr == "model" else fr, drive=drive), None
+        name = Path(spec).name
+        return same_drive(given, load_feasible_drive(spec), name, f"the one {name} holds")
+    return given if given is not None else drive_of_robot_file(spec, n)
+
+
+def _drive(drive: Drive | Path | None, n: int) -> Drive | None:
+    """A drive given as one or as a TOML file of one (for ``n`` joints)."""
+    return load_drive(drive, n) if isinstance(drive, str | Path) else drive
 
 
 #: The calibration's options, which a thresholds file fixes (with their defaults).
@@ -215,7 +269,8 @@ _CALIBRATION_FIELDS = (
 
 def _refuse_unused(opts: ObserveOptions) -> None:
     """Options that do not apply: the calibration's with ``thresholds`` (the file fixes
-    them), ``frame`` and ``merge_s`` when calibrating (no wrench or event is computed)."""
+    them), ``frame``, ``merge_s`` and ``min_duration_s`` when calibrating (no wrench or
+    event is computed)."""
     default = ObserveOptions(data=())
     if opts.thresholds is not None:
         for name in _CALIBRATION_FIELDS:
@@ -231,10 +286,12 @@ def _refuse_unused(opts: ObserveOptions) -> None:
             "thresholds only",
             field="frame",
         )
-    elif opts.merge_s != default.merge_s:
-        raise OptionError(
-            "applies when detecting (joins events); calibrating finds none", field="merge_s"
-        )
+    else:
+        for name in ("merge_s", "min_duration_s"):
+            if getattr(opts, name) != getattr(default, name):
+                raise OptionError(
+                    "applies when detecting (events); calibrating finds none", field=name
+                )
 
 
 def _observer_options(opts: ObserveOptions, thresholds: Thresholds | None) -> ObserverOptions:
@@ -269,7 +326,7 @@ def observe_files(opts: ObserveOptions, sink: ResidualSink | None = None) -> Obs
         raise OptionError("give --calibrate (collision-free logs) or --thresholds thresholds.json")
     _refuse_unused(opts)
     model, recorded = load_observer_model(
-        opts.model, opts.params, opts.friction, base=opts.base, tip=opts.tip
+        opts.model, opts.params, opts.friction, base=opts.base, tip=opts.tip, drive=opts.drive
     )
     given = None if opts.thresholds is None else load_thresholds(opts.thresholds)
     if given is not None and given.n != model.n:
@@ -305,6 +362,7 @@ def observe_files(opts: ObserveOptions, sink: ResidualSink | None = None) -> Obs
                 options,
                 wants=(wants_std, wants_margin),
                 merge_s=opts.merge_s,
+                min_duration_s=opts.min_duration_s,
                 frame=opts.frame,
                 keep_series=opts.keep_series,
                 figure_points=opts.figure_points,

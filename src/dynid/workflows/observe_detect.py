@@ -4,7 +4,8 @@ The observer runs over the log's pieces a block at a time
 (:func:`~dynid.workflows.observe_logs.observed_rows`, its state carried), and each block
 goes at once to the events (:class:`~dynid.observer.events.EventDetector`, the event open
 at a block's end carried), to the residual table of a ``sink`` (written a block at a
-time), to the wrench at ``frame`` and to running statistics (the largest residual, the
+time), to the wrench at ``frame`` (:func:`observed_wrench`: NaN where the observer did
+not run) and to running statistics (the largest residual, the
 error against the true external torques ``tau_ext`` of a simulated log, the largest
 standstill margin): a long log is detected with one block's temporaries. The
 full-length series are kept only when asked (``keep_series``, the Python API); a figure
@@ -33,7 +34,7 @@ from ..observer.wrench import WrenchEstimate, external_wrench
 from .data_files import in_file
 from .observe_logs import ObservedBlock, PreparedLog, Series, observed_rows
 
-__all__ = ["ResidualSink", "detected_log", "true_torques"]
+__all__ = ["ResidualSink", "detected_log", "observed_wrench", "true_torques"]
 
 
 class ResidualSink(Protocol):
@@ -69,17 +70,19 @@ def detected_log(
     *,
     wants: tuple[bool, bool],
     merge_s: float,
+    min_duration_s: float,
     frame: str | None,
     keep_series: bool,
     figure_points: int | None = None,
     table: AbstractContextManager[Callable[..., None] | None] | None = None,
 ) -> LogObservation:
-    """The events of one prepared log (module docstring), ``wants`` the residual's std and
+    """The events of one prepared log (module docstring; ``merge_s`` and ``min_duration_s``
+    of :class:`~dynid.observer.events.EventDetector`), ``wants`` the residual's std and
     the standstill margin, ``table`` the sink's writer of its residual table (or none);
     ``figure_points``: keep every k-th sample (at most that many) for a figure."""
     log, n = prep.log, model.n
     starts = tuple(a for a, _ in prep.spans)
-    det = EventDetector(thresholds, merge_s=merge_s, restarts=starts)
+    det = EventDetector(thresholds, merge_s=merge_s, min_duration_s=min_duration_s, restarts=starts)
     keep = Series.new(prep, n, *wants) if keep_series else None
     ext = in_file(prep.path, lambda: true_torques(prep, model, mapped))
     stats = _Running(n)
@@ -90,7 +93,7 @@ def detected_log(
         for blk in observed_rows(prep, model, options, *wants):
             a, b = blk.a, blk.a + blk.r.shape[0]
             events += det.feed(log.t[a:b], blk.r, std=blk.std, standstill=blk.margin)
-            w = None if frame is None else external_wrench(model.robot, log.q[a:b], blk.r, frame)
+            w = None if frame is None else observed_wrench(model, log.q[a:b], blk.r, frame)
             if put is not None:
                 put(log.t[a:b], blk.r, *((None, None) if w is None else (w.wrench, w.damped)))
             if w is not None and keep is not None:
@@ -116,6 +119,22 @@ def detected_log(
         truth_rms=stats.truth(),
         figure=None if strided is None else strided.series(),
     )
+
+
+def observed_wrench(model: ObserverModel, q: NDArray, r: NDArray, frame: str) -> WrenchEstimate:
+    """The external wrench at ``frame`` (:func:`~dynid.observer.wrench.external_wrench`)
+    of the samples the observer ran on; NaN wrench and ``sigma_min``, not flagged damped,
+    where the residual ``r`` (m, n) is NaN (not observed: a log's unobserved edges)."""
+    seen = np.all(np.isfinite(r), axis=1)
+    if seen.all():
+        return external_wrench(model.robot, q, r, frame)
+    m = r.shape[0]
+    wrench, smin = np.full((m, 6), np.nan), np.full(m, np.nan)
+    damped = np.zeros(m, dtype=bool)
+    if seen.any():
+        w = external_wrench(model.robot, q[seen], r[seen], frame)
+        wrench[seen], smin[seen], damped[seen] = w.wrench, w.sigma_min, w.damped
+    return WrenchEstimate(frame, wrench, smin, damped)
 
 
 def _joined(blocks: list[WrenchEstimate], frame: str | None) -> WrenchEstimate | None:
