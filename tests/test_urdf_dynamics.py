@@ -13,11 +13,12 @@ import pytest
 import dynid
 from dynid.cli.__main__ import main
 from dynid.exceptions import ModelError
-from dynid.friction.model import ClassicalFriction
+from dynid.friction.model import ClassicalFriction, robot_friction
 from dynid.identification.classical import identify_from_log
 from dynid.io.robot.export_options import ExportOptions
 from dynid.io.robot.toml import load_toml, save_toml
 from dynid.io.robot.urdf import export_urdf, load_urdf, robot_from_urdf_string
+from dynid.model.drive import Drive
 from dynid.simulation.measurement import SensorNoise, sample_times, simulate_measurement
 from dynid.simulation.trajectories import random_fourier
 
@@ -56,7 +57,7 @@ def test_export_then_load_gives_the_same_friction_as_pinocchio_reads(tmp_path, c
     with caplog.at_level(logging.INFO, logger="dynid.io.robot.urdf_parse"):
         robot = load_urdf(path)
     fr = robot.friction
-    assert fr.kind == "classical" and fr.drive is None
+    assert fr.kind == "classical" and fr.drive.is_bare and fr.drive.friction_at == "joint"
     np.testing.assert_allclose(fr.fv, FV, rtol=0, atol=1e-12)
     np.testing.assert_allclose(fr.fc, FC, rtol=0, atol=1e-12)
     np.testing.assert_array_equal(fr.fo, 0.0)
@@ -192,3 +193,15 @@ def test_identify_does_not_read_the_robots_friction(tmp_path):
     b = identify_from_log(robot.with_friction(None), log, cutoff_hz=None)
     np.testing.assert_array_equal(a.fit.beta, b.fit.beta)
     np.testing.assert_allclose(a.frictions[0].params[:, :2], np.c_[FV, FC], atol=1e-6)
+
+
+def test_the_urdf_friction_stays_at_the_joints_through_a_geared_drive(tmp_path):
+    """``<dynamics>`` is joint friction: read through a drive of gear ratio 50 (whose own
+    friction acts at the motors) it stays ``fv dq + fc sign(dq)`` at the joints; it was
+    placed at the motors, ``K^T f(K dq)``, 2500 times the viscous torque."""
+    robot = load_urdf(_arm(tmp_path))
+    drive = Drive.from_gears([50.0, 50.0])
+    assert drive.friction_at == "motor"
+    dq = np.array([[0.3, -0.2], [-0.05, 0.4]])
+    placed = robot_friction(robot, drive)
+    np.testing.assert_allclose(placed.torques(dq), FV * dq + FC * np.sign(dq), atol=1e-12)

@@ -33,7 +33,8 @@ Conventions
   as Pinocchio reads it (``model.damping``, ``model.friction``): ``damping`` the viscous
   coefficient ``fv`` [N m s/rad or N s/m], ``friction`` the Coulomb level ``fc`` [N m or
   N] (a missing attribute is 0). When some joint holds a non-zero value the robot's own
-  friction is the classical law at the joints, ``tau_f = fv dq + fc sign(dq)``
+  friction is the classical law at the joints (there whatever drive the robot is used
+  with), ``tau_f = fv dq + fc sign(dq)``
   (:func:`~dynid.friction.model.ClassicalFriction`, no offset, no standstill band), and one
   log line names those joints; zeros everywhere mean no friction. dynid's export writes
   its friction there (:func:`~dynid.io.robot.urdf.export_urdf`), so it reads back. A
@@ -46,6 +47,7 @@ Conventions
 
 from __future__ import annotations
 
+import dataclasses
 import logging
 import warnings
 import xml.etree.ElementTree as ET
@@ -57,6 +59,7 @@ from numpy.typing import NDArray
 
 from ...exceptions import DynidWarning, ModelError, UnknownNameError
 from ...friction.model import ClassicalFriction, Friction
+from ...model.drive import Drive
 from ...model.inertia import inertial_problems, phi_from_inertial
 from ...model.robot import MAX_LINK_MASS, MAX_LINK_OFFSET, Frame, Robot
 from ..input_files import file_bytes
@@ -185,7 +188,11 @@ def _friction(w: _Walk) -> Friction | None:
     fv_fc = np.array(w.dynamics, dtype=np.float64).reshape(-1, 2)
     if not np.any(fv_fc != 0.0):
         return None
-    return ClassicalFriction(fv_fc[:, 0], fv_fc[:, 1], np.zeros(len(fv_fc)))
+    n = len(fv_fc)
+    # at the joints, where the file puts it: a geared drive given later does not move it
+    # to the motors (a joint's damping read per motor, times the gear ratio squared)
+    at = dataclasses.replace(Drive.identity(n), friction_at="joint")
+    return ClassicalFriction(fv_fc[:, 0], fv_fc[:, 1], np.zeros(n)).at(at)
 
 
 def robot_from_urdf_string(
