@@ -23,7 +23,7 @@ from dynid.identification.model import IdentifiedModel
 from dynid.model.drive import Drive
 from dynid.regressors.base import base_parameters
 from dynid.simulation.measurement import SensorNoise, sample_times, simulate_measurement
-from dynid.simulation.trajectories import random_fourier
+from dynid.simulation.trajectories import Trajectory, random_fourier
 from dynid.simulation.unmodelled import UnmodelledEffects
 
 
@@ -195,3 +195,31 @@ def recordings(
             log = dataclasses.replace(log, tau=log.tau + added(log))
         logs.append(log)
     return logs
+
+
+def point_to_point(robot: dynid.Robot, seed: int, fs: float = 500.0) -> Trajectory:
+    """Eight moves between random configurations (quintic profiles of 1.2 s), each
+    followed by a rest of 1 s: the joints stand still more than a third of the time."""
+    rng = np.random.default_rng(seed)
+    lo, hi = np.asarray(robot.q_min), np.asarray(robot.q_max)
+    mid, span = (lo + hi) / 2, (hi - lo) / 2
+    q0 = mid + 0.3 * span * rng.uniform(-1, 1, robot.n)
+    s = np.arange(0.0, 1.2, 1 / fs) / 1.2
+    h = np.column_stack(
+        [
+            10 * s**3 - 15 * s**4 + 6 * s**5,
+            (30 * s**2 - 60 * s**3 + 30 * s**4) / 1.2,
+            (60 * s - 180 * s**2 + 120 * s**3) / 1.2**2,
+        ]
+    )
+    rest = int(fs)
+    parts = []
+    for _ in range(8):
+        q1 = mid + 0.5 * span * rng.uniform(-1, 1, robot.n)
+        d = q1 - q0
+        moving = [q0 + np.outer(h[:, 0], d), np.outer(h[:, 1], d), np.outer(h[:, 2], d)]
+        still = [np.tile(q1, (rest, 1)), np.zeros((rest, robot.n)), np.zeros((rest, robot.n))]
+        parts.append([np.vstack([m, r]) for m, r in zip(moving, still, strict=True)])
+        q0 = q1
+    q, dq, ddq = (np.vstack([p[k] for p in parts]) for k in range(3))
+    return Trajectory(np.arange(q.shape[0]) / fs, q, dq, ddq)

@@ -14,9 +14,9 @@ from dynid.friction.validation import own_friction, recorded_cutoff, validate_to
 from dynid.identification.selection import identify_recordings
 from dynid.identification.structure import Structure
 from dynid.simulation.measurement import SensorNoise, sample_times, simulate_measurement
-from dynid.simulation.trajectories import Trajectory, random_fourier
+from dynid.simulation.trajectories import random_fourier
 
-from conftest import recordings
+from conftest import point_to_point, recordings
 
 NOISE = 0.05  # N m, the simulated torque sensors' noise
 
@@ -79,34 +79,6 @@ def test_a_sharp_coulomb_law_is_predicted_through_noisy_velocities_by_a_narrow_s
 _SHARP = ("viscous", "coulomb")
 
 
-def _point_to_point(robot, seed: int, fs: float = 500.0) -> Trajectory:
-    """Eight moves between random configurations (quintic profiles of 1.2 s), each
-    followed by a rest of 1 s: the joints stand still more than a third of the time."""
-    rng = np.random.default_rng(seed)
-    lo, hi = np.asarray(robot.q_min), np.asarray(robot.q_max)
-    mid, span = (lo + hi) / 2, (hi - lo) / 2
-    q0 = mid + 0.3 * span * rng.uniform(-1, 1, robot.n)
-    s = np.arange(0.0, 1.2, 1 / fs) / 1.2
-    h = np.column_stack(
-        [
-            10 * s**3 - 15 * s**4 + 6 * s**5,
-            (30 * s**2 - 60 * s**3 + 30 * s**4) / 1.2,
-            (60 * s - 180 * s**2 + 120 * s**3) / 1.2**2,
-        ]
-    )
-    rest = int(fs)
-    parts = []
-    for _ in range(8):
-        q1 = mid + 0.5 * span * rng.uniform(-1, 1, robot.n)
-        d = q1 - q0
-        moving = [q0 + np.outer(h[:, 0], d), np.outer(h[:, 1], d), np.outer(h[:, 2], d)]
-        still = [np.tile(q1, (rest, 1)), np.zeros((rest, robot.n)), np.zeros((rest, robot.n))]
-        parts.append([np.vstack([m, r]) for m, r in zip(moving, still, strict=True)])
-        q0 = q1
-    q, dq, ddq = (np.vstack([p[k] for p in parts]) for k in range(3))
-    return Trajectory(np.arange(q.shape[0]) / fs, q, dq, ddq)
-
-
 def test_with_rests_the_banded_coulomb_law_is_kept(panda):
     """The same sharp friction and velocity noise on point-to-point motion with rests: at
     rest the smooth sign of the noise puts up to the whole Coulomb torque on a joint
@@ -116,7 +88,7 @@ def test_with_rests_the_banded_coulomb_law_is_kept(panda):
     noise = SensorNoise(dq_std=2e-3)
     *logs, test = [
         simulate_measurement(
-            panda, _point_to_point(panda, s), rng=np.random.default_rng(s + 100), noise=noise,
+            panda, point_to_point(panda, s), rng=np.random.default_rng(s + 100), noise=noise,
             friction=fr,
         )
         for s in (1, 2, 3, 4)

@@ -47,9 +47,13 @@ from numpy.typing import ArrayLike, NDArray
 
 from .. import _checks
 from ..exceptions import DataError, OptionError, ShapeError
-from ..identification.log import DEFAULT_CUTOFF_HZ
 from .events import ContactEvent, EventDetector, detect
-from .friction import derived_velocity_bands, standstill_margin, velocity_bands
+from .friction import (
+    DERIVED_CUTOFF_HZ,
+    derived_velocity_bands,
+    standstill_margin,
+    velocity_bands,
+)
 from .model import ObserverModel
 from .residual import DEFAULT_OPTIONS, ObserverOptions, first_order_lag
 from .terms import base_momentum_regressor
@@ -167,7 +171,7 @@ def standstill_series(
     options: ObserverOptions = DEFAULT_OPTIONS,
     *,
     q: ArrayLike | None = None,
-    cutoff_hz: float = DEFAULT_CUTOFF_HZ,
+    cutoff_hz: float = DERIVED_CUTOFF_HZ,
 ) -> NDArray[np.float64]:
     """The standstill margin (N, n) [N m] of the model's friction at the velocities ``dq``
     (N, n) [rad/s], through the observer's lag ``K_O/(s + K_O)`` over the times ``t`` (N,)

@@ -23,10 +23,10 @@ from numpy.typing import NDArray
 
 from ..exceptions import DataError, DynidWarning
 from ..exceptions import in_file as about_file
-from ..identification.log import DEFAULT_CUTOFF_HZ, TorqueLog, default_max_gap, joint_side_log
+from ..identification.log import TorqueLog, default_max_gap, joint_side_log
 from ..identification.pieces import unwrapped, with_start_turns, wrappable
 from ..observer.detection import residual_std_blocks, standstill_blocks
-from ..observer.friction import derived_velocity_bands
+from ..observer.friction import DERIVED_CUTOFF_HZ, derived_velocity_bands
 from ..observer.model import ObserverModel
 from ..observer.pieces import PositionJump, pieces, position_jumps
 from ..observer.residual import MomentumObserver, ObserverOptions
@@ -190,7 +190,7 @@ def _bands(prep: PreparedLog, model: ObserverModel, a: int, b: int) -> dict[str,
         return {}
     t, q = prep.log.t[a:b], prep.log.q[a:b]
     return {
-        "bands": derived_velocity_bands(model.friction, t, q, DEFAULT_CUTOFF_HZ),
+        "bands": derived_velocity_bands(model.friction, t, q, DERIVED_CUTOFF_HZ),
         "derived": True,
     }
 
@@ -225,7 +225,7 @@ def _piece_velocities(log: TorqueLog, starts: list[int]) -> NDArray[np.float64]:
     dq = np.array(log.dq)
     for a, b in zip(starts, [*starts[1:], log.t.shape[0]], strict=True):
         try:
-            dq[a:b] = filtered_derivative(log.t[a:b], log.q[a:b], DEFAULT_CUTOFF_HZ)
+            dq[a:b] = filtered_derivative(log.t[a:b], log.q[a:b], DERIVED_CUTOFF_HZ)
         except DataError:  # too short to filter: its span is not observed
             dq[a:b] = np.nan
     return dq
@@ -238,7 +238,7 @@ def _observed_spans(path: Path, log: TorqueLog, starts: list[int]) -> list[tuple
     ends = [*starts[1:], log.t.shape[0]]
     if not log.dq_derived:
         return list(zip(starts, ends, strict=True))
-    edge = edge_seconds(DEFAULT_CUTOFF_HZ)
+    edge = edge_seconds(DERIVED_CUTOFF_HZ)
     spans = []
     for a, b in zip(starts, ends, strict=True):
         t = log.t[a:b]
