@@ -248,7 +248,10 @@ def _observed_spans(path: Path, log: TorqueLog, starts: list[int]) -> list[tuple
     warnings.warn(
         f"{path.name}: velocities derived from the positions of each piece: the first and "
         f"last {edge:g} s of each piece (the low-pass's transient) are not observed (NaN "
-        "residuals)" + ("" if spans else "; no piece is long enough: nothing is observed"),
+        "residuals)"
+        + ("" if spans else "; no piece is long enough: nothing is observed")
+        + "; the low-pass is zero-phase (it sees ahead), so detection delays are shorter "
+        "than an online observer's",
         DynidWarning,
         stacklevel=4,
     )
