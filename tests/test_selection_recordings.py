@@ -55,7 +55,9 @@ def test_a_recording_with_a_contact_is_named_and_does_not_decide_the_structure(p
     assert sel["outlying_recordings"] == ["hit.csv"]
     assert any(m.startswith("hit.csv: held-out error") for m in said)
     # the friction the clean recordings hold is kept: the choice of the clean recordings
-    assert sel["chosen"] == ref["chosen"]
+    # (its terms; a single joint's coefficient may go either way, the final fit holding
+    # the contact too)
+    assert sel["chosen"].split(" - ")[0] == ref["chosen"].split(" - ")[0]
     assert "viscous" in sel["chosen"]
     per = {r["file"]: r["heldout_error_percent"] for r in sel["heldout_per_recording"]}
     assert list(per) == ["a.csv", "b.csv", "c.csv", "hit.csv"]

@@ -69,8 +69,11 @@ FRICTION_LADDER: tuple[tuple[str, ...], ...] = (
 #: reaches 76 % of ``fc`` at ``dq = w``. The narrowest (0.3 bands: about the velocity
 #: noise's standard deviation) predicts a sharp Coulomb law best where the velocity
 #: crosses zero in motion (the expected sign given the noise); the standstill band of
-#: ``coulomb`` best at rest; the held-out data choose.
-SMOOTH_WIDTHS = (0.3, 1.0, 3.0, 10.0)
+#: ``coulomb`` best at rest; the held-out data choose. The widest (30 to 300 bands: 0.045
+#: to 0.45 rad/s at a band of 1.5 mrad/s) are the friction's own rounding, as in the
+#: sigmoid of the Panda's published model (``tanh(phi2 dq / 2)``: ``2 / phi2`` of 0.12 to
+#: 0.39 rad/s).
+SMOOTH_WIDTHS = (0.3, 1.0, 3.0, 10.0, 30.0, 100.0, 300.0)
 #: Stribeck velocities [rad/s] of the Stribeck candidates.
 STRIBECK_VELOCITIES = (0.02, 0.05, 0.1, 0.2)
 #: Smallest smooth width [rad/s] (a noise-free log has no standstill band).
