@@ -181,7 +181,10 @@ def test_identified_classical_friction_is_written_as_it_is():
     """Classical fv, fc go to damping and frictionloss exactly; the offset fo is reported."""
     robot = dynid.panda()
     fr = dynid.ClassicalFriction(np.linspace(0.1, 0.7, 7), np.linspace(0.2, 0.8, 7), np.ones(7))
-    text, approx = mjcf_from_robot(robot, friction=fr)
+    from dynid.exceptions import DynidWarning
+
+    with pytest.warns(DynidWarning, match=r"offsets fo \(up to \+1 N m"):
+        text, approx = mjcf_from_robot(robot, friction=fr)
     model = mujoco.MjModel.from_xml_string(text)
     np.testing.assert_array_equal(model.dof_damping, fr.fv)
     np.testing.assert_array_equal(model.dof_frictionloss, fr.fc)

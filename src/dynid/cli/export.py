@@ -6,8 +6,10 @@ comes from --format or the suffix of --out (.urdf, .xml/.mjcf, .toml).
 
 URDF without a template: the chain with the source robot's link and joint names. With
 --urdf-template ORIGINAL.urdf (and --base/--tip for its chain): the original file written
-back with only the chain's <inertial> elements replaced; names, meshes, other links, the
-gripper and <dynamics> are kept. Links fixed to a moving link (a hand): they keep their
+back with only the chain's <inertial> elements and the damping and friction of its joints'
+<dynamics> replaced (read back, a vendor's <dynamics> would be the robot's friction;
+removed, and said so, when no friction is written); names, meshes, other links and the
+gripper are kept. Links fixed to a moving link (a hand): they keep their
 inertials and the moving link gets the rest of the identified body (--merged subtract,
 default: the body was identified with them); they keep their inertials and the moving link
 gets the whole identified body (--merged keep: identified without them, such as a Panda
@@ -21,9 +23,11 @@ velocity range); --no-friction for frictionless joints. A drive (feasible.json's
 TOML's [drive] table, or --drive) adds its rotor inertias as armature and reflects friction
 at the motors to the joints; what MJCF cannot hold (a coupled rotor's off-diagonal inertia)
 is named in a warning. TOML keeps the drive as a [drive] table and the identified friction
-as a [friction] table. URDF holds per joint damping and friction (<dynamics>, the chain
-export only); what it cannot hold (the rotor inertias, an offset, a coupled drive's
-off-diagonal terms) is named in one warning.
+as a [friction] table (exactly, as feasible.json does). URDF holds per joint damping and
+sharp Coulomb friction (<dynamics>); MJCF and URDF name in one warning what they cannot
+hold of the friction (a smooth law's rounding, a standstill band, the offsets, a Stribeck
+peak, a quadratic term, an asymmetry, friction at the motors, a coupled drive's
+off-diagonal terms) and of the drive (URDF: the rotor inertias).
 
 examples:
   dynid export --params feasible/feasible.json --out panda.xml
@@ -80,7 +84,11 @@ def register(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParser:
         "moving link gets the rest of the body (subtract, default) or the whole body (keep: "
         "identified without them), or they give theirs to it (move)",
     )
-    p.add_argument("--no-friction", action="store_true", help="MJCF: frictionless joints")
+    p.add_argument(
+        "--no-friction",
+        action="store_true",
+        help="no friction: frictionless MJCF joints; URDF without <dynamics> friction",
+    )
     p.add_argument("--all-frames", action="store_true", help="URDF chain: every named frame")
     add_drive_option(p)
     return p

@@ -4,16 +4,19 @@ The residual tau_measured - (M ddq + c + g) of the model (an identification.json
 robot's own link parameters with --robot) is fitted per joint by a friction law:
 --friction-model auto (default) fits every law of the registry (listed below, with none:
 no extra friction) on 4 of 5 contiguous blocks of the log in turn (with several
-recordings: on all but one recording in turn), predicts the block left out, keeps the law
-with the lowest held-out error (the model's own friction is a candidate too, its law
-refitted and judged on the same blocks) and prints the table; a law's name fits that
-law. --data takes several recordings (or a folder of them): each recording, and each
-piece of one cut at a gap longer than --max-gap, is filtered on its own, and the laws are
-fitted on the residual of all pieces together. Coulomb friction is off where |dq| is
-inside the velocity noise band. The states are low-pass filtered with zero phase
-(--cutoff) and the accelerations differentiated from the filtered velocities. With a
-drive (--drive, or the model's own) the log is read through it and the law is fitted per
-motor at the motor velocities where the drive's friction acts there (tau_f = K^T f(K dq)).
+recordings: on all but one recording in turn), predicts the block left out, keeps the
+law with the lowest held-out error (the model's own friction is a candidate too, judged
+on the same blocks: as it is, or its law refitted on the other blocks when --model was
+identified from these recordings; a robot's own friction is never refitted) and prints
+the table; a law's name fits that law. --data takes several recordings (or a folder of
+them): each recording, and each piece of one cut at a gap longer than --max-gap, is
+filtered on its own, and the laws are fitted on the residual of all pieces together.
+Coulomb friction is off where |dq| is inside the velocity noise band. The states are
+low-pass filtered with zero phase (--cutoff) and the accelerations differentiated from
+the filtered velocities. With a drive (--drive, the model's own, or a --robot TOML's
+[drive] table) the log is read through it, a robot's links get the drive's known rotor
+torques K^T diag(I_a) K ddq as validate adds them, and the law is fitted per motor at
+the motor velocities where the drive's friction acts there (tau_f = K^T f(K dq)).
 
 Writes OUT/friction.json (parameters, RMS of the residual before and after, the held-out
 table) and

@@ -68,6 +68,7 @@ __all__ = [
     "same_drive",
     "moving_joints",
     "rigid_body_torques",
+    "torques_through",
     "velocity_noise_std",
 ]
 
@@ -97,6 +98,30 @@ def rigid_body_torques(
 
 #: Samples per block in :func:`rigid_body_torques`.
 BLOCK_SAMPLES = 16_384
+
+
+def torques_through(
+    model: TorqueModel,
+    drive: Drive | None,
+    q: NDArray[np.float64],
+    dq: NDArray[np.float64],
+    ddq: NDArray[np.float64],
+) -> NDArray[np.float64]:
+    """The model's torques [N m] (N, n) on a log read through ``drive``, friction not
+    included: :func:`rigid_body_torques`, plus the drive's known rotor torques
+    ``K^T diag(I_a) K ddq`` for a robot's links or a callable (an identified model's
+    torques hold its rotors already). Validation and the friction fit's residual both
+    read the model so, so that a robot's own friction scores the same in both.
+    """
+    tau = rigid_body_torques(model, q, dq, ddq)
+    if drive is None or drive.rotor_inertia is None or isinstance(model, IdentifiedModel):
+        return tau
+    if not isinstance(model, Robot):  # a callable's array is its own: not changed here
+        tau = np.array(tau)
+    for a in range(0, q.shape[0], BLOCK_SAMPLES):
+        b = slice(a, a + BLOCK_SAMPLES)
+        tau[b] += drive.rotor_torques(ddq[b], drive.rotor_inertia)
+    return tau
 
 
 def _rigid_body_torques(
@@ -219,12 +244,13 @@ def friction_residual(
     -------
     FrictionResidual
     """
-    log = joint_side_log(log, model_drive(model, drive))
+    d = model_drive(model, drive)
+    log = joint_side_log(log, d)
     p = prepare_log(
         log, cutoff_hz=cutoff_hz, trim_s=trim_s, filter_tau=filter_tau, max_gap_s=max_gap_s
     )
     assert p.ddq is not None  # prepare_log always fills ddq
-    tau_m = rigid_body_torques(model, p.q, p.dq, p.ddq)
+    tau_m = torques_through(model, d, p.q, p.dq, p.ddq)
     noise = _checks.frozen(velocity_noise_std(log.dq))
     return FrictionResidual(log=p, tau_model=tau_m, residual=p.tau - tau_m, dq_noise_std=noise)
 

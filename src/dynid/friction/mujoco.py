@@ -26,7 +26,7 @@ from numpy.typing import ArrayLike, NDArray
 from .. import _checks
 from ..exceptions import ShapeError
 from .laws.sigmoid import odd_part
-from .model import FrictionModel, FrictionSum
+from .model import FrictionModel, FrictionSum, friction_parts
 
 __all__ = [
     "CoulombViscous",
@@ -34,6 +34,7 @@ __all__ = [
     "coulomb_viscous_from_sigmoid",
     "drive_joint_terms",
     "joint_coulomb_viscous",
+    "unheld_friction",
 ]
 
 
@@ -224,3 +225,43 @@ def joint_coulomb_viscous(
         return replace(jt, notes=notes + jt.notes, offset=terms.offset)
     z = np.zeros(n)
     return DriveJointTerms(z, terms.damping, terms.frictionloss, notes, terms.offset)
+
+
+def unheld_friction(
+    friction: FrictionModel | FrictionSum, dq_max: ArrayLike | None = None
+) -> tuple[str, ...]:
+    """What per-joint viscous and sharp Coulomb friction (MJCF ``damping`` and
+    ``frictionloss``, URDF ``<dynamics damping friction>``) cannot hold of a friction
+    model beyond the law's own losses (:func:`joint_coulomb_viscous`'s ``notes``), one
+    line each: the smooth law's ``tanh(dq / v_s)`` rounding, a standstill band, the
+    offsets ``fo`` [N m], and that the friction acts at the motors (written reflected to
+    the joints). Empty when the coefficients hold the model exactly.
+    """
+    notes: list[str] = []
+    for p in friction_parts(friction):
+        if p.kind == "none":
+            continue
+        what = "motor" if p.at_motors else "joint"
+        where = " at the motors" if p.at_motors else ""
+        band = np.asarray(p.band)
+        if np.any(band > 0):
+            j = int(np.argmax(band))
+            if p.kind == "smooth":
+                notes.append(
+                    f"the smooth law's rounding fc tanh(dq / v_s){where} over its standstill "
+                    f"band (v_s up to {band[j]:.3g} rad/s at {what} {j + 1}; written as plain "
+                    "Coulomb friction)"
+                )
+            else:
+                notes.append(
+                    f"the standstill band{where} (no Coulomb friction for |dq| up to "
+                    f"{band[j]:.3g} rad/s at {what} {j + 1})"
+                )
+        vmax = np.full(p.n, 2.0) if dq_max is None else np.asarray(dq_max, dtype=np.float64)
+        offset = np.asarray(p.law.mjcf(p.as_array(), vmax).offset)
+        if p.kind != "sigmoid" and np.any(offset != 0):  # the sigmoid's: its law's note
+            j = int(np.argmax(np.abs(offset)))
+            notes.append(f"the offsets fo{where} (up to {offset[j]:+.3g} N m at {what} {j + 1})")
+        if p.at_motors:
+            notes.append("friction at the motors (written reflected to the joints)")
+    return tuple(notes)

@@ -46,7 +46,7 @@ from ..identification.sanity import velocity_noise_std
 from ..identification.trim import common_cutoff, edge_seconds
 from ..model.drive import Drive
 from ..model.robot import Robot
-from .fit import FrictionResidual, TorqueModel, model_drive, rigid_body_torques
+from .fit import FrictionResidual, TorqueModel, model_drive, torques_through
 from .model import FrictionModel, FrictionSum
 from .validation import (
     RECORDED,
@@ -559,6 +559,10 @@ def _pooled(
 def pieces_residual(model: TorqueModel, pieces: Pieces) -> FrictionResidual:
     """The torque residual of ``model`` on every piece, the pieces one after another.
 
+    The model's torques are those validation compares (:func:`validate_pieces`): a robot's
+    links plus the known rotor torques of the drive the pieces were read through
+    (:func:`~dynid.friction.fit.torques_through`).
+
     The returned log holds the pieces' samples in order, their times laid end to end (each
     piece shifted to start one median step after the previous one ends: a time axis for
     figures, not a recording; one piece keeps its times); ``recording`` holds each
@@ -567,7 +571,7 @@ def pieces_residual(model: TorqueModel, pieces: Pieces) -> FrictionResidual:
     if len(pieces.logs) == 1:  # one piece: its own times
         p = pieces.logs[0]
         assert p.ddq is not None  # prepare_log always fills ddq
-        tau_m = rigid_body_torques(model, p.q, p.dq, p.ddq)
+        tau_m = torques_through(model, pieces.drive, p.q, p.dq, p.ddq)
         return FrictionResidual(p, tau_m, p.tau - tau_m, pieces.dq_noise_std)
     cols: dict[str, list[NDArray[np.float64]]] = {k: [] for k in ("t", "q", "dq", "tau", "ddq")}
     taus = []
@@ -579,7 +583,7 @@ def pieces_residual(model: TorqueModel, pieces: Pieces) -> FrictionResidual:
         start = float(cols["t"][-1][-1]) + step
         for k in ("q", "dq", "tau", "ddq"):
             cols[k].append(getattr(p, k))
-        taus.append(rigid_body_torques(model, p.q, p.dq, p.ddq))
+        taus.append(torques_through(model, pieces.drive, p.q, p.dq, p.ddq))
     t, q, dq, tau, ddq = (np.concatenate(cols[k]) for k in ("t", "q", "dq", "tau", "ddq"))
     log = TorqueLog(t, q, dq, tau, ddq)
     tau_m = np.concatenate(taus)

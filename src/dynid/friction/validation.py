@@ -38,7 +38,7 @@ from ..identification.recordings import common_cutoff
 from ..identification.sanity import anticorrelated
 from ..model.drive import Drive
 from ..model.robot import Robot
-from .fit import TorqueModel, model_drive, rigid_body_torques
+from .fit import TorqueModel, model_drive, torques_through
 from .model import Friction, FrictionModel, FrictionSum, combined, robot_friction
 
 __all__ = [
@@ -284,16 +284,12 @@ def _validated_blocks(
     sums: dict[str, NDArray[np.float64]] = {}
     kept: dict[str, list[NDArray[np.float64]]] = {}
     N = 0
-    rotors = drive is not None and drive.rotor_inertia is not None
     for p in blocks:
         assert p.ddq is not None  # prepare_log always fills ddq
         if not sums:
             n = p.n
             sums = {k: np.zeros(n) for k in ("tau", "model", "sum")}
-        tau_model = np.array(rigid_body_torques(model, p.q, p.dq, p.ddq))
-        if rotors and not isinstance(model, IdentifiedModel):  # a robot's links: add rotors
-            assert drive is not None and drive.rotor_inertia is not None
-            tau_model += drive.rotor_torques(p.ddq, drive.rotor_inertia)
+        tau_model = np.array(torques_through(model, drive, p.q, p.dq, p.ddq))
         _checks.finite("tau_model", tau_model)
         with np.errstate(over="ignore"):
             e = p.tau - tau_model
@@ -351,14 +347,8 @@ def validated(
     """
     if friction is not None and friction.n != p.n:
         raise ShapeError(f"friction model has {friction.n} joints; the log has {p.n}")
-    d = drive
     assert p.ddq is not None  # prepare_log always fills ddq
-    tau_model = rigid_body_torques(model, p.q, p.dq, p.ddq)
-    if d is not None and d.rotor_inertia is not None and not isinstance(model, IdentifiedModel):
-        if not isinstance(model, Robot):  # a callable's array is its own: not changed here
-            tau_model = np.array(tau_model)
-        for b in _blocks(p.n_samples):  # a robot's links only: add the known rotors
-            tau_model[b] += d.rotor_torques(p.ddq[b], d.rotor_inertia)
+    tau_model = torques_through(model, drive, p.q, p.dq, p.ddq)  # a robot's: with rotors
     without = torque_errors(p.tau, tau_model)
     _warn_opposite_sign(p.tau, tau_model)
     tf = with_ = None

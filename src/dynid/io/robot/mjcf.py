@@ -29,7 +29,10 @@ keeping the robot's link and joint names:
   (:mod:`dynid.friction.laws`) is written as its law maps itself
   (:attr:`~dynid.friction.laws.base.FrictionLaw.mjcf`: the classical law's ``fc`` and
   ``fv`` as they are, the asymmetric law's means, the Stribeck law's ``fv`` and ``fc``),
-  what MJCF cannot hold (an offset, an asymmetry, coupled terms) named in one warning line.
+  what MJCF cannot hold (the offsets, a smooth law's rounding, a standstill band, an
+  asymmetry, a Stribeck peak, a quadratic term, friction at the motors, coupled terms;
+  :func:`dynid.friction.mujoco.unheld_friction`) named in one warning line with the files
+  that hold it.
   With ``friction=False`` the joints are frictionless, and ``mj_inverse`` equals
   :func:`dynid.rnea`.
 
@@ -54,6 +57,7 @@ from ...friction.mujoco import (
     coulomb_viscous_from_sigmoid,
     drive_joint_terms,
     joint_coulomb_viscous,
+    unheld_friction,
 )
 from ...model.drive import Drive
 from ...model.inertia import inertia6_from_matrix
@@ -83,10 +87,23 @@ def _law_terms(
     friction: FrictionModel | FrictionSum, dq_max: NDArray[np.float64]
 ) -> tuple[CoulombViscous, tuple[str, ...]]:
     """A friction model as MuJoCo holds it, and what it drops (one line each)."""
-    jt = joint_coulomb_viscous(friction, np.where(np.isfinite(dq_max), dq_max, 2.0))
+    vmax = np.where(np.isfinite(dq_max), dq_max, 2.0)
+    jt = joint_coulomb_viscous(friction, vmax)
     z = np.zeros(friction.n)
     offset = z if jt.offset is None else jt.offset
-    return CoulombViscous(jt.frictionloss, jt.damping, offset, z, z), jt.notes
+    lost = jt.notes + unheld_friction(friction, vmax)
+    if not lost:
+        return CoulombViscous(jt.frictionloss, jt.damping, offset, z, z), ()
+    holds = (
+        "feasible.json holds it exactly"
+        if isinstance(friction, FrictionSum)
+        else "the TOML export (robot.toml) and feasible.json hold it exactly"
+    )
+    note = (
+        f"the joints' frictionloss and damping (Coulomb and viscous friction at the joints) "
+        f"hold the {friction.kind} friction without {', '.join(lost)}: {holds}"
+    )
+    return CoulombViscous(jt.frictionloss, jt.damping, offset, z, z), (note,)
 
 
 def _joint_terms(

@@ -26,7 +26,10 @@ feasible parameters, say, for simulators) gives one ``<link>`` per link of the r
   :func:`load_urdf` needs no ``tip_link``. With ``all_frames=True`` every other
   named frame is written the same way (then load with ``tip_link=`` the tip's name).
 * with ``template=`` the original URDF is written back with only the chain's
-  ``<inertial>`` elements replaced (:func:`dynid.io.robot.urdf_patch.patch_urdf_inertials`).
+  ``<inertial>`` elements replaced (:func:`dynid.io.robot.urdf_patch.patch_urdf_inertials`)
+  and, by the export (:func:`export_urdf`), the friction of their ``<dynamics>``
+  (:func:`dynid.io.robot.urdf_patch.patch_urdf_dynamics`): read back, a vendor's damping
+  would be the robot's friction.
 
 Gravity is not part of URDF; a friction model (``dynamics=``, :func:`export_urdf`) is
 written as ``<dynamics damping friction>`` per joint, the description's sigmoid is not;
@@ -47,8 +50,8 @@ from numpy.typing import NDArray
 
 from ... import __version__, spatial
 from ...exceptions import DynidWarning, ModelError, ShapeError
-from ...friction.model import Friction, robot_friction, sigmoid_parameters
-from ...friction.mujoco import drive_joint_terms, joint_coulomb_viscous
+from ...friction.model import Friction, FrictionSum, robot_friction, sigmoid_parameters
+from ...friction.mujoco import drive_joint_terms, joint_coulomb_viscous, unheld_friction
 from ...model.drive import Drive
 from ...model.inertia import inertia6_from_matrix
 from ...model.robot import Robot
@@ -56,7 +59,7 @@ from ..atomic import write_text
 from ..input_files import file_text
 from .export_options import ExportOptions
 from .urdf_parse import load_urdf, robot_from_urdf_string
-from .urdf_patch import patch_urdf_inertials
+from .urdf_patch import patch_urdf_dynamics, patch_urdf_inertials
 
 __all__ = [
     "export_urdf",
@@ -228,6 +231,7 @@ def save_urdf(
     tip: str | None = None,
     merged: str = "subtract",
     dynamics: tuple[NDArray[np.float64], NDArray[np.float64]] | None = None,
+    template_dynamics: bool = False,
 ) -> Path:
     """Write the robot as URDF to ``path``; returns the path.
 
@@ -242,7 +246,12 @@ def save_urdf(
         elements replaced (:func:`dynid.io.robot.urdf_patch.patch_urdf_inertials`, with
         ``base``, ``tip`` and ``merged``).
     dynamics : (ndarray, ndarray), optional
-        Chain export only: per-joint damping and Coulomb friction (:func:`urdf_from_robot`).
+        Per-joint damping and Coulomb friction (:func:`urdf_from_robot`); with a template
+        written only with ``template_dynamics``.
+    template_dynamics : bool
+        Template: also replace the friction of the chain's ``<dynamics>`` by ``dynamics``
+        (None: removed; :func:`dynid.io.robot.urdf_patch.patch_urdf_dynamics`); default:
+        the template's ``<dynamics>`` are kept.
 
     Raises
     ------
@@ -268,6 +277,11 @@ def save_urdf(
             merged=merged,
             source=f"URDF template {tpath.name!r}",
         )
+        if template_dynamics:
+            with warnings.catch_warnings():
+                warnings.simplefilter("ignore", DynidWarning)  # the template's own
+                chain = robot_from_urdf_string(original, base, tip)
+            text = patch_urdf_dynamics(text, list(chain.joint_names), dynamics)
     write_text(path, text)
     return path
 
@@ -292,12 +306,15 @@ def export_urdf(path: str | Path, robot: Robot, options: ExportOptions) -> Path:
     A friction model (``options.friction``, any law of the registry, at the joints or
     reflected from the motors of a drive) is written as ``<dynamics damping friction>``,
     what its law maps to viscous and dry friction
-    (:func:`dynid.friction.mujoco.joint_coulomb_viscous`); what URDF cannot hold (an offset,
-    an asymmetry, a Stribeck peak, a coupled drive's off-diagonal terms, the rotor inertias
-    of a drive, friction with a template) is named in one warning line, with the export
-    that holds it. ``friction=True`` writes the robot's own friction when it is a law other
-    than the description's sigmoid at the joints (which URDF does not hold); the drive is
-    not part of URDF.
+    (:func:`dynid.friction.mujoco.joint_coulomb_viscous`), into the chain export or the
+    template's joints (a template's own ``<dynamics>`` friction replaced, or removed when
+    nothing is written). What URDF cannot hold of the model's friction (a smooth law's
+    rounding, a standstill band, the offsets, an asymmetry, a Stribeck peak, a quadratic
+    term, friction at the motors, a coupled drive's off-diagonal terms;
+    :func:`dynid.friction.mujoco.unheld_friction`) and the rotor inertias of a drive are
+    named in one warning line, with the files that hold them. ``friction=True`` writes the
+    robot's own friction when it is a law other than the description's sigmoid at the
+    joints (which URDF does not hold); the drive is not part of URDF.
 
     Raises
     ------
@@ -314,20 +331,27 @@ def export_urdf(path: str | Path, robot: Robot, options: ExportOptions) -> Path:
     if model is not None:
         if model.n != robot.n:
             raise ShapeError(f"friction has {model.n} joints; robot {robot.name!r} has {robot.n}")
-        jt = joint_coulomb_viscous(model, np.where(np.isfinite(robot.dq_max), robot.dq_max, 2.0))
+        vmax = np.where(np.isfinite(robot.dq_max), robot.dq_max, 2.0)
+        jt = joint_coulomb_viscous(model, vmax)
         dynamics = (jt.damping, jt.frictionloss)
-        notes = jt.notes
-        if jt.offset is not None and np.any(jt.offset != 0):
-            notes += (f"{model.kind} friction: the velocity-independent offset has no URDF term",)
-        if options.template is not None:
-            notes = (
-                ()
-                if _template_holds(options, dynamics)
-                else (
-                    f"the {model.kind} friction is not written (a template's inertials alone are "
-                    "replaced; its <dynamics> are kept as they are)",
-                )
+        lost = jt.notes + unheld_friction(model, vmax)
+        if lost:
+            holds = (
+                "feasible.json holds it exactly"
+                if isinstance(model, FrictionSum)
+                else "the TOML export (robot.toml) and feasible.json hold it exactly"
             )
+            notes = (
+                f"{Path(path).name} holds the {model.kind} friction as <dynamics damping "
+                f"friction> (viscous and sharp Coulomb friction at the joints), not "
+                f"{', '.join(lost)}: {holds}",
+            )
+    replace = False
+    if options.template is not None:
+        held = _template_friction(options)
+        replace = not _holds(held, dynamics)
+        if replace and dynamics is None and held is not None:
+            notes += (_removed_note(held, robot),)
     drive = options.drive if options.drive is not None else getattr(model, "drive", None)
     notes += _rotor_note(drive)
     out = save_urdf(
@@ -339,29 +363,52 @@ def export_urdf(path: str | Path, robot: Robot, options: ExportOptions) -> Path:
         tip=options.tip,
         merged=options.merged,
         dynamics=dynamics,
+        template_dynamics=replace,
     )
     if notes:  # one line, once written: what URDF cannot hold
         warnings.warn(f"URDF export: {'; '.join(notes)}", DynidWarning, stacklevel=2)
     return out
 
 
-def _template_holds(
-    options: ExportOptions, dynamics: tuple[NDArray[np.float64], NDArray[np.float64]]
-) -> bool:
-    """Whether the template's chain already holds ``dynamics`` (damping, friction) in its
-    ``<dynamics>`` (a robot read from that template, say): then nothing is lost."""
+def _template_friction(options: ExportOptions) -> Robot | None:
+    """The template's chain (its ``<dynamics>`` read as its friction), None when it
+    cannot be read (:func:`save_urdf` names what is wrong with it)."""
     assert options.template is not None
     try:
         with warnings.catch_warnings():
             warnings.simplefilter("ignore", DynidWarning)
-            held = load_urdf(options.template, options.base, options.tip).friction
-    except ModelError:  # save_urdf names what is wrong with the template
-        return False
+            return load_urdf(options.template, options.base, options.tip)
+    except ModelError:
+        return None
+
+
+def _holds(
+    chain: Robot | None, dynamics: tuple[NDArray[np.float64], NDArray[np.float64]] | None
+) -> bool:
+    """Whether the template's chain already holds ``dynamics`` (damping, friction; None:
+    no friction) in its ``<dynamics>`` (a robot read from that template, say): then its
+    bytes are kept."""
+    held = None if chain is None else chain.friction
     if held is None:
-        return not np.any(dynamics[0]) and not np.any(dynamics[1])
-    P = np.asarray(held.as_array() if isinstance(held, Friction) else 0.0)
+        return dynamics is None or (not np.any(dynamics[0]) and not np.any(dynamics[1]))
+    if dynamics is None or not isinstance(held, Friction):
+        return False
+    P = np.asarray(held.as_array())
     return bool(
         P.shape == (len(dynamics[0]), 3)
         and np.array_equal(P[:, 0], dynamics[0])
         and np.array_equal(P[:, 1], dynamics[1])
+    )
+
+
+def _removed_note(chain: Robot, robot: Robot) -> str:
+    """The line saying which joints' ``<dynamics>`` friction the template loses."""
+    held = chain.friction
+    P = np.asarray(held.as_array()) if isinstance(held, Friction) else np.ones((chain.n, 2))
+    names = [chain.joint_names[j] for j in range(chain.n) if np.any(P[j, :2] != 0)]
+    return (
+        f"the template's <dynamics> friction of joint(s) {', '.join(names)} is removed "
+        f"(damping and friction 0 where the element holds other attributes): the model of "
+        f"{robot.name!r} written has no friction URDF holds, and read back it would be the "
+        "robot's friction"
     )

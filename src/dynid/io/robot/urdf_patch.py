@@ -29,6 +29,12 @@ chain (fingers), are left as they are.
 
 Inertials are written as ``<origin xyz="c" rpy="0 0 0"/>`` (CoM in the link frame [m]),
 ``<mass>`` [kg] and ``<inertia>`` about the CoM in link axes [kg m^2].
+
+Joint friction (:func:`patch_urdf_dynamics`): a URDF's ``<dynamics damping friction>`` of
+the chain's joints is read back as the robot's friction (as Pinocchio reads it), so the
+export replaces a template's (a vendor's damping, say) by the identified viscous and
+Coulomb coefficients, or removes them when the model has no friction (the element, or
+its two attributes set to 0 when it holds others); every other byte is kept.
 """
 
 from __future__ import annotations
@@ -47,13 +53,16 @@ from ...model.inertia import inertia6_from_matrix, inertial_from_phi, phi_from_i
 from ...model.robot import Robot
 from .urdf_parse import robot_from_urdf_string
 
-__all__ = ["MERGED_POLICIES", "patch_urdf_inertials"]
+__all__ = ["MERGED_POLICIES", "patch_urdf_dynamics", "patch_urdf_inertials"]
 
 MERGED_POLICIES = ("subtract", "move", "keep")
 
 _LINK = re.compile(r"<link\b[^>]*?\bname\s*=\s*([\"'])(.*?)\1[^>]*?(/?)>", re.S)
 _INERTIAL = re.compile(r"<inertial\b[^>]*?/>|<inertial\b.*?</inertial>", re.S)
 _COMMENT = re.compile(r"<!--.*?-->", re.S)
+_JOINT = re.compile(r"<joint\b[^>]*?\bname\s*=\s*([\"'])(.*?)\1[^>]*?(/?)>", re.S)
+_DYNAMICS = re.compile(r"<dynamics\b[^>]*?/>|<dynamics\b[^>]*?>.*?</dynamics>", re.S)
+_FRICTION_ATTR = re.compile(r"\s+(damping|friction)\s*=\s*([\"']).*?\2", re.S)
 _ATTRS = ("ixx", "ixy", "ixz", "iyy", "iyz", "izz")
 
 
@@ -288,3 +297,98 @@ def _check_masses(fixed: list[str], elems: dict, source: str) -> None:
                 "correct its <inertial> in the template",
                 file=source,
             )
+
+
+def patch_urdf_dynamics(
+    template: str,
+    joints: list[str],
+    dynamics: tuple[NDArray[np.float64], NDArray[np.float64]] | None,
+) -> str:
+    """The template with the ``<dynamics>`` friction of ``joints`` replaced.
+
+    Parameters
+    ----------
+    template : str
+        URDF text.
+    joints : list of str
+        The chain's moving joints, in order.
+    dynamics : (ndarray, ndarray) or None
+        Per joint ``damping`` [N m s/rad or N s/m] and Coulomb ``friction`` [N m or N]:
+        written as those attributes of each joint's ``<dynamics>`` (added, after the
+        joint's last child, when it has none), each value where it stands; None: the
+        element is removed, or, when it holds other attributes (Gazebo's), its two set to
+        0 (urdfdom refuses a ``<dynamics>`` without either). Other attributes stay.
+
+    Raises
+    ------
+    ModelError
+        A joint of ``joints`` is not in the template, or has no closing ``</joint>``.
+    """
+    masked = _COMMENT.sub(lambda m: " " * len(m.group(0)), template)
+    spans = {  # a robot's joints have a type; a <transmission>'s <joint> has none
+        html.unescape(m.group(2)): m
+        for m in _JOINT.finditer(masked)
+        if re.search(r"\btype\s*=", m.group(0))
+    }
+    edits: list[tuple[int, int, str]] = []
+    for i, name in enumerate(joints):
+        m = spans.get(name)
+        if m is None or m.group(3) == "/":
+            raise ModelError(f"joint {_checks.short(name)} of the chain has no <joint> element")
+        end = masked.find("</joint>", m.end())
+        if end < 0:
+            raise ModelError(f"joint {_checks.short(name)} has no closing </joint>")
+        found = _DYNAMICS.search(masked, m.end(), end)
+        if dynamics is None:
+            if found is not None:
+                edits.append(_removed(template, found.start(), found.end()))
+            continue
+        attrs = f'damping="{_f(dynamics[0][i])}" friction="{_f(dynamics[1][i])}"'
+        if found is None:
+            inner = re.search(r"\n([ \t]*)<", template[m.end() : end])
+            child = inner.group(1) if inner else _line_indent(template, m.start()) + "  "
+            line = template.rfind("\n", m.end(), end)
+            if line >= 0 and not template[line + 1 : end].strip():  # </joint> on its line
+                edits.append((line, line, f"\n{child}<dynamics {attrs}/>"))
+            else:
+                edits.append((end, end, f"<dynamics {attrs}/>"))
+            continue
+        edits.append(_set_friction(template, found.start(), dynamics[0][i], dynamics[1][i]))
+    out = template
+    for a, b, text in sorted(edits, reverse=True):
+        out = out[:a] + text + out[b:]
+    return out
+
+
+def _set_friction(template: str, a: int, damping: float, friction: float) -> tuple[int, int, str]:
+    """The edit giving the ``<dynamics>`` tag at ``a`` these ``damping`` and ``friction``:
+    each value replaced where it stands, a missing attribute added after the others."""
+    tag_end = template.index(">", a)
+    closed = template[tag_end - 1] == "/"
+    head = template[a : tag_end - (1 if closed else 0)]
+    for name, value in (("damping", damping), ("friction", friction)):
+        attr = re.compile(rf"(\s{name}\s*=\s*)([\"'])(.*?)\2", re.S)
+        found = attr.search(head)
+        if found is not None:
+            q = found.group(2)
+            head = f"{head[: found.start()]}{found.group(1)}{q}{_f(value)}{q}{head[found.end() :]}"
+        else:
+            head = head.rstrip() + f' {name}="{_f(value)}"'
+    return a, tag_end + 1, head + ("/>" if closed else ">")
+
+
+def _removed(template: str, a: int, b: int) -> tuple[int, int, str]:
+    """The edit removing the friction of the ``<dynamics>`` at ``[a, b)``: the element (and
+    its line) when it holds nothing else, else its ``damping`` and ``friction`` set to 0
+    (urdfdom refuses a ``<dynamics>`` without either)."""
+    tag_end = template.index(">", a)
+    closed = template[tag_end - 1] == "/"
+    head = template[a + len("<dynamics") : tag_end - (1 if closed else 0)]
+    rest = _FRICTION_ATTR.sub("", head).rstrip()
+    body = "" if closed else template[tag_end + 1 : b - len("</dynamics>")]
+    if rest.strip() or body.strip():
+        return _set_friction(template, a, 0.0, 0.0)
+    line_start = template.rfind("\n", 0, a)
+    if _line_indent(template, a) and line_start >= 0:
+        a = line_start
+    return a, b, ""

@@ -1,0 +1,175 @@
+"""What the URDF and MJCF exports hold of an identified friction model, and what they say
+they leave out.
+
+URDF's ``<dynamics damping friction>`` (read back, as Pinocchio reads it, as viscous and
+sharp Coulomb friction at the joints) and MJCF's ``damping``/``frictionloss`` hold
+``fv dq + fc sign(dq)``. References: the closed forms of the laws (what is lost is
+``fc (tanh(dq / v_s) - sign(dq)) + fo`` for the smooth law), Pinocchio's reading of the
+files, MuJoCo's compiled model, the vendor template's own text.
+"""
+
+from __future__ import annotations
+
+import re
+import warnings
+
+import numpy as np
+import pytest
+
+from dynid.exceptions import DynidWarning
+from dynid.friction.laws import law_named
+from dynid.friction.model import ClassicalFriction
+from dynid.io.robot.export_options import ExportOptions
+from dynid.io.robot.mjcf import mjcf_from_robot
+from dynid.io.robot.urdf import export_urdf, load_urdf
+from dynid.model.drive import Drive
+
+from conftest import planar_2r, robot_data_urdf
+
+FV, FC = np.array([0.9, 0.3]), np.array([0.7, 0.2])  # N m s/rad, N m
+FO = np.array([0.3, -0.44])  # N m
+BAND = np.array([0.004, 0.006])  # rad/s
+
+
+def _arm():
+    lim = np.array([2.5, 2.5])
+    return planar_2r().replace(q_min=-lim, q_max=lim, dq_max=lim, ddq_max=4 * lim)
+
+
+def _warnings(fn, *args, **kw):
+    with warnings.catch_warnings(record=True) as got:
+        warnings.simplefilter("always")
+        out = fn(*args, **kw)
+    return out, [str(w.message) for w in got if issubclass(w.category, DynidWarning)]
+
+
+def test_urdf_export_of_smooth_friction_names_everything_it_leaves_out(tmp_path):
+    """The smooth law with a band and offsets: the URDF reads back fv dq + fc sign(dq);
+    the model minus that is fc (tanh(dq / v_s) - sign(dq)) + fo exactly, and the one
+    warning names the rounding, the offsets and the files that hold the model."""
+    smooth = law_named("smooth").model(np.column_stack([FV, FC, FO]), BAND)
+    path, lines = _warnings(
+        export_urdf, tmp_path / "robot.urdf", _arm(), ExportOptions(friction=smooth)
+    )
+    assert len(lines) == 1 and lines[0].startswith("URDF export: robot.urdf holds"), lines
+    for said in ("tanh(dq / v_s)", "standstill band", "0.006 rad/s at joint 2", "offsets fo",
+                 "-0.44 N m at joint 2", "robot.toml", "feasible.json"):  # fmt: skip
+        assert said in lines[0], (said, lines[0])
+    back = load_urdf(path).friction
+    dq = np.linspace(-0.05, 0.05, 101)[:, None] * np.ones(2)
+    np.testing.assert_allclose(back.torques(dq), FV * dq + FC * np.sign(dq), atol=1e-12)
+    lost = FC * (np.tanh(dq / BAND) - np.sign(dq)) + FO
+    np.testing.assert_allclose(smooth.torques(dq) - back.torques(dq), lost, atol=1e-12)
+
+
+@pytest.mark.parametrize(
+    ("law", "params", "band", "said"),
+    [
+        ("classical", [FV, FC, 0 * FV], BAND, "standstill band (no Coulomb friction"),
+        ("quadratic", [FV, [0.1, 0.0], FC, 0 * FV], None, "quadratic viscous term"),
+        ("stribeck", [FV, FC, 1.5 * FC, [0.05, 0.05], 0 * FV], None, "Stribeck peak"),
+    ],
+)
+def test_urdf_export_names_a_band_a_quadratic_term_a_stribeck_peak(
+    tmp_path, law, params, band, said
+):
+    """Each shape the URDF's sign cannot hold is named (no offset: none named)."""
+    fr = law_named(law).model(np.column_stack(params), band)
+    _, lines = _warnings(export_urdf, tmp_path / "r.urdf", _arm(), ExportOptions(friction=fr))
+    assert len(lines) == 1 and said in lines[0] and "offsets" not in lines[0], lines
+
+
+def test_urdf_export_of_what_it_holds_says_nothing_and_motors_are_named(tmp_path):
+    """Classical friction at the joints without band or offset: held exactly, no warning;
+    at the motors of a gear-10 drive it is written reflected (100 fv, 10 fc, exact for a
+    diagonal drive) and its place is named."""
+    fr = ClassicalFriction(FV, FC, 0 * FV)
+    path, lines = _warnings(export_urdf, tmp_path / "a.urdf", _arm(), ExportOptions(friction=fr))
+    assert lines == []
+    back = load_urdf(path).friction
+    np.testing.assert_allclose(back.fv, FV, atol=1e-12)
+    np.testing.assert_allclose(back.fc, FC, atol=1e-12)
+    drive = Drive.from_gears([10.0, 10.0], side="motor", friction_at="motor")
+    motor = fr.at(drive)
+    path, lines = _warnings(export_urdf, tmp_path / "m.urdf", _arm(), ExportOptions(friction=motor))
+    assert len(lines) == 1 and "friction at the motors" in lines[0], lines
+    back = load_urdf(path).friction
+    np.testing.assert_allclose(back.fv, 100 * FV, rtol=1e-12)
+    np.testing.assert_allclose(back.fc, 10 * FC, rtol=1e-12)
+
+
+def _z1():
+    path = robot_data_urdf("z1_description/urdf/z1.urdf")
+    if path is None:
+        pytest.skip("example-robot-data's Z1 not installed")
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", DynidWarning)
+        return path, load_urdf(path, tip_link="link06")
+
+
+_DYN = re.compile(r"<dynamics\b[^>]*/>")
+
+
+def test_template_dynamics_are_replaced_by_the_identified_friction(tmp_path):
+    """A vendor template with damping/friction 1-2 on every joint: patched, the chain's
+    <dynamics> hold the identified fv and fc (read back to 1e-12, Pinocchio reads the
+    same), the gripper's stay, and every other byte is the template's."""
+    pin = pytest.importorskip("pinocchio")
+    path, chain = _z1()
+    text = open(path).read()
+    assert chain.friction is not None and np.all(chain.friction.fv >= 1.0)  # the vendor's
+    fv, fc = np.linspace(0.2, 1.5, 6), np.linspace(0.1, 1.2, 6)
+    fr = ClassicalFriction(fv, fc, np.zeros(6))
+    options = ExportOptions(template=path, tip="link06", merged="keep", friction=fr)
+    out, lines = _warnings(export_urdf, tmp_path / "z1.urdf", chain, options)
+    assert lines == []
+    patched = out.read_text()
+    inertial = re.compile(r"<inertial\b.*?</inertial>", re.S)
+    assert _DYN.sub("", inertial.sub("", patched)) == _DYN.sub("", inertial.sub("", text))
+    assert len(_DYN.findall(patched)) == len(_DYN.findall(text))
+    assert _DYN.findall(patched)[-1] == _DYN.findall(text)[-1]  # the gripper's joint
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", DynidWarning)
+        back = load_urdf(out, tip_link="link06").friction
+    np.testing.assert_allclose(back.fv, fv, rtol=0, atol=1e-12)
+    np.testing.assert_allclose(back.fc, fc, rtol=0, atol=1e-12)
+    model = pin.buildModelFromUrdf(str(out))
+    idx = [model.joints[model.getJointId(n)].idx_v for n in chain.joint_names]
+    np.testing.assert_allclose(np.asarray(model.damping)[idx], fv, rtol=0, atol=1e-12)
+    np.testing.assert_allclose(np.asarray(model.friction)[idx], fc, rtol=0, atol=1e-12)
+
+
+def test_template_dynamics_are_removed_when_the_model_has_no_friction(tmp_path):
+    """Without friction the chain's <dynamics> go (one line says so): read back, the arm
+    has no friction, and Pinocchio reads zeros."""
+    pin = pytest.importorskip("pinocchio")
+    path, chain = _z1()
+    options = ExportOptions(template=path, tip="link06", merged="move", friction=False)
+    out, lines = _warnings(export_urdf, tmp_path / "z1.urdf", chain, options)
+    assert len(lines) == 1 and "joint1, joint2, joint3, joint4, joint5, joint6" in lines[0]
+    assert "is removed" in lines[0], lines
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", DynidWarning)
+        assert load_urdf(out, tip_link="link06").friction is None
+    model = pin.buildModelFromUrdf(str(out))
+    idx = [model.joints[model.getJointId(n)].idx_v for n in chain.joint_names]
+    np.testing.assert_array_equal(np.asarray(model.damping)[idx], 0.0)
+    np.testing.assert_array_equal(np.asarray(model.friction)[idx], 0.0)
+
+
+def test_mjcf_export_names_the_offsets_it_drops():
+    """Classical friction with offsets: MuJoCo compiles damping = fv and frictionloss = fc
+    exactly, and one warning names the offsets (the largest, 0.44 N m at joint 2) and the
+    files that hold them."""
+    mujoco = pytest.importorskip("mujoco")
+    fr = ClassicalFriction(FV, FC, FO)
+    (text, approx), lines = _warnings(mjcf_from_robot, _arm(), friction=fr)
+    assert len(lines) == 1 and lines[0].startswith("MJCF export: "), lines
+    assert "offsets fo (up to -0.44 N m at joint 2)" in lines[0], lines[0]
+    assert "robot.toml" in lines[0] and "feasible.json" in lines[0]
+    model = mujoco.MjModel.from_xml_string(text)
+    np.testing.assert_array_equal(model.dof_damping, FV)
+    np.testing.assert_array_equal(model.dof_frictionloss, FC)
+    np.testing.assert_array_equal(approx.offset, FO)
+    (_, _), lines = _warnings(mjcf_from_robot, _arm(), friction=ClassicalFriction(FV, FC, 0 * FV))
+    assert lines == []
