@@ -204,6 +204,16 @@ def check_torque_log(robot: Robot, log: TorqueLog) -> list[str]:
     return out
 
 
+def _correlations(reference: NDArray[np.float64], tau: NDArray[np.float64]) -> NDArray[np.float64]:
+    """Per-joint correlation (n,) of ``tau`` with ``reference`` (both centred; 0 where
+    either is constant)."""
+    with np.errstate(invalid="ignore", divide="ignore"):
+        corr = np.sum(reference * tau, axis=0) / np.sqrt(
+            np.sum(reference**2, axis=0) * np.sum(tau**2, axis=0)
+        )
+    return np.where(np.isfinite(corr), corr, 0.0)
+
+
 def anticorrelated(
     reference: NDArray[np.float64], tau: NDArray[np.float64], loaded: NDArray[np.bool_]
 ) -> tuple[int, float] | None:
@@ -214,11 +224,7 @@ def anticorrelated(
     positively and at least one correlates below -0.5 (that one, the most negative, is
     returned).
     """
-    with np.errstate(invalid="ignore", divide="ignore"):
-        corr = np.sum(reference * tau, axis=0) / np.sqrt(
-            np.sum(reference**2, axis=0) * np.sum(tau**2, axis=0)
-        )
-    corr = np.where(np.isfinite(corr), corr, 0.0)
+    corr = _correlations(reference, tau)
     neg = loaded & (corr < -0.5)
     if not np.any(neg) or np.sum(corr[loaded] < 0) <= np.sum(corr[loaded] > 0):
         return None
@@ -255,16 +261,40 @@ def opposite_sign(robot: Robot, log: TorqueLog) -> str | None:
 def _opposite(
     robot: Robot, q: NDArray[np.float64], tau: NDArray[np.float64], names: tuple[str, ...]
 ) -> str | None:
+    """The sign finding: every joint gravity loads anti-correlated (``--units tau=-1``), or
+    only some (named, with their torque columns to flip: ``--units`` scales every joint
+    alike)."""
     centred = _gravity_spread(robot, q, tau)
     found = None if centred is None else anticorrelated(*centred)
-    if found is None:
+    if found is None or centred is None:
         return None
     j, c = found
+    gc, tc, loaded = centred
+    corr = _correlations(gc, tc)
+    neg = np.flatnonzero(loaded & (corr < 0))
+    if neg.size == int(np.sum(loaded)):
+        return (
+            f"the measured torques are anti-correlated with the model's gravity torques "
+            f"(correlation {c:+.2f} on {names[j]}): the torque sign is probably opposite "
+            "to the model's; hint: --units tau=-1 (or a drive file whose transmission has "
+            "the sign)"
+        )
+    pos = np.flatnonzero(loaded & (corr >= 0))
+    free = np.flatnonzero(~loaded)
+    said = ", ".join(f"{names[k]} {corr[k]:+.2f}" for k in neg)
     return (
-        f"the measured torques are anti-correlated with the model's gravity torques "
-        f"(correlation {c:+.2f} on {names[j]}): the torque sign is probably opposite "
-        "to the model's; hint: --units tau=-1 (or a drive file whose transmission has "
-        "the sign)"
+        f"the measured torques are anti-correlated with the model's gravity torques on "
+        f"some joints only (correlation {said}; positive on "
+        f"{', '.join(names[k] for k in pos)}): the torque sign of "
+        f"{', '.join(names[k] for k in neg)} is probably opposite to the model's"
+        + (
+            f" (the sign of {', '.join(names[k] for k in free)}, which gravity does not "
+            "load, is not told by this check)"
+            if free.size
+            else ""
+        )
+        + "; hint: flip the sign of their torque columns in the file (--units tau=-1 "
+        "flips every joint)"
     )
 
 
