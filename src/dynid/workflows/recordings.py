@@ -183,7 +183,9 @@ def given_start(
     if len(logs) != 1:
         raise OptionError(
             f"gives the joint positions at the first sample of one recording; got {len(logs)} "
-            f"({', '.join(names)})",
+            f"({', '.join(names)}); hint: give one recording with --q-start (one at a time), "
+            "or log the motors' multi-turn angles or the joint positions (a joint-side log) "
+            "to read several",
             field="q_start",
         )
     return (with_start_turns(names[0], logs[0], robot, drive, np.asarray(q_start), max_gap_s),)
