@@ -110,3 +110,42 @@ def test_a_sign_flipped_on_some_joints_names_them(panda, log):
     assert not loaded[0] and f"the sign of {panda.joint_names[0]}" in said
     every = opposite_sign(panda, _flipped(log, list(range(7))))
     assert every is not None and "hint: --units tau=-1" in every
+
+
+def _joint(name: str, parent: str, child: str, axis: str) -> str:
+    return (
+        f'<joint name="{name}" type="revolute"><parent link="{parent}"/><child link="{child}"/>'
+        f'<origin xyz="0 0 0.3"/><axis xyz="{axis}"/>'
+        '<limit lower="-2" upper="2" effort="10" velocity="2"/></joint>'
+        f'<link name="{child}"><inertial><origin xyz="0 0 0.1"/><mass value="1.0"/>'
+        '<inertia ixx="0.01" ixy="0" ixz="0" iyy="0.01" iyz="0" izz="0.01"/></inertial></link>'
+    )
+
+
+ARM_WITH_GRIPPER = (
+    '<robot name="arm"><link name="base"/>'
+    + _joint("shoulder", "base", "upper", "0 0 1")
+    + _joint("elbow", "upper", "fore", "0 1 0")
+    + _joint("finger_joint", "fore", "finger", "1 0 0")
+    + "</robot>"
+)
+
+
+@pytest.mark.parametrize("command", ["identify --robot", "validate --robot", "observe --params"])
+def test_a_log_without_the_gripper_joint_names_it_and_the_tip(tmp_path, capsys, command):
+    """A URDF chain of 3 joints whose last is a gripper's, a log of the arm's 2: one line
+    naming the gripper joint and --tip with the link before it (it said only "6 joints;
+    model has 7"); the robot read up to that link has the log's joint count."""
+    urdf = tmp_path / "arm.urdf"
+    urdf.write_text(ARM_WITH_GRIPPER)
+    t = np.arange(0.0, 1.0, 0.01)
+    q = 0.3 * np.stack([np.sin(t), np.cos(t)], axis=1)
+    save_torque_log(tmp_path / "arm.csv", TorqueLog(t, q, np.gradient(q, t, axis=0), 0 * q))
+    argv = [*command.split(), str(urdf), "--data", str(tmp_path / "arm.csv")]
+    if command.startswith("observe"):
+        argv.append("--calibrate")
+    assert main([*argv, "--out", str(tmp_path / "o")]) == 2
+    err = [s for s in capsys.readouterr().err.splitlines() if "error" in s]
+    assert len(err) == 1 and "arm.csv" in err[0], err
+    assert "finger_joint" in err[0] and "--tip fore" in err[0], err
+    assert dynid.Robot.from_urdf(urdf, tip_link="fore").n == 2

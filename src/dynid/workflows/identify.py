@@ -370,7 +370,12 @@ def _read_logs(robot: Robot, paths: list[Path], cmap: Any, opt: IdentifyOptions)
     from ``q_start`` (:func:`given_start`)."""
     logs = [
         read_torque_log(
-            p, robot.n, columns=cmap, drop_invalid=opt.drop_invalid, owner=f"robot {robot.name!r}"
+            p,
+            robot.n,
+            columns=cmap,
+            drop_invalid=opt.drop_invalid,
+            owner=f"robot {robot.name!r}",
+            robot=robot,
         )
         for p in paths
     ]

@@ -384,7 +384,14 @@ def _read_logs(
     (:mod:`dynid.workflows.recordings`)."""
     cmap = column_map(*columns)
     logs = [
-        read_torque_log(p, model.n, columns=cmap, drop_invalid=opts.drop_invalid, owner="the model")
+        read_torque_log(
+            p,
+            model.n,
+            columns=cmap,
+            drop_invalid=opts.drop_invalid,
+            owner="the model",
+            robot=model.robot,
+        )
         for p in map(Path, paths)
     ]
     names = [Path(p).name for p in paths]

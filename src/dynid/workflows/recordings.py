@@ -143,7 +143,9 @@ def read_recordings(
     cmap = column_map(names, units, cutoff_hz=cutoff_hz)
 
     def read(p: Path) -> TorqueLog:
-        return read_torque_log(p, robot.n, columns=cmap, drop_invalid=drop_invalid, owner=owner)
+        return read_torque_log(
+            p, robot.n, columns=cmap, drop_invalid=drop_invalid, owner=owner, robot=robot
+        )
 
     logs = tuple(in_file(p, lambda p=p: read(p)) for p in paths)  # type: ignore[misc]
     logs = given_start(logs, [p.name for p in paths], robot, drive, q_start, max_gap_s)
