@@ -7,7 +7,9 @@ with them before fitting (:func:`log_findings`). None of them changes the data.
 * **Sign**: the measured torques against the model's gravity torques ``g(q)`` at the logged
   configurations (with the robot's own link parameters, when it has any): a correlation
   below ``-0.5`` on a joint that gravity loads means the torque sign is opposite to the
-  model's (``--units tau=-1``).
+  model's (``--units tau=-1``; refused by ``identify`` and ``observe``, naming the joints
+  when only some are); on a minority of the loaded joints, a warning naming them (their
+  sign, or the robot's parameters of the links they carry).
 * **Scale**: the least-squares factor ``a`` in ``tau ~ a g(q)`` over the gravity-loaded
   joints; ``a`` near 1e3 or 1e-3 is a unit off by a power of ten (mN m against N m), and
   currents logged as torques show as a factor far from 1 (a drive file with
@@ -308,6 +310,17 @@ def _sign_and_scale(
         return []
     gc, tc, loaded = centred
     out = []
+    corr = _correlations(gc, tc)
+    if np.any(few := loaded & (corr < -0.5)):  # a minority: said, not refused
+        idx = np.flatnonzero(few)
+        out.append(
+            f"the measured torques of {', '.join(names[k] for k in idx)} are anti-correlated "
+            f"with the model's gravity torques (correlation "
+            f"{', '.join(f'{corr[k]:+.2f}' for k in idx)}) while the other joints' agree: "
+            "their torque sign is probably opposite, or the robot's parameters of the links "
+            "they carry are wrong; hint: if so, flip the sign of their torque columns in the "
+            "file (--units tau=-1 flips every joint)"
+        )
     a = float(np.sum(gc[:, loaded] * tc[:, loaded]) / np.sum(gc[:, loaded] ** 2))
     if abs(a) > 30 or 0 < abs(a) < 1 / 30:
         p = round(math.log10(abs(a)))
