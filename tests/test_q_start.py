@@ -64,7 +64,7 @@ def test_without_q_start_the_turns_are_refused_naming_the_option(arm):
     """The Panda's limits leave dozens of counts per 50:1 motor: refused, naming the file
     and --q-start."""
     robot, drive, _, _, wrapped, _ = arm
-    said = r"w\.csv: motor\(s\) 1, 2, .*7 recorded wrapped.*--q-start"
+    said = r"w\.csv: motor\(s\) 1, 2, .*7 recorded wrapped.*--q-start .*one recording"
     with pytest.raises(DataError, match=said):
         with warnings.catch_warnings():
             warnings.simplefilter("ignore", DynidWarning)
@@ -96,6 +96,23 @@ def test_q_start_midway_between_two_counts_is_refused(arm):
         with_start_turns("w.csv", wrapped, robot, drive, q_start)
 
 
+def test_q_start_in_degrees_or_outside_a_joint_s_limits_is_refused_naming_it(arm):
+    """The truth in degrees: refused as outside the limits, "in degrees?" (it was "0.0915
+    rad from one count"); joint 2 given 0.3 rad beyond its upper limit: refused naming
+    it and its limits (it only warned after the turns were set from it)."""
+    robot, drive, traj, _, wrapped, _ = arm
+    with pytest.raises(OptionError, match=r"outside the joint limits .*: in degrees\?") as e:
+        with_start_turns("w.csv", wrapped, robot, drive, np.degrees(traj.q[0]))
+    assert e.value.field == "q_start"
+    beyond = traj.q[0].copy()
+    beyond[1] = robot.q_max[1] + 0.3
+    name, lo, hi = robot.joint_names[1], robot.q_min[1], robot.q_max[1]
+    with pytest.raises(
+        OptionError, match=rf"\({name} {beyond[1]:.4g} outside \[{lo:.4g}, {hi:.4g}\]\)"
+    ):
+        with_start_turns("w.csv", wrapped, robot, drive, beyond)
+
+
 def test_validate_with_q_start_on_the_command_line(arm, capsys):
     """validate --drive --q-start on the wrapped log: the model's own torques predicted as
     on the multi-turn log (noise-free: the same errors); without --q-start exit 2 with one
@@ -125,6 +142,7 @@ DRV = "--drive {d}/drive.toml"
         ("--data {d}/w.csv --q-start 0,0,0,0,0,0,0", 'apply without a --drive of side = "motor"'),
         (f"{DRV} --data {{d}}/m.csv --q-start 0,0,0,0,0,0,0", "does not apply to m.csv"),
         (f"{DRV} --data {{d}}/w.csv {{d}}/m.csv --q-start 0,0,0,0,0,0,0", "one recording; got 2"),
+        (f"{DRV} --data {{d}}/w.csv {{d}}/m.csv --q-start 0,0,0,0,0,0,0", "(one at a time)"),
         (f"{DRV} --data {{d}}/w.csv --q-start 0,x", "--q-start: must be comma-separated numbers"),
     ],
 )

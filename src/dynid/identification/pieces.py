@@ -33,6 +33,7 @@ from .log import TorqueLog, default_max_gap
 from .sanity import time_unit_finding
 
 __all__ = [
+    "Q_START_TOLERANCE",
     "WRAP_SPAN",
     "joined",
     "nearest_turns",
@@ -290,8 +291,8 @@ def start_turns(
             f"{'; motor '.join(told) or 'none fits every joint'}); hint: "
             + (
                 "give the joint positions at the log's first sample with --q-start "
-                "(comma list, rad), log the motors' multi-turn angles, or the joint "
-                "positions (a joint-side log)"
+                "(comma list, rad; it applies to one recording: give this one alone), log "
+                "the motors' multi-turn angles, or the joint positions (a joint-side log)"
                 if log_start
                 else "this piece follows a gap, across which the turns are lost: "
                 "--q-start gives those of the log's first sample only; log the motors' "
@@ -371,7 +372,8 @@ def with_start_turns(
     Raises
     ------
     OptionError
-        ``q_start`` not ``n`` finite numbers; a drive whose log is not motor side; no motor
+        ``q_start`` not ``n`` finite numbers, or outside the joint limits (the joints and
+        their limits named; degrees said); a drive whose log is not motor side; no motor
         of the log recorded wrapped (its angles tell the turns: ``--q-start`` does not
         apply).
     DataError
@@ -398,6 +400,8 @@ def with_start_turns(
             "[-pi, pi] (its angles tell the turns); leave it out",
             field="q_start",
         )
+    if q_start is not None:
+        _check_q_start_limits(np.asarray(q_start, dtype=np.float64), robot)
     q = np.array(log.q)
     for k, ((a, b), (piece, _)) in enumerate(zip(spans, done, strict=True)):
         given = q_start if k == 0 else None
@@ -429,6 +433,39 @@ def _check_q_start(q_start: NDArray[np.float64], robot: Robot, drive: Drive | No
             others=("drive",),
         )
 
+
+def _check_q_start_limits(q_start: NDArray[np.float64], robot: Robot) -> None:
+    """Refuse joint positions at the first sample outside the joint limits (beyond
+    :data:`Q_START_TOLERANCE`), naming the joints and their limits; positions beyond a turn
+    that fit them read in degrees are said to be degrees (:func:`with_start_turns`)."""
+    lo = np.asarray(robot.q_min, dtype=np.float64) - Q_START_TOLERANCE
+    hi = np.asarray(robot.q_max, dtype=np.float64) + Q_START_TOLERANCE
+    out = np.flatnonzero((q_start < lo) | (q_start > hi))
+    if out.size:
+        deg = q_start * np.pi / 180.0
+        # beyond a turn, and every joint within its limits read in degrees
+        in_degrees = bool(np.any(np.abs(q_start[out]) > 2 * np.pi)) and bool(
+            np.all((deg >= lo) & (deg <= hi))
+        )
+        said = ", ".join(
+            f"{robot.joint_names[j]} {q_start[j]:.4g} outside [{robot.q_min[j]:.4g}, "
+            f"{robot.q_max[j]:.4g}]"
+            for j in out
+        )
+        raise OptionError(
+            f"lies outside the joint limits of robot {robot.name!r} ({said})"
+            + (
+                ": in degrees? hint: give the joint positions in radians (x pi/180)"
+                if in_degrees
+                else "; hint: give the joint positions [rad] at the log's first sample"
+            ),
+            field="q_start",
+        )
+
+
+#: How far [rad or m] ``--q-start`` may lie beyond a joint's limits (a joint stopped
+#: at its limit, read by its encoder).
+Q_START_TOLERANCE = 0.02
 
 #: The checks of a recording cut into pieces read at most about this many of its samples.
 _CHECKED_SAMPLES = 200_000

@@ -7,7 +7,9 @@ with them before fitting (:func:`log_findings`). None of them changes the data.
 * **Sign**: the measured torques against the model's gravity torques ``g(q)`` at the logged
   configurations (with the robot's own link parameters, when it has any): a correlation
   below ``-0.5`` on a joint that gravity loads means the torque sign is opposite to the
-  model's (``--units tau=-1``).
+  model's (``--units tau=-1``; refused by ``identify`` and ``observe``, naming the joints
+  when only some are); on a minority of the loaded joints, a warning naming them (their
+  sign, or the robot's parameters of the links they carry).
 * **Scale**: the least-squares factor ``a`` in ``tau ~ a g(q)`` over the gravity-loaded
   joints; ``a`` near 1e3 or 1e-3 is a unit off by a power of ten (mN m against N m), and
   currents logged as torques show as a factor far from 1 (a drive file with
@@ -204,6 +206,16 @@ def check_torque_log(robot: Robot, log: TorqueLog) -> list[str]:
     return out
 
 
+def _correlations(reference: NDArray[np.float64], tau: NDArray[np.float64]) -> NDArray[np.float64]:
+    """Per-joint correlation (n,) of ``tau`` with ``reference`` (both centred; 0 where
+    either is constant)."""
+    with np.errstate(invalid="ignore", divide="ignore"):
+        corr = np.sum(reference * tau, axis=0) / np.sqrt(
+            np.sum(reference**2, axis=0) * np.sum(tau**2, axis=0)
+        )
+    return np.where(np.isfinite(corr), corr, 0.0)
+
+
 def anticorrelated(
     reference: NDArray[np.float64], tau: NDArray[np.float64], loaded: NDArray[np.bool_]
 ) -> tuple[int, float] | None:
@@ -214,11 +226,7 @@ def anticorrelated(
     positively and at least one correlates below -0.5 (that one, the most negative, is
     returned).
     """
-    with np.errstate(invalid="ignore", divide="ignore"):
-        corr = np.sum(reference * tau, axis=0) / np.sqrt(
-            np.sum(reference**2, axis=0) * np.sum(tau**2, axis=0)
-        )
-    corr = np.where(np.isfinite(corr), corr, 0.0)
+    corr = _correlations(reference, tau)
     neg = loaded & (corr < -0.5)
     if not np.any(neg) or np.sum(corr[loaded] < 0) <= np.sum(corr[loaded] > 0):
         return None
@@ -255,16 +263,40 @@ def opposite_sign(robot: Robot, log: TorqueLog) -> str | None:
 def _opposite(
     robot: Robot, q: NDArray[np.float64], tau: NDArray[np.float64], names: tuple[str, ...]
 ) -> str | None:
+    """The sign finding: every joint gravity loads anti-correlated (``--units tau=-1``), or
+    only some (named, with their torque columns to flip: ``--units`` scales every joint
+    alike)."""
     centred = _gravity_spread(robot, q, tau)
     found = None if centred is None else anticorrelated(*centred)
-    if found is None:
+    if found is None or centred is None:
         return None
     j, c = found
+    gc, tc, loaded = centred
+    corr = _correlations(gc, tc)
+    neg = np.flatnonzero(loaded & (corr < 0))
+    if neg.size == int(np.sum(loaded)):
+        return (
+            f"the measured torques are anti-correlated with the model's gravity torques "
+            f"(correlation {c:+.2f} on {names[j]}): the torque sign is probably opposite "
+            "to the model's; hint: --units tau=-1 (or a drive file whose transmission has "
+            "the sign)"
+        )
+    pos = np.flatnonzero(loaded & (corr >= 0))
+    free = np.flatnonzero(~loaded)
+    said = ", ".join(f"{names[k]} {corr[k]:+.2f}" for k in neg)
     return (
-        f"the measured torques are anti-correlated with the model's gravity torques "
-        f"(correlation {c:+.2f} on {names[j]}): the torque sign is probably opposite "
-        "to the model's; hint: --units tau=-1 (or a drive file whose transmission has "
-        "the sign)"
+        f"the measured torques are anti-correlated with the model's gravity torques on "
+        f"some joints only (correlation {said}; positive on "
+        f"{', '.join(names[k] for k in pos)}): the torque sign of "
+        f"{', '.join(names[k] for k in neg)} is probably opposite to the model's"
+        + (
+            f" (the sign of {', '.join(names[k] for k in free)}, which gravity does not "
+            "load, is not told by this check)"
+            if free.size
+            else ""
+        )
+        + "; hint: flip the sign of their torque columns in the file (--units tau=-1 "
+        "flips every joint)"
     )
 
 
@@ -278,6 +310,17 @@ def _sign_and_scale(
         return []
     gc, tc, loaded = centred
     out = []
+    corr = _correlations(gc, tc)
+    if np.any(few := loaded & (corr < -0.5)):  # a minority: said, not refused
+        idx = np.flatnonzero(few)
+        out.append(
+            f"the measured torques of {', '.join(names[k] for k in idx)} are anti-correlated "
+            f"with the model's gravity torques (correlation "
+            f"{', '.join(f'{corr[k]:+.2f}' for k in idx)}) while the other joints' agree: "
+            "their torque sign is probably opposite, or the robot's parameters of the links "
+            "they carry are wrong; hint: if so, flip the sign of their torque columns in the "
+            "file (--units tau=-1 flips every joint)"
+        )
     a = float(np.sum(gc[:, loaded] * tc[:, loaded]) / np.sum(gc[:, loaded] ** 2))
     if abs(a) > 30 or 0 < abs(a) < 1 / 30:
         p = round(math.log10(abs(a)))

@@ -18,6 +18,13 @@ against the joint limits:
 The finding names which columns to convert: the positions, and the velocities when their
 RMS is also ``180 / pi`` times the others' (a velocity in radians beside positions in
 degrees also shows in :func:`dynid.workflows.recordings.check_units`).
+
+Within one recording, a joint in degrees among joints in radians
+(:func:`joints_in_degrees`): its positions lie outside its limits (beyond a margin), they
+span more than the joint can travel (the width of its limits: a recording of another
+robot, shifted, does not), divided by ``180 / pi`` they fit the limits, and its velocities
+do not say radians (where they agree with the positions' derivative and stay below the
+joint's speed limit, an unwrapped continuous joint turning several times, they do).
 """
 
 from __future__ import annotations
@@ -29,8 +36,9 @@ from numpy.typing import NDArray
 
 from ..model.robot import Robot
 from .log import TorqueLog
+from .sanity import _rate_verdict
 
-__all__ = ["DEGREE_TOLERANCE", "degrees_among_radians"]
+__all__ = ["DEGREE_TOLERANCE", "degrees_among_radians", "joints_in_degrees"]
 
 #: A scale ratio within this factor of ``180 / pi`` reads as degrees against radians.
 DEGREE_TOLERANCE = 2.0
@@ -104,3 +112,57 @@ def degrees_among_radians(
             "(--units applies to every file)"
         )
     return None
+
+
+def joints_in_degrees(robot: Robot, log: TorqueLog, margin: float) -> tuple[list[int], str]:
+    """The joints of a joint-side ``log`` whose positions read as degrees (module
+    docstring), and the finding (one line, without the file's name; empty without them).
+
+    Parameters
+    ----------
+    robot : Robot
+        The model's robot (its joint limits [rad or m] and speed limits [rad/s]).
+    log : TorqueLog
+        A joint-side log.
+    margin : float
+        Margin [rad or m] beyond the joint limits before positions are outside them.
+    """
+    step = max(1, log.n_samples // _MAX_SAMPLES)
+    q = log.q[::step]
+    lo, hi = q.min(axis=0), q.max(axis=0)
+    q_min, q_max = np.asarray(robot.q_min), np.asarray(robot.q_max)
+    width = q_max - q_min
+    suspect = (
+        ~np.asarray(robot.prismatic, dtype=bool)
+        & np.isfinite(width)
+        & ((lo < q_min - margin) | (hi > q_max + margin))
+        & (hi - lo > width)
+        & (lo / _DEG >= q_min - margin)
+        & (hi / _DEG <= q_max + margin)
+    )
+    thin = TorqueLog(log.t[::step], q, log.dq[::step], log.tau[::step])
+    verdicts = {j: _rate_verdict(robot, thin, j) for j in map(int, np.flatnonzero(suspect))}
+    found = [j for j, v in verdicts.items() if v is not None]
+    if not found:
+        return [], ""
+    both = all("dq=deg/s" in verdicts[j][1] for j in found)  # type: ignore[index]
+    names = robot.joint_names
+    spans = ", ".join(
+        f"{names[j]} spans [{lo[j]:.4g}, {hi[j]:.4g}], limits [{q_min[j]:.4g}, {q_max[j]:.4g}]"
+        for j in found[:3]
+    ) + (f" (and {len(found) - 3} more)" if len(found) > 3 else "")
+    moving = ~np.asarray(robot.prismatic, dtype=bool) & (hi - lo > 1e-3)
+    if set(found) >= set(map(int, np.flatnonzero(moving))):
+        what = "positions in degrees"
+        hint = "--units q=deg" + (",dq=deg/s" if both else "")
+    else:
+        what = "joint(s) in degrees among joints in radians"
+        cols = "positions and velocities" if both else "positions"
+        hint = (
+            f"convert the {cols} of {', '.join(names[j] for j in found)} to radians "
+            "(x pi/180) in the file (--units converts every joint alike)"
+        )
+    return found, (
+        f"{what}: {spans}: more than the joint can travel, and within its limits read in "
+        f"degrees; hint: {hint}"
+    )

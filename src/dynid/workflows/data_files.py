@@ -167,6 +167,7 @@ def read_torque_log(
     columns: ColumnMap | None = None,
     drop_invalid: bool = False,
     owner: str | None = None,
+    robot: Robot | None = None,
 ) -> TorqueLog:
     """The torque log ``path``, read strictly, with ``n`` joints.
 
@@ -182,6 +183,9 @@ def read_torque_log(
         Drop rows with NaN/inf or a repeated timestamp (logged) instead of failing.
     owner : str, optional
         What has ``n`` joints, for the message (default ``"the robot"``).
+    robot : Robot, optional
+        The robot of ``n`` joints: a log of fewer joints is told which joints of its chain
+        it lacks (a gripper's, say) and the ``--tip`` link before them.
 
     Returns
     -------
@@ -217,10 +221,23 @@ def read_torque_log(
     if n is not None and log.n != n:
         raise DataError(
             f"the log has {log.n} joints; {owner or 'the robot'} has {n}; "
-            "hint: pass the robot the log was recorded with",
+            + _joint_count_hint(log.n, robot if robot is not None and robot.n == n else None),
             file=path.name,
         )
     return log
+
+
+def _joint_count_hint(n_log: int, robot: Robot | None) -> str:
+    """The hint of a log of ``n_log`` joints for ``robot``: the joints its chain holds
+    beyond the log's (a gripper's) and the ``--tip`` link before them, when it has more."""
+    if robot is None or not 0 < n_log < robot.n:
+        return "hint: pass the robot the log was recorded with"
+    extra = ", ".join(robot.joint_names[n_log:])
+    return (
+        f"its chain goes on past the log's joints with {extra}; hint: end the URDF's chain "
+        f"before them with --tip {robot.link_names[n_log]}, or pass the robot the log was "
+        "recorded with"
+    )
 
 
 def read_static_file(

@@ -52,7 +52,7 @@ from .data_files import (
 )
 from .options import check_band, check_choice, check_count, check_number, only_with, refused_with
 from .prior import load_prior
-from .recordings import Recorded, check_degrees, check_units, given_start
+from .recordings import Recorded, check_limits, check_units, given_start
 
 __all__ = ["ColumnSpec", "IdentifyOptions", "IdentifyResult", "data_files", "identify_files"]
 
@@ -363,20 +363,26 @@ def _identify(robot: Robot, paths: list[Path], opt: IdentifyOptions) -> Identifi
 
 def _read_logs(robot: Robot, paths: list[Path], cmap: Any, opt: IdentifyOptions) -> list[Any]:
     """The torque logs ``paths``, read strictly for ``robot`` (recorded through
-    ``opt.drive``); a recording in degrees among recordings in radians, or in other units
-    than the others, refused, naming it (:func:`~dynid.workflows.recordings.check_degrees`,
+    ``opt.drive``); a recording in degrees among recordings in radians, with joints in
+    degrees, or in other units than the others, refused, and one far outside the joint
+    limits warned about, naming it (:func:`~dynid.workflows.recordings.check_limits`,
     :func:`~dynid.workflows.recordings.check_units`); the whole turns of wrapped motors
     from ``q_start`` (:func:`given_start`)."""
     logs = [
         read_torque_log(
-            p, robot.n, columns=cmap, drop_invalid=opt.drop_invalid, owner=f"robot {robot.name!r}"
+            p,
+            robot.n,
+            columns=cmap,
+            drop_invalid=opt.drop_invalid,
+            owner=f"robot {robot.name!r}",
+            robot=robot,
         )
         for p in paths
     ]
     names = [p.name for p in paths]
     logs = list(given_start(logs, names, robot, opt.drive, opt.q_start, opt.max_gap_s))
     rec = Recorded(tuple(logs), tuple(paths))
-    check_degrees(rec, robot, opt.drive)
+    check_limits(rec, robot, opt.drive)
     check_units(rec)
     return logs
 

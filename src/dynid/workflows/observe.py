@@ -69,7 +69,7 @@ from .data_files import (
 )
 from .observe_detect import ResidualSink, detected_log, true_torques
 from .observe_logs import ObservedBlock, PreparedLog, Series, observed_blocks, prepared_log
-from .recordings import Recorded, check_limits, check_units, given_start
+from .recordings import Recorded, check_limits, check_signs, check_units, given_start
 
 __all__ = [
     "LogObservation",
@@ -378,12 +378,20 @@ def _read_logs(
     columns: tuple[str | None, str | None],
     opts: ObserveOptions,
 ) -> Recorded:
-    """The logs ``paths`` read strictly for the model; a log in other units than the others
-    refused and one far outside the joint limits warned about, each naming the file
+    """The logs ``paths`` read strictly for the model; a log in other units than the others,
+    with joints in degrees or with torques of the opposite sign to the model's refused,
+    and one far outside the joint limits warned about, each naming the file
     (:mod:`dynid.workflows.recordings`)."""
     cmap = column_map(*columns)
     logs = [
-        read_torque_log(p, model.n, columns=cmap, drop_invalid=opts.drop_invalid, owner="the model")
+        read_torque_log(
+            p,
+            model.n,
+            columns=cmap,
+            drop_invalid=opts.drop_invalid,
+            owner="the model",
+            robot=model.robot,
+        )
         for p in map(Path, paths)
     ]
     names = [Path(p).name for p in paths]
@@ -391,6 +399,7 @@ def _read_logs(
     read = Recorded(tuple(logs), tuple(map(Path, paths)))
     check_limits(read, model.robot, model.drive)
     check_units(read)
+    check_signs(read, model.robot, model.drive)
     return read
 
 

@@ -1,6 +1,6 @@
 """Several torque recordings read for a model: the ``--data a.csv b.csv ...`` (or a
-folder) of ``validate``, ``friction`` and ``payload`` (``identify`` applies the units
-check, :func:`check_units`; ``observe`` both checks).
+folder) of ``validate``, ``friction`` and ``payload`` (``identify`` and ``observe`` apply
+:func:`check_limits` and :func:`check_units` to the logs they read).
 
 Every recording is read strictly (:func:`~.data_files.read_torque_log`, through the
 column map the model's data were read with when none is given), and each problem is one
@@ -16,8 +16,12 @@ line naming the file, never a recording dropped silently:
 * a recording in degrees among recordings in radians (positions and velocities both in
   degrees pass the check above): an error naming it and the columns to convert
   (:mod:`~dynid.identification.unit_mix`);
-* a recording whose positions lie far outside the model's joint limits (of another robot,
-  or in degrees): a warning naming it.
+* a recording with joints in degrees (one joint's column written in degrees: its
+  positions span more than the joint can travel and fit its limits read in degrees): an
+  error naming it, the joints and the conversion (``identify``, ``validate``, ``observe``
+  alike);
+* a recording whose positions lie far outside the model's joint limits (of another robot):
+  a warning naming it.
 
 Pieces too short to filter are the preparation's (:mod:`dynid.friction.recordings`).
 """
@@ -35,8 +39,8 @@ import numpy as np
 from ..exceptions import DataError, DynidWarning, OptionError
 from ..identification.log import TorqueLog, joint_side_log
 from ..identification.pieces import with_start_turns
-from ..identification.sanity import moving_joints, time_unit_finding
-from ..identification.unit_mix import degrees_among_radians
+from ..identification.sanity import moving_joints, opposite_sign, time_unit_finding
+from ..identification.unit_mix import degrees_among_radians, joints_in_degrees
 from ..model.drive import Drive
 from ..model.robot import Robot
 from .data_files import (
@@ -53,6 +57,7 @@ __all__ = [
     "Recorded",
     "check_degrees",
     "check_limits",
+    "check_signs",
     "check_units",
     "given_start",
     "read_recordings",
@@ -138,7 +143,9 @@ def read_recordings(
     cmap = column_map(names, units, cutoff_hz=cutoff_hz)
 
     def read(p: Path) -> TorqueLog:
-        return read_torque_log(p, robot.n, columns=cmap, drop_invalid=drop_invalid, owner=owner)
+        return read_torque_log(
+            p, robot.n, columns=cmap, drop_invalid=drop_invalid, owner=owner, robot=robot
+        )
 
     logs = tuple(in_file(p, lambda p=p: read(p)) for p in paths)  # type: ignore[misc]
     logs = given_start(logs, [p.name for p in paths], robot, drive, q_start, max_gap_s)
@@ -178,7 +185,9 @@ def given_start(
     if len(logs) != 1:
         raise OptionError(
             f"gives the joint positions at the first sample of one recording; got {len(logs)} "
-            f"({', '.join(names)})",
+            f"({', '.join(names)}); hint: give one recording with --q-start (one at a time), "
+            "or log the motors' multi-turn angles or the joint positions (a joint-side log) "
+            "to read several",
             field="q_start",
         )
     return (with_start_turns(names[0], logs[0], robot, drive, np.asarray(q_start), max_gap_s),)
@@ -257,25 +266,49 @@ def check_degrees(rec: Recorded, robot: Robot, drive: Drive | None) -> None:
         raise DataError(found[1], file=rec.names[found[0]])
 
 
+def check_signs(rec: Recorded, robot: Robot, drive: Drive | None) -> None:
+    """Refuse a recording whose (joint-side) torques have the opposite sign to the
+    robot's, on every joint gravity loads or on some
+    (:func:`~dynid.identification.sanity.opposite_sign`), as ``identify`` does: thresholds
+    calibrated on it, or residuals of it, would be of the wrong sign.
+
+    Raises
+    ------
+    DataError
+        Naming the recording, the joints and the remedy (``--units tau=-1``, or the
+        columns to flip).
+    """
+    for name, log in zip(rec.names, rec.logs, strict=True):
+        if (opposite := opposite_sign(robot, _joint_side(log, drive))) is not None:
+            raise DataError(opposite, file=name)
+
+
 def _joint_side(log: TorqueLog, drive: Drive | None) -> TorqueLog:
     return log if drive is None or drive.n != log.n else joint_side_log(log, drive)
 
 
 def check_limits(rec: Recorded, robot: Robot, drive: Drive | None) -> None:
-    """Refuse a recording in degrees among recordings in radians (:func:`check_degrees`);
-    warn about a recording whose (joint-side) positions lie far outside the joint limits
-    (:data:`LIMIT_MARGIN` beyond them), naming it.
+    """Refuse a recording in degrees among recordings in radians (:func:`check_degrees`)
+    and a recording with joints in degrees
+    (:func:`~dynid.identification.unit_mix.joints_in_degrees`); warn about a recording
+    whose (joint-side) positions lie far outside the joint limits (:data:`LIMIT_MARGIN`
+    beyond them), naming it.
 
     Raises
     ------
     DataError
-        A recording in degrees among recordings in radians.
+        A recording in degrees among recordings in radians, or with joints in degrees
+        (naming the file, the joints and the conversion).
     """
     check_degrees(rec, robot, drive)
+    sides = [_joint_side(log, drive) for log in rec.logs]
+    for name, log in zip(rec.names, sides, strict=True):
+        if (found := joints_in_degrees(robot, log, LIMIT_MARGIN))[0]:
+            raise DataError(found[1], file=name)
     lo = np.asarray(robot.q_min) - LIMIT_MARGIN
     hi = np.asarray(robot.q_max) + LIMIT_MARGIN
-    for name, log in zip(rec.names, rec.logs, strict=True):
-        q = _joint_side(log, drive).q
+    for name, log in zip(rec.names, sides, strict=True):
+        q = log.q
         qmin, qmax = np.min(q, axis=0), np.max(q, axis=0)
         bad = np.flatnonzero((qmin < lo) | (qmax > hi))
         if bad.size:

@@ -1,0 +1,166 @@
+"""Faults of one recording that every command refuses alike, before any fit or residual.
+
+Reference: a simulated Panda log (the robot's own model) in radians and N m, rewritten
+with one fault: one joint's columns in degrees (``x 180 / pi``), the torques of every joint
+or of some joints negated. The Panda's joint limits and gravity torques are the model's.
+Before, ``identify`` never checked the joint limits (one joint in degrees: exit 0, a model
+of 16.8 % training error), ``observe --calibrate`` calibrated on torques of the opposite
+sign (thresholds 80 times too wide), and a sign flipped on some joints was told to flip
+them all with ``--units tau=-1``.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+import dynid
+from dynid.cli.__main__ import main
+from dynid.dynamics.terms import gravity_torques
+from dynid.exceptions import DataError
+from dynid.identification.log import TorqueLog
+from dynid.identification.sanity import check_torque_log, opposite_sign
+from dynid.io.torque_log import save_torque_log
+from dynid.simulation.measurement import sample_times, simulate_measurement
+from dynid.simulation.trajectories import random_fourier
+from dynid.workflows.recordings import Recorded, check_limits
+
+DEG = 180.0 / np.pi
+
+
+@pytest.fixture(scope="module")
+def panda():
+    return dynid.panda()
+
+
+@pytest.fixture(scope="module")
+def log(panda) -> TorqueLog:
+    traj = random_fourier(panda, np.random.default_rng(4))(sample_times(4.0, 200.0))
+    g = simulate_measurement(panda, traj, rng=np.random.default_rng(5))
+    return TorqueLog(g.t, g.q, g.dq, g.tau)
+
+
+def _joint_in_degrees(log: TorqueLog, j: int) -> TorqueLog:
+    q, dq = log.q.copy(), log.dq.copy()
+    q[:, j] *= DEG
+    dq[:, j] *= DEG
+    return TorqueLog(log.t, q, dq, log.tau)
+
+
+def _flipped(log: TorqueLog, joints: list[int]) -> TorqueLog:
+    tau = log.tau.copy()
+    tau[:, joints] *= -1
+    return TorqueLog(log.t, log.q, log.dq, tau)
+
+
+def test_one_joint_in_degrees_is_refused_naming_the_file_the_joint_and_the_fix(panda, log):
+    """Joint 1 in degrees (it spans more than its limits' width, which it fits read in
+    degrees): refused; the same log shifted by 3 rad (another robot) only warned about."""
+    deg = _joint_in_degrees(log, 0)
+    assert np.ptp(deg.q[:, 0]) > panda.q_max[0] - panda.q_min[0]
+    with pytest.raises(DataError) as e:
+        check_limits(Recorded((deg,), (Path("one.csv"),)), panda, None)
+    said = str(e.value)
+    assert said.startswith("one.csv: joint(s) in degrees among joints in radians")
+    first, second = panda.joint_names[:2]
+    assert f"convert the positions and velocities of {first} to radians" in said
+    assert f"{second} spans" not in said
+    whole = TorqueLog(log.t, log.q * DEG, log.dq * DEG, log.tau)
+    with pytest.raises(DataError, match=r"w.csv: positions in degrees.*--units q=deg,dq=deg/s"):
+        check_limits(Recorded((whole,), (Path("w.csv"),)), panda, None)
+    shifted = TorqueLog(log.t, log.q + 3.0, log.dq, log.tau)
+    with pytest.warns(UserWarning, match="far outside the limits"):
+        check_limits(Recorded((shifted,), (Path("s.csv"),)), panda, None)
+
+
+def test_identify_refuses_one_joint_in_degrees(panda, log, tmp_path, capsys):
+    """The command: exit 2 with one line naming the file and the joint (it fitted, exit
+    0)."""
+    save_torque_log(tmp_path / "deg1.csv", _joint_in_degrees(log, 0))
+    argv = ["identify", "--robot", "panda", "--data", str(tmp_path / "deg1.csv")]
+    assert main([*argv, "--out", str(tmp_path / "i"), "--no-figures"]) == 2
+    err = [s for s in capsys.readouterr().err.splitlines() if "error" in s]
+    assert len(err) == 1 and "deg1.csv" in err[0] and panda.joint_names[0] in err[0], err
+
+
+def test_observe_refuses_torques_of_the_opposite_sign(log, tmp_path, capsys):
+    """observe --calibrate on a log whose torques are all negated: refused in one line
+    naming the file and --units tau=-1, as identify refuses it."""
+    save_torque_log(tmp_path / "neg.csv", TorqueLog(log.t, log.q, log.dq, -log.tau))
+    argv = ["observe", "--params", "panda", "-q", "--calibrate"]
+    assert main([*argv, "--data", str(tmp_path / "neg.csv"), "--out", str(tmp_path / "c")]) == 2
+    err = [s for s in capsys.readouterr().err.splitlines() if "error" in s]
+    assert len(err) == 1 and "neg.csv" in err[0] and "--units tau=-1" in err[0], err
+
+
+def test_a_sign_flipped_on_some_joints_names_them(panda, log):
+    """Joints 1-3 negated (as in the trial): the finding names the joints gravity loads
+    (computed here) among them, tells to flip their columns, and does not say --units
+    tau=-1 would fix it; all negated: --units tau=-1."""
+    flipped = [0, 1, 2]
+    g = gravity_torques(panda, log.q)
+    loaded = np.std(g, axis=0) > 0.05 * np.std(g, axis=0).max()
+    said = opposite_sign(panda, _flipped(log, flipped))
+    assert said is not None and "some joints only" in said
+    head = said.split("is probably opposite")[0].split("the torque sign of ")[1]
+    assert set(head.strip().split(", ")) == {panda.joint_names[j] for j in flipped if loaded[j]}
+    assert "hint: flip the sign of their torque columns" in said
+    assert not loaded[0] and f"the sign of {panda.joint_names[0]}" in said
+    every = opposite_sign(panda, _flipped(log, list(range(7))))
+    assert every is not None and "hint: --units tau=-1" in every
+
+
+def _joint(name: str, parent: str, child: str, axis: str) -> str:
+    return (
+        f'<joint name="{name}" type="revolute"><parent link="{parent}"/><child link="{child}"/>'
+        f'<origin xyz="0 0 0.3"/><axis xyz="{axis}"/>'
+        '<limit lower="-2" upper="2" effort="10" velocity="2"/></joint>'
+        f'<link name="{child}"><inertial><origin xyz="0 0 0.1"/><mass value="1.0"/>'
+        '<inertia ixx="0.01" ixy="0" ixz="0" iyy="0.01" iyz="0" izz="0.01"/></inertial></link>'
+    )
+
+
+ARM_WITH_GRIPPER = (
+    '<robot name="arm"><link name="base"/>'
+    + _joint("shoulder", "base", "upper", "0 0 1")
+    + _joint("elbow", "upper", "fore", "0 1 0")
+    + _joint("finger_joint", "fore", "finger", "1 0 0")
+    + "</robot>"
+)
+
+
+@pytest.mark.parametrize("command", ["identify --robot", "validate --robot", "observe --params"])
+def test_a_log_without_the_gripper_joint_names_it_and_the_tip(tmp_path, capsys, command):
+    """A URDF chain of 3 joints whose last is a gripper's, a log of the arm's 2: one line
+    naming the gripper joint and --tip with the link before it (it said only "6 joints;
+    model has 7"); the robot read up to that link has the log's joint count."""
+    urdf = tmp_path / "arm.urdf"
+    urdf.write_text(ARM_WITH_GRIPPER)
+    t = np.arange(0.0, 1.0, 0.01)
+    q = 0.3 * np.stack([np.sin(t), np.cos(t)], axis=1)
+    save_torque_log(tmp_path / "arm.csv", TorqueLog(t, q, np.gradient(q, t, axis=0), 0 * q))
+    argv = [*command.split(), str(urdf), "--data", str(tmp_path / "arm.csv")]
+    if command.startswith("observe"):
+        argv.append("--calibrate")
+    assert main([*argv, "--out", str(tmp_path / "o")]) == 2
+    err = [s for s in capsys.readouterr().err.splitlines() if "error" in s]
+    assert len(err) == 1 and "arm.csv" in err[0], err
+    assert "finger_joint" in err[0] and "--tip fore" in err[0], err
+    assert dynid.Robot.from_urdf(urdf, tip_link="fore").n == 2
+
+
+def test_a_sign_flipped_on_one_joint_of_three_loaded_is_said(panda, log):
+    """Joint 4 negated, one of the three joints gravity loads (computed here): not
+    refused (the robot's parameters may be what is wrong), but a warning naming that
+    joint alone (nothing was said: a model of 30 % error, exit 0)."""
+    g = gravity_torques(panda, log.q)
+    loaded = np.flatnonzero(np.std(g, axis=0) > 0.05 * np.std(g, axis=0).max())
+    assert 3 in loaded and loaded.size >= 3
+    assert opposite_sign(panda, _flipped(log, [3])) is None
+    found = [f for f in check_torque_log(panda, _flipped(log, [3])) if "anti-correlated" in f]
+    assert len(found) == 1 and found[0].startswith(
+        f"the measured torques of {panda.joint_names[3]} are anti-correlated"
+    )
+    assert not [f for f in check_torque_log(panda, log) if "anti-correlated" in f]
