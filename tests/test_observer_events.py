@@ -25,7 +25,8 @@ def _reference(t, r, contact, collision, merge_s, restarts, min_duration_s=0.0):
         if not over.any():
             continue
         new_piece = cur is not None and any(cur["last"] < s <= k for s in restarts)
-        if cur is None or t[k] - t[cur["last"]] > merge_s or new_piece:
+        apart = k - cur["last"] > 1 and t[k] - t[cur["last"]] > merge_s if cur else True
+        if apart or new_piece:
             if cur is not None:
                 events.append(cur)
             cur = {"first": k, "last": k, "joints": set()}
@@ -55,11 +56,14 @@ def _as_tuples(events):
     return [(e.start, e.end, e.joints, e.peak, e.level) for e in events]
 
 
+@pytest.mark.parametrize("merge", [0.05, 0.0])
 @pytest.mark.parametrize("block", [1, 3, 17, 64, 1000])
-def test_events_fed_in_blocks_are_those_of_the_definition(block):
+def test_events_fed_in_blocks_are_those_of_the_definition(block, merge):
     """A noisy residual with bursts (some closer than merge_s, one across a restart, NaN
     samples, the uncertainty's std and a standstill margin): every block size gives the
-    reference's events, as the whole log in one block (detect) does."""
+    reference's events, as the whole log in one block (detect) does. With ``merge_s = 0``
+    a run of samples over the threshold one after the other is one event (each sample
+    was one)."""
     rng = np.random.default_rng(4)
     N, n = 1000, 3
     t = np.cumsum(rng.uniform(0.8e-3, 1.2e-3, N))
@@ -79,11 +83,13 @@ def test_events_fed_in_blocks_are_those_of_the_definition(block):
     restarts = [0, 610]
     c = 3.0 * np.nan_to_num(std) + 0.15 + margin
     k = 3.0 * (3.0 * np.nan_to_num(std) + 0.15) + margin
-    want = _reference(t, r, c, k, 0.05, restarts, 0.01)
-    assert len(want) >= 5 and {e[4] for e in want} == {"contact", "collision"}
-    raw = _reference(t, r, c, k, 0.05, restarts)
+    want = _reference(t, r, c, k, merge, restarts, 0.01)
+    levels = {e[4] for e in want}
+    assert len(want) >= 5 and levels == ({"contact", "collision"} if merge else {"collision"})
+    assert all(e[1] - e[0] >= 0.01 or e[4] == "collision" for e in want)
+    raw = _reference(t, r, c, k, merge, restarts)
     assert any(e[1] - e[0] < 0.01 for e in raw)  # some dropped
-    det = EventDetector(th, merge_s=0.05, min_duration_s=0.01, restarts=restarts)
+    det = EventDetector(th, merge_s=merge, min_duration_s=0.01, restarts=restarts)
     got = []
     for a in range(0, N, block):
         k = slice(a, a + block)
@@ -91,7 +97,7 @@ def test_events_fed_in_blocks_are_those_of_the_definition(block):
     got += det.finish()
     assert _as_tuples(got) == want
     whole = detect(
-        t, r, th, std=std, standstill=margin, merge_s=0.05, min_duration_s=0.01,
+        t, r, th, std=std, standstill=margin, merge_s=merge, min_duration_s=0.01,
         restarts=restarts,
     )  # fmt: skip
     assert _as_tuples(whole) == want
@@ -244,3 +250,23 @@ def test_a_detection_figure_keeps_every_kth_sample_of_the_series(contact_log, mo
     p = ["observe", "--params", "panda", "--thresholds", str(d / "cal" / "thresholds.json")]
     assert main([*p, "--data", str(d / "hit.csv"), "--out", str(d / "fig")]) == 0
     assert (d / "fig" / "residuals.png").stat().st_size > 0
+
+
+def test_without_merging_a_run_over_the_threshold_is_one_event():
+    """``merge_s = 0``: a push of 50 samples over the threshold is one event (it was 50,
+    one per sample), in any blocks; two runs one sample apart are two."""
+    N, n = 200, 2
+    t = np.arange(N) * 1e-3
+    r = np.zeros((N, n))
+    r[50:100, 0] = 1.0
+    r[101:110, 0] = 1.0
+    th = Thresholds(
+        contact=np.full(n, 0.5), collision=np.full(n, 5.0), margin=1.0, quantile=1.0,
+        collision_factor=10.0, options=ObserverOptions(), samples=1, k_sigma=0.0,
+        noise=np.zeros(n), standstill=False,
+    )  # fmt: skip
+    whole = detect(t, r, th, merge_s=0.0, min_duration_s=0.0)
+    assert [(e.start, e.end) for e in whole] == [(t[50], t[99]), (t[101], t[109])]
+    det = EventDetector(th, merge_s=0.0, min_duration_s=0.0)
+    got = [e for a in range(0, N, 7) for e in det.feed(t[a : a + 7], r[a : a + 7])]
+    assert _as_tuples(got + det.finish()) == _as_tuples(whole)

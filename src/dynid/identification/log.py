@@ -332,7 +332,8 @@ def velocity_note(cutoff_hz: float) -> str:
     return (
         "no velocity columns: velocities derived from the positions (zero-phase low-pass, "
         "then central differences) at the cut-off of the step that prepares the log "
-        f"(identification, validation, friction; {cutoff_hz:g} Hz when read alone)"
+        "(identification, validation and friction at theirs, the observer at its own; "
+        f"{cutoff_hz:g} Hz when read alone)"
     )
 
 

@@ -119,6 +119,7 @@ class _Open:
     piece: int
     held: _Stretch
     after: _Stretch
+    since: int = 0  # samples fed after its last one over the threshold
 
     def closed(self) -> ContactEvent:
         level: Literal["contact", "collision"] = "collision" if self.held.collision else "contact"
@@ -219,9 +220,12 @@ class EventDetector:
             if self._open is not None:
                 beyond = np.abs(ra) > collision
                 self._open.after = self._open.after.then(_Stretch.of(ra, over, beyond))
+                self._open.since += m
             return out
         piece = np.searchsorted(self._restarts, first + hit, side="right")
-        split = (ta[hit[1:]] - ta[hit[:-1]] > self.merge_s) | (piece[1:] != piece[:-1])
+        # a run: samples over the threshold one after the other, or closer than merge_s
+        apart = (np.diff(hit) > 1) & (ta[hit[1:]] - ta[hit[:-1]] > self.merge_s)
+        split = apart | (piece[1:] != piece[:-1])
         runs = np.split(np.arange(hit.size), np.flatnonzero(split) + 1)
         beyond = np.abs(ra) > collision
         for i, run in enumerate(runs):
@@ -229,7 +233,10 @@ class EventDetector:
             joins = (
                 i == 0
                 and self._open is not None
-                and not ta[a] - self._open.last > self.merge_s
+                and (
+                    (a == 0 and self._open.since == 0)  # the next sample after the last block's
+                    or not ta[a] - self._open.last > self.merge_s
+                )
                 and int(piece[run[0]]) == self._open.piece
             )
             if joins:
@@ -252,6 +259,7 @@ class EventDetector:
         assert self._open is not None
         b = int(hit[-1]) + 1
         self._open.after = _Stretch.of(ra[b:], over[b:], beyond[b:])
+        self._open.since = m - b
         return out
 
     def finish(self) -> list[ContactEvent]:
