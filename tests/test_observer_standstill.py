@@ -199,3 +199,30 @@ def test_the_margin_of_friction_at_the_motors_and_the_joints_adds_both():
     # motors as in the coupled test; joint 2's own 0.3 where |dq_2| <= 0.002
     expected = np.array([[250.0, 50.3], [50.0, 50.3], [200.0, 0.0]])
     assert standstill_margin(FrictionSum((motor, joint)), dq) == pytest.approx(expected, abs=1e-12)
+
+
+def test_a_smooth_law_narrower_than_the_noise_band_is_observed_with_the_band():
+    """``fc tanh(dq / w)`` with ``w`` (0.5 mrad/s) inside the velocity noise band (5
+    mrad/s), the law identification chooses for motion: the observer evaluates it as the
+    classical law with the band (0 inside it, the sign outside), so that a joint at rest
+    is bounded by ``fc``, not by the ``2 fc`` a tanh of the noise needs; a wider law is
+    evaluated as it is."""
+    from dynid.friction.laws import LAWS
+    from dynid.observer.friction import banded_if_narrow, standstill_margin
+
+    n = 2
+    P = np.array([[0.4, 2.0, 0.1], [0.2, 1.0, -0.05]])  # fv, fc, fo
+    band = np.full(n, 5e-3)
+    narrow = LAWS["smooth"].model(P, np.full(n, 5e-4))
+    seen = banded_if_narrow(narrow, (band,))
+    assert seen.kind == "classical"
+    v = np.array([[-0.2, 0.3], [0.004, -0.001], [0.006, -0.02]])
+    sign = np.where(np.abs(v) > band, np.sign(v), 0.0)
+    np.testing.assert_allclose(seen.torques(v), P[:, 0] * v + P[:, 1] * sign + P[:, 2], atol=1e-12)
+    at_rest = np.zeros((1, n))
+    np.testing.assert_allclose(
+        standstill_margin(narrow, at_rest, (band,)), [2 * P[:, 1]], rtol=1e-6
+    )
+    np.testing.assert_allclose(standstill_margin(seen, at_rest, (band,)), [P[:, 1]], rtol=1e-12)
+    wide = LAWS["smooth"].model(P, np.full(n, 5e-2))
+    assert banded_if_narrow(wide, (band,)) is wide

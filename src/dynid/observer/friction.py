@@ -68,6 +68,7 @@ from ..friction.model import FrictionModel, FrictionSum, friction_parts
 __all__ = [
     "DERIVED_CUTOFF_HZ",
     "FRICTION_COLUMNS",
+    "banded_if_narrow",
     "canonical_friction",
     "derived_velocity_bands",
     "standstill_margin",
@@ -188,6 +189,35 @@ def _derivative_noise_gain(dt: float, cutoff_hz: float) -> float:
     x[half] = 1.0
     h = filtered_derivative(dt * np.arange(2 * half + 1), x, cutoff_hz)[:, 0]
     return float(np.sqrt(np.sum(h**2)))
+
+
+def banded_if_narrow(
+    friction: FrictionModel | FrictionSum | None, bands: tuple[NDArray[np.float64], ...]
+) -> FrictionModel | FrictionSum | None:
+    """``friction`` as the observer evaluates it on velocities of noise band ``bands``
+    (:func:`velocity_bands` or :func:`derived_velocity_bands`, one per part): a smooth
+    Coulomb law ``fc tanh(dq / w)`` narrower than the band on every motor becomes the
+    classical law with the band as its standstill band (``fc sign(dq)`` outside it, 0
+    inside); any other friction as it is.
+
+    Inside the band a narrow ``tanh`` of the noise is a random level in ``[-fc, fc]``, which
+    bounds the residual of a joint at rest by ``2 fc`` (:func:`standstill_margin`); the
+    band's zero bounds it by ``fc``, as for a law identified with the band, and outside
+    the band both are the sign. Identification chooses the narrow law because it predicts
+    torques in motion best; at rest the observer needs the band (a UR10 with a contact
+    at rest: margins of 15.9 N m on joint 1 with the narrow law, 7.1 N m with the band)."""
+    if friction is None or isinstance(friction, FrictionSum) or friction.kind != "smooth":
+        return friction
+    (b,) = bands
+    width = np.asarray(friction.band, dtype=np.float64)
+    if width.size != b.size or not np.all(width < b):
+        return friction
+    from ..friction.laws import LAWS
+
+    banded: FrictionModel = LAWS["classical"].model(
+        np.asarray(friction.params), b, getattr(friction, "drive", None)
+    )
+    return banded
 
 
 def standstill_margin(

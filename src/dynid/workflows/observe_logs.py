@@ -26,7 +26,12 @@ from ..exceptions import in_file as about_file
 from ..identification.log import TorqueLog, default_max_gap, joint_side_log
 from ..identification.pieces import unwrapped, with_start_turns, wrappable
 from ..observer.detection import residual_std_blocks, standstill_blocks
-from ..observer.friction import DERIVED_CUTOFF_HZ, derived_velocity_bands
+from ..observer.friction import (
+    DERIVED_CUTOFF_HZ,
+    banded_if_narrow,
+    derived_velocity_bands,
+    velocity_bands,
+)
 from ..observer.model import ObserverModel
 from ..observer.pieces import PositionJump, pieces, position_jumps
 from ..observer.residual import MomentumObserver, ObserverOptions
@@ -128,7 +133,12 @@ def observed_blocks(
     t, q, tau, dq = prep.log.t, prep.log.q, prep.log.tau, prep.dq
     with about_file(prep.path.name):
         for a, b in prep.spans:
-            obs = MomentumObserver(model, options)
+            kw = _bands(prep, model, a, b)
+            here = model
+            if model.friction is not None:  # a smooth law narrower than the noise: banded
+                kw.setdefault("bands", velocity_bands(model.friction, dq[a:b]))
+                here = model.with_friction(banded_if_narrow(model.friction, kw["bands"]))
+            obs = MomentumObserver(here, options)
             stds = _rechunked(
                 residual_std_blocks(model, t[a:b], q[a:b], dq[a:b], options)
                 if wants_std
@@ -136,9 +146,7 @@ def observed_blocks(
                 OBSERVE_BLOCK,
             )
             margins = (
-                standstill_blocks(
-                    model, t[a:b], dq[a:b], options, OBSERVE_BLOCK, **_bands(prep, model, a, b)
-                )
+                standstill_blocks(here, t[a:b], dq[a:b], options, OBSERVE_BLOCK, **kw)
                 if wants_margin
                 else iter(())
             )
