@@ -112,7 +112,7 @@ def main(argv: list[str] | None = None) -> int:
             np.max(np.abs(got.fit.beta - ref.fit.beta) / np.maximum(np.abs(ref.fit.beta), 1e-12))
         )
         n_rows = int(ref.info.n_rows)
-        width = int(ref.fit.beta.size + (0 if ref.friction is None else ref.friction.size))
+        width = int(ref.fit.beta.size + (0 if ref.friction is None else ref.friction.params.size))
         streams = any(seen)
         ratio = streamed / stacked
         chosen = default / min(stacked, streamed)
