@@ -55,7 +55,7 @@ from common import (  # noqa: E402
 import dynid  # noqa: E402
 from dynid.friction.model import ClassicalFriction  # noqa: E402
 from dynid.identification.classical import identify_from_log  # noqa: E402
-from dynid.identification.log import prepare_log  # noqa: E402
+from dynid.identification.prepare import prepare_log  # noqa: E402
 from dynid.model.drive import Drive  # noqa: E402
 from dynid.regressors.base import base_parameters  # noqa: E402
 from dynid.regressors.torque import torque_regressor  # noqa: E402
