@@ -53,7 +53,7 @@ from common import (  # noqa: E402
 )
 
 import dynid  # noqa: E402
-from dynid.friction.model import ClassicalFriction  # noqa: E402
+from dynid.friction.validation import own_friction  # noqa: E402
 from dynid.identification.classical import identify_from_log  # noqa: E402
 from dynid.identification.prepare import prepare_log  # noqa: E402
 from dynid.model.drive import Drive  # noqa: E402
@@ -103,7 +103,7 @@ def main(argv: list[str] | None = None) -> int:
     held = random_fourier(robot, np.random.default_rng(2))(sample_times(10.0, args.rate))
     meas = simulate_measurement(robot, held, rng=np.random.default_rng(3), friction=None)
     pred = ident.torques(held.q, held.dq, held.ddq)
-    pred = pred + ClassicalFriction.from_array(ident.friction).torques(held.dq)
+    pred = pred + own_friction(ident).torques(held.dq)
     rms = np.sqrt(np.mean((meas.tau - pred) ** 2, axis=0))
     check_close("held-out torque RMS vs 0.05 N m sensor noise", rms, np.full(7, 0.05), atol=0.01)
     beta = base_parameters(robot, kind="torque").beta_from_phi(robot.phi)
