@@ -54,11 +54,22 @@ REFERENCE = {
         ),
         [[0.3, 0.6, 1.2, 0.08, 0.1], [0.1, 0.3, 0.5, 0.15, -0.05]],
     ),
+    "smooth_stribeck": (
+        lambda v, p, b: (
+            p[0] * v + (p[1] + (p[2] - p[1]) * np.exp(-((v / p[3]) ** 2))) * np.tanh(v / b) + p[4]
+        ),
+        [[0.3, 0.6, 1.2, 0.08, 0.1], [0.1, 0.3, 0.5, 0.15, -0.05]],
+    ),
     "sigmoid": (
         lambda v, p, b: p[0] / (1 + np.exp(-p[1] * (v + p[2]))) - p[0] / (1 + np.exp(-p[1] * p[2])),
         [[1.5, 20.0, 0.02], [0.8, 35.0, -0.01]],
     ),
 }
+
+
+#: The laws in the order their random seeds were given (a new law goes last).
+SEED_ORDER = ("asymmetric", "classical", "quadratic", "sigmoid", "smooth", "stribeck")
+SEED_ORDER += ("smooth_stribeck",)
 
 
 def _sweep(N=20_000, fs=1000.0):
@@ -75,9 +86,10 @@ def _friction(name, dq, P, band=BAND):
 
 
 def test_the_registry_names_every_law_and_refuses_others():
-    """The registry holds the six laws and 'none'; an unknown name names the flag."""
+    """The registry holds the seven laws and 'none'; an unknown name names the flag."""
     assert list(LAWS) == [
-        "none", "classical", "smooth", "quadratic", "asymmetric", "stribeck", "sigmoid"
+        "none", "classical", "smooth", "quadratic", "asymmetric", "stribeck",
+        "smooth_stribeck", "sigmoid",
     ]  # fmt: skip
     for law in LAWS.values():
         assert len(law.params) == len(law.units) == len(law.lower) == len(law.upper)
@@ -91,7 +103,7 @@ def test_every_law_recovers_its_own_simulated_parameters(name):
     parameters (to 1 %; 3 % for the Stribeck velocity, the sigmoid's steepness and the
     quadratic law's viscous pair), and the
     RMS after is the noise; the fitted model's torques are the written-out law's."""
-    rng = np.random.default_rng(40 + sorted(REFERENCE).index(name))
+    rng = np.random.default_rng(40 + list(SEED_ORDER).index(name))
     _, dq = _sweep()
     P = np.array(REFERENCE[name][1])
     r = _friction(name, dq, P) + rng.normal(0.0, TAU_NOISE, dq.shape)
@@ -99,10 +111,12 @@ def test_every_law_recovers_its_own_simulated_parameters(name):
     got = fit.friction.as_array()
     scale = np.maximum(np.abs(P), 0.05)
     rtol = np.full(P.shape, 0.01)
-    if name in ("stribeck", "sigmoid"):
-        rtol[:, 3 if name == "stribeck" else 1] = 0.03
+    if name in ("stribeck", "smooth_stribeck", "sigmoid"):
+        rtol[:, 1 if name == "sigmoid" else 3] = 0.03
     if name == "quadratic":  # v and v |v| are correlated over a sweep: 3 % for fv and fq
         rtol[:, :2] = 0.03
+    if name.endswith("stribeck"):  # v and the bump near vst: 4 % for fv
+        rtol[:, 0] = 0.04
     assert np.all(np.abs(got - P) <= rtol * scale + 2e-3), (got, P)
     np.testing.assert_allclose(fit.rms_after, TAU_NOISE, rtol=0.05)
     v = np.linspace(-1.2, 1.2, 1001)[:, None] * np.ones(2)
@@ -151,7 +165,7 @@ def _residual(dq_true, r, seed):
 def test_the_selection_keeps_the_true_law_and_never_predicts_worse_than_none(name):
     """Simulated friction of one law: the held-out selection keeps that law, its held-out
     error is the lowest and below that of no friction and of an own friction given."""
-    rng = np.random.default_rng(60 + list(LAWS).index(name))
+    rng = np.random.default_rng({"classical": 61, "asymmetric": 64, "stribeck": 65}.get(name, 66))
     _, dq = _sweep(10_000)
     r = _friction(name, dq, np.array(REFERENCE[name][1])) + rng.normal(0, TAU_NOISE, dq.shape)
     own = ClassicalFriction([0.2, 0.2], [0.5, 0.5], [0.0, 0.0])
@@ -161,7 +175,8 @@ def test_the_selection_keeps_the_true_law_and_never_predicts_worse_than_none(nam
     assert held[name] == min(held.values()) < min(held["none"], held["own"])
     assert sel.fit.kind == name and "* " + name in sel.table()
     doc = sel.as_dict()
-    assert doc["chosen"] == name and len(doc["candidates"]) == len(LAWS) + 1
+    compared = [n for n in LAWS if n != "smooth_stribeck"]  # given by name only
+    assert doc["chosen"] == name and len(doc["candidates"]) == len(compared) + 1
 
 
 def test_the_selection_keeps_the_own_friction_when_nothing_predicts_better():

@@ -72,7 +72,7 @@ def test_armature_and_viscous_friction_are_chosen_by_default(panda, armature_log
     assert sel is not None and sel["chosen"] == "links + armature + viscous", sel
     assert sel["validation"].startswith("leave one recording out")
     names = [c["name"] for c in sel["candidates"]]
-    assert "links + viscous + coulomb + offset" in names and len(names) == 50
+    assert "links + viscous + coulomb + offset" in names and len(names) == 84
     rms = np.sqrt(np.mean((test.tau - _predict(model, held)) ** 2, axis=0))
     assert np.all(rms < 1.1 * NOISE), rms  # the held-out recording's noise, nothing more
     # without the armature (the structure of the paper) the same data predict far worse
@@ -399,7 +399,7 @@ def test_friction_of_a_coupled_drive_is_placed_where_the_data_say(panda, truth):
     sel = model.info.selection
     names = [c["name"] for c in sel["candidates"]]
     assert "links + viscous + at:joint" in names and "links + viscous + at:motor" in names
-    assert len(names) == 54  # 24 per placement, 5 at both, the model without friction once
+    assert len(names) == 88  # 41 per placement, 5 at both, the model without friction once
     assert sel["chosen"] == f"links + viscous + coulomb + at:{truth}", sel["chosen"]
     assert model.drive.friction_at == truth
     np.testing.assert_allclose(model.friction.params[:, :2], fr.as_array()[:, :2], atol=1e-7)
@@ -457,3 +457,36 @@ def test_a_fast_motor_is_not_taken_for_a_wrapped_joint():
     back, joints = unwrapped(wrapped, np.array([True, True]))
     assert joints == (0,)
     np.testing.assert_allclose(back.q[:, 0] - back.q[0, 0], q[:, 0] - q[0, 0], atol=1e-9)
+
+
+def test_a_stribeck_bump_on_noisy_velocities_is_chosen_on_the_smooth_sign(panda, tmp_path):
+    """An arm whose friction is a sharp Coulomb law with a Stribeck bump (``fs = 1.8 fc``
+    at 0.05 rad/s) on the true velocities, logged with 2e-3 rad/s of velocity noise: the
+    default identification chooses the Stribeck law on the smooth sign at 0.05 rad/s (the
+    banded sign switches the bump off where the measured velocity crosses zero, right
+    where it is largest), and it predicts a recording it never saw closer to that
+    recording's noise floor (the true model's error) than the banded Stribeck law does."""
+    fc = np.linspace(0.8, 0.3, 7)
+    P = np.column_stack([VISCOUS, fc, 1.8 * fc, np.full(7, 0.05), np.zeros(7)])
+    truth = LawFriction(LAWS["stribeck"], P)  # no band: the sharp sign of the true velocity
+    noisy = SensorNoise(tau_std=0.02, q_std=2e-5, dq_std=2e-3)
+    logs = recordings(panda, (71, 72, 73, 74), friction=truth, duration=6.0, noise=noisy)
+    files = []
+    for i, log in enumerate(logs):
+        files.append(str(tmp_path / f"r{i + 1}.csv"))
+        save_torque_log(files[-1], log)
+    errors = {}
+    for tag, extra in (("default", []), ("banded", ["--terms", "viscous,coulomb,stribeck:0.05"])):
+        out = tmp_path / tag
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore", DynidWarning)
+            assert main(["identify", "--robot", "panda", "--data", *files[:3], "--out", str(out)]
+                        + extra) == 0  # fmt: skip
+            assert main(["validate", "--model", str(out / "identification.json"), "--data",
+                         files[3], "--out", str(out / "val")]) == 0  # fmt: skip
+        errors[tag] = json.loads((out / "val" / "validation.json").read_text())
+    chosen = json.loads((tmp_path / "default" / "identification.json").read_text())
+    assert "smooth:0.3 + stribeck:0.05" in chosen["metadata"]["selection"]["chosen"]
+    floor = errors["default"]["noise_floor_percent"]
+    default, banded = (errors[k]["relative_error_percent"] for k in ("default", "banded"))
+    assert default < 2.0 * floor and default < 0.7 * banded, (default, banded, floor)

@@ -165,10 +165,10 @@ def _law(F, m, v):
     elif s < 0.0:
         f -= fcn
     dfs, vst = F[m, 6], F[m, 7]
-    if vst > 0.0 and dfs != 0.0:
-        x = v / vst
-        f += dfs * math.exp(-x * x) * s
     ft, vs = F[m, 8], F[m, 9]
+    if vst > 0.0 and dfs != 0.0:  # the bump takes the Coulomb term's sign: tanh where vs > 0
+        x = v / vst
+        f += dfs * math.exp(-x * x) * (math.tanh(v / vs) if vs > 0.0 else s)
     if ft != 0.0:
         if vs > 0.0:
             f += ft * math.tanh(v / vs)

@@ -246,9 +246,9 @@ def unheld_friction(
         band = np.asarray(p.band)
         if np.any(band > 0):
             j = int(np.argmax(band))
-            if p.kind == "smooth":
+            if p.kind in ("smooth", "smooth_stribeck"):
                 notes.append(
-                    f"the smooth law's rounding fc tanh(dq / v_s){where} over its standstill "
+                    f"the {p.kind} law's rounding fc tanh(dq / v_s){where} over its standstill "
                     f"band (v_s up to {band[j]:.3g} rad/s at {what} {j + 1}; written as plain "
                     "Coulomb friction)"
                 )

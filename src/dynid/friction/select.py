@@ -182,7 +182,8 @@ def select_friction(
     drive : Drive, optional
         The drive whose motors the friction acts at (:func:`~dynid.friction.fit.fit_law_through`).
     candidates : sequence of str, optional
-        Laws of the registry to compare (default: all, :data:`~dynid.friction.laws.LAWS`).
+        Laws of the registry to compare (default: those of :data:`~dynid.friction.laws.LAWS`
+        it compares, :attr:`~dynid.friction.laws.base.FrictionLaw.compared`).
     own : FrictionModel or FrictionSum, optional
         The model's own friction, a candidate as it is (``"own"``); a sum is refitted
         part by part together (module docstring).
@@ -209,7 +210,8 @@ def select_friction(
     DynidWarning
         Joints that never move (their friction is zero).
     """
-    names = list(LAWS) if candidates is None else list(candidates)
+    compared = [name for name, law in LAWS.items() if law.compared]
+    names = compared if candidates is None else list(candidates)
     unknown = [c for c in names if c not in LAWS]
     if unknown:
         raise OptionError(f"--friction-model must be one of {', '.join(LAWS)}; got {unknown[0]!r}")

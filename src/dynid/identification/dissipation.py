@@ -45,14 +45,14 @@ def _part_columns(term: LinearFriction, v: NDArray[np.float64]) -> dict[str, Any
     """Each part's column at the velocities ``v`` (s, n) of the term's motors."""
     n = v.shape[-1]
     band = np.asarray(term.band, dtype=np.float64) if term.band else np.zeros(n)
+    smooth = "smooth" in term.parts
+    sign = smooth_sign(v, np.asarray(term.width)) if smooth else standstill_sign(v, band)
     return {
         "viscous": v,
         "quadratic": v * np.abs(v),
         "coulomb": standstill_sign(v, band),
-        "smooth": smooth_sign(v, np.asarray(term.width)) if "smooth" in term.parts else None,
-        "stribeck": standstill_sign(v, band) * stribeck_decay(v, term.vst)
-        if "stribeck" in term.parts
-        else None,
+        "smooth": sign if smooth else None,
+        "stribeck": sign * stribeck_decay(v, term.vst) if "stribeck" in term.parts else None,
     }
 
 

@@ -76,6 +76,7 @@ from .structure import (
     joint_side_joints,
     largest_terms,
     own_rotors,
+    regressor_group,
     structure_terms,
 )
 
@@ -327,21 +328,20 @@ def select_structure(
     judge, how, fold_labels = _judge(robot, data, est, folds, validation)
     fit_rtol = 1e-10 if rtol is None else rtol
     groups: _Groups = {}
-    columns: list[tuple[Structure, NDArray[np.bool_], tuple[bool, str]]] = []
-    # one regressor per armature choice and friction placement (friction at the motors and
-    # at the joints of a coupled drive, together, would be dependent columns)
-    for arm, at in sorted({(c.armature, c.at) for c in cands}):
-        mine = [c for c in cands if c.armature == arm and c.at == at]
+    columns: list[tuple[Structure, NDArray[np.bool_], _Key]] = []
+    for key in sorted({regressor_group(c) for c in cands}):
+        arm = key[0]
+        mine = [c for c in cands if regressor_group(c) == key]
         fitted = _fit_largest(robot, data, mine, arm, drive, est, rtol, judge, notes, fold_labels)
         if fitted is None:
             continue
         model, terms, mine = fitted
         if model.holdout is None:
             return None
-        groups[(arm, at)] = (model, terms)
+        groups[key] = (model, terms)
         for c in mine:
             use = candidate_columns(c, model, terms)
-            columns.append((c, use, (arm, at)))
+            columns.append((c, use, key))
             judged.append(_judged(c, use, model, terms, model.holdout, fit_rtol))
     if not judged:
         return None
@@ -398,12 +398,13 @@ def select_structure(
     )
 
 
-_Groups = dict[tuple[bool, str], tuple[IdentifiedModel, list[tuple[ModelTerm, Any]]]]
+_Key = tuple[bool, str, str]  # regressor_group
+_Groups = dict[_Key, tuple[IdentifiedModel, list[tuple[ModelTerm, Any]]]]
 
 
 def _without_odd(
     judged: list[Candidate],
-    columns: list[tuple[Structure, NDArray[np.bool_], tuple[bool, str]]],
+    columns: list[tuple[Structure, NDArray[np.bool_], _Key]],
     groups: _Groups,
     names: Sequence[str],
     rtol: float,
@@ -468,7 +469,7 @@ def _per_recording(
     every other recording."""
     here = next((c for c in judged if c.structure == chosen), None)
     if here is None:  # a per-joint structure: judged again on every recording
-        m, t = groups[(chosen.armature, chosen.at)]
+        m, t = groups[regressor_group(chosen)]
         use = candidate_columns(chosen, m, t)
         here = _judged(chosen, use, m, t, heldout_of(m), rtol)
     return tuple(zip(names, here.fold_errors_percent, strict=True))
@@ -476,7 +477,7 @@ def _per_recording(
 
 def _per_joint(
     judged: Sequence[Candidate],
-    groups: dict[tuple[bool, str], tuple[IdentifiedModel, list[tuple[ModelTerm, Any]], HeldOut]],
+    groups: dict[_Key, tuple[IdentifiedModel, list[tuple[ModelTerm, Any]], HeldOut]],
     n: int,
     rtol: float,
 ) -> list[Candidate]:
@@ -494,7 +495,7 @@ def _per_joint(
     best = min(_physical(judged), key=lambda c: c.heldout_error_percent)
     repaired = None
     if best_any.unphysical and not best.unphysical:
-        group = groups[(best_any.structure.armature, best_any.structure.at)]
+        group = groups[regressor_group(best_any.structure)]
         repaired = _repaired(best_any, *group, n, rtol)
     starts = [best, *([] if repaired is None else [repaired])]
     best = min(starts, key=lambda c: c.heldout_error_percent)
@@ -504,7 +505,7 @@ def _per_joint(
     for start in dict.fromkeys(starts):
         if not start.structure.friction and not start.structure.armature:
             continue
-        model, terms, held = groups[(start.structure.armature, start.structure.at)]
+        model, terms, held = groups[regressor_group(start.structure)]
         here = start
         while True:
             trials = [
@@ -608,10 +609,10 @@ def _fit_largest(
             place = {"both": "motors and the joints"}
             what += "".join(f", friction at the {place.get(at, at + 's')}" for at in where)
             shaped = k == 0 and len(tries[1]) < len(group)
+            laws = "smooth-sign Stribeck" if regressor_group(group[0])[2] else "smooth and Stribeck"
             notes.append(
                 (
-                    f"the smooth and Stribeck candidates {what}: the data do not tell "
-                    "them from Coulomb friction"
+                    f"the {laws} candidates {what}: the data do not tell them from Coulomb friction"
                     if shaped
                     else f"the candidates {what}: not identifiable from these data"
                 )

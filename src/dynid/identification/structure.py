@@ -37,6 +37,7 @@ __all__ = [
     "JOINT_PREFIX",
     "MIN_WIDTH",
     "SMOOTH_WIDTHS",
+    "SMOOTH_STRIBECK_WIDTHS",
     "STRIBECK_VELOCITIES",
     "Structure",
     "candidate_columns",
@@ -46,6 +47,7 @@ __all__ = [
     "friction_placements",
     "joint_side_joints",
     "own_rotors",
+    "regressor_group",
     "largest_terms",
     "smooth_width",
     "structure_terms",
@@ -75,7 +77,12 @@ FRICTION_LADDER: tuple[tuple[str, ...], ...] = (
 #: 0.39 rad/s).
 SMOOTH_WIDTHS = (0.3, 1.0, 3.0, 10.0, 30.0, 100.0, 300.0)
 #: Stribeck velocities [rad/s] of the Stribeck candidates.
-STRIBECK_VELOCITIES = (0.02, 0.05, 0.1, 0.2)
+STRIBECK_VELOCITIES = (0.02, 0.03, 0.05, 0.07, 0.1, 0.15, 0.2)
+#: Widths (in standstill bands, as :data:`SMOOTH_WIDTHS`) of the Stribeck candidates
+#: whose Coulomb term and bump take the smooth sign ``tanh(dq / w)`` (the narrowest: the
+#: expected sign of a sharp law given the noise, where the bump sits; the banded sign
+#: switches the bump off right where it is largest).
+SMOOTH_STRIBECK_WIDTHS = (0.3, 1.0)
 #: Smallest smooth width [rad/s] (a noise-free log has no standstill band).
 MIN_WIDTH = 1e-3
 
@@ -151,7 +158,7 @@ class Structure:
             object.__setattr__(self, "width", 1.0)
         if "stribeck" in parts and not self.vst > 0:
             object.__setattr__(self, "vst", 0.05)
-        if "stribeck" in parts and "coulomb" not in parts:
+        if "stribeck" in parts and not {"coulomb", "smooth"} & set(parts):
             parts = tuple(p for p in FRICTION_PARTS if p in parts + ("coulomb",))
         object.__setattr__(self, "friction", parts)
         if not parts:
@@ -195,7 +202,7 @@ class Structure:
             if self.at == "both" and p in self.joint_parts:  # removed at both places
                 labels |= {f"{JOINT_PREFIX}{PART_LABELS[p]}{j + 1}" for j in joints}
                 labels |= set() if joints else {"the joints unknown"}
-            if labels <= drop and not (p == "coulomb" and "stribeck" in parts):
+            if labels <= drop and not (p in ("coulomb", "smooth") and "stribeck" in parts):
                 parts.remove(p)
                 drop -= labels
         rotors = {f"{ARMATURE_LABEL}{j + 1}" for j in range(n)}
@@ -385,7 +392,8 @@ def candidate_structures(
     """The candidates, simplest first: every classical ladder of :data:`FRICTION_LADDER`,
     the smooth Coulomb at each of :data:`SMOOTH_WIDTHS` (with viscous friction, without
     and with offsets), the quadratic viscous law and the Stribeck law at each of
-    :data:`STRIBECK_VELOCITIES` (with viscous friction, Coulomb friction and offsets),
+    :data:`STRIBECK_VELOCITIES` (with viscous friction, Coulomb friction and offsets; with
+    the banded sign, and with the smooth sign at each of :data:`SMOOTH_STRIBECK_WIDTHS`),
     without and (``armature``) with the armature, the friction at each of ``placements``
     (:func:`friction_placements`; the model without friction once; at ``"both"`` the
     classical ladder alone)."""
@@ -404,6 +412,11 @@ def candidate_structures(
             out.append(Structure(a, ("viscous", "quadratic", "coulomb", "offset"), at=at))
             out += [
                 Structure(a, _CLASSICAL + ("stribeck",), vst=v, at=at) for v in STRIBECK_VELOCITIES
+            ]
+            out += [
+                Structure(a, ("viscous", "smooth", "stribeck", "offset"), w, v, at=at)
+                for w in SMOOTH_STRIBECK_WIDTHS
+                for v in STRIBECK_VELOCITIES
             ]
     return tuple(out)
 
@@ -533,8 +546,9 @@ def largest_terms(
     """The terms of every candidate with ``armature == arm`` at once (their friction at
     one place: :attr:`Structure.at`; bands as :func:`structure_terms`), each with what it
     stands for:
-    ``("classical", parts)``, ``("smooth", width)`` or ``("stribeck", vst)``; a candidate
-    is a choice of their columns."""
+    ``("classical", parts)``, ``("smooth", width)``, ``("stribeck", vst)`` or
+    ``("smooth_stribeck", (width, vst))`` (the bump alone: its smooth Coulomb term is the
+    ``smooth`` one); a candidate is a choice of their columns."""
     mine = [c for c in cands if c.armature == arm]
     places = {c.at for c in mine if c.friction}
     if len(places) > 1:
@@ -569,12 +583,42 @@ def largest_terms(
             name=f"friction smooth {w:g}",
         )
         out.append((t, ("smooth", w)))
-    for v in sorted({c.vst for c in mine if "stribeck" in c.friction}):
+    for v in sorted({c.vst for c in mine if _banded_stribeck(c)}):
         t = LinearFriction(
             at, ("stribeck",), band=_times(b, gain), vst=v, name=f"friction stribeck {v:g}"
         )
         out.append((t, ("stribeck", v)))
+    for w, v in sorted({(c.width, c.vst) for c in mine if _smooth_stribeck(c)}):
+        t = LinearFriction(
+            at,
+            ("smooth", "stribeck"),
+            band=_times(b, gain),
+            width=smooth_width(_times(b, gain), w),
+            vst=v,
+            name=f"friction smooth {w:g} stribeck {v:g}",
+            mask=(False, True) * n,  # the bump alone: the smooth Coulomb is the term above
+        )
+        out.append((t, ("smooth_stribeck", (w, v))))
     return model_drive, out
+
+
+def regressor_group(c: Structure) -> tuple[bool, str, str]:
+    """The candidates that share one regressor (:func:`largest_terms`): one per armature
+    choice and friction placement (friction at the motors and at the joints of a coupled
+    drive, together, would be dependent columns), the smooth-sign Stribeck laws of each
+    width apart (``"smooth_stribeck:0.3"``): their bumps differ from the banded ones, and
+    from those of another width, only near rest, where the bump is 1 and the difference
+    of two bumps that of two smooth Coulomb columns; together they would be nearly
+    dependent columns."""
+    return c.armature, c.at, f"smooth_stribeck:{c.width:g}" if _smooth_stribeck(c) else ""
+
+
+def _banded_stribeck(c: Structure) -> bool:
+    return "stribeck" in c.friction and "smooth" not in c.friction
+
+
+def _smooth_stribeck(c: Structure) -> bool:
+    return {"smooth", "stribeck"} <= set(c.friction)
 
 
 def candidate_columns(structure: Structure, model: Any, terms: list[tuple[ModelTerm, Any]]) -> Any:
@@ -595,8 +639,11 @@ def candidate_columns(structure: Structure, model: Any, terms: list[tuple[ModelT
             on = np.array([part[_stem(lab)] in structure.friction for lab in t.labels])
         elif kind == "smooth":
             on = np.full(len(t.labels), "smooth" in structure.friction and structure.width == shape)
+        elif kind == "stribeck":
+            on = np.full(len(t.labels), _banded_stribeck(structure) and structure.vst == shape)
         else:
-            on = np.full(len(t.labels), "stribeck" in structure.friction and structure.vst == shape)
+            mine = _smooth_stribeck(structure) and (structure.width, structure.vst) == shape
+            on = np.full(len(t.labels), mine)
         if structure.drop:
             on &= np.array([lab not in structure.drop for lab in t.labels])
         use.append(on)

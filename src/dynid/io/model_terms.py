@@ -35,6 +35,7 @@ __all__ = [
 
 #: The parameters per joint of each law a file's ``friction`` may hold.
 FRICTION_LAWS = {"classical": 3, "smooth": 3, "quadratic": 4, "stribeck": 5}
+FRICTION_LAWS["smooth_stribeck"] = 5
 #: One entry of ``terms``.
 TERM_RECORD = Record(
     {
@@ -132,7 +133,8 @@ def older_terms(
     labels = [str(x) for x in metadata.get("friction_labels") or ()]
     if not labels:
         labels = [f"{c}{j + 1}" for j in range(n) for c in ("fv", "fc", "fo")]
-    part = {"fv": "viscous", "fc": "smooth" if law == "smooth" else "coulomb"}
+    smooth = law in ("smooth", "smooth_stribeck")
+    part = {"fv": "viscous", "fc": "smooth" if smooth else "coulomb"}
     part |= {"fq": "quadratic", "fsp": "stribeck", "fo": "offset"}
     try:
         held = [(part[lab.rstrip("0123456789")], int(lab.lstrip("fvcqspo")) - 1) for lab in labels]
@@ -145,9 +147,9 @@ def older_terms(
     term = LinearFriction(
         at,
         parts=parts,
-        band=() if law == "smooth" else band,
-        width=band if law == "smooth" else (),
-        vst=float(np.max(P[:, 3])) if law == "stribeck" else 0.0,
+        band=() if smooth else band,
+        width=band if smooth else (),
+        vst=float(np.max(P[:, 3])) if law.endswith("stribeck") else 0.0,
         mask=() if all(mask) else mask,
     )
     p = len(term.labels)

@@ -7,7 +7,9 @@ Every law of the registry (:mod:`dynid.friction.laws`) is a special case of, per
           + \\varphi_1 \\big(\\sigma(\\varphi_2 (v + \\varphi_3))
           - \\sigma(\\varphi_2 \\varphi_3)\\big) + f_q v |v|
 
-with ``s`` the sign outside the standstill band (:func:`~dynid.friction.model.coulomb_sign`)
+with ``s`` the sign outside the standstill band (:func:`~dynid.friction.model.coulomb_sign`),
+in the bump ``\\Delta_s e^{-(v / v_{st})^2}`` replaced by ``\\tanh(v / v_s)`` where
+``v_s > 0`` (the smooth-sign Stribeck law: its bump takes its Coulomb term's sign),
 and ``sigma`` the logistic function; ``tau_f = K_f^T f(K_f dq)`` with ``K_f`` the drive's
 friction transmission (the identity at the joints). The 14 columns per motor, in order:
 ``fv+, fv-, fc+, fc-, fo, band, fs - fc, vst, ft, vs, phi1, phi2, phi3, fq``
@@ -25,9 +27,10 @@ at its level), while the true friction of a slow reversal or a standstill lies a
 .. math:: w(v) = \\big(\\max(|f_{c+}|, |f_{c-}|) + |f_s - f_c|\\big) [|v| \\le b]
           + |f_t| \\big(1 - \\tanh(|v| / v_s)\\big)
 
-(``b`` the band; the Stribeck bump is off inside it as well), ``|K_f|^T w(K_f dq)`` at the
-joints; 0 for the sigmoid law (no Coulomb level) and for laws without a canonical form
-(before the noise band's term below).
+(``b`` the band; the Stribeck bump is off inside it as well; a bump on the smooth sign
+is not yet at its level with it: ``|f_s - f_c| (1 - tanh(|v| / v_s))`` instead),
+``|K_f|^T w(K_f dq)`` at the joints; 0 for the sigmoid law (no Coulomb level) and for
+laws without a canonical form (before the noise band's term below).
 A :class:`~dynid.friction.model.FrictionSum` (friction at the motors and at the joints)
 gets the sum of its parts' bounds, each seen at the joints through its own transmission.
 
@@ -198,7 +201,8 @@ def banded_if_narrow(
     (:func:`velocity_bands` or :func:`derived_velocity_bands`, one per part): a smooth
     Coulomb law ``fc tanh(dq / w)`` narrower than the band on every motor becomes the
     classical law with the band as its standstill band (``fc sign(dq)`` outside it, 0
-    inside); any other friction as it is.
+    inside), a smooth-sign Stribeck law the banded Stribeck law; any other friction as it
+    is.
 
     Inside the band a narrow ``tanh`` of the noise is a random level in ``[-fc, fc]``, which
     bounds the residual of a joint at rest by ``2 fc`` (:func:`standstill_margin`); the
@@ -206,7 +210,8 @@ def banded_if_narrow(
     the band both are the sign. Identification chooses the narrow law because it predicts
     torques in motion best; at rest the observer needs the band (a UR10 with a contact
     at rest: margins of 15.9 N m on joint 1 with the narrow law, 7.1 N m with the band)."""
-    if friction is None or isinstance(friction, FrictionSum) or friction.kind != "smooth":
+    banded_law = {"smooth": "classical", "smooth_stribeck": "stribeck"}
+    if friction is None or isinstance(friction, FrictionSum) or friction.kind not in banded_law:
         return friction
     (b,) = bands
     width = np.asarray(friction.band, dtype=np.float64)
@@ -214,7 +219,7 @@ def banded_if_narrow(
         return friction
     from ..friction.laws import LAWS
 
-    banded: FrictionModel = LAWS["classical"].model(
+    banded: FrictionModel = LAWS[banded_law[friction.kind]].model(
         np.asarray(friction.params), b, getattr(friction, "drive", None)
     )
     return banded
@@ -250,9 +255,10 @@ def standstill_margin(
         return np.zeros_like(v)
     K, F = canon
     vm = v @ K.T  # motor velocities
-    level = np.maximum(np.abs(F[:, 2]), np.abs(F[:, 3])) + np.abs(F[:, 6])
+    smooth = F[:, 9] > 0  # the bump on the smooth sign: with ft below
+    level = np.maximum(np.abs(F[:, 2]), np.abs(F[:, 3])) + np.where(smooth, 0.0, np.abs(F[:, 6]))
     w = np.where(np.abs(vm) <= F[:, 5], level, 0.0)
-    ft, vs = np.abs(F[:, 8]), F[:, 9]
+    ft, vs = np.abs(F[:, 8]) + np.where(smooth, np.abs(F[:, 6]), 0.0), F[:, 9]
     with np.errstate(divide="ignore", invalid="ignore"):
         x = np.where(vs > 0, np.abs(vm) / np.where(vs > 0, vs, 1.0), np.inf)
     w = w + ft * np.where(vs > 0, 1.0 - np.tanh(x), np.where(vm == 0.0, 1.0, 0.0))
@@ -276,8 +282,10 @@ def _step_spread(
         with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
             # phi1 sigma(phi2 (v + phi3)) less its constant phi1 / 2
             sig = F[:, 10] * (0.5 * np.tanh(0.5 * F[:, 11] * (v + F[:, 12])))
-            vs = F[:, 9]
-            th = np.where(vs > 0, F[:, 8] * np.tanh(v / np.where(vs > 0, vs, 1.0)), 0.0)
+            vs, vst = F[:, 9], F[:, 7]
+            decay = np.exp(-((v / np.where(vst > 0, vst, 1.0)) ** 2))
+            bump = np.where(vst > 0, F[:, 6] * decay, 0.0)
+            th = np.where(vs > 0, (F[:, 8] + bump) * np.tanh(v / np.where(vs > 0, vs, 1.0)), 0.0)
         return sig, th
 
     mid, lo, hi = steps(vm), steps(vm - b), steps(vm + b)

@@ -316,9 +316,9 @@ class LinearFriction:
             raise OptionError(f"friction parts must be among {FRICTION_PARTS}; got {self.parts}")
         if "smooth" in self.parts and "coulomb" in self.parts:
             raise OptionError("friction parts: smooth replaces coulomb; give one of them")
-        if len({"quadratic", "smooth", "stribeck"} & set(self.parts)) > 1:
+        if "quadratic" in self.parts and {"smooth", "stribeck"} & set(self.parts):
             raise OptionError(
-                "friction parts: quadratic, smooth and stribeck are laws of their own; give one"
+                "friction parts: quadratic and smooth or stribeck are laws of their own; give one"
             )
         for key, v in (("band", self.band), ("width", self.width)):
             if v and len(v) != self.drive.n:
@@ -348,7 +348,10 @@ class LinearFriction:
     @property
     def law(self) -> str:
         """The registry law the coefficients are parameters of (:meth:`as_array`):
-        ``"stribeck"``, ``"smooth"``, ``"quadratic"`` or ``"classical"``."""
+        ``"smooth_stribeck"`` (a Stribeck part beside the smooth Coulomb), ``"stribeck"``,
+        ``"smooth"``, ``"quadratic"`` or ``"classical"``."""
+        if {"smooth", "stribeck"} <= set(self.parts):
+            return "smooth_stribeck"
         for law in ("stribeck", "smooth", "quadratic"):
             if law in self.parts:
                 return law
@@ -420,12 +423,18 @@ class LinearFriction:
         self, v: NDArray[np.float64], band: NDArray[np.float64]
     ) -> NDArray[np.float64]:
         """(..., n, k): each part's column at the motor (joint) velocities ``v`` (..., n)."""
+
+        def sign() -> NDArray[np.float64]:  # the Coulomb part's sign, which the bump shares
+            if "smooth" in self.parts:
+                return smooth_sign(v, np.asarray(self.width))
+            return standstill_sign(v, band)
+
         col = {
             "viscous": lambda: v,
             "quadratic": lambda: v * np.abs(v),
             "coulomb": lambda: standstill_sign(v, band),
             "smooth": lambda: smooth_sign(v, np.asarray(self.width)),
-            "stribeck": lambda: standstill_sign(v, band) * stribeck_decay(v, self.vst),
+            "stribeck": lambda: sign() * stribeck_decay(v, self.vst),
             "offset": lambda: np.ones_like(v),
         }
         return np.stack([col[p]() for p in self.parts], axis=-1)
@@ -456,7 +465,7 @@ class LinearFriction:
         c = dict(zip(self.parts, np.reshape(every, (n, k)).T, strict=True))
         z = np.zeros(n)
         fc = c.get("coulomb", c.get("smooth", z))
-        if self.law == "stribeck":
+        if "stribeck" in self.parts:
             cols = [c.get("viscous", z), fc, fc + c["stribeck"], np.full(n, self.vst)]
             return np.column_stack(cols + [c.get("offset", z)])
         if self.law == "quadratic":
@@ -512,7 +521,7 @@ class LinearFriction:
         P = np.asarray(params, dtype=np.float64)
         names: dict[str, tuple[str, ...]] = {"classical": ("fv", "fc", "fo")}
         names |= {"smooth": ("fv", "fc", "fo"), "quadratic": ("fv", "fq", "fc", "fo")}
-        names["stribeck"] = ("fv", "fc", "fs", "vst", "fo")
+        names["stribeck"] = names["smooth_stribeck"] = ("fv", "fc", "fs", "vst", "fo")
         col = dict(zip(names[self.law], P.T, strict=True))
         part = {"viscous": col["fv"], "coulomb": col["fc"], "smooth": col["fc"]}
         part |= {"offset": col["fo"], "quadratic": col.get("fq"), "stribeck": None}

@@ -1,16 +1,17 @@
 """The registry of friction laws: one module per law, one line each here.
 
-=============  ===========================================================  ==============
-name           law                                                          fit
-=============  ===========================================================  ==============
-``none``       ``0`` (no extra friction)                                    none
-``classical``  ``fv dq + fc s(dq) + fo`` (Gaz et al. 2019, eq. 24)          bounded linear
-``smooth``     ``fv dq + fc tanh(dq / v_s) + fo``, ``v_s`` the noise band   bounded linear
-``quadratic``  ``fv dq + fq dq |dq| + fc s(dq) + fo``                       bounded linear
-``asymmetric`` ``fv+ dq+ + fv- dq- + fc+ [s > 0] - fc- [s < 0]``            bounded linear
-``stribeck``   ``fv dq + (fc + (fs - fc) exp(-(dq/vst)^2)) s(dq) + fo``     var. projection
-``sigmoid``    Gaz et al. 2019, eq. 25                                      Nelder-Mead
-=============  ===========================================================  ==============
+===================  ==========================================================  ===============
+name                 law                                                         fit
+===================  ==========================================================  ===============
+``none``             ``0`` (no extra friction)                                   none
+``classical``        ``fv dq + fc s(dq) + fo`` (Gaz et al. 2019, eq. 24)         bounded linear
+``smooth``           ``fv dq + fc tanh(dq / v_s) + fo``, ``v_s`` the noise band  bounded linear
+``quadratic``        ``fv dq + fq dq |dq| + fc s(dq) + fo``                      bounded linear
+``asymmetric``       ``fv+ dq+ + fv- dq- + fc+ [s > 0] - fc- [s < 0]``           bounded linear
+``stribeck``         ``fv dq + (fc + (fs - fc) exp(-(dq/vst)^2)) s(dq) + fo``    var. projection
+``smooth_stribeck``  the same with ``tanh(dq / v_s)`` for ``s(dq)``              var. projection
+``sigmoid``          Gaz et al. 2019, eq. 25                                     Nelder-Mead
+===================  ==========================================================  ===============
 
 ``s(dq)`` is the sign outside the standstill band (:mod:`dynid.friction.laws.base`). The
 registry gives ``--friction-model``'s choices, ``friction.json``'s ``model`` values, the
@@ -23,7 +24,7 @@ in :data:`LAWS`, and its test.
 from __future__ import annotations
 
 from ...exceptions import OptionError
-from . import asymmetric, classical, none, quadratic, sigmoid, smooth, stribeck
+from . import asymmetric, classical, none, quadratic, sigmoid, smooth, smooth_stribeck, stribeck
 from .base import FrictionLaw
 
 __all__ = ["LAWS", "FrictionLaw", "law_named"]
@@ -38,6 +39,7 @@ LAWS: dict[str, FrictionLaw] = {
         quadratic.LAW,
         asymmetric.LAW,
         stribeck.LAW,
+        smooth_stribeck.LAW,
         sigmoid.LAW,
     )
 }

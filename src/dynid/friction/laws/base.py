@@ -127,6 +127,10 @@ class FrictionLaw:
     standstill : bool
         Whether the law has a standstill band (the sigmoid, smooth and zero at rest, has
         none: its band is always zero and ``friction.json`` writes none).
+    compared : bool
+        Whether ``dynid friction`` compares it by default
+        (:func:`~dynid.friction.select.select_friction`); a law it fits at a width it
+        cannot choose is given by name only.
     """
 
     name: str
@@ -140,6 +144,7 @@ class FrictionLaw:
     mjcf: Mjcf = field(repr=False)
     canonical: Canonical | None = field(repr=False, default=None)
     standstill: bool = True
+    compared: bool = True
 
     def model(
         self, params: ArrayLike, band: ArrayLike | None = None, drive: Drive | None = None

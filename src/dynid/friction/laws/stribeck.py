@@ -3,7 +3,9 @@
 .. math:: \\tau_f(\\dot q) = f_v \\dot q
           + \\big(f_c + (f_s - f_c)\\, e^{-(\\dot q / v_{st})^2}\\big)\\, s(\\dot q) + f_o
 
-with ``s`` the sign outside the standstill band (:func:`~dynid.friction.model.coulomb_sign`).
+with ``s`` the sign outside the standstill band (:func:`~dynid.friction.model.coulomb_sign`);
+:func:`stribeck_law` makes the law for another sign
+(:mod:`dynid.friction.laws.smooth_stribeck`).
 ``fv`` [N m s/rad], ``fc``, ``fs`` [N m] ``>= 0``, the Stribeck velocity ``vst`` [rad/s]
 in ``[1e-3, 10]``, the offset ``fo`` [N m] of either sign. Given ``vst`` the law is linear
 in the others; the fit is a variable projection: bounded linear least squares for each
@@ -14,23 +16,29 @@ as ``frictionloss``; the peak ``fs - fc`` at low speed and the offset are droppe
 
 from __future__ import annotations
 
+from collections.abc import Callable
+from functools import partial
+
 import numpy as np
 from numpy.typing import NDArray
 
 from ...regressors.friction_columns import standstill_sign, stribeck_decay
-from .base import FrictionLaw, JointFit, MjcfTerms, bounded_lstsq, canonical_rows
+from .base import Canonical, FrictionLaw, JointFit, MjcfTerms, bounded_lstsq, canonical_rows
 
-__all__ = ["LAW"]
+__all__ = ["LAW", "stribeck_law"]
 
 _LOWER = (0.0, 0.0, 0.0, 1e-3, -np.inf)
 _UPPER = (np.inf, np.inf, np.inf, 10.0, np.inf)
 _LIN = [0, 1, 2, 4]  # the parameters the law is linear in: fv, fc, fs, fo
 
+#: ``sign(dq (..., n), band (n,))``: the law's Coulomb sign.
+Sign = Callable[[NDArray[np.float64], NDArray[np.float64]], NDArray[np.float64]]
+
 
 def _columns(
-    dq: NDArray[np.float64], band: NDArray[np.float64], vst: NDArray[np.float64]
+    dq: NDArray[np.float64], band: NDArray[np.float64], vst: NDArray[np.float64], sign: Sign
 ) -> NDArray[np.float64]:
-    s = standstill_sign(dq, band)
+    s = sign(dq, band)
     # vst = 0 is a joint left unidentified (it never moved; every coefficient 0): the
     # limit of exp(-(dq / vst)^2) as vst -> 0 (stribeck_decay gives 0 there)
     e = stribeck_decay(dq, vst)
@@ -38,14 +46,14 @@ def _columns(
 
 
 def _torques(
-    dq: NDArray[np.float64], P: NDArray[np.float64], band: NDArray[np.float64]
+    dq: NDArray[np.float64], P: NDArray[np.float64], band: NDArray[np.float64], sign: Sign
 ) -> NDArray[np.float64]:
-    C = _columns(dq, band, P[:, 3])
+    C = _columns(dq, band, P[:, 3], sign)
     out: NDArray[np.float64] = np.einsum("...jk,jk->...j", C, P[:, _LIN])
     return out
 
 
-def _fit(dq: NDArray[np.float64], r: NDArray[np.float64], band: float) -> JointFit:
+def _fit(dq: NDArray[np.float64], r: NDArray[np.float64], band: float, sign: Sign) -> JointFit:
     lo = np.asarray(_LOWER)[_LIN]
     hi = np.asarray(_UPPER)[_LIN]
     step = max(1, dq.size // 5_000)  # the search on a subsample, the final solve on all
@@ -54,7 +62,7 @@ def _fit(dq: NDArray[np.float64], r: NDArray[np.float64], band: float) -> JointF
     def solve(
         ln_vst: float, v: NDArray[np.float64], rr: NDArray[np.float64]
     ) -> tuple[NDArray[np.float64], float]:
-        A = _columns(v, np.asarray(band), np.asarray(np.exp(ln_vst)))
+        A = _columns(v, np.asarray(band), np.asarray(np.exp(ln_vst)), sign)
         x = bounded_lstsq(A, rr, lo, hi)
         return x, float(np.sum((A @ x - rr) ** 2))
 
@@ -87,16 +95,29 @@ def _canonical(P: NDArray[np.float64], band: NDArray[np.float64]) -> NDArray[np.
     )
 
 
-LAW = FrictionLaw(
+def stribeck_law(
+    name: str, sign: Sign, formula: str, canonical: Canonical, compared: bool = True
+) -> FrictionLaw:
+    """A Stribeck law whose Coulomb term and bump take ``sign(dq, band)``, its ``formula``
+    of ``s(dq)`` and its observer form ``canonical``."""
+    return FrictionLaw(
+        name,
+        ("fv", "fc", "fs", "vst", "fo"),
+        ("N m s/rad", "N m", "N m", "rad/s", "N m"),
+        "tau_f = fv dq + (fc + (fs - fc) exp(-(dq / vst)^2)) s(dq) + fo, " + formula,
+        partial(_torques, sign=sign),
+        partial(_fit, sign=sign),
+        _LOWER,
+        _UPPER,
+        _mjcf,
+        canonical,
+        compared=compared,
+    )
+
+
+LAW = stribeck_law(
     "stribeck",
-    ("fv", "fc", "fs", "vst", "fo"),
-    ("N m s/rad", "N m", "N m", "rad/s", "N m"),
-    "tau_f = fv dq + (fc + (fs - fc) exp(-(dq / vst)^2)) s(dq) + fo, "
+    standstill_sign,
     "s(dq) = sign(dq) where |dq| > standstill_band, else 0",
-    _torques,
-    _fit,
-    _LOWER,
-    _UPPER,
-    _mjcf,
     _canonical,
 )
