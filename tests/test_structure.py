@@ -72,7 +72,7 @@ def test_armature_and_viscous_friction_are_chosen_by_default(panda, armature_log
     assert sel is not None and sel["chosen"] == "links + armature + viscous", sel
     assert sel["validation"].startswith("leave one recording out")
     names = [c["name"] for c in sel["candidates"]]
-    assert "links + viscous + coulomb + offset" in names and len(names) == 84
+    assert "links + viscous + coulomb + offset" in names and len(names) == 70
     rms = np.sqrt(np.mean((test.tau - _predict(model, held)) ** 2, axis=0))
     assert np.all(rms < 1.1 * NOISE), rms  # the held-out recording's noise, nothing more
     # without the armature (the structure of the paper) the same data predict far worse
@@ -399,7 +399,7 @@ def test_friction_of_a_coupled_drive_is_placed_where_the_data_say(panda, truth):
     sel = model.info.selection
     names = [c["name"] for c in sel["candidates"]]
     assert "links + viscous + at:joint" in names and "links + viscous + at:motor" in names
-    assert len(names) == 88  # 41 per placement, 5 at both, the model without friction once
+    assert len(names) == 74  # 35 per placement, 5 at both, the model without friction once
     assert sel["chosen"] == f"links + viscous + coulomb + at:{truth}", sel["chosen"]
     assert model.drive.friction_at == truth
     np.testing.assert_allclose(model.friction.params[:, :2], fr.as_array()[:, :2], atol=1e-7)

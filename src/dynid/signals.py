@@ -245,19 +245,25 @@ def lowpass(
     ends = _CubicEnds(N, min(N, max(4, int(np.ceil(_FIT_PERIODS * period)))), period)
     padlen = max(minimum, int(np.ceil(period)))
 
-    def filtered(col: NDArray[np.float64]) -> NDArray[np.float64]:
-        ext = ends.extended(col)
-        y = scipy.signal.sosfiltfilt(sos, ext, padtype="odd", padlen=min(ext.size - 1, padlen))
+    def filtered(cols: NDArray[np.float64]) -> NDArray[np.float64]:  # (N, k) -> (N, k)
+        ext = ends.extended(cols)
+        pad = min(ext.shape[0] - 1, padlen)
+        y = scipy.signal.sosfiltfilt(sos, ext, axis=0, padtype="odd", padlen=pad)
         return np.asarray(y[ends.length : ends.length + N])
 
     if x.ndim < 2:
-        return filtered(x) if axis in (0, -1) else filtered(np.ravel(x))
-    # one signal at a time: the filter's padded temporaries stay the size of one column
-    # (a 2-million-sample log would otherwise need several copies of every signal)
+        return filtered(np.ravel(x)[:, None])[:, 0]
+    # signals in groups of at most _FILTER_ELEMENTS samples: the filter's padded
+    # temporaries stay a few times that (a 2-million-sample log would otherwise need
+    # several copies of every signal), and short signals are filtered many at a time
     y = np.empty(x.shape)
-    xt, yt = np.moveaxis(x, axis, -1), np.moveaxis(y, axis, -1)
-    for idx in np.ndindex(*xt.shape[:-1]):
-        yt[idx] = filtered(np.ascontiguousarray(xt[idx]))
+    xt, yt = np.moveaxis(x, axis, 0), np.moveaxis(y, axis, 0)
+    flat = xt.reshape(N, -1)  # a view where it can be, else a copy
+    out = np.empty(flat.shape)
+    k = max(1, _FILTER_ELEMENTS // N)
+    for a in range(0, flat.shape[1], k):
+        out[:, a : a + k] = filtered(np.ascontiguousarray(flat[:, a : a + k]))
+    yt[...] = out.reshape(xt.shape)
     return y
 
 
@@ -298,6 +304,10 @@ def lowpass_noise_gain(
     return float(min(1.0, np.sqrt(np.sum(h * h))))
 
 
+#: Samples filtered at once by :func:`lowpass` (signals grouped up to this size).
+_FILTER_ELEMENTS = 1 << 18
+
+
 class _CubicEnds:
     """Each end of a signal of ``n`` samples continued by ``length`` samples (three
     periods of the cut-off, ``period`` samples each) of the cubic fitted to its ``m``
@@ -313,9 +323,9 @@ class _CubicEnds:
         self.left = before @ fit  # (length, m): the continuation before the first sample
         self.right = after @ fit  # ... after the last, from the last m samples
 
-    def extended(self, col: NDArray[np.float64]) -> NDArray[np.float64]:
-        """``col`` (n,) with its two continuations, (n + 2 length,)."""
-        return np.concatenate([self.left @ col[: self.m], col, self.right @ col[-self.m :]])
+    def extended(self, cols: NDArray[np.float64]) -> NDArray[np.float64]:
+        """``cols`` (n, k) with their two continuations, (n + 2 length, k)."""
+        return np.concatenate([self.left @ cols[: self.m], cols, self.right @ cols[-self.m :]])
 
 
 def derivative(t: ArrayLike, x: ArrayLike) -> NDArray[np.float64]:

@@ -82,7 +82,7 @@ STRIBECK_VELOCITIES = (0.02, 0.03, 0.05, 0.07, 0.1, 0.15, 0.2)
 #: whose Coulomb term and bump take the smooth sign ``tanh(dq / w)`` (the narrowest: the
 #: expected sign of a sharp law given the noise, where the bump sits; the banded sign
 #: switches the bump off right where it is largest).
-SMOOTH_STRIBECK_WIDTHS = (0.3, 1.0)
+SMOOTH_STRIBECK_WIDTHS = (0.3,)
 #: Smallest smooth width [rad/s] (a noise-free log has no standstill band).
 MIN_WIDTH = 1e-3
 
