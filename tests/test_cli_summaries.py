@@ -6,7 +6,8 @@ from types import SimpleNamespace
 
 import numpy as np
 
-from dynid.cli.summaries import format_newton_euler_rms, format_rms_table, selection_lines
+from dynid.cli.structure_table import selection_lines
+from dynid.cli.summaries import format_newton_euler_rms, format_rms_table
 
 
 def _column_ends(line: str) -> list[int]:
@@ -78,3 +79,23 @@ def test_the_structure_table_lists_every_coefficient_the_per_joint_search_left_o
     assert lines[1].endswith("left out of the candidate its per-joint search began at")
     assert lines[3].startswith("  * links + coulomb + offset ") and lines[3].endswith("  fv1-7 fo2")
     assert lines[2].rstrip() == lines[2] and not lines[2].endswith("fo2")
+
+
+def test_the_structure_table_shows_each_shaped_law_at_its_best_shape():
+    """Candidates that differ only in a smooth width or a Stribeck velocity: the table
+    shows the one with the lowest held-out error of each law (and the one chosen), and one
+    line counts the others, which the file keeps."""
+    row = {"n_params": 40, "train_error_percent": 1.5, "heldout_se_percent": 0.1}
+    names = ["links + viscous + coulomb"]
+    names += [f"links + viscous + smooth:{w}" for w in (0.3, 1, 3)]
+    names += [f"links + viscous + coulomb + stribeck:{v}" for v in (0.02, 0.05)]
+    held = [5.0, 4.0, 3.0, 3.5, 2.5, 2.0]
+    pairs = zip(names, held, strict=True)
+    cands = [row | {"name": n, "heldout_error_percent": h} for n, h in pairs]
+    chosen = "links + viscous + smooth:0.3"  # the simplest within one standard error
+    sel = {"validation": "5 folds", "chosen": chosen, "rule": "rule", "candidates": cands}
+    lines = selection_lines(sel)
+    rows = [line[4:].split("  ")[0].strip() for line in lines[2:] if line.startswith("  ")]
+    shown = [r for r in rows if r.startswith("links")]
+    assert shown == [names[0], chosen, names[2], names[5]], lines
+    assert any(line.startswith("  (2 candidate(s) of a smooth or Stribeck law") for line in lines)

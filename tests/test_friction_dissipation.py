@@ -84,7 +84,7 @@ def test_the_selection_skips_a_law_that_pushes_the_arm(panda_data):
     assert any(v.startswith("fq") for v in judged[quadratic].unphysical)
     assert sel.chosen == cands[0]
     # the printed table marks the skipped candidate (x) and one line says why
-    from dynid.cli.summaries import selection_lines
+    from dynid.cli.structure_table import selection_lines
 
     lines = selection_lines(sel.as_dict())
     marks = {line[4:].split("  ")[0].strip(): line[2] for line in lines[2:] if line[2] in "*x "}

@@ -21,6 +21,7 @@ from ..observer.detection import undetected_at_rest
 from ..observer.results import LogObservation, ObserveResult
 from ..pipeline.collision import CollisionStageResult
 from ..regressors.base import identifiability
+from .structure_table import selection_lines, text_width
 
 __all__ = [
     "format_consistent",
@@ -33,11 +34,6 @@ __all__ = [
     "term_lines",
     "progress_printer",
 ]
-
-
-def _width(header: str, cells: Any, least: int = 0) -> int:
-    """The width of a left-aligned column: its header's, its longest cell's, or ``least``."""
-    return max([least, len(header), *(len(str(c)) for c in cells)])
 
 
 def format_identification(model: IdentifiedModel, *, width: int = 60) -> str:
@@ -87,7 +83,7 @@ def format_identification(model: IdentifiedModel, *, width: int = 60) -> str:
         + (f" ({', '.join(groups['unidentifiable'])})" if groups["unidentifiable"] else "")
     )
     head += recordings_lines(info.recordings) + selection_lines(info.selection)
-    lw = _width("name", model.base.labels[: model.base.rank], 7)
+    lw = text_width("name", model.base.labels[: model.base.rank], 7)
     head.append(f"{'#':>3}  {'name':<{lw}} {'value':>13} {'std %':>9}  kept  expression")
     rows = []
     for k in range(model.base.rank):
@@ -176,88 +172,6 @@ def _lost(rec: Any) -> str:
         return ""
     parts = [f"{rec[k]} {why}" for k, why in _LOST if rec.get(k)]
     return f" of {rec['recorded']} recorded" + (": " + ", ".join(parts) if parts else "")
-
-
-def selection_lines(selection: Any) -> list[str]:
-    """The model structures judged on held-out data, the one kept marked ``*``, those
-    skipped because their friction is not dissipative ``x`` (one note says why)."""
-    if not selection:
-        return []
-    # a per-joint structure's coefficients left out go last ("- fo1 - fc4"), so that the
-    # table is as wide as the structures' names without them
-    split = [str(c["name"]).partition(" - ") for c in selection["candidates"]]
-    # the per-joint search's every coefficient left out: a part left out on every joint
-    # is gone from the name (``viscous``) and listed here (``fv1-7``)
-    split = [
-        (name, _, " - ".join(c.get("left_out") or ()) or dropped)
-        for c, (name, _, dropped) in zip(selection["candidates"], split, strict=True)
-    ]
-    w = _width("structure", [name for name, _, _ in split], 46)
-    left = any(dropped for _, _, dropped in split)
-    out = [
-        f"model structure chosen on held-out data ({selection['validation']}): "
-        f"{selection['chosen']} ({selection['rule']})",
-        f"    {'structure':<{w}} {'params':>6} {'train %':>9} {'held-out %':>11} {'se vs best':>10}"
-        + ("  left out of the candidate its per-joint search began at" if left else ""),
-    ]
-    cands = selection["candidates"]
-    # skipped (not dissipative within the velocity limits) unless every candidate is
-    skip = not all(c.get("not_dissipative") for c in cands)
-    for c, (name, _, dropped) in zip(cands, split, strict=True):
-        mark = "*" if c["name"] == selection["chosen"] else " "
-        mark = "x" if skip and c.get("not_dissipative") else mark
-        out.append(
-            f"  {mark} {name:<{w}} {c['n_params']:>6} {c['train_error_percent']:>9.4g} "
-            f"{c['heldout_error_percent']:>11.4g} {_se_vs_best(c):>10}"
-            + (f"  {_compact(dropped.split(' - '))}" if dropped else "")
-        )
-    per = selection.get("heldout_per_recording") or ()
-    if per:
-        odd = set(selection.get("outlying_recordings") or ())
-        out.append(
-            "  held-out error of the chosen structure per recording (fitted on the others): "
-            + ", ".join(
-                f"{r['file']} {r['heldout_error_percent']:.3g} %"
-                + (" (outlying)" if r["file"] in odd else "")
-                for r in per
-            )
-        )
-    out += [f"  note: {line}" for line in selection.get("notes", ())]
-    return out
-
-
-def _se_vs_best(c: dict[str, Any]) -> str:
-    """The standard error of a candidate's held-out error's difference from the lowest
-    (paired over the folds), blank where there is none (the best, one fold); files
-    written before it was recorded give each candidate's own standard error."""
-    se = c.get("heldout_se_vs_best_percent", c.get("heldout_se_percent"))
-    return f"{se:.2g}" if se else ""
-
-
-def _compact(labels: list[str]) -> str:
-    """``fv1 fv2 fv3 fo2`` as ``fv1-3 fo2``: each coefficient's joints, runs joined."""
-    joints: dict[str, list[int]] = {}
-    for lab in labels:
-        stem = lab.rstrip("0123456789")
-        if stem == lab:
-            joints.setdefault(lab, [])
-            continue
-        joints.setdefault(stem, []).append(int(lab[len(stem) :]))
-    out = []
-    for stem, js in joints.items():
-        if not js:
-            out.append(stem)
-            continue
-        js = sorted(set(js))
-        runs: list[list[int]] = [[js[0]]]
-        for j in js[1:]:
-            if j == runs[-1][-1] + 1:
-                runs[-1].append(j)
-            else:
-                runs.append([j])
-        for r in runs:
-            out += [f"{stem}{r[0]}-{r[-1]}"] if len(r) > 2 else [f"{stem}{j}" for j in r]
-    return " ".join(out)
 
 
 def samples_text(log: LogInfo) -> str:
@@ -355,7 +269,7 @@ def format_retrieval(result: RetrievalResult) -> str:
     lam = principal_moments(r.inertia)
     tri = {c.link: c.margin for c in r.report.select("triangle_inequality")}
     names = r.robot.link_names[1:]
-    w = _width("link", names)
+    w = text_width("link", names)
     lines = [
         f"{'link':<{w}}  {'mass [kg]':>9}  {'CoM [m]':^26}  "
         f"{'principal moments [kg m^2]':^30}  {'triangle':>9}",
@@ -427,7 +341,7 @@ def format_consistent(result: ConsistentResult) -> str:
     """Readable summary of a convex retrieval: per link mass, CoM, margin; fit; notes."""
     r = result
     names = r.robot.link_names[1:]
-    w = _width("link", names)
+    w = text_width("link", names)
     lines = [
         f"{'link':<{w}}  {'mass [kg]':>9}  {'prior [kg]':>10}  {'CoM [m]':^26}  "
         f"{'lambda_min(J)/tr(J)':>19}",
@@ -472,7 +386,7 @@ def format_consistent(result: ConsistentResult) -> str:
 
 def format_rms_table(names: list[str], columns: dict[str, np.ndarray]) -> str:
     """A per-joint table of RMS values [N m]: columns as wide as their longest name."""
-    w = _width("joint", names, 9) + 1
+    w = text_width("joint", names, 9) + 1
     cw = {k: max(22, len(k) + 2) for k in columns}
     head = f"{'joint':<{w}}" + "".join(f"{k:>{cw[k]}}" for k in columns)
     rows = [head]
@@ -487,7 +401,7 @@ def format_newton_euler_rms(val: NewtonEulerValidation) -> str:
     """Per-joint RMS of the Newton-Euler torques with retrieved parameters [N m] (and of
     the identified model, when compared)."""
     names = val.joint_names
-    w = _width("joint", names)
+    w = text_width("joint", names)
     head = f"{'joint':<{w}}  {'RMS NE [N m]':>12}" + (
         "  {:>20}".format("RMS identified [N m]") if val.errors_reference is not None else ""
     )

@@ -1,0 +1,121 @@
+"""The table of the model structures judged on held-out data, as ``identify`` prints it."""
+
+from __future__ import annotations
+
+import re
+from collections.abc import Sequence
+from typing import Any
+
+__all__ = ["selection_lines", "text_width"]
+
+
+def text_width(header: str, cells: Any, least: int = 0) -> int:
+    """The width of a left-aligned column: its header's, its longest cell's, or ``least``."""
+    return max([least, len(header), *(len(str(c)) for c in cells)])
+
+
+def selection_lines(selection: Any) -> list[str]:
+    """The model structures judged on held-out data, the one kept marked ``*``, those
+    skipped because their friction is not dissipative ``x`` (one note says why)."""
+    if not selection:
+        return []
+    # a per-joint structure's coefficients left out go last ("- fo1 - fc4"), so that the
+    # table is as wide as the structures' names without them
+    split = [str(c["name"]).partition(" - ") for c in selection["candidates"]]
+    # the per-joint search's every coefficient left out: a part left out on every joint
+    # is gone from the name (``viscous``) and listed here (``fv1-7``)
+    split = [
+        (name, _, " - ".join(c.get("left_out") or ()) or dropped)
+        for c, (name, _, dropped) in zip(selection["candidates"], split, strict=True)
+    ]
+    w = text_width("structure", [name for name, _, _ in split], 46)
+    left = any(dropped for _, _, dropped in split)
+    out = [
+        f"model structure chosen on held-out data ({selection['validation']}): "
+        f"{selection['chosen']} ({selection['rule']})",
+        f"    {'structure':<{w}} {'params':>6} {'train %':>9} {'held-out %':>11} {'se vs best':>10}"
+        + ("  left out of the candidate its per-joint search began at" if left else ""),
+    ]
+    cands = selection["candidates"]
+    # skipped (not dissipative within the velocity limits) unless every candidate is
+    skip = not all(c.get("not_dissipative") for c in cands)
+    shown, hidden = _best_of_shapes(cands, selection["chosen"])
+    for c, (name, _, dropped) in zip(cands, split, strict=True):
+        if c["name"] not in shown:
+            continue
+        mark = "*" if c["name"] == selection["chosen"] else " "
+        mark = "x" if skip and c.get("not_dissipative") else mark
+        out.append(
+            f"  {mark} {name:<{w}} {c['n_params']:>6} {c['train_error_percent']:>9.4g} "
+            f"{c['heldout_error_percent']:>11.4g} {_se_vs_best(c):>10}"
+            + (f"  {_compact(dropped.split(' - '))}" if dropped else "")
+        )
+    if hidden:
+        x = sum(1 for c in cands if c["name"] not in shown and skip and c.get("not_dissipative"))
+        out.append(
+            f"  ({hidden} candidate(s) of a smooth or Stribeck law at other widths or Stribeck "
+            "velocities not shown, each law's best is"
+            + (f"; {x} of them skipped as not dissipative" if x else "")
+            + ": metadata.selection.candidates holds every one)"
+        )
+    per = selection.get("heldout_per_recording") or ()
+    if per:
+        odd = set(selection.get("outlying_recordings") or ())
+        out.append(
+            "  held-out error of the chosen structure per recording (fitted on the others): "
+            + ", ".join(
+                f"{r['file']} {r['heldout_error_percent']:.3g} %"
+                + (" (outlying)" if r["file"] in odd else "")
+                for r in per
+            )
+        )
+    out += [f"  note: {line}" for line in selection.get("notes", ())]
+    return out
+
+
+def _best_of_shapes(cands: Sequence[dict[str, Any]], chosen: str) -> tuple[set[str], int]:
+    """The names of the candidates the table shows, and how many it leaves out: of the
+    candidates that differ only in a shape (``smooth:0.3`` and ``smooth:1``,
+    ``stribeck:0.05`` and ``stribeck:0.1``), the one with the lowest held-out error; every
+    other candidate, and the one chosen."""
+    best: dict[str, dict[str, Any]] = {}
+    for c in cands:
+        family = re.sub(r"(smooth|stribeck):[0-9.eE+-]+", r"\1:*", str(c["name"]))
+        if family not in best or c["heldout_error_percent"] < best[family]["heldout_error_percent"]:
+            best[family] = c
+    shown = {str(c["name"]) for c in best.values()} | {chosen}
+    return shown, sum(1 for c in cands if c["name"] not in shown)
+
+
+def _se_vs_best(c: dict[str, Any]) -> str:
+    """The standard error of a candidate's held-out error's difference from the lowest
+    (paired over the folds), blank where there is none (the best, one fold); files
+    written before it was recorded give each candidate's own standard error."""
+    se = c.get("heldout_se_vs_best_percent", c.get("heldout_se_percent"))
+    return f"{se:.2g}" if se else ""
+
+
+def _compact(labels: list[str]) -> str:
+    """``fv1 fv2 fv3 fo2`` as ``fv1-3 fo2``: each coefficient's joints, runs joined."""
+    joints: dict[str, list[int]] = {}
+    for lab in labels:
+        stem = lab.rstrip("0123456789")
+        if stem == lab:
+            joints.setdefault(lab, [])
+            continue
+        joints.setdefault(stem, []).append(int(lab[len(stem) :]))
+    out = []
+    for stem, js in joints.items():
+        if not js:
+            out.append(stem)
+            continue
+        js = sorted(set(js))
+        runs: list[list[int]] = [[js[0]]]
+        for j in js[1:]:
+            if j == runs[-1][-1] + 1:
+                runs[-1].append(j)
+            else:
+                runs.append([j])
+        for r in runs:
+            out += [f"{stem}{r[0]}-{r[-1]}"] if len(r) > 2 else [f"{stem}{j}" for j in r]
+    return " ".join(out)
