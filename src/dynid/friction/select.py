@@ -211,6 +211,8 @@ def select_friction(
         Joints that never move (their friction is zero).
     """
     compared = [name for name, law in LAWS.items() if law.compared]
+    if own_fitted_here and isinstance(own, FrictionModel) and own.kind in LAWS:
+        compared = [*dict.fromkeys(compared + [own.kind])]  # the own law, refitted as the rest
     names = compared if candidates is None else list(candidates)
     unknown = [c for c in names if c not in LAWS]
     if unknown:

@@ -67,6 +67,7 @@ from .recordings import Recordings, prepare_recordings
 from .streaming import BlockSource, normals_by_label
 from .structure import (
     ERROR_FLOOR_PERCENT,
+    STRIBECK_COARSE,
     Structure,
     candidate_columns,
     candidate_structures,
@@ -349,6 +350,10 @@ def select_structure(
     skip: tuple[int, ...] = ()
     if len(data.names) > 2 and validation is None:
         judged, skip = _without_odd(judged, columns, groups, data.names, fit_rtol, notes)
+    # the regressor each candidate's columns are in; a per-joint structure's is that of
+    # the candidate its search began at (a smooth-sign Stribeck law without its bumps is
+    # a smooth law, in the Stribeck law's regressor)
+    where = {c: key for c, _, key in columns}
     if per_joint:
         judged += _per_joint(
             judged,
@@ -358,6 +363,7 @@ def select_structure(
             },
             robot.n,
             fit_rtol,
+            where,
         )
     chosen = _chosen(judged)
     best = min(_physical(judged), key=lambda c: c.heldout_error_percent)
@@ -378,7 +384,7 @@ def select_structure(
         )
     per: tuple[tuple[str, float], ...] = ()
     if len(data.names) > 1 and validation is None:
-        per = _per_recording(chosen, full, groups, data.names, robot.n, fit_rtol)
+        per = _per_recording(chosen, full, groups, where, data.names, fit_rtol)
     for i in skip:
         warnings.warn(
             f"{data.names[i]}: held-out error {per[i][1]:.3g} % with the chosen structure, far "
@@ -461,15 +467,15 @@ def _per_recording(
     chosen: Structure,
     judged: Sequence[Candidate],
     groups: _Groups,
+    where: dict[Structure, _Key],
     names: Sequence[str],
-    n: int,
     rtol: float,
 ) -> tuple[tuple[str, float], ...]:
     """Each recording's name and the held-out error [%] of ``chosen`` on it, fitted on
-    every other recording."""
+    every other recording (its columns in the regressor ``where`` says)."""
     here = next((c for c in judged if c.structure == chosen), None)
     if here is None:  # a per-joint structure: judged again on every recording
-        m, t = groups[regressor_group(chosen)]
+        m, t = groups[where[chosen]]
         use = candidate_columns(chosen, m, t)
         here = _judged(chosen, use, m, t, heldout_of(m), rtol)
     return tuple(zip(names, here.fold_errors_percent, strict=True))
@@ -480,6 +486,7 @@ def _per_joint(
     groups: dict[_Key, tuple[IdentifiedModel, list[tuple[ModelTerm, Any]], HeldOut]],
     n: int,
     rtol: float,
+    where: dict[Structure, _Key],
 ) -> list[Candidate]:
     """Per-joint structures: from the candidate with the lowest held-out error and from
     the one chosen, friction coefficients and armatures (rotors that are base parameters
@@ -495,8 +502,10 @@ def _per_joint(
     best = min(_physical(judged), key=lambda c: c.heldout_error_percent)
     repaired = None
     if best_any.unphysical and not best.unphysical:
-        group = groups[regressor_group(best_any.structure)]
+        group = groups[where[best_any.structure]]
         repaired = _repaired(best_any, *group, n, rtol)
+        if repaired is not None:
+            where[repaired.structure] = where[best_any.structure]
     starts = [best, *([] if repaired is None else [repaired])]
     best = min(starts, key=lambda c: c.heldout_error_percent)
     chosen = _chosen(judged)
@@ -505,7 +514,7 @@ def _per_joint(
     for start in dict.fromkeys(starts):
         if not start.structure.friction and not start.structure.armature:
             continue
-        model, terms, held = groups[regressor_group(start.structure)]
+        model, terms, held = groups[where[start.structure]]
         here = start
         while True:
             trials = [
@@ -520,6 +529,7 @@ def _per_joint(
         drive = model.drive if start.structure.at == "both" else None
         reached = here.structure.collapsed(n, () if drive is None else joint_side_joints(drive))
         if reached not in [c.structure for c in (*judged, *out)]:
+            where[reached] = where[start.structure]
             origin = best_any.structure if start is repaired else start.structure
             left = tuple(lab for lab in here.structure.drop if lab not in origin.drop)
             out.append(replace(here, structure=reached, left_out=left))
@@ -580,12 +590,23 @@ def _fit_largest(
     notes: list[str],
     fold_labels: NDArray[np.intp] | None = None,
 ) -> tuple[IdentifiedModel, list[tuple[ModelTerm, Any]], list[Structure]] | None:
-    """The model of every candidate's columns at once (the classical candidates alone when
-    the data cannot tell the shaped laws apart), with its terms and the candidates it
-    holds; None (and a note) when not even those are identifiable."""
-    tries = [mine, [c for c in mine if not ({"smooth", "stribeck"} & set(c.friction))]]
+    """The model of every candidate's columns at once, with its terms and the candidates it
+    holds; when the data cannot tell its columns apart, the Stribeck laws at
+    :data:`~dynid.identification.structure.STRIBECK_COARSE` only, then the classical
+    candidates alone (a note says which were left out); None (and a note) when not even
+    those are identifiable."""
+    shaped = [c for c in mine if {"smooth", "stribeck"} & set(c.friction)]
+    coarse = [c for c in mine if "stribeck" not in c.friction or c.vst in STRIBECK_COARSE]
+    tries = [mine, coarse, [c for c in mine if c not in shaped]]
+    what = ("with" if arm else "without") + " armature"
+    place = {"both": "motors and the joints"}
+    what += "".join(f", friction at the {place.get(a, a + 's')}" for a in {c.at for c in mine})
+    family = regressor_group(mine[0])[2]
+    laws = "smooth-sign Stribeck" if family.startswith("smooth") else family or "smooth"
+    laws = "Stribeck" if laws == "stribeck" else laws
+    failed: list[str] = []
     for k, group in enumerate(tries):
-        if not group or (k and len(group) == len(mine)):
+        if not group or (k and len(group) == len(tries[k - 1])):
             continue
         model_drive, terms = largest_terms(
             group, arm, drive, robot.n, tuple(data.band), _bands(data), data.band_gain
@@ -604,22 +625,31 @@ def _fit_largest(
                     fold_labels=fold_labels,
                 )
         except RankDeficientError as exc:
-            what = ("with" if arm else "without") + " armature"
-            where = {c.at for c in group if c.at}
-            place = {"both": "motors and the joints"}
-            what += "".join(f", friction at the {place.get(at, at + 's')}" for at in where)
-            shaped = k == 0 and len(tries[1]) < len(group)
-            laws = "smooth-sign Stribeck" if regressor_group(group[0])[2] else "smooth and Stribeck"
+            failed.append(f"rank {exc.rank} < {exc.needed}")
+            continue
+        if failed:
+            left = sorted({c.vst for c in mine if c not in group and c.vst}) if k == 1 else []
             notes.append(
                 (
-                    f"the {laws} candidates {what}: the data do not tell them from Coulomb friction"
-                    if shaped
-                    else f"the candidates {what}: not identifiable from these data"
+                    f"the {laws} candidates {what} at the Stribeck velocities "
+                    f"{', '.join(f'{v:g}' for v in left)} rad/s: the data do not tell them "
+                    "from their neighbours"
+                    if left
+                    else f"the {laws} candidates {what}: the data do not tell them from "
+                    "Coulomb friction"
                 )
-                + f" (rank {exc.rank} < {exc.needed})"
+                + f" ({'; '.join(failed)})"
             )
-            continue
         return model, terms, group
+    if failed:
+        notes.append(
+            (
+                f"the {laws} candidates {what}: the data do not tell them from Coulomb friction"
+                if shaped and len(shaped) == len(mine)
+                else f"the candidates {what}: not identifiable from these data"
+            )
+            + f" ({'; '.join(failed)})"
+        )
     return None
 
 

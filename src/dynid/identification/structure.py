@@ -38,6 +38,7 @@ __all__ = [
     "MIN_WIDTH",
     "SMOOTH_WIDTHS",
     "SMOOTH_STRIBECK_WIDTHS",
+    "STRIBECK_COARSE",
     "STRIBECK_VELOCITIES",
     "Structure",
     "candidate_columns",
@@ -78,6 +79,9 @@ FRICTION_LADDER: tuple[tuple[str, ...], ...] = (
 SMOOTH_WIDTHS = (0.3, 1.0, 3.0, 10.0, 30.0, 100.0, 300.0)
 #: Stribeck velocities [rad/s] of the Stribeck candidates.
 STRIBECK_VELOCITIES = (0.02, 0.03, 0.05, 0.07, 0.1, 0.15, 0.2)
+#: The Stribeck velocities [rad/s] judged where the data cannot tell the candidates at
+#: every one of :data:`STRIBECK_VELOCITIES` apart (neighbours too alike: slow motion).
+STRIBECK_COARSE = (0.02, 0.05, 0.1, 0.2)
 #: Widths (in standstill bands, as :data:`SMOOTH_WIDTHS`) of the Stribeck candidates
 #: whose Coulomb term and bump take the smooth sign ``tanh(dq / w)`` (the narrowest: the
 #: expected sign of a sharp law given the noise, where the bump sits; the banded sign
@@ -605,12 +609,15 @@ def largest_terms(
 def regressor_group(c: Structure) -> tuple[bool, str, str]:
     """The candidates that share one regressor (:func:`largest_terms`): one per armature
     choice and friction placement (friction at the motors and at the joints of a coupled
-    drive, together, would be dependent columns), the smooth-sign Stribeck laws of each
-    width apart (``"smooth_stribeck:0.3"``): their bumps differ from the banded ones, and
-    from those of another width, only near rest, where the bump is 1 and the difference
-    of two bumps that of two smooth Coulomb columns; together they would be nearly
-    dependent columns."""
-    return c.armature, c.at, f"smooth_stribeck:{c.width:g}" if _smooth_stribeck(c) else ""
+    drive, together, would be dependent columns), the Stribeck laws apart: banded
+    (``"stribeck"``) and on the smooth sign of each width (``"smooth_stribeck:0.3"``).
+    Their bumps differ from each other only near rest, where the bump is 1 and the
+    difference of two bumps that of two Coulomb columns, and a grid of Stribeck
+    velocities holds close neighbours: together, or with the smooth laws, they would be
+    nearly dependent columns, and the data's rank decision would cost every shaped law."""
+    if _smooth_stribeck(c):
+        return c.armature, c.at, f"smooth_stribeck:{c.width:g}"
+    return c.armature, c.at, "stribeck" if _banded_stribeck(c) else ""
 
 
 def _banded_stribeck(c: Structure) -> bool:
