@@ -20,7 +20,9 @@ Two steps:
   of a slow reversal lies anywhere within its Coulomb level: that level, through the
   observer's lag, is left out of the calibration and added to the thresholds (the
   standstill margin; --no-standstill-margin turns it off). --gain,
-  --discretisation and --rule choose the observer, which the thresholds keep.
+  --discretisation and --rule choose the observer, which the thresholds keep. A log
+  whose torques have the opposite sign to the model's on some joint (the residual there
+  twice the torque) is refused, naming the file and the joints.
   --thresholds thresholds.json on any logs writes OUT/events.json (dynid-events/1: start
   and end [s], joints (1-based) and joint_names, peak [N m] per joint and level, contact
   or collision, and the log of every event), OUT/residuals.csv (t, r1..rn and, with
