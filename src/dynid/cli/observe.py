@@ -34,8 +34,9 @@ One contact is one event: runs over the threshold closer than --merge (0.2 s) ar
 (a push near the threshold on a joint at rest crosses it again and again as the
 standstill margin follows the velocity noise), and an event shorter than --min-duration
 (0.01 s) that stays at the contact level is dropped (the velocity noise crosses for a
-few samples); neither delays an event's start. --merge 0 --min-duration 0: every run
-over the threshold.
+few samples). A crossing shorter than --min-duration with no other within half of
+--merge is dropped before runs are joined: it neither starts nor extends an event.
+--merge 0 --min-duration 0: every run over the threshold.
 Several logs (or a folder of them): residuals_<name>.csv and .png each, one events.json;
 logs of one name in different folders are named by their folder. With --thresholds the
 calibration's options (--gain, --discretisation, --rule, --margin, --quantile,
@@ -130,8 +131,9 @@ def register(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParser:
         type=nonnegative_type,
         default=DEFAULT_MIN_DURATION_S,
         metavar="SECONDS",
-        help="drop contact-level events shorter than this (default "
-        f"{DEFAULT_MIN_DURATION_S:g} s; 0 with --merge 0: every run over the threshold)",
+        help="drop contact-level events shorter than this, and crossings shorter than it "
+        f"with no other within --merge / 2 (default {DEFAULT_MIN_DURATION_S:g} s; 0 with "
+        "--merge 0: every run over the threshold)",
     )
     add_column_options(p)
     add_drop_invalid(p)

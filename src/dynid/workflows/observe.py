@@ -30,10 +30,11 @@ the command applies, so that the Python API behaves as the command does.
   (:mod:`dynid.observer.sign`), is refused naming the file and the joints; detecting
   warns about one.
 * Otherwise the thresholds (``thresholds.json``) fix the observer (gains, discretisation,
-  rule) and the detection; runs over the threshold closer than ``merge_s`` are one event
-  and contact-level events shorter than ``min_duration_s`` are dropped
-  (:mod:`dynid.observer.events`); the true external torques ``tau_ext1..n`` that
-  ``dynid simulate --contact`` writes beside a log are kept for the figure.
+  rule) and the detection; runs over the threshold closer than ``merge_s`` are one event,
+  contact-level events shorter than ``min_duration_s`` are dropped, and so is an isolated
+  crossing before runs are joined (:mod:`dynid.observer.events`); the true external
+  torques ``tau_ext1..n`` that ``dynid simulate --contact`` writes beside a log are kept
+  for the figure.
 """
 
 from __future__ import annotations
@@ -125,7 +126,8 @@ class ObserveOptions:
         Runs over the threshold closer than this [s] are one event
         (:data:`~dynid.observer.events.DEFAULT_MERGE_S`).
     min_duration_s : float
-        Contact-level events shorter than this [s] are dropped
+        Contact-level events shorter than this [s] are dropped, and so are isolated
+        crossings shorter than it, before runs are joined
         (:data:`~dynid.observer.events.DEFAULT_MIN_DURATION_S`); ``merge_s = 0`` and
         ``min_duration_s = 0``: every run over the threshold is an event.
     columns : (str or None, str or None)
