@@ -188,10 +188,41 @@ def test_positions_only_bag_derives_velocities(tmp_path):
     msgs = [(T0_NS + int(t[k] * 1e9),) * 2 + (names, q[k], [], np.zeros(7)) for k in range(len(t))]
     write_bag(tmp_path / "b", "sqlite3", msgs)
     res = load_joint_state_bag(tmp_path / "b", robot.joint_names)
-    assert res.velocity_derived and any("derived from positions" in s for s in res.notes)
+    assert res.velocity_derived and res.log.dq_derived
     dq = 2 * np.pi * f * np.cos(2 * np.pi * f * t[:, None])
     inner = slice(1000, -1000)
     assert np.max(np.abs(res.log.dq[inner] - dq[inner])) < 1e-4 * np.max(np.abs(dq))
+
+
+def test_cli_import_of_a_bag_without_velocities_writes_none(tmp_path, capsys):
+    """A bag without velocities: the CSV and NPZ hold positions and torques only (they
+    held velocities derived at a fixed 5 Hz that every command then took for measured
+    ones), the summary line says so, and the log read back is marked derived with the
+    bag's positions and torques; a bag with velocities keeps them, and says nothing."""
+    robot = dynid.panda()
+    log = _small(robot, N=400)
+    no_dq = [(*m[:4], [], m[5]) for m in _shuffled(log, robot, 8)]
+    write_bag(tmp_path / "p.bag", "ros1", no_dq)
+    for out in ("p.csv", "p.npz"):
+        assert main(["import", str(tmp_path / "p.bag"), "--out", str(tmp_path / out)]) == 0
+        first = capsys.readouterr().out.splitlines()[0]
+        assert first.endswith(
+            "; positions and torques only: the bag has no velocities (every command derives "
+            "them from the positions at its own cut-off)"
+        )
+        back = load_torque_log(tmp_path / out)
+        assert back.dq_derived
+        np.testing.assert_array_equal(back.q, log.q)
+        np.testing.assert_array_equal(back.tau, log.tau)
+    header = (tmp_path / "p.csv").read_text().splitlines()[2].split(",")
+    assert header == ["t", *(f"q{j}" for j in range(1, 8)), *(f"tau{j}" for j in range(1, 8))]
+    assert set(np.load(tmp_path / "p.npz").files) == {"t", "q", "tau", "n_rows"}
+    write_bag(tmp_path / "v.bag", "ros1", _shuffled(log, robot, 8))
+    assert main(["import", str(tmp_path / "v.bag"), "--out", str(tmp_path / "v.csv")]) == 0
+    assert "velocities" not in capsys.readouterr().out
+    back = load_torque_log(tmp_path / "v.csv")
+    assert not back.dq_derived
+    np.testing.assert_array_equal(back.dq, log.dq)
 
 
 def test_match_joints_rule_and_override():

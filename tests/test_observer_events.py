@@ -16,27 +16,47 @@ from dynid.observer.residual import ObserverOptions
 
 
 def _reference(t, r, contact, collision, merge_s, restarts, min_duration_s=0.0):
-    """Events sample by sample: (start, end, joints, peak, level); those shorter than
-    ``min_duration_s`` at the contact level left out."""
+    """Events sample by sample: (start, end, joints, peak, level). Runs of samples over
+    the threshold one after the other in one piece; a run shorter than
+    ``min_duration_s`` at the contact level with no other run within ``merge_s / 2``
+    before or after it in its piece left out; the other runs joined when closer than
+    ``merge_s`` in one piece; events shorter than ``min_duration_s`` at the contact
+    level left out; joints, peaks and level over every sample of an event."""
     r = np.where(np.isfinite(r), r, 0.0)
-    events, cur = [], None
+
+    def piece(k):
+        return sum(s <= k for s in restarts)
+
+    def collides(a, b):
+        return bool(np.any(np.abs(r[a : b + 1]) > collision[a : b + 1]))
+
+    runs = []
     for k in range(t.shape[0]):
-        over = np.abs(r[k]) > contact[k]
-        if not over.any():
+        if not (np.abs(r[k]) > contact[k]).any():
             continue
-        new_piece = cur is not None and any(cur["last"] < s <= k for s in restarts)
-        apart = k - cur["last"] > 1 and t[k] - t[cur["last"]] > merge_s if cur else True
-        if apart or new_piece:
-            if cur is not None:
-                events.append(cur)
-            cur = {"first": k, "last": k, "joints": set()}
-        cur["last"] = k
-        cur["joints"] |= {j + 1 for j in np.flatnonzero(over)}
-    if cur is not None:
-        events.append(cur)
+        if runs and runs[-1][1] == k - 1 and piece(k) == piece(k - 1):
+            runs[-1][1] = k
+        else:
+            runs.append([k, k])
+    kept = []
+    for i, (a, b) in enumerate(runs):
+        others = [x for x in runs[:i] + runs[i + 1 :] if piece(x[0]) == piece(a)]
+        near = any(0.0 < t[x[0]] - t[b] <= merge_s / 2 or 0.0 < t[a] - t[x[1]] <= merge_s / 2
+                   for x in others)  # fmt: skip
+        if t[b] - t[a] >= min_duration_s or collides(a, b) or near:
+            kept.append((a, b))
+    events = []
+    for a, b in kept:
+        if events and piece(a) == piece(events[-1][1]) and t[a] - t[events[-1][1]] <= merge_s:
+            events[-1][1] = b
+        else:
+            events.append([a, b])
     out = []
-    for e in events:
-        a, b = e["first"], e["last"] + 1
+    for a, last in events:
+        if t[last] - t[a] < min_duration_s and not collides(a, last):
+            continue
+        b = last + 1
+        joints = tuple(int(j) + 1 for j in np.flatnonzero((np.abs(r[a:b]) > contact[a:b]).any(0)))
         peak = []
         for j in range(r.shape[1]):
             best = 0
@@ -44,11 +64,8 @@ def _reference(t, r, contact, collision, merge_s, restarts, min_duration_s=0.0):
                 if abs(r[k, j]) > abs(r[best + a, j]):
                     best = k - a
             peak.append(float(r[a + best, j]))
-        hit = np.any(np.abs(r[a:b]) > collision[a:b])
-        if t[b - 1] - t[a] < min_duration_s and not hit:
-            continue
-        out.append((float(t[a]), float(t[b - 1]), tuple(sorted(e["joints"])), tuple(peak),
-                    "collision" if hit else "contact"))  # fmt: skip
+        out.append((float(t[a]), float(t[b - 1]), joints, tuple(peak),
+                    "collision" if collides(a, last) else "contact"))  # fmt: skip
     return out
 
 
@@ -57,13 +74,15 @@ def _as_tuples(events):
 
 
 @pytest.mark.parametrize("merge", [0.05, 0.0])
-@pytest.mark.parametrize("block", [1, 3, 17, 64, 1000])
-def test_events_fed_in_blocks_are_those_of_the_definition(block, merge):
+def test_events_fed_in_blocks_are_those_of_the_definition(merge):
     """A noisy residual with bursts (some closer than merge_s, one across a restart, NaN
-    samples, the uncertainty's std and a standstill margin): every block size gives the
-    reference's events, as the whole log in one block (detect) does. With ``merge_s = 0``
-    a run of samples over the threshold one after the other is one event (each sample
-    was one)."""
+    samples, the uncertainty's std and a standstill margin, a one-sample crossing 40 ms
+    before a burst, a contact-level burst that the noise dips below the threshold):
+    blocks of every size from 1 sample to the whole log give the reference's events, as
+    the whole log in one block (detect) does. The lone crossing does not start the
+    burst's event (joined first, it began the event 40 ms early); the dipping burst is
+    one contact event (its crossings are close together). With ``merge_s = 0`` a run of
+    samples over the threshold one after the other is one event (each sample was one)."""
     rng = np.random.default_rng(4)
     N, n = 1000, 3
     t = np.cumsum(rng.uniform(0.8e-3, 1.2e-3, N))
@@ -72,8 +91,10 @@ def test_events_fed_in_blocks_are_those_of_the_definition(block, merge):
         r[a : a + size, j] += rng.choice([-1, 1]) * rng.uniform(0.3, 1.2, size)
     r[850:870, 2] += 0.35  # a contact-level burst
     r[450:470] = np.nan  # the observer did not run
+    r[360, 2] = 0.4  # one sample over the contact level only (std 0 there, no margin)
     std = np.abs(0.02 * rng.standard_normal((N, n)))
     std[450:470] = np.nan
+    std[360] = 0.0
     margin = np.where(np.arange(N)[:, None] % 200 < 20, 0.1, 0.0) * np.ones(n)
     th = Thresholds(
         contact=np.full(n, 0.2), collision=np.full(n, 0.6), margin=1.5, quantile=1.0,
@@ -89,18 +110,27 @@ def test_events_fed_in_blocks_are_those_of_the_definition(block, merge):
     assert all(e[1] - e[0] >= 0.01 or e[4] == "collision" for e in want)
     raw = _reference(t, r, c, k, merge, restarts)
     assert any(e[1] - e[0] < 0.01 for e in raw)  # some dropped
-    det = EventDetector(th, merge_s=merge, min_duration_s=0.01, restarts=restarts)
-    got = []
-    for a in range(0, N, block):
-        k = slice(a, a + block)
-        got += det.feed(t[k], r[k], std=std[k], standstill=margin[k])
-    got += det.finish()
-    assert _as_tuples(got) == want
+    assert t[360] in {e[0] for e in _reference(t, r, c, k, 0.0, restarts)}  # a crossing
+    burst = [e for e in want if e[0] <= t[420] <= e[1]]
+    assert len(burst) == 1 and burst[0][0] >= t[400]
+    if merge:
+        assert t[400] - t[360] <= merge  # joined first, it began the event
+        dipping = [e for e in want if e[0] <= t[860] <= e[1]]
+        assert len(dipping) == 1 and dipping[0][4] == "contact"
+        runs = [e for e in _reference(t, r, c, k, 0.0, restarts) if t[845] <= e[0] <= t[875]]
+        assert len(runs) > 1 and all(e[1] - e[0] < 0.01 for e in runs)  # each one short
     whole = detect(
         t, r, th, std=std, standstill=margin, merge_s=merge, min_duration_s=0.01,
         restarts=restarts,
     )  # fmt: skip
     assert _as_tuples(whole) == want
+    for block in range(1, N + 1):
+        det = EventDetector(th, merge_s=merge, min_duration_s=0.01, restarts=restarts)
+        got = []
+        for a in range(0, N, block):
+            k = slice(a, a + block)
+            got += det.feed(t[k], r[k], std=std[k], standstill=margin[k])
+        assert _as_tuples(got + det.finish()) == want, block
 
 
 def test_one_push_near_a_flickering_threshold_is_one_event_starting_at_its_first_crossing():
@@ -140,6 +170,47 @@ def test_one_push_near_a_flickering_threshold_is_one_event_starting_at_its_first
     others = [(e.start, e.level) for e in default if e not in in_push]
     assert others == [(t[2300], "collision")]
     assert {t[200], t[1900]} <= {e.start for e in raw}
+
+
+def test_a_lone_crossing_before_a_contact_does_not_start_its_event():
+    """A 0.5 s step contact of 1.0 N m through the observer's lag K_O / (s + K_O) (closed
+    form) with a one-sample noise crossing 0.13 s before it, as on the TALOS arm: by
+    default the event starts at the closed form's crossing of the threshold (it started
+    at the lone crossing, 130 ms early, joined to it within merge_s); in blocks of any
+    size as in one. Two one-sample crossings 20 ms apart (closer than merge_s / 2) are
+    not isolated: one contact-level event of 20 ms; a lone crossing far from anything is
+    dropped."""
+    rng = np.random.default_rng(2)
+    fs, K, A, t0 = 500.0, 50.0, 1.0, 2.0
+    t = np.arange(0.0, 4.0, 1 / fs)
+    r = np.zeros((t.size, 1))
+    on = (t >= t0) & (t < t0 + 0.5)
+    r[on, 0] = A * -np.expm1(-K * (t[on] - t0))
+    off = t >= t0 + 0.5
+    r[off, 0] = A * -np.expm1(-K * 0.5) * np.exp(-K * (t[off] - t0 - 0.5))
+    r += 0.01 * rng.standard_normal(r.shape)
+    blip = int(round((t0 - 0.13) * fs))
+    r[blip, 0] = 0.6
+    pair = [int(round(3.0 * fs)), int(round(3.02 * fs))]
+    r[pair, 0] = 0.6
+    r[int(round(1.0 * fs)), 0] = 0.6  # alone
+    th = Thresholds(
+        contact=np.full(1, 0.5), collision=np.full(1, 5.0), margin=1.5, quantile=1.0,
+        collision_factor=10.0, options=ObserverOptions(), samples=1, k_sigma=0.0,
+        noise=np.zeros(1), standstill=False,
+    )  # fmt: skip
+    crossing = t[np.argmax(np.where(on, A * -np.expm1(-K * (t - t0)), 0.0) > 0.5)]
+    got = detect(t, r, th)
+    assert t[pair[1]] - t[blip] > 0.2 and t0 - t[blip] < 0.2  # the blip within merge_s
+    starts = [e.start for e in got]
+    assert len(got) == 2 and abs(starts[0] - crossing) < 3 / fs, starts
+    assert starts[1] == t[pair[0]] and got[1].end == t[pair[1]]
+    for block in (1, 7, 64, 65, 650):
+        det = EventDetector(th)
+        ev = [
+            e for a in range(0, t.size, block) for e in det.feed(t[a : a + block], r[a : a + block])
+        ]
+        assert _as_tuples(ev + det.finish()) == _as_tuples(got)
 
 
 @pytest.fixture(scope="module")

@@ -185,6 +185,26 @@ def test_a_position_jump_is_warned_about(folder, capsys):
     assert "at t = 4 s" in err
 
 
+def test_samples_lost_in_one_short_step_cut_the_log_and_invent_no_event(folder, capsys):
+    """0.3 s of rows lost while the arm moves, the time stamps after shifted so that the
+    step there is 2 ms (one sample missing: under the default --max-gap of 20 ms): the
+    positions jump; cut there, no event and one warning naming the jump as samples lost
+    (it was taken for a gap bridged by --max-gap and made a collision of the jump)."""
+    d = folder
+    log = _log(2)
+    keep = (log.t < 2.0) | (log.t >= 2.3)
+    lost = _rows(log, keep)
+    t = np.where(lost.t >= 2.3, lost.t - 0.3 + 1e-3, lost.t)
+    jump = np.abs(lost.q[t >= 2.0][0] - lost.q[t < 2.0][-1]).max()
+    assert jump > 0.05 and np.diff(t).max() == pytest.approx(2e-3)
+    save_torque_log(d / "lost.csv", TorqueLog(t, lost.q, lost.dq, lost.tau))
+    rc, events = _observe(d, "lost.csv")
+    assert rc == 0 and events == []
+    (line,) = [x for x in capsys.readouterr().err.splitlines() if "warning" in x]
+    assert "lost.csv: position jumps more than the recorded velocity explains" in line
+    assert "samples lost without a gap in the time stamps" in line
+
+
 def test_a_long_standstill_raises_nothing(folder, capsys):
     rc, events = _observe(folder, "still.csv")
     assert rc == 0 and events == []

@@ -95,6 +95,37 @@ def test_observe_refuses_torques_of_the_opposite_sign(log, tmp_path, capsys):
     assert len(err) == 1 and "neg.csv" in err[0] and "--units tau=-1" in err[0], err
 
 
+@pytest.mark.parametrize("flipped", [[3], [6], [3, 6]])
+def test_observe_calibrate_refuses_a_sign_flipped_on_some_joints(
+    panda, log, flipped, tmp_path, capsys
+):
+    """Joint 4 (one of three joints gravity loads, computed here: the gravity check only
+    warns) or joint 7 (which gravity does not load: that check cannot tell) negated:
+    ``observe --calibrate`` exits 2 with one line naming the file, exactly those joints
+    and the columns to flip (it wrote thresholds blind on them, the residual there twice
+    the torque); the unflipped log calibrates. Detecting on the flipped log with the
+    right thresholds reports its events and warns once, naming the file."""
+    g = gravity_torques(panda, log.q)
+    loaded = np.std(g, axis=0) > 0.05 * np.std(g, axis=0).max()
+    assert loaded[3] and not loaded[6] and np.sum(loaded) >= 3
+    save_torque_log(tmp_path / "some.csv", _flipped(log, flipped))
+    save_torque_log(tmp_path / "free.csv", log)
+    argv = ["observe", "--params", "panda", "-q", "--calibrate", "--no-figures"]
+    assert main([*argv, "--data", str(tmp_path / "free.csv"), "--out", str(tmp_path / "f")]) == 0
+    assert main([*argv, "--data", str(tmp_path / "some.csv"), "--out", str(tmp_path / "c")]) == 2
+    err = [s for s in capsys.readouterr().err.splitlines() if "error" in s]
+    assert len(err) == 1 and "some.csv" in err[0], err
+    head = err[0].split(" are anti-correlated")[0].split("the measured torques of ")[1]
+    assert set(head.split(", ")) == {panda.joint_names[j] for j in flipped}
+    assert "hint: flip the sign of their torque columns" in err[0]
+    assert not (tmp_path / "c" / "thresholds.json").exists()
+    detect = ["observe", "--params", "panda", "--no-figures", "--data", str(tmp_path / "some.csv")]
+    th = ["--thresholds", str(tmp_path / "f" / "thresholds.json"), "--out", str(tmp_path / "d")]
+    assert main([*detect, *th]) == 0  # detection reports, and says why
+    warned = [s for s in capsys.readouterr().err.splitlines() if "anti-correlated" in s]
+    assert len(warned) == 1 and warned[0].startswith("dynid observe: warning: some.csv: ")
+
+
 def test_a_sign_flipped_on_some_joints_names_them(panda, log):
     """Joints 1-3 negated (as in the trial): the finding names the joints gravity loads
     (computed here) among them, tells to flip their columns, and does not say --units

@@ -8,8 +8,9 @@ not taken for joint1); bag joints matching none (a gripper's) are left out, said
 note; otherwise give --joints with the bag's names in the robot's joint order. Times
 are header stamps (receive times when stamps are unset, said so), in seconds from the
 first message. Messages on other topics, missing joints or fields, NaN, out-of-order and
-repeated stamps are handled and counted. Without velocities in the bag they come from the
-zero-phase filtered derivative of the positions (said so).
+repeated stamps are handled and counted. Without velocities in the bag the log holds
+positions and torques only (said so): every command derives the velocities from the
+positions at its own cut-off, and none takes them for measured ones.
 
 Writes the torque log (--out .csv or .npz) that identify, friction and validate read.
 
@@ -24,10 +25,9 @@ from collections.abc import Sequence
 from pathlib import Path
 from typing import Any
 
-from ..identification.log import DEFAULT_CUTOFF_HZ
 from ..io.rosbag import BagImport, load_joint_state_bag
 from ..io.torque_log import save_torque_log
-from .common import add_robot_options, add_subcommand, load_robot, output_path, positive_type
+from .common import add_robot_options, add_subcommand, load_robot, output_path
 from .console import Console
 
 NAME = "import"
@@ -52,13 +52,6 @@ def register(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParser:
     p.add_argument(
         "--joints", default=None, help="the bag's joint names in the robot's order, comma-separated"
     )
-    p.add_argument(
-        "--cutoff",
-        type=positive_type,
-        default=DEFAULT_CUTOFF_HZ,
-        metavar="HZ",
-        help="low-pass cutoff [Hz] when velocities are derived from positions",
-    )
     p.add_argument("--json", action="store_true", help="print the import summary as JSON")
     return p
 
@@ -67,9 +60,7 @@ def run(args: argparse.Namespace, console: Console) -> int:
     """Read the bag, write the log, print what was found; returns the exit code."""
     robot = load_robot(args)
     joints = None if args.joints is None else [s.strip() for s in args.joints.split(",")]
-    res = load_joint_state_bag(
-        args.bag, robot.joint_names, topic=args.topic, joints=joints, velocity_cutoff_hz=args.cutoff
-    )
+    res = load_joint_state_bag(args.bag, robot.joint_names, topic=args.topic, joints=joints)
     path = save_torque_log(args.out, res.log)
     if args.json:
         console.json(_summary(args.bag, res, robot.joint_names, path))
@@ -97,6 +88,7 @@ def _summary(bag: Path, res: BagImport, names: Sequence[str], path: Path) -> dic
         "out_of_order": res.n_out_of_order,
         "duplicate_stamps": res.n_duplicate_stamps,
         "velocity_derived": res.velocity_derived,
+        "velocities_written": not res.velocity_derived,
         "notes": list(res.notes),
     }
 
@@ -107,6 +99,12 @@ def print_import(console: Console, res: BagImport, names: Sequence[str], path: P
         f"{res.log.n_samples} samples, {res.log.duration:.3f} s at "
         f"{res.log.sample_rate:.1f} Hz from {res.n_messages} messages on {res.topic}; "
         f"time from {res.time_source} stamps, t = 0 at {res.t0_ns} ns"
+        + (
+            "; positions and torques only: the bag has no velocities (every command derives "
+            "them from the positions at its own cut-off)"
+            if res.velocity_derived
+            else ""
+        )
     )
     for rj, bj in zip(names, res.joints, strict=True):
         console.print(f"  {rj} <- {bj}")

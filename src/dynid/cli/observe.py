@@ -20,7 +20,9 @@ Two steps:
   of a slow reversal lies anywhere within its Coulomb level: that level, through the
   observer's lag, is left out of the calibration and added to the thresholds (the
   standstill margin; --no-standstill-margin turns it off). --gain,
-  --discretisation and --rule choose the observer, which the thresholds keep.
+  --discretisation and --rule choose the observer, which the thresholds keep. A log
+  whose torques have the opposite sign to the model's on some joint (the residual there
+  twice the torque) is refused, naming the file and the joints.
   --thresholds thresholds.json on any logs writes OUT/events.json (dynid-events/1: start
   and end [s], joints (1-based) and joint_names, peak [N m] per joint and level, contact
   or collision, and the log of every event), OUT/residuals.csv (t, r1..rn and, with
@@ -32,8 +34,9 @@ One contact is one event: runs over the threshold closer than --merge (0.2 s) ar
 (a push near the threshold on a joint at rest crosses it again and again as the
 standstill margin follows the velocity noise), and an event shorter than --min-duration
 (0.01 s) that stays at the contact level is dropped (the velocity noise crosses for a
-few samples); neither delays an event's start. --merge 0 --min-duration 0: every run
-over the threshold.
+few samples). A crossing shorter than --min-duration with no other within half of
+--merge is dropped before runs are joined: it neither starts nor extends an event.
+--merge 0 --min-duration 0: every run over the threshold.
 Several logs (or a folder of them): residuals_<name>.csv and .png each, one events.json;
 logs of one name in different folders are named by their folder. With --thresholds the
 calibration's options (--gain, --discretisation, --rule, --margin, --quantile,
@@ -128,8 +131,9 @@ def register(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParser:
         type=nonnegative_type,
         default=DEFAULT_MIN_DURATION_S,
         metavar="SECONDS",
-        help="drop contact-level events shorter than this (default "
-        f"{DEFAULT_MIN_DURATION_S:g} s; 0 with --merge 0: every run over the threshold)",
+        help="drop contact-level events shorter than this, and crossings shorter than it "
+        f"with no other within --merge / 2 (default {DEFAULT_MIN_DURATION_S:g} s; 0 with "
+        "--merge 0: every run over the threshold)",
     )
     add_column_options(p)
     add_drop_invalid(p)

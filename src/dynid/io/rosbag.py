@@ -13,9 +13,12 @@
   said in ``notes``. A missing or ambiguous match is an error unless ``joints=`` names the
   bag's joints in the robot's joint order (the message gives the value to pass).
 * **Signals.** ``position`` -> ``q`` [rad or m], ``velocity`` -> ``dq``, ``effort`` ->
-  ``tau`` [N m or N]. When no message carries velocities they come from the zero-phase
-  filtered derivative of the positions (:func:`dynid.signals.filtered_derivative`), said
-  in ``notes``. Messages without effort cannot make a torque log.
+  ``tau`` [N m or N]. When no message carries velocities the log is one of positions
+  and torques (``velocity_derived``): its ``dq`` is the zero-phase filtered derivative of
+  the positions (:func:`~dynid.identification.log.with_derived_velocities`), marked
+  derived, so that every command derives it again at its own cut-off and
+  :func:`~dynid.io.torque_log.save_torque_log` writes no velocities. Messages without
+  effort cannot make a torque log.
 * **Time.** ``header.stamp``; when any stamp on the topic is zero (unset), the receive
   times of the bag are used for all messages instead, said in ``notes``. Times are
   seconds **from the first message** (``t0_ns`` holds the first stamp in nanoseconds), so
@@ -35,9 +38,9 @@ from pathlib import Path
 import numpy as np
 from numpy.typing import NDArray
 
-from .. import _checks, signals
+from .. import _checks
 from ..exceptions import DataError
-from ..identification.log import DEFAULT_CUTOFF_HZ, TorqueLog
+from ..identification.log import DEFAULT_CUTOFF_HZ, TorqueLog, with_derived_velocities
 from .input_files import regular_file
 
 __all__ = [
@@ -176,7 +179,8 @@ class BagImport:
     n_duplicate_stamps : int
         Messages dropped because their time repeated the previous one.
     velocity_derived : bool
-        Velocities from the filtered derivative of positions.
+        No message carried velocities: the log's ``dq`` is derived from its positions
+        (marked so; a saved log holds none).
     notes : tuple of str
     """
 
@@ -237,7 +241,8 @@ def load_joint_state_bag(
     joints : sequence of str, optional
         The bag's joint names in the robot's order (default: :func:`match_joints`).
     velocity_cutoff_hz : float
-        Low-pass cutoff [Hz] when velocities are derived from positions.
+        Low-pass cutoff [Hz] of the velocities derived from positions when the bag has
+        none (the returned log's ``dq``, never saved).
     gap_factor : float
         See :meth:`TorqueLog.from_raw`.
 
@@ -458,12 +463,7 @@ def _assemble(
             log = TorqueLog.from_raw(t, q, dq, tau, gap_factor=gap_factor)
         else:
             raw = TorqueLog.from_raw(t, q, np.zeros_like(q), tau, gap_factor=gap_factor)
-            dq_d = signals.filtered_derivative(raw.t, raw.q, cutoff_hz)
-            log = TorqueLog(raw.t, raw.q, dq_d, raw.tau, None, raw.cleaning)
-            notes.append(
-                "no velocities in the bag: derived from positions (zero-phase low-pass at "
-                f"{cutoff_hz:g} Hz, then central differences)"
-            )
+            log = with_derived_velocities(raw, cutoff_hz)  # marked derived: never saved
     except DataError as exc:
         raise DataError(str(exc), file=name) from exc
     for count, what in (

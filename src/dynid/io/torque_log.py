@@ -27,8 +27,10 @@ the file records its row count (``# rows:``, ``n_rows``), a different count is a
 the file, the column and the line.
 
 Writing is atomic (:mod:`dynid.io.atomic`) with 17 significant digits, so a round trip is
-exact. The CSV body is read by :func:`dynid.io.csv_tables.csv_table` (numpy's C reader,
-straight into arrays allocated once), so a long log needs about the memory of its arrays.
+exact; a log whose velocities were derived from its positions is written without them
+(positions and torques only), so that no reader takes them for measured ones. The CSV
+body is read by :func:`dynid.io.csv_tables.csv_table` (numpy's C reader, straight into
+arrays allocated once), so a long log needs about the memory of its arrays.
 """
 
 from __future__ import annotations
@@ -68,10 +70,11 @@ _UNITS = "# dynid torque log; units: t [s], q [rad], dq [rad/s], tau [N m], ddq 
 _SIGNALS = ("q", "dq", "tau", "ddq")
 
 
-def torque_log_columns(n: int, *, with_ddq: bool = False) -> list[str]:
-    """Column names ``t, q1..qn, dq1..dqn, tau1..taun`` (then ``ddq1..ddqn``)."""
+def torque_log_columns(n: int, *, with_ddq: bool = False, with_dq: bool = True) -> list[str]:
+    """Column names ``t, q1..qn, dq1..dqn, tau1..taun`` (then ``ddq1..ddqn``; without
+    ``dq1..dqn`` when not ``with_dq``)."""
     cols = ["t"]
-    for k in ("q", "dq", "tau") + (("ddq",) if with_ddq else ()):
+    for k in ("q",) + (("dq",) if with_dq else ()) + ("tau",) + (("ddq",) if with_ddq else ()):
         cols += [f"{k}{j}" for j in range(1, n + 1)]
     return cols
 
@@ -79,13 +82,22 @@ def torque_log_columns(n: int, *, with_ddq: bool = False) -> list[str]:
 def save_torque_log(path: str | Path, log: TorqueLog) -> Path:
     """Write ``log`` to ``path`` (``.csv`` or ``.npz``, by suffix); returns the path.
 
+    A log whose velocities were derived from its positions (``log.dq_derived``) is written
+    without them, positions and torques only: a reader derives them again at its own
+    cut-off (every command does), never taking them for measured ones.
+
     Raises
     ------
     DataError
         Unknown suffix.
     """
     return save_torque_log_pieces(
-        path, lambda: (log,), n=log.n, n_rows=log.n_samples, with_ddq=log.ddq is not None
+        path,
+        lambda: (log,),
+        n=log.n,
+        n_rows=log.n_samples,
+        with_ddq=log.ddq is not None,
+        with_dq=not log.dq_derived,
     )
 
 
@@ -97,6 +109,7 @@ def save_torque_log_pieces(
     n_rows: int,
     with_ddq: bool = False,
     extra: tuple[str, Callable[[], Iterable[NDArray[np.float64]]]] | None = None,
+    with_dq: bool = True,
 ) -> Path:
     """Write a log given in consecutive pieces (never held whole) to ``path`` (``.csv``
     or ``.npz``, by suffix), as :func:`save_torque_log` writes the pieces joined.
@@ -116,6 +129,9 @@ def save_torque_log_pieces(
         ``(name, pieces)``: one more (N, n) signal beside the log, ``pieces()`` yielding
         its rows piece by piece like ``pieces``: columns ``name1..namen`` (the array
         ``name`` in an NPZ), which readers of the log ignore.
+    with_dq : bool
+        Whether the velocities are written (not: positions and torques only, whose
+        readers derive the velocities).
 
     Raises
     ------
@@ -125,7 +141,7 @@ def save_torque_log_pieces(
     path = Path(path)
     suffix = path.suffix.lower()
     if suffix == ".npz":
-        names = ["t", "q", "dq", "tau"] + (["ddq"] if with_ddq else [])
+        names = ["t", "q"] + (["dq"] if with_dq else []) + ["tau"] + (["ddq"] if with_ddq else [])
         names += [] if extra is None else [extra[0]]
         with open_atomic(path, "wb") as f, zipfile.ZipFile(f, "w", allowZip64=True) as zf:
             for name in names:
@@ -153,7 +169,7 @@ def save_torque_log_pieces(
             _UNITS,
             f"{ROWS_PREFIX} {n_rows}",
             ",".join(
-                torque_log_columns(n, with_ddq=with_ddq)
+                torque_log_columns(n, with_ddq=with_ddq, with_dq=with_dq)
                 + ([] if extra is None else [f"{extra[0]}{j}" for j in range(1, n + 1)])
             ),
         ]
@@ -164,7 +180,7 @@ def save_torque_log_pieces(
         more = iter(()) if extra is None else iter(extra[1]())
         for log in pieces():
             rows += _piece_rows(path, log, n)
-            parts = [log.t[:, None], log.q, log.dq, log.tau]
+            parts = [log.t[:, None], log.q] + ([log.dq] if with_dq else []) + [log.tau]
             if with_ddq:
                 assert log.ddq is not None
                 parts.append(log.ddq)

@@ -14,15 +14,22 @@ band) crosses it again and again: runs closer than :data:`DEFAULT_MERGE_S` (0.2 
 one event. A crossing of a few samples is the velocity noise, which the residual passes
 unfiltered through ``M(q) dq``: an event shorter than :data:`DEFAULT_MIN_DURATION_S`
 (0.01 s from its first to its last sample over the threshold) is dropped unless it
-reached the collision level. Neither moves an event's start: it is the first sample over
-the threshold (a dropped run only goes unreported). ``merge_s = 0`` and
-``min_duration_s = 0`` give every run over the threshold as its own event.
+reached the collision level. Before runs are joined, an *isolated crossing* is dropped:
+a run shorter than ``min_duration_s`` at the contact level with no other run within
+:data:`ISOLATION_FRACTION` of ``merge_s`` (0.1 s by default) before or after it in its
+piece. It neither starts, extends nor joins an event: a one-sample crossing 0.136 s
+before a contact on a TALOS arm was joined to it and put its start there. A contact near
+the threshold whose residual the noise dips below it makes crossings closer together,
+which are kept and joined. An event's start is its first sample over the threshold that
+is not an isolated crossing. ``merge_s = 0`` and ``min_duration_s = 0`` give every run
+over the threshold as its own event.
 
-:class:`EventDetector` finds them a block of samples at a time: the event still open at
-the end of a block (its start, last sample over the threshold, peaks, joints and level)
-and the largest residual since its last sample over the threshold are carried to the
-next block, so a long log is read with one block's temporaries and gives the events of
-the whole log exactly. :func:`detect` is the detector fed the whole log as one block.
+:class:`EventDetector` finds them a block of samples at a time: the last run over the
+threshold (not judged until the next run says whether it is isolated), the event still
+open (its start, last sample over the threshold, peaks, joints and level) and the largest
+residual since its last sample over the threshold are carried to the next block, so a
+long log is read with one block's temporaries and gives the events of the whole log
+exactly. :func:`detect` is the detector fed the whole log as one block.
 """
 
 from __future__ import annotations
@@ -37,13 +44,24 @@ from .. import _checks
 from ..exceptions import OptionError, ShapeError
 from .thresholds import Thresholds, threshold_series
 
-__all__ = ["DEFAULT_MERGE_S", "DEFAULT_MIN_DURATION_S", "ContactEvent", "EventDetector", "detect"]
+__all__ = [
+    "DEFAULT_MERGE_S",
+    "DEFAULT_MIN_DURATION_S",
+    "ISOLATION_FRACTION",
+    "ContactEvent",
+    "EventDetector",
+    "detect",
+]
 
 #: Runs over the threshold closer than this [s] are one event (module docstring).
 DEFAULT_MERGE_S = 0.2
 #: Events shorter than this [s] (first to last sample over the threshold) are dropped
 #: unless they reached the collision level (module docstring).
 DEFAULT_MIN_DURATION_S = 0.01
+#: A run shorter than ``min_duration_s`` with no other run within this fraction of
+#: ``merge_s`` before or after it is an isolated crossing, dropped before runs are joined
+#: (module docstring).
+ISOLATION_FRACTION = 0.5
 
 
 @dataclass(frozen=True, slots=True)
@@ -108,18 +126,33 @@ class _Stretch:
 
 
 @dataclass(slots=True)
+class _Run:
+    """A run of samples over the threshold one after the other in one piece, not judged
+    yet (the next run decides whether it is isolated): its first and last sample (time
+    [s], and the last one's index in the log), its piece, whether another run ends within
+    the isolation window before it, what its samples hold and what the samples after it
+    hold."""
+
+    start: float
+    last: float
+    last_k: int
+    piece: int
+    near: bool
+    held: _Stretch
+    tail: _Stretch
+
+
+@dataclass(slots=True)
 class _Open:
     """An event not closed yet: its first and last sample over the threshold (time [s]
     and piece), what its samples hold, and what the samples after its last one over
-    the threshold hold (joined to it only if another sample over the threshold follows
-    within ``merge_s``)."""
+    the threshold hold (joined to it only if a kept run follows within ``merge_s``)."""
 
     start: float
     last: float
     piece: int
     held: _Stretch
     after: _Stretch
-    since: int = 0  # samples fed after its last one over the threshold
 
     def closed(self) -> ContactEvent:
         level: Literal["contact", "collision"] = "collision" if self.held.collision else "contact"
@@ -137,9 +170,11 @@ class EventDetector:
     ----------
     thresholds : Thresholds
     merge_s : float
-        Runs over the threshold closer than this [s] are one event (>= 0).
+        Runs over the threshold closer than this [s] are one event (>= 0); an isolated
+        crossing (:data:`ISOLATION_FRACTION` of it) is dropped first.
     min_duration_s : float
-        Events shorter than this [s] at the contact level are dropped (>= 0).
+        Events shorter than this [s] at the contact level are dropped, and so are
+        isolated crossings shorter than it (>= 0).
     restarts : array_like of int, optional
         Samples of the log (counted from its first, over every block) where the observer
         started again (the first of each piece of a log cut at its gaps): no event spans
@@ -171,9 +206,13 @@ class EventDetector:
             raise OptionError(f"min_duration_s must be >= 0 [s]; got {min_duration_s}")
         self.thresholds, self.merge_s = thresholds, float(merge_s)
         self.min_duration_s = float(min_duration_s)
+        #: A run shorter than ``min_duration_s`` with no other run this close [s] is an
+        #: isolated crossing (module docstring).
+        self.isolation_s = ISOLATION_FRACTION * self.merge_s
         self._restarts = np.sort(np.asarray([] if restarts is None else restarts, dtype=np.int64))
         self._next = 0  # the log's sample the next block starts at
         self._open: _Open | None = None
+        self._run: _Run | None = None  # a run that reached the end of the last block
 
     def feed(
         self,
@@ -184,7 +223,8 @@ class EventDetector:
         standstill: ArrayLike | None = None,
     ) -> list[ContactEvent]:
         """The events closed by the next block of samples (an event still open at its
-        end is carried to the next block or :meth:`finish`).
+        end, and a run over the threshold that reaches it, are carried to the next block
+        or :meth:`finish`).
 
         Parameters
         ----------
@@ -214,58 +254,78 @@ class EventDetector:
         contact, collision = threshold_series(self.thresholds, m, std, standstill)
         first, self._next = self._next, self._next + m
         over = np.abs(ra) > contact
-        hit = np.flatnonzero(over.any(axis=1))
-        out: list[ContactEvent] = []
-        if hit.size == 0:
-            if self._open is not None:
-                beyond = np.abs(ra) > collision
-                self._open.after = self._open.after.then(_Stretch.of(ra, over, beyond))
-                self._open.since += m
-            return out
-        piece = np.searchsorted(self._restarts, first + hit, side="right")
-        # a run: samples over the threshold one after the other, or closer than merge_s
-        apart = (np.diff(hit) > 1) & (ta[hit[1:]] - ta[hit[:-1]] > self.merge_s)
-        split = apart | (piece[1:] != piece[:-1])
-        runs = np.split(np.arange(hit.size), np.flatnonzero(split) + 1)
         beyond = np.abs(ra) > collision
-        for i, run in enumerate(runs):
-            a, b = int(hit[run[0]]), int(hit[run[-1]]) + 1
-            joins = (
-                i == 0
-                and self._open is not None
-                and (
-                    (a == 0 and self._open.since == 0)  # the next sample after the last block's
-                    or not ta[a] - self._open.last > self.merge_s
-                )
-                and int(piece[run[0]]) == self._open.piece
-            )
-            if joins:
-                assert self._open is not None
-                held = self._open.held.then(self._open.after)
-                held = held.then(_Stretch.of(ra[:b], over[:b], beyond[:b]))
-                self._open.held = held
+
+        def stretch(a: int, b: int) -> _Stretch:
+            return _Stretch.of(ra[a:b], over[a:b], beyond[a:b])
+
+        hit = np.flatnonzero(over.any(axis=1))
+        piece = np.searchsorted(self._restarts, first + hit, side="right")
+        # runs: samples over the threshold one after the other, in one piece
+        cut = np.flatnonzero((np.diff(hit) > 1) | (piece[1:] != piece[:-1])) + 1
+        bounds = zip([0, *cut], [*cut, hit.size], strict=True) if hit.size else ()
+        out: list[ContactEvent] = []
+        run, done = self._run, 0  # done: the block's samples given to a run or the event
+        for i, j in bounds:
+            a, b, p = int(hit[i]), int(hit[j - 1]) + 1, int(piece[i])
+            gap = stretch(done, a)
+            if run is not None and p == run.piece and first + a == run.last_k + 1:
+                # the run at the end of the last block goes on
+                run.held = run.held.then(gap).then(stretch(a, b))
+                run.last, run.last_k = float(ta[b - 1]), first + b - 1
             else:
-                if self._open is not None:
-                    out += self._closed(self._open)
-                self._open = _Open(
-                    float(ta[a]), 0.0, 0, _Stretch.of(ra[a:b], over[a:b], beyond[a:b]),
+                near = False
+                if run is not None:
+                    near = p == run.piece and not ta[a] - run.last > self.isolation_s
+                    run.tail = run.tail.then(gap)
+                    out += self._judged(run, near)
+                else:
+                    self._between(gap)
+                run = _Run(
+                    float(ta[a]), float(ta[b - 1]), first + b - 1, p, near, stretch(a, b),
                     _Stretch.empty(ra.shape[1]),
                 )  # fmt: skip
-            self._open.last, self._open.piece = float(ta[b - 1]), int(piece[run[-1]])
-            self._open.after = _Stretch.empty(ra.shape[1])
-            if i < len(runs) - 1:
-                out += self._closed(self._open)
-                self._open = None
-        assert self._open is not None
-        b = int(hit[-1]) + 1
-        self._open.after = _Stretch.of(ra[b:], over[b:], beyond[b:])
-        self._open.since = m - b
+            done = b
+        if run is not None:  # the next run, in this block or a later one, judges it
+            run.tail = run.tail.then(stretch(done, m))
+        else:
+            self._between(stretch(done, m))
+        self._run = run
         return out
 
     def finish(self) -> list[ContactEvent]:
         """The event still open after the last block (none or one)."""
-        done, self._open = self._open, None
-        return [] if done is None else self._closed(done)
+        out = [] if self._run is None else self._judged(self._run, False)
+        self._run = None
+        if self._open is not None:
+            out += self._closed(self._open)
+        self._open = None
+        return out
+
+    def _between(self, held: _Stretch) -> None:
+        """Samples after the open event's last one over the threshold (an isolated
+        crossing's included): its peaks take them only if a run joins it later."""
+        if self._open is not None:
+            self._open.after = self._open.after.then(held)
+
+    def _judged(self, run: _Run, near: bool) -> list[ContactEvent]:
+        """A run whose next run is known (``near``: within the isolation window, in the
+        same piece): an isolated crossing is dropped (it neither starts, extends nor
+        joins an event); another run is joined to the open event when within ``merge_s``
+        of it in the same piece, else the open event is closed (returned unless too
+        short) and the run opens the next."""
+        short = run.last - run.start < self.min_duration_s and not run.held.collision
+        if short and not (run.near or near):
+            self._between(run.held)
+            self._between(run.tail)
+            return []
+        ev = self._open
+        if ev is not None and ev.piece == run.piece and not run.start - ev.last > self.merge_s:
+            ev.held = ev.held.then(ev.after).then(run.held)
+            ev.last, ev.after = run.last, run.tail
+            return []
+        self._open = _Open(run.start, run.last, run.piece, run.held, run.tail)
+        return [] if ev is None else self._closed(ev)
 
     def _closed(self, event: _Open) -> list[ContactEvent]:
         """The event closed, or none when it is shorter than ``min_duration_s`` and

@@ -25,12 +25,16 @@ the command applies, so that the Python API behaves as the command does.
   (``uncertainty``, default on); the standstill margin of the model's friction (its
   Coulomb level where the law's Coulomb term is off, through the observer's lag) is left
   out of the residuals they read and added to the thresholds (``standstill``, default on;
-  :mod:`dynid.observer.detection`).
+  :mod:`dynid.observer.detection`). A log whose torques have the opposite sign to the
+  model's on some joint or every joint, read from its residual
+  (:mod:`dynid.observer.sign`), is refused naming the file and the joints; detecting
+  warns about one.
 * Otherwise the thresholds (``thresholds.json``) fix the observer (gains, discretisation,
-  rule) and the detection; runs over the threshold closer than ``merge_s`` are one event
-  and contact-level events shorter than ``min_duration_s`` are dropped
-  (:mod:`dynid.observer.events`); the true external torques ``tau_ext1..n`` that
-  ``dynid simulate --contact`` writes beside a log are kept for the figure.
+  rule) and the detection; runs over the threshold closer than ``merge_s`` are one event,
+  contact-level events shorter than ``min_duration_s`` are dropped, and so is an isolated
+  crossing before runs are joined (:mod:`dynid.observer.events`); the true external
+  torques ``tau_ext1..n`` that ``dynid simulate --contact`` writes beside a log are kept
+  for the figure.
 """
 
 from __future__ import annotations
@@ -43,7 +47,7 @@ from pathlib import Path
 import numpy as np
 from numpy.typing import NDArray
 
-from ..exceptions import OptionError
+from ..exceptions import DataError, OptionError
 from ..exceptions import in_file as about_file
 from ..friction.fit import same_drive
 from ..friction.model import FrictionModel, FrictionSum
@@ -59,6 +63,7 @@ from ..observer.events import DEFAULT_MERGE_S, DEFAULT_MIN_DURATION_S
 from ..observer.model import ObserverModel, from_identified, from_robot
 from ..observer.residual import DEFAULT_GAIN, ObserverOptions
 from ..observer.results import LogObservation, ObserveResult
+from ..observer.sign import TorqueSign, opposite_finding
 from .data_files import (
     ColumnSpec,
     column_map,
@@ -121,7 +126,8 @@ class ObserveOptions:
         Runs over the threshold closer than this [s] are one event
         (:data:`~dynid.observer.events.DEFAULT_MERGE_S`).
     min_duration_s : float
-        Contact-level events shorter than this [s] are dropped
+        Contact-level events shorter than this [s] are dropped, and so are isolated
+        crossings shorter than it, before runs are joined
         (:data:`~dynid.observer.events.DEFAULT_MIN_DURATION_S`); ``merge_s = 0`` and
         ``min_duration_s = 0``: every run over the threshold is an event.
     columns : (str or None, str or None)
@@ -414,20 +420,32 @@ def _calibrated(
 ) -> ObserveResult:
     """The thresholds of the collision-free logs ``read``: their residuals a block at a
     time into :func:`~dynid.observer.detection.calibrate` (running maxima), each log's
-    series kept only with ``opts.keep_series``."""
+    series kept only with ``opts.keep_series``.
+
+    Raises
+    ------
+    DataError
+        A log whose torques have the opposite sign to the model's on some joint or every
+        joint (:mod:`dynid.observer.sign`, from its residual), naming the file and the
+        joints: its thresholds would be blind there."""
     logs: list[LogObservation] = []
+    names = model.robot.joint_names
 
     def blocks() -> Iterator[ObservedBlock]:
         for path, log in zip(read.paths, read.logs, strict=True):
             prep = prepared_log(Path(path), log, model, opts.max_gap)
             keep = Series.new(prep, model.n, wants_std, wants_margin) if opts.keep_series else None
             peak = np.zeros(model.n)
+            sign = TorqueSign(model.n)
             for blk in observed_blocks(prep, model, options, wants_std, wants_margin):
                 if blk.margin is not None:
                     np.maximum(peak, blk.margin.max(axis=0), out=peak)
                 if keep is not None:
                     keep.put(blk)
+                sign.add(prep.log.tau[blk.a : blk.a + blk.r.shape[0]], blk.r)
                 yield blk
+            if (opposite := opposite_finding(sign, names)) is not None:
+                raise DataError(opposite, file=Path(path).name)
             logs.append(_observation(prep, model, mapped, opts, keep, peak))
 
     # calibrate reads a block's residual, then its margin and std: these two come from the

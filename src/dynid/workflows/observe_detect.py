@@ -15,6 +15,7 @@ gets every k-th sample of the residual, its thresholds and the true torques
 
 from __future__ import annotations
 
+import warnings
 from collections.abc import Callable, Sequence
 from contextlib import AbstractContextManager, nullcontext
 from pathlib import Path
@@ -23,12 +24,14 @@ from typing import Any, Protocol
 import numpy as np
 from numpy.typing import NDArray
 
+from ..exceptions import DynidWarning
 from ..exceptions import in_file as about_file
 from ..io.columns import load_joint_columns
 from ..observer.events import ContactEvent, EventDetector
 from ..observer.model import ObserverModel
 from ..observer.residual import ObserverOptions
 from ..observer.results import FigureSeries, LogObservation
+from ..observer.sign import TorqueSign, opposite_finding
 from ..observer.thresholds import Thresholds, threshold_series
 from ..observer.wrench import WrenchEstimate, external_wrench
 from .data_files import in_file
@@ -86,6 +89,7 @@ def detected_log(
     keep = Series.new(prep, n, *wants) if keep_series else None
     ext = in_file(prep.path, lambda: true_torques(prep, model, mapped))
     stats = _Running(n)
+    sign = TorqueSign(n)
     strided = None if not figure_points else _Strided(log.t.shape[0], figure_points, thresholds)
     events: list[ContactEvent] = []
     wrenches: list[WrenchEstimate] = []
@@ -99,11 +103,16 @@ def detected_log(
             if w is not None and keep is not None:
                 wrenches.append(w)
             stats.add(blk.r, blk.margin, None if ext is None else ext[a:b])
+            sign.add(log.tau[a:b], blk.r)
             if keep is not None:
                 keep.put(blk)
             if strided is not None:
                 strided.add(log.t, blk, None if ext is None else ext[a:b])
         events += det.finish()
+    if (opposite := opposite_finding(sign, model.robot.joint_names)) is not None:
+        warnings.warn(  # a whole-log "collision" on each such joint follows
+            f"{prep.path.name}: {opposite}", DynidWarning, stacklevel=3
+        )
     return LogObservation(
         prep.path,
         log.t,

@@ -1,0 +1,138 @@
+"""Measured torques of the opposite sign to the observer model's, read from the residual.
+
+The residual estimates the external joint torques, ``dr/dt = K_O (tau_ext - r)`` with
+``tau_ext = tau_model - tau`` (:mod:`dynid.observer.residual`): ``tau + r`` is the model's
+torque as the observer sees it (through its lag, plus the measured torque's part faster
+than ``K_O``). On a collision-free log it follows the measured torque, correlation near
+``+1``; on a joint whose measured torque has the opposite sign to the model's it is its
+negative, correlation near ``-1``, and the residual there is twice the torque: thresholds
+calibrated on it are blind on that joint. The check sees every joint the model moves, the
+joints gravity does not load included (a wrist), where the gravity check of
+:mod:`dynid.identification.sanity` tells nothing, and a sign flipped on a minority of the
+joints, which that check only warns about.
+
+A joint is called opposite when the correlation is below :data:`OPPOSITE_CORRELATION`.
+A model without torques on a joint (no parameters, no friction) gives ``tau + r`` equal
+to the measured torque's fast part, whose correlation with it is never negative: such a
+joint is never called opposite.
+
+:class:`TorqueSign` keeps running sums over the blocks of a log (one block's temporaries)
+and :func:`opposite_finding` makes the one-line finding.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+
+from .. import _checks
+from ..exceptions import ShapeError
+
+__all__ = ["OPPOSITE_CORRELATION", "TorqueSign", "opposite_finding"]
+
+#: A joint whose measured torque correlates with the model's below this is of the opposite
+#: sign (module docstring).
+OPPOSITE_CORRELATION = -0.5
+
+
+class TorqueSign:
+    """Per joint, the correlation of the measured torques ``tau`` with the model's
+    ``tau + r`` over a log fed a block of samples at a time (module docstring).
+
+    Parameters
+    ----------
+    n : int
+        Joints.
+
+    Examples
+    --------
+    >>> s = TorqueSign(2)
+    >>> t = np.linspace(0.0, 1.0, 50)
+    >>> tau = np.stack([np.sin(6 * t), np.cos(6 * t)], axis=1)
+    >>> s.add(tau, np.stack([0.01 * tau[:, 0], -2.0 * tau[:, 1]], axis=1))
+    >>> s.opposite().tolist()
+    [False, True]
+    """
+
+    def __init__(self, n: int) -> None:
+        self.n = int(n)
+        self._count = 0
+        self._mean = np.zeros((2, self.n))  # tau, model
+        self._m2 = np.zeros((3, self.n))  # sums of squares: tau, model, cross
+
+    def add(self, tau: ArrayLike, r: ArrayLike) -> None:
+        """Add a block: measured torques ``tau`` (m, n) [N m] and the residual ``r`` (m, n)
+        [N m] of the same samples (rows where ``r`` is NaN, not observed, are skipped).
+
+        Raises
+        ------
+        ShapeError
+            Shapes that disagree.
+        """
+        ta = _checks.as_array("tau", tau, allow_nonfinite=True)
+        if ta.ndim != 2 or ta.shape[1] != self.n:
+            raise ShapeError(f"tau must have shape (m, {self.n}); got {ta.shape}")
+        ra = _checks.as_exact("r", r, ta.shape, allow_nonfinite=True)
+        seen = np.all(np.isfinite(ra), axis=1) & np.all(np.isfinite(ta), axis=1)
+        k = int(np.count_nonzero(seen))
+        if k == 0:
+            return
+        x = np.stack([ta[seen], ta[seen] + ra[seen]])  # (2, k, n)
+        mean = x.mean(axis=1)
+        d = x - mean[:, None, :]
+        m2 = np.stack([(d[0] ** 2).sum(0), (d[1] ** 2).sum(0), (d[0] * d[1]).sum(0)])
+        # Chan et al.'s pairwise update: the sums about the joint mean, no cancellation
+        total = self._count + k
+        delta = mean - self._mean
+        w = self._count * k / total
+        self._m2 += m2 + w * np.stack([delta[0] ** 2, delta[1] ** 2, delta[0] * delta[1]])
+        self._mean += delta * (k / total)
+        self._count = total
+
+    def correlation(self) -> NDArray[np.float64]:
+        """Per joint (n,): the correlation of ``tau`` with ``tau + r``; 0 where either is
+        constant or nothing was observed."""
+        with np.errstate(invalid="ignore", divide="ignore"):
+            c = self._m2[2] / np.sqrt(self._m2[0] * self._m2[1])
+        return np.where(np.isfinite(c), c, 0.0)
+
+    def opposite(self) -> NDArray[np.bool_]:
+        """Per joint (n,): its measured torques have the opposite sign to the model's."""
+        out: NDArray[np.bool_] = self.correlation() < OPPOSITE_CORRELATION
+        return out
+
+
+def opposite_finding(sign: TorqueSign, names: Sequence[str]) -> str | None:
+    """The one-line finding of the joints of opposite sign (naming them, their
+    correlations and the remedy: ``--units tau=-1`` when every joint is, their torque
+    columns to flip otherwise), or None when there is none.
+
+    Raises
+    ------
+    ShapeError
+        ``names`` not one per joint.
+    """
+    if len(names) != sign.n:
+        raise ShapeError(f"names must hold {sign.n} joint names; got {len(names)}")
+    bad = [int(k) for k in np.flatnonzero(sign.opposite())]
+    if not bad:
+        return None
+    corr = sign.correlation()
+    said = ", ".join(f"{corr[k]:+.2f} on {names[k]}" for k in bad)
+    if len(bad) == sign.n:
+        return (
+            f"the measured torques of every joint are anti-correlated with the model's "
+            f"torques (correlation {said}): the torque sign is probably opposite to the "
+            "model's, and the residual is about twice the torque; hint: --units tau=-1 (or "
+            "a drive file whose transmission has the sign)"
+        )
+    which = ", ".join(names[k] for k in bad)
+    return (
+        f"the measured torques of {which} are anti-correlated with the model's torques "
+        f"(correlation {said}) while the other joints' agree: their torque sign is "
+        "probably opposite to the model's (or the model is wrong there), and the residual "
+        "there is about twice the torque; hint: flip the sign of their torque columns in "
+        "the file (--units tau=-1 flips every joint)"
+    )

@@ -1,0 +1,59 @@
+"""The sign check of the observer (:mod:`dynid.observer.sign`): the correlation of the
+measured torques with ``tau + r`` fed in blocks equals numpy's ``corrcoef`` of the whole
+(observed) samples, and a residual of twice the torque on a joint (the sign of its torque
+opposite to the model's: ``r = K_O / (s + K_O) (tau_model - tau)`` with ``tau_model =
+-tau``) names that joint, while a model without torques (``r`` the lagged measured torque)
+never does."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from dynid.exceptions import ShapeError
+from dynid.observer.residual import first_order_lag
+from dynid.observer.sign import TorqueSign, opposite_finding
+
+
+@pytest.mark.parametrize("block", [1, 7, 1000])
+def test_correlation_fed_in_blocks_is_numpys_over_the_observed_samples(block):
+    """Torques with large offsets (the running sums stay exact about their mean) and NaN
+    residual rows (not observed: skipped)."""
+    rng = np.random.default_rng(3)
+    N, n = 600, 3
+    tau = 40.0 + rng.standard_normal((N, n)) * [1.0, 0.1, 3.0]
+    r = rng.standard_normal((N, n)) * 0.5 - tau * [0.0, 2.0, 0.3]
+    r[100:130] = np.nan
+    s = TorqueSign(n)
+    for a in range(0, N, block):
+        s.add(tau[a : a + block], r[a : a + block])
+    ok = np.all(np.isfinite(r), axis=1)
+    want = [np.corrcoef(tau[ok, j], tau[ok, j] + r[ok, j])[0, 1] for j in range(n)]
+    np.testing.assert_allclose(s.correlation(), want, rtol=1e-10, atol=1e-12)
+
+
+def test_a_residual_of_twice_the_torque_names_the_joint_a_model_without_torques_none():
+    """A 1 Hz torque at 500 Hz with noise, K_O = 50/s (closed-form lag of
+    :func:`first_order_lag`): joint 2 of the opposite sign to the model (r the lag of
+    ``-2 tau``) is named alone with its columns to flip; every joint flipped gives
+    ``--units tau=-1``; a model without torques (r the lag of ``-tau``) names none."""
+    t = np.arange(0.0, 4.0, 2e-3)
+    rng = np.random.default_rng(1)
+    tau = np.stack([np.sin(2 * np.pi * t), 0.3 * np.cos(2 * np.pi * t + 0.4)], axis=1)
+    tau = tau + 0.02 * rng.standard_normal(tau.shape)
+    lag = lambda x: first_order_lag(t, x, 50.0)  # noqa: E731
+    names = ("a", "b")
+    one = TorqueSign(2)
+    one.add(tau, lag(tau * [0.01, -2.0]))
+    assert one.opposite().tolist() == [False, True]
+    said = opposite_finding(one, names)
+    assert said is not None and said.startswith("the measured torques of b are")
+    assert "flip the sign of their torque columns" in said
+    every = TorqueSign(2)
+    every.add(tau, lag(-2.0 * tau))
+    assert "hint: --units tau=-1" in (opposite_finding(every, names) or "")
+    none = TorqueSign(2)
+    none.add(tau, lag(-tau))
+    assert not none.opposite().any() and opposite_finding(none, names) is None
+    with pytest.raises(ShapeError):
+        opposite_finding(none, ("a",))
