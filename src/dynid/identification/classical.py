@@ -74,7 +74,7 @@ from .log_rows import (
     term_regressor,
 )
 from .model import IdentifiedModel
-from .prepare import measured_torques, prepare_log
+from .prepare import Preprocessing, measured_torques, prepare_log
 from .rate import cutoff_from_motion, decimation, motion_frequency
 from .sanity import check_torque_log, moving_joints, opposite_sign, velocity_noise_std
 from .streaming import BlockSource, normals_by_label
@@ -331,7 +331,7 @@ def _validation_rows(
             f"--validate-on log has {log.n} joints; robot {robot.name!r} has {robot.n}"
         )
     drive = columns.drive
-    p = prepare_log(joint_side_log(log, drive), cutoff_hz=cutoff_hz, trim_s=trim_s)
+    p = prepare_log(joint_side_log(log, drive), Preprocessing(cutoff_hz=cutoff_hz, trim_s=trim_s))
     step = max(1, int(round(log.sample_rate / rate_hz)))
     sl = slice(None, None, step)
     assert p.ddq is not None
@@ -518,11 +518,11 @@ def prepare_torque_log(
     k = decimation(fs, cutoff_hz) if decimate is None else int(decimate)
     if k < 1:
         raise ShapeError(f"decimate must be >= 1; got {decimate}")
-    same = dict(cutoff_hz=cutoff_hz, trim_s=trim_s, max_gap_s=max_gap_s, decimate=k)
-    prepared = prepare_log(jlog, **same)  # type: ignore[arg-type]
+    prep = Preprocessing(cutoff_hz=cutoff_hz, trim_s=trim_s, max_gap_s=max_gap_s, decimate=k)
+    prepared = prepare_log(jlog, prep)
     raw = None
     if cutoff_hz is not None:  # the torques as measured at the same samples
-        raw = measured_torques(jlog, **same)  # type: ignore[arg-type]
+        raw = measured_torques(jlog, prep)
     noise = velocity_noise_std(jlog.tau) if jlog.n_samples >= 3 else None
     del jlog
     return PreparedLog(
