@@ -249,15 +249,11 @@ class Recordings:
         """The friction columns of the joints (motors) that never move in any piece."""
         return still_columns(columns, self.still)
 
-    def raw_offsets(self) -> NDArray[np.float64] | None:
-        """Per row of :meth:`blocks` (sample-major within each piece), the measured torque
-        minus the low-passed one [N m]: ``y + raw_offsets()`` are the targets as measured;
-        None when a piece was not filtered."""
-        if any(p.tau_raw is None for p in self.pieces):
-            return None
-        return np.concatenate(
-            [(np.asarray(p.tau_raw) - p.log.tau).reshape(-1) for p in self.pieces]
-        )
+    @property
+    def measured(self) -> bool:
+        """Whether every piece holds its torques as measured beside the low-passed ones
+        (``tau_raw``: the pieces were filtered); :meth:`measured_blocks` predicts them."""
+        return all(p.tau_raw is not None for p in self.pieces)
 
     def blocks(self, robot: Robot, columns: ModelColumns) -> Iterator[RegressorBlock]:
         """The pieces' rows stacked in one block (sample-major within each piece), or the
@@ -283,7 +279,9 @@ class Recordings:
         """The rows of :meth:`blocks` in the same order, in blocks, with the torques as
         measured and the columns that step at a reversal (Coulomb, smooth, Stribeck) as the
         model applies them, not through the torques' low-pass: what a held-out recording
-        is judged on (a piece whose torques were not filtered: its own)."""
+        is judged on (a piece whose torques were not filtered: its own rows). The one
+        computation of these rows: the held-out judgement of stacked rows and of rows in
+        blocks both pass over them (:mod:`dynid.identification.selection`)."""
         for p in self.pieces:
             log = p.log if p.tau_raw is None else dataclasses.replace(p.log, tau=p.tau_raw)
             yield from log_blocks(robot, log, columns, stream=True, cutoff_hz=None)

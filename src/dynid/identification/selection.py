@@ -104,7 +104,7 @@ def _judge(
     if validation is not None:
         how = "a separate recording"
     scheme = "recordings" if len(data.names) > 1 else "blocks"
-    measured_ok = all(p.tau_raw is not None for p in data.pieces)
+    measured_ok = data.measured  # judged on the torques as measured: one more pass
 
     def judge(
         stack: RegressorStack | StreamedRows,
@@ -113,14 +113,11 @@ def _judge(
         beta: NDArray[Any],
     ) -> HeldOut | None:
         b = np.asarray(beta)[cols]
+        rows = selected_columns(_rows(data, robot, columns), cols)  # read only when passed
         normals: Callable[[NDArray[np.intp]], tuple[Normals, ...]]
-        measured: Callable[[NDArray[np.intp]], tuple[Normals, ...]] | None = None
         if isinstance(stack, StreamedRows) and stack.normals is not None and validation is None:
             assert labels is not None  # the fit gathered the folds' normals by these labels
-            judged = None
-            if measured_ok:  # judged on the torques as measured: one more pass
-                rows = selected_columns(_rows(data, robot, columns), cols)
-                judged = normals_by_label(rows, labels)
+            judged = normals_by_label(rows, labels) if measured_ok else None
             return replace(HeldOut.k_fold(stack.normals, judged), scheme=scheme).expanded(cols)
         if isinstance(stack, StreamedRows):  # rows in blocks: one pass per set of labels
             source = selected_columns(stack.source, cols)
@@ -128,29 +125,19 @@ def _judge(
             rw = estimator.row_weights(e, np.tile(np.arange(data.n), e.size // data.n), b.size)
             m = e.size
             normals = lambda lab: normals_by_label(source, lab, rw)  # noqa: E731
-            if measured_ok:  # judged on the torques as measured
-                rows = selected_columns(_rows(data, robot, columns), cols)
-                measured = lambda lab: normals_by_label(rows, lab, rw)  # noqa: E731
         else:
             W = stack.W if cols.all() else stack.W[:, cols]
             rw = row_weights(estimator, W, stack.y, stack.groups, b)
             Ww, yw, m = W * rw[:, None], stack.y * rw, stack.y.size
             normals = lambda lab: block_normals(Ww, yw, lab)  # noqa: E731
-            raw = data.raw_offsets() if measured_ok else None
-            if raw is not None:  # judged on the torques as measured
-                if raw.size != m:
-                    raise AssertionError(f"{raw.size} measured targets for {m} rows")
-                Wm = _measured_rows(data, columns, stack.W)
-                Wm = (Wm if cols.all() else Wm[:, cols]) * rw[:, None]
-                measured = lambda lab: block_normals(Wm, (stack.y + raw) * rw, lab)  # noqa: E731
         if validation is not None:
             test = _normals(robot, validation, columns, cols, b, estimator)
             held = HeldOut.separate(normals(np.zeros(m, np.intp))[0], test)
         elif labels is None:
             return None
         else:
-            held = HeldOut.k_fold(normals(labels), None if measured is None else measured(labels))
-            held = replace(held, scheme=scheme)
+            judged = normals_by_label(rows, labels, rw) if measured_ok else None
+            held = replace(HeldOut.k_fold(normals(labels), judged), scheme=scheme)
         return held.expanded(cols)
 
     return judge, how, (labels if validation is None else None)
@@ -162,34 +149,6 @@ def _rows(data: Recordings, robot: Robot, columns: ModelColumns) -> BlockSource:
     return lambda: ((b.W, b.y, b.groups) for b in data.measured_blocks(robot, columns))
 
 
-def _measured_rows(
-    data: Recordings, columns: ModelColumns, W: NDArray[np.float64]
-) -> NDArray[np.float64]:
-    """``W`` (rows of :meth:`~dynid.identification.recordings.Recordings.blocks`, every
-    column of ``columns``) with the columns that step at a reversal (Coulomb, smooth,
-    Stribeck) as they act on the measured torques: not through the torques' low-pass
-    (the parallel filtering of the fit), as the model predicts a recording."""
-    steps = columns.step_columns()
-    if not steps.any():
-        return W
-    r = W.shape[1] - int(sum(len(t.labels) for t in columns.appended))
-    sharp = np.concatenate(
-        [
-            np.concatenate(
-                [
-                    t.torque_columns(p.log.q, p.log.dq, np.asarray(p.log.ddq))
-                    for t in columns.appended
-                ],
-                axis=-1,
-            ).reshape(p.log.n_samples * p.log.n, -1)
-            for p in data.pieces
-        ]
-    )
-    out = W.copy()
-    out[:, r:][:, steps[r:]] = sharp[:, steps[r:]]
-    return out
-
-
 def _normals(
     robot: Robot,
     data: Recordings,
@@ -198,16 +157,12 @@ def _normals(
     b: NDArray[np.float64],
     estimator: Estimator,
 ) -> Normals:
-    """The normal equations of a separate recording over the fitted columns."""
-    blocks = list(data.blocks(robot, columns))
+    """The normal equations of a separate recording over the fitted columns, on its rows
+    as measured (:meth:`~.recordings.Recordings.measured_blocks`), weighted as the
+    estimator weighs them at ``b``."""
+    blocks = list(data.measured_blocks(robot, columns))
     W = np.concatenate([blk.W for blk in blocks])[:, cols]
     y = np.concatenate([blk.y for blk in blocks])
-    raw = data.raw_offsets()
-    if raw is not None:  # the torques as measured
-        if raw.size != y.size:
-            raise AssertionError(f"{raw.size} measured targets for {y.size} rows")
-        W = _measured_rows(data, columns, np.concatenate([blk.W for blk in blocks]))[:, cols]
-        y = y + raw
     g = np.concatenate([blk.groups for blk in blocks])
     rw = row_weights(estimator, W, y, g, b)
     return block_normals(W * rw[:, None], y * rw, np.zeros(y.size, np.intp))[0]
@@ -232,7 +187,7 @@ def _with_floor(heldout: Any, data: Recordings) -> Any:
     pieces = data.pieces
     if heldout is None or any(p.torque_noise_std is None for p in pieces):
         return heldout
-    measured = data.raw_offsets() is not None  # judged on the torques as measured
+    measured = data.measured  # judged on the torques as measured
     floor = noise_floor_percent(
         [p.tau_raw if measured else p.log.tau for p in pieces],  # type: ignore[misc]
         [p.torque_noise_std for p in pieces],  # type: ignore[misc]
