@@ -21,7 +21,7 @@ Here:
    each read from its pieces on its own time axis
    (:func:`~dynid.identification.trim.common_cutoff`);
 4. each piece is read through the drive, filtered, differentiated and decimated on its own
-   (:func:`~dynid.identification.classical.prepare_torque_log`), the filter's edges
+   (:func:`~dynid.identification.prepared_log.prepare_torque_log`), the filter's edges
    trimmed at both of its ends (:func:`~dynid.identification.trim.edge_seconds`, half a
    period of the cut-off; the rule validation and the friction fit apply too); a piece
    too short for the filter is left out with a warning naming its file and times, never
@@ -48,11 +48,11 @@ from ..exceptions import DataError, DynidWarning, ShapeError
 from ..model.drive import Drive
 from ..model.robot import Robot
 from ..signals import lowpass_noise_gain
-from .classical import PreparedLog, log_blocks, prepare_torque_log, still_columns
 from .core import ModelColumns, RegressorBlock
 from .holdout import DEFAULT_FOLDS, block_labels
 from .info import IdentificationInfo, LogInfo
 from .log import TorqueLog, joint_side_log
+from .log_rows import log_blocks, still_columns
 from .pieces import (
     WRAP_SPAN,
     joined,
@@ -62,6 +62,7 @@ from .pieces import (
     unwrapped,
     wrappable,
 )
+from .prepared_log import PreparedLog, prepare_torque_log
 from .rate import CUTOFF_MULTIPLE
 from .sanity import (
     check_torque_log,
@@ -408,7 +409,7 @@ def prepare_recordings(
     names : sequence of str, optional
         One name per recording (default ``log1, log2, ...``), for messages and the record.
     cutoff_hz, trim_s, decimate, drive
-        As :func:`~dynid.identification.classical.prepare_torque_log`; one cut-off for all.
+        As :func:`~dynid.identification.prepared_log.prepare_torque_log`; one cut-off for all.
     max_gap_s : float, optional
         Gaps up to this long [s] are bridged; longer ones cut the log into pieces.
 
@@ -512,7 +513,7 @@ def _prepared(
     drive: Drive | None,
     **kw: Any,
 ) -> tuple[list[PreparedLog], list[int], list[str], dict[int, dict[str, int]]]:
-    """Each piece prepared (:func:`~dynid.identification.classical.prepare_torque_log`
+    """Each piece prepared (:func:`~dynid.identification.prepared_log.prepare_torque_log`
     with ``kw``), a piece too short to filter left out with a warning; per recording, the
     samples left out, trimmed and decimated away."""
     prepared, recording, skipped = [], [], []

@@ -42,6 +42,7 @@ from numpy.typing import NDArray
 from ..exceptions import DynidWarning, OptionError, RankDeficientError
 from ..model.drive import Drive
 from ..model.robot import Robot
+from ..regressors.base import BaseParameters
 from ..regressors.terms import ModelTerm
 from ..signals import lowpass_noise_gain
 from .candidates import (
@@ -595,6 +596,7 @@ def identify_recordings(
     folds: int = DEFAULT_FOLDS,
     validate_on: TorqueLog | None = None,
     friction: tuple[str, ...] | None = None,
+    base: BaseParameters | None = None,
 ) -> IdentifiedModel:
     """Identify the base parameters and the model's terms from one or more torque logs.
 
@@ -613,10 +615,29 @@ def identify_recordings(
         Their names (file names) for messages and the record.
     structure : Structure or "auto"
         The terms beside the links; ``"auto"`` (default) chooses them on held-out data.
-    cutoff_hz, trim_s, decimate, drive, estimator, std, max_std_percent, rtol
-        As :func:`~dynid.identification.classical.identify_from_log`.
+    cutoff_hz : float, "auto" or None
+        Zero-phase low-pass cut-off [Hz] of every recording; ``"auto"`` (default) read from
+        their motion (:func:`~dynid.identification.trim.common_cutoff`); None for
+        noise-free data (the logs' ``ddq`` used if present, else differentiated).
+    trim_s : float, optional
+        Seconds dropped at each end of every piece after filtering (default: the filter's
+        edge, :func:`~dynid.identification.trim.edge_seconds`).
     max_gap_s : float, optional
         Gaps up to this long [s] are bridged; longer ones cut a log into pieces.
+    decimate : int, optional
+        Keep every ``decimate``-th sample after filtering; default
+        :func:`~dynid.identification.rate.decimation` (at least 10 % of the samples).
+    drive : Drive, optional
+        The drive train the logs were recorded through (:mod:`dynid.model.drive`); default:
+        link-side torques of a direct drive.
+    estimator, std
+        Least squares (:mod:`dynid.identification.estimators`); ``"classical"`` or
+        ``"robust"`` standard deviations (:func:`~dynid.identification.core.identify`).
+    max_std_percent : float, optional
+        Remove coefficients with a larger relative standard deviation [%] and re-fit.
+    rtol : float, optional
+        Relative rank tolerance of the base parameters and of the least squares (default:
+        the first clear gap of the singular values, and ``1e-10``).
     folds : int
         Contiguous time blocks of one recording's held-out judgement (several recordings:
         one left out at a time).
@@ -625,6 +646,8 @@ def identify_recordings(
     friction : tuple of str, optional
         The friction parts fitted whatever the chosen structure holds (its armature and
         placement kept; the consistent fit's classical parts): the data prepared once.
+    base : BaseParameters, optional
+        The base parameters of a structure given (default: the structural ones).
 
     Returns
     -------
@@ -638,52 +661,31 @@ def identify_recordings(
         From :func:`~dynid.identification.recordings.prepare_recordings`.
     OptionError
         An armature asked with known rotor inertias; a friction placement (``at:``)
-        without a drive that couples joints.
+        without a drive that couples joints; ``base`` with ``structure="auto"``.
     RankDeficientError
         The chosen (or given) structure is not identifiable from the data.
     """
     if isinstance(structure, Structure):
         check_placement(structure, drive)
-    data = prepare_recordings(
-        robot,
-        logs,
-        names,
-        cutoff_hz=cutoff_hz,
-        trim_s=trim_s,
-        max_gap_s=max_gap_s,
-        decimate=decimate,
-        drive=drive,
-    )
-    validation = None
-    if validate_on is not None:  # prepared as the recordings
-        validation = prepare_recordings(
-            robot, [validate_on], ["validation log"], cutoff_hz=data.cutoff_hz, trim_s=trim_s,
-            max_gap_s=max_gap_s, decimate=data.pieces[0].decimate, drive=drive,
-        )  # fmt: skip
+    elif base is not None:
+        raise OptionError("base applies to a structure given, not to one chosen (auto)")
+    data, validation = _recordings(
+        robot, logs, names, validate_on, drive,
+        cutoff_hz=cutoff_hz, trim_s=trim_s, max_gap_s=max_gap_s, decimate=decimate,
+    )  # fmt: skip
     est = estimator_named(estimator)
     selection = None
     if structure == "auto":
         selection = select_structure(
             robot, data, drive=drive, estimator=est, folds=folds, validation=validation, rtol=rtol
         )
-        chosen = Structure() if selection is None else selection.chosen
-        structure = (
-            chosen if friction is None else Structure(chosen.armature, friction, at=chosen.at)
-        )
+        structure = _fitted_structure(selection, friction)
     model_drive, terms = _terms_of(structure, drive, robot.n, data)
     judge, _, fold_labels = _judge(robot, data, est, folds, validation)
     model = identify(
-        robot,
-        data,
-        drive=model_drive,
-        terms=terms,
-        estimator=est,
-        std=std,
-        max_std_percent=max_std_percent,
-        rtol=rtol,
-        judge=judge,
-        fold_labels=fold_labels,
-    )
+        robot, data, drive=model_drive, terms=terms, estimator=est, std=std, base=base,
+        max_std_percent=max_std_percent, rtol=rtol, judge=judge, fold_labels=fold_labels,
+    )  # fmt: skip
     warn_unphysical(model, terms)
     info = replace(
         model.info,
@@ -692,3 +694,27 @@ def identify_recordings(
         extra={**model.info.extra, "terms": list(structure.terms)},
     )
     return replace(model, info=info)
+
+
+def _fitted_structure(selection: Selection | None, friction: tuple[str, ...] | None) -> Structure:
+    """The structure chosen (the links alone when the data are too short to judge), with
+    the friction parts ``friction`` in place of its own when given."""
+    chosen = Structure() if selection is None else selection.chosen
+    return chosen if friction is None else Structure(chosen.armature, friction, at=chosen.at)
+
+
+def _recordings(
+    robot: Robot,
+    logs: Sequence[TorqueLog],
+    names: Sequence[str] | None,
+    validate_on: TorqueLog | None,
+    drive: Drive | None,
+    **kw: Any,
+) -> tuple[Recordings, Recordings | None]:
+    """The recordings prepared (:func:`~.recordings.prepare_recordings` with ``kw``) and the
+    separate recording ``validate_on`` prepared as they are (their cut-off and decimation)."""
+    data = prepare_recordings(robot, logs, names, drive=drive, **kw)
+    if validate_on is None:
+        return data, None
+    same = {**kw, "cutoff_hz": data.cutoff_hz, "decimate": data.pieces[0].decimate}
+    return data, prepare_recordings(robot, [validate_on], ["validation log"], drive=drive, **same)
