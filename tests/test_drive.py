@@ -413,13 +413,15 @@ def test_friction_fitted_per_motor_through_the_coupled_drive(tmp_path):
     friction.json keeps the drive and loads back to the same joint torques."""
     from dynid.friction.fit import fit_friction_through, friction_residual
     from dynid.friction.model import DriveFriction
+    from dynid.identification.prepare import Preprocessing
     from dynid.io.friction_json import load_friction_json, save_friction_json
 
     robot, model, data = _ur5()
     train, _ = _motor_log(model, data, seed=1)
     held, _ = _motor_log(model, data, seed=2)
     m = identify_from_log(robot, train, cutoff_hz=None, decimate=1, drive=_drive())
-    res = friction_residual(m, held, cutoff_hz=None)  # read through the model's drive
+    unfiltered = Preprocessing(cutoff_hz=None, filter_tau=False)
+    res = friction_residual(m, held, unfiltered)  # read through the model's drive
     fit = fit_friction_through(res, m.drive, "classical")
     assert isinstance(fit.friction, DriveFriction)
     law = fit.friction

@@ -103,14 +103,14 @@ def test_a_consistent_fit_far_above_least_squares_in_training_is_accepted_held_o
         ls["heldout_error_percent"], rel=1e-9
     )
     # least squares refitted without each block, on rows built here
-    from dynid.identification.prepare import prepare_log
+    from dynid.identification.prepare import Preprocessing, prepare_log
     from dynid.model.drive import Drive
     from dynid.regressors.base import base_parameters
     from dynid.regressors.terms import LinearFriction
 
     robot = dynid.panda()
     meta = ident["metadata"]
-    p = prepare_log(log, cutoff_hz=meta["cutoff_hz"], trim_s=meta["trim_s"])
+    p = prepare_log(log, Preprocessing(cutoff_hz=meta["cutoff_hz"], trim_s=meta["trim_s"]))
     s = slice(None, None, meta["decimate"])
     q, dq, ddq, tau = p.q[s], p.dq[s], p.ddq[s], p.tau[s]
     bp = base_parameters(robot, kind="torque")

@@ -15,7 +15,7 @@ import scipy.signal
 from dynid.exceptions import ShapeError
 from dynid.identification import prepare as prepare_module
 from dynid.identification.log import TorqueLog
-from dynid.identification.prepare import prepare_log, prepared_blocks
+from dynid.identification.prepare import Preprocessing, prepare_log, prepared_blocks
 
 
 def _log(seed: int, N: int, n: int = 3, *, jitter: bool = False) -> TorqueLog:
@@ -86,8 +86,9 @@ def test_blocks_equal_the_whole_array_steps(monkeypatch, filter_tau, k, jitter):
     fs, cut = 1000.0, 20.0
     ref = _reference(log, fs, cut, filter_tau, k, jitter)
     monkeypatch.setattr(prepare_module, "PREPARE_BLOCK_SAMPLES", 500)
-    p = prepare_log(log, cutoff_hz=cut, filter_tau=filter_tau, decimate=k, fs=fs)
-    blocks = list(prepared_blocks(log, cutoff_hz=cut, filter_tau=filter_tau, decimate=k, fs=fs))
+    prep = Preprocessing(cutoff_hz=cut, filter_tau=filter_tau, decimate=k, fs=fs)
+    p = prepare_log(log, prep)
+    blocks = list(prepared_blocks(log, prep))
     assert len(blocks) > 2
     for name, x in ref.items():
         scale = float(np.max(np.abs(x)))
@@ -110,14 +111,14 @@ def test_blocks_of_derived_velocities_equal_the_whole_log(monkeypatch):
     ddq = np.gradient(dq, log.t, axis=0, edge_order=2)
     keep = (log.t >= 2 / cut) & (log.t <= log.t[-1] - 2 / cut)
     monkeypatch.setattr(prepare_module, "PREPARE_BLOCK_SAMPLES", 600)
-    p = prepare_log(log, cutoff_hz=cut)
+    p = prepare_log(log, Preprocessing(cutoff_hz=cut))
     for got, want in ((p.dq, dq[keep]), (p.ddq, ddq[keep])):
         np.testing.assert_allclose(got, want, rtol=0, atol=1e-12 * float(np.max(np.abs(want))))
 
 
 def test_a_block_size_below_one_is_refused():
     with pytest.raises(ShapeError, match="block_samples"):
-        next(prepared_blocks(_log(3, 2_000), cutoff_hz=20.0, block_samples=0))
+        next(prepared_blocks(_log(3, 2_000), Preprocessing(cutoff_hz=20.0), block_samples=0))
 
 
 def test_a_long_recording_is_validated_in_blocks_with_every_samples_errors(monkeypatch):

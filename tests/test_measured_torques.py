@@ -3,12 +3,14 @@
 
 from __future__ import annotations
 
+import dataclasses
+
 import numpy as np
 import pytest
 
 import dynid
 from dynid.identification.log import TorqueLog
-from dynid.identification.prepare import measured_torques, prepare_log
+from dynid.identification.prepare import Preprocessing, measured_torques, prepare_log
 from dynid.simulation.measurement import sample_times, simulate_measurement
 from dynid.simulation.trajectories import random_fourier
 
@@ -21,6 +23,6 @@ def test_measured_torques_are_prepare_logs_unfiltered_ones(jitter):
     t = np.sort(t)
     log = simulate_measurement(panda, random_fourier(panda, rng)(t), rng=rng)
     log = TorqueLog(log.t, log.q, log.dq, log.tau)
-    same = dict(cutoff_hz=6.0, trim_s=0.2, decimate=4)
-    want = prepare_log(log, filter_tau=False, **same).tau
-    np.testing.assert_array_equal(measured_torques(log, **same), want)
+    prep = Preprocessing(cutoff_hz=6.0, trim_s=0.2, decimate=4)
+    want = prepare_log(log, dataclasses.replace(prep, filter_tau=False)).tau
+    np.testing.assert_array_equal(measured_torques(log, prep), want)

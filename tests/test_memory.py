@@ -21,7 +21,7 @@ from dynid.friction.model import ClassicalFriction
 from dynid.friction.validation import BLOCK_SAMPLES, validate_torques
 from dynid.identification.classical import identify_from_log
 from dynid.identification.log import TorqueLog
-from dynid.identification.prepare import prepare_log
+from dynid.identification.prepare import Preprocessing, prepare_log
 from dynid.io.torque_log import load_torque_log, save_torque_log
 from dynid.simulation.measurement import sample_times, simulate_measurement
 from dynid.simulation.trajectories import random_fourier
@@ -36,7 +36,7 @@ def _log(seed: int, N: int, n: int = 3) -> TorqueLog:
 
 @pytest.mark.parametrize("filter_tau", [True, False])
 def test_decimated_preparation_equals_the_whole_array_steps(filter_tau):
-    """prepare_log(decimate=k), which works column by column, equals the zero-phase
+    """prepare_log with decimate=k, which works column by column, equals the zero-phase
     Butterworth of scipy on whole arrays (their ends continued by numpy's cubic), numpy's
     gradient of the filtered dq, trimmed and every k-th sample taken."""
     log = _log(1, 12_000)
@@ -49,7 +49,7 @@ def test_decimated_preparation_equals_the_whole_array_steps(filter_tau):
     ref = {"q": lp(log.q), "dq": dq, "ddq": np.gradient(dq, log.t, axis=0, edge_order=2)}
     ref["tau"] = lp(log.tau) if filter_tau else log.tau
     keep = (log.t >= log.t[0] + 2 / cut) & (log.t <= log.t[-1] - 2 / cut)
-    p = prepare_log(log, cutoff_hz=cut, filter_tau=filter_tau, decimate=k)
+    p = prepare_log(log, Preprocessing(cutoff_hz=cut, filter_tau=filter_tau, decimate=k))
     np.testing.assert_array_equal(p.t, log.t[keep][::k])
     for name, x in ref.items():
         np.testing.assert_allclose(getattr(p, name), x[keep][::k], rtol=0, atol=1e-12)
@@ -57,7 +57,7 @@ def test_decimated_preparation_equals_the_whole_array_steps(filter_tau):
 
 def test_prepare_log_refuses_a_bad_decimation():
     with pytest.raises(ShapeError, match="decimate"):
-        prepare_log(_log(2, 1000), decimate=0)
+        prepare_log(_log(2, 1000), Preprocessing(decimate=0))
 
 
 def test_validation_of_a_long_log_sums_its_errors_by_blocks():

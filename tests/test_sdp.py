@@ -17,7 +17,7 @@ from dynid.feasibility.convex import SDPOptions, identify_consistent, retrieve_s
 from dynid.feasibility.lmi import pseudo_inertia_margin
 from dynid.feasibility.prior import generic_prior, prior_from_robot
 from dynid.friction.validation import own_friction
-from dynid.identification.prepare import prepare_log
+from dynid.identification.prepare import MEASURED, prepare_log
 from dynid.identification.structure import Structure
 from dynid.simulation.measurement import SensorNoise, sample_times, simulate_measurement
 from dynid.simulation.trajectories import random_fourier
@@ -89,7 +89,7 @@ def test_one_step_on_a_log_with_model_error_predicts_held_out_torques_like_least
     res = identify_consistent(robot, log(5, 20.0), prior=robot, structure=classical)
     assert res.kind == "log" and res.feasible and res.friction is not None
     assert pseudo_inertia_margin(res.phi).min() >= 1e-4 * (1 - 1e-9)
-    p = prepare_log(log(15, 10.0), filter_tau=False)
+    p = prepare_log(log(15, 10.0), MEASURED)
     ols = res.identified
     assert ols is not None and ols.friction is not None
     own = own_friction(ols)

@@ -21,7 +21,7 @@ from dynid.friction.laws import LAWS
 from dynid.friction.model import ClassicalFriction, LawFriction
 from dynid.friction.validation import own_friction
 from dynid.identification.log import TorqueLog, with_derived_velocities
-from dynid.identification.prepare import prepare_log
+from dynid.identification.prepare import Preprocessing, prepare_log
 from dynid.identification.recordings import prepare_recordings, split_at_gaps, unwrapped
 from dynid.identification.selection import identify_recordings
 from dynid.identification.structure import Structure
@@ -266,7 +266,7 @@ def test_positions_only_log_gets_velocities_at_the_preparation_cutoff():
     inner = slice(1000, -1000)
     loss_5hz = np.max(np.abs(derived.dq[inner] - dq_true[inner])) / np.max(np.abs(dq_true))
     assert loss_5hz > 0.01
-    p = prepare_log(derived, cutoff_hz=30.0, trim_s=1.0)
+    p = prepare_log(derived, Preprocessing(cutoff_hz=30.0, trim_s=1.0))
     ref = (
         2
         * np.pi

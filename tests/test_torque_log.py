@@ -7,7 +7,7 @@ import pytest
 
 from dynid.exceptions import DataError, NonFiniteError, ShapeError
 from dynid.identification.log import TorqueLog
-from dynid.identification.prepare import prepare_log
+from dynid.identification.prepare import Preprocessing, prepare_log
 from dynid.io.torque_log import load_torque_log, save_torque_log, torque_log_columns
 from dynid.simulation.measurement import SensorNoise, sample_times, simulate_measurement
 from dynid.simulation.trajectories import sinusoid_trajectory
@@ -167,7 +167,7 @@ def test_prepare_log_resamples_jittered_and_dropped_samples(panda):
     )
     raw = TorqueLog.from_raw(log.t, log.q, log.dq, log.tau)
     assert len(raw.cleaning.gaps) > 50 and raw.cleaning.dt_jitter > 0.05
-    p = prepare_log(raw, cutoff_hz=10.0)
+    p = prepare_log(raw, Preprocessing(cutoff_hz=10.0))
     np.testing.assert_allclose(np.diff(p.t), 1e-3, rtol=1e-6)
     ref = sinusoid_trajectory(p.t, q0, A, T)
     assert np.max(np.abs(p.q - ref.q)) < 1e-5
@@ -181,7 +181,7 @@ def test_prepare_log_rejects_long_gaps():
     t = np.concatenate([np.arange(100), np.arange(150, 250)]) * 1e-3
     z = np.zeros((200, 2))
     with pytest.raises(DataError, match=r"gap of 0.051 s .* t = 0.099 s"):
-        prepare_log(TorqueLog(t, z, z, z), cutoff_hz=None)
+        prepare_log(TorqueLog(t, z, z, z), Preprocessing(cutoff_hz=None))
 
 
 def test_blank_lines_keep_the_fast_reader_and_the_same_arrays(tmp_path, monkeypatch):

@@ -86,11 +86,12 @@ def log_preparation(
     info = arm.info.log if isinstance(arm, IdentifiedModel) else None
     if info is None:
         return "auto", decimate, "motion"
+    own = info.preprocessing
     if decimate is None and logs:
         rate = float(np.median([log.sample_rate for log in logs]))
         if abs(rate - info.sample_rate_hz) <= 0.01 * info.sample_rate_hz:
-            decimate = int(info.decimate)
-    return info.cutoff_hz, decimate, "model"
+            decimate = own.decimate
+    return own.cutoff_hz, decimate, "model"
 
 
 def still_joints(logs: Sequence[TorqueLog], drive: Drive | None) -> NDArray[np.bool_]:

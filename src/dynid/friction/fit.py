@@ -44,9 +44,9 @@ from numpy.typing import ArrayLike, NDArray
 from .. import _checks
 from ..dynamics.rnea import rnea
 from ..exceptions import ConvergenceError, DataError, DynidWarning, ShapeError, WrongTypeError
-from ..identification.log import DEFAULT_CUTOFF_HZ, TorqueLog, joint_side_log
+from ..identification.log import TorqueLog, joint_side_log
 from ..identification.model import IdentifiedModel
-from ..identification.prepare import prepare_log
+from ..identification.prepare import MEASURED, Preprocessing, prepare_log
 from ..identification.sanity import moving_joints, noise_band, velocity_noise_std
 from ..model.drive import Drive
 from ..model.robot import Robot
@@ -220,11 +220,8 @@ def same_drive(drive: Drive | None, own: Drive | None, whose: str, what: str) ->
 def friction_residual(
     model: TorqueModel,
     log: TorqueLog,
+    prep: Preprocessing = MEASURED,
     *,
-    cutoff_hz: float | None = DEFAULT_CUTOFF_HZ,
-    trim_s: float | None = None,
-    max_gap_s: float | None = None,
-    filter_tau: bool = False,
     drive: Drive | None = None,
 ) -> FrictionResidual:
     """Prepare ``log`` and compute the torque residual of ``model``.
@@ -233,9 +230,9 @@ def friction_residual(
     ----------
     model : TorqueModel
     log : TorqueLog
-    cutoff_hz, trim_s, filter_tau, max_gap_s
-        Passed to :func:`~dynid.identification.prepare.prepare_log` (``cutoff_hz=None``: no
-        filtering).
+    prep : Preprocessing
+        The preparation of the log (:func:`~dynid.identification.prepare.prepare_log`);
+        default :data:`MEASURED` (the default cut-off, the torques as measured).
     drive : Drive, optional
         The drive the log was recorded through; default: an identified model's own
         (:func:`model_drive`). The residual is in joint torques.
@@ -246,9 +243,7 @@ def friction_residual(
     """
     d = model_drive(model, drive)
     log = joint_side_log(log, d)
-    p = prepare_log(
-        log, cutoff_hz=cutoff_hz, trim_s=trim_s, filter_tau=filter_tau, max_gap_s=max_gap_s
-    )
+    p = prepare_log(log, prep)
     assert p.ddq is not None  # prepare_log always fills ddq
     tau_m = torques_through(model, d, p.q, p.dq, p.ddq)
     noise = _checks.frozen(velocity_noise_std(log.dq))
@@ -477,9 +472,7 @@ def fit_friction(
     log: TorqueLog,
     *,
     kind: str = "sigmoid",
-    cutoff_hz: float | None = DEFAULT_CUTOFF_HZ,
-    trim_s: float | None = None,
-    filter_tau: bool = False,
+    prep: Preprocessing = MEASURED,
 ) -> FrictionFit:
     """Fit a friction law to the residual of ``model`` on a torque log.
 
@@ -492,7 +485,7 @@ def fit_friction(
     kind : str
         A law of the registry (:mod:`dynid.friction.laws`); the choice among them on
         held-out data is :func:`~dynid.friction.select.select_friction`.
-    cutoff_hz, trim_s, filter_tau
+    prep : Preprocessing
         Preparation of the log (:func:`friction_residual`).
 
     Returns
@@ -514,7 +507,7 @@ def fit_friction(
         Some joints do not move: their friction is set to zero (:func:`fit_law`).
     """
     law = law_named(kind)
-    res = friction_residual(model, log, cutoff_hz=cutoff_hz, trim_s=trim_s, filter_tau=filter_tau)
+    res = friction_residual(model, log, prep)
     return fit_law(law, res.dq, res.residual, dq_noise_std=res.dq_noise_std)
 
 

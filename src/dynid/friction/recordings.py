@@ -41,7 +41,7 @@ from ..identification.log import TorqueLog, joint_side_log
 from ..identification.metrics import TorqueErrors
 from ..identification.model import IdentifiedModel
 from ..identification.pieces import recording_pieces, skipped_piece, wrappable
-from ..identification.prepare import prepare_log
+from ..identification.prepare import Preprocessing, prepare_log
 from ..identification.sanity import velocity_noise_std
 from ..identification.trim import common_cutoff, edge_seconds
 from ..model.drive import Drive
@@ -204,22 +204,16 @@ def prepare_pieces(
         No recording; a recording of another joint count than the model's, or with no
         piece long enough to filter (the file is named); another drive than the model's.
     """
-    gap, k = _recorded_preparation(model, max_gap_s, decimate)
-    raw = _raw_pieces(model, logs, names, cutoff_hz, gap, drive, trim_s)
+    prep = _recorded_preparation(model, max_gap_s, decimate, filter_tau)
+    raw = _raw_pieces(model, logs, names, cutoff_hz, prep.max_gap_s, drive, trim_s)
+    prep = dataclasses.replace(prep, cutoff_hz=raw.cutoff_hz, trim_s=raw.trim_s)
     prepared, recording, skipped = [], [], []
     for r, piece in raw.pieces:
         try:
-            p = prepare_log(
-                piece,
-                cutoff_hz=raw.cutoff_hz,
-                trim_s=raw.trim_s,
-                filter_tau=filter_tau,
-                max_gap_s=gap,
-            )
+            prepared.append(prepare_log(piece, prep))
         except DataError as exc:
             skipped.append(skipped_piece(raw.names[r], piece, exc))
             continue
-        prepared.append(p if k == 1 else p.select(np.arange(0, p.n_samples, k)))
         recording.append(r)
     return _kept(raw, prepared, recording, skipped)
 
@@ -336,21 +330,13 @@ def validate_recordings(
     the errors over every sample, the prepared logs and predictions of a long piece kept
     at every k-th sample only (``Validation.step``), so that a long recording is never
     held prepared whole. Parameters and errors as the two."""
-    gap, _ = _recorded_preparation(model, max_gap_s, RECORDED)  # every sample judged
-    raw = _raw_pieces(model, logs, names, cutoff_hz, gap, drive, trim_s)
+    prep = _recorded_preparation(model, max_gap_s, 1, filter_tau)  # every sample judged
+    raw = _raw_pieces(model, logs, names, cutoff_hz, prep.max_gap_s, drive, trim_s)
+    prep = dataclasses.replace(prep, cutoff_hz=raw.cutoff_hz, trim_s=raw.trim_s)
     parts, recording, skipped = [], [], []
     for r, piece in raw.pieces:
         try:
-            v = validated_log(
-                model,
-                piece,
-                friction,
-                raw.drive,
-                cutoff_hz=raw.cutoff_hz,
-                trim_s=raw.trim_s,
-                filter_tau=filter_tau,
-                max_gap_s=gap,
-            )
+            v = validated_log(model, piece, friction, raw.drive, prep)
         except DataError as exc:
             skipped.append(skipped_piece(raw.names[r], piece, exc))
             continue
@@ -371,9 +357,12 @@ def _recorded_preparation(
     model: TorqueModel,
     max_gap_s: float | None | Literal["recorded"],
     decimate: int | Literal["recorded"],
-) -> tuple[float | None, int]:
+    filter_tau: bool,
+) -> Preprocessing:
     """The gap rule and the decimation: as given, or as the model was identified with
-    (the library defaults for another model).
+    (:attr:`~dynid.identification.info.LogInfo.preprocessing`; the library defaults for
+    another model), with the torques filtered as ``filter_tau`` says; the cut-off and the
+    trim are the recordings' (:func:`_raw_pieces`).
 
     Raises
     ------
@@ -381,13 +370,14 @@ def _recorded_preparation(
         ``decimate`` below 1.
     """
     log = model.info.log if isinstance(model, IdentifiedModel) else None
+    own = Preprocessing() if log is None else log.preprocessing
     if max_gap_s is None or isinstance(max_gap_s, str):
-        max_gap_s = None if log is None else log.max_gap_s
+        max_gap_s = own.max_gap_s
     if isinstance(decimate, str):
-        decimate = 1 if log is None else int(log.decimate)
+        decimate = own.decimate
     if int(decimate) < 1:
         raise OptionError(f"decimate must be at least 1; got {decimate}")
-    return max_gap_s, int(decimate)
+    return Preprocessing(max_gap_s=max_gap_s, decimate=int(decimate), filter_tau=filter_tau)
 
 
 def _robot(model: TorqueModel) -> Robot | None:

@@ -33,7 +33,7 @@ from ..exceptions import DynidWarning, OptionError, ShapeError, WrongTypeError
 from ..identification.log import DEFAULT_CUTOFF_HZ, TorqueLog, joint_side_log
 from ..identification.metrics import TorqueErrors, torque_errors
 from ..identification.model import IdentifiedModel
-from ..identification.prepare import prepare_log, prepared_blocks
+from ..identification.prepare import Preprocessing, prepare_log, prepared_blocks
 from ..identification.recordings import common_cutoff
 from ..identification.sanity import anticorrelated
 from ..model.drive import Drive
@@ -218,16 +218,8 @@ def validate_torques(
     jlog = joint_side_log(log, d)
     cut = recorded_cutoff(model, jlog) if isinstance(cutoff_hz, str) else cutoff_hz
     del log  # a long log's raw signals are freed here when the caller holds no other reference
-    return validated_log(
-        model,
-        jlog,
-        friction,
-        d,
-        cutoff_hz=cut,
-        trim_s=trim_s,
-        filter_tau=filter_tau,
-        max_gap_s=max_gap_s,
-    )
+    prep = Preprocessing(cutoff_hz=cut, trim_s=trim_s, max_gap_s=max_gap_s, filter_tau=filter_tau)
+    return validated_log(model, jlog, friction, d, prep)
 
 
 #: Prepared samples a :class:`Validation` keeps (for its figures): of a longer log it keeps
@@ -241,14 +233,10 @@ def validated_log(
     jlog: TorqueLog,
     friction: FrictionModel | FrictionSum | None,
     drive: Drive | None,
-    *,
-    cutoff_hz: float | None,
-    trim_s: float | None = None,
-    filter_tau: bool = False,
-    max_gap_s: float | None = None,
+    prep: Preprocessing,
 ) -> Validation:
-    """:func:`validated` on the joint-side log ``jlog`` prepared
-    (:func:`~dynid.identification.prepare.prepare_log` with these settings); a log longer than
+    """:func:`validated` on the joint-side log ``jlog`` prepared as ``prep`` says
+    (:func:`~dynid.identification.prepare.prepare_log`); a log longer than
     :data:`KEPT_SAMPLES` is prepared and predicted a block at a time
     (:func:`~dynid.identification.prepare.prepared_blocks`): the errors over every sample, the
     Validation keeping every k-th sample (``step``).
@@ -260,15 +248,12 @@ def validated_log(
     ShapeError
         The friction model's joint count differs from the log's.
     """
-    kw = {"cutoff_hz": cutoff_hz, "trim_s": trim_s, "filter_tau": filter_tau}
     step = -(-jlog.n_samples // KEPT_SAMPLES)
     if step <= 1:
-        p = prepare_log(jlog, max_gap_s=max_gap_s, **kw)  # type: ignore[arg-type]
-        return validated(model, p, friction, drive)
+        return validated(model, prepare_log(jlog, prep), friction, drive)
     if friction is not None and friction.n != jlog.n:
         raise ShapeError(f"friction model has {friction.n} joints; the log has {jlog.n}")
-    blocks = prepared_blocks(jlog, max_gap_s=max_gap_s, **kw)  # type: ignore[arg-type]
-    return _validated_blocks(model, blocks, friction, drive, step)
+    return _validated_blocks(model, prepared_blocks(jlog, prep), friction, drive, step)
 
 
 def _validated_blocks(

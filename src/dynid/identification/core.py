@@ -18,7 +18,7 @@ Every route is the same steps over a :class:`Dataset`:
 
 A data set is anything with the :class:`Dataset` protocol: static data
 (:class:`~dynid.identification.data.StaticDataset`) and prepared torque logs
-(:class:`~dynid.identification.classical.PreparedLog`). Its blocks come as an iterator so
+(:class:`~dynid.identification.prepared_log.PreparedLog`). Its blocks come as an iterator so
 that a long log can be read in pieces; they are concatenated here.
 """
 
@@ -207,7 +207,7 @@ def identify(
         Kinematics and gravity the data belong to; its inertial parameters are not used.
     data : Dataset
         Static data (:class:`~dynid.identification.data.StaticDataset`) or a prepared
-        torque log (:func:`~dynid.identification.classical.prepare_torque_log`).
+        torque log (:func:`~dynid.identification.prepared_log.prepare_torque_log`).
     drive : Drive, optional
         The drive train: its rotor inertias are identified with the links (known ones
         subtracted) and its friction acts where it says.

@@ -2,7 +2,7 @@
 
 A data set is anything with the :class:`Dataset` protocol: static data
 (:class:`~dynid.identification.data.StaticDataset`) and prepared torque logs
-(:class:`~dynid.identification.classical.PreparedLog`); the core
+(:class:`~dynid.identification.prepared_log.PreparedLog`); the core
 (:func:`~dynid.identification.core.identify`) fits the regressor blocks it gives over the
 :class:`ModelColumns`.
 """

@@ -18,6 +18,7 @@ from dataclasses import dataclass, field
 from typing import Any, Literal
 
 from .least_squares import StdMethod
+from .prepare import Preprocessing
 
 __all__ = ["IdentificationInfo", "LogInfo", "Route", "StaticInfo"]
 
@@ -93,6 +94,18 @@ class LogInfo:
     resampled: bool = False
     n_cuts: int = 0
     max_gap_s: float | None = None
+
+    @property
+    def preprocessing(self) -> Preprocessing:
+        """The preparation the log was identified with, as the record
+        :func:`~dynid.identification.prepare.prepare_log` reads: the cut-off, the gap rule and
+        the decimation (the torques low-passed), ``trim_s`` None (each recording's filter
+        edge is its own, :func:`~dynid.identification.trim.edge_seconds`). Validation, the
+        friction fit and payload identification prepare their recordings with it unless told
+        otherwise."""
+        return Preprocessing(
+            cutoff_hz=self.cutoff_hz, max_gap_s=self.max_gap_s, decimate=int(self.decimate)
+        )
 
 
 @dataclass(frozen=True, slots=True)

@@ -127,7 +127,7 @@ class TorqueLog:
     dq_derived : bool
         True when ``dq`` was derived from ``q`` (a log that records positions only,
         :func:`with_derived_velocities`): identification derives it again at its own
-        cut-off (:func:`~dynid.identification.classical.prepare_torque_log`), never at a
+        cut-off (:func:`~dynid.identification.prepared_log.prepare_torque_log`), never at a
         reader's default.
 
     Raises

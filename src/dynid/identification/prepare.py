@@ -1,6 +1,9 @@
 """Preparing a torque log for identification and validation: resample onto a uniform grid,
 zero-phase low-pass, differentiate, trim the filter's edges and decimate
-(:func:`prepare_log`), whole or in blocks of bounded memory (:func:`prepared_blocks`).
+(:func:`prepare_log`), whole or in blocks of bounded memory (:func:`prepared_blocks`), or
+only its torques as measured (:func:`measured_torques`); the three read one record of
+the settings, :class:`Preprocessing` (an identified model's:
+:attr:`~dynid.identification.info.LogInfo.preprocessing`).
 
 The signals are those of a :class:`~dynid.identification.log.TorqueLog`: ``t`` [s], ``q``
 [rad or m], ``dq`` [rad/s or m/s], ``tau`` [N m or N], ``ddq`` [rad/s^2 or m/s^2], rows the
@@ -21,59 +24,34 @@ from ..exceptions import DataError, DynidWarning, ShapeError
 from .log import _SIGNALS, DEFAULT_CUTOFF_HZ, TorqueLog, default_max_gap
 
 __all__ = [
+    "MEASURED",
     "PREPARE_BLOCK_SAMPLES",
     "SETTLE_CYCLES",
+    "Preprocessing",
     "measured_torques",
     "prepare_log",
     "prepared_blocks",
 ]
 
 
-def prepare_log(
-    log: TorqueLog,
-    *,
-    cutoff_hz: float | None = DEFAULT_CUTOFF_HZ,
-    trim_s: float | None = None,
-    fs: float | None = None,
-    max_gap_s: float | None = None,
-    jitter_rtol: float = 1e-6,
-    filter_tau: bool = True,
-    decimate: int = 1,
-) -> TorqueLog:
-    """Resample, zero-phase filter, differentiate, trim and decimate a torque log.
+@dataclass(frozen=True, slots=True)
+class Preprocessing:
+    """How a torque log is prepared (:func:`prepare_log`): the settings of the steps, with
+    their defaults, in one record.
 
-    Steps (:mod:`dynid.signals`):
-
-    1. If the steps of ``t`` differ from their median by more than ``jitter_rtol``
-       (jitter, gaps) or ``fs`` differs from the log's rate, resample every signal
-       linearly onto ``t[0] + k / fs``.
-    2. If ``cutoff_hz`` is given, low-pass ``q``, ``dq``, ``tau`` (and ``ddq`` if the log
-       has it) with the zero-phase Butterworth (order 4 applied twice); ``tau`` only if
-       ``filter_tau``.
-    3. If the log has no ``ddq``: ``ddq`` = derivative of the (filtered) ``dq``
-       (second-order differences). A log whose ``dq`` was derived from ``q``
-       (``log.dq_derived``) gets it derived again at ``cutoff_hz`` first, so that
-       velocities, accelerations, positions and torques share one cut-off.
-    4. Drop ``trim_s`` seconds at each end (default ``2 / cutoff_hz`` when filtering,
-       else 0).
-    5. Keep every ``decimate``-th sample of what is left.
-
-    Steps 2-5 run one column at a time, so that a long log needs, beside its own arrays,
-    the decimated result and a few full-length columns (not full-length copies of every
-    filtered signal); the values are those of the steps applied to whole arrays.
-
-    Parameters
+    Attributes
     ----------
-    log : TorqueLog
     cutoff_hz : float or None
-        Low-pass cutoff [Hz]; None skips filtering (noise-free or pre-filtered data).
+        Zero-phase low-pass cut-off [Hz]; None skips filtering (noise-free or pre-filtered
+        data). Default :data:`~dynid.identification.log.DEFAULT_CUTOFF_HZ`.
     trim_s : float, optional
-        Seconds dropped at each end.
+        Seconds dropped at each end [s]; default ``2 / cutoff_hz`` when filtering, else 0
+        (:func:`~dynid.signals.edge_seconds`).
     fs : float, optional
         Rate of the uniform grid [Hz]; default the log's median rate.
     max_gap_s : float, optional
-        Longest gap bridged by interpolation [s]; default :func:`default_max_gap` of the
-        median step.
+        Longest gap bridged by interpolation [s]; default
+        :func:`~dynid.identification.log.default_max_gap` of the median step.
     jitter_rtol : float
         Relative step tolerance under which the log counts as uniform.
     filter_tau : bool
@@ -83,7 +61,67 @@ def prepare_log(
         that the friction model, evaluated on the velocities, keeps sharp.
     decimate : int
         Keep every ``decimate``-th sample after trimming (the classical route's
-        decimation, :func:`~dynid.identification.classical.auto_decimation`).
+        decimation, :func:`~dynid.identification.rate.decimation`).
+
+    Raises
+    ------
+    ShapeError
+        ``decimate`` not an integer >= 1.
+    DataError
+        ``trim_s < 0``.
+    """
+
+    cutoff_hz: float | None = DEFAULT_CUTOFF_HZ
+    trim_s: float | None = None
+    fs: float | None = None
+    max_gap_s: float | None = None
+    jitter_rtol: float = 1e-6
+    filter_tau: bool = True
+    decimate: int = 1
+
+    def __post_init__(self) -> None:
+        if int(self.decimate) != self.decimate or self.decimate < 1:
+            raise ShapeError(f"decimate must be an integer >= 1; got {self.decimate}")
+        if self.trim_s is not None and self.trim_s < 0:
+            raise DataError(f"seconds must be >= 0; got {self.trim_s}")
+
+
+#: The default preparation (:class:`Preprocessing` with its defaults).
+_DEFAULT = Preprocessing()
+
+#: The preparation of validation and of the friction fit by default: the default cut-off,
+#: the torques kept as measured (``filter_tau=False``).
+MEASURED = Preprocessing(filter_tau=False)
+
+
+def prepare_log(log: TorqueLog, prep: Preprocessing = _DEFAULT) -> TorqueLog:
+    """Resample, zero-phase filter, differentiate, trim and decimate a torque log.
+
+    Steps (:mod:`dynid.signals`):
+
+    1. If the steps of ``t`` differ from their median by more than ``prep.jitter_rtol``
+       (jitter, gaps) or ``prep.fs`` differs from the log's rate, resample every signal
+       linearly onto ``t[0] + k / fs``.
+    2. If ``prep.cutoff_hz`` is given, low-pass ``q``, ``dq``, ``tau`` (and ``ddq`` if the
+       log has it) with the zero-phase Butterworth (order 4 applied twice); ``tau`` only if
+       ``prep.filter_tau``.
+    3. If the log has no ``ddq``: ``ddq`` = derivative of the (filtered) ``dq``
+       (second-order differences). A log whose ``dq`` was derived from ``q``
+       (``log.dq_derived``) gets it derived again at ``cutoff_hz`` first, so that
+       velocities, accelerations, positions and torques share one cut-off.
+    4. Drop ``prep.trim_s`` seconds at each end (default ``2 / cutoff_hz`` when
+       filtering, else 0).
+    5. Keep every ``prep.decimate``-th sample of what is left.
+
+    Steps 2-5 run one column at a time, so that a long log needs, beside its own arrays,
+    the decimated result and a few full-length columns (not full-length copies of every
+    filtered signal); the values are those of the steps applied to whole arrays.
+
+    Parameters
+    ----------
+    log : TorqueLog
+    prep : Preprocessing
+        The settings of the steps (default: :class:`Preprocessing` ``()``).
 
     Returns
     -------
@@ -93,10 +131,8 @@ def prepare_log(
     Raises
     ------
     DataError
-        A gap longer than ``max_gap_s``; a cutoff not below the Nyquist frequency; too few
-        samples to filter, or nothing left after trimming.
-    ShapeError
-        ``decimate < 1``.
+        A gap longer than ``prep.max_gap_s``; a cutoff not below the Nyquist frequency; too
+        few samples to filter, or nothing left after trimming.
 
     Warns
     -----
@@ -104,16 +140,16 @@ def prepare_log(
         The default cutoff :data:`DEFAULT_CUTOFF_HZ` is not below the log's Nyquist
         frequency (a log slower than 10 Hz): a quarter of the rate is used instead.
     """
-    plan = _plan(log, cutoff_hz, trim_s, fs, max_gap_s, jitter_rtol, decimate)
+    plan = _plan(log, prep)
     n_out = len(plan.out)
     parts = _windows(plan, PREPARE_BLOCK_SAMPLES)
     if len(parts) == 1:  # short: the whole log at once
-        out = _prepared_window(log, plan, *parts[0], filter_tau)
+        out = _prepared_window(log, plan, *parts[0], prep.filter_tau)
     else:  # long: block by block into the result (one block's temporaries at a time)
         out = {}
         o = 0
         for w in parts:
-            piece = _prepared_window(log, plan, *w, filter_tau)
+            piece = _prepared_window(log, plan, *w, prep.filter_tau)
             m = piece["t"].shape[0]
             for k, v in piece.items():
                 if k not in out:
@@ -126,16 +162,7 @@ def prepare_log(
 
 
 def prepared_blocks(
-    log: TorqueLog,
-    *,
-    cutoff_hz: float | None = DEFAULT_CUTOFF_HZ,
-    trim_s: float | None = None,
-    fs: float | None = None,
-    max_gap_s: float | None = None,
-    jitter_rtol: float = 1e-6,
-    filter_tau: bool = True,
-    decimate: int = 1,
-    block_samples: int | None = None,
+    log: TorqueLog, prep: Preprocessing = _DEFAULT, *, block_samples: int | None = None
 ) -> Iterator[TorqueLog]:
     """:func:`prepare_log` in consecutive blocks of at most ``block_samples`` prepared
     samples (default :data:`PREPARE_BLOCK_SAMPLES`): their concatenation is
@@ -152,27 +179,19 @@ def prepared_blocks(
     """
     if block_samples is not None and block_samples < 1:
         raise ShapeError(f"block_samples must be >= 1; got {block_samples}")
-    plan = _plan(log, cutoff_hz, trim_s, fs, max_gap_s, jitter_rtol, decimate)
+    plan = _plan(log, prep)
     size = PREPARE_BLOCK_SAMPLES if block_samples is None else int(block_samples)
     for w in _windows(plan, size):
-        out = _prepared_window(log, plan, *w, filter_tau)
+        out = _prepared_window(log, plan, *w, prep.filter_tau)
         yield _as_log(out, log)
 
 
-def measured_torques(
-    log: TorqueLog,
-    *,
-    cutoff_hz: float | None = DEFAULT_CUTOFF_HZ,
-    trim_s: float | None = None,
-    fs: float | None = None,
-    max_gap_s: float | None = None,
-    jitter_rtol: float = 1e-6,
-    decimate: int = 1,
-) -> NDArray[np.float64]:
-    """The torques [N m] (M, n) at the samples of :func:`prepare_log` (same parameters)
-    as measured: resampled as it resamples a log that is not uniform, not low-passed,
-    ``prepare_log(log, filter_tau=False, ...).tau`` without preparing the other signals."""
-    plan = _plan(log, cutoff_hz, trim_s, fs, max_gap_s, jitter_rtol, decimate)
+def measured_torques(log: TorqueLog, prep: Preprocessing = _DEFAULT) -> NDArray[np.float64]:
+    """The torques [N m] (M, n) at the samples of :func:`prepare_log` ``(log, prep)`` as
+    measured: resampled as it resamples a log that is not uniform, not low-passed,
+    ``prepare_log(log, replace(prep, filter_tau=False)).tau`` without preparing the other
+    signals (``prep.filter_tau`` is not read)."""
+    plan = _plan(log, prep)
     idx = np.asarray(plan.out)
     if plan.uniform:
         return np.array(log.tau[idx])
@@ -212,32 +231,24 @@ class _Plan:
     derived: bool  # dq derived again from q at the cut-off
 
 
-def _plan(
-    log: TorqueLog,
-    cutoff_hz: float | None,
-    trim_s: float | None,
-    fs: float | None,
-    max_gap_s: float | None,
-    jitter_rtol: float,
-    decimate: int,
-) -> _Plan:
+def _plan(log: TorqueLog, prep: Preprocessing) -> _Plan:
     """Steps 1 and 4-5 of :func:`prepare_log` decided: the checks, the grid, the rows."""
     t = log.t
     dt = np.diff(t)
-    _check_gaps(t, dt, max_gap_s)
-    if int(decimate) != decimate or decimate < 1:
-        raise ShapeError(f"decimate must be an integer >= 1; got {decimate}")
+    _check_gaps(t, dt, prep.max_gap_s)
+    fs, decimate = prep.fs, prep.decimate
     rate = signals.sample_rate(t) if fs is None else float(fs)
-    uniform = signals.is_uniform(t, rtol=jitter_rtol) and abs(rate * np.median(dt) - 1.0) < 1e-9
+    uniform = (
+        signals.is_uniform(t, rtol=prep.jitter_rtol) and abs(rate * np.median(dt) - 1.0) < 1e-9
+    )
     del dt
     if not uniform:  # the grid of signals.resample_uniform
         m = int(np.floor((t[-1] - t[0]) * rate * (1.0 + 1e-12))) + 1
         t = t[0] + np.arange(m) / rate
-    cutoff_hz = _usable_cutoff(cutoff_hz, rate, log.n_samples)
+    cutoff_hz = _usable_cutoff(prep.cutoff_hz, rate, log.n_samples)
+    trim_s = prep.trim_s
     if trim_s is None:
         trim_s = signals.edge_seconds(cutoff_hz) if cutoff_hz is not None else 0.0
-    if trim_s < 0:
-        raise DataError(f"seconds must be >= 0; got {trim_s}")
     # the samples of signals.trim_edges (t increases): its first and last, no mask of them
     first = int(np.searchsorted(t, t[0] + trim_s, side="left"))
     last = int(np.searchsorted(t, t[-1] - trim_s, side="right")) - 1

@@ -21,7 +21,7 @@ Here:
    each read from its pieces on its own time axis
    (:func:`~dynid.identification.trim.common_cutoff`);
 4. each piece is read through the drive, filtered, differentiated and decimated on its own
-   (:func:`~dynid.identification.classical.prepare_torque_log`), the filter's edges
+   (:func:`~dynid.identification.prepared_log.prepare_torque_log`), the filter's edges
    trimmed at both of its ends (:func:`~dynid.identification.trim.edge_seconds`, half a
    period of the cut-off; the rule validation and the friction fit apply too); a piece
    too short for the filter is left out with a warning naming its file and times, never
@@ -48,11 +48,11 @@ from ..exceptions import DataError, DynidWarning, ShapeError
 from ..model.drive import Drive
 from ..model.robot import Robot
 from ..signals import lowpass_noise_gain
-from .classical import PreparedLog, log_blocks, prepare_torque_log, still_columns
 from .core import ModelColumns, RegressorBlock
 from .holdout import DEFAULT_FOLDS, block_labels
 from .info import IdentificationInfo, LogInfo
 from .log import TorqueLog, joint_side_log
+from .log_rows import log_blocks, still_columns
 from .pieces import (
     WRAP_SPAN,
     joined,
@@ -62,6 +62,7 @@ from .pieces import (
     unwrapped,
     wrappable,
 )
+from .prepared_log import PreparedLog, prepare_torque_log
 from .rate import CUTOFF_MULTIPLE
 from .sanity import (
     check_torque_log,
@@ -249,15 +250,11 @@ class Recordings:
         """The friction columns of the joints (motors) that never move in any piece."""
         return still_columns(columns, self.still)
 
-    def raw_offsets(self) -> NDArray[np.float64] | None:
-        """Per row of :meth:`blocks` (sample-major within each piece), the measured torque
-        minus the low-passed one [N m]: ``y + raw_offsets()`` are the targets as measured;
-        None when a piece was not filtered."""
-        if any(p.tau_raw is None for p in self.pieces):
-            return None
-        return np.concatenate(
-            [(np.asarray(p.tau_raw) - p.log.tau).reshape(-1) for p in self.pieces]
-        )
+    @property
+    def measured(self) -> bool:
+        """Whether every piece holds its torques as measured beside the low-passed ones
+        (``tau_raw``: the pieces were filtered); :meth:`measured_blocks` predicts them."""
+        return all(p.tau_raw is not None for p in self.pieces)
 
     def blocks(self, robot: Robot, columns: ModelColumns) -> Iterator[RegressorBlock]:
         """The pieces' rows stacked in one block (sample-major within each piece), or the
@@ -283,7 +280,9 @@ class Recordings:
         """The rows of :meth:`blocks` in the same order, in blocks, with the torques as
         measured and the columns that step at a reversal (Coulomb, smooth, Stribeck) as the
         model applies them, not through the torques' low-pass: what a held-out recording
-        is judged on (a piece whose torques were not filtered: its own)."""
+        is judged on (a piece whose torques were not filtered: its own rows). The one
+        computation of these rows: the held-out judgement of stacked rows and of rows in
+        blocks both pass over them (:mod:`dynid.identification.selection`)."""
         for p in self.pieces:
             log = p.log if p.tau_raw is None else dataclasses.replace(p.log, tau=p.tau_raw)
             yield from log_blocks(robot, log, columns, stream=True, cutoff_hz=None)
@@ -410,7 +409,7 @@ def prepare_recordings(
     names : sequence of str, optional
         One name per recording (default ``log1, log2, ...``), for messages and the record.
     cutoff_hz, trim_s, decimate, drive
-        As :func:`~dynid.identification.classical.prepare_torque_log`; one cut-off for all.
+        As :func:`~dynid.identification.prepared_log.prepare_torque_log`; one cut-off for all.
     max_gap_s : float, optional
         Gaps up to this long [s] are bridged; longer ones cut the log into pieces.
 
@@ -514,7 +513,7 @@ def _prepared(
     drive: Drive | None,
     **kw: Any,
 ) -> tuple[list[PreparedLog], list[int], list[str], dict[int, dict[str, int]]]:
-    """Each piece prepared (:func:`~dynid.identification.classical.prepare_torque_log`
+    """Each piece prepared (:func:`~dynid.identification.prepared_log.prepare_torque_log`
     with ``kw``), a piece too short to filter left out with a warning; per recording, the
     samples left out, trimmed and decimated away."""
     prepared, recording, skipped = [], [], []

@@ -42,6 +42,7 @@ from numpy.typing import NDArray
 from ..exceptions import DynidWarning, OptionError, RankDeficientError
 from ..model.drive import Drive
 from ..model.robot import Robot
+from ..regressors.base import BaseParameters
 from ..regressors.terms import ModelTerm
 from ..signals import lowpass_noise_gain
 from .candidates import (
@@ -106,7 +107,7 @@ def _judge(
     if validation is not None:
         how = "a separate recording"
     scheme = "recordings" if len(data.names) > 1 else "blocks"
-    measured_ok = all(p.tau_raw is not None for p in data.pieces)
+    measured_ok = data.measured  # judged on the torques as measured: one more pass
 
     def judge(
         stack: RegressorStack | StreamedRows,
@@ -115,14 +116,11 @@ def _judge(
         beta: NDArray[Any],
     ) -> HeldOut | None:
         b = np.asarray(beta)[cols]
+        rows = selected_columns(_rows(data, robot, columns), cols)  # read only when passed
         normals: Callable[[NDArray[np.intp]], tuple[Normals, ...]]
-        measured: Callable[[NDArray[np.intp]], tuple[Normals, ...]] | None = None
         if isinstance(stack, StreamedRows) and stack.normals is not None and validation is None:
             assert labels is not None  # the fit gathered the folds' normals by these labels
-            judged = None
-            if measured_ok:  # judged on the torques as measured: one more pass
-                rows = selected_columns(_rows(data, robot, columns), cols)
-                judged = normals_by_label(rows, labels)
+            judged = normals_by_label(rows, labels) if measured_ok else None
             return replace(HeldOut.k_fold(stack.normals, judged), scheme=scheme).expanded(cols)
         if isinstance(stack, StreamedRows):  # rows in blocks: one pass per set of labels
             source = selected_columns(stack.source, cols)
@@ -130,29 +128,19 @@ def _judge(
             rw = estimator.row_weights(e, np.tile(np.arange(data.n), e.size // data.n), b.size)
             m = e.size
             normals = lambda lab: normals_by_label(source, lab, rw)  # noqa: E731
-            if measured_ok:  # judged on the torques as measured
-                rows = selected_columns(_rows(data, robot, columns), cols)
-                measured = lambda lab: normals_by_label(rows, lab, rw)  # noqa: E731
         else:
             W = stack.W if cols.all() else stack.W[:, cols]
             rw = row_weights(estimator, W, stack.y, stack.groups, b)
             Ww, yw, m = W * rw[:, None], stack.y * rw, stack.y.size
             normals = lambda lab: block_normals(Ww, yw, lab)  # noqa: E731
-            raw = data.raw_offsets() if measured_ok else None
-            if raw is not None:  # judged on the torques as measured
-                if raw.size != m:
-                    raise AssertionError(f"{raw.size} measured targets for {m} rows")
-                Wm = _measured_rows(data, columns, stack.W)
-                Wm = (Wm if cols.all() else Wm[:, cols]) * rw[:, None]
-                measured = lambda lab: block_normals(Wm, (stack.y + raw) * rw, lab)  # noqa: E731
         if validation is not None:
             test = _normals(robot, validation, columns, cols, b, estimator)
             held = HeldOut.separate(normals(np.zeros(m, np.intp))[0], test)
         elif labels is None:
             return None
         else:
-            held = HeldOut.k_fold(normals(labels), None if measured is None else measured(labels))
-            held = replace(held, scheme=scheme)
+            judged = normals_by_label(rows, labels, rw) if measured_ok else None
+            held = replace(HeldOut.k_fold(normals(labels), judged), scheme=scheme)
         return held.expanded(cols)
 
     return judge, how, (labels if validation is None else None)
@@ -164,34 +152,6 @@ def _rows(data: Recordings, robot: Robot, columns: ModelColumns) -> BlockSource:
     return lambda: ((b.W, b.y, b.groups) for b in data.measured_blocks(robot, columns))
 
 
-def _measured_rows(
-    data: Recordings, columns: ModelColumns, W: NDArray[np.float64]
-) -> NDArray[np.float64]:
-    """``W`` (rows of :meth:`~dynid.identification.recordings.Recordings.blocks`, every
-    column of ``columns``) with the columns that step at a reversal (Coulomb, smooth,
-    Stribeck) as they act on the measured torques: not through the torques' low-pass
-    (the parallel filtering of the fit), as the model predicts a recording."""
-    steps = columns.step_columns()
-    if not steps.any():
-        return W
-    r = W.shape[1] - int(sum(len(t.labels) for t in columns.appended))
-    sharp = np.concatenate(
-        [
-            np.concatenate(
-                [
-                    t.torque_columns(p.log.q, p.log.dq, np.asarray(p.log.ddq))
-                    for t in columns.appended
-                ],
-                axis=-1,
-            ).reshape(p.log.n_samples * p.log.n, -1)
-            for p in data.pieces
-        ]
-    )
-    out = W.copy()
-    out[:, r:][:, steps[r:]] = sharp[:, steps[r:]]
-    return out
-
-
 def _normals(
     robot: Robot,
     data: Recordings,
@@ -200,16 +160,12 @@ def _normals(
     b: NDArray[np.float64],
     estimator: Estimator,
 ) -> Normals:
-    """The normal equations of a separate recording over the fitted columns."""
-    blocks = list(data.blocks(robot, columns))
+    """The normal equations of a separate recording over the fitted columns, on its rows
+    as measured (:meth:`~.recordings.Recordings.measured_blocks`), weighted as the
+    estimator weighs them at ``b``."""
+    blocks = list(data.measured_blocks(robot, columns))
     W = np.concatenate([blk.W for blk in blocks])[:, cols]
     y = np.concatenate([blk.y for blk in blocks])
-    raw = data.raw_offsets()
-    if raw is not None:  # the torques as measured
-        if raw.size != y.size:
-            raise AssertionError(f"{raw.size} measured targets for {y.size} rows")
-        W = _measured_rows(data, columns, np.concatenate([blk.W for blk in blocks]))[:, cols]
-        y = y + raw
     g = np.concatenate([blk.groups for blk in blocks])
     rw = row_weights(estimator, W, y, g, b)
     return block_normals(W * rw[:, None], y * rw, np.zeros(y.size, np.intp))[0]
@@ -234,7 +190,7 @@ def _with_floor(heldout: Any, data: Recordings) -> Any:
     pieces = data.pieces
     if heldout is None or any(p.torque_noise_std is None for p in pieces):
         return heldout
-    measured = data.raw_offsets() is not None  # judged on the torques as measured
+    measured = data.measured  # judged on the torques as measured
     floor = noise_floor_percent(
         [p.tau_raw if measured else p.log.tau for p in pieces],  # type: ignore[misc]
         [p.torque_noise_std for p in pieces],  # type: ignore[misc]
@@ -671,6 +627,7 @@ def identify_recordings(
     folds: int = DEFAULT_FOLDS,
     validate_on: TorqueLog | None = None,
     friction: tuple[str, ...] | None = None,
+    base: BaseParameters | None = None,
 ) -> IdentifiedModel:
     """Identify the base parameters and the model's terms from one or more torque logs.
 
@@ -689,10 +646,29 @@ def identify_recordings(
         Their names (file names) for messages and the record.
     structure : Structure or "auto"
         The terms beside the links; ``"auto"`` (default) chooses them on held-out data.
-    cutoff_hz, trim_s, decimate, drive, estimator, std, max_std_percent, rtol
-        As :func:`~dynid.identification.classical.identify_from_log`.
+    cutoff_hz : float, "auto" or None
+        Zero-phase low-pass cut-off [Hz] of every recording; ``"auto"`` (default) read from
+        their motion (:func:`~dynid.identification.trim.common_cutoff`); None for
+        noise-free data (the logs' ``ddq`` used if present, else differentiated).
+    trim_s : float, optional
+        Seconds dropped at each end of every piece after filtering (default: the filter's
+        edge, :func:`~dynid.identification.trim.edge_seconds`).
     max_gap_s : float, optional
         Gaps up to this long [s] are bridged; longer ones cut a log into pieces.
+    decimate : int, optional
+        Keep every ``decimate``-th sample after filtering; default
+        :func:`~dynid.identification.rate.decimation` (at least 10 % of the samples).
+    drive : Drive, optional
+        The drive train the logs were recorded through (:mod:`dynid.model.drive`); default:
+        link-side torques of a direct drive.
+    estimator, std
+        Least squares (:mod:`dynid.identification.estimators`); ``"classical"`` or
+        ``"robust"`` standard deviations (:func:`~dynid.identification.core.identify`).
+    max_std_percent : float, optional
+        Remove coefficients with a larger relative standard deviation [%] and re-fit.
+    rtol : float, optional
+        Relative rank tolerance of the base parameters and of the least squares (default:
+        the first clear gap of the singular values, and ``1e-10``).
     folds : int
         Contiguous time blocks of one recording's held-out judgement (several recordings:
         one left out at a time).
@@ -701,6 +677,8 @@ def identify_recordings(
     friction : tuple of str, optional
         The friction parts fitted whatever the chosen structure holds (its armature and
         placement kept; the consistent fit's classical parts): the data prepared once.
+    base : BaseParameters, optional
+        The base parameters of a structure given (default: the structural ones).
 
     Returns
     -------
@@ -714,52 +692,31 @@ def identify_recordings(
         From :func:`~dynid.identification.recordings.prepare_recordings`.
     OptionError
         An armature asked with known rotor inertias; a friction placement (``at:``)
-        without a drive that couples joints.
+        without a drive that couples joints; ``base`` with ``structure="auto"``.
     RankDeficientError
         The chosen (or given) structure is not identifiable from the data.
     """
     if isinstance(structure, Structure):
         check_placement(structure, drive)
-    data = prepare_recordings(
-        robot,
-        logs,
-        names,
-        cutoff_hz=cutoff_hz,
-        trim_s=trim_s,
-        max_gap_s=max_gap_s,
-        decimate=decimate,
-        drive=drive,
-    )
-    validation = None
-    if validate_on is not None:  # prepared as the recordings
-        validation = prepare_recordings(
-            robot, [validate_on], ["validation log"], cutoff_hz=data.cutoff_hz, trim_s=trim_s,
-            max_gap_s=max_gap_s, decimate=data.pieces[0].decimate, drive=drive,
-        )  # fmt: skip
+    elif base is not None:
+        raise OptionError("base applies to a structure given, not to one chosen (auto)")
+    data, validation = _recordings(
+        robot, logs, names, validate_on, drive,
+        cutoff_hz=cutoff_hz, trim_s=trim_s, max_gap_s=max_gap_s, decimate=decimate,
+    )  # fmt: skip
     est = estimator_named(estimator)
     selection = None
     if structure == "auto":
         selection = select_structure(
             robot, data, drive=drive, estimator=est, folds=folds, validation=validation, rtol=rtol
         )
-        chosen = Structure() if selection is None else selection.chosen
-        structure = (
-            chosen if friction is None else Structure(chosen.armature, friction, at=chosen.at)
-        )
+        structure = _fitted_structure(selection, friction)
     model_drive, terms = _terms_of(structure, drive, robot.n, data)
     judge, _, fold_labels = _judge(robot, data, est, folds, validation)
     model = identify(
-        robot,
-        data,
-        drive=model_drive,
-        terms=terms,
-        estimator=est,
-        std=std,
-        max_std_percent=max_std_percent,
-        rtol=rtol,
-        judge=judge,
-        fold_labels=fold_labels,
-    )
+        robot, data, drive=model_drive, terms=terms, estimator=est, std=std, base=base,
+        max_std_percent=max_std_percent, rtol=rtol, judge=judge, fold_labels=fold_labels,
+    )  # fmt: skip
     warn_unphysical(model, terms)
     info = replace(
         model.info,
@@ -768,3 +725,27 @@ def identify_recordings(
         extra={**model.info.extra, "terms": list(structure.terms)},
     )
     return replace(model, info=info)
+
+
+def _fitted_structure(selection: Selection | None, friction: tuple[str, ...] | None) -> Structure:
+    """The structure chosen (the links alone when the data are too short to judge), with
+    the friction parts ``friction`` in place of its own when given."""
+    chosen = Structure() if selection is None else selection.chosen
+    return chosen if friction is None else Structure(chosen.armature, friction, at=chosen.at)
+
+
+def _recordings(
+    robot: Robot,
+    logs: Sequence[TorqueLog],
+    names: Sequence[str] | None,
+    validate_on: TorqueLog | None,
+    drive: Drive | None,
+    **kw: Any,
+) -> tuple[Recordings, Recordings | None]:
+    """The recordings prepared (:func:`~.recordings.prepare_recordings` with ``kw``) and the
+    separate recording ``validate_on`` prepared as they are (their cut-off and decimation)."""
+    data = prepare_recordings(robot, logs, names, drive=drive, **kw)
+    if validate_on is None:
+        return data, None
+    same = {**kw, "cutoff_hz": data.cutoff_hz, "decimate": data.pieces[0].decimate}
+    return data, prepare_recordings(robot, [validate_on], ["validation log"], drive=drive, **same)

@@ -41,7 +41,7 @@ from ..friction.validation import (
 from ..identification.data import StaticDataset
 from ..identification.log import TorqueLog
 from ..identification.model import IdentifiedModel
-from ..identification.prepare import prepare_log
+from ..identification.prepare import MEASURED, prepare_log
 from ..identification.static import identify_static
 from ..kinematics.forward import fk
 from ..kinematics.inverse import IKOptions, IKResult, ik
@@ -436,9 +436,7 @@ def feasible_stage(
             )
         validation_log = _validation_log(truth, seed)
     log = (
-        validation_log
-        if validation_log.ddq is not None
-        else prepare_log(validation_log, filter_tau=False)
+        validation_log if validation_log.ddq is not None else prepare_log(validation_log, MEASURED)
     )
     assert log.ddq is not None
     val = validate_newton_euler(

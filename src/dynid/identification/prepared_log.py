@@ -1,0 +1,233 @@
+"""A torque log prepared for identification: read through the drive, checked, filtered,
+differentiated and decimated (:func:`prepare_torque_log`), and the data set of the
+classical route it is (:class:`PreparedLog`, a
+:class:`~dynid.identification.dataset.Dataset`; a recording's pieces,
+:class:`~dynid.identification.recordings.Recordings`, are made of them).
+
+The signals are those of a :class:`~dynid.identification.log.TorqueLog`: ``q`` [rad],
+``dq`` [rad/s], ``ddq`` [rad/s^2], ``tau`` [N m] on the joint side of the drive, rows the
+samples.
+"""
+
+from __future__ import annotations
+
+import warnings
+from collections.abc import Iterator
+from dataclasses import dataclass
+from typing import Literal
+
+import numpy as np
+from numpy.typing import NDArray
+
+from .. import signals
+from ..exceptions import DataError, DynidWarning, OptionError, ShapeError
+from ..model.drive import Drive
+from ..model.robot import Robot
+from .dataset import ModelColumns, RegressorBlock
+from .info import IdentificationInfo, LogInfo
+from .log import LogCleaning, TorqueLog, joint_side_log
+from .log_rows import log_blocks, still_columns, still_friction
+from .prepare import Preprocessing, measured_torques, prepare_log
+from .rate import cutoff_from_motion, decimation, motion_frequency
+from .sanity import check_torque_log, moving_joints, opposite_sign, velocity_noise_std
+
+__all__ = ["PreparedLog", "prepare_torque_log"]
+
+
+@dataclass(frozen=True, slots=True, eq=False)
+class PreparedLog:
+    """A torque log ready for identification (the :class:`~dynid.identification.core.Dataset`
+    of the classical route): joint side, filtered, decimated, with ``ddq``.
+
+    Attributes
+    ----------
+    log : TorqueLog
+        The prepared samples: ``q`` [rad], ``dq`` [rad/s], ``ddq`` [rad/s^2], ``tau`` [N m]
+        on the joint side of ``drive``, every ``decimate``-th sample.
+    drive : Drive, optional
+        The drive the log was read through.
+    still : ndarray of bool, shape (n,)
+        Joints (motors, where the drive's friction acts there) whose velocity never leaves
+        its noise band in the raw log: their viscous and Coulomb friction is not fitted.
+    cutoff_hz, trim_s : float or None
+        Low-pass cutoff [Hz] and seconds trimmed at the start.
+    motion_frequency_hz : float or None
+        The motion's highest significant frequency [Hz] when the cut-off was read from it
+        (:mod:`dynid.identification.rate`), else None.
+    resampled : bool
+        The timestamps were not uniform: the log was resampled onto a uniform grid.
+    decimate : int
+    sample_rate_hz : float
+        Of the raw log.
+    raw : TorqueLog
+        The raw log's counts (``n_samples``, ``duration``, ``cleaning``).
+    torque_noise_std : ndarray, shape (n,), or None
+        White-noise std [N m] per joint of the raw log's joint-side torques
+        (:func:`~dynid.identification.sanity.velocity_noise_std`, which reads any signal's).
+    tau_raw : ndarray, shape like ``log.tau``, or None
+        The joint-side torques at the prepared samples as measured, not low-passed (None
+        when the log was not filtered): the held-out judgement predicts them, as
+        ``dynid validate`` does.
+    """
+
+    log: TorqueLog
+    drive: Drive | None
+    still: NDArray[np.bool_]
+    cutoff_hz: float | None
+    trim_s: float
+    decimate: int
+    sample_rate_hz: float
+    n_samples_log: int
+    duration_s: float
+    cleaning: LogCleaning
+    motion_frequency_hz: float | None = None
+    resampled: bool = False
+    torque_noise_std: NDArray[np.float64] | None = None
+    tau_raw: NDArray[np.float64] | None = None
+
+    @property
+    def route(self) -> Literal["classical"]:
+        """``"classical"`` (Gaz et al. 2019, Sec. IV-B)."""
+        return "classical"
+
+    @property
+    def regressor_kind(self) -> Literal["torque"]:
+        """Joint torques."""
+        return "torque"
+
+    @property
+    def moving(self) -> bool:
+        """True: friction acts."""
+        return True
+
+    @property
+    def n(self) -> int:
+        """Joints."""
+        return self.log.n
+
+    @property
+    def source(self) -> str:
+        """``"torque log of N samples"``."""
+        return f"torque log of {self.log.n_samples} samples"
+
+    @property
+    def hint(self) -> str:
+        """What to do when the trajectory does not excite every column."""
+        return (
+            "hint: a trajectory that moves every joint at varied speeds in both directions "
+            "excites them (dynid excite optimises one); a joint that never moves leaves its "
+            "friction unidentifiable"
+        )
+
+    def check_robot(self, robot: Robot) -> None:
+        """Raise :class:`ShapeError` unless the log has ``robot.n`` joints."""
+        if self.n != robot.n:
+            raise ShapeError(f"log has {self.n} joints; robot {robot.name!r} has {robot.n}")
+
+    def frozen_columns(self, columns: ModelColumns) -> NDArray[np.bool_]:
+        """The viscous and Coulomb columns of the joints (motors) that never move."""
+        return still_columns(columns, self.still)
+
+    def blocks(self, robot: Robot, columns: ModelColumns) -> Iterator[RegressorBlock]:
+        """One block (:func:`log_blocks`); several when the log is too long to stack."""
+        if columns.drive is not self.drive:
+            raise OptionError("the log was prepared for another drive than the model's")
+        yield from log_blocks(robot, self.log, columns, cutoff_hz=self.cutoff_hz)
+
+    def record(self, n_rows: int) -> IdentificationInfo:
+        """Filtering, decimation and sample counts."""
+        return IdentificationInfo(
+            reference="Gaz et al. 2019, Sec. IV-B, eq. 24 (classical friction)",
+            log=LogInfo(
+                cutoff_hz=self.cutoff_hz,
+                trim_s=self.trim_s,
+                decimate=self.decimate,
+                sample_rate_hz=self.sample_rate_hz,
+                n_samples_log=self.n_samples_log,
+                n_samples_used=self.log.n_samples,
+                duration_s=self.duration_s,
+                n_nan_rows=self.cleaning.n_nan_rows,
+                n_duplicates=self.cleaning.n_duplicates,
+                n_gaps=len(self.cleaning.gaps),
+                cutoff_source="given" if self.motion_frequency_hz is None else "motion",
+                motion_frequency_hz=self.motion_frequency_hz,
+                resampled=self.resampled,
+            ),
+        )
+
+
+def prepare_torque_log(
+    robot: Robot,
+    log: TorqueLog,
+    *,
+    cutoff_hz: float | Literal["auto"] | None = "auto",
+    trim_s: float | None = None,
+    max_gap_s: float | None = None,
+    decimate: int | None = None,
+    drive: Drive | None = None,
+    check: bool = True,
+) -> PreparedLog:
+    """Read a torque log through the drive, check it, filter and decimate it.
+
+    The checks of :func:`~dynid.identification.sanity.check_torque_log` (sign, units,
+    frozen joints) are warned first (unless ``check`` is False: a piece of a recording
+    checked whole); then :func:`~dynid.identification.prepare.prepare_log`
+    and every ``decimate``-th sample (default :func:`~dynid.identification.rate.decimation`;
+    the cut-off ``"auto"``: :func:`~dynid.identification.rate.cutoff_from_motion`).
+    Parameters as in
+    :func:`~dynid.identification.classical.identify_from_log`.
+
+    Raises
+    ------
+    ShapeError
+        ``log.n != robot.n`` or ``decimate < 1``.
+    DataError
+        From :func:`~dynid.identification.prepare.prepare_log`.
+
+    Warns
+    -----
+    DynidWarning
+        The findings of the checks.
+    """
+    n = robot.n
+    if log.n != n:
+        raise ShapeError(f"log has {log.n} joints; robot {robot.name!r} has {n}")
+    if drive is not None:
+        drive.check(n)
+    fs = log.sample_rate
+    jlog = joint_side_log(log, drive)
+    if check and (opposite := opposite_sign(robot, jlog)) is not None:
+        raise DataError(opposite)  # a fit would negate the masses
+    for finding in check_torque_log(robot, jlog) if check else ():  # said first
+        warnings.warn(finding, DynidWarning, stacklevel=3)
+    still = still_friction(jlog, drive)
+    f_q = None
+    if cutoff_hz == "auto":
+        f_q = motion_frequency(jlog.q, fs, moving_joints(jlog.dq))
+        cutoff_hz = cutoff_from_motion(jlog.q, jlog.dq, fs)
+    k = decimation(fs, cutoff_hz) if decimate is None else int(decimate)
+    if k < 1:
+        raise ShapeError(f"decimate must be >= 1; got {decimate}")
+    prep = Preprocessing(cutoff_hz=cutoff_hz, trim_s=trim_s, max_gap_s=max_gap_s, decimate=k)
+    prepared = prepare_log(jlog, prep)
+    raw = None
+    if cutoff_hz is not None:  # the torques as measured at the same samples
+        raw = measured_torques(jlog, prep)
+    noise = velocity_noise_std(jlog.tau) if jlog.n_samples >= 3 else None
+    del jlog
+    return PreparedLog(
+        log=prepared,
+        drive=drive,
+        still=still,
+        cutoff_hz=cutoff_hz,
+        trim_s=float(prepared.t[0] - log.t[0]),
+        decimate=k,
+        sample_rate_hz=fs,
+        n_samples_log=log.n_samples,
+        duration_s=log.duration,
+        cleaning=log.cleaning,
+        motion_frequency_hz=f_q,
+        resampled=not signals.is_uniform(log.t),
+        torque_noise_std=noise,
+        tau_raw=None if raw is None or raw.shape != prepared.tau.shape else raw,
+    )
