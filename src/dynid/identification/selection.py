@@ -324,20 +324,7 @@ def select_structure(
     chosen = _chosen(judged)
     best = min(_physical(judged), key=lambda c: c.heldout_error_percent)
     judged = [replace(c, se_vs_best_percent=paired_se(c, best)) for c in judged]
-    wild = [c for c in judged if c.heldout_error_percent > max(100.0, 10 * c.train_error_percent)]
-    if wild:
-        notes.append(
-            f"{len(wild)} candidate(s) predict held-out data far worse than they fit (up to "
-            f"{max(c.heldout_error_percent for c in wild):.3g} %): some folds' training data "
-            "hardly excite their columns (a Stribeck term whose velocities the held-out data "
-            "reach and the others seldom do), so their fits on those folds extrapolate"
-        )
-    skipped = [c for c in judged if c.unphysical] if len(_physical(judged)) < len(judged) else []
-    if skipped:  # one line: the table marks each (metadata.selection names the joints)
-        notes.append(
-            f"{len(skipped)} candidate(s) marked x skipped: their friction is not dissipative "
-            "within the velocity limits (where: metadata.selection.candidates[].not_dissipative)"
-        )
+    notes += _candidate_notes(judged)
     per: tuple[tuple[str, float], ...] = ()
     if len(data.names) > 1 and validation is None:
         per = _per_recording(chosen, full, groups, where, data.names, fit_rtol)
@@ -358,6 +345,27 @@ def select_structure(
         per_recording=per,
         outlying=tuple(data.names[i] for i in skip),
     )
+
+
+def _candidate_notes(judged: Sequence[Candidate]) -> list[str]:
+    """Notes on the candidates that predict held-out data far worse than they fit, and on
+    those skipped because their friction is not dissipative."""
+    notes = []
+    wild = [c for c in judged if c.heldout_error_percent > max(100.0, 10 * c.train_error_percent)]
+    if wild:
+        notes.append(
+            f"{len(wild)} candidate(s) predict held-out data far worse than they fit (up to "
+            f"{max(c.heldout_error_percent for c in wild):.3g} %): some folds' training data "
+            "hardly excite their columns (a Stribeck term whose velocities the held-out data "
+            "reach and the others seldom do), so their fits on those folds extrapolate"
+        )
+    skipped = [c for c in judged if c.unphysical] if len(_physical(judged)) < len(judged) else []
+    if skipped:  # one line: the table marks each (metadata.selection names the joints)
+        notes.append(
+            f"{len(skipped)} candidate(s) marked x skipped: their friction is not dissipative "
+            "within the velocity limits (where: metadata.selection.candidates[].not_dissipative)"
+        )
+    return notes
 
 
 _Key = tuple[bool, str, str]  # regressor_group
