@@ -53,7 +53,10 @@ def test_library_and_command_choose_the_same_structure_on_one_log(panda, one_log
         warnings.simplefilter("ignore", DynidWarning)
         lib = identify_from_log(panda, log, structure="auto")
         cli = _command(path, tmp_path / "auto")
-    assert lib.info.selection["chosen"] == "links + viscous + coulomb"
+    # the truth's terms: viscous and sharp Coulomb friction (or the narrow smooth sign, its
+    # expected value given the velocity noise)
+    name = lib.info.selection["chosen"].partition(" - ")[0]
+    assert name in ("links + viscous + coulomb", "links + viscous + smooth:0.3"), name
     assert cli.info.selection["chosen"] == lib.info.selection["chosen"]
     assert cli.info.selection["rule"] == lib.info.selection["rule"]
     _same(lib, cli)
