@@ -57,10 +57,6 @@ REFUSED = [
         "--base applies to a URDF --robot only",
     ),
     (
-        "observe --model {d}/m.json --data {d}/l.csv --calibrate --tip x",
-        "--tip applies to a URDF --params only",
-    ),
-    (
         "simulate --trajectory sinusoid --harmonics 3 --base-freq 0.3",
         "--harmonics applies to --trajectory fourier only",
     ),
@@ -88,7 +84,7 @@ def test_an_option_off_the_route_is_refused_in_one_line(tmp_path, capsys, argv, 
     args = argv.format(d=tmp_path).split()
     if args[0] == "simulate":
         args += ["--out", str(tmp_path / "x.csv")]
-    elif args[0] in ("retrieve", "identify", "friction", "validate", "observe"):
+    elif args[0] in ("retrieve", "identify", "friction", "validate"):
         args += ["--out", str(tmp_path / "out")]
     assert main(args) == 2
     err = capsys.readouterr().err.strip().splitlines()

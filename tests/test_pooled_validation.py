@@ -4,6 +4,7 @@ every piece at once (numpy on the concatenated residuals as the reference)."""
 from __future__ import annotations
 
 import numpy as np
+import pytest
 
 from dynid.friction.pooled import joined_validation
 from dynid.friction.validation import Validation
@@ -31,3 +32,15 @@ def test_joined_pieces_pool_every_sample():
     assert v.without_friction.n_samples == 130 and v.log.n_samples == 130
     np.testing.assert_array_equal(v.log.t, np.concatenate([p.log.t for p in parts]))
     assert joined_validation(parts[:1]) is parts[0]
+
+
+def test_the_torque_figure_breaks_its_lines_at_a_gap():
+    """Pieces one after another are drawn as pieces (no line across the gap)."""
+    pytest.importorskip("matplotlib")
+    from dynid.plots.torques import plot_torque_validation
+
+    rng = np.random.default_rng(5)
+    fig = plot_torque_validation(joined_validation([_part(rng, 0.0, 50), _part(rng, 2.0, 80)]))
+    x = fig.axes[0].lines[0].get_xdata()
+    assert np.isnan(x).sum() == 1 and np.isnan(x[50])
+    fig.clf()

@@ -57,7 +57,6 @@ from pathlib import Path
 from ..observer.events import DEFAULT_MERGE_S, DEFAULT_MIN_DURATION_S
 from ..observer.residual import DEFAULT_GAIN
 from ..workflows.observe import ObserveOptions, observe_files
-from .applies import urdf_chain
 from .common import (
     add_column_options,
     add_drive_option,
@@ -78,8 +77,6 @@ NAME = "observe"
 FIGURE_POINTS = 20000
 #: ``--out`` is a folder: its files are one output set (:mod:`dynid.outputs.run_output`).
 OUTPUT = "folder"
-#: Options that apply to one route only (:mod:`dynid.cli.applies`).
-APPLIES = (urdf_chain("params", ("base", "tip")),)
 
 
 def register(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParser:
