@@ -38,11 +38,14 @@ class Applies:
         ``when(args)`` is True on the route where they apply.
     route : str
         The route as the user names it (``"--trajectory fourier"``), for the message.
+    why : str
+        Why they do not apply elsewhere, when the route does not say it.
     """
 
     options: tuple[str, ...]
     when: Callable[[argparse.Namespace], bool]
     route: str
+    why: str = ""
 
 
 def is_urdf(spec: object) -> bool:
@@ -90,4 +93,5 @@ def check_applies(args: argparse.Namespace, given: Iterable[str], table: Iterabl
             continue
         for dest in rule.options:
             if dest in given:
-                raise OptionError(f"applies to {rule.route} only; leave it out", field=dest)
+                why = f" ({rule.why})" if rule.why else ""
+                raise OptionError(f"applies to {rule.route} only{why}; leave it out", field=dest)

@@ -78,7 +78,7 @@ OUTPUT = "folder"
 _SEEDED = tuple(name for name, m in METHODS.items() if m.parallel)
 #: Options that apply to one route only (:mod:`dynid.cli.applies`).
 APPLIES = (
-    Applies(("robot",), lambda a: a.static is not None, "--static (--model holds its robot)"),
+    Applies(("robot",), lambda a: a.static is not None, "--static", "--model holds its robot"),
     urdf_chain(),
     urdf_chain("prior", ("prior_base", "prior_tip")),
     Applies(

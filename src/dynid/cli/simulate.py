@@ -70,7 +70,8 @@ APPLIES = (
     Applies(
         ("q0",),
         lambda a: a.trajectory in ("sinusoid", "fourier"),
-        "--trajectory sinusoid or fourier (a trajectory file holds its start)",
+        "--trajectory sinusoid or fourier",
+        "a trajectory file holds its start",
     ),
 )
 
