@@ -40,3 +40,34 @@ def test_heldout_json_from_a_folder_and_without_figures(folder, tmp_path):
     assert not (tmp_path / "c" / "heldout_torques.png").exists()
     assert _heldout(tmp_path / "b") == _heldout(tmp_path / "a")
     assert _heldout(tmp_path / "c") == _heldout(tmp_path / "a")
+
+
+def _with_gap(src, dst, start: int, stop: int) -> None:
+    """``src`` without its data rows ``start:stop`` (a gap), its ``# rows:`` line fixed."""
+    lines = src.read_text().splitlines()
+    head = [i for i, line in enumerate(lines) if line.startswith("#")]
+    hdr = max(head) + 1
+    rows = lines[hdr + 1 :]
+    rows = rows[:start] + rows[stop:]
+    meta = [f"# rows: {len(rows)}" if m.startswith("# rows:") else m for m in lines[:hdr]]
+    dst.write_text("\n".join([*meta, lines[hdr], *rows]) + "\n")
+
+
+@pytest.mark.filterwarnings("ignore::dynid.exceptions.DynidWarning")
+def test_heldout_json_when_the_held_out_recording_has_a_gap(folder, tmp_path, capsys):
+    """Several recordings, the last with a 1 s gap (cut into two pieces, as documented):
+    heldout.json and both figures are written, over both pieces (it was skipped with a
+    note blaming the gap)."""
+    gap = tmp_path / "gap.csv"
+    _with_gap(folder / "r2.csv", gap, 300, 550)
+    base = ["identify", "--robot", "panda", "--terms", "viscous"]
+    argv = [*base, "--data", str(folder / "r1.csv"), str(gap), "--out", str(tmp_path / "a")]
+    assert main(argv) == 0
+    assert "skipped the held-out" not in capsys.readouterr().err
+    doc = _heldout(tmp_path / "a")
+    assert "2 pieces between gaps" in doc["block"]
+    assert (tmp_path / "a" / "heldout_torques.png").is_file()
+    assert (tmp_path / "a" / "heldout_residuals.png").is_file()
+    argv = [*base, "--data", str(folder / "r1.csv"), str(gap), "--no-figures"]
+    assert main([*argv, "-q", "--out", str(tmp_path / "b")]) == 0
+    assert _heldout(tmp_path / "b") == doc

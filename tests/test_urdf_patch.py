@@ -217,7 +217,10 @@ def test_chain_export_keeps_the_source_tip_name():
         chain = dynid.Robot.from_urdf(path, "panda_link0", "panda_link8")
     text = urdf_from_robot(chain)
     assert '<link name="panda_link8"/>' in text and "flange" not in text
-    assert re.findall(r'<joint name="(panda_joint\d)"', text) == list(chain.joint_names)
+    moving = re.findall(r'<joint name="(panda_joint\d)" type="revolute"', text)
+    assert moving == list(chain.joint_names)
+    # the tip's fixed joint keeps the source's name (it was panda_link8_joint)
+    assert re.findall(r'<joint name="([^"]+)" type="fixed"', text) == ["panda_joint8"]
     assert '<link name="flange"/>' in urdf_from_robot(dynid.panda())
     tooled = dynid.panda().with_tool(np.eye(4), 0.5, (0, 0, 0.05), name="gripper")
     assert '<link name="flange"/>' in urdf_from_robot(tooled)  # a later frame is not the tip

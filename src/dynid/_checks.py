@@ -167,6 +167,23 @@ def integer(text: str) -> int:
     return int(s)
 
 
+_SURROGATE = re.compile("[\ud800-\udfff]")
+
+
+def text(s: str) -> str:
+    """``s`` as text: a name the locale could not decode (under ``LC_ALL=C`` without UTF-8
+    mode its UTF-8 bytes are surrogate escapes, ``l\\udcc3\\udcb6g.csv``) back to its
+    characters (``l\u00f6g.csv``); bytes that are not UTF-8, and a lone surrogate of any
+    other origin, become U+FFFD. Every other string is returned as it is."""
+    if _SURROGATE.search(s) is None:
+        return s
+    try:
+        raw = s.encode("utf-8", "surrogateescape")
+    except UnicodeEncodeError:  # a surrogate that stands for no byte
+        return _SURROGATE.sub("\ufffd", s)
+    return raw.decode("utf-8", "replace")
+
+
 def control_character(name: str) -> str | None:
     """The first control character other than a tab (NUL, a line break, ...) or half of a
     surrogate pair in ``name``, or None: names with one cannot be written to URDF or MJCF and

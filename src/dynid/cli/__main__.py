@@ -40,6 +40,7 @@ from .._checks import one_line
 from ..exceptions import DynidError, OptionError
 from ..io.atomic import output_transaction
 from ..outputs.run_output import RunOutput, run_output
+from .applies import check_applies, given_options
 from .console import Console, log_to_stderr
 from .run_report import RunRecord, save_run_report
 
@@ -112,7 +113,7 @@ def build_parser(commands: Sequence[str] = SUBCOMMANDS) -> argparse.ArgumentPars
                 help="replace read-only files, files of another command's outputs and files "
                 "no dynid run wrote in --out",
             )
-        p.set_defaults(_run=mod.run, _output=output)
+        p.set_defaults(_run=mod.run, _output=output, _applies=getattr(mod, "APPLIES", ()))
     return parser
 
 
@@ -203,16 +204,29 @@ def decode_text_options(args: argparse.Namespace) -> None:
     Under an ASCII locale without UTF-8 mode (``LC_ALL=C PYTHONUTF8=0``) the interpreter
     gives each such byte as a surrogate escape (``w\\udcc3\\udcbcrfel``): a frame, link,
     joint or column name would not be the name the robot or the file holds (read as UTF-8).
-    Names are decoded in place, so that they mean the same under every locale; values that
-    may name files (:data:`FILE_OPTIONS`, and every ``Path``) keep the escaped form, which
-    opens the file.
+    Names are decoded in place (a repeated option's every value too), so that they mean the
+    same under every locale; values that may name files (:data:`FILE_OPTIONS`, and every
+    ``Path``) keep the escaped form, which opens the file, and are decoded where they are
+    shown or stored (:func:`dynid._checks.text`: the console, JSON files, a prior's name,
+    a log's label in figures).
     """
     for dest, value in vars(args).items():
+        if isinstance(value, list) and all(isinstance(v, str) for v in value):
+            if dest not in FILE_OPTIONS:  # a repeated option (--contact NAME:...)
+                setattr(args, dest, [_decoded(v) for v in value])
+            continue
         if not isinstance(value, str) or not _SURROGATE.search(value):
             continue
         if dest in FILE_OPTIONS and (dest != "columns" or value.lower().endswith(".toml")):
             continue
-        setattr(args, dest, os.fsencode(value).decode("utf-8", "surrogateescape"))
+        setattr(args, dest, _decoded(value))
+
+
+def _decoded(value: str) -> str:
+    """``value`` with its surrogate escapes decoded as the UTF-8 bytes they stand for."""
+    if not _SURROGATE.search(value):
+        return value
+    return os.fsencode(value).decode("utf-8", "surrogateescape")
 
 
 @contextlib.contextmanager
@@ -265,6 +279,7 @@ def _main(argv: Sequence[str] | None) -> int:
     record = RunRecord()
     console = Console(args.command, quiet=args.quiet, verbose=args.verbose, record=record)
     try:
+        check_applies(args, given_options(parser, argv), args._applies)
         with (
             record,
             _signals_and_warnings(console),

@@ -28,6 +28,7 @@ from pathlib import Path
 from ..io.static_data import save_static_data
 from ..simulation.controller import DEFAULT_MARGIN
 from ..workflows.acquire_static import AcquireStaticOptions, acquire_static_data
+from .applies import urdf_chain
 from .common import (
     add_robot_options,
     add_seed_option,
@@ -43,6 +44,8 @@ from .console import Console
 NAME = "acquire-static"
 #: ``--out`` is the one file written (:mod:`dynid.outputs.run_output`).
 OUTPUT = "file"
+#: Options that apply to one route only (:mod:`dynid.cli.applies`).
+APPLIES = (urdf_chain(),)
 
 
 def register(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParser:

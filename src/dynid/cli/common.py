@@ -16,11 +16,12 @@ from typing import Any, TypeVar
 import numpy as np
 
 from .. import _checks, spatial
+from .._checks import text as as_text
 from ..exceptions import DataError, OptionError, ShapeError, in_file
 from ..io.drive_file import drive_of_robot_file, load_drive
 from ..io.robot_file import load_robot as load_robot_file
 from ..kinematics.inverse import default_q0
-from ..model.builtin import BUILTIN_ROBOTS, builtin_robot
+from ..model.builtin import BUILTIN_ROBOTS
 from ..model.robot import Robot
 from ..plots.save import save_figure as write_figure
 from ..workflows.prior import load_prior as workflow_prior
@@ -48,6 +49,7 @@ FLAGS: dict[str, str] = {
     "min_duration_s": "--min-duration",
     "uncertainty": "--no-uncertainty",
     "standstill": "--no-standstill-margin",
+    "total_mass_band": "--no-total-mass",
 }
 
 
@@ -207,7 +209,7 @@ def shown(text: str) -> str:
     """``text`` as it can be drawn: a file name given under an ASCII locale (its UTF-8
     bytes escaped as surrogates, ``l\\udcc3\\udcb6g.csv``) back to its characters
     (``l\u00f6g.csv``); bytes that are not UTF-8 become U+FFFD."""
-    return text.encode("utf-8", "surrogateescape").decode("utf-8", "replace")
+    return as_text(text)
 
 
 def add_robot_options(p: argparse.ArgumentParser) -> None:
@@ -291,17 +293,16 @@ def load_robot(args: argparse.Namespace) -> Robot:
     Raises
     ------
     OptionError
-        ``--snap-angles`` with a robot that is not a URDF.
+        ``--base``, ``--tip`` or ``--snap-angles`` with a robot that is not a URDF.
     """
     spec = args.robot
     snap = bool(getattr(args, "snap_angles", False))
-    if snap and Path(str(spec)).suffix.lower() != ".urdf":
-        raise OptionError(f"--snap-angles applies to a URDF --robot; got {str(spec)!r}")
+    chain = {"base": args.base, "tip": args.tip, "snap_angles": snap}
     if spec in BUILTIN_ROBOTS:
-        return builtin_robot(spec)
+        return load_robot_file(spec, **chain, what="--robot")
     path = Path(spec)
     with in_file(path.name):
-        return load_robot_file(path, base=args.base, tip=args.tip, what="--robot", snap_angles=snap)
+        return load_robot_file(path, **chain, what="--robot")
 
 
 def add_consistency_options(p: argparse.ArgumentParser) -> None:

@@ -18,6 +18,7 @@ import sys
 from collections.abc import Mapping
 from typing import Any
 
+from .._checks import text as as_text
 from ..io.json_files import dumps
 from .run_report import RunRecord
 
@@ -52,6 +53,7 @@ class Console:
         self._record = record
 
     def _write(self, text: str, *, stdout: bool) -> None:
+        text = as_text(text)  # file names of an ASCII locale: their characters
         if self.quiet:
             if self._record is not None:
                 (self._record.out_parts if stdout else self._record.err_parts).append(text)
@@ -85,7 +87,7 @@ class Console:
     def notice(self, text: str) -> None:
         """A line on stderr printed also with ``-q``: something asked for was not done as
         asked (``--workers`` capped at the cores; a figure skipped)."""
-        sys.stderr.write(f"{text}\n")
+        sys.stderr.write(f"{as_text(text)}\n")
         sys.stderr.flush()
 
     def json(self, obj: Mapping[str, Any]) -> None:

@@ -40,12 +40,15 @@ from ..io.excitation import save_excitation_json, save_trajectory_csv
 from ..model.robot import Robot
 from ..simulation.excitation import ExcitationOptions
 from ..workflows.excite import ExcitationDesign, design_excitation
+from .applies import urdf_chain
 from .common import add_robot_options, add_subcommand, load_robot, output_path, save_figure
 from .console import Console
 
 NAME = "excite"
 #: ``--out`` is a folder: its files are one output set (:mod:`dynid.outputs.run_output`).
 OUTPUT = "folder"
+#: Options that apply to one route only (:mod:`dynid.cli.applies`).
+APPLIES = (urdf_chain(),)
 
 
 def register(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParser:

@@ -40,15 +40,34 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
-from ..io.export import EXPORT_FORMATS
+from ..exceptions import DynidError
+from ..io.export import EXPORT_FORMATS, export_format
 from ..io.robot.urdf_patch import MERGED_POLICIES
 from ..workflows.export import ExportRobotOptions, export_robot, save_export
+from .applies import Applies
 from .common import add_drive_option, add_subcommand, options_from, output_path
 from .console import Console
 
 NAME = "export"
 #: ``--out`` is the one file written (:mod:`dynid.outputs.run_output`).
 OUTPUT = "file"
+
+
+def _urdf_chain_export(args: argparse.Namespace) -> bool:
+    """The export writes the chain itself as URDF (no template)."""
+    if args.urdf_template is not None:
+        return False
+    try:
+        return export_format(args.out, args.format) == "urdf"
+    except DynidError:  # an unknown suffix: said by the export itself
+        return True
+
+
+#: Options that apply to one route only (:mod:`dynid.cli.applies`).
+APPLIES = (
+    Applies(("merged",), lambda a: a.urdf_template is not None, "--urdf-template"),
+    Applies(("all_frames",), _urdf_chain_export, "a URDF export without --urdf-template"),
+)
 
 
 def register(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParser:

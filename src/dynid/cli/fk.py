@@ -17,6 +17,7 @@ import argparse
 
 from ..kinematics.forward import fk
 from ..spatial import rpy_from_matrix
+from .applies import urdf_chain
 from .common import (
     add_frame_tool_options,
     add_q_option,
@@ -31,6 +32,8 @@ from .common import (
 from .console import Console
 
 NAME = "fk"
+#: Options that apply to one route only (:mod:`dynid.cli.applies`).
+APPLIES = (urdf_chain(),)
 
 
 def register(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParser:

@@ -41,6 +41,7 @@ from ..io.friction_json import save_friction_json
 from ..io.model_json import load_model_json
 from ..model.robot import Robot
 from ..workflows.friction import FrictionOptions, fit_friction_files
+from .applies import urdf_chain
 from .common import (
     add_column_options,
     add_drive_option,
@@ -62,6 +63,8 @@ from .summaries import format_rms_table
 NAME = "friction"
 #: ``--out`` is a folder: its files are one output set (:mod:`dynid.outputs.run_output`).
 OUTPUT = "folder"
+#: Options that apply to one route only (:mod:`dynid.cli.applies`).
+APPLIES = (urdf_chain(),)
 
 
 def register(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParser:

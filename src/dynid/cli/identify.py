@@ -90,6 +90,7 @@ from ..identification.least_squares import STD_METHODS
 from ..io.feasible_bundle import save_feasible_bundle
 from ..io.model_json import save_model_json
 from ..workflows.identify import IdentifyOptions, identify_files
+from .applies import urdf_chain
 from .common import (
     add_column_options,
     add_consistency_options,
@@ -114,6 +115,8 @@ from .summaries import format_consistent, format_identification
 NAME = "identify"
 #: ``--out`` is a folder: its files are one output set (:mod:`dynid.outputs.run_output`).
 OUTPUT = "folder"
+#: Options that apply to one route only (:mod:`dynid.cli.applies`).
+APPLIES = (urdf_chain(), urdf_chain("prior", ("prior_base", "prior_tip")))
 
 
 def register(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParser:

@@ -30,6 +30,7 @@ from ..exceptions import DynidError
 from ..kinematics.inverse import IKOptions, IKResult, default_q0, ik
 from ..model.robot import Robot
 from ..workflows.kinematics import goal_pose
+from .applies import urdf_chain
 from .common import (
     add_frame_tool_options,
     add_robot_options,
@@ -47,6 +48,8 @@ from .common import (
 from .console import Console
 
 NAME = "ik"
+#: Options that apply to one route only (:mod:`dynid.cli.applies`).
+APPLIES = (urdf_chain(),)
 
 
 def register(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParser:

@@ -27,12 +27,15 @@ from typing import Any
 
 from ..io.rosbag import BagImport, load_joint_state_bag
 from ..io.torque_log import save_torque_log
+from .applies import urdf_chain
 from .common import add_robot_options, add_subcommand, load_robot, output_path
 from .console import Console
 
 NAME = "import"
 #: ``--out`` is the one file written (:mod:`dynid.outputs.run_output`).
 OUTPUT = "file"
+#: Options that apply to one route only (:mod:`dynid.cli.applies`).
+APPLIES = (urdf_chain(),)
 
 
 def register(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParser:

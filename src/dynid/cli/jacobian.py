@@ -17,6 +17,7 @@ from __future__ import annotations
 import argparse
 
 from ..kinematics.jacobian import jacobian
+from .applies import urdf_chain
 from .common import (
     add_frame_tool_options,
     add_q_option,
@@ -30,6 +31,8 @@ from .common import (
 from .console import Console
 
 NAME = "jacobian"
+#: Options that apply to one route only (:mod:`dynid.cli.applies`).
+APPLIES = (urdf_chain(),)
 
 #: Row labels of the geometric Jacobian (linear, then angular velocity; base frame).
 ROWS = ("vx", "vy", "vz", "wx", "wy", "wz")

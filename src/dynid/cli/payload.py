@@ -36,6 +36,7 @@ from ..io.payload_json import save_payload_json
 from ..io.robot.toml import save_toml
 from ..model.inertia import INERTIA_ORDER, inertia6_from_matrix
 from ..workflows.payload import PayloadFileResult, identify_payload_files
+from .applies import urdf_chain
 from .common import (
     add_column_options,
     add_drive_option,
@@ -52,6 +53,8 @@ from .sources import load_model_source
 NAME = "payload"
 #: ``--out`` is a folder: its files are one output set (:mod:`dynid.outputs.run_output`).
 OUTPUT = "folder"
+#: Options that apply to one route only (:mod:`dynid.cli.applies`).
+APPLIES = (urdf_chain(),)
 
 
 def register(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParser:

@@ -53,6 +53,7 @@ from ..feasibility.methods import METHODS
 from ..feasibility.penalty import RetrievalOptions, RetrievalResult
 from ..io.feasible_bundle import save_feasible_bundle
 from ..workflows.retrieve import RetrieveOptions, retrieve_files
+from .applies import Applies, urdf_chain
 from .common import (
     add_consistency_options,
     add_robot_options,
@@ -73,6 +74,17 @@ from .summaries import format_consistent, format_retrieval, progress_printer
 NAME = "retrieve"
 #: ``--out`` is a folder: its files are one output set (:mod:`dynid.outputs.run_output`).
 OUTPUT = "folder"
+#: Methods with independent seeded runs (``--seed`` applies to them).
+_SEEDED = tuple(name for name, m in METHODS.items() if m.parallel)
+#: Options that apply to one route only (:mod:`dynid.cli.applies`).
+APPLIES = (
+    Applies(("robot",), lambda a: a.static is not None, "--static", "--model holds its robot"),
+    urdf_chain(),
+    urdf_chain("prior", ("prior_base", "prior_tip")),
+    Applies(
+        ("seed",), lambda a: a.method in _SEEDED, " or ".join(f"--method {m}" for m in _SEEDED)
+    ),
+)
 
 
 def register(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParser:

@@ -37,6 +37,7 @@ from ..exceptions import OptionError
 from ..io.torque_log import save_torque_log_pieces
 from ..simulation.contact import Contact
 from ..workflows.simulate import SimulateOptions, simulate_log
+from .applies import Applies, urdf_chain
 from .common import (
     add_drive_option,
     add_robot_options,
@@ -57,6 +58,22 @@ from .console import Console
 NAME = "simulate"
 #: ``--out`` is the one file written (:mod:`dynid.outputs.run_output`).
 OUTPUT = "file"
+#: Options that apply to one route only (:mod:`dynid.cli.applies`).
+APPLIES = (
+    urdf_chain(),
+    Applies(
+        ("harmonics", "base_freq"), lambda a: a.trajectory == "fourier", "--trajectory fourier"
+    ),
+    Applies(
+        ("amplitudes", "periods"), lambda a: a.trajectory == "sinusoid", "--trajectory sinusoid"
+    ),
+    Applies(
+        ("q0",),
+        lambda a: a.trajectory in ("sinusoid", "fourier"),
+        "--trajectory sinusoid or fourier",
+        "a trajectory file holds its start",
+    ),
+)
 
 
 def register(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParser:

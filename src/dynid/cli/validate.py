@@ -52,6 +52,7 @@ from pathlib import Path
 from ..identification.model import IdentifiedModel
 from ..io.validation_json import save_validation_json
 from ..workflows.validate import ValidateOptions, ValidateResult, validate_files
+from .applies import urdf_chain
 from .common import (
     add_column_options,
     add_drive_option,
@@ -72,6 +73,8 @@ from .summaries import format_rms_table
 NAME = "validate"
 #: ``--out`` is a folder: its files are one output set (:mod:`dynid.outputs.run_output`).
 OUTPUT = "folder"
+#: Options that apply to one route only (:mod:`dynid.cli.applies`).
+APPLIES = (urdf_chain(),)
 
 
 def register(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParser:

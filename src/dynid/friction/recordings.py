@@ -48,10 +48,10 @@ from ..model.drive import Drive
 from ..model.robot import Robot
 from .fit import FrictionResidual, TorqueModel, model_drive, torques_through
 from .model import FrictionModel, FrictionSum
+from .pooled import pooled_errors
 from .validation import (
     RECORDED,
     Validation,
-    errors_from_sums,
     recorded_cutoff,
     validated,
     validated_log,
@@ -507,23 +507,8 @@ def _pooled(
     labels = np.asarray(pieces.recording)
 
     def pooled(sel: NDArray[np.bool_], with_friction: bool) -> TorqueErrors:
-        n = parts[0].log.n
-        se2, sa2, N = np.zeros(n), np.zeros(n), 0
-        for v in (p for p, s in zip(parts, sel, strict=True) if s):
-            if v.step > 1:  # every k-th sample kept: the sums over all of them
-                assert v.tau_ss is not None
-                err = v.with_friction if with_friction else v.without_friction
-                assert err is not None
-                se2 += np.asarray(err.mse) * err.n_samples
-                sa2 += v.tau_ss
-                N += err.n_samples
-                continue
-            hat = v.tau_hat if with_friction else v.tau_model
-            e = v.log.tau - hat
-            se2 += np.einsum("ij,ij->j", e, e)
-            sa2 += np.einsum("ij,ij->j", v.log.tau, v.log.tau)
-            N += v.log.n_samples
-        return errors_from_sums(se2, sa2, N)
+        chosen = [p for p, s in zip(parts, sel, strict=True) if s]
+        return pooled_errors(chosen, with_friction, parts[0].log.n)
 
     fr = friction is not None
     every = np.ones(len(parts), bool)

@@ -29,6 +29,7 @@ from typing import Any
 import numpy as np
 
 from .. import _checks
+from .._checks import text
 from ..exceptions import DataError, NonFiniteError
 from .atomic import write_text
 from .input_files import file_bytes
@@ -39,7 +40,9 @@ __all__ = ["dumps", "finite_or_none", "jsonable", "load_json", "loads", "save_js
 def jsonable(x: Any, where: str = "") -> Any:
     """``x`` with numpy types converted; raises :class:`NonFiniteError` on NaN/inf."""
     if isinstance(x, Mapping):
-        return {str(k): jsonable(v, f"{where}.{k}" if where else str(k)) for k, v in x.items()}
+        return {
+            text(str(k)): jsonable(v, f"{where}.{k}" if where else str(k)) for k, v in x.items()
+        }
     if isinstance(x, np.ndarray):
         return jsonable(x.tolist(), where)
     if isinstance(x, (list, tuple)):
@@ -53,10 +56,10 @@ def jsonable(x: Any, where: str = "") -> Any:
         if not math.isfinite(v):
             raise NonFiniteError(f"{where or 'value'} is {v}; JSON has no NaN or infinity")
         return v
-    if x is None or isinstance(x, str):
+    if x is None:
         return x
-    if isinstance(x, Path):
-        return str(x)
+    if isinstance(x, str | Path):  # a file name of an ASCII locale: its characters
+        return text(str(x))
     raise DataError(f"{where or 'value'}: cannot write a {type(x).__name__} as JSON")
 
 

@@ -33,6 +33,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from .. import __version__
+from .._checks import text
 from ..exceptions import DataError, DynidError
 from ..observer.detection import ContactEvent, Thresholds
 from ..observer.residual import ObserverOptions
@@ -302,7 +303,7 @@ def log_labels(paths: Sequence[str | Path]) -> list[str]:
             o[-depth:] == mine[-depth:] for i, o in enumerate(parts) if i != k
         ):
             depth += 1
-        out.append("/".join(mine[-depth:]))
+        out.append(text("/".join(mine[-depth:])))
     return out
 
 

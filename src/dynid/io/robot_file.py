@@ -11,7 +11,7 @@ from __future__ import annotations
 import warnings
 from pathlib import Path
 
-from ..exceptions import DataError, DynidWarning
+from ..exceptions import DataError, DynidWarning, OptionError
 from ..model.builtin import BUILTIN_ROBOTS, builtin_robot
 from ..model.robot import Robot
 
@@ -43,11 +43,18 @@ def load_robot(
     ------
     DataError
         Another suffix, or a file that does not exist.
+    OptionError
+        ``base``, ``tip`` or ``snap_angles`` with a robot that is not a URDF (``field``
+        names it).
     """
-    if str(spec) in BUILTIN_ROBOTS:
-        return builtin_robot(str(spec))
     path = Path(spec)
     suffix = path.suffix.lower()
+    chain = {"base": base, "tip": tip, "snap_angles": snap_angles or None}
+    given = next((k for k, v in chain.items() if v is not None), None)
+    if given is not None and suffix != ".urdf":
+        raise OptionError(f"applies to a URDF {what} only; leave it out", field=given)
+    if str(spec) in BUILTIN_ROBOTS:
+        return builtin_robot(str(spec))
     if suffix not in ROBOT_FILE_SUFFIXES:
         raise DataError(
             f"{what} must be {_names()} or a .urdf, .toml or .json (feasible.json) file; "

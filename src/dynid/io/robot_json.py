@@ -6,7 +6,8 @@ gravity vector they were identified with. Fields (see :class:`dynid.Robot`): ``n
 ``axes`` (n, 3) (unit, link coordinates), ``prismatic`` (n,), ``limits`` (``q_min``,
 ``q_max`` [rad or m], ``dq_max`` [rad/s], ``ddq_max`` [rad/s^2], ``tau_max`` [N m]; ``null``
 where there is no limit), ``gravity`` (3,) [m/s^2] in the base frame, and ``frames``
-(name -> ``{"link": index, "T_link_frame": 4x4}``).
+(name -> ``{"link": index, "T_link_frame": 4x4}``, and ``"joint"``: the fixed joint that
+attaches it in the source URDF, when it has one).
 
 Inertial parameters and friction are not written: a robot read back has zero standard
 parameters and no friction model. Floats are written with Python's shortest round-trip
@@ -55,6 +56,7 @@ ROBOT_RECORD = Record(
                 {
                     "link": Field("integer", required=True, low=0),
                     "T_link_frame": Field("numbers", required=True, shape=(4, 4)),
+                    "joint": Field("string"),
                 }
             ),
         ),
@@ -76,7 +78,11 @@ def robot_to_dict(robot: Robot) -> dict[str, Any]:
         "limits": {k: finite_or_none(getattr(robot, k)) for k in _LIMITS},
         "gravity": robot.gravity.tolist(),
         "frames": {
-            name: {"link": int(f.link), "T_link_frame": f.T_link_frame.tolist()}
+            name: {
+                "link": int(f.link),
+                "T_link_frame": f.T_link_frame.tolist(),
+                **({} if f.joint is None else {"joint": f.joint}),
+            }
             for name, f in robot.frames.items()
         },
         "units": {
@@ -122,7 +128,9 @@ def robot_from_dict(
             phi=np.zeros((n, 10)),
             gravity=np.array(d["gravity"], dtype=float),
             frames={
-                str(name): Frame(f["link"], np.array(f["T_link_frame"], dtype=float))
+                str(name): Frame(
+                    f["link"], np.array(f["T_link_frame"], dtype=float), f.get("joint")
+                )
                 for name, f in d["frames"].items()
             },
             **lim,

@@ -57,17 +57,23 @@ class Frame:
         Index of the link that carries the frame (0 = base, ``i`` = link ``i``).
     T_link_frame : ndarray, shape (4, 4)
         Pose of the frame in the link frame [m].
+    joint : str, optional
+        The name of the fixed joint that attaches it in the robot's source (a URDF), kept
+        so that an export names that joint as the source did; None: a frame of its own.
     """
 
     link: int
     T_link_frame: NDArray[np.float64]
+    joint: str | None = None
 
 
 def _fixed_frames(frames: Mapping[str, Frame]) -> Mapping[str, Frame]:
     out = {}
     for k, f in frames.items():
         T = _checks.as_exact(f"frames[{k!r}].T_link_frame", f.T_link_frame, (4, 4))
-        out[str(k)] = Frame(int(f.link), _checks.frozen(T))
+        joint = None if f.joint is None else str(f.joint)
+        out[str(k)] = Frame(int(f.link), _checks.frozen(T), joint)
+    _check_names("joint", [f.joint for f in out.values() if f.joint is not None])
     return MappingProxyType(out)
 
 

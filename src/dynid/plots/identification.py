@@ -21,9 +21,12 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 from numpy.typing import NDArray
 
+from ..exceptions import DynidError
+from ..friction.pooled import joined_validation
 from ..friction.validation import Validation, own_friction, validate_torques
 from ..identification.log import TorqueLog
 from ..identification.model import IdentifiedModel
+from ..identification.pieces import split_at_gaps
 from ..identification.sanity import velocity_noise_std
 
 if TYPE_CHECKING:  # pragma: no cover
@@ -97,6 +100,8 @@ def heldout_torques(
         Identified from ``log`` by the classical route (with its held-out folds).
     log : TorqueLog
         The log it was identified from, as read (several recordings: the last one).
+        Held-out samples with gaps longer than the identification's ``max_gap_s`` are
+        prepared piece by piece and pooled, as the identification took them.
     separate : TorqueLog, optional
         The ``--validate-on`` log (the model judged on it), as read.
 
@@ -133,9 +138,36 @@ def heldout_torques(
         block = f"the last of {k} recordings, predicted by the fit of the other {k - 1}"
     else:
         return None
-    v = validate_torques(fitted, held, friction=own_friction(fitted))
+    v, said = _pieces_validation(fitted, split_at_gaps(held, model.info.log.max_gap_s))
+    block += said
     cutoff = model.info.log.cutoff_hz or 0.2 * model.info.log.sample_rate_hz
     return HeldOutTorques(v, _noise(v, cutoff), block, tuple(model.robot.joint_names))
+
+
+def _pieces_validation(model: IdentifiedModel, pieces: list[TorqueLog]) -> tuple[Validation, str]:
+    """``model`` on the pieces of a log cut at its gaps, each prepared on its own as the
+    identification prepared them (one too short to filter is left out), pooled; and what
+    to add to the block's description.
+
+    Raises
+    ------
+    DynidError
+        Every piece too short (the first one's error).
+    """
+    friction = own_friction(model)
+    parts, first = [], None
+    for p in pieces:
+        try:
+            parts.append(validate_torques(model, p, friction=friction))
+        except DynidError as exc:
+            first = first or exc
+    if not parts:
+        assert first is not None
+        raise first
+    said = "" if len(pieces) == 1 else f" ({len(pieces)} pieces between gaps"
+    if len(parts) < len(pieces):
+        said += f", {len(pieces) - len(parts)} too short to filter left out"
+    return joined_validation(parts), said + (")" if said else "")
 
 
 def _noise(v: Validation, cutoff_hz: float) -> NDArray[np.float64]:

@@ -10,7 +10,7 @@ from collections.abc import Mapping, Sequence
 from typing import TYPE_CHECKING
 
 import numpy as np
-from numpy.typing import ArrayLike
+from numpy.typing import ArrayLike, NDArray
 
 from ..friction.validation import Validation
 
@@ -27,6 +27,15 @@ _FRICTION = dict(color="tab:blue", lw=1.1, ls="--", label="model + friction")
 
 def _stride(N: int, max_points: int) -> slice:
     return slice(None, None, max(1, int(np.ceil(N / max_points))))
+
+
+def _gaps(t: NDArray[np.float64]) -> NDArray[np.intp]:
+    """Where the times ``t`` [s] jump by more than ten median steps (pieces of a log cut at
+    its gaps, one after another): the indices before which a line is broken."""
+    dt = np.diff(t)
+    if dt.size == 0:
+        return np.zeros(0, dtype=np.intp)
+    return np.flatnonzero(dt > 10.0 * float(np.median(dt))) + 1
 
 
 def plot_torque_validation(
@@ -69,25 +78,31 @@ def plot_torque_validation(
     axes = fig.subplots(n, 2, sharex=True, squeeze=False, gridspec_kw={"width_ratios": [3, 2]})
     s = _stride(log.n_samples, max_points)
     t = log.t[s] - log.t[0]
+    cut = _gaps(t)
     e0 = log.tau - validation.tau_model
     e1 = None if validation.tau_friction is None else e0 - validation.tau_friction
+    t = np.insert(t, cut, np.nan)  # the line is broken at a gap between pieces
+
+    def at(y: NDArray[np.float64]) -> NDArray[np.float64]:
+        return np.insert(y[s], cut, np.nan)
+
     for j in range(n):
         ax, axe = axes[j]
-        ax.plot(t, log.tau[s, j], **_MEASURED)
-        ax.plot(t, validation.tau_model[s, j], **_NO_FRICTION)
+        ax.plot(t, at(log.tau[:, j]), **_MEASURED)
+        ax.plot(t, at(validation.tau_model[:, j]), **_NO_FRICTION)
         if e1 is not None:
-            ax.plot(t, validation.tau_hat[s, j], **_FRICTION)
+            ax.plot(t, at(validation.tau_hat[:, j]), **_FRICTION)
         ax.set_ylabel(f"{names[j]}\n[N m]")
         ax.grid(alpha=0.3)
         r0 = validation.without_friction.rms[j]
         axe.plot(
-            t, e0[s, j], color=_NO_FRICTION["color"], lw=0.8, label=f"no friction, RMS {r0:.3f}"
+            t, at(e0[:, j]), color=_NO_FRICTION["color"], lw=0.8, label=f"no friction, RMS {r0:.3f}"
         )
         if e1 is not None and validation.with_friction is not None:
             r1 = validation.with_friction.rms[j]
             axe.plot(
                 t,
-                e1[s, j],
+                at(e1[:, j]),
                 color=_FRICTION["color"],
                 lw=0.6,
                 alpha=0.8,

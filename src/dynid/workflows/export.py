@@ -139,7 +139,7 @@ def export_robot(
     fmt = export_format(out, opt.format)
     if opt.urdf_template is not None and not ROBOT_FORMATS[fmt].template:
         raise OptionError(f"applies to the urdf format only; got {fmt}", field="urdf_template")
-    robot = load_robot(params, base=opt.base, tip=opt.tip)
+    robot = load_robot(params, base=opt.base, tip=opt.tip) if urdf else load_robot(params)
     linear, drive = model_terms_of(params, robot.n)
     if opt.drive is not None:
         drive = opt.drive if isinstance(opt.drive, Drive) else load_drive(opt.drive, robot.n)

@@ -8,6 +8,7 @@ from pathlib import Path
 
 import numpy as np
 
+from .._checks import text
 from ..exceptions import DynidError, OptionError
 from ..io.robot_file import ROBOT_FILE_SUFFIXES, load_robot
 from ..model.builtin import BUILTIN_ROBOTS, builtin_robot
@@ -44,8 +45,15 @@ def load_prior(
     ------
     OptionError
         A prior of another kind, missing or unreadable, or with joint types other than
-        the robot's (``field`` is ``"prior"``).
+        the robot's (``field`` is ``"prior"``); ``base`` or ``tip`` without a URDF prior.
     """
+    if base is not None or tip is not None:
+        if not (isinstance(spec, str | Path) and Path(spec).suffix.lower() == ".urdf"):
+            raise OptionError(
+                "applies to a URDF {prior} only; leave it out",
+                field="prior_base" if base is not None else "prior_tip",
+                others=("prior",),
+            )
     if spec is None:
         return None
     spec = str(spec)
@@ -63,9 +71,12 @@ def load_prior(
             raise OptionError(f"{path.name}: {path} does not exist", field="prior")
         urdf = path.suffix.lower() == ".urdf"
         try:
-            prior = load_robot(
-                path, base=base or robot.link_names[0], tip=tip or robot.link_names[-1]
-            )
+            if urdf:
+                prior = load_robot(
+                    path, base=base or robot.link_names[0], tip=tip or robot.link_names[-1]
+                )
+            else:
+                prior = load_robot(path)
         except DynidError as exc:
             hint = " (name the chain with {prior_base}/{prior_tip})" if urdf else ""
             raise OptionError(
@@ -73,7 +84,7 @@ def load_prior(
                 field="prior",
                 others=("prior_base", "prior_tip") if urdf else (),
             ) from None
-        prior = prior.replace(name=path.name)
+        prior = prior.replace(name=text(path.name))  # an ASCII locale's name: its characters
     pk, rk = ("".join("P" if x else "R" for x in r.prismatic) for r in (prior, robot))
     if pk != rk:
         raise OptionError(f"{spec}: joints {pk}; the robot's are {rk}", field="prior")

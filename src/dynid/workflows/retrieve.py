@@ -148,8 +148,9 @@ class RetrieveOptions:
     Raises
     ------
     OptionError
-        An unknown method; an option of the other method; a value out of its range
-        (``field`` names it).
+        An unknown method; an option of the other method; a value out of its range;
+        ``total_mass`` without ``total_mass_band``; ``prior_weight`` with the penalty
+        method and no prior (``field`` names it).
     """
 
     method: str = "sdp"
@@ -184,6 +185,19 @@ class RetrieveOptions:
                 raise OptionError(
                     f"applies to {{method}} {method} only", field=name, others=("method",)
                 )
+        if self.total_mass is not None and not self.total_mass_band:
+            raise OptionError(
+                "sets the band {total_mass_band} drops; give one of them",
+                field="total_mass",
+                others=("total_mass_band",),
+            )
+        if self.method == "penalty" and self.prior is None and self.prior_weight is not None:
+            raise OptionError(
+                "applies to the penalty method with a {prior} only (the weight of its pull "
+                "towards the prior); leave it out",
+                field="prior_weight",
+                others=("prior",),
+            )
 
     def method_options(self) -> SDPOptions | RetrievalOptions:
         """The settings of the method (its ``options_type``).

@@ -54,7 +54,7 @@ from ...friction.model import Friction, FrictionSum, robot_friction, sigmoid_par
 from ...friction.mujoco import drive_joint_terms, joint_coulomb_viscous, unheld_friction
 from ...model.drive import Drive
 from ...model.inertia import inertia6_from_matrix
-from ...model.robot import Robot
+from ...model.robot import Frame, Robot
 from ..atomic import write_text
 from ..input_files import file_text
 from .export_options import ExportOptions
@@ -84,11 +84,13 @@ def _v(v: np.ndarray) -> str:
     return " ".join(_f(x) for x in v)
 
 
-def _fixed(name: str, parent: str, T: np.ndarray, joints: set[str]) -> list[str]:
-    """A fixed joint ``<name>_joint`` (``<name>_joint_2``, ... when ``joints`` holds that
-    name; added to ``joints``) from ``parent`` to a massless link ``name``."""
+def _fixed(name: str, parent: str, f: Frame, joints: set[str]) -> list[str]:
+    """A fixed joint from ``parent`` to a massless link ``name`` at the frame ``f``: named
+    as in the robot's source (``f.joint``), else ``<name>_joint`` (``<name>_joint_2``, ...
+    when ``joints`` holds that name; added to ``joints``)."""
+    T = f.T_link_frame
     rpy = spatial.rpy_from_matrix(T[:3, :3])
-    joint, k = name + "_joint", 1
+    joint, k = f.joint or name + "_joint", 1
     while joint in joints:
         k += 1
         joint = f"{name}_joint_{k}"
@@ -209,14 +211,14 @@ def urdf_from_robot(
         ]
     names = set(robot.link_names)
     tip = tip_name(robot)
-    frames = [] if tip is None else [(tip, robot.frame("flange"))]
+    frames = [] if tip is None else [(tip, robot.frames.get(tip, robot.frame("flange")))]
     if all_frames:
         frames += [
             (k, f) for k, f in robot.frames.items() if k not in names and k not in ("flange", tip)
         ]
     joints = set(robot.joint_names)
     for name, f in frames:
-        lines += _fixed(name, robot.link_names[f.link], f.T_link_frame, joints)
+        lines += _fixed(name, robot.link_names[f.link], f, joints)
     lines.append("</robot>")
     return "\n".join(lines) + "\n"
 

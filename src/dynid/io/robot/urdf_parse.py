@@ -51,7 +51,7 @@ import dataclasses
 import logging
 import warnings
 import xml.etree.ElementTree as ET
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
@@ -335,7 +335,8 @@ class _Walk:
     """The chain walked from the base: the robot's joints and where every URDF link sits.
 
     ``placed[link] = (k, T_k_link)``: the link is rigidly part of body ``k`` (0 = base) at
-    pose ``T_k_link``; ``order`` lists the placed links in the order they were placed.
+    pose ``T_k_link``; ``order`` lists the placed links in the order they were placed;
+    ``fixed_joint[link]`` names the fixed joint whose child the link is.
     """
 
     link_names: list[str]
@@ -347,6 +348,7 @@ class _Walk:
     dynamics: list[tuple[float, float]]
     placed: dict[str, tuple[int, NDArray[np.float64]]]
     order: list[str]
+    fixed_joint: dict[str, str] = field(default_factory=dict)
 
 
 def _walk(path: list[_Joint], base_link: str, angles: AngleRounding) -> _Walk:
@@ -357,6 +359,7 @@ def _walk(path: list[_Joint], base_link: str, angles: AngleRounding) -> _Walk:
         T = T_k_cur @ _origin(joint.elem, f"joint {joint.name!r}", angles, joint.name)
         if joint.type == "fixed":
             T_k_cur = T
+            w.fixed_joint[joint.child] = joint.name
         else:
             w.axes.append(_axis(joint))
             w.joint_names.append(joint.name)
@@ -384,6 +387,7 @@ def _place_fixed_links(w: _Walk, path: list[_Joint], child_joints: dict[str, lis
             if joint.child in w.placed:
                 raise ModelError(f"the joints form a cycle through link {joint.child!r}")
             w.placed[joint.child] = (kl, T_k_link @ _origin(joint.elem, f"joint {joint.name!r}"))
+            w.fixed_joint[joint.child] = joint.name
             w.order.append(joint.child)
             stack.append(joint.child)
 
@@ -460,7 +464,11 @@ def _read_chain(
     phi = _body_phi(w, links)
 
     moving_links = set(w.link_names)
-    frames = {link: Frame(kl, T) for link, (kl, T) in w.placed.items() if link not in moving_links}
+    frames = {
+        link: Frame(kl, T, w.fixed_joint.get(link))
+        for link, (kl, T) in w.placed.items()
+        if link not in moving_links
+    }
     if "flange" in w.placed and tip != "flange":
         warnings.warn(
             f"URDF link 'flange' is not the tip link {tip!r}; the frame 'flange' is the tip link's",
