@@ -114,7 +114,7 @@ def term_lines(model: IdentifiedModel) -> list[str]:
             stem = lab.rstrip("0123456789")
             units[stem] = t.term.units[k] if k < len(t.term.units) else ""
             cells[(stem, int(lab[len(stem) :]))] = _coefficient(
-                float(t.values[k]), float(t.std[k]), bool(t.kept[k]), t.term.in_base
+                float(t.values[k]), float(t.std[k]), bool(t.kept[k]), bool(t.regrouped[k])
             )
         drive = getattr(t.term, "drive", None)
         row = "motor" if drive is not None and drive.friction_at == "motor" else "joint"
@@ -135,10 +135,10 @@ def term_lines(model: IdentifiedModel) -> list[str]:
     return out
 
 
-def _coefficient(value: float, std: float, kept: bool, in_base: bool) -> str:
+def _coefficient(value: float, std: float, kept: bool, regrouped: bool) -> str:
     """One coefficient of a term's table (:func:`term_lines`)."""
     if not kept:
-        return "in beta" if in_base and not np.isfinite(std) else "-"
+        return "in beta" if regrouped else "-"
     if not np.isfinite(std) or not value:
         return f"{value:+.4g}"
     return f"{value:+.4g} ({abs(100.0 * std / value):.2g} %)"
@@ -353,12 +353,19 @@ def format_consistent(result: ConsistentResult) -> str:
             f"{r.pseudo_inertia_margin[i]:>19.3e}"
         )
     status = "CONSISTENT" if r.feasible else "NOT CONSISTENT WITH THE SPECIFICATION (closest set)"
+    over = f"{100 * (r.residual_ratio - 1):.3f} % above the unconstrained fit"
     lines += [
         f"total mass {float(np.sum(r.mass)):.4f} kg"
         + ("" if r.total_mass is None else f" (band {r.total_mass[0]:g}..{r.total_mass[1]:g} kg)"),
         f"{status}: method sdp ({r.options.objective}, prior {r.prior.source}), fit {r.fit}, "
-        f"relative residual on the coefficients {r.relative_residual:.3e}, data residual "
-        f"{100 * (r.residual_ratio - 1):.3f} % above the unconstrained fit",
+        f"relative residual on the coefficients {r.relative_residual:.3e}, "
+        + (
+            f"data residual {over}"
+            if r.heldout is None
+            else "judged on held-out data (below): its training residual, above least "
+            f"squares' by construction, does not decide ({over} in the covariance-weighted "
+            "data term)"
+        ),
         f"solver {r.solver}: {r.status}, {r.run_time:.2f} s",
     ]
     lines += consistent_structure_lines(r)
@@ -373,15 +380,50 @@ def format_consistent(result: ConsistentResult) -> str:
                 for j, (name, unit) in enumerate(zip(fr.names, fr.law.units, strict=True))
             )
         )
+    prior_masses, prior_rotors = _decided_by_prior(r)
     if r.rotor_inertia is not None:
         lines.append(
             "rotor inertia at the motors [kg m^2] (>= 0): "
-            + " ".join(f"{x:.4g}" for x in r.rotor_inertia)
+            + " ".join(
+                f"{x:.4g}" + ("*" if prior_rotors[m] else "") for m, x in enumerate(r.rotor_inertia)
+            )
+        )
+        if prior_rotors.any():
+            motors = ", ".join(str(m + 1) for m in np.flatnonzero(prior_rotors))
+            lines.append(
+                f"  * rotor(s) {motors}: the data give each only in a sum with link inertias "
+                "(in beta): the prior and the constraints decide its share"
+            )
+    if prior_masses:
+        lines.append(
+            "note: masses the data do not give (unidentifiable: "
+            + ", ".join(prior_masses)
+            + "): the prior, the bounds and the total-mass band decide them"
         )
     lines += [f"note: {s}" for s in r.notes]
     if not r.feasible:
         lines.append(str(r.report))
     return "\n".join(lines)
+
+
+def _decided_by_prior(r: ConsistentResult) -> tuple[list[str], NDArray[np.bool_]]:
+    """What the data of a one-step consistent fit do not give and the prior decides: the
+    unidentifiable link masses (their labels) and the rotors (n,) regrouped with link
+    inertias."""
+    n = 0 if r.rotor_inertia is None else len(r.rotor_inertia)
+    rotors = np.zeros(n, dtype=bool)
+    model = r.identified
+    if model is None:
+        return [], rotors
+    status = dict(zip(model.base.std_labels, identifiability(model.base), strict=True))
+    masses = [
+        f"m{i}" for i in range(1, model.robot.n + 1) if status.get(f"m{i}") == "unidentifiable"
+    ]
+    for t in model.terms.values():
+        shares = t.term.inertia(t.regrouped.astype(np.float64))
+        if shares is not None and shares.shape == rotors.shape:
+            rotors |= shares > 0
+    return masses, rotors
 
 
 def format_rms_table(names: list[str], columns: dict[str, np.ndarray]) -> str:
