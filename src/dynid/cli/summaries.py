@@ -16,6 +16,7 @@ from ..friction.model import friction_parts
 from ..friction.validation import NewtonEulerValidation
 from ..identification.info import LogInfo
 from ..identification.model import IdentifiedModel
+from ..identification.structure import MIN_WIDTH
 from ..io.observer_files import log_labels
 from ..observer.detection import undetected_at_rest
 from ..observer.results import LogObservation, ObserveResult
@@ -119,6 +120,11 @@ def term_lines(model: IdentifiedModel) -> list[str]:
         drive = getattr(t.term, "drive", None)
         row = "motor" if drive is not None and drive.friction_at == "motor" else "joint"
         n = getattr(drive, "n", None) or max(j for _, j in cells)
+        scales = _velocity_scales(t.term, n)
+        for stem, values in scales.items():
+            stems.append(stem)
+            units[stem] = "rad/s"
+            cells |= {(stem, j + 1): f"{float(x):.3g}" for j, x in enumerate(values)}
         heads = [f"{stem} [{units[stem]}]" if units[stem] else stem for stem in stems]
         widths = [
             max(len(h), *(len(cells.get((stem, j), "-")) for j in range(1, n + 1)))
@@ -132,6 +138,36 @@ def term_lines(model: IdentifiedModel) -> list[str]:
                 f"{cells.get((stem, j), '-'):<{w}}" for stem, w in zip(stems, widths, strict=True)
             ]
             out.append(f"  {j:<5}  " + "  ".join(cols).rstrip())
+        out += _scales_lines(scales, model)
+    return out
+
+
+def _velocity_scales(term: Any, n: int) -> dict[str, tuple[float, ...]]:
+    """A friction term's velocities per joint (motor) [rad/s]: its standstill band and,
+    for a smooth Coulomb, its width (none for another term)."""
+    out = {}
+    for key in ("band", "width"):
+        v = getattr(term, key, ())
+        if isinstance(v, tuple) and len(v) == n and (key == "band" or "smooth" in term.parts):
+            out[key] = v
+    return out
+
+
+def _scales_lines(scales: dict[str, tuple[float, ...]], model: IdentifiedModel) -> list[str]:
+    """What the band and the smooth width of the friction table mean."""
+    if not scales:
+        return []
+    out = [
+        "  band: the standstill band of the velocities as prepared (5 std of their noise; of "
+        "velocities derived from positions, the positions' noise through the derivative filter)"
+    ]
+    if "width" in scales:
+        given = [str(x) for x in model.info.extra.get("terms", ()) if str(x).startswith("smooth")]
+        k = given[0].split(":")[1] if given and ":" in given[0] else "K"
+        out.append(
+            f"  width: the smooth Coulomb fc tanh(dq / width), smooth:{k} = {k} x max(band, "
+            f"{MIN_WIDTH:g} rad/s)"
+        )
     return out
 
 
