@@ -147,7 +147,9 @@ class Recordings:
     band : ndarray, shape (n,)
         Standstill band [rad/s] per joint (motor, where the drive's friction acts there):
         the velocity noise band of the raw logs
-        (:func:`~dynid.identification.sanity.noise_band`).
+        (:func:`~dynid.identification.sanity.noise_band`); for velocities derived from the
+        positions, the noise they carry divided by ``band_gain``
+        (:mod:`~dynid.identification.derived_band`).
     skipped : tuple of str
         One line per piece left out (too short to filter).
     unwrapped : tuple of int
