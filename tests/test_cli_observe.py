@@ -254,3 +254,59 @@ def test_calibrating_an_identified_model_in_blocks_keeps_no_series(logs, monkeyp
     np.testing.assert_allclose(lean.thresholds.contact, 1.5 * A.max(axis=0), rtol=1e-9)
     noise = 1.5 * np.clip(A - 3.0 * s, 0.0, None).max(axis=0)
     np.testing.assert_allclose(lean.thresholds.noise, noise, rtol=1e-9, atol=1e-12)
+
+
+def _without_velocities(src, dst) -> None:
+    """``src``'s log with its velocity columns left out (t, q, tau)."""
+    lines = [x for x in src.read_text().splitlines() if not x.startswith("#")]
+    head = lines[0].split(",")
+    keep = [i for i, h in enumerate(head) if not h.startswith("dq")]
+    assert len(keep) == 15, head
+    dst.write_text("\n".join(",".join(x.split(",")[i] for i in keep) for x in lines) + "\n")
+
+
+@pytest.mark.filterwarnings("ignore:.*velocities derived:UserWarning")
+def test_calibrating_on_a_log_without_velocities_draws_its_figure(logs, capsys):
+    """A log without velocity columns (the edges of its derived velocities not observed:
+    NaN residual, NaN std) calibrated with an identified model's uncertainty and the
+    figure: the command succeeds, writes thresholds.json and the figure, whose thresholds
+    are NaN where the residual is (the std there was refused: exit 2, no file)."""
+    from dynid.observer.thresholds import threshold_series
+    from dynid.workflows.observe import ObserveOptions, observe_files
+
+    _without_velocities(logs / "free.csv", logs / "free_q.csv")
+    model = logs / "id" / "identification.json"
+    out = logs / "cal_q"
+    cmd = ["observe", "--model", str(model), "--data", str(logs / "free_q.csv"), "--calibrate"]
+    assert main([*cmd, "--out", str(out)]) == 0
+    assert (out / "thresholds.json").exists() and (out / "residuals.png").stat().st_size > 10_000
+    assert "skipped" not in capsys.readouterr().err
+    opts = ObserveOptions(data=(logs / "free_q.csv",), model=model, calibrate=True)
+    x = observe_files(opts).logs[0]
+    unseen = np.isnan(x.r).any(axis=1)
+    assert unseen[0] and unseen[-1] and not unseen.all()
+    th = load_thresholds(out / "thresholds.json")
+    c, k = threshold_series(th, x.r.shape[0], x.std, x.standstill)
+    np.testing.assert_array_equal(np.isnan(c).any(axis=1), unseen)
+    np.testing.assert_array_equal(np.isnan(k).any(axis=1), unseen)
+    # where observed: k sigma + nu plus the standstill margin
+    s = unseen
+    want = th.k_sigma * x.std[~s] + th.noise + (x.standstill[~s] if th.standstill else 0.0)
+    np.testing.assert_allclose(c[~s], want, rtol=1e-12)
+
+
+def test_a_calibration_figure_that_fails_costs_no_data_file(logs, capsys, monkeypatch):
+    """What the figure computes (its thresholds at every sample) raises: a one-line note,
+    exit 0, thresholds.json written (the error escaped the figure: exit 2, no file)."""
+
+    def broken(*a, **k):
+        raise RuntimeError("the plot is broken")
+
+    monkeypatch.setattr("dynid.cli.figures.threshold_series", broken)
+    model = ["--model", str(logs / "id" / "identification.json")]
+    out = logs / "cal_broken"
+    cmd = ["observe", *model, "--data", str(logs / "free.csv"), "--calibrate", "--out", str(out)]
+    assert main(cmd) == 0
+    assert (out / "thresholds.json").exists() and not (out / "residuals.png").exists()
+    err = capsys.readouterr().err
+    assert "note: skipped the figure residuals.png: RuntimeError: the plot is broken" in err

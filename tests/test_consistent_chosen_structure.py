@@ -20,11 +20,13 @@ import pytest
 import dynid
 from dynid.cli.__main__ import main
 from dynid.exceptions import DynidWarning
+from dynid.identification.log import TorqueLog
 from dynid.io.torque_log import save_torque_log
 from dynid.model.drive import Drive
 from dynid.regressors.terms import LinearFriction
 from dynid.simulation.measurement import SensorNoise, sample_times, simulate_measurement
 from dynid.simulation.trajectories import random_fourier
+from dynid.simulation.unmodelled import UnmodelledEffects
 from dynid.workflows.identify import IdentifyOptions, identify_files
 
 TERMS = "viscous,coulomb,stribeck:0.2,offset,-fo3"
@@ -103,3 +105,39 @@ def test_dissipation_rows_bound_a_saturating_quadratic_viscous_at_the_limit():
     assert np.all(G @ np.array([1.0, -0.45]) >= 0)  # 1 - 0.9 >= 0
     assert np.any(G @ np.array([1.0, -0.55]) < 0)  # 1 - 1.1 < 0 at the limit
     assert not term.nonnegative[1] and term.nonnegative[0]
+
+
+def test_dissipation_rows_leave_the_offset_aside():
+    """The offset is a constant torque of either sign, not friction: its column is zero in
+    ``G`` and a negative offset beside friction that opposes the motion is physical."""
+    term = LinearFriction(Drive.identity(1), parts=("viscous", "coulomb", "offset"))
+    G = term.dissipation_rows(np.array([2.0]))
+    assert G.shape[0] > 0 and np.all(G[:, 2] == 0.0)
+    assert np.all(G @ np.array([0.2, 0.3, -5.0]) >= 0)
+    assert np.any(G @ np.array([0.2, -0.3, 0.0]) < 0)  # fc < 0 still refused
+
+
+def test_a_consistent_fit_keeps_a_negative_offset(tmp_path):
+    """Exact torques of the Panda's links with viscous and Coulomb friction and offsets of
+    either sign (-0.5 N m at joint 4): the consistent fit returns the data's offsets (the
+    closed form: the constant in the torques) and friction. Offsets kept inside the
+    dissipation rows came out pulled towards ``-fc`` (fo4 -0.38, fo2 +0.43 for +0.3)."""
+    robot = dynid.panda()
+    fo = np.array([0.0, 0.3, 0.0, -0.5, 0.0, 0.0, 0.0])
+    fv, fc = 0.2, 0.3
+    traj = random_fourier(robot, np.random.default_rng(3))(sample_times(8.0, 200.0))
+    log = simulate_measurement(
+        robot, traj, rng=np.random.default_rng(4), noise=SensorNoise.none(), friction=None,
+        effects=UnmodelledEffects(np.zeros(7), fo),
+    )  # fmt: skip
+    tau = log.tau + fv * log.dq + fc * np.sign(log.dq)
+    path = save_torque_log(tmp_path / "log.csv", TorqueLog(t=log.t, q=log.q, dq=log.dq, tau=tau))
+    opt = IdentifyOptions(
+        terms="viscous,coulomb,offset", consistent=True, prior="panda", prior_weight=1e-3
+    )
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", DynidWarning)
+        P = np.asarray(identify_files(robot, path, opt).consistent.friction.params)
+    np.testing.assert_allclose(P[:, 2], fo, atol=0.01)  # fo
+    np.testing.assert_allclose(P[:, 0], fv, atol=0.01)
+    np.testing.assert_allclose(P[:, 1], fc, atol=0.01)

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import numpy as np
+import pytest
 
 from dynid.cli.summaries import format_identification, term_lines
 from dynid.friction.model import ClassicalFriction
@@ -25,14 +26,19 @@ def test_the_friction_identified_with_the_links_is_printed_per_joint(panda):
     model = identify_recordings(panda, logs, structure=structure, cutoff_hz=None)
     lines = term_lines(model)
     assert lines[0].startswith("friction identified with the links")
-    assert lines[1].split() == ["joint", "fv", "[N", "m", "s/rad]", "fc", "[N", "m]"]
-    rows = {int(r.split()[0]): r.split()[1:] for r in lines[2:]}
+    assert lines[1].split() == [
+        "joint", "fv", "[N", "m", "s/rad]", "fc", "[N", "m]", "band", "[rad/s]",
+    ]  # fmt: skip
+    rows = {int(r.split()[0]): r.split()[1:] for r in lines[2:9]}
     assert sorted(rows) == list(range(1, 8))
+    band = model.terms["friction"].term.band
     for j in range(7):
         printed_fv = float(rows[j + 1][0])
         assert abs(printed_fv - fv[j]) < 1e-3 * fv[j]
         if j == 3:
-            assert rows[j + 1][-1] == "-"
+            assert rows[j + 1][-2] == "-"
         else:
             assert abs(float(rows[j + 1][3]) - fc[j]) < 1e-3 * fc[j]
+        assert float(rows[j + 1][-1]) == pytest.approx(band[j], rel=5e-3)
+    assert lines[9].startswith("  band: the standstill band")
     assert "\n".join(lines) in format_identification(model)

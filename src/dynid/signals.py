@@ -43,6 +43,7 @@ __all__ = [
     "EDGE_PERIODS",
     "MOTION_EDGE_PERIODS",
     "derivative",
+    "derivative_noise_gain",
     "edge_seconds",
     "filtered_derivative",
     "is_uniform",
@@ -430,6 +431,25 @@ def filtered_derivative(
     flat = du.reshape(du.shape[0], -1)
     out = np.stack([np.interp(t, tu, flat[:, k]) for k in range(flat.shape[1])], axis=1)
     return out.reshape((t.shape[0],) + x.shape[1:])
+
+
+def derivative_noise_gain(dt: float, cutoff_hz: float, *, lowpassed: bool = False) -> float:
+    """The std [1/s] of :func:`filtered_derivative`'s output for white input noise of std 1.
+
+    .. math:: g = \\Big(\\sum_k h_k^2\\Big)^{1/2}
+
+    with ``h`` the impulse response (far from the ends) of :func:`filtered_derivative` at
+    the step ``dt`` [s] and ``cutoff_hz`` [Hz], followed by :func:`lowpass` at the same
+    cut-off with ``lowpassed`` (the velocities identification prepares from positions).
+    Velocities derived from positions with white noise of std ``s`` [rad] hold noise of
+    std ``g s`` [rad/s]."""
+    half = int(np.ceil(4.0 * edge_seconds(cutoff_hz) / dt)) + 8
+    x = np.zeros((2 * half + 1, 1))
+    x[half] = 1.0
+    h = filtered_derivative(dt * np.arange(2 * half + 1), x, cutoff_hz)[:, 0]
+    if lowpassed:
+        h = lowpass(h, 1.0 / dt, cutoff_hz)
+    return float(np.sqrt(np.sum(h**2)))
 
 
 def edge_seconds(cutoff_hz: float, motion_hz: float | None = None) -> float:

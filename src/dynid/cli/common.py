@@ -323,8 +323,10 @@ def add_consistency_options(p: argparse.ArgumentParser) -> None:
         type=nonnegative_type,
         default=None,
         metavar="W",
-        help="weight of the distance to the prior (default: the largest that keeps the data "
-        "residual RMS within 1 %% of the unconstrained fit; printed)",
+        help="weight of the distance to the prior (default, printed: from a torque log the "
+        "largest whose held-out error is within 1 %% of the best weight's; from coefficients "
+        "or static data the largest that keeps the data residual RMS within 1 %% of the "
+        "unconstrained fit)",
     )
     g.add_argument(
         "--objective",

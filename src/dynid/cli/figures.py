@@ -160,32 +160,26 @@ def save_identify_figures(
 
 def save_observer_figures(out: Path, result: ObserveResult, *, names: list[str]) -> list[Path]:
     """``out/<residuals name>.png`` of every log: residual, thresholds, events, and the true
-    external torques stored beside a simulated log (those skipped are left out)."""
+    external torques stored beside a simulated log (those skipped are left out). Everything
+    a figure computes is done inside :func:`~dynid.cli.common.save_figure`, so that a
+    figure that fails is skipped with a note and never fails the command."""
     paths = []
     labels = log_labels([x.path for x in result.logs])
     for x, stem, label in zip(result.logs, observation_names(result.logs), labels, strict=True):
-        if x.figure is not None:  # a detection's every k-th sample
-            f = x.figure
-            t, r, contact, collision, ext = f.t, f.r, f.contact, f.collision, f.tau_ext
-        elif x.r is not None:
-            t, r, ext = x.t, x.r, x.tau_ext
-            contact, collision = threshold_series(
-                result.thresholds, t.shape[0], x.std, x.standstill
-            )
-        else:  # a calibration that kept no series
+        if x.figure is None and x.r is None:  # a calibration that kept no series
             continue
 
-        def draw(
-            t: Any = t,
-            r: Any = r,
-            c: Any = contact,
-            k: Any = collision,
-            ext: Any = ext,
-            events: Any = x.events,
-            lab: str = label,
-        ) -> Any:
+        def draw(x: Any = x, lab: str = label) -> Any:
+            if x.figure is not None:  # a detection's every k-th sample
+                f = x.figure
+                t, r, contact, collision, ext = f.t, f.r, f.contact, f.collision, f.tau_ext
+            else:  # a calibration's whole series, NaN where not observed
+                t, r, ext = x.t, x.r, x.tau_ext
+                contact, collision = threshold_series(
+                    result.thresholds, t.shape[0], x.std, x.standstill
+                )
             return observer_plots.plot_residuals(
-                t, r, c, k, events=events, tau_ext=ext, joint_names=names,
+                t, r, contact, collision, events=x.events, tau_ext=ext, joint_names=names,
                 title=f"momentum observer on {lab}: residual, thresholds, events",
             )  # fmt: skip
 

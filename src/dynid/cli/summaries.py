@@ -16,6 +16,7 @@ from ..friction.model import friction_parts
 from ..friction.validation import NewtonEulerValidation
 from ..identification.info import LogInfo
 from ..identification.model import IdentifiedModel
+from ..identification.structure import MIN_WIDTH
 from ..io.observer_files import log_labels
 from ..observer.detection import undetected_at_rest
 from ..observer.results import LogObservation, ObserveResult
@@ -114,11 +115,16 @@ def term_lines(model: IdentifiedModel) -> list[str]:
             stem = lab.rstrip("0123456789")
             units[stem] = t.term.units[k] if k < len(t.term.units) else ""
             cells[(stem, int(lab[len(stem) :]))] = _coefficient(
-                float(t.values[k]), float(t.std[k]), bool(t.kept[k]), t.term.in_base
+                float(t.values[k]), float(t.std[k]), bool(t.kept[k]), bool(t.regrouped[k])
             )
         drive = getattr(t.term, "drive", None)
         row = "motor" if drive is not None and drive.friction_at == "motor" else "joint"
         n = getattr(drive, "n", None) or max(j for _, j in cells)
+        scales = _velocity_scales(t.term, n)
+        for stem, values in scales.items():
+            stems.append(stem)
+            units[stem] = "rad/s"
+            cells |= {(stem, j + 1): f"{float(x):.3g}" for j, x in enumerate(values)}
         heads = [f"{stem} [{units[stem]}]" if units[stem] else stem for stem in stems]
         widths = [
             max(len(h), *(len(cells.get((stem, j), "-")) for j in range(1, n + 1)))
@@ -132,13 +138,43 @@ def term_lines(model: IdentifiedModel) -> list[str]:
                 f"{cells.get((stem, j), '-'):<{w}}" for stem, w in zip(stems, widths, strict=True)
             ]
             out.append(f"  {j:<5}  " + "  ".join(cols).rstrip())
+        out += _scales_lines(scales, model)
     return out
 
 
-def _coefficient(value: float, std: float, kept: bool, in_base: bool) -> str:
+def _velocity_scales(term: Any, n: int) -> dict[str, tuple[float, ...]]:
+    """A friction term's velocities per joint (motor) [rad/s]: its standstill band and,
+    for a smooth Coulomb, its width (none for another term)."""
+    out = {}
+    for key in ("band", "width"):
+        v = getattr(term, key, ())
+        if isinstance(v, tuple) and len(v) == n and (key == "band" or "smooth" in term.parts):
+            out[key] = v
+    return out
+
+
+def _scales_lines(scales: dict[str, tuple[float, ...]], model: IdentifiedModel) -> list[str]:
+    """What the band and the smooth width of the friction table mean."""
+    if not scales:
+        return []
+    out = [
+        "  band: the standstill band of the velocities as prepared (5 std of their noise; of "
+        "velocities derived from positions, the positions' noise through the derivative filter)"
+    ]
+    if "width" in scales:
+        given = [str(x) for x in model.info.extra.get("terms", ()) if str(x).startswith("smooth")]
+        k = given[0].split(":")[1] if given and ":" in given[0] else "K"
+        out.append(
+            f"  width: the smooth Coulomb fc tanh(dq / width), smooth:{k} = {k} x max(band, "
+            f"{MIN_WIDTH:g} rad/s)"
+        )
+    return out
+
+
+def _coefficient(value: float, std: float, kept: bool, regrouped: bool) -> str:
     """One coefficient of a term's table (:func:`term_lines`)."""
     if not kept:
-        return "in beta" if in_base and not np.isfinite(std) else "-"
+        return "in beta" if regrouped else "-"
     if not np.isfinite(std) or not value:
         return f"{value:+.4g}"
     return f"{value:+.4g} ({abs(100.0 * std / value):.2g} %)"
@@ -353,12 +389,19 @@ def format_consistent(result: ConsistentResult) -> str:
             f"{r.pseudo_inertia_margin[i]:>19.3e}"
         )
     status = "CONSISTENT" if r.feasible else "NOT CONSISTENT WITH THE SPECIFICATION (closest set)"
+    over = f"{100 * (r.residual_ratio - 1):.3f} % above the unconstrained fit"
     lines += [
         f"total mass {float(np.sum(r.mass)):.4f} kg"
         + ("" if r.total_mass is None else f" (band {r.total_mass[0]:g}..{r.total_mass[1]:g} kg)"),
         f"{status}: method sdp ({r.options.objective}, prior {r.prior.source}), fit {r.fit}, "
-        f"relative residual on the coefficients {r.relative_residual:.3e}, data residual "
-        f"{100 * (r.residual_ratio - 1):.3f} % above the unconstrained fit",
+        f"relative residual on the coefficients {r.relative_residual:.3e}, "
+        + (
+            f"data residual {over}"
+            if r.heldout is None
+            else "judged on held-out data (below): its training residual, above least "
+            f"squares' by construction, does not decide ({over} in the covariance-weighted "
+            "data term)"
+        ),
         f"solver {r.solver}: {r.status}, {r.run_time:.2f} s",
     ]
     lines += consistent_structure_lines(r)
@@ -373,15 +416,50 @@ def format_consistent(result: ConsistentResult) -> str:
                 for j, (name, unit) in enumerate(zip(fr.names, fr.law.units, strict=True))
             )
         )
+    prior_masses, prior_rotors = _decided_by_prior(r)
     if r.rotor_inertia is not None:
         lines.append(
             "rotor inertia at the motors [kg m^2] (>= 0): "
-            + " ".join(f"{x:.4g}" for x in r.rotor_inertia)
+            + " ".join(
+                f"{x:.4g}" + ("*" if prior_rotors[m] else "") for m, x in enumerate(r.rotor_inertia)
+            )
+        )
+        if prior_rotors.any():
+            motors = ", ".join(str(m + 1) for m in np.flatnonzero(prior_rotors))
+            lines.append(
+                f"  * rotor(s) {motors}: the data give each only in a sum with link inertias "
+                "(in beta): the prior and the constraints decide its share"
+            )
+    if prior_masses:
+        lines.append(
+            "note: masses the data do not give (unidentifiable: "
+            + ", ".join(prior_masses)
+            + "): the prior, the bounds and the total-mass band decide them"
         )
     lines += [f"note: {s}" for s in r.notes]
     if not r.feasible:
         lines.append(str(r.report))
     return "\n".join(lines)
+
+
+def _decided_by_prior(r: ConsistentResult) -> tuple[list[str], NDArray[np.bool_]]:
+    """What the data of a one-step consistent fit do not give and the prior decides: the
+    unidentifiable link masses (their labels) and the rotors (n,) regrouped with link
+    inertias."""
+    n = 0 if r.rotor_inertia is None else len(r.rotor_inertia)
+    rotors = np.zeros(n, dtype=bool)
+    model = r.identified
+    if model is None:
+        return [], rotors
+    status = dict(zip(model.base.std_labels, identifiability(model.base), strict=True))
+    masses = [
+        f"m{i}" for i in range(1, model.robot.n + 1) if status.get(f"m{i}") == "unidentifiable"
+    ]
+    for t in model.terms.values():
+        shares = t.term.inertia(t.regrouped.astype(np.float64))
+        if shares is not None and shares.shape == rotors.shape:
+            rotors |= shares > 0
+    return masses, rotors
 
 
 def format_rms_table(names: list[str], columns: dict[str, np.ndarray]) -> str:

@@ -78,6 +78,18 @@ class IdentifiedTerm:
         return self.term.labels
 
     @property
+    def regrouped(self) -> NDArray[np.bool_]:
+        """(p,): the coefficients the data give only in a base combination with link
+        inertias (a term in the base: ``J1zz + J2yy + Ia1``), not on their own (no standard
+        deviation of their own); what splits such a sum is a prior, not the data."""
+        out: NDArray[np.bool_] = (
+            np.zeros(self.kept.shape, dtype=bool)
+            if not self.term.in_base
+            else ~self.kept & ~np.isfinite(self.std)
+        )
+        return out
+
+    @property
     def friction(self) -> FrictionValues | None:
         """The term as a friction law's parameters (None: not friction)."""
         return self.term.friction(self.values)

@@ -49,9 +49,10 @@ from ..model.drive import Drive
 from ..model.robot import Robot
 from ..signals import lowpass_noise_gain
 from .core import ModelColumns, RegressorBlock
+from .derived_band import derived_velocity_band
 from .holdout import DEFAULT_FOLDS, block_labels
 from .info import IdentificationInfo, LogInfo
-from .log import TorqueLog, joint_side_log
+from .log import DEFAULT_CUTOFF_HZ, TorqueLog, joint_side_log
 from .log_rows import log_blocks, still_columns
 from .pieces import (
     WRAP_SPAN,
@@ -147,7 +148,9 @@ class Recordings:
     band : ndarray, shape (n,)
         Standstill band [rad/s] per joint (motor, where the drive's friction acts there):
         the velocity noise band of the raw logs
-        (:func:`~dynid.identification.sanity.noise_band`).
+        (:func:`~dynid.identification.sanity.noise_band`); for velocities derived from the
+        positions, the noise they carry divided by ``band_gain``
+        (:mod:`~dynid.identification.derived_band`).
     skipped : tuple of str
         One line per piece left out (too short to filter).
     unwrapped : tuple of int
@@ -483,15 +486,19 @@ def prepare_recordings(
     if cutoff_hz == "auto" and cutoff is not None:  # read from the motion: recorded so
         f_q = cutoff / CUTOFF_MULTIPLE
         prepared = [dataclasses.replace(p, motion_frequency_hz=f_q) for p in prepared]
+    gain = lowpass_noise_gain(float(np.median([p.sample_rate for _, p in pieces])), cutoff)
+    # velocities derived from positions: at this cut-off and low-passed again when filtering,
+    # else as read (at the readers' default cut-off)
+    derived = (DEFAULT_CUTOFF_HZ if cutoff is None else cutoff, cutoff is not None, gain)
     return Recordings(
         pieces=tuple(prepared),
         recording=tuple(recording),
         names=names,
-        band=_band([piece for _, piece in pieces], drive),
+        band=_band([piece for _, piece in pieces], drive, derived),
         skipped=tuple(skipped),
         unwrapped=tuple(sorted(turned)),
-        bands=_bands([piece for _, piece in pieces], drive),
-        band_gain=lowpass_noise_gain(float(np.median([p.sample_rate for _, p in pieces])), cutoff),
+        bands=_bands([piece for _, piece in pieces], drive, derived),
+        band_gain=gain,
         max_gap_s=None if max_gap_s is None else float(max_gap_s),
         cuts=tuple(cuts),
         n_recorded=sum(log.n_samples for log in logs),
@@ -535,23 +542,42 @@ def _prepared(
     return prepared, recording, skipped, gone
 
 
-def _bands(pieces: list[TorqueLog], drive: Drive | None) -> dict[str, NDArray[np.float64]]:
+def _bands(
+    pieces: list[TorqueLog], drive: Drive | None, derived: tuple[float, bool, float]
+) -> dict[str, NDArray[np.float64]]:
     """The standstill bands at a drive's motors and at the joints (none without a drive)."""
     if drive is None:
         return {}
     places: tuple[Literal["motor", "joint"], ...] = ("motor", "joint")
-    return {at: _band(pieces, dataclasses.replace(drive, friction_at=at)) for at in places}
+    return {at: _band(pieces, dataclasses.replace(drive, friction_at=at), derived) for at in places}
 
 
-def _band(pieces: list[TorqueLog], drive: Drive | None) -> NDArray[np.float64]:
+def _band(
+    pieces: list[TorqueLog], drive: Drive | None, derived: tuple[float, bool, float]
+) -> NDArray[np.float64]:
     """The standstill band [rad/s] from the raw velocities of every piece (at the motors
-    where the drive's friction acts there)."""
-    if len(pieces) == 1:  # one piece: its velocities as they are, not a copy
-        dq = joint_side_log(pieces[0], drive).dq
-    else:
-        dq = np.concatenate([joint_side_log(p, drive).dq for p in pieces])
-    if drive is not None:
-        dq = dq @ drive.friction_transmission.T
-    if dq.shape[0] < 8:
-        return np.zeros(dq.shape[1])
-    return np.asarray(noise_band(velocity_noise_std(dq)), dtype=np.float64)
+    where the drive's friction acts there), per unit of ``band_gain``: measured ones' noise
+    band; for velocities derived from the positions, the positions' noise through the
+    derivative filter (:mod:`~dynid.identification.derived_band`; ``derived`` is its
+    cut-off, whether the preparation low-passes them again, and ``band_gain``), divided by
+    ``band_gain`` (the noise the prepared velocities hold is this band times it). The
+    larger of the two where both kinds of piece are given."""
+    sides = [joint_side_log(p, drive) for p in pieces]
+    K = None if drive is None else np.asarray(drive.friction_transmission)
+    measured = [x.dq for x, p in zip(sides, pieces, strict=True) if not p.dq_derived]
+    n = sides[0].dq.shape[1] if K is None else K.shape[0]
+    out = np.zeros(n)
+    if measured:
+        dq = measured[0] if len(measured) == 1 else np.concatenate(measured)
+        if K is not None:
+            dq = dq @ K.T
+        if dq.shape[0] >= 8:
+            out = np.asarray(noise_band(velocity_noise_std(dq)), dtype=np.float64)
+    cutoff, lowpassed, gain = derived
+    of_q = [
+        (x.t, x.q if K is None else x.q @ K.T)
+        for x, p in zip(sides, pieces, strict=True)
+        if p.dq_derived
+    ]
+    band = derived_velocity_band(of_q, cutoff, lowpassed=lowpassed) if of_q else None
+    return out if band is None else np.maximum(out, band / gain)

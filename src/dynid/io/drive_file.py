@@ -207,9 +207,14 @@ def drive_from_record(
 
 
 def drive_of_robot_file(spec: str | Path, n: int) -> Drive | None:
-    """The ``[drive]`` table of a robot TOML named by ``--robot``, or None (any other robot
-    source, or a TOML without one)."""
+    """The ``[drive]`` table of a robot TOML named by ``--robot``, the joints' armature of
+    an MJCF (:func:`~dynid.io.robot.mjcf_read.mjcf_drive`), or None (any other robot
+    source, or a file without one)."""
     p = Path(spec)
+    if p.suffix.lower() == ".xml" and p.is_file():
+        from .robot.mjcf_read import mjcf_drive
+
+        return mjcf_drive(p)
     if p.suffix.lower() != ".toml" or not p.is_file():
         return None
     try:

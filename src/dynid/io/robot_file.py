@@ -1,4 +1,5 @@
-"""One entry point for reading a robot: a built-in name, a URDF, a dynid TOML or a feasible.json.
+"""One entry point for reading a robot: a built-in name, a URDF, a dynid TOML, a feasible.json
+or an MJCF.
 
 :func:`load_robot` takes a name of :data:`dynid.model.builtin.BUILTIN_ROBOTS` (``"panda"``,
 ``"fr3"``) or picks the reader by the file's suffix; every command line option that names a
@@ -18,7 +19,7 @@ from ..model.robot import Robot
 __all__ = ["ROBOT_FILE_SUFFIXES", "load_robot"]
 
 #: Robot files :func:`load_robot` reads, by suffix.
-ROBOT_FILE_SUFFIXES = (".urdf", ".toml", ".json")
+ROBOT_FILE_SUFFIXES = (".urdf", ".toml", ".json", ".xml")
 
 
 def load_robot(
@@ -36,8 +37,9 @@ def load_robot(
     ``snap_angles``: :func:`dynid.io.robot.urdf.load_urdf`),
     ``.toml`` (:func:`dynid.io.robot.toml.load_toml`) or ``.json`` (a ``feasible.json``,
     :func:`dynid.io.feasible.load_feasible_json`, with the friction identified with the links
-    when the file holds it, acting where it was identified). ``what`` names the option in
-    errors.
+    when the file holds it, acting where it was identified) or ``.xml`` (an MJCF, read by
+    MuJoCo's compiler when the ``mujoco`` package is installed:
+    :func:`dynid.io.robot.mjcf_read.load_mjcf`). ``what`` names the option in errors.
 
     Raises
     ------
@@ -57,7 +59,8 @@ def load_robot(
         return builtin_robot(str(spec))
     if suffix not in ROBOT_FILE_SUFFIXES:
         raise DataError(
-            f"{what} must be {_names()} or a .urdf, .toml or .json (feasible.json) file; "
+            f"{what} must be {_names()} or a .urdf, .toml, .json (feasible.json) or .xml "
+            "(MJCF) file; "
             f"got {str(spec)!r}"
         )
     if not path.exists():
@@ -70,6 +73,10 @@ def load_robot(
         from .robot.toml import load_toml
 
         return load_toml(path)
+    if suffix == ".xml":
+        from .robot.mjcf_read import load_mjcf
+
+        return load_mjcf(path)
     from ..friction.model import FrictionSum
     from .feasible import load_feasible_json, load_feasible_linear_friction
 

@@ -160,12 +160,13 @@ def derived_velocity_bands(
     of its positions, the median over windows) times the filter's noise gain; zeros for
     fewer than 4 samples."""
     from ..identification.sanity import noise_band, velocity_noise_std
+    from ..signals import derivative_noise_gain
 
     parts = friction_parts(friction)
     N = q.shape[0]
     if N < 4:
         return tuple(np.zeros(p.n) for p in parts)
-    gain = _derivative_noise_gain(float(np.median(np.diff(t))), cutoff_hz)
+    gain = derivative_noise_gain(float(np.median(np.diff(t))), cutoff_hz)
     out = []
     for part in parts:
         K = np.asarray(part.transmission)
@@ -179,19 +180,6 @@ def derived_velocity_bands(
             sd[k] = np.median(est)
         out.append(np.asarray(noise_band(gain * sd), dtype=np.float64))
     return tuple(out)
-
-
-def _derivative_noise_gain(dt: float, cutoff_hz: float) -> float:
-    """``sqrt(sum h_k^2)`` [1/s] of the impulse response ``h`` of
-    :func:`~dynid.signals.filtered_derivative` at the step ``dt`` [s]: the std of its
-    output for white input noise of std 1."""
-    from ..signals import edge_seconds, filtered_derivative
-
-    half = int(np.ceil(4.0 * edge_seconds(cutoff_hz) / dt)) + 8
-    x = np.zeros((2 * half + 1, 1))
-    x[half] = 1.0
-    h = filtered_derivative(dt * np.arange(2 * half + 1), x, cutoff_hz)[:, 0]
-    return float(np.sqrt(np.sum(h**2)))
 
 
 def banded_if_narrow(

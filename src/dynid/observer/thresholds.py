@@ -14,7 +14,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from .. import _checks
-from ..exceptions import DataError
+from ..exceptions import DataError, ShapeError
 from .residual import ObserverOptions
 
 __all__ = ["Thresholds", "threshold_series"]
@@ -82,17 +82,35 @@ def threshold_series(
     """The contact and collision thresholds at every sample, each (N, n) [N m]: fixed, or
     ``k sigma + nu`` (and its ``collision_factor`` multiple) when ``std`` (N, n) is given
     and the thresholds use the model's uncertainty; plus the standstill margin
-    ``standstill`` (N, n) when given and the thresholds use it."""
+    ``standstill`` (N, n) when given and the thresholds use it.
+
+    ``std`` and ``standstill`` are NaN where the observer did not run (the edges of a
+    piece whose velocities are derived from the positions, where the residual is NaN
+    too): the thresholds are NaN at those samples.
+
+    Raises
+    ------
+    ShapeError
+        ``std`` or ``standstill`` not (N, n), or infinite.
+    """
     n = thresholds.n
     if std is not None and thresholds.uses_uncertainty:
         assert thresholds.k_sigma is not None and thresholds.noise is not None
-        s = _checks.as_exact("std", std, (N, n))
+        s = _unobserved_nan("std", std, (N, n))
         c = thresholds.k_sigma * s + thresholds.noise
         k = thresholds.collision_factor * c
     else:
         c = np.broadcast_to(thresholds.contact, (N, n)).copy()
         k = np.broadcast_to(thresholds.collision, (N, n)).copy()
     if standstill is not None and thresholds.standstill:
-        w = _checks.as_exact("standstill", standstill, (N, n))
+        w = _unobserved_nan("standstill", standstill, (N, n))
         c, k = c + w, k + w
     return c, k
+
+
+def _unobserved_nan(name: str, x: ArrayLike, shape: tuple[int, int]) -> NDArray[np.float64]:
+    """``x`` of ``shape``, finite or NaN (a sample not observed), never infinite."""
+    a = _checks.as_exact(name, x, shape, allow_nonfinite=True)
+    if np.any(np.isinf(a)):
+        raise ShapeError(f"{name} must be finite or NaN (not observed); got inf")
+    return a

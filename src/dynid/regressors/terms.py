@@ -391,8 +391,9 @@ class LinearFriction:
 
     def dissipation_rows(self, dq_max: NDArray[np.float64]) -> NDArray[np.float64]:
         """Rows ``G`` (m, p): ``G values >= 0`` says the friction opposes the motion,
-        ``f(v) >= 0`` for ``0 < v <= v_max`` of every motor (joint) (the offset left aside;
-        every part is odd in ``v``, so the negative velocities follow).
+        ``f(v) >= 0`` for ``0 < v <= v_max`` of every motor (joint), the offset left aside
+        (its column is zero in ``G``: a constant torque of either sign, not friction; every
+        other part is odd in ``v``, so the negative velocities follow).
 
         ``v_max`` of a motor is ``sum_j |K_mj| dq_max_j`` (:data:`DISSIPATION_VMAX` [rad/s]
         where a joint has no limit); the velocities checked: :data:`DISSIPATION_GRID` evenly
@@ -409,6 +410,8 @@ class LinearFriction:
         v = unit[:, None] * vmax[None, :]  # (s, n)
         band = np.asarray(self.band, dtype=np.float64) if self.band else np.zeros(n)
         F = self._part_columns(v, band)  # (s, n, k)
+        if "offset" in self.parts:  # not friction: the constant torque is of either sign
+            F[..., self.parts.index("offset")] = 0.0
         rows = []
         for m in range(n):
             moving = v[:, m] > band[m]

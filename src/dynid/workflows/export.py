@@ -183,7 +183,7 @@ def _check_params(params: str | Path) -> bool:
     path = Path(params)
     if path.suffix.lower() not in ROBOT_FILE_SUFFIXES:
         raise OptionError(
-            f"must be feasible.json, a robot .toml or .urdf, or "
+            f"must be feasible.json, a robot .toml, .urdf or .xml (MJCF), or "
             f"{' or '.join(map(repr, BUILTIN_ROBOTS))}; got {str(params)!r}",
             field="params",
         )

@@ -63,8 +63,8 @@ def load_prior(
         path = Path(spec)
         if path.suffix.lower() not in ROBOT_FILE_SUFFIXES:
             raise OptionError(
-                f"must be {' or '.join(map(repr, BUILTIN_ROBOTS))} or a .urdf, .toml or .json "
-                f"(feasible.json) file; got {spec!r}",
+                f"must be {' or '.join(map(repr, BUILTIN_ROBOTS))} or a .urdf, .toml, .json "
+                f"(feasible.json) or .xml (MJCF) file; got {spec!r}",
                 field="prior",
             )
         if not path.exists():
