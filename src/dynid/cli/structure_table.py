@@ -29,11 +29,15 @@ def selection_lines(selection: Any) -> list[str]:
         for c, (name, _, dropped) in zip(selection["candidates"], split, strict=True)
     ]
     w = text_width("structure", [name for name, _, _ in split], 46)
+    # the choice reads the held-out error with each joint in units of its own noise
+    white = any(c.get("heldout_whitened_percent") is not None for c in selection["candidates"])
     left = any(dropped for _, _, dropped in split)
     out = [
         f"model structure chosen on held-out data ({selection['validation']}): "
         f"{selection['chosen']} ({selection['rule']})",
-        f"    {'structure':<{w}} {'params':>6} {'train %':>9} {'held-out %':>11} {'se vs best':>10}"
+        f"    {'structure':<{w}} {'params':>6} {'train %':>9} {'held-out %':>11}"
+        + (f" {'whitened %':>11}" if white else "")
+        + f" {'se vs best':>10}"
         + ("  left out of the candidate its per-joint search began at" if left else ""),
     ]
     cands = selection["candidates"]
@@ -47,7 +51,9 @@ def selection_lines(selection: Any) -> list[str]:
         mark = "x" if skip and c.get("not_dissipative") else mark
         out.append(
             f"  {mark} {name:<{w}} {c['n_params']:>6} {c['train_error_percent']:>9.4g} "
-            f"{c['heldout_error_percent']:>11.4g} {_se_vs_best(c):>10}"
+            f"{c['heldout_error_percent']:>11.4g}"
+            + (f" {c.get('heldout_whitened_percent') or float('nan'):>11.4g}" if white else "")
+            + f" {_se_vs_best(c):>10}"
             + (f"  {_compact(dropped.split(' - '))}" if dropped else "")
         )
     if hidden:

@@ -41,7 +41,10 @@ __all__ = [
 
 
 #: How the structure is chosen (:func:`paired_se`).
-RULE = "simplest within one standard error of the lowest held-out error, paired over the folds"
+RULE = (
+    "simplest within one standard error of the lowest held-out error (each joint in units "
+    "of its own noise), paired over the folds"
+)
 #: Held-out errors closer than this fraction of the lowest one count as equal: a model
 #: that predicts 1 % better (relative) is not worth a term.
 RELATIVE_TIE = 0.01
@@ -76,6 +79,12 @@ class Candidate:
         A per-joint structure's coefficients left out from the candidate its search
         started at, every one (``fv1 .. fv7`` too when the name no longer holds
         ``viscous``).
+    whitened_error_percent : float or None
+        The held-out error [%] with every joint's torques in units of its own noise
+        (:attr:`~.holdout.HeldOut.whitened`): what the choice reads (:attr:`score`); None
+        when the noise is not known.
+    fold_whitened_percent : tuple of float
+        The same per fold.
     """
 
     structure: Structure
@@ -87,6 +96,20 @@ class Candidate:
     se_vs_best_percent: float = 0.0
     unphysical: tuple[str, ...] = ()
     left_out: tuple[str, ...] = ()
+    whitened_error_percent: float | None = None
+    fold_whitened_percent: tuple[float, ...] = ()
+
+    @property
+    def score(self) -> float:
+        """What the choice compares: the held-out error of the torques in units of each
+        joint's noise when known, else the held-out error [%]."""
+        w = self.whitened_error_percent
+        return self.heldout_error_percent if w is None else w
+
+    @property
+    def fold_scores(self) -> tuple[float, ...]:
+        """:attr:`score` per fold."""
+        return self.fold_whitened_percent or self.fold_errors_percent
 
     def as_dict(self) -> dict[str, Any]:
         """JSON-ready."""
@@ -101,6 +124,7 @@ class Candidate:
             "heldout_per_fold_percent": list(self.fold_errors_percent),
             "not_dissipative": list(self.unphysical),
             "left_out": list(self.left_out),
+            "heldout_whitened_percent": self.whitened_error_percent,
         }
 
 
@@ -114,7 +138,7 @@ def paired_se(c: Candidate, best: Candidate) -> float:
     call a consistently worse candidate as good as the best. The one-standard-error rule
     reads the spread of the differences instead. 0 for one fold (the folds of two
     candidates always match: the same held-out data)."""
-    a, b = c.fold_errors_percent, best.fold_errors_percent
+    a, b = c.fold_scores, best.fold_scores
     if len(a) < 2 or len(a) != len(b):
         return 0.0
     d = np.subtract(a, b)
@@ -197,6 +221,7 @@ def candidate_judged(
     xs = [t.solve(rtol) for t in sub.train]
     per_fold = [t.relative_error_percent(x) for t, x in zip(sub.test, xs, strict=True)]
     se = float(np.std(per_fold, ddof=1) / math.sqrt(len(per_fold))) if len(per_fold) > 1 else 0.0
+    white = [t.relative_error_percent(x) for t, x in zip(sub.whitened, xs, strict=True)]
     whole, whole_std = sub.whole.solve_with_std(rtol, std=check is not None)
     unphysical: tuple[str, ...] = ()
     if check is not None:
@@ -211,6 +236,8 @@ def candidate_judged(
         heldout_se_percent=se,
         fold_errors_percent=tuple(per_fold),
         unphysical=unphysical,
+        whitened_error_percent=sub.heldout_error_percent(xs, whitened=True) if white else None,
+        fold_whitened_percent=tuple(white),
     )
 
 
@@ -225,7 +252,8 @@ def without_recordings(model: IdentifiedModel, skip: tuple[int, ...]) -> HeldOut
     and every judgement."""
     held = heldout_of(model)
     kept = [t for j, t in enumerate(held.test) if j not in skip]
-    return replace(HeldOut.k_fold(kept), scheme=held.scheme, noise=held.noise)
+    white = tuple(t for j, t in enumerate(held.whitened) if j not in skip)
+    return replace(HeldOut.k_fold(kept), scheme=held.scheme, noise=held.noise, whitened=white)
 
 
 def recording_oddness(use: NDArray[np.bool_], model: IdentifiedModel, rtol: float) -> list[float]:

@@ -228,6 +228,11 @@ class HeldOut:
     noise : float
         Residual standard deviation of least squares on all data, ``sqrt(SSE / (m - p))``
         (scales a fold's data term).
+    whitened : tuple of Normals
+        What fold ``j`` predicts with each joint's rows divided by that joint's torque
+        noise (every joint counts in units of its own noise: a wrist whose noise is a
+        hundredth of the shoulder's is not lost in the pooled error); empty when the
+        noise is not known.
     """
 
     train: tuple[Normals, ...]
@@ -235,6 +240,7 @@ class HeldOut:
     whole: Normals
     scheme: str
     noise: float = 1.0
+    whitened: tuple[Normals, ...] = ()
 
     @classmethod
     def k_fold(cls, blocks: Sequence[Normals], test: Sequence[Normals] | None = None) -> HeldOut:
@@ -282,6 +288,7 @@ class HeldOut:
             self.whole.restricted(columns),
             self.scheme,
             self.noise,
+            tuple(t.restricted(columns) for t in self.whitened),
         )
 
     def expanded(self, mask: NDArray[np.bool_]) -> HeldOut:
@@ -292,15 +299,20 @@ class HeldOut:
             self.whole.expanded(mask),
             self.scheme,
             self.noise,
+            tuple(t.expanded(mask) for t in self.whitened),
         )
 
-    def heldout_error_percent(self, xs: Sequence[NDArray[np.float64]]) -> float:
+    def heldout_error_percent(
+        self, xs: Sequence[NDArray[np.float64]], *, whitened: bool = False
+    ) -> float:
         """Pooled held-out error [%] of one candidate per fold,
-        ``100 sqrt(sum_j SSE_j(x_j) / sum_j ||y_j||^2)``."""
-        if len(xs) != self.folds:
-            raise ShapeError(f"{len(xs)} candidates for {self.folds} folds")
-        sse = sum(t.sse(x) for t, x in zip(self.test, xs, strict=True))
-        c = sum(t.c for t in self.test)
+        ``100 sqrt(sum_j SSE_j(x_j) / sum_j ||y_j||^2)``; of the :attr:`whitened` rows
+        with ``whitened``."""
+        test = self.whitened if whitened else self.test
+        if len(xs) != len(test):
+            raise ShapeError(f"{len(xs)} candidates for {len(test)} folds")
+        sse = sum(t.sse(x) for t, x in zip(test, xs, strict=True))
+        c = sum(t.c for t in test)
         return 100.0 * math.sqrt(sse / c) if c > 0 else 0.0
 
     def describe(self) -> str:

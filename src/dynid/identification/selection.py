@@ -108,6 +108,7 @@ def _judge(
         how = "a separate recording"
     scheme = "recordings" if len(data.names) > 1 else "blocks"
     measured_ok = data.measured  # judged on the torques as measured: one more pass
+    inverse_noise = _inverse_noise(data)
 
     def judge(
         stack: RegressorStack | StreamedRows,
@@ -121,18 +122,23 @@ def _judge(
         if isinstance(stack, StreamedRows) and stack.normals is not None and validation is None:
             assert labels is not None  # the fit gathered the folds' normals by these labels
             judged = normals_by_label(rows, labels) if measured_ok else None
-            return replace(HeldOut.k_fold(stack.normals, judged), scheme=scheme).expanded(cols)
+            source = rows if measured_ok else selected_columns(stack.source, cols)
+            white = _whitened(source, labels, inverse_noise)
+            held = replace(HeldOut.k_fold(stack.normals, judged), scheme=scheme, whitened=white)
+            return held.expanded(cols)
         if isinstance(stack, StreamedRows):  # rows in blocks: one pass per set of labels
             source = selected_columns(stack.source, cols)
             e = np.concatenate([y - W @ b for W, y, _ in source()])
             rw = estimator.row_weights(e, np.tile(np.arange(data.n), e.size // data.n), b.size)
             m = e.size
             normals = lambda lab: normals_by_label(source, lab, rw)  # noqa: E731
+            fitted = source
         else:
             W = stack.W if cols.all() else stack.W[:, cols]
             rw = row_weights(estimator, W, stack.y, stack.groups, b)
             Ww, yw, m = W * rw[:, None], stack.y * rw, stack.y.size
             normals = lambda lab: block_normals(Ww, yw, lab)  # noqa: E731
+            fitted = lambda: iter([(Ww, yw, stack.groups)])  # noqa: E731
         if validation is not None:
             test = _normals(robot, validation, columns, cols, b, estimator)
             held = HeldOut.separate(normals(np.zeros(m, np.intp))[0], test)
@@ -140,10 +146,54 @@ def _judge(
             return None
         else:
             judged = normals_by_label(rows, labels, rw) if measured_ok else None
-            held = replace(HeldOut.k_fold(normals(labels), judged), scheme=scheme)
+            white = _whitened(rows if measured_ok else fitted, labels, inverse_noise, rw)
+            held = replace(HeldOut.k_fold(normals(labels), judged), scheme=scheme, whitened=white)
         return held.expanded(cols)
 
     return judge, how, (labels if validation is None else None)
+
+
+#: A joint's torque noise counts at least this share of the largest joint's in the
+#: whitened judgement (:func:`_inverse_noise`): a joint whose noise estimate is next to
+#: nothing (a quantised or filtered sensor) must not outweigh every other.
+NOISE_FLOOR_SHARE = 1e-2
+
+
+def _inverse_noise(data: Recordings) -> NDArray[np.float64] | None:
+    """Per joint, one over the torque noise std [1/(N m)] of the recordings (the samples'
+    mean square over the pieces, at least :data:`NOISE_FLOOR_SHARE` of the largest
+    joint's); None when a piece's noise is not known or no joint has any."""
+    noise = [p.torque_noise_std for p in data.pieces]
+    if not noise or any(x is None for x in noise):
+        return None
+    counts = np.array([p.log.n_samples for p in data.pieces], dtype=np.float64)
+    var = np.asarray(noise, dtype=np.float64) ** 2
+    sigma = np.sqrt(counts @ var / counts.sum())
+    top = float(np.max(sigma)) if sigma.size else 0.0
+    if not (np.all(np.isfinite(sigma)) and top > 0):
+        return None
+    return 1.0 / np.maximum(sigma, NOISE_FLOOR_SHARE * top)
+
+
+def _whitened(
+    source: BlockSource,
+    labels: NDArray[np.intp],
+    inverse_noise: NDArray[np.float64] | None,
+    weights: NDArray[np.float64] | None = None,
+) -> tuple[Normals, ...]:
+    """The folds' normal equations of ``source``'s rows (times ``weights``) with each
+    joint's rows divided by its noise (:attr:`~.holdout.HeldOut.whitened`); empty without
+    the noise."""
+    if inverse_noise is None:
+        return ()
+    inv = inverse_noise
+
+    def scaled() -> Any:
+        for W, y, g in source():
+            k = inv[np.asarray(g)]
+            yield W * k[:, None], y * k, g
+
+    return normals_by_label(scaled, labels, weights)
 
 
 def _rows(data: Recordings, robot: Robot, columns: ModelColumns) -> BlockSource:
@@ -210,9 +260,9 @@ def _within(c: Candidate, best: Candidate) -> bool:
     at most one standard error of the difference, paired over the folds
     (:func:`~.candidates.paired_se`), or by less than :data:`~.candidates.RELATIVE_TIE` of
     the lowest (or :data:`~.structure.ERROR_FLOOR_PERCENT`)."""
-    low = best.heldout_error_percent
+    low = best.score
     tie = max(paired_se(c, best), RELATIVE_TIE * low, ERROR_FLOOR_PERCENT)
-    return c.heldout_error_percent <= low + tie
+    return c.score <= low + tie
 
 
 def _chosen(candidates: Sequence[Candidate]) -> Structure:
@@ -220,7 +270,7 @@ def _chosen(candidates: Sequence[Candidate]) -> Structure:
     (:func:`_within`), among those whose friction is dissipative within the velocity
     limits."""
     candidates = _physical(candidates)
-    best = min(candidates, key=lambda c: c.heldout_error_percent)
+    best = min(candidates, key=lambda c: c.score)
     within = [c for c in candidates if _within(c, best)]
     # of as many parameters, the one with fewer terms: an armature whose every own rotor
     # is left out holds only rotors that regroup with the links (the same columns)
@@ -229,7 +279,7 @@ def _chosen(candidates: Sequence[Candidate]) -> Structure:
         key=lambda c: (
             c.n_params,
             c.structure.armature + len(c.structure.friction),
-            c.heldout_error_percent,
+            c.score,
         ),
     ).structure
 
@@ -322,7 +372,7 @@ def select_structure(
             where,
         )
     chosen = _chosen(judged)
-    best = min(_physical(judged), key=lambda c: c.heldout_error_percent)
+    best = min(_physical(judged), key=lambda c: c.score)
     judged = [replace(c, se_vs_best_percent=paired_se(c, best)) for c in judged]
     notes += _candidate_notes(judged)
     per: tuple[tuple[str, float], ...] = ()
@@ -462,8 +512,8 @@ def _per_joint(
     When the lowest held-out error is a candidate whose friction is not dissipative, its
     offending coefficients are left out first (:func:`_repaired`): a joint's small
     negative viscous coefficient does not cost the whole candidate its place."""
-    best_any = min(judged, key=lambda c: c.heldout_error_percent)
-    best = min(_physical(judged), key=lambda c: c.heldout_error_percent)
+    best_any = min(judged, key=lambda c: c.score)
+    best = min(_physical(judged), key=lambda c: c.score)
     repaired = None
     if best_any.unphysical and not best.unphysical:
         group = groups[where[best_any.structure]]
@@ -471,7 +521,7 @@ def _per_joint(
         if repaired is not None:
             where[repaired.structure] = where[best_any.structure]
     starts = [best, *([] if repaired is None else [repaired])]
-    best = min(starts, key=lambda c: c.heldout_error_percent)
+    best = min(starts, key=lambda c: c.score)
     chosen = _chosen(judged)
     starts += [c for c in judged if c.structure == chosen][:1]
     out: list[Candidate] = []
@@ -486,7 +536,7 @@ def _per_joint(
                 for c in _dropped(here, model, terms, held, n, rtol)
                 if not c.unphysical or here.unphysical
             ]
-            step = min(trials, key=lambda c: c.heldout_error_percent, default=None)
+            step = min(trials, key=lambda c: c.score, default=None)
             if step is None or not _within(step, best):
                 break
             here = step
@@ -533,7 +583,7 @@ def _repaired(
     while here.unphysical:
         step = min(
             _dropped(here, model, terms, held, n, rtol),
-            key=lambda c: (len(c.unphysical), c.heldout_error_percent),
+            key=lambda c: (len(c.unphysical), c.score),
             default=None,
         )
         if step is None or len(step.unphysical) >= len(here.unphysical):

@@ -17,6 +17,12 @@ unusable      50 % or more, or torques anti-correlated      check the data first
               with the model's (opposite sign)              robot, other units, other sign
 ============  ===========================================  ================================
 
+The pooled error is dominated by the joints of the largest torques: a wrist whose noise is
+a hundredth of the shoulder's can err ten times its noise within a pooled error at the
+floor. With each joint's error over its own noise known (``joint_ratios``), the level is
+also the worst joint's (the same thresholds, 1.5 and 3 x), never worse than ``poor``, and
+the reason names the joints above 1.5 x.
+
 At 50 % the model explains less than three quarters of the torques' square; at 100 % it
 errs as much as predicting no torque at all. The thresholds are this library's rules of
 thumb (1.5 and 3 x the floor, 5 and 15 %), the same for ``dynid validate``'s verdict line,
@@ -26,8 +32,12 @@ its exit status and the verdicts of the HTML reports.
 from __future__ import annotations
 
 import math
+from collections.abc import Sequence
 from dataclasses import dataclass
 from typing import Literal
+
+import numpy as np
+from numpy.typing import ArrayLike
 
 __all__ = [
     "FAIR_PERCENT",
@@ -38,6 +48,7 @@ __all__ = [
     "UNUSABLE_PERCENT",
     "Verdict",
     "judge_prediction",
+    "pooled_verdict",
     "worst",
 ]
 
@@ -85,6 +96,44 @@ def worst(*levels: Level) -> Level:
 
 
 def judge_prediction(
+    error_percent: float,
+    floor_percent: float | None = None,
+    *,
+    opposite_sign: bool = False,
+    joint_ratios: ArrayLike | None = None,
+    joint_names: Sequence[str] | None = None,
+) -> Verdict:
+    """The level of a prediction (module docstring): :func:`pooled_verdict`, made worse by
+    the worst of ``joint_ratios`` (each joint's RMS error over its torque noise), the
+    joints above :data:`FLOOR_GOOD` named (``joint_names``, default 1-based numbers)."""
+    v = pooled_verdict(error_percent, floor_percent, opposite_sign=opposite_sign)
+    if joint_ratios is None or np.size(joint_ratios) == 0 or v.level in ("poor", "unusable"):
+        return v
+    r = np.asarray(joint_ratios, dtype=np.float64)
+    bad = np.flatnonzero(np.isfinite(r) & (r > FLOOR_GOOD))
+    if bad.size == 0:
+        return v
+    names = list(joint_names) if joint_names is not None else [str(j + 1) for j in range(r.size)]
+    worst_r = float(np.max(r[bad]))
+    level: Level = "fair" if worst_r <= FLOOR_FAIR else "poor"
+    if LEVELS.index(level) <= LEVELS.index(v.level):
+        return v
+    which = ", ".join(f"{names[j]} ({r[j]:.2g} x)" for j in bad)
+    what = (
+        "effects outside the model remain there"
+        if level == "fair"
+        else ("the model misses effects the data show there (model terms, excitation, the drive)")
+    )
+    label = "usable" if level == "fair" else "poor"
+    return Verdict(
+        level,
+        label,
+        f"{v.reason.split(':')[0]}, but joint(s) {which} their noise: {what}",
+        v.ratio,
+    )
+
+
+def pooled_verdict(
     error_percent: float,
     floor_percent: float | None = None,
     *,

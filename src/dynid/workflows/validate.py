@@ -278,8 +278,14 @@ def _judged(
     spread = np.std(model, axis=0)
     loaded = spread > 0.05 * max(float(spread.max(initial=0.0)), 1e-300)
     opposite = anticorrelated(model - model.mean(axis=0), tau - tau.mean(axis=0), loaded)
+    # each joint's error over its noise (a noise next to nothing, as a filtered sensor's,
+    # counted at least a hundredth of the largest joint's)
+    ratios = np.asarray(errors.rms) / np.maximum(noise, 1e-2 * float(noise.max(initial=0.0)))
     verdict = judge_prediction(
-        errors.relative_error_percent, floor, opposite_sign=opposite is not None
+        errors.relative_error_percent,
+        floor,
+        opposite_sign=opposite is not None,
+        joint_ratios=ratios if np.all(noise > 0) else None,
     )
     return verdict, noise, floor
 
