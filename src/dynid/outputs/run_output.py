@@ -21,8 +21,10 @@
   the run did not write are never touched, except where it must write the same name:
   a file of another command's set, or a file no dynid run recorded (the user's), is
   replaced only with ``--force``; otherwise the run refuses before moving anything, with
-  a line naming the files. A single ``--out FILE`` is the file the user named and is
-  replaced.
+  a line naming the files. A single ``--out FILE`` is recorded in ``.dynid-files.json``
+  of its folder (command, size, modification time); the next run of the same command
+  replaces it, and a file that record does not hold as it is now (the user's, one another
+  command wrote, or one changed since) is replaced only with ``--force``.
 * **Read-only files** (no write permission) are never replaced without ``--force``. A
   read-only or foreign target is refused as soon as the run writes the file (before the
   command says it wrote it), and again when the set moves.
@@ -58,11 +60,14 @@ try:
 except ImportError:  # pragma: no cover - not POSIX
     fcntl = None  # type: ignore[assignment]
 
-__all__ = ["MANIFEST", "RunOutput", "run_output"]
+__all__ = ["FILES_RECORD", "MANIFEST", "RunOutput", "run_output"]
 
 #: Name of the record of a folder's output set (hidden, strict JSON).
 MANIFEST = ".dynid-run.json"
 _SCHEMA = "dynid-run/1"
+#: Name of the record, in a folder, of the single files that runs wrote there.
+FILES_RECORD = ".dynid-files.json"
+_FILES_SCHEMA = "dynid-files/1"
 _STAGING = ".dynid-"
 _log = logging.getLogger(__name__)
 #: Signals held back while a set moves into place (the command line turns them into exits).
@@ -155,6 +160,39 @@ def _read_manifest(folder: Path) -> dict | None:
     return doc
 
 
+def _read_files_record(folder: Path) -> dict[str, dict]:
+    """The single files recorded in ``folder``: name -> {command, size, mtime_ns, ...}
+    (empty when absent or unreadable: no file recorded)."""
+    try:
+        doc = load_json(folder / FILES_RECORD, schema=_FILES_SCHEMA, what="dynid file record")
+    except (OSError, DataError):
+        return {}
+    files = doc.get("files")
+    if not isinstance(files, dict):
+        return {}
+    return {k: v for k, v in files.items() if isinstance(k, str) and isinstance(v, dict)}
+
+
+def _file_state(path: Path) -> tuple[int, int]:
+    """What the record holds of a file to tell it unchanged: (size [bytes], mtime [ns])."""
+    st = path.stat()
+    return int(st.st_size), int(st.st_mtime_ns)
+
+
+def _recorded_writer(path: Path) -> str | None:
+    """The command whose run wrote the single file ``path`` as it is now, or None (no run
+    recorded it, or it changed since)."""
+    entry = _read_files_record(path.parent).get(path.name)
+    if entry is None or path.is_symlink() or not path.is_file():
+        return None
+    try:
+        same = (entry.get("size"), entry.get("mtime_ns")) == _file_state(path)
+    except OSError:
+        return None
+    command = entry.get("command")
+    return command if same and isinstance(command, str) else None
+
+
 def _write_manifest(folder: Path, doc: dict) -> None:
     """Write the record directly into ``folder`` (not staged), atomically, as strict JSON."""
     save_json(folder / MANIFEST, doc, schema=_SCHEMA)
@@ -224,6 +262,8 @@ class RunOutput:
             raise OutputError(f"{self.flag} {self.given}: is a folder; give a file name")
         if self.kind == "folder" and not self.force:
             self._check_other_command(_read_manifest(out) if out.is_dir() else None)
+        if self.kind == "file" and os.path.lexists(out):  # refused before any work
+            self._check_targets([out.name], set())
         parent = out.parent
         missing = []
         p = parent
@@ -314,6 +354,8 @@ class RunOutput:
         """True for this run's record of its set (``.dynid-run.json`` in ``--out`` or in
         the staging folder), which the run itself writes, puts back or removes."""
         p = Path(os.path.abspath(path))
+        if self.kind == "file":
+            return p.name == FILES_RECORD and p.parent == self.out.parent
         return p.name == MANIFEST and p.parent in (self.out, self.staging)
 
     def written(self) -> dict[str, Path]:
@@ -361,6 +403,10 @@ class RunOutput:
                 f"{'is' if len(read_only) == 1 else 'are'} read-only; pass --force to "
                 "replace, or choose another output"
             )
+        if self.kind == "file":
+            for n in names:
+                if os.path.lexists(base / n):
+                    self._check_single_file(base / n)
         if self.kind == "folder":
             foreign = [n for n in names if n not in owned and os.path.lexists(base / n)]
             if foreign:
@@ -370,6 +416,21 @@ class RunOutput:
                     f"{'it' if len(foreign) == 1 else 'them'} there; pass --force to replace, "
                     f"or choose another {self.flag}"
                 )
+
+    def _check_single_file(self, path: Path) -> None:
+        """Refuse to replace a single file that no run of this command wrote as it is."""
+        writer = _recorded_writer(path)
+        if writer == self.command:
+            return
+        if writer is not None:
+            raise OutputError(
+                f"{self.flag} {self.given}: holds the output of `dynid {writer}`; choose "
+                f"another {self.flag} or pass --force to replace it"
+            )
+        raise OutputError(
+            f"{self.flag} {self.given}: exists and no dynid run wrote it (or it changed "
+            f"since); pass --force to replace, or choose another {self.flag}"
+        )
 
     # ------------------------------------------------------------------ commit
     def _remove_stale_staging(self) -> None:
@@ -427,7 +488,26 @@ class RunOutput:
         self._check_targets(names, set())
         assert self.staging is not None
         os.replace(self.staging / names[0], self.out)
-        self._remove_stale_temporaries(self.out.parent, {self.out.name})
+        self._remove_stale_temporaries(self.out.parent, {self.out.name, FILES_RECORD})
+        self._record_file()
+
+    def _record_file(self) -> None:
+        """Record the file just moved into place in its folder's :data:`FILES_RECORD`
+        (the folder's lock held); entries of files no longer there are dropped."""
+        folder = self.out.parent
+        files = {k: v for k, v in _read_files_record(folder).items() if (folder / k).is_file()}
+        size, mtime = _file_state(self.out)
+        rec = self._record([self.out.name], "complete")
+        files[self.out.name] = {
+            "command": self.command,
+            "size": size,
+            "mtime_ns": mtime,
+            **{k: rec[k] for k in ("argv", "dynid", "time")},
+        }
+        try:
+            save_json(folder / FILES_RECORD, {"files": files}, schema=_FILES_SCHEMA)
+        except OSError as exc:  # the file is in place; only a later run's check is lost
+            _log.warning("could not record %s in %s: %s", self.out.name, FILES_RECORD, exc)
 
     def _commit_folder(self, names: list[str]) -> None:
         assert self.staging is not None
