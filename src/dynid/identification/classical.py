@@ -76,7 +76,13 @@ from .log_rows import (
 from .model import IdentifiedModel
 from .prepare import measured_torques, prepare_log
 from .rate import cutoff_from_motion, decimation, motion_frequency
-from .sanity import check_torque_log, moving_joints, opposite_sign, velocity_noise_std
+from .sanity import (
+    check_torque_log,
+    moving_joints,
+    opposite_sign,
+    too_few_samples,
+    velocity_noise_std,
+)
 from .streaming import BlockSource, normals_by_label
 
 __all__ = [
@@ -506,6 +512,8 @@ def prepare_torque_log(
         drive.check(n)
     fs = log.sample_rate
     jlog = joint_side_log(log, drive)
+    if (few := too_few_samples(jlog)) is not None:
+        raise DataError(few)
     if check and (opposite := opposite_sign(robot, jlog)) is not None:
         raise DataError(opposite)  # a fit would negate the masses
     for finding in check_torque_log(robot, jlog) if check else ():  # said first

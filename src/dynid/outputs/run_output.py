@@ -22,9 +22,9 @@
   a file of another command's set, or a file no dynid run recorded (the user's), is
   replaced only with ``--force``; otherwise the run refuses before moving anything, with
   a line naming the files. A single ``--out FILE`` is recorded in ``.dynid-files.json``
-  of its folder (command, size, modification time); the next run of the same command
-  replaces it, and a file that record does not hold as it is now (the user's, one another
-  command wrote, or one changed since) is replaced only with ``--force``.
+  of its folder (:mod:`.file_record`); the next run of the same command replaces it, and
+  a file that record does not hold as it is now (the user's, one another command wrote,
+  or one changed since) is replaced only with ``--force``.
 * **Read-only files** (no write permission) are never replaced without ``--force``. A
   read-only or foreign target is refused as soon as the run writes the file (before the
   command says it wrote it), and again when the set moves.
@@ -46,7 +46,6 @@ import os
 import shutil
 import signal
 import tempfile
-import threading
 import time
 from collections.abc import Iterator, Sequence
 from pathlib import Path
@@ -54,6 +53,8 @@ from pathlib import Path
 from ..exceptions import DataError, OutputError
 from ..io import atomic
 from ..io.json_files import load_json, save_json
+from .file_record import FILES_RECORD, record_file, recorded_writer
+from .held_signals import signals_held
 
 try:
     import fcntl
@@ -65,15 +66,8 @@ __all__ = ["FILES_RECORD", "MANIFEST", "RunOutput", "run_output"]
 #: Name of the record of a folder's output set (hidden, strict JSON).
 MANIFEST = ".dynid-run.json"
 _SCHEMA = "dynid-run/1"
-#: Name of the record, in a folder, of the single files that runs wrote there.
-FILES_RECORD = ".dynid-files.json"
-_FILES_SCHEMA = "dynid-files/1"
 _STAGING = ".dynid-"
 _log = logging.getLogger(__name__)
-#: Signals held back while a set moves into place (the command line turns them into exits).
-_HELD = tuple(
-    getattr(signal, s) for s in ("SIGINT", "SIGTERM", "SIGHUP", "SIGQUIT") if hasattr(signal, s)
-)
 
 
 def _flock(fd: int, *, block: bool) -> bool:
@@ -102,45 +96,6 @@ def _folder_lock(folder: Path) -> Iterator[None]:
         os.close(fd)  # releases the lock
 
 
-@contextlib.contextmanager
-def _signals_held() -> Iterator[list[int]]:
-    """Hold the termination signals back inside the block; yields the list of those that
-    arrived meanwhile (filled when the block ends), which are not delivered when the block
-    ends normally and are delivered again when it raises.
-
-    Blocked in this thread, and, in the main thread, their handlers replaced by a record
-    of their arrival: a signal that another thread takes still runs its handler in the
-    main thread, and one left pending would arrive right after the block, both when the
-    set is already in place (a complete folder, and an exit as interrupted).
-    """
-    arrived: list[int] = []
-    handlers = {}
-    if threading.current_thread() is threading.main_thread():
-        for s in _HELD:
-            h = signal.getsignal(s)
-            if h is not None:  # a handler Python can put back
-                handlers[s] = h
-                signal.signal(s, lambda signum, frame: arrived.append(signum))
-    blocking = hasattr(signal, "pthread_sigmask")
-    old = signal.pthread_sigmask(signal.SIG_BLOCK, _HELD) if blocking else set()
-    ok = False
-    try:
-        yield arrived
-        ok = True
-    finally:
-        if blocking:
-            for s in sorted(signal.sigpending() & set(_HELD)):  # taken here, not after
-                with contextlib.suppress(OSError):
-                    if signal.sigtimedwait([s], 0) is not None:
-                        arrived.append(s)
-            signal.pthread_sigmask(signal.SIG_SETMASK, old)
-        for s, h in handlers.items():
-            signal.signal(s, h)
-        if not ok:
-            for s in dict.fromkeys(arrived):  # the set did not move: stop as asked
-                signal.raise_signal(s)
-
-
 def _is_temporary(name: str, targets: set[str]) -> bool:
     """``.<target>.<random>.tmp<suffix>``: a writer's temporary file of one of ``targets``."""
     if not name.startswith(".") or ".tmp" not in name:
@@ -160,42 +115,14 @@ def _read_manifest(folder: Path) -> dict | None:
     return doc
 
 
-def _read_files_record(folder: Path) -> dict[str, dict]:
-    """The single files recorded in ``folder``: name -> {command, size, mtime_ns, ...}
-    (empty when absent or unreadable: no file recorded)."""
-    try:
-        doc = load_json(folder / FILES_RECORD, schema=_FILES_SCHEMA, what="dynid file record")
-    except (OSError, DataError):
-        return {}
-    files = doc.get("files")
-    if not isinstance(files, dict):
-        return {}
-    return {k: v for k, v in files.items() if isinstance(k, str) and isinstance(v, dict)}
-
-
-def _file_state(path: Path) -> tuple[int, int]:
-    """What the record holds of a file to tell it unchanged: (size [bytes], mtime [ns])."""
-    st = path.stat()
-    return int(st.st_size), int(st.st_mtime_ns)
-
-
-def _recorded_writer(path: Path) -> str | None:
-    """The command whose run wrote the single file ``path`` as it is now, or None (no run
-    recorded it, or it changed since)."""
-    entry = _read_files_record(path.parent).get(path.name)
-    if entry is None or path.is_symlink() or not path.is_file():
-        return None
-    try:
-        same = (entry.get("size"), entry.get("mtime_ns")) == _file_state(path)
-    except OSError:
-        return None
-    command = entry.get("command")
-    return command if same and isinstance(command, str) else None
-
-
 def _write_manifest(folder: Path, doc: dict) -> None:
     """Write the record directly into ``folder`` (not staged), atomically, as strict JSON."""
     save_json(folder / MANIFEST, doc, schema=_SCHEMA)
+
+
+def _can_write(folder: Path) -> bool:
+    """Whether this process may create files in ``folder`` (always, for root)."""
+    return os.access(folder, os.W_OK | os.X_OK)
 
 
 def _writable(path: Path) -> bool:
@@ -274,15 +201,35 @@ class RunOutput:
             raise OutputError(
                 f"{self.flag} {self.given}: {p} is a file, not a folder; choose another {self.flag}"
             )
-        parent.mkdir(parents=True, exist_ok=True)
-        self._created_parents = missing  # deepest first
-        with _folder_lock(parent):
-            self._remove_stale_staging()
-            self.staging = Path(
-                tempfile.mkdtemp(dir=parent, prefix=f".{out.name}{_STAGING}", suffix="")
+        # checked before any work: a run that cannot put its files in place would compute,
+        # say "wrote ..." and fail on a hidden temporary file
+        if self.kind == "folder" and out.is_dir() and not _can_write(out):
+            raise OutputError(
+                f"{self.flag} {self.given}: this folder is not writable (permission denied); "
+                f"choose another {self.flag}"
             )
-            self._fd = os.open(self.staging, os.O_RDONLY)
-            _flock(self._fd, block=False)
+        if not _can_write(p):
+            where = "the folder" if p == parent else "the nearest existing folder"
+            raise OutputError(
+                f"{self.flag} {self.given}: {where} {p} is not writable (permission denied; "
+                f"the outputs are staged beside {self.flag}); choose another {self.flag}"
+            )
+        try:
+            parent.mkdir(parents=True, exist_ok=True)
+            self._created_parents = missing  # deepest first
+            with _folder_lock(parent):
+                self._remove_stale_staging()
+                self.staging = Path(
+                    tempfile.mkdtemp(dir=parent, prefix=f".{out.name}{_STAGING}", suffix="")
+                )
+                self._fd = os.open(self.staging, os.O_RDONLY)
+                _flock(self._fd, block=False)
+        except OSError as exc:
+            self._close(False)
+            raise OutputError(
+                f"{self.flag} {self.given}: cannot write there ({exc.strerror or exc}); "
+                f"choose another {self.flag}"
+            ) from exc
         atomic._REDIRECTS.append(self)
 
     def close(self, ok: bool) -> None:
@@ -296,7 +243,7 @@ class RunOutput:
         if not ok:
             self._close(ok)
             return
-        with _signals_held() as arrived:
+        with signals_held() as arrived:
             self._close(ok)
         if arrived and self.committed:
             names = ", ".join(signal.Signals(s).name for s in dict.fromkeys(arrived))
@@ -419,7 +366,7 @@ class RunOutput:
 
     def _check_single_file(self, path: Path) -> None:
         """Refuse to replace a single file that no run of this command wrote as it is."""
-        writer = _recorded_writer(path)
+        writer = recorded_writer(path)
         if writer == self.command:
             return
         if writer is not None:
@@ -475,11 +422,17 @@ class RunOutput:
     def _commit(self) -> None:
         assert self.staging is not None
         names = list(self.written())
-        with _folder_lock(self.out.parent):
-            if self.kind == "file":
-                self._commit_file(names)
-            else:
-                self._commit_folder(names)
+        try:
+            with _folder_lock(self.out.parent):
+                if self.kind == "file":
+                    self._commit_file(names)
+                else:
+                    self._commit_folder(names)
+        except OSError as exc:  # a failed move puts back what --out held (_move_into)
+            raise OutputError(
+                f"{self.flag} {self.given}: the outputs could not be put in place "
+                f"({exc.strerror or exc}); choose another {self.flag}"
+            ) from exc
         self.committed = True
 
     def _commit_file(self, names: list[str]) -> None:
@@ -492,22 +445,9 @@ class RunOutput:
         self._record_file()
 
     def _record_file(self) -> None:
-        """Record the file just moved into place in its folder's :data:`FILES_RECORD`
-        (the folder's lock held); entries of files no longer there are dropped."""
-        folder = self.out.parent
-        files = {k: v for k, v in _read_files_record(folder).items() if (folder / k).is_file()}
-        size, mtime = _file_state(self.out)
+        """Record the file just moved into place (:mod:`.file_record`)."""
         rec = self._record([self.out.name], "complete")
-        files[self.out.name] = {
-            "command": self.command,
-            "size": size,
-            "mtime_ns": mtime,
-            **{k: rec[k] for k in ("argv", "dynid", "time")},
-        }
-        try:
-            save_json(folder / FILES_RECORD, {"files": files}, schema=_FILES_SCHEMA)
-        except OSError as exc:  # the file is in place; only a later run's check is lost
-            _log.warning("could not record %s in %s: %s", self.out.name, FILES_RECORD, exc)
+        record_file(self.out, self.command, **{k: rec[k] for k in ("argv", "dynid", "time")})
 
     def _commit_folder(self, names: list[str]) -> None:
         assert self.staging is not None
