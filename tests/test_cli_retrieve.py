@@ -154,7 +154,8 @@ def test_retrieve_single_step_from_static_data_with_a_bounds_file(tmp_path, caps
         ([], "not a JSON file"),
         (["--method", "penalty", "--runs", "0"], "--runs"),
         (["--prior", "missing.urdf"], "does not exist"),
-        (["--prior-weight", "-2"], "--prior-weight: must be a finite number >= 0"),
+        (["--prior-weight", "-2"], "--prior-weight: must be a finite number > 0"),
+        (["--prior-weight", "0"], "--prior-weight: must be a finite number > 0"),
         (["--total-mass", "5,1"], "--total-mass"),
     ],
 )

@@ -24,7 +24,7 @@ from pathlib import Path
 import pytest
 
 from dynid.cli.__main__ import main
-from dynid.outputs.run_output import MANIFEST
+from dynid.outputs.run_output import FILES_RECORD, MANIFEST
 
 pytestmark = pytest.mark.skipif(sys.platform == "win32", reason="POSIX locks and signals")
 
@@ -71,7 +71,10 @@ def _snapshot(folder: Path) -> dict[str, tuple[bytes, int]]:
 
 
 def _staging(parent: Path) -> list[str]:
-    return sorted(p.name for p in parent.iterdir() if ".dynid-" in p.name)
+    """Staging folders and leftovers (the record of single files is no leftover)."""
+    return sorted(
+        p.name for p in parent.iterdir() if ".dynid-" in p.name and p.name != FILES_RECORD
+    )
 
 
 def _complete_set(folder: Path) -> list[str]:
@@ -335,7 +338,7 @@ def test_a_file_out_is_staged_too(tmp_path):
     _, err = proc.communicate(timeout=60)
     assert proc.returncode == 143, err
     assert log.read_bytes() == before
-    assert sorted(p.name for p in tmp_path.iterdir()) == ["log.csv"]
+    assert sorted(p.name for p in tmp_path.iterdir()) == [FILES_RECORD, "log.csv"]
 
 
 def test_library_writers_outside_a_run_are_unchanged(tmp_path):

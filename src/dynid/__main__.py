@@ -2,6 +2,10 @@
 
 import sys
 
-from .cli.__main__ import main
+try:
+    from .cli.__main__ import main
+except KeyboardInterrupt:  # Ctrl-C while the (light) entry module loads
+    print("dynid: interrupted; no partial output left", file=sys.stderr)
+    sys.exit(130)
 
 sys.exit(main())

@@ -33,16 +33,19 @@ import signal
 import sys
 import warnings
 from collections.abc import Iterator, Sequence
-from typing import TextIO
+from typing import TYPE_CHECKING, TextIO
 
 from .. import __version__
-from .._checks import one_line
 from ..exceptions import DynidError, OptionError
-from ..io.atomic import output_transaction
-from ..outputs.run_output import RunOutput, run_output
-from .applies import check_applies, given_options
-from .console import Console, log_to_stderr
-from .run_report import RunRecord, save_run_report
+
+if TYPE_CHECKING:
+    from ..outputs.run_output import RunOutput
+    from .console import Console
+
+# This module imports the standard library alone at its top (and the package's light
+# ``dynid/__init__``): the library and numpy are imported inside :func:`main`, whose
+# Ctrl-C handling covers them (an interrupt during the imports, the first seconds of a
+# run on a loaded machine, is one line and exit 130, not a traceback).
 
 #: Longest error line printed [characters]: a message echoing megabytes of input keeps
 #: its start and its end (the hint).
@@ -232,6 +235,8 @@ def _decoded(value: str) -> str:
 @contextlib.contextmanager
 def _output_set(args: argparse.Namespace, argv: Sequence[str]) -> Iterator[RunOutput | None]:
     """The run's output set under ``--out`` (:func:`dynid.outputs.run_output.run_output`)."""
+    from ..outputs.run_output import run_output
+
     kind, out = getattr(args, "_output", None), getattr(args, "out", None)
     if kind is None or out is None:
         yield None
@@ -251,6 +256,13 @@ def main(argv: Sequence[str] | None = None) -> int:
     """
     try:
         return _main(argv)
+    except KeyboardInterrupt:  # while the modules are imported, before the run's own handler
+        if "--debug" in (sys.argv[1:] if argv is None else argv):
+            raise
+        command = _command(sys.argv[1:] if argv is None else argv)
+        name = "dynid" if command is None else f"dynid {command.replace('_', '-')}"
+        print(f"{name}: interrupted; no partial output left", file=_stderr())
+        return 130
     finally:
         if argv is None:
             for sig in (signal.SIGINT, *TERMINATING):
@@ -258,6 +270,12 @@ def main(argv: Sequence[str] | None = None) -> int:
 
 
 def _main(argv: Sequence[str] | None) -> int:
+    from .._checks import one_line
+    from ..io.atomic import output_transaction
+    from .applies import check_applies, given_options
+    from .console import Console, log_to_stderr
+    from .run_report import RunRecord, save_run_report
+
     _printable_streams()
     argv = join_negative_values(sys.argv[1:] if argv is None else list(argv))
     command = _command(argv)

@@ -320,7 +320,7 @@ def add_consistency_options(p: argparse.ArgumentParser) -> None:
     g.add_argument("--prior-tip", default=None, help="URDF tip link of the prior's chain")
     g.add_argument(
         "--prior-weight",
-        type=nonnegative_type,
+        type=positive_type,  # > 0: without the prior, what the data leave free has no one value
         default=None,
         metavar="W",
         help="weight of the distance to the prior (default, printed: from a torque log the "

@@ -332,12 +332,28 @@ def format_retrieval(result: RetrievalResult) -> str:
             if r.report.select(n)
         )
         + (f", total mass {_band_margin(r):.3g} kg" if r.report.select("total_mass_min") else ""),
-        f"stage costs {', '.join(f'{x:.3g}' for x in r.stage_costs)}; "
-        f"{r.run_time:.1f} s on {r.workers} worker(s), seed {r.seed}",
+        f"{_stage_costs(r.stage_costs)}; {r.run_time:.1f} s on {r.workers} worker(s), "
+        f"seed {r.seed}",
     ]
     if not r.feasible:
         lines.append(str(r.report))
     return "\n".join(lines)
+
+
+#: Stage costs printed in full up to this many; more: the first and last three.
+_STAGE_COSTS_SHOWN = 8
+
+
+def _stage_costs(costs: NDArray[np.float64]) -> str:
+    """``stage costs a, b, c``; a long schedule as its first and last three and the count
+    (every cost is in report.json)."""
+    shown = [f"{x:.3g}" for x in costs]
+    if len(shown) <= _STAGE_COSTS_SHOWN:
+        return f"stage costs {', '.join(shown)}"
+    return (
+        f"stage costs {', '.join(shown[:3])}, ..., {', '.join(shown[-3:])} ({len(shown)} "
+        "stages; all in report.json)"
+    )
 
 
 def consistent_structure_lines(result: ConsistentResult) -> list[str]:

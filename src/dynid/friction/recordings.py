@@ -40,7 +40,7 @@ from ..exceptions import DataError, OptionError
 from ..identification.log import TorqueLog, joint_side_log
 from ..identification.metrics import TorqueErrors
 from ..identification.model import IdentifiedModel
-from ..identification.pieces import recording_pieces, skipped_piece, wrappable
+from ..identification.pieces import check_below_nyquist, recording_pieces, skipped_piece, wrappable
 from ..identification.prepare import Preprocessing, prepare_log
 from ..identification.sanity import velocity_noise_std
 from ..identification.trim import common_cutoff, edge_seconds
@@ -271,6 +271,7 @@ def _raw_pieces(
         cut = recorded_cutoff(model, jpieces, labels) if isinstance(cutoff_hz, str) else cutoff_hz
     if trim_s is None:
         trim_s = edge_seconds(jpieces, labels, cut, from_motion=from_motion, turns=jturns)
+    check_below_nyquist(jpieces, None if isinstance(cutoff_hz, str) else cut)  # as given
     return _Raw(raw, names, cut, trim_s, tuple(sorted(turned)), d)
 
 
@@ -306,10 +307,11 @@ def _check_kept(raw: _Raw, recording: list[int]) -> None:
     """Refuse a recording left without any piece long enough to filter (named)."""
     lost = [raw.names[r] for r in range(len(raw.names)) if r not in recording]
     if lost:
-        raise DataError(
-            f"{', '.join(lost)}: no piece long enough to filter at {raw.cutoff_hz or 0:.4g} Hz "
-            "(gaps longer than --max-gap cut a recording into pieces); hint: record longer "
-            "stretches without gaps, or raise --max-gap"
+        raise DataError(  # the file named once (a caller's in_file adds no second name)
+            f"no piece long enough to filter at {raw.cutoff_hz or 0:.4g} Hz (gaps longer "
+            "than --max-gap cut a recording into pieces); hint: record longer stretches "
+            "without gaps, or raise --max-gap",
+            file=", ".join(lost),
         )
 
 

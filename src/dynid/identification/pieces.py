@@ -30,11 +30,12 @@ from ..exceptions import DataError, DynidWarning, OptionError
 from ..model.drive import Drive
 from ..model.robot import Robot
 from .log import TorqueLog, default_max_gap
-from .sanity import time_unit_finding
+from .sanity import time_unit_finding, too_few_samples
 
 __all__ = [
     "Q_START_TOLERANCE",
     "WRAP_SPAN",
+    "check_below_nyquist",
     "joined",
     "nearest_turns",
     "recording_pieces",
@@ -49,6 +50,26 @@ __all__ = [
 #: Positions recorded wrapped span at most this many turns (one, and the noise or offset
 #: a logger may add after wrapping).
 WRAP_SPAN = 1.05
+
+
+def check_below_nyquist(pieces: list[TorqueLog], cutoff_hz: float | None) -> None:
+    """Refuse a cut-off [Hz] at or above half the sample rate of every piece: no piece can
+    be filtered at it, whatever its length (the cut-off is at fault, not the recording).
+
+    Raises
+    ------
+    OptionError
+        ``cutoff_hz`` (``field``), with the sample rate.
+    """
+    rates = [p.sample_rate for p in pieces if p.n_samples >= 2]
+    if cutoff_hz is None or not rates or any(cutoff_hz < 0.5 * fs for fs in rates):
+        return
+    fs = max(rates)
+    raise OptionError(
+        f"{cutoff_hz:g} Hz: must be below half the sample rate, {0.5 * fs:.4g} Hz (the "
+        f"recording is sampled at {fs:.4g} Hz)",
+        field="cutoff_hz",
+    )
 
 
 def split_at_gaps(
@@ -174,12 +195,15 @@ def recording_pieces(
     Raises
     ------
     DataError
-        The time column looks like ms, us or ns (the file and the factor are named); a
+        Too few samples (:func:`~dynid.identification.sanity.too_few_samples`); the time
+        column looks like ms, us or ns (the file and the factor are named); a
         motor-side log's motors recorded wrapped whose turns the joints' limits do not
         tell (:func:`start_turns`).
     OptionError
         ``max_gap_s`` below the sample step.
     """
+    if (few := too_few_samples(log)) is not None:  # before any statistic of it
+        raise DataError(few, file=name)
     if (unit := time_unit_finding(name, log)) is not None:  # it names the file
         raise DataError(unit.removeprefix(f"{name}: "), file=name)
     pieces: list[TorqueLog] = []

@@ -29,7 +29,13 @@ from .log import LogCleaning, TorqueLog, joint_side_log
 from .log_rows import log_blocks, still_columns, still_friction
 from .prepare import Preprocessing, measured_torques, prepare_log
 from .rate import cutoff_from_motion, decimation, motion_frequency
-from .sanity import check_torque_log, moving_joints, opposite_sign, velocity_noise_std
+from .sanity import (
+    check_torque_log,
+    moving_joints,
+    opposite_sign,
+    too_few_samples,
+    velocity_noise_std,
+)
 
 __all__ = ["PreparedLog", "prepare_torque_log"]
 
@@ -196,6 +202,8 @@ def prepare_torque_log(
         drive.check(n)
     fs = log.sample_rate
     jlog = joint_side_log(log, drive)
+    if (few := too_few_samples(jlog)) is not None:
+        raise DataError(few)
     if check and (opposite := opposite_sign(robot, jlog)) is not None:
         raise DataError(opposite)  # a fit would negate the masses
     for finding in check_torque_log(robot, jlog) if check else ():  # said first

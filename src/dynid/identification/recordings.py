@@ -56,6 +56,7 @@ from .log import DEFAULT_CUTOFF_HZ, TorqueLog, joint_side_log
 from .log_rows import log_blocks, still_columns
 from .pieces import (
     WRAP_SPAN,
+    check_below_nyquist,
     joined,
     recording_pieces,
     skipped_piece,
@@ -462,6 +463,8 @@ def prepare_recordings(
         )
         if cutoff is None:
             raise DataError("no piece is long enough to read the motion's frequency from")
+    else:
+        check_below_nyquist([joint_side_log(p, drive) for _, p in pieces], cutoff)
     if trim_s is not None:
         edge: float | None = trim_s
     else:
@@ -482,7 +485,7 @@ def prepare_recordings(
     used = sorted(set(recording))
     if len(used) < len(names):
         lost = [names[r] for r in range(len(names)) if r not in used]
-        raise DataError(f"{', '.join(lost)}: no piece long enough to filter{_at(cutoff)}")
+        raise DataError(f"no piece long enough to filter{_at(cutoff)}", file=", ".join(lost))
     if cutoff_hz == "auto" and cutoff is not None:  # read from the motion: recorded so
         f_q = cutoff / CUTOFF_MULTIPLE
         prepared = [dataclasses.replace(p, motion_frequency_hz=f_q) for p in prepared]

@@ -58,9 +58,11 @@ __all__ = [
     "opposite_sign",
     "moving_joints",
     "noise_band",
+    "MIN_LOG_SAMPLES",
     "SPIKE_SIGMAS",
     "spike_finding",
     "time_unit_finding",
+    "too_few_samples",
     "torque_spikes",
     "velocity_noise_std",
     "velocity_rate_factor",
@@ -141,6 +143,24 @@ def noise_band(noise_std: ArrayLike) -> NDArray[np.float64]:
     """
     out: NDArray[np.float64] = NOISE_BAND_STD * np.asarray(noise_std, dtype=np.float64)
     return out
+
+
+#: Fewest samples of a recording that the checks and the filter are asked to read: two
+#: samples correlate at +-1 with anything, three give one curvature.
+MIN_LOG_SAMPLES = 10
+
+
+def too_few_samples(log: TorqueLog) -> str | None:
+    """The finding that ``log`` holds too few samples to be checked or filtered (fewer
+    than :data:`MIN_LOG_SAMPLES`), or None; said before any statistic of it."""
+    n = log.n_samples
+    if n >= MIN_LOG_SAMPLES:
+        return None
+    return (
+        f"{n} sample{'' if n == 1 else 's'}: too few to check or filter a torque log (at "
+        f"least {MIN_LOG_SAMPLES} are needed); hint: check that the file holds the whole "
+        "recording"
+    )
 
 
 def moving_joints(dq: ArrayLike, noise_std: ArrayLike | None = None) -> NDArray[np.bool_]:

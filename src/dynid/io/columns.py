@@ -225,6 +225,13 @@ class _Table:
     groups: dict[str, tuple[list[str], NDArray[np.float64]]] = field(default_factory=dict)
     #: the quantities whose groups were scaled to SI as they were read (in place)
     scaled: set[str] = field(default_factory=set)
+    #: every column (CSV header) or array (NPZ) of the file, read or not, in file order
+    header: list[str] = field(default_factory=list)
+
+    def has(self) -> str:
+        """``the file has [...]`` for messages: its first 12 columns (or arrays)."""
+        names = self.header or list(self.columns)
+        return f"the file has {names[:12]}{'...' if len(names) > 12 else ''}"
 
 
 def _read_table(path: Path, cmap: ColumnMap, quantities: tuple[str, ...]) -> _Table:
@@ -246,7 +253,7 @@ def _read_table(path: Path, cmap: ColumnMap, quantities: tuple[str, ...]) -> _Ta
             ) from exc
         if complex_:
             raise DataError(f"array {complex_[0]!r} holds complex numbers", file=path.name)
-        return _Table(path.name, arrays)
+        return _Table(path.name, arrays, header=list(raw))
     if suffix != ".csv":
         raise DataError("expected a .csv or .npz file", file=path.name)
 
@@ -263,6 +270,7 @@ def _read_table(path: Path, cmap: ColumnMap, quantities: tuple[str, ...]) -> _Ta
                 file=path.name,
                 at=f"line {line}",
             )
+        header[:] = names
         groups_of.update(_grouped(names, cmap, quantities))
         grouped = {c for cols in groups_of.values() for c in cols}
         index = {c: k for k, c in enumerate(names)}
@@ -270,9 +278,10 @@ def _read_table(path: Path, cmap: ColumnMap, quantities: tuple[str, ...]) -> _Ta
         return out | {c: [k] for k, c in enumerate(names) if c in wanted and c not in grouped}
 
     groups_of: dict[str, list[str]] = {}  # layout key -> its columns, filled by layout()
+    header: list[str] = []  # every column, filled by layout()
 
     arrays, _ = csv_table(path, layout, "a header naming the columns", freeze=False)
-    table = _Table(path.name, {})
+    table = _Table(path.name, {}, header=header)
     for key in list(arrays):  # one at a time: scaled in place, then its immutable copy
         a = arrays.pop(key)
         if key.startswith(_GROUP):
@@ -385,10 +394,8 @@ def _need(table: _Table, cmap: ColumnMap, quantity: str, n: int | None) -> NDArr
     if a is None:
         tpl = cmap.template(quantity)
         first = _fill(tpl, 0) if "{" in tpl else tpl
-        have = list(table.columns)[:12]
         raise DataError(
-            f"no column {first!r} for {quantity!r} (template {tpl!r}); "
-            f"the file has {have}{'...' if len(table.columns) > 12 else ''}; "
+            f"no column {first!r} for {quantity!r} (template {tpl!r}); {table.has()}; "
             "hint: map it with --columns",
             file=table.name,
         )
@@ -441,8 +448,8 @@ def load_mapped_torque_log(
     t = table.columns.get(columns.template("t"))
     if t is None:
         raise DataError(
-            f"no time column {columns.template('t')!r}; "
-            f"the file has {list(table.columns)[:12]}; hint: map it with --columns t=NAME",
+            f"no time column {columns.template('t')!r}; {table.has()}; "
+            "hint: map it with --columns t=NAME",
             file=path.name,
         )
     t = t if columns.factor("t") == 1.0 else _checks.frozen(t * columns.factor("t"))

@@ -93,6 +93,7 @@ def csv_table(
             break
         if names is None:
             raise DataError(f"no header line found; expected columns {expected}", file=path.name)
+        _check_delimiter(path, names, lineno)
         layout = layout_of(names, lineno)
         first = lineno + 1
         start = fb.tell()
@@ -108,6 +109,25 @@ def csv_table(
         raise DataError("no data rows after the header", file=path.name)
     check_row_count(path, recorded, N)
     return arrays, ((first, N) if one_to_one else None)
+
+
+#: Delimiters of other tools' tables, by the name a message gives them.
+_OTHER_DELIMITERS = (("\t", "tab"), (";", "semicolon"), ("|", "vertical bar"))
+
+
+def _check_delimiter(path: Path, names: list[str], lineno: int) -> None:
+    """Refuse a header of one column that holds another delimiter (a tab- or
+    semicolon-separated file), naming it, before its column names are judged."""
+    if len(names) != 1:
+        return
+    for sep, what in _OTHER_DELIMITERS:
+        if sep in names[0]:
+            raise DataError(
+                f"the header holds {what}s and no comma: a {what}-separated file; dynid "
+                f"reads comma-separated files; hint: replace each {what} with a comma",
+                file=path.name,
+                at=f"line {lineno}",
+            )
 
 
 def _count_lines(fb: IO[bytes]) -> int:

@@ -63,7 +63,7 @@ def export_format(path: str | Path, format: str | None = None) -> str:
     DataError
         Unknown format, or a suffix that names none.
     """
-    names = tuple(ROBOT_FORMATS)
+    names = ", ".join(ROBOT_FORMATS)
     if format is not None:
         if format not in ROBOT_FORMATS:
             raise DataError(f"format must be one of {names}; got {format!r}")
@@ -75,7 +75,7 @@ def export_format(path: str | Path, format: str | None = None) -> str:
     use = ", ".join("/".join(f.suffixes) for f in ROBOT_FORMATS.values())
     raise DataError(
         f"cannot tell the format of {Path(path).name!r} from its suffix; "
-        f"use {use}, or give the format ({names})"
+        f"use {use}, or give the format: one of {names}"
     )
 
 

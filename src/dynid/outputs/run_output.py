@@ -21,8 +21,10 @@
   the run did not write are never touched, except where it must write the same name:
   a file of another command's set, or a file no dynid run recorded (the user's), is
   replaced only with ``--force``; otherwise the run refuses before moving anything, with
-  a line naming the files. A single ``--out FILE`` is the file the user named and is
-  replaced.
+  a line naming the files. A single ``--out FILE`` is recorded in ``.dynid-files.json``
+  of its folder (:mod:`.file_record`); the next run of the same command replaces it, and
+  a file that record does not hold as it is now (the user's, one another command wrote,
+  or one changed since) is replaced only with ``--force``.
 * **Read-only files** (no write permission) are never replaced without ``--force``. A
   read-only or foreign target is refused as soon as the run writes the file (before the
   command says it wrote it), and again when the set moves.
@@ -44,7 +46,6 @@ import os
 import shutil
 import signal
 import tempfile
-import threading
 import time
 from collections.abc import Iterator, Sequence
 from pathlib import Path
@@ -52,23 +53,21 @@ from pathlib import Path
 from ..exceptions import DataError, OutputError
 from ..io import atomic
 from ..io.json_files import load_json, save_json
+from .file_record import FILES_RECORD, record_file, recorded_writer
+from .held_signals import signals_held
 
 try:
     import fcntl
 except ImportError:  # pragma: no cover - not POSIX
     fcntl = None  # type: ignore[assignment]
 
-__all__ = ["MANIFEST", "RunOutput", "run_output"]
+__all__ = ["FILES_RECORD", "MANIFEST", "RunOutput", "run_output"]
 
 #: Name of the record of a folder's output set (hidden, strict JSON).
 MANIFEST = ".dynid-run.json"
 _SCHEMA = "dynid-run/1"
 _STAGING = ".dynid-"
 _log = logging.getLogger(__name__)
-#: Signals held back while a set moves into place (the command line turns them into exits).
-_HELD = tuple(
-    getattr(signal, s) for s in ("SIGINT", "SIGTERM", "SIGHUP", "SIGQUIT") if hasattr(signal, s)
-)
 
 
 def _flock(fd: int, *, block: bool) -> bool:
@@ -97,45 +96,6 @@ def _folder_lock(folder: Path) -> Iterator[None]:
         os.close(fd)  # releases the lock
 
 
-@contextlib.contextmanager
-def _signals_held() -> Iterator[list[int]]:
-    """Hold the termination signals back inside the block; yields the list of those that
-    arrived meanwhile (filled when the block ends), which are not delivered when the block
-    ends normally and are delivered again when it raises.
-
-    Blocked in this thread, and, in the main thread, their handlers replaced by a record
-    of their arrival: a signal that another thread takes still runs its handler in the
-    main thread, and one left pending would arrive right after the block, both when the
-    set is already in place (a complete folder, and an exit as interrupted).
-    """
-    arrived: list[int] = []
-    handlers = {}
-    if threading.current_thread() is threading.main_thread():
-        for s in _HELD:
-            h = signal.getsignal(s)
-            if h is not None:  # a handler Python can put back
-                handlers[s] = h
-                signal.signal(s, lambda signum, frame: arrived.append(signum))
-    blocking = hasattr(signal, "pthread_sigmask")
-    old = signal.pthread_sigmask(signal.SIG_BLOCK, _HELD) if blocking else set()
-    ok = False
-    try:
-        yield arrived
-        ok = True
-    finally:
-        if blocking:
-            for s in sorted(signal.sigpending() & set(_HELD)):  # taken here, not after
-                with contextlib.suppress(OSError):
-                    if signal.sigtimedwait([s], 0) is not None:
-                        arrived.append(s)
-            signal.pthread_sigmask(signal.SIG_SETMASK, old)
-        for s, h in handlers.items():
-            signal.signal(s, h)
-        if not ok:
-            for s in dict.fromkeys(arrived):  # the set did not move: stop as asked
-                signal.raise_signal(s)
-
-
 def _is_temporary(name: str, targets: set[str]) -> bool:
     """``.<target>.<random>.tmp<suffix>``: a writer's temporary file of one of ``targets``."""
     if not name.startswith(".") or ".tmp" not in name:
@@ -158,6 +118,11 @@ def _read_manifest(folder: Path) -> dict | None:
 def _write_manifest(folder: Path, doc: dict) -> None:
     """Write the record directly into ``folder`` (not staged), atomically, as strict JSON."""
     save_json(folder / MANIFEST, doc, schema=_SCHEMA)
+
+
+def _can_write(folder: Path) -> bool:
+    """Whether this process may create files in ``folder`` (always, for root)."""
+    return os.access(folder, os.W_OK | os.X_OK)
 
 
 def _writable(path: Path) -> bool:
@@ -224,6 +189,8 @@ class RunOutput:
             raise OutputError(f"{self.flag} {self.given}: is a folder; give a file name")
         if self.kind == "folder" and not self.force:
             self._check_other_command(_read_manifest(out) if out.is_dir() else None)
+        if self.kind == "file" and os.path.lexists(out):  # refused before any work
+            self._check_targets([out.name], set())
         parent = out.parent
         missing = []
         p = parent
@@ -234,15 +201,35 @@ class RunOutput:
             raise OutputError(
                 f"{self.flag} {self.given}: {p} is a file, not a folder; choose another {self.flag}"
             )
-        parent.mkdir(parents=True, exist_ok=True)
-        self._created_parents = missing  # deepest first
-        with _folder_lock(parent):
-            self._remove_stale_staging()
-            self.staging = Path(
-                tempfile.mkdtemp(dir=parent, prefix=f".{out.name}{_STAGING}", suffix="")
+        # checked before any work: a run that cannot put its files in place would compute,
+        # say "wrote ..." and fail on a hidden temporary file
+        if self.kind == "folder" and out.is_dir() and not _can_write(out):
+            raise OutputError(
+                f"{self.flag} {self.given}: this folder is not writable (permission denied); "
+                f"choose another {self.flag}"
             )
-            self._fd = os.open(self.staging, os.O_RDONLY)
-            _flock(self._fd, block=False)
+        if not _can_write(p):
+            where = "the folder" if p == parent else "the nearest existing folder"
+            raise OutputError(
+                f"{self.flag} {self.given}: {where} {p} is not writable (permission denied; "
+                f"the outputs are staged beside {self.flag}); choose another {self.flag}"
+            )
+        try:
+            parent.mkdir(parents=True, exist_ok=True)
+            self._created_parents = missing  # deepest first
+            with _folder_lock(parent):
+                self._remove_stale_staging()
+                self.staging = Path(
+                    tempfile.mkdtemp(dir=parent, prefix=f".{out.name}{_STAGING}", suffix="")
+                )
+                self._fd = os.open(self.staging, os.O_RDONLY)
+                _flock(self._fd, block=False)
+        except OSError as exc:
+            self._close(False)
+            raise OutputError(
+                f"{self.flag} {self.given}: cannot write there ({exc.strerror or exc}); "
+                f"choose another {self.flag}"
+            ) from exc
         atomic._REDIRECTS.append(self)
 
     def close(self, ok: bool) -> None:
@@ -256,7 +243,7 @@ class RunOutput:
         if not ok:
             self._close(ok)
             return
-        with _signals_held() as arrived:
+        with signals_held() as arrived:
             self._close(ok)
         if arrived and self.committed:
             names = ", ".join(signal.Signals(s).name for s in dict.fromkeys(arrived))
@@ -314,6 +301,8 @@ class RunOutput:
         """True for this run's record of its set (``.dynid-run.json`` in ``--out`` or in
         the staging folder), which the run itself writes, puts back or removes."""
         p = Path(os.path.abspath(path))
+        if self.kind == "file":
+            return p.name == FILES_RECORD and p.parent == self.out.parent
         return p.name == MANIFEST and p.parent in (self.out, self.staging)
 
     def written(self) -> dict[str, Path]:
@@ -361,6 +350,10 @@ class RunOutput:
                 f"{'is' if len(read_only) == 1 else 'are'} read-only; pass --force to "
                 "replace, or choose another output"
             )
+        if self.kind == "file":
+            for n in names:
+                if os.path.lexists(base / n):
+                    self._check_single_file(base / n)
         if self.kind == "folder":
             foreign = [n for n in names if n not in owned and os.path.lexists(base / n)]
             if foreign:
@@ -370,6 +363,21 @@ class RunOutput:
                     f"{'it' if len(foreign) == 1 else 'them'} there; pass --force to replace, "
                     f"or choose another {self.flag}"
                 )
+
+    def _check_single_file(self, path: Path) -> None:
+        """Refuse to replace a single file that no run of this command wrote as it is."""
+        writer = recorded_writer(path)
+        if writer == self.command:
+            return
+        if writer is not None:
+            raise OutputError(
+                f"{self.flag} {self.given}: holds the output of `dynid {writer}`; choose "
+                f"another {self.flag} or pass --force to replace it"
+            )
+        raise OutputError(
+            f"{self.flag} {self.given}: exists and no dynid run wrote it (or it changed "
+            f"since); pass --force to replace, or choose another {self.flag}"
+        )
 
     # ------------------------------------------------------------------ commit
     def _remove_stale_staging(self) -> None:
@@ -414,11 +422,17 @@ class RunOutput:
     def _commit(self) -> None:
         assert self.staging is not None
         names = list(self.written())
-        with _folder_lock(self.out.parent):
-            if self.kind == "file":
-                self._commit_file(names)
-            else:
-                self._commit_folder(names)
+        try:
+            with _folder_lock(self.out.parent):
+                if self.kind == "file":
+                    self._commit_file(names)
+                else:
+                    self._commit_folder(names)
+        except OSError as exc:  # a failed move puts back what --out held (_move_into)
+            raise OutputError(
+                f"{self.flag} {self.given}: the outputs could not be put in place "
+                f"({exc.strerror or exc}); choose another {self.flag}"
+            ) from exc
         self.committed = True
 
     def _commit_file(self, names: list[str]) -> None:
@@ -427,7 +441,13 @@ class RunOutput:
         self._check_targets(names, set())
         assert self.staging is not None
         os.replace(self.staging / names[0], self.out)
-        self._remove_stale_temporaries(self.out.parent, {self.out.name})
+        self._remove_stale_temporaries(self.out.parent, {self.out.name, FILES_RECORD})
+        self._record_file()
+
+    def _record_file(self) -> None:
+        """Record the file just moved into place (:mod:`.file_record`)."""
+        rec = self._record([self.out.name], "complete")
+        record_file(self.out, self.command, **{k: rec[k] for k in ("argv", "dynid", "time")})
 
     def _commit_folder(self, names: list[str]) -> None:
         assert self.staging is not None

@@ -306,7 +306,7 @@ def recorded_columns(
 def data_files(paths: str | Path | Sequence[str | Path]) -> list[Path]:
     """The data files of ``--data``: the paths given, a folder standing for its ``.csv``
     and ``.npz`` files in name order (its other files, hidden ones and folders apart,
-    named in a logged note).
+    named in a logged note, and so are its sub-folders that hold data files: not read).
 
     Raises
     ------
@@ -333,6 +333,18 @@ def data_files(paths: str | Path | Sequence[str | Path]) -> list[Path]:
                     len(other),
                     ", ".join(other[:5]) + (", ..." if len(other) > 5 else ""),
                 )
+            nested = sorted(
+                f.name
+                for f in p.iterdir()
+                if f.is_dir() and not f.name.startswith(".") and _holds_data(f)
+            )
+            if nested:  # not read (a folder stands for its own files): said
+                _log.warning(
+                    "%s: sub-folder(s) holding data files left out (not read): %s; hint: "
+                    "give them to --data as well",
+                    p.name,
+                    ", ".join(nested[:5]) + (", ..." if len(nested) > 5 else ""),
+                )
             out += found
         else:
             out.append(p)
@@ -344,6 +356,14 @@ def data_files(paths: str | Path | Sequence[str | Path]) -> list[Path]:
         raise DataError(f"{', '.join(twice)}: data file given twice")
     _refuse_copies(out)
     return out
+
+
+def _holds_data(folder: Path) -> bool:
+    """Whether ``folder`` holds a ``.csv`` or ``.npz`` file (not looking deeper)."""
+    try:
+        return any(f.suffix.lower() in (".csv", ".npz") for f in folder.iterdir())
+    except OSError:  # unreadable: not ours to judge
+        return False
 
 
 def _refuse_copies(paths: list[Path]) -> None:

@@ -39,7 +39,12 @@ import numpy as np
 from ..exceptions import DataError, DynidWarning, OptionError
 from ..identification.log import TorqueLog, joint_side_log
 from ..identification.pieces import with_start_turns
-from ..identification.sanity import moving_joints, opposite_sign, time_unit_finding
+from ..identification.sanity import (
+    moving_joints,
+    opposite_sign,
+    time_unit_finding,
+    too_few_samples,
+)
 from ..identification.unit_mix import degrees_among_radians, joints_in_degrees
 from ..model.drive import Drive
 from ..model.robot import Robot
@@ -279,6 +284,8 @@ def check_signs(rec: Recorded, robot: Robot, drive: Drive | None) -> None:
         columns to flip).
     """
     for name, log in zip(rec.names, rec.logs, strict=True):
+        if (few := too_few_samples(log)) is not None:  # before the correlations
+            raise DataError(few, file=name)
         if (opposite := opposite_sign(robot, _joint_side(log, drive))) is not None:
             raise DataError(opposite, file=name)
 

@@ -105,9 +105,11 @@ def load_model_with_friction(
     return IdentifiedModel(robot, model.base, model.fit, model.terms, model.info, drive=model.drive)
 
 
-#: Options of the penalty method only, and of the convex method only.
+#: Options of the penalty method only, and of the convex method only (the prior: the
+#: penalty method's pull towards one is too weak to make a plausible link of an
+#: implausible one, and the command documents the prior for the convex method alone).
 PENALTY_ONLY = ("runs", "stages", "workers")
-CONVEX_ONLY = ("margin", "objective")
+CONVEX_ONLY = ("margin", "objective", "prior", "prior_base", "prior_tip")
 
 
 @dataclass(frozen=True, slots=True)
@@ -120,10 +122,10 @@ class RetrieveOptions:
         A name of :data:`~dynid.feasibility.methods.METHODS`: ``"sdp"``, the convex
         retrieval with a prior, or ``"penalty"``, the penalty method (Algorithm 1).
     prior : str, Path or Robot, optional
-        The prior link parameters (:func:`~dynid.workflows.prior.load_prior`); default
-        generic.
+        Convex method: the prior link parameters
+        (:func:`~dynid.workflows.prior.load_prior`); default generic.
     prior_base, prior_tip : str, optional
-        The chain of a URDF prior.
+        Convex method: the chain of a URDF prior.
     prior_weight : float, optional
         Weight of the distance to the prior (>= 0; default: the method's).
     objective : {"logdet", "euclidean"}, optional

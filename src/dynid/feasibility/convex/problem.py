@@ -120,6 +120,7 @@ class ConvexProblem:
         phi = cp.hstack(phis)
         self.phi_links = phis
         self.w = cp.Parameter(nonneg=True, value=1.0, name="w")
+        self.v = cp.Parameter(nonneg=True, value=1.0, name="v")
         eps = self.margin = options.margin
         self.scale = 1.0 if equality or closest else float(max(term.dof, 1))
         self.equality = equality
@@ -176,8 +177,10 @@ class ConvexProblem:
             obj = 1e-6 * div + 0.5 * cp.sum_squares(cp.multiply(1.0 / s, x - term.x_hat))
         else:
             # divided by dof (the data term's size at a good fit): same minimiser, better scaled
+            # (and, above weight 1, both terms divided by the weight: same minimiser again,
+            # and a weight of 1e200 does not make the solver's numbers overflow)
             ks = 1.0 / math.sqrt(self.scale)
-            obj = self.w * div + 0.5 * cp.sum_squares(
+            obj = self.w * div + self.v * 0.5 * cp.sum_squares(
                 (ks * term.A) @ x - (ks * term.A) @ term.x_hat
             )
         self.problem = cp.Problem(cp.Minimize(obj), cons)
@@ -192,7 +195,7 @@ class ConvexProblem:
         """
         import cvxpy as cp
 
-        self.w.value = float(w) / self.scale
+        self.w.value, self.v.value = objective_weights(float(w) / self.scale)
         attempts: list[tuple[str, dict[str, Any]]] = [
             ("CLARABEL", {}),
             ("CLARABEL", {"max_iter": 500, "static_regularization_constant": 1e-7}),
@@ -207,6 +210,11 @@ class ConvexProblem:
                     self.problem.solve(solver=scs() if solver == "SCS" else clarabel(), **kw)
             except (cp.error.SolverError, ArithmeticError, ValueError) as exc:
                 seen.append(f"{solver}: {exc}")
+                continue
+            except BaseException as exc:  # a panic of the compiled solver is a failed solve
+                if not is_solver_panic(exc):
+                    raise  # Ctrl-C, termination, exit
+                seen.append(f"{solver}: panicked ({' '.join(str(exc).split())})")
                 continue
             status = str(self.problem.status)
             seen.append(f"{solver}: {status}")
@@ -236,6 +244,27 @@ class ConvexProblem:
         Xs, f, ia = self._snapshot
         phi = np.stack([self.B[i] @ X.reshape(-1) for i, X in enumerate(Xs)])
         return _with_margin(phi, self.margin), f, ia
+
+
+#: Below this, the data term's coefficient is held (:func:`objective_weights`): its share
+#: of the objective is already far below the solver's tolerance (about 1e-8).
+_DATA_FLOOR = 1e-16
+
+
+def objective_weights(w: float) -> tuple[float, float]:
+    """The coefficients ``(a, b)`` of the objective ``a divergence + b data`` at the
+    (dof-scaled) prior weight ``w``: ``(w, 1)`` up to 1, ``(1, 1 / w)`` above (the same
+    minimiser, with numbers the solver can hold for any finite weight; ``b`` is held at
+    1e-16 above ``w = 1e16``, where the data's share is below the solver's tolerance)."""
+    if not w > 1.0:
+        return w, 1.0
+    return 1.0, max(1.0 / w, _DATA_FLOOR)
+
+
+def is_solver_panic(exc: BaseException) -> bool:
+    """Whether ``exc`` is a compiled solver's panic (Clarabel's ``pyo3_runtime.PanicException``,
+    a :class:`BaseException` that is no :class:`Exception`): a failed solve, not a stop."""
+    return type(exc).__name__ == "PanicException"
 
 
 def data_scale(term: DataTerm, prior: Prior) -> float:

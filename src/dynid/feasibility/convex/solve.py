@@ -10,7 +10,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
-from ...exceptions import InfeasibleError, ModelError, ShapeError
+from ...exceptions import InfeasibleError, ModelError, OptionError, ShapeError, SolverError
 from ...model.robot import Robot
 from ..bounds import Bounds, default_bounds
 from ..heldout import HeldOutJudgement
@@ -73,6 +73,9 @@ def solve_consistent(
         link mass bounds allow).
     SolverError
         The solver failed; its status is named.
+    OptionError
+        The solver failed at the given ``prior_weight`` (``field``): the solver's statuses
+        are named.
     ShapeError
         The prior or the bounds are for another number of links.
     """
@@ -121,10 +124,33 @@ def solve_consistent(
 
     if equality:
         return _solve_equality(common, friction_nonneg, constraints, notes, finish)
-    prob = ConvexProblem(*common, False, False, friction_nonneg, constraints)
+    if opts.prior_weight is None:
+        return _solve_weighted(common, friction_nonneg, constraints, notes, search, finish)
+    try:
+        return _solve_weighted(common, friction_nonneg, constraints, notes, search, finish)
+    except SolverError as exc:  # at the user's weight: the option to change
+        raise OptionError(
+            f"{opts.prior_weight:g}: {exc}; hint: a smaller weight, or none (the automatic choice)",
+            field="prior_weight",
+        ) from exc
+
+
+def _solve_weighted(
+    common: tuple[Any, ...],
+    friction_nonneg: bool,
+    constraints: Sequence[Callable[..., Any]],
+    notes: list[str],
+    search: list[tuple[float, float]],
+    finish: Callable[..., ConsistentResult],
+) -> ConsistentResult:
+    """Noisy coefficients: the covariance-weighted fit at the given prior weight, the
+    automatic one, or the one judged on held-out folds."""
+    term, pr, lo, hi, nb, band, opts = common
+    rest = (False, False, friction_nonneg, constraints)
+    prob = ConvexProblem(term, pr, lo, hi, nb, band, opts, *rest)
     if term.holdout is not None:
         folds = [
-            ConvexProblem(ft, *common[1:], False, False, friction_nonneg, constraints)
+            ConvexProblem(ft, pr, lo, hi, nb, band, opts, *rest)
             for ft in fold_terms(term, term.holdout)
         ]
         w, judgement = judged(folds, term.holdout, opts)
