@@ -178,7 +178,7 @@ def test_text_output_is_a_readable_table(capsys, command):
         (["fk", "--q=nan,0,0,-1,0,1,0"], "--q must be finite"),
         (["fk", "--frame", "gripper"], "Unknown frame 'gripper'"),
         (["jacobian", "--tool", "0,0"], "--tool must have 3 values"),
-        (["jacobian", "--robot", "robot.xml"], "--robot must be 'panda'"),
+        (["jacobian", "--robot", "robot.stl"], "--robot must be 'panda'"),
         (["ik"], "give the goal as either --goal"),
         (["ik", "--goal", "1,0,0,0"], "--goal must have 16 values"),
         (["ik", "--goal", "1,0,0,0,0,2,0,0,0,0,1,0,0,0,0,1"], "rotation block must be orthonormal"),

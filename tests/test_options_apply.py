@@ -36,7 +36,7 @@ REFUSED = [
     ),
     (
         "retrieve --model {d}/m.json --method penalty --prior-weight 3",
-        "--prior-weight applies to the penalty method with a --prior only",
+        "--prior-weight applies to --method sdp only",
     ),
     (
         "identify --robot panda --data {d}/s.csv --base nonexistent",
@@ -117,7 +117,8 @@ def test_the_library_refuses_alike():
     with pytest.raises(OptionError) as exc:
         RetrieveOptions(method="penalty", prior_weight=3.0)
     assert exc.value.field == "prior_weight"
-    RetrieveOptions(method="penalty", prior="panda", prior_weight=3.0)  # with a prior: taken
+    with pytest.raises(OptionError):  # the penalty method takes no prior, nor its weight
+        RetrieveOptions(method="penalty", prior="panda", prior_weight=3.0)
     RetrieveOptions(prior_weight=3.0)  # the convex method's generic prior: taken
     for kw, field in (
         ({"base": "x"}, "base"),

@@ -109,7 +109,7 @@ def load_model_with_friction(
 #: penalty method's pull towards one is too weak to make a plausible link of an
 #: implausible one, and the command documents the prior for the convex method alone).
 PENALTY_ONLY = ("runs", "stages", "workers")
-CONVEX_ONLY = ("margin", "objective", "prior", "prior_base", "prior_tip")
+CONVEX_ONLY = ("margin", "objective", "prior", "prior_base", "prior_tip", "prior_weight")
 
 
 @dataclass(frozen=True, slots=True)
@@ -185,20 +185,15 @@ class RetrieveOptions:
         for name in other:
             if getattr(self, name) is not None:
                 raise OptionError(
-                    f"applies to {{method}} {method} only", field=name, others=("method",)
+                    f"applies to {{method}} {method} only; leave it out",
+                    field=name,
+                    others=("method",),
                 )
         if self.total_mass is not None and not self.total_mass_band:
             raise OptionError(
                 "sets the band {total_mass_band} drops; give one of them",
                 field="total_mass",
                 others=("total_mass_band",),
-            )
-        if self.method == "penalty" and self.prior is None and self.prior_weight is not None:
-            raise OptionError(
-                "applies to the penalty method with a {prior} only (the weight of its pull "
-                "towards the prior); leave it out",
-                field="prior_weight",
-                others=("prior",),
             )
 
     def method_options(self) -> SDPOptions | RetrievalOptions:
