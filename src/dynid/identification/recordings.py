@@ -454,27 +454,7 @@ def prepare_recordings(
                 shown = finding if len(names) == 1 else f"{name}: {finding}"
                 warnings.warn(shown, DynidWarning, stacklevel=2)
         pieces += [(r, p) for p in mine]
-    cutoff: float | None = None if cutoff_hz == "auto" else cutoff_hz
-    # joint-side pieces of a motor-side log differ by turns of the motors, not joints
-    jturns = None if drive is not None and drive.side == "motor" else turns
-    if cutoff_hz == "auto":
-        cutoff = common_cutoff(
-            [joint_side_log(p, drive) for _, p in pieces], [r for r, _ in pieces], jturns
-        )
-        if cutoff is None:
-            raise DataError("no piece is long enough to read the motion's frequency from")
-    else:
-        check_below_nyquist([joint_side_log(p, drive) for _, p in pieces], cutoff)
-    if trim_s is not None:
-        edge: float | None = trim_s
-    else:
-        edge = edge_seconds(
-            [joint_side_log(p, drive) for _, p in pieces],
-            [r for r, _ in pieces],
-            cutoff,
-            from_motion=cutoff_hz == "auto",
-            turns=jturns,
-        )
+    cutoff, edge = _cutoff_and_edge(pieces, drive, turns, cutoff_hz, trim_s)
     kw = dict(cutoff_hz=cutoff, trim_s=edge, max_gap_s=max_gap_s, decimate=decimate)
     prepared, recording, skipped, gone = _prepared(robot, pieces, names, drive, **kw)
     if not prepared:
@@ -514,6 +494,34 @@ def prepare_recordings(
             for r, log in enumerate(logs)
         ),
     )
+
+
+def _cutoff_and_edge(
+    pieces: list[tuple[int, TorqueLog]],
+    drive: Drive | None,
+    turns: Any,
+    cutoff_hz: float | Literal["auto"] | None,
+    trim_s: float | None,
+) -> tuple[float | None, float | None]:
+    """The cut-off [Hz] of every piece (read from the motion with ``"auto"``, else as
+    given and below the Nyquist frequency) and the seconds trimmed at the pieces' ends
+    (``trim_s``, else the filter's edge transient)."""
+    cutoff: float | None = None if cutoff_hz == "auto" else cutoff_hz
+    # joint-side pieces of a motor-side log differ by turns of the motors, not joints
+    jturns = None if drive is not None and drive.side == "motor" else turns
+    logs = [joint_side_log(p, drive) for _, p in pieces]
+    if cutoff_hz == "auto":
+        cutoff = common_cutoff(logs, [r for r, _ in pieces], jturns)
+        if cutoff is None:
+            raise DataError("no piece is long enough to read the motion's frequency from")
+    else:
+        check_below_nyquist(logs, cutoff)
+    if trim_s is not None:
+        return cutoff, trim_s
+    edge = edge_seconds(
+        logs, [r for r, _ in pieces], cutoff, from_motion=cutoff_hz == "auto", turns=jturns
+    )
+    return cutoff, edge
 
 
 def _prepared(
