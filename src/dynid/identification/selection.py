@@ -611,10 +611,18 @@ def _fit_largest(
     those are identifiable."""
     shaped = [c for c in mine if {"smooth", "stribeck"} & set(c.friction)]
     coarse = [c for c in mine if "stribeck" not in c.friction or c.vst in STRIBECK_COARSE]
-    tries = [mine, coarse, [c for c in mine if c not in shaped]]
+    tries = [mine, coarse]
+    # smooth widths the data cannot tell apart (velocities seldom within a few bands of
+    # zero: tanh(v / w) is the sign for every narrow w): the narrow ones but the
+    # narrowest left out first, then it, then the wider ones
+    gone: set[float] = set()
+    for w in SMOOTH_THINNING:
+        gone.add(w)
+        tries.append([c for c in coarse if "stribeck" in c.friction or c.width not in gone])
+    tries.append([c for c in mine if c not in shaped])
     what = ("with" if arm else "without") + " armature"
     place = {"both": "motors and the joints"}
-    what += "".join(f", friction at the {place.get(a, a + 's')}" for a in {c.at for c in mine})
+    what += "".join(f", friction at the {place.get(a, a + 's')}" for a in {c.at for c in mine} - {""})
     family = regressor_group(mine[0])[2]
     laws = "smooth-sign Stribeck" if family.startswith("smooth") else family or "smooth"
     laws = "Stribeck" if laws == "stribeck" else laws
@@ -642,18 +650,7 @@ def _fit_largest(
             failed.append(f"rank {exc.rank} < {exc.needed}")
             continue
         if failed:
-            left = sorted({c.vst for c in mine if c not in group and c.vst}) if k == 1 else []
-            notes.append(
-                (
-                    f"the {laws} candidates {what} at the Stribeck velocities "
-                    f"{', '.join(f'{v:g}' for v in left)} rad/s: the data do not tell them "
-                    "from their neighbours"
-                    if left
-                    else f"the {laws} candidates {what}: the data do not tell them from "
-                    "Coulomb friction"
-                )
-                + f" ({'; '.join(failed)})"
-            )
+            notes.append(_left_out_note(mine, group, laws, what) + f" ({'; '.join(failed)})")
         return model, terms, group
     if failed:
         notes.append(
@@ -665,6 +662,28 @@ def _fit_largest(
             + f" ({'; '.join(failed)})"
         )
     return None
+
+
+#: The order in which smooth widths (in bands) are left out of a regressor whose columns
+#: the data cannot tell apart (:func:`_fit_largest`).
+SMOOTH_THINNING = (1.0, 3.0, 0.3, 10.0, 30.0, 100.0, 300.0)
+
+
+def _left_out_note(mine: list[Structure], group: list[Structure], laws: str, what: str) -> str:
+    """One note naming the shaped candidates of ``mine`` left out of ``group``."""
+    vst = sorted({c.vst for c in mine if c not in group and c.vst})
+    widths = sorted(
+        {c.width for c in mine if c not in group and c.friction and "stribeck" not in c.friction}
+        - {0.0}
+    )
+    if len(group) > len([c for c in mine if not {"smooth", "stribeck"} & set(c.friction)]):
+        parts = [f"Stribeck velocities {', '.join(f'{v:g}' for v in vst)} rad/s"] if vst else []
+        parts += [f"widths {', '.join(f'{w:g}' for w in widths)} bands"] if widths else []
+        return (
+            f"the {laws} candidates {what} at the {' and '.join(parts)}: the data do not "
+            "tell them from their neighbours (left out)"
+        )
+    return f"the {laws} candidates {what}: the data do not tell them from Coulomb friction"
 
 
 def identify_recordings(
