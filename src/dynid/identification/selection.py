@@ -32,14 +32,14 @@ structure chosen (or given).
 from __future__ import annotations
 
 import warnings
-from collections.abc import Callable, Sequence
+from collections.abc import Sequence
 from dataclasses import replace
 from typing import Any, Literal
 
 import numpy as np
 from numpy.typing import NDArray
 
-from ..exceptions import DynidWarning, OptionError, RankDeficientError
+from ..exceptions import DynidWarning, OptionError
 from ..model.drive import Drive
 from ..model.robot import Robot
 from ..regressors.base import BaseParameters
@@ -56,19 +56,19 @@ from .candidates import (
     recording_oddness,
     without_recordings,
 )
-from .core import Judge, ModelColumns, RegressorStack, StreamedRows, identify, selected_columns
+from .core import identify
 from .dissipation import friction_columns, friction_violations, warn_unphysical
-from .estimators import Estimator, EstimatorName, estimator_named, row_weights
-from .holdout import DEFAULT_FOLDS, HeldOut, Normals, block_normals
+from .estimators import Estimator, EstimatorName, estimator_named
+from .holdout import DEFAULT_FOLDS, HeldOut
+from .judge import heldout_judge
+from .largest import fit_largest, recording_bands
 from .least_squares import StdMethod
 from .log import TorqueLog
 from .metrics import noise_floor_percent
 from .model import IdentifiedModel
 from .recordings import Recordings, prepare_recordings
-from .streaming import BlockSource, normals_by_label
 from .structure import (
     ERROR_FLOOR_PERCENT,
-    STRIBECK_COARSE,
     Structure,
     candidate_columns,
     candidate_structures,
@@ -76,7 +76,6 @@ from .structure import (
     coefficient_labels,
     friction_placements,
     joint_side_joints,
-    largest_terms,
     own_rotors,
     regressor_group,
     structure_terms,
@@ -91,146 +90,13 @@ __all__ = [
 ]
 
 
-def _judge(
-    robot: Robot,
-    data: Recordings,
-    estimator: Estimator,
-    folds: int,
-    validation: Recordings | None,
-) -> tuple[Judge, str, NDArray[np.intp] | None]:
-    """The held-out judgement over the recordings' folds (or a separate recording), how,
-    and the fold of every row (None with a separate recording or too few samples)."""
-    try:
-        labels, how = data.fold_labels(folds)
-    except OptionError:
-        labels, how = None, "none (too few samples for held-out blocks)"
-    if validation is not None:
-        how = "a separate recording"
-    scheme = "recordings" if len(data.names) > 1 else "blocks"
-    measured_ok = data.measured  # judged on the torques as measured: one more pass
-    inverse_noise = _inverse_noise(data)
-
-    def judge(
-        stack: RegressorStack | StreamedRows,
-        columns: ModelColumns,
-        cols: NDArray[np.bool_],
-        beta: NDArray[Any],
-    ) -> HeldOut | None:
-        b = np.asarray(beta)[cols]
-        rows = selected_columns(_rows(data, robot, columns), cols)  # read only when passed
-        normals: Callable[[NDArray[np.intp]], tuple[Normals, ...]]
-        if isinstance(stack, StreamedRows) and stack.normals is not None and validation is None:
-            assert labels is not None  # the fit gathered the folds' normals by these labels
-            judged = normals_by_label(rows, labels) if measured_ok else None
-            source = rows if measured_ok else selected_columns(stack.source, cols)
-            white = _whitened(source, labels, inverse_noise)
-            held = replace(HeldOut.k_fold(stack.normals, judged), scheme=scheme, whitened=white)
-            return held.expanded(cols)
-        if isinstance(stack, StreamedRows):  # rows in blocks: one pass per set of labels
-            source = selected_columns(stack.source, cols)
-            e = np.concatenate([y - W @ b for W, y, _ in source()])
-            rw = estimator.row_weights(e, np.tile(np.arange(data.n), e.size // data.n), b.size)
-            m = e.size
-            normals = lambda lab: normals_by_label(source, lab, rw)  # noqa: E731
-            fitted = source
-        else:
-            W = stack.W if cols.all() else stack.W[:, cols]
-            rw = row_weights(estimator, W, stack.y, stack.groups, b)
-            Ww, yw, m = W * rw[:, None], stack.y * rw, stack.y.size
-            normals = lambda lab: block_normals(Ww, yw, lab)  # noqa: E731
-            fitted = lambda: iter([(Ww, yw, stack.groups)])  # noqa: E731
-        if validation is not None:
-            test = _normals(robot, validation, columns, cols, b, estimator)
-            held = HeldOut.separate(normals(np.zeros(m, np.intp))[0], test)
-        elif labels is None:
-            return None
-        else:
-            judged = normals_by_label(rows, labels, rw) if measured_ok else None
-            white = _whitened(rows if measured_ok else fitted, labels, inverse_noise, rw)
-            held = replace(HeldOut.k_fold(normals(labels), judged), scheme=scheme, whitened=white)
-        return held.expanded(cols)
-
-    return judge, how, (labels if validation is None else None)
-
-
-#: A joint's torque noise counts at least this share of the largest joint's in the
-#: whitened judgement (:func:`_inverse_noise`): a joint whose noise estimate is next to
-#: nothing (a quantised or filtered sensor) must not outweigh every other.
-NOISE_FLOOR_SHARE = 1e-2
-
-
-def _inverse_noise(data: Recordings) -> NDArray[np.float64] | None:
-    """Per joint, one over the torque noise std [1/(N m)] of the recordings (the samples'
-    mean square over the pieces, at least :data:`NOISE_FLOOR_SHARE` of the largest
-    joint's); None when a piece's noise is not known or no joint has any."""
-    noise = [p.torque_noise_std for p in data.pieces]
-    if not noise or any(x is None for x in noise):
-        return None
-    counts = np.array([p.log.n_samples for p in data.pieces], dtype=np.float64)
-    var = np.asarray(noise, dtype=np.float64) ** 2
-    sigma = np.sqrt(counts @ var / counts.sum())
-    top = float(np.max(sigma)) if sigma.size else 0.0
-    if not (np.all(np.isfinite(sigma)) and top > 0):
-        return None
-    return 1.0 / np.maximum(sigma, NOISE_FLOOR_SHARE * top)
-
-
-def _whitened(
-    source: BlockSource,
-    labels: NDArray[np.intp],
-    inverse_noise: NDArray[np.float64] | None,
-    weights: NDArray[np.float64] | None = None,
-) -> tuple[Normals, ...]:
-    """The folds' normal equations of ``source``'s rows (times ``weights``) with each
-    joint's rows divided by its noise (:attr:`~.holdout.HeldOut.whitened`); empty without
-    the noise."""
-    if inverse_noise is None:
-        return ()
-    inv = inverse_noise
-
-    def scaled() -> Any:
-        for W, y, g in source():
-            k = inv[np.asarray(g)]
-            yield W * k[:, None], y * k, g
-
-    return normals_by_label(scaled, labels, weights)
-
-
-def _rows(data: Recordings, robot: Robot, columns: ModelColumns) -> BlockSource:
-    """The recordings' rows as measured (:meth:`~.recordings.Recordings.measured_blocks`),
-    a source of blocks for a pass."""
-    return lambda: ((b.W, b.y, b.groups) for b in data.measured_blocks(robot, columns))
-
-
-def _normals(
-    robot: Robot,
-    data: Recordings,
-    columns: ModelColumns,
-    cols: NDArray[np.bool_],
-    b: NDArray[np.float64],
-    estimator: Estimator,
-) -> Normals:
-    """The normal equations of a separate recording over the fitted columns, on its rows
-    as measured (:meth:`~.recordings.Recordings.measured_blocks`), weighted as the
-    estimator weighs them at ``b``."""
-    blocks = list(data.measured_blocks(robot, columns))
-    W = np.concatenate([blk.W for blk in blocks])[:, cols]
-    y = np.concatenate([blk.y for blk in blocks])
-    g = np.concatenate([blk.groups for blk in blocks])
-    rw = row_weights(estimator, W, y, g, b)
-    return block_normals(W * rw[:, None], y * rw, np.zeros(y.size, np.intp))[0]
-
-
-def _bands(data: Recordings) -> dict[str, tuple[float, ...]]:
-    """The standstill bands at a drive's motors and joints, as tuples."""
-    return {at: tuple(float(x) for x in b) for at, b in data.bands.items()}
-
-
 def _terms_of(
     structure: Structure, drive: Drive | None, n: int, data: Recordings
 ) -> tuple[Drive | None, tuple[ModelTerm, ...]]:
     """:func:`~dynid.identification.structure.structure_terms` with the recordings' bands."""
-    return structure_terms(structure, drive, n, tuple(data.band), _bands(data), data.band_gain)
+    return structure_terms(
+        structure, drive, n, tuple(data.band), recording_bands(data), data.band_gain
+    )
 
 
 def _with_floor(heldout: Any, data: Recordings) -> Any:
@@ -332,14 +198,14 @@ def select_structure(
     )
     judged: list[Candidate] = []
     notes: list[str] = []
-    judge, how, fold_labels = _judge(robot, data, est, folds, validation)
+    judge, how, fold_labels = heldout_judge(robot, data, est, folds, validation)
     fit_rtol = 1e-10 if rtol is None else rtol
     groups: _Groups = {}
     columns: list[tuple[Structure, NDArray[np.bool_], _Key]] = []
     for key in sorted({regressor_group(c) for c in cands}):
         arm = key[0]
         mine = [c for c in cands if regressor_group(c) == key]
-        fitted = _fit_largest(robot, data, mine, arm, drive, est, rtol, judge, notes, fold_labels)
+        fitted = fit_largest(robot, data, mine, arm, drive, est, rtol, judge, notes, fold_labels)
         if fitted is None:
             continue
         model, terms, mine = fitted
@@ -592,100 +458,6 @@ def _repaired(
     return here
 
 
-def _fit_largest(
-    robot: Robot,
-    data: Recordings,
-    mine: list[Structure],
-    arm: bool,
-    drive: Drive | None,
-    est: Estimator,
-    rtol: float | None,
-    judge: Judge,
-    notes: list[str],
-    fold_labels: NDArray[np.intp] | None = None,
-) -> tuple[IdentifiedModel, list[tuple[ModelTerm, Any]], list[Structure]] | None:
-    """The model of every candidate's columns at once, with its terms and the candidates it
-    holds; when the data cannot tell its columns apart, the Stribeck laws at
-    :data:`~dynid.identification.structure.STRIBECK_COARSE` only, then the classical
-    candidates alone (a note says which were left out); None (and a note) when not even
-    those are identifiable."""
-    shaped = [c for c in mine if {"smooth", "stribeck"} & set(c.friction)]
-    coarse = [c for c in mine if "stribeck" not in c.friction or c.vst in STRIBECK_COARSE]
-    tries = [mine, coarse]
-    # smooth widths the data cannot tell apart (velocities seldom within a few bands of
-    # zero: tanh(v / w) is the sign for every narrow w): the narrow ones but the
-    # narrowest left out first, then it, then the wider ones
-    gone: set[float] = set()
-    for w in SMOOTH_THINNING:
-        gone.add(w)
-        tries.append([c for c in coarse if "stribeck" in c.friction or c.width not in gone])
-    tries.append([c for c in mine if c not in shaped])
-    what = ("with" if arm else "without") + " armature"
-    place = {"both": "motors and the joints"}
-    what += "".join(f", friction at the {place.get(a, a + 's')}" for a in {c.at for c in mine} - {""})
-    family = regressor_group(mine[0])[2]
-    laws = "smooth-sign Stribeck" if family.startswith("smooth") else family or "smooth"
-    laws = "Stribeck" if laws == "stribeck" else laws
-    failed: list[str] = []
-    for k, group in enumerate(tries):
-        if not group or (k and len(group) == len(tries[k - 1])):
-            continue
-        model_drive, terms = largest_terms(
-            group, arm, drive, robot.n, tuple(data.band), _bands(data), data.band_gain
-        )
-        try:
-            with warnings.catch_warnings():  # the candidates' fits: only the chosen one speaks
-                warnings.simplefilter("ignore", DynidWarning)
-                model = identify(
-                    robot,
-                    data,
-                    drive=model_drive,
-                    terms=tuple(t for t, _ in terms),
-                    estimator=est,
-                    rtol=rtol,
-                    judge=judge,
-                    fold_labels=fold_labels,
-                )
-        except RankDeficientError as exc:
-            failed.append(f"rank {exc.rank} < {exc.needed}")
-            continue
-        if failed:
-            notes.append(_left_out_note(mine, group, laws, what) + f" ({'; '.join(failed)})")
-        return model, terms, group
-    if failed:
-        notes.append(
-            (
-                f"the {laws} candidates {what}: the data do not tell them from Coulomb friction"
-                if shaped and len(shaped) == len(mine)
-                else f"the candidates {what}: not identifiable from these data"
-            )
-            + f" ({'; '.join(failed)})"
-        )
-    return None
-
-
-#: The order in which smooth widths (in bands) are left out of a regressor whose columns
-#: the data cannot tell apart (:func:`_fit_largest`).
-SMOOTH_THINNING = (1.0, 3.0, 0.3, 10.0, 30.0, 100.0, 300.0)
-
-
-def _left_out_note(mine: list[Structure], group: list[Structure], laws: str, what: str) -> str:
-    """One note naming the shaped candidates of ``mine`` left out of ``group``."""
-    vst = sorted({c.vst for c in mine if c not in group and c.vst})
-    widths = sorted(
-        {c.width for c in mine if c not in group and c.friction and "stribeck" not in c.friction}
-        - {0.0}
-    )
-    if len(group) > len([c for c in mine if not {"smooth", "stribeck"} & set(c.friction)]):
-        parts = [f"Stribeck velocities {', '.join(f'{v:g}' for v in vst)} rad/s"] if vst else []
-        parts += [f"widths {', '.join(f'{w:g}' for w in widths)} bands"] if widths else []
-        return (
-            f"the {laws} candidates {what} at the {' and '.join(parts)}: the data do not "
-            "tell them from their neighbours (left out)"
-        )
-    return f"the {laws} candidates {what}: the data do not tell them from Coulomb friction"
-
-
 def identify_recordings(
     robot: Robot,
     logs: Sequence[TorqueLog],
@@ -789,7 +561,7 @@ def identify_recordings(
         )
         structure = _fitted_structure(selection, friction)
     model_drive, terms = _terms_of(structure, drive, robot.n, data)
-    judge, _, fold_labels = _judge(robot, data, est, folds, validation)
+    judge, _, fold_labels = heldout_judge(robot, data, est, folds, validation)
     model = identify(
         robot, data, drive=model_drive, terms=terms, estimator=est, std=std, base=base,
         max_std_percent=max_std_percent, rtol=rtol, judge=judge, fold_labels=fold_labels,

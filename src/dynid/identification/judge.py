@@ -1,0 +1,159 @@
+"""The held-out judgement of the candidates' models: the folds' normal equations.
+
+:func:`heldout_judge` gives :func:`~dynid.identification.core.identify` its judge: the
+normal equations of every fold (:class:`~dynid.identification.holdout.HeldOut`), fitted on
+the rows as prepared and judged on the torques as measured (one more pass over
+:meth:`~dynid.identification.recordings.Recordings.measured_blocks`), and the same judged
+rows with each joint's torques in units of its own noise (:func:`inverse_noise`), which
+the structure choice reads: pooled in N m, a wrist whose noise is a hundredth of the
+shoulder's would not count.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from dataclasses import replace
+from typing import Any
+
+import numpy as np
+from numpy.typing import NDArray
+
+from ..exceptions import OptionError
+from ..model.robot import Robot
+from .core import Judge, ModelColumns, RegressorStack, StreamedRows, selected_columns
+from .estimators import Estimator, row_weights
+from .holdout import HeldOut, Normals, block_normals
+from .recordings import Recordings
+from .streaming import BlockSource, normals_by_label
+
+__all__ = ["NOISE_FLOOR_SHARE", "heldout_judge", "inverse_noise"]
+
+
+def heldout_judge(
+    robot: Robot,
+    data: Recordings,
+    estimator: Estimator,
+    folds: int,
+    validation: Recordings | None,
+) -> tuple[Judge, str, NDArray[np.intp] | None]:
+    """The held-out judgement over the recordings' folds (or a separate recording), how,
+    and the fold of every row (None with a separate recording or too few samples)."""
+    try:
+        labels, how = data.fold_labels(folds)
+    except OptionError:
+        labels, how = None, "none (too few samples for held-out blocks)"
+    if validation is not None:
+        how = "a separate recording"
+    scheme = "recordings" if len(data.names) > 1 else "blocks"
+    measured_ok = data.measured  # judged on the torques as measured: one more pass
+    inv_noise = inverse_noise(data)
+
+    def judge(
+        stack: RegressorStack | StreamedRows,
+        columns: ModelColumns,
+        cols: NDArray[np.bool_],
+        beta: NDArray[Any],
+    ) -> HeldOut | None:
+        b = np.asarray(beta)[cols]
+        rows = selected_columns(_rows(data, robot, columns), cols)  # read only when passed
+        normals: Callable[[NDArray[np.intp]], tuple[Normals, ...]]
+        if isinstance(stack, StreamedRows) and stack.normals is not None and validation is None:
+            assert labels is not None  # the fit gathered the folds' normals by these labels
+            judged = normals_by_label(rows, labels) if measured_ok else None
+            source = rows if measured_ok else selected_columns(stack.source, cols)
+            white = _whitened(source, labels, inv_noise)
+            held = replace(HeldOut.k_fold(stack.normals, judged), scheme=scheme, whitened=white)
+            return held.expanded(cols)
+        if isinstance(stack, StreamedRows):  # rows in blocks: one pass per set of labels
+            source = selected_columns(stack.source, cols)
+            e = np.concatenate([y - W @ b for W, y, _ in source()])
+            rw = estimator.row_weights(e, np.tile(np.arange(data.n), e.size // data.n), b.size)
+            m = e.size
+            normals = lambda lab: normals_by_label(source, lab, rw)  # noqa: E731
+            fitted = source
+        else:
+            W = stack.W if cols.all() else stack.W[:, cols]
+            rw = row_weights(estimator, W, stack.y, stack.groups, b)
+            Ww, yw, m = W * rw[:, None], stack.y * rw, stack.y.size
+            normals = lambda lab: block_normals(Ww, yw, lab)  # noqa: E731
+            fitted = lambda: iter([(Ww, yw, stack.groups)])  # noqa: E731
+        if validation is not None:
+            test = _normals(robot, validation, columns, cols, b, estimator)
+            held = HeldOut.separate(normals(np.zeros(m, np.intp))[0], test)
+        elif labels is None:
+            return None
+        else:
+            judged = normals_by_label(rows, labels, rw) if measured_ok else None
+            white = _whitened(rows if measured_ok else fitted, labels, inv_noise, rw)
+            held = replace(HeldOut.k_fold(normals(labels), judged), scheme=scheme, whitened=white)
+        return held.expanded(cols)
+
+    return judge, how, (labels if validation is None else None)
+
+
+#: A joint's torque noise counts at least this share of the largest joint's in the
+#: whitened judgement (:func:`inverse_noise`): a joint whose noise estimate is next to
+#: nothing (a quantised or filtered sensor) must not outweigh every other.
+NOISE_FLOOR_SHARE = 1e-2
+
+
+def inverse_noise(data: Recordings) -> NDArray[np.float64] | None:
+    """Per joint, one over the torque noise std [1/(N m)] of the recordings (the samples'
+    mean square over the pieces, at least :data:`NOISE_FLOOR_SHARE` of the largest
+    joint's); None when a piece's noise is not known or no joint has any."""
+    noise = [p.torque_noise_std for p in data.pieces]
+    if not noise or any(x is None for x in noise):
+        return None
+    counts = np.array([p.log.n_samples for p in data.pieces], dtype=np.float64)
+    var = np.asarray(noise, dtype=np.float64) ** 2
+    sigma = np.sqrt(counts @ var / counts.sum())
+    top = float(np.max(sigma)) if sigma.size else 0.0
+    if not (np.all(np.isfinite(sigma)) and top > 0):
+        return None
+    return 1.0 / np.maximum(sigma, NOISE_FLOOR_SHARE * top)
+
+
+def _whitened(
+    source: BlockSource,
+    labels: NDArray[np.intp],
+    inverse_noise: NDArray[np.float64] | None,
+    weights: NDArray[np.float64] | None = None,
+) -> tuple[Normals, ...]:
+    """The folds' normal equations of ``source``'s rows (times ``weights``) with each
+    joint's rows divided by its noise (:attr:`~.holdout.HeldOut.whitened`); empty without
+    the noise."""
+    if inverse_noise is None:
+        return ()
+    inv = inverse_noise
+
+    def scaled() -> Any:
+        for W, y, g in source():
+            k = inv[np.asarray(g)]
+            yield W * k[:, None], y * k, g
+
+    return normals_by_label(scaled, labels, weights)
+
+
+def _rows(data: Recordings, robot: Robot, columns: ModelColumns) -> BlockSource:
+    """The recordings' rows as measured (:meth:`~.recordings.Recordings.measured_blocks`),
+    a source of blocks for a pass."""
+    return lambda: ((b.W, b.y, b.groups) for b in data.measured_blocks(robot, columns))
+
+
+def _normals(
+    robot: Robot,
+    data: Recordings,
+    columns: ModelColumns,
+    cols: NDArray[np.bool_],
+    b: NDArray[np.float64],
+    estimator: Estimator,
+) -> Normals:
+    """The normal equations of a separate recording over the fitted columns, on its rows
+    as measured (:meth:`~.recordings.Recordings.measured_blocks`), weighted as the
+    estimator weighs them at ``b``."""
+    blocks = list(data.measured_blocks(robot, columns))
+    W = np.concatenate([blk.W for blk in blocks])[:, cols]
+    y = np.concatenate([blk.y for blk in blocks])
+    g = np.concatenate([blk.groups for blk in blocks])
+    rw = row_weights(estimator, W, y, g, b)
+    return block_normals(W * rw[:, None], y * rw, np.zeros(y.size, np.intp))[0]

@@ -1,0 +1,135 @@
+"""The one regressor a group of candidate structures shares, fitted once.
+
+:func:`fit_largest` fits the model holding every column of a group of candidates
+(:func:`~dynid.identification.structure.largest_terms`; the groups:
+:func:`~dynid.identification.structure.regressor_group`) with the held-out judge, so that
+each candidate is judged on its own columns of the folds' normal equations. Where the data
+cannot tell some columns apart, only the alike candidates are left out, one set after the
+other (:data:`SMOOTH_THINNING`), each named in one note.
+"""
+
+from __future__ import annotations
+
+import warnings
+from typing import Any
+
+import numpy as np
+from numpy.typing import NDArray
+
+from ..exceptions import DynidWarning, RankDeficientError
+from ..model.drive import Drive
+from ..model.robot import Robot
+from ..regressors.terms import ModelTerm
+from .core import Judge, identify
+from .estimators import Estimator
+from .model import IdentifiedModel
+from .recordings import Recordings
+from .structure import (
+    STRIBECK_COARSE,
+    Structure,
+    largest_terms,
+    regressor_group,
+)
+
+__all__ = ["SMOOTH_THINNING", "fit_largest", "recording_bands"]
+
+
+def recording_bands(data: Recordings) -> dict[str, tuple[float, ...]]:
+    """The standstill bands at a drive's motors and joints, as tuples."""
+    return {at: tuple(float(x) for x in b) for at, b in data.bands.items()}
+
+
+def fit_largest(
+    robot: Robot,
+    data: Recordings,
+    mine: list[Structure],
+    arm: bool,
+    drive: Drive | None,
+    est: Estimator,
+    rtol: float | None,
+    judge: Judge,
+    notes: list[str],
+    fold_labels: NDArray[np.intp] | None = None,
+) -> tuple[IdentifiedModel, list[tuple[ModelTerm, Any]], list[Structure]] | None:
+    """The model of every candidate's columns at once, with its terms and the candidates it
+    holds; when the data cannot tell its columns apart, the Stribeck laws at
+    :data:`~dynid.identification.structure.STRIBECK_COARSE` only, then the classical
+    candidates alone (a note says which were left out); None (and a note) when not even
+    those are identifiable."""
+    shaped = [c for c in mine if {"smooth", "stribeck"} & set(c.friction)]
+    coarse = [c for c in mine if "stribeck" not in c.friction or c.vst in STRIBECK_COARSE]
+    tries = [mine, coarse]
+    # smooth widths the data cannot tell apart (velocities seldom within a few bands of
+    # zero: tanh(v / w) is the sign for every narrow w): the narrow ones but the
+    # narrowest left out first, then it, then the wider ones
+    gone: set[float] = set()
+    for w in SMOOTH_THINNING:
+        gone.add(w)
+        tries.append([c for c in coarse if "stribeck" in c.friction or c.width not in gone])
+    tries.append([c for c in mine if c not in shaped])
+    what = ("with" if arm else "without") + " armature"
+    place = {"both": "motors and the joints"}
+    what += "".join(
+        f", friction at the {place.get(a, a + 's')}" for a in {c.at for c in mine} - {""}
+    )
+    family = regressor_group(mine[0])[2]
+    laws = "smooth-sign Stribeck" if family.startswith("smooth") else family or "smooth"
+    laws = "Stribeck" if laws == "stribeck" else laws
+    failed: list[str] = []
+    for k, group in enumerate(tries):
+        if not group or (k and len(group) == len(tries[k - 1])):
+            continue
+        model_drive, terms = largest_terms(
+            group, arm, drive, robot.n, tuple(data.band), recording_bands(data), data.band_gain
+        )
+        try:
+            with warnings.catch_warnings():  # the candidates' fits: only the chosen one speaks
+                warnings.simplefilter("ignore", DynidWarning)
+                model = identify(
+                    robot,
+                    data,
+                    drive=model_drive,
+                    terms=tuple(t for t, _ in terms),
+                    estimator=est,
+                    rtol=rtol,
+                    judge=judge,
+                    fold_labels=fold_labels,
+                )
+        except RankDeficientError as exc:
+            failed.append(f"rank {exc.rank} < {exc.needed}")
+            continue
+        if failed:
+            notes.append(_left_out_note(mine, group, laws, what) + f" ({'; '.join(failed)})")
+        return model, terms, group
+    if failed:
+        notes.append(
+            (
+                f"the {laws} candidates {what}: the data do not tell them from Coulomb friction"
+                if shaped and len(shaped) == len(mine)
+                else f"the candidates {what}: not identifiable from these data"
+            )
+            + f" ({'; '.join(failed)})"
+        )
+    return None
+
+
+#: The order in which smooth widths (in bands) are left out of a regressor whose columns
+#: the data cannot tell apart (:func:`_fit_largest`).
+SMOOTH_THINNING = (1.0, 3.0, 0.3, 10.0, 30.0, 100.0, 300.0)
+
+
+def _left_out_note(mine: list[Structure], group: list[Structure], laws: str, what: str) -> str:
+    """One note naming the shaped candidates of ``mine`` left out of ``group``."""
+    vst = sorted({c.vst for c in mine if c not in group and c.vst})
+    widths = sorted(
+        {c.width for c in mine if c not in group and c.friction and "stribeck" not in c.friction}
+        - {0.0}
+    )
+    if len(group) > len([c for c in mine if not {"smooth", "stribeck"} & set(c.friction)]):
+        parts = [f"Stribeck velocities {', '.join(f'{v:g}' for v in vst)} rad/s"] if vst else []
+        parts += [f"widths {', '.join(f'{w:g}' for w in widths)} bands"] if widths else []
+        return (
+            f"the {laws} candidates {what} at the {' and '.join(parts)}: the data do not "
+            "tell them from their neighbours (left out)"
+        )
+    return f"the {laws} candidates {what}: the data do not tell them from Coulomb friction"
