@@ -59,10 +59,10 @@ def selection_lines(selection: Any) -> list[str]:
     if hidden:
         x = sum(1 for c in cands if c["name"] not in shown and skip and c.get("not_dissipative"))
         out.append(
-            f"  ({hidden} candidate(s) of a smooth or Stribeck law at other widths or Stribeck "
-            "velocities not shown, each law's best is"
-            + (f"; {x} of them skipped as not dissipative" if x else "")
-            + ": metadata.selection.candidates holds every one)"
+            f"  ({hidden} more candidate(s) of a smooth or Stribeck law at other widths or "
+            "Stribeck velocities"
+            + (f", {x} of them skipped as not dissipative" if x else "")
+            + ": the table shows each law's best; metadata.selection.candidates holds every one)"
         )
     per = selection.get("heldout_per_recording") or ()
     if per:

@@ -76,7 +76,7 @@ def heldout_judge(
             rw = row_weights(estimator, W, stack.y, stack.groups, b)
             Ww, yw, m = W * rw[:, None], stack.y * rw, stack.y.size
             normals = lambda lab: block_normals(Ww, yw, lab)  # noqa: E731
-            fitted = lambda: iter([(Ww, yw, stack.groups)])  # noqa: E731
+            fitted = lambda: iter([(W, stack.y, stack.groups)])  # noqa: E731
         if validation is not None:
             test = _normals(robot, validation, columns, cols, b, estimator)
             held = HeldOut.separate(normals(np.zeros(m, np.intp))[0], test)
@@ -84,7 +84,10 @@ def heldout_judge(
             return None
         else:
             judged = normals_by_label(rows, labels, rw) if measured_ok else None
-            white = _whitened(rows if measured_ok else fitted, labels, inv_noise, rw)
+            # in units of each joint's noise alone: the estimator's weights (its own
+            # estimate of each joint's residual level, at the largest model) would make a
+            # joint's error vanish with the terms it loses
+            white = _whitened(rows if measured_ok else fitted, labels, inv_noise)
             held = replace(HeldOut.k_fold(normals(labels), judged), scheme=scheme, whitened=white)
         return held.expanded(cols)
 

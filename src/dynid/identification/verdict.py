@@ -118,7 +118,7 @@ def judge_prediction(
     level: Level = "fair" if worst_r <= FLOOR_FAIR else "poor"
     if LEVELS.index(level) <= LEVELS.index(v.level):
         return v
-    which = ", ".join(f"{names[j]} ({r[j]:.2g} x)" for j in bad)
+    which = ", ".join(f"{names[j]} at {r[j]:.2g} x" for j in bad)
     what = (
         "effects outside the model remain there"
         if level == "fair"
@@ -128,7 +128,7 @@ def judge_prediction(
     return Verdict(
         level,
         label,
-        f"{v.reason.split(':')[0]}, but joint(s) {which} their noise: {what}",
+        f"{v.reason.split(':')[0]}; joint(s) {which} their noise: {what}",
         v.ratio,
     )
 
