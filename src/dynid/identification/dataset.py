@@ -22,7 +22,14 @@ from ..regressors.base import BaseParameters
 from ..regressors.terms import ModelTerm
 from .info import IdentificationInfo, Route
 
-__all__ = ["Dataset", "ModelColumns", "RegressorBlock", "RegressorKind", "Route"]
+__all__ = [
+    "Dataset",
+    "ModelColumns",
+    "RegressorBlock",
+    "RegressorKind",
+    "Route",
+    "TorqueRoute",
+]
 
 #: Which regressor a data set stacks (the kind of :func:`~dynid.regressors.base.
 #: base_parameters`).
@@ -154,3 +161,25 @@ class Dataset(Protocol):
         """The data's part of the model's record (reference, counts, preparation), given
         the rows used; the core fills in the rest."""
         ...
+
+
+class TorqueRoute:
+    """What every data set of joint-torque logs says of itself (a mixin of slotted
+    dataclasses): the classical route, the torque regressor, friction acting."""
+
+    __slots__ = ()
+
+    @property
+    def route(self) -> Literal["classical"]:
+        """``"classical"`` (Gaz et al. 2019, Sec. IV-B)."""
+        return "classical"
+
+    @property
+    def regressor_kind(self) -> Literal["torque"]:
+        """Joint torques."""
+        return "torque"
+
+    @property
+    def moving(self) -> bool:
+        """True: friction acts."""
+        return True

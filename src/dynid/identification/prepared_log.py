@@ -23,7 +23,7 @@ from .. import signals
 from ..exceptions import DataError, DynidWarning, OptionError, ShapeError
 from ..model.drive import Drive
 from ..model.robot import Robot
-from .dataset import ModelColumns, RegressorBlock
+from .dataset import ModelColumns, RegressorBlock, TorqueRoute
 from .info import IdentificationInfo, LogInfo
 from .log import LogCleaning, TorqueLog, joint_side_log
 from .log_rows import log_blocks, still_columns, still_friction
@@ -41,7 +41,7 @@ __all__ = ["PreparedLog", "prepare_torque_log"]
 
 
 @dataclass(frozen=True, slots=True, eq=False)
-class PreparedLog:
+class PreparedLog(TorqueRoute):
     """A torque log ready for identification (the :class:`~dynid.identification.core.Dataset`
     of the classical route): joint side, filtered, decimated, with ``ddq``.
 
@@ -90,21 +90,6 @@ class PreparedLog:
     resampled: bool = False
     torque_noise_std: NDArray[np.float64] | None = None
     tau_raw: NDArray[np.float64] | None = None
-
-    @property
-    def route(self) -> Literal["classical"]:
-        """``"classical"`` (Gaz et al. 2019, Sec. IV-B)."""
-        return "classical"
-
-    @property
-    def regressor_kind(self) -> Literal["torque"]:
-        """Joint torques."""
-        return "torque"
-
-    @property
-    def moving(self) -> bool:
-        """True: friction acts."""
-        return True
 
     @property
     def n(self) -> int:

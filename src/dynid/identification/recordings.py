@@ -49,6 +49,7 @@ from ..model.drive import Drive
 from ..model.robot import Robot
 from ..signals import lowpass_noise_gain
 from .core import ModelColumns, RegressorBlock
+from .dataset import TorqueRoute
 from .derived_band import derived_velocity_band
 from .holdout import DEFAULT_FOLDS, block_labels
 from .info import IdentificationInfo, LogInfo
@@ -134,7 +135,7 @@ class SampleCounts:
 
 
 @dataclass(frozen=True, slots=True, eq=False)
-class Recordings:
+class Recordings(TorqueRoute):
     """Prepared pieces of one or more recordings: a
     :class:`~dynid.identification.core.Dataset` of the classical route (module docstring).
 
@@ -189,21 +190,6 @@ class Recordings:
     n_recorded: int = 0
     band_gain: float = 1.0
     counts: tuple[SampleCounts, ...] = ()
-
-    @property
-    def route(self) -> Literal["classical"]:
-        """``"classical"`` (Gaz et al. 2019, Sec. IV-B)."""
-        return "classical"
-
-    @property
-    def regressor_kind(self) -> Literal["torque"]:
-        """Joint torques."""
-        return "torque"
-
-    @property
-    def moving(self) -> bool:
-        """True: friction acts."""
-        return True
 
     @property
     def n(self) -> int:
