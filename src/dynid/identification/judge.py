@@ -24,7 +24,7 @@ from .core import Judge, ModelColumns, RegressorStack, StreamedRows, selected_co
 from .estimators import Estimator, row_weights
 from .holdout import HeldOut, Normals, block_normals
 from .recordings import Recordings
-from .streaming import BlockSource, normals_by_label
+from .streaming import BlockSource, normals_by_label, normals_by_label_scaled
 
 __all__ = ["NOISE_FLOOR_SHARE", "heldout_judge", "inverse_noise"]
 
@@ -59,9 +59,9 @@ def heldout_judge(
         normals: Callable[[NDArray[np.intp]], tuple[Normals, ...]]
         if isinstance(stack, StreamedRows) and stack.normals is not None and validation is None:
             assert labels is not None  # the fit gathered the folds' normals by these labels
-            judged = normals_by_label(rows, labels) if measured_ok else None
             source = rows if measured_ok else selected_columns(stack.source, cols)
-            white = _whitened(source, labels, inv_noise)
+            plain, white = normals_by_label_scaled(source, labels, None, inv_noise)
+            judged = plain if measured_ok else None
             held = replace(HeldOut.k_fold(stack.normals, judged), scheme=scheme, whitened=white)
             return held.expanded(cols)
         if isinstance(stack, StreamedRows):  # rows in blocks: one pass per set of labels
@@ -83,11 +83,13 @@ def heldout_judge(
         elif labels is None:
             return None
         else:
-            judged = normals_by_label(rows, labels, rw) if measured_ok else None
-            # in units of each joint's noise alone: the estimator's weights (its own
-            # estimate of each joint's residual level, at the largest model) would make a
-            # joint's error vanish with the terms it loses
-            white = _whitened(rows if measured_ok else fitted, labels, inv_noise)
+            # the whitened rows in units of each joint's noise alone: the estimator's
+            # weights (its own estimate of each joint's residual level, at the largest
+            # model) would make a joint's error vanish with the terms it loses
+            plain, white = normals_by_label_scaled(
+                rows if measured_ok else fitted, labels, rw, inv_noise
+            )
+            judged = plain if measured_ok else None
             held = replace(HeldOut.k_fold(normals(labels), judged), scheme=scheme, whitened=white)
         return held.expanded(cols)
 
@@ -114,27 +116,6 @@ def inverse_noise(data: Recordings) -> NDArray[np.float64] | None:
     if not (np.all(np.isfinite(sigma)) and top > 0):
         return None
     return 1.0 / np.maximum(sigma, NOISE_FLOOR_SHARE * top)
-
-
-def _whitened(
-    source: BlockSource,
-    labels: NDArray[np.intp],
-    inverse_noise: NDArray[np.float64] | None,
-    weights: NDArray[np.float64] | None = None,
-) -> tuple[Normals, ...]:
-    """The folds' normal equations of ``source``'s rows (times ``weights``) with each
-    joint's rows divided by its noise (:attr:`~.holdout.HeldOut.whitened`); empty without
-    the noise."""
-    if inverse_noise is None:
-        return ()
-    inv = inverse_noise
-
-    def scaled() -> Any:
-        for W, y, g in source():
-            k = inv[np.asarray(g)]
-            yield W * k[:, None], y * k, g
-
-    return normals_by_label(scaled, labels, weights)
 
 
 def _rows(data: Recordings, robot: Robot, columns: ModelColumns) -> BlockSource:

@@ -65,6 +65,7 @@ __all__ = [
     "group_factors",
     "max_stack_bytes",
     "normals_by_label",
+    "normals_by_label_scaled",
     "streams",
 ]
 
@@ -390,28 +391,59 @@ def normals_by_label(
     ShapeError
         The blocks hold another number of rows than ``labels``.
     """
+    return normals_by_label_scaled(source, labels, weights)[0]
+
+
+def normals_by_label_scaled(
+    source: BlockSource,
+    labels: NDArray[np.intp],
+    weights: NDArray[np.float64] | None = None,
+    group_scale: NDArray[np.float64] | None = None,
+) -> tuple[tuple[Normals, ...], tuple[Normals, ...]]:
+    """:func:`normals_by_label` of the rows times ``weights``, and in the same pass those
+    of the rows times ``group_scale[group]`` (each row's noise group: a joint) alone (empty
+    without ``group_scale``).
+
+    Raises
+    ------
+    ShapeError
+        The blocks hold another number of rows than ``labels``.
+    """
     k = int(labels.max()) + 1 if labels.size else 0
-    G: NDArray[np.float64] | None = None
-    b = np.zeros((k, 0))
-    c = np.zeros(k)
+    sets = 1 if group_scale is None else 2
+    G: list[NDArray[np.float64]] = []
+    b: list[NDArray[np.float64]] = []
+    c = np.zeros((sets, k))
     o = 0
-    for W, y, _g in _blocks(source):
-        if G is None:
-            G, b = np.zeros((k, W.shape[1], W.shape[1])), np.zeros((k, W.shape[1]))
+    for W, y, g in _blocks(source):
+        if not G:
+            G = [np.zeros((k, W.shape[1], W.shape[1])) for _ in range(sets)]
+            b = [np.zeros((k, W.shape[1])) for _ in range(sets)]
         lab = labels[o : o + y.size]
         if lab.size != y.size:
             raise ShapeError(f"labels hold {labels.size} rows; the blocks more")
         for j in np.unique(lab):
             sel = lab == j
-            Wj, yj = W[sel], y[sel]
-            if weights is not None:
-                wj = weights[o : o + y.size][sel]
-                Wj, yj = Wj * wj[:, None], yj * wj
-            G[j] += Wj.T @ Wj
-            b[j] += Wj.T @ yj
-            c[j] += float(yj @ yj)
+            for s_ in range(sets):
+                Wj, yj = W[sel], y[sel]
+                if s_ == 0 and weights is not None:
+                    wj = weights[o : o + y.size][sel]
+                elif s_ == 1:
+                    assert group_scale is not None
+                    wj = group_scale[np.asarray(g)[sel]]
+                else:
+                    wj = None
+                if wj is not None:
+                    Wj, yj = Wj * wj[:, None], yj * wj
+                G[s_][j] += Wj.T @ Wj
+                b[s_][j] += Wj.T @ yj
+                c[s_, j] += float(yj @ yj)
         o += y.size
-    if o != labels.size or G is None:
+    if o != labels.size or not G:
         raise ShapeError(f"labels hold {labels.size} rows; the blocks {o}")
     cnt = np.bincount(labels, minlength=k)
-    return tuple(Normals(G[j], b[j], float(c[j]), int(cnt[j])) for j in range(k))
+    out = [
+        tuple(Normals(G[s_][j], b[s_][j], float(c[s_, j]), int(cnt[j])) for j in range(k))
+        for s_ in range(sets)
+    ]
+    return out[0], (out[1] if sets == 2 else ())
