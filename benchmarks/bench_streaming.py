@@ -8,7 +8,7 @@ blocks (``DYNID_MAX_STACK_BYTES=0``). The time is the process's CPU time (user +
 the best of ``--repeats``), the whole route (preparation, regressor, fit, held-out folds)
 since that is what a user waits for; the two fits must agree (coefficients to 1e-8
 relative). The default crossover (:data:`~dynid.identification.streaming.MAX_STACK_BYTES`,
-a stacked regressor of 256 MB) streams the longer logs only; the target (issue 28): the
+a stacked regressor of 128 MiB) streams the longer logs only; the target (issue 28): the
 streamed fit within 1.2x the CPU of the stacked one wherever the default streams, and the
 default path within 1.2x the faster of the two on every length.
 

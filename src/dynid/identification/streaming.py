@@ -82,8 +82,10 @@ BlockSource = Callable[[], Iterable[Block]]
 BLOCK_ROWS = 8_192
 
 #: Largest stacked regressor [bytes] a route holds whole before it streams its rows
-#: (``DYNID_MAX_STACK_BYTES`` overrides): below it the stacked fit is the faster one.
-MAX_STACK_BYTES = 256 << 20
+#: (``DYNID_MAX_STACK_BYTES`` overrides): below it the stacked fit is the faster one
+#: (``benchmarks/bench_streaming.py``: the same CPU at 109 MB, streamed 0.73 x stacked at
+#: 255 MB).
+MAX_STACK_BYTES = 128 << 20
 
 _ENV = "DYNID_MAX_STACK_BYTES"
 
