@@ -304,3 +304,28 @@ def test_the_classical_law_has_the_identification_s_friction_columns():
     C = columns(dq, np.zeros(3))
     for j in range(3):
         np.testing.assert_array_equal(F[:, j, 3 * j : 3 * j + 3], C[:, j, :])
+
+
+def test_a_negative_viscous_term_is_not_exported_as_negative_damping():
+    """A smooth law identified with the links can hold fv < 0 beside a larger smooth
+    Coulomb term (dissipative as a whole): MuJoCo and URDF would read a negative damping
+    as a joint that pushes. The export writes the nonnegative viscous and Coulomb friction
+    closest to the law's odd part over the velocity range (scipy's NNLS on the same grid),
+    and says so; a smooth law's rounding is fitted alike, a sharp law keeps its terms."""
+    from scipy.optimize import nnls
+
+    P = np.array([[-0.1, 1.0, 0.0], [0.3, 0.5, 0.0]])
+    band = np.array([0.3, 0.3])
+    fr = LAWS["smooth"].model(P, band)
+    terms = joint_coulomb_viscous(fr, dq_max=np.array([2.0, 2.0]))
+    assert np.all(terms.damping >= 0) and np.all(terms.frictionloss >= 0)
+    v = np.linspace(0.0, 2.0, 201)[1:]
+    odd = -0.1 * v + 1.0 * np.tanh(v / 0.3)
+    x, _ = nnls(np.column_stack([v, np.ones_like(v)]), odd)
+    np.testing.assert_allclose([terms.damping[0], terms.frictionloss[0]], x, atol=1e-9)
+    odd = 0.3 * v + 0.5 * np.tanh(v / 0.3)  # a smooth law's rounding: fitted alike
+    x, _ = nnls(np.column_stack([v, np.ones_like(v)]), odd)
+    np.testing.assert_allclose([terms.damping[1], terms.frictionloss[1]], x, atol=1e-9)
+    assert any("negative viscous or Coulomb term on 1)" in note for note in terms.notes)
+    sharp = joint_coulomb_viscous(LAWS["smooth"].model(P[1:]), dq_max=np.array([2.0]))
+    np.testing.assert_allclose([sharp.damping[0], sharp.frictionloss[0]], [0.3, 0.5])

@@ -25,6 +25,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from .. import _checks
 from ..exceptions import ShapeError
+from .laws.base import MjcfTerms, bounded_lstsq
 from .laws.sigmoid import odd_part
 from .model import FrictionModel, FrictionSum, friction_parts
 
@@ -213,6 +214,8 @@ def joint_coulomb_viscous(
     notes = (f"{friction.kind} friction: {terms.dropped} has no per-joint term",) * bool(
         terms.dropped
     )
+    terms, refit = _dissipative(friction, terms, vmax)
+    notes += refit
     if friction.drive is not None:
         d = friction.drive
         jt = drive_joint_terms(
@@ -225,6 +228,46 @@ def joint_coulomb_viscous(
         return replace(jt, notes=notes + jt.notes, offset=terms.offset)
     z = np.zeros(n)
     return DriveJointTerms(z, terms.damping, terms.frictionloss, notes, terms.offset)
+
+
+def _dissipative(
+    friction: FrictionModel, terms: MjcfTerms, vmax: NDArray[np.float64]
+) -> tuple[MjcfTerms, tuple[str, ...]]:
+    """``terms`` with every motor (joint) whose ``damping`` or ``frictionloss`` came out
+    negative (a law identified with the links whose viscous part is negative beside a
+    larger smooth Coulomb part: dissipative as a whole, not term by term), and every one of
+    a smooth-sign law, replaced by the nonnegative ``fv dq + fc sign(dq)`` closest to the
+    law's odd part over ``(0, vmax]`` (bounded least squares); the note naming them.
+    MuJoCo and URDF readers take a negative damping as a joint that pushes."""
+    negative = (terms.damping < 0) | (terms.frictionloss < 0)
+    # a smooth sign's rounding (tanh over a width) written as the sharp sign would cost
+    # every reversal: its odd part is fitted as the sigmoid's is
+    P = friction.as_array()
+    band = np.asarray(friction.band, dtype=np.float64)
+    band = band if band.size == P.shape[0] else np.zeros(P.shape[0])
+    smooth = (band > 0) & (friction.kind in ("smooth", "smooth_stribeck"))
+    bad = np.flatnonzero(negative | smooth)
+    if bad.size == 0:
+        return terms, ()
+    damping, loss = terms.damping.copy(), terms.frictionloss.copy()
+    worst = 0.0
+    for m in bad:
+        v = np.linspace(0.0, float(vmax[m]) if np.isfinite(vmax[m]) else 2.0, 201)[1:]
+        grid = np.zeros((v.size, P.shape[0]))
+        grid[:, m] = v
+        odd = 0.5 * (friction.law.torques(grid, P, band) - friction.law.torques(-grid, P, band))
+        A = np.column_stack([v, np.ones_like(v)])
+        x = bounded_lstsq(A, odd[:, m], np.zeros(2), np.full(2, np.inf))
+        damping[m], loss[m] = x
+        worst = max(worst, float(np.sqrt(np.mean((A @ x - odd[:, m]) ** 2))))
+    where = ", ".join(str(m + 1) for m in np.flatnonzero(negative))
+    said = f" (a negative viscous or Coulomb term on {where})" if where else ""
+    note = (
+        f"{friction.kind} friction{said}: written as the nonnegative viscous and Coulomb "
+        f"friction closest to the law over the velocity range (RMS difference up to "
+        f"{worst:.3g} N m)"
+    )
+    return replace(terms, damping=damping, frictionloss=loss), (note,)
 
 
 def unheld_friction(
