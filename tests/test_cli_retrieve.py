@@ -373,3 +373,28 @@ def test_consistent_routes_fail_in_one_line_and_write_nothing(tmp_path, capsys):
         err = capsys.readouterr().err
         assert rc == 2 and match in err and len(err.strip().splitlines()) == 1, (argv, err)
         assert not out.exists(), argv
+
+
+def test_a_friction_file_for_a_model_with_its_own_friction_is_refused(tmp_path, capsys):
+    """A model identified from torque logs holds friction identified with the links, which
+    feasible.json and the exports carry: a friction.json beside it was dropped without a
+    word; it is refused in one line naming the option, before any work."""
+    from dynid.friction.model import ClassicalFriction
+    from dynid.identification.selection import identify_recordings
+    from dynid.identification.structure import Structure
+
+    from conftest import recordings
+
+    panda = dynid.panda()
+    fr = ClassicalFriction(np.full(7, 0.2), np.full(7, 0.5), np.zeros(7))
+    logs = recordings(panda, (5, 6), friction=fr, duration=3.0)
+    model = identify_recordings(panda, logs, structure=Structure(False, ("viscous", "coulomb")))
+    path = save_model_json(tmp_path / "identification.json", model)
+    sig = save_friction_json(tmp_path / "friction.json", panda.friction)
+    argv = ["retrieve", "--model", str(path), "--friction", str(sig), "--out", str(tmp_path / "o")]
+    assert main(argv) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and "--friction applies to a model without friction" in err[0], err
+    assert (
+        "classical friction identified with the links" in err[0] and not (tmp_path / "o").exists()
+    )

@@ -96,9 +96,18 @@ def load_model_with_friction(
     Raises
     ------
     DynidError
-        A malformed file; a friction file that is not sigmoid friction.
+        A malformed file; a friction file that is not sigmoid friction, or given for a
+        model that holds friction of its own (identified with the links).
     """
     model = load_model_json(path)
+    own = combined(model.frictions)
+    if friction is not None and own is not None:
+        raise OptionError(
+            f"applies to a model without friction (static data); {Path(path).name} holds "
+            f"{own.kind} friction identified with the links, which feasible.json and the "
+            "exports carry: leave it out",
+            field="friction",
+        )
     robot = _with_friction(model.robot, friction)
     if robot is model.robot:
         return model
