@@ -19,14 +19,16 @@ A log without velocity columns gets its velocities from the positions at that cu
 Model structure. Beside the links' base parameters a torque log may need an armature
 (I_a ddq per joint; with a drive file, the rotor inertias at the motors), viscous and
 Coulomb friction (sign(dq) off inside each joint's velocity noise band, or a smooth
-tanh(dq/w) at four widths w, the narrowest about the velocity noise), a Stribeck bump
-exp(-(dq/vst)^2) at four Stribeck velocities, and torque offsets, each identified with
-the links. By default every combination is fitted and judged on data it was not fitted
-to (one recording left out at a time when there are several, else --folds contiguous
-time blocks, or --validate-on), and the simplest within one standard error of the lowest
-held-out error (of the difference, paired over the folds) is kept. The summary prints
-the table of candidates and the choice, and the terms' coefficients per joint;
-identification.json records them. --terms fixes the structure by hand
+tanh(dq/w) at seven widths w from 0.3 to 300 bands, the narrowest about the velocity
+noise), a Stribeck bump exp(-(dq/vst)^2) at seven Stribeck velocities from 0.02 to
+0.2 rad/s (on the banded sign or on the narrowest smooth one), and torque offsets, each
+identified with the links. By default every combination is fitted and judged on data it
+was not fitted to (one recording left out at a time when there are several, else --folds
+contiguous time blocks, or --validate-on), with every joint's torques in units of its own
+noise, and the simplest within one standard error of the lowest held-out error (of the
+difference, paired over the folds) is kept. The summary prints the table of candidates
+(each smooth or Stribeck law at its best shape) and the choice, and the terms'
+coefficients per joint; identification.json records them all. --terms fixes the structure by hand
 (e.g. --terms armature,viscous,coulomb,offset).
 
 Checks that the data belong to --robot: a static data file that records another robot
@@ -42,7 +44,9 @@ used as given, low-pass filtered at the cut-off with the other signals; without 
 are the derivative of the filtered velocities (an incomplete set is an error).
 
 Writes DIR/identification.json (coefficients, expressions, std, metrics, kinematics,
-identifiability of every standard parameter) and prints a summary table.
+identifiability of every standard parameter), from torque logs heldout.json and the
+held-out figures (heldout_torques.png, heldout_residuals.png; not with --no-figures),
+and report.html, and prints a summary table.
 
 Rank and conditioning. The base parameters come from the robot's kinematics: their number
 (the rank) is read from the first clear gap (a factor >= 1e3, below 1e-3 of the largest)
@@ -68,10 +72,10 @@ dominant coefficient, which then goes too (fix the conditioning first).
 With --consistent, the link parameters are identified physically consistent in one step
 (convex, every link's pseudo-inertia positive definite, pulled towards --prior; see
 `dynid retrieve --help`): from torque logs (one or more, prepared as above) with the
-classical friction (fv, fc >= 0) and the armature when the model structure chosen on
-held-out data has one (rotor inertias >= 0; --terms armature forces it), or from static
-data. Writes next to identification.json (the unconstrained fit) the files of
-`dynid retrieve`: feasible.json (links, and the friction identified with them), robot.urdf,
+friction of the structure chosen (viscous and Coulomb >= 0) and the armature when it has
+one (rotor inertias >= 0; --terms armature forces it), or from static data. Writes next
+to identification.json (the unconstrained fit) the files of `dynid retrieve`:
+feasible.json (links, and the friction identified with them), robot.urdf, robot.xml,
 robot.toml, report.json, retrieval.png. Exit code 1 when no consistent set satisfies the
 constraints (the closest one is written and reported).
 

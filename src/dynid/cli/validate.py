@@ -8,8 +8,9 @@ measured ones, per joint (RMS, MSE) and overall (relative error). Model sources:
   --robot ROBOT                 a robot's own link parameters and friction ('panda': the
                                 published feasible parameters and sigmoid friction)
   --params feasible.json        retrieved feasible link parameters (dynid retrieve), with
-                                the sigmoid friction stored beside them: Newton-Euler
-                                torques (RNEA) with those parameters (the paper's Fig. 5)
+                                the friction stored in them (the law identified with the
+                                links, or a sigmoid): Newton-Euler torques (RNEA) with
+                                those parameters (the paper's Fig. 5)
 
 --friction friction.json replaces the model's own friction. The states are low-pass
 filtered with zero phase (--cutoff), the accelerations differentiated from the filtered
