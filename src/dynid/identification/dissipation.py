@@ -23,7 +23,6 @@ import numpy as np
 from numpy.typing import NDArray
 
 from ..exceptions import DynidWarning
-from ..regressors.friction_columns import smooth_sign, standstill_sign, stribeck_decay
 from ..regressors.terms import PART_LABELS, LinearFriction, ModelTerm
 
 if TYPE_CHECKING:
@@ -39,21 +38,6 @@ __all__ = [
 
 #: Velocities checked per joint (motor), evenly over ``[-v_max, v_max]``.
 GRID = 401
-
-
-def _part_columns(term: LinearFriction, v: NDArray[np.float64]) -> dict[str, Any]:
-    """Each part's column at the velocities ``v`` (s, n) of the term's motors."""
-    n = v.shape[-1]
-    band = np.asarray(term.band, dtype=np.float64) if term.band else np.zeros(n)
-    smooth = "smooth" in term.parts
-    sign = smooth_sign(v, np.asarray(term.width)) if smooth else standstill_sign(v, band)
-    return {
-        "viscous": v,
-        "quadratic": v * np.abs(v),
-        "coulomb": standstill_sign(v, band),
-        "smooth": sign if smooth else None,
-        "stribeck": sign * stribeck_decay(v, term.vst) if "stribeck" in term.parts else None,
-    }
 
 
 #: Standard deviations by which each coefficient is moved towards zero before the check:
@@ -101,7 +85,7 @@ def friction_violations(
     f = np.zeros_like(v)
     coefficients: list[dict[str, float]] = [{} for _ in range(n)]
     for k, (term, values) in enumerate(terms):
-        cols = _part_columns(term, v)
+        cols = term.part_columns(v)  # (s, n, k): the parts in order
         every = [(j, p) for j in range(n) for p in term.parts]
         mask = term.mask or (True,) * len(every)
         held = [jp for jp, h in zip(every, mask, strict=True) if h]
@@ -112,7 +96,7 @@ def friction_violations(
         for (j, p), x in zip(held, x_all, strict=True):
             if p == "offset" or x == 0.0:
                 continue
-            f[:, j] += x * cols[p][:, j]
+            f[:, j] += x * cols[:, j, term.parts.index(p)]
             lab = f"{PART_LABELS[p]}{j + 1}"
             coefficients[j][lab] = coefficients[j].get(lab, 0.0) + float(x)
     power = f * v

@@ -409,7 +409,7 @@ class LinearFriction:
         unit = np.concatenate([np.linspace(1.0 / g, 1.0, g), np.geomspace(1e-4, 1.0, g)])
         v = unit[:, None] * vmax[None, :]  # (s, n)
         band = np.asarray(self.band, dtype=np.float64) if self.band else np.zeros(n)
-        F = self._part_columns(v, band)  # (s, n, k)
+        F = self.part_columns(v)  # (s, n, k)
         if "offset" in self.parts:  # not friction: the constant torque is of either sign
             F[..., self.parts.index("offset")] = 0.0
         rows = []
@@ -422,10 +422,11 @@ class LinearFriction:
         G = every[:, self._held]
         return distinct_rows(G[np.any(G != 0.0, axis=1)])
 
-    def _part_columns(
-        self, v: NDArray[np.float64], band: NDArray[np.float64]
-    ) -> NDArray[np.float64]:
-        """(..., n, k): each part's column at the motor (joint) velocities ``v`` (..., n)."""
+    def part_columns(self, v: NDArray[np.float64]) -> NDArray[np.float64]:
+        """(..., n, k): each part's column (:attr:`parts` in order) at the motor (joint)
+        velocities ``v`` (..., n), with the term's standstill band and width."""
+        n = v.shape[-1]
+        band = np.asarray(self.band, dtype=np.float64) if self.band else np.zeros(n)
 
         def sign() -> NDArray[np.float64]:  # the Coulomb part's sign, which the bump shares
             if "smooth" in self.parts:
@@ -484,8 +485,7 @@ class LinearFriction:
         n, k = v.shape[-1], len(self.parts)
         F = np.zeros(v.shape + (k * n,))
         m = np.arange(n)
-        band = np.asarray(self.band, dtype=np.float64) if self.band else np.zeros(n)
-        parts = self._part_columns(v, band)
+        parts = self.part_columns(v)
         for i in range(k):
             F[..., m, k * m + i] = parts[..., i]
         if self.mask:
