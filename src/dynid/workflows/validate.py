@@ -36,6 +36,7 @@ from ..friction.fit import same_drive
 from ..friction.model import FrictionModel, FrictionSum
 from ..friction.recordings import RecordingsValidation, validate_recordings
 from ..friction.validation import RECORDED, own_friction
+from ..identification.judge import NOISE_FLOOR_SHARE
 from ..identification.metrics import TorqueErrors
 from ..identification.model import IdentifiedModel
 from ..identification.sanity import anticorrelated, velocity_noise_std
@@ -279,8 +280,9 @@ def _judged(
     loaded = spread > 0.05 * max(float(spread.max(initial=0.0)), 1e-300)
     opposite = anticorrelated(model - model.mean(axis=0), tau - tau.mean(axis=0), loaded)
     # each joint's error over its noise (a noise next to nothing, as a filtered sensor's,
-    # counted at least a hundredth of the largest joint's)
-    ratios = np.asarray(errors.rms) / np.maximum(noise, 1e-2 * float(noise.max(initial=0.0)))
+    # counted at least the share of the largest joint's that the structure choice counts)
+    least = NOISE_FLOOR_SHARE * float(noise.max(initial=0.0))
+    ratios = np.asarray(errors.rms) / np.maximum(noise, least)
     verdict = judge_prediction(
         errors.relative_error_percent,
         floor,
