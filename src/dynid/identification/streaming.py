@@ -426,8 +426,9 @@ def normals_by_label_scaled(
             raise ShapeError(f"labels hold {labels.size} rows; the blocks more")
         for j in np.unique(lab):
             sel = lab == j
+            Ws, ys = W[sel], y[sel]
             for s_ in range(sets):
-                Wj, yj = W[sel], y[sel]
+                Wj, yj = Ws, ys
                 if s_ == 0 and weights is not None:
                     wj = weights[o : o + y.size][sel]
                 elif s_ == 1:
