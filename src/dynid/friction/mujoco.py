@@ -25,7 +25,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from .. import _checks
 from ..exceptions import ShapeError
-from .laws.base import MjcfTerms, bounded_lstsq
+from .laws.base import MjcfTerms, odd_coulomb_viscous
 from .laws.sigmoid import odd_part
 from .model import FrictionModel, FrictionSum, friction_parts
 
@@ -237,8 +237,9 @@ def _dissipative(
     negative (a law identified with the links whose viscous part is negative beside a
     larger smooth Coulomb part: dissipative as a whole, not term by term), and every one of
     a smooth-sign law, replaced by the nonnegative ``fv dq + fc sign(dq)`` closest to the
-    law's odd part over ``(0, vmax]`` (bounded least squares); the note naming them.
-    MuJoCo and URDF readers take a negative damping as a joint that pushes."""
+    law's odd part over ``(0, vmax]`` (:func:`~dynid.friction.laws.base.odd_coulomb_viscous`);
+    the note naming them. MuJoCo and URDF readers take a negative damping as a joint that
+    pushes."""
     negative = (terms.damping < 0) | (terms.frictionloss < 0)
     # a smooth sign's rounding (tanh over a width) written as the sharp sign would cost
     # every reversal: its odd part is fitted as the sigmoid's is
@@ -252,14 +253,15 @@ def _dissipative(
     damping, loss = terms.damping.copy(), terms.frictionloss.copy()
     worst = 0.0
     for m in bad:
-        v = np.linspace(0.0, float(vmax[m]) if np.isfinite(vmax[m]) else 2.0, 201)[1:]
-        grid = np.zeros((v.size, P.shape[0]))
-        grid[:, m] = v
-        odd = 0.5 * (friction.law.torques(grid, P, band) - friction.law.torques(-grid, P, band))
-        A = np.column_stack([v, np.ones_like(v)])
-        x = bounded_lstsq(A, odd[:, m], np.zeros(2), np.full(2, np.inf))
-        damping[m], loss[m] = x
-        worst = max(worst, float(np.sqrt(np.mean((A @ x - odd[:, m]) ** 2))))
+
+        def torque(v: NDArray[np.float64], m: int = int(m)) -> NDArray[np.float64]:
+            grid = np.zeros((v.size, P.shape[0]))
+            grid[:, m] = v
+            return friction.law.torques(grid, P, band)[:, m]
+
+        top = float(vmax[m]) if np.isfinite(vmax[m]) else 2.0
+        loss[m], damping[m], _, rms = odd_coulomb_viscous(torque, top)
+        worst = max(worst, rms)
     where = ", ".join(str(m + 1) for m in np.flatnonzero(negative))
     said = f" (a negative viscous or Coulomb term on {where})" if where else ""
     note = (

@@ -42,6 +42,7 @@ __all__ = [
     "canonical_rows",
     "coulomb_sign",
     "linear_law",
+    "odd_coulomb_viscous",
 ]
 
 #: The canonical friction parameters per motor that the observer's compiled step evaluates
@@ -330,6 +331,25 @@ def bounded_lstsq(
 
         x[used] = scipy.optimize.lsq_linear(A[:, used], b, bounds=(lo, hi), method="bvls").x
     return x
+
+
+def odd_coulomb_viscous(
+    torque: Callable[[NDArray[np.float64]], NDArray[np.float64]],
+    dq_max: float,
+    n_points: int = 200,
+) -> tuple[float, float, float, float]:
+    """``fc sign(dq) + fv dq`` with ``fc, fv >= 0`` closest (least squares) to the odd part
+    ``(torque(dq) - torque(-dq)) / 2`` of one joint's friction on ``n_points`` velocities
+    spread evenly over ``(0, dq_max]`` [rad/s]: ``(fc [N m], fv [N m s/rad], offset, rms)``,
+    ``offset`` the even part at ``dq_max`` [N m] (what the fit drops at large speed) and
+    ``rms`` the fit's RMS error [N m]. ``torque`` maps velocities (k,) to torques (k,)."""
+    v = np.linspace(dq_max / n_points, dq_max, n_points)
+    up, down = torque(v), torque(-v)
+    odd = 0.5 * (up - down)
+    A = np.stack([np.ones_like(v), v], axis=1)
+    x = bounded_lstsq(A, odd, np.zeros(2), np.full(2, np.inf))
+    rms = float(np.sqrt(np.mean((A @ x - odd) ** 2)))
+    return float(x[0]), float(x[1]), float(0.5 * (up[-1] + down[-1])), rms
 
 
 def linear_law(

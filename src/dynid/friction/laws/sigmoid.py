@@ -9,7 +9,7 @@ grid point (the law is linear in ``phi1``); deterministic. The law is smooth and
 rest, so it needs no standstill band.
 
 MuJoCo holds the odd part of the sigmoid, ``(tau_f(dq) - tau_f(-dq)) / 2``, fitted by
-``fc sign(dq) + fv dq`` (non-negative least squares on velocities up to ``dq_max``,
+``fc sign(dq) + fv dq`` (bounded least squares on velocities up to ``dq_max``,
 :func:`odd_part`); the even part (an offset at large speed) is dropped.
 """
 
@@ -19,7 +19,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from ..torques import sigmoid_friction
-from .base import FrictionLaw, JointFit, MjcfTerms, canonical_rows
+from .base import FrictionLaw, JointFit, MjcfTerms, canonical_rows, odd_coulomb_viscous
 
 __all__ = ["LAW", "odd_part"]
 
@@ -78,23 +78,13 @@ def odd_part(
     """``fc sign(dq) + fv dq`` fitted to the odd part of sigmoids (n, 3) on ``n_points``
     velocities in ``(0, dq_max]`` (n,) [rad/s]: ``(fc, fv, offset, rms)``, each (n,), with
     ``fc, fv >= 0``, ``offset`` the even part at ``dq_max`` [N m] and ``rms`` the fit's RMS
-    error [N m]."""
-    import scipy.optimize  # here: a robot holding the law loads no solver
-
-    n = P.shape[0]
-    coulomb, viscous, offset, rms = (np.zeros(n) for _ in range(4))
-    for j in range(n):
-        v = np.linspace(dq_max[j] / n_points, dq_max[j], n_points)
-        p1, p2, p3 = P[j]
-        up = sigmoid_friction(v, p1, p2, p3)
-        down = sigmoid_friction(-v, p1, p2, p3)
-        odd = (up - down) / 2.0
-        A = np.stack([np.ones_like(v), v], axis=1)
-        x, _ = scipy.optimize.nnls(A, odd)
-        coulomb[j], viscous[j] = x
-        offset[j] = (up[-1] + down[-1]) / 2.0
-        rms[j] = float(np.sqrt(np.mean((A @ x - odd) ** 2)))
-    return coulomb, viscous, offset, rms
+    error [N m] (:func:`~dynid.friction.laws.base.odd_coulomb_viscous` per joint)."""
+    fits = [
+        odd_coulomb_viscous(lambda v, p=p: sigmoid_friction(v, *p), float(vmax), n_points)
+        for p, vmax in zip(P, dq_max, strict=True)
+    ]
+    out = np.array(fits, dtype=np.float64).reshape(-1, 4).T
+    return out[0], out[1], out[2], out[3]
 
 
 def _torques(
