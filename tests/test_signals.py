@@ -65,6 +65,18 @@ def test_lowpass_edges_are_small_after_trimming():
     assert np.max(np.abs(y - x)) > 1e-3  # the untrimmed edges are worse
 
 
+def test_lowpass_ends_do_not_jump_with_the_last_bit_of_the_rate():
+    """A rate read as 1000.0000000000002 Hz from a window of a log (the least-squares
+    slope's rounding) filters as 1000 Hz does: the ends' lengths came from ceil(fs / f_c),
+    which jumped from 40 to 41 samples and moved a block's derived velocities by 1e-4 of
+    the whole log's."""
+    rng = np.random.default_rng(7)
+    x = np.cumsum(rng.normal(size=(3000, 2)), axis=0)
+    a = signals.lowpass(x, 1000.0, 25.0)
+    b = signals.lowpass(x, 1000.0 * (1 + 2e-16), 25.0)
+    np.testing.assert_allclose(b, a, rtol=0, atol=1e-9 * float(np.abs(a).max()))
+
+
 def test_lowpass_rejects_bad_cutoff_short_signal_and_nan():
     """Cutoff at or above Nyquist, too few samples and NaN raise clear errors."""
     x = np.zeros(100)

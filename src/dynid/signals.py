@@ -242,7 +242,9 @@ def lowpass(
     N = x.shape[axis]
     if N <= minimum:
         raise DataError(f"lowpass needs more than {minimum} samples along axis {axis}; got {N}")
-    period = fs / cutoff_hz  # samples
+    # samples; rounded so that a rate read as 1000.0000000000002 Hz from a window of a log
+    # does not lengthen the ends by a sample (a block then differs from the whole log)
+    period = round(fs / cutoff_hz, 9)
     ends = _CubicEnds(N, min(N, max(4, int(np.ceil(_FIT_PERIODS * period)))), period)
     padlen = max(minimum, int(np.ceil(period)))
 
