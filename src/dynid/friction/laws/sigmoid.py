@@ -79,10 +79,13 @@ def odd_part(
     velocities in ``(0, dq_max]`` (n,) [rad/s]: ``(fc, fv, offset, rms)``, each (n,), with
     ``fc, fv >= 0``, ``offset`` the even part at ``dq_max`` [N m] and ``rms`` the fit's RMS
     error [N m] (:func:`~dynid.friction.laws.base.odd_coulomb_viscous` per joint)."""
-    fits = [
-        odd_coulomb_viscous(lambda v, p=p: sigmoid_friction(v, *p), float(vmax), n_points)
-        for p, vmax in zip(P, dq_max, strict=True)
-    ]
+    fits = []
+    for p, vmax in zip(P, dq_max, strict=True):
+
+        def torque(v: NDArray[np.float64], p: NDArray[np.float64] = p) -> NDArray[np.float64]:
+            return sigmoid_friction(v, p[0], p[1], p[2])
+
+        fits.append(odd_coulomb_viscous(torque, float(vmax), n_points))
     out = np.array(fits, dtype=np.float64).reshape(-1, 4).T
     return out[0], out[1], out[2], out[3]
 
