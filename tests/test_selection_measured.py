@@ -1,9 +1,10 @@
 """The structure's held-out judgement predicts the torques as measured, with the columns
 that step at a reversal as the model applies them; checked against a direct computation
 of that judgement, written out here: two noisy recordings, each left out in turn, the fit
-on the low-passed rows (the Coulomb columns through the torques' low-pass, the "parallel
-filtering" of the fit) predicting the other recording's measured torques from the sharp
-Coulomb columns, ``100 sqrt(sum SSE / sum ||tau||^2)``."""
+on the low-passed rows (the Coulomb columns through the torques' low-pass at the
+recording's own rate, before decimation: the "parallel filtering and decimation" of the
+fit) predicting the other recording's measured torques from the sharp Coulomb columns,
+``100 sqrt(sum SSE / sum ||tau||^2)``."""
 
 from __future__ import annotations
 
@@ -25,28 +26,33 @@ from dynid.simulation.measurement import SensorNoise
 from conftest import recordings
 
 
-def _rows(robot, base, band, labels, piece, cutoff_hz):
+def _rows(robot, base, band, labels, piece, raw, cutoff_hz):
     """The rows (sample-major) of one prepared piece: the rigid base columns (numpy
     reference regressor), ``dq_j`` and ``sign(dq_j)`` (0 within the standstill band) in the
-    row of joint ``j``; with the Coulomb columns as fitted (low-passed at ``cutoff_hz``) and
-    as the model applies them (sharp); the low-passed and the measured torques."""
+    row of joint ``j``; with the Coulomb columns as fitted and as the model applies them
+    (sharp); the low-passed and the measured torques. The fitted Coulomb columns come from
+    the ``raw`` recording: its velocities low-passed, the sign taken and low-passed at its
+    own rate (as its torques were), then read at the piece's samples."""
     log = piece.log
     N, n = log.q.shape
     Y = torque_regressor_numpy(robot, log.q, log.dq, log.ddq)[..., np.asarray(base.independent)]
+    fs = 1.0 / float(np.median(np.diff(raw.t)))
+    at = np.searchsorted(raw.t, log.t - 1e-9)
+    np.testing.assert_allclose(raw.t[at], log.t, rtol=0, atol=1e-12)
+    dq_full = signals.lowpass(raw.dq, fs, cutoff_hz, axis=0)
     F = np.zeros((N, n, len(labels)))
-    sharp = np.zeros(len(labels), bool)
+    Ff = np.zeros((N, n, len(labels)))
     for c, label in enumerate(labels):
         j = int(label[2:]) - 1
         v = log.dq[:, j]
         if label.startswith("fv"):
-            F[:, j, c] = v
+            F[:, j, c] = Ff[:, j, c] = v
         else:
             assert label.startswith("fc")
             F[:, j, c] = np.where(np.abs(v) > band[j], np.sign(v), 0.0)
-            sharp[c] = True
-    Ff = F.copy()
-    fs = 1.0 / float(np.median(np.diff(log.t)))
-    Ff[..., sharp] = signals.lowpass(F[..., sharp], fs, cutoff_hz, axis=0)
+            w = dq_full[:, j]
+            step = np.where(np.abs(w) > band[j], np.sign(w), 0.0)
+            Ff[:, j, c] = signals.lowpass(step, fs, cutoff_hz)[at]
     fitted = np.concatenate([Y, Ff], axis=-1).reshape(N * n, -1)
     measured = np.concatenate([Y, F], axis=-1).reshape(N * n, -1)
     return fitted, log.tau.reshape(-1), measured, np.asarray(piece.tau_raw).reshape(-1)
@@ -68,8 +74,11 @@ def test_heldout_error_of_a_structure_is_the_direct_one_on_measured_torques(
     term = model.terms["friction"].term
     band = np.asarray(term.band)
     assert band.size == 7 and np.all(band > 0)
-    rows = [_rows(panda, model.base, band, term.labels, p, data.cutoff_hz) for p in data.pieces]
-    assert len(rows) == 2  # one piece per recording: leave one recording out
+    assert len(data.pieces) == 2  # one piece per recording: leave one recording out
+    rows = [
+        _rows(panda, model.base, band, term.labels, p, raw, data.cutoff_hz)
+        for p, raw in zip(data.pieces, logs, strict=True)
+    ]
     assert streams(data.n_samples * 7, rows[0][0].shape[1]) == (stack_bytes is not None)
     sse = norm = 0.0
     for k, (_, _, Wm, ym) in enumerate(rows):
@@ -80,7 +89,11 @@ def test_heldout_error_of_a_structure_is_the_direct_one_on_measured_torques(
     want = 100.0 * np.sqrt(sse / norm)
     held = model.info.heldout
     assert held["scheme"] == "recordings" and held["folds"] == 2
-    assert held["heldout_error_percent"] == pytest.approx(want, rel=1e-7)
+    # the fit's columns are computed from the decimated velocities interpolated between
+    # their samples: equal to 2e-7 inside a recording, they differ where it starts and ends
+    # at rest, its velocity at the standstill band (rel 3e-4 here; the columns filtered at
+    # the decimated rate were 20 % off: 0.843 % against 0.699 %)
+    assert held["heldout_error_percent"] == pytest.approx(want, rel=1e-3)
     # the measured torques are what is judged: the low-passed ones give another error
     sse_f = sum(
         float(np.sum((r[1] - r[0] @ np.linalg.lstsq(o[0], o[1], rcond=None)[0]) ** 2))

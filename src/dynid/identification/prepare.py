@@ -31,6 +31,7 @@ __all__ = [
     "measured_torques",
     "prepare_log",
     "prepared_blocks",
+    "trimmed_margins",
 ]
 
 
@@ -197,6 +198,34 @@ def measured_torques(log: TorqueLog, prep: Preprocessing = _DEFAULT) -> NDArray[
         return np.array(log.tau[idx])
     ts = plan.t[idx]
     return np.stack([np.interp(ts, log.t, log.tau[:, j]) for j in range(log.n)], axis=1)
+
+
+def trimmed_margins(
+    log: TorqueLog, prep: Preprocessing = _DEFAULT
+) -> tuple[TorqueLog | None, TorqueLog | None]:
+    """The samples :func:`prepare_log` trims, prepared as it prepares the kept ones: the
+    signals at every ``prep.decimate``-th sample of the grid before its first kept sample
+    and after its last, in phase with them (the head's last sample one decimated step
+    before the first kept one). A column filtered as the torques were (the parallel
+    filtering of :mod:`~dynid.identification.log_rows`) needs them: the torques near
+    the kept ends were filtered with what came before and after. None for a margin of
+    fewer than 2 such samples."""
+    plan = _plan(log, prep)
+    out, M = plan.out, plan.t.shape[0]
+    k = out.step
+    head_rows = range(out.start % k, out.start, k)
+    tail_rows = range(out[-1] + k, M, k)
+
+    def margin(rows: range) -> TorqueLog | None:
+        if len(rows) < 2:
+            return None
+        lo, hi = max(0, rows.start - plan.pad), min(M, rows[-1] + 1 + plan.pad)
+        piece = _prepared_window(
+            log, plan, lo, hi, slice(rows.start - lo, rows[-1] + 1 - lo, k), prep.filter_tau
+        )
+        return _as_log(piece, log)
+
+    return margin(head_rows), margin(tail_rows)
 
 
 def _as_log(out: dict[str, NDArray[np.float64]], log: TorqueLog) -> TorqueLog:

@@ -14,7 +14,7 @@ from __future__ import annotations
 import warnings
 from collections.abc import Iterator
 from dataclasses import dataclass
-from typing import Literal
+from typing import Any, Literal
 
 import numpy as np
 from numpy.typing import NDArray
@@ -27,7 +27,7 @@ from .dataset import ModelColumns, RegressorBlock, TorqueRoute
 from .info import IdentificationInfo, LogInfo
 from .log import LogCleaning, TorqueLog, joint_side_log
 from .log_rows import log_blocks, still_columns, still_friction
-from .prepare import Preprocessing, measured_torques, prepare_log
+from .prepare import Preprocessing, measured_torques, prepare_log, trimmed_margins
 from .rate import cutoff_from_motion, decimation, motion_frequency
 from .sanity import (
     check_torque_log,
@@ -74,6 +74,11 @@ class PreparedLog(TorqueRoute):
         The joint-side torques at the prepared samples as measured, not low-passed (None
         when the log was not filtered): the held-out judgement predicts them, as
         ``dynid validate`` does.
+    head, tail : TorqueLog or None
+        The samples trimmed before and after ``log``, prepared alike at the same decimated
+        step (:func:`~dynid.identification.prepare.trimmed_margins`): the parallel
+        filtering of the columns that step at a reversal reads them near the ends; None
+        without filtering or for a margin of fewer than 2 samples.
     """
 
     log: TorqueLog
@@ -90,6 +95,8 @@ class PreparedLog(TorqueRoute):
     resampled: bool = False
     torque_noise_std: NDArray[np.float64] | None = None
     tau_raw: NDArray[np.float64] | None = None
+    head: TorqueLog | None = None
+    tail: TorqueLog | None = None
 
     @property
     def n(self) -> int:
@@ -123,7 +130,17 @@ class PreparedLog(TorqueRoute):
         """One block (:func:`log_blocks`); several when the log is too long to stack."""
         if columns.drive is not self.drive:
             raise OptionError("the log was prepared for another drive than the model's")
-        yield from log_blocks(robot, self.log, columns, cutoff_hz=self.cutoff_hz)
+        yield from log_blocks(robot, self.log, columns, **self.filtering)
+
+    @property
+    def filtering(self) -> dict[str, Any]:
+        """How :func:`log_blocks` filters the columns that step at a reversal as the
+        torques were: the cut-off, the decimation and the trimmed margins."""
+        return {
+            "cutoff_hz": self.cutoff_hz,
+            "upsample": self.decimate,
+            "edges": (self.head, self.tail),
+        }
 
     def record(self, n_rows: int) -> IdentificationInfo:
         """Filtering, decimation and sample counts."""
@@ -204,8 +221,10 @@ def prepare_torque_log(
     prep = Preprocessing(cutoff_hz=cutoff_hz, trim_s=trim_s, max_gap_s=max_gap_s, decimate=k)
     prepared = prepare_log(jlog, prep)
     raw = None
+    head = tail = None
     if cutoff_hz is not None:  # the torques as measured at the same samples
         raw = measured_torques(jlog, prep)
+        head, tail = trimmed_margins(jlog, prep)
     noise = velocity_noise_std(jlog.tau) if jlog.n_samples >= 3 else None
     del jlog
     return PreparedLog(
@@ -223,4 +242,6 @@ def prepare_torque_log(
         resampled=not signals.is_uniform(log.t),
         torque_noise_std=noise,
         tau_raw=None if raw is None or raw.shape != prepared.tau.shape else raw,
+        head=head,
+        tail=tail,
     )

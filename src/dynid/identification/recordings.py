@@ -252,11 +252,9 @@ class Recordings(TorqueRoute):
         n = self.n
         if streams(self.n_samples * n, len(columns.labels)):
             for p in self.pieces:
-                yield from log_blocks(robot, p.log, columns, stream=True, cutoff_hz=p.cutoff_hz)
+                yield from log_blocks(robot, p.log, columns, stream=True, **p.filtering)
             return
-        parts = [
-            b for p in self.pieces for b in log_blocks(robot, p.log, columns, cutoff_hz=p.cutoff_hz)
-        ]
+        parts = [b for p in self.pieces for b in log_blocks(robot, p.log, columns, **p.filtering)]
         if len(parts) == 1:
             yield parts[0]
             return
