@@ -1,8 +1,9 @@
 """Detection a block of samples at a time: the events of :class:`EventDetector` fed any
 blocks equal those of a per-sample reference written from the definition (runs over the
 threshold, joined within merge_s, never across a restart; peaks at the first largest
-magnitude); ``dynid observe --thresholds`` in blocks that cut a contact gives the events
-and the residual table of one block, and finds a simulated contact at its time."""
+magnitude; the largest residual over its sample's threshold); ``dynid observe
+--thresholds`` in blocks that cut a contact gives the events and the residual table of one
+block, and finds a simulated contact at its time."""
 
 from __future__ import annotations
 
@@ -124,6 +125,9 @@ def test_events_fed_in_blocks_are_those_of_the_definition(merge):
         restarts=restarts,
     )  # fmt: skip
     assert _as_tuples(whole) == want
+    # the largest |r| over the threshold at its sample, what the console prints beside the
+    # largest |r| (that one over the base threshold made 'max |r| > contact, 0 events')
+    ratio = np.nanmax(np.abs(r) / c, axis=0)
     for block in range(1, N + 1):
         det = EventDetector(th, merge_s=merge, min_duration_s=0.01, restarts=restarts)
         got = []
@@ -131,6 +135,7 @@ def test_events_fed_in_blocks_are_those_of_the_definition(merge):
             k = slice(a, a + block)
             got += det.feed(t[k], r[k], std=std[k], standstill=margin[k])
         assert _as_tuples(got + det.finish()) == want, block
+        np.testing.assert_allclose(det.largest_ratio, ratio, rtol=1e-12)
 
 
 def test_one_push_near_a_flickering_threshold_is_one_event_starting_at_its_first_crossing():

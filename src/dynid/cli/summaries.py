@@ -527,7 +527,11 @@ def format_observation(result: ObserveResult, names: list[str], *, calibrating: 
         peaks = [x.largest() for x in result.logs]
         one = len(peaks) == 1
         cols = {("max |r| [N m]" if one else "max |r| all logs [N m]"): np.nanmax(peaks, axis=0)}
-    cols |= {"contact [N m]": th.contact, "collision [N m]": th.collision}
+        ratios = [x.peak_ratio for x in result.logs if x.peak_ratio is not None]
+        if ratios:  # what decides: the threshold at each sample, not its base value
+            cols["max |r|/contact"] = np.nanmax(ratios, axis=0)
+    base = " base" if th.uses_uncertainty or th.standstill else ""
+    cols |= {f"contact{base} [N m]": th.contact, f"collision{base} [N m]": th.collision}
     rest = undetected_at_rest(result.model, th)
     at_rest = calibrating and th.standstill and np.any(rest > th.contact)
     if at_rest:
@@ -569,6 +573,11 @@ def format_observation(result: ObserveResult, names: list[str], *, calibrating: 
     if calibrating:
         rows.append(f"calibrated on {th.samples} samples of {len(result.logs)} log(s)")
         return "\n".join(rows)
+    if "max |r|/contact" in cols:
+        rows.append(
+            "max |r|/contact: the largest residual over the contact threshold at the same "
+            "sample (as it stood then); an event needs 1 or more"
+        )
     labels = log_labels([x.path for x in result.logs])
     if len(result.logs) > 1:  # the pooled column holds the contacts of every log
         rows.append("max |r| per log [N m], joints in the table's order:")

@@ -213,6 +213,15 @@ class EventDetector:
         self._next = 0  # the log's sample the next block starts at
         self._open: _Open | None = None
         self._run: _Run | None = None  # a run that reached the end of the last block
+        self._ratio = np.full(thresholds.n, np.nan)
+
+    @property
+    def largest_ratio(self) -> NDArray[np.float64]:
+        """The largest ``|r| / contact threshold`` of each joint (n,) over the samples fed
+        so far, the threshold as it stood at each sample (uncertainty and standstill
+        margin included); NaN where never observed. 1 or more where a run over the
+        threshold began (an event, unless too short or isolated)."""
+        return self._ratio.copy()
 
     def feed(
         self,
@@ -252,6 +261,10 @@ class EventDetector:
             std = np.where(seen[:, None], np.asarray(std, dtype=np.float64), 0.0)
         ra = np.where(seen[:, None], ra, 0.0)
         contact, collision = threshold_series(self.thresholds, m, std, standstill)
+        if seen.any():
+            with np.errstate(divide="ignore", invalid="ignore"):
+                ratio = np.abs(ra[seen]) / contact[seen]
+            self._ratio = np.fmax(self._ratio, np.nanmax(np.where(ratio >= 0, ratio, np.nan), 0))
         first, self._next = self._next, self._next + m
         over = np.abs(ra) > contact
         beyond = np.abs(ra) > collision

@@ -79,6 +79,10 @@ class LogObservation:
         without the series.
     truth_rms : ndarray, shape (n,), or None
         :meth:`truth_error` computed while observing (kept without the series).
+    peak_ratio : ndarray, shape (n,), or None
+        The largest ``|r|`` over the contact threshold at the same sample of each joint
+        (:attr:`~dynid.observer.events.EventDetector.largest_ratio`; NaN: never
+        observed), when detecting.
     figure : FigureSeries or None
         Every few samples of the series for a figure (kept without the series).
     """
@@ -96,6 +100,7 @@ class LogObservation:
     peak: NDArray[np.float64] | None = None
     truth_rms: NDArray[np.float64] | None = None
     figure: FigureSeries | None = None
+    peak_ratio: NDArray[np.float64] | None = None
 
     @property
     def series(self) -> NDArray[np.float64]:

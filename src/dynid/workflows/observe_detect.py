@@ -127,6 +127,7 @@ def detected_log(
         peak=stats.peak,
         truth_rms=stats.truth(),
         figure=None if strided is None else strided.series(),
+        peak_ratio=det.largest_ratio,
     )
 
 
