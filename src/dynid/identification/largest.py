@@ -5,12 +5,16 @@
 :func:`~dynid.identification.structure.regressor_group`) with the held-out judge, so that
 each candidate is judged on its own columns of the folds' normal equations. Where the data
 cannot tell some columns apart, only the alike candidates are left out, one set after the
-other (:data:`SMOOTH_THINNING`), each named in one note.
+other (:data:`SMOOTH_THINNING`), each named in one note; the smooth widths left out are
+judged each in a regressor of its own: alike the others near rest in
+the rank's eyes, they need not predict alike (the narrowest, the expected sign of a sharp
+Coulomb law given the velocity noise, against the banded sign).
 """
 
 from __future__ import annotations
 
 import warnings
+from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
@@ -31,7 +35,12 @@ from .structure import (
     regressor_group,
 )
 
-__all__ = ["SMOOTH_THINNING", "fit_largest", "recording_bands"]
+__all__ = ["SMOOTH_THINNING", "Fitted", "fit_largest", "recording_bands"]
+
+#: A regressor fitted with the held-out judge: its family (the third item of
+#: :func:`~dynid.identification.structure.regressor_group`, ``smooth:W`` for a width
+#: judged apart), the model, its terms (with what each stands for) and its candidates.
+Fitted = tuple[str, IdentifiedModel, list[tuple[ModelTerm, Any]], list[Structure]]
 
 
 def recording_bands(data: Recordings) -> dict[str, tuple[float, ...]]:
@@ -50,12 +59,13 @@ def fit_largest(
     judge: Judge,
     notes: list[str],
     fold_labels: NDArray[np.intp] | None = None,
-) -> tuple[IdentifiedModel, list[tuple[ModelTerm, Any]], list[Structure]] | None:
-    """The model of every candidate's columns at once, with its terms and the candidates it
-    holds; when the data cannot tell its columns apart, the Stribeck laws at
-    :data:`~dynid.identification.structure.STRIBECK_COARSE` only, then the classical
-    candidates alone (a note says which were left out); None (and a note) when not even
-    those are identifiable."""
+) -> list[Fitted]:
+    """The model of every candidate's columns at once, with its terms and the candidates
+    it holds; when the data cannot tell its columns apart, the Stribeck laws at
+    :data:`~dynid.identification.structure.STRIBECK_COARSE` only, then fewer smooth widths,
+    then the classical candidates alone, and after it the smooth widths left out, each in
+    a regressor of its own (one note says which were judged apart and which left out);
+    empty (and a note) when not even the classical candidates are identifiable."""
     shaped = [c for c in mine if {"smooth", "stribeck"} & set(c.friction)]
     coarse = [c for c in mine if "stribeck" not in c.friction or c.vst in STRIBECK_COARSE]
     tries = [mine, coarse]
@@ -76,31 +86,32 @@ def fit_largest(
     laws = "smooth-sign Stribeck" if family.startswith("smooth") else family or "smooth"
     laws = "Stribeck" if laws == "stribeck" else laws
     failed: list[str] = []
+    fit = _Fit(robot, data, arm, drive, est, rtol, judge, fold_labels)
     for k, group in enumerate(tries):
         if not group or (k and len(group) == len(tries[k - 1])):
             continue
-        model_drive, terms = largest_terms(
-            group, arm, drive, robot.n, tuple(data.band), recording_bands(data), data.band_gain
-        )
         try:
-            with warnings.catch_warnings():  # the candidates' fits: only the chosen one speaks
-                warnings.simplefilter("ignore", DynidWarning)
-                model = identify(
-                    robot,
-                    data,
-                    drive=model_drive,
-                    terms=tuple(t for t, _ in terms),
-                    estimator=est,
-                    rtol=rtol,
-                    judge=judge,
-                    fold_labels=fold_labels,
-                )
+            model, terms = fit(group)
         except RankDeficientError as exc:
             failed.append(f"rank {exc.rank} < {exc.needed}")
             continue
+        out: list[Fitted] = [(family, model, terms, group)]
         if failed:
-            notes.append(_left_out_note(mine, group, laws, what) + f" ({'; '.join(failed)})")
-        return model, terms, group
+            apart = _fit_apart(fit, [c for c in mine if c not in group], family)
+            out += apart
+            judged = {c for *_, g in apart for c in g}
+            note = _left_out_note(mine, group + list(judged), laws, what)
+            if judged:
+                widths = ", ".join(f"{w:g}" for w in sorted({c.width for c in judged}))
+                note += (
+                    f"; the widths {widths} bands judged each in a regressor of its own"
+                    if note
+                    else f"the {laws} candidates {what} at the widths {widths} bands: too "
+                    "alike their neighbours near rest to share a regressor with them, "
+                    "judged each in a regressor of its own"
+                )
+            notes.append(note + f" ({'; '.join(failed)})")
+        return out
     if failed:
         notes.append(
             (
@@ -110,7 +121,67 @@ def fit_largest(
             )
             + f" ({'; '.join(failed)})"
         )
-    return None
+    return []
+
+
+@dataclass(frozen=True)
+class _Fit:
+    """The model of a group of candidates' columns (:func:`largest_terms`) with the
+    held-out judge, on the data and options of one :func:`fit_largest`."""
+
+    robot: Robot
+    data: Recordings
+    arm: bool
+    drive: Drive | None
+    est: Estimator
+    rtol: float | None
+    judge: Judge
+    fold_labels: NDArray[np.intp] | None
+
+    def __call__(
+        self, group: list[Structure]
+    ) -> tuple[IdentifiedModel, list[tuple[ModelTerm, Any]]]:
+        """The model and its terms; raises RankDeficientError where the data cannot tell
+        the group's columns apart."""
+        data = self.data
+        model_drive, terms = largest_terms(
+            group,
+            self.arm,
+            self.drive,
+            self.robot.n,
+            tuple(data.band),
+            recording_bands(data),
+            data.band_gain,
+        )
+        with warnings.catch_warnings():  # the candidates' fits: only the chosen one speaks
+            warnings.simplefilter("ignore", DynidWarning)
+            model = identify(
+                self.robot,
+                data,
+                drive=model_drive,
+                terms=tuple(t for t, _ in terms),
+                estimator=self.est,
+                rtol=self.rtol,
+                judge=self.judge,
+                fold_labels=self.fold_labels,
+            )
+        return model, terms
+
+
+def _fit_apart(fit: _Fit, left: list[Structure], family: str = "") -> list[Fitted]:
+    """The smooth candidates (not Stribeck) of ``left`` (left out of their shared
+    regressor) in one regressor per width, family ``smooth:W`` (after ``family``); those
+    of a width whose own columns the data cannot tell apart stay left out."""
+    out: list[Fitted] = []
+    smooth = [c for c in left if "smooth" in c.friction and "stribeck" not in c.friction]
+    for w in sorted({c.width for c in smooth}):
+        group = [c for c in smooth if c.width == w]
+        try:
+            model, terms = fit(group)
+        except RankDeficientError:
+            continue
+        out.append(((f"{family} " if family else "") + f"smooth:{w:g}", model, terms, group))
+    return out
 
 
 #: The order in which smooth widths (in bands) are left out of a regressor whose columns
@@ -119,12 +190,15 @@ SMOOTH_THINNING = (1.0, 3.0, 0.3, 10.0, 30.0, 100.0, 300.0)
 
 
 def _left_out_note(mine: list[Structure], group: list[Structure], laws: str, what: str) -> str:
-    """One note naming the shaped candidates of ``mine`` left out of ``group``."""
+    """One note naming the shaped candidates of ``mine`` left out of ``group`` ("" for
+    none)."""
     vst = sorted({c.vst for c in mine if c not in group and c.vst})
     widths = sorted(
         {c.width for c in mine if c not in group and c.friction and "stribeck" not in c.friction}
         - {0.0}
     )
+    if not vst and not widths:
+        return ""
     if len(group) > len([c for c in mine if not {"smooth", "stribeck"} & set(c.friction)]):
         parts = [f"Stribeck velocities {', '.join(f'{v:g}' for v in vst)} rad/s"] if vst else []
         parts += [f"widths {', '.join(f'{w:g}' for w in widths)} bands"] if widths else []

@@ -205,17 +205,16 @@ def select_structure(
     for key in sorted({regressor_group(c) for c in cands}):
         arm = key[0]
         mine = [c for c in cands if regressor_group(c) == key]
-        fitted = fit_largest(robot, data, mine, arm, drive, est, rtol, judge, notes, fold_labels)
-        if fitted is None:
-            continue
-        model, terms, mine = fitted
-        if model.holdout is None:
-            return None
-        groups[key] = (model, terms)
-        for c in mine:
-            use = candidate_columns(c, model, terms)
-            columns.append((c, use, key))
-            judged.append(_judged(c, use, model, terms, model.holdout, fit_rtol))
+        fits = fit_largest(robot, data, mine, arm, drive, est, rtol, judge, notes, fold_labels)
+        for family, model, terms, held in fits:  # a smooth width judged apart: its own key
+            if model.holdout is None:
+                return None
+            own = (arm, key[1], family)
+            groups[own] = (model, terms)
+            for c in held:
+                use = candidate_columns(c, model, terms)
+                columns.append((c, use, own))
+                judged.append(_judged(c, use, model, terms, model.holdout, fit_rtol))
     if not judged:
         return None
     full = list(judged)
