@@ -690,3 +690,36 @@ def test_the_held_out_verdict_has_levels_a_person_can_act_on(tmp_path, error, fl
     got, text = _verdict_of(render_html_report(RunSummary(command="identify"), files))
     assert got == level, text
     assert text.strip().lower().startswith(label), text
+
+
+def test_a_consistent_fit_heads_its_page_with_its_own_held_out_error(tmp_path):
+    """identify --consistent: the verdict's headline is the consistent fit's held-out error
+    against the noise floor the command printed, least squares' the comparison (the page
+    opened on the least-squares fit's error, which the user had not asked for)."""
+    ident = {
+        "schema": "dynid-identification/1",
+        "route": "classical",
+        "rank": 2,
+        "metadata": {
+            "heldout": {"training_error_percent": 1.0, "heldout_error_percent": 1.1,
+                        "scheme": "blocks", "folds": 5, "noise_floor_percent": 0.5},
+        },
+    }  # fmt: skip
+    heldout = {
+        "scheme": "blocks",
+        "folds": 5,
+        "least_squares": {"training_error_percent": 1.0, "heldout_error_percent": 1.1},
+        "consistent": {"training_error_percent": 1.2, "heldout_error_percent": 1.3},
+    }
+    (tmp_path / "identification.json").write_text(json.dumps(ident))
+    (tmp_path / "report.json").write_text(json.dumps({"schema": "x/1", "heldout": heldout}))
+    (tmp_path / "feasible.json").write_text(
+        json.dumps({"schema": "x/1", "feasible": True, "links": [{"name": "l1", "mass": 1.0}]})
+    )
+    files = {p.name: p for p in tmp_path.glob("*.json")}
+    page = render_html_report(RunSummary(command="identify"), files)
+    headline = re.sub(r"<[^>]+>", "", re.search(r'class="headline">(.*?)</p>', page, re.S)[1])
+    assert "consistent fit predicts held-out torques to 1.3 %" in headline, headline
+    assert "least squares: 1.1 %" in headline and "2.6 times" in headline, headline
+    level, _ = _verdict_of(page)
+    assert level == "fair"  # 2.6 x the floor: usable

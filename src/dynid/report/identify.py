@@ -6,10 +6,13 @@ the last time block predicted by the fit of the others, unfiltered torques, agai
 noise read from the log above the motion's band), the training against the held-out error
 (over-fitting), the rank against the columns of the model (the base parameters are the
 structural rank of the kinematics), and the relative standard deviations (the paper pruned
-above 30 %). Below it: the measured against the predicted torques on held-out data, the
-residuals, the model structure (``selection``, when the identification chose terms), the
-coefficients with their standard deviations as bars, and each appended term (friction at
-the motors and at the joints, armature: :mod:`.model_terms`).
+above 30 %). A one-step consistent fit (``identify --consistent``: ``report.json``'s
+``heldout``) is the result asked for: the headline is its held-out error against the
+noise floor of the torques it was judged on, least squares' the comparison. Below it: the
+measured against the predicted torques on held-out data, the residuals, the model
+structure (``selection``, when the identification chose terms), the coefficients with their
+standard deviations as bars, and each appended term (friction at the motors and at the
+joints, armature: :mod:`.model_terms`).
 """
 
 from __future__ import annotations
@@ -123,6 +126,53 @@ def _heldout_facts(doc: dict, held: dict | None) -> tuple[list[str], list[str], 
             "Sensor-noise floor not measured (heldout.json absent: the run was made with "
             "--no-figures, or the log could not be read back)"
         )
+    return facts, problems, headline
+
+
+def _consistent_heldout(run: RunFiles) -> dict | None:
+    """The held-out judgement of a one-step consistent fit (``report.json``'s ``heldout``:
+    its errors and least squares' on the same folds), or None without one."""
+    ho = _get(run.doc("report.json"), "heldout")
+    errors = [_get(ho, f, k) for f in ("consistent", "least_squares") for k in _ERRORS]
+    return ho if all(is_number(e) for e in errors) else None
+
+
+#: The errors [%] of a fit in the held-out judgement's records.
+_ERRORS = ("training_error_percent", "heldout_error_percent")
+
+
+def _consistent_facts(doc: dict, ho: dict) -> tuple[list[str], list[str], str]:
+    """(facts, problems, headline) of the consistent fit the user asked for
+    (``identify --consistent``): its held-out error first, against the sensor-noise floor
+    of the torques it was judged on (``metadata.heldout.noise_floor_percent``, the one the
+    command prints), least squares' on the same folds as the comparison."""
+    train, test = (ho["consistent"][k] for k in _ERRORS)
+    ls_train, ls_test = (ho["least_squares"][k] for k in _ERRORS)
+    scheme = {
+        "blocks": f"over {ho.get('folds')} contiguous time blocks",
+        "recordings": f"leaving out each of {ho.get('folds')} recordings in turn",
+    }.get(str(ho.get("scheme")), "on the separate log")
+    facts = [
+        f"Held-out error of the consistent fit <b>{percent(test)}</b> {esc(scheme)} (filtered "
+        f"torques, as fitted), training error {percent(train)}; least squares, for "
+        f"comparison: held-out {percent(ls_test)}, training {percent(ls_train)}"
+    ]
+    headline = (
+        f"The consistent fit predicts held-out torques to {percent(test)} (least squares: "
+        f"{percent(ls_test)})"
+    )
+    floor = _get(doc, "metadata", "heldout", "noise_floor_percent")
+    v = judge_prediction(test, floor if is_number(floor) and floor > 0 else None)
+    problems: list[str] = [] if v.level == "good" else [v.level]
+    if v.ratio is not None:
+        level = "at" if v.ratio <= FLOOR_GOOD else f"{v.ratio:.3g} times"
+        headline += f", {level} the sensor-noise floor of {percent(floor)}"
+        facts.append(
+            f"Consistent fit: <b>{v.ratio:.3g} x the sensor-noise floor</b> of "
+            f"{percent(floor)} of the torques it was judged on ({esc(v.label)})"
+        )
+    if v.unusable:
+        headline = f"The consistent fit does not explain held-out torques: error {percent(test)}"
     return facts, problems, headline
 
 
@@ -246,6 +296,11 @@ def answer(run: RunFiles) -> Answer | None:
         facts, problems, headline = _static_facts(doc)
     else:
         facts, problems, headline = _heldout_facts(doc, held)
+        consistent = _consistent_heldout(run)
+        if consistent is not None:  # the answer asked for: the consistent fit's error
+            first, more, headline = _consistent_facts(doc, consistent)
+            facts = first + [f"Least squares: {f[0].lower()}{f[1:]}" for f in facts]
+            problems = more + problems
     rank, p = _rank_fact(doc)
     facts.append(rank)
     problems += p
