@@ -723,3 +723,26 @@ def test_a_consistent_fit_heads_its_page_with_its_own_held_out_error(tmp_path):
     assert "least squares: 1.1 %" in headline and "2.6 times" in headline, headline
     level, _ = _verdict_of(page)
     assert level == "fair"  # 2.6 x the floor: usable
+
+
+def test_a_calibration_says_it_calibrated_thresholds_not_that_it_has_no_events(tmp_path):
+    """observe --calibrate writes thresholds and residuals but no events: its badge says
+    the thresholds were calibrated, on how many samples of which logs (it said "no events
+    file to judge" with a reservation, as if a detection had lost its file)."""
+    out = tmp_path / "cal"
+    out.mkdir()
+    thresholds = {
+        "schema": "dynid-thresholds/1",
+        "joints": ["joint1", "joint2"],
+        "contact": [0.5, 0.25],
+        "collision": [1.0, 0.5],
+        "calibration": {"samples": 1200, "data": ["free.csv"], "model": "m.json"},
+    }
+    (out / "thresholds.json").write_text(json.dumps(thresholds))
+    (out / "residuals.png").write_bytes(_png(300, 200, seed=6))
+    files = {f.name: f for f in out.iterdir()}
+    page = render_html_report(RunSummary(command="observe"), files)
+    level, text = _verdict_of(page)
+    assert "events file" not in text and level == "info", text
+    assert text.strip().startswith("thresholds calibrated Thresholds calibrated on 1200"), text
+    assert "free.csv" in text and "contact 0.25-0.5 N m" in text, text
