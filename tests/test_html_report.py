@@ -432,8 +432,10 @@ def test_identify_on_a_log_judges_held_out_torques_against_the_sensor_noise(runs
         assert (out / f).read_bytes().startswith(b"\x89PNG")
     page = Page((out / REPORT_NAME).read_text(encoding="utf-8"))
     text = " ".join(" ".join(page.text).split())
-    floor = f"{held['noise_floor_percent']:.3g} %"
+    recorded = _identification_doc(runs)["metadata"]["heldout"]
+    floor = f"{recorded['noise_floor_percent']:.3g} %"  # the one the summary prints
     assert f"sensor-noise floor of {floor}" in text, text[:800]
+    assert held["noise_rms"] == recorded["noise_rms"]  # one noise for the table and the floor
     headers = {h for t in page.tables for h in t[0]}
     assert {"held-out RMS error [N m]", "sensor noise RMS [N m]", "fv [N m s/rad]"} <= headers
     assert not any(h.isdigit() for h in headers)  # no "1, 2, 3" column names
@@ -746,3 +748,25 @@ def test_a_calibration_says_it_calibrated_thresholds_not_that_it_has_no_events(t
     assert "events file" not in text and level == "info", text
     assert text.strip().startswith("thresholds calibrated Thresholds calibrated on 1200"), text
     assert "free.csv" in text and "contact 0.25-0.5 N m" in text, text
+
+
+def test_the_page_shows_the_noise_floor_the_command_printed(tmp_path):
+    """identify's page judges the held-out error against the record's noise floor
+    (``metadata.heldout``, the one the summary prints: 0.327 %), not a second estimate
+    from the last block of heldout.json (0.315 %: the page and the console disagreed)."""
+    ident = {
+        "schema": "dynid-identification/1",
+        "route": "classical",
+        "rank": 2,
+        "metadata": {
+            "heldout": {"training_error_percent": 0.348, "heldout_error_percent": 0.35,
+                        "scheme": "blocks", "folds": 5, "noise_floor_percent": 0.327},
+        },
+    }  # fmt: skip
+    held = {"relative_error_percent": 0.343, "noise_floor_percent": 0.315, "block": "the last"}
+    (tmp_path / "identification.json").write_text(json.dumps(ident))
+    (tmp_path / "heldout.json").write_text(json.dumps(held))
+    files = {p.name: p for p in tmp_path.glob("*.json")}
+    level, text = _verdict_of(render_html_report(RunSummary(command="identify"), files))
+    assert "floor of 0.327 %" in text and "1.07 x the floor" in text, text
+    assert "0.315" not in text and level == "good", text

@@ -17,12 +17,13 @@ joints, armature: :mod:`.model_terms`).
 
 from __future__ import annotations
 
+import math
 import re
 from typing import Any
 
 from ..exceptions import DynidError
 from ..identification.structure import Structure
-from ..identification.verdict import FLOOR_GOOD, judge_prediction, worst
+from ..identification.verdict import FLOOR_GOOD, Verdict, judge_prediction, worst
 from .html import bar, cell, esc, figure, is_number, number, percent, section, table, verdict
 from .model_terms import terms_sections
 from .run import Answer, RunFiles
@@ -62,71 +63,129 @@ def _get(doc: Any, *keys: str) -> Any:
 
 
 def _heldout_facts(doc: dict, held: dict | None) -> tuple[list[str], list[str], str]:
-    """(facts, problems, headline) of the held-out judgement."""
-    facts, problems, headline = [], [], ""
+    """(facts, problems, headline) of the held-out judgement: the record's held-out error
+    against the record's sensor-noise floor (``metadata.heldout``: the numbers the command
+    prints); the last block's unfiltered error (``heldout.json``) beside it, against a
+    floor of its own only for a record without one (an older file)."""
+    facts, problems = [], []
     ho = _get(doc, "metadata", "heldout")
     train, test = _get(ho, "training_error_percent"), _get(ho, "heldout_error_percent")
-    at_floor = False  # the unfiltered held-out error at the sensor-noise floor
-    if held is not None and is_number(held.get("relative_error_percent")):
-        floor = held.get("noise_floor_percent")
-        at_floor = is_number(floor) and floor > 0
-        at_floor = at_floor and held["relative_error_percent"] / floor <= FLOOR_GOOD
+    floor = _get(ho, "noise_floor_percent")
+    judged = None  # the record's held-out error against its floor
+    if is_number(test) and is_number(floor) and floor > 0:
+        judged = judge_prediction(test, floor)
+    block = held is not None and is_number(held.get("relative_error_percent"))
+    if judged is not None:
+        at_floor = judged.ratio is not None and judged.ratio <= FLOOR_GOOD
+    elif block:
+        assert held is not None
+        bf = held.get("noise_floor_percent")
+        at_floor = is_number(bf) and bf > 0
+        at_floor = at_floor and held["relative_error_percent"] / bf <= FLOOR_GOOD
+    else:
+        at_floor = False
+    headline = ""
     if is_number(train) and is_number(test):
-        scheme = {
-            "blocks": f"over {ho.get('folds')} contiguous time blocks",
-            "recordings": f"leaving out each of {ho.get('folds')} recordings in turn",
-        }.get(str(ho.get("scheme")), "on the separate log")
-        ratio = test / train if train > 0 else 1.0
-        if ratio <= OVERFIT_GOOD:
-            why = "no sign of over-fitting"
-        elif at_floor:  # the fit follows some noise, and predicts as well as noise allows
-            why = "the fit follows some of the noise, yet predicts to the noise floor below"
-        else:
-            why = "the fit over-fits"
-        facts.append(
-            f"Held-out error <b>{percent(test)}</b> {esc(scheme)} (filtered torques, as "
-            f"fitted), training error {percent(train)} (ratio {ratio:.2f}: {why})"
-        )
-        if ratio > OVERFIT_FAIR and not at_floor:
-            problems.append("poor")
-        elif ratio > OVERFIT_GOOD and not at_floor:
-            problems.append("fair")
+        fact, more = _overfit_fact(ho, train, test, at_floor)
+        facts.append(fact)
+        problems += more
         headline = f"The model predicts held-out torques to {percent(test)}"
-    if held is not None and is_number(held.get("relative_error_percent")):
-        err, floor = held["relative_error_percent"], held.get("noise_floor_percent")
-        where = esc(held.get("block", "held-out data"))
-        v = judge_prediction(err, floor if is_number(floor) else None)
-        if v.level != "good":
-            problems.append(v.level)
-        if v.ratio is not None:
-            r = v.ratio
-            facts.append(
-                f"On {where}, unfiltered: error {percent(err)} against a sensor-noise floor "
-                f"of {percent(floor)} (<b>{r:.3g} x the floor</b>: {esc(v.label)}"
-                + (
-                    ", only noise is left)"
-                    if r <= FLOOR_GOOD
-                    else ", effects outside the model remain, see the residuals)"
-                )
-            )
-            level = "at" if r <= FLOOR_GOOD else f"{r:.3g} times"  # as in the fact
-            headline = (
-                f"The model predicts held-out torques to {percent(err)}, {level} the "
-                f"sensor-noise floor of {percent(floor)} (unfiltered torques)"
-            )
-        else:
-            facts.append(
-                f"On {where}, unfiltered: error {percent(err)} (noise floor unknown: "
-                f"{esc(v.label)})"
-            )
-        if v.unusable:
-            headline = f"The model does not explain held-out torques: error {percent(err)}"
-    elif headline:
+    if judged is not None:
+        fact, more, headline = _floor_fact(judged, test, floor, "torques it was judged on")
+        facts.append(fact)
+        problems += more
+    if block:
+        assert held is not None
+        fact, more, said = _block_fact(held, judged is None)
+        facts.append(fact)
+        problems += more
+        headline = said or headline
+    elif headline and judged is None:
         facts.append(
             "Sensor-noise floor not measured (heldout.json absent: the run was made with "
             "--no-figures, or the log could not be read back)"
         )
     return facts, problems, headline
+
+
+def _overfit_fact(ho: dict, train: float, test: float, at_floor: bool) -> tuple[str, list[str]]:
+    """The training against the held-out error (over-fitting), and its problem."""
+    scheme = {
+        "blocks": f"over {ho.get('folds')} contiguous time blocks",
+        "recordings": f"leaving out each of {ho.get('folds')} recordings in turn",
+    }.get(str(ho.get("scheme")), "on the separate log")
+    ratio = test / train if train > 0 else 1.0
+    if ratio <= OVERFIT_GOOD:
+        why = "no sign of over-fitting"
+    elif at_floor:  # the fit follows some noise, and predicts as well as noise allows
+        why = "the fit follows some of the noise, yet predicts to the noise floor below"
+    else:
+        why = "the fit over-fits"
+    fact = (
+        f"Held-out error <b>{percent(test)}</b> {esc(scheme)} (filtered torques, as "
+        f"fitted), training error {percent(train)} (ratio {ratio:.2f}: {why})"
+    )
+    if ratio > OVERFIT_FAIR and not at_floor:
+        return fact, ["poor"]
+    return fact, ["fair"] if ratio > OVERFIT_GOOD and not at_floor else []
+
+
+def _floor_fact(v: Verdict, err: float, floor: float, torques: str) -> tuple[str, list[str], str]:
+    """(fact, problems, headline) of an error against a sensor-noise floor."""
+    r = v.ratio if v.ratio is not None else math.inf
+    fact = (
+        f"Error {percent(err)} against a sensor-noise floor of {percent(floor)} of the "
+        f"{esc(torques)} (<b>{r:.3g} x the floor</b>: {esc(v.label)}"
+        + (
+            ", only noise is left)"
+            if r <= FLOOR_GOOD
+            else ", effects outside the model remain, see the residuals)"
+        )
+    )
+    level = "at" if r <= FLOOR_GOOD else f"{r:.3g} times"  # as in the fact
+    headline = (
+        f"The model predicts held-out torques to {percent(err)}, {level} the "
+        f"sensor-noise floor of {percent(floor)}"
+    )
+    if v.unusable:
+        headline = f"The model does not explain held-out torques: error {percent(err)}"
+    return fact, [] if v.level == "good" else [v.level], headline
+
+
+def _block_fact(held: dict, judge: bool) -> tuple[str, list[str], str]:
+    """(fact, problems, headline or "") of the last block's unfiltered error
+    (``heldout.json``, the figures' and the table's data): against its own floor when
+    ``judge`` (a record without one), else the error alone (the floor is the record's)."""
+    err, floor = held["relative_error_percent"], held.get("noise_floor_percent")
+    where = f"On {esc(held.get('block', 'held-out data'))}, unfiltered"
+    if not judge:
+        v = judge_prediction(err)  # only a model that explains nothing is judged here
+        fact = f"{where} (the figures and the table below): error {percent(err)}"
+        bad = v.unusable
+        return (
+            fact,
+            ["unusable"] if bad else [],
+            (f"The model does not explain held-out torques: error {percent(err)}" if bad else ""),
+        )
+    floor = floor if is_number(floor) else None
+    v = judge_prediction(err, floor)
+    if v.ratio is None or floor is None:
+        fact = f"{where}: error {percent(err)} (noise floor unknown: {esc(v.label)})"
+        return (
+            fact,
+            [] if v.level == "good" else [v.level],
+            (
+                f"The model does not explain held-out torques: error {percent(err)}"
+                if v.unusable
+                else ""
+            ),
+        )
+    fact, problems, headline = _floor_fact(v, err, floor, "unfiltered torques")
+    return (
+        f"{where}: {fact[0].lower()}{fact[1:]}",
+        problems,
+        headline + ("" if v.unusable else " (unfiltered torques)"),
+    )
 
 
 def _consistent_heldout(run: RunFiles) -> dict | None:
