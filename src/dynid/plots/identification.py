@@ -30,6 +30,7 @@ from ..identification.log import TorqueLog
 from ..identification.model import IdentifiedModel
 from ..identification.pieces import split_at_gaps
 from ..identification.sanity import velocity_noise_std
+from .style import COLOURS
 
 if TYPE_CHECKING:  # pragma: no cover
     from matplotlib.figure import Figure
@@ -215,7 +216,7 @@ def plot_residual_histograms(h: HeldOutTorques, *, title: str | None = None) -> 
             ax.set_visible(False)
             continue
         s = float(h.noise_rms[j])
-        ax.hist(e[:, j], bins=40, density=True, color="tab:blue", alpha=0.6, label="residual")
+        ax.hist(e[:, j], bins=40, density=True, color=COLOURS["model"], alpha=0.6, label="residual")
         if s > 0:
             lo, hi = ax.get_xlim()
             x = np.linspace(float(lo), float(hi), 200)
