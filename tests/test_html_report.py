@@ -723,8 +723,9 @@ def test_a_consistent_fit_heads_its_page_with_its_own_held_out_error(tmp_path):
     headline = re.sub(r"<[^>]+>", "", re.search(r'class="headline">(.*?)</p>', page, re.S)[1])
     assert "consistent fit predicts held-out torques to 1.3 %" in headline, headline
     assert "least squares: 1.1 %" in headline and "2.6 times" in headline, headline
-    level, _ = _verdict_of(page)
+    level, text = _verdict_of(page)
     assert level == "fair"  # 2.6 x the floor: usable
+    assert text.count("sensor-noise floor") == 2, text  # the headline's and its fact, once
 
 
 def test_a_calibration_says_it_calibrated_thresholds_not_that_it_has_no_events(tmp_path):

@@ -62,10 +62,13 @@ def _get(doc: Any, *keys: str) -> Any:
     return doc
 
 
-def _heldout_facts(doc: dict, held: dict | None) -> tuple[list[str], list[str], str]:
+def _heldout_facts(
+    doc: dict, held: dict | None, *, floor_fact: bool = True
+) -> tuple[list[str], list[str], str]:
     """(facts, problems, headline) of the held-out judgement: the record's held-out error
     against the record's sensor-noise floor (``metadata.heldout``: the numbers the command
-    prints); the last block's unfiltered error (``heldout.json``) beside it, against a
+    prints; its fact left out without ``floor_fact``, where another fit's states the
+    floor); the last block's unfiltered error (``heldout.json``) beside it, against a
     floor of its own only for a record without one (an older file)."""
     facts, problems = [], []
     ho = _get(doc, "metadata", "heldout")
@@ -92,7 +95,7 @@ def _heldout_facts(doc: dict, held: dict | None) -> tuple[list[str], list[str], 
         headline = f"The model predicts held-out torques to {percent(test)}"
     if judged is not None:
         fact, more, headline = _floor_fact(judged, test, floor, "torques it was judged on")
-        facts.append(fact)
+        facts += [fact] if floor_fact else []
         problems += more
     if block:
         assert held is not None
@@ -354,8 +357,8 @@ def answer(run: RunFiles) -> Answer | None:
     if doc.get("route") == "static":
         facts, problems, headline = _static_facts(doc)
     else:
-        facts, problems, headline = _heldout_facts(doc, held)
         consistent = _consistent_heldout(run)
+        facts, problems, headline = _heldout_facts(doc, held, floor_fact=consistent is None)
         if consistent is not None:  # the answer asked for: the consistent fit's error
             first, more, headline = _consistent_facts(doc, consistent)
             facts = first + [f"Least squares: {f[0].lower()}{f[1:]}" for f in facts]
