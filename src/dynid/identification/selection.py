@@ -100,8 +100,9 @@ def _terms_of(
 
 
 def _with_floor(heldout: Any, data: Recordings) -> Any:
-    """The held-out record with the noise floor of the torques it was judged on (as
-    measured, or filtered when the recordings were not)
+    """The held-out record with the noise floor of the torques it was judged on, ``data``
+    (the recordings of the folds, or the separate recording; as measured, or filtered when
+    the recordings were not)
     (:func:`~dynid.identification.metrics.noise_floor_percent`) and the sensor noise it
     is made of, each joint's raw torque noise [N m] as the RMS over the samples used
     (``noise_rms``: the one value the summary, heldout.json and the report read), when
@@ -579,7 +580,7 @@ def identify_recordings(
     warn_unphysical(model, terms)
     info = replace(
         model.info,
-        heldout=_with_floor(model.info.heldout, data),
+        heldout=_with_floor(model.info.heldout, data if validation is None else validation),
         selection=None if selection is None else selection.as_dict(),
         extra={**model.info.extra, "terms": list(structure.terms)},
     )
