@@ -1,9 +1,10 @@
 """The answer of ``dynid identify``: is the model good enough, and how sure are we.
 
 The verdict (at the noise floor, usable, poor, unusable: :mod:`dynid.identification.verdict`)
-weighs the held-out error against the sensor-noise floor (``heldout.json``:
-the last time block predicted by the fit of the others, unfiltered torques, against the
-noise read from the log above the motion's band), the training against the held-out error
+weighs the held-out error against the sensor-noise floor of the torques it was judged on
+(``metadata.heldout``: the floor the command prints; for an older record without one,
+``heldout.json``'s: the last time block predicted by the fit of the others, unfiltered
+torques, against the noise read from the log), the training against the held-out error
 (over-fitting), the rank against the columns of the model (the base parameters are the
 structural rank of the kinematics), and the relative standard deviations (the paper pruned
 above 30 %). A one-step consistent fit (``identify --consistent``: ``report.json``'s
