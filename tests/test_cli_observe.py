@@ -310,3 +310,20 @@ def test_a_calibration_figure_that_fails_costs_no_data_file(logs, capsys, monkey
     assert (out / "thresholds.json").exists() and not (out / "residuals.png").exists()
     err = capsys.readouterr().err
     assert "note: skipped the figure residuals.png: RuntimeError: the plot is broken" in err
+
+
+def test_observe_says_when_the_model_holds_no_friction(logs, tmp_path, capsys):
+    """A model without friction (the robot's without its friction) leaves the joints'
+    friction in the residual: observe says so in one line naming --friction (the README's
+    recipe ran a model identified from static data on logs with friction and said nothing);
+    the robot's own friction gets no such line."""
+    from dynid import panda
+    from dynid.io.robot.toml import save_toml
+
+    save_toml(tmp_path / "bare.toml", panda().with_friction(None))
+    cal = ["observe", "--data", str(logs / "free.csv"), "--calibrate", "--no-figures"]
+    assert main([*cal, "--params", str(tmp_path / "bare.toml"), "--out", str(tmp_path / "a")]) == 0
+    (line,) = [x for x in capsys.readouterr().err.splitlines() if "no friction" in x]
+    assert "note: the model holds no friction" in line and "--friction" in line
+    assert main([*cal, "--params", "panda", "--out", str(tmp_path / "b")]) == 0
+    assert "no friction" not in capsys.readouterr().err

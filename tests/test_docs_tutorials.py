@@ -105,3 +105,23 @@ def test_page_runs_as_written(page, tmp_path):
         assert "report.html" in json.loads(manifest.read_text("utf-8"))["files"], where
         assert (manifest.parent / "report.html").is_file(), where
         assert "### report.html" in formats
+
+
+def test_every_urdf_template_the_docs_name_is_shipped_written_or_a_placeholder():
+    """A file the README, a page or export's --help gives to --urdf-template is shipped,
+    written by a command of the same text (--out FILE), or an upper-case placeholder for
+    the reader's own URDF (they named panda_original.urdf and fr3_original.urdf, which no
+    one has: neither shipped nor written by any command)."""
+    from dynid.cli import export
+
+    texts = {p.name: p.read_text("utf-8") for p in [ROOT / "README.md", *DOCS.rglob("*.md")]}
+    texts["dynid export --help"] = export.__doc__ or ""
+    shipped = {p.name for p in ROOT.rglob("*.urdf") if ".git" not in p.parts}
+    named = 0
+    for where, text in texts.items():
+        for name in re.findall(r"--urdf-template[ =]+([^\s`]+)", text):
+            named += 1
+            placeholder = Path(name).stem.isupper()
+            written = re.search(rf"--out[ =]+{re.escape(name)}(?![\w.])", text) is not None
+            assert placeholder or written or Path(name).name in shipped, f"{where}: {name}"
+    assert named >= 3  # the README, the paper's tutorial, export's --help

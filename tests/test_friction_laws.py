@@ -190,6 +190,27 @@ def test_the_selection_keeps_the_own_friction_when_nothing_predicts_better():
     assert held[sel.chosen] <= held["none"]
 
 
+def test_the_models_own_friction_is_judged_by_the_law_it_was_trained_with():
+    """A model identified from this log with smooth Coulomb friction 0.3 rad/s wide and
+    joint 2's offset left out: its row is judged by that law (width, left-out coefficient)
+    refitted on the other blocks, so its held-out error is the noise floor as its training
+    error is (it was judged by the registry's smooth law at the velocity noise band, 60
+    times narrower: a sharp Coulomb step, another law, 0.455 % against 0.348 %)."""
+    rng = np.random.default_rng(72)
+    _, dq = _sweep(10_000)
+    width = 0.3  # [rad/s]
+    P = np.array([[0.3, 0.8, 0.1], [0.05, 0.4, 0.0]])  # fv, fc, fo; joint 2 without fo
+    noise = rng.normal(0.0, TAU_NOISE, dq.shape)
+    r = _friction("smooth", dq, P, band=width) + noise
+    floor = 100.0 * np.linalg.norm(noise) / np.linalg.norm(r)
+    own = LAWS["smooth"].model(P, [width, width])
+    sel = select_friction(_residual(dq, r, 73), own=own, own_fitted_here=True)
+    score = {s.name: s for s in sel.scores}
+    assert score["own"].heldout_error_percent < 1.02 * floor, sel.table()
+    assert abs(score["own"].heldout_error_percent / score["own"].train_error_percent - 1) < 0.02
+    assert score["smooth"].heldout_error_percent > 1.1 * floor  # the registry's: narrower
+
+
 @pytest.mark.parametrize("name", list(LAWS))
 def test_friction_json_round_trip_of_every_law(tmp_path, name):
     """Every law, at the joints and at the motors of a drive, reads back as written

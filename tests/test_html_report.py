@@ -432,8 +432,10 @@ def test_identify_on_a_log_judges_held_out_torques_against_the_sensor_noise(runs
         assert (out / f).read_bytes().startswith(b"\x89PNG")
     page = Page((out / REPORT_NAME).read_text(encoding="utf-8"))
     text = " ".join(" ".join(page.text).split())
-    floor = f"{held['noise_floor_percent']:.3g} %"
+    recorded = _identification_doc(runs)["metadata"]["heldout"]
+    floor = f"{recorded['noise_floor_percent']:.3g} %"  # the one the summary prints
     assert f"sensor-noise floor of {floor}" in text, text[:800]
+    assert held["noise_rms"] == recorded["noise_rms"]  # one noise for the table and the floor
     headers = {h for t in page.tables for h in t[0]}
     assert {"held-out RMS error [N m]", "sensor noise RMS [N m]", "fv [N m s/rad]"} <= headers
     assert not any(h.isdigit() for h in headers)  # no "1, 2, 3" column names
@@ -690,3 +692,82 @@ def test_the_held_out_verdict_has_levels_a_person_can_act_on(tmp_path, error, fl
     got, text = _verdict_of(render_html_report(RunSummary(command="identify"), files))
     assert got == level, text
     assert text.strip().lower().startswith(label), text
+
+
+def test_a_consistent_fit_heads_its_page_with_its_own_held_out_error(tmp_path):
+    """identify --consistent: the verdict's headline is the consistent fit's held-out error
+    against the noise floor the command printed, least squares' the comparison (the page
+    opened on the least-squares fit's error, which the user had not asked for)."""
+    ident = {
+        "schema": "dynid-identification/1",
+        "route": "classical",
+        "rank": 2,
+        "metadata": {
+            "heldout": {"training_error_percent": 1.0, "heldout_error_percent": 1.1,
+                        "scheme": "blocks", "folds": 5, "noise_floor_percent": 0.5},
+        },
+    }  # fmt: skip
+    heldout = {
+        "scheme": "blocks",
+        "folds": 5,
+        "least_squares": {"training_error_percent": 1.0, "heldout_error_percent": 1.1},
+        "consistent": {"training_error_percent": 1.2, "heldout_error_percent": 1.3},
+    }
+    (tmp_path / "identification.json").write_text(json.dumps(ident))
+    (tmp_path / "report.json").write_text(json.dumps({"schema": "x/1", "heldout": heldout}))
+    (tmp_path / "feasible.json").write_text(
+        json.dumps({"schema": "x/1", "feasible": True, "links": [{"name": "l1", "mass": 1.0}]})
+    )
+    files = {p.name: p for p in tmp_path.glob("*.json")}
+    page = render_html_report(RunSummary(command="identify"), files)
+    headline = re.sub(r"<[^>]+>", "", re.search(r'class="headline">(.*?)</p>', page, re.S)[1])
+    assert "consistent fit predicts held-out torques to 1.3 %" in headline, headline
+    assert "least squares: 1.1 %" in headline and "2.6 times" in headline, headline
+    level, text = _verdict_of(page)
+    assert level == "fair"  # 2.6 x the floor: usable
+    assert text.count("sensor-noise floor") == 2, text  # the headline's and its fact, once
+
+
+def test_a_calibration_says_it_calibrated_thresholds_not_that_it_has_no_events(tmp_path):
+    """observe --calibrate writes thresholds and residuals but no events: its badge says
+    the thresholds were calibrated, on how many samples of which logs (it said "no events
+    file to judge" with a reservation, as if a detection had lost its file)."""
+    out = tmp_path / "cal"
+    out.mkdir()
+    thresholds = {
+        "schema": "dynid-thresholds/1",
+        "joints": ["joint1", "joint2"],
+        "contact": [0.5, 0.25],
+        "collision": [1.0, 0.5],
+        "calibration": {"samples": 1200, "data": ["free.csv"], "model": "m.json"},
+    }
+    (out / "thresholds.json").write_text(json.dumps(thresholds))
+    (out / "residuals.png").write_bytes(_png(300, 200, seed=6))
+    files = {f.name: f for f in out.iterdir()}
+    page = render_html_report(RunSummary(command="observe"), files)
+    level, text = _verdict_of(page)
+    assert "events file" not in text and level == "info", text
+    assert text.strip().startswith("thresholds calibrated Thresholds calibrated on 1200"), text
+    assert "free.csv" in text and "contact 0.25-0.5 N m" in text, text
+
+
+def test_the_page_shows_the_noise_floor_the_command_printed(tmp_path):
+    """identify's page judges the held-out error against the record's noise floor
+    (``metadata.heldout``, the one the summary prints: 0.327 %), not a second estimate
+    from the last block of heldout.json (0.315 %: the page and the console disagreed)."""
+    ident = {
+        "schema": "dynid-identification/1",
+        "route": "classical",
+        "rank": 2,
+        "metadata": {
+            "heldout": {"training_error_percent": 0.348, "heldout_error_percent": 0.35,
+                        "scheme": "blocks", "folds": 5, "noise_floor_percent": 0.327},
+        },
+    }  # fmt: skip
+    held = {"relative_error_percent": 0.343, "noise_floor_percent": 0.315, "block": "the last"}
+    (tmp_path / "identification.json").write_text(json.dumps(ident))
+    (tmp_path / "heldout.json").write_text(json.dumps(held))
+    files = {p.name: p for p in tmp_path.glob("*.json")}
+    level, text = _verdict_of(render_html_report(RunSummary(command="identify"), files))
+    assert "floor of 0.327 %" in text and "1.07 x the floor" in text, text
+    assert "0.315" not in text and level == "good", text

@@ -46,3 +46,25 @@ def test_the_floor_is_named_after_what_was_measured():
     assert "3 x the measured torques' noise floor (0.5 %)" in heldout_line(ho)
     line = heldout_line(ho, "current")
     assert "3 x the motor currents' noise floor (0.5 %)" in line and "sensor" not in line
+
+
+def test_the_floor_of_a_separate_log_is_that_log_s_noise(panda):
+    """Judged on a separate log (--validate-on) four times noisier than the training logs,
+    the floor is the separate log's noise, which the held-out error meets (it was the
+    training logs', so the error read about 4 x a floor no model could reach)."""
+    fr = ClassicalFriction(np.linspace(0.3, 0.1, 7), np.zeros(7), np.zeros(7))
+
+    def logs(seeds, tau_std):
+        noise = SensorNoise(tau_std=tau_std, q_std=0.0, dq_std=0.0)
+        return recordings(panda, seeds, friction=fr, duration=8.0, noise=noise)
+
+    train, (other,) = logs((51, 52), 0.05), logs((53,), 0.2)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", DynidWarning)
+        model = identify_recordings(
+            panda, train, structure=Structure(False, ("viscous",)), validate_on=other
+        )
+    ho = model.info.heldout
+    assert ho["scheme"] == "file"
+    assert ho["heldout_error_percent"] == pytest.approx(ho["noise_floor_percent"], rel=0.15)
+    np.testing.assert_allclose(ho["noise_rms"], 0.2, rtol=0.15)  # the separate log's sensor

@@ -5,7 +5,8 @@ from --base to --tip; by default its only root and leaf), 'panda' or 'fr3'. The 
 comes from --format or the suffix of --out (.urdf, .xml/.mjcf, .toml).
 
 URDF without a template: the chain with the source robot's link and joint names. With
---urdf-template ORIGINAL.urdf (and --base/--tip for its chain): the original file written
+--urdf-template ORIGINAL.urdf (the robot's own URDF that you supply, such as its maker's:
+dynid ships and writes none; --base/--tip for its chain): the original file written
 back with only the chain's <inertial> elements and the damping and friction of its joints'
 <dynamics> replaced (read back, a vendor's <dynamics> would be the robot's friction;
 removed, and said so, when no friction is written); names, meshes, other links and the
@@ -32,7 +33,7 @@ off-diagonal terms) and of the drive (URDF: the rotor inertias).
 examples:
   dynid export --params feasible/feasible.json --out panda.xml
   dynid export --params feasible/feasible.json --out panda.urdf \\
-      --urdf-template panda_original.urdf --base panda_link0 --tip panda_hand
+      --urdf-template VENDOR_PANDA.urdf --base panda_link0 --tip panda_hand
 """
 
 from __future__ import annotations

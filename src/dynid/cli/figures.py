@@ -75,9 +75,6 @@ def save_validation_figures(
 ) -> list[Path]:
     """Write ``<prefix>_torques.png`` (Fig. 3) and ``<prefix>_rms.png`` under ``out``
     (those skipped are left out)."""
-    rms = {"without friction": validation.without_friction.rms}
-    if validation.with_friction is not None:
-        rms["with friction"] = validation.with_friction.rms
     paths = [
         save_figure(
             lambda: torque_plots.plot_torque_validation(validation, joint_names=names, title=title),
@@ -85,7 +82,9 @@ def save_validation_figures(
             dpi=100,
         ),
         save_figure(
-            lambda: torque_plots.plot_rms_comparison(rms, noise_std=noise_std, title=title),
+            lambda: torque_plots.plot_validation_rms(
+                validation, joint_names=names, noise_std=noise_std, title=title
+            ),
             out / f"{prefix}_rms.png",
         ),
     ]

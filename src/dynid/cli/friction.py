@@ -6,8 +6,9 @@ robot's own link parameters with --robot) is fitted per joint by a friction law:
 no extra friction) on 4 of 5 contiguous blocks of the log in turn (with several
 recordings: on all but one recording in turn), predicts the block left out, keeps the
 law with the lowest held-out error (the model's own friction is a candidate too, judged
-on the same blocks: as it is, or its law refitted on the other blocks when --model was
-identified from these recordings; a robot's own friction is never refitted) and prints
+on the same blocks: as it is, or its own law, band and coefficients refitted on the other
+blocks when --model was identified from these recordings, the law it was trained with; a
+robot's own friction is never refitted) and prints
 the table; a law's name fits that law. --data takes several recordings (or a folder of
 them): each recording, and each piece of one cut at a gap longer than --max-gap, is
 filtered on its own, and the laws are fitted on the residual of all pieces together.

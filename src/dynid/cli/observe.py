@@ -8,7 +8,9 @@ base parameters, rotor inertias, drive and friction) or a robot (--params: a
 feasible.json with its drive and friction, a URDF, or a TOML robot with its [drive]
 table); --drive gives the drive of a robot without one (as validate takes it; another
 drive than the model's or the feasible.json's is refused); --friction replaces the
-friction (a friction.json of `dynid friction`, with its standstill band).
+friction (a friction.json of `dynid friction`, with its standstill band). A model that
+holds no friction (identified from static data) leaves the joints' friction in the
+residual, where it reads as an external torque: a note says so.
 
 Two steps:
   --calibrate on collision-free logs writes OUT/thresholds.json: per joint, the largest
@@ -56,6 +58,7 @@ from pathlib import Path
 
 from ..observer.events import DEFAULT_MERGE_S, DEFAULT_MIN_DURATION_S
 from ..observer.residual import DEFAULT_GAIN
+from ..observer.results import NO_FRICTION
 from ..workflows.observe import ObserveOptions, observe_files
 from .common import (
     add_column_options,
@@ -174,6 +177,9 @@ def run(args: argparse.Namespace, console: Console) -> int:
     result = observe_files(opts, tables)
     names = list(result.model.robot.joint_names)
     console.print(format_observation(result, names, calibrating=args.calibrate))
+    for note in result.notes:
+        hint = "; --friction FILE (a friction.json of `dynid friction`) takes it out"
+        console.note(note + (hint if note == NO_FRICTION else ""))
     meta = {"model": str(args.model or args.params), "source": result.model.source}
     saved = save_observation(
         args.out, result, joints=names, calibrating=args.calibrate, meta=meta, residuals=False

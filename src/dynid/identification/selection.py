@@ -100,19 +100,30 @@ def _terms_of(
 
 
 def _with_floor(heldout: Any, data: Recordings) -> Any:
-    """The held-out record with the noise floor of the torques it was judged on (as
-    measured, or filtered when the recordings were not)
-    (:func:`~dynid.identification.metrics.noise_floor_percent`), when both are known."""
+    """The held-out record with the noise floor of the torques it was judged on, ``data``
+    (the recordings of the folds, or the separate recording; as measured, or filtered when
+    the recordings were not)
+    (:func:`~dynid.identification.metrics.noise_floor_percent`) and the sensor noise it
+    is made of, each joint's raw torque noise [N m] as the RMS over the samples used
+    (``noise_rms``: the one value the summary, heldout.json and the report read), when
+    both are known."""
     pieces = data.pieces
     if heldout is None or any(p.torque_noise_std is None for p in pieces):
         return heldout
     measured = data.measured  # judged on the torques as measured
+    taus = [p.log.tau if p.tau_raw is None or not measured else p.tau_raw for p in pieces]
+    stds = [p.torque_noise_std for p in pieces]
+    noise = [np.asarray(s, dtype=np.float64) for s in stds if s is not None]
     floor = noise_floor_percent(
-        [p.tau_raw if measured else p.log.tau for p in pieces],  # type: ignore[misc]
-        [p.torque_noise_std for p in pieces],  # type: ignore[misc]
+        taus,
+        noise,
         [1.0 if measured else lowpass_noise_gain(p.sample_rate_hz, p.cutoff_hz) for p in pieces],
     )
-    return heldout if floor is None else {**heldout, "noise_floor_percent": floor}
+    if floor is None:
+        return heldout
+    counts = np.array([np.shape(t)[0] for t in taus], dtype=np.float64)
+    rms = np.sqrt(counts @ np.square(np.stack(noise)) / counts.sum())
+    return {**heldout, "noise_floor_percent": floor, "noise_rms": rms.tolist()}
 
 
 def _physical(candidates: Sequence[Candidate]) -> list[Candidate]:
@@ -568,7 +579,7 @@ def identify_recordings(
     warn_unphysical(model, terms)
     info = replace(
         model.info,
-        heldout=_with_floor(model.info.heldout, data),
+        heldout=_with_floor(model.info.heldout, data if validation is None else validation),
         selection=None if selection is None else selection.as_dict(),
         extra={**model.info.extra, "terms": list(structure.terms)},
     )

@@ -17,7 +17,7 @@ from .detection import ContactEvent, Thresholds
 from .model import ObserverModel
 from .wrench import WrenchEstimate
 
-__all__ = ["FigureSeries", "LogObservation", "ObserveResult"]
+__all__ = ["NO_FRICTION", "FigureSeries", "LogObservation", "ObserveResult"]
 
 
 @dataclass(frozen=True, slots=True, eq=False)
@@ -156,3 +156,19 @@ class ObserveResult:
     model: ObserverModel
     thresholds: Thresholds
     logs: tuple[LogObservation, ...]
+
+    @property
+    def notes(self) -> tuple[str, ...]:
+        """What the run's reader should know, one line each: a model without friction
+        (static data identify none) leaves the joints' friction in the residual, and in
+        thresholds calibrated on it, where it reads as an external torque."""
+        if self.model.friction is None:
+            return (NO_FRICTION,)
+        return ()
+
+
+#: The note of a model that holds no friction (:attr:`ObserveResult.notes`).
+NO_FRICTION = (
+    "the model holds no friction: the joints' friction stays in the residual as an "
+    "external torque (and in thresholds calibrated on it)"
+)

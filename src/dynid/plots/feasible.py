@@ -21,6 +21,7 @@ from ..feasibility.convex import ConsistentResult
 from ..feasibility.penalty import RetrievalResult
 from ..feasibility.result import FeasibleResult
 from ..friction.validation import NewtonEulerValidation
+from .style import COLOURS
 
 if TYPE_CHECKING:  # pragma: no cover
     from matplotlib.axes import Axes
@@ -80,14 +81,14 @@ def plot_newton_euler_validation(
     label_ne = "Newton-Euler, feasible p" + (" + friction" if v.tau_friction is not None else "")
     for j in range(n):
         ax = axes[j]
-        ax.plot(t, v.tau[s, j], color="0.35", lw=0.6, label="measured")
-        ax.plot(t, v.tau_model[s, j], color="tab:blue", lw=1.0, label=label_ne)
+        ax.plot(t, v.tau[s, j], color=COLOURS["measured"], lw=0.6, label="measured")
+        ax.plot(t, v.tau_model[s, j], color=COLOURS["consistent"], lw=1.0, label=label_ne)
         parts = [f"NE {v.errors.rms[j]:.3g}"]
         if v.tau_reference is not None and v.errors_reference is not None:
             ax.plot(
                 t,
                 v.tau_reference[s, j],
-                color="tab:orange",
+                color=COLOURS["model"],
                 lw=0.9,
                 ls="--",
                 label="identified model",

@@ -12,6 +12,7 @@ import numpy as np
 
 from ..friction.fit import FrictionFit, FrictionResidual
 from ..friction.model import FrictionModel
+from .style import COLOURS
 
 if TYPE_CHECKING:  # pragma: no cover
     from matplotlib.figure import Figure
@@ -76,7 +77,7 @@ def plot_friction_fit(
             r[::step, j],
             ".",
             ms=1.5,
-            color="0.55",
+            color=COLOURS["samples"],
             alpha=0.5,
             rasterized=True,
             label="residual (measured - model)",
@@ -86,11 +87,20 @@ def plot_friction_fit(
         V = np.zeros((v.size, n))
         V[:, j] = v
         ax.plot(
-            v, fit.friction.torques(V)[:, j], color="tab:red", lw=1.8, label=f"fitted {fit.kind}"
+            v,
+            fit.friction.torques(V)[:, j],
+            color=COLOURS["friction"],
+            lw=1.8,
+            label=f"fitted {fit.kind}",
         )
         if reference is not None:
             ax.plot(
-                v, reference.torques(V)[:, j], color="k", lw=1.0, ls="--", label=reference_label
+                v,
+                reference.torques(V)[:, j],
+                color=COLOURS["reference"],
+                lw=1.0,
+                ls="--",
+                label=reference_label,
             )
         ax.axhline(0.0, color="0.7", lw=0.5)
         ax.axvline(0.0, color="0.7", lw=0.5)

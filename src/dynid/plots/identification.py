@@ -7,8 +7,10 @@ coefficients and friction of the fold fitted on the other blocks (solved from th
 normal equations the model keeps), or the separate ``--validate-on`` log with the model
 itself. The torques are compared unfiltered (:func:`dynid.friction.validation.validate_torques`),
 so a correct model leaves the sensor noise, which is read from the same torques above the
-low-pass cut-off (white noise: the band's share of its variance restored). The ratio of
-the two is the identification's distance to its noise floor.
+low-pass cut-off (white noise: the band's share of its variance restored), or taken from
+the identification's record (``info.heldout["noise_rms"]``: the noise of the floor the
+summary prints) when it holds it. The ratio of the two is the identification's distance to
+its noise floor.
 
 matplotlib is imported inside the plotting functions (never by ``import dynid``).
 """
@@ -28,6 +30,7 @@ from ..identification.log import TorqueLog
 from ..identification.model import IdentifiedModel
 from ..identification.pieces import split_at_gaps
 from ..identification.sanity import velocity_noise_std
+from .style import COLOURS
 
 if TYPE_CHECKING:  # pragma: no cover
     from matplotlib.figure import Figure
@@ -141,7 +144,19 @@ def heldout_torques(
     v, said = _pieces_validation(fitted, split_at_gaps(held, model.info.log.max_gap_s))
     block += said
     cutoff = model.info.log.cutoff_hz or 0.2 * model.info.log.sample_rate_hz
-    return HeldOutTorques(v, _noise(v, cutoff), block, tuple(model.robot.joint_names))
+    noise = _recorded_noise(model)
+    noise = _noise(v, cutoff) if noise is None else noise
+    return HeldOutTorques(v, noise, block, tuple(model.robot.joint_names))
+
+
+def _recorded_noise(model: IdentifiedModel) -> NDArray[np.float64] | None:
+    """Each joint's sensor noise [N m] as the identification recorded it
+    (``info.heldout["noise_rms"]``, the noise of its printed floor), or None for a record
+    without it."""
+    noise = (model.info.heldout or {}).get("noise_rms")
+    if noise is None or np.shape(noise) != (model.robot.n,):
+        return None
+    return np.asarray(noise, dtype=np.float64)
 
 
 def _pieces_validation(model: IdentifiedModel, pieces: list[TorqueLog]) -> tuple[Validation, str]:
@@ -201,7 +216,7 @@ def plot_residual_histograms(h: HeldOutTorques, *, title: str | None = None) -> 
             ax.set_visible(False)
             continue
         s = float(h.noise_rms[j])
-        ax.hist(e[:, j], bins=40, density=True, color="tab:blue", alpha=0.6, label="residual")
+        ax.hist(e[:, j], bins=40, density=True, color=COLOURS["model"], alpha=0.6, label="residual")
         if s > 0:
             lo, hi = ax.get_xlim()
             x = np.linspace(float(lo), float(hi), 200)

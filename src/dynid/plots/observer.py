@@ -12,6 +12,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from ..observer.detection import ContactEvent
+from .style import COLOURS
 
 if TYPE_CHECKING:  # pragma: no cover
     from matplotlib.figure import Figure
@@ -65,18 +66,26 @@ def plot_residuals(
         for e in events:
             ax.axvspan(
                 e.start, max(e.end, e.start + 1e-3),
-                color="tab:red" if e.level == "collision" else "tab:orange", alpha=0.25, lw=0,
+                color=COLOURS["collision" if e.level == "collision" else "contact"],
+                alpha=0.25, lw=0,
             )  # fmt: skip
-        ax.plot(t[s], r[s, j], color="tab:blue", lw=0.9, label="residual")
+        ax.plot(t[s], r[s, j], color=COLOURS["residual"], lw=0.9, label="residual")
         if tau_ext is not None:
-            ax.plot(t[s], tau_ext[s, j], color="tab:green", lw=0.8, label="true external torque")
+            ax.plot(
+                t[s], tau_ext[s, j], color=COLOURS["external"], lw=0.8,
+                label="true external torque",
+            )  # fmt: skip
         for th, style, label in ((contact, "--", "contact"), (collision, ":", "collision")):
-            ax.plot(t[s], th[s, j], "k" + style, lw=0.7, label=f"{label} threshold")
-            ax.plot(t[s], -th[s, j], "k" + style, lw=0.7)
+            line = dict(color=COLOURS["reference"], ls=style, lw=0.7)
+            ax.plot(t[s], th[s, j], **line, label=f"{label} threshold")
+            ax.plot(t[s], -th[s, j], **line)
         ax.set_ylabel(f"{names[j]}\n[N m]", fontsize=8)
         ax.tick_params(labelsize=7)
-    axes[0, 0].legend(fontsize=7, loc="upper right", ncol=4)
     axes[-1, 0].set_xlabel("t [s]")
     fig.suptitle(title or "momentum observer: residual, thresholds and events", fontsize=10)
-    fig.tight_layout()
+    handles, labels = axes[0, 0].get_legend_handles_labels()
+    top = 1.0 - 0.45 / fig.get_figheight()  # the legend above the axes, over no data
+    fig.legend(handles, labels, loc="upper center", ncol=len(labels), fontsize=7,
+               frameon=False, bbox_to_anchor=(0.5, top))  # fmt: skip
+    fig.tight_layout(rect=(0, 0, 1, top - 0.1 / fig.get_figheight()))
     return fig

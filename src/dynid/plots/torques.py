@@ -13,16 +13,17 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from ..friction.validation import Validation
+from .style import COLOURS
 
 if TYPE_CHECKING:  # pragma: no cover
     from matplotlib.axes import Axes
     from matplotlib.figure import Figure
 
-__all__ = ["plot_torque_validation", "plot_rms_comparison"]
+__all__ = ["plot_rms_comparison", "plot_torque_validation", "plot_validation_rms"]
 
-_MEASURED = dict(color="0.35", lw=0.6, label="measured")
-_NO_FRICTION = dict(color="tab:orange", lw=1.1, label="model, no friction")
-_FRICTION = dict(color="tab:blue", lw=1.1, ls="--", label="model + friction")
+_MEASURED = dict(color=COLOURS["measured"], lw=0.6, label="measured")
+_NO_FRICTION = dict(color=COLOURS["no_friction"], lw=1.1, label="model, no friction")
+_FRICTION = dict(color=COLOURS["model"], lw=1.1, ls="--", label="model + friction")
 
 
 def _stride(N: int, max_points: int) -> slice:
@@ -94,32 +95,51 @@ def plot_torque_validation(
             ax.plot(t, at(validation.tau_hat[:, j]), **_FRICTION)
         ax.set_ylabel(f"{names[j]}\n[N m]")
         ax.grid(alpha=0.3)
-        r0 = validation.without_friction.rms[j]
-        axe.plot(
-            t, at(e0[:, j]), color=_NO_FRICTION["color"], lw=0.8, label=f"no friction, RMS {r0:.3f}"
-        )
+        rms = f"RMS [N m]\nno friction {validation.without_friction.rms[j]:.3f}"
+        axe.plot(t, at(e0[:, j]), color=_NO_FRICTION["color"], lw=0.8)
         if e1 is not None and validation.with_friction is not None:
-            r1 = validation.with_friction.rms[j]
-            axe.plot(
-                t,
-                at(e1[:, j]),
-                color=_FRICTION["color"],
-                lw=0.6,
-                alpha=0.8,
-                label=f"+ friction, RMS {r1:.3f}",
-            )
+            rms += f"\n+ friction {validation.with_friction.rms[j]:.3f}"
+            axe.plot(t, at(e1[:, j]), color=_FRICTION["color"], lw=0.6, alpha=0.8)
         axe.axhline(0.0, color="0.5", lw=0.6)
         axe.grid(alpha=0.3)
-        axe.legend(loc="upper right", fontsize=7, framealpha=0.8)
+        axe.yaxis.set_label_position("right")  # beside the data, not over it
+        axe.set_ylabel(rms, fontsize=7, rotation=0, ha="left", va="center")
     axes[0, 0].set_title("joint torques [N m]", fontsize=10)
     axes[0, 1].set_title("error: measured - model [N m]", fontsize=10)
-    axes[0, 0].legend(loc="upper left", ncol=3, fontsize=7, framealpha=0.8)
+    handles, labels = axes[0, 0].get_legend_handles_labels()
+    top = 1.0 - (0.6 if title else 0.3) / fig.get_figheight()  # room for the legend above
+    fig.legend(handles, labels, loc="upper center", ncol=len(labels), fontsize=8,
+               frameon=False, bbox_to_anchor=(0.5, top))  # fmt: skip
     axes[-1, 0].set_xlabel("time [s]")
     axes[-1, 1].set_xlabel("time [s]")
     if title:
         fig.suptitle(title, fontsize=11)
-    fig.tight_layout()
+    fig.tight_layout(rect=(0, 0, 1, top - 0.1 / fig.get_figheight()))
     return fig
+
+
+def plot_validation_rms(
+    validation: Validation,
+    *,
+    joint_names: Sequence[str] | None = None,
+    noise_std: float | None = None,
+    title: str | None = None,
+) -> Figure:
+    """Per joint, the torque RMS error [N m] without and with friction, in the colours
+    of :func:`plot_torque_validation` (:data:`~dynid.plots.style.COLOURS`).
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+    """
+    rms = {"without friction": validation.without_friction.rms}
+    colours = [COLOURS["no_friction"]]
+    if validation.with_friction is not None:
+        rms["with friction"] = validation.with_friction.rms
+        colours.append(COLOURS["model"])
+    return plot_rms_comparison(
+        rms, joint_names=joint_names, noise_std=noise_std, title=title, colours=colours
+    )
 
 
 def plot_rms_comparison(
@@ -129,6 +149,7 @@ def plot_rms_comparison(
     noise_std: float | None = None,
     title: str | None = None,
     ax: Axes | None = None,
+    colours: Sequence[str] | None = None,
 ) -> Figure:
     """Grouped bars of per-joint torque RMS [N m] for several predictions.
 
@@ -141,6 +162,8 @@ def plot_rms_comparison(
         Torque sensor noise [N m], drawn as a horizontal line.
     title : str, optional
     ax : Axes, optional
+    colours : sequence of str, optional
+        One colour per prediction (default: matplotlib's cycle).
 
     Returns
     -------
@@ -160,14 +183,18 @@ def plot_rms_comparison(
     width = 0.8 / len(vals)
     x = np.arange(n)
     for k, (label, v) in enumerate(zip(rms, vals, strict=True)):
-        ax.bar(x + (k - (len(vals) - 1) / 2) * width, v, width, label=label)
+        colour = None if colours is None else colours[k]
+        ax.bar(x + (k - (len(vals) - 1) / 2) * width, v, width, label=label, color=colour)
     if noise_std is not None:
-        ax.axhline(noise_std, color="k", ls=":", lw=1.0, label=f"sensor noise {noise_std:g} N m")
+        ax.axhline(
+            noise_std, color=COLOURS["reference"], ls=":", lw=1.0,
+            label=f"sensor noise {noise_std:g} N m",
+        )  # fmt: skip
     ax.set_xticks(x, names)
     ax.set_xlabel("joint")
     ax.set_ylabel("torque RMS error [N m]")
     ax.grid(axis="y", alpha=0.3)
-    ax.legend(fontsize=8)
+    ax.legend(fontsize=8, loc="upper left", bbox_to_anchor=(1.01, 1.0), frameon=False)
     if title:
         ax.set_title(title)
     fig.tight_layout()

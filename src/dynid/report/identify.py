@@ -1,25 +1,30 @@
 """The answer of ``dynid identify``: is the model good enough, and how sure are we.
 
 The verdict (at the noise floor, usable, poor, unusable: :mod:`dynid.identification.verdict`)
-weighs the held-out error against the sensor-noise floor (``heldout.json``:
-the last time block predicted by the fit of the others, unfiltered torques, against the
-noise read from the log above the motion's band), the training against the held-out error
+weighs the held-out error against the sensor-noise floor of the torques it was judged on
+(``metadata.heldout``: the floor the command prints; for an older record without one,
+``heldout.json``'s: the last time block predicted by the fit of the others, unfiltered
+torques, against the noise read from the log), the training against the held-out error
 (over-fitting), the rank against the columns of the model (the base parameters are the
 structural rank of the kinematics), and the relative standard deviations (the paper pruned
-above 30 %). Below it: the measured against the predicted torques on held-out data, the
-residuals, the model structure (``selection``, when the identification chose terms), the
-coefficients with their standard deviations as bars, and each appended term (friction at
-the motors and at the joints, armature: :mod:`.model_terms`).
+above 30 %). A one-step consistent fit (``identify --consistent``: ``report.json``'s
+``heldout``) is the result asked for: the headline is its held-out error against the
+noise floor of the torques it was judged on, least squares' the comparison. Below it: the
+measured against the predicted torques on held-out data, the residuals, the model
+structure (``selection``, when the identification chose terms), the coefficients with their
+standard deviations as bars, and each appended term (friction at the motors and at the
+joints, armature: :mod:`.model_terms`).
 """
 
 from __future__ import annotations
 
+import math
 import re
 from typing import Any
 
 from ..exceptions import DynidError
 from ..identification.structure import Structure
-from ..identification.verdict import FLOOR_GOOD, judge_prediction, worst
+from ..identification.verdict import FLOOR_GOOD, Verdict, judge_prediction, worst
 from .html import bar, cell, esc, figure, is_number, number, percent, section, table, verdict
 from .model_terms import terms_sections
 from .run import Answer, RunFiles
@@ -58,71 +63,179 @@ def _get(doc: Any, *keys: str) -> Any:
     return doc
 
 
-def _heldout_facts(doc: dict, held: dict | None) -> tuple[list[str], list[str], str]:
-    """(facts, problems, headline) of the held-out judgement."""
-    facts, problems, headline = [], [], ""
+def _heldout_facts(
+    doc: dict, held: dict | None, *, floor_fact: bool = True
+) -> tuple[list[str], list[str], str]:
+    """(facts, problems, headline) of the held-out judgement: the record's held-out error
+    against the record's sensor-noise floor (``metadata.heldout``: the numbers the command
+    prints; its fact left out without ``floor_fact``, where another fit's states the
+    floor); the last block's unfiltered error (``heldout.json``) beside it, against a
+    floor of its own only for a record without one (an older file)."""
+    facts, problems = [], []
     ho = _get(doc, "metadata", "heldout")
     train, test = _get(ho, "training_error_percent"), _get(ho, "heldout_error_percent")
-    at_floor = False  # the unfiltered held-out error at the sensor-noise floor
-    if held is not None and is_number(held.get("relative_error_percent")):
-        floor = held.get("noise_floor_percent")
-        at_floor = is_number(floor) and floor > 0
-        at_floor = at_floor and held["relative_error_percent"] / floor <= FLOOR_GOOD
+    floor = _get(ho, "noise_floor_percent")
+    judged = None  # the record's held-out error against its floor
+    if is_number(test) and is_number(floor) and floor > 0:
+        judged = judge_prediction(test, floor)
+    block = held is not None and is_number(held.get("relative_error_percent"))
+    if judged is not None:
+        at_floor = judged.ratio is not None and judged.ratio <= FLOOR_GOOD
+    elif block:
+        assert held is not None
+        bf = held.get("noise_floor_percent")
+        at_floor = is_number(bf) and bf > 0
+        at_floor = at_floor and held["relative_error_percent"] / bf <= FLOOR_GOOD
+    else:
+        at_floor = False
+    headline = ""
     if is_number(train) and is_number(test):
-        scheme = {
-            "blocks": f"over {ho.get('folds')} contiguous time blocks",
-            "recordings": f"leaving out each of {ho.get('folds')} recordings in turn",
-        }.get(str(ho.get("scheme")), "on the separate log")
-        ratio = test / train if train > 0 else 1.0
-        if ratio <= OVERFIT_GOOD:
-            why = "no sign of over-fitting"
-        elif at_floor:  # the fit follows some noise, and predicts as well as noise allows
-            why = "the fit follows some of the noise, yet predicts to the noise floor below"
-        else:
-            why = "the fit over-fits"
-        facts.append(
-            f"Held-out error <b>{percent(test)}</b> {esc(scheme)} (filtered torques, as "
-            f"fitted), training error {percent(train)} (ratio {ratio:.2f}: {why})"
-        )
-        if ratio > OVERFIT_FAIR and not at_floor:
-            problems.append("poor")
-        elif ratio > OVERFIT_GOOD and not at_floor:
-            problems.append("fair")
+        fact, more = _overfit_fact(ho, train, test, at_floor)
+        facts.append(fact)
+        problems += more
         headline = f"The model predicts held-out torques to {percent(test)}"
-    if held is not None and is_number(held.get("relative_error_percent")):
-        err, floor = held["relative_error_percent"], held.get("noise_floor_percent")
-        where = esc(held.get("block", "held-out data"))
-        v = judge_prediction(err, floor if is_number(floor) else None)
-        if v.level != "good":
-            problems.append(v.level)
-        if v.ratio is not None:
-            r = v.ratio
-            facts.append(
-                f"On {where}, unfiltered: error {percent(err)} against a sensor-noise floor "
-                f"of {percent(floor)} (<b>{r:.3g} x the floor</b>: {esc(v.label)}"
-                + (
-                    ", only noise is left)"
-                    if r <= FLOOR_GOOD
-                    else ", effects outside the model remain, see the residuals)"
-                )
-            )
-            level = "at" if r <= FLOOR_GOOD else f"{r:.3g} times"  # as in the fact
-            headline = (
-                f"The model predicts held-out torques to {percent(err)}, {level} the "
-                f"sensor-noise floor of {percent(floor)} (unfiltered torques)"
-            )
-        else:
-            facts.append(
-                f"On {where}, unfiltered: error {percent(err)} (noise floor unknown: "
-                f"{esc(v.label)})"
-            )
-        if v.unusable:
-            headline = f"The model does not explain held-out torques: error {percent(err)}"
-    elif headline:
+    if judged is not None:
+        fact, more, headline = _floor_fact(judged, test, floor, "torques it was judged on")
+        facts += [fact] if floor_fact else []
+        problems += more
+    if block:
+        assert held is not None
+        fact, more, said = _block_fact(held, judged is None)
+        facts.append(fact)
+        problems += more
+        headline = said or headline
+    elif headline and judged is None:
         facts.append(
             "Sensor-noise floor not measured (heldout.json absent: the run was made with "
             "--no-figures, or the log could not be read back)"
         )
+    return facts, problems, headline
+
+
+def _overfit_fact(ho: dict, train: float, test: float, at_floor: bool) -> tuple[str, list[str]]:
+    """The training against the held-out error (over-fitting), and its problem."""
+    scheme = {
+        "blocks": f"over {ho.get('folds')} contiguous time blocks",
+        "recordings": f"leaving out each of {ho.get('folds')} recordings in turn",
+    }.get(str(ho.get("scheme")), "on the separate log")
+    ratio = test / train if train > 0 else 1.0
+    if ratio <= OVERFIT_GOOD:
+        why = "no sign of over-fitting"
+    elif at_floor:  # the fit follows some noise, and predicts as well as noise allows
+        why = "the fit follows some of the noise, yet predicts to the noise floor below"
+    else:
+        why = "the fit over-fits"
+    fact = (
+        f"Held-out error <b>{percent(test)}</b> {esc(scheme)} (filtered torques, as "
+        f"fitted), training error {percent(train)} (ratio {ratio:.2f}: {why})"
+    )
+    if ratio > OVERFIT_FAIR and not at_floor:
+        return fact, ["poor"]
+    return fact, ["fair"] if ratio > OVERFIT_GOOD and not at_floor else []
+
+
+def _floor_fact(v: Verdict, err: float, floor: float, torques: str) -> tuple[str, list[str], str]:
+    """(fact, problems, headline) of an error against a sensor-noise floor."""
+    r = v.ratio if v.ratio is not None else math.inf
+    fact = (
+        f"Error {percent(err)} against a sensor-noise floor of {percent(floor)} of the "
+        f"{esc(torques)} (<b>{r:.3g} x the floor</b>: {esc(v.label)}"
+        + (
+            ", only noise is left)"
+            if r <= FLOOR_GOOD
+            else ", effects outside the model remain, see the residuals)"
+        )
+    )
+    level = "at" if r <= FLOOR_GOOD else f"{r:.3g} times"  # as in the fact
+    headline = (
+        f"The model predicts held-out torques to {percent(err)}, {level} the "
+        f"sensor-noise floor of {percent(floor)}"
+    )
+    if v.unusable:
+        headline = f"The model does not explain held-out torques: error {percent(err)}"
+    return fact, [] if v.level == "good" else [v.level], headline
+
+
+def _block_fact(held: dict, judge: bool) -> tuple[str, list[str], str]:
+    """(fact, problems, headline or "") of the last block's unfiltered error
+    (``heldout.json``, the figures' and the table's data): against its own floor when
+    ``judge`` (a record without one), else the error alone (the floor is the record's)."""
+    err, floor = held["relative_error_percent"], held.get("noise_floor_percent")
+    where = f"On {esc(held.get('block', 'held-out data'))}, unfiltered"
+    if not judge:
+        v = judge_prediction(err)  # only a model that explains nothing is judged here
+        fact = f"{where} (the figures and the table below): error {percent(err)}"
+        bad = v.unusable
+        return (
+            fact,
+            ["unusable"] if bad else [],
+            (f"The model does not explain held-out torques: error {percent(err)}" if bad else ""),
+        )
+    floor = floor if is_number(floor) else None
+    v = judge_prediction(err, floor)
+    if v.ratio is None or floor is None:
+        fact = f"{where}: error {percent(err)} (noise floor unknown: {esc(v.label)})"
+        return (
+            fact,
+            [] if v.level == "good" else [v.level],
+            (
+                f"The model does not explain held-out torques: error {percent(err)}"
+                if v.unusable
+                else ""
+            ),
+        )
+    fact, problems, headline = _floor_fact(v, err, floor, "unfiltered torques")
+    return (
+        f"{where}: {fact[0].lower()}{fact[1:]}",
+        problems,
+        headline + ("" if v.unusable else " (unfiltered torques)"),
+    )
+
+
+def _consistent_heldout(run: RunFiles) -> dict | None:
+    """The held-out judgement of a one-step consistent fit (``report.json``'s ``heldout``:
+    its errors and least squares' on the same folds), or None without one."""
+    ho = _get(run.doc("report.json"), "heldout")
+    errors = [_get(ho, f, k) for f in ("consistent", "least_squares") for k in _ERRORS]
+    return ho if all(is_number(e) for e in errors) else None
+
+
+#: The errors [%] of a fit in the held-out judgement's records.
+_ERRORS = ("training_error_percent", "heldout_error_percent")
+
+
+def _consistent_facts(doc: dict, ho: dict) -> tuple[list[str], list[str], str]:
+    """(facts, problems, headline) of the consistent fit the user asked for
+    (``identify --consistent``): its held-out error first, against the sensor-noise floor
+    of the torques it was judged on (``metadata.heldout.noise_floor_percent``, the one the
+    command prints), least squares' on the same folds as the comparison."""
+    train, test = (ho["consistent"][k] for k in _ERRORS)
+    ls_train, ls_test = (ho["least_squares"][k] for k in _ERRORS)
+    scheme = {
+        "blocks": f"over {ho.get('folds')} contiguous time blocks",
+        "recordings": f"leaving out each of {ho.get('folds')} recordings in turn",
+    }.get(str(ho.get("scheme")), "on the separate log")
+    facts = [
+        f"Held-out error of the consistent fit <b>{percent(test)}</b> {esc(scheme)} (filtered "
+        f"torques, as fitted), training error {percent(train)}; least squares, for "
+        f"comparison: held-out {percent(ls_test)}, training {percent(ls_train)}"
+    ]
+    headline = (
+        f"The consistent fit predicts held-out torques to {percent(test)} (least squares: "
+        f"{percent(ls_test)})"
+    )
+    floor = _get(doc, "metadata", "heldout", "noise_floor_percent")
+    v = judge_prediction(test, floor if is_number(floor) and floor > 0 else None)
+    problems: list[str] = [] if v.level == "good" else [v.level]
+    if v.ratio is not None:
+        level = "at" if v.ratio <= FLOOR_GOOD else f"{v.ratio:.3g} times"
+        headline += f", {level} the sensor-noise floor of {percent(floor)}"
+        facts.append(
+            f"Consistent fit: <b>{v.ratio:.3g} x the sensor-noise floor</b> of "
+            f"{percent(floor)} of the torques it was judged on ({esc(v.label)})"
+        )
+    if v.unusable:
+        headline = f"The consistent fit does not explain held-out torques: error {percent(test)}"
     return facts, problems, headline
 
 
@@ -245,7 +358,12 @@ def answer(run: RunFiles) -> Answer | None:
     if doc.get("route") == "static":
         facts, problems, headline = _static_facts(doc)
     else:
-        facts, problems, headline = _heldout_facts(doc, held)
+        consistent = _consistent_heldout(run)
+        facts, problems, headline = _heldout_facts(doc, held, floor_fact=consistent is None)
+        if consistent is not None:  # the answer asked for: the consistent fit's error
+            first, more, headline = _consistent_facts(doc, consistent)
+            facts = first + [f"Least squares: {f[0].lower()}{f[1:]}" for f in facts]
+            problems = more + problems
     rank, p = _rank_fact(doc)
     facts.append(rank)
     problems += p

@@ -1,6 +1,8 @@
 """The answer of a run that watched a log for events (collision detection): the residuals,
 the thresholds and the events, from ``events.json``, ``thresholds.json``,
-``residuals.png`` and ``residuals.csv`` when the run wrote them.
+``residuals.png`` and ``residuals.csv`` when the run wrote them. A calibration
+(``thresholds.json`` recording its ``calibration``, no events file) judges no events: its
+answer says what it calibrated.
 
 The files' layouts belong to the command that writes them; this page reads them
 generically: the events are the records of ``events.json`` (a list, or the list under
@@ -11,7 +13,7 @@ from __future__ import annotations
 
 from typing import Any
 
-from .html import esc, figure, href, section, verdict
+from .html import esc, figure, href, is_number, section, verdict
 from .json_tables import json_section
 from .run import Answer, RunFiles
 
@@ -26,6 +28,24 @@ def _events(doc: Any) -> list | None:
     return None
 
 
+def _calibration(doc: Any) -> str | None:
+    """What a calibration did, in one sentence (``thresholds.json``'s ``calibration``: the
+    samples and logs, and the thresholds' range over the joints), or None when the file
+    records none."""
+    cal = doc.get("calibration") if isinstance(doc, dict) else None
+    if not isinstance(cal, dict):
+        return None
+    logs = [str(d) for d in cal.get("data") or ()]
+    said = f"Thresholds calibrated on {cal.get('samples', 'the')} samples of {len(logs)} log"
+    said += ("s" if len(logs) != 1 else "") + (f" ({', '.join(logs)})" if logs else "")
+    ranges = [
+        f"{key} {min(v):.3g}-{max(v):.3g} N m"
+        for key in ("contact", "collision")
+        if isinstance(v := doc.get(key), list) and v and all(is_number(x) for x in v)
+    ]
+    return said + (": " + ", ".join(ranges) + " over the joints" if ranges else "") + "."
+
+
 def answer(run: RunFiles) -> Answer | None:
     """The events found, the thresholds and the residuals, or None without those files."""
     names = ("events.json", "thresholds.json", "residuals.png", "residuals.csv")
@@ -34,7 +54,11 @@ def answer(run: RunFiles) -> Answer | None:
         return None
     events = _events(run.docs.get(found["events.json"] or ""))
     facts = []
-    if events is None:
+    label = None
+    calibrated = _calibration(run.docs.get(found["thresholds.json"] or ""))
+    if events is None and calibrated is not None:  # a calibration judges no events
+        head, level, label = calibrated, "info", "thresholds calibrated"
+    elif events is None:
         head, level = "The run wrote residuals; no events file to judge.", "fair"
     elif events:
         head, level = f"{len(events)} event{'s' if len(events) != 1 else ''} detected.", "info"
@@ -59,7 +83,7 @@ def answer(run: RunFiles) -> Answer | None:
         sections.append(section("thresholds", "Thresholds", json_section(name, run.docs[name])))
     shown = frozenset(r for r in (found["residuals.png"],) if r is not None)
     return Answer(
-        verdict(level, esc(head), facts or ["Residuals, thresholds and events below"]),
+        verdict(level, esc(head), facts or ["Residuals, thresholds and events below"], label),
         tuple(sections),
         shown,
     )

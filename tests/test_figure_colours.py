@@ -1,0 +1,68 @@
+"""The figures of a report draw each quantity in one colour (dynid.plots.style.COLOURS)
+and keep their legends off the data."""
+
+from __future__ import annotations
+
+import numpy as np
+from matplotlib.colors import to_rgba
+
+from dynid.friction.validation import Validation
+from dynid.identification.log import TorqueLog
+from dynid.identification.metrics import torque_errors
+
+
+def _validation(rng: np.random.Generator, N: int = 400, n: int = 3) -> Validation:
+    """Measured torques, a rigid-body prediction and a friction term (random signals)."""
+    t = 0.01 * np.arange(N)
+    q, dq, ddq = (rng.normal(size=(N, n)) for _ in range(3))
+    tau = rng.normal(size=(N, n))
+    model, friction = tau + rng.normal(0, 0.3, (N, n)), rng.normal(0, 0.2, (N, n))
+    log = TorqueLog(t, q, dq, tau, ddq)
+    return Validation(
+        log, model, friction, torque_errors(tau, model), torque_errors(tau, model + friction), None
+    )
+
+
+def test_without_and_with_friction_keep_their_colours_from_traces_to_rms_bars():
+    """The model without friction and the model with it are drawn in the same colours in
+    the torque traces, the error panels and the RMS bars of one report (the bars drew
+    "without friction" blue beside traces where blue was "with friction")."""
+    from dynid.plots.style import COLOURS
+    from dynid.plots.torques import plot_torque_validation, plot_validation_rms
+
+    v = _validation(np.random.default_rng(1))
+    traces = plot_torque_validation(v)
+    lines = {ln.get_label(): to_rgba(ln.get_color()) for ln in traces.axes[0].lines}
+    bars = plot_validation_rms(v)
+    patches = {
+        c.get_label(): to_rgba(c.patches[0].get_facecolor()) for c in bars.axes[0].containers
+    }
+    no, yes = to_rgba(COLOURS["no_friction"]), to_rgba(COLOURS["model"])
+    assert lines["model, no friction"] == patches["without friction"] == no
+    assert lines["model + friction"] == patches["with friction"] == yes
+    errors = [to_rgba(ln.get_color()) for ln in traces.axes[1].lines[:2]]
+    assert errors == [no, yes]  # the error panels: the same two colours
+
+
+def _overlaps(fig, legend) -> list[int]:
+    """Indices of the axes of ``fig`` whose drawing area ``legend`` overlaps [pixels]."""
+    fig.canvas.draw()
+    box = legend.get_window_extent()
+    return [k for k, ax in enumerate(fig.axes) if ax.get_window_extent().overlaps(box)]
+
+
+def test_torque_and_observer_legends_cover_no_data():
+    """The legends of the torque traces and of the observer's residuals stand outside
+    every axes (they sat in the first panels, over the error traces and the thresholds)."""
+    from dynid.plots.observer import plot_residuals
+    from dynid.plots.torques import plot_torque_validation
+
+    rng = np.random.default_rng(2)
+    fig = plot_torque_validation(_validation(rng))
+    t = np.linspace(0.0, 4.0, 400)
+    r = rng.normal(size=(400, 2))
+    obs = plot_residuals(t, r, np.full_like(r, 2.0), np.full_like(r, 4.0), events=())
+    for f in (fig, obs):
+        assert all(ax.get_legend() is None for ax in f.axes)
+        (legend,) = f.legends
+        assert _overlaps(f, legend) == []
