@@ -166,9 +166,11 @@ def test_friction_is_recovered_from_several_recordings(panda, files):
 
 def test_the_own_friction_is_judged_on_the_same_recordings(panda, files):
     """A model identified from rec1 and rec2: on those recordings its friction is judged by
-    its law refitted on the recording left out, exactly as that law is, and a tie keeps the
-    refitted law; the robot's own (true) friction on recordings new to it is judged as it
-    is, and predicts them best."""
+    the law it was identified with (its standstill band or smooth width) refitted on the
+    recording left out, which predicts them at least as well as the registry's law at the
+    noise band (0.445 % against 0.832 %: judged with the registry's band it read 0.832 %);
+    the robot's own (true) friction on recordings new to it is judged as it is, and
+    predicts them best."""
     paths = [files / "rec1.csv", files / "rec2.csv"]
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", DynidWarning)
@@ -177,8 +179,8 @@ def test_the_own_friction_is_judged_on_the_same_recordings(panda, files):
         robot = fit_friction_files(panda, paths).selection
     held = {s.name: s.heldout_error_percent for s in sel.scores}
     law = model.friction.law
-    assert sel.scores[-1].name == "own" and held["own"] == pytest.approx(held[law], rel=1e-12)
-    assert sel.chosen != "own" and sel.method.startswith("leave one recording out")
+    assert sel.scores[-1].name == "own" and held["own"] <= held[law]
+    assert sel.method.startswith("leave one recording out")
     held_r = {s.name: s.heldout_error_percent for s in robot.scores}
     assert robot.scores[0].name == "own"
     assert held_r["own"] <= 1.01 * min(held_r.values())
