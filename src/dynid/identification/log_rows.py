@@ -142,10 +142,44 @@ def stepped_filtered(
             fine = tw[0] + np.arange((hi - lo - 1) * k + 1) * (1.0 / (k * rate))
             x = CubicSpline(tw, x, axis=0)(np.minimum(fine, tw[-1]))
         states = (x[:, :n], x[:, n : 2 * n], x[:, 2 * n :])
-        A = np.concatenate([t.torque_columns(*states) for t in terms], axis=-1)[..., steps]
-        A = parallel_filtered(A, np.ones(A.shape[-1], bool), None, cutoff_hz, rate=k * rate)
-        out[s - h - a : e - h - a] = A[(s - lo) * k : (e - lo - 1) * k + 1 : k]
+        keep = slice((s - lo) * k, (e - lo - 1) * k + 1, k)  # the span's prepared samples
+        got = [_filtered_columns(t, states, cutoff_hz, k * rate, keep) for t in terms]
+        out[s - h - a : e - h - a] = np.concatenate(got, axis=-1)[..., steps]
     return out
+
+
+def _filtered_columns(
+    term: ModelTerm,
+    states: tuple[NDArray[np.float64], ...],
+    cutoff_hz: float,
+    rate: float,
+    keep: slice,
+) -> NDArray[np.float64]:
+    """A term's columns (m, n, p) at the samples ``keep`` of ``states`` (the fine grid at
+    ``rate`` [Hz]), those that step low-passed there first (:func:`parallel_filtered`);
+    zeros for a term without such columns. Friction's parts are filtered per motor before
+    they are placed (a linear map), not its mostly zero columns."""
+    m = len(range(*keep.indices(states[0].shape[0])))
+    steps = np.asarray(getattr(term, "steps", np.zeros(len(term.labels), bool)), dtype=bool)
+    if not steps.any():
+        return np.zeros((m, states[0].shape[1], len(term.labels)))
+    if isinstance(term, LinearFriction):
+        P = term.part_columns(term.drive.motor_velocities(states[1]))  # (M, n, k)
+        stepping = np.array([p in ("coulomb", "smooth", "stribeck") for p in term.parts])
+        flat = P[..., stepping].reshape(P.shape[0], -1)
+        flat = parallel_filtered(flat[:, None, :], np.ones(flat.shape[1], bool), None,
+                                 cutoff_hz, rate=rate)[:, 0, :]  # fmt: skip
+        Pk = P[keep]
+        Pk[..., stepping] = flat[keep].reshape(m, P.shape[1], -1)
+        return term.placed(Pk)
+    A = term.torque_columns(*states)
+    flat = A.reshape(A.shape[0], -1)  # the signals (joint, column), a view
+    used = np.flatnonzero(np.tile(steps, A.shape[1]) & flat.any(axis=0))
+    sig = parallel_filtered(flat[:, used][:, None, :], np.ones(used.size, bool), None,
+                            cutoff_hz, rate=rate)[:, 0, :]  # fmt: skip
+    got = np.array(flat[keep])
+    got[:, used] = sig[keep]
+    return got.reshape(m, A.shape[1], -1)
 
 
 def _joined(

@@ -481,11 +481,15 @@ class LinearFriction:
     ) -> NDArray[np.float64]:
         """(B, n, k n): motor ``m``'s columns of the parts held at ``v = (K dq)_m``,
         mapped by ``K^T`` onto the joints (``K = 1`` at the joints)."""
-        v = self.drive.motor_velocities(dq)
-        n, k = v.shape[-1], len(self.parts)
-        F = np.zeros(v.shape + (k * n,))
+        return self.placed(self.part_columns(self.drive.motor_velocities(dq)))
+
+    def placed(self, parts: NDArray[np.float64]) -> NDArray[np.float64]:
+        """(B, n, p): the columns of :meth:`part_columns` ``parts`` (B, n, k), each motor's
+        in its own columns, mapped by ``K^T`` onto the joints (a linear map: a part
+        filtered along time gives the columns filtered)."""
+        n, k = parts.shape[-2], len(self.parts)
+        F = np.zeros(parts.shape[:-1] + (k * n,))
         m = np.arange(n)
-        parts = self.part_columns(v)
         for i in range(k):
             F[..., m, k * m + i] = parts[..., i]
         if self.mask:
