@@ -10,7 +10,9 @@ other (:data:`SMOOTH_THINNING`), each named in one note.
 
 from __future__ import annotations
 
+import re
 import warnings
+from collections.abc import Callable
 from typing import Any
 
 import numpy as np
@@ -50,12 +52,17 @@ def fit_largest(
     judge: Judge,
     notes: list[str],
     fold_labels: NDArray[np.intp] | None = None,
+    unexcited: set[str] | None = None,
 ) -> tuple[IdentifiedModel, list[tuple[ModelTerm, Any]], list[Structure]] | None:
     """The model of every candidate's columns at once, with its terms and the candidates it
     holds; when the data cannot tell its columns apart, the Stribeck laws at
     :data:`~dynid.identification.structure.STRIBECK_COARSE` only, then the classical
-    candidates alone (a note says which were left out); None (and a note) when not even
-    those are identifiable."""
+    candidates alone (a note says which were left out). When not even those are
+    identifiable for want of single joints' friction coefficients (a joint that never
+    reverses: its Coulomb friction is an offset), those coefficients are left out of every
+    candidate (:func:`_unexcited_coefficients`; ``unexcited`` gathers them over the
+    groups, and a group starts without those already found) and the candidates judged
+    again; None (and a note) when still none is identifiable."""
     shaped = [c for c in mine if {"smooth", "stribeck"} & set(c.friction)]
     coarse = [c for c in mine if "stribeck" not in c.friction or c.vst in STRIBECK_COARSE]
     tries = [mine, coarse]
@@ -66,7 +73,8 @@ def fit_largest(
     for w in SMOOTH_THINNING:
         gone.add(w)
         tries.append([c for c in coarse if "stribeck" in c.friction or c.width not in gone])
-    tries.append([c for c in mine if c not in shaped])
+    classical = [c for c in mine if c not in shaped]
+    tries.append(classical)
     what = ("with" if arm else "without") + " armature"
     place = {"both": "motors and the joints"}
     what += "".join(
@@ -75,32 +83,29 @@ def fit_largest(
     family = regressor_group(mine[0])[2]
     laws = "smooth-sign Stribeck" if family.startswith("smooth") else family or "smooth"
     laws = "Stribeck" if laws == "stribeck" else laws
-    failed: list[str] = []
-    for k, group in enumerate(tries):
-        if not group or (k and len(group) == len(tries[k - 1])):
-            continue
-        model_drive, terms = largest_terms(
-            group, arm, drive, robot.n, tuple(data.band), recording_bands(data), data.band_gain
-        )
-        try:
-            with warnings.catch_warnings():  # the candidates' fits: only the chosen one speaks
-                warnings.simplefilter("ignore", DynidWarning)
-                model = identify(
-                    robot,
-                    data,
-                    drive=model_drive,
-                    terms=tuple(t for t, _ in terms),
-                    estimator=est,
-                    rtol=rtol,
-                    judge=judge,
-                    fold_labels=fold_labels,
-                )
-        except RankDeficientError as exc:
-            failed.append(f"rank {exc.rank} < {exc.needed}")
-            continue
-        if failed:
+
+    def fit(group: list[Structure], drop: frozenset[str]) -> _Fitted:
+        return _fit_group(robot, data, group, arm, drive, est, rtol, judge, fold_labels, drop)
+
+    found = unexcited if unexcited is not None else set()
+    drop = frozenset(found)
+    fitted, failed = _first_fitted(tries, drop, fit)
+    if fitted is None and classical:
+        more, why = _unexcited_coefficients(classical, drop, fit)
+        if more:
+            drop |= more
+            found |= more
+            fitted, failed = _first_fitted(tries, drop, fit)
+            note = (
+                f"the data do not excite {'; '.join(why)}: "
+                f"{', '.join(sorted(more, key=_order))} left out of every candidate"
+            )
+            notes += [] if note in notes else [note]
+    if fitted is not None:
+        model, terms, group, k = fitted
+        if k:
             notes.append(_left_out_note(mine, group, laws, what) + f" ({'; '.join(failed)})")
-        return model, terms, group
+        return model, terms, [c.without(drop) for c in group]
     if failed:
         notes.append(
             (
@@ -111,6 +116,106 @@ def fit_largest(
             + f" ({'; '.join(failed)})"
         )
     return None
+
+
+_Fitted = tuple[IdentifiedModel, list[tuple[ModelTerm, Any]]]
+_FirstFit = tuple[IdentifiedModel, list[tuple[ModelTerm, Any]], list[Structure], int]
+
+
+def _fit_group(
+    robot: Robot,
+    data: Recordings,
+    group: list[Structure],
+    arm: bool,
+    drive: Drive | None,
+    est: Estimator,
+    rtol: float | None,
+    judge: Judge,
+    fold_labels: NDArray[np.intp] | None,
+    drop: frozenset[str],
+) -> _Fitted:
+    """The model of the columns of every candidate of ``group`` (the friction coefficients
+    ``drop`` left out), fitted with the held-out judge, and its terms.
+
+    Raises
+    ------
+    RankDeficientError
+        The data do not identify those columns.
+    """
+    model_drive, terms = largest_terms(
+        group, arm, drive, robot.n, tuple(data.band), recording_bands(data), data.band_gain, drop
+    )
+    with warnings.catch_warnings():  # the candidates' fits: only the chosen one speaks
+        warnings.simplefilter("ignore", DynidWarning)
+        model = identify(
+            robot,
+            data,
+            drive=model_drive,
+            terms=tuple(t for t, _ in terms),
+            estimator=est,
+            rtol=rtol,
+            judge=judge,
+            fold_labels=fold_labels,
+        )
+    return model, terms
+
+
+def _first_fitted(
+    tries: list[list[Structure]],
+    drop: frozenset[str],
+    fit: Callable[[list[Structure], frozenset[str]], _Fitted],
+) -> tuple[_FirstFit | None, list[str]]:
+    """The first of ``tries`` the data identify (its model, terms, candidates and place),
+    and the ranks of those before it that they do not."""
+    failed: list[str] = []
+    for k, group in enumerate(tries):
+        if not group or (k and len(group) == len(tries[k - 1])):
+            continue
+        try:
+            return (*fit(group, drop), group, k), failed
+        except RankDeficientError as exc:
+            failed.append(f"rank {exc.rank} < {exc.needed}")
+    return None, failed
+
+
+#: At most this many rounds of single joints' coefficients left out
+#: (:func:`_unexcited_coefficients`).
+MAX_DROP_ROUNDS = 3
+
+
+def _unexcited_coefficients(
+    classical: list[Structure],
+    drop: frozenset[str],
+    fit: Callable[[list[Structure], frozenset[str]], _Fitted],
+) -> tuple[frozenset[str], list[str]]:
+    """The single joints' friction coefficients (``"fc3"``) beside ``drop`` without which
+    the data identify the classical candidates' columns, and the combinations the data do
+    not excite that named them (:attr:`~dynid.exceptions.RankDeficientError.redundant`);
+    none when other columns (the links') are not identifiable either."""
+    more: set[str] = set()
+    why: list[str] = []
+    for _ in range(MAX_DROP_ROUNDS):
+        try:
+            fit(classical, drop | more)
+        except RankDeficientError as exc:
+            new = set(exc.redundant) - drop - more
+            if not new or not all(_FRICTION_LABEL.fullmatch(lab) for lab in new):
+                return frozenset(), []
+            more |= new
+            why += list(exc.combinations)
+            continue
+        return frozenset(more), why
+    return frozenset(), []
+
+
+#: A friction coefficient of one joint (motor): ``fc3``, ``jfv7``.
+_FRICTION_LABEL = re.compile(r"j?f[a-z]+[0-9]+")
+
+
+def _order(label: str) -> tuple[int, str]:
+    """Joint first, then the label: ``fv2 < fo2 < fv3``."""
+    prefix = label.rstrip("0123456789")
+    return int(label[len(prefix) :]), prefix
 
 
 #: The order in which smooth widths (in bands) are left out of a regressor whose columns

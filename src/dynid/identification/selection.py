@@ -31,6 +31,7 @@ structure chosen (or given).
 
 from __future__ import annotations
 
+import copy
 import warnings
 from collections.abc import Sequence
 from dataclasses import replace
@@ -39,7 +40,7 @@ from typing import Any, Literal
 import numpy as np
 from numpy.typing import NDArray
 
-from ..exceptions import DynidWarning, OptionError
+from ..exceptions import DynidWarning, OptionError, RankDeficientError
 from ..model.drive import Drive
 from ..model.robot import Robot
 from ..regressors.base import BaseParameters
@@ -202,10 +203,13 @@ def select_structure(
     fit_rtol = 1e-10 if rtol is None else rtol
     groups: _Groups = {}
     columns: list[tuple[Structure, NDArray[np.bool_], _Key]] = []
+    unexcited: set[str] = set()  # single joints' coefficients the data do not excite
     for key in sorted({regressor_group(c) for c in cands}):
         arm = key[0]
         mine = [c for c in cands if regressor_group(c) == key]
-        fitted = fit_largest(robot, data, mine, arm, drive, est, rtol, judge, notes, fold_labels)
+        fitted = fit_largest(
+            robot, data, mine, arm, drive, est, rtol, judge, notes, fold_labels, unexcited
+        )
         if fitted is None:
             continue
         model, terms, mine = fitted
@@ -562,10 +566,13 @@ def identify_recordings(
         structure = _fitted_structure(selection, friction)
     model_drive, terms = _terms_of(structure, drive, robot.n, data)
     judge, _, fold_labels = heldout_judge(robot, data, est, folds, validation)
-    model = identify(
-        robot, data, drive=model_drive, terms=terms, estimator=est, std=std, base=base,
-        max_std_percent=max_std_percent, rtol=rtol, judge=judge, fold_labels=fold_labels,
-    )  # fmt: skip
+    try:
+        model = identify(
+            robot, data, drive=model_drive, terms=terms, estimator=est, std=std, base=base,
+            max_std_percent=max_std_percent, rtol=rtol, judge=judge, fold_labels=fold_labels,
+        )  # fmt: skip
+    except RankDeficientError as exc:
+        raise _without_hint(exc, structure) from exc
     warn_unphysical(model, terms)
     info = replace(
         model.info,
@@ -574,6 +581,23 @@ def identify_recordings(
         extra={**model.info.extra, "terms": list(structure.terms)},
     )
     return replace(model, info=info)
+
+
+def _without_hint(exc: RankDeficientError, structure: Structure) -> RankDeficientError:
+    """``exc`` with a hint naming the terms that leave out the single joints' friction
+    coefficients that name the combinations the data do not excite (``-fc3``), when those
+    are all it names."""
+    fewer = structure.without(exc.redundant)
+    if not exc.redundant or len(fewer.drop) - len(structure.drop) < len(set(exc.redundant)):
+        return exc
+    labels = ", ".join(exc.redundant)
+    out = copy.copy(exc)
+    out.args = (
+        f"{exc.args[0]}; or leave {labels} out: --terms {','.join(fewer.terms)} "
+        f"(-LABEL leaves out one joint's coefficient)",
+        *exc.args[1:],
+    )
+    return out
 
 
 def _fitted_structure(selection: Selection | None, friction: tuple[str, ...] | None) -> Structure:
