@@ -16,6 +16,7 @@ import pytest
 from dynid.exceptions import DynidWarning, RankDeficientError
 from dynid.friction.model import ClassicalFriction
 from dynid.friction.validation import own_friction
+from dynid.identification.largest import LeftOut
 from dynid.identification.selection import identify_recordings
 from dynid.identification.structure import Structure
 from dynid.simulation.measurement import SensorNoise, sample_times, simulate_measurement
@@ -89,3 +90,21 @@ def test_a_fixed_structure_the_log_cannot_identify_names_the_terms_without_it(pa
         model = identify_recordings(panda, logs, structure=fewer)
     labels = model.terms["friction"].labels
     assert len(labels) == 20 and fewer.drop[0] not in labels, labels
+
+
+def test_a_chosen_smooth_width_is_not_named_as_left_out():
+    """Regression (a note named the chosen ``smooth:0.3`` as left out): the smooth widths
+    the data do not tell apart are left out of the smooth candidates' regressor, while the
+    width 0.3 is judged, and chosen, with the smooth-sign Stribeck candidates (their bumps
+    left out); the note names the widths 1 and 3 as left out and 0.3 as kept."""
+    smooth, bumps = (True, "", ""), (True, "", "smooth_stribeck:0.3")
+    left = LeftOut("smooth", "with armature", smooth, (0.3, 1.0, 3.0), (), False, ("r",))
+    chosen = Structure.parse("links + armature + viscous + smooth:0.3")
+    note = left.note(chosen, bumps)
+    assert "at the widths 1, 3 bands" in note and "widths 0.3" not in note, note
+    assert "the width 0.3, chosen, was kept" in note and "smooth-sign Stribeck" in note, note
+    # a choice elsewhere (no armature, another width) leaves the note as it was
+    for other, group in ((chosen, (False, "", "smooth_stribeck:0.3")), (chosen, smooth)):
+        assert left.note(other, group).startswith(
+            "the smooth candidates with armature at the widths 0.3, 1, 3 bands"
+        )

@@ -13,6 +13,7 @@ from __future__ import annotations
 import re
 import warnings
 from collections.abc import Callable
+from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
@@ -33,7 +34,7 @@ from .structure import (
     regressor_group,
 )
 
-__all__ = ["SMOOTH_THINNING", "fit_largest", "recording_bands"]
+__all__ = ["LeftOut", "SMOOTH_THINNING", "fit_largest", "recording_bands"]
 
 
 def recording_bands(data: Recordings) -> dict[str, tuple[float, ...]]:
@@ -53,11 +54,13 @@ def fit_largest(
     notes: list[str],
     fold_labels: NDArray[np.intp] | None = None,
     unexcited: set[str] | None = None,
+    left_out: list[LeftOut] | None = None,
 ) -> tuple[IdentifiedModel, list[tuple[ModelTerm, Any]], list[Structure]] | None:
     """The model of every candidate's columns at once, with its terms and the candidates it
     holds; when the data cannot tell its columns apart, the Stribeck laws at
     :data:`~dynid.identification.structure.STRIBECK_COARSE` only, then the classical
-    candidates alone (a note says which were left out). When not even those are
+    candidates alone (a note says which were left out; a :class:`LeftOut` appended to
+    ``left_out`` instead when given, said once the choice is made). When not even those are
     identifiable for want of single joints' friction coefficients (a joint that never
     reverses: its Coulomb friction is an offset), those coefficients are left out of every
     candidate (:func:`_unexcited_coefficients`; ``unexcited`` gathers them over the
@@ -80,9 +83,7 @@ def fit_largest(
     what += "".join(
         f", friction at the {place.get(a, a + 's')}" for a in {c.at for c in mine} - {""}
     )
-    family = regressor_group(mine[0])[2]
-    laws = "smooth-sign Stribeck" if family.startswith("smooth") else family or "smooth"
-    laws = "Stribeck" if laws == "stribeck" else laws
+    laws = _family(regressor_group(mine[0])[2])
 
     def fit(group: list[Structure], drop: frozenset[str]) -> _Fitted:
         return _fit_group(robot, data, group, arm, drive, est, rtol, judge, fold_labels, drop)
@@ -104,7 +105,11 @@ def fit_largest(
     if fitted is not None:
         model, terms, group, k = fitted
         if k:
-            notes.append(_left_out_note(mine, group, laws, what) + f" ({'; '.join(failed)})")
+            record = _left_out(mine, group, laws, what, failed)
+            if left_out is None:
+                notes.append(record.note())
+            else:
+                left_out.append(record)
         return model, terms, [c.without(drop) for c in group]
     if failed:
         notes.append(
@@ -223,18 +228,92 @@ def _order(label: str) -> tuple[int, str]:
 SMOOTH_THINNING = (1.0, 3.0, 0.3, 10.0, 30.0, 100.0, 300.0)
 
 
-def _left_out_note(mine: list[Structure], group: list[Structure], laws: str, what: str) -> str:
-    """One note naming the shaped candidates of ``mine`` left out of ``group``."""
+@dataclass(frozen=True, slots=True)
+class LeftOut:
+    """Shaped candidates of one regressor left out because the data do not tell their
+    columns apart (:func:`fit_largest`); :meth:`note` says it once the choice is made.
+
+    Attributes
+    ----------
+    laws : str
+        The family (``"smooth"``, ``"Stribeck"``, ``"smooth-sign Stribeck"``).
+    what : str
+        Which regressor (``"with armature"``, ``", friction at the motors"``).
+    group : tuple of (bool, str, str)
+        Its :func:`~dynid.identification.structure.regressor_group`.
+    widths : tuple of float
+        The smooth widths [bands] left out.
+    vsts : tuple of float
+        The Stribeck velocities [rad/s] left out.
+    from_coulomb : bool
+        Every shaped candidate left out (the data do not tell them from Coulomb friction).
+    failed : tuple of str
+        The ranks of the regressors tried (``"rank 101 < 102"``).
+    """
+
+    laws: str
+    what: str
+    group: tuple[bool, str, str]
+    widths: tuple[float, ...]
+    vsts: tuple[float, ...]
+    from_coulomb: bool
+    failed: tuple[str, ...]
+
+    def note(self, chosen: Structure | None = None, chosen_group: Any = None) -> str:
+        """One line; a smooth ``chosen`` structure at one of :attr:`widths` judged in
+        another regressor of the same armature and placement (``chosen_group``: a
+        smooth-sign Stribeck law whose bumps were left out) is said to be kept, not named
+        as left out."""
+        ranks = f" ({'; '.join(self.failed)})"
+        if self.from_coulomb:
+            return (
+                f"the {self.laws} candidates {self.what}: the data do not tell them from "
+                f"Coulomb friction{ranks}"
+            )
+        kept = (
+            chosen is not None
+            and chosen_group is not None
+            and chosen_group != self.group
+            and tuple(chosen_group[:2]) == self.group[:2]
+            and "smooth" in chosen.friction
+            and chosen.width in self.widths
+        )
+        width = chosen.width if kept and chosen is not None else None
+        widths = [w for w in self.widths if w != width]
+        parts = [f"Stribeck velocities {', '.join(f'{v:g}' for v in self.vsts)} rad/s"]
+        parts = parts if self.vsts else []
+        parts += [f"widths {', '.join(f'{w:g}' for w in widths)} bands"] if widths else []
+        text = f"the {self.laws} candidates {self.what}"
+        if parts:
+            text += (
+                f" at the {' and '.join(parts)}: the data do not tell them from their "
+                "neighbours (left out)"
+            )
+        if width is not None:
+            text += (
+                f"{';' if parts else ':'} the width {width:g}, chosen, was kept: judged with "
+                f"the {_family(chosen_group[2])} candidates (their bumps left out)"
+            )
+        return text + ranks
+
+
+def _family(key: str) -> str:
+    """The laws of a regressor's key: ``"smooth_stribeck:0.3"`` -> ``"smooth-sign
+    Stribeck"``, ``""`` -> ``"smooth"``."""
+    laws = "smooth-sign Stribeck" if key.startswith("smooth") else key or "smooth"
+    return "Stribeck" if laws == "stribeck" else laws
+
+
+def _left_out(
+    mine: list[Structure], group: list[Structure], laws: str, what: str, failed: list[str]
+) -> LeftOut:
+    """The shaped candidates of ``mine`` left out of ``group``."""
     vst = sorted({c.vst for c in mine if c not in group and c.vst})
     widths = sorted(
         {c.width for c in mine if c not in group and c.friction and "stribeck" not in c.friction}
         - {0.0}
     )
-    if len(group) > len([c for c in mine if not {"smooth", "stribeck"} & set(c.friction)]):
-        parts = [f"Stribeck velocities {', '.join(f'{v:g}' for v in vst)} rad/s"] if vst else []
-        parts += [f"widths {', '.join(f'{w:g}' for w in widths)} bands"] if widths else []
-        return (
-            f"the {laws} candidates {what} at the {' and '.join(parts)}: the data do not "
-            "tell them from their neighbours (left out)"
-        )
-    return f"the {laws} candidates {what}: the data do not tell them from Coulomb friction"
+    shaped = len(group) > len([c for c in mine if not {"smooth", "stribeck"} & set(c.friction)])
+    return LeftOut(
+        laws, what, regressor_group(mine[0]), tuple(widths), tuple(vst), not shaped, tuple(failed)
+    )

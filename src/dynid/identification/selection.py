@@ -62,7 +62,7 @@ from .dissipation import friction_columns, friction_violations, warn_unphysical
 from .estimators import Estimator, EstimatorName, estimator_named
 from .holdout import DEFAULT_FOLDS, HeldOut
 from .judge import heldout_judge
-from .largest import fit_largest, recording_bands
+from .largest import LeftOut, fit_largest, recording_bands
 from .least_squares import StdMethod
 from .log import TorqueLog
 from .metrics import noise_floor_percent
@@ -204,11 +204,12 @@ def select_structure(
     groups: _Groups = {}
     columns: list[tuple[Structure, NDArray[np.bool_], _Key]] = []
     unexcited: set[str] = set()  # single joints' coefficients the data do not excite
+    left_out: list[LeftOut] = []  # shaped candidates left out, said once the choice is made
     for key in sorted({regressor_group(c) for c in cands}):
         arm = key[0]
         mine = [c for c in cands if regressor_group(c) == key]
         fitted = fit_largest(
-            robot, data, mine, arm, drive, est, rtol, judge, notes, fold_labels, unexcited
+            robot, data, mine, arm, drive, est, rtol, judge, notes, fold_labels, unexcited, left_out
         )
         if fitted is None:
             continue
@@ -242,6 +243,7 @@ def select_structure(
             where,
         )
     chosen = _chosen(judged)
+    notes[:0] = [lo.note(chosen, where.get(chosen)) for lo in left_out]
     best = min(_physical(judged), key=lambda c: c.score)
     judged = [replace(c, se_vs_best_percent=paired_se(c, best)) for c in judged]
     notes += _candidate_notes(judged)
