@@ -76,9 +76,29 @@ def test_the_structure_table_lists_every_coefficient_the_per_joint_search_left_o
     chosen = cands[1]["name"]
     sel = {"validation": "5 folds", "chosen": chosen, "rule": "lowest", "candidates": cands}
     lines = selection_lines(sel)
-    assert lines[1].endswith("left out of the candidate its per-joint search began at")
+    assert lines[1].endswith("  coefficients left out")
     assert lines[3].startswith("  * links + coulomb + offset ") and lines[3].endswith("  fv1-7 fo2")
     assert lines[2].rstrip() == lines[2] and not lines[2].endswith("fo2")
+
+
+def test_the_structure_table_has_no_left_out_column_when_no_row_shown_fills_it():
+    """Regression (a garbled last header printed over an empty column): a coefficient left
+    out only by a candidate the table does not show (a shape other than its law's best)
+    gives no left-out column; a row shown that leaves one out gives a short header."""
+    row = {"n_params": 40, "train_error_percent": 1.5, "heldout_se_percent": 0.1}
+    cands = [
+        row | {"name": "links + viscous + smooth:0.3", "heldout_error_percent": 2.0},
+        row | {"name": "links + viscous + smooth:1", "heldout_error_percent": 3.0},
+    ]
+    cands[1]["left_out"] = ["fo1", "fo2"]  # reached from smooth:1 + offset: every fo left out
+    sel = {"validation": "5 folds", "chosen": cands[0]["name"], "rule": "r", "candidates": cands}
+    lines = selection_lines(sel)
+    assert lines[1].endswith("se vs best"), lines[1]
+    assert all(line.rstrip() == line for line in lines), lines
+    cands[1]["heldout_error_percent"] = 1.0  # now the law's best: shown, with fo1 fo2
+    lines = selection_lines(sel)
+    assert lines[1].endswith("  coefficients left out"), lines[1]
+    assert any(line.endswith("  fo1 fo2") for line in lines[2:]), lines
 
 
 def test_the_structure_table_shows_each_shaped_law_at_its_best_shape():

@@ -106,15 +106,15 @@ def test_a_width_the_shared_regressor_cannot_tell_apart_is_judged_in_its_own(log
     :data:`~dynid.identification.largest.SMOOTH_THINNING` orders, is judged in a
     regressor of its own, said in one note, rather than dropped."""
     robot = planar_2r()
-    fit = largest_module._Fit.__call__
+    fit = largest_module._fit_group
 
-    def alike(self, group):  # the 1-band width beside other widths: rank deficient
+    def alike(robot, data, group, *rest):  # the 1-band width beside others: rank deficient
         widths = {c.width for c in group if "smooth" in c.friction}
         if 1.0 in widths and len(widths) > 1:
             raise RankDeficientError("alike", rank=1, needed=2)
-        return fit(self, group)
+        return fit(robot, data, group, *rest)
 
-    monkeypatch.setattr(largest_module._Fit, "__call__", alike)
+    monkeypatch.setattr(largest_module, "_fit_group", alike)
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", DynidWarning)
         data = prepare_recordings(robot, logs, drive=DRIVE)

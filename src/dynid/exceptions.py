@@ -134,6 +134,9 @@ class RankDeficientError(DynidError, ValueError):
     combinations : tuple of str
         Every combination of the columns the data do not excite (``needed - rank`` of
         them, ``"beta40 - 0.31*fc6"``); empty when not known.
+    redundant : tuple of str
+        The label naming each of those combinations (its first): without these columns
+        the others have full rank (``("beta40",)``); empty when not known.
     """
 
     def __init__(
@@ -144,12 +147,14 @@ class RankDeficientError(DynidError, ValueError):
         needed: int | None = None,
         dependent: tuple[str, ...] = (),
         combinations: tuple[str, ...] = (),
+        redundant: tuple[str, ...] = (),
     ) -> None:
         super().__init__(message)
         self.rank = rank
         self.needed = needed
         self.dependent = tuple(dependent)
         self.combinations = tuple(combinations)
+        self.redundant = tuple(redundant)
 
 
 class InfeasibleError(DynidError, ValueError):

@@ -187,7 +187,9 @@ def register(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParser:
         choices=list(ESTIMATORS),
         default="ols",
         help="least squares: ordinary (default), weighted by each joint's (static: each row's) "
-        "noise level from a first fit, or Huber-reweighted against outliers",
+        "noise level from a first fit, or Huber-reweighted against outlying rows after "
+        "filtering (one-sample torque spikes are replaced before filtering, whatever the "
+        "estimator, with a warning)",
     )
     p.add_argument(
         "--rtol",

@@ -31,19 +31,20 @@ def selection_lines(selection: Any) -> list[str]:
     w = text_width("structure", [name for name, _, _ in split], 46)
     # the choice reads the held-out error with each joint in units of its own noise
     white = any(c.get("heldout_whitened_percent") is not None for c in selection["candidates"])
-    left = any(dropped for _, _, dropped in split)
+    cands = selection["candidates"]
+    shown, hidden = _best_of_shapes(cands, selection["chosen"])
+    # the column of the coefficients left out, when a row shown holds some
+    left = any(d for c, (_, _, d) in zip(cands, split, strict=True) if c["name"] in shown)
     out = [
         f"model structure chosen on held-out data ({selection['validation']}): "
         f"{selection['chosen']} ({selection['rule']})",
         f"    {'structure':<{w}} {'params':>6} {'train %':>9} {'held-out %':>11}"
         + (f" {'whitened %':>11}" if white else "")
         + f" {'se vs best':>10}"
-        + ("  left out of the candidate its per-joint search began at" if left else ""),
+        + ("  coefficients left out" if left else ""),
     ]
-    cands = selection["candidates"]
     # skipped (not dissipative within the velocity limits) unless every candidate is
     skip = not all(c.get("not_dissipative") for c in cands)
-    shown, hidden = _best_of_shapes(cands, selection["chosen"])
     for c, (name, _, dropped) in zip(cands, split, strict=True):
         if c["name"] not in shown:
             continue
@@ -54,7 +55,7 @@ def selection_lines(selection: Any) -> list[str]:
             f"{c['heldout_error_percent']:>11.4g}"
             + (f" {c.get('heldout_whitened_percent') or float('nan'):>11.4g}" if white else "")
             + f" {_se_vs_best(c):>10}"
-            + (f"  {_compact(dropped.split(' - '))}" if dropped else "")
+            + (f"  {_compact(dropped.split(' - '))}" if dropped and left else "")
         )
     if hidden:
         x = sum(1 for c in cands if c["name"] not in shown and skip and c.get("not_dissipative"))

@@ -319,6 +319,7 @@ def _rank_error(
         needed=needed,
         dependent=exc.dependent,
         combinations=exc.combinations,
+        redundant=exc.redundant,
     )
 
 

@@ -309,6 +309,7 @@ def _fit(
                     needed=rk,
                     dependent=names,
                     combinations=exc.combinations,
+                    redundant=tuple(str(kl[i]) for i in exc.redundant) if kl else (),
                 ) from None
     rank, cond, bk, e, cov_s, scale, cond_u, vmin = solved
     if not (np.all(np.isfinite(bk)) and np.all(np.isfinite(e)) and np.all(np.isfinite(cov_s))):

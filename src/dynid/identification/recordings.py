@@ -69,6 +69,7 @@ from .prepared_log import PreparedLog, prepare_torque_log
 from .rate import CUTOFF_MULTIPLE
 from .sanity import (
     check_torque_log,
+    despiked,
     noise_band,
     opposite_sign,
     spike_finding,
@@ -427,6 +428,7 @@ def prepare_recordings(
             )
         if (spikes := spike_finding(name, log, robot.joint_names)) is not None:
             warnings.warn(spikes, DynidWarning, stacklevel=2)
+            log = despiked(log)[0]  # before the filter spreads them
         mine, joints = recording_pieces(name, log, turns, max_gap_s, robot=robot, drive=drive)
         turned.update(joints)
         cuts.append(max(0, len(mine) - 1))

@@ -33,11 +33,13 @@ with them before fitting (:func:`log_findings`). None of them changes the data.
 * **Torque spikes**: samples that stand off both neighbours, on the same side, by more
   than :data:`SPIKE_SIGMAS` robust noise levels (:func:`torque_spikes`); a sensor or
   logging fault that least squares weighs by its square (:func:`spike_finding` names the
-  file, the joints and the counts).
+  file, the joints and the counts). The one change to the data: :func:`despiked`
+  replaces them by the line between their neighbours, before filtering spreads them.
 """
 
 from __future__ import annotations
 
+import dataclasses
 import math
 
 import numpy as np
@@ -59,7 +61,9 @@ __all__ = [
     "moving_joints",
     "noise_band",
     "MIN_LOG_SAMPLES",
+    "SLOW_SPIKE_SHARE",
     "SPIKE_SIGMAS",
+    "despiked",
     "spike_finding",
     "time_unit_finding",
     "too_few_samples",
@@ -460,9 +464,11 @@ def torque_spikes(
     least the data's resolution (the smallest step between samples) and ``1e-9`` of the
     column's largest magnitude (noise-free data); a height must also exceed ``1e-3`` of
     the column's range (p1 to p99). With the velocities ``dq``, samples where the joint
-    moves slowly are not judged (``|dq|`` at the sample or a neighbour under a tenth of
-    its 99th percentile, or of another sign): friction changes abruptly there (Coulomb
-    and Stribeck friction at a reversal or a near stop) without any fault.
+    moves slowly are judged by a higher bar (``|dq|`` at the sample or a neighbour under
+    a tenth of its 99th percentile, or of another sign): friction changes abruptly there
+    (Coulomb and Stribeck friction at a reversal or a near stop) without any fault, so a
+    sample there is a spike only when it stands off by :data:`SLOW_SPIKE_SHARE` of the
+    column's range.
 
     Parameters
     ----------
@@ -490,42 +496,81 @@ def torque_spikes(
     v = None if dq is None else _checks.as_array("dq", dq)
     if v is not None and v.shape != a.shape:
         raise ShapeError(f"dq must have the shape of tau {a.shape}; got {v.shape}")
-    N = a.shape[0]
-    if N < 5:
-        return []
-    k = max(1, N // 200_000)  # the noise level from 200,000 differences spread over the log
-    m = (N - 1) // k
     out = []
     for j in range(a.shape[1]):
-        x = a[:, j]
-        d = x[1::k][:m] - x[0::k][:m]  # consecutive samples, spread over the log
-        ad = np.abs(d)
-        step = float(np.min(ad[ad > 0])) if np.any(ad > 0) else 0.0
-        s = 1.4826 * float(np.median(np.abs(d - np.median(d)))) / math.sqrt(2.0)
-        lo, hi = np.quantile(x[::k], [0.01, 0.99])
-        level = max(s, step, 1e-9 * float(np.max(np.abs(x[::k]))), 1e-300)
-        least = max(sigmas * level, 1e-3 * float(hi - lo))
-        slow = 0.1 * float(np.quantile(np.abs(v[::k, j]), 0.99)) if v is not None else 0.0
-        count, first, top = 0, -1, 0.0
-        for start in range(1, N - 1, _SPIKE_BLOCK):
-            stop = min(start + _SPIKE_BLOCK, N - 1)
-            d1 = x[start:stop] - x[start - 1 : stop - 1]
-            d2 = x[start:stop] - x[start + 1 : stop + 1]
-            h = np.where(np.sign(d1) == np.sign(d2), np.minimum(np.abs(d1), np.abs(d2)), 0.0)
-            if v is not None:
-                w = v[start - 1 : stop + 1, j]
-                fast = (np.abs(w) > slow) & (w > 0)
-                up = fast[:-2] & fast[1:-1] & fast[2:]
-                fast = (np.abs(w) > slow) & (w < 0)
-                h[~(up | (fast[:-2] & fast[1:-1] & fast[2:]))] = 0.0
-            hit = np.flatnonzero(h > least)
-            if hit.size:
-                count += int(hit.size)
-                first = first if first >= 0 else start + int(hit[0])
-                top = max(top, float(h[hit].max()) / level)
-        if count:
-            out.append((j, count, first, top))
+        rows, heights = _column_spikes(a[:, j], None if v is None else v[:, j], sigmas)
+        if rows.size:
+            out.append((j, int(rows.size), int(rows[0]), float(heights.max())))
     return out
+
+
+#: In slow motion (where :func:`torque_spikes` does not judge by the noise: friction
+#: steps there) a sample that stands off both neighbours by more than this share of its
+#: column's range (p1 to p99) is still a spike: no friction step is that large.
+SLOW_SPIKE_SHARE = 0.5
+
+
+def _column_spikes(
+    x: NDArray[np.float64], v: NDArray[np.float64] | None, sigmas: float
+) -> tuple[NDArray[np.intp], NDArray[np.float64]]:
+    """The spikes of one column ``x`` (N,) (:func:`torque_spikes`; ``v`` its velocities):
+    their rows, ascending, and heights in noise levels."""
+    N = x.size
+    if N < 5:
+        return np.zeros(0, np.intp), np.zeros(0)
+    k = max(1, N // 200_000)  # the noise level from 200,000 differences spread over the log
+    m = (N - 1) // k
+    d = x[1::k][:m] - x[0::k][:m]  # consecutive samples, spread over the log
+    ad = np.abs(d)
+    step = float(np.min(ad[ad > 0])) if np.any(ad > 0) else 0.0
+    s = 1.4826 * float(np.median(np.abs(d - np.median(d)))) / math.sqrt(2.0)
+    lo, hi = np.quantile(x[::k], [0.01, 0.99])
+    level = max(s, step, 1e-9 * float(np.max(np.abs(x[::k]))), 1e-300)
+    least = max(sigmas * level, 1e-3 * float(hi - lo))
+    huge = max(least, SLOW_SPIKE_SHARE * float(hi - lo))
+    slow = 0.1 * float(np.quantile(np.abs(v[::k]), 0.99)) if v is not None else 0.0
+    rows, heights = [], []
+    for start in range(1, N - 1, _SPIKE_BLOCK):
+        stop = min(start + _SPIKE_BLOCK, N - 1)
+        d1 = x[start:stop] - x[start - 1 : stop - 1]
+        d2 = x[start:stop] - x[start + 1 : stop + 1]
+        h = np.where(np.sign(d1) == np.sign(d2), np.minimum(np.abs(d1), np.abs(d2)), 0.0)
+        bar = np.full(h.size, least)
+        if v is not None:
+            w = v[start - 1 : stop + 1]
+            fast = (np.abs(w) > slow) & (w > 0)
+            up = fast[:-2] & fast[1:-1] & fast[2:]
+            fast = (np.abs(w) > slow) & (w < 0)
+            bar[~(up | (fast[:-2] & fast[1:-1] & fast[2:]))] = huge
+        hit = np.flatnonzero(h > bar)
+        rows.append(start + hit)
+        heights.append(h[hit] / level)
+    return np.concatenate(rows), np.concatenate(heights)
+
+
+def despiked(log: TorqueLog) -> tuple[TorqueLog, tuple[int, ...]]:
+    """``log`` with its torque spikes (:func:`torque_spikes`, judged with its velocities)
+    replaced by the straight line between the samples around them, and how many per
+    joint; ``log`` itself when it has none.
+
+    A spike is one sample off both neighbours by far more than the noise while the joint
+    moves: no rigid-body or friction torque changes so within one sample there. Low-passed
+    with the rest, it would spread over the filter's length and bias every fit (robust
+    weights too: they see the filtered rows), so it goes before filtering.
+    """
+    tau = np.array(log.tau, dtype=np.float64)
+    t = np.asarray(log.t, dtype=np.float64)
+    counts = []
+    for j in range(log.n):
+        rows, _ = _column_spikes(tau[:, j], np.asarray(log.dq[:, j]), SPIKE_SIGMAS)
+        counts.append(int(rows.size))
+        if rows.size:
+            good = np.ones(t.size, dtype=bool)
+            good[rows] = False
+            tau[rows, j] = np.interp(t[rows], t[good], tau[good, j])
+    if not any(counts):
+        return log, tuple(counts)
+    return dataclasses.replace(log, tau=tau), tuple(counts)
 
 
 def spike_finding(name: str, log: TorqueLog, joint_names: tuple[str, ...]) -> str | None:
@@ -541,8 +586,9 @@ def spike_finding(name: str, log: TorqueLog, joint_names: tuple[str, ...]) -> st
     )
     return (
         f"{name}: {total} torque sample(s) stand off both neighbours by more than "
-        f"{SPIKE_SIGMAS:g} times the noise: {parts}; spikes (a sensor or logging fault) bias "
-        "the fit by their square; hint: remove those rows from the log"
+        f"{SPIKE_SIGMAS:g} times the noise: {parts}; replaced by the line between their "
+        "neighbours before filtering (spikes, a sensor or logging fault, would bias the fit "
+        "by their square, robust estimators too); hint: check the torque sensor's logging"
     )
 
 

@@ -31,6 +31,7 @@ structure chosen (or given).
 
 from __future__ import annotations
 
+import copy
 import warnings
 from collections.abc import Sequence
 from dataclasses import replace
@@ -39,7 +40,7 @@ from typing import Any, Literal
 import numpy as np
 from numpy.typing import NDArray
 
-from ..exceptions import DynidWarning, OptionError
+from ..exceptions import DynidWarning, OptionError, RankDeficientError
 from ..model.drive import Drive
 from ..model.robot import Robot
 from ..regressors.base import BaseParameters
@@ -61,7 +62,7 @@ from .dissipation import friction_columns, friction_violations, warn_unphysical
 from .estimators import Estimator, EstimatorName, estimator_named
 from .holdout import DEFAULT_FOLDS, HeldOut
 from .judge import heldout_judge
-from .largest import fit_largest, recording_bands
+from .largest import LeftOut, fit_largest, recording_bands
 from .least_squares import StdMethod
 from .log import TorqueLog
 from .metrics import noise_floor_percent
@@ -213,10 +214,14 @@ def select_structure(
     fit_rtol = 1e-10 if rtol is None else rtol
     groups: _Groups = {}
     columns: list[tuple[Structure, NDArray[np.bool_], _Key]] = []
+    unexcited: set[str] = set()  # single joints' coefficients the data do not excite
+    left_out: list[LeftOut] = []  # shaped candidates left out, said once the choice is made
     for key in sorted({regressor_group(c) for c in cands}):
         arm = key[0]
         mine = [c for c in cands if regressor_group(c) == key]
-        fits = fit_largest(robot, data, mine, arm, drive, est, rtol, judge, notes, fold_labels)
+        fits = fit_largest(
+            robot, data, mine, arm, drive, est, rtol, judge, notes, fold_labels, unexcited, left_out
+        )
         for family, model, terms, held in fits:  # a smooth width judged apart: its own key
             if model.holdout is None:
                 return None
@@ -248,6 +253,7 @@ def select_structure(
             where,
         )
     chosen = _chosen(judged)
+    notes[:0] = [lo.note(chosen, where.get(chosen)) for lo in left_out]
     best = min(_physical(judged), key=lambda c: c.score)
     judged = [replace(c, se_vs_best_percent=paired_se(c, best)) for c in judged]
     notes += _candidate_notes(judged)
@@ -572,10 +578,13 @@ def identify_recordings(
         structure = _fitted_structure(selection, friction)
     model_drive, terms = _terms_of(structure, drive, robot.n, data)
     judge, _, fold_labels = heldout_judge(robot, data, est, folds, validation)
-    model = identify(
-        robot, data, drive=model_drive, terms=terms, estimator=est, std=std, base=base,
-        max_std_percent=max_std_percent, rtol=rtol, judge=judge, fold_labels=fold_labels,
-    )  # fmt: skip
+    try:
+        model = identify(
+            robot, data, drive=model_drive, terms=terms, estimator=est, std=std, base=base,
+            max_std_percent=max_std_percent, rtol=rtol, judge=judge, fold_labels=fold_labels,
+        )  # fmt: skip
+    except RankDeficientError as exc:
+        raise _without_hint(exc, structure) from exc
     warn_unphysical(model, terms)
     info = replace(
         model.info,
@@ -584,6 +593,23 @@ def identify_recordings(
         extra={**model.info.extra, "terms": list(structure.terms)},
     )
     return replace(model, info=info)
+
+
+def _without_hint(exc: RankDeficientError, structure: Structure) -> RankDeficientError:
+    """``exc`` with a hint naming the terms that leave out the single joints' friction
+    coefficients that name the combinations the data do not excite (``-fc3``), when those
+    are all it names."""
+    fewer = structure.without(exc.redundant)
+    if not exc.redundant or len(fewer.drop) - len(structure.drop) < len(set(exc.redundant)):
+        return exc
+    labels = ", ".join(exc.redundant)
+    out = copy.copy(exc)
+    out.args = (
+        f"{exc.args[0]}; or leave {labels} out: --terms {','.join(fewer.terms)} "
+        f"(-LABEL leaves out one joint's coefficient)",
+        *exc.args[1:],
+    )
+    return out
 
 
 def _fitted_structure(selection: Selection | None, friction: tuple[str, ...] | None) -> Structure:

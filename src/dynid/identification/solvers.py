@@ -18,7 +18,14 @@ from numpy.typing import NDArray
 from .. import _checks
 from ..exceptions import OptionError, RankDeficientError
 
-__all__ = ["STD_METHODS", "StdMethod", "block_grams", "checked_std", "unexcited_combinations"]
+__all__ = [
+    "STD_METHODS",
+    "StdMethod",
+    "block_grams",
+    "checked_std",
+    "unexcited_columns",
+    "unexcited_combinations",
+]
 
 #: How the standard deviations are estimated (``std=``, ``--std``): ``"classical"``
 #: ``sigma^2 (W^T W)^{-1}`` (Gaz et al. 2019) or ``"robust"``, heteroscedasticity-consistent
@@ -77,15 +84,12 @@ def unexcited_combinations(
     the coefficients' own units, to 4 significant digits; entries below 1e-3 of a
     direction's largest (scaled) weight are left out.
     """
-    k = R.shape[1]
-    d = k - rank
+    d = R.shape[1] - rank
     if d <= 0:
         return ()
-    Vt = np.linalg.svd(R)[2]
-    N = Vt[k - d :]  # (d, k), scaled coefficients
-    piv = scipy.linalg.qr(N, mode="r", pivoting=True)[1][:d]  # labels of largest weight
-    B = N / scale[None, :]  # the same directions in the coefficients' units
+    B, piv = _null_echelon(R, scale, rank)
     E = np.linalg.solve(B[:, piv], B)  # reduced echelon: E[:, piv] = identity
+    k = R.shape[1]
     names = labels if labels is not None else tuple(f"column {j}" for j in range(k))
     out = []
     for i in np.argsort(piv):  # in the order of the columns the directions are named by
@@ -99,6 +103,31 @@ def unexcited_combinations(
             parts.append(f"{'-' if c < 0 else '+'} {abs(c):.4g}*{names[j]}")
         out.append(" ".join(parts))
     return tuple(out)
+
+
+def unexcited_columns(
+    R: NDArray[np.float64], scale: NDArray[np.float64], rank: int
+) -> NDArray[np.intp]:
+    """The columns (``k - rank`` of them, in column order) that name the combinations the
+    data do not excite (:func:`unexcited_combinations`, same arguments): each combination
+    holds one of them and no other, so that without them the other columns have full rank.
+    """
+    if R.shape[1] - rank <= 0:
+        return np.zeros(0, dtype=np.intp)
+    return np.sort(_null_echelon(R, scale, rank)[1])
+
+
+def _null_echelon(
+    R: NDArray[np.float64], scale: NDArray[np.float64], rank: int
+) -> tuple[NDArray[np.float64], NDArray[np.intp]]:
+    """The ``k - rank`` null directions of ``R`` in the coefficients' units (d, k) and the
+    column of largest (scaled) weight naming each."""
+    k = R.shape[1]
+    d = k - rank
+    Vt = np.linalg.svd(R)[2]
+    N = Vt[k - d :]  # (d, k), scaled coefficients
+    piv = scipy.linalg.qr(N, mode="r", pivoting=True)[1][:d]  # labels of largest weight
+    return N / scale[None, :], piv
 
 
 def _merged(blk: NDArray[np.intp]) -> NDArray[np.intp]:
@@ -204,12 +233,18 @@ class _RankDeficient(Exception):
     """Internal: rank deficiency, with the null direction (column order) for the message."""
 
     def __init__(
-        self, msg: str, null: NDArray[np.float64], rank: int, combinations: tuple[str, ...]
+        self,
+        msg: str,
+        null: NDArray[np.float64],
+        rank: int,
+        combinations: tuple[str, ...],
+        redundant: NDArray[np.intp] | None = None,
     ) -> None:
         super().__init__(msg)
         self.null = null
         self.rank = rank
         self.combinations = combinations
+        self.redundant = np.zeros(0, np.intp) if redundant is None else redundant
 
 
 def _conditioning(
@@ -339,6 +374,7 @@ def _solve_qr(
             vmin,
             rank,
             unexcited_combinations(R[:, order], scale, rank, labels),
+            unexcited_columns(R[:, order], scale, rank),
         )
     z = scipy.linalg.solve_triangular(R, Q.T @ b)
     bs = np.empty(rk)

@@ -21,7 +21,7 @@ from ..exceptions import DataError, NonFiniteError, RankDeficientError
 from .engine import fit_rows
 from .estimators import Estimator, Weights
 from .least_squares import LeastSquaresFit, StdMethod, assembled
-from .solvers import _conditioning, unexcited_combinations
+from .solvers import _conditioning, unexcited_columns, unexcited_combinations
 from .streaming import (
     BlockSource,
     GroupFactors,
@@ -74,9 +74,12 @@ def _solve(
     if m < rk or rank < rk:
         names = _names(labels, vmin, idx)
         combos: tuple[str, ...] = ()
+        redundant: tuple[str, ...] = ()
         if rank < rk and m >= rk:
             kl = tuple(labels[k] if labels is not None else f"column {k}" for k in idx)
             combos = unexcited_combinations(R[:, np.argsort(piv)], scale, rank, kl)
+            cols = unexcited_columns(R[:, np.argsort(piv)], scale, rank)
+            redundant = tuple(kl[i] for i in cols) if labels is not None else ()
         why = (
             f"{m} rows for {rk} coefficients; add configurations"
             if m < rk
@@ -93,6 +96,7 @@ def _solve(
             needed=rk,
             dependent=names,
             combinations=combos,
+            redundant=redundant,
         )
     z = scipy.linalg.solve_triangular(R, Q.T @ b)
     bs = np.empty(rk)

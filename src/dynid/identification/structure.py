@@ -15,7 +15,7 @@ each candidate's columns in it.
 from __future__ import annotations
 
 import math
-from collections.abc import Mapping, Sequence
+from collections.abc import Collection, Mapping, Sequence
 from dataclasses import dataclass, replace
 from typing import Any
 
@@ -193,6 +193,19 @@ class Structure:
                     f"(-{prefix}3 leaves out joint 3's {prefix})"
                 )
         object.__setattr__(self, "drop", tuple(sorted(set(self.drop), key=_label_order)))
+
+    def without(self, labels: Collection[str]) -> Structure:
+        """The same structure with those of the coefficients ``labels`` (``"fc3"``) that
+        it holds left out too (:attr:`drop`); itself when it holds none of them."""
+        held = {PART_LABELS[p] for p in self.friction}
+        if self.at == "both":
+            held |= {JOINT_PREFIX + PART_LABELS[p] for p in self.joint_parts}
+        mine = tuple(
+            lab
+            for lab in sorted(labels, key=_label_order)
+            if lab.rstrip("0123456789") in held and lab not in self.drop
+        )
+        return replace(self, drop=self.drop + mine) if mine else self
 
     def collapsed(self, n: int, joints: Sequence[int] = ()) -> Structure:
         """The same model with a part whose coefficients :attr:`drop` leaves out on every
@@ -546,13 +559,15 @@ def largest_terms(
     band: Sequence[float],
     bands: Mapping[str, Sequence[float]] | None = None,
     gain: float = 1.0,
+    drop: Collection[str] = (),
 ) -> tuple[Drive | None, list[tuple[ModelTerm, Any]]]:
     """The terms of every candidate with ``armature == arm`` at once (their friction at
     one place: :attr:`Structure.at`; bands as :func:`structure_terms`), each with what it
     stands for:
     ``("classical", parts)``, ``("smooth", width)``, ``("stribeck", vst)`` or
     ``("smooth_stribeck", (width, vst))`` (the bump alone: its smooth Coulomb term is the
-    ``smooth`` one); a candidate is a choice of their columns."""
+    ``smooth`` one); a candidate is a choice of their columns. The friction coefficients
+    labelled in ``drop`` (``"fc3"``: every term's) are left out of every term."""
     mine = [c for c in cands if c.armature == arm]
     places = {c.at for c in mine if c.friction}
     if len(places) > 1:
@@ -603,7 +618,17 @@ def largest_terms(
             mask=(False, True) * n,  # the bump alone: the smooth Coulomb is the term above
         )
         out.append((t, ("smooth_stribeck", (w, v))))
+    if drop:
+        out = [(t if what is None else _without(t, drop), what) for t, what in out]
     return model_drive, out
+
+
+def _without(t: Any, drop: Collection[str]) -> Any:
+    """The friction term ``t`` without its coefficients labelled in ``drop``."""
+    every = [f"{t.prefix}{PART_LABELS[p]}{j + 1}" for j in range(t.drive.n) for p in t.parts]
+    held = t.mask or (True,) * len(every)
+    mask = tuple(h and lab not in drop for h, lab in zip(held, every, strict=True))
+    return t if mask == tuple(held) else replace(t, mask=mask)
 
 
 def regressor_group(c: Structure) -> tuple[bool, str, str]:
