@@ -224,6 +224,8 @@ def judge_prediction(
         if level == "fair"
         else "the model misses effects the data show there (model terms, excitation, the drive)"
     )
+    if p is not None and any(p[j] >= 100.0 for j in bad):  # worse than no torque at all
+        what += "; at 100 % or more: a log of another robot, or other kinematics?"
     label = "usable" if level == "fair" else "poor"
     return Verdict(level, label, f"{v.reason.split(':')[0]}; joint(s) {which}: {what}", v.ratio)
 

@@ -19,7 +19,13 @@ from typing import Any
 
 from ..exceptions import DynidError
 from ..identification.structure import Structure
-from ..identification.verdict import FLOOR_GOOD, judge_prediction, worst
+from ..identification.verdict import (
+    FLOOR_GOOD,
+    Verdict,
+    joint_ratios,
+    judge_prediction,
+    worst,
+)
 from .html import bar, cell, esc, figure, is_number, number, percent, section, table, verdict
 from .model_terms import terms_sections
 from .run import Answer, RunFiles
@@ -92,29 +98,26 @@ def _heldout_facts(doc: dict, held: dict | None) -> tuple[list[str], list[str], 
     if held is not None and is_number(held.get("relative_error_percent")):
         err, floor = held["relative_error_percent"], held.get("noise_floor_percent")
         where = esc(held.get("block", "held-out data"))
-        v = judge_prediction(err, floor if is_number(floor) else None)
+        v = _heldout_verdict(held)
         if v.level != "good":
             problems.append(v.level)
         if v.ratio is not None:
             r = v.ratio
+            joints = v.reason.split("; ", 1)[1] if "; joint(s) " in v.reason else ""
             facts.append(
                 f"On {where}, unfiltered: error {percent(err)} against a sensor-noise floor "
-                f"of {percent(floor)} (<b>{r:.3g} x the floor</b>: {esc(v.label)}"
-                + (
-                    ", only noise is left)"
-                    if r <= FLOOR_GOOD
-                    else ", effects outside the model remain, see the residuals)"
-                )
+                f"of {percent(floor)} (<b>{r:.3g} x the floor</b>): <b>{esc(v.label)}</b>: "
+                + esc(joints or v.reason.split("): ", 1)[-1])
             )
-            level = "at" if r <= FLOOR_GOOD else f"{r:.3g} times"  # as in the fact
+            level = "at" if r <= FLOOR_GOOD else f"{r:.3g} times"
             headline = (
                 f"The model predicts held-out torques to {percent(err)}, {level} the "
                 f"sensor-noise floor of {percent(floor)} (unfiltered torques)"
             )
         else:
             facts.append(
-                f"On {where}, unfiltered: error {percent(err)} (noise floor unknown: "
-                f"{esc(v.label)})"
+                f"On {where}, unfiltered torques (noise floor unknown): <b>{esc(v.label)}</b>: "
+                + esc(v.reason)
             )
         if v.unusable:
             headline = f"The model does not explain held-out torques: error {percent(err)}"
@@ -124,6 +127,34 @@ def _heldout_facts(doc: dict, held: dict | None) -> tuple[list[str], list[str], 
             "--no-figures, or the log could not be read back)"
         )
     return facts, problems, headline
+
+
+def _heldout_verdict(held: dict) -> Verdict:
+    """heldout.json judged as ``validate`` judges a log (the pooled error against the floor,
+    each joint against its noise and in relative terms), from the file's numbers."""
+    err, floor = held["relative_error_percent"], held.get("noise_floor_percent")
+    rms, noise = held.get("rms"), held.get("noise_rms")
+    per = held.get("relative_error_percent_per_joint")
+    names = held.get("joint_names")
+
+    def numbers(x: Any) -> list[float] | None:
+        ok = isinstance(x, list) and x and all(is_number(v) or v is None for v in x)
+        return [float("nan") if v is None else float(v) for v in x] if ok else None
+
+    rms, noise, per = numbers(rms), numbers(noise), numbers(per)
+    ratios = joint_ratios(rms, noise) if rms and noise and len(rms) == len(noise) else None
+    if per is not None and ratios is not None and len(per) != len(ratios):
+        per = None
+    n = len(per) if per is not None else (len(ratios) if ratios is not None else 0)
+    return judge_prediction(
+        err,
+        floor if is_number(floor) else None,
+        joint_ratios=ratios,
+        joint_percent=per,
+        joint_names=[str(x) for x in names]
+        if isinstance(names, list) and len(names) == n
+        else None,
+    )
 
 
 def _static_facts(doc: dict) -> tuple[list[str], list[str], str]:
