@@ -14,7 +14,9 @@ with them before fitting (:func:`log_findings`). None of them changes the data.
   joints; ``a`` near 1e3 or 1e-3 is a unit off by a power of ten (mN m against N m), and
   currents logged as torques show as a factor far from 1 (a drive file with
   ``torque_constant``). Sign and scale compare variations: not made on a log at rest
-  (every joint frozen), whose variations are noise.
+  (every joint frozen), whose variations are noise, nor on a joint whose gravity torques
+  span less than :data:`GRAVITY_RANGE_SHARE` of the log's largest (a short stretch, whose
+  torque variations are the motion's).
 * **Degrees**: positions whose range exceeds ``2 pi`` on a revolute joint while the range
   divided by ``180 / pi`` fits in the joint's limits, unless the velocities say otherwise:
   where ``dq`` agrees with the derivative of ``q`` (one unit for both) the positions are
@@ -55,6 +57,7 @@ __all__ = [
     "MOVING_FRACTION",
     "NOISE_BAND_STD",
     "check_torque_log",
+    "GRAVITY_RANGE_SHARE",
     "opposite_sign",
     "moving_joints",
     "noise_band",
@@ -77,6 +80,11 @@ NOISE_BAND_STD = 5.0
 MIN_MOTION = 1e-3
 #: Fraction of the samples that must lie outside the noise band for a joint to move.
 MOVING_FRACTION = 0.01
+#: The sign and scale checks judge a joint only where its gravity torques span at least
+#: this share of the log's largest gravity torque (a UR5's shoulder: 0.9 over 20 s of
+#: Fourier motion, 0.14 over 0.5 s, 0.008 over 0.05 s, where the correlation was -0.95
+#: on a log of the right sign).
+GRAVITY_RANGE_SHARE = 0.1
 #: A torque sample this many robust noise levels off both its neighbours is a spike.
 SPIKE_SIGMAS = 20.0
 
@@ -258,10 +266,14 @@ def _gravity_spread(
     robot: Robot, q: NDArray[np.float64], tau: NDArray[np.float64]
 ) -> tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.bool_]] | None:
     """The robot's gravity torques and ``tau`` with their means removed, and the joints
-    gravity loads (None when it loads none)."""
+    gravity loads over the log (None when it loads none): those whose gravity torques vary
+    by at least 5 % of the most varied joint's and span at least
+    :data:`GRAVITY_RANGE_SHARE` of the largest gravity torque (on a short stretch gravity
+    barely changes, and the torques' variations are the motion's, of either sign)."""
     g = gravity_torques(robot, q)
     spread = np.std(g, axis=0)
-    loaded = spread > 0.05 * max(float(spread.max()), 1e-300)
+    varied = np.ptp(g, axis=0) >= GRAVITY_RANGE_SHARE * float(np.max(np.abs(g)))
+    loaded = (spread > 0.05 * max(float(spread.max()), 1e-300)) & varied
     if not np.any(loaded) or not np.any(spread > 0):
         return None
     return g - g.mean(axis=0), tau - tau.mean(axis=0), loaded
