@@ -7,9 +7,8 @@ with them before fitting (:func:`log_findings`). None of them changes the data.
 * **Sign**: the measured torques against the model's gravity torques ``g(q)`` at the logged
   configurations (with the robot's own link parameters, when it has any): a correlation
   below ``-0.5`` on a joint that gravity loads means the torque sign is opposite to the
-  model's (``--units tau=-1``; refused by ``identify`` and ``observe``, naming the joints
-  when only some are); on a minority of the loaded joints, a warning naming them (their
-  sign, or the robot's parameters of the links they carry).
+  model's, refused by ``identify``, ``validate`` and ``observe``: on every loaded joint,
+  ``--units tau=-1``; on some, naming them and their torque columns to flip.
 * **Scale**: the least-squares factor ``a`` in ``tau ~ a g(q)`` over the gravity-loaded
   joints; ``a`` near 1e3 or 1e-3 is a unit off by a power of ten (mN m against N m), and
   currents logged as torques show as a factor far from 1 (a drive file with
@@ -61,6 +60,7 @@ __all__ = [
     "opposite_sign",
     "moving_joints",
     "noise_band",
+    "OPPOSITE_CORRELATION",
     "MIN_LOG_SAMPLES",
     "SPIKE_SIGMAS",
     "spike_finding",
@@ -85,6 +85,9 @@ MOVING_FRACTION = 0.01
 #: Fourier motion, 0.14 over 0.5 s, 0.008 over 0.05 s, where the correlation was -0.95
 #: on a log of the right sign).
 GRAVITY_RANGE_SHARE = 0.1
+#: A joint whose torques correlate below this with its gravity torques has the opposite
+#: sign (gravity explains a quarter or more of their variance, with the other sign).
+OPPOSITE_CORRELATION = -0.5
 #: A torque sample this many robust noise levels off both its neighbours is a spike.
 SPIKE_SIGMAS = 20.0
 
@@ -296,39 +299,41 @@ def _opposite(
     robot: Robot, q: NDArray[np.float64], tau: NDArray[np.float64], names: tuple[str, ...]
 ) -> str | None:
     """The sign finding: every joint gravity loads anti-correlated (``--units tau=-1``), or
-    only some (named, with their torque columns to flip: ``--units`` scales every joint
-    alike)."""
+    only some, each below :data:`OPPOSITE_CORRELATION` (named, with their torque columns to
+    flip: ``--units`` scales every joint alike)."""
     centred = _gravity_spread(robot, q, tau)
-    found = None if centred is None else anticorrelated(*centred)
-    if found is None or centred is None:
+    if centred is None:
         return None
-    j, c = found
     gc, tc, loaded = centred
     corr = _correlations(gc, tc)
-    neg = np.flatnonzero(loaded & (corr < 0))
-    if neg.size == int(np.sum(loaded)):
+    strong = np.flatnonzero(loaded & (corr < OPPOSITE_CORRELATION))
+    if strong.size == 0:
+        return None
+    if np.all(corr[loaded] < 0):
+        j = int(strong[np.argmin(corr[strong])])
         return (
             f"the measured torques are anti-correlated with the model's gravity torques "
-            f"(correlation {c:+.2f} on {names[j]}): the torque sign is probably opposite "
-            "to the model's; hint: --units tau=-1 (or a drive file whose transmission has "
-            "the sign)"
+            f"(correlation {corr[j]:+.2f} on {names[j]}): the torque sign is probably "
+            "opposite to the model's; hint: --units tau=-1 (or a drive file whose "
+            "transmission has the sign)"
         )
-    pos = np.flatnonzero(loaded & (corr >= 0))
+    rest = np.flatnonzero(loaded & (corr >= OPPOSITE_CORRELATION))
     free = np.flatnonzero(~loaded)
-    said = ", ".join(f"{names[k]} {corr[k]:+.2f}" for k in neg)
+    which = ", ".join(names[k] for k in strong)
     return (
-        f"the measured torques are anti-correlated with the model's gravity torques on "
-        f"some joints only (correlation {said}; positive on "
-        f"{', '.join(names[k] for k in pos)}): the torque sign of "
-        f"{', '.join(names[k] for k in neg)} is probably opposite to the model's"
+        f"the measured torques of {which} are anti-correlated with the model's gravity "
+        f"torques (correlation {', '.join(f'{corr[k]:+.2f}' for k in strong)}) while those "
+        f"of {', '.join(f'{names[k]} ({corr[k]:+.2f})' for k in rest)} are not, on some "
+        f"joints only: the torque sign of {which} is probably opposite to the model's"
         + (
             f" (the sign of {', '.join(names[k] for k in free)}, which gravity does not "
             "load, is not told by this check)"
             if free.size
             else ""
         )
-        + "; hint: flip the sign of their torque columns in the file (--units tau=-1 "
-        "flips every joint)"
+        + "; hint: flip the sign of their torque columns in the file ("
+        + ", ".join(f"tau{k + 1}" for k in strong)
+        + " in dynid's column names; --units tau=-1 flips every joint)"
     )
 
 
@@ -342,17 +347,6 @@ def _sign_and_scale(
         return []
     gc, tc, loaded = centred
     out = []
-    corr = _correlations(gc, tc)
-    if np.any(few := loaded & (corr < -0.5)):  # a minority: said, not refused
-        idx = np.flatnonzero(few)
-        out.append(
-            f"the measured torques of {', '.join(names[k] for k in idx)} are anti-correlated "
-            f"with the model's gravity torques (correlation "
-            f"{', '.join(f'{corr[k]:+.2f}' for k in idx)}) while the other joints' agree: "
-            "their torque sign is probably opposite, or the robot's parameters of the links "
-            "they carry are wrong; hint: if so, flip the sign of their torque columns in the "
-            "file (--units tau=-1 flips every joint)"
-        )
     a = float(np.sum(gc[:, loaded] * tc[:, loaded]) / np.sum(gc[:, loaded] ** 2))
     if abs(a) > 30 or 0 < abs(a) < 1 / 30:
         p = round(math.log10(abs(a)))

@@ -64,8 +64,12 @@ def _get(doc: Any, *keys: str) -> Any:
     return doc
 
 
-def _heldout_facts(doc: dict, held: dict | None) -> tuple[list[str], list[str], str]:
-    """(facts, problems, headline) of the held-out judgement."""
+def _heldout_facts(
+    doc: dict, held: dict | None, contradicted: bool = False
+) -> tuple[list[str], list[str], str]:
+    """(facts, problems, headline) of the held-out judgement; ``contradicted``: the data
+    contradict the robot (:func:`_warning_facts`), which makes the verdict unusable
+    whatever the errors, and the held-out fact says so instead of its own level."""
     facts, problems, headline = [], [], ""
     ho = _get(doc, "metadata", "heldout")
     train, test = _get(ho, "training_error_percent"), _get(ho, "heldout_error_percent")
@@ -104,10 +108,14 @@ def _heldout_facts(doc: dict, held: dict | None) -> tuple[list[str], list[str], 
         if v.ratio is not None:
             r = v.ratio
             joints = v.reason.split("; ", 1)[1] if "; joint(s) " in v.reason else ""
+            said = (
+                "<b>unusable</b>: the data contradict the robot (below), whatever the error"
+                if contradicted
+                else f"<b>{esc(v.label)}</b>: " + esc(joints or v.reason.split("): ", 1)[-1])
+            )
             facts.append(
                 f"On {where}, unfiltered: error {percent(err)} against a sensor-noise floor "
-                f"of {percent(floor)} (<b>{r:.3g} x the floor</b>): <b>{esc(v.label)}</b>: "
-                + esc(joints or v.reason.split("): ", 1)[-1])
+                f"of {percent(floor)} (<b>{r:.3g} x the floor</b>): {said}"
             )
             level = "at" if r <= FLOOR_GOOD else f"{r:.3g} times"
             headline = (
@@ -116,8 +124,12 @@ def _heldout_facts(doc: dict, held: dict | None) -> tuple[list[str], list[str], 
             )
         else:
             facts.append(
-                f"On {where}, unfiltered torques (noise floor unknown): <b>{esc(v.label)}</b>: "
-                + esc(v.reason)
+                f"On {where}, unfiltered torques (noise floor unknown): "
+                + (
+                    "<b>unusable</b>: the data contradict the robot (below)"
+                    if contradicted
+                    else f"<b>{esc(v.label)}</b>: {esc(v.reason)}"
+                )
             )
         if v.unusable:
             headline = f"The model does not explain held-out torques: error {percent(err)}"
@@ -276,7 +288,8 @@ def answer(run: RunFiles) -> Answer | None:
     if doc.get("route") == "static":
         facts, problems, headline = _static_facts(doc)
     else:
-        facts, problems, headline = _heldout_facts(doc, held)
+        contradicted = any(k in w for w in run.summary.warnings for k in _DATA_WARNINGS)
+        facts, problems, headline = _heldout_facts(doc, held, contradicted)
     rank, p = _rank_fact(doc)
     facts.append(rank)
     problems += p
