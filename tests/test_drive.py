@@ -642,3 +642,26 @@ def test_a_robots_own_friction_is_placed_in_one_place_as_written_out():
         np.testing.assert_allclose(arm.torques(dq), want, rtol=1e-12, atol=1e-15)
     # the robot description holds the law per joint: without a drive it is returned as held
     assert own_friction(robot) is robot.friction
+
+
+def test_a_simulated_current_log_says_its_unit(tmp_path):
+    """Regression: simulate with a drive whose effort is "current" wrote "tau [N m]" over
+    columns of currents; it writes "tau [A]", and the columns times the torque constants
+    are the joint torques of the same simulation written without the drive."""
+    from dynid.cli.__main__ import main
+    from dynid.io.torque_log import load_torque_log
+
+    kt = [8.0, 8.0, 6.0, 4.0, 2.0, 2.0, 1.0]
+    (tmp_path / "cur.toml").write_text(
+        f'schema = "dynid-drive/1"\nside = "joint"\neffort = "current"\ntorque_constant = {kt}\n'
+    )
+    sim = ["simulate", "--robot", "panda", "--trajectory", "fourier", "--duration", "1"]
+    sim += ["--rate", "200", "--noise", "0", "--q-noise", "0", "--dq-noise", "0", "-q"]
+    cur, tau = tmp_path / "cur.csv", tmp_path / "tau.csv"
+    assert main([*sim, "--drive", str(tmp_path / "cur.toml"), "--out", str(cur)]) == 0
+    assert main([*sim, "--out", str(tau)]) == 0
+    assert "tau [A]" in cur.read_text().splitlines()[0]
+    assert "tau [N m]" in tau.read_text().splitlines()[0]
+    np.testing.assert_allclose(
+        load_torque_log(cur).tau * kt, load_torque_log(tau).tau, rtol=1e-12, atol=1e-12
+    )

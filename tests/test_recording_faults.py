@@ -99,12 +99,14 @@ def test_observe_refuses_torques_of_the_opposite_sign(log, tmp_path, capsys):
 def test_observe_calibrate_refuses_a_sign_flipped_on_some_joints(
     panda, log, flipped, tmp_path, capsys
 ):
-    """Joint 4 (one of three joints gravity loads, computed here: the gravity check only
-    warns) or joint 7 (which gravity does not load: that check cannot tell) negated:
-    ``observe --calibrate`` exits 2 with one line naming the file, exactly those joints
-    and the columns to flip (it wrote thresholds blind on them, the residual there twice
-    the torque); the unflipped log calibrates. Detecting on the flipped log with the
-    right thresholds reports its events and warns once, naming the file."""
+    """Joint 4 (one of three joints gravity loads, computed here) or joint 7 (which
+    gravity does not load: that check cannot tell) negated: ``observe --calibrate`` exits
+    2 with one line naming the file, the joints (those gravity loads when there are any,
+    told first) and the columns to flip (it wrote thresholds blind on them, the residual
+    there twice the torque); the unflipped
+    log calibrates. Detecting on the flipped log with the right thresholds: refused as
+    identify refuses it where gravity tells the sign (joint 4), else it reports its events
+    and warns once, naming the file."""
     g = gravity_torques(panda, log.q)
     loaded = np.std(g, axis=0) > 0.05 * np.std(g, axis=0).max()
     assert loaded[3] and not loaded[6] and np.sum(loaded) >= 3
@@ -116,11 +118,18 @@ def test_observe_calibrate_refuses_a_sign_flipped_on_some_joints(
     err = [s for s in capsys.readouterr().err.splitlines() if "error" in s]
     assert len(err) == 1 and "some.csv" in err[0], err
     head = err[0].split(" are anti-correlated")[0].split("the measured torques of ")[1]
-    assert set(head.split(", ")) == {panda.joint_names[j] for j in flipped}
+    # the gravity check names the joints gravity loads, before any residual is read
+    named = {panda.joint_names[j] for j in flipped if loaded[j]}
+    assert set(head.split(", ")) == (named or {panda.joint_names[j] for j in flipped})
     assert "hint: flip the sign of their torque columns" in err[0]
     assert not (tmp_path / "c" / "thresholds.json").exists()
     detect = ["observe", "--params", "panda", "--no-figures", "--data", str(tmp_path / "some.csv")]
     th = ["--thresholds", str(tmp_path / "f" / "thresholds.json"), "--out", str(tmp_path / "d")]
+    if 3 in flipped:  # gravity tells joint 4's sign: refused, as identify refuses it
+        assert main([*detect, *th]) == 2
+        err = [s for s in capsys.readouterr().err.splitlines() if "error" in s]
+        assert len(err) == 1 and "some.csv" in err[0] and "tau4" in err[0], err
+        return
     assert main([*detect, *th]) == 0  # detection reports, and says why
     warned = [s for s in capsys.readouterr().err.splitlines() if "anti-correlated" in s]
     assert len(warned) == 1 and warned[0].startswith("dynid observe: warning: some.csv: ")
@@ -183,15 +192,32 @@ def test_a_log_without_the_gripper_joint_names_it_and_the_tip(tmp_path, capsys, 
 
 
 def test_a_sign_flipped_on_one_joint_of_three_loaded_is_said(panda, log):
-    """Joint 4 negated, one of the three joints gravity loads (computed here): not
-    refused (the robot's parameters may be what is wrong), but a warning naming that
-    joint alone (nothing was said: a model of 30 % error, exit 0)."""
+    """Joint 4 negated, one of the three joints gravity loads (computed here): refused,
+    naming that joint alone (nothing was said: a model of 30 % error, exit 0; then a
+    warning, while the documentation said refused)."""
     g = gravity_torques(panda, log.q)
     loaded = np.flatnonzero(np.std(g, axis=0) > 0.05 * np.std(g, axis=0).max())
     assert 3 in loaded and loaded.size >= 3
-    assert opposite_sign(panda, _flipped(log, [3])) is None
+    refused = opposite_sign(panda, _flipped(log, [3]))
+    assert refused is not None and "some joints only" in refused
     found = [f for f in check_torque_log(panda, _flipped(log, [3])) if "anti-correlated" in f]
     assert len(found) == 1 and found[0].startswith(
         f"the measured torques of {panda.joint_names[3]} are anti-correlated"
     )
     assert not [f for f in check_torque_log(panda, log) if "anti-correlated" in f]
+
+
+@pytest.mark.parametrize("j", [1, 3])
+def test_identify_refuses_one_joint_of_the_opposite_sign(panda, log, j, tmp_path, capsys):
+    """Regression: one joint gravity loads negated (as documented, the refusal names it):
+    identify warned and fitted (a UR5: 29 % held out, exit 0); it exits 2 with one line
+    naming the file, the joint and its torque column to flip."""
+    save_torque_log(tmp_path / "one.csv", _flipped(log, [j]))
+    argv = ["identify", "--robot", "panda", "--data", str(tmp_path / "one.csv"), "--no-figures"]
+    assert main([*argv, "--out", str(tmp_path / "i")]) == 2
+    err = [s for s in capsys.readouterr().err.splitlines() if "error" in s]
+    assert len(err) == 1 and "one.csv" in err[0], err
+    head = err[0].split(" are anti-correlated")[0].split("the measured torques of ")[1]
+    assert head == panda.joint_names[j], err[0]
+    assert f"flip the sign of their torque columns in the file (tau{j + 1} " in err[0]
+    assert not (tmp_path / "i" / "identification.json").exists()

@@ -153,3 +153,26 @@ def test_the_headline_and_its_fact_give_the_same_ratio_to_the_noise_floor(tmp_pa
     text = " ".join("".join(Page(render_html_report(RunSummary("identify"), files)).text).split())
     said = f"{err / floor:.3g}"
     assert f"{said} times the sensor-noise floor" in text and f"{said} x the floor" in text
+
+
+def test_the_held_out_fact_agrees_with_an_unusable_badge(tmp_path):
+    """Regression: a run whose torques contradict the robot (a warning: anti-correlated)
+    is unusable whatever its errors; the held-out fact under that badge said "poor" (124 x
+    the floor). It says unusable, and without the warning it keeps its own level."""
+    ident = {
+        "route": "classical",
+        "coefficients": [],
+        "metadata": {"heldout": {"training_error_percent": 26.2, "heldout_error_percent": 29.2}},
+    }
+    held = {"relative_error_percent": 31.0, "noise_floor_percent": 0.25, "block": "b.csv"}
+    (tmp_path / "identification.json").write_text(json.dumps(ident))
+    (tmp_path / "heldout.json").write_text(json.dumps(held))
+    files = {p.name: p for p in tmp_path.iterdir()}
+    warning = "the measured torques of j2 are anti-correlated with the model's gravity torques"
+    for warnings, level in (((warning,), "unusable"), ((), "poor")):
+        summary = RunSummary("identify", warnings=warnings)
+        text = " ".join("".join(Page(render_html_report(summary, files)).text).split())
+        box = text.split("Held-out error")[1].split("Sensor")[0]
+        fact = box.split("x the floor):")[1][:40]
+        assert fact.strip().startswith(level), fact
+        assert ("poor" in box) == (level == "poor"), box

@@ -20,6 +20,7 @@ from ..feasibility.convex import ConsistentResult
 from ..friction.fit import FrictionFit, FrictionResidual
 from ..friction.validation import Validation
 from ..identification.model import IdentifiedModel
+from ..identification.verdict import Verdict
 from ..io.json_files import save_json
 from ..io.observer_files import log_labels, observation_names
 from ..observer.detection import threshold_series
@@ -106,16 +107,17 @@ def _said_before() -> Iterator[None]:
 
 def save_identify_figures(
     out: Path, model: IdentifiedModel, args: Any, *, figures: bool = True
-) -> list[Path]:
+) -> tuple[list[Path], Verdict | None]:
     """A torque log's identification on held-out data, under ``out``: ``heldout.json``
     (errors per joint against the sensor noise; data, written without ``figures`` too),
     ``heldout_torques.png`` (measured and predicted torques) and ``heldout_residuals.png``
     (residual histograms). The held-out recording is the last data file (a folder given
     to ``--data`` stands for its files), its reading's warnings not said again. Nothing
     for static data or a model without held-out folds; a log that cannot be read back is
-    noted and skipped (the identification's own files are written)."""
+    noted and skipped (the identification's own files are written). Returns the files and
+    the held-out verdict (None without one)."""
     if model.info.log is None or model.holdout is None:
-        return []
+        return [], None
     try:
         cmap = column_map(args.columns, args.units, cutoff_hz=args.cutoff)
 
@@ -131,15 +133,15 @@ def save_identify_figures(
         held = identification_plots.heldout_torques(model, read(data), separate=separate)
     except Exception as exc:  # a figure never fails the command
         print(f"note: skipped the held-out torque figures: {exc}", file=sys.stderr)
-        return []
+        return [], None
     if held is None:
-        return []
+        return [], None
     names = list(held.joint_names)
     data_file = save_json(
         Path(out) / "heldout.json", held.as_dict(), schema="dynid-heldout-torques/1"
     )
     if not figures:
-        return [data_file]
+        return [data_file], held.verdict
     paths = [
         data_file,
         save_figure(
@@ -154,7 +156,7 @@ def save_identify_figures(
             Path(out) / "heldout_residuals.png",
         ),
     ]
-    return [p for p in paths if p is not None]
+    return [p for p in paths if p is not None], held.verdict
 
 
 def save_observer_figures(out: Path, result: ObserveResult, *, names: list[str]) -> list[Path]:

@@ -257,8 +257,11 @@ def run(args: argparse.Namespace, console: Console) -> int:
     note_prior(args, console)
     result = identify_files(robot, args.data, options)
     files = [save_model_json(args.out / "identification.json", result.model)]
-    files += save_identify_figures(args.out, result.model, args, figures=not args.no_figures)
+    held, verdict = save_identify_figures(args.out, result.model, args, figures=not args.no_figures)
+    files += held
     text = [format_identification(result.model)]
+    if verdict is not None:
+        text.append(f"held-out verdict: {verdict.label}: {verdict.reason}")
     if result.consistent is not None:
         files += save_feasible_bundle(args.out, result.consistent, source=str(args.data[0]))
         files += [] if args.no_figures else save_retrieval_figure(args.out, result.consistent)

@@ -237,7 +237,13 @@ def run(args: argparse.Namespace, console: Console) -> int:
     log = result.log
     extra = None if log.external is None else ("tau_ext", log.external)
     save_torque_log_pieces(
-        args.out, log, n=log.n, n_rows=log.n_samples, with_ddq=log.with_ddq, extra=extra
+        args.out,
+        log,
+        n=log.n,
+        n_rows=log.n_samples,
+        with_ddq=log.with_ddq,
+        extra=extra,
+        tau_unit="N m" if options.drive is None else options.drive.effort_unit,
     )
     console.print(f"wrote {args.out}: {result.describe(options)}")
     return 0

@@ -486,7 +486,7 @@ def format_rms_table(names: list[str], columns: dict[str, np.ndarray]) -> str:
     rows = [head]
     for j, name in enumerate(names):
         rows.append(
-            f"{name:<{w}}" + "".join(f"{float(v[j]):>{cw[k]}.4f}" for k, v in columns.items())
+            f"{name:<{w}}" + "".join(f"{float(v[j]):>{cw[k]}.4g}" for k, v in columns.items())
         )
     return "\n".join(rows)
 

@@ -157,10 +157,10 @@ def print_validation(
     if len(val.recordings) > 1:
         console.print(
             *(
-                f"  {r.file}: relative error {r.errors.relative_error_percent:.3f} %"
+                f"  {r.file}: relative error {r.errors.relative_error_percent:.3g} %"
                 for r in val.recordings
             )
         )
-    console.print(f"relative error {val.errors.relative_error_percent:.3f} %; wrote {path}")
+    console.print(f"relative error {val.errors.relative_error_percent:.3g} %; wrote {path}")
     v = result.verdict
     console.print(f"verdict: {v.label}: {v.reason}")

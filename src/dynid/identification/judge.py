@@ -25,6 +25,7 @@ from .estimators import Estimator, row_weights
 from .holdout import HeldOut, Normals, block_normals
 from .recordings import Recordings
 from .streaming import BlockSource, normals_by_label, normals_by_label_scaled
+from .verdict import NOISE_FLOOR_SHARE
 
 __all__ = ["NOISE_FLOOR_SHARE", "heldout_judge", "inverse_noise"]
 
@@ -94,12 +95,6 @@ def heldout_judge(
         return held.expanded(cols)
 
     return judge, how, (labels if validation is None else None)
-
-
-#: A joint's torque noise counts at least this share of the largest joint's in the
-#: whitened judgement (:func:`inverse_noise`): a joint whose noise estimate is next to
-#: nothing (a quantised or filtered sensor) must not outweigh every other.
-NOISE_FLOOR_SHARE = 1e-2
 
 
 def inverse_noise(data: Recordings) -> NDArray[np.float64] | None:

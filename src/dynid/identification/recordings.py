@@ -499,7 +499,13 @@ def _cutoff_and_edge(
     if cutoff_hz == "auto":
         cutoff = common_cutoff(logs, [r for r, _ in pieces], jturns)
         if cutoff is None:
-            raise DataError("no piece is long enough to read the motion's frequency from")
+            n = sum(log.n_samples for log in logs)
+            span = max(float(log.t[-1] - log.t[0]) for log in logs)
+            raise DataError(
+                f"too short to identify ({n} samples, {span:.3g} s, the longest piece): no "
+                "piece is long enough to read the motion's frequency from; hint: record "
+                "several periods of the motion (seconds, not a fraction of one)"
+            )
     else:
         check_below_nyquist(logs, cutoff)
     if trim_s is not None:

@@ -7,14 +7,15 @@ with them before fitting (:func:`log_findings`). None of them changes the data.
 * **Sign**: the measured torques against the model's gravity torques ``g(q)`` at the logged
   configurations (with the robot's own link parameters, when it has any): a correlation
   below ``-0.5`` on a joint that gravity loads means the torque sign is opposite to the
-  model's (``--units tau=-1``; refused by ``identify`` and ``observe``, naming the joints
-  when only some are); on a minority of the loaded joints, a warning naming them (their
-  sign, or the robot's parameters of the links they carry).
+  model's, refused by ``identify``, ``validate`` and ``observe``: on every loaded joint,
+  ``--units tau=-1``; on some, naming them and their torque columns to flip.
 * **Scale**: the least-squares factor ``a`` in ``tau ~ a g(q)`` over the gravity-loaded
   joints; ``a`` near 1e3 or 1e-3 is a unit off by a power of ten (mN m against N m), and
   currents logged as torques show as a factor far from 1 (a drive file with
   ``torque_constant``). Sign and scale compare variations: not made on a log at rest
-  (every joint frozen), whose variations are noise.
+  (every joint frozen), whose variations are noise, nor on a joint whose gravity torques
+  span less than :data:`GRAVITY_RANGE_SHARE` of the log's largest (a short stretch, whose
+  torque variations are the motion's).
 * **Degrees**: positions whose range exceeds ``2 pi`` on a revolute joint while the range
   divided by ``180 / pi`` fits in the joint's limits, unless the velocities say otherwise:
   where ``dq`` agrees with the derivative of ``q`` (one unit for both) the positions are
@@ -57,9 +58,11 @@ __all__ = [
     "MOVING_FRACTION",
     "NOISE_BAND_STD",
     "check_torque_log",
+    "GRAVITY_RANGE_SHARE",
     "opposite_sign",
     "moving_joints",
     "noise_band",
+    "OPPOSITE_CORRELATION",
     "MIN_LOG_SAMPLES",
     "SLOW_SPIKE_SHARE",
     "SPIKE_SIGMAS",
@@ -81,6 +84,14 @@ NOISE_BAND_STD = 5.0
 MIN_MOTION = 1e-3
 #: Fraction of the samples that must lie outside the noise band for a joint to move.
 MOVING_FRACTION = 0.01
+#: The sign and scale checks judge a joint only where its gravity torques span at least
+#: this share of the log's largest gravity torque (a UR5's shoulder: 0.9 over 20 s of
+#: Fourier motion, 0.14 over 0.5 s, 0.008 over 0.05 s, where the correlation was -0.95
+#: on a log of the right sign).
+GRAVITY_RANGE_SHARE = 0.1
+#: A joint whose torques correlate below this with its gravity torques has the opposite
+#: sign (gravity explains a quarter or more of their variance, with the other sign).
+OPPOSITE_CORRELATION = -0.5
 #: A torque sample this many robust noise levels off both its neighbours is a spike.
 SPIKE_SIGMAS = 20.0
 
@@ -262,10 +273,14 @@ def _gravity_spread(
     robot: Robot, q: NDArray[np.float64], tau: NDArray[np.float64]
 ) -> tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.bool_]] | None:
     """The robot's gravity torques and ``tau`` with their means removed, and the joints
-    gravity loads (None when it loads none)."""
+    gravity loads over the log (None when it loads none): those whose gravity torques vary
+    by at least 5 % of the most varied joint's and span at least
+    :data:`GRAVITY_RANGE_SHARE` of the largest gravity torque (on a short stretch gravity
+    barely changes, and the torques' variations are the motion's, of either sign)."""
     g = gravity_torques(robot, q)
     spread = np.std(g, axis=0)
-    loaded = spread > 0.05 * max(float(spread.max()), 1e-300)
+    varied = np.ptp(g, axis=0) >= GRAVITY_RANGE_SHARE * float(np.max(np.abs(g)))
+    loaded = (spread > 0.05 * max(float(spread.max()), 1e-300)) & varied
     if not np.any(loaded) or not np.any(spread > 0):
         return None
     return g - g.mean(axis=0), tau - tau.mean(axis=0), loaded
@@ -288,39 +303,41 @@ def _opposite(
     robot: Robot, q: NDArray[np.float64], tau: NDArray[np.float64], names: tuple[str, ...]
 ) -> str | None:
     """The sign finding: every joint gravity loads anti-correlated (``--units tau=-1``), or
-    only some (named, with their torque columns to flip: ``--units`` scales every joint
-    alike)."""
+    only some, each below :data:`OPPOSITE_CORRELATION` (named, with their torque columns to
+    flip: ``--units`` scales every joint alike)."""
     centred = _gravity_spread(robot, q, tau)
-    found = None if centred is None else anticorrelated(*centred)
-    if found is None or centred is None:
+    if centred is None:
         return None
-    j, c = found
     gc, tc, loaded = centred
     corr = _correlations(gc, tc)
-    neg = np.flatnonzero(loaded & (corr < 0))
-    if neg.size == int(np.sum(loaded)):
+    strong = np.flatnonzero(loaded & (corr < OPPOSITE_CORRELATION))
+    if strong.size == 0:
+        return None
+    if np.all(corr[loaded] < 0):
+        j = int(strong[np.argmin(corr[strong])])
         return (
             f"the measured torques are anti-correlated with the model's gravity torques "
-            f"(correlation {c:+.2f} on {names[j]}): the torque sign is probably opposite "
-            "to the model's; hint: --units tau=-1 (or a drive file whose transmission has "
-            "the sign)"
+            f"(correlation {corr[j]:+.2f} on {names[j]}): the torque sign is probably "
+            "opposite to the model's; hint: --units tau=-1 (or a drive file whose "
+            "transmission has the sign)"
         )
-    pos = np.flatnonzero(loaded & (corr >= 0))
+    rest = np.flatnonzero(loaded & (corr >= OPPOSITE_CORRELATION))
     free = np.flatnonzero(~loaded)
-    said = ", ".join(f"{names[k]} {corr[k]:+.2f}" for k in neg)
+    which = ", ".join(names[k] for k in strong)
     return (
-        f"the measured torques are anti-correlated with the model's gravity torques on "
-        f"some joints only (correlation {said}; positive on "
-        f"{', '.join(names[k] for k in pos)}): the torque sign of "
-        f"{', '.join(names[k] for k in neg)} is probably opposite to the model's"
+        f"the measured torques of {which} are anti-correlated with the model's gravity "
+        f"torques (correlation {', '.join(f'{corr[k]:+.2f}' for k in strong)}) while those "
+        f"of {', '.join(f'{names[k]} ({corr[k]:+.2f})' for k in rest)} are not, on some "
+        f"joints only: the torque sign of {which} is probably opposite to the model's"
         + (
             f" (the sign of {', '.join(names[k] for k in free)}, which gravity does not "
             "load, is not told by this check)"
             if free.size
             else ""
         )
-        + "; hint: flip the sign of their torque columns in the file (--units tau=-1 "
-        "flips every joint)"
+        + "; hint: flip the sign of their torque columns in the file ("
+        + ", ".join(f"tau{k + 1}" for k in strong)
+        + " in dynid's column names; --units tau=-1 flips every joint)"
     )
 
 
@@ -334,17 +351,6 @@ def _sign_and_scale(
         return []
     gc, tc, loaded = centred
     out = []
-    corr = _correlations(gc, tc)
-    if np.any(few := loaded & (corr < -0.5)):  # a minority: said, not refused
-        idx = np.flatnonzero(few)
-        out.append(
-            f"the measured torques of {', '.join(names[k] for k in idx)} are anti-correlated "
-            f"with the model's gravity torques (correlation "
-            f"{', '.join(f'{corr[k]:+.2f}' for k in idx)}) while the other joints' agree: "
-            "their torque sign is probably opposite, or the robot's parameters of the links "
-            "they carry are wrong; hint: if so, flip the sign of their torque columns in the "
-            "file (--units tau=-1 flips every joint)"
-        )
     a = float(np.sum(gc[:, loaded] * tc[:, loaded]) / np.sum(gc[:, loaded] ** 2))
     if abs(a) > 30 or 0 < abs(a) < 1 / 30:
         p = round(math.log10(abs(a)))

@@ -19,14 +19,19 @@ unusable      50 % or more, or torques anti-correlated      check the data first
 
 The pooled error is dominated by the joints of the largest torques: a wrist whose noise is
 a hundredth of the shoulder's can err ten times its noise within a pooled error at the
-floor. With each joint's error over its own noise known (``joint_ratios``), the level is
-also the worst joint's (the same thresholds, 1.5 and 3 x), never worse than ``poor``, and
-the reason names the joints above 1.5 x.
+floor. Each joint is judged by :func:`joint_levels`: good below 10 % relative error or
+within 1.5 x its noise, usable below 25 % or within 3 x, else poor (a joint of small
+torques errs more in relative terms than the log as a whole). With the joints' errors
+known, the level is also the worst joint's, never worse than ``poor`` (``usable`` when
+the pooled error is below 0.01 %), and the reason names the joints judged worse than good.
+An error below 0.01 % is good whatever the floor: a floor read from exact data is the
+round-off and filter error of the preparation, not a sensor's.
 
 At 50 % the model explains less than three quarters of the torques' square; at 100 % it
 errs as much as predicting no torque at all. The thresholds are this library's rules of
-thumb (1.5 and 3 x the floor, 5 and 15 %), the same for ``dynid validate``'s verdict line,
-its exit status and the verdicts of the HTML reports.
+thumb (1.5 and 3 x the floor, 5 and 15 %; 10 and 25 % per joint), the same for ``dynid
+validate``'s verdict line, its exit status, ``dynid identify``'s held-out judgement and
+the verdicts of the HTML reports.
 """
 
 from __future__ import annotations
@@ -37,16 +42,24 @@ from dataclasses import dataclass
 from typing import Literal
 
 import numpy as np
-from numpy.typing import ArrayLike
+from numpy.typing import ArrayLike, NDArray
+
+from ..exceptions import ShapeError
 
 __all__ = [
     "FAIR_PERCENT",
     "FLOOR_FAIR",
     "FLOOR_GOOD",
     "GOOD_PERCENT",
+    "JOINT_FAIR",
+    "JOINT_GOOD",
     "LEVELS",
+    "NEGLIGIBLE_PERCENT",
+    "NOISE_FLOOR_SHARE",
     "UNUSABLE_PERCENT",
     "Verdict",
+    "joint_levels",
+    "joint_ratios",
     "judge_prediction",
     "pooled_verdict",
     "worst",
@@ -61,6 +74,15 @@ FLOOR_GOOD, FLOOR_FAIR = 1.5, 3.0
 GOOD_PERCENT, FAIR_PERCENT = 5.0, 15.0
 #: Relative error [%] from which the model does not explain the torques.
 UNUSABLE_PERCENT = 50.0
+#: Relative error [%] of a joint: good below JOINT_GOOD, usable below JOINT_FAIR (or
+#: within FLOOR_GOOD, FLOOR_FAIR x its noise).
+JOINT_GOOD, JOINT_FAIR = 10.0, 25.0
+#: Relative error [%] below which a prediction is good whatever its noise floor.
+NEGLIGIBLE_PERCENT = 0.01
+#: A joint's torque noise counts at least this share of the largest joint's: a joint whose
+#: noise estimate is next to nothing (a quantised or filtered sensor) must not outweigh
+#: every other (the whitened judgement of the structure choice and the verdict).
+NOISE_FLOOR_SHARE = 1e-2
 
 
 @dataclass(frozen=True, slots=True)
@@ -95,42 +117,117 @@ def worst(*levels: Level) -> Level:
     return max(levels, key=LEVELS.index, default="good")
 
 
+def joint_ratios(rms: ArrayLike, noise_rms: ArrayLike) -> NDArray[np.float64]:
+    """Each joint's RMS error over its torque noise, the noise counted at least
+    :data:`NOISE_FLOOR_SHARE` of the largest joint's.
+
+    Parameters
+    ----------
+    rms, noise_rms : array_like, shape (n,)
+        RMS prediction error and sensor noise per joint [N m].
+
+    Returns
+    -------
+    ndarray, shape (n,)
+        Error over noise; inf where the noise is zero on every joint and the error is not.
+    """
+    e = np.asarray(rms, dtype=np.float64)
+    s = np.asarray(noise_rms, dtype=np.float64)
+    least = NOISE_FLOOR_SHARE * float(np.max(s, initial=0.0))
+    with np.errstate(divide="ignore", invalid="ignore"):
+        r = e / np.maximum(s, least)
+    return np.where(e == 0, 0.0, r)
+
+
+def joint_levels(percent: ArrayLike | None, ratios: ArrayLike | None) -> tuple[Level, ...]:
+    """Each joint's level: good below :data:`JOINT_GOOD` % relative error or within
+    :data:`FLOOR_GOOD` x its noise, fair below :data:`JOINT_FAIR` % or within
+    :data:`FLOOR_FAIR` x, else poor.
+
+    Parameters
+    ----------
+    percent : array_like, shape (n,), optional
+        Relative error per joint [%]; None: unknown (judged on ``ratios`` alone).
+    ratios : array_like, shape (n,), optional
+        RMS error over torque noise per joint (:func:`joint_ratios`); None: unknown
+        (judged on ``percent`` alone). A NaN is unknown too; a joint unknown in both is
+        good (nothing to judge it by).
+
+    Returns
+    -------
+    tuple of {"good", "fair", "poor"}
+
+    Raises
+    ------
+    ShapeError
+        ``percent`` and ``ratios`` of different joint counts.
+    """
+    if percent is None and ratios is None:
+        return ()
+    p = None if percent is None else np.asarray(percent, dtype=np.float64).ravel()
+    r = None if ratios is None else np.asarray(ratios, dtype=np.float64).ravel()
+    n = p.size if p is not None else r.size  # type: ignore[union-attr]
+    p = np.full(n, np.nan) if p is None else p
+    r = np.full(n, np.nan) if r is None else r
+    if p.size != r.size:
+        raise ShapeError(f"percent has {p.size} joints, ratios {r.size}")
+    unknown = np.isnan(p) & np.isnan(r)
+    p, r = np.where(np.isnan(p), np.inf, p), np.where(np.isnan(r), np.inf, r)
+    levels: list[Level] = []
+    for pj, rj, none in zip(p, r, unknown, strict=True):
+        if none or pj < JOINT_GOOD or rj <= FLOOR_GOOD:
+            levels.append("good")
+        elif pj < JOINT_FAIR or rj <= FLOOR_FAIR:
+            levels.append("fair")
+        else:
+            levels.append("poor")
+    return tuple(levels)
+
+
 def judge_prediction(
     error_percent: float,
     floor_percent: float | None = None,
     *,
     opposite_sign: bool = False,
     joint_ratios: ArrayLike | None = None,
+    joint_percent: ArrayLike | None = None,
     joint_names: Sequence[str] | None = None,
 ) -> Verdict:
     """The level of a prediction (module docstring): :func:`pooled_verdict`, made worse by
-    the worst of ``joint_ratios`` (each joint's RMS error over its torque noise), the
-    joints above :data:`FLOOR_GOOD` named (``joint_names``, default 1-based numbers)."""
+    the worst of :func:`joint_levels` (``joint_ratios``: each joint's RMS error over its
+    torque noise; ``joint_percent``: its relative error [%]; either may be None), the
+    joints judged worse than good named (``joint_names``, default 1-based numbers)."""
     v = pooled_verdict(error_percent, floor_percent, opposite_sign=opposite_sign)
-    if joint_ratios is None or np.size(joint_ratios) == 0 or v.level in ("poor", "unusable"):
+    levels = joint_levels(joint_percent, joint_ratios)
+    if not levels or v.level in ("poor", "unusable"):
         return v
-    r = np.asarray(joint_ratios, dtype=np.float64)
-    bad = np.flatnonzero(np.isfinite(r) & (r > FLOOR_GOOD))
-    if bad.size == 0:
-        return v
-    names = list(joint_names) if joint_names is not None else [str(j + 1) for j in range(r.size)]
-    worst_r = float(np.max(r[bad]))
-    level: Level = "fair" if worst_r <= FLOOR_FAIR else "poor"
+    bad = [j for j, lv in enumerate(levels) if lv != "good"]
+    level = worst(*(levels[j] for j in bad))
+    if float(error_percent) < NEGLIGIBLE_PERCENT:
+        level = min(level, "fair", key=LEVELS.index)  # never poor: near-exact data
     if LEVELS.index(level) <= LEVELS.index(v.level):
         return v
-    which = ", ".join(f"{names[j]} at {r[j]:.2g} x" for j in bad)
+    names = (
+        list(joint_names) if joint_names is not None else [str(j + 1) for j in range(len(levels))]
+    )
+    r = None if joint_ratios is None else np.asarray(joint_ratios, dtype=np.float64).ravel()
+    p = None if joint_percent is None else np.asarray(joint_percent, dtype=np.float64).ravel()
+    if r is not None:
+        which = ", ".join(
+            f"{names[j]} at {r[j]:.2g} x" + ("" if p is None else f" ({p[j]:.3g} %)") for j in bad
+        )
+        which += " their noise"
+    else:
+        which = ", ".join(f"{names[j]} at {p[j]:.3g} %" for j in bad)  # type: ignore[index]
     what = (
         "effects outside the model remain there"
         if level == "fair"
-        else ("the model misses effects the data show there (model terms, excitation, the drive)")
+        else "the model misses effects the data show there (model terms, excitation, the drive)"
     )
+    if p is not None and any(p[j] >= 100.0 for j in bad):  # worse than no torque at all
+        what += "; at 100 % or more: a log of another robot, or other kinematics?"
     label = "usable" if level == "fair" else "poor"
-    return Verdict(
-        level,
-        label,
-        f"{v.reason.split(':')[0]}; joint(s) {which} their noise: {what}",
-        v.ratio,
-    )
+    return Verdict(level, label, f"{v.reason.split(':')[0]}; joint(s) {which}: {what}", v.ratio)
 
 
 def pooled_verdict(
@@ -183,6 +280,10 @@ def pooled_verdict(
         )
     if r is not None and r <= FLOOR_GOOD:
         return Verdict("good", "at the noise floor", f"error {e:.3g} %{at}: only noise is left", r)
+    if e < NEGLIGIBLE_PERCENT:
+        return Verdict(
+            "good", "good", f"error {e:.3g} %{at}: below {NEGLIGIBLE_PERCENT:g} %, negligible", r
+        )
     if r is None and e < GOOD_PERCENT:
         return Verdict("good", "good", f"error {e:.3g} % (below {GOOD_PERCENT:g} %)", r)
     if (r is not None and r <= FLOOR_FAIR) or e < FAIR_PERCENT:

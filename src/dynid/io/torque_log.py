@@ -7,7 +7,8 @@ columns, then one row per sample::
     # rows: N
     t,q1,...,qn,dq1,...,dqn,tau1,...,taun[,ddq1,...,ddqn]
 
-Columns are found by name, in any order; ``n`` is the number of ``q`` columns
+(``tau [A]`` when the ``tau`` columns hold the motor currents a drive with ``effort =
+"current"`` logs.) Columns are found by name, in any order; ``n`` is the number of ``q`` columns
 (``q1..qn``, no gap). A duplicated column, a joint signal's column outside ``1..n``, or an
 incomplete ``ddq1..ddqn`` set is an error (a wrong column silently used is a wrong
 answer); any other column (labels, a vendor's estimates) is ignored with a warning; the
@@ -66,7 +67,12 @@ __all__ = [
 
 _log = logging.getLogger(__name__)
 
-_UNITS = "# dynid torque log; units: t [s], q [rad], dq [rad/s], tau [N m], ddq [rad/s^2]"
+
+def _units(tau_unit: str) -> str:
+    """The units line of a torque log whose ``tau`` columns are in ``tau_unit``."""
+    return f"# dynid torque log; units: t [s], q [rad], dq [rad/s], tau [{tau_unit}], ddq [rad/s^2]"
+
+
 _SIGNALS = ("q", "dq", "tau", "ddq")
 
 
@@ -110,6 +116,7 @@ def save_torque_log_pieces(
     with_ddq: bool = False,
     extra: tuple[str, Callable[[], Iterable[NDArray[np.float64]]]] | None = None,
     with_dq: bool = True,
+    tau_unit: str = "N m",
 ) -> Path:
     """Write a log given in consecutive pieces (never held whole) to ``path`` (``.csv``
     or ``.npz``, by suffix), as :func:`save_torque_log` writes the pieces joined.
@@ -132,6 +139,10 @@ def save_torque_log_pieces(
     with_dq : bool
         Whether the velocities are written (not: positions and torques only, whose
         readers derive the velocities).
+    tau_unit : str
+        The unit of the ``tau`` columns said in a CSV's units line: ``"N m"``, or ``"A"``
+        for the currents of a drive with ``effort = "current"``
+        (:attr:`~dynid.model.drive.Drive.effort_unit`).
 
     Raises
     ------
@@ -166,7 +177,7 @@ def save_torque_log_pieces(
         raise DataError(f"torque log must be a .csv or .npz file; got {path.name!r}")
     preamble = "\n".join(
         [
-            _UNITS,
+            _units(tau_unit),
             f"{ROWS_PREFIX} {n_rows}",
             ",".join(
                 torque_log_columns(n, with_ddq=with_ddq, with_dq=with_dq)

@@ -171,6 +171,11 @@ class Drive:
         return int(self.transmission.shape[0])
 
     @property
+    def effort_unit(self) -> str:
+        """The unit of a log's ``tau`` columns: ``"A"`` for currents, else ``"N m"``."""
+        return "A" if self.effort == "current" else "N m"
+
+    @property
     def is_bare(self) -> bool:
         """True for :meth:`identity`: ``K = 1``, no offsets, joint-side torques, no torque
         constants or rotor inertias (a drive with nothing to write or to add)."""

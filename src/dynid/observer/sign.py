@@ -8,8 +8,8 @@ than ``K_O``). On a collision-free log it follows the measured torque, correlati
 negative, correlation near ``-1``, and the residual there is twice the torque: thresholds
 calibrated on it are blind on that joint. The check sees every joint the model moves, the
 joints gravity does not load included (a wrist), where the gravity check of
-:mod:`dynid.identification.sanity` tells nothing, and a sign flipped on a minority of the
-joints, which that check only warns about.
+:mod:`dynid.identification.sanity` tells nothing (that check refuses a sign flipped on
+any joint gravity loads, before the residual is read).
 
 A joint is called opposite when the correlation is below :data:`OPPOSITE_CORRELATION`.
 A model without torques on a joint (no parameters, no friction) gives ``tau + r`` equal

@@ -30,6 +30,7 @@ from ..identification.log import TorqueLog
 from ..identification.model import IdentifiedModel
 from ..identification.pieces import split_at_gaps
 from ..identification.sanity import velocity_noise_std
+from ..identification.verdict import Verdict, joint_ratios, judge_prediction
 from .style import COLOURS
 
 if TYPE_CHECKING:  # pragma: no cover
@@ -66,9 +67,24 @@ class HeldOutTorques:
         norm = float(np.linalg.norm(tau))
         return 100.0 * float(np.sqrt(len(tau) * np.sum(self.noise_rms**2))) / norm if norm else 0.0
 
-    def as_dict(self) -> dict[str, Any]:
-        """JSON-ready: the errors per joint, the noise, the floor (schema ``heldout.json``)."""
+    @property
+    def verdict(self) -> Verdict:
+        """The held-out prediction judged as ``validate`` judges one
+        (:func:`~dynid.identification.verdict.judge_prediction`): the error against the
+        noise floor, each joint's against its noise and in relative terms."""
         e = self.validation.errors
+        return judge_prediction(
+            e.relative_error_percent,
+            self.noise_floor_percent,
+            joint_ratios=joint_ratios(e.rms, self.noise_rms),
+            joint_percent=e.relative_error_percent_per_joint,
+            joint_names=self.joint_names,
+        )
+
+    def as_dict(self) -> dict[str, Any]:
+        """JSON-ready: the errors per joint, the noise, the floor and the verdict (schema
+        ``heldout.json``)."""
+        e, v = self.validation.errors, self.verdict
         return {
             "block": self.block,
             "joint_names": list(self.joint_names),
@@ -78,6 +94,7 @@ class HeldOutTorques:
             "relative_error_percent": float(e.relative_error_percent),
             "relative_error_percent_per_joint": e.relative_error_percent_per_joint.tolist(),
             "noise_floor_percent": self.noise_floor_percent,
+            "verdict": {"level": v.level, "label": v.label, "reason": v.reason},
             "units": {"rms": "N m", "noise_rms": "N m", "relative_error_percent": "%"},
         }
 

@@ -24,7 +24,7 @@ from typing import Any
 
 from ..exceptions import DynidError
 from ..identification.structure import Structure
-from ..identification.verdict import FLOOR_GOOD, Verdict, judge_prediction, worst
+from ..identification.verdict import FLOOR_GOOD, Verdict, joint_ratios, judge_prediction, worst
 from .html import bar, cell, esc, figure, is_number, number, percent, section, table, verdict
 from .model_terms import terms_sections
 from .run import Answer, RunFiles
@@ -64,20 +64,23 @@ def _get(doc: Any, *keys: str) -> Any:
 
 
 def _heldout_facts(
-    doc: dict, held: dict | None, *, floor_fact: bool = True
+    doc: dict, held: dict | None, contradicted: bool = False, *, floor_fact: bool = True
 ) -> tuple[list[str], list[str], str]:
     """(facts, problems, headline) of the held-out judgement: the record's held-out error
     against the record's sensor-noise floor (``metadata.heldout``: the numbers the command
     prints; its fact left out without ``floor_fact``, where another fit's states the
-    floor); the last block's unfiltered error (``heldout.json``) beside it, against a
-    floor of its own only for a record without one (an older file)."""
+    floor), each joint against its noise as ``validate`` judges (``heldout.json``'s
+    per-joint errors); the last block's unfiltered error beside it, against a floor of its
+    own only for a record without one (an older file). ``contradicted``: the data
+    contradict the robot (:func:`_warning_facts`), which makes the verdict unusable
+    whatever the errors, and the held-out fact says so instead of its own level."""
     facts, problems = [], []
     ho = _get(doc, "metadata", "heldout")
     train, test = _get(ho, "training_error_percent"), _get(ho, "heldout_error_percent")
     floor = _get(ho, "noise_floor_percent")
     judged = None  # the record's held-out error against its floor
     if is_number(test) and is_number(floor) and floor > 0:
-        judged = judge_prediction(test, floor)
+        judged = _heldout_verdict(held, test, floor) if held else judge_prediction(test, floor)
     block = held is not None and is_number(held.get("relative_error_percent"))
     if judged is not None:
         at_floor = judged.ratio is not None and judged.ratio <= FLOOR_GOOD
@@ -95,12 +98,14 @@ def _heldout_facts(
         problems += more
         headline = f"The model predicts held-out torques to {percent(test)}"
     if judged is not None:
-        fact, more, headline = _floor_fact(judged, test, floor, "torques it was judged on")
+        fact, more, headline = _floor_fact(
+            judged, test, floor, "torques it was judged on", contradicted
+        )
         facts += [fact] if floor_fact else []
         problems += more
     if block:
         assert held is not None
-        fact, more, said = _block_fact(held, judged is None)
+        fact, more, said = _block_fact(held, judged is None, contradicted)
         facts.append(fact)
         problems += more
         headline = said or headline
@@ -134,17 +139,22 @@ def _overfit_fact(ho: dict, train: float, test: float, at_floor: bool) -> tuple[
     return fact, ["fair"] if ratio > OVERFIT_GOOD and not at_floor else []
 
 
-def _floor_fact(v: Verdict, err: float, floor: float, torques: str) -> tuple[str, list[str], str]:
-    """(fact, problems, headline) of an error against a sensor-noise floor."""
+def _floor_fact(
+    v: Verdict, err: float, floor: float, torques: str, contradicted: bool = False
+) -> tuple[str, list[str], str]:
+    """(fact, problems, headline) of an error against a sensor-noise floor (the joints
+    the verdict names, or why it was reached; unusable where the data contradict the
+    robot)."""
     r = v.ratio if v.ratio is not None else math.inf
+    joints = v.reason.split("; ", 1)[1] if "; joint(s) " in v.reason else ""
+    said = (
+        "<b>unusable</b>: the data contradict the robot (below), whatever the error"
+        if contradicted
+        else f"<b>{esc(v.label)}</b>: " + esc(joints or v.reason.split("): ", 1)[-1])
+    )
     fact = (
         f"Error {percent(err)} against a sensor-noise floor of {percent(floor)} of the "
-        f"{esc(torques)} (<b>{r:.3g} x the floor</b>: {esc(v.label)}"
-        + (
-            ", only noise is left)"
-            if r <= FLOOR_GOOD
-            else ", effects outside the model remain, see the residuals)"
-        )
+        f"{esc(torques)} (<b>{r:.3g} x the floor</b>): {said}"
     )
     level = "at" if r <= FLOOR_GOOD else f"{r:.3g} times"  # as in the fact
     headline = (
@@ -156,7 +166,7 @@ def _floor_fact(v: Verdict, err: float, floor: float, torques: str) -> tuple[str
     return fact, [] if v.level == "good" else [v.level], headline
 
 
-def _block_fact(held: dict, judge: bool) -> tuple[str, list[str], str]:
+def _block_fact(held: dict, judge: bool, contradicted: bool = False) -> tuple[str, list[str], str]:
     """(fact, problems, headline or "") of the last block's unfiltered error
     (``heldout.json``, the figures' and the table's data): against its own floor when
     ``judge`` (a record without one), else the error alone (the floor is the record's)."""
@@ -172,9 +182,13 @@ def _block_fact(held: dict, judge: bool) -> tuple[str, list[str], str]:
             (f"The model does not explain held-out torques: error {percent(err)}" if bad else ""),
         )
     floor = floor if is_number(floor) else None
-    v = judge_prediction(err, floor)
+    v = _heldout_verdict(held)
     if v.ratio is None or floor is None:
-        fact = f"{where}: error {percent(err)} (noise floor unknown: {esc(v.label)})"
+        fact = f"{where}: error {percent(err)} (noise floor unknown): " + (
+            "<b>unusable</b>: the data contradict the robot (below)"
+            if contradicted
+            else f"<b>{esc(v.label)}</b>: {esc(v.reason)}"
+        )
         return (
             fact,
             [] if v.level == "good" else [v.level],
@@ -184,11 +198,41 @@ def _block_fact(held: dict, judge: bool) -> tuple[str, list[str], str]:
                 else ""
             ),
         )
-    fact, problems, headline = _floor_fact(v, err, floor, "unfiltered torques")
+    fact, problems, headline = _floor_fact(v, err, floor, "unfiltered torques", contradicted)
     return (
         f"{where}: {fact[0].lower()}{fact[1:]}",
         problems,
         headline + ("" if v.unusable else " (unfiltered torques)"),
+    )
+
+
+def _heldout_verdict(held: dict, err: float | None = None, floor: float | None = None) -> Verdict:
+    """heldout.json judged as ``validate`` judges a log (the pooled error against the floor,
+    each joint against its noise and in relative terms), from the file's numbers; the
+    pooled error and floor ``err``, ``floor`` [%] when given (the record's)."""
+    if err is None:
+        err, floor = held["relative_error_percent"], held.get("noise_floor_percent")
+    rms, noise = held.get("rms"), held.get("noise_rms")
+    per = held.get("relative_error_percent_per_joint")
+    names = held.get("joint_names")
+
+    def numbers(x: Any) -> list[float] | None:
+        ok = isinstance(x, list) and x and all(is_number(v) or v is None for v in x)
+        return [float("nan") if v is None else float(v) for v in x] if ok else None
+
+    rms, noise, per = numbers(rms), numbers(noise), numbers(per)
+    ratios = joint_ratios(rms, noise) if rms and noise and len(rms) == len(noise) else None
+    if per is not None and ratios is not None and len(per) != len(ratios):
+        per = None
+    n = len(per) if per is not None else (len(ratios) if ratios is not None else 0)
+    return judge_prediction(
+        err,
+        floor if is_number(floor) else None,
+        joint_ratios=ratios,
+        joint_percent=per,
+        joint_names=[str(x) for x in names]
+        if isinstance(names, list) and len(names) == n
+        else None,
     )
 
 
@@ -359,7 +403,10 @@ def answer(run: RunFiles) -> Answer | None:
         facts, problems, headline = _static_facts(doc)
     else:
         consistent = _consistent_heldout(run)
-        facts, problems, headline = _heldout_facts(doc, held, floor_fact=consistent is None)
+        contradicted = any(k in w for w in run.summary.warnings for k in _DATA_WARNINGS)
+        facts, problems, headline = _heldout_facts(
+            doc, held, contradicted, floor_fact=consistent is None
+        )
         if consistent is not None:  # the answer asked for: the consistent fit's error
             first, more, headline = _consistent_facts(doc, consistent)
             facts = first + [f"Least squares: {f[0].lower()}{f[1:]}" for f in facts]

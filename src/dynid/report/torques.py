@@ -19,19 +19,17 @@ from ..identification.verdict import (
     FLOOR_FAIR,
     FLOOR_GOOD,
     GOOD_PERCENT,
+    JOINT_FAIR,
+    JOINT_GOOD,
     LEVELS,
     UNUSABLE_PERCENT,
+    joint_levels,
     judge_prediction,
 )
 from .html import cell, esc, figure, is_number, percent, section, table, verdict
 from .run import Answer, RunFiles
 
 __all__ = ["friction_answer", "validate_answer"]
-
-#: Relative error [%] of the worst joint: good below JOINT_GOOD, usable below JOINT_FAIR
-#: (a joint of small torques, a wrist, errs more in relative terms than the log as a
-#: whole, whose error the large torques of the shoulder dominate).
-JOINT_GOOD, JOINT_FAIR = 10.0, 25.0
 
 
 def _names(doc: dict, n: int) -> list[str]:
@@ -95,13 +93,7 @@ def validate_answer(run: RunFiles) -> Answer | None:
     if isinstance(per, list) and per and all(is_number(p) for p in per):
         ratio = _noise_ratios(doc, len(per))
         j = max(range(len(per)), key=lambda k: (ratio[k], per[k]))
-        joint = (
-            "good"
-            if per[j] < JOINT_GOOD or ratio[j] <= FLOOR_GOOD
-            else "fair"
-            if per[j] < JOINT_FAIR or ratio[j] <= FLOOR_FAIR
-            else "poor"
-        )
+        joint = joint_levels([per[j]], [ratio[j]])[0]
         if LEVELS.index(joint) > LEVELS.index(level) and level != "unusable":
             level = joint
         noise = f", {ratio[j]:.2f} x its sensor noise" if ratio[j] < float("inf") else ""

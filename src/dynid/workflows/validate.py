@@ -36,11 +36,10 @@ from ..friction.fit import same_drive
 from ..friction.model import FrictionModel, FrictionSum
 from ..friction.recordings import RecordingsValidation, validate_recordings
 from ..friction.validation import RECORDED, own_friction
-from ..identification.judge import NOISE_FLOOR_SHARE
 from ..identification.metrics import TorqueErrors
 from ..identification.model import IdentifiedModel
 from ..identification.sanity import anticorrelated, velocity_noise_std
-from ..identification.verdict import LEVELS, Verdict, judge_prediction
+from ..identification.verdict import LEVELS, Verdict, joint_ratios, judge_prediction
 from ..io.feasible import load_feasible_drive, load_feasible_linear_friction
 from ..io.friction_json import load_friction_json
 from ..model.drive import Drive
@@ -233,11 +232,13 @@ def validate_files(
     errors = val.errors
     if not np.isfinite(errors.relative_error_percent) or not np.all(np.isfinite(errors.rms)):
         raise DataError(_overflow(rec.names, val, label, opt))
-    verdict, noise, floor = _judged(val, np.ones(len(val.parts), bool), errors)
+    names = robot.joint_names
+    verdict, noise, floor = _judged(val, np.ones(len(val.parts), bool), errors, names)
     labels = np.asarray(val.pieces.recording)
     if len(rec.names) > 1:  # recordings judged apart: the worst named, when they differ
         each = [
-            _judged(val, labels == r, val.recordings[r].errors)[0] for r in range(len(rec.names))
+            _judged(val, labels == r, val.recordings[r].errors, names)[0]
+            for r in range(len(rec.names))
         ]
         rank = [LEVELS.index(v.level) for v in each]
         r = int(np.argmax(rank))
@@ -257,7 +258,10 @@ def validate_files(
 
 
 def _judged(
-    val: RecordingsValidation, sel: NDArray[np.bool_], errors: TorqueErrors
+    val: RecordingsValidation,
+    sel: NDArray[np.bool_],
+    errors: TorqueErrors,
+    names: Sequence[str],
 ) -> tuple[Verdict, NDArray[np.float64], float]:
     """The verdict, the sensor noise per joint [N m] and the noise floor [%] of the pieces
     ``sel`` (bool per piece), whose pooled errors are ``errors``: the noise read from each
@@ -279,15 +283,13 @@ def _judged(
     spread = np.std(model, axis=0)
     loaded = spread > 0.05 * max(float(spread.max(initial=0.0)), 1e-300)
     opposite = anticorrelated(model - model.mean(axis=0), tau - tau.mean(axis=0), loaded)
-    # each joint's error over its noise (a noise next to nothing, as a filtered sensor's,
-    # counted at least the share of the largest joint's that the structure choice counts)
-    least = NOISE_FLOOR_SHARE * float(noise.max(initial=0.0))
-    ratios = np.asarray(errors.rms) / np.maximum(noise, least)
     verdict = judge_prediction(
         errors.relative_error_percent,
         floor,
         opposite_sign=opposite is not None,
-        joint_ratios=ratios if np.all(noise > 0) else None,
+        joint_ratios=joint_ratios(errors.rms, noise) if np.all(noise > 0) else None,
+        joint_percent=errors.relative_error_percent_per_joint,
+        joint_names=names,
     )
     return verdict, noise, floor
 
