@@ -479,16 +479,24 @@ def _decided_by_prior(r: ConsistentResult) -> tuple[list[str], NDArray[np.bool_]
 
 
 def format_rms_table(names: list[str], columns: dict[str, np.ndarray]) -> str:
-    """A per-joint table of RMS values [N m]: columns as wide as their longest name."""
+    """A per-joint table of RMS values [N m]: columns as wide as their longest name, four
+    decimals from 0.1 up, four significant digits below (an error of 2.8e-5 N m is not
+    0.0000)."""
     w = text_width("joint", names, 9) + 1
     cw = {k: max(22, len(k) + 2) for k in columns}
     head = f"{'joint':<{w}}" + "".join(f"{k:>{cw[k]}}" for k in columns)
     rows = [head]
     for j, name in enumerate(names):
         rows.append(
-            f"{name:<{w}}" + "".join(f"{float(v[j]):>{cw[k]}.4g}" for k, v in columns.items())
+            f"{name:<{w}}"
+            + "".join(f"{_rms_text(float(v[j])):>{cw[k]}}" for k, v in columns.items())
         )
     return "\n".join(rows)
+
+
+def _rms_text(x: float) -> str:
+    """``x`` with four decimals from 0.1 up (and 0), else four significant digits."""
+    return f"{x:.4f}" if abs(x) >= 0.1 or x == 0 or not np.isfinite(x) else f"{x:.4g}"
 
 
 def format_newton_euler_rms(val: NewtonEulerValidation) -> str:
