@@ -66,3 +66,24 @@ def test_torque_and_observer_legends_cover_no_data():
         assert all(ax.get_legend() is None for ax in f.axes)
         (legend,) = f.legends
         assert _overlaps(f, legend) == []
+
+
+def test_residual_histograms_show_the_distribution_not_the_few_reversal_samples():
+    """Residuals of 0.05 N m noise with a few samples of 2.5 N m (a velocity reversal the
+    model rounds): the axis spans the noise's distribution (within 0.45 N m either side),
+    not the outliers' (it stretched to -1..2.5 N m, the noise in one bin), and the title
+    counts the samples left beyond it."""
+    from dynid.plots.identification import HeldOutTorques, plot_residual_histograms
+
+    rng = np.random.default_rng(3)
+    v = _validation(rng, N=4000, n=2)
+    tau = np.array(v.log.tau)
+    hat = tau - rng.normal(0.0, 0.05, tau.shape)
+    hat[[10, 700, 2100], 0] = tau[[10, 700, 2100], 0] - 2.5
+    v = Validation(v.log, hat, np.zeros_like(hat), torque_errors(tau, hat), None, None)
+    h = HeldOutTorques(v, np.full(2, 0.05), "block 5", ("a", "b"))
+    fig = plot_residual_histograms(h)
+    lo, hi = fig.axes[0].get_xlim()
+    assert -0.45 < lo < -0.2 and 0.2 < hi < 0.45
+    assert "3 sample(s) beyond the axis" in fig.axes[0].get_title()
+    assert "beyond" not in fig.axes[1].get_title()

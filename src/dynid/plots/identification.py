@@ -212,6 +212,18 @@ def _noise(v: Validation, cutoff_hz: float) -> NDArray[np.float64]:
     return np.asarray(velocity_noise_std(v.log.tau), dtype=np.float64)
 
 
+def _histogram_range(e: NDArray[np.float64], noise: float) -> tuple[float, float]:
+    """The residual range [N m] a histogram shows: the central 99.5 % of ``e`` widened by a
+    fifth, and at least 5 times the sensor ``noise`` either side, so that a few samples
+    at velocity reversals do not squash the distribution into one bin."""
+    a, b = (float(x) for x in np.quantile(e, [0.0025, 0.9975]))
+    pad = 0.2 * (b - a)
+    lo, hi = min(a - pad, -5.0 * noise), max(b + pad, 5.0 * noise)
+    if not hi > lo:
+        lo, hi = lo - 1.0, hi + 1.0
+    return lo, hi
+
+
 def plot_residual_histograms(h: HeldOutTorques, *, title: str | None = None) -> Figure:
     """Per joint, the histogram of the held-out residual (measured minus predicted) with
     the normal density of the sensor noise over it.
@@ -233,10 +245,13 @@ def plot_residual_histograms(h: HeldOutTorques, *, title: str | None = None) -> 
             ax.set_visible(False)
             continue
         s = float(h.noise_rms[j])
-        ax.hist(e[:, j], bins=40, density=True, color=COLOURS["model"], alpha=0.6, label="residual")
+        lo, hi = _histogram_range(e[:, j], s)
+        inside = (e[:, j] >= lo) & (e[:, j] <= hi)
+        ax.hist(e[inside, j], bins=40, range=(lo, hi), density=True, color=COLOURS["model"],
+                alpha=0.6, label="residual")  # fmt: skip
+        ax.set_xlim(lo, hi)
         if s > 0:
-            lo, hi = ax.get_xlim()
-            x = np.linspace(float(lo), float(hi), 200)
+            x = np.linspace(lo, hi, 200)
             ax.plot(
                 x,
                 np.exp(-0.5 * (x / s) ** 2) / (s * np.sqrt(2 * np.pi)),
@@ -244,8 +259,11 @@ def plot_residual_histograms(h: HeldOutTorques, *, title: str | None = None) -> 
                 lw=1.0,
                 label="sensor noise",
             )
+        out = int(e.shape[0] - inside.sum())
         ax.set_title(
-            f"{h.joint_names[j]}: RMS {np.sqrt(np.mean(e[:, j] ** 2)):.3g} N m", fontsize=9
+            f"{h.joint_names[j]}: RMS {np.sqrt(np.mean(e[:, j] ** 2)):.3g} N m"
+            + (f"\n{out} sample(s) beyond the axis" if out else ""),
+            fontsize=9,
         )
         ax.set_xlabel("residual [N m]", fontsize=8)
         ax.tick_params(labelsize=7)
