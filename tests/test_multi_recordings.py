@@ -82,6 +82,20 @@ def test_the_true_robot_over_two_recordings_with_gaps_is_at_the_noise_level(pand
     assert res.friction_source == "model" and res.files == ("rec1.csv", "rec2.csv")
 
 
+def test_the_validate_report_names_its_worst_joint_by_the_robots_name(panda, files, tmp_path):
+    """validation.json holds the robot's joint names, so that the page names the worst
+    joint as the robot does (it said "Worst joint joint 1")."""
+    from dynid.io.validation_json import save_validation_json
+    from dynid.report import RunSummary, render_html_report
+
+    res = validate_files(panda, files / "rec1.csv")
+    assert res.metadata()["joint_names"] == list(panda.joint_names)
+    p = save_validation_json(tmp_path / "validation.json", res.validation, **res.metadata())
+    page = render_html_report(RunSummary(command="validate"), {p.name: p})
+    worst = page.split("Worst joint ", 1)[1].split(":", 1)[0]
+    assert worst in panda.joint_names
+
+
 def test_a_gap_bridged_across_ruins_what_the_pieces_keep(panda, files):
     """The same recording with its 0.5 s gap bridged by interpolation (--max-gap 1): the
     filter and the derivatives run across the join and the error grows far above the

@@ -131,6 +131,8 @@ class ValidateResult:
     noise_floor_percent : float
         The noise relative to the measured torques' norm [%]: the smallest relative error
         a model can reach on them.
+    joint_names : tuple of str
+        The robot's joints, in the columns' order (empty: not known).
     """
 
     validation: RecordingsValidation
@@ -141,12 +143,13 @@ class ValidateResult:
     verdict: Verdict
     noise_rms: NDArray[np.float64]
     noise_floor_percent: float
+    joint_names: tuple[str, ...] = ()
 
     def metadata(self) -> dict[str, Any]:
         """The keys ``validation.json`` records beside the errors: ``model``,
         ``friction_source``, ``data`` (the files, comma-separated), ``files``,
-        ``cutoff_hz``, ``noise_rms``, ``noise_floor_percent`` and ``verdict`` (``level``,
-        ``label``, ``reason``)."""
+        ``cutoff_hz``, ``noise_rms``, ``noise_floor_percent``, ``verdict`` (``level``,
+        ``label``, ``reason``) and ``joint_names`` (when known)."""
         v = self.verdict
         return {
             "model": self.model,
@@ -157,7 +160,7 @@ class ValidateResult:
             "noise_rms": [float(x) for x in self.noise_rms],
             "noise_floor_percent": self.noise_floor_percent,
             "verdict": {"level": v.level, "label": v.label, "reason": v.reason},
-        }
+        } | ({"joint_names": list(self.joint_names)} if self.joint_names else {})
 
 
 def validate_files(
@@ -254,6 +257,7 @@ def validate_files(
         verdict=verdict,
         noise_rms=noise,
         noise_floor_percent=floor,
+        joint_names=tuple(robot.joint_names),
     )
 
 
