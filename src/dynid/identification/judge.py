@@ -79,8 +79,9 @@ def heldout_judge(
             normals = lambda lab: block_normals(Ww, yw, lab)  # noqa: E731
             fitted = lambda: iter([(W, stack.y, stack.groups)])  # noqa: E731
         if validation is not None:
-            test = _normals(robot, validation, columns, cols, b, estimator)
+            test, test_white = _normals(robot, validation, columns, cols, b, estimator)
             held = HeldOut.separate(normals(np.zeros(m, np.intp))[0], test)
+            held = held if test_white is None else replace(held, whitened=(test_white,))
         elif labels is None:
             return None
         else:
@@ -126,13 +127,17 @@ def _normals(
     cols: NDArray[np.bool_],
     b: NDArray[np.float64],
     estimator: Estimator,
-) -> Normals:
+) -> tuple[Normals, Normals | None]:
     """The normal equations of a separate recording over the fitted columns, on its rows
     as measured (:meth:`~.recordings.Recordings.measured_blocks`), weighted as the
-    estimator weighs them at ``b``."""
+    estimator weighs them at ``b``; and those of its rows with each joint in units of its
+    own noise (:func:`inverse_noise`; None when not known), as the folds are whitened."""
     blocks = list(data.measured_blocks(robot, columns))
     W = np.concatenate([blk.W for blk in blocks])[:, cols]
     y = np.concatenate([blk.y for blk in blocks])
     g = np.concatenate([blk.groups for blk in blocks])
     rw = row_weights(estimator, W, y, g, b)
-    return block_normals(W * rw[:, None], y * rw, np.zeros(y.size, np.intp))[0]
+    one = np.zeros(y.size, np.intp)
+    inv = inverse_noise(data)
+    white = None if inv is None else block_normals(W * inv[g][:, None], y * inv[g], one)[0]
+    return block_normals(W * rw[:, None], y * rw, one)[0], white

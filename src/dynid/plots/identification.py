@@ -28,7 +28,7 @@ from ..friction.pooled import joined_validation
 from ..friction.validation import Validation, own_friction, validate_torques
 from ..identification.log import TorqueLog
 from ..identification.model import IdentifiedModel
-from ..identification.pieces import split_at_gaps
+from ..identification.pieces import split_at_gaps, unwrapped, wrappable
 from ..identification.sanity import velocity_noise_std
 from ..identification.verdict import Verdict, joint_ratios, judge_prediction
 from .style import COLOURS
@@ -121,7 +121,8 @@ def heldout_torques(
     log : TorqueLog
         The log it was identified from, as read (several recordings: the last one).
         Held-out samples with gaps longer than the identification's ``max_gap_s`` are
-        prepared piece by piece and pooled, as the identification took them.
+        prepared piece by piece and pooled, joints recorded wrapped into ``[-pi, pi]``
+        unwrapped, as the identification took them.
     separate : TorqueLog, optional
         The ``--validate-on`` log (the model judged on it), as read.
 
@@ -158,7 +159,9 @@ def heldout_torques(
         block = f"the last of {k} recordings, predicted by the fit of the other {k - 1}"
     else:
         return None
-    v, said = _pieces_validation(fitted, split_at_gaps(held, model.info.log.max_gap_s))
+    turns = wrappable(model.robot, model.drive)  # wrapped joints unwrapped, as identified
+    pieces = [unwrapped(p, turns)[0] for p in split_at_gaps(held, model.info.log.max_gap_s)]
+    v, said = _pieces_validation(fitted, pieces)
     block += said
     cutoff = model.info.log.cutoff_hz or 0.2 * model.info.log.sample_rate_hz
     noise = _recorded_noise(model)
