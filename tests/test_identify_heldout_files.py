@@ -99,5 +99,5 @@ def test_another_arms_log_is_judged_poor_naming_its_wrist(tmp_path, capsys):
     assert verdict["level"] == "poor", verdict
     for name in ("wrist_1_joint", "wrist_2_joint", "wrist_3_joint"):
         assert name in verdict["reason"] and name in said, verdict["reason"]
-    assert "held-out verdict: poor" in said
+    assert "held-out verdict on " in said and "every sample: poor" in said
     assert '<section class="verdict poor"' in (out / "report.html").read_text()

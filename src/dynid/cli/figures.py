@@ -20,7 +20,6 @@ from ..feasibility.convex import ConsistentResult
 from ..friction.fit import FrictionFit, FrictionResidual
 from ..friction.validation import Validation
 from ..identification.model import IdentifiedModel
-from ..identification.verdict import Verdict
 from ..io.json_files import save_json
 from ..io.observer_files import log_labels, observation_names
 from ..observer.detection import threshold_series
@@ -30,6 +29,7 @@ from ..plots import friction as friction_plots
 from ..plots import identification as identification_plots
 from ..plots import observer as observer_plots
 from ..plots import torques as torque_plots
+from ..plots.identification import HeldOutTorques
 from ..workflows.data_files import column_map, read_torque_log
 from ..workflows.identify import data_files
 from .common import save_figure
@@ -107,7 +107,7 @@ def _said_before() -> Iterator[None]:
 
 def save_identify_figures(
     out: Path, model: IdentifiedModel, args: Any, *, figures: bool = True
-) -> tuple[list[Path], Verdict | None]:
+) -> tuple[list[Path], HeldOutTorques | None]:
     """A torque log's identification on held-out data, under ``out``: ``heldout.json``
     (errors per joint against the sensor noise; data, written without ``figures`` too),
     ``heldout_torques.png`` (measured and predicted torques) and ``heldout_residuals.png``
@@ -115,7 +115,7 @@ def save_identify_figures(
     to ``--data`` stands for its files), its reading's warnings not said again. Nothing
     for static data or a model without held-out folds; a log that cannot be read back is
     noted and skipped (the identification's own files are written). Returns the files and
-    the held-out verdict (None without one)."""
+    the held-out prediction (its block and verdict; None without one)."""
     if model.info.log is None or model.holdout is None:
         return [], None
     try:
@@ -141,7 +141,7 @@ def save_identify_figures(
         Path(out) / "heldout.json", held.as_dict(), schema="dynid-heldout-torques/1"
     )
     if not figures:
-        return [data_file], held.verdict
+        return [data_file], held
     paths = [
         data_file,
         save_figure(
@@ -156,7 +156,7 @@ def save_identify_figures(
             Path(out) / "heldout_residuals.png",
         ),
     ]
-    return [p for p in paths if p is not None], held.verdict
+    return [p for p in paths if p is not None], held
 
 
 def save_observer_figures(out: Path, result: ObserveResult, *, names: list[str]) -> list[Path]:

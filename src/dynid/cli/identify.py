@@ -257,11 +257,14 @@ def run(args: argparse.Namespace, console: Console) -> int:
     note_prior(args, console)
     result = identify_files(robot, args.data, options)
     files = [save_model_json(args.out / "identification.json", result.model)]
-    held, verdict = save_identify_figures(args.out, result.model, args, figures=not args.no_figures)
+    held, prediction = save_identify_figures(
+        args.out, result.model, args, figures=not args.no_figures
+    )
     files += held
     text = [format_identification(result.model)]
-    if verdict is not None:
-        text.append(f"held-out verdict: {verdict.label}: {verdict.reason}")
+    if prediction is not None:  # every sample of the figures' data, not the decimated rows
+        v = prediction.verdict
+        text.append(f"held-out verdict on {prediction.block}, every sample: {v.label}: {v.reason}")
     if result.consistent is not None:
         files += save_feasible_bundle(args.out, result.consistent, source=str(args.data[0]))
         files += [] if args.no_figures else save_retrieval_figure(args.out, result.consistent)
