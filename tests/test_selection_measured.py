@@ -101,3 +101,31 @@ def test_heldout_error_of_a_structure_is_the_direct_one_on_measured_torques(
     )
     filtered = 100.0 * np.sqrt(sse_f / sum(float(np.sum(r[1] ** 2)) for r in rows))
     assert abs(filtered - want) > 1e-3 * want
+
+
+def test_a_weighted_estimator_is_judged_on_the_torques_as_measured_unweighted(panda):
+    """irls: each recording's fold fit (the estimator's, from the model's own folds)
+    predicting the other recording's measured torques, unweighted, is the held-out error
+    printed (its Huber and per-joint weights in the judgement made a UR5's 0.279 % read
+    0.398 %, where the same model predicted a new recording to 0.252 %)."""
+    fr = ClassicalFriction(np.linspace(0.6, 0.2, 7), np.linspace(3.0, 1.0, 7), np.zeros(7))
+    logs = recordings(panda, (63, 64), friction=fr, duration=4.0, noise=SensorNoise())
+    structure = Structure(friction=("viscous", "coulomb"))
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", DynidWarning)
+        model = identify_recordings(panda, logs, structure=structure, estimator="irls")
+        data = prepare_recordings(panda, logs)
+    term = model.terms["friction"].term
+    band = np.asarray(term.band)
+    rows = [
+        _rows(panda, model.base, band, term.labels, p, raw, data.cutoff_hz)
+        for p, raw in zip(data.pieces, logs, strict=True)
+    ]
+    assert model.holdout is not None and model.holdout.folds == 2
+    sse = norm = 0.0
+    for k, (_, _, Wm, ym) in enumerate(rows):
+        x = model.holdout.train[k].solve()  # the fit without recording k
+        sse += float(np.sum((ym - Wm @ x) ** 2))
+        norm += float(np.sum(ym**2))
+    want = 100.0 * np.sqrt(sse / norm)
+    assert model.info.heldout["heldout_error_percent"] == pytest.approx(want, rel=1e-3)

@@ -79,7 +79,7 @@ def heldout_judge(
             normals = lambda lab: block_normals(Ww, yw, lab)  # noqa: E731
             fitted = lambda: iter([(W, stack.y, stack.groups)])  # noqa: E731
         if validation is not None:
-            test, test_white = _normals(robot, validation, columns, cols, b, estimator)
+            test, test_white = _normals(robot, validation, columns, cols)
             held = HeldOut.separate(normals(np.zeros(m, np.intp))[0], test)
             held = held if test_white is None else replace(held, whitened=(test_white,))
         elif labels is None:
@@ -87,9 +87,11 @@ def heldout_judge(
         else:
             # the whitened rows in units of each joint's noise alone: the estimator's
             # weights (its own estimate of each joint's residual level, at the largest
-            # model) would make a joint's error vanish with the terms it loses
+            # model) would make a joint's error vanish with the terms it loses; the
+            # measured rows judged unweighted too, the error of the torques as measured
+            # (weighted, an irls fit read 40 % above the same model's plain error)
             plain, white = normals_by_label_scaled(
-                rows if measured_ok else fitted, labels, rw, inv_noise
+                rows if measured_ok else fitted, labels, None if measured_ok else rw, inv_noise
             )
             judged = plain if measured_ok else None
             held = replace(HeldOut.k_fold(normals(labels), judged), scheme=scheme, whitened=white)
@@ -125,19 +127,17 @@ def _normals(
     data: Recordings,
     columns: ModelColumns,
     cols: NDArray[np.bool_],
-    b: NDArray[np.float64],
-    estimator: Estimator,
 ) -> tuple[Normals, Normals | None]:
     """The normal equations of a separate recording over the fitted columns, on its rows
-    as measured (:meth:`~.recordings.Recordings.measured_blocks`), weighted as the
-    estimator weighs them at ``b``; and those of its rows with each joint in units of its
-    own noise (:func:`inverse_noise`; None when not known), as the folds are whitened."""
+    as measured (:meth:`~.recordings.Recordings.measured_blocks`), unweighted (the error
+    of the torques as measured, whatever the estimator); and those of its rows with each
+    joint in units of its own noise (:func:`inverse_noise`; None when not known), as the
+    folds are whitened."""
     blocks = list(data.measured_blocks(robot, columns))
     W = np.concatenate([blk.W for blk in blocks])[:, cols]
     y = np.concatenate([blk.y for blk in blocks])
     g = np.concatenate([blk.groups for blk in blocks])
-    rw = row_weights(estimator, W, y, g, b)
     one = np.zeros(y.size, np.intp)
     inv = inverse_noise(data)
     white = None if inv is None else block_normals(W * inv[g][:, None], y * inv[g], one)[0]
-    return block_normals(W * rw[:, None], y * rw, one)[0], white
+    return block_normals(W, y, one)[0], white
