@@ -87,3 +87,20 @@ def test_residual_histograms_show_the_distribution_not_the_few_reversal_samples(
     assert -0.45 < lo < -0.2 and 0.2 < hi < 0.45
     assert "3 sample(s) beyond the axis" in fig.axes[0].get_title()
     assert "beyond" not in fig.axes[1].get_title()
+
+
+def test_rms_bars_of_very_different_sizes_are_drawn_on_a_log_scale():
+    """Errors without friction of 7 N m beside 0.05 N m with it: the axis is logarithmic
+    (on a linear one the bars with friction could not be seen) and long joint names are
+    slanted; bars of like sizes keep a linear axis."""
+    from dynid.plots.torques import plot_rms_comparison
+
+    names = [f"shoulder_pan_joint_{j}" for j in range(6)]
+    fig = plot_rms_comparison(
+        {"without friction": np.full(6, 7.0), "with friction": np.full(6, 0.05)}, joint_names=names
+    )
+    ax = fig.axes[0]
+    assert ax.get_yscale() == "log"
+    assert all(abs(t.get_rotation()) > 0 for t in ax.get_xticklabels())
+    like = plot_rms_comparison({"a": np.full(3, 1.0), "b": np.full(3, 2.0)})
+    assert like.axes[0].get_yscale() == "linear"
