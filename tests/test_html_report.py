@@ -694,19 +694,24 @@ def test_the_held_out_verdict_has_levels_a_person_can_act_on(tmp_path, error, fl
     assert text.strip().lower().startswith(label), text
 
 
+def _identification(train: float, test: float, floor: float) -> dict:
+    """An identification.json of the classical route held out over 5 time blocks: its
+    training and held-out errors and noise floor [%]."""
+    held = {"training_error_percent": train, "heldout_error_percent": test,
+            "scheme": "blocks", "folds": 5, "noise_floor_percent": floor}  # fmt: skip
+    return {
+        "schema": "dynid-identification/1",
+        "route": "classical",
+        "rank": 2,
+        "metadata": {"heldout": held},
+    }
+
+
 def test_a_consistent_fit_heads_its_page_with_its_own_held_out_error(tmp_path):
     """identify --consistent: the verdict's headline is the consistent fit's held-out error
     against the noise floor the command printed, least squares' the comparison (the page
     opened on the least-squares fit's error, which the user had not asked for)."""
-    ident = {
-        "schema": "dynid-identification/1",
-        "route": "classical",
-        "rank": 2,
-        "metadata": {
-            "heldout": {"training_error_percent": 1.0, "heldout_error_percent": 1.1,
-                        "scheme": "blocks", "folds": 5, "noise_floor_percent": 0.5},
-        },
-    }  # fmt: skip
+    ident = _identification(1.0, 1.1, 0.5)
     heldout = {
         "scheme": "blocks",
         "folds": 5,
@@ -755,15 +760,7 @@ def test_the_page_shows_the_noise_floor_the_command_printed(tmp_path):
     """identify's page judges the held-out error against the record's noise floor
     (``metadata.heldout``, the one the summary prints: 0.327 %), not a second estimate
     from the last block of heldout.json (0.315 %: the page and the console disagreed)."""
-    ident = {
-        "schema": "dynid-identification/1",
-        "route": "classical",
-        "rank": 2,
-        "metadata": {
-            "heldout": {"training_error_percent": 0.348, "heldout_error_percent": 0.35,
-                        "scheme": "blocks", "folds": 5, "noise_floor_percent": 0.327},
-        },
-    }  # fmt: skip
+    ident = _identification(0.348, 0.35, 0.327)
     held = {"relative_error_percent": 0.343, "noise_floor_percent": 0.315, "block": "the last"}
     (tmp_path / "identification.json").write_text(json.dumps(ident))
     (tmp_path / "heldout.json").write_text(json.dumps(held))

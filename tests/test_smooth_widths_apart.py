@@ -76,23 +76,32 @@ def _exact_error(model: object) -> float:
     return float(val.errors.relative_error_percent)
 
 
+def _selection(logs):
+    """The structure selection on ``logs`` and the smooth widths [bands] it judged at the
+    motors (viscous and smooth friction)."""
+    robot = planar_2r()
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", DynidWarning)
+        sel = select_structure(robot, prepare_recordings(robot, logs, drive=DRIVE), drive=DRIVE)
+    assert sel is not None
+    judged = {
+        c.structure.width
+        for c in sel.candidates
+        if c.structure.at == "motor" and c.structure.friction == ("viscous", "smooth")
+    }
+    return sel, judged
+
+
 def test_narrow_smooth_widths_at_the_motors_are_judged_and_predict_a_sharp_law(logs):
     """Regression (a geared motor-side log without velocity columns: the narrow widths
     left out, the banded sign chosen): every width is judged, the narrowest chosen, and it
     predicts the exact torques of new recordings better than the banded sign."""
     robot = planar_2r()
+    sel, judged = _selection(logs)
+    assert judged == set(SMOOTH_WIDTHS)
+    assert "smooth" in sel.chosen.friction and sel.chosen.width == 0.3
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", DynidWarning)
-        data = prepare_recordings(robot, logs, drive=DRIVE)
-        sel = select_structure(robot, data, drive=DRIVE)
-        assert sel is not None
-        judged = {
-            c.structure.width
-            for c in sel.candidates
-            if c.structure.at == "motor" and c.structure.friction == ("viscous", "smooth")
-        }
-        assert judged == set(SMOOTH_WIDTHS)
-        assert "smooth" in sel.chosen.friction and sel.chosen.width == 0.3
         chosen = identify_recordings(robot, logs, drive=DRIVE)
         sign = Structure(friction=("viscous", "coulomb", "offset"), at="motor")
         banded = identify_recordings(robot, logs, drive=DRIVE, structure=sign)
@@ -105,7 +114,6 @@ def test_a_width_the_shared_regressor_cannot_tell_apart_is_judged_in_its_own(log
     decimation), that width, the first left out as
     :data:`~dynid.identification.largest.SMOOTH_THINNING` orders, is judged in a
     regressor of its own, said in one note, rather than dropped."""
-    robot = planar_2r()
     fit = largest_module._fit_group
 
     def alike(robot, data, group, *rest):  # the 1-band width beside others: rank deficient
@@ -115,15 +123,6 @@ def test_a_width_the_shared_regressor_cannot_tell_apart_is_judged_in_its_own(log
         return fit(robot, data, group, *rest)
 
     monkeypatch.setattr(largest_module, "_fit_group", alike)
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore", DynidWarning)
-        data = prepare_recordings(robot, logs, drive=DRIVE)
-        sel = select_structure(robot, data, drive=DRIVE)
-    assert sel is not None
-    judged = {
-        c.structure.width
-        for c in sel.candidates
-        if c.structure.at == "motor" and c.structure.friction == ("viscous", "smooth")
-    }
+    sel, judged = _selection(logs)
     assert judged == set(SMOOTH_WIDTHS)
     assert any("judged each in a regressor of its own" in n for n in sel.notes), sel.notes
