@@ -125,3 +125,12 @@ def test_joint_levels_judge_on_what_is_known():
     assert levels == ("good", "good", "fair", "poor")
     with pytest.raises(ShapeError, match="percent has 1 joints, ratios 2"):
         joint_levels([1.0], [1.0, 2.0])
+
+
+def test_the_ratio_to_the_noise_floor_is_printed_with_three_significant_digits():
+    """A sharp model on exact data sits a million times above a round-off floor: the
+    verdict says 9.5e+05 x, not 950310.26 x; a ratio near 1 keeps its two decimals."""
+    far = judge_prediction(0.21, 0.21 / 950310.26)
+    assert "(9.5e+05 x the noise floor" in far.reason, far.reason
+    near = judge_prediction(0.279, 0.268)
+    assert "(1.04 x the noise floor" in near.reason, near.reason

@@ -255,7 +255,7 @@ def pooled_verdict(
     floor = float(floor_percent) if floor_percent is not None else 0.0
     known = math.isfinite(floor) and floor > 0
     r = e / floor if known and math.isfinite(e) else None
-    at = f" ({r:.2f} x the noise floor of {floor:.3g} %)" if r is not None else ""
+    at = f" ({r:.3g} x the noise floor of {floor:.3g} %)" if r is not None else ""
     if opposite_sign:
         return Verdict(
             "unusable",

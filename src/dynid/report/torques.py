@@ -96,7 +96,7 @@ def validate_answer(run: RunFiles) -> Answer | None:
         joint = joint_levels([per[j]], [ratio[j]])[0]
         if LEVELS.index(joint) > LEVELS.index(level) and level != "unusable":
             level = joint
-        noise = f", {ratio[j]:.2f} x its sensor noise" if ratio[j] < float("inf") else ""
+        noise = f", {ratio[j]:.3g} x its sensor noise" if ratio[j] < float("inf") else ""
         facts.append(
             f"Worst joint {esc(_names(doc, len(per))[j])}: relative error "
             f"<b>{percent(per[j])}</b>{noise} (per joint judged good below {JOINT_GOOD:g} % or "
