@@ -158,11 +158,14 @@ def test_stack_limit_from_the_environment(monkeypatch):
         max_stack_bytes()
 
 
-def test_a_filtered_log_read_in_blocks_equals_the_log_stacked(monkeypatch):
+@pytest.mark.parametrize("decimate", [1, 5])
+def test_a_filtered_log_read_in_blocks_equals_the_log_stacked(monkeypatch, decimate):
     """A log read in several blocks whose friction columns go through the torques' low-pass
-    (parallel filtering) gives the stacked fit's estimates to 1e-9: each block is filtered
-    with enough of its neighbours' samples that its edges are the whole log's."""
+    (parallel filtering, at the rate before decimation) gives the stacked fit's estimates
+    to 1e-9: each span of blocks is filtered with enough of its neighbours' samples that
+    its edges are the whole log's."""
     import dynid
+    from dynid.identification import log_rows
     from dynid.identification.classical import identify_from_log
     from dynid.simulation.measurement import sample_times, simulate_measurement
     from dynid.simulation.trajectories import random_fourier
@@ -170,9 +173,10 @@ def test_a_filtered_log_read_in_blocks_equals_the_log_stacked(monkeypatch):
     robot = dynid.panda()
     traj = random_fourier(robot, np.random.default_rng(3))(sample_times(12.0, 1000.0))
     log = simulate_measurement(robot, traj, rng=np.random.default_rng(4))
-    kw = {"decimate": 1, "cutoff_hz": 20.0}
+    kw = {"decimate": decimate, "cutoff_hz": 20.0}
     ref = identify_from_log(robot, log, **kw)
     monkeypatch.setenv("DYNID_MAX_STACK_BYTES", "0")  # 12 000 samples: 3 blocks of rows
+    monkeypatch.setattr(log_rows, "STEP_SPAN", 700)  # a span of stepping columns per block
     got = identify_from_log(robot, log, **kw)
     np.testing.assert_allclose(got.fit.beta, ref.fit.beta, rtol=1e-9, atol=1e-12)
     np.testing.assert_allclose(got.friction.params, ref.friction.params, rtol=1e-9, atol=1e-12)

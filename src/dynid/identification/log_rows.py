@@ -82,16 +82,21 @@ def log_blocks(
     step = max(1, BLOCK_ROWS // n) if stream else N
     steps = columns.step_columns()
     filtered = cutoff_hz is not None and bool(steps.any())
+    held: NDArray[np.float64] | None = None  # the stepping columns of the rows lo:hi
+    lo = hi = 0
     for a in range(0, N, step):
         b = slice(a, a + step)
         q, dq, ddq, tau = log.q[b], log.dq[b], log.ddq[b], log.tau[b]
         Y, _ = term_regressor(robot, columns.base, columns.terms, q, dq, ddq)
-        if filtered:
+        if filtered:  # a span of STEP_SPAN rows at once: its margins cost once, not per block
             assert cutoff_hz is not None
-            Y[..., steps] = stepped_filtered(
-                columns.appended, (edges[0], log, edges[1]), steps[columns.base.rank :],
-                cutoff_hz, upsample, b,
-            )  # fmt: skip
+            if held is None or a + Y.shape[0] > hi:
+                lo, hi = a, min(N, a + max(step, STEP_SPAN))
+                held = stepped_filtered(
+                    columns.appended, (edges[0], log, edges[1]), steps[columns.base.rank :],
+                    cutoff_hz, upsample, slice(lo, hi),
+                )  # fmt: skip
+            Y[..., steps] = held[a - lo : a - lo + Y.shape[0]]
         if drive is not None and drive.rotor_inertia is not None:  # known: subtracted
             tau = tau - drive.rotor_torques(ddq, drive.rotor_inertia)
         m = Y.shape[0]
