@@ -267,3 +267,30 @@ def test_a_log_in_other_units_is_scaled_in_place_as_it_is_read(tmp_path, monkeyp
     N, n = 60_000, 3
     arrays, one = 8 * N * (1 + 3 * n), 8 * N * n
     assert peak < arrays + one + (2 << 20), (peak, arrays)  # the arrays, a copy, a chunk
+
+
+def test_validate_reads_a_log_in_other_units_than_the_models(tmp_path, caplog):
+    """A model identified from a log in mN m validates an SI log given --units tau=Nm as it
+    validates the mN m log (the model's recorded units were forced onto every later log)."""
+    import json
+
+    from dynid.io.torque_log import load_torque_log, save_torque_log
+
+    si = tmp_path / "si.csv"
+    argv = ["simulate", "--robot", "panda", "--duration", "6", "--rate", "200", "--seed", "3"]
+    assert main(argv + ["--out", str(si), "-q"]) == 0
+    log = load_torque_log(si)
+    mnm = tmp_path / "mnm.csv"
+    save_torque_log(mnm, TorqueLog(log.t, log.q, log.dq, log.tau * 1e3))
+    ident = ["identify", "--data", str(mnm), "--units", "tau=mNm", "--terms", "viscous,coulomb"]
+    assert main(ident + ["--no-figures", "--out", str(tmp_path / "id"), "-q"]) == 0
+    model = str(tmp_path / "id" / "identification.json")
+    errors = []
+    for data, units in ((mnm, []), (si, ["--units", "tau=Nm"])):
+        out = tmp_path / data.stem
+        argv = ["validate", "--model", model, "--data", str(data), *units, "--no-figures"]
+        assert main(argv + ["--out", str(out), "-q"]) == 0
+        errors.append(json.loads((out / "validation.json").read_text())["relative_error_percent"])
+    assert "the model's data were read with" in caplog.text
+    assert errors[1] == pytest.approx(errors[0], rel=1e-9)
+    assert errors[0] < 5.0

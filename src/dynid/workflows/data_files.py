@@ -25,7 +25,7 @@ from typing import Any, Literal, TypeVar
 
 import numpy as np
 
-from ..exceptions import DataError, OptionError
+from ..exceptions import DataError
 from ..exceptions import in_file as about_file
 from ..identification.data import StaticDataset
 from ..identification.log import TorqueLog
@@ -273,34 +273,25 @@ def read_static_file(
 def recorded_columns(
     recorded: Mapping[str, Any] | None, columns: str | None, units: str | None
 ) -> tuple[str | None, str | None]:
-    """The ``--columns``/``--units`` to read a log with for a model identified with the
-    column map ``recorded`` (its ``info.column_map``): the recorded ones when none are
-    given (logged).
-
-    Raises
-    ------
-    DataError
-        Other ones than recorded (the log would be read another way).
-    """
-    rec = recorded
-    if rec is None:
+    """The ``--columns`` and ``--units`` to read a log with for a model identified with
+    the column map ``recorded`` (its ``info.column_map``): each as given, else as recorded
+    (another file may be written in other units or with other names); logged where the
+    recorded one is used or one given differs from it."""
+    if recorded is None:
         return columns, units
-    if (columns, units) == (None, None):
-        columns, units = rec.get("columns"), rec.get("units")
+    rec = (recorded.get("columns"), recorded.get("units"))
+    given = (columns, units)
+    used = tuple(g if g is not None else r for g, r in zip(given, rec, strict=True))
+    if used == rec and used != given:
+        _log.warning("reading the data as the model's data were read: columns %r, units %r", *used)
+    elif used != rec:
         _log.warning(
-            "reading the data as the model's data were read: columns %r, units %r",
-            columns,
-            units,
+            "reading the data with columns %r, units %r; the model's data were read with "
+            "columns %r, units %r",
+            *used,
+            *rec,
         )
-    elif (columns, units) != (rec.get("columns"), rec.get("units")):
-        raise OptionError(
-            f"{columns!r} {{units}} {units!r} differ from those the model was identified "
-            f"with ({rec.get('columns')!r}, {rec.get('units')!r}); hint: leave them out to "
-            "use the model's",
-            field="columns",
-            others=("units",),
-        )
-    return columns, units
+    return used[0], used[1]
 
 
 def data_files(paths: str | Path | Sequence[str | Path]) -> list[Path]:
