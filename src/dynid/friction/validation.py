@@ -33,7 +33,13 @@ from ..exceptions import DynidWarning, OptionError, ShapeError, WrongTypeError
 from ..identification.log import DEFAULT_CUTOFF_HZ, TorqueLog, joint_side_log
 from ..identification.metrics import TorqueErrors, torque_errors
 from ..identification.model import IdentifiedModel
-from ..identification.prepare import Preprocessing, prepare_log, prepared_blocks
+from ..identification.prepare import (
+    Preprocessing,
+    at_measured_samples,
+    prepare_log,
+    prepared_blocks,
+    resamples,
+)
 from ..identification.recordings import common_cutoff
 from ..identification.sanity import anticorrelated
 from ..model.drive import Drive
@@ -236,7 +242,9 @@ def validated_log(
     prep: Preprocessing,
 ) -> Validation:
     """:func:`validated` on the joint-side log ``jlog`` prepared as ``prep`` says
-    (:func:`~dynid.identification.prepare.prepare_log`); a log longer than
+    (:func:`~dynid.identification.prepare.prepare_log`), on the log's own samples where
+    the preparation resamples it and leaves the torques as measured
+    (:func:`~dynid.identification.prepare.at_measured_samples`); a log longer than
     :data:`KEPT_SAMPLES` is prepared and predicted a block at a time
     (:func:`~dynid.identification.prepare.prepared_blocks`): the errors over every sample, the
     Validation keeping every k-th sample (``step``).
@@ -249,11 +257,18 @@ def validated_log(
         The friction model's joint count differs from the log's.
     """
     step = -(-jlog.n_samples // KEPT_SAMPLES)
+    own = not prep.filter_tau and prep.decimate == 1 and resamples(jlog, prep)
     if step <= 1:
-        return validated(model, prepare_log(jlog, prep), friction, drive)
+        p = prepare_log(jlog, prep)
+        if own:  # judged on the measured samples, not on a grid between them
+            p = next(at_measured_samples([p], jlog), p)
+        return validated(model, p, friction, drive)
     if friction is not None and friction.n != jlog.n:
         raise ShapeError(f"friction model has {friction.n} joints; the log has {jlog.n}")
-    return _validated_blocks(model, prepared_blocks(jlog, prep), friction, drive, step)
+    blocks = prepared_blocks(jlog, prep)
+    if own:
+        blocks = at_measured_samples(blocks, jlog)
+    return _validated_blocks(model, blocks, friction, drive, step)
 
 
 def _validated_blocks(

@@ -13,7 +13,7 @@ samples.
 from __future__ import annotations
 
 import warnings
-from collections.abc import Iterator
+from collections.abc import Iterable, Iterator
 from dataclasses import dataclass
 
 import numpy as np
@@ -28,9 +28,11 @@ __all__ = [
     "PREPARE_BLOCK_SAMPLES",
     "SETTLE_CYCLES",
     "Preprocessing",
+    "at_measured_samples",
     "measured_torques",
     "prepare_log",
     "prepared_blocks",
+    "resamples",
     "trimmed_margins",
 ]
 
@@ -198,6 +200,50 @@ def measured_torques(log: TorqueLog, prep: Preprocessing = _DEFAULT) -> NDArray[
         return np.array(log.tau[idx])
     ts = plan.t[idx]
     return np.stack([np.interp(ts, log.t, log.tau[:, j]) for j in range(log.n)], axis=1)
+
+
+def resamples(log: TorqueLog, prep: Preprocessing = _DEFAULT) -> bool:
+    """Whether :func:`prepare_log` resamples ``log`` onto a grid of other instants than
+    its own (jittered or dropped samples, or another rate ``prep.fs``)."""
+    return not _plan(log, prep).uniform
+
+
+def at_measured_samples(blocks: Iterable[TorqueLog], log: TorqueLog) -> Iterator[TorqueLog]:
+    """Consecutive prepared ``blocks`` of ``log`` (its uniform grid, as
+    :func:`prepared_blocks` yields them, torques not filtered) read at the samples of
+    ``log`` itself: a block's positions, velocities and accelerations interpolated at the
+    measured instants from its first grid time up to the next block's (the last block: up
+    to its own last time), by a cubic spline of the
+    low-passed, hence band-limited, signals; the torques as measured. A log of jittered
+    or dropped samples is then judged on its own samples: the linear grid smears a torque
+    step (Coulomb friction at a reversal) between two stamps and averages a sample's noise
+    with its neighbour's (an xArm7 at 100 Hz, stamps +-2 ms: the true model's error 1.79 %
+    on the grid, 0.80 % on uniform stamps). A block with fewer than 2 measured samples
+    (a log's last few) is left out."""
+    from scipy.interpolate import CubicSpline  # here: a robot model loads no scipy
+
+    n = log.n
+    it = iter(blocks)
+    p = next(it, None)
+    while p is not None:
+        nxt = next(it, None)
+        assert p.ddq is not None  # prepare_log always fills ddq
+        a = int(np.searchsorted(log.t, p.t[0], side="left"))
+        if nxt is not None:
+            b = int(np.searchsorted(log.t, nxt.t[0], side="left"))
+        else:
+            b = int(np.searchsorted(log.t, p.t[-1], side="right"))
+        if b - a >= 2:
+            x = CubicSpline(p.t, np.concatenate([p.q, p.dq, p.ddq], axis=1), axis=0)(log.t[a:b])
+            yield TorqueLog(
+                t=log.t[a:b],
+                q=x[:, :n],
+                dq=x[:, n : 2 * n],
+                tau=log.tau[a:b],
+                ddq=x[:, 2 * n :],
+                cleaning=log.cleaning,
+            )
+        p = nxt
 
 
 def trimmed_margins(
