@@ -281,9 +281,9 @@ def test_mjcf_coupled_rotor_says_what_it_drops(tmp_path):
 
 def test_urdf_export_names_what_it_drops_and_mjcf_holds_it(tmp_path):
     """A coupled drive with rotor inertias and friction at its motors: the URDF export
-    warns once, in URDF's words, that the armature has no URDF element (naming the MJCF
-    export, which holds it) and what of the coupled friction it drops; the URDF holds the
-    reflected diagonal friction and no armature; MuJoCo reads the MJCF's armature as
+    warns, in URDF's words, what of the coupled friction it drops and, on a line of its
+    own, that it leaves out the armature (naming the MJCF export, which holds it); the
+    URDF holds the reflected diagonal friction and no armature; MuJoCo reads the MJCF's armature as
     diag(K^T diag(I_a) K) and the same diagonal friction."""
     import warnings
     import xml.etree.ElementTree as ET
@@ -301,11 +301,11 @@ def test_urdf_export_names_what_it_drops_and_mjcf_holds_it(tmp_path):
         warnings.simplefilter("always")
         urdf = save_robot(tmp_path / "r.urdf", robot, friction=motor, drive=drive)
     lines = [str(w.message) for w in got if issubclass(w.category, DynidWarning)]
-    assert len(lines) == 1 and lines[0].startswith("URDF export: "), lines
-    assert "MJCF" not in lines[0].split("MJCF export holds")[0], lines[0]
-    assert "rotor inertias (armature per joint" in lines[0]
-    assert "the MJCF export holds them as armature" in lines[0]
-    assert "Coulomb friction of coupled motors" in lines[0]
+    assert len(lines) == 2 and all(x.startswith("URDF export: ") for x in lines), lines
+    assert "Coulomb friction of coupled motors" in lines[0] and "rotor" not in lines[0]
+    assert "MJCF" not in lines[1].split("MJCF export (r.xml) holds")[0], lines[1]
+    assert "leaves out the drive's rotor inertias" in lines[1]
+    assert "the MJCF export (r.xml) holds them as armature" in lines[1]
     K = drive.transmission
     arm = np.diag(K.T @ np.diag(ia) @ K)
     damping = np.diag(K.T @ np.diag(fv) @ K)

@@ -756,6 +756,45 @@ def test_a_calibration_says_it_calibrated_thresholds_not_that_it_has_no_events(t
     assert "free.csv" in text and "contact 0.25-0.5 N m" in text, text
 
 
+def test_calibration_thresholds_table_names_its_rows_by_joint(tmp_path):
+    """Regression: the calibration page's thresholds table numbered its rows 1..6 though
+    thresholds.json lists the joints by name; events as many as the joints are still
+    numbered, not named after the joints."""
+    from dynid.io.observer_files import save_events, save_thresholds
+    from dynid.observer.detection import Thresholds
+    from dynid.observer.events import ContactEvent
+    from dynid.observer.residual import ObserverOptions
+    from dynid.report.json_tables import json_section
+
+    names = ["shoulder_pan_joint", "shoulder_lift_joint", "elbow_joint"]
+    th = Thresholds(
+        contact=np.array([0.5, 0.25, 0.125]),
+        collision=np.array([1.0, 0.5, 0.25]),
+        margin=1.5,
+        quantile=1.0,
+        collision_factor=2.0,
+        options=ObserverOptions(gain=(10.0, 20.0, 30.0)),
+        samples=1200,
+    )
+    out = tmp_path / "cal"
+    out.mkdir()
+    save_thresholds(out / "thresholds.json", th, joints=names, calibration={"data": ["a.csv"]})
+    page = render_html_report(
+        RunSummary(command="observe"), {"thresholds.json": out / "thresholds.json"}
+    )
+    rows = [r for t in Page(page).tables for r in t]
+    assert ["shoulder_lift_joint", "0.25", "0.5"] in [r[:3] for r in rows], rows
+    assert ["elbow_joint", "30"] in rows, rows  # the observer's gains, nested
+    assert not any(r[0] in ("1", "2", "3") for r in rows), rows
+    events = [
+        ContactEvent(float(k), k + 0.5, (k + 1,), (1.0, 2.0, 3.0), "contact") for k in range(3)
+    ]
+    save_events(out / "events.json", events, joints=names)
+    doc = json.loads((out / "events.json").read_text())
+    rows = [r for t in Page(json_section("events.json", doc)).tables for r in t]
+    assert [r[0] for r in rows if r[0] in ("1", "2", "3") + tuple(names)] == ["1", "2", "3"]
+
+
 def test_the_page_shows_the_noise_floor_the_command_printed(tmp_path):
     """identify's page judges the held-out error against the record's noise floor
     (``metadata.heldout``, the one the summary prints: 0.327 %), not a second estimate

@@ -96,7 +96,16 @@ def test_a_prediction_below_a_hundredth_of_a_percent_is_never_poor():
     v = judge_prediction(5.7e-4, 4.4e-5)
     assert v.level == "good" and "negligible" in v.reason, v
     v = judge_prediction(5.7e-4, 4.4e-5, joint_ratios=[17.0, 150.0], joint_percent=[1e-4, 40.0])
-    assert v.level == "fair" and "2 at 1.5e+02 x (40 %)" in v.reason, v
+    assert v.level == "fair" and "2 at 150 x (40 %)" in v.reason, v
+
+
+def test_joint_ratios_print_three_significant_digits():
+    """Regression: a joint's ratio to its noise printed with two significant digits (123.4
+    read "1.2e+02 x", 46.4 "46 x"); every "N x" ratio has three."""
+    v = judge_prediction(
+        1.0, 0.1, joint_ratios=[1.0, 123.4, 46.4, 2.0], joint_percent=[1.0, 40.0, 30.0, 5.0]
+    )
+    assert "2 at 123 x (40 %), 3 at 46.4 x (30 %)" in v.reason, v.reason
 
 
 def test_the_true_robot_on_an_exact_log_is_judged_good(panda, tmp_path):

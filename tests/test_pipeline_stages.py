@@ -105,3 +105,15 @@ def test_collision_stage_finds_the_push_with_the_identified_model():
     res = collision_stage(model, robot.friction, 0, truth=robot)
     assert len(res.events) == 1 and res.delay is not None and 0 <= res.delay < 0.02
     assert np.all(res.residual_error_rms < 0.2)
+
+
+def test_demo_help_lists_every_stage(capsys):
+    """Regression: `dynid demo --help` listed stages 1-5 while the demo runs a sixth, the
+    collision detection; every stage the pipeline runs is listed by number and kind."""
+    from dynid.cli.__main__ import main
+    from dynid.pipeline import STAGES
+
+    assert main(["demo", "--help"]) == 0
+    text = capsys.readouterr().out
+    for stage in STAGES:
+        assert f"{stage.number}. {stage.kind}" in text, (stage, text)

@@ -242,3 +242,21 @@ def test_specifications_that_exclude_the_robot_are_reported_not_hidden():
     )
     with pytest.raises(DataError, match="not positive semidefinite"):
         retrieve_sdp(bad, prior=robot)
+
+
+def test_implausible_note_says_when_the_prior_holds_the_same_inertia():
+    """Regression: an implausible radius of gyration was blamed on absorbed rotor inertia or
+    unseen inertia even when the prior (a UR5's URDF) held it itself; with the prior's link
+    implausible too the note says "the prior has it too", else it keeps the causes."""
+    robot = dynid.panda()
+    I = robot.inertia.copy()
+    I[-1] *= 20.0  # link 7: radius of gyration sqrt(tr(I) / 2 m) = 0.61 m, extent 0.15 m
+    truth = robot.with_inertials(robot.mass, robot.com, I)
+    rg = np.sqrt(np.trace(I[-1]) / (2.0 * robot.mass[-1]))
+    model = exact_model(robot, truth)
+    same = [s for s in retrieve_sdp(model, prior=truth).notes if s.startswith("implausible")]
+    assert len(same) == 1 and same[0].startswith("implausible: link7 has a radius of gyration")
+    assert same[0].endswith(f"the prior has it too ({rg:.3g} m)"), same
+    own = [s for s in retrieve_sdp(model, prior=robot).notes if s.startswith("implausible")]
+    assert len(own) == 1 and own[0].startswith("implausible: link7 has a radius of gyration")
+    assert "prior" not in own[0] and "rotor inertia the link absorbed" in own[0], own

@@ -20,6 +20,11 @@ Stages (each prints what it does and lists the files it writes):
                  the convex (LMI) retrieval with the published set as prior against the
                  penalty method (without and with that prior): residual, margins, distance
                  to the truth and to the prior, time (consistent/).
+  6. collision   beyond the paper, its future work: the model of stage 2 with the friction
+                 of stage 3 runs the momentum observer on two simulated 8 s motions of the
+                 Panda; a free one calibrates the thresholds, in the other a push of 15 N
+                 on link 6 from 4 s to 4.5 s is searched for: the events found, the delay
+                 and the residual's error against the true external torque (printed only).
 
 Finally paper.json sets dynid's results beside the paper's published values (Table III's
 43 coefficients with their standard deviations, the friction, the retrieved links, the

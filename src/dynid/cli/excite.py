@@ -20,8 +20,10 @@ controller), DIR/trajectory.json (coefficients, limits, margins, obstacles, cond
 numbers, the smallest margin to every limit and obstacle at 1 kHz) and
 DIR/excitation.png (joint motion and swept workspace). Seeded; about a minute for the
 Panda. `dynid simulate --trajectory DIR/trajectory.csv` records a torque log along it.
-Exit status 1 when no admissible trajectory was found: the files are written for
-inspection (as retrieve's when no feasible set exists).
+The result is the best admissible iterate, never worse than an admissible start (the
+start itself then, said in a third line, as is a result worse than a start that violated
+a limit). Exit status 1 when no admissible trajectory was found, naming the violated
+limits: the files are written for inspection (as retrieve's when no feasible set exists).
 
 example:
   dynid excite --robot panda --duration 20 --seed 1 --out excite
@@ -119,11 +121,17 @@ def run(args: argparse.Namespace, console: Console) -> int:
     console.print(*design.describe(robot), *(f"wrote {p}" for p in written))
     if not design.admissible:  # a negative result, as retrieve's: exit 1, files kept
         print(
-            f"dynid {NAME}: no admissible trajectory found (files written for inspection); "
-            "hint: fewer or smaller obstacles, smaller --radius or another --seed",
+            f"dynid {NAME}: no admissible trajectory found (violated at 1 kHz: "
+            f"{', '.join(design.result.violations())}; files written for inspection); "
+            "hint: fewer or smaller obstacles, smaller --radius, more --max-iter or another "
+            "--seed",
             file=sys.stderr,
         )
         return 1
+    if not design.result.improved:
+        console.note(
+            "more --max-iter or another --seed may find a trajectory better than the start"
+        )
     return 0
 
 

@@ -28,7 +28,8 @@ as a [friction] table (exactly, as feasible.json does). URDF holds per joint dam
 sharp Coulomb friction (<dynamics>); MJCF and URDF name in one warning what they cannot
 hold of the friction (a smooth law's rounding, a standstill band, the offsets, a Stribeck
 peak, a quadratic term, an asymmetry, friction at the motors, a coupled drive's
-off-diagonal terms) and of the drive (URDF: the rotor inertias).
+off-diagonal terms) and of the drive (MJCF: a coupled rotor's off-diagonal inertia); URDF
+names the rotor inertias it drops, by joint, in a warning of its own.
 
 examples:
   dynid export --params feasible/feasible.json --out panda.xml

@@ -332,7 +332,7 @@ def _estimate(
         factor, lags = serial_correlation_factor(resid, n, int(np.ceil(rate / prep["cutoff_hz"])))
         cov = cov * factor
         notes.append(
-            f"standard deviations widened x{np.sqrt(factor):.2f} for the serial correlation "
+            f"standard deviations widened x{np.sqrt(factor):.3g} for the serial correlation "
             f"of the filtered samples (Newey-West, {lags} lags)"
         )
     phi, active, marg = load_parameters(est[:p], float(np.sqrt(cov[0, 0])), W, margin, notes)

@@ -214,7 +214,7 @@ def judge_prediction(
     p = None if joint_percent is None else np.asarray(joint_percent, dtype=np.float64).ravel()
     if r is not None:
         which = ", ".join(
-            f"{names[j]} at {r[j]:.2g} x" + ("" if p is None else f" ({p[j]:.3g} %)") for j in bad
+            f"{names[j]} at {r[j]:.3g} x" + ("" if p is None else f" ({p[j]:.3g} %)") for j in bad
         )
         which += " their noise"
     else:

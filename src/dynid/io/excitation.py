@@ -109,6 +109,8 @@ def save_excitation_json(
         "condition_number_of": "classical regressor [Y_b, F] (base parameters, then fv, fc, fo "
         "per joint), unscaled, samples at 200 Hz (Gaz et al. 2019 report 121.88 for theirs)",
         "status": result.status,
+        "improved": result.improved,
+        "start_admissible": result.start_admissible,
         "iterations": result.iterations,
         "evaluations": result.evaluations,
         "limits": {
@@ -190,6 +192,8 @@ EXCITATION = Format(
             "criterion": Field("string"),
             "condition_number_of": Field("string"),
             "status": Field("any"),
+            "improved": Field("bool"),
+            "start_admissible": Field("bool"),
             "iterations": Field("any"),
             "evaluations": Field("any"),
             "limits": Field("any"),

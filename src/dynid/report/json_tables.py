@@ -133,10 +133,13 @@ def _object_html(
 ) -> str:
     """A JSON object: its scalars as a key/value table, then its vectors, records,
     matrices and nested objects (nested objects in collapsible blocks). ``labels`` name
-    the rows of per-joint vectors (``joint_names``); ``units`` (the file's ``units``)
-    give units to keys."""
+    the rows of per-joint vectors (``joint_names``, or ``joints`` when it lists names as in
+    ``thresholds.json``); ``units`` (the file's ``units``) give units to keys."""
     own = [doc[k] for k in ("joint_names", "link_names") if is_string_list(doc.get(k))]
     labels = [*own, *labels]
+    # a ``joints`` list of names names per-joint vectors, not records (events.json's events)
+    named = [doc["joints"]] if is_string_list(doc.get("joints")) else []
+    vector_labels = [*own, *named, *labels[len(own) :]]
     own_units = doc.get("units") if isinstance(doc.get("units"), dict) else None
     units = own_units or units or {}
     scalars, vectors, records, matrices, objects, other = [], {}, [], [], [], []
@@ -161,10 +164,10 @@ def _object_html(
         by_length.setdefault(len(v), {})[key] = v
     for group in by_length.values():
         n = len(next(iter(group.values())))
-        if not _has_names(n, labels) and (n <= 3 or (len(group) == 1 and n <= MAX_VECTOR)):
+        if not _has_names(n, vector_labels) and (n <= 3 or (len(group) == 1 and n <= MAX_VECTOR)):
             scalars += list(group.items())  # xyz, a few values: inline
         elif len(next(iter(group.values()))) <= MAX_ROWS:
-            parts.append(_vectors_table(group, labels, units))
+            parts.append(_vectors_table(group, vector_labels, units))
         else:
             other += list(group.items())
     rows = [[esc(k), cell(v), esc(units.get(k, ""))] for k, v in scalars + other]
@@ -173,12 +176,14 @@ def _object_html(
         headers = ["key", "value", "unit"] if with_units else ["key", "value"]
         parts.insert(0, table(headers, [r if with_units else r[:2] for r in rows], cls="kv"))
     parts += [_records_table(k, v, units, labels) for k, v in records]
-    parts += [_matrix_table(k, v, labels) for k, v in matrices]
+    parts += [_matrix_table(k, v, vector_labels) for k, v in matrices]
     for key, v in objects:
         if depth >= MAX_DEPTH:
             parts.append(f'<p class="dim">{esc(key)}: {len(v)} entries (in the file)</p>')
             continue
-        inner = _object_html(v, depth + 1, labels, units) if v else '<p class="dim">empty</p>'
+        inner = (
+            _object_html(v, depth + 1, vector_labels, units) if v else '<p class="dim">empty</p>'
+        )
         parts.append(f"<details><summary>{esc(key)}</summary>{inner}</details>")
     return "".join(parts)
 

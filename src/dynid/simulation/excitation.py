@@ -18,8 +18,11 @@ maximise ``log det`` of its column-scaled Gram matrix (D-optimality). Constraint
 * torques ``|M ddq + c + g + tau_f(dq)| <= (1 - m_tau) tau_max`` (the model's, with its
   friction), capsule clearances to obstacles and between non-adjacent links
   (:mod:`dynid.simulation.collision`) enter as quadratic penalties;
-* the result is checked at 1 kHz; if a torque or clearance is still violated the
-  amplitudes are reduced until none is (``status`` says so).
+* the result is the best iterate (the start included) free of penalty, else the optimiser's
+  last; it is checked at 1 kHz and, if a torque or clearance is still violated, its
+  amplitudes are reduced until none is (``status`` says so; kept unreduced when reducing
+  does not help). The start itself is returned when it is admissible and the result is
+  not better on the same 200 Hz grid (``improved`` is then False).
 
 scipy's L-BFGS-B with finite-difference gradients; the start is the best of ``n_starts``
 seeded random candidates. Seeded and reproducible; ``progress(iteration, max_iter, cond)``
@@ -65,6 +68,8 @@ __all__ = [
 ]
 
 _log = logging.getLogger(__name__)
+#: Rate [Hz] of the samples the result and its start are compared on (and reported).
+_FS_REPORTED = 200.0
 
 
 @dataclass(frozen=True, slots=True)
@@ -169,21 +174,27 @@ class ExcitationResult:
     scaled_condition_number : float
         The same with unit column norms.
     initial_condition_number : float
-        That of the start of the optimisation.
+        That of the start of the optimisation (the same 200 Hz samples).
     margins : dict
         Smallest margin to every limit at 1 kHz (:func:`limit_margins`), plus
         ``"obstacles"`` (name -> smallest clearance minus the required one [m]) and
         ``"self_collision"`` (smallest clearance between non-adjacent capsules minus the
         required one [m]); all >= 0 when the trajectory is admissible.
     status : str
-        ``"ok"``, or ``"reduced"`` when the amplitudes had to be reduced after the
-        optimisation.
+        ``"ok"``, ``"reduced"`` when the amplitudes had to be reduced after the
+        optimisation, ``"infeasible"`` when no admissible trajectory was found.
     iterations : int
     evaluations : int
     history : tuple of float
         Condition number after each iteration.
     options : ExcitationOptions
     obstacles : Obstacles
+    start_margins : dict
+        :attr:`margins` of the start of the optimisation.
+    improved : bool
+        Whether the result is better than the start by the criterion (on the same 200 Hz
+        samples); False when the start, admissible, is returned, or when neither is
+        admissible and the optimiser only reduced the violations.
     """
 
     trajectory: ExcitingTrajectory
@@ -197,6 +208,17 @@ class ExcitationResult:
     history: tuple[float, ...]
     options: ExcitationOptions
     obstacles: Obstacles = field(default_factory=Obstacles)
+    start_margins: dict[str, Any] = field(default_factory=dict)
+    improved: bool = True
+
+    @property
+    def start_admissible(self) -> bool:
+        """Whether the start of the optimisation kept every limit and clearance at 1 kHz."""
+        return bool(self.start_margins) and _admissible(self.start_margins)
+
+    def violations(self, start: bool = False) -> list[str]:
+        """The negative margins of the result (or of the start), e.g. ``torque[2] -8.34``."""
+        return _violations(self.start_margins if start else self.margins)
 
 
 def _classical_regressor(
@@ -208,6 +230,17 @@ def _classical_regressor(
     ]
     W = np.concatenate([Y, friction_regressor(np.asarray(traj.dq))], axis=-1)
     return W.reshape(-1, W.shape[-1])
+
+
+def _criterion(W: NDArray[np.float64], criterion: str) -> float:
+    """The optimised criterion of ``[Y_b, F]`` (lower is better): ``log cond`` (unscaled) or
+    ``-mean log s`` of the column-scaled singular values (``logdet``)."""
+    if criterion == "cond":
+        s = np.linalg.svd(W, compute_uv=False)
+        return float(np.log(s[0] / max(s[-1], 1e-300)))
+    nrm = np.linalg.norm(W, axis=0)
+    s = np.linalg.svd(W / np.where(nrm > 0, nrm, 1.0), compute_uv=False)
+    return -float(np.mean(np.log(np.maximum(s, 1e-300))))
 
 
 def _conds(W: NDArray[np.float64]) -> tuple[float, float]:
@@ -224,7 +257,7 @@ def excitation_condition_number(
     traj: Trajectory | ExcitingTrajectory,
     *,
     base: BaseParameters | None = None,
-    fs: float = 200.0,
+    fs: float = _FS_REPORTED,
 ) -> tuple[float, float]:
     """Unscaled and scaled condition numbers of the classical regressor along a trajectory.
 
@@ -356,19 +389,15 @@ class _Problem:
         Pq, Pd, Pa = B
         return Trajectory(t=t, q=q0 + Pq @ c.T, dq=Pd @ c.T, ddq=Pa @ c.T)
 
+    def criterion(self, c: NDArray, q0: NDArray) -> float:
+        """The criterion on the regressor's grid (:func:`_criterion`)."""
+        tr = self._traj(self.B_reg, c, q0, self.t_reg)
+        return _criterion(_classical_regressor(self.robot, self.base, tr), self.opts.criterion)
+
     def objective(self, x: NDArray[np.float64]) -> float:
         self.evaluations += 1
         c, q0 = self.coefficients(x)
-        tr = self._traj(self.B_reg, c, q0, self.t_reg)
-        W = _classical_regressor(self.robot, self.base, tr)
-        if self.opts.criterion == "cond":
-            s = np.linalg.svd(W, compute_uv=False)
-            f = float(np.log(s[0] / max(s[-1], 1e-300)))
-        else:
-            nrm = np.linalg.norm(W, axis=0)
-            s = np.linalg.svd(W / np.where(nrm > 0, nrm, 1.0), compute_uv=False)
-            f = -float(np.mean(np.log(np.maximum(s, 1e-300))))
-        return f + self.penalty(c, q0)
+        return self.criterion(c, q0) + self.penalty(c, q0)
 
     def penalty(self, c: NDArray, q0: NDArray) -> float:
         pen = 0.0
@@ -492,19 +521,16 @@ def optimise_excitation(
         starts.append((prob.objective(x), x))
     _, x0 = min(starts, key=lambda p: p[0])
     history: list[float] = []
-
-    def cond_at(xk: NDArray[np.float64]) -> float:
-        """The unscaled condition number at ``xk`` (the objective adds the penalties: its
-        exponential overflowed when the start violated a constraint)."""
-        c, q0 = prob.coefficients(xk)
-        tr = prob._traj(prob.B_reg, c, q0, prob.t_reg)
-        return float(_conds(_classical_regressor(robot, base, tr))[0])
-
-    init_cond = cond_at(x0) if options.criterion == "cond" else float("nan")
+    best = _BestFeasible(prob)
+    best.offer(x0)
 
     def callback(xk: NDArray[np.float64]) -> None:
-        cond = cond_at(xk)
+        # the unscaled condition number (the objective adds the penalties)
+        c, q0 = prob.coefficients(xk)
+        tr = prob._traj(prob.B_reg, c, q0, prob.t_reg)
+        cond = float(_conds(_classical_regressor(robot, base, tr))[0])
         history.append(cond)
+        best.offer(xk)
         if progress is not None:
             progress(len(history), options.max_iter, cond)
 
@@ -515,22 +541,21 @@ def optimise_excitation(
         callback=callback,
         options={"maxiter": options.max_iter, "maxfun": options.max_evaluations, "eps": 1e-4},
     )
-    traj = prob.trajectory(res.x)
-    margins = _check(robot, traj, options, obstacles, caps)
-    status = "ok"
-    shrink = 0
-    while not _admissible(margins) and shrink < 60:
-        _log.info("violated at 1 kHz: %s", _violations(margins))
-        shrink += 1
-        status = "reduced"
-        # smaller excursions about the start stay inside the position limits
-        traj = ExcitingTrajectory(
-            traj.w_f, 0.97 * traj.a, 0.97 * traj.b, traj.q_start, traj.duration, traj.ramp
-        )
-        margins = _check(robot, traj, options, obstacles, caps)
-    if not _admissible(margins):
-        status = "infeasible"
-    cu, cs = excitation_condition_number(robot, traj, base=base)
+    best.offer(res.x)
+    # the best penalty-free iterate; without one, the optimiser's (the least violation)
+    chosen = prob.trajectory(res.x if best.x is None else best.x)
+    traj, margins, status = _admissible_version(robot, chosen, options, obstacles, caps)
+    start = prob.trajectory(x0)
+    start_margins = _check(robot, start, options, obstacles, caps)
+    W = _classical_regressor(robot, base, traj.sample(_FS_REPORTED))
+    W0 = _classical_regressor(robot, base, start.sample(_FS_REPORTED))
+    crit = (_criterion(W, options.criterion), _criterion(W0, options.criterion))
+    kept_start = _admissible(start_margins) and (status == "infeasible" or crit[0] >= crit[1])
+    if kept_start:  # never worse than an admissible start
+        _log.info("excitation: the start is kept (%s, criterion %.4g)", status, crit[0])
+        traj, margins, status, W = start, start_margins, "ok", W0
+    cu, cs = _conds(W)
+    init_cond = _conds(W0)[0]
     _log.info("excitation: cond %.4g -> %.4g (%s)", init_cond, cu, status)
     return ExcitationResult(
         trajectory=traj,
@@ -544,4 +569,49 @@ def optimise_excitation(
         history=tuple(history),
         options=options,
         obstacles=obstacles,
+        start_margins=start_margins,
+        improved=not kept_start and crit[0] < crit[1],
     )
+
+
+class _BestFeasible:
+    """The iterate of lowest criterion among those without penalty (internal)."""
+
+    def __init__(self, prob: _Problem) -> None:
+        self.prob = prob
+        self.x: NDArray[np.float64] | None = None
+        self.value = float("inf")
+
+    def offer(self, x: NDArray[np.float64]) -> None:
+        c, q0 = self.prob.coefficients(x)
+        if self.prob.penalty(c, q0) > 0:
+            return
+        f = self.prob.criterion(c, q0)
+        if f < self.value:
+            self.x, self.value = np.array(x, copy=True), f
+
+
+def _admissible_version(
+    robot: Robot,
+    traj: ExcitingTrajectory,
+    options: ExcitationOptions,
+    obstacles: Obstacles,
+    caps: CapsuleModel,
+) -> tuple[ExcitingTrajectory, dict[str, Any], str]:
+    """``traj`` checked at 1 kHz, its amplitudes reduced (by 3 % steps, at most 60) until it
+    is admissible: the trajectory, its margins and ``"ok"``/``"reduced"``; unreduced and
+    ``"infeasible"`` when no reduction is admissible (it would only lose excitation)."""
+    margins = _check(robot, traj, options, obstacles, caps)
+    reduced, m = traj, margins
+    for _ in range(60):
+        if _admissible(m):
+            return reduced, m, ("ok" if reduced is traj else "reduced")
+        _log.info("violated at 1 kHz: %s", _violations(m))
+        # smaller excursions about the start stay inside the position limits
+        reduced = ExcitingTrajectory(
+            traj.w_f, 0.97 * reduced.a, 0.97 * reduced.b, traj.q_start, traj.duration, traj.ramp
+        )
+        m = _check(robot, reduced, options, obstacles, caps)
+    if _admissible(m):
+        return reduced, m, "reduced"
+    return traj, margins, "infeasible"

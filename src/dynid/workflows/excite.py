@@ -51,8 +51,9 @@ class ExcitationDesign:
         """Whether the trajectory keeps every limit and clearance."""
         return self.result.status != "infeasible"
 
-    def describe(self, robot: Robot) -> tuple[str, str]:
-        """Two lines: the condition numbers and iterations; the smallest margins."""
+    def describe(self, robot: Robot) -> tuple[str, ...]:
+        """Two lines: the condition numbers and iterations; the smallest margins; a third
+        when the optimiser did not improve on its start (:meth:`start_note`)."""
         res, m = self.result, self.result.margins
         first = (
             f"exciting trajectory for {robot.name}: {res.trajectory.total_duration:g} s, "
@@ -67,7 +68,26 @@ class ExcitationDesign:
             f"{min(m['torque']):.3g} N m, self-collision {m['self_collision']:.3g} m"
             + "".join(f", {k} {v:.3g} m" for k, v in m["obstacles"].items())
         )
-        return first, second
+        note = self.start_note()
+        return (first, second) if note is None else (first, second, note)
+
+    def start_note(self) -> str | None:
+        """Why the result is not better than the optimiser's start, or None when it is."""
+        res = self.result
+        if res.improved:
+            return None
+        if res.start_admissible:  # then the result is the start itself
+            return (
+                "the optimiser did not improve on its start: the start, admissible, is "
+                "returned unchanged"
+            )
+        start = (
+            f"the optimiser's start (condition number {res.initial_condition_number:.4g}) "
+            f"violates {', '.join(res.violations(start=True))}"
+        )
+        if not self.admissible:
+            return f"not improved: {start}, and no admissible iterate was found"
+        return f"not better than the start: {start}; the result is the best admissible iterate"
 
 
 def design_excitation(

@@ -288,17 +288,21 @@ def save_urdf(
     return path
 
 
-def _rotor_note(drive: Drive | None) -> tuple[str, ...]:
-    """What URDF cannot hold of a drive: its rotor inertias (the armature per joint,
-    ``diag(K^T diag(I_a) K)`` [kg m^2]), which the MJCF export writes as ``armature``."""
+def _rotor_warning(drive: Drive | None, robot: Robot, path: Path) -> str | None:
+    """What URDF cannot hold of a drive, as a warning of its own: its rotor inertias (the
+    armature per joint, ``diag(K^T diag(I_a) K)`` [kg m^2]) by joint, and the exports that
+    hold them (MJCF ``armature``, the TOML ``[drive]`` table); None without any."""
     if drive is None or drive.rotor_inertia is None or not np.any(drive.rotor_inertia != 0):
-        return ()
+        return None
     arm = drive_joint_terms(drive.transmission, drive.rotor_inertia, None, None).armature
-    j = int(np.argmax(arm))
+    values = ", ".join(
+        f"{name} {a:.4g}" for name, a in zip(robot.joint_names, arm, strict=True) if a != 0
+    )
     return (
-        f"the drive's rotor inertias (armature per joint, up to {arm[j]:.4g} kg m^2 at joint "
-        f"{j + 1}) have no URDF element and are left out: the MJCF export holds them as "
-        "armature, the TOML export as its [drive] table",
+        f"URDF export: {path.name} leaves out the drive's rotor inertias, which URDF has no "
+        f"element for (armature per joint [kg m^2]: {values}); the MJCF export "
+        f"({path.stem}.xml) holds them as armature, the TOML export ({path.stem}.toml) as "
+        "its [drive] table"
     )
 
 
@@ -313,10 +317,11 @@ def export_urdf(path: str | Path, robot: Robot, options: ExportOptions) -> Path:
     nothing is written). What URDF cannot hold of the model's friction (a smooth law's
     rounding, a standstill band, the offsets, an asymmetry, a Stribeck peak, a quadratic
     term, friction at the motors, a coupled drive's off-diagonal terms;
-    :func:`dynid.friction.mujoco.unheld_friction`) and the rotor inertias of a drive are
-    named in one warning line, with the files that hold them. ``friction=True`` writes the
-    robot's own friction when it is a law other than the description's sigmoid at the
-    joints (which URDF does not hold); the drive is not part of URDF.
+    :func:`dynid.friction.mujoco.unheld_friction`) is named in one warning line, and the
+    rotor inertias of a drive, by joint, in a second, each with the files that hold them.
+    ``friction=True`` writes the robot's own friction when it is a law other than the
+    description's sigmoid at the joints (which URDF does not hold); the drive is not part
+    of URDF.
 
     Raises
     ------
@@ -355,7 +360,6 @@ def export_urdf(path: str | Path, robot: Robot, options: ExportOptions) -> Path:
         if replace and dynamics is None and held is not None:
             notes += (_removed_note(held, robot),)
     drive = options.drive if options.drive is not None else getattr(model, "drive", None)
-    notes += _rotor_note(drive)
     out = save_urdf(
         path,
         robot,
@@ -367,8 +371,11 @@ def export_urdf(path: str | Path, robot: Robot, options: ExportOptions) -> Path:
         dynamics=dynamics,
         template_dynamics=replace,
     )
-    if notes:  # one line, once written: what URDF cannot hold
+    if notes:  # one line, once written: what URDF cannot hold of the friction
         warnings.warn(f"URDF export: {'; '.join(notes)}", DynidWarning, stacklevel=2)
+    rotors = _rotor_warning(drive, robot, Path(path))
+    if rotors is not None:  # a line of its own: it costs far more than the friction's
+        warnings.warn(rotors, DynidWarning, stacklevel=2)
     return out
 
 
