@@ -126,3 +126,23 @@ def test_hac_std_matches_spread_over_seeds() -> None:
     # 60 seeds: the empirical std's relative error is 1 / sqrt(118) ~ 9 %; 3.5 of them
     assert np.all((ratio > 0.7) & (ratio < 1.4)), ratio
     assert 0.85 < np.median(ratio) < 1.2, ratio
+
+
+def test_structure_search_stds_follow_the_models() -> None:
+    """The search's dissipation check scales the candidates' classical standard deviations
+    (from normal equations) to the model's own: 1 for a model fitted with classical ones,
+    above 1.4 on every coefficient of a filtered log fitted with HAC ones."""
+    from dynid.identification.candidates import std_inflation
+
+    robot = planar_2r()
+    traj = random_fourier(robot, np.random.default_rng(3))(sample_times(20.0, 500.0))
+    log = simulate_measurement(
+        robot, traj, rng=np.random.default_rng(7), noise=SensorNoise(), friction=None
+    )
+    structure = Structure(True, ("viscous",))
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        classical = identify_recordings(robot, [log], structure=structure, std="classical")
+        hac = identify_recordings(robot, [log], structure=structure)
+    np.testing.assert_allclose(std_inflation(classical, 1e-10), 1.0, rtol=1e-8)
+    assert np.all(std_inflation(hac, 1e-10) > 1.4)
