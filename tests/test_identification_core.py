@@ -46,6 +46,8 @@ class _TorqueRows:
     def check_robot(self, robot: dynid.Robot) -> None:
         assert robot.n == self.q.shape[1]
 
+    serial = None
+
     def frozen_columns(self, columns: ModelColumns) -> np.ndarray:
         return np.zeros(len(columns.labels), dtype=bool)
 

@@ -179,8 +179,10 @@ def register(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParser:
         "--std",
         choices=STD_METHODS,
         default=None,
-        help="standard deviations: heteroscedasticity-consistent or sigma^2 (W^T W)^-1 "
-        "(default: robust for static data, classical for torque logs; honoured on both)",
+        help="standard deviations: hac (consistent for residuals correlated over the filtered, "
+        "decimated samples of each recording piece), robust (heteroscedasticity-consistent) "
+        "or classical (sigma^2 (W^T W)^-1, Gaz et al.) (default: robust for static data, "
+        "hac for torque logs; honoured on both)",
     )
     p.add_argument(
         "--estimator",

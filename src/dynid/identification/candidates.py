@@ -36,6 +36,7 @@ __all__ = [
     "heldout_of",
     "paired_se",
     "recording_oddness",
+    "std_inflation",
     "without_recordings",
 ]
 
@@ -225,8 +226,9 @@ def candidate_judged(
     whole, whole_std = sub.whole.solve_with_std(rtol, std=check is not None)
     unphysical: tuple[str, ...] = ()
     if check is not None:
+        assert whole_std is not None  # asked for with the check
         x, sd = np.zeros(use.size), np.zeros(use.size)
-        x[idx], sd[idx] = whole, whole_std
+        x[idx], sd[idx] = whole, whole_std * std_inflation(model, rtol)[idx]
         unphysical = check(x, sd)
     return Candidate(
         structure=structure,
@@ -239,6 +241,24 @@ def candidate_judged(
         whitened_error_percent=sub.heldout_error_percent(xs, whitened=True) if white else None,
         fold_whitened_percent=tuple(white),
     )
+
+
+def std_inflation(model: IdentifiedModel, rtol: float) -> NDArray[np.float64]:
+    """Per column of ``model`` (c,): its reported standard deviation over the classical one
+    from the normal equations of all its rows (its held-out folds' ``whole``; 1 where
+    either is 0 or the column is not kept). A candidate's standard deviations come from
+    the normal equations (``sigma^2 G^-1``, which take the residual as white); times these
+    they hold for the residual as the model's own do (``std="hac"``: a filtered log's residual is
+    correlated over several samples, about 2 times the classical on a 2R arm)."""
+    fit = model.joint_fit if model.joint_fit is not None else model.fit
+    kept = np.flatnonzero(np.asarray(fit.kept, dtype=bool))
+    out = np.ones(np.size(fit.kept))
+    whole = heldout_of(model).whole.restricted(kept)
+    classical = whole.std(whole.solve(rtol), rtol)
+    reported = np.asarray(fit.std, dtype=np.float64)[kept]
+    ok = (classical > 0) & (reported > 0)
+    out[kept[ok]] = reported[ok] / classical[ok]
+    return out
 
 
 def heldout_of(model: IdentifiedModel) -> HeldOut:

@@ -110,7 +110,7 @@ def identify_from_log(
     rtol: float | None = None,
     drive: Drive | None = None,
     estimator: EstimatorName | Estimator = "ols",
-    std: StdMethod = "classical",
+    std: StdMethod = "hac",
     folds: int = DEFAULT_FOLDS,
     validate_on: TorqueLog | None = None,
 ) -> IdentifiedModel:

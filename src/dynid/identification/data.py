@@ -162,6 +162,9 @@ class StaticDataset:
         """None: every column acts at rest or is structurally zero (a rank error says so)."""
         return np.zeros(len(columns.labels), dtype=bool)
 
+    #: Configurations are independent: no time structure (``std="hac"`` is HC1).
+    serial = None
+
     def blocks(self, robot: Robot, columns: ModelColumns) -> Iterator[RegressorBlock]:
         """One block of ``N`` rows per row of ``s = [tril M; g]`` (``static_labels``).
 

@@ -21,6 +21,7 @@ from ..model.robot import Robot
 from ..regressors.base import BaseParameters
 from ..regressors.terms import ModelTerm
 from .info import IdentificationInfo, Route
+from .serial import Serial
 
 __all__ = [
     "Dataset",
@@ -160,6 +161,13 @@ class Dataset(Protocol):
     def record(self, n_rows: int) -> IdentificationInfo:
         """The data's part of the model's record (reference, counts, preparation), given
         the rows used; the core fills in the rest."""
+        ...
+
+    @property
+    def serial(self) -> Serial | None:
+        """The time structure of the rows of :meth:`blocks` (rows per sample, pieces, the
+        HAC window) for ``std="hac"`` (:mod:`dynid.identification.serial`); None: the
+        rows are independent."""
         ...
 
 

@@ -10,7 +10,8 @@ row-weighting policy, and the engine
    each noise group's sum of squares, and every row's residual when it asks) and fits again
    with the weights it gives, until it answers None (ordinary least squares at once,
    weighted least squares after one reweighting, Huber IRLS when converged);
-3. returns the last fit with its standard deviations (``"classical"`` or ``"robust"``),
+3. returns the last fit with its standard deviations (``"classical"``, ``"robust"`` or
+   ``"hac"``),
    pruned when asked, and the residual statistics of the unweighted rows.
 
 The rows come as :class:`Rows`, which accumulate and solve them. Two kinds, chosen by where
@@ -43,6 +44,7 @@ from .. import _checks
 from ..exceptions import ShapeError
 from .estimators import Estimator, Residuals, Weights, noise_from_squares
 from .least_squares import LeastSquaresFit, StdMethod, _fit_with_pruning, checked_std
+from .serial import Serial
 
 __all__ = ["HeldRows", "Rows", "fit_rows", "fit_stacked", "weighted_fit"]
 
@@ -103,8 +105,10 @@ def fit_rows(
     estimator : Estimator
     rtol : float
         Relative rank tolerance on the diagonal of R of the column-scaled regressor.
-    std : {"classical", "robust"}
-        Standard deviations of the last fit.
+    std : {"classical", "robust", "hac"}
+        Standard deviations of the last fit (``"hac"``: over the time structure the rows
+        carry, :class:`HeldRows` and :class:`~dynid.identification.streamed.BlockRows`'
+        ``serial``).
     max_std_percent : float, optional
         Remove the coefficients above this relative standard deviation from the last fit
         and re-fit once.
@@ -197,6 +201,9 @@ class HeldRows:
         so the products skip it); default every row, one block.
     gram : ndarray, shape (c, c), optional
         ``W^T W`` over the rows used, when known.
+    serial : Serial, optional
+        The samples and pieces of the rows used (``std="hac"``; default: rows
+        independent).
     """
 
     def __init__(
@@ -206,8 +213,10 @@ class HeldRows:
         groups: NDArray[np.intp],
         blocks: NDArray[np.intp] | None = None,
         gram: NDArray[np.float64] | None = None,
+        serial: Serial | None = None,
     ) -> None:
         self.W, self.y, self.groups, self.blocks, self.gram = W, y, groups, blocks, gram
+        self.serial = serial
         self._rows: tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.intp]] | None
         self._rows = None
 
@@ -263,10 +272,12 @@ class HeldRows:
                 blocks=self.blocks,
                 gram=self.gram,
                 labels=labels,
+                serial=self.serial,
             )
         W, y, g = self._used()
         _checks.finite("regressor", W)
-        return _weighted(W, y, weights.of_rows(g), rtol, std, max_std_percent, labels)
+        w = weights.of_rows(g)
+        return _weighted(W, y, w, rtol, std, max_std_percent, labels, self.serial)
 
     def residuals(
         self, beta: NDArray[np.float64], per_row: bool
@@ -293,10 +304,18 @@ def _weighted(
     std: StdMethod,
     max_std_percent: float | None,
     labels: tuple[str, ...] | None,
+    serial: Serial | None = None,
 ) -> LeastSquaresFit:
-    """The fit of ``diag(w) W beta = diag(w) y`` with the unweighted residual statistics."""
+    """The fit of ``diag(w) W beta = diag(w) y`` with the unweighted residual statistics
+    (the HAC covariance, ``serial``, of the weighted rows: the weighted sandwich)."""
     fit = _fit_with_pruning(
-        W * w[:, None], y * w, max_std_percent=max_std_percent, rtol=rtol, std=std, labels=labels
+        W * w[:, None],
+        y * w,
+        max_std_percent=max_std_percent,
+        rtol=rtol,
+        std=std,
+        labels=labels,
+        serial=serial,
     )
     e = y - W @ fit.beta
     ss, ny = float(e @ e), float(np.linalg.norm(y))

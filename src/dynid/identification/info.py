@@ -125,7 +125,7 @@ class IdentificationInfo:
     pruned : tuple of str
         Labels of the coefficients removed above ``max_std_percent``.
     max_std_percent : float or None
-    std : {"classical", "robust"} or None
+    std : {"classical", "robust", "hac"} or None
         How the standard deviations were estimated (``std=``, ``--std``; the file's
         ``std_estimator``).
     estimator : str

@@ -18,7 +18,11 @@ Statistics:
 * or, with ``std="robust"``, the heteroscedasticity-consistent covariance (White
   1980, HC1) ``m / (m - r) (W^T W)^{-1} W^T diag(e^2) W (W^T W)^{-1}``, valid when the
   rows' errors differ in size: the static data stack kg m^2 and N m, and a relative error
-  scales with each entry.
+  scales with each entry;
+* or, with ``std="hac"``, the heteroskedasticity-and-autocorrelation-consistent one
+  (Newey and West 1987) over the samples of each piece of a recording
+  (:mod:`dynid.identification.serial`, ``serial=``): a filtered, decimated log's residual
+  is correlated over several samples. Without a time structure it is HC1.
 
 Method: corrected semi-normal equations (Björck 1987) for a tall ``W`` whose scaled
 condition number is at most 100, Householder QR with column pivoting otherwise (short,
@@ -44,6 +48,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from .. import _checks
 from ..exceptions import NonFiniteError, RankDeficientError, ShapeError
+from .serial import Serial, serial_meat
 from .solvers import (
     STD_METHODS,
     StdMethod,
@@ -67,6 +72,7 @@ __all__ = [
     "conditioning_advice",
     "fit_least_squares",
     "fit_with_pruning",
+    "hac_covariance",
     "unexcited_combinations",
 ]
 
@@ -194,6 +200,7 @@ def fit_least_squares(
     kept: ArrayLike | None = None,
     rtol: float = 1e-10,
     std: StdMethod = "classical",
+    serial: Serial | None = None,
 ) -> LeastSquaresFit:
     """Least-squares estimate of ``beta`` in ``W beta = y`` with its statistics.
 
@@ -207,9 +214,13 @@ def fit_least_squares(
         Columns to use (others are fixed to 0).
     rtol : float
         Relative rank tolerance on the diagonal of R of the column-scaled ``W``.
-    std : {"classical", "robust"}
+    std : {"classical", "robust", "hac"}
         ``"classical"``: ``sigma^2 (W^T W)^{-1}`` (Gaz et al. 2019); ``"robust"``: the
-        heteroscedasticity-consistent (HC1) estimate, for rows of unequal error variance.
+        heteroscedasticity-consistent (HC1) estimate, for rows of unequal error variance;
+        ``"hac"``: also consistent for errors correlated in time (``serial``).
+    serial : Serial, optional
+        The rows' samples and pieces and the HAC window (``std="hac"``); default one row
+        a sample, window 0 (HC1).
 
     Raises
     ------
@@ -222,7 +233,7 @@ def fit_least_squares(
         gives the rank found and the rank needed.
     """
     W, y = _validated(W, y, std)
-    return _fit(W, y, kept=kept, rtol=rtol, std=std)
+    return _fit(W, y, kept=kept, rtol=rtol, std=std, serial=serial)
 
 
 def _validated(
@@ -251,13 +262,15 @@ def _fit(
     blocks: ArrayLike | None = None,
     gram: NDArray[np.float64] | None = None,
     labels: tuple[str, ...] | None = None,
+    serial: Serial | None = None,
 ) -> LeastSquaresFit:
     """:func:`fit_least_squares` on validated ``W`` (M, r) and ``y`` (M,).
 
     ``blocks`` (k, 3) of ``(start, stop, first)`` selects the rows used, ``start:stop``
     for each block, and states that ``W[start:stop, :first]`` is exactly zero, so that the
     products over the rows skip those columns (default: every row, one block, ``first``
-    0). ``gram``, when given, is ``W^T W`` over the rows used (r, r).
+    0). ``gram``, when given, is ``W^T W`` over the rows used (r, r). ``serial``: the
+    time structure of the rows used (``std="hac"``).
     """
     M, r = W.shape
     if blocks is None:
@@ -312,6 +325,8 @@ def _fit(
                     redundant=tuple(str(kl[i]) for i in exc.redundant) if kl else (),
                 ) from None
     rank, cond, bk, e, cov_s, scale, cond_u, vmin = solved
+    if std == "hac":
+        cov_s = _hac(cov_s, float(e @ e), serial_meat(Wk, blk, e, serial or Serial()), scale, m)
     if not (np.all(np.isfinite(bk)) and np.all(np.isfinite(e)) and np.all(np.isfinite(cov_s))):
         k = int(np.argmax(np.abs(yu)))
         raise NonFiniteError(
@@ -321,6 +336,32 @@ def _fit(
         )
     ny = float(np.linalg.norm(yu))
     return assembled(keep, bk, cov_s, scale, float(e @ e), ny, m, rank, cond, cond_u, vmin, rtol)
+
+
+def hac_covariance(
+    gi: NDArray[np.float64], meat: NDArray[np.float64], scale: NDArray[np.float64], m: int
+) -> NDArray[np.float64]:
+    """The HAC covariance of the column-scaled coefficients: ``m / (m - r) G^-1 M G^-1``
+    from ``gi`` (r, r) the inverse Gram matrix of the scaled columns and ``meat`` (r, r)
+    the unscaled middle factor (:mod:`dynid.identification.serial`)."""
+    rk = gi.shape[0]
+    mt = meat / np.outer(scale, scale)
+    return np.asarray(gi @ mt @ gi * (m / max(m - rk, 1)), dtype=np.float64)
+
+
+def _hac(
+    cov_s: NDArray[np.float64],
+    ss: float,
+    meat: NDArray[np.float64],
+    scale: NDArray[np.float64],
+    m: int,
+) -> NDArray[np.float64]:
+    """:func:`hac_covariance` from a solver's classical covariance ``cov_s`` (``G^-1``
+    times ``ss / (m - r)``, ``ss`` the residual sum of squares)."""
+    if not ss > 0:  # an exact fit: no residual, no spread
+        return np.zeros_like(cov_s)
+    gi = cov_s * (max(m - cov_s.shape[0], 1) / ss)
+    return hac_covariance(gi, meat, scale, m)
 
 
 def assembled(
@@ -390,16 +431,17 @@ def fit_with_pruning(
     rtol: float = 1e-10,
     std: StdMethod = "classical",
     labels: tuple[str, ...] | None = None,
+    serial: Serial | None = None,
 ) -> LeastSquaresFit:
     """Fit, then (optionally) remove coefficients with ``std_percent > max_std_percent`` and re-fit.
 
     Gaz et al. 2019 discard coefficients whose relative standard deviation exceeds 30 %.
-    One removal pass, as in the paper. ``std`` as in :func:`fit_least_squares`;
-    ``labels`` (r,) name the columns in a rank-deficiency error.
+    One removal pass, as in the paper. ``std`` and ``serial`` as in
+    :func:`fit_least_squares`; ``labels`` (r,) name the columns in a rank-deficiency error.
     """
     W, y = _validated(W, y, std)
     return _fit_with_pruning(
-        W, y, max_std_percent=max_std_percent, rtol=rtol, std=std, labels=labels
+        W, y, max_std_percent=max_std_percent, rtol=rtol, std=std, labels=labels, serial=serial
     )
 
 
@@ -413,10 +455,11 @@ def _fit_with_pruning(
     blocks: ArrayLike | None = None,
     gram: NDArray[np.float64] | None = None,
     labels: tuple[str, ...] | None = None,
+    serial: Serial | None = None,
 ) -> LeastSquaresFit:
-    """:func:`fit_with_pruning` on validated input; ``blocks``, ``gram``, ``labels`` as in
-    :func:`_fit`."""
-    fit = _fit(W, y, rtol=rtol, std=std, blocks=blocks, gram=gram, labels=labels)
+    """:func:`fit_with_pruning` on validated input; ``blocks``, ``gram``, ``labels``,
+    ``serial`` as in :func:`_fit`."""
+    fit = _fit(W, y, rtol=rtol, std=std, blocks=blocks, gram=gram, labels=labels, serial=serial)
     if max_std_percent is None:
         return fit
     keep = ~(fit.std_percent > max_std_percent)
@@ -431,4 +474,5 @@ def _fit_with_pruning(
         blocks=blocks,
         gram=gram,
         labels=labels,
+        serial=serial,
     )

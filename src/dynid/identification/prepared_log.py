@@ -36,6 +36,7 @@ from .sanity import (
     too_few_samples,
     velocity_noise_std,
 )
+from .serial import Serial, hac_lag
 
 __all__ = ["PreparedLog", "prepare_torque_log"]
 
@@ -125,6 +126,17 @@ class PreparedLog(TorqueRoute):
     def frozen_columns(self, columns: ModelColumns) -> NDArray[np.bool_]:
         """The viscous and Coulomb columns of the joints (motors) that never move."""
         return still_columns(columns, self.still)
+
+    @property
+    def lag(self) -> int:
+        """The HAC window [samples] of its residual (:func:`~.serial.hac_lag` of the
+        cut-off at the decimated rate)."""
+        return hac_lag(self.cutoff_hz, self.sample_rate_hz / self.decimate)
+
+    @property
+    def serial(self) -> Serial:
+        """One piece of samples of ``n`` rows, window :attr:`lag`."""
+        return Serial(self.n, self.lag)
 
     def blocks(self, robot: Robot, columns: ModelColumns) -> Iterator[RegressorBlock]:
         """One block (:func:`log_blocks`); several when the log is too long to stack."""

@@ -75,6 +75,7 @@ from .sanity import (
     spike_finding,
     velocity_noise_std,
 )
+from .serial import Serial, serial_of_pieces
 from .streaming import streams
 from .trim import common_cutoff, edge_seconds, within_edges
 
@@ -240,6 +241,13 @@ class Recordings(TorqueRoute):
     def frozen_columns(self, columns: ModelColumns) -> NDArray[np.bool_]:
         """The friction columns of the joints (motors) that never move in any piece."""
         return still_columns(columns, self.still)
+
+    @property
+    def serial(self) -> Serial:
+        """The pieces of :meth:`blocks` in order, samples of ``n`` rows, the longest of
+        their HAC windows: a window never spans two pieces."""
+        p = self.pieces
+        return serial_of_pieces([x.log.n_samples for x in p], self.n, [x.lag for x in p])
 
     @property
     def measured(self) -> bool:

@@ -486,7 +486,7 @@ def identify_recordings(
     decimate: int | None = None,
     drive: Drive | None = None,
     estimator: EstimatorName | Estimator = "ols",
-    std: StdMethod = "classical",
+    std: StdMethod = "hac",
     max_std_percent: float | None = None,
     rtol: float | None = None,
     folds: int = DEFAULT_FOLDS,
@@ -527,8 +527,9 @@ def identify_recordings(
         The drive train the logs were recorded through (:mod:`dynid.model.drive`); default:
         link-side torques of a direct drive.
     estimator, std
-        Least squares (:mod:`dynid.identification.estimators`); ``"classical"`` or
-        ``"robust"`` standard deviations (:func:`~dynid.identification.core.identify`).
+        Least squares (:mod:`dynid.identification.estimators`); ``"hac"`` (default),
+        ``"robust"`` or ``"classical"`` standard deviations
+        (:func:`~dynid.identification.core.identify`).
     max_std_percent : float, optional
         Remove coefficients with a larger relative standard deviation [%] and re-fit.
     rtol : float, optional

@@ -28,9 +28,11 @@ __all__ = [
 ]
 
 #: How the standard deviations are estimated (``std=``, ``--std``): ``"classical"``
-#: ``sigma^2 (W^T W)^{-1}`` (Gaz et al. 2019) or ``"robust"``, heteroscedasticity-consistent
-#: (White 1980, HC1).
-StdMethod = Literal["classical", "robust"]
+#: ``sigma^2 (W^T W)^{-1}`` (Gaz et al. 2019), ``"robust"``, heteroscedasticity-consistent
+#: (White 1980, HC1), or ``"hac"``, heteroskedasticity-and-autocorrelation-consistent over
+#: the samples of each piece of a recording (Newey and West 1987,
+#: :mod:`dynid.identification.serial`; HC1 for rows without a time structure).
+StdMethod = Literal["classical", "robust", "hac"]
 
 #: The values of :data:`StdMethod` (the choices of ``--std``).
 STD_METHODS: tuple[StdMethod, ...] = get_args(StdMethod)
@@ -308,7 +310,7 @@ def _solve_semi_normal(
     dof = max(m - rk, 1)
     Rinv = scipy.linalg.solve_triangular(R, np.eye(rk), check_finite=False)
     Gi = Rinv @ Rinv.T
-    if std == "classical":
+    if std != "robust":  # "hac": from this by the caller (least_squares._fit)
         cov_s = Gi * (float(e @ e) / dof)
     else:  # HC1: (R^T R)^{-1} D^{-1} W^T diag(e^2) W D^{-1} (R^T R)^{-1}
         meat = meat / scale[:, None] / scale[None, :]
@@ -386,7 +388,7 @@ def _solve_qr(
     sigma = np.sqrt(ss / dof)
     Rinv = scipy.linalg.solve_triangular(R, np.eye(rk))
     G = Rinv @ Rinv.T
-    if std == "classical":
+    if std != "robust":  # "hac": from this by the caller (least_squares._fit)
         cov_p = G * sigma**2
     else:  # HC1: (R^T R)^{-1} Ws^T diag(e^2) Ws (R^T R)^{-1}, in pivoted order
         We = Wk * e[:, None]

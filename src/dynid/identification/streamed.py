@@ -20,7 +20,8 @@ from numpy.typing import NDArray
 from ..exceptions import DataError, NonFiniteError, RankDeficientError
 from .engine import fit_rows
 from .estimators import Estimator, Weights
-from .least_squares import LeastSquaresFit, StdMethod, assembled
+from .least_squares import LeastSquaresFit, StdMethod, assembled, hac_covariance
+from .serial import Serial, SerialMeat
 from .solvers import _conditioning, unexcited_columns, unexcited_combinations
 from .streaming import (
     BlockSource,
@@ -127,11 +128,15 @@ def _meat(
     beta: NDArray[np.float64],
     keep: NDArray[np.bool_],
     weights: Callable[[int, NDArray[np.intp]], NDArray[np.float64]] | None,
+    serial: Serial | None = None,
 ) -> NDArray[np.float64]:
     """``Ww^T diag(ew^2) Ww`` over the kept columns, ``Ww`` the weighted rows and ``ew``
-    the weighted residual of ``beta`` (one pass; HC1's middle factor)."""
+    the weighted residual of ``beta`` (one pass; HC1's middle factor), or with ``serial``
+    the HAC one (:class:`~dynid.identification.serial.SerialMeat`, the last scores of a
+    piece carried from block to block)."""
     rk = int(keep.sum())
     meat = np.zeros((rk, rk))
+    acc = None if serial is None else SerialMeat(serial, rk)
     o = 0
     for W, y, g in _blocks(source):
         Wk = W[:, keep]
@@ -140,9 +145,12 @@ def _meat(
             w = weights(o, g)
             Wk, e = Wk * w[:, None], e * w
         We = Wk * e[:, None]
-        meat += We.T @ We
+        if acc is None:
+            meat += We.T @ We
+        else:
+            acc.add(We)
         o += y.size
-    return meat
+    return meat if acc is None else acc.result()
 
 
 def _fit_factor(
@@ -163,9 +171,8 @@ def _fit_factor(
     dof = max(m - rk, 1)
     if std == "classical":
         cov_s = s.gi * (s.ss / dof)
-    else:
-        mt = meat(s.beta, keep) / np.outer(s.scale, s.scale)
-        cov_s = s.gi @ mt @ s.gi * (m / dof)
+    else:  # HC1 or HAC: the middle factor ``meat`` gives
+        cov_s = hac_covariance(s.gi, meat(s.beta, keep), s.scale, m)
     if not (np.all(np.isfinite(s.beta)) and np.all(np.isfinite(cov_s)) and np.isfinite(s.ss)):
         raise NonFiniteError(
             "least squares overflowed: the data or the regressor hold values too large to be "
@@ -228,6 +235,8 @@ class BlockRows:
     labels : ndarray of int, shape (m,), optional
         Labels of the rows whose unweighted normal equations the first pass gathers too
         (``factors.normals``: the folds of a held-out judgement, no pass of their own).
+    serial : Serial, optional
+        The samples and pieces of the rows (``std="hac"``; default: rows independent).
     """
 
     #: A pass computes the rows again.
@@ -240,8 +249,10 @@ class BlockRows:
         by_group: bool,
         per_row: bool,
         labels: NDArray[np.intp] | None = None,
+        serial: Serial | None = None,
     ) -> None:
         self.source = source
+        self.serial = serial
         self._by_group = by_group
         self._per_row = per_row
         self._labels = labels
@@ -276,15 +287,16 @@ class BlockRows:
         """The fit of the weighted rows, unweighted residual statistics (the engine's)."""
         F = self.factors
         kw = {"rtol": rtol, "std": std, "max_std_percent": max_std_percent, "labels": labels}
+        ser = (self.serial or Serial()) if std == "hac" else None
         if weights is None:
-            meat = lambda b, k: _meat(self.source, b, k, None)  # noqa: E731
+            meat = lambda b, k: _meat(self.source, b, k, None, ser)  # noqa: E731
             return _fit_pruned(F.combined(), F.n_rows, meat=meat, **kw)  # type: ignore[arg-type]
         w = weights
         if w.group is not None:
             factor = F.combined(w.group)
         else:
             factor = _weighted_factor(self.source, lambda o, g: w.of_rows(g, o), F.n_columns)
-        meat = lambda b, k: _meat(self.source, b, k, lambda o, g: w.of_rows(g, o))  # noqa: E731
+        meat = lambda b, k: _meat(self.source, b, k, lambda o, g: w.of_rows(g, o), ser)  # noqa: E731
         fit = _fit_pruned(factor, F.n_rows, meat=meat, **kw)  # type: ignore[arg-type]
         return _unweighted(fit, F)
 
@@ -325,9 +337,11 @@ def fit_streamed(
     std: StdMethod = "classical",
     max_std_percent: float | None = None,
     labels: tuple[str, ...] | None = None,
+    serial: Serial | None = None,
 ) -> LeastSquaresFit:
     """Fit ``W beta = y`` with an estimator over the blocks of ``source``: the engine
-    (:func:`~dynid.identification.engine.fit_rows`) on :class:`BlockRows`.
+    (:func:`~dynid.identification.engine.fit_rows`) on :class:`BlockRows` (``serial``: the
+    rows' time structure, for ``std="hac"``).
 
     The estimates and statistics are those of the same estimator on the rows stacked, to
     rounding.
@@ -343,7 +357,7 @@ def fit_streamed(
     RankDeficientError
         Rank below the column count.
     """
-    rows = BlockRows(source, by_group=estimator.weighted, per_row=estimator.per_row)
+    rows = BlockRows(source, by_group=estimator.weighted, per_row=estimator.per_row, serial=serial)
     return fit_rows(
         rows, estimator, rtol=rtol, std=std, max_std_percent=max_std_percent, labels=labels
     )

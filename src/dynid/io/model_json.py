@@ -350,7 +350,7 @@ _BASE = Record(
 _META = Record(
     {
         "route": Field("string", nullable=True, choices=("static", "classical")),
-        "std_estimator": Field("string", nullable=True, choices=("classical", "robust")),
+        "std_estimator": Field("string", nullable=True, choices=("classical", "robust", "hac")),
         "friction_law": Field("string", choices=tuple(FRICTION_LAWS)),
         "friction_std": Field("numbers", null_items=True),
         "friction_band": Field("numbers", null_items=True),

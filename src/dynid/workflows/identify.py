@@ -7,7 +7,7 @@ command applies, so that the Python API behaves as the command does.
 * Static data: configurations outside the joint limits and a relative error far above
   the recorded noise level are :class:`~dynid.exceptions.DynidWarning` warnings.
 * ``std`` (standard deviations) is honoured on both routes (default: robust for static
-  data, classical for torque logs); the consistent fit refuses it and ``max_std_percent``,
+  data, hac for torque logs); the consistent fit refuses it and ``max_std_percent``,
   which do not apply to it, and the prior, its weight, objective, margin and mass band
   apply to the consistent fit only (:class:`IdentifyOptions`).
 * The column map the data were read with is recorded in the model (``info.column_map``).
@@ -332,7 +332,7 @@ def _identify(robot: Robot, paths: list[Path], opt: IdentifyOptions) -> Identifi
             max_gap_s=opt.max_gap_s,
             drive=opt.drive,
             estimator=opt.estimator,
-            std=opt.std or "classical",
+            std=opt.std or "hac",
             cutoff_hz="auto" if opt.cutoff_hz is None else opt.cutoff_hz,
             **heldout,
         )

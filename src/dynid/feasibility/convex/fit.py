@@ -196,6 +196,7 @@ def identify_consistent(
             decimate=decimate,
             drive=drive,
             estimator=estimator,
+            std="classical",  # the data term is the residual itself: sigma^2 (W^T W)^-1
             rtol=rtol,
             folds=folds,
             validate_on=validate_on,
