@@ -294,3 +294,23 @@ def test_validate_reads_a_log_in_other_units_than_the_models(tmp_path, caplog):
     assert "the model's data were read with" in caplog.text
     assert errors[1] == pytest.approx(errors[0], rel=1e-9)
     assert errors[0] < 5.0
+
+
+def test_a_header_with_units_is_refused_with_the_map_that_reads_it(tmp_path):
+    """'q1 [rad]' headers: the refusal names the --columns map, and that map reads the log
+    back to its values (a header with units was refused without a way out)."""
+    from dynid.io.torque_log import load_torque_log
+
+    log = _log(4, n=2, N=50)
+    names = ["t [s]", "q1 [rad]", "q2 [rad]", "dq1 [rad/s]", "dq2 [rad/s]"]
+    names += ["tau1 (Nm)", "tau2 (Nm)"]
+    data = np.column_stack([log.t, log.q, log.dq, log.tau])
+    path = tmp_path / "units.csv"
+    np.savetxt(path, data, delimiter=",", header=",".join(names), comments="", fmt="%.17g")
+    with pytest.raises(DataError, match="hint: names with units") as err:
+        load_torque_log(path)
+    spec = str(err.value).split("--columns '")[1].split("'")[0]
+    assert spec == "t=t [s],q=q{i} [rad],dq=dq{i} [rad/s],tau=tau{i} (Nm)"
+    got = load_mapped_torque_log(path, parse_column_map(spec, None)).log
+    for k in ("t", "q", "dq", "tau"):
+        np.testing.assert_array_equal(getattr(got, k), getattr(log, k))

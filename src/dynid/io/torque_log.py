@@ -395,6 +395,20 @@ def _read_npz(path: Path) -> dict[str, NDArray[np.float64]]:
     return arrays
 
 
+def _annotated_hint(names: list[str]) -> str:
+    """A hint for a header whose names carry units (``q1 [rad]``, ``tau1 (Nm)``): the
+    ``--columns`` map that reads them (``q=q{i} [rad]``), or nothing."""
+    found: dict[str, str] = {}
+    for c in names:
+        m = re.fullmatch(r"(t|q|dq|tau|ddq)([1-9]\d*)?(\s*[\[(].*[\])])", c.strip())
+        if m and m.group(1) not in found and (m.group(1) == "t") == (m.group(2) is None):
+            found[m.group(1)] = m.group(1) + ("{i}" if m.group(2) else "") + m.group(3)
+    if "t" not in found or "q" not in found:
+        return ""
+    spec = ",".join(f"{k}={found[k]}" for k in ("t", "q", "dq", "tau", "ddq") if k in found)
+    return f"; hint: names with units are read by --columns '{spec}' (and --units if not SI)"
+
+
 def _columns(path: Path, names: list[str], line: int) -> tuple[int, bool]:
     """Check the header; return the joint count n and whether ddq columns are present."""
     at = f"line {line}"
@@ -408,7 +422,7 @@ def _columns(path: Path, names: list[str], line: int) -> tuple[int, bool]:
     if "t" not in names or n == 0:
         raise DataError(
             f"header must name columns t, q1..qn, dq1..dqn, tau1..taun; "
-            f"got {names[:8]}{' ...' if len(names) > 8 else ''}",
+            f"got {names[:8]}{' ...' if len(names) > 8 else ''}{_annotated_hint(names)}",
             file=path.name,
             at=at,
         )
