@@ -246,7 +246,7 @@ def friction_residual(
     p = prepare_log(log, prep)
     assert p.ddq is not None  # prepare_log always fills ddq
     tau_m = torques_through(model, d, p.q, p.dq, p.ddq)
-    noise = _checks.frozen(velocity_noise_std(log.dq))
+    noise = _checks.frozen(velocity_noise_std(log.dq, log.t))
     return FrictionResidual(log=p, tau_model=tau_m, residual=p.tau - tau_m, dq_noise_std=noise)
 
 

@@ -394,7 +394,7 @@ def _noise_std(pieces: list[TorqueLog]) -> NDArray[np.float64]:
     var, w = [], []
     for p in pieces:
         if p.n_samples >= 8:
-            var.append(velocity_noise_std(p.dq) ** 2)
+            var.append(velocity_noise_std(p.dq, p.t) ** 2)
             w.append(p.n_samples)
     if not var:
         return _checks.frozen(np.zeros(pieces[0].n))

@@ -233,6 +233,10 @@ class HeldOut:
         noise (every joint counts in units of its own noise: a wrist whose noise is a
         hundredth of the shoulder's is not lost in the pooled error); empty when the
         noise is not known.
+    judged : Normals or None
+        With a separate log: all of the identification data with the targets the separate
+        log is judged on (the measured torques), where the training error is read; None:
+        ``whole``.
     """
 
     train: tuple[Normals, ...]
@@ -241,6 +245,7 @@ class HeldOut:
     scheme: str
     noise: float = 1.0
     whitened: tuple[Normals, ...] = ()
+    judged: Normals | None = None
 
     @classmethod
     def k_fold(cls, blocks: Sequence[Normals], test: Sequence[Normals] | None = None) -> HeldOut:
@@ -254,9 +259,11 @@ class HeldOut:
         return cls(tuple(whole - b for b in blocks), judged, whole, "blocks", _noise(whole))
 
     @classmethod
-    def separate(cls, whole: Normals, test: Normals) -> HeldOut:
-        """One fold: fitted on all of ``whole``, predicting ``test`` (another recording)."""
-        return cls((whole,), (test,), whole, "file", _noise(whole))
+    def separate(cls, whole: Normals, test: Normals, judged: Normals | None = None) -> HeldOut:
+        """One fold: fitted on all of ``whole``, predicting ``test`` (another recording);
+        ``judged``: ``whole``'s rows with the targets ``test`` holds (the measured torques
+        beside the low-passed ones fitted)."""
+        return cls((whole,), (test,), whole, "file", _noise(whole), judged=judged)
 
     @property
     def folds(self) -> int:
@@ -266,10 +273,10 @@ class HeldOut:
     @property
     def judged_whole(self) -> Normals:
         """All of the data with the targets the folds are judged on (the measured torques
-        when :meth:`k_fold` was given them; ``whole`` for a separate log): the training
-        error is read on it, so that it compares with the held-out error."""
+        when :meth:`k_fold` or :meth:`separate` was given them, else ``whole``): the
+        training error is read on it, so that it compares with the held-out error."""
         if self.scheme == "file":
-            return self.whole
+            return self.whole if self.judged is None else self.judged
         out = self.test[0]
         for t in self.test[1:]:
             out = out + t
@@ -289,6 +296,7 @@ class HeldOut:
             self.scheme,
             self.noise,
             tuple(t.restricted(columns) for t in self.whitened),
+            None if self.judged is None else self.judged.restricted(columns),
         )
 
     def expanded(self, mask: NDArray[np.bool_]) -> HeldOut:
@@ -300,6 +308,7 @@ class HeldOut:
             self.scheme,
             self.noise,
             tuple(t.expanded(mask) for t in self.whitened),
+            None if self.judged is None else self.judged.expanded(mask),
         )
 
     def heldout_error_percent(

@@ -80,7 +80,9 @@ def heldout_judge(
             fitted = lambda: iter([(W, stack.y, stack.groups)])  # noqa: E731
         if validation is not None:
             test, test_white = _normals(robot, validation, columns, cols)
-            held = HeldOut.separate(normals(np.zeros(m, np.intp))[0], test)
+            one = np.zeros(m, np.intp)  # the training error on the torques as measured too
+            whole = normals_by_label_scaled(rows, one)[0][0] if measured_ok else None
+            held = HeldOut.separate(normals(one)[0], test, whole)
             held = held if test_white is None else replace(held, whitened=(test_white,))
         elif labels is None:
             return None

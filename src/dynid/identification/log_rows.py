@@ -7,7 +7,8 @@ Khalil), and the known rotor torques of a drive are subtracted from the targets.
 
 from __future__ import annotations
 
-from collections.abc import Iterator
+from collections.abc import Callable, Iterator
+from functools import partial
 
 import numpy as np
 from numpy.typing import NDArray
@@ -59,6 +60,7 @@ def log_blocks(
     cutoff_hz: float | None = None,
     upsample: int = 1,
     edges: tuple[TorqueLog | None, TorqueLog | None] = (None, None),
+    stamps: NDArray[np.float64] | None = None,
 ) -> Iterator[RegressorBlock]:
     """The regressor rows of a prepared log over ``columns``: sample-major (row ``k n + j``
     is sample ``k``, joint ``j``, its noise group ``j``); known rotor torques of
@@ -72,8 +74,10 @@ def log_blocks(
     reversal, and ``sign(dq)`` left sharp would bias every friction coefficient, as would
     a step placed on the decimated samples or a filter that does not see the samples
     trimmed before and after the log (``edges``: prepared alike; a 1 kHz log decimated to
-    100 Hz: rotor inertias off by 2-3 % on exact data). The rows equal those of the log
-    filtered whole, in blocks too."""
+    100 Hz: rotor inertias off by 2-3 % on exact data). ``stamps``: the instants [s] the
+    log was measured at when they were not uniform (its torques interpolated linearly onto
+    the grid before the low-pass): the stepping columns are computed there and
+    interpolated alike. The rows equal those of the log filtered whole, in blocks too."""
     assert log.ddq is not None  # prepare_log always fills ddq
     N, n = log.n_samples, log.n
     drive = columns.drive
@@ -94,7 +98,7 @@ def log_blocks(
                 lo, hi = a, min(N, a + max(step, STEP_SPAN))
                 held = stepped_filtered(
                     columns.appended, (edges[0], log, edges[1]), steps[columns.base.rank :],
-                    cutoff_hz, upsample, slice(lo, hi),
+                    cutoff_hz, upsample, slice(lo, hi), stamps,
                 )  # fmt: skip
             Y[..., steps] = held[a - lo : a - lo + Y.shape[0]]
         if drive is not None and drive.rotor_inertia is not None:  # known: subtracted
@@ -117,6 +121,7 @@ def stepped_filtered(
     cutoff_hz: float,
     upsample: int,
     rows: slice,
+    stamps: NDArray[np.float64] | None = None,
 ) -> NDArray[np.float64]:
     """The columns ``steps`` (c,) of the appended ``terms`` at the prepared samples
     ``rows`` of a log, computed as its torques were filtered. ``logs``: the samples trimmed
@@ -124,10 +129,12 @@ def stepped_filtered(
     step. The states are interpolated (cubic spline of the low-passed, hence band-limited,
     signals) onto ``upsample`` times that rate, the columns computed there and low-passed
     at ``cutoff_hz`` (:func:`parallel_filtered`), then every ``upsample``-th sample kept
-    ("parallel filtering and decimation", Gautier and Khalil). Each span of
-    :data:`STEP_SPAN` samples is computed with :data:`_SETTLE_CYCLES` periods of the
-    cut-off on either side, where the filter has forgotten the window's edges.
-    (m, n, steps.sum())."""
+    ("parallel filtering and decimation", Gautier and Khalil). A log measured at the
+    instants ``stamps`` [s] (not uniform: its torques were interpolated linearly onto the
+    grid) has its columns computed at those instants and interpolated so too, which puts
+    a reversal's step where the torques have it. Each span of :data:`STEP_SPAN` samples is
+    computed with :data:`_SETTLE_CYCLES` periods of the cut-off on either side, where the
+    filter has forgotten the window's edges. (m, n, steps.sum())."""
     from scipy.interpolate import CubicSpline  # here: a robot model loads no scipy
 
     head, log, tail = logs
@@ -143,12 +150,19 @@ def stepped_filtered(
         e = min(b + h, s + STEP_SPAN)
         lo, hi = max(0, s - pad), min(total, e + pad)
         tw, x = _joined(logs, lo, hi)
-        if k > 1 and hi - lo > 1:
-            fine = tw[0] + np.arange((hi - lo - 1) * k + 1) * (1.0 / (k * rate))
+        fine = tw[0] + np.arange((hi - lo - 1) * k + 1) * (1.0 / (k * rate))
+        onto = None
+        if stamps is not None and hi - lo > 1:  # the columns where the torques were measured
+            i0 = max(int(np.searchsorted(stamps, fine[0], side="right")) - 1, 0)
+            i1 = int(np.searchsorted(stamps, fine[-1], side="left")) + 1
+            at = stamps[i0:i1]
+            x = CubicSpline(tw, x, axis=0)(at)
+            onto = partial(_interpolated, at, fine)
+        elif k > 1 and hi - lo > 1:
             x = CubicSpline(tw, x, axis=0)(np.minimum(fine, tw[-1]))
         states = (x[:, :n], x[:, n : 2 * n], x[:, 2 * n :])
         keep = slice((s - lo) * k, (e - lo - 1) * k + 1, k)  # the span's prepared samples
-        got = [_filtered_columns(t, states, cutoff_hz, k * rate, keep) for t in terms]
+        got = [_filtered_columns(t, states, cutoff_hz, k * rate, keep, onto) for t in terms]
         out[s - h - a : e - h - a] = np.concatenate(got, axis=-1)[..., steps]
     return out
 
@@ -159,17 +173,21 @@ def _filtered_columns(
     cutoff_hz: float,
     rate: float,
     keep: slice,
+    onto: Callable[[NDArray[np.float64]], NDArray[np.float64]] | None = None,
 ) -> NDArray[np.float64]:
-    """A term's columns (m, n, p) at the samples ``keep`` of ``states`` (the fine grid at
-    ``rate`` [Hz]), those that step low-passed there first (:func:`parallel_filtered`);
-    zeros for a term without such columns. Friction's parts are filtered per motor before
-    they are placed (a linear map), not its mostly zero columns."""
-    m = len(range(*keep.indices(states[0].shape[0])))
+    """A term's columns (m, n, p) at the samples ``keep`` of the fine grid at ``rate``
+    [Hz], those that step low-passed there first (:func:`parallel_filtered`); zeros for a
+    term without such columns. ``states`` are on that grid, or at other instants that
+    ``onto`` interpolates a column from onto it. Friction's parts are filtered per motor
+    before they are placed (a linear map), not its mostly zero columns."""
+    if onto is None:
+        onto = _same
+    m = len(range(*keep.indices(onto(states[0][:, :1]).shape[0])))
     steps = np.asarray(getattr(term, "steps", np.zeros(len(term.labels), bool)), dtype=bool)
     if not steps.any():
         return np.zeros((m, states[0].shape[1], len(term.labels)))
     if isinstance(term, LinearFriction):
-        P = term.part_columns(term.drive.motor_velocities(states[1]))  # (M, n, k)
+        P = onto(term.part_columns(term.drive.motor_velocities(states[1])))  # (M, n, k)
         stepping = np.array([p in ("coulomb", "smooth", "stribeck") for p in term.parts])
         flat = P[..., stepping].reshape(P.shape[0], -1)
         flat = parallel_filtered(flat[:, None, :], np.ones(flat.shape[1], bool), None,
@@ -177,7 +195,7 @@ def _filtered_columns(
         Pk = P[keep]
         Pk[..., stepping] = flat[keep].reshape(m, P.shape[1], -1)
         return term.placed(Pk)
-    A = term.torque_columns(*states)
+    A = onto(term.torque_columns(*states))
     flat = A.reshape(A.shape[0], -1)  # the signals (joint, column), a view
     used = np.flatnonzero(np.tile(steps, A.shape[1]) & flat.any(axis=0))
     sig = parallel_filtered(flat[:, used][:, None, :], np.ones(used.size, bool), None,
@@ -185,6 +203,23 @@ def _filtered_columns(
     got = np.array(flat[keep])
     got[:, used] = sig[keep]
     return got.reshape(m, A.shape[1], -1)
+
+
+def _same(x: NDArray[np.float64]) -> NDArray[np.float64]:
+    """``x`` as it is (columns already on the fine grid)."""
+    return x
+
+
+def _interpolated(
+    at: NDArray[np.float64], grid: NDArray[np.float64], x: NDArray[np.float64]
+) -> NDArray[np.float64]:
+    """``x`` (M, ...) at the instants ``at`` (M,) [s] interpolated linearly onto ``grid``
+    (G,): as :func:`dynid.signals.resample_uniform` puts a log's torques on its grid."""
+    flat = x.reshape(x.shape[0], -1)
+    out = np.empty((grid.shape[0], flat.shape[1]))
+    for c in range(flat.shape[1]):
+        out[:, c] = np.interp(grid, at, flat[:, c])
+    return out.reshape((grid.shape[0],) + x.shape[1:])
 
 
 def _joined(

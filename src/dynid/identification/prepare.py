@@ -28,8 +28,11 @@ __all__ = [
     "PREPARE_BLOCK_SAMPLES",
     "SETTLE_CYCLES",
     "Preprocessing",
+    "at_instants",
     "at_measured_samples",
+    "measured_instants",
     "measured_torques",
+    "nearest_samples",
     "prepare_log",
     "prepared_blocks",
     "resamples",
@@ -191,15 +194,49 @@ def prepared_blocks(
 
 def measured_torques(log: TorqueLog, prep: Preprocessing = _DEFAULT) -> NDArray[np.float64]:
     """The torques [N m] (M, n) at the samples of :func:`prepare_log` ``(log, prep)`` as
-    measured: resampled as it resamples a log that is not uniform, not low-passed,
-    ``prepare_log(log, replace(prep, filter_tau=False)).tau`` without preparing the other
-    signals (``prep.filter_tau`` is not read)."""
+    measured, not low-passed: of a log that is not uniform, those of the measured sample
+    nearest each (:func:`measured_instants`; :func:`at_instants` moves the prepared states
+    there), not interpolated between two (``prep.filter_tau`` is not read)."""
     plan = _plan(log, prep)
     idx = np.asarray(plan.out)
     if plan.uniform:
         return np.array(log.tau[idx])
-    ts = plan.t[idx]
-    return np.stack([np.interp(ts, log.t, log.tau[:, j]) for j in range(log.n)], axis=1)
+    return np.array(log.tau[nearest_samples(plan.t[idx], log.t)])
+
+
+def nearest_samples(t: NDArray[np.float64], stamps: NDArray[np.float64]) -> NDArray[np.intp]:
+    """The index (M,) of the instant of ``stamps`` (N,) [s], increasing, nearest each time
+    of ``t`` (M,) [s] (the earlier one on a tie)."""
+    i = np.clip(np.searchsorted(stamps, t), 1, max(stamps.shape[0] - 1, 1))
+    return np.where(t - stamps[i - 1] <= stamps[i] - t, i - 1, i).astype(np.intp)
+
+
+def measured_instants(t: NDArray[np.float64], stamps: NDArray[np.float64]) -> NDArray[np.float64]:
+    """The measured instants [s] (M,) the prepared times ``t`` (M,) are judged at: the
+    instant of ``stamps`` nearest each (:func:`nearest_samples`; next to a dropped sample
+    two prepared times may share one)."""
+    return stamps[nearest_samples(t, stamps)]
+
+
+def at_instants(p: TorqueLog, t: NDArray[np.float64]) -> TorqueLog:
+    """The prepared log ``p`` (uniform, with ``ddq``) with its positions, velocities and
+    accelerations moved to the instants ``t`` (one per sample, each within about a step of
+    the sample's own) by their Taylor series to the third derivative (read by central
+    differences of ``ddq``); its times and torques as they are (the torques: those
+    measured at ``t``; the times keep the samples' order where two share an instant).
+    The error is of order ``(2 pi f dt)^2`` of ``ddq`` for a motion of frequency ``f``
+    moved by ``dt``: 1e-4 at 1 Hz and 2 ms, where a linear step reads 1 %."""
+    assert p.ddq is not None  # prepare_log always fills ddq
+    d = (np.asarray(t, dtype=np.float64) - p.t)[:, None]
+    dddq = np.gradient(p.ddq, p.t, axis=0) if p.n_samples > 1 else np.zeros_like(p.ddq)
+    return TorqueLog(
+        t=p.t,
+        q=p.q + d * (p.dq + d / 2 * (p.ddq + d / 3 * dddq)),
+        dq=p.dq + d * (p.ddq + d / 2 * dddq),
+        tau=p.tau,
+        ddq=p.ddq + d * dddq,
+        cleaning=p.cleaning,
+    )
 
 
 def resamples(log: TorqueLog, prep: Preprocessing = _DEFAULT) -> bool:

@@ -27,7 +27,7 @@ from .dataset import ModelColumns, RegressorBlock, TorqueRoute
 from .info import IdentificationInfo, LogInfo
 from .log import LogCleaning, TorqueLog, joint_side_log
 from .log_rows import log_blocks, still_columns, still_friction
-from .prepare import Preprocessing, measured_torques, prepare_log, trimmed_margins
+from .prepare import Preprocessing, measured_torques, prepare_log, resamples, trimmed_margins
 from .rate import cutoff_from_motion, decimation, motion_frequency
 from .sanity import (
     check_torque_log,
@@ -80,6 +80,12 @@ class PreparedLog(TorqueRoute):
         step (:func:`~dynid.identification.prepare.trimmed_margins`): the parallel
         filtering of the columns that step at a reversal reads them near the ends; None
         without filtering or for a margin of fewer than 2 samples.
+    stamps : ndarray, shape (N,), or None
+        The instants [s] the raw log was measured at, when they were not uniform (the
+        log resampled onto a grid): the stepping columns are computed there and
+        interpolated onto the grid as the torques were, and the held-out judgement reads
+        each prepared sample at its own measured instant
+        (:func:`~dynid.identification.prepare.measured_instants`). None otherwise.
     """
 
     log: TorqueLog
@@ -98,6 +104,7 @@ class PreparedLog(TorqueRoute):
     tau_raw: NDArray[np.float64] | None = None
     head: TorqueLog | None = None
     tail: TorqueLog | None = None
+    stamps: NDArray[np.float64] | None = None
 
     @property
     def n(self) -> int:
@@ -152,6 +159,7 @@ class PreparedLog(TorqueRoute):
             "cutoff_hz": self.cutoff_hz,
             "upsample": self.decimate,
             "edges": (self.head, self.tail),
+            "stamps": self.stamps,
         }
 
     def record(self, n_rows: int) -> IdentificationInfo:
@@ -232,12 +240,13 @@ def prepare_torque_log(
         raise ShapeError(f"decimate must be >= 1; got {decimate}")
     prep = Preprocessing(cutoff_hz=cutoff_hz, trim_s=trim_s, max_gap_s=max_gap_s, decimate=k)
     prepared = prepare_log(jlog, prep)
-    raw = None
+    raw = stamps = None
     head = tail = None
     if cutoff_hz is not None:  # the torques as measured at the same samples
         raw = measured_torques(jlog, prep)
         head, tail = trimmed_margins(jlog, prep)
-    noise = velocity_noise_std(jlog.tau) if jlog.n_samples >= 3 else None
+        stamps = jlog.t if resamples(jlog, prep) else None
+    noise = velocity_noise_std(jlog.tau, jlog.t) if jlog.n_samples >= 3 else None
     del jlog
     return PreparedLog(
         log=prepared,
@@ -256,4 +265,5 @@ def prepare_torque_log(
         tau_raw=None if raw is None or raw.shape != prepared.tau.shape else raw,
         head=head,
         tail=tail,
+        stamps=stamps,
     )

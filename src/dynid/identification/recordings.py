@@ -65,6 +65,7 @@ from .pieces import (
     unwrapped,
     wrappable,
 )
+from .prepare import at_instants, measured_instants
 from .prepared_log import PreparedLog, prepare_torque_log
 from .rate import CUTOFF_MULTIPLE
 from .sanity import (
@@ -282,6 +283,8 @@ class Recordings(TorqueRoute):
         blocks both pass over them (:mod:`dynid.identification.selection`)."""
         for p in self.pieces:
             log = p.log if p.tau_raw is None else dataclasses.replace(p.log, tau=p.tau_raw)
+            if p.stamps is not None and p.tau_raw is not None:  # at the measured instants
+                log = at_instants(log, measured_instants(log.t, p.stamps))
             yield from log_blocks(robot, log, columns, stream=True, cutoff_hz=None)
 
     def fold_labels(self, folds: int = DEFAULT_FOLDS) -> tuple[NDArray[np.intp], str]:
@@ -575,15 +578,16 @@ def _band(
     larger of the two where both kinds of piece are given."""
     sides = [joint_side_log(p, drive) for p in pieces]
     K = None if drive is None else np.asarray(drive.friction_transmission)
-    measured = [x.dq for x, p in zip(sides, pieces, strict=True) if not p.dq_derived]
+    measured = [x for x, p in zip(sides, pieces, strict=True) if not p.dq_derived]
     n = sides[0].dq.shape[1] if K is None else K.shape[0]
     out = np.zeros(n)
     if measured:
-        dq = measured[0] if len(measured) == 1 else np.concatenate(measured)
+        dq = np.concatenate([x.dq for x in measured])
         if K is not None:
             dq = dq @ K.T
-        if dq.shape[0] >= 8:
-            out = np.asarray(noise_band(velocity_noise_std(dq)), dtype=np.float64)
+        if dq.shape[0] >= 8:  # the times of joined pieces step back: left out there
+            t = np.concatenate([x.t for x in measured])
+            out = np.asarray(noise_band(velocity_noise_std(dq, t)), dtype=np.float64)
     cutoff, lowpassed, gain = derived
     of_q = [
         (x.t, x.q if K is None else x.q @ K.T)

@@ -212,7 +212,7 @@ def _noise(v: Validation, cutoff_hz: float) -> NDArray[np.float64]:
     above the cut-off is no measure of it: it holds the steps of Coulomb friction at every
     reversal (on a UR5 with 3 N m of Coulomb friction it read 3-10 times the noise).
     ``cutoff_hz`` is kept for the signature."""
-    return np.asarray(velocity_noise_std(v.log.tau), dtype=np.float64)
+    return np.asarray(velocity_noise_std(v.log.tau, v.log.t), dtype=np.float64)
 
 
 def _histogram_range(e: NDArray[np.float64], noise: float) -> tuple[float, float]:

@@ -131,8 +131,8 @@ def _overfit_fact(ho: dict, train: float, test: float, at_floor: bool) -> tuple[
     else:
         why = "the fit over-fits"
     fact = (
-        f"Held-out error <b>{percent(test)}</b> {esc(scheme)} (filtered torques, as "
-        f"fitted), training error {percent(train)} (ratio {ratio:.2f}: {why})"
+        f"Held-out error <b>{percent(test)}</b> {esc(scheme)} (the torques as measured), "
+        f"training error {percent(train)} on the same (ratio {ratio:.2f}: {why})"
     )
     if ratio > OVERFIT_FAIR and not at_floor:
         return fact, ["poor"]
@@ -260,8 +260,8 @@ def _consistent_facts(doc: dict, ho: dict) -> tuple[list[str], list[str], str]:
         "recordings": f"leaving out each of {ho.get('folds')} recordings in turn",
     }.get(str(ho.get("scheme")), "on the separate log")
     facts = [
-        f"Held-out error of the consistent fit <b>{percent(test)}</b> {esc(scheme)} (filtered "
-        f"torques, as fitted), training error {percent(train)}; least squares, for "
+        f"Held-out error of the consistent fit <b>{percent(test)}</b> {esc(scheme)} (the "
+        f"torques as measured), training error {percent(train)}; least squares, for "
         f"comparison: held-out {percent(ls_test)}, training {percent(ls_train)}"
     ]
     headline = (

@@ -276,7 +276,7 @@ def _judged(
     var, norm2, N = np.zeros(n), 0.0, 0
     for v in parts:
         if v.log.n_samples >= 3:
-            var += v.log.n_samples * velocity_noise_std(v.log.tau) ** 2
+            var += v.log.n_samples * velocity_noise_std(v.log.tau, v.log.t) ** 2
         norm2 += float(np.sum(v.log.tau**2))
         N += v.log.n_samples
     noise = np.sqrt(var / max(N, 1))
