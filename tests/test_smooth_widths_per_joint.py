@@ -14,9 +14,13 @@ import warnings
 import numpy as np
 import pytest
 
+import dynid
 from dynid.cli.__main__ import main
 from dynid.exceptions import DynidWarning, OptionError
 from dynid.friction.laws import LAWS
+from dynid.friction.recordings import validate_recordings
+from dynid.friction.validation import own_friction
+from dynid.identification.selection import identify_recordings
 from dynid.identification.structure import Structure, structure_terms
 from dynid.io.torque_log import save_torque_log
 from dynid.simulation.measurement import SensorNoise
@@ -32,6 +36,37 @@ def _truth(widths: np.ndarray):
     n = widths.size
     P = np.column_stack([np.linspace(0.3, 0.1, n), np.linspace(2.0, 0.5, n), np.zeros(n)])
     return LAWS["smooth"].model(P, widths)
+
+
+def _chosen(widths: np.ndarray):
+    """The model identified by default from three noisy 10 s recordings of the Panda with
+    that friction, the one of the best single width, and two exact new recordings."""
+    robot = dynid.panda()
+    truth = _truth(widths)
+    logs = recordings(robot, (1, 2, 3), friction=truth, duration=10.0, noise=NOISE)
+    new = recordings(robot, (4, 5), friction=truth, duration=10.0)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", DynidWarning)
+        model = identify_recordings(robot, logs)
+        cands = model.info.selection["candidates"]
+        single = min(
+            (c for c in cands if "/" not in c["name"] and "smooth:" in c["name"]),
+            key=lambda c: c["heldout_whitened_percent"],
+        )
+        one = identify_recordings(robot, logs, structure=Structure.parse(",".join(single["terms"])))
+    return model, one, single, new
+
+
+@pytest.fixture(scope="module")
+def alternating():
+    return _chosen(np.array([SHARP, ROUND] * 3 + [SHARP]))
+
+
+def _new_error(model, new) -> float:
+    """The relative error [%] of ``model`` (its own friction) on exact new recordings."""
+    return float(
+        validate_recordings(model, new, friction=own_friction(model)).errors.relative_error_percent
+    )
 
 
 def test_per_joint_widths_parse_print_and_collapse():
@@ -73,6 +108,30 @@ def test_per_joint_widths_are_each_joint_s_factor_of_its_band():
     band = (0.002, 0.0005, 0.004)
     _, terms = structure_terms(Structure.parse("viscous,smooth:0.3/10/100"), None, 3, band)
     np.testing.assert_allclose(terms[0].width, [0.3 * 0.002, 10 * 0.001, 100 * 0.004])
+
+
+def test_different_widths_are_chosen_per_joint_and_predict_closer_to_the_floor(alternating):
+    """Joints alternately sharp (0.005 rad/s) and round (0.1 rad/s): the default search
+    chooses a width per joint, wider on every round joint than on every sharp one, whose
+    held-out error is nearer the noise floor than the best single width's, and which
+    predicts exact new recordings better than that width does."""
+    model, one, single, new = alternating
+    chosen = Structure.parse(",".join(model.info.extra["terms"]))
+    w = np.array(chosen.widths(7))
+    assert min(w[1::2]) > max(w[0::2]), w
+    sel = model.info.selection
+    mine = next(c for c in sel["candidates"] if c["name"] == sel["chosen"])
+    floor = model.info.heldout["noise_floor_percent"]
+    assert mine["heldout_error_percent"] - floor < 0.5 * (single["heldout_error_percent"] - floor)
+    assert _new_error(model, new) < 0.6 * _new_error(one, new)
+
+
+def test_equal_widths_keep_one_width():
+    """Every joint at 0.005 rad/s: the per-joint search keeps one width for all (the
+    chosen structure holds no per-joint width)."""
+    model, _, _, _ = _chosen(np.full(7, SHARP))
+    chosen = Structure.parse(",".join(model.info.extra["terms"]))
+    assert not isinstance(chosen.width, tuple), chosen.name
 
 
 def test_per_joint_widths_given_with_terms_come_back_through_validate(panda, tmp_path):

@@ -2,7 +2,8 @@
 
 A joint-torque log of a real arm holds more than the rigid links: the rotors' inertia
 (an armature ``I_a ddq`` per joint, or the rotors of a drive), viscous and Coulomb friction,
-torque offsets, friction laws with a shape (a smooth Coulomb's width, a Stribeck velocity).
+torque offsets, friction laws with a shape (a smooth Coulomb's width, one for every joint
+or one per joint, and a Stribeck velocity).
 A :class:`Structure` names the terms: ``armature`` (per joint ``I_a ddq`` without a drive,
 the drive's rotor inertias with one) and the parts of the joint (motor) friction
 (:data:`~dynid.regressors.terms.FRICTION_PARTS`); :func:`structure_terms` makes its model
