@@ -16,7 +16,8 @@ standard error of the best** (the one-standard-error rule of cross-validation: H
 Tibshirani and Friedman, *The Elements of Statistical Learning*, 2nd ed., Sec. 7.10),
 the standard error being that of the difference of the two candidates' errors paired
 over the folds (:func:`~dynid.identification.candidates.paired_se`), and differences
-under 1 % of the lowest error counting as ties.
+under 1 % of the lowest error counting as ties. A smooth Coulomb's width is then chosen
+per joint (:mod:`dynid.identification.widths`).
 The folds leave one recording out at a time when there are several, contiguous time
 blocks otherwise (:meth:`~dynid.identification.recordings.Recordings.fold_labels`), or
 judge on a separate recording. A recording that holds what no candidate models is left
@@ -384,9 +385,9 @@ def _widths_per_joint(
     where: dict[Structure, _Key],
 ) -> list[Candidate]:
     """Smooth Coulomb widths per joint (:func:`~.widths.per_joint_widths`) from the smooth
-    candidate (banded Stribeck bump aside: its bumps are of one width) with the lowest
-    held-out error and from the one chosen, each among the widths of its regressor; the
-    candidates reached where they differ from where they started."""
+    candidate with the lowest held-out error and from the one chosen (not the smooth-sign
+    Stribeck law: its bumps are judged at one width), each among the widths of its
+    regressor; the candidates reached where they differ from where they started."""
     smooth = [
         c
         for c in _physical(judged)
