@@ -17,6 +17,8 @@ import pytest
 
 import dynid
 from dynid.cli.__main__ import main
+from dynid.cli.structure_table import selection_lines
+from dynid.cli.summaries import term_lines
 from dynid.exceptions import DynidWarning, OptionError
 from dynid.friction.laws import LAWS
 from dynid.friction.model import LawFriction
@@ -137,6 +139,17 @@ def test_different_widths_are_chosen_per_joint_and_predict_closer_to_the_floor(a
     floor = model.info.heldout["noise_floor_percent"]
     assert mine["heldout_error_percent"] - floor < 0.5 * (single["heldout_error_percent"] - floor)
     assert _new_error(model, new) < 0.6 * _new_error(one, new)
+
+
+def test_the_summary_names_the_widths_chosen_per_joint(alternating):
+    """The choice line and the marked row of the structure table name the widths per
+    joint, and the friction table says each joint's width is its own factor."""
+    model = alternating[0]
+    name = model.info.selection["chosen"]
+    lines = selection_lines(model.info.selection)
+    assert "/" in name and name in lines[0]
+    assert any(line.startswith(f"  * {name} ") for line in lines), lines
+    assert any("K_j x max(band_j" in line for line in term_lines(model)), term_lines(model)
 
 
 def test_a_geared_arm_s_motors_get_their_own_widths():
