@@ -16,20 +16,20 @@ filtered, differentiated and decimated on its own and never joined to another; o
 cut-off serves all. Continuous joints recorded wrapped into [-pi, pi] are unwrapped.
 A log without velocity columns gets its velocities from the positions at that cut-off.
 
-Model structure. Beside the links' base parameters a torque log may need an armature
-(I_a ddq per joint; with a drive file, the rotor inertias at the motors), viscous and
-Coulomb friction (sign(dq) off inside each joint's velocity noise band, or a smooth
-tanh(dq/w) at seven widths w from 0.3 to 300 bands, the narrowest about the velocity
-noise), a Stribeck bump exp(-(dq/vst)^2) at seven Stribeck velocities from 0.02 to
-0.2 rad/s (on the banded sign or on the narrowest smooth one), and torque offsets, each
+Model structure. Beside the links' base parameters a torque log may need an armature (I_a
+ddq per joint; with a drive file, the rotor inertias at the motors), viscous and Coulomb
+friction (sign(dq) off inside each joint's velocity noise band, or a smooth tanh(dq/w) at
+seven widths w from 0.3 to 300 bands, the narrowest about the velocity noise, then chosen
+per joint), a Stribeck bump exp(-(dq/vst)^2) at seven Stribeck velocities from 0.02 to 0.2
+rad/s (on the banded sign or on the narrowest smooth one), and torque offsets, each
 identified with the links. By default every combination is fitted and judged on data it
 was not fitted to (one recording left out at a time when there are several, else --folds
 contiguous time blocks, or --validate-on), with every joint's torques in units of its own
 noise, and the simplest within one standard error of the lowest held-out error (of the
 difference, paired over the folds) is kept. The summary prints the table of candidates
 (each smooth or Stribeck law at its best shape) and the choice, and the terms'
-coefficients per joint; identification.json records them all. --terms fixes the structure by hand
-(e.g. --terms armature,viscous,coulomb,offset).
+coefficients per joint; identification.json records them all. --terms fixes the structure
+by hand (e.g. --terms armature,viscous,coulomb,offset).
 
 Checks that the data belong to --robot: a static data file that records another robot
 (name, joint count or kinematics) is an error; configurations outside the joint limits,
@@ -151,11 +151,11 @@ def register(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParser:
         help="torque logs: the model's terms beside the links, comma-separated from armature, "
         "viscous, quadratic, coulomb, smooth[:W], stribeck[:V], offset, "
         "at:motor|at:joint|at:both, -LABEL ('links' for none; W the smooth Coulomb's width in "
-        "standstill bands, V the Stribeck velocity [rad/s]; at: where a coupled drive's "
-        "friction acts, both: at the motors and at the joints no motor turns alone; -fo3 leaves "
-        "joint 3's offset out, -fc5 joint 5's Coulomb friction, -Ia2 joint 2's armature); "
-        "default: chosen on held-out "
-        "data (see Model structure above)",
+        "standstill bands, or one per joint as W1/W2/..., V the Stribeck velocity [rad/s]; "
+        "at: where a coupled drive's friction acts, both: at the motors and at the joints no "
+        "motor turns alone; -fo3 leaves joint 3's offset out, -fc5 joint 5's Coulomb "
+        "friction, -Ia2 joint 2's armature); default: chosen on held-out data (see Model "
+        "structure above)",
     )
     add_column_options(p)
     p.add_argument("--out", type=output_path, required=True, help="output folder")

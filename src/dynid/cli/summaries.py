@@ -164,9 +164,12 @@ def _scales_lines(scales: dict[str, tuple[float, ...]], model: IdentifiedModel) 
     if "width" in scales:
         given = [str(x) for x in model.info.extra.get("terms", ()) if str(x).startswith("smooth")]
         k = given[0].split(":")[1] if given and ":" in given[0] else "K"
+        each = "/" in k  # one width per joint: smooth:K1/K2/..
         out.append(
-            f"  width: the smooth Coulomb fc tanh(dq / width), smooth:{k} = {k} x max(band, "
-            f"{MIN_WIDTH:g} rad/s)"
+            f"  width: the smooth Coulomb fc tanh(dq / width), smooth:{k} = "
+            + ("K_j x max(band_j, " if each else f"{k} x max(band, ")
+            + f"{MIN_WIDTH:g} rad/s)"
+            + (" per joint j" if each else "")
         )
     return out
 

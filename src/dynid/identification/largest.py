@@ -35,6 +35,8 @@ from .structure import (
     Structure,
     largest_terms,
     regressor_group,
+    width_key,
+    width_text,
 )
 
 __all__ = ["Fitted", "LeftOut", "SMOOTH_THINNING", "fit_largest", "recording_bands"]
@@ -208,13 +210,13 @@ def _fit_apart(
     of a width whose own columns the data cannot tell apart stay left out."""
     out: list[Fitted] = []
     smooth = [c for c in left if "smooth" in c.friction and "stribeck" not in c.friction]
-    for w in sorted({c.width for c in smooth}):
+    for w in sorted({c.width for c in smooth}, key=width_key):
         group = [c for c in smooth if c.width == w]
         try:
             model, terms = fit(group, drop)
         except RankDeficientError:
             continue
-        key = (f"{family} " if family else "") + f"smooth:{w:g}"
+        key = (f"{family} " if family else "") + f"smooth:{width_text(w)}"
         out.append((key, model, terms, [c.without(drop) for c in group]))
     return out
 
@@ -378,9 +380,16 @@ def _left_out(
     """The shaped candidates of ``mine`` left out of ``group`` (those of ``apart`` judged in
     regressors of their own)."""
     vst = sorted({c.vst for c in mine if c not in group and c.vst})
-    alone = {c.width for c in apart}
+    alone = {c.width for c in apart if isinstance(c.width, float)}
     widths = sorted(
-        {c.width for c in mine if c not in group and c.friction and "stribeck" not in c.friction}
+        {
+            c.width
+            for c in mine
+            if c not in group
+            and c.friction
+            and "stribeck" not in c.friction
+            and isinstance(c.width, float)
+        }
         - {0.0}
         - alone
     )

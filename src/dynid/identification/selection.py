@@ -16,7 +16,8 @@ standard error of the best** (the one-standard-error rule of cross-validation: H
 Tibshirani and Friedman, *The Elements of Statistical Learning*, 2nd ed., Sec. 7.10),
 the standard error being that of the difference of the two candidates' errors paired
 over the folds (:func:`~dynid.identification.candidates.paired_se`), and differences
-under 1 % of the lowest error counting as ties.
+under 1 % of the lowest error counting as ties. A smooth Coulomb's width is then chosen
+per joint (:mod:`dynid.identification.widths`).
 The folds leave one recording out at a time when there are several, contiguous time
 blocks otherwise (:meth:`~dynid.identification.recordings.Recordings.fold_labels`), or
 judge on a separate recording. A recording that holds what no candidate models is left
@@ -33,7 +34,7 @@ from __future__ import annotations
 
 import copy
 import warnings
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from dataclasses import replace
 from typing import Any, Literal
 
@@ -81,6 +82,7 @@ from .structure import (
     regressor_group,
     structure_terms,
 )
+from .widths import per_joint_widths, regressor_widths
 
 __all__ = [
     "OUTLIER_RATIO",
@@ -192,8 +194,10 @@ def select_structure(
     validation : Recordings, optional
         A separate recording to judge on instead of the folds.
     per_joint : bool
-        Also judge per-joint structures: friction coefficients of single joints left out
-        while the held-out error stays within one standard error of the lowest
+        Also judge per-joint structures: a smooth Coulomb's width per joint
+        (:func:`~dynid.identification.widths.per_joint_widths`), then friction
+        coefficients of single joints left out while the held-out error stays within one
+        standard error of the lowest
         (:attr:`~dynid.identification.structure.Structure.drop`).
 
     Returns
@@ -242,16 +246,12 @@ def select_structure(
     # a smooth law, in the Stribeck law's regressor)
     where = {c: key for c, _, key in columns}
     if per_joint:
-        judged += _per_joint(
-            judged,
-            {
-                g: (m, t, without_recordings(m, skip) if skip else heldout_of(m))
-                for g, (m, t) in groups.items()
-            },
-            robot.n,
-            fit_rtol,
-            where,
-        )
+        by_group = {
+            g: (m, t, without_recordings(m, skip) if skip else heldout_of(m))
+            for g, (m, t) in groups.items()
+        }
+        judged += _widths_per_joint(judged, by_group, robot.n, fit_rtol, where)
+        judged += _per_joint(judged, by_group, robot.n, fit_rtol, where)
     chosen = _chosen(judged)
     notes[:0] = [lo.note(chosen, where.get(chosen)) for lo in left_out]
     best = min(_physical(judged), key=lambda c: c.score)
@@ -375,6 +375,53 @@ def _per_recording(
         use = candidate_columns(chosen, m, t)
         here = _judged(chosen, use, m, t, heldout_of(m), rtol)
     return tuple(zip(names, here.fold_errors_percent, strict=True))
+
+
+def _widths_per_joint(
+    judged: Sequence[Candidate],
+    groups: dict[_Key, tuple[IdentifiedModel, list[tuple[ModelTerm, Any]], HeldOut]],
+    n: int,
+    rtol: float,
+    where: dict[Structure, _Key],
+) -> list[Candidate]:
+    """Smooth Coulomb widths per joint (:func:`~.widths.per_joint_widths`) from the smooth
+    candidate with the lowest held-out error and from the one chosen (not the smooth-sign
+    Stribeck law: its bumps are judged at one width), each among the widths of its
+    regressor; the candidates reached where they differ from where they started."""
+    smooth = [
+        c
+        for c in _physical(judged)
+        if "smooth" in c.structure.friction and "stribeck" not in c.structure.friction
+    ]
+    if not smooth:
+        return []
+    chosen = _chosen(judged)
+    starts = [min(smooth, key=lambda c: c.score), *[c for c in smooth if c.structure == chosen]]
+    out: list[Candidate] = []
+    for start in dict.fromkeys(starts):
+        group = groups[where[start.structure]]
+        reached = per_joint_widths(
+            start, regressor_widths(group[1]), n, _judge_in(group, rtol), _better
+        )
+        if reached is not start and reached.structure not in [c.structure for c in out]:
+            where[reached.structure] = where[start.structure]
+            out.append(reached)
+    return out
+
+
+def _judge_in(
+    group: tuple[IdentifiedModel, list[tuple[ModelTerm, Any]], HeldOut], rtol: float
+) -> Callable[[Structure], Candidate]:
+    """A structure judged on the folds of the regressor ``group`` (its model, terms and
+    folds)."""
+    model, terms, held = group
+    return lambda s: _judged(s, candidate_columns(s, model, terms), model, terms, held, rtol)
+
+
+def _better(c: Candidate, than: Candidate) -> bool:
+    """Whether ``c`` predicts held-out data better than ``than`` beyond one standard
+    error of the difference (``than`` not :func:`_within` it)."""
+    return not _within(than, c)
 
 
 def _per_joint(

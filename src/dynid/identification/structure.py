@@ -2,7 +2,8 @@
 
 A joint-torque log of a real arm holds more than the rigid links: the rotors' inertia
 (an armature ``I_a ddq`` per joint, or the rotors of a drive), viscous and Coulomb friction,
-torque offsets, friction laws with a shape (a smooth Coulomb's width, a Stribeck velocity).
+torque offsets, friction laws with a shape (a smooth Coulomb's width, one for every joint
+or one per joint, and a Stribeck velocity).
 A :class:`Structure` names the terms: ``armature`` (per joint ``I_a ddq`` without a drive,
 the drive's rotor inertias with one) and the parts of the joint (motor) friction
 (:data:`~dynid.regressors.terms.FRICTION_PARTS`); :func:`structure_terms` makes its model
@@ -52,6 +53,8 @@ __all__ = [
     "largest_terms",
     "smooth_width",
     "structure_terms",
+    "width_key",
+    "width_text",
 ]
 
 #: Held-out errors [%] closer than this count as equal: the folds are judged through their
@@ -117,8 +120,10 @@ class Structure:
         The parts of the friction per joint (motor) held, linear in their coefficients
         (:data:`~dynid.regressors.terms.FRICTION_PARTS`: ``viscous``, ``coulomb``,
         ``smooth``, ``stribeck``, ``offset``); empty for none.
-    width : float
-        With ``smooth``: its width in multiples of each joint's standstill band.
+    width : float or tuple of float
+        With ``smooth``: its width in multiples of each joint's (motor's) standstill band,
+        one for every joint, or one per joint (motor) in order (a tuple whose widths are
+        all equal is the one width: ``(3, 3)`` is ``3``).
     vst : float
         With ``stribeck``: the Stribeck velocity [rad/s].
     at : {"", "motor", "joint", "both"}
@@ -139,7 +144,7 @@ class Structure:
 
     armature: bool = False
     friction: tuple[str, ...] = _CLASSICAL
-    width: float = 0.0
+    width: float | tuple[float, ...] = 0.0
     vst: float = 0.0
     at: str = ""
     drop: tuple[str, ...] = ()
@@ -158,7 +163,8 @@ class Structure:
         parts = tuple(p for p in FRICTION_PARTS if p in self.friction)
         if "smooth" in parts and "coulomb" in parts:
             raise OptionError(": smooth replaces coulomb; give one of them", field="terms")
-        if "smooth" in parts and not self.width > 0:
+        object.__setattr__(self, "width", _one_or_per_joint(self.width))
+        if "smooth" in parts and not self.width:
             object.__setattr__(self, "width", 1.0)
         if "stribeck" in parts and not self.vst > 0:
             object.__setattr__(self, "vst", 0.05)
@@ -233,6 +239,30 @@ class Structure:
             self, armature=armature, friction=tuple(parts), drop=tuple(drop), width=width, vst=vst
         )
 
+    def widths(self, n: int) -> tuple[float, ...]:
+        """The smooth Coulomb's width [bands] of each of ``n`` joints (motors).
+
+        Raises
+        ------
+        OptionError
+            Widths per joint given for another number of joints.
+        """
+        if isinstance(self.width, float):
+            return (self.width,) * n
+        if len(self.width) != n:
+            raise OptionError(
+                f"--terms smooth:{width_text(self.width)}: {len(self.width)} widths for {n} "
+                "joints (motors); give one width, or one per joint separated by '/'"
+            )
+        return self.width
+
+    def with_width(self, joint: int, width: float, n: int) -> Structure:
+        """The same structure with the smooth Coulomb of ``joint`` (0-based, of ``n``) at
+        ``width`` [bands], the other joints' as they are."""
+        w = list(self.widths(n))
+        w[joint] = float(width)
+        return replace(self, width=tuple(w))
+
     def armature_mask(self, n: int) -> tuple[bool, ...]:
         """Which of the ``n`` rotor inertias the armature holds: all but :attr:`drop`
         (``Ia3``); empty when every one is.
@@ -302,7 +332,7 @@ class Structure:
     @property
     def terms(self) -> tuple[str, ...]:
         """The term names held, e.g. ``("armature", "viscous", "smooth:3")``."""
-        shape = {"smooth": f"smooth:{self.width:g}", "stribeck": f"stribeck:{self.vst:g}"}
+        shape = {"smooth": f"smooth:{width_text(self.width)}", "stribeck": f"stribeck:{self.vst:g}"}
         where = (f"at:{self.at}",) if self.at and self.friction else ()
         return (
             (("armature",) if self.armature else ())
@@ -321,8 +351,9 @@ class Structure:
     @classmethod
     def parse(cls, text: str) -> Structure:
         """From ``"armature,viscous,coulomb"`` (``"links"`` or ``""`` for none);
-        ``smooth:W`` gives the smooth Coulomb's width in standstill bands, ``stribeck:V``
-        the Stribeck velocity [rad/s], ``at:joint`` or ``at:motor`` where the friction acts.
+        ``smooth:W`` gives the smooth Coulomb's width in standstill bands (``smooth:W1/W2/..``
+        one per joint or motor), ``stribeck:V`` the Stribeck velocity [rad/s], ``at:joint``
+        or ``at:motor`` where the friction acts.
 
         Raises
         ------
@@ -332,7 +363,7 @@ class Structure:
         text = text.replace(" - ", ",-").replace("+", ",")
         words = [w.strip() for w in text.split(",") if w.strip()]
         words = [w for w in words if w != "links"]
-        shapes: dict[str, float] = {}
+        shapes: dict[str, tuple[float, ...]] = {}
         names = []
         at = ""
         drop = []
@@ -345,21 +376,66 @@ class Structure:
                 drop.append(name[1:].strip())
                 continue
             if value:
-                try:
-                    shapes[name] = float(value)
-                except ValueError:
-                    shapes[name] = -1.0
-                if not shapes[name] > 0 or not math.isfinite(shapes[name]):
-                    raise OptionError(f"{w}: the shape must be a positive number", field="terms")
+                shapes[name] = _shape(w, name, value)
             names.append(name)
         return cls(
             armature="armature" in names,
             friction=tuple(w for w in names if w != "armature"),
-            width=shapes.get("smooth", 0.0),
-            vst=shapes.get("stribeck", 0.0),
+            width=shapes["smooth"] if "smooth" in shapes else 0.0,
+            vst=shapes.get("stribeck", (0.0,))[0],
             at=at,
             drop=tuple(drop),
         )
+
+
+def _shape(word: str, name: str, value: str) -> tuple[float, ...]:
+    """The shape of the term ``word`` (``smooth:0.3/1``): positive numbers, one or (a
+    smooth width) one per joint separated by ``/``.
+
+    Raises
+    ------
+    OptionError
+        A shape that is not a positive number, or several but of a smooth width.
+    """
+    parts = value.split("/")
+    if len(parts) > 1 and name != "smooth":
+        raise OptionError(f"{word}: one shape; only smooth takes one per joint", field="terms")
+    try:
+        out = tuple(float(x) for x in parts)
+    except ValueError:
+        out = (-1.0,)
+    if not all(x > 0 and math.isfinite(x) for x in out):
+        raise OptionError(
+            f"{word}: the shape must be a positive number"
+            + (" (one per joint separated by '/')" if len(parts) > 1 else ""),
+            field="terms",
+        )
+    return out
+
+
+def _one_or_per_joint(width: float | Sequence[float]) -> float | tuple[float, ...]:
+    """A smooth width as :attr:`Structure.width` holds it: one float, or a tuple of floats
+    when they differ."""
+    if isinstance(width, (int, float, np.floating, np.integer)):
+        return float(width)
+    w = tuple(float(x) for x in width)
+    if not all(x > 0 and math.isfinite(x) for x in w) or not w:
+        raise OptionError(
+            f"smooth:{width_text(w)}: the widths must be positive numbers", field="terms"
+        )
+    return w[0] if len(set(w)) == 1 else w
+
+
+def width_text(width: float | Sequence[float]) -> str:
+    """A smooth width as ``--terms`` writes it: ``3``, or ``0.3/1/3`` one per joint."""
+    if isinstance(width, (int, float)):
+        return f"{width:g}"
+    return "/".join(f"{x:g}" for x in width)
+
+
+def width_key(width: float | Sequence[float]) -> tuple[float, ...]:
+    """A sort key of smooth widths, one or per joint."""
+    return (float(width),) if isinstance(width, (int, float)) else tuple(width)
 
 
 def friction_placements(drive: Drive | None) -> tuple[str, ...]:
@@ -438,10 +514,11 @@ def candidate_structures(
     return tuple(out)
 
 
-def smooth_width(band: Sequence[float], factor: float) -> tuple[float, ...]:
-    """The smooth Coulomb's width [rad/s] per joint: ``factor`` standstill bands, at least
-    ``factor`` times :data:`MIN_WIDTH`."""
-    return tuple(factor * max(float(b), MIN_WIDTH) for b in band)
+def smooth_width(band: Sequence[float], factor: float | Sequence[float]) -> tuple[float, ...]:
+    """The smooth Coulomb's width [rad/s] per joint: ``factor`` standstill bands (one for
+    every joint, or one per joint), at least ``factor`` times :data:`MIN_WIDTH`."""
+    k = (factor,) * len(band) if isinstance(factor, (int, float)) else tuple(factor)
+    return tuple(f * max(float(b), MIN_WIDTH) for f, b in zip(k, band, strict=True))
 
 
 def structure_terms(
@@ -474,7 +551,7 @@ def structure_terms(
                 at,
                 parts=structure.friction,
                 band=_times(b, gain),
-                width=smooth_width(_times(b, gain), structure.width)
+                width=smooth_width(_times(b, gain), structure.widths(n))
                 if "smooth" in structure.friction
                 else (),
                 vst=structure.vst,
@@ -488,7 +565,7 @@ def structure_terms(
                     jt,
                     parts=structure.joint_parts,
                     band=_times(jb, gain),
-                    width=smooth_width(_times(jb, gain), structure.width)
+                    width=smooth_width(_times(jb, gain), structure.widths(n))
                     if "smooth" in structure.friction
                     else (),
                     vst=structure.vst,
@@ -593,7 +670,7 @@ def largest_terms(
             prefix=JOINT_PREFIX,
         )
         out.append((t, ("classical", t.parts)))
-    for w in sorted({c.width for c in mine if "smooth" in c.friction}):
+    for w in sorted({w for c in mine if "smooth" in c.friction for w in c.widths(n)}):
         t = LinearFriction(
             at,
             ("smooth",),
@@ -607,17 +684,18 @@ def largest_terms(
             at, ("stribeck",), band=_times(b, gain), vst=v, name=f"friction stribeck {v:g}"
         )
         out.append((t, ("stribeck", v)))
-    for w, v in sorted({(c.width, c.vst) for c in mine if _smooth_stribeck(c)}):
+    bumps = {(c.width, c.vst) for c in mine if _smooth_stribeck(c)}
+    for bw, v in sorted(bumps, key=lambda wv: (width_key(wv[0]), wv[1])):
         t = LinearFriction(
             at,
             ("smooth", "stribeck"),
             band=_times(b, gain),
-            width=smooth_width(_times(b, gain), w),
+            width=smooth_width(_times(b, gain), bw),
             vst=v,
-            name=f"friction smooth {w:g} stribeck {v:g}",
+            name=f"friction smooth {width_text(bw)} stribeck {v:g}",
             mask=(False, True) * n,  # the bump alone: the smooth Coulomb is the term above
         )
-        out.append((t, ("smooth_stribeck", (w, v))))
+        out.append((t, ("smooth_stribeck", (bw, v))))
     if drop:
         out = [(t if what is None else _without(t, drop), what) for t, what in out]
     return model_drive, out
@@ -641,7 +719,7 @@ def regressor_group(c: Structure) -> tuple[bool, str, str]:
     velocities holds close neighbours: together, or with the smooth laws, they would be
     nearly dependent columns, and the data's rank decision would cost every shaped law."""
     if _smooth_stribeck(c):
-        return c.armature, c.at, f"smooth_stribeck:{c.width:g}"
+        return c.armature, c.at, f"smooth_stribeck:{width_text(c.width)}"
     return c.armature, c.at, "stribeck" if _banded_stribeck(c) else ""
 
 
@@ -669,8 +747,10 @@ def candidate_columns(structure: Structure, model: Any, terms: list[tuple[ModelT
         if kind == "classical":
             part = {PART_LABELS[p]: p for p in shape}
             on = np.array([part[_stem(lab)] in structure.friction for lab in t.labels])
-        elif kind == "smooth":
-            on = np.full(len(t.labels), "smooth" in structure.friction and structure.width == shape)
+        elif kind == "smooth":  # one column per joint: those whose width it is
+            held = "smooth" in structure.friction
+            widths = structure.widths(len(t.labels)) if held else ()
+            on = np.array([held and w == shape for w in widths or (0.0,) * len(t.labels)])
         elif kind == "stribeck":
             on = np.full(len(t.labels), _banded_stribeck(structure) and structure.vst == shape)
         else:
