@@ -1,5 +1,6 @@
 """The torques as measured at the prepared samples: what ``prepare_log`` gives with
-``filter_tau=False``, without preparing the other signals."""
+``filter_tau=False`` on uniform stamps, the nearest measured sample's on jittered ones,
+without preparing the other signals."""
 
 from __future__ import annotations
 
@@ -24,5 +25,9 @@ def test_measured_torques_are_prepare_logs_unfiltered_ones(jitter):
     log = simulate_measurement(panda, random_fourier(panda, rng)(t), rng=rng)
     log = TorqueLog(log.t, log.q, log.dq, log.tau)
     prep = Preprocessing(cutoff_hz=6.0, trim_s=0.2, decimate=4)
-    want = prepare_log(log, dataclasses.replace(prep, filter_tau=False)).tau
+    grid = prepare_log(log, dataclasses.replace(prep, filter_tau=False))
+    # uniform: the unfiltered prepared torques; jittered: those of the measured sample
+    # nearest each prepared one (brute force), not a line between two
+    nearest = np.argmin(np.abs(log.t[None, :] - grid.t[:, None]), axis=1)
+    want = grid.tau if jitter == 0.0 else log.tau[nearest]
     np.testing.assert_array_equal(measured_torques(log, prep), want)
