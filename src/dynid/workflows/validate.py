@@ -217,6 +217,7 @@ def validate_files(
         drive=own if drive is None else drive,
         q_start=opt.q_start,
         max_gap_s=opt.max_gap_s,
+        reference=model.equivalent_robot if isinstance(model, IdentifiedModel) else None,
     )
     friction, source = _friction(model, opt.friction, feasible, drive)
 
