@@ -47,6 +47,7 @@ from numpy.typing import NDArray
 from ..exceptions import DataError, DynidWarning, ShapeError
 from ..model.drive import Drive
 from ..model.robot import Robot
+from ..progress import report
 from ..signals import lowpass_noise_gain
 from .core import ModelColumns, RegressorBlock
 from .dataset import TorqueRoute
@@ -550,7 +551,9 @@ def _prepared(
     keys = ("too_short", "trimmed", "decimated", "added")
     gone = {r: dict.fromkeys(keys, 0) for r in range(len(names))}
     said: set[tuple[int, str]] = set()
-    for r, piece in pieces:
+    for k, (r, piece) in enumerate(pieces):
+        several = f", piece {k + 1} of {len(pieces)}" if len(pieces) > 1 else ""
+        report(f"preparing {names[r]}{several}")
         try:
             with _named_findings(names[r] if len(names) > 1 else None, r, said):
                 p = prepare_torque_log(robot, piece, drive=drive, check=False, **kw)
