@@ -9,7 +9,7 @@ SRC = Path(__file__).resolve().parents[1] / "src" / "dynid"
 
 #: Layers in data-flow order (ARCHITECTURE.md, "Layers").
 LAYERS = [
-    {"exceptions", "_checks", "_kernels", "_parallel", "spatial", "signals"},
+    {"exceptions", "_checks", "_kernels", "_parallel", "progress", "spatial", "signals"},
     {"model"},
     {"kinematics"},
     {"dynamics"},

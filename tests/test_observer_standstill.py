@@ -167,6 +167,37 @@ def test_the_calibration_summary_prints_the_residual_the_rule_read_and_the_level
     assert "contact = 1.5 x the largest |r| of the calibration after the standstill margin" in text
 
 
+def test_the_calibration_report_gives_the_thresholds_at_rest_beside_the_moving_ones(case, tmp_path):
+    """The report's headline gave only the thresholds in motion (0.12-0.49 N m on an
+    xArm7), not those of a joint standing still (2.2-3.5 N m): thresholds.json records
+    them (the Coulomb level plus the contact threshold) and the headline names both."""
+    import json
+    import re
+    from pathlib import Path
+
+    from dynid.io.observer_files import load_thresholds, save_observation
+    from dynid.observer.results import LogObservation, ObserveResult
+    from dynid.report import RunSummary, render_html_report
+
+    model, opts, cal, _ = case
+    r = _residual(model, opts, cal)
+    w = standstill_series(model, cal.t, cal.dq, opts)
+    th = calibrate([r], opts, standstill=[w])
+    log = LogObservation(Path("cal.csv"), cal.t, r, None, [], None, None, w)
+    names = [f"j{k}" for k in range(1, 8)]
+    (path,) = save_observation(
+        tmp_path, ObserveResult(model, th, (log,)), joints=names, calibrating=True
+    )
+    rest = np.array(json.loads(path.read_text())["calibration"]["at_rest"])
+    np.testing.assert_allclose(rest, FC + th.contact, rtol=1e-12)
+    np.testing.assert_array_equal(load_thresholds(path).contact, th.contact)  # still read
+    page = render_html_report(RunSummary(command="observe"), {path.name: path})
+    box = re.search(r'<section class="verdict \w+" id="verdict">(.*?)</section>', page, re.S)
+    text = re.sub(r"<[^>]+>", "", box[1])
+    assert f"contact {th.contact.min():.3g}-{th.contact.max():.3g} N m" in text, text
+    assert f"goes undetected below {rest.min():.3g}-{rest.max():.3g} N m" in text, text
+
+
 def test_the_margin_of_a_coupled_drive_is_taken_at_the_motors():
     """Friction at the motors of a coupled drive (K = [[100, 0], [50, 50]], motor 2 turns
     with both joints): each motor's Coulomb level where its own velocity K dq is inside

@@ -49,10 +49,11 @@ class _Stop(Exception):
 
 
 def test_the_consistent_route_warns_each_finding_of_the_data_once(panda, tmp_path, monkeypatch):
-    """Torques in mN m: the consistent route's unconstrained fit (structure chosen on
-    held-out data and fitted as chosen) prepares the log once, so its finding is warned
-    once (it was warned by the selection's fit and again by the final one), and the
-    friction warnings are those of the model kept."""
+    """Torques in mN m read as N m (said with --units tau=Nm: not refused): the consistent
+    route's unconstrained fit (structure chosen on held-out data and fitted as chosen)
+    prepares the log once, so its finding is warned once (it was warned by the selection's
+    fit and again by the final one), and the friction warnings are those of the model
+    kept."""
     log = _log(panda, 3)
     save_torque_log(tmp_path / "neg.csv", type(log)(log.t, log.q, log.dq, 1e3 * log.tau))
     kept = {}
@@ -65,7 +66,8 @@ def test_the_consistent_route_warns_each_finding_of_the_data_once(panda, tmp_pat
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")
         with pytest.raises(_Stop):
-            identify_files(panda, [tmp_path / "neg.csv"], IdentifyOptions(consistent=True))
+            opt = IdentifyOptions(consistent=True, columns=(None, "tau=Nm"))
+            identify_files(panda, [tmp_path / "neg.csv"], opt)
     said = [str(w.message) for w in caught if issubclass(w.category, DynidWarning)]
     assert sum("times the model's gravity torques" in s for s in said) == 1
     assert len(said) == len(set(said)), said
@@ -212,6 +214,40 @@ def test_identify_refuses_a_recording_in_other_units_naming_it(panda, logs, tmp_
     assert main([*argv, str(logs / "rec1.csv"), str(mnm)]) == 2
     err = [s for s in capsys.readouterr().err.splitlines() if s.strip()]
     assert len(err) == 1 and "error: mnm.csv: its torques (RMS) are 1" in err[0], err
+
+
+def test_torques_in_mNm_read_as_Nm_are_refused_on_every_command(panda, logs, tmp_path, capsys):
+    """A recording in mN m without --units: identify fitted a model 1000 times too heavy,
+    with a warning only, and reported it at the noise floor; now identify, validate,
+    friction and observe each refuse it in one line with the hint --units tau=mNm, as a
+    flipped sign or degrees, and --units tau=Nm (the unit said) reads it as it is."""
+    model = tmp_path / "model"
+    argv = ["identify", "--robot", "panda", "--no-figures", "--out", str(model), "--data"]
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", DynidWarning)
+        assert main([*argv, str(logs / "rec1.csv")]) == 0
+    mnm = _rewritten(load_torque_log(logs / "rec2.csv"), tmp_path / "mnm.csv", tau=1000.0)
+    given = ["--model", str(model / "identification.json")]
+    runs = {
+        "identify": ["identify", "--robot", "panda", "--terms", "viscous,coulomb"],
+        "validate": ["validate", *given],
+        "friction": ["friction", *given],
+        "observe": ["observe", *given, "--calibrate"],
+    }
+    capsys.readouterr()
+    for name, run in runs.items():
+        out = ["--no-figures", "--out", str(tmp_path / name), "--data", str(mnm)]
+        assert main([*run, *out]) == 2, name
+        err = [s for s in capsys.readouterr().err.splitlines() if s.strip()]
+        assert len(err) == 1 and re.search(
+            r"error: mnm.csv: the measured torques are 1(\.\d+)?e\+03 times .*--units tau=mNm",
+            err[0],
+        ), err
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", DynidWarning)
+        out = ["--no-figures", "--out", str(tmp_path / "said"), "--data", str(mnm)]
+        assert main([*runs["validate"], *out, "--units", "tau=Nm", "-q"]) == 1  # unusable
+        assert main([*runs["validate"], *out, "--units", "tau=mNm", "-q"]) == 0
 
 
 def test_identify_names_the_recording_its_findings_are_about(panda, logs, tmp_path):

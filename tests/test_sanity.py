@@ -12,7 +12,7 @@ from dynid.dynamics.terms import gravity_torques
 from dynid.exceptions import DataError, DynidWarning
 from dynid.identification.classical import identify_from_log
 from dynid.identification.log import TorqueLog
-from dynid.identification.sanity import check_torque_log, opposite_sign
+from dynid.identification.sanity import check_torque_log, opposite_sign, torque_unit_finding
 from dynid.identification.selection import identify_recordings
 from dynid.simulation.measurement import SensorNoise, sample_times, simulate_measurement
 from dynid.simulation.trajectories import random_fourier
@@ -46,6 +46,26 @@ def test_unit_and_sign_faults_are_named_with_their_remedy(panda_log, change, mat
     """Each fault gives one finding that names the flag that fixes it."""
     found = check_torque_log(dynid.panda(), change(panda_log))
     assert len(found) == 1 and match in found[0]
+
+
+def test_only_a_clean_factor_of_1000_reads_as_torques_in_other_units(panda_log):
+    """Torques in mN m (or kN m) read as N m were warned about only, and fitted; now they
+    are a unit finding (refused by the commands), while a correct log of an arm whose
+    URDF masses are 0.6 or 1.6 times the true ones and a factor of 300 (a wrong model or
+    currents: warned) are not."""
+    robot = dynid.panda()
+    scaled = {
+        k: TorqueLog(panda_log.t, panda_log.q, panda_log.dq, k * panda_log.tau)
+        for k in (1e3, 1.6e3, 1e-3, 300.0)
+    }
+    assert "--units tau=mNm" in torque_unit_finding(robot, scaled[1e3])
+    assert "--units tau=mNm" in torque_unit_finding(robot, scaled[1.6e3])
+    assert "--units tau=1000" in torque_unit_finding(robot, scaled[1e-3])
+    assert torque_unit_finding(robot, scaled[300.0]) is None
+    assert "times the model's gravity torques" in check_torque_log(robot, scaled[300.0])[0]
+    for k in (0.6, 1.6):  # a URDF whose masses (and so inertias) are off
+        off = robot.with_params(k * np.asarray(robot.phi))
+        assert torque_unit_finding(off, panda_log) is None
 
 
 @pytest.mark.filterwarnings("ignore:.*indistinguishable from zero")  # expected: weak coefficients

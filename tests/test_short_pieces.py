@@ -66,6 +66,32 @@ def test_short_pieces_keep_most_samples_with_accurate_derivatives(pieces):
     assert summary["trimmed"] == expected and summary["recorded"] == rows.size
 
 
+def test_dropped_samples_are_counted_as_grid_points_added_not_as_negative_decimation():
+    """A 100 Hz log missing every 25th sample is resampled onto a uniform grid that holds
+    the missing places: the recording lines printed "-84 between the decimated samples";
+    now the grid points added are counted as such, every count is non-negative and the
+    counts add up to the samples used."""
+    from dynid.cli.summaries import recordings_lines
+
+    panda = dynid.panda()
+    rng = np.random.default_rng(7)
+    traj = random_fourier(panda, rng)(sample_times(8.0, 100.0))
+    log = simulate_measurement(panda, traj, rng=rng, noise=SensorNoise.none())
+    dropped = np.arange(12, log.n_samples - 1, 25)
+    rows = np.setdiff1d(np.arange(log.n_samples), dropped)
+    cut = TorqueLog(log.t[rows], log.q[rows], log.dq[rows], log.tau[rows])
+    rec = prepare_recordings(panda, [cut, cut], ["a.csv", "b.csv"], decimate=1)
+    p = rec.pieces[0]
+    inside = (log.t[dropped] >= p.log.t[0]) & (log.t[dropped] <= p.log.t[-1])
+    counts = rec.counts[0]
+    assert counts.added == int(np.sum(inside)) > 0
+    assert counts.decimated == 0 and counts.trimmed > 0
+    assert counts.used == p.log.n_samples == rows.size - counts.trimmed + counts.added
+    line = recordings_lines(rec.summary())[0]
+    assert f"{counts.added} added by resampling onto a uniform grid" in line
+    assert " -" not in line, line
+
+
 def test_the_filter_edge_of_a_smooth_signal_is_as_accurate_as_its_interior():
     """A velocity sinusoid well below the cut-off, 0.4 s long: the acceleration derived
     from its filtered samples within 3e-3 of its amplitude at the end samples and within

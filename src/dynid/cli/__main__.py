@@ -272,6 +272,7 @@ def main(argv: Sequence[str] | None = None) -> int:
 def _main(argv: Sequence[str] | None) -> int:
     from .._checks import one_line
     from ..io.atomic import output_transaction
+    from ..progress import reporting
     from .applies import check_applies, given_options
     from .console import Console, log_to_stderr
     from .run_report import RunRecord, save_run_report
@@ -303,6 +304,7 @@ def _main(argv: Sequence[str] | None) -> int:
             _signals_and_warnings(console),
             output_transaction(),
             _output_set(args, argv) as run,
+            reporting(console.progress_callback()),  # a long run's steps, on a terminal
         ):
             code = int(args._run(args, console) or 0)
             if run is not None and run.kind == "folder":

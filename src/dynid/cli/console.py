@@ -15,14 +15,20 @@ from __future__ import annotations
 
 import logging
 import sys
-from collections.abc import Mapping
+import time
+from collections.abc import Callable, Mapping
 from typing import Any
 
 from .._checks import text as as_text
 from ..io.json_files import dumps
 from .run_report import RunRecord
 
-__all__ = ["Console", "LogFormat", "log_to_stderr"]
+__all__ = ["PROGRESS_AFTER_S", "PROGRESS_EVERY_S", "Console", "LogFormat", "log_to_stderr"]
+
+#: Progress lines (:meth:`Console.progress_callback`) start once a run has taken this long
+#: [s], and come at most one every :data:`PROGRESS_EVERY_S` [s].
+PROGRESS_AFTER_S = 3.0
+PROGRESS_EVERY_S = 2.0
 
 
 class Console:
@@ -75,6 +81,30 @@ class Console:
     def progress(self, text: str) -> None:
         """A progress line on stderr (flushed); nothing with ``-q``."""
         self._write(f"{text}\n", stdout=False)
+
+    def progress_callback(self) -> Callable[[str], None] | None:
+        """A renderer of the library's progress (:mod:`dynid.progress`) for a long run:
+        ``dynid CMD: <step> (12 s)`` on stderr once the run has taken
+        :data:`PROGRESS_AFTER_S`, at most one line every :data:`PROGRESS_EVERY_S`; None
+        with ``-q`` or when stderr is not a terminal (a file or a pipe gets no lines that
+        depend on the machine's speed; ``excite``'s bar alike)."""
+        try:
+            tty = bool(sys.stderr.isatty())
+        except (AttributeError, ValueError):  # no stream, or a closed one
+            tty = False
+        if self.quiet or not tty:
+            return None
+        start = time.monotonic()
+        last = [start - PROGRESS_EVERY_S]
+
+        def show(step: str) -> None:
+            now = time.monotonic()
+            if now - start < PROGRESS_AFTER_S or now - last[0] < PROGRESS_EVERY_S:
+                return
+            last[0] = now
+            self.progress(f"dynid {self.command}: {step} ({now - start:.0f} s)")
+
+        return show
 
     def note(self, message: str) -> None:
         """``dynid CMD: note: message`` on stderr; nothing with ``-q``."""

@@ -206,10 +206,18 @@ _LOST = (
 
 def _lost(rec: Any) -> str:
     """`` of 820 recorded: 274 trimmed at the pieces' ends (...), ...`` (empty when the
-    record does not count them)."""
+    record does not count them), with the points a uniform grid added to resampled
+    pieces."""
     if "recorded" not in rec:
         return ""
     parts = [f"{rec[k]} {why}" for k, why in _LOST if rec.get(k)]
+    added = rec.get("added", 0)
+    if added:  # the uniform grid of resampled pieces holds the dropped samples' places
+        parts.append(
+            f"{added} added by resampling onto a uniform grid (the places of dropped samples)"
+            if added > 0
+            else f"{-added} fewer on the uniform grid they were resampled onto"
+        )
     return f" of {rec['recorded']} recorded" + (": " + ", ".join(parts) if parts else "")
 
 

@@ -44,6 +44,7 @@ from ..identification.recordings import common_cutoff
 from ..identification.sanity import anticorrelated
 from ..model.drive import Drive
 from ..model.robot import Robot
+from ..progress import report
 from .fit import TorqueModel, model_drive, torques_through
 from .model import Friction, FrictionModel, FrictionSum, combined, robot_friction
 
@@ -286,6 +287,7 @@ def _validated_blocks(
     N = 0
     for p in blocks:
         assert p.ddq is not None  # prepare_log always fills ddq
+        report(f"predicting the torques: {N + p.n_samples:,} samples")
         if not sums:
             n = p.n
             sums = {k: np.zeros(n) for k in ("tau", "model", "sum")}

@@ -30,6 +30,7 @@ __all__ = [
     "Preprocessing",
     "at_instants",
     "at_measured_samples",
+    "grid_samples",
     "measured_instants",
     "measured_torques",
     "nearest_samples",
@@ -237,6 +238,14 @@ def at_instants(p: TorqueLog, t: NDArray[np.float64]) -> TorqueLog:
         ddq=p.ddq + d * dddq,
         cleaning=p.cleaning,
     )
+
+
+def grid_samples(log: TorqueLog, prep: Preprocessing = _DEFAULT) -> int:
+    """Samples :func:`prepare_log` keeps within the trimmed edges before decimation, on the
+    grid it reads ``log`` on: its own samples, or the uniform grid it resamples them onto
+    (which holds the places of dropped samples too)."""
+    out = _plan(log, prep).out
+    return out.stop - out.start
 
 
 def resamples(log: TorqueLog, prep: Preprocessing = _DEFAULT) -> bool:

@@ -47,6 +47,7 @@ from numpy.typing import NDArray
 from ..exceptions import DataError, DynidWarning, ShapeError
 from ..model.drive import Drive
 from ..model.robot import Robot
+from ..progress import report
 from ..signals import lowpass_noise_gain
 from .core import ModelColumns, RegressorBlock
 from .dataset import TorqueRoute
@@ -65,7 +66,7 @@ from .pieces import (
     unwrapped,
     wrappable,
 )
-from .prepare import at_instants, measured_instants
+from .prepare import Preprocessing, at_instants, grid_samples, measured_instants
 from .prepared_log import PreparedLog, prepare_torque_log
 from .rate import CUTOFF_MULTIPLE
 from .sanity import (
@@ -110,9 +111,13 @@ class SampleCounts:
         Samples within the filter's edge transient at the pieces' ends, trimmed
         (:func:`~dynid.signals.edge_seconds`).
     decimated : int
-        Samples between the decimated samples kept.
+        Samples between the decimated samples kept (on the uniform grid of a resampled
+        piece).
+    added : int
+        Points the uniform grid of a resampled piece holds beyond its samples within the
+        trimmed edges: the places of dropped samples (negative: it holds fewer).
     used : int
-        Samples used: ``recorded`` less the others.
+        Samples used: ``recorded`` less the others, plus ``added``.
     """
 
     recorded: int
@@ -120,20 +125,24 @@ class SampleCounts:
     too_short: int = 0
     trimmed: int = 0
     decimated: int = 0
+    added: int = 0
 
     @property
     def used(self) -> int:
         """Samples used."""
-        return self.recorded - self.isolated - self.too_short - self.trimmed - self.decimated
+        lost = self.isolated + self.too_short + self.trimmed + self.decimated
+        return self.recorded - lost + self.added
 
     def as_dict(self) -> dict[str, int]:
-        """``recorded``, ``isolated``, ``too_short``, ``trimmed``, ``decimated``."""
+        """``recorded``, ``isolated``, ``too_short``, ``trimmed``, ``decimated``,
+        ``added``."""
         return {
             "recorded": self.recorded,
             "isolated": self.isolated,
             "too_short": self.too_short,
             "trimmed": self.trimmed,
             "decimated": self.decimated,
+            "added": self.added,
         }
 
 
@@ -536,11 +545,15 @@ def _prepared(
 ) -> tuple[list[PreparedLog], list[int], list[str], dict[int, dict[str, int]]]:
     """Each piece prepared (:func:`~dynid.identification.prepared_log.prepare_torque_log`
     with ``kw``), a piece too short to filter left out with a warning; per recording, the
-    samples left out, trimmed and decimated away."""
+    samples left out, trimmed and decimated away, and the grid points a resampled piece
+    added (:class:`SampleCounts`)."""
     prepared, recording, skipped = [], [], []
-    gone = {r: dict.fromkeys(("too_short", "trimmed", "decimated"), 0) for r in range(len(names))}
+    keys = ("too_short", "trimmed", "decimated", "added")
+    gone = {r: dict.fromkeys(keys, 0) for r in range(len(names))}
     said: set[tuple[int, str]] = set()
-    for r, piece in pieces:
+    for k, (r, piece) in enumerate(pieces):
+        several = f", piece {k + 1} of {len(pieces)}" if len(pieces) > 1 else ""
+        report(f"preparing {names[r]}{several}")
         try:
             with _named_findings(names[r] if len(names) > 1 else None, r, said):
                 p = prepare_torque_log(robot, piece, drive=drive, check=False, **kw)
@@ -551,8 +564,16 @@ def _prepared(
         prepared.append(p)
         recording.append(r)
         kept = within_edges(piece.t, kw["trim_s"] or 0.0)
+        prep = Preprocessing(
+            cutoff_hz=kw["cutoff_hz"],
+            trim_s=kw["trim_s"],
+            max_gap_s=kw["max_gap_s"],
+            decimate=p.decimate,
+        )
+        grid = grid_samples(piece, prep)  # kept, on the uniform grid of a resampled piece
         gone[r]["trimmed"] += piece.n_samples - kept
-        gone[r]["decimated"] += kept - p.log.n_samples
+        gone[r]["added"] += grid - kept
+        gone[r]["decimated"] += grid - p.log.n_samples
     return prepared, recording, skipped, gone
 
 

@@ -10,9 +10,10 @@ with them before fitting (:func:`log_findings`). None of them changes the data.
   model's, refused by ``identify``, ``validate`` and ``observe``: on every loaded joint,
   ``--units tau=-1``; on some, naming them and their torque columns to flip.
 * **Scale**: the least-squares factor ``a`` in ``tau ~ a g(q)`` over the gravity-loaded
-  joints; ``a`` near 1e3 or 1e-3 is a unit off by a power of ten (mN m against N m), and
-  currents logged as torques show as a factor far from 1 (a drive file with
-  ``torque_constant``). Sign and scale compare variations: not made on a log at rest
+  joints; ``a`` near 1e3 or 1e-3 is a unit off by a power of ten (mN m against N m:
+  :func:`torque_unit_finding`, refused by the commands unless ``--units`` names the
+  torques' unit), and currents logged as torques show as a factor far from 1 (a drive
+  file with ``torque_constant``). Sign and scale compare variations: not made on a log at rest
   (every joint frozen), whose variations are noise, nor on a joint whose gravity torques
   span less than :data:`GRAVITY_RANGE_SHARE` of the log's largest (a short stretch, whose
   torque variations are the motion's).
@@ -71,6 +72,8 @@ __all__ = [
     "time_unit_finding",
     "too_few_samples",
     "torque_spikes",
+    "torque_unit_finding",
+    "UNIT_SCALE_TOLERANCE",
     "velocity_noise_std",
     "velocity_rate_factor",
 ]
@@ -92,6 +95,10 @@ GRAVITY_RANGE_SHARE = 0.1
 #: A joint whose torques correlate below this with its gravity torques has the opposite
 #: sign (gravity explains a quarter or more of their variance, with the other sign).
 OPPOSITE_CORRELATION = -0.5
+#: A torque scale (:func:`torque_unit_finding`) within this factor of ``1e3`` or ``1e-3``
+#: reads as torques in mN m or kN m read as N m (a URDF whose masses are off by tens of
+#: percent gives a factor near 1, currents one near the inverse torque constant).
+UNIT_SCALE_TOLERANCE = 2.0
 #: A torque sample this many robust noise levels off both its neighbours is a spike.
 SPIKE_SIGMAS = 20.0
 
@@ -398,26 +405,65 @@ def _sign_and_scale(
 ) -> list[str]:
     if (opposite := _opposite(robot, q, tau, names)) is not None:
         return [opposite]
+    a = _torque_scale(robot, q, tau)
+    if a is not None and (abs(a) > 30 or 0 < abs(a) < 1 / 30):
+        return [_scale_line(a)]
+    return []
+
+
+def _torque_scale(robot: Robot, q: NDArray[np.float64], tau: NDArray[np.float64]) -> float | None:
+    """The least-squares factor ``a`` of ``tau ~ a g(q)`` over the joints gravity loads,
+    their means removed (None when gravity loads none)."""
     centred = _gravity_spread(robot, q, tau)
     if centred is None:
-        return []
+        return None
     gc, tc, loaded = centred
-    out = []
-    a = float(np.sum(gc[:, loaded] * tc[:, loaded]) / np.sum(gc[:, loaded] ** 2))
-    if abs(a) > 30 or 0 < abs(a) < 1 / 30:
-        p = round(math.log10(abs(a)))
-        hint = (
-            "--units tau=mNm"
-            if p == 3
-            else "--units tau=kNm"
-            if p == -3
-            else "currents need a drive file with torque_constant"
-        )
-        out.append(
-            f"the measured torques are {abs(a):.3g} times the model's gravity torques: a unit "
-            f"off by a power of ten, or currents logged as torques; hint: {hint}"
-        )
-    return out
+    return float(np.sum(gc[:, loaded] * tc[:, loaded]) / np.sum(gc[:, loaded] ** 2))
+
+
+def _scale_line(a: float, refused: bool = False) -> str:
+    """The scale finding of factor ``a``, with its hint (and, ``refused``, the way to read
+    the torques as they are)."""
+    p = round(math.log10(abs(a)))
+    hint = (
+        "--units tau=mNm"
+        if p == 3
+        else "--units tau=1000 (kN m)"
+        if p == -3
+        else "currents need a drive file with torque_constant"
+    )
+    if refused:
+        hint += " (--units tau=Nm reads them as N m)"
+    return (
+        f"the measured torques are {abs(a):.3g} times the model's gravity torques: a unit "
+        f"off by a power of ten, or currents logged as torques; hint: {hint}"
+    )
+
+
+def torque_unit_finding(robot: Robot, log: TorqueLog) -> str | None:
+    """The finding that a joint-side log's torques are in mN m (or kN m) read as N m, or
+    None: their factor to ``robot``'s gravity torques (:func:`check_torque_log`'s scale)
+    within :data:`UNIT_SCALE_TOLERANCE` of ``1e3`` (or ``1e-3``).
+
+    The commands refuse such a log unless the torques' unit is said (``--units tau=...``):
+    a fit of it is a model 1000 times too heavy that predicts its own log to the noise
+    floor. A factor far from a power of ten (a model that is wrong, currents) is only
+    warned. None too where :func:`check_torque_log` makes no scale finding: a robot without
+    inertial parameters, every joint frozen, positions that look like degrees, torques of
+    the opposite sign."""
+    if not np.any(robot.phi) or not np.any(moving_joints(log.dq)) or _degrees(robot, log):
+        return None
+    step = max(1, log.n_samples // _MAX_SAMPLES)
+    q, tau = log.q[::step], log.tau[::step]
+    if _opposite(robot, q, tau, robot.joint_names) is not None:
+        return None
+    a = _torque_scale(robot, q, tau)
+    if a is None or a == 0:
+        return None
+    off = math.log10(abs(a))
+    if abs(abs(off) - 3) > math.log10(UNIT_SCALE_TOLERANCE):
+        return None
+    return _scale_line(a, refused=True)
 
 
 #: Relative tolerance of "``dq`` agrees with the derivative of ``q``" (filtered velocities

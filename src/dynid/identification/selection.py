@@ -44,6 +44,7 @@ from numpy.typing import NDArray
 from ..exceptions import DynidWarning, OptionError, RankDeficientError
 from ..model.drive import Drive
 from ..model.robot import Robot
+from ..progress import stage
 from ..regressors.base import BaseParameters
 from ..regressors.terms import ModelTerm
 from ..signals import lowpass_noise_gain
@@ -220,12 +221,15 @@ def select_structure(
     columns: list[tuple[Structure, NDArray[np.bool_], _Key]] = []
     unexcited: set[str] = set()  # single joints' coefficients the data do not excite
     left_out: list[LeftOut] = []  # shaped candidates left out, said once the choice is made
-    for key in sorted({regressor_group(c) for c in cands}):
+    keys = sorted({regressor_group(c) for c in cands})
+    for i, key in enumerate(keys):
         arm = key[0]
         mine = [c for c in cands if regressor_group(c) == key]
-        fits = fit_largest(
-            robot, data, mine, arm, drive, est, rtol, judge, notes, fold_labels, unexcited, left_out
-        )
+        with stage(f"structure search, regressor {i + 1} of {len(keys)}"):
+            fits = fit_largest(
+                robot, data, mine, arm, drive, est, rtol, judge, notes, fold_labels, unexcited,
+                left_out,
+            )  # fmt: skip
         for family, model, terms, held in fits:  # a smooth width judged apart: its own key
             if model.holdout is None:
                 return None
@@ -545,8 +549,7 @@ def identify_recordings(
 
     Each recording (and each piece of one between its gaps) is prepared on its own
     (:func:`~dynid.identification.recordings.prepare_recordings`); the structure is chosen
-    on held-out data (:func:`select_structure`) unless given; then the chosen model is
-    fitted on all the data.
+    on held-out data (:func:`select_structure`) unless given, then fitted on all the data.
 
     Parameters
     ----------
@@ -627,10 +630,11 @@ def identify_recordings(
     model_drive, terms = _terms_of(structure, drive, robot.n, data)
     judge, _, fold_labels = heldout_judge(robot, data, est, folds, validation)
     try:
-        model = identify(
-            robot, data, drive=model_drive, terms=terms, estimator=est, std=std, base=base,
-            max_std_percent=max_std_percent, rtol=rtol, judge=judge, fold_labels=fold_labels,
-        )  # fmt: skip
+        with stage("the fit of the structure chosen" if selection else "the fit"):
+            model = identify(
+                robot, data, drive=model_drive, terms=terms, estimator=est, std=std, base=base,
+                max_std_percent=max_std_percent, rtol=rtol, judge=judge, fold_labels=fold_labels,
+            )  # fmt: skip
     except RankDeficientError as exc:
         raise _without_hint(exc, structure) from exc
     warn_unphysical(model, terms)

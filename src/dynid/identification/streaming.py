@@ -53,6 +53,7 @@ from numpy.typing import NDArray
 
 from .. import _checks
 from ..exceptions import OptionError, ShapeError
+from ..progress import report
 from .holdout import Normals
 
 __all__ = [
@@ -230,6 +231,7 @@ def _stacked_r(buf: NDArray[np.float64]) -> NDArray[np.float64]:
 def _blocks(source: BlockSource) -> Iterable[Block]:
     """The source's blocks checked: shapes, finite values, integer groups."""
     c = None
+    rows = 0
     for W, y, g in source():
         W = np.asarray(W, dtype=np.float64)
         y = np.asarray(y, dtype=np.float64)
@@ -246,6 +248,8 @@ def _blocks(source: BlockSource) -> Iterable[Block]:
             raise ShapeError("noise groups must be non-negative integers")
         _checks.finite("regressor", W)
         _checks.finite("y", y)
+        rows += y.size
+        report(f"a pass over the rows, {rows:,} read")
         yield W, y, g
 
 

@@ -22,6 +22,7 @@ from numpy.typing import NDArray
 
 from .. import _checks
 from ..exceptions import DataError
+from ..progress import report
 from .input_files import regular_file
 from .static_data import check_row_count
 
@@ -218,6 +219,7 @@ def _parse(
         for k, cols in take.items():
             out[k][row : row + rows] = table[:, cols]
         row += rows
+        report(f"reading {path.name}: {row:,} of {capacity:,} rows")
         if last:
             break
     if not freeze:

@@ -8,7 +8,8 @@
               "standstill_margin": true},     # false or absent: fixed levels only
      "uncertainty": null | {"k_sigma": 3.0, "noise": [...]},
      "observer": {"gain": [...], "discretisation": "exact", "rule": "trapezoid"},
-     "calibration": {"samples": N, "data": [file names], "model": ...},
+     "calibration": {"samples": N, "data": [file names], "model": ...,
+                     "at_rest": [...]},   # N m per joint, with the standstill margin
      "units": {...}}
 
 ``events.json`` (schema ``dynid-events/1``): ``events``, a list of ``{"start", "end"}``
@@ -35,7 +36,7 @@ from numpy.typing import NDArray
 from .. import __version__
 from .._checks import text
 from ..exceptions import DataError, DynidError
-from ..observer.detection import ContactEvent, Thresholds
+from ..observer.detection import ContactEvent, Thresholds, undetected_at_rest
 from ..observer.residual import ObserverOptions
 from ..observer.results import LogObservation, ObserveResult
 from .atomic import open_atomic
@@ -339,15 +340,20 @@ def save_observation(
 ) -> list[Path]:
     """The files of ``dynid observe`` in the folder ``out``; returns them.
 
-    Calibrating: ``thresholds.json``. Detecting: ``events.json`` (every log's events, each
-    with its log's name and its joints' names) and, with ``residuals``, a residual table
-    per log from its series (:func:`observation_names`; False: written while observing,
-    :class:`ResidualTables`).
+    Calibrating: ``thresholds.json``, its calibration with ``at_rest`` where the standstill
+    margin raises a joint's threshold at rest
+    (:func:`~dynid.observer.detection.undetected_at_rest`). Detecting: ``events.json``
+    (every log's events, each with its log's name and its joints' names) and, with
+    ``residuals``, a residual table per log from its series (:func:`observation_names`;
+    False: written while observing, :class:`ResidualTables`).
     """
     out = Path(out)
     meta = dict(meta or {})
     if calibrating:
         cal = {"data": log_labels([x.path for x in result.logs]), **meta}
+        rest = undetected_at_rest(result.model, result.thresholds)
+        if result.thresholds.standstill and np.any(rest > result.thresholds.contact):
+            cal["at_rest"] = rest.tolist()  # the thresholds of a joint standing still
         return [
             save_thresholds(
                 out / "thresholds.json", result.thresholds, joints=joints, calibration=cal

@@ -26,6 +26,7 @@ from numpy.typing import NDArray
 from ..exceptions import DynidError
 from ..friction.pooled import joined_validation
 from ..friction.validation import Validation, own_friction, validate_torques
+from ..identification.derived_cutoff import with_derived_cutoff_hint
 from ..identification.log import TorqueLog
 from ..identification.model import IdentifiedModel
 from ..identification.pieces import split_at_gaps, unwrapped, wrappable
@@ -52,12 +53,20 @@ class HeldOutTorques:
     block : str
         What was held out (``"the last of 5 time blocks, 8.2-10.0 s"``).
     joint_names : tuple of str
+    logs : tuple of TorqueLog
+        The held-out log(s) as read: velocities derived from positions at a cut-off well
+        above the motion's add the hint to lower it to the verdict
+        (:mod:`~dynid.identification.derived_cutoff`).
+    cutoff_hz : float or None
+        The cut-off [Hz] the held-out data were prepared at.
     """
 
     validation: Validation
     noise_rms: NDArray[np.float64]
     block: str
     joint_names: tuple[str, ...]
+    logs: tuple[TorqueLog, ...] = ()
+    cutoff_hz: float | None = None
 
     @property
     def noise_floor_percent(self) -> float:
@@ -71,15 +80,18 @@ class HeldOutTorques:
     def verdict(self) -> Verdict:
         """The held-out prediction judged as ``validate`` judges one
         (:func:`~dynid.identification.verdict.judge_prediction`): the error against the
-        noise floor, each joint's against its noise and in relative terms."""
+        noise floor, each joint's against its noise and in relative terms; above the
+        floor, with the hint of a cut-off too high for velocities derived from positions
+        (:func:`~dynid.identification.derived_cutoff.with_derived_cutoff_hint`)."""
         e = self.validation.errors
-        return judge_prediction(
+        verdict = judge_prediction(
             e.relative_error_percent,
             self.noise_floor_percent,
             joint_ratios=joint_ratios(e.rms, self.noise_rms),
             joint_percent=e.relative_error_percent_per_joint,
             joint_names=self.joint_names,
         )
+        return with_derived_cutoff_hint(verdict, self.logs, self.cutoff_hz)
 
     def as_dict(self) -> dict[str, Any]:
         """JSON-ready: the errors per joint, the noise, the floor and the verdict (schema
@@ -166,7 +178,10 @@ def heldout_torques(
     cutoff = model.info.log.cutoff_hz or 0.2 * model.info.log.sample_rate_hz
     noise = _recorded_noise(model)
     noise = _noise(v, cutoff) if noise is None else noise
-    return HeldOutTorques(v, noise, block, tuple(model.robot.joint_names))
+    names = tuple(model.robot.joint_names)
+    read = (held if model.holdout.scheme == "file" else log,)  # the motion of a whole log
+    given = None if model.info.log.cutoff_source == "motion" else model.info.log.cutoff_hz
+    return HeldOutTorques(v, noise, block, names, read, given)
 
 
 def _recorded_noise(model: IdentifiedModel) -> NDArray[np.float64] | None:

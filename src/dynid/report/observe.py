@@ -30,8 +30,8 @@ def _events(doc: Any) -> list | None:
 
 def _calibration(doc: Any) -> str | None:
     """What a calibration did, in one sentence (``thresholds.json``'s ``calibration``: the
-    samples and logs, and the thresholds' range over the joints), or None when the file
-    records none."""
+    samples and logs, and the thresholds' range over the joints, moving and, where the
+    file records them, standing still), or None when the file records none."""
     cal = doc.get("calibration") if isinstance(doc, dict) else None
     if not isinstance(cal, dict):
         return None
@@ -39,11 +39,25 @@ def _calibration(doc: Any) -> str | None:
     said = f"Thresholds calibrated on {cal.get('samples', 'the')} samples of {len(logs)} log"
     said += ("s" if len(logs) != 1 else "") + (f" ({', '.join(logs)})" if logs else "")
     ranges = [
-        f"{key} {min(v):.3g}-{max(v):.3g} N m"
-        for key in ("contact", "collision")
-        if isinstance(v := doc.get(key), list) and v and all(is_number(x) for x in v)
+        f"{key} {_span(v)} N m" for key in ("contact", "collision") if _numbers(v := doc.get(key))
     ]
-    return said + (": " + ", ".join(ranges) + " over the joints" if ranges else "") + "."
+    rest = cal.get("at_rest")
+    said += ": " + ", ".join(ranges) + " over the joints" if ranges else ""
+    if ranges and _numbers(rest):  # the standstill margin raises a still joint's threshold
+        said += (
+            " while they move; on a joint standing still (inside its friction's standstill "
+            f"band) a contact goes undetected below {_span(rest)} N m (its Coulomb level "
+            "plus the contact threshold)"
+        )
+    return said + "."
+
+
+def _numbers(v: Any) -> bool:
+    return isinstance(v, list) and bool(v) and all(is_number(x) for x in v)
+
+
+def _span(v: Any) -> str:
+    return f"{min(v):.3g}-{max(v):.3g}"
 
 
 def answer(run: RunFiles) -> Answer | None:

@@ -174,6 +174,7 @@ def fit_friction_files(
         drive=(model.drive if isinstance(model, IdentifiedModel) else None) or drive,
         q_start=opt.q_start,
         max_gap_s=max_gap_s,
+        reference=model.equivalent_robot if isinstance(model, IdentifiedModel) else None,
     )
 
     def fit() -> FrictionFileResult:

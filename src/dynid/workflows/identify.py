@@ -52,7 +52,7 @@ from .data_files import (
 )
 from .options import check_band, check_choice, check_count, check_number, only_with, refused_with
 from .prior import load_prior
-from .recordings import Recorded, check_limits, check_units, given_start
+from .recordings import Recorded, check_limits, check_torque_unit, check_units, given_start
 
 __all__ = ["ColumnSpec", "IdentifyOptions", "IdentifyResult", "data_files", "identify_files"]
 
@@ -364,9 +364,11 @@ def _identify(robot: Robot, paths: list[Path], opt: IdentifyOptions) -> Identifi
 def _read_logs(robot: Robot, paths: list[Path], cmap: Any, opt: IdentifyOptions) -> list[Any]:
     """The torque logs ``paths``, read strictly for ``robot`` (recorded through
     ``opt.drive``); a recording in degrees among recordings in radians, with joints in
-    degrees, or in other units than the others, refused, and one far outside the joint
-    limits warned about, naming it (:func:`~dynid.workflows.recordings.check_limits`,
-    :func:`~dynid.workflows.recordings.check_units`); the whole turns of wrapped motors
+    degrees, in other units than the others, or in mN m read as N m, refused, and one far
+    outside the joint limits warned about, naming it
+    (:func:`~dynid.workflows.recordings.check_limits`,
+    :func:`~dynid.workflows.recordings.check_units`,
+    :func:`~dynid.workflows.recordings.check_torque_unit`); the whole turns of wrapped motors
     from ``q_start`` (:func:`given_start`)."""
     logs = [
         read_torque_log(
@@ -384,6 +386,7 @@ def _read_logs(robot: Robot, paths: list[Path], cmap: Any, opt: IdentifyOptions)
     rec = Recorded(tuple(logs), tuple(paths))
     check_limits(rec, robot, opt.drive)
     check_units(rec)
+    check_torque_unit(rec, robot, opt.drive, cmap)
     return logs
 
 

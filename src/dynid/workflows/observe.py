@@ -74,7 +74,14 @@ from .data_files import (
 )
 from .observe_detect import ResidualSink, detected_log, true_torques
 from .observe_logs import ObservedBlock, PreparedLog, Series, observed_blocks, prepared_log
-from .recordings import Recorded, check_limits, check_signs, check_units, given_start
+from .recordings import (
+    Recorded,
+    check_limits,
+    check_signs,
+    check_torque_unit,
+    check_units,
+    given_start,
+)
 
 __all__ = [
     "LogObservation",
@@ -385,7 +392,8 @@ def _read_logs(
     opts: ObserveOptions,
 ) -> Recorded:
     """The logs ``paths`` read strictly for the model; a log in other units than the others,
-    with joints in degrees or with torques of the opposite sign to the model's refused,
+    with joints in degrees, with torques of the opposite sign to the model's or in mN m
+    read as N m refused,
     and one far outside the joint limits warned about, each naming the file
     (:mod:`dynid.workflows.recordings`)."""
     cmap = column_map(*columns)
@@ -406,6 +414,7 @@ def _read_logs(
     check_limits(read, model.robot, model.drive)
     check_units(read)
     check_signs(read, model.robot, model.drive)
+    check_torque_unit(read, model.robot, model.drive, cmap)
     return read
 
 

@@ -35,6 +35,7 @@ from ..observer.friction import (
 from ..observer.model import ObserverModel
 from ..observer.pieces import PositionJump, pieces, position_jumps
 from ..observer.residual import MomentumObserver, ObserverOptions
+from ..progress import report
 from ..signals import edge_seconds, filtered_derivative
 
 __all__ = [
@@ -153,6 +154,7 @@ def observed_blocks(
             pending = next(margins, None)
             for c in range(a, b, OBSERVE_BLOCK):
                 d = min(c + OBSERVE_BLOCK, b)
+                report(f"observing {prep.path.name}: sample {d:,} of {t.shape[0]:,}")
                 m = None
                 if pending is not None and pending[0] == c - a:
                     m, pending = pending[1], next(margins, None)

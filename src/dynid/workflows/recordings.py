@@ -20,6 +20,10 @@ line naming the file, never a recording dropped silently:
   positions span more than the joint can travel and fit its limits read in degrees): an
   error naming it, the joints and the conversion (``identify``, ``validate``, ``observe``
   alike);
+* a recording whose torques read as mN m (or kN m) taken for N m, about 1000 times the
+  model's gravity torques, unless the column map says the torques' unit (``--units
+  tau=...``, or the model's recorded one): an error naming it and ``--units tau=mNm``
+  (:func:`check_torque_unit`; ``identify`` and ``observe`` alike);
 * a recording whose positions lie far outside the model's joint limits (of another robot):
   a warning naming it.
 
@@ -44,8 +48,10 @@ from ..identification.sanity import (
     opposite_sign,
     time_unit_finding,
     too_few_samples,
+    torque_unit_finding,
 )
 from ..identification.unit_mix import degrees_among_radians, joints_in_degrees
+from ..io.columns import ColumnMap
 from ..model.drive import Drive
 from ..model.robot import Robot
 from .data_files import (
@@ -63,6 +69,7 @@ __all__ = [
     "check_degrees",
     "check_limits",
     "check_signs",
+    "check_torque_unit",
     "check_units",
     "given_start",
     "read_recordings",
@@ -106,6 +113,7 @@ def read_recordings(
     drive: Drive | None = None,
     q_start: Sequence[float] | None = None,
     max_gap_s: float | None = None,
+    reference: Robot | None = None,
 ) -> Recorded:
     """The torque logs of ``data`` (files, or folders of ``.csv``/``.npz`` files) of
     ``robot``, read and checked (module docstring).
@@ -131,6 +139,9 @@ def read_recordings(
     q_start, max_gap_s : optional
         The joint positions [rad] at the first sample of one motor-side recording whose
         motors were recorded wrapped, and the gap rule cutting it (:func:`given_start`).
+    reference : Robot, optional
+        A robot whose link parameters give the model's gravity torques (an identified
+        model's ``equivalent_robot``) for :func:`check_torque_unit`; default ``robot``.
 
     Returns
     -------
@@ -140,8 +151,8 @@ def read_recordings(
     ------
     DataError
         No file, a bad file, another joint count, invalid rows without ``drop_invalid``,
-        other columns than the model's, a recording in other units than the others or in
-        degrees among recordings in radians (each names the file).
+        other columns than the model's, a recording in other units than the others, in
+        degrees among recordings in radians or in mN m read as N m (each names the file).
     """
     paths = data_files(data)
     names, units = recorded_columns(recorded, *(columns or (None, None)))
@@ -160,6 +171,7 @@ def read_recordings(
         if (unit := time_unit_finding(name, log)) is not None:  # it names the file
             raise DataError(unit.removeprefix(f"{name}: "), file=name)
     check_units(out)
+    check_torque_unit(out, robot if reference is None else reference, drive, cmap)
     return out
 
 
@@ -288,6 +300,27 @@ def check_signs(rec: Recorded, robot: Robot, drive: Drive | None) -> None:
             raise DataError(few, file=name)
         if (opposite := opposite_sign(robot, _joint_side(log, drive))) is not None:
             raise DataError(opposite, file=name)
+
+
+def check_torque_unit(
+    rec: Recorded, robot: Robot, drive: Drive | None, cmap: ColumnMap | None
+) -> None:
+    """Refuse a recording whose (joint-side) torques read as mN m (or kN m) taken for N m
+    (:func:`~dynid.identification.sanity.torque_unit_finding`), as the opposite sign and
+    degrees are refused, unless the column map ``cmap`` they were read with says the
+    torques' unit (``--units tau=Nm`` reads such torques as they are, with the finding
+    warned).
+
+    Raises
+    ------
+    DataError
+        Naming the recording, the factor and ``--units tau=mNm``.
+    """
+    if cmap is not None and "tau" in cmap.factors:
+        return
+    for name, log in zip(rec.names, rec.logs, strict=True):
+        if (found := torque_unit_finding(robot, _joint_side(log, drive))) is not None:
+            raise DataError(found, file=name)
 
 
 def _joint_side(log: TorqueLog, drive: Drive | None) -> TorqueLog:

@@ -36,6 +36,7 @@ from ..friction.fit import same_drive
 from ..friction.model import FrictionModel, FrictionSum
 from ..friction.recordings import RecordingsValidation, validate_recordings
 from ..friction.validation import RECORDED, own_friction
+from ..identification.derived_cutoff import with_derived_cutoff_hint
 from ..identification.metrics import TorqueErrors
 from ..identification.model import IdentifiedModel
 from ..identification.sanity import anticorrelated, velocity_noise_std
@@ -217,6 +218,7 @@ def validate_files(
         drive=own if drive is None else drive,
         q_start=opt.q_start,
         max_gap_s=opt.max_gap_s,
+        reference=model.equivalent_robot if isinstance(model, IdentifiedModel) else None,
     )
     friction, source = _friction(model, opt.friction, feasible, drive)
 
@@ -248,6 +250,7 @@ def validate_files(
         if min(rank) < rank[r] and rank[r] >= LEVELS.index(verdict.level):
             v = each[r]
             verdict = Verdict(v.level, v.label, f"{rec.names[r]}: {v.reason}", v.ratio)
+    verdict = with_derived_cutoff_hint(verdict, rec.logs, val.pieces.cutoff_hz)
     return ValidateResult(
         validation=val,
         model=label or f"robot {robot.name}",

@@ -1,0 +1,82 @@
+"""The hint of a cut-off too high for velocities derived from positions: a positions-only
+log validated at a cut-off well above the one read from its motion was judged "effects
+outside the model remain" while the derived accelerations' noise made the error; now the
+verdict says to lower --cutoff.
+
+Reference: a simulated Panda log (the robot's own model, torque noise 0.05 N m, position
+noise 2e-4 rad) validated with the robot that made it, so that any error above the noise
+floor comes from the preparation, not the model.
+"""
+
+from __future__ import annotations
+
+import re
+import warnings
+
+import numpy as np
+import pytest
+
+import dynid
+from dynid.exceptions import DynidWarning
+from dynid.identification.derived_cutoff import derived_cutoff_hint, with_derived_cutoff_hint
+from dynid.identification.log import TorqueLog, with_derived_velocities
+from dynid.identification.trim import common_cutoff
+from dynid.identification.verdict import Verdict
+from dynid.io.torque_log import save_torque_log
+from dynid.simulation.measurement import SensorNoise, sample_times, simulate_measurement
+from dynid.simulation.trajectories import random_fourier
+from dynid.workflows.validate import ValidateOptions, validate_files
+
+
+@pytest.fixture(scope="module")
+def logs(tmp_path_factory):
+    """The same 20 s, 100 Hz Panda log twice: positions only, and with measured velocities."""
+    panda = dynid.panda()
+    rng = np.random.default_rng(11)
+    traj = random_fourier(panda, rng)(sample_times(20.0, 100.0))
+    log = simulate_measurement(panda, traj, rng=rng, noise=SensorNoise(q_std=2e-4))
+    d = tmp_path_factory.mktemp("derived")
+    measured = TorqueLog(log.t, log.q, log.dq, log.tau)
+    save_torque_log(d / "measured.csv", measured)
+    save_torque_log(d / "positions.csv", with_derived_velocities(measured))
+    return panda, d
+
+
+def _verdict(panda, path, cutoff_hz):
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", DynidWarning)  # "no velocity columns"
+        return validate_files(panda, [path], ValidateOptions(cutoff_hz=cutoff_hz)).verdict
+
+
+def test_a_positions_only_log_above_its_motions_cut_off_is_told_to_lower_it(logs):
+    """At 10 Hz, 1.8 times the 5.5 Hz read from the motion, the true model of a
+    positions-only log is judged above the noise floor and the verdict names the cut-off
+    and the remedy; at the motion's cut-off, or with measured velocities at 10 Hz, the
+    model is at the floor and nothing is said."""
+    panda, d = logs
+    high = _verdict(panda, d / "positions.csv", 10.0)
+    assert high.level != "good"
+    assert re.search(r"derived from the positions at 10 Hz, 1.8 times .* \(5.5 Hz\)", high.reason)
+    assert "hint: lower --cutoff (toward 5.5 Hz)" in high.reason
+    for path, cutoff in ((d / "positions.csv", None), (d / "measured.csv", 10.0)):
+        v = _verdict(panda, path, cutoff)
+        assert v.level == "good" and "--cutoff" not in v.reason, (path.name, v)
+
+
+def test_the_hint_needs_derived_velocities_and_a_cut_off_well_above_the_motions(logs):
+    """None for measured velocities, without a cut-off or within 1.5 times the motion's;
+    a verdict at the floor is left as it is."""
+    from dynid.io.torque_log import load_torque_log
+
+    _, d = logs
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", DynidWarning)
+        pos, meas = load_torque_log(d / "positions.csv"), load_torque_log(d / "measured.csv")
+    motion = common_cutoff([pos])
+    assert pos.dq_derived and not meas.dq_derived
+    assert derived_cutoff_hint([pos], 1.6 * motion) is not None
+    assert derived_cutoff_hint([pos], 1.4 * motion) is None
+    assert derived_cutoff_hint([pos], None) is None
+    assert derived_cutoff_hint([meas], 3.0 * motion) is None
+    good = Verdict("good", "at the noise floor", "error 0.5 %", 1.1)
+    assert with_derived_cutoff_hint(good, [pos], 3.0 * motion) is good
