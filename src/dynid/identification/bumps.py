@@ -5,14 +5,15 @@ The grid of :func:`~dynid.identification.structure.candidate_structures` pairs t
 (:data:`~dynid.identification.structure.SMOOTH_STRIBECK_WIDTHS`): the bumps of every
 width are one regressor each (alike near rest, they cannot share one), and a regressor
 per width would double the search's fits. A friction rounded over many bands (a smooth
-Coulomb of 10 bands with a bump: 1.95 % held out on a UR5's point-to-point moves, the
-bump at its own width 0.70 %, the noise floor 0.38 %) needs the bump at its own width.
-:func:`bump_widths` adds it to the smooth law that predicts held-out data best, at every
-Stribeck velocity; where that predicts better by more than one standard error (paired
-over the folds), it walks the bump's width along the grid of smooth widths each way
-while the held-out error keeps falling as much: a smooth law without its bump is fitted
-at a width rounded to make up for the bump (3 bands for a bump at 10), so its own width
-is a start, not the answer.
+Coulomb of 10 bands with a bump: 1.95 % on a new recording of a UR5's point-to-point
+moves, the bump at its own width 0.70 %, the noise floor 0.38 %) needs the bump at its
+own width. :func:`bump_widths` adds it to the smooth law that predicts held-out data
+best, at every Stribeck velocity (the search asks only where that law predicts better
+than the laws without a Coulomb term: a bump rides on Coulomb friction). Where the bump
+predicts better by more than one standard error (paired over the folds), it walks the
+bump's width along the grid of smooth widths each way while the held-out error keeps
+falling as much: a smooth law without its bump is fitted at a width rounded to make up
+for the bump (3 bands for a bump at 10), so its own width is a start, not the answer.
 """
 
 from __future__ import annotations

@@ -435,12 +435,18 @@ def _smooth_bumps(
     the widths walked along those of ``cands``' smooth laws: the candidates not judged
     yet, each width's fitted in a regressor of its own (``fit``; recorded in ``groups``,
     ``by_group`` and ``where``) and judged without the recordings ``skip``. None when
-    ``cands`` hold no Stribeck law or no smooth law was judged."""
+    ``cands`` hold no Stribeck law, no smooth law was judged, or the best predicts no
+    better than the laws without a Coulomb term (beyond one standard error)."""
     smooth = [c for c in _physical(judged) if _plain_smooth(c.structure)]
     vsts = sorted({c.vst for c in cands if "stribeck" in c.friction})
     if not smooth or not vsts:
         return []
     start = min(smooth, key=lambda c: c.score)
+    signless = [
+        c for c in _physical(judged) if not {"coulomb", "smooth"} & set(c.structure.friction)
+    ]
+    if signless and not _better(start, min(signless, key=lambda c: c.score)):
+        return []  # no Coulomb friction in the data: no bump on it either
     widths = sorted({c.width for c in cands if _plain_smooth(c) and isinstance(c.width, float)})
     mine = {(c.structure, where.get(c.structure)): c for c in judged}
     new: list[Candidate] = []
