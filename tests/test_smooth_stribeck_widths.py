@@ -97,3 +97,19 @@ def test_a_rounded_stribeck_law_is_found_at_its_own_width(rounded):
     np.testing.assert_allclose(fs - fc, P[:, 2] - P[:, 1], rtol=0.02)
     val = validate_recordings(model, new, friction=own_friction(model))
     assert float(val.errors.relative_error_percent) < 0.1
+
+
+def test_no_bump_is_tried_without_coulomb_friction(panda):
+    """Viscous friction alone (no Coulomb term to ride on): no smooth-sign Stribeck law
+    beyond the grid's (0.3 bands) is judged, so no fit is spent on one, and viscous
+    friction without a sign is chosen."""
+    noise = SensorNoise(tau_std=0.05, q_std=1e-5, dq_std=1e-3)
+    truth = LAWS["classical"].model(np.column_stack([np.linspace(0.3, 0.1, 7), np.zeros((7, 2))]))
+    logs = recordings(panda, (6, 7), friction=truth, duration=4.0, noise=noise)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", DynidWarning)
+        sel = identify_recordings(panda, logs).info.selection
+    assert sel["chosen"].startswith("links + viscous"), sel["chosen"]
+    assert not any(law in sel["chosen"] for law in ("coulomb", "smooth", "stribeck"))
+    bumps = [c["name"] for c in sel["candidates"] if "+ stribeck:" in c["name"]]
+    assert bumps and all("smooth:0.3 + stribeck" in b or "coulomb" in b for b in bumps), bumps
