@@ -17,7 +17,8 @@ Tibshirani and Friedman, *The Elements of Statistical Learning*, 2nd ed., Sec. 7
 the standard error being that of the difference of the two candidates' errors paired
 over the folds (:func:`~dynid.identification.candidates.paired_se`), and differences
 under 1 % of the lowest error counting as ties. A smooth Coulomb's width is then chosen
-per joint (:mod:`dynid.identification.widths`).
+per joint (:mod:`dynid.identification.widths`), and the Stribeck bump on the smooth sign
+judged at the width of the best smooth law (:mod:`dynid.identification.bumps`).
 The folds leave one recording out at a time when there are several, contiguous time
 blocks otherwise (:meth:`~dynid.identification.recordings.Recordings.fold_labels`), or
 judge on a separate recording. A recording that holds what no candidate models is left
@@ -48,6 +49,7 @@ from ..progress import stage
 from ..regressors.base import BaseParameters
 from ..regressors.terms import ModelTerm
 from ..signals import lowpass_noise_gain
+from .bumps import bump_widths
 from .candidates import (
     OUTLIER_RATIO,
     RELATIVE_TIE,
@@ -64,7 +66,7 @@ from .dissipation import friction_columns, friction_violations, warn_unphysical
 from .estimators import Estimator, EstimatorName, estimator_named
 from .holdout import DEFAULT_FOLDS, HeldOut
 from .judge import heldout_judge
-from .largest import LeftOut, fit_largest, recording_bands
+from .largest import Fitted, LeftOut, fit_largest, recording_bands
 from .least_squares import StdMethod
 from .log import TorqueLog
 from .metrics import noise_floor_percent
@@ -81,6 +83,7 @@ from .structure import (
     joint_side_joints,
     own_rotors,
     regressor_group,
+    smooth_stribeck_candidates,
     structure_terms,
 )
 from .widths import per_joint_widths, regressor_widths
@@ -221,16 +224,26 @@ def select_structure(
     columns: list[tuple[Structure, NDArray[np.bool_], _Key]] = []
     unexcited: set[str] = set()  # single joints' coefficients the data do not excite
     left_out: list[LeftOut] = []  # shaped candidates left out, said once the choice is made
+
+    def fit(
+        mine: list[Structure], what: str = "structure search, a Stribeck bump on the smooth sign"
+    ) -> list[Fitted]:
+        """The regressor of the candidates ``mine`` (one group), fitted with the judge
+        (``what``: the step the progress names)."""
+        arm = mine[0].armature
+        with stage(what):
+            return fit_largest(
+                robot, data, mine, arm, drive, est, rtol, judge, notes, fold_labels, unexcited,
+                left_out,
+            )  # fmt: skip
+
     keys = sorted({regressor_group(c) for c in cands})
     for i, key in enumerate(keys):
         arm = key[0]
         mine = [c for c in cands if regressor_group(c) == key]
-        with stage(f"structure search, regressor {i + 1} of {len(keys)}"):
-            fits = fit_largest(
-                robot, data, mine, arm, drive, est, rtol, judge, notes, fold_labels, unexcited,
-                left_out,
-            )  # fmt: skip
-        for family, model, terms, held in fits:  # a smooth width judged apart: its own key
+        for family, model, terms, held in fit(
+            mine, f"structure search, regressor {i + 1} of {len(keys)}"
+        ):  # a smooth width judged apart: its own key
             if model.holdout is None:
                 return None
             own = (arm, key[1], family)
@@ -249,12 +262,14 @@ def select_structure(
     # the candidate its search began at (a smooth-sign Stribeck law without its bumps is
     # a smooth law, in the Stribeck law's regressor)
     where = {c: key for c, _, key in columns}
+    by_group = {
+        g: (m, t, without_recordings(m, skip) if skip else heldout_of(m))
+        for g, (m, t) in groups.items()
+    }
     if per_joint:
-        by_group = {
-            g: (m, t, without_recordings(m, skip) if skip else heldout_of(m))
-            for g, (m, t) in groups.items()
-        }
         judged += _widths_per_joint(judged, by_group, robot.n, fit_rtol, where)
+    judged += _smooth_bumps(judged, cands, fit, groups, by_group, where, skip, fit_rtol)
+    if per_joint:
         judged += _per_joint(judged, by_group, robot.n, fit_rtol, where)
     chosen = _chosen(judged)
     notes[:0] = [lo.note(chosen, where.get(chosen)) for lo in left_out]
@@ -411,6 +426,66 @@ def _widths_per_joint(
             where[reached.structure] = where[start.structure]
             out.append(reached)
     return out
+
+
+def _smooth_bumps(
+    judged: Sequence[Candidate],
+    cands: Sequence[Structure],
+    fit: Callable[[list[Structure]], list[Fitted]],
+    groups: _Groups,
+    by_group: dict[_Key, tuple[IdentifiedModel, list[tuple[ModelTerm, Any]], HeldOut]],
+    where: dict[Structure, _Key],
+    skip: tuple[int, ...],
+    rtol: float,
+) -> list[Candidate]:
+    """The Stribeck bump on the smooth sign at the width of the smooth law that predicts
+    held-out data best (:func:`~.bumps.bump_widths`; one width or, from
+    :func:`_widths_per_joint`, one per joint) at each Stribeck velocity of ``cands``,
+    the widths walked along those of ``cands``' smooth laws: the candidates not judged
+    yet, each width's fitted in a regressor of its own (``fit``; recorded in ``groups``,
+    ``by_group`` and ``where``) and judged without the recordings ``skip``. None when
+    ``cands`` hold no Stribeck law, no smooth law was judged, or the best predicts no
+    better than the laws without a Coulomb term (beyond one standard error)."""
+    smooth = [c for c in _physical(judged) if _plain_smooth(c.structure)]
+    vsts = sorted({c.vst for c in cands if "stribeck" in c.friction})
+    if not smooth or not vsts:
+        return []
+    start = min(smooth, key=lambda c: c.score)
+    signless = [
+        c for c in _physical(judged) if not {"coulomb", "smooth"} & set(c.structure.friction)
+    ]
+    if signless and not _better(start, min(signless, key=lambda c: c.score)):
+        return []  # no Coulomb friction in the data: no bump on it either
+    widths = sorted({c.width for c in cands if _plain_smooth(c) and isinstance(c.width, float)})
+    mine = {(c.structure, where.get(c.structure)): c for c in judged}
+    new: list[Candidate] = []
+
+    def at_width(w: float | tuple[float, ...]) -> list[Candidate]:
+        structures = smooth_stribeck_candidates(replace(start.structure, width=w), vsts)
+        key = regressor_group(structures[0])
+        if any(regressor_group(c) == key for c in cands):  # in the grid: judged already
+            return [m for s in structures if (m := mine.get((s, key))) is not None]
+        out = []
+        for family, model, terms, held in fit(list(structures)):
+            own = (key[0], key[1], family)
+            groups[own] = (model, terms)
+            folds = without_recordings(model, skip) if skip else heldout_of(model)
+            by_group[own] = (model, terms, folds)
+            for c in held:
+                where[c] = own
+                out.append(
+                    _judged(c, candidate_columns(c, model, terms), model, terms, folds, rtol)
+                )
+        new.extend(out)
+        return out
+
+    bump_widths(start, widths, at_width, _better)
+    return new
+
+
+def _plain_smooth(c: Structure) -> bool:
+    """A smooth Coulomb law without a Stribeck bump."""
+    return "smooth" in c.friction and "stribeck" not in c.friction
 
 
 def _judge_in(

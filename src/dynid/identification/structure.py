@@ -51,6 +51,7 @@ __all__ = [
     "own_rotors",
     "regressor_group",
     "largest_terms",
+    "smooth_stribeck_candidates",
     "smooth_width",
     "structure_terms",
     "width_key",
@@ -88,7 +89,8 @@ STRIBECK_COARSE = (0.02, 0.05, 0.1, 0.2)
 #: Widths (in standstill bands, as :data:`SMOOTH_WIDTHS`) of the Stribeck candidates
 #: whose Coulomb term and bump take the smooth sign ``tanh(dq / w)`` (the narrowest: the
 #: expected sign of a sharp law given the noise, where the bump sits; the banded sign
-#: switches the bump off right where it is largest).
+#: switches the bump off right where it is largest); the search then adds the bump at the
+#: width of the best smooth law (:mod:`dynid.identification.bumps`).
 SMOOTH_STRIBECK_WIDTHS = (0.3,)
 #: Smallest smooth width [rad/s] (a noise-free log has no standstill band).
 MIN_WIDTH = 1e-3
@@ -486,7 +488,8 @@ def candidate_structures(
     the smooth Coulomb at each of :data:`SMOOTH_WIDTHS` (with viscous friction, without
     and with offsets), the quadratic viscous law and the Stribeck law at each of
     :data:`STRIBECK_VELOCITIES` (with viscous friction, Coulomb friction and offsets; with
-    the banded sign, and with the smooth sign at each of :data:`SMOOTH_STRIBECK_WIDTHS`),
+    the banded sign, and with the smooth sign at each of :data:`SMOOTH_STRIBECK_WIDTHS`:
+    :func:`smooth_stribeck_candidates`; the search adds them at the width it chooses),
     without and (``armature``) with the armature, the friction at each of ``placements``
     (:func:`friction_placements`; the model without friction once; at ``"both"`` the
     classical ladder alone)."""
@@ -507,11 +510,21 @@ def candidate_structures(
                 Structure(a, _CLASSICAL + ("stribeck",), vst=v, at=at) for v in STRIBECK_VELOCITIES
             ]
             out += [
-                Structure(a, ("viscous", "smooth", "stribeck", "offset"), w, v, at=at)
+                c
                 for w in SMOOTH_STRIBECK_WIDTHS
-                for v in STRIBECK_VELOCITIES
+                for c in smooth_stribeck_candidates(Structure(a, ("smooth",), w, at=at))
             ]
     return tuple(out)
+
+
+def smooth_stribeck_candidates(
+    smooth: Structure, vsts: Sequence[float] = STRIBECK_VELOCITIES
+) -> tuple[Structure, ...]:
+    """The smooth-sign Stribeck candidates (viscous friction, the smooth Coulomb with its
+    bump, offsets) at the smooth width of ``smooth`` (one, or one per joint), with its
+    armature and placement, at each Stribeck velocity of ``vsts`` [rad/s]."""
+    parts = ("viscous", "smooth", "stribeck", "offset")
+    return tuple(Structure(smooth.armature, parts, smooth.width, v, at=smooth.at) for v in vsts)
 
 
 def smooth_width(band: Sequence[float], factor: float | Sequence[float]) -> tuple[float, ...]:
