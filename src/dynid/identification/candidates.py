@@ -13,6 +13,7 @@ it.
 
 from __future__ import annotations
 
+import functools
 import math
 from collections.abc import Callable
 from dataclasses import dataclass, replace
@@ -243,6 +244,7 @@ def candidate_judged(
     )
 
 
+@functools.lru_cache(maxsize=8)  # one per largest model: every candidate of it reads it
 def std_inflation(model: IdentifiedModel, rtol: float) -> NDArray[np.float64]:
     """Per column of ``model`` (c,): its reported standard deviation over the classical one
     from the normal equations of all its rows (its held-out folds' ``whole``; 1 where
@@ -258,6 +260,7 @@ def std_inflation(model: IdentifiedModel, rtol: float) -> NDArray[np.float64]:
     reported = np.asarray(fit.std, dtype=np.float64)[kept]
     ok = (classical > 0) & (reported > 0)
     out[kept[ok]] = reported[ok] / classical[ok]
+    out.flags.writeable = False  # shared by the candidates of the model
     return out
 
 
