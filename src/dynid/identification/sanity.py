@@ -450,8 +450,10 @@ def torque_unit_finding(robot: Robot, log: TorqueLog) -> str | None:
     floor. A factor far from a power of ten (a model that is wrong, currents) is only
     warned. None too where :func:`check_torque_log` makes no scale finding: a robot without
     inertial parameters, every joint frozen, positions that look like degrees, torques of
-    the opposite sign."""
-    if not np.any(robot.phi) or not np.any(moving_joints(log.dq)) or _degrees(robot, log):
+    the opposite sign, a log too short to check (:func:`too_few_samples`)."""
+    if too_few_samples(log) is not None or not np.any(robot.phi):
+        return None
+    if not np.any(moving_joints(log.dq)) or _degrees(robot, log):
         return None
     step = max(1, log.n_samples // _MAX_SAMPLES)
     q, tau = log.q[::step], log.tau[::step]

@@ -279,15 +279,7 @@ def select_structure(
     per: tuple[tuple[str, float], ...] = ()
     if len(data.names) > 1 and validation is None:
         per = _per_recording(chosen, full, groups, where, data.names, fit_rtol)
-    for i in skip:
-        warnings.warn(
-            f"{data.names[i]}: held-out error {per[i][1]:.3g} % with the chosen structure, far "
-            "above the other recordings' (metadata.selection.heldout_per_recording): it holds "
-            "torques the model does not (contacts, a payload?); the structure is chosen on "
-            "the other recordings",
-            DynidWarning,
-            stacklevel=2,
-        )
+    _warn_outlying(skip, per)
     return Selection(
         tuple(judged),
         chosen,
@@ -296,6 +288,20 @@ def select_structure(
         per_recording=per,
         outlying=tuple(data.names[i] for i in skip),
     )
+
+
+def _warn_outlying(skip: tuple[int, ...], per: tuple[tuple[str, float], ...]) -> None:
+    """A warning for each recording ``skip`` left out of the judgement (its name and
+    held-out error with the chosen structure in ``per``)."""
+    for i in skip:
+        warnings.warn(
+            f"{per[i][0]}: held-out error {per[i][1]:.3g} % with the chosen structure, far "
+            "above the other recordings' (metadata.selection.heldout_per_recording): it holds "
+            "torques the model does not (contacts, a payload?); the structure is chosen on "
+            "the other recordings",
+            DynidWarning,
+            stacklevel=3,
+        )
 
 
 def _candidate_notes(judged: Sequence[Candidate]) -> list[str]:
