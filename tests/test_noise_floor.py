@@ -48,17 +48,16 @@ def test_the_floor_is_named_after_what_was_measured():
     assert "3 x the motor currents' noise floor (0.5 %)" in line and "sensor" not in line
 
 
-def test_the_floor_of_a_separate_log_is_that_log_s_noise(panda):
-    """Judged on a separate log (--validate-on) four times noisier than the training logs,
-    the floor is the separate log's noise, which the held-out error meets (it was the
-    training logs', so the error read about 4 x a floor no model could reach)."""
+def _judged_on_a_separate_log(panda, train_seeds, other_seed, other_std):
+    """The held-out record of the true structure fitted on recordings of noise 0.05 N m and
+    judged on one of noise ``other_std`` [N m] (--validate-on)."""
     fr = ClassicalFriction(np.linspace(0.3, 0.1, 7), np.zeros(7), np.zeros(7))
 
     def logs(seeds, tau_std):
         noise = SensorNoise(tau_std=tau_std, q_std=0.0, dq_std=0.0)
         return recordings(panda, seeds, friction=fr, duration=8.0, noise=noise)
 
-    train, (other,) = logs((51, 52), 0.05), logs((53,), 0.2)
+    train, (other,) = logs(train_seeds, 0.05), logs((other_seed,), other_std)
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", DynidWarning)
         model = identify_recordings(
@@ -66,6 +65,14 @@ def test_the_floor_of_a_separate_log_is_that_log_s_noise(panda):
         )
     ho = model.info.heldout
     assert ho["scheme"] == "file"
+    return ho
+
+
+def test_the_floor_of_a_separate_log_is_that_log_s_noise(panda):
+    """Judged on a separate log (--validate-on) four times noisier than the training logs,
+    the floor is the separate log's noise, which the held-out error meets (it was the
+    training logs', so the error read about 4 x a floor no model could reach)."""
+    ho = _judged_on_a_separate_log(panda, (51, 52), 53, 0.2)
     assert ho["heldout_error_percent"] == pytest.approx(ho["noise_floor_percent"], rel=0.15)
     np.testing.assert_allclose(ho["noise_rms"], 0.2, rtol=0.15)  # the separate log's sensor
 
@@ -75,14 +82,5 @@ def test_with_a_separate_log_the_training_error_is_read_on_the_measured_torques(
     torques as measured, as the held-out one and as without --validate-on: the two agree
     (it was read on the low-passed torques, a third of the held-out error, which the
     report took for a fit that follows the noise)."""
-    fr = ClassicalFriction(np.linspace(0.3, 0.1, 7), np.zeros(7), np.zeros(7))
-    noise = SensorNoise(tau_std=0.05, q_std=0.0, dq_std=0.0)
-    *train, other = recordings(panda, (61, 62, 63), friction=fr, duration=8.0, noise=noise)
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore", DynidWarning)
-        model = identify_recordings(
-            panda, train, structure=Structure(False, ("viscous",)), validate_on=other
-        )
-    ho = model.info.heldout
-    assert ho["scheme"] == "file"
+    ho = _judged_on_a_separate_log(panda, (61, 62), 63, 0.05)
     assert ho["training_error_percent"] == pytest.approx(ho["heldout_error_percent"], rel=0.15)

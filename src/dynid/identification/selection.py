@@ -327,6 +327,8 @@ def _candidate_notes(judged: Sequence[Candidate]) -> list[str]:
 
 _Key = tuple[bool, str, str]  # regressor_group
 _Groups = dict[_Key, tuple[IdentifiedModel, list[tuple[ModelTerm, Any]]]]
+#: The regressors and the folds they are judged on.
+_Folds = dict[_Key, tuple[IdentifiedModel, list[tuple[ModelTerm, Any]], HeldOut]]
 
 
 def _without_odd(
@@ -404,7 +406,7 @@ def _per_recording(
 
 def _widths_per_joint(
     judged: Sequence[Candidate],
-    groups: dict[_Key, tuple[IdentifiedModel, list[tuple[ModelTerm, Any]], HeldOut]],
+    groups: _Folds,
     n: int,
     rtol: float,
     where: dict[Structure, _Key],
@@ -439,7 +441,7 @@ def _smooth_bumps(
     cands: Sequence[Structure],
     fit: Callable[[list[Structure]], list[Fitted]],
     groups: _Groups,
-    by_group: dict[_Key, tuple[IdentifiedModel, list[tuple[ModelTerm, Any]], HeldOut]],
+    by_group: _Folds,
     where: dict[Structure, _Key],
     skip: tuple[int, ...],
     rtol: float,
@@ -511,7 +513,7 @@ def _better(c: Candidate, than: Candidate) -> bool:
 
 def _per_joint(
     judged: Sequence[Candidate],
-    groups: dict[_Key, tuple[IdentifiedModel, list[tuple[ModelTerm, Any]], HeldOut]],
+    groups: _Folds,
     n: int,
     rtol: float,
     where: dict[Structure, _Key],
