@@ -222,21 +222,29 @@ def measured_instants(t: NDArray[np.float64], stamps: NDArray[np.float64]) -> ND
 def at_instants(p: TorqueLog, t: NDArray[np.float64]) -> TorqueLog:
     """The prepared log ``p`` (uniform, with ``ddq``) with its positions, velocities and
     accelerations moved to the instants ``t`` (one per sample, each within about a step of
-    the sample's own) by their Taylor series to the third derivative (read by central
-    differences of ``ddq``); its times and torques as they are (the torques: those
-    measured at ``t``; the times keep the samples' order where two share an instant).
-    The error is of order ``(2 pi f dt)^2`` of ``ddq`` for a motion of frequency ``f``
-    moved by ``dt``: 1e-4 at 1 Hz and 2 ms, where a linear step reads 1 %."""
+    the sample's own: :func:`_moved`); its times and torques as they are (the torques:
+    those measured at ``t``; the times keep the samples' order where two share an
+    instant)."""
+    q, dq, ddq = _moved(p, np.arange(p.n_samples), t)
+    return TorqueLog(t=p.t, q=q, dq=dq, tau=p.tau, ddq=ddq, cleaning=p.cleaning)
+
+
+def _moved(
+    p: TorqueLog, rows: NDArray[np.intp], t: NDArray[np.float64]
+) -> tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.float64]]:
+    """Positions, velocities and accelerations (M, n) of the prepared log ``p`` (uniform,
+    with ``ddq``) at the instants ``t`` (M,) [s], each moved from the sample ``rows`` (M,)
+    near it by their Taylor series to the third derivative (read by central differences
+    of ``ddq``). The error is of order ``(2 pi f dt)^2`` of ``ddq`` for a motion of
+    frequency ``f`` moved by ``dt``: 1e-4 at 1 Hz and 2 ms, where a linear step reads 1 %."""
     assert p.ddq is not None  # prepare_log always fills ddq
-    d = (np.asarray(t, dtype=np.float64) - p.t)[:, None]
-    dddq = np.gradient(p.ddq, p.t, axis=0) if p.n_samples > 1 else np.zeros_like(p.ddq)
-    return TorqueLog(
-        t=p.t,
-        q=p.q + d * (p.dq + d / 2 * (p.ddq + d / 3 * dddq)),
-        dq=p.dq + d * (p.ddq + d / 2 * dddq),
-        tau=p.tau,
-        ddq=p.ddq + d * dddq,
-        cleaning=p.cleaning,
+    d = (np.asarray(t, dtype=np.float64) - p.t[rows])[:, None]
+    dddq = np.gradient(p.ddq, p.t, axis=0, edge_order=2) if p.n_samples > 2 else 0 * p.ddq
+    q, dq, ddq, j = p.q[rows], p.dq[rows], p.ddq[rows], dddq[rows]
+    return (
+        q + d * (dq + d / 2 * (ddq + d / 3 * j)),
+        dq + d * (ddq + d / 2 * j),
+        ddq + d * j,
     )
 
 
@@ -257,39 +265,28 @@ def resamples(log: TorqueLog, prep: Preprocessing = _DEFAULT) -> bool:
 def at_measured_samples(blocks: Iterable[TorqueLog], log: TorqueLog) -> Iterator[TorqueLog]:
     """Consecutive prepared ``blocks`` of ``log`` (its uniform grid, as
     :func:`prepared_blocks` yields them, torques not filtered) read at the samples of
-    ``log`` itself: a block's positions, velocities and accelerations interpolated at the
-    measured instants from its first grid time up to the next block's (the last block: up
-    to its own last time), by a cubic spline of the
-    low-passed, hence band-limited, signals; the torques as measured. A log of jittered
-    or dropped samples is then judged on its own samples: the linear grid smears a torque
-    step (Coulomb friction at a reversal) between two stamps and averages a sample's noise
-    with its neighbour's (an xArm7 at 100 Hz, stamps +-2 ms: the true model's error 1.79 %
-    on the grid, 0.80 % on uniform stamps). A block with fewer than 2 measured samples
-    (a log's last few) is left out."""
-    from scipy.interpolate import CubicSpline  # here: a robot model loads no scipy
-
-    n = log.n
+    ``log`` itself: at each measured instant nearer a block's grid than the next block's
+    (the first block: from its first grid time; the last: up to its last), the positions,
+    velocities and accelerations moved from the nearest grid sample (:func:`_moved`), the
+    torques as measured. A log of jittered or dropped samples is then judged on its own samples: the
+    linear grid smears a torque step (Coulomb friction at a reversal) between two stamps
+    and averages a sample's noise with its neighbour's (an xArm7 at 100 Hz, stamps +-2 ms:
+    the true model's error 1.79 % on the grid, 0.80 % on uniform stamps). A block with
+    fewer than 2 measured samples (a log's last few) is left out."""
     it = iter(blocks)
     p = next(it, None)
+    a = int(np.searchsorted(log.t, p.t[0], side="left")) if p is not None else 0
     while p is not None:
         nxt = next(it, None)
-        assert p.ddq is not None  # prepare_log always fills ddq
-        a = int(np.searchsorted(log.t, p.t[0], side="left"))
-        if nxt is not None:
-            b = int(np.searchsorted(log.t, nxt.t[0], side="left"))
+        if nxt is not None:  # up to the midpoint: each instant moved from its nearest sample
+            b = int(np.searchsorted(log.t, 0.5 * (p.t[-1] + nxt.t[0]), side="left"))
         else:
             b = int(np.searchsorted(log.t, p.t[-1], side="right"))
         if b - a >= 2:
-            x = CubicSpline(p.t, np.concatenate([p.q, p.dq, p.ddq], axis=1), axis=0)(log.t[a:b])
-            yield TorqueLog(
-                t=log.t[a:b],
-                q=x[:, :n],
-                dq=x[:, n : 2 * n],
-                tau=log.tau[a:b],
-                ddq=x[:, 2 * n :],
-                cleaning=log.cleaning,
-            )
-        p = nxt
+            t = log.t[a:b]
+            q, dq, ddq = _moved(p, nearest_samples(t, p.t), t)
+            yield TorqueLog(t=t, q=q, dq=dq, tau=log.tau[a:b], ddq=ddq, cleaning=log.cleaning)
+        p, a = nxt, b
 
 
 def trimmed_margins(
