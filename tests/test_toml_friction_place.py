@@ -114,3 +114,37 @@ def test_friction_at_the_joints_without_a_drive_table_stays_there(tmp_path, moti
     )
     text = save_toml(tmp_path / "back.toml", robot).read_text()
     assert "[drive]" not in text and 'at = "joint"' in text
+
+
+def test_a_friction_file_acts_where_simulation_put_it_for_validate_and_observe(tmp_path):
+    """A per-joint friction file given to simulate, validate and observe through a geared
+    drive (friction at the motors): the three place it alike, per motor. validate read
+    the true model on its own simulated log as "unusable, 100 %" (the file at the joints)
+    and observe --calibrate set thresholds of about 1e5 N m without a word."""
+    import json
+
+    from dynid.cli.__main__ import main
+    from dynid.friction.model import ClassicalFriction
+    from dynid.io.friction_json import save_friction_json
+
+    fr = save_friction_json(
+        tmp_path / "fr.json",
+        ClassicalFriction(np.full(7, 2e-4), np.full(7, 2e-3), np.zeros(7)),
+    )
+    drive = tmp_path / "drive.toml"
+    drive.write_text(
+        'schema = "dynid-drive/1"\nside = "motor"\ngear_ratio = [50.0, 50, 50, 50, 30, 30, 30]\n'
+    )
+    common = ["--robot", "panda", "--drive", str(drive), "--friction", str(fr)]
+    log = tmp_path / "log.csv"
+    argv = ["simulate", *common, "--duration", "6", "--rate", "500", "--seed", "2", "-q"]
+    assert main([*argv, "--out", str(log)]) == 0
+    argv = ["validate", *common, "--data", str(log), "--no-figures", "-q"]
+    assert main([*argv, "--out", str(tmp_path / "v")]) == 0
+    doc = json.loads((tmp_path / "v" / "validation.json").read_text())
+    assert doc["with_friction"]["relative_error_percent"] < 2 * doc["noise_floor_percent"]
+    common[common.index("--robot")] = "--params"
+    argv = ["observe", *common, "--data", str(log), "--calibrate", "--no-figures", "-q"]
+    assert main([*argv, "--out", str(tmp_path / "c")]) == 0
+    th = json.loads((tmp_path / "c" / "thresholds.json").read_text())
+    assert max(th["contact"]) < 5.0  # N m: the model's error, not the file misplaced

@@ -70,6 +70,7 @@ __all__ = [
     "through_drive",
     "coulomb_sign",
     "friction_of",
+    "placed_friction",
     "robot_friction",
     "sigmoid_friction",
     "sigmoid_parameters",
@@ -280,6 +281,18 @@ def robot_friction(robot: Robot, drive: Drive | None = None) -> Friction | None:
     Without ``drive``: as held (what a robot description file writes)."""
     own = cast(Friction | None, robot.friction)
     return None if own is None else own.placed(drive)
+
+
+def placed_friction(
+    friction: FrictionModel | FrictionSum | None, drive: Drive | None
+) -> FrictionModel | FrictionSum | None:
+    """A friction given for a robot's own (a ``friction.json``, a model) where ``drive``
+    puts a robot's own (:func:`robot_friction`): a law per joint without a drive of its
+    own acts per motor (``K^T f(K dq)``) when the drive's friction acts at the motors; any
+    other acts as it says. Simulation, validation and the observer read a given friction
+    alike (a file validated through a geared drive read at the joints what simulation put
+    at the motors: "unusable, 100 %" for the true model)."""
+    return friction.placed(drive) if isinstance(friction, Friction) else friction
 
 
 def sigmoid_parameters(friction: object) -> NDArray[np.float64] | None:

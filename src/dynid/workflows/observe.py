@@ -50,7 +50,7 @@ from numpy.typing import NDArray
 from ..exceptions import DataError, OptionError
 from ..exceptions import in_file as about_file
 from ..friction.fit import same_drive
-from ..friction.model import FrictionModel, FrictionSum
+from ..friction.model import FrictionModel, FrictionSum, placed_friction
 from ..io.drive_file import drive_of_robot_file, load_drive
 from ..io.feasible import load_feasible_drive, load_feasible_linear_friction
 from ..io.friction_json import load_friction_json
@@ -220,14 +220,15 @@ def load_observer_model(
         raise OptionError(
             f"--base/--tip choose the chain of a --params URDF; {given} holds its own chain"
         )
-    fr: FrictionModel | FrictionSum | None | str
-    fr = "model" if friction is None else load_friction_json(friction)
+    fr: FrictionModel | FrictionSum | None | str = "model"
     if model is not None:
         ident = load_model_json(model)
         held = ident.drive
         own = same_drive(
             _drive(drive, ident.robot.n), held, "the model", "the one the model was identified with"
         )
+        if friction is not None:  # a file: where the drive puts a robot's own, as simulated
+            fr = placed_friction(load_friction_json(friction), own)
         obs = from_identified(ident, fr)
         if own is not held:  # a model without one: its logs are read through it
             obs = dataclasses.replace(obs, drive=own)
@@ -238,6 +239,8 @@ def load_observer_model(
         lin = load_feasible_linear_friction(spec)
         fr = "robot" if lin is None else lin
     own = observer_drive(spec, robot.n, drive)
+    if friction is not None:  # a file: where the drive puts a robot's own, as simulated
+        fr = placed_friction(load_friction_json(friction), own)
     return from_robot(robot, friction="robot" if fr == "model" else fr, drive=own), None
 
 

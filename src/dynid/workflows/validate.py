@@ -33,7 +33,7 @@ from numpy.typing import NDArray
 
 from ..exceptions import DataError, OptionError
 from ..friction.fit import same_drive
-from ..friction.model import FrictionModel, FrictionSum
+from ..friction.model import FrictionModel, FrictionSum, placed_friction
 from ..friction.recordings import RecordingsValidation, validate_recordings
 from ..friction.validation import RECORDED, own_friction
 from ..identification.derived_cutoff import with_derived_cutoff_hint
@@ -220,7 +220,7 @@ def validate_files(
         max_gap_s=opt.max_gap_s,
         reference=model.equivalent_robot if isinstance(model, IdentifiedModel) else None,
     )
-    friction, source = _friction(model, opt.friction, feasible, drive)
+    friction, source = _friction(model, opt.friction, feasible, own if drive is None else drive)
 
     def run() -> RecordingsValidation:
         return validate_recordings(
@@ -316,9 +316,9 @@ def _friction(
         if feasible is not None:
             own = load_feasible_linear_friction(feasible) or own
         return own, None if own is None else "model"
-    if isinstance(friction, str | Path):
-        return load_friction_json(friction), Path(friction).name
-    return friction, "given"
+    if isinstance(friction, str | Path):  # where the drive puts a robot's own, as simulated
+        return placed_friction(load_friction_json(friction), drive), Path(friction).name
+    return placed_friction(friction, drive), "given"
 
 
 def _overflow(names: Any, val: Any, label: str | None, opt: ValidateOptions) -> str:
