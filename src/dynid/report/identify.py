@@ -93,7 +93,7 @@ def _heldout_facts(
         at_floor = False
     headline = ""
     if is_number(train) and is_number(test):
-        fact, more = _overfit_fact(ho, train, test, at_floor)
+        fact, more = _overfit_fact(ho, train, test, at_floor, _parameters_per_row(doc))
         facts.append(fact)
         problems += more
         headline = f"The model predicts held-out torques to {percent(test)}"
@@ -117,15 +117,42 @@ def _heldout_facts(
     return facts, problems, headline
 
 
-def _overfit_fact(ho: dict, train: float, test: float, at_floor: bool) -> tuple[str, list[str]]:
-    """The training against the held-out error (over-fitting), and its problem."""
+def _parameters_per_row(doc: dict) -> float | None:
+    """The fit's coefficients over its rows (``metadata.n_rows``), or None."""
+    rows = _get(doc, "metadata", "n_rows")
+    if not (is_number(rows) and rows > 0):
+        return None
+    labels = _get(doc, "metadata", "friction_labels")
+    p = len(doc.get("coefficients") or []) + (len(labels) if isinstance(labels, list) else 0)
+    return p / rows
+
+
+#: Coefficients per row below which a fit cannot over-fit noticeably (least squares on
+#: white noise: held-out over training error about 1 + p / m).
+FEW_PARAMETERS_PER_ROW = 0.01
+
+
+def _overfit_fact(
+    ho: dict, train: float, test: float, at_floor: bool, per_row: float | None = None
+) -> tuple[str, list[str]]:
+    """The training against the held-out error (over-fitting), and its problem. With few
+    coefficients per row (``per_row`` below :data:`FEW_PARAMETERS_PER_ROW`) a gap between
+    recordings left out in turn is not over-fitting: the recordings hold effects outside
+    the model that differ between them (the held-out error against the floor judges it)."""
     scheme = {
         "blocks": f"over {ho.get('folds')} contiguous time blocks",
         "recordings": f"leaving out each of {ho.get('folds')} recordings in turn",
     }.get(str(ho.get("scheme")), "on the separate log")
     ratio = test / train if train > 0 else 1.0
+    few = per_row is not None and per_row < FEW_PARAMETERS_PER_ROW
     if ratio <= OVERFIT_GOOD:
         why = "no sign of over-fitting"
+    elif few:
+        why = (
+            f"not over-fitting, {per_row:.2g} coefficients per row: the "
+            + ("recordings" if ho.get("scheme") == "recordings" else "held-out data")
+            + " hold effects outside the model that differ from the training data's"
+        )
     elif at_floor:  # the fit follows some noise, and predicts as well as noise allows
         why = "the fit follows some of the noise, yet predicts to the noise floor below"
     else:
@@ -134,9 +161,11 @@ def _overfit_fact(ho: dict, train: float, test: float, at_floor: bool) -> tuple[
         f"Held-out error <b>{percent(test)}</b> {esc(scheme)} (the torques as measured), "
         f"training error {percent(train)} on the same (ratio {ratio:.2f}: {why})"
     )
-    if ratio > OVERFIT_FAIR and not at_floor:
+    if few or at_floor:
+        return fact, []
+    if ratio > OVERFIT_FAIR:
         return fact, ["poor"]
-    return fact, ["fair"] if ratio > OVERFIT_GOOD and not at_floor else []
+    return fact, ["fair"] if ratio > OVERFIT_GOOD else []
 
 
 def _floor_fact(
