@@ -57,3 +57,34 @@ def test_a_residual_of_twice_the_torque_names_the_joint_a_model_without_torques_
     assert not none.opposite().any() and opposite_finding(none, names) is None
     with pytest.raises(ShapeError):
         opposite_finding(none, ("a",))
+
+
+def test_a_model_that_explains_little_of_the_log_is_said_at_calibration(tmp_path, capsys):
+    """Calibrated on a log whose friction the model does not hold (Coulomb 15 N m against
+    the Panda's own sigmoid), the residual spreads over most of the torques' on the joints
+    it dominates: a warning names them (the thresholds were written without a word); the
+    model's own log gives none."""
+    import json
+
+    from dynid.cli.__main__ import main
+    from dynid.friction.model import ClassicalFriction
+    from dynid.io.friction_json import save_friction_json
+
+    big = save_friction_json(
+        tmp_path / "big.json", ClassicalFriction(np.zeros(7), np.full(7, 15.0), np.zeros(7))
+    )
+    for name, extra in (("own", []), ("big", ["--friction", str(big)])):
+        log = tmp_path / f"{name}.csv"
+        argv = ["simulate", "--robot", "panda", "--duration", "6", "--rate", "500", "-q"]
+        assert main([*argv, "--seed", "3", *extra, "--out", str(log)]) == 0
+    said = {}
+    for name in ("own", "big"):
+        capsys.readouterr()
+        argv = ["observe", "--params", "panda", "--data", str(tmp_path / f"{name}.csv")]
+        out = tmp_path / f"c_{name}"
+        assert main([*argv, "--calibrate", "--no-figures", "--out", str(out)]) == 0
+        err = capsys.readouterr().err.splitlines()
+        said[name] = [line for line in err if "unexplained" in line]
+        assert json.loads((out / "thresholds.json").read_text())["contact"]
+    assert not said["own"], said["own"]
+    assert len(said["big"]) == 1 and "big.csv: the model leaves" in said["big"][0], said["big"]

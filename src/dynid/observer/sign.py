@@ -30,7 +30,13 @@ from numpy.typing import ArrayLike, NDArray
 from .. import _checks
 from ..exceptions import ShapeError
 
-__all__ = ["OPPOSITE_CORRELATION", "TorqueSign", "opposite_finding"]
+__all__ = [
+    "OPPOSITE_CORRELATION",
+    "UNEXPLAINED_SHARE",
+    "TorqueSign",
+    "opposite_finding",
+    "unexplained_finding",
+]
 
 #: A joint whose measured torque correlates with the model's below this is of the opposite
 #: sign (module docstring).
@@ -98,6 +104,20 @@ class TorqueSign:
             c = self._m2[2] / np.sqrt(self._m2[0] * self._m2[1])
         return np.where(np.isfinite(c), c, 0.0)
 
+    def torque_spread(self) -> NDArray[np.float64]:
+        """Per joint (n,): the measured torques' spread, ``sqrt(sum (tau - mean)^2)``
+        [N m]."""
+        return np.sqrt(np.maximum(self._m2[0], 0.0))
+
+    def unexplained(self) -> NDArray[np.float64]:
+        """Per joint (n,): the residual's spread over the measured torques', ``std(r) /
+        std(tau)`` (``r`` the model's ``tau + r`` minus ``tau``); 0 where the torques are
+        constant or nothing was observed."""
+        tau, model, cross = self._m2
+        with np.errstate(invalid="ignore", divide="ignore"):
+            u = np.sqrt(np.maximum(model + tau - 2.0 * cross, 0.0) / tau)
+        return np.where(np.isfinite(u), u, 0.0)
+
     def opposite(self) -> NDArray[np.bool_]:
         """Per joint (n,): its measured torques have the opposite sign to the model's."""
         out: NDArray[np.bool_] = self.correlation() < OPPOSITE_CORRELATION
@@ -135,4 +155,37 @@ def opposite_finding(sign: TorqueSign, names: Sequence[str]) -> str | None:
         "probably opposite to the model's (or the model is wrong there), and the residual "
         "there is about twice the torque; hint: flip the sign of their torque columns in "
         "the file (--units tau=-1 flips every joint)"
+    )
+
+
+#: A residual whose spread is above this share of the measured torques' on a joint: the
+#: model explains too little of the log there to calibrate on it.
+UNEXPLAINED_SHARE = 0.5
+
+
+def unexplained_finding(sign: TorqueSign, names: Sequence[str]) -> str | None:
+    """The one-line finding of the joints whose residual spreads over more than
+    :data:`UNEXPLAINED_SHARE` of their measured torques' spread (the model, its drive or
+    its friction do not fit the log: thresholds calibrated on it detect nothing smaller),
+    among the joints whose torques vary (a tenth of the largest spread), or None.
+
+    Raises
+    ------
+    ShapeError
+        ``names`` not one per joint.
+    """
+    if len(names) != sign.n:
+        raise ShapeError(f"names must hold {sign.n} joint names; got {len(names)}")
+    spread = sign.torque_spread()
+    u = sign.unexplained()
+    varies = spread > 0.1 * float(spread.max(initial=0.0))
+    bad = [int(k) for k in np.flatnonzero((u > UNEXPLAINED_SHARE) & varies)]
+    if not bad:
+        return None
+    said = ", ".join(f"{names[k]} {u[k]:.3g}" for k in bad)
+    return (
+        f"the model leaves most of the measured torques unexplained (the residual's spread "
+        f"over the torques': {said}): thresholds calibrated on it detect only contacts "
+        "larger than the model's error; hint: check the model, its drive and friction on "
+        "this log with dynid validate"
     )

@@ -40,6 +40,7 @@ the command applies, so that the Python API behaves as the command does.
 from __future__ import annotations
 
 import dataclasses
+import warnings
 from collections.abc import Callable, Iterator, Mapping
 from dataclasses import dataclass
 from pathlib import Path
@@ -47,7 +48,7 @@ from pathlib import Path
 import numpy as np
 from numpy.typing import NDArray
 
-from ..exceptions import DataError, OptionError
+from ..exceptions import DataError, DynidWarning, OptionError
 from ..exceptions import in_file as about_file
 from ..friction.fit import same_drive
 from ..friction.model import FrictionModel, FrictionSum, placed_friction
@@ -63,7 +64,7 @@ from ..observer.events import DEFAULT_MERGE_S, DEFAULT_MIN_DURATION_S
 from ..observer.model import ObserverModel, from_identified, from_robot
 from ..observer.residual import DEFAULT_GAIN, ObserverOptions
 from ..observer.results import LogObservation, ObserveResult
-from ..observer.sign import TorqueSign, opposite_finding
+from ..observer.sign import TorqueSign, opposite_finding, unexplained_finding
 from .data_files import (
     ColumnSpec,
     column_map,
@@ -458,6 +459,8 @@ def _calibrated(
                 yield blk
             if (opposite := opposite_finding(sign, names)) is not None:
                 raise DataError(opposite, file=Path(path).name)
+            if (unexplained := unexplained_finding(sign, names)) is not None:
+                warnings.warn(f"{Path(path).name}: {unexplained}", DynidWarning, stacklevel=2)
             logs.append(_observation(prep, model, mapped, opts, keep, peak))
 
     # calibrate reads a block's residual, then its margin and std: these two come from the
