@@ -124,6 +124,19 @@ class TorqueSign:
         return out
 
 
+def _flagged(sign: TorqueSign, mask: NDArray[np.bool_], names: Sequence[str]) -> list[int]:
+    """The joints ``mask`` (n,) flags, for a finding naming them by ``names``.
+
+    Raises
+    ------
+    ShapeError
+        ``names`` not one per joint.
+    """
+    if len(names) != sign.n:
+        raise ShapeError(f"names must hold {sign.n} joint names; got {len(names)}")
+    return [int(k) for k in np.flatnonzero(mask)]
+
+
 def opposite_finding(sign: TorqueSign, names: Sequence[str]) -> str | None:
     """The one-line finding of the joints of opposite sign (naming them, their
     correlations and the remedy: ``--units tau=-1`` when every joint is, their torque
@@ -134,9 +147,7 @@ def opposite_finding(sign: TorqueSign, names: Sequence[str]) -> str | None:
     ShapeError
         ``names`` not one per joint.
     """
-    if len(names) != sign.n:
-        raise ShapeError(f"names must hold {sign.n} joint names; got {len(names)}")
-    bad = [int(k) for k in np.flatnonzero(sign.opposite())]
+    bad = _flagged(sign, sign.opposite(), names)
     if not bad:
         return None
     corr = sign.correlation()
@@ -174,12 +185,10 @@ def unexplained_finding(sign: TorqueSign, names: Sequence[str]) -> str | None:
     ShapeError
         ``names`` not one per joint.
     """
-    if len(names) != sign.n:
-        raise ShapeError(f"names must hold {sign.n} joint names; got {len(names)}")
     spread = sign.torque_spread()
     u = sign.unexplained()
     varies = spread > 0.1 * float(spread.max(initial=0.0))
-    bad = [int(k) for k in np.flatnonzero((u > UNEXPLAINED_SHARE) & varies)]
+    bad = _flagged(sign, (u > UNEXPLAINED_SHARE) & varies, names)
     if not bad:
         return None
     said = ", ".join(f"{names[k]} {u[k]:.3g}" for k in bad)
