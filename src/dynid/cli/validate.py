@@ -27,7 +27,10 @@ measured torques (the smallest error a model can reach on them): "at the noise f
 (at most 1.5 x the floor), "usable" (at most 3 x, or below 15 %), "poor" (below 50 %: the
 model misses effects the data show), "unusable" (50 % or more, or torques anti-correlated
 with the model's: a log of another robot, in other units or of the other sign). With
-several recordings, a recording worse than the whole is named.
+several recordings, a recording worse than the whole is named. When most of the error
+above the noise sits at low speed (standstill, reversals, the edges of a move: where the
+velocities' noise and low-pass blur a friction step) the verdict says so, with the error
+elsewhere against the noise.
 
 Exit status: 0 when the model explains the log (at the noise floor, usable or poor); 1
 when it is unusable, its files written all the same (the verdict line says why); 2 an

@@ -28,6 +28,7 @@ from ..friction.pooled import joined_validation
 from ..friction.validation import Validation, own_friction, validate_torques
 from ..identification.derived_cutoff import with_derived_cutoff_hint
 from ..identification.log import TorqueLog
+from ..identification.low_speed import with_low_speed_hint
 from ..identification.model import IdentifiedModel
 from ..identification.pieces import split_at_gaps, unwrapped, wrappable
 from ..identification.sanity import velocity_noise_std
@@ -82,7 +83,9 @@ class HeldOutTorques:
         (:func:`~dynid.identification.verdict.judge_prediction`): the error against the
         noise floor, each joint's against its noise and in relative terms; above the
         floor, with the hint of a cut-off too high for velocities derived from positions
-        (:func:`~dynid.identification.derived_cutoff.with_derived_cutoff_hint`)."""
+        (:func:`~dynid.identification.derived_cutoff.with_derived_cutoff_hint`) and that
+        of an error mostly at low speed
+        (:func:`~dynid.identification.low_speed.with_low_speed_hint`)."""
         e = self.validation.errors
         verdict = judge_prediction(
             e.relative_error_percent,
@@ -91,7 +94,11 @@ class HeldOutTorques:
             joint_percent=e.relative_error_percent_per_joint,
             joint_names=self.joint_names,
         )
-        return with_derived_cutoff_hint(verdict, self.logs, self.cutoff_hz)
+        verdict = with_derived_cutoff_hint(verdict, self.logs, self.cutoff_hz)
+        v = self.validation
+        return with_low_speed_hint(
+            verdict, [v.log.dq], [v.log.tau - v.tau_hat], self.noise_rms, self.joint_names
+        )
 
     def as_dict(self) -> dict[str, Any]:
         """JSON-ready: the errors per joint, the noise, the floor and the verdict (schema

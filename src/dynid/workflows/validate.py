@@ -18,7 +18,8 @@ with every policy the command applies, so that the Python API behaves as the com
 * The verdict (:func:`~dynid.identification.verdict.judge_prediction`): the error against
   the sensor-noise floor read from the measured torques, and whether they are
   anti-correlated with the model's; over all recordings and per recording, the worst
-  recording named when the recordings differ.
+  recording named when the recordings differ; an error mostly at low speed said so
+  (:func:`~dynid.identification.low_speed.with_low_speed_hint`).
 """
 
 from __future__ import annotations
@@ -37,6 +38,7 @@ from ..friction.model import FrictionModel, FrictionSum, placed_friction
 from ..friction.recordings import RecordingsValidation, validate_recordings
 from ..friction.validation import RECORDED, own_friction
 from ..identification.derived_cutoff import with_derived_cutoff_hint
+from ..identification.low_speed import with_low_speed_hint
 from ..identification.metrics import TorqueErrors
 from ..identification.model import IdentifiedModel
 from ..identification.sanity import anticorrelated, velocity_noise_std
@@ -251,6 +253,13 @@ def validate_files(
             v = each[r]
             verdict = Verdict(v.level, v.label, f"{rec.names[r]}: {v.reason}", v.ratio)
     verdict = with_derived_cutoff_hint(verdict, rec.logs, val.pieces.cutoff_hz)
+    verdict = with_low_speed_hint(
+        verdict,
+        [v.log.dq for v in val.parts],
+        [v.log.tau - v.tau_hat for v in val.parts],
+        noise,
+        names,
+    )
     return ValidateResult(
         validation=val,
         model=label or f"robot {robot.name}",
