@@ -67,7 +67,7 @@ from .estimators import Estimator, EstimatorName, estimator_named
 from .holdout import DEFAULT_FOLDS, HeldOut
 from .judge import heldout_judge
 from .largest import Fitted, LeftOut, fit_largest, recording_bands
-from .least_squares import StdMethod
+from .least_squares import StdMethod, within_motion_caveat
 from .log import TorqueLog
 from .metrics import noise_floor_percent
 from .model import IdentifiedModel
@@ -131,6 +131,15 @@ def _with_floor(heldout: Any, data: Recordings) -> Any:
     counts = np.array([np.shape(t)[0] for t in taus], dtype=np.float64)
     rms = np.sqrt(counts @ np.square(np.stack(noise)) / counts.sum())
     return {**heldout, "noise_floor_percent": floor, "noise_rms": rms.tolist()}
+
+
+def _heldout_record(model: IdentifiedModel, data: Recordings) -> Any:
+    """The model's held-out record with its noise floor (:func:`_with_floor`) and, judged
+    on time blocks of an ill-conditioned motion, the caveat of what they cannot tell
+    (:func:`~dynid.identification.least_squares.within_motion_caveat`)."""
+    heldout = _with_floor(model.info.heldout, data)
+    caveat = within_motion_caveat(model.fit, None if heldout is None else heldout.get("scheme"))
+    return heldout if caveat is None else {**heldout, "caveat": caveat}
 
 
 def _physical(candidates: Sequence[Candidate]) -> list[Candidate]:
@@ -723,7 +732,7 @@ def identify_recordings(
     warn_unphysical(model, terms)
     info = replace(
         model.info,
-        heldout=_with_floor(model.info.heldout, data if validation is None else validation),
+        heldout=_heldout_record(model, data if validation is None else validation),
         selection=None if selection is None else selection.as_dict(),
         extra={**model.info.extra, "terms": list(structure.terms)},
     )

@@ -62,6 +62,7 @@ __all__ = [
     "joint_ratios",
     "judge_prediction",
     "pooled_verdict",
+    "with_caveat",
     "worst",
 ]
 
@@ -297,3 +298,16 @@ def pooled_verdict(
         "excitation, the drive)",
         r,
     )
+
+
+def with_caveat(verdict: Verdict, caveat: str | None) -> Verdict:
+    """``verdict`` with a ``caveat`` on what the data it was judged on can tell: a verdict
+    at the noise floor (``"good"``) is ``"fair"`` (usable) with the caveat, a worse one
+    keeps its level and gets the caveat appended; ``verdict`` itself without one."""
+    if caveat is None:
+        return verdict
+    if verdict.level == "good":
+        return Verdict(
+            "fair", "usable", f"{verdict.reason} on these data, but {caveat}", verdict.ratio
+        )
+    return Verdict(verdict.level, verdict.label, f"{verdict.reason}; {caveat}", verdict.ratio)

@@ -32,7 +32,7 @@ from ..identification.low_speed import with_low_speed_hint
 from ..identification.model import IdentifiedModel
 from ..identification.pieces import split_at_gaps, unwrapped, wrappable
 from ..identification.sanity import velocity_noise_std
-from ..identification.verdict import Verdict, joint_ratios, judge_prediction
+from ..identification.verdict import Verdict, joint_ratios, judge_prediction, with_caveat
 from .style import COLOURS
 
 if TYPE_CHECKING:  # pragma: no cover
@@ -60,6 +60,11 @@ class HeldOutTorques:
         (:mod:`~dynid.identification.derived_cutoff`).
     cutoff_hz : float or None
         The cut-off [Hz] the held-out data were prepared at.
+    caveat : str or None
+        What the held-out data cannot tell (time blocks of a motion that leaves parameters
+        loose: :func:`~dynid.identification.least_squares.within_motion_caveat`), which
+        keeps the verdict from the noise floor (:func:`~dynid.identification.verdict.
+        with_caveat`).
     """
 
     validation: Validation
@@ -68,6 +73,7 @@ class HeldOutTorques:
     joint_names: tuple[str, ...]
     logs: tuple[TorqueLog, ...] = ()
     cutoff_hz: float | None = None
+    caveat: str | None = None
 
     @property
     def noise_floor_percent(self) -> float:
@@ -96,9 +102,10 @@ class HeldOutTorques:
         )
         verdict = with_derived_cutoff_hint(verdict, self.logs, self.cutoff_hz)
         v = self.validation
-        return with_low_speed_hint(
+        verdict = with_low_speed_hint(
             verdict, [v.log.dq], [v.log.tau - v.tau_hat], self.noise_rms, self.joint_names
         )
+        return with_caveat(verdict, self.caveat)
 
     def as_dict(self) -> dict[str, Any]:
         """JSON-ready: the errors per joint, the noise, the floor and the verdict (schema
@@ -188,7 +195,8 @@ def heldout_torques(
     names = tuple(model.robot.joint_names)
     read = (held if model.holdout.scheme == "file" else log,)  # the motion of a whole log
     given = None if model.info.log.cutoff_source == "motion" else model.info.log.cutoff_hz
-    return HeldOutTorques(v, noise, block, names, read, given)
+    caveat = (model.info.heldout or {}).get("caveat") if model.holdout.scheme == "blocks" else None
+    return HeldOutTorques(v, noise, block, names, read, given, caveat)
 
 
 def _recorded_noise(model: IdentifiedModel) -> NDArray[np.float64] | None:

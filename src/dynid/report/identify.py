@@ -24,7 +24,14 @@ from typing import Any
 
 from ..exceptions import DynidError
 from ..identification.structure import Structure
-from ..identification.verdict import FLOOR_GOOD, Verdict, joint_ratios, judge_prediction, worst
+from ..identification.verdict import (
+    FLOOR_GOOD,
+    Verdict,
+    joint_ratios,
+    judge_prediction,
+    with_caveat,
+    worst,
+)
 from .html import bar, cell, esc, figure, is_number, number, percent, section, table, verdict
 from .model_terms import terms_sections
 from .run import Answer, RunFiles
@@ -79,8 +86,10 @@ def _heldout_facts(
     train, test = _get(ho, "training_error_percent"), _get(ho, "heldout_error_percent")
     floor = _get(ho, "noise_floor_percent")
     judged = None  # the record's held-out error against its floor
+    caveat = ho.get("caveat") if isinstance(ho, dict) else None
     if is_number(test) and is_number(floor) and floor > 0:
         judged = _heldout_verdict(held, test, floor) if held else judge_prediction(test, floor)
+        judged = with_caveat(judged, caveat)
     block = held is not None and is_number(held.get("relative_error_percent"))
     if judged is not None:
         at_floor = judged.ratio is not None and judged.ratio <= FLOOR_GOOD
@@ -99,8 +108,9 @@ def _heldout_facts(
         headline = f"The model predicts held-out torques to {percent(test)}"
     if judged is not None:
         fact, more, headline = _floor_fact(
-            judged, test, floor, "torques it was judged on", contradicted
-        )
+            judged, test, floor, "torques it was judged on", contradicted,
+            within_motion=isinstance(caveat, str),
+        )  # fmt: skip
         facts += [fact] if floor_fact else []
         problems += more
     if block:
@@ -169,11 +179,18 @@ def _overfit_fact(
 
 
 def _floor_fact(
-    v: Verdict, err: float, floor: float, torques: str, contradicted: bool = False
+    v: Verdict,
+    err: float,
+    floor: float,
+    torques: str,
+    contradicted: bool = False,
+    *,
+    within_motion: bool = False,
 ) -> tuple[str, list[str], str]:
     """(fact, problems, headline) of an error against a sensor-noise floor (the joints
     the verdict names, or why it was reached; unusable where the data contradict the
-    robot)."""
+    robot; ``within_motion``: judged on blocks of the motion the model was fitted to, which
+    test too little, :func:`~dynid.identification.least_squares.within_motion_caveat`)."""
     r = v.ratio if v.ratio is not None else math.inf
     joints = v.reason.split("; ", 1)[1] if "; joint(s) " in v.reason else ""
     said = (
@@ -192,6 +209,8 @@ def _floor_fact(
     )
     if v.unusable:
         headline = f"The model does not explain held-out torques: error {percent(err)}"
+    elif within_motion:  # held-out data that test too little
+        headline += " on held-out blocks of the motion it was fitted to"
     return fact, [] if v.level == "good" else [v.level], headline
 
 
