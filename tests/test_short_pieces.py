@@ -16,6 +16,7 @@ import pytest
 import dynid
 from dynid import signals
 from dynid.identification.log import TorqueLog
+from dynid.identification.rate import decimation
 from dynid.identification.recordings import prepare_recordings
 from dynid.simulation.measurement import SensorNoise, sample_times, simulate_measurement
 from dynid.simulation.trajectories import random_fourier
@@ -90,6 +91,31 @@ def test_dropped_samples_are_counted_as_grid_points_added_not_as_negative_decima
     line = recordings_lines(rec.summary())[0]
     assert f"{counts.added} added by resampling onto a uniform grid" in line
     assert " -" not in line, line
+
+
+def test_recordings_at_other_rates_say_each_its_own_decimation():
+    """A 1 kHz and a 200 Hz recording of the same motion: each is decimated at its own
+    rate (1 in 10 and 1 in 4 at a 4.5 Hz cut-off, ``rate.decimation``); the summary
+    printed "1 in 10" for both, now each recording line says its own and the header the
+    range."""
+    from dynid.cli.summaries import recordings_lines, samples_text
+
+    panda = dynid.panda()
+    traj = random_fourier(panda, np.random.default_rng(8))
+    logs = [
+        simulate_measurement(
+            panda, traj(sample_times(6.0, fs)), rng=np.random.default_rng(1), noise=SensorNoise()
+        )
+        for fs in (1000.0, 200.0)
+    ]
+    rec = prepare_recordings(panda, logs, ["fast.csv", "slow.csv"], cutoff_hz=4.5)
+    expected = [decimation(fs, 4.5) for fs in (1000.0, 200.0)]
+    assert expected == [10, 4]
+    lines = recordings_lines(rec.summary())
+    for line, k in zip(lines, expected, strict=True):
+        assert f", 1 in {k})" in line, line
+    head = samples_text(rec.record(1).log, [4, 10])
+    assert "1 in 4 to 10, per recording below," in head, head
 
 
 def test_the_filter_edge_of_a_smooth_signal_is_as_accurate_as_its_interior():

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import sys
+from collections.abc import Sequence
 from typing import Any
 
 import numpy as np
@@ -43,7 +44,7 @@ def format_identification(model: IdentifiedModel, *, width: int = 60) -> str:
     if info.static is not None:
         data = f"{info.static.n_configurations} configurations"
     elif info.log is not None:
-        data = samples_text(info.log)
+        data = samples_text(info.log, _decimations(info.recordings))
     else:
         data = "? samples"
     head = [
@@ -188,11 +189,18 @@ def recordings_lines(recordings: Any) -> list[str]:
     recs = list(recordings or ())
     if len(recs) < 2 and all(r.get("pieces", 1) == 1 for r in recs):
         return []
+    each = len(_decimations(recs)) > 1  # recordings at other rates: each its own
     return [
         f"recording {r['file']}: {r['pieces']} piece(s), {r['samples']} samples used "
-        f"({r['duration_s']:.4g} s){_lost(r)}"
+        f"({r['duration_s']:.4g} s" + (f", 1 in {r['decimate']}" if each else "") + f"){_lost(r)}"
         for r in recs
     ]
+
+
+def _decimations(recordings: Any) -> tuple[int, ...]:
+    """The recordings' decimations, each once, smallest first (a record without them:
+    none)."""
+    return tuple(sorted({int(r["decimate"]) for r in recordings or () if "decimate" in r}))
 
 
 #: The causes a recording's samples are not used for, as a recording's record counts them
@@ -221,15 +229,21 @@ def _lost(rec: Any) -> str:
     return f" of {rec['recorded']} recorded" + (": " + ", ".join(parts) if parts else "")
 
 
-def samples_text(log: LogInfo) -> str:
+def samples_text(log: LogInfo, decimations: Sequence[int] = ()) -> str:
     """The samples of a torque log: used and recorded, the filter and decimation that chose
-    them, and the resampling when the timestamps were not uniform."""
+    them (``decimations``: the recordings', when they differ, e.g. at other rates), and the
+    resampling when the timestamps were not uniform."""
     cut = log.cutoff_hz
     how = "no low-pass" if cut is None else f"{cut:.3g} Hz low-pass"
     if log.cutoff_source == "motion" and log.motion_frequency_hz:
         how += f" (10 x the motion's {log.motion_frequency_hz:.3g} Hz)"
+    k = (
+        f"{decimations[0]} to {decimations[-1]}, per recording below,"
+        if len(decimations) > 1
+        else str(log.decimate)
+    )
     text = (
-        f"{log.n_samples_used} samples used (1 in {log.decimate} after the {how} and trimming "
+        f"{log.n_samples_used} samples used (1 in {k} after the {how} and trimming "
         f"of {log.n_samples_log} recorded"
     )
     if log.resampled:

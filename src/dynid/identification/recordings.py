@@ -320,7 +320,8 @@ class Recordings(TorqueRoute):
 
     def summary(self) -> tuple[dict[str, Any], ...]:
         """Per recording: ``file``, ``pieces``, ``samples`` used and ``duration_s`` used,
-        and where the others went (:meth:`SampleCounts.as_dict`) when counted."""
+        ``decimate`` (every k-th sample kept: at its own rate, 10 times the cut-off or
+        more), and where the others went (:meth:`SampleCounts.as_dict`) when counted."""
         out = []
         for r, name in enumerate(self.names):
             mine = [p for p, k in zip(self.pieces, self.recording, strict=True) if k == r]
@@ -329,6 +330,7 @@ class Recordings(TorqueRoute):
                 "pieces": len(mine),
                 "samples": sum(p.log.n_samples for p in mine),
                 "duration_s": float(sum(p.log.duration for p in mine)),
+                "decimate": max(p.decimate for p in mine),
             }
             if self.counts:
                 rec.update(self.counts[r].as_dict())
