@@ -201,6 +201,29 @@ def test_torque_log_leaves_out_the_friction_columns_of_a_still_joint():
     np.testing.assert_array_equal(model.friction.params[6, :2], 0.0)
 
 
+def test_a_joint_still_in_every_recording_is_said_once():
+    """Three recordings in which joint 7 never moves: the finding was printed once per
+    file, three identical lines; now once, the files named."""
+    import warnings
+
+    from dynid.identification.recordings import prepare_recordings
+
+    robot = dynid.panda()
+    t = np.arange(0, 4, 1 / 200.0)
+    logs = []
+    for seed in (31, 32, 33):
+        tr = dynid.random_fourier(robot, np.random.default_rng(seed), w_f=2 * np.pi * 0.2)(t)
+        q, dq, ddq = np.array(tr.q), np.array(tr.dq), np.array(tr.ddq)
+        q[:, 6], dq[:, 6], ddq[:, 6] = 0.3, 0.0, 0.0
+        logs.append(TorqueLog(t=t, q=q, dq=dq, tau=dynid.rnea(robot, q, dq, ddq), ddq=ddq))
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        prepare_recordings(robot, logs, ["a.csv", "b.csv", "c.csv"], cutoff_hz=None)
+    still = [str(w.message) for w in caught if "joint7 never leave" in str(w.message)]
+    assert len(still) == 1, still
+    assert still[0].startswith("a.csv, b.csv, c.csv: "), still[0]
+
+
 def test_condition_number_on_the_papers_1010_configurations_is_the_papers_48_9():
     """Issue 9: the paper's own configurations give its reported 48.9 (unscaled)."""
     from pathlib import Path

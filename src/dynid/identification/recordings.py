@@ -443,6 +443,7 @@ def prepare_recordings(
     pieces: list[tuple[int, TorqueLog]] = []
     turned: set[int] = set()
     cuts: list[int] = []
+    found: dict[str, list[str]] = {}  # each finding and the recordings it holds for
     for r, (name, log) in enumerate(zip(names, logs, strict=True)):
         if log.n != robot.n:
             raise ShapeError(
@@ -459,9 +460,11 @@ def prepare_recordings(
             if (opposite := opposite_sign(robot, whole)) is not None:
                 raise DataError(opposite, file=name)  # a fit would negate the masses
             for finding in check_torque_log(robot, whole):
-                shown = finding if len(names) == 1 else f"{name}: {finding}"
-                warnings.warn(shown, DynidWarning, stacklevel=2)
+                found.setdefault(finding, []).append(name)
         pieces += [(r, p) for p in mine]
+    for finding, which in found.items():  # one warning a finding, its recordings named
+        shown = finding if len(names) == 1 else f"{', '.join(which)}: {finding}"
+        warnings.warn(shown, DynidWarning, stacklevel=2)
     cutoff, edge = _cutoff_and_edge(pieces, drive, turns, cutoff_hz, trim_s)
     kw = dict(cutoff_hz=cutoff, trim_s=edge, max_gap_s=max_gap_s, decimate=decimate)
     prepared, recording, skipped, gone = _prepared(robot, pieces, names, drive, **kw)
