@@ -68,6 +68,23 @@ def test_urdf_export_of_smooth_friction_names_everything_it_leaves_out(tmp_path)
     assert "closest to the law over the velocity range" in lines[0]
 
 
+def test_a_narrow_smooth_law_is_said_once_not_as_an_approximation(tmp_path):
+    """A smooth law of width 0.0003 rad/s: the viscous and Coulomb terms written hold it to
+    round-off over the velocity range (2e-10 N m RMS): the export said so in a paragraph of
+    its own beside the rounding's; now the warning names the rounding alone, and the file
+    reads back the law's fv and fc."""
+    narrow = np.array([0.0003, 0.0002])  # rad/s
+    smooth = law_named("smooth").model(np.column_stack([FV, FC, 0 * FV]), narrow)
+    path, lines = _warnings(
+        export_urdf, tmp_path / "robot.urdf", _arm(), ExportOptions(friction=smooth)
+    )
+    assert len(lines) == 1 and "tanh(dq / v_s)" in lines[0], lines
+    assert "closest to the law over the velocity range" not in lines[0], lines[0]
+    np.testing.assert_allclose(
+        load_urdf(path).friction.as_array()[:, :2], np.column_stack([FV, FC]), atol=1e-6
+    )
+
+
 @pytest.mark.parametrize(
     ("law", "params", "band", "said"),
     [

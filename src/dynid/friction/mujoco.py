@@ -230,6 +230,13 @@ def joint_coulomb_viscous(
     return DriveJointTerms(z, terms.damping, terms.frictionloss, notes, terms.offset)
 
 
+#: RMS difference [N m] over the velocity range below which the viscous and Coulomb terms
+#: written for a smooth law hold it to round-off (a width of 0.0003 rad/s: 2e-10 N m), no
+#: note of its own: the rounding over the standstill band is said once, by
+#: :func:`unheld_friction`.
+ROUND_OFF_NM = 1e-6
+
+
 def _dissipative(
     friction: FrictionModel, terms: MjcfTerms, vmax: NDArray[np.float64]
 ) -> tuple[MjcfTerms, tuple[str, ...]]:
@@ -263,13 +270,16 @@ def _dissipative(
         loss[m], damping[m], _, rms = odd_coulomb_viscous(torque, top)
         worst = max(worst, rms)
     where = ", ".join(str(m + 1) for m in np.flatnonzero(negative))
+    replaced = replace(terms, damping=damping, frictionloss=loss)
+    if not where and worst < ROUND_OFF_NM:  # a narrow smooth law: its rounding is noted apart
+        return replaced, ()
     said = f" (a negative viscous or Coulomb term on {where})" if where else ""
     note = (
         f"{friction.kind} friction{said}: written as the nonnegative viscous and Coulomb "
         f"friction closest to the law over the velocity range (RMS difference up to "
         f"{worst:.3g} N m)"
     )
-    return replace(terms, damping=damping, frictionloss=loss), (note,)
+    return replaced, (note,)
 
 
 def unheld_friction(

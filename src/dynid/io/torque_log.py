@@ -460,14 +460,15 @@ def _columns(path: Path, names: list[str], line: int) -> tuple[int, bool]:
 
 
 def _say_unread(name: str, kind: str, extra: list[str]) -> None:
-    """One warning for the true external torques a simulation writes (``tau_ext``: ground
-    truth, which ``dynid observe`` compares its residual with), one for other columns
-    (labels, vendor estimates): kept in the file, not read as data."""
+    """An informational line for the true external torques a simulation writes
+    (``tau_ext``: ground truth, which ``dynid observe`` compares its residual with and says
+    so; a log of dynid's own simulation is no cause for a warning), a warning for other
+    columns (labels, vendor estimates): kept in the file, not read as data."""
     truth = [c for c in extra if re.fullmatch(r"tau_ext\d*", c)]
     rest = [c for c in extra if c not in truth]
     if truth:
         span = truth[0] if len(truth) == 1 else f"{truth[0]}..{truth[-1]}"
-        _log.warning(
+        _log.info(
             "%s: %s %s hold the true external torques of a simulation: ground truth, never "
             "read as data (dynid observe reports its residual against them)",
             name,
