@@ -227,6 +227,25 @@ def test_an_inadmissible_result_keeps_the_optimisers_amplitudes():
     assert "no admissible iterate" in ExcitationDesign(res, None).describe(robot)[2]
 
 
+def test_a_continuous_joint_without_acceleration_limits_is_designed_without_numpy_warnings():
+    """A 2R arm whose first joint is continuous (no position limits) and which has no
+    acceleration limits: the start position was the mean of -inf and inf (a numpy
+    "invalid value" warning a user saw as ``dynid excite: warning: invalid value
+    encountered in add``); the margins line said "acceleration inf rad/s^2". Now no
+    warning, the continuous joint starts at 0, and the line says "(no limit)" and which
+    margins were kept."""
+    robot = _torque_limited_2r(50.0).replace(
+        q_min=[-np.inf, -2.0], q_max=[np.inf, 2.0], ddq_max=[np.inf, np.inf]
+    )
+    opts = ExcitationOptions(duration=2.0, harmonics=2, base_frequency=0.5, max_iter=2)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", RuntimeWarning)
+        res = optimise_excitation(robot, np.random.default_rng(0), opts, obstacles=Obstacles())
+    line = ExcitationDesign(res, None).describe(robot)[1]
+    assert "acceleration (no limit)" in line and "inf" not in line, line
+    assert "beyond those kept (position 5 deg, velocity 10 deg/s" in line, line
+
+
 def test_excite_cli_writes_csv_json_and_figure_and_simulate_reads_them(tmp_path, capsys):
     """excite -> trajectory.csv/.json/excitation.png; simulate --trajectory on both files."""
     out = tmp_path / "ex"

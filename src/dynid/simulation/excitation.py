@@ -510,7 +510,8 @@ def optimise_excitation(
     caps = capsule_model(robot, options.radii)
     if q_start is None:
         finite = np.isfinite(robot.q_min) & np.isfinite(robot.q_max)
-        mid = np.where(finite, 0.5 * (robot.q_min + robot.q_max), 0.0)
+        lo, hi = np.where(finite, robot.q_min, 0.0), np.where(finite, robot.q_max, 0.0)
+        mid = 0.5 * (lo + hi)  # continuous joints (-inf, inf) start at 0
         q_start = robot.q_neutral if robot.q_neutral is not None else mid
     q_start = _checks.as_exact("q_start", q_start, (robot.n,))
     prob = _Problem(robot, options, obstacles, caps, base, q_start)

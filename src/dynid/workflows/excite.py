@@ -28,6 +28,15 @@ __all__ = ["EXCITE_RATE_HZ", "ExcitationDesign", "design_excitation"]
 EXCITE_RATE_HZ = 1000.0
 
 
+#: The limits an exciting trajectory keeps a margin from, and their units.
+MARGIN_UNITS = {"position": "rad", "velocity": "rad/s", "acceleration": "rad/s^2", "torque": "N m"}
+
+
+def _margin(x: float, unit: str) -> str:
+    """A margin with its unit, or ``(no limit)`` where the robot gives none."""
+    return f"{x:.3g} {unit}" if np.isfinite(x) else "(no limit)"
+
+
 @dataclass(frozen=True, slots=True, eq=False)
 class ExcitationDesign:
     """Result of :func:`design_excitation`.
@@ -61,11 +70,19 @@ class ExcitationDesign:
             f"{res.initial_condition_number:.4g}), scaled {res.scaled_condition_number:.4g}, "
             f"{res.iterations} iterations, status {res.status}"
         )
+        o = res.options
+        kept = (
+            f"position {np.rad2deg(o.position_margin):.3g} deg, velocity "
+            f"{np.rad2deg(o.velocity_margin):.3g} deg/s, acceleration "
+            f"{100 * o.acceleration_margin:.3g} % and torque {100 * o.torque_margin:.3g} % "
+            "of the limit"
+        )
         second = (
-            "smallest margins at 1 kHz: position "
-            f"{min(m['position']):.3g} rad, velocity {min(m['velocity']):.3g} rad/s, "
-            f"acceleration {min(m['acceleration']):.3g} rad/s^2, torque "
-            f"{min(m['torque']):.3g} N m, self-collision {m['self_collision']:.3g} m"
+            f"smallest margins at 1 kHz beyond those kept ({kept}; 0: at a kept margin): "
+            + ", ".join(
+                f"{name} {_margin(min(m[name]), unit)}" for name, unit in MARGIN_UNITS.items()
+            )
+            + f", self-collision {m['self_collision']:.3g} m"
             + "".join(f", {k} {v:.3g} m" for k, v in m["obstacles"].items())
         )
         note = self.start_note()
