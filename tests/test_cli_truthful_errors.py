@@ -329,6 +329,24 @@ def test_a_file_of_another_delimiter_is_named_as_such(sep, what, kind, tmp_path,
     )
 
 
+def test_a_semicolon_file_with_decimal_commas_is_told_to_convert_them_first(tmp_path, capsys):
+    """A semicolon-separated log with decimal commas (a spreadsheet's export in many
+    locales): "replace each semicolon with a comma" alone would make 0,05 two cells; the
+    hint converts the decimal commas first, and following it reads the file."""
+    csv = tmp_path / "comma.csv"
+    _log_rows(csv, 50)
+    text = csv.read_text()
+    euro = tmp_path / "euro.csv"
+    euro.write_text(text.replace(",", ";").replace(".", ","))
+    assert main(["identify", "--data", str(euro), "--out", str(tmp_path / "o")]) == 2
+    err = capsys.readouterr().err
+    assert "hint: the numbers have decimal commas: replace each comma with a point, then " \
+        "replace each semicolon with a comma" in err, err  # fmt: skip
+    fixed = tmp_path / "fixed.csv"
+    fixed.write_text(euro.read_text().replace(",", ".").replace(";", ","))
+    assert fixed.read_text() == text
+
+
 # ---------------------------------------------------------------------- smaller wording
 def test_smaller_wording_defects(tmp_path, capsys, caplog):
     """No Python tuple in the export's format line; --prior-weight 0 refused by the parser

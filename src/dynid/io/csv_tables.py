@@ -94,7 +94,10 @@ def csv_table(
             break
         if names is None:
             raise DataError(f"no header line found; expected columns {expected}", file=path.name)
-        _check_delimiter(path, names, lineno)
+        if len(names) == 1:  # another delimiter: its first row tells the decimal mark
+            at = fb.tell()
+            _check_delimiter(path, names, lineno, fb.readline().decode("utf-8", "replace"))
+            fb.seek(at)
         layout = layout_of(names, lineno)
         first = lineno + 1
         start = fb.tell()
@@ -116,16 +119,22 @@ def csv_table(
 _OTHER_DELIMITERS = (("\t", "tab"), (";", "semicolon"), ("|", "vertical bar"))
 
 
-def _check_delimiter(path: Path, names: list[str], lineno: int) -> None:
+def _check_delimiter(path: Path, names: list[str], lineno: int, row: str = "") -> None:
     """Refuse a header of one column that holds another delimiter (a tab- or
-    semicolon-separated file), naming it, before its column names are judged."""
+    semicolon-separated file), naming it, before its column names are judged; the first
+    ``row`` holding commas as well: decimal commas, which the hint converts first."""
     if len(names) != 1:
         return
     for sep, what in _OTHER_DELIMITERS:
         if sep in names[0]:
+            hint = f"replace each {what} with a comma"
+            if sep in row and "," in row:  # 0,05;2,15: commas are the decimal mark
+                hint = (
+                    f"the numbers have decimal commas: replace each comma with a point, then {hint}"
+                )
             raise DataError(
                 f"the header holds {what}s and no comma: a {what}-separated file; dynid "
-                f"reads comma-separated files; hint: replace each {what} with a comma",
+                f"reads comma-separated files; hint: {hint}",
                 file=path.name,
                 at=f"line {lineno}",
             )
