@@ -15,12 +15,11 @@ so, with the remedy; a verdict above the floor carries it
 
 from __future__ import annotations
 
-import dataclasses
 from collections.abc import Sequence
 
 from .log import TorqueLog
 from .trim import common_cutoff
-from .verdict import Verdict
+from .verdict import Verdict, with_hint
 
 __all__ = ["DERIVED_CUTOFF_RATIO", "derived_cutoff_hint", "with_derived_cutoff_hint"]
 
@@ -64,7 +63,4 @@ def with_derived_cutoff_hint(
     applies; else ``verdict`` itself."""
     if verdict.level == "good":
         return verdict
-    hint = derived_cutoff_hint(logs, cutoff_hz)
-    if hint is None:
-        return verdict
-    return dataclasses.replace(verdict, reason=f"{verdict.reason}, or {hint}")
+    return with_hint(verdict, derived_cutoff_hint(logs, cutoff_hz), ", or ")

@@ -77,6 +77,11 @@ class LogInfo:
         The longest gap bridged, as given [s]; None: the default rule
         (:func:`~dynid.identification.log.default_max_gap`). ``validate`` and ``friction``
         cut their recordings with it unless told otherwise.
+    speed_max : tuple of float or None
+        Each joint's largest speed [rad/s or m/s] over the samples used (as prepared, at
+        the joints): the motion the model was identified on, which ``validate`` compares
+        a recording's with (:mod:`~dynid.identification.motion_range`); None in older
+        records.
     """
 
     cutoff_hz: float | None
@@ -94,6 +99,7 @@ class LogInfo:
     resampled: bool = False
     n_cuts: int = 0
     max_gap_s: float | None = None
+    speed_max: tuple[float, ...] | None = None
 
     @property
     def preprocessing(self) -> Preprocessing:

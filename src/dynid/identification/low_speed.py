@@ -19,13 +19,12 @@ samples.
 
 from __future__ import annotations
 
-import dataclasses
 from collections.abc import Sequence
 
 import numpy as np
 from numpy.typing import NDArray
 
-from .verdict import FLOOR_GOOD, Verdict
+from .verdict import FLOOR_GOOD, Verdict, with_hint
 
 __all__ = ["LOW_SPEED_SHARE", "MOSTLY", "low_speed_hint", "with_low_speed_hint"]
 
@@ -105,7 +104,4 @@ def with_low_speed_hint(
     noise floor (not ``"good"``) and the hint applies; else ``verdict`` itself."""
     if verdict.level == "good":
         return verdict
-    hint = low_speed_hint(dq, error, noise_rms, joint_names)
-    if hint is None:
-        return verdict
-    return dataclasses.replace(verdict, reason=f"{verdict.reason}; {hint}")
+    return with_hint(verdict, low_speed_hint(dq, error, noise_rms, joint_names))

@@ -180,6 +180,7 @@ class PreparedLog(TorqueRoute):
                 cutoff_source="given" if self.motion_frequency_hz is None else "motion",
                 motion_frequency_hz=self.motion_frequency_hz,
                 resampled=self.resampled,
+                speed_max=tuple(float(x) for x in np.max(np.abs(self.log.dq), axis=0)),
             ),
         )
 

@@ -360,6 +360,9 @@ class Recordings(TorqueRoute):
             motion_frequency_hz=first.motion_frequency_hz,
             resampled=any(p.resampled for p in ps),
             n_cuts=sum(cuts),
+            speed_max=tuple(
+                float(x) for x in np.max([np.max(np.abs(p.log.dq), axis=0) for p in ps], axis=0)
+            ),
             max_gap_s=self.max_gap_s,
         )
         notes = tuple(self.skipped)

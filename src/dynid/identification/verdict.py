@@ -63,6 +63,7 @@ __all__ = [
     "judge_prediction",
     "pooled_verdict",
     "with_caveat",
+    "with_hint",
     "worst",
 ]
 
@@ -311,3 +312,11 @@ def with_caveat(verdict: Verdict, caveat: str | None) -> Verdict:
             "fair", "usable", f"{verdict.reason} on these data, but {caveat}", verdict.ratio
         )
     return Verdict(verdict.level, verdict.label, f"{verdict.reason}; {caveat}", verdict.ratio)
+
+
+def with_hint(verdict: Verdict, hint: str | None, joiner: str = "; ") -> Verdict:
+    """``verdict`` with ``hint`` appended to its reason (after ``joiner``) when it is above
+    the noise floor (not ``"good"``) and there is a hint; else ``verdict`` itself."""
+    if verdict.level == "good" or hint is None:
+        return verdict
+    return Verdict(verdict.level, verdict.label, f"{verdict.reason}{joiner}{hint}", verdict.ratio)

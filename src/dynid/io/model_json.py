@@ -304,6 +304,8 @@ def _route_parts(m: dict[str, Any]) -> tuple[StaticInfo | None, LogInfo | None]:
         static = StaticInfo(n_conf, int(m.pop("rows_per_configuration", 0)))
     if "decimate" in m:
         vals = {k: m.pop(k) for k in _LOG_KEYS if k in m}
+        if vals.get("speed_max") is not None:
+            vals["speed_max"] = tuple(float(x) for x in vals["speed_max"])
         log = LogInfo(**vals)
     return static, log
 

@@ -19,7 +19,9 @@ with every policy the command applies, so that the Python API behaves as the com
   the sensor-noise floor read from the measured torques, and whether they are
   anti-correlated with the model's; over all recordings and per recording, the worst
   recording named when the recordings differ; an error mostly at low speed said so
-  (:func:`~dynid.identification.low_speed.with_low_speed_hint`).
+  (:func:`~dynid.identification.low_speed.with_low_speed_hint`), and joints moved far
+  faster than in an identified model's data
+  (:func:`~dynid.identification.motion_range.with_motion_range_hint`).
 """
 
 from __future__ import annotations
@@ -41,6 +43,7 @@ from ..identification.derived_cutoff import with_derived_cutoff_hint
 from ..identification.low_speed import with_low_speed_hint
 from ..identification.metrics import TorqueErrors
 from ..identification.model import IdentifiedModel
+from ..identification.motion_range import with_motion_range_hint
 from ..identification.sanity import anticorrelated, velocity_noise_std
 from ..identification.verdict import LEVELS, Verdict, joint_ratios, judge_prediction
 from ..io.feasible import load_feasible_drive, load_feasible_linear_friction
@@ -260,6 +263,9 @@ def validate_files(
         noise,
         names,
     )
+    if isinstance(model, IdentifiedModel) and model.info.log is not None:
+        speeds = model.info.log.speed_max
+        verdict = with_motion_range_hint(verdict, speeds, [v.log.dq for v in val.parts], names)
     return ValidateResult(
         validation=val,
         model=label or f"robot {robot.name}",
