@@ -456,7 +456,7 @@ def prepare_recordings(
             whole = joined([joint_side_log(p, drive) for p in mine])
             if (opposite := opposite_sign(robot, whole)) is not None:
                 raise DataError(opposite, file=name)  # a fit would negate the masses
-            for finding in check_torque_log(robot, whole):
+            for finding in check_torque_log(robot, whole, drive):
                 shown = finding if len(names) == 1 else f"{name}: {finding}"
                 warnings.warn(shown, DynidWarning, stacklevel=2)
         pieces += [(r, p) for p in mine]

@@ -13,7 +13,8 @@ with them before fitting (:func:`log_findings`). None of them changes the data.
   joints; ``a`` near 1e3 or 1e-3 is a unit off by a power of ten (mN m against N m:
   :func:`torque_unit_finding`, refused by the commands unless ``--units`` names the
   torques' unit), and currents logged as torques show as a factor far from 1 (a drive
-  file with ``torque_constant``). Sign and scale compare variations: not made on a log at rest
+  file with ``torque_constant``; currents read through one: its ``torque_constant`` or
+  ``gear_ratio`` is off by the factor). Sign and scale compare variations: not made on a log at rest
   (every joint frozen), whose variations are noise, nor on a joint whose gravity torques
   span less than :data:`GRAVITY_RANGE_SHARE` of the log's largest (a short stretch, whose
   torque variations are the motion's).
@@ -50,6 +51,7 @@ from numpy.typing import ArrayLike, NDArray
 from .. import _checks, signals
 from ..dynamics.terms import gravity_torques
 from ..exceptions import ShapeError
+from ..model.drive import Drive
 from ..model.robot import Robot
 from .log import TorqueLog
 
@@ -275,9 +277,10 @@ def moving_joints(dq: ArrayLike, noise_std: ArrayLike | None = None) -> NDArray[
     return out
 
 
-def check_torque_log(robot: Robot, log: TorqueLog) -> list[str]:
-    """One line per finding on a joint-side log of ``robot`` (module docstring); empty when
-    nothing looks wrong."""
+def check_torque_log(robot: Robot, log: TorqueLog, drive: Drive | None = None) -> list[str]:
+    """One line per finding on a joint-side log of ``robot`` (module docstring), read
+    through ``drive`` (its torque constants and gear ratios are named by the scale
+    finding); empty when nothing looks wrong."""
     step = max(1, log.n_samples // _MAX_SAMPLES)
     q, dq, tau, t = log.q[::step], log.dq[::step], log.tau[::step], log.t[::step]
     out: list[str] = []
@@ -287,7 +290,7 @@ def check_torque_log(robot: Robot, log: TorqueLog) -> list[str]:
     # the robot's own parameters: a model to compare with; at rest the torques' and the
     # gravity torques' variations are noise, whose ratio says nothing of the units
     if np.any(robot.phi) and not out and not np.all(frozen):
-        out += _sign_and_scale(robot, q, tau, names)
+        out += _sign_and_scale(robot, q, tau, names, drive)
     out += _milliseconds(log)
     if np.any(frozen) and not np.all(frozen):
         which = ", ".join(names[j] for j in np.flatnonzero(frozen))
@@ -401,13 +404,17 @@ def _opposite(
 
 
 def _sign_and_scale(
-    robot: Robot, q: NDArray[np.float64], tau: NDArray[np.float64], names: tuple[str, ...]
+    robot: Robot,
+    q: NDArray[np.float64],
+    tau: NDArray[np.float64],
+    names: tuple[str, ...],
+    drive: Drive | None,
 ) -> list[str]:
     if (opposite := _opposite(robot, q, tau, names)) is not None:
         return [opposite]
     a = _torque_scale(robot, q, tau)
     if a is not None and (abs(a) > 30 or 0 < abs(a) < 1 / 30):
-        return [_scale_line(a)]
+        return [_scale_line(a, drive=drive)]
     return []
 
 
@@ -421,16 +428,29 @@ def _torque_scale(robot: Robot, q: NDArray[np.float64], tau: NDArray[np.float64]
     return float(np.sum(gc[:, loaded] * tc[:, loaded]) / np.sum(gc[:, loaded] ** 2))
 
 
-def _scale_line(a: float, refused: bool = False) -> str:
+def _scale_line(a: float, refused: bool = False, drive: Drive | None = None) -> str:
     """The scale finding of factor ``a``, with its hint (and, ``refused``, the way to read
-    the torques as they are)."""
+    the torques as they are); through a ``drive`` of currents, the torque constants and
+    gear ratios the torques were made with are named, not a missing drive file."""
     p = round(math.log10(abs(a)))
+    if drive is not None and drive.effort == "current":
+        at = "at the motor" if drive.side == "motor" else "at the joint"
+        hint = (
+            f"check torque_constant (N m per A, {at}) and gear_ratio in the drive file"
+            + ("; currents in mA: --units tau=0.001" if p == 3 else "")
+            + (" (--units tau=1 reads the currents as they are)" if refused else "")
+        )
+        return (
+            f"the measured torques (the currents times the drive's torque constants) are "
+            f"{abs(a):.3g} times the model's gravity torques: the drive file's torque_constant "
+            f"or gear_ratio looks off by that factor; hint: {hint}"
+        )
     hint = (
         "--units tau=mNm"
         if p == 3
         else "--units tau=1000 (kN m)"
         if p == -3
-        else "currents need a drive file with torque_constant"
+        else 'currents need a drive file with effort = "current" and torque_constant'
     )
     if refused:
         hint += " (--units tau=Nm reads them as N m)"
@@ -440,7 +460,7 @@ def _scale_line(a: float, refused: bool = False) -> str:
     )
 
 
-def torque_unit_finding(robot: Robot, log: TorqueLog) -> str | None:
+def torque_unit_finding(robot: Robot, log: TorqueLog, drive: Drive | None = None) -> str | None:
     """The finding that a joint-side log's torques are in mN m (or kN m) read as N m, or
     None: their factor to ``robot``'s gravity torques (:func:`check_torque_log`'s scale)
     within :data:`UNIT_SCALE_TOLERANCE` of ``1e3`` (or ``1e-3``).
@@ -450,7 +470,8 @@ def torque_unit_finding(robot: Robot, log: TorqueLog) -> str | None:
     floor. A factor far from a power of ten (a model that is wrong, currents) is only
     warned. None too where :func:`check_torque_log` makes no scale finding: a robot without
     inertial parameters, every joint frozen, positions that look like degrees, torques of
-    the opposite sign, a log too short to check (:func:`too_few_samples`)."""
+    the opposite sign, a log too short to check (:func:`too_few_samples`). Through a
+    ``drive`` of currents, the line names its torque constants and gear ratios."""
     if too_few_samples(log) is not None or not np.any(robot.phi):
         return None
     if not np.any(moving_joints(log.dq)) or _degrees(robot, log):
@@ -465,7 +486,7 @@ def torque_unit_finding(robot: Robot, log: TorqueLog) -> str | None:
     off = math.log10(abs(a))
     if abs(abs(off) - 3) > math.log10(UNIT_SCALE_TOLERANCE):
         return None
-    return _scale_line(a, refused=True)
+    return _scale_line(a, refused=True, drive=drive)
 
 
 #: Relative tolerance of "``dq`` agrees with the derivative of ``q``" (filtered velocities

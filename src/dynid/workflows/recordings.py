@@ -319,7 +319,7 @@ def check_torque_unit(
     if cmap is not None and "tau" in cmap.factors:
         return
     for name, log in zip(rec.names, rec.logs, strict=True):
-        if (found := torque_unit_finding(robot, _joint_side(log, drive))) is not None:
+        if (found := torque_unit_finding(robot, _joint_side(log, drive), drive)) is not None:
             raise DataError(found, file=name)
 
 
