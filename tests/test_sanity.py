@@ -99,6 +99,33 @@ def test_a_current_drive_with_torque_constants_is_named_not_asked_for(panda_log)
         prepare_recordings(robot, [currents], drive=wrong, cutoff_hz=None)
 
 
+def test_the_unit_refusal_and_the_warnings_judge_scale_behind_the_same_guards(panda_log):
+    """The torque unit refusal and the log's findings each wrote out which logs the scale
+    is judged on (degrees, every joint frozen, the opposite sign, no inertial parameters),
+    two chains that could drift apart: on each such log both stay silent on scale, and
+    on mN m both speak."""
+    robot = dynid.panda()
+    g = panda_log
+    z = np.zeros_like(g.dq)
+    cases = {
+        "degrees": (robot, TorqueLog(g.t, np.degrees(g.q), np.degrees(g.dq), 1e3 * g.tau)),
+        "frozen": (robot, TorqueLog(g.t, g.q[:1] + z, z, 1e3 * g.tau)),
+        "flipped": (robot, TorqueLog(g.t, g.q, g.dq, -1e3 * g.tau)),
+        "no inertial parameters": (
+            robot.with_params(np.zeros_like(robot.phi)),
+            TorqueLog(g.t, g.q, g.dq, 1e3 * g.tau),
+        ),
+    }
+    for name, (r, log) in cases.items():
+        assert torque_unit_finding(r, log) is None, name
+        scale = [f for f in check_torque_log(r, log) if "gravity torques:" in f]
+        assert scale == [], (name, scale)
+    mnm = TorqueLog(g.t, g.q, g.dq, 1e3 * g.tau)
+    refused = torque_unit_finding(robot, mnm)
+    (warned,) = check_torque_log(robot, mnm)
+    assert refused is not None and refused.startswith(warned.split("; hint")[0])
+
+
 @pytest.mark.filterwarnings("ignore:.*indistinguishable from zero")  # expected: weak coefficients
 def test_identification_refuses_a_flipped_sign_before_fitting(panda_log):
     """identify_from_log refuses torques of the opposite sign, with the hint: the fit

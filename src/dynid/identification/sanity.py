@@ -44,6 +44,7 @@ from __future__ import annotations
 
 import dataclasses
 import math
+from dataclasses import dataclass
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -281,17 +282,15 @@ def check_torque_log(robot: Robot, log: TorqueLog, drive: Drive | None = None) -
     """One line per finding on a joint-side log of ``robot`` (module docstring), read
     through ``drive`` (its torque constants and gear ratios are named by the scale
     finding); empty when nothing looks wrong."""
-    step = max(1, log.n_samples // _MAX_SAMPLES)
-    q, dq, tau, t = log.q[::step], log.dq[::step], log.tau[::step], log.t[::step]
-    out: list[str] = []
-    names = robot.joint_names
-    out += _degrees(robot, log)  # first: the gravity torques at such positions say nothing
-    frozen = ~moving_joints(log.dq)
-    # the robot's own parameters: a model to compare with; at rest the torques' and the
-    # gravity torques' variations are noise, whose ratio says nothing of the units
-    if np.any(robot.phi) and not out and not np.all(frozen):
-        out += _sign_and_scale(robot, q, tau, names, drive)
+    seen = _against_gravity(robot, log)
+    out = list(seen.degrees)
+    a = seen.scale
+    if seen.opposite is not None:
+        out.append(seen.opposite)
+    elif a is not None and (abs(a) > 30 or 0 < abs(a) < 1 / 30):
+        out.append(_scale_line(a, drive=drive))
     out += _milliseconds(log)
+    frozen, names = seen.frozen, robot.joint_names
     if np.any(frozen) and not np.all(frozen):
         which = ", ".join(names[j] for j in np.flatnonzero(frozen))
         out.append(
@@ -299,8 +298,48 @@ def check_torque_log(robot: Robot, log: TorqueLog, drive: Drive | None = None) -
             "unidentifiable and is left out (zero) rather than fitted from noise; hint: a "
             "trajectory that moves every joint identifies them"
         )
-    del t, dq
     return out
+
+
+@dataclass(frozen=True, slots=True)
+class _GravitySaid:
+    """What a joint-side log says against the robot's gravity torques: the sign and scale
+    findings' guards, one for :func:`check_torque_log` and :func:`torque_unit_finding`.
+
+    Attributes
+    ----------
+    degrees : tuple of str
+        The degrees finding (said first, and instead of sign and scale: the gravity
+        torques at positions in degrees say nothing of the torques).
+    frozen : ndarray of bool, shape (n,)
+        The joints that never leave their velocity noise band.
+    opposite : str or None
+        The sign finding (:func:`_opposite`).
+    scale : float or None
+        ``a`` of ``tau ~ a g(q)`` (:func:`_torque_scale`); None where not compared: a
+        robot without inertial parameters, every joint frozen (at rest the variations are
+        noise, whose ratio says nothing of the units), degrees, the opposite sign, no
+        joint gravity loads.
+    """
+
+    degrees: tuple[str, ...]
+    frozen: NDArray[np.bool_]
+    opposite: str | None = None
+    scale: float | None = None
+
+
+def _against_gravity(robot: Robot, log: TorqueLog) -> _GravitySaid:
+    """The degrees, frozen joints, sign and scale of ``log`` against ``robot``'s gravity
+    torques (:class:`_GravitySaid`), each judged only where the ones before allow."""
+    degrees = tuple(_degrees(robot, log))
+    frozen = ~moving_joints(log.dq)
+    if not np.any(robot.phi) or degrees or np.all(frozen):
+        return _GravitySaid(degrees, frozen)
+    step = max(1, log.n_samples // _MAX_SAMPLES)
+    q, tau = log.q[::step], log.tau[::step]
+    if (opposite := _opposite(robot, q, tau, robot.joint_names)) is not None:
+        return _GravitySaid(degrees, frozen, opposite)
+    return _GravitySaid(degrees, frozen, None, _torque_scale(robot, q, tau))
 
 
 def _correlations(reference: NDArray[np.float64], tau: NDArray[np.float64]) -> NDArray[np.float64]:
@@ -403,21 +442,6 @@ def _opposite(
     )
 
 
-def _sign_and_scale(
-    robot: Robot,
-    q: NDArray[np.float64],
-    tau: NDArray[np.float64],
-    names: tuple[str, ...],
-    drive: Drive | None,
-) -> list[str]:
-    if (opposite := _opposite(robot, q, tau, names)) is not None:
-        return [opposite]
-    a = _torque_scale(robot, q, tau)
-    if a is not None and (abs(a) > 30 or 0 < abs(a) < 1 / 30):
-        return [_scale_line(a, drive=drive)]
-    return []
-
-
 def _torque_scale(robot: Robot, q: NDArray[np.float64], tau: NDArray[np.float64]) -> float | None:
     """The least-squares factor ``a`` of ``tau ~ a g(q)`` over the joints gravity loads,
     their means removed (None when gravity loads none)."""
@@ -472,15 +496,9 @@ def torque_unit_finding(robot: Robot, log: TorqueLog, drive: Drive | None = None
     inertial parameters, every joint frozen, positions that look like degrees, torques of
     the opposite sign, a log too short to check (:func:`too_few_samples`). Through a
     ``drive`` of currents, the line names its torque constants and gear ratios."""
-    if too_few_samples(log) is not None or not np.any(robot.phi):
+    if too_few_samples(log) is not None:
         return None
-    if not np.any(moving_joints(log.dq)) or _degrees(robot, log):
-        return None
-    step = max(1, log.n_samples // _MAX_SAMPLES)
-    q, tau = log.q[::step], log.tau[::step]
-    if _opposite(robot, q, tau, robot.joint_names) is not None:
-        return None
-    a = _torque_scale(robot, q, tau)
+    a = _against_gravity(robot, log).scale
     if a is None or a == 0:
         return None
     off = math.log10(abs(a))
