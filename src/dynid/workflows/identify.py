@@ -408,14 +408,14 @@ def _read_logs(
     ]
     names = [p.name for p in paths]
     logs = list(given_start(logs, names, robot, opt.drive, opt.q_start, opt.max_gap_s))
-    held = Recorded((), ())
+    held: list[tuple[TorqueLog, Path]] = []
     if heldout is not None and opt.validate_on is not None:
-        held = Recorded((heldout,), (Path(opt.validate_on),))
-    rec = Recorded((*logs, *held.logs), (*paths, *held.paths))
-    check_limits(rec, robot, opt.drive)
+        held.append((heldout, Path(opt.validate_on)))
+    rec = Recorded((*logs, *(g for g, _ in held)), (*paths, *(p for _, p in held)), opt.drive)
+    check_limits(rec, robot)
     check_units(rec)
-    check_signs(held, robot, opt.drive)
-    check_torque_unit(rec, robot, opt.drive, cmap)
+    check_signs(rec.select(slice(len(logs), None)), robot)  # the held-out log's
+    check_torque_unit(rec, robot, cmap)
     return logs
 
 
