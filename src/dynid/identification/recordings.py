@@ -219,6 +219,11 @@ class Recordings(TorqueRoute):
         return sum(p.log.n_samples for p in self.pieces)
 
     @property
+    def n_rows(self) -> int:
+        """Rows of :meth:`blocks` (and of :meth:`measured_blocks`): samples times joints."""
+        return self.n_samples * self.n
+
+    @property
     def cutoff_hz(self) -> float | None:
         """The one cut-off of every piece [Hz]."""
         return self.pieces[0].cutoff_hz
