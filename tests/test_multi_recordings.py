@@ -283,7 +283,7 @@ def test_a_recording_of_another_robot_is_named(panda, files, tmp_path):
     far = type(log)(log.t, log.q + 3.0, log.dq, log.tau)
     rec = Recorded((log, far), (files / "rec2.csv", tmp_path / "far.csv"))
     with pytest.warns(DynidWarning, match="far.csv: joint .* far outside the limits of robot"):
-        check_limits(rec, panda, None)
+        check_limits(rec, panda)
     save_torque_log(tmp_path / "deg.csv", type(log)(log.t, np.degrees(log.q), log.dq, log.tau))
     with pytest.raises(DataError, match="deg.csv: its positions look like degrees"):
         validate_files(panda, [files / "rec1.csv", tmp_path / "deg.csv"])

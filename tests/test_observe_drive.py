@@ -114,3 +114,22 @@ def _drive_file() -> str:
         f"gear_ratio = [{vec(map(repr, GEARS.tolist()))}]\n"
         f"torque_constant = [{vec(map(repr, KT.tolist()))}]\n"
     )
+
+
+def test_each_log_is_mapped_to_the_joint_side_once(logs, tmp_path, monkeypatch):
+    """observe mapped every log through the drive five times (the degrees, limits, sign and
+    unit checks and the observer each on its own); now once per log, the checks and the
+    observer reading the same joint-side log."""
+    calls = []
+    through = Drive.joint_torques
+
+    def counted(self, effort):
+        calls.append(effort.shape[0])
+        return through(self, effort)
+
+    monkeypatch.setattr(Drive, "joint_torques", counted)
+    p = ["observe", "--params", str(logs / "robot.toml"), "--no-figures", "-q", "--calibrate"]
+    data = [str(logs / "free.csv"), str(logs / "hit.csv")]
+    assert main([*p, "--data", *data, "--out", str(tmp_path / "c")]) == 0
+    rows = [len((logs / f).read_text().splitlines()) - 3 for f in ("free.csv", "hit.csv")]
+    assert sorted(calls) == sorted(rows), (calls, rows)

@@ -20,7 +20,7 @@ import dynid
 from dynid.cli import console
 from dynid.cli.__main__ import main
 from dynid.io.torque_log import save_torque_log
-from dynid.progress import report, reporting, stage
+from dynid.progress import report, reporting, rows_read, stage
 from dynid.simulation.measurement import sample_times, simulate_measurement
 from dynid.simulation.trajectories import random_fourier
 
@@ -64,7 +64,7 @@ def test_a_long_identify_shows_its_steps_on_a_terminal(
     assert "dynid identify: reading long.csv: 1,201 of 1,201 rows (" in said, said
     assert "dynid identify: preparing long.csv (" in said, said
     assert re.search(
-        r"structure search, regressor 1 of \d+: a pass over the rows, [\d,]+ read", said
+        r"structure search, regressor 1 of \d+: a pass over the rows, [\d,]+ of [\d,]+ read", said
     )
     assert "the fit of the structure chosen: a pass over the rows" in said, said
     assert all(s.endswith(" s)") for s in lines), lines
@@ -93,3 +93,40 @@ def test_steps_within_a_stage_carry_its_name_and_nothing_is_told_without_a_callb
         report("after")
     report("unheard again")
     assert heard == ["reading", "search", "search: pass", "after"]
+
+
+def test_passes_over_the_rows_say_how_many_rows_there_are(
+    log_file, tmp_path, terminal, capsys, monkeypatch
+):
+    """A pass over the rows said only the rows read so far ("155,610 read"), with no total
+    to tell how far it had got; now it says "of" the rows the fit reads, the count the
+    summary gives, and the last pass reaches it."""
+    terms = ("--terms", "viscous,coulomb")
+    assert _identify(log_file, tmp_path / "id", *terms, monkeypatch=monkeypatch) == 0
+    out, err = capsys.readouterr()
+    rows = int(re.search(r"([\d,]+) rows\b", out)[1].replace(",", ""))  # the summary's count
+    passes = re.findall(r"the fit: a pass over the rows, ([\d,]+) of ([\d,]+) read", err)
+    assert passes, err
+    assert {int(total.replace(",", "")) for _, total in passes} == {rows}
+    assert int(passes[-1][0].replace(",", "")) == rows
+
+
+def test_a_stage_gives_its_rows_to_its_passes_alone():
+    """rows_read tells the total of the stage it runs in, not an enclosing stage's nor one
+    it has passed."""
+    heard: list[str] = []
+    with reporting(heard.append):
+        with stage("fit", rows=20):
+            rows_read(10)
+            rows_read(30)  # beyond the stage's rows: another set, no total
+            with stage("inner"):
+                rows_read(5)
+        rows_read(7)
+    assert heard == [
+        "fit",
+        "fit: a pass over the rows, 10 of 20 read",
+        "fit: a pass over the rows, 30 read",
+        "fit: inner",
+        "inner: a pass over the rows, 5 read",
+        "a pass over the rows, 7 read",
+    ]

@@ -61,7 +61,7 @@ def test_one_joint_in_degrees_is_refused_naming_the_file_the_joint_and_the_fix(p
     deg = _joint_in_degrees(log, 0)
     assert np.ptp(deg.q[:, 0]) > panda.q_max[0] - panda.q_min[0]
     with pytest.raises(DataError) as e:
-        check_limits(Recorded((deg,), (Path("one.csv"),)), panda, None)
+        check_limits(Recorded((deg,), (Path("one.csv"),)), panda)
     said = str(e.value)
     assert said.startswith("one.csv: joint(s) in degrees among joints in radians")
     first, second = panda.joint_names[:2]
@@ -69,10 +69,10 @@ def test_one_joint_in_degrees_is_refused_naming_the_file_the_joint_and_the_fix(p
     assert f"{second} spans" not in said
     whole = TorqueLog(log.t, log.q * DEG, log.dq * DEG, log.tau)
     with pytest.raises(DataError, match=r"w.csv: positions in degrees.*--units q=deg,dq=deg/s"):
-        check_limits(Recorded((whole,), (Path("w.csv"),)), panda, None)
+        check_limits(Recorded((whole,), (Path("w.csv"),)), panda)
     shifted = TorqueLog(log.t, log.q + 3.0, log.dq, log.tau)
     with pytest.warns(UserWarning, match="far outside the limits"):
-        check_limits(Recorded((shifted,), (Path("s.csv"),)), panda, None)
+        check_limits(Recorded((shifted,), (Path("s.csv"),)), panda)
 
 
 def test_identify_refuses_one_joint_in_degrees(panda, log, tmp_path, capsys):

@@ -360,6 +360,30 @@ def test_validate_on_one_of_the_recordings_fitted_is_refused(panda, logs, tmp_pa
         assert f"error: --validate-on {other.name} is one of the recordings fitted" in err[0]
 
 
+@pytest.mark.parametrize(
+    ("factor", "said"),
+    [
+        (1e3, "rec2_bad.csv: its torques (RMS) are"),
+        (-1.0, "rec2_bad.csv: the measured torques are anti-correlated"),
+    ],
+    ids=["mNm", "opposite sign"],
+)
+def test_the_held_out_log_is_checked_like_the_recordings(
+    panda, logs, tmp_path, capsys, factor, said
+):
+    """identify --validate-on a log in mN m read as N m was judged (held-out error 99.9 %,
+    exit 0, the unit only warned) and one of the opposite sign was refused as "validation
+    log"; now both are refused as a recording fitted would be, one line naming the file."""
+    log = load_torque_log(logs / "rec2.csv")
+    save_torque_log(tmp_path / "rec2_bad.csv", type(log)(log.t, log.q, log.dq, factor * log.tau))
+    argv = ["identify", "--robot", "panda", "--out", str(tmp_path / "i"), "--data"]
+    argv += [str(logs / "rec1.csv"), "--validate-on", str(tmp_path / "rec2_bad.csv")]
+    assert main(argv) == 2
+    err = [s for s in capsys.readouterr().err.splitlines() if s.strip()]
+    assert len(err) == 1 and said in err[0], err
+    assert not (tmp_path / "i").exists()
+
+
 def test_a_stretch_lost_without_a_gap_in_the_stamps_makes_no_event(logs, tmp_path, capsys):
     """The observer on a log whose logger lost 0.2 s of samples but stamped on evenly (the
     positions jump): it reported a 'collision' on every joint at the jump; now it starts

@@ -4,6 +4,9 @@ friction is not fitted from noise."""
 
 from __future__ import annotations
 
+import dataclasses
+import re
+
 import numpy as np
 import pytest
 
@@ -11,9 +14,11 @@ import dynid
 from dynid.dynamics.terms import gravity_torques
 from dynid.exceptions import DataError, DynidWarning
 from dynid.identification.classical import identify_from_log
-from dynid.identification.log import TorqueLog
+from dynid.identification.log import TorqueLog, joint_side_log, recorded_side_log
+from dynid.identification.recordings import prepare_recordings
 from dynid.identification.sanity import check_torque_log, opposite_sign, torque_unit_finding
 from dynid.identification.selection import identify_recordings
+from dynid.model.drive import Drive
 from dynid.simulation.measurement import SensorNoise, sample_times, simulate_measurement
 from dynid.simulation.trajectories import random_fourier
 
@@ -68,6 +73,59 @@ def test_only_a_clean_factor_of_1000_reads_as_torques_in_other_units(panda_log):
         assert torque_unit_finding(off, panda_log) is None
 
 
+def test_a_current_drive_with_torque_constants_is_named_not_asked_for(panda_log):
+    """Currents read through a drive file whose torque constants are 100 (or 1000) times too
+    small were told that "currents need a drive file with torque_constant", the file they
+    came with; the line now names the factor (the constants' ratio) and the drive file's
+    torque_constant and gear_ratio."""
+    robot = dynid.panda()
+    true = Drive(np.eye(7), np.zeros(7), effort="current", torque_constant=np.full(7, 2.0))
+    currents = recorded_side_log(panda_log, true)
+    for k in (1e-2, 1e-3):
+        wrong = dataclasses.replace(true, torque_constant=np.full(7, 2.0 * k))
+        read = joint_side_log(currents, wrong)
+        found = check_torque_log(robot, read, wrong)
+        assert len(found) == 1 and "currents need" not in found[0]
+        assert "torque_constant" in found[0] and "gear_ratio" in found[0]
+        factor = re.search(r"are (\S+) times the model's", found[0])
+        # the torques hold more than gravity: the factor within 15 % of the constants' ratio
+        assert factor is not None and float(factor[1]) == pytest.approx(k, rel=0.15)
+    refused = torque_unit_finding(robot, read, wrong)
+    assert "torque_constant" in refused and "--units tau=1000" not in refused
+    bare = joint_side_log(currents, dataclasses.replace(true, torque_constant=np.full(7, 0.02)))
+    assert "currents need" in check_torque_log(robot, bare)[0]  # no drive given: asked for
+    wrong = dataclasses.replace(true, torque_constant=np.full(7, 0.02))
+    with pytest.warns(DynidWarning, match="drive file's torque_constant or gear_ratio"):
+        prepare_recordings(robot, [currents], drive=wrong, cutoff_hz=None)
+
+
+def test_the_unit_refusal_and_the_warnings_judge_scale_behind_the_same_guards(panda_log):
+    """The torque unit refusal and the log's findings each wrote out which logs the scale
+    is judged on (degrees, every joint frozen, the opposite sign, no inertial parameters),
+    two chains that could drift apart: on each such log both stay silent on scale, and
+    on mN m both speak."""
+    robot = dynid.panda()
+    g = panda_log
+    z = np.zeros_like(g.dq)
+    cases = {
+        "degrees": (robot, TorqueLog(g.t, np.degrees(g.q), np.degrees(g.dq), 1e3 * g.tau)),
+        "frozen": (robot, TorqueLog(g.t, g.q[:1] + z, z, 1e3 * g.tau)),
+        "flipped": (robot, TorqueLog(g.t, g.q, g.dq, -1e3 * g.tau)),
+        "no inertial parameters": (
+            robot.with_params(np.zeros_like(robot.phi)),
+            TorqueLog(g.t, g.q, g.dq, 1e3 * g.tau),
+        ),
+    }
+    for name, (r, log) in cases.items():
+        assert torque_unit_finding(r, log) is None, name
+        scale = [f for f in check_torque_log(r, log) if "gravity torques:" in f]
+        assert scale == [], (name, scale)
+    mnm = TorqueLog(g.t, g.q, g.dq, 1e3 * g.tau)
+    refused = torque_unit_finding(robot, mnm)
+    (warned,) = check_torque_log(robot, mnm)
+    assert refused is not None and refused.startswith(warned.split("; hint")[0])
+
+
 @pytest.mark.filterwarnings("ignore:.*indistinguishable from zero")  # expected: weak coefficients
 def test_identification_refuses_a_flipped_sign_before_fitting(panda_log):
     """identify_from_log refuses torques of the opposite sign, with the hint: the fit
@@ -118,8 +176,6 @@ def _turning_log(robot: dynid.Robot, seed: int) -> TorqueLog:
 
 def _continuous_panda() -> dynid.Robot:
     """The Panda with joints 1, 3, 5 and 7 continuous (no position limits)."""
-    import dataclasses
-
     robot = dynid.panda()
     free = np.isin(np.arange(7), [0, 2, 4, 6])
     return dataclasses.replace(

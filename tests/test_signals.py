@@ -150,6 +150,25 @@ def test_sample_rate_with_jitter_and_dropped_samples():
     assert signals.sample_rate(large) == pytest.approx(FS, rel=1e-2)
 
 
+def test_sample_rate_of_gaussian_jitter_is_not_the_median_step():
+    """Regression: stamps whose Gaussian jitter (0.15-0.2 periods) is too large to count
+    periods by steps fell back to the median step, off by up to 1.3 % on 4000 stamps and
+    biased by dropped samples (-0.15 % mean at 2 % dropped, -0.87 % at 10 %); each stamp
+    is now placed on the grid, within 2e-5 of the true rate, and so are two logs joined
+    across a pause of no whole number of periods."""
+    true = 100.0
+    for seed, (sigma, drop) in enumerate([(0.15, 0.0), (0.2, 0.02), (0.2, 0.1)] * 3):
+        rng = np.random.default_rng(seed)
+        k = np.arange(4000)
+        k = k[rng.random(k.size) >= drop]
+        t = np.sort((k + rng.normal(0, sigma, k.size)) / true)
+        assert signals.sample_rate(t) == pytest.approx(true, rel=2e-5), (sigma, drop)
+    rng = np.random.default_rng(11)
+    k = np.concatenate([np.arange(2000), np.arange(2000) + 2013.37])  # a pause
+    t = (k + rng.normal(0, 0.15, k.size)) / true
+    assert signals.sample_rate(t) == pytest.approx(true, rel=2e-5)
+
+
 def test_time_checks_raise_on_non_increasing_timestamps():
     """Repeated or decreasing timestamps are rejected with the offending index."""
     with pytest.raises(DataError, match=r"t\[2\]"):

@@ -59,11 +59,11 @@ def test_the_recording_in_degrees_is_named_with_the_columns_to_convert(panda, lo
     assert np.all(logs[1].q >= panda.q_min - LIMIT_MARGIN)
     assert np.all(logs[1].q <= panda.q_max + LIMIT_MARGIN)
     with pytest.raises(DataError, match=r"r1.csv: its positions and velocities look like") as e:
-        check_degrees(_rec(logs[0], _deg(logs[1]), logs[2]), panda, None)
+        check_degrees(_rec(logs[0], _deg(logs[1]), logs[2]), panda)
     assert "convert its q and dq to radians" in str(e.value)
     assert "--units applies to every file" in str(e.value)
     with pytest.raises(DataError, match=r"r0.csv: its positions look like degrees") as e:
-        check_degrees(_rec(_deg(logs[0], velocities=False), logs[1]), panda, None)
+        check_degrees(_rec(_deg(logs[0], velocities=False), logs[1]), panda)
     assert "convert its q to radians" in str(e.value)
 
 
@@ -74,8 +74,8 @@ def test_recordings_in_radians_pass(panda, logs):
     rest = TorqueLog(
         logs[2].t, np.broadcast_to(logs[2].q[0], logs[2].q.shape), 0 * logs[2].dq, logs[2].tau
     )
-    check_degrees(_rec(*logs, rest), panda, None)
-    check_degrees(_rec(*(_deg(g) for g in logs)), panda, None)
+    check_degrees(_rec(*logs, rest), panda)
+    check_degrees(_rec(*(_deg(g) for g in logs)), panda)
     found = check_torque_log(panda, _deg(logs[0]))
     assert len(found) == 1 and found[0].startswith("positions look like degrees"), found
 

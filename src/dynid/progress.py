@@ -5,7 +5,9 @@ text per step) with :func:`reporting`; the steps deep in the library (reading a 
 preparing recordings, each regressor of the structure search, the blocks of a pass over a
 log's rows) call :func:`report`, which does nothing without a callback, so that no function
 between the two carries it. A :func:`stage` names what the steps belong to
-(``"structure search, regressor 2 of 6: 240,000 rows"``). The command line installs a
+(``"structure search, regressor 2 of 6: a pass over the rows, 240,000 of 480,000
+read"``): every count it knows the total of is told with it (:func:`rows_read`: the rows
+of a stage that says how many it holds). The command line installs a
 renderer for every command (throttled, on a terminal, silent with ``-q``:
 :meth:`dynid.cli.console.Console.progress_callback`); in Python::
 
@@ -19,13 +21,14 @@ import contextlib
 from collections.abc import Callable, Iterator
 from contextvars import ContextVar
 
-__all__ = ["Progress", "report", "reporting", "stage"]
+__all__ = ["Progress", "report", "reporting", "rows_read", "stage"]
 
 #: A progress callback: one line of text per step.
 Progress = Callable[[str], None]
 
 _CURRENT: ContextVar[Progress | None] = ContextVar("dynid_progress", default=None)
 _STAGE: ContextVar[str] = ContextVar("dynid_progress_stage", default="")
+_ROWS: ContextVar[int | None] = ContextVar("dynid_progress_rows", default=None)
 
 
 @contextlib.contextmanager
@@ -40,14 +43,26 @@ def reporting(progress: Progress | None) -> Iterator[None]:
 
 
 @contextlib.contextmanager
-def stage(name: str) -> Iterator[None]:
-    """Report ``name`` and prefix the steps reported within the block with it."""
+def stage(name: str, *, rows: int | None = None) -> Iterator[None]:
+    """Report ``name`` and prefix the steps reported within the block with it; ``rows``:
+    the rows a pass over the stage's data reads, the total of :func:`rows_read` within
+    the block (none: the stage's rows are not known, and an enclosing stage's are not
+    its)."""
     report(name)
-    token = _STAGE.set(name)
+    token, rows_token = _STAGE.set(name), _ROWS.set(rows)
     try:
         yield
     finally:
+        _ROWS.reset(rows_token)
         _STAGE.reset(token)
+
+
+def rows_read(done: int) -> None:
+    """Report a pass over the rows at ``done`` rows read, of the stage's ``rows`` when it
+    said them (:func:`stage`) and the pass is within them."""
+    total = _ROWS.get()
+    of = f" of {total:,}" if total is not None and done <= total else ""
+    report(f"a pass over the rows, {done:,}{of} read")
 
 
 def report(step: str) -> None:

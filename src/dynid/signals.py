@@ -94,8 +94,15 @@ def sample_rate(t: ArrayLike) -> float:
     median step (a gap of dropped samples counts as several periods); the period is the
     least-squares slope of ``t`` against the cumulative count, whose error falls as
     ``N^-1.5``. When some step lies far from a whole number of periods (``|dt_i / h0 -
-    m_i| > 0.4``: jitter too large to count periods), the period is the median of the steps
-    within ``(0.5, 1.5) h0`` instead. For uniform ``t`` both give ``1 / dt``.
+    m_i| > 0.4``: jitter too large to count periods by steps), each stamp is given its
+    place on the grid instead (:func:`_grid_indices`, on the runs between gaps longer
+    than :data:`_RUN_GAP` periods), and the period is the slope of the stamps against
+    those places, pooled over the runs. For uniform ``t`` both give ``1 / dt``.
+
+    The median of the steps errs as ``1.25 sigma_dt / sqrt(N)`` and is biased by dropped
+    samples (1 kHz stamps with Gaussian jitter of 0.2 ms, 2 % dropped, 5 million of them:
+    998.43 Hz, the grid 1000.0000 Hz); it is kept for a jitter beyond
+    :data:`_GRID_JITTER` periods, where the grid's indices slip.
     """
     t = _time(t)
     m = np.diff(t)
@@ -113,9 +120,81 @@ def sample_rate(t: ArrayLike) -> float:
         kc -= kc.mean()
         h = float(kc @ (t - t.mean()) / (kc @ kc))
     else:
-        dt = np.diff(t)
-        h = float(np.median(dt[(dt > 0.5 * h0) & (dt < 1.5 * h0)]))
+        h = _lattice_period(t, h0)
     return 1.0 / h
+
+
+#: Steps longer than this many median steps split the stamps into runs, each placed on
+#: its own grid: a pause that is no whole number of periods (logs joined) does not shift
+#: the grid of the stamps after it. (Shorter, it would split at drops whose jitter makes
+#: them long: each run's ends biased, and short runs.)
+_RUN_GAP = 10.0
+#: Stamps of the first run whose grid is found by scanning periods (:func:`_grid_indices`).
+_FIRST_BLOCK = 256
+#: Stamp jitter (std, in periods) up to which the stamps are placed on a grid; beyond,
+#: an index is often a period off and the median step errs less (Gaussian jitter of 0.3
+#: periods: up to 12 % on 4000 stamps, the median 2.5 %). A grid whose period is more
+#: than 5 % from the median step's is not taken either.
+_GRID_JITTER = 0.25
+
+
+def _lattice_period(t: NDArray[np.float64], h0: float) -> float:
+    """The period [s] of stamps ``t`` (N,) whose steps are too jittered to count: the
+    least-squares slope of the stamps against their grid indices (:func:`_grid_indices`),
+    pooled over the runs between steps longer than :data:`_RUN_GAP` ``h0`` (each run its
+    own offset; the longest first); the median of the steps within ``(0.5, 1.5) h0`` when
+    no run has three stamps or the stamps' jitter exceeds :data:`_GRID_JITTER` periods
+    (read from the steps' median absolute deviation)."""
+    dt = np.diff(t)
+    median = float(np.median(dt[(dt > 0.5 * h0) & (dt < 1.5 * h0)]))
+    jitter = 1.4826 * float(np.median(np.abs(dt - h0))) / np.sqrt(2.0)
+    if jitter > _GRID_JITTER * h0:
+        return median
+    cuts = np.concatenate([[0], np.flatnonzero(dt > _RUN_GAP * h0) + 1, [t.size]])
+    runs = sorted(zip(cuts[:-1], cuts[1:], strict=True), key=lambda r: int(r[0] - r[1]))
+    num = den = 0.0
+    h: float | None = None  # the period: scanned on the longest run, then as fitted
+    for a, b in runs:
+        if b - a < 3:
+            break
+        n = _grid_indices(t[a:b] - t[a], h0 if h is None else h, scan=h is None)
+        n -= n.mean()
+        num += float(n @ (t[a:b] - t[a:b].mean()))
+        den += float(n @ n)
+        h = num / den
+    return median if h is None or abs(h / median - 1.0) > 0.05 else h
+
+
+def _grid_indices(s: NDArray[np.float64], h: float, scan: bool = True) -> NDArray[np.float64]:
+    """The grid index of each stamp ``s`` (N,) [s] (from 0 at the first) of a run whose
+    period is about ``h`` (within 10 %; ``scan`` False: ``h`` fitted already on a run
+    before), dropped samples skipped.
+
+    The first :data:`_FIRST_BLOCK` stamps give the period that puts them nearest to a
+    grid (``scan``: the largest ``|sum_k exp(2 pi i s_k / h)|`` over periods within 10 %
+    of ``h``, no index needed) and the grid's offset (its phase); then, on a prefix
+    doubled each time, the stamps are rounded to that grid and the period and offset
+    refitted by least squares, whose error over ``L`` stamps (``sqrt(12) sigma / L^1.5``
+    for a jitter ``sigma``) moves the grid by a fraction of a period only well beyond
+    ``2 L``. Each index is right while the stamp's own jitter stays within half a period;
+    beyond, it is one off, either way alike.
+    """
+    L = min(s.size, _FIRST_BLOCK)
+    block = s[:L]
+    if scan:
+        periods = h * (1.0 + np.arange(-0.1, 0.1, 0.25 / L))
+        power = np.abs(np.exp(2j * np.pi * block[None, :] / periods[:, None]).sum(axis=1))
+        h = float(periods[np.argmax(power)])
+    offset = h * float(np.angle(np.exp(2j * np.pi * block / h).sum())) / (2 * np.pi)
+    while True:
+        n = np.round((s[:L] - offset) / h)
+        nc = n - n.mean()
+        h = float(nc @ (s[:L] - s[:L].mean()) / (nc @ nc))
+        offset = float(s[:L].mean() - h * n.mean())
+        if L == s.size:
+            out: NDArray[np.float64] = np.round((s - offset) / h)
+            return out
+        L = min(2 * L, s.size)
 
 
 def is_uniform(t: ArrayLike, *, rtol: float = 1e-6) -> bool:

@@ -153,9 +153,9 @@ def print_validation(
 ) -> None:
     """The RMS table, the pieces, the error per recording and overall, the verdict."""
     val = result.validation
-    cols = {"RMS no friction [N m]": val.without_friction.rms}
+    cols = {f"RMS no {val.added} [N m]": val.without_friction.rms}
     if val.with_friction is not None:
-        cols["RMS + friction [N m]"] = val.with_friction.rms
+        cols[f"RMS + {val.added} [N m]"] = val.with_friction.rms
     console.print(format_rms_table(names, cols), val.pieces.describe())
     if len(val.recordings) > 1:
         console.print(

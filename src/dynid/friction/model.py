@@ -67,6 +67,7 @@ __all__ = [
     "classical_friction",
     "combined",
     "friction_parts",
+    "friction_words",
     "through_drive",
     "coulomb_sign",
     "friction_of",
@@ -246,6 +247,30 @@ def friction_parts(friction: Friction | FrictionSum | None) -> tuple[Friction, .
     if friction is None:
         return ()
     return friction.parts if isinstance(friction, FrictionSum) else (friction,)
+
+
+#: Joint velocities [rad/s] at which :func:`friction_words` reads what a model adds: from
+#: inside any standstill band to beyond any joint's speed, each sign.
+_PROBE_SPEEDS = np.array([0.0, 1e-3, -1e-3, 1e-2, -1e-2, 0.1, -0.1, 1.0, -1.0, 10.0, -10.0])
+
+
+def friction_words(friction: Friction | FrictionSum | None) -> str:
+    """What ``friction`` adds to a model's torques, in words: ``"friction"`` (torques that
+    change with the velocity), ``"offsets"`` (constant torques, the same at rest: not
+    friction; an identified model with the offset term alone) or ``"friction and
+    offsets"``; ``"friction"`` for None or a model that adds nothing.
+
+    Read from its torques: the offsets are the torques at rest (every law's friction is
+    zero at ``dq = 0``), the friction what changes over ``dq`` from -10 to 10 rad/s."""
+    if friction is None:
+        return "friction"
+    v = _PROBE_SPEEDS[:, None] * np.ones(friction.n)
+    tau = friction.torques(v)
+    offsets = bool(np.any(tau[0] != 0))
+    moves = bool(np.any(tau != tau[0]))
+    if offsets and not moves:
+        return "offsets"
+    return "friction and offsets" if offsets else "friction"
 
 
 def through_drive(

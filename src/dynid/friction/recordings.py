@@ -47,7 +47,7 @@ from ..identification.trim import common_cutoff, edge_seconds
 from ..model.drive import Drive
 from ..model.robot import Robot
 from .fit import FrictionResidual, TorqueModel, model_drive, torques_through
-from .model import FrictionModel, FrictionSum
+from .model import FrictionModel, FrictionSum, friction_words
 from .pooled import pooled_errors
 from .validation import (
     RECORDED,
@@ -461,6 +461,12 @@ class RecordingsValidation:
         return self.with_friction if self.with_friction is not None else self.without_friction
 
     @property
+    def added(self) -> str:
+        """What ``friction`` adds, in words (:func:`~dynid.friction.model.friction_words`:
+        offsets are not friction)."""
+        return friction_words(self.friction)
+
+    @property
     def shown(self) -> Validation:
         """The longest piece of the first recording, with the pooled errors: its torques
         are drawn, the errors are every sample's."""
@@ -476,6 +482,7 @@ class RecordingsValidation:
         ``unwrapped_joints`` (1-based)."""
         out: dict[str, object] = dict(self.errors.as_dict())
         out["friction_model"] = None if self.friction is None else self.friction.kind
+        out["friction_terms"] = self.added
         out["without_friction"] = self.without_friction.as_dict()
         if self.with_friction is not None:
             out["with_friction"] = self.with_friction.as_dict()

@@ -46,7 +46,14 @@ from ..model.drive import Drive
 from ..model.robot import Robot
 from ..progress import report
 from .fit import TorqueModel, model_drive, torques_through
-from .model import Friction, FrictionModel, FrictionSum, combined, robot_friction
+from .model import (
+    Friction,
+    FrictionModel,
+    FrictionSum,
+    combined,
+    friction_words,
+    robot_friction,
+)
 
 __all__ = [
     "KEPT_SAMPLES",
@@ -142,11 +149,19 @@ class Validation:
         """Errors of the full prediction (with friction when given)."""
         return self.with_friction if self.with_friction is not None else self.without_friction
 
+    @property
+    def added(self) -> str:
+        """What ``friction`` adds, in words (:func:`~dynid.friction.model.friction_words`:
+        offsets are not friction)."""
+        return friction_words(self.friction)
+
     def as_dict(self) -> dict[str, object]:
         """JSON-ready summary: ``rms``, ``mse``, ``relative_error_percent`` of the full
-        prediction, plus ``without_friction`` (and ``with_friction``) blocks."""
+        prediction, plus ``without_friction`` (and ``with_friction``) blocks and
+        ``friction_terms`` (:attr:`added`: the blocks' "friction" may be offsets)."""
         out: dict[str, object] = dict(self.errors.as_dict())
         out["friction_model"] = None if self.friction is None else self.friction.kind
+        out["friction_terms"] = self.added
         out["without_friction"] = self.without_friction.as_dict()
         if self.with_friction is not None:
             out["with_friction"] = self.with_friction.as_dict()

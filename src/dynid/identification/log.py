@@ -189,7 +189,7 @@ class TorqueLog:
 
     @property
     def sample_rate(self) -> float:
-        """Nominal sample rate [Hz] (inverse median step)."""
+        """Nominal sample rate [Hz] (:func:`dynid.signals.sample_rate`)."""
         return signals.sample_rate(self.t)
 
     def __len__(self) -> int:

@@ -229,7 +229,7 @@ def prepare_torque_log(
         raise DataError(few)
     if check and (opposite := opposite_sign(robot, jlog)) is not None:
         raise DataError(opposite)  # a fit would negate the masses
-    for finding in check_torque_log(robot, jlog) if check else ():  # said first
+    for finding in check_torque_log(robot, jlog, drive) if check else ():  # said first
         warnings.warn(finding, DynidWarning, stacklevel=3)
     still = still_friction(jlog, drive)
     f_q = None

@@ -219,6 +219,11 @@ class Recordings(TorqueRoute):
         return sum(p.log.n_samples for p in self.pieces)
 
     @property
+    def n_rows(self) -> int:
+        """Rows of :meth:`blocks` (and of :meth:`measured_blocks`): samples times joints."""
+        return self.n_samples * self.n
+
+    @property
     def cutoff_hz(self) -> float | None:
         """The one cut-off of every piece [Hz]."""
         return self.pieces[0].cutoff_hz
@@ -462,7 +467,7 @@ def prepare_recordings(
             whole = joined([joint_side_log(p, drive) for p in mine])
             if (opposite := opposite_sign(robot, whole)) is not None:
                 raise DataError(opposite, file=name)  # a fit would negate the masses
-            for finding in check_torque_log(robot, whole):
+            for finding in check_torque_log(robot, whole, drive):
                 found.setdefault(finding, []).append(name)
         pieces += [(r, p) for p in mine]
     for finding, which in found.items():  # one warning a finding, its recordings named

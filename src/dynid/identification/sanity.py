@@ -13,7 +13,8 @@ with them before fitting (:func:`log_findings`). None of them changes the data.
   joints; ``a`` near 1e3 or 1e-3 is a unit off by a power of ten (mN m against N m:
   :func:`torque_unit_finding`, refused by the commands unless ``--units`` names the
   torques' unit), and currents logged as torques show as a factor far from 1 (a drive
-  file with ``torque_constant``). Sign and scale compare variations: not made on a log at rest
+  file with ``torque_constant``; currents read through one: its ``torque_constant`` or
+  ``gear_ratio`` is off by the factor). Sign and scale compare variations: not made on a log at rest
   (every joint frozen), whose variations are noise, nor on a joint whose gravity torques
   span less than :data:`GRAVITY_RANGE_SHARE` of the log's largest (a short stretch, whose
   torque variations are the motion's).
@@ -43,6 +44,7 @@ from __future__ import annotations
 
 import dataclasses
 import math
+from dataclasses import dataclass
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -50,6 +52,7 @@ from numpy.typing import ArrayLike, NDArray
 from .. import _checks, signals
 from ..dynamics.terms import gravity_torques
 from ..exceptions import ShapeError
+from ..model.drive import Drive
 from ..model.robot import Robot
 from .log import TorqueLog
 
@@ -275,20 +278,19 @@ def moving_joints(dq: ArrayLike, noise_std: ArrayLike | None = None) -> NDArray[
     return out
 
 
-def check_torque_log(robot: Robot, log: TorqueLog) -> list[str]:
-    """One line per finding on a joint-side log of ``robot`` (module docstring); empty when
-    nothing looks wrong."""
-    step = max(1, log.n_samples // _MAX_SAMPLES)
-    q, dq, tau, t = log.q[::step], log.dq[::step], log.tau[::step], log.t[::step]
-    out: list[str] = []
-    names = robot.joint_names
-    out += _degrees(robot, log)  # first: the gravity torques at such positions say nothing
-    frozen = ~moving_joints(log.dq)
-    # the robot's own parameters: a model to compare with; at rest the torques' and the
-    # gravity torques' variations are noise, whose ratio says nothing of the units
-    if np.any(robot.phi) and not out and not np.all(frozen):
-        out += _sign_and_scale(robot, q, tau, names)
+def check_torque_log(robot: Robot, log: TorqueLog, drive: Drive | None = None) -> list[str]:
+    """One line per finding on a joint-side log of ``robot`` (module docstring), read
+    through ``drive`` (its torque constants and gear ratios are named by the scale
+    finding); empty when nothing looks wrong."""
+    seen = _against_gravity(robot, log)
+    out = list(seen.degrees)
+    a = seen.scale
+    if seen.opposite is not None:
+        out.append(seen.opposite)
+    elif a is not None and (abs(a) > 30 or 0 < abs(a) < 1 / 30):
+        out.append(_scale_line(a, drive=drive))
     out += _milliseconds(log)
+    frozen, names = seen.frozen, robot.joint_names
     if np.any(frozen) and not np.all(frozen):
         which = ", ".join(names[j] for j in np.flatnonzero(frozen))
         out.append(
@@ -296,8 +298,48 @@ def check_torque_log(robot: Robot, log: TorqueLog) -> list[str]:
             "unidentifiable and is left out (zero) rather than fitted from noise; hint: a "
             "trajectory that moves every joint identifies them"
         )
-    del t, dq
     return out
+
+
+@dataclass(frozen=True, slots=True)
+class _GravitySaid:
+    """What a joint-side log says against the robot's gravity torques: the sign and scale
+    findings' guards, one for :func:`check_torque_log` and :func:`torque_unit_finding`.
+
+    Attributes
+    ----------
+    degrees : tuple of str
+        The degrees finding (said first, and instead of sign and scale: the gravity
+        torques at positions in degrees say nothing of the torques).
+    frozen : ndarray of bool, shape (n,)
+        The joints that never leave their velocity noise band.
+    opposite : str or None
+        The sign finding (:func:`_opposite`).
+    scale : float or None
+        ``a`` of ``tau ~ a g(q)`` (:func:`_torque_scale`); None where not compared: a
+        robot without inertial parameters, every joint frozen (at rest the variations are
+        noise, whose ratio says nothing of the units), degrees, the opposite sign, no
+        joint gravity loads.
+    """
+
+    degrees: tuple[str, ...]
+    frozen: NDArray[np.bool_]
+    opposite: str | None = None
+    scale: float | None = None
+
+
+def _against_gravity(robot: Robot, log: TorqueLog) -> _GravitySaid:
+    """The degrees, frozen joints, sign and scale of ``log`` against ``robot``'s gravity
+    torques (:class:`_GravitySaid`), each judged only where the ones before allow."""
+    degrees = tuple(_degrees(robot, log))
+    frozen = ~moving_joints(log.dq)
+    if not np.any(robot.phi) or degrees or np.all(frozen):
+        return _GravitySaid(degrees, frozen)
+    step = max(1, log.n_samples // _MAX_SAMPLES)
+    q, tau = log.q[::step], log.tau[::step]
+    if (opposite := _opposite(robot, q, tau, robot.joint_names)) is not None:
+        return _GravitySaid(degrees, frozen, opposite)
+    return _GravitySaid(degrees, frozen, None, _torque_scale(robot, q, tau))
 
 
 def _correlations(reference: NDArray[np.float64], tau: NDArray[np.float64]) -> NDArray[np.float64]:
@@ -400,17 +442,6 @@ def _opposite(
     )
 
 
-def _sign_and_scale(
-    robot: Robot, q: NDArray[np.float64], tau: NDArray[np.float64], names: tuple[str, ...]
-) -> list[str]:
-    if (opposite := _opposite(robot, q, tau, names)) is not None:
-        return [opposite]
-    a = _torque_scale(robot, q, tau)
-    if a is not None and (abs(a) > 30 or 0 < abs(a) < 1 / 30):
-        return [_scale_line(a)]
-    return []
-
-
 def _torque_scale(robot: Robot, q: NDArray[np.float64], tau: NDArray[np.float64]) -> float | None:
     """The least-squares factor ``a`` of ``tau ~ a g(q)`` over the joints gravity loads,
     their means removed (None when gravity loads none)."""
@@ -421,16 +452,29 @@ def _torque_scale(robot: Robot, q: NDArray[np.float64], tau: NDArray[np.float64]
     return float(np.sum(gc[:, loaded] * tc[:, loaded]) / np.sum(gc[:, loaded] ** 2))
 
 
-def _scale_line(a: float, refused: bool = False) -> str:
+def _scale_line(a: float, refused: bool = False, drive: Drive | None = None) -> str:
     """The scale finding of factor ``a``, with its hint (and, ``refused``, the way to read
-    the torques as they are)."""
+    the torques as they are); through a ``drive`` of currents, the torque constants and
+    gear ratios the torques were made with are named, not a missing drive file."""
     p = round(math.log10(abs(a)))
+    if drive is not None and drive.effort == "current":
+        at = "at the motor" if drive.side == "motor" else "at the joint"
+        hint = (
+            f"check torque_constant (N m per A, {at}) and gear_ratio in the drive file"
+            + ("; currents in mA: --units tau=0.001" if p == 3 else "")
+            + (" (--units tau=1 reads the currents as they are)" if refused else "")
+        )
+        return (
+            f"the measured torques (the currents times the drive's torque constants) are "
+            f"{abs(a):.3g} times the model's gravity torques: the drive file's torque_constant "
+            f"or gear_ratio looks off by that factor; hint: {hint}"
+        )
     hint = (
         "--units tau=mNm"
         if p == 3
         else "--units tau=1000 (kN m)"
         if p == -3
-        else "currents need a drive file with torque_constant"
+        else 'currents need a drive file with effort = "current" and torque_constant'
     )
     if refused:
         hint += " (--units tau=Nm reads them as N m)"
@@ -440,7 +484,7 @@ def _scale_line(a: float, refused: bool = False) -> str:
     )
 
 
-def torque_unit_finding(robot: Robot, log: TorqueLog) -> str | None:
+def torque_unit_finding(robot: Robot, log: TorqueLog, drive: Drive | None = None) -> str | None:
     """The finding that a joint-side log's torques are in mN m (or kN m) read as N m, or
     None: their factor to ``robot``'s gravity torques (:func:`check_torque_log`'s scale)
     within :data:`UNIT_SCALE_TOLERANCE` of ``1e3`` (or ``1e-3``).
@@ -450,22 +494,17 @@ def torque_unit_finding(robot: Robot, log: TorqueLog) -> str | None:
     floor. A factor far from a power of ten (a model that is wrong, currents) is only
     warned. None too where :func:`check_torque_log` makes no scale finding: a robot without
     inertial parameters, every joint frozen, positions that look like degrees, torques of
-    the opposite sign, a log too short to check (:func:`too_few_samples`)."""
-    if too_few_samples(log) is not None or not np.any(robot.phi):
+    the opposite sign, a log too short to check (:func:`too_few_samples`). Through a
+    ``drive`` of currents, the line names its torque constants and gear ratios."""
+    if too_few_samples(log) is not None:
         return None
-    if not np.any(moving_joints(log.dq)) or _degrees(robot, log):
-        return None
-    step = max(1, log.n_samples // _MAX_SAMPLES)
-    q, tau = log.q[::step], log.tau[::step]
-    if _opposite(robot, q, tau, robot.joint_names) is not None:
-        return None
-    a = _torque_scale(robot, q, tau)
+    a = _against_gravity(robot, log).scale
     if a is None or a == 0:
         return None
     off = math.log10(abs(a))
     if abs(abs(off) - 3) > math.log10(UNIT_SCALE_TOLERANCE):
         return None
-    return _scale_line(a, refused=True)
+    return _scale_line(a, refused=True, drive=drive)
 
 
 #: Relative tolerance of "``dq`` agrees with the derivative of ``q``" (filtered velocities

@@ -240,7 +240,7 @@ def select_structure(
         """The regressor of the candidates ``mine`` (one group), fitted with the judge
         (``what``: the step the progress names)."""
         arm = mine[0].armature
-        with stage(what):
+        with stage(what, rows=data.n_rows):
             return fit_largest(
                 robot, data, mine, arm, drive, est, rtol, judge, notes, fold_labels, unexcited,
                 left_out,
@@ -722,7 +722,7 @@ def identify_recordings(
     model_drive, terms = _terms_of(structure, drive, robot.n, data)
     judge, _, fold_labels = heldout_judge(robot, data, est, folds, validation)
     try:
-        with stage("the fit of the structure chosen" if selection else "the fit"):
+        with stage("the fit of the structure chosen" if selection else "the fit", rows=data.n_rows):
             model = identify(
                 robot, data, drive=model_drive, terms=terms, estimator=est, std=std, base=base,
                 max_std_percent=max_std_percent, rtol=rtol, judge=judge, fold_labels=fold_labels,

@@ -53,7 +53,7 @@ from numpy.typing import NDArray
 
 from .. import _checks
 from ..exceptions import OptionError, ShapeError
-from ..progress import report
+from ..progress import rows_read
 from .holdout import Normals
 
 __all__ = [
@@ -249,7 +249,7 @@ def _blocks(source: BlockSource) -> Iterable[Block]:
         _checks.finite("regressor", W)
         _checks.finite("y", y)
         rows += y.size
-        report(f"a pass over the rows, {rows:,} read")
+        rows_read(rows)
         yield W, y, g
 
 

@@ -6,7 +6,8 @@
     {"schema": "dynid-validation/1",
      "rms": [...], "mse": [...], "relative_error_percent": x,
      "relative_error_percent_per_joint": [...], "n_samples": N, "friction_model": ...,
-     "without_friction": {...}, "with_friction": {...},
+     "friction_terms": "friction" | "offsets" | "friction and offsets",
+     "without_friction": {...}, "with_friction": {...},  (the model without and with them)
      "recordings": [{"file": ..., "pieces": k, "rms": [...], ...}, ...],  (several recordings)
      ...the caller's keys (model, friction_source, data, cutoff_hz; seed)...,
      "units": {"rms": "N m", "mse": "N^2 m^2", "relative_error_percent": "%"}}

@@ -87,18 +87,19 @@ def plot_torque_validation(
     def at(y: NDArray[np.float64]) -> NDArray[np.float64]:
         return np.insert(y[s], cut, np.nan)
 
+    added = validation.added  # offsets are not friction
     for j in range(n):
         ax, axe = axes[j]
         ax.plot(t, at(log.tau[:, j]), **_MEASURED)
-        ax.plot(t, at(validation.tau_model[:, j]), **_NO_FRICTION)
+        ax.plot(t, at(validation.tau_model[:, j]), **_NO_FRICTION | {"label": f"model, no {added}"})
         if e1 is not None:
-            ax.plot(t, at(validation.tau_hat[:, j]), **_FRICTION)
+            ax.plot(t, at(validation.tau_hat[:, j]), **_FRICTION | {"label": f"model + {added}"})
         ax.set_ylabel(f"{names[j]}\n[N m]")
         ax.grid(alpha=0.3)
-        rms = f"RMS [N m]\nno friction {validation.without_friction.rms[j]:.3f}"
+        rms = f"RMS [N m]\nno {added} {validation.without_friction.rms[j]:.3f}"
         axe.plot(t, at(e0[:, j]), color=_NO_FRICTION["color"], lw=0.8)
         if e1 is not None and validation.with_friction is not None:
-            rms += f"\n+ friction {validation.with_friction.rms[j]:.3f}"
+            rms += f"\n+ {added} {validation.with_friction.rms[j]:.3f}"
             axe.plot(t, at(e1[:, j]), color=_FRICTION["color"], lw=0.6, alpha=0.8)
         axe.axhline(0.0, color="0.5", lw=0.6)
         axe.grid(alpha=0.3)
@@ -132,10 +133,10 @@ def plot_validation_rms(
     -------
     matplotlib.figure.Figure
     """
-    rms = {"without friction": validation.without_friction.rms}
+    rms = {f"without {validation.added}": validation.without_friction.rms}
     colours = [COLOURS["no_friction"]]
     if validation.with_friction is not None:
-        rms["with friction"] = validation.with_friction.rms
+        rms[f"with {validation.added}"] = validation.with_friction.rms
         colours.append(COLOURS["model"])
     return plot_rms_comparison(
         rms, joint_names=joint_names, noise_std=noise_std, title=title, colours=colours

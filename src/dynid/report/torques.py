@@ -57,6 +57,7 @@ def validate_answer(run: RunFiles) -> Answer | None:
         return None
     judged: dict[str, Any] = doc["verdict"] if isinstance(doc.get("verdict"), dict) else {}
     floor = doc.get("noise_floor_percent")
+    added = _added(doc)
     if judged.get("level") in LEVELS:  # the command's own verdict
         level, label = str(judged["level"]), str(judged.get("label") or judged["level"])
         reason = str(judged.get("reason", ""))
@@ -70,9 +71,11 @@ def validate_answer(run: RunFiles) -> Answer | None:
         label = {"poor": "poor: improve the model", "unusable": "unusable: check the data"}[level]
     facts = [
         f"<b>{esc(label[0].upper() + label[1:])}</b>: {esc(reason)}",
-        f"Relative error without friction {percent(without.get('relative_error_percent'))}"
+        f"Relative error without {added} {percent(without.get('relative_error_percent'))}"
         + (
-            f", with friction ({esc(doc.get('friction_model'))}) "
+            f", with {added}"
+            + ("" if added == "offsets" else f" ({esc(doc.get('friction_model'))})")
+            + " "
             f"<b>{percent(with_.get('relative_error_percent'))}</b>"
             if isinstance(with_, dict)
             else " (no friction model given)"
@@ -117,7 +120,7 @@ def validate_answer(run: RunFiles) -> Answer | None:
         run,
         (
             ("validation_torques.png", "Measured and predicted torques"),
-            ("validation_rms.png", "RMS error per joint, without and with friction"),
+            ("validation_rms.png", f"RMS error per joint, without and with {added}"),
         ),
     )
     shown_label = label if level == judged_level else None  # a worse joint: the level's own
@@ -136,6 +139,13 @@ def _noise_ratios(doc: dict, n: int) -> list[float]:
     ]
 
 
+def _added(doc: dict) -> str:
+    """What the model's friction adds (validation.json ``friction_terms``: offsets are not
+    friction); "friction" in a file without the key (or with another value)."""
+    words = doc.get("friction_terms")
+    return words if words in ("offsets", "friction and offsets") else "friction"
+
+
 def _joint_errors(doc: dict) -> str:
     w = doc.get("without_friction") or {}
     f = doc.get("with_friction") or {}
@@ -151,12 +161,13 @@ def _joint_errors(doc: dict) -> str:
             gain = 100.0 * (1 - r1[j] / r0[j]) if r0[j] > 0 else None
             row += [cell(r1[j]), cell(p1[j] if j < len(p1) else None), cell(gain)]
         rows.append(row)
-    headers = ["joint", "RMS without friction [N m]", "relative error without [%]"]
+    added = _added(doc)
+    headers = ["joint", f"RMS without {added} [N m]", "relative error without [%]"]
     if r1:
         headers += [
-            "RMS with friction [N m]",
+            f"RMS with {added} [N m]",
             "relative error with [%]",
-            "friction lowers RMS by [%]",
+            f"{added} {'lowers' if added == 'friction' else 'lower'} RMS by [%]",
         ]
     return section("errors", "Errors per joint", table(headers, rows))
 

@@ -35,6 +35,7 @@ from ..feasibility.convex import (
 from ..identification.consistency import fit_mismatch, limit_violations
 from ..identification.estimators import ESTIMATORS, EstimatorName
 from ..identification.least_squares import STD_METHODS, StdMethod
+from ..identification.log import TorqueLog
 from ..identification.model import IdentifiedModel
 from ..identification.selection import identify_recordings
 from ..identification.static import identify_static
@@ -52,7 +53,14 @@ from .data_files import (
 )
 from .options import check_band, check_choice, check_count, check_number, only_with, refused_with
 from .prior import load_prior
-from .recordings import Recorded, check_limits, check_torque_unit, check_units, given_start
+from .recordings import (
+    Recorded,
+    check_limits,
+    check_signs,
+    check_torque_unit,
+    check_units,
+    given_start,
+)
 
 __all__ = ["ColumnSpec", "IdentifyOptions", "IdentifyResult", "data_files", "identify_files"]
 
@@ -66,13 +74,14 @@ def _heldout(
     kind: str,
     folds: int | None,
     validate_on: str | Path | None,
-    n: int,
+    robot: Robot,
     cmap: Any,
     drop_invalid: bool,
 ) -> dict[str, Any]:
     """``folds``/``validate_on`` of the torque-log routes (the log read as ``paths[0]``
-    is); refused for static data, ``folds`` with several recordings (each recording is
-    a fold), ``validate_on`` one of the recordings (or a copy)."""
+    is, and checked with the recordings: :func:`_read_logs`); refused for static data,
+    ``folds`` with several recordings (each recording is a fold), ``validate_on`` one of
+    the recordings (or a copy)."""
     if folds is None and validate_on is None:
         return {}
     path = paths[0]
@@ -98,7 +107,14 @@ def _heldout(
                 "the fit does not see",
                 field="validate_on",
             ) from None
-        kw["validate_on"] = read_torque_log(validate_on, n, columns=cmap, drop_invalid=drop_invalid)
+        kw["validate_on"] = read_torque_log(
+            validate_on,
+            robot.n,
+            columns=cmap,
+            drop_invalid=drop_invalid,
+            owner=f"robot {robot.name!r}",
+            robot=robot,
+        )
     return kw
 
 
@@ -319,9 +335,9 @@ def _identify(robot: Robot, paths: list[Path], opt: IdentifyOptions) -> Identifi
     path = paths[0]
     cmap = _columns(opt.columns, opt.cutoff_hz)
     kind = data_kind(path, cmap)
-    heldout = _heldout(paths, kind, opt.folds, opt.validate_on, robot.n, cmap, opt.drop_invalid)
+    heldout = _heldout(paths, kind, opt.folds, opt.validate_on, robot, cmap, opt.drop_invalid)
     if kind == "torque_log":
-        logs = _read_logs(robot, paths, cmap, opt)
+        logs = _read_logs(robot, paths, cmap, opt, heldout.get("validate_on"))
         fit = lambda: identify_recordings(  # noqa: E731
             robot,
             logs,
@@ -361,7 +377,13 @@ def _identify(robot: Robot, paths: list[Path], opt: IdentifyOptions) -> Identifi
     return _record(model, opt.columns)
 
 
-def _read_logs(robot: Robot, paths: list[Path], cmap: Any, opt: IdentifyOptions) -> list[Any]:
+def _read_logs(
+    robot: Robot,
+    paths: list[Path],
+    cmap: Any,
+    opt: IdentifyOptions,
+    heldout: TorqueLog | None = None,
+) -> list[Any]:
     """The torque logs ``paths``, read strictly for ``robot`` (recorded through
     ``opt.drive``); a recording in degrees among recordings in radians, with joints in
     degrees, in other units than the others, or in mN m read as N m, refused, and one far
@@ -369,7 +391,10 @@ def _read_logs(robot: Robot, paths: list[Path], cmap: Any, opt: IdentifyOptions)
     (:func:`~dynid.workflows.recordings.check_limits`,
     :func:`~dynid.workflows.recordings.check_units`,
     :func:`~dynid.workflows.recordings.check_torque_unit`); the whole turns of wrapped motors
-    from ``q_start`` (:func:`given_start`)."""
+    from ``q_start`` (:func:`given_start`). The held-out log of ``opt.validate_on``
+    (``heldout``, read) is checked with them, and its sign too
+    (:func:`~dynid.workflows.recordings.check_signs`; the fit checks the recordings'):
+    judged on torques in other units or of the other sign, a held-out error says nothing."""
     logs = [
         read_torque_log(
             p,
@@ -383,10 +408,14 @@ def _read_logs(robot: Robot, paths: list[Path], cmap: Any, opt: IdentifyOptions)
     ]
     names = [p.name for p in paths]
     logs = list(given_start(logs, names, robot, opt.drive, opt.q_start, opt.max_gap_s))
-    rec = Recorded(tuple(logs), tuple(paths))
-    check_limits(rec, robot, opt.drive)
+    held: list[tuple[TorqueLog, Path]] = []
+    if heldout is not None and opt.validate_on is not None:
+        held.append((heldout, Path(opt.validate_on)))
+    rec = Recorded((*logs, *(g for g, _ in held)), (*paths, *(p for _, p in held)), opt.drive)
+    check_limits(rec, robot)
     check_units(rec)
-    check_torque_unit(rec, robot, opt.drive, cmap)
+    check_signs(rec.select(slice(len(logs), None)), robot)  # the held-out log's
+    check_torque_unit(rec, robot, cmap)
     return logs
 
 
@@ -424,10 +453,10 @@ def _identify_consistent(
     path = paths[0]
     cmap = _columns(opt.columns, opt.cutoff_hz)
     kind = data_kind(path, cmap)
-    heldout = _heldout(paths, kind, opt.folds, opt.validate_on, robot.n, cmap, opt.drop_invalid)
+    heldout = _heldout(paths, kind, opt.folds, opt.validate_on, robot, cmap, opt.drop_invalid)
     common: dict[str, Any] = dict(prior=prior, total_mass=opt.total_mass, options=opt.sdp())
     if kind == "torque_log":
-        logs = _read_logs(robot, paths, cmap, opt)
+        logs = _read_logs(robot, paths, cmap, opt, heldout.get("validate_on"))
 
         def fit() -> ConsistentResult:
             return identify_consistent(

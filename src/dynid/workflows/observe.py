@@ -369,7 +369,7 @@ def observe_files(opts: ObserveOptions, sink: ResidualSink | None = None) -> Obs
         rows = log.t.shape[0]
         table = None if sink is None else sink.table(paths, k, rows, model.n, opts.frame)
         with about_file(path.name):
-            prep = prepared_log(path, log, model, opts.max_gap)
+            prep = prepared_log(path, log, model, opts.max_gap, read.joint_side[k])
         logs.append(
             detected_log(
                 prep,
@@ -414,11 +414,11 @@ def _read_logs(
     ]
     names = [Path(p).name for p in paths]
     logs = list(given_start(logs, names, model.robot, model.drive, opts.q_start, opts.max_gap))
-    read = Recorded(tuple(logs), tuple(map(Path, paths)))
-    check_limits(read, model.robot, model.drive)
+    read = Recorded(tuple(logs), tuple(map(Path, paths)), model.drive)  # mapped once
+    check_limits(read, model.robot)
     check_units(read)
-    check_signs(read, model.robot, model.drive)
-    check_torque_unit(read, model.robot, model.drive, cmap)
+    check_signs(read, model.robot)
+    check_torque_unit(read, model.robot, cmap)
     return read
 
 
@@ -445,8 +445,8 @@ def _calibrated(
     names = model.robot.joint_names
 
     def blocks() -> Iterator[ObservedBlock]:
-        for path, log in zip(read.paths, read.logs, strict=True):
-            prep = prepared_log(Path(path), log, model, opts.max_gap)
+        for path, log, side in zip(read.paths, read.logs, read.joint_side, strict=True):
+            prep = prepared_log(Path(path), log, model, opts.max_gap, side)
             keep = Series.new(prep, model.n, wants_std, wants_margin) if opts.keep_series else None
             peak = np.zeros(model.n)
             sign = TorqueSign(model.n)

@@ -98,13 +98,21 @@ class Series:
 
 
 def prepared_log(
-    path: Path, log: TorqueLog, model: ObserverModel, max_gap: float | None
+    path: Path,
+    log: TorqueLog,
+    model: ObserverModel,
+    max_gap: float | None,
+    side: TorqueLog | None = None,
 ) -> PreparedLog:
     """The log at the joints, unwrapped, cut at its gaps and jumps, with the velocities
-    and the spans the observer runs on (warnings name the file)."""
+    and the spans the observer runs on (warnings name the file). ``side``: ``log`` already
+    on the joint side (the checks' :attr:`~dynid.workflows.recordings.Recorded.sides`),
+    used unless its motors' whole turns change it."""
     # motors recorded wrapped given their whole turns (refused when the limits leave several)
-    log = with_start_turns(path.name, log, model.robot, model.drive, max_gap_s=max_gap)
-    log = joint_side_log(log, model.drive)
+    whole = with_start_turns(path.name, log, model.robot, model.drive, max_gap_s=max_gap)
+    if side is None or whole is not log:
+        side = joint_side_log(whole, model.drive)
+    log = side
     log, turned = unwrapped(log, wrappable(model.robot))  # joints whose limits span a turn
     if turned:  # M(q) is periodic; velocities derived across a wrap are not
         warnings.warn(

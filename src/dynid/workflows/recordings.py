@@ -84,21 +84,44 @@ LIMIT_MARGIN = 0.2
 
 @dataclass(frozen=True, slots=True, eq=False)
 class Recorded:
-    """The recordings as read.
+    """The recordings as read, and on the joint side.
 
     Attributes
     ----------
     logs : tuple of TorqueLog
     paths : tuple of Path
+    drive : Drive or None
+        The drive they were recorded through.
+    sides : tuple of TorqueLog
+        The logs in joint positions and torques through ``drive``
+        (:func:`~dynid.identification.log.joint_side_log`; the logs themselves without
+        it or through a drive of another joint count), mapped once when made (default)
+        for every check and for the observer.
     """
 
     logs: tuple[TorqueLog, ...]
     paths: tuple[Path, ...]
+    drive: Drive | None = None
+    sides: tuple[TorqueLog, ...] | None = None
+
+    def __post_init__(self) -> None:
+        if self.sides is None:
+            object.__setattr__(self, "sides", tuple(_joint_side(g, self.drive) for g in self.logs))
 
     @property
     def names(self) -> tuple[str, ...]:
         """The files' names."""
         return tuple(p.name for p in self.paths)
+
+    @property
+    def joint_side(self) -> tuple[TorqueLog, ...]:
+        """:attr:`sides`, typed."""
+        assert self.sides is not None  # set when made
+        return self.sides
+
+    def select(self, rows: slice) -> Recorded:
+        """The recordings ``rows`` (a slice), their joint-side logs not mapped again."""
+        return Recorded(self.logs[rows], self.paths[rows], self.drive, self.joint_side[rows])
 
 
 def read_recordings(
@@ -165,13 +188,13 @@ def read_recordings(
 
     logs = tuple(in_file(p, lambda p=p: read(p)) for p in paths)  # type: ignore[misc]
     logs = given_start(logs, [p.name for p in paths], robot, drive, q_start, max_gap_s)
-    out = Recorded(logs, tuple(paths))
-    check_limits(out, robot, drive)
+    out = Recorded(logs, tuple(paths), drive)
+    check_limits(out, robot)
     for name, log in zip(out.names, out.logs, strict=True):  # the time unit named first
         if (unit := time_unit_finding(name, log)) is not None:  # it names the file
             raise DataError(unit.removeprefix(f"{name}: "), file=name)
     check_units(out)
-    check_torque_unit(out, robot if reference is None else reference, drive, cmap)
+    check_torque_unit(out, robot if reference is None else reference, cmap)
     return out
 
 
@@ -268,7 +291,7 @@ def check_units(rec: Recorded) -> None:
             )
 
 
-def check_degrees(rec: Recorded, robot: Robot, drive: Drive | None) -> None:
+def check_degrees(rec: Recorded, robot: Robot) -> None:
     """Refuse a recording in degrees among recordings in radians
     (:func:`~dynid.identification.unit_mix.degrees_among_radians`), naming it.
 
@@ -277,13 +300,12 @@ def check_degrees(rec: Recorded, robot: Robot, drive: Drive | None) -> None:
     DataError
         Naming the recording, the scales and the columns to convert.
     """
-    logs = [_joint_side(log, drive) for log in rec.logs]
-    found = degrees_among_radians(robot, logs, rec.names, LIMIT_MARGIN)
+    found = degrees_among_radians(robot, list(rec.joint_side), rec.names, LIMIT_MARGIN)
     if found is not None:
         raise DataError(found[1], file=rec.names[found[0]])
 
 
-def check_signs(rec: Recorded, robot: Robot, drive: Drive | None) -> None:
+def check_signs(rec: Recorded, robot: Robot) -> None:
     """Refuse a recording whose (joint-side) torques have the opposite sign to the
     robot's, on every joint gravity loads or on some
     (:func:`~dynid.identification.sanity.opposite_sign`), as ``identify`` does: thresholds
@@ -295,16 +317,14 @@ def check_signs(rec: Recorded, robot: Robot, drive: Drive | None) -> None:
         Naming the recording, the joints and the remedy (``--units tau=-1``, or the
         columns to flip).
     """
-    for name, log in zip(rec.names, rec.logs, strict=True):
+    for name, log in zip(rec.names, rec.joint_side, strict=True):
         if (few := too_few_samples(log)) is not None:  # before the correlations
             raise DataError(few, file=name)
-        if (opposite := opposite_sign(robot, _joint_side(log, drive))) is not None:
+        if (opposite := opposite_sign(robot, log)) is not None:
             raise DataError(opposite, file=name)
 
 
-def check_torque_unit(
-    rec: Recorded, robot: Robot, drive: Drive | None, cmap: ColumnMap | None
-) -> None:
+def check_torque_unit(rec: Recorded, robot: Robot, cmap: ColumnMap | None) -> None:
     """Refuse a recording whose (joint-side) torques read as mN m (or kN m) taken for N m
     (:func:`~dynid.identification.sanity.torque_unit_finding`), as the opposite sign and
     degrees are refused, unless the column map ``cmap`` they were read with says the
@@ -318,8 +338,8 @@ def check_torque_unit(
     """
     if cmap is not None and "tau" in cmap.factors:
         return
-    for name, log in zip(rec.names, rec.logs, strict=True):
-        if (found := torque_unit_finding(robot, _joint_side(log, drive))) is not None:
+    for name, log in zip(rec.names, rec.joint_side, strict=True):
+        if (found := torque_unit_finding(robot, log, rec.drive)) is not None:
             raise DataError(found, file=name)
 
 
@@ -327,7 +347,7 @@ def _joint_side(log: TorqueLog, drive: Drive | None) -> TorqueLog:
     return log if drive is None or drive.n != log.n else joint_side_log(log, drive)
 
 
-def check_limits(rec: Recorded, robot: Robot, drive: Drive | None) -> None:
+def check_limits(rec: Recorded, robot: Robot) -> None:
     """Refuse a recording in degrees among recordings in radians (:func:`check_degrees`)
     and a recording with joints in degrees
     (:func:`~dynid.identification.unit_mix.joints_in_degrees`); warn about a recording
@@ -340,8 +360,8 @@ def check_limits(rec: Recorded, robot: Robot, drive: Drive | None) -> None:
         A recording in degrees among recordings in radians, or with joints in degrees
         (naming the file, the joints and the conversion).
     """
-    check_degrees(rec, robot, drive)
-    sides = [_joint_side(log, drive) for log in rec.logs]
+    check_degrees(rec, robot)
+    sides = rec.joint_side
     for name, log in zip(rec.names, sides, strict=True):
         if (found := joints_in_degrees(robot, log, LIMIT_MARGIN))[0]:
             raise DataError(found[1], file=name)
