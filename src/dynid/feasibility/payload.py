@@ -22,9 +22,11 @@ or a robot's links with its drive's known rotor inertias and its own friction.
   each recording and each piece between gaps on its own; an identified model's recorded
   cut-off and decimation by default), ``Y`` the torque regressor, and the classical
   friction ``fv, fc, fo`` per joint estimated alongside (what the arm's own friction
-  leaves); a joint whose measured velocity never leaves its noise band
-  (:func:`~dynid.identification.sanity.moving_joints`) does not move: its velocity and
-  acceleration are zero in the regressor and its ``fv, fc`` are not fitted (zero);
+  leaves); the Coulomb columns and the arm's own friction low-passed as the torques were
+  (parallel filtering, as identification's rows); a joint whose measured velocity never
+  leaves its noise band (:func:`~dynid.identification.sanity.moving_joints`) does not
+  move: its velocity and acceleration are zero in the regressor and its ``fv, fc`` are
+  not fitted (zero);
 * **difference method** (``unloaded=`` data of the same kind recorded without the load):
   the arm is first identified from the unloaded data with identification's structure
   selection, or the structure of the identified model given
