@@ -16,7 +16,9 @@ arm's whole prediction (:class:`~dynid.feasibility.payload_arm.ArmModel`).
   identification's rows do (:func:`~dynid.identification.log_rows.stepped_columns`);
   left sharp, they leave a residual at every reversal that the load's inertia absorbs;
 * :func:`log_preparation`: the cut-off and decimation: given, else the identified model's
-  recorded ones, else read from the recordings' motion as identification reads them.
+  recorded ones, else read from the recordings' motion as identification reads them;
+* :func:`filtered_noise_rms`: the RMS the torque sensors' noise leaves in the rows after
+  the low-pass, what a perfect model's residual comes to.
 """
 
 from __future__ import annotations
@@ -38,9 +40,16 @@ from ..model.drive import Drive
 from ..regressors.static import static_regressor_columns, static_rows, static_vector
 from ..regressors.terms import LinearFriction
 from ..regressors.torque import torque_regressor
+from ..signals import lowpass_noise_gain
 from .payload_arm import ArmModel, FrictionTorques
 
-__all__ = ["log_preparation", "log_rows", "static_load_rows", "still_joints"]
+__all__ = [
+    "filtered_noise_rms",
+    "log_preparation",
+    "log_rows",
+    "static_load_rows",
+    "still_joints",
+]
 
 
 def static_load_rows(
@@ -209,6 +218,25 @@ def log_rows(
     k = len(data.names)
     route = "torque log" if k == 1 else f"{k} torque logs"
     return W, y, route, kept
+
+
+def filtered_noise_rms(data: Recordings) -> float | None:
+    """The RMS [N m] of the torque noise in the prepared rows: each piece's white noise per
+    joint (:attr:`~dynid.identification.prepared_log.PreparedLog.torque_noise_std`, read
+    from its raw torques) through the low-pass's noise gain
+    (:func:`~dynid.signals.lowpass_noise_gain`), weighted by the piece's samples,
+
+    .. math:: \\sqrt{\\sum_p N_p g_p^2 \\sum_j \\sigma_{pj}^2 \\Big/ \\Big(n \\sum_p N_p\\Big)};
+
+    None when a piece's noise is not known."""
+    total = count = 0.0
+    for p in data.pieces:
+        if p.torque_noise_std is None:
+            return None
+        g = lowpass_noise_gain(p.sample_rate_hz, p.cutoff_hz)
+        total += p.log.n_samples * g * g * float(np.sum(np.square(p.torque_noise_std)))
+        count += p.log.n_samples * p.n
+    return float(np.sqrt(total / count)) if count else None
 
 
 def _with_own_friction(
