@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import dataclasses
 import json
+import re
 import warnings
 
 import numpy as np
@@ -19,16 +20,18 @@ from dynid.cli.__main__ import main
 from dynid.exceptions import DynidWarning, ModelError
 from dynid.feasibility.payload import identify_payload
 from dynid.feasibility.payload_arm import arm_model
-from dynid.feasibility.payload_doubts import arm_length
+from dynid.feasibility.payload_doubts import arm_length, undetermined_inertia
 from dynid.feasibility.payload_fit import serial_correlation_factor
 from dynid.identification.selection import identify_recordings
 from dynid.identification.structure import Structure
 from dynid.io.model_json import save_model_json
+from dynid.io.payload_json import payload_to_dict
 from dynid.io.torque_log import save_torque_log
 from dynid.model.drive import Drive
 from dynid.model.inertia import inertia6_from_matrix
+from dynid.signals import lowpass_noise_gain
 from dynid.simulation.measurement import simulate_measurement
-from dynid.simulation.trajectories import random_fourier, uniform_times
+from dynid.simulation.trajectories import random_fourier, sinusoid_trajectory, uniform_times
 
 IA = np.array([0.08, 0.08, 0.06, 0.09, 0.1, 0.03, 0.06])  # armature [kg m^2]
 MASS, COM = 0.73, np.array([0.01, -0.02, 0.06])
@@ -193,3 +196,82 @@ def test_cli_model_preprocessing_recorded_and_several_unloaded_files(logs, tmp_p
     d = json.loads((tmp_path / "q" / "payload.json").read_text())
     assert "difference" in d["route"] and abs(d["mass"] - MASS) < 0.01 * MASS
     assert any("links + armature + viscous (given)" in note for note in d["notes"])
+
+
+def test_undetermined_inertia_against_its_definition():
+    """A moment under 3 std above zero, and a product whose std exceeds a third of half
+    the third moment (``|Ixy| <= Izz / 2``), are named; tighter ones, and an inertia not
+    identified (NaN std), are not."""
+    I = np.array([[0.004, 0.0002, 0.0], [0.0002, 0.005, 0.0], [0.0, 0.0, 0.002]])
+    std = np.array([1e-4, 3.4e-4, 1e-4, 1e-4, 1e-4, 6.7e-4])  # Ixy: 3.4e-4 > 0.001 / 3
+    assert undetermined_inertia(I, std) == ("Ixy", "Izz")
+    assert undetermined_inertia(I, np.array([1e-4, 3.3e-4, 1e-4, 1e-4, 1e-4, 6.6e-4])) == ()
+    assert undetermined_inertia(I, np.full(6, np.nan)) == ()
+
+
+def _slow_or_fast(amplitude, seed):
+    """10 s at 500 Hz of the Panda carrying the load, every joint a sinusoid of
+    ``amplitude`` [rad/s] times the fast pattern, default sensor noise (0.05 N m)."""
+    fast = np.array([2.21, -2.21, 1.2, 1.5, -2.3, 2.1, -2.5])
+    arm = dynid.panda()
+    traj = sinusoid_trajectory(
+        uniform_times(10.0, 500.0), q0=dynid.PANDA_NEUTRAL_Q, amplitudes=amplitude * fast
+    )
+    loaded = arm.with_tool(np.eye(4), MASS, COM, INERTIA, name="load")
+    return arm, simulate_measurement(loaded, traj, rng=np.random.default_rng(seed))
+
+
+def test_an_inertia_the_motion_does_not_determine_is_a_doubt_not_a_setload_value():
+    """Regression: a load whose inertia the data did not determine (std about the value)
+    was written to setLoad with ``plausible: true`` and no doubt. Turned slowly (0.14-0.3
+    rad/s) the load's mass is known to 0.2 % but Ixx, Iyy, Ixy are not: a warning names
+    them, the estimate is not plausible, and payload.json keeps setLoad's mass and CoM
+    without its inertia; turned fast, every element is determined and handed on. The
+    residual is compared with the torque noise after the low-pass (0.05 N m through the
+    filter's noise gain)."""
+    for scale, seed in ((0.135, 21), (1.0, 22)):
+        arm, log = _slow_or_fast(scale, seed)
+        with warnings.catch_warnings(record=True) as caught:
+            warnings.simplefilter("always")
+            est = identify_payload(arm, log)
+        doc = payload_to_dict(est, arm)
+        floor = 0.05 * lowpass_noise_gain(500.0, est.preprocessing["cutoff_hz"])
+        assert abs(est.noise_rms / floor - 1) < 0.05 and est.residual_rms < 2 * est.noise_rms
+        assert doc["load_mass"] == est.mass and abs(est.mass - MASS) < 0.01 * MASS
+        said = [str(w.message) for w in caught if "inertia is not determined" in str(w.message)]
+        if scale < 1:
+            assert {"Ixx", "Iyy", "Ixy"} <= set(est.undetermined)
+            assert len(said) == 1 and said[0].startswith(
+                "the load's inertia is not determined: Ixx"
+            )
+            assert not est.plausible and doc["doubts"] == said and doc["load_inertia"] is None
+            assert doc["inertia_determined"] is False
+        else:
+            assert est.undetermined == () and not said and est.plausible
+            assert doc["load_inertia"] is not None and doc["inertia_determined"] is True
+
+
+def test_payload_report_covers_mass_com_and_inertia_and_weighs_the_residual(tmp_path, capsys):
+    """Regression: the report's headline gave the mass alone, 'usable, with reservations'
+    without a reason, and the residual without a unit. On a slowly turned load: the
+    headline names the mass, the CoM and the inertia's undetermined elements; the
+    reservation says which; the residual is in N m against the torque noise; the command
+    prints it too."""
+    arm, log = _slow_or_fast(0.135, 21)
+    save_torque_log(tmp_path / "slow.csv", log)
+    argv = ["payload", "--robot", "panda", "--data", str(tmp_path / "slow.csv")]
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", DynidWarning)
+        assert main([*argv, "--out", str(tmp_path / "p")]) == 0
+    printed = capsys.readouterr().out
+    assert re.search(r"residual RMS \S+ N m, \S+ x the torque noise \(\S+ N m after", printed)
+    assert "Ixx      " in printed and "not determined" in printed
+    html = (tmp_path / "p" / "report.html").read_text(encoding="utf-8")
+    box = re.search(r'<section class="verdict.*?</section>', html, re.S)
+    assert box is not None
+    text = " ".join(re.sub(r"<[^>]+>", " ", box.group(0)).split())
+    assert re.search(r"usable, with reservations The payload weighs 0\.7\d* kg \(known to", text)
+    assert "its centre of mass is known to" in text
+    assert "its inertia is not determined (Ixx, Ixy" in text
+    assert "Reservations: the data do not determine the inertia&#x27;s Ixx" in text
+    assert re.search(r"Residual RMS \S+ N m, \S+ x the torque noise after the low-pass", text)

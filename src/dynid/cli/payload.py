@@ -15,7 +15,11 @@ structure identify chooses (or --model's). The estimate is physically consistent
 (pseudo-inertia LMI). --columns/--units read files of other tools.
 
 A mass less than 3 standard deviations above zero, or a CoM farther from --frame than
-the arm is long, is warned about and no setLoad values are written.
+the arm is long, is warned about and no setLoad values are written. An inertia whose
+moments lie less than 3 standard deviations above zero, or whose products have a
+standard deviation above a third of their largest possible magnitude, is not determined:
+warned about (naming the elements, and the fit's residual against the torque noise), and
+setLoad's load_inertia is not written.
 
 Writes DIR/payload.json (mass, com [m] in --frame, inertia about the CoM, their std, the
 preprocessing used, and libfranka's setLoad values load_mass, F_x_Cload, load_inertia)
@@ -31,6 +35,7 @@ import argparse
 from pathlib import Path
 from typing import Any
 
+from ..feasibility.payload import PayloadEstimate
 from ..identification.model import IdentifiedModel
 from ..io.payload_json import save_payload_json
 from ..io.robot.toml import save_toml
@@ -147,7 +152,9 @@ def print_payload(console: Console, result: PayloadFileResult, label: str) -> No
         for name, v, s in zip(
             INERTIA_ORDER, inertia6_from_matrix(est.inertia), est.std_inertia, strict=True
         ):
-            console.print(f"  I{name}      {v:+.4e} kg m^2  (std {s:.2g})")
+            flag = "  not determined" if f"I{name}" in est.undetermined else ""
+            console.print(f"  I{name}      {v:+.4e} kg m^2  (std {s:.2g}){flag}")
+    console.print(f"  {residual_line(est)}")
     if result.recordings:
         console.print(result.describe())
     prep = est.preprocessing
@@ -163,3 +170,21 @@ def print_payload(console: Console, result: PayloadFileResult, label: str) -> No
         console.print(f"note: {note}")
     if est.doubts:
         console.print("not a load to trust: no setLoad values written (see the warnings)")
+    elif est.inertia_identified and not est.inertia_determined:
+        console.print(
+            f"inertia not determined ({', '.join(est.undetermined)}): setLoad's mass and CoM "
+            "written, its inertia not (see the warnings)"
+        )
+
+
+def residual_line(est: PayloadEstimate) -> str:
+    """``residual RMS 0.0067 N m, 1.5 x the torque noise (0.0044 N m after the low-pass)``
+    for torque logs; the static rows' residual without a unit of its own."""
+    if not est.noise_rms:  # static data, or no noise read from the logs
+        mixed = est.route.startswith("static M")
+        unit = " (rows of M [kg m^2] and g [N m])" if mixed else " N m"
+        return f"residual RMS {est.residual_rms:.2g}{unit}"
+    return (
+        f"residual RMS {est.residual_rms:.2g} N m, {est.residual_rms / est.noise_rms:.3g} x "
+        f"the torque noise ({est.noise_rms:.2g} N m after the low-pass)"
+    )

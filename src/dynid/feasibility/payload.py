@@ -22,9 +22,11 @@ or a robot's links with its drive's known rotor inertias and its own friction.
   each recording and each piece between gaps on its own; an identified model's recorded
   cut-off and decimation by default), ``Y`` the torque regressor, and the classical
   friction ``fv, fc, fo`` per joint estimated alongside (what the arm's own friction
-  leaves); a joint whose measured velocity never leaves its noise band
-  (:func:`~dynid.identification.sanity.moving_joints`) does not move: its velocity and
-  acceleration are zero in the regressor and its ``fv, fc`` are not fitted (zero);
+  leaves); the Coulomb columns and the arm's own friction low-passed as the torques were
+  (parallel filtering, as identification's rows); a joint whose measured velocity never
+  leaves its noise band (:func:`~dynid.identification.sanity.moving_joints`) does not
+  move: its velocity and acceleration are zero in the regressor and its ``fv, fc`` are
+  not fitted (zero);
 * **difference method** (``unloaded=`` data of the same kind recorded without the load):
   the arm is first identified from the unloaded data with identification's structure
   selection, or the structure of the identified model given
@@ -47,7 +49,11 @@ a mass less than :data:`MIN_MASS_SIGMAS` standard deviations above zero (no load
 can tell from none: unloaded data, or a load too light for them), or a CoM farther from
 the frame than the arm is long (no load the arm carries reaches past its own base; such
 a CoM is the first moment ``m c`` divided by a mass near zero). A doubtful estimate is
-not a load to hand to a controller.
+not a load to hand to a controller. An inertia whose elements the data do not determine
+(:attr:`PayloadEstimate.undetermined`, :mod:`dynid.feasibility.payload_doubts`) is doubted
+on its own (:attr:`PayloadEstimate.inertia_doubts`): the mass and CoM are handed on, the
+inertia is not. The fit's residual is compared with the torque noise left after the
+low-pass (:attr:`PayloadEstimate.noise_rms`).
 """
 
 from __future__ import annotations
@@ -76,9 +82,15 @@ from ..model.drive import Drive
 from ..model.robot import Robot
 from .lmi import phi_from_pseudo_inertia, pseudo_inertia
 from .payload_arm import ArmFriction, ArmModel, arm_model, model_structure, unloaded_arm
-from .payload_doubts import doubts_about
+from .payload_doubts import doubts_about, inertia_doubts, undetermined_inertia
 from .payload_fit import fit_load, load_parameters, serial_correlation_factor, summary
-from .payload_rows import log_preparation, log_rows, static_load_rows, still_joints
+from .payload_rows import (
+    filtered_noise_rms,
+    log_preparation,
+    log_rows,
+    static_load_rows,
+    still_joints,
+)
 
 __all__ = [
     "PayloadEstimate",
@@ -131,6 +143,17 @@ class PayloadEstimate:
     notes : tuple of str
     doubts : tuple of str
         Why the estimate is not a load to trust (module docstring); empty when none.
+    undetermined : tuple of str
+        The inertia's elements the data do not determine (``"Ixx"`` .. ``"Izz"``,
+        :func:`~dynid.feasibility.payload_doubts.undetermined_inertia`); empty when every
+        one is or the inertia was not identified.
+    inertia_doubts : tuple of str
+        Why the inertia is not to be trusted (naming :attr:`undetermined`); empty when none.
+    noise_rms : float or None
+        Torque logs: the RMS [N m] the torque sensors' noise alone leaves in the rows
+        after the low-pass (each piece's white noise per joint through the filter's noise
+        gain): the :attr:`residual_rms` of a perfect model. None for static data, or when
+        a recording's noise could not be read.
     preprocessing : mapping
         Torque logs: ``cutoff_hz`` [Hz], ``cutoff_source`` (``"given"``, ``"model"``: the
         identification's, ``"motion"``: read from the recordings), ``decimate``,
@@ -168,11 +191,20 @@ class PayloadEstimate:
     preprocessing: Mapping[str, Any] = field(default_factory=dict)
     recordings: tuple[Mapping[str, Any], ...] = ()
     skipped: tuple[str, ...] = ()
+    undetermined: tuple[str, ...] = ()
+    inertia_doubts: tuple[str, ...] = ()
+    noise_rms: float | None = None
 
     @property
     def plausible(self) -> bool:
-        """No doubt about the estimate (:attr:`doubts` empty)."""
-        return not self.doubts
+        """No doubt about the estimate, its inertia included (:attr:`doubts` and
+        :attr:`inertia_doubts` empty)."""
+        return not self.doubts and not self.inertia_doubts
+
+    @property
+    def inertia_determined(self) -> bool:
+        """The inertia was identified and the data determine each of its elements."""
+        return self.inertia_identified and not self.undetermined
 
 
 def link_params_from_frame(T_link_frame: NDArray[np.float64]) -> NDArray[np.float64]:
@@ -262,7 +294,8 @@ def identify_payload(
     SolverError
         The constrained problem failed.
 
-    Each of :attr:`PayloadEstimate.doubts` is also a :class:`DynidWarning`.
+    Each of :attr:`PayloadEstimate.doubts` and :attr:`PayloadEstimate.inertia_doubts` is
+    also a :class:`DynidWarning`.
     """
     inner = arm.model if isinstance(arm, ArmModel) else arm
     kin = inner.robot if isinstance(inner, IdentifiedModel) else inner
@@ -338,7 +371,10 @@ def _estimate(
     phi, active, marg = load_parameters(est[:p], float(np.sqrt(cov[0, 0])), W, margin, notes)
     m, c, I, sm, sc, si = summary(phi, cov, p == 10)
     doubts = doubts_about(kin, frame, m, sm, c)
-    for line in doubts:
+    undetermined = undetermined_inertia(I, si) if p == 10 and not doubts else ()
+    noise = record.get("noise_rms")
+    about_inertia = inertia_doubts(undetermined, I, si, fit.residual_rms, noise)
+    for line in doubts + about_inertia:
         warnings.warn(line, DynidWarning, stacklevel=3)
     return PayloadEstimate(
         frame=frame,
@@ -362,6 +398,8 @@ def _estimate(
         friction=None if static else est[10:].reshape(n, 3),
         notes=tuple(notes),
         doubts=doubts,
+        undetermined=undetermined,
+        inertia_doubts=about_inertia,
         **record,
     )
 
@@ -411,7 +449,7 @@ def _log_route(
         notes.append(note)
     W, yv, route, kept = log_rows(the_arm, rec, still_joints(logs, d), cols, A, notes)
     record = {"preprocessing": prep, "recordings": rec.summary(), "skipped": rec.skipped}
-    return W, yv, route, kept, record
+    return W, yv, route, kept, record | {"noise_rms": filtered_noise_rms(rec)}
 
 
 def _items(

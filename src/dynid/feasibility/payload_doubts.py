@@ -8,6 +8,14 @@
 
 Such an estimate is not handed to a controller (``payload.json`` leaves libfranka's
 ``setLoad`` values out).
+
+The inertia is judged element by element (:func:`undetermined_inertia`): a moment less
+than :data:`MIN_INERTIA_SIGMAS` standard deviations above zero, or a product of inertia
+whose standard deviation exceeds a :data:`MIN_INERTIA_SIGMAS`-th of the largest magnitude
+a rigid body allows it (half the third moment: ``|Ixy| <= Izz / 2``), is not determined
+by the data (a load that barely rotates, or torques the arm's model leaves, which the
+inertia absorbs). :func:`inertia_doubts` says which, with the fit's residual against the
+torque noise; the mass and CoM are still handed on, the inertia is not.
 """
 
 from __future__ import annotations
@@ -15,13 +23,28 @@ from __future__ import annotations
 import numpy as np
 from numpy.typing import NDArray
 
+from ..identification.verdict import FLOOR_FAIR
 from ..kinematics.forward import link_poses
+from ..model.inertia import INERTIA_ORDER, inertia6_from_matrix
 from ..model.robot import Robot
 
-__all__ = ["MIN_MASS_SIGMAS", "arm_length", "doubts_about"]
+__all__ = [
+    "MIN_INERTIA_SIGMAS",
+    "MIN_MASS_SIGMAS",
+    "arm_length",
+    "doubts_about",
+    "inertia_doubts",
+    "undetermined_inertia",
+]
 
 #: A load's mass must lie this many standard deviations above zero to be told from none.
 MIN_MASS_SIGMAS = 3.0
+#: A moment of inertia must lie this many standard deviations above zero, and a product's
+#: standard deviation stay below this part of its largest possible magnitude.
+MIN_INERTIA_SIGMAS = 3.0
+#: The moment that bounds each product of inertia, ``|I_ab| <= I_cc / 2`` (indices into
+#: ``xx xy xz yy yz zz``); a moment is judged against itself.
+_BOUND = {"xx": 0, "xy": 5, "xz": 3, "yy": 3, "yz": 0, "zz": 5}
 
 
 def arm_length(robot: Robot) -> float:
@@ -54,3 +77,63 @@ def doubts_about(
             "moment m c was divided by a mass near zero, or the arm's model is wrong"
         )
     return tuple(out)
+
+
+def undetermined_inertia(inertia: NDArray[np.float64], std: NDArray[np.float64]) -> tuple[str, ...]:
+    """The elements of the inertia the data do not determine (module docstring), named
+    ``"Ixx"`` .. ``"Izz"`` in the order ``xx xy xz yy yz zz``; empty when every one is,
+    or when the inertia was not identified (``std`` NaN).
+
+    Parameters
+    ----------
+    inertia : ndarray, shape (3, 3)
+        About the CoM [kg m^2].
+    std : ndarray, shape (6,)
+        Standard deviations of ``xx xy xz yy yz zz`` [kg m^2].
+    """
+    v = inertia6_from_matrix(np.asarray(inertia, dtype=np.float64))
+    s = np.asarray(std, dtype=np.float64)
+    out = []
+    for k, name in enumerate(INERTIA_ORDER):
+        b = _BOUND[name]
+        scale = v[b] if b == k else 0.5 * v[b]
+        if np.isfinite(s[k]) and not MIN_INERTIA_SIGMAS * s[k] < scale:
+            out.append(f"I{name}")
+    return tuple(out)
+
+
+def inertia_doubts(
+    names: tuple[str, ...],
+    inertia: NDArray[np.float64],
+    std: NDArray[np.float64],
+    residual_rms: float,
+    noise_rms: float | None,
+) -> tuple[str, ...]:
+    """The doubt about an inertia whose elements ``names`` are not determined
+    (:func:`undetermined_inertia`): each with its value and standard deviation [kg m^2],
+    and the likely cause, the fit's residual [N m] against the torque noise after the
+    low-pass ``noise_rms`` [N m] when known; empty for no names."""
+    if not names:
+        return ()
+    v = inertia6_from_matrix(np.asarray(inertia, dtype=np.float64))
+    order = [f"I{n}" for n in INERTIA_ORDER]
+    which = ", ".join(f"{n} {v[order.index(n)]:.2g} (std {std[order.index(n)]:.2g})" for n in names)
+    ratio = residual_rms / noise_rms if noise_rms else None
+    if ratio is not None and ratio > FLOOR_FAIR:
+        cause = (
+            f"the fit leaves {residual_rms:.2g} N m RMS, {ratio:.3g} x the {noise_rms:.2g} N m "
+            "of the torque noise: torques the arm's model does not explain (its friction, "
+            "drive or armature, or the states' noise at a high cut-off) go into the inertia"
+        )
+        hint = (
+            "validate the arm's model on a log without the load, give --unloaded logs, or "
+            "keep the cut-off the motion needs"
+        )
+    else:
+        cause = "the load turns too little or too slowly about some axis for the data to weigh it"
+        hint = "a trajectory that turns the load faster about every axis"
+    return (
+        f"the load's inertia is not determined: {which} kg m^2 (a moment needs "
+        f"{MIN_INERTIA_SIGMAS:g} std above zero, a product a std under 1/{MIN_INERTIA_SIGMAS:g} "
+        f"of half the third moment); {cause}; setLoad's inertia is not written; hint: {hint}",
+    )

@@ -10,31 +10,46 @@ arm's whole prediction (:class:`~dynid.feasibility.payload_arm.ArmModel`).
   unwrapped, cut at gaps longer than ``max_gap_s``, each piece filtered, differentiated
   and decimated on its own at one cut-off), with the classical friction ``fv, fc, fo`` per
   joint beside the load's columns: what the arm's own friction leaves (the load presses
-  the bearings harder), or all of it for an arm modelled without friction;
+  the bearings harder), or all of it for an arm modelled without friction. The torques
+  are low-passed, which rounds the step of Coulomb friction at a velocity reversal: the
+  Coulomb columns and the arm's own friction go through the same low-pass, as
+  identification's rows do (:func:`~dynid.identification.log_rows.stepped_columns`);
+  left sharp, they leave a residual at every reversal that the load's inertia absorbs;
 * :func:`log_preparation`: the cut-off and decimation: given, else the identified model's
-  recorded ones, else read from the recordings' motion as identification reads them.
+  recorded ones, else read from the recordings' motion as identification reads them;
+* :func:`filtered_noise_rms`: the RMS the torque sensors' noise leaves in the rows after
+  the low-pass, what a perfect model's residual comes to.
 """
 
 from __future__ import annotations
 
 from collections.abc import Sequence
+from dataclasses import dataclass
 from typing import Any, Literal
 
 import numpy as np
 from numpy.typing import NDArray
 
-from ..identification.classical import friction_regressor
 from ..identification.data import StaticDataset
 from ..identification.log import TorqueLog, joint_side_log
+from ..identification.log_rows import stepped_columns
 from ..identification.model import IdentifiedModel
 from ..identification.recordings import Recordings
 from ..identification.sanity import moving_joints
 from ..model.drive import Drive
 from ..regressors.static import static_regressor_columns, static_rows, static_vector
+from ..regressors.terms import LinearFriction
 from ..regressors.torque import torque_regressor
-from .payload_arm import ArmModel
+from ..signals import lowpass_noise_gain
+from .payload_arm import ArmModel, FrictionTorques
 
-__all__ = ["log_preparation", "log_rows", "static_load_rows", "still_joints"]
+__all__ = [
+    "filtered_noise_rms",
+    "log_preparation",
+    "log_rows",
+    "static_load_rows",
+    "still_joints",
+]
 
 
 def static_load_rows(
@@ -119,6 +134,33 @@ def _load_columns(
     return np.concatenate(parts)
 
 
+@dataclass(frozen=True, slots=True, eq=False)
+class _ArmFriction:
+    """The arm's own friction torques as one column that steps at a reversal, for
+    :func:`~dynid.identification.log_rows.stepped_columns`: low-passed whole (its smooth
+    part, far below the cut-off, passes the filter all but unchanged). Joints in ``still`` (n,)
+    are taken at rest, as in the load's rows."""
+
+    friction: FrictionTorques
+    still: NDArray[np.bool_]
+
+    @property
+    def labels(self) -> tuple[str, ...]:
+        """The one column: the friction torque."""
+        return ("tau_f",)
+
+    @property
+    def steps(self) -> NDArray[np.bool_]:
+        """(1,): it steps at a reversal."""
+        return np.ones(1, dtype=bool)
+
+    def torque_columns(
+        self, q: NDArray[np.float64], dq: NDArray[np.float64], ddq: NDArray[np.float64]
+    ) -> NDArray[np.float64]:
+        """The friction torques [N m] (B, n, 1) at joint velocities ``dq`` (B, n)."""
+        return np.asarray(self.friction.torques(dq * ~self.still))[..., None]
+
+
 def log_rows(
     arm: ArmModel,
     data: Recordings,
@@ -139,18 +181,20 @@ def log_rows(
     sigmoid on an arm with viscous friction only) would otherwise bias the load; without
     it, the classical friction fitted alongside is the arm's whole friction."""
     robot = arm.robot
+    n = robot.n
+    classical = LinearFriction(Drive.identity(n))
+    own = None if arm.friction is None else _ArmFriction(arm.friction, still)
     Ws, ys, fs = [], [], []
     for piece in data.pieces:
         log = piece.log
         assert log.ddq is not None  # prepared logs are differentiated
         q, dq, ddq = log.q, log.dq * ~still, log.ddq * ~still
         Y = _load_columns(robot, q, dq, ddq, cols, A)
-        Y = np.concatenate([Y, friction_regressor(dq)], axis=-1)
+        Y = np.concatenate([Y, stepped_columns(classical, log, **piece.filtering)], axis=-1)
         Ws.append(Y.reshape(-1, Y.shape[-1]))
         ys.append((np.asarray(log.tau) - arm.torques(q, dq, ddq, with_friction=False)).ravel())
-        if arm.friction is not None:
-            fs.append(np.asarray(arm.friction.torques(dq)).ravel())
-    n = robot.n
+        if own is not None:
+            fs.append(stepped_columns(own, log, **piece.filtering).ravel())
     kept = np.ones(Ws[0].shape[-1], dtype=bool)
     kept[10:] = ~(np.repeat(still, 3) & (np.arange(3 * n) % 3 != 2))
     W, y = np.concatenate(Ws), np.concatenate(ys)
@@ -174,6 +218,25 @@ def log_rows(
     k = len(data.names)
     route = "torque log" if k == 1 else f"{k} torque logs"
     return W, y, route, kept
+
+
+def filtered_noise_rms(data: Recordings) -> float | None:
+    """The RMS [N m] of the torque noise in the prepared rows: each piece's white noise per
+    joint (:attr:`~dynid.identification.prepared_log.PreparedLog.torque_noise_std`, read
+    from its raw torques) through the low-pass's noise gain
+    (:func:`~dynid.signals.lowpass_noise_gain`), weighted by the piece's samples,
+
+    .. math:: \\sqrt{\\sum_p N_p g_p^2 \\sum_j \\sigma_{pj}^2 \\Big/ \\Big(n \\sum_p N_p\\Big)};
+
+    None when a piece's noise is not known."""
+    total = count = 0.0
+    for p in data.pieces:
+        if p.torque_noise_std is None:
+            return None
+        g = lowpass_noise_gain(p.sample_rate_hz, p.cutoff_hz)
+        total += p.log.n_samples * g * g * float(np.sum(np.square(p.torque_noise_std)))
+        count += p.log.n_samples * p.n
+    return float(np.sqrt(total / count)) if count else None
 
 
 def _with_own_friction(

@@ -9,6 +9,7 @@ from __future__ import annotations
 
 from collections.abc import Callable, Iterator
 from functools import partial
+from typing import Protocol
 
 import numpy as np
 from numpy.typing import NDArray
@@ -33,13 +34,33 @@ from .streaming import BLOCK_ROWS, streams
 _SETTLE_CYCLES = 20.0
 
 __all__ = [
+    "SteppingColumns",
     "friction_regressor",
     "log_blocks",
     "parallel_filtered",
     "still_columns",
+    "stepped_columns",
     "still_friction",
     "term_regressor",
 ]
+
+
+class SteppingColumns(Protocol):
+    """What :func:`stepped_filtered` needs of a term: its columns at joint states (a
+    :class:`~dynid.regressors.terms.ModelTerm`, or another signal that steps at a
+    reversal, such as a known friction's torques). Which columns step is read from
+    ``steps`` (bool per label) when the object has it, else none do."""
+
+    @property
+    def labels(self) -> tuple[str, ...]:
+        """One label per column."""
+        ...
+
+    def torque_columns(
+        self, q: NDArray[np.float64], dq: NDArray[np.float64], ddq: NDArray[np.float64]
+    ) -> NDArray[np.float64]:
+        """Joint-torque columns (B, n, p) of (B, n) joint states."""
+        ...
 
 
 def friction_regressor(dq: NDArray[np.float64]) -> NDArray[np.float64]:
@@ -114,8 +135,33 @@ def log_blocks(
 STEP_SPAN = 4_096
 
 
+def stepped_columns(
+    term: SteppingColumns,
+    log: TorqueLog,
+    *,
+    cutoff_hz: float | None = None,
+    upsample: int = 1,
+    edges: tuple[TorqueLog | None, TorqueLog | None] = (None, None),
+    stamps: NDArray[np.float64] | None = None,
+) -> NDArray[np.float64]:
+    """One term's columns (N, n, p) at every sample of a prepared log, those that step at
+    a reversal low-passed as the log's torques were (:func:`stepped_filtered`), as
+    :func:`log_blocks` computes them; the keywords are :func:`log_blocks`' (a
+    :class:`~dynid.identification.prepared_log.PreparedLog`'s ``filtering``). Another
+    fit on low-passed torques (a payload's friction) takes its rows from here."""
+    assert log.ddq is not None  # prepared logs are differentiated
+    Y = np.array(term.torque_columns(log.q, log.dq, log.ddq), dtype=np.float64)
+    steps = np.asarray(getattr(term, "steps", np.zeros(len(term.labels), bool)), dtype=bool)
+    if cutoff_hz is not None and steps.any():
+        Y[..., steps] = stepped_filtered(
+            (term,), (edges[0], log, edges[1]), steps, cutoff_hz, upsample,
+            slice(0, log.n_samples), stamps,
+        )  # fmt: skip
+    return Y
+
+
 def stepped_filtered(
-    terms: tuple[ModelTerm, ...],
+    terms: tuple[SteppingColumns, ...],
     logs: tuple[TorqueLog | None, TorqueLog, TorqueLog | None],
     steps: NDArray[np.bool_],
     cutoff_hz: float,
@@ -168,7 +214,7 @@ def stepped_filtered(
 
 
 def _filtered_columns(
-    term: ModelTerm,
+    term: SteppingColumns,
     states: tuple[NDArray[np.float64], ...],
     cutoff_hz: float,
     rate: float,

@@ -9,8 +9,9 @@
      "load_mass": ..., "F_x_Cload": [...], "load_inertia": [9 numbers, column-major],
      "with_tool": "robot_with_payload.toml", "inertia_identified": true,
      "constraint_active": false, "pseudo_inertia_margin": ..., "rank": 10,
-     "condition_number": ..., "residual_rms": ..., "n_rows": ..., "notes": [...],
-     "plausible": true, "doubts": [...],
+     "condition_number": ..., "residual_rms": ..., "noise_rms": ... | null,
+     "n_rows": ..., "notes": [...], "plausible": true, "doubts": [...],
+     "inertia_determined": true, "undetermined_inertia": ["Izz", ...],
      "preprocessing": {"cutoff_hz": ..., "cutoff_source": "model", "decimate": ...,
                        "max_gap_s": null} | null,
      "recordings": [{"file": ..., "pieces": ..., "samples": ..., "duration_s": ...}],
@@ -20,10 +21,14 @@
 [kg m^2]. ``load_mass``, ``F_x_Cload`` (CoM in the flange frame [m]) and ``load_inertia``
 (inertia about the CoM in flange axes, 3x3 column-major) are libfranka's
 ``Robot::setLoad`` arguments: the load carried into the flange frame when the frame is on
-the flange's link and the estimate is plausible; null otherwise (and ``load_inertia``
-null when the inertia was not identified). ``doubts`` says why an estimate is not
-plausible (:mod:`dynid.feasibility.payload_doubts`: a mass not significantly above zero,
-a CoM farther than the arm is long): such a load is not handed to a controller.
+the flange's link and its mass and CoM are not in doubt; null otherwise (and
+``load_inertia`` null when the inertia was not identified or the data do not determine
+it). ``doubts`` says why an estimate is not plausible
+(:mod:`dynid.feasibility.payload_doubts`: a mass not significantly above zero, a CoM
+farther than the arm is long: such a load is not handed to a controller; inertia elements
+not determined, ``undetermined_inertia``: its inertia is not). ``residual_rms`` [N m for
+torque logs] is the fit's, ``noise_rms`` [N m] what the torque noise alone leaves after
+the low-pass (null for static data).
 ``preprocessing`` is how torque logs were prepared (cut-off [Hz] and where it came from:
 ``given``, ``model`` (the identification's) or ``motion``; decimation; longest gap
 bridged [s], null for the default rule); null for static data. Floats use Python's
@@ -77,13 +82,13 @@ def payload_to_dict(
         },
     }
     fl, fr = robot.frame("flange"), robot.frame(est.frame)
-    if fl.link == fr.link and est.plausible:
+    if fl.link == fr.link and not est.doubts:
         T_flange_frame = spatial.inverse_transform(fl.T_link_frame) @ fr.T_link_frame
         R, p = T_flange_frame[:3, :3], T_flange_frame[:3, 3]
         I_fl = R @ est.inertia @ R.T
         d["load_mass"] = _num(est.mass)
         d["F_x_Cload"] = _list(R @ est.com + p)
-        d["load_inertia"] = _list(I_fl.T) if est.inertia_identified else None
+        d["load_inertia"] = _list(I_fl.T) if est.inertia_determined else None
     else:
         d["load_mass"] = d["F_x_Cload"] = d["load_inertia"] = None
     d.update(
@@ -95,20 +100,30 @@ def payload_to_dict(
             "rank": int(est.rank),
             "condition_number": _num(est.condition_number),
             "residual_rms": _num(est.residual_rms),
+            "noise_rms": None if est.noise_rms is None else _num(est.noise_rms),
             "n_rows": int(est.n_rows),
             "notes": list(est.notes),
             "plausible": est.plausible,
-            "doubts": list(est.doubts),
+            "doubts": list(est.doubts + est.inertia_doubts),
+            "inertia_determined": est.inertia_determined,
+            "undetermined_inertia": list(est.undetermined),
             "preprocessing": dict(est.preprocessing) or None,
             "recordings": [dict(r) for r in est.recordings],
-            "units": {"mass": "kg", "com": "m", "inertia": "kg m^2"},
+            "units": {
+                "mass": "kg",
+                "com": "m",
+                "inertia": "kg m^2",
+                "residual_rms": "N m (torque logs); the rows' SI units (static data)",
+                "noise_rms": "N m",
+            },
             "conventions": {
                 "com": f"centre of mass in frame {est.frame!r}",
                 "inertia": "about the CoM, frame axes, order " + " ".join(INERTIA_ORDER),
                 "load_inertia": "libfranka setLoad: about the CoM, flange axes, column-major",
                 "F_x_Cload": "libfranka setLoad: CoM in the flange frame",
-                "setLoad": "null when the frame is not on the flange's link or the estimate "
-                "is not plausible (doubts)",
+                "setLoad": "null when the frame is not on the flange's link or the mass or "
+                "CoM is in doubt (doubts); load_inertia null too when the inertia is not "
+                "identified or not determined (undetermined_inertia)",
             },
         }
     )

@@ -11,7 +11,7 @@ from __future__ import annotations
 
 from collections.abc import Callable
 
-from . import demo, feasible, identify, observe, torques
+from . import demo, feasible, identify, observe, payload, torques
 from .run import Answer, RunFiles
 
 __all__ = ["ANSWERS", "answer_for"]
@@ -24,7 +24,7 @@ ANSWERS: dict[str, tuple[AnswerFunction, ...]] = {
     "validate": (torques.validate_answer,),
     "friction": (torques.friction_answer,),
     "retrieve": (feasible.answer,),
-    "payload": (feasible.payload_answer,),
+    "payload": (payload.payload_answer,),
     "demo": (demo.answer,),
 }
 

@@ -1,0 +1,150 @@
+"""The answer of ``payload``: the load's mass, centre of mass and inertia, how well each is
+known, and whether the fit explains the torques to their noise.
+
+The headline covers all three: the mass with its relative standard deviation, the CoM
+with its largest standard deviation, the inertia with its largest one, or the elements
+the data do not determine (``undetermined_inertia`` of ``payload.json``). The level:
+
+* not a load to trust (poor): a doubt about the mass or the CoM (no setLoad values);
+* usable, with reservations (fair), each reason listed: inertia elements not determined,
+  a mass known to 5 % or worse, a residual above :data:`~dynid.identification.verdict.FLOOR_FAIR`
+  times the torque noise left after the low-pass (effects outside the arm's model), the
+  physical-consistency constraint active (the least-squares estimate was not a body);
+* good otherwise.
+
+The residual is given in N m beside that noise (``noise_rms``) for torque logs.
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+from ..identification.verdict import FLOOR_FAIR, FLOOR_GOOD
+from .html import cell, esc, is_number, number, section, table, verdict
+from .run import Answer, RunFiles
+
+__all__ = ["MASS_SURE", "payload_answer"]
+
+#: Relative standard deviation of the mass below which it is known.
+MASS_SURE = 0.05
+
+
+def payload_answer(run: RunFiles) -> Answer | None:
+    """payload's verdict (module docstring) and its parameters with their standard
+    deviations, or None without payload.json."""
+    doc = run.doc("payload.json")
+    if doc is None or not is_number(doc.get("mass")):
+        return None
+    std: dict[str, Any] = doc["std"] if isinstance(doc.get("std"), dict) else {}
+    m, sm = doc["mass"], std.get("mass")
+    rel = abs(sm / m) if is_number(sm) and m else None
+    frame = esc(doc.get("frame", ""))
+    undetermined = [str(x) for x in doc.get("undetermined_inertia") or []]
+    doubts = [str(x) for x in doc.get("doubts") or []]
+    # the inertia is judged only when the mass and CoM are not in doubt (its one line last)
+    load_doubts = [] if undetermined else doubts
+    facts = [
+        f"Mass <b>{number(m)} kg</b>"
+        + (f" &plusmn; {number(sm, 2)} kg (1 std)" if is_number(sm) else "")
+        + f", centre of mass {cell(doc.get('com'))} m in {frame}",
+        _residual_fact(doc),
+        f"Physically consistent: pseudo-inertia margin {cell(doc.get('pseudo_inertia_margin'))}"
+        + (
+            "; the constraint is active (the unconstrained fit was not a body)"
+            if doc.get("constraint_active")
+            else ""
+        ),
+        f"From {esc(doc.get('route', ''))}: rank {cell(doc.get('rank'))}, condition number "
+        f"{cell(doc.get('condition_number'))}",
+    ]
+    if doc.get("inertia_identified") is False:
+        facts.append("Inertia not identified from these data (mass and CoM only)")
+    head = _headline(doc, std, rel, undetermined)
+    if load_doubts:
+        facts = [esc(d[0].upper() + d[1:]) for d in load_doubts] + facts
+        label = "not a load to trust"
+        return Answer(verdict("poor", esc(head), facts, label), (_section(doc, std, frame),))
+    reasons = _reservations(doc, rel, undetermined)
+    if reasons:
+        facts = ["Reservations: " + esc("; ".join(reasons)) + "."] + facts
+    level = "fair" if reasons else "good"
+    return Answer(verdict(level, esc(head), facts), (_section(doc, std, frame),))
+
+
+def _noise_ratio(doc: dict[str, Any]) -> float | None:
+    """The fit's residual over the torque noise after the low-pass, when both are known."""
+    r, n = doc.get("residual_rms"), doc.get("noise_rms")
+    return r / n if is_number(r) and is_number(n) and n > 0 else None
+
+
+def _residual_fact(doc: dict[str, Any]) -> str:
+    """The residual RMS in N m beside the torque noise (torque logs), or in the rows' units."""
+    r = doc.get("residual_rms")
+    ratio = _noise_ratio(doc)
+    if ratio is not None:
+        said = "at the noise floor" if ratio <= FLOOR_GOOD else "close to it"
+        if ratio > FLOOR_FAIR:
+            said = "effects outside the arm's model remain"
+        return (
+            f"Residual RMS {number(doc['residual_rms'], 2)} N m, {number(ratio, 3)} x the "
+            f"torque noise after the low-pass ({number(doc['noise_rms'], 2)} N m): {said}"
+        )
+    static_m = str(doc.get("route", "")).startswith("static M")
+    unit = " (rows of M [kg m^2] and g [N m])" if static_m else " N m"
+    return f"Residual RMS {cell(r)}{esc(unit)}"
+
+
+def _headline(
+    doc: dict[str, Any], std: dict[str, Any], rel: float | None, undetermined: list[str]
+) -> str:
+    """``The payload weighs 1.2 kg (known to 0.12 %), its centre of mass is known to 0.1 mm
+    and its inertia to 0.00066 kg m^2.`` (the largest standard deviations; or which of the
+    inertia's elements are not determined)."""
+    m = doc["mass"]
+    parts = [
+        f"The payload weighs {number(m)} kg" + (f" (known to {100 * rel:.2g} %)" if rel else "")
+    ]
+    sc = std.get("com")
+    if isinstance(sc, list) and sc and all(is_number(x) for x in sc):
+        parts.append(f"its centre of mass is known to {1000 * max(sc):.2g} mm")
+    si = std.get("inertia")
+    if doc.get("inertia_identified") is False:
+        parts.append("its inertia is not identified")
+    elif undetermined:
+        parts.append(f"its inertia is not determined ({', '.join(undetermined)})")
+    elif isinstance(si, list) and si and all(is_number(x) for x in si):
+        parts.append(f"its inertia to {number(max(si), 2)} kg m^2")
+    return ", ".join(parts[:-1]) + (" and " if len(parts) > 1 else "") + parts[-1] + "."
+
+
+def _reservations(doc: dict[str, Any], rel: float | None, undetermined: list[str]) -> list[str]:
+    """Why the estimate is usable with reservations (module docstring); empty: good."""
+    out = []
+    if undetermined:
+        out.append(
+            f"the data do not determine the inertia's {', '.join(undetermined)} "
+            "(setLoad's inertia not written)"
+        )
+    if rel is None or rel >= MASS_SURE:
+        out.append(
+            "the mass is known to " + (f"{100 * rel:.2g} %" if rel is not None else "no std")
+        )
+    ratio = _noise_ratio(doc)
+    if ratio is not None and ratio > FLOOR_FAIR:
+        out.append(
+            f"the fit leaves {number(ratio, 3)} x the torque noise: the arm's model misses "
+            "torques the load's parameters may absorb"
+        )
+    if doc.get("constraint_active"):
+        out.append("the least-squares estimate was not a physical body (the constraint moved it)")
+    return out
+
+
+def _section(doc: dict[str, Any], std: dict[str, Any], frame: str) -> str:
+    """The table of the load's parameters with their standard deviations."""
+    rows = []
+    for key, unit in (("mass", "kg"), ("com", "m"), ("inertia", "kg m^2")):
+        rows.append([esc(key), cell(doc.get(key)), cell(std.get(key)), esc(unit)])
+    body = table(["quantity", "value", "std", "unit"], rows)
+    note = f"<p>CoM in {frame}; inertia about the CoM, order xx xy xz yy yz zz.</p>"
+    return section("payload", "Payload", note, body)
