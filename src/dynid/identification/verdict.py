@@ -36,6 +36,7 @@ the verdicts of the HTML reports.
 
 from __future__ import annotations
 
+import dataclasses
 import math
 from collections.abc import Sequence
 from dataclasses import dataclass
@@ -62,6 +63,7 @@ __all__ = [
     "joint_ratios",
     "judge_prediction",
     "pooled_verdict",
+    "with_replaced_spikes",
     "worst",
 ]
 
@@ -297,3 +299,16 @@ def pooled_verdict(
         "excitation, the drive)",
         r,
     )
+
+
+def with_replaced_spikes(verdict: Verdict, count: int, detail: str = "") -> Verdict:
+    """``verdict`` with its reason saying that it was judged with ``count`` one-sample torque
+    spikes replaced (:func:`~dynid.identification.sanity.despiked`), ``detail`` appended
+    (``", as the fit replaced them"``, the files); ``verdict`` itself when ``count`` is 0."""
+    if count <= 0:
+        return verdict
+    said = (
+        f"{verdict.reason}; judged with {count} one-sample torque spike(s) replaced by the "
+        f"line between their neighbours{detail}"
+    )
+    return dataclasses.replace(verdict, reason=said)
