@@ -136,3 +136,26 @@ def test_identify_heldout_verdict_judges_spiked_torques_as_the_fit_used_them(jud
         b.verdict.reason
     )
     assert b.as_dict()["torque_spikes_replaced"] == count
+
+
+def test_validate_judges_a_spiked_log_as_its_clean_log_and_says_how_many(judged, tmp_path):
+    """Regression (validate judged a spiked Kinova log 'poor, 13.8 %: the model misses
+    effects' without a word of the spikes identify finds in it, 0.87 % clean): the spiked
+    log is warned about with its count and gets the clean log's verdict level and error
+    within 2 %; the verdict and validation.json's record count the spikes replaced."""
+    from dynid.io.torque_log import save_torque_log
+    from dynid.workflows.validate import validate_files
+
+    model, clean, spiked, count = judged
+    save_torque_log(tmp_path / "clean.csv", clean)
+    save_torque_log(tmp_path / "spiked.csv", spiked)
+    a = validate_files(model, tmp_path / "clean.csv")
+    with pytest.warns(DynidWarning, match=rf"spiked\.csv: {count} torque sample\(s\)"):
+        b = validate_files(model, tmp_path / "spiked.csv")
+    assert a.verdict.level == "good" and b.verdict.level == a.verdict.level, b.verdict
+    e_a = a.validation.errors.relative_error_percent
+    assert b.validation.errors.relative_error_percent == pytest.approx(e_a, rel=0.02)
+    assert f"{count} one-sample torque spike(s) replaced" in b.verdict.reason
+    assert f"(spiked.csv {count})" in b.verdict.reason
+    assert b.metadata()["torque_spikes_replaced"] == {"spiked.csv": count}
+    assert a.metadata()["torque_spikes_replaced"] == {"clean.csv": 0}

@@ -37,8 +37,8 @@ with them before fitting (:func:`log_findings`). None of them changes the data.
   logging fault that least squares weighs by its square (:func:`spike_finding` names the
   file, the joints, the counts and the times). The one change to the data:
   :func:`despiked` replaces them by the line between their neighbours, before filtering
-  spreads them; ``identify`` (before fitting) and its held-out verdict (before judging)
-  apply the same rule.
+  spreads them; ``identify`` (before fitting), ``validate`` and identify's held-out
+  verdict (before judging) apply the same rule.
 """
 
 from __future__ import annotations
@@ -68,6 +68,8 @@ __all__ = [
     "OPPOSITE_CORRELATION",
     "MIN_LOG_SAMPLES",
     "SLOW_SPIKE_SHARE",
+    "SPIKES_BEFORE_FIT",
+    "SPIKES_BEFORE_JUDGING",
     "SPIKE_SIGMAS",
     "SPIKE_TIMES_SHOWN",
     "despiked",
@@ -682,14 +684,27 @@ def despiked(log: TorqueLog) -> tuple[TorqueLog, tuple[int, ...]]:
     return dataclasses.replace(log, tau=tau), tuple(counts)
 
 
+#: What replacing the spikes is for, said by :func:`spike_finding`: before identification
+#: filters a log (the default), before a prediction is judged (``validate``).
+SPIKES_BEFORE_FIT = (
+    "before filtering (spikes, a sensor or logging fault, would bias the fit by their "
+    "square, robust estimators too)"
+)
+SPIKES_BEFORE_JUDGING = (
+    "before judging, as identify replaces them before fitting (spikes, a sensor or "
+    "logging fault, would dominate the error by their square)"
+)
 #: Times of the spikes :func:`spike_finding` lists per joint (the rest counted).
 SPIKE_TIMES_SHOWN = 3
 
 
-def spike_finding(name: str, log: TorqueLog, joint_names: tuple[str, ...]) -> str | None:
+def spike_finding(
+    name: str, log: TorqueLog, joint_names: tuple[str, ...], *, before: str = SPIKES_BEFORE_FIT
+) -> str | None:
     """One line naming the file ``name``, the joints, the counts and the first times of
     the torque spikes of ``log`` (:func:`torque_spikes`, judged with its velocities, as
-    :func:`despiked` finds them), or None without spikes."""
+    :func:`despiked` finds them), and ``before`` what they are replaced
+    (:data:`SPIKES_BEFORE_FIT`, :data:`SPIKES_BEFORE_JUDGING`); None without spikes."""
     tau, dq = np.asarray(log.tau), np.asarray(log.dq)
     found = []
     for j in range(log.n):
@@ -703,8 +718,7 @@ def spike_finding(name: str, log: TorqueLog, joint_names: tuple[str, ...]) -> st
     return (
         f"{name}: {total} torque sample(s) stand off both neighbours by more than "
         f"{SPIKE_SIGMAS:g} times the noise: {parts}; replaced by the line between their "
-        "neighbours before filtering (spikes, a sensor or logging fault, would bias the fit "
-        "by their square, robust estimators too); hint: check the torque sensor's logging"
+        f"neighbours {before}; hint: check the torque sensor's logging"
     )
 
 

@@ -25,7 +25,11 @@ line naming the file, never a recording dropped silently:
   tau=...``, or the model's recorded one): an error naming it and ``--units tau=mNm``
   (:func:`check_torque_unit`; ``identify`` and ``observe`` alike);
 * a recording whose positions lie far outside the model's joint limits (of another robot):
-  a warning naming it.
+  a warning naming it;
+* one-sample torque spikes (:func:`~dynid.identification.sanity.despiked`, the rule
+  ``identify`` applies before fitting): replaced by :func:`despiked_recordings`
+  (``validate`` before judging), with a warning per file naming the joints, the counts
+  and the times.
 
 Pieces too short to filter are the preparation's (:mod:`dynid.friction.recordings`).
 """
@@ -44,8 +48,10 @@ from ..exceptions import DataError, DynidWarning, OptionError
 from ..identification.log import TorqueLog, joint_side_log
 from ..identification.pieces import with_start_turns
 from ..identification.sanity import (
+    despiked,
     moving_joints,
     opposite_sign,
+    spike_finding,
     time_unit_finding,
     too_few_samples,
     torque_unit_finding,
@@ -71,6 +77,7 @@ __all__ = [
     "check_signs",
     "check_torque_unit",
     "check_units",
+    "despiked_recordings",
     "given_start",
     "read_recordings",
 ]
@@ -173,6 +180,25 @@ def read_recordings(
     check_units(out)
     check_torque_unit(out, robot if reference is None else reference, drive, cmap)
     return out
+
+
+def despiked_recordings(
+    rec: Recorded, joint_names: Sequence[str], before: str
+) -> tuple[Recorded, tuple[int, ...]]:
+    """The recordings with their one-sample torque spikes replaced by the line between their
+    neighbours (:func:`~dynid.identification.sanity.despiked`, the rule ``identify``
+    applies before fitting), a warning per recording with spikes naming it, the joints,
+    the counts, the times and ``before`` what they were replaced
+    (:func:`~dynid.identification.sanity.spike_finding`); and the torque samples replaced
+    per recording."""
+    logs, counts = [], []
+    for name, log in zip(rec.names, rec.logs, strict=True):
+        if (found := spike_finding(name, log, tuple(joint_names), before=before)) is not None:
+            warnings.warn(found, DynidWarning, stacklevel=3)
+        clean, per_joint = despiked(log)
+        logs.append(clean)
+        counts.append(sum(per_joint))
+    return Recorded(tuple(logs), rec.paths), tuple(counts)
 
 
 def given_start(
