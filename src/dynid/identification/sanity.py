@@ -38,7 +38,7 @@ with them before fitting (:func:`log_findings`). None of them changes the data.
   file, the joints, the counts and the times). The one change to the data:
   :func:`despiked` replaces them by the line between their neighbours, before filtering
   spreads them; ``identify`` (before fitting), ``validate`` and identify's held-out
-  verdict (before judging) apply the same rule.
+  verdict (before judging) and ``observe`` (before the observer runs) apply the same rule.
 """
 
 from __future__ import annotations
@@ -70,6 +70,7 @@ __all__ = [
     "SLOW_SPIKE_SHARE",
     "SPIKES_BEFORE_FIT",
     "SPIKES_BEFORE_JUDGING",
+    "SPIKES_BEFORE_OBSERVER",
     "SPIKE_SIGMAS",
     "SPIKE_TIMES_SHOWN",
     "despiked",
@@ -685,7 +686,8 @@ def despiked(log: TorqueLog) -> tuple[TorqueLog, tuple[int, ...]]:
 
 
 #: What replacing the spikes is for, said by :func:`spike_finding`: before identification
-#: filters a log (the default), before a prediction is judged (``validate``).
+#: filters a log (the default), before a prediction is judged (``validate``, the held-out
+#: verdict), before the momentum observer runs (``observe``).
 SPIKES_BEFORE_FIT = (
     "before filtering (spikes, a sensor or logging fault, would bias the fit by their "
     "square, robust estimators too)"
@@ -693,6 +695,10 @@ SPIKES_BEFORE_FIT = (
 SPIKES_BEFORE_JUDGING = (
     "before judging, as identify replaces them before fitting (spikes, a sensor or "
     "logging fault, would dominate the error by their square)"
+)
+SPIKES_BEFORE_OBSERVER = (
+    "before the observer runs (a sensor or logging fault of one sample, not a contact, "
+    "which lasts several samples; not reported as events)"
 )
 #: Times of the spikes :func:`spike_finding` lists per joint (the rest counted).
 SPIKE_TIMES_SHOWN = 3
@@ -704,7 +710,8 @@ def spike_finding(
     """One line naming the file ``name``, the joints, the counts and the first times of
     the torque spikes of ``log`` (:func:`torque_spikes`, judged with its velocities, as
     :func:`despiked` finds them), and ``before`` what they are replaced
-    (:data:`SPIKES_BEFORE_FIT`, :data:`SPIKES_BEFORE_JUDGING`); None without spikes."""
+    (:data:`SPIKES_BEFORE_FIT`, :data:`SPIKES_BEFORE_JUDGING`,
+    :data:`SPIKES_BEFORE_OBSERVER`); None without spikes."""
     tau, dq = np.asarray(log.tau), np.asarray(log.dq)
     found = []
     for j in range(log.n):

@@ -28,8 +28,8 @@ line naming the file, never a recording dropped silently:
   a warning naming it;
 * one-sample torque spikes (:func:`~dynid.identification.sanity.despiked`, the rule
   ``identify`` applies before fitting): replaced by :func:`despiked_recordings`
-  (``validate`` before judging), with a warning per file naming the joints, the counts
-  and the times.
+  (``validate`` before judging, ``observe`` before the observer runs), with a warning per
+  file naming the joints, the counts and the times.
 
 Pieces too short to filter are the preparation's (:mod:`dynid.friction.recordings`).
 """
