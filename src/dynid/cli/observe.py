@@ -39,6 +39,10 @@ standstill margin follows the velocity noise), and an event shorter than --min-d
 few samples). A crossing shorter than --min-duration with no other within half of
 --merge is dropped before runs are joined: it neither starts nor extends an event.
 --merge 0 --min-duration 0: every run over the threshold.
+A torque sample off both neighbours by more than 20 times the noise while the joint moves
+(a one-sample spike, a sensor or logging fault, as identify finds them) is replaced by the
+line between its neighbours before the observer runs, calibrating or detecting, with a
+warning naming the file, the joints, the counts and the times: never an event.
 Several logs (or a folder of them): residuals_<name>.csv and .png each, one events.json;
 logs of one name in different folders are named by their folder. With --thresholds the
 calibration's options (--gain, --discretisation, --rule, --margin, --quantile,

@@ -14,7 +14,11 @@ measured ones, per joint (RMS, MSE) and overall (relative error). Model sources:
 
 --friction friction.json replaces the model's own friction. The states are low-pass
 filtered with zero phase (--cutoff), the accelerations differentiated from the filtered
-velocities; the measured torques are compared unfiltered.
+velocities; the measured torques are compared unfiltered. One-sample torque spikes (a
+sample off both neighbours by more than 20 times the noise while the joint moves: a sensor
+or logging fault) are replaced by the line between their neighbours before judging, as
+identify replaces them before fitting; a warning names the file, the joints, the counts and
+the times, and the verdict says how many.
 
 --data takes several recordings (or a folder of them): each recording, and each piece of
 one cut at a gap longer than --max-gap, is filtered on its own and never joined to

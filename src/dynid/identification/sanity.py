@@ -36,8 +36,10 @@ with them before fitting (:func:`log_findings`). None of them changes the data.
 * **Torque spikes**: samples that stand off both neighbours, on the same side, by more
   than :data:`SPIKE_SIGMAS` robust noise levels (:func:`torque_spikes`); a sensor or
   logging fault that least squares weighs by its square (:func:`spike_finding` names the
-  file, the joints and the counts). The one change to the data: :func:`despiked`
-  replaces them by the line between their neighbours, before filtering spreads them.
+  file, the joints, the counts and the times). The one change to the data:
+  :func:`despiked` replaces them by the line between their neighbours, before filtering
+  spreads them; ``identify`` (before fitting), ``validate`` and identify's held-out
+  verdict (before judging) and ``observe`` (before the observer runs) apply the same rule.
 """
 
 from __future__ import annotations
@@ -69,7 +71,11 @@ __all__ = [
     "OPPOSITE_CORRELATION",
     "MIN_LOG_SAMPLES",
     "SLOW_SPIKE_SHARE",
+    "SPIKES_BEFORE_FIT",
+    "SPIKES_BEFORE_JUDGING",
+    "SPIKES_BEFORE_OBSERVER",
     "SPIKE_SIGMAS",
+    "SPIKE_TIMES_SHOWN",
     "despiked",
     "spike_finding",
     "time_unit_finding",
@@ -718,23 +724,62 @@ def despiked(log: TorqueLog) -> tuple[TorqueLog, tuple[int, ...]]:
     return dataclasses.replace(log, tau=tau), tuple(counts)
 
 
-def spike_finding(name: str, log: TorqueLog, joint_names: tuple[str, ...]) -> str | None:
-    """One line naming the file ``name``, the joints and the counts of the torque spikes
-    of ``log`` (:func:`torque_spikes`), or None without spikes."""
-    found = torque_spikes(log.tau, log.dq)
+#: What replacing the spikes is for, said by :func:`spike_finding`: before identification
+#: filters a log (the default), before a prediction is judged (``validate``, the held-out
+#: verdict), before the momentum observer runs (``observe``).
+SPIKES_BEFORE_FIT = (
+    "before filtering (spikes, a sensor or logging fault, would bias the fit by their "
+    "square, robust estimators too)"
+)
+SPIKES_BEFORE_JUDGING = (
+    "before judging, as identify replaces them before fitting (spikes, a sensor or "
+    "logging fault, would dominate the error by their square)"
+)
+SPIKES_BEFORE_OBSERVER = (
+    "before the observer runs (a sensor or logging fault of one sample, not a contact, "
+    "which lasts several samples; not reported as events)"
+)
+#: Times of the spikes :func:`spike_finding` lists per joint (the rest counted).
+SPIKE_TIMES_SHOWN = 3
+
+
+def spike_finding(
+    name: str,
+    log: TorqueLog,
+    joint_names: tuple[str, ...],
+    *,
+    before: str = SPIKES_BEFORE_FIT,
+    kept: str | None = None,
+) -> str | None:
+    """One line naming the file ``name``, the joints, the counts and the first times of
+    the torque spikes of ``log`` (:func:`torque_spikes`, judged with its velocities, as
+    :func:`despiked` finds them), and ``before`` what they are replaced
+    (:data:`SPIKES_BEFORE_FIT`, :data:`SPIKES_BEFORE_JUDGING`,
+    :data:`SPIKES_BEFORE_OBSERVER`), or why they are ``kept``; None without spikes."""
+    tau, dq = np.asarray(log.tau), np.asarray(log.dq)
+    found = []
+    for j in range(log.n):
+        rows, heights = _column_spikes(tau[:, j], dq[:, j], SPIKE_SIGMAS)
+        if rows.size:
+            found.append((j, rows, float(heights.max())))
     if not found:
         return None
-    total = sum(c for _, c, _, _ in found)
-    parts = ", ".join(
-        f"{joint_names[j]} {c} (first at t = {float(log.t[r]):.6g} s, largest {h:.3g} sigma)"
-        for j, c, r, h in found
-    )
+    total = sum(rows.size for _, rows, _ in found)
+    parts = ", ".join(f"{joint_names[j]} {_spike_times(log.t, rows, h)}" for j, rows, h in found)
     return (
         f"{name}: {total} torque sample(s) stand off both neighbours by more than "
-        f"{SPIKE_SIGMAS:g} times the noise: {parts}; replaced by the line between their "
-        "neighbours before filtering (spikes, a sensor or logging fault, would bias the fit "
-        "by their square, robust estimators too); hint: check the torque sensor's logging"
+        f"{SPIKE_SIGMAS:g} times the noise: {parts}; "
+        + (f"replaced by the line between their neighbours {before}" if kept is None else kept)
+        + "; hint: check the torque sensor's logging"
     )
+
+
+def _spike_times(t: NDArray[np.float64], rows: NDArray[np.intp], largest: float) -> str:
+    """``3 (at t = 1.2, 3.4, 5.6 s and 2 more, largest 600 sigma)``: a joint's spikes."""
+    shown = ", ".join(f"{float(t[r]):.6g}" for r in rows[:SPIKE_TIMES_SHOWN])
+    more = rows.size - min(rows.size, SPIKE_TIMES_SHOWN)
+    rest = f" and {more} more" if more else ""
+    return f"{rows.size} (at t = {shown} s{rest}, largest {largest:.3g} sigma)"
 
 
 #: Time units a time column may be recorded in instead of seconds: the ``--units t=``

@@ -36,6 +36,7 @@ the verdicts of the HTML reports.
 
 from __future__ import annotations
 
+import dataclasses
 import math
 from collections.abc import Sequence
 from dataclasses import dataclass
@@ -64,6 +65,7 @@ __all__ = [
     "pooled_verdict",
     "with_caveat",
     "with_hint",
+    "with_replaced_spikes",
     "worst",
 ]
 
@@ -320,3 +322,16 @@ def with_hint(verdict: Verdict, hint: str | None, joiner: str = "; ") -> Verdict
     if verdict.level == "good" or hint is None:
         return verdict
     return Verdict(verdict.level, verdict.label, f"{verdict.reason}{joiner}{hint}", verdict.ratio)
+
+
+def with_replaced_spikes(verdict: Verdict, count: int, detail: str = "") -> Verdict:
+    """``verdict`` with its reason saying that it was judged with ``count`` one-sample torque
+    spikes replaced (:func:`~dynid.identification.sanity.despiked`), ``detail`` appended
+    (``", as the fit replaced them"``, the files); ``verdict`` itself when ``count`` is 0."""
+    if count <= 0:
+        return verdict
+    said = (
+        f"{verdict.reason}; judged with {count} one-sample torque spike(s) replaced by the "
+        f"line between their neighbours{detail}"
+    )
+    return dataclasses.replace(verdict, reason=said)

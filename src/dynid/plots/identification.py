@@ -10,7 +10,9 @@ so a correct model leaves the sensor noise, which is read from the same torques 
 low-pass cut-off (white noise: the band's share of its variance restored), or taken from
 the identification's record (``info.heldout["noise_rms"]``: the noise of the floor the
 summary prints) when it holds it. The ratio of the two is the identification's distance to
-its noise floor.
+its noise floor. The held-out torques are judged as the fit used them: their one-sample
+spikes replaced (:func:`~dynid.identification.sanity.despiked`, as identification replaces
+them before filtering), the verdict saying how many.
 
 matplotlib is imported inside the plotting functions (never by ``import dynid``).
 """
@@ -31,8 +33,14 @@ from ..identification.log import TorqueLog
 from ..identification.low_speed import with_low_speed_hint
 from ..identification.model import IdentifiedModel
 from ..identification.pieces import split_at_gaps, unwrapped, wrappable
-from ..identification.sanity import velocity_noise_std
-from ..identification.verdict import Verdict, joint_ratios, judge_prediction, with_caveat
+from ..identification.sanity import despiked, velocity_noise_std
+from ..identification.verdict import (
+    Verdict,
+    joint_ratios,
+    judge_prediction,
+    with_caveat,
+    with_replaced_spikes,
+)
 from .style import COLOURS
 
 if TYPE_CHECKING:  # pragma: no cover
@@ -65,6 +73,10 @@ class HeldOutTorques:
         loose: :func:`~dynid.identification.least_squares.within_motion_caveat`), which
         keeps the verdict from the noise floor (:func:`~dynid.identification.verdict.
         with_caveat`).
+    spikes : int
+        Torque samples of the held-out data replaced as one-sample spikes before they were
+        judged, as the fit replaced them
+        (:func:`~dynid.identification.sanity.despiked`).
     """
 
     validation: Validation
@@ -74,6 +86,7 @@ class HeldOutTorques:
     logs: tuple[TorqueLog, ...] = ()
     cutoff_hz: float | None = None
     caveat: str | None = None
+    spikes: int = 0
 
     @property
     def noise_floor_percent(self) -> float:
@@ -91,7 +104,9 @@ class HeldOutTorques:
         floor, with the hint of a cut-off too high for velocities derived from positions
         (:func:`~dynid.identification.derived_cutoff.with_derived_cutoff_hint`) and that
         of an error mostly at low speed
-        (:func:`~dynid.identification.low_speed.with_low_speed_hint`)."""
+        (:func:`~dynid.identification.low_speed.with_low_speed_hint`); the torque
+        spikes replaced before judging counted
+        (:func:`~dynid.identification.verdict.with_replaced_spikes`)."""
         e = self.validation.errors
         verdict = judge_prediction(
             e.relative_error_percent,
@@ -105,11 +120,12 @@ class HeldOutTorques:
         verdict = with_low_speed_hint(
             verdict, [v.log.dq], [v.log.tau - v.tau_hat], self.noise_rms, self.joint_names
         )
-        return with_caveat(verdict, self.caveat)
+        verdict = with_caveat(verdict, self.caveat)
+        return with_replaced_spikes(verdict, self.spikes, ", as the fit replaced them")
 
     def as_dict(self) -> dict[str, Any]:
-        """JSON-ready: the errors per joint, the noise, the floor and the verdict (schema
-        ``heldout.json``)."""
+        """JSON-ready: the errors per joint, the noise, the floor, the torque spikes replaced
+        before judging and the verdict (schema ``heldout.json``)."""
         e, v = self.validation.errors, self.verdict
         return {
             "block": self.block,
@@ -120,6 +136,7 @@ class HeldOutTorques:
             "relative_error_percent": float(e.relative_error_percent),
             "relative_error_percent_per_joint": e.relative_error_percent_per_joint.tolist(),
             "noise_floor_percent": self.noise_floor_percent,
+            "torque_spikes_replaced": self.spikes,
             "verdict": {"level": v.level, "label": v.label, "reason": v.reason},
             "units": {"rms": "N m", "noise_rms": "N m", "relative_error_percent": "%"},
         }
@@ -148,9 +165,10 @@ def heldout_torques(
         The log it was identified from, as read (several recordings: the last one).
         Held-out samples with gaps longer than the identification's ``max_gap_s`` are
         prepared piece by piece and pooled, joints recorded wrapped into ``[-pi, pi]``
-        unwrapped, as the identification took them.
+        unwrapped, and its one-sample torque spikes replaced, as the identification took
+        them.
     separate : TorqueLog, optional
-        The ``--validate-on`` log (the model judged on it), as read.
+        The ``--validate-on`` log (the model judged on it), as read (its spikes replaced).
 
     Returns
     -------
@@ -161,7 +179,8 @@ def heldout_torques(
     if model.holdout is None or model.info.log is None:
         return None
     if model.holdout.scheme == "file" and separate is not None:
-        fitted, held, block = model, separate, "the separate log (--validate-on)"
+        (held, spikes), fitted = _despiked_from(separate), model
+        block = "the separate log (--validate-on)"
     elif model.holdout.scheme == "blocks":
         k = model.holdout.folds
         fold = _fold_model(model, k - 1)
@@ -171,7 +190,7 @@ def heldout_torques(
         t0, t1 = float(log.t[0]) + trim, float(log.t[-1]) - trim
         start = t0 + (k - 1) / k * (t1 - t0)
         first = int(np.searchsorted(log.t, start - trim))  # the block's rows: a view
-        fitted, held = fold, log.select(slice(first, None))
+        (held, spikes), fitted = _despiked_from(log, first), fold  # found on the whole log
         block = (
             f"the last of {k} time blocks, {start:.1f}-{float(log.t[-1]):.1f} s, predicted by "
             f"the fit of the other {k - 1}"
@@ -181,7 +200,7 @@ def heldout_torques(
         fold = _fold_model(model, k - 1)
         if fold is None:
             return None
-        fitted, held = fold, log
+        (held, spikes), fitted = _despiked_from(log), fold
         block = f"the last of {k} recordings, predicted by the fit of the other {k - 1}"
     else:
         return None
@@ -196,7 +215,20 @@ def heldout_torques(
     read = (held if model.holdout.scheme == "file" else log,)  # the motion of a whole log
     given = None if model.info.log.cutoff_source == "motion" else model.info.log.cutoff_hz
     caveat = (model.info.heldout or {}).get("caveat") if model.holdout.scheme == "blocks" else None
-    return HeldOutTorques(v, noise, block, names, read, given, caveat)
+    return HeldOutTorques(v, noise, block, names, read, given, caveat, spikes)
+
+
+def _despiked_from(log: TorqueLog, first: int = 0) -> tuple[TorqueLog, int]:
+    """Rows ``first:`` of ``log`` with its torque spikes replaced as the identification
+    replaced them before fitting (found on the whole log,
+    :func:`~dynid.identification.sanity.despiked`), and how many of those rows' torque
+    samples were replaced."""
+    clean, _ = despiked(log)
+    if clean is log:
+        held = log if first == 0 else log.select(slice(first, None))
+        return held, 0
+    replaced = int(np.count_nonzero(clean.tau[first:] != log.tau[first:]))
+    return (clean if first == 0 else clean.select(slice(first, None))), replaced
 
 
 def _recorded_noise(model: IdentifiedModel) -> NDArray[np.float64] | None:

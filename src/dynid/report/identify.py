@@ -4,7 +4,8 @@ The verdict (at the noise floor, usable, poor, unusable: :mod:`dynid.identificat
 weighs the held-out error against the sensor-noise floor of the torques it was judged on
 (``metadata.heldout``: the floor the command prints; for an older record without one,
 ``heldout.json``'s: the last time block predicted by the fit of the others, unfiltered
-torques, against the noise read from the log), the training against the held-out error
+torques with their one-sample spikes replaced as the fit replaced them, against the noise
+read from the log), the training against the held-out error
 (over-fitting), the rank against the columns of the model (the base parameters are the
 structural rank of the kinematics), and the relative standard deviations (the paper pruned
 above 30 %). A one-step consistent fit (``identify --consistent``: ``report.json``'s
@@ -220,6 +221,9 @@ def _block_fact(held: dict, judge: bool, contradicted: bool = False) -> tuple[st
     ``judge`` (a record without one), else the error alone (the floor is the record's)."""
     err, floor = held["relative_error_percent"], held.get("noise_floor_percent")
     where = f"On {esc(held.get('block', 'held-out data'))}, unfiltered"
+    spikes = held.get("torque_spikes_replaced")
+    if is_number(spikes) and spikes > 0:  # replaced before judging, as before the fit
+        where += f" ({int(spikes)} one-sample torque spike(s) replaced, as the fit replaced them)"
     if not judge:
         v = judge_prediction(err)  # only a model that explains nothing is judged here
         fact = f"{where} (the figures and the table below): error {percent(err)}"

@@ -20,6 +20,14 @@ the command applies, so that the Python API behaves as the command does.
   encoder glitch) cuts the log there too, with a warning (:mod:`dynid.observer.pieces`).
   Several logs are checked together: one in other units than the others is refused, one
   far outside the joint limits warned about (:mod:`dynid.workflows.recordings`).
+* One-sample torque spikes (a sensor or logging fault, by the rule ``identify`` replaces
+  them by before fitting: :func:`~dynid.identification.sanity.despiked`) are replaced by
+  the line between their neighbours before the observer runs, with a warning per log
+  naming the joints, the counts and the times
+  (:func:`~dynid.workflows.recordings.despiked_recordings`): the residual of a 30 N m
+  spike of 1 ms crosses a collision threshold for tens of ms, while a contact lasts
+  several samples and stays. Calibration and detection alike; a log sampled below
+  :data:`SPIKE_RATE_HZ` keeps them (a short impact can be one sample there), said so.
 * ``calibrate``: the residuals of every (collision-free) log give the thresholds; with an
   identified model that has a covariance, they also grow with the model's uncertainty
   (``uncertainty``, default on); the standstill margin of the model's friction (its
@@ -52,6 +60,7 @@ from ..exceptions import DataError, DynidWarning, OptionError
 from ..exceptions import in_file as about_file
 from ..friction.fit import same_drive
 from ..friction.model import FrictionModel, FrictionSum, placed_friction
+from ..identification.sanity import SPIKES_BEFORE_OBSERVER
 from ..io.drive_file import drive_of_robot_file, load_drive
 from ..io.feasible import load_feasible_drive, load_feasible_linear_friction
 from ..io.friction_json import load_friction_json
@@ -81,6 +90,7 @@ from .recordings import (
     check_signs,
     check_torque_unit,
     check_units,
+    despiked_recordings,
     given_start,
 )
 
@@ -92,6 +102,12 @@ __all__ = [
     "observe_files",
     "observer_drive",
 ]
+
+
+#: Logs sampled at or above this rate [Hz] have their one-sample torque spikes replaced
+#: before the observer runs: a sample lasts 2 ms or less, and an impact of a robot arm
+#: lasts several. Below it a short impact can be one sample, and the spikes are kept.
+SPIKE_RATE_HZ = 500.0
 
 
 @dataclass(frozen=True, slots=True)
@@ -359,6 +375,9 @@ def observe_files(opts: ObserveOptions, sink: ResidualSink | None = None) -> Obs
     wants_margin = opts.standstill if given is None else given.standstill
     columns = recorded_columns(recorded, *opts.columns)  # (names, units), said once
     read = _read_logs(data_files(opts.data), model, columns, opts)
+    read, _ = despiked_recordings(
+        read, model.robot.joint_names, SPIKES_BEFORE_OBSERVER, min_rate_hz=SPIKE_RATE_HZ
+    )
     if given is None:
         return _calibrated(
             read, model, columns[0] is not None, opts, options, wants_std, wants_margin

@@ -25,7 +25,11 @@ line naming the file, never a recording dropped silently:
   tau=...``, or the model's recorded one): an error naming it and ``--units tau=mNm``
   (:func:`check_torque_unit`; ``identify`` and ``observe`` alike);
 * a recording whose positions lie far outside the model's joint limits (of another robot):
-  a warning naming it.
+  a warning naming it;
+* one-sample torque spikes (:func:`~dynid.identification.sanity.despiked`, the rule
+  ``identify`` applies before fitting): replaced by :func:`despiked_recordings`
+  (``validate`` before judging, ``observe`` before the observer runs), with a warning per
+  file naming the joints, the counts and the times.
 
 Pieces too short to filter are the preparation's (:mod:`dynid.friction.recordings`).
 """
@@ -44,8 +48,10 @@ from ..exceptions import DataError, DynidWarning, OptionError
 from ..identification.log import TorqueLog, joint_side_log
 from ..identification.pieces import with_start_turns
 from ..identification.sanity import (
+    despiked,
     moving_joints,
     opposite_sign,
+    spike_finding,
     time_unit_finding,
     too_few_samples,
     torque_unit_finding,
@@ -54,6 +60,7 @@ from ..identification.unit_mix import degrees_among_radians, joints_in_degrees
 from ..io.columns import ColumnMap
 from ..model.drive import Drive
 from ..model.robot import Robot
+from ..signals import sample_rate
 from .data_files import (
     ColumnSpec,
     column_map,
@@ -71,6 +78,7 @@ __all__ = [
     "check_signs",
     "check_torque_unit",
     "check_units",
+    "despiked_recordings",
     "given_start",
     "read_recordings",
 ]
@@ -196,6 +204,38 @@ def read_recordings(
     check_units(out)
     check_torque_unit(out, robot if reference is None else reference, cmap)
     return out
+
+
+def despiked_recordings(
+    rec: Recorded, joint_names: Sequence[str], before: str, min_rate_hz: float = 0.0
+) -> tuple[Recorded, tuple[int, ...]]:
+    """The recordings with their one-sample torque spikes replaced by the line between their
+    neighbours (:func:`~dynid.identification.sanity.despiked`, the rule ``identify``
+    applies before fitting), a warning per recording with spikes naming it, the joints,
+    the counts, the times and ``before`` what they were replaced
+    (:func:`~dynid.identification.sanity.spike_finding`); and the torque samples replaced
+    per recording. A recording sampled below ``min_rate_hz`` [Hz] keeps its spikes, said
+    in its warning (``observe``: at 100 Hz a short impact can be one sample)."""
+    logs, counts = [], []
+    for name, log in zip(rec.names, rec.logs, strict=True):
+        rate = sample_rate(log.t) if log.n_samples > 1 else np.inf
+        kept = (
+            f"kept: at {rate:.3g} Hz, below {min_rate_hz:g} Hz, a short impact can be one "
+            "sample (events at their times may be faults)"
+            if rate < min_rate_hz
+            else None
+        )
+        found = spike_finding(name, log, tuple(joint_names), before=before, kept=kept)
+        if found is not None:
+            warnings.warn(found, DynidWarning, stacklevel=3)
+        if kept is not None:
+            logs.append(log)
+            counts.append(0)
+            continue
+        clean, per_joint = despiked(log)
+        logs.append(clean)
+        counts.append(sum(per_joint))
+    return Recorded(tuple(logs), rec.paths), tuple(counts)
 
 
 def given_start(

@@ -15,6 +15,11 @@ with every policy the command applies, so that the Python API behaves as the com
   filtered and differentiated on its own; the errors are pooled over every sample and
   given per recording (:func:`~dynid.friction.recordings.validate_recordings`: a long
   piece prepared and predicted a block at a time).
+* One-sample torque spikes (a sensor or logging fault) are replaced by the line between
+  their neighbours before judging, by the rule ``identify`` replaces them by before
+  fitting (:func:`~dynid.workflows.recordings.despiked_recordings`), with a warning per
+  file; the verdict's reason and ``torque_spikes_replaced`` say how many: a model at the
+  noise floor on clean data is judged at the floor on the same data with spikes.
 * The verdict (:func:`~dynid.identification.verdict.judge_prediction`): the error against
   the sensor-noise floor read from the measured torques, and whether they are
   anti-correlated with the model's; over all recordings and per recording, the worst
@@ -44,14 +49,20 @@ from ..identification.low_speed import with_low_speed_hint
 from ..identification.metrics import TorqueErrors
 from ..identification.model import IdentifiedModel
 from ..identification.motion_range import with_motion_range_hint
-from ..identification.sanity import anticorrelated, velocity_noise_std
-from ..identification.verdict import LEVELS, Verdict, joint_ratios, judge_prediction
+from ..identification.sanity import SPIKES_BEFORE_JUDGING, anticorrelated, velocity_noise_std
+from ..identification.verdict import (
+    LEVELS,
+    Verdict,
+    joint_ratios,
+    judge_prediction,
+    with_replaced_spikes,
+)
 from ..io.feasible import load_feasible_drive, load_feasible_linear_friction
 from ..io.friction_json import load_friction_json
 from ..model.drive import Drive
 from ..model.robot import Robot
 from .data_files import ColumnSpec, in_file
-from .recordings import read_recordings
+from .recordings import despiked_recordings, read_recordings
 
 __all__ = ["ValidateOptions", "ValidateResult", "validate_files"]
 
@@ -139,6 +150,9 @@ class ValidateResult:
         a model can reach on them.
     joint_names : tuple of str
         The robot's joints, in the columns' order (empty: not known).
+    spikes : tuple of int
+        Torque samples of each recording replaced as one-sample spikes before judging
+        (empty: not known).
     """
 
     validation: RecordingsValidation
@@ -150,13 +164,16 @@ class ValidateResult:
     noise_rms: NDArray[np.float64]
     noise_floor_percent: float
     joint_names: tuple[str, ...] = ()
+    spikes: tuple[int, ...] = ()
 
     def metadata(self) -> dict[str, Any]:
         """The keys ``validation.json`` records beside the errors: ``model``,
         ``friction_source``, ``data`` (the files, comma-separated), ``files``,
-        ``cutoff_hz``, ``noise_rms``, ``noise_floor_percent``, ``verdict`` (``level``,
-        ``label``, ``reason``) and ``joint_names`` (when known)."""
+        ``cutoff_hz``, ``noise_rms``, ``noise_floor_percent``, ``torque_spikes_replaced``
+        (per file, when known), ``verdict`` (``level``, ``label``, ``reason``) and
+        ``joint_names`` (when known)."""
         v = self.verdict
+        spikes = dict(zip(self.files, self.spikes, strict=True)) if self.spikes else None
         return {
             "model": self.model,
             "friction_source": self.friction_source,
@@ -165,6 +182,7 @@ class ValidateResult:
             "cutoff_hz": self.cutoff_hz,
             "noise_rms": [float(x) for x in self.noise_rms],
             "noise_floor_percent": self.noise_floor_percent,
+            **({"torque_spikes_replaced": spikes} if spikes is not None else {}),
             "verdict": {"level": v.level, "label": v.label, "reason": v.reason},
         } | ({"joint_names": list(self.joint_names)} if self.joint_names else {})
 
@@ -225,6 +243,7 @@ def validate_files(
         max_gap_s=opt.max_gap_s,
         reference=model.equivalent_robot if isinstance(model, IdentifiedModel) else None,
     )
+    rec, spikes = despiked_recordings(rec, robot.joint_names, SPIKES_BEFORE_JUDGING)
     friction, source = _friction(model, opt.friction, feasible, own if drive is None else drive)
 
     def run() -> RecordingsValidation:
@@ -266,6 +285,8 @@ def validate_files(
     if isinstance(model, IdentifiedModel) and model.info.log is not None:
         speeds = model.info.log.speed_max
         verdict = with_motion_range_hint(verdict, speeds, [v.log.dq for v in val.parts], names)
+    files = ", ".join(f"{n} {c}" for n, c in zip(rec.names, spikes, strict=True) if c)
+    verdict = with_replaced_spikes(verdict, sum(spikes), f" before judging ({files})")
     return ValidateResult(
         validation=val,
         model=label or f"robot {robot.name}",
@@ -276,6 +297,7 @@ def validate_files(
         noise_rms=noise,
         noise_floor_percent=floor,
         joint_names=tuple(robot.joint_names),
+        spikes=spikes,
     )
 
 
