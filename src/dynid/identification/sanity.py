@@ -60,6 +60,7 @@ __all__ = [
     "NOISE_BAND_STD",
     "check_torque_log",
     "GRAVITY_RANGE_SHARE",
+    "gravity_loaded",
     "opposite_sign",
     "moving_joints",
     "noise_band",
@@ -328,6 +329,14 @@ def anticorrelated(
     return j, float(corr[j])
 
 
+def _loaded(g: NDArray[np.float64]) -> NDArray[np.bool_]:
+    """The joints the gravity torques ``g`` (N, n) load (:func:`_gravity_spread`)."""
+    spread = np.std(g, axis=0)
+    varied = np.ptp(g, axis=0) >= GRAVITY_RANGE_SHARE * float(np.max(np.abs(g)))
+    out: NDArray[np.bool_] = (spread > 0.05 * max(float(spread.max()), 1e-300)) & varied
+    return out & bool(np.any(spread > 0))
+
+
 def _gravity_spread(
     robot: Robot, q: NDArray[np.float64], tau: NDArray[np.float64]
 ) -> tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.bool_]] | None:
@@ -337,12 +346,20 @@ def _gravity_spread(
     :data:`GRAVITY_RANGE_SHARE` of the largest gravity torque (on a short stretch gravity
     barely changes, and the torques' variations are the motion's, of either sign)."""
     g = gravity_torques(robot, q)
-    spread = np.std(g, axis=0)
-    varied = np.ptp(g, axis=0) >= GRAVITY_RANGE_SHARE * float(np.max(np.abs(g)))
-    loaded = (spread > 0.05 * max(float(spread.max()), 1e-300)) & varied
-    if not np.any(loaded) or not np.any(spread > 0):
+    loaded = _loaded(g)
+    if not np.any(loaded):
         return None
     return g - g.mean(axis=0), tau - tau.mean(axis=0), loaded
+
+
+def gravity_loaded(robot: Robot, q: ArrayLike) -> NDArray[np.bool_]:
+    """The joints (n,) whose torque sign the check against gravity judges at the
+    configurations ``q`` (N, n) [rad] (:func:`opposite_sign`): those gravity loads enough
+    over them; none for a robot without inertial parameters."""
+    qq = _checks.as_array("q", q)
+    if qq.ndim != 2 or qq.shape[0] < 2 or not np.any(robot.phi):
+        return np.zeros(robot.n, dtype=bool)
+    return _loaded(gravity_torques(robot, qq[:: max(1, qq.shape[0] // _MAX_SAMPLES)]))
 
 
 def opposite_sign(robot: Robot, log: TorqueLog) -> str | None:
