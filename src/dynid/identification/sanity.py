@@ -61,6 +61,7 @@ __all__ = [
     "check_torque_log",
     "GRAVITY_RANGE_SHARE",
     "gravity_loaded",
+    "joint_rate_factor",
     "opposite_sign",
     "moving_joints",
     "noise_band",
@@ -519,6 +520,17 @@ def _degrees(robot: Robot, log: TorqueLog) -> list[str]:
     return []
 
 
+def joint_rate_factor(log: TorqueLog, j: int) -> float:
+    """``k`` [1] of ``d q / dt ~ k dq`` on joint ``j`` of ``log``, by least squares: 1 when
+    its positions and velocities share a unit, ``180 / pi`` for positions in degrees and
+    velocities in radians per second; NaN for fewer than 5 samples or a joint at rest."""
+    t, q, v = log.t, log.q[:, j], np.ascontiguousarray(log.dq[:, j])
+    den = float(v @ v)
+    if t.size < 5 or not den > 0:
+        return float("nan")
+    return float(signals.derivative(t, q) @ v) / den  # in blocks: a long log's column
+
+
 def _rate_verdict(robot: Robot, log: TorqueLog, j: int) -> tuple[str, str] | None:
     """What the velocities of joint ``j`` say of positions that may be degrees: None (they
     are radians), or the reason and the hint of the warning.
@@ -526,11 +538,10 @@ def _rate_verdict(robot: Robot, log: TorqueLog, j: int) -> tuple[str, str] | Non
     ``k`` is the least-squares factor of ``d q / dt ~ k dq``: 1 when ``q`` and ``dq``
     share a unit, ``180 / pi`` when ``q`` is in degrees and ``dq`` in radians per second.
     """
-    t, q, v = log.t, log.q[:, j], np.ascontiguousarray(log.dq[:, j])
-    den = float(v @ v)
-    if t.size < 5 or not den > 0:
+    k = joint_rate_factor(log, j)
+    if not np.isfinite(k):
         return "", "--units q=deg"
-    k = float(signals.derivative(t, q) @ v) / den  # in blocks: a long log's column
+    v = log.dq[:, j]
     deg = 180.0 / np.pi
     if abs(k / deg - 1.0) < _RATE_AGREES:
         return (
