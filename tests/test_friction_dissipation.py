@@ -1,5 +1,6 @@
 """Identified friction that is not dissipative within the velocity limits is named, and
-the structure selection does not choose it.
+the structure selection does not choose it; friction that puts energy in at every speed
+is a torque of the opposite sign, refused.
 
 References: closed forms of ``f(v) v`` for the quadratic law (``fv v^2 + fq v^2 |v| +
 fc |v|``, negative beyond ``|v|`` where ``fv + fq |v| + fc / |v| = 0``) and for the
@@ -10,16 +11,19 @@ own friction (a sigmoid that saturates, which a quadratic viscous term follows o
 
 from __future__ import annotations
 
+import dataclasses
 import warnings
 
 import numpy as np
 import pytest
 
 import dynid
+from dynid.dynamics.terms import gravity_torques
 from dynid.exceptions import DynidWarning
-from dynid.identification.dissipation import GRID, friction_violations
+from dynid.identification.dissipation import GRID, friction_violations, reversed_sign_finding
 from dynid.identification.recordings import prepare_recordings
-from dynid.identification.selection import select_structure
+from dynid.identification.sanity import opposite_sign
+from dynid.identification.selection import reversed_friction, select_structure
 from dynid.identification.structure import Structure
 from dynid.model.drive import Drive
 from dynid.regressors.terms import LinearFriction
@@ -38,8 +42,9 @@ def test_a_quadratic_law_that_turns_negative_is_named_at_the_limit():
     # beyond, worst at the limit; joint 2: fq > 0, and the offset is no friction of motion
     x = np.array([fv, fq, fc, 0.5, 0.2, 0.01, 0.1, -3.0])
     (line,) = friction_violations([(_quadratic(), x)], vmax)
-    assert line.startswith("fq1 = -0.2 (joint 1:")
-    assert "|v| = 2 rad/s" in line
+    assert str(line).startswith("fq1 = -0.2 (joint 1:")
+    assert "|v| = 2 rad/s" in str(line)
+    assert not line.everywhere  # dissipative at low speed: no sign flip
 
 
 def test_a_quadratic_law_dissipative_up_to_the_limit_is_not_named():
@@ -48,14 +53,15 @@ def test_a_quadratic_law_dissipative_up_to_the_limit_is_not_named():
     assert friction_violations([(_quadratic(), x)], np.array([2.0, 2.0])) == ()
     # the same law beyond a higher limit: (0.2 + 0.1 / v) / 0.1 = v at v = 2.22
     (line,) = friction_violations([(_quadratic(), x)], np.array([3.0, np.inf]))
-    assert line.startswith("fq1 = -0.1 (joint 1:")
+    assert str(line).startswith("fq1 = -0.1 (joint 1:")
 
 
 def test_a_stribeck_bump_below_zero_pushes_at_standstill():
     t = LinearFriction(Drive.identity(1), parts=("viscous", "coulomb", "stribeck"), vst=0.05)
     (line,) = friction_violations([(t, np.array([0.1, 0.2, -0.5]))], np.array([2.0]))
-    assert line.startswith("fsp1 = -0.5 (joint 1:")
-    worst = float(line.split("|v| = ")[1].split(" rad/s")[0])
+    assert str(line).startswith("fsp1 = -0.5 (joint 1:")
+    worst = float(str(line).split("|v| = ")[1].split(" rad/s")[0])
+    assert worst == pytest.approx(line.speed)
     # f(v) = 0.1 v + 0.2 - 0.5 exp(-(v / 0.05)^2) < 0 up to v = 0.05 sqrt(ln 2.5) = 0.048
     assert worst == pytest.approx(0.05 * np.sqrt(np.log(2.5)), abs=2 * 2.0 / GRID + 1e-3)
 
@@ -81,7 +87,7 @@ def test_the_selection_skips_a_law_that_pushes_the_arm(panda_data):
     # the saturating friction of the Panda is fitted with fq < 0: the quadratic candidate
     # predicts better than the links alone, yet its friction turns negative at speed
     assert judged[quadratic].heldout_error_percent < judged[cands[0]].heldout_error_percent
-    assert any(v.startswith("fq") for v in judged[quadratic].unphysical)
+    assert any(lab.startswith("fq") for v in judged[quadratic].unphysical for lab in v.labels)
     assert sel.chosen == cands[0]
     # the printed table marks the skipped candidate (x) and one line says why
     from dynid.cli.structure_table import selection_lines
@@ -172,3 +178,91 @@ def test_normal_equations_give_the_classical_standard_deviations():
     ref = np.sqrt(rss[0] / (400 - 5) * np.diag(np.linalg.inv(W.T @ W)))
     np.testing.assert_allclose(x, ref_x, rtol=1e-9)
     np.testing.assert_allclose(N.std(x), ref, rtol=1e-8)
+
+
+def test_friction_that_pushes_at_every_speed_is_told_from_friction_that_pushes_at_some():
+    """Closed forms of ``f(v) v`` up to 4 rad/s: ``-0.2 v^2 - 0.1 |v|`` and ``-0.3 |v|``
+    are below zero at every ``v != 0`` (a torque of the opposite sign); ``-0.2 v^2 + 0.5
+    |v|`` only beyond 2.5 rad/s (a law following friction that falls with speed), ``0.2
+    v^2 - 0.3 |v|`` only below 1.5 rad/s: not a sign, and no finding."""
+    term = LinearFriction(Drive.identity(4), parts=("viscous", "coulomb"))
+    x = np.array([-0.2, -0.1, -0.2, 0.5, 0.2, -0.3, 0.0, -0.3])
+    found = friction_violations([(term, x)], np.full(4, 4.0))
+    assert [(v.joint, v.labels, v.everywhere) for v in found] == [
+        (0, ("fv1", "fc1"), True),
+        (1, ("fv2",), False),
+        (2, ("fc3",), False),
+        (3, ("fc4",), True),
+    ]
+    assert found[1].speed == pytest.approx(4.0) and found[2].speed == pytest.approx(1.5, abs=0.02)
+    assert found[0].values == (-0.2, -0.1)
+    said = reversed_sign_finding(found, ("a", "b", "c", "d"))
+    assert said is not None and said.startswith("the friction identified on a, d puts energy")
+    assert "(fv1 = -0.2, fc1 = -0.1; fc4 = -0.3)" in said
+    assert "their torque columns in the file (tau1, tau4 in dynid's column names" in said
+    assert reversed_sign_finding(found[1:3], ("a", "b", "c", "d")) is None
+
+
+def _flipped_logs(robot, joint):
+    """Three noisy recordings of ``robot`` (its own friction) with the torques of
+    ``joint`` negated."""
+    logs = []
+    for s in (1, 2, 3):
+        traj = random_fourier(robot, np.random.default_rng(s))(sample_times(5.0, 400.0))
+        log = simulate_measurement(robot, traj, rng=np.random.default_rng(s), noise=SensorNoise())
+        tau = np.array(log.tau)
+        tau[:, joint] *= -1
+        logs.append(dataclasses.replace(log, tau=tau))
+    return logs
+
+
+@pytest.fixture(scope="module")
+def flipped_wrist():
+    """The Panda's joint 7 (the flange's rotation, which gravity barely loads: its gravity
+    torque spans under 1 % of the shoulder's) with its torques negated, which the check of
+    the torques against gravity cannot see."""
+    robot = dynid.panda()
+    logs = _flipped_logs(robot, 6)
+    g = np.ptp(gravity_torques(robot, logs[0].q), axis=0)
+    assert g[6] < 0.01 * g.max() and opposite_sign(robot, logs[0]) is None
+    return robot, logs
+
+
+def test_a_flipped_joint_loses_its_own_friction_and_the_others_keep_theirs(flipped_wrist):
+    """Regression: joint 7's torques negated give its friction below zero in every friction
+    candidate; leaving out its one coefficient named below zero turned the other negative,
+    the repair gave up and every joint lost its friction (a Kinova arm with joint 6
+    flipped: links only, 25.7 % held out against 1.02 % for its best friction candidate).
+    The Panda's simulated friction holds a Coulomb level on every joint: joints 1-6 keep
+    theirs."""
+    robot, logs = flipped_wrist
+    sel = select_structure(robot, prepare_recordings(robot, logs, ["a", "b", "c"]))
+    judged = {c.structure: c for c in sel.candidates}
+    assert [v.joint for v in reversed_friction(sel)] == [6]
+    chosen = judged[sel.chosen]
+    assert not chosen.unphysical and sel.chosen.friction
+    assert "fc7" in sel.chosen.drop
+    assert not [lab for lab in sel.chosen.drop if lab.startswith("fc") and lab != "fc7"]
+    links = judged[Structure(friction=())]
+    assert chosen.heldout_error_percent < 0.5 * links.heldout_error_percent
+
+
+def test_identify_refuses_a_flipped_joint_gravity_does_not_load(flipped_wrist):
+    """Regression: the held-out data need joint 7's friction to put energy in at every
+    speed, and gravity does not load joint 7; identify refuses, as it refuses a flipped
+    joint gravity loads, naming the joint and its torque column (it returned a model
+    without friction, exit 0), and gives the structure without that friction."""
+    from dynid.exceptions import DataError
+    from dynid.identification.selection import identify_recordings
+
+    robot, logs = flipped_wrist
+    name = robot.joint_names[6]
+    with pytest.raises(DataError) as e:
+        identify_recordings(robot, logs)
+    said = str(e.value)
+    assert said.startswith(f"the friction identified on {name} puts energy into the arm")
+    assert f"the torque sign of {name} is probably opposite" in said
+    assert "hint: flip the sign of its torque column in the file (tau7 " in said
+    # the way on for a sign that is right: the structure chosen without that friction
+    terms = said.split("--terms ")[1].split(" ")[0]
+    assert "fc7" in Structure.parse(terms).drop

@@ -221,3 +221,90 @@ def test_identify_refuses_one_joint_of_the_opposite_sign(panda, log, j, tmp_path
     assert head == panda.joint_names[j], err[0]
     assert f"flip the sign of their torque columns in the file (tau{j + 1} " in err[0]
     assert not (tmp_path / "i" / "identification.json").exists()
+
+
+def _arm_joint(name: str, parent: str, child: str, axis: str, limits: str) -> str:
+    return (
+        f'<joint name="{name}" type="{"continuous" if not limits else "revolute"}">'
+        f'<parent link="{parent}"/><child link="{child}"/><origin xyz="0 0 0.3"/>'
+        f'<axis xyz="{axis}"/><limit {limits} effort="10" velocity="1"/></joint>'
+        f'<link name="{child}"><inertial><origin xyz="0.05 0 0.1"/><mass value="1.0"/>'
+        '<inertia ixx="0.01" ixy="0" ixz="0" iyy="0.01" iyz="0" izz="0.01"/></inertial></link>'
+    )
+
+
+#: An arm whose base and wrist joints turn without limits (as a Kinova's 1, 4 and 6).
+ARM_WITH_CONTINUOUS_JOINTS = (
+    '<robot name="arm"><link name="base"/>'
+    + _arm_joint("yaw", "base", "l1", "0 0 1", "")
+    + _arm_joint("shoulder", "l1", "l2", "0 1 0", 'lower="-2" upper="2"')
+    + _arm_joint("elbow", "l2", "l3", "0 1 0", 'lower="-2.5" upper="2.5"')
+    + _arm_joint("wrist", "l3", "l4", "1 0 0", "")
+    + "</robot>"
+)
+
+
+@pytest.fixture(scope="module")
+def arm_log(tmp_path_factory):
+    """The arm and a simulated log of it in radians (the reference every conversion of
+    the degrees below must give back)."""
+    urdf = tmp_path_factory.mktemp("arm") / "arm.urdf"
+    urdf.write_text(ARM_WITH_CONTINUOUS_JOINTS)
+    arm = dynid.Robot.from_urdf(urdf)
+    assert list(np.isfinite(arm.q_max)) == [False, True, True, False]
+    traj = random_fourier(arm, np.random.default_rng(7))(sample_times(4.0, 200.0))
+    g = simulate_measurement(arm, traj, rng=np.random.default_rng(8))
+    return arm, TorqueLog(g.t, g.q, g.dq, g.tau)
+
+
+def _in_degrees(log: TorqueLog, joints: list[int]) -> TorqueLog:
+    q, dq = log.q.copy(), log.dq.copy()
+    q[:, joints] *= DEG
+    dq[:, joints] *= DEG
+    return TorqueLog(log.t, q, dq, log.tau)
+
+
+def test_a_log_all_in_degrees_is_told_by_every_joint_and_given_units(arm_log):
+    """Regression: positions and velocities of every joint in degrees. The joints without
+    limits are judged by their speeds (in radians, 57 times what the arm reaches), so the
+    refusal says the whole file is in degrees, names every joint and gives --units
+    q=deg,dq=deg/s (it named only the joints with limits and said to convert those: the
+    others left in degrees read as 1000 % error, 'another robot?'). The log in radians,
+    which that option reads the file as, passes."""
+    arm, log = arm_log
+    with pytest.raises(DataError) as e:
+        check_limits(Recorded((_in_degrees(log, [0, 1, 2, 3]),), (Path("deg.csv"),)), arm)
+    said = str(e.value)
+    assert said.startswith("deg.csv: positions in degrees: ")
+    assert said.endswith("hint: --units q=deg,dq=deg/s")
+    assert all(name in said for name in arm.joint_names)
+    assert "yaw (no position limits) moves at up to" in said
+    check_limits(Recorded((log,), (Path("rad.csv"),)), arm)
+
+
+def test_joints_without_limits_left_in_degrees_are_named(arm_log):
+    """Regression: the joints with limits converted to radians, the two without left in
+    degrees (following the earlier hint): refused, naming those two and not the others
+    (nothing was said: 1000 % error, 'a log of another robot')."""
+    arm, log = arm_log
+    with pytest.raises(DataError) as e:
+        check_limits(Recorded((_in_degrees(log, [0, 3]),), (Path("half.csv"),)), arm)
+    said = str(e.value)
+    assert said.startswith("half.csv: joint(s) in degrees among joints in radians: yaw ")
+    assert "convert the positions and velocities of yaw, wrist to radians" in said
+    assert "shoulder" not in said and "elbow" not in said
+
+
+def test_slow_joints_without_limits_do_not_hide_a_file_in_degrees(arm_log):
+    """The joints with limits in degrees and those without too slow to tell (a tenth of a
+    degree per second reads as plausible radians per second): --units comes first, the conversion of
+    the joints with limits as the alternative."""
+    arm, log = arm_log
+    scale = np.array([1e-3, 1.0, 1.0, 1e-3])
+    slow = TorqueLog(log.t, log.q * scale, log.dq * scale, log.tau)
+    with pytest.raises(DataError) as e:
+        check_limits(Recorded((_in_degrees(slow, [0, 1, 2, 3]),), (Path("s.csv"),)), arm)
+    said = str(e.value)
+    assert "positions in degrees on every joint with position limits" in said
+    assert "hint: --units q=deg,dq=deg/s if the whole file is in degrees" in said
+    assert "the speeds of yaw, wrist, without position limits, do not tell" in said

@@ -22,6 +22,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
+from .dissipation import Violation
 from .holdout import HeldOut
 from .model import IdentifiedModel
 from .structure import Structure
@@ -75,7 +76,7 @@ class Candidate:
     fold_errors_percent : tuple of float
         Relative held-out error [%] of every fold judged (each recording left out, when
         the folds are recordings).
-    unphysical : tuple of str
+    unphysical : tuple of Violation
         Where its friction is not dissipative within the velocity limits.
     left_out : tuple of str
         A per-joint structure's coefficients left out from the candidate its search
@@ -96,7 +97,7 @@ class Candidate:
     heldout_se_percent: float
     fold_errors_percent: tuple[float, ...] = ()
     se_vs_best_percent: float = 0.0
-    unphysical: tuple[str, ...] = ()
+    unphysical: tuple[Violation, ...] = ()
     left_out: tuple[str, ...] = ()
     whitened_error_percent: float | None = None
     fold_whitened_percent: tuple[float, ...] = ()
@@ -124,7 +125,7 @@ class Candidate:
             "heldout_se_percent": self.heldout_se_percent,
             "heldout_se_vs_best_percent": self.se_vs_best_percent,
             "heldout_per_fold_percent": list(self.fold_errors_percent),
-            "not_dissipative": list(self.unphysical),
+            "not_dissipative": [str(v) for v in self.unphysical],
             "left_out": list(self.left_out),
             "heldout_whitened_percent": self.whitened_error_percent,
         }
@@ -211,7 +212,8 @@ def candidate_judged(
     model: IdentifiedModel,
     held: HeldOut,
     rtol: float,
-    check: Callable[[NDArray[np.float64], NDArray[np.float64]], tuple[str, ...]] | None = None,
+    check: Callable[[NDArray[np.float64], NDArray[np.float64]], tuple[Violation, ...]]
+    | None = None,
 ) -> Candidate:
     """``structure`` (the columns ``use`` of ``model``) judged on the folds ``held``;
     ``check`` (of every column's coefficients fitted on all data and their standard
@@ -225,7 +227,7 @@ def candidate_judged(
     se = float(np.std(per_fold, ddof=1) / math.sqrt(len(per_fold))) if len(per_fold) > 1 else 0.0
     white = [t.relative_error_percent(x) for t, x in zip(sub.whitened, xs, strict=True)]
     whole, whole_std = sub.whole.solve_with_std(rtol, std=check is not None)
-    unphysical: tuple[str, ...] = ()
+    unphysical: tuple[Violation, ...] = ()
     if check is not None:
         assert whole_std is not None  # asked for with the check
         x, sd = np.zeros(use.size), np.zeros(use.size)

@@ -7,7 +7,11 @@ bounds, and a law with a term that grows faster than the others (``fq v |v|``) o
 Stribeck bump (``fsp``) can turn negative inside the limits: a model whose friction pushes
 the arm. :func:`friction_violations` names every joint (motor) where it does, with its
 coefficients below zero, for the structure selection to skip such a candidate and for
-``identify`` to warn.
+``identify`` to warn. Friction that pushes at every velocity (:attr:`Violation.everywhere`:
+``fv6 = -0.14, fc6 = -0.30``) is the signature of a torque logged with the opposite sign on
+that joint, when the data need it (:func:`reversed_sign_finding`): the sign flip that the
+gravity check of :mod:`~dynid.identification.sanity` cannot see on a joint gravity does
+not load.
 
 The velocity limit of a motor is ``sum_j |K_mj| dq_max_j`` (``K`` the drive's friction
 transmission, the identity at the joints); joints without a limit are not checked.
@@ -17,6 +21,7 @@ from __future__ import annotations
 
 import warnings
 from collections.abc import Sequence
+from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
@@ -27,12 +32,15 @@ from ..regressors.terms import PART_LABELS, LinearFriction, ModelTerm
 
 if TYPE_CHECKING:
     from .model import IdentifiedModel
+    from .structure import Structure
 
 __all__ = [
     "GRID",
     "SIGNIFICANCE",
+    "Violation",
     "friction_columns",
     "friction_violations",
+    "reversed_sign_finding",
     "warn_unphysical",
 ]
 
@@ -46,11 +54,56 @@ GRID = 401
 SIGNIFICANCE = 3.0
 
 
+@dataclass(frozen=True, slots=True)
+class Violation:
+    """Friction of one joint (motor) that is not dissipative within its velocity limit.
+
+    Attributes
+    ----------
+    joint : int
+        The joint (motor) index, from 0.
+    place : str
+        ``"joint"`` or ``"motor"``: where the friction acts.
+    labels : tuple of str
+        The coefficients below zero (every coefficient of the joint when none is), as
+        ``--terms`` leaves them out (``fv6``).
+    values : tuple of float
+        Their values, moved towards zero by their uncertainty (:data:`SIGNIFICANCE`).
+    speed : float
+        The largest ``|v|`` [rad/s] where ``f(v) v < 0``.
+    limit : float
+        The joint's (motor's) velocity limit [rad/s].
+    everywhere : bool
+        ``f(v) v < 0`` at every velocity checked but 0: friction that puts energy in at
+        every speed, as a torque of the opposite sign gives.
+    """
+
+    joint: int
+    place: str
+    labels: tuple[str, ...]
+    values: tuple[float, ...]
+    speed: float
+    limit: float
+    everywhere: bool
+
+    @property
+    def coefficients(self) -> str:
+        """``"fv6 = -0.142, fc6 = -0.298"``."""
+        return ", ".join(f"{k} = {x:.3g}" for k, x in zip(self.labels, self.values, strict=True))
+
+    def __str__(self) -> str:
+        """``"fq3 = -0.12 (joint 3: f(v) v < 0 at |v| = 2.1 rad/s, limit 2.18 rad/s)"``."""
+        return (
+            f"{self.coefficients} ({self.place} {self.joint + 1}: f(v) v < 0 at |v| = "
+            f"{self.speed:.3g} rad/s, limit {self.limit:.3g} rad/s)"
+        )
+
+
 def friction_violations(
     terms: Sequence[tuple[LinearFriction, NDArray[np.float64]]],
     dq_max: NDArray[np.float64],
     std: Sequence[NDArray[np.float64]] | None = None,
-) -> tuple[str, ...]:
+) -> tuple[Violation, ...]:
     """Where identified friction is not dissipative within the velocity limits, beyond
     its uncertainty.
 
@@ -67,8 +120,8 @@ def friction_violations(
 
     Returns
     -------
-    tuple of str
-        One entry per joint (motor) where ``f(v) v < 0`` for some ``|v| <= v_max``:
+    tuple of Violation
+        One per joint (motor) where ``f(v) v < 0`` for some ``|v| <= v_max``; as text
         ``"fq3 = -0.12 (joint 3: f(v) v < 0 at |v| = 2.1 rad/s, limit 2.18 rad/s)"``,
         naming the coefficients below zero (else every coefficient of the joint).
     """
@@ -110,12 +163,53 @@ def friction_violations(
             continue
         at = float(np.max(np.abs(v[bad, j])))
         neg = {k: x for k, x in coefficients[j].items() if x < 0} or coefficients[j]
-        named = ", ".join(f"{k} = {x:.3g}" for k, x in neg.items())
+        everywhere = bool(np.all(bad[grid != 0.0]))
         out.append(
-            f"{named} ({where} {j + 1}: f(v) v < 0 at |v| = {at:.3g} rad/s, "
-            f"limit {vmax[j]:.3g} rad/s)"
+            Violation(j, where, tuple(neg), tuple(neg.values()), at, float(vmax[j]), everywhere)
         )
     return tuple(out)
+
+
+def reversed_sign_finding(
+    violations: Sequence[Violation], names: Sequence[str], instead: Structure | None = None
+) -> str | None:
+    """The finding that the torques of some joints (motors) have the opposite sign to the
+    model's, read from friction that puts energy in at every speed
+    (:attr:`Violation.everywhere`), or None.
+
+    Parameters
+    ----------
+    violations : sequence of Violation
+        Of a fit whose held-out error needs that friction (the structure selection's
+        best candidate, predicting better than any without it).
+    names : sequence of str
+        The joint names (a motor is named by its number).
+    instead : Structure, optional
+        The structure without that friction, for the user whose sign is right (a
+        controller's compensation) to give with ``--terms``.
+    """
+    flipped = [v for v in violations if v.everywhere]
+    if not flipped:
+        return None
+    which = ", ".join(
+        names[v.joint] if v.place == "joint" else f"motor {v.joint + 1}" for v in flipped
+    )
+    its = "its torque column" if len(flipped) == 1 else "their torque columns"
+    return (
+        f"the friction identified on {which} puts energy into the arm at every velocity up "
+        f"to the limit ({'; '.join(v.coefficients for v in flipped)}): the torque sign of "
+        f"{which} is probably opposite to the model's (the check of the torques against "
+        f"gravity does not tell it on a joint that gravity barely loads); hint: flip the "
+        f"sign of {its} in the file ("
+        + ", ".join(f"tau{v.joint + 1}" for v in flipped)
+        + " in dynid's column names; --units tau=-1 flips every joint)"
+        + (
+            ""
+            if instead is None
+            else "; if the sign is right (a controller's compensation), --terms "
+            f"{','.join(instead.terms) or 'links'} fits without that friction"
+        )
+    )
 
 
 def friction_columns(
@@ -145,11 +239,17 @@ def warn_unphysical(model: IdentifiedModel, terms: Sequence[ModelTerm]) -> None:
     sd = np.nan_to_num(np.asarray(fit.std, dtype=float))
     columns = friction_columns(terms, model.base.rank)
     terms_x = [(t, beta[sl]) for t, sl in columns]
-    for line in friction_violations(terms_x, model.robot.dq_max, [sd[sl] for _, sl in columns]):
+    for v in friction_violations(terms_x, model.robot.dq_max, [sd[sl] for _, sl in columns]):
+        sign = (
+            f"; friction that pushes at every speed is what a torque of the opposite sign "
+            f"gives: check the sign of tau{v.joint + 1}"
+            if v.everywhere
+            else ""
+        )
         warnings.warn(
-            f"identified friction not dissipative within the velocity limits: {line}; "
+            f"identified friction not dissipative within the velocity limits: {v}; "
             "the friction pushes the arm there (--terms without that part, or with "
-            "the part left out on that joint: -LABEL)",
+            f"the part left out on that joint: -LABEL){sign}",
             DynidWarning,
             stacklevel=3,
         )

@@ -65,6 +65,8 @@ __all__ = [
     "NOISE_BAND_STD",
     "check_torque_log",
     "GRAVITY_RANGE_SHARE",
+    "gravity_loaded",
+    "joint_rate_factor",
     "opposite_sign",
     "moving_joints",
     "noise_band",
@@ -376,6 +378,14 @@ def anticorrelated(
     return j, float(corr[j])
 
 
+def _loaded(g: NDArray[np.float64]) -> NDArray[np.bool_]:
+    """The joints the gravity torques ``g`` (N, n) load (:func:`_gravity_spread`)."""
+    spread = np.std(g, axis=0)
+    varied = np.ptp(g, axis=0) >= GRAVITY_RANGE_SHARE * float(np.max(np.abs(g)))
+    out: NDArray[np.bool_] = (spread > 0.05 * max(float(spread.max()), 1e-300)) & varied
+    return out & bool(np.any(spread > 0))
+
+
 def _gravity_spread(
     robot: Robot, q: NDArray[np.float64], tau: NDArray[np.float64]
 ) -> tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.bool_]] | None:
@@ -385,12 +395,20 @@ def _gravity_spread(
     :data:`GRAVITY_RANGE_SHARE` of the largest gravity torque (on a short stretch gravity
     barely changes, and the torques' variations are the motion's, of either sign)."""
     g = gravity_torques(robot, q)
-    spread = np.std(g, axis=0)
-    varied = np.ptp(g, axis=0) >= GRAVITY_RANGE_SHARE * float(np.max(np.abs(g)))
-    loaded = (spread > 0.05 * max(float(spread.max()), 1e-300)) & varied
-    if not np.any(loaded) or not np.any(spread > 0):
+    loaded = _loaded(g)
+    if not np.any(loaded):
         return None
     return g - g.mean(axis=0), tau - tau.mean(axis=0), loaded
+
+
+def gravity_loaded(robot: Robot, q: ArrayLike) -> NDArray[np.bool_]:
+    """The joints (n,) whose torque sign the check against gravity judges at the
+    configurations ``q`` (N, n) [rad] (:func:`opposite_sign`): those gravity loads enough
+    over them; none for a robot without inertial parameters."""
+    qq = _checks.as_array("q", q)
+    if qq.ndim != 2 or qq.shape[0] < 2 or not np.any(robot.phi):
+        return np.zeros(robot.n, dtype=bool)
+    return _loaded(gravity_torques(robot, qq[:: max(1, qq.shape[0] // _MAX_SAMPLES)]))
 
 
 def opposite_sign(robot: Robot, log: TorqueLog) -> str | None:
@@ -547,6 +565,17 @@ def _degrees(robot: Robot, log: TorqueLog) -> list[str]:
     return []
 
 
+def joint_rate_factor(log: TorqueLog, j: int) -> float:
+    """``k`` [1] of ``d q / dt ~ k dq`` on joint ``j`` of ``log``, by least squares: 1 when
+    its positions and velocities share a unit, ``180 / pi`` for positions in degrees and
+    velocities in radians per second; NaN for fewer than 5 samples or a joint at rest."""
+    t, q, v = log.t, log.q[:, j], np.ascontiguousarray(log.dq[:, j])
+    den = float(v @ v)
+    if t.size < 5 or not den > 0:
+        return float("nan")
+    return float(signals.derivative(t, q) @ v) / den  # in blocks: a long log's column
+
+
 def _rate_verdict(robot: Robot, log: TorqueLog, j: int) -> tuple[str, str] | None:
     """What the velocities of joint ``j`` say of positions that may be degrees: None (they
     are radians), or the reason and the hint of the warning.
@@ -554,11 +583,10 @@ def _rate_verdict(robot: Robot, log: TorqueLog, j: int) -> tuple[str, str] | Non
     ``k`` is the least-squares factor of ``d q / dt ~ k dq``: 1 when ``q`` and ``dq``
     share a unit, ``180 / pi`` when ``q`` is in degrees and ``dq`` in radians per second.
     """
-    t, q, v = log.t, log.q[:, j], np.ascontiguousarray(log.dq[:, j])
-    den = float(v @ v)
-    if t.size < 5 or not den > 0:
+    k = joint_rate_factor(log, j)
+    if not np.isfinite(k):
         return "", "--units q=deg"
-    k = float(signals.derivative(t, q) @ v) / den  # in blocks: a long log's column
+    v = log.dq[:, j]
     deg = 180.0 / np.pi
     if abs(k / deg - 1.0) < _RATE_AGREES:
         return (

@@ -26,6 +26,9 @@ out of the judgement and named (:mod:`dynid.identification.candidates`); a candi
 whose friction is not dissipative within the velocity limits is not chosen
 (:mod:`dynid.identification.dissipation`); when it predicts best, its offending
 coefficients are left out joint by joint and the candidate reached is judged instead.
+When no dissipative candidate predicts as well, friction that puts energy in at every
+speed (:func:`reversed_friction`) on a joint gravity does not load is a torque of the
+opposite sign there: :func:`identify_recordings` refuses it.
 
 :func:`identify_recordings` is the classical route over one or more recordings with the
 structure chosen (or given).
@@ -42,12 +45,12 @@ from typing import Any, Literal
 import numpy as np
 from numpy.typing import NDArray
 
-from ..exceptions import DynidWarning, OptionError, RankDeficientError
+from ..exceptions import DataError, DynidWarning, OptionError, RankDeficientError
 from ..model.drive import Drive
 from ..model.robot import Robot
 from ..progress import stage
 from ..regressors.base import BaseParameters
-from ..regressors.terms import ModelTerm
+from ..regressors.terms import PART_LABELS, ModelTerm
 from ..signals import lowpass_noise_gain
 from .bumps import bump_widths
 from .candidates import (
@@ -62,7 +65,13 @@ from .candidates import (
     without_recordings,
 )
 from .core import identify
-from .dissipation import friction_columns, friction_violations, warn_unphysical
+from .dissipation import (
+    Violation,
+    friction_columns,
+    friction_violations,
+    reversed_sign_finding,
+    warn_unphysical,
+)
 from .estimators import Estimator, EstimatorName, estimator_named
 from .holdout import DEFAULT_FOLDS, HeldOut
 from .judge import heldout_judge
@@ -72,6 +81,7 @@ from .log import TorqueLog
 from .metrics import noise_floor_percent
 from .model import IdentifiedModel
 from .recordings import Recordings, prepare_recordings
+from .sanity import gravity_loaded
 from .structure import (
     ERROR_FLOOR_PERCENT,
     Structure,
@@ -93,6 +103,7 @@ __all__ = [
     "Candidate",
     "Selection",
     "identify_recordings",
+    "reversed_friction",
     "select_structure",
 ]
 
@@ -299,6 +310,17 @@ def select_structure(
     )
 
 
+def reversed_friction(selection: Selection) -> tuple[Violation, ...]:
+    """The joints whose friction puts energy in at every speed in the candidate of
+    ``selection`` that predicts best, when no dissipative candidate predicts as well
+    (:func:`_within`): the held-out data need friction of the opposite sign there."""
+    best_any = min(selection.candidates, key=lambda c: c.score)
+    best = min(_physical(selection.candidates), key=lambda c: c.score)
+    if best.unphysical or _within(best, best_any):
+        return ()
+    return tuple(v for v in best_any.unphysical if v.everywhere)
+
+
 def _warn_outlying(skip: tuple[int, ...], per: tuple[tuple[str, float], ...]) -> None:
     """A warning for each recording ``skip`` left out of the judgement (its name and
     held-out error with the chosen structure in ``per``)."""
@@ -387,7 +409,7 @@ def _judged(
     columns = friction_columns(terms, model.base.rank)
     dq_max = model.robot.dq_max
 
-    def check(x: NDArray[np.float64], sd: NDArray[np.float64]) -> tuple[str, ...]:
+    def check(x: NDArray[np.float64], sd: NDArray[np.float64]) -> tuple[Violation, ...]:
         return friction_violations(
             [(t, x[sl]) for t, sl in columns], dq_max, [sd[sl] for _, sl in columns]
         )
@@ -582,14 +604,17 @@ def _dropped(
     held: HeldOut,
     n: int,
     rtol: float,
+    among: frozenset[str] | None = None,
 ) -> list[Candidate]:
-    """``here`` with one more coefficient left out, every way, judged."""
+    """``here`` with one more coefficient left out (one of ``among`` when given), every
+    way, judged."""
     rotors = tuple(own_rotors(model.base, n))
     return [
         _judged(s, candidate_columns(s, model, terms), model, terms, held, rtol)
         for s in (
             replace(here.structure, drop=here.structure.drop + (lab,))
             for lab in coefficient_labels(here.structure, n, rotors)
+            if among is None or lab in among
         )
     ]
 
@@ -602,16 +627,28 @@ def _repaired(
     n: int,
     rtol: float,
 ) -> Candidate | None:
-    """``here`` (friction not dissipative somewhere) with coefficients left out one at a
-    time, each step the one that leaves the fewest joints not dissipative at the lowest
-    held-out error, until its friction is dissipative; None when a step helps no joint."""
+    """``here`` (friction not dissipative somewhere) with friction coefficients of the
+    joints not dissipative left out one at a time, each step the one that leaves the
+    fewest such joints, then the fewest coefficients below zero, at the lowest held-out
+    error, until its friction is dissipative; None when a step adds such a joint.
+
+    The other joints keep theirs, and a joint may need several steps: a torque of the
+    opposite sign gives ``fv6`` and ``fc6`` below zero, and leaving out ``fc6`` alone can
+    turn ``fv6`` negative (counting joints alone called such steps no help, and every
+    joint lost its friction for one)."""
+
+    def left(c: Candidate) -> tuple[int, int]:
+        return len(c.unphysical), sum(len(v.labels) for v in c.unphysical)
+
     while here.unphysical:
+        parts = [p for p in here.structure.friction if p != "offset"]  # no friction of motion
+        mine = frozenset(f"{PART_LABELS[p]}{v.joint + 1}" for v in here.unphysical for p in parts)
         step = min(
-            _dropped(here, model, terms, held, n, rtol),
-            key=lambda c: (len(c.unphysical), c.score),
+            _dropped(here, model, terms, held, n, rtol, mine),
+            key=lambda c: (*left(c), c.score),
             default=None,
         )
-        if step is None or len(step.unphysical) >= len(here.unphysical):
+        if step is None or len(step.unphysical) > len(here.unphysical):
             return None
         here = step
     return here
@@ -669,9 +706,8 @@ def identify_recordings(
         The drive train the logs were recorded through (:mod:`dynid.model.drive`); default:
         link-side torques of a direct drive.
     estimator, std
-        Least squares (:mod:`dynid.identification.estimators`); ``"hac"`` (default),
-        ``"robust"`` or ``"classical"`` standard deviations
-        (:func:`~dynid.identification.core.identify`).
+        Least squares (:mod:`dynid.identification.estimators`); standard deviations
+        ``"hac"`` (default), ``"robust"`` or ``"classical"`` (:func:`~.core.identify`).
     max_std_percent : float, optional
         Remove coefficients with a larger relative standard deviation [%] and re-fit.
     rtol : float, optional
@@ -697,7 +733,8 @@ def identify_recordings(
     Raises
     ------
     DataError, ShapeError
-        From :func:`~dynid.identification.recordings.prepare_recordings`.
+        From :func:`~dynid.identification.recordings.prepare_recordings`; a DataError
+        too where the friction shows a joint's torque sign flipped (:func:`reversed_friction`).
     OptionError
         An armature asked with known rotor inertias; a friction placement (``at:``)
         without a drive that couples joints; ``base`` with ``structure="auto"``.
@@ -718,7 +755,7 @@ def identify_recordings(
         selection = select_structure(
             robot, data, drive=drive, estimator=est, folds=folds, validation=validation, rtol=rtol
         )
-        structure = _fitted_structure(selection, friction)
+        structure = _fitted_structure(robot, data, selection, friction)
     model_drive, terms = _terms_of(structure, drive, robot.n, data)
     judge, _, fold_labels = heldout_judge(robot, data, est, folds, validation)
     try:
@@ -756,9 +793,23 @@ def _without_hint(exc: RankDeficientError, structure: Structure) -> RankDeficien
     return out
 
 
-def _fitted_structure(selection: Selection | None, friction: tuple[str, ...] | None) -> Structure:
+def _fitted_structure(
+    robot: Robot, data: Recordings, selection: Selection | None, friction: tuple[str, ...] | None
+) -> Structure:
     """The structure chosen (the links alone when the data are too short to judge), with
-    the friction parts ``friction`` in place of its own when given."""
+    the friction parts ``friction`` in place of its own when given.
+
+    Refused (:class:`~dynid.exceptions.DataError`), as a flipped joint gravity loads is
+    before any fit: friction the held-out data need to put energy in at every speed
+    (:func:`reversed_friction`) on a joint whose sign the check against gravity does not
+    judge (:func:`~.sanity.gravity_loaded`), a torque of the opposite sign there. On a
+    joint it judges the sign is right (a controller's compensation, ``-0.05 dq2``), and
+    that friction is left out instead."""
+    if selection is not None and (pushing := reversed_friction(selection)):
+        loaded = gravity_loaded(robot, np.concatenate([p.log.q for p in data.pieces]))
+        unseen = [v for v in pushing if not loaded[v.joint]]
+        if found := reversed_sign_finding(unseen, robot.joint_names, selection.chosen):
+            raise DataError(found)
     chosen = Structure() if selection is None else selection.chosen
     return chosen if friction is None else Structure(chosen.armature, friction, at=chosen.at)
 

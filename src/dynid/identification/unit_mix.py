@@ -25,6 +25,12 @@ span more than the joint can travel (the width of its limits: a recording of ano
 robot, shifted, does not), divided by ``180 / pi`` they fit the limits, and its velocities
 do not say radians (where they agree with the positions' derivative and stay below the
 joint's speed limit, an unwrapped continuous joint turning several times, they do).
+A joint without position limits (continuous) is judged by its velocities alone: ``180 /
+pi`` times slower than the derivative of its positions, or agreeing with it and
+:data:`FREE_SPEED_FACTOR` times its speed limit. When every joint that moves reads as
+degrees the hint is ``--units q=deg,dq=deg/s``; when every joint with limits does and the
+continuous ones do not tell (slow), it is still that first, the conversion of the joints
+named second: a file is written in one unit.
 """
 
 from __future__ import annotations
@@ -36,12 +42,17 @@ from numpy.typing import NDArray
 
 from ..model.robot import Robot
 from .log import TorqueLog
-from .sanity import _rate_verdict
+from .sanity import _RATE_AGREES, _rate_verdict, joint_rate_factor
 
-__all__ = ["DEGREE_TOLERANCE", "degrees_among_radians", "joints_in_degrees"]
+__all__ = ["DEGREE_TOLERANCE", "FREE_SPEED_FACTOR", "degrees_among_radians", "joints_in_degrees"]
 
 #: A scale ratio within this factor of ``180 / pi`` reads as degrees against radians.
 DEGREE_TOLERANCE = 2.0
+#: A joint without position limits whose velocities, in the unit of its positions, reach
+#: this many times its speed limit reads as degrees (within the limit read in degrees per
+#: second): radians that fast are no motion of the arm (the Kinova's continuous joints in
+#: degrees reach 41-45 times theirs).
+FREE_SPEED_FACTOR = 10.0
 _DEG = 180.0 / np.pi
 _MAX_SAMPLES = 20_000  # statistics: evenly spaced samples
 
@@ -114,6 +125,33 @@ def degrees_among_radians(
     return None
 
 
+def _free_in_degrees(robot: Robot, log: TorqueLog, j: int) -> tuple[str, bool] | None:
+    """What says joint ``j``, which has no position limits to tell, is in degrees: its
+    velocities ``180 / pi`` times slower than the derivative of its positions (positions
+    in degrees), or agreeing with it and above :data:`FREE_SPEED_FACTOR` times its speed
+    limit (``2 pi`` rad/s without one) while within it read in degrees per second (both
+    in degrees); the words and whether the velocities are in degrees too, or None."""
+    k = joint_rate_factor(log, j)
+    if not np.isfinite(k):
+        return None
+    name = robot.joint_names[j]
+    if abs(k / _DEG - 1.0) < _RATE_AGREES:
+        return (
+            f"{name} (no position limits) has velocities {k:.3g} times slower than the "
+            "derivative of its positions",
+            False,
+        )
+    fast = float(robot.dq_max[j]) if np.isfinite(robot.dq_max[j]) else 2 * np.pi
+    peak = float(np.quantile(np.abs(log.dq[:, j]), 0.99))
+    if abs(k - 1.0) < _RATE_AGREES and FREE_SPEED_FACTOR * fast < peak <= 1.5 * fast * _DEG:
+        return (
+            f"{name} (no position limits) moves at up to {peak:.4g} per second, "
+            f"{peak / fast:.3g} times its speed limit {fast:.3g} rad/s",
+            True,
+        )
+    return None
+
+
 def joints_in_degrees(robot: Robot, log: TorqueLog, margin: float) -> tuple[list[int], str]:
     """The joints of a joint-side ``log`` whose positions read as degrees (module
     docstring), and the finding (one line, without the file's name; empty without them).
@@ -132,8 +170,9 @@ def joints_in_degrees(robot: Robot, log: TorqueLog, margin: float) -> tuple[list
     lo, hi = q.min(axis=0), q.max(axis=0)
     q_min, q_max = np.asarray(robot.q_min), np.asarray(robot.q_max)
     width = q_max - q_min
+    moving = ~np.asarray(robot.prismatic, dtype=bool) & (hi - lo > 1e-3)
     suspect = (
-        ~np.asarray(robot.prismatic, dtype=bool)
+        moving
         & np.isfinite(width)
         & ((lo < q_min - margin) | (hi > q_max + margin))
         & (hi - lo > width)
@@ -142,27 +181,51 @@ def joints_in_degrees(robot: Robot, log: TorqueLog, margin: float) -> tuple[list
     )
     thin = TorqueLog(log.t[::step], q, log.dq[::step], log.tau[::step])
     verdicts = {j: _rate_verdict(robot, thin, j) for j in map(int, np.flatnonzero(suspect))}
-    found = [j for j, v in verdicts.items() if v is not None]
-    if not found:
+    hints = {j: v[1] for j, v in verdicts.items() if v is not None}
+    found = list(hints)
+    unbounded = map(int, np.flatnonzero(moving & ~np.isfinite(width)))
+    free = {j: _free_in_degrees(robot, thin, j) for j in unbounded}
+    seen = {j: f for j, f in free.items() if f is not None}
+    if not found and not seen:
         return [], ""
-    both = all("dq=deg/s" in verdicts[j][1] for j in found)  # type: ignore[index]
+    both = (
+        not log.dq_derived
+        and all("dq=deg/s" in h for h in hints.values())
+        and all(f[1] for f in seen.values())
+    )
     names = robot.joint_names
-    spans = ", ".join(
-        f"{names[j]} spans [{lo[j]:.4g}, {hi[j]:.4g}], limits [{q_min[j]:.4g}, {q_max[j]:.4g}]"
-        for j in found[:3]
-    ) + (f" (and {len(found) - 3} more)" if len(found) > 3 else "")
-    moving = ~np.asarray(robot.prismatic, dtype=bool) & (hi - lo > 1e-3)
-    if set(found) >= set(map(int, np.flatnonzero(moving))):
-        what = "positions in degrees"
-        hint = "--units q=deg" + (",dq=deg/s" if both else "")
+    said = []
+    if found:
+        said.append(
+            ", ".join(
+                f"{names[j]} spans [{lo[j]:.4g}, {hi[j]:.4g}], limits [{q_min[j]:.4g}, "
+                f"{q_max[j]:.4g}]"
+                for j in found[:3]
+            )
+            + (f" (and {len(found) - 3} more)" if len(found) > 3 else "")
+            + ": more than the joint can travel, and within its limits read in degrees"
+        )
+    said += [f[0] for f in seen.values()]
+    every = sorted(found + list(seen))
+    units = "--units q=deg" + (",dq=deg/s" if both else "")
+    units += ",ddq=deg/s^2" if both and log.ddq is not None else ""
+    cols = "positions and velocities" if both else "positions"
+    convert = (
+        f"convert the {cols} of {', '.join(names[j] for j in every)} to radians (x pi/180) "
+        "in the file"
+    )
+    unclear = [j for j, f in free.items() if f is None]
+    bounded = np.flatnonzero(moving & np.isfinite(width))
+    if set(every) >= set(map(int, np.flatnonzero(moving))):
+        what, hint = "positions in degrees", units
+    elif found and set(found) >= set(map(int, bounded)):
+        what = "positions in degrees on every joint with position limits"
+        hint = (
+            f"{units} if the whole file is in degrees, as a file usually is (the speeds of "
+            f"{', '.join(names[j] for j in unclear)}, without position limits, do not tell); "
+            f"else {convert}"
+        )
     else:
         what = "joint(s) in degrees among joints in radians"
-        cols = "positions and velocities" if both else "positions"
-        hint = (
-            f"convert the {cols} of {', '.join(names[j] for j in found)} to radians "
-            "(x pi/180) in the file (--units converts every joint alike)"
-        )
-    return found, (
-        f"{what}: {spans}: more than the joint can travel, and within its limits read in "
-        f"degrees; hint: {hint}"
-    )
+        hint = f"{convert} (--units converts every joint alike)"
+    return every, f"{what}: {'; '.join(said)}; hint: {hint}"
