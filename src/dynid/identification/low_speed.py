@@ -24,7 +24,7 @@ from collections.abc import Sequence
 import numpy as np
 from numpy.typing import NDArray
 
-from .verdict import FLOOR_GOOD, Verdict, with_hint
+from .verdict import FLOOR_FAIR, FLOOR_GOOD, Verdict, with_hint
 
 __all__ = ["LOW_SPEED_SHARE", "MOSTLY", "low_speed_hint", "with_low_speed_hint"]
 
@@ -41,9 +41,11 @@ def low_speed_hint(
     noise_rms: NDArray[np.float64],
     joint_names: Sequence[str],
 ) -> str | None:
-    """Where most of a prediction's error above the noise sits at low speed, the sentence
-    that says so (the share, the joints, the error elsewhere against the noise); None
-    otherwise.
+    """Where most of a prediction's error above the noise sits at low speed and the moving
+    samples are within :data:`~dynid.identification.verdict.FLOOR_FAIR` times the noise,
+    the sentence that says so (the share, the joints, the moving samples' error against
+    the noise); None otherwise (an error also while moving: the model misses more than
+    friction near zero velocity).
 
     Parameters
     ----------
@@ -82,14 +84,15 @@ def low_speed_hint(
     elsewhere = np.sqrt(
         np.sum(np.where(moving, e2[:, loud], 0.0)) / np.sum(np.where(moving, var[loud], 0.0))
     )
+    if elsewhere > FLOOR_FAIR:  # the model misses effects while the joints move too
+        return None
     return (
-        f"{100 * min(share, 1.0):.0f} % of the error above the noise sits at low speed "
-        f"(|dq| under {100 * LOW_SPEED_SHARE:g} % of its RMS: standstill, reversals, "
-        f"{100 * float(np.mean(slow[:, loud])):.0f} % of the samples) on "
-        f"{where}: friction near zero velocity, whose step the velocities' noise and "
-        "low-pass blur; elsewhere the error is "
-        f"{elsewhere:.3g} x the noise (a smooth Coulomb law, a standstill band or a "
-        "Stribeck term may reach further)"
+        f"at low speed: {100 * min(share, 1.0):.0f} % of the error above the noise sits "
+        f"where |dq| is under {100 * LOW_SPEED_SHARE:g} % of its RMS (standstill, reversals, "
+        f"{100 * float(np.mean(slow[:, loud])):.0f} % of the samples) on {where}, the "
+        f"moving samples at {elsewhere:.3g} x the noise: friction near zero velocity, "
+        "whose step the velocities' noise and low-pass blur (the law's shape there, a "
+        "standstill band or a Stribeck term can move it; the noise bounds it)"
     )
 
 
@@ -104,4 +107,4 @@ def with_low_speed_hint(
     noise floor (not ``"good"``) and the hint applies; else ``verdict`` itself."""
     if verdict.level == "good":
         return verdict
-    return with_hint(verdict, low_speed_hint(dq, error, noise_rms, joint_names))
+    return with_hint(verdict, low_speed_hint(dq, error, noise_rms, joint_names), ", ")
