@@ -235,7 +235,12 @@ def despiked_recordings(
         clean, per_joint = despiked(log)
         logs.append(clean)
         counts.append(sum(per_joint))
-    return Recorded(tuple(logs), rec.paths), tuple(counts)
+    assert rec.sides is not None  # made in __post_init__
+    sides = tuple(  # only a recording whose spikes were replaced mapped anew
+        side if new is old else _joint_side(new, rec.drive)
+        for new, old, side in zip(logs, rec.logs, rec.sides, strict=True)
+    )
+    return Recorded(tuple(logs), rec.paths, rec.drive, sides), tuple(counts)
 
 
 def given_start(
