@@ -106,6 +106,28 @@ def test_a_drive_given_follows_validates_rule(logs, tmp_path):
         load_observer_model(tmp_path / "held.json", None, drive=tmp_path / "d.toml")
 
 
+def test_a_model_of_torques_reads_a_log_of_currents_through_the_logging_fields(logs):
+    """A model whose drive records torques, given a drive that differs in how the log
+    records the effort alone (currents, torque constants): the log is read through the
+    model's drive with those fields (``validate --drive`` was refused, "the drive given
+    differs", and leaving it out read amperes as N m); the model is the simulation's, so
+    the error is at the noise floor. A drive of other gears is refused as before."""
+    from dynid.friction.fit import model_drive
+    from dynid.workflows.validate import ValidateOptions, validate_files
+
+    panda = dynid.panda().with_friction(None)
+    torques = Drive.from_gears(GEARS, side="joint", rotor_inertia=ROTORS)
+    model = dataclasses.replace(exact_model(panda, panda), drive=torques)
+    read = model_drive(model, _drive())
+    assert read is not None and read.effort == "current"
+    assert read.torque_constant.tolist() == KT.tolist()
+    assert read.rotor_inertia.tolist() == ROTORS.tolist()
+    res = validate_files(model, logs / "free.csv", ValidateOptions(friction="none", drive=_drive()))
+    assert res.verdict.level == "good", res.verdict.reason
+    with pytest.raises(DataError, match="drive given differs.*transmission"):
+        model_drive(model, Drive.from_gears(2 * GEARS, side="joint", rotor_inertia=ROTORS))
+
+
 def _drive_file() -> str:
     """A drive file (dynid-drive/1) of the drive's gears and currents."""
     vec = ", ".join

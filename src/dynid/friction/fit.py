@@ -192,21 +192,31 @@ def model_drive(model: TorqueModel, drive: Drive | None) -> Drive | None:
     return same_drive(drive, own, "the model", "the one the model was identified with")
 
 
+#: The fields of a drive that say how a log records the effort, not the arm's mechanics:
+#: a log of currents is read through another drive's than the model's torques.
+LOGGING_FIELDS = ("effort", "torque_constant")
+
+
 def same_drive(drive: Drive | None, own: Drive | None, whose: str, what: str) -> Drive | None:
     """``own`` (a model's or a file's drive), the same as ``drive`` when both are given,
-    else the one given.
+    else the one given; ``own`` read as ``drive`` records the effort when they differ in
+    :data:`LOGGING_FIELDS` alone (a model identified from torques, a log of motor
+    currents with their torque constants).
 
     Raises
     ------
     DataError
-        ``drive`` differs from ``own``: each differing field named with ``whose`` value
-        (``what`` names the drive: "the one the model was identified with").
+        ``drive`` differs from ``own`` in its mechanics: each differing field named with
+        ``whose`` value (``what`` names the drive: "the one the model was identified
+        with").
     """
     if drive is None or own is None:
         return own if drive is None else drive
     mine, theirs = drive.as_dict(), own.as_dict()
     if mine != theirs:
         keys = sorted(k for k in {*mine, *theirs} if mine.get(k) != theirs.get(k))
+        if set(keys) <= set(LOGGING_FIELDS):
+            return replace(own, effort=drive.effort, torque_constant=drive.torque_constant)
         given = ", ".join(
             f"{k} = {_short(mine.get(k))} ({whose}'s {_short(theirs.get(k))})" for k in keys
         )
