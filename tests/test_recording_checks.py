@@ -109,6 +109,20 @@ def test_validation_with_an_identity_drive_unwraps_like_identification(panda, lo
         np.testing.assert_allclose(back - back[0], log.q - log.q[0], atol=1e-9)
 
 
+def test_recordings_wrapped_alike_are_said_once(panda, log):
+    """Four recordings with joints 1 and 7 wrapped: four identical warnings, one per file;
+    now one, naming the files."""
+    arm = _continuous(panda, [0, 6])
+    wrapped = _wrap(log, [0, 6])
+    names = ["r1.csv", "r2.csv", "r3.csv", "r4.csv"]
+    with warnings.catch_warnings(record=True) as got:
+        warnings.simplefilter("always", DynidWarning)
+        prepare_recordings(arm, [wrapped] * 4, names, cutoff_hz=10.0)
+    said = [str(w.message) for w in got if "recorded wrapped" in str(w.message)]
+    assert said == [f"{', '.join(names)}: joint(s) 1, 7 recorded wrapped into [-pi, pi] "
+                    "(jumps of a whole turn): unwrapped"], said  # fmt: skip
+
+
 def test_a_motor_side_log_is_unwrapped_at_its_motors(panda, log):
     """A geared motor-side log wraps the motor angles: unwrapped before the drive maps
     them to the joints (mapped first, the joint angles came out wrong by 2 pi / 50); the

@@ -22,6 +22,7 @@ from __future__ import annotations
 
 import itertools
 import warnings
+from collections.abc import Sequence
 
 import numpy as np
 from numpy.typing import NDArray
@@ -33,6 +34,7 @@ from .log import TorqueLog, default_max_gap
 from .sanity import time_unit_finding, too_few_samples
 
 __all__ = [
+    "wrapped_finding",
     "Q_START_TOLERANCE",
     "WRAP_SPAN",
     "check_below_nyquist",
@@ -173,6 +175,7 @@ def recording_pieces(
     stacklevel: int = 3,
     robot: Robot | None = None,
     drive: Drive | None = None,
+    say_wrapped: bool = True,
 ) -> tuple[list[TorqueLog], tuple[int, ...]]:
     """One recording checked, cut at its gaps and unwrapped piece by piece.
 
@@ -227,15 +230,20 @@ def recording_pieces(
             stacklevel=stacklevel,
         )
     joints = tuple(sorted(turned))
-    if joints:
-        what = "motor(s)" if motors else "joint(s)"
-        warnings.warn(
-            f"{name}: {what} {', '.join(str(j + 1) for j in joints)} recorded wrapped "
-            "into [-pi, pi] (jumps of a whole turn): unwrapped",
-            DynidWarning,
-            stacklevel=stacklevel,
-        )
+    if joints and say_wrapped:
+        warnings.warn(f"{name}: {wrapped_finding(joints, motors)}", DynidWarning, stacklevel)
     return pieces, joints
+
+
+def wrapped_finding(joints: Sequence[int], motors: bool = False) -> str:
+    """The finding of the joints (0-based; ``motors``: the motors) recorded wrapped into
+    ``[-pi, pi]`` and unwrapped, without the file's name (:func:`recording_pieces` says it
+    per recording; several recordings say it once, naming them)."""
+    what = "motor(s)" if motors else "joint(s)"
+    return (
+        f"{what} {', '.join(str(j + 1) for j in joints)} recorded wrapped into [-pi, pi] "
+        "(jumps of a whole turn): unwrapped"
+    )
 
 
 def start_turns(

@@ -65,6 +65,7 @@ from .pieces import (
     split_at_gaps,
     unwrapped,
     wrappable,
+    wrapped_finding,
 )
 from .prepare import Preprocessing, at_instants, grid_samples, measured_instants
 from .prepared_log import PreparedLog, prepare_torque_log
@@ -452,6 +453,7 @@ def prepare_recordings(
     turned: set[int] = set()
     cuts: list[int] = []
     found: dict[str, list[str]] = {}  # each finding and the recordings it holds for
+    wrapped: dict[str, list[str]] = {}  # each set of wrapped joints and its recordings
     for r, (name, log) in enumerate(zip(names, logs, strict=True)):
         if log.n != robot.n:
             raise ShapeError(
@@ -460,8 +462,13 @@ def prepare_recordings(
         if (spikes := spike_finding(name, log, robot.joint_names)) is not None:
             warnings.warn(spikes, DynidWarning, stacklevel=2)
             log = despiked(log)[0]  # before the filter spreads them
-        mine, joints = recording_pieces(name, log, turns, max_gap_s, robot=robot, drive=drive)
+        mine, joints = recording_pieces(
+            name, log, turns, max_gap_s, robot=robot, drive=drive, say_wrapped=False
+        )
         turned.update(joints)
+        if joints:
+            motors = drive is not None and drive.side == "motor"
+            wrapped.setdefault(wrapped_finding(joints, motors), []).append(name)
         cuts.append(max(0, len(mine) - 1))
         if mine:  # sign, units, frozen joints: on the whole recording, said once
             whole = joined([joint_side_log(p, drive) for p in mine])
@@ -470,6 +477,8 @@ def prepare_recordings(
             for finding in check_torque_log(robot, whole, drive):
                 found.setdefault(finding, []).append(name)
         pieces += [(r, p) for p in mine]
+    for finding, which in wrapped.items():
+        warnings.warn(f"{', '.join(which)}: {finding}", DynidWarning, stacklevel=2)
     for finding, which in found.items():  # one warning a finding, its recordings named
         shown = finding if len(names) == 1 else f"{', '.join(which)}: {finding}"
         warnings.warn(shown, DynidWarning, stacklevel=2)
