@@ -314,3 +314,18 @@ def test_a_header_with_units_is_refused_with_the_map_that_reads_it(tmp_path):
     got = load_mapped_torque_log(path, parse_column_map(spec, None)).log
     for k in ("t", "q", "dq", "tau"):
         np.testing.assert_array_equal(getattr(got, k), getattr(log, k))
+
+
+def test_the_recorded_units_are_said_with_how_to_read_another_file(caplog):
+    """A model identified from mN m logs reads a new file in mN m unless told: the warning
+    said so without saying how to read an SI file, and the user met "unusable, 9.99e4 %";
+    it now names the option."""
+    import logging
+
+    from dynid.workflows.data_files import recorded_columns
+
+    with caplog.at_level(logging.WARNING):
+        used = recorded_columns({"columns": None, "units": "tau=mNm"}, None, None)
+    assert used == (None, "tau=mNm")
+    (said,) = [r.getMessage() for r in caplog.records]
+    assert "units 'tau=mNm'" in said and "--units tau=Nm for SI torques" in said, said

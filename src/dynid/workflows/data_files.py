@@ -283,7 +283,12 @@ def recorded_columns(
     given = (columns, units)
     used = tuple(g if g is not None else r for g, r in zip(given, rec, strict=True))
     if used == rec and used != given:
-        _log.warning("reading the data as the model's data were read: columns %r, units %r", *used)
+        _log.warning(
+            "reading the data as the model's data were read: columns %r, units %r; a file of "
+            "other names or units is read with its own --columns/--units (e.g. --units "
+            "tau=Nm for SI torques)",
+            *used,
+        )
     elif used != rec:
         _log.warning(
             "reading the data with columns %r, units %r; the model's data were read with "
