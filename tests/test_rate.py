@@ -100,13 +100,14 @@ def test_summary_counts_validate_reuses_the_cutoff_and_resampling_is_said(tmp_pa
     keep[3000] = False  # one dropped sample: a gap the preparation bridges
     path = save_torque_log(tmp_path / "log.csv", log.select(np.flatnonzero(keep)))
     out = tmp_path / "id"
-    terms = ["--terms", "viscous,coulomb,offset"]  # 21 friction columns (default: chosen)
+    terms = ["--terms", "viscous,coulomb,offset"]  # 14 friction, 7 offset columns
     assert main(["identify", "--data", str(path), *terms, "--out", str(out)]) == 0
     text = capsys.readouterr().out
     meta = json.loads((out / "identification.json").read_text())["metadata"]
     r = len(json.loads((out / "identification.json").read_text())["coefficients"])
     assert (
-        f"columns: {r} base parameters and 21 friction columns, rank {r + 21} of {r + 21}" in text
+        f"columns: {r} base parameters and 14 friction and 7 offset columns, rank {r + 21} of "
+        f"{r + 21}" in text
     )
     assert meta["cutoff_source"] == "motion" and meta["cutoff_hz"] != DEFAULT_CUTOFF_HZ
     assert f"{meta['cutoff_hz']:.3g} Hz low-pass (10 x the motion's" in text

@@ -254,10 +254,23 @@ def samples_text(log: LogInfo, decimations: Sequence[int] = ()) -> str:
 
 
 def columns_text(model: IdentifiedModel) -> str:
-    """The base parameters, the friction columns and the rank, counted separately."""
+    """The base parameters, the appended terms' columns by what they are (friction,
+    offsets, rotor inertias) and the rank, counted separately."""
     r = model.base.rank
     k = 0 if model.joint_fit is None else int(np.size(model.joint_fit.beta)) - r
-    cols = f"{r} base parameters" + (f" and {k} friction columns" if k else "")
+    counts: dict[str, int] = {}
+    for t in model.appended:
+        for label in t.term.labels:
+            what = (
+                "rotor inertia"
+                if t.term.kind == "rotor_inertia"
+                else "offset"
+                if label.startswith("fo")  # the offset term's coefficients, fo1 .. fon
+                else "friction"
+            )
+            counts[what] = counts.get(what, 0) + 1
+    said = " and ".join(f"{c} {what}" for what, c in counts.items()) or str(k)
+    cols = f"{r} base parameters" + (f" and {said} columns" if k else "")
     return f"columns: {cols}, rank {model.fit.rank} of {r + k}"
 
 
