@@ -176,3 +176,29 @@ def test_the_held_out_fact_agrees_with_an_unusable_badge(tmp_path):
         fact = box.split("x the floor):")[1][:40]
         assert fact.strip().startswith(level), fact
         assert ("poor" in box) == (level == "poor"), box
+
+
+def test_torques_a_hundred_times_off_the_gravity_torques_make_the_report_unusable(tmp_path):
+    """Regression: currents read through a torque constant 100 times too small fit as well
+    as the right ones (the relative error cannot see a scale), and the report showed a
+    green "at the noise floor" with the scale warning folded away; the masses are 100
+    times off. The scale warning now makes it unusable, the warning shown."""
+    ident = {
+        "route": "classical",
+        "coefficients": [],
+        "metadata": {"heldout": {"training_error_percent": 1.0, "heldout_error_percent": 1.05,
+                                 "noise_floor_percent": 0.95}},
+    }  # fmt: skip
+    (tmp_path / "identification.json").write_text(json.dumps(ident))
+    files = {p.name: p for p in tmp_path.iterdir()}
+    warning = (
+        "the measured torques (the currents times the drive's torque constants and gear "
+        "ratios) are 0.0104 times the model's gravity torques: the drive file's "
+        "torque_constant or gear_ratio looks off by that factor"
+    )
+    for warnings, level in (((warning,), "unusable"), ((), "at the noise floor")):
+        summary = RunSummary("identify", warnings=warnings)
+        text = " ".join("".join(Page(render_html_report(summary, files)).text).split())
+        fact = text.split("x the floor):")[1][:40]
+        assert fact.strip().startswith(level), fact
+        assert ("The data contradict the robot" in text) == bool(warnings)

@@ -208,7 +208,12 @@ def _floor_fact(
         f"The model predicts held-out torques to {percent(err)}, {level} the "
         f"sensor-noise floor of {percent(floor)}"
     )
-    if v.unusable:
+    if contradicted:
+        headline = (
+            f"The data contradict the robot (below): a held-out error of {percent(err)} "
+            "cannot be trusted"
+        )
+    elif v.unusable:
         headline = f"The model does not explain held-out torques: error {percent(err)}"
     elif within_motion:  # held-out data that test too little
         headline += " on held-out blocks of the motion it was fitted to"
@@ -489,7 +494,10 @@ def answer(run: RunFiles) -> Answer | None:
 
 #: Warnings that say the data contradict the model whatever its errors: the verdict is
 #: unusable (check the data before the model).
-_DATA_WARNINGS = ("anti-correlated", "look like degrees")
+#: Warnings that say the data contradict the robot: torques of the opposite sign,
+#: positions in degrees, torques 30 or more times off its gravity torques (a torque
+#: constant or unit a power of ten off: the masses fitted are off by as much).
+_DATA_WARNINGS = ("anti-correlated", "look like degrees", "times the model's gravity torques")
 
 
 def _warning_facts(run: RunFiles, problems: list[str]) -> list[str]:
