@@ -34,7 +34,8 @@ demo: $(RUNTIME)
 # one worker per core (pytest-xdist); PYTEST_WORKERS=0 runs in one process. Each test file
 # runs on one worker (--dist loadscope), so a module-scoped fixture is computed once, not once
 # per worker; the files are handed out in collection order (--no-loadscope-reorder: the
-# default order, most tests first, would leave the one-test demo file for the end).
+# default order, most tests first, would leave the one-test demo file for the end), which
+# tests/conftest.py begins with the files holding a test marked slow.
 PYTEST_WORKERS ?= auto
 PYTEST_XDIST := -n $(PYTEST_WORKERS) --dist loadscope --no-loadscope-reorder
 # one BLAS thread per worker: each worker already has a core, and threaded BLAS on the small

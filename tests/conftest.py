@@ -48,6 +48,15 @@ def pytest_sessionstart(session: pytest.Session) -> None:
         p.wait()  # (a failure is not checked here: the tests meet the same fault)
 
 
+def pytest_collection_modifyitems(config: pytest.Config, items: list[pytest.Item]) -> None:
+    """The files holding a test marked ``slow`` first, then the others, each file's tests in
+    their order: the workers of ``make test`` take whole files in collection order
+    (``--dist loadscope --no-loadscope-reorder``), and a long file handed out last leaves
+    the other worker idle while it runs."""
+    slow = {item.path for item in items if item.get_closest_marker("slow") is not None}
+    items.sort(key=lambda item: item.path not in slow)  # (a stable sort)
+
+
 @pytest.fixture(scope="session")
 def panda() -> dynid.Robot:
     return dynid.panda()

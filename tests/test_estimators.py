@@ -138,6 +138,9 @@ def test_cli_std_and_estimator_are_honoured_on_both_routes(tmp_path):
                 "robust",
                 "--estimator",
                 "irls",
+                "--terms",  # one fit: the structure search is not what is checked here
+                "viscous,coulomb,offset",
+                "--no-figures",
                 "--out",
                 str(tmp_path / "r"),
                 "-q",
