@@ -95,6 +95,36 @@ def test_an_overwhelming_prior_weight_returns_the_prior(noisy_panda_model, weigh
     assert res.prior_weight == weight
 
 
+def test_an_inaccurate_clarabel_answer_is_kept_without_scs(noisy_panda_model, monkeypatch):
+    """Both Clarabel attempts ending ``optimal_inaccurate``: SCS ran after them (12-20 s a
+    solve on a weight search's hard data, ending inaccurate too, its answer not kept); now
+    the first inaccurate answer is kept and SCS is not run."""
+    import cvxpy as cp
+
+    import dynid.feasibility.convex.problem as problem
+
+    calls: list[str] = []
+    solve = cp.Problem.solve
+
+    def inaccurate(self, *args, **kwargs):
+        out = solve(self, *args, **kwargs)
+        name = type(kwargs.get("solver")).__name__
+        calls.append(name)
+        if "CLARABEL" in name.upper():
+            self._status = "optimal_inaccurate"
+        return out
+
+    def no_scs():
+        raise AssertionError("SCS run after an inaccurate Clarabel answer")
+
+    monkeypatch.setattr(cp.Problem, "solve", inaccurate)
+    monkeypatch.setattr(problem, "scs", no_scs)
+    model, prior = noisy_panda_model
+    res = retrieve_sdp(model, prior=prior, options=SDPOptions(prior_weight=1.0))
+    assert calls and all("CLARABEL" in c.upper() for c in calls), calls
+    assert res.phi.shape == prior_from_robot(prior).phi.shape
+
+
 def test_a_solver_panic_is_a_failed_solve(noisy_panda_model, monkeypatch, tmp_path, capsys):
     """A panic of the compiled solver (a BaseException, no Exception) is a failed attempt:
     the next solver is tried, and when every one fails at the given weight the one line

@@ -191,7 +191,10 @@ class ConvexProblem:
 
         The first ``optimal`` attempt is kept; otherwise an ``optimal_inaccurate`` one;
         ``infeasible`` only when every attempt says so (an interior-point method can
-        misreport a badly scaled feasible problem).
+        misreport a badly scaled feasible problem). SCS runs only when neither Clarabel
+        attempt gave a solution: after an ``optimal_inaccurate`` one it too ended
+        inaccurate, at 12-20 s a solve, eight times in one weight search, and the first
+        inaccurate answer was kept all the same.
         """
         import cvxpy as cp
 
@@ -204,6 +207,8 @@ class ConvexProblem:
         seen: list[str] = []
         inaccurate = None
         for solver, kw in attempts:
+            if solver == "SCS" and inaccurate is not None:
+                break  # Clarabel's inaccurate answer stands
             try:
                 with warnings.catch_warnings():  # the status says it; retried below
                     warnings.simplefilter("ignore", UserWarning)
