@@ -202,3 +202,24 @@ def test_torques_a_hundred_times_off_the_gravity_torques_make_the_report_unusabl
         fact = text.split("x the floor):")[1][:40]
         assert fact.strip().startswith(level), fact
         assert ("The data contradict the robot" in text) == bool(warnings)
+
+
+def test_the_low_speed_note_of_the_held_out_prediction_is_on_the_first_screen(tmp_path):
+    """Regression: the held-out prediction's note that its error sits at low speed was in
+    the console's verdict line and heldout.json, but the report's first screen said only
+    "usable: effects outside the model remain"; it now holds the note as a fact."""
+    ident = {
+        "route": "classical",
+        "coefficients": [],
+        "metadata": {"heldout": {"training_error_percent": 3.0, "heldout_error_percent": 3.1,
+                                 "noise_floor_percent": 0.44}},
+    }  # fmt: skip
+    note = "at low speed: 99 % of the error above the noise sits where |dq| is under 5 %"
+    held = {"relative_error_percent": 3.5, "noise_floor_percent": 0.5, "block": "p3.csv",
+            "low_speed": note}  # fmt: skip
+    (tmp_path / "identification.json").write_text(json.dumps(ident))
+    (tmp_path / "heldout.json").write_text(json.dumps(held))
+    files = {p.name: p for p in tmp_path.iterdir()}
+    text = " ".join("".join(Page(render_html_report(RunSummary("identify"), files)).text).split())
+    box = text.split("Held-out error")[1].split("Torques on held-out data")[0]
+    assert "At low speed: 99 % of the error above the noise" in box, box

@@ -30,7 +30,7 @@ from ..friction.pooled import joined_validation
 from ..friction.validation import Validation, own_friction, validate_torques
 from ..identification.derived_cutoff import with_derived_cutoff_hint
 from ..identification.log import TorqueLog
-from ..identification.low_speed import with_low_speed_hint
+from ..identification.low_speed import low_speed_hint
 from ..identification.model import IdentifiedModel
 from ..identification.pieces import split_at_gaps, unwrapped, wrappable
 from ..identification.sanity import despiked, velocity_noise_std
@@ -39,6 +39,7 @@ from ..identification.verdict import (
     joint_ratios,
     judge_prediction,
     with_caveat,
+    with_hint,
     with_replaced_spikes,
 )
 from .style import COLOURS
@@ -116,16 +117,21 @@ class HeldOutTorques:
             joint_names=self.joint_names,
         )
         verdict = with_derived_cutoff_hint(verdict, self.logs, self.cutoff_hz)
-        v = self.validation
-        verdict = with_low_speed_hint(
-            verdict, [v.log.dq], [v.log.tau - v.tau_hat], self.noise_rms, self.joint_names
-        )
+        verdict = with_hint(verdict, self.low_speed, ", ")
         verdict = with_caveat(verdict, self.caveat)
         return with_replaced_spikes(verdict, self.spikes, ", as the fit replaced them")
 
+    @property
+    def low_speed(self) -> str | None:
+        """Where most of the error above the noise sits at low speed, the sentence that says
+        so (:func:`~dynid.identification.low_speed.low_speed_hint`), or None."""
+        v = self.validation
+        return low_speed_hint([v.log.dq], [v.log.tau - v.tau_hat], self.noise_rms, self.joint_names)
+
     def as_dict(self) -> dict[str, Any]:
         """JSON-ready: the errors per joint, the noise, the floor, the torque spikes replaced
-        before judging and the verdict (schema ``heldout.json``)."""
+        before judging, the verdict and, above the floor, the low-speed note (``low_speed``,
+        the report's own line; schema ``heldout.json``)."""
         e, v = self.validation.errors, self.verdict
         return {
             "block": self.block,
@@ -138,6 +144,7 @@ class HeldOutTorques:
             "noise_floor_percent": self.noise_floor_percent,
             "torque_spikes_replaced": self.spikes,
             "verdict": {"level": v.level, "label": v.label, "reason": v.reason},
+            "low_speed": None if v.level == "good" else self.low_speed,
             "units": {"rms": "N m", "noise_rms": "N m", "relative_error_percent": "%"},
         }
 

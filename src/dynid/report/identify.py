@@ -120,6 +120,9 @@ def _heldout_facts(
         facts.append(fact)
         problems += more
         headline = said or headline
+        low = held.get("low_speed")
+        if isinstance(low, str) and low:  # where the rest of the error sits
+            facts.append(esc(low[0].upper() + low[1:]))
     elif headline and judged is None:
         facts.append(
             "Sensor-noise floor not measured (heldout.json absent: the run was made with "
