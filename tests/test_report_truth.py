@@ -223,3 +223,23 @@ def test_the_low_speed_note_of_the_held_out_prediction_is_on_the_first_screen(tm
     text = " ".join("".join(Page(render_html_report(RunSummary("identify"), files)).text).split())
     box = text.split("Held-out error")[1].split("Torques on held-out data")[0]
     assert "At low speed: 99 % of the error above the noise" in box, box
+
+
+def test_the_demo_counts_the_coefficients_the_paper_prints(tmp_path):
+    """Regression: the demo's first screen said "37 of 37 printed coefficients agree"
+    where the paper prints 41 of Table III's 43, 4 of them with a transcription error:
+    the count compared and the count printed are now said apart."""
+    rows = [
+        {"index": k + 1, "expression": f"c{k}", "dynid": 0.1, "dynid_std": 1e-5,
+         "published": 0.1, "difference": 1e-5}
+        for k in range(43)
+    ]  # fmt: skip
+    for k in (5, 6):
+        rows[k].update(published=None, difference=None)
+    for k in (10, 11, 12, 13):
+        rows[k].update(difference=0.5, transcription_error=True)
+    (tmp_path / "paper.json").write_text(json.dumps({"table_iii": rows}))
+    files = {p.name: p for p in tmp_path.iterdir()}
+    text = " ".join("".join(Page(render_html_report(RunSummary("demo"), files)).text).split())
+    assert "Table III: 37 of the 37 coefficients compared agree" in text, text[:2000]
+    assert "the paper prints 41 of the 43, 4 of them with a transcription error" in text

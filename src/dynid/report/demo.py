@@ -32,17 +32,19 @@ def answer(run: RunFiles) -> Answer | None:
     ]
     agree = sum(1 for r in comparable if _agrees(r))
     worst = max(comparable, key=lambda r: abs(r["difference"]), default=None)
+    wrong = sum(1 for r in rows if r.get("transcription_error"))
+    printed = len(rows) - sum(1 for r in rows if r.get("published") is None)
     facts = [
-        f"Table III: <b>{agree} of {len(comparable)}</b> printed coefficients agree with the "
-        f"published value (within its rounding, &plusmn;{ROUNDING:g}, and {AGREE_STD:g} std)"
+        f"Table III: <b>{agree} of the {len(comparable)}</b> coefficients compared agree with "
+        f"the published value (within its rounding, &plusmn;{ROUNDING:g}, and {AGREE_STD:g} "
+        "std)"
         + (
             f"; largest difference {number(worst['difference'], 3)} (coefficient {worst['index']})"
             if worst
             else ""
         )
-        + f"; {sum(1 for r in rows if r.get('transcription_error'))} printed values carry a "
-        "transcription error of the paper, and the paper prints no value for "
-        f"{sum(1 for r in rows if r.get('published') is None)} (marked in the table)",
+        + f"; the paper prints {printed} of the {len(rows)}, {wrong} of them with a "
+        "transcription error (not compared; marked in the table)",
     ]
     fr = [r for r in doc.get("friction") or [] if is_number(r.get("difference"))]
     if fr:
