@@ -34,11 +34,12 @@ from ..friction.recordings import Pieces, pieces_residual, prepare_pieces
 from ..friction.select import FrictionSelection, select_friction
 from ..friction.validation import RECORDED, own_friction
 from ..identification.model import IdentifiedModel
+from ..identification.sanity import SPIKES_BEFORE_FIT
 from ..model.drive import Drive
 from ..model.robot import Robot
 from .data_files import ColumnSpec, in_file
 from .options import check_choice, check_number
-from .recordings import read_recordings
+from .recordings import despiked_recordings, read_recordings
 
 __all__ = ["FrictionFileResult", "FrictionOptions", "fit_friction_files"]
 
@@ -176,6 +177,7 @@ def fit_friction_files(
         max_gap_s=max_gap_s,
         reference=model.equivalent_robot if isinstance(model, IdentifiedModel) else None,
     )
+    rec, _ = despiked_recordings(rec, robot.joint_names, SPIKES_BEFORE_FIT)  # as identify
 
     def fit() -> FrictionFileResult:
         pieces = prepare_pieces(

@@ -27,12 +27,13 @@ from ..exceptions import DataError, OptionError
 from ..feasibility.payload import PayloadEstimate, identify_payload, robot_with_payload
 from ..feasibility.payload_arm import ArmFriction
 from ..identification.model import IdentifiedModel
+from ..identification.sanity import SPIKES_BEFORE_FIT
 from ..io.feasible import load_feasible_drive, load_feasible_linear_friction
 from ..model.drive import Drive
 from ..model.robot import Robot
 from .data_files import ColumnSpec, column_map, data_kind, in_file, read_static_file
 from .identify import data_files
-from .recordings import read_recordings
+from .recordings import despiked_recordings, read_recordings
 
 __all__ = ["PayloadFileResult", "identify_payload_files"]
 
@@ -172,9 +173,11 @@ def identify_payload_files(
     rec = read_recordings(
         paths, kin, owner=f"robot {kin.name!r}", q_start=q_start, max_gap_s=max_gap_s, **read_as
     )
+    rec, _ = despiked_recordings(rec, kin.joint_names, SPIKES_BEFORE_FIT)  # as identify
     without_rec = None
     if base is not None:
         without_rec = read_recordings(base, kin, owner=f"robot {kin.name!r}", **read_as)
+        without_rec, _ = despiked_recordings(without_rec, kin.joint_names, SPIKES_BEFORE_FIT)
     fit = lambda: identify_payload(  # noqa: E731
         arm,
         rec.logs,
