@@ -675,11 +675,23 @@ def torque_spikes(
     v = None if dq is None else _checks.as_array("dq", dq)
     if v is not None and v.shape != a.shape:
         raise ShapeError(f"dq must have the shape of tau {a.shape}; got {v.shape}")
+    return [
+        (j, int(rows.size), int(rows[0]), float(heights.max()))
+        for j, rows, heights in _spikes_per_column(a, v, sigmas)
+    ]
+
+
+def _spikes_per_column(
+    tau: NDArray[np.float64], dq: NDArray[np.float64] | None, sigmas: float = SPIKE_SIGMAS
+) -> list[tuple[int, NDArray[np.intp], NDArray[np.float64]]]:
+    """``(joint, rows, heights)`` of each column of ``tau`` (N, n) with spikes
+    (:func:`_column_spikes`, judged with the velocities ``dq`` when given): the one loop
+    :func:`torque_spikes`, :func:`despiked` and :func:`spike_finding` share."""
     out = []
-    for j in range(a.shape[1]):
-        rows, heights = _column_spikes(a[:, j], None if v is None else v[:, j], sigmas)
+    for j in range(tau.shape[1]):
+        rows, heights = _column_spikes(tau[:, j], None if dq is None else dq[:, j], sigmas)
         if rows.size:
-            out.append((j, int(rows.size), int(rows[0]), float(heights.max())))
+            out.append((j, rows, heights))
     return out
 
 
@@ -739,15 +751,14 @@ def despiked(log: TorqueLog) -> tuple[TorqueLog, tuple[int, ...]]:
     """
     tau = np.array(log.tau, dtype=np.float64)
     t = np.asarray(log.t, dtype=np.float64)
-    counts = []
-    for j in range(log.n):
-        rows, _ = _column_spikes(tau[:, j], np.asarray(log.dq[:, j]), SPIKE_SIGMAS)
-        counts.append(int(rows.size))
-        if rows.size:
-            good = np.ones(t.size, dtype=bool)
-            good[rows] = False
-            tau[rows, j] = np.interp(t[rows], t[good], tau[good, j])
-    if not any(counts):
+    counts = [0] * log.n
+    found = _spikes_per_column(tau, np.asarray(log.dq, dtype=np.float64))
+    for j, rows, _ in found:
+        counts[j] = int(rows.size)
+        good = np.ones(t.size, dtype=bool)
+        good[rows] = False
+        tau[rows, j] = np.interp(t[rows], t[good], tau[good, j])
+    if not found:
         return log, tuple(counts)
     return dataclasses.replace(log, tau=tau), tuple(counts)
 
@@ -784,16 +795,15 @@ def spike_finding(
     :func:`despiked` finds them), and ``before`` what they are replaced
     (:data:`SPIKES_BEFORE_FIT`, :data:`SPIKES_BEFORE_JUDGING`,
     :data:`SPIKES_BEFORE_OBSERVER`), or why they are ``kept``; None without spikes."""
-    tau, dq = np.asarray(log.tau), np.asarray(log.dq)
-    found = []
-    for j in range(log.n):
-        rows, heights = _column_spikes(tau[:, j], dq[:, j], SPIKE_SIGMAS)
-        if rows.size:
-            found.append((j, rows, float(heights.max())))
+    found = _spikes_per_column(
+        np.asarray(log.tau, dtype=np.float64), np.asarray(log.dq, dtype=np.float64)
+    )
     if not found:
         return None
     total = sum(rows.size for _, rows, _ in found)
-    parts = ", ".join(f"{joint_names[j]} {_spike_times(log.t, rows, h)}" for j, rows, h in found)
+    parts = ", ".join(
+        f"{joint_names[j]} {_spike_times(log.t, rows, float(h.max()))}" for j, rows, h in found
+    )
     return (
         f"{name}: {total} torque sample(s) stand off both neighbours by more than "
         f"{SPIKE_SIGMAS:g} times the noise: {parts}; "
