@@ -13,7 +13,8 @@ import dynid
 from dynid.cli.__main__ import main
 from dynid.exceptions import DataError
 from dynid.identification.log import TorqueLog
-from dynid.io.rosbag import load_joint_state_bag, match_joints
+from dynid.io.joint_states import match_joints
+from dynid.io.rosbag import load_joint_state_bag
 from dynid.io.torque_log import load_torque_log, save_torque_log
 
 rosbags = pytest.importorskip("rosbags")

@@ -1,21 +1,26 @@
-"""Import sensor_msgs/JointState from a ROS 1 bag or a ROS 2 bag into a torque log.
+"""Import sensor_msgs/JointState from a ROS bag or a CSV export into a torque log.
 
-BAG is a ROS 1 .bag file or a ROS 2 bag folder (sqlite3 or MCAP); reading needs the
-optional package rosbags (pip install 'dynid[ros]'). Joints are matched by name to the
-robot's: equal names, or one name preceded by a prefix ending in '_' (panda_joint1 matches
-joint1; of several, the prefix matching the most robot joints, so panda_finger_joint1 is
-not taken for joint1); bag joints matching none (a gripper's) are left out, said in a
-note; otherwise give --joints with the bag's names in the robot's joint order. Times
-are header stamps (receive times when stamps are unset, said so), in seconds from the
-first message. Messages on other topics, missing joints or fields, NaN, out-of-order and
-repeated stamps are handled and counted. Without velocities in the bag the log holds
-positions and torques only (said so): every command derives the velocities from the
-positions at its own cut-off, and none takes them for measured ones.
+RECORDING is a ROS 1 .bag file or a ROS 2 bag folder (sqlite3 or MCAP; reading needs the
+optional package rosbags: pip install 'dynid[ros]'), or a .csv export of the JointState
+topic: `rostopic echo -p /joint_states > log.csv` (ROS 1), or a PlotJuggler CSV export
+(its columns <topic>/<joint>/position, velocity, effort; --topic picks the topic, rows of
+other topics are skipped). Joints are matched by name to the robot's, whatever order the
+messages list them in: equal names, or one name preceded by a prefix ending in '_'
+(panda_joint1 matches joint1; of several, the prefix matching the most robot joints, so
+panda_finger_joint1 is not taken for joint1); recorded joints matching none (a
+gripper's) are left out, said in a note; otherwise give --joints with the recorded names
+in the robot's joint order. Times are header stamps (receive times when stamps are unset,
+said so), in seconds from the first message, read to the nanosecond. Messages on other
+topics, missing joints or fields, NaN, out-of-order and repeated stamps are handled and
+counted. Without velocities in the recording the log holds positions and torques only
+(said so): every command derives the velocities from the positions at its own cut-off,
+and none takes them for measured ones.
 
 Writes the torque log (--out .csv or .npz) that identify, friction and validate read.
 
-example:
+examples:
   dynid import recording/ --out log.csv --robot panda --topic /joint_states
+  dynid import joint_states.csv --out log.csv --robot arm.urdf   (rostopic echo -p)
 """
 
 from __future__ import annotations
@@ -25,7 +30,8 @@ from collections.abc import Sequence
 from pathlib import Path
 from typing import Any
 
-from ..io.rosbag import BagImport, load_joint_state_bag
+from ..io.joint_states import JointStateImport
+from ..io.ros_recordings import load_joint_state_recording
 from ..io.torque_log import save_torque_log
 from .applies import urdf_chain
 from .common import add_robot_options, add_subcommand, load_robot, output_path
@@ -44,26 +50,37 @@ def register(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParser:
         subparsers,
         NAME,
         __doc__,
-        help="torque log from sensor_msgs/JointState in a ROS 1 or ROS 2 bag",
+        help="torque log from sensor_msgs/JointState in a ROS bag or a CSV export",
     )
-    p.add_argument("bag", type=Path, help="ROS 1 .bag file or ROS 2 bag folder")
+    p.add_argument(
+        "bag",
+        type=Path,
+        metavar="RECORDING",
+        help="ROS 1 .bag file, ROS 2 bag folder, or .csv export (rostopic echo -p, PlotJuggler)",
+    )
     p.add_argument(
         "--out", type=output_path, required=True, help="torque log to write (.csv or .npz)"
     )
-    p.add_argument("--topic", default="/joint_states", help="JointState topic")
+    p.add_argument(
+        "--topic",
+        default="/joint_states",
+        help="JointState topic (of a bag or a PlotJuggler export; default /joint_states)",
+    )
     add_robot_options(p)
     p.add_argument(
-        "--joints", default=None, help="the bag's joint names in the robot's order, comma-separated"
+        "--joints",
+        default=None,
+        help="the recording's joint names in the robot's order, comma-separated",
     )
     p.add_argument("--json", action="store_true", help="print the import summary as JSON")
     return p
 
 
 def run(args: argparse.Namespace, console: Console) -> int:
-    """Read the bag, write the log, print what was found; returns the exit code."""
+    """Read the recording, write the log, print what was found; returns the exit code."""
     robot = load_robot(args)
     joints = None if args.joints is None else [s.strip() for s in args.joints.split(",")]
-    res = load_joint_state_bag(args.bag, robot.joint_names, topic=args.topic, joints=joints)
+    res = load_joint_state_recording(args.bag, robot.joint_names, topic=args.topic, joints=joints)
     path = save_torque_log(args.out, res.log)
     if args.json:
         console.json(_summary(args.bag, res, robot.joint_names, path))
@@ -72,7 +89,7 @@ def run(args: argparse.Namespace, console: Console) -> int:
     return 0
 
 
-def _summary(bag: Path, res: BagImport, names: Sequence[str], path: Path) -> dict[str, Any]:
+def _summary(bag: Path, res: JointStateImport, names: Sequence[str], path: Path) -> dict[str, Any]:
     """What ``--json`` prints: the bag, the topic, the log written and what the reading found."""
     return {
         "bag": str(bag.name),
@@ -96,7 +113,7 @@ def _summary(bag: Path, res: BagImport, names: Sequence[str], path: Path) -> dic
     }
 
 
-def print_import(console: Console, res: BagImport, names: Sequence[str], path: Path) -> None:
+def print_import(console: Console, res: JointStateImport, names: Sequence[str], path: Path) -> None:
     """Samples, duration and rate, the time source, the joint map, the notes, the file."""
     console.print(
         f"{res.log.n_samples} samples, {res.log.duration:.3f} s at "

@@ -46,6 +46,7 @@ from ..identification.log import (
 from ..model.robot import Robot
 from .csv_tables import csv_table
 from .input_files import file_text, regular_file
+from .joint_state_csv import import_hint
 from .npz_files import check_npz
 
 __all__ = [
@@ -266,7 +267,8 @@ def _read_table(path: Path, cmap: ColumnMap, quantities: tuple[str, ...]) -> _Ta
             raise DataError(
                 f"no column the map names (templates "
                 f"{[cmap.template(k) for k in quantities]}); the file has {names[:12]}"
-                f"{'...' if len(names) > 12 else ''}; hint: map them with --columns",
+                f"{'...' if len(names) > 12 else ''}"
+                + (import_hint(names, path.name) or "; hint: map them with --columns"),
                 file=path.name,
                 at=f"line {line}",
             )
@@ -395,8 +397,8 @@ def _need(table: _Table, cmap: ColumnMap, quantity: str, n: int | None) -> NDArr
         tpl = cmap.template(quantity)
         first = _fill(tpl, 0) if "{" in tpl else tpl
         raise DataError(
-            f"no column {first!r} for {quantity!r} (template {tpl!r}); {table.has()}; "
-            "hint: map it with --columns",
+            f"no column {first!r} for {quantity!r} (template {tpl!r}); {table.has()}"
+            + (import_hint(table.header, table.name) or "; hint: map it with --columns"),
             file=table.name,
         )
     return a
@@ -448,8 +450,8 @@ def load_mapped_torque_log(
     t = table.columns.get(columns.template("t"))
     if t is None:
         raise DataError(
-            f"no time column {columns.template('t')!r}; {table.has()}; "
-            "hint: map it with --columns t=NAME",
+            f"no time column {columns.template('t')!r}; {table.has()}"
+            + (import_hint(table.header, path.name) or "; hint: map it with --columns t=NAME"),
             file=path.name,
         )
     t = t if columns.factor("t") == 1.0 else _checks.frozen(t * columns.factor("t"))

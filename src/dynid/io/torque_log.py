@@ -55,6 +55,7 @@ from ..identification.log import (
 )
 from .atomic import open_atomic
 from .csv_tables import ROWS_PREFIX, csv_table
+from .joint_state_csv import import_hint
 from .npz_files import check_npz
 from .static_data import check_row_count
 
@@ -422,7 +423,8 @@ def _columns(path: Path, names: list[str], line: int) -> tuple[int, bool]:
     if "t" not in names or n == 0:
         raise DataError(
             f"header must name columns t, q1..qn, dq1..dqn, tau1..taun; "
-            f"got {names[:8]}{' ...' if len(names) > 8 else ''}{_annotated_hint(names)}",
+            f"got {names[:8]}{' ...' if len(names) > 8 else ''}{_annotated_hint(names)}"
+            f"{import_hint(names, path.name)}",
             file=path.name,
             at=at,
         )
