@@ -19,6 +19,7 @@ from dynid.feasibility.prior import generic_prior, prior_from_robot
 from dynid.friction.validation import own_friction
 from dynid.identification.prepare import MEASURED, prepare_log
 from dynid.identification.structure import Structure
+from dynid.progress import reporting
 from dynid.simulation.measurement import SensorNoise, sample_times, simulate_measurement
 from dynid.simulation.trajectories import random_fourier
 from dynid.simulation.unmodelled import UnmodelledEffects
@@ -102,11 +103,15 @@ def test_one_step_on_a_log_with_model_error_predicts_held_out_torques_like_least
 
 
 def test_one_step_on_static_data_without_model_error_reproduces_m_and_g():
-    """Static one-step with noise: M and g of the result within the noise of the truth's."""
+    """Static one-step with noise: M and g of the result within the noise of the truth's;
+    each solve is told to a progress callback."""
     robot = dynid.panda()
     ctl = dynid.SimulatedController(robot, relative_noise=1e-4, rng=np.random.default_rng(7))
     data = dynid.acquire_static(ctl, 200, np.random.default_rng(8))
-    res = identify_consistent(robot, data, prior=robot)
+    told: list[str] = []
+    with reporting(told.append):  # a fit of minutes on a long log was silent throughout
+        res = identify_consistent(robot, data, prior=robot)
+    assert any(t.startswith("the consistent fit") and "solving at prior weight" in t for t in told)
     assert res.kind == "static" and res.feasible and res.residual_ratio <= 1.01 + 1e-9
     q = np.random.default_rng(9).uniform(robot.q_min, robot.q_max, (50, 7))
     g_true = dynid.gravity_torques(robot, q)

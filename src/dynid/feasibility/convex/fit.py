@@ -42,6 +42,7 @@ from ...identification.static import identify_static
 from ...identification.structure import Structure
 from ...model.drive import Drive
 from ...model.robot import Robot
+from ...progress import stage
 from ..bounds import Bounds
 from ..prior import Prior
 from .data_term import DataTerm, coefficient_term
@@ -252,16 +253,17 @@ def consistent_from_identified(
     """
     if term is None:  # a structure without friction (links, armature) has no joint fit
         term = coefficient_term(model, with_friction=kind == "log" and model.joint_fit is not None)
-    res = solve_consistent(
-        robot,
-        term,
-        prior=prior,
-        bounds=bounds,
-        total_mass=total_mass,
-        options=options,
-        constraints=constraints,
-        kind=kind,
-    )
+    with stage("the consistent fit (a semidefinite program for each prior weight and fold)"):
+        res = solve_consistent(
+            robot,
+            term,
+            prior=prior,
+            bounds=bounds,
+            total_mass=total_mass,
+            options=options,
+            constraints=constraints,
+            kind=kind,
+        )
     res = replace(res, identified=model, rotor_inertia=_rotor_inertia(model, res.rotor_inertia))
     return res if model.drive is None else with_drive(res, model.drive)
 

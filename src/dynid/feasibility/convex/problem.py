@@ -14,6 +14,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from ...exceptions import InfeasibleError, SolverError
+from ...progress import report
 from ..bounds import Bounds
 from ..lmi import (
     pseudo_inertia_margin,
@@ -198,6 +199,7 @@ class ConvexProblem:
         """
         import cvxpy as cp
 
+        report(f"solving at prior weight {float(w):.3g}")  # (seconds each, dozens a search)
         self.w.value, self.v.value = objective_weights(float(w) / self.scale)
         attempts: list[tuple[str, dict[str, Any]]] = [
             ("CLARABEL", {}),
