@@ -14,6 +14,7 @@ from dynid.exceptions import DataError, DynidWarning
 from dynid.friction.model import sigmoid_friction
 from dynid.identification.classical import identify_from_log
 from dynid.io.excitation import load_obstacles, load_trajectory
+from dynid.io.torque_log import load_torque_log
 from dynid.model import panda as P
 from dynid.regressors.base import base_parameters
 from dynid.regressors.torque import torque_regressor
@@ -247,7 +248,8 @@ def test_a_continuous_joint_without_acceleration_limits_is_designed_without_nump
 
 
 def test_excite_cli_writes_csv_json_and_figure_and_simulate_reads_them(tmp_path, capsys):
-    """excite -> trajectory.csv/.json/excitation.png; simulate --trajectory on both files."""
+    """excite -> trajectory.csv/.json/excitation.png; simulate --trajectory on both files,
+    the CSV at half its rate, and a JSON that excite found inadmissible (said so)."""
     out = tmp_path / "ex"
     args = ["excite", "--duration", "3", "--harmonics", "2", "--base-frequency", "0.3"]
     assert main([*args, "--max-iter", "2", "--seed", "5", "--out", str(out)]) == 0
@@ -266,6 +268,21 @@ def test_excite_cli_writes_csv_json_and_figure_and_simulate_reads_them(tmp_path,
         log = tmp_path / f"log_{src}.csv"
         assert main(["simulate", "--trajectory", str(out / src), "--out", str(log)]) == 0
     assert "4001 samples" in capsys.readouterr().out
+    # --rate on a 1 kHz trajectory.csv: one row in 2 (a 1 kHz log was written without a word)
+    log = tmp_path / "half.csv"
+    argv = ["simulate", "--trajectory", str(out / "trajectory.csv"), "--rate", "500"]
+    assert main([*argv, "--q-noise", "0", "--out", str(log)]) == 0
+    assert "2001 samples" in capsys.readouterr().out
+    np.testing.assert_allclose(load_torque_log(log).q, tr_csv.q[::2], atol=1e-12)
+    # a trajectory excite found inadmissible is simulated with its violations said
+    d.update(status="infeasible", start_admissible=False)
+    d["smallest_margins_at_1khz"]["self_collision_m"] = -0.015
+    (out / "bad.json").write_text(json.dumps(d))
+    argv = ["simulate", "--trajectory", str(out / "bad.json"), "--out", str(tmp_path / "b.csv")]
+    assert main(argv) == 0
+    said = capsys.readouterr()
+    assert "found no admissible trajectory" in said.out + said.err
+    assert "self-collision clearance -0.015 m" in said.out + said.err
 
 
 def test_obstacles_file_is_read_and_errors_name_the_problem(tmp_path):

@@ -94,7 +94,11 @@ def register(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParser:
     )
     p.add_argument("--duration", type=positive_type, default=20.0, help="seconds (default 20)")
     p.add_argument(
-        "--rate", type=positive_type, default=1000.0, help="sample rate [Hz] (default 1000)"
+        "--rate",
+        type=positive_type,
+        default=1000.0,
+        help="sample rate [Hz] (default 1000); a trajectory.csv keeps its own times, one "
+        "row in k when its rate is k times this",
     )
     p.add_argument(
         "--noise",

@@ -48,6 +48,7 @@ __all__ = [
     "OBSTACLES",
     "OBSTACLES_SCHEMA",
     "load_obstacles",
+    "inadmissible_note",
     "load_exciting_trajectory",
     "load_trajectory",
     "obstacles_from_dict",
@@ -305,6 +306,45 @@ def load_exciting_trajectory(path: str | Path, n: int) -> ExcitingTrajectory:
         )
     _check_derived(tr, traj, path.name)
     return traj
+
+
+#: The margins of ``smallest_margins_at_1khz``: their words and units.
+_MARGINS = {
+    "position_rad": ("position margin", "rad"),
+    "velocity_rad_s": ("velocity margin", "rad/s"),
+    "acceleration_rad_s2": ("acceleration margin", "rad/s^2"),
+    "torque_nm": ("torque margin", "N m"),
+    "obstacles_m": ("clearance to", "m"),
+    "self_collision_m": ("self-collision clearance", "m"),
+}
+
+
+def inadmissible_note(path: str | Path) -> str | None:
+    """What ``dynid excite`` recorded against the trajectory of ``trajectory.json``, for a
+    command that runs it: None when its status is not ``"infeasible"``; else the margins
+    it violates (each smallest margin below zero, as recorded at 1 kHz, in its unit)."""
+    doc = load_document(Path(path), EXCITATION)
+    if doc.get("status") != "infeasible":
+        return None
+    low = []
+    for key, v in (doc.get("smallest_margins_at_1khz") or {}).items():
+        word, unit = _MARGINS.get(key, (key, ""))
+        if isinstance(v, dict):  # obstacles by name
+            low += [f"{word} {k} {x:.3g} {unit}" for k, x in v.items() if _below(x)]
+        elif isinstance(v, list):  # per joint
+            low += [f"{word} of joint {j + 1} {x:.3g} {unit}" for j, x in enumerate(v) if _below(x)]
+        elif _below(v):
+            low.append(f"{word} {v:.3g} {unit}")
+    start = "" if doc.get("start_admissible", True) else "; its start is not admissible either"
+    return (
+        f"{Path(path).name}: `dynid excite` found no admissible trajectory and wrote this one "
+        f"all the same ({', '.join(low) or 'margins violated'}{start}): simulated as given; "
+        "a real arm should not run it"
+    )
+
+
+def _below(x: Any) -> bool:
+    return isinstance(x, (int, float)) and x < 0
 
 
 def _trajectory_csv(path: Path, n: int) -> Trajectory:

@@ -26,7 +26,7 @@ import numpy as np
 
 from ..exceptions import OptionError
 from ..friction.model import FrictionModel
-from ..io.excitation import load_exciting_trajectory, load_trajectory
+from ..io.excitation import inadmissible_note, load_exciting_trajectory, load_trajectory
 from ..io.friction_json import load_friction_json
 from ..model.drive import Drive
 from ..model.robot import Robot
@@ -205,8 +205,8 @@ def simulate_log(robot: Robot, options: SimulateOptions | None = None) -> Simula
         robot.frame(c.frame)  # an unknown frame: UnknownNameError naming the robot's frames
     rng = np.random.default_rng(opt.seed)
     t = sample_times(opt.duration_s, opt.rate_hz, jitter_std=opt.jitter_s, rng=rng)
-    traj_at, N = _trajectory(opt, robot, t, rng)
     notes: list[str] = []
+    traj_at, N = _trajectory(opt, robot, t, rng, notes)
     traj_at = _in_limits(opt, robot, traj_at, N, notes)
     first, last = traj_at(slice(0, 1)).t[0], traj_at(slice(N - 1, N)).t[0]
     for c in opt.contacts:
@@ -272,20 +272,27 @@ def _per_joint(opt: SimulateOptions, name: str, n: int) -> np.ndarray | None:
 
 
 def _trajectory(
-    opt: SimulateOptions, robot: Robot, t: np.ndarray, rng: np.random.Generator
+    opt: SimulateOptions,
+    robot: Robot,
+    t: np.ndarray,
+    rng: np.random.Generator,
+    notes: list[str],
 ) -> tuple[_Slice, int]:
     """The true trajectory, a slice of the sample times ``t`` at a time (a file's
     trajectory is held; the sinusoids and the Fourier series are evaluated per slice),
-    and its number of samples."""
+    and its number of samples; ``notes`` say what was found in a trajectory file (a
+    ``trajectory.json`` that excite found inadmissible, a ``trajectory.csv`` whose own
+    rate is not ``rate_hz``)."""
     n = robot.n
     q0 = _per_joint(opt, "q0", n)
     if opt.trajectory not in ("sinusoid", "fourier"):
         path = Path(opt.trajectory)
         if path.suffix.lower() == ".json":  # the series, evaluated a block at a time
             exciting = load_exciting_trajectory(path, n)
+            notes += [x] if (x := inadmissible_note(path)) is not None else []
             t_file = uniform_times(exciting.total_duration, opt.rate_hz)
             return lambda b: exciting(t_file[b]), t_file.size
-        traj = load_trajectory(path, n, fs=opt.rate_hz)
+        traj = _at_rate(load_trajectory(path, n, fs=opt.rate_hz), opt.rate_hz, path.name, notes)
         return lambda b: Trajectory(traj.t[b], traj.q[b], traj.dq[b], traj.ddq[b]), len(traj)
     if opt.trajectory == "fourier":
         series = random_fourier(
@@ -308,6 +315,25 @@ def _trajectory(
     per = np.asarray(GAZ2019_SINUSOID_PERIODS if T is None else T, dtype=np.float64)
     start = centered_start(robot, amp, per) if q0 is None else q0
     return lambda b: sinusoid_trajectory(t[b], start, amp, per), t.size
+
+
+def _at_rate(traj: Trajectory, rate_hz: float, name: str, notes: list[str]) -> Trajectory:
+    """A ``trajectory.csv`` at ``rate_hz``: every k-th row when its own rate is k times
+    ``rate_hz`` (k >= 2 a whole number); else as it is, a note saying so when its rate
+    differs (``--rate 500`` wrote a 1 kHz log without a word)."""
+    own = 1.0 / float(np.median(np.diff(traj.t))) if len(traj) > 1 else rate_hz
+    k = own / rate_hz
+    if abs(k - 1.0) <= 0.01:
+        return traj
+    if k >= 2.0 - 0.01 and abs(k - round(k)) <= 0.01 * k:
+        s = slice(None, None, int(round(k)))
+        notes.append(f"{name}: one row in {int(round(k))} of its {own:.6g} Hz, for {rate_hz:g} Hz")
+        return Trajectory(traj.t[s], traj.q[s], traj.dq[s], traj.ddq[s])
+    notes.append(
+        f"{name}: its own sample times kept ({own:.6g} Hz; {rate_hz:g} Hz is not a whole "
+        "fraction of it): the rate applies to sinusoid, fourier and a trajectory.json"
+    )
+    return traj
 
 
 def _in_limits(
