@@ -73,7 +73,8 @@ def test_residual_histograms_show_the_distribution_not_the_few_reversal_samples(
     model rounds): the axis spans the noise's distribution (within 0.45 N m either side),
     not the outliers' (it stretched to -1..2.5 N m, the noise in one bin), and the title
     counts the samples left beyond it."""
-    from dynid.plots.identification import HeldOutTorques, plot_residual_histograms
+    from dynid.friction.heldout_torques import HeldOutTorques
+    from dynid.plots.identification import plot_residual_histograms
 
     rng = np.random.default_rng(3)
     v = _validation(rng, N=4000, n=2)

@@ -101,36 +101,3 @@ def test_another_arms_log_is_judged_poor_naming_its_wrist(tmp_path, capsys):
         assert name in verdict["reason"] and name in said, verdict["reason"]
     assert "held-out verdict on " in said and "every sample: poor" in said
     assert '<section class="verdict poor"' in (out / "report.html").read_text()
-
-
-def test_the_heldout_prediction_does_not_judge_the_torques_sign_again(folder, tmp_path):
-    """The figures' held-out prediction re-reads the data identify has checked: what its
-    fold fit's prediction says of the torques' sign is not said (a right-signed 2 s UR5 log
-    read "anti-correlated ... sign probably opposite" from a poor fold fit). Here the
-    held-out file handed to the figures is the negated log, which the prediction would
-    call opposite; the data identify read are right."""
-    import argparse
-    import warnings
-
-    from dynid import panda
-    from dynid.cli.figures import save_identify_figures
-    from dynid.exceptions import DynidWarning
-    from dynid.identification.selection import identify_recordings
-    from dynid.identification.structure import Structure
-    from dynid.io.torque_log import load_torque_log, save_torque_log
-
-    logs = [load_torque_log(folder / f"r{s}.csv") for s in (1, 2)]
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore", DynidWarning)
-        model = identify_recordings(panda(), logs, structure=Structure(False, ("viscous",)))
-    log = load_torque_log(folder / "r2.csv")
-    neg = tmp_path / "neg.csv"
-    save_torque_log(neg, log.__class__(log.t, log.q, log.dq, -log.tau))
-    args = argparse.Namespace(
-        columns=None, units=None, cutoff=None, drop_invalid=False, validate_on=None,
-        data=[str(folder / "r1.csv"), str(neg)],
-    )  # fmt: skip
-    with warnings.catch_warnings():
-        warnings.simplefilter("error", DynidWarning)
-        files_written, held = save_identify_figures(tmp_path / "fig", model, args, figures=False)
-    assert held is not None and files_written

@@ -122,7 +122,7 @@ def test_identify_heldout_verdict_judges_spiked_torques_as_the_fit_used_them(jud
     its held-out recording on the raw spiked torques: 'poor: error 13.7 %' beside a
     held-out error of 1.03 % at the noise floor): the spiked recording held out gets the
     clean one's verdict level and error within 2 %, and the verdict counts the spikes."""
-    from dynid.plots.identification import heldout_torques
+    from dynid.friction.heldout_torques import heldout_torques
 
     model, clean, spiked, count = judged
     a, b = heldout_torques(model, clean), heldout_torques(model, spiked)

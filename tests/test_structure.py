@@ -222,7 +222,7 @@ def test_the_heldout_prediction_of_a_wrapped_log_is_that_of_the_unwrapped_one(pa
     """The held-out figures' prediction (heldout.json, the verdict line, the page) unwraps
     a continuous joint as the fit does: on a wrapped xArm7 log it predicted the wrapped
     positions, 11.6 % where the fit's held-out error was 0.68 %."""
-    from dynid.plots.identification import heldout_torques
+    from dynid.friction.heldout_torques import heldout_torques
 
     arm = _continuous(panda, [6])
     fr = ClassicalFriction(VISCOUS, np.zeros(7), np.zeros(7))

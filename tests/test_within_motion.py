@@ -11,12 +11,12 @@ import numpy as np
 
 from dynid.dynamics.rnea import rnea
 from dynid.exceptions import DynidWarning
+from dynid.friction.heldout_torques import heldout_torques
 from dynid.friction.model import ClassicalFriction
 from dynid.friction.validation import own_friction
 from dynid.identification.least_squares import fit_least_squares, within_motion_caveat
 from dynid.identification.selection import identify_recordings
 from dynid.identification.verdict import judge_prediction, with_caveat
-from dynid.plots.identification import heldout_torques
 from dynid.simulation.measurement import SensorNoise, sample_times
 from dynid.simulation.trajectories import random_fourier
 

@@ -1,26 +1,19 @@
 """The figures the commands write (skipped with a note when they cannot be drawn, see
 :func:`~dynid.cli.common.save_figure`): retrieval, friction fit, torque validation, the
-identification's torques on held-out data.
+identification's torques on held-out data (predicted by the library, drawn here).
 
 The plotting modules are called through their module (``feasible_plots.plot_consistent``)
 so that a test can replace a plotting function."""
 
 from __future__ import annotations
 
-import contextlib
-import logging
-import sys
-import warnings
-from collections.abc import Iterator
 from pathlib import Path
 from typing import Any
 
-from ..exceptions import DynidWarning
 from ..feasibility.convex import ConsistentResult
 from ..friction.fit import FrictionFit, FrictionResidual
+from ..friction.heldout_torques import HeldOutTorques
 from ..friction.validation import Validation
-from ..identification.model import IdentifiedModel
-from ..io.json_files import save_json
 from ..io.observer_files import log_labels, observation_names
 from ..observer.detection import threshold_series
 from ..observer.results import ObserveResult
@@ -29,14 +22,11 @@ from ..plots import friction as friction_plots
 from ..plots import identification as identification_plots
 from ..plots import observer as observer_plots
 from ..plots import torques as torque_plots
-from ..plots.identification import HeldOutTorques
-from ..workflows.data_files import column_map, read_torque_log
-from ..workflows.identify import data_files
 from .common import save_figure
 
 __all__ = [
     "save_friction_figure",
-    "save_identify_figures",
+    "save_heldout_figures",
     "save_observer_figures",
     "save_retrieval_figure",
     "save_validation_figures",
@@ -92,62 +82,13 @@ def save_validation_figures(
     return [p for p in paths if p is not None]
 
 
-@contextlib.contextmanager
-def _said_before() -> Iterator[None]:
-    """A log read again for its figures: what its reading warns or logs (ignored columns,
-    dropped rows) was said when the identification read it, and is not said twice."""
-    logging.disable(logging.WARNING)
-    try:
-        with warnings.catch_warnings():
-            warnings.simplefilter("ignore", DynidWarning)
-            yield
-    finally:
-        logging.disable(logging.NOTSET)
-
-
-def save_identify_figures(
-    out: Path, model: IdentifiedModel, args: Any, *, figures: bool = True
-) -> tuple[list[Path], HeldOutTorques | None]:
-    """A torque log's identification on held-out data, under ``out``: ``heldout.json``
-    (errors per joint against the sensor noise; data, written without ``figures`` too),
+def save_heldout_figures(out: Path, held: HeldOutTorques) -> list[Path]:
+    """The held-out prediction of a torque log's identification (made by the library,
+    :attr:`~dynid.workflows.identify.IdentifyResult.heldout`) drawn under ``out``:
     ``heldout_torques.png`` (measured and predicted torques) and ``heldout_residuals.png``
-    (residual histograms). The held-out recording is the last data file (a folder given
-    to ``--data`` stands for its files), its reading's warnings not said again. Nothing
-    for static data or a model without held-out folds; a log that cannot be read back is
-    noted and skipped (the identification's own files are written). Returns the files and
-    the held-out prediction (its block and verdict; None without one)."""
-    if model.info.log is None or model.holdout is None:
-        return [], None
-    try:
-        cmap = column_map(args.columns, args.units, cutoff_hz=args.cutoff)
-
-        def read(p: Any) -> Any:
-            with _said_before():
-                return read_torque_log(
-                    p, model.robot.n, columns=cmap, drop_invalid=args.drop_invalid
-                )
-
-        separate = None if args.validate_on is None else read(args.validate_on)
-        with _said_before():
-            data = data_files(args.data)[-1]
-        log = read(data)
-        with _said_before():  # the data were checked when identified: a fold fit's
-            # prediction of a short block is no measure of the torques' sign (a 2 s UR5 log
-            # read "anti-correlated ... sign probably opposite" from it)
-            held = identification_plots.heldout_torques(model, log, separate=separate)
-    except Exception as exc:  # a figure never fails the command
-        print(f"note: skipped the held-out torque figures: {exc}", file=sys.stderr)
-        return [], None
-    if held is None:
-        return [], None
+    (residual histograms against the sensor noise); those skipped are left out."""
     names = list(held.joint_names)
-    data_file = save_json(
-        Path(out) / "heldout.json", held.as_dict(), schema="dynid-heldout-torques/1"
-    )
-    if not figures:
-        return [data_file], held
     paths = [
-        data_file,
         save_figure(
             lambda: torque_plots.plot_torque_validation(
                 held.validation, joint_names=names, title=f"Held-out: {held.block}"
@@ -160,7 +101,7 @@ def save_identify_figures(
             Path(out) / "heldout_residuals.png",
         ),
     ]
-    return [p for p in paths if p is not None], held
+    return [p for p in paths if p is not None]
 
 
 def save_observer_figures(out: Path, result: ObserveResult, *, names: list[str]) -> list[Path]:

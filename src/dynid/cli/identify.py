@@ -92,6 +92,7 @@ from pathlib import Path
 from ..identification.estimators import ESTIMATORS
 from ..identification.least_squares import STD_METHODS
 from ..io.feasible_bundle import save_feasible_bundle
+from ..io.json_files import save_json
 from ..io.model_json import save_model_json
 from ..workflows.identify import IdentifyOptions, identify_files
 from .applies import urdf_chain
@@ -113,7 +114,7 @@ from .common import (
     positive_type,
 )
 from .console import Console
-from .figures import save_identify_figures, save_retrieval_figure
+from .figures import save_heldout_figures, save_retrieval_figure
 from .summaries import format_consistent, format_identification
 
 NAME = "identify"
@@ -259,14 +260,14 @@ def run(args: argparse.Namespace, console: Console) -> int:
     note_prior(args, console)
     result = identify_files(robot, args.data, options)
     files = [save_model_json(args.out / "identification.json", result.model)]
-    held, prediction = save_identify_figures(
-        args.out, result.model, args, figures=not args.no_figures
-    )
-    files += held
     text = [format_identification(result.model)]
-    if prediction is not None:  # every sample of the figures' data, not the decimated rows
-        v = prediction.verdict
-        text.append(f"held-out verdict on {prediction.block}, every sample: {v.label}: {v.reason}")
+    held = result.heldout
+    if held is not None:  # every sample of the figures' data, not the decimated rows
+        doc = held.as_dict()
+        files.append(save_json(args.out / "heldout.json", doc, schema="dynid-heldout-torques/1"))
+        files += [] if args.no_figures else save_heldout_figures(args.out, held)
+        v = held.verdict
+        text.append(f"held-out verdict on {held.block}, every sample: {v.label}: {v.reason}")
     if result.consistent is not None:
         files += save_feasible_bundle(args.out, result.consistent, source=str(args.data[0]))
         files += [] if args.no_figures else save_retrieval_figure(args.out, result.consistent)

@@ -1,287 +1,29 @@
-"""Figures of an identification on held-out data: measured against predicted torques, and
-the residuals against the sensor noise.
+"""Figures of an identification on held-out data: the residuals against the sensor noise
+(the measured against predicted torques are :func:`dynid.plots.torques.plot_torque_validation`
+of the same prediction).
 
-:func:`heldout_torques` predicts data the fit did not see: the last of the contiguous time
-blocks of the held-out judgement (:mod:`dynid.identification.holdout`), with the
-coefficients and friction of the fold fitted on the other blocks (solved from the folds'
-normal equations the model keeps), or the separate ``--validate-on`` log with the model
-itself. The torques are compared unfiltered (:func:`dynid.friction.validation.validate_torques`),
-so a correct model leaves the sensor noise, which is read from the same torques above the
-low-pass cut-off (white noise: the band's share of its variance restored), or taken from
-the identification's record (``info.heldout["noise_rms"]``: the noise of the floor the
-summary prints) when it holds it. The ratio of the two is the identification's distance to
-its noise floor. The held-out torques are judged as the fit used them: their one-sample
-spikes replaced (:func:`~dynid.identification.sanity.despiked`, as identification replaces
-them before filtering), the verdict saying how many.
+The prediction itself, :class:`~dynid.friction.heldout_torques.HeldOutTorques`, is made by
+the library (:func:`~dynid.friction.heldout_torques.heldout_torques`, returned by
+:func:`~dynid.workflows.identify.identify_files`); this module only draws it.
 
 matplotlib is imported inside the plotting functions (never by ``import dynid``).
 """
 
 from __future__ import annotations
 
-from dataclasses import dataclass
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING
 
 import numpy as np
 from numpy.typing import NDArray
 
-from ..exceptions import DynidError
-from ..friction.pooled import joined_validation
-from ..friction.validation import Validation, own_friction, validate_torques
-from ..identification.derived_cutoff import with_derived_cutoff_hint
-from ..identification.log import TorqueLog
-from ..identification.low_speed import low_speed_hint
-from ..identification.model import IdentifiedModel
-from ..identification.pieces import split_at_gaps, unwrapped, wrappable
-from ..identification.sanity import despiked, velocity_noise_std
-from ..identification.verdict import (
-    Verdict,
-    joint_ratios,
-    judge_prediction,
-    with_caveat,
-    with_hint,
-    with_replaced_spikes,
-)
 from .style import COLOURS
 
 if TYPE_CHECKING:  # pragma: no cover
     from matplotlib.figure import Figure
 
-__all__ = ["HeldOutTorques", "heldout_torques", "plot_residual_histograms"]
+    from ..friction.heldout_torques import HeldOutTorques
 
-
-@dataclass(frozen=True, slots=True, eq=False)
-class HeldOutTorques:
-    """Predicted against measured torques on data the fit did not see.
-
-    Attributes
-    ----------
-    validation : Validation
-        The prediction on the held-out samples (unfiltered measured torques).
-    noise_rms : ndarray, shape (n,)
-        Sensor noise per joint, read above the cut-off [N m].
-    block : str
-        What was held out (``"the last of 5 time blocks, 8.2-10.0 s"``).
-    joint_names : tuple of str
-    logs : tuple of TorqueLog
-        The held-out log(s) as read: velocities derived from positions at a cut-off well
-        above the motion's add the hint to lower it to the verdict
-        (:mod:`~dynid.identification.derived_cutoff`).
-    cutoff_hz : float or None
-        The cut-off [Hz] the held-out data were prepared at.
-    caveat : str or None
-        What the held-out data cannot tell (time blocks of a motion that leaves parameters
-        loose: :func:`~dynid.identification.least_squares.within_motion_caveat`), which
-        keeps the verdict from the noise floor (:func:`~dynid.identification.verdict.
-        with_caveat`).
-    spikes : int
-        Torque samples of the held-out data replaced as one-sample spikes before they were
-        judged, as the fit replaced them
-        (:func:`~dynid.identification.sanity.despiked`).
-    """
-
-    validation: Validation
-    noise_rms: NDArray[np.float64]
-    block: str
-    joint_names: tuple[str, ...]
-    logs: tuple[TorqueLog, ...] = ()
-    cutoff_hz: float | None = None
-    caveat: str | None = None
-    spikes: int = 0
-
-    @property
-    def noise_floor_percent(self) -> float:
-        """The noise relative to the measured torques' norm [%]: the smallest relative
-        error a model can reach on these torques."""
-        tau = self.validation.log.tau
-        norm = float(np.linalg.norm(tau))
-        return 100.0 * float(np.sqrt(len(tau) * np.sum(self.noise_rms**2))) / norm if norm else 0.0
-
-    @property
-    def verdict(self) -> Verdict:
-        """The held-out prediction judged as ``validate`` judges one
-        (:func:`~dynid.identification.verdict.judge_prediction`): the error against the
-        noise floor, each joint's against its noise and in relative terms; above the
-        floor, with the hint of a cut-off too high for velocities derived from positions
-        (:func:`~dynid.identification.derived_cutoff.with_derived_cutoff_hint`) and that
-        of an error mostly at low speed
-        (:func:`~dynid.identification.low_speed.with_low_speed_hint`); the torque
-        spikes replaced before judging counted
-        (:func:`~dynid.identification.verdict.with_replaced_spikes`)."""
-        e = self.validation.errors
-        verdict = judge_prediction(
-            e.relative_error_percent,
-            self.noise_floor_percent,
-            joint_ratios=joint_ratios(e.rms, self.noise_rms),
-            joint_percent=e.relative_error_percent_per_joint,
-            joint_names=self.joint_names,
-        )
-        verdict = with_derived_cutoff_hint(verdict, self.logs, self.cutoff_hz)
-        verdict = with_hint(verdict, self.low_speed, ", ")
-        verdict = with_caveat(verdict, self.caveat)
-        return with_replaced_spikes(verdict, self.spikes, ", as the fit replaced them")
-
-    @property
-    def low_speed(self) -> str | None:
-        """Where most of the error above the noise sits at low speed, the sentence that says
-        so (:func:`~dynid.identification.low_speed.low_speed_hint`), or None."""
-        v = self.validation
-        return low_speed_hint([v.log.dq], [v.log.tau - v.tau_hat], self.noise_rms, self.joint_names)
-
-    def as_dict(self) -> dict[str, Any]:
-        """JSON-ready: the errors per joint, the noise, the floor, the torque spikes replaced
-        before judging, the verdict and, above the floor, the low-speed note (``low_speed``,
-        the report's own line; schema ``heldout.json``)."""
-        e, v = self.validation.errors, self.verdict
-        return {
-            "block": self.block,
-            "joint_names": list(self.joint_names),
-            "n_samples": int(len(self.validation.log.tau)),
-            "rms": e.rms.tolist(),
-            "noise_rms": self.noise_rms.tolist(),
-            "relative_error_percent": float(e.relative_error_percent),
-            "relative_error_percent_per_joint": e.relative_error_percent_per_joint.tolist(),
-            "noise_floor_percent": self.noise_floor_percent,
-            "torque_spikes_replaced": self.spikes,
-            "verdict": {"level": v.level, "label": v.label, "reason": v.reason},
-            "low_speed": None if v.level == "good" else self.low_speed,
-            "units": {"rms": "N m", "noise_rms": "N m", "relative_error_percent": "%"},
-        }
-
-
-def _fold_model(model: IdentifiedModel, fold: int) -> IdentifiedModel | None:
-    """The model fitted on every block but ``fold`` (None: the columns are not the base
-    parameters followed by ``fv, fc, fo`` per joint)."""
-    assert model.holdout is not None
-    x = model.holdout.train[fold].solve()
-    if x.size != model.base.rank + sum(len(t.labels) for t in model.appended):
-        return None
-    return model.with_coefficients(x)
-
-
-def heldout_torques(
-    model: IdentifiedModel, log: TorqueLog, *, separate: TorqueLog | None = None
-) -> HeldOutTorques | None:
-    """The torques of data the identification held out, predicted.
-
-    Parameters
-    ----------
-    model : IdentifiedModel
-        Identified from ``log`` by the classical route (with its held-out folds).
-    log : TorqueLog
-        The log it was identified from, as read (several recordings: the last one).
-        Held-out samples with gaps longer than the identification's ``max_gap_s`` are
-        prepared piece by piece and pooled, joints recorded wrapped into ``[-pi, pi]``
-        unwrapped, and its one-sample torque spikes replaced, as the identification took
-        them.
-    separate : TorqueLog, optional
-        The ``--validate-on`` log (the model judged on it), as read (its spikes replaced).
-
-    Returns
-    -------
-    HeldOutTorques or None
-        None when the model keeps no held-out folds or its columns are not the base
-        parameters and the classical friction.
-    """
-    if model.holdout is None or model.info.log is None:
-        return None
-    if model.holdout.scheme == "file" and separate is not None:
-        (held, spikes), fitted = _despiked_from(separate), model
-        block = "the separate log (--validate-on)"
-    elif model.holdout.scheme == "blocks":
-        k = model.holdout.folds
-        fold = _fold_model(model, k - 1)
-        if fold is None:
-            return None
-        trim = model.info.log.trim_s
-        t0, t1 = float(log.t[0]) + trim, float(log.t[-1]) - trim
-        start = t0 + (k - 1) / k * (t1 - t0)
-        first = int(np.searchsorted(log.t, start - trim))  # the block's rows: a view
-        (held, spikes), fitted = _despiked_from(log, first), fold  # found on the whole log
-        block = (
-            f"the last of {k} time blocks, {start:.1f}-{float(log.t[-1]):.1f} s, predicted by "
-            f"the fit of the other {k - 1}"
-        )
-    elif model.holdout.scheme == "recordings":  # ``log``: the last recording
-        k = model.holdout.folds
-        fold = _fold_model(model, k - 1)
-        if fold is None:
-            return None
-        (held, spikes), fitted = _despiked_from(log), fold
-        block = f"the last of {k} recordings, predicted by the fit of the other {k - 1}"
-    else:
-        return None
-    turns = wrappable(model.robot, model.drive)  # wrapped joints unwrapped, as identified
-    pieces = [unwrapped(p, turns)[0] for p in split_at_gaps(held, model.info.log.max_gap_s)]
-    v, said = _pieces_validation(fitted, pieces)
-    block += said
-    cutoff = model.info.log.cutoff_hz or 0.2 * model.info.log.sample_rate_hz
-    noise = _recorded_noise(model)
-    noise = _noise(v, cutoff) if noise is None else noise
-    names = tuple(model.robot.joint_names)
-    read = (held if model.holdout.scheme == "file" else log,)  # the motion of a whole log
-    given = None if model.info.log.cutoff_source == "motion" else model.info.log.cutoff_hz
-    caveat = (model.info.heldout or {}).get("caveat") if model.holdout.scheme == "blocks" else None
-    return HeldOutTorques(v, noise, block, names, read, given, caveat, spikes)
-
-
-def _despiked_from(log: TorqueLog, first: int = 0) -> tuple[TorqueLog, int]:
-    """Rows ``first:`` of ``log`` with its torque spikes replaced as the identification
-    replaced them before fitting (found on the whole log,
-    :func:`~dynid.identification.sanity.despiked`), and how many of those rows' torque
-    samples were replaced."""
-    clean, _ = despiked(log)
-    if clean is log:
-        held = log if first == 0 else log.select(slice(first, None))
-        return held, 0
-    replaced = int(np.count_nonzero(clean.tau[first:] != log.tau[first:]))
-    return (clean if first == 0 else clean.select(slice(first, None))), replaced
-
-
-def _recorded_noise(model: IdentifiedModel) -> NDArray[np.float64] | None:
-    """Each joint's sensor noise [N m] as the identification recorded it
-    (``info.heldout["noise_rms"]``, the noise of its printed floor), or None for a record
-    without it."""
-    noise = (model.info.heldout or {}).get("noise_rms")
-    if noise is None or np.shape(noise) != (model.robot.n,):
-        return None
-    return np.asarray(noise, dtype=np.float64)
-
-
-def _pieces_validation(model: IdentifiedModel, pieces: list[TorqueLog]) -> tuple[Validation, str]:
-    """``model`` on the pieces of a log cut at its gaps, each prepared on its own as the
-    identification prepared them (one too short to filter is left out), pooled; and what
-    to add to the block's description.
-
-    Raises
-    ------
-    DynidError
-        Every piece too short (the first one's error).
-    """
-    friction = own_friction(model)
-    parts, first = [], None
-    for p in pieces:
-        try:
-            parts.append(validate_torques(model, p, friction=friction))
-        except DynidError as exc:
-            first = first or exc
-    if not parts:
-        assert first is not None
-        raise first
-    said = "" if len(pieces) == 1 else f" ({len(pieces)} pieces between gaps"
-    if len(parts) < len(pieces):
-        said += f", {len(pieces) - len(parts)} too short to filter left out"
-    return joined_validation(parts), said + (")" if said else "")
-
-
-def _noise(v: Validation, cutoff_hz: float) -> NDArray[np.float64]:
-    """Per-joint sensor noise [N m] of the unfiltered torques, robustly
-    (:func:`~dynid.identification.sanity.velocity_noise_std`, the same estimate for any
-    signal: the median absolute deviation of second and third differences). The torque
-    above the cut-off is no measure of it: it holds the steps of Coulomb friction at every
-    reversal (on a UR5 with 3 N m of Coulomb friction it read 3-10 times the noise).
-    ``cutoff_hz`` is kept for the signature."""
-    return np.asarray(velocity_noise_std(v.log.tau, v.log.t), dtype=np.float64)
+__all__ = ["plot_residual_histograms"]
 
 
 def _histogram_range(e: NDArray[np.float64], noise: float) -> tuple[float, float]:

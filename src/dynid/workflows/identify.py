@@ -11,6 +11,9 @@ command applies, so that the Python API behaves as the command does.
   which do not apply to it, and the prior, its weight, objective, margin and mass band
   apply to the consistent fit only (:class:`IdentifyOptions`).
 * The column map the data were read with is recorded in the model (``info.column_map``).
+* From torque logs, the held-out prediction (:mod:`dynid.friction.heldout_torques`: the
+  last time block, the last recording or the ``validate_on`` log, every sample) is made
+  from the logs read for the fit, each file read once, and returned with the model.
 
 Every refusal of an option is an :class:`~dynid.exceptions.OptionError` carrying the
 option's field; the command line names it by its flag.
@@ -25,13 +28,14 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any, Literal
 
-from ..exceptions import DataError, DynidWarning, OptionError
+from ..exceptions import DataError, DynidError, DynidWarning, OptionError
 from ..feasibility.convex import (
     DEFAULT_SDP_MARGIN,
     ConsistentResult,
     SDPOptions,
     identify_consistent,
 )
+from ..friction.heldout_torques import HeldOutTorques, heldout_torques
 from ..identification.consistency import fit_mismatch, limit_violations
 from ..identification.estimators import ESTIMATORS, EstimatorName
 from ..identification.least_squares import STD_METHODS, StdMethod
@@ -281,11 +285,17 @@ class IdentifyResult:
         says whether they satisfy every constraint).
     files : tuple of Path
         The data files read, in order.
+    heldout : HeldOutTorques or None
+        Torque logs: the unconstrained fit's prediction of the data it held out, every
+        sample (:func:`~dynid.friction.heldout_torques.heldout_torques`; ``heldout.json``
+        and the held-out figures); None for static data, or when it could not be made (a
+        :class:`~dynid.exceptions.DynidWarning` says why).
     """
 
     model: IdentifiedModel
     consistent: ConsistentResult | None
     files: tuple[Path, ...]
+    heldout: HeldOutTorques | None = None
 
 
 def identify_files(
@@ -324,14 +334,35 @@ def identify_files(
         prior = opt.prior
         if not isinstance(prior, Robot) and prior is not None:
             prior = load_prior(prior, robot, base=opt.prior_base, tip=opt.prior_tip)
-        result = _identify_consistent(robot, paths, opt, prior)
+        result, held = _identify_consistent(robot, paths, opt, prior)
         assert result.identified is not None  # _identify_consistent sets it
-        return IdentifyResult(result.identified, result, tuple(paths))
-    return IdentifyResult(_identify(robot, paths, opt), None, tuple(paths))
+        return IdentifyResult(result.identified, result, tuple(paths), held)
+    model, held = _identify(robot, paths, opt)
+    return IdentifyResult(model, None, tuple(paths), held)
 
 
-def _identify(robot: Robot, paths: list[Path], opt: IdentifyOptions) -> IdentifiedModel:
-    """The unconstrained fit of :func:`identify_files`."""
+def _predicted_heldout(
+    model: IdentifiedModel, logs: Sequence[TorqueLog], separate: TorqueLog | None
+) -> HeldOutTorques | None:
+    """The held-out prediction of ``model`` fitted to ``logs`` (``separate``: the
+    ``validate_on`` log), from the logs as the fit took them; one it cannot make (every
+    held-out piece too short to filter) is a warning, never a failed identification."""
+    try:
+        return heldout_torques(model, logs[-1], separate=separate)
+    except DynidError as exc:
+        warnings.warn(
+            f"skipped the held-out prediction (heldout.json and its figures): {exc}",
+            DynidWarning,
+            stacklevel=4,
+        )
+        return None
+
+
+def _identify(
+    robot: Robot, paths: list[Path], opt: IdentifyOptions
+) -> tuple[IdentifiedModel, HeldOutTorques | None]:
+    """The unconstrained fit of :func:`identify_files` and, from torque logs, its
+    held-out prediction."""
     path = paths[0]
     cmap = _columns(opt.columns, opt.cutoff_hz)
     kind = data_kind(path, cmap)
@@ -353,7 +384,9 @@ def _identify(robot: Robot, paths: list[Path], opt: IdentifyOptions) -> Identifi
             **heldout,
         )
         model = in_file(path, fit) if len(paths) == 1 else fit()
+        held = _predicted_heldout(model, logs, heldout.get("validate_on"))
     else:
+        held = None
         _one_static_file(paths, opt)
         data = read_static_file(path, robot, columns=cmap, drop_invalid=opt.drop_invalid)
         outside = limit_violations(robot, data.q)
@@ -374,7 +407,7 @@ def _identify(robot: Robot, paths: list[Path], opt: IdentifyOptions) -> Identifi
         misfit = fit_mismatch(model.fit.relative_error_percent, data.metadata)
         if misfit is not None:
             warnings.warn(f"{path.name}: {misfit}", DynidWarning, stacklevel=3)
-    return _record(model, opt.columns)
+    return _record(model, opt.columns), held
 
 
 def _read_logs(
@@ -438,10 +471,11 @@ def _one_static_file(paths: list[Path], opt: IdentifyOptions) -> None:
 
 def _identify_consistent(
     robot: Robot, paths: list[Path], opt: IdentifyOptions, prior: Robot | None
-) -> ConsistentResult:
+) -> tuple[ConsistentResult, HeldOutTorques | None]:
     """The one-step consistent fit of :func:`identify_files`
     (:func:`~dynid.feasibility.convex.fit.identify_consistent`), the data read and checked
-    as for the unconstrained fit.
+    as for the unconstrained fit, and (torque logs) the unconstrained fit's held-out
+    prediction.
 
     Torque logs (one or more, ``max_gap_s`` honoured): the model's structure is chosen on
     held-out data as the unconstrained fit chooses it (or given by ``terms``), and the
@@ -456,7 +490,8 @@ def _identify_consistent(
     heldout = _heldout(paths, kind, opt.folds, opt.validate_on, robot, cmap, opt.drop_invalid)
     common: dict[str, Any] = dict(prior=prior, total_mass=opt.total_mass, options=opt.sdp())
     if kind == "torque_log":
-        logs = _read_logs(robot, paths, cmap, opt, heldout.get("validate_on"))
+        separate = heldout.get("validate_on")
+        logs = _read_logs(robot, paths, cmap, opt, separate)
 
         def fit() -> ConsistentResult:
             return identify_consistent(
@@ -474,7 +509,10 @@ def _identify_consistent(
             )
 
         result = in_file(path, fit) if len(paths) == 1 else fit()
+        unconstrained = result.identified
+        held = None if unconstrained is None else _predicted_heldout(unconstrained, logs, separate)
     else:
+        held = None
         _one_static_file(paths, opt)
         data = read_static_file(path, robot, columns=cmap, drop_invalid=opt.drop_invalid)
         result = in_file(
@@ -485,4 +523,4 @@ def _identify_consistent(
         )
     if result.identified is None:  # pragma: no cover - identify_consistent always sets it
         raise DataError("the one-step identification returned no unconstrained fit")
-    return dataclasses.replace(result, identified=_record(result.identified, opt.columns))
+    return dataclasses.replace(result, identified=_record(result.identified, opt.columns)), held
