@@ -87,6 +87,27 @@ def test_urdf_and_mjcf_hold_motor_friction_reflected_through_the_gears(tmp_path)
     assert len(mj_lines) == 1 and "friction at the motors" in mj_lines[0], mj_lines
 
 
+def test_a_sigmoid_at_the_motors_is_fitted_over_the_motors_velocities(tmp_path):
+    """Gaz et al.'s sigmoid (eq. 25) at the motors of a gear-100 drive: the URDF holds the
+    NNLS fit of its joint torque's odd part, ``G (s(G dq) - s(-G dq)) / 2``, over the
+    joint's range (closed form here); the fit over the motors' first 2.5 rad/s had written
+    joint 1's damping 14.3 for 0.0008."""
+    P = np.array([[8e-3, 2.0, 0.1], [6e-3, 1.5, -0.2]])  # phi1 [N m], phi2 [s/rad], phi3 [rad/s]
+    drive = Drive.from_gears([G, G], side="joint", friction_at="motor")
+    law = law_named("sigmoid").model(P).at(drive)
+
+    def s(v, p):
+        return p[0] / (1 + np.exp(-p[1] * (v + p[2]))) - p[0] / (1 + np.exp(-p[1] * p[2]))
+
+    path, _ = _warnings(export_urdf, tmp_path / "r.urdf", _arm(), ExportOptions(friction=law))
+    back = load_urdf(path).friction
+    for j in range(2):
+        v = np.linspace(0.0, DQ_MAX[j], 201)[1:]
+        odd = G * (s(G * v, P[j]) - s(-G * v, P[j])) / 2
+        x, _ = nnls(np.column_stack([v, np.ones_like(v)]), odd)
+        np.testing.assert_allclose([back.fv[j], back.fc[j]], x, rtol=1e-7, atol=1e-12)
+
+
 def test_the_exported_urdf_predicts_a_geared_arm_as_the_model_does(tmp_path):
     """A planar arm with gear-100 drives and smooth friction at the motors, simulated with
     sensor noise: the URDF read back (friction at the joints) predicts the torques within
