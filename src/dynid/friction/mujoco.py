@@ -35,6 +35,8 @@ __all__ = [
     "coulomb_viscous_from_sigmoid",
     "drive_joint_terms",
     "joint_coulomb_viscous",
+    "joint_rms_difference",
+    "law_velocity_range",
     "unheld_friction",
 ]
 
@@ -166,11 +168,13 @@ def drive_joint_terms(
     if fc is not None:
         fcv = np.asarray(fc)
         loss = np.abs(np.diag(Kf)) * fcv
-        off = Kf - np.diag(np.diag(Kf))
-        if np.any(off * fcv[:, None]):
+        lost = np.abs(Kf - np.diag(np.diag(Kf))).T @ np.abs(fcv)  # per joint [N m]
+        if np.any(lost):
+            j = int(np.argmax(lost))
             notes.append(
                 "Coulomb friction of coupled motors on other joints has no per-joint term and "
-                "is dropped (the joint's dry friction holds its own motor's)"
+                "is dropped (the joint's dry friction holds its own motor's; up to "
+                f"{lost[j]:.4g} N m at joint {j + 1}, sum_m |K_mj| fc_m over the other motors)"
             )
     return DriveJointTerms(arm, damp, loss, tuple(notes))
 
@@ -183,14 +187,17 @@ def joint_coulomb_viscous(
     (:func:`drive_joint_terms`).
 
     Each law of the registry maps itself (:attr:`~dynid.friction.laws.base.FrictionLaw.mjcf`:
-    the classical law's ``fv`` and ``fc``, the asymmetric law's means, ...); what MJCF cannot
-    hold (an offset, an asymmetry, a Stribeck peak, coupled terms) is named in ``notes``.
+    the classical law's ``fv`` and ``fc``, the asymmetric law's means, ...) over the
+    velocities where it acts (:func:`law_velocity_range`: a law at the motors of a drive over
+    the motors' range, ``sum_j |K_mj| dq_max_j``); what MJCF cannot hold (an offset, an
+    asymmetry, a Stribeck peak, coupled terms) is named in ``notes``, a law approximated
+    with the RMS difference at the joints (:func:`joint_rms_difference`).
 
     Parameters
     ----------
     friction : FrictionModel
     dq_max : array_like, shape (n,), optional
-        Velocity range [rad/s] of the sigmoid's approximation (default 2 rad/s).
+        Velocity range of the joints [rad/s] (default 2 rad/s).
 
     Returns
     -------
@@ -210,43 +217,84 @@ def joint_coulomb_viscous(
         )
     n = friction.n
     vmax = np.full(n, 2.0) if dq_max is None else _checks.as_exact("dq_max", dq_max, (n,))
-    terms = friction.law.mjcf(friction.as_array(), vmax)
+    vlaw = law_velocity_range(friction, vmax)
+    terms = friction.law.mjcf(friction.as_array(), vlaw)
     notes = (f"{friction.kind} friction: {terms.dropped} has no per-joint term",) * bool(
         terms.dropped
     )
-    terms, refit = _dissipative(friction, terms, vmax)
-    notes += refit
+    terms, negative, refit = _dissipative(friction, terms, vlaw)
+    z = np.zeros(n)
+    jt = DriveJointTerms(z, terms.damping, terms.frictionloss, (), terms.offset)
     if friction.drive is not None:
         d = friction.drive
-        jt = drive_joint_terms(
-            d.transmission,
-            None,
-            terms.damping,
-            terms.frictionloss,
-            friction_at_motor=d.friction_at == "motor",
+        jt = replace(
+            drive_joint_terms(
+                d.transmission,
+                None,
+                terms.damping,
+                terms.frictionloss,
+                friction_at_motor=d.friction_at == "motor",
+            ),
+            offset=terms.offset,
         )
-        return replace(jt, notes=notes + jt.notes, offset=terms.offset)
-    z = np.zeros(n)
-    return DriveJointTerms(z, terms.damping, terms.frictionloss, notes, terms.offset)
+    if refit.size:
+        notes += _refit_note(friction, jt, vmax, negative, refit)
+    return replace(jt, notes=notes + jt.notes)
 
 
-#: RMS difference [N m] over the velocity range below which the viscous and Coulomb terms
-#: written for a smooth law hold it to round-off (a width of 0.0003 rad/s: 2e-10 N m), no
-#: note of its own: the rounding over the standstill band is said once, by
+def law_velocity_range(friction: FrictionModel, dq_max: ArrayLike) -> NDArray[np.float64]:
+    """The velocities [rad/s] (n,) up to which a law acts where it is placed: the joints'
+    ``dq_max`` (n,) at the joints, ``sum_j |K_mj| dq_max_j`` at motor ``m`` of a drive
+    (the rule of the dissipation check,
+    :meth:`~dynid.regressors.terms.LinearFriction.dissipation_rows`)."""
+    limit = np.asarray(dq_max, dtype=np.float64)
+    return np.asarray(np.abs(friction.transmission) @ limit, dtype=np.float64)
+
+
+def joint_rms_difference(
+    friction: FrictionModel | FrictionSum,
+    damping: ArrayLike,
+    frictionloss: ArrayLike,
+    dq_max: ArrayLike,
+    n_points: int = 200,
+) -> NDArray[np.float64]:
+    """RMS difference [N m] (n,) at each joint between the odd part of the model's joint
+    friction torque, ``(tau_f(dq) - tau_f(-dq)) / 2`` with that joint moving alone (a law
+    at the motors reflected through its drive, ``K^T f(K dq)``), and the written
+    ``frictionloss_j sign(dq_j) + damping_j dq_j``, on ``n_points`` velocities spread evenly
+    over ``(0, dq_max_j]`` [rad/s]: what a joint of a URDF or MJCF file misses of the law."""
+    n = friction.n
+    fv = np.asarray(damping, dtype=np.float64)
+    fc = np.asarray(frictionloss, dtype=np.float64)
+    vmax = np.asarray(dq_max, dtype=np.float64)
+    rms = np.zeros(n)
+    for j in range(n):
+        v = np.linspace(vmax[j] / n_points, vmax[j], n_points)
+        grid = np.zeros((n_points, n))
+        grid[:, j] = v
+        odd = 0.5 * (friction.torques(grid)[:, j] - friction.torques(-grid)[:, j])
+        rms[j] = float(np.sqrt(np.mean((fc[j] + fv[j] * v - odd) ** 2)))
+    return rms
+
+
+#: RMS difference at a joint [N m] over its velocity range below which the viscous and
+#: Coulomb terms written for a smooth law hold it to round-off (a width of 0.0003 rad/s:
+#: 2e-10 N m), no note of its own: the rounding over the standstill band is said once, by
 #: :func:`unheld_friction`.
 ROUND_OFF_NM = 1e-6
 
 
 def _dissipative(
-    friction: FrictionModel, terms: MjcfTerms, vmax: NDArray[np.float64]
-) -> tuple[MjcfTerms, tuple[str, ...]]:
+    friction: FrictionModel, terms: MjcfTerms, vlaw: NDArray[np.float64]
+) -> tuple[MjcfTerms, NDArray[np.intp], NDArray[np.intp]]:
     """``terms`` with every motor (joint) whose ``damping`` or ``frictionloss`` came out
     negative (a law identified with the links whose viscous part is negative beside a
     larger smooth Coulomb part: dissipative as a whole, not term by term), and every one of
     a smooth-sign law, replaced by the nonnegative ``fv dq + fc sign(dq)`` closest to the
-    law's odd part over ``(0, vmax]`` (:func:`~dynid.friction.laws.base.odd_coulomb_viscous`);
-    the note naming them. MuJoCo and URDF readers take a negative damping as a joint that
-    pushes."""
+    law's odd part over ``(0, vlaw]``, the velocities where the law acts
+    (:func:`~dynid.friction.laws.base.odd_coulomb_viscous`); with the motors (joints)
+    negative and those replaced. MuJoCo and URDF readers take a negative damping as a
+    joint that pushes."""
     negative = (terms.damping < 0) | (terms.frictionloss < 0)
     # a smooth sign's rounding (tanh over a width) written as the sharp sign would cost
     # every reversal: its odd part is fitted as the sigmoid's is
@@ -255,10 +303,7 @@ def _dissipative(
     band = band if band.size == P.shape[0] else np.zeros(P.shape[0])
     smooth = (band > 0) & (friction.kind in ("smooth", "smooth_stribeck"))
     bad = np.flatnonzero(negative | smooth)
-    if bad.size == 0:
-        return terms, ()
     damping, loss = terms.damping.copy(), terms.frictionloss.copy()
-    worst = 0.0
     for m in bad:
 
         def torque(v: NDArray[np.float64], m: int = int(m)) -> NDArray[np.float64]:
@@ -266,20 +311,37 @@ def _dissipative(
             grid[:, m] = v
             return friction.law.torques(grid, P, band)[:, m]
 
-        top = float(vmax[m]) if np.isfinite(vmax[m]) else 2.0
-        loss[m], damping[m], _, rms = odd_coulomb_viscous(torque, top)
-        worst = max(worst, rms)
-    where = ", ".join(str(m + 1) for m in np.flatnonzero(negative))
+        top = float(vlaw[m]) if np.isfinite(vlaw[m]) else 2.0
+        loss[m], damping[m], _, _ = odd_coulomb_viscous(torque, top)
     replaced = replace(terms, damping=damping, frictionloss=loss)
-    if not where and worst < ROUND_OFF_NM:  # a narrow smooth law: its rounding is noted apart
-        return replaced, ()
+    return replaced, np.flatnonzero(negative), bad
+
+
+def _refit_note(
+    friction: FrictionModel,
+    written: DriveJointTerms,
+    vmax: NDArray[np.float64],
+    negative: NDArray[np.intp],
+    refit: NDArray[np.intp],
+) -> tuple[str, ...]:
+    """The line saying that the law of the motors (joints) ``refit`` was written as the
+    closest nonnegative viscous and Coulomb friction, with the largest RMS difference at
+    the joints they turn (:func:`joint_rms_difference`, joint-side torques over the
+    joints' range ``vmax``); none for a narrow smooth law held to round-off (its rounding
+    is said by :func:`unheld_friction`)."""
+    turned = np.any(friction.transmission[refit] != 0, axis=0)
+    rms = joint_rms_difference(friction, written.damping, written.frictionloss, vmax)
+    rms = np.where(turned, rms, 0.0)
+    j = int(np.argmax(rms))
+    if not negative.size and rms[j] < ROUND_OFF_NM:
+        return ()
+    where = ", ".join(str(m + 1) for m in negative)
     said = f" (a negative viscous or Coulomb term on {where})" if where else ""
-    note = (
+    return (
         f"{friction.kind} friction{said}: written as the nonnegative viscous and Coulomb "
-        f"friction closest to the law over the velocity range (RMS difference up to "
-        f"{worst:.3g} N m)"
+        f"friction closest to the law over the velocity range (RMS difference at the "
+        f"joints up to {rms[j]:.3g} N m, at joint {j + 1} moving alone)",
     )
-    return replaced, (note,)
 
 
 def unheld_friction(
@@ -313,7 +375,7 @@ def unheld_friction(
                     f"{band[j]:.3g} rad/s at {what} {j + 1})"
                 )
         vmax = np.full(p.n, 2.0) if dq_max is None else np.asarray(dq_max, dtype=np.float64)
-        offset = np.asarray(p.law.mjcf(p.as_array(), vmax).offset)
+        offset = np.asarray(p.law.mjcf(p.as_array(), law_velocity_range(p, vmax)).offset)
         if p.kind != "sigmoid" and np.any(offset != 0):  # the sigmoid's: its law's note
             j = int(np.argmax(np.abs(offset)))
             notes.append(f"the offsets fo{where} (up to {offset[j]:+.3g} N m at {what} {j + 1})")
