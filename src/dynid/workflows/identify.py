@@ -38,6 +38,7 @@ from ..feasibility.convex import (
 from ..friction.heldout_torques import HeldOutTorques, heldout_torques
 from ..identification.consistency import fit_mismatch, limit_violations
 from ..identification.estimators import ESTIMATORS, EstimatorName
+from ..identification.gravity_scale import gravity_scale_finding
 from ..identification.least_squares import STD_METHODS, StdMethod
 from ..identification.log import TorqueLog
 from ..identification.model import IdentifiedModel
@@ -358,6 +359,17 @@ def _predicted_heldout(
         return None
 
 
+def _say_gravity_scale(
+    robot: Robot, model: IdentifiedModel, logs: Sequence[TorqueLog], drive: Drive | None
+) -> None:
+    """Warn when ``model``'s gravity torques are one factor off the description's on every
+    loaded joint (:func:`~dynid.identification.gravity_scale.gravity_scale_finding`)."""
+    q = [log.q if drive is None else drive.joint_states(log.q)[0] for log in logs]
+    found = gravity_scale_finding(robot, model, q, drive)
+    if found is not None:
+        warnings.warn(found, DynidWarning, stacklevel=4)
+
+
 def _identify(
     robot: Robot, paths: list[Path], opt: IdentifyOptions
 ) -> tuple[IdentifiedModel, HeldOutTorques | None]:
@@ -385,6 +397,7 @@ def _identify(
         )
         model = in_file(path, fit) if len(paths) == 1 else fit()
         held = _predicted_heldout(model, logs, heldout.get("validate_on"))
+        _say_gravity_scale(robot, model, logs, opt.drive)
     else:
         held = None
         _one_static_file(paths, opt)
@@ -511,6 +524,8 @@ def _identify_consistent(
         result = in_file(path, fit) if len(paths) == 1 else fit()
         unconstrained = result.identified
         held = None if unconstrained is None else _predicted_heldout(unconstrained, logs, separate)
+        if unconstrained is not None:
+            _say_gravity_scale(robot, unconstrained, logs, opt.drive)
     else:
         held = None
         _one_static_file(paths, opt)

@@ -1,0 +1,100 @@
+"""An identified model's gravity torques against the robot description's: one factor on
+every joint is a scale the fit cannot see.
+
+A log of currents read through a torque constant that is off by a factor ``c`` (a guessed
+``torque_constant``), or torques from a sensor of another scale, is fitted as well as the
+right one: every identified inertial parameter is scaled by ``1/c`` and the model predicts
+the log to its noise. Only something outside the log tells: the robot description's
+masses. Its gravity torques at the logged configurations ``g_d(q)`` against the identified
+model's ``g_m(q)``, per joint that gravity loads
+(:func:`~dynid.identification.sanity.gravity_loaded`): the least-squares factor ``r_j`` of
+``g_m ~ r_j g_d``. A description's masses are off
+joint by joint (a cable, a motor left out of the CAD); a factor that is the same on every
+loaded joint (within :data:`UNIFORM`) and at least :data:`OFF` away from 1, with the
+shapes agreeing (correlation at least :data:`SHAPE`), is a scale: the finding names it and
+what to change, for the user to judge (the description may be uniformly off instead).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+
+import numpy as np
+from numpy.typing import NDArray
+
+from ..dynamics.terms import gravity_torques
+from ..model.drive import Drive
+from ..model.robot import Robot
+from .model import IdentifiedModel
+from .sanity import gravity_loaded
+
+__all__ = ["OFF", "SHAPE", "UNIFORM", "gravity_scale_finding", "gravity_ratios"]
+
+#: Relative distance from 1 of the common factor that makes a finding.
+OFF = 0.10
+#: Largest relative spread of the loaded joints' factors about their mean for "the same".
+UNIFORM = 0.05
+#: Smallest correlation of a loaded joint's identified and described gravity torques.
+SHAPE = 0.98
+#: Configurations used at most (spread over the logs).
+_SAMPLES = 2_000
+
+
+def gravity_ratios(
+    robot: Robot, model: IdentifiedModel, q: NDArray[np.float64]
+) -> tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.bool_]]:
+    """Per joint: the factor ``r_j`` of the model's gravity torques to the description's
+    at the configurations ``q`` (N, n) [rad] (least squares, means kept: gravity has an
+    absolute level), their correlation, and which joints gravity loads (the others' entries
+    are NaN)."""
+    loaded = gravity_loaded(robot, q)
+    gd = gravity_torques(robot, q)
+    gm = model.gravity_torques(q)
+    r = np.full(robot.n, np.nan)
+    c = np.full(robot.n, np.nan)
+    for j in np.flatnonzero(loaded):
+        d, m = gd[:, j], gm[:, j]
+        r[j] = float(d @ m / (d @ d))
+        sd, sm = np.std(d), np.std(m)
+        c[j] = float(np.mean((d - d.mean()) * (m - m.mean())) / (sd * sm)) if sd * sm > 0 else 0
+    return r, c, loaded
+
+
+def gravity_scale_finding(
+    robot: Robot,
+    model: IdentifiedModel,
+    q: Sequence[NDArray[np.float64]],
+    drive: Drive | None = None,
+) -> str | None:
+    """The finding (module docstring) of ``model`` identified from logs at the
+    configurations ``q`` (one (N, n) array per log) of ``robot``, or None: no inertial
+    parameters in the description, fewer than 2 loaded joints, factors that differ between
+    joints or lie within :data:`OFF` of 1. ``drive``: the drive the log was read through (a
+    log of currents: its torque constant is named)."""
+    if not np.any(robot.phi) or not q:
+        return None
+    every = np.concatenate([np.asarray(a, dtype=np.float64) for a in q])
+    qs = every[:: max(1, every.shape[0] // _SAMPLES)]
+    r, c, loaded = gravity_ratios(robot, model, qs)
+    js = np.flatnonzero(loaded)
+    if js.size < 2 or np.any(c[js] < SHAPE) or np.any(r[js] <= 0):
+        return None
+    mean = float(np.mean(r[js]))
+    if np.max(np.abs(r[js] - mean)) > UNIFORM * mean or abs(mean - 1.0) < OFF:
+        return None
+    names = ", ".join(robot.joint_names[j] for j in js)
+    said = (
+        f"the identified gravity torques are {mean:.3g} times the robot description's on "
+        f"every joint gravity loads ({names}: {r[js].min():.3g} to {r[js].max():.3g}): one "
+        "factor on every joint is a scale the fit cannot see (it predicts the log as well "
+        "with it; its masses and inertias carry it)"
+    )
+    if drive is not None and drive.effort == "current":
+        return (
+            f"{said}; if the description's masses are right, the drive file's torque_constant "
+            f"is {mean:.3g} times the true one: multiply it by {1 / mean:.3g}"
+        )
+    return (
+        f"{said}; if the description's masses are right, the torques are {1 / mean:.3g} "
+        f"times too small (a sensor scale: --units tau={1 / mean:.3g})"
+    )
