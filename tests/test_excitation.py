@@ -87,7 +87,8 @@ def test_paper_trajectory_condition_number_is_near_the_published_one():
 
 
 def _check_admissible(robot, traj, opts, obstacles):
-    """Independent check at 1 kHz of every limit and clearance; returns the samples."""
+    """Independent check at 1 kHz of every limit and clearance (``opts`` as used: the
+    result's, its radius and clearances sized for the arm); returns the samples."""
     tr = traj.sample(1000.0)
     q, dq, ddq = np.asarray(tr.q), np.asarray(tr.dq), np.asarray(tr.ddq)
     assert np.all(q <= robot.q_max - opts.position_margin + 1e-12)
@@ -123,7 +124,7 @@ def test_short_optimisation_respects_every_limit_at_1khz_and_is_reproducible():
         progress=lambda k, m, c: seen.append((k, m, c)),
     )
     assert res.status in ("ok", "reduced")
-    _check_admissible(robot, res.trajectory, opts, obstacles)
+    _check_admissible(robot, res.trajectory, res.options, obstacles)
     assert all(
         v >= 0 for k in ("position", "velocity", "acceleration", "torque") for v in res.margins[k]
     )
@@ -206,7 +207,7 @@ def test_optimiser_never_returns_worse_than_its_admissible_start(seed):
     opts = ExcitationOptions(duration=4.0, harmonics=3, base_frequency=0.25, max_iter=3, n_starts=4)
     res = optimise_excitation(robot, np.random.default_rng(seed), opts, obstacles=Obstacles())
     assert res.start_admissible and res.status in ("ok", "reduced")
-    _check_admissible(robot, res.trajectory, opts, Obstacles())
+    _check_admissible(robot, res.trajectory, res.options, Obstacles())
     cond, _ = excitation_condition_number(robot, res.trajectory.sample(200.0))
     assert res.condition_number == pytest.approx(cond, rel=1e-12)
     assert res.condition_number <= res.initial_condition_number

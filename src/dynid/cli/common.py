@@ -50,6 +50,7 @@ FLAGS: dict[str, str] = {
     "uncertainty": "--no-uncertainty",
     "standstill": "--no-standstill-margin",
     "total_mass_band": "--no-total-mass",
+    "radii": "--radius",
 }
 
 

@@ -7,9 +7,13 @@ parameters plus viscous, Coulomb and offset friction per joint; unscaled, the fi
 paper reports: 121.88 for theirs) or, with --criterion logdet, maximise log det of its
 scaled Gram matrix. It respects, with margins: joint positions (--position-margin, 5 deg),
 velocities (--velocity-margin, 10 deg/s), accelerations and the model's torques (10 % of
-each limit), and clearances (capsules of --radius around the links; 5 cm to obstacles,
-2 cm between non-adjacent links). Obstacles: the floor z = 0 of the base frame by default,
-or planes and boxes from --obstacles FILE (JSON):
+each limit), and clearances: capsules of --radius around the links keep
+--obstacle-clearance from obstacles and --self-clearance between non-adjacent links. By
+default these scale with the arm: 0.06, 0.05 and 0.02 m for an arm whose chain (base to
+flange, the links' lengths summed) is 1.3 m or longer, such as the Panda (1.32 m), and
+that times chain / 1.3 m for a shorter one (an SO-101 of 0.55 m: 0.025, 0.021 and
+0.0085 m); the summary says which were used and why. Obstacles: the floor z = 0 of the
+base frame by default, or planes and boxes from --obstacles FILE (JSON):
 
   {"schema": "dynid-obstacles/1",
    "planes": [{"name": "table", "point": [0, 0, 0], "normal": [0, 0, 1]}],
@@ -24,6 +28,20 @@ The result is the best admissible iterate, never worse than an admissible start 
 start itself then, said in a third line, as is a result worse than a start that violated
 a limit). Exit status 1 when no admissible trajectory was found, naming the violated
 limits: the files are written for inspection (as retrieve's when no feasible set exists).
+A violated clearance names the two links (or the link and the obstacle), their distance,
+when, and the options that change it.
+
+status (the first line of the summary, and trajectory.json's "status"):
+  ok          the optimised trajectory keeps every limit and clearance when checked at
+              1 kHz (or, when nothing admissible was better, the optimiser's admissible
+              start is returned: said in a third line)
+  reduced     the optimised trajectory violated a torque or clearance limit between the
+              samples it was optimised on; its amplitudes were reduced (in 3 % steps about
+              its start position) until it kept every limit at 1 kHz: admissible, but less
+              exciting than optimised (the condition number is the reduced one's)
+  infeasible  no admissible trajectory was found, even with reduced amplitudes: the
+              optimiser's trajectory is written, unreduced, for inspection, the violated
+              limits named, and the exit status is 1
 
 example:
   dynid excite --robot panda --duration 20 --seed 1 --out excite
@@ -43,7 +61,14 @@ from ..model.robot import Robot
 from ..simulation.excitation import ExcitationOptions
 from ..workflows.excite import ExcitationDesign, design_excitation
 from .applies import urdf_chain
-from .common import add_robot_options, add_subcommand, load_robot, output_path, save_figure
+from .common import (
+    add_robot_options,
+    add_subcommand,
+    flag,
+    load_robot,
+    output_path,
+    save_figure,
+)
 from .console import Console
 
 NAME = "excite"
@@ -73,7 +98,29 @@ def register(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParser:
         help="w_f / (2 pi) [Hz] (default 0.075, the paper's 0.15 pi rad/s)",
     )
     p.add_argument("--obstacles", type=Path, default=None, help="obstacles JSON (default: floor)")
-    p.add_argument("--radius", type=float, default=None, help="capsule radius [m] (default 0.06)")
+    p.add_argument(
+        "--radius",
+        type=float,
+        default=None,
+        metavar="M",
+        help="capsule radius [m] (default scaled to the arm: 0.06 for a chain of 1.3 m or longer)",
+    )
+    p.add_argument(
+        "--self-clearance",
+        type=float,
+        default=None,
+        metavar="M",
+        help="distance kept between non-adjacent links' capsules [m] (default scaled to the "
+        "arm: 0.02 for a chain of 1.3 m or longer)",
+    )
+    p.add_argument(
+        "--obstacle-clearance",
+        type=float,
+        default=None,
+        metavar="M",
+        help="distance kept from obstacles [m] (default scaled to the arm: 0.05 for a chain "
+        "of 1.3 m or longer)",
+    )
     p.add_argument(
         "--position-margin",
         type=float,
@@ -118,13 +165,13 @@ def run(args: argparse.Namespace, console: Console) -> int:
     )
     print(end="\n" if show else "", file=sys.stderr)
     written = _save(args, robot, design)
-    console.print(*design.describe(robot), *(f"wrote {p}" for p in written))
+    console.print(*design.describe(robot, flag), *(f"wrote {p}" for p in written))
     if not design.admissible:  # a negative result, as retrieve's: exit 1, files kept
         print(
             f"dynid {NAME}: no admissible trajectory found (violated at 1 kHz: "
             f"{', '.join(design.result.violations())}; files written for inspection); "
-            "hint: fewer or smaller obstacles, smaller --radius, more --max-iter or another "
-            "--seed",
+            "hint: fewer or smaller obstacles, a smaller --radius, --self-clearance or "
+            "--obstacle-clearance, more --max-iter or another --seed",
             file=sys.stderr,
         )
         return 1
@@ -144,6 +191,8 @@ def _options(args: argparse.Namespace) -> ExcitationOptions:
         position_margin=float(np.deg2rad(args.position_margin)),
         velocity_margin=float(np.deg2rad(args.velocity_margin)),
         radii=args.radius,
+        self_clearance=args.self_clearance,
+        obstacle_clearance=args.obstacle_clearance,
         criterion=args.criterion,
         max_iter=args.max_iter,
     )

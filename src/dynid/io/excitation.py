@@ -34,6 +34,7 @@ import numpy as np
 from .. import __version__, _checks
 from ..exceptions import DataError, DynidError
 from ..model.robot import Robot
+from ..simulation.clearance import Approach
 from ..simulation.collision import Box, Obstacles, Plane, capsule_model
 from ..simulation.excitation import ExcitationResult, ExcitingTrajectory
 from ..simulation.trajectories import Trajectory
@@ -128,6 +129,9 @@ def save_excitation_json(
             "torque_fraction": o.torque_margin,
             "obstacle_clearance_m": o.obstacle_clearance,
             "self_clearance_m": o.self_clearance,
+            "scaled_to_the_arm": list(result.derived),
+            "chain_length_m": None if result.sizes is None else result.sizes.chain_length,
+            "scale": None if result.sizes is None else result.sizes.scale,
         },
         "capsule_radii_m": capsule_model(robot, o.radii).radii.tolist(),
         "obstacles": obstacles_to_dict(result.obstacles),
@@ -138,11 +142,23 @@ def save_excitation_json(
             "torque_nm": result.margins["torque"],
             "obstacles_m": result.margins["obstacles"],
             "self_collision_m": result.margins["self_collision"],
+            "closest": [_approach(a) for a in result.margins.get("closest", ())],
         },
         "history": list(result.history),
     }
     # limits, margins and condition numbers may be infinite (no limit, no obstacle): null
     return save_document(path, EXCITATION, finite_or_none(d))
+
+
+def _approach(a: Approach) -> dict[str, Any]:
+    """An :class:`~dynid.simulation.clearance.Approach` as ``trajectory.json`` writes it."""
+    return {
+        "link": a.link,
+        ("obstacle" if a.obstacle else "other_link"): a.other,
+        "distance_m": a.distance,
+        "required_m": a.required,
+        "t_s": a.t,
+    }
 
 
 _V3 = Field("numbers", required=True, shape=(3,), unit="m")

@@ -5,15 +5,22 @@ to the origin of link frame ``k + 1`` (for ``k = n``, the ``flange``), swept by 
 of radius ``r_k``; it belongs to link ``k`` (0 = the base), and both ends are fixed in
 that link, so its length is a constant of the kinematics. A modified-DH link with both an
 ``a`` and a ``d`` offset is an L; the straight segment cuts the corner, which the radius
-covers for radii above about a third of the shorter leg. Default radius
-:data:`DEFAULT_RADIUS` = 0.06 m for every capsule: the Panda's links are 0.11-0.13 m
-across (Franka's collision meshes), so the capsules enclose the arm's cross-section; pass
-``radii`` for another arm, a tool or a gripper.
+covers for radii above about a third of the shorter leg.
+
+Sizes. The default radius and clearances scale with the arm (:func:`collision_sizes`):
+an arm whose chain (the capsules' lengths summed, base to flange, and the strokes of its
+prismatic joints) is at least :data:`FULL_SIZE_CHAIN` = 1.3 m long gets
+:data:`DEFAULT_RADIUS` = 0.06 m, :data:`DEFAULT_SELF_CLEARANCE` = 0.02 m and
+:data:`DEFAULT_OBSTACLE_CLEARANCE` = 0.05 m (the Panda, 1.32 m: its links are 0.11-0.13 m
+across in Franka's collision meshes, so the capsules enclose the arm's cross-section); a
+shorter arm gets them scaled by its chain over 1.3 m (an SO-101 of 0.55 m: 0.025 m,
+0.0085 m, 0.021 m). Pass ``radii`` for a tool or a gripper.
 
 Self-collision. Two capsules are checked when the links strictly between them are longer
-in total than the sum of their radii ("non-adjacent": a zero-length link, such as the
-Panda's links 1 and 5 whose frame origins coincide with the next one, does not separate
-its neighbours, which touch by construction).
+in total than the sum of their radii and the clearance ("non-adjacent"): nearer, no
+motion can part them by the clearance (their distance is at most those links' length),
+so they touch by construction, as the Panda's links 1 and 5 do, whose frame origins
+coincide with the next one.
 
 Obstacles, in the base frame [m]: a :class:`Plane` (``point`` and a ``normal`` pointing
 to the free side; a floor or a table top) and axis-aligned :class:`Box` es (``center``,
@@ -40,20 +47,33 @@ from ..model.robot import Robot
 
 __all__ = [
     "BOX_SAMPLES",
+    "DEFAULT_OBSTACLE_CLEARANCE",
     "DEFAULT_RADIUS",
+    "DEFAULT_SELF_CLEARANCE",
+    "FULL_SIZE_CHAIN",
     "MAX_OBSTACLE_EXTENT",
     "Box",
     "CapsuleModel",
+    "CollisionSizes",
     "Obstacles",
     "Plane",
     "capsule_model",
     "capsule_segments",
+    "chain_length",
+    "collision_sizes",
+    "obstacle_capsule_distances",
     "obstacle_distances",
     "self_distances",
 ]
 
-#: Default capsule radius [m] (see the module docstring).
+#: Capsule radius [m] of an arm of chain :data:`FULL_SIZE_CHAIN` or longer (module docstring).
 DEFAULT_RADIUS = 0.06
+#: Smallest distance between non-adjacent capsules [m] of such an arm.
+DEFAULT_SELF_CLEARANCE = 0.02
+#: Smallest distance of a capsule to an obstacle [m] of such an arm.
+DEFAULT_OBSTACLE_CLEARANCE = 0.05
+#: Chain length [m] from which the defaults hold unscaled (the Panda's is 1.32 m).
+FULL_SIZE_CHAIN = 1.3
 #: Points along a capsule's segment at which its distance to a box is evaluated.
 BOX_SAMPLES = 9
 #: The largest coordinate of a plane's point or a box's centre, and the largest box edge
@@ -175,8 +195,63 @@ def capsule_segments(robot: Robot, q: ArrayLike) -> NDArray[np.float64]:
     return np.stack([starts, ends], axis=-2)
 
 
-def capsule_model(robot: Robot, radii: ArrayLike | float | None = None) -> CapsuleModel:
-    """Capsules of ``robot`` with ``radii`` (scalar or (n + 1,); default :data:`DEFAULT_RADIUS`).
+def chain_length(robot: Robot) -> float:
+    """Length of the arm's chain [m]: its capsules' lengths at ``q = 0`` summed, base to
+    flange, plus the stroke of each prismatic joint with finite limits (the Panda's:
+    1.319 m)."""
+    seg = capsule_segments(robot, np.zeros(robot.n))
+    stroke = np.where(robot.prismatic, robot.q_max - robot.q_min, 0.0)
+    return float(
+        np.linalg.norm(seg[:, 1] - seg[:, 0], axis=-1).sum() + stroke[np.isfinite(stroke)].sum()
+    )
+
+
+@dataclass(frozen=True, slots=True)
+class CollisionSizes:
+    """The default capsule radius and clearances of an arm, scaled to its size.
+
+    Attributes
+    ----------
+    radius : float
+        Capsule radius [m]: :data:`DEFAULT_RADIUS` times ``scale``.
+    self_clearance : float
+        Between non-adjacent capsules [m]: :data:`DEFAULT_SELF_CLEARANCE` times ``scale``.
+    obstacle_clearance : float
+        To obstacles [m]: :data:`DEFAULT_OBSTACLE_CLEARANCE` times ``scale``.
+    chain_length : float
+        The arm's chain [m] (:func:`chain_length`).
+    scale : float
+        ``min(1, chain_length / FULL_SIZE_CHAIN)``; 1 for a chain of no length (one joint
+        at the base's origin: nothing to scale by).
+    """
+
+    radius: float
+    self_clearance: float
+    obstacle_clearance: float
+    chain_length: float
+    scale: float
+
+
+def collision_sizes(robot: Robot) -> CollisionSizes:
+    """The default capsule radius and clearances of ``robot`` (module docstring): those of
+    an arm of chain :data:`FULL_SIZE_CHAIN` or longer, scaled by a shorter chain's length."""
+    length = chain_length(robot)
+    scale = min(1.0, length / FULL_SIZE_CHAIN) if length > 0 else 1.0
+    return CollisionSizes(
+        radius=DEFAULT_RADIUS * scale,
+        self_clearance=DEFAULT_SELF_CLEARANCE * scale,
+        obstacle_clearance=DEFAULT_OBSTACLE_CLEARANCE * scale,
+        chain_length=length,
+        scale=scale,
+    )
+
+
+def capsule_model(
+    robot: Robot, radii: ArrayLike | float | None = None, *, clearance: float = 0.0
+) -> CapsuleModel:
+    """Capsules of ``robot`` with ``radii`` (scalar or (n + 1,); default the arm's
+    :func:`collision_sizes` radius), checked pairwise when the links between them are
+    longer than both radii and ``clearance`` [m] (module docstring).
 
     Raises
     ------
@@ -186,7 +261,9 @@ def capsule_model(robot: Robot, radii: ArrayLike | float | None = None) -> Capsu
         A radius above :data:`MAX_OBSTACLE_EXTENT`.
     """
     n1 = robot.n + 1
-    r = np.full(n1, DEFAULT_RADIUS) if radii is None else np.asarray(radii, dtype=np.float64)
+    if radii is None:
+        radii = collision_sizes(robot).radius
+    r = np.asarray(radii, dtype=np.float64)
     if r.ndim == 0:
         r = np.full(n1, float(r))
     if r.shape != (n1,) or not np.all(r > 0):
@@ -198,7 +275,7 @@ def capsule_model(robot: Robot, radii: ArrayLike | float | None = None) -> Capsu
         (i, j)
         for i in range(n1)
         for j in range(i + 2, n1)
-        if lengths[i + 1 : j].sum() > r[i] + r[j]
+        if lengths[i + 1 : j].sum() > r[i] + r[j] + clearance
     ]
     return CapsuleModel(
         radii=_checks.frozen(r),
@@ -254,6 +331,37 @@ def self_distances(
     return d - model.radii[i] - model.radii[j]
 
 
+def obstacle_capsule_distances(
+    robot: Robot,
+    q: ArrayLike,
+    obstacles: Obstacles,
+    model: CapsuleModel,
+    *,
+    segments: NDArray | None = None,
+) -> NDArray[np.float64]:
+    """Signed distance of each of capsules 2 .. n to each obstacle:
+    (..., n) -> (..., n - 1, len(obstacles)) [m] (capsule ``k`` at index ``k - 2``)."""
+    seg = capsule_segments(robot, q) if segments is None else segments
+    seg = seg[..., 2:, :, :]
+    rad = model.radii[2:]
+    out = []
+    for pl in obstacles.planes:
+        nrm, p0 = np.asarray(pl.normal), np.asarray(pl.point)
+        out.append(np.einsum("...i,i->...", seg - p0, nrm).min(axis=-1) - rad)
+    if obstacles.boxes:
+        u = np.linspace(0.0, 1.0, BOX_SAMPLES)
+        pts = seg[..., :1, :] + u[:, None] * (seg[..., 1:2, :] - seg[..., :1, :])  # (..., c, S, 3)
+        for bx in obstacles.boxes:
+            c, h = np.asarray(bx.center), 0.5 * np.asarray(bx.size)
+            o = np.abs(pts - c) - h
+            outside = np.linalg.norm(np.maximum(o, 0.0), axis=-1)
+            inside = np.minimum(o.max(axis=-1), 0.0)
+            out.append((outside + inside).min(axis=-1) - rad)
+    if not out:
+        return np.zeros(np.shape(seg)[:-2] + (0,))
+    return np.stack(out, axis=-1)
+
+
 def obstacle_distances(
     robot: Robot,
     q: ArrayLike,
@@ -268,26 +376,7 @@ def obstacle_distances(
     one-joint arm, which has no capsule to check.
     """
     seg = capsule_segments(robot, q) if segments is None else segments
-    seg = seg[..., 2:, :, :]
-    rad = model.radii[2:]
-    if seg.shape[-3] == 0:  # a one-joint arm: no capsule is checked, none can touch
+    if seg.shape[-3] <= 2:  # a one-joint arm: no capsule is checked, none can touch
         return np.full(seg.shape[:-3] + (len(obstacles),), np.inf)
-    out = []
-    for pl in obstacles.planes:
-        nrm, p0 = np.asarray(pl.normal), np.asarray(pl.point)
-        h = np.einsum("...i,i->...", seg - p0, nrm).min(axis=-1) - rad
-        out.append(h.min(axis=-1))
-    if obstacles.boxes:
-        u = np.linspace(0.0, 1.0, BOX_SAMPLES)
-        pts = seg[..., :1, :] + u[:, None] * (seg[..., 1:2, :] - seg[..., :1, :])  # (..., c, S, 3)
-        for bx in obstacles.boxes:
-            c, h = np.asarray(bx.center), 0.5 * np.asarray(bx.size)
-            o = np.abs(pts - c) - h
-            outside = np.linalg.norm(np.maximum(o, 0.0), axis=-1)
-            inside = np.minimum(o.max(axis=-1), 0.0)
-            d = (outside + inside).min(axis=-1) - rad
-            out.append(d.min(axis=-1))
-    if not out:
-        shape = np.shape(seg)[:-3]
-        return np.zeros(shape + (0,))
-    return np.stack(out, axis=-1)
+    d = obstacle_capsule_distances(robot, q, obstacles, model, segments=seg)
+    return d.min(axis=-2)

@@ -17,12 +17,15 @@ maximise ``log det`` of its column-scaled Gram matrix (D-optimality). Constraint
   start position is the requested one clipped to where the motion fits;
 * torques ``|M ddq + c + g + tau_f(dq)| <= (1 - m_tau) tau_max`` (the model's, with its
   friction), capsule clearances to obstacles and between non-adjacent links
-  (:mod:`dynid.simulation.collision`) enter as quadratic penalties;
+  (:mod:`dynid.simulation.collision`; radius and clearances by default scaled to the arm,
+  :func:`~dynid.simulation.collision.collision_sizes`) enter as quadratic penalties;
 * the result is the best iterate (the start included) free of penalty, else the optimiser's
   last; it is checked at 1 kHz and, if a torque or clearance is still violated, its
-  amplitudes are reduced until none is (``status`` says so; kept unreduced when reducing
-  does not help). The start itself is returned when it is admissible and the result is
-  not better on the same 200 Hz grid (``improved`` is then False).
+  amplitudes are reduced until none is, the motion drawn toward the requested start
+  (``status`` says so; kept unreduced when reducing does not help). The start itself is
+  returned when it is admissible and the result is not better on the same 200 Hz grid
+  (``improved`` is then False). The closest pair of links and the closest link to each
+  obstacle are named with their distances (:mod:`dynid.simulation.clearance`).
 
 scipy's L-BFGS-B with finite-difference gradients; the start is the best of ``n_starts``
 seeded random candidates. Seeded and reproducible; ``progress(iteration, max_iter, cond)``
@@ -31,6 +34,7 @@ is called after each iteration.
 
 from __future__ import annotations
 
+import dataclasses
 import logging
 from collections.abc import Callable
 from dataclasses import dataclass, field
@@ -47,11 +51,14 @@ from ..identification.classical import friction_regressor
 from ..model.robot import Robot
 from ..regressors.base import BaseParameters, base_parameters
 from ..regressors.torque import torque_regressor_prepared
+from .clearance import Approach, closest_approaches
 from .collision import (
     CapsuleModel,
+    CollisionSizes,
     Obstacles,
     capsule_model,
     capsule_segments,
+    collision_sizes,
     obstacle_distances,
     self_distances,
 )
@@ -61,6 +68,7 @@ from .trajectories import Trajectory, uniform_times
 __all__ = [
     "ExcitationOptions",
     "ExcitationResult",
+    "STATUSES",
     "ExcitingTrajectory",
     "excitation_condition_number",
     "limit_margins",
@@ -68,6 +76,8 @@ __all__ = [
 ]
 
 _log = logging.getLogger(__name__)
+#: The statuses a design ends with (:attr:`ExcitationResult.status`).
+STATUSES = ("ok", "reduced", "infeasible")
 #: Rate [Hz] of the samples the result and its start are compared on (and reported).
 _FS_REPORTED = 200.0
 
@@ -101,12 +111,15 @@ class ExcitationOptions:
         Fraction of the acceleration limits kept free (0.1).
     torque_margin : float
         Fraction of the torque limits kept free (0.1).
-    obstacle_clearance : float
-        Smallest capsule distance to an obstacle [m] (0.05).
-    self_clearance : float
-        Smallest distance between non-adjacent capsules [m] (0.02).
+    obstacle_clearance : float, optional
+        Smallest capsule distance to an obstacle [m] (default scaled to the arm: 0.05 for
+        a chain of 1.3 m or longer, :func:`~dynid.simulation.collision.collision_sizes`).
+    self_clearance : float, optional
+        Smallest distance between non-adjacent capsules [m] (default scaled to the arm:
+        0.02 for a chain of 1.3 m or longer).
     radii : float or tuple of float, optional
-        Capsule radii [m] (default :data:`~dynid.simulation.collision.DEFAULT_RADIUS`).
+        Capsule radii [m] (default scaled to the arm: 0.06 for a chain of 1.3 m or
+        longer).
     criterion : {"cond", "logdet"}
         Minimise the (unscaled) condition number, or maximise ``log det`` of the
         column-scaled Gram matrix.
@@ -130,8 +143,8 @@ class ExcitationOptions:
     velocity_margin: float = float(np.deg2rad(10.0))
     acceleration_margin: float = 0.1
     torque_margin: float = 0.1
-    obstacle_clearance: float = 0.05
-    self_clearance: float = 0.02
+    obstacle_clearance: float | None = None
+    self_clearance: float | None = None
     radii: float | tuple[float, ...] | None = None
     criterion: str = "cond"
     max_iter: int = 60
@@ -157,9 +170,32 @@ class ExcitationOptions:
             if not 0 <= getattr(self, k) < 1:
                 raise OptionError(f"{k} must be in [0, 1); got {getattr(self, k)}")
         for k in ("position_margin", "velocity_margin", "obstacle_clearance", "self_clearance"):
-            if not 0 <= getattr(self, k) < float("inf"):  # a negative one widens the limits
-                flag = f" (--{k.replace('_', '-')})" if k.endswith("_margin") else ""
-                raise OptionError(f"{k}{flag} must be finite and >= 0; got {getattr(self, k):g}")
+            v = getattr(self, k)
+            if v is not None and not 0 <= v < float("inf"):  # a negative one widens the limits
+                flag = f"--{k.replace('_', '-')}"
+                raise OptionError(f"{k} ({flag}) must be finite and >= 0; got {v:g}")
+
+    def sized_for(self, robot: Robot) -> ExcitationOptions:
+        """These options with the radius and clearances not given set to ``robot``'s
+        (:func:`~dynid.simulation.collision.collision_sizes`)."""
+        sizes = collision_sizes(robot)
+        return dataclasses.replace(
+            self,
+            radii=sizes.radius if self.radii is None else self.radii,
+            self_clearance=_given(self.self_clearance, sizes.self_clearance),
+            obstacle_clearance=_given(self.obstacle_clearance, sizes.obstacle_clearance),
+        )
+
+    @property
+    def derived(self) -> tuple[str, ...]:
+        """The options left to their defaults scaled to the arm (not given)."""
+        return tuple(
+            k for k in ("radii", "self_clearance", "obstacle_clearance") if getattr(self, k) is None
+        )
+
+
+def _given(value: float | None, default: float) -> float:
+    return default if value is None else value
 
 
 @dataclass(frozen=True, slots=True, eq=False)
@@ -179,7 +215,9 @@ class ExcitationResult:
         Smallest margin to every limit at 1 kHz (:func:`limit_margins`), plus
         ``"obstacles"`` (name -> smallest clearance minus the required one [m]) and
         ``"self_collision"`` (smallest clearance between non-adjacent capsules minus the
-        required one [m]); all >= 0 when the trajectory is admissible.
+        required one [m]); all >= 0 when the trajectory is admissible. ``"closest"``: the
+        closest pair of links, then the closest link to each obstacle
+        (:class:`~dynid.simulation.clearance.Approach`, naming them).
     status : str
         ``"ok"``, ``"reduced"`` when the amplitudes had to be reduced after the
         optimisation, ``"infeasible"`` when no admissible trajectory was found.
@@ -188,6 +226,8 @@ class ExcitationResult:
     history : tuple of float
         Condition number after each iteration.
     options : ExcitationOptions
+        The options used: the radius and clearances not given set to the arm's
+        (:meth:`ExcitationOptions.sized_for`).
     obstacles : Obstacles
     start_margins : dict
         :attr:`margins` of the start of the optimisation.
@@ -195,6 +235,11 @@ class ExcitationResult:
         Whether the result is better than the start by the criterion (on the same 200 Hz
         samples); False when the start, admissible, is returned, or when neither is
         admissible and the optimiser only reduced the violations.
+    sizes : CollisionSizes or None
+        The arm's default radius and clearances and the chain length they are scaled by.
+    derived : tuple of str
+        The options among ``radii``, ``self_clearance``, ``obstacle_clearance`` that were
+        not given and took the arm's defaults (``sizes``).
     """
 
     trajectory: ExcitingTrajectory
@@ -210,6 +255,8 @@ class ExcitationResult:
     obstacles: Obstacles = field(default_factory=Obstacles)
     start_margins: dict[str, Any] = field(default_factory=dict)
     improved: bool = True
+    sizes: CollisionSizes | None = None
+    derived: tuple[str, ...] = ()
 
     @property
     def start_admissible(self) -> bool:
@@ -217,8 +264,14 @@ class ExcitationResult:
         return bool(self.start_margins) and _admissible(self.start_margins)
 
     def violations(self, start: bool = False) -> list[str]:
-        """The negative margins of the result (or of the start), e.g. ``torque[2] -8.34``."""
+        """The negative margins of the result (or of the start), e.g. ``torque[2] -8.34``,
+        ``self_collision -0.031 (link2, link5)``."""
         return _violations(self.start_margins if start else self.margins)
+
+    def violated_clearances(self, start: bool = False) -> tuple[Approach, ...]:
+        """The closest approaches of the result (or of the start) that violate a clearance."""
+        m = self.start_margins if start else self.margins
+        return tuple(a for a in m.get("closest", ()) if a.margin < -1e-9)
 
 
 def _classical_regressor(
@@ -409,14 +462,14 @@ class _Problem:
             pen += float(np.sum(np.maximum(v, 0.0) ** 2))
         qc = q0 + self.B_col @ c.T
         seg = capsule_segments(self.robot, qc)
-        o = self.opts
+        c_self, c_obstacle = _clearances(self.opts)
         if self.caps.pairs.size:
             d = self_distances(self.robot, qc, self.caps, segments=seg).min(axis=0)
-            pen += float(np.sum(np.maximum(o.self_clearance + 0.01 - d, 0.0) ** 2)) / 0.05**2
+            pen += float(np.sum(np.maximum(c_self + 0.01 - d, 0.0) ** 2)) / 0.05**2
         if len(self.obstacles):
             d = obstacle_distances(self.robot, qc, self.obstacles, self.caps, segments=seg)
             d = d.min(axis=0)
-            pen += float(np.sum(np.maximum(o.obstacle_clearance + 0.01 - d, 0.0) ** 2)) / 0.05**2
+            pen += float(np.sum(np.maximum(c_obstacle + 0.01 - d, 0.0) ** 2)) / 0.05**2
         return 100.0 * pen
 
 
@@ -427,24 +480,26 @@ def _check(
     obstacles: Obstacles,
     caps: CapsuleModel,
 ) -> dict[str, Any]:
-    """Margins at 1 kHz (limits, obstacles, self-collision)."""
+    """Margins at 1 kHz (limits, obstacles, self-collision) and the closest approaches."""
     tr = traj.sample(1000.0)
     margins: dict[str, Any] = limit_margins(robot, tr, opts)
-    seg = capsule_segments(robot, tr.q)
-    if len(obstacles):
-        d = obstacle_distances(robot, tr.q, obstacles, caps, segments=seg).min(axis=0)
-        margins["obstacles"] = {
-            name: float(v - opts.obstacle_clearance)
-            for name, v in zip(obstacles.names, d, strict=True)
-        }
-    else:
-        margins["obstacles"] = {}
-    if caps.pairs.size:
-        d = self_distances(robot, tr.q, caps, segments=seg).min()
-        margins["self_collision"] = float(d - opts.self_clearance)
-    else:
-        margins["self_collision"] = float("inf")
+    c_self, c_obstacle = _clearances(opts)
+    pair, near = closest_approaches(
+        robot, tr.t, tr.q, caps, obstacles, self_clearance=c_self, obstacle_clearance=c_obstacle
+    )
+    # a one-joint arm checks no capsule against obstacles: none can touch (inf)
+    margins["obstacles"] = {k: float("inf") for k in obstacles.names}
+    margins["obstacles"].update({a.other: a.margin for a in near})
+    margins["self_collision"] = pair[0].margin if pair else float("inf")
+    margins["closest"] = pair + near
     return margins
+
+
+def _clearances(opts: ExcitationOptions) -> tuple[float, float]:
+    """The self and obstacle clearances [m] of options sized for the arm."""
+    if opts.self_clearance is None or opts.obstacle_clearance is None:
+        raise OptionError("the options must be sized for the arm first (sized_for(robot))")
+    return opts.self_clearance, opts.obstacle_clearance
 
 
 def _violations(m: dict[str, Any]) -> list[str]:
@@ -455,9 +510,16 @@ def _violations(m: dict[str, Any]) -> list[str]:
         for j, v in enumerate(m[k])
         if v < -1e-9
     ]
-    out += [f"obstacles[{k}] {v:.3g}" for k, v in m["obstacles"].items() if v < -1e-9]
+    near = {a.other: a for a in m.get("closest", ()) if a.obstacle}
+    out += [
+        f"obstacles[{k}] {v:.3g}" + (f" ({near[k].link})" if k in near else "")
+        for k, v in m["obstacles"].items()
+        if v < -1e-9
+    ]
     if m["self_collision"] < -1e-9:
-        out.append(f"self_collision {m['self_collision']:.3g}")
+        pair = [a for a in m.get("closest", ()) if not a.obstacle]
+        names = f" ({pair[0].link}, {pair[0].other})" if pair else ""
+        out.append(f"self_collision {m['self_collision']:.3g}{names}")
     return out
 
 
@@ -507,7 +569,9 @@ def optimise_excitation(
     """
     obstacles = Obstacles.floor() if obstacles is None else obstacles
     base = base_parameters(robot, kind="torque") if base is None else base
-    caps = capsule_model(robot, options.radii)
+    derived = options.derived
+    options = options.sized_for(robot)
+    caps = capsule_model(robot, options.radii, clearance=_clearances(options)[0])
     if q_start is None:
         finite = np.isfinite(robot.q_min) & np.isfinite(robot.q_max)
         lo, hi = np.where(finite, robot.q_min, 0.0), np.where(finite, robot.q_max, 0.0)
@@ -545,7 +609,8 @@ def optimise_excitation(
     best.offer(res.x)
     # the best penalty-free iterate; without one, the optimiser's (the least violation)
     chosen = prob.trajectory(res.x if best.x is None else best.x)
-    traj, margins, status = _admissible_version(robot, chosen, options, obstacles, caps)
+    centre = np.clip(q_start, prob.lo, prob.hi)  # within the limits and their margins
+    traj, margins, status = _admissible_version(robot, chosen, options, obstacles, caps, centre)
     start = prob.trajectory(x0)
     start_margins = _check(robot, start, options, obstacles, caps)
     W = _classical_regressor(robot, base, traj.sample(_FS_REPORTED))
@@ -572,6 +637,8 @@ def optimise_excitation(
         obstacles=obstacles,
         start_margins=start_margins,
         improved=not kept_start and crit[0] < crit[1],
+        sizes=collision_sizes(robot),
+        derived=derived,
     )
 
 
@@ -598,20 +665,27 @@ def _admissible_version(
     options: ExcitationOptions,
     obstacles: Obstacles,
     caps: CapsuleModel,
+    centre: NDArray[np.float64],
 ) -> tuple[ExcitingTrajectory, dict[str, Any], str]:
     """``traj`` checked at 1 kHz, its amplitudes reduced (by 3 % steps, at most 60) until it
     is admissible: the trajectory, its margins and ``"ok"``/``"reduced"``; unreduced and
-    ``"infeasible"`` when no reduction is admissible (it would only lose excitation)."""
+    ``"infeasible"`` when no reduction is admissible (it would only lose excitation).
+
+    A reduction by ``f`` draws the whole motion toward ``centre`` (the requested start,
+    within the limits): ``q'(t) = centre + f (q(t) - centre)``, inside the position limits
+    as ``q`` and ``centre`` are, and at rest at ``centre`` as ``f -> 0``: a rest position
+    the optimiser moved into a collision (a joint's range filled to a limit where two
+    links meet) is drawn out of it, which a reduction about that rest position never did.
+    """
     margins = _check(robot, traj, options, obstacles, caps)
     reduced, m = traj, margins
-    for _ in range(60):
+    for k in range(1, 61):
         if _admissible(m):
             return reduced, m, ("ok" if reduced is traj else "reduced")
         _log.info("violated at 1 kHz: %s", _violations(m))
-        # smaller excursions about the start stay inside the position limits
-        reduced = ExcitingTrajectory(
-            traj.w_f, 0.97 * reduced.a, 0.97 * reduced.b, traj.q_start, traj.duration, traj.ramp
-        )
+        f = 0.97**k
+        q0 = centre + f * (traj.q_start - centre)
+        reduced = ExcitingTrajectory(traj.w_f, f * traj.a, f * traj.b, q0, traj.duration, traj.ramp)
         m = _check(robot, reduced, options, obstacles, caps)
     if _admissible(m):
         return reduced, m, "reduced"

@@ -109,7 +109,7 @@ def _collision_free_pool(
     radii: float | ArrayLike | None,
     clearance: float,
 ) -> NDArray[np.float64]:
-    caps = capsule_model(robot, radii)
+    caps = capsule_model(robot, radii, clearance=clearance)
     kept: list[NDArray[np.float64]] = []
     total = 0
     for _ in range(50):

@@ -3,6 +3,9 @@ command applies, so that the Python API behaves as the command does.
 
 * The obstacles: a file's (``obstacles.json``), else the floor
   (:func:`~dynid.simulation.excitation.optimise_excitation`).
+* The capsule radius and the clearances not given are scaled to the arm
+  (:meth:`~dynid.simulation.excitation.ExcitationOptions.sized_for`); the summary says
+  which were used and why, and names the links of a violated clearance.
 * The trajectory is optimised from one seed and checked, and given sampled at 1 kHz (the
   rate of the checks and of ``trajectory.csv``).
 * A trajectory that is not admissible is a result, not an error (``admissible`` is False;
@@ -20,6 +23,12 @@ import numpy as np
 
 from ..io.excitation import load_obstacles
 from ..model.robot import Robot
+from ..simulation.collision import (
+    DEFAULT_OBSTACLE_CLEARANCE,
+    DEFAULT_RADIUS,
+    DEFAULT_SELF_CLEARANCE,
+    FULL_SIZE_CHAIN,
+)
 from ..simulation.excitation import ExcitationOptions, ExcitationResult, optimise_excitation
 
 __all__ = ["EXCITE_RATE_HZ", "ExcitationDesign", "design_excitation"]
@@ -60,9 +69,12 @@ class ExcitationDesign:
         """Whether the trajectory keeps every limit and clearance."""
         return self.result.status != "infeasible"
 
-    def describe(self, robot: Robot) -> tuple[str, ...]:
+    def describe(self, robot: Robot, name: Callable[[str], str] = str) -> tuple[str, ...]:
         """Two lines: the condition numbers and iterations; the smallest margins; a third
-        when the optimiser did not improve on its start (:meth:`start_note`)."""
+        when the optimiser did not improve on its start (:meth:`start_note`); then the
+        capsule radius and clearances used (:meth:`sizes_line`) and each clearance the
+        result, or a start that mattered, violates (:meth:`clearance_lines`). Options are
+        named by ``name`` (``str``: as the Python API names them)."""
         res, m = self.result, self.result.margins
         first = (
             f"exciting trajectory for {robot.name}: {res.trajectory.total_duration:g} s, "
@@ -86,7 +98,48 @@ class ExcitationDesign:
             + "".join(f", {k} {v:.3g} m" for k, v in m["obstacles"].items())
         )
         note = self.start_note()
-        return (first, second) if note is None else (first, second, note)
+        head = (first, second) if note is None else (first, second, note)
+        return head + (self.sizes_line(name),) + self.clearance_lines(name)
+
+    def sizes_line(self, name: Callable[[str], str] = str) -> str:
+        """The capsule radius and clearances used, which option sets each, and why: given,
+        or the defaults scaled to the arm's chain
+        (:func:`~dynid.simulation.collision.collision_sizes`)."""
+        res, o = self.result, self.result.options
+        radii = np.atleast_1d(np.asarray(o.radii, dtype=np.float64))
+        radius = f"{radii[0]:.3g}" if np.ptp(radii) == 0 else f"{radii.min():.3g}-{radii.max():.3g}"
+        parts = [
+            ("radii", f"capsule radius {radius} m"),
+            ("self_clearance", f"self-clearance {o.self_clearance:.3g} m"),
+            ("obstacle_clearance", f"obstacle clearance {o.obstacle_clearance:.3g} m"),
+        ]
+        text = ", ".join(
+            f"{what} ({'default' if k in res.derived else 'given'}, {name(k)})" for k, what in parts
+        )
+        s = res.sizes
+        if not res.derived or s is None:
+            return text
+        full = f"the defaults for a chain of {FULL_SIZE_CHAIN:g} m or longer"
+        if s.scale == 1.0:
+            return f"{text}; {full} (this arm's is {s.chain_length:.3g} m)"
+        return (
+            f"{text}; {full} ({DEFAULT_RADIUS:g}, {DEFAULT_SELF_CLEARANCE:g}, "
+            f"{DEFAULT_OBSTACLE_CLEARANCE:g} m) scaled by {s.scale:.3g}: this arm's chain is "
+            f"{s.chain_length:.3g} m"
+        )
+
+    def clearance_lines(self, name: Callable[[str], str] = str) -> tuple[str, ...]:
+        """One line per clearance the result violates, naming the links (or the link and
+        the obstacle), their distance and the options that change it; the same for the
+        start when the result is not admissible or the start was not improved on."""
+        res = self.result
+        lines = tuple(f"clearance violated: {a.describe(name)}" for a in res.violated_clearances())
+        if not self.admissible or not res.improved:
+            lines += tuple(
+                f"the optimiser's start violates a clearance: {a.describe(name)}"
+                for a in res.violated_clearances(start=True)
+            )
+        return lines
 
     def start_note(self) -> str | None:
         """Why the result is not better than the optimiser's start, or None when it is."""
@@ -104,6 +157,11 @@ class ExcitationDesign:
         )
         if not self.admissible:
             return f"not improved: {start}, and no admissible iterate was found"
+        if res.status == "reduced":
+            return (
+                f"not better than the start: {start}; the result is the optimiser's "
+                "trajectory with its amplitudes reduced until admissible (status reduced)"
+            )
         return f"not better than the start: {start}; the result is the best admissible iterate"
 
 
