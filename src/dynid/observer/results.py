@@ -13,7 +13,9 @@ import numpy as np
 from numpy.typing import NDArray
 
 from ..exceptions import DataError
+from ..friction.model import FrictionModel, FrictionSum
 from .detection import ContactEvent, Thresholds
+from .friction import banding_note
 from .model import ObserverModel
 from .wrench import WrenchEstimate
 
@@ -85,6 +87,10 @@ class LogObservation:
         observed), when detecting.
     figure : FigureSeries or None
         Every few samples of the series for a figure (kept without the series).
+    friction : FrictionModel, FrictionSum or None
+        The friction the observer evaluated on this log when it is not the model's own:
+        the model's banded for the log's velocity noise
+        (:func:`~dynid.observer.friction.banded_if_narrow`); None: the model's own.
     """
 
     path: Path
@@ -101,6 +107,7 @@ class LogObservation:
     truth_rms: NDArray[np.float64] | None = None
     figure: FigureSeries | None = None
     peak_ratio: NDArray[np.float64] | None = None
+    friction: FrictionModel | FrictionSum | None = None
 
     @property
     def series(self) -> NDArray[np.float64]:
@@ -161,10 +168,13 @@ class ObserveResult:
     def notes(self) -> tuple[str, ...]:
         """What the run's reader should know, one line each: a model without friction
         (static data identify none) leaves the joints' friction in the residual, and in
-        thresholds calibrated on it, where it reads as an external torque."""
+        thresholds calibrated on it, where it reads as an external torque; a friction
+        whose Coulomb step is narrower than the logs' velocity noise is observed with the
+        noise band (:func:`~dynid.observer.friction.banding_note`)."""
         if self.model.friction is None:
             return (NO_FRICTION,)
-        return ()
+        banded = banding_note(self.model.friction, [x.friction for x in self.logs])
+        return () if banded is None else (banded,)
 
 
 #: The note of a model that holds no friction (:attr:`ObserveResult.notes`).

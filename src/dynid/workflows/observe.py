@@ -469,7 +469,10 @@ def _calibrated(
             keep = Series.new(prep, model.n, wants_std, wants_margin) if opts.keep_series else None
             peak = np.zeros(model.n)
             sign = TorqueSign(model.n)
+            seen = model.friction
             for blk in observed_blocks(prep, model, options, wants_std, wants_margin):
+                if blk.friction is not None and blk.friction is not model.friction:
+                    seen = blk.friction  # banded for the velocity noise (a note says so)
                 if blk.margin is not None:
                     np.maximum(peak, blk.margin.max(axis=0), out=peak)
                 if keep is not None:
@@ -480,7 +483,7 @@ def _calibrated(
                 raise DataError(opposite, file=Path(path).name)
             if (unexplained := unexplained_finding(sign, names)) is not None:
                 warnings.warn(f"{Path(path).name}: {unexplained}", DynidWarning, stacklevel=2)
-            logs.append(_observation(prep, model, mapped, opts, keep, peak))
+            logs.append(_observation(prep, model, mapped, opts, keep, peak, seen))
 
     # calibrate reads a block's residual, then its margin and std: these two come from the
     # block the residual was last read from (one block held; itertools.tee would keep up
@@ -530,8 +533,10 @@ def _observation(
     opts: ObserveOptions,
     keep: Series | None,
     peak: NDArray[np.float64],
+    seen: FrictionModel | FrictionSum | None,
 ) -> LogObservation:
-    """A log's observation from its series (None: not kept) and its margin's peak."""
+    """A log's observation from its series (None: not kept), its margin's peak and the
+    friction it was observed with (``seen``)."""
     path, log = prep.path, prep.log
 
     def run() -> LogObservation:
@@ -547,6 +552,7 @@ def _observation(
             None if keep is None else keep.margin,
             tuple(a for a, _ in prep.spans),
             peak,
+            friction=None if seen is model.friction else seen,
         )
 
     return in_file(path, run)
