@@ -17,9 +17,16 @@ from ..friction.model import FrictionModel, FrictionSum
 from .detection import ContactEvent, Thresholds
 from .friction import banding_note
 from .model import ObserverModel
+from .thresholds import ModelFingerprint
 from .wrench import WrenchEstimate
 
-__all__ = ["NO_FRICTION", "FigureSeries", "LogObservation", "ObserveResult"]
+__all__ = [
+    "NO_FRICTION",
+    "FigureSeries",
+    "LogObservation",
+    "ObserveResult",
+    "robot_friction_note",
+]
 
 
 @dataclass(frozen=True, slots=True, eq=False)
@@ -158,23 +165,32 @@ class LogObservation:
 @dataclass(frozen=True, slots=True, eq=False)
 class ObserveResult:
     """What :func:`observe_files` computed: the model, the thresholds (calibrated or read)
-    and every log's observation."""
+    and every log's observation; ``fingerprint``, the files the model was read from, and
+    ``friction_source``, the robot file whose own friction the model holds (a URDF's
+    ``<dynamics>``; None: a friction given or identified)."""
 
     model: ObserverModel
     thresholds: Thresholds
     logs: tuple[LogObservation, ...]
+    fingerprint: ModelFingerprint | None = None
+    friction_source: str | None = None
 
     @property
     def notes(self) -> tuple[str, ...]:
         """What the run's reader should know, one line each: a model without friction
         (static data identify none) leaves the joints' friction in the residual, and in
-        thresholds calibrated on it, where it reads as an external torque; a friction
+        thresholds calibrated on it, where it reads as an external torque; the friction
+        a robot file holds of its own, used when none is given (a URDF's ``<dynamics>``:
+        often a vendor's rough values); a friction
         whose Coulomb step is narrower than the logs' velocity noise is observed with the
         noise band (:func:`~dynid.observer.friction.banding_note`)."""
         if self.model.friction is None:
             return (NO_FRICTION,)
+        own = None
+        if self.friction_source is not None:
+            own = robot_friction_note(self.friction_source, self.model.friction)
         banded = banding_note(self.model.friction, [x.friction for x in self.logs])
-        return () if banded is None else (banded,)
+        return tuple(x for x in (own, banded) if x is not None)
 
 
 #: The note of a model that holds no friction (:attr:`ObserveResult.notes`).
@@ -182,3 +198,20 @@ NO_FRICTION = (
     "the model holds no friction: the joints' friction stays in the residual as an "
     "external torque (and in thresholds calibrated on it)"
 )
+
+
+def robot_friction_note(source: str, friction: FrictionModel | FrictionSum) -> str:
+    """The note of a model whose friction is the robot file ``source``'s own (the law and
+    its largest Coulomb and viscous coefficients)."""
+    parts = friction.parts if isinstance(friction, FrictionSum) else (friction,)
+    sizes = []
+    for name, unit in (("fc", "N m"), ("fv", "N m s/rad")):
+        values = [np.abs(getattr(p, name)) for p in parts if name in p.law.params]
+        if values:
+            sizes.append(f"{name} up to {max(float(v.max()) for v in values):.3g} {unit}")
+    where = " <dynamics damping friction>" if source.lower().endswith(".urdf") else ""
+    return (
+        f"the friction is {source}'s own{where} ({friction.kind}"
+        + (f": {', '.join(sizes)}" if sizes else "")
+        + "); --friction friction.json (of `dynid friction`) replaces it"
+    )

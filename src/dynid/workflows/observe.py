@@ -48,6 +48,7 @@ the command applies, so that the Python API behaves as the command does.
 from __future__ import annotations
 
 import dataclasses
+import hashlib
 import warnings
 from collections.abc import Callable, Iterator, Mapping
 from dataclasses import dataclass
@@ -74,6 +75,7 @@ from ..observer.model import ObserverModel, from_identified, from_robot
 from ..observer.residual import DEFAULT_GAIN, ObserverOptions
 from ..observer.results import LogObservation, ObserveResult
 from ..observer.sign import TorqueSign, opposite_finding, unexplained_finding
+from ..observer.thresholds import ModelFingerprint
 from .data_files import (
     ColumnSpec,
     column_map,
@@ -98,7 +100,9 @@ __all__ = [
     "LogObservation",
     "ObserveOptions",
     "ObserveResult",
+    "friction_source",
     "load_observer_model",
+    "model_fingerprint",
     "observe_files",
     "observer_drive",
 ]
@@ -366,6 +370,17 @@ def observe_files(opts: ObserveOptions, sink: ResidualSink | None = None) -> Obs
         raise OptionError(
             f"{opts.thresholds}: thresholds for {given.n} joints; the model has {model.n}"
         )
+    fingerprint = model_fingerprint(opts)
+    if given is not None and given.model is not None and given.model.sha256 != fingerprint.sha256:
+        assert opts.thresholds is not None
+        warnings.warn(
+            f"{opts.thresholds.name} was calibrated with {given.model}, not with this model "
+            f"({fingerprint}): thresholds fit the residual of their own model; calibrate "
+            "again with this one",
+            DynidWarning,
+            stacklevel=2,
+        )
+    own = friction_source(opts) if model.friction is not None else None
     options = _observer_options(opts, given)
     wants_std = (
         opts.uncertainty and model.covariance is not None
@@ -379,9 +394,11 @@ def observe_files(opts: ObserveOptions, sink: ResidualSink | None = None) -> Obs
         read, model.robot.joint_names, SPIKES_BEFORE_OBSERVER, min_rate_hz=SPIKE_RATE_HZ
     )
     if given is None:
-        return _calibrated(
+        cal = _calibrated(
             read, model, columns[0] is not None, opts, options, wants_std, wants_margin
         )
+        th = dataclasses.replace(cal.thresholds, model=fingerprint)
+        return ObserveResult(model, th, cal.logs, fingerprint, own)
     paths = tuple(map(Path, read.paths))
     logs = []
     for k, (path, log) in enumerate(zip(paths, read.logs, strict=True)):
@@ -405,7 +422,49 @@ def observe_files(opts: ObserveOptions, sink: ResidualSink | None = None) -> Obs
                 table=table,
             )  # fmt: skip
         )
-    return ObserveResult(model, given, tuple(logs))
+    return ObserveResult(model, given, tuple(logs), fingerprint, own)
+
+
+def model_fingerprint(opts: ObserveOptions) -> ModelFingerprint:
+    """The files ``opts`` reads the model from (``model`` or ``params``, ``friction``,
+    ``drive``) by name, and a SHA-256 of their content and of the chain (``base``,
+    ``tip``): a built-in robot's name stands for its file, a :class:`Drive` given as one
+    for its arrays."""
+    h = hashlib.sha256()
+    files = []
+    for what, src in (
+        ("model", opts.model),
+        ("params", opts.params),
+        ("friction", opts.friction),
+        ("drive", opts.drive),
+    ):
+        if src is None:
+            continue
+        h.update(f"\0{what}\0".encode())
+        if isinstance(src, Drive):
+            for f in dataclasses.fields(src):
+                h.update(f"{f.name}={getattr(src, f.name)!r};".encode())
+                if isinstance(v := getattr(src, f.name), np.ndarray):
+                    h.update(np.ascontiguousarray(v, dtype=np.float64).tobytes())
+            files.append("a drive")
+        elif Path(src).is_file():
+            h.update(Path(src).read_bytes())
+            files.append(Path(src).name)
+        else:  # a built-in robot's name
+            h.update(str(src).encode())
+            files.append(str(src))
+    h.update(f"\0base={opts.base}\0tip={opts.tip}".encode())
+    return ModelFingerprint(tuple(files), h.hexdigest())
+
+
+def friction_source(opts: ObserveOptions) -> str | None:
+    """The robot file (or built-in name) whose own friction the model holds: a
+    ``params`` URDF or TOML without ``friction`` (a ``feasible.json``'s friction was
+    identified with it), else None."""
+    if opts.params is None or opts.friction is not None:
+        return None
+    spec = str(opts.params)
+    return None if spec.lower().endswith(".json") else Path(spec).name
 
 
 def _read_logs(
