@@ -36,7 +36,9 @@ Two steps:
   --frame, the external wrench at that frame by damped least squares, NaN where the
   residual is) and OUT/residuals.png (residuals, thresholds, events, and the true
   tau_ext that `dynid simulate --contact` writes beside a log; the summary then gives
-  the RMS of the residual against it per joint), and prints the largest |r| of each log.
+  the RMS of the residual against it per joint), and prints the largest |r| of each log
+  and the events with the time they cover (seconds and % of the logs' duration;
+  events.json's flagged_s and duration_s per log): fewer events can cover more time.
 One contact is one event: runs over the threshold closer than --merge (0.2 s) are joined
 (a push near the threshold on a joint at rest crosses it again and again as the
 standstill margin follows the velocity noise), and an event shorter than --min-duration

@@ -17,7 +17,8 @@
 [s], ``joints`` (1-based) and ``joint_names`` (the same joints by name), ``peak`` [N m]
 (one per joint, signed), ``level`` (``contact`` or ``collision``) and ``log`` (the name
 of the event's log, one log or several), with the model's ``joints`` (names), the data
-files, their sample counts, the model's files and their SHA-256 (``model_files``,
+files, their sample counts, durations and the time their events cover (``duration_s``,
+``flagged_s`` [s] per log), the model's files and their SHA-256 (``model_files``,
 ``model_sha256``) and the units.
 
 ``residuals.csv``: a dynid CSV table (comment lines, ``# rows: N``, a header) with ``t``
@@ -226,7 +227,8 @@ def save_events(
             for k, e in enumerate(events)
         ],
         **(meta or {}),
-        "units": {"start": "s", "end": "s", "peak": "N m", "joints": "1-based"},
+        "units": {"start": "s", "end": "s", "peak": "N m", "joints": "1-based"}
+        | {k: "s" for k in ("duration_s", "flagged_s") if k in (meta or {})},
     }
     return save_json(path, doc, schema=EVENTS_SCHEMA)
 
@@ -399,6 +401,8 @@ def save_observation(
     info = {
         "data": labels,
         "samples": [int(x.t.shape[0]) for x in result.logs],
+        "duration_s": [x.duration() for x in result.logs],
+        "flagged_s": [x.flagged_seconds() for x in result.logs],
         **_fingerprint(result.fingerprint),
         **meta,
     }

@@ -25,6 +25,7 @@ __all__ = [
     "FigureSeries",
     "LogObservation",
     "ObserveResult",
+    "flagged_words",
     "robot_friction_note",
 ]
 
@@ -129,6 +130,15 @@ class LogObservation:
             raise DataError(f"{self.path.name}: no residual series kept (keep_series off)")
         return self.r
 
+    def flagged_seconds(self) -> float:
+        """Time [s] the log's events cover: the sum of ``end - start`` (events never
+        overlap)."""
+        return float(sum(e.end - e.start for e in self.events))
+
+    def duration(self) -> float:
+        """The log's duration [s], first to last sample (0 for fewer than two)."""
+        return float(self.t[-1] - self.t[0]) if self.t.shape[0] > 1 else 0.0
+
     def largest(self) -> NDArray[np.float64]:
         """The largest ``|r|`` of each joint (n,) [N m] (NaN: never observed).
 
@@ -175,6 +185,15 @@ class ObserveResult:
     fingerprint: ModelFingerprint | None = None
     friction_source: str | None = None
 
+    def flagged(self) -> tuple[float, float]:
+        """``(flagged, logged)`` [s]: the time every log's events cover and the logs'
+        total duration. An event count alone misleads as a false-alarm measure: a lower
+        threshold can give fewer events that cover more time (runs merged into one)."""
+        return (
+            float(sum(x.flagged_seconds() for x in self.logs)),
+            float(sum(x.duration() for x in self.logs)),
+        )
+
     @property
     def notes(self) -> tuple[str, ...]:
         """What the run's reader should know, one line each: a model without friction
@@ -215,3 +234,10 @@ def robot_friction_note(source: str, friction: FrictionModel | FrictionSum) -> s
         + (f": {', '.join(sizes)}" if sizes else "")
         + "); --friction friction.json (of `dynid friction`) replaces it"
     )
+
+
+def flagged_words(flagged: float, logged: float) -> str:
+    """``"15.1 s flagged (50.3 % of 30 s logged)"``: the time events cover and its share
+    of the logs' duration."""
+    share = 100.0 * flagged / logged if logged > 0 else 0.0
+    return f"{flagged:.3g} s flagged ({share:.3g} % of {logged:.3g} s logged)"
