@@ -73,6 +73,7 @@ from numpy.typing import NDArray
 
 from ..friction.laws.base import CANONICAL_COLUMNS
 from ..friction.model import FrictionModel, FrictionSum, friction_parts
+from ..identification.log import OBSERVER_CUTOFF_HZ
 
 __all__ = [
     "DERIVED_CUTOFF_HZ",
@@ -98,7 +99,7 @@ FRICTION_COLUMNS = CANONICAL_COLUMNS
 #: identified on such logs): 16 and 7 false events at 5 Hz, 7 and 0 at 10 Hz, none at
 #: 20 Hz, where the position noise through the derivative (bounded by
 #: :func:`derived_velocity_bands`) raises the calibrated thresholds by 20-30 %.
-DERIVED_CUTOFF_HZ = 20.0
+DERIVED_CUTOFF_HZ = OBSERVER_CUTOFF_HZ
 
 
 def canonical_friction(

@@ -47,6 +47,8 @@ the command applies, so that the Python API behaves as the command does.
 
 from __future__ import annotations
 
+import contextlib
+import copy
 import dataclasses
 import hashlib
 import warnings
@@ -57,7 +59,7 @@ from pathlib import Path
 import numpy as np
 from numpy.typing import NDArray
 
-from ..exceptions import DataError, DynidWarning, OptionError
+from ..exceptions import DataError, DynidWarning, OptionError, ShapeError
 from ..exceptions import in_file as about_file
 from ..friction.fit import same_drive
 from ..friction.model import FrictionModel, FrictionSum, placed_friction
@@ -69,6 +71,7 @@ from ..io.model_json import load_model_json
 from ..io.observer_files import load_thresholds
 from ..io.robot_file import load_robot
 from ..model.drive import Drive
+from ..model.robot import Robot
 from ..observer.detection import Thresholds, calibrate
 from ..observer.events import DEFAULT_MERGE_S, DEFAULT_MIN_DURATION_S
 from ..observer.model import ObserverModel, from_identified, from_robot
@@ -100,6 +103,7 @@ __all__ = [
     "LogObservation",
     "ObserveOptions",
     "ObserveResult",
+    "default_tip_hint",
     "friction_source",
     "load_observer_model",
     "model_fingerprint",
@@ -259,10 +263,47 @@ def load_observer_model(
     if spec.lower().endswith(".json") and friction is None:
         lin = load_feasible_linear_friction(spec)
         fr = "robot" if lin is None else lin
-    own = observer_drive(spec, robot.n, drive)
+    chain = default_tip_hint(spec, robot, tip)
+    with _said_with(chain):
+        own = observer_drive(spec, robot.n, drive)
     if friction is not None:  # a file: where the drive puts a robot's own, as simulated
-        fr = placed_friction(load_friction_json(friction), own)
+        loaded = load_friction_json(friction)
+        if loaded.n != robot.n:
+            raise DataError(
+                f"friction for {loaded.n} joints; the model has {robot.n}"
+                + ("" if chain is None else f"; {chain}"),
+                file=Path(friction).name,
+            )
+        fr = placed_friction(loaded, own)
     return from_robot(robot, friction="robot" if fr == "model" else fr, drive=own), None
+
+
+def default_tip_hint(params: str, robot: Robot, tip: str | None) -> str | None:
+    """What a joint-count error says of a ``params`` URDF read to its default tip (no
+    ``tip``): the chain's joints, its last joint and link, and ``--tip``; None otherwise (a
+    chain chosen, another kind of robot). A Z1's default leaf brings in its gripper's
+    joint, and the 6-joint drive file was blamed instead."""
+    if tip is not None or not params.lower().endswith(".urdf"):
+        return None
+    return (
+        f"the model is {Path(params).name}'s chain to its only leaf ({robot.n} joints, the "
+        f"last {robot.joint_names[-1]} moving {robot.link_names[-1]}); hint: end it "
+        "earlier with --tip LINK"
+    )
+
+
+@contextlib.contextmanager
+def _said_with(hint: str | None) -> Iterator[None]:
+    """A :class:`DataError` or :class:`ShapeError` raised inside ends with ``hint`` (the
+    chain a URDF's default tip gave: :func:`default_tip_hint`)."""
+    try:
+        yield
+    except (DataError, ShapeError) as exc:
+        if hint is None or not exc.args:
+            raise
+        err = copy.copy(exc)
+        err.args = (f"{exc.args[0]}; {hint}", *exc.args[1:])
+        raise err from None
 
 
 def observer_drive(params: str | Path, n: int, drive: Drive | Path | None = None) -> Drive | None:
@@ -367,8 +408,11 @@ def observe_files(opts: ObserveOptions, sink: ResidualSink | None = None) -> Obs
     )
     given = None if opts.thresholds is None else load_thresholds(opts.thresholds)
     if given is not None and given.n != model.n:
+        spec = None if opts.params is None else str(opts.params)
+        chain = None if spec is None else default_tip_hint(spec, model.robot, opts.tip)
         raise OptionError(
             f"{opts.thresholds}: thresholds for {given.n} joints; the model has {model.n}"
+            + ("" if chain is None else f"; {chain}")
         )
     fingerprint = model_fingerprint(opts)
     if given is not None and given.model is not None and given.model.sha256 != fingerprint.sha256:
