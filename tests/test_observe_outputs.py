@@ -67,6 +67,28 @@ def test_events_name_their_log_and_joints_with_one_log_or_several(runs):
         assert len(pushed) == 1 and 0 <= pushed[0]["start"] - PUSH.start < 0.02
 
 
+def test_the_time_flagged_is_given_beside_the_event_count(runs):
+    """The count alone misled as a false-alarm measure (fewer events covering more time at
+    a lower threshold): events.json gives each log's duration and the time its events
+    cover, the push's 0.5 s (less the observer's rise, plus its decay) on the pushed log;
+    the report's headline gives the sum and its share of the time logged."""
+    import re
+
+    doc = json.loads((runs / "two" / "events.json").read_text())
+    assert doc["data"] == ["hit.csv", "other.csv"]
+    t_end = 4.0  # uniform_times(4.0): first to last sample
+    assert doc["duration_s"] == pytest.approx([t_end, t_end], abs=1e-9)
+    for log, flagged in zip(doc["data"], doc["flagged_s"], strict=True):
+        covered = sum(e["end"] - e["start"] for e in doc["events"] if e["log"] == log)
+        assert flagged == pytest.approx(covered, abs=1e-12)
+    assert 0.4 < doc["flagged_s"][0] < 0.6
+    page = (runs / "two" / "report.html").read_text()
+    text = re.sub(r"<[^>]+>", "", page)
+    total = sum(doc["flagged_s"])
+    share = 100 * total / (2 * t_end)
+    assert f"{total:.3g} s flagged ({share:.3g} % of {2 * t_end:.3g} s logged)" in text
+
+
 def test_the_largest_residual_is_printed_per_log(runs, capsys):
     """With two logs the table's column says it pools them, and a line per log gives that
     log's largest |r| per joint: those of its residual table."""

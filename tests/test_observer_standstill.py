@@ -257,3 +257,79 @@ def test_a_smooth_law_narrower_than_the_noise_band_is_observed_with_the_band():
     np.testing.assert_allclose(standstill_margin(seen, at_rest, (band,)), [P[:, 1]], rtol=1e-12)
     wide = LAWS["smooth"].model(P, np.full(n, 5e-2))
     assert banded_if_narrow(wide, (band,)) is wide
+
+
+def _observed(model, log, name):
+    """The residual and the standstill margin of ``log`` as ``dynid observe`` runs it
+    (velocity bands estimated on the log, the friction banded where narrower), and the
+    friction it was observed with."""
+    from pathlib import Path
+
+    from dynid.identification.log import TorqueLog
+    from dynid.workflows.observe_logs import observed_blocks, prepared_log
+
+    log = TorqueLog(t=log.t, q=log.q, dq=log.dq, tau=log.tau)
+    prep = prepared_log(Path(name), log, model, None)
+    blocks = list(observed_blocks(prep, model, ObserverOptions(gain=K), False, True))
+    r = np.concatenate([x.r for x in blocks])
+    w = np.concatenate([x.margin for x in blocks])
+    return log.t, r, w, blocks[0].friction
+
+
+def test_a_sign_law_without_a_band_on_noisy_velocities_is_observed_with_the_noise_band():
+    """Classical friction typed without a standstill band (``fc sign(dq)``) on velocities
+    with noise: at every rest the sign of the noise flips the whole Coulomb torque, which
+    the calibration read as collision-free residual (thresholds 4-5 times those of the same
+    law with its band on a Z1, weak contacts missed). Observed with the velocity noise band
+    as its band, the thresholds are within 1.5 times those of the true banded law
+    (simulated truth: the same law, band 5 noise stds), and a push on a joint at rest is
+    found at its time, with no other event."""
+    from dynid.observer.friction import banded_if_narrow, banding_note
+
+    from conftest import point_to_point
+
+    robot = dynid.panda()
+    noise = SensorNoise(tau_std=0.05, q_std=1e-5, dq_std=1e-3)
+    truth = ClassicalFriction(FV, FC, np.zeros(7))
+    sim = [
+        simulate_measurement(
+            robot,
+            point_to_point(robot, seed),
+            rng=np.random.default_rng(seed),
+            noise=noise,
+            friction=truth,
+        )  # fmt: skip
+        for seed in (11, 12)
+    ]
+    bare = from_robot(robot).with_friction(truth)
+    banded = from_robot(robot).with_friction(
+        ClassicalFriction(FV, FC, np.zeros(7), np.full(7, 5 * 1e-3))
+    )
+    opts = ObserverOptions(gain=K)
+    t, r, w, seen = _observed(bare, sim[0], "cal.csv")
+    fixed = calibrate([r], opts, standstill=[w])
+    assert seen is not truth and np.all(seen.band > 3e-3) and np.all(seen.band < 7e-3)
+    _, r0, w0, _ = _observed(banded, sim[0], "cal.csv")
+    reference = calibrate([r0], opts, standstill=[w0])
+    plain = _residual(bare, opts, sim[0])  # the defect: the sign of the noise as a residual
+    defect = calibrate([plain], opts, standstill=[standstill_series(bare, t, sim[0].dq, opts)])
+    assert np.max(defect.contact / reference.contact) > 2.0
+    ratio = fixed.contact / reference.contact
+    assert np.all(ratio < 1.5) and np.all(ratio > 1 / 1.5), ratio
+    note = banding_note(truth, [seen])
+    assert note is not None and "joint(s) 1, 2, 3, 4, 5, 6, 7" in note
+    assert banded_if_narrow(banded.friction, (seen.band,)) is banded.friction  # its own band
+    smooth = LAWS["smooth"].model(np.column_stack([FV, FC, np.zeros(7)]), np.full(7, 1e-4))
+    assert banding_note(smooth, [banded_if_narrow(smooth, (seen.band,))]) is None  # as meant
+
+    # a push of 5 N m on joint 2 during the fourth rest (7.8-8.8 s of each point-to-point log)
+    j, A, (a, b) = 1, 5.0, (8.0, 8.4)
+    log = sim[1]
+    hit = (log.t >= a) & (log.t < b)
+    tau = np.array(log.tau)
+    tau[hit, j] -= A
+    pushed = type(log)(t=log.t, q=log.q, dq=log.dq, tau=tau)
+    t, r, w, _ = _observed(bare, pushed, "hit.csv")
+    events = detect(t, r, fixed, standstill=w)
+    assert len(events) == 1 and j + 1 in events[0].joints, events
+    assert a <= events[0].start <= a + 0.1

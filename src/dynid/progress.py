@@ -18,10 +18,17 @@ renderer for every command (throttled, on a terminal, silent with ``-q``:
 from __future__ import annotations
 
 import contextlib
+import logging
 from collections.abc import Callable, Iterator
 from contextvars import ContextVar
 
-__all__ = ["Progress", "report", "reporting", "rows_read", "stage"]
+__all__ = ["NOTE", "Progress", "report", "reporting", "rows_read", "stage"]
+
+#: Logging level of a note, between ``INFO`` and ``WARNING``: what the reader should know
+#: that is no problem (a unit converted as asked, a sign flipped by ``--units tau=-1``).
+#: The command line prints it as ``dynid CMD: note: ...`` (silent with ``-q``).
+NOTE = 25
+logging.addLevelName(NOTE, "NOTE")
 
 #: A progress callback: one line of text per step.
 Progress = Callable[[str], None]

@@ -37,6 +37,7 @@ from typing import TYPE_CHECKING, TextIO
 
 from .. import __version__
 from ..exceptions import DynidError, OptionError
+from ..progress import NOTE
 
 if TYPE_CHECKING:
     from ..outputs.run_output import RunOutput
@@ -289,9 +290,7 @@ def _main(argv: Sequence[str] | None) -> int:
     level = (
         logging.ERROR
         if args.quiet
-        else (
-            logging.DEBUG if args.verbose > 1 else logging.INFO if args.verbose else logging.WARNING
-        )
+        else (logging.DEBUG if args.verbose > 1 else logging.INFO if args.verbose else NOTE)
     )
     log_to_stderr(args.command, level)
     say = f"dynid {args.command}"

@@ -21,6 +21,7 @@ from typing import Any
 
 from .._checks import text as as_text
 from ..io.json_files import dumps
+from ..progress import NOTE
 from .run_report import RunRecord
 
 __all__ = ["PROGRESS_AFTER_S", "PROGRESS_EVERY_S", "Console", "LogFormat", "log_to_stderr"]
@@ -127,8 +128,9 @@ class Console:
 
 
 class LogFormat(logging.Formatter):
-    """Log lines as the command's own: a warning or error logged by the library reads
-    ``dynid identify: warning: r1.csv: ...`` like :meth:`Console.warn`; the informational
+    """Log lines as the command's own: a note, warning or error logged by the library reads
+    ``dynid identify: warning: r1.csv: ...`` like :meth:`Console.warn` (a note like
+    :meth:`Console.note`, level :data:`~dynid.progress.NOTE`); the informational
     and debug lines of ``-v`` keep their level and logger (``INFO dynid.identification.core:
     ...``)."""
 
@@ -138,7 +140,7 @@ class LogFormat(logging.Formatter):
 
     def format(self, record: logging.LogRecord) -> str:
         """One line of ``record``."""
-        if record.levelno >= logging.WARNING:
+        if record.levelno >= NOTE:
             return f"dynid {self.command}: {record.levelname.lower()}: {record.getMessage()}"
         return f"{record.levelname} {record.name}: {record.getMessage()}"
 

@@ -10,7 +10,10 @@ table); --drive gives the drive of a robot without one (as validate takes it; an
 drive than the model's or the feasible.json's is refused); --friction replaces the
 friction (a friction.json of `dynid friction`, with its standstill band). A model that
 holds no friction (identified from static data) leaves the joints' friction in the
-residual, where it reads as an external torque: a note says so.
+residual, where it reads as an external torque: a note says so; so does a note name
+the friction a URDF brings of its own (<dynamics damping friction>) when no --friction
+is given, and a sharp Coulomb law without a standstill band (or with one well inside the
+velocity noise), which is observed with the noise band as its band.
 
 Two steps:
   --calibrate on collision-free logs writes OUT/thresholds.json: per joint, the largest
@@ -25,13 +28,17 @@ Two steps:
   --discretisation and --rule choose the observer, which the thresholds keep. A log
   whose torques have the opposite sign to the model's on some joint (the residual there
   twice the torque) is refused, naming the file and the joints.
+  thresholds.json records the model's files and a SHA-256 of their content: detecting
+  with another model warns.
   --thresholds thresholds.json on any logs writes OUT/events.json (dynid-events/1: start
   and end [s], joints (1-based) and joint_names, peak [N m] per joint and level, contact
   or collision, and the log of every event), OUT/residuals.csv (t, r1..rn and, with
   --frame, the external wrench at that frame by damped least squares, NaN where the
   residual is) and OUT/residuals.png (residuals, thresholds, events, and the true
   tau_ext that `dynid simulate --contact` writes beside a log; the summary then gives
-  the RMS of the residual against it per joint), and prints the largest |r| of each log.
+  the RMS of the residual against it per joint), and prints the largest |r| of each log
+  and the events with the time they cover (seconds and % of the logs' duration;
+  events.json's flagged_s and duration_s per log): fewer events can cover more time.
 One contact is one event: runs over the threshold closer than --merge (0.2 s) are joined
 (a push near the threshold on a joint at rest crosses it again and again as the
 standstill margin follows the velocity noise), and an event shorter than --min-duration

@@ -21,6 +21,7 @@ from collections.abc import Sequence
 from typing import Any, TextIO
 
 from ..outputs.run_output import RunOutput
+from ..progress import NOTE
 from ..report import REPORT_NAME, ReportTable, RunSummary, save_html_report
 
 __all__ = ["RunRecord", "save_run_report"]
@@ -68,10 +69,11 @@ class RunRecord:
         self.err_parts: list[str] = []
         self.stdout_closed = False
         self.logged: list[str] = []
+        self.logged_notes: list[str] = []
         self.tables: list[tuple[str, list[str], list[list[str]]]] = []
         self.started = time.time()
         self._saved: tuple[Any, Any] | None = None
-        self._handler = _Collect(self.logged)
+        self._handler = _Collect(self.logged, self.logged_notes)
 
     def __enter__(self) -> RunRecord:
         self._saved = (sys.stdout, sys.stderr)
@@ -96,27 +98,30 @@ class RunRecord:
 
     def lines(self, prefix: str) -> list[str]:
         """Lines of stdout and stderr that hold ``prefix`` (``"warning: "``, ``"note: "``),
-        from the prefix on; logged warnings count as warnings (once, printed or not)."""
+        from the prefix on; logged warnings and notes count as such (once, printed or
+        not)."""
         found = []
         for text in ("".join(self.err_parts), self.printed):
             for line in text.splitlines():
                 s = line.strip()
                 if prefix in s:
                     found.append(s[s.index(prefix) + len(prefix) :])
-        logged = self.logged if prefix == "warning: " else []
+        logged = {"warning: ": self.logged, "note: ": self.logged_notes}.get(prefix, [])
         return found + [m for m in logged if m not in found]
 
 
 class _Collect(logging.Handler):
-    """Keeps the messages of the warnings logged during a run."""
+    """Keeps the messages of the warnings and of the notes (:data:`~dynid.progress.NOTE`)
+    logged during a run."""
 
-    def __init__(self, into: list[str]) -> None:
-        super().__init__(logging.WARNING)
-        self._into = into
+    def __init__(self, warned: list[str], noted: list[str]) -> None:
+        super().__init__(NOTE)
+        self._warned, self._noted = warned, noted
 
     def emit(self, record: logging.LogRecord) -> None:
         with contextlib.suppress(Exception):
-            self._into.append(record.getMessage())
+            into = self._warned if record.levelno >= logging.WARNING else self._noted
+            into.append(record.getMessage())
 
 
 def option_text(value: object) -> str:

@@ -20,7 +20,7 @@ from ..identification.model import IdentifiedModel
 from ..identification.structure import MIN_WIDTH
 from ..io.observer_files import log_labels
 from ..observer.detection import undetected_at_rest
-from ..observer.results import LogObservation, ObserveResult
+from ..observer.results import LogObservation, ObserveResult, flagged_words
 from ..pipeline.collision import CollisionStageResult
 from ..regressors.base import identifiability
 from .structure_table import selection_lines, text_width
@@ -631,7 +631,7 @@ def format_observation(result: ObserveResult, names: list[str], *, calibrating: 
         for label, x in zip(labels, result.logs, strict=True):
             rows.append(f"  {label:<{width}}  " + "  ".join(f"{v:8.4g}" for v in x.largest()))
     events = [(label, e) for x, label in zip(result.logs, labels, strict=True) for e in x.events]
-    rows.append(f"{len(events)} event(s)")
+    rows.append(f"{len(events)} event(s), {flagged_words(*result.flagged())}")
     for log, e in events:
         top = max(e.joints, key=lambda j: abs(e.peak[j - 1]))
         rows.append(

@@ -44,6 +44,7 @@ from ..model.drive import Drive
 
 __all__ = [
     "DEFAULT_CUTOFF_HZ",
+    "OBSERVER_CUTOFF_HZ",
     "LogCleaning",
     "TorqueLog",
     "default_max_gap",
@@ -59,6 +60,11 @@ __all__ = [
 #: add to the torques, so the default here is higher. Choose the cutoff well above the
 #: highest frequency of the trajectory (several times its highest harmonic).
 DEFAULT_CUTOFF_HZ = 5.0
+
+#: Cut-off [Hz] at which ``dynid observe`` derives the velocities of a log without them,
+#: above the observer's own bandwidth (:data:`dynid.observer.friction.DERIVED_CUTOFF_HZ`
+#: says why), named here for :func:`velocity_note`.
+OBSERVER_CUTOFF_HZ = 20.0
 
 _SIGNALS = ("q", "dq", "tau", "ddq")
 
@@ -328,12 +334,15 @@ def with_derived_velocities(log: TorqueLog, cutoff_hz: float = DEFAULT_CUTOFF_HZ
 
 
 def velocity_note(cutoff_hz: float) -> str:
-    """The note said when :func:`with_derived_velocities` derives a log's velocities."""
+    """The note said when :func:`with_derived_velocities` derives a log's velocities at
+    ``cutoff_hz`` [Hz] (the reader's): each step derives them again at its own cut-off, the
+    observer at :data:`OBSERVER_CUTOFF_HZ`."""
     return (
         "no velocity columns: velocities derived from the positions (zero-phase low-pass, "
         "then central differences) at the cut-off of the step that prepares the log "
-        "(identification, validation and friction at theirs, the observer at its own; "
-        f"{cutoff_hz:g} Hz when read alone)"
+        "(identification, validation and friction at theirs, "
+        f"{cutoff_hz:g} Hz when the log is read alone; the observer at "
+        f"{OBSERVER_CUTOFF_HZ:g} Hz)"
     )
 
 

@@ -25,7 +25,7 @@ from __future__ import annotations
 
 import math
 import re
-from collections.abc import Mapping
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 from types import MappingProxyType
@@ -53,6 +53,7 @@ __all__ = [
     "ColumnMap",
     "MappedLog",
     "MappedStatic",
+    "conversion_notes",
     "load_column_map",
     "parse_column_map",
     "load_mapped_static_data",
@@ -412,11 +413,14 @@ class MappedLog:
     ----------
     log : TorqueLog
     notes : tuple of str
-        Human-readable notes (velocities derived, units converted).
+        What the reader should be warned of (velocities derived from the positions).
+    conversions : tuple of str
+        The units converted as the map asked (:func:`conversion_notes`), said as notes.
     """
 
     log: TorqueLog
     notes: tuple[str, ...] = ()
+    conversions: tuple[str, ...] = ()
 
 
 def load_mapped_torque_log(
@@ -461,19 +465,32 @@ def load_mapped_torque_log(
     dq = _vector(table, columns, "dq", n)
     ddq = _vector(table, columns, "ddq", n)
     _check_distinct(table, columns, ("t", "q", "dq", "tau", "ddq"), n)
-    notes = [
-        f"{k} scaled by {columns.factor(k):.17g} to SI" for k in columns.factors if k in _DEFAULT
-    ]
+    said = conversion_notes(columns, [k for k in columns.factors if k in _DEFAULT])
     try:
         if dq is not None:
             return MappedLog(
-                TorqueLog.from_raw(t, q, dq, tau, ddq, gap_factor=gap_factor), tuple(notes)
+                TorqueLog.from_raw(t, q, dq, tau, ddq, gap_factor=gap_factor), (), said
             )
         raw = TorqueLog.from_raw(t, q, np.zeros_like(q), tau, ddq, gap_factor=gap_factor)
     except DataError as exc:
         raise DataError(str(exc), file=path.name) from exc
-    notes.append(velocity_note(columns.velocity_cutoff_hz))
-    return MappedLog(with_derived_velocities(raw, columns.velocity_cutoff_hz), tuple(notes))
+    notes = (velocity_note(columns.velocity_cutoff_hz),)
+    return MappedLog(with_derived_velocities(raw, columns.velocity_cutoff_hz), notes, said)
+
+
+def conversion_notes(columns: ColumnMap, quantities: Sequence[str]) -> tuple[str, ...]:
+    """What reading through ``columns`` did to ``quantities``, one line each:
+    ``tau sign flipped (--units tau=-1)`` for a factor of -1 (a sign convention, not a
+    unit), ``q scaled by 0.017453292519943295 to SI`` for any other (``(sign flipped)``
+    added where negative)."""
+    out = []
+    for k in quantities:
+        f = columns.factor(k)
+        if f == -1.0:
+            out.append(f"{k} sign flipped (--units {k}=-1)")
+        else:
+            out.append(f"{k} scaled by {f:.17g} to SI" + (" (sign flipped)" if f < 0 else ""))
+    return tuple(out)
 
 
 def load_joint_columns(path: str | Path, name: str, n: int) -> NDArray[np.float64] | None:
@@ -499,10 +516,12 @@ def load_joint_columns(path: str | Path, name: str, n: int) -> NDArray[np.float6
 
 @dataclass(frozen=True, slots=True)
 class MappedStatic:
-    """Static data read through a column map: the data set and notes."""
+    """Static data read through a column map: the data set, what the reader should be
+    warned of (``notes``) and the units converted (``conversions``, said as notes)."""
 
     data: StaticDataset
     notes: tuple[str, ...] = ()
+    conversions: tuple[str, ...] = ()
 
 
 def load_mapped_static_data(
@@ -564,5 +583,5 @@ def load_mapped_static_data(
     bad |= ~np.all(np.isfinite(M.reshape(len(M), -1)), 1)
     if bad.any():
         raise DataError(f"row {int(np.argmax(bad))} holds NaN or inf", file=path.name)
-    notes = extra + tuple(f"{k} scaled by {columns.factor(k):.17g} to SI" for k in columns.factors)
-    return MappedStatic(StaticDataset(q, M, g, {"file": path.name}), notes)
+    said = conversion_notes(columns, list(columns.factors))
+    return MappedStatic(StaticDataset(q, M, g, {"file": path.name}), extra, said)

@@ -9,6 +9,7 @@
      "uncertainty": null | {"k_sigma": 3.0, "noise": [...]},
      "observer": {"gain": [...], "discretisation": "exact", "rule": "trapezoid"},
      "calibration": {"samples": N, "data": [file names], "model": ...,
+                     "model_files": [...], "model_sha256": "...",  # what the model was
                      "at_rest": [...]},   # N m per joint, with the standstill margin
      "units": {...}}
 
@@ -16,7 +17,9 @@
 [s], ``joints`` (1-based) and ``joint_names`` (the same joints by name), ``peak`` [N m]
 (one per joint, signed), ``level`` (``contact`` or ``collision``) and ``log`` (the name
 of the event's log, one log or several), with the model's ``joints`` (names), the data
-files, their sample counts and the units.
+files, their sample counts, durations and the time their events cover (``duration_s``,
+``flagged_s`` [s] per log), the model's files and their SHA-256 (``model_files``,
+``model_sha256``) and the units.
 
 ``residuals.csv``: a dynid CSV table (comment lines, ``# rows: N``, a header) with ``t``
 [s], ``r1 .. rn`` [N m] and, with a frame, ``fx, fy, fz`` [N], ``mx, my, mz`` [N m] and
@@ -39,6 +42,7 @@ from ..exceptions import DataError, DynidError
 from ..observer.detection import ContactEvent, Thresholds, undetected_at_rest
 from ..observer.residual import ObserverOptions
 from ..observer.results import LogObservation, ObserveResult
+from ..observer.thresholds import ModelFingerprint
 from .atomic import open_atomic
 from .json_files import save_json
 from .schema import Field, Format, Record, load_document, save_document
@@ -145,10 +149,17 @@ def save_thresholds(
             "discretisation": o.discretisation,
             "rule": o.rule,
         },
-        "calibration": {"samples": th.samples, **(calibration or {})},
+        "calibration": {"samples": th.samples, **_fingerprint(th.model), **(calibration or {})},
         "units": {"contact": "N m", "collision": "N m", "noise": "N m", "gain": "1/s"},
     }
     return save_document(path, THRESHOLDS, doc)
+
+
+def _fingerprint(model: ModelFingerprint | None) -> dict[str, Any]:
+    """The keys a model's fingerprint is written as (none without one)."""
+    if model is None:
+        return {}
+    return {"model_files": list(model.files), "model_sha256": model.sha256}
 
 
 def load_thresholds(path: str | Path) -> Thresholds:
@@ -162,6 +173,11 @@ def load_thresholds(path: str | Path) -> Thresholds:
     path = Path(path)
     d = load_document(path, THRESHOLDS)
     rule, obs, unc = d["rule"], d["observer"], d.get("uncertainty")
+    cal = d.get("calibration", {})
+    files, sha = cal.get("model_files"), cal.get("model_sha256")
+    model = None
+    if isinstance(sha, str) and isinstance(files, list):
+        model = ModelFingerprint(tuple(str(f) for f in files), sha)
     try:
         return Thresholds(
             contact=np.array(d["contact"], dtype=float),
@@ -178,6 +194,7 @@ def load_thresholds(path: str | Path) -> Thresholds:
             k_sigma=None if unc is None else float(unc["k_sigma"]),
             noise=None if unc is None else np.array(unc["noise"], dtype=float),
             standstill=bool(rule.get("standstill_margin", False)),
+            model=model,
         )
     except DynidError as exc:
         raise DataError(str(exc), file=path.name) from None
@@ -210,7 +227,8 @@ def save_events(
             for k, e in enumerate(events)
         ],
         **(meta or {}),
-        "units": {"start": "s", "end": "s", "peak": "N m", "joints": "1-based"},
+        "units": {"start": "s", "end": "s", "peak": "N m", "joints": "1-based"}
+        | {k: "s" for k in ("duration_s", "flagged_s") if k in (meta or {})},
     }
     return save_json(path, doc, schema=EVENTS_SCHEMA)
 
@@ -383,6 +401,9 @@ def save_observation(
     info = {
         "data": labels,
         "samples": [int(x.t.shape[0]) for x in result.logs],
+        "duration_s": [x.duration() for x in result.logs],
+        "flagged_s": [x.flagged_seconds() for x in result.logs],
+        **_fingerprint(result.fingerprint),
         **meta,
     }
     paths.insert(

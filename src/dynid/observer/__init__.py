@@ -32,12 +32,13 @@ from .events import ContactEvent, EventDetector, detect
 from .model import ObserverModel, from_identified, from_robot
 from .residual import MomentumObserver, ObserverOptions, ObserverResult, first_order_lag, observe
 from .terms import base_momentum_regressor, momentum_regressor, momentum_terms
-from .thresholds import Thresholds
+from .thresholds import ModelFingerprint, Thresholds
 from .wrench import WrenchEstimate, external_wrench
 
 __all__ = [
     "ContactEvent",
     "EventDetector",
+    "ModelFingerprint",
     "MomentumObserver",
     "ObserverModel",
     "ObserverOptions",

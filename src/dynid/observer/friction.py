@@ -46,7 +46,11 @@ than that band changes by up to its whole height between the two: per motor, eac
 ``w``. Through a gear of ratio ``K`` a motor's velocity noise and its friction both grow
 with ``K``: a motor sigmoid of 8 N m and ``phi2 = 30`` s/rad behind a ratio of 120 moves
 the joint torque by up to 960 N m within the noise of a reversal, which a calibration
-without this bound reads as the collision-free residual.
+without this bound reads as the collision-free residual. A sharp step (``fc sign(dq)``)
+with a standstill band well inside that noise band (none at all: a law typed without one)
+flips its whole height with the sign of the noise at every rest; the observer takes the
+noise band as its standstill band instead (:func:`banded_if_narrow`, as it bands a
+narrow smooth law), and a note says so (:func:`banding_note`).
 
 Velocities *derived* from the positions (a log without velocity columns) are smooth: the
 noise estimate above finds next to nothing, and an identification on them a standstill
@@ -62,16 +66,21 @@ the wrong side of zero: ``w`` then also holds the step's change within the band,
 
 from __future__ import annotations
 
+from collections.abc import Sequence
+
 import numpy as np
 from numpy.typing import NDArray
 
 from ..friction.laws.base import CANONICAL_COLUMNS
 from ..friction.model import FrictionModel, FrictionSum, friction_parts
+from ..identification.log import OBSERVER_CUTOFF_HZ
 
 __all__ = [
     "DERIVED_CUTOFF_HZ",
     "FRICTION_COLUMNS",
+    "NARROW_BAND",
     "banded_if_narrow",
+    "banding_note",
     "canonical_friction",
     "derived_velocity_bands",
     "standstill_margin",
@@ -90,7 +99,7 @@ FRICTION_COLUMNS = CANONICAL_COLUMNS
 #: identified on such logs): 16 and 7 false events at 5 Hz, 7 and 0 at 10 Hz, none at
 #: 20 Hz, where the position noise through the derivative (bounded by
 #: :func:`derived_velocity_bands`) raises the calibrated thresholds by 20-30 %.
-DERIVED_CUTOFF_HZ = 20.0
+DERIVED_CUTOFF_HZ = OBSERVER_CUTOFF_HZ
 
 
 def canonical_friction(
@@ -182,35 +191,108 @@ def derived_velocity_bands(
     return tuple(out)
 
 
+#: A sharp Coulomb step (``fc s(dq)``) whose standstill band is below this fraction of the
+#: velocity noise band is observed with the noise band (:func:`banded_if_narrow`). An
+#: identified band is its own logs' noise band, estimated again on each observed log within
+#: some tens of percent: only a band well inside the noise (none at all, a law typed by
+#: hand) is widened.
+NARROW_BAND = 0.5
+
+
 def banded_if_narrow(
-    friction: FrictionModel | FrictionSum | None, bands: tuple[NDArray[np.float64], ...]
+    friction: FrictionModel | FrictionSum | None,
+    bands: tuple[NDArray[np.float64], ...],
+    *,
+    derived: bool = False,
 ) -> FrictionModel | FrictionSum | None:
     """``friction`` as the observer evaluates it on velocities of noise band ``bands``
     (:func:`velocity_bands` or :func:`derived_velocity_bands`, one per part): a smooth
     Coulomb law ``fc tanh(dq / w)`` narrower than the band on every motor becomes the
     classical law with the band as its standstill band (``fc sign(dq)`` outside it, 0
-    inside), a smooth-sign Stribeck law the banded Stribeck law; any other friction as it
-    is.
+    inside), a smooth-sign Stribeck law the banded Stribeck law; a law with a sharp Coulomb
+    step (classical, quadratic, asymmetric, Stribeck) gets the band as its standstill band
+    on every motor whose own band is below :data:`NARROW_BAND` times it (measured
+    velocities only: ``derived`` bands are bounded by :func:`standstill_margin`'s derived
+    term instead); each part of a sum on its own; any other friction as it is
+    (:func:`banding_note` says what changed).
 
-    Inside the band a narrow ``tanh`` of the noise is a random level in ``[-fc, fc]``, which
-    bounds the residual of a joint at rest by ``2 fc`` (:func:`standstill_margin`); the
-    band's zero bounds it by ``fc``, as for a law identified with the band, and outside
-    the band both are the sign. Identification chooses the narrow law because it predicts
-    torques in motion best; at rest the observer needs the band (a UR10 with a contact
-    at rest: margins of 15.9 N m on joint 1 with the narrow law, 7.1 N m with the band)."""
-    banded_law = {"smooth": "classical", "smooth_stribeck": "stribeck"}
-    if friction is None or isinstance(friction, FrictionSum) or friction.kind not in banded_law:
+    Inside the band a narrow ``tanh`` of the noise is a random level in ``[-fc, fc]``, and
+    ``sign(dq)`` of the noise a random ``+-fc``, which bounds the residual of a joint at rest
+    by ``2 fc`` (:func:`standstill_margin`); the band's zero bounds it by ``fc``, as for a
+    law identified with the band, and outside the band both are the sign. Identification
+    chooses the narrow law because it predicts torques in motion best; at rest the
+    observer needs the band (a UR10 with a contact at rest: margins of 15.9 N m on joint
+    1 with the narrow law, 7.1 N m with the band; a Z1 with classical friction typed
+    without a band: thresholds 4-5 times those of the same law with its band, 10 of 13
+    weak contacts missed)."""
+    if isinstance(friction, FrictionSum):
+        parts = tuple(
+            _banded_part(p, b, derived) for p, b in zip(friction.parts, bands, strict=True)
+        )
+        if all(a is b for a, b in zip(parts, friction.parts, strict=True)):
+            return friction
+        return FrictionSum(parts)
+    if friction is None:
         return friction
     (b,) = bands
-    width = np.asarray(friction.band, dtype=np.float64)
-    if width.size != b.size or not np.all(width < b):
-        return friction
+    return _banded_part(friction, b, derived)
+
+
+def _banded_part(friction: FrictionModel, b: NDArray[np.float64], derived: bool) -> FrictionModel:
+    """One part of :func:`banded_if_narrow`."""
     from ..friction.laws import LAWS
 
-    banded: FrictionModel = LAWS[banded_law[friction.kind]].model(
-        np.asarray(friction.params), b, getattr(friction, "drive", None)
+    banded_law = {"smooth": "classical", "smooth_stribeck": "stribeck"}
+    width = np.asarray(friction.band, dtype=np.float64)
+    drive = getattr(friction, "drive", None)
+    if width.size != b.size:
+        return friction
+    if friction.kind in banded_law:
+        if not np.all(width < b):
+            return friction
+        return LAWS[banded_law[friction.kind]].model(np.asarray(friction.params), b, drive)
+    canon = canonical_friction(friction, b.size)
+    if derived or canon is None or not getattr(friction.law, "standstill", False):
+        return friction
+    F = canon[1]
+    sharp = (F[:, 2] != 0) | (F[:, 3] != 0) | ((F[:, 6] != 0) & (F[:, 9] == 0))
+    narrow = sharp & (width < NARROW_BAND * b)
+    if not narrow.any():
+        return friction
+    return friction.law.model(np.asarray(friction.params), np.where(narrow, b, width), drive)
+
+
+def banding_note(
+    friction: FrictionModel | FrictionSum | None,
+    seen: Sequence[FrictionModel | FrictionSum | None],
+) -> str | None:
+    """One line saying which sharp Coulomb steps of ``friction`` :func:`banded_if_narrow`
+    widened for the logs (``seen``: the friction each log was observed with): the law, the
+    joints (or motors) and the largest band used [rad/s]; None where it widened none (a
+    smooth law observed with the band, as identification means it, is not noted)."""
+    changed = [s for s in seen if s is not None and s is not friction]
+    said = []
+    for k, part in enumerate(friction_parts(friction) if changed else ()):
+        used = [u for s in changed if (u := friction_parts(s)[k]).kind == part.kind]
+        widened = [np.asarray(u.band) > np.asarray(part.band) for u in used]
+        if not np.any(widened):
+            continue
+        moved = np.any(widened, axis=0)
+        bands = [np.asarray(u.band)[w] for u, w in zip(used, widened, strict=True)]
+        top = max(float(np.max(b, initial=0.0)) for b in bands)
+        where = "motor" if part.at_motors else "joint"
+        said.append(
+            f"{part.kind} friction: the standstill band of {where}(s) "
+            f"{', '.join(str(j + 1) for j in np.flatnonzero(moved))} is inside the velocity "
+            f"noise, observed with the noise band (up to {top:.3g} rad/s)"
+        )
+    if not said:
+        return None
+    return (
+        "; ".join(said) + ": sign(dq) of the noise at rest would flip the whole Coulomb "
+        "torque, read as external torque (a friction.json of `dynid friction` carries its "
+        "own band)"
     )
-    return banded
 
 
 def standstill_margin(

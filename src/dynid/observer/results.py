@@ -13,11 +13,21 @@ import numpy as np
 from numpy.typing import NDArray
 
 from ..exceptions import DataError
+from ..friction.model import FrictionModel, FrictionSum
 from .detection import ContactEvent, Thresholds
+from .friction import banding_note
 from .model import ObserverModel
+from .thresholds import ModelFingerprint
 from .wrench import WrenchEstimate
 
-__all__ = ["NO_FRICTION", "FigureSeries", "LogObservation", "ObserveResult"]
+__all__ = [
+    "NO_FRICTION",
+    "FigureSeries",
+    "LogObservation",
+    "ObserveResult",
+    "flagged_words",
+    "robot_friction_note",
+]
 
 
 @dataclass(frozen=True, slots=True, eq=False)
@@ -85,6 +95,10 @@ class LogObservation:
         observed), when detecting.
     figure : FigureSeries or None
         Every few samples of the series for a figure (kept without the series).
+    friction : FrictionModel, FrictionSum or None
+        The friction the observer evaluated on this log when it is not the model's own:
+        the model's banded for the log's velocity noise
+        (:func:`~dynid.observer.friction.banded_if_narrow`); None: the model's own.
     """
 
     path: Path
@@ -101,6 +115,7 @@ class LogObservation:
     truth_rms: NDArray[np.float64] | None = None
     figure: FigureSeries | None = None
     peak_ratio: NDArray[np.float64] | None = None
+    friction: FrictionModel | FrictionSum | None = None
 
     @property
     def series(self) -> NDArray[np.float64]:
@@ -114,6 +129,15 @@ class LogObservation:
         if self.r is None:
             raise DataError(f"{self.path.name}: no residual series kept (keep_series off)")
         return self.r
+
+    def flagged_seconds(self) -> float:
+        """Time [s] the log's events cover: the sum of ``end - start`` (events never
+        overlap)."""
+        return float(sum(e.end - e.start for e in self.events))
+
+    def duration(self) -> float:
+        """The log's duration [s], first to last sample (0 for fewer than two)."""
+        return float(self.t[-1] - self.t[0]) if self.t.shape[0] > 1 else 0.0
 
     def largest(self) -> NDArray[np.float64]:
         """The largest ``|r|`` of each joint (n,) [N m] (NaN: never observed).
@@ -151,20 +175,41 @@ class LogObservation:
 @dataclass(frozen=True, slots=True, eq=False)
 class ObserveResult:
     """What :func:`observe_files` computed: the model, the thresholds (calibrated or read)
-    and every log's observation."""
+    and every log's observation; ``fingerprint``, the files the model was read from, and
+    ``friction_source``, the robot file whose own friction the model holds (a URDF's
+    ``<dynamics>``; None: a friction given or identified)."""
 
     model: ObserverModel
     thresholds: Thresholds
     logs: tuple[LogObservation, ...]
+    fingerprint: ModelFingerprint | None = None
+    friction_source: str | None = None
+
+    def flagged(self) -> tuple[float, float]:
+        """``(flagged, logged)`` [s]: the time every log's events cover and the logs'
+        total duration. An event count alone misleads as a false-alarm measure: a lower
+        threshold can give fewer events that cover more time (runs merged into one)."""
+        return (
+            float(sum(x.flagged_seconds() for x in self.logs)),
+            float(sum(x.duration() for x in self.logs)),
+        )
 
     @property
     def notes(self) -> tuple[str, ...]:
         """What the run's reader should know, one line each: a model without friction
         (static data identify none) leaves the joints' friction in the residual, and in
-        thresholds calibrated on it, where it reads as an external torque."""
+        thresholds calibrated on it, where it reads as an external torque; the friction
+        a robot file holds of its own, used when none is given (a URDF's ``<dynamics>``:
+        often a vendor's rough values); a friction
+        whose Coulomb step is narrower than the logs' velocity noise is observed with the
+        noise band (:func:`~dynid.observer.friction.banding_note`)."""
         if self.model.friction is None:
             return (NO_FRICTION,)
-        return ()
+        own = None
+        if self.friction_source is not None:
+            own = robot_friction_note(self.friction_source, self.model.friction)
+        banded = banding_note(self.model.friction, [x.friction for x in self.logs])
+        return tuple(x for x in (own, banded) if x is not None)
 
 
 #: The note of a model that holds no friction (:attr:`ObserveResult.notes`).
@@ -172,3 +217,27 @@ NO_FRICTION = (
     "the model holds no friction: the joints' friction stays in the residual as an "
     "external torque (and in thresholds calibrated on it)"
 )
+
+
+def robot_friction_note(source: str, friction: FrictionModel | FrictionSum) -> str:
+    """The note of a model whose friction is the robot file ``source``'s own (the law and
+    its largest Coulomb and viscous coefficients)."""
+    parts = friction.parts if isinstance(friction, FrictionSum) else (friction,)
+    sizes = []
+    for name, unit in (("fc", "N m"), ("fv", "N m s/rad")):
+        values = [np.abs(getattr(p, name)) for p in parts if name in p.law.params]
+        if values:
+            sizes.append(f"{name} up to {max(float(v.max()) for v in values):.3g} {unit}")
+    where = " <dynamics damping friction>" if source.lower().endswith(".urdf") else ""
+    return (
+        f"the friction is {source}'s own{where} ({friction.kind}"
+        + (f": {', '.join(sizes)}" if sizes else "")
+        + "); --friction friction.json (of `dynid friction`) replaces it"
+    )
+
+
+def flagged_words(flagged: float, logged: float) -> str:
+    """``"15.1 s flagged (50.3 % of 30 s logged)"``: the time events cover and its share
+    of the logs' duration."""
+    share = 100.0 * flagged / logged if logged > 0 else 0.0
+    return f"{flagged:.3g} s flagged ({share:.3g} % of {logged:.3g} s logged)"

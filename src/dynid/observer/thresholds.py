@@ -17,7 +17,29 @@ from .. import _checks
 from ..exceptions import DataError, ShapeError
 from .residual import ObserverOptions
 
-__all__ = ["Thresholds", "threshold_series"]
+__all__ = ["ModelFingerprint", "Thresholds", "threshold_series"]
+
+
+@dataclass(frozen=True, slots=True)
+class ModelFingerprint:
+    """What a model was made of: the files (or names) it was read from and a SHA-256 of
+    their content and of the chain chosen in them
+    (:func:`~dynid.workflows.observe.model_fingerprint`).
+
+    Attributes
+    ----------
+    files : tuple of str
+        The model's files by name (``identification.json``; ``z1.urdf``,
+        ``friction.json``, ``drive.toml``), or a built-in robot's name.
+    sha256 : str
+        Hex digest: equal for the same content, whatever the files are called.
+    """
+
+    files: tuple[str, ...]
+    sha256: str
+
+    def __str__(self) -> str:
+        return f"{' + '.join(self.files)} (sha256 {self.sha256[:12]})"
 
 
 @dataclass(frozen=True, slots=True, eq=False)
@@ -41,6 +63,9 @@ class Thresholds:
         The observer the thresholds were calibrated with (the residual they apply to).
     samples : int
         Calibration samples.
+    model : ModelFingerprint or None
+        The model they were calibrated with (None: not recorded, a file of an earlier
+        version).
     """
 
     contact: NDArray[np.float64]
@@ -53,6 +78,7 @@ class Thresholds:
     k_sigma: float | None = None
     noise: NDArray[np.float64] | None = field(default=None)
     standstill: bool = False
+    model: ModelFingerprint | None = None
 
     def __post_init__(self) -> None:
         n = np.shape(self.contact)[0]

@@ -52,6 +52,23 @@ def _calibration(doc: Any) -> str | None:
     return said + "."
 
 
+def _flagged(doc: Any) -> str:
+    """``", 15.1 s flagged (50.3 % of 30 s logged)"``: the time the events cover and its
+    share of the logs (``events.json``'s ``flagged_s`` and ``duration_s``, summed over its
+    logs; :func:`~dynid.observer.results.flagged_words`), or nothing where the file has
+    none. The count alone misleads: fewer events can cover more time."""
+    if not isinstance(doc, dict):
+        return ""
+    flagged, logged = doc.get("flagged_s"), doc.get("duration_s")
+    if not (isinstance(flagged, list) and isinstance(logged, list)):
+        return ""
+    if not (_numbers(flagged) and _numbers(logged)):
+        return ""
+    from ..observer.results import flagged_words
+
+    return ", " + flagged_words(float(sum(flagged)), float(sum(logged)))
+
+
 def _numbers(v: Any) -> bool:
     return isinstance(v, list) and bool(v) and all(is_number(x) for x in v)
 
@@ -75,7 +92,8 @@ def answer(run: RunFiles) -> Answer | None:
     elif events is None:
         head, level = "The run wrote residuals; no events file to judge.", "fair"
     elif events:
-        head, level = f"{len(events)} event{'s' if len(events) != 1 else ''} detected.", "info"
+        head = f"{len(events)} event{'s' if len(events) != 1 else ''} detected"
+        head, level = head + _flagged(run.docs.get(found["events.json"] or "")) + ".", "info"
     else:
         head, level = "No event: every residual stayed below its threshold.", "good"
     if found["thresholds.json"] is not None:

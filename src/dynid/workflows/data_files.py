@@ -40,6 +40,7 @@ from ..io.input_files import regular_file
 from ..io.static_data import load_static_data
 from ..io.torque_log import load_torque_log
 from ..model.robot import Robot
+from ..progress import NOTE
 
 __all__ = [
     "ColumnSpec",
@@ -178,7 +179,8 @@ def read_torque_log(
     n : int, optional
         Joint count the log must have.
     columns : ColumnMap, optional
-        Column names and units of another tool's file (notes are logged as warnings).
+        Column names and units of another tool's file (its notes are logged as warnings,
+        the units it converts as notes).
     drop_invalid : bool
         Drop rows with NaN/inf or a repeated timestamp (logged) instead of failing.
     owner : str, optional
@@ -202,6 +204,8 @@ def read_torque_log(
         log = load_torque_log(path, drop_invalid=drop_invalid)
     else:
         mapped = load_mapped_torque_log(path, columns, n=n)
+        for note in mapped.conversions:  # as asked: a note
+            _log.log(NOTE, "%s: %s", path.name, note)
         for note in mapped.notes:
             _log.warning("%s: %s", path.name, note)
         c = mapped.log.cleaning
@@ -252,8 +256,8 @@ def read_static_file(
 
     A dynid file is read by :func:`~dynid.io.static_data.load_static_data` (its recorded
     robot checked against ``robot``); a file of another tool through ``columns`` (notes
-    logged as warnings), as is one without ``M`` columns when ``require_M`` is False
-    (gravity torques only: ``M`` zero).
+    logged as warnings, the units converted as notes), as is one without ``M`` columns
+    when ``require_M`` is False (gravity torques only: ``M`` zero).
 
     Raises
     ------
@@ -263,6 +267,8 @@ def read_static_file(
     path = Path(path)
     if columns is not None or not require_M:
         mapped = load_mapped_static_data(path, columns or ColumnMap(), robot, require_M=require_M)
+        for note in mapped.conversions:  # as asked: a note
+            _log.log(NOTE, "%s: %s", path.name, note)
         for note in mapped.notes:
             _log.warning("%s: %s", path.name, note)
         return mapped.data

@@ -47,7 +47,10 @@ the command applies, so that the Python API behaves as the command does.
 
 from __future__ import annotations
 
+import contextlib
+import copy
 import dataclasses
+import hashlib
 import warnings
 from collections.abc import Callable, Iterator, Mapping
 from dataclasses import dataclass
@@ -56,7 +59,7 @@ from pathlib import Path
 import numpy as np
 from numpy.typing import NDArray
 
-from ..exceptions import DataError, DynidWarning, OptionError
+from ..exceptions import DataError, DynidWarning, OptionError, ShapeError
 from ..exceptions import in_file as about_file
 from ..friction.fit import same_drive
 from ..friction.model import FrictionModel, FrictionSum, placed_friction
@@ -68,12 +71,14 @@ from ..io.model_json import load_model_json
 from ..io.observer_files import load_thresholds
 from ..io.robot_file import load_robot
 from ..model.drive import Drive
+from ..model.robot import Robot
 from ..observer.detection import Thresholds, calibrate
 from ..observer.events import DEFAULT_MERGE_S, DEFAULT_MIN_DURATION_S
 from ..observer.model import ObserverModel, from_identified, from_robot
 from ..observer.residual import DEFAULT_GAIN, ObserverOptions
 from ..observer.results import LogObservation, ObserveResult
 from ..observer.sign import TorqueSign, opposite_finding, unexplained_finding
+from ..observer.thresholds import ModelFingerprint
 from .data_files import (
     ColumnSpec,
     column_map,
@@ -98,7 +103,10 @@ __all__ = [
     "LogObservation",
     "ObserveOptions",
     "ObserveResult",
+    "default_tip_hint",
+    "friction_source",
     "load_observer_model",
+    "model_fingerprint",
     "observe_files",
     "observer_drive",
 ]
@@ -255,10 +263,47 @@ def load_observer_model(
     if spec.lower().endswith(".json") and friction is None:
         lin = load_feasible_linear_friction(spec)
         fr = "robot" if lin is None else lin
-    own = observer_drive(spec, robot.n, drive)
+    chain = default_tip_hint(spec, robot, tip)
+    with _said_with(chain):
+        own = observer_drive(spec, robot.n, drive)
     if friction is not None:  # a file: where the drive puts a robot's own, as simulated
-        fr = placed_friction(load_friction_json(friction), own)
+        loaded = load_friction_json(friction)
+        if loaded.n != robot.n:
+            raise DataError(
+                f"friction for {loaded.n} joints; the model has {robot.n}"
+                + ("" if chain is None else f"; {chain}"),
+                file=Path(friction).name,
+            )
+        fr = placed_friction(loaded, own)
     return from_robot(robot, friction="robot" if fr == "model" else fr, drive=own), None
+
+
+def default_tip_hint(params: str, robot: Robot, tip: str | None) -> str | None:
+    """What a joint-count error says of a ``params`` URDF read to its default tip (no
+    ``tip``): the chain's joints, its last joint and link, and ``--tip``; None otherwise (a
+    chain chosen, another kind of robot). A Z1's default leaf brings in its gripper's
+    joint, and the 6-joint drive file was blamed instead."""
+    if tip is not None or not params.lower().endswith(".urdf"):
+        return None
+    return (
+        f"the model is {Path(params).name}'s chain to its only leaf ({robot.n} joints, the "
+        f"last {robot.joint_names[-1]} moving {robot.link_names[-1]}); hint: end it "
+        "earlier with --tip LINK"
+    )
+
+
+@contextlib.contextmanager
+def _said_with(hint: str | None) -> Iterator[None]:
+    """A :class:`DataError` or :class:`ShapeError` raised inside ends with ``hint`` (the
+    chain a URDF's default tip gave: :func:`default_tip_hint`)."""
+    try:
+        yield
+    except (DataError, ShapeError) as exc:
+        if hint is None or not exc.args:
+            raise
+        err = copy.copy(exc)
+        err.args = (f"{exc.args[0]}; {hint}", *exc.args[1:])
+        raise err from None
 
 
 def observer_drive(params: str | Path, n: int, drive: Drive | Path | None = None) -> Drive | None:
@@ -363,9 +408,23 @@ def observe_files(opts: ObserveOptions, sink: ResidualSink | None = None) -> Obs
     )
     given = None if opts.thresholds is None else load_thresholds(opts.thresholds)
     if given is not None and given.n != model.n:
+        spec = None if opts.params is None else str(opts.params)
+        chain = None if spec is None else default_tip_hint(spec, model.robot, opts.tip)
         raise OptionError(
             f"{opts.thresholds}: thresholds for {given.n} joints; the model has {model.n}"
+            + ("" if chain is None else f"; {chain}")
         )
+    fingerprint = model_fingerprint(opts)
+    if given is not None and given.model is not None and given.model.sha256 != fingerprint.sha256:
+        assert opts.thresholds is not None
+        warnings.warn(
+            f"{opts.thresholds.name} was calibrated with {given.model}, not with this model "
+            f"({fingerprint}): thresholds fit the residual of their own model; calibrate "
+            "again with this one",
+            DynidWarning,
+            stacklevel=2,
+        )
+    own = friction_source(opts) if model.friction is not None else None
     options = _observer_options(opts, given)
     wants_std = (
         opts.uncertainty and model.covariance is not None
@@ -379,9 +438,11 @@ def observe_files(opts: ObserveOptions, sink: ResidualSink | None = None) -> Obs
         read, model.robot.joint_names, SPIKES_BEFORE_OBSERVER, min_rate_hz=SPIKE_RATE_HZ
     )
     if given is None:
-        return _calibrated(
+        cal = _calibrated(
             read, model, columns[0] is not None, opts, options, wants_std, wants_margin
         )
+        th = dataclasses.replace(cal.thresholds, model=fingerprint)
+        return ObserveResult(model, th, cal.logs, fingerprint, own)
     paths = tuple(map(Path, read.paths))
     logs = []
     for k, (path, log) in enumerate(zip(paths, read.logs, strict=True)):
@@ -405,7 +466,49 @@ def observe_files(opts: ObserveOptions, sink: ResidualSink | None = None) -> Obs
                 table=table,
             )  # fmt: skip
         )
-    return ObserveResult(model, given, tuple(logs))
+    return ObserveResult(model, given, tuple(logs), fingerprint, own)
+
+
+def model_fingerprint(opts: ObserveOptions) -> ModelFingerprint:
+    """The files ``opts`` reads the model from (``model`` or ``params``, ``friction``,
+    ``drive``) by name, and a SHA-256 of their content and of the chain (``base``,
+    ``tip``): a built-in robot's name stands for its file, a :class:`Drive` given as one
+    for its arrays."""
+    h = hashlib.sha256()
+    files = []
+    for what, src in (
+        ("model", opts.model),
+        ("params", opts.params),
+        ("friction", opts.friction),
+        ("drive", opts.drive),
+    ):
+        if src is None:
+            continue
+        h.update(f"\0{what}\0".encode())
+        if isinstance(src, Drive):
+            for f in dataclasses.fields(src):
+                h.update(f"{f.name}={getattr(src, f.name)!r};".encode())
+                if isinstance(v := getattr(src, f.name), np.ndarray):
+                    h.update(np.ascontiguousarray(v, dtype=np.float64).tobytes())
+            files.append("a drive")
+        elif Path(src).is_file():
+            h.update(Path(src).read_bytes())
+            files.append(Path(src).name)
+        else:  # a built-in robot's name
+            h.update(str(src).encode())
+            files.append(str(src))
+    h.update(f"\0base={opts.base}\0tip={opts.tip}".encode())
+    return ModelFingerprint(tuple(files), h.hexdigest())
+
+
+def friction_source(opts: ObserveOptions) -> str | None:
+    """The robot file (or built-in name) whose own friction the model holds: a
+    ``params`` URDF or TOML without ``friction`` (a ``feasible.json``'s friction was
+    identified with it), else None."""
+    if opts.params is None or opts.friction is not None:
+        return None
+    spec = str(opts.params)
+    return None if spec.lower().endswith(".json") else Path(spec).name
 
 
 def _read_logs(
@@ -469,7 +572,10 @@ def _calibrated(
             keep = Series.new(prep, model.n, wants_std, wants_margin) if opts.keep_series else None
             peak = np.zeros(model.n)
             sign = TorqueSign(model.n)
+            seen = model.friction
             for blk in observed_blocks(prep, model, options, wants_std, wants_margin):
+                if blk.friction is not None and blk.friction is not model.friction:
+                    seen = blk.friction  # banded for the velocity noise (a note says so)
                 if blk.margin is not None:
                     np.maximum(peak, blk.margin.max(axis=0), out=peak)
                 if keep is not None:
@@ -480,7 +586,7 @@ def _calibrated(
                 raise DataError(opposite, file=Path(path).name)
             if (unexplained := unexplained_finding(sign, names)) is not None:
                 warnings.warn(f"{Path(path).name}: {unexplained}", DynidWarning, stacklevel=2)
-            logs.append(_observation(prep, model, mapped, opts, keep, peak))
+            logs.append(_observation(prep, model, mapped, opts, keep, peak, seen))
 
     # calibrate reads a block's residual, then its margin and std: these two come from the
     # block the residual was last read from (one block held; itertools.tee would keep up
@@ -530,8 +636,10 @@ def _observation(
     opts: ObserveOptions,
     keep: Series | None,
     peak: NDArray[np.float64],
+    seen: FrictionModel | FrictionSum | None,
 ) -> LogObservation:
-    """A log's observation from its series (None: not kept) and its margin's peak."""
+    """A log's observation from its series (None: not kept), its margin's peak and the
+    friction it was observed with (``seen``)."""
     path, log = prep.path, prep.log
 
     def run() -> LogObservation:
@@ -547,6 +655,7 @@ def _observation(
             None if keep is None else keep.margin,
             tuple(a for a, _ in prep.spans),
             peak,
+            friction=None if seen is model.friction else seen,
         )
 
     return in_file(path, run)

@@ -93,9 +93,12 @@ def detected_log(
     strided = None if not figure_points else _Strided(log.t.shape[0], figure_points, thresholds)
     events: list[ContactEvent] = []
     wrenches: list[WrenchEstimate] = []
+    seen = model.friction
     with about_file(prep.path.name), table or nullcontext(None) as put:
         for blk in observed_rows(prep, model, options, *wants):
             a, b = blk.a, blk.a + blk.r.shape[0]
+            if blk.friction is not None and blk.friction is not model.friction:
+                seen = blk.friction  # banded for the velocity noise (a note says so)
             events += det.feed(log.t[a:b], blk.r, std=blk.std, standstill=blk.margin)
             w = None if frame is None else observed_wrench(model, log.q[a:b], blk.r, frame)
             if put is not None:
@@ -128,6 +131,7 @@ def detected_log(
         truth_rms=stats.truth(),
         figure=None if strided is None else strided.series(),
         peak_ratio=det.largest_ratio,
+        friction=None if seen is model.friction else seen,
     )
 
 

@@ -23,6 +23,7 @@ from numpy.typing import NDArray
 
 from ..exceptions import DataError, DynidWarning
 from ..exceptions import in_file as about_file
+from ..friction.model import FrictionModel, FrictionSum
 from ..identification.log import TorqueLog, default_max_gap, joint_side_log
 from ..identification.pieces import unwrapped, with_start_turns, wrappable
 from ..observer.detection import residual_std_blocks, standstill_blocks
@@ -62,12 +63,15 @@ class PreparedLog:
 
 @dataclass(frozen=True, slots=True)
 class ObservedBlock:
-    """The residual of samples ``[a, a + len(r))`` of a log, their std and margin."""
+    """The residual of samples ``[a, a + len(r))`` of a log, their std and margin, and the
+    friction the observer evaluated there (the model's, or the model's banded for the
+    velocity noise: :func:`~dynid.observer.friction.banded_if_narrow`)."""
 
     a: int
     r: NDArray[np.float64]
     std: NDArray[np.float64] | None
     margin: NDArray[np.float64] | None
+    friction: FrictionModel | FrictionSum | None = None
 
 
 @dataclass(frozen=True, slots=True)
@@ -146,7 +150,10 @@ def observed_blocks(
             here = model
             if model.friction is not None:  # a smooth law narrower than the noise: banded
                 kw.setdefault("bands", velocity_bands(model.friction, dq[a:b]))
-                here = model.with_friction(banded_if_narrow(model.friction, kw["bands"]))
+                seen = banded_if_narrow(
+                    model.friction, kw["bands"], derived=kw.get("derived", False)
+                )
+                here = model.with_friction(seen)
             obs = MomentumObserver(here, options)
             stds = _rechunked(
                 residual_std_blocks(model, t[a:b], q[a:b], dq[a:b], options)
@@ -171,6 +178,7 @@ def observed_blocks(
                     obs.run(t[c:d], q[c:d], dq[c:d], tau[c:d]),
                     next(stds) if wants_std else None,
                     m,
+                    here.friction,
                 )
 
 
