@@ -28,9 +28,10 @@ Two steps:
   --thresholds thresholds.json on any logs writes OUT/events.json (dynid-events/1: start
   and end [s], joints (1-based) and joint_names, peak [N m] per joint and level, contact
   or collision, and the log of every event), OUT/residuals.csv (t, r1..rn and, with
-  --frame, the external wrench at that frame by damped least squares, NaN where the
-  residual is) and OUT/residuals.png (residuals, thresholds, events, and the true
-  tau_ext that `dynid simulate --contact` writes beside a log; the summary then gives
+  --frame, the external wrench at that frame by damped least squares, the least-norm
+  one where fewer than 6 joints move the frame, NaN where the residual is) and
+  OUT/residuals.png (residuals, thresholds, events, and the true tau_ext that `dynid
+  simulate --contact` writes beside a log; the summary then gives
   the RMS of the residual against it per joint), and prints the largest |r| of each log.
 One contact is one event: runs over the threshold closer than --merge (0.2 s) are joined
 (a push near the threshold on a joint at rest crosses it again and again as the

@@ -15,7 +15,7 @@ from numpy.typing import NDArray
 from ..exceptions import DataError
 from .detection import ContactEvent, Thresholds
 from .model import ObserverModel
-from .wrench import WrenchEstimate
+from .wrench import WrenchEstimate, underdetermined_note
 
 __all__ = ["NO_FRICTION", "FigureSeries", "LogObservation", "ObserveResult"]
 
@@ -156,15 +156,22 @@ class ObserveResult:
     model: ObserverModel
     thresholds: Thresholds
     logs: tuple[LogObservation, ...]
+    frame: str | None = None
 
     @property
     def notes(self) -> tuple[str, ...]:
         """What the run's reader should know, one line each: a model without friction
         (static data identify none) leaves the joints' friction in the residual, and in
-        thresholds calibrated on it, where it reads as an external torque."""
-        if self.model.friction is None:
-            return (NO_FRICTION,)
-        return ()
+        thresholds calibrated on it, where it reads as an external torque; a wrench at a
+        frame that fewer than six joints move is the least-norm one
+        (:func:`~dynid.observer.wrench.underdetermined_note`)."""
+        out: tuple[str, ...] = (NO_FRICTION,) if self.model.friction is None else ()
+        if (
+            self.frame is not None
+            and (note := underdetermined_note(self.model.robot, self.frame)) is not None
+        ):
+            out += (note,)
+        return out
 
 
 #: The note of a model that holds no friction (:attr:`ObserveResult.notes`).

@@ -405,7 +405,7 @@ def observe_files(opts: ObserveOptions, sink: ResidualSink | None = None) -> Obs
                 table=table,
             )  # fmt: skip
         )
-    return ObserveResult(model, given, tuple(logs))
+    return ObserveResult(model, given, tuple(logs), opts.frame)
 
 
 def _read_logs(
