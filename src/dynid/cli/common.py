@@ -503,5 +503,6 @@ def add_column_options(p: argparse.ArgumentParser) -> None:
         "--units",
         default=None,
         metavar="MAP",
-        help="units of --data: 'q=deg,tau=mNm,t=ms' (converted to SI)",
+        help="units of --data: 'q=deg,tau=mNm,t=ms' (converted to SI; tau=mA or A: motor "
+        "currents, with a --drive of effort = current)",
     )

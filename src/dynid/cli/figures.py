@@ -119,7 +119,7 @@ def save_identify_figures(
     if model.info.log is None or model.holdout is None:
         return [], None
     try:
-        cmap = column_map(args.columns, args.units, cutoff_hz=args.cutoff)
+        cmap = column_map(args.columns, args.units, cutoff_hz=args.cutoff, drive=model.drive)
 
         def read(p: Any) -> Any:
             with _said_before():

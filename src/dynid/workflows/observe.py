@@ -419,7 +419,7 @@ def _read_logs(
     read as N m refused,
     and one far outside the joint limits warned about, each naming the file
     (:mod:`dynid.workflows.recordings`)."""
-    cmap = column_map(*columns)
+    cmap = column_map(*columns, drive=model.drive)
     logs = [
         read_torque_log(
             p,
