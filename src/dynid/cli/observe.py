@@ -70,6 +70,7 @@ from .common import (
     add_drive_option,
     add_drop_invalid,
     add_q_start_option,
+    add_snap_angles_option,
     add_subcommand,
     nonnegative_type,
     output_path,
@@ -97,6 +98,7 @@ def register(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParser:
     src.add_argument("--params", help="a robot: feasible.json, a .urdf or .toml, or a name")
     p.add_argument("--base", help="--params URDF: base link of the chain (default: the root)")
     p.add_argument("--tip", help="--params URDF: tip link of the chain (default: the only leaf)")
+    add_snap_angles_option(p, "--params")
     p.add_argument("--friction", type=Path, help="friction.json replacing the model's friction")
     add_drive_option(p)
     add_q_start_option(p)
@@ -173,7 +175,8 @@ def run(args: argparse.Namespace, console: Console) -> int:
         uncertainty=not args.no_uncertainty, standstill=not args.no_standstill_margin,
         merge_s=args.merge, min_duration_s=args.min_duration,
         columns=(args.columns, args.units), drop_invalid=args.drop_invalid,
-        max_gap=args.max_gap, base=args.base, tip=args.tip, q_start=args.q_start,
+        max_gap=args.max_gap, base=args.base, tip=args.tip, snap_angles=args.snap_angles,
+        q_start=args.q_start,
         # the series serve the figures only: a calibration's whole, a detection's strided
         keep_series=args.calibrate and not args.no_figures,
         figure_points=None if args.no_figures else FIGURE_POINTS,
