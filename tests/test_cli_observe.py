@@ -161,7 +161,7 @@ def test_observe_params_urdf_with_two_leaves_takes_the_chain_of_tip(tmp_path, ca
     other = ["observe", "--params", "panda", "--tip", "link7", *cal[4:]]
     assert main([*other, "--out", str(tmp_path / "c1")]) != 0
     (line,) = capsys.readouterr().err.strip().splitlines()
-    assert "--base/--tip choose the chain of a --params URDF" in line
+    assert "--base/--tip/--snap-angles read the chain of a --params URDF" in line
 
 
 @pytest.mark.parametrize(

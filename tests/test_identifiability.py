@@ -318,6 +318,45 @@ def test_cli_snap_angles_reads_a_rounded_urdf_exactly_and_is_refused_elsewhere(t
     assert "--snap-angles applies to a URDF --robot" in err and len(err.strip().splitlines()) == 1
 
 
+def test_every_command_reading_a_urdf_takes_snap_angles():
+    """Regression (the rounded-angle warning's hint --snap-angles refused by validate as
+    'unrecognized arguments'): every command whose --robot, --params or --prior may be a
+    URDF takes --snap-angles, so the hint it prints is a flag it accepts."""
+    import argparse
+
+    from dynid.cli.__main__ import build_parser
+
+    parser = build_parser()
+    sub = next(a for a in parser._actions if isinstance(a, argparse._SubParsersAction))
+    reading = []
+    for name, p in sub.choices.items():
+        opts = {o for a in p._actions for o in a.option_strings}
+        takes_urdf = [
+            a for a in p._actions if {"--robot", "--params", "--prior"} & set(a.option_strings)
+        ]
+        if any("urdf" in (a.help or "").lower() for a in takes_urdf):
+            reading.append(name)
+            assert "--snap-angles" in opts, name
+    assert {"validate", "friction", "payload", "observe", "export", "identify"} <= set(reading)
+
+
+def test_a_rounded_urdf_prior_is_not_warned_about_again(tmp_path):
+    """Regression (the rounded-angle warning said twice with --prior): a URDF prior is read
+    with its angles snapped, without the robot's warning (only its inertials are used, in
+    the robot's frames), and its inertials are those of the file."""
+    from dynid.workflows.prior import load_prior
+
+    path = tmp_path / "rounded6.urdf"
+    path.write_text(rounded_arm_urdf())
+    with pytest.warns(DynidWarning, match="rounded"):
+        robot = dynid.Robot.from_urdf(path, "base", "l6")
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", DynidWarning)
+        prior = load_prior(path, robot)
+    assert prior is not None
+    np.testing.assert_allclose(prior.phi, robot.phi, rtol=0, atol=1e-12)
+
+
 def test_identify_help_says_when_a_ddq_column_is_used(capsys):
     """identify --help: accelerations from ddq columns are used as given, else derived."""
     try:

@@ -61,7 +61,11 @@ def test_renamed_rescaled_log_reads_as_the_original(tmp_path):
     np.testing.assert_allclose(got.log.t, log.t, rtol=1e-15, atol=1e-18)
     for k in ("q", "dq", "tau"):
         np.testing.assert_allclose(getattr(got.log, k), getattr(log, k), rtol=1e-14, atol=1e-15)
-    assert any("q scaled" in s for s in got.conversions) and not got.notes
+    assert not got.conversions and not got.notes  # the units given: the map's one note
+    assert cmap.unit_note() == (
+        "data read with --units t in ms (x 0.001 to SI), q in deg (x 0.017453292519943295 "
+        "to SI), dq in deg/s (x 0.017453292519943295 to SI), tau in mNm (x 0.001 to SI)"
+    )
 
 
 def test_positions_only_gives_filtered_derivative_velocities(tmp_path):
@@ -329,3 +333,38 @@ def test_the_recorded_units_are_said_with_how_to_read_another_file(caplog):
     assert used == (None, "tau=mNm")
     (said,) = [r.getMessage() for r in caplog.records]
     assert "units 'tau=mNm'" in said and "--units tau=Nm for SI torques" in said, said
+
+
+def test_currents_in_ma_are_read_through_a_current_drive_and_said_once(tmp_path, caplog):
+    """Regression (--units tau=mA refused, tau=0.001 warned on every file): with a drive
+    of effort = current, mA and A read the file's numbers x 1e-3 and x 1, said once as a
+    note, never as a warning per file; a torque drive or none refuses them, naming
+    --units and the drive."""
+    import logging
+
+    from dynid.exceptions import OptionError
+    from dynid.model.drive import Drive
+    from dynid.workflows.data_files import column_map, read_torque_log
+
+    log = _log(4)
+    paths = [tmp_path / "a.csv", tmp_path / "b.csv"]
+    for p in paths:
+        dynid.io.save_torque_log(p, TorqueLog(log.t, log.q, log.dq, log.tau * 1e3))
+    n = log.n
+    current = Drive(np.eye(n), np.zeros(n), effort="current", torque_constant=np.ones(n))
+    for unit, factor in (("mA", 1e-3), ("A", 1.0), ("0.001", 1e-3)):
+        caplog.clear()
+        with caplog.at_level(logging.INFO):
+            cmap = column_map(None, f"tau={unit}", drive=current)
+            got = [read_torque_log(p, n, columns=cmap) for p in paths]
+        for g in got:
+            np.testing.assert_allclose(g.tau, log.tau * 1e3 * factor, rtol=1e-15)
+        assert not [r for r in caplog.records if r.levelno >= logging.WARNING]
+        notes = [r.getMessage() for r in caplog.records if "--units" in r.getMessage()]
+        assert len(notes) == (unit != "A"), notes
+    assert "tau in mA (x 0.001 to A)" in column_map(None, "tau=mA", drive=current).unit_note()
+    torque = Drive(np.eye(n), np.zeros(n))
+    with pytest.raises(OptionError, match="--units tau=mA declares motor currents, but no --drive"):
+        column_map(None, "tau=mA")
+    with pytest.raises(OptionError, match="the drive's effort is 'torque'"):
+        column_map(None, "tau=A", drive=torque)

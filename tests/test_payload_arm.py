@@ -275,3 +275,22 @@ def test_payload_report_covers_mass_com_and_inertia_and_weighs_the_residual(tmp_
     assert "its inertia is not determined (Ixx, Ixy" in text
     assert "Reservations: the data do not determine the inertia&#x27;s Ixx" in text
     assert re.search(r"Residual RMS \S+ N m, \S+ x the torque noise after the low-pass", text)
+
+
+@pytest.mark.parametrize(
+    "own, bare, how, printed",
+    [
+        (0.0027012, 0.0027003, "as well (within 1 %) as with it", ("0.0027", "0.002701")),
+        (0.0030, 0.0027, "better", ("0.0027", "0.003")),
+    ],
+)
+def test_friction_residuals_equal_in_print_are_not_called_better(own, bare, how, printed):
+    """Regression (payload: the classical friction "fits better", residual RMS 0.0027 N m
+    against 0.0027): residuals within 1 % fit "as well", printed with the digits that tell
+    them apart; a 10 % lower one is "better"."""
+    from dynid.feasibility.payload_rows import own_friction_note
+
+    note = own_friction_note("smooth", own, bare)
+    assert f"estimated alongside {how} (residual RMS {printed[0]} N m; {printed[1]} with" in note
+    kept = own_friction_note("smooth", bare, own)  # the arm's own fits no worse: subtracted
+    assert "subtracted" in kept and "better" not in kept

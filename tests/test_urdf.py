@@ -126,10 +126,15 @@ def test_panda_urdf_structure_names_limits_and_frames(panda_urdf):
 
 
 def test_panda_urdf_loads_without_warnings(panda_urdf):
-    """The Panda URDF's inertials are consistent, so loading it warns about nothing."""
-    with warnings.catch_warnings():
-        warnings.simplefilter("error")
+    """The Panda URDF's inertials are consistent, so loading it warns about nothing but
+    the two fingers (prismatic joints off the hand) left out of the chain, 0.015 kg each
+    as the file writes."""
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
         load_urdf(panda_urdf, tip_link="panda_hand")
+    (said,) = [str(w.message) for w in caught]
+    assert "panda_leftfinger (0.015 kg, through prismatic joint 'panda_finger_joint1'" in said
+    assert "panda_rightfinger (0.015 kg" in said
 
 
 def test_panda_urdf_equals_builtin_mdh_panda(panda_urdf):
@@ -315,6 +320,75 @@ def test_default_tip_is_the_unique_leaf():
         robot.frames["flange"].T_link_frame, robot.frames["c"].T_link_frame
     )
     np.testing.assert_allclose(dynid.fk(robot, [0.25])[:3, 3], [0, 0, 0.75], atol=0)
+
+
+def _gripper_arm(jaw: str) -> str:
+    """One revolute joint carrying an arm (1 kg) with a fixed TCP (0.1 kg) and a tip
+    frame, and a jaw (12 g, with a 3 g pad fixed to it) on a joint of type ``jaw``."""
+
+    def link(name: str, mass: float | None = None) -> str:
+        if mass is None:
+            return f'<link name="{name}"/>'
+        inertia = 'ixx="1e-4" iyy="1e-4" izz="1e-4" ixy="0" ixz="0" iyz="0"'
+        return (
+            f'<link name="{name}"><inertial><mass value="{mass}"/>'
+            f"<inertia {inertia}/></inertial></link>"
+        )
+
+    def joint(name: str, kind: str, parent: str, child: str) -> str:
+        axis = '<axis xyz="0 0 1"/><limit lower="-1" upper="1" effort="1" velocity="1"/>'
+        return (
+            f'<joint name="{name}" type="{kind}"><parent link="{parent}"/>'
+            f'<child link="{child}"/><origin xyz="0 0.1 0"/>'
+            f"{axis if kind != 'fixed' else ''}</joint>"
+        )
+
+    return (
+        '<robot name="g">'
+        + link("base")
+        + link("stand", 2.0)
+        + link("arm", 1.0)
+        + link("tcp", 0.1)
+        + link("tip")
+        + link("jaw", 0.012)
+        + link("pad", 0.003)
+        + joint("stand_joint", "fixed", "base", "stand")
+        + joint("j1", "revolute", "base", "arm")
+        + joint("tcp_joint", "fixed", "arm", "tcp")
+        + joint("tip_joint", "fixed", "arm", "tip")
+        + joint("jaw_joint", jaw, "arm", "jaw")
+        + joint("pad_joint", "fixed", "jaw", "pad")
+        + "</robot>"
+    )
+
+
+def test_a_moving_branch_off_the_chain_is_named_with_its_mass_and_fixed_links_merged(caplog):
+    """Regression (a gripper's moving jaw, 12 g, dropped from the model with nothing said,
+    even with -v): the jaw and the pad fixed to it are named once with their 0.015 kg, the
+    fixed TCP is logged as merged into the arm; the model's mass is the file's arm and
+    TCP, 1.1 kg; with a fixed jaw joint nothing is left out and the mass is 1.115 kg."""
+    import logging
+
+    with caplog.at_level(logging.INFO, logger="dynid"):
+        with pytest.warns(dynid.DynidWarning, match="left out of the chain") as caught:
+            robot = robot_from_urdf_string(_gripper_arm("revolute"), "base", "tip")
+    said = [str(w.message) for w in caught if "left out" in str(w.message)]
+    assert said == [
+        "URDF text: left out of the chain, as they move on joints of their own: jaw and 1 "
+        "link(s) below it (0.015 kg, through revolute joint 'jaw_joint' on arm); their mass "
+        "is in no link of the model (a fixed joint in place of the moving one merges a link "
+        "into the one it hangs from)"
+    ]
+    merged = [r.getMessage() for r in caplog.records if "merged" in r.getMessage()]
+    assert merged == [
+        "URDF text: links fixed to the chain merged (their inertials added): tip into arm "
+        "(0 kg), tcp into arm (0.1 kg)"
+    ]
+    assert robot.phi[:, 0].sum() == pytest.approx(1.1, rel=1e-15)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        fixed = robot_from_urdf_string(_gripper_arm("fixed"), "base", "tip")
+    assert fixed.phi[:, 0].sum() == pytest.approx(1.115, rel=1e-15)
 
 
 # ---------------------------------------------------------------------------- errors

@@ -225,12 +225,18 @@ def add_robot_options(p: argparse.ArgumentParser) -> None:
     p.add_argument(
         "--tip", default=None, help="URDF tip link of the chain (default: the only leaf)"
     )
+    add_snap_angles_option(p)
+
+
+def add_snap_angles_option(p: argparse.ArgumentParser, robot: str = "--robot") -> None:
+    """``--snap-angles`` for the URDF of ``robot``: every command that reads a URDF and
+    may print the rounded-angle warning's hint takes it."""
     p.add_argument(
         "--snap-angles",
         action="store_true",
-        help="read URDF joint angles within 1e-3 rad of a multiple of pi/2 as that multiple "
-        '(rpy="1.5708" as pi/2); without it such rounded angles are reported with the '
-        "condition numbers they cause",
+        help=f"a URDF {robot}: read joint angles within 1e-3 rad of a multiple of pi/2 as "
+        'that multiple (rpy="1.5708" as pi/2); without it such rounded angles are reported '
+        "with the condition numbers they cause",
     )
 
 
@@ -504,5 +510,6 @@ def add_column_options(p: argparse.ArgumentParser) -> None:
         "--units",
         default=None,
         metavar="MAP",
-        help="units of --data: 'q=deg,tau=mNm,t=ms' (converted to SI)",
+        help="units of --data: 'q=deg,tau=mNm,t=ms' (converted to SI; tau=mA or A: motor "
+        "currents, with a --drive of effort = current)",
     )

@@ -47,7 +47,13 @@ from ..io.export import EXPORT_FORMATS, export_format
 from ..io.robot.urdf_patch import MERGED_POLICIES
 from ..workflows.export import ExportRobotOptions, export_robot, save_export
 from .applies import Applies
-from .common import add_drive_option, add_subcommand, options_from, output_path
+from .common import (
+    add_drive_option,
+    add_snap_angles_option,
+    add_subcommand,
+    options_from,
+    output_path,
+)
 from .console import Console
 
 NAME = "export"
@@ -97,6 +103,7 @@ def register(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParser:
         help="tip link of the chain of a URDF --params and the template (default: the only "
         "leaf; a URDF with several leaves, such as an arm with a two-finger hand, needs it)",
     )
+    add_snap_angles_option(p, "--params")
     p.add_argument(
         "--merged",
         choices=MERGED_POLICIES,

@@ -49,6 +49,7 @@ from .common import (
     add_log_options,
     add_q_start_option,
     add_recordings_option,
+    add_snap_angles_option,
     add_subcommand,
     load_drive_arg,
     load_robot,
@@ -81,6 +82,7 @@ def register(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParser:
     src.add_argument("--robot", help="'panda', 'fr3', a .urdf or a .toml: its link parameters")
     p.add_argument("--base", default=None, help="URDF base link (with --robot)")
     p.add_argument("--tip", default=None, help="URDF tip link (with --robot)")
+    add_snap_angles_option(p)
     add_recordings_option(p)
     add_column_options(p)
     add_drive_option(p)

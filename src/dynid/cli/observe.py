@@ -33,12 +33,13 @@ Two steps:
   --thresholds thresholds.json on any logs writes OUT/events.json (dynid-events/1: start
   and end [s], joints (1-based) and joint_names, peak [N m] per joint and level, contact
   or collision, and the log of every event), OUT/residuals.csv (t, r1..rn and, with
-  --frame, the external wrench at that frame by damped least squares, NaN where the
-  residual is) and OUT/residuals.png (residuals, thresholds, events, and the true
-  tau_ext that `dynid simulate --contact` writes beside a log; the summary then gives
-  the RMS of the residual against it per joint), and prints the largest |r| of each log
-  and the events with the time they cover (seconds and % of the logs' duration;
-  events.json's flagged_s and duration_s per log): fewer events can cover more time.
+  --frame, the external wrench at that frame by damped least squares, the least-norm
+  one where fewer than 6 joints move the frame, NaN where the residual is) and
+  OUT/residuals.png (residuals, thresholds, events, and the true tau_ext that `dynid
+  simulate --contact` writes beside a log; the summary then gives the RMS of the residual
+  against it per joint), and prints the largest |r| of each log and the events with the
+  time they cover (seconds and % of the logs' duration; events.json's flagged_s and
+  duration_s per log): fewer events can cover more time.
 One contact is one event: runs over the threshold closer than --merge (0.2 s) are joined
 (a push near the threshold on a joint at rest crosses it again and again as the
 standstill margin follows the velocity noise), and an event shorter than --min-duration
@@ -76,6 +77,7 @@ from .common import (
     add_drive_option,
     add_drop_invalid,
     add_q_start_option,
+    add_snap_angles_option,
     add_subcommand,
     nonnegative_type,
     output_path,
@@ -103,6 +105,7 @@ def register(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParser:
     src.add_argument("--params", help="a robot: feasible.json, a .urdf or .toml, or a name")
     p.add_argument("--base", help="--params URDF: base link of the chain (default: the root)")
     p.add_argument("--tip", help="--params URDF: tip link of the chain (default: the only leaf)")
+    add_snap_angles_option(p, "--params")
     p.add_argument("--friction", type=Path, help="friction.json replacing the model's friction")
     add_drive_option(p)
     add_q_start_option(p)
@@ -179,7 +182,8 @@ def run(args: argparse.Namespace, console: Console) -> int:
         uncertainty=not args.no_uncertainty, standstill=not args.no_standstill_margin,
         merge_s=args.merge, min_duration_s=args.min_duration,
         columns=(args.columns, args.units), drop_invalid=args.drop_invalid,
-        max_gap=args.max_gap, base=args.base, tip=args.tip, q_start=args.q_start,
+        max_gap=args.max_gap, base=args.base, tip=args.tip, snap_angles=args.snap_angles,
+        q_start=args.q_start,
         # the series serve the figures only: a calibration's whole, a detection's strided
         keep_series=args.calibrate and not args.no_figures,
         figure_points=None if args.no_figures else FIGURE_POINTS,

@@ -47,6 +47,7 @@ from .common import (
     add_drive_option,
     add_log_options,
     add_q_start_option,
+    add_snap_angles_option,
     add_subcommand,
     load_drive_arg,
     output_path,
@@ -73,6 +74,7 @@ def register(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParser:
     src.add_argument("--params", type=Path, help="feasible.json of the arm")
     p.add_argument("--base", default=None, help="URDF base link (with --robot)")
     p.add_argument("--tip", default=None, help="URDF tip link (with --robot)")
+    add_snap_angles_option(p)
     p.add_argument(
         "--data",
         type=Path,

@@ -67,6 +67,7 @@ from .common import (
     add_log_options,
     add_q_start_option,
     add_recordings_option,
+    add_snap_angles_option,
     add_subcommand,
     load_drive_arg,
     output_path,
@@ -101,6 +102,7 @@ def register(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParser:
     )
     p.add_argument("--base", default=None, help="URDF base link (with --robot)")
     p.add_argument("--tip", default=None, help="URDF tip link (with --robot)")
+    add_snap_angles_option(p)
     fr = p.add_mutually_exclusive_group()
     fr.add_argument("--friction", type=Path, help="friction.json to add to the model")
     fr.add_argument("--no-friction", action="store_true", help="ignore the model's own friction")

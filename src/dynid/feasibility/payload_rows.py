@@ -44,9 +44,11 @@ from ..signals import lowpass_noise_gain
 from .payload_arm import ArmModel, FrictionTorques
 
 __all__ = [
+    "AS_WELL",
     "filtered_noise_rms",
     "log_preparation",
     "log_rows",
+    "own_friction_note",
     "static_load_rows",
     "still_joints",
 ]
@@ -257,16 +259,40 @@ def _with_own_friction(
 
     law = arm.friction.kind if arm.friction is not None else "?"
     own, bare = rms(y - f), rms(y)
+    notes.append(own_friction_note(law, own, bare))
+    return y - f if own <= bare else y
+
+
+#: Residuals within this fraction of each other fit "as well": neither is called better.
+AS_WELL = 0.01
+
+
+def own_friction_note(law: str, own: float, bare: float) -> str:
+    """The note of the choice :func:`log_rows` makes: the arm's own friction (of law
+    ``law``) subtracted when the residual RMS [N m] with it, ``own``, is not above the one
+    without it, ``bare``; else left out, "better" only when ``bare`` is lower by more
+    than :data:`AS_WELL`, "as well" otherwise. The two printed with the digits that tell
+    them apart."""
+    a, b = _apart(own, bare)
     if own <= bare:
-        notes.append(
+        return (
             f"the arm's own friction ({law}) subtracted, classical friction fv, fc, fo per "
-            f"joint estimated alongside as its correction (residual RMS {own:.3g} N m; "
-            f"{bare:.3g} without the arm's friction)"
+            f"joint estimated alongside as its correction (residual RMS {a} N m; "
+            f"{b} without the arm's friction)"
         )
-        return y - f
-    notes.append(
+    how = "better" if own - bare > AS_WELL * own else "as well (within 1 %) as with it"
+    return (
         f"the arm's own friction ({law}) left out: the loaded data follow the classical "
-        f"friction fv, fc, fo estimated alongside better (residual RMS {bare:.3g} N m; "
-        f"{own:.3g} with the arm's friction)"
+        f"friction fv, fc, fo estimated alongside {how} (residual RMS {b} N m; {a} with "
+        "the arm's friction)"
     )
-    return y
+
+
+def _apart(x: float, y: float) -> tuple[str, str]:
+    """``x`` and ``y`` printed with the fewest significant digits, 3 to 8, that tell them
+    apart (the same text only when they agree to 8 digits)."""
+    for d in range(3, 9):
+        sx, sy = f"{x:.{d}g}", f"{y:.{d}g}"
+        if sx != sy:
+            break
+    return sx, sy

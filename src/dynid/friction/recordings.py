@@ -28,6 +28,7 @@ another joint count, is an error naming the file: no recording is dropped silent
 from __future__ import annotations
 
 import dataclasses
+import warnings
 from collections.abc import Sequence
 from dataclasses import dataclass
 from typing import Any, Literal
@@ -36,7 +37,8 @@ import numpy as np
 from numpy.typing import NDArray
 
 from .. import _checks
-from ..exceptions import DataError, OptionError
+from ..exceptions import DataError, DynidWarning, OptionError
+from ..identification.cut_loss import left_out_finding
 from ..identification.log import TorqueLog, joint_side_log
 from ..identification.metrics import TorqueErrors
 from ..identification.model import IdentifiedModel
@@ -207,14 +209,16 @@ def prepare_pieces(
     prep = _recorded_preparation(model, max_gap_s, decimate, filter_tau)
     raw = _raw_pieces(model, logs, names, cutoff_hz, prep.max_gap_s, drive, trim_s)
     prep = dataclasses.replace(prep, cutoff_hz=raw.cutoff_hz, trim_s=raw.trim_s)
-    prepared, recording, skipped = [], [], []
-    for r, piece in raw.pieces:
+    prepared, recording, skipped, left = [], [], [], []
+    for k, (r, piece) in enumerate(raw.pieces):
         try:
             prepared.append(prepare_log(piece, prep))
         except DataError as exc:
             skipped.append(skipped_piece(raw.names[r], piece, exc))
+            left.append((k, str(exc)))
             continue
         recording.append(r)
+    _say_left_out(raw, left, prep.max_gap_s)
     return _kept(raw, prepared, recording, skipped)
 
 
@@ -281,6 +285,14 @@ def _no_recorded_cutoff(model: TorqueModel) -> bool:
     return not (isinstance(model, IdentifiedModel) and model.info.log is not None)
 
 
+def _say_left_out(raw: _Raw, left: list[tuple[int, str]], max_gap_s: float | None) -> None:
+    """One warning for every piece left out (:func:`left_out_finding`)."""
+    if (
+        finding := left_out_finding(raw.names, raw.pieces, left, raw.trim_s, max_gap_s)
+    ) is not None:
+        warnings.warn(finding, DynidWarning, stacklevel=3)
+
+
 def _kept(
     raw: _Raw,
     logs: list[TorqueLog],
@@ -335,15 +347,17 @@ def validate_recordings(
     prep = _recorded_preparation(model, max_gap_s, 1, filter_tau)  # every sample judged
     raw = _raw_pieces(model, logs, names, cutoff_hz, prep.max_gap_s, drive, trim_s)
     prep = dataclasses.replace(prep, cutoff_hz=raw.cutoff_hz, trim_s=raw.trim_s)
-    parts, recording, skipped = [], [], []
-    for r, piece in raw.pieces:
+    parts, recording, skipped, left = [], [], [], []
+    for k, (r, piece) in enumerate(raw.pieces):
         try:
             v = validated_log(model, piece, friction, raw.drive, prep)
         except DataError as exc:
             skipped.append(skipped_piece(raw.names[r], piece, exc))
+            left.append((k, str(exc)))
             continue
         parts.append(v)
         recording.append(r)
+    _say_left_out(raw, left, prep.max_gap_s)
     pieces = _kept(
         raw,
         [v.log for v in parts],

@@ -12,7 +12,7 @@
 * :func:`recording_pieces`: all four for one recording, its time column checked first
   (:func:`~dynid.identification.sanity.time_unit_finding`);
 * :func:`joined`: the pieces of one recording as one log for its checks;
-* :func:`skipped_piece`: the line (and warning) of a piece left out.
+* :func:`skipped_piece`: the line of a piece left out, for the record.
 
 Used by identification (:mod:`dynid.identification.recordings`), validation and the
 friction fit (:mod:`dynid.friction.recordings`) and the payload.
@@ -527,12 +527,11 @@ def _every_kth(n: int, k: int) -> NDArray[np.intp]:
     return rows if rows.size > 1 else np.array([0, n - 1])
 
 
-def skipped_piece(name: str, piece: TorqueLog, exc: Exception, stacklevel: int = 3) -> str:
-    """Warn that a piece of recording ``name`` is left out (too short to filter, the
-    reason ``exc``); returns the line, for the record."""
-    line = (
+def skipped_piece(name: str, piece: TorqueLog, exc: Exception) -> str:
+    """The line of a piece of recording ``name`` left out (too short to filter, the reason
+    ``exc``), for the record; the warning is one for all the pieces left out
+    (:func:`~dynid.identification.cut_loss.left_out_finding`)."""
+    return (
         f"{name}: piece {piece.t[0]:.6g}-{piece.t[-1]:.6g} s ({piece.n_samples} samples) "
         f"left out: {exc}"
     )
-    warnings.warn(line, DynidWarning, stacklevel=stacklevel)
-    return line

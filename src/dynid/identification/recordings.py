@@ -50,6 +50,7 @@ from ..model.robot import Robot
 from ..progress import report
 from ..signals import lowpass_noise_gain
 from .core import ModelColumns, RegressorBlock
+from .cut_loss import left_out_finding
 from .dataset import TorqueRoute
 from .derived_band import derived_velocity_band
 from .holdout import DEFAULT_FOLDS, block_labels
@@ -566,13 +567,15 @@ def _prepared(
     **kw: Any,
 ) -> tuple[list[PreparedLog], list[int], list[str], dict[int, dict[str, int]]]:
     """Each piece prepared (:func:`~dynid.identification.prepared_log.prepare_torque_log`
-    with ``kw``), a piece too short to filter left out with a warning; per recording, the
+    with ``kw``), the pieces too short to filter left out with one warning
+    (:func:`~dynid.identification.cut_loss.left_out_finding`); per recording, the
     samples left out, trimmed and decimated away, and the grid points a resampled piece
     added (:class:`SampleCounts`)."""
     prepared, recording, skipped = [], [], []
     keys = ("too_short", "trimmed", "decimated", "added")
     gone = {r: dict.fromkeys(keys, 0) for r in range(len(names))}
     said: set[tuple[int, str]] = set()
+    left: list[tuple[int, str]] = []
     for k, (r, piece) in enumerate(pieces):
         several = f", piece {k + 1} of {len(pieces)}" if len(pieces) > 1 else ""
         report(f"preparing {names[r]}{several}")
@@ -580,7 +583,8 @@ def _prepared(
             with _named_findings(names[r] if len(names) > 1 else None, r, said):
                 p = prepare_torque_log(robot, piece, drive=drive, check=False, **kw)
         except DataError as exc:
-            skipped.append(skipped_piece(names[r], piece, exc, stacklevel=4))
+            skipped.append(skipped_piece(names[r], piece, exc))
+            left.append((k, str(exc)))
             gone[r]["too_short"] += piece.n_samples
             continue
         prepared.append(p)
@@ -596,6 +600,10 @@ def _prepared(
         gone[r]["trimmed"] += piece.n_samples - kept
         gone[r]["added"] += grid - kept
         gone[r]["decimated"] += grid - p.log.n_samples
+    if (
+        finding := left_out_finding(names, pieces, left, kw["trim_s"], kw["max_gap_s"])
+    ) is not None:
+        warnings.warn(finding, DynidWarning, stacklevel=3)
     return prepared, recording, skipped, gone
 
 

@@ -10,8 +10,10 @@ A :class:`ColumnMap` names, per quantity, the column template of a file and its 
   (``q{i}``, ``tau{i}``, ``M{i}_{j}``, ...). In an NPZ file a template names an array;
 * units (converted to SI on reading): ``t`` in ``s, ms, us, ns``; ``q`` in ``rad, deg``
   (``m, mm`` for prismatic arms); ``dq`` in ``rad/s, deg/s``; ``ddq`` in ``rad/s^2,
-  deg/s^2``; ``tau`` and ``g`` in ``Nm, N m, mNm, mN m``; ``M`` in ``kg m^2, g m^2``; or
-  a number, the factor to SI.
+  deg/s^2``; ``tau`` and ``g`` in ``Nm, N m, mNm, mN m``, ``tau`` also in ``A, mA`` (motor
+  currents, read through a drive whose effort is current); ``M`` in ``kg m^2, g m^2``; or
+  a number, the factor to SI. A unit given is the user's word, not a finding: the map
+  says it once (:meth:`ColumnMap.unit_note`), not each file.
 
 Written on the command line as ``--columns 'q=position_{i0},tau=effort_{i0}'`` and
 ``--units 'q=deg,tau=mNm'``, or as a TOML file with tables ``[columns]`` and ``[units]``.
@@ -50,6 +52,7 @@ from .joint_state_csv import import_hint
 from .npz_files import check_npz
 
 __all__ = [
+    "CURRENT_UNITS",
     "ColumnMap",
     "MappedLog",
     "MappedStatic",
@@ -73,12 +76,14 @@ _DEFAULT = {
 _TIME = {"s": 1.0, "ms": 1e-3, "us": 1e-6, "ns": 1e-9}
 _ANGLE = {"rad": 1.0, "deg": math.pi / 180, "m": 1.0, "mm": 1e-3}
 _TORQUE = {"Nm": 1.0, "N m": 1.0, "N": 1.0, "mNm": 1e-3, "mN m": 1e-3}
+#: Motor currents for ``tau`` [A]: a drive of effort = "current" makes them torques.
+CURRENT_UNITS = {"A": 1.0, "mA": 1e-3}
 _UNITS: dict[str, dict[str, float]] = {
     "t": _TIME,
     "q": _ANGLE,
     "dq": {k + "/s": v for k, v in _ANGLE.items()},
     "ddq": {k + "/s^2": v for k, v in _ANGLE.items()},
-    "tau": _TORQUE,
+    "tau": {**_TORQUE, **CURRENT_UNITS},
     "g": _TORQUE,
     "M": {"kg m^2": 1.0, "g m^2": 1e-3},
 }
@@ -117,11 +122,14 @@ class ColumnMap:
         Quantity -> factor to SI (degrees: ``pi / 180``); missing: 1.
     velocity_cutoff_hz : float
         Cutoff [Hz] of the low-pass before differentiating positions into velocities.
+    names : mapping of str to str
+        Quantity -> the unit as given (``"mA"``, ``"0.001"``), for messages.
     """
 
     columns: Mapping[str, str] = field(default_factory=dict)
     factors: Mapping[str, float] = field(default_factory=dict)
     velocity_cutoff_hz: float = DEFAULT_CUTOFF_HZ
+    names: Mapping[str, str] = field(default_factory=dict)
 
     def __post_init__(self) -> None:
         for key in list(self.columns) + list(self.factors):
@@ -129,6 +137,7 @@ class ColumnMap:
                 raise DataError(f"unknown quantity {key!r}; expected one of {list(_DEFAULT)}")
         object.__setattr__(self, "columns", MappingProxyType(dict(self.columns)))
         object.__setattr__(self, "factors", MappingProxyType(dict(self.factors)))
+        object.__setattr__(self, "names", MappingProxyType(dict(self.names)))
 
     @classmethod
     def from_units(
@@ -138,7 +147,25 @@ class ColumnMap:
         for key in units:
             if key not in _DEFAULT:
                 raise DataError(f"unknown quantity {key!r}; expected one of {list(_DEFAULT)}")
-        return cls(dict(columns), {k: _to_factor(k, u) for k, u in units.items()}, **kw)
+        factors = {k: _to_factor(k, u) for k, u in units.items()}
+        return cls(dict(columns), factors, names={k: str(u) for k, u in units.items()}, **kw)
+
+    @property
+    def tau_is_current(self) -> bool:
+        """Whether ``tau`` was declared in a current's unit (``A``, ``mA``)."""
+        return str(self.names.get("tau", "")).strip() in CURRENT_UNITS
+
+    def unit_note(self) -> str | None:
+        """One line saying the units declared and their factors (``tau in mA: x 0.001 to
+        A``), or None when none scales a quantity."""
+        parts = []
+        for k, f in self.factors.items():
+            if f in (1.0, -1.0):  # (a sign flip is the note of each file read)
+                continue
+            given = self.names.get(k, f"{f:.17g}")
+            to = "A" if k == "tau" and self.tau_is_current else "SI"
+            parts.append(f"{k} in {given} (x {f:.17g} to {to})")
+        return None if not parts else "data read with --units " + ", ".join(parts)
 
     def template(self, quantity: str) -> str:
         """The column template of a quantity."""
@@ -479,17 +506,16 @@ def load_mapped_torque_log(
 
 
 def conversion_notes(columns: ColumnMap, quantities: Sequence[str]) -> tuple[str, ...]:
-    """What reading through ``columns`` did to ``quantities``, one line each:
-    ``tau sign flipped (--units tau=-1)`` for a factor of -1 (a sign convention, not a
-    unit), ``q scaled by 0.017453292519943295 to SI`` for any other (``(sign flipped)``
-    added where negative)."""
+    """The sign flips of reading through ``columns``, one line per quantity of
+    ``quantities`` whose factor is negative: ``tau sign flipped (--units tau=-1)`` (a
+    sign convention, not a unit; ``and scaled by ...`` for another negative factor). The
+    units declared are the map's one note (:meth:`ColumnMap.unit_note`), not said per file."""
     out = []
     for k in quantities:
         f = columns.factor(k)
-        if f == -1.0:
-            out.append(f"{k} sign flipped (--units {k}=-1)")
-        else:
-            out.append(f"{k} scaled by {f:.17g} to SI" + (" (sign flipped)" if f < 0 else ""))
+        if f < 0:
+            scaled = "" if f == -1.0 else f" and scaled by {-f:.17g} to SI"
+            out.append(f"{k} sign flipped{scaled} (--units {k}={f:.17g})")
     return tuple(out)
 
 

@@ -23,7 +23,7 @@ files, their sample counts, durations and the time their events cover (``duratio
 
 ``residuals.csv``: a dynid CSV table (comment lines, ``# rows: N``, a header) with ``t``
 [s], ``r1 .. rn`` [N m] and, with a frame, ``fx, fy, fz`` [N], ``mx, my, mz`` [N m] and
-``damped`` (1 near a singular configuration).
+``damped`` (1 near a singular configuration of the joints that move the frame).
 """
 
 from __future__ import annotations
@@ -262,7 +262,10 @@ def residuals_csv(
     units = "t [s], r [N m]"
     if frame is not None:
         names += ["fx", "fy", "fz", "mx", "my", "mz", "damped"]
-        units += f"; wrench at {frame}: f [N], m [N m], base axes; damped: 1 near a singularity"
+        units += (
+            f"; wrench at {frame}: f [N], m [N m], base axes (least-norm where fewer than "
+            "6 joints move the frame); damped: 1 near a singular configuration of those joints"
+        )
     with open_atomic(Path(path), "w") as fh:
         fh.write(f"# dynid residuals; units: {units}\n# rows: {rows}\n")
         fh.write(",".join(names) + "\n")

@@ -18,7 +18,7 @@ from .detection import ContactEvent, Thresholds
 from .friction import banding_note
 from .model import ObserverModel
 from .thresholds import ModelFingerprint
-from .wrench import WrenchEstimate
+from .wrench import WrenchEstimate, underdetermined_note
 
 __all__ = [
     "NO_FRICTION",
@@ -184,6 +184,7 @@ class ObserveResult:
     logs: tuple[LogObservation, ...]
     fingerprint: ModelFingerprint | None = None
     friction_source: str | None = None
+    frame: str | None = None
 
     def flagged(self) -> tuple[float, float]:
         """``(flagged, logged)`` [s]: the time every log's events cover and the logs'
@@ -202,14 +203,22 @@ class ObserveResult:
         a robot file holds of its own, used when none is given (a URDF's ``<dynamics>``:
         often a vendor's rough values); a friction
         whose Coulomb step is narrower than the logs' velocity noise is observed with the
-        noise band (:func:`~dynid.observer.friction.banding_note`)."""
-        if self.model.friction is None:
-            return (NO_FRICTION,)
-        own = None
-        if self.friction_source is not None:
-            own = robot_friction_note(self.friction_source, self.model.friction)
-        banded = banding_note(self.model.friction, [x.friction for x in self.logs])
-        return tuple(x for x in (own, banded) if x is not None)
+        noise band (:func:`~dynid.observer.friction.banding_note`); a wrench at a frame that
+        fewer than six joints move is the least-norm one
+        (:func:`~dynid.observer.wrench.underdetermined_note`)."""
+        out: tuple[str, ...] = (NO_FRICTION,) if self.model.friction is None else ()
+        if self.model.friction is not None:
+            own = None
+            if self.friction_source is not None:
+                own = robot_friction_note(self.friction_source, self.model.friction)
+            banded = banding_note(self.model.friction, [x.friction for x in self.logs])
+            out += tuple(x for x in (own, banded) if x is not None)
+        if (
+            self.frame is not None
+            and (note := underdetermined_note(self.model.robot, self.frame)) is not None
+        ):
+            out += (note,)
+        return out
 
 
 #: The note of a model that holds no friction (:attr:`ObserveResult.notes`).

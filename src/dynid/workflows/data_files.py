@@ -25,7 +25,7 @@ from typing import Any, Literal, TypeVar
 
 import numpy as np
 
-from ..exceptions import DataError
+from ..exceptions import DataError, OptionError
 from ..exceptions import in_file as about_file
 from ..identification.data import StaticDataset
 from ..identification.log import TorqueLog
@@ -39,6 +39,7 @@ from ..io.columns import (
 from ..io.input_files import regular_file
 from ..io.static_data import load_static_data
 from ..io.torque_log import load_torque_log
+from ..model.drive import Drive
 from ..model.robot import Robot
 from ..progress import NOTE
 
@@ -83,9 +84,15 @@ def in_file(path: Path, fit: Callable[[], _T]) -> _T:
 
 
 def column_map(
-    columns: str | None = None, units: str | None = None, *, cutoff_hz: float | None = None
+    columns: str | None = None,
+    units: str | None = None,
+    *,
+    cutoff_hz: float | None = None,
+    drive: Drive | None = None,
 ) -> ColumnMap | None:
-    """The column map of ``--columns`` (text or a ``.toml`` file) and ``--units``, or None.
+    """The column map of ``--columns`` (text or a ``.toml`` file) and ``--units``, or None;
+    the units declared logged once as a note (:meth:`~dynid.io.columns.ColumnMap.unit_note`),
+    never a warning per file.
 
     Parameters
     ----------
@@ -96,11 +103,16 @@ def column_map(
         ``'q=deg,tau=mNm,t=ms'``; added to (and overriding) a TOML file's units.
     cutoff_hz : float, optional
         Cut-off [Hz] of the velocities derived from positions (default: the library's).
+    drive : Drive, optional
+        The drive the logs are read through: ``tau`` in ``A`` or ``mA`` needs one whose
+        effort is current.
 
     Raises
     ------
     DataError
         A malformed map or unit (named).
+    OptionError
+        ``tau`` in a current's unit without a drive of effort = "current".
     """
     if columns is None and units is None:
         return None
@@ -109,9 +121,38 @@ def column_map(
         cmap = load_column_map(columns, **kw)
         if units is not None:
             extra = parse_column_map(None, units)
-            cmap = type(cmap)(cmap.columns, {**cmap.factors, **extra.factors}, **kw)
-        return cmap
-    return parse_column_map(columns, units, **kw)
+            cmap = type(cmap)(
+                cmap.columns,
+                {**cmap.factors, **extra.factors},
+                names={**cmap.names, **extra.names},
+                **kw,
+            )
+    else:
+        cmap = parse_column_map(columns, units, **kw)
+    check_current_unit(cmap, drive)
+    if (note := cmap.unit_note()) is not None:
+        _log.info(note)
+    return cmap
+
+
+def check_current_unit(cmap: ColumnMap | None, drive: Drive | None) -> None:
+    """Refuse ``tau`` declared a current (``--units tau=mA``) unless ``drive`` makes
+    currents torques (effort = "current", with its torque constants).
+
+    Raises
+    ------
+    OptionError
+        Naming ``--units`` and the drive's effort.
+    """
+    if cmap is None or not cmap.tau_is_current:
+        return
+    if drive is None or drive.effort != "current":
+        has = "no --drive" if drive is None else f"the drive's effort is {drive.effort!r}"
+        raise OptionError(
+            f"--units tau={cmap.names['tau']} declares motor currents, but {has}; give a "
+            '--drive with effort = "current" and its torque_constant, or torques\' units '
+            "(--units tau=Nm, tau=mNm, or a factor to N m)"
+        )
 
 
 def data_kind(path: str | Path, columns: ColumnMap | None = None) -> DataKind:

@@ -49,6 +49,8 @@ class ExportRobotOptions:
     base, tip : str, optional
         The chain's base and tip links in a URDF robot and in the template (default: the
         file's only root and leaf).
+    snap_angles : bool
+        Read a URDF robot's joint angles rounded near multiples of pi/2 as those multiples.
     merged : {"subtract", "keep", "move"}
         Template: how a body is split over its moving link and the links fixed to it.
     friction : bool
@@ -68,6 +70,7 @@ class ExportRobotOptions:
     urdf_template: str | Path | None = None
     base: str | None = None
     tip: str | None = None
+    snap_angles: bool = False
     merged: str = "subtract"
     friction: bool = True
     all_frames: bool = False
@@ -139,7 +142,8 @@ def export_robot(
     fmt = export_format(out, opt.format)
     if opt.urdf_template is not None and not ROBOT_FORMATS[fmt].template:
         raise OptionError(f"applies to the urdf format only; got {fmt}", field="urdf_template")
-    robot = load_robot(params, base=opt.base, tip=opt.tip) if urdf else load_robot(params)
+    base, tip = (opt.base, opt.tip) if urdf else (None, None)  # also the template's
+    robot = load_robot(params, base=base, tip=tip, snap_angles=opt.snap_angles)
     linear, drive = model_terms_of(params, robot.n)
     if opt.drive is not None:
         drive = opt.drive if isinstance(opt.drive, Drive) else load_drive(opt.drive, robot.n)

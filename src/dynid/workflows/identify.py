@@ -70,8 +70,8 @@ from .recordings import (
 __all__ = ["ColumnSpec", "IdentifyOptions", "IdentifyResult", "data_files", "identify_files"]
 
 
-def _columns(spec: ColumnSpec | None, cutoff_hz: float | None) -> Any:
-    return None if spec is None else column_map(*spec, cutoff_hz=cutoff_hz)
+def _columns(spec: ColumnSpec | None, cutoff_hz: float | None, drive: Drive | None) -> Any:
+    return None if spec is None else column_map(*spec, cutoff_hz=cutoff_hz, drive=drive)
 
 
 def _heldout(
@@ -376,7 +376,7 @@ def _identify(
     """The unconstrained fit of :func:`identify_files` and, from torque logs, its
     held-out prediction."""
     path = paths[0]
-    cmap = _columns(opt.columns, opt.cutoff_hz)
+    cmap = _columns(opt.columns, opt.cutoff_hz, opt.drive)
     kind = data_kind(path, cmap)
     heldout = _heldout(paths, kind, opt.folds, opt.validate_on, robot, cmap, opt.drop_invalid)
     if kind == "torque_log":
@@ -498,7 +498,7 @@ def _identify_consistent(
     result holds the unconstrained fit.
     """
     path = paths[0]
-    cmap = _columns(opt.columns, opt.cutoff_hz)
+    cmap = _columns(opt.columns, opt.cutoff_hz, opt.drive)
     kind = data_kind(path, cmap)
     heldout = _heldout(paths, kind, opt.folds, opt.validate_on, robot, cmap, opt.drop_invalid)
     common: dict[str, Any] = dict(prior=prior, total_mass=opt.total_mass, options=opt.sdp())

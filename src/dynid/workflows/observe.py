@@ -172,6 +172,9 @@ class ObserveOptions:
     base, tip : str, optional
         The chain of a ``params`` URDF with several leaves (its root and only leaf by
         default).
+    snap_angles : bool
+        Read a ``params`` URDF's joint angles rounded near multiples of pi/2 as those
+        multiples (:func:`dynid.io.robot.urdf.load_urdf`).
     q_start : tuple of float, optional
         The joint positions [rad] at the first sample of one motor-side log whose motor
         encoders wrap every turn (:func:`~dynid.workflows.recordings.given_start`).
@@ -210,6 +213,7 @@ class ObserveOptions:
     max_gap: float | None = None
     base: str | None = None
     tip: str | None = None
+    snap_angles: bool = False
     q_start: tuple[float, ...] | None = None
     keep_series: bool = True
     figure_points: int | None = None
@@ -223,27 +227,32 @@ def load_observer_model(
     base: str | None = None,
     tip: str | None = None,
     drive: Drive | Path | None = None,
+    snap_angles: bool = False,
 ) -> tuple[ObserverModel, Mapping[str, str | None] | None]:
     """The observer model of ``--model`` or ``--params`` (and ``--friction``), with the
     column map the model's data were read with (None for a robot); ``base`` and ``tip``
-    choose the chain of a ``params`` URDF; ``drive`` the one given (``--drive``,
+    choose the chain of a ``params`` URDF, ``snap_angles`` snaps its rounded angles;
+    ``drive`` the one given (``--drive``,
     :func:`observer_drive`).
 
     Raises
     ------
     OptionError
-        Neither or both of ``model`` and ``params``; ``base`` or ``tip`` with another
-        model than a URDF.
+        Neither or both of ``model`` and ``params``; ``base``, ``tip`` or ``snap_angles``
+        with another model than a URDF.
     DataError
         A file that is not what it should be (named), a ``drive`` other than the one the
         model or the ``feasible.json`` holds.
     """
     if (model is None) == (params is None):
         raise OptionError("give one of --model identification.json and --params ROBOT")
-    if (base is not None or tip is not None) and not str(params).lower().endswith(".urdf"):
+    if (base is not None or tip is not None or snap_angles) and not str(params).lower().endswith(
+        ".urdf"
+    ):
         given = "--model" if model is not None else f"--params {params}"
         raise OptionError(
-            f"--base/--tip choose the chain of a --params URDF; {given} holds its own chain"
+            f"--base/--tip/--snap-angles read the chain of a --params URDF; {given} holds "
+            "its own chain"
         )
     fr: FrictionModel | FrictionSum | None | str = "model"
     if model is not None:
@@ -259,7 +268,7 @@ def load_observer_model(
             obs = dataclasses.replace(obs, drive=own)
         return obs, ident.info.column_map
     spec = str(params)
-    robot = load_robot(spec, base=base, tip=tip, what="--params")
+    robot = load_robot(spec, base=base, tip=tip, snap_angles=snap_angles, what="--params")
     if spec.lower().endswith(".json") and friction is None:
         lin = load_feasible_linear_friction(spec)
         fr = "robot" if lin is None else lin
@@ -404,7 +413,13 @@ def observe_files(opts: ObserveOptions, sink: ResidualSink | None = None) -> Obs
         raise OptionError("give --calibrate (collision-free logs) or --thresholds thresholds.json")
     _refuse_unused(opts)
     model, recorded = load_observer_model(
-        opts.model, opts.params, opts.friction, base=opts.base, tip=opts.tip, drive=opts.drive
+        opts.model,
+        opts.params,
+        opts.friction,
+        base=opts.base,
+        tip=opts.tip,
+        drive=opts.drive,
+        snap_angles=opts.snap_angles,
     )
     given = None if opts.thresholds is None else load_thresholds(opts.thresholds)
     if given is not None and given.n != model.n:
@@ -466,7 +481,7 @@ def observe_files(opts: ObserveOptions, sink: ResidualSink | None = None) -> Obs
                 table=table,
             )  # fmt: skip
         )
-    return ObserveResult(model, given, tuple(logs), fingerprint, own)
+    return ObserveResult(model, given, tuple(logs), fingerprint, own, opts.frame)
 
 
 def model_fingerprint(opts: ObserveOptions) -> ModelFingerprint:
@@ -522,7 +537,7 @@ def _read_logs(
     read as N m refused,
     and one far outside the joint limits warned about, each naming the file
     (:mod:`dynid.workflows.recordings`)."""
-    cmap = column_map(*columns)
+    cmap = column_map(*columns, drive=model.drive)
     logs = [
         read_torque_log(
             p,

@@ -33,7 +33,7 @@ from ..observer.residual import ObserverOptions
 from ..observer.results import FigureSeries, LogObservation
 from ..observer.sign import TorqueSign, opposite_finding
 from ..observer.thresholds import Thresholds, threshold_series
-from ..observer.wrench import WrenchEstimate, external_wrench
+from ..observer.wrench import WrenchEstimate, external_wrench, wrench_rank
 from .data_files import in_file
 from .observe_logs import ObservedBlock, PreparedLog, Series, observed_rows
 
@@ -148,7 +148,7 @@ def observed_wrench(model: ObserverModel, q: NDArray, r: NDArray, frame: str) ->
     if seen.any():
         w = external_wrench(model.robot, q[seen], r[seen], frame)
         wrench[seen], smin[seen], damped[seen] = w.wrench, w.sigma_min, w.damped
-    return WrenchEstimate(frame, wrench, smin, damped)
+    return WrenchEstimate(frame, wrench, smin, damped, wrench_rank(model.robot, frame))
 
 
 def _joined(blocks: list[WrenchEstimate], frame: str | None) -> WrenchEstimate | None:
@@ -160,6 +160,7 @@ def _joined(blocks: list[WrenchEstimate], frame: str | None) -> WrenchEstimate |
         np.concatenate([w.wrench for w in blocks]),
         np.concatenate([w.sigma_min for w in blocks]),
         np.concatenate([w.damped for w in blocks]),
+        blocks[0].determined,
     )
 
 

@@ -150,7 +150,8 @@ def identify_payload_files(
         friction = load_feasible_linear_friction(feasible) or "own"
     recorded = arm.info.log if isinstance(arm, IdentifiedModel) else None
     known = cutoff_hz if cutoff_hz is not None or recorded is None else recorded.cutoff_hz
-    cmap = column_map(*(columns or (None, None)), cutoff_hz=known)
+    read_drive = arm.drive if isinstance(arm, IdentifiedModel) and drive is None else drive
+    cmap = column_map(*(columns or (None, None)), cutoff_hz=known, drive=read_drive)
     kind = data_kind(paths[0], cmap)
     common: dict[str, Any] = dict(frame=frame, drive=drive, friction=friction)
     if kind != "torque_log":
@@ -168,7 +169,7 @@ def identify_payload_files(
         columns=columns,
         drop_invalid=drop_invalid,
         cutoff_hz=known,
-        drive=arm.drive if isinstance(arm, IdentifiedModel) and drive is None else drive,
+        drive=read_drive,
     )
     rec = read_recordings(
         paths, kin, owner=f"robot {kin.name!r}", q_start=q_start, max_gap_s=max_gap_s, **read_as

@@ -28,7 +28,9 @@ def load_prior(
     ----------
     spec : str or Path, optional
         ``'panda'``, ``'fr3'``, a ``.urdf`` (chain ``base`` to ``tip``, default: the
-        robot's first and last link names), a ``.toml`` or a ``feasible.json``.
+        robot's first and last link names; its angles rounded near multiples of pi/2
+        read snapped and not warned about: only its inertials are used), a ``.toml`` or
+        a ``feasible.json``.
     robot : Robot
         The robot being identified.
     base, tip : str, optional
@@ -72,8 +74,11 @@ def load_prior(
         urdf = path.suffix.lower() == ".urdf"
         try:
             if urdf:
-                prior = load_robot(
-                    path, base=base or robot.link_names[0], tip=tip or robot.link_names[-1]
+                prior = load_robot(  # its angles snapped: only its inertials are used,
+                    path,  # in the robot's frames; their rounding is the robot's to say
+                    base=base or robot.link_names[0],
+                    tip=tip or robot.link_names[-1],
+                    snap_angles=True,
                 )
             else:
                 prior = load_robot(path)

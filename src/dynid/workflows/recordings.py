@@ -187,7 +187,7 @@ def read_recordings(
     """
     paths = data_files(data)
     names, units = recorded_columns(recorded, *(columns or (None, None)))
-    cmap = column_map(names, units, cutoff_hz=cutoff_hz)
+    cmap = column_map(names, units, cutoff_hz=cutoff_hz, drive=drive)
 
     def read(p: Path) -> TorqueLog:
         return read_torque_log(

@@ -39,10 +39,14 @@ Conventions
   log line names those joints; zeros everywhere mean no friction. dynid's export writes
   its friction there (:func:`~dynid.io.robot.urdf.export_urdf`), so it reads back. A
   negative coefficient is refused.
-* Ignored: what is off the chain (other branches through moving joints, mimic joints off
-  the chain, transmissions, gazebo tags), visual and collision geometry, ``<dynamics>`` of
-  fixed joints, the other attributes of ``<dynamics>`` (Gazebo's ``K``, ``D``,
-  ``mu_coulomb``, ...), ``<safety_controller>``.
+* Left out, said once (:mod:`dynid.io.robot.urdf_branches`): the links hanging off the
+  chain's moving links through moving joints (a gripper's jaw, the joints past the tip),
+  a warning naming them and their mass, which no link of the model holds (a log line when
+  they are massless); the links merged through fixed joints are named in a log line
+  (``-v``).
+* Ignored: mimic joints off the chain, transmissions, gazebo tags, visual and collision
+  geometry, ``<dynamics>`` of fixed joints, the other attributes of ``<dynamics>``
+  (Gazebo's ``K``, ``D``, ``mu_coulomb``, ...), ``<safety_controller>``.
 """
 
 from __future__ import annotations
@@ -64,6 +68,7 @@ from ...model.inertia import inertial_problems, phi_from_inertial
 from ...model.robot import MAX_LINK_MASS, MAX_LINK_OFFSET, Frame, Robot
 from ..input_files import file_bytes
 from .urdf_angles import AngleRounding, rounding_message
+from .urdf_branches import OffChain, off_chain
 from .urdf_tree import (
     _chain,
     _child,
@@ -417,11 +422,18 @@ def _robot_from_text(
 ) -> Robot:
     """Body of the two public readers (called directly by both, so warnings point at the caller)."""
     angles = AngleRounding(snap=snap_angles)
-    robot = _read_chain(text, base_link, tip_link, source, angles)
+    robot, found = _read_chain(text, base_link, tip_link, source, angles)
+    if (left := found.left_out) is not None:
+        if found.mass_left_out > 0.0:  # a mass the model misses
+            warnings.warn(left, DynidWarning, stacklevel=3)
+        else:
+            _log.info("%s", left)
+    if (merged := found.merged_line) is not None:
+        _log.info("%s", merged)
     if angles.found and not snap_angles:
         with warnings.catch_warnings():  # the inertials' warnings were given once
             warnings.simplefilter("ignore", DynidWarning)
-            snapped = _read_chain(text, base_link, tip_link, source, AngleRounding(snap=True))
+            snapped = _read_chain(text, base_link, tip_link, source, AngleRounding(snap=True))[0]
         msg, harmful = rounding_message(source, angles.found, robot, snapped)
         if harmful:
             warnings.warn(msg, DynidWarning, stacklevel=3)
@@ -449,8 +461,9 @@ def _read_chain(
     tip_link: str | None,
     source: str,
     angles: AngleRounding,
-) -> Robot:
-    """The robot of the chain, its joint-origin angles through ``angles``."""
+) -> tuple[Robot, OffChain]:
+    """The robot of the chain, its joint-origin angles through ``angles``, and what it
+    leaves out or merges (:func:`~dynid.io.robot.urdf_branches.off_chain`)."""
     try:
         root = ET.fromstring(text)
     except ET.ParseError as exc:
@@ -480,7 +493,9 @@ def _read_chain(
 
     n = len(w.joint_names)
     lim = np.array(w.limits)
-    return Robot(
+    on_chain = {j.name for j in path}
+    found = off_chain(source, links, child_joints, on_chain, w.placed, w.link_names, w.fixed_joint)
+    robot = Robot(
         name=name,
         joint_names=tuple(w.joint_names),
         link_names=tuple(w.link_names),
@@ -496,6 +511,7 @@ def _read_chain(
         frames=frames,
         friction=_friction(w),
     )
+    return robot, found
 
 
 def load_urdf(
