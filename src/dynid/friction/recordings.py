@@ -37,6 +37,7 @@ from numpy.typing import NDArray
 
 from .. import _checks
 from ..exceptions import DataError, OptionError
+from ..identification.input_noise import StateNoise, state_noise
 from ..identification.log import TorqueLog, joint_side_log
 from ..identification.metrics import TorqueErrors
 from ..identification.model import IdentifiedModel
@@ -95,6 +96,9 @@ class Pieces:
     samples, durations : tuple, optional
         Prepared samples and duration [s] of each piece, when ``logs`` keep only every
         k-th sample of long pieces (:func:`validate_recordings`); default: the logs' own.
+    state_noise : StateNoise or None
+        The white noise of the prepared velocities and accelerations, read from the raw
+        pieces (:func:`~dynid.identification.input_noise.state_noise`); None: not known.
     """
 
     logs: tuple[TorqueLog, ...]
@@ -107,6 +111,7 @@ class Pieces:
     drive: Drive | None = None
     samples: tuple[int, ...] | None = None
     durations: tuple[float, ...] | None = None
+    state_noise: StateNoise | None = None
 
     def __post_init__(self) -> None:
         if self.samples is None:  # the logs hold every prepared sample
@@ -299,6 +304,7 @@ def _kept(
         skipped=tuple(skipped),
         unwrapped=raw.unwrapped,
         drive=raw.drive,
+        state_noise=state_noise([p for _, p in raw.pieces], raw.cutoff_hz),
         **counts,
     )
 
