@@ -27,6 +27,7 @@ from dynid.identification.input_noise import (
     StateNoise,
     derived_noise_gains,
     input_noise_var,
+    noise_floor,
     quantization_step,
     quantized_noise_std,
 )
@@ -160,3 +161,25 @@ def test_a_wrong_model_on_the_same_data_is_still_judged_worse(quantized, wrong):
     assert v.ratio is not None and true.ratio is not None
     assert v.level != "good", v.reason
     assert v.ratio > 2 * true.ratio, (v.reason, true.reason)
+
+
+def test_the_floor_weighs_each_sample_against_its_own_noise():
+    """A constant states' noise (far above the sensors'): the ratio is the plain quotient
+    of the norms; the same mean noise put at 1 % of the samples (reversals) does not excuse
+    an error spread over the others (ratio 10 x larger), while an error at those samples
+    alone is within it."""
+    rng = np.random.default_rng(3)
+    N, n = 10_000, 2
+    tau = rng.normal(0, 1.0, (N, n))
+    spread = rng.normal(0, 0.1, (N, n))
+    flat = noise_floor([tau], [spread], [np.full(n, 1e-5)], [(1, np.full((N, n), 0.005))])
+    quotient = np.linalg.norm(spread) / np.linalg.norm(tau) * 100 / flat.percent
+    assert flat.ratio == pytest.approx(quotient, rel=1e-9)
+    V = np.zeros((N, n))
+    V[:100] = 0.5  # the same mean variance, at 1 % of the samples
+    rare = noise_floor([tau], [spread], [np.full(n, 1e-5)], [(1, V)])
+    assert rare.percent == pytest.approx(flat.percent, rel=1e-9)
+    assert rare.ratio > 10 * flat.ratio
+    there = np.zeros((N, n))
+    there[:100] = rng.normal(0, 1.0, (100, n))
+    assert noise_floor([tau], [there], [np.full(n, 1e-5)], [(1, V)]).ratio < 1.5

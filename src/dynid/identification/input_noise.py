@@ -23,7 +23,8 @@ no noise at all).
 preparation (:func:`derived_noise_gains`); :func:`input_noise_var` propagates it through
 the prediction: exactly for the accelerations (the torques are linear in them), by
 equal-probability nodes of the noise for the velocities (a friction step is not
-differentiable).
+differentiable); :func:`noise_floor` weighs a prediction's error against both, sample by
+sample, in the terms :func:`~dynid.identification.verdict.judge_prediction` takes.
 """
 
 from __future__ import annotations
@@ -38,13 +39,16 @@ from .. import _checks, signals
 from ..exceptions import ShapeError
 from .log import TorqueLog
 from .sanity import velocity_noise_std
+from .verdict import NOISE_FLOOR_SHARE, joint_ratios
 
 __all__ = [
     "LATTICE_SHARE",
     "NODES",
+    "NoiseFloor",
     "StateNoise",
     "derived_noise_gains",
     "input_noise_var",
+    "noise_floor",
     "quantization_step",
     "quantized_noise_std",
     "state_noise",
@@ -247,3 +251,110 @@ def input_noise_var(
                     up[:, i] = dq[:, i] + s * e
                     var += (friction(up) - f0) ** 2 / z.size
     return var
+
+
+@dataclass(frozen=True, slots=True)
+class NoiseFloor:
+    """The noise a perfect model leaves on some pieces, and an error weighed against it.
+
+    Attributes
+    ----------
+    sensor_rms : ndarray, shape (n,)
+        The torque sensors' noise per joint [N m].
+    input_rms : ndarray, shape (n,), or None
+        The states' noise through the model per joint [N m] (RMS over the samples); None:
+        not known.
+    total_rms : ndarray, shape (n,)
+        Both, root sum of squares [N m].
+    percent : float
+        ``total`` over every sample relative to the torques' norm [%] (0: torques of zero
+        norm).
+    ratio : float or None
+        The error over the floor, each sample's squared error weighed by its joint's mean
+        noise variance over its own (None: the plain quotient applies, no states' noise).
+    joint_ratios : ndarray, shape (n,), or None
+        Each joint's error over its noise, weighed so (None: no noise known).
+    words : str or None
+        The floor's parts for the verdict (``judge_prediction``'s ``floor_parts``).
+    """
+
+    sensor_rms: NDArray[np.float64]
+    input_rms: NDArray[np.float64] | None
+    total_rms: NDArray[np.float64]
+    percent: float
+    ratio: float | None
+    joint_ratios: NDArray[np.float64] | None
+    words: str | None
+
+
+def noise_floor(
+    tau: Sequence[NDArray[np.float64]],
+    error: Sequence[NDArray[np.float64]],
+    sensor_var: Sequence[NDArray[np.float64] | None],
+    inputs: Sequence[tuple[int, NDArray[np.float64]]] | None = None,
+    rms: NDArray[np.float64] | None = None,
+) -> NoiseFloor:
+    """The noise floor of pieces and their prediction error weighed against it.
+
+    The floor is the sensors' noise and, with ``inputs``, the states' noise through the
+    model (:func:`input_noise_var`). The latter varies from sample to sample (a friction
+    step where the velocity's noise can flip its sign): each sample's squared error is
+    weighed by its joint's mean noise variance over its own, so that the noise at a few
+    reversals does not excuse an error spread over the moving samples; a constant noise
+    gives the plain quotient of the errors' and the floor's norms. A joint's noise counts at
+    least :data:`~dynid.identification.verdict.NOISE_FLOOR_SHARE` of the largest joint's.
+
+    Parameters
+    ----------
+    tau, error : sequence of ndarray, each (N_p, n)
+        Each piece's measured torques and measured less predicted torques [N m].
+    sensor_var : sequence of ndarray (n,) or None
+        Each piece's sensor noise variance [N^2 m^2] (None: unknown, the pieces' mean).
+    inputs : sequence of (int, ndarray (M_p, n)), optional
+        Each piece's step ``k`` and the states' noise variance at its every k-th sample
+        [N^2 m^2].
+    rms : ndarray, shape (n,), optional
+        The RMS error per joint over every sample [N m] (default: over ``error``'s), for
+        pieces that keep every k-th sample of a longer prediction.
+    """
+    n = tau[0].shape[1]
+    N = sum(t.shape[0] for t in tau)
+    var = sum(
+        (t.shape[0] * s for t, s in zip(tau, sensor_var, strict=True) if s is not None), np.zeros(n)
+    )
+    norm2 = float(sum(np.sum(t**2) for t in tau))
+    put = np.zeros(n)
+    if inputs is not None:
+        put = sum((k * np.sum(V, axis=0) for k, V in inputs), np.zeros(n))
+        put *= N / max(sum(k * V.shape[0] for k, V in inputs), 1)  # to every sample
+    total = np.sqrt((var + put) / max(N, 1))
+    percent = 100.0 * float(np.sqrt((var + put).sum() / norm2)) if norm2 > 0 else 0.0
+    if rms is None:
+        rms = np.sqrt(sum(np.sum(e**2, axis=0) for e in error) / max(N, 1))
+    ratio, ratios, words = None, None, None
+    if np.all(total > 0):
+        ratios = joint_ratios(rms, total)
+    if inputs is not None and norm2 > 0 and put.sum() > 0 and np.all(total > 0):
+        least = (NOISE_FLOOR_SHARE * float(np.max(total))) ** 2
+        mean = np.maximum(total**2, least)
+        w_e2, count = np.zeros(n), 0
+        for (k, V), e, s2 in zip(inputs, error, sensor_var, strict=True):
+            f = np.maximum(V + (var / max(N, 1) if s2 is None else s2), least)
+            w_e2 += np.sum(e[::k] ** 2 * mean / f, axis=0)
+            count += V.shape[0]
+        ratios = np.sqrt(w_e2 / max(count, 1) / mean)
+        ratio = float(np.sqrt(np.sum(w_e2) / max(count, 1) / np.sum(mean)))
+        words = (
+            f", of which the torques' noise {100 * np.sqrt(var.sum() / norm2):.3g} % and that "
+            f"of the states through the model {100 * np.sqrt(put.sum() / norm2):.3g} %; "
+            "each sample against its own noise"
+        )
+    return NoiseFloor(
+        sensor_rms=np.sqrt(var / max(N, 1)),
+        input_rms=None if inputs is None else np.sqrt(put / max(N, 1)),
+        total_rms=total,
+        percent=percent,
+        ratio=ratio,
+        joint_ratios=ratios,
+        words=words,
+    )

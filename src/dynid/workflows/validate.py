@@ -51,7 +51,7 @@ from ..friction.model import FrictionModel, FrictionSum, placed_friction
 from ..friction.recordings import RecordingsValidation, validate_recordings
 from ..friction.validation import RECORDED, own_friction
 from ..identification.derived_cutoff import derived_cutoff_hint, with_derived_cutoff_hint
-from ..identification.input_noise import input_noise_var, quantized_noise_std
+from ..identification.input_noise import input_noise_var, noise_floor, quantized_noise_std
 from ..identification.low_speed import with_low_speed_hint
 from ..identification.metrics import TorqueErrors
 from ..identification.model import IdentifiedModel
@@ -60,7 +60,6 @@ from ..identification.sanity import SPIKES_BEFORE_JUDGING, anticorrelated
 from ..identification.verdict import (
     LEVELS,
     Verdict,
-    joint_ratios,
     judge_prediction,
     with_replaced_spikes,
 )
@@ -388,68 +387,42 @@ def _judged(
 
     The noise is the sensors', read from each piece's measured torques
     (:func:`~dynid.identification.input_noise.quantized_noise_std`), and the states'
-    through the model (``inputs``: :func:`_input_noise`; None: not known). The states'
-    noise varies from sample to sample (a friction step where the velocity's noise can
-    flip its sign): the error is weighed against it sample by sample (each sample's
-    squared error times its joint's mean noise variance over its own), so that the noise
-    at a few reversals does not excuse an error spread over the moving samples. The
-    model's torques are checked for the opposite sign (on at most 20 000 samples).
+    through the model (``inputs``: :func:`_input_noise`; None: not known), the error
+    weighed against it sample by sample
+    (:func:`~dynid.identification.input_noise.noise_floor`). The model's torques are
+    checked for the opposite sign (on at most 20 000 samples).
     """
     chosen = [k for k, s in enumerate(sel) if s]
     parts = [val.parts[k] for k in chosen]
-    n = parts[0].log.n
-    var, norm2, N = np.zeros(n), 0.0, 0
-    sensor_each = []
-    for v in parts:
-        s2 = quantized_noise_std(v.log.tau, v.log.t) ** 2 if v.log.n_samples >= 3 else None
-        sensor_each.append(s2)
-        if s2 is not None:
-            var += v.log.n_samples * s2
-        norm2 += float(np.sum(v.log.tau**2))
-        N += v.log.n_samples
-    sensor = np.sqrt(var / max(N, 1))
-    put, ratio, ratios, said = np.zeros(n), None, None, None
-    if inputs is not None:
-        used = [inputs[k] for k in chosen]
-        put = sum((k * np.sum(V, axis=0) for k, V in used), np.zeros(n))
-        put *= N / max(sum(k * V.shape[0] for k, V in used), 1)  # to every sample
-    total = np.sqrt((var + put) / max(N, 1))
-    floor = 100.0 * float(np.sqrt((var + put).sum() / norm2)) if norm2 > 0 else 0.0
-    if inputs is not None and norm2 > 0 and put.sum() > 0 and np.all(total > 0):
-        mean = total**2
-        w_e2, count = np.zeros(n), 0
-        for (k, V), v, s2 in zip(used, parts, sensor_each, strict=True):
-            e = (v.log.tau - v.tau_hat)[::k]
-            f = V + (var / max(N, 1) if s2 is None else s2)
-            w_e2 += np.sum(e**2 * mean / np.maximum(f, 1e-300), axis=0)
-            count += e.shape[0]
-        ratios = np.sqrt(w_e2 / max(count, 1) / mean)
-        ratio = float(np.sqrt(np.sum(w_e2) / max(count, 1) / np.sum(mean)))
-        said = (
-            f", of which the torques' noise {100 * np.sqrt(var.sum() / norm2):.3g} % and that "
-            f"of the states through the model {100 * np.sqrt(put.sum() / norm2):.3g} %; "
-            "each sample against its own noise"
-        )
-    noise = _Noise(sensor, None if inputs is None else np.sqrt(put / max(N, 1)), total)
+    fl = noise_floor(
+        [v.log.tau for v in parts],
+        [v.log.tau - v.tau_hat for v in parts],
+        [
+            quantized_noise_std(v.log.tau, v.log.t) ** 2 if v.log.n_samples >= 3 else None
+            for v in parts
+        ],
+        None if inputs is None else [inputs[k] for k in chosen],
+        rms=errors.rms,
+    )
+    noise = _Noise(fl.sensor_rms, fl.input_rms, fl.total_rms)
+    N = sum(v.log.n_samples for v in parts)
     step = max(1, N // 20_000)
     tau = np.concatenate([v.log.tau[::step] for v in parts])
     model = np.concatenate([v.tau_model[::step] for v in parts])
     spread = np.std(model, axis=0)
     loaded = spread > 0.05 * max(float(spread.max(initial=0.0)), 1e-300)
     opposite = anticorrelated(model - model.mean(axis=0), tau - tau.mean(axis=0), loaded)
-    if ratios is None and np.all(total > 0):
-        ratios = joint_ratios(errors.rms, total)
     verdict = judge_prediction(
         errors.relative_error_percent,
-        floor,
+        fl.percent,
         opposite_sign=opposite is not None,
-        joint_ratios=ratios,
+        joint_ratios=fl.joint_ratios,
         joint_percent=errors.relative_error_percent_per_joint,
         joint_names=names,
-        floor_parts=said,
-        ratio=ratio,
+        floor_parts=fl.words,
+        ratio=fl.ratio,
     )
-    return verdict, noise, floor
+    return verdict, noise, fl.percent
 
 
 def _friction(
