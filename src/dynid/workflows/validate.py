@@ -306,7 +306,7 @@ def validate_files(
         verdict,
         [v.log.dq for v in val.parts],
         [v.log.tau - v.tau_hat for v in val.parts],
-        noise.total,
+        noise.sensor,  # the hint's "above the noise": the sensors' (its module docstring)
         names,
     )
     if isinstance(model, IdentifiedModel) and model.info.log is not None:
