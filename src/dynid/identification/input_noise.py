@@ -170,6 +170,8 @@ def state_noise(pieces: Sequence[TorqueLog], cutoff_hz: float | None) -> StateNo
         fc = cutoff_hz
         if fc is not None and fc >= 0.5 / dt:  # moved below Nyquist, as the preparation does
             fc = 0.25 / dt
+        if p.dq_derived and fc is None:  # not prepared so (derived at a cut-off only)
+            continue
         derived |= p.dq_derived
         src = p.q if p.dq_derived else p.dq
         sigma = quantized_noise_std(src, p.t)
