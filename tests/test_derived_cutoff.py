@@ -50,12 +50,16 @@ def _verdict(panda, path, cutoff_hz):
 
 def test_a_positions_only_log_above_its_motions_cut_off_is_told_to_lower_it(logs):
     """At 10 Hz, 1.8 times the 5.5 Hz read from the motion, the true model of a
-    positions-only log is judged above the noise floor and the verdict names the cut-off
-    and the remedy; at the motion's cut-off, or with measured velocities at 10 Hz, the
-    model is at the floor and nothing is said."""
+    positions-only log is at a noise floor the derived states raise (the floor counts
+    their noise through the model), and the verdict names the cut-off and the remedy; at
+    the motion's cut-off, or with measured velocities at 10 Hz, the model is at the floor
+    and nothing is said."""
     panda, d = logs
     high = _verdict(panda, d / "positions.csv", 10.0)
-    assert high.level != "good"
+    low = _verdict(panda, d / "positions.csv", None)
+    assert high.level == "good" and "a floor raised because" in high.reason, high.reason
+    floor = lambda v: float(v.reason.split("noise floor of ")[1].split(" %")[0])  # noqa: E731
+    assert floor(high) > 1.3 * floor(low), (high.reason, low.reason)
     assert re.search(r"derived from the positions at 10 Hz, 1.8 times .* \(5.5 Hz\)", high.reason)
     assert "hint: lower --cutoff (toward 5.5 Hz)" in high.reason
     for path, cutoff in ((d / "positions.csv", None), (d / "measured.csv", 10.0)):

@@ -129,12 +129,13 @@ def logs(panda, tmp_path_factory):
 
 def test_validate_of_the_true_robot_is_at_the_noise_floor(panda, logs):
     """The robot that made the logs: at the noise floor, and the noise read from the
-    measured torques is the simulated sensor's (0.05 N m)."""
+    measured torques is the simulated sensor's (0.05 N m); the ratio, weighed sample by
+    sample against a noise the states' part makes vary, is within 5 % of error over floor."""
     res = validate_files(panda, [logs / "rec1.csv", logs / "rec2.csv"])
     np.testing.assert_allclose(res.noise_rms, NOISE, rtol=0.1)
     assert res.verdict.level == "good" and res.verdict.label == "at the noise floor"
     assert res.verdict.ratio == pytest.approx(
-        res.validation.errors.relative_error_percent / res.noise_floor_percent
+        res.validation.errors.relative_error_percent / res.noise_floor_percent, rel=0.05
     )
     meta = res.metadata()
     assert meta["verdict"]["level"] == "good" and meta["noise_floor_percent"] > 0

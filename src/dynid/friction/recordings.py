@@ -39,6 +39,7 @@ from numpy.typing import NDArray
 from .. import _checks
 from ..exceptions import DataError, DynidWarning, OptionError
 from ..identification.cut_loss import left_out_finding
+from ..identification.input_noise import StateNoise, state_noise
 from ..identification.log import TorqueLog, joint_side_log
 from ..identification.metrics import TorqueErrors
 from ..identification.model import IdentifiedModel
@@ -97,6 +98,9 @@ class Pieces:
     samples, durations : tuple, optional
         Prepared samples and duration [s] of each piece, when ``logs`` keep only every
         k-th sample of long pieces (:func:`validate_recordings`); default: the logs' own.
+    state_noise : StateNoise or None
+        The white noise of the prepared velocities and accelerations, read from the raw
+        pieces (:func:`~dynid.identification.input_noise.state_noise`); None: not known.
     """
 
     logs: tuple[TorqueLog, ...]
@@ -109,6 +113,7 @@ class Pieces:
     drive: Drive | None = None
     samples: tuple[int, ...] | None = None
     durations: tuple[float, ...] | None = None
+    state_noise: StateNoise | None = None
 
     def __post_init__(self) -> None:
         if self.samples is None:  # the logs hold every prepared sample
@@ -311,6 +316,7 @@ def _kept(
         skipped=tuple(skipped),
         unwrapped=raw.unwrapped,
         drive=raw.drive,
+        state_noise=state_noise([p for _, p in raw.pieces], raw.cutoff_hz),
         **counts,
     )
 

@@ -1,8 +1,10 @@
 """How well a model predicts measured torques, in four levels a person can act on.
 
 The relative error ``100 ||tau - tau_hat||_F / ||tau||_F`` [%] of unfiltered torques is
-weighed against the sensor-noise floor when it is known (the smallest error any model can
-reach on those torques: the noise's norm over the torques', [%]):
+weighed against the noise floor when it is known (the smallest error any model can reach
+on those torques: the noise's norm over the torques', [%]; the sensors' noise, and in
+``validate`` also that the model's inputs put into its prediction,
+:mod:`~dynid.identification.input_noise`, then weighed sample by sample):
 
 ============  ===========================================  ================================
 level         when                                         what to do
@@ -196,12 +198,21 @@ def judge_prediction(
     joint_ratios: ArrayLike | None = None,
     joint_percent: ArrayLike | None = None,
     joint_names: Sequence[str] | None = None,
+    floor_parts: str | None = None,
+    ratio: float | None = None,
 ) -> Verdict:
     """The level of a prediction (module docstring): :func:`pooled_verdict`, made worse by
     the worst of :func:`joint_levels` (``joint_ratios``: each joint's RMS error over its
     torque noise; ``joint_percent``: its relative error [%]; either may be None), the
-    joints judged worse than good named (``joint_names``, default 1-based numbers)."""
-    v = pooled_verdict(error_percent, floor_percent, opposite_sign=opposite_sign)
+    joints judged worse than good named (``joint_names``, default 1-based numbers);
+    ``floor_parts`` and ``ratio`` as :func:`pooled_verdict`'s."""
+    v = pooled_verdict(
+        error_percent,
+        floor_percent,
+        opposite_sign=opposite_sign,
+        floor_parts=floor_parts,
+        ratio=ratio,
+    )
     levels = joint_levels(joint_percent, joint_ratios)
     if not levels or v.level in ("poor", "unusable"):
         return v
@@ -239,6 +250,8 @@ def pooled_verdict(
     floor_percent: float | None = None,
     *,
     opposite_sign: bool = False,
+    floor_parts: str | None = None,
+    ratio: float | None = None,
 ) -> Verdict:
     """The level of a prediction of relative error ``error_percent`` [%] (module docstring).
 
@@ -247,9 +260,17 @@ def pooled_verdict(
     error_percent : float
         Relative error of the unfiltered torques [%].
     floor_percent : float, optional
-        The sensor-noise floor of the same torques [%]; None or 0: unknown.
+        The noise floor of the same torques [%]: their sensors' noise, and the noise the
+        model's inputs put into its prediction when known
+        (:mod:`~dynid.identification.input_noise`); None or 0: unknown.
     opposite_sign : bool
         The measured torques are anti-correlated with the model's.
+    floor_parts : str, optional
+        What the floor is made of, said after it (``", of which the torques' noise ..."``;
+        no colon: the reason is cut at its first).
+    ratio : float, optional
+        The error over the floor when it is not ``error_percent / floor_percent``: weighed
+        sample by sample against a noise that varies (default: that quotient).
 
     Returns
     -------
@@ -259,7 +280,10 @@ def pooled_verdict(
     floor = float(floor_percent) if floor_percent is not None else 0.0
     known = math.isfinite(floor) and floor > 0
     r = e / floor if known and math.isfinite(e) else None
-    at = f" ({r:.3g} x the noise floor of {floor:.3g} %)" if r is not None else ""
+    if r is not None and ratio is not None and math.isfinite(ratio):
+        r = float(ratio)
+    parts = floor_parts or ""
+    at = f" ({r:.3g} x the noise floor of {floor:.3g} %{parts})" if r is not None else ""
     if opposite_sign:
         return Verdict(
             "unusable",

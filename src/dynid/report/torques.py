@@ -82,7 +82,7 @@ def validate_answer(run: RunFiles) -> Answer | None:
         ),
         f"Judged on {cell(doc.get('n_samples'))} samples of {esc(doc.get('data', 'the log'))}, "
         f"model {esc(doc.get('model', ''))}: at the noise floor up to {FLOOR_GOOD:g} x the "
-        f"sensor-noise floor"
+        f"noise floor"
         + (
             f" ({percent(floor)})"
             if is_number(floor)

@@ -21,9 +21,14 @@ with every policy the command applies, so that the Python API behaves as the com
   file; the verdict's reason and ``torque_spikes_replaced`` say how many: a model at the
   noise floor on clean data is judged at the floor on the same data with spikes.
 * The verdict (:func:`~dynid.identification.verdict.judge_prediction`): the error against
-  the sensor-noise floor read from the measured torques, and whether they are
-  anti-correlated with the model's; over all recordings and per recording, the worst
-  recording named when the recordings differ; an error mostly at low speed said so
+  the noise floor, and whether the torques are anti-correlated with the model's. The floor
+  is the sensors' noise read from the measured torques (a quantized sensor's at least
+  ``step / sqrt(12)``) and the noise the prepared velocities and accelerations put into
+  the model's prediction (:mod:`~dynid.identification.input_noise`), each sample weighed
+  against its own noise: the true model of quantized positions is at the floor, while an
+  error spread over the moving samples is not excused by the noise at a few reversals;
+  over all recordings and per recording, the worst recording named when the recordings
+  differ; an error mostly at low speed said so
   (:func:`~dynid.identification.low_speed.with_low_speed_hint`), and joints moved far
   faster than in an identified model's data
   (:func:`~dynid.identification.motion_range.with_motion_range_hint`).
@@ -31,6 +36,7 @@ with every policy the command applies, so that the Python API behaves as the com
 
 from __future__ import annotations
 
+import dataclasses
 from collections.abc import Sequence
 from dataclasses import dataclass
 from pathlib import Path
@@ -40,20 +46,20 @@ import numpy as np
 from numpy.typing import NDArray
 
 from ..exceptions import DataError, OptionError
-from ..friction.fit import same_drive
+from ..friction.fit import same_drive, torques_through
 from ..friction.model import FrictionModel, FrictionSum, placed_friction
 from ..friction.recordings import RecordingsValidation, validate_recordings
 from ..friction.validation import RECORDED, own_friction
-from ..identification.derived_cutoff import with_derived_cutoff_hint
+from ..identification.derived_cutoff import derived_cutoff_hint, with_derived_cutoff_hint
+from ..identification.input_noise import input_noise_var, noise_floor, quantized_noise_std
 from ..identification.low_speed import with_low_speed_hint
 from ..identification.metrics import TorqueErrors
 from ..identification.model import IdentifiedModel
 from ..identification.motion_range import with_motion_range_hint
-from ..identification.sanity import SPIKES_BEFORE_JUDGING, anticorrelated, velocity_noise_std
+from ..identification.sanity import SPIKES_BEFORE_JUDGING, anticorrelated
 from ..identification.verdict import (
     LEVELS,
     Verdict,
-    joint_ratios,
     judge_prediction,
     with_replaced_spikes,
 )
@@ -144,7 +150,9 @@ class ValidateResult:
         Over every recording, or, when the recordings differ, the worst one's (its ``reason``
         names the file).
     noise_rms : ndarray, shape (n,)
-        Sensor noise of the measured torques per joint, over every piece [N m].
+        The noise a perfect model leaves per joint, over every piece [N m]: the torque
+        sensors' (``sensor_noise_rms``) and that of the states it is evaluated at
+        (``input_noise_rms``), root sum of squares.
     noise_floor_percent : float
         The noise relative to the measured torques' norm [%]: the smallest relative error
         a model can reach on them.
@@ -165,15 +173,26 @@ class ValidateResult:
     noise_floor_percent: float
     joint_names: tuple[str, ...] = ()
     spikes: tuple[int, ...] = ()
+    sensor_noise_rms: NDArray[np.float64] | None = None
+    input_noise_rms: NDArray[np.float64] | None = None
 
     def metadata(self) -> dict[str, Any]:
         """The keys ``validation.json`` records beside the errors: ``model``,
         ``friction_source``, ``data`` (the files, comma-separated), ``files``,
-        ``cutoff_hz``, ``noise_rms``, ``noise_floor_percent``, ``torque_spikes_replaced``
-        (per file, when known), ``verdict`` (``level``, ``label``, ``reason``) and
-        ``joint_names`` (when known)."""
+        ``cutoff_hz``, ``noise_rms``, ``noise_floor_percent``, ``sensor_noise_rms`` and
+        ``input_noise_rms`` (its parts, when known), ``torque_spikes_replaced`` (per file,
+        when known), ``verdict`` (``level``, ``label``, ``reason``) and ``joint_names``
+        (when known)."""
         v = self.verdict
         spikes = dict(zip(self.files, self.spikes, strict=True)) if self.spikes else None
+        parts = {
+            k: [float(x) for x in a]
+            for k, a in (
+                ("sensor_noise_rms", self.sensor_noise_rms),
+                ("input_noise_rms", self.input_noise_rms),
+            )
+            if a is not None
+        }
         return {
             "model": self.model,
             "friction_source": self.friction_source,
@@ -182,6 +201,7 @@ class ValidateResult:
             "cutoff_hz": self.cutoff_hz,
             "noise_rms": [float(x) for x in self.noise_rms],
             "noise_floor_percent": self.noise_floor_percent,
+            **parts,
             **({"torque_spikes_replaced": spikes} if spikes is not None else {}),
             "verdict": {"level": v.level, "label": v.label, "reason": v.reason},
         } | ({"joint_names": list(self.joint_names)} if self.joint_names else {})
@@ -262,11 +282,12 @@ def validate_files(
     if not np.isfinite(errors.relative_error_percent) or not np.all(np.isfinite(errors.rms)):
         raise DataError(_overflow(rec.names, val, label, opt))
     names = robot.joint_names
-    verdict, noise, floor = _judged(val, np.ones(len(val.parts), bool), errors, names)
+    inputs = _input_noise(model, friction, val)
+    verdict, noise, floor = _judged(val, np.ones(len(val.parts), bool), errors, names, inputs)
     labels = np.asarray(val.pieces.recording)
     if len(rec.names) > 1:  # recordings judged apart: the worst named, when they differ
         each = [
-            _judged(val, labels == r, val.recordings[r].errors, names)[0]
+            _judged(val, labels == r, val.recordings[r].errors, names, inputs)[0]
             for r in range(len(rec.names))
         ]
         rank = [LEVELS.index(v.level) for v in each]
@@ -275,11 +296,17 @@ def validate_files(
             v = each[r]
             verdict = Verdict(v.level, v.label, f"{rec.names[r]}: {v.reason}", v.ratio)
     verdict = with_derived_cutoff_hint(verdict, rec.logs, val.pieces.cutoff_hz)
+    high = derived_cutoff_hint(rec.logs, val.pieces.cutoff_hz)
+    if verdict.level == "good" and high is not None and noise.inputs is not None:
+        # at a floor the derived states raise: a lower cut-off lowers it
+        verdict = dataclasses.replace(
+            verdict, reason=f"{verdict.reason}; a floor raised because {high}"
+        )
     verdict = with_low_speed_hint(
         verdict,
         [v.log.dq for v in val.parts],
         [v.log.tau - v.tau_hat for v in val.parts],
-        noise,
+        noise.sensor,  # the hint's "above the noise": the sensors' (its module docstring)
         names,
     )
     if isinstance(model, IdentifiedModel) and model.info.log is not None:
@@ -294,11 +321,58 @@ def validate_files(
         files=rec.names,
         cutoff_hz=val.pieces.cutoff_hz,
         verdict=verdict,
-        noise_rms=noise,
+        noise_rms=noise.total,
         noise_floor_percent=floor,
         joint_names=tuple(robot.joint_names),
         spikes=spikes,
+        sensor_noise_rms=noise.sensor,
+        input_noise_rms=noise.inputs,
     )
+
+
+@dataclass(frozen=True, slots=True)
+class _Noise:
+    """The noise per joint [N m] (n,) of the pieces judged: the torque sensors', that of
+    the states the model is evaluated at (None: not known) and both (root sum of
+    squares)."""
+
+    sensor: NDArray[np.float64]
+    inputs: NDArray[np.float64] | None
+    total: NDArray[np.float64]
+
+
+#: Samples of a piece at most at which the states' noise is carried through the model
+#: (every k-th).
+_INPUT_SAMPLES = 20_000
+
+
+def _input_noise(
+    model: IdentifiedModel | Robot,
+    friction: FrictionModel | FrictionSum | None,
+    val: RecordingsValidation,
+) -> list[tuple[int, NDArray[np.float64]]] | None:
+    """Per piece, every k-th of its kept samples and the variance [N^2 m^2] (N_k, n) the
+    states' noise puts into the model's prediction there
+    (:func:`~dynid.identification.input_noise.input_noise_var`), or None when the states'
+    noise is not known."""
+    noise = val.pieces.state_noise
+    if noise is None:
+        return None
+    drive = val.pieces.drive
+
+    def rigid(
+        q: NDArray[np.float64], dq: NDArray[np.float64], ddq: NDArray[np.float64]
+    ) -> NDArray[np.float64]:
+        return np.asarray(torques_through(model, drive, q, dq, ddq), dtype=np.float64)
+
+    out = []
+    for v in val.parts:
+        assert v.log.ddq is not None  # prepared: always with ddq
+        k = max(1, v.log.n_samples // _INPUT_SAMPLES)
+        q, dq, ddq = (np.ascontiguousarray(x[::k]) for x in (v.log.q, v.log.dq, v.log.ddq))
+        fr = None if friction is None else friction.torques
+        out.append((k, input_noise_var(rigid, fr, q, dq, ddq, noise)))
+    return out
 
 
 def _judged(
@@ -306,21 +380,32 @@ def _judged(
     sel: NDArray[np.bool_],
     errors: TorqueErrors,
     names: Sequence[str],
-) -> tuple[Verdict, NDArray[np.float64], float]:
-    """The verdict, the sensor noise per joint [N m] and the noise floor [%] of the pieces
-    ``sel`` (bool per piece), whose pooled errors are ``errors``: the noise read from each
-    piece's measured torques (:func:`~dynid.identification.sanity.velocity_noise_std`),
-    the model's torques checked for the opposite sign (on at most 20 000 samples)."""
-    parts = [v for v, s in zip(val.parts, sel, strict=True) if s]
-    n = parts[0].log.n
-    var, norm2, N = np.zeros(n), 0.0, 0
-    for v in parts:
-        if v.log.n_samples >= 3:
-            var += v.log.n_samples * velocity_noise_std(v.log.tau, v.log.t) ** 2
-        norm2 += float(np.sum(v.log.tau**2))
-        N += v.log.n_samples
-    noise = np.sqrt(var / max(N, 1))
-    floor = 100.0 * float(np.sqrt(var.sum() / norm2)) if norm2 > 0 else 0.0
+    inputs: list[tuple[int, NDArray[np.float64]]] | None = None,
+) -> tuple[Verdict, _Noise, float]:
+    """The verdict, the noise per joint and the noise floor [%] of the pieces ``sel`` (bool
+    per piece), whose pooled errors are ``errors``.
+
+    The noise is the sensors', read from each piece's measured torques
+    (:func:`~dynid.identification.input_noise.quantized_noise_std`), and the states'
+    through the model (``inputs``: :func:`_input_noise`; None: not known), the error
+    weighed against it sample by sample
+    (:func:`~dynid.identification.input_noise.noise_floor`). The model's torques are
+    checked for the opposite sign (on at most 20 000 samples).
+    """
+    chosen = [k for k, s in enumerate(sel) if s]
+    parts = [val.parts[k] for k in chosen]
+    fl = noise_floor(
+        [v.log.tau for v in parts],
+        [v.log.tau - v.tau_hat for v in parts],
+        [
+            quantized_noise_std(v.log.tau, v.log.t) ** 2 if v.log.n_samples >= 3 else None
+            for v in parts
+        ],
+        None if inputs is None else [inputs[k] for k in chosen],
+        rms=errors.rms,
+    )
+    noise = _Noise(fl.sensor_rms, fl.input_rms, fl.total_rms)
+    N = sum(v.log.n_samples for v in parts)
     step = max(1, N // 20_000)
     tau = np.concatenate([v.log.tau[::step] for v in parts])
     model = np.concatenate([v.tau_model[::step] for v in parts])
@@ -329,13 +414,15 @@ def _judged(
     opposite = anticorrelated(model - model.mean(axis=0), tau - tau.mean(axis=0), loaded)
     verdict = judge_prediction(
         errors.relative_error_percent,
-        floor,
+        fl.percent,
         opposite_sign=opposite is not None,
-        joint_ratios=joint_ratios(errors.rms, noise) if np.all(noise > 0) else None,
+        joint_ratios=fl.joint_ratios,
         joint_percent=errors.relative_error_percent_per_joint,
         joint_names=names,
+        floor_parts=fl.words,
+        ratio=fl.ratio,
     )
-    return verdict, noise, floor
+    return verdict, noise, fl.percent
 
 
 def _friction(

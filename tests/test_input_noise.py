@@ -1,0 +1,185 @@
+"""The noise a prediction's own inputs put into its torques, and the floor that counts it.
+
+An SO-101 trial (positions quantized to 4096 ticks per turn, currents to 6.5 mA steps,
+100 Hz, no velocity columns) judged its true model "usable: effects outside the model
+remain" at 2.3 x a floor of the torques' noise alone: the wrist currents read no noise at
+all, and the derived states' noise through the model (a Coulomb step flipped at reversals,
+the rotors' inertia times the accelerations' noise) was not counted.
+
+References: the rounding error of a known signal, a Monte Carlo of white noise through the
+preparation, the closed form of a Coulomb step under Gaussian noise, and simulated Panda
+logs validated with the law that made them and with a wrong one.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import warnings
+
+import numpy as np
+import pytest
+from scipy.stats import norm
+
+import dynid
+from dynid.exceptions import DynidWarning
+from dynid.friction.model import ClassicalFriction
+from dynid.identification.input_noise import (
+    StateNoise,
+    derived_noise_gains,
+    input_noise_var,
+    noise_floor,
+    quantization_step,
+    quantized_noise_std,
+)
+from dynid.identification.log import TorqueLog, with_derived_velocities
+from dynid.identification.prepare import Preprocessing, prepare_log
+from dynid.identification.sanity import velocity_noise_std
+from dynid.io.torque_log import save_torque_log
+from dynid.simulation.measurement import SensorNoise, sample_times, simulate_measurement
+from dynid.simulation.trajectories import random_fourier
+from dynid.workflows.validate import ValidateOptions, validate_files
+
+TICK = 2 * np.pi / 4096
+FV, FC = np.linspace(0.6, 0.2, 7), np.linspace(1.5, 0.5, 7)
+
+
+def test_the_step_of_a_quantized_signal_is_found_and_a_smooth_one_has_none():
+    """Currents of 6.5 mA steps times 1.2 N m/A, printed to 6 decimals, 1 % of the samples
+    off the lattice: the step 7.8e-3 N m; a smooth float signal: none."""
+    rng = np.random.default_rng(1)
+    t = np.linspace(0, 20, 2000)
+    x = 0.3 * np.sin(t) + 0.001 * rng.standard_normal(t.size)
+    q = np.round(np.round(x / 0.0065) * 0.0065 * 1.2, 6)
+    q[rng.choice(t.size, 20, replace=False)] += 0.0017
+    step = quantization_step(np.column_stack([q, x]))
+    assert step[0] == pytest.approx(0.0078, rel=1e-4)
+    assert step[1] == 0.0
+
+
+def test_a_slow_quantized_signal_reads_its_rounding_noise():
+    """A wrist torque that moves less than a step between samples: the differences' median
+    reads no noise, the quantized estimate the rounding error's RMS (within 10 %)."""
+    t = np.arange(0, 20, 0.01)
+    x = 0.12 * np.sin(0.5 * t) + 0.05 * np.sin(1.3 * t)
+    step = 0.0078
+    q = np.round(x / step) * step
+    rounding = float(np.sqrt(np.mean((q - x) ** 2)))
+    assert velocity_noise_std(q[:, None], t)[0] < 0.1 * rounding
+    assert quantized_noise_std(q[:, None], t)[0] == pytest.approx(rounding, rel=0.1)
+
+
+@pytest.mark.parametrize("derived", [True, False])
+def test_the_preparations_noise_gains_match_white_noise_through_it(derived):
+    """White noise on the positions (velocities derived) or on the measured velocities,
+    prepared at 4.4 Hz from 100 Hz: the prepared velocities' and accelerations' std is the
+    gains times the noise (within 5 %)."""
+    rng = np.random.default_rng(2)
+    t = np.arange(0, 200, 0.01)
+    noise = rng.standard_normal((t.size, 1))
+    zero = np.zeros((t.size, 1))
+    log = TorqueLog(t, noise, zero, zero) if derived else TorqueLog(t, zero, noise, zero)
+    if derived:
+        log = with_derived_velocities(log)
+    p = prepare_log(log, Preprocessing(cutoff_hz=4.4))
+    gv, ga = derived_noise_gains(0.01, 4.4, derived=derived)
+    assert np.std(p.dq) == pytest.approx(gv, rel=0.05)
+    assert np.std(p.ddq) == pytest.approx(ga, rel=0.05)
+
+
+def test_a_coulomb_step_and_an_inertia_carry_the_states_noise_as_the_closed_form():
+    """tau = m ddq + fc sign(dq) under velocity noise s_v and acceleration noise s_a:
+    variance m^2 s_a^2 + (2 fc)^2 Phi(-|dq| / s_v) per sample (within the 16 nodes'
+    resolution), its mean over the samples within 3 %."""
+    m, fc, sv, sa = 0.025, 0.1, 0.002, 0.03
+    dq = np.linspace(-0.01, 0.01, 2000)[:, None]  # sign(0) = 0 left out
+    q, ddq = np.zeros_like(dq), np.ones_like(dq)
+    V = input_noise_var(
+        lambda q, dq, ddq: m * ddq,
+        lambda dq: fc * np.sign(dq),
+        q,
+        dq,
+        ddq,
+        StateNoise(np.array([sv]), np.array([sa])),
+    )
+    exact = (m * sa) ** 2 + (2 * fc) ** 2 * norm.cdf(-np.abs(dq) / sv)
+    assert np.max(np.abs(V - exact)) <= (2 * fc) ** 2 / 16 + 1e-12
+    assert np.mean(V) == pytest.approx(np.mean(exact), rel=0.03)
+
+
+@pytest.fixture(scope="module")
+def quantized(tmp_path_factory):
+    """A 20 s, 100 Hz Panda log with sharp Coulomb friction (0.5-1.5 N m), positions
+    rounded to 4096 ticks per turn, torques to 0.02 N m steps, no velocity columns; and
+    the law that made it."""
+    panda = dynid.panda()
+    rng = np.random.default_rng(7)
+    fr = ClassicalFriction(FV, FC, np.zeros(7))
+    traj = random_fourier(panda, rng)(sample_times(20.0, 100.0))
+    log = simulate_measurement(
+        panda, traj, rng=rng, noise=SensorNoise(tau_std=0.005, q_std=0.0), friction=fr
+    )
+    q = np.round(log.q / TICK) * TICK
+    tau = np.round(log.tau / 0.02) * 0.02
+    path = tmp_path_factory.mktemp("quantized") / "q.csv"
+    save_torque_log(path, with_derived_velocities(TorqueLog(log.t, q, log.dq, tau)))
+    return panda, path, fr
+
+
+def _validated(panda, path, fr):
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", DynidWarning)  # "no velocity columns"
+        return validate_files(panda, path, ValidateOptions(friction=fr))
+
+
+def test_the_true_model_on_quantized_derived_states_is_at_the_floor(quantized):
+    """Regression: the true model of a quantized positions-only log is at the noise floor,
+    the floor naming the states' share; the torques' noise alone would put it above."""
+    panda, path, fr = quantized
+    res = _validated(panda, path, fr)
+    v = res.verdict
+    assert v.level == "good", v.reason
+    assert "that of the states through the model" in v.reason
+    assert res.input_noise_rms is not None and np.all(res.input_noise_rms > 0)
+    alone = 100 * np.sqrt(res.validation.errors.n_samples * np.sum(res.sensor_noise_rms**2))
+    alone /= float(np.sqrt(sum(np.sum(p.log.tau**2) for p in res.validation.parts)))
+    assert res.validation.errors.relative_error_percent > 1.5 * alone
+
+
+@pytest.mark.parametrize("wrong", ["coulomb", "armature"])
+def test_a_wrong_model_on_the_same_data_is_still_judged_worse(quantized, wrong):
+    """A Coulomb friction 20 % low, or a rotor inertia of 0.05 kg m^2 on every joint that
+    the arm does not have: above the noise floor, at least twice the true model's ratio to
+    it (the states' noise at a few reversals does not excuse an error while moving)."""
+    panda, path, fr = quantized
+    true = _validated(panda, path, fr).verdict
+    if wrong == "coulomb":
+        v = _validated(panda, path, ClassicalFriction(FV, 0.8 * FC, np.zeros(7))).verdict
+    else:
+        phi = np.array(panda.phi)
+        phi[:, 9] += 0.05  # Izz about each joint's axis
+        v = _validated(dataclasses.replace(panda, phi=phi), path, fr).verdict
+    assert v.ratio is not None and true.ratio is not None
+    assert v.level != "good", v.reason
+    assert v.ratio > 2 * true.ratio, (v.reason, true.reason)
+
+
+def test_the_floor_weighs_each_sample_against_its_own_noise():
+    """A constant states' noise (far above the sensors'): the ratio is the plain quotient
+    of the norms; the same mean noise put at 1 % of the samples (reversals) does not excuse
+    an error spread over the others (ratio 10 x larger), while an error at those samples
+    alone is within it."""
+    rng = np.random.default_rng(3)
+    N, n = 10_000, 2
+    tau = rng.normal(0, 1.0, (N, n))
+    spread = rng.normal(0, 0.1, (N, n))
+    flat = noise_floor([tau], [spread], [np.full(n, 1e-5)], [(1, np.full((N, n), 0.005))])
+    quotient = np.linalg.norm(spread) / np.linalg.norm(tau) * 100 / flat.percent
+    assert flat.ratio == pytest.approx(quotient, rel=1e-9)
+    V = np.zeros((N, n))
+    V[:100] = 0.5  # the same mean variance, at 1 % of the samples
+    rare = noise_floor([tau], [spread], [np.full(n, 1e-5)], [(1, V)])
+    assert rare.percent == pytest.approx(flat.percent, rel=1e-9)
+    assert rare.ratio > 10 * flat.ratio
+    there = np.zeros((N, n))
+    there[:100] = rng.normal(0, 1.0, (100, n))
+    assert noise_floor([tau], [there], [np.full(n, 1e-5)], [(1, V)]).ratio < 1.5
