@@ -51,18 +51,18 @@ from ..friction.model import FrictionModel, FrictionSum, placed_friction
 from ..friction.recordings import RecordingsValidation, validate_recordings
 from ..friction.validation import RECORDED, own_friction
 from ..identification.derived_cutoff import derived_cutoff_hint, with_derived_cutoff_hint
-from ..identification.input_noise import input_noise_var, noise_floor, quantized_noise_std
+from ..identification.floor_verdict import (
+    judged_prediction,
+    opposite_sign,
+    prediction_input_noise,
+    sensor_variance,
+)
 from ..identification.low_speed import with_low_speed_hint
 from ..identification.metrics import TorqueErrors
 from ..identification.model import IdentifiedModel
 from ..identification.motion_range import with_motion_range_hint
-from ..identification.sanity import SPIKES_BEFORE_JUDGING, anticorrelated
-from ..identification.verdict import (
-    LEVELS,
-    Verdict,
-    judge_prediction,
-    with_replaced_spikes,
-)
+from ..identification.sanity import SPIKES_BEFORE_JUDGING
+from ..identification.verdict import LEVELS, Verdict, with_replaced_spikes
 from ..io.feasible import load_feasible_drive, load_feasible_linear_friction
 from ..io.friction_json import load_friction_json
 from ..model.drive import Drive
@@ -237,9 +237,8 @@ def validate_files(
     Raises
     ------
     DataError
-        A bad file, another joint count, invalid rows without ``drop_invalid``, a
-        recording in other units, no piece of a recording long enough to filter, another
-        drive than the model's, errors that overflow (each naming the file).
+        A bad file, another joint count, invalid rows without ``drop_invalid``, other
+        units, no piece long enough to filter, another drive, errors that overflow (named).
     ShapeError
         A friction model of another joint count.
     """
@@ -341,23 +340,14 @@ class _Noise:
     total: NDArray[np.float64]
 
 
-#: Samples of a piece at most at which the states' noise is carried through the model
-#: (every k-th).
-_INPUT_SAMPLES = 20_000
-
-
 def _input_noise(
     model: IdentifiedModel | Robot,
     friction: FrictionModel | FrictionSum | None,
     val: RecordingsValidation,
 ) -> list[tuple[int, NDArray[np.float64]]] | None:
-    """Per piece, every k-th of its kept samples and the variance [N^2 m^2] (N_k, n) the
-    states' noise puts into the model's prediction there
-    (:func:`~dynid.identification.input_noise.input_noise_var`), or None when the states'
-    noise is not known."""
-    noise = val.pieces.state_noise
-    if noise is None:
-        return None
+    """Per piece, the states' noise through the model's prediction
+    (:func:`~dynid.identification.floor_verdict.prediction_input_noise`), or None when the
+    states' noise is not known."""
     drive = val.pieces.drive
 
     def rigid(
@@ -365,14 +355,8 @@ def _input_noise(
     ) -> NDArray[np.float64]:
         return np.asarray(torques_through(model, drive, q, dq, ddq), dtype=np.float64)
 
-    out = []
-    for v in val.parts:
-        assert v.log.ddq is not None  # prepared: always with ddq
-        k = max(1, v.log.n_samples // _INPUT_SAMPLES)
-        q, dq, ddq = (np.ascontiguousarray(x[::k]) for x in (v.log.q, v.log.dq, v.log.ddq))
-        fr = None if friction is None else friction.torques
-        out.append((k, input_noise_var(rigid, fr, q, dq, ddq, noise)))
-    return out
+    fr = None if friction is None else friction.torques
+    return prediction_input_noise(rigid, fr, [v.log for v in val.parts], val.pieces.state_noise)
 
 
 def _judged(
@@ -383,46 +367,24 @@ def _judged(
     inputs: list[tuple[int, NDArray[np.float64]]] | None = None,
 ) -> tuple[Verdict, _Noise, float]:
     """The verdict, the noise per joint and the noise floor [%] of the pieces ``sel`` (bool
-    per piece), whose pooled errors are ``errors``.
-
-    The noise is the sensors', read from each piece's measured torques
-    (:func:`~dynid.identification.input_noise.quantized_noise_std`), and the states'
-    through the model (``inputs``: :func:`_input_noise`; None: not known), the error
-    weighed against it sample by sample
-    (:func:`~dynid.identification.input_noise.noise_floor`). The model's torques are
-    checked for the opposite sign (on at most 20 000 samples).
-    """
+    per piece), whose pooled errors are ``errors``
+    (:func:`~dynid.identification.floor_verdict.judged_prediction`): the sensors' noise
+    read from each piece's measured torques
+    (:func:`~dynid.identification.floor_verdict.sensor_variance`) and the states' through
+    the model (``inputs``: :func:`_input_noise`; None: not known); the model's torques
+    checked for the opposite sign."""
     chosen = [k for k, s in enumerate(sel) if s]
     parts = [val.parts[k] for k in chosen]
-    fl = noise_floor(
+    verdict, fl = judged_prediction(
         [v.log.tau for v in parts],
         [v.log.tau - v.tau_hat for v in parts],
-        [
-            quantized_noise_std(v.log.tau, v.log.t) ** 2 if v.log.n_samples >= 3 else None
-            for v in parts
-        ],
+        [sensor_variance(v.log) for v in parts],
+        errors,
+        names,
         None if inputs is None else [inputs[k] for k in chosen],
-        rms=errors.rms,
+        opposite=opposite_sign([v.log.tau for v in parts], [v.tau_model for v in parts]),
     )
-    noise = _Noise(fl.sensor_rms, fl.input_rms, fl.total_rms)
-    N = sum(v.log.n_samples for v in parts)
-    step = max(1, N // 20_000)
-    tau = np.concatenate([v.log.tau[::step] for v in parts])
-    model = np.concatenate([v.tau_model[::step] for v in parts])
-    spread = np.std(model, axis=0)
-    loaded = spread > 0.05 * max(float(spread.max(initial=0.0)), 1e-300)
-    opposite = anticorrelated(model - model.mean(axis=0), tau - tau.mean(axis=0), loaded)
-    verdict = judge_prediction(
-        errors.relative_error_percent,
-        fl.percent,
-        opposite_sign=opposite is not None,
-        joint_ratios=fl.joint_ratios,
-        joint_percent=errors.relative_error_percent_per_joint,
-        joint_names=names,
-        floor_parts=fl.words,
-        ratio=fl.ratio,
-    )
-    return verdict, noise, fl.percent
+    return verdict, _Noise(fl.sensor_rms, fl.input_rms, fl.total_rms), fl.percent
 
 
 def _friction(
