@@ -421,21 +421,23 @@ def test_each_report_opens_with_its_verdict_in_chromium(runs, name, tmp_path):
 
 @pytest.mark.slow
 def test_identify_on_a_log_judges_held_out_torques_against_the_sensor_noise(runs):
-    """identify on a log stages heldout.json and the two figures; the noise it reads above
-    the cut-off is the simulated sensor's (0.05 N m); the page's verdict sets the held-out
-    error beside that floor, and its tables name their columns with units."""
+    """identify on a log stages heldout.json and the two figures; the sensors' noise it
+    reads above the cut-off is the simulated sensor's (0.05 N m), the fit's record; the
+    page's verdict sets the held-out error beside the floor the verdict line printed (the
+    sensors' and the states' noise), and its tables name their columns with units."""
     out = runs / "identify-log"
     held = json.loads((out / "heldout.json").read_text())
-    noise = np.array(held["noise_rms"])
+    noise = np.array(held["sensor_noise_rms"])
     assert np.all(np.abs(noise / 0.05 - 1.0) < 0.2), noise
     for f in ("heldout_torques.png", "heldout_residuals.png"):
         assert (out / f).read_bytes().startswith(b"\x89PNG")
     page = Page((out / REPORT_NAME).read_text(encoding="utf-8"))
     text = " ".join(" ".join(page.text).split())
     recorded = _identification_doc(runs)["metadata"]["heldout"]
-    floor = f"{recorded['noise_floor_percent']:.3g} %"  # the one the summary prints
-    assert f"sensor-noise floor of {floor}" in text, text[:800]
-    assert held["noise_rms"] == recorded["noise_rms"]  # one noise for the table and the floor
+    floor = f"{held['noise_floor_percent']:.3g} %"  # the one the verdict line prints
+    assert f"noise floor of {floor}" in text, text[:800]
+    assert f"{held['verdict']['ratio']:.3g} x the floor" in text
+    assert held["sensor_noise_rms"] == recorded["noise_rms"]  # the sensors': the fit's record
     headers = {h for t in page.tables for h in t[0]}
     assert {"held-out RMS error [N m]", "sensor noise RMS [N m]", "fv [N m s/rad]"} <= headers
     assert not any(h.isdigit() for h in headers)  # no "1, 2, 3" column names

@@ -14,10 +14,12 @@ from types import SimpleNamespace
 
 import numpy as np
 import pytest
-from test_html_report import Page
+from test_html_report import Page, _verdict_of
+from test_input_noise import FC, FV, _quantized_log
 
 import dynid
 from dynid.cli.__main__ import main
+from dynid.friction.model import ClassicalFriction
 from dynid.report import RunSummary, render_html_report
 
 
@@ -243,3 +245,54 @@ def test_the_demo_counts_the_coefficients_the_paper_prints(tmp_path):
     text = " ".join("".join(Page(render_html_report(RunSummary("demo"), files)).text).split())
     assert "Table III: 37 of the 37 coefficients compared agree" in text, text[:2000]
     assert "the paper prints 41 of the 43, 4 of them with a transcription error" in text
+
+
+def test_the_page_shows_the_held_out_verdict_the_command_printed(tmp_path, capsys):
+    """Regression: identify's held-out verdict counts the held-out states' noise (a
+    quantized positions-only log: at the noise floor), while the page judged the record's
+    held-out error against the sensors' noise alone (usable, several times the floor): the
+    page's level, ratio and floor are the printed line's."""
+    panda = dynid.panda()
+    fr = ClassicalFriction(FV, 0.2 * FC, np.zeros(7))
+    train = _quantized_log(panda, fr, 8, tmp_path / "t.csv", 60.0)
+    held = _quantized_log(panda, fr, 7, tmp_path / "h.csv")
+    out = tmp_path / "run"
+    argv = ["identify", "--data", str(train), "--validate-on", str(held), "--no-figures"]
+    assert main([*argv, "--terms", "viscous,coulomb", "--out", str(out)]) == 0
+    line = next(x for x in capsys.readouterr().out.splitlines() if "held-out verdict" in x)
+    doc = json.loads((out / "heldout.json").read_text())
+    v = doc["verdict"]
+    assert f": {v['label']}: " in line and f"{v['ratio']:.3g} x the noise floor" in line
+    assert v["level"] == "good" and doc["input_noise_rms"] is not None, line
+    recorded = json.loads((out / "identification.json").read_text())["metadata"]["heldout"]
+    assert recorded["heldout_error_percent"] > 3 * recorded["noise_floor_percent"]
+    level, text = _verdict_of((out / "report.html").read_text())
+    text = " ".join(text.split())
+    assert level == v["level"] and text.lower().startswith(v["label"]), text
+    assert f"{v['ratio']:.3g} x the floor" in text, text
+    assert f"noise floor of {doc['noise_floor_percent']:.3g} %" in text, text
+
+
+def test_an_older_held_out_file_is_judged_on_the_record_s_floor(tmp_path):
+    """A heldout.json without the states' noise (an older run) is judged as before, on the
+    record's held-out error against its sensors' floor; a newer one by its own verdict."""
+    ident = {
+        "route": "classical",
+        "coefficients": [],
+        "metadata": {"heldout": {"training_error_percent": 1.4, "heldout_error_percent": 1.43,
+                                 "noise_floor_percent": 0.553}},
+    }  # fmt: skip
+    held = {"relative_error_percent": 1.37, "noise_floor_percent": 0.554, "block": "lo4.csv"}
+    (tmp_path / "identification.json").write_text(json.dumps(ident))
+    h = tmp_path / "heldout.json"
+    h.write_text(json.dumps(held))
+    files = {p.name: p for p in tmp_path.iterdir()}
+    level, text = _verdict_of(render_html_report(RunSummary("identify"), files))
+    assert level == "fair" and "2.59 x the floor" in " ".join(text.split()), text
+    verdict = {"level": "good", "label": "at the noise floor", "reason": "r", "ratio": 1.01}
+    newer = held | {"noise_floor_percent": 0.872, "sensor_noise_rms": [0.002], "verdict": verdict}
+    h.write_text(json.dumps(newer))
+    level, text = _verdict_of(render_html_report(RunSummary("identify"), files))
+    text = " ".join(text.split())
+    assert level == "good" and "1.01 x the floor" in text and "0.872 %" in text, text
+    assert "2.59" not in text, text

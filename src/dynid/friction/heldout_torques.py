@@ -8,13 +8,18 @@ normal equations the model keeps), the last recording with the fit of the others
 separate ``--validate-on`` log with the model itself; from the logs as the identification
 read them (:func:`dynid.workflows.identify.identify_files` passes those it holds: no file
 is read again). The torques are compared unfiltered
-(:func:`dynid.friction.validation.validate_torques`), so a correct model leaves the sensor
-noise, taken from the identification's record (``info.heldout["noise_rms"]``: the noise of
-the floor the summary prints) when it holds it, else read from the same torques. The ratio
-of the two is the identification's distance to its noise floor. The held-out torques are
-judged as the fit used them: their one-sample spikes replaced
-(:func:`~dynid.identification.sanity.despiked`, as identification replaces them before
-filtering), the verdict saying how many.
+(:func:`dynid.friction.validation.validate_torques`) and judged as ``validate`` judges a
+log, by the same engine (:func:`~dynid.identification.floor_verdict.judged_prediction`):
+against the sensors' noise, taken from the identification's record
+(``info.heldout["noise_rms"]``: the noise of the training fit's floor the summary prints)
+when it holds it, else read from the same torques, at least the held-out torques'
+rounding (a quantized sensor's ``step / sqrt(12)``), and the noise the held-out pieces'
+prepared states put into the prediction (:mod:`~dynid.identification.input_noise`), each
+sample against its own noise. The true structure of an SO-101 with quantized currents and
+positions-only logs was "usable, 2.47 x the noise floor of 0.554 %" on the sensors' noise
+alone (now 1.01 x a floor of 0.872 %). The held-out torques are judged as the fit used
+them: their one-sample spikes replaced (:func:`~dynid.identification.sanity.despiked`, as
+identification replaces them before filtering), the verdict saying how many.
 """
 
 from __future__ import annotations
@@ -28,19 +33,15 @@ from numpy.typing import NDArray
 
 from ..exceptions import DynidError, DynidWarning
 from ..identification.derived_cutoff import with_derived_cutoff_hint
-from ..identification.log import TorqueLog
+from ..identification.floor_verdict import judged_prediction, prediction_input_noise
+from ..identification.input_noise import NoiseFloor, quantization_step, state_noise
+from ..identification.log import TorqueLog, joint_side_log
 from ..identification.low_speed import low_speed_hint
 from ..identification.model import IdentifiedModel
 from ..identification.pieces import split_at_gaps, unwrapped, wrappable
 from ..identification.sanity import despiked, velocity_noise_std
-from ..identification.verdict import (
-    Verdict,
-    joint_ratios,
-    judge_prediction,
-    with_caveat,
-    with_hint,
-    with_replaced_spikes,
-)
+from ..identification.verdict import Verdict, with_caveat, with_hint, with_replaced_spikes
+from .fit import model_drive, torques_through
 from .pooled import joined_validation
 from .validation import Validation, own_friction, validate_torques
 
@@ -56,8 +57,8 @@ class HeldOutTorques:
     validation : Validation
         The prediction on the held-out samples (unfiltered measured torques).
     noise_rms : ndarray, shape (n,)
-        Sensor noise per joint [N m]: the identification's record, else read from the
-        held-out torques.
+        The torque sensors' noise per joint [N m]: the identification's record, else read
+        from the held-out torques; at least the held-out torques' rounding.
     block : str
         What was held out (``"the last of 5 time blocks, 8.2-10.0 s"``).
     joint_names : tuple of str
@@ -76,6 +77,10 @@ class HeldOutTorques:
         Torque samples of the held-out data replaced as one-sample spikes before they were
         judged, as the fit replaced them
         (:func:`~dynid.identification.sanity.despiked`).
+    inputs : tuple of (int, ndarray) or None
+        The variance [N^2 m^2] the held-out states' noise puts into the prediction at every
+        k-th sample (:func:`~dynid.identification.floor_verdict.prediction_input_noise`);
+        None: not known (the floor is the sensors' noise alone).
     """
 
     validation: Validation
@@ -86,34 +91,47 @@ class HeldOutTorques:
     cutoff_hz: float | None = None
     caveat: str | None = None
     spikes: int = 0
+    inputs: tuple[tuple[int, NDArray[np.float64]], ...] | None = None
+
+    def _judged(self) -> tuple[Verdict, NoiseFloor]:
+        """:func:`~dynid.identification.floor_verdict.judged_prediction` of the held-out
+        pieces pooled (no sign check: a fold fit's prediction of a short block is no
+        measure of the torques' sign, :func:`heldout_torques`' Notes)."""
+        v = self.validation
+        return judged_prediction(
+            [v.log.tau],
+            [v.log.tau - v.tau_hat],
+            [self.noise_rms**2],
+            v.errors,
+            self.joint_names,
+            self.inputs,
+        )
+
+    @property
+    def floor(self) -> NoiseFloor:
+        """The noise floor of the held-out torques: the sensors' noise and the states'
+        through the model, the error weighed against it
+        (:func:`~dynid.identification.input_noise.noise_floor`)."""
+        return self._judged()[1]
 
     @property
     def noise_floor_percent(self) -> float:
         """The noise relative to the measured torques' norm [%]: the smallest relative
-        error a model can reach on these torques."""
-        tau = self.validation.log.tau
-        norm = float(np.linalg.norm(tau))
-        return 100.0 * float(np.sqrt(len(tau) * np.sum(self.noise_rms**2))) / norm if norm else 0.0
+        error a model can reach on these torques (the sensors' and the states' noise)."""
+        return self.floor.percent
 
     @property
     def verdict(self) -> Verdict:
-        """The held-out prediction judged as ``validate`` judges one
-        (:func:`~dynid.identification.verdict.judge_prediction`): the error against the
-        noise floor, each joint's against its noise and in relative terms; above the
-        floor, with the hint of a cut-off too high for velocities derived from positions
-        (:func:`~dynid.identification.derived_cutoff.with_derived_cutoff_hint`) and that
-        of an error mostly at low speed
-        (:func:`~dynid.identification.low_speed.with_low_speed_hint`); the torque
-        spikes replaced before judging counted
+        """The held-out prediction judged as ``validate`` judges one, by the same engine
+        (:func:`~dynid.identification.floor_verdict.judged_prediction`): the error against
+        the noise floor (:attr:`floor`), each joint's against its noise and in relative
+        terms; above the floor, with the hint of a cut-off too high for velocities derived
+        from positions (:func:`~dynid.identification.derived_cutoff.with_derived_cutoff_hint`)
+        and that of an error mostly at low speed
+        (:func:`~dynid.identification.low_speed.with_low_speed_hint`); the torque spikes
+        replaced before judging counted
         (:func:`~dynid.identification.verdict.with_replaced_spikes`)."""
-        e = self.validation.errors
-        verdict = judge_prediction(
-            e.relative_error_percent,
-            self.noise_floor_percent,
-            joint_ratios=joint_ratios(e.rms, self.noise_rms),
-            joint_percent=e.relative_error_percent_per_joint,
-            joint_names=self.joint_names,
-        )
+        verdict = self._judged()[0]
         verdict = with_derived_cutoff_hint(verdict, self.logs, self.cutoff_hz)
         verdict = with_hint(verdict, self.low_speed, ", ")
         verdict = with_caveat(verdict, self.caveat)
@@ -127,23 +145,34 @@ class HeldOutTorques:
         return low_speed_hint([v.log.dq], [v.log.tau - v.tau_hat], self.noise_rms, self.joint_names)
 
     def as_dict(self) -> dict[str, Any]:
-        """JSON-ready: the errors per joint, the noise, the floor, the torque spikes replaced
-        before judging, the verdict and, above the floor, the low-speed note (``low_speed``,
-        the report's own line; schema ``heldout.json``)."""
-        e, v = self.validation.errors, self.verdict
+        """JSON-ready: the errors per joint, the noise (``noise_rms``: the sensors' and the
+        states', root sum of squares; ``sensor_noise_rms``, ``input_noise_rms``: its parts,
+        the latter null when not known), the floor, the torque spikes replaced before
+        judging, the verdict (with its ``ratio`` to the floor, each sample weighed against
+        its own noise) and, above the floor, the low-speed note (``low_speed``, the
+        report's own line; schema ``heldout.json``)."""
+        e, v, fl = self.validation.errors, self.verdict, self.floor
         return {
             "block": self.block,
             "joint_names": list(self.joint_names),
             "n_samples": int(len(self.validation.log.tau)),
             "rms": e.rms.tolist(),
-            "noise_rms": self.noise_rms.tolist(),
+            "noise_rms": fl.total_rms.tolist(),
+            "sensor_noise_rms": self.noise_rms.tolist(),
+            "input_noise_rms": None if fl.input_rms is None else fl.input_rms.tolist(),
             "relative_error_percent": float(e.relative_error_percent),
             "relative_error_percent_per_joint": e.relative_error_percent_per_joint.tolist(),
-            "noise_floor_percent": self.noise_floor_percent,
+            "noise_floor_percent": fl.percent,
             "torque_spikes_replaced": self.spikes,
-            "verdict": {"level": v.level, "label": v.label, "reason": v.reason},
+            "verdict": {"level": v.level, "label": v.label, "reason": v.reason, "ratio": v.ratio},
             "low_speed": None if v.level == "good" else self.low_speed,
-            "units": {"rms": "N m", "noise_rms": "N m", "relative_error_percent": "%"},
+            "units": {
+                "rms": "N m",
+                "noise_rms": "N m",
+                "sensor_noise_rms": "N m",
+                "input_noise_rms": "N m",
+                "relative_error_percent": "%",
+            },
         }
 
 
@@ -234,14 +263,37 @@ def _predicted(
     pieces = [unwrapped(p, turns)[0] for p in split_at_gaps(held, model.info.log.max_gap_s)]
     v, said = _pieces_validation(fitted, pieces)
     block += said
-    cutoff = model.info.log.cutoff_hz or 0.2 * model.info.log.sample_rate_hz
     noise = _recorded_noise(model)
-    noise = _noise(v, cutoff) if noise is None else noise
+    noise = _noise(v) if noise is None else noise
+    noise = np.maximum(noise, quantization_step(v.log.tau) / np.sqrt(12.0))  # at least rounding
     names = tuple(model.robot.joint_names)
     read = (held if model.holdout.scheme == "file" else log,)  # the motion of a whole log
     given = None if model.info.log.cutoff_source == "motion" else model.info.log.cutoff_hz
     caveat = (model.info.heldout or {}).get("caveat") if model.holdout.scheme == "blocks" else None
-    return HeldOutTorques(v, noise, block, names, read, given, caveat, spikes)
+    inputs = _input_noise(fitted, v, pieces)
+    return HeldOutTorques(v, noise, block, names, read, given, caveat, spikes, inputs)
+
+
+def _input_noise(
+    model: IdentifiedModel, v: Validation, pieces: list[TorqueLog]
+) -> tuple[tuple[int, NDArray[np.float64]], ...] | None:
+    """The variance the noise of the raw held-out ``pieces``' states, prepared at the
+    identification's cut-off (:func:`~dynid.identification.input_noise.state_noise`), puts
+    into ``model``'s prediction ``v`` (:func:`~dynid.identification.floor_verdict.
+    prediction_input_noise`), or None when it is not known."""
+    assert model.info.log is not None  # identified from logs
+    drive = model_drive(model, None)
+    noise = state_noise([joint_side_log(p, drive) for p in pieces], model.info.log.cutoff_hz)
+
+    def rigid(
+        q: NDArray[np.float64], dq: NDArray[np.float64], ddq: NDArray[np.float64]
+    ) -> NDArray[np.float64]:
+        return np.asarray(torques_through(model, drive, q, dq, ddq), dtype=np.float64)
+
+    friction = own_friction(model)
+    fr = None if friction is None else friction.torques
+    inputs = prediction_input_noise(rigid, fr, [v.log], noise)
+    return None if inputs is None else tuple(inputs)
 
 
 def _despiked_from(log: TorqueLog, first: int = 0) -> tuple[TorqueLog, int]:
@@ -293,11 +345,10 @@ def _pieces_validation(model: IdentifiedModel, pieces: list[TorqueLog]) -> tuple
     return joined_validation(parts), said + (")" if said else "")
 
 
-def _noise(v: Validation, cutoff_hz: float) -> NDArray[np.float64]:
+def _noise(v: Validation) -> NDArray[np.float64]:
     """Per-joint sensor noise [N m] of the unfiltered torques, robustly
     (:func:`~dynid.identification.sanity.velocity_noise_std`, the same estimate for any
     signal: the median absolute deviation of second and third differences). The torque
     above the cut-off is no measure of it: it holds the steps of Coulomb friction at every
-    reversal (on a UR5 with 3 N m of Coulomb friction it read 3-10 times the noise).
-    ``cutoff_hz`` is kept for the signature."""
+    reversal (on a UR5 with 3 N m of Coulomb friction it read 3-10 times the noise)."""
     return np.asarray(velocity_noise_std(v.log.tau, v.log.t), dtype=np.float64)

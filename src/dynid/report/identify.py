@@ -1,7 +1,10 @@
 """The answer of ``dynid identify``: is the model good enough, and how sure are we.
 
 The verdict (at the noise floor, usable, poor, unusable: :mod:`dynid.identification.verdict`)
-weighs the held-out error against the sensor-noise floor of the torques it was judged on
+is ``heldout.json``'s, the one the command prints: the held-out block's error against the
+noise of its sensors and of its states through the model, each sample against its own
+(:mod:`dynid.identification.floor_verdict`). For an older file it weighs the held-out error
+against the sensor-noise floor of the torques it was judged on
 (``metadata.heldout``: the floor the command prints; for an older record without one,
 ``heldout.json``'s: the last time block predicted by the fit of the others, unfiltered
 torques with their one-sample spikes replaced as the fit replaced them, against the noise
@@ -27,6 +30,7 @@ from ..exceptions import DynidError
 from ..identification.structure import Structure
 from ..identification.verdict import (
     FLOOR_GOOD,
+    LEVELS,
     Verdict,
     joint_ratios,
     judge_prediction,
@@ -81,14 +85,19 @@ def _heldout_facts(
     per-joint errors); the last block's unfiltered error beside it, against a floor of its
     own only for a record without one (an older file). ``contradicted``: the data
     contradict the robot (:func:`_warning_facts`), which makes the verdict unusable
-    whatever the errors, and the held-out fact says so instead of its own level."""
+    whatever the errors, and the held-out fact says so instead of its own level. A
+    heldout.json judged against the held-out states' noise too (:func:`_own_verdict`)
+    gives the verdict itself, the one the command printed."""
     facts, problems = [], []
     ho = _get(doc, "metadata", "heldout")
     train, test = _get(ho, "training_error_percent"), _get(ho, "heldout_error_percent")
     floor = _get(ho, "noise_floor_percent")
     judged = None  # the record's held-out error against its floor
     caveat = ho.get("caveat") if isinstance(ho, dict) else None
-    if is_number(test) and is_number(floor) and floor > 0:
+    own = _own_verdict(held)
+    if own is not None:  # the block judged against its own floor, as the command printed
+        judged = own
+    elif is_number(test) and is_number(floor) and floor > 0:
         judged = _heldout_verdict(held, test, floor) if held else judge_prediction(test, floor)
         judged = with_caveat(judged, caveat)
     block = held is not None and is_number(held.get("relative_error_percent"))
@@ -107,6 +116,10 @@ def _heldout_facts(
         facts.append(fact)
         problems += more
         headline = f"The model predicts held-out torques to {percent(test)}"
+    if own is not None:
+        assert held is not None
+        more_facts, more, headline = _own_facts(held, own, contradicted, isinstance(caveat, str))
+        return facts + more_facts, problems + more, headline
     if judged is not None:
         fact, more, headline = _floor_fact(
             judged, test, floor, "torques it was judged on", contradicted,
@@ -128,6 +141,31 @@ def _heldout_facts(
             "Sensor-noise floor not measured (heldout.json absent: the run was made with "
             "--no-figures, or the log could not be read back)"
         )
+    return facts, problems, headline
+
+
+def _own_facts(
+    held: dict, own: Verdict, contradicted: bool, within_motion: bool
+) -> tuple[list[str], list[str], str]:
+    """(facts, problems, headline) of heldout.json's own verdict (:func:`_own_verdict`):
+    the block's unfiltered error against its noise floor (the sensors' and the states'),
+    the torque spikes replaced before judging and the low-speed note."""
+    fact, problems, headline = _floor_fact(
+        own,
+        held["relative_error_percent"],
+        held["noise_floor_percent"],
+        "unfiltered held-out torques",
+        contradicted,
+        within_motion=within_motion,
+        what="noise floor",
+    )
+    facts = [f"On {esc(str(held.get('block', 'held-out data')))}: {fact[0].lower()}{fact[1:]}"]
+    spikes = held.get("torque_spikes_replaced")
+    if is_number(spikes) and spikes > 0:
+        facts.append(f"{int(spikes)} one-sample torque spike(s) replaced, as the fit replaced them")
+    low = held.get("low_speed")
+    if isinstance(low, str) and low:  # where the rest of the error sits
+        facts.append(esc(low[0].upper() + low[1:]))
     return facts, problems, headline
 
 
@@ -190,9 +228,10 @@ def _floor_fact(
     contradicted: bool = False,
     *,
     within_motion: bool = False,
+    what: str = "sensor-noise floor",
 ) -> tuple[str, list[str], str]:
-    """(fact, problems, headline) of an error against a sensor-noise floor (the joints
-    the verdict names, or why it was reached; unusable where the data contradict the
+    """(fact, problems, headline) of an error against a noise floor, ``what`` it is (the
+    joints the verdict names, or why it was reached; unusable where the data contradict the
     robot; ``within_motion``: judged on blocks of the motion the model was fitted to, which
     test too little, :func:`~dynid.identification.least_squares.within_motion_caveat`)."""
     r = v.ratio if v.ratio is not None else math.inf
@@ -203,13 +242,13 @@ def _floor_fact(
         else f"<b>{esc(v.label)}</b>: " + esc(joints or v.reason.split("): ", 1)[-1])
     )
     fact = (
-        f"Error {percent(err)} against a sensor-noise floor of {percent(floor)} of the "
+        f"Error {percent(err)} against a {what} of {percent(floor)} of the "
         f"{esc(torques)} (<b>{r:.3g} x the floor</b>): {said}"
     )
     level = "at" if r <= FLOOR_GOOD else f"{r:.3g} times"  # as in the fact
     headline = (
         f"The model predicts held-out torques to {percent(err)}, {level} the "
-        f"sensor-noise floor of {percent(floor)}"
+        f"{what} of {percent(floor)}"
     )
     if contradicted:
         headline = (
@@ -263,6 +302,31 @@ def _block_fact(held: dict, judge: bool, contradicted: bool = False) -> tuple[st
         f"{where}: {fact[0].lower()}{fact[1:]}",
         problems,
         headline + ("" if v.unusable else " (unfiltered torques)"),
+    )
+
+
+def _own_verdict(held: dict | None) -> Verdict | None:
+    """heldout.json's own verdict, made against the floor of the sensors' and the held-out
+    states' noise, each sample against its own (a file with ``sensor_noise_rms``; the
+    ratio cannot be re-derived from the file's sums): the verdict the command printed, or
+    None for an older file."""
+    if not isinstance(held, dict) or "sensor_noise_rms" not in held:
+        return None
+    v, err, floor = (
+        held.get("verdict"),
+        held.get("relative_error_percent"),
+        held.get("noise_floor_percent"),
+    )
+    if not (isinstance(v, dict) and v.get("level") in LEVELS and is_number(err)):
+        return None
+    if not is_number(floor):
+        return None
+    ratio = v.get("ratio")
+    return Verdict(
+        v["level"],
+        str(v.get("label") or v["level"]),
+        str(v.get("reason", "")),
+        float(ratio) if is_number(ratio) else None,
     )
 
 
@@ -480,7 +544,7 @@ def answer(run: RunFiles) -> Answer | None:
     facts += _warning_facts(run, problems)
     level = worst(*problems)  # type: ignore[arg-type]
     label = None
-    if level == "good" and headline and "at the sensor-noise floor" in headline:
+    if level == "good" and re.search(r"at the (sensor-)?noise floor", headline):
         label = "at the noise floor"
     if not headline:
         headline = "The identification's record holds no error to judge it by"
@@ -520,16 +584,21 @@ def _torques_section(run: RunFiles, held: dict | None) -> str:
     if held is not None and isinstance(held.get("rms"), list):
         names = held.get("joint_names") or [f"joint {j + 1}" for j in range(len(held["rms"]))]
         noise = held.get("noise_rms") or [None] * len(names)
+        sensor = held.get("sensor_noise_rms") or noise  # an older file: the sensors' alone
+        states = held.get("input_noise_rms")  # the held-out states' noise through the model
         rel = held.get("relative_error_percent_per_joint") or [None] * len(names)
         rows = []
         for j, name in enumerate(names):
             e, s = held["rms"][j], noise[j] if j < len(noise) else None
             ratio = e / s if is_number(e) and is_number(s) and s > 0 else None
-            rows.append([esc(name), cell(e), cell(s), cell(ratio), cell(rel[j])])
+            row = [esc(name), cell(e), cell(sensor[j] if j < len(sensor) else None)]
+            row += [cell(states[j] if j < len(states) else None)] if states else []
+            rows.append([*row, cell(ratio), cell(rel[j])])
         headers = [
             "joint",
             "held-out RMS error [N m]",
             "sensor noise RMS [N m]",
+            *(["states' noise through the model RMS [N m]"] if states else []),
             "error / noise",
             "held-out relative error [%]",
         ]
