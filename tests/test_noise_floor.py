@@ -35,7 +35,7 @@ def test_a_true_model_meets_the_noise_floor_it_is_given(panda):
         model = identify_recordings(panda, logs, structure=Structure(False, ("viscous",)))
     ho = model.info.heldout
     assert ho["heldout_error_percent"] == pytest.approx(ho["noise_floor_percent"], rel=0.15)
-    assert "noise floor" in heldout_line(ho)
+    assert "noise alone" in heldout_line(ho)
 
 
 def test_the_floor_is_named_after_what_was_measured():
@@ -43,9 +43,9 @@ def test_the_floor_is_named_after_what_was_measured():
     sensors: the line said "the torque sensors' noise floor" for it."""
     ho = dict(training_error_percent=1.0, heldout_error_percent=1.5, noise_floor_percent=0.5)
     ho.update(scheme="recordings", folds=3)
-    assert "3 x the measured torques' noise floor (0.5 %)" in heldout_line(ho)
+    assert "3 x the measured torques' noise alone (0.5 %;" in heldout_line(ho)
     line = heldout_line(ho, "current")
-    assert "3 x the motor currents' noise floor (0.5 %)" in line and "sensor" not in line
+    assert "3 x the motor currents' noise alone (0.5 %;" in line and "sensor" not in line
 
 
 def _judged_on_a_separate_log(panda, train_seeds, other_seed, other_std):
