@@ -148,7 +148,8 @@ def test_the_summary_names_the_widths_chosen_per_joint(alternating):
     name = model.info.selection["chosen"]
     lines = selection_lines(model.info.selection)
     assert "/" in name and name in lines[0]
-    assert any(line.startswith(f"  * {name} ") for line in lines), lines
+    # a coefficient left out on single joints stands in the table's own column
+    assert any(line.startswith(f"  * {name.partition(' - ')[0]} ") for line in lines), lines
     assert any("K_j x max(band_j" in line for line in term_lines(model)), term_lines(model)
 
 

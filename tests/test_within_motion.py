@@ -57,10 +57,12 @@ def test_a_caveat_keeps_a_verdict_from_the_noise_floor():
 
 def test_a_two_second_recording_is_not_judged_at_the_noise_floor(panda):
     """The Panda with viscous and Coulomb friction, one 2 s recording (scaled condition
-    number about 2e3): a new trajectory errs several times more than its own blocks; the
-    record carries the caveat and the held-out verdict is not "good"."""
+    number about 1.6e3): a new trajectory errs several times more than its own blocks; the
+    record carries the caveat and the held-out verdict is not "good". (The recording of
+    seed 4 got a better-conditioned structure once determined coefficients were kept:
+    condition number 386, blocks 5.2 %, the new trajectory 5.9 %.)"""
     fr = ClassicalFriction(np.linspace(0.6, 0.2, 7), np.linspace(3.0, 1.0, 7), np.zeros(7))
-    (log,) = recordings(panda, (4,), friction=fr, duration=2.0, noise=SensorNoise())
+    (log,) = recordings(panda, (1,), friction=fr, duration=2.0, noise=SensorNoise())
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", DynidWarning)
         model = identify_recordings(panda, [log])

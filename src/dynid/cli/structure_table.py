@@ -38,6 +38,7 @@ def selection_lines(selection: Any) -> list[str]:
     out = [
         f"model structure chosen on held-out data ({selection['validation']}): "
         f"{selection['chosen']} ({selection['rule']})",
+        *_determined_line(selection.get("kept_determined") or ()),
         f"    {'structure':<{w}} {'params':>6} {'train %':>9} {'held-out %':>11}"
         + (f" {'whitened %':>11}" if white else "")
         + f" {'se vs best':>10}"
@@ -78,6 +79,22 @@ def selection_lines(selection: Any) -> list[str]:
         )
     out += [f"  note: {line}" for line in selection.get("notes", ())]
     return out
+
+
+def _determined_line(kept: Sequence[dict[str, Any]]) -> list[str]:
+    """The coefficients kept because the data determine them although the held-out error
+    would not miss them: ``Ia5, Ia6 kept: determined to 2.9 %, 2.4 %``."""
+    if not kept:
+        return []
+    return [
+        "  "
+        + ", ".join(str(k["coefficient"]) for k in kept)
+        + " kept: determined to "
+        + ", ".join(f"{k['std_percent']:.2g} %" for k in kept)
+        + " (relative standard deviation), though held-out errors alone would leave "
+        + ("it" if len(kept) == 1 else "them")
+        + " out"
+    ]
 
 
 def _best_of_shapes(cands: Sequence[dict[str, Any]], chosen: str) -> tuple[set[str], int]:

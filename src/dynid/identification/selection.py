@@ -16,9 +16,17 @@ standard error of the best** (the one-standard-error rule of cross-validation: H
 Tibshirani and Friedman, *The Elements of Statistical Learning*, 2nd ed., Sec. 7.10),
 the standard error being that of the difference of the two candidates' errors paired
 over the folds (:func:`~dynid.identification.candidates.paired_se`), and differences
-under 1 % of the lowest error counting as ties. A smooth Coulomb's width is then chosen
-per joint (:mod:`dynid.identification.widths`), and the Stribeck bump on the smooth sign
-judged at the width of the best smooth law (:mod:`dynid.identification.bumps`).
+under 1 % of the lowest error counting as ties. A coefficient the data determine (its
+relative standard deviation in the fit that holds it at most
+:data:`~dynid.identification.candidates.DETERMINED_STD_PERCENT`, the standard deviation
+that holds for the filtered log's coloured residual) is never left out that way: a term
+leaves when held-out data do not miss it **and** the fit cannot tell it from zero (a wrist
+armature whose torque stays within the noise at the training's accelerations, yet
+determined to 3 %, kept ``M(q)`` of the wrist right;
+:attr:`~.candidates.Selection.determined` names what was kept so). A smooth Coulomb's
+width is then chosen per joint (:mod:`dynid.identification.widths`), and the Stribeck
+bump on the smooth sign judged at the width of the best smooth law
+(:mod:`dynid.identification.bumps`).
 The folds leave one recording out at a time when there are several, contiguous time
 blocks otherwise (:meth:`~dynid.identification.recordings.Recordings.fold_labels`), or
 judge on a separate recording. A recording that holds what no candidate models is left
@@ -38,7 +46,7 @@ from __future__ import annotations
 
 import copy
 import warnings
-from collections.abc import Callable, Sequence
+from collections.abc import Callable, Collection, Sequence
 from dataclasses import replace
 from typing import Any, Literal
 
@@ -89,6 +97,7 @@ from .structure import (
     candidate_structures,
     check_placement,
     coefficient_labels,
+    column_labels,
     friction_placements,
     joint_side_joints,
     own_rotors,
@@ -171,11 +180,12 @@ def _within(c: Candidate, best: Candidate) -> bool:
 
 def _chosen(candidates: Sequence[Candidate]) -> Structure:
     """The simplest candidate within one standard error of the lowest held-out error
-    (:func:`_within`), among those whose friction is dissipative within the velocity
-    limits."""
+    (:func:`_within`) that holds every coefficient the lowest's fit determines
+    (:meth:`~.candidates.Candidate.determined`), among those whose friction is dissipative
+    within the velocity limits."""
     candidates = _physical(candidates)
     best = min(candidates, key=lambda c: c.score)
-    within = [c for c in candidates if _within(c, best)]
+    within = [c for c in candidates if _within(c, best) and not _lacks(c, best)]
     # of as many parameters, the one with fewer terms: an armature whose every own rotor
     # is left out holds only rotors that regroup with the links (the same columns)
     return min(
@@ -186,6 +196,13 @@ def _chosen(candidates: Sequence[Candidate]) -> Structure:
             c.score,
         ),
     ).structure
+
+
+def _lacks(c: Candidate, best: Candidate) -> dict[str, float]:
+    """The coefficients ``best``'s fit determines that ``c`` does not hold (the armature
+    of joint 5 in a candidate without it), and their relative standard deviations [%]."""
+    held = {lab for lab, _ in c.relative_std}
+    return {lab: r for lab, r in best.determined().items() if lab not in held}
 
 
 def select_structure(
@@ -221,7 +238,7 @@ def select_structure(
         Also judge per-joint structures: a smooth Coulomb's width per joint
         (:func:`~dynid.identification.widths.per_joint_widths`), then friction
         coefficients of single joints left out while the held-out error stays within one
-        standard error of the lowest
+        standard error of the lowest, none that the fit determines
         (:attr:`~dynid.identification.structure.Structure.drop`).
 
     Returns
@@ -294,6 +311,7 @@ def select_structure(
     chosen = _chosen(judged)
     notes[:0] = [lo.note(chosen, where.get(chosen)) for lo in left_out]
     best = min(_physical(judged), key=lambda c: c.score)
+    determined = _kept_determined(chosen, best, judged, by_group, robot.n, fit_rtol, where)
     judged = [replace(c, se_vs_best_percent=paired_se(c, best)) for c in judged]
     notes += _candidate_notes(judged)
     per: tuple[tuple[str, float], ...] = ()
@@ -307,7 +325,34 @@ def select_structure(
         notes=tuple(notes),
         per_recording=per,
         outlying=tuple(data.names[i] for i in skip),
+        determined=determined,
     )
+
+
+def _kept_determined(
+    chosen: Structure,
+    best: Candidate,
+    judged: Sequence[Candidate],
+    groups: _Folds,
+    n: int,
+    rtol: float,
+    where: dict[Structure, _Key],
+) -> tuple[tuple[str, float], ...]:
+    """The coefficients of ``chosen`` that its fit determines
+    (:meth:`~.candidates.Candidate.determined`) and whose absence the held-out error would
+    not miss (``chosen`` without it within one standard error of ``best``): kept for being
+    determined alone, each with its relative standard deviation [%]."""
+    here = next(c for c in judged if c.structure == chosen)
+    mine = here.determined()
+    if not mine:
+        return ()
+    model, terms, held = groups[where[chosen]]
+    out = []
+    for c in _dropped(here, model, terms, held, n, rtol, among=mine):
+        (lab,) = set(c.structure.drop) - set(chosen.drop)
+        if _within(c, best):
+            out.append((lab, mine[lab]))
+    return tuple(out)
 
 
 def reversed_friction(selection: Selection) -> tuple[Violation, ...]:
@@ -414,7 +459,7 @@ def _judged(
             [(t, x[sl]) for t, sl in columns], dq_max, [sd[sl] for _, sl in columns]
         )
 
-    return candidate_judged(structure, use, model, held, rtol, check)
+    return candidate_judged(structure, use, model, held, rtol, check, column_labels(model, terms))
 
 
 def _per_recording(
@@ -553,8 +598,9 @@ def _per_joint(
     the one chosen, friction coefficients and armatures (rotors that are base parameters
     of their own) of single joints left out one at a time (the one whose absence the
     held-out data miss least first) while the held-out error stays within one standard
-    error of the lowest; the candidates reached, when they hold fewer coefficients than
-    where they started.
+    error of the lowest, none that the fit it is left out of determines
+    (:meth:`~.candidates.Candidate.determined`); the candidates reached, when they hold
+    fewer coefficients than where they started.
 
     When the lowest held-out error is a candidate whose friction is not dissipative, its
     offending coefficients are left out first (:func:`_repaired`): a joint's small
@@ -580,7 +626,7 @@ def _per_joint(
         while True:
             trials = [
                 c
-                for c in _dropped(here, model, terms, held, n, rtol)
+                for c in _dropped(here, model, terms, held, n, rtol, keep=here.determined())
                 if not c.unphysical or here.unphysical
             ]
             step = min(trials, key=lambda c: c.score, default=None)
@@ -604,17 +650,18 @@ def _dropped(
     held: HeldOut,
     n: int,
     rtol: float,
-    among: frozenset[str] | None = None,
+    among: Collection[str] | None = None,
+    keep: Collection[str] = (),
 ) -> list[Candidate]:
-    """``here`` with one more coefficient left out (one of ``among`` when given), every
-    way, judged."""
+    """``here`` with one more coefficient left out (one of ``among`` when given, none of
+    ``keep``), every way, judged."""
     rotors = tuple(own_rotors(model.base, n))
     return [
         _judged(s, candidate_columns(s, model, terms), model, terms, held, rtol)
         for s in (
             replace(here.structure, drop=here.structure.drop + (lab,))
             for lab in coefficient_labels(here.structure, n, rotors)
-            if among is None or lab in among
+            if (among is None or lab in among) and lab not in keep
         )
     ]
 

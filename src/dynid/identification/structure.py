@@ -44,6 +44,7 @@ __all__ = [
     "Structure",
     "candidate_columns",
     "candidate_structures",
+    "column_labels",
     "check_placement",
     "coefficient_labels",
     "friction_placements",
@@ -773,6 +774,19 @@ def candidate_columns(structure: Structure, model: Any, terms: list[tuple[ModelT
             on &= np.array([lab not in structure.drop for lab in t.labels])
         use.append(on)
     return np.concatenate(use)
+
+
+def column_labels(model: Any, terms: list[tuple[ModelTerm, Any]]) -> tuple[str, ...]:
+    """The label of each column of :func:`candidate_columns` that a per-joint structure
+    may leave out (the rotors of :func:`own_rotors`, ``Ia3``; the appended terms', ``fv1``,
+    ``fc1`` at every width), ``""`` for the others (the links' base parameters)."""
+    out = [""] * model.base.rank
+    for lab, k in own_rotors(model.base, model.robot.n).items():
+        out[k] = lab
+    for t, what in terms:
+        if not t.in_base and what is not None:
+            out += t.labels
+    return tuple(out)
 
 
 def own_rotors(base: Any, n_links: int) -> dict[str, int]:
