@@ -360,3 +360,24 @@ def test_a_recording_in_short_pieces_is_checked_once_and_whole(panda):
     flipped = TorqueLog(cut.t, cut.q, cut.dq, -cut.tau)
     with pytest.raises(DataError, match=r"^f\.csv: the measured torques are anti-corr"):
         prepare_recordings(panda, [flipped], ["f.csv"], cutoff_hz=10.0)
+
+
+def test_positions_only_recordings_are_said_once(panda, log, tmp_path, caplog):
+    """Four recordings without velocity columns: four copies of one long warning, one per
+    file; now one, naming the files (the reader's own line at -v only)."""
+    from dynid.io.torque_log import save_torque_log
+    from dynid.workflows.recordings import read_recordings
+
+    paths = [  # written without dq; each its own (a copy is refused)
+        save_torque_log(
+            tmp_path / f"r{k}.csv", TorqueLog(log.t, log.q, log.dq, log.tau + k, dq_derived=True)
+        )
+        for k in range(1, 5)
+    ]
+    with warnings.catch_warnings(record=True) as got, caplog.at_level("WARNING"):
+        warnings.simplefilter("always", DynidWarning)
+        rec = read_recordings(paths, panda)
+    assert all(g.dq_derived for g in rec.logs)
+    said = [str(w.message) for w in got if "no velocity columns" in str(w.message)]
+    said += [r.getMessage() for r in caplog.records if "no velocity columns" in r.getMessage()]
+    assert len(said) == 1 and said[0].startswith("r1.csv, r2.csv, r3.csv, r4.csv: "), said

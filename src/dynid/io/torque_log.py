@@ -264,7 +264,9 @@ def load_torque_log(
     try:
         log = TorqueLog.from_raw(**arrays, gap_factor=gap_factor)
         if derive:
-            _log.warning("%s: %s", path.name, velocity_note(DEFAULT_CUTOFF_HZ))
+            # (-v; the commands say it once for every such recording they read:
+            # dynid.workflows.recordings.check_derived_velocities)
+            _log.info("%s: %s", path.name, velocity_note(DEFAULT_CUTOFF_HZ))
             log = with_derived_velocities(log, DEFAULT_CUTOFF_HZ)
         return log
     except DataError as exc:

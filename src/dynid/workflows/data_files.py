@@ -247,8 +247,8 @@ def read_torque_log(
         mapped = load_mapped_torque_log(path, columns, n=n)
         for note in mapped.conversions:  # as asked: a note
             _log.log(NOTE, "%s: %s", path.name, note)
-        for note in mapped.notes:
-            _log.warning("%s: %s", path.name, note)
+        for note in mapped.notes:  # velocities derived: said once for every such recording
+            _log.info("%s: %s", path.name, note)  # (recordings.check_derived_velocities)
         c = mapped.log.cleaning
         if c.n_nan_rows or c.n_duplicates:
             what = (

@@ -60,6 +60,7 @@ from .options import check_band, check_choice, check_count, check_number, only_w
 from .prior import load_prior
 from .recordings import (
     Recorded,
+    check_derived_velocities,
     check_limits,
     check_signs,
     check_torque_unit,
@@ -460,6 +461,7 @@ def _read_logs(
     rec = Recorded((*logs, *(g for g, _ in held)), (*paths, *(p for _, p in held)), opt.drive)
     check_limits(rec, robot)
     check_units(rec)
+    check_derived_velocities(rec, cmap)
     check_signs(rec.select(slice(len(logs), None)), robot)  # the held-out log's
     check_torque_unit(rec, robot, cmap)
     return logs

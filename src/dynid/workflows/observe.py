@@ -91,6 +91,7 @@ from .observe_detect import ResidualSink, detected_log, true_torques
 from .observe_logs import ObservedBlock, PreparedLog, Series, observed_blocks, prepared_log
 from .recordings import (
     Recorded,
+    check_derived_velocities,
     check_limits,
     check_signs,
     check_torque_unit,
@@ -554,6 +555,7 @@ def _read_logs(
     read = Recorded(tuple(logs), tuple(map(Path, paths)), model.drive)  # mapped once
     check_limits(read, model.robot)
     check_units(read)
+    check_derived_velocities(read, cmap)
     check_signs(read, model.robot)
     check_torque_unit(read, model.robot, cmap)
     return read

@@ -45,7 +45,7 @@ from typing import Any
 import numpy as np
 
 from ..exceptions import DataError, DynidWarning, OptionError
-from ..identification.log import TorqueLog, joint_side_log
+from ..identification.log import DEFAULT_CUTOFF_HZ, TorqueLog, joint_side_log, velocity_note
 from ..identification.pieces import with_start_turns
 from ..identification.sanity import (
     despiked,
@@ -74,6 +74,7 @@ __all__ = [
     "UNIT_RATIO",
     "Recorded",
     "check_degrees",
+    "check_derived_velocities",
     "check_limits",
     "check_signs",
     "check_torque_unit",
@@ -202,6 +203,7 @@ def read_recordings(
         if (unit := time_unit_finding(name, log)) is not None:  # it names the file
             raise DataError(unit.removeprefix(f"{name}: "), file=name)
     check_units(out)
+    check_derived_velocities(out, cmap)
     check_torque_unit(out, robot if reference is None else reference, cmap)
     return out
 
@@ -334,6 +336,17 @@ def check_units(rec: Recorded) -> None:
                 "units; convert it or leave it out",
                 file=rec.names[worst],
             )
+
+
+def check_derived_velocities(rec: Recorded, cmap: ColumnMap | None = None) -> None:
+    """Warn once for every recording without velocity columns (``dq_derived``), naming
+    them: four positions-only logs gave four copies of one long line."""
+    names = [n for n, log in zip(rec.names, rec.logs, strict=True) if log.dq_derived]
+    if not names:
+        return
+    cutoff = DEFAULT_CUTOFF_HZ if cmap is None else cmap.velocity_cutoff_hz
+    which = ", ".join(names) if len(names) <= 4 else f"{len(names)} recordings ({names[0]}, ...)"
+    warnings.warn(f"{which}: {velocity_note(cutoff)}", DynidWarning, stacklevel=3)
 
 
 def check_degrees(rec: Recorded, robot: Robot) -> None:
