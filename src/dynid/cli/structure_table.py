@@ -6,6 +6,8 @@ import re
 from collections.abc import Sequence
 from typing import Any
 
+from ..identification.candidates import determined_sentence
+
 __all__ = ["selection_lines", "text_width"]
 
 
@@ -83,18 +85,9 @@ def selection_lines(selection: Any) -> list[str]:
 
 def _determined_line(kept: Sequence[dict[str, Any]]) -> list[str]:
     """The coefficients kept because the data determine them although the held-out error
-    would not miss them: ``Ia5, Ia6 kept: determined to 2.9 %, 2.4 %``."""
-    if not kept:
-        return []
-    return [
-        "  "
-        + ", ".join(str(k["coefficient"]) for k in kept)
-        + " kept: determined to "
-        + ", ".join(f"{k['std_percent']:.2g} %" for k in kept)
-        + " (relative standard deviation), though held-out errors alone would leave "
-        + ("it" if len(kept) == 1 else "them")
-        + " out"
-    ]
+    would not miss them (:func:`~dynid.identification.candidates.determined_sentence`)."""
+    said = determined_sentence(kept)
+    return [] if said is None else ["  " + said]
 
 
 def _best_of_shapes(cands: Sequence[dict[str, Any]], chosen: str) -> tuple[set[str], int]:

@@ -27,6 +27,7 @@ import re
 from typing import Any
 
 from ..exceptions import DynidError
+from ..identification.candidates import determined_sentence
 from ..identification.structure import Structure
 from ..identification.verdict import (
     FLOOR_GOOD,
@@ -647,6 +648,8 @@ def _structure_section(doc: dict) -> str:
         "std. error of the difference from the best [%]",
     ] + (["left out per joint"] if left else [])
     rule = f"Rule: {esc(sel.get('rule', ''))}; validation: {esc(sel.get('validation', ''))}."
+    kept = determined_sentence(sel.get("kept_determined"))
+    rule += "" if kept is None else f" {esc(kept[0].upper() + kept[1:])}."
     parts = [f"<p>{rule}</p>", table(headers, rows, marked=marked)]
     per = [r for r in sel.get("heldout_per_recording") or () if isinstance(r, dict)]
     if per:
