@@ -296,7 +296,8 @@ def test_identify_routes_a_torque_log_to_the_classical_identification(tmp_path):
         == 0
     )
     terms = ["--terms", "viscous,coulomb,offset"]  # the paper's eq. 24 (default: chosen)
-    assert main(["identify", "--data", str(log), *terms, "--out", str(tmp_path / "cls"), "-q"]) == 0
+    argv = ["identify", "--data", str(log), *terms, "--no-figures", "-q"]  # (no figure read)
+    assert main([*argv, "--out", str(tmp_path / "cls")]) == 0
     d = json.loads((tmp_path / "cls" / "identification.json").read_text())
     for key in (
         "rank",

@@ -28,7 +28,7 @@ def consistent(tmp_path_factory):
     robot = dynid.panda()
     d = tmp_path_factory.mktemp("consistent")
     for s in (1, 2, 3):
-        traj = random_fourier(robot, np.random.default_rng(s))(sample_times(5.0, 400.0))
+        traj = random_fourier(robot, np.random.default_rng(s))(sample_times(5.0, 200.0))
         log = simulate_measurement(
             robot, traj, rng=np.random.default_rng(s + 100), noise=SensorNoise()
         )

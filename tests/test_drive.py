@@ -238,7 +238,7 @@ def test_cli_motor_side_positions_only_identify_then_validate(tmp_path, currents
     )
     args = ["identify", "--robot", path, "--base", "base_link", "--tip", "tool0"]
     args += ["--drive", str(tmp_path / "drive.toml"), "--data", str(tmp_path / "log.csv")]
-    assert main([*args, "--out", str(tmp_path / "r"), "-q"]) == 0
+    assert main([*args, "--out", str(tmp_path / "r"), "--no-figures", "-q"]) == 0
     assert (
         main(
             [
@@ -456,7 +456,7 @@ def test_validate_reads_a_log_as_the_model_was_identified(tmp_path):
     cols = ["--columns", "t=time,q=pos_{i},tau=eff_{i}", "--units", "t=ms,tau=mNm"]
     args = ["identify", "--robot", path, "--base", "base_link", "--tip", "tool0", *cols]
     args += ["--drive", str(tmp_path / "drive.toml"), "--data", str(tmp_path / "log.csv")]
-    assert main([*args, "--out", str(tmp_path / "r"), "-q"]) == 0
+    assert main([*args, "--out", str(tmp_path / "r"), "--no-figures", "-q"]) == 0
     val = ["validate", "--model", str(tmp_path / "r" / "identification.json")]
     val += ["--data", str(tmp_path / "held.csv"), "--no-figures", "-q"]
     assert main([*val, "--out", str(tmp_path / "v")]) == 0

@@ -356,11 +356,11 @@ def _simulate_peak(tmp_path, seconds: float) -> int:
 
 @pytest.mark.slow
 def test_simulate_memory_does_not_grow_with_the_length_of_the_log(tmp_path):
-    """dynid simulate computes and writes a log in blocks: 1,000,001 samples peak within
-    100 MB of 100,001 (the whole arrays of the longer log, trajectory and measurements,
-    are 0.7 GB more)."""
+    """dynid simulate computes and writes a log in blocks: 400,001 samples (four blocks)
+    peak within 100 MB of 150,001 (two blocks; the whole arrays of the longer log,
+    trajectory and measurements, are 0.19 GB more)."""
     if not os.path.exists("/proc/self/status"):
         pytest.skip("needs /proc/self/status (Linux)")
-    short = _simulate_peak(tmp_path, 100.0)
-    long = _simulate_peak(tmp_path, 1000.0)
+    short = _simulate_peak(tmp_path, 150.0)
+    long = _simulate_peak(tmp_path, 400.0)
     assert long < short + 100 * 2**20, (short, long)

@@ -343,6 +343,7 @@ def test_identify_command_prints_and_records_the_choice(panda, tmp_path, capsys)
             str(tmp_path / "rec52.csv"),
             "--out",
             str(tmp_path / "auto"),
+            "--no-figures",
             "-q",
         ]
     )
@@ -365,6 +366,7 @@ def test_identify_command_prints_and_records_the_choice(panda, tmp_path, capsys)
             "viscous,coulomb",
             "--out",
             str(tmp_path / "fixed"),
+            "--no-figures",
         ]
     )
     out = capsys.readouterr().out
@@ -439,10 +441,10 @@ def test_a_stribeck_bump_on_noisy_velocities_is_chosen_on_the_smooth_sign(panda,
         out = tmp_path / tag
         with warnings.catch_warnings():
             warnings.simplefilter("ignore", DynidWarning)
-            assert main(["identify", "--robot", "panda", "--data", *files[:3], "--out", str(out)]
-                        + extra) == 0  # fmt: skip
+            assert main(["identify", "--robot", "panda", "--data", *files[:3], "--out", str(out),
+                         "--no-figures"] + extra) == 0  # fmt: skip
             assert main(["validate", "--model", str(out / "identification.json"), "--data",
-                         files[3], "--out", str(out / "val")]) == 0  # fmt: skip
+                         files[3], "--out", str(out / "val"), "--no-figures"]) == 0  # fmt: skip
         errors[tag] = json.loads((out / "val" / "validation.json").read_text())
     chosen = json.loads((tmp_path / "default" / "identification.json").read_text())
     assert "smooth:0.3 + stribeck:0.05" in chosen["metadata"]["selection"]["chosen"]

@@ -175,7 +175,7 @@ def test_std_is_honoured_on_every_route_or_refused(files, tmp_path, capsys):
             out = tmp_path / f"{data}-{std}"
             argv = ["identify", "--data", str(files / data), "--std", std, "--out", str(out)]
             argv += [] if terms is None else ["--terms", terms]
-            assert main([*argv, "-q"]) == 0
+            assert main([*argv, "--no-figures", "-q"]) == 0
             doc = json.loads((out / "identification.json").read_text())
             assert doc["std_estimator"] == std
             got = [c["std"] for c in doc["coefficients"]]
@@ -192,12 +192,13 @@ def test_std_is_honoured_on_every_route_or_refused(files, tmp_path, capsys):
 def test_the_output_bundle_of_a_consistent_fit_is_the_same_for_identify_and_retrieve(
     files, tmp_path
 ):
-    """identify --consistent and retrieve write the bundle of dynid.io.feasible_bundle
-    (plus retrieval.png); the feasible.json of retrieve --static equals the API's."""
+    """identify --consistent and retrieve write the bundle of dynid.io.feasible_bundle;
+    the feasible.json of retrieve --static equals the API's."""
     a, b = tmp_path / "identify", tmp_path / "retrieve"
     s = str(files / "s.csv")
-    assert main(["identify", "--consistent", "--data", s, "--out", str(a), "-q"]) in (0, 1)
-    assert main(["retrieve", "--static", s, "--out", str(b), "-q"]) in (0, 1)
+    flags = ["--no-figures", "-q"]  # the figures are not part of the bundle
+    assert main(["identify", "--consistent", "--data", s, "--out", str(a), *flags]) in (0, 1)
+    assert main(["retrieve", "--static", s, "--out", str(b), *flags]) in (0, 1)
     for folder in (a, b):
         names = {p.name for p in folder.iterdir() if not p.name.startswith(".")}
         assert set(FEASIBLE_BUNDLE) <= names
@@ -237,7 +238,14 @@ QUIET = [
 ]
 
 
-@pytest.mark.parametrize("argv", QUIET, ids=[" ".join(a[:2]) for a in QUIET])
+def _quiet_case(argv: list[str]):
+    """One command of QUIET; identify on the log (its structure search run twice, about
+    10 s) is marked slow, which hands this file out among the first (tests/conftest.py)."""
+    slow = argv[:3] == ["identify", "--data", "{d}/log.csv"]
+    return pytest.param(argv, id=" ".join(argv[:2]), marks=[pytest.mark.slow] if slow else [])
+
+
+@pytest.mark.parametrize("argv", [_quiet_case(a) for a in QUIET])
 def test_quiet_silences_every_command(files, tmp_path, capsys, argv):
     """-q prints nothing (no table, summary, progress, note or warning) for every command;
     without it the same command prints its summary."""
