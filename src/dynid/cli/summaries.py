@@ -290,7 +290,7 @@ def heldout_line(ho: dict[str, Any], effort: str = "torque") -> str:
         ""
         if floor is None
         else f"; {ho['heldout_error_percent'] / floor:.3g} x the {measured} noise alone "
-        f"({floor:.3g} %; the held-out verdict's floor adds the prepared states' noise)"
+        f"({floor:.3g} %; the verdict's floor below adds the prepared states' noise)"
         if floor > 0
         else ""
     )
