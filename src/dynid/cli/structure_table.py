@@ -6,7 +6,7 @@ import re
 from collections.abc import Sequence
 from typing import Any
 
-from ..identification.candidates import determined_sentence
+from ..identification.determined import determined_sentence
 
 __all__ = ["selection_lines", "text_width"]
 

@@ -36,7 +36,6 @@ __all__ = [
     "Candidate",
     "Selection",
     "candidate_judged",
-    "determined_sentence",
     "heldout_of",
     "paired_se",
     "recording_oddness",
@@ -230,24 +229,6 @@ class Selection:
                 {"coefficient": lab, "std_percent": r} for lab, r in self.determined
             ],
         }
-
-
-def determined_sentence(kept: Any) -> str | None:
-    """The sentence of the coefficients a selection kept because the data determine them
-    (``metadata.selection.kept_determined``: ``coefficient``, ``std_percent``), or None:
-    ``Ia5, Ia6 kept: determined to 2.9 %, 2.4 % (relative standard deviation), though
-    held-out errors alone would leave them out``."""
-    rows = [k for k in kept or () if isinstance(k, dict) and "coefficient" in k]
-    if not rows:
-        return None
-    return (
-        ", ".join(str(k["coefficient"]) for k in rows)
-        + " kept: determined to "
-        + ", ".join(f"{float(k.get('std_percent', float('nan'))):.2g} %" for k in rows)
-        + " (relative standard deviation), though held-out errors alone would leave "
-        + ("it" if len(rows) == 1 else "them")
-        + " out"
-    )
 
 
 #: A recording whose held-out error exceeds this multiple of the other recordings' median

@@ -236,10 +236,9 @@ def select_structure(
         A separate recording to judge on instead of the folds.
     per_joint : bool
         Also judge per-joint structures: a smooth Coulomb's width per joint
-        (:func:`~dynid.identification.widths.per_joint_widths`), then friction
-        coefficients of single joints left out while the held-out error stays within one
-        standard error of the lowest, none that the fit determines
-        (:attr:`~dynid.identification.structure.Structure.drop`).
+        (:func:`~dynid.identification.widths.per_joint_widths`), single joints' friction
+        coefficients left out within one standard error of the lowest held-out error,
+        none the fit determines (:attr:`~dynid.identification.structure.Structure.drop`).
 
     Returns
     -------
@@ -265,8 +264,7 @@ def select_structure(
     def fit(
         mine: list[Structure], what: str = "structure search, a Stribeck bump on the smooth sign"
     ) -> list[Fitted]:
-        """The regressor of the candidates ``mine`` (one group), fitted with the judge
-        (``what``: the step the progress names)."""
+        """The regressor of ``mine`` (one group) fitted with the judge; ``what``: its step."""
         arm = mine[0].armature
         with stage(what, rows=data.n_rows):
             return fit_largest(

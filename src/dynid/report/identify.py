@@ -27,7 +27,7 @@ import re
 from typing import Any
 
 from ..exceptions import DynidError
-from ..identification.candidates import determined_sentence
+from ..identification.determined import determined_sentence
 from ..identification.structure import Structure
 from ..identification.verdict import (
     FLOOR_GOOD,
