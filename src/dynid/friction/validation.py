@@ -332,7 +332,8 @@ def _validated_blocks(
         N += p.n_samples
     joined = {k: np.concatenate(v) for k, v in kept.items()}
     log = TorqueLog(joined["t"], joined["q"], joined["dq"], joined["tau"], joined["ddq"])
-    _warn_opposite_sign(log.tau, joined["tau_model"])
+    tf_all = joined.get("tau_friction")
+    _warn_opposite_sign(log.tau, joined["tau_model"] + (0.0 if tf_all is None else tf_all))
     return Validation(
         log=log,
         tau_model=_checks.frozen(joined["tau_model"]),
@@ -367,13 +368,13 @@ def validated(
     assert p.ddq is not None  # prepare_log always fills ddq
     tau_model = torques_through(model, drive, p.q, p.dq, p.ddq)  # a robot's: with rotors
     without = torque_errors(p.tau, tau_model)
-    _warn_opposite_sign(p.tau, tau_model)
     tf = with_ = None
     if friction is not None:
         tf = np.empty(p.dq.shape)
         for b in _blocks(p.n_samples):
             tf[b] = friction.torques(p.dq[b])
         with_ = _errors_of_sum(p.tau, tau_model, tf)
+    _warn_opposite_sign(p.tau, tau_model if tf is None else tau_model + tf)
     return Validation(
         log=p,
         tau_model=tau_model,
@@ -386,7 +387,9 @@ def validated(
 
 def _warn_opposite_sign(tau: NDArray[np.float64], tau_model: NDArray[np.float64]) -> None:
     """A :class:`DynidWarning` when the measured torques (N, n) [N m] have the opposite sign
-    to the model's prediction on most joints (a log recorded with another sign convention
+    to the model's whole prediction (friction included: a geared drive's friction at the
+    motors can outweigh the rigid body's torques, which then read as anti-correlated with
+    a log the model predicts to 0.45 %) on most joints (a log recorded with another sign convention
     than the model's; the errors are then about 200 %)."""
     step = max(1, tau.shape[0] // 20_000)
     m, t = tau_model[::step], tau[::step]

@@ -37,6 +37,7 @@ with every policy the command applies, so that the Python API behaves as the com
 from __future__ import annotations
 
 import dataclasses
+import logging
 from collections.abc import Sequence
 from dataclasses import dataclass
 from pathlib import Path
@@ -67,10 +68,13 @@ from ..io.feasible import load_feasible_drive, load_feasible_linear_friction
 from ..io.friction_json import load_friction_json
 from ..model.drive import Drive
 from ..model.robot import Robot
+from ..progress import NOTE
 from .data_files import ColumnSpec, in_file
 from .recordings import despiked_recordings, read_recordings
 
 __all__ = ["ValidateOptions", "ValidateResult", "validate_files"]
+
+_log = logging.getLogger(__name__)
 
 
 @dataclass(frozen=True, slots=True)
@@ -382,7 +386,7 @@ def _judged(
         errors,
         names,
         None if inputs is None else [inputs[k] for k in chosen],
-        opposite=opposite_sign([v.log.tau for v in parts], [v.tau_model for v in parts]),
+        opposite=opposite_sign([v.log.tau for v in parts], [v.tau_hat for v in parts]),
     )
     return verdict, _Noise(fl.sensor_rms, fl.input_rms, fl.total_rms), fl.percent
 
@@ -401,10 +405,30 @@ def _friction(
         own = own_friction(model, drive)
         if feasible is not None:
             own = load_feasible_linear_friction(feasible) or own
+        elif isinstance(model, Robot) and (said := _own_at_motors(model, drive)) is not None:
+            _log.log(NOTE, said)
         return own, None if own is None else "model"
     if isinstance(friction, str | Path):  # where the drive puts a robot's own, as simulated
         return placed_friction(load_friction_json(friction), drive), Path(friction).name
     return placed_friction(friction, drive), "given"
+
+
+def _own_at_motors(robot: Robot, drive: Drive | None) -> str | None:
+    """The note when ``robot``'s own friction (a description file's) acts at the motors
+    of a geared ``drive`` (``friction_at = "motor"``, a geared drive's default): its
+    coefficients are then read as the motors' (a URDF's ``<dynamics>`` hold the joints':
+    an SO-101 exported to URDF, validated through a hand-written drive of gear ratio 345,
+    read 6e6 % with no word why)."""
+    if robot.friction is None or drive is None or drive.friction_at != "motor":
+        return None
+    if np.allclose(drive.transmission, np.eye(robot.n)):
+        return None
+    return (
+        f"the robot's own friction ({robot.name}) acts at the motors through the drive "
+        '(friction_at = "motor", the default of a geared drive): its coefficients are '
+        "read as the motors'; a URDF's or MJCF's joint friction (as dynid exports write "
+        'it) is the joints\': friction_at = "joint" in the drive file reads it so'
+    )
 
 
 def _overflow(names: Any, val: Any, label: str | None, opt: ValidateOptions) -> str:
