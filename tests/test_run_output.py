@@ -341,6 +341,30 @@ def test_a_file_out_is_staged_too(tmp_path):
     assert sorted(p.name for p in tmp_path.iterdir()) == [FILES_RECORD, "log.csv"]
 
 
+def test_a_termination_whose_exception_was_dropped_still_ends_the_run(tmp_path, monkeypatch):
+    """SIGTERM while numba wrote its cache through a ctypes callback: Python printed the
+    Terminated raised there and dropped it, and the run wrote its log and exited 0; the
+    signal received now ends the run before its outputs move (143, the old log kept)."""
+    import dynid.cli.simulate as sim
+
+    log = tmp_path / "log.csv"
+    assert main(["simulate", "--duration", "1", "--rate", "100", "--out", str(log), "-q"]) == 0
+    before = log.read_bytes()
+    run = sim.run
+
+    def swallowed(args, console):  # the handler's exception lost, as in a C callback
+        with contextlib.suppress(BaseException):
+            os.kill(os.getpid(), signal.SIGTERM)
+        return run(args, console)
+
+    monkeypatch.setattr(sim, "run", swallowed)
+    argv = ["simulate", "--duration", "2", "--rate", "100", "--out", str(log), "-q"]
+    assert main(argv) == 143
+    assert log.read_bytes() == before and _staging(tmp_path) == []
+    monkeypatch.setattr(sim, "run", run)
+    assert main(argv) == 0  # the next run in this process is not terminated by it
+
+
 def test_library_writers_outside_a_run_are_unchanged(tmp_path):
     """Without a run, the writers write where they are told (no staging, no manifest)."""
     from dynid.io.atomic import current_location, write_text

@@ -159,8 +159,22 @@ class Terminated(BaseException):
     arrives; ``args[0]`` is the signal's number."""
 
 
+#: The termination signals received by the current run: a :class:`Terminated` raised
+#: while Python runs a callback from C code (numba writing its cache through ctypes) is
+#: printed and dropped, and the run went on to write its outputs and exit 0.
+_RECEIVED: list[int] = []
+
+
 def _terminate(signum: int, frame: object) -> None:
+    _RECEIVED.append(signum)
     raise Terminated(signum)
+
+
+def _raise_if_terminated() -> None:
+    """Raise the :class:`Terminated` of a termination signal whose exception was dropped
+    (see :data:`_RECEIVED`), before the run's outputs move into place."""
+    if _RECEIVED:
+        raise Terminated(_RECEIVED[0])
 
 
 @contextlib.contextmanager
@@ -168,6 +182,7 @@ def _signals_and_warnings(console: Console) -> Iterator[None]:
     """SIGTERM, SIGHUP and SIGQUIT raise :class:`Terminated`; warnings go to
     :meth:`Console.warn` (one line, no source line; kept for the run's report with -q)."""
     old = {}
+    _RECEIVED.clear()  # (a signal of an earlier run in this process is not this run's)
     with contextlib.suppress(ValueError):  # not the main thread: leave signals alone
         for sig in TERMINATING:
             old[sig] = signal.signal(sig, _terminate)
@@ -306,6 +321,7 @@ def _main(argv: Sequence[str] | None) -> int:
             reporting(console.progress_callback()),  # a long run's steps, on a terminal
         ):
             code = int(args._run(args, console) or 0)
+            _raise_if_terminated()
             if run is not None and run.kind == "folder":
                 save_run_report(run, record, args, argv, code)
         if record.stdout_closed:

@@ -393,6 +393,8 @@ def _warn_opposite_sign(tau: NDArray[np.float64], tau_model: NDArray[np.float64]
     than the model's; the errors are then about 200 %)."""
     step = max(1, tau.shape[0] // 20_000)
     m, t = tau_model[::step], tau[::step]
+    if not (np.all(np.isfinite(m)) and np.all(np.abs(m) < 1e150)):
+        return  # a prediction that overflows: the caller names its source, not a sign
     mc, tc = m - m.mean(axis=0), t - t.mean(axis=0)
     spread = np.std(m, axis=0)
     found = anticorrelated(mc, tc, spread > 0.05 * max(float(spread.max(initial=0.0)), 1e-300))
