@@ -19,15 +19,19 @@ DRIVE = 'schema = "dynid-drive/1"\nside = "joint"\ngear_ratio = [50, 50, 50, 50,
 
 
 @pytest.mark.parametrize("at", [None, "joint"])
-def test_the_robots_own_friction_at_the_motors_is_said(tmp_path, caplog, at):
-    """friction_at unset (the motors, a geared drive's default): one note naming
-    friction_at = "joint"; set to "joint": none. Either way the log the model simulated
-    is at its noise floor (the sign judged on the prediction with its friction)."""
+def test_the_robots_own_friction_at_the_motors_is_said(tmp_path, caplog, capsys, at):
+    """friction_at unset (the motors, a geared drive's default): simulate and validate say
+    so, validate in one note naming friction_at = "joint"; set to "joint": neither. Either
+    way the log the model simulated is at its noise floor (the sign judged on the
+    prediction with its friction)."""
     drive = tmp_path / "drive.toml"
     drive.write_text(DRIVE + ("" if at is None else f'friction_at = "{at}"\n'))
     log = tmp_path / "log.csv"
-    sim = ["simulate", "--drive", str(drive), "--duration", "2", "--rate", "200", "-q"]
-    assert main([*sim, "--trajectory", "fourier", "--out", str(log)]) == 0
+    sim = ["simulate", "--drive", str(drive), "--duration", "2", "--rate", "200"]
+    with caplog.at_level(logging.INFO):
+        assert main([*sim, "--trajectory", "fourier", "--out", str(log)]) == 0
+    simulated = capsys.readouterr()
+    assert ("acts at the motors" in simulated.out + simulated.err) == (at is None)
     argv = ["validate", "--robot", "panda", "--drive", str(drive), "--data", str(log)]
     with caplog.at_level(logging.INFO):
         assert main([*argv, "--no-figures", "-q", "--out", str(tmp_path / "v")]) == 0

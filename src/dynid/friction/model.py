@@ -72,6 +72,7 @@ __all__ = [
     "coulomb_sign",
     "friction_of",
     "placed_friction",
+    "own_at_motors_note",
     "robot_friction",
     "sigmoid_friction",
     "sigmoid_parameters",
@@ -306,6 +307,24 @@ def robot_friction(robot: Robot, drive: Drive | None = None) -> Friction | None:
     Without ``drive``: as held (what a robot description file writes)."""
     own = cast(Friction | None, robot.friction)
     return None if own is None else own.placed(drive)
+
+
+def own_at_motors_note(robot: Robot, drive: Drive | None) -> str | None:
+    """The note when ``robot``'s own friction (a description file's) acts at the motors
+    of a geared ``drive`` (``friction_at = "motor"``, a geared drive's default,
+    :func:`robot_friction`): its coefficients are then read as the motors' while a URDF's
+    ``<dynamics>`` hold the joints' (an SO-101 exported to URDF, validated through a
+    hand-written drive of gear ratio 345, read 6e6 % with no word why); None otherwise."""
+    if robot.friction is None or drive is None or drive.friction_at != "motor":
+        return None
+    if np.allclose(drive.transmission, np.eye(robot.n)):
+        return None
+    return (
+        f"the robot's own friction ({robot.name}) acts at the motors through the drive "
+        '(friction_at = "motor", the default of a geared drive): its coefficients are '
+        "read as the motors'; a URDF's or MJCF's joint friction (as dynid exports write "
+        'it) is the joints\': friction_at = "joint" in the drive file reads it so'
+    )
 
 
 def placed_friction(

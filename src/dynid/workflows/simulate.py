@@ -25,7 +25,7 @@ from typing import Literal
 import numpy as np
 
 from ..exceptions import OptionError
-from ..friction.model import FrictionModel
+from ..friction.model import FrictionModel, own_at_motors_note
 from ..io.excitation import inadmissible_note, load_exciting_trajectory, load_trajectory
 from ..io.friction_json import load_friction_json
 from ..model.drive import Drive
@@ -220,6 +220,8 @@ def simulate_log(robot: Robot, options: SimulateOptions | None = None) -> Simula
         notes.append(
             f"drive: {opt.drive.describe()}; the log is written on the {opt.drive.side} side"
         )
+        if opt.friction == "robot" and (said := own_at_motors_note(robot, opt.drive)):
+            notes.append(said)
     effects = None
     if opt.unmodelled:
         from ..simulation.unmodelled import UnmodelledEffects

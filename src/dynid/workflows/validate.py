@@ -48,7 +48,7 @@ from numpy.typing import NDArray
 
 from ..exceptions import DataError, OptionError
 from ..friction.fit import same_drive, torques_through
-from ..friction.model import FrictionModel, FrictionSum, placed_friction
+from ..friction.model import FrictionModel, FrictionSum, own_at_motors_note, placed_friction
 from ..friction.recordings import RecordingsValidation, validate_recordings
 from ..friction.validation import RECORDED, own_friction
 from ..identification.derived_cutoff import derived_cutoff_hint, with_derived_cutoff_hint
@@ -405,30 +405,12 @@ def _friction(
         own = own_friction(model, drive)
         if feasible is not None:
             own = load_feasible_linear_friction(feasible) or own
-        elif isinstance(model, Robot) and (said := _own_at_motors(model, drive)) is not None:
+        elif isinstance(model, Robot) and (said := own_at_motors_note(model, drive)) is not None:
             _log.log(NOTE, said)
         return own, None if own is None else "model"
     if isinstance(friction, str | Path):  # where the drive puts a robot's own, as simulated
         return placed_friction(load_friction_json(friction), drive), Path(friction).name
     return placed_friction(friction, drive), "given"
-
-
-def _own_at_motors(robot: Robot, drive: Drive | None) -> str | None:
-    """The note when ``robot``'s own friction (a description file's) acts at the motors
-    of a geared ``drive`` (``friction_at = "motor"``, a geared drive's default): its
-    coefficients are then read as the motors' (a URDF's ``<dynamics>`` hold the joints':
-    an SO-101 exported to URDF, validated through a hand-written drive of gear ratio 345,
-    read 6e6 % with no word why)."""
-    if robot.friction is None or drive is None or drive.friction_at != "motor":
-        return None
-    if np.allclose(drive.transmission, np.eye(robot.n)):
-        return None
-    return (
-        f"the robot's own friction ({robot.name}) acts at the motors through the drive "
-        '(friction_at = "motor", the default of a geared drive): its coefficients are '
-        "read as the motors'; a URDF's or MJCF's joint friction (as dynid exports write "
-        'it) is the joints\': friction_at = "joint" in the drive file reads it so'
-    )
 
 
 def _overflow(names: Any, val: Any, label: str | None, opt: ValidateOptions) -> str:
