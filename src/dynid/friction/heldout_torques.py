@@ -34,12 +34,17 @@ from numpy.typing import NDArray
 from ..exceptions import DynidError, DynidWarning
 from ..identification.derived_cutoff import with_derived_cutoff_hint
 from ..identification.floor_verdict import judged_prediction, prediction_input_noise
-from ..identification.input_noise import NoiseFloor, quantization_step, state_noise
+from ..identification.input_noise import (
+    NoiseFloor,
+    quantized_noise_std,
+    rounding_std,
+    state_noise,
+)
 from ..identification.log import TorqueLog, joint_side_log
 from ..identification.low_speed import low_speed_hint
 from ..identification.model import IdentifiedModel
 from ..identification.pieces import split_at_gaps, unwrapped, wrappable
-from ..identification.sanity import despiked, velocity_noise_std
+from ..identification.sanity import despiked
 from ..identification.verdict import Verdict, with_caveat, with_hint, with_replaced_spikes
 from .fit import model_drive, torques_through
 from .pooled import joined_validation
@@ -263,9 +268,12 @@ def _predicted(
     pieces = [unwrapped(p, turns)[0] for p in split_at_gaps(held, model.info.log.max_gap_s)]
     v, said = _pieces_validation(fitted, pieces)
     block += said
-    noise = _recorded_noise(model)
-    noise = _noise(v) if noise is None else noise
-    noise = np.maximum(noise, quantization_step(v.log.tau) / np.sqrt(12.0))  # at least rounding
+    recorded = _recorded_noise(model)  # at least the held-out torques' rounding
+    noise = (
+        quantized_noise_std(v.log.tau, v.log.t)
+        if recorded is None
+        else np.maximum(recorded, rounding_std(v.log.tau))
+    )
     names = tuple(model.robot.joint_names)
     read = (held if model.holdout.scheme == "file" else log,)  # the motion of a whole log
     given = None if model.info.log.cutoff_source == "motion" else model.info.log.cutoff_hz
@@ -343,12 +351,3 @@ def _pieces_validation(model: IdentifiedModel, pieces: list[TorqueLog]) -> tuple
     if len(parts) < len(pieces):
         said += f", {len(pieces) - len(parts)} too short to filter left out"
     return joined_validation(parts), said + (")" if said else "")
-
-
-def _noise(v: Validation) -> NDArray[np.float64]:
-    """Per-joint sensor noise [N m] of the unfiltered torques, robustly
-    (:func:`~dynid.identification.sanity.velocity_noise_std`, the same estimate for any
-    signal: the median absolute deviation of second and third differences). The torque
-    above the cut-off is no measure of it: it holds the steps of Coulomb friction at every
-    reversal (on a UR5 with 3 N m of Coulomb friction it read 3-10 times the noise)."""
-    return np.asarray(velocity_noise_std(v.log.tau, v.log.t), dtype=np.float64)

@@ -51,6 +51,7 @@ __all__ = [
     "noise_floor",
     "quantization_step",
     "quantized_noise_std",
+    "rounding_std",
     "state_noise",
 ]
 
@@ -107,8 +108,13 @@ def quantized_noise_std(x: ArrayLike, t: ArrayLike | None = None) -> NDArray[np.
     that spans many steps.
     """
     a = _checks.as_array("x", x)
-    est = velocity_noise_std(a, t)
-    return np.maximum(est, quantization_step(a) / np.sqrt(12.0))
+    return np.maximum(velocity_noise_std(a, t), rounding_std(a))
+
+
+def rounding_std(x: ArrayLike) -> NDArray[np.float64]:
+    """The RMS error ``step / sqrt(12)`` (n,) of rounding each column of ``x`` (N, n) to its
+    quantization step (:func:`quantization_step`; 0 for a column that is not quantized)."""
+    return quantization_step(x) / np.sqrt(12.0)
 
 
 def derived_noise_gains(
