@@ -43,3 +43,20 @@ def test_the_robots_own_friction_at_the_motors_is_said(tmp_path, caplog, capsys,
         assert 'friction_at = "joint" in the drive file' in said[0].getMessage()
     else:
         assert not said
+
+
+def test_observe_says_the_robots_own_friction_acts_at_the_motors(tmp_path, caplog):
+    """observe --params through a geared drive without friction_at says, as validate and
+    simulate do, that the robot's own friction is read at the motors (it did not: a URDF's
+    joint friction read there gave thresholds of another model without a word)."""
+    drive = tmp_path / "drive.toml"
+    drive.write_text(DRIVE)
+    log = tmp_path / "log.csv"
+    sim = ["simulate", "--drive", str(drive), "--duration", "2", "--rate", "200"]
+    assert main([*sim, "--trajectory", "fourier", "--out", str(log), "-q"]) == 0
+    caplog.clear()
+    argv = ["observe", "--params", "panda", "--drive", str(drive), "--data", str(log)]
+    with caplog.at_level(logging.INFO):
+        assert main([*argv, "--calibrate", "--no-figures", "-q", "--out", str(tmp_path / "o")]) == 0
+    said = [r for r in caplog.records if "acts at the motors" in r.getMessage()]
+    assert [r.levelno for r in said] == [NOTE], said

@@ -51,6 +51,7 @@ import contextlib
 import copy
 import dataclasses
 import hashlib
+import logging
 import warnings
 from collections.abc import Callable, Iterator, Mapping
 from dataclasses import dataclass
@@ -62,7 +63,7 @@ from numpy.typing import NDArray
 from ..exceptions import DataError, DynidWarning, OptionError, ShapeError
 from ..exceptions import in_file as about_file
 from ..friction.fit import same_drive
-from ..friction.model import FrictionModel, FrictionSum, placed_friction
+from ..friction.model import FrictionModel, FrictionSum, own_at_motors_note, placed_friction
 from ..identification.sanity import SPIKES_BEFORE_OBSERVER
 from ..io.drive_file import drive_of_robot_file, load_drive
 from ..io.feasible import load_feasible_drive, load_feasible_linear_friction
@@ -79,6 +80,7 @@ from ..observer.residual import DEFAULT_GAIN, ObserverOptions
 from ..observer.results import LogObservation, ObserveResult
 from ..observer.sign import TorqueSign, opposite_finding, unexplained_finding
 from ..observer.thresholds import ModelFingerprint
+from ..progress import NOTE
 from .data_files import (
     ColumnSpec,
     column_map,
@@ -111,6 +113,8 @@ __all__ = [
     "observe_files",
     "observer_drive",
 ]
+
+_log = logging.getLogger(__name__)
 
 
 #: Logs sampled at or above this rate [Hz] have their one-sample torque spikes replaced
@@ -285,6 +289,8 @@ def load_observer_model(
                 file=Path(friction).name,
             )
         fr = placed_friction(loaded, own)
+    if fr in ("model", "robot") and (said := own_at_motors_note(robot, own)) is not None:
+        _log.log(NOTE, said)
     return from_robot(robot, friction="robot" if fr == "model" else fr, drive=own), None
 
 
