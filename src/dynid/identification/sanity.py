@@ -5,10 +5,14 @@ what looks wrong, the numbers, and the remedy as the user types it; identificati
 with them before fitting (:func:`log_findings`). None of them changes the data.
 
 * **Sign**: the measured torques against the model's gravity torques ``g(q)`` at the logged
-  configurations (with the robot's own link parameters, when it has any): a correlation
-  below ``-0.5`` on a joint that gravity loads means the torque sign is opposite to the
-  model's, refused by ``identify``, ``validate`` and ``observe``: on every loaded joint,
-  ``--units tau=-1``; on some, naming them and their torque columns to flip.
+  configurations and against its whole rigid-body torques ``M ddq + c + g`` along the
+  logged motion (with the robot's own link parameters, when it has any): a correlation
+  below ``-0.5`` with both on a joint that gravity loads means the torque sign is opposite
+  to the model's, refused by ``identify``, ``validate`` and ``observe``: on every loaded
+  joint, ``--units tau=-1``; on some, naming them and their torque columns to flip. Each
+  comparison alone can be fooled: on 2 s of fast motion a Panda's elbow torques of the
+  right sign correlated -0.70 with its gravity torques (+0.99 with the whole torques),
+  and a description's poor inertias could turn the whole torques.
 * **Scale**: the least-squares factor ``a`` in ``tau ~ a g(q)`` over the gravity-loaded
   joints; ``a`` near 1e3 or 1e-3 is a unit off by a power of ten (mN m against N m:
   :func:`torque_unit_finding`, refused by the commands unless ``--units`` names the
@@ -52,6 +56,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from .. import _checks, signals
+from ..dynamics.rnea import rnea
 from ..dynamics.terms import gravity_torques
 from ..exceptions import ShapeError
 from ..model.drive import Drive
@@ -60,6 +65,8 @@ from .log import TorqueLog
 
 __all__ = [
     "MIN_MOTION",
+    "MOTION_HALF_SPAN_S",
+    "MOTION_MIN_SAMPLES",
     "anticorrelated",
     "MOVING_FRACTION",
     "NOISE_BAND_STD",
@@ -106,6 +113,12 @@ GRAVITY_RANGE_SHARE = 0.1
 #: A joint whose torques correlate below this with its gravity torques has the opposite
 #: sign (gravity explains a quarter or more of their variance, with the other sign).
 OPPOSITE_CORRELATION = -0.5
+#: Half the span [s] of the central difference of the logged velocities that gives the
+#: sign check its accelerations (:func:`opposite_sign`): a 20 Hz smoothing, whose bias
+#: is 2 % of a 2 Hz motion's accelerations and which divides velocity noise by 35 at 1 kHz.
+MOTION_HALF_SPAN_S = 0.025
+#: Fewest samples with known accelerations for the sign check to use the whole torques.
+MOTION_MIN_SAMPLES = 20
 #: A torque scale (:func:`torque_unit_finding`) within this factor of ``1e3`` or ``1e-3``
 #: reads as torques in mN m or kN m read as N m (a URDF whose masses are off by tens of
 #: percent gives a factor near 1, currents one near the inverse torque constant).
@@ -343,11 +356,10 @@ def _against_gravity(robot: Robot, log: TorqueLog) -> _GravitySaid:
     frozen = ~moving_joints(log.dq)
     if not np.any(robot.phi) or degrees or np.all(frozen):
         return _GravitySaid(degrees, frozen)
-    step = max(1, log.n_samples // _MAX_SAMPLES)
-    q, tau = log.q[::step], log.tau[::step]
-    if (opposite := _opposite(robot, q, tau, robot.joint_names)) is not None:
+    if (opposite := opposite_sign(robot, log)) is not None:
         return _GravitySaid(degrees, frozen, opposite)
-    return _GravitySaid(degrees, frozen, None, _torque_scale(robot, q, tau))
+    step = max(1, log.n_samples // _MAX_SAMPLES)
+    return _GravitySaid(degrees, frozen, None, _torque_scale(robot, log.q[::step], log.tau[::step]))
 
 
 def _correlations(reference: NDArray[np.float64], tau: NDArray[np.float64]) -> NDArray[np.float64]:
@@ -413,32 +425,80 @@ def gravity_loaded(robot: Robot, q: ArrayLike) -> NDArray[np.bool_]:
 
 def opposite_sign(robot: Robot, log: TorqueLog) -> str | None:
     """The finding that a joint-side log's torques have the opposite sign to ``robot``'s
-    (anti-correlated with its gravity torques: :func:`anticorrelated`), or None; None
-    too for a robot without inertial parameters to compare with.
+    (anti-correlated with its gravity torques and with its whole rigid-body torques along
+    the logged motion, module docstring), or None; None too for a robot without inertial
+    parameters to compare with.
 
     ``identify`` refuses such a log: a fit of the negated torques returns negated
     masses, and friction that pushes the arm."""
     if not np.any(robot.phi):
         return None
     step = max(1, log.n_samples // _MAX_SAMPLES)
-    return _opposite(robot, log.q[::step], log.tau[::step], robot.joint_names)
-
-
-def _opposite(
-    robot: Robot, q: NDArray[np.float64], tau: NDArray[np.float64], names: tuple[str, ...]
-) -> str | None:
-    """The sign finding: every joint gravity loads anti-correlated (``--units tau=-1``), or
-    only some, each below :data:`OPPOSITE_CORRELATION` (named, with their torque columns to
-    flip: ``--units`` scales every joint alike)."""
-    centred = _gravity_spread(robot, q, tau)
+    at = np.arange(0, log.n_samples, step)
+    centred = _gravity_spread(robot, log.q[at], log.tau[at])
     if centred is None:
         return None
     gc, tc, loaded = centred
-    corr = _correlations(gc, tc)
+    corr = overall = _correlations(gc, tc)
+    whole = _motion_torques(robot, log, at)
+    if whole is not None:  # the weaker of the two: each can be fooled alone
+        model, ok = whole
+        overall = _correlations(_centred(model[ok]), _centred(log.tau[at][ok]))
+        corr = np.maximum(corr, overall)
+    return _opposite(corr, loaded, robot.joint_names, every=bool(np.all(overall[loaded] < 0)))
+
+
+def _centred(x: NDArray[np.float64]) -> NDArray[np.float64]:
+    out: NDArray[np.float64] = x - x.mean(axis=0)
+    return out
+
+
+def _motion_torques(
+    robot: Robot, log: TorqueLog, at: NDArray[np.intp]
+) -> tuple[NDArray[np.float64], NDArray[np.bool_]] | None:
+    """The robot's rigid-body torques ``M ddq + c + g`` (no friction) at the samples
+    ``at`` of ``log``, and where they are known: with its logged accelerations, else the
+    central difference of its velocities over +-:data:`MOTION_HALF_SPAN_S` (at least one
+    and a half sample steps), known where that span stays inside the log and crosses no
+    gap (a step over three median steps). None when fewer than
+    :data:`MOTION_MIN_SAMPLES` samples are known."""
+    t, dq = log.t, log.dq
+    ts = t[at]
+    if log.ddq is not None:
+        ddq, ok = log.ddq[at], np.ones(at.size, dtype=bool)
+    else:
+        dt = np.diff(t)
+        h = max(MOTION_HALF_SPAN_S, 1.5 * float(np.median(dt)))
+        gaps = np.concatenate([[0], np.cumsum(dt > 3.0 * float(np.median(dt)))])
+        lo, hi = np.searchsorted(t, ts - h), np.searchsorted(t, ts + h)
+        ok = (ts - h >= t[0]) & (ts + h <= t[-1])
+        ok &= gaps[np.minimum(hi, t.size - 1)] == gaps[np.maximum(lo - 1, 0)]
+        ddq = np.column_stack(
+            [
+                (np.interp(ts + h, t, dq[:, j]) - np.interp(ts - h, t, dq[:, j])) / (2 * h)
+                for j in range(log.n)
+            ]
+        )
+    ok &= np.all(np.isfinite(ddq) & np.isfinite(log.q[at]) & np.isfinite(dq[at]), axis=1)
+    if np.count_nonzero(ok) < MOTION_MIN_SAMPLES:
+        return None
+    model = np.zeros_like(ddq)
+    model[ok] = rnea(robot, log.q[at][ok], dq[at][ok], ddq[ok])
+    return model, ok
+
+
+def _opposite(
+    corr: NDArray[np.float64], loaded: NDArray[np.bool_], names: tuple[str, ...], *, every: bool
+) -> str | None:
+    """The sign finding of the correlations ``corr`` (n,) of the joints ``loaded``: when
+    ``every`` one is anti-correlated (by the whole torques where they are known: gravity
+    alone can hold one of them positive), ``--units tau=-1``; else the ones below
+    :data:`OPPOSITE_CORRELATION` (named, with their torque columns to flip: ``--units``
+    scales every joint alike)."""
     strong = np.flatnonzero(loaded & (corr < OPPOSITE_CORRELATION))
     if strong.size == 0:
         return None
-    if np.all(corr[loaded] < 0):
+    if every:
         j = int(strong[np.argmin(corr[strong])])
         return (
             f"the measured torques are anti-correlated with the model's gravity torques "
