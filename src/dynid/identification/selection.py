@@ -89,7 +89,7 @@ from .log import TorqueLog
 from .metrics import noise_floor_percent
 from .model import IdentifiedModel
 from .recordings import Recordings, prepare_recordings
-from .sanity import gravity_loaded
+from .sanity import gravity_loaded, sign_confirmed
 from .structure import (
     ERROR_FLOOR_PERCENT,
     Structure,
@@ -847,12 +847,15 @@ def _fitted_structure(
     Refused (:class:`~dynid.exceptions.DataError`), as a flipped joint gravity loads is
     before any fit: friction the held-out data need to put energy in at every speed
     (:func:`reversed_friction`) on a joint whose sign the check against gravity does not
-    judge (:func:`~.sanity.gravity_loaded`), a torque of the opposite sign there. On a
-    joint it judges the sign is right (a controller's compensation, ``-0.05 dq2``), and
-    that friction is left out instead."""
+    judge (:func:`~.sanity.gravity_loaded`) nor the whole rigid-body torques confirm
+    (:func:`~.sanity.sign_confirmed`), a torque of the opposite sign there. On a joint
+    they judge the sign is right (a controller's compensation, ``-0.05 dq2``; a short
+    log's loose viscous coefficient), and that friction is left out instead."""
     if selection is not None and (pushing := reversed_friction(selection)):
-        loaded = gravity_loaded(robot, np.concatenate([p.log.q for p in data.pieces]))
-        unseen = [v for v in pushing if not loaded[v.joint]]
+        logs = [p.log for p in data.pieces]
+        judged = gravity_loaded(robot, np.concatenate([g.q for g in logs]))
+        judged |= sign_confirmed(robot, logs)
+        unseen = [v for v in pushing if not judged[v.joint]]
         if found := reversed_sign_finding(unseen, robot.joint_names, selection.chosen):
             raise DataError(found)
     chosen = Structure() if selection is None else selection.chosen
