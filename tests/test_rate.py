@@ -24,6 +24,26 @@ from dynid.simulation.trajectories import random_fourier
 pytestmark = pytest.mark.filterwarnings("ignore::dynid.DynidWarning")
 
 
+def test_a_joint_nearly_a_trend_under_noise_does_not_read_as_fast_motion():
+    """Regression: a joint whose motion is nearly a straight line over a short log keeps
+    little power once the trend is removed, and its position noise (1e-4 rad) held more
+    than 0.1 % of it: 1.5 s of a Panda's motion read 181 Hz and the cut-off went to
+    fs / 4 (250 Hz), with accelerations as noisy as that. The noise's power is taken
+    out: the sinusoids' 1.33 Hz is read, as without noise."""
+    fs = 1000.0
+    t = np.arange(0, 1.5, 1 / fs)
+    rng = np.random.default_rng(3)
+    q = np.stack(
+        [0.3 * np.sin(2 * np.pi * 1.33 * t), 0.22 * t + 0.002 * np.sin(2 * np.pi * 1.33 * t)],
+        axis=1,
+    )
+    exact = motion_frequency(q, fs)
+    assert exact == pytest.approx(1.33, abs=0.7)  # the bins of 1.5 s are 0.67 Hz apart
+    noisy = q + rng.normal(0.0, 1e-4, q.shape)
+    assert motion_frequency(noisy, fs) == exact
+    assert cutoff_from_motion(noisy, np.gradient(q, t, axis=0), fs) == pytest.approx(10 * exact)
+
+
 def test_motion_frequency_of_sinusoids_and_the_cutoff_it_gives():
     fs = 1000.0
     t = np.arange(0, 20.0, 1 / fs)
