@@ -199,8 +199,14 @@ def test_friction_that_pushes_at_every_speed_is_told_from_friction_that_pushes_a
     said = reversed_sign_finding(found, ("a", "b", "c", "d"))
     assert said is not None and said.startswith("the friction identified on a, d puts energy")
     assert "(fv1 = -0.2, fc1 = -0.1; fc4 = -0.3)" in said
-    assert "their torque columns in the file (tau1, tau4 in dynid's column names" in said
+    assert "hint: --units tau1=-1,tau4=-1 reads them flipped" in said
+    assert "coupling" not in said
     assert reversed_sign_finding(found[1:3], ("a", "b", "c", "d")) is None
+    # a joint the drive couples to another: its coupling's sign is named too (a coupling
+    # of the wrong sign left a wrist's fv6 = -0.247, and the hint to flip tau6 came back
+    # once followed)
+    linked = reversed_sign_finding(found, ("a", "b", "c", "d"), coupled=frozenset({3}))
+    assert linked is not None and "or the drive's coupling of d has the wrong sign" in linked
 
 
 def _flipped_logs(robot, joint):
@@ -262,7 +268,7 @@ def test_identify_refuses_a_flipped_joint_gravity_does_not_load(flipped_wrist):
     said = str(e.value)
     assert said.startswith(f"the friction identified on {name} puts energy into the arm")
     assert f"the torque sign of {name} is probably opposite" in said
-    assert "hint: flip the sign of its torque column in the file (tau7 " in said
+    assert "hint: --units tau7=-1 reads it flipped" in said
     # the way on for a sign that is right: the structure chosen without that friction
     terms = said.split("--terms ")[1].split(" ")[0]
     assert "fc7" in Structure.parse(terms).drop

@@ -368,3 +368,32 @@ def test_currents_in_ma_are_read_through_a_current_drive_and_said_once(tmp_path,
         column_map(None, "tau=mA")
     with pytest.raises(OptionError, match="the drive's effort is 'torque'"):
         column_map(None, "tau=A", drive=torque)
+
+
+def test_single_joints_are_flipped_as_read_after_their_quantitys_unit(tmp_path):
+    """A controller whose torque convention differs on joints 2 and 3 only: ``--units
+    tau=mNm,tau2=-1,tau3=-1`` reads the file's columns (written here) with those joints
+    negated and the rest as they are, said as one note; a TOML map's [units] does the same
+    (with a CSV and an NPZ file); a joint beyond the file's, or a scale other than -1 or 1,
+    is refused in one line (a joint's scale is a drive's torque constant)."""
+    log = _log(5)
+    path = tmp_path / "other.csv"
+    _write_renamed(path, log)
+    columns = "t=time_ms,q=position_{i0},dq=velocity_{i0},tau=effort_{i0}"
+    sign = np.array([1.0, -1.0, -1.0])
+    got = load_mapped_torque_log(
+        path, parse_column_map(columns, "t=ms,q=deg,dq=deg/s,tau=mNm,tau2=-1,tau3=-1")
+    )
+    np.testing.assert_allclose(got.log.tau, log.tau * sign, rtol=1e-14, atol=1e-15)
+    np.testing.assert_allclose(got.log.q, log.q, rtol=1e-14, atol=1e-15)
+    assert got.conversions == ("tau2, tau3 sign flipped (--units tau2=-1,tau3=-1)",)
+    np.savez(tmp_path / "log.npz", t=log.t, q=log.q, dq=log.dq, tau=log.tau)
+    (tmp_path / "map.toml").write_text(
+        '[columns]\nq = "q"\ndq = "dq"\ntau = "tau"\n[units]\ntau2 = -1\ntau3 = -1\ntau1 = 1\n'
+    )
+    npz = load_mapped_torque_log(tmp_path / "log.npz", load_column_map(tmp_path / "map.toml"))
+    np.testing.assert_array_equal(npz.log.tau, log.tau * sign)
+    with pytest.raises(DataError, match=r"--units tau4=-1 names joint 4; the file has 3"):
+        load_mapped_torque_log(path, parse_column_map(columns, "t=ms,tau4=-1"))
+    with pytest.raises(DataError, match=r"tau2=2: a single joint's entry flips its sign"):
+        parse_column_map(None, "tau2=2")

@@ -48,7 +48,7 @@ def test_a_residual_of_twice_the_torque_names_the_joint_a_model_without_torques_
     assert one.opposite().tolist() == [False, True]
     said = opposite_finding(one, names)
     assert said is not None and said.startswith("the measured torques of b are")
-    assert "flip the sign of their torque columns" in said
+    assert "hint: --units tau2=-1 reads it flipped" in said
     every = TorqueSign(2)
     every.add(tau, lag(-2.0 * tau))
     assert "hint: --units tau=-1" in (opposite_finding(every, names) or "")

@@ -121,7 +121,8 @@ def test_observe_calibrate_refuses_a_sign_flipped_on_some_joints(
     # the gravity check names the joints gravity loads, before any residual is read
     named = {panda.joint_names[j] for j in flipped if loaded[j]}
     assert set(head.split(", ")) == (named or {panda.joint_names[j] for j in flipped})
-    assert "hint: flip the sign of their torque columns" in err[0]
+    flags = ",".join(f"tau{panda.joint_names.index(x) + 1}=-1" for x in sorted(named))
+    assert not named or f"hint: --units {flags} reads" in err[0]
     assert not (tmp_path / "c" / "thresholds.json").exists()
     detect = ["observe", "--params", "panda", "--no-figures", "--data", str(tmp_path / "some.csv")]
     th = ["--thresholds", str(tmp_path / "f" / "thresholds.json"), "--out", str(tmp_path / "d")]
@@ -136,18 +137,20 @@ def test_observe_calibrate_refuses_a_sign_flipped_on_some_joints(
 
 
 def test_a_sign_flipped_on_some_joints_names_them(panda, log):
-    """Joints 1-3 negated (as in the trial): the finding names the joints gravity loads
-    (computed here) among them, tells to flip their columns, and does not say --units
-    tau=-1 would fix it; all negated: --units tau=-1."""
+    """Joints 1-3 negated (as in the trial): the finding names exactly those three (joint
+    1, which gravity does not load (computed here), by the whole rigid-body torques: it
+    went unnamed), gives the --units entries that flip them alone, and does not say
+    --units tau=-1 would fix it; all negated: --units tau=-1."""
     flipped = [0, 1, 2]
     g = gravity_torques(panda, log.q)
     loaded = np.std(g, axis=0) > 0.05 * np.std(g, axis=0).max()
+    assert not loaded[0]
     said = opposite_sign(panda, _flipped(log, flipped))
     assert said is not None and "some joints only" in said
     head = said.split("is probably opposite")[0].split("the torque sign of ")[1]
-    assert set(head.strip().split(", ")) == {panda.joint_names[j] for j in flipped if loaded[j]}
-    assert "hint: flip the sign of their torque columns" in said
-    assert not loaded[0] and f"the sign of {panda.joint_names[0]}" in said
+    assert set(head.strip().split(", ")) == {panda.joint_names[j] for j in flipped}
+    assert "hint: --units tau1=-1,tau2=-1,tau3=-1 reads them flipped" in said
+    assert "--units tau=-1" not in said
     every = opposite_sign(panda, _flipped(log, list(range(7))))
     assert every is not None and "hint: --units tau=-1" in every
 
@@ -219,7 +222,7 @@ def test_identify_refuses_one_joint_of_the_opposite_sign(panda, log, j, tmp_path
     assert len(err) == 1 and "one.csv" in err[0], err
     head = err[0].split(" are anti-correlated")[0].split("the measured torques of ")[1]
     assert head == panda.joint_names[j], err[0]
-    assert f"flip the sign of their torque columns in the file (tau{j + 1} " in err[0]
+    assert f"hint: --units tau{j + 1}=-1 reads it flipped" in err[0]
     assert not (tmp_path / "i" / "identification.json").exists()
 
 

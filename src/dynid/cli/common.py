@@ -511,5 +511,6 @@ def add_column_options(p: argparse.ArgumentParser) -> None:
         default=None,
         metavar="MAP",
         help="units of --data: 'q=deg,tau=mNm,t=ms' (converted to SI; tau=mA or A: motor "
-        "currents, with a --drive of effort = current)",
+        "currents, with a --drive of effort = current; tau=-1 flips every joint's sign, "
+        "tau2=-1 joint 2's alone)",
     )

@@ -170,8 +170,15 @@ def friction_violations(
     return tuple(out)
 
 
+def _named(v: Violation, names: Sequence[str]) -> str:
+    return names[v.joint] if v.place == "joint" else f"motor {v.joint + 1}"
+
+
 def reversed_sign_finding(
-    violations: Sequence[Violation], names: Sequence[str], instead: Structure | None = None
+    violations: Sequence[Violation],
+    names: Sequence[str],
+    instead: Structure | None = None,
+    coupled: frozenset[int] = frozenset(),
 ) -> str | None:
     """The finding that the torques of some joints (motors) have the opposite sign to the
     model's, read from friction that puts energy in at every speed
@@ -187,22 +194,31 @@ def reversed_sign_finding(
     instead : Structure, optional
         The structure without that friction, for the user whose sign is right (a
         controller's compensation) to give with ``--terms``.
+    coupled : frozenset of int
+        The joints (motors) a drive couples to another: there the coupling's sign is
+        named too (a coupling of the wrong sign left ``fv6 = -0.247`` on a wrist, and the
+        hint to flip ``tau6`` came back after it was followed).
     """
     flipped = [v for v in violations if v.everywhere]
     if not flipped:
         return None
-    which = ", ".join(
-        names[v.joint] if v.place == "joint" else f"motor {v.joint + 1}" for v in flipped
-    )
-    its = "its torque column" if len(flipped) == 1 else "their torque columns"
+    which = ", ".join(_named(v, names) for v in flipped)
+    its = "it" if len(flipped) == 1 else "them"
+    linked = [v for v in flipped if v.joint in coupled]
     return (
         f"the friction identified on {which} puts energy into the arm at every velocity up "
         f"to the limit ({'; '.join(v.coefficients for v in flipped)}): the torque sign of "
         f"{which} is probably opposite to the model's (the check of the torques against "
-        f"gravity does not tell it on a joint that gravity barely loads); hint: flip the "
-        f"sign of {its} in the file ("
-        + ", ".join(f"tau{v.joint + 1}" for v in flipped)
-        + " in dynid's column names; --units tau=-1 flips every joint)"
+        f"the model's does not tell it on a joint whose torques gravity and the links "
+        f"barely make); hint: --units "
+        + ",".join(f"tau{v.joint + 1}=-1" for v in flipped)
+        + f" reads {its} flipped (beside the torques' unit, if one is given)"
+        + (
+            f"; or the drive's coupling of {', '.join(_named(v, names) for v in linked)} has "
+            "the wrong sign (a flipped column there makes the coupled one push instead)"
+            if linked
+            else ""
+        )
         + (
             ""
             if instead is None

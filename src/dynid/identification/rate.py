@@ -66,7 +66,7 @@ MIN_KEPT_SHARE = 0.1
 BRIDGE_GROWTH = 2.0
 
 
-def _white_noise_power(p: NDArray[np.float64], f: NDArray[np.float64], fs: float) -> float:
+def _white_noise_power(p: NDArray[np.float64], f: NDArray[np.floating], fs: float) -> float:
     """The power per bin of the positions' white noise in the spectrum ``p`` at the
     frequencies ``f``: the mean power above ``fs / 4`` (where no cut-off is chosen, far
     above any arm's motion), read from its median (``ln 2`` of the mean, for the

@@ -448,13 +448,59 @@ def opposite_sign(robot: Robot, log: TorqueLog) -> str | None:
     if centred is None:
         return None
     gc, tc, loaded = centred
-    corr = overall = _correlations(gc, tc)
-    whole = _motion_torques(robot, log, at)
-    if whole is not None:  # the weaker of the two: each can be fooled alone
+    corr = _correlations(gc, tc)
+    right = flipped = np.zeros(robot.n, dtype=bool)
+    every = corr
+    if (whole := _motion_torques(robot, log, at)) is not None:  # each can be fooled alone
         model, ok = whole
-        overall = _correlations(_centred(model[ok]), _centred(log.tau[at][ok]))
-        corr = np.maximum(corr, overall)
-    return _opposite(corr, loaded, robot.joint_names, every=bool(np.all(overall[loaded] < 0)))
+        every, slope = _explained(model[ok], log.tau[at][ok])
+        corr = np.where(loaded, np.maximum(corr, every), every)
+        right, flipped = _confirmed(every, slope), _confirmed(-every, -slope) & ~loaded
+    strong = (loaded & (corr < OPPOSITE_CORRELATION)) | flipped
+    if not strong.any():
+        return None
+    if right.any() or not bool(np.all(every[loaded] < 0)):
+        return _opposite(corr, strong, loaded | right, robot.joint_names)
+    names = robot.joint_names
+    j = int(np.flatnonzero(strong)[np.argmin(corr[strong])])
+    said = (
+        f"the measured torques are anti-correlated with the model's torques (gravity and "
+        f"motion; correlation {corr[j]:+.2f} on {names[j]})"
+    )
+    unjudged = np.flatnonzero(~(loaded | strong))
+    if unjudged.size == 0:
+        return (
+            f"{said}: the torque sign is probably opposite to the model's; hint: --units "
+            "tau=-1 reads them flipped"
+        )
+    seen = np.flatnonzero(loaded | strong)
+    return (
+        f"{said} on every joint judged ({', '.join(f'{names[k]} {corr[k]:+.2f}' for k in seen)}"
+        "): the torque sign is probably opposite to the model's there; the sign of "
+        f"{', '.join(names[k] for k in unjudged)}, whose torques the model's do not explain "
+        "(gravity barely loads them, and friction or a drive's rotor inertia outweighs their "
+        "links'), is not told by this check; hint: --units tau=-1 if every joint's is "
+        f"opposite, --units {','.join(f'tau{k + 1}=-1' for k in seen)} if these only"
+    )
+
+
+def _explained(
+    model: NDArray[np.float64], tau: NDArray[np.float64]
+) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+    """The correlation (n,) of the measured torques ``tau`` (N, n) with the model's
+    ``model`` (N, n), both centred, and the least-squares factor of ``tau`` on ``model``."""
+    m, y = _centred(model), _centred(tau)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        slope = np.sum(m * y, axis=0) / np.sum(m**2, axis=0)
+    return _correlations(m, y), np.where(np.isfinite(slope), slope, 0.0)
+
+
+def _confirmed(corr: NDArray[np.float64], slope: NDArray[np.float64]) -> NDArray[np.bool_]:
+    """The joints whose measured torques the model's explain at about their own scale
+    (:data:`CONFIRMED_CORRELATION`, :data:`CONFIRMED_SLOPE`)."""
+    lo, hi = CONFIRMED_SLOPE
+    out: NDArray[np.bool_] = (corr >= CONFIRMED_CORRELATION) & (slope >= lo) & (slope <= hi)
+    return out
 
 
 def _centred(x: NDArray[np.float64]) -> NDArray[np.float64]:
@@ -516,52 +562,42 @@ def sign_confirmed(robot: Robot, logs: Sequence[TorqueLog]) -> NDArray[np.bool_]
             tau.append(g.tau[at][whole[1]])
     if not model:
         return np.zeros(robot.n, dtype=bool)
-    m, y = _centred(np.concatenate(model)), _centred(np.concatenate(tau))
-    with np.errstate(invalid="ignore", divide="ignore"):
-        slope = np.sum(m * y, axis=0) / np.sum(m**2, axis=0)
-    lo, hi = CONFIRMED_SLOPE
-    out: NDArray[np.bool_] = (_correlations(m, y) >= CONFIRMED_CORRELATION) & (
-        (slope >= lo) & (slope <= hi)
-    )
-    return out
+    return _confirmed(*_explained(np.concatenate(model), np.concatenate(tau)))
 
 
 def _opposite(
-    corr: NDArray[np.float64], loaded: NDArray[np.bool_], names: tuple[str, ...], *, every: bool
+    corr: NDArray[np.float64],
+    strong: NDArray[np.bool_],
+    judged: NDArray[np.bool_],
+    names: tuple[str, ...],
 ) -> str | None:
-    """The sign finding of the correlations ``corr`` (n,) of the joints ``loaded``: when
-    ``every`` one is anti-correlated (by the whole torques where they are known: gravity
-    alone can hold one of them positive), ``--units tau=-1``; else the ones below
-    :data:`OPPOSITE_CORRELATION` (named, with their torque columns to flip: ``--units``
-    scales every joint alike)."""
-    strong = np.flatnonzero(loaded & (corr < OPPOSITE_CORRELATION))
-    if strong.size == 0:
-        return None
-    if every:
-        j = int(strong[np.argmin(corr[strong])])
-        return (
-            f"the measured torques are anti-correlated with the model's gravity torques "
-            f"(correlation {corr[j]:+.2f} on {names[j]}): the torque sign is probably "
-            "opposite to the model's; hint: --units tau=-1 (or a drive file whose "
-            "transmission has the sign)"
-        )
-    rest = np.flatnonzero(loaded & (corr >= OPPOSITE_CORRELATION))
-    free = np.flatnonzero(~loaded)
-    which = ", ".join(names[k] for k in strong)
+    """The finding of the joints ``strong`` (n,) anti-correlated with the model's torques
+    (``corr``, n) while others the checks judge (``judged``) are not: named, with the
+    ``--units`` entries that flip their columns alone (``tau2=-1``), and the joints
+    neither check judges."""
+    rest = np.flatnonzero(judged & ~strong)
+    free = np.flatnonzero(~judged & ~strong)
+    bad = np.flatnonzero(strong)
+    which = ", ".join(names[k] for k in bad)
     return (
-        f"the measured torques of {which} are anti-correlated with the model's gravity "
-        f"torques (correlation {', '.join(f'{corr[k]:+.2f}' for k in strong)}) while those "
-        f"of {', '.join(f'{names[k]} ({corr[k]:+.2f})' for k in rest)} are not, on some "
-        f"joints only: the torque sign of {which} is probably opposite to the model's"
+        f"the measured torques of {which} are anti-correlated with the model's torques "
+        f"(gravity and motion; correlation {', '.join(f'{corr[k]:+.2f}' for k in bad)})"
         + (
-            f" (the sign of {', '.join(names[k] for k in free)}, which gravity does not "
-            "load, is not told by this check)"
+            f" while those of {', '.join(f'{names[k]} ({corr[k]:+.2f})' for k in rest)} are "
+            "not, on some joints only"
+            if rest.size
+            else ""
+        )
+        + f": the torque sign of {which} is probably opposite to the model's"
+        + (
+            f" (the sign of {', '.join(names[k] for k in free)}, whose torques the model's "
+            "do not explain, is not told by this check)"
             if free.size
             else ""
         )
-        + "; hint: flip the sign of their torque columns in the file ("
-        + ", ".join(f"tau{k + 1}" for k in strong)
-        + " in dynid's column names; --units tau=-1 flips every joint)"
+        + f"; hint: --units {','.join(f'tau{k + 1}=-1' for k in bad)} reads "
+        + ("it" if bad.size == 1 else "them")
+        + " flipped (beside the torques' unit, if one is given)"
     )
 
 

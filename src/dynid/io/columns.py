@@ -13,7 +13,10 @@ A :class:`ColumnMap` names, per quantity, the column template of a file and its 
   deg/s^2``; ``tau`` and ``g`` in ``Nm, N m, mNm, mN m``, ``tau`` also in ``A, mA`` (motor
   currents, read through a drive whose effort is current); ``M`` in ``kg m^2, g m^2``; or
   a number, the factor to SI. A unit given is the user's word, not a finding: the map
-  says it once (:meth:`ColumnMap.unit_note`), not each file.
+  says it once (:meth:`ColumnMap.unit_note`), not each file;
+* sign flips of single joints: ``tau2=-1`` (also ``q3``, ``dq3``, ``ddq3``; joints from 1)
+  flips that joint's column as it is read, after its quantity's unit (a controller whose
+  convention differs on some joints; ``tau=-1`` flips every joint).
 
 Written on the command line as ``--columns 'q=position_{i0},tau=effort_{i0}'`` and
 ``--units 'q=deg,tau=mNm'``, or as a TOML file with tables ``[columns]`` and ``[units]``.
@@ -124,17 +127,25 @@ class ColumnMap:
         Cutoff [Hz] of the low-pass before differentiating positions into velocities.
     names : mapping of str to str
         Quantity -> the unit as given (``"mA"``, ``"0.001"``), for messages.
+    flips : mapping of str to tuple of int
+        Quantity -> the joints (from 0) whose columns are read with the opposite sign
+        (``--units tau2=-1,tau3=-1``: ``{"tau": (1, 2)}``).
     """
 
     columns: Mapping[str, str] = field(default_factory=dict)
     factors: Mapping[str, float] = field(default_factory=dict)
     velocity_cutoff_hz: float = DEFAULT_CUTOFF_HZ
     names: Mapping[str, str] = field(default_factory=dict)
+    flips: Mapping[str, tuple[int, ...]] = field(default_factory=dict)
 
     def __post_init__(self) -> None:
         for key in list(self.columns) + list(self.factors):
             if key not in _DEFAULT:
                 raise DataError(f"unknown quantity {key!r}; expected one of {list(_DEFAULT)}")
+        for key in self.flips:
+            if key not in _FLIPPABLE:
+                raise DataError(f"a joint's sign flips one of {list(_FLIPPABLE)}; got {key!r}")
+        object.__setattr__(self, "flips", MappingProxyType(dict(self.flips)))
         object.__setattr__(self, "columns", MappingProxyType(dict(self.columns)))
         object.__setattr__(self, "factors", MappingProxyType(dict(self.factors)))
         object.__setattr__(self, "names", MappingProxyType(dict(self.names)))
@@ -143,12 +154,20 @@ class ColumnMap:
     def from_units(
         cls, columns: Mapping[str, str], units: Mapping[str, Any], **kw: Any
     ) -> ColumnMap:
-        """Map from templates and unit names (``{"q": "deg", "tau": "mNm"}``)."""
-        for key in units:
-            if key not in _DEFAULT:
+        """Map from templates and unit names (``{"q": "deg", "tau": "mNm"}``) and single
+        joints' sign flips (``{"tau2": -1}``)."""
+        flips: dict[str, set[int]] = {}
+        for key, u in units.items():
+            if (joint := _joint_key(key)) is not None:
+                if _sign_flip(key, u):
+                    flips.setdefault(joint[0], set()).add(joint[1])
+            elif key not in _DEFAULT:
                 raise DataError(f"unknown quantity {key!r}; expected one of {list(_DEFAULT)}")
-        factors = {k: _to_factor(k, u) for k, u in units.items()}
-        return cls(dict(columns), factors, names={k: str(u) for k, u in units.items()}, **kw)
+        given = {k: u for k, u in units.items() if _joint_key(k) is None}
+        factors = {k: _to_factor(k, u) for k, u in given.items()}
+        names = {k: str(u) for k, u in given.items()}
+        signs = {k: tuple(sorted(v)) for k, v in flips.items()}
+        return cls(dict(columns), factors, names=names, flips=signs, **kw)
 
     @property
     def tau_is_current(self) -> bool:
@@ -178,6 +197,37 @@ class ColumnMap:
     def mapped(self, quantity: str) -> bool:
         """Whether the quantity was given a template."""
         return quantity in self.columns
+
+
+#: The quantities whose single joints' columns ``--units`` can flip (``tau2=-1``).
+_FLIPPABLE = ("q", "dq", "ddq", "tau")
+
+
+def _joint_key(key: str) -> tuple[str, int] | None:
+    """``("tau", 1)`` for ``"tau2"`` (a flippable quantity and a joint from 1), else
+    None."""
+    m = re.fullmatch(r"(ddq|dq|q|tau)([1-9][0-9]*)", key.strip())
+    return None if m is None else (m.group(1), int(m.group(2)) - 1)
+
+
+def _sign_flip(key: str, value: Any) -> bool:
+    """Whether a single joint's entry flips its sign (``-1``) or keeps it (``1``).
+
+    Raises
+    ------
+    DataError
+        Another value: a joint's scale is not a unit (a drive's torque constants are).
+    """
+    try:
+        f = _checks.decimal(str(value).strip())
+    except ValueError:
+        f = math.nan
+    if f in (1.0, -1.0):
+        return f == -1.0
+    raise DataError(
+        f"{key}={value}: a single joint's entry flips its sign ({key}=-1); its unit is its "
+        "quantity's (a joint's scale: a drive's torque_constant or gear_ratio)"
+    )
 
 
 def _pairs(text: str, what: str) -> dict[str, str]:
@@ -377,7 +427,7 @@ def _vector(table: _Table, cmap: ColumnMap, quantity: str, n: int | None) -> NDA
         a = a[:, None] if a.ndim == 1 else a
         if n is not None and a.shape[1] != n:
             raise DataError(f"{tpl!r} has {a.shape[1]} joints; expected {n}", file=table.name)
-        return a * cmap.factor(quantity)
+        return _flipped(a * cmap.factor(quantity), cmap, quantity, table.name)
     if n is None:
         n = 0
         while _fill(tpl, n) in table.columns:
@@ -394,8 +444,32 @@ def _vector(table: _Table, cmap: ColumnMap, quantity: str, n: int | None) -> NDA
     # the columns of a group scaled as read are in SI (the first n of the group: names)
     f = 1.0 if quantity in table.scaled else cmap.factor(quantity)
     if group is not None and group[0] == names:  # read side by side: no copy when in SI
-        return group[1] if f == 1.0 else _checks.frozen(group[1] * f)
-    return np.stack([table.columns[c] for c in names], axis=1) * f
+        a = group[1] if f == 1.0 else _checks.frozen(group[1] * f)
+    else:
+        a = np.stack([table.columns[c] for c in names], axis=1) * f
+    return _flipped(a, cmap, quantity, table.name)
+
+
+def _flipped(a: NDArray, cmap: ColumnMap, quantity: str, name: str) -> NDArray:
+    """``a`` (N, n) with the joints ``cmap`` flips of ``quantity`` negated.
+
+    Raises
+    ------
+    DataError
+        A flip names a joint the file does not hold.
+    """
+    joints = cmap.flips.get(quantity, ())
+    if not joints:
+        return a
+    if max(joints) >= a.shape[1]:
+        raise DataError(
+            f"--units {quantity}{max(joints) + 1}=-1 names joint {max(joints) + 1}; the file "
+            f"has {a.shape[1]} joints of {quantity!r}",
+            file=name,
+        )
+    out = np.array(a, dtype=np.float64)
+    out[:, list(joints)] *= -1.0
+    return _checks.frozen(out)
 
 
 def _check_distinct(table: _Table, cmap: ColumnMap, quantities: tuple[str, ...], n: int) -> None:
@@ -492,7 +566,9 @@ def load_mapped_torque_log(
     dq = _vector(table, columns, "dq", n)
     ddq = _vector(table, columns, "ddq", n)
     _check_distinct(table, columns, ("t", "q", "dq", "tau", "ddq"), n)
-    said = conversion_notes(columns, [k for k in columns.factors if k in _DEFAULT])
+    said = conversion_notes(
+        columns, [k for k in _DEFAULT if k in {**columns.factors, **columns.flips}]
+    )
     try:
         if dq is not None:
             return MappedLog(
@@ -516,6 +592,10 @@ def conversion_notes(columns: ColumnMap, quantities: Sequence[str]) -> tuple[str
         if f < 0:
             scaled = "" if f == -1.0 else f" and scaled by {-f:.17g} to SI"
             out.append(f"{k} sign flipped{scaled} (--units {k}={f:.17g})")
+        if joints := columns.flips.get(k, ()):
+            which = ", ".join(f"{k}{j + 1}" for j in joints)
+            flags = ",".join(f"{k}{j + 1}=-1" for j in joints)
+            out.append(f"{which} sign flipped (--units {flags})")
     return tuple(out)
 
 

@@ -139,8 +139,8 @@ def _flagged(sign: TorqueSign, mask: NDArray[np.bool_], names: Sequence[str]) ->
 
 def opposite_finding(sign: TorqueSign, names: Sequence[str]) -> str | None:
     """The one-line finding of the joints of opposite sign (naming them, their
-    correlations and the remedy: ``--units tau=-1`` when every joint is, their torque
-    columns to flip otherwise), or None when there is none.
+    correlations and the remedy: ``--units tau=-1`` when every joint is, the entries that
+    flip their columns alone otherwise, ``--units tau2=-1``), or None when there is none.
 
     Raises
     ------
@@ -156,16 +156,17 @@ def opposite_finding(sign: TorqueSign, names: Sequence[str]) -> str | None:
         return (
             f"the measured torques of every joint are anti-correlated with the model's "
             f"torques (correlation {said}): the torque sign is probably opposite to the "
-            "model's, and the residual is about twice the torque; hint: --units tau=-1 (or "
-            "a drive file whose transmission has the sign)"
+            "model's, and the residual is about twice the torque; hint: --units tau=-1 reads "
+            "them flipped"
         )
     which = ", ".join(names[k] for k in bad)
     return (
         f"the measured torques of {which} are anti-correlated with the model's torques "
         f"(correlation {said}) while the other joints' agree: their torque sign is "
         "probably opposite to the model's (or the model is wrong there), and the residual "
-        "there is about twice the torque; hint: flip the sign of their torque columns in "
-        "the file (--units tau=-1 flips every joint)"
+        f"there is about twice the torque; hint: --units {','.join(f'tau{k + 1}=-1' for k in bad)} "
+        f"reads {'it' if len(bad) == 1 else 'them'} flipped (beside the torques' unit, if one "
+        "is given)"
     )
 
 

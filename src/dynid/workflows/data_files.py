@@ -125,6 +125,7 @@ def column_map(
                 cmap.columns,
                 {**cmap.factors, **extra.factors},
                 names={**cmap.names, **extra.names},
+                flips={**cmap.flips, **extra.flips},
                 **kw,
             )
     else:
