@@ -5,6 +5,7 @@ force of a wrench with a moment, and a contact simulated by ``dynid simulate --c
 
 from __future__ import annotations
 
+import dataclasses
 import json
 import re
 
@@ -243,3 +244,26 @@ def test_observe_wrench_needs_a_frame(tmp_path, capsys):
     assert main(argv) == 2
     (line,) = capsys.readouterr().err.strip().splitlines()
     assert "--wrench says what is estimated at --frame; give the frame" in line
+
+
+def test_observe_files_takes_the_estimate_as_an_option(observed, arm5_urdf):
+    """The Python API as the command: ObserveOptions(wrench="force") gives a result and a
+    kept wrench series that say FORCE, the series equal to residuals.csv's columns; a
+    wrench without a frame is an OptionError naming its field."""
+    from dynid.workflows.observe import ObserveOptions, observe_files
+
+    opts = ObserveOptions(
+        data=(observed / "hit.csv",),
+        params=str(arm5_urdf),
+        thresholds=observed / "cal" / "thresholds.json",
+        frame="flange",
+        wrench="force",
+    )
+    result = observe_files(opts)
+    (log,) = result.logs
+    assert result.wrench is FORCE and log.wrench is not None and log.wrench.kind is FORCE
+    table = np.loadtxt(observed / "force" / "residuals.csv", delimiter=",", skiprows=3)
+    np.testing.assert_allclose(log.wrench.wrench, table[:, 6:12], rtol=1e-12, atol=1e-12)
+    with pytest.raises(dynid.OptionError) as err:
+        observe_files(dataclasses.replace(opts, frame=None))
+    assert err.value.field == "wrench"
