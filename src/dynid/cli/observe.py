@@ -34,7 +34,10 @@ Two steps:
   and end [s], joints (1-based) and joint_names, peak [N m] per joint and level, contact
   or collision, and the log of every event), OUT/residuals.csv (t, r1..rn and, with
   --frame, the external wrench at that frame by damped least squares, the least-norm
-  one where fewer than 6 joints move the frame, NaN where the residual is) and
+  one where fewer than 6 joints move the frame, NaN where the residual is; --wrench force:
+  the force of a point contact at the frame's origin instead, the moment taken as zero,
+  which 3 joints or more determine whole, as on a 5-joint arm; the summary, the table's
+  units line and events.json say which) and
   OUT/residuals.png (residuals, thresholds, events, and the true tau_ext that `dynid
   simulate --contact` writes beside a log; the summary then gives the RMS of the residual
   against it per joint), and prints the largest |r| of each log and the events with the
@@ -55,7 +58,8 @@ Several logs (or a folder of them): residuals_<name>.csv and .png each, one even
 logs of one name in different folders are named by their folder. With --thresholds the
 calibration's options (--gain, --discretisation, --rule, --margin, --quantile,
 --collision-factor, --k-sigma, --no-uncertainty, --no-standstill-margin) are refused:
-the file fixes them; --frame, --merge and --min-duration apply to detection only.
+the file fixes them; --frame, --wrench, --merge and --min-duration apply to detection
+only.
 
 Examples:
   dynid observe --model id/identification.json --data free.csv --calibrate --out cal
@@ -71,6 +75,7 @@ from pathlib import Path
 from ..observer.events import DEFAULT_MERGE_S, DEFAULT_MIN_DURATION_S
 from ..observer.residual import DEFAULT_GAIN
 from ..observer.results import NO_FRICTION
+from ..observer.wrench import WRENCH_KINDS
 from ..workflows.observe import ObserveOptions, observe_files
 from .common import (
     add_column_options,
@@ -123,6 +128,15 @@ def register(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParser:
     )
     mode.add_argument("--thresholds", type=Path, help="thresholds.json of --calibrate")
     p.add_argument("--frame", help="also estimate the external wrench at this frame")
+    p.add_argument(
+        "--wrench",
+        choices=tuple(WRENCH_KINDS),
+        default="full",
+        help="what --frame estimates: full, the wrench (force and moment; the least-norm one "
+        "where fewer than 6 joints move the frame), or force, the force of a point contact "
+        "at the frame's origin (moment zero: 3 unknowns, which 3 joints or more determine; "
+        "a moment there reads as a wrong force) (default full)",
+    )
     p.add_argument("--gain", default=str(DEFAULT_GAIN), help="K_O [1/s], one or per joint")
     p.add_argument("--discretisation", choices=("exact", "euler"), default="exact")
     p.add_argument("--rule", choices=("trapezoid", "rectangle"), default="trapezoid")
@@ -176,6 +190,7 @@ def run(args: argparse.Namespace, console: Console) -> int:
         data=tuple(args.data), model=args.model, params=args.params, friction=args.friction,
         drive=args.drive,
         calibrate=args.calibrate, thresholds=args.thresholds, frame=args.frame,
+        wrench=args.wrench,
         gain=float(gain[0]) if gain.size == 1 else tuple(gain), discretisation=args.discretisation,
         rule=args.rule, margin=args.margin, quantile=args.quantile,
         collision_factor=args.collision_factor, k_sigma=args.k_sigma,

@@ -21,6 +21,7 @@ from ..identification.structure import MIN_WIDTH
 from ..io.observer_files import log_labels
 from ..observer.detection import undetected_at_rest
 from ..observer.results import LogObservation, ObserveResult, flagged_words
+from ..observer.wrench import estimate_words
 from ..pipeline.collision import CollisionStageResult
 from ..regressors.base import identifiability
 from .structure_table import selection_lines, text_width
@@ -640,6 +641,9 @@ def format_observation(result: ObserveResult, names: list[str], *, calibrating: 
             f"  {log}: {e.level:<9} {e.start:9.3f} s .. {e.end:9.3f} s  joints "
             f"{','.join(map(str, e.joints))}  peak {e.peak[top - 1]:+.2f} N m (joint {top})"
         )
+    if result.frame is not None:  # what the residual tables' fx..mz hold
+        words = estimate_words(result.model.robot, result.frame, result.wrench)
+        rows.append(f"estimated (fx..mz of the residual tables): {words}")
     return "\n".join(rows)
 
 

@@ -23,7 +23,10 @@ files, their sample counts, durations and the time their events cover (``duratio
 
 ``residuals.csv``: a dynid CSV table (comment lines, ``# rows: N``, a header) with ``t``
 [s], ``r1 .. rn`` [N m] and, with a frame, ``fx, fy, fz`` [N], ``mx, my, mz`` [N m] and
-``damped`` (1 near a singular configuration of the joints that move the frame).
+``damped`` (1 near a singular configuration of the joints that move the frame); the
+units line says what was estimated there: the wrench, or the force of a point contact
+(``--wrench force``: ``mx, my, mz`` written 0). ``events.json`` then says it too
+(``wrench``: the frame, the estimate and the components determined).
 """
 
 from __future__ import annotations
@@ -43,6 +46,7 @@ from ..observer.detection import ContactEvent, Thresholds, undetected_at_rest
 from ..observer.residual import ObserverOptions
 from ..observer.results import LogObservation, ObserveResult
 from ..observer.thresholds import ModelFingerprint
+from ..observer.wrench import FULL, WrenchKind, wrench_rank
 from .atomic import open_atomic
 from .json_files import save_json
 from .schema import Field, Format, Record, load_document, save_document
@@ -241,10 +245,12 @@ def save_residuals_csv(
     wrench: NDArray[np.float64] | None = None,
     damped: NDArray[np.bool_] | None = None,
     frame: str | None = None,
+    kind: WrenchKind = FULL,
 ) -> Path:
-    """Write ``residuals.csv``: ``t, r1..rn`` (and the wrench at ``frame``); returns the path."""
+    """Write ``residuals.csv``: ``t, r1..rn`` (and the wrench at ``frame``, or the force
+    alone: ``kind``); returns the path."""
     with residuals_csv(
-        path, t.shape[0], r.shape[1], frame=frame if wrench is not None else None
+        path, t.shape[0], r.shape[1], frame=frame if wrench is not None else None, kind=kind
     ) as put:
         put(t, r, wrench, damped)
     return Path(path)
@@ -252,20 +258,18 @@ def save_residuals_csv(
 
 @contextlib.contextmanager
 def residuals_csv(
-    path: str | Path, rows: int, n: int, *, frame: str | None = None
+    path: str | Path, rows: int, n: int, *, frame: str | None = None, kind: WrenchKind = FULL
 ) -> Iterator[Callable[..., None]]:
     """``residuals.csv`` written a block of rows at a time: yields ``put(t, r, wrench=None,
     damped=None)`` for consecutive blocks ``t`` (m,), ``r`` (m, n) and, with ``frame``,
-    the wrench (m, 6) and its flag (m,); the file (``rows`` in its header) appears when the
-    block ends normally (atomic), the bytes of :func:`save_residuals_csv` of the whole."""
+    the wrench (m, 6) and its flag (m,), its units line saying what was estimated
+    (``kind``); the file (``rows`` in its header) appears when the block ends normally
+    (atomic), the bytes of :func:`save_residuals_csv` of the whole."""
     names = ["t"] + [f"r{j + 1}" for j in range(n)]
     units = "t [s], r [N m]"
     if frame is not None:
         names += ["fx", "fy", "fz", "mx", "my", "mz", "damped"]
-        units += (
-            f"; wrench at {frame}: f [N], m [N m], base axes (least-norm where fewer than "
-            "6 joints move the frame); damped: 1 near a singular configuration of those joints"
-        )
+        units += f"; {_estimate_units(frame, kind)}"
     with open_atomic(Path(path), "w") as fh:
         fh.write(f"# dynid residuals; units: {units}\n# rows: {rows}\n")
         fh.write(",".join(names) + "\n")
@@ -292,6 +296,16 @@ def residuals_csv(
 _CSV_ROWS = 100_000
 
 
+def _estimate_units(frame: str, kind: WrenchKind) -> str:
+    """The units line's words on the wrench columns at ``frame``: what was estimated."""
+    moment = "m [N m]" if kind.rows == 6 else "m [N m] written 0"
+    return (
+        f"{kind.what} at {frame}'s origin (--wrench {kind.name}): f [N], {moment}, base "
+        f"axes (least-norm where fewer than {kind.rows} joints move the frame); damped: 1 "
+        "near a singular configuration of those joints"
+    )
+
+
 class ResidualTables:
     """The residual tables of ``dynid observe`` in the folder ``out``, each written a block
     at a time while the log is observed (:func:`dynid.workflows.observe.observe_files`'s
@@ -304,11 +318,17 @@ class ResidualTables:
 
     @contextlib.contextmanager
     def table(
-        self, paths: Sequence[str | Path], index: int, rows: int, n: int, frame: str | None
+        self,
+        paths: Sequence[str | Path],
+        index: int,
+        rows: int,
+        n: int,
+        frame: str | None,
+        kind: WrenchKind = FULL,
     ) -> Iterator[Callable[..., None]]:
         """The writer of log ``index`` of ``paths`` (:func:`residuals_csv`)."""
         path = self.out / f"{residual_names(paths)[index]}.csv"
-        with residuals_csv(path, rows, n, frame=frame) as put:
+        with residuals_csv(path, rows, n, frame=frame, kind=kind) as put:
             yield put
         self.written.append(path)
 
@@ -395,6 +415,7 @@ def save_observation(
                 wrench=None if w is None else w.wrench,
                 damped=None if w is None else w.damped,
                 frame=None if w is None else w.frame,
+                kind=FULL if w is None else w.kind,
             )  # fmt: skip
         )
     labels = log_labels([x.path for x in result.logs])
@@ -407,6 +428,7 @@ def save_observation(
         "duration_s": [x.duration() for x in result.logs],
         "flagged_s": [x.flagged_seconds() for x in result.logs],
         **_fingerprint(result.fingerprint),
+        **({} if result.frame is None else {"wrench": _estimate_info(result)}),
         **meta,
     }
     paths.insert(
@@ -414,3 +436,16 @@ def save_observation(
         save_events(out / "events.json", events, meta=info, logs=logs_of, joints=joints),
     )
     return paths
+
+
+def _estimate_info(result: ObserveResult) -> dict[str, Any]:
+    """``events.json``'s ``wrench``: what was estimated at the frame (``full`` or
+    ``force``), its components and those the joints moving the frame determine."""
+    assert result.frame is not None
+    robot, frame, kind = result.model.robot, result.frame, result.wrench
+    return {
+        "frame": frame,
+        "estimate": kind.name,
+        "components": kind.rows,
+        "determined": wrench_rank(robot, frame, kind),
+    }

@@ -18,7 +18,7 @@ from .detection import ContactEvent, Thresholds
 from .friction import banding_note
 from .model import ObserverModel
 from .thresholds import ModelFingerprint
-from .wrench import WrenchEstimate, underdetermined_note
+from .wrench import FULL, WrenchEstimate, WrenchKind, underdetermined_note
 
 __all__ = [
     "NO_FRICTION",
@@ -177,7 +177,9 @@ class ObserveResult:
     """What :func:`observe_files` computed: the model, the thresholds (calibrated or read)
     and every log's observation; ``fingerprint``, the files the model was read from, and
     ``friction_source``, the robot file whose own friction the model holds (a URDF's
-    ``<dynamics>``; None: a friction given or identified)."""
+    ``<dynamics>``; None: a friction given or identified); ``frame``, where the wrench was
+    estimated (None: nowhere), and ``wrench``, what was estimated there (the whole wrench
+    or the force of a point contact)."""
 
     model: ObserverModel
     thresholds: Thresholds
@@ -185,6 +187,7 @@ class ObserveResult:
     fingerprint: ModelFingerprint | None = None
     friction_source: str | None = None
     frame: str | None = None
+    wrench: WrenchKind = FULL
 
     def flagged(self) -> tuple[float, float]:
         """``(flagged, logged)`` [s]: the time every log's events cover and the logs'
@@ -205,7 +208,8 @@ class ObserveResult:
         whose Coulomb step is narrower than the logs' velocity noise is observed with the
         noise band (:func:`~dynid.observer.friction.banding_note`); a wrench at a frame that
         fewer than six joints move is the least-norm one
-        (:func:`~dynid.observer.wrench.underdetermined_note`)."""
+        (:func:`~dynid.observer.wrench.underdetermined_note`), a force alone at a frame
+        that fewer than three joints move too."""
         out: tuple[str, ...] = (NO_FRICTION,) if self.model.friction is None else ()
         if self.model.friction is not None:
             own = None
@@ -215,7 +219,8 @@ class ObserveResult:
             out += tuple(x for x in (own, banded) if x is not None)
         if (
             self.frame is not None
-            and (note := underdetermined_note(self.model.robot, self.frame)) is not None
+            and (note := underdetermined_note(self.model.robot, self.frame, self.wrench))
+            is not None
         ):
             out += (note,)
         return out

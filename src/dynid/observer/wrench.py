@@ -22,6 +22,14 @@ pose), and the estimate is the least-norm wrench that explains them (in the norm
 ``L^2 |f|^2 + |m|^2``), zero
 along the wrenches the joints cannot feel (``J^T a = 0``); that is no singularity and is
 not flagged (:func:`underdetermined_note`).
+
+A contact on a link is most often a point contact: a force at a known point, no moment.
+The estimate of ``kind="force"`` (:data:`WRENCH_KINDS`) takes that as its model: the
+moment at the frame's origin is zero and the force alone, three unknowns, is solved the
+same way on the linear rows ``J_v`` of the Jacobian (``D = E / L``, ``k = min(3, joints
+moving the frame)``), so that three to five joints determine it whole. A moment about
+the origin (a force elsewhere on the link, a twist) is outside that model: the force
+that best explains its torques is written, off the true one.
 """
 
 from __future__ import annotations
@@ -38,12 +46,73 @@ from ..kinematics.jacobian import jacobian
 from ..model.robot import Robot
 
 __all__ = [
+    "FORCE",
+    "FULL",
+    "WRENCH_KINDS",
     "WrenchEstimate",
+    "WrenchKind",
     "chain_length",
+    "estimate_words",
     "external_wrench",
     "underdetermined_note",
+    "wrench_kind",
     "wrench_rank",
 ]
+
+
+@dataclass(frozen=True, slots=True)
+class WrenchKind:
+    """What an estimate solves for at a frame's origin (module docstring).
+
+    Attributes
+    ----------
+    name : str
+        ``full`` or ``force`` (``dynid observe --wrench``).
+    rows : int
+        The Jacobian rows solved on, first to last: 6 (``v, w``: force and moment) or 3
+        (``v``: the force, the moment zero).
+    what : str
+        What is estimated, in words (summaries, file headers).
+    noun : str
+        Its name in a sentence (``wrench``, ``force``).
+    caveat : str
+        What the estimate cannot tell, in words ("" when nothing).
+    """
+
+    name: str
+    rows: int
+    what: str
+    noun: str
+    caveat: str = ""
+
+
+#: The whole wrench: force and moment at the frame's origin, 6 unknowns.
+FULL = WrenchKind("full", 6, "the wrench (force and moment)", "wrench")
+#: A point contact at the frame's origin: the force alone, the moment zero, 3 unknowns.
+FORCE = WrenchKind(
+    "force",
+    3,
+    "the force of a point contact (moment zero)",
+    "force",
+    "a moment there (a force elsewhere on the link) reads as a wrong force",
+)
+#: The estimates by name.
+WRENCH_KINDS = {k.name: k for k in (FULL, FORCE)}
+
+
+def wrench_kind(kind: str | WrenchKind) -> WrenchKind:
+    """The :class:`WrenchKind` of a name in :data:`WRENCH_KINDS` (or the kind itself).
+
+    Raises
+    ------
+    OptionError
+        An unknown name.
+    """
+    if isinstance(kind, WrenchKind):
+        return kind
+    if kind not in WRENCH_KINDS:
+        raise OptionError(f"must be one of {', '.join(WRENCH_KINDS)}; got {kind!r}", field="wrench")
+    return WRENCH_KINDS[kind]
 
 
 @dataclass(frozen=True, slots=True, eq=False)
@@ -54,15 +123,21 @@ class WrenchEstimate:
     ----------
     frame : str
     wrench : ndarray, shape (..., 6)
-        ``fx, fy, fz`` [N], ``mx, my, mz`` [N m], base axes, at the frame's origin.
+        ``fx, fy, fz`` [N], ``mx, my, mz`` [N m], base axes, at the frame's origin (the
+        moment 0 when ``kind`` is :data:`FORCE`).
     sigma_min : ndarray, shape (...)
-        Smallest of the ``determined`` singular values of the frame's Jacobian, its linear
-        rows divided by the chain's length (unitless; module docstring).
+        Smallest of the ``determined`` singular values of the frame's Jacobian (its
+        ``kind.rows`` first rows), its linear rows divided by the chain's length
+        (unitless; module docstring).
     damped : ndarray of bool, shape (...)
         Near a singular configuration (``sigma_min < epsilon``): the estimate is damped.
     determined : int
-        Wrench components the joint torques determine: the joints moving the frame, at
-        most 6; with fewer the wrench is the least-norm one (module docstring).
+        Components the joint torques determine: the joints moving the frame, at most
+        ``kind.rows`` (6 or 3); with fewer the estimate is the least-norm one (module
+        docstring).
+    kind : WrenchKind
+        What was estimated: :data:`FULL` (the wrench) or :data:`FORCE` (the force of a
+        point contact at the frame's origin).
     """
 
     frame: str
@@ -70,6 +145,7 @@ class WrenchEstimate:
     sigma_min: NDArray[np.float64]
     damped: NDArray[np.bool_]
     determined: int = 6
+    kind: WrenchKind = FULL
 
 
 def external_wrench(
@@ -80,8 +156,10 @@ def external_wrench(
     *,
     epsilon: float = 0.05,
     damping: float = 0.05,
+    kind: str | WrenchKind = FULL,
 ) -> WrenchEstimate:
-    """The wrench at ``frame`` whose joint torques best explain the residual ``r``.
+    """The wrench at ``frame`` whose joint torques best explain the residual ``r`` (or,
+    ``kind="force"``, the force at its origin whose torques ``J_v^T f`` do).
 
     Parameters
     ----------
@@ -97,6 +175,9 @@ def external_wrench(
         lever of ``epsilon`` times the chain's length).
     damping : float
         Largest damping ``lambda_max`` (> 0, unitless).
+    kind : str or WrenchKind
+        ``full`` (:data:`FULL`: force and moment, 6 unknowns) or ``force`` (:data:`FORCE`:
+        a point contact at the frame's origin, moment zero, 3 unknowns).
 
     Returns
     -------
@@ -107,24 +188,26 @@ def external_wrench(
     ShapeError, NonFiniteError, UnknownNameError
         Bad shapes, NaN, an unknown frame.
     OptionError
-        ``epsilon`` or ``damping`` not positive.
+        ``epsilon`` or ``damping`` not positive, an unknown ``kind``.
     """
     if not (np.isfinite(epsilon) and epsilon > 0 and np.isfinite(damping) and damping > 0):
         raise OptionError(f"epsilon and damping must be > 0; got {epsilon}, {damping}")
+    kd = wrench_kind(kind)
     qa = _checks.as_batch("q", q, (robot.n,))
     ra = _checks.as_exact("r", r, qa.shape)
-    k = wrench_rank(robot, frame)
-    D = np.repeat([1.0 / chain_length(robot, frame), 1.0], 3)
-    J = D[:, None] * jacobian(robot, qa, frame)
-    U, s, Vt = np.linalg.svd(J, full_matrices=False)  # s descending, (..., min(6, n))
+    k = wrench_rank(robot, frame, kd)
+    D = np.repeat([1.0 / chain_length(robot, frame), 1.0], 3)[: kd.rows]
+    J = D[:, None] * jacobian(robot, qa, frame)[..., : kd.rows, :]
+    U, s, Vt = np.linalg.svd(J, full_matrices=False)  # s descending, (..., min(rows, n))
     U, s, Vt = U[..., :k], s[..., :k], Vt[..., :k, :]
     smin = s[..., -1]
     damped = smin < epsilon
     lam2 = np.where(damped, damping**2 * (1.0 - smin**2 / epsilon**2), 0.0)
     gain = s / (s**2 + lam2[..., None])
     coef = gain * (Vt @ ra[..., None])[..., 0]
-    w = np.asarray(D * (U @ coef[..., None])[..., 0], dtype=np.float64)
-    return WrenchEstimate(frame, w, smin, damped, k)
+    w = np.zeros((*qa.shape[:-1], 6))
+    w[..., : kd.rows] = D * (U @ coef[..., None])[..., 0]
+    return WrenchEstimate(frame, w, smin, damped, k, kd)
 
 
 def chain_length(robot: Robot, frame: str) -> float:
@@ -144,39 +227,74 @@ def chain_length(robot: Robot, frame: str) -> float:
     return length if length > 0.0 else 1.0
 
 
-def wrench_rank(robot: Robot, frame: str) -> int:
-    """The wrench components at ``frame`` that joint torques determine: the joints that
-    move it (those up to its link), at most 6.
+def wrench_rank(robot: Robot, frame: str, kind: str | WrenchKind = FULL) -> int:
+    """The components at ``frame`` that joint torques determine: the joints that move it
+    (those up to its link), at most 6 for the wrench and 3 for the force alone
+    (``kind``).
 
     Raises
     ------
     UnknownNameError
         An unknown frame.
     OptionError
-        A frame on the base (no joint moves it).
+        A frame on the base (no joint moves it), an unknown ``kind``.
     """
-    k = min(6, int(robot.frame(frame).link))
+    k = min(wrench_kind(kind).rows, int(robot.frame(frame).link))
     if k == 0:
         raise OptionError(f"frame {frame!r} is fixed to the base: no joint torque tells its wrench")
     return k
 
 
-def underdetermined_note(robot: Robot, frame: str) -> str | None:
-    """One line when the joint torques cannot determine a whole wrench at ``frame`` (fewer
-    than six joints move it), saying what the estimate is; None otherwise.
+def underdetermined_note(robot: Robot, frame: str, kind: str | WrenchKind = FULL) -> str | None:
+    """One line when the joint torques cannot determine the whole estimate at ``frame``
+    (fewer than six joints move it for the wrench, fewer than three for the force alone:
+    ``kind``), saying what the estimate is; None otherwise.
 
     Raises
     ------
     UnknownNameError
         An unknown frame.
+    OptionError
+        An unknown ``kind``.
     """
-    k = wrench_rank(robot, frame)
-    if k >= 6:
+    kd = wrench_kind(kind)
+    k = wrench_rank(robot, frame, kd)
+    if k >= kd.rows:
         return None
+    what = kd.noun
+    hint = ""
+    if kd.rows > FORCE.rows and k >= FORCE.rows:
+        hint = (
+            f"; the force of a point contact at {frame}'s origin (3 components, moment zero) "
+            "is determined: --wrench force"
+        )
     return (
-        f"{k} joint torques determine only {k} of the 6 wrench components at {frame} (those "
-        f"in the range of its Jacobian, turning with the pose): the wrench written is the "
-        f"least-norm one that explains the residual, blind to any wrench the joints do not "
-        f"feel (J^T a = 0), so a force's components can differ from the true ones; 'damped' "
-        f"flags only poses where the {k} joints lose one more direction"
+        f"{k} joint torques determine only {k} of the {kd.rows} {what} components at {frame} "
+        f"(those in the range of its Jacobian, turning with the pose): the {what} written is "
+        f"the least-norm one that explains the residual, blind to any {what} the joints do "
+        f"not feel (J^T a = 0), so a force's components can differ from the true ones; "
+        f"'damped' flags only poses where the {k} joints lose one more direction" + hint
     )
+
+
+def estimate_words(robot: Robot, frame: str, kind: str | WrenchKind = FULL) -> str:
+    """What is estimated at ``frame``, in words for a summary: the wrench or the force of
+    a point contact (``kind``), with the components the joints moving it determine
+    (``"the force of a point contact (moment zero) at tool0's origin: 3 components from
+    5 joints"``).
+
+    Raises
+    ------
+    UnknownNameError
+        An unknown frame.
+    OptionError
+        An unknown ``kind``.
+    """
+    kd = wrench_kind(kind)
+    k, joints = wrench_rank(robot, frame, kd), int(robot.frame(frame).link)
+    part = "" if k >= kd.rows else f" ({k} determined, the least-norm estimate)"
+    out = (
+        f"{kd.what} at {frame}'s origin, base axes: {kd.rows} components{part} from "
+        f"{joints} joint{'s' if joints > 1 else ''}"
+    )
+    return out + (f"; {kd.caveat}" if kd.caveat else "")

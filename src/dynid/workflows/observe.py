@@ -80,6 +80,7 @@ from ..observer.residual import DEFAULT_GAIN, ObserverOptions
 from ..observer.results import LogObservation, ObserveResult
 from ..observer.sign import TorqueSign, opposite_finding, unexplained_finding
 from ..observer.thresholds import ModelFingerprint
+from ..observer.wrench import wrench_kind, wrench_rank
 from ..progress import NOTE
 from .data_files import (
     ColumnSpec,
@@ -147,6 +148,11 @@ class ObserveOptions:
         ``thresholds.json`` to detect with (required unless ``calibrate``).
     frame : str, optional
         Also estimate the external wrench at this frame.
+    wrench : str
+        What is estimated at ``frame`` (:data:`~dynid.observer.wrench.WRENCH_KINDS`):
+        ``full``, the wrench (force and moment, 6 unknowns: the least-norm one where fewer
+        than six joints move the frame), or ``force``, the force of a point contact at the
+        frame's origin (moment zero, 3 unknowns, which three joints or more determine).
     gain : float or tuple of float
         ``K_O`` [1/s] when calibrating (else the thresholds' own).
     discretisation, rule : str
@@ -202,6 +208,7 @@ class ObserveOptions:
     calibrate: bool = False
     thresholds: Path | None = None
     frame: str | None = None
+    wrench: str = "full"
     gain: float | tuple[float, ...] = DEFAULT_GAIN
     discretisation: str = "exact"
     rule: str = "trapezoid"
@@ -364,8 +371,13 @@ _CALIBRATION_FIELDS = (
 def _refuse_unused(opts: ObserveOptions) -> None:
     """Options that do not apply: the calibration's with ``thresholds`` (the file fixes
     them), ``frame``, ``merge_s`` and ``min_duration_s`` when calibrating (no wrench or
-    event is computed)."""
+    event is computed), ``wrench`` without ``frame`` (or not one of its kinds)."""
     default = ObserveOptions(data=())
+    wrench_kind(opts.wrench)
+    if opts.frame is None and opts.wrench != default.wrench:
+        raise OptionError(
+            "says what is estimated at {frame}; give the frame", field="wrench", others=("frame",)
+        )
     if opts.thresholds is not None:
         for name in _CALIBRATION_FIELDS:
             if getattr(opts, name) != getattr(default, name):
@@ -467,9 +479,14 @@ def observe_files(opts: ObserveOptions, sink: ResidualSink | None = None) -> Obs
         return ObserveResult(model, th, cal.logs, fingerprint, own)
     paths = tuple(map(Path, read.paths))
     logs = []
+    kind = wrench_kind(opts.wrench)
+    if opts.frame is not None:  # an unknown frame, a frame on the base: before any log
+        wrench_rank(model.robot, opts.frame, kind)
     for k, (path, log) in enumerate(zip(paths, read.logs, strict=True)):
         rows = log.t.shape[0]
-        table = None if sink is None else sink.table(paths, k, rows, model.n, opts.frame)
+        table = None
+        if sink is not None:
+            table = sink.table(paths, k, rows, model.n, opts.frame, kind)
         with about_file(path.name):
             prep = prepared_log(path, log, model, opts.max_gap, read.joint_side[k])
         logs.append(
@@ -486,9 +503,10 @@ def observe_files(opts: ObserveOptions, sink: ResidualSink | None = None) -> Obs
                 keep_series=opts.keep_series,
                 figure_points=opts.figure_points,
                 table=table,
+                kind=kind,
             )  # fmt: skip
         )
-    return ObserveResult(model, given, tuple(logs), fingerprint, own, opts.frame)
+    return ObserveResult(model, given, tuple(logs), fingerprint, own, opts.frame, kind)
 
 
 def model_fingerprint(opts: ObserveOptions) -> ModelFingerprint:

@@ -33,7 +33,7 @@ from ..observer.residual import ObserverOptions
 from ..observer.results import FigureSeries, LogObservation
 from ..observer.sign import TorqueSign, opposite_finding
 from ..observer.thresholds import Thresholds, threshold_series
-from ..observer.wrench import WrenchEstimate, external_wrench, wrench_rank
+from ..observer.wrench import FULL, WrenchEstimate, WrenchKind, external_wrench, wrench_rank
 from .data_files import in_file
 from .observe_logs import ObservedBlock, PreparedLog, Series, observed_rows
 
@@ -45,11 +45,17 @@ class ResidualSink(Protocol):
     (:class:`dynid.io.observer_files.ResidualTables`)."""
 
     def table(
-        self, paths: Sequence[Path], index: int, rows: int, n: int, frame: str | None
+        self,
+        paths: Sequence[Path],
+        index: int,
+        rows: int,
+        n: int,
+        frame: str | None,
+        kind: WrenchKind = FULL,
     ) -> AbstractContextManager[Callable[..., None]]:
         """A writer ``put(t, r, wrench, damped)`` of log ``index`` of ``paths`` (``rows``
-        samples, ``n`` joints, the wrench at ``frame`` or none), called for consecutive
-        blocks of samples."""
+        samples, ``n`` joints, the estimate ``kind`` at ``frame`` or none), called for
+        consecutive blocks of samples."""
         ...
 
 
@@ -78,11 +84,13 @@ def detected_log(
     keep_series: bool,
     figure_points: int | None = None,
     table: AbstractContextManager[Callable[..., None] | None] | None = None,
+    kind: WrenchKind = FULL,
 ) -> LogObservation:
     """The events of one prepared log (module docstring; ``merge_s`` and ``min_duration_s``
     of :class:`~dynid.observer.events.EventDetector`), ``wants`` the residual's std and
     the standstill margin, ``table`` the sink's writer of its residual table (or none);
-    ``figure_points``: keep every k-th sample (at most that many) for a figure."""
+    ``figure_points``: keep every k-th sample (at most that many) for a figure; ``kind``:
+    the wrench or the force alone at ``frame``."""
     log, n = prep.log, model.n
     starts = tuple(a for a, _ in prep.spans)
     det = EventDetector(thresholds, merge_s=merge_s, min_duration_s=min_duration_s, restarts=starts)
@@ -100,7 +108,7 @@ def detected_log(
             if blk.friction is not None and blk.friction is not model.friction:
                 seen = blk.friction  # banded for the velocity noise (a note says so)
             events += det.feed(log.t[a:b], blk.r, std=blk.std, standstill=blk.margin)
-            w = None if frame is None else observed_wrench(model, log.q[a:b], blk.r, frame)
+            w = None if frame is None else observed_wrench(model, log.q[a:b], blk.r, frame, kind)
             if put is not None:
                 put(log.t[a:b], blk.r, *((None, None) if w is None else (w.wrench, w.damped)))
             if w is not None and keep is not None:
@@ -135,20 +143,24 @@ def detected_log(
     )
 
 
-def observed_wrench(model: ObserverModel, q: NDArray, r: NDArray, frame: str) -> WrenchEstimate:
-    """The external wrench at ``frame`` (:func:`~dynid.observer.wrench.external_wrench`)
-    of the samples the observer ran on; NaN wrench and ``sigma_min``, not flagged damped,
-    where the residual ``r`` (m, n) is NaN (not observed: a log's unobserved edges)."""
+def observed_wrench(
+    model: ObserverModel, q: NDArray, r: NDArray, frame: str, kind: WrenchKind = FULL
+) -> WrenchEstimate:
+    """The external wrench (or the force alone: ``kind``) at ``frame``
+    (:func:`~dynid.observer.wrench.external_wrench`) of the samples the observer ran on;
+    NaN wrench and ``sigma_min``, not flagged damped, where the residual ``r`` (m, n) is
+    NaN (not observed: a log's unobserved edges)."""
     seen = np.all(np.isfinite(r), axis=1)
     if seen.all():
-        return external_wrench(model.robot, q, r, frame)
+        return external_wrench(model.robot, q, r, frame, kind=kind)
     m = r.shape[0]
     wrench, smin = np.full((m, 6), np.nan), np.full(m, np.nan)
     damped = np.zeros(m, dtype=bool)
     if seen.any():
-        w = external_wrench(model.robot, q[seen], r[seen], frame)
+        w = external_wrench(model.robot, q[seen], r[seen], frame, kind=kind)
         wrench[seen], smin[seen], damped[seen] = w.wrench, w.sigma_min, w.damped
-    return WrenchEstimate(frame, wrench, smin, damped, wrench_rank(model.robot, frame))
+    k = wrench_rank(model.robot, frame, kind)
+    return WrenchEstimate(frame, wrench, smin, damped, k, kind)
 
 
 def _joined(blocks: list[WrenchEstimate], frame: str | None) -> WrenchEstimate | None:
@@ -161,6 +173,7 @@ def _joined(blocks: list[WrenchEstimate], frame: str | None) -> WrenchEstimate |
         np.concatenate([w.sigma_min for w in blocks]),
         np.concatenate([w.damped for w in blocks]),
         blocks[0].determined,
+        blocks[0].kind,
     )
 
 
