@@ -87,15 +87,22 @@ def test_identify_files_returns_the_prediction_of_a_separate_log(panda, logs):
     assert np.linalg.norm(v.tau_hat - tau) < 1e-4 * np.linalg.norm(tau)
 
 
-def test_identify_files_returns_the_prediction_of_the_last_recording(panda, logs):
-    """Two recordings: the last one, predicted by the fit of the first, is the one
-    returned (RNEA plus the true friction, to 1e-4 of their norm)."""
-    (_, last), paths = logs
+def test_identify_files_returns_the_prediction_of_every_recording(panda, logs):
+    """Two recordings: each, predicted by the fit of the other, pooled one after the
+    other (the verdict was the last recording's alone, while the leave-one-recording-out
+    judgement printed under it pooled them all): both recordings' samples, in order on
+    one increasing time axis, and their predicted torques RNEA plus the true friction at
+    the prepared states (to 1e-4 of their norm)."""
+    (first, last), paths = logs
     held = _identified(panda, paths).heldout
-    assert held is not None and held.block.startswith("the last of 2 recordings")
-    rows, tau = _truth(panda, last, held.validation.log.t)
-    assert rows.size > 0.8 * last.t.size
-    assert np.linalg.norm(held.validation.tau_hat - tau) < 1e-4 * np.linalg.norm(tau)
+    assert held is not None
+    assert held.block == "each of the 2 recordings, predicted by the fit of the other 1"
+    v = held.validation
+    assert v.log.t.size > 0.8 * (first.t.size + last.t.size) and np.all(np.diff(v.log.t) > 0)
+    tau = rnea(panda, v.log.q, v.log.dq, v.log.ddq) + FRICTION.torques(v.log.dq)
+    assert np.linalg.norm(v.tau_hat - tau) < 1e-4 * np.linalg.norm(tau)
+    rows = np.searchsorted(first.t, v.log.t[:50])  # the first recording's, as it was
+    np.testing.assert_array_equal(v.log.tau[:50], first.tau[rows])
 
 
 @pytest.mark.parametrize("case", ["folder", "validate_on"])

@@ -12,7 +12,8 @@ command applies, so that the Python API behaves as the command does.
   apply to the consistent fit only (:class:`IdentifyOptions`).
 * The column map the data were read with is recorded in the model (``info.column_map``).
 * From torque logs, the held-out prediction (:mod:`dynid.friction.heldout_torques`: the
-  last time block, the last recording or the ``validate_on`` log, every sample) is made
+  last time block, every recording predicted by the fit of the others, or the
+  ``validate_on`` log, every sample) is made
   from the logs read for the fit, each file read once, and returned with the model.
 
 Every refusal of an option is an :class:`~dynid.exceptions.OptionError` carrying the
@@ -350,7 +351,7 @@ def _predicted_heldout(
     ``validate_on`` log), from the logs as the fit took them; one it cannot make (every
     held-out piece too short to filter) is a warning, never a failed identification."""
     try:
-        return heldout_torques(model, logs[-1], separate=separate)
+        return heldout_torques(model, logs[-1], separate=separate, others=logs[:-1])
     except DynidError as exc:
         warnings.warn(
             f"skipped the held-out prediction (heldout.json and its figures): {exc}",
