@@ -296,7 +296,9 @@ def _each_recording(
     """Every recording of ``logs`` (the folds' order) predicted by the fold fitted on the
     others, pooled; the states' noise through ``model`` itself (the floor, not the
     prediction: the folds' coefficients barely move it)."""
-    parts, pieces, spikes = [], [], 0
+    parts: list[Validation] = []
+    pieces: list[TorqueLog] = []
+    spikes = 0
     for fold, rec in enumerate(logs):
         fitted = _fold_model(model, fold)
         if fitted is None:
