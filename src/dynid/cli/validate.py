@@ -12,7 +12,10 @@ measured ones, per joint (RMS, MSE) and overall (relative error). Model sources:
                                 links, or a sigmoid): Newton-Euler torques (RNEA) with
                                 those parameters (the paper's Fig. 5)
 
---friction friction.json replaces the model's own friction. The states are low-pass
+--friction friction.json replaces the model's own friction. A Coulomb step whose
+standstill band lies well inside the measured velocities' noise (none at all: a URDF's
+<dynamics friction>, MJCF's frictionloss) is judged with the noise band, as observe
+evaluates it (a note says so): sign(dq) of the noise at every rest would flip it. The states are low-pass
 filtered with zero phase (--cutoff), the accelerations differentiated from the filtered
 velocities; the measured torques are compared unfiltered. One-sample torque spikes (a
 sample off both neighbours by more than 20 times the noise while the joint moves: a sensor

@@ -265,11 +265,16 @@ def _banded_part(friction: FrictionModel, b: NDArray[np.float64], derived: bool)
 def banding_note(
     friction: FrictionModel | FrictionSum | None,
     seen: Sequence[FrictionModel | FrictionSum | None],
+    *,
+    verb: str = "observed",
+    read_as: str = "external torque",
 ) -> str | None:
     """One line saying which sharp Coulomb steps of ``friction`` :func:`banded_if_narrow`
     widened for the logs (``seen``: the friction each log was observed with): the law, the
     joints (or motors) and the largest band used [rad/s]; None where it widened none (a
-    smooth law observed with the band, as identification means it, is not noted)."""
+    smooth law observed with the band, as identification means it, is not noted).
+    ``verb`` and ``read_as``: what the command did with the band and what the flips would
+    be read as (validation: ``"judged"``, ``"model error"``)."""
     changed = [s for s in seen if s is not None and s is not friction]
     said = []
     for k, part in enumerate(friction_parts(friction) if changed else ()):
@@ -284,13 +289,13 @@ def banding_note(
         said.append(
             f"{part.kind} friction: the standstill band of {where}(s) "
             f"{', '.join(str(j + 1) for j in np.flatnonzero(moved))} is inside the velocity "
-            f"noise, observed with the noise band (up to {top:.3g} rad/s)"
+            f"noise, {verb} with the noise band (up to {top:.3g} rad/s)"
         )
     if not said:
         return None
     return (
         "; ".join(said) + ": sign(dq) of the noise at rest would flip the whole Coulomb "
-        "torque, read as external torque (a friction.json of `dynid friction` carries its "
+        f"torque, read as {read_as} (a friction.json of `dynid friction` carries its "
         "own band)"
     )
 

@@ -58,6 +58,7 @@ from ..identification.floor_verdict import (
     prediction_input_noise,
     sensor_variance,
 )
+from ..identification.log import TorqueLog, joint_side_log
 from ..identification.low_speed import with_low_speed_hint
 from ..identification.metrics import TorqueErrors
 from ..identification.model import IdentifiedModel
@@ -68,6 +69,7 @@ from ..io.feasible import load_feasible_drive, load_feasible_linear_friction
 from ..io.friction_json import load_friction_json
 from ..model.drive import Drive
 from ..model.robot import Robot
+from ..observer.friction import banded_if_narrow, banding_note, velocity_bands
 from ..progress import NOTE
 from .data_files import ColumnSpec, in_file
 from .recordings import despiked_recordings, read_recordings
@@ -268,6 +270,7 @@ def validate_files(
     )
     rec, spikes = despiked_recordings(rec, robot.joint_names, SPIKES_BEFORE_JUDGING)
     friction, source = _friction(model, opt.friction, feasible, own if drive is None else drive)
+    friction = _banded(friction, rec.logs, own if drive is None else drive)
 
     def run() -> RecordingsValidation:
         return validate_recordings(
@@ -411,6 +414,29 @@ def _friction(
     if isinstance(friction, str | Path):  # where the drive puts a robot's own, as simulated
         return placed_friction(load_friction_json(friction), drive), Path(friction).name
     return placed_friction(friction, drive), "given"
+
+
+def _banded(
+    friction: FrictionModel | FrictionSum | None,
+    logs: Sequence[TorqueLog],
+    drive: Drive | None,
+) -> FrictionModel | FrictionSum | None:
+    """``friction`` as the observer evaluates it on the recordings ``logs`` (as read,
+    through ``drive``): a sharp Coulomb step whose standstill band lies well inside the
+    measured velocities' noise band, or a smooth step narrower than it, gets the noise band
+    (:func:`~dynid.observer.friction.banded_if_narrow` of
+    :func:`~dynid.observer.friction.velocity_bands` over every recording's velocities),
+    said in a note (:func:`~dynid.observer.friction.banding_note`). Without it
+    ``sign(dq)`` of the noise at every rest flips the whole Coulomb torque (a URDF's
+    ``<dynamics friction>``, which holds no band). Velocities derived from the positions
+    are smooth: the friction as it is."""
+    if friction is None or not logs or any(log.dq_derived for log in logs):
+        return friction
+    dq = np.concatenate([joint_side_log(log, drive).dq for log in logs])
+    banded = banded_if_narrow(friction, velocity_bands(friction, dq))
+    if said := banding_note(friction, [banded], verb="judged", read_as="model error"):
+        _log.log(NOTE, said)
+    return banded
 
 
 def _overflow(names: Any, val: Any, label: str | None, opt: ValidateOptions) -> str:
