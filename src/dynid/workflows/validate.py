@@ -254,7 +254,7 @@ def validate_files(
     if feasible is not None:  # the file's drive holds the rotor inertias identified
         held = load_feasible_drive(feasible)
         drive = same_drive(drive, held, Path(feasible).name, f"the one {Path(feasible).name} holds")
-    own = model.drive if isinstance(model, IdentifiedModel) else None
+    placed = model.drive if drive is None and isinstance(model, IdentifiedModel) else drive
     rec = read_recordings(
         data,
         robot,
@@ -263,14 +263,13 @@ def validate_files(
         drop_invalid=opt.drop_invalid,
         cutoff_hz=opt.cutoff_hz,
         owner=f"the model ({label or robot.name})",
-        drive=own if drive is None else drive,
+        drive=placed,
         q_start=opt.q_start,
         max_gap_s=opt.max_gap_s,
         reference=model.equivalent_robot if isinstance(model, IdentifiedModel) else None,
     )
     rec, spikes = despiked_recordings(rec, robot.joint_names, SPIKES_BEFORE_JUDGING)
-    friction, source = _friction(model, opt.friction, feasible, own if drive is None else drive)
-    friction = _banded(friction, rec.logs, own if drive is None else drive)
+    friction, source = _friction(model, opt.friction, feasible, placed, rec.logs)
 
     def run() -> RecordingsValidation:
         return validate_recordings(
@@ -395,6 +394,19 @@ def _judged(
 
 
 def _friction(
+    model: IdentifiedModel | Robot,
+    friction: str | Path | FrictionModel,
+    feasible: str | Path | None,
+    drive: Drive | None,
+    logs: Sequence[TorqueLog],
+) -> tuple[FrictionModel | FrictionSum | None, str | None]:
+    """The friction added to the model (:func:`_added_friction`) as observe evaluates it on
+    the recordings ``logs`` (:func:`_banded`), and where it comes from."""
+    added, source = _added_friction(model, friction, feasible, drive)
+    return _banded(added, logs, drive), source
+
+
+def _added_friction(
     model: IdentifiedModel | Robot,
     friction: str | Path | FrictionModel,
     feasible: str | Path | None,
