@@ -309,12 +309,32 @@ def test_the_robot_with_the_load_keeps_the_arms_drive_and_friction(tmp_path):
         'schema = "dynid-drive/1"\nside = "joint"\ngear_ratio = [100, 100, 100, 100, 50, 50, 50]'
         "\nrotor_inertia = [3e-5, 3e-5, 3e-5, 3e-5, 1e-5, 1e-5, 1e-5]\n"
     )
-    assert main(["export", "--params", "panda", "--drive", str(drive), "--out", str(tmp_path / "arm.toml"), "-q"]) == 0
+    assert (
+        main(
+            [
+                "export",
+                "--params",
+                "panda",
+                "--drive",
+                str(drive),
+                "--out",
+                str(tmp_path / "arm.toml"),
+                "-q",
+            ]
+        )
+        == 0
+    )
     loaded = arm.with_tool(np.eye(4), MASS, COM, _inertia(), name="load")
     data = _static(loaded, 200, 0.0, 17)
     rotors = np.diag(np.array([100.0] * 4 + [50.0] * 3) ** 2 * ([3e-5] * 4 + [1e-5] * 3))
     save_static_csv(tmp_path / "loaded.csv", dataclasses.replace(data, M=data.M + rotors))
-    argv = ["payload", "--robot", str(tmp_path / "arm.toml"), "--data", str(tmp_path / "loaded.csv")]
+    argv = [
+        "payload",
+        "--robot",
+        str(tmp_path / "arm.toml"),
+        "--data",
+        str(tmp_path / "loaded.csv"),
+    ]
     assert main([*argv, "--out", str(tmp_path / "p"), "-q"]) == 0
     written = tmp_path / "p" / "robot_with_payload.toml"
     robot = dynid.Robot.from_toml(written)
