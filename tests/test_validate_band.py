@@ -1,20 +1,24 @@
 """A friction law without a standstill band (a URDF's ``<dynamics friction>``, MJCF's
-``frictionloss``) is judged with the velocities' noise band, as observe evaluates it: an
-xArm7 export at the noise floor through its feasible.json (3.08 %) was "poor, 17.5 %" read
-from its URDF, sign(dq) of the velocity noise at the rests flipping the whole Coulomb
-torque, with a floor of 15.6 % of which the states through the model 15.4 %."""
+``frictionloss``) is judged with the noise band of the velocities it is evaluated at, by
+the function observe bands it with: an xArm7 export at the noise floor through its
+feasible.json (3.08 %) was "poor, 17.5 %" read from its URDF, sign(dq) of the velocity
+noise at the rests flipping the whole Coulomb torque, with a floor of 15.6 % of which
+the states through the model 15.4 %."""
 
 from __future__ import annotations
 
 import json
 import logging
+import re
 
 import numpy as np
 import pytest
 
 from dynid.cli.__main__ import main
+from dynid.identification.input_noise import derived_noise_gains
+from dynid.identification.sanity import NOISE_BAND_STD
 
-#: Velocity noise std of the simulated log [rad/s]; the noise band is 5 times it.
+#: Velocity noise std of the simulated log [rad/s].
 DQ_NOISE = 0.003
 
 
@@ -49,25 +53,33 @@ def _friction(path, band: float) -> None:
 
 def test_a_law_without_a_band_is_judged_with_the_noise_band(tmp_path, caplog):
     """The true model's classical friction without a band scores as the same law carrying
-    the noise band (5 x the simulated velocity noise) does: the same error and floor within
-    5 %, said in one note; not the band-less law's flips at every rest."""
+    the noise band of the prepared velocities (5 x the simulated velocity noise through
+    the low-pass) does: the same error and floor within 5 %, said in one note; not the
+    band-less law's flips at every rest (9.7 % against 3.0 %)."""
     traj, log = tmp_path / "traj.csv", tmp_path / "log.csv"
     _p2p_trajectory(traj)
     _friction(tmp_path / "none.json", 0.0)
-    _friction(tmp_path / "band.json", 5 * DQ_NOISE)
     sim = ["simulate", "--robot", "panda", "--trajectory", str(traj), "--seed", "1"]
     fr = ["--friction", str(tmp_path / "none.json")]
     assert main([*sim, *fr, "--dq-noise", str(DQ_NOISE), "--out", str(log), "-q"]) == 0
-    got = {}
-    for name in ("none", "band"):
+
+    def validated(name):
         out = tmp_path / name
         argv = ["validate", "--robot", "panda", "--friction", str(tmp_path / f"{name}.json")]
-        with caplog.at_level(logging.INFO):
-            main([*argv, "--data", str(log), "--no-figures", "-q", "--out", str(out)])
-        got[name] = json.loads((out / "validation.json").read_text())
+        main([*argv, "--data", str(log), "--no-figures", "-q", "--out", str(out)])
+        return json.loads((out / "validation.json").read_text())
+
+    with caplog.at_level(logging.INFO):
+        none = validated("none")
     said = [
         r.getMessage() for r in caplog.records if "judged with the noise band" in r.getMessage()
     ]
     assert len(said) == 1 and "joint(s) 1, 2, 3, 4, 5, 6, 7" in said[0], said
+    gain = derived_noise_gains(1 / 200, none["cutoff_hz"], derived=False)[0]
+    band = NOISE_BAND_STD * DQ_NOISE * gain
+    top = float(re.search(r"up to ([0-9.e-]+) rad/s", said[0]).group(1))
+    assert top == pytest.approx(band, rel=0.2)
+    _friction(tmp_path / "band.json", band)
+    banded = validated("band")
     for key in ("relative_error_percent", "noise_floor_percent"):
-        assert got["none"][key] == pytest.approx(got["band"][key], rel=0.05), key
+        assert none[key] == pytest.approx(banded[key], rel=0.05), key

@@ -83,6 +83,7 @@ __all__ = [
     "banding_note",
     "canonical_friction",
     "derived_velocity_bands",
+    "noise_bands",
     "standstill_margin",
     "velocity_bands",
 ]
@@ -153,6 +154,23 @@ def velocity_bands(
             sd[k] = np.median(est)
         out.append(np.asarray(noise_band(sd), dtype=np.float64))
     return tuple(out)
+
+
+def noise_bands(
+    friction: FrictionModel | FrictionSum | None, dq_std: NDArray[np.float64]
+) -> tuple[NDArray[np.float64], ...]:
+    """The velocity noise band [rad/s] of the motors of every part of ``friction`` (one
+    (n,) array per part) for joint velocities of white-noise std ``dq_std`` (n,) [rad/s],
+    independent per joint: :data:`~dynid.identification.sanity.NOISE_BAND_STD` times
+    ``sqrt(K^2 dq_std^2)`` through the part's transmission ``K`` (the noise a validation's
+    prepared velocities carry, :func:`~dynid.identification.input_noise.state_noise`)."""
+    from ..identification.sanity import noise_band
+
+    var = np.asarray(dq_std, dtype=np.float64) ** 2
+    return tuple(
+        np.asarray(noise_band(np.sqrt(np.asarray(p.transmission) ** 2 @ var)), dtype=np.float64)
+        for p in friction_parts(friction)
+    )
 
 
 def derived_velocity_bands(
