@@ -61,7 +61,7 @@ from .common import (
     positive_type,
 )
 from .console import Console
-from .sources import load_model_source
+from .sources import load_model_source, params_as_robot
 
 NAME = "payload"
 #: ``--out`` is a folder: its files are one output set (:mod:`dynid.outputs.run_output`).
@@ -82,7 +82,11 @@ def register(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParser:
     src = p.add_mutually_exclusive_group(required=True)
     src.add_argument("--robot", help="'panda', 'fr3', a .urdf or a .toml with the arm's parameters")
     src.add_argument("--model", type=Path, help="identification.json of the arm")
-    src.add_argument("--params", type=Path, help="feasible.json of the arm")
+    src.add_argument(
+        "--params",
+        type=Path,
+        help="feasible.json of the arm (a .urdf, .toml or .xml: read as --robot reads it)",
+    )
     p.add_argument("--base", default=None, help="URDF base link (with --robot)")
     p.add_argument("--tip", default=None, help="URDF tip link (with --robot)")
     add_snap_angles_option(p)
@@ -124,6 +128,7 @@ def register(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParser:
 
 def run(args: argparse.Namespace, console: Console) -> int:
     """Identify, write payload.json and the arm's model with the load, print a summary."""
+    args = params_as_robot(args)  # a URDF, TOML or MJCF --params: as --robot reads it
     arm, label = load_model_source(args)
     kin = arm.robot if isinstance(arm, IdentifiedModel) else arm
     drive = load_drive_arg(args, kin.n)
