@@ -7,6 +7,7 @@ of the reported standard deviations over seeded repetitions.
 
 from __future__ import annotations
 
+import dataclasses
 import json
 
 import numpy as np
@@ -29,6 +30,8 @@ from dynid.feasibility.payload import (
     robot_with_payload,
 )
 from dynid.identification.data import StaticDataset
+from dynid.io.drive_file import drive_of_robot_file
+from dynid.io.model_json import load_model_json
 from dynid.io.static_data import save_static_csv
 from dynid.model.inertia import inertia6_from_matrix, phi_from_inertial
 from dynid.signals import lowpass_noise_gain
@@ -284,6 +287,65 @@ def test_cli_payload_on_an_identified_arm(tmp_path):
     assert main(argv + ["--out", str(tmp_path / "p"), "-q"]) == 0
     d = json.loads((tmp_path / "p" / "payload.json").read_text())
     assert abs(d["mass"] - MASS) < 1e-8 and np.max(np.abs(np.subtract(d["com"], COM))) < 1e-8
+    # the model carrying the load predicts the loaded arm (its base parameters; a TOML of
+    # its equivalent robot, links of mass 0 holding first moments, lost gravity: 71.8 %)
+    assert d["with_tool"] == "model_with_payload.json"
+    assert not (tmp_path / "p" / "robot_with_payload.toml").exists()
+    carried = load_model_json(tmp_path / "p" / d["with_tool"])
+    q = _static(arm, 20, 0.0, 16).q
+    np.testing.assert_allclose(
+        carried.gravity_torques(q), dynid.gravity_torques(loaded, q), atol=1e-8
+    )
+    np.testing.assert_allclose(carried.mass_matrix(q), dynid.mass_matrix(loaded, q), atol=1e-8)
+
+
+def test_the_robot_with_the_load_keeps_the_arms_drive_and_friction(tmp_path):
+    """robot_with_payload.toml of a robot TOML holds its [drive] (rotor inertias) and
+    friction, as `dynid export` writes them (it had the links alone: an xArm7's file
+    without its friction and rotor inertias predicted its own load's log to 25.4 %)."""
+    arm = dynid.panda()
+    drive = tmp_path / "drive.toml"
+    drive.write_text(
+        'schema = "dynid-drive/1"\nside = "joint"\ngear_ratio = [100, 100, 100, 100, 50, 50, 50]'
+        "\nrotor_inertia = [3e-5, 3e-5, 3e-5, 3e-5, 1e-5, 1e-5, 1e-5]\n"
+    )
+    assert (
+        main(
+            [
+                "export",
+                "--params",
+                "panda",
+                "--drive",
+                str(drive),
+                "--out",
+                str(tmp_path / "arm.toml"),
+                "-q",
+            ]
+        )
+        == 0
+    )
+    loaded = arm.with_tool(np.eye(4), MASS, COM, _inertia(), name="load")
+    data = _static(loaded, 200, 0.0, 17)
+    rotors = np.diag(np.array([100.0] * 4 + [50.0] * 3) ** 2 * ([3e-5] * 4 + [1e-5] * 3))
+    save_static_csv(tmp_path / "loaded.csv", dataclasses.replace(data, M=data.M + rotors))
+    argv = [
+        "payload",
+        "--robot",
+        str(tmp_path / "arm.toml"),
+        "--data",
+        str(tmp_path / "loaded.csv"),
+    ]
+    assert main([*argv, "--out", str(tmp_path / "p"), "-q"]) == 0
+    written = tmp_path / "p" / "robot_with_payload.toml"
+    robot = dynid.Robot.from_toml(written)
+    np.testing.assert_allclose(robot.phi, loaded.phi, atol=1e-8)
+    held, own = drive_of_robot_file(written, 7), drive_of_robot_file(tmp_path / "arm.toml", 7)
+    assert held is not None and own is not None
+    for name in ("transmission", "rotor_inertia"):
+        np.testing.assert_array_equal(getattr(held, name), getattr(own, name))
+    own_friction = dynid.Robot.from_toml(tmp_path / "arm.toml").friction
+    assert robot.friction.kind == own_friction.kind == "sigmoid"
+    np.testing.assert_array_equal(robot.friction.params, own_friction.params)
 
 
 def _sinusoid_log(amplitudes, seed):

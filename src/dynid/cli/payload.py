@@ -23,7 +23,13 @@ setLoad's load_inertia is not written.
 
 Writes DIR/payload.json (mass, com [m] in --frame, inertia about the CoM, their std, the
 preprocessing used, and libfranka's setLoad values load_mass, F_x_Cload, load_inertia)
-and DIR/robot_with_payload.toml (the robot carrying the load).
+and the arm carrying the load, for the other commands: with --robot or --params
+DIR/robot_with_payload.toml (what `dynid export` writes of the arm, as TOML: its links,
+the load added to the link of --frame, its friction and drive); with --model
+DIR/model_with_payload.json (an identification.json: its base parameters with the load's,
+its friction, rotor inertias and offsets; base parameters are combinations of the links'
+parameters, which no robot description holds, so no TOML is written). The standard
+deviations in it are the arm's.
 
 example:
   dynid payload --robot panda --data static_with_gripper.csv --out payload
@@ -37,11 +43,12 @@ from typing import Any
 
 from ..feasibility.payload import PayloadEstimate
 from ..identification.model import IdentifiedModel
+from ..io.model_json import save_model_json
 from ..io.payload_json import save_payload_json
-from ..io.robot.toml import save_toml
 from ..model.inertia import INERTIA_ORDER, inertia6_from_matrix
+from ..workflows.export import ExportRobotOptions, save_export
 from ..workflows.payload import PayloadFileResult, identify_payload_files
-from .applies import urdf_chain
+from .applies import is_urdf, urdf_chain
 from .common import (
     add_column_options,
     add_drive_option,
@@ -54,13 +61,17 @@ from .common import (
     positive_type,
 )
 from .console import Console
-from .sources import load_model_source
+from .sources import load_model_source, params_as_robot
 
 NAME = "payload"
 #: ``--out`` is a folder: its files are one output set (:mod:`dynid.outputs.run_output`).
 OUTPUT = "folder"
 #: Options that apply to one route only (:mod:`dynid.cli.applies`).
 APPLIES = (urdf_chain(),)
+#: The arm carrying the load: a robot's (what ``dynid export`` writes of it, as TOML), an
+#: identified model's (its base parameters with the load's).
+ROBOT_WITH_LOAD = "robot_with_payload.toml"
+MODEL_WITH_LOAD = "model_with_payload.json"
 
 
 def register(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParser:
@@ -71,7 +82,11 @@ def register(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParser:
     src = p.add_mutually_exclusive_group(required=True)
     src.add_argument("--robot", help="'panda', 'fr3', a .urdf or a .toml with the arm's parameters")
     src.add_argument("--model", type=Path, help="identification.json of the arm")
-    src.add_argument("--params", type=Path, help="feasible.json of the arm")
+    src.add_argument(
+        "--params",
+        type=Path,
+        help="feasible.json of the arm (a .urdf, .toml or .xml: read as --robot reads it)",
+    )
     p.add_argument("--base", default=None, help="URDF base link (with --robot)")
     p.add_argument("--tip", default=None, help="URDF tip link (with --robot)")
     add_snap_angles_option(p)
@@ -112,20 +127,37 @@ def register(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParser:
 
 
 def run(args: argparse.Namespace, console: Console) -> int:
-    """Identify, write payload.json and the robot with the load, print a summary."""
+    """Identify, write payload.json and the arm's model with the load, print a summary."""
+    args = params_as_robot(args)  # a URDF, TOML or MJCF --params: as --robot reads it
     arm, label = load_model_source(args)
     kin = arm.robot if isinstance(arm, IdentifiedModel) else arm
-    result = identify_payload_files(arm, args.data, **_options(args, kin.n))
-    save_toml(args.out / "robot_with_payload.toml", result.robot_with_load(arm))
-    path = save_payload_json(
-        args.out / "payload.json", result.estimate, kin, with_tool="robot_with_payload.toml"
-    )
+    drive = load_drive_arg(args, kin.n)
+    result = identify_payload_files(arm, args.data, **_options(args, kin.n, drive))
+    if isinstance(arm, IdentifiedModel):
+        loaded = save_model_json(args.out / MODEL_WITH_LOAD, result.model_with_load(arm))
+    else:
+        spec = args.robot if args.robot is not None else args.params
+        chain = dict(base=args.base, tip=args.tip, snap_angles=args.snap_angles)
+        plan = result.export_with_load(
+            spec,
+            args.out / ROBOT_WITH_LOAD,
+            ExportRobotOptions(format="toml", drive=drive, **(chain if is_urdf(spec) else {})),
+        )
+        loaded = save_export(args.out / ROBOT_WITH_LOAD, plan)
+    path = save_payload_json(args.out / "payload.json", result.estimate, kin, with_tool=loaded.name)
     print_payload(console, result, label)
-    console.print(f"wrote {path} and {args.out / 'robot_with_payload.toml'}")
+    if isinstance(arm, IdentifiedModel):
+        console.print(
+            f"note: {args.model.name} holds base parameters (combinations of the links' "
+            f"parameters), which no robot description holds: the model carrying the load is "
+            f"{loaded.name} (with its friction, rotor inertias and offsets; validate and "
+            "observe read it as --model), no robot_with_payload.toml"
+        )
+    console.print(f"wrote {path} and {loaded}")
     return 0
 
 
-def _options(args: argparse.Namespace, n: int) -> dict[str, Any]:
+def _options(args: argparse.Namespace, n: int, drive: Any) -> dict[str, Any]:
     """The keyword arguments of :func:`~dynid.workflows.payload.identify_payload_files`."""
     return dict(
         unloaded=args.unloaded,
@@ -135,7 +167,7 @@ def _options(args: argparse.Namespace, n: int) -> dict[str, Any]:
         drop_invalid=args.drop_invalid,
         cutoff_hz=args.cutoff,
         max_gap_s=args.max_gap,
-        drive=load_drive_arg(args, n),
+        drive=drive,
         feasible=args.params,
         q_start=args.q_start,
     )

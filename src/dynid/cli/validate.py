@@ -10,11 +10,17 @@ measured ones, per joint (RMS, MSE) and overall (relative error). Model sources:
   --params feasible.json        retrieved feasible link parameters (dynid retrieve), with
                                 the friction stored in them (the law identified with the
                                 links, or a sigmoid): Newton-Euler torques (RNEA) with
-                                those parameters (the paper's Fig. 5)
+                                those parameters (the paper's Fig. 5); a robot
+                                .urdf, .toml or .xml (MJCF) given here is read
+                                as --robot reads it
 
---friction friction.json replaces the model's own friction. The states are low-pass
-filtered with zero phase (--cutoff), the accelerations differentiated from the filtered
-velocities; the measured torques are compared unfiltered. One-sample torque spikes (a
+--friction friction.json replaces the model's own friction. A Coulomb step whose
+standstill band lies well inside the noise of the velocities it is evaluated at (none at
+all: a URDF's <dynamics friction>, MJCF's frictionloss) is judged with that noise band,
+as observe bands it (a note says so): sign(dq) of the noise at every rest would flip it.
+The states are low-pass filtered with zero phase (--cutoff), the accelerations
+differentiated from the filtered velocities; the measured torques are compared
+unfiltered. One-sample torque spikes (a
 sample off both neighbours by more than 20 times the noise while the joint moves: a sensor
 or logging fault) are replaced by the line between their neighbours before judging, as
 identify replaces them before fitting; a warning names the file, the joints, the counts and
@@ -76,7 +82,7 @@ from .common import (
 )
 from .console import Console
 from .figures import save_validation_figures
-from .sources import load_model_source
+from .sources import load_model_source, params_as_robot
 from .summaries import format_rms_table
 
 NAME = "validate"
@@ -98,7 +104,10 @@ def register(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParser:
     src.add_argument("--model", type=Path, help="identification.json of an identified model")
     src.add_argument("--robot", help="'panda', 'fr3', a .urdf or a .toml: its own parameters")
     src.add_argument(
-        "--params", type=Path, help="feasible.json of retrieved link parameters (RNEA)"
+        "--params",
+        type=Path,
+        help="feasible.json of retrieved link parameters (RNEA); a .urdf, .toml or .xml is "
+        "read as --robot reads it",
     )
     p.add_argument("--base", default=None, help="URDF base link (with --robot)")
     p.add_argument("--tip", default=None, help="URDF tip link (with --robot)")
@@ -125,6 +134,7 @@ def register(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParser:
 
 def run(args: argparse.Namespace, console: Console) -> int:
     """Validate, write validation.json and the figures, print the RMS table (unless -q)."""
+    args = params_as_robot(args)  # a URDF, TOML or MJCF --params: as --robot reads it
     model, label = load_model_source(args)
     robot = model.robot if isinstance(model, IdentifiedModel) else model
     options = ValidateOptions(

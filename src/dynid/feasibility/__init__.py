@@ -28,7 +28,7 @@ from .convex import (
 )
 from .lmi import log_det_divergence, pseudo_inertia, pseudo_inertia_margin
 from .methods import METHODS, ConsistentMethod, method
-from .payload import PayloadEstimate, identify_payload, robot_with_payload
+from .payload import PayloadEstimate, identify_payload, model_with_payload, robot_with_payload
 from .penalty import RetrievalOptions, RetrievalResult, retrieve, retrieve_from_static
 from .prior import Prior, generic_prior, prior_from_robot
 from .result import FeasibleResult
@@ -62,6 +62,7 @@ __all__ = [
     "retrieve",
     "retrieve_from_static",
     "retrieve_sdp",
+    "model_with_payload",
     "robot_with_payload",
     "solve_consistent",
     "validate_newton_euler",

@@ -96,6 +96,7 @@ __all__ = [
     "PayloadEstimate",
     "identify_payload",
     "link_params_from_frame",
+    "model_with_payload",
     "robot_with_payload",
 ]
 
@@ -467,3 +468,24 @@ def _items(
 def robot_with_payload(robot: Robot, est: PayloadEstimate, *, name: str = "payload") -> Robot:
     """The robot carrying the load: :meth:`Robot.with_tool` at the estimate's frame."""
     return robot.with_tool(np.eye(4), est.mass, est.com, est.inertia, parent=est.frame, name=name)
+
+
+def model_with_payload(model: IdentifiedModel, est: PayloadEstimate) -> IdentifiedModel:
+    """The identified model carrying the load: its base parameters ``beta + P dphi``, with
+    ``dphi`` the load's standard parameters on the link of the estimate's frame
+    (:func:`robot_with_payload`) and ``P`` the model's base-parameter map
+    (:attr:`~dynid.regressors.base.BaseParameters.projection`); its friction, rotor
+    inertias, offsets, drive and recorded preprocessing as they are. The standard
+    deviations stay the arm's (the load's are the estimate's).
+
+    A base-parameter model has no links of its own to add the load to: its
+    ``equivalent_robot`` puts each combination on one parameter (masses of 0 holding first
+    moments), which no robot description holds.
+    """
+    kin = model.robot
+    loaded = robot_with_payload(kin, est)
+    dphi = (np.asarray(loaded.phi) - np.asarray(kin.phi)).reshape(-1)
+    P = model.base.projection[:, : dphi.size]
+    beta = np.asarray(model.fit.beta) + P @ dphi
+    rest = [np.asarray(t.values) for t in model.appended]
+    return model.with_coefficients(np.concatenate([beta, *rest]))

@@ -83,6 +83,7 @@ __all__ = [
     "banding_note",
     "canonical_friction",
     "derived_velocity_bands",
+    "noise_bands",
     "standstill_margin",
     "velocity_bands",
 ]
@@ -153,6 +154,23 @@ def velocity_bands(
             sd[k] = np.median(est)
         out.append(np.asarray(noise_band(sd), dtype=np.float64))
     return tuple(out)
+
+
+def noise_bands(
+    friction: FrictionModel | FrictionSum | None, dq_std: NDArray[np.float64]
+) -> tuple[NDArray[np.float64], ...]:
+    """The velocity noise band [rad/s] of the motors of every part of ``friction`` (one
+    (n,) array per part) for joint velocities of white-noise std ``dq_std`` (n,) [rad/s],
+    independent per joint: :data:`~dynid.identification.sanity.NOISE_BAND_STD` times
+    ``sqrt(K^2 dq_std^2)`` through the part's transmission ``K`` (the noise a validation's
+    prepared velocities carry, :func:`~dynid.identification.input_noise.state_noise`)."""
+    from ..identification.sanity import noise_band
+
+    var = np.asarray(dq_std, dtype=np.float64) ** 2
+    return tuple(
+        np.asarray(noise_band(np.sqrt(np.asarray(p.transmission) ** 2 @ var)), dtype=np.float64)
+        for p in friction_parts(friction)
+    )
 
 
 def derived_velocity_bands(
@@ -265,11 +283,16 @@ def _banded_part(friction: FrictionModel, b: NDArray[np.float64], derived: bool)
 def banding_note(
     friction: FrictionModel | FrictionSum | None,
     seen: Sequence[FrictionModel | FrictionSum | None],
+    *,
+    verb: str = "observed",
+    read_as: str = "external torque",
 ) -> str | None:
     """One line saying which sharp Coulomb steps of ``friction`` :func:`banded_if_narrow`
     widened for the logs (``seen``: the friction each log was observed with): the law, the
     joints (or motors) and the largest band used [rad/s]; None where it widened none (a
-    smooth law observed with the band, as identification means it, is not noted)."""
+    smooth law observed with the band, as identification means it, is not noted).
+    ``verb`` and ``read_as``: what the command did with the band and what the flips would
+    be read as (validation: ``"judged"``, ``"model error"``)."""
     changed = [s for s in seen if s is not None and s is not friction]
     said = []
     for k, part in enumerate(friction_parts(friction) if changed else ()):
@@ -284,13 +307,13 @@ def banding_note(
         said.append(
             f"{part.kind} friction: the standstill band of {where}(s) "
             f"{', '.join(str(j + 1) for j in np.flatnonzero(moved))} is inside the velocity "
-            f"noise, observed with the noise band (up to {top:.3g} rad/s)"
+            f"noise, {verb} with the noise band (up to {top:.3g} rad/s)"
         )
     if not said:
         return None
     return (
         "; ".join(said) + ": sign(dq) of the noise at rest would flip the whole Coulomb "
-        "torque, read as external torque (a friction.json of `dynid friction` carries its "
+        f"torque, read as {read_as} (a friction.json of `dynid friction` carries its "
         "own band)"
     )
 

@@ -18,13 +18,19 @@ every policy the command applies, so that the Python API behaves as the command 
 
 from __future__ import annotations
 
+import dataclasses
 from collections.abc import Sequence
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
-from ..exceptions import DataError, OptionError
-from ..feasibility.payload import PayloadEstimate, identify_payload, robot_with_payload
+from ..exceptions import DataError, ModelError, OptionError
+from ..feasibility.payload import (
+    PayloadEstimate,
+    identify_payload,
+    model_with_payload,
+    robot_with_payload,
+)
 from ..feasibility.payload_arm import ArmFriction
 from ..identification.model import IdentifiedModel
 from ..identification.sanity import SPIKES_BEFORE_FIT
@@ -32,6 +38,7 @@ from ..io.feasible import load_feasible_drive, load_feasible_linear_friction
 from ..model.drive import Drive
 from ..model.robot import Robot
 from .data_files import ColumnSpec, column_map, data_kind, in_file, read_static_file
+from .export import ExportRobotOptions, RobotExport, export_robot
 from .identify import data_files
 from .recordings import despiked_recordings, read_recordings
 
@@ -63,11 +70,38 @@ class PayloadFileResult:
         """One line per piece left out (too short to filter)."""
         return self.estimate.skipped
 
-    def robot_with_load(self, arm: Robot | IdentifiedModel) -> Robot:
-        """The arm carrying the load: ``arm`` (an identified model's equivalent robot) with
-        the estimated load added to the link of its frame."""
-        base = arm.equivalent_robot if isinstance(arm, IdentifiedModel) else arm
-        return robot_with_payload(base, self.estimate)
+    def robot_with_load(self, arm: Robot) -> Robot:
+        """The robot ``arm`` carrying the load: the estimated load added to the link of its
+        frame.
+
+        Raises
+        ------
+        ModelError
+            ``arm`` is an identified model: its base parameters are combinations of the
+            links' parameters, not a robot's links (:meth:`model_with_load`).
+        """
+        if isinstance(arm, IdentifiedModel):
+            raise ModelError(
+                "an identified model holds base parameters (combinations of the links' "
+                "parameters), not a robot's links: its model with the load is "
+                "model_with_load (a robot of links: dynid retrieve or identify --consistent)"
+            )
+        return robot_with_payload(arm, self.estimate)
+
+    def model_with_load(self, model: IdentifiedModel) -> IdentifiedModel:
+        """The identified model ``model`` carrying the load: the load's parameters added to
+        its base parameters, its friction, rotor inertias, offsets and drive kept
+        (:func:`~dynid.feasibility.payload.model_with_payload`)."""
+        return model_with_payload(model, self.estimate)
+
+    def export_with_load(
+        self, robot: str | Path, out: str | Path, options: ExportRobotOptions | None = None
+    ) -> RobotExport:
+        """What ``dynid export`` writes of the robot file ``robot`` (a ``feasible.json``
+        with its friction and drive, a robot TOML with its ``[drive]``, a URDF, a built-in
+        name) to ``out``, the robot carrying the load (:func:`~.export.export_robot`)."""
+        plan = export_robot(robot, out, options)
+        return dataclasses.replace(plan, robot=self.robot_with_load(plan.robot))
 
     def describe(self) -> str:
         """``"a.csv: 2 pieces, 3000 samples; ..."`` (empty for static data)."""

@@ -38,7 +38,7 @@ from __future__ import annotations
 
 import dataclasses
 import logging
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any, Literal
@@ -68,6 +68,7 @@ from ..io.feasible import load_feasible_drive, load_feasible_linear_friction
 from ..io.friction_json import load_friction_json
 from ..model.drive import Drive
 from ..model.robot import Robot
+from ..observer.friction import banded_if_narrow, banding_note, noise_bands
 from ..progress import NOTE
 from .data_files import ColumnSpec, in_file
 from .recordings import despiked_recordings, read_recordings
@@ -252,7 +253,7 @@ def validate_files(
     if feasible is not None:  # the file's drive holds the rotor inertias identified
         held = load_feasible_drive(feasible)
         drive = same_drive(drive, held, Path(feasible).name, f"the one {Path(feasible).name} holds")
-    own = model.drive if isinstance(model, IdentifiedModel) else None
+    placed = model.drive if drive is None and isinstance(model, IdentifiedModel) else drive
     rec = read_recordings(
         data,
         robot,
@@ -261,31 +262,30 @@ def validate_files(
         drop_invalid=opt.drop_invalid,
         cutoff_hz=opt.cutoff_hz,
         owner=f"the model ({label or robot.name})",
-        drive=own if drive is None else drive,
+        drive=placed,
         q_start=opt.q_start,
         max_gap_s=opt.max_gap_s,
         reference=model.equivalent_robot if isinstance(model, IdentifiedModel) else None,
     )
     rec, spikes = despiked_recordings(rec, robot.joint_names, SPIKES_BEFORE_JUDGING)
-    friction, source = _friction(model, opt.friction, feasible, own if drive is None else drive)
+    friction, source = _friction(model, opt.friction, feasible, placed)
 
-    def run() -> RecordingsValidation:
+    def run(fr: FrictionModel | FrictionSum | None) -> RecordingsValidation:
         return validate_recordings(
             model,
             rec.logs,
             rec.names,
-            friction=friction,
+            friction=fr,
             cutoff_hz=RECORDED if opt.cutoff_hz is None else opt.cutoff_hz,
             max_gap_s=opt.max_gap_s,
             drive=drive,
         )
 
-    val = in_file(rec.paths[0], run) if len(rec.paths) == 1 else run()
-    errors = val.errors
-    if not np.isfinite(errors.relative_error_percent) or not np.all(np.isfinite(errors.rms)):
-        raise DataError(_overflow(rec.names, val, label, opt))
+    val = in_file(rec.paths[0], lambda: _banded(run, friction)) if len(rec.paths) == 1 else None
+    val = _banded(run, friction) if val is None else val  # friction as observe evaluates it
+    errors = _finite(val, rec.names, label, opt)
     names = robot.joint_names
-    inputs = _input_noise(model, friction, val)
+    inputs = _input_noise(model, val.friction, val)
     verdict, noise, floor = _judged(val, np.ones(len(val.parts), bool), errors, names, inputs)
     labels = np.asarray(val.pieces.recording)
     if len(rec.names) > 1:  # recordings judged apart: the worst named, when they differ
@@ -411,6 +411,43 @@ def _friction(
     if isinstance(friction, str | Path):  # where the drive puts a robot's own, as simulated
         return placed_friction(load_friction_json(friction), drive), Path(friction).name
     return placed_friction(friction, drive), "given"
+
+
+def _banded(
+    run: Callable[[FrictionModel | FrictionSum | None], RecordingsValidation],
+    friction: FrictionModel | FrictionSum | None,
+) -> RecordingsValidation:
+    """The validation ``run`` gives with ``friction`` as the observer evaluates it on
+    velocities of the noise the recordings are prepared to (``state_noise``): a sharp
+    Coulomb step whose standstill band lies well inside that noise band, or a smooth step
+    narrower than it, gets the noise band
+    (:func:`~dynid.observer.friction.banded_if_narrow` of
+    :func:`~dynid.observer.friction.noise_bands`), said in a note
+    (:func:`~dynid.observer.friction.banding_note`); run again only then. Without it
+    ``sign(dq)`` of the noise at every rest flips the whole Coulomb torque (a URDF's
+    ``<dynamics friction>``, which holds no band). An identified law's band is that noise
+    band already: it stays as it is."""
+    val = run(friction)
+    noise = val.pieces.state_noise
+    if friction is None or noise is None:
+        return val
+    bands = noise_bands(friction, noise.dq)
+    banded = banded_if_narrow(friction, bands, derived=noise.derived)
+    if banded is friction:
+        return val
+    if said := banding_note(friction, [banded], verb="judged", read_as="model error"):
+        _log.log(NOTE, said)
+    return run(banded)
+
+
+def _finite(
+    val: RecordingsValidation, names: Any, label: str | None, opt: ValidateOptions
+) -> TorqueErrors:
+    """The pooled errors of ``val``, refused when they overflow (:func:`_overflow`)."""
+    errors = val.errors
+    if not np.isfinite(errors.relative_error_percent) or not np.all(np.isfinite(errors.rms)):
+        raise DataError(_overflow(names, val, label, opt))
+    return errors
 
 
 def _overflow(names: Any, val: Any, label: str | None, opt: ValidateOptions) -> str:
