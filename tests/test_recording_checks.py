@@ -27,6 +27,7 @@ from dynid.identification.recordings import (
     wrappable,
 )
 from dynid.model.drive import Drive
+from dynid.progress import NOTE
 from dynid.simulation.measurement import SensorNoise, sample_times, simulate_measurement
 from dynid.simulation.trajectories import Trajectory, random_fourier
 
@@ -364,7 +365,8 @@ def test_a_recording_in_short_pieces_is_checked_once_and_whole(panda):
 
 def test_positions_only_recordings_are_said_once(panda, log, tmp_path, caplog):
     """Four recordings without velocity columns: four copies of one long warning, one per
-    file; now one, naming the files (the reader's own line at -v only)."""
+    file; now one note (nothing is wrong with such logs), naming the files (the reader's
+    own line at -v only)."""
     from dynid.io.torque_log import save_torque_log
     from dynid.workflows.recordings import read_recordings
 
@@ -374,10 +376,11 @@ def test_positions_only_recordings_are_said_once(panda, log, tmp_path, caplog):
         )
         for k in range(1, 5)
     ]
-    with warnings.catch_warnings(record=True) as got, caplog.at_level("WARNING"):
+    with warnings.catch_warnings(record=True) as got, caplog.at_level(NOTE):
         warnings.simplefilter("always", DynidWarning)
         rec = read_recordings(paths, panda)
     assert all(g.dq_derived for g in rec.logs)
     said = [str(w.message) for w in got if "no velocity columns" in str(w.message)]
     said += [r.getMessage() for r in caplog.records if "no velocity columns" in r.getMessage()]
     assert len(said) == 1 and said[0].startswith("r1.csv, r2.csv, r3.csv, r4.csv: "), said
+    assert not [w for w in got if "no velocity columns" in str(w.message)]

@@ -36,6 +36,7 @@ Pieces too short to filter are the preparation's (:mod:`dynid.friction.recording
 
 from __future__ import annotations
 
+import logging
 import warnings
 from collections.abc import Sequence
 from dataclasses import dataclass
@@ -60,6 +61,7 @@ from ..identification.unit_mix import degrees_among_radians, joints_in_degrees
 from ..io.columns import ColumnMap
 from ..model.drive import Drive
 from ..model.robot import Robot
+from ..progress import NOTE
 from ..signals import sample_rate
 from .data_files import (
     ColumnSpec,
@@ -83,6 +85,8 @@ __all__ = [
     "given_start",
     "read_recordings",
 ]
+
+_log = logging.getLogger(__name__)
 
 #: Ratio of a recording's torque scale (or velocity unit) to the other recordings' median
 #: beyond which it is taken to be in another unit (a power of ten: mN m, ms, degrees).
@@ -339,14 +343,16 @@ def check_units(rec: Recorded) -> None:
 
 
 def check_derived_velocities(rec: Recorded, cmap: ColumnMap | None = None) -> None:
-    """Warn once for every recording without velocity columns (``dq_derived``), naming
-    them: four positions-only logs gave four copies of one long line."""
+    """Say once, as a note, every recording without velocity columns (``dq_derived``),
+    naming them: four positions-only logs gave four copies of one long line; and a
+    warning it was, though nothing is wrong with such a log (an industrial controller
+    logs positions only)."""
     names = [n for n, log in zip(rec.names, rec.logs, strict=True) if log.dq_derived]
     if not names:
         return
     cutoff = DEFAULT_CUTOFF_HZ if cmap is None else cmap.velocity_cutoff_hz
     which = ", ".join(names) if len(names) <= 4 else f"{len(names)} recordings ({names[0]}, ...)"
-    warnings.warn(f"{which}: {velocity_note(cutoff)}", DynidWarning, stacklevel=3)
+    _log.log(NOTE, "%s: %s", which, velocity_note(cutoff))
 
 
 def check_degrees(rec: Recorded, robot: Robot) -> None:
