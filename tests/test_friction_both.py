@@ -304,3 +304,20 @@ def test_validate_refuses_a_drive_other_than_the_one_feasible_json_holds(panda, 
     assert code == 2 and len(lines) == 1, lines
     assert "differs from the one feasible.json holds: friction_at" in lines[0]
     assert not (tmp_path / "v").exists()
+
+
+def test_the_summary_says_which_joints_friction_the_motors_hold(both):
+    """The summary's table of the friction at the joints: joints 1-6, each turned by one
+    motor alone (:func:`joint_side_joints`), read "motor's" with one line saying their
+    friction at the joint is identified in the motor's; they read "-" (left out), and a
+    user holding a datasheet read the motor's Coulomb 35 % high. Joint 7 holds its own."""
+    from dynid.cli.summaries import term_lines
+
+    model, _, _ = both
+    lines = term_lines(model)
+    at = next(k for k, x in enumerate(lines) if x.startswith("joint friction identified"))
+    rows = {int(r.split()[0]): r.split()[1:] for r in lines[at + 2 : at + 9]}
+    assert all(rows[j][:2] == ["motor's", "motor's"] for j in range(1, 7)), rows
+    assert rows[7][0] != "motor's"
+    said = lines[at + 9]
+    assert said.startswith("  motor's: a motor turns joint(s) 1, 2, 3, 4, 5, 6 alone")

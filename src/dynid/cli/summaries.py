@@ -132,16 +132,31 @@ def term_lines(model: IdentifiedModel) -> list[str]:
             max(len(h), *(len(cells.get((stem, j), "-")) for j in range(1, n + 1)))
             for h, stem in zip(heads, stems, strict=True)
         ]
+        held = {j for (stem, j) in cells if stem not in scales}
+        # a joint friction of a drive on a joint a motor turns alone: the motor's columns
+        alone = [j for j in range(1, n + 1) if j not in held] if drive is not None else []
+        alone = alone if row == "joint" and len(alone) < n else []
         out.append(f"{name} identified with the links (value, std %; - left out):")
         titles = [f"{h:<{w}}" for h, w in zip(heads, widths, strict=True)]
         out.append(f"  {row:<5}  " + "  ".join(titles).rstrip())
         for j in range(1, n + 1):
             cols = [
-                f"{cells.get((stem, j), '-'):<{w}}" for stem, w in zip(stems, widths, strict=True)
+                f"{cells.get((stem, j), MOTORS if j in alone and stem not in scales else '-'):<{w}}"
+                for stem, w in zip(stems, widths, strict=True)
             ]
             out.append(f"  {j:<5}  " + "  ".join(cols).rstrip())
+        if alone:
+            out.append(
+                f"  {MOTORS}: a motor turns joint(s) {', '.join(map(str, alone))} alone: "
+                "their friction at the joint acts on the motor's columns and is identified "
+                "in the motor's (its fc holds fc_motor + fc_joint / gear ratio)"
+            )
         out += _scales_lines(scales, model)
     return out
+
+
+#: The cell of a joint's friction at the joint that the motor's friction holds.
+MOTORS = "motor's"
 
 
 def _velocity_scales(term: Any, n: int) -> dict[str, tuple[float, ...]]:
