@@ -368,3 +368,16 @@ def test_currents_in_ma_are_read_through_a_current_drive_and_said_once(tmp_path,
         column_map(None, "tau=mA")
     with pytest.raises(OptionError, match="the drive's effort is 'torque'"):
         column_map(None, "tau=A", drive=torque)
+
+
+def test_recorded_column_map_warning_names_flags_not_python_none(caplog):
+    """Regression: a model read with --units alone warned "columns None, units 'q=deg'"."""
+    from dynid.workflows.data_files import recorded_columns
+
+    with caplog.at_level("WARNING"):
+        used = recorded_columns({"columns": None, "units": "q=deg"}, None, None)
+        recorded_columns({"columns": None, "units": "q=deg"}, None, "tau=Nm")
+    assert used == (None, "q=deg")
+    assert "None" not in caplog.text
+    assert "(--units q=deg)" in caplog.text
+    assert "with --units tau=Nm; the model's data were read with --units q=deg" in caplog.text
