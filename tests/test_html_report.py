@@ -598,7 +598,7 @@ def test_validate_is_not_good_while_a_joint_errs_by_15_percent(tmp_path):
     p.write_text(json.dumps(doc))
     level, text = _verdict_of(render_html_report(RunSummary(command="validate"), {p.name: p}))
     assert level == "fair", text
-    assert "Worst joint panda_joint6" in text and "19" in text
+    assert "Worst joint by relative error panda_joint6" in text and "19" in text
     doc["without_friction"]["relative_error_percent_per_joint"] = [2.0] * 7
     p.write_text(json.dumps(doc))
     assert _verdict_of(render_html_report(RunSummary(command="validate"), {p.name: p}))[0] == (

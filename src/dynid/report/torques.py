@@ -100,8 +100,14 @@ def validate_answer(run: RunFiles) -> Answer | None:
         if LEVELS.index(joint) > LEVELS.index(level) and level != "unusable":
             level = joint
         noise = f", {ratio[j]:.3g} x its sensor noise" if ratio[j] < float("inf") else ""
+        ranked = (
+            "Worst joint against its own noise (the largest RMS error over sensor noise; "
+            "another joint's relative error can be larger)"
+            if ratio[j] < float("inf")
+            else "Worst joint by relative error"
+        )
         facts.append(
-            f"Worst joint {esc(_names(doc, len(per))[j])}: relative error "
+            f"{ranked} {esc(_names(doc, len(per))[j])}: relative error "
             f"<b>{percent(per[j])}</b>{noise} (per joint judged good below {JOINT_GOOD:g} % or "
             f"at its noise, usable below {JOINT_FAIR:g} % or {FLOOR_FAIR:g} x its noise)"
         )
