@@ -230,11 +230,11 @@ def friction_answer(run: RunFiles) -> Answer | None:
     )
     head = f"Friction law chosen: {esc(written)}."
     figs, shown = _figures(run, (("friction.png", "Friction against velocity over the data"),))
-    sections = (
+    sections = (  # the figure first: the tables of a sum and its RMS would push it down
+        figs,
         *_law_tables(doc, names),
         _rms_table(joints, names),
         _candidates_table(cands, sel.get("chosen")),
-        figs,
     )
     return Answer(verdict(level, head, facts), sections, shown)
 
