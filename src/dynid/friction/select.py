@@ -21,7 +21,7 @@ to:
    the training error is that of the law fitted on the whole log, on the whole log.
 4. The candidates are compared, as identification's structure selection compares its
    candidates (:mod:`dynid.identification.selection`), on the held-out error with each
-   joint in units of its own torque noise (a wrist whose noise is a tenth of the
+   joint in units of its own torque noise (a wrist whose noise is a fortieth of the
    shoulder's is not lost in the pooled error: a coupled wrist's bearing friction missed
    by every law at the motors cost 3.12 % against 3.14 % pooled, 6 times the wrist's noise
    in validation), and the **simplest candidate within one standard error of the lowest**
@@ -177,8 +177,8 @@ class FrictionSelection:
 
     def table(self) -> str:
         """The candidates as a text table, the kept one marked with ``*``, and the rule."""
-        w = max(12, *(len(s.name) for s in self.scores))
-        p = max(10, *(len(", ".join(s.params)) for s in self.scores))
+        w = max([12, *(len(s.name) for s in self.scores)])
+        p = max([10, *(len(", ".join(s.params)) for s in self.scores)])
         rows = [
             f"  {'friction law':<{w}} {'parameters':<{p}} {'train [%]':>10} "
             f"{'held-out [%]':>13} {'by noise [%]':>13}"
