@@ -332,7 +332,7 @@ def test_the_recorded_units_are_said_with_how_to_read_another_file(caplog):
         used = recorded_columns({"columns": None, "units": "tau=mNm"}, None, None)
     assert used == (None, "tau=mNm")
     (said,) = [r.getMessage() for r in caplog.records]
-    assert "units 'tau=mNm'" in said and "--units tau=Nm for SI torques" in said, said
+    assert "(--units tau=mNm)" in said and "--units tau=Nm for SI torques" in said, said
 
 
 def test_currents_in_ma_are_read_through_a_current_drive_and_said_once(tmp_path, caplog):
