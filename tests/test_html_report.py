@@ -8,6 +8,7 @@ installed, rendered by it): what a browser sees, not our own strings.
 from __future__ import annotations
 
 import base64
+import html
 import json
 import re
 import shutil
@@ -598,7 +599,7 @@ def test_validate_is_not_good_while_a_joint_errs_by_15_percent(tmp_path):
     p.write_text(json.dumps(doc))
     level, text = _verdict_of(render_html_report(RunSummary(command="validate"), {p.name: p}))
     assert level == "fair", text
-    assert "Worst joint panda_joint6" in text and "19" in text
+    assert "Worst joint by relative error panda_joint6" in text and "19" in text
     doc["without_friction"]["relative_error_percent_per_joint"] = [2.0] * 7
     p.write_text(json.dumps(doc))
     assert _verdict_of(render_html_report(RunSummary(command="validate"), {p.name: p}))[0] == (
@@ -833,3 +834,40 @@ def test_recordings_that_differ_are_not_called_over_fitted(tmp_path):
     p.write_text(json.dumps(ident | {"metadata": {"heldout": ho, "n_rows": 1000}}))
     _, text = _verdict_of(render_html_report(RunSummary(command="identify"), {p.name: p}))
     assert "the fit over-fits" in text, text
+
+
+def test_the_friction_page_names_what_friction_json_holds(tmp_path):
+    """Regression: the page said "Friction law chosen: stribeck ... held-out error 3.12 %,
+    the lowest" while the candidate kept at 3.12 % was the model's own friction (stribeck
+    scored 3.136 %), and labelled the motors' coefficients "joint 1..6". A sum at the
+    motors and at the joints is named as written, its error is the own candidate's, and
+    the motors' table has motor rows."""
+    from dynid.friction.laws import LAWS
+    from dynid.friction.model import FrictionSum
+    from dynid.io.friction_json import save_friction_json
+    from dynid.model.drive import Drive
+
+    K = np.diag([100.0, 50.0])
+    K[1, 0] = 20.0
+    drive = Drive(transmission=K, offset=np.zeros(2))
+    at_motors = LAWS["classical"].model(np.array([[1e-3, 0.05, 0.0], [1e-3, 0.02, 0.0]]))
+    at_joints = LAWS["classical"].model(np.array([[0.0, 0.0, 0.0], [0.0, 0.3, 0.0]]))
+    own = FrictionSum((at_motors.at(drive), at_joints))
+    rows = [("stribeck", 3.136), ("classical", 3.141), ("own", 3.120)]
+    selection = {
+        "method": "leave one recording out (3 recordings)",
+        "folds": 3,
+        "rule": "the simplest within one standard error of the lowest held-out error",
+        "chosen": "own",
+        "candidates": [
+            {"model": m, "parameters": [], "train_error_percent": e, "heldout_error_percent": e}
+            for m, e in rows
+        ],
+    }
+    p = save_friction_json(tmp_path / "friction.json", own, selection=selection)
+    page = render_html_report(RunSummary(command="friction"), {p.name: p})
+    text = html.unescape(_verdict_of(page)[1])
+    assert "chosen: classical at the motors + classical at the joints" in text, text
+    assert "the model's own friction (classical at the motors" in text and "3.12 %" in text
+    assert "3.136" not in text and "the lowest of" not in text
+    assert ">motor 1<" in page and ">motor 2<" in page

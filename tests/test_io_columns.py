@@ -332,7 +332,7 @@ def test_the_recorded_units_are_said_with_how_to_read_another_file(caplog):
         used = recorded_columns({"columns": None, "units": "tau=mNm"}, None, None)
     assert used == (None, "tau=mNm")
     (said,) = [r.getMessage() for r in caplog.records]
-    assert "units 'tau=mNm'" in said and "--units tau=Nm for SI torques" in said, said
+    assert "(--units tau=mNm)" in said and "--units tau=Nm for SI torques" in said, said
 
 
 def test_currents_in_ma_are_read_through_a_current_drive_and_said_once(tmp_path, caplog):
@@ -397,3 +397,16 @@ def test_single_joints_are_flipped_as_read_after_their_quantitys_unit(tmp_path):
         load_mapped_torque_log(path, parse_column_map(columns, "t=ms,tau4=-1"))
     with pytest.raises(DataError, match=r"tau2=2: a single joint's entry flips its sign"):
         parse_column_map(None, "tau2=2")
+
+
+def test_recorded_column_map_warning_names_flags_not_python_none(caplog):
+    """Regression: a model read with --units alone warned "columns None, units 'q=deg'"."""
+    from dynid.workflows.data_files import recorded_columns
+
+    with caplog.at_level("WARNING"):
+        used = recorded_columns({"columns": None, "units": "q=deg"}, None, None)
+        recorded_columns({"columns": None, "units": "q=deg"}, None, "tau=Nm")
+    assert used == (None, "q=deg")
+    assert "None" not in caplog.text
+    assert "(--units q=deg)" in caplog.text
+    assert "with --units tau=Nm; the model's data were read with --units q=deg" in caplog.text

@@ -266,14 +266,19 @@ def test_quiet_keeps_a_json_result(capsys):
 
 def test_the_friction_law_policy_is_the_library_s(files, tmp_path, capsys):
     """fit_friction_files applies dynid friction's policy: auto compares every law on
-    held-out blocks (the model's own friction too) and keeps the lowest held-out error, a
-    named law is fitted as asked, an unknown one is refused; the command writes what the
-    API returns."""
+    held-out blocks (the model's own friction too) and keeps the simplest within one
+    standard error of the lowest, a named law is fitted as asked, an unknown one is
+    refused; the command writes what the API returns."""
+    from dynid.friction.select import simplest_within
+
     panda = dynid.panda()
     auto = fit_friction_files(panda, files / "log.csv")
     assert auto.selection is not None and auto.fit is auto.selection.fit
-    held = {s.name: s.heldout_error_percent for s in auto.selection.scores}
-    assert held[auto.selection.chosen] == min(held.values()) and "own" in held
+    scores = {s.name: s for s in auto.selection.scores}
+    chosen = scores[auto.selection.chosen]
+    assert chosen.name == simplest_within(auto.selection.scores).name and "own" in scores
+    low = min(s.scaled_error_percent for s in scores.values())
+    assert chosen.scaled_error_percent <= 1.05 * low < scores["none"].scaled_error_percent
     named = fit_friction_files(panda, files / "log.csv", FrictionOptions(law="classical"))
     assert named.selection is None and named.fit.kind == "classical"
     with pytest.raises(OptionError, match="law must be one of auto, none") as api:

@@ -5,13 +5,19 @@ robot's own link parameters with --robot) is fitted per joint by a friction law:
 --friction-model auto (default) fits every law of the registry (listed below, with none:
 no extra friction) on 4 of 5 contiguous blocks of the log in turn (with several
 recordings: on all but one recording in turn), predicts the block left out, keeps the
-law with the lowest held-out error (the model's own friction is a candidate too, judged
-on the same blocks: as it is, or its own law, band and coefficients refitted on the other
-blocks when --model was identified from these recordings, the law it was trained with; a
-robot's own friction is never refitted) and prints
-the table; a law's name fits that law. --data takes several recordings (or a folder of
-them): each recording, and each piece of one cut at a gap longer than --max-gap, is
-filtered on its own, and the laws are fitted on the residual of all pieces together.
+simplest law within one standard error of the lowest held-out error, each joint in units
+of its own torque noise, as identify chooses its structure (the model's own friction is a
+candidate too, judged on the same blocks: as it is, or its own law, band and coefficients
+refitted on the other blocks when --model was identified from these recordings, the law
+it was trained with; a robot's own friction is never refitted; kept, it is kept as it is,
+friction at the motors and at the joints both) and prints the table; a law's name fits
+that law. smooth_stribeck is compared only when the model's own friction is that law.
+The rigid-body model is not refitted per block: on the recordings --model was identified
+from, the errors are training errors of the links (validate judges new data). --data
+takes several recordings (or a folder of them): each recording, and each piece of one
+cut at a gap longer than --max-gap, is filtered on its own, and the laws are fitted on
+the residual of all pieces together, at every sample as measured (the torques validate
+judges; a log of jittered stamps at its own samples, not on a grid between them).
 Coulomb friction is off where |dq| is inside the velocity noise band. The states are
 low-pass filtered with zero phase (--cutoff) and the accelerations differentiated from
 the filtered velocities. With a drive (--drive, the model's own, or a --robot TOML's
@@ -19,8 +25,8 @@ the filtered velocities. With a drive (--drive, the model's own, or a --robot TO
 torques K^T diag(I_a) K ddq as validate adds them, and the law is fitted per motor at
 the motor velocities where the drive's friction acts there (tau_f = K^T f(K dq)).
 
-Writes OUT/friction.json (parameters, RMS of the residual before and after, the held-out
-table) and
+Writes OUT/friction.json (parameters, RMS of the residual before and after, the torques'
+sensor noise per joint, the held-out table) and
 OUT/friction.png (residual against velocity with the fitted curve, per joint; skipped,
 with a note, without matplotlib). The log is read strictly: rows with NaN/inf or a
 repeated timestamp are an error unless --drop-invalid; gaps up to --max-gap are bridged,
@@ -60,7 +66,7 @@ from .common import (
 )
 from .console import Console
 from .figures import save_friction_figure
-from .summaries import format_rms_table
+from .summaries import format_friction_rms
 
 NAME = "friction"
 #: ``--out`` is a folder: its files are one output set (:mod:`dynid.outputs.run_output`).
@@ -92,7 +98,8 @@ def register(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParser:
         "--friction-model",
         choices=("auto", *LAWS),
         default="auto",
-        help="friction law; auto (default): the one with the lowest held-out error; the laws "
+        help="friction law; auto (default): the simplest within one standard error of the "
+        "lowest held-out error; the laws "
         "and their parameters per joint: "
         + ", ".join(f"{law.name} ({' '.join(law.params) or 'zero'})" for law in LAWS.values()),
     )
@@ -140,8 +147,7 @@ def run(args: argparse.Namespace, console: Console) -> int:
         )
     if sel is not None:
         console.print(sel.table())
-    cols = {"RMS before [N m]": fit.rms_before, "RMS after [N m]": fit.rms_after}
-    console.print(format_rms_table(names, cols))
+    console.print(format_friction_rms(names, fit, result.noise_std))
     if result.pieces is not None:
         console.print(result.pieces.describe())
     console.wrote(args.out / "friction.json")

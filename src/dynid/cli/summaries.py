@@ -13,6 +13,7 @@ from ..feasibility.constraints import principal_moments
 from ..feasibility.convex import ConsistentResult
 from ..feasibility.heldout import HeldOutJudgement
 from ..feasibility.penalty import RetrievalProgress, RetrievalResult
+from ..friction.fit import FrictionFit
 from ..friction.model import friction_parts
 from ..friction.validation import NewtonEulerValidation
 from ..identification.info import LogInfo
@@ -31,6 +32,7 @@ __all__ = [
     "format_identification",
     "format_newton_euler_rms",
     "format_retrieval",
+    "format_friction_rms",
     "format_rms_table",
     "heldout_line",
     "heldout_table",
@@ -548,6 +550,21 @@ def format_rms_table(names: list[str], columns: dict[str, np.ndarray]) -> str:
             + "".join(f"{_rms_text(float(v[j])):>{cw[k]}}" for k, v in columns.items())
         )
     return "\n".join(rows)
+
+
+def format_friction_rms(names: list[str], fit: FrictionFit, noise: np.ndarray | None) -> str:
+    """``dynid friction``'s table: per joint the residual RMS before and after the friction
+    [N m] and the torques' sensor noise, and what they are: on the recordings the friction
+    was fitted to, every sample as measured (the torques validate judges)."""
+    cols = {"RMS before [N m]": fit.rms_before, "RMS after [N m]": fit.rms_after}
+    if noise is not None:
+        cols["sensor noise [N m]"] = noise
+    return (
+        format_rms_table(names, cols)
+        + "\nRMS on the recordings the friction was fitted to (training data of the friction, "
+        "and of the rigid-body model when identified from them), every sample as measured; "
+        "validate judges new recordings"
+    )
 
 
 def _rms_text(x: float) -> str:

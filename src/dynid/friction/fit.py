@@ -51,7 +51,7 @@ from ..identification.sanity import moving_joints, noise_band, velocity_noise_st
 from ..model.drive import Drive
 from ..model.robot import Robot
 from .laws import FrictionLaw, law_named
-from .model import FrictionModel
+from .model import FrictionModel, FrictionSum
 
 __all__ = [
     "FrictionFit",
@@ -287,8 +287,9 @@ class FrictionFit:
 
     Attributes
     ----------
-    friction : Friction
-        The fitted law with its parameters per joint (per motor at the motors of a drive).
+    friction : Friction or FrictionSum
+        The fitted law with its parameters per joint (per motor at the motors of a drive);
+        a model's own friction at the motors and at the joints kept as it is (a sum).
     rms_before : ndarray, shape (n,)
         RMS of the residual without friction compensation [N m].
     rms_after : ndarray, shape (n,)
@@ -304,7 +305,7 @@ class FrictionFit:
         band and have zero friction (:func:`moving_joints`).
     """
 
-    friction: FrictionModel
+    friction: FrictionModel | FrictionSum
     rms_before: NDArray[np.float64]
     rms_after: NDArray[np.float64]
     converged: NDArray[np.bool_]
@@ -603,6 +604,7 @@ def fit_law_through(
     r = np.asarray(np.linalg.solve(K.T, residual.T).T, dtype=np.float64)
     noise = None if dq_noise_std is None else np.sqrt((K**2) @ np.asarray(dq_noise_std) ** 2)
     fit = fit_law(law, v, r, dq_noise_std=noise, warn=warn)
+    assert isinstance(fit.friction, FrictionModel)  # fit_law fits one law
     fr = fit.friction.at(drive)  # the law per motor
     after = residual - fr.torques(dq)
     return replace(

@@ -44,7 +44,7 @@ from ..identification.log import TorqueLog, joint_side_log
 from ..identification.metrics import TorqueErrors
 from ..identification.model import IdentifiedModel
 from ..identification.pieces import check_below_nyquist, recording_pieces, skipped_piece, wrappable
-from ..identification.prepare import Preprocessing, prepare_log
+from ..identification.prepare import Preprocessing, at_measured_samples, prepare_log, resamples
 from ..identification.sanity import velocity_noise_std
 from ..identification.trim import common_cutoff, edge_seconds
 from ..model.drive import Drive
@@ -171,6 +171,7 @@ def prepare_pieces(
     filter_tau: bool = False,
     drive: Drive | None = None,
     decimate: int | Literal["recorded"] = RECORDED,
+    measured_samples: bool = False,
 ) -> Pieces:
     """Read every recording at the joints, unwrap, cut at its gaps and prepare each piece.
 
@@ -200,6 +201,13 @@ def prepare_pieces(
     drive : Drive, optional
         The drive the logs were recorded through, for a model without one
         (:func:`~dynid.friction.fit.model_drive`).
+    measured_samples : bool
+        With ``decimate=1`` and the torques as measured: a piece the preparation resamples
+        (jittered or dropped stamps) is read back at its own samples, the torques as
+        measured (:func:`~dynid.identification.prepare.at_measured_samples`), as
+        validation judges it; else the grid (whose linear interpolation averages a
+        sample's noise with its neighbour's: an xArm7 at 100 Hz, stamps +-2 ms, fitted
+        0.277 N m RMS on a joint whose sensor noise is 0.3 N m).
 
     Returns
     -------
@@ -214,14 +222,18 @@ def prepare_pieces(
     prep = _recorded_preparation(model, max_gap_s, decimate, filter_tau)
     raw = _raw_pieces(model, logs, names, cutoff_hz, prep.max_gap_s, drive, trim_s)
     prep = dataclasses.replace(prep, cutoff_hz=raw.cutoff_hz, trim_s=raw.trim_s)
+    own = measured_samples and not prep.filter_tau and prep.decimate == 1
     prepared, recording, skipped, left = [], [], [], []
     for k, (r, piece) in enumerate(raw.pieces):
         try:
-            prepared.append(prepare_log(piece, prep))
+            p = prepare_log(piece, prep)
         except DataError as exc:
             skipped.append(skipped_piece(raw.names[r], piece, exc))
             left.append((k, str(exc)))
             continue
+        if own and resamples(piece, prep):  # its own samples, not a grid between them
+            p = next(at_measured_samples([p], piece), p)
+        prepared.append(p)
         recording.append(r)
     _say_left_out(raw, left, prep.max_gap_s)
     return _kept(raw, prepared, recording, skipped)

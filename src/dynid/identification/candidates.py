@@ -37,6 +37,7 @@ __all__ = [
     "Selection",
     "candidate_judged",
     "heldout_of",
+    "paired_fold_se",
     "paired_se",
     "recording_oddness",
     "relative_stds",
@@ -168,7 +169,13 @@ def paired_se(c: Candidate, best: Candidate) -> float:
     call a consistently worse candidate as good as the best. The one-standard-error rule
     reads the spread of the differences instead. 0 for one fold (the folds of two
     candidates always match: the same held-out data)."""
-    a, b = c.fold_scores, best.fold_scores
+    return paired_fold_se(c.fold_scores, best.fold_scores)
+
+
+def paired_fold_se(a: Sequence[float], b: Sequence[float]) -> float:
+    """Standard error [%] of the mean of ``a - b`` over the folds (the fold errors [%] of
+    two candidates judged on the same folds, :func:`paired_se`); 0 for fewer than two
+    folds or folds that do not match."""
     if len(a) < 2 or len(a) != len(b):
         return 0.0
     d = np.subtract(a, b)

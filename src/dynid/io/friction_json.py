@@ -20,6 +20,12 @@ band, its parameters are zero) are written when a
 :class:`~dynid.friction.fit.FrictionFit` is saved and are optional on reading;
 ``selection`` (the held-out comparison of :mod:`dynid.friction.select`) when the law was
 chosen on held-out data.
+
+Friction at the motors and at the joints together (a coupled drive's ``at:both``,
+:class:`~dynid.friction.model.FrictionSum`) is ``"model": "sum"`` with its ``parts``, each
+``{"model", "at": "motor" | "joint", "convention", "units", "joints"}`` holding that law's
+parameters (and band) per joint, acting at the motors of ``drive`` or at the joints;
+``joints`` then holds the fit's ``rms_before``/``rms_after``/``identified`` alone.
 """
 
 from __future__ import annotations
@@ -33,7 +39,7 @@ from .. import _checks
 from ..exceptions import DataError, DynidError
 from ..friction.fit import FrictionFit
 from ..friction.laws import LAWS
-from ..friction.model import FrictionModel
+from ..friction.model import FrictionModel, FrictionSum, friction_parts
 from .drive_file import drive_from_record
 from .json_files import load_json
 from .schema import Field, Format, Record, check, describe, fault, save_document
@@ -41,13 +47,15 @@ from .schema import Field, Format, Record, check, describe, fault, save_document
 __all__ = ["FORMAT", "load_friction_json", "save_friction_json"]
 
 FORMAT = "dynid-friction/1"
+#: ``model`` of friction at the motors and at the joints together (module docstring).
+SUM = "sum"
 
 _CONVENTION = "tau = M ddq + c + g + tau_f(dq); "
 
 
 def save_friction_json(
     path: str | Path,
-    friction: FrictionModel | FrictionFit,
+    friction: FrictionModel | FrictionSum | FrictionFit,
     *,
     metadata: dict[str, Any] | None = None,
     selection: dict[str, Any] | None = None,
@@ -56,6 +64,8 @@ def save_friction_json(
 
     ``selection``: the held-out comparison of the candidate laws
     (:meth:`~dynid.friction.select.FrictionSelection.as_dict`), written as ``selection``.
+    A :class:`~dynid.friction.model.FrictionSum` is written part by part (module
+    docstring).
 
     Returns
     -------
@@ -69,40 +79,62 @@ def save_friction_json(
         fit, model = friction, friction.friction
     else:
         fit, model = None, friction
-    drive, law, P = model.drive, model.law, model.as_array()
+    parts = [_law_doc(p) for p in friction_parts(model)]
+    joints: list[dict[str, float | bool]] = (
+        parts[0]["joints"] if len(parts) == 1 else [{} for _ in range(model.n)]
+    )
+    units: dict[str, str] = parts[0]["units"] if len(parts) == 1 else {}
+    if fit is not None:
+        for j, d in enumerate(joints):
+            d["rms_before"] = float(fit.rms_before[j])
+            d["rms_after"] = float(fit.rms_after[j])
+            d["identified"] = bool(fit.identified[j])
+        units.update(rms_before="N m", rms_after="N m")
+    drive = model.drive
+    doc: dict[str, Any] = {
+        "schema": FORMAT,
+        "dynid_version": __version__,
+        "model": model.kind if len(parts) == 1 else SUM,
+        "convention": parts[0]["convention"]
+        if len(parts) == 1
+        else _CONVENTION + "tau_f = the sum of the parts' (each at its motors or joints)",
+        "units": units,
+        "joints": joints,
+    }
+    if len(parts) > 1:
+        doc["parts"] = parts
+    doc |= {"drive": None if drive is None else drive.as_dict(), "metadata": metadata or {}}
+    if selection is not None:
+        doc["selection"] = selection
+    return save_document(path, Format(FORMAT, _record(str(doc["model"])), _WHAT), doc)
+
+
+def _law_doc(model: FrictionModel) -> dict[str, Any]:
+    """One law's ``model``, ``at``, ``convention``, ``units`` and ``joints`` (its
+    parameters and standstill band per joint)."""
+    law, P = model.law, model.as_array()
     band = model.band if law.standstill else None
     joints = []
     for j in range(model.n):
         d: dict[str, float | bool] = {k: float(P[j, i]) for i, k in enumerate(model.names)}
         if band is not None:
             d["standstill_band"] = float(band[j])
-        if fit is not None:
-            d["rms_before"] = float(fit.rms_before[j])
-            d["rms_after"] = float(fit.rms_after[j])
-            d["identified"] = bool(fit.identified[j])
         joints.append(d)
     units = dict(zip(law.params, law.units, strict=True))
     if band is not None:
         units["standstill_band"] = "rad/s"
-    if fit is not None:
-        units.update(rms_before="N m", rms_after="N m")
-    doc = {
-        "schema": FORMAT,
-        "dynid_version": __version__,
+    return {
         "model": model.kind,
+        "at": "motor" if model.at_motors else "joint",
         "convention": _CONVENTION + law.formula,
         "units": units,
         "joints": joints,
-        "drive": None if drive is None else drive.as_dict(),
-        "metadata": metadata or {},
     }
-    if selection is not None:
-        doc["selection"] = selection
-    return save_document(path, Format(FORMAT, _record(model.kind), _WHAT), doc)
 
 
-def load_friction_json(path: str | Path) -> FrictionModel:
-    """Read a friction model from ``path``.
+def load_friction_json(path: str | Path) -> FrictionModel | FrictionSum:
+    """Read a friction model from ``path`` (a sum of friction at the motors and at the
+    joints: :class:`~dynid.friction.model.FrictionSum`, module docstring).
 
     Raises
     ------
@@ -119,9 +151,38 @@ def load_friction_json(path: str | Path) -> FrictionModel:
     if tag != FORMAT:
         raise fault(path.name, "schema", f"expected {FORMAT!r} ({_WHAT}); got {_checks.short(tag)}")
     kind = doc.get("model")
-    if kind not in LAWS:
+    if kind not in LAWS and kind != SUM:
         raise fault(path.name, "model", f"expected {describe(_MODEL)}; got {_checks.short(kind)}")
     check(doc, _record(kind), path.name)
+    n = len(doc["joints"])
+    drive = None
+    if doc.get("drive") is not None:
+        drive = drive_from_record(doc["drive"], n, source=path.name, at="drive")
+    if kind != SUM:
+        fr = _law_from(doc, kind, path.name)
+        return fr if drive is None else fr.at(drive)
+    parts = []
+    for i, part in enumerate(doc["parts"]):
+        where = f"parts[{i}]"
+        if part.get("model") not in LAWS:
+            raise fault(path.name, f"{where}.model", f"expected one of {', '.join(LAWS)}")
+        check(part, _part_record(part["model"]), path.name, at=where)
+        if len(part["joints"]) != n:
+            raise fault(path.name, f"{where}.joints", f"expected {n} joints")
+        fr = _law_from(part, part["model"], path.name)
+        if part["at"] == "motor":
+            if drive is None:
+                raise fault(path.name, f"{where}.at", "a part at the motors needs the drive")
+            fr = fr.at(drive)
+        parts.append(fr)
+    try:
+        return FrictionSum(tuple(parts))
+    except DynidError as exc:
+        raise DataError(str(exc), file=path.name) from exc
+
+
+def _law_from(doc: dict[str, Any], kind: str, source: str) -> FrictionModel:
+    """The law ``kind`` with the parameters and bands of ``doc["joints"]``."""
     joints = doc["joints"]
     law = LAWS[kind]
     P = np.zeros((len(joints), len(law.params)))
@@ -130,27 +191,44 @@ def load_friction_json(path: str | Path) -> FrictionModel:
     # no standstill_band: files of earlier versions, the plain sign(dq)
     band = np.array([d.get("standstill_band", 0.0) for d in joints], dtype=float)
     try:
-        fr = law.model(P, band)
+        return law.model(P, band)
     except DynidError as exc:
-        raise DataError(str(exc), file=path.name) from exc
-    if doc.get("drive") is None:
-        return fr
-    return fr.at(drive_from_record(doc["drive"], len(joints), source=path.name, at="drive"))
+        raise DataError(str(exc), file=source) from exc
 
 
 _WHAT = "friction file (dynid friction)"
-_MODEL = Field("string", required=True, choices=tuple(LAWS))
+_MODEL = Field("string", required=True, choices=(*LAWS, SUM))
 
 
-def _record(kind: str) -> Record:
-    """The fields of a friction file of the law ``kind`` (module docstring)."""
+def _law_fields(kind: str) -> dict[str, Field]:
+    """A joint's parameters of the law ``kind`` and its standstill band."""
     law = LAWS[kind]
     joint = {
         p: Field("number", required=True, unit=u)
         for p, u in zip(law.params, law.units, strict=True)
     }
+    return joint | {"standstill_band": Field("number", low=0.0, unit="rad/s")}
+
+
+def _part_record(kind: str) -> Record:
+    """The fields of one part of a sum (module docstring)."""
+    return Record(
+        {
+            "model": Field("string", required=True, choices=tuple(LAWS)),
+            "at": Field("string", required=True, choices=("motor", "joint")),
+            "convention": Field("string"),
+            "units": Field("any"),
+            "joints": Field(
+                "objects", required=True, non_empty=True, record=Record(_law_fields(kind))
+            ),
+        }
+    )
+
+
+def _record(kind: str) -> Record:
+    """The fields of a friction file of the law ``kind``, or of a sum (module docstring)."""
+    joint = {} if kind == SUM else _law_fields(kind)
     joint |= {
-        "standstill_band": Field("number", low=0.0, unit="rad/s"),
         "rms_before": Field("number", unit="N m"),
         "rms_after": Field("number", unit="N m"),
         "identified": Field("bool"),
@@ -167,4 +245,6 @@ def _record(kind: str) -> Record:
         "metadata": Field("any"),
         "selection": Field("any"),
     }
+    if kind == SUM:
+        top["parts"] = Field("objects", required=True, non_empty=True)
     return Record(top)

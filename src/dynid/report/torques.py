@@ -6,8 +6,9 @@ the sensor-noise floor, at the floor / usable / poor / unusable,
 :mod:`dynid.identification.verdict`; the worst joint's error can lower a good one), the
 relative error with and without friction, the errors per joint, the measured against the
 predicted torques. friction: per
-joint the law chosen and its parameters with their units, every candidate law's training
-and held-out error (the chosen one marked), the friction curve over the data.
+motor or joint the law written and its parameters with their units (the model's own
+friction kept: each of its parts), every candidate law's training and held-out error (the
+chosen one marked), the friction curve over the data.
 """
 
 from __future__ import annotations
@@ -100,8 +101,14 @@ def validate_answer(run: RunFiles) -> Answer | None:
         if LEVELS.index(joint) > LEVELS.index(level) and level != "unusable":
             level = joint
         noise = f", {ratio[j]:.3g} x its sensor noise" if ratio[j] < float("inf") else ""
+        ranked = (
+            "Worst joint against its own noise (the largest RMS error over sensor noise; "
+            "another joint's relative error can be larger)"
+            if ratio[j] < float("inf")
+            else "Worst joint by relative error"
+        )
         facts.append(
-            f"Worst joint {esc(_names(doc, len(per))[j])}: relative error "
+            f"{ranked} {esc(_names(doc, len(per))[j])}: relative error "
             f"<b>{percent(per[j])}</b>{noise} (per joint judged good below {JOINT_GOOD:g} % or "
             f"at its noise, usable below {JOINT_FAIR:g} % or {FLOOR_FAIR:g} x its noise)"
         )
@@ -173,21 +180,25 @@ def _joint_errors(doc: dict) -> str:
 
 
 def friction_answer(run: RunFiles) -> Answer | None:
-    """friction's verdict, the law and parameters per joint, the candidates, the figure."""
+    """friction's verdict, the law and parameters per joint (per motor at the motors), the
+    candidates, the figure."""
     doc = run.doc("friction.json")
     if doc is None or not isinstance(doc.get("joints"), list):
         return None
-    law, joints = doc.get("model"), doc["joints"]
+    joints = doc["joints"]
     sel: dict[str, Any] = doc["selection"] if isinstance(doc.get("selection"), dict) else {}
     cands = [c for c in sel.get("candidates") or [] if isinstance(c, dict)]
     chosen = next((c for c in cands if c.get("model") == sel.get("chosen")), None)
     none = next((c for c in cands if c.get("model") == "none"), None)
+    written = _written(doc)
     facts = []
     if chosen is not None:
+        rule = sel.get("rule") or "the lowest held-out error"
         facts.append(
-            f"Held-out error of {esc(law)} <b>{percent(chosen.get('heldout_error_percent'))}</b>"
-            f", the lowest of {len(cands)} candidates ({esc(sel.get('method', ''))}, "
-            f"{cell(sel.get('folds'))} folds)"
+            f"Held-out error of {esc(_candidate_name(chosen, written))} "
+            f"<b>{percent(chosen.get('heldout_error_percent'))}</b>"
+            f" ({esc(sel.get('method', ''))}, {cell(sel.get('folds'))} folds, the rigid-body "
+            f"model as given); kept of {len(cands)} candidates as {esc(rule)}"
             + (
                 f"; without friction {percent(none.get('heldout_error_percent'))}"
                 if none is not None
@@ -210,17 +221,48 @@ def friction_answer(run: RunFiles) -> Answer | None:
     if before and after:
         facts.append(
             f"Largest residual RMS over the joints {cell(max(before))} N m before friction, "
-            f"{cell(max(after))} N m after"
+            f"{cell(max(after))} N m after (on the recordings the friction was fitted to)"
         )
     level = (
         "poor"
         if unidentified and len(unidentified) == len(joints)
         else ("fair" if unidentified or stalled else "good")
     )
-    head = f"Friction law chosen: {esc(law)}, on every joint."
+    head = f"Friction law chosen: {esc(written)}."
     figs, shown = _figures(run, (("friction.png", "Friction against velocity over the data"),))
-    sections = (_law_table(doc, names), _candidates_table(cands, sel.get("chosen")), figs)
+    sections = (  # the figure first: the tables of a sum and its RMS would push it down
+        figs,
+        *_law_tables(doc, names),
+        _rms_table(joints, names),
+        _candidates_table(cands, sel.get("chosen")),
+    )
     return Answer(verdict(level, head, facts), sections, shown)
+
+
+def _parts(doc: dict) -> list[dict[str, Any]]:
+    """The laws friction.json holds: its parts (a sum), or the one law at the motors of
+    its drive (``friction_at`` motor) or at the joints."""
+    if isinstance(doc.get("parts"), list):
+        return [p for p in doc["parts"] if isinstance(p, dict)]
+    drive = doc.get("drive")
+    at = "motor" if isinstance(drive, dict) and drive.get("friction_at") == "motor" else "joint"
+    return [
+        {"model": doc.get("model"), "at": at, "units": doc.get("units"), "joints": doc["joints"]}
+    ]
+
+
+def _written(doc: dict) -> str:
+    """The friction the file holds, in words: ``stribeck at the motors``, ``classical at
+    the motors + classical at the joints``."""
+    return " + ".join(
+        f"{p.get('model')} at the {'motors' if p.get('at') == 'motor' else 'joints'}"
+        for p in _parts(doc)
+    )
+
+
+def _candidate_name(c: dict, written: str) -> str:
+    """A candidate's name for a sentence: the model's own friction named by what it is."""
+    return f"the model's own friction ({written})" if c.get("model") == "own" else str(c["model"])
 
 
 def _get_list(doc: Any, *keys: str) -> list[Any]:
@@ -229,24 +271,58 @@ def _get_list(doc: Any, *keys: str) -> list[Any]:
     return doc if isinstance(doc, list) else []
 
 
-def _law_table(doc: dict, names: list[str]) -> str:
-    units: dict[str, Any] = doc["units"] if isinstance(doc.get("units"), dict) else {}
-    joints = doc["joints"]
-    params = [k for k in joints[0] if k not in ("rms_before", "rms_after", "identified")]
-    headers = ["joint", "law", *(f"{k} [{units[k]}]" if k in units else k for k in params)]
-    headers += ["residual RMS before [N m]", "residual RMS after [N m]", "identified"]
+_FIT_KEYS = ("rms_before", "rms_after", "identified")
+
+
+def _law_tables(doc: dict, names: list[str]) -> list[str]:
+    """One table of parameters per law the file holds, its rows the motors (``motor 1``)
+    or the joints it acts at."""
+    out = []
+    parts = _parts(doc)
+    for i, part in enumerate(parts):
+        units: dict[str, Any] = part["units"] if isinstance(part.get("units"), dict) else {}
+        rows_in = [r for r in part.get("joints") or [] if isinstance(r, dict)]
+        if not rows_in:
+            continue
+        params = [k for k in rows_in[0] if k not in _FIT_KEYS]
+        motors = part.get("at") == "motor"
+        label = [f"motor {j + 1}" for j in range(len(rows_in))] if motors else names
+        headers = [
+            "motor" if motors else "joint",
+            "law",
+            *(f"{k} [{units[k]}]" if k in units else k for k in params),
+        ]
+        rows = [
+            [esc(label[j]), esc(part.get("model", ""))] + [cell(r.get(k)) for k in params]
+            for j, r in enumerate(rows_in)
+        ]
+        where = "per motor (at the motor's velocity)" if motors else "per joint"
+        anchor = "law" if len(parts) == 1 else f"law{i + 1}"
+        out.append(section(anchor, f"Law and parameters {where}", table(headers, rows)))
+    return out
+
+
+def _rms_table(joints: list[dict], names: list[str]) -> str:
+    """The residual RMS per joint before and after the friction, and whether identified."""
+    if not any(is_number(r.get("rms_before")) for r in joints):
+        return ""
     rows = [
-        [esc(names[j]), esc(doc.get("model", ""))]
-        + [cell(r.get(k)) for k in params]
-        + [cell(r.get("rms_before")), cell(r.get("rms_after")), cell(r.get("identified"))]
+        [
+            esc(names[j]),
+            cell(r.get("rms_before")),
+            cell(r.get("rms_after")),
+            cell(r.get("identified")),
+        ]
         for j, r in enumerate(joints)
     ]
-    return section("law", "Law and parameters per joint", table(headers, rows))
+    headers = ["joint", "residual RMS before [N m]", "residual RMS after [N m]", "identified"]
+    return section("rms", "Residual per joint (the recordings fitted)", table(headers, rows))
 
 
 def _candidates_table(cands: list[dict], chosen: Any) -> str:
     if not cands:
         return ""
+    scaled = any(is_number(c.get("heldout_scaled_percent")) for c in cands)
     rows = [
         [
             "&#10003; chosen" if c.get("model") == chosen else "",
@@ -255,8 +331,11 @@ def _candidates_table(cands: list[dict], chosen: Any) -> str:
             cell(c.get("train_error_percent")),
             cell(c.get("heldout_error_percent")),
         ]
+        + ([cell(c.get("heldout_scaled_percent"))] if scaled else [])
         for c in cands
     ]
     headers = ["", "law", "parameters per joint", "training error [%]", "held-out error [%]"]
+    if scaled:
+        headers.append("held-out, each joint by its noise [%]")
     marked = [c.get("model") == chosen for c in cands]
     return section("candidates", "Candidate laws", table(headers, rows, marked=marked))

@@ -332,19 +332,24 @@ def recorded_columns(
     used = tuple(g if g is not None else r for g, r in zip(given, rec, strict=True))
     if used == rec and used != given:
         _log.warning(
-            "reading the data as the model's data were read: columns %r, units %r; a file of "
-            "other names or units is read with its own --columns/--units (e.g. --units "
-            "tau=Nm for SI torques)",
-            *used,
+            "reading the data as the model's data were read (%s); a file of other names or "
+            "units is read with its own --columns/--units (e.g. --units tau=Nm for SI torques)",
+            _read_with(*used),
         )
     elif used != rec:
         _log.warning(
-            "reading the data with columns %r, units %r; the model's data were read with "
-            "columns %r, units %r",
-            *used,
-            *rec,
+            "reading the data with %s; the model's data were read with %s",
+            _read_with(*used),
+            _read_with(*rec),
         )
     return used[0], used[1]
+
+
+def _read_with(columns: str | None, units: str | None) -> str:
+    """``--columns`` and ``--units`` as the user types them, those given only ("the
+    default column names and units" for neither)."""
+    given = [f"{flag} {v}" for flag, v in (("--columns", columns), ("--units", units)) if v]
+    return ", ".join(given) or "the default column names and units"
 
 
 def data_files(paths: str | Path | Sequence[str | Path]) -> list[Path]:

@@ -12,7 +12,8 @@ as the command does.
   refused, :func:`~dynid.friction.fit.model_drive`).
 * ``law="auto"`` fits every law of the registry on held-out blocks (one recording left
   out at a time when there are several, contiguous time blocks otherwise) and keeps the
-  best, the model's own friction a candidate judged on the same blocks
+  simplest within one standard error of the best, the model's own friction a candidate
+  judged on the same blocks and kept as it is (a sum at the motors and joints too)
   (:func:`~dynid.friction.select.select_friction`);
   a law's name fits that law (:func:`~dynid.friction.fit.fit_friction_through`).
 """
@@ -26,12 +27,14 @@ from pathlib import Path
 from typing import Any
 
 import numpy as np
+from numpy.typing import NDArray
 
 from ..exceptions import DynidWarning
 from ..friction.fit import FrictionFit, FrictionResidual, fit_friction_through
 from ..friction.laws import LAWS
+from ..friction.model import FrictionSum
 from ..friction.recordings import Pieces, pieces_residual, prepare_pieces
-from ..friction.select import FrictionSelection, select_friction
+from ..friction.select import FrictionSelection, select_friction, torque_noise_std
 from ..friction.validation import RECORDED, own_friction
 from ..identification.model import IdentifiedModel
 from ..identification.sanity import SPIKES_BEFORE_FIT
@@ -51,7 +54,8 @@ class FrictionOptions:
     Attributes
     ----------
     law : str
-        ``"auto"`` (the law with the lowest held-out error) or a law of
+        ``"auto"`` (the law chosen on held-out data,
+        :func:`~dynid.friction.select.select_friction`) or a law of
         :data:`~dynid.friction.laws.LAWS`.
     columns : (str or None, str or None), optional
         Column names and units of another tool's files; default: those the model's data
@@ -108,6 +112,10 @@ class FrictionFileResult:
         The low-pass cut-off the log was prepared with [Hz].
     pieces : Pieces or None
         The recordings' prepared pieces (how many pieces and samples each file gave).
+    noise_std : ndarray, shape (n,), or None
+        Per joint, the white-noise std [N m] of the measured torques
+        (:func:`~dynid.friction.select.torque_noise_std`): what ``rms_after`` reaches for
+        a correct model; None when not known.
     """
 
     fit: FrictionFit
@@ -115,10 +123,12 @@ class FrictionFileResult:
     selection: FrictionSelection | None
     cutoff_hz: float | None = None
     pieces: Pieces | None = None
+    noise_std: NDArray[np.float64] | None = None
 
     def metadata(self, model: str) -> dict[str, Any]:
         """The keys ``friction.json`` records beside the fit: the recordings, ``model``
-        (what the rigid-body model is), the cut-off, the samples and the convergence."""
+        (what the rigid-body model is), the cut-off, the samples, the convergence and the
+        torques' noise per joint (``noise_rms`` [N m])."""
         files = [s["file"] for s in self.pieces.summary()] if self.pieces else []
         return {
             "data": ", ".join(files),
@@ -128,6 +138,7 @@ class FrictionFileResult:
             "cutoff_hz": self.cutoff_hz,
             "n_samples": self.fit.n_samples,
             "converged": [bool(x) for x in self.fit.converged],
+            "noise_rms": None if self.noise_std is None else [float(x) for x in self.noise_std],
         }
 
 
@@ -187,6 +198,8 @@ def fit_friction_files(
             cutoff_hz=RECORDED if cutoff_hz is None else cutoff_hz,
             max_gap_s=max_gap_s,
             drive=drive,
+            decimate=1,  # every sample, at its own time: the torques validate judges
+            measured_samples=True,
         )
         res = pieces_residual(model, pieces)
         cut = pieces.cutoff_hz
@@ -199,11 +212,11 @@ def fit_friction_files(
             # where it acts (a robot's where the drive puts it); a sum judged too
             own = own_friction(model, pieces.drive)
             sel = select_friction(res, pieces.drive, own=own, own_fitted_here=here)
-            return FrictionFileResult(sel.fit, res, sel, cut, pieces)
+            return FrictionFileResult(sel.fit, res, sel, cut, pieces, torque_noise_std(res))
         chosen = fit_friction_through(res, pieces.drive, law)
         if law == "quadratic":
             _quadratic_at_bound(chosen)
-        return FrictionFileResult(chosen, res, None, cut, pieces)
+        return FrictionFileResult(chosen, res, None, cut, pieces, torque_noise_std(res))
 
     result: FrictionFileResult = in_file(rec.paths[0], fit) if len(rec.paths) == 1 else fit()
     return result
@@ -214,6 +227,8 @@ def _quadratic_at_bound(fit: FrictionFit) -> None:
     identified on: the friction of the data grows slower than linearly with speed (it
     saturates), which ``fq >= 0`` (dissipative at every speed) cannot follow, so the law
     is the classical one there."""
+    if isinstance(fit.friction, FrictionSum):
+        return
     fq = np.asarray(fit.friction.params)[:, 1]
     held = [j + 1 for j in range(fq.size) if fit.identified[j] and fq[j] == 0.0]
     if held:

@@ -23,7 +23,7 @@ from ..feasibility.methods import METHODS
 from ..feasibility.methods import method as consistent_method
 from ..feasibility.penalty import RetrievalOptions, RetrievalProgress
 from ..feasibility.result import FeasibleResult
-from ..friction.model import combined, through_drive
+from ..friction.model import FrictionModel, combined, through_drive
 from ..identification.model import IdentifiedModel
 from ..io.bounds_file import load_bounds
 from ..io.friction_json import load_friction_json
@@ -64,7 +64,7 @@ def _with_friction(robot: Robot, path: str | Path | None) -> Robot:
     fr = load_friction_json(path)
     if fr.kind == "none":  # no friction: nothing to put on the robot
         return robot
-    if fr.kind != "sigmoid" or fr.drive is not None:  # what the robot files hold
+    if not isinstance(fr, FrictionModel) or fr.kind != "sigmoid" or fr.drive is not None:
         raise OptionError(
             f"{Path(path).name} holds {fr.kind} friction; sigmoid friction goes on the robot "
             "(the law a robot description holds): give a friction.json of the sigmoid law "

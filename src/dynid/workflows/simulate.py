@@ -255,7 +255,15 @@ def _friction(friction: str | Path | FrictionModel) -> FrictionModel | str | Non
     if isinstance(friction, str) and friction in ("robot", "none"):
         return None if friction == "none" else "robot"
     if isinstance(friction, str | Path):
-        return load_friction_json(friction)
+        loaded = load_friction_json(friction)
+        if not isinstance(loaded, FrictionModel):  # a sum: no one law to put on the robot
+            raise OptionError(
+                f"{Path(friction).name} holds {loaded.kind} friction (at the motors and at "
+                "the joints); simulate takes one law: give a friction.json of one law "
+                "(`dynid friction --friction-model classical`)",
+                field="friction",
+            )
+        return loaded
     return friction
 
 
