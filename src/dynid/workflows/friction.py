@@ -33,7 +33,7 @@ from ..exceptions import DynidWarning
 from ..friction.fit import FrictionFit, FrictionResidual, fit_friction_through
 from ..friction.laws import LAWS
 from ..friction.model import FrictionSum
-from ..friction.recordings import Pieces, pieces_residual, prepare_pieces
+from ..friction.recordings import Pieces, pieces_residual, prepare_pieces, thinned
 from ..friction.select import FrictionSelection, select_friction, torque_noise_std
 from ..friction.validation import RECORDED, own_friction
 from ..identification.model import IdentifiedModel
@@ -201,6 +201,7 @@ def fit_friction_files(
             decimate=1,  # every sample, at its own time: the torques validate judges
             measured_samples=True,
         )
+        pieces = thinned(pieces, _recorded_decimation(model))  # samples, not averages
         res = pieces_residual(model, pieces)
         cut = pieces.cutoff_hz
         if law == "auto":
@@ -220,6 +221,14 @@ def fit_friction_files(
 
     result: FrictionFileResult = in_file(rec.paths[0], fit) if len(rec.paths) == 1 else fit()
     return result
+
+
+def _recorded_decimation(model: Robot | IdentifiedModel) -> int:
+    """The decimation a model was identified with (1: a robot, or a model of static
+    data): friction is fitted on every k-th measured sample alike."""
+    if isinstance(model, IdentifiedModel) and model.info.log is not None:
+        return max(1, int(model.info.log.preprocessing.decimate))
+    return 1
 
 
 def _quadratic_at_bound(fit: FrictionFit) -> None:
