@@ -60,6 +60,9 @@ class DataTerm:
         Rows ``G`` with ``G f >= 0`` for friction that opposes the motion within the
         velocity limits (each term's :meth:`~dynid.regressors.terms.ModelTerm.
         dissipation_rows`, over the unknowns fitted); None: none.
+    std : ndarray, shape (r + k,), optional
+        The standard deviations the fit reports for ``x_hat`` (its estimator's: hac,
+        robust or classical), against which the result's moves are told; None: unknown.
     """
 
     P: NDArray[np.float64]
@@ -74,6 +77,7 @@ class DataTerm:
     notes: tuple[str, ...] = ()
     holdout: HeldOut | None = None
     dissipation: NDArray[np.float64] | None = None
+    std: NDArray[np.float64] | None = None
 
     @property
     def r(self) -> int:
@@ -208,6 +212,7 @@ def coefficient_term(
         labels=labels,
         notes=notes,
         holdout=held,
+        std=np.asarray(fit.std, dtype=np.float64)[kept],
     )
 
 
