@@ -205,7 +205,8 @@ class IdentifyOptions:
         Also identify physically consistent link parameters in one step (convex).
     prior : str, Path or Robot, optional
         ``consistent``: the prior link parameters (``"panda"``, ``"fr3"``, a robot file or
-        a ``feasible.json``, :func:`~dynid.workflows.prior.load_prior`); default generic.
+        a ``feasible.json``, :func:`~dynid.workflows.prior.load_prior`); default the
+        robot's own inertials (generic without any).
     prior_base, prior_tip : str, optional
         ``consistent``: the chain of a URDF prior.
     prior_weight : float, optional
