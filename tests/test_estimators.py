@@ -106,7 +106,7 @@ def test_classical_route_with_outliers_and_a_noisy_joint():
 
 def test_cli_std_and_estimator_are_honoured_on_both_routes(tmp_path):
     """--std robust on a torque log is recorded and used (it was ignored); --estimator wls on
-    static data too; --std with --consistent is refused rather than ignored."""
+    static data too (--std with --consistent: tests/test_workflows.py)."""
     import json
 
     from dynid.cli.__main__ import main
@@ -184,22 +184,6 @@ def test_cli_std_and_estimator_are_honoured_on_both_routes(tmp_path):
     )
     d = json.loads((tmp_path / "s" / "identification.json").read_text())
     assert d["std_estimator"] == "robust" and d["metadata"]["estimator"] == "wls"
-    assert (
-        main(
-            [
-                "identify",
-                "--data",
-                str(tmp_path / "log.csv"),
-                "--consistent",
-                "--std",
-                "robust",
-                "--out",
-                str(tmp_path / "c"),
-                "-q",
-            ]
-        )
-        == 2
-    )
 
 
 def test_weights_of_groups_or_rows_give_numpys_weighted_solution_and_bad_ones_are_refused():

@@ -120,7 +120,8 @@ def test_one_step_on_static_data_without_model_error_reproduces_m_and_g():
 
 
 def test_generic_prior_of_a_ur5_is_consistent_and_retrieval_runs_without_a_prior():
-    """UR5 from its URDF: the cylinders are strictly consistent; exact coefficients are met."""
+    """UR5 from its URDF: the cylinders are strictly consistent; exact coefficients are met
+    with them and with the default prior (the URDF's own inertials)."""
     ur5 = dynid.Robot.from_urdf(
         robot_data_urdf("ur_description/urdf/ur5_robot.urdf"),
         base_link="base_link",
@@ -131,9 +132,12 @@ def test_generic_prior_of_a_ur5_is_consistent_and_retrieval_runs_without_a_prior
     natural = generic_prior(ur5).mass.sum()  # scaled into the band, to its nearer end
     assert pr.mass.sum() == pytest.approx(min(max(natural, 15.0), 25.0))
     model = exact_model(ur5, ur5)
-    res = retrieve_sdp(model)  # generic prior from the kinematics
+    res = retrieve_sdp(model, prior=generic_prior(ur5))  # a prior from the kinematics
     assert res.feasible and res.prior.source == "generic"
     assert res.relative_residual < 1e-9
+    own = retrieve_sdp(model)  # without one: the description's inertials
+    assert own.feasible and own.prior.source == "description"
+    assert own.relative_residual < 1e-9
 
 
 def test_a_cad_prior_violating_the_triangle_inequality_is_repaired_and_reported():

@@ -320,8 +320,9 @@ def add_consistency_options(p: argparse.ArgumentParser) -> None:
         default=None,
         metavar="panda|fr3|FILE",
         help="prior link parameters: 'panda', 'fr3' (the Panda's), a .urdf (with "
-        "--prior-base/--prior-tip), a .toml or a feasible.json; default: a solid cylinder "
-        "per link from the kinematics",
+        "--prior-base/--prior-tip), a .toml or a feasible.json; default: the --robot "
+        "description's own inertials (a solid cylinder per link from the kinematics when "
+        "it has none)",
     )
     g.add_argument("--prior-base", default=None, help="URDF base link of the prior's chain")
     g.add_argument("--prior-tip", default=None, help="URDF tip link of the prior's chain")
@@ -358,7 +359,8 @@ def note_prior(args: argparse.Namespace, console: Console) -> None:
 
 
 def load_prior(args: argparse.Namespace, robot: Robot, console: Console) -> Robot | None:
-    """The prior robot named by ``--prior`` (None: the generic prior), checked against
+    """The prior robot named by ``--prior`` (None: the robot's own inertials, or the generic
+    prior without any), checked against
     ``robot`` (:func:`dynid.workflows.prior.load_prior`); a built-in prior's note on its
     parameters is printed."""
     note_prior(args, console)

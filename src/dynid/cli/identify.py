@@ -185,7 +185,7 @@ def register(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParser:
         help="standard deviations: hac (consistent for residuals correlated over the filtered, "
         "decimated samples of each recording piece), robust (heteroscedasticity-consistent) "
         "or classical (sigma^2 (W^T W)^-1, Gaz et al.) (default: robust for static data, "
-        "hac for torque logs; honoured on both)",
+        "hac for torque logs; honoured on both, and with --consistent for its unconstrained fit)",
     )
     p.add_argument(
         "--estimator",

@@ -30,7 +30,7 @@ from .lmi import log_det_divergence, pseudo_inertia, pseudo_inertia_margin
 from .methods import METHODS, ConsistentMethod, method
 from .payload import PayloadEstimate, identify_payload, model_with_payload, robot_with_payload
 from .penalty import RetrievalOptions, RetrievalResult, retrieve, retrieve_from_static
-from .prior import Prior, generic_prior, prior_from_robot
+from .prior import Prior, default_prior, generic_prior, prior_from_robot
 from .result import FeasibleResult
 
 __all__ = [
@@ -48,6 +48,7 @@ __all__ = [
     "compare_methods",
     "default_bounds",
     "feasibility_report",
+    "default_prior",
     "generic_prior",
     "identify_consistent",
     "identify_payload",

@@ -235,6 +235,16 @@ class FrictionSum:
         (``fv@1, fc@1, ..., fv@2, ...``)."""
         return tuple(f"{name}@{i + 1}" for i, p in enumerate(self.parts) for name in p.names)
 
+    def as_array(self) -> NDArray[np.float64]:
+        """The parts' parameters side by side (n, k1 + k2 + ...), in the order of
+        :attr:`names`."""
+        return np.concatenate([p.as_array() for p in self.parts], axis=1)
+
+    def placed(self, drive: Drive | None) -> FrictionSum:
+        """A robot's friction sum where ``drive`` puts it: each part placed as
+        :meth:`Friction.placed` places it (a part naming its own drive acts as it says)."""
+        return FrictionSum(tuple(p.placed(drive) for p in self.parts))
+
     def torques(self, dq: ArrayLike) -> NDArray[np.float64]:
         """Joint friction torques [N m] (..., n): the sum of the parts'."""
         out = self.parts[0].torques(dq)
@@ -295,7 +305,7 @@ def combined(frictions: tuple[FrictionValues, ...]) -> Friction | FrictionSum | 
     return FrictionSum(tuple(friction_of(f) for f in frictions))
 
 
-def robot_friction(robot: Robot, drive: Drive | None = None) -> Friction | None:
+def robot_friction(robot: Robot, drive: Drive | None = None) -> Friction | FrictionSum | None:
     """A robot's friction, ``robot.friction``, typed as the :class:`Friction` it is (the
     model layer names it by a protocol), or None.
 
@@ -305,7 +315,7 @@ def robot_friction(robot: Robot, drive: Drive | None = None) -> Friction | None:
     own drive acts as it says). This is the one place a robot's own friction is placed:
     simulation, validation, payload identification and the observer all read it here.
     Without ``drive``: as held (what a robot description file writes)."""
-    own = cast(Friction | None, robot.friction)
+    own = cast(Friction | FrictionSum | None, robot.friction)
     return None if own is None else own.placed(drive)
 
 

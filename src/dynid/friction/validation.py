@@ -523,7 +523,7 @@ class NewtonEulerValidation:
         return out
 
 
-def _friction_model(robot: Robot, friction: Any) -> FrictionModel | None:
+def _friction_model(robot: Robot, friction: Any) -> FrictionModel | FrictionSum | None:
     if isinstance(friction, str):
         if friction != "robot":
             raise OptionError(

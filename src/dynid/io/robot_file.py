@@ -9,10 +9,9 @@ it needs, so a command on a built-in robot loads no file reader at all.
 
 from __future__ import annotations
 
-import warnings
 from pathlib import Path
 
-from ..exceptions import DataError, DynidWarning, OptionError
+from ..exceptions import DataError, OptionError
 from ..model.builtin import BUILTIN_ROBOTS, builtin_robot
 from ..model.robot import Robot
 
@@ -77,23 +76,14 @@ def load_robot(
         from .robot.mjcf_read import load_mjcf
 
         return load_mjcf(path)
-    from ..friction.model import FrictionSum
     from .feasible import load_feasible_json, load_feasible_linear_friction
 
     robot = load_feasible_json(path)
     identified = load_feasible_linear_friction(path)
     if identified is None:
         return robot
-    if isinstance(identified, FrictionSum):  # at the motors and at the joints: no one law
-        warnings.warn(
-            f"{path.name}: its friction acts at the motors and at the joints, which a robot "
-            "does not hold; the robot gets neither; hint: --params "
-            f"{path.name} uses both",
-            DynidWarning,
-            stacklevel=2,
-        )
-        return robot
-    return robot.with_friction(identified)  # the friction identified with the links
+    # the friction identified with the links (at the motors and the joints: their sum)
+    return robot.with_friction(identified)
 
 
 def _names() -> str:

@@ -31,7 +31,7 @@ from numpy.typing import ArrayLike, NDArray
 from ..exceptions import DynidError
 from ..feasibility.penalty import RetrievalResult, retrieve
 from ..friction.fit import FrictionFit, FrictionResidual, fit_sigmoid, friction_residual
-from ..friction.model import Friction, robot_friction
+from ..friction.model import Friction, FrictionSum, robot_friction
 from ..friction.validation import (
     NewtonEulerValidation,
     Validation,
@@ -269,7 +269,7 @@ class FrictionStageResult:
     seed: int
 
     @property
-    def reference_friction(self) -> Friction | None:
+    def reference_friction(self) -> Friction | FrictionSum | None:
         """The truth's friction, or None."""
         return robot_friction(self.truth)
 

@@ -30,7 +30,7 @@ from numpy.typing import NDArray
 from .. import _checks
 from ..dynamics.rnea import rnea
 from ..exceptions import OptionError, ShapeError
-from ..friction.model import FrictionModel, robot_friction
+from ..friction.model import FrictionModel, FrictionSum, robot_friction
 from ..identification.log import TorqueLog, recorded_side_log
 from ..model.drive import Drive
 from ..model.robot import Robot
@@ -191,8 +191,8 @@ def simulate_measurement(
     n = robot.n
     if traj.n != n:
         raise ShapeError(f"trajectory has {traj.n} joints; robot {robot.name!r} has {n}")
-    friction = _checked(robot, drop_fraction, friction, effects, drive)
-    tau = _true_torques(robot, traj, friction, effects, drive, contacts)
+    placed = _checked(robot, drop_fraction, friction, effects, drive)
+    tau = _true_torques(robot, traj, placed, effects, drive, contacts)
     N = len(traj)
     sd_tau, sd_q, sd_dq = _stds(noise, n)
     tau = tau + rng.standard_normal((N, n)) * sd_tau
@@ -215,7 +215,7 @@ def _checked(
     friction: FrictionModel | None | str,
     effects: UnmodelledEffects | None,
     drive: Drive | None,
-) -> FrictionModel | None:
+) -> FrictionModel | FrictionSum | None:
     """Check the options of a simulation; the friction model (``"robot"`` resolved)."""
     n = robot.n
     if not 0.0 <= drop_fraction < 0.5:
@@ -236,7 +236,7 @@ def _checked(
 def _true_torques(
     robot: Robot,
     traj: Trajectory,
-    friction: FrictionModel | None,
+    friction: FrictionModel | FrictionSum | None,
     effects: UnmodelledEffects | None,
     drive: Drive | None,
     contacts: tuple[Contact, ...] = (),

@@ -6,10 +6,11 @@ command applies, so that the Python API behaves as the command does.
   (:mod:`dynid.workflows.data_files`: joint count, recorded robot, log cleaning).
 * Static data: configurations outside the joint limits and a relative error far above
   the recorded noise level are :class:`~dynid.exceptions.DynidWarning` warnings.
-* ``std`` (standard deviations) is honoured on both routes (default: robust for static
-  data, hac for torque logs); the consistent fit refuses it and ``max_std_percent``,
-  which do not apply to it, and the prior, its weight, objective, margin and mass band
-  apply to the consistent fit only (:class:`IdentifyOptions`).
+* ``std`` (standard deviations) is honoured on both routes and with the consistent fit
+  (default: robust for static data, hac for torque logs; the consistent fit's data term is
+  the residual itself whichever is reported); the consistent fit refuses
+  ``max_std_percent`` (it prunes nothing), and the prior, its weight, objective, margin
+  and mass band apply to the consistent fit only (:class:`IdentifyOptions`).
 * The column map the data were read with is recorded in the model (``info.column_map``).
 * From torque logs, the held-out prediction (:mod:`dynid.friction.heldout_torques`: the
   last time block, every recording predicted by the fit of the others, or the
@@ -181,8 +182,9 @@ class IdentifyOptions:
         Remove the coefficients above this relative standard deviation [%] and re-fit.
     rtol : float, optional
         Fixed relative rank tolerance, 0 < rtol < 1 (default: the first clear gap).
-    std : {"robust", "classical"}, optional
-        Standard deviations (default robust for static data, classical for a log).
+    std : {"classical", "robust", "hac"}, optional
+        Standard deviations (default robust for static data, hac for a log; with
+        ``consistent`` too, those of the unconstrained fit it returns).
     estimator : {"ols", "wls", "irls"}
         Least squares: ordinary, weighted by the noise level, or Huber-reweighted.
     drive : Drive, optional
@@ -204,7 +206,8 @@ class IdentifyOptions:
         Also identify physically consistent link parameters in one step (convex).
     prior : str, Path or Robot, optional
         ``consistent``: the prior link parameters (``"panda"``, ``"fr3"``, a robot file or
-        a ``feasible.json``, :func:`~dynid.workflows.prior.load_prior`); default generic.
+        a ``feasible.json``, :func:`~dynid.workflows.prior.load_prior`); default the
+        robot's own inertials (generic without any).
     prior_base, prior_tip : str, optional
         ``consistent``: the chain of a URDF prior.
     prior_weight : float, optional
@@ -220,7 +223,7 @@ class IdentifyOptions:
     ------
     OptionError
         A value out of its range or choices; a consistent-only option without
-        ``consistent``; ``max_std_percent`` or ``std`` with it (``field`` names it).
+        ``consistent``; ``max_std_percent`` with it (``field`` names it).
     """
 
     terms: str | Structure | None = None
@@ -259,7 +262,7 @@ class IdentifyOptions:
         only_with(self, CONSISTENT_ONLY, "consistent")
         refused_with(
             self,
-            ("max_std_percent", "std"),
+            ("max_std_percent",),
             "consistent",
             "nothing is pruned; its data term is the residual itself, weighted by the estimator",
         )
@@ -518,6 +521,7 @@ def _identify_consistent(
                 rtol=opt.rtol,
                 drive=opt.drive,
                 estimator=opt.estimator,
+                std=opt.std,
                 cutoff_hz="auto" if opt.cutoff_hz is None else opt.cutoff_hz,
                 max_gap_s=opt.max_gap_s,
                 **heldout,
@@ -536,7 +540,13 @@ def _identify_consistent(
         result = in_file(
             path,
             lambda: identify_consistent(
-                robot, data, rtol=opt.rtol, drive=opt.drive, estimator=opt.estimator, **common
+                robot,
+                data,
+                rtol=opt.rtol,
+                drive=opt.drive,
+                estimator=opt.estimator,
+                std=opt.std,
+                **common,
             ),
         )
     if result.identified is None:  # pragma: no cover - identify_consistent always sets it

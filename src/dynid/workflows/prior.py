@@ -22,7 +22,8 @@ _log = logging.getLogger(__name__)
 def load_prior(
     spec: str | Path | None, robot: Robot, *, base: str | None = None, tip: str | None = None
 ) -> Robot | None:
-    """The prior robot ``spec`` for ``robot``, or None (the generic prior).
+    """The prior robot ``spec`` for ``robot``, or None (the default prior: the robot's own
+    inertials, or the generic one without any).
 
     Parameters
     ----------

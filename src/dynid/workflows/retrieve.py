@@ -132,7 +132,8 @@ class RetrieveOptions:
         retrieval with a prior, or ``"penalty"``, the penalty method (Algorithm 1).
     prior : str, Path or Robot, optional
         Convex method: the prior link parameters
-        (:func:`~dynid.workflows.prior.load_prior`); default generic.
+        (:func:`~dynid.workflows.prior.load_prior`); default the model's robot's own
+        inertials (generic without any).
     prior_base, prior_tip : str, optional
         Convex method: the chain of a URDF prior.
     prior_weight : float, optional

@@ -29,7 +29,8 @@ residual sum of squares in units of its noise variance (``Delta chi^2``).
 
 **The prior's weight** ``w``: when the data term holds held-out folds (torque logs: k-fold
 over contiguous time blocks, or a separate log), the largest weight whose *held-out* error
-is within ``residual_increase`` (1 %) of the best, and the result is accepted when its
+is within ``residual_increase`` (1 %) of the best and, with two folds or more, within one
+standard error of the difference paired over the folds, and the result is accepted when its
 held-out error is within ``heldout_tol`` (5 %) of unconstrained least squares', whatever its
 training residual (:mod:`dynid.feasibility.heldout`). Otherwise (static data,
 coefficients) the largest weight (over a logarithmic search) whose fit keeps the

@@ -1,9 +1,12 @@
 """The convex method's data term ``1/2 ||A (x - x_hat)||^2`` (:class:`DataTerm`) and the
-term of identified coefficients with their covariance (:func:`coefficient_term`)."""
+term of identified coefficients (:func:`coefficient_term`): weighted by their covariance
+(two steps, from a file), or by the data's own residual ``||W x - y||^2 / sigma^2`` (one
+step: the normal equations the fit kept, whatever standard deviations it reports)."""
 
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import Literal
 
 import numpy as np
 from numpy.typing import NDArray
@@ -57,6 +60,9 @@ class DataTerm:
         Rows ``G`` with ``G f >= 0`` for friction that opposes the motion within the
         velocity limits (each term's :meth:`~dynid.regressors.terms.ModelTerm.
         dissipation_rows`, over the unknowns fitted); None: none.
+    std : ndarray, shape (r + k,), optional
+        The standard deviations the fit reports for ``x_hat`` (its estimator's: hac,
+        robust or classical), against which the result's moves are told; None: unknown.
     """
 
     P: NDArray[np.float64]
@@ -71,6 +77,7 @@ class DataTerm:
     notes: tuple[str, ...] = ()
     holdout: HeldOut | None = None
     dissipation: NDArray[np.float64] | None = None
+    std: NDArray[np.float64] | None = None
 
     @property
     def r(self) -> int:
@@ -118,11 +125,21 @@ def _whitening(cov: NDArray[np.float64]) -> NDArray[np.float64]:
     return (U[:, keep] / np.sqrt(s[keep])).T
 
 
-def coefficient_term(model: IdentifiedModel, *, with_friction: bool = False) -> DataTerm:
-    """The data term of identified coefficients (and their friction) with their covariance.
+def coefficient_term(
+    model: IdentifiedModel,
+    *,
+    with_friction: bool = False,
+    weight: Literal["covariance", "residual"] = "covariance",
+) -> DataTerm:
+    """The data term of identified coefficients (and their friction).
 
-    Uses ``model.fit.covariance`` (or ``model.joint_fit``'s with friction); without a
+    ``weight="covariance"``: ``model.fit.covariance`` (or ``model.joint_fit``'s with
+    friction), of the estimator its standard deviations were made with; without a
     covariance (a file written before it was kept) the standard deviations, uncorrelated.
+    ``weight="residual"``: the fit's own rows, ``A^T A = W^T W / sigma^2`` from the normal
+    equations it kept (``model.holdout.whole``, the rows the folds are cut from), so that
+    the term is the increase of the residual sum of squares whatever standard deviations
+    the model reports (hac, robust); the covariance, with a note, when none were kept.
     Pruned coefficients are left out.
     """
     fit: LeastSquaresFit = model.fit
@@ -170,10 +187,22 @@ def coefficient_term(model: IdentifiedModel, *, with_friction: bool = False) -> 
     held = model.holdout
     if held is not None and held.whole.p != kept.size:
         held = None  # folds over other columns (friction left out of the term)
+    if held is not None:
+        held = held.restricted(np.flatnonzero(kept))
+    A = np.zeros((0, x_hat.size))
+    if not exact and weight == "residual" and held is not None:
+        A = held.whole.sqrt() / max(held.noise, 1e-300)
+    elif not exact:
+        A = _whitening(cov)
+        if weight == "residual" and fit.covariance is not None:
+            notes += (
+                "no normal equations of the fit kept: the data term is weighted by the "
+                "coefficients' covariance (the standard deviations reported)",
+            )
     return DataTerm(
         P=P,
         x_hat=x_hat,
-        A=np.zeros((0, x_hat.size)) if exact else _whitening(cov),
+        A=A,
         dof=max(int(fit.n_rows) - int(fit.rank), 1),
         exact=exact,
         n_friction=int(kept[r_all:].sum()) if k else 0,
@@ -182,7 +211,8 @@ def coefficient_term(model: IdentifiedModel, *, with_friction: bool = False) -> 
         dissipation=_dissipation(terms, index, model.robot.dq_max) if k else None,
         labels=labels,
         notes=notes,
-        holdout=None if held is None else held.restricted(np.flatnonzero(kept)),
+        holdout=held,
+        std=np.asarray(fit.std, dtype=np.float64)[kept],
     )
 
 

@@ -9,8 +9,10 @@ ordinary least squares,
 
 .. math:: \\|W x - y\\|^2 = \\|W \\hat x - y\\|^2 + (x - \\hat x)^T W^T W (x - \\hat x),
 
-so the classical covariance ``sigma^2 (W^T W)^{-1}`` of the unconstrained fit ``x_hat`` gives
-the data term exactly (up to the constant ``RSS / sigma^2``). Torque logs (one or several
+so the normal equations ``W^T W / sigma^2`` of the unconstrained fit ``x_hat`` give the data
+term exactly (up to the constant ``RSS / sigma^2``); the standard deviations the fit reports
+are those of ``dynid identify`` (``std``: hac for torque logs, robust for static data),
+which the data term does not depend on. Torque logs (one or several
 recordings) go through the route of ``dynid identify``
 (:func:`~dynid.identification.selection.identify_recordings`: each recording and each piece
 between its gaps filtered, differentiated and decimated on its own, the model's structure
@@ -35,6 +37,7 @@ from ...friction.model import through_drive
 from ...identification.data import StaticDataset
 from ...identification.estimators import Estimator, EstimatorName
 from ...identification.holdout import DEFAULT_FOLDS
+from ...identification.least_squares import StdMethod
 from ...identification.log import TorqueLog
 from ...identification.model import IdentifiedModel
 from ...identification.selection import identify_recordings
@@ -126,6 +129,7 @@ def identify_consistent(
     structure: Structure | Literal["auto"] = "auto",
     max_gap_s: float | None = None,
     names: Sequence[str] | None = None,
+    std: StdMethod | None = None,
 ) -> ConsistentResult:
     """Physically consistent link parameters (and friction) identified from data.
 
@@ -164,6 +168,10 @@ def identify_consistent(
         into pieces prepared on their own.
     names : sequence of str, optional
         Torque logs: one name per recording (file names), for messages and the record.
+    std : {"classical", "robust", "hac"}, optional
+        The unconstrained fit's standard deviations, as ``dynid identify`` reports them
+        (default hac for torque logs, robust for static data); the data term is the
+        residual itself whichever is chosen.
 
     Returns
     -------
@@ -181,10 +189,10 @@ def identify_consistent(
     logs = [data] if isinstance(data, TorqueLog) else data
     term: DataTerm | None = None
     if isinstance(data, StaticDataset):
-        model = identify_static(
-            robot, data, rtol=rtol, std="classical", drive=drive, estimator=estimator
-        )
-        term = coefficient_term(model)
+        kw: dict[str, Any] = dict(rtol=rtol, drive=drive, estimator=estimator)
+        residual = identify_static(robot, data, std="classical", **kw)  # sigma^2 (W^T W)^-1
+        term = coefficient_term(residual)
+        model = identify_static(robot, data, std=std or "robust", **kw)
         kind = "static"
     elif isinstance(logs, Sequence) and all(isinstance(g, TorqueLog) for g in logs):
         model = identify_recordings(
@@ -197,7 +205,7 @@ def identify_consistent(
             decimate=decimate,
             drive=drive,
             estimator=estimator,
-            std="classical",  # the data term is the residual itself: sigma^2 (W^T W)^-1
+            std=std or "hac",  # the data term is the residual itself, whichever is reported
             rtol=rtol,
             folds=folds,
             validate_on=validate_on,
@@ -242,17 +250,22 @@ def consistent_from_identified(
     robot : Robot
     model : IdentifiedModel
         The unconstrained fit (:func:`identify_consistent` makes it; several recordings:
-        :func:`~dynid.identification.selection.identify_recordings` with the classical
-        friction); its drive (a drive file's, or the direct drive of an armature) is kept.
+        :func:`~dynid.identification.selection.identify_recordings`); its drive (a drive
+        file's, or the direct drive of an armature) is kept.
     term : DataTerm, optional
         Default :func:`~dynid.feasibility.convex.data_term.coefficient_term` of ``model``
-        (with its friction for ``kind="log"``).
+        (with its friction for ``kind="log"``), weighted by the fit's residual (its normal
+        equations; its covariance when it kept none).
     kind : {"log", "static"}
     prior, bounds, total_mass, options, constraints
         As in :func:`~dynid.feasibility.convex.solve.solve_consistent`.
     """
     if term is None:  # a structure without friction (links, armature) has no joint fit
-        term = coefficient_term(model, with_friction=kind == "log" and model.joint_fit is not None)
+        term = coefficient_term(
+            model,
+            with_friction=kind == "log" and model.joint_fit is not None,
+            weight="residual",
+        )
     with stage("the consistent fit (a semidefinite program for each prior weight and fold)"):
         res = solve_consistent(
             robot,

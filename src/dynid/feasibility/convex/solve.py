@@ -14,7 +14,7 @@ from ...exceptions import InfeasibleError, ModelError, OptionError, ShapeError, 
 from ...model.robot import Robot
 from ..bounds import Bounds, default_bounds
 from ..heldout import HeldOutJudgement
-from ..prior import Prior, generic_prior, prior_from_robot
+from ..prior import Prior, default_prior, prior_from_robot
 from .data_term import DataTerm
 from .options import SDPOptions
 from .problem import ConvexProblem, check_band, mass_bounds, polish, solution_x
@@ -41,13 +41,15 @@ def solve_consistent(
     Parameters
     ----------
     robot : Robot
-        Kinematics, gravity and friction of the result (its inertials are not used).
+        Kinematics, gravity and friction of the result (its inertials are the default
+        prior).
     term : DataTerm
         From :func:`coefficient_term` (or built by the one-step routes).
     prior : Prior or Robot, optional
         A :class:`~dynid.feasibility.prior.Prior`, a robot with link inertials (checked
         and repaired by :func:`~dynid.feasibility.prior.prior_from_robot`), or None for
-        :func:`~dynid.feasibility.prior.generic_prior`.
+        :func:`~dynid.feasibility.prior.default_prior`: ``robot``'s own inertials when it
+        has them, else the generic prior.
     bounds : Bounds, optional
         Mass and CoM boxes and the total-mass band; default
         :func:`~dynid.feasibility.bounds.default_bounds`. The inertia-entry bounds of
@@ -192,9 +194,11 @@ def _checked_bounds(
 def _resolved_prior(
     prior: Prior | Robot | None, robot: Robot, band: tuple[float, float] | None
 ) -> Prior:
-    """The prior as a :class:`Prior` (the generic one for None), checked against the robot."""
+    """The prior as a :class:`Prior` (for None the robot's own inertials, or the generic
+    one when it has none: :func:`~dynid.feasibility.prior.default_prior`), checked against
+    the robot."""
     if prior is None:
-        pr = generic_prior(robot, band)
+        pr = default_prior(robot, band)
     elif isinstance(prior, Prior):
         pr = prior
     else:

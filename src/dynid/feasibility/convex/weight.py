@@ -78,12 +78,14 @@ def judged(
     prior); the training errors are filled in by :func:`replace_training`."""
     share = held.training_share
     fold_terms = [p.term for p in folds]
+    per_fold: dict[float, tuple[float, ...]] = {}
 
     def heldout_at(w: float) -> float:
         xs = []
         for p, ft in zip(folds, fold_terms, strict=True):
             solved(p, w * share)
             xs.append(solution_x(ft, *p.values()))
+        per_fold[w] = tuple(t.relative_error_percent(x) for t, x in zip(held.test, xs, strict=True))
         return held.heldout_error_percent(xs)
 
     if opts.prior_weight is not None:
@@ -91,7 +93,9 @@ def judged(
         search = [(w, heldout_at(w))]
         choice = "given"
     else:
-        w, search, choice = search_weight(heldout_at, opts.residual_increase, WEIGHT_RANGE)
+        w, search, choice = search_weight(
+            heldout_at, opts.residual_increase, WEIGHT_RANGE, per_fold.__getitem__
+        )
     ls = cross_validate(held)
     return w, HeldOutJudgement(
         scheme=held.scheme,
