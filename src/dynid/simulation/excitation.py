@@ -33,7 +33,8 @@ or a clearance (a small arm's elbow folded into its shoulder at the top of its r
 candidates at 80, 60 and 40 % of that amplitude too, from which the optimiser can shrink or
 grow a motion (at the largest that fits, the scaling undoes either, and a start in
 collision was never left). Seeded and reproducible; ``progress(iteration, max_iter, cond)``
-is called after each iteration.
+is called after each iteration and ``evaluated(evaluations, budget)`` after each evaluation
+of the objective (an iteration can take thousands when its line search struggles).
 """
 
 from __future__ import annotations
@@ -414,6 +415,9 @@ class _Problem:
         self.tmax = (1 - opts.torque_margin) * robot.tau_max
         self.q_start = q_start
         self.evaluations = 0
+        #: Called after each evaluation with the evaluations so far and their budget.
+        self.evaluated: Callable[[int, int], None] | None = None
+        self.budget = opts.max_evaluations
 
     def coefficients(self, x: NDArray[np.float64]) -> tuple[NDArray, NDArray]:
         """Coefficients (n, 2L) within the limits and start position (n,) of ``x``: each
@@ -483,6 +487,8 @@ class _Problem:
 
     def objective(self, x: NDArray[np.float64]) -> float:
         self.evaluations += 1
+        if self.evaluated is not None:
+            self.evaluated(self.evaluations, self.budget)
         c, q0 = self.coefficients(x)
         return self.criterion(c, q0) + self.penalty(c, q0)
 
@@ -572,6 +578,7 @@ def optimise_excitation(
     q_start: ArrayLike | None = None,
     base: BaseParameters | None = None,
     progress: Callable[[int, int, float], None] | None = None,
+    evaluated: Callable[[int, int], None] | None = None,
 ) -> ExcitationResult:
     """Optimise an exciting trajectory for the classical identification.
 
@@ -590,7 +597,12 @@ def optimise_excitation(
     base : BaseParameters, optional
         Default ``base_parameters(robot, kind="torque")``.
     progress : callable, optional
-        ``progress(iteration, max_iter, condition_number)``.
+        ``progress(iteration, max_iter, condition_number)`` after each iteration.
+    evaluated : callable, optional
+        ``evaluated(evaluations, budget)`` after each evaluation of the objective (several
+        per millisecond to one per 15 ms: throttle what it shows); ``budget`` is
+        ``options.max_evaluations`` plus those that chose the start (L-BFGS-B may
+        overrun it by the evaluations of one gradient).
 
     Returns
     -------
@@ -613,7 +625,9 @@ def optimise_excitation(
         q_start = robot.q_neutral if robot.q_neutral is not None else mid
     q_start = _checks.as_exact("q_start", q_start, (robot.n,))
     prob = _Problem(robot, options, obstacles, caps, base, q_start)
+    prob.evaluated, prob.budget = evaluated, options.max_evaluations + options.n_starts
     x0 = _start(prob, rng)
+    prob.budget = options.max_evaluations + prob.evaluations
     history: list[float] = []
     best = _BestFeasible(prob)
     best.offer(x0)
