@@ -51,6 +51,7 @@ from __future__ import annotations
 
 import argparse
 import sys
+import time
 from pathlib import Path
 from typing import Any
 
@@ -143,15 +144,42 @@ def register(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParser:
     return p
 
 
-def _progress(show: bool) -> Any:
-    """A bar of the iterations on stderr when ``show`` (a terminal, without -q)."""
+#: Least time [s] between two redraws of the bar within an iteration.
+BAR_EVERY_S = 0.25
 
-    def progress(k: int, total: int, cond: float) -> None:
-        if show:
-            bar = "#" * int(30 * k / max(total, 1))
-            print(f"\r[{bar:<30}] iteration {k}/{total}, cond {cond:.4g}", end="", file=sys.stderr)
 
-    return progress
+class _Bar:
+    """The optimiser's progress on one stderr line (a terminal, without -q): iterations
+    and objective evaluations done, the bar at the larger share of their budgets (the
+    evaluations' runs out first when a line search struggles: an iteration can take a
+    minute), redrawn after each iteration and at most every :data:`BAR_EVERY_S` within
+    one."""
+
+    def __init__(self, max_iter: int) -> None:
+        self.iteration, self.max_iter, self.cond = 0, max_iter, float("nan")
+        self.evaluations, self.budget = 0, 1
+        self.last, self.width = 0.0, 0
+
+    def on_iteration(self, k: int, total: int, cond: float) -> None:
+        self.iteration, self.max_iter, self.cond = k, total, cond
+        self._draw()
+
+    def on_evaluation(self, done: int, budget: int) -> None:
+        self.evaluations, self.budget = done, budget
+        if time.monotonic() - self.last >= BAR_EVERY_S:
+            self._draw()
+
+    def _draw(self) -> None:
+        self.last = time.monotonic()
+        share = max(self.iteration / max(self.max_iter, 1), self.evaluations / max(self.budget, 1))
+        bar = "#" * int(30 * min(share, 1.0))
+        cond = f", cond {self.cond:.4g}" if self.iteration else ""
+        text = (
+            f"[{bar:<30}] iteration {self.iteration}/{self.max_iter}, "
+            f"{self.evaluations:,}/{self.budget:,} evaluations{cond}"
+        )
+        self.width = max(self.width, len(text))
+        print(f"\r{text:<{self.width}}", end="", file=sys.stderr, flush=True)
 
 
 def run(args: argparse.Namespace, console: Console) -> int:
@@ -159,9 +187,14 @@ def run(args: argparse.Namespace, console: Console) -> int:
     robot = load_robot(args)
     opts = _options(args)
     show = not console.quiet and sys.stderr.isatty()
-    progress = _progress(show)
+    bar = _Bar(opts.max_iter) if show else None
     design = design_excitation(
-        robot, opts, obstacles=args.obstacles, seed=args.seed, progress=progress
+        robot,
+        opts,
+        obstacles=args.obstacles,
+        seed=args.seed,
+        progress=None if bar is None else bar.on_iteration,
+        evaluated=None if bar is None else bar.on_evaluation,
     )
     print(end="\n" if show else "", file=sys.stderr)
     written = _save(args, robot, design)

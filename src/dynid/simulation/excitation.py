@@ -28,8 +28,13 @@ maximise ``log det`` of its column-scaled Gram matrix (D-optimality). Constraint
   obstacle are named with their distances (:mod:`dynid.simulation.clearance`).
 
 scipy's L-BFGS-B with finite-difference gradients; the start is the best of ``n_starts``
-seeded random candidates. Seeded and reproducible; ``progress(iteration, max_iter, cond)``
-is called after each iteration.
+seeded random candidates, each as large as its joints' limits allow; when the best violates a torque
+or a clearance (a small arm's elbow folded into its shoulder at the top of its range), the
+candidates at 80, 60 and 40 % of that amplitude too, from which the optimiser can shrink or
+grow a motion (at the largest that fits, the scaling undoes either, and a start in
+collision was never left). Seeded and reproducible; ``progress(iteration, max_iter, cond)``
+is called after each iteration and ``evaluated(evaluations, budget)`` after each evaluation
+of the objective (an iteration can take thousands when its line search struggles).
 """
 
 from __future__ import annotations
@@ -80,6 +85,9 @@ _log = logging.getLogger(__name__)
 STATUSES = ("ok", "reduced", "infeasible")
 #: Rate [Hz] of the samples the result and its start are compared on (and reported).
 _FS_REPORTED = 200.0
+#: Fractions of their amplitudes the random starts are also tried at when none at full
+#: amplitude keeps the torques and clearances (:func:`_start`).
+_START_FRACTIONS = (0.8, 0.6, 0.4)
 
 
 @dataclass(frozen=True, slots=True)
@@ -407,18 +415,31 @@ class _Problem:
         self.tmax = (1 - opts.torque_margin) * robot.tau_max
         self.q_start = q_start
         self.evaluations = 0
+        #: Called after each evaluation with the evaluations so far and their budget.
+        self.evaluated: Callable[[int, int], None] | None = None
+        self.budget = opts.max_evaluations
 
     def coefficients(self, x: NDArray[np.float64]) -> tuple[NDArray, NDArray]:
-        """Coefficients (n, 2L) within the limits and start position (n,) of ``x``."""
-        n, L = self.n, self.L
-        c = x[: n * 2 * L].reshape(n, 2 * L) @ self.Pi.T
+        """Coefficients (n, 2L) within the limits and start position (n,) of ``x``: each
+        joint's raw coefficients (n 2L) scaled down to fit the limits when they exceed
+        them, and its rest position's offset from ``q_start`` (n) [rad], clipped to where
+        the motion fits."""
+        n, k = self.n, self.n * 2 * self.L
+        c, lo, hi = self._fitted(x[:k].reshape(n, 2 * self.L) @ self.Pi.T)
+        return c, np.clip(self.q_start + x[k:], lo, hi)
+
+    def _fitted(self, c: NDArray[np.float64], fraction: float = 1.0) -> tuple[NDArray, ...]:
+        """Coefficients ``c`` (n, 2L) scaled to ``fraction`` of the largest motion within
+        the position, velocity and acceleration limits (never up), and the lowest and
+        highest rest positions (n each) [rad] that keep that motion within the position
+        limits and their margins."""
         Pq, Pd, Pa = self.B_lim
         q, dq, ddq = Pq @ c.T, Pd @ c.T, Pa @ c.T
         span = q.max(axis=0) - q.min(axis=0)
         with np.errstate(divide="ignore", invalid="ignore"):
             s = np.minimum.reduce(
                 [
-                    np.ones(n),
+                    np.ones(self.n),
                     (self.hi - self.lo) / span,
                     self.vmax / np.abs(dq).max(axis=0),
                     self.amax / np.abs(ddq).max(axis=0),
@@ -426,11 +447,28 @@ class _Problem:
             )
         # 1e-3 to spare: the peaks between the 100 Hz samples are higher by < 5e-4
         s = np.where(np.isfinite(s), s, 1.0) * (1 - 1e-3)
-        c = c * s[:, None]
-        qmin, qmax = q.min(axis=0) * s, q.max(axis=0) * s
+        if fraction != 1:
+            s = s * fraction
         tol = 2.5e-4 * (self.hi - self.lo)  # inside the 1e-3 spared by the scaling
-        q0 = np.clip(self.q_start + x[n * 2 * L :], self.lo - qmin + tol, self.hi - qmax - tol)
-        return c, q0
+        qmin, qmax = q.min(axis=0) * s, q.max(axis=0) * s
+        return c * s[:, None], self.lo - qmin + tol, self.hi - qmax - tol
+
+    def initial(
+        self, raw: NDArray[np.float64], offset: NDArray[np.float64], fraction: float = 1.0
+    ) -> NDArray:
+        """The variables of raw coefficients ``raw`` (n 2L) and a rest position offset
+        ``offset`` (n) [rad]; below 1, ``fraction`` scales each joint's motion to that
+        fraction of the largest that fits (the optimiser can then grow or shrink it; at
+        the largest, the scaling to the limits undoes either) and moves the offset to
+        where the motion fits (within the window, the optimiser can move it)."""
+        if fraction == 1:
+            return np.concatenate([raw, offset])
+        n, L = self.n, self.L
+        c = raw.reshape(n, 2 * L) @ self.Pi.T
+        scaled, lo, hi = self._fitted(c, fraction)
+        ratio = np.linalg.norm(scaled, axis=1) / np.maximum(np.linalg.norm(c, axis=1), 1e-300)
+        q0 = np.clip(self.q_start + offset, lo, hi)
+        return np.concatenate([raw * np.repeat(ratio, 2 * L), q0 - self.q_start])
 
     def trajectory(self, x: NDArray[np.float64]) -> ExcitingTrajectory:
         c, q0 = self.coefficients(x)
@@ -449,6 +487,8 @@ class _Problem:
 
     def objective(self, x: NDArray[np.float64]) -> float:
         self.evaluations += 1
+        if self.evaluated is not None:
+            self.evaluated(self.evaluations, self.budget)
         c, q0 = self.coefficients(x)
         return self.criterion(c, q0) + self.penalty(c, q0)
 
@@ -538,6 +578,7 @@ def optimise_excitation(
     q_start: ArrayLike | None = None,
     base: BaseParameters | None = None,
     progress: Callable[[int, int, float], None] | None = None,
+    evaluated: Callable[[int, int], None] | None = None,
 ) -> ExcitationResult:
     """Optimise an exciting trajectory for the classical identification.
 
@@ -556,7 +597,12 @@ def optimise_excitation(
     base : BaseParameters, optional
         Default ``base_parameters(robot, kind="torque")``.
     progress : callable, optional
-        ``progress(iteration, max_iter, condition_number)``.
+        ``progress(iteration, max_iter, condition_number)`` after each iteration.
+    evaluated : callable, optional
+        ``evaluated(evaluations, budget)`` after each evaluation of the objective (several
+        per millisecond to one per 15 ms: throttle what it shows); ``budget`` is
+        ``options.max_evaluations`` plus those that chose the start (L-BFGS-B may
+        overrun it by the evaluations of one gradient).
 
     Returns
     -------
@@ -579,12 +625,9 @@ def optimise_excitation(
         q_start = robot.q_neutral if robot.q_neutral is not None else mid
     q_start = _checks.as_exact("q_start", q_start, (robot.n,))
     prob = _Problem(robot, options, obstacles, caps, base, q_start)
-    n, L = robot.n, options.harmonics
-    starts = []
-    for _ in range(max(options.n_starts, 1)):
-        x = np.concatenate([rng.standard_normal(n * 2 * L), 0.3 * rng.standard_normal(n)])
-        starts.append((prob.objective(x), x))
-    _, x0 = min(starts, key=lambda p: p[0])
+    prob.evaluated, prob.budget = evaluated, options.max_evaluations + options.n_starts
+    x0 = _start(prob, rng)
+    prob.budget = options.max_evaluations + prob.evaluations
     history: list[float] = []
     best = _BestFeasible(prob)
     best.offer(x0)
@@ -640,6 +683,29 @@ def optimise_excitation(
         sizes=collision_sizes(robot),
         derived=derived,
     )
+
+
+def _start(prob: _Problem, rng: np.random.Generator) -> NDArray[np.float64]:
+    """The start of the optimisation: the best of ``n_starts`` random candidates at full
+    amplitude (lowest criterion plus penalty); when even that one violates a torque or a
+    clearance, the best of them all at :data:`_START_FRACTIONS` of their amplitudes too.
+
+    Regression (SO-101): every full-amplitude candidate filled each joint's range, the
+    elbow folded into the shoulder, and the optimiser, started in that collision, never
+    left it (status reduced).
+    """
+    n, L = prob.n, prob.L
+    draws = [
+        (rng.standard_normal(n * 2 * L), 0.3 * rng.standard_normal(n))
+        for _ in range(max(prob.opts.n_starts, 1))
+    ]
+    scored = [(prob.objective(x), x) for x in (prob.initial(*d) for d in draws)]
+    x0 = min(scored, key=lambda p: p[0])[1]
+    if prob.penalty(*prob.coefficients(x0)) == 0:
+        return x0
+    for f in _START_FRACTIONS:
+        scored += [(prob.objective(x), x) for x in (prob.initial(*d, f) for d in draws)]
+    return min(scored, key=lambda p: p[0])[1]
 
 
 class _BestFeasible:

@@ -172,6 +172,7 @@ def design_excitation(
     obstacles: str | Path | None = None,
     seed: int = 0,
     progress: Callable[[int, int, float], None] | None = None,
+    evaluated: Callable[[int, int], None] | None = None,
 ) -> ExcitationDesign:
     """An exciting trajectory for ``robot``, optimised and checked
     (:func:`~dynid.simulation.excitation.optimise_excitation`).
@@ -186,6 +187,8 @@ def design_excitation(
         Seed of the starts of the optimisation.
     progress : callable, optional
         ``progress(iteration, total, condition_number)`` after each iteration.
+    evaluated : callable, optional
+        ``evaluated(evaluations, budget)`` after each evaluation of the objective.
 
     Returns
     -------
@@ -203,5 +206,6 @@ def design_excitation(
         options or ExcitationOptions(),
         obstacles=obs,
         progress=progress,
+        evaluated=evaluated,
     )
     return ExcitationDesign(res, res.trajectory.sample(EXCITE_RATE_HZ), seed)
