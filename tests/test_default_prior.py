@@ -79,3 +79,20 @@ def test_moved_note_names_determined_coefficients_pulled_away_from_the_data():
     assert note is not None and "moves 1 coefficient(s)" in note
     assert "Ia5 0.0128 +- 10 % -> 0.00256 (8 sd)" in note
     assert moved_note(term, term.x_hat) is None
+
+
+def test_prior_generic_still_asks_for_the_cylinders():
+    """``--prior generic`` takes the solid cylinders of the kinematics, as the default did
+    before it took the description's inertials: each link's mass and first moment are the
+    cylinder's (closed form: the generic prior of the same kinematics), whatever the
+    description holds; an unknown name lists 'generic' among the choices."""
+    from dynid.exceptions import OptionError
+    from dynid.workflows.prior import load_prior
+
+    panda = dynid.panda()
+    prior = load_prior("generic", panda)
+    assert prior is not None and prior.name.startswith("generic")
+    np.testing.assert_allclose(prior.phi, generic_prior(panda).phi, rtol=0, atol=0)
+    assert not np.allclose(prior.phi[:, 0], panda.phi[:, 0])
+    with pytest.raises(OptionError, match="'generic' or 'panda'"):
+        load_prior("cylinders", panda)

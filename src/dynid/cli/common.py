@@ -318,11 +318,11 @@ def add_consistency_options(p: argparse.ArgumentParser) -> None:
     g.add_argument(
         "--prior",
         default=None,
-        metavar="panda|fr3|FILE",
-        help="prior link parameters: 'panda', 'fr3' (the Panda's), a .urdf (with "
-        "--prior-base/--prior-tip), a .toml or a feasible.json; default: the --robot "
-        "description's own inertials (a solid cylinder per link from the kinematics when "
-        "it has none)",
+        metavar="generic|panda|fr3|FILE",
+        help="prior link parameters: 'generic' (a solid cylinder per link from the "
+        "kinematics), 'panda', 'fr3' (the Panda's), a .urdf (with --prior-base/--prior-tip), "
+        "a .toml or a feasible.json; default: the --robot description's own inertials "
+        "(generic when it has none)",
     )
     g.add_argument("--prior-base", default=None, help="URDF base link of the prior's chain")
     g.add_argument("--prior-tip", default=None, help="URDF tip link of the prior's chain")

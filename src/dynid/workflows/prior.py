@@ -19,6 +19,12 @@ __all__ = ["load_prior"]
 _log = logging.getLogger(__name__)
 
 
+#: The ``--prior`` that asks for a solid cylinder per link from the kinematics (the
+#: default prior when the description holds no inertials; the default is else the
+#: description's own).
+GENERIC = "generic"
+
+
 def load_prior(
     spec: str | Path | None, robot: Robot, *, base: str | None = None, tip: str | None = None
 ) -> Robot | None:
@@ -28,10 +34,11 @@ def load_prior(
     Parameters
     ----------
     spec : str or Path, optional
-        ``'panda'``, ``'fr3'``, a ``.urdf`` (chain ``base`` to ``tip``, default: the
-        robot's first and last link names; its angles rounded near multiples of pi/2
-        read snapped and not warned about: only its inertials are used), a ``.toml`` or
-        a ``feasible.json``.
+        ``'generic'`` (a solid cylinder per link,
+        :func:`~dynid.feasibility.prior.generic_prior`), ``'panda'``, ``'fr3'``, a
+        ``.urdf`` (chain ``base`` to ``tip``, default: the robot's first and last link
+        names; its angles rounded near multiples of pi/2 read snapped and not warned
+        about: only its inertials are used), a ``.toml`` or a ``feasible.json``.
     robot : Robot
         The robot being identified.
     base, tip : str, optional
@@ -60,14 +67,20 @@ def load_prior(
     if spec is None:
         return None
     spec = str(spec)
+    if spec == GENERIC:  # the cylinders the default takes only without inertials
+        from ..feasibility.prior import generic_prior
+
+        return robot.with_params(generic_prior(robot).phi).replace(
+            name="generic (a solid cylinder per link)"
+        )
     if spec in BUILTIN_ROBOTS:
         prior = builtin_robot(spec)
     else:
         path = Path(spec)
         if path.suffix.lower() not in ROBOT_FILE_SUFFIXES:
             raise OptionError(
-                f"must be {' or '.join(map(repr, BUILTIN_ROBOTS))} or a .urdf, .toml, .json "
-                f"(feasible.json) or .xml (MJCF) file; got {spec!r}",
+                f"must be {' or '.join(map(repr, (GENERIC, *BUILTIN_ROBOTS)))} or a .urdf, "
+                f".toml, .json (feasible.json) or .xml (MJCF) file; got {spec!r}",
                 field="prior",
             )
         if not path.exists():
