@@ -37,7 +37,13 @@ def test_one_factor_on_every_parameter_is_named_with_the_torque_constant(q):
     assert said is not None and "0.83 times the robot description's" in said
     assert "torque_constant" in said and "multiply it by 1.2" in said
     plain = gravity_scale_finding(robot, model, [q])
-    assert plain is not None and "--units tau=1.2" in plain
+    assert plain is not None and "--units tau=1.2" in plain and "currents" not in plain
+    # currents read as torques (3 times the model's): the drive of currents is named too,
+    # its torque constants one per motor (a single --units factor fits one joint at most)
+    currents = exact_model(robot, robot.with_params(1 / 3 * robot.phi))
+    said = gravity_scale_finding(robot, currents, [q])
+    assert said is not None and "--units tau=3" in said
+    assert 'effort = "current"' in said and "torque_constant" in said
 
 
 def test_masses_off_joint_by_joint_or_a_factor_near_one_say_nothing(q):

@@ -94,7 +94,13 @@ def gravity_scale_finding(
             f"{said}; if the description's masses are right, the drive file's torque_constant "
             f"is {mean:.3g} times the true one: multiply it by {1 / mean:.3g}"
         )
+    currents = (
+        '; or the log holds motor currents: a drive file with effort = "current" and each '
+        "motor's torque_constant (a factor per joint)"
+        if not 0.5 <= mean <= 2.0
+        else ""
+    )
     return (
         f"{said}; if the description's masses are right, the torques are {1 / mean:.3g} "
-        f"times too small (a sensor scale: --units tau={1 / mean:.3g})"
+        f"times too small (a sensor scale: --units tau={1 / mean:.3g}){currents}"
     )
