@@ -222,6 +222,7 @@ def banded_if_narrow(
     bands: tuple[NDArray[np.float64], ...],
     *,
     derived: bool = False,
+    smooth: bool = True,
 ) -> FrictionModel | FrictionSum | None:
     """``friction`` as the observer evaluates it on velocities of noise band ``bands``
     (:func:`velocity_bands` or :func:`derived_velocity_bands`, one per part): a smooth
@@ -232,7 +233,9 @@ def banded_if_narrow(
     on every motor whose own band is below :data:`NARROW_BAND` times it (measured
     velocities only: ``derived`` bands are bounded by :func:`standstill_margin`'s derived
     term instead); each part of a sum on its own; any other friction as it is
-    (:func:`banding_note` says what changed).
+    (:func:`banding_note` says what changed). ``smooth`` False keeps smooth laws as they
+    are (validation judges a model's prediction in motion, for which identification chose
+    the narrow law; the observer needs the band at rest).
 
     Inside the band a narrow ``tanh`` of the noise is a random level in ``[-fc, fc]``, and
     ``sign(dq)`` of the noise a random ``+-fc``, which bounds the residual of a joint at rest
@@ -245,7 +248,7 @@ def banded_if_narrow(
     weak contacts missed)."""
     if isinstance(friction, FrictionSum):
         parts = tuple(
-            _banded_part(p, b, derived) for p, b in zip(friction.parts, bands, strict=True)
+            _banded_part(p, b, derived, smooth) for p, b in zip(friction.parts, bands, strict=True)
         )
         if all(a is b for a, b in zip(parts, friction.parts, strict=True)):
             return friction
@@ -253,10 +256,12 @@ def banded_if_narrow(
     if friction is None:
         return friction
     (b,) = bands
-    return _banded_part(friction, b, derived)
+    return _banded_part(friction, b, derived, smooth)
 
 
-def _banded_part(friction: FrictionModel, b: NDArray[np.float64], derived: bool) -> FrictionModel:
+def _banded_part(
+    friction: FrictionModel, b: NDArray[np.float64], derived: bool, smooth: bool = True
+) -> FrictionModel:
     """One part of :func:`banded_if_narrow`."""
     from ..friction.laws import LAWS
 
@@ -266,7 +271,7 @@ def _banded_part(friction: FrictionModel, b: NDArray[np.float64], derived: bool)
     if width.size != b.size:
         return friction
     if friction.kind in banded_law:
-        if not np.all(width < b):
+        if not smooth or not np.all(width < b):
             return friction
         return LAWS[banded_law[friction.kind]].model(np.asarray(friction.params), b, drive)
     canon = canonical_friction(friction, b.size)

@@ -426,13 +426,14 @@ def _banded(
     (:func:`~dynid.observer.friction.banding_note`); run again only then. Without it
     ``sign(dq)`` of the noise at every rest flips the whole Coulomb torque (a URDF's
     ``<dynamics friction>``, which holds no band). An identified law's band is that noise
-    band already: it stays as it is."""
+    band already, and a smooth law (identification chose its width for the prediction
+    in motion, which validation judges) stays as it is too."""
     val = run(friction)
     noise = val.pieces.state_noise
     if friction is None or noise is None:
         return val
     bands = noise_bands(friction, noise.dq)
-    banded = banded_if_narrow(friction, bands, derived=noise.derived)
+    banded = banded_if_narrow(friction, bands, derived=noise.derived, smooth=False)
     if banded is friction:
         return val
     if said := banding_note(friction, [banded], verb="judged", read_as="model error"):
