@@ -306,10 +306,11 @@ def simplest_within(scores: Sequence[CandidateScore], prefer: str | None = None)
     folds, :func:`~dynid.identification.candidates.paired_fold_se`; differences under
     :data:`~dynid.identification.candidates.RELATIVE_TIE` of the lowest are ties); of as
     many coefficients, the lower error, then the earlier. The candidate named ``prefer``
-    (the model's own friction, identified with its links) is kept when it is within and
-    no candidate within has fewer coefficients: a law refitted to tie with it is no
-    reason to replace it (a 5-joint arm's own smooth law, 1.7 rad/s wide, gave way to a
-    refitted one 0.023 rad/s wide at the same error, and new data were predicted worse)."""
+    (the model's own friction, identified with its links) is kept when it is within (or
+    ties with the one kept) and has no more coefficients than that one: a law refitted to
+    tie with it is no reason to replace it (a 5-joint arm's own smooth law, 1.7 rad/s
+    wide, gave way to a refitted one 0.023 rad/s wide at the same error, and new data
+    were predicted worse)."""
     best = min(scores, key=lambda s: s.scaled_error_percent)
     low = best.scaled_error_percent
 
@@ -319,7 +320,14 @@ def simplest_within(scores: Sequence[CandidateScore], prefer: str | None = None)
 
     near = [s for s in scores if within(s)]
     kept = min(near, key=lambda s: (s.n_params, s.scaled_error_percent))
-    mine = [s for s in near if s.name == prefer and s.n_params <= kept.n_params]
+    tied = kept.scaled_error_percent * (1.0 + RELATIVE_TIE)
+    mine = [
+        s
+        for s in scores
+        if s.name == prefer
+        and s.n_params <= kept.n_params
+        and (within(s) or s.scaled_error_percent <= tied)
+    ]
     return mine[0] if mine else kept
 
 
