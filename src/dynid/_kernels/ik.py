@@ -20,14 +20,14 @@ import math
 import numba
 import numpy as np
 
-from .chain import angles, inline, jit
+from .chain import angles, called, inline, jit
 from .dense import cholesky, cholesky_solve
 from .kinematics import frame_jacobian
 
 __all__ = ["solve_one", "solve_batch"]
 
 
-@inline
+@called
 def _min_eigenvalue(G, d, A, w, off):
     """Smallest eigenvalue of the symmetric ``G[:d, :d]`` (scratch ``A`` (6, 6), ``w``, ``off``).
 
@@ -244,7 +244,7 @@ def _gram(Jf, nf, d, G, V):
     return tot
 
 
-@inline
+@called
 def _jacobi(G, V, d, tot):
     """Cyclic Jacobi rotations: ``G`` becomes ``diag(w)`` and ``V`` its eigenvectors."""
     for _sweep in range(50):
