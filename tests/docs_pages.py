@@ -4,18 +4,23 @@ with this checkout's ``dynid`` and Python; and every JSON file they write is des
 docs/file-formats.md.
 
 Blocks fenced ```console or ```text are shown, not run (``make`` targets, a URDF template
-the reader supplies). The pages are shared among a few test files (:data:`OWN_FILE`): each
-file runs on one test worker (``--dist loadscope``), and one file of all the pages kept
-its worker busy for over a minute.
+the reader supplies). A page's ``dynid`` commands are processes forked from one that has
+imported the command line (:mod:`docs_commands`; the first of each subcommand starts
+afresh): they spent most of a second each on imports. The pages are shared among a few
+test files (:data:`OWN_FILE`): each file runs on one test worker (``--dist loadscope``),
+and one file of all the pages kept its worker busy for over a minute.
 """
 
 from __future__ import annotations
 
+import atexit
 import json
 import os
 import re
+import shutil
 import subprocess
 import sys
+import tempfile
 from pathlib import Path
 
 import pytest
@@ -37,20 +42,63 @@ def all_pages() -> list[Path]:
     return sorted(p for p in DOCS.rglob("*.md") if runnable_blocks(p.read_text("utf-8")))
 
 
-def _environment(tmp: Path) -> dict[str, str]:
-    """PATH with ``dynid`` and ``python`` of this interpreter first, this checkout's sources
-    first on PYTHONPATH, figures without a display."""
-    bin_dir = tmp / ".bin"
-    bin_dir.mkdir()
-    (bin_dir / "dynid").write_text(f'#!/bin/sh\nexec "{sys.executable}" -m dynid "$@"\n')
-    (bin_dir / "python").write_text(f'#!/bin/sh\nexec "{sys.executable}" "$@"\n')
-    for f in bin_dir.iterdir():
-        f.chmod(0o755)
+def _base_environment() -> dict[str, str]:
+    """This checkout's sources first on PYTHONPATH, figures without a display."""
     env = dict(os.environ)
-    env["PATH"] = f"{bin_dir}{os.pathsep}{env.get('PATH', '')}"
     src = str(ROOT / "src")
     env["PYTHONPATH"] = os.pathsep.join(p for p in (src, env.get("PYTHONPATH")) if p)
     env["MPLBACKEND"] = "Agg"
+    return env
+
+
+class _Server:
+    """The process that forks the pages' ``dynid`` commands (:mod:`docs_commands`), one
+    per test process, started on first use and stopped when the process exits."""
+
+    proc: subprocess.Popen | None = None
+    socket: str | None = None
+
+    @classmethod
+    def path(cls) -> str | None:
+        """The server's socket, or None (the commands then run fresh)."""
+        if cls.proc is None:
+            folder = tempfile.mkdtemp(prefix="dynid-docs-")
+            cls.socket = os.path.join(folder, "s")
+            cls.proc = subprocess.Popen(
+                [sys.executable, str(Path(__file__).with_name("docs_commands.py")), "serve",
+                 cls.socket],
+                stdin=subprocess.PIPE, stdout=subprocess.PIPE, stderr=subprocess.DEVNULL,
+                env=_base_environment(), text=True,
+            )  # fmt: skip
+            atexit.register(cls.stop, folder)
+            if cls.proc.stdout is None or cls.proc.stdout.readline() != "ready\n":
+                cls.socket = None
+        return cls.socket
+
+    @classmethod
+    def stop(cls, folder: str) -> None:
+        if cls.proc is not None:
+            cls.proc.terminate()
+            cls.proc.wait()
+        shutil.rmtree(folder, ignore_errors=True)
+
+
+def _environment(tmp: Path) -> dict[str, str]:
+    """PATH with ``dynid`` and ``python`` of this interpreter first (``dynid`` through the
+    server of :mod:`docs_commands` when it runs), :func:`_base_environment`."""
+    bin_dir = tmp / ".bin"
+    bin_dir.mkdir()
+    server = _Server.path()
+    dynid = f'"{sys.executable}" -m dynid'
+    if server is not None:
+        client = Path(__file__).with_name("docs_commands.py")
+        dynid = f'"{sys.executable}" -S "{client}" run "{server}"'
+    (bin_dir / "dynid").write_text(f'#!/bin/sh\nexec {dynid} "$@"\n')
+    (bin_dir / "python").write_text(f'#!/bin/sh\nexec "{sys.executable}" "$@"\n')
+    for f in bin_dir.iterdir():
+        f.chmod(0o755)
+    env = _base_environment()
+    env["PATH"] = f"{bin_dir}{os.pathsep}{env.get('PATH', '')}"
     return env
 
 

@@ -7,12 +7,12 @@ start of ``tests/conftest.py`` runs this module in one process per group, in par
 before the workers exist; they then load the kernels from the cache. Nothing here is
 checked: a kernel left out is compiled by the first test that needs it, as before.
 
-Usage: ``python tests/warm_kernels.py GROUP`` with GROUP 0 (the forward and inverse
-kinematics, a batch of goals and one goal: about a minute on one core) or 1 (the Jacobians
-and link poses, the dynamics, the regressors and the momentum observer: about 40 s). No
-compiled function is called from both groups (the inverse kinematics' Jacobian is inlined,
-the observer's helpers are the dynamics'): two processes writing one function's cache index
-at once can lose an entry.
+Usage: ``python tests/warm_kernels.py GROUP`` with GROUP 0 (the kinematics, forward and
+inverse, the Jacobians and link poses, and the regressors, each for a batch and one
+sample: about 35 s on one core) or 1 (the dynamics and the momentum observer: about 35 s).
+No compiled function is called from both groups (the inverse kinematics' Jacobian is
+inlined, as are the dynamics' functions the observer shares): two processes writing one
+function's cache index at once can lose an entry.
 """
 
 from __future__ import annotations
@@ -34,16 +34,16 @@ def warm(group: int) -> None:
     for x, v in ((Q, Q), (q, q)):  # a batch first: it loads the kernels for single samples
         if group == 0:
             dynid.ik(robot, dynid.fk(robot, x), q0=x)
+            dynid.jacobian(robot, x)
+            dynid.link_poses(robot, x)
+            dynid.static_regressor(robot, x)
+            dynid.torque_regressor(robot, x, v, v)
             continue
-        dynid.jacobian(robot, x)
-        dynid.link_poses(robot, x)
         dynid.rnea(robot, x, v, v)
         dynid.mass_matrix(robot, x)
         dynid.gravity_torques(robot, x)
         dynid.coriolis(robot, x, v)
         dynid.forward_dynamics(robot, x, v, v)
-        dynid.static_regressor(robot, x)
-        dynid.torque_regressor(robot, x, v, v)
     if group == 1:  # the observer
         from dynid.observer import MomentumObserver, from_robot, momentum_terms
 

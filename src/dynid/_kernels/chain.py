@@ -49,6 +49,7 @@ from .layout import C_PRISMATIC, C_ROT, C_SLIDE, C_T
 
 __all__ = [
     "jit",
+    "called",
     "lean",
     "stack",
     "flat_view",
@@ -101,6 +102,13 @@ def jit(fn=None, **options):
 def inline(fn):
     """A helper inlined into its callers (numba ``inline="always"``)."""
     return numba.njit(inline="always", fastmath=FASTMATH)(fn)
+
+
+def called(fn):
+    """A function compiled on its own and called, not inlined: for long code on a rare
+    path, each inlined copy of which costs seconds of compilation (its caller's cache
+    keeps it)."""
+    return numba.njit(fastmath=FASTMATH)(fn)
 
 
 def lean(fn):

@@ -20,14 +20,14 @@ import math
 import numba
 import numpy as np
 
-from .chain import angles, inline, jit
+from .chain import angles, called, inline, jit
 from .dense import cholesky, cholesky_solve
 from .kinematics import frame_jacobian
 
 __all__ = ["solve_one", "solve_batch"]
 
 
-@inline
+@called
 def _min_eigenvalue(G, d, A, w, off):
     """Smallest eigenvalue of the symmetric ``G[:d, :d]`` (scratch ``A`` (6, 6), ``w``, ``off``).
 
@@ -244,7 +244,7 @@ def _gram(Jf, nf, d, G, V):
     return tot
 
 
-@inline
+@called
 def _jacobi(G, V, d, tot):
     """Cyclic Jacobi rotations: ``G`` becomes ``diag(w)`` and ``V`` its eigenvectors."""
     for _sweep in range(50):
@@ -497,16 +497,15 @@ def _solve(C, m, q_min, q_max, inv_vmax, q_restart, goal, fpar, ipar, path, keep
 
 @jit
 def solve_one(C, m, q_min, q_max, inv_vmax, q_restart, goal, fpar, ipar, path, q_best):
-    """One goal, keeping the path; see :func:`_solve`."""
-    return _solve(C, m, q_min, q_max, inv_vmax, q_restart, goal, fpar, ipar, path, True, q_best)
+    """One goal; see :func:`_solve`. The path is kept unless ``path`` has a single row.
 
-
-@jit
-def _solve_goal(C, m, q_min, q_max, inv_vmax, q_restart, goal, fpar, ipar, path, q_best):
-    """One goal without its path: a compiled call, not inlined, so that the parallel loop
-    of :func:`solve_batch` does not analyse the solver's tuples (numba's parfor array
-    analysis fails on them when it compiles afresh)."""
-    return _solve(C, m, q_min, q_max, inv_vmax, q_restart, goal, fpar, ipar, path, False, q_best)
+    :func:`solve_batch` calls it with a single row: one compilation of the solver serves
+    both (it takes most of a minute on one core), and the parallel loop calls it compiled,
+    not inlined, so that numba's parfor array analysis, which fails on the solver's tuples
+    when it compiles afresh, does not see them.
+    """
+    keep = path.shape[0] > 1
+    return _solve(C, m, q_min, q_max, inv_vmax, q_restart, goal, fpar, ipar, path, keep, q_best)
 
 
 @jit(parallel=True)
@@ -523,7 +522,7 @@ def solve_batch(C, m, q_min, q_max, inv_vmax, q_restart, goals, fpar, ipar, q0, 
         path = np.empty((1, n))
         for j in range(n):
             path[0, j] = q0[g, j]
-        k, _, ep, eo, conv, rs, more = _solve_goal(
+        k, _, ep, eo, conv, rs, more = solve_one(
             C, m, q_min, q_max, inv_vmax, q_restart[g], goals[g], fpar, ipar, path, out[g]
         )
         stats[g, 0] = k

@@ -509,7 +509,8 @@ def _ik_batch(
     n, m = robot.n, link
     start = default_q0(robot) if q0 is None else _checks.as_batch("q0", q0, (n,))
     try:
-        starts = np.ascontiguousarray(np.broadcast_to(start, shape + (n,))).reshape(-1, n)
+        # a new C array, writable whether q0 was broadcast or not: one compiled signature
+        starts = np.array(np.broadcast_to(start, shape + (n,)), order="C").reshape(-1, n)
     except ValueError:
         raise ShapeError(
             f"q0 must broadcast to the goals' batch shape {shape}; got {np.shape(start)}"

@@ -286,7 +286,8 @@ class MomentumObserver:
                 D, u = self._D_batch, self._u(qa, dqa, taua, friction=True)
             r = np.empty((N, n))
             fl = _kernels.flat
-            stop = mod.observer_batch(D, self._S, ta, fl(qa), fl(dqa), fl(u), r.reshape(-1))
+            # every array flat, C and writable (t of a frozen log is copied): one signature
+            stop = mod.observer_batch(D, self._S, fl(ta), fl(qa), fl(dqa), fl(u), r.reshape(-1))
             if stop < 0:
                 return r
             raise DataError(f"sample {stop} of the log stopped the observer (t = {ta[stop]!r})")
@@ -377,12 +378,15 @@ def first_order_lag(
     ta = np.asarray(t, dtype=np.float64)
     xa = np.asarray(x, dtype=np.float64)
     K = np.asarray(gain, dtype=np.float64)
-    out = np.zeros_like(xa)
     mod = _kernels.load("observer")
     if mod is not None and xa.ndim == 2 and ta.shape == xa.shape[:1]:
-        Kn = np.ascontiguousarray(np.broadcast_to(K, xa.shape[1:]), dtype=np.float64)
-        mod.first_order_lag(ta, np.ascontiguousarray(xa), Kn, rule == "trapezoid", out)
+        # C and writable arrays whatever the caller's (one compiled signature)
+        Kn = np.array(np.broadcast_to(K, xa.shape[1:]), order="C")
+        out = np.zeros(xa.shape)
+        fl = _kernels.flat
+        mod.first_order_lag(fl(ta), fl(xa).reshape(xa.shape), Kn, rule == "trapezoid", out)
         return out
+    out = np.zeros_like(xa)
     for k in range(1, ta.shape[0]):
         a = -np.expm1(-K * (ta[k] - ta[k - 1]))
         xk = 0.5 * (xa[k] + xa[k - 1]) if rule == "trapezoid" else xa[k]
