@@ -59,8 +59,8 @@ def _with_gap(src, dst, start: int, stop: int) -> None:
 @pytest.mark.filterwarnings("ignore::dynid.exceptions.DynidWarning")
 def test_heldout_json_when_the_held_out_recording_has_a_gap(folder, tmp_path, capsys):
     """Several recordings, the last with a 1 s gap (cut into two pieces, as documented):
-    heldout.json and both figures are written, over both pieces (it was skipped with a
-    note blaming the gap)."""
+    heldout.json and both figures are written, over every piece of both recordings (the
+    first one piece, the last two; it was skipped with a note blaming the gap)."""
     gap = tmp_path / "gap.csv"
     _with_gap(folder / "r2.csv", gap, 300, 550)
     base = ["identify", "--robot", "panda", "--terms", "viscous"]
@@ -68,7 +68,7 @@ def test_heldout_json_when_the_held_out_recording_has_a_gap(folder, tmp_path, ca
     assert main(argv) == 0
     assert "skipped the held-out" not in capsys.readouterr().err
     doc = _heldout(tmp_path / "a")
-    assert "2 pieces between gaps" in doc["block"]
+    assert "each of the 2 recordings" in doc["block"] and "(3 pieces between gaps)" in doc["block"]
     assert (tmp_path / "a" / "heldout_torques.png").is_file()
     assert (tmp_path / "a" / "heldout_residuals.png").is_file()
     argv = [*base, "--data", str(folder / "r1.csv"), str(gap), "--no-figures"]
