@@ -76,7 +76,7 @@ def test_the_torque_margins_include_the_rotor_inertias_in_closed_form():
     panda = dynid.panda()
     gears = np.array([141.0, 121, 101, 81, 71, 51, 51])
     ia = np.array([8e-4, 8e-4, 5e-4, 3e-4, 2e-4, 1.2e-4, 1.2e-4])
-    drive = Drive.from_gears(gears, [(7, 6, 25.0)], rotor_inertia=ia)
+    drive = Drive.from_gears(gears, [(7, 6, 25.0)], rotor_inertia=ia, friction_at="joint")
     tr = _sine(panda)
     o = ExcitationOptions()
     tau = _torques_closed_form(panda, tr, gears, ia, (6, 5, 25.0))
@@ -87,11 +87,25 @@ def test_the_torque_margins_include_the_rotor_inertias_in_closed_form():
     assert bare[0] - got[0] > 10.0  # 141^2 x 8e-4 = 15.9 kg m^2 at joint 1: not negligible
 
 
+def test_the_torque_margins_place_the_friction_where_the_drive_puts_it():
+    """With a drive whose friction acts at the motors, the robot's friction law acts on
+    the motors' velocities and reaches the joints through the gears: ``K^T f(K dq)``."""
+    panda = dynid.panda()  # the sigmoid law of Gaz et al.
+    K = Drive.from_gears(np.full(7, 50.0), [(7, 6, 10.0)]).transmission
+    drive = Drive(transmission=K, offset=np.zeros(7), friction_at="motor")
+    tr = _sine(panda)
+    o = ExcitationOptions()
+    tau = rnea(panda, tr.q, tr.dq, tr.ddq) + panda.friction.torques(np.asarray(tr.dq) @ K.T) @ K
+    want = (1 - o.torque_margin) * panda.tau_max - np.abs(tau).max(axis=0)
+    got = limit_margins(panda, tr, o, drive=drive)["torque"]
+    np.testing.assert_allclose(got, want, rtol=1e-10, atol=1e-9)
+
+
 def test_a_drive_that_identifies_its_rotors_leaves_them_out_and_says_so():
     """A drive without rotor inertias (to be identified) changes no margin, and the
     summary says the torque margins leave the rotors out."""
     panda = dynid.panda()
-    drive = Drive.from_gears(np.full(7, 100.0))
+    drive = Drive.from_gears(np.full(7, 100.0), friction_at="joint")
     tr = _sine(panda)
     o = ExcitationOptions()
     assert limit_margins(panda, tr, o, drive=drive) == limit_margins(panda, tr, o)
@@ -145,7 +159,7 @@ SO101_IA = np.array([2e-4, 2e-4, 2e-4, 1e-4, 1e-4])
 def so101_design(so101):
     """The SO-101 designed with the short options, its shoulder lift and elbow narrowed,
     with a geared drive of known rotor inertias (seed 0)."""
-    drive = Drive.from_gears(SO101_GEARS, rotor_inertia=SO101_IA)
+    drive = Drive.from_gears(SO101_GEARS, rotor_inertia=SO101_IA, friction_at="joint")
     ranges = ((1, -1.0, 1.0), (2, -1.2, 0.8))
     opts = ExcitationOptions(**SHORT, ranges=ranges)
     return optimise_excitation(so101, np.random.default_rng(0), opts, drive=drive)

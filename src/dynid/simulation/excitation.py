@@ -55,6 +55,7 @@ from numpy.typing import ArrayLike, NDArray
 from .. import _checks
 from ..dynamics.rnea import rnea
 from ..exceptions import OptionError
+from ..friction.model import robot_friction
 from ..identification.classical import friction_regressor
 from ..model.drive import Drive
 from ..model.robot import Robot
@@ -377,11 +378,14 @@ def excitation_condition_number(
 
 
 def _motor_torques(robot: Robot, tr: Trajectory, drive: Drive | None = None) -> NDArray[np.float64]:
-    """Joint torques [N m] (N, n): ``M ddq + c + g``, the model's friction and, with a
-    drive of known rotor inertias, their reflected torques ``K^T diag(I_a) K ddq``."""
+    """Joint torques [N m] (N, n): ``M ddq + c + g``, the model's friction (where the
+    drive puts it: at the motors, ``K^T f(K dq)``, for a drive whose friction acts there,
+    :func:`~dynid.friction.model.robot_friction`) and, with a drive of known rotor
+    inertias, their reflected torques ``K^T diag(I_a) K ddq``."""
     tau = rnea(robot, tr.q, tr.dq, tr.ddq)
-    if robot.friction is not None:
-        tau = tau + robot.friction.torques(tr.dq)
+    friction = robot.friction if drive is None else robot_friction(robot, drive)
+    if friction is not None:
+        tau = tau + friction.torques(tr.dq)
     if drive is not None and drive.rotor_inertia is not None:
         tau = tau + drive.rotor_torques(np.asarray(tr.ddq), drive.rotor_inertia)
     return tau
@@ -399,9 +403,9 @@ def limit_margins(
     Keys ``position`` [rad], ``velocity`` [rad/s], ``acceleration`` [rad/s^2] and
     ``torque`` [N m], each a list of n floats: e.g. ``min_t (q_max - m_q - q_j(t))`` and
     the same at the lower limit; ``inf`` where a limit is infinite. Torques are the
-    model's (``M ddq + c + g`` plus its friction) plus, with a ``drive`` of known rotor
-    inertias, their reflected torques ``K^T diag(I_a) K ddq`` (``k^2 I_a ddq`` on a joint
-    of gear ratio ``k``, uncoupled).
+    model's (``M ddq + c + g`` plus its friction, where ``drive`` puts it) plus, with a
+    ``drive`` of known rotor inertias, their reflected torques ``K^T diag(I_a) K ddq``
+    (``k^2 I_a ddq`` on a joint of gear ratio ``k``, uncoupled).
     """
     q, dq, ddq = np.asarray(tr.q), np.asarray(tr.dq), np.asarray(tr.ddq)
     m = options

@@ -24,6 +24,7 @@ from typing import Any
 
 import numpy as np
 
+from ..friction.model import own_at_motors_note
 from ..io.excitation import load_obstacles
 from ..model.drive import Drive
 from ..model.robot import Robot
@@ -105,6 +106,8 @@ class ExcitationDesign:
         head: tuple[str, ...] = (first, second) if note is None else (first, second, note)
         drive = self.drive_line(name)
         head += () if drive is None else (drive,)
+        at_motors = own_at_motors_note(robot, self.result.drive)
+        head += () if at_motors is None else (at_motors,)
         ranges = self.ranges_line(robot, name)
         head += () if ranges is None else (ranges,)
         return head + (self.sizes_line(name),) + self.clearance_lines(name)
