@@ -51,6 +51,7 @@ FLAGS: dict[str, str] = {
     "standstill": "--no-standstill-margin",
     "total_mass_band": "--no-total-mass",
     "radii": "--radius",
+    "ranges": "--range",
 }
 
 

@@ -31,6 +31,17 @@ limits: the files are written for inspection (as retrieve's when no feasible set
 A violated clearance names the two links (or the link and the obstacle), their distance,
 when, and the options that change it.
 
+With --drive FILE.toml (default: the [drive] table of a --robot TOML, as simulate reads it)
+the torques checked include the drive's known rotor inertias, reflected through its gears
+(K^T diag(I_a) K ddq: k^2 I_a ddq on an uncoupled joint of gear ratio k); a drive that
+leaves them to be identified is said to leave them out of the torque margins.
+
+--range qJ=LO:HI,... keeps joints within narrower ranges [rad] than their limits (qJ or J
+a joint's number from 1, or its name), the position margin kept inside them: an arm whose
+joints turn +-2 pi reaches the floor and itself in most of that range, and a motion over
+all of it seldom clears them. trajectory.json records the drive, the ranges (its
+"limits" are the ranges kept, "robot_limits" the robot's).
+
 status (the first line of the summary, and trajectory.json's "status"):
   ok          the optimised trajectory keeps every limit and clearance when checked at
               1 kHz (or, when nothing admissible was better, the optimiser's admissible
@@ -57,15 +68,18 @@ from typing import Any
 
 import numpy as np
 
+from ..exceptions import OptionError
 from ..io.excitation import save_excitation_json, save_trajectory_csv
 from ..model.robot import Robot
 from ..simulation.excitation import ExcitationOptions
 from ..workflows.excite import ExcitationDesign, design_excitation
 from .applies import urdf_chain
 from .common import (
+    add_drive_option,
     add_robot_options,
     add_subcommand,
     flag,
+    load_drive_arg,
     load_robot,
     output_path,
     save_figure,
@@ -88,6 +102,7 @@ def register(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParser:
         help="optimise an exciting trajectory within limits and obstacles",
     )
     add_robot_options(p)
+    add_drive_option(p)
     d = ExcitationOptions()
     p.add_argument("--duration", type=float, default=d.duration, help="Fourier part [s] (20)")
     p.add_argument("--harmonics", type=int, default=d.harmonics, help="harmonics L (5)")
@@ -135,6 +150,13 @@ def register(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParser:
         default=float(np.rad2deg(d.velocity_margin)),
         metavar="DEG_S",
         help="subtracted from the velocity limits [deg/s] (10)",
+    )
+    p.add_argument(
+        "--range",
+        default=None,
+        metavar="qJ=LO:HI,...",
+        help="narrow joints' ranges for the design [rad], qJ (or J) a joint's number from 1, "
+        "or its name (e.g. 'q1=-1.5:1.5,q2=-2.6:-0.5'); default: the robot's limits",
     )
     p.add_argument("--criterion", choices=("cond", "logdet"), default=d.criterion)
     p.add_argument("--max-iter", type=int, default=d.max_iter, help="optimiser iterations (60)")
@@ -185,7 +207,7 @@ class _Bar:
 def run(args: argparse.Namespace, console: Console) -> int:
     """Optimise, write the trajectory files and the figure; returns the exit code."""
     robot = load_robot(args)
-    opts = _options(args)
+    opts = _options(args, robot)
     show = not console.quiet and sys.stderr.isatty()
     bar = _Bar(opts.max_iter) if show else None
     design = design_excitation(
@@ -195,6 +217,7 @@ def run(args: argparse.Namespace, console: Console) -> int:
         seed=args.seed,
         progress=None if bar is None else bar.on_iteration,
         evaluated=None if bar is None else bar.on_evaluation,
+        drive=load_drive_arg(args, robot.n),
     )
     print(end="\n" if show else "", file=sys.stderr)
     written = _save(args, robot, design)
@@ -203,21 +226,25 @@ def run(args: argparse.Namespace, console: Console) -> int:
         print(
             f"dynid {NAME}: no admissible trajectory found (violated at 1 kHz: "
             f"{', '.join(design.result.violations())}; files written for inspection); "
-            "hint: fewer or smaller obstacles, a smaller --radius, --self-clearance or "
-            "--obstacle-clearance, more --max-iter or another --seed",
+            "hint: narrower joint ranges (--range q1=LO:HI,...; a joint that turns +-2 pi "
+            "reaches the floor and the arm itself), fewer or smaller obstacles, a smaller "
+            "--radius, --self-clearance or --obstacle-clearance, more --max-iter or another "
+            "--seed",
             file=sys.stderr,
         )
         return 1
     if not design.result.improved:
         console.note(
-            "more --max-iter or another --seed may find a trajectory better than the start"
+            "more --max-iter, another --seed or narrower joint ranges (--range "
+            "q1=LO:HI,...) may find a trajectory better than the start"
         )
     return 0
 
 
-def _options(args: argparse.Namespace) -> ExcitationOptions:
+def _options(args: argparse.Namespace, robot: Robot) -> ExcitationOptions:
     """The design's options from the flags (margins given in degrees)."""
     return ExcitationOptions(
+        ranges=() if args.range is None else parse_ranges(args.range, robot.joint_names),
         duration=args.duration,
         harmonics=args.harmonics,
         base_frequency=args.base_frequency,
@@ -229,6 +256,45 @@ def _options(args: argparse.Namespace) -> ExcitationOptions:
         criterion=args.criterion,
         max_iter=args.max_iter,
     )
+
+
+def parse_ranges(text: str, joints: tuple[str, ...]) -> tuple[tuple[int, float, float], ...]:
+    """``--range`` (``qJ=LO:HI,...``, ``qJ`` or ``J`` a joint's number from 1, or its
+    name) as
+    :attr:`~dynid.simulation.excitation.ExcitationOptions.ranges` (index from 0, [rad]).
+
+    Raises
+    ------
+    OptionError
+        An item not ``J=LO:HI``, an unknown joint, numbers that are not, a joint twice.
+    """
+    out: dict[int, tuple[int, float, float]] = {}
+    for item in (x.strip() for x in text.split(",") if x.strip()):
+        name, eq, span = item.partition("=")
+        lo, colon, hi = span.partition(":")
+        if not (eq and colon):
+            raise OptionError(f"--range: {item!r} is not qJ=LO:HI (e.g. q1=-1.5:1.5)")
+        name = name.strip()
+        number = name[1:] if name[:1] == "q" and name[1:].isdigit() else name
+        if name in joints:
+            j = joints.index(name)
+        elif number.isdigit() and 1 <= int(number) <= len(joints):
+            j = int(number) - 1
+        else:
+            raise OptionError(
+                f"--range: no joint {name!r}; give its number 1..{len(joints)} or one of "
+                f"{', '.join(joints)}"
+            )
+        try:
+            lo_hi = float(lo), float(hi)
+        except ValueError:
+            raise OptionError(f"--range: {item!r}: LO and HI must be numbers [rad]") from None
+        if j in out:
+            raise OptionError(f"--range: joint {j + 1} given twice")
+        out[j] = (j, *lo_hi)
+    if not out:
+        raise OptionError("--range: no J=LO:HI given")
+    return tuple(out[j] for j in sorted(out))
 
 
 def _save(args: argparse.Namespace, robot: Robot, design: ExcitationDesign) -> list[Path]:

@@ -36,7 +36,7 @@ from ..exceptions import DataError, DynidError
 from ..model.robot import Robot
 from ..simulation.clearance import Approach
 from ..simulation.collision import Box, Obstacles, Plane, capsule_model
-from ..simulation.excitation import ExcitationResult, ExcitingTrajectory
+from ..simulation.excitation import ExcitationResult, ExcitingTrajectory, within_ranges
 from ..simulation.trajectories import Trajectory
 from .atomic import open_atomic
 from .csv_tables import csv_table
@@ -97,6 +97,8 @@ def save_excitation_json(
 ) -> Path:
     """Write ``trajectory.json``: coefficients, limits, margins, obstacles, conditioning."""
     o = result.options
+    given = robot
+    robot = within_ranges(robot, o.ranges)  # the limits the design kept to
     d = {
         "schema": EXCITATION_SCHEMA,
         "dynid_version": __version__,
@@ -122,6 +124,12 @@ def save_excitation_json(
             "ddq_max_rad_s2": robot.ddq_max.tolist(),
             "tau_max_nm": robot.tau_max.tolist(),
         },
+        # the joint ranges given (--range): the limits above, narrowed from the robot's
+        "ranges": {
+            given.joint_names[j]: {"joint": j + 1, "lo_rad": lo, "hi_rad": hi}
+            for j, lo, hi in o.ranges
+        },
+        "robot_limits": {"q_min_rad": given.q_min.tolist(), "q_max_rad": given.q_max.tolist()},
         "margins_required": {
             "position_rad": o.position_margin,
             "velocity_rad_s": o.velocity_margin,
@@ -145,6 +153,8 @@ def save_excitation_json(
             "closest": [_approach(a) for a in result.margins.get("closest", ())],
         },
         "history": list(result.history),
+        # the drive whose known rotor inertias the torques checked include (null: none)
+        "drive": None if result.drive is None else result.drive.as_dict(),
     }
     # limits, margins and condition numbers may be infinite (no limit, no obstacle): null
     return save_document(path, EXCITATION, finite_or_none(d))
@@ -219,6 +229,9 @@ EXCITATION = Format(
             "obstacles": Field("object", record=OBSTACLES.top),
             "smallest_margins_at_1khz": Field("any"),
             "history": Field("any"),
+            "ranges": Field("any"),
+            "robot_limits": Field("any"),
+            "drive": Field("any"),
         }
     ),
     "trajectory file (dynid excite)",

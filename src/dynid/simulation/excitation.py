@@ -28,13 +28,16 @@ maximise ``log det`` of its column-scaled Gram matrix (D-optimality). Constraint
   obstacle are named with their distances (:mod:`dynid.simulation.clearance`).
 
 scipy's L-BFGS-B with finite-difference gradients; the start is the best of ``n_starts``
-seeded random candidates, each as large as its joints' limits allow; when the best violates a torque
-or a clearance (a small arm's elbow folded into its shoulder at the top of its range), the
-candidates at 80, 60 and 40 % of that amplitude too, from which the optimiser can shrink or
+seeded random candidates, each as large as its joints' limits allow; when the best
+violates a torque or a clearance (a small arm's elbow folded into its shoulder at the top
+of its range), the candidates at 80, 60, 40 and 20 % of that amplitude too, the best of
+those that keep the torques and clearances first (an arm whose joints turn +-2 pi reaches
+the floor and itself at most of those amplitudes), from which the optimiser can shrink or
 grow a motion (at the largest that fits, the scaling undoes either, and a start in
-collision was never left). Seeded and reproducible; ``progress(iteration, max_iter, cond)``
-is called after each iteration and ``evaluated(evaluations, budget)`` after each evaluation
-of the objective (an iteration can take thousands when its line search struggles).
+collision was never left). Seeded and reproducible; ``progress(iteration, max_iter,
+cond)`` is called after each iteration and ``evaluated(evaluations, budget)`` after each
+evaluation of the objective (an iteration can take thousands when its line search
+struggles).
 """
 
 from __future__ import annotations
@@ -52,7 +55,9 @@ from numpy.typing import ArrayLike, NDArray
 from .. import _checks
 from ..dynamics.rnea import rnea
 from ..exceptions import OptionError
+from ..friction.model import robot_friction
 from ..identification.classical import friction_regressor
+from ..model.drive import Drive
 from ..model.robot import Robot
 from ..regressors.base import BaseParameters, base_parameters
 from ..regressors.torque import torque_regressor_prepared
@@ -78,6 +83,7 @@ __all__ = [
     "excitation_condition_number",
     "limit_margins",
     "optimise_excitation",
+    "within_ranges",
 ]
 
 _log = logging.getLogger(__name__)
@@ -87,7 +93,7 @@ STATUSES = ("ok", "reduced", "infeasible")
 _FS_REPORTED = 200.0
 #: Fractions of their amplitudes the random starts are also tried at when none at full
 #: amplitude keeps the torques and clearances (:func:`_start`).
-_START_FRACTIONS = (0.8, 0.6, 0.4)
+_START_FRACTIONS = (0.8, 0.6, 0.4, 0.2)
 
 
 @dataclass(frozen=True, slots=True)
@@ -141,6 +147,11 @@ class ExcitationOptions:
         Grids [Hz] of the regressor (5), of the limit and torque checks (100) and of
         the collision checks (15) during the optimisation; the clearances there are
         required with 1 cm to spare (the result is checked at 1 kHz).
+    ranges : tuple of (int, float, float)
+        Joint ranges the design keeps to, narrower than the robot's limits: ``(j, lo,
+        hi)`` with ``j`` the joint's index from 0 and ``lo < hi`` [rad] (default none: the
+        limits); they replace the limits of the design and its checks
+        (:func:`within_ranges`), the position margin kept inside them.
     """
 
     duration: float = 20.0
@@ -161,8 +172,15 @@ class ExcitationOptions:
     fs_regressor: float = 10.0
     fs_limits: float = 100.0
     fs_collision: float = 15.0
+    ranges: tuple[tuple[int, float, float], ...] = ()
 
     def __post_init__(self) -> None:
+        for j, lo, hi in self.ranges:
+            if not (j >= 0 and np.isfinite(lo) and np.isfinite(hi) and lo < hi):
+                raise OptionError(
+                    f"ranges (--range) must name a joint and finite lo < hi; got joint "
+                    f"{j + 1}: {lo:g}:{hi:g}"
+                )
         if self.criterion not in ("cond", "logdet"):
             raise OptionError(f"criterion must be 'cond' or 'logdet'; got {self.criterion!r}")
         if self.harmonics < 1 or not (self.duration > 0 and self.base_frequency > 0):
@@ -200,6 +218,31 @@ class ExcitationOptions:
         return tuple(
             k for k in ("radii", "self_clearance", "obstacle_clearance") if getattr(self, k) is None
         )
+
+
+def within_ranges(robot: Robot, ranges: tuple[tuple[int, float, float], ...]) -> Robot:
+    """``robot`` with its position limits narrowed to ``ranges`` (``(j, lo, hi)`` [rad],
+    :attr:`ExcitationOptions.ranges`); its neutral position clipped into them.
+
+    Raises
+    ------
+    OptionError
+        A joint index beyond the robot's, or a range not inside the joint's limits.
+    """
+    if not ranges:
+        return robot
+    q_min, q_max = robot.q_min.copy(), robot.q_max.copy()
+    for j, lo, hi in ranges:
+        if j >= robot.n:
+            raise OptionError(f"--range: joint {j + 1} of a robot of {robot.n} joints")
+        if lo < robot.q_min[j] or hi > robot.q_max[j]:
+            raise OptionError(
+                f"--range: joint {j + 1}'s {lo:g}:{hi:g} rad is not within its limits "
+                f"{robot.q_min[j]:g}:{robot.q_max[j]:g} rad"
+            )
+        q_min[j], q_max[j] = lo, hi
+    qn = None if robot.q_neutral is None else np.clip(robot.q_neutral, q_min, q_max)
+    return robot.replace(q_min=q_min, q_max=q_max, q_neutral=qn)
 
 
 def _given(value: float | None, default: float) -> float:
@@ -248,6 +291,8 @@ class ExcitationResult:
     derived : tuple of str
         The options among ``radii``, ``self_clearance``, ``obstacle_clearance`` that were
         not given and took the arm's defaults (``sizes``).
+    drive : Drive or None
+        The drive whose known rotor inertias the torques checked include.
     """
 
     trajectory: ExcitingTrajectory
@@ -265,6 +310,7 @@ class ExcitationResult:
     improved: bool = True
     sizes: CollisionSizes | None = None
     derived: tuple[str, ...] = ()
+    drive: Drive | None = None
 
     @property
     def start_admissible(self) -> bool:
@@ -331,10 +377,17 @@ def excitation_condition_number(
     return _conds(_classical_regressor(robot, base, tr))
 
 
-def _motor_torques(robot: Robot, tr: Trajectory) -> NDArray[np.float64]:
+def _motor_torques(robot: Robot, tr: Trajectory, drive: Drive | None = None) -> NDArray[np.float64]:
+    """Joint torques [N m] (N, n): ``M ddq + c + g``, the model's friction (where the
+    drive puts it: at the motors, ``K^T f(K dq)``, for a drive whose friction acts there,
+    :func:`~dynid.friction.model.robot_friction`) and, with a drive of known rotor
+    inertias, their reflected torques ``K^T diag(I_a) K ddq``."""
     tau = rnea(robot, tr.q, tr.dq, tr.ddq)
-    if robot.friction is not None:
-        tau = tau + robot.friction.torques(tr.dq)
+    friction = robot.friction if drive is None else robot_friction(robot, drive)
+    if friction is not None:
+        tau = tau + friction.torques(tr.dq)
+    if drive is not None and drive.rotor_inertia is not None:
+        tau = tau + drive.rotor_torques(np.asarray(tr.ddq), drive.rotor_inertia)
     return tau
 
 
@@ -342,13 +395,17 @@ def limit_margins(
     robot: Robot,
     tr: Trajectory,
     options: ExcitationOptions = ExcitationOptions(),
+    *,
+    drive: Drive | None = None,
 ) -> dict[str, list[float]]:
     """Smallest margin of each joint to each limit, after the required margins (>= 0: ok).
 
     Keys ``position`` [rad], ``velocity`` [rad/s], ``acceleration`` [rad/s^2] and
     ``torque`` [N m], each a list of n floats: e.g. ``min_t (q_max - m_q - q_j(t))`` and
     the same at the lower limit; ``inf`` where a limit is infinite. Torques are the
-    model's (``M ddq + c + g`` plus its friction).
+    model's (``M ddq + c + g`` plus its friction, where ``drive`` puts it) plus, with a
+    ``drive`` of known rotor inertias, their reflected torques ``K^T diag(I_a) K ddq``
+    (``k^2 I_a ddq`` on a joint of gear ratio ``k``, uncoupled).
     """
     q, dq, ddq = np.asarray(tr.q), np.asarray(tr.dq), np.asarray(tr.ddq)
     m = options
@@ -359,7 +416,9 @@ def limit_margins(
         )
         vel = (robot.dq_max - m.velocity_margin) - np.abs(dq).max(axis=0)
         acc = (1 - m.acceleration_margin) * robot.ddq_max - np.abs(ddq).max(axis=0)
-        tau = (1 - m.torque_margin) * robot.tau_max - np.abs(_motor_torques(robot, tr)).max(axis=0)
+        tau = (1 - m.torque_margin) * robot.tau_max - np.abs(_motor_torques(robot, tr, drive)).max(
+            axis=0
+        )
     return {
         k: [float(x) for x in v]
         for k, v in (("position", pos), ("velocity", vel), ("acceleration", acc), ("torque", tau))
@@ -418,6 +477,8 @@ class _Problem:
         #: Called after each evaluation with the evaluations so far and their budget.
         self.evaluated: Callable[[int, int], None] | None = None
         self.budget = opts.max_evaluations
+        #: The drive whose known rotor inertias the torques include (None: none).
+        self.drive: Drive | None = None
 
     def coefficients(self, x: NDArray[np.float64]) -> tuple[NDArray, NDArray]:
         """Coefficients (n, 2L) within the limits and start position (n,) of ``x``: each
@@ -496,7 +557,7 @@ class _Problem:
         pen = 0.0
         if np.any(np.isfinite(self.tmax)):
             tr = self._traj(self.B_lim, c, q0, self.t_lim)
-            tau = np.abs(_motor_torques(self.robot, tr)).max(axis=0)
+            tau = np.abs(_motor_torques(self.robot, tr, self.drive)).max(axis=0)
             with np.errstate(invalid="ignore"):
                 v = np.where(np.isfinite(self.tmax), (tau - self.tmax) / self.tmax, 0.0)
             pen += float(np.sum(np.maximum(v, 0.0) ** 2))
@@ -519,10 +580,11 @@ def _check(
     opts: ExcitationOptions,
     obstacles: Obstacles,
     caps: CapsuleModel,
+    drive: Drive | None = None,
 ) -> dict[str, Any]:
     """Margins at 1 kHz (limits, obstacles, self-collision) and the closest approaches."""
     tr = traj.sample(1000.0)
-    margins: dict[str, Any] = limit_margins(robot, tr, opts)
+    margins: dict[str, Any] = limit_margins(robot, tr, opts, drive=drive)
     c_self, c_obstacle = _clearances(opts)
     pair, near = closest_approaches(
         robot, tr.t, tr.q, caps, obstacles, self_clearance=c_self, obstacle_clearance=c_obstacle
@@ -579,6 +641,7 @@ def optimise_excitation(
     base: BaseParameters | None = None,
     progress: Callable[[int, int, float], None] | None = None,
     evaluated: Callable[[int, int], None] | None = None,
+    drive: Drive | None = None,
 ) -> ExcitationResult:
     """Optimise an exciting trajectory for the classical identification.
 
@@ -589,6 +652,7 @@ def optimise_excitation(
     rng : numpy.random.Generator
         Source of the random starts.
     options : ExcitationOptions
+        With ``ranges``, the design keeps to them instead of the robot's position limits.
     obstacles : Obstacles, optional
         Default :meth:`Obstacles.floor` (the plane ``z = 0`` of the base frame).
     q_start : array_like, shape (n,), optional
@@ -603,6 +667,9 @@ def optimise_excitation(
         per millisecond to one per 15 ms: throttle what it shows); ``budget`` is
         ``options.max_evaluations`` plus those that chose the start (L-BFGS-B may
         overrun it by the evaluations of one gradient).
+    drive : Drive, optional
+        The drive train: the torques checked include its known rotor inertias' reflected
+        torques ``K^T diag(I_a) K ddq`` (none when it leaves them to be identified).
 
     Returns
     -------
@@ -611,8 +678,11 @@ def optimise_excitation(
     Raises
     ------
     ShapeError
-        ``q_start`` not (n,).
+        ``q_start`` not (n,), or a drive for another number of joints.
     """
+    if drive is not None:
+        drive.check(robot.n)
+    robot = within_ranges(robot, options.ranges)
     obstacles = Obstacles.floor() if obstacles is None else obstacles
     base = base_parameters(robot, kind="torque") if base is None else base
     derived = options.derived
@@ -625,6 +695,7 @@ def optimise_excitation(
         q_start = robot.q_neutral if robot.q_neutral is not None else mid
     q_start = _checks.as_exact("q_start", q_start, (robot.n,))
     prob = _Problem(robot, options, obstacles, caps, base, q_start)
+    prob.drive = drive
     prob.evaluated, prob.budget = evaluated, options.max_evaluations + options.n_starts
     x0 = _start(prob, rng)
     prob.budget = options.max_evaluations + prob.evaluations
@@ -653,9 +724,11 @@ def optimise_excitation(
     # the best penalty-free iterate; without one, the optimiser's (the least violation)
     chosen = prob.trajectory(res.x if best.x is None else best.x)
     centre = np.clip(q_start, prob.lo, prob.hi)  # within the limits and their margins
-    traj, margins, status = _admissible_version(robot, chosen, options, obstacles, caps, centre)
+    traj, margins, status = _admissible_version(
+        robot, chosen, options, obstacles, caps, centre, drive
+    )
     start = prob.trajectory(x0)
-    start_margins = _check(robot, start, options, obstacles, caps)
+    start_margins = _check(robot, start, options, obstacles, caps, drive)
     W = _classical_regressor(robot, base, traj.sample(_FS_REPORTED))
     W0 = _classical_regressor(robot, base, start.sample(_FS_REPORTED))
     crit = (_criterion(W, options.criterion), _criterion(W0, options.criterion))
@@ -682,13 +755,16 @@ def optimise_excitation(
         improved=not kept_start and crit[0] < crit[1],
         sizes=collision_sizes(robot),
         derived=derived,
+        drive=drive,
     )
 
 
 def _start(prob: _Problem, rng: np.random.Generator) -> NDArray[np.float64]:
     """The start of the optimisation: the best of ``n_starts`` random candidates at full
     amplitude (lowest criterion plus penalty); when even that one violates a torque or a
-    clearance, the best of them all at :data:`_START_FRACTIONS` of their amplitudes too.
+    clearance, the best of them all at :data:`_START_FRACTIONS` of their amplitudes too,
+    one free of penalty (clear of the floor, the obstacles and itself, within the
+    torques) first when there is one.
 
     Regression (SO-101): every full-amplitude candidate filled each joint's range, the
     elbow folded into the shoulder, and the optimiser, started in that collision, never
@@ -705,7 +781,10 @@ def _start(prob: _Problem, rng: np.random.Generator) -> NDArray[np.float64]:
         return x0
     for f in _START_FRACTIONS:
         scored += [(prob.objective(x), x) for x in (prob.initial(*d, f) for d in draws)]
-    return min(scored, key=lambda p: p[0])[1]
+    # a candidate clear of every torque and clearance (by the penalty the optimiser
+    # sees) before one that is less so, however better its criterion
+    clear = [(v, x) for v, x in scored if prob.penalty(*prob.coefficients(x)) == 0]
+    return min(clear or scored, key=lambda p: p[0])[1]
 
 
 class _BestFeasible:
@@ -732,6 +811,7 @@ def _admissible_version(
     obstacles: Obstacles,
     caps: CapsuleModel,
     centre: NDArray[np.float64],
+    drive: Drive | None = None,
 ) -> tuple[ExcitingTrajectory, dict[str, Any], str]:
     """``traj`` checked at 1 kHz, its amplitudes reduced (by 3 % steps, at most 60) until it
     is admissible: the trajectory, its margins and ``"ok"``/``"reduced"``; unreduced and
@@ -743,7 +823,7 @@ def _admissible_version(
     the optimiser moved into a collision (a joint's range filled to a limit where two
     links meet) is drawn out of it, which a reduction about that rest position never did.
     """
-    margins = _check(robot, traj, options, obstacles, caps)
+    margins = _check(robot, traj, options, obstacles, caps, drive)
     reduced, m = traj, margins
     for k in range(1, 61):
         if _admissible(m):
@@ -752,7 +832,7 @@ def _admissible_version(
         f = 0.97**k
         q0 = centre + f * (traj.q_start - centre)
         reduced = ExcitingTrajectory(traj.w_f, f * traj.a, f * traj.b, q0, traj.duration, traj.ramp)
-        m = _check(robot, reduced, options, obstacles, caps)
+        m = _check(robot, reduced, options, obstacles, caps, drive)
     if _admissible(m):
         return reduced, m, "reduced"
     return traj, margins, "infeasible"

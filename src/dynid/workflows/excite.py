@@ -8,6 +8,9 @@ command applies, so that the Python API behaves as the command does.
   which were used and why, and names the links of a violated clearance.
 * The trajectory is optimised from one seed and checked, and given sampled at 1 kHz (the
   rate of the checks and of ``trajectory.csv``).
+* The torques checked include a drive's known rotor inertias (reflected through its
+  gears: ``k^2 I_a ddq`` on an uncoupled joint); a drive that leaves them to be identified
+  is said to leave them out of the torque margins.
 * A trajectory that is not admissible is a result, not an error (``admissible`` is False;
   the command writes it for inspection and exits 1).
 """
@@ -21,7 +24,9 @@ from typing import Any
 
 import numpy as np
 
+from ..friction.model import own_at_motors_note
 from ..io.excitation import load_obstacles
+from ..model.drive import Drive
 from ..model.robot import Robot
 from ..simulation.collision import (
     DEFAULT_OBSTACLE_CLEARANCE,
@@ -98,8 +103,45 @@ class ExcitationDesign:
             + "".join(f", {k} {v:.3g} m" for k, v in m["obstacles"].items())
         )
         note = self.start_note()
-        head = (first, second) if note is None else (first, second, note)
+        head: tuple[str, ...] = (first, second) if note is None else (first, second, note)
+        drive = self.drive_line(name)
+        head += () if drive is None else (drive,)
+        at_motors = own_at_motors_note(robot, self.result.drive)
+        head += () if at_motors is None else (at_motors,)
+        ranges = self.ranges_line(robot, name)
+        head += () if ranges is None else (ranges,)
         return head + (self.sizes_line(name),) + self.clearance_lines(name)
+
+    def ranges_line(self, robot: Robot, name: Callable[[str], str] = str) -> str | None:
+        """The joint ranges the design kept to instead of the limits (given by
+        ``ranges``), or None."""
+        ranges = self.result.options.ranges
+        if not ranges:
+            return None
+        return f"joint ranges kept ({name('ranges')}, instead of the limits): " + ", ".join(
+            f"{robot.joint_names[j]} {lo:.3g}:{hi:.3g} rad" for j, lo, hi in ranges
+        )
+
+    def drive_line(self, name: Callable[[str], str] = str) -> str | None:
+        """What the torques checked hold of the drive (given by ``drive``): its known
+        rotor inertias' reflected torques and their largest, or that it leaves them to be
+        identified and the torque margins leave them out; None without a drive."""
+        drive = self.result.drive
+        if drive is None:
+            return None
+        if drive.rotor_inertia is None:
+            return (
+                f"the drive ({name('drive')}) leaves its rotor inertias to be identified: the "
+                "torques checked leave them out, and the torque margins are optimistic by "
+                "their reflected torques (K^T diag(I_a) K ddq)"
+            )
+        ddq = np.asarray(self.samples.ddq)
+        tau = np.abs(drive.rotor_torques(ddq, drive.rotor_inertia)).max(axis=0)
+        j = int(np.argmax(tau))
+        return (
+            f"the torques checked include the drive's rotor inertias ({name('drive')}; "
+            f"K^T diag(I_a) K ddq, largest {tau[j]:.3g} N m at joint {j + 1})"
+        )
 
     def sizes_line(self, name: Callable[[str], str] = str) -> str:
         """The capsule radius and clearances used, which option sets each, and why: given,
@@ -173,6 +215,7 @@ def design_excitation(
     seed: int = 0,
     progress: Callable[[int, int, float], None] | None = None,
     evaluated: Callable[[int, int], None] | None = None,
+    drive: Drive | None = None,
 ) -> ExcitationDesign:
     """An exciting trajectory for ``robot``, optimised and checked
     (:func:`~dynid.simulation.excitation.optimise_excitation`).
@@ -189,6 +232,8 @@ def design_excitation(
         ``progress(iteration, total, condition_number)`` after each iteration.
     evaluated : callable, optional
         ``evaluated(evaluations, budget)`` after each evaluation of the objective.
+    drive : Drive, optional
+        The drive train: the torques checked include its known rotor inertias.
 
     Returns
     -------
@@ -207,5 +252,6 @@ def design_excitation(
         obstacles=obs,
         progress=progress,
         evaluated=evaluated,
+        drive=drive,
     )
     return ExcitationDesign(res, res.trajectory.sample(EXCITE_RATE_HZ), seed)
