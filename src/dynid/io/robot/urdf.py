@@ -350,8 +350,8 @@ def export_urdf(path: str | Path, robot: Robot, options: ExportOptions) -> Path:
             )
             notes = (
                 f"{Path(path).name} holds the {model.kind} friction as <dynamics damping "
-                f"friction> (viscous and sharp Coulomb friction at the joints), not "
-                f"{', '.join(lost)}: {holds}",
+                f"friction> (viscous and sharp Coulomb friction at the joints), not as the "
+                f"law itself; {'; '.join(lost)}; {holds}",
             )
     replace = False
     if options.template is not None:
