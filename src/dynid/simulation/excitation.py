@@ -631,6 +631,22 @@ def _admissible(m: dict[str, Any]) -> bool:
     return bool(np.all(np.asarray(vals) >= -1e-9))
 
 
+def _preferred_rest(robot: Robot, q_start: ArrayLike | None) -> NDArray[np.float64]:
+    """The rest position the design prefers [rad]: ``q_start``, else ``robot.q_neutral``,
+    else the middle of the limits (a continuous joint, ``(-inf, inf)``, at 0).
+
+    Raises
+    ------
+    ShapeError
+        ``q_start`` not (n,).
+    """
+    if q_start is None:
+        finite = np.isfinite(robot.q_min) & np.isfinite(robot.q_max)
+        lo, hi = np.where(finite, robot.q_min, 0.0), np.where(finite, robot.q_max, 0.0)
+        q_start = robot.q_neutral if robot.q_neutral is not None else 0.5 * (lo + hi)
+    return _checks.as_exact("q_start", q_start, (robot.n,))
+
+
 def optimise_excitation(
     robot: Robot,
     rng: np.random.Generator,
@@ -688,15 +704,10 @@ def optimise_excitation(
     derived = options.derived
     options = options.sized_for(robot)
     caps = capsule_model(robot, options.radii, clearance=_clearances(options)[0])
-    if q_start is None:
-        finite = np.isfinite(robot.q_min) & np.isfinite(robot.q_max)
-        lo, hi = np.where(finite, robot.q_min, 0.0), np.where(finite, robot.q_max, 0.0)
-        mid = 0.5 * (lo + hi)  # continuous joints (-inf, inf) start at 0
-        q_start = robot.q_neutral if robot.q_neutral is not None else mid
-    q_start = _checks.as_exact("q_start", q_start, (robot.n,))
+    q_start = _preferred_rest(robot, q_start)
     prob = _Problem(robot, options, obstacles, caps, base, q_start)
-    prob.drive = drive
-    prob.evaluated, prob.budget = evaluated, options.max_evaluations + options.n_starts
+    prob.drive, prob.evaluated = drive, evaluated
+    prob.budget = options.max_evaluations + options.n_starts
     x0 = _start(prob, rng)
     prob.budget = options.max_evaluations + prob.evaluations
     history: list[float] = []
@@ -736,8 +747,7 @@ def optimise_excitation(
     if kept_start:  # never worse than an admissible start
         _log.info("excitation: the start is kept (%s, criterion %.4g)", status, crit[0])
         traj, margins, status, W = start, start_margins, "ok", W0
-    cu, cs = _conds(W)
-    init_cond = _conds(W0)[0]
+    (cu, cs), init_cond = _conds(W), _conds(W0)[0]
     _log.info("excitation: cond %.4g -> %.4g (%s)", init_cond, cu, status)
     return ExcitationResult(
         trajectory=traj,
