@@ -232,3 +232,16 @@ def point_to_point(robot: dynid.Robot, seed: int, fs: float = 500.0) -> Trajecto
         q0 = q1
     q, dq, ddq = (np.vstack([p[k] for p in parts]) for k in range(3))
     return Trajectory(np.arange(q.shape[0]) / fs, q, dq, ddq)
+
+
+#: A test asset: the SO-101's 5-joint arm (joints, limits and inertials; no meshes, no jaw).
+SO101_URDF = Path(__file__).parent / "data" / "so101_arm.urdf"
+#: A short exciting-trajectory design for tests: 6 s, 3 harmonics, a budget a test affords.
+SHORT_EXCITATION = {
+    "duration": 6.0,
+    "harmonics": 3,
+    "base_frequency": 1 / 6,
+    "max_iter": 40,
+    "n_starts": 8,
+    "max_evaluations": 1500,
+}

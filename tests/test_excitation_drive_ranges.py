@@ -9,7 +9,6 @@ user could narrow the joints' ranges for the design only by editing the URDF.
 from __future__ import annotations
 
 import json
-from pathlib import Path
 from types import SimpleNamespace
 
 import numpy as np
@@ -32,16 +31,8 @@ from dynid.simulation.excitation import (
 from dynid.simulation.trajectories import Trajectory
 from dynid.workflows.excite import ExcitationDesign
 
-SO101 = Path(__file__).parent / "data" / "so101_arm.urdf"
-#: A short design (as in test_excitation_small_arm).
-SHORT = {
-    "duration": 6.0,
-    "harmonics": 3,
-    "base_frequency": 1 / 6,
-    "max_iter": 40,
-    "n_starts": 8,
-    "max_evaluations": 1500,
-}
+from conftest import SHORT_EXCITATION as SHORT
+from conftest import SO101_URDF as SO101
 
 
 def _sine(robot, amplitude=0.3, w=2.0):

@@ -12,8 +12,6 @@ minute with the bar still: the bar now counts the evaluations.
 
 from __future__ import annotations
 
-from pathlib import Path
-
 import numpy as np
 import pytest
 
@@ -32,16 +30,8 @@ from dynid.simulation.excitation import (
     optimise_excitation,
 )
 
-SO101 = Path(__file__).parent / "data" / "so101_arm.urdf"
-#: A short design: 6 s, 3 harmonics, a budget of evaluations a test affords.
-SHORT = {
-    "duration": 6.0,
-    "harmonics": 3,
-    "base_frequency": 1 / 6,
-    "max_iter": 40,
-    "n_starts": 8,
-    "max_evaluations": 1500,
-}
+from conftest import SHORT_EXCITATION as SHORT
+from conftest import SO101_URDF as SO101
 
 
 @pytest.fixture(scope="module")
