@@ -856,21 +856,11 @@ def _fitted_structure(
         judged = gravity_loaded(robot, np.concatenate([g.q for g in logs]))
         judged |= sign_confirmed(robot, logs)
         unseen = [v for v in pushing if not judged[v.joint]]
-        coupled = _coupled(data.drive)
+        coupled = frozenset(() if data.drive is None else data.drive.coupled)
         if found := reversed_sign_finding(unseen, robot.joint_names, selection.chosen, coupled):
             raise DataError(found)
     chosen = Structure() if selection is None else selection.chosen
     return chosen if friction is None else Structure(chosen.armature, friction, at=chosen.at)
-
-
-def _coupled(drive: Drive | None) -> frozenset[int]:
-    """The joints (motors) that ``drive`` couples to another (an off-diagonal entry of its
-    transmission in their row or column)."""
-    if drive is None:
-        return frozenset()
-    K = np.asarray(drive.transmission, dtype=np.float64)
-    off = (K != 0.0) & ~np.eye(K.shape[0], dtype=bool)
-    return frozenset(int(k) for k in np.flatnonzero(off.any(axis=0) | off.any(axis=1)))
 
 
 def _recordings(

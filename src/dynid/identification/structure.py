@@ -449,9 +449,7 @@ def friction_placements(drive: Drive | None) -> tuple[str, ...]:
     the coefficients)."""
     if drive is None:
         return ("",)
-    K = np.asarray(drive.transmission)
-    coupled = bool(np.any(K[~np.eye(drive.n, dtype=bool)] != 0))
-    return ("motor", "joint", "both") if coupled else ("",)
+    return ("motor", "joint", "both") if drive.is_coupled else ("",)
 
 
 def joint_side_joints(drive: Drive) -> tuple[int, ...]:

@@ -194,8 +194,15 @@ class Drive:
     @property
     def is_coupled(self) -> bool:
         """True when ``K`` has off-diagonal entries."""
-        K = self.transmission
-        return bool(np.any(K - np.diag(np.diag(K))))
+        return bool(self.coupled)
+
+    @property
+    def coupled(self) -> tuple[int, ...]:
+        """The joints (motors; 0-based) that ``K`` couples to another: an off-diagonal
+        entry in their row or column."""
+        K = np.asarray(self.transmission)
+        off = (K != 0.0) & ~np.eye(K.shape[0], dtype=bool)
+        return tuple(int(k) for k in np.flatnonzero(off.any(axis=0) | off.any(axis=1)))
 
     @property
     def rotor_labels(self) -> tuple[str, ...]:
