@@ -25,7 +25,6 @@ identification replaces them before filtering), the verdict saying how many.
 
 from __future__ import annotations
 
-import dataclasses
 import warnings
 from collections.abc import Sequence
 from dataclasses import dataclass
@@ -305,8 +304,7 @@ def _each_recording(
             return None
         held, replaced = _despiked_from(rec)
         mine = _pieces(model, held, turns)
-        part = _pieces_validation(fitted, mine)[0]
-        parts.append(part if not parts else _after(part, parts[-1].log.t))
+        parts.append(_pieces_validation(fitted, mine)[0])  # pooled one after another
         pieces += mine
         spikes += replaced
     v = joined_validation(parts)
@@ -315,15 +313,6 @@ def _each_recording(
     if len(pieces) > k:
         block += f" ({len(pieces)} pieces between gaps)"
     return _held_out(model, v, block, logs, None, spikes, _input_noise(model, v, pieces))
-
-
-def _after(v: Validation, before: NDArray[np.float64]) -> Validation:
-    """``v`` with its times moved to begin one sample step after ``before`` ends: the
-    recordings pooled one after another on one time axis (each starts its own clock)."""
-    t = v.log.t
-    step = float(np.median(np.diff(t))) if t.size > 1 else 1.0
-    moved = dataclasses.replace(v.log, t=t - t[0] + before[-1] + step)
-    return dataclasses.replace(v, log=moved)
 
 
 def _pieces(model: IdentifiedModel, held: TorqueLog, turns: NDArray[np.bool_]) -> list[TorqueLog]:

@@ -44,7 +44,9 @@ def pooled_errors(
 def joined_validation(parts: Sequence[Validation]) -> Validation:
     """One :class:`~dynid.friction.validation.Validation` of the pieces ``parts`` (each
     prepared on its own, of one model and friction): their samples one after another
-    (time keeps its gaps), the errors pooled (:func:`pooled_errors`)."""
+    (time keeps its gaps; a part that starts no later than the one before ends, another
+    recording with its own clock, is moved to begin one of its sample steps after it),
+    the errors pooled (:func:`pooled_errors`)."""
     if len(parts) == 1:
         return parts[0]
     logs = [v.log for v in parts]
@@ -53,7 +55,7 @@ def joined_validation(parts: Sequence[Validation]) -> Validation:
         return np.concatenate([getattr(x, str(get)) for x in logs])
 
     ddq = None if any(x.ddq is None for x in logs) else cat("ddq")
-    log = TorqueLog(cat("t"), cat("q"), cat("dq"), cat("tau"), ddq, logs[0].cleaning)
+    log = TorqueLog(_times(logs), cat("q"), cat("dq"), cat("tau"), ddq, logs[0].cleaning)
     fr = parts[0].friction
     tf = None if fr is None else np.concatenate([np.asarray(v.tau_friction) for v in parts])
     sums = [v.tau_ss if v.tau_ss is not None else np.sum(v.log.tau**2, axis=0) for v in parts]
@@ -67,3 +69,17 @@ def joined_validation(parts: Sequence[Validation]) -> Validation:
         step=max(v.step for v in parts),
         tau_ss=np.sum(sums, axis=0),
     )
+
+
+def _times(logs: Sequence[TorqueLog]) -> NDArray[np.float64]:
+    """The logs' times one after another, a log that starts no later than the one before
+    ends moved to begin one of its median steps after it."""
+    out = [logs[0].t]
+    for g in logs[1:]:
+        end = float(out[-1][-1])
+        if g.t[0] > end:
+            out.append(g.t)
+            continue
+        step = float(np.median(np.diff(g.t))) if g.t.size > 1 else 1.0
+        out.append(g.t - g.t[0] + end + step)
+    return np.concatenate(out)
