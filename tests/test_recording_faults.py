@@ -311,3 +311,18 @@ def test_slow_joints_without_limits_do_not_hide_a_file_in_degrees(arm_log):
     assert "positions in degrees on every joint with position limits" in said
     assert "hint: --units q=deg,dq=deg/s if the whole file is in degrees" in said
     assert "the speeds of yaw, wrist, without position limits, do not tell" in said
+
+
+def test_validate_names_the_joint_of_the_opposite_sign(panda, log, tmp_path, capsys):
+    """Regression: validate judged a log with joint 4's torques negated "unusable" with a
+    generic hint (another robot, units, sign?) where identify and observe name the joint;
+    the verdict stands (exit 1, its files written) and one warning names the file, the
+    joint and the --units entry that reads it."""
+    save_torque_log(tmp_path / "one.csv", _flipped(log, [3]))
+    argv = ["validate", "--robot", "panda", "--data", str(tmp_path / "one.csv"), "--no-figures"]
+    assert main([*argv, "--out", str(tmp_path / "v")]) == 1
+    said = [s for s in capsys.readouterr().err.splitlines() if "anti-correlated" in s]
+    assert len(said) == 1 and "warning: one.csv: " in said[0], said
+    assert f"the measured torques of {panda.joint_names[3]} are anti-correlated" in said[0]
+    assert "hint: --units tau4=-1 reads it flipped" in said[0]
+    assert (tmp_path / "v" / "validation.json").is_file()

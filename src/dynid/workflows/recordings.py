@@ -79,6 +79,7 @@ __all__ = [
     "check_derived_velocities",
     "check_limits",
     "check_signs",
+    "warn_signs",
     "check_torque_unit",
     "check_units",
     "despiked_recordings",
@@ -150,6 +151,7 @@ def read_recordings(
     q_start: Sequence[float] | None = None,
     max_gap_s: float | None = None,
     reference: Robot | None = None,
+    signs: bool = False,
 ) -> Recorded:
     """The torque logs of ``data`` (files, or folders of ``.csv``/``.npz`` files) of
     ``robot``, read and checked (module docstring).
@@ -178,6 +180,10 @@ def read_recordings(
     reference : Robot, optional
         A robot whose link parameters give the model's gravity torques (an identified
         model's ``equivalent_robot``) for :func:`check_torque_unit`; default ``robot``.
+    signs : bool
+        Warn of a recording of the opposite torque sign, naming its joints and the
+        ``--units`` entries (:func:`warn_signs`, against ``reference``), as ``validate``
+        does before judging it.
 
     Returns
     -------
@@ -208,6 +214,8 @@ def read_recordings(
             raise DataError(unit.removeprefix(f"{name}: "), file=name)
     check_units(out)
     check_derived_velocities(out, cmap)
+    if signs:  # said, naming the joints: the verdict judges the log as it is
+        warn_signs(out, robot if reference is None else reference)
     check_torque_unit(out, robot if reference is None else reference, cmap)
     return out
 
@@ -367,6 +375,17 @@ def check_degrees(rec: Recorded, robot: Robot) -> None:
     found = degrees_among_radians(robot, list(rec.joint_side), rec.names, LIMIT_MARGIN)
     if found is not None:
         raise DataError(found[1], file=rec.names[found[0]])
+
+
+def warn_signs(rec: Recorded, robot: Robot) -> None:
+    """Warn of each recording whose (joint-side) torques have the opposite sign to the
+    robot's (:func:`~dynid.identification.sanity.opposite_sign`, the finding
+    :func:`check_signs` refuses with), naming the file: ``validate`` judges such a log
+    "unusable" and writes its files, and said only "of another sign?" without the joints
+    or the ``--units`` entries that read them."""
+    for name, log in zip(rec.names, rec.joint_side, strict=True):
+        if too_few_samples(log) is None and (opposite := opposite_sign(robot, log)):
+            warnings.warn(f"{name}: {opposite}", DynidWarning, stacklevel=3)
 
 
 def check_signs(rec: Recorded, robot: Robot) -> None:

@@ -266,6 +266,7 @@ def validate_files(
         q_start=opt.q_start,
         max_gap_s=opt.max_gap_s,
         reference=model.equivalent_robot if isinstance(model, IdentifiedModel) else None,
+        signs=True,  # the joints of the opposite sign named before the verdict
     )
     rec, spikes = despiked_recordings(rec, robot.joint_names, SPIKES_BEFORE_JUDGING)
     friction, source = _friction(model, opt.friction, feasible, placed)
