@@ -7,9 +7,11 @@ with them before fitting (:func:`log_findings`). None of them changes the data.
 * **Sign**: the measured torques against the model's gravity torques ``g(q)`` at the logged
   configurations and against its whole rigid-body torques ``M ddq + c + g`` along the
   logged motion (with the robot's own link parameters, when it has any): a correlation
-  below ``-0.5`` with both on a joint that gravity loads means the torque sign is opposite
-  to the model's, refused by ``identify``, ``validate`` and ``observe``: on every loaded
-  joint, ``--units tau=-1``; on some, naming them and their torque columns to flip. Each
+  below ``-0.5`` with both on a joint that gravity loads (or, where the whole torques
+  explain a joint's at about their own scale, a correlation of -0.8 or below) means the
+  torque sign is opposite to the model's, refused by ``identify`` and ``observe`` and
+  warned by ``validate``: on every joint judged, ``--units tau=-1``; on some, naming them
+  and the ``--units tau2=-1`` entries that flip them alone. Each
   comparison alone can be fooled: on 2 s of fast motion a Panda's elbow torques of the
   right sign correlated -0.70 with its gravity torques (+0.99 with the whole torques),
   and a description's poor inertias could turn the whole torques.
