@@ -37,6 +37,7 @@ def test_a_logged_warning_reads_as_the_commands_warning(tmp_path):
     said = [s for s in run.stderr.splitlines() if "dropped 1 invalid row" in s]
     assert len(said) == 1 and said[0].startswith("dynid identify: warning: s.csv: "), said
     assert not any(s.startswith(("WARNING ", "INFO ")) for s in run.stderr.splitlines())
-    # the run's report lists it once among the warnings
+    # the run's report lists it once among the warnings, and its last line says where it is
+    assert run.stdout.splitlines()[-1] == f"report: {Path('fit') / 'report.html'}"
     report = (tmp_path / "fit" / "report.html").read_text()
     assert report.count("dropped 1 invalid row") == 1

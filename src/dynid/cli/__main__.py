@@ -33,6 +33,7 @@ import signal
 import sys
 import warnings
 from collections.abc import Iterator, Sequence
+from pathlib import Path
 from typing import TYPE_CHECKING, TextIO
 
 from .. import __version__
@@ -289,6 +290,7 @@ def _main(argv: Sequence[str] | None) -> int:
     from .._checks import one_line
     from ..io.atomic import output_transaction
     from ..progress import reporting
+    from ..report import REPORT_NAME
     from .applies import check_applies, given_options
     from .console import Console, log_to_stderr
     from .run_report import RunRecord, save_run_report
@@ -324,6 +326,8 @@ def _main(argv: Sequence[str] | None) -> int:
             _raise_if_terminated()
             if run is not None and run.kind == "folder":
                 save_run_report(run, record, args, argv, code)
+        if run is not None and run.kind == "folder":
+            console.print(f"report: {Path(args.out) / REPORT_NAME}")
         if record.stdout_closed:
             _drop_stdout()
             return STDOUT_CLOSED

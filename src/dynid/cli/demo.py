@@ -167,6 +167,7 @@ def run(args: argparse.Namespace, console: Console) -> int:
     demo = run_demo(robot, args.seed, progress=render)
     render.files.append(save_paper_comparison(args.out, demo))
     console.print(f"\nthe paper's numbers beside dynid's: {render.files[-1]}")
-    console.print(f"report: {args.out / 'report.html'} ({time.perf_counter() - t0:.0f} s)")
-    console.print(f"\ndone: {len(render.files)} files in {args.out}")
+    console.print(
+        f"\ndone in {time.perf_counter() - t0:.0f} s: {len(render.files)} files in {args.out}"
+    )
     return 0
