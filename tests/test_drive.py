@@ -521,6 +521,42 @@ def test_geared_coupled_arm_base_is_complete_for_every_gear_ratio(ratio, ia):
     assert np.linalg.norm(tau_hat - tau_held) / np.linalg.norm(tau_held) < 1e-6
 
 
+def test_geared_arm_with_default_filtering_predicts_held_out_torques_to_1e_6(monkeypatch):
+    """Gear ratios 200 x (1, 1, 1, 0.8, 0.8, 0.5) and a coupled wrist, friction at the
+    motors, an exact 500 Hz motor-side log identified with the default preparation (the
+    cut-off read from the motion, 1 in k samples kept): held-out joint torques to 1e-6.
+    The Coulomb columns computed from states interpolated between the kept samples (a
+    log too long to hold every sample's states) put the motors' reversals off the
+    torques' steps: 3.8e-5."""
+    import dynid.identification.prepared_log as prepared_log
+
+    robot, model, data = _ur5()
+    gear = 200.0 * np.array([1.0, 1.0, 1.0, 0.8, 0.8, 0.5])
+    drive = Drive.from_gears(gear, [(6, 5, 60.0)], side="motor")
+    K = drive.transmission
+    rotor = 1e-5 * np.linspace(1.5, 0.5, 6)
+
+    def log(seed: int) -> tuple[TorqueLog, np.ndarray]:
+        t, q, dq, ddq = _trajectory(6, seed, duration=6.0, fs=500.0)
+        tau = np.array([pin.rnea(model, data, *s) for s in zip(q, dq, ddq, strict=True)])
+        dqm, ddqm = dq @ K.T, ddq @ K.T
+        tau += (rotor * ddqm) @ K + (FV * dqm + FC * np.sign(dqm) + FO) @ K
+        return TorqueLog(t, q @ K.T, dqm, np.linalg.solve(K.T, tau.T).T, ddqm), tau
+
+    (train, _), (held, tau_held) = log(1), log(2)
+    h = dynid.identification.log.joint_side_log(held, drive)
+
+    def error() -> float:
+        m = identify_from_log(robot, train, drive=drive)
+        own = dynid.friction.validation.own_friction(m)
+        tau_hat = m.torques(h.q, h.dq, h.ddq) + own.torques(h.dq)
+        return float(np.linalg.norm(tau_hat - tau_held) / np.linalg.norm(tau_held))
+
+    assert error() < 1e-6
+    monkeypatch.setattr(prepared_log, "MAX_FINE_BYTES", 0)
+    assert error() > 1e-5
+
+
 def test_gear_ratio_1_in_a_drive_file_identifies_a_joint_side_armature(tmp_path):
     """``gear_ratio = 1`` (the documented default, one number for every joint) with
     ``rotor_inertia = "identify"``: a direct drive whose rotor term is a joint-side

@@ -14,6 +14,7 @@ import numpy as np
 from dynid import signals
 from dynid.friction.model import ClassicalFriction
 from dynid.identification.log_rows import stepped_filtered
+from dynid.identification.prepare import Preprocessing, trimmed_margins
 from dynid.identification.prepared_log import prepare_torque_log
 from dynid.identification.selection import identify_recordings
 from dynid.identification.structure import Structure
@@ -29,22 +30,32 @@ ARMATURE = np.array([0.3, 0.3, 0.2, 0.2, 0.1, 0.1, 0.1])
 
 def test_stepped_columns_are_the_recordings_filtered_at_its_own_rate(panda):
     """The Coulomb columns at the prepared (decimated) samples equal the recording's sign
-    of its low-passed velocities, low-passed at its own rate, to 1e-4 of the step inside
-    the log and 1e-2 at its ends; those filtered at the decimated rate without the trimmed
-    samples were 10 times further off inside and 20 times at the ends."""
+    of its low-passed velocities, low-passed at its own rate: to 1e-9 from the states at
+    every sample (the log's ``fine`` states), to 1e-4 of the step inside the log and 1e-2
+    at its ends from states interpolated between the decimated samples (a log too long to
+    hold them); those filtered at the decimated rate without the trimmed samples were 10
+    times further off inside and 20 times at the ends."""
     (log,) = recordings(panda, (5,), friction=FRICTION, duration=6.0, fs=1000.0)
     p = prepare_torque_log(panda, log)
-    assert p.decimate > 1 and p.head is not None and p.tail is not None
+    assert p.decimate > 1 and p.fine is not None and p.head is None
+    prep = Preprocessing(cutoff_hz=p.cutoff_hz, decimate=p.decimate)
+    head, tail = trimmed_margins(log, prep)
+    assert head is not None and tail is not None
     term = LinearFriction(Drive.identity(7))
     steps = np.asarray(term.steps)
     dq = signals.lowpass(log.dq, log.sample_rate, p.cutoff_hz, axis=0)
     want = signals.lowpass(np.sign(dq), log.sample_rate, p.cutoff_hz, axis=0)
     want = want[np.searchsorted(log.t, p.log.t - 1e-9)]
     rows = slice(0, p.log.n_samples)
-    got, old = (  # column j acts in the row of joint j
-        np.einsum("kjj->kj", stepped_filtered((term,), logs, steps, p.cutoff_hz, k, rows))
-        for logs, k in (((p.head, p.log, p.tail), p.decimate), ((None, p.log, None), 1))
+    fine, got, old = (  # column j acts in the row of joint j
+        np.einsum("kjj->kj", stepped_filtered((term,), logs, steps, p.cutoff_hz, k, rows, None, f))
+        for logs, k, f in (
+            ((None, p.log, None), p.decimate, (p.fine, p.fine_start)),
+            ((head, p.log, tail), p.decimate, None),
+            ((None, p.log, None), 1, None),
+        )
     )
+    assert np.abs(fine - want).max() < 1e-9
     edge = int(np.ceil(2.0 * p.log.sample_rate / p.cutoff_hz))  # two periods of the cut-off
     inside = slice(edge, -edge)
     assert np.abs(got - want)[inside].max() < 1e-4

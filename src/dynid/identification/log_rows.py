@@ -82,6 +82,7 @@ def log_blocks(
     upsample: int = 1,
     edges: tuple[TorqueLog | None, TorqueLog | None] = (None, None),
     stamps: NDArray[np.float64] | None = None,
+    fine: tuple[TorqueLog, int] | None = None,
 ) -> Iterator[RegressorBlock]:
     """The regressor rows of a prepared log over ``columns``: sample-major (row ``k n + j``
     is sample ``k``, joint ``j``, its noise group ``j``); known rotor torques of
@@ -98,7 +99,11 @@ def log_blocks(
     100 Hz: rotor inertias off by 2-3 % on exact data). ``stamps``: the instants [s] the
     log was measured at when they were not uniform (its torques interpolated linearly onto
     the grid before the low-pass): the stepping columns are computed there and
-    interpolated alike. The rows equal those of the log filtered whole, in blocks too."""
+    interpolated alike. ``fine``: the log prepared at every sample of its grid and the
+    index there of its first sample (:func:`~dynid.identification.prepare.fine_states`):
+    the stepping columns are computed from those states rather than from states
+    interpolated between the decimated ones. The rows equal those of the log filtered
+    whole, in blocks too."""
     assert log.ddq is not None  # prepare_log always fills ddq
     N, n = log.n_samples, log.n
     drive = columns.drive
@@ -119,7 +124,7 @@ def log_blocks(
                 lo, hi = a, min(N, a + max(step, STEP_SPAN))
                 held = stepped_filtered(
                     columns.appended, (edges[0], log, edges[1]), steps[columns.base.rank :],
-                    cutoff_hz, upsample, slice(lo, hi), stamps,
+                    cutoff_hz, upsample, slice(lo, hi), stamps, fine,
                 )  # fmt: skip
             Y[..., steps] = held[a - lo : a - lo + Y.shape[0]]
         if drive is not None and drive.rotor_inertia is not None:  # known: subtracted
@@ -143,6 +148,7 @@ def stepped_columns(
     upsample: int = 1,
     edges: tuple[TorqueLog | None, TorqueLog | None] = (None, None),
     stamps: NDArray[np.float64] | None = None,
+    fine: tuple[TorqueLog, int] | None = None,
 ) -> NDArray[np.float64]:
     """One term's columns (N, n, p) at every sample of a prepared log, those that step at
     a reversal low-passed as the log's torques were (:func:`stepped_filtered`), as
@@ -155,7 +161,7 @@ def stepped_columns(
     if cutoff_hz is not None and steps.any():
         Y[..., steps] = stepped_filtered(
             (term,), (edges[0], log, edges[1]), steps, cutoff_hz, upsample,
-            slice(0, log.n_samples), stamps,
+            slice(0, log.n_samples), stamps, fine,
         )  # fmt: skip
     return Y
 
@@ -168,6 +174,7 @@ def stepped_filtered(
     upsample: int,
     rows: slice,
     stamps: NDArray[np.float64] | None = None,
+    fine: tuple[TorqueLog, int] | None = None,
 ) -> NDArray[np.float64]:
     """The columns ``steps`` (c,) of the appended ``terms`` at the prepared samples
     ``rows`` of a log, computed as its torques were filtered. ``logs``: the samples trimmed
@@ -180,7 +187,10 @@ def stepped_filtered(
     grid) has its columns computed at those instants and interpolated so too, which puts
     a reversal's step where the torques have it. Each span of :data:`STEP_SPAN` samples is
     computed with :data:`_SETTLE_CYCLES` periods of the cut-off on either side, where the
-    filter has forgotten the window's edges. (m, n, steps.sum())."""
+    filter has forgotten the window's edges. ``fine``: the log prepared at every sample
+    of its grid and the index there of ``log``'s first sample (``log`` is every
+    ``upsample``-th sample from there): its states are read instead of interpolated, and
+    ``logs``' margins are not needed. (m, n, steps.sum())."""
     from scipy.interpolate import CubicSpline  # here: a robot model loads no scipy
 
     head, log, tail = logs
@@ -192,24 +202,32 @@ def stepped_filtered(
     rate = signals.sample_rate(log.t)
     pad = int(np.ceil(_SETTLE_CYCLES * rate / cutoff_hz))
     out = np.empty((b - a, n, int(steps.sum())))
-    for s in range(a + h, b + h, STEP_SPAN):
-        e = min(b + h, s + STEP_SPAN)
-        lo, hi = max(0, s - pad), min(total, e + pad)
-        tw, x = _joined(logs, lo, hi)
-        fine = tw[0] + np.arange((hi - lo - 1) * k + 1) * (1.0 / (k * rate))
+    for s in range(a, b, STEP_SPAN):
+        e = min(b, s + STEP_SPAN)
+        if fine is None:  # the states interpolated between the decimated samples
+            lo, hi = max(0, s + h - pad), min(total, e + h + pad)
+            tw, x = _joined(logs, lo, hi)
+            grid = tw[0] + np.arange((hi - lo - 1) * k + 1) * (1.0 / (k * rate))
+            keep = slice((s + h - lo) * k, (e + h - lo - 1) * k + 1, k)
+        else:  # the states at every sample of the grid, as the torques were filtered
+            f, start = fine
+            lo = max(0, start + s * k - pad * k)
+            hi = min(f.n_samples, start + (e - 1) * k + 1 + pad * k)
+            tw, x = _joined((f,), lo, hi)
+            grid = tw
+            keep = slice(start + s * k - lo, start + (e - 1) * k + 1 - lo, k)
         onto = None
-        if stamps is not None and hi - lo > 1:  # the columns where the torques were measured
-            i0 = max(int(np.searchsorted(stamps, fine[0], side="right")) - 1, 0)
-            i1 = int(np.searchsorted(stamps, fine[-1], side="left")) + 1
+        if stamps is not None and tw.shape[0] > 1:  # where the torques were measured
+            i0 = max(int(np.searchsorted(stamps, grid[0], side="right")) - 1, 0)
+            i1 = int(np.searchsorted(stamps, grid[-1], side="left")) + 1
             at = stamps[i0:i1]
             x = CubicSpline(tw, x, axis=0)(at)
-            onto = partial(_interpolated, at, fine)
-        elif k > 1 and hi - lo > 1:
-            x = CubicSpline(tw, x, axis=0)(np.minimum(fine, tw[-1]))
+            onto = partial(_interpolated, at, grid)
+        elif grid is not tw and k > 1 and tw.shape[0] > 1:
+            x = CubicSpline(tw, x, axis=0)(np.minimum(grid, tw[-1]))
         states = (x[:, :n], x[:, n : 2 * n], x[:, 2 * n :])
-        keep = slice((s - lo) * k, (e - lo - 1) * k + 1, k)  # the span's prepared samples
         got = [_filtered_columns(t, states, cutoff_hz, k * rate, keep, onto) for t in terms]
-        out[s - h - a : e - h - a] = np.concatenate(got, axis=-1)[..., steps]
+        out[s - a : e - a] = np.concatenate(got, axis=-1)[..., steps]
     return out
 
 

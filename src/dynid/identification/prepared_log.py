@@ -27,7 +27,15 @@ from .dataset import ModelColumns, RegressorBlock, TorqueRoute
 from .info import IdentificationInfo, LogInfo
 from .log import LogCleaning, TorqueLog, joint_side_log
 from .log_rows import log_blocks, still_columns, still_friction
-from .prepare import Preprocessing, measured_torques, prepare_log, resamples, trimmed_margins
+from .prepare import (
+    Preprocessing,
+    fine_states,
+    grid_samples,
+    measured_torques,
+    prepare_log,
+    resamples,
+    trimmed_margins,
+)
 from .rate import cutoff_from_motion, decimation, motion_frequency
 from .sanity import (
     check_torque_log,
@@ -38,7 +46,12 @@ from .sanity import (
 )
 from .serial import Serial, hac_lag
 
-__all__ = ["PreparedLog", "prepare_torque_log"]
+__all__ = ["MAX_FINE_BYTES", "PreparedLog", "prepare_torque_log"]
+
+#: The largest full-rate prepared log (``t``, ``q``, ``dq``, ``ddq``, ``tau``) [bytes] a decimated log holds
+#: for its stepping columns (:attr:`PreparedLog.fine`): a 7-joint log of 19 minutes at
+#: 1 kHz; a longer one has its states interpolated between its decimated samples.
+MAX_FINE_BYTES = 256 << 20
 
 
 @dataclass(frozen=True, slots=True, eq=False)
@@ -86,6 +99,15 @@ class PreparedLog(TorqueRoute):
         interpolated onto the grid as the torques were, and the held-out judgement reads
         each prepared sample at its own measured instant
         (:func:`~dynid.identification.prepare.measured_instants`). None otherwise.
+    fine : TorqueLog or None
+        The log prepared at every sample of its grid, none trimmed
+        (:func:`~dynid.identification.prepare.fine_states`): ``log`` is
+        ``fine[fine_start :: decimate]``. The stepping columns are computed from it when
+        it is held (a filtered, decimated log whose states fit in
+        :data:`MAX_FINE_BYTES`), else from states
+        interpolated between the decimated samples and the margins ``head``, ``tail``.
+    fine_start : int
+        The index in ``fine`` of the first prepared sample.
     """
 
     log: TorqueLog
@@ -105,6 +127,8 @@ class PreparedLog(TorqueRoute):
     head: TorqueLog | None = None
     tail: TorqueLog | None = None
     stamps: NDArray[np.float64] | None = None
+    fine: TorqueLog | None = None
+    fine_start: int = 0
 
     @property
     def n(self) -> int:
@@ -160,6 +184,7 @@ class PreparedLog(TorqueRoute):
             "upsample": self.decimate,
             "edges": (self.head, self.tail),
             "stamps": self.stamps,
+            "fine": None if self.fine is None else (self.fine, self.fine_start),
         }
 
     def record(self, n_rows: int) -> IdentificationInfo:
@@ -242,10 +267,14 @@ def prepare_torque_log(
     prep = Preprocessing(cutoff_hz=cutoff_hz, trim_s=trim_s, max_gap_s=max_gap_s, decimate=k)
     prepared = prepare_log(jlog, prep)
     raw = stamps = None
-    head = tail = None
+    head = tail = fine = None
+    start = 0
     if cutoff_hz is not None:  # the torques as measured at the same samples
         raw = measured_torques(jlog, prep)
-        head, tail = trimmed_margins(jlog, prep)
+        if k > 1 and grid_samples(jlog, prep) * (1 + 4 * n) * 8 <= MAX_FINE_BYTES:
+            fine, start = fine_states(jlog, prep)  # the states the torques were filtered at
+        else:
+            head, tail = trimmed_margins(jlog, prep)
         stamps = jlog.t if resamples(jlog, prep) else None
     noise = velocity_noise_std(jlog.tau, jlog.t) if jlog.n_samples >= 3 else None
     del jlog
@@ -267,4 +296,6 @@ def prepare_torque_log(
         head=head,
         tail=tail,
         stamps=stamps,
+        fine=fine,
+        fine_start=start,
     )
