@@ -48,9 +48,10 @@ from .serial import Serial, hac_lag
 
 __all__ = ["MAX_FINE_BYTES", "PreparedLog", "prepare_torque_log"]
 
-#: The largest full-rate prepared log (``t``, ``q``, ``dq``, ``ddq``, ``tau``) [bytes] a decimated log holds
-#: for its stepping columns (:attr:`PreparedLog.fine`): a 7-joint log of 19 minutes at
-#: 1 kHz; a longer one has its states interpolated between its decimated samples.
+#: The largest full-rate prepared log (``t``, ``q``, ``dq``, ``ddq``, ``tau``) [bytes] a
+#: decimated log holds for its stepping columns (:attr:`PreparedLog.fine`): a 7-joint log
+#: of 19 minutes at 1 kHz; a longer one has its states interpolated between its decimated
+#: samples.
 MAX_FINE_BYTES = 256 << 20
 
 
