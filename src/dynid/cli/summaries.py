@@ -233,16 +233,22 @@ _LOST = (
 def _lost(rec: Any) -> str:
     """`` of 820 recorded: 274 trimmed at the pieces' ends (...), ...`` (empty when the
     record does not count them), with the points a uniform grid added to resampled
-    pieces."""
+    pieces: at the places of dropped samples, and the rest (either sign) at the grid's
+    ends against jittered stamps."""
     if "recorded" not in rec:
         return ""
     parts = [f"{rec[k]} {why}" for k, why in _LOST if rec.get(k)]
     added = rec.get("added", 0)
-    if added:  # the uniform grid of resampled pieces holds the dropped samples' places
+    dropped = rec.get("dropped", added if added > 0 else 0)  # a record without: as it said
+    if dropped:  # the uniform grid of resampled pieces holds the dropped samples' places
         parts.append(
-            f"{added} added by resampling onto a uniform grid (the places of dropped samples)"
-            if added > 0
-            else f"{-added} fewer on the uniform grid they were resampled onto"
+            f"{dropped} added by resampling onto a uniform grid (the places of dropped samples)"
+        )
+    if rest := added - dropped:  # jittered stamps: the grid's ends fall elsewhere
+        parts.append(
+            f"{abs(rest)} {'more' if rest > 0 else 'fewer'} on the uniform grid the jittered "
+            "stamps were resampled onto (the grid's ends against the stamps'"
+            + ("; no sample dropped)" if not dropped else ")")
         )
     return f" of {rec['recorded']} recorded" + (": " + ", ".join(parts) if parts else "")
 
