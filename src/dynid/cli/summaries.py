@@ -16,15 +16,17 @@ from ..feasibility.penalty import RetrievalProgress, RetrievalResult
 from ..friction.fit import FrictionFit
 from ..friction.model import friction_parts
 from ..friction.validation import NewtonEulerValidation
+from ..identification.dissipation import negative_viscous
 from ..identification.info import LogInfo
 from ..identification.model import IdentifiedModel
-from ..identification.structure import MIN_WIDTH
+from ..identification.structure import MIN_WIDTH, joint_side_joints
 from ..io.observer_files import log_labels
 from ..observer.detection import undetected_at_rest
 from ..observer.results import LogObservation, ObserveResult, flagged_words
 from ..observer.wrench import estimate_words
 from ..pipeline.collision import CollisionStageResult
 from ..regressors.base import identifiability
+from ..regressors.terms import LinearFriction
 from .structure_table import selection_lines, text_width
 
 __all__ = [
@@ -134,10 +136,7 @@ def term_lines(model: IdentifiedModel) -> list[str]:
             max(len(h), *(len(cells.get((stem, j), "-")) for j in range(1, n + 1)))
             for h, stem in zip(heads, stems, strict=True)
         ]
-        held = {j for (stem, j) in cells if stem not in scales}
-        # a joint friction of a drive on a joint a motor turns alone: the motor's columns
-        alone = [j for j in range(1, n + 1) if j not in held] if drive is not None else []
-        alone = alone if row == "joint" and len(alone) < n else []
+        alone = _motors_hold(t.term, model)
         out.append(f"{name} identified with the links (value, std %; - left out):")
         titles = [f"{h:<{w}}" for h, w in zip(heads, widths, strict=True)]
         out.append(f"  {row:<5}  " + "  ".join(titles).rstrip())
@@ -154,11 +153,59 @@ def term_lines(model: IdentifiedModel) -> list[str]:
                 "in the motor's (its fc holds fc_motor + fc_joint / gear ratio)"
             )
         out += _scales_lines(scales, model)
+        out += _negative_viscous_line(t)
     return out
+
+
+def _negative_viscous_line(t: Any) -> list[str]:
+    """One line naming the viscous coefficients a friction term fitted below zero (not
+    dissipative): within one std of zero, indistinguishable from 0; beyond it, the law
+    misfits (a negative slope stands in for a shape the law lacks)."""
+    if not isinstance(t.term, LinearFriction):
+        return []
+    found = negative_viscous(
+        t.labels, np.asarray(t.values), np.asarray(t.std), np.asarray(t.kept), t.term.prefix
+    )
+    if not found:
+        return []
+    near = [f for f in found if f.within_std]
+    far = [f for f in found if not f.within_std]
+    said = []
+    if far:
+        said.append(
+            ", ".join(f"{f.label} {f.value:+.4g} ({f.stds:.2g} std from 0)" for f in far)
+            + ": each beyond its std, so the friction law misfits there (a negative slope "
+            "stands in for a shape the law lacks, such as friction that levels off at speed; "
+            "dynid friction compares other laws)"
+        )
+    if near:
+        said.append(
+            ", ".join(f"{f.label} {f.value:+.4g}" for f in near)
+            + ": within its std of zero, indistinguishable from 0"
+        )
+    return ["  viscous friction below zero (not dissipative): " + "; ".join(said)]
 
 
 #: The cell of a joint's friction at the joint that the motor's friction holds.
 MOTORS = "motor's"
+
+
+def _motors_hold(term: Any, model: IdentifiedModel) -> list[int]:
+    """The joints (1-based) whose friction at the joint a motor's friction holds: for the
+    friction at the joints beside friction at the motors of a drive, those a motor turns
+    alone (:func:`~dynid.identification.structure.joint_side_joints`); none for another
+    term (a rotor inertia left out is left out: without a drive no motor holds it)."""
+    drive = getattr(term, "drive", None)
+    if not isinstance(term, LinearFriction) or drive is None or drive.friction_at != "joint":
+        return []
+    at_motors = any(
+        isinstance(t.term, LinearFriction) and t.term.drive.friction_at == "motor"
+        for t in model.appended
+    )
+    if not at_motors:
+        return []
+    beside = set(joint_side_joints(drive))
+    return [j + 1 for j in range(drive.n) if j not in beside]
 
 
 def _velocity_scales(term: Any, n: int) -> dict[str, tuple[float, ...]]:
