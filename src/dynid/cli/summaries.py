@@ -22,6 +22,7 @@ from ..identification.model import IdentifiedModel
 from ..identification.structure import MIN_WIDTH, joint_side_joints
 from ..io.observer_files import log_labels
 from ..observer.detection import undetected_at_rest
+from ..observer.gain_noise import GainNoise
 from ..observer.results import LogObservation, ObserveResult, flagged_words
 from ..observer.wrench import estimate_words
 from ..pipeline.collision import CollisionStageResult
@@ -644,6 +645,25 @@ def format_newton_euler_rms(val: NewtonEulerValidation) -> str:
     return "\n".join(rows)
 
 
+def _gain_noise_line(noise: GainNoise | None, names: Sequence[str]) -> list[str]:
+    """One line when the velocities' noise times the gain dominates some joints'
+    calibration residual (:mod:`dynid.observer.gain_noise`): their thresholds grow with
+    ``--gain``."""
+    if noise is None or not noise.dominated:
+        return []
+    js = noise.dominated
+    gains = sorted({float(noise.gain[j]) for j in js})
+    share = noise.share
+    return [
+        f"velocity noise x gain: on {', '.join(names[j] for j in js)} the velocities' noise "
+        f"through K_O M(q) (RMS {', '.join(f'{noise.predicted[j]:.3g}' for j in js)} N m at "
+        f"K_O {'/'.join(f'{g:g}' for g in gains)} 1/s) makes up "
+        f"{', '.join(f'{100 * share[j]:.0f}' for j in js)} % of the residual's mean square: "
+        "these thresholds grow in proportion to --gain, so a larger gain does not detect "
+        "sooner there (calibrate at two gains and compare the thresholds)"
+    ]
+
+
 def _margin_peak(x: LogObservation) -> NDArray[np.float64] | None:
     """A log's largest standstill margin per joint [N m] (its own, or of its series)."""
     if x.standstill_peak is not None:
@@ -705,6 +725,7 @@ def format_observation(result: ObserveResult, names: list[str], *, calibrating: 
             f"up to {', '.join(f'{v:.3g}' for v in top)} N m)"
         )
     if calibrating:
+        rows += _gain_noise_line(result.gain_noise, names)
         rows.append(f"calibrated on {th.samples} samples of {len(result.logs)} log(s)")
         return "\n".join(rows)
     if "max |r|/contact" in cols:
