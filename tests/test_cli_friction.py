@@ -8,6 +8,7 @@ import matplotlib
 import numpy as np
 import pytest
 
+import dynid
 from dynid.cli.__main__ import main
 from dynid.identification.classical import identify_from_log
 from dynid.io.torque_log import load_torque_log
@@ -251,19 +252,27 @@ def test_cli_errors_are_one_line_with_exit_code_2(workdir, capsys):
     assert "missing column" in capsys.readouterr().err
 
 
-def test_demo_friction_stage_fits_friction_validates_and_writes_its_files(tmp_path, panda):
-    """The demo's stage 3 (library) gives per-joint RMS before/after; the CLI writes its files."""
-    from dynid.cli.demo_stages import format_friction_stage, save_friction_stage
+@pytest.fixture(scope="module")
+def friction_demo():
+    """The demo's stage 3 on a model identified from a 15 s Fourier log without friction."""
     from dynid.pipeline import friction_stage
     from dynid.simulation.measurement import sample_times, simulate_measurement
     from dynid.simulation.trajectories import random_fourier
 
+    panda = dynid.panda()
     series = random_fourier(panda, np.random.default_rng(51))
     log = simulate_measurement(
         panda, series(sample_times(15.0)), rng=np.random.default_rng(52), friction=None
     )
     model = identify_from_log(panda, log, friction=False)
-    out = friction_stage(model, seed=3)
+    return panda, friction_stage(model, seed=3)
+
+
+def test_demo_friction_stage_fits_friction_validates_and_writes_its_files(tmp_path, friction_demo):
+    """The demo's stage 3 (library) gives per-joint RMS before/after; the CLI writes its files."""
+    from dynid.cli.demo_stages import format_friction_stage, save_friction_stage
+
+    _, out = friction_demo
     assert np.all(out.rms_with_friction < 0.06)
     assert np.all(out.rms_without_friction > 0.1)
     assert out.friction_curve_rms is not None and np.all(out.friction_curve_rms < 0.01)
@@ -273,6 +282,29 @@ def test_demo_friction_stage_fits_friction_validates_and_writes_its_files(tmp_pa
     for f in files:
         assert (tmp_path / "demo" / f.name).stat().st_size > 0
     assert "RMS + friction" in format_friction_stage(out)
+
+
+def test_demo_friction_stage_validates_on_motion_the_fit_did_not_see(friction_demo):
+    """Regression: stage 3 validated on the very sinusoids it fitted friction on (a new
+    noise draw only), and printed "amplitudes scaled by 0.9350:" over the "limit exceeded"
+    lines as if the scaled motion still exceeded them; the validation log is now the next
+    20 s of the sinusoids (other phases: joint states apart from the fit's at every
+    sample), within the limits, and the wording says what was exceeded before scaling."""
+    from dynid.cli.demo_stages import format_friction_stage
+
+    panda, out = friction_demo
+    fit, val = out.residual.log, out.validation.log
+    assert val.t[0] >= fit.t[-1] and val.t[0] >= 20.0
+    m = min(fit.t.size, val.t.size)  # the same time into each log: other states
+    apart = np.linalg.norm(val.q[:m] - fit.q[:m], axis=1)
+    assert np.median(apart) > 0.3, np.median(apart)
+    assert not out.limits.ok and out.scaled_limits.ok
+    assert np.all(np.abs(val.dq) <= panda.dq_max) and np.all(np.abs(fit.dq) <= panda.dq_max)
+    text = format_friction_stage(out)
+    before, after = text.split("amplitudes scaled by 0.9350")
+    assert "as published exceed the limits" in before and "exceeded" in before
+    assert after.startswith(": the scaled motion is within the limits")
+    assert "exceeded" not in after
 
 
 def test_identify_routes_a_torque_log_to_the_classical_identification(tmp_path):

@@ -327,3 +327,28 @@ def test_observe_says_when_the_model_holds_no_friction(logs, tmp_path, capsys):
     assert "note: the model holds no friction" in line and "--friction" in line
     assert main([*cal, "--params", "panda", "--out", str(tmp_path / "b")]) == 0
     assert "no friction" not in capsys.readouterr().err
+
+
+def test_calibration_says_when_velocity_noise_times_the_gain_sets_the_thresholds(logs, capsys):
+    """Regression: the docs said a larger --gain detects sooner, while on noisy velocities
+    the thresholds grow with it (a Panda's joint 1: 0.72, 1.79, 5.6 N m at gains 20, 50,
+    150). Calibrated at gains 20 and 100 on one free log, the joints the printout names
+    have thresholds that grow about fivefold; a log without velocities (derived, smooth)
+    names none."""
+    model = ["--model", str(logs / "id" / "identification.json"), "--no-figures"]
+    cal = ["observe", *model, "--data", str(logs / "free.csv"), "--calibrate"]
+    contact, named = {}, {}
+    for gain in (20, 100):
+        out = logs / f"cal_gain{gain}"
+        assert main([*cal, "--gain", str(gain), "--out", str(out)]) == 0
+        contact[gain] = load_thresholds(out / "thresholds.json").contact
+        said = [x for x in capsys.readouterr().out.splitlines() if "velocity noise x gain" in x]
+        assert len(said) <= 1
+        named[gain] = [j for j in range(7) if said and f"joint{j + 1}" in said[0].split(" the")[0]]
+    assert named[100] and set(named[20]) <= set(named[100]), named
+    ratio = contact[100][named[100]] / contact[20][named[100]]
+    assert np.all(ratio > 3.0), ratio  # in proportion to the gain (5) where noise sets it
+    _without_velocities(logs / "free.csv", logs / "free_q2.csv")
+    derived = ["observe", *model, "--data", str(logs / "free_q2.csv"), "--calibrate"]
+    assert main([*derived, "--out", str(logs / "cal_q2")]) == 0
+    assert "velocity noise x gain" not in capsys.readouterr().out

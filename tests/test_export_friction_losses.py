@@ -156,6 +156,37 @@ def test_urdf_export_names_each_rotor_inertia_it_drops_on_a_line_of_its_own(tmp_
     assert len(alone) == 1 and alone[0].startswith("URDF export: r.urdf leaves out"), alone
 
 
+def _mass_diagonal_2r_at_zero() -> np.ndarray:
+    """The planar 2R arm's M_11 and M_22 [kg m^2] at q = 0 (the middle of +-2.5 rad), in
+    closed form: I1 + m1 (l1/2)^2 + I2 + m2 (l1^2 + (l2/2)^2 + l1 l2) and I2 + m2 (l2/2)^2."""
+    l1, l2, m1, m2, i1, i2 = 0.7, 0.5, 2.0, 1.5, 0.05, 0.03
+    return np.array(
+        [
+            i1 + m1 * (l1 / 2) ** 2 + i2 + m2 * (l1**2 + (l2 / 2) ** 2 + l1 * l2),
+            i2 + m2 * (l2 / 2) ** 2,
+        ]
+    )
+
+
+def test_urdf_export_names_an_armature_without_gears_only_when_not_negligible(tmp_path):
+    """Regression: identify without a drive warned that robot.urdf leaves out "the drive's
+    rotor inertias" of 1e-7 kg m^2; an armature below 0.1 % of its joint's M_jj at the
+    middle of the ranges is not named now, and one above is named as the armature, with
+    its share of M_jj (closed form of the 2R arm)."""
+    diag = _mass_diagonal_2r_at_zero()
+    below = Drive.from_gears([1.0, 1.0], rotor_inertia=0.99e-3 * diag, side="joint")
+    _, lines = _warnings(export_urdf, tmp_path / "a.urdf", _arm(), ExportOptions(drive=below))
+    assert lines == []
+    ia = np.array([0.5e-3, 1.5e-3]) * diag  # joint 2 above the rule
+    above = Drive.from_gears([1.0, 1.0], rotor_inertia=ia, side="joint")
+    _, lines = _warnings(export_urdf, tmp_path / "b.urdf", _arm(), ExportOptions(drive=above))
+    assert len(lines) == 1, lines
+    assert lines[0].startswith("URDF export: b.urdf leaves out the armature (rotor inertia")
+    assert "drive's" not in lines[0]
+    assert f"joint2 {ia[1]:.4g} (0.15 % of its M_jj)" in lines[0], lines[0]
+    assert f"joint1 {ia[0]:.4g} (0.05 % of its M_jj)" in lines[0], lines[0]
+
+
 def test_template_dynamics_are_replaced_by_the_identified_friction(tmp_path):
     """A vendor template with damping/friction 1-2 on every joint: patched, the chain's
     <dynamics> hold the identified fv and fc (read back to 1e-12, Pinocchio reads the

@@ -93,6 +93,36 @@ def test_dropped_samples_are_counted_as_grid_points_added_not_as_negative_decima
     assert " -" not in line, line
 
 
+def test_jittered_stamps_without_dropped_samples_add_no_dropped_places():
+    """Regression: a 1 kHz log with 50 us of jitter and no sample dropped (largest step
+    1.27 ms) read "2 added by resampling onto a uniform grid (the places of dropped
+    samples)"; only steps of 1.5 periods or more count as dropped samples now (here the
+    three removed, known), and the grid's other points are said to be jitter."""
+    from dynid.cli.summaries import recordings_lines
+
+    panda = dynid.panda()
+    rng = np.random.default_rng(11)
+    t = sample_times(6.0, 1000.0)
+    traj = random_fourier(panda, rng)(t)
+    log = simulate_measurement(panda, traj, rng=rng, noise=SensorNoise.none())
+    jitter = t + rng.normal(0.0, 50e-6, t.size)
+    jitter[0] = t[0]
+    assert np.diff(jitter).max() < 1.5e-3
+    whole = TorqueLog(jitter, log.q, log.dq, log.tau)
+    rows = np.setdiff1d(np.arange(t.size), [2000, 4000, 4001])  # 3 dropped, inside
+    cut = TorqueLog(jitter[rows], log.q[rows], log.dq[rows], log.tau[rows])
+    rec = prepare_recordings(panda, [whole, cut], ["a.csv", "b.csv"], cutoff_hz=10.0)
+    a, b = rec.counts
+    assert a.dropped == 0 and b.dropped == 3
+    assert b.added - b.dropped == a.added  # the same grid: jitter alike
+    lines = recordings_lines(rec.summary())
+    assert a.added != 0  # the grid's ends fall other than the jittered stamps'
+    assert "places of dropped samples" not in lines[0], lines
+    assert "on the uniform grid the jittered stamps were resampled onto" in lines[0]
+    assert "no sample dropped" in lines[0]
+    assert "3 added by resampling onto a uniform grid (the places of dropped samples)" in lines[1]
+
+
 def test_recordings_at_other_rates_say_each_its_own_decimation():
     """A 1 kHz and a 200 Hz recording of the same motion: each is decimated at its own
     rate (1 in 10 and 1 in 4 at a 4.5 Hz cut-off, ``rate.decimation``); the summary

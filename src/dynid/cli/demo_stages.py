@@ -139,10 +139,17 @@ def format_friction_stage(res: FrictionStageResult) -> str:
     per-joint RMS without and with friction, the relative errors."""
     lines = []
     if not res.limits.ok:
+        lines.append(f"the sinusoids of Table I as published exceed the limits:\n{res.limits}")
         lines.append(
-            f"sinusoids of Table I exceed the limits; amplitudes scaled by {res.scale:.4f}:\n"
-            f"{res.limits}"
+            f"amplitudes scaled by {res.scale:.4f}: the scaled motion is within the limits "
+            "at every sample"
+            if res.scaled_limits.ok
+            else f"amplitudes scaled by {res.scale:.4f}; still exceeded:\n{res.scaled_limits}"
         )
+    lines.append(
+        "friction fitted on the sinusoids' first log, validated on the next (the motion "
+        "continued: each joint's sinusoid at another phase, states the fit did not see)"
+    )
     names = list(res.truth.joint_names)
     lines.append(
         format_rms_table(

@@ -137,7 +137,16 @@ def register(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParser:
         "at the frame's origin (moment zero: 3 unknowns, which 3 joints or more determine; "
         "a moment there reads as a wrong force) (default full)",
     )
-    p.add_argument("--gain", default=str(DEFAULT_GAIN), help="K_O [1/s], one or per joint")
+    p.add_argument(
+        "--gain",
+        default=str(DEFAULT_GAIN),
+        help=(
+            f"K_O [1/s], one or per joint (default {DEFAULT_GAIN:g}): a larger gain shortens "
+            "the lag, but the velocities' noise enters the residual times the gain and the "
+            "calibrated thresholds grow with it, so it is not always sooner; calibrate at "
+            "two gains and compare the thresholds"
+        ),
+    )
     p.add_argument("--discretisation", choices=("exact", "euler"), default="exact")
     p.add_argument("--rule", choices=("trapezoid", "rectangle"), default="trapezoid")
     p.add_argument("--margin", type=positive_type, default=1.5, help="factor over |r| (1.5)")

@@ -16,15 +16,18 @@ from ..feasibility.penalty import RetrievalProgress, RetrievalResult
 from ..friction.fit import FrictionFit
 from ..friction.model import friction_parts
 from ..friction.validation import NewtonEulerValidation
+from ..identification.dissipation import negative_viscous
 from ..identification.info import LogInfo
 from ..identification.model import IdentifiedModel
-from ..identification.structure import MIN_WIDTH
+from ..identification.structure import MIN_WIDTH, joint_side_joints
 from ..io.observer_files import log_labels
 from ..observer.detection import undetected_at_rest
+from ..observer.gain_noise import GainNoise
 from ..observer.results import LogObservation, ObserveResult, flagged_words
 from ..observer.wrench import estimate_words
 from ..pipeline.collision import CollisionStageResult
 from ..regressors.base import identifiability
+from ..regressors.terms import LinearFriction
 from .structure_table import selection_lines, text_width
 
 __all__ = [
@@ -134,10 +137,7 @@ def term_lines(model: IdentifiedModel) -> list[str]:
             max(len(h), *(len(cells.get((stem, j), "-")) for j in range(1, n + 1)))
             for h, stem in zip(heads, stems, strict=True)
         ]
-        held = {j for (stem, j) in cells if stem not in scales}
-        # a joint friction of a drive on a joint a motor turns alone: the motor's columns
-        alone = [j for j in range(1, n + 1) if j not in held] if drive is not None else []
-        alone = alone if row == "joint" and len(alone) < n else []
+        alone = _motors_hold(t.term, model)
         out.append(f"{name} identified with the links (value, std %; - left out):")
         titles = [f"{h:<{w}}" for h, w in zip(heads, widths, strict=True)]
         out.append(f"  {row:<5}  " + "  ".join(titles).rstrip())
@@ -154,11 +154,59 @@ def term_lines(model: IdentifiedModel) -> list[str]:
                 "in the motor's (its fc holds fc_motor + fc_joint / gear ratio)"
             )
         out += _scales_lines(scales, model)
+        out += _negative_viscous_line(t)
     return out
+
+
+def _negative_viscous_line(t: Any) -> list[str]:
+    """One line naming the viscous coefficients a friction term fitted below zero (not
+    dissipative): within one std of zero, indistinguishable from 0; beyond it, the law
+    misfits (a negative slope stands in for a shape the law lacks)."""
+    if not isinstance(t.term, LinearFriction):
+        return []
+    found = negative_viscous(
+        t.labels, np.asarray(t.values), np.asarray(t.std), np.asarray(t.kept), t.term.prefix
+    )
+    if not found:
+        return []
+    near = [f for f in found if f.within_std]
+    far = [f for f in found if not f.within_std]
+    said = []
+    if far:
+        said.append(
+            ", ".join(f"{f.label} {f.value:+.4g} ({f.stds:.2g} std from 0)" for f in far)
+            + ": each beyond its std, so the friction law misfits there (a negative slope "
+            "stands in for a shape the law lacks, such as friction that levels off at speed; "
+            "dynid friction compares other laws)"
+        )
+    if near:
+        said.append(
+            ", ".join(f"{f.label} {f.value:+.4g}" for f in near)
+            + ": within its std of zero, indistinguishable from 0"
+        )
+    return ["  viscous friction below zero (not dissipative): " + "; ".join(said)]
 
 
 #: The cell of a joint's friction at the joint that the motor's friction holds.
 MOTORS = "motor's"
+
+
+def _motors_hold(term: Any, model: IdentifiedModel) -> list[int]:
+    """The joints (1-based) whose friction at the joint a motor's friction holds: for the
+    friction at the joints beside friction at the motors of a drive, those a motor turns
+    alone (:func:`~dynid.identification.structure.joint_side_joints`); none for another
+    term (a rotor inertia left out is left out: without a drive no motor holds it)."""
+    drive = getattr(term, "drive", None)
+    if not isinstance(term, LinearFriction) or drive is None or drive.friction_at != "joint":
+        return []
+    at_motors = any(
+        isinstance(t.term, LinearFriction) and t.term.drive.friction_at == "motor"
+        for t in model.appended
+    )
+    if not at_motors:
+        return []
+    beside = set(joint_side_joints(drive))
+    return [j + 1 for j in range(drive.n) if j not in beside]
 
 
 def _velocity_scales(term: Any, n: int) -> dict[str, tuple[float, ...]]:
@@ -233,16 +281,22 @@ _LOST = (
 def _lost(rec: Any) -> str:
     """`` of 820 recorded: 274 trimmed at the pieces' ends (...), ...`` (empty when the
     record does not count them), with the points a uniform grid added to resampled
-    pieces."""
+    pieces: at the places of dropped samples, and the rest (either sign) at the grid's
+    ends against jittered stamps."""
     if "recorded" not in rec:
         return ""
     parts = [f"{rec[k]} {why}" for k, why in _LOST if rec.get(k)]
     added = rec.get("added", 0)
-    if added:  # the uniform grid of resampled pieces holds the dropped samples' places
+    dropped = rec.get("dropped", added if added > 0 else 0)  # a record without: as it said
+    if dropped:  # the uniform grid of resampled pieces holds the dropped samples' places
         parts.append(
-            f"{added} added by resampling onto a uniform grid (the places of dropped samples)"
-            if added > 0
-            else f"{-added} fewer on the uniform grid they were resampled onto"
+            f"{dropped} added by resampling onto a uniform grid (the places of dropped samples)"
+        )
+    if rest := added - dropped:  # jittered stamps: the grid's ends fall elsewhere
+        parts.append(
+            f"{abs(rest)} {'more' if rest > 0 else 'fewer'} on the uniform grid the jittered "
+            "stamps were resampled onto (the grid's ends against the stamps'"
+            + ("; no sample dropped)" if not dropped else ")")
         )
     return f" of {rec['recorded']} recorded" + (": " + ", ".join(parts) if parts else "")
 
@@ -591,6 +645,25 @@ def format_newton_euler_rms(val: NewtonEulerValidation) -> str:
     return "\n".join(rows)
 
 
+def _gain_noise_line(noise: GainNoise | None, names: Sequence[str]) -> list[str]:
+    """One line when the velocities' noise times the gain dominates some joints'
+    calibration residual (:mod:`dynid.observer.gain_noise`): their thresholds grow with
+    ``--gain``."""
+    if noise is None or not noise.dominated:
+        return []
+    js = noise.dominated
+    gains = sorted({float(noise.gain[j]) for j in js})
+    share = noise.share
+    return [
+        f"velocity noise x gain: on {', '.join(names[j] for j in js)} the velocities' noise "
+        f"through K_O M(q) (RMS {', '.join(f'{noise.predicted[j]:.3g}' for j in js)} N m at "
+        f"K_O {'/'.join(f'{g:g}' for g in gains)} 1/s) makes up "
+        f"{', '.join(f'{100 * share[j]:.0f}' for j in js)} % of the residual's mean square: "
+        "these thresholds grow in proportion to --gain, so a larger gain does not detect "
+        "sooner there (calibrate at two gains and compare the thresholds)"
+    ]
+
+
 def _margin_peak(x: LogObservation) -> NDArray[np.float64] | None:
     """A log's largest standstill margin per joint [N m] (its own, or of its series)."""
     if x.standstill_peak is not None:
@@ -652,6 +725,7 @@ def format_observation(result: ObserveResult, names: list[str], *, calibrating: 
             f"up to {', '.join(f'{v:.3g}' for v in top)} N m)"
         )
     if calibrating:
+        rows += _gain_noise_line(result.gain_noise, names)
         rows.append(f"calibrated on {th.samples} samples of {len(result.logs)} log(s)")
         return "\n".join(rows)
     if "max |r|/contact" in cols:

@@ -37,9 +37,11 @@ if TYPE_CHECKING:
 __all__ = [
     "GRID",
     "SIGNIFICANCE",
+    "NegativeViscous",
     "Violation",
     "friction_columns",
     "friction_violations",
+    "negative_viscous",
     "reversed_sign_finding",
     "warn_unphysical",
 ]
@@ -97,6 +99,70 @@ class Violation:
             f"{self.coefficients} ({self.place} {self.joint + 1}: f(v) v < 0 at |v| = "
             f"{self.speed:.3g} rad/s, limit {self.limit:.3g} rad/s)"
         )
+
+
+@dataclass(frozen=True, slots=True)
+class NegativeViscous:
+    """A viscous coefficient fitted below zero: friction that pushes in proportion to the
+    velocity, not dissipative by itself (the law's other parts may still make the whole
+    friction dissipative within the limits: :func:`friction_violations` judges that).
+
+    Attributes
+    ----------
+    label : str
+        The coefficient (``fv2``; ``jfv7`` at a joint beside the motors).
+    value : float
+        Its value [N m s/rad], below zero.
+    std : float
+        Its standard deviation [N m s/rad].
+    """
+
+    label: str
+    value: float
+    std: float
+
+    @property
+    def within_std(self) -> bool:
+        """Whether zero lies within one standard deviation: indistinguishable from 0."""
+        return abs(self.value) <= self.std
+
+    @property
+    def stds(self) -> float:
+        """Standard deviations from zero (``inf`` for a std of 0)."""
+        return abs(self.value) / self.std if self.std > 0 else float("inf")
+
+
+def negative_viscous(
+    labels: Sequence[str],
+    values: NDArray[np.float64],
+    std: NDArray[np.float64],
+    kept: NDArray[np.bool_],
+    prefix: str = "",
+) -> tuple[NegativeViscous, ...]:
+    """The viscous coefficients of one friction term fitted below zero (kept ones only).
+
+    Parameters
+    ----------
+    labels : sequence of str
+        The term's coefficient labels (``fv1, fc1, ...``; ``prefix`` before them).
+    values, std : ndarray, shape (k,)
+        Their values and standard deviations (``N m s/rad`` for a viscous one).
+    kept : ndarray of bool, shape (k,)
+        Whether each was fitted (False: left out or regrouped).
+    prefix : str
+        The term's label prefix (``"j"`` for friction at the joints beside the motors).
+
+    Returns
+    -------
+    tuple of NegativeViscous
+        In the order of ``labels``.
+    """
+    stem = prefix + PART_LABELS["viscous"]
+    return tuple(
+        NegativeViscous(lab, float(v), float(s))
+        for lab, v, s, k in zip(labels, values, std, kept, strict=True)
+        if k and lab.rstrip("0123456789") == stem and v < 0
+    )
 
 
 def friction_violations(

@@ -68,7 +68,13 @@ from .pieces import (
     wrappable,
     wrapped_finding,
 )
-from .prepare import Preprocessing, at_instants, grid_samples, measured_instants
+from .prepare import (
+    Preprocessing,
+    at_instants,
+    dropped_places,
+    grid_samples,
+    measured_instants,
+)
 from .prepared_log import PreparedLog, prepare_torque_log
 from .rate import CUTOFF_MULTIPLE
 from .sanity import (
@@ -117,7 +123,11 @@ class SampleCounts:
         piece).
     added : int
         Points the uniform grid of a resampled piece holds beyond its samples within the
-        trimmed edges: the places of dropped samples (negative: it holds fewer).
+        trimmed edges (negative: it holds fewer): the places of dropped samples
+        (``dropped``) and the grid's ends against jittered stamps (the rest).
+    dropped : int
+        Of ``added``, the places of dropped samples: steps between stamps of at least
+        1.5 periods (:func:`~dynid.identification.prepare.dropped_places`).
     used : int
         Samples used: ``recorded`` less the others, plus ``added``.
     """
@@ -128,6 +138,7 @@ class SampleCounts:
     trimmed: int = 0
     decimated: int = 0
     added: int = 0
+    dropped: int = 0
 
     @property
     def used(self) -> int:
@@ -137,7 +148,7 @@ class SampleCounts:
 
     def as_dict(self) -> dict[str, int]:
         """``recorded``, ``isolated``, ``too_short``, ``trimmed``, ``decimated``,
-        ``added``."""
+        ``added``, ``dropped``."""
         return {
             "recorded": self.recorded,
             "isolated": self.isolated,
@@ -145,6 +156,7 @@ class SampleCounts:
             "trimmed": self.trimmed,
             "decimated": self.decimated,
             "added": self.added,
+            "dropped": self.dropped,
         }
 
 
@@ -572,7 +584,7 @@ def _prepared(
     samples left out, trimmed and decimated away, and the grid points a resampled piece
     added (:class:`SampleCounts`)."""
     prepared, recording, skipped = [], [], []
-    keys = ("too_short", "trimmed", "decimated", "added")
+    keys = ("too_short", "trimmed", "decimated", "added", "dropped")
     gone = {r: dict.fromkeys(keys, 0) for r in range(len(names))}
     said: set[tuple[int, str]] = set()
     left: list[tuple[int, str]] = []
@@ -599,6 +611,7 @@ def _prepared(
         grid = grid_samples(piece, prep)  # kept, on the uniform grid of a resampled piece
         gone[r]["trimmed"] += piece.n_samples - kept
         gone[r]["added"] += grid - kept
+        gone[r]["dropped"] += dropped_places(piece, prep)
         gone[r]["decimated"] += grid - p.log.n_samples
     if (
         finding := left_out_finding(names, pieces, left, kw["trim_s"], kw["max_gap_s"])

@@ -23,6 +23,8 @@ Albu-Schaeffer, IEEE T-RO 2017), on any model dynid produces.
 * :mod:`~dynid.observer.sign`: measured torques of the opposite sign to the model's,
   read from the residual (a calibration refuses them);
 * :mod:`~dynid.observer.thresholds`: the thresholds and their value at every sample;
+* :mod:`~dynid.observer.gain_noise`: how much of a calibration residual is the
+  velocities' noise times the gain (thresholds that grow with it);
 * :mod:`~dynid.observer.events`: contact and collision events, from a whole log or a
   block of samples at a time (:class:`EventDetector`).
 """

@@ -16,6 +16,7 @@ from ..exceptions import DataError
 from ..friction.model import FrictionModel, FrictionSum
 from .detection import ContactEvent, Thresholds
 from .friction import banding_note
+from .gain_noise import GainNoise
 from .model import ObserverModel
 from .thresholds import ModelFingerprint
 from .wrench import FULL, WrenchEstimate, WrenchKind, underdetermined_note
@@ -179,7 +180,8 @@ class ObserveResult:
     ``friction_source``, the robot file whose own friction the model holds (a URDF's
     ``<dynamics>``; None: a friction given or identified); ``frame``, where the wrench was
     estimated (None: nowhere), and ``wrench``, what was estimated there (the whole wrench
-    or the force of a point contact)."""
+    or the force of a point contact); ``gain_noise``, of a calibration: how much of its
+    residual is the velocities' noise times the gain (None: not calibrated)."""
 
     model: ObserverModel
     thresholds: Thresholds
@@ -188,6 +190,7 @@ class ObserveResult:
     friction_source: str | None = None
     frame: str | None = None
     wrench: WrenchKind = FULL
+    gain_noise: GainNoise | None = None
 
     def flagged(self) -> tuple[float, float]:
         """``(flagged, logged)`` [s]: the time every log's events cover and the logs'

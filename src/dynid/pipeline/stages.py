@@ -50,7 +50,12 @@ from ..model.robot import Robot
 from ..simulation.controller import SimulatedController, acquire_static
 from ..simulation.limits import LimitReport, check_limits, scale_into_limits
 from ..simulation.measurement import SensorNoise, sample_times, simulate_measurement
-from ..simulation.trajectories import centered_start, random_fourier, sinusoid_trajectory
+from ..simulation.trajectories import (
+    Trajectory,
+    centered_start,
+    random_fourier,
+    sinusoid_trajectory,
+)
 from ..spatial import rpy_from_matrix, transform_from_xyz_rpy
 
 __all__ = [
@@ -245,13 +250,17 @@ class FrictionStageResult:
         The sinusoids of Table I against the limits, before scaling.
     scale : float
         Amplitude scale that keeps the sinusoids within the limits.
+    scaled_limits : LimitReport
+        The scaled sinusoids (both logs) against the limits: ``ok`` when they are within.
     noise : SensorNoise
     residual : FrictionResidual
         Torque residual of the model on the fitting log.
     fit : FrictionFit
         Sigmoid friction fitted to it.
     validation : Validation
-        Model without and with the fitted friction on the validation log.
+        Model without and with the fitted friction on the validation log: the 20 s of the
+        sinusoids after the fitting log's (each joint's sinusoid at another phase, its
+        combination with the others a motion the fit did not see).
     friction_curve_rms : ndarray, shape (n,), or None
         RMS of the fitted minus the true friction over the visited velocities [N m]
         (None: the truth has no friction).
@@ -261,6 +270,7 @@ class FrictionStageResult:
     truth: Robot
     limits: LimitReport
     scale: float
+    scaled_limits: LimitReport
     noise: SensorNoise
     residual: FrictionResidual
     fit: FrictionFit
@@ -297,11 +307,12 @@ def friction_stage(
 ) -> FrictionStageResult:
     """Friction and validation from a rigid-body model (e.g. the static one).
 
-    Simulates two 20 s logs at 1 kHz of the velocity-mode sinusoids (Gaz et al. 2019,
-    eq. 31, Table I; started centred in the joint ranges and scaled in amplitude into the
-    limits) on ``truth`` (default ``model.robot``), with independent sensor noise: one to
-    fit the sigmoid friction to the model's residual, one to validate the model without
-    and with it.
+    Simulates 40 s at 1 kHz of the velocity-mode sinusoids (Gaz et al. 2019, eq. 31,
+    Table I; started centred in the joint ranges and scaled in amplitude into the limits)
+    on ``truth`` (default ``model.robot``), as two 20 s logs with independent sensor
+    noise: the first to fit the sigmoid friction to the model's residual, the second (the
+    sinusoids 20 s on: each joint's at another phase, so the joints' states combine as
+    the fit never saw) to validate the model without and with it.
 
     Raises
     ------
@@ -315,13 +326,15 @@ def friction_stage(
             "pass truth=<Robot>"
         )
     rng = np.random.default_rng(seed)
-    t = sample_times(20.0, 1000.0)
+    t = sample_times(2 * _SINUSOID_LOG_S, 1000.0)
     traj = sinusoid_trajectory(t, centered_start(truth))
     limits = check_limits(truth, traj)
     traj, scale = scale_into_limits(truth, traj, method="amplitude")
+    scaled_limits = check_limits(truth, traj)
+    half = int(np.searchsorted(traj.t, traj.t[0] + _SINUSOID_LOG_S))
     noise = SensorNoise()
-    fit_log = simulate_measurement(truth, traj, rng=rng, noise=noise)
-    val_log = simulate_measurement(truth, traj, rng=rng, noise=noise)
+    fit_log = simulate_measurement(truth, _part(traj, 0, half), rng=rng, noise=noise)
+    val_log = simulate_measurement(truth, _part(traj, half, len(traj)), rng=rng, noise=noise)
     res = friction_residual(model, fit_log)
     fit = fit_sigmoid(res.dq, res.residual, dq_noise_std=res.dq_noise_std)
     val = validate_torques(model, val_log, friction=fit.friction)
@@ -331,7 +344,18 @@ def friction_stage(
     if true_f is not None:
         v = np.linspace(-1.0, 1.0, 801)[:, None] * np.max(np.abs(traj.dq), axis=0)
         curve = np.sqrt(np.mean((fit.friction.torques(v) - true_f.torques(v)) ** 2, axis=0))
-    return FrictionStageResult(truth, limits, float(scale), noise, res, fit, val, curve, seed)
+    return FrictionStageResult(
+        truth, limits, float(scale), scaled_limits, noise, res, fit, val, curve, seed
+    )
+
+
+#: Seconds of each of the friction stage's sinusoid logs (fitting, then validation).
+_SINUSOID_LOG_S = 20.0
+
+
+def _part(traj: Trajectory, a: int, b: int) -> Trajectory:
+    """The samples ``a:b`` of ``traj``."""
+    return Trajectory(t=traj.t[a:b], q=traj.q[a:b], dq=traj.dq[a:b], ddq=traj.ddq[a:b])
 
 
 # ----------------------------------------------------------------------------- stage 4

@@ -75,6 +75,7 @@ from ..model.drive import Drive
 from ..model.robot import Robot
 from ..observer.detection import Thresholds, calibrate
 from ..observer.events import DEFAULT_MERGE_S, DEFAULT_MIN_DURATION_S
+from ..observer.gain_noise import GainNoiseTally
 from ..observer.model import ObserverModel, from_identified, from_robot
 from ..observer.residual import DEFAULT_GAIN, ObserverOptions
 from ..observer.results import LogObservation, ObserveResult
@@ -476,7 +477,7 @@ def observe_files(opts: ObserveOptions, sink: ResidualSink | None = None) -> Obs
             read, model, columns[0] is not None, opts, options, wants_std, wants_margin
         )
         th = dataclasses.replace(cal.thresholds, model=fingerprint)
-        return ObserveResult(model, th, cal.logs, fingerprint, own)
+        return dataclasses.replace(cal, thresholds=th, fingerprint=fingerprint, friction_source=own)
     paths = tuple(map(Path, read.paths))
     logs = []
     kind = wrench_kind(opts.wrench)
@@ -606,6 +607,7 @@ def _calibrated(
         joints: its thresholds would be blind there."""
     logs: list[LogObservation] = []
     names = model.robot.joint_names
+    tally = GainNoiseTally(model, np.asarray(options.gain, dtype=np.float64))
 
     def blocks() -> Iterator[ObservedBlock]:
         for path, log, side in zip(read.paths, read.logs, read.joint_side, strict=True):
@@ -613,6 +615,7 @@ def _calibrated(
             keep = Series.new(prep, model.n, wants_std, wants_margin) if opts.keep_series else None
             peak = np.zeros(model.n)
             sign = TorqueSign(model.n)
+            q, dq = prep.log.q, prep.dq
             seen = model.friction
             for blk in observed_blocks(prep, model, options, wants_std, wants_margin):
                 if blk.friction is not None and blk.friction is not model.friction:
@@ -621,7 +624,9 @@ def _calibrated(
                     np.maximum(peak, blk.margin.max(axis=0), out=peak)
                 if keep is not None:
                     keep.put(blk)
-                sign.add(prep.log.tau[blk.a : blk.a + blk.r.shape[0]], blk.r)
+                rows = slice(blk.a, blk.a + blk.r.shape[0])
+                sign.add(prep.log.tau[rows], blk.r)
+                tally.add(q[rows], dq[rows], blk.r)
                 yield blk
             if (opposite := opposite_finding(sign, names)) is not None:
                 raise DataError(opposite, file=Path(path).name)
@@ -658,7 +663,7 @@ def _calibrated(
         collision_factor=opts.collision_factor,
         k_sigma=opts.k_sigma,
     )
-    return ObserveResult(model, th, tuple(logs))
+    return ObserveResult(model, th, tuple(logs), gain_noise=tally.result())
 
 
 def _std(x: ObservedBlock) -> NDArray[np.float64]:

@@ -49,6 +49,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from ... import __version__, spatial
+from ...dynamics.terms import mass_matrix
 from ...exceptions import DynidWarning, ModelError, ShapeError
 from ...friction.model import Friction, FrictionSum, robot_friction, sigmoid_parameters
 from ...friction.mujoco import drive_joint_terms, joint_coulomb_viscous, unheld_friction
@@ -288,22 +289,60 @@ def save_urdf(
     return path
 
 
+#: An armature below this fraction of its joint's inertia (the diagonal ``M_jj`` of the
+#: arm's mass matrix at the middle of the joint ranges) is negligible: leaving it out
+#: changes that joint's inertial torque by less than 0.1 %, far below a torque sensor's
+#: noise, and the URDF export does not warn of it (:func:`armature_shares`).
+NEGLIGIBLE_ARMATURE = 1e-3
+
+
+def armature_shares(robot: Robot, armature: NDArray[np.float64]) -> NDArray[np.float64]:
+    """Each joint's ``armature`` (n,) [kg m^2] over the diagonal ``M_jj`` (n,) of the
+    robot's mass matrix at the middle of its joint ranges (0 for an unlimited joint): the
+    share of the joint's inertia a URDF without it leaves out (``inf`` where ``M_jj`` is 0,
+    a robot without link inertias)."""
+    lo, hi = np.asarray(robot.q_min), np.asarray(robot.q_max)
+    mid = np.where(np.isfinite(lo) & np.isfinite(hi), 0.5 * (lo + hi), 0.0)
+    diag = np.diagonal(mass_matrix(robot, mid)) if np.any(robot.phi) else np.zeros(robot.n)
+    a = np.asarray(armature, dtype=np.float64)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        return np.where(a == 0, 0.0, a / np.abs(diag))
+
+
 def _rotor_warning(drive: Drive | None, robot: Robot, path: Path) -> str | None:
     """What URDF cannot hold of a drive, as a warning of its own: its rotor inertias (the
-    armature per joint, ``diag(K^T diag(I_a) K)`` [kg m^2]) by joint, and the exports that
-    hold them (MJCF ``armature``, the TOML ``[drive]`` table); None without any."""
+    armature per joint, ``diag(K^T diag(I_a) K)`` [kg m^2]) by joint with their share of
+    the joint's inertia, and the exports that hold them; None without any, or when every
+    one is below :data:`NEGLIGIBLE_ARMATURE` of its joint's inertia. A drive without gears
+    (``K = 1``: an armature identified without a drive) is spoken of as the armature."""
     if drive is None or drive.rotor_inertia is None or not np.any(drive.rotor_inertia != 0):
         return None
     arm = drive_joint_terms(drive.transmission, drive.rotor_inertia, None, None).armature
+    share = armature_shares(robot, arm)
+    if not np.any(share >= NEGLIGIBLE_ARMATURE):
+        return None
     values = ", ".join(
-        f"{name} {a:.4g}" for name, a in zip(robot.joint_names, arm, strict=True) if a != 0
+        f"{name} {a:.4g} ({_share(s)} of its M_jj)"
+        for name, a, s in zip(robot.joint_names, arm, share, strict=True)
+        if a != 0
+    )
+    geared = not np.array_equal(np.asarray(drive.transmission), np.eye(drive.n))
+    what = (
+        "the drive's rotor inertias"
+        if geared
+        else "the armature (rotor inertia at the joints, without gears)"
     )
     return (
-        f"URDF export: {path.name} leaves out the drive's rotor inertias, which URDF has no "
-        f"element for (armature per joint [kg m^2]: {values}); the MJCF export "
-        f"({path.stem}.xml) holds them as armature, the TOML export ({path.stem}.toml) as "
-        "its [drive] table"
+        f"URDF export: {path.name} leaves out {what}, which URDF has no element for "
+        f"(armature per joint [kg m^2]: {values}; M_jj at the middle of the joint ranges); "
+        f"the MJCF export ({path.stem}.xml) holds them as armature, the TOML export "
+        f"({path.stem}.toml) as its [drive] table"
     )
+
+
+def _share(x: float) -> str:
+    """``12 %``, or ``all`` for a joint without inertia."""
+    return f"{100.0 * x:.2g} %" if np.isfinite(x) else "all"
 
 
 def export_urdf(path: str | Path, robot: Robot, options: ExportOptions) -> Path:
