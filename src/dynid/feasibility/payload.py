@@ -31,7 +31,9 @@ or a robot's links with its drive's known rotor inertias and its own friction.
   the arm is first identified from the unloaded data with identification's structure
   selection, or the structure of the identified model given
   (:func:`~dynid.feasibility.payload_arm.unloaded_arm`), at the loaded data's cut-off and
-  decimation; model errors common to both recordings cancel.
+  decimation; model errors common to both recordings cancel (when the unloaded data
+  repeat the loaded motion; the recordings an identified model given was identified from
+  give that model again, which a note says).
 
 Physical consistency: the least-squares estimate is kept when its pseudo-inertia is
 positive definite with ``lambda_min(J) >= margin tr(J)``; otherwise the estimate closest to
@@ -42,7 +44,12 @@ the constraint is ``m > 0``.
 Standard deviations: the heteroscedasticity-consistent (HC1) covariance of the least
 squares (relative, multiplicative sensor noise gives rows of unequal variance), carried to
 mass, CoM and inertia about the CoM through the Jacobian of that map (central differences).
-When the LMI is active they describe the unconstrained estimate.
+Torque logs: widened for the filtered rows' serial correlation (Newey-West) and, each
+parameter's variance, to the estimate's spread over held-out time blocks where that is
+larger (:func:`~dynid.feasibility.payload_fit.block_jackknife_covariance`): an error of
+the arm's model that varies along the motion moves the estimate, which the residual does
+not show. When the LMI is active they describe the unconstrained estimate, and the
+inertia, set by the bound, is not determined.
 
 Doubts (:attr:`PayloadEstimate.doubts`, each also a :class:`~dynid.exceptions.DynidWarning`):
 a mass less than :data:`MIN_MASS_SIGMAS` standard deviations above zero (no load the data
@@ -79,11 +86,19 @@ from ..identification.model import IdentifiedModel
 from ..identification.recordings import prepare_recordings
 from ..identification.structure import Structure
 from ..model.drive import Drive
+from ..model.inertia import INERTIA_ORDER
 from ..model.robot import Robot
 from .lmi import phi_from_pseudo_inertia, pseudo_inertia
 from .payload_arm import ArmFriction, ArmModel, arm_model, model_structure, unloaded_arm
 from .payload_doubts import doubts_about, inertia_doubts, undetermined_inertia
-from .payload_fit import fit_load, load_parameters, serial_correlation_factor, summary
+from .payload_fit import (
+    HELD_OUT_BLOCKS,
+    block_jackknife_covariance,
+    fit_load,
+    load_parameters,
+    serial_correlation_factor,
+    summary,
+)
 from .payload_rows import (
     filtered_noise_rms,
     log_preparation,
@@ -127,7 +142,8 @@ class PayloadEstimate:
         Covariance of the estimated entries of ``phi`` (``p`` = 10, or 4 for ``g`` only).
     route : str
         ``"static M and g"``, ``"static g"`` or ``"torque log"`` (``", difference"`` appended
-        for the difference method).
+        for the difference method, unless the arm identified from the unloaded data is the
+        identified model given: then a note says so).
     inertia_identified : bool
     constraint_active : bool
         The LMI changed the least-squares estimate.
@@ -319,12 +335,15 @@ def identify_payload(
     kept: NDArray[np.bool_] | None = None
     record: dict[str, Any] = {}
     if isinstance(data, StaticDataset):
+        same = None
         if base is None:
             the_arm = arm_model(arm, drive=d, friction=friction)
         else:
             the_arm, note = unloaded_arm(kin, base[0], rtol=rtol, drive=d)  # type: ignore[arg-type]
-            notes.append(note)
+            same = _unchanged(inner, the_arm)
+            notes.append(same or note)
         W, yv, route = static_load_rows(the_arm, data, cols, A, gravity_only, notes)
+        route += ", difference" if base is not None and same is None else ""
     else:
         opt = dict(structure=structure, drive=d, friction=friction, cutoff_hz=cutoff_hz)
         opt |= dict(decimate=decimate, max_gap_s=max_gap_s, rtol=rtol)
@@ -333,8 +352,6 @@ def identify_payload(
         W, yv, route, kept, record = _log_route(
             arm, logs, names, without, unloaded_names, cols, A, notes, opt
         )
-    if base is not None:
-        route += ", difference"
     p = 4 if (static and gravity_only) else 10
     return _estimate(W, yv, kept, p, static, rtol, margin, kin, frame, route, notes, record)
 
@@ -369,12 +386,24 @@ def _estimate(
             f"standard deviations widened x{np.sqrt(factor):.3g} for the serial correlation "
             f"of the filtered samples (Newey-West, {lags} lags)"
         )
+        cov = _held_out_spread(cov, W[:, cols], yv, n, notes)
     phi, active, marg = load_parameters(est[:p], float(np.sqrt(cov[0, 0])), W, margin, notes)
     m, c, I, sm, sc, si = summary(phi, cov, p == 10)
     doubts = doubts_about(kin, frame, m, sm, c)
-    undetermined = undetermined_inertia(I, si) if p == 10 and not doubts else ()
+    by_std = undetermined_inertia(I, si) if p == 10 and not doubts else ()
+    at_bound = active and p == 10 and not doubts  # the bound, not the data, set it
+    undetermined = tuple(f"I{name}" for name in INERTIA_ORDER) if at_bound else by_std
     noise = record.get("noise_rms")
-    about_inertia = inertia_doubts(undetermined, I, si, fit.residual_rms, noise)
+    about_inertia = inertia_doubts(
+        by_std,
+        I,
+        si,
+        fit.residual_rms,
+        noise,
+        at_bound=at_bound,
+        margin=margin,
+        difference=route.endswith("difference"),
+    )
     for line in doubts + about_inertia:
         warnings.warn(line, DynidWarning, stacklevel=3)
     return PayloadEstimate(
@@ -405,6 +434,39 @@ def _estimate(
     )
 
 
+def _held_out_spread(
+    cov: NDArray[np.float64],
+    W: NDArray[np.float64],
+    yv: NDArray[np.float64],
+    n: int,
+    notes: list[str],
+) -> NDArray[np.float64]:
+    """``cov`` (the load's ``p`` parameters) with each variance raised to the spread of the
+    estimate over :data:`~dynid.feasibility.payload_fit.HELD_OUT_BLOCKS` held-out time
+    blocks where that is larger (:func:`~dynid.feasibility.payload_fit.block_jackknife_covariance`;
+    the correlations kept), and a note when it widened a standard deviation by more than
+    10 %: an error of the arm's model that varies along the motion, which the residual's
+    covariance does not see."""
+    jack = block_jackknife_covariance(W, yv, n)
+    p = cov.shape[0]
+    if jack is None:
+        notes.append(
+            "the standard deviations were not checked on held-out time blocks (a block alone "
+            "excites some direction of the load, or the log is too short)"
+        )
+        return cov
+    var = np.diag(cov)
+    widen = np.sqrt(np.maximum(1.0, np.diag(jack)[:p] / np.where(var > 0, var, np.inf)))
+    if widen.max() > 1.1:
+        notes.append(
+            f"standard deviations widened up to x{widen.max():.3g} to the spread of the "
+            f"estimate over {HELD_OUT_BLOCKS} held-out time blocks (block jackknife): the "
+            "fit's errors vary along the motion (the arm's model), more than the residual's "
+            "covariance says"
+        )
+    return cov * np.outer(widen, widen)
+
+
 def _log_route(
     arm: Robot | IdentifiedModel | ArmModel,
     logs: list[TorqueLog],
@@ -429,6 +491,7 @@ def _log_route(
     used = max(p.decimate for p in rec.pieces)
     prep = {"cutoff_hz": rec.cutoff_hz, "cutoff_source": source, "decimate": used}
     prep |= {"max_gap_s": gap, "sample_rate_hz": rec.pieces[0].sample_rate_hz}
+    same = None
     if base is None:
         the_arm = arm_model(arm, drive=d, friction=opt["friction"])
     else:
@@ -447,10 +510,29 @@ def _log_route(
             drive=d,
             rtol=opt["rtol"],
         )
-        notes.append(note)
+        same = _unchanged(inner, the_arm)
+        notes.append(same or note)
     W, yv, route, kept = log_rows(the_arm, rec, still_joints(logs, d), cols, A, notes)
+    route += ", difference" if base is not None and same is None else ""
     record = {"preprocessing": prep, "recordings": rec.summary(), "skipped": rec.skipped}
     return W, yv, route, kept, record | {"noise_rms": filtered_noise_rms(rec)}
+
+
+def _unchanged(given: Robot | IdentifiedModel, arm: ArmModel) -> str | None:
+    """The note of a difference method that changed nothing: the arm identified from the
+    unloaded data is the identified model given (its coefficients to 1e-9), as when the
+    unloaded recordings are the ones it was identified from; None otherwise."""
+    if not isinstance(given, IdentifiedModel) or not isinstance(arm.model, IdentifiedModel):
+        return None
+    a, b = np.asarray(given.fit.beta), np.asarray(arm.model.fit.beta)
+    if a.shape != b.shape or not np.allclose(a, b, rtol=1e-9, atol=0.0):
+        return None
+    return (
+        "difference method: the arm identified from the --unloaded data is the --model's own "
+        "(the same recordings, structure and preprocessing it was identified from), so the "
+        "result is the one without --unloaded; the difference method cancels the arm's model "
+        "errors only with a recording of the loaded motion repeated without the load"
+    )
 
 
 def _items(
