@@ -343,17 +343,20 @@ def identify_payload(
             same = _unchanged(inner, the_arm)
             notes.append(same or note)
         W, yv, route = static_load_rows(the_arm, data, cols, A, gravity_only, notes)
-        route += ", difference" if base is not None and same is None else ""
+        differenced = base is not None and same is None
     else:
         opt = dict(structure=structure, drive=d, friction=friction, cutoff_hz=cutoff_hz)
         opt |= dict(decimate=decimate, max_gap_s=max_gap_s, rtol=rtol)
         logs = cast(list[TorqueLog], list(items))
         without = None if base is None else cast(list[TorqueLog], list(base))
-        W, yv, route, kept, record = _log_route(
+        W, yv, route, kept, record, differenced = _log_route(
             arm, logs, names, without, unloaded_names, cols, A, notes, opt
         )
     p = 4 if (static and gravity_only) else 10
-    return _estimate(W, yv, kept, p, static, rtol, margin, kin, frame, route, notes, record)
+    route += ", difference" if differenced else ""
+    return _estimate(
+        W, yv, kept, p, static, rtol, margin, kin, frame, route, notes, record, differenced
+    )
 
 
 def _estimate(
@@ -369,8 +372,10 @@ def _estimate(
     route: str,
     notes: list[str],
     record: dict[str, Any],
+    difference: bool,
 ) -> PayloadEstimate:
-    """The load's estimate from its rows: least squares, consistency, doubts (warned)."""
+    """The load's estimate from its rows: least squares, consistency, doubts (warned);
+    ``difference``: the arm was identified from unloaded data (its hint differs)."""
     n, k = kin.n, kin.frame(frame).link
     fit = fit_load(W, yv, kept, rtol, p, static)
     est = np.asarray(fit.beta)
@@ -402,7 +407,7 @@ def _estimate(
         noise,
         at_bound=at_bound,
         margin=margin,
-        difference=route.endswith("difference"),
+        difference=difference,
     )
     for line in doubts + about_inertia:
         warnings.warn(line, DynidWarning, stacklevel=3)
@@ -477,11 +482,12 @@ def _log_route(
     A: NDArray[np.float64],
     notes: list[str],
     opt: dict[str, Any],
-) -> tuple[NDArray[np.float64], NDArray[np.float64], str, NDArray[np.bool_], dict[str, Any]]:
+) -> tuple[NDArray[np.float64], NDArray[np.float64], str, NDArray[np.bool_], dict[str, Any], bool]:
     """The rows of recordings (:func:`~dynid.feasibility.payload_rows.log_rows`) with the
     arm given or identified from ``base``; the preprocessing, recordings and pieces left
-    out, for the record (:class:`PayloadEstimate`'s fields). ``opt``: the options of
-    :func:`identify_payload`."""
+    out, for the record (:class:`PayloadEstimate`'s fields); whether the arm identified
+    from ``base`` differs from the one given (the difference method changed it). ``opt``:
+    the options of :func:`identify_payload`."""
     inner = arm.model if isinstance(arm, ArmModel) else arm
     kin = inner.robot if isinstance(inner, IdentifiedModel) else inner
     d = opt["drive"]
@@ -513,9 +519,9 @@ def _log_route(
         same = _unchanged(inner, the_arm)
         notes.append(same or note)
     W, yv, route, kept = log_rows(the_arm, rec, still_joints(logs, d), cols, A, notes)
-    route += ", difference" if base is not None and same is None else ""
+    differenced = base is not None and same is None
     record = {"preprocessing": prep, "recordings": rec.summary(), "skipped": rec.skipped}
-    return W, yv, route, kept, record | {"noise_rms": filtered_noise_rms(rec)}
+    return W, yv, route, kept, record | {"noise_rms": filtered_noise_rms(rec)}, differenced
 
 
 def _unchanged(given: Robot | IdentifiedModel, arm: ArmModel) -> str | None:
