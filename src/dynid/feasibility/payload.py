@@ -335,15 +335,12 @@ def identify_payload(
     kept: NDArray[np.bool_] | None = None
     record: dict[str, Any] = {}
     if isinstance(data, StaticDataset):
-        same = None
         if base is None:
-            the_arm = arm_model(arm, drive=d, friction=friction)
+            the_arm, differenced = arm_model(arm, drive=d, friction=friction), False
         else:
             the_arm, note = unloaded_arm(kin, base[0], rtol=rtol, drive=d)  # type: ignore[arg-type]
-            same = _unchanged(inner, the_arm)
-            notes.append(same or note)
+            differenced = _difference_said(inner, the_arm, note, notes)
         W, yv, route = static_load_rows(the_arm, data, cols, A, gravity_only, notes)
-        differenced = base is not None and same is None
     else:
         opt = dict(structure=structure, drive=d, friction=friction, cutoff_hz=cutoff_hz)
         opt |= dict(decimate=decimate, max_gap_s=max_gap_s, rtol=rtol)
@@ -381,8 +378,8 @@ def _estimate(
     est = np.asarray(fit.beta)
     cov = np.asarray(fit.covariance)[:p, :p]
     prep = record.get("preprocessing") or {}
+    cols = np.ones(W.shape[1], bool) if kept is None else kept
     if prep.get("cutoff_hz"):  # filtered rows: their noise is serially correlated
-        cols = np.ones(W.shape[1], bool) if kept is None else kept
         rate = prep["sample_rate_hz"] / prep["decimate"]
         resid = yv - W[:, cols] @ est[cols]
         factor, lags = serial_correlation_factor(resid, n, int(np.ceil(rate / prep["cutoff_hz"])))
@@ -391,6 +388,7 @@ def _estimate(
             f"standard deviations widened x{np.sqrt(factor):.3g} for the serial correlation "
             f"of the filtered samples (Newey-West, {lags} lags)"
         )
+    if not static:  # static configurations are exchangeable: their blocks spread alike
         cov = _held_out_spread(cov, W[:, cols], yv, n, notes)
     phi, active, marg = load_parameters(est[:p], float(np.sqrt(cov[0, 0])), W, margin, notes)
     m, c, I, sm, sc, si = summary(phi, cov, p == 10)
@@ -448,8 +446,9 @@ def _held_out_spread(
 ) -> NDArray[np.float64]:
     """``cov`` (the load's ``p`` parameters) with each variance raised to the spread of the
     estimate over :data:`~dynid.feasibility.payload_fit.HELD_OUT_BLOCKS` held-out time
-    blocks where that is larger (:func:`~dynid.feasibility.payload_fit.block_jackknife_covariance`;
-    the correlations kept), and a note when it widened a standard deviation by more than
+    blocks (``n`` rows a sample) where that is larger
+    (:func:`~dynid.feasibility.payload_fit.block_jackknife_covariance`; the correlations
+    kept), and a note when it widened a standard deviation by more than
     10 %: an error of the arm's model that varies along the motion, which the residual's
     covariance does not see."""
     jack = block_jackknife_covariance(W, yv, n)
@@ -497,9 +496,8 @@ def _log_route(
     used = max(p.decimate for p in rec.pieces)
     prep = {"cutoff_hz": rec.cutoff_hz, "cutoff_source": source, "decimate": used}
     prep |= {"max_gap_s": gap, "sample_rate_hz": rec.pieces[0].sample_rate_hz}
-    same = None
     if base is None:
-        the_arm = arm_model(arm, drive=d, friction=opt["friction"])
+        the_arm, differenced = arm_model(arm, drive=d, friction=opt["friction"]), False
     else:
         structure = opt["structure"]
         if structure is None:
@@ -516,29 +514,32 @@ def _log_route(
             drive=d,
             rtol=opt["rtol"],
         )
-        same = _unchanged(inner, the_arm)
-        notes.append(same or note)
+        differenced = _difference_said(inner, the_arm, note, notes)
     W, yv, route, kept = log_rows(the_arm, rec, still_joints(logs, d), cols, A, notes)
-    differenced = base is not None and same is None
     record = {"preprocessing": prep, "recordings": rec.summary(), "skipped": rec.skipped}
     return W, yv, route, kept, record | {"noise_rms": filtered_noise_rms(rec)}, differenced
 
 
-def _unchanged(given: Robot | IdentifiedModel, arm: ArmModel) -> str | None:
-    """The note of a difference method that changed nothing: the arm identified from the
-    unloaded data is the identified model given (its coefficients to 1e-9), as when the
-    unloaded recordings are the ones it was identified from; None otherwise."""
-    if not isinstance(given, IdentifiedModel) or not isinstance(arm.model, IdentifiedModel):
-        return None
-    a, b = np.asarray(given.fit.beta), np.asarray(arm.model.fit.beta)
-    if a.shape != b.shape or not np.allclose(a, b, rtol=1e-9, atol=0.0):
-        return None
-    return (
+def _difference_said(
+    given: Robot | IdentifiedModel, arm: ArmModel, note: str, notes: list[str]
+) -> bool:
+    """Whether the arm identified from the unloaded data differs from the identified model
+    given (its coefficients to 1e-9), with ``note`` (how it was identified) appended to
+    ``notes`` when it does, else a note that the difference method changed nothing (as
+    when the unloaded recordings are the ones the model was identified from)."""
+    same = False
+    if isinstance(given, IdentifiedModel) and isinstance(arm.model, IdentifiedModel):
+        a, b = np.asarray(given.fit.beta), np.asarray(arm.model.fit.beta)
+        same = a.shape == b.shape and bool(np.allclose(a, b, rtol=1e-9, atol=0.0))
+    notes.append(
         "difference method: the arm identified from the --unloaded data is the --model's own "
         "(the same recordings, structure and preprocessing it was identified from), so the "
         "result is the one without --unloaded; the difference method cancels the arm's model "
         "errors only with a recording of the loaded motion repeated without the load"
+        if same
+        else note
     )
+    return not same
 
 
 def _items(
