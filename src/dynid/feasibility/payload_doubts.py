@@ -142,12 +142,13 @@ def inertia_doubts(
     if ratio is not None and ratio > FLOOR_FAIR:
         cause = (
             f"the fit leaves {ratio:.3g} x the torque noise ({residual_rms:.2g} N m RMS): "
-            "torques the arm's model does not explain go into the inertia"
+            "torques the arm's model does not explain (its links, friction, drive or "
+            "armature, or the states' noise at a high cut-off) go into the inertia"
         )
         hint = (
             "record the same motion without the load and give it as --unloaded (the "
-            "difference method cancels the arm's model errors), or validate the arm's model "
-            "on a log without the load"
+            "difference method cancels the arm's model errors), validate the arm's model "
+            "on a log without the load, or keep the cut-off the motion needs"
         )
         if difference:
             hint = (
