@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import argparse
 import json
+import logging
 from pathlib import Path
 
 import numpy as np
@@ -13,11 +14,12 @@ import pytest
 import dynid
 from dynid.cli.__main__ import main
 from dynid.cli.common import load_prior
-from dynid.cli.console import Console
+from dynid.cli.console import Console, log_to_stderr
 from dynid.exceptions import UnknownNameError
 from dynid.io.robot_file import load_robot
 from dynid.model import fr3 as fr3_module
 from dynid.model.builtin import BUILTIN_ROBOTS, builtin_robot
+from dynid.progress import NOTE
 
 from conftest import random_states
 
@@ -84,16 +86,35 @@ def test_builtin_names_read_through_one_table():
         builtin_robot("ur5")
 
 
-def test_prior_fr3_is_said_to_be_the_pandas(capsys):
-    """--prior fr3 prints one note that its link parameters are the Panda's; -q silences it."""
-    args = argparse.Namespace(prior="fr3", prior_base=None, prior_tip=None)
-    prior = load_prior(args, dynid.fr3(), Console("identify"))
-    assert prior is not None and prior.name == "fr3"
-    err = capsys.readouterr().err.strip().splitlines()
-    assert err == [f"dynid identify: note: --prior fr3: {fr3_module.FR3_PARAMETER_NOTE}"]
+def test_fr3_parameters_are_said_once_per_run_where_the_name_is_resolved(
+    tmp_path, capsys, monkeypatch
+):
+    """Regression (only --prior fr3 said that the FR3's link parameters are the Panda's;
+    acquire-static, simulate, payload, validate and observe --params said nothing): the
+    note is logged where the name is resolved, so every command on fr3 prints it, once per
+    run however often the name is resolved (--robot and --prior); -q silences it; the
+    Panda has none."""
+    root = logging.getLogger()  # a process without logging of its own, as the command's
+    monkeypatch.setattr(root, "handlers", [])
+    monkeypatch.setattr(root, "level", root.level)
+    line = f"dynid acquire-static: note: {fr3_module.FR3_PARAMETER_NOTE}"
+    out = str(tmp_path / "s.csv")
+    for robot, quiet, said in (("fr3", [], [line]), ("fr3", ["-q"], []), ("panda", [], [])):
+        argv = ["acquire-static", "--robot", robot, "--n", "5", "--seed", "1", "--out", out]
+        assert main(argv + quiet) == 0
+        err = capsys.readouterr().err.splitlines()
+        assert [s for s in err if "note:" in s] == said
+    log_to_stderr("identify", NOTE)
+    for run in range(2):
+        if run:
+            log_to_stderr("identify", NOTE)  # the next run says it again
+        for _ in range(2):  # --robot fr3 --prior fr3
+            load_robot("fr3")
+            args = argparse.Namespace(prior="fr3", prior_base=None, prior_tip=None)
+            assert load_prior(args, dynid.fr3(), Console("identify")) is not None
+        err = capsys.readouterr().err.strip().splitlines()
+        assert err == [f"dynid identify: note: {fr3_module.FR3_PARAMETER_NOTE}"]
     assert "Panda's" in err[0]
-    load_prior(args, dynid.fr3(), Console("identify", quiet=True))
-    assert capsys.readouterr().err == ""
 
 
 def test_identify_robot_fr3_runs_on_data_acquired_within_its_limits(tmp_path):

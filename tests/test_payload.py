@@ -32,6 +32,7 @@ from dynid.feasibility.payload import (
 from dynid.identification.data import StaticDataset
 from dynid.io.drive_file import drive_of_robot_file
 from dynid.io.model_json import load_model_json
+from dynid.io.payload_json import payload_to_dict
 from dynid.io.static_data import save_static_csv
 from dynid.model.inertia import inertia6_from_matrix, phi_from_inertial
 from dynid.signals import lowpass_noise_gain
@@ -109,7 +110,6 @@ def test_load_in_another_frame_and_franka_convention(tmp_path):
     loaded = arm.with_tool(np.eye(4), MASS, COM, _inertia(), parent="tcp", name="load")
     est = identify_payload(arm, _static(loaded, 200, 0.0, 3), frame="tcp")
     np.testing.assert_allclose(est.com, COM, atol=1e-10)
-    from dynid.io.payload_json import payload_to_dict
 
     d = payload_to_dict(est, arm)
     R, p = T[:3, :3], T[:3, 3]
@@ -132,15 +132,21 @@ def test_link_params_from_frame_matches_with_tool():
 
 
 def test_inconsistent_least_squares_is_projected_by_the_lmi():
-    """A load no body can have (triangle inequality violated) comes out consistent."""
+    """A load no body can have (triangle inequality violated) comes out consistent.
+    Regression (an inertia the LMI set on its bound was handed to setLoad as determined):
+    the whole inertia is called not determined, a warning says the bound set it, and
+    setLoad's inertia is not written."""
     arm = dynid.panda()
     bad = np.diag([0.001, 0.001, 0.004])  # 0.001 + 0.001 < 0.004
     A = link_params_from_frame(arm.frame("flange").T_link_frame)
     phi = np.array(arm.phi)
     phi[6] += A @ phi_from_inertial(MASS, COM, bad)
     data = _static(arm.with_params(phi), 100, 0.0, 5)
-    est = identify_payload(arm, data, margin=1e-6)
+    with pytest.warns(dynid.DynidWarning, match=r"set it on its bound, not the data"):
+        est = identify_payload(arm, data, margin=1e-6)
     assert est.constraint_active and any("LMI" in s for s in est.notes)
+    assert est.undetermined == ("Ixx", "Ixy", "Ixz", "Iyy", "Iyz", "Izz")
+    assert not est.plausible and payload_to_dict(est, arm)["load_inertia"] is None
     assert pseudo_inertia_margin(est.phi) >= 1e-6 * (1 - 1e-4)
     lam = np.linalg.eigvalsh(est.inertia)
     assert lam[0] + lam[1] >= lam[2] - 1e-9 and abs(est.mass - MASS) < 0.05 * MASS

@@ -173,7 +173,10 @@ def test_a_robot_whose_rotor_inertias_are_to_be_identified_is_refused():
 
 def test_cli_model_preprocessing_recorded_and_several_unloaded_files(logs, tmp_path):
     """--model: its cut-off reused and recorded in payload.json; --unloaded takes several
-    files, the arm identified from them with the model's terms."""
+    files, the arm identified from them with the model's terms. Regression (--unloaded
+    gave numbers identical to its absence, silently): --unloaded with the recordings the
+    model was identified from re-identifies the model itself, which a note says (the route
+    no difference, the estimate the one without); one of them alone makes another arm."""
     loaded, unloaded = logs
     for k, log in enumerate(loaded):
         save_torque_log(tmp_path / f"l{k}.csv", log)
@@ -193,7 +196,12 @@ def test_cli_model_preprocessing_recorded_and_several_unloaded_files(logs, tmp_p
     argv = ["payload", "--model", str(tmp_path / "id.json"), "--data", *data, "--unloaded"]
     argv += [str(tmp_path / "u0.csv"), str(tmp_path / "u1.csv"), "-q"]
     assert main(argv + ["--out", str(tmp_path / "q")]) == 0
-    d = json.loads((tmp_path / "q" / "payload.json").read_text())
+    same = json.loads((tmp_path / "q" / "payload.json").read_text())
+    assert same["route"] == d["route"] == "2 torque logs" and same["inertia"] == d["inertia"]
+    assert any("is the --model's own (the same recordings" in note for note in same["notes"])
+    argv[-3:] = [str(tmp_path / "u0.csv"), "-q"]
+    assert main(argv + ["--out", str(tmp_path / "r")]) == 0
+    d = json.loads((tmp_path / "r" / "payload.json").read_text())
     assert "difference" in d["route"] and abs(d["mass"] - MASS) < 0.01 * MASS
     assert any("links + armature + viscous (given)" in note for note in d["notes"])
 

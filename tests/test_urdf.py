@@ -365,8 +365,9 @@ def _gripper_arm(jaw: str) -> str:
 def test_a_moving_branch_off_the_chain_is_named_with_its_mass_and_fixed_links_merged(caplog):
     """Regression (a gripper's moving jaw, 12 g, dropped from the model with nothing said,
     even with -v): the jaw and the pad fixed to it are named once with their 0.015 kg, the
-    fixed TCP is logged as merged into the arm; the model's mass is the file's arm and
-    TCP, 1.1 kg; with a fixed jaw joint nothing is left out and the mass is 1.115 kg."""
+    fixed TCP is logged as merged into the arm, and noted with its 0.1 kg as it lies
+    beyond the tip; the model's mass is the file's arm and TCP, 1.1 kg; with a fixed jaw
+    joint nothing is left out and the mass is 1.115 kg."""
     import logging
 
     with caplog.at_level(logging.INFO, logger="dynid"):
@@ -381,8 +382,11 @@ def test_a_moving_branch_off_the_chain_is_named_with_its_mass_and_fixed_links_me
     ]
     merged = [r.getMessage() for r in caplog.records if "merged" in r.getMessage()]
     assert merged == [
+        "URDF text: links fixed to the chain beyond its own (past the tip or off its side) "
+        "merged into its bodies, their inertials added (0.1 kg in all): tcp (0.1 kg) into "
+        "arm; for an arm run without them, leave them out of the URDF",
         "URDF text: links fixed to the chain merged (their inertials added): tip into arm "
-        "(0 kg), tcp into arm (0.1 kg)"
+        "(0 kg), tcp into arm (0.1 kg)",
     ]
     assert robot.phi[:, 0].sum() == pytest.approx(1.1, rel=1e-15)
     with warnings.catch_warnings():
@@ -609,3 +613,37 @@ def test_absurd_axes_and_masses_are_refused_by_every_reader():
             q_min=[-1.0], q_max=[1.0], dq_max=[1.0], ddq_max=[1.0], tau_max=[1.0],
             gravity=[0.0, 0.0, -9.81],
         )  # fmt: skip
+
+
+def test_a_hand_merged_beyond_the_tip_is_noted_with_its_mass(caplog):
+    """Regression (example-robot-data's panda.urdf read to tip panda_link8 for --robot or
+    --prior: the hand, 0.73 kg, was merged into link 7 silently): one note names it with
+    its mass (the URDF's <mass>); link 7 is Pinocchio's body of joint 7 (link 7, link 8 and
+    the hand); read to tip panda_hand, the hand is a link of the chain and no note."""
+    import xml.etree.ElementTree as ET
+
+    pin = pytest.importorskip("pinocchio")
+    from dynid.progress import NOTE
+    from dynid.workflows.prior import load_prior
+
+    urdf = robot_data_urdf("panda_description/urdf/panda.urdf")
+    hand = ET.parse(urdf).getroot().find("link[@name='panda_hand']/inertial/mass")
+    assert hand is not None
+    said = f"panda_hand ({float(hand.get('value', 'nan')):.4g} kg) into panda_link7"
+
+    def notes(read):
+        caplog.clear()
+        with caplog.at_level(NOTE, logger="dynid"), warnings.catch_warnings():
+            warnings.simplefilter("ignore", dynid.DynidWarning)  # the fingers left out
+            robot = read()
+        return robot, [r.getMessage() for r in caplog.records if r.levelno == NOTE]
+
+    robot, lines = notes(lambda: load_urdf(urdf, tip_link="panda_link8"))
+    assert len(lines) == 1 and said in lines[0] and "0.73 kg in all" in lines[0]
+    full = pin.buildModelFromUrdf(urdf)
+    mass7 = full.inertias[full.getJointId("panda_joint7")].mass
+    assert robot.mass[6] == pytest.approx(mass7, rel=1e-12)
+    _, lines = notes(lambda: load_prior(urdf, robot, tip="panda_link8"))
+    assert len(lines) == 1 and said in lines[0]
+    _, lines = notes(lambda: load_urdf(urdf, tip_link="panda_hand"))
+    assert lines == []

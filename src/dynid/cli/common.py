@@ -352,19 +352,12 @@ def add_consistency_options(p: argparse.ArgumentParser) -> None:
     )
 
 
-def note_prior(args: argparse.Namespace, console: Console) -> None:
-    """Print the note of a built-in ``--prior`` on its parameters (``fr3``: the Panda's)."""
-    spec = getattr(args, "prior", None)
-    if isinstance(spec, str) and spec in BUILTIN_ROBOTS and BUILTIN_ROBOTS[spec].parameter_note:
-        console.note(f"--prior {spec}: {BUILTIN_ROBOTS[spec].parameter_note}")
-
-
 def load_prior(args: argparse.Namespace, robot: Robot, console: Console) -> Robot | None:
     """The prior robot named by ``--prior`` (None: the robot's own inertials, or the generic
     prior without any), checked against
-    ``robot`` (:func:`dynid.workflows.prior.load_prior`); a built-in prior's note on its
-    parameters is printed."""
-    note_prior(args, console)
+    ``robot`` (:func:`dynid.workflows.prior.load_prior`; a built-in prior's note on its
+    parameters is logged where its name is resolved,
+    :func:`~dynid.model.builtin.builtin_robot`)."""
     return workflow_prior(args.prior, robot, base=args.prior_base, tip=args.prior_tip)
 
 

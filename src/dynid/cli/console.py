@@ -145,10 +145,30 @@ class LogFormat(logging.Formatter):
         return f"{record.levelname} {record.name}: {record.getMessage()}"
 
 
+class NoteOnce(logging.Filter):
+    """Lets a note (level :data:`~dynid.progress.NOTE`) through once: the same note logged
+    again in the run (a robot name resolved for ``--robot`` and ``--prior``) is dropped."""
+
+    def __init__(self) -> None:
+        super().__init__()
+        self.said: set[str] = set()
+
+    def filter(self, record: logging.LogRecord) -> bool:
+        """False for a note already let through."""
+        if record.levelno != NOTE:
+            return True
+        text = record.getMessage()
+        if text in self.said:
+            return False
+        self.said.add(text)
+        return True
+
+
 def log_to_stderr(command: str, level: int) -> None:
     """Print the library's log records of ``level`` and above on stderr as ``command``'s
-    own lines (:class:`LogFormat`), as :func:`logging.basicConfig` does: only when the
-    process has no logging set up of its own (a handler of an earlier run replaced)."""
+    own lines (:class:`LogFormat`; each note once, :class:`NoteOnce`), as
+    :func:`logging.basicConfig` does: only when the process has no logging set up of its
+    own (a handler of an earlier run replaced)."""
     root = logging.getLogger()
     for h in [h for h in root.handlers if isinstance(h.formatter, LogFormat)]:
         root.removeHandler(h)
@@ -156,5 +176,6 @@ def log_to_stderr(command: str, level: int) -> None:
         return
     handler = logging.StreamHandler()
     handler.setFormatter(LogFormat(command))
+    handler.addFilter(NoteOnce())
     root.addHandler(handler)
     root.setLevel(level)

@@ -108,7 +108,6 @@ from .common import (
     add_subcommand,
     load_drive_arg,
     load_robot,
-    note_prior,
     number,
     options_from,
     output_path,
@@ -259,7 +258,6 @@ def run(args: argparse.Namespace, console: Console) -> int:
         drive=load_drive_arg(args, robot.n),
         total_mass=parse_mass_band(args.total_mass),
     )
-    note_prior(args, console)
     result = identify_files(robot, args.data, options)
     files = [save_model_json(args.out / "identification.json", result.model)]
     text = [format_identification(result.model)]

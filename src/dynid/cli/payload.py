@@ -11,15 +11,20 @@ are its model's whole prediction: an identified model's armature (or rotor inert
 friction, a robot's drive (--drive, or the [drive] table of a --robot TOML) and friction,
 a feasible.json's drive and friction. With --unloaded DATA0 ... (the same kind of data
 without the load) the arm is identified from DATA0 first (difference method), with the
-structure identify chooses (or --model's). The estimate is physically consistent
-(pseudo-inertia LMI). --columns/--units read files of other tools.
+structure identify chooses (or --model's); it cancels the arm's model errors when DATA0
+repeats the loaded motion (the recordings --model was identified from give the model
+itself, which a note says). The estimate is physically consistent (pseudo-inertia LMI).
+--columns/--units read files of other tools.
 
 A mass less than 3 standard deviations above zero, or a CoM farther from --frame than
 the arm is long, is warned about and no setLoad values are written. An inertia whose
 moments lie less than 3 standard deviations above zero, or whose products have a
-standard deviation above a third of their largest possible magnitude, is not determined:
-warned about (naming the elements, and the fit's residual against the torque noise), and
-setLoad's load_inertia is not written.
+standard deviation above a third of their largest possible magnitude, or that the
+consistency constraint set on its bound, is not determined: warned about (naming the
+elements, the fit's residual against the torque noise and what to record), and setLoad's
+load_inertia is not written. Standard deviations from torque logs are widened to the
+estimate's spread over 10 held-out time blocks where that is larger (errors of the arm's
+model that vary along the motion).
 
 Writes DIR/payload.json (mass, com [m] in --frame, inertia about the CoM, their std, the
 preprocessing used, and libfranka's setLoad values load_mass, F_x_Cload, load_inertia)

@@ -62,7 +62,6 @@ from .common import (
     count_type,
     flag,
     load_robot,
-    note_prior,
     options_from,
     output_path,
     parse_mass_band,
@@ -152,7 +151,6 @@ def run(args: argparse.Namespace, console: Console) -> int:
         total_mass_band=not args.no_total_mass,
         total_mass=parse_mass_band(args.total_mass),
     )
-    note_prior(args, console)
     retrieval = retrieve_files(
         source,
         options,

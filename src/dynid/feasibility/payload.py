@@ -31,7 +31,9 @@ or a robot's links with its drive's known rotor inertias and its own friction.
   the arm is first identified from the unloaded data with identification's structure
   selection, or the structure of the identified model given
   (:func:`~dynid.feasibility.payload_arm.unloaded_arm`), at the loaded data's cut-off and
-  decimation; model errors common to both recordings cancel.
+  decimation; model errors common to both recordings cancel (when the unloaded data
+  repeat the loaded motion; the recordings an identified model given was identified from
+  give that model again, which a note says).
 
 Physical consistency: the least-squares estimate is kept when its pseudo-inertia is
 positive definite with ``lambda_min(J) >= margin tr(J)``; otherwise the estimate closest to
@@ -42,7 +44,12 @@ the constraint is ``m > 0``.
 Standard deviations: the heteroscedasticity-consistent (HC1) covariance of the least
 squares (relative, multiplicative sensor noise gives rows of unequal variance), carried to
 mass, CoM and inertia about the CoM through the Jacobian of that map (central differences).
-When the LMI is active they describe the unconstrained estimate.
+Torque logs: widened for the filtered rows' serial correlation (Newey-West) and, each
+parameter's variance, to the estimate's spread over held-out time blocks where that is
+larger (:func:`~dynid.feasibility.payload_fit.block_jackknife_covariance`): an error of
+the arm's model that varies along the motion moves the estimate, which the residual does
+not show. When the LMI is active they describe the unconstrained estimate, and the
+inertia, set by the bound, is not determined.
 
 Doubts (:attr:`PayloadEstimate.doubts`, each also a :class:`~dynid.exceptions.DynidWarning`):
 a mass less than :data:`MIN_MASS_SIGMAS` standard deviations above zero (no load the data
@@ -79,11 +86,19 @@ from ..identification.model import IdentifiedModel
 from ..identification.recordings import prepare_recordings
 from ..identification.structure import Structure
 from ..model.drive import Drive
+from ..model.inertia import INERTIA_ORDER
 from ..model.robot import Robot
 from .lmi import phi_from_pseudo_inertia, pseudo_inertia
 from .payload_arm import ArmFriction, ArmModel, arm_model, model_structure, unloaded_arm
 from .payload_doubts import doubts_about, inertia_doubts, undetermined_inertia
-from .payload_fit import fit_load, load_parameters, serial_correlation_factor, summary
+from .payload_fit import (
+    HELD_OUT_BLOCKS,
+    block_jackknife_covariance,
+    fit_load,
+    load_parameters,
+    serial_correlation_factor,
+    summary,
+)
 from .payload_rows import (
     filtered_noise_rms,
     log_preparation,
@@ -127,7 +142,8 @@ class PayloadEstimate:
         Covariance of the estimated entries of ``phi`` (``p`` = 10, or 4 for ``g`` only).
     route : str
         ``"static M and g"``, ``"static g"`` or ``"torque log"`` (``", difference"`` appended
-        for the difference method).
+        for the difference method, unless the arm identified from the unloaded data is the
+        identified model given: then a note says so).
     inertia_identified : bool
     constraint_active : bool
         The LMI changed the least-squares estimate.
@@ -320,23 +336,24 @@ def identify_payload(
     record: dict[str, Any] = {}
     if isinstance(data, StaticDataset):
         if base is None:
-            the_arm = arm_model(arm, drive=d, friction=friction)
+            the_arm, differenced = arm_model(arm, drive=d, friction=friction), False
         else:
             the_arm, note = unloaded_arm(kin, base[0], rtol=rtol, drive=d)  # type: ignore[arg-type]
-            notes.append(note)
+            differenced = _difference_said(inner, the_arm, note, notes)
         W, yv, route = static_load_rows(the_arm, data, cols, A, gravity_only, notes)
     else:
         opt = dict(structure=structure, drive=d, friction=friction, cutoff_hz=cutoff_hz)
         opt |= dict(decimate=decimate, max_gap_s=max_gap_s, rtol=rtol)
         logs = cast(list[TorqueLog], list(items))
         without = None if base is None else cast(list[TorqueLog], list(base))
-        W, yv, route, kept, record = _log_route(
+        W, yv, route, kept, record, differenced = _log_route(
             arm, logs, names, without, unloaded_names, cols, A, notes, opt
         )
-    if base is not None:
-        route += ", difference"
     p = 4 if (static and gravity_only) else 10
-    return _estimate(W, yv, kept, p, static, rtol, margin, kin, frame, route, notes, record)
+    route += ", difference" if differenced else ""
+    return _estimate(
+        W, yv, kept, p, static, rtol, margin, kin, frame, route, notes, record, differenced
+    )
 
 
 def _estimate(
@@ -352,15 +369,17 @@ def _estimate(
     route: str,
     notes: list[str],
     record: dict[str, Any],
+    difference: bool,
 ) -> PayloadEstimate:
-    """The load's estimate from its rows: least squares, consistency, doubts (warned)."""
+    """The load's estimate from its rows: least squares, consistency, doubts (warned);
+    ``difference``: the arm was identified from unloaded data (its hint differs)."""
     n, k = kin.n, kin.frame(frame).link
     fit = fit_load(W, yv, kept, rtol, p, static)
     est = np.asarray(fit.beta)
     cov = np.asarray(fit.covariance)[:p, :p]
     prep = record.get("preprocessing") or {}
+    cols = np.ones(W.shape[1], bool) if kept is None else kept
     if prep.get("cutoff_hz"):  # filtered rows: their noise is serially correlated
-        cols = np.ones(W.shape[1], bool) if kept is None else kept
         rate = prep["sample_rate_hz"] / prep["decimate"]
         resid = yv - W[:, cols] @ est[cols]
         factor, lags = serial_correlation_factor(resid, n, int(np.ceil(rate / prep["cutoff_hz"])))
@@ -369,12 +388,25 @@ def _estimate(
             f"standard deviations widened x{np.sqrt(factor):.3g} for the serial correlation "
             f"of the filtered samples (Newey-West, {lags} lags)"
         )
+    if not static:  # static configurations are exchangeable: their blocks spread alike
+        cov = _held_out_spread(cov, W[:, cols], yv, n, notes)
     phi, active, marg = load_parameters(est[:p], float(np.sqrt(cov[0, 0])), W, margin, notes)
     m, c, I, sm, sc, si = summary(phi, cov, p == 10)
     doubts = doubts_about(kin, frame, m, sm, c)
-    undetermined = undetermined_inertia(I, si) if p == 10 and not doubts else ()
+    by_std = undetermined_inertia(I, si) if p == 10 and not doubts else ()
+    at_bound = active and p == 10 and not doubts  # the bound, not the data, set it
+    undetermined = tuple(f"I{name}" for name in INERTIA_ORDER) if at_bound else by_std
     noise = record.get("noise_rms")
-    about_inertia = inertia_doubts(undetermined, I, si, fit.residual_rms, noise)
+    about_inertia = inertia_doubts(
+        by_std,
+        I,
+        si,
+        fit.residual_rms,
+        noise,
+        at_bound=at_bound,
+        margin=margin,
+        difference=difference,
+    )
     for line in doubts + about_inertia:
         warnings.warn(line, DynidWarning, stacklevel=3)
     return PayloadEstimate(
@@ -405,6 +437,40 @@ def _estimate(
     )
 
 
+def _held_out_spread(
+    cov: NDArray[np.float64],
+    W: NDArray[np.float64],
+    yv: NDArray[np.float64],
+    n: int,
+    notes: list[str],
+) -> NDArray[np.float64]:
+    """``cov`` (the load's ``p`` parameters) with each variance raised to the spread of the
+    estimate over :data:`~dynid.feasibility.payload_fit.HELD_OUT_BLOCKS` held-out time
+    blocks (``n`` rows a sample) where that is larger
+    (:func:`~dynid.feasibility.payload_fit.block_jackknife_covariance`; the correlations
+    kept), and a note when it widened a standard deviation by more than
+    10 %: an error of the arm's model that varies along the motion, which the residual's
+    covariance does not see."""
+    jack = block_jackknife_covariance(W, yv, n)
+    p = cov.shape[0]
+    if jack is None:
+        notes.append(
+            "the standard deviations were not checked on held-out time blocks (a block alone "
+            "excites some direction of the load, or the log is too short)"
+        )
+        return cov
+    var = np.diag(cov)
+    widen = np.sqrt(np.maximum(1.0, np.diag(jack)[:p] / np.where(var > 0, var, np.inf)))
+    if widen.max() > 1.1:
+        notes.append(
+            f"standard deviations widened up to x{widen.max():.3g} to the spread of the "
+            f"estimate over {HELD_OUT_BLOCKS} held-out time blocks (block jackknife): the "
+            "fit's errors vary along the motion (the arm's model), more than the residual's "
+            "covariance says"
+        )
+    return cov * np.outer(widen, widen)
+
+
 def _log_route(
     arm: Robot | IdentifiedModel | ArmModel,
     logs: list[TorqueLog],
@@ -415,11 +481,12 @@ def _log_route(
     A: NDArray[np.float64],
     notes: list[str],
     opt: dict[str, Any],
-) -> tuple[NDArray[np.float64], NDArray[np.float64], str, NDArray[np.bool_], dict[str, Any]]:
+) -> tuple[NDArray[np.float64], NDArray[np.float64], str, NDArray[np.bool_], dict[str, Any], bool]:
     """The rows of recordings (:func:`~dynid.feasibility.payload_rows.log_rows`) with the
     arm given or identified from ``base``; the preprocessing, recordings and pieces left
-    out, for the record (:class:`PayloadEstimate`'s fields). ``opt``: the options of
-    :func:`identify_payload`."""
+    out, for the record (:class:`PayloadEstimate`'s fields); whether the arm identified
+    from ``base`` differs from the one given (the difference method changed it). ``opt``:
+    the options of :func:`identify_payload`."""
     inner = arm.model if isinstance(arm, ArmModel) else arm
     kin = inner.robot if isinstance(inner, IdentifiedModel) else inner
     d = opt["drive"]
@@ -430,7 +497,7 @@ def _log_route(
     prep = {"cutoff_hz": rec.cutoff_hz, "cutoff_source": source, "decimate": used}
     prep |= {"max_gap_s": gap, "sample_rate_hz": rec.pieces[0].sample_rate_hz}
     if base is None:
-        the_arm = arm_model(arm, drive=d, friction=opt["friction"])
+        the_arm, differenced = arm_model(arm, drive=d, friction=opt["friction"]), False
     else:
         structure = opt["structure"]
         if structure is None:
@@ -447,10 +514,32 @@ def _log_route(
             drive=d,
             rtol=opt["rtol"],
         )
-        notes.append(note)
+        differenced = _difference_said(inner, the_arm, note, notes)
     W, yv, route, kept = log_rows(the_arm, rec, still_joints(logs, d), cols, A, notes)
     record = {"preprocessing": prep, "recordings": rec.summary(), "skipped": rec.skipped}
-    return W, yv, route, kept, record | {"noise_rms": filtered_noise_rms(rec)}
+    return W, yv, route, kept, record | {"noise_rms": filtered_noise_rms(rec)}, differenced
+
+
+def _difference_said(
+    given: Robot | IdentifiedModel, arm: ArmModel, note: str, notes: list[str]
+) -> bool:
+    """Whether the arm identified from the unloaded data differs from the identified model
+    given (its coefficients to 1e-9), with ``note`` (how it was identified) appended to
+    ``notes`` when it does, else a note that the difference method changed nothing (as
+    when the unloaded recordings are the ones the model was identified from)."""
+    same = False
+    if isinstance(given, IdentifiedModel) and isinstance(arm.model, IdentifiedModel):
+        a, b = np.asarray(given.fit.beta), np.asarray(arm.model.fit.beta)
+        same = a.shape == b.shape and bool(np.allclose(a, b, rtol=1e-9, atol=0.0))
+    notes.append(
+        "difference method: the arm identified from the --unloaded data is the --model's own "
+        "(the same recordings, structure and preprocessing it was identified from), so the "
+        "result is the one without --unloaded; the difference method cancels the arm's model "
+        "errors only with a recording of the loaded motion repeated without the load"
+        if same
+        else note
+    )
+    return not same
 
 
 def _items(

@@ -14,8 +14,11 @@ than :data:`MIN_INERTIA_SIGMAS` standard deviations above zero, or a product of 
 whose standard deviation exceeds a :data:`MIN_INERTIA_SIGMAS`-th of the largest magnitude
 a rigid body allows it (half the third moment: ``|Ixy| <= Izz / 2``), is not determined
 by the data (a load that barely rotates, or torques the arm's model leaves, which the
-inertia absorbs). :func:`inertia_doubts` says which, with the fit's residual against the
-torque noise; the mass and CoM are still handed on, the inertia is not.
+inertia absorbs). An inertia the pseudo-inertia LMI moved onto the consistency bound is
+not determined as a whole: the least squares gave no body's inertia, and the bound, not
+the data, sets the result (the torques the arm's model leaves, as a rule).
+:func:`inertia_doubts` says which, with the fit's residual against the torque noise and
+what to record; the mass and CoM are still handed on, the inertia is not.
 """
 
 from __future__ import annotations
@@ -108,32 +111,54 @@ def inertia_doubts(
     std: NDArray[np.float64],
     residual_rms: float,
     noise_rms: float | None,
+    *,
+    at_bound: bool = False,
+    margin: float = 0.0,
+    difference: bool = False,
 ) -> tuple[str, ...]:
     """The doubt about an inertia whose elements ``names`` are not determined
-    (:func:`undetermined_inertia`): each with its value and standard deviation [kg m^2],
-    and the likely cause, the fit's residual [N m] against the torque noise after the
-    low-pass ``noise_rms`` [N m] when known; empty for no names."""
-    if not names:
+    (:func:`undetermined_inertia`), each with its value and standard deviation [kg m^2],
+    or that the LMI of ``margin`` put on its bound (``at_bound``): the likely cause, the
+    fit's residual [N m] against the torque noise after the low-pass ``noise_rms`` [N m]
+    when known, and what to record (``difference``: the arm was identified from unloaded
+    data already); empty for no names and not ``at_bound``."""
+    if not names and not at_bound:
         return ()
     v = inertia6_from_matrix(np.asarray(inertia, dtype=np.float64))
     order = [f"I{n}" for n in INERTIA_ORDER]
     which = ", ".join(f"{n} {v[order.index(n)]:.2g} (std {std[order.index(n)]:.2g})" for n in names)
+    what = []
+    if names:
+        what.append(
+            f"{which} kg m^2 (a moment needs {MIN_INERTIA_SIGMAS:g} std above zero, a product "
+            f"a std under 1/{MIN_INERTIA_SIGMAS:g} of half the third moment)"
+        )
+    if at_bound:
+        what.append(
+            f"the consistency constraint (pseudo-inertia margin {margin:g}) set it on its "
+            "bound, not the data (the least squares gave no body's inertia)"
+        )
     ratio = residual_rms / noise_rms if noise_rms else None
     if ratio is not None and ratio > FLOOR_FAIR:
         cause = (
-            f"the fit leaves {residual_rms:.2g} N m RMS, {ratio:.3g} x the {noise_rms:.2g} N m "
-            "of the torque noise: torques the arm's model does not explain (its friction, "
-            "drive or armature, or the states' noise at a high cut-off) go into the inertia"
+            f"the fit leaves {ratio:.3g} x the torque noise ({residual_rms:.2g} N m RMS): "
+            "torques the arm's model does not explain (its links, friction, drive or "
+            "armature, or the states' noise at a high cut-off) go into the inertia"
         )
         hint = (
-            "validate the arm's model on a log without the load, give --unloaded logs, or "
-            "keep the cut-off the motion needs"
+            "record the same motion without the load and give it as --unloaded (the "
+            "difference method cancels the arm's model errors), validate the arm's model "
+            "on a log without the load, or keep the cut-off the motion needs"
         )
+        if difference:
+            hint = (
+                "longer recordings of one motion with and without the load (the arm fitted "
+                "to the unloaded one carries its noise), turning the flange about every axis"
+            )
     else:
         cause = "the load turns too little or too slowly about some axis for the data to weigh it"
-        hint = "a trajectory that turns the load faster about every axis"
+        hint = "a recording that turns the flange faster, about every axis"
     return (
-        f"the load's inertia is not determined: {which} kg m^2 (a moment needs "
-        f"{MIN_INERTIA_SIGMAS:g} std above zero, a product a std under 1/{MIN_INERTIA_SIGMAS:g} "
-        f"of half the third moment); {cause}; setLoad's inertia is not written; hint: {hint}",
+        f"the load's inertia is not determined: {'; '.join(what)}; {cause}; setLoad's "
+        f"inertia is not written; hint: {hint}",
     )

@@ -8,7 +8,10 @@
   (the closest point in the metric of the data; Wensing, Kim, Slotine, RA-L 2018);
 * :func:`summary`: mass, CoM, inertia about the CoM and their standard deviations;
 * :func:`serial_correlation_factor`: how much the variances of a fit to low-pass filtered
-  samples exceed those of independent rows.
+  samples exceed those of independent rows;
+* :func:`block_jackknife_covariance`: the spread of the estimate over held-out time
+  blocks, which an error of the arm's model that varies along the motion widens (the
+  residual's covariance does not see the part of that error the load's columns absorb).
 """
 
 from __future__ import annotations
@@ -23,7 +26,17 @@ from ..regressors.base import RANK_FLOOR
 from ..regressors.terms import friction_labels
 from .lmi import pseudo_inertia, pseudo_inertia_margin
 
-__all__ = ["fit_load", "load_parameters", "serial_correlation_factor", "summary"]
+__all__ = [
+    "HELD_OUT_BLOCKS",
+    "block_jackknife_covariance",
+    "fit_load",
+    "load_parameters",
+    "serial_correlation_factor",
+    "summary",
+]
+
+#: Contiguous time blocks of :func:`block_jackknife_covariance`.
+HELD_OUT_BLOCKS = 10
 
 
 def summary(phi: NDArray[np.float64], cov: NDArray[np.float64], full: bool):
@@ -224,3 +237,52 @@ def serial_correlation_factor(
         rho = float(np.sum(R[lag:] * R[:-lag])) / var
         f += 2.0 * (1.0 - lag / (L + 1)) * rho
     return max(f, 1.0), L
+
+
+def block_jackknife_covariance(
+    W: NDArray[np.float64], y: NDArray[np.float64], n: int, blocks: int = HELD_OUT_BLOCKS
+) -> NDArray[np.float64] | None:
+    """The delete-one-block jackknife covariance of the least squares ``W b = y``.
+
+    The rows (sample-major, ``n`` a sample) are cut into ``blocks`` contiguous blocks of
+    whole samples; ``b_i`` is the fit without block ``i`` and the covariance
+    ``(K - 1) / K sum_i (b_i - b_bar)(b_i - b_bar)^T`` (``K = blocks``; Kuensch, Ann.
+    Statist. 17, 1989). Each block's normal equations of the column-scaled rows are formed
+    once, so the ``K`` fits cost one pass over the rows.
+
+    Parameters
+    ----------
+    W : ndarray, shape (m, p)
+        The fitted columns only.
+    y : ndarray, shape (m,)
+    n : int
+        Rows per sample.
+    blocks : int
+        ``K`` (at least 2).
+
+    Returns
+    -------
+    ndarray, shape (p, p), or None
+        None when there are fewer than ``2 K`` samples or a fit without a block is
+        singular (that block alone excites some direction).
+    """
+    import scipy.linalg  # as the rest of the module: scipy on first use
+
+    samples = W.shape[0] // n
+    if blocks < 2 or samples < 2 * blocks:
+        return None
+    norms = np.linalg.norm(W, axis=0)
+    s = np.where(norms > 0, norms, 1.0)
+    edges = np.linspace(0, samples, blocks + 1).astype(int) * n
+    G = [(W[a:b] / s).T @ (W[a:b] / s) for a, b in zip(edges[:-1], edges[1:], strict=True)]
+    h = [(W[a:b] / s).T @ y[a:b] for a, b in zip(edges[:-1], edges[1:], strict=True)]
+    G_all, h_all = sum(G), sum(h)
+    est = []
+    for Gi, hi in zip(G, h, strict=True):
+        A = G_all - Gi
+        if np.linalg.cond(A) > 1.0 / RANK_FLOOR**2:  # the normal equations square it
+            return None
+        est.append(scipy.linalg.solve(A, h_all - hi, assume_a="pos") / s)
+    b = np.asarray(est)
+    d = b - b.mean(axis=0)
+    return (blocks - 1) / blocks * (d.T @ d)

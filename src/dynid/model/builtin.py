@@ -2,21 +2,28 @@
 
 Every option that names a robot (``--robot``, ``--prior``, ``--params``) and
 :func:`dynid.io.robot_file.load_robot` read :data:`BUILTIN_ROBOTS`; adding a robot is one
-module in :mod:`dynid.model` and one entry here.
+module in :mod:`dynid.model` and one entry here. A robot whose link parameters are not
+its own (the FR3's are the Panda's) is said so where its name is resolved
+(:func:`builtin_robot`, a log record of level :data:`~dynid.progress.NOTE`, which the
+command line prints once per run).
 """
 
 from __future__ import annotations
 
+import logging
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass
 from types import MappingProxyType
 
 from ..exceptions import UnknownNameError
+from ..progress import NOTE
 from .fr3 import FR3_PARAMETER_NOTE, fr3
 from .panda import panda
 from .robot import Robot
 
 __all__ = ["BuiltinRobot", "BUILTIN_ROBOTS", "builtin_robot"]
+
+_log = logging.getLogger(__name__)
 
 
 @dataclass(frozen=True, slots=True)
@@ -63,7 +70,9 @@ BUILTIN_ROBOTS: Mapping[str, BuiltinRobot] = MappingProxyType(
 
 
 def builtin_robot(name: str) -> Robot:
-    """The built-in robot ``name`` (``"panda"``, ``"fr3"``).
+    """The built-in robot ``name`` (``"panda"``, ``"fr3"``); its
+    :attr:`~BuiltinRobot.parameter_note`, when it has one, is logged at level
+    :data:`~dynid.progress.NOTE`.
 
     Raises
     ------
@@ -76,4 +85,6 @@ def builtin_robot(name: str) -> Robot:
         raise UnknownNameError(
             f"unknown built-in robot {name!r}; available: {sorted(BUILTIN_ROBOTS)}"
         ) from None
+    if entry.parameter_note:
+        _log.log(NOTE, "%s", entry.parameter_note)
     return entry.make()

@@ -6,7 +6,8 @@ tool-centre-point frame) are merged into that link: their inertials are added to
 link hanging off it through a moving joint (a gripper's jaw, fingers, the joints past the
 tip) cannot be merged exactly, as it moves: it is left out with everything below it, and
 its mass is in no link of the model. :func:`off_chain` names both, with their masses (the
-reader warns about a branch with mass and logs a massless one and the merged links).
+reader warns about a branch with mass and logs a massless one; it notes the merged links
+with mass that hang off the chain, a hand beyond the tip, and logs the others).
 """
 
 from __future__ import annotations
@@ -47,12 +48,14 @@ class Branch:
 @dataclass(frozen=True, slots=True)
 class OffChain:
     """What the chain leaves out (``branches``) and merges (``merged``: fixed link, the
-    moving link it is merged into, its mass [kg]); :attr:`left_out` and
-    :attr:`merged_line` say it."""
+    moving link it is merged into, its mass [kg]; ``hanging``: the merged links off the
+    chain, below its links rather than between them, as a hand beyond the tip);
+    :attr:`left_out`, :attr:`merged_line` and :attr:`hanging_line` say it."""
 
     source: str
     branches: tuple[Branch, ...]
     merged: tuple[tuple[str, str, float], ...]
+    hanging: tuple[str, ...] = ()
 
     @property
     def mass_left_out(self) -> float:
@@ -83,6 +86,22 @@ class OffChain:
             return None
         said = ", ".join(f"{link} into {body} ({m:.4g} kg)" for link, body, m in self.merged)
         return f"{self.source}: links fixed to the chain merged (their inertials added): {said}"
+
+    @property
+    def hanging_line(self) -> str | None:
+        """One line naming the links with mass that hang off the chain through fixed joints
+        (a hand beyond the tip) and were merged into its bodies, with their masses; None
+        when there are none."""
+        said = [(x, body, m) for x, body, m in self.merged if x in self.hanging and m > 0]
+        if not said:
+            return None
+        names = ", ".join(f"{link} ({m:.4g} kg) into {body}" for link, body, m in said)
+        total = sum(m for _, _, m in said)
+        return (
+            f"{self.source}: links fixed to the chain beyond its own (past the tip or off its "
+            f"side) merged into its bodies, their inertials added ({total:.4g} kg in all): "
+            f"{names}; for an arm run without them, leave them out of the URDF"
+        )
 
 
 def _mass(el: ET.Element, link: str) -> float:
@@ -144,4 +163,5 @@ def off_chain(
         for link, (k, _) in placed.items()
         if k > 0 and link in fixed_joint
     )
-    return OffChain(source, tuple(branches), merged)
+    hanging = tuple(link for link, _, _ in merged if fixed_joint[link] not in on_chain)
+    return OffChain(source, tuple(branches), merged, hanging)

@@ -42,8 +42,10 @@ Conventions
 * Left out, said once (:mod:`dynid.io.robot.urdf_branches`): the links hanging off the
   chain's moving links through moving joints (a gripper's jaw, the joints past the tip),
   a warning naming them and their mass, which no link of the model holds (a log line when
-  they are massless); the links merged through fixed joints are named in a log line
-  (``-v``).
+  they are massless); the links with mass hanging off the chain through fixed joints
+  and merged into its bodies (a hand beyond the tip) in a note naming them and their
+  mass (level :data:`~dynid.progress.NOTE`); every link merged through a fixed joint in a
+  log line (``-v``).
 * Ignored: mimic joints off the chain, transmissions, gazebo tags, visual and collision
   geometry, ``<dynamics>`` of fixed joints, the other attributes of ``<dynamics>``
   (Gazebo's ``K``, ``D``, ``mu_coulomb``, ...), ``<safety_controller>``.
@@ -66,6 +68,7 @@ from ...friction.model import ClassicalFriction, Friction
 from ...model.drive import Drive
 from ...model.inertia import inertial_problems, phi_from_inertial
 from ...model.robot import MAX_LINK_MASS, MAX_LINK_OFFSET, Frame, Robot
+from ...progress import NOTE
 from ..input_files import file_bytes
 from .urdf_angles import AngleRounding, rounding_message
 from .urdf_branches import OffChain, off_chain
@@ -428,6 +431,8 @@ def _robot_from_text(
             warnings.warn(left, DynidWarning, stacklevel=3)
         else:
             _log.info("%s", left)
+    if (hanging := found.hanging_line) is not None:
+        _log.log(NOTE, "%s", hanging)
     if (merged := found.merged_line) is not None:
         _log.info("%s", merged)
     if angles.found and not snap_angles:
