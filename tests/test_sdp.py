@@ -19,6 +19,7 @@ from dynid.feasibility.prior import generic_prior, prior_from_robot
 from dynid.friction.validation import own_friction
 from dynid.identification.prepare import MEASURED, prepare_log
 from dynid.identification.structure import Structure
+from dynid.io.bounds_file import bounds_from_dict
 from dynid.progress import reporting
 from dynid.simulation.measurement import SensorNoise, sample_times, simulate_measurement
 from dynid.simulation.trajectories import random_fourier
@@ -138,6 +139,29 @@ def test_generic_prior_of_a_ur5_is_consistent_and_retrieval_runs_without_a_prior
     own = retrieve_sdp(model)  # without one: the description's inertials
     assert own.feasible and own.prior.source == "description"
     assert own.relative_residual < 1e-9
+
+
+def test_a_prior_mass_above_the_generic_bound_is_kept_not_capped():
+    """A UR5 whose shoulder link weighs 25 kg (a PR2's weighs 25.8 kg), above the generic
+    bound of 10.4 kg from its length: with its description as the prior, exact
+    coefficients give the shoulder's 25 kg (it was capped at 10.43 kg), and a note says
+    which bound gave way. A bounds file's own mass bounds still hold."""
+    ur5 = dynid.Robot.from_urdf(
+        robot_data_urdf("ur_description/urdf/ur5_robot.urdf"),
+        base_link="base_link",
+        tip_link="tool0",
+    )
+    mass = ur5.mass.copy()
+    mass[0] = 25.0
+    heavy = ur5.with_inertials(mass, ur5.com, ur5.inertia * (mass / ur5.mass)[:, None, None])
+    model = exact_model(ur5, heavy)
+    res = retrieve_sdp(model, prior=heavy)
+    assert res.feasible and res.mass[0] == pytest.approx(25.0, rel=1e-3)
+    said = "link 1: the prior's mass 25 kg lies above the generic bound"
+    assert any(said in n for n in res.notes)
+    given = bounds_from_dict({"links": [{"name": ur5.link_names[1], "mass": [0.5, 12.0]}]}, ur5)
+    capped = retrieve_sdp(model, prior=heavy, bounds=given)
+    assert capped.mass[0] <= 12.0 * (1 + 1e-6)
 
 
 def test_a_cad_prior_violating_the_triangle_inequality_is_repaired_and_reported():

@@ -17,7 +17,7 @@ from ..friction.fit import FrictionFit
 from ..friction.model import friction_parts
 from ..friction.validation import NewtonEulerValidation
 from ..identification.dissipation import negative_viscous
-from ..identification.info import LogInfo
+from ..identification.info import IdentificationInfo, LogInfo
 from ..identification.model import IdentifiedModel
 from ..identification.structure import MIN_WIDTH, joint_side_joints
 from ..io.observer_files import log_labels
@@ -44,6 +44,15 @@ __all__ = [
 ]
 
 
+def _fitted_rows(info: IdentificationInfo) -> str:
+    """What the least-squares rows hold: the low-passed, decimated torques of a filtered
+    log (not the torques as measured that the training and held-out errors predict), or
+    the rows as given."""
+    if info.log is not None and info.log.cutoff_hz is not None:
+        return f"torques low-passed at {info.log.cutoff_hz:.3g} Hz"
+    return "rows"
+
+
 def format_identification(model: IdentifiedModel, *, width: int = 60) -> str:
     """A readable summary: metrics, then one line per coefficient (expressions shortened)."""
     fit, info = model.fit, model.info
@@ -58,8 +67,9 @@ def format_identification(model: IdentifiedModel, *, width: int = 60) -> str:
         + f", {fit.n_rows} rows"
         + (f", dropped rows {', '.join(info.dropped_rows)}" if info.dropped_rows else ""),
         f"{columns_text(model)}, condition number {fit.condition_number:.4g} (unscaled, as the "
-        f"paper), scaled {fit.scaled_condition_number:.4g}, relative error "
-        f"{fit.relative_error_percent:.4g} %, estimator {info.estimator}, "
+        f"paper), scaled {fit.scaled_condition_number:.4g}, residual "
+        f"{fit.relative_error_percent:.4g} % of the {_fitted_rows(info)} fitted, estimator "
+        f"{info.estimator}, "
         f"std {info.std or '?'}"
         + (
             f", pruned {len(info.pruned)} above {info.max_std_percent:g} %"

@@ -57,6 +57,10 @@ class Bounds:
         Band ``(min, max)`` on the sum of the link masses [kg]; None for no band.
     link_names : tuple of str, or None
         Names of the links the bounds belong to (``robot.link_names[1:]``), for files.
+    mass_guessed : tuple of bool, or None
+        Per link, True where the mass bounds are the generic guess from the link's length
+        (:func:`kinematic_bounds`): a prior's masses, better knowledge, bound that link's
+        mass instead where they lie above it (the consistent fit). None: none guessed.
 
     Raises
     ------
@@ -79,6 +83,7 @@ class Bounds:
     inertia_max: NDArray[np.float64]
     total_mass: tuple[float, float] | None = None
     link_names: tuple[str, ...] | None = None
+    mass_guessed: tuple[bool, ...] | None = None
 
     def __post_init__(self) -> None:
         put = lambda k, v: object.__setattr__(self, k, v)  # noqa: E731 (frozen init)
@@ -121,6 +126,11 @@ class Bounds:
                     f"most {MAX_LINK_MASS:g} kg); got {m_hi:g}"
                 )
             put("total_mass", (m_lo, m_hi))
+        if self.mass_guessed is not None:
+            guessed = tuple(bool(x) for x in self.mass_guessed)
+            if len(guessed) != n:
+                raise ShapeError(f"mass_guessed must have {n} entries; got {len(guessed)}")
+            put("mass_guessed", guessed)
         if self.link_names is not None:
             names = tuple(str(x) for x in self.link_names)
             if len(names) != n:
@@ -149,6 +159,7 @@ class Bounds:
         upper: ArrayLike,
         total_mass: tuple[float, float] | None = None,
         link_names: Sequence[str] | None = None,
+        mass_guessed: Sequence[bool] | None = None,
     ) -> Bounds:
         """Bounds from (n, 10) lower and upper arrays in the decision layout."""
         lo = _checks.as_array("lower", lower)
@@ -164,6 +175,7 @@ class Bounds:
             hi[:, 4:],
             total_mass=total_mass,
             link_names=None if link_names is None else tuple(link_names),
+            mass_guessed=None if mass_guessed is None else tuple(mass_guessed),
         )
 
     def with_total_mass(self, total_mass: tuple[float, float] | None) -> Bounds:
@@ -177,6 +189,7 @@ class Bounds:
             self.inertia_max,
             total_mass,
             self.link_names,
+            self.mass_guessed,
         )
 
     def inertia_scale(self) -> NDArray[np.float64]:
@@ -332,6 +345,7 @@ def kinematic_bounds(
         inertia_max=i_max,
         total_mass=total_mass,
         link_names=robot.link_names[1:],
+        mass_guessed=(mass_max is None,) * n,
     )
 
 

@@ -117,6 +117,7 @@ def bounds_from_dict(d: Mapping[str, Any], robot: Robot, *, source: str = "bound
     base = default_bounds(robot)
     lo, hi = base.lower.copy(), base.upper.copy()
     names = list(robot.link_names[1:])
+    guessed = list(base.mass_guessed or (False,) * len(names))
     seen: set[str] = set()
     for k, link in enumerate(d.get("links") or []):
         name = link["name"]
@@ -129,6 +130,7 @@ def bounds_from_dict(d: Mapping[str, Any], robot: Robot, *, source: str = "bound
         i = names.index(name)
         if "mass" in link:
             lo[i, 0], hi[i, 0] = link["mass"]
+            guessed[i] = False
         for key, arr, sl in (
             ("com_min", lo, slice(1, 4)),
             ("com_max", hi, slice(1, 4)),
@@ -148,7 +150,7 @@ def bounds_from_dict(d: Mapping[str, Any], robot: Robot, *, source: str = "bound
             )
         band = tuple(float(x) for x in tm) if tm else None
     try:
-        return Bounds.from_arrays(lo, hi, band, names)
+        return Bounds.from_arrays(lo, hi, band, names, guessed)
     except (ValueError, ShapeError) as exc:
         raise DataError(str(exc), file=source) from exc
 

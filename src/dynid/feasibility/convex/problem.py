@@ -14,6 +14,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from ...exceptions import InfeasibleError, SolverError
+from ...model.robot import MAX_LINK_MASS
 from ...progress import report
 from ..bounds import Bounds
 from ..lmi import (
@@ -65,6 +66,15 @@ def mass_bounds(
         return lo, hi, notes
     m0 = prior.mass
     plo, phi_ = m0 / factor, m0 * factor
+    guessed = np.asarray(bounds.mass_guessed or (False,) * len(m0), dtype=bool)
+    above = guessed & (m0 > hi)  # a description's mass against a guess from a length
+    for i in np.flatnonzero(above):
+        notes.append(
+            f"link {i + 1}: the prior's mass {m0[i]:.4g} kg lies above the generic bound "
+            f"{hi[i]:.4g} kg (from the link's length); the prior's range up to "
+            f"{min(phi_[i], MAX_LINK_MASS):.4g} kg is used"
+        )
+    hi = np.where(above, np.minimum(phi_, MAX_LINK_MASS), hi)
     nlo, nhi = np.maximum(lo, plo), np.minimum(hi, phi_)
     empty = nlo > nhi
     for i in np.flatnonzero(empty):
