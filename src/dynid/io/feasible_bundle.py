@@ -59,7 +59,7 @@ def save_feasible_bundle(
     folder = Path(folder)
     files = [save_feasible_json(folder / "feasible.json", result)]
     friction: Any = True if result.friction is None else result.friction
-    options = ExportOptions(friction=friction, drive=result.drive)
+    options = ExportOptions(friction=friction, drive=result.drive, source=files[0].name)
     files += save_robot_files(folder, fitted_robot(result), options)
     files.append(save_report_json(folder / "report.json", result, **report_extra))
     return files

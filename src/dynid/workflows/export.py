@@ -161,6 +161,7 @@ def export_robot(
         friction=friction,
         all_frames=opt.all_frames,
         drive=drive,
+        source=_friction_source(params, linear is not None and opt.friction),
     )
     approx = None
     sigmoid = sigmoid_parameters(robot.friction)
@@ -201,6 +202,14 @@ def _check_params(params: str | Path) -> bool:
             field="params",
         )
     return path.suffix.lower() == ".urdf"
+
+
+def _friction_source(params: str | Path, identified: bool) -> str | None:
+    """The file that holds the exported friction exactly, for the writers' warnings: the
+    ``feasible.json`` it was identified in, or a robot TOML (its ``[friction]`` table);
+    None for a URDF, an MJCF or a built-in robot."""
+    suffix = Path(params).suffix.lower()
+    return Path(params).name if identified or suffix == ".toml" else None
 
 
 def _schema(path: Path) -> str | None:

@@ -57,7 +57,7 @@ from ...model.inertia import inertia6_from_matrix
 from ...model.robot import Frame, Robot
 from ..atomic import write_text
 from ..input_files import file_text
-from .export_options import ExportOptions
+from .export_options import ExportOptions, kept_elsewhere
 from .urdf_parse import load_urdf, robot_from_urdf_string
 from .urdf_patch import patch_urdf_dynamics, patch_urdf_inertials
 
@@ -288,21 +288,24 @@ def save_urdf(
     return path
 
 
-def _rotor_warning(drive: Drive | None, robot: Robot, path: Path) -> str | None:
+def _rotor_warning(
+    drive: Drive | None, robot: Robot, path: Path, options: ExportOptions
+) -> str | None:
     """What URDF cannot hold of a drive, as a warning of its own: its rotor inertias (the
     armature per joint, ``diag(K^T diag(I_a) K)`` [kg m^2]) by joint, and the exports that
-    hold them (MJCF ``armature``, the TOML ``[drive]`` table); None without any."""
+    hold them (MJCF ``armature``, the TOML ``[drive]`` table: the files written beside it,
+    or how to write them); None without any."""
     if drive is None or drive.rotor_inertia is None or not np.any(drive.rotor_inertia != 0):
         return None
     arm = drive_joint_terms(drive.transmission, drive.rotor_inertia, None, None).armature
     values = ", ".join(
         f"{name} {a:.4g}" for name, a in zip(robot.joint_names, arm, strict=True) if a != 0
     )
+    holders = (("mjcf", "as armature"), ("toml", "as its [drive] table"))
     return (
         f"URDF export: {path.name} leaves out the drive's rotor inertias, which URDF has no "
-        f"element for (armature per joint [kg m^2]: {values}); the MJCF export "
-        f"({path.stem}.xml) holds them as armature, the TOML export ({path.stem}.toml) as "
-        "its [drive] table"
+        f"element for (armature per joint [kg m^2]: {values}); "
+        + kept_elsewhere(options, path, "them", holders)
     )
 
 
@@ -343,15 +346,12 @@ def export_urdf(path: str | Path, robot: Robot, options: ExportOptions) -> Path:
         dynamics = (jt.damping, jt.frictionloss)
         lost = jt.notes + unheld_friction(model, vmax)
         if lost:
-            holds = (
-                "feasible.json holds it exactly"
-                if isinstance(model, FrictionSum)
-                else "the TOML export (robot.toml) and feasible.json hold it exactly"
-            )
+            exact = () if isinstance(model, FrictionSum) else (("toml", "exactly"),)
+            holds = kept_elsewhere(options, path, "it", exact, source="exactly")
             notes = (
                 f"{Path(path).name} holds the {model.kind} friction as <dynamics damping "
                 f"friction> (viscous and sharp Coulomb friction at the joints), not as the "
-                f"law itself; {'; '.join(lost)}; {holds}",
+                f"law itself; {'; '.join(lost)}" + (f"; {holds}" if holds else ""),
             )
     replace = False
     if options.template is not None:
@@ -373,7 +373,7 @@ def export_urdf(path: str | Path, robot: Robot, options: ExportOptions) -> Path:
     )
     if notes:  # one line, once written: what URDF cannot hold of the friction
         warnings.warn(f"URDF export: {'; '.join(notes)}", DynidWarning, stacklevel=2)
-    rotors = _rotor_warning(drive, robot, Path(path))
+    rotors = _rotor_warning(drive, robot, Path(path), options)
     if rotors is not None:  # a line of its own: it costs far more than the friction's
         warnings.warn(rotors, DynidWarning, stacklevel=2)
     return out
