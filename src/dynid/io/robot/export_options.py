@@ -18,7 +18,7 @@ from ...friction.model import Friction, FrictionSum
 from ...model.drive import Drive
 from ...model.robot import Robot
 
-__all__ = ["ExportOptions", "RobotFormat", "kept_elsewhere"]
+__all__ = ["ExportOptions", "RobotFormat", "kept_elsewhere", "with_caveat"]
 
 
 @dataclass(frozen=True, slots=True)
@@ -49,6 +49,9 @@ class ExportOptions:
         The name of the file that holds the exported friction exactly (the
         ``feasible.json`` or robot TOML it was read from, or written beside), for the
         same warnings; None: no such file.
+    caveat : str or None
+        A line every format writes at the top of the file, as a comment: why the fit
+        whose parameters it holds was not accepted (:func:`with_caveat`).
     """
 
     template: Path | None = None
@@ -60,6 +63,7 @@ class ExportOptions:
     drive: Drive | None = None
     beside: Mapping[str, str] = field(default_factory=dict)
     source: str | None = None
+    caveat: str | None = None
 
 
 @dataclass(frozen=True, slots=True)
@@ -157,3 +161,18 @@ def kept_elsewhere(
 def _article(name: str) -> str:
     """``an MJCF``, ``a TOML``, ``a URDF``: the article as the letters are spoken."""
     return f"{'an' if name[0] in 'AEFHILMNORSX' else 'a'} {name}"
+
+
+def with_caveat(text: str, caveat: str | None, *, xml: bool) -> str:
+    """A robot file's ``text`` with ``caveat`` as a comment at its top (after an XML
+    declaration); ``text`` itself when ``caveat`` is None."""
+    if caveat is None:
+        return text
+    flat = " ".join(caveat.split())
+    if not xml:
+        return f"# {flat}\n{text}"
+    line = f"<!-- {flat.replace('--', '- -')} -->\n"
+    if text.startswith("<?xml"):
+        head, _, rest = text.partition("\n")
+        return f"{head}\n{line}{rest}"
+    return line + text

@@ -63,7 +63,7 @@ from ...model.drive import Drive
 from ...model.inertia import inertia6_from_matrix
 from ...model.robot import Robot
 from ..atomic import write_text
-from .export_options import ExportOptions, kept_elsewhere
+from .export_options import ExportOptions, kept_elsewhere, with_caveat
 
 __all__ = ["export_mjcf", "mjcf_from_robot", "save_mjcf"]
 
@@ -292,11 +292,13 @@ def save_mjcf(
     friction: bool | FrictionModel | FrictionSum = True,
     drive: Drive | None = None,
     kept: str = "",
+    caveat: str | None = None,
 ) -> Path:
-    """Write :func:`mjcf_from_robot` to ``path``; returns the path."""
+    """Write :func:`mjcf_from_robot` to ``path``; returns the path. ``caveat``: a comment
+    at the top, why the fit was not accepted."""
     path = Path(path)
     text, _ = mjcf_from_robot(robot, friction=friction, drive=drive, kept=kept)
-    write_text(path, text)
+    write_text(path, with_caveat(text, caveat, xml=True))
     return path
 
 
@@ -312,4 +314,5 @@ def export_mjcf(path: str | Path, robot: Robot, options: ExportOptions) -> Path:
         friction=options.friction,
         drive=options.drive,
         kept=kept,
+        caveat=options.caveat,
     )

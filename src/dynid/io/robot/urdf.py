@@ -57,7 +57,7 @@ from ...model.inertia import inertia6_from_matrix
 from ...model.robot import Frame, Robot
 from ..atomic import write_text
 from ..input_files import file_text
-from .export_options import ExportOptions, kept_elsewhere
+from .export_options import ExportOptions, kept_elsewhere, with_caveat
 from .urdf_parse import load_urdf, robot_from_urdf_string
 from .urdf_patch import patch_urdf_dynamics, patch_urdf_inertials
 
@@ -234,6 +234,7 @@ def save_urdf(
     merged: str = "subtract",
     dynamics: tuple[NDArray[np.float64], NDArray[np.float64]] | None = None,
     template_dynamics: bool = False,
+    caveat: str | None = None,
 ) -> Path:
     """Write the robot as URDF to ``path``; returns the path.
 
@@ -254,6 +255,9 @@ def save_urdf(
         Template: also replace the friction of the chain's ``<dynamics>`` by ``dynamics``
         (None: removed; :func:`dynid.io.robot.urdf_patch.patch_urdf_dynamics`); default:
         the template's ``<dynamics>`` are kept.
+    caveat : str, optional
+        A comment at the top of the file (after the XML declaration): why the fit was not
+        accepted.
 
     Raises
     ------
@@ -284,7 +288,7 @@ def save_urdf(
                 warnings.simplefilter("ignore", DynidWarning)  # the template's own
                 chain = robot_from_urdf_string(original, base, tip)
             text = patch_urdf_dynamics(text, list(chain.joint_names), dynamics)
-    write_text(path, text)
+    write_text(path, with_caveat(text, caveat, xml=True))
     return path
 
 
@@ -370,6 +374,7 @@ def export_urdf(path: str | Path, robot: Robot, options: ExportOptions) -> Path:
         merged=options.merged,
         dynamics=dynamics,
         template_dynamics=replace,
+        caveat=options.caveat,
     )
     if notes:  # one line, once written: what URDF cannot hold of the friction
         warnings.warn(f"URDF export: {'; '.join(notes)}", DynidWarning, stacklevel=2)
