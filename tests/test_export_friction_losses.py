@@ -52,9 +52,11 @@ def test_urdf_export_of_smooth_friction_names_everything_it_leaves_out(tmp_path)
         export_urdf, tmp_path / "robot.urdf", _arm(), ExportOptions(friction=smooth)
     )
     assert len(lines) == 1 and lines[0].startswith("URDF export: robot.urdf holds"), lines
+    toml = "not written: a TOML export (--out robot.toml) would hold it exactly"
     for said in ("tanh(dq / v_s)", "standstill band", "0.006 rad/s at joint 2", "offsets fo",
-                 "-0.44 N m at joint 2", "robot.toml", "feasible.json"):  # fmt: skip
+                 "-0.44 N m at joint 2", toml):  # fmt: skip
         assert said in lines[0], (said, lines[0])
+    assert "feasible.json" not in lines[0]  # none was written or read
     back = load_urdf(path).friction
     # the URDF holds the nonnegative fv dq + fc sign(dq) closest to the law's odd part over
     # the velocity range (scipy's NNLS on the same grid), not fc tanh's fc as a sharp step
@@ -150,8 +152,8 @@ def test_urdf_export_names_each_rotor_inertia_it_drops_on_a_line_of_its_own(tmp_
     names = _arm().joint_names
     for name, g, i in zip(names, (3.0, 2.0), ia, strict=True):  # armature g^2 I_a
         assert f"{name} {g**2 * i:.4g}" in rotors, rotors
-    assert "MJCF export (robot.xml) holds them as armature" in rotors
-    assert "TOML export (robot.toml) as its [drive] table" in rotors
+    assert "an MJCF export (--out robot.xml) would hold them as armature" in rotors
+    assert "a TOML export (--out robot.toml) as its [drive] table" in rotors
     _, alone = _warnings(export_urdf, tmp_path / "r.urdf", _arm(), ExportOptions(drive=drive))
     assert len(alone) == 1 and alone[0].startswith("URDF export: r.urdf leaves out"), alone
 
@@ -236,14 +238,14 @@ def test_template_dynamics_are_removed_when_the_model_has_no_friction(tmp_path):
 
 def test_mjcf_export_names_the_offsets_it_drops():
     """Classical friction with offsets: MuJoCo compiles damping = fv and frictionloss = fc
-    exactly, and one warning names the offsets (the largest, 0.44 N m at joint 2) and the
-    files that hold them."""
+    exactly, and one warning names the offsets (the largest, 0.44 N m at joint 2) and no
+    file, none being written beside it."""
     mujoco = pytest.importorskip("mujoco")
     fr = ClassicalFriction(FV, FC, FO)
     (text, approx), lines = _warnings(mjcf_from_robot, _arm(), friction=fr)
     assert len(lines) == 1 and lines[0].startswith("MJCF export: "), lines
     assert "offsets fo (up to -0.44 N m at joint 2)" in lines[0], lines[0]
-    assert "robot.toml" in lines[0] and "feasible.json" in lines[0]
+    assert "robot.toml" not in lines[0] and "feasible.json" not in lines[0]  # none written
     model = mujoco.MjModel.from_xml_string(text)
     np.testing.assert_array_equal(model.dof_damping, FV)
     np.testing.assert_array_equal(model.dof_frictionloss, FC)

@@ -31,6 +31,10 @@ peak, a quadratic term, an asymmetry, friction at the motors, a coupled drive's
 off-diagonal terms) and of the drive (MJCF: a coupled rotor's off-diagonal inertia); URDF
 names the rotor inertias it drops, by joint, in a warning of its own.
 
+A feasible.json of a fit that was not accepted ("feasible": false: its held-out error too
+far above least squares', or a constraint that does not hold) is refused with the reason
+it records; --allow-rejected writes it anyway, with a warning that says why.
+
 examples:
   dynid export --params feasible/feasible.json --out panda.xml
   dynid export --params feasible/feasible.json --out panda.urdf \\
@@ -118,6 +122,12 @@ def register(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParser:
         help="no friction: frictionless MJCF joints; URDF without <dynamics> friction",
     )
     p.add_argument("--all-frames", action="store_true", help="URDF chain: every named frame")
+    p.add_argument(
+        "--allow-rejected",
+        action="store_true",
+        help='write a feasible.json whose fit was not accepted ("feasible": false), '
+        "with a warning that says why, instead of refusing it",
+    )
     add_drive_option(p)
     return p
 

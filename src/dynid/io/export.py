@@ -139,7 +139,8 @@ def save_robot_files(
     """Write ``robot`` once per format of :data:`ROBOT_FORMATS` into ``folder``.
 
     The files are ``<stem><first suffix>`` (``robot.urdf``, ``robot.xml``, ``robot.toml``),
-    each written with ``options`` (a template, which one format takes, is not used here).
+    each written with ``options`` (a template, which one format takes, is not used here)
+    and the others named in its warnings as written beside it (``ExportOptions.beside``).
 
     Returns
     -------
@@ -147,8 +148,9 @@ def save_robot_files(
         The files written, in the table's order.
     """
     folder = Path(folder)
-    plain = replace(options, template=None)
-    return [f.save(folder / f"{stem}{f.suffixes[0]}", robot, plain) for f in ROBOT_FORMATS.values()]
+    names = {f.name: f"{stem}{f.suffixes[0]}" for f in ROBOT_FORMATS.values()}
+    plain = replace(options, template=None, beside=names)
+    return [f.save(folder / names[f.name], robot, plain) for f in ROBOT_FORMATS.values()]
 
 
 def model_terms_of(spec: str | Path, n: int) -> tuple[Friction | FrictionSum | None, Drive | None]:

@@ -19,7 +19,14 @@ and was not on a torque log; the friction identified with the links in ``linear_
          and at the joints of a coupled drive: the part at the joints),
      "drive": null | {dynid-drive/1 record, rotor_inertia: the identified values},
      "kinematics": {...}, "feasible": true, "relative_residual": ..., "seed": ...,
-     "units": {...}, "conventions": {...}}
+     "violated": [...], "heldout": {...}, "units": {...}, "conventions": {...}}
+
+A result whose constraints do not all hold, or whose held-out error is more than the
+tolerance above least squares', is written with ``"feasible": false``, the constraints it
+violates in ``violated`` and the judgement in ``heldout``: :func:`fit_rejection` says why in
+one line, :func:`load_feasible_json` warns with it, and ``dynid export`` refuses such a file
+unless told otherwise; the robot files written of it say why at their top
+(:func:`rejection_caveat`).
 """
 
 from __future__ import annotations
@@ -34,6 +41,7 @@ from numpy.typing import NDArray
 
 from .. import __version__, _checks
 from ..exceptions import DataError, DynidWarning, ModelError, ShapeError
+from ..feasibility.constraints import Constraint
 from ..feasibility.result import FeasibleResult
 from ..friction.laws import LAWS
 from ..friction.model import (
@@ -61,6 +69,10 @@ __all__ = [
     "FEASIBLE",
     "FEASIBLE_SCHEMA",
     "feasible_to_dict",
+    "fit_rejection",
+    "load_fit_rejection",
+    "rejection_caveat",
+    "result_rejection",
     "load_feasible_drive",
     "load_feasible_json",
     "fitted_robot",
@@ -130,6 +142,7 @@ FEASIBLE = Format(
             "feasible": Field("bool"),
             "relative_residual": Field("number", nullable=True),
             "seed": Field("integer", nullable=True),
+            "violated": Field("strings"),
             "heldout": Field("object", nullable=True),
         }
     ),
@@ -213,12 +226,74 @@ def feasible_to_dict(source: FeasibleResult | Robot, *, seed: int | None = None)
     if result is None:
         return d if seed is None else d | {"seed": seed}
     d["method"] = result.method
-    d["feasible"] = bool(result.feasible)
     d["relative_residual"] = finite_or_none(result.relative_residual)
     d["seed"] = result.seed
+    return d | _judgement(result)
+
+
+def _judgement(result: FeasibleResult) -> dict[str, Any]:
+    """``feasible``, ``violated`` and ``heldout`` of ``feasible.json``: whether the fit
+    was accepted, and why not."""
+    d: dict[str, Any] = {
+        "feasible": bool(result.feasible),
+        "violated": [_violated_text(c) for c in result.report.violated],
+    }
     if result.heldout is not None:
         d["heldout"] = result.heldout.as_dict()
     return d
+
+
+def _violated_text(c: Constraint) -> str:
+    """A violated constraint as ``feasible.json``'s ``violated`` holds it:
+    ``mass_positive (link 3) by 0.2 kg`` (how far outside, in its unit)."""
+    return f"{c.name}{f' (link {c.link})' if c.link else ''} by {-c.margin:.3g} {c.unit}"
+
+
+def fit_rejection(d: Mapping[str, Any]) -> str | None:
+    """Why the fit a ``feasible.json`` document holds was not accepted, in one line, from
+    what the file records; None for an accepted fit or a robot written as the file.
+
+    The held-out judgement (``heldout``: the fit's held-out torque error against least
+    squares' and the tolerance) when it refused the fit, and the other constraints that do
+    not hold (``violated``); a file of a version that did not record them says that its
+    constraints do not all hold. Such as ``held-out torque error 2.52 %, 7.79 % above
+    least squares' 2.34 % (tolerance 5 %)``.
+    """
+    if d.get("feasible", True) is not False:
+        return None
+    parts = []
+    held = d.get("heldout")
+    judged = isinstance(held, Mapping) and held.get("accepted") is False
+    if judged and isinstance(held, Mapping):
+        try:
+            ls = float(held["least_squares"]["heldout_error_percent"])
+            own = float(held["consistent"]["heldout_error_percent"])
+            over, tol = 100 * (float(held["ratio"]) - 1), 100 * float(held["tolerance"])
+            parts.append(
+                f"held-out torque error {own:.3g} %, {over:.3g} % above least squares' "
+                f"{ls:.3g} % (tolerance {tol:g} %)"
+            )
+        except (KeyError, TypeError, ValueError):
+            parts.append("its held-out error is above the tolerance of least squares'")
+    violated = [
+        str(v) for v in d.get("violated") or () if not (judged and str(v).startswith("data_fit"))
+    ]
+    if violated:
+        parts.append("violated: " + "; ".join(violated[:4]) + (" ..." if len(violated) > 4 else ""))
+    if not parts:
+        parts.append("its constraints do not all hold (report.json beside it names them)")
+    return ", ".join(parts)
+
+
+def result_rejection(result: FeasibleResult) -> str | None:
+    """:func:`fit_rejection` of a result, as its ``feasible.json`` would say it."""
+    return fit_rejection(_judgement(result))
+
+
+def rejection_caveat(reason: str) -> str:
+    """The comment at the top of a robot file written from a fit that was not accepted
+    (``reason``: :func:`fit_rejection`)."""
+    return f"NOT ACCEPTED: these parameters come from a fit that was not accepted ({reason})"
 
 
 def fitted_robot(result: FeasibleResult) -> Robot:
@@ -341,8 +416,35 @@ def load_feasible_json(path: str | Path, robot: Robot | None = None) -> Robot:
     ------
     DataError
         Not JSON, or not a feasible-parameter file (see :func:`robot_from_feasible_dict`).
+
+    Warns
+    -----
+    DynidWarning
+        The file holds a fit that was not accepted (:func:`fit_rejection` says why): its
+        parameters are used as given.
     """
-    return robot_from_feasible_dict(load_json(path), robot, source=Path(path).name)
+    d = load_json(path)
+    out = robot_from_feasible_dict(d, robot, source=Path(path).name)
+    rejected = fit_rejection(d)
+    if rejected is not None:
+        warnings.warn(
+            f"{Path(path).name} holds a fit that was not accepted ({rejected}): its "
+            "parameters are used as given",
+            DynidWarning,
+            stacklevel=2,
+        )
+    return out
+
+
+def load_fit_rejection(path: str | Path) -> str | None:
+    """:func:`fit_rejection` of the file ``path``: why its fit was not accepted, or None.
+
+    Raises
+    ------
+    DataError
+        Not JSON, or not a feasible-parameter file.
+    """
+    return fit_rejection(load_document(path, FEASIBLE))
 
 
 def load_feasible_linear_friction(path: str | Path) -> Friction | FrictionSum | None:

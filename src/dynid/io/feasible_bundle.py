@@ -15,7 +15,7 @@ from typing import Any
 
 from ..feasibility.result import FeasibleResult
 from .export import ROBOT_FORMATS, ExportOptions, save_robot_files
-from .feasible import fitted_robot, save_feasible_json
+from .feasible import fitted_robot, rejection_caveat, result_rejection, save_feasible_json
 from .report_json import save_report_json
 
 __all__ = ["FEASIBLE_BUNDLE", "save_feasible_bundle"]
@@ -59,7 +59,13 @@ def save_feasible_bundle(
     folder = Path(folder)
     files = [save_feasible_json(folder / "feasible.json", result)]
     friction: Any = True if result.friction is None else result.friction
-    options = ExportOptions(friction=friction, drive=result.drive)
+    reason = result_rejection(result)
+    options = ExportOptions(
+        friction=friction,
+        drive=result.drive,
+        source=files[0].name,
+        caveat=None if reason is None else rejection_caveat(reason),
+    )
     files += save_robot_files(folder, fitted_robot(result), options)
     files.append(save_report_json(folder / "report.json", result, **report_extra))
     return files

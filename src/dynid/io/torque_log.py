@@ -54,6 +54,7 @@ from ..identification.log import (
     with_derived_velocities,
 )
 from .atomic import open_atomic
+from .column_hint import column_hint, position_count
 from .csv_tables import ROWS_PREFIX, csv_table
 from .joint_state_csv import import_hint
 from .npz_files import check_npz
@@ -423,10 +424,15 @@ def _columns(path: Path, names: list[str], line: int) -> tuple[int, bool]:
     qs = sorted(int(c[1:]) for c in names if re.fullmatch(r"q[1-9]\d*", c))
     n = len(qs)
     if "t" not in names or n == 0:
+        hint = _annotated_hint(names) or import_hint(names, path.name)
+        if not hint and "t" in names and (k := position_count(names)):
+            signals = [s for s in ("q", "tau") if f"{s}1" not in names]
+            optional = ["dq"] if "dq1" not in names else []
+            hint = column_hint(names, k, signals, {"t"}, optional).split("; hint: ", 1)[-1]
+            hint = f"; hint: {hint}"
         raise DataError(
             f"header must name columns t, q1..qn, dq1..dqn, tau1..taun; "
-            f"got {names[:8]}{' ...' if len(names) > 8 else ''}{_annotated_hint(names)}"
-            f"{import_hint(names, path.name)}",
+            f"got {names[:8]}{' ...' if len(names) > 8 else ''}{hint}",
             file=path.name,
             at=at,
         )
@@ -440,7 +446,13 @@ def _columns(path: Path, names: list[str], line: int) -> tuple[int, bool]:
         need = [c for c in need if not c.startswith("dq")]
     missing = [c for c in need if c not in names]
     if missing:
-        raise DataError(f"missing column(s) {missing} (n = {n} from q1..q{n})", file=path.name)
+        gone = [s for s in _SIGNALS[1:3] if all(f"{s}{j}" in missing for j in range(1, n + 1))]
+        used = {"t", *need, *(f"ddq{j}" for j in range(1, n + 1))}
+        raise DataError(
+            f"missing column(s) {_span(missing)} (n = {n} from q1..q{n})"
+            + column_hint(names, n, gone, used),
+            file=path.name,
+        )
     ddq = [f"ddq{j}" for j in range(1, n + 1)]
     have = [c for c in ddq if c in names]
     if have and len(have) != n:
@@ -461,6 +473,16 @@ def _columns(path: Path, names: list[str], line: int) -> tuple[int, bool]:
         )
     _say_unread(path.name, "column(s)", unknown)
     return n, bool(have)
+
+
+def _span(columns: list[str]) -> str:
+    """Columns for a message: ``tau1..tau7`` for a run of one signal, else the list."""
+    m = [re.fullmatch(r"([a-z]+)(\d+)", c) for c in columns]
+    if len(columns) > 2 and all(m) and len({x.group(1) for x in m if x}) == 1:
+        idx = [int(x.group(2)) for x in m if x]
+        if idx == list(range(idx[0], idx[0] + len(idx))):
+            return f"{columns[0]}..{columns[-1]}"
+    return _checks.short(columns)
 
 
 def _say_unread(name: str, kind: str, extra: list[str]) -> None:

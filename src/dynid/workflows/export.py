@@ -8,6 +8,11 @@ command applies, so that the Python API behaves as the command does.
 * The friction written: the linear friction identified with the links (a
   ``feasible.json``'s; reflected from the motors when its drive has friction there), else
   the robot's own; none on request. The drive: the file's own, or the one given.
+* A ``feasible.json`` of a fit that was not accepted (``"feasible": false``: its held-out
+  error too far above least squares', or a constraint that does not hold) is refused,
+  naming the reason the file records, unless ``allow_rejected``; written then, it is said
+  in a warning (:func:`~dynid.io.feasible.load_feasible_json`) and in a comment at the
+  top of the file (:func:`~dynid.io.feasible.rejection_caveat`).
 * MJCF holds friction as ``frictionloss`` and ``damping``: the robot's sigmoid is
   approximated and the fit is part of the result
   (:func:`~dynid.friction.mujoco.coulomb_viscous_from_sigmoid`).
@@ -25,6 +30,7 @@ from ..friction.model import Friction, sigmoid_parameters
 from ..friction.mujoco import CoulombViscous, coulomb_viscous_from_sigmoid
 from ..io.drive_file import load_drive
 from ..io.export import EXPORT_FORMATS, ROBOT_FORMATS, export_format, model_terms_of
+from ..io.feasible import load_fit_rejection, rejection_caveat
 from ..io.robot.export_options import ExportOptions
 from ..io.robot.urdf_patch import MERGED_POLICIES
 from ..io.robot_file import ROBOT_FILE_SUFFIXES, load_robot
@@ -59,6 +65,9 @@ class ExportRobotOptions:
         URDF chain: every named frame as a fixed, massless link.
     drive : Drive, str or Path, optional
         The drive train (or its ``.toml`` file), in place of the robot file's own.
+    allow_rejected : bool
+        Write a ``feasible.json`` whose fit was not accepted (``"feasible": false``),
+        with a warning that says why, instead of refusing it.
 
     Raises
     ------
@@ -75,6 +84,7 @@ class ExportRobotOptions:
     friction: bool = True
     all_frames: bool = False
     drive: Drive | str | Path | None = None
+    allow_rejected: bool = False
 
     def __post_init__(self) -> None:
         check_choice(self, "format", EXPORT_FORMATS)
@@ -125,13 +135,15 @@ def export_robot(
     Raises
     ------
     OptionError
-        ``params`` of another kind or missing; ``base``/``tip`` with neither a URDF robot
+        ``params`` of another kind or missing, or a ``feasible.json`` of a fit that was not
+        accepted without ``allow_rejected``; ``base``/``tip`` with neither a URDF robot
         nor a template; a template for another format (``field`` names it).
     DataError, ModelError
         An unreadable robot file; a URDF with several leaves and no ``tip``.
     """
     opt = options or ExportRobotOptions()
     urdf = _check_params(params)
+    rejected = _check_accepted(params, opt.allow_rejected)
     for name in ("base", "tip"):
         if getattr(opt, name) is not None and not urdf and opt.urdf_template is None:
             raise OptionError(
@@ -161,6 +173,8 @@ def export_robot(
         friction=friction,
         all_frames=opt.all_frames,
         drive=drive,
+        source=_friction_source(params, linear is not None and opt.friction),
+        caveat=None if rejected is None else rejection_caveat(rejected),
     )
     approx = None
     sigmoid = sigmoid_parameters(robot.friction)
@@ -201,6 +215,38 @@ def _check_params(params: str | Path) -> bool:
             field="params",
         )
     return path.suffix.lower() == ".urdf"
+
+
+def _friction_source(params: str | Path, identified: bool) -> str | None:
+    """The file that holds the exported friction exactly, for the writers' warnings: the
+    ``feasible.json`` it was identified in, or a robot TOML (its ``[friction]`` table);
+    None for a URDF, an MJCF or a built-in robot."""
+    suffix = Path(params).suffix.lower()
+    return Path(params).name if identified or suffix == ".toml" else None
+
+
+def _check_accepted(params: str | Path, allowed: bool) -> str | None:
+    """Refuse a ``feasible.json`` of a fit that was not accepted, unless ``allowed``;
+    returns why it was not accepted (None: accepted, or not a ``feasible.json``).
+
+    Raises
+    ------
+    OptionError
+        Its reason, as the file records it (:func:`~dynid.io.feasible.fit_rejection`).
+    """
+    path = Path(params)
+    if path.suffix.lower() != ".json" or not path.exists():
+        return None
+    rejected = load_fit_rejection(path)
+    if rejected is not None and not allowed:
+        raise OptionError(
+            f": {path.name} holds a fit that was not accepted ({rejected}); fit again "
+            "(identify --consistent or retrieve with another --prior, --prior-weight, "
+            "--bounds, --total-mass or --margin) or give {allow_rejected} to write it anyway",
+            field="params",
+            others=("allow_rejected",),
+        )
+    return rejected
 
 
 def _schema(path: Path) -> str | None:

@@ -10,15 +10,15 @@ A format is one module of :mod:`dynid.io.robot` with a writer
 
 from __future__ import annotations
 
-from collections.abc import Callable
-from dataclasses import dataclass
+from collections.abc import Callable, Mapping, Sequence
+from dataclasses import dataclass, field
 from pathlib import Path
 
 from ...friction.model import Friction, FrictionSum
 from ...model.drive import Drive
 from ...model.robot import Robot
 
-__all__ = ["ExportOptions", "RobotFormat"]
+__all__ = ["ExportOptions", "RobotFormat", "kept_elsewhere", "with_caveat"]
 
 
 @dataclass(frozen=True, slots=True)
@@ -40,6 +40,18 @@ class ExportOptions:
         URDF chain: every named frame as a fixed, massless link.
     drive : Drive or None
         A drive train: MJCF ``armature`` from its rotor inertias, a TOML ``[drive]`` table.
+    beside : mapping of str to str
+        The files of other formats written beside this one by the same run, by format
+        name (an output folder's ``{"mjcf": "robot.xml", "toml": "robot.toml"}``); a
+        warning names them as holding what this format cannot, and says how to write the
+        others (:func:`kept_elsewhere`).
+    source : str or None
+        The name of the file that holds the exported friction exactly (the
+        ``feasible.json`` or robot TOML it was read from, or written beside), for the
+        same warnings; None: no such file.
+    caveat : str or None
+        A line every format writes at the top of the file, as a comment: why the fit
+        whose parameters it holds was not accepted (:func:`with_caveat`).
     """
 
     template: Path | None = None
@@ -49,6 +61,9 @@ class ExportOptions:
     friction: bool | Friction | FrictionSum = True
     all_frames: bool = False
     drive: Drive | None = None
+    beside: Mapping[str, str] = field(default_factory=dict)
+    source: str | None = None
+    caveat: str | None = None
 
 
 @dataclass(frozen=True, slots=True)
@@ -72,3 +87,92 @@ class RobotFormat:
     suffixes: tuple[str, ...]
     save: Callable[[str | Path, Robot, ExportOptions], Path]
     template: bool = False
+
+
+#: How a warning names a format's export, and the suffix of the file that writes it.
+_EXPORT_NAMES = {"urdf": ("URDF", ".urdf"), "mjcf": ("MJCF", ".xml"), "toml": ("TOML", ".toml")}
+
+
+def kept_elsewhere(
+    options: ExportOptions,
+    path: str | Path,
+    what: str,
+    holders: Sequence[tuple[str, str]],
+    source: str = "",
+) -> str:
+    """Where what the file ``path`` cannot hold is kept, for its warning: only files that
+    are written, and how to write the others.
+
+    Parameters
+    ----------
+    options : ExportOptions
+        Its ``beside`` (formats written by the same run) and ``source``.
+    path : str or Path
+        The file written.
+    what : str
+        The pronoun of what is kept (``"it"``, ``"them"``).
+    holders : sequence of (str, str)
+        The formats that hold it, and how (``("mjcf", "as armature")``).
+    source : str
+        How ``options.source`` holds it (``"exactly"``); empty: ``options.source`` is not
+        named. When named, a format of its own suffix is not offered.
+
+    Returns
+    -------
+    str
+        ``the MJCF export (robot.xml) holds them as armature, the TOML export (robot.toml)
+        as its [drive] table``; a format not written as ``a TOML export (--out r.toml)
+        would hold it exactly``.
+    """
+    stem = Path(path).stem
+    named = source and options.source is not None
+    own = Path(options.source).suffix.lower() if named and options.source else None
+    held = [
+        (f"the {_EXPORT_NAMES[f][0]} export ({options.beside[f]})", how)
+        for f, how in holders
+        if f in options.beside
+    ]
+    if named:
+        held.append((str(options.source), source))
+    groups: dict[str, list[str]] = {}  # how -> the files that hold it so, in order
+    for name, how in held:
+        groups.setdefault(how, []).append(name)
+    verb = ["holds" if len(names) == 1 else "hold" for names in groups.values()]
+    said = [
+        " and ".join(names) + (f" {verb[0]} {what}" if k == 0 else "") + f" {how}"
+        for k, (how, names) in enumerate(groups.items())
+    ]
+    parts = [", ".join(said)] if said else []
+    unwritten = [
+        (f, how)
+        for f, how in holders
+        if f not in options.beside and _EXPORT_NAMES[f][1] != own  # the source's own format
+    ]
+    others = [
+        f"{_article(_EXPORT_NAMES[f][0])} export (--out {stem}{_EXPORT_NAMES[f][1]})"
+        + (f" would hold {what} {how}" if k == 0 else f" {how}")
+        for k, (f, how) in enumerate(unwritten)
+    ]
+    if others:
+        parts.append("not written: " + ", ".join(others))
+    return "; ".join(parts)
+
+
+def _article(name: str) -> str:
+    """``an MJCF``, ``a TOML``, ``a URDF``: the article as the letters are spoken."""
+    return f"{'an' if name[0] in 'AEFHILMNORSX' else 'a'} {name}"
+
+
+def with_caveat(text: str, caveat: str | None, *, xml: bool) -> str:
+    """A robot file's ``text`` with ``caveat`` as a comment at its top (after an XML
+    declaration); ``text`` itself when ``caveat`` is None."""
+    if caveat is None:
+        return text
+    flat = " ".join(caveat.split())
+    if not xml:
+        return f"# {flat}\n{text}"
+    line = f"<!-- {flat.replace('--', '- -')} -->\n"
+    if text.startswith("<?xml"):
+        head, _, rest = text.partition("\n")
+        return f"{head}\n{line}{rest}"
+    return line + text

@@ -63,7 +63,7 @@ from ...model.drive import Drive
 from ...model.inertia import inertia6_from_matrix
 from ...model.robot import Robot
 from ..atomic import write_text
-from .export_options import ExportOptions
+from .export_options import ExportOptions, kept_elsewhere, with_caveat
 
 __all__ = ["export_mjcf", "mjcf_from_robot", "save_mjcf"]
 
@@ -84,9 +84,10 @@ def _pose(T: np.ndarray) -> str:
 
 
 def _law_terms(
-    friction: FrictionModel | FrictionSum, dq_max: NDArray[np.float64]
+    friction: FrictionModel | FrictionSum, dq_max: NDArray[np.float64], kept: str
 ) -> tuple[CoulombViscous, tuple[str, ...]]:
-    """A friction model as MuJoCo holds it, and what it drops (one line each)."""
+    """A friction model as MuJoCo holds it, and what it drops (one line each, ending with
+    ``kept``: the files that hold it, :func:`~dynid.io.robot.export_options.kept_elsewhere`)."""
     vmax = np.where(np.isfinite(dq_max), dq_max, 2.0)
     jt = joint_coulomb_viscous(friction, vmax)
     z = np.zeros(friction.n)
@@ -94,20 +95,16 @@ def _law_terms(
     lost = jt.notes + unheld_friction(friction, vmax)
     if not lost:
         return CoulombViscous(jt.frictionloss, jt.damping, offset, z, z), ()
-    holds = (
-        "feasible.json holds it exactly"
-        if isinstance(friction, FrictionSum)
-        else "the TOML export (robot.toml) and feasible.json hold it exactly"
-    )
     note = (
         f"the joints' frictionloss and damping (Coulomb and viscous friction at the joints) "
-        f"hold the {friction.kind} friction without {', '.join(lost)}: {holds}"
+        f"hold the {friction.kind} friction without {', '.join(lost)}"
+        + (f": {kept}" if kept else "")
     )
     return CoulombViscous(jt.frictionloss, jt.damping, offset, z, z), (note,)
 
 
 def _joint_terms(
-    robot: Robot, friction: bool | FrictionModel | FrictionSum, drive: Drive | None
+    robot: Robot, friction: bool | FrictionModel | FrictionSum, drive: Drive | None, kept: str
 ) -> tuple[CoulombViscous | None, NDArray[np.float64] | None, tuple[str, ...]]:
     """The friction written to the joints, the rotor ``armature`` and what MJCF cannot hold.
 
@@ -138,7 +135,7 @@ def _joint_terms(
         return coulomb_viscous_from_sigmoid(sigmoid, robot.dq_max), armature, notes
     if model is None:
         return None, armature, notes
-    approx, more = _law_terms(model, robot.dq_max)
+    approx, more = _law_terms(model, robot.dq_max, kept)
     return approx, armature, notes + more
 
 
@@ -231,6 +228,7 @@ def mjcf_from_robot(
     friction: bool | FrictionModel | FrictionSum = True,
     comment: str | None = None,
     drive: Drive | None = None,
+    kept: str = "",
 ) -> tuple[str, CoulombViscous | None]:
     """The MJCF document of a robot, and the friction approximation it holds.
 
@@ -250,6 +248,9 @@ def mjcf_from_robot(
         A drive with known rotor inertias: ``armature`` = ``diag(K^T diag(I_a) K)``; what
         MJCF cannot hold (a coupled rotor's off-diagonal inertia) is said in a
         :class:`~dynid.exceptions.DynidWarning` and in the comment, never dropped silently.
+    kept : str
+        The files that hold the friction exactly, said after what MJCF drops of it
+        (:func:`~dynid.io.robot.export_options.kept_elsewhere`); empty: none named.
 
     Returns
     -------
@@ -263,7 +264,7 @@ def mjcf_from_robot(
     ModelError
         A link other than the base is named ``world`` (MuJoCo's world body).
     """
-    approx, armature, notes = _joint_terms(robot, friction, drive)
+    approx, armature, notes = _joint_terms(robot, friction, drive, kept)
     if notes:  # one line: what MJCF cannot hold
         warnings.warn(f"MJCF export: {'; '.join(notes)}", DynidWarning, stacklevel=2)
     text = comment or _comment(friction, approx, armature, notes)
@@ -290,15 +291,28 @@ def save_mjcf(
     *,
     friction: bool | FrictionModel | FrictionSum = True,
     drive: Drive | None = None,
+    kept: str = "",
+    caveat: str | None = None,
 ) -> Path:
-    """Write :func:`mjcf_from_robot` to ``path``; returns the path."""
+    """Write :func:`mjcf_from_robot` to ``path``; returns the path. ``caveat``: a comment
+    at the top, why the fit was not accepted."""
     path = Path(path)
-    text, _ = mjcf_from_robot(robot, friction=friction, drive=drive)
-    write_text(path, text)
+    text, _ = mjcf_from_robot(robot, friction=friction, drive=drive, kept=kept)
+    write_text(path, with_caveat(text, caveat, xml=True))
     return path
 
 
 def export_mjcf(path: str | Path, robot: Robot, options: ExportOptions) -> Path:
     """:func:`save_mjcf` with the export options' ``friction`` and ``drive`` (the entry of
-    ``mjcf`` in the exports)."""
-    return save_mjcf(path, robot, friction=options.friction, drive=options.drive)
+    ``mjcf`` in the exports); the friction's warning names the files that hold it exactly
+    (``options.beside``, ``options.source``) or how to write them."""
+    exact = () if isinstance(options.friction, FrictionSum) else (("toml", "exactly"),)
+    kept = kept_elsewhere(options, path, "it", exact, source="exactly")
+    return save_mjcf(
+        path,
+        robot,
+        friction=options.friction,
+        drive=options.drive,
+        kept=kept,
+        caveat=options.caveat,
+    )

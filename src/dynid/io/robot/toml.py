@@ -63,7 +63,7 @@ from ..atomic import write_text
 from ..drive_file import drive_toml
 from ..input_files import file_text
 from ..schema import Field, Record, check, fault
-from .export_options import ExportOptions
+from .export_options import ExportOptions, with_caveat
 from .toml_friction import FRICTION_TABLE, friction_tables, table_friction
 
 __all__ = [
@@ -537,6 +537,7 @@ def save_toml(
     *,
     drive: Drive | None = None,
     friction: Friction | FrictionSum | None = None,
+    caveat: str | None = None,
 ) -> Path:
     """Write the TOML description of ``robot`` (:func:`toml_from_robot`) to ``path``.
 
@@ -546,6 +547,8 @@ def save_toml(
     robot : Robot
     drive, friction
         As :func:`toml_from_robot`.
+    caveat : str, optional
+        A comment at the top of the file: why the fit was not accepted.
 
     Returns
     -------
@@ -553,16 +556,15 @@ def save_toml(
         The path written.
     """
     text = toml_from_robot(robot, drive=drive, friction=friction)
-    return write_text(path, text)
+    return write_text(path, with_caveat(text, caveat, xml=False))
 
 
 def export_toml(path: str | Path, robot: Robot, options: ExportOptions) -> Path:
     """:func:`save_toml` with the export options' ``drive`` and ``friction`` (the entry of
     ``toml`` in the exports): ``True`` the robot's own friction, ``False`` none, a friction
     model (the one identified with the links) written in its place."""
-    f = options.friction
+    f, caveat = options.friction, options.caveat
     if f is True:
-        return save_toml(path, robot, drive=options.drive)
-    return save_toml(
-        path, robot if f else robot.with_friction(None), drive=options.drive, friction=f or None
-    )
+        return save_toml(path, robot, drive=options.drive, caveat=caveat)
+    held = robot if f else robot.with_friction(None)
+    return save_toml(path, held, drive=options.drive, friction=f or None, caveat=caveat)

@@ -58,7 +58,7 @@ from ...model.inertia import inertia6_from_matrix
 from ...model.robot import Frame, Robot
 from ..atomic import write_text
 from ..input_files import file_text
-from .export_options import ExportOptions
+from .export_options import ExportOptions, kept_elsewhere, with_caveat
 from .urdf_parse import load_urdf, robot_from_urdf_string
 from .urdf_patch import patch_urdf_dynamics, patch_urdf_inertials
 
@@ -235,6 +235,7 @@ def save_urdf(
     merged: str = "subtract",
     dynamics: tuple[NDArray[np.float64], NDArray[np.float64]] | None = None,
     template_dynamics: bool = False,
+    caveat: str | None = None,
 ) -> Path:
     """Write the robot as URDF to ``path``; returns the path.
 
@@ -255,6 +256,9 @@ def save_urdf(
         Template: also replace the friction of the chain's ``<dynamics>`` by ``dynamics``
         (None: removed; :func:`dynid.io.robot.urdf_patch.patch_urdf_dynamics`); default:
         the template's ``<dynamics>`` are kept.
+    caveat : str, optional
+        A comment at the top of the file (after the XML declaration): why the fit was not
+        accepted.
 
     Raises
     ------
@@ -285,7 +289,7 @@ def save_urdf(
                 warnings.simplefilter("ignore", DynidWarning)  # the template's own
                 chain = robot_from_urdf_string(original, base, tip)
             text = patch_urdf_dynamics(text, list(chain.joint_names), dynamics)
-    write_text(path, text)
+    write_text(path, with_caveat(text, caveat, xml=True))
     return path
 
 
@@ -309,12 +313,16 @@ def armature_shares(robot: Robot, armature: NDArray[np.float64]) -> NDArray[np.f
         return np.where(a == 0, 0.0, a / np.abs(diag))
 
 
-def _rotor_warning(drive: Drive | None, robot: Robot, path: Path) -> str | None:
+def _rotor_warning(
+    drive: Drive | None, robot: Robot, path: Path, options: ExportOptions
+) -> str | None:
     """What URDF cannot hold of a drive, as a warning of its own: its rotor inertias (the
     armature per joint, ``diag(K^T diag(I_a) K)`` [kg m^2]) by joint with their share of
-    the joint's inertia, and the exports that hold them; None without any, or when every
-    one is below :data:`NEGLIGIBLE_ARMATURE` of its joint's inertia. A drive without gears
-    (``K = 1``: an armature identified without a drive) is spoken of as the armature."""
+    the joint's inertia, and the exports that hold them (MJCF ``armature``, the TOML
+    ``[drive]`` table: the files written beside it, or how to write them); None without
+    any, or when every one is below :data:`NEGLIGIBLE_ARMATURE` of its joint's inertia. A
+    drive without gears (``K = 1``: an armature identified without a drive) is spoken of
+    as the armature."""
     if drive is None or drive.rotor_inertia is None or not np.any(drive.rotor_inertia != 0):
         return None
     arm = drive_joint_terms(drive.transmission, drive.rotor_inertia, None, None).armature
@@ -332,11 +340,11 @@ def _rotor_warning(drive: Drive | None, robot: Robot, path: Path) -> str | None:
         if geared
         else "the armature (rotor inertia at the joints, without gears)"
     )
+    holders = (("mjcf", "as armature"), ("toml", "as its [drive] table"))
     return (
         f"URDF export: {path.name} leaves out {what}, which URDF has no element for "
         f"(armature per joint [kg m^2]: {values}; M_jj at the middle of the joint ranges); "
-        f"the MJCF export ({path.stem}.xml) holds them as armature, the TOML export "
-        f"({path.stem}.toml) as its [drive] table"
+        + kept_elsewhere(options, path, "them", holders)
     )
 
 
@@ -382,15 +390,12 @@ def export_urdf(path: str | Path, robot: Robot, options: ExportOptions) -> Path:
         dynamics = (jt.damping, jt.frictionloss)
         lost = jt.notes + unheld_friction(model, vmax)
         if lost:
-            holds = (
-                "feasible.json holds it exactly"
-                if isinstance(model, FrictionSum)
-                else "the TOML export (robot.toml) and feasible.json hold it exactly"
-            )
+            exact = () if isinstance(model, FrictionSum) else (("toml", "exactly"),)
+            holds = kept_elsewhere(options, path, "it", exact, source="exactly")
             notes = (
                 f"{Path(path).name} holds the {model.kind} friction as <dynamics damping "
                 f"friction> (viscous and sharp Coulomb friction at the joints), not as the "
-                f"law itself; {'; '.join(lost)}; {holds}",
+                f"law itself; {'; '.join(lost)}" + (f"; {holds}" if holds else ""),
             )
     replace = False
     if options.template is not None:
@@ -409,10 +414,11 @@ def export_urdf(path: str | Path, robot: Robot, options: ExportOptions) -> Path:
         merged=options.merged,
         dynamics=dynamics,
         template_dynamics=replace,
+        caveat=options.caveat,
     )
     if notes:  # one line, once written: what URDF cannot hold of the friction
         warnings.warn(f"URDF export: {'; '.join(notes)}", DynidWarning, stacklevel=2)
-    rotors = _rotor_warning(drive, robot, Path(path))
+    rotors = _rotor_warning(drive, robot, Path(path), options)
     if rotors is not None:  # a line of its own: it costs far more than the friction's
         warnings.warn(rotors, DynidWarning, stacklevel=2)
     return out

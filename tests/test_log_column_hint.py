@@ -1,0 +1,83 @@
+"""A torque log whose joint signals carry another tool's names (ROS JointState's
+``position``, ``velocity``, ``effort``; a vendor's ``torque``) is refused, never read by
+guess (an ``effort`` is a motor current on some arms), but the error names the columns
+left unused and the ``--columns`` map that reads them; the map it gives is then read back
+against the values written."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from dynid.exceptions import DataError
+from dynid.io.columns import load_mapped_torque_log, parse_column_map
+from dynid.io.torque_log import load_torque_log
+
+N = 7
+
+
+def _write(path, names: dict[str, list[str]], seed: int = 0) -> dict[str, np.ndarray]:
+    """A 50-sample log at 100 Hz with the given column names per signal; its arrays."""
+    rng = np.random.default_rng(seed)
+    arrays = {"t": np.arange(50) / 100.0}
+    arrays |= {k: rng.uniform(-1, 1, (50, N)) for k in names}
+    header = ["t", *(c for cols in names.values() for c in cols)]
+    body = np.column_stack([arrays["t"], *(arrays[k] for k in names)])
+    np.savetxt(path, body, delimiter=",", header=",".join(header), comments="", fmt="%.17g")
+    return arrays
+
+
+def _cols(prefix: str, first: int = 1) -> list[str]:
+    return [f"{prefix}{j + first}" for j in range(N)]
+
+
+def test_effort_columns_are_named_with_the_map_that_reads_them(tmp_path):
+    """Regression: effort1..effort7 in place of tau1..tau7 gave only "missing column(s)
+    ['tau1', ..., 'tau7']"; now the error names the unused columns and --columns
+    'tau=effort{i}', which reads the torques written."""
+    path = tmp_path / "log.csv"
+    arrays = _write(path, {"q": _cols("q"), "dq": _cols("dq"), "tau": _cols("effort")})
+    with pytest.raises(DataError) as err:
+        load_torque_log(path)
+    said = str(err.value)
+    assert "missing column(s) tau1..tau7 (n = 7 from q1..q7)" in said, said
+    assert "present but unused: effort1..effort7" in said, said
+    spec = said.split("--columns '")[1].split("'")[0]
+    assert spec == "tau=effort{i}" and "motor currents" in said, said
+    log = load_mapped_torque_log(path, parse_column_map(spec)).log
+    np.testing.assert_array_equal(log.tau, arrays["tau"])
+
+
+def test_a_joint_state_header_counted_from_zero_gets_its_whole_map(tmp_path):
+    """position_0.., velocity_0.., effort_0..: the header error gives the map of all three
+    with {i0}, and it reads the positions, velocities and torques written."""
+    path = tmp_path / "js.csv"
+    names = {"q": _cols("position_", 0), "dq": _cols("velocity_", 0), "tau": _cols("effort_", 0)}
+    arrays = _write(path, names)
+    with pytest.raises(DataError, match="header must name columns") as err:
+        load_torque_log(path)
+    spec = str(err.value).split("--columns '")[1].split("'")[0]
+    assert spec == "q=position_{i0},dq=velocity_{i0},tau=effort_{i0}", str(err.value)
+    log = load_mapped_torque_log(path, parse_column_map(spec)).log
+    for k in ("q", "dq", "tau"):
+        np.testing.assert_array_equal(getattr(log, k), arrays[k])
+
+
+def test_two_candidate_torque_families_are_named_but_none_is_chosen(tmp_path):
+    """effort1..7 beside torque1..7: both named as unused, no map offered for either."""
+    path = tmp_path / "two.csv"
+    _write(path, {"q": _cols("q"), "tau": _cols("effort"), "e": _cols("torque")})
+    with pytest.raises(DataError) as err:
+        load_torque_log(path)
+    said = str(err.value)
+    assert "effort1..effort7" in said and "torque1..torque7" in said, said
+    assert "--columns '" not in said and "name the columns tau1..tau7" in said, said
+
+
+def test_a_single_missing_torque_column_is_named_without_a_map(tmp_path):
+    """tau7 alone missing: named as before, and no map is offered."""
+    path = tmp_path / "six.csv"
+    _write(path, {"q": _cols("q"), "tau": _cols("tau")[:6] + ["note"]})
+    with pytest.raises(DataError, match=r"missing column\(s\) \['tau7'\]") as err:
+        load_torque_log(path)
+    assert "present but unused: note" in str(err.value) and "--columns '" not in str(err.value)
