@@ -172,12 +172,13 @@ def test_validate_of_a_log_the_model_cannot_explain_says_so_and_exits_1(
             code = main([*argv, *map(str, data)])
         said = capsys.readouterr().out.splitlines()
         assert code == 1
-        assert said[-1].startswith("verdict: unusable: ") and why in said[-1], said[-1]
+        assert said[-1] == f"report: {out / 'report.html'}"  # the page, after the verdict
+        assert said[-2].startswith("verdict: unusable: ") and why in said[-2], said[-2]
         doc = json.loads((out / "validation.json").read_text())
         assert doc["verdict"]["level"] == "unusable"
     argv = ["validate", "--robot", "panda", "--no-figures", "--out", str(tmp_path / "ok")]
     assert main([*argv, "--data", str(logs / "rec1.csv")]) == 0
-    assert capsys.readouterr().out.splitlines()[-1].startswith("verdict: at the noise floor: ")
+    assert capsys.readouterr().out.splitlines()[-2].startswith("verdict: at the noise floor: ")
 
 
 def test_validate_refuses_another_joint_count_in_one_line_naming_the_file(
