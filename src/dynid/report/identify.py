@@ -567,6 +567,8 @@ def answer(run: RunFiles) -> Answer | None:
         )
         if consistent is not None:  # the answer asked for: the consistent fit's error
             first, more, headline = _consistent_facts(doc, consistent)
+            above = _above_noise(held) if isinstance(held, dict) else ""
+            headline += f"; least squares leaves {esc(above)}" if above else ""
             facts = first + [f"Least squares: {f[0].lower()}{f[1:]}" for f in facts]
             problems = more + problems
     rank, p = _rank_fact(doc)
