@@ -198,13 +198,17 @@ def outside_model_note(found: Sequence[Dependence], joint_names: Sequence[str]) 
     when least squares itself leaves a systematic residual (``found``:
     :func:`residual_dependence` of its held-out prediction): an effect outside the
     rigid-body model pulls the links' parameters, which least squares may bend to and the
-    consistent fit may not. None when ``found`` is empty."""
+    consistent fit may not; the :data:`NAMED` farthest above their noise first. None when
+    ``found`` is empty."""
     if not found:
         return None
+    found = sorted(found, key=lambda d: d.rms / d.noise, reverse=True)
+    more = len(found) - NAMED
+    found = found[:NAMED]
     which = ", ".join(
         f"{joint_names[d.joint]} ({d.rms / d.noise:.3g} x its noise, {d.rms:.3g} N m RMS)"
         for d in found
-    )
+    ) + (f" and {more} more joint(s)" if more > 0 else "")
     return (
         f"least squares itself leaves a systematic residual on {which}: an effect outside "
         "the rigid-body model there pulls the links' parameters, and the consistent fit "
