@@ -151,13 +151,13 @@ def register(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParser:
         default=None,
         metavar="TERMS",
         help="torque logs: the model's terms beside the links, comma-separated from armature, "
-        "viscous, quadratic, coulomb, smooth[:W], stribeck[:V], offset, "
+        "spring, viscous, quadratic, coulomb, smooth[:W], stribeck[:V], offset, "
         "at:motor|at:joint|at:both, -LABEL ('links' for none; W the smooth Coulomb's width in "
         "standstill bands, or one per joint as W1/W2/..., V the Stribeck velocity [rad/s]; "
         "at: where a coupled drive's friction acts, both: at the motors and at the joints no "
         "motor turns alone; -fo3 leaves joint 3's offset out, -fc5 joint 5's Coulomb "
-        "friction, -Ia2 joint 2's armature); default: chosen on held-out data (see Model "
-        "structure above)",
+        "friction, -Ia2 joint 2's armature; spring: a stiffness per joint, with offset); "
+        "default: chosen on held-out data (see Model structure above)",
     )
     add_column_options(p)
     p.add_argument("--out", type=output_path, required=True, help="output folder")

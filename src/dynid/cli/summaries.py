@@ -335,6 +335,10 @@ def samples_text(log: LogInfo, decimations: Sequence[int] = ()) -> str:
     return text + ")"
 
 
+#: How the columns summary names a term's columns that are not friction, by its kind.
+_KIND_WORDS = {"rotor_inertia": "rotor inertia", "joint_spring": "spring"}
+
+
 def columns_text(model: IdentifiedModel) -> str:
     """The base parameters, the appended terms' columns by what they are (friction,
     offsets, rotor inertias) and the rank, counted separately."""
@@ -344,8 +348,8 @@ def columns_text(model: IdentifiedModel) -> str:
     for t in model.appended:
         for label in t.term.labels:
             what = (
-                "rotor inertia"
-                if t.term.kind == "rotor_inertia"
+                _KIND_WORDS[t.term.kind]
+                if t.term.kind in _KIND_WORDS
                 else "offset"
                 if label.startswith("fo")  # the offset term's coefficients, fo1 .. fon
                 else "friction"

@@ -46,6 +46,11 @@ from ..identification.log import TorqueLog, joint_side_log
 from ..identification.low_speed import low_speed_hint
 from ..identification.model import IdentifiedModel
 from ..identification.pieces import split_at_gaps, unwrapped, wrappable
+from ..identification.residual_dependence import (
+    Dependence,
+    residual_dependence,
+    with_dependence_hint,
+)
 from ..identification.sanity import despiked
 from ..identification.verdict import Verdict, with_caveat, with_hint, with_replaced_spikes
 from .fit import model_drive, torques_through
@@ -137,12 +142,26 @@ class HeldOutTorques:
         and that of an error mostly at low speed
         (:func:`~dynid.identification.low_speed.with_low_speed_hint`); the torque spikes
         replaced before judging counted
-        (:func:`~dynid.identification.verdict.with_replaced_spikes`)."""
-        verdict = self._judged()[0]
+        (:func:`~dynid.identification.verdict.with_replaced_spikes`); each joint above its
+        noise, what its residual follows
+        (:func:`~dynid.identification.residual_dependence.with_dependence_hint`)."""
+        verdict, fl = self._judged()
+        v = self.validation
+        verdict = with_dependence_hint(
+            verdict, [v.log.q], [v.log.dq], [v.log.tau - v.tau_hat], fl.total_rms, self.joint_names
+        )
         verdict = with_derived_cutoff_hint(verdict, self.logs, self.cutoff_hz)
         verdict = with_hint(verdict, self.low_speed, ", ")
         verdict = with_caveat(verdict, self.caveat)
         return with_replaced_spikes(verdict, self.spikes, ", as the fit replaced them")
+
+    @property
+    def systematic(self) -> tuple[Dependence, ...]:
+        """The joints whose held-out residual is above their noise and what it follows
+        (:func:`~dynid.identification.residual_dependence.residual_dependence`)."""
+        v = self.validation
+        fl = self._judged()[1]
+        return residual_dependence([v.log.q], [v.log.dq], [v.log.tau - v.tau_hat], fl.total_rms)
 
     @property
     def low_speed(self) -> str | None:

@@ -140,6 +140,8 @@ def judged_prediction(
         joint_ratios=fl.joint_ratios,
         joint_percent=errors.relative_error_percent_per_joint,
         joint_names=joint_names,
+        joint_rms=errors.rms,
+        joint_rough=None if fl.input_rms is None else fl.input_rms > fl.sensor_rms,
         floor_parts=fl.words,
         ratio=fl.ratio,
     )

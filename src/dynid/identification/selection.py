@@ -118,12 +118,27 @@ __all__ = [
 
 
 def _terms_of(
-    structure: Structure, drive: Drive | None, n: int, data: Recordings
+    structure: Structure,
+    drive: Drive | None,
+    n: int,
+    data: Recordings,
+    rest: tuple[float, ...] = (),
 ) -> tuple[Drive | None, tuple[ModelTerm, ...]]:
-    """:func:`~dynid.identification.structure.structure_terms` with the recordings' bands."""
+    """:func:`~dynid.identification.structure.structure_terms` with the recordings' bands
+    (a spring about ``rest`` [rad])."""
     return structure_terms(
-        structure, drive, n, tuple(data.band), recording_bands(data), data.band_gain
+        structure, drive, n, tuple(data.band), recording_bands(data), data.band_gain, rest
     )
+
+
+def _limits_middle(robot: Robot) -> tuple[float, ...]:
+    """The middle of each joint's limits [rad], zero for a joint without finite limits: a
+    spring's rest position, whose true value the offset absorbs."""
+    lo, hi = np.asarray(robot.q_min, dtype=np.float64), np.asarray(robot.q_max, dtype=np.float64)
+    finite = np.isfinite(lo) & np.isfinite(hi)  # a continuous joint: -inf .. inf
+    mid = np.zeros(lo.shape)
+    mid[finite] = (lo[finite] + hi[finite]) / 2
+    return tuple(float(x) for x in mid)
 
 
 def _with_floor(heldout: Any, data: Recordings) -> Any:
@@ -801,7 +816,7 @@ def identify_recordings(
             robot, data, drive=drive, estimator=est, folds=folds, validation=validation, rtol=rtol
         )
         structure = _fitted_structure(robot, data, selection, friction)
-    model_drive, terms = _terms_of(structure, drive, robot.n, data)
+    model_drive, terms = _terms_of(structure, drive, robot.n, data, _limits_middle(robot))
     judge, _, fold_labels = heldout_judge(robot, data, est, folds, validation)
     try:
         with stage("the fit of the structure chosen" if selection else "the fit", rows=data.n_rows):

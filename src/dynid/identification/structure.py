@@ -3,7 +3,8 @@
 A joint-torque log of a real arm holds more than the rigid links: the rotors' inertia
 (an armature ``I_a ddq`` per joint, or the rotors of a drive), viscous and Coulomb friction,
 torque offsets, friction laws with a shape (a smooth Coulomb's width, one for every joint
-or one per joint, and a Stribeck velocity).
+or one per joint, and a Stribeck velocity), and a spring per joint (a gravity
+compensator, a cable: :class:`~dynid.regressors.spring.JointSpring`).
 A :class:`Structure` names the terms: ``armature`` (per joint ``I_a ddq`` without a drive,
 the drive's rotor inertias with one) and the parts of the joint (motor) friction
 (:data:`~dynid.regressors.terms.FRICTION_PARTS`); :func:`structure_terms` makes its model
@@ -24,6 +25,7 @@ import numpy as np
 
 from ..exceptions import OptionError
 from ..model.drive import Drive
+from ..regressors.spring import JointSpring
 from ..regressors.terms import (
     FRICTION_PARTS,
     PART_LABELS,
@@ -143,6 +145,11 @@ class Structure:
         ``fc``, ``fsp``, ``fo``; 1-based; ``jfc7``: joint 7's Coulomb friction at the joint
         with ``at="both"``), ``"Ia3"`` (or ``ia3``) joint 3 (motor 3) without armature;
         every other joint holds every term.
+    spring : bool
+        A linear stiffness ``k_j (q_j - q0_j)`` [N m/rad] per joint (labels ``k1 .. k_n``,
+        :class:`~dynid.regressors.spring.JointSpring`) about a fixed ``q0`` (the middle of
+        the joint's limits, :func:`structure_terms`): the spring's true rest position only
+        adds a constant torque, which the offset (``offset``) absorbs.
     """
 
     armature: bool = False
@@ -151,6 +158,7 @@ class Structure:
     vst: float = 0.0
     at: str = ""
     drop: tuple[str, ...] = ()
+    spring: bool = False
 
     def __post_init__(self) -> None:
         if self.at not in _PLACEMENTS:
@@ -158,7 +166,7 @@ class Structure:
         bad = [p for p in self.friction if p not in FRICTION_PARTS]
         if bad:
             raise OptionError(
-                f"names unknown model term(s) {bad}; terms are armature, "
+                f"names unknown model term(s) {bad}; terms are armature, spring, "
                 + ", ".join(FRICTION_PARTS)
                 + " (or links for none)",
                 field="terms",
@@ -339,6 +347,7 @@ class Structure:
         where = (f"at:{self.at}",) if self.at and self.friction else ()
         return (
             (("armature",) if self.armature else ())
+            + (("spring",) if self.spring else ())
             + tuple(shape.get(p, p) for p in self.friction)
             + where
             + tuple(f"-{lab}" for lab in self.drop)
@@ -356,7 +365,7 @@ class Structure:
         """From ``"armature,viscous,coulomb"`` (``"links"`` or ``""`` for none);
         ``smooth:W`` gives the smooth Coulomb's width in standstill bands (``smooth:W1/W2/..``
         one per joint or motor), ``stribeck:V`` the Stribeck velocity [rad/s], ``at:joint``
-        or ``at:motor`` where the friction acts.
+        or ``at:motor`` where the friction acts; ``spring`` a stiffness per joint.
 
         Raises
         ------
@@ -383,11 +392,12 @@ class Structure:
             names.append(name)
         return cls(
             armature="armature" in names,
-            friction=tuple(w for w in names if w != "armature"),
+            friction=tuple(w for w in names if w not in ("armature", "spring")),
             width=shapes["smooth"] if "smooth" in shapes else 0.0,
             vst=shapes.get("stribeck", (0.0,))[0],
             at=at,
             drop=tuple(drop),
+            spring="spring" in names,
         )
 
 
@@ -540,6 +550,7 @@ def structure_terms(
     band: Sequence[float] = (),
     bands: Mapping[str, Sequence[float]] | None = None,
     gain: float = 1.0,
+    rest: Sequence[float] = (),
 ) -> tuple[Drive | None, tuple[ModelTerm, ...]]:
     """The model's drive and terms of ``structure``: without a drive, an armature is the
     rotor inertia of a direct drive (``K = 1``); friction acts where the structure says
@@ -548,7 +559,8 @@ def structure_terms(
     ``bands["motor"]`` or ``bands["joint"]``, else ``band``. The Coulomb sign's standstill
     band is ``gain`` times it (the noise the filtered velocities keep:
     :attr:`~dynid.identification.recordings.Recordings.band_gain`), and so does a smooth
-    Coulomb's width.
+    Coulomb's width. A spring acts about ``rest`` [rad] (n,) (default zeros; identify
+    passes the middle of each joint's limits, zero for a joint without).
 
     Raises
     ------
@@ -556,6 +568,8 @@ def structure_terms(
         An armature asked of a drive whose rotor inertias are known (given in its file).
     """
     model_drive, terms = _rotor_terms(structure.armature, drive, n, structure.armature_mask(n))
+    if structure.spring:
+        terms.append(JointSpring(tuple(float(x) for x in rest) if rest else (0.0,) * n))
     if structure.friction:
         model_drive, at, b = _placed(structure.at, model_drive, n, band, bands)
         terms.append(

@@ -60,6 +60,10 @@ class ObserverModel:
         (:meth:`~dynid.regressors.terms.ModelTerm.momentum_columns`).
     source : str
         What the model was made from (``"identified"``, ``"robot"``), for reports.
+    position_terms : tuple of (ModelTerm, ndarray)
+        The identified model's terms that are neither friction nor in the base (a joint
+        spring), each with its coefficients: torques of the position that the measured
+        torque spends beside the links' (:meth:`position_torques`), no momentum.
     """
 
     robot: Robot
@@ -71,6 +75,7 @@ class ObserverModel:
     drive: Drive | None = None
     source: str = "robot"
     base_terms: tuple[ModelTerm, ...] = ()
+    position_terms: tuple[tuple[ModelTerm, NDArray[np.float64]], ...] = ()
 
     def __post_init__(self) -> None:
         n = self.robot.n
@@ -92,8 +97,19 @@ class ObserverModel:
         """The same model with another friction (None: none)."""
         return ObserverModel(
             self.robot, self.rotor_mass, friction, self.base, self.beta, self.covariance,
-            self.drive, self.source, self.base_terms,
+            self.drive, self.source, self.base_terms, self.position_terms,
         )  # fmt: skip
+
+    def position_torques(self, q: NDArray[np.float64]) -> NDArray[np.float64] | None:
+        """The torques (N, n) [N m] of :attr:`position_terms` at the positions ``q`` (N, n)
+        [rad] (at rest), or None without such terms."""
+        if not self.position_terms:
+            return None
+        z = np.zeros_like(q)
+        return sum(
+            (term.torque_columns(q, z, z) @ values for term, values in self.position_terms),
+            np.zeros_like(q),
+        )
 
     def mass_matrix(self, q: ArrayLike) -> NDArray[np.float64]:
         """``M(q)`` [kg m^2] with the rotor part: (..., n) -> (..., n, n)."""
@@ -140,6 +156,11 @@ def from_identified(
         drive=model.drive,
         source="identified",
         base_terms=tuple(t.term for t in in_base),
+        position_terms=tuple(
+            (t.term, np.asarray(t.values, dtype=np.float64))
+            for t in model.terms.values()
+            if not t.term.in_base and t.term.friction(t.values) is None
+        ),
     )
 
 

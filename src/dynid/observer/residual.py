@@ -245,6 +245,9 @@ class MomentumObserver:
             raise DataError(
                 f"t must increase from sample to sample; got {tf!r} after {self._S[1]!r}"
             )
+        held = self.model.position_torques(qa[None])
+        if held is not None:  # a spring's torque: spent beside the links'
+            taua = taua - held[0]
         if self._python_friction and self.model.friction is not None:
             taua = taua - self.model.friction.torques(dqa)
         r = np.empty(n)
@@ -279,6 +282,9 @@ class MomentumObserver:
             raise DataError(
                 f"t must increase from sample to sample; sample {k} (t = {ta[k]!r}) does not"
             )
+        held = self.model.position_torques(qa)
+        if held is not None:  # a spring's torque: spent beside the links'
+            taua = taua - held
         mod = self._kernels
         if mod is not None and N:
             D, u = self._D, taua  # friction in the kernel, or first by the model's own law

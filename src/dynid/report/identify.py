@@ -26,6 +26,8 @@ import math
 import re
 from typing import Any
 
+import numpy as np
+
 from ..exceptions import DynidError
 from ..identification.determined import determined_sentence
 from ..identification.structure import Structure
@@ -33,6 +35,7 @@ from ..identification.verdict import (
     FLOOR_GOOD,
     LEVELS,
     Verdict,
+    joint_levels,
     joint_ratios,
     judge_prediction,
     with_caveat,
@@ -159,6 +162,7 @@ def _own_facts(
         contradicted,
         within_motion=within_motion,
         what="noise floor",
+        above=_above_noise(held),
     )
     facts = [f"On {esc(str(held.get('block', 'held-out data')))}: {fact[0].lower()}{fact[1:]}"]
     spikes = held.get("torque_spikes_replaced")
@@ -168,6 +172,32 @@ def _own_facts(
     if isinstance(low, str) and low:  # where the rest of the error sits
         facts.append(esc(low[0].upper() + low[1:]))
     return facts, problems, headline
+
+
+def _above_noise(held: dict) -> str:
+    """The joints of heldout.json judged above their noise
+    (:func:`~dynid.identification.verdict.joint_levels`: beyond
+    :data:`~dynid.identification.verdict.SYSTEMATIC_RATIO` x it), in words
+    (``"right_s1 at 2.43 x its noise (0.738 N m RMS)"``), or ``""``."""
+    rms, noise, names = held.get("rms"), held.get("noise_rms"), held.get("joint_names")
+    if not (isinstance(rms, list) and isinstance(noise, list) and isinstance(names, list)):
+        return ""
+    if not len(rms) == len(noise) == len(names) or not all(map(is_number, rms + noise)):
+        return ""
+    r = joint_ratios(rms, noise)
+    s, i = held.get("sensor_noise_rms"), held.get("input_noise_rms")
+    rough = None
+    if isinstance(s, list) and isinstance(i, list) and len(s) == len(i) == len(r):
+        rough = [is_number(a) and is_number(b) and b > a for a, b in zip(s, i, strict=True)]
+    per = held.get("relative_error_percent_per_joint")
+    per = per if isinstance(per, list) and len(per) == len(r) and all(map(is_number, per)) else None
+    levels = joint_levels(per, r, rough)
+    said = [
+        f"{names[j]} at {r[j]:.3g} x its noise ({float(rms[j]):.3g} N m RMS)"
+        for j in np.argsort(-r)
+        if levels[j] != "good"
+    ]
+    return ", ".join(said) + (" (a systematic residual)" if said else "")
 
 
 def _parameters_per_row(doc: dict) -> float | None:
@@ -230,13 +260,15 @@ def _floor_fact(
     *,
     within_motion: bool = False,
     what: str = "sensor-noise floor",
+    above: str = "",
 ) -> tuple[str, list[str], str]:
     """(fact, problems, headline) of an error against a noise floor, ``what`` it is (the
     joints the verdict names, or why it was reached; unusable where the data contradict the
     robot; ``within_motion``: judged on blocks of the motion the model was fitted to, which
-    test too little, :func:`~dynid.identification.least_squares.within_motion_caveat`)."""
+    test too little, :func:`~dynid.identification.least_squares.within_motion_caveat`);
+    ``above``: the joints above their own noise in words, said in the headline."""
     r = v.ratio if v.ratio is not None else math.inf
-    joints = v.reason.split("; ", 1)[1] if "; joint(s) " in v.reason else ""
+    joints = "joint(s) " + v.reason.split("; joint(s) ", 1)[1] if "; joint(s) " in v.reason else ""
     said = (
         "<b>unusable</b>: the data contradict the robot (below), whatever the error"
         if contradicted
@@ -246,10 +278,10 @@ def _floor_fact(
         f"Error {percent(err)} against a {what} of {percent(floor)} of the "
         f"{esc(torques)} (<b>{r:.3g} x the floor</b>): {said}"
     )
-    level = "at" if r <= FLOOR_GOOD else f"{r:.3g} times"  # as in the fact
+    level = "at" if r <= FLOOR_GOOD and not above else f"{r:.3g} times"  # as in the fact
     headline = (
         f"The model predicts held-out torques to {percent(err)}, {level} the "
-        f"{what} of {percent(floor)}"
+        f"{what} of {percent(floor)}" + (f"; {esc(above)}" if above else "")
     )
     if contradicted:
         headline = (
@@ -355,6 +387,7 @@ def _heldout_verdict(held: dict, err: float | None = None, floor: float | None =
         floor if is_number(floor) else None,
         joint_ratios=ratios,
         joint_percent=per,
+        joint_rms=rms if ratios is not None else None,
         joint_names=[str(x) for x in names]
         if isinstance(names, list) and len(names) == n
         else None,
@@ -534,6 +567,8 @@ def answer(run: RunFiles) -> Answer | None:
         )
         if consistent is not None:  # the answer asked for: the consistent fit's error
             first, more, headline = _consistent_facts(doc, consistent)
+            above = _above_noise(held) if isinstance(held, dict) else ""
+            headline += f"; least squares leaves {esc(above)}" if above else ""
             facts = first + [f"Least squares: {f[0].lower()}{f[1:]}" for f in facts]
             problems = more + problems
     rank, p = _rank_fact(doc)

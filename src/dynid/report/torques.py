@@ -23,6 +23,7 @@ from ..identification.verdict import (
     JOINT_FAIR,
     JOINT_GOOD,
     LEVELS,
+    SYSTEMATIC_RATIO,
     UNUSABLE_PERCENT,
     joint_levels,
     judge_prediction,
@@ -97,7 +98,8 @@ def validate_answer(run: RunFiles) -> Answer | None:
     if isinstance(per, list) and per and all(is_number(p) for p in per):
         ratio = _noise_ratios(doc, len(per))
         j = max(range(len(per)), key=lambda k: (ratio[k], per[k]))
-        joint = joint_levels([per[j]], [ratio[j]])[0]
+        known = ratio[j] if ratio[j] < float("inf") else float("nan")
+        joint = joint_levels([per[j]], [known], _rough(doc, j))[0]
         if LEVELS.index(joint) > LEVELS.index(level) and level != "unusable":
             level = joint
         noise = f", {ratio[j]:.3g} x its sensor noise" if ratio[j] < float("inf") else ""
@@ -109,8 +111,9 @@ def validate_answer(run: RunFiles) -> Answer | None:
         )
         facts.append(
             f"{ranked} {esc(_names(doc, len(per))[j])}: relative error "
-            f"<b>{percent(per[j])}</b>{noise} (per joint judged good below {JOINT_GOOD:g} % or "
-            f"at its noise, usable below {JOINT_FAIR:g} % or {FLOOR_FAIR:g} x its noise)"
+            f"<b>{percent(per[j])}</b>{noise} (per joint judged good within "
+            f"{SYSTEMATIC_RATIO:g} x its noise, or below {JOINT_GOOD:g} % where its noise is "
+            f"not known; usable below {JOINT_FAIR:g} % or {FLOOR_FAIR:g} x its noise)"
         )
     rms = doc.get("rms")
     if isinstance(rms, list) and rms:
@@ -144,6 +147,18 @@ def _noise_ratios(doc: dict, n: int) -> list[float]:
         r / s if is_number(r) and is_number(s) and s > 0 else float("inf")
         for r, s in zip(rms, noise, strict=True)
     ]
+
+
+def _rough(doc: dict, j: int) -> list[bool] | None:
+    """Whether joint ``j``'s noise is mostly the states' through the model
+    (validation.json ``input_noise_rms`` above ``sensor_noise_rms``), as a one-joint
+    list; None where the file does not say."""
+    s, i = doc.get("sensor_noise_rms"), doc.get("input_noise_rms")
+    if not (isinstance(s, list) and isinstance(i, list) and len(s) == len(i) > j):
+        return None
+    if not (is_number(s[j]) and is_number(i[j])):
+        return None
+    return [bool(i[j] > s[j])]
 
 
 def _added(doc: dict) -> str:

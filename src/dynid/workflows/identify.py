@@ -44,6 +44,7 @@ from ..identification.gravity_scale import gravity_scale_finding
 from ..identification.least_squares import STD_METHODS, StdMethod
 from ..identification.log import TorqueLog
 from ..identification.model import IdentifiedModel
+from ..identification.residual_dependence import outside_model_note
 from ..identification.selection import identify_recordings
 from ..identification.static import identify_static
 from ..identification.structure import Structure
@@ -488,6 +489,18 @@ def _one_static_file(paths: list[Path], opt: IdentifyOptions) -> None:
             )
 
 
+def _with_outside_model_note(
+    result: ConsistentResult, held: HeldOutTorques | None, names: Sequence[str]
+) -> ConsistentResult:
+    """``result`` with the note that least squares' own held-out residual is systematic
+    (:func:`~dynid.identification.residual_dependence.outside_model_note`) first, when its
+    held-out judgement rejected it; else ``result`` itself."""
+    if held is None or result.heldout is None or result.heldout.accepted:
+        return result
+    said = outside_model_note(held.systematic, names)
+    return result if said is None else dataclasses.replace(result, notes=(said, *result.notes))
+
+
 def _identify_consistent(
     robot: Robot, paths: list[Path], opt: IdentifyOptions, prior: Robot | None
 ) -> tuple[ConsistentResult, HeldOutTorques | None]:
@@ -533,6 +546,7 @@ def _identify_consistent(
         held = None if unconstrained is None else _predicted_heldout(unconstrained, logs, separate)
         if unconstrained is not None:
             _say_gravity_scale(robot, unconstrained, logs, opt.drive)
+        result = _with_outside_model_note(result, held, robot.joint_names)
     else:
         held = None
         _one_static_file(paths, opt)

@@ -58,10 +58,12 @@ from ..identification.floor_verdict import (
     prediction_input_noise,
     sensor_variance,
 )
+from ..identification.log import TorqueLog
 from ..identification.low_speed import with_low_speed_hint
 from ..identification.metrics import TorqueErrors
 from ..identification.model import IdentifiedModel
 from ..identification.motion_range import with_motion_range_hint
+from ..identification.residual_dependence import with_dependence_hint
 from ..identification.sanity import SPIKES_BEFORE_JUDGING
 from ..identification.verdict import LEVELS, Verdict, with_replaced_spikes
 from ..io.feasible import load_feasible_drive, load_feasible_linear_friction
@@ -299,20 +301,7 @@ def validate_files(
         if min(rank) < rank[r] and rank[r] >= LEVELS.index(verdict.level):
             v = each[r]
             verdict = Verdict(v.level, v.label, f"{rec.names[r]}: {v.reason}", v.ratio)
-    verdict = with_derived_cutoff_hint(verdict, rec.logs, val.pieces.cutoff_hz)
-    high = derived_cutoff_hint(rec.logs, val.pieces.cutoff_hz)
-    if verdict.level == "good" and high is not None and noise.inputs is not None:
-        # at a floor the derived states raise: a lower cut-off lowers it
-        verdict = dataclasses.replace(
-            verdict, reason=f"{verdict.reason}; a floor raised because {high}"
-        )
-    verdict = with_low_speed_hint(
-        verdict,
-        [v.log.dq for v in val.parts],
-        [v.log.tau - v.tau_hat for v in val.parts],
-        noise.sensor,  # the hint's "above the noise": the sensors' (its module docstring)
-        names,
-    )
+    verdict = _with_hints(verdict, val, rec.logs, noise, names)
     if isinstance(model, IdentifiedModel) and model.info.log is not None:
         speeds = model.info.log.speed_max
         verdict = with_motion_range_hint(verdict, speeds, [v.log.dq for v in val.parts], names)
@@ -332,6 +321,31 @@ def validate_files(
         sensor_noise_rms=noise.sensor,
         input_noise_rms=noise.inputs,
     )
+
+
+def _with_hints(
+    verdict: Verdict,
+    val: RecordingsValidation,
+    logs: Sequence[TorqueLog],
+    noise: _Noise,
+    names: Sequence[str],
+) -> Verdict:
+    """``verdict`` with what the residual of each joint above its noise follows
+    (:func:`~dynid.identification.residual_dependence.with_dependence_hint`), the hint of a
+    cut-off too high for derived states, and that of an error at low speed."""
+    error = [v.log.tau - v.tau_hat for v in val.parts]
+    dq = [v.log.dq for v in val.parts]
+    q = [v.log.q for v in val.parts]
+    verdict = with_dependence_hint(verdict, q, dq, error, noise.total, names)
+    verdict = with_derived_cutoff_hint(verdict, logs, val.pieces.cutoff_hz)
+    high = derived_cutoff_hint(logs, val.pieces.cutoff_hz)
+    if verdict.level == "good" and high is not None and noise.inputs is not None:
+        # at a floor the derived states raise: a lower cut-off lowers it
+        verdict = dataclasses.replace(
+            verdict, reason=f"{verdict.reason}; a floor raised because {high}"
+        )
+    # the low-speed hint's "above the noise": the sensors' (its module docstring)
+    return with_low_speed_hint(verdict, dq, error, noise.sensor, names)
 
 
 @dataclass(frozen=True, slots=True)
