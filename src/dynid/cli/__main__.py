@@ -326,8 +326,7 @@ def _main(argv: Sequence[str] | None) -> int:
             _raise_if_terminated()
             if run is not None and run.kind == "folder":
                 save_run_report(run, record, args, argv, code)
-        if run is not None and run.kind == "folder":
-            console.print(f"report: {Path(args.out) / REPORT_NAME}")
+                console.print(f"report: {Path(args.out) / REPORT_NAME}")
         if record.stdout_closed:
             _drop_stdout()
             return STDOUT_CLOSED
