@@ -62,7 +62,7 @@ from ..identification.log import TorqueLog
 from ..identification.low_speed import with_low_speed_hint
 from ..identification.metrics import TorqueErrors
 from ..identification.model import IdentifiedModel
-from ..identification.motion_range import with_motion_range_hint
+from ..identification.motion_range import motion_range_hint, with_motion_range_hint
 from ..identification.residual_dependence import with_dependence_hint
 from ..identification.sanity import SPIKES_BEFORE_JUDGING
 from ..identification.verdict import LEVELS, Verdict, with_replaced_spikes
@@ -301,10 +301,16 @@ def validate_files(
         if min(rank) < rank[r] and rank[r] >= LEVELS.index(verdict.level):
             v = each[r]
             verdict = Verdict(v.level, v.label, f"{rec.names[r]}: {v.reason}", v.ratio)
-    verdict = _with_hints(verdict, val, rec.logs, noise, names)
-    if isinstance(model, IdentifiedModel) and model.info.log is not None:
-        speeds = model.info.log.speed_max
-        verdict = with_motion_range_hint(verdict, speeds, [v.log.dq for v in val.parts], names)
+    speeds = (
+        model.info.log.speed_max
+        if isinstance(model, IdentifiedModel) and model.info.log is not None
+        else None
+    )
+    dq = [v.log.dq for v in val.parts]
+    # a motion beyond the identification's is the likelier cause of what the residual follows
+    beyond = motion_range_hint(speeds, dq, names) is not None
+    verdict = _with_hints(verdict, val, rec.logs, noise, names, dependence=not beyond)
+    verdict = with_motion_range_hint(verdict, speeds, dq, names)
     files = ", ".join(f"{n} {c}" for n, c in zip(rec.names, spikes, strict=True) if c)
     verdict = with_replaced_spikes(verdict, sum(spikes), f" before judging ({files})")
     return ValidateResult(
@@ -329,14 +335,19 @@ def _with_hints(
     logs: Sequence[TorqueLog],
     noise: _Noise,
     names: Sequence[str],
+    *,
+    dependence: bool = True,
 ) -> Verdict:
     """``verdict`` with what the residual of each joint above its noise follows
-    (:func:`~dynid.identification.residual_dependence.with_dependence_hint`), the hint of a
-    cut-off too high for derived states, and that of an error at low speed."""
+    (:func:`~dynid.identification.residual_dependence.with_dependence_hint`; not with
+    ``dependence`` False: a recording that moves beyond the identification's data, where
+    any residual follows the motion), the hint of a cut-off too high for derived states,
+    and that of an error at low speed."""
     error = [v.log.tau - v.tau_hat for v in val.parts]
     dq = [v.log.dq for v in val.parts]
     q = [v.log.q for v in val.parts]
-    verdict = with_dependence_hint(verdict, q, dq, error, noise.total, names)
+    if dependence:
+        verdict = with_dependence_hint(verdict, q, dq, error, noise.total, names)
     verdict = with_derived_cutoff_hint(verdict, logs, val.pieces.cutoff_hz)
     high = derived_cutoff_hint(logs, val.pieces.cutoff_hz)
     if verdict.level == "good" and high is not None and noise.inputs is not None:
