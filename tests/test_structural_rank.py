@@ -1,0 +1,120 @@
+"""Columns no data can identify told from columns the data do not excite.
+
+Reference: a planar 2R arm whose two joints are turned by a differential (``K = G [[1, 1],
+[1, -1]]``, as a PR2 wrist), with exact simulated torques of known viscous friction at its
+motors and at its joints. Its damping ``K^T diag(fv) K + diag(jfv)`` has three independent
+entries for four coefficients: in closed form, ``(fv1, fv2, jfv1, jfv2) = (1, 1, -2 G^2,
+-2 G^2)`` changes no torque, whatever the motion.
+"""
+
+from __future__ import annotations
+
+import re
+
+import numpy as np
+import pytest
+
+from dynid.exceptions import RankDeficientError
+from dynid.friction.model import ClassicalFriction
+from dynid.identification.selection import identify_recordings
+from dynid.identification.structure import Structure
+from dynid.model.drive import Drive
+
+from conftest import planar_2r, recordings
+
+G = 30.0  # the differential's gear ratio
+FV = np.array([0.02, 0.03])  # N m s/rad, at the motors (1e-5 of the PR2 times 2000)
+JFV = np.array([4.0, 6.0])  # N m s/rad, at the joints
+
+
+def _drive() -> Drive:
+    return Drive.from_gears([G, -G], [(1, 2, G), (2, 1, G)], rotor_inertia=np.zeros(2))
+
+
+def _logs():
+    """Two exact recordings: viscous friction at both motors and at both joints."""
+    robot, drive = planar_2r(), _drive()
+    motor = ClassicalFriction(FV, np.zeros(2), np.zeros(2)).at(drive)
+    joint = ClassicalFriction(JFV, np.zeros(2), np.zeros(2))
+    logs = recordings(
+        robot,
+        (3, 4),
+        friction=motor,
+        drive=drive,
+        duration=6.0,
+        added=lambda g: joint.torques(g.dq),
+    )
+    return robot, drive, logs
+
+
+def _coefficients(combination: str) -> dict[str, float]:
+    """``{"jfv2": 1.0, "fv2": -0.0005556, ...}`` of ``"jfv2 - 0.0005556*fv2 + 1*jfv1"``."""
+    first, *rest = combination.split(" ")
+    out = {first: 1.0}
+    for sign, term in zip(rest[::2], rest[1::2], strict=True):
+        c, _, lab = term.rpartition("*")
+        out[lab] = (1.0 if sign == "+" else -1.0) * (float(c) if c else 1.0)
+    return out
+
+
+def test_the_differentials_viscous_friction_at_both_sides_is_structurally_dependent():
+    """Regression (PR2 trial: 'not excited by the data ... dynid excite optimises one' for a
+    combination no trajectory separates): the error names the combination of the closed
+    form (motors 1 / (2 G^2) of a joint's), says it is structural and gives the fix,
+    never more excitation."""
+    robot, drive, logs = _logs()
+    with pytest.raises(RankDeficientError) as err:
+        identify_recordings(
+            robot, logs, cutoff_hz=None, drive=drive, structure=Structure.parse("viscous,at:both")
+        )
+    exc, msg = err.value, str(err.value)
+    assert len(exc.structural) == 1 and exc.structural == exc.combinations
+    c = _coefficients(exc.structural[0])
+    assert set(c) == {"fv1", "fv2", "jfv1", "jfv2"}
+    top = max(c, key=lambda k: abs(c[k]))  # normalise to the closed form's (1, 1, -2G^2, -2G^2)
+    closed = {"fv1": 1.0, "fv2": 1.0, "jfv1": -2 * G**2, "jfv2": -2 * G**2}
+    for k, v in c.items():
+        assert v / c[top] == pytest.approx(closed[k] / closed[top], rel=1e-3)
+    assert "structurally not identifiable" in msg and "excite" not in msg.split("rtol")[1]
+    assert re.search(r"--terms viscous,at:both,-j?fv[12] ", msg), msg
+
+
+def test_the_default_choice_says_the_combination_left_out_is_structural():
+    """The candidates' note names the combination as structural, not as unexcited data,
+    and the coefficient left out is one of it."""
+    robot, drive, logs = _logs()
+    model = identify_recordings(robot, logs, cutoff_hz=None, drive=drive)
+    notes = [n for n in model.info.selection["notes"] if "left out of every candidate" in n]
+    assert len(notes) == 1 and notes[0].startswith("structurally not identifiable"), notes
+    assert "do not excite" not in notes[0]
+
+
+def _evaluated(expression: str, truth: dict[str, float]) -> float:
+    """``"jfv1 + 1800*fv1"`` at the true coefficients."""
+    return sum(c * truth[lab] for lab, c in _coefficients(expression).items())
+
+
+def test_the_coefficients_holding_the_one_left_out_are_marked_combined_with_the_truth():
+    """Regression (PR2 trial: motor fv6, fv7 printed 2.663e-5 +-0.74 % against a true 1e-5,
+    holding fv + jfv7 / (2 G^2), as if determined alone): every coefficient of the
+    combination is recorded with what it holds, which equals its fitted value at the
+    true coefficients; the table, identification.json and a consistent fit's notes say so."""
+    from dynid.cli.summaries import term_lines
+    from dynid.feasibility.convex.fit import consistent_from_identified
+    from dynid.io.model_json import model_from_dict, model_to_dict
+
+    robot, drive, logs = _logs()
+    model = identify_recordings(robot, logs, cutoff_hz=None, drive=drive)
+    truth = {"fv1": FV[0], "fv2": FV[1], "jfv1": JFV[0], "jfv2": JFV[1]}
+    combined = model.info.combined
+    left = [lab for lab in truth if not any(lab in t.labels for t in model.terms.values())]
+    assert len(left) == 1 and set(combined) == set(truth) - set(left)
+    for t in model.terms.values():
+        for lab, v in zip(t.labels, t.values, strict=True):
+            assert v == pytest.approx(_evaluated(combined[lab], truth), rel=1e-6), lab
+    assert model_from_dict(model_to_dict(model)).info.combined == combined
+    lines = term_lines(model)
+    assert sum(line.endswith("combined") or " combined " in line for line in lines) == 3
+    assert any(f"{lab} holds {combined[lab]}" in line for line in lines for lab in combined)
+    notes = consistent_from_identified(robot, model).notes
+    assert any("structurally dependent" in n for n in notes)
