@@ -9,6 +9,7 @@ entries for four coefficients: in closed form, ``(fv1, fv2, jfv1, jfv2) = (1, 1,
 
 from __future__ import annotations
 
+import json
 import re
 
 import numpy as np
@@ -94,11 +95,12 @@ def _evaluated(expression: str, truth: dict[str, float]) -> float:
     return sum(c * truth[lab] for lab, c in _coefficients(expression).items())
 
 
-def test_the_coefficients_holding_the_one_left_out_are_marked_combined_with_the_truth():
+def test_the_coefficients_holding_the_one_left_out_are_marked_combined_with_the_truth(tmp_path):
     """Regression (PR2 trial: motor fv6, fv7 printed 2.663e-5 +-0.74 % against a true 1e-5,
     holding fv + jfv7 / (2 G^2), as if determined alone): every coefficient of the
     combination is recorded with what it holds, which equals its fitted value at the
-    true coefficients; the table, identification.json and a consistent fit's notes say so."""
+    true coefficients; the table, identification.json, a consistent fit's notes,
+    feasible.json and the robot exports say so."""
     from dynid.cli.summaries import term_lines
     from dynid.feasibility.convex.fit import consistent_from_identified
     from dynid.io.model_json import model_from_dict, model_to_dict
@@ -116,5 +118,17 @@ def test_the_coefficients_holding_the_one_left_out_are_marked_combined_with_the_
     lines = term_lines(model)
     assert sum(line.endswith("combined") or " combined " in line for line in lines) == 3
     assert any(f"{lab} holds {combined[lab]}" in line for line in lines for lab in combined)
-    notes = consistent_from_identified(robot, model).notes
-    assert any("structurally dependent" in n for n in notes)
+    res = consistent_from_identified(robot, model)
+    assert any("structurally dependent" in n for n in res.notes)
+    from dynid.io.feasible import load_feasible_json, save_feasible_json
+
+    path = save_feasible_json(tmp_path / "feasible.json", res)
+    doc = json.loads(path.read_text())
+    assert doc["combined"] == combined and "fv2 holds" in doc["conventions"]["combined"]
+    assert load_feasible_json(path).n == 2
+    from dynid.io.feasible_bundle import save_feasible_bundle
+
+    (tmp_path / "bundle").mkdir()
+    for f in save_feasible_bundle(tmp_path / "bundle", res):
+        if f.suffix in (".urdf", ".xml", ".toml"):  # the exports' leading comment says it
+            assert "fv2 holds" in f.read_text().split("\n", 3)[1 if f.suffix != ".toml" else 2]

@@ -14,8 +14,9 @@ from pathlib import Path
 from typing import Any
 
 from ..feasibility.result import FeasibleResult
+from ..identification.structural import combined_notes
 from .export import ROBOT_FORMATS, ExportOptions, save_robot_files
-from .feasible import fitted_robot, save_feasible_json
+from .feasible import combined_coefficients, fitted_robot, save_feasible_json
 from .report_json import save_report_json
 
 __all__ = ["FEASIBLE_BUNDLE", "save_feasible_bundle"]
@@ -59,7 +60,8 @@ def save_feasible_bundle(
     folder = Path(folder)
     files = [save_feasible_json(folder / "feasible.json", result)]
     friction: Any = True if result.friction is None else result.friction
-    options = ExportOptions(friction=friction, drive=result.drive)
+    notes = combined_notes(combined_coefficients(result))  # not the motors' own friction alone
+    options = ExportOptions(friction=friction, drive=result.drive, note=notes[0] if notes else None)
     files += save_robot_files(folder, fitted_robot(result), options)
     files.append(save_report_json(folder / "report.json", result, **report_extra))
     return files

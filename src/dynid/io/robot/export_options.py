@@ -40,6 +40,9 @@ class ExportOptions:
         URDF chain: every named frame as a fixed, massless link.
     drive : Drive or None
         A drive train: MJCF ``armature`` from its rotor inertias, a TOML ``[drive]`` table.
+    note : str or None
+        A remark on the friction written, put in the file's leading comment (URDF chain,
+        MJCF, TOML): coefficients that hold structurally combined ones left out.
     """
 
     template: Path | None = None
@@ -49,6 +52,7 @@ class ExportOptions:
     friction: bool | Friction | FrictionSum = True
     all_frames: bool = False
     drive: Drive | None = None
+    note: str | None = None
 
 
 @dataclass(frozen=True, slots=True)

@@ -231,6 +231,7 @@ def mjcf_from_robot(
     friction: bool | FrictionModel | FrictionSum = True,
     comment: str | None = None,
     drive: Drive | None = None,
+    note: str | None = None,
 ) -> tuple[str, CoulombViscous | None]:
     """The MJCF document of a robot, and the friction approximation it holds.
 
@@ -266,7 +267,9 @@ def mjcf_from_robot(
     approx, armature, notes = _joint_terms(robot, friction, drive)
     if notes:  # one line: what MJCF cannot hold
         warnings.warn(f"MJCF export: {'; '.join(notes)}", DynidWarning, stacklevel=2)
-    text = comment or _comment(friction, approx, armature, notes)
+    text = (comment or _comment(friction, approx, armature, notes)) + (
+        "" if note is None else f"; {note}"
+    )
     lines = [
         '<?xml version="1.0"?>',
         f"<!-- {text.replace('--', '- -')} -->",
@@ -290,10 +293,11 @@ def save_mjcf(
     *,
     friction: bool | FrictionModel | FrictionSum = True,
     drive: Drive | None = None,
+    note: str | None = None,
 ) -> Path:
     """Write :func:`mjcf_from_robot` to ``path``; returns the path."""
     path = Path(path)
-    text, _ = mjcf_from_robot(robot, friction=friction, drive=drive)
+    text, _ = mjcf_from_robot(robot, friction=friction, drive=drive, note=note)
     write_text(path, text)
     return path
 
@@ -301,4 +305,4 @@ def save_mjcf(
 def export_mjcf(path: str | Path, robot: Robot, options: ExportOptions) -> Path:
     """:func:`save_mjcf` with the export options' ``friction`` and ``drive`` (the entry of
     ``mjcf`` in the exports)."""
-    return save_mjcf(path, robot, friction=options.friction, drive=options.drive)
+    return save_mjcf(path, robot, friction=options.friction, drive=options.drive, note=options.note)

@@ -431,7 +431,11 @@ def _xyz_rpy(T: NDArray[np.float64]) -> tuple[str, str]:
 
 
 def toml_from_robot(
-    robot: Robot, *, drive: Drive | None = None, friction: Friction | FrictionSum | None = None
+    robot: Robot,
+    *,
+    drive: Drive | None = None,
+    friction: Friction | FrictionSum | None = None,
+    note: str | None = None,
 ) -> str:
     """The dynid TOML description of a robot (schema: see the module docstring).
 
@@ -452,6 +456,8 @@ def toml_from_robot(
         Written instead of the robot's own (the friction identified with the links; a sum
         of friction at the motors and at the joints as ``[friction]`` and
         ``[joint_friction]``, :mod:`dynid.io.robot.toml_friction`).
+    note : str, optional
+        A remark on the friction, a ``# note:`` comment under the header.
 
     Returns
     -------
@@ -473,6 +479,7 @@ def toml_from_robot(
     out = [
         "# dynid robot description; schema: dynid.io.robot.toml",
         "# units: m, rad, kg, kg m^2, s; inertia about the CoM, in link axes",
+        *([] if note is None else [f"# note: {note}"]),
         f"format_version = {FORMAT_VERSION}",
         f"name = {_s(robot.name)}",
         f"gravity = {_arr(robot.gravity)}",
@@ -537,6 +544,7 @@ def save_toml(
     *,
     drive: Drive | None = None,
     friction: Friction | FrictionSum | None = None,
+    note: str | None = None,
 ) -> Path:
     """Write the TOML description of ``robot`` (:func:`toml_from_robot`) to ``path``.
 
@@ -544,7 +552,7 @@ def save_toml(
     ----------
     path : str or Path
     robot : Robot
-    drive, friction
+    drive, friction, note
         As :func:`toml_from_robot`.
 
     Returns
@@ -552,7 +560,7 @@ def save_toml(
     Path
         The path written.
     """
-    text = toml_from_robot(robot, drive=drive, friction=friction)
+    text = toml_from_robot(robot, drive=drive, friction=friction, note=note)
     return write_text(path, text)
 
 
@@ -562,7 +570,11 @@ def export_toml(path: str | Path, robot: Robot, options: ExportOptions) -> Path:
     model (the one identified with the links) written in its place."""
     f = options.friction
     if f is True:
-        return save_toml(path, robot, drive=options.drive)
+        return save_toml(path, robot, drive=options.drive, note=options.note)
     return save_toml(
-        path, robot if f else robot.with_friction(None), drive=options.drive, friction=f or None
+        path,
+        robot if f else robot.with_friction(None),
+        drive=options.drive,
+        friction=f or None,
+        note=options.note,
     )

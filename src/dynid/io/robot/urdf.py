@@ -131,6 +131,7 @@ def urdf_from_robot(
     all_frames: bool = False,
     comment: str | None = None,
     dynamics: tuple[NDArray[np.float64], NDArray[np.float64]] | None = None,
+    note: str | None = None,
 ) -> str:
     """The URDF document of a robot: kinematics, limits and link inertials.
 
@@ -145,6 +146,8 @@ def urdf_from_robot(
     dynamics : (ndarray, ndarray), optional
         Per-joint ``damping`` [N m s/rad] and Coulomb ``friction`` [N m], written as
         ``<dynamics damping friction>`` (identified linear friction).
+    note : str, optional
+        Added to the comment.
 
     Returns
     -------
@@ -161,7 +164,7 @@ def urdf_from_robot(
             if dynamics is not None
             else "; gravity and friction are not part of URDF"
         )
-    )
+    ) + ("" if note is None else f"; {note}")
     lines = [
         '<?xml version="1.0"?>',
         f"<!-- {text.replace('--', '- -')} -->",
@@ -234,6 +237,7 @@ def save_urdf(
     merged: str = "subtract",
     dynamics: tuple[NDArray[np.float64], NDArray[np.float64]] | None = None,
     template_dynamics: bool = False,
+    note: str | None = None,
 ) -> Path:
     """Write the robot as URDF to ``path``; returns the path.
 
@@ -254,6 +258,8 @@ def save_urdf(
         Template: also replace the friction of the chain's ``<dynamics>`` by ``dynamics``
         (None: removed; :func:`dynid.io.robot.urdf_patch.patch_urdf_dynamics`); default:
         the template's ``<dynamics>`` are kept.
+    note : str, optional
+        Chain export: added to the leading comment.
 
     Raises
     ------
@@ -264,7 +270,7 @@ def save_urdf(
     """
     path = Path(path)
     if template is None:
-        text = urdf_from_robot(robot, all_frames=all_frames, dynamics=dynamics)
+        text = urdf_from_robot(robot, all_frames=all_frames, dynamics=dynamics, note=note)
     else:
         tpath = Path(template)
         try:
@@ -370,6 +376,7 @@ def export_urdf(path: str | Path, robot: Robot, options: ExportOptions) -> Path:
         merged=options.merged,
         dynamics=dynamics,
         template_dynamics=replace,
+        note=options.note,
     )
     if notes:  # one line, once written: what URDF cannot hold of the friction
         warnings.warn(f"URDF export: {'; '.join(notes)}", DynidWarning, stacklevel=2)
