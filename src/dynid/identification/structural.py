@@ -70,15 +70,15 @@ def structural_rank(
     columns: ModelColumns,
     used: NDArray[np.bool_] | None = None,
     *,
-    n_samples: int = 64,
+    n_samples: int = 128,
     rng: np.random.Generator | None = None,
 ) -> StructuralRank:
     """The rank of the torque regressor over ``columns`` (those ``used``) at random states.
 
-    Positions uniform within the limits (``[-pi, pi]`` where unlimited), velocities in
-    ``[-2, 2]`` rad/s and accelerations in ``[-5, 5]`` rad/s^2, as the base parameters are
-    found; the columns scaled to unit norm, the rank from the singular values at
-    :data:`STRUCTURAL_RTOL`.
+    Positions uniform within the limits (``[-pi, pi]`` where unlimited), speeds
+    log-uniform from 0.002 to 2 rad/s of either sign (every friction law's shape, a
+    Stribeck bump's too) and accelerations in ``[-5, 5]`` rad/s^2; the columns scaled to
+    unit norm, the rank from the singular values at :data:`STRUCTURAL_RTOL`.
 
     Parameters
     ----------
@@ -115,13 +115,15 @@ def _random_columns(
     robot: Robot, columns: ModelColumns, n_samples: int, rng: np.random.Generator | None
 ) -> NDArray[np.float64]:
     """The torque regressor over ``columns`` (stacked rows, c) at random states:
-    positions within the limits (``[-pi, pi]`` where unlimited), velocities in ``[-2, 2]``
-    rad/s, accelerations in ``[-5, 5]`` rad/s^2, as the base parameters are found."""
+    positions within the limits (``[-pi, pi]`` where unlimited), speeds from 0.002 to 2
+    rad/s (log-uniform, either sign), accelerations in ``[-5, 5]`` rad/s^2."""
     rng = np.random.default_rng(0) if rng is None else rng
     lo = np.where(np.isfinite(robot.q_min), robot.q_min, -np.pi)
     hi = np.where(np.isfinite(robot.q_max), robot.q_max, np.pi)
     q = rng.uniform(lo, hi, (n_samples, robot.n))
-    dq = rng.uniform(-2, 2, q.shape)
+    # speeds log-uniform over three decades: a Stribeck bump of 0.002 rad/s is 0 at most
+    # speeds of a uniform draw in [-2, 2], which would call its column structurally zero
+    dq = rng.choice([-2.0, 2.0], q.shape) * 10.0 ** rng.uniform(-3, 0, q.shape)
     ddq = rng.uniform(-5, 5, q.shape)
     full = [torque_regressor_prepared(robot, q, dq, ddq, robot.gravity)]
     full += [t.torque_columns(q, dq, ddq) for t in columns.terms if t.in_base]
@@ -135,7 +137,7 @@ def absorbed_by(
     columns: ModelColumns,
     label: str,
     *,
-    n_samples: int = 64,
+    n_samples: int = 128,
     rng: np.random.Generator | None = None,
 ) -> dict[str, str]:
     """What the other coefficients hold when ``label`` is left out of ``columns`` (which
