@@ -258,3 +258,33 @@ def test_a_rest_position_in_collision_is_drawn_toward_the_requested_start():
     q = reduced.sample(1000.0).q
     assert self_distances(robot, q, caps).min() >= opts.self_clearance
     assert self_distances(robot, folded, caps).min() < 0  # the rest position it came from
+
+
+def test_a_floor_through_the_rest_position_is_named_with_its_plane_and_how_to_move_it(tmp_path):
+    """Regression (PR2 trial, --base torso_lift_link: the default floor z = 0 of the base
+    passed through the shoulder; 'no admissible trajectory' hinted at ranges and seeds): the
+    failure names the plane and where it comes from, the rest position's clearance, equal
+    to the capsules' own distance there, and the file that moves it."""
+    robot = _scaled_panda(0.1)
+    opts = ExcitationOptions(**SHORT, radii=0.06, self_clearance=0.02, obstacle_clearance=0.05)
+    res = optimise_excitation(robot, np.random.default_rng(0), opts)
+    assert res.status == "infeasible" and res.rest_clearances
+    d = obstacle_distances(robot, res.rest, Obstacles.floor(), capsule_model(robot, 0.06))
+    near = min(res.rest_clearances, key=lambda a: a.distance)
+    assert near.distance == pytest.approx(float(d.min()), abs=1e-12)
+    text = ExcitationDesign(res, res.trajectory.sample(100.0)).failure(robot)
+    assert "the default floor (no obstacles), in the base frame" in text
+    assert "floor: z = 0 m" in text and "rest position the design starts from" in text
+    assert f"{near.link} {-near.distance:.3g} m into floor" in text
+    assert '"point": [0, 0, Z]' in text and "max_iter" not in text
+    # a floor from a file: named with its height, moved in that file
+    path = tmp_path / "raised.json"
+    plane = '{"name": "floor", "point": [0, 0, 0.05], "normal": [0, 0, 1]}'
+    path.write_text(f'{{"schema": "dynid-obstacles/1", "planes": [{plane}]}}')
+    from dynid.workflows.excite import design_excitation
+
+    design = design_excitation(robot, ExcitationOptions(**SHORT), obstacles=path)
+    assert not design.admissible and design.result.rest_clearances
+    text = design.failure(robot)
+    assert "from raised.json (obstacles)" in text and "floor: z = 0.05 m" in text
+    assert "move the obstacles in raised.json" in text

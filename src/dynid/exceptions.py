@@ -137,6 +137,10 @@ class RankDeficientError(DynidError, ValueError):
     redundant : tuple of str
         The label naming each of those combinations (its first): without these columns
         the others have full rank (``("beta40",)``); empty when not known.
+    structural : tuple of str
+        The combinations that vanish at every state of the model, which no data identify
+        (:func:`~dynid.identification.structural.structural_rank`; ``redundant`` then names
+        these first); empty when none or not checked.
     """
 
     def __init__(
@@ -148,6 +152,7 @@ class RankDeficientError(DynidError, ValueError):
         dependent: tuple[str, ...] = (),
         combinations: tuple[str, ...] = (),
         redundant: tuple[str, ...] = (),
+        structural: tuple[str, ...] = (),
     ) -> None:
         super().__init__(message)
         self.rank = rank
@@ -155,6 +160,7 @@ class RankDeficientError(DynidError, ValueError):
         self.dependent = tuple(dependent)
         self.combinations = tuple(combinations)
         self.redundant = tuple(redundant)
+        self.structural = tuple(structural)
 
 
 class InfeasibleError(DynidError, ValueError):

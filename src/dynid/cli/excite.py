@@ -223,15 +223,7 @@ def run(args: argparse.Namespace, console: Console) -> int:
     written = _save(args, robot, design)
     console.print(*design.describe(robot, flag), *(f"wrote {p}" for p in written))
     if not design.admissible:  # a negative result, as retrieve's: exit 1, files kept
-        print(
-            f"dynid {NAME}: no admissible trajectory found (violated at 1 kHz: "
-            f"{', '.join(design.result.violations())}; files written for inspection); "
-            "hint: narrower joint ranges (--range q1=LO:HI,...; a joint that turns +-2 pi "
-            "reaches the floor and the arm itself), fewer or smaller obstacles, a smaller "
-            "--radius, --self-clearance or --obstacle-clearance, more --max-iter or another "
-            "--seed",
-            file=sys.stderr,
-        )
+        print(f"dynid {NAME}: {design.failure(robot, flag)}", file=sys.stderr)
         return 1
     if not design.result.improved:
         console.note(

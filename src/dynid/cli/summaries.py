@@ -120,7 +120,9 @@ def term_lines(model: IdentifiedModel) -> list[str]:
     """The terms identified with the links (friction, armature), one table each: a row per
     joint (motor, where the term acts at the motors), a column per coefficient, each
     value with its standard deviation in %; ``in beta`` where the coefficient is regrouped
-    into a base parameter (a rotor with a link's inertia), ``-`` where left out."""
+    into a base parameter (a rotor with a link's inertia), ``-`` where left out,
+    ``combined`` where it holds a coefficient left out as structurally combined with it
+    (named below the table with what it holds)."""
     out: list[str] = []
     for name, t in model.terms.items():
         if not t.labels:
@@ -133,7 +135,7 @@ def term_lines(model: IdentifiedModel) -> list[str]:
             units[stem] = t.term.units[k] if k < len(t.term.units) else ""
             cells[(stem, int(lab[len(stem) :]))] = _coefficient(
                 float(t.values[k]), float(t.std[k]), bool(t.kept[k]), bool(t.regrouped[k])
-            )
+            ) + (f" {COMBINED}" if lab in model.info.combined and t.kept[k] else "")
         drive = getattr(t.term, "drive", None)
         row = "motor" if drive is not None and drive.friction_at == "motor" else "joint"
         n = getattr(drive, "n", None) or max(j for _, j in cells)
@@ -165,6 +167,13 @@ def term_lines(model: IdentifiedModel) -> list[str]:
             )
         out += _scales_lines(scales, model)
         out += _negative_viscous_line(t)
+        mine = [lab for lab in t.labels if lab in model.info.combined]
+        if mine:
+            out.append(
+                f"  {COMBINED}: holds a coefficient left out as structurally dependent on it "
+                "(no data tell them apart), not its own value alone: "
+                + "; ".join(f"{lab} holds {model.info.combined[lab]}" for lab in mine)
+            )
     return out
 
 
@@ -195,6 +204,10 @@ def _negative_viscous_line(t: Any) -> list[str]:
             + ": within its std of zero, indistinguishable from 0"
         )
     return ["  viscous friction below zero (not dissipative): " + "; ".join(said)]
+
+
+#: The mark of a coefficient that holds a structurally combined one left out.
+COMBINED = "combined"
 
 
 #: The cell of a joint's friction at the joint that the motor's friction holds.

@@ -55,6 +55,7 @@ from .stacking import (
     stack_dataset,
 )
 from .streamed import BlockRows
+from .structural import StructuralRank, structural_rank
 
 __all__ = [
     "DEFAULT_FIT_RTOL",
@@ -290,7 +291,10 @@ def identify(
             stack, labels, est, std, max_std_percent, fit_rtol, frozen, fold_labels, data.serial
         )
     except RankDeficientError as exc:
-        raise _rank_error(exc, data, columns, stack, fit_rtol) from exc
+        structural = None
+        if data.regressor_kind == "torque":
+            structural = structural_rank(robot, columns, ~frozen)
+        raise _rank_error(exc, data, columns, stack, fit_rtol, structural) from exc
     held = None if judge is None else judge(stack, columns, ~frozen, fit.beta)
     for msg in conditioning_advice(fit, labels, what=_what(data)):
         warnings.warn(msg, DynidWarning, stacklevel=2)
@@ -318,23 +322,52 @@ def _rank_error(
     columns: ModelColumns,
     stack: RegressorStack | StreamedRows,
     rtol: float,
+    structural: StructuralRank | None = None,
 ) -> RankDeficientError:
-    """The estimator's rank error said for the data, with the data's hint."""
+    """The estimator's rank error said for the data, with the data's hint; combinations
+    that vanish at every state (``structural``) are said to be the model's, with no hint
+    of more excitation when they are all the data lack."""
     needed = exc.needed if exc.needed is not None else len(columns.labels)
     what = "the base parameters" + "".join(f" and {t.name}" for t in columns.appended)
     cols = ", ".join(exc.dependent) or "none named"
     combos = "; ".join(exc.combinations) or cols
     rows = f"{stack.n_rows} rows" if stack.n_rows else "rows read in blocks"
+    head = (
+        f"{data.source} ({rows}) has rank {exc.rank} < {needed} needed for {what} (rtol={rtol:g})"
+    )
+    rank = needed if exc.rank is None else exc.rank
+    said: tuple[str, ...] = ()
+    redundant = exc.redundant
+    if structural is not None and structural.rank < structural.needed:
+        whole = needed - rank <= structural.needed - structural.rank  # all the data lack
+        said = exc.combinations if whole and exc.combinations else structural.combinations
+        redundant = exc.redundant if whole else structural.redundant
+        why = (
+            f"{head}: structurally not identifiable, the model's columns are dependent at "
+            f"every motion (rank {structural.rank} of {structural.needed} at random states), "
+            f"no trajectory separates {'; '.join(said)}{columns.base.meaning(said)}; leave "
+            "one coefficient of each combination out"
+        )
+        if not whole:
+            why += (
+                f"; and not excited by the data besides: {combos}"
+                f"{columns.base.meaning(exc.combinations)}; nearly dependent columns: "
+                f"{cols}; {data.hint}"
+            )
+    else:
+        why = (
+            f"{head}, the model's structural rank; not excited by the data: "
+            f"{combos}{columns.base.meaning(exc.combinations)}; nearly dependent columns: "
+            f"{cols}; {data.hint}"
+        )
     return RankDeficientError(
-        f"{data.source} ({rows}) has rank {exc.rank} < {needed} needed for "
-        f"{what} (rtol={rtol:g}), the model's structural rank; not excited by the data: "
-        f"{combos}{columns.base.meaning(exc.combinations)}; nearly dependent columns: "
-        f"{cols}; {data.hint}",
+        why,
         rank=exc.rank,
         needed=needed,
         dependent=exc.dependent,
         combinations=exc.combinations,
-        redundant=exc.redundant,
+        redundant=redundant,
+        structural=said,
     )
 
 

@@ -164,6 +164,11 @@ class IdentificationInfo:
         Remarks for the reader (one sentence each).
     extra : mapping
         Entries of a file that this version does not know (kept when saved again).
+    combined : mapping of str to str
+        The coefficients that hold a structurally combined one left out (a differential
+        wrist's viscous friction at both motors and both joints: ``jfv7`` left out), each
+        with what it holds (``{"fv6": "fv6 + 0.0005556*jfv7"}``,
+        :func:`~dynid.identification.structural.absorbed_by`); empty for none.
     """
 
     route: Route | None = None
@@ -187,3 +192,4 @@ class IdentificationInfo:
     extra: Mapping[str, Any] = field(default_factory=dict)
     selection: Mapping[str, Any] | None = None
     recordings: tuple[Mapping[str, Any], ...] = ()
+    combined: Mapping[str, str] = field(default_factory=dict)

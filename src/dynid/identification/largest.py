@@ -105,13 +105,13 @@ def fit_largest(
     drop = frozenset(found)
     fitted, failed = _first_fitted(tries, drop, fit)
     if fitted is None and classical:
-        more, why = _unexcited_coefficients(classical, drop, fit)
+        more, why, structural = _unexcited_coefficients(classical, drop, fit)
         if more:
             drop |= more
             found |= more
             fitted, failed = _first_fitted(tries, drop, fit)
             note = (
-                f"the data do not excite {'; '.join(why)}: "
+                f"{_unexcited_text(why, structural)}: "
                 f"{', '.join(sorted(more, key=_order))} left out of every candidate"
             )
             notes += [] if note in notes else [note]
@@ -230,13 +230,16 @@ def _unexcited_coefficients(
     classical: list[Structure],
     drop: frozenset[str],
     fit: Callable[[list[Structure], frozenset[str]], _Fitted],
-) -> tuple[frozenset[str], list[str]]:
+) -> tuple[frozenset[str], list[str], list[str]]:
     """The single joints' friction coefficients (``"fc3"``) beside ``drop`` without which
-    the data identify the classical candidates' columns, and the combinations the data do
-    not excite that named them (:attr:`~dynid.exceptions.RankDeficientError.redundant`);
-    none when other columns (the links') are not identifiable either."""
+    the data identify the classical candidates' columns, the combinations the data do
+    not excite that named them (:attr:`~dynid.exceptions.RankDeficientError.redundant`)
+    and those of them no data excite (the model's columns dependent at every motion,
+    :attr:`~dynid.exceptions.RankDeficientError.structural`); none when other columns
+    (the links') are not identifiable either."""
     more: set[str] = set()
     why: list[str] = []
+    structural: list[str] = []
     for _ in range(MAX_DROP_ROUNDS):
         try:
             fit(classical, drop | more)
@@ -244,12 +247,27 @@ def _unexcited_coefficients(
             named = {_offset_instead(lab, exc.combinations) for lab in exc.redundant}
             new = named - drop - more
             if not new or not all(_FRICTION_LABEL.fullmatch(lab) for lab in new):
-                return frozenset(), []
+                return frozenset(), [], []
             more |= new
-            why += list(exc.combinations)
+            why += [c for c in exc.combinations if c not in exc.structural]
+            structural += list(exc.structural)
             continue
-        return frozenset(more), why
-    return frozenset(), []
+        return frozenset(more), why, structural
+    return frozenset(), [], []
+
+
+def _unexcited_text(why: list[str], structural: list[str]) -> str:
+    """What left single joints' coefficients out: the model's columns dependent at every
+    motion (no trajectory helps) and the combinations the data do not excite."""
+    parts = []
+    if structural:
+        parts.append(
+            f"structurally not identifiable (dependent at every motion, whatever the "
+            f"trajectory): {'; '.join(structural)}"
+        )
+    if why:
+        parts.append(f"the data do not excite {'; '.join(why)}")
+    return "; ".join(parts)
 
 
 def _offset_instead(label: str, combinations: tuple[str, ...]) -> str:

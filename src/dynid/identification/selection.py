@@ -45,6 +45,7 @@ structure chosen (or given).
 from __future__ import annotations
 
 import copy
+import re
 import warnings
 from collections.abc import Callable, Collection, Sequence
 from dataclasses import replace
@@ -72,7 +73,7 @@ from .candidates import (
     recording_oddness,
     without_recordings,
 )
-from .core import identify
+from .core import identify, model_columns
 from .dissipation import (
     Violation,
     friction_columns,
@@ -90,6 +91,7 @@ from .metrics import noise_floor_percent
 from .model import IdentifiedModel
 from .recordings import Recordings, prepare_recordings
 from .sanity import gravity_loaded, sign_confirmed
+from .structural import absorbed_by
 from .structure import (
     ERROR_FLOOR_PERCENT,
     Structure,
@@ -827,13 +829,39 @@ def identify_recordings(
     except RankDeficientError as exc:
         raise _without_hint(exc, structure) from exc
     warn_unphysical(model, terms)
+    heldout = _heldout_record(model, data if validation is None else validation)
     info = replace(
-        model.info,
-        heldout=_heldout_record(model, data if validation is None else validation),
-        selection=None if selection is None else selection.as_dict(),
-        extra={**model.info.extra, "terms": list(structure.terms)},
+        model.info, combined=_combined(robot, data, structure, drive, model.base), heldout=heldout
     )
+    extra = {**model.info.extra, "terms": list(structure.terms)}
+    info = replace(info, selection=None if selection is None else selection.as_dict(), extra=extra)
     return replace(model, info=info)
+
+
+def _combined(
+    robot: Robot,
+    data: Recordings,
+    structure: Structure,
+    drive: Drive | None,
+    base: BaseParameters | None,
+) -> dict[str, str]:
+    """What the coefficients fitted hold of the friction coefficients ``structure`` leaves
+    out because they are structurally combined with them (:func:`~.structural.absorbed_by`:
+    ``{"fv6": "fv6 + 0.0005556*jfv7"}``); empty when it leaves none such out."""
+    out: dict[str, str] = {}
+    for lab in structure.drop:
+        if not _FRICTION_LABEL.fullmatch(lab):
+            continue
+        held = replace(structure, drop=tuple(d for d in structure.drop if d != lab))
+        model_drive, terms = _terms_of(held, drive, robot.n, data)
+        columns = model_columns(robot, data, drive=model_drive, terms=terms, base=base)
+        for k, expr in absorbed_by(robot, columns, lab).items():
+            out[k] = expr if k not in out else f"{out[k]}{expr[len(k) :]}"
+    return out
+
+
+#: A friction coefficient of one joint (motor): ``fc3``, ``jfv7``.
+_FRICTION_LABEL = re.compile(r"j?f[a-z]+[0-9]+")
 
 
 def _without_hint(exc: RankDeficientError, structure: Structure) -> RankDeficientError:
@@ -845,8 +873,10 @@ def _without_hint(exc: RankDeficientError, structure: Structure) -> RankDeficien
         return exc
     labels = ", ".join(exc.redundant)
     out = copy.copy(exc)
+    # structural: the core's message already says to leave one out; here is how
+    how = ": " if exc.structural else f"; or leave {labels} out: "
     out.args = (
-        f"{exc.args[0]}; or leave {labels} out: --terms {','.join(fewer.terms)} "
+        f"{exc.args[0]}{how}--terms {','.join(fewer.terms)} "
         f"(-LABEL leaves out one joint's coefficient)",
         *exc.args[1:],
     )

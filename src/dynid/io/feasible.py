@@ -18,6 +18,8 @@ and was not on a torque log; the friction identified with the links in ``linear_
      "joint_friction": {"model": "classical", "fv": [...], ...} (with friction at the motors
          and at the joints of a coupled drive: the part at the joints),
      "drive": null | {dynid-drive/1 record, rotor_inertia: the identified values},
+     "combined": {"fv6": "fv6 + 0.0005556*jfv7", ...} (only when friction coefficients
+         hold one left out as structurally combined with them),
      "kinematics": {...}, "feasible": true, "relative_residual": ..., "seed": ...,
      "violated": [...], "heldout": {...}, "units": {...}, "conventions": {...}}
 
@@ -76,6 +78,7 @@ __all__ = [
     "load_feasible_drive",
     "load_feasible_json",
     "fitted_robot",
+    "combined_coefficients",
     "load_feasible_linear_friction",
     "robot_from_feasible_dict",
     "save_feasible_json",
@@ -144,6 +147,7 @@ FEASIBLE = Format(
             "seed": Field("integer", nullable=True),
             "violated": Field("strings"),
             "heldout": Field("object", nullable=True),
+            "combined": Field("object"),
         }
     ),
     "feasible-parameter file",
@@ -223,6 +227,14 @@ def feasible_to_dict(source: FeasibleResult | Robot, *, seed: int | None = None)
     }
     if len(parts) > 1:
         d["joint_friction"] = law_record(parts[1])
+    combined = combined_coefficients(result)
+    if combined:  # not the motors' (joints') own friction alone: said beside the values
+        d["combined"] = combined
+        conventions["combined"] = (
+            "friction coefficients that hold one left out as structurally dependent on them "
+            "(no data tell them apart), not their own values alone: "
+            + "; ".join(f"{lab} holds {expr}" for lab, expr in combined.items())
+        )
     if result is None:
         return d if seed is None else d | {"seed": seed}
     d["method"] = result.method
@@ -294,6 +306,14 @@ def rejection_caveat(reason: str) -> str:
     """The comment at the top of a robot file written from a fit that was not accepted
     (``reason``: :func:`fit_rejection`)."""
     return f"NOT ACCEPTED: these parameters come from a fit that was not accepted ({reason})"
+
+
+def combined_coefficients(result: FeasibleResult | None) -> dict[str, str]:
+    """The identified model's coefficients that hold a structurally combined one left out
+    (:attr:`~dynid.identification.info.IdentificationInfo.combined`), when the result has
+    the model."""
+    model = getattr(result, "identified", None)
+    return {} if model is None else dict(model.info.combined)
 
 
 def fitted_robot(result: FeasibleResult) -> Robot:

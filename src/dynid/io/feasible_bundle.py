@@ -14,8 +14,15 @@ from pathlib import Path
 from typing import Any
 
 from ..feasibility.result import FeasibleResult
+from ..identification.structural import combined_notes
 from .export import ROBOT_FORMATS, ExportOptions, save_robot_files
-from .feasible import fitted_robot, rejection_caveat, result_rejection, save_feasible_json
+from .feasible import (
+    combined_coefficients,
+    fitted_robot,
+    rejection_caveat,
+    result_rejection,
+    save_feasible_json,
+)
 from .report_json import save_report_json
 
 __all__ = ["FEASIBLE_BUNDLE", "save_feasible_bundle"]
@@ -60,11 +67,13 @@ def save_feasible_bundle(
     files = [save_feasible_json(folder / "feasible.json", result)]
     friction: Any = True if result.friction is None else result.friction
     reason = result_rejection(result)
+    notes = combined_notes(combined_coefficients(result))  # not the motors' own friction alone
+    caveats = ([] if reason is None else [rejection_caveat(reason)]) + list(notes[:1])
     options = ExportOptions(
         friction=friction,
         drive=result.drive,
         source=files[0].name,
-        caveat=None if reason is None else rejection_caveat(reason),
+        caveat="; ".join(caveats) if caveats else None,
     )
     files += save_robot_files(folder, fitted_robot(result), options)
     files.append(save_report_json(folder / "report.json", result, **report_extra))

@@ -237,6 +237,8 @@ def info_to_dict(info: IdentificationInfo, drive: Drive | None = None) -> dict[s
         out["selection"] = dict(info.selection)
     if info.recordings:
         out["recordings"] = [dict(r) for r in info.recordings]
+    if info.combined:
+        out["combined"] = dict(info.combined)
     if drive is not None:
         out["drive"] = drive.as_dict()
     return _jsonable(out)
@@ -280,6 +282,7 @@ def info_from_dict(
             notes=tuple(str(x) for x in m.pop("notes", ())),
             selection=None if m.get("selection") is None else dict(m.pop("selection")),
             recordings=tuple(dict(r) for r in m.pop("recordings", ())),
+            combined={str(k): str(v) for k, v in dict(m.pop("combined", {})).items()},
             extra={k: v for k, v in m.items() if k not in _DERIVED_KEYS + _FRICTION_KEYS},
         )
     except (TypeError, ValueError, IndexError) as exc:

@@ -47,7 +47,10 @@ def _unit(code: str) -> str:
     return f" [{unit}]" if unit else ""
 
 
-def _term_table(term: dict[str, Any], joint_names: list[str]) -> str:
+def _term_table(
+    term: dict[str, Any], joint_names: list[str], combined: dict[str, str] | None = None
+) -> str:
+    combined = combined or {}
     labels, values = term.get("labels") or [], term.get("values") or []
     std = term.get("std") or []
     at_motors = term.get("kind") == "rotor_inertia" or (
@@ -63,6 +66,7 @@ def _term_table(term: dict[str, Any], joint_names: list[str]) -> str:
         s = std[k] if k < len(std) else None
         v = values[k] if k < len(values) else None
         text = cell(v) + (f" &plusmn; {number(s, 2)}" if is_number(s) else "")
+        text += " (combined)" if str(lab) in combined else ""
         rows.setdefault(index, {})[code] = text
     body = []
     for index in sorted(rows):
@@ -74,7 +78,16 @@ def _term_table(term: dict[str, Any], joint_names: list[str]) -> str:
             who = f"joint {index}"
         body.append([esc(who), *(rows[index].get(c, "") for c in codes)])
     headers = ["motor" if at_motors else "joint", *(f"{c}{_unit(c)}" for c in codes)]
-    return table(headers, body)
+    mine = [str(lab) for lab in labels if str(lab) in combined]
+    note = (
+        "<p>combined: holds a coefficient left out as structurally dependent on it (no "
+        "data tell them apart), not its own value alone: "
+        + esc("; ".join(f"{lab} holds {combined[lab]}" for lab in mine))
+        + "</p>"
+        if mine
+        else ""
+    )
+    return table(headers, body) + note
 
 
 def _classical(doc: dict[str, Any], joint_names: list[str]) -> str:
@@ -106,10 +119,13 @@ def terms_sections(doc: dict[str, Any]) -> list[str]:
     if not isinstance(terms, list) or not terms:
         classical = _classical(doc, names)
         return [classical] if classical else []
+    meta = doc.get("metadata") or {}
+    combined = meta.get("combined") if isinstance(meta, dict) else None
+    combined = {str(k): str(v) for k, v in combined.items()} if isinstance(combined, dict) else {}
     out: list[str] = []
     for k, term in enumerate(terms):
         if not isinstance(term, dict) or not term.get("labels"):
             continue
         anchor = "friction" if k == 0 and term.get("kind") == "linear_friction" else f"term-{k}"
-        out.append(section(anchor, _heading(term), _term_table(term, names)))
+        out.append(section(anchor, _heading(term), _term_table(term, names, combined)))
     return out

@@ -293,6 +293,12 @@ class ExcitationResult:
         not given and took the arm's defaults (``sizes``).
     drive : Drive or None
         The drive whose known rotor inertias the torques checked include.
+    rest : ndarray, shape (n,), or None
+        The rest position the motion is centred on and every reduction of its amplitudes
+        shrinks toward [rad] (the preferred one within the limits).
+    rest_clearances : tuple of Approach
+        The obstacle clearances the rest position already violates: then no trajectory
+        about it is admissible.
     """
 
     trajectory: ExcitingTrajectory
@@ -311,6 +317,8 @@ class ExcitationResult:
     sizes: CollisionSizes | None = None
     derived: tuple[str, ...] = ()
     drive: Drive | None = None
+    rest: NDArray[np.float64] | None = None
+    rest_clearances: tuple[Approach, ...] = ()
 
     @property
     def start_admissible(self) -> bool:
@@ -672,17 +680,15 @@ def optimise_excitation(
     obstacles : Obstacles, optional
         Default :meth:`Obstacles.floor` (the plane ``z = 0`` of the base frame).
     q_start : array_like, shape (n,), optional
-        Preferred rest position [rad] (the optimiser moves it where the motion fits);
-        default the middle of the limits (``robot.q_neutral`` if set).
+        Preferred rest position [rad] (moved where the motion fits); default the middle
+        of the limits (``robot.q_neutral`` if set); its clearances: ``rest_clearances``.
     base : BaseParameters, optional
         Default ``base_parameters(robot, kind="torque")``.
     progress : callable, optional
         ``progress(iteration, max_iter, condition_number)`` after each iteration.
     evaluated : callable, optional
-        ``evaluated(evaluations, budget)`` after each evaluation of the objective (several
-        per millisecond to one per 15 ms: throttle what it shows); ``budget`` is
-        ``options.max_evaluations`` plus those that chose the start (L-BFGS-B may
-        overrun it by the evaluations of one gradient).
+        ``evaluated(evaluations, budget)`` after each evaluation (up to several per ms);
+        ``budget``: ``options.max_evaluations`` and those of the start (L-BFGS-B may overrun).
     drive : Drive, optional
         The drive train: the torques checked include its known rotor inertias' reflected
         torques ``K^T diag(I_a) K ddq`` (none when it leaves them to be identified).
@@ -766,7 +772,24 @@ def optimise_excitation(
         sizes=collision_sizes(robot),
         derived=derived,
         drive=drive,
+        rest=centre,
+        rest_clearances=_rest_clearances(robot, centre, options, obstacles, caps),
     )
+
+
+def _rest_clearances(
+    robot: Robot,
+    rest: NDArray[np.float64],
+    opts: ExcitationOptions,
+    obstacles: Obstacles,
+    caps: CapsuleModel,
+) -> tuple[Approach, ...]:
+    """The obstacle clearances the rest position ``rest`` (n,) [rad] violates."""
+    near = closest_approaches(
+        robot, np.zeros(1), rest[None], caps, obstacles,
+        self_clearance=_clearances(opts)[0], obstacle_clearance=_clearances(opts)[1],
+    )[1]  # fmt: skip
+    return tuple(a for a in near if a.margin < -1e-9)
 
 
 def _start(prob: _Problem, rng: np.random.Generator) -> NDArray[np.float64]:

@@ -63,11 +63,14 @@ class ExcitationDesign:
         The trajectory sampled at :data:`EXCITE_RATE_HZ`.
     seed : int
         The seed it was optimised from.
+    obstacles_file : str or None
+        The obstacles file's name (None: the default floor, ``z = 0`` of the base frame).
     """
 
     result: ExcitationResult
     samples: Any
     seed: int = field(default=0)
+    obstacles_file: str | None = None
 
     @property
     def admissible(self) -> bool:
@@ -183,6 +186,60 @@ class ExcitationDesign:
             )
         return lines
 
+    def failure(self, robot: Robot, name: Callable[[str], str] = str) -> str:
+        """Why no admissible trajectory was found, in one line: what is violated, the
+        obstacles' planes used and where they come from, the rest position's clearance
+        when it already violates one (then no amplitude helps), and what to change."""
+        res = self.result
+        text = (
+            f"no admissible trajectory found (violated at 1 kHz: "
+            f"{', '.join(res.violations())}; files written for inspection)"
+        )
+        if any(k.startswith("obstacles[") for k in res.violations()):
+            text += f"; {self.planes_text(robot, name)}"
+        if res.rest_clearances:
+            near = ", ".join(
+                f"{a.link} {-a.distance:.3g} m into {a.other}"
+                if a.distance < 0
+                else f"{a.link} {a.distance:.3g} m from {a.other} ({a.required:.3g} m required)"
+                for a in res.rest_clearances
+            )
+            where = (
+                f"lower it with {name('obstacles')} FILE holding "
+                '{"schema": "dynid-obstacles/1", "planes": [{"name": "floor", "point": '
+                f'[0, 0, Z], "normal": [0, 0, 1]}}]}} (Z in m in {robot.link_names[0]}\'s '
+                "frame, below the arm)"
+                if self.obstacles_file is None
+                else f"move the obstacles in {self.obstacles_file} ({name('obstacles')})"
+            )
+            return (
+                f"{text}; the rest position the design starts from already violates it "
+                f"({near}); hint: {where}, or narrow the joint ranges to a rest position "
+                f"clear of it ({name('ranges')} q1=LO:HI,...)"
+            )
+        return (
+            f"{text}; hint: narrower joint ranges ({name('ranges')} q1=LO:HI,...; a joint "
+            "that turns +-2 pi reaches the floor and the arm itself), fewer or smaller "
+            f"obstacles ({name('obstacles')}), a smaller {name('radii')}, "
+            f"{name('self_clearance')} or {name('obstacle_clearance')}, more "
+            f"{name('max_iter')} or another {name('seed')}"
+        )
+
+    def planes_text(self, robot: Robot, name: Callable[[str], str] = str) -> str:
+        """The obstacles' planes in the base frame and where they come from."""
+        obs = self.result.obstacles
+        where = (
+            f"the default floor (no {name('obstacles')})"
+            if self.obstacles_file is None
+            else f"from {self.obstacles_file} ({name('obstacles')})"
+        )
+        planes = ", ".join(
+            f"{n}: {_plane_text(p.point, p.normal)}"
+            for n, p in zip(obs.names, obs.planes, strict=False)
+        )
+        base = robot.link_names[0]
+        return f"obstacle planes {where}, in the base frame {base}: {planes or 'none'}"
+
     def start_note(self) -> str | None:
         """Why the result is not better than the optimiser's start, or None when it is."""
         res = self.result
@@ -254,4 +311,14 @@ def design_excitation(
         evaluated=evaluated,
         drive=drive,
     )
-    return ExcitationDesign(res, res.trajectory.sample(EXCITE_RATE_HZ), seed)
+    file = None if obstacles is None else Path(obstacles).name
+    return ExcitationDesign(res, res.trajectory.sample(EXCITE_RATE_HZ), seed, file)
+
+
+def _plane_text(point: tuple[float, ...], normal: tuple[float, ...]) -> str:
+    """``z = -0.8`` for a horizontal plane, else its point and normal [m]."""
+    if tuple(normal) == (0.0, 0.0, 1.0):
+        return f"z = {point[2]:.3g} m"
+    return (
+        f"point {tuple(round(x, 3) for x in point)} m, normal {tuple(round(x, 3) for x in normal)}"
+    )

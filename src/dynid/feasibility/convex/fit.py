@@ -42,6 +42,7 @@ from ...identification.log import TorqueLog
 from ...identification.model import IdentifiedModel
 from ...identification.selection import identify_recordings
 from ...identification.static import identify_static
+from ...identification.structural import combined_notes
 from ...identification.structure import Structure
 from ...model.drive import Drive
 from ...model.robot import Robot
@@ -277,7 +278,12 @@ def consistent_from_identified(
             constraints=constraints,
             kind=kind,
         )
-    res = replace(res, identified=model, rotor_inertia=_rotor_inertia(model, res.rotor_inertia))
+    res = replace(
+        res,
+        identified=model,
+        rotor_inertia=_rotor_inertia(model, res.rotor_inertia),
+        notes=res.notes + combined_notes(model.info.combined),
+    )
     return res if model.drive is None else with_drive(res, model.drive)
 
 

@@ -431,7 +431,10 @@ def _xyz_rpy(T: NDArray[np.float64]) -> tuple[str, str]:
 
 
 def toml_from_robot(
-    robot: Robot, *, drive: Drive | None = None, friction: Friction | FrictionSum | None = None
+    robot: Robot,
+    *,
+    drive: Drive | None = None,
+    friction: Friction | FrictionSum | None = None,
 ) -> str:
     """The dynid TOML description of a robot (schema: see the module docstring).
 
