@@ -7,6 +7,7 @@ import dataclasses
 import os
 import subprocess
 import sys
+import warnings
 from collections.abc import Callable, Sequence
 from pathlib import Path
 
@@ -15,6 +16,7 @@ import pytest
 from numpy.typing import ArrayLike
 
 import dynid
+from dynid.exceptions import DynidWarning
 from dynid.feasibility.compare import perturbed_robot  # noqa: F401 (shared with the tests)
 from dynid.friction.model import Friction
 from dynid.identification.least_squares import LeastSquaresFit
@@ -245,3 +247,11 @@ SHORT_EXCITATION = {
     "n_starts": 8,
     "max_evaluations": 1500,
 }
+
+
+def said_warnings(fn: Callable[..., object], *args: object, **kw: object):
+    """``fn(*args, **kw)``'s result and the messages of the DynidWarnings it gave."""
+    with warnings.catch_warnings(record=True) as got:
+        warnings.simplefilter("always")
+        out = fn(*args, **kw)
+    return out, [str(w.message) for w in got if issubclass(w.category, DynidWarning)]

@@ -9,12 +9,10 @@ from __future__ import annotations
 
 import json
 import re
-import warnings
 
 import numpy as np
 
 import dynid
-from dynid.exceptions import DynidWarning
 from dynid.friction.model import ClassicalFriction
 from dynid.io.export import save_robot_files
 from dynid.io.feasible import save_feasible_json
@@ -23,6 +21,8 @@ from dynid.io.robot.export_options import ExportOptions
 from dynid.io.robot_file import load_robot
 from dynid.model.drive import Drive
 from dynid.workflows.export import export_robot, save_export
+
+from conftest import said_warnings
 
 #: A 7-joint drive with rotor inertias [kg m^2], joint side.
 DRIVE = Drive.from_gears([1.0] * 7, rotor_inertia=np.full(7, 0.1), side="joint")
@@ -40,14 +40,6 @@ def _feasible(path):
     return path
 
 
-def _said(fn, *args, **kw):
-    """``fn``'s result and the DynidWarnings it gave."""
-    with warnings.catch_warnings(record=True) as got:
-        warnings.simplefilter("always")
-        out = fn(*args, **kw)
-    return out, [str(w.message) for w in got if issubclass(w.category, DynidWarning)]
-
-
 def _named(line: str) -> list[str]:
     """The files a warning names in parentheses (``(robot.xml)``)."""
     return re.findall(r"\(([\w.]+\.(?:xml|toml|urdf|json))\)", line)
@@ -60,7 +52,9 @@ def test_a_single_export_names_only_files_that_exist(tmp_path):
     params = _feasible(tmp_path / "feasible.json")
     lines = []
     for out in ("one.urdf", "one.xml"):
-        lines += _said(lambda p, o: save_export(o, export_robot(p, o)), params, tmp_path / out)[1]
+        lines += said_warnings(
+            lambda p, o: save_export(o, export_robot(p, o)), params, tmp_path / out
+        )[1]
     assert len(lines) == 3, lines  # URDF: friction, rotors; MJCF: friction
     for line in lines:
         assert all((tmp_path / name).exists() for name in _named(line)), line
@@ -77,7 +71,7 @@ def test_an_output_folder_names_the_files_written_beside_each_other(tmp_path):
     params = _feasible(tmp_path / "feasible.json")
     robot = load_robot(params)
     opts = ExportOptions(friction=robot.friction, drive=DRIVE, source="feasible.json")
-    _, lines = _said(save_robot_files, tmp_path, robot, opts)
+    _, lines = said_warnings(save_robot_files, tmp_path, robot, opts)
     assert len(lines) == 3 and not any("not written" in x for x in lines), lines
     for line in lines:
         assert _named(line) and all((tmp_path / n).exists() for n in _named(line)), line
@@ -90,7 +84,7 @@ def test_a_robot_toml_is_named_as_the_file_that_holds_its_own_friction(tmp_path)
     no other TOML."""
     params = _feasible(tmp_path / "feasible.json")
     toml = tmp_path / "arm.toml"
-    _said(lambda: save_export(toml, export_robot(params, toml)))
+    said_warnings(lambda: save_export(toml, export_robot(params, toml)))
     out = tmp_path / "arm2.urdf"
-    lines = _said(lambda: save_export(out, export_robot(toml, out)))[1]
+    lines = said_warnings(lambda: save_export(out, export_robot(toml, out)))[1]
     assert "arm.toml holds it exactly" in lines[0] and "TOML export" not in lines[0], lines

@@ -31,7 +31,7 @@ from dynid.simulation.measurement import SensorNoise, simulate_measurement
 from dynid.simulation.trajectories import random_fourier, uniform_times
 from dynid.workflows.export import ExportRobotOptions, export_robot
 
-from conftest import exact_model
+from conftest import exact_model, said_warnings
 
 #: The Baxter trial's judgement: held-out 2.524 % against least squares' 2.342 %.
 HELDOUT = {
@@ -58,14 +58,6 @@ def _feasible(path, *, rejected: bool):
     return path
 
 
-def _said(fn, *args, **kw):
-    """``fn``'s result and the DynidWarnings it gave."""
-    with warnings.catch_warnings(record=True) as got:
-        warnings.simplefilter("always")
-        out = fn(*args, **kw)
-    return out, [str(w.message) for w in got if issubclass(w.category, DynidWarning)]
-
-
 @pytest.mark.parametrize("out", ["r.urdf", "r.xml", "r.toml", "patched.urdf"])
 def test_every_export_refuses_a_fit_that_was_not_accepted_with_its_held_out_numbers(tmp_path, out):
     """Regression: a rejected fit (held-out +7.79 % over least squares) was written to every
@@ -86,7 +78,7 @@ def test_an_accepted_fit_exports_without_a_word_about_acceptance(tmp_path):
     """A fit within the tolerance (held-out 1 % above least squares) is written, silently."""
     params = _feasible(tmp_path / "feasible.json", rejected=False)
     assert load_fit_rejection(params) is None
-    _, lines = _said(export_robot, params, tmp_path / "r.urdf")
+    _, lines = said_warnings(export_robot, params, tmp_path / "r.urdf")
     assert not any("accepted" in x for x in lines), lines
 
 
@@ -116,11 +108,11 @@ def test_reading_a_rejected_fit_as_a_robot_warns_with_its_reason(tmp_path):
     with the reason; an accepted fit reads silently."""
     params = _feasible(tmp_path / "feasible.json", rejected=True)
     for read in (load_feasible_json, load_robot):
-        robot, lines = _said(read, params)
+        robot, lines = said_warnings(read, params)
         assert len(lines) == 1 and "2.52 %" in lines[0], lines
         assert robot.n == 7
     good = _feasible(tmp_path / "good.json", rejected=False)
-    assert _said(load_robot, good)[1] == []
+    assert said_warnings(load_robot, good)[1] == []
 
 
 def _log(path, seed: int) -> None:
@@ -163,7 +155,7 @@ def test_an_output_folder_of_a_rejected_fit_says_why_in_every_file(tmp_path):
     opts = RetrievalOptions(runs=2)
     res = retrieve(exact_model(panda, panda), total_mass=(1.0, 3.0), options=opts, seed=0)
     assert not res.feasible
-    files = _said(save_feasible_bundle, tmp_path, res)[0]
+    files = said_warnings(save_feasible_bundle, tmp_path, res)[0]
     doc = json.loads((tmp_path / "feasible.json").read_text())
     bad = [c.name for c in res.report.violated]
     assert [v.split()[0] for v in doc["violated"]] == bad and "total_mass_max" in bad
@@ -173,7 +165,7 @@ def test_an_output_folder_of_a_rejected_fit_says_why_in_every_file(tmp_path):
             assert any(x.lstrip("<!-# ").startswith("NOT ACCEPTED") for x in head), (f, head)
             assert "total_mass_max" in " ".join(head)
     for name in ("robot.urdf", "robot.toml"):  # read back with the comment
-        assert _said(load_robot, tmp_path / name)[0].n == 7
+        assert said_warnings(load_robot, tmp_path / name)[0].n == 7
     with pytest.raises(OptionError, match="violated: .*total_mass_max"):
         export_robot(tmp_path / "feasible.json", tmp_path / "r.xml")
 
