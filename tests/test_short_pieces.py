@@ -96,8 +96,8 @@ def test_dropped_samples_are_counted_as_grid_points_added_not_as_negative_decima
 def test_jittered_stamps_without_dropped_samples_add_no_dropped_places():
     """Regression: a 1 kHz log with 50 us of jitter and no sample dropped (largest step
     1.27 ms) read "2 added by resampling onto a uniform grid (the places of dropped
-    samples)"; only steps of 1.5 periods or more count as dropped samples now (here the
-    three removed, known), and the grid's other points are said to be jitter."""
+    samples)"; the dropped samples are counted over the span now (here the three
+    removed, known), and the grid's other points are said to be jitter."""
     from dynid.cli.summaries import recordings_lines
 
     panda = dynid.panda()
@@ -121,6 +121,26 @@ def test_jittered_stamps_without_dropped_samples_add_no_dropped_places():
     assert "on the uniform grid the jittered stamps were resampled onto" in lines[0]
     assert "no sample dropped" in lines[0]
     assert "3 added by resampling onto a uniform grid (the places of dropped samples)" in lines[1]
+
+
+def test_heavy_jitter_counts_only_the_samples_dropped():
+    """Regression: 100 Hz stamps jittered by up to +-3 ms (0.3 of a period) with 1 % of the
+    samples dropped: 68 were counted dropped where 20 were (every step of 1.5 periods
+    counted, and jitter alone makes steps of 1.6); now the count is the known one."""
+    panda = dynid.panda()
+    rng = np.random.default_rng(12)
+    t = sample_times(20.0, 100.0)
+    log = simulate_measurement(
+        panda, random_fourier(panda, rng)(t), rng=rng, noise=SensorNoise.none()
+    )
+    stamps = t + rng.uniform(-3e-3, 3e-3, t.size)
+    stamps[0], stamps[-1] = t[0], t[-1]
+    gone = np.sort(rng.choice(np.arange(300, t.size - 300), 20, replace=False))
+    gone = gone[np.diff(gone, prepend=0) > 1]  # no two in a row: each its own place
+    rows = np.setdiff1d(np.arange(t.size), gone)
+    cut = TorqueLog(stamps[rows], log.q[rows], log.dq[rows], log.tau[rows])
+    rec = prepare_recordings(panda, [cut], ["j.csv"], cutoff_hz=2.0)
+    assert rec.counts[0].dropped == gone.size
 
 
 def test_recordings_at_other_rates_say_each_its_own_decimation():

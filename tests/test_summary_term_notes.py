@@ -64,15 +64,16 @@ def test_a_negative_viscous_coefficient_beyond_its_std_is_said_to_misfit(model):
 
 
 def test_negative_viscous_tells_within_its_std_from_beyond():
-    """Only kept viscous coefficients below zero are named; zero within one std of the
-    value is indistinguishable from 0, beyond it is not (values given by hand)."""
+    """Only kept viscous coefficients below zero are named; zero within 3 std of the value
+    is indistinguishable from 0, beyond it is not (values given by hand; a true zero lies
+    beyond one std on a third of the joints)."""
     labels = ("fv1", "fc1", "fv2", "fc2", "fv3", "fv4", "jfv5")
-    values = np.array([-0.01, -0.3, -0.05, 0.3, 0.02, -0.2, -0.1])
+    values = np.array([-0.025, -0.3, -0.05, 0.3, 0.02, -0.2, -0.1])
     std = np.array([0.02, 0.01, 0.005, 0.01, 0.01, 0.01, 0.01])
     kept = np.array([True, True, True, True, True, False, True])
     found = negative_viscous(labels, values, std, kept)
     assert [f.label for f in found] == ["fv1", "fv2"]
-    assert [f.within_std for f in found] == [True, False]
+    assert [f.indistinguishable for f in found] == [True, False]
     assert found[1].stds == pytest.approx(10.0)
     (joint,) = negative_viscous(labels, values, std, kept, prefix="j")
-    assert joint.label == "jfv5" and not joint.within_std
+    assert joint.label == "jfv5" and not joint.indistinguishable

@@ -16,7 +16,7 @@ from ..feasibility.penalty import RetrievalProgress, RetrievalResult
 from ..friction.fit import FrictionFit
 from ..friction.model import friction_parts
 from ..friction.validation import NewtonEulerValidation
-from ..identification.dissipation import negative_viscous
+from ..identification.dissipation import SIGNIFICANCE, negative_viscous
 from ..identification.info import IdentificationInfo, LogInfo
 from ..identification.model import IdentifiedModel
 from ..identification.structure import MIN_WIDTH, joint_side_joints
@@ -188,20 +188,21 @@ def _negative_viscous_line(t: Any) -> list[str]:
     )
     if not found:
         return []
-    near = [f for f in found if f.within_std]
-    far = [f for f in found if not f.within_std]
+    near = [f for f in found if f.indistinguishable]
+    far = [f for f in found if not f.indistinguishable]
     said = []
     if far:
         said.append(
             ", ".join(f"{f.label} {f.value:+.4g} ({f.stds:.2g} std from 0)" for f in far)
-            + ": each beyond its std, so the friction law misfits there (a negative slope "
+            + f": each {SIGNIFICANCE:g} std or more below zero, so the friction law "
+            "misfits there (a negative slope "
             "stands in for a shape the law lacks, such as friction that levels off at speed; "
             "dynid friction compares other laws)"
         )
     if near:
         said.append(
             ", ".join(f"{f.label} {f.value:+.4g}" for f in near)
-            + ": within its std of zero, indistinguishable from 0"
+            + f": within {SIGNIFICANCE:g} std of zero, indistinguishable from 0"
         )
     return ["  viscous friction below zero (not dissipative): " + "; ".join(said)]
 

@@ -122,9 +122,12 @@ class NegativeViscous:
     std: float
 
     @property
-    def within_std(self) -> bool:
-        """Whether zero lies within one standard deviation: indistinguishable from 0."""
-        return abs(self.value) <= self.std
+    def indistinguishable(self) -> bool:
+        """Whether zero lies within :data:`SIGNIFICANCE` standard deviations of the
+        value: indistinguishable from 0 (a true zero lies beyond one std on 32 % of the
+        joints: a geared arm without joint viscous friction read "the friction law
+        misfits" at 1.3 std)."""
+        return abs(self.value) < SIGNIFICANCE * self.std
 
     @property
     def stds(self) -> float:
