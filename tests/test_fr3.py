@@ -159,3 +159,24 @@ def test_excite_robot_fr3_keeps_the_fr3_limits(tmp_path):
     dq = table[:, [cols.index(f"dq{j}") for j in range(1, 8)]]
     assert np.all(q > PUBLISHED["q_min"]) and np.all(q < PUBLISHED["q_max"])
     assert np.all(np.abs(dq) < PUBLISHED["dq_max"])
+
+
+def test_kinematics_commands_on_fr3_say_nothing_of_its_link_parameters(capsys, monkeypatch):
+    """Regression (fk, jacobian and ik on fr3 printed the note that its link parameters are
+    the Panda's, which they do not use): the kinematics commands print no note; a command
+    that uses the parameters still does."""
+    root = logging.getLogger()
+    monkeypatch.setattr(root, "handlers", [])
+    monkeypatch.setattr(root, "level", root.level)
+    q = "0,-0.3,0,-2,0,1.8,0.8"
+    for argv in (["fk", "--q", q], ["jacobian", "--q", q]):
+        assert main([argv[0], "--robot", "fr3", *argv[1:]]) == 0
+        assert "note:" not in capsys.readouterr().err
+    assert (
+        main(["ik", "--robot", "fr3", "--goal-xyz", "0.4,0.1,0.5", "--goal-rpy", "3.14159,0,0"])
+        == 0
+    )
+    assert "note:" not in capsys.readouterr().err
+    log_to_stderr("identify", NOTE)
+    load_robot("fr3")
+    assert capsys.readouterr().err.count("note:") == 1

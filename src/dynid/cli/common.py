@@ -294,9 +294,10 @@ def load_drive_arg(args: argparse.Namespace, n: int) -> Any:
     return None if spec is None else drive_of_robot_file(spec, n)
 
 
-def load_robot(args: argparse.Namespace) -> Robot:
+def load_robot(args: argparse.Namespace, *, parameters: bool = True) -> Robot:
     """The robot named by ``--robot`` (and ``--base``/``--tip``/``--snap-angles`` for a
-    URDF).
+    URDF); ``parameters`` False for a command of the kinematics alone (no note on a built-in
+    robot's link parameters).
 
     Raises
     ------
@@ -307,7 +308,7 @@ def load_robot(args: argparse.Namespace) -> Robot:
     snap = bool(getattr(args, "snap_angles", False))
     chain = {"base": args.base, "tip": args.tip, "snap_angles": snap}
     if spec in BUILTIN_ROBOTS:
-        return load_robot_file(spec, **chain, what="--robot")
+        return load_robot_file(spec, **chain, what="--robot", parameters=parameters)
     path = Path(spec)
     with in_file(path.name):
         return load_robot_file(path, **chain, what="--robot")

@@ -125,7 +125,7 @@ def _goal(
 
 def run(args: argparse.Namespace, console: Console) -> int:
     """Solve and print (table or JSON); exit status 1 when not converged."""
-    robot = load_robot(args)
+    robot = load_robot(args, parameters=False)
     tool = parse_tool(args.tool)
     q0 = default_q0(robot) if args.q0 is None else parse_q(args.q0, robot, "--q0")
     T_goal = _goal(args, robot, q0, tool)

@@ -52,7 +52,7 @@ def register(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParser:
 
 def run(args: argparse.Namespace, console: Console) -> int:
     """Print the Jacobian (table or JSON)."""
-    robot = load_robot(args)
+    robot = load_robot(args, parameters=False)
     q = joint_positions(args, robot)
     J = jacobian(robot, q, args.frame, parse_tool(args.tool))
     if args.json:

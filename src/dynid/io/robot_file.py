@@ -28,6 +28,7 @@ def load_robot(
     tip: str | None = None,
     what: str = "robot",
     snap_angles: bool = False,
+    parameters: bool = True,
 ) -> Robot:
     """A built-in robot by name, or a robot file by its suffix: the one dispatch of robots.
 
@@ -38,7 +39,9 @@ def load_robot(
     :func:`dynid.io.feasible.load_feasible_json`, with the friction identified with the links
     when the file holds it, acting where it was identified) or ``.xml`` (an MJCF, read by
     MuJoCo's compiler when the ``mujoco`` package is installed:
-    :func:`dynid.io.robot.mjcf_read.load_mjcf`). ``what`` names the option in errors.
+    :func:`dynid.io.robot.mjcf_read.load_mjcf`). ``what`` names the option in errors;
+    ``parameters`` False: the caller uses the kinematics alone, and a built-in robot's note
+    on its link parameters is not given (:func:`~dynid.model.builtin.builtin_robot`).
 
     Raises
     ------
@@ -55,7 +58,7 @@ def load_robot(
     if given is not None and suffix != ".urdf":
         raise OptionError(f"applies to a URDF {what} only; leave it out", field=given)
     if str(spec) in BUILTIN_ROBOTS:
-        return builtin_robot(str(spec))
+        return builtin_robot(str(spec), parameters=parameters)
     if suffix not in ROBOT_FILE_SUFFIXES:
         raise DataError(
             f"{what} must be {_names()} or a .urdf, .toml, .json (feasible.json) or .xml "

@@ -69,10 +69,11 @@ BUILTIN_ROBOTS: Mapping[str, BuiltinRobot] = MappingProxyType(
 )
 
 
-def builtin_robot(name: str) -> Robot:
+def builtin_robot(name: str, *, parameters: bool = True) -> Robot:
     """The built-in robot ``name`` (``"panda"``, ``"fr3"``); its
     :attr:`~BuiltinRobot.parameter_note`, when it has one, is logged at level
-    :data:`~dynid.progress.NOTE`.
+    :data:`~dynid.progress.NOTE` unless ``parameters`` is False (the caller uses the
+    kinematics and limits alone: forward kinematics, Jacobians, inverse kinematics).
 
     Raises
     ------
@@ -85,6 +86,6 @@ def builtin_robot(name: str) -> Robot:
         raise UnknownNameError(
             f"unknown built-in robot {name!r}; available: {sorted(BUILTIN_ROBOTS)}"
         ) from None
-    if entry.parameter_note:
+    if entry.parameter_note and parameters:
         _log.log(NOTE, "%s", entry.parameter_note)
     return entry.make()
