@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import re
 import warnings
+from dataclasses import replace
 
 import numpy as np
 import pytest
@@ -21,6 +22,7 @@ from dynid.identification.residual_dependence import (
     outside_model_note,
     residual_dependence,
 )
+from dynid.identification.sanity import opposite_sign
 from dynid.identification.selection import identify_recordings
 from dynid.identification.structure import Structure
 from dynid.io.torque_log import save_torque_log
@@ -164,3 +166,18 @@ def test_a_consistent_fit_rejected_over_a_spring_says_least_squares_is_off_first
         assert "joint2: " in said[0] and "follows its position" in said[0], said[0]
         rejected = [i for i, n in enumerate(notes) if "worse than least squares" in n]
         assert rejected and rejected[0] > 0, notes
+
+
+def test_a_stiff_spring_is_not_called_a_flipped_torque_sign(panda):
+    """Regression: a 60 N m/rad spring on joint 2 that the rigid-body model lacks made its
+    torques correlate -0.51 with the model's while every other joint agreed, and identify
+    refused the log as of the opposite sign on joint 2 (its hint, --units tau2=-1, would
+    have corrupted the data). The negated model explains that joint at 0.29 of its scale,
+    a flipped sign at about 1: the same joint's torques truly negated are still refused."""
+    log = _logs(panda, True, k=60.0)[0]
+    assert opposite_sign(panda, log) is None
+    plain = _logs(panda, False)[0]
+    tau = plain.tau.copy()
+    tau[:, 1] *= -1.0
+    said = opposite_sign(panda, replace(plain, tau=tau))
+    assert said is not None and "tau2=-1" in said and "joint2" in said, said

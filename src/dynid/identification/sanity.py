@@ -14,7 +14,11 @@ with them before fitting (:func:`log_findings`). None of them changes the data.
   and the ``--units tau2=-1`` entries that flip them alone. Each
   comparison alone can be fooled: on 2 s of fast motion a Panda's elbow torques of the
   right sign correlated -0.70 with its gravity torques (+0.99 with the whole torques),
-  and a description's poor inertias could turn the whole torques.
+  and a description's poor inertias could turn the whole torques. Where the whole torques
+  explain other joints at their scale, a joint is called opposite only if the negated
+  ones explain it at about its own (least-squares factor within :data:`CONFIRMED_SLOPE`):
+  a 60 N m/rad spring the rigid bodies lack turned a Panda shoulder's correlation to
+  -0.51 at a factor of -0.29, and that is no sign to flip.
 * **Scale**: the least-squares factor ``a`` in ``tau ~ a g(q)`` over the gravity-loaded
   joints; ``a`` near 1e3 or 1e-3 is a unit off by a power of ten (mN m against N m:
   :func:`torque_unit_finding`, refused by the commands unless ``--units`` names the
@@ -453,12 +457,18 @@ def opposite_sign(robot: Robot, log: TorqueLog) -> str | None:
     corr = _correlations(gc, tc)
     right = flipped = np.zeros(robot.n, dtype=bool)
     every = corr
+    off_scale = np.zeros(robot.n, dtype=bool)
     if (whole := _motion_torques(robot, log, at)) is not None:  # each can be fooled alone
         model, ok = whole
         every, slope = _explained(model[ok], log.tau[at][ok])
         corr = np.where(loaded, np.maximum(corr, every), every)
         right, flipped = _confirmed(every, slope), _confirmed(-every, -slope) & ~loaded
-    strong = (loaded & (corr < OPPOSITE_CORRELATION)) | flipped
+        lo, hi = CONFIRMED_SLOPE
+        off_scale = right.any() & ((-slope < lo) | (-slope > hi))
+    # where the model explains other joints at their scale, a joint whose negated model
+    # torques would not explain its own at about theirs holds something the rigid bodies
+    # lack (a spring, a counterbalance), not a flipped sign
+    strong = (loaded & (corr < OPPOSITE_CORRELATION) & ~off_scale) | flipped
     if not strong.any():
         return None
     if right.any() or not bool(np.all(every[loaded] < 0)):
