@@ -15,7 +15,7 @@ import numpy as np
 import pytest
 
 from dynid.dynamics.rnea import rnea
-from dynid.exceptions import DynidWarning
+from dynid.exceptions import DataError, DynidWarning, ShapeError, WrongTypeError
 from dynid.feasibility.convex.fit import identify_consistent
 from dynid.friction.model import ClassicalFriction
 from dynid.identification.structure import Structure
@@ -105,7 +105,7 @@ def test_validate_params_feasible_predicts_the_spring(fitted):
 def test_the_mjcf_export_is_mujocos_passive_spring(fitted):
     """The exported MJCF loaded in MuJoCo: ``qfrc_spring`` at random positions is
     ``-k (q - q0)`` of the identified spring to 1e-10 (MuJoCo's sign: the spring's own
-    torque, the opposite of the motors')."""
+    torque, the opposite of the motors'); the file read back holds the same spring."""
     mujoco = pytest.importorskip("mujoco")
     res, out = fitted
     m = mujoco.MjModel.from_xml_path(str(out / "robot.xml"))
@@ -115,6 +115,10 @@ def test_the_mjcf_export_is_mujocos_passive_spring(fitted):
         d.qpos[:] = q
         mujoco.mj_forward(m, d)
         np.testing.assert_allclose(d.qfrc_spring, -res.spring.k * (q - res.spring.q0), atol=1e-10)
+    back = load_robot(out / "robot.xml").spring  # read by MuJoCo's compiler
+    assert back is not None
+    np.testing.assert_allclose(back.k, res.spring.k, rtol=1e-15)
+    np.testing.assert_allclose(back.q0, res.spring.q0, rtol=1e-15)
 
 
 def test_toml_and_feasible_round_trips_give_the_spring_torques(fitted, tmp_path):
@@ -167,3 +171,21 @@ def test_only_the_urdf_export_says_it_leaves_the_spring_out(arm, tmp_path):
         assert "leaves out" not in (tmp_path / name).read_text()
     text = (tmp_path / "r.xml").read_text()
     assert 'stiffness="4.0" springref="0.3"' in text and 'stiffness="0" springref="0.3"' in text
+
+
+def test_springs_of_the_wrong_shape_or_sign_are_refused(arm, tmp_path):
+    """A spring of unequal ``k`` and ``q0``, a non-finite value, another joint count than
+    the robot's, and a negative stiffness in a TOML ``[spring]`` table are each refused
+    with a message naming what is wrong."""
+    with pytest.raises(ShapeError, match="k and q0 must be"):
+        JointStiffness(np.ones(2), np.zeros(3))
+    with pytest.raises(ShapeError, match="must be finite"):
+        JointStiffness(np.array([1.0, np.nan]), np.zeros(2))
+    with pytest.raises(ShapeError, match="spring has 3 joints; robot has 2"):
+        arm.with_spring(JointStiffness(np.ones(3), np.zeros(3)))
+    with pytest.raises(WrongTypeError, match="must be a JointStiffness"):
+        arm.replace(spring=np.ones(2))
+    path = save_robot(tmp_path / "r.toml", arm, friction=False)
+    path.write_text(path.read_text() + "\n[spring]\nk = [1.0, -2.0]\nq0 = [0.0, 0.0]\n")
+    with pytest.raises(DataError, match=r"key 'spring.k\[1\]': expected a number >= 0"):
+        load_robot(path)

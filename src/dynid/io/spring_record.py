@@ -27,7 +27,7 @@ SPRING_FIELD = Field(
     nullable=True,
     record=Record(
         {
-            "k": Field("numbers", required=True, shape=("n",), unit="N m/rad"),
+            "k": Field("numbers", required=True, shape=("n",), low=0.0, unit="N m/rad"),
             "q0": Field("numbers", required=True, shape=("n",), unit="rad"),
         }
     ),
