@@ -75,11 +75,13 @@ With --consistent, the link parameters are identified physically consistent in o
 (convex, every link's pseudo-inertia positive definite, pulled towards --prior; see
 `dynid retrieve --help`): from torque logs (one or more, prepared as above) with the
 friction of the structure chosen (viscous and Coulomb >= 0) and the armature when it has
-one (rotor inertias >= 0; --terms armature forces it), or from static data. Writes next
+one (rotor inertias >= 0; --terms armature forces it), and the joint springs with
+--terms ...,spring (stiffnesses >= 0), or from static data. Writes next
 to identification.json (the unconstrained fit) the files of `dynid retrieve`:
-feasible.json (links, and the friction identified with them), robot.urdf, robot.xml,
-robot.toml, report.json, retrieval.png. Exit code 1 when no consistent set satisfies the
-constraints (the closest one is written and reported).
+feasible.json (links, and the friction and springs identified with them), robot.urdf,
+robot.xml (springs as stiffness and springref), robot.toml (a [spring] table),
+report.json, retrieval.png; URDF holds no spring and says so. Exit code 1 when no
+consistent set satisfies the constraints (the closest one is written and reported).
 
 example:
   dynid identify --robot panda --data static.csv --out result --max-std-percent 30

@@ -508,8 +508,10 @@ def consistent_structure_lines(result: ConsistentResult) -> list[str]:
     used = " + ".join(["links", *kept]) + "".join(f" - {t[1:]}" for t in terms if t[:1] == "-")
     out = [
         f"structure of the consistent fit: {used} (its friction law, leave-outs and armature "
-        "as fitted by least squares; kept physical: fv, fc, rotor inertias >= 0 and the "
-        "friction opposing the motion within the velocity limits, the offset free)"
+        "as fitted by least squares; kept physical: fv, fc, rotor inertias"
+        + (", spring stiffnesses" if result.spring is not None else "")
+        + " >= 0 and the friction opposing the motion within the velocity limits, the "
+        "offset free)"
     ]
     sel = model.info.selection
     if sel:
@@ -571,6 +573,13 @@ def format_consistent(result: ConsistentResult) -> str:
                 f"{name} [{unit}]: " + " ".join(f"{x:.4g}" for x in fr.params[:, j])
                 for j, (name, unit) in enumerate(zip(fr.names, fr.law.units, strict=True))
             )
+        )
+    if r.spring is not None:
+        lines.append(
+            "joint spring k (q - q0): k [N m/rad] (>= 0): "
+            + " ".join(f"{x:.4g}" for x in r.spring.k)
+            + "; q0 [rad]: "
+            + " ".join(f"{x:.4g}" for x in r.spring.q0)
         )
     prior_masses, prior_rotors = _decided_by_prior(r)
     if r.rotor_inertia is not None:

@@ -113,12 +113,14 @@ class ArmModel:
         with_friction: bool = True,
     ) -> NDArray[np.float64]:
         """Joint torques [N m] (N, n) of the arm at joint positions [rad], velocities
-        [rad/s] and accelerations [rad/s^2] (N, n): rigid body, rotors and (unless
-        ``with_friction`` is False) friction."""
+        [rad/s] and accelerations [rad/s^2] (N, n): rigid body, a robot's joint spring,
+        rotors and (unless ``with_friction`` is False) friction."""
         if isinstance(self.model, IdentifiedModel):
             tau = self.model.torques(q, dq, ddq)
         else:
             tau = rnea(self.model, q, dq, ddq)
+            if self.model.spring is not None:
+                tau = tau + self.model.spring.torques(q)
         ia = self._known_rotors()
         if ia is not None and self.drive is not None:
             tau = tau + self.drive.rotor_torques(ddq, ia)

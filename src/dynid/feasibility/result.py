@@ -29,6 +29,7 @@ from ..friction.model import Friction, FrictionSum
 from ..model.drive import Drive
 from ..model.inertia import params_from_inertial
 from ..model.robot import Robot
+from ..model.stiffness import JointStiffness
 from .bounds import Bounds
 from .constraints import FeasibilityReport
 from .heldout import HeldOutJudgement
@@ -78,6 +79,9 @@ class FeasibleResult:
     rotor_inertia : ndarray, shape (n,), or None
         Rotor inertias at the motors identified with the links [kg m^2] (0 for a rotor the
         model's armature leaves out); None otherwise.
+    spring : JointStiffness or None
+        The joint springs identified with the links (stiffness ``>= 0`` [N m/rad] about the
+        term's rest positions, :mod:`dynid.model.stiffness`); None without a spring term.
     drive : Drive or None
         The drive train of the data, its rotor inertias the identified ones.
     heldout : HeldOutJudgement or None
@@ -106,6 +110,7 @@ class FeasibleResult:
     friction: Friction | FrictionSum | None = None
     rotor_inertia: NDArray[np.float64] | None = None
     drive: Drive | None = None
+    spring: JointStiffness | None = None
     heldout: HeldOutJudgement | None = None
 
     method: ClassVar[str] = ""

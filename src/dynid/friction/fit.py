@@ -108,12 +108,15 @@ def torques_through(
     ddq: NDArray[np.float64],
 ) -> NDArray[np.float64]:
     """The model's torques [N m] (N, n) on a log read through ``drive``, friction not
-    included: :func:`rigid_body_torques`, plus the drive's known rotor torques
-    ``K^T diag(I_a) K ddq`` for a robot's links or a callable (an identified model's
-    torques hold its rotors already). Validation and the friction fit's residual both
-    read the model so, so that a robot's own friction scores the same in both.
+    included: :func:`rigid_body_torques`, plus a robot's joint spring
+    (:attr:`~dynid.model.robot.Robot.spring`, ``k (q - q0)``) and the drive's known rotor
+    torques ``K^T diag(I_a) K ddq`` for a robot's links or a callable (an identified
+    model's torques hold its spring and rotors already). Validation and the friction fit's
+    residual both read the model so, so that a robot's own friction scores the same in both.
     """
     tau = rigid_body_torques(model, q, dq, ddq)
+    if isinstance(model, Robot) and model.spring is not None:
+        tau = tau + model.spring.torques(q)
     if drive is None or drive.rotor_inertia is None or isinstance(model, IdentifiedModel):
         return tau
     if not isinstance(model, Robot):  # a callable's array is its own: not changed here

@@ -30,6 +30,7 @@ from ..dynamics.terms import coriolis, gravity_torques, mass_matrix
 from ..exceptions import ModelError, ShapeError
 from ..model.drive import Drive
 from ..model.robot import Robot
+from ..model.stiffness import JointStiffness
 from ..regressors.base import BaseParameters
 from ..regressors.terms import FrictionValues, ModelTerm, RotorInertia
 from .holdout import HeldOut
@@ -98,6 +99,11 @@ class IdentifiedTerm:
     def inertia(self) -> NDArray[np.float64] | None:
         """The term as rotor inertias [kg m^2] (None: not rotor inertias)."""
         return self.term.inertia(self.values)
+
+    @property
+    def stiffness(self) -> JointStiffness | None:
+        """The term as joint springs (None: not a spring)."""
+        return self.term.stiffness(self.values)
 
     def torques(self, q: ArrayLike, dq: ArrayLike, ddq: ArrayLike) -> NDArray[np.float64]:
         """The term's joint torques [N m] (..., n) at joint states (..., n)."""
@@ -230,6 +236,21 @@ class IdentifiedModel:
         """Every friction term's law and parameters, in order (a view of :attr:`terms`):
         one, or two for friction at the motors and at the joints of a coupled drive."""
         return tuple(f for f in (t.friction for t in self.terms.values()) if f is not None)
+
+    @property
+    def spring(self) -> JointStiffness | None:
+        """The spring term's stiffnesses about its rest positions (a view of :attr:`terms`);
+        None without one.
+
+        Raises
+        ------
+        ModelError
+            The model holds several spring terms.
+        """
+        found = [s for s in (t.stiffness for t in self.terms.values()) if s is not None]
+        if len(found) > 1:
+            raise ModelError(f"the model holds {len(found)} spring terms; one is expected")
+        return found[0] if found else None
 
     @property
     def friction(self) -> FrictionValues | None:

@@ -24,6 +24,7 @@ _NAMES = {
     "load_feasible_json": "feasible",
     "load_feasible_linear_friction": "feasible",
     "load_feasible_drive": "feasible",
+    "load_feasible_spring": "feasible",
     "load_drive": "drive_file",
     "save_report_json": "report_json",
     "save_bounds": "bounds_file",

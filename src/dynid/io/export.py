@@ -6,9 +6,12 @@
 * ``urdf`` (``.urdf``): :func:`dynid.io.robot.urdf.export_urdf` (chain export, or
   ``template=`` the original URDF patched with the new inertials);
 * ``mjcf`` (``.xml``, ``.mjcf``): :func:`dynid.io.robot.mjcf.export_mjcf` (``friction`` as
-  ``frictionloss`` and ``damping``, a drive's rotors as ``armature``);
+  ``frictionloss`` and ``damping``, a drive's rotors as ``armature``, the robot's joint
+  spring as ``stiffness`` and ``springref``);
 * ``toml`` (``.toml``): :func:`dynid.io.robot.toml.export_toml` (kinematics, inertials,
-  limits, sigmoid friction, a drive as a ``[drive]`` table).
+  limits, sigmoid friction, a drive as a ``[drive]`` table, the spring as ``[spring]``).
+
+URDF holds no spring: its export says, in a warning and a comment, that it leaves it out.
 
 :func:`save_robot` picks the format by ``format`` or the file suffix; :func:`save_robot_files`
 writes one file per format into an output folder. ``dynid export`` (its ``--format``

@@ -20,6 +20,8 @@ and was not on a torque log; the friction identified with the links in ``linear_
      "drive": null | {dynid-drive/1 record, rotor_inertia: the identified values},
      "combined": {"fv6": "fv6 + 0.0005556*jfv7", ...} (only when friction coefficients
          hold one left out as structurally combined with them),
+     "spring": {"k": [...], "q0": [...]} (only with a spring term: the stiffnesses
+         identified with the links, :mod:`dynid.io.spring_record`),
      "kinematics": {...}, "feasible": true, "relative_residual": ..., "seed": ...,
      "violated": [...], "heldout": {...}, "units": {...}, "conventions": {...}}
 
@@ -61,11 +63,13 @@ from ..model.inertia import (
     matrix_from_inertia6,
 )
 from ..model.robot import MAX_LINK_MASS, MAX_LINK_OFFSET, Robot
+from ..model.stiffness import JointStiffness
 from .drive_file import drive_from_record
 from .json_files import finite_or_none, load_json
 from .law_friction import law_friction, law_record
 from .robot_json import ROBOT_RECORD, robot_from_dict, robot_to_dict
 from .schema import Field, Format, Record, check, fault, load_document, save_document
+from .spring_record import SPRING_FIELD, SPRING_FORMULA, spring_from_record, spring_record
 
 __all__ = [
     "FEASIBLE",
@@ -80,6 +84,7 @@ __all__ = [
     "fitted_robot",
     "combined_coefficients",
     "load_feasible_linear_friction",
+    "load_feasible_spring",
     "robot_from_feasible_dict",
     "save_feasible_json",
 ]
@@ -148,6 +153,7 @@ FEASIBLE = Format(
             "violated": Field("strings"),
             "heldout": Field("object", nullable=True),
             "combined": Field("object"),
+            "spring": SPRING_FIELD,
         }
     ),
     "feasible-parameter file",
@@ -227,6 +233,10 @@ def feasible_to_dict(source: FeasibleResult | Robot, *, seed: int | None = None)
     }
     if len(parts) > 1:
         d["joint_friction"] = law_record(parts[1])
+    spring = robot.spring if result is None else result.spring
+    if spring is not None:
+        d["spring"] = spring_record(spring)
+        conventions["spring"] = SPRING_FORMULA
     combined = combined_coefficients(result)
     if combined:  # not the motors' (joints') own friction alone: said beside the values
         d["combined"] = combined
@@ -317,7 +327,8 @@ def combined_coefficients(result: FeasibleResult | None) -> dict[str, str]:
 
 
 def fitted_robot(result: FeasibleResult) -> Robot:
-    """The result's robot with the friction of the fitted model, as the files hold it.
+    """The result's robot with the friction of the fitted model, as the files hold it, and
+    the joint springs identified with the links (``result.spring``).
 
     The friction identified with the links (``result.friction``; none when it acts at the
     motors and at the joints, which a robot does not hold: ``feasible.json`` keeps both
@@ -326,9 +337,10 @@ def fitted_robot(result: FeasibleResult) -> Robot:
     retrieval or a fit of static data, which identify none.
     """
     f = result.friction
+    robot = result.robot if result.spring is None else result.robot.with_spring(result.spring)
     if f is not None:
-        return result.robot.with_friction(None if isinstance(f, FrictionSum) else f)
-    return result.robot.with_friction(None) if result.kind == "log" else result.robot
+        return robot.with_friction(None if isinstance(f, FrictionSum) else f)
+    return robot.with_friction(None) if result.kind == "log" else robot
 
 
 def _at_motors(friction: Friction) -> bool:
@@ -388,6 +400,10 @@ def robot_from_feasible_dict(
                 robot = robot.with_friction(SigmoidFriction.from_array(F))
             except (ModelError, ShapeError) as exc:
                 raise fault(source, "friction", str(exc)) from exc
+        try:  # the joint springs identified with the links
+            robot = robot.with_spring(spring_from_record(d.get("spring")))
+        except ShapeError as exc:
+            raise fault(source, "spring", str(exc)) from exc
     if len(links) != robot.n:
         raise fault(
             source,
@@ -491,6 +507,11 @@ def load_feasible_linear_friction(path: str | Path) -> Friction | FrictionSum | 
     if d.get("joint_friction") is not None:
         parts.append(law_friction(d["joint_friction"], None, n, name, "joint_friction"))
     return parts[0] if len(parts) == 1 else FrictionSum(tuple(parts))
+
+
+def load_feasible_spring(path: str | Path) -> JointStiffness | None:
+    """The joint springs identified with the links held by ``feasible.json``, or None."""
+    return spring_from_record(load_document(path, FEASIBLE).get("spring"))
 
 
 def load_feasible_drive(path: str | Path) -> Drive | None:

@@ -32,6 +32,7 @@ from numpy.typing import ArrayLike, NDArray
 from .. import _checks
 from ..exceptions import ModelError, ShapeError, UnknownNameError, WrongTypeError
 from .inertia import inertial_from_phi, param_labels, phi_from_inertial
+from .stiffness import JointStiffness
 
 __all__ = ["Frame", "MAX_LINK_MASS", "MAX_LINK_OFFSET", "Robot", "STANDARD_GRAVITY"]
 
@@ -213,6 +214,11 @@ class Robot:
         one with ``dynid.SigmoidFriction.from_array(P)``; a bare array is refused.
     q_neutral : ndarray, shape (n,), or None
         A documented neutral pose (start of IK, demos); None: the middle of the limits.
+    spring : JointStiffness or None
+        A linear spring at every joint, ``tau_s = k (q - q0)`` (the torque the motors supply
+        against it [N m], added to the rigid-body torques like friction:
+        :class:`~dynid.model.stiffness.JointStiffness`); None for none. An identified
+        spring term carried by a consistent fit (``feasible.json``, a TOML ``[spring]``).
 
     Raises
     ------
@@ -239,6 +245,7 @@ class Robot:
     frames: Mapping[str, Frame] = field(default_factory=dict)
     friction: FrictionLike | None = None
     q_neutral: NDArray[np.float64] | None = None
+    spring: JointStiffness | None = None
 
     def __post_init__(self) -> None:
         n = len(self.joint_names)
@@ -319,6 +326,13 @@ class Robot:
             if np.any((qn < self.q_min) | (qn > self.q_max)):
                 raise ModelError("q_neutral must lie within the position limits")
             put("q_neutral", _checks.frozen(qn))
+        if self.spring is not None:
+            if not isinstance(self.spring, JointStiffness):
+                raise WrongTypeError(
+                    f"a robot's spring must be a JointStiffness; got {type(self.spring).__name__}"
+                )
+            if self.spring.n != n:
+                raise ShapeError(f"spring has {self.spring.n} joints; robot has {n}")
 
     # ------------------------------------------------------------------ properties
     @property
@@ -385,6 +399,10 @@ class Robot:
         standstill band and drive, or None (sigmoid parameters (n, 3):
         ``dynid.SigmoidFriction.from_array(P)``)."""
         return self.replace(friction=friction)
+
+    def with_spring(self, spring: JointStiffness | None) -> Robot:
+        """A copy with a spring at every joint (:attr:`spring`), or None."""
+        return self.replace(spring=spring)
 
     def with_gravity(self, gravity: ArrayLike) -> Robot:
         """A copy with the gravity vector (3,) [m/s^2] in the base frame."""

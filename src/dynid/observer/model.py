@@ -28,6 +28,7 @@ from ..identification.model import IdentifiedModel
 from ..model.drive import Drive
 from ..model.robot import Robot
 from ..regressors.base import BaseParameters
+from ..regressors.spring import JointSpring
 from ..regressors.terms import ModelTerm
 
 __all__ = ["ObserverModel", "from_identified", "from_robot", "term_mass"]
@@ -207,4 +208,13 @@ def from_robot(
         if drive.rotor_inertia is not None:
             Mr = drive.rotor_mass_matrix(drive.rotor_inertia)
     fr = own_friction(robot, drive) if isinstance(friction, str) else friction
-    return ObserverModel(robot=robot, rotor_mass=Mr, friction=fr, drive=drive, source="robot")
+    s = robot.spring  # the robot's joint spring: a term of the positions, as identified
+    springs = () if s is None else ((JointSpring(tuple(map(float, s.q0))), np.array(s.k)),)
+    return ObserverModel(
+        robot=robot,
+        rotor_mass=Mr,
+        friction=fr,
+        drive=drive,
+        source="robot",
+        position_terms=springs,
+    )

@@ -21,6 +21,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from ..model.drive import Drive
+from ..model.stiffness import JointStiffness
 
 __all__ = ["JointSpring"]
 
@@ -86,6 +87,10 @@ class JointSpring:
     def inertia(self, values: NDArray[np.float64]) -> None:
         """None: not rotor inertias."""
         return None
+
+    def stiffness(self, values: NDArray[np.float64]) -> JointStiffness:
+        """The stiffnesses ``values`` (n,) [N m/rad] about :attr:`q0`."""
+        return JointStiffness(np.asarray(values, dtype=np.float64), np.asarray(self.q0))
 
     def definition(self) -> dict[str, Any]:
         """``{"q0": [...]}``."""

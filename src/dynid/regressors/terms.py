@@ -38,6 +38,7 @@ from numpy.typing import NDArray
 
 from ..exceptions import OptionError
 from ..model.drive import Drive
+from ..model.stiffness import JointStiffness
 from .friction_columns import distinct_rows, smooth_sign, standstill_sign, stribeck_decay
 from .spring import JointSpring
 
@@ -151,6 +152,11 @@ class ModelTerm(Protocol):
         drive; None: not rotor inertias."""
         ...
 
+    def stiffness(self, values: NDArray[np.float64]) -> JointStiffness | None:
+        """The coefficients (p,) as joint springs (stiffness and rest position); None: not
+        a spring."""
+        ...
+
     def definition(self) -> dict[str, Any]:
         """JSON-ready: what :data:`TERM_KINDS` needs beside the model's drive to rebuild it."""
         ...
@@ -238,6 +244,10 @@ class RotorInertia:
         out = np.zeros(self.drive.n)
         out[self._held] = values
         return out
+
+    def stiffness(self, values: NDArray[np.float64]) -> None:
+        """None: not a spring."""
+        return None
 
     def definition(self) -> dict[str, Any]:
         """``mask`` (the model's drive is all it needs beside it)."""
@@ -536,6 +546,10 @@ class LinearFriction:
             part["stribeck"] = col["fs"] - col["fc"]
         every = np.column_stack([part[p] for p in self.parts]).ravel()
         return every[self._held]
+
+    def stiffness(self, values: NDArray[np.float64]) -> None:
+        """None: not a spring."""
+        return None
 
     def definition(self) -> dict[str, Any]:
         """``parts``, ``band``, ``width``, ``vst``, ``mask``, ``at`` (``"motor"`` or

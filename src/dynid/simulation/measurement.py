@@ -246,6 +246,8 @@ def _true_torques(
         tau = rnea(effects.true_robot(robot), traj.q, traj.dq, traj.ddq) + effects.torques(traj.ddq)
     else:
         tau = rnea(robot, traj.q, traj.dq, traj.ddq)
+    if robot.spring is not None:  # the motors hold the joint springs too
+        tau = tau + robot.spring.torques(traj.q)
     if friction is not None:  # placed where the drive puts it (_checked)
         tau = tau + friction.torques(traj.dq)
     if drive is not None and drive.rotor_inertia is not None:

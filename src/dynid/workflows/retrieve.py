@@ -78,7 +78,10 @@ def with_model_friction(result: FeasibleResult, model: IdentifiedModel) -> Feasi
     """``result`` (links retrieved from ``model``'s coefficients) with the friction
     identified with the links beside them, unchanged (the retrieval fits the links alone),
     and the model's drive, so that its files predict the model's torques: a torque-log
-    identification's friction was left out of ``feasible.json`` and ``robot.toml``."""
+    identification's friction was left out of ``feasible.json`` and ``robot.toml``. Its
+    spring (stiffnesses beside the links) likewise, unchanged."""
+    if result.spring is None and model.spring is not None:
+        result = replace(result, spring=model.spring)
     fr = combined(model.frictions)
     if result.friction is not None or fr is None:
         return result

@@ -15,6 +15,7 @@ from ...exceptions import DataError, ModelError
 from ...identification.holdout import HeldOut
 from ...identification.least_squares import LeastSquaresFit
 from ...identification.model import IdentifiedModel
+from ...model.stiffness import JointStiffness
 from ...regressors.terms import FrictionValues, ModelTerm
 from .options import EXACT_RTOL
 
@@ -111,6 +112,19 @@ class DataTerm:
             if fr is not None:
                 out.append(fr)
         return tuple(out)
+
+    def stiffness(self, f: NDArray[np.float64]) -> JointStiffness | None:
+        """The unknowns ``f`` (k,) as the spring of the terms (zero for the stiffnesses not
+        fitted); None when no term is a spring."""
+        every = np.zeros(sum(len(t.labels) for t in self.terms))
+        every[self.friction_layout()] = f
+        found, c = None, 0
+        for t in self.terms:
+            k = len(t.labels)
+            spring = t.stiffness(every[c : c + k])
+            found = found if spring is None else spring
+            c += k
+        return found
 
     def chi2(self, x: NDArray[np.float64]) -> float:
         """``||A (x - x_hat)||^2``: the increase of the residual sum of squares / sigma^2."""

@@ -293,6 +293,7 @@ def build_result(
         robot=out,
         friction=None if f is None else combined(term.frictions(f)),
         rotor_inertia=ia,
+        spring=None if f is None else term.stiffness(f),
         relative_residual=rel,
         residual_ratio=ratio,
         feasible=bool(report.ok) and status != "infeasible",

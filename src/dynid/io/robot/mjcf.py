@@ -34,7 +34,11 @@ keeping the robot's link and joint names:
   :func:`dynid.friction.mujoco.unheld_friction`) named in one warning line with the files
   that hold it.
   With ``friction=False`` the joints are frictionless, and ``mj_inverse`` equals
-  :func:`dynid.rnea`.
+  :func:`dynid.rnea`;
+* a joint spring (:attr:`~dynid.model.robot.Robot.spring`, the motors' torque
+  ``k (q - q0)`` against it) as MuJoCo's passive spring, joint ``stiffness = k``
+  [N m/rad] and ``springref = q0`` [rad]: MuJoCo's ``qfrc_spring = -k (q - q0)`` is the
+  spring's own torque, the opposite of dynid's.
 
 Numbers use Python's shortest round-trip representation.
 """
@@ -140,6 +144,7 @@ def _joint_terms(
 
 
 def _comment(
+    robot: Robot,
     friction: bool | FrictionModel | FrictionSum,
     approx: CoulombViscous | None,
     armature: NDArray[np.float64] | None,
@@ -157,6 +162,8 @@ def _comment(
             text += " (reflected from the motors)"
     if armature is not None:
         text += "; rotor inertia as armature"
+    if robot.spring is not None:
+        text += "; joint spring as stiffness about springref"
     return text + "".join(f"; {note}" for note in notes)
 
 
@@ -193,6 +200,9 @@ def _bodies(
             attrs += f' frictionloss="{_f(approx.coulomb[i])}" damping="{_f(approx.viscous[i])}"'
         if armature is not None:
             attrs += f' armature="{_f(armature[i])}"'
+        if robot.spring is not None:  # MuJoCo's own torque -k (q - q0): dynid's tau_s held
+            k, q0 = robot.spring.k[i], robot.spring.q0[i]
+            attrs += f' stiffness="{_f(k)}" springref="{_f(q0)}"'
         lines += [
             f"{ind[:-2]}<body name={quoteattr(robot.link_names[i + 1])} "
             f"{_pose(robot.T_parent_joint[i])}>",
@@ -267,7 +277,7 @@ def mjcf_from_robot(
     approx, armature, notes = _joint_terms(robot, friction, drive, kept)
     if notes:  # one line: what MJCF cannot hold
         warnings.warn(f"MJCF export: {'; '.join(notes)}", DynidWarning, stacklevel=2)
-    text = comment or _comment(friction, approx, armature, notes)
+    text = comment or _comment(robot, friction, approx, armature, notes)
     lines = [
         '<?xml version="1.0"?>',
         f"<!-- {text.replace('--', '- -')} -->",

@@ -21,8 +21,13 @@ compiled model is read at ``qpos = 0`` in world coordinates:
   :mod:`dynid.io.robot.mjcf` writes them); their ``armature`` [kg m^2], a direct drive's
   rotor inertias (:func:`mjcf_drive`).
 
+* the joints' ``stiffness`` [N m/rad] about ``springref`` [rad], MuJoCo's passive spring
+  ``qfrc_spring = -k (q - q0)``, is the robot's joint spring
+  (:attr:`~dynid.model.robot.Robot.spring`, the motors' torque ``k (q - q0)`` against it;
+  none when every stiffness is zero).
+
 What a serial-chain model cannot hold is refused in one line naming the file: ball and
-free joints, a body with several joints, a tree with branches, joint stiffness.
+free joints, a body with several joints, a tree with branches.
 """
 
 from __future__ import annotations
@@ -38,6 +43,7 @@ from ...exceptions import DataError, DynidError
 from ...model.drive import Drive
 from ...model.inertia import phi_from_inertial
 from ...model.robot import Frame, Robot
+from ...model.stiffness import JointStiffness
 
 __all__ = ["load_mjcf", "mjcf_drive"]
 
@@ -83,8 +89,6 @@ def _compiled(path: Path) -> _Compiled:
     several = [b for b in range(m.nbody) if m.body_jntnum[b] > 1]
     if several:
         raise DataError(f"body {_body(m, several[0])} has several joints", file=path.name)
-    if np.any(m.jnt_stiffness != 0.0):
-        raise DataError("joint stiffness (a spring) is not held by a robot", file=path.name)
     owner = np.zeros(m.nbody, dtype=np.intp)
     chain: list[int] = []
     for b in range(1, m.nbody):  # parents come before their children
@@ -193,6 +197,10 @@ def load_mjcf(path: str | Path) -> Robot:
         raise DataError(str(exc), file=path.name) from exc
     if np.any(fv != 0.0) or np.any(fc != 0.0):
         robot = robot.with_friction(ClassicalFriction(fv, fc, np.zeros(n)))
+    k = np.asarray(m.jnt_stiffness[jnt], dtype=np.float64)
+    if np.any(k != 0.0):
+        q0 = np.asarray(m.qpos_spring[m.jnt_qposadr[jnt]], dtype=np.float64)
+        robot = robot.with_spring(JointStiffness(k, q0))
     return robot
 
 

@@ -11,7 +11,9 @@ Layout: optional top-level ``format_version = 1``, ``name``, ``gravity`` and
 ``q_neutral``; one ``[[joints]]`` table per joint from the base to the tip (``name``,
 ``type`` "revolute" or "prismatic", ``parent``, ``child``, an ``origin`` (xyz, URDF rpy) or
 ``mdh`` pose, ``axis``, ``limits``, ``friction`` and a ``[joints.inertial]`` table with
-``mass``, ``com`` and ``inertia`` about the CoM); optional ``[[frames]]``. The full schema,
+``mass``, ``com`` and ``inertia`` about the CoM); optional ``[[frames]]``; an optional
+``[spring]`` table, ``k`` [N m/rad] and ``q0`` [rad] per joint (the joint springs a
+consistent fit identified, ``tau_s = k (q - q0)``: :mod:`dynid.io.spring_record`). The full schema,
 with an annotated example, is in ``docs/robot-description.md``.
 
 The keys are declared once (:data:`ROBOT_TOML`) and checked by the one strict codec of
@@ -63,6 +65,7 @@ from ..atomic import write_text
 from ..drive_file import drive_toml
 from ..input_files import file_text
 from ..schema import Field, Record, check, fault
+from ..spring_record import SPRING_FIELD, spring_from_record, spring_record
 from .export_options import ExportOptions, with_caveat
 from .toml_friction import FRICTION_TABLE, friction_tables, table_friction
 
@@ -146,6 +149,7 @@ ROBOT_TOML = Record(
         "drive": Field("any"),
         "friction": FRICTION_TABLE,
         "joint_friction": FRICTION_TABLE,
+        "spring": SPRING_FIELD,
     }
 )
 #: Rate limits: ``limits.velocity`` [rad/s or m/s], ``acceleration``, ``effort`` [N m or N].
@@ -329,7 +333,7 @@ def robot_from_toml_string(text: str, *, source: str = "TOML text") -> Robot:
     -------
     Robot
         With the joints' sigmoid ``friction`` as a ``dynid.SigmoidFriction`` (none when
-        the description gives none).
+        the description gives none), and the ``[spring]`` table as its ``spring``.
 
     Raises
     ------
@@ -371,6 +375,7 @@ def robot_from_toml_string(text: str, *, source: str = "TOML text") -> Robot:
             frames=frames,
             friction=SigmoidFriction.from_array(np.stack(sigmoid)) if sigmoid else law,
             q_neutral=_vector(doc["q_neutral"], ()) if "q_neutral" in doc else None,
+            spring=spring_from_record(doc.get("spring")),
         )
     except DynidError as exc:
         raise DataError(str(exc), file=source) from exc
@@ -528,6 +533,9 @@ def toml_from_robot(
             f"xyz = {xyz}",
             f"rpy = {rpy}",
         ]
+    if robot.spring is not None:  # a table of its own, after the arrays of tables
+        rec = spring_record(robot.spring)
+        out += ["", "[spring]", f"k = {_arr(rec['k'])}", f"q0 = {_arr(rec['q0'])}"]
     text = "\n".join(out) + "\n"
     tables = friction_tables(held)
     text = text if not tables else text + "\n" + tables

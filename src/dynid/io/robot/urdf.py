@@ -365,7 +365,9 @@ def export_urdf(path: str | Path, robot: Robot, options: ExportOptions) -> Path:
     rounding, a standstill band, the offsets, an asymmetry, a Stribeck peak, a quadratic
     term, friction at the motors, a coupled drive's off-diagonal terms;
     :func:`dynid.friction.mujoco.unheld_friction`) is named in one warning line, and the
-    rotor inertias of a drive, by joint, in a second, each with the files that hold them.
+    rotor inertias of a drive, by joint, in a second, each with the files that hold them;
+    a joint spring (``robot.spring``), which URDF does not hold, in a third and in a
+    comment at the top of the file.
     ``friction=True`` writes the robot's own friction when it is a law other than the
     description's sigmoid at the joints (which URDF does not hold); the drive is not part
     of URDF.
@@ -404,6 +406,9 @@ def export_urdf(path: str | Path, robot: Robot, options: ExportOptions) -> Path:
         if replace and dynamics is None and held is not None:
             notes += (_removed_note(held, robot),)
     drive = options.drive if options.drive is not None else getattr(model, "drive", None)
+    spring = _spring_note(robot, Path(path), options)
+    caveat = "; ".join(c for c in (options.caveat, spring) if c is not None) or None
+    spring = None if spring is None else f"URDF export: {spring}"
     out = save_urdf(
         path,
         robot,
@@ -414,14 +419,35 @@ def export_urdf(path: str | Path, robot: Robot, options: ExportOptions) -> Path:
         merged=options.merged,
         dynamics=dynamics,
         template_dynamics=replace,
-        caveat=options.caveat,
+        caveat=caveat,
     )
     if notes:  # one line, once written: what URDF cannot hold of the friction
         warnings.warn(f"URDF export: {'; '.join(notes)}", DynidWarning, stacklevel=2)
     rotors = _rotor_warning(drive, robot, Path(path), options)
     if rotors is not None:  # a line of its own: it costs far more than the friction's
         warnings.warn(rotors, DynidWarning, stacklevel=2)
+    if spring is not None:  # said in the file too (a comment at its top)
+        warnings.warn(spring, DynidWarning, stacklevel=2)
     return out
+
+
+def _spring_note(robot: Robot, path: Path, options: ExportOptions) -> str | None:
+    """What the URDF export says of the robot's joint spring, which URDF has no element
+    for: the stiffnesses left out and the exports that hold them (MJCF ``stiffness`` and
+    ``springref``, the TOML ``[spring]`` table); None without a spring."""
+    if robot.spring is None:
+        return None
+    values = ", ".join(
+        f"{name} {k:.4g}"
+        for name, k in zip(robot.joint_names, robot.spring.k, strict=True)
+        if k != 0
+    )
+    holders = (("mjcf", "as stiffness and springref"), ("toml", "as its [spring] table"))
+    return (
+        f"{path.name} leaves out the joint spring (tau_s = k (q - q0)), which "
+        f"URDF has no element for (k [N m/rad]: {values or 'all zero'}); "
+        + kept_elsewhere(options, path, "it", holders, source="exactly")
+    )
 
 
 def _template_friction(options: ExportOptions) -> Robot | None:

@@ -1,0 +1,191 @@
+"""The identified joint spring carried downstream of identification: the consistent fit,
+``feasible.json``, validation, the observer, simulation and the robot exports.
+
+References: simulated recordings of the planar 2R arm (``tests/conftest.py``) whose torques
+hold a known spring ``k (q - q0)`` about the middle of the joints' limits, classical friction
+and sensor noise (the stiffnesses judged against the truth, the torques on a recording the
+fit did not see against its noise); MuJoCo's passive spring force for the MJCF export.
+"""
+
+from __future__ import annotations
+
+import warnings
+
+import numpy as np
+import pytest
+
+from dynid.dynamics.rnea import rnea
+from dynid.exceptions import DataError, DynidWarning, ShapeError, WrongTypeError
+from dynid.feasibility.convex.fit import identify_consistent
+from dynid.friction.model import ClassicalFriction
+from dynid.identification.structure import Structure
+from dynid.io.export import save_robot
+from dynid.io.feasible import load_feasible_spring
+from dynid.io.feasible_bundle import save_feasible_bundle
+from dynid.io.robot_file import load_robot
+from dynid.io.torque_log import save_torque_log
+from dynid.model.stiffness import JointStiffness
+from dynid.observer.model import from_robot
+from dynid.simulation.measurement import SensorNoise, sample_times, simulate_measurement
+from dynid.simulation.trajectories import random_fourier
+from dynid.workflows.validate import ValidateOptions, validate_files
+
+from conftest import planar_2r, recordings, said_warnings
+
+K = np.array([4.0, 2.0])  # the truth's stiffnesses [N m/rad]
+LOWER, UPPER = np.array([-2.0, -2.2]), np.array([2.6, 2.8])  # q0 = (0.3, 0.3) rad
+NOISE = 0.05  # torque noise [N m]
+
+
+@pytest.fixture(scope="module")
+def arm():
+    """The 2R arm with finite limits (so the spring's rest position is not zero)."""
+    return planar_2r().replace(q_min=LOWER, q_max=UPPER)
+
+
+@pytest.fixture(scope="module")
+def fitted(arm, tmp_path_factory):
+    """``identify --consistent --terms viscous,coulomb,spring`` on two recordings of the
+    arm with a spring, judged on a third; its files and the held-out recording."""
+    q0 = (LOWER + UPPER) / 2
+    fr = ClassicalFriction(np.array([0.3, 0.2]), np.array([0.4, 0.3]), np.zeros(2))
+    noise = SensorNoise(tau_std=NOISE, q_std=1e-5, dq_std=1e-3)
+    logs = recordings(
+        arm,
+        (11, 12, 13),
+        friction=fr,
+        duration=6.0,
+        noise=noise,
+        added=lambda log: K * (log.q - q0),
+    )
+    out = tmp_path_factory.mktemp("spring")
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", DynidWarning)
+        res = identify_consistent(
+            arm, logs[:2], structure=Structure.parse("viscous,coulomb,spring"), validate_on=logs[2]
+        )
+        save_feasible_bundle(out, res)
+    save_torque_log(out / "held.csv", logs[2])
+    return res, out
+
+
+def test_the_consistent_fit_recovers_the_spring_and_reaches_the_floor(fitted):
+    """The consistent fit holds the spring: both stiffnesses within 4 of the least-squares
+    standard deviations of the truth (and 3 %), ``>= 0``, about the middle of the limits;
+    its held-out error is the least-squares fit's (the noise: about 0.37 %)."""
+    res, _ = fitted
+    assert res.spring is not None
+    std = np.asarray(res.identified.terms["spring"].std)
+    k = res.spring.k
+    assert np.all(np.abs(k - K) < 4 * std) and np.all(np.abs(k - K) < 0.03 * K), (k, std)
+    assert np.all(k >= 0)
+    np.testing.assert_array_equal(res.spring.q0, (LOWER + UPPER) / 2)
+    h = res.heldout
+    assert h is not None and h.heldout_percent < 1.05 * h.ls_heldout_percent, h
+
+
+def test_validate_params_feasible_predicts_the_spring(fitted):
+    """``validate --params feasible.json`` on the held-out recording: at the noise on each
+    joint (RMS within 1.15 x its noise) with the spring the file holds; the same robot
+    without it (the spring dropped, as before) is many times its noise."""
+    _, out = fitted
+    robot = load_robot(out / "feasible.json")
+    ratios = []
+    for r in (robot, robot.with_spring(None)):
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore", DynidWarning)
+            v = validate_files(
+                r, out / "held.csv", ValidateOptions(), feasible=out / "feasible.json"
+            )
+        ratios.append(v.validation.errors.rms / v.noise_rms)
+    assert np.all(ratios[0] < 1.15), ratios
+    assert np.all(ratios[1] > 3.0), ratios
+
+
+def test_the_mjcf_export_is_mujocos_passive_spring(fitted):
+    """The exported MJCF loaded in MuJoCo: ``qfrc_spring`` at random positions is
+    ``-k (q - q0)`` of the identified spring to 1e-10 (MuJoCo's sign: the spring's own
+    torque, the opposite of the motors'); the file read back holds the same spring."""
+    mujoco = pytest.importorskip("mujoco")
+    res, out = fitted
+    m = mujoco.MjModel.from_xml_path(str(out / "robot.xml"))
+    d = mujoco.MjData(m)
+    rng = np.random.default_rng(5)
+    for q in rng.uniform(LOWER, UPPER, (5, 2)):
+        d.qpos[:] = q
+        mujoco.mj_forward(m, d)
+        np.testing.assert_allclose(d.qfrc_spring, -res.spring.k * (q - res.spring.q0), atol=1e-10)
+    back = load_robot(out / "robot.xml").spring  # read by MuJoCo's compiler
+    assert back is not None
+    np.testing.assert_allclose(back.k, res.spring.k, rtol=1e-15)
+    np.testing.assert_allclose(back.q0, res.spring.q0, rtol=1e-15)
+
+
+def test_toml_and_feasible_round_trips_give_the_spring_torques(fitted, tmp_path):
+    """``robot.toml``'s ``[spring]`` table and ``feasible.json``'s ``spring`` read back to
+    the identified torques ``k (q - q0)``; the robot read from them carries the spring
+    into the observer and into a simulation (``tau - rnea`` of an exact log is it)."""
+    res, out = fitted
+    rng = np.random.default_rng(6)
+    q = rng.uniform(LOWER, UPPER, (20, 2))
+    want = res.spring.k * (q - res.spring.q0)
+    for path in (out / "robot.toml", out / "feasible.json"):
+        robot = load_robot(path)
+        assert robot.spring is not None
+        np.testing.assert_allclose(robot.spring.torques(q), want, rtol=0, atol=1e-12)
+        held = from_robot(robot).position_torques(q)
+        np.testing.assert_allclose(held, want, rtol=0, atol=1e-12)
+    spring = load_feasible_spring(out / "feasible.json")
+    assert spring is not None
+    np.testing.assert_allclose(spring.torques(q), want, rtol=0, atol=1e-12)
+    robot = load_robot(out / "robot.toml")
+    t = sample_times(0.5, 200.0)
+    log = simulate_measurement(
+        robot,
+        random_fourier(robot, np.random.default_rng(7))(t),
+        rng=np.random.default_rng(8),
+        noise=SensorNoise.none(),
+        friction=None,
+        with_ddq=True,
+    )
+    tau_s = log.tau - rnea(robot, log.q, log.dq, log.ddq)
+    np.testing.assert_allclose(tau_s, res.spring.k * (log.q - res.spring.q0), atol=1e-9)
+    save_robot(tmp_path / "again.toml", robot, friction=False)  # written back from a TOML
+    again = load_robot(tmp_path / "again.toml").spring
+    assert again is not None
+    np.testing.assert_array_equal(again.k, res.spring.k)
+
+
+def test_only_the_urdf_export_says_it_leaves_the_spring_out(arm, tmp_path):
+    """URDF has no spring: its export warns and comments that the spring is left out,
+    naming the stiffnesses and the exports that hold it; the MJCF and TOML exports hold it
+    and say nothing of it."""
+    robot = arm.with_spring(JointStiffness(np.array([4.0, 0.0]), np.array([0.3, 0.3])))
+    _, said = said_warnings(save_robot, tmp_path / "r.urdf", robot)
+    spring = [s for s in said if "spring" in s]
+    assert len(spring) == 1 and "joint1 4" in spring[0], said
+    assert "leaves out the joint spring" in (tmp_path / "r.urdf").read_text()
+    for name in ("r.xml", "r.toml"):
+        _, said = said_warnings(save_robot, tmp_path / name, robot)
+        assert not [s for s in said if "spring" in s], said
+        assert "leaves out" not in (tmp_path / name).read_text()
+    text = (tmp_path / "r.xml").read_text()
+    assert 'stiffness="4.0" springref="0.3"' in text and 'stiffness="0" springref="0.3"' in text
+
+
+def test_springs_of_the_wrong_shape_or_sign_are_refused(arm, tmp_path):
+    """A spring of unequal ``k`` and ``q0``, a non-finite value, another joint count than
+    the robot's, and a negative stiffness in a TOML ``[spring]`` table are each refused
+    with a message naming what is wrong."""
+    with pytest.raises(ShapeError, match="k and q0 must be"):
+        JointStiffness(np.ones(2), np.zeros(3))
+    with pytest.raises(ShapeError, match="must be finite"):
+        JointStiffness(np.array([1.0, np.nan]), np.zeros(2))
+    with pytest.raises(ShapeError, match="spring has 3 joints; robot has 2"):
+        arm.with_spring(JointStiffness(np.ones(3), np.zeros(3)))
+    with pytest.raises(WrongTypeError, match="must be a JointStiffness"):
+        arm.replace(spring=np.ones(2))
+    path = save_robot(tmp_path / "r.toml", arm, friction=False)
+    path.write_text(path.read_text() + "\n[spring]\nk = [1.0, -2.0]\nq0 = [0.0, 0.0]\n")
+    with pytest.raises(DataError, match=r"key 'spring.k\[1\]': expected a number >= 0"):
+        load_robot(path)
