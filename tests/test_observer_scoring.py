@@ -1,0 +1,88 @@
+"""Scoring detected events against labelled contacts (dynid.observer.scoring): intervals
+of a 0/1 series, matching, counts; and ``dynid observe`` on simulated contacts and on a
+log with a label column, whose counts equal the contacts simulated."""
+
+from __future__ import annotations
+
+import json
+
+import numpy as np
+import pytest
+
+from dynid.cli.__main__ import main
+from dynid.exceptions import ShapeError
+from dynid.observer.scoring import (
+    ContactScore,
+    combined,
+    interval_peaks,
+    label_intervals,
+    match_events,
+    score_events,
+    truth_flags,
+)
+
+
+def test_intervals_of_a_series_are_its_runs_with_edges_and_nan():
+    """Runs at the first and last sample, a one-sample run, NaN as no contact: the first
+    and last sample time of each run."""
+    t = np.arange(10) * 0.5
+    flags = [1, 1, 0, 0, 1, np.nan, 3, 0, 0, 1]
+    np.testing.assert_array_equal(
+        label_intervals(t, flags), [[0.0, 0.5], [2.0, 2.0], [3.0, 3.0], [4.5, 4.5]]
+    )
+    assert label_intervals(t, np.zeros(10)).shape == (0, 2)
+    np.testing.assert_array_equal(label_intervals(t, np.ones(10)), [[0.0, 4.5]])
+    with pytest.raises(ShapeError, match="both be"):
+        label_intervals(t, np.ones(9))
+
+
+def test_truth_flags_and_peaks_of_true_torques():
+    """Some joint over the level is contact; the peak is the largest |tau_ext| over the
+    interval's samples and joints."""
+    rng = np.random.default_rng(5)
+    t = np.arange(8) * 0.1
+    ext = np.zeros((8, 2))
+    ext[2:5, 1] = [-0.5, -2.0, 0.3]
+    ext[6, 0] = 0.05 + 0.01 * rng.random()
+    flags = truth_flags(ext, 0.1)
+    np.testing.assert_array_equal(flags, [0, 0, 1, 1, 1, 0, 0, 0])
+    iv = label_intervals(t, flags)
+    np.testing.assert_allclose(interval_peaks(t, ext, iv), [2.0])
+
+
+def test_matching_a_miss_a_false_alarm_two_events_in_one_contact_one_over_two():
+    """Contacts [1, 2], [5, 6], [8, 8.5], [8.6, 9]; events (1.05, 1.3) and (1.5, 2.05) in the
+    first (one detection, delay 0.05), one at 3 (a false alarm), none near the second
+    (missed), one over the last two (both detected, one delay), one starting 0.08 s
+    after a contact's end (within the tolerance of 0.1 s)."""
+    labels = np.array([[1.0, 2.0], [5.0, 6.0], [8.0, 8.5], [8.6, 9.0], [10.0, 10.2]])
+    events = np.array([[1.05, 1.3], [1.5, 2.05], [3.0, 3.2], [8.02, 8.9], [10.28, 10.4]])
+    first, false = match_events(events, labels, 0.1)
+    np.testing.assert_array_equal(first, [0, -1, 3, 3, 4])
+    np.testing.assert_array_equal(false, [False, False, True, False, False])
+    s = score_events(events, labels, (0.0, 12.0), tolerance_s=0.1, peaks=[3, 0.7, 2, 2, 5])
+    assert (s.labelled, s.detected, s.false_alarms) == (5, 4, 1)
+    assert [(m.start, m.end, m.peak) for m in s.missed] == [(5.0, 6.0, 0.7)]
+    np.testing.assert_allclose(s.delays, [0.05, 0.02, 0.28])
+    # contact-free: 12 s less [1, 2.1], [5, 6.1], [8, 9.1] (two windows joined), [10, 10.3]
+    assert s.contact_free_s == pytest.approx(12.0 - 1.1 - 1.1 - 1.1 - 0.3)
+    assert s.false_alarms_per_min == pytest.approx(60.0 / s.contact_free_s)
+    assert s.delay_median == pytest.approx(0.05) and s.delay_max == pytest.approx(0.28)
+    tight = score_events(events, labels, (0.0, 12.0), tolerance_s=0.05)
+    assert (tight.detected, tight.false_alarms) == (3, 2)  # the late event: a false alarm
+
+
+def test_no_labels_every_event_false_and_totals_pool_logs():
+    """Without contacts every event is a false alarm over the whole span; the total adds
+    counts and times and pools delays."""
+    a = score_events([[1.0, 1.1]], np.zeros((0, 2)), (0.0, 30.0), source="x")
+    assert (a.labelled, a.detected, a.false_alarms, a.contact_free_s) == (0, 0, 1, 30.0)
+    assert a.delay_median is None and a.false_alarms_per_min == pytest.approx(2.0)
+    b = ContactScore("x", 0.1, 2, 1, (), 0, 10.0, (0.04,))
+    total = combined([a, b])
+    assert (total.labelled, total.detected, total.false_alarms) == (2, 1, 1)
+    assert total.contact_free_s == 40.0 and total.delays == (0.04,)
+    with pytest.raises(ValueError, match="no score"):
+        combined([])
+    with pytest.raises(ShapeError, match="peaks"):
+        score_events([], [[0.0, 1.0]], (0.0, 2.0), peaks=[1.0, 2.0])
