@@ -75,6 +75,7 @@ from pathlib import Path
 from ..observer.events import DEFAULT_MERGE_S, DEFAULT_MIN_DURATION_S
 from ..observer.residual import DEFAULT_GAIN
 from ..observer.results import NO_FRICTION
+from ..observer.scoring import DEFAULT_TOLERANCE_S
 from ..observer.wrench import WRENCH_KINDS
 from ..workflows.observe import ObserveOptions, observe_files
 from .common import (
@@ -175,6 +176,15 @@ def register(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParser:
         f"with no other within --merge / 2 (default {DEFAULT_MIN_DURATION_S:g} s; 0 with "
         "--merge 0: every run over the threshold)",
     )
+    p.add_argument(
+        "--label-tolerance",
+        type=nonnegative_type,
+        default=DEFAULT_TOLERANCE_S,
+        metavar="SECONDS",
+        help="logs with labelled contacts (a label column, or the true tau_ext of a "
+        "simulated log): an event starting up to this long after a contact's end still "
+        f"detects it, the observer's lag (default {DEFAULT_TOLERANCE_S:g} s)",
+    )
     add_column_options(p)
     add_drop_invalid(p)
     p.add_argument(
@@ -211,6 +221,7 @@ def run(args: argparse.Namespace, console: Console) -> int:
         # the series serve the figures only: a calibration's whole, a detection's strided
         keep_series=args.calibrate and not args.no_figures,
         figure_points=None if args.no_figures else FIGURE_POINTS,
+        label_tolerance_s=args.label_tolerance,
     )  # fmt: skip
     tables = ResidualTables(args.out)  # written a block at a time while detecting
     result = observe_files(opts, tables)
