@@ -86,3 +86,96 @@ def test_no_labels_every_event_false_and_totals_pool_logs():
         combined([])
     with pytest.raises(ShapeError, match="peaks"):
         score_events([], [[0.0, 1.0]], (0.0, 2.0), peaks=[1.0, 2.0])
+
+
+@pytest.fixture(scope="module")
+def pushes(tmp_path_factory):
+    """Thresholds from a free 3 s Panda log, and a 4 s log with three pushes at 0.8-1.1,
+    1.9-2.3 and 3.0-3.2 s (tau_ext written beside it)."""
+    d = tmp_path_factory.mktemp("scoring")
+    sim = ["simulate", "--robot", "panda", "--trajectory", "fourier", "-q"]
+    assert main([*sim, "--duration", "3", "--seed", "2", "--out", str(d / "free.csv")]) == 0
+    hit = [
+        "--contact", "link6:0,0,-15:0.8,1.1", "--contact", "flange:10,0,0:1.9,2.3",
+        "--contact", "link4:0,0,-20:3,3.2",
+    ]  # fmt: skip
+    assert main([*sim, "--duration", "4", "--seed", "3", *hit, "--out", str(d / "hit.csv")]) == 0
+    p = ["observe", "--params", "panda", "--no-figures", "-q"]
+    assert main([*p, "--data", str(d / "free.csv"), "--calibrate", "--out", str(d / "cal")]) == 0
+    return d
+
+
+def _with_column(src, dst, name, values):
+    """``src`` (a dynid CSV log) with one more column ``name`` holding ``values``."""
+    lines = src.read_text().splitlines()
+    head, rows = lines[:3], lines[3:]
+    head[2] += f",{name}"
+    dst.write_text("\n".join(head + [f"{r},{v:g}" for r, v in zip(rows, values, strict=True)]))
+
+
+def test_observe_scores_a_simulated_log_against_its_true_torques(pushes, capsys):
+    """dynid observe on the log of three simulated pushes: 3 labelled (tau_ext > 0.1 N m),
+    3 detected, none missed, no false alarm, each within 25 ms (K_O = 50/s: a 20 ms time
+    constant) of the push; the summary and events.json say so."""
+    d = pushes
+    p = ["observe", "--params", "panda", "--no-figures"]
+    th = ["--thresholds", str(d / "cal" / "thresholds.json")]
+    assert main([*p, *th, "--data", str(d / "hit.csv"), "--out", str(d / "sim")]) == 0
+    out = capsys.readouterr().out
+    assert "3 labelled, 3 detected, 0 missed; 0 false alarm(s)" in out
+    score = json.loads((d / "sim" / "events.json").read_text())["score"]
+    assert (score["labelled"], score["detected"], score["missed"]) == (3, 3, 0)
+    assert score["false_alarms"] == 0 and score["source"] == "tau_ext > 0.1 N m"
+    assert 0.0 <= score["delay_median_ms"] <= score["delay_max_ms"] <= 25.0
+    (log,) = score["logs"]
+    starts = [a for a, _ in log["contacts"]]
+    np.testing.assert_allclose(starts, [0.8, 1.9, 3.0], atol=2e-3)
+    assert log["contact_free_s"] == pytest.approx(4.0 - sum(b + 0.1 - a for a, b in log["contacts"]))
+
+
+@pytest.mark.parametrize("mapped", [False, True])
+def test_observe_scores_against_a_label_column_by_default_name_or_mapped(pushes, capsys, mapped):
+    """A 0/1 column labelling the first push and a contact that never happened
+    (3.5-3.7 s), the second and third unlabelled: 2 labelled, 1 detected, the made-up
+    one missed (its times, no peak), 2 false alarms; read as ``collision`` or through
+    ``--columns label=touch``; the figure hatches the labels."""
+    from dynid.io.torque_log import load_torque_log
+
+    d = pushes
+    t = load_torque_log(d / "hit.csv").t
+    flags = ((t >= 0.8) & (t <= 1.1)) | ((t >= 3.5) & (t <= 3.7))
+    name = "touch" if mapped else "collision"
+    _with_column(d / "hit.csv", d / f"{name}.csv", name, flags.astype(float))
+    args = ["--columns", f"label={name}"] if mapped else []
+    th = ["--thresholds", str(d / "cal" / "thresholds.json")]
+    out_dir = d / f"lab_{name}"
+    cmd = ["observe", "--params", "panda", *th, *args, "--data", str(d / f"{name}.csv")]
+    assert main([*cmd, "--out", str(out_dir)]) == 0
+    out = capsys.readouterr().out
+    assert "2 labelled, 1 detected, 1 missed; 2 false alarm(s)" in out
+    assert "missed in" in out and "3.500 s .. 3.700 s" in out
+    score = json.loads((out_dir / "events.json").read_text())["score"]
+    assert score["source"] == f"column {name!r}"
+    assert score["missed_contacts"] == [{"start": 3.5, "end": 3.7, "peak": None}]
+    assert (out_dir / "residuals.png").stat().st_size > 0
+
+
+def test_a_log_without_labels_is_not_scored(pushes, capsys):
+    """A free simulated log (no tau_ext, no label column): no score printed nor written."""
+    d = pushes
+    p = ["observe", "--params", "panda", "--no-figures"]
+    th = ["--thresholds", str(d / "cal" / "thresholds.json")]
+    assert main([*p, *th, "--data", str(d / "free.csv"), "--out", str(d / "free")]) == 0
+    assert "scored against" not in capsys.readouterr().out
+    assert "score" not in json.loads((d / "free" / "events.json").read_text())
+
+
+def test_a_mapped_label_the_log_lacks_and_a_label_unit_are_refused(pushes, capsys):
+    """--columns label=NAME without that column names it; --units label=... is refused."""
+    d = pushes
+    p = ["observe", "--params", "panda", "--no-figures", "--thresholds"]
+    p += [str(d / "cal" / "thresholds.json"), "--data", str(d / "hit.csv")]
+    assert main([*p, "--columns", "label=bump", "--out", str(d / "x")]) != 0
+    assert "no column 'bump' for 'label'" in capsys.readouterr().err
+    assert main([*p, "--units", "label=s", "--out", str(d / "y")]) != 0
+    assert "a label column has no unit" in capsys.readouterr().err
