@@ -116,7 +116,7 @@ def _with_column(src, dst, name, values):
 def test_observe_scores_a_simulated_log_against_its_true_torques(pushes, capsys):
     """dynid observe on the log of three simulated pushes: 3 labelled (tau_ext > 0.1 N m),
     3 detected, none missed, no false alarm, each within 25 ms (K_O = 50/s: a 20 ms time
-    constant) of the push; the summary and events.json say so."""
+    constant) of the push; the summary, events.json and the report say so."""
     d = pushes
     p = ["observe", "--params", "panda", "--no-figures"]
     th = ["--thresholds", str(d / "cal" / "thresholds.json")]
@@ -130,7 +130,11 @@ def test_observe_scores_a_simulated_log_against_its_true_torques(pushes, capsys)
     (log,) = score["logs"]
     starts = [a for a, _ in log["contacts"]]
     np.testing.assert_allclose(starts, [0.8, 1.9, 3.0], atol=2e-3)
-    assert log["contact_free_s"] == pytest.approx(4.0 - sum(b + 0.1 - a for a, b in log["contacts"]))
+    report = (d / "sim" / "report.html").read_text()
+    assert "3 labelled, 3 detected, 0 missed; 0 false alarm(s)" in report
+    assert log["contact_free_s"] == pytest.approx(
+        4.0 - sum(b + 0.1 - a for a, b in log["contacts"])
+    )
 
 
 @pytest.mark.parametrize("mapped", [False, True])

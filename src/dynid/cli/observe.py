@@ -40,9 +40,20 @@ Two steps:
   units line and events.json say which) and
   OUT/residuals.png (residuals, thresholds, events, and the true tau_ext that `dynid
   simulate --contact` writes beside a log; the summary then gives the RMS of the residual
-  against it per joint), and prints the largest |r| of each log and the events with the
-  time they cover (seconds and % of the logs' duration; events.json's flagged_s and
-  duration_s per log): fewer events can cover more time.
+  against it per joint, and the score below), and prints the largest |r| of each log and
+  the events with the time they cover (seconds and % of the logs' duration;
+  events.json's flagged_s and duration_s per log): fewer events can cover more time.
+A log with labelled contacts is scored: a 0/1 column (nonzero in contact; NaN none)
+named collision, contact or label (the first the log has), or mapped with --columns
+label=NAME, else the true tau_ext that `dynid simulate --contact` writes beside a log (in
+contact where some joint's |tau_ext| exceeds 0.1 N m). A contact is detected when an
+event overlaps it or starts within --label-tolerance (0.1 s, the observer's lag) after
+its end; an event overlapping no contact is a false alarm. The summary prints per log
+and in total the contacts labelled, detected and missed (each missed one with its times
+and, from tau_ext, its peak true torque), the false alarms and their rate per minute of
+contact-free time, and the delays (event start less contact start, median and max);
+events.json holds them under score; residuals.png hatches the labelled contacts. A log
+without labels is not scored.
 One contact is one event: runs over the threshold closer than --merge (0.2 s) are joined
 (a push near the threshold on a joint at rest crosses it again and again as the
 standstill margin follows the velocity noise), and an event shorter than --min-duration
@@ -58,8 +69,8 @@ Several logs (or a folder of them): residuals_<name>.csv and .png each, one even
 logs of one name in different folders are named by their folder. With --thresholds the
 calibration's options (--gain, --discretisation, --rule, --margin, --quantile,
 --collision-factor, --k-sigma, --no-uncertainty, --no-standstill-margin) are refused:
-the file fixes them; --frame, --wrench, --merge and --min-duration apply to detection
-only.
+the file fixes them; --frame, --wrench, --merge, --min-duration and --label-tolerance
+apply to detection only.
 
 Examples:
   dynid observe --model id/identification.json --data free.csv --calibrate --out cal

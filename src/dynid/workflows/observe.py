@@ -43,6 +43,11 @@ the command applies, so that the Python API behaves as the command does.
   crossing before runs are joined (:mod:`dynid.observer.events`); the true external
   torques ``tau_ext1..n`` that ``dynid simulate --contact`` writes beside a log are kept
   for the figure.
+* A log with labelled contacts has its events scored against them
+  (:mod:`dynid.observer.scoring`, ``label_tolerance_s``): a label column (the ``label``
+  of the column map, else ``collision``, ``contact`` or ``label``;
+  :func:`~dynid.workflows.observe_detect.contact_labels`), else the true external torques
+  of a simulated log (:func:`~dynid.workflows.observe_detect.scored`).
 """
 
 from __future__ import annotations
@@ -378,8 +383,9 @@ _CALIBRATION_FIELDS = (
 
 def _refuse_unused(opts: ObserveOptions) -> None:
     """Options that do not apply: the calibration's with ``thresholds`` (the file fixes
-    them), ``frame``, ``merge_s`` and ``min_duration_s`` when calibrating (no wrench or
-    event is computed), ``wrench`` without ``frame`` (or not one of its kinds)."""
+    them), ``frame``, ``merge_s``, ``min_duration_s`` and ``label_tolerance_s`` when
+    calibrating (no wrench or event is computed), ``wrench`` without ``frame`` (or not
+    one of its kinds)."""
     default = ObserveOptions(data=())
     wrench_kind(opts.wrench)
     if opts.frame is None and opts.wrench != default.wrench:
