@@ -183,3 +183,31 @@ def test_a_mapped_label_the_log_lacks_and_a_label_unit_are_refused(pushes, capsy
     assert "no column 'bump' for 'label'" in capsys.readouterr().err
     assert main([*p, "--units", "label=s", "--out", str(d / "y")]) != 0
     assert "a label column has no unit" in capsys.readouterr().err
+
+
+def test_labels_follow_the_log_past_rows_dropped_and_a_column_not_numbers(pushes, capsys):
+    """Rows dropped for NaN (--drop-invalid): the labels matched by time give the same
+    score; a ``label`` column of text is warned about and the true torques score
+    instead."""
+    from dynid.io.torque_log import load_torque_log
+
+    d = pushes
+    t = load_torque_log(d / "hit.csv").t
+    flags = ((t >= 0.8) & (t <= 1.1)) | ((t >= 3.5) & (t <= 3.7))
+    _with_column(d / "hit.csv", d / "holes.csv", "contact", flags.astype(float))
+    lines = (d / "holes.csv").read_text().splitlines()
+    for k in (500, 2700):  # rows at 0.497 and 2.697 s, outside the pushes: NaN tau1
+        cells = lines[k].split(",")
+        cells[15] = "nan"
+        lines[k] = ",".join(cells)
+    (d / "holes.csv").write_text("\n".join(lines))
+    p = ["observe", "--params", "panda", "--no-figures", "--drop-invalid", "--thresholds"]
+    p += [str(d / "cal" / "thresholds.json")]
+    assert main([*p, "--data", str(d / "holes.csv"), "--out", str(d / "holes")]) == 0
+    assert "2 labelled, 1 detected, 1 missed; 2 false alarm(s)" in capsys.readouterr().out
+    _with_column(d / "hit.csv", d / "text.csv", "label", np.zeros(t.size))
+    (d / "text.csv").write_text((d / "text.csv").read_text().replace(",0\n", ",no\n"))
+    assert main([*p, "--data", str(d / "text.csv"), "--out", str(d / "text")]) == 0
+    captured = capsys.readouterr()
+    assert "column 'label' read as no contact labels" in captured.err
+    assert "(tau_ext > 0.1 N m;" in captured.out and "3 labelled, 3 detected" in captured.out

@@ -30,6 +30,7 @@ from __future__ import annotations
 
 import math
 import re
+import warnings
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -40,7 +41,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from .. import _checks
-from ..exceptions import DataError
+from ..exceptions import DataError, DynidWarning
 from ..identification.data import StaticDataset
 from ..identification.log import (
     DEFAULT_CUTOFF_HZ,
@@ -53,6 +54,7 @@ from .csv_tables import csv_table
 from .input_files import file_text, regular_file
 from .joint_state_csv import import_hint
 from .npz_files import check_npz
+from .torque_log import LABEL_COLUMNS
 
 __all__ = [
     "CURRENT_UNITS",
@@ -79,9 +81,6 @@ _DEFAULT = {
     "g": "g{i}",
     "label": "label",
 }
-#: The columns (CSV) or arrays (NPZ) read as contact labels when ``label`` is not mapped,
-#: the first the file has (:func:`load_label_column`).
-LABEL_COLUMNS = ("collision", "contact", "label")
 _TIME = {"s": 1.0, "ms": 1e-3, "us": 1e-6, "ns": 1e-9}
 _ANGLE = {"rad": 1.0, "deg": math.pi / 180, "m": 1.0, "mm": 1e-3}
 _TORQUE = {"Nm": 1.0, "N m": 1.0, "N": 1.0, "mNm": 1e-3, "mN m": 1e-3}
@@ -649,7 +648,12 @@ def load_label_column(
     Raises
     ------
     DataError
-        A ``label`` mapped that the file lacks, a malformed file.
+        A ``label`` mapped that the file lacks or that is not numbers, a malformed file.
+
+    Warns
+    -----
+    DynidWarning
+        A column of a default name that is not numbers (read as no labels).
     """
     path = Path(path)
     cmap = columns if columns is not None else ColumnMap()
@@ -668,7 +672,18 @@ def load_label_column(
             return None
         name = found[0]
     tpl = cmap.template("t")
-    table = _read_table(path, ColumnMap({"t": tpl, "label": name}), ("t", "label"))
+    try:
+        table = _read_table(path, ColumnMap({"t": tpl, "label": name}), ("t", "label"))
+    except DataError as exc:
+        if cmap.mapped("label"):
+            raise
+        warnings.warn(
+            f"{path.name}: column {name!r} read as no contact labels ({exc}); hint: name the "
+            "labels with --columns label=NAME",
+            DynidWarning,
+            stacklevel=2,
+        )
+        return None
     if tpl not in table.columns:
         return None  # the log's reader names the missing time column
     t = np.asarray(table.columns[tpl], dtype=np.float64).reshape(-1) * cmap.factor("t")
