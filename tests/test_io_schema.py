@@ -28,7 +28,7 @@ from dynid.io.excitation import EXCITATION, OBSTACLES, load_obstacles
 from dynid.io.feasible import FEASIBLE, load_feasible_json, save_feasible_json
 from dynid.io.friction_json import FORMAT, _record, load_friction_json, save_friction_json
 from dynid.io.model_json import MODEL
-from dynid.io.observer_files import THRESHOLDS, load_thresholds, save_thresholds
+from dynid.io.observer_files import EVENTS, THRESHOLDS, load_thresholds, save_thresholds
 from dynid.io.robot.toml import ROBOT_TOML, robot_from_toml_string
 from dynid.io.robot_json import ROBOT_RECORD, ROBOT_SCHEMA
 from dynid.io.schema import Field, Format, Record, check, load_document, save_document
@@ -41,6 +41,7 @@ from conftest import planar_2r
 #: every format with a declaration, as files (the records read inside other files too)
 FORMATS = {
     "thresholds": THRESHOLDS,
+    "events": EVENTS,
     "feasible": FEASIBLE,
     "obstacles": OBSTACLES,
     "excitation": EXCITATION,

@@ -277,8 +277,9 @@ def test_npz_bombs_and_absurd_headers_are_refused_before_reading(tmp_path, monke
 
 def test_extra_columns_are_ignored_with_a_warning_and_read_back_by_name(tmp_path, caplog):
     """A label column and tau_ext1..n beside the log (as simulate --contact writes them) are
-    ignored by the reader, named (the label in a warning, the true external torques of
-    dynid's simulations in an informational line); load_joint_columns reads them."""
+    ignored by the reader, named (the contact labels observe scores against and the true
+    external torques of dynid's simulations in informational lines, another column in a
+    warning); load_joint_columns reads them."""
     import logging
 
     from dynid.identification.log import TorqueLog
@@ -309,9 +310,14 @@ def test_extra_columns_are_ignored_with_a_warning_and_read_back_by_name(tmp_path
         assert load_joint_columns(path, "vendor_tau", n) is None
         caplog.clear()
     text = (tmp_path / "log.csv").read_text().splitlines()
-    text[2] += ",label"
-    text[3:] = [row + ",contact" for row in text[3:]]
+    text[2] += ",label,note"
+    text[3:] = [row + ",1,contact" for row in text[3:]]
     (tmp_path / "labelled.csv").write_text("\n".join(text) + "\n")
-    with caplog.at_level(logging.WARNING):
+    with caplog.at_level(logging.INFO):
         np.testing.assert_array_equal(load_torque_log(tmp_path / "labelled.csv").q, log.q)
-    assert "label" in caplog.text
+    levels = {r.getMessage().split(": ", 1)[1]: r.levelno for r in caplog.records}
+    assert levels["column(s) ['label'] hold contact labels: never read as data (dynid "
+                  "observe scores its events against them)"] == logging.INFO  # fmt: skip
+    assert levels["column(s) ['note'] are not torque-log signals: ignored as data"] == (
+        logging.WARNING
+    )

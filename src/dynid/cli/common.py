@@ -47,6 +47,7 @@ FLAGS: dict[str, str] = {
     "law": "--friction-model",
     "merge_s": "--merge",
     "min_duration_s": "--min-duration",
+    "label_tolerance_s": "--label-tolerance",
     "uncertainty": "--no-uncertainty",
     "standstill": "--no-standstill-margin",
     "total_mass_band": "--no-total-mass",

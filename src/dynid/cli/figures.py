@@ -127,6 +127,7 @@ def save_observer_figures(out: Path, result: ObserveResult, *, names: list[str])
             return observer_plots.plot_residuals(
                 t, r, contact, collision, events=x.events, tau_ext=ext, joint_names=names,
                 title=f"momentum observer on {lab}: residual, thresholds, events",
+                labelled=() if x.score is None else x.score.intervals,
             )  # fmt: skip
 
         fig = save_figure(draw, Path(out) / f"{stem}.png")

@@ -40,9 +40,20 @@ Two steps:
   units line and events.json say which) and
   OUT/residuals.png (residuals, thresholds, events, and the true tau_ext that `dynid
   simulate --contact` writes beside a log; the summary then gives the RMS of the residual
-  against it per joint), and prints the largest |r| of each log and the events with the
-  time they cover (seconds and % of the logs' duration; events.json's flagged_s and
-  duration_s per log): fewer events can cover more time.
+  against it per joint, and the score below), and prints the largest |r| of each log and
+  the events with the time they cover (seconds and % of the logs' duration;
+  events.json's flagged_s and duration_s per log): fewer events can cover more time.
+A log with labelled contacts is scored: a 0/1 column (nonzero in contact; NaN none)
+named collision, contact or label (the first the log has), or mapped with --columns
+label=NAME, else the true tau_ext that `dynid simulate --contact` writes beside a log (in
+contact where some joint's |tau_ext| exceeds 0.1 N m). A contact is detected when an
+event overlaps it or starts within --label-tolerance (0.1 s, the observer's lag) after
+its end; an event overlapping no contact is a false alarm. The summary prints per log
+and in total the contacts labelled, detected and missed (each missed one with its times
+and, from tau_ext, its peak true torque), the false alarms and their rate per minute of
+contact-free time, and the delays (event start less contact start, median and max);
+events.json holds them under score; residuals.png hatches the labelled contacts. A log
+without labels is not scored.
 One contact is one event: runs over the threshold closer than --merge (0.2 s) are joined
 (a push near the threshold on a joint at rest crosses it again and again as the
 standstill margin follows the velocity noise), and an event shorter than --min-duration
@@ -58,8 +69,8 @@ Several logs (or a folder of them): residuals_<name>.csv and .png each, one even
 logs of one name in different folders are named by their folder. With --thresholds the
 calibration's options (--gain, --discretisation, --rule, --margin, --quantile,
 --collision-factor, --k-sigma, --no-uncertainty, --no-standstill-margin) are refused:
-the file fixes them; --frame, --wrench, --merge and --min-duration apply to detection
-only.
+the file fixes them; --frame, --wrench, --merge, --min-duration and --label-tolerance
+apply to detection only.
 
 Examples:
   dynid observe --model id/identification.json --data free.csv --calibrate --out cal
@@ -75,6 +86,7 @@ from pathlib import Path
 from ..observer.events import DEFAULT_MERGE_S, DEFAULT_MIN_DURATION_S
 from ..observer.residual import DEFAULT_GAIN
 from ..observer.results import NO_FRICTION
+from ..observer.scoring import DEFAULT_TOLERANCE_S
 from ..observer.wrench import WRENCH_KINDS
 from ..workflows.observe import ObserveOptions, observe_files
 from .common import (
@@ -175,6 +187,15 @@ def register(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParser:
         f"with no other within --merge / 2 (default {DEFAULT_MIN_DURATION_S:g} s; 0 with "
         "--merge 0: every run over the threshold)",
     )
+    p.add_argument(
+        "--label-tolerance",
+        type=nonnegative_type,
+        default=DEFAULT_TOLERANCE_S,
+        metavar="SECONDS",
+        help="logs with labelled contacts (a label column, or the true tau_ext of a "
+        "simulated log): an event starting up to this long after a contact's end still "
+        f"detects it, the observer's lag (default {DEFAULT_TOLERANCE_S:g} s)",
+    )
     add_column_options(p)
     add_drop_invalid(p)
     p.add_argument(
@@ -211,6 +232,7 @@ def run(args: argparse.Namespace, console: Console) -> int:
         # the series serve the figures only: a calibration's whole, a detection's strided
         keep_series=args.calibrate and not args.no_figures,
         figure_points=None if args.no_figures else FIGURE_POINTS,
+        label_tolerance_s=args.label_tolerance,
     )  # fmt: skip
     tables = ResidualTables(args.out)  # written a block at a time while detecting
     result = observe_files(opts, tables)

@@ -24,6 +24,7 @@ from ..io.observer_files import log_labels
 from ..observer.detection import undetected_at_rest
 from ..observer.gain_noise import GainNoise
 from ..observer.results import LogObservation, ObserveResult, flagged_words
+from ..observer.scoring import score_words
 from ..observer.wrench import estimate_words
 from ..pipeline.collision import CollisionStageResult
 from ..regressors.base import identifiability
@@ -784,6 +785,7 @@ def format_observation(result: ObserveResult, names: list[str], *, calibrating: 
             f"  {log}: {e.level:<9} {e.start:9.3f} s .. {e.end:9.3f} s  joints "
             f"{','.join(map(str, e.joints))}  peak {e.peak[top - 1]:+.2f} N m (joint {top})"
         )
+    rows += _score_lines(result, labels)
     if result.frame is not None:  # what the residual tables' fx..mz hold
         words = estimate_words(result.model.robot, result.frame, result.wrench)
         rows.append(f"estimated (fx..mz of the residual tables): {words}")
@@ -807,3 +809,25 @@ def format_collision_stage(res: CollisionStageResult) -> str:
         "(first-order lag) RMS [N m]: " + " ".join(f"{x:.3f}" for x in res.residual_error_rms)
     )
     return "\n".join(rows)
+
+
+def _score_lines(result: ObserveResult, labels: list[str]) -> list[str]:
+    """The events against the labelled contacts (:mod:`dynid.observer.scoring`): per log
+    with several, then in total, and every missed contact; nothing without labels."""
+    total = result.score()
+    if total is None:
+        return []
+    scored = [(lab, x.score) for lab, x in zip(labels, result.logs, strict=True) if x.score]
+    rows = [
+        f"scored against labelled contacts ({total.source}; an event starting up to "
+        f"{total.tolerance_s:g} s after a contact's end detects it):"
+    ]
+    width = max(len(lab) for lab, _ in scored)
+    parts = [(lab, sc) for lab, sc in scored] if len(scored) > 1 else []
+    for lab, sc in [*parts, ("total" if parts else scored[0][0], total)]:
+        rows.append(f"  {lab:<{width}}  {score_words(sc)}")
+    for lab, sc in scored:
+        for m in sc.missed:
+            peak = "" if m.peak is None else f", peak true torque {m.peak:.3g} N m"
+            rows.append(f"  missed in {lab}: {m.start:.3f} s .. {m.end:.3f} s{peak}")
+    return rows

@@ -30,6 +30,7 @@ from __future__ import annotations
 
 import math
 import re
+import warnings
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -40,7 +41,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from .. import _checks
-from ..exceptions import DataError
+from ..exceptions import DataError, DynidWarning
 from ..identification.data import StaticDataset
 from ..identification.log import (
     DEFAULT_CUTOFF_HZ,
@@ -53,9 +54,11 @@ from .csv_tables import csv_table
 from .input_files import file_text, regular_file
 from .joint_state_csv import import_hint
 from .npz_files import check_npz
+from .torque_log import LABEL_COLUMNS
 
 __all__ = [
     "CURRENT_UNITS",
+    "LABEL_COLUMNS",
     "ColumnMap",
     "MappedLog",
     "MappedStatic",
@@ -65,6 +68,7 @@ __all__ = [
     "load_mapped_static_data",
     "load_mapped_torque_log",
     "load_joint_columns",
+    "load_label_column",
 ]
 
 _DEFAULT = {
@@ -75,6 +79,7 @@ _DEFAULT = {
     "ddq": "ddq{i}",
     "M": "M{i}_{j}",
     "g": "g{i}",
+    "label": "label",
 }
 _TIME = {"s": 1.0, "ms": 1e-3, "us": 1e-6, "ns": 1e-9}
 _ANGLE = {"rad": 1.0, "deg": math.pi / 180, "m": 1.0, "mm": 1e-3}
@@ -163,6 +168,11 @@ class ColumnMap:
                     flips.setdefault(joint[0], set()).add(joint[1])
             elif key not in _DEFAULT:
                 raise DataError(f"unknown quantity {key!r}; expected one of {list(_DEFAULT)}")
+            elif key == "label":
+                raise DataError(
+                    f"label={u}: a label column has no unit (nonzero is in contact); give "
+                    "its name with --columns label=NAME"
+                )
         given = {k: u for k, u in units.items() if _joint_key(k) is None}
         factors = {k: _to_factor(k, u) for k, u in given.items()}
         names = {k: str(u) for k, u in given.items()}
@@ -618,6 +628,85 @@ def load_joint_columns(path: str | Path, name: str, n: int) -> NDArray[np.float6
             return None
         raise
     return _vector(table, cmap, "tau", n)
+
+
+def load_label_column(
+    path: str | Path, columns: ColumnMap | None = None
+) -> tuple[str, NDArray[np.float64], NDArray[np.float64]] | None:
+    """The contact labels of a log (nonzero in contact) and the times of its rows.
+
+    The column (CSV) or array (NPZ) that ``columns`` maps ``label`` to
+    (``--columns label=collision``), else the first of :data:`LABEL_COLUMNS` the file
+    has; the times through the map's ``t`` template and unit. Rows as stored (NaN kept):
+    the caller aligns them with the cleaned log by their times.
+
+    Returns
+    -------
+    (str, ndarray (N,), ndarray (N,)) or None
+        The column's name, ``t`` [s] and the labels; None when the file has no label.
+
+    Raises
+    ------
+    DataError
+        A ``label`` mapped that the file lacks or that is not numbers, a malformed file.
+
+    Warns
+    -----
+    DynidWarning
+        A column of a default name that is not numbers (read as no labels).
+    """
+    path = Path(path)
+    cmap = columns if columns is not None else ColumnMap()
+    present = _header(path)
+    if cmap.mapped("label"):
+        name = cmap.template("label")
+        if name not in present:
+            raise DataError(
+                f"no column {name!r} for 'label' (--columns label={name}); the file has "
+                f"{present[:12]}{'...' if len(present) > 12 else ''}",
+                file=path.name,
+            )
+    else:
+        found = [c for c in LABEL_COLUMNS if c in present]
+        if not found:
+            return None
+        name = found[0]
+    tpl = cmap.template("t")
+    try:
+        table = _read_table(path, ColumnMap({"t": tpl, "label": name}), ("t", "label"))
+    except DataError as exc:
+        if cmap.mapped("label"):
+            raise
+        warnings.warn(
+            f"{path.name}: column {name!r} read as no contact labels ({exc}); hint: name the "
+            "labels with --columns label=NAME",
+            DynidWarning,
+            stacklevel=2,
+        )
+        return None
+    if tpl not in table.columns:
+        return None  # the log's reader names the missing time column
+    t = np.asarray(table.columns[tpl], dtype=np.float64).reshape(-1) * cmap.factor("t")
+    label = np.asarray(table.columns[name], dtype=np.float64).reshape(-1)
+    if label.shape != t.shape:
+        raise DataError(f"label {name!r} has {label.size} rows; t has {t.size}", file=path.name)
+    return name, t, label
+
+
+def _header(path: Path) -> list[str]:
+    """The column names of a CSV (its first line that is not a comment) or the array
+    names of an NPZ file."""
+    regular_file(path)
+    if path.suffix.lower() == ".npz":
+        check_npz(path)
+        with np.load(path, allow_pickle=False) as z:
+            return list(z.files)
+    with path.open(encoding="utf-8-sig", errors="replace") as fh:
+        for line in fh:
+            s = line.strip()
+            if s and not s.startswith("#"):
+                return [c.strip() for c in s.split(",")]
+    return []
 
 
 @dataclass(frozen=True, slots=True)

@@ -45,14 +45,16 @@ from ..exceptions import DataError, DynidError
 from ..observer.detection import ContactEvent, Thresholds, undetected_at_rest
 from ..observer.residual import ObserverOptions
 from ..observer.results import LogObservation, ObserveResult
+from ..observer.scoring import ContactScore
 from ..observer.thresholds import ModelFingerprint
 from ..observer.wrench import FULL, WrenchKind, wrench_rank
 from .atomic import open_atomic
-from .json_files import save_json
 from .schema import Field, Format, Record, load_document, save_document
 
 __all__ = [
+    "EVENTS",
     "EVENTS_SCHEMA",
+    "SCORE",
     "ResidualTables",
     "THRESHOLDS",
     "THRESHOLDS_SCHEMA",
@@ -122,6 +124,82 @@ THRESHOLDS = Format(
         }
     ),
     "thresholds file (dynid observe --calibrate)",
+)
+
+_COUNT = Field("integer", required=True, low=0)
+_S = Field("number", required=True, low=0.0, unit="s")
+#: A score of detected events against labelled contacts (:mod:`dynid.observer.scoring`).
+_SCORE_FIELDS = {
+    "source": Field("string", required=True),
+    "tolerance_s": _S,
+    "labelled": _COUNT,
+    "detected": _COUNT,
+    "missed": _COUNT,
+    "false_alarms": _COUNT,
+    "contact_free_s": _S,
+    "false_alarms_per_min": Field("number", nullable=True, low=0.0, unit="1/min"),
+    "delay_median_ms": Field("number", nullable=True, unit="ms"),
+    "delay_max_ms": Field("number", nullable=True, unit="ms"),
+    "missed_contacts": Field(
+        "objects",
+        required=True,
+        record=Record(
+            {
+                "start": Field("number", required=True, unit="s"),
+                "end": Field("number", required=True, unit="s"),
+                "peak": Field("number", nullable=True, low=0.0, unit=_NM),
+            }
+        ),
+    ),
+}
+#: ``events.json``'s ``score``: in total, and per log with labels (``logs``).
+SCORE = Record(
+    {
+        **_SCORE_FIELDS,
+        "logs": Field(
+            "objects",
+            required=True,
+            record=Record(
+                {
+                    "log": Field("string", required=True),
+                    **_SCORE_FIELDS,
+                    "contacts": Field("numbers", required=True, shape=(None, 2), unit="s"),
+                }
+            ),
+        ),
+    }
+)
+#: ``events.json``: the events and the score declared; the logs' and the model's
+#: metadata (``data``, ``samples``, ``duration_s``, ``model``, ...) kept unchecked.
+EVENTS = Format(
+    EVENTS_SCHEMA,
+    Record(
+        {
+            "dynid_version": Field("string"),
+            "joints": Field("strings"),
+            "events": Field(
+                "objects",
+                required=True,
+                record=Record(
+                    {
+                        "start": Field("number", required=True, unit="s"),
+                        "end": Field("number", required=True, unit="s"),
+                        "joints": Field("numbers", required=True, shape=(None,)),
+                        "joint_names": Field("strings"),
+                        "peak": Field("numbers", required=True, shape=(None,), unit=_NM),
+                        "level": Field("string", required=True, choices=("contact", "collision")),
+                        "log": Field("string"),
+                    }
+                ),
+            ),
+            "duration_s": Field("numbers", shape=(None,), low=0.0, unit="s"),
+            "flagged_s": Field("numbers", shape=(None,), low=0.0, unit="s"),
+            "score": Field("object", record=SCORE),
+            "units": Field("any"),
+        },
+        open=True,
+    ),
+    "events file (dynid observe --thresholds)",
 )
 
 
@@ -234,7 +312,7 @@ def save_events(
         "units": {"start": "s", "end": "s", "peak": "N m", "joints": "1-based"}
         | {k: "s" for k in ("duration_s", "flagged_s") if k in (meta or {})},
     }
-    return save_json(path, doc, schema=EVENTS_SCHEMA)
+    return save_document(path, EVENTS, doc)
 
 
 def save_residuals_csv(
@@ -429,6 +507,7 @@ def save_observation(
         "flagged_s": [x.flagged_seconds() for x in result.logs],
         **_fingerprint(result.fingerprint),
         **({} if result.frame is None else {"wrench": _estimate_info(result)}),
+        **({} if (total := result.score()) is None else {"score": _score_info(result, total)}),
         **meta,
     }
     paths.insert(
@@ -436,6 +515,36 @@ def save_observation(
         save_events(out / "events.json", events, meta=info, logs=logs_of, joints=joints),
     )
     return paths
+
+
+def _score_record(sc: ContactScore) -> dict[str, Any]:
+    """One score as ``events.json`` writes it (:data:`SCORE`)."""
+    return {
+        "source": sc.source,
+        "tolerance_s": sc.tolerance_s,
+        "labelled": sc.labelled,
+        "detected": sc.detected,
+        "missed": len(sc.missed),
+        "false_alarms": sc.false_alarms,
+        "contact_free_s": sc.contact_free_s,
+        "false_alarms_per_min": sc.false_alarms_per_min,
+        "delay_median_ms": None if sc.delay_median is None else 1e3 * sc.delay_median,
+        "delay_max_ms": None if sc.delay_max is None else 1e3 * sc.delay_max,
+        "missed_contacts": [{"start": m.start, "end": m.end, "peak": m.peak} for m in sc.missed],
+    }
+
+
+def _score_info(result: ObserveResult, total: ContactScore) -> dict[str, Any]:
+    """``events.json``'s ``score``: the events against the labelled contacts in total and
+    per log with labels (``logs``: the log's name, its score and its labelled
+    ``contacts``, ``[start, end]`` [s])."""
+    labels = log_labels([x.path for x in result.logs])
+    per = [
+        {"log": lab, **_score_record(x.score), "contacts": [list(c) for c in x.score.intervals]}
+        for x, lab in zip(result.logs, labels, strict=True)
+        if x.score is not None
+    ]
+    return {**_score_record(total), "logs": per}
 
 
 def _estimate_info(result: ObserveResult) -> dict[str, Any]:

@@ -61,6 +61,7 @@ from .npz_files import check_npz
 from .static_data import check_row_count
 
 __all__ = [
+    "LABEL_COLUMNS",
     "load_torque_log",
     "save_torque_log",
     "save_torque_log_pieces",
@@ -475,6 +476,12 @@ def _columns(path: Path, names: list[str], line: int) -> tuple[int, bool]:
     return n, bool(have)
 
 
+#: The columns (CSV) or arrays (NPZ) of a log read as contact labels (nonzero: in
+#: contact) when no ``label`` column is mapped, the first the log has
+#: (:func:`dynid.io.columns.load_label_column`).
+LABEL_COLUMNS = ("collision", "contact", "label")
+
+
 def _span(columns: list[str]) -> str:
     """Columns for a message: ``tau1..tau7`` for a run of one signal, else the list."""
     m = [re.fullmatch(r"([a-z]+)(\d+)", c) for c in columns]
@@ -488,10 +495,21 @@ def _span(columns: list[str]) -> str:
 def _say_unread(name: str, kind: str, extra: list[str]) -> None:
     """An informational line for the true external torques a simulation writes
     (``tau_ext``: ground truth, which ``dynid observe`` compares its residual with and says
-    so; a log of dynid's own simulation is no cause for a warning), a warning for other
-    columns (labels, vendor estimates): kept in the file, not read as data."""
+    so; a log of dynid's own simulation is no cause for a warning) and for a column of
+    contact labels (:data:`LABEL_COLUMNS`, which ``dynid observe`` scores its events
+    against), a warning for other columns (vendor estimates): kept in the file, not read
+    as data."""
     truth = [c for c in extra if re.fullmatch(r"tau_ext\d*", c)]
-    rest = [c for c in extra if c not in truth]
+    labels = [c for c in extra if c in LABEL_COLUMNS]
+    rest = [c for c in extra if c not in truth and c not in labels]
+    if labels:
+        _log.info(
+            "%s: %s %s hold contact labels: never read as data (dynid observe scores its "
+            "events against them)",
+            name,
+            kind,
+            _checks.short(labels),
+        )
     if truth:
         span = truth[0] if len(truth) == 1 else f"{truth[0]}..{truth[-1]}"
         _log.info(

@@ -26,7 +26,9 @@ Albu-Schaeffer, IEEE T-RO 2017), on any model dynid produces.
 * :mod:`~dynid.observer.gain_noise`: how much of a calibration residual is the
   velocities' noise times the gain (thresholds that grow with it);
 * :mod:`~dynid.observer.events`: contact and collision events, from a whole log or a
-  block of samples at a time (:class:`EventDetector`).
+  block of samples at a time (:class:`EventDetector`);
+* :mod:`~dynid.observer.scoring`: the events against labelled contacts (a 0/1 column or
+  the true external torques): detected, missed, false alarms and delays.
 """
 
 from .detection import calibrate, residual_std

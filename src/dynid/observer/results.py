@@ -18,6 +18,7 @@ from .detection import ContactEvent, Thresholds
 from .friction import banding_note
 from .gain_noise import GainNoise
 from .model import ObserverModel
+from .scoring import ContactScore, combined
 from .thresholds import ModelFingerprint
 from .wrench import FULL, WrenchEstimate, WrenchKind, underdetermined_note
 
@@ -100,6 +101,10 @@ class LogObservation:
         The friction the observer evaluated on this log when it is not the model's own:
         the model's banded for the log's velocity noise
         (:func:`~dynid.observer.friction.banded_if_narrow`); None: the model's own.
+    score : ContactScore or None
+        The events against the log's labelled contacts (a label column, or the true
+        external torques of a simulated log: :mod:`~dynid.observer.scoring`); None: no
+        label.
     """
 
     path: Path
@@ -117,6 +122,7 @@ class LogObservation:
     figure: FigureSeries | None = None
     peak_ratio: NDArray[np.float64] | None = None
     friction: FrictionModel | FrictionSum | None = None
+    score: ContactScore | None = None
 
     @property
     def series(self) -> NDArray[np.float64]:
@@ -191,6 +197,12 @@ class ObserveResult:
     frame: str | None = None
     wrench: WrenchKind = FULL
     gain_noise: GainNoise | None = None
+
+    def score(self) -> ContactScore | None:
+        """The events of every log with labelled contacts against them, in total
+        (:func:`~dynid.observer.scoring.combined`); None: no log has labels."""
+        scores = [x.score for x in self.logs if x.score is not None]
+        return combined(scores) if scores else None
 
     def flagged(self) -> tuple[float, float]:
         """``(flagged, logged)`` [s]: the time every log's events cover and the logs'

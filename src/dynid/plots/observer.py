@@ -31,6 +31,7 @@ def plot_residuals(
     joint_names: Sequence[str] | None = None,
     max_points: int = 20000,
     title: str | None = None,
+    labelled: Sequence[tuple[float, float]] = (),
 ) -> Figure:
     """One panel per joint: the residual over time with its thresholds and the events.
 
@@ -50,6 +51,9 @@ def plot_residuals(
     max_points : int
         Samples drawn per curve (evenly strided).
     title : str, optional
+    labelled : sequence of (float, float)
+        Labelled contacts ``(start, end)`` [s] (:mod:`dynid.observer.scoring`), hatched
+        grey over the full height.
 
     Returns
     -------
@@ -63,6 +67,11 @@ def plot_residuals(
     s = slice(None, None, max(1, int(np.ceil(t.size / max_points))))
     for j in range(n):
         ax = axes[j, 0]
+        for k, (a, b) in enumerate(labelled):
+            ax.axvspan(
+                a, max(b, a + 1e-3), facecolor="none", edgecolor=COLOURS["label"],
+                hatch="///", lw=0, label="labelled contact" if k == 0 else None,
+            )  # fmt: skip
         for e in events:
             ax.axvspan(
                 e.start, max(e.end, e.start + 1e-3),

@@ -29,5 +29,6 @@ COLOURS: Mapping[str, str] = MappingProxyType(
         "external": "tab:green",  # the true external torques of a simulated contact
         "contact": "gold",  # a contact event's window
         "collision": "tab:red",  # a collision event's window
+        "label": "0.55",  # a labelled contact's window (hatched)
     }
 )

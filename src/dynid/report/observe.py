@@ -69,6 +69,26 @@ def _flagged(doc: Any) -> str:
     return ", " + flagged_words(float(sum(flagged)), float(sum(logged)))
 
 
+def _scored(doc: Any) -> str | None:
+    """The events against the labelled contacts in one escaped sentence (``events.json``'s
+    ``score``: counts, false alarms per minute of contact-free time, delays), or None where
+    the file has none."""
+    sc = doc.get("score") if isinstance(doc, dict) else None
+    keys = ("labelled", "detected", "missed", "false_alarms")
+    if not isinstance(sc, dict) or not all(is_number(sc.get(k)) for k in keys):
+        return None
+    said = (
+        f"Against the labelled contacts ({sc.get('source', '?')}): {sc['labelled']} labelled, "
+        f"{sc['detected']} detected, {sc['missed']} missed; {sc['false_alarms']} false "
+        "alarm(s)"
+    )
+    if is_number(rate := sc.get("false_alarms_per_min")):
+        said += f" ({rate:.3g} per minute of contact-free time)"
+    if is_number(mid := sc.get("delay_median_ms")) and is_number(top := sc.get("delay_max_ms")):
+        said += f"; delay median {mid:.0f} ms, max {top:.0f} ms"
+    return esc(said + ".")
+
+
 def _numbers(v: Any) -> bool:
     return isinstance(v, list) and bool(v) and all(is_number(x) for x in v)
 
@@ -96,6 +116,8 @@ def answer(run: RunFiles) -> Answer | None:
         head, level = head + _flagged(run.docs.get(found["events.json"] or "")) + ".", "info"
     else:
         head, level = "No event: every residual stayed below its threshold.", "good"
+    if (scored := _scored(run.docs.get(found["events.json"] or ""))) is not None:
+        facts.append(scored)
     if found["thresholds.json"] is not None:
         facts.append("Thresholds: see the table below (from thresholds.json)")
     if found["residuals.csv"] is not None:

@@ -43,6 +43,11 @@ the command applies, so that the Python API behaves as the command does.
   crossing before runs are joined (:mod:`dynid.observer.events`); the true external
   torques ``tau_ext1..n`` that ``dynid simulate --contact`` writes beside a log are kept
   for the figure.
+* A log with labelled contacts has its events scored against them
+  (:mod:`dynid.observer.scoring`, ``label_tolerance_s``): a label column (the ``label``
+  of the column map, else ``collision``, ``contact`` or ``label``;
+  :func:`~dynid.workflows.observe_detect.contact_labels`), else the true external torques
+  of a simulated log (:func:`~dynid.workflows.observe_detect.scored`).
 """
 
 from __future__ import annotations
@@ -65,6 +70,7 @@ from ..exceptions import in_file as about_file
 from ..friction.fit import same_drive
 from ..friction.model import FrictionModel, FrictionSum, own_at_motors_note, placed_friction
 from ..identification.sanity import SPIKES_BEFORE_OBSERVER
+from ..io.columns import ColumnMap
 from ..io.drive_file import drive_of_robot_file, load_drive
 from ..io.feasible import load_feasible_drive, load_feasible_linear_friction
 from ..io.friction_json import load_friction_json
@@ -79,6 +85,7 @@ from ..observer.gain_noise import GainNoiseTally
 from ..observer.model import ObserverModel, from_identified, from_robot
 from ..observer.residual import DEFAULT_GAIN, ObserverOptions
 from ..observer.results import LogObservation, ObserveResult
+from ..observer.scoring import DEFAULT_TOLERANCE_S
 from ..observer.sign import TorqueSign, opposite_finding, unexplained_finding
 from ..observer.thresholds import ModelFingerprint
 from ..observer.wrench import wrench_kind, wrench_rank
@@ -91,7 +98,7 @@ from .data_files import (
     read_torque_log,
     recorded_columns,
 )
-from .observe_detect import ResidualSink, detected_log, true_torques
+from .observe_detect import ResidualSink, contact_labels, detected_log, true_torques
 from .observe_logs import ObservedBlock, PreparedLog, Series, observed_blocks, prepared_log
 from .recordings import (
     Recorded,
@@ -199,6 +206,10 @@ class ObserveOptions:
     figure_points : int, optional
         Detecting: keep every k-th sample of the residual, its thresholds and the true
         torques, at most this many, for a figure (``LogObservation.figure``).
+    label_tolerance_s : float
+        Detecting a log with labelled contacts (a label column, or the true torques of a
+        simulated log): how long after a contact's end [s] an event may start and still
+        detect it (:mod:`dynid.observer.scoring`).
     """
 
     data: tuple[Path, ...]
@@ -230,6 +241,7 @@ class ObserveOptions:
     q_start: tuple[float, ...] | None = None
     keep_series: bool = True
     figure_points: int | None = None
+    label_tolerance_s: float = DEFAULT_TOLERANCE_S
 
 
 def load_observer_model(
@@ -371,8 +383,9 @@ _CALIBRATION_FIELDS = (
 
 def _refuse_unused(opts: ObserveOptions) -> None:
     """Options that do not apply: the calibration's with ``thresholds`` (the file fixes
-    them), ``frame``, ``merge_s`` and ``min_duration_s`` when calibrating (no wrench or
-    event is computed), ``wrench`` without ``frame`` (or not one of its kinds)."""
+    them), ``frame``, ``merge_s``, ``min_duration_s`` and ``label_tolerance_s`` when
+    calibrating (no wrench or event is computed), ``wrench`` without ``frame`` (or not
+    one of its kinds)."""
     default = ObserveOptions(data=())
     wrench_kind(opts.wrench)
     if opts.frame is None and opts.wrench != default.wrench:
@@ -394,7 +407,7 @@ def _refuse_unused(opts: ObserveOptions) -> None:
             field="frame",
         )
     else:
-        for name in ("merge_s", "min_duration_s"):
+        for name in ("merge_s", "min_duration_s", "label_tolerance_s"):
             if getattr(opts, name) != getattr(default, name):
                 raise OptionError(
                     "applies when detecting (events); calibrating finds none", field=name
@@ -468,7 +481,8 @@ def observe_files(opts: ObserveOptions, sink: ResidualSink | None = None) -> Obs
     )
     wants_margin = opts.standstill if given is None else given.standstill
     columns = recorded_columns(recorded, *opts.columns)  # (names, units), said once
-    read = _read_logs(data_files(opts.data), model, columns, opts)
+    cmap = column_map(*columns, drive=model.drive)
+    read = _read_logs(data_files(opts.data), model, cmap, opts)
     read, _ = despiked_recordings(
         read, model.robot.joint_names, SPIKES_BEFORE_OBSERVER, min_rate_hz=SPIKE_RATE_HZ
     )
@@ -490,6 +504,7 @@ def observe_files(opts: ObserveOptions, sink: ResidualSink | None = None) -> Obs
             table = sink.table(paths, k, rows, model.n, opts.frame, kind)
         with about_file(path.name):
             prep = prepared_log(path, log, model, opts.max_gap, read.joint_side[k])
+            labels = contact_labels(prep, cmap)
         logs.append(
             detected_log(
                 prep,
@@ -505,6 +520,8 @@ def observe_files(opts: ObserveOptions, sink: ResidualSink | None = None) -> Obs
                 figure_points=opts.figure_points,
                 table=table,
                 kind=kind,
+                labels=labels,
+                tolerance_s=opts.label_tolerance_s,
             )  # fmt: skip
         )
     return ObserveResult(model, given, tuple(logs), fingerprint, own, opts.frame, kind)
@@ -555,15 +572,14 @@ def friction_source(opts: ObserveOptions) -> str | None:
 def _read_logs(
     paths: list[Path],
     model: ObserverModel,
-    columns: tuple[str | None, str | None],
+    cmap: ColumnMap | None,
     opts: ObserveOptions,
 ) -> Recorded:
-    """The logs ``paths`` read strictly for the model; a log in other units than the others,
-    with joints in degrees, with torques of the opposite sign to the model's or in mN m
-    read as N m refused,
+    """The logs ``paths`` read strictly for the model through ``cmap``; a log in other
+    units than the others, with joints in degrees, with torques of the opposite sign to the
+    model's or in mN m read as N m refused,
     and one far outside the joint limits warned about, each naming the file
     (:mod:`dynid.workflows.recordings`)."""
-    cmap = column_map(*columns, drive=model.drive)
     logs = [
         read_torque_log(
             p,

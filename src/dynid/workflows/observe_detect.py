@@ -18,26 +18,54 @@ from __future__ import annotations
 import warnings
 from collections.abc import Callable, Sequence
 from contextlib import AbstractContextManager, nullcontext
+from dataclasses import dataclass
 from pathlib import Path
 from typing import Any, Protocol
 
 import numpy as np
 from numpy.typing import NDArray
 
-from ..exceptions import DynidWarning
+from .. import _checks
+from ..exceptions import DataError, DynidWarning
 from ..exceptions import in_file as about_file
-from ..io.columns import load_joint_columns
+from ..io.columns import ColumnMap, load_joint_columns, load_label_column
 from ..observer.events import ContactEvent, EventDetector
 from ..observer.model import ObserverModel
 from ..observer.residual import ObserverOptions
 from ..observer.results import FigureSeries, LogObservation
+from ..observer.scoring import (
+    DEFAULT_TOLERANCE_S,
+    TRUTH_LEVEL,
+    ContactScore,
+    interval_peaks,
+    label_intervals,
+    score_events,
+    truth_flags,
+)
 from ..observer.sign import TorqueSign, opposite_finding
 from ..observer.thresholds import Thresholds, threshold_series
 from ..observer.wrench import FULL, WrenchEstimate, WrenchKind, external_wrench, wrench_rank
 from .data_files import in_file
 from .observe_logs import ObservedBlock, PreparedLog, Series, observed_rows
 
-__all__ = ["ResidualSink", "detected_log", "observed_wrench", "true_torques"]
+__all__ = [
+    "Labels",
+    "ResidualSink",
+    "contact_labels",
+    "detected_log",
+    "observed_wrench",
+    "scored",
+    "true_torques",
+]
+
+
+@dataclass(frozen=True, slots=True, eq=False)
+class Labels:
+    """A log's contact labels: ``source`` (``column 'collision'``) and ``flags`` (N,),
+    one per row of the cleaned log, nonzero in contact (NaN: no label)."""
+
+    source: str
+    flags: NDArray[np.float64]
 
 
 class ResidualSink(Protocol):
@@ -70,6 +98,36 @@ def true_torques(prep: PreparedLog, model: ObserverModel, mapped: bool) -> NDArr
     return None if ext is None or ext.shape[0] != N else ext
 
 
+def contact_labels(prep: PreparedLog, columns: ColumnMap | None) -> Labels | None:
+    """The contact labels of a log, one per row of its cleaned log (N,), nonzero in
+    contact (:func:`~dynid.io.columns.load_label_column`: the column ``columns`` maps
+    ``label`` to, else ``collision``, ``contact`` or ``label``), with the words of their
+    source (``column 'collision'``), or None when the log has none. Rows dropped while
+    reading (``--drop-invalid``) are matched by their times.
+
+    Raises
+    ------
+    DataError
+        A ``label`` mapped that the log lacks; labels whose times are not the log's.
+    """
+    found = load_label_column(prep.path, columns)
+    if found is None:
+        return None
+    name, t, flags = found
+    log_t = prep.log.t
+    if t.shape != log_t.shape or not np.array_equal(t, log_t):
+        ok = np.isfinite(t)
+        t, flags = t[ok], flags[ok]
+        k = np.clip(np.searchsorted(t, log_t), 0, max(t.size - 1, 0))
+        if t.size == 0 or not np.array_equal(t[k], log_t):
+            raise DataError(
+                f"the times of label {name!r} are not the log's ({t.size} rows against "
+                f"{log_t.size}); hint: one label per row of the log"
+            )
+        flags = flags[k]
+    return Labels(f"column {name!r}", _checks.frozen(np.asarray(flags, dtype=np.float64)))
+
+
 def detected_log(
     prep: PreparedLog,
     model: ObserverModel,
@@ -85,12 +143,17 @@ def detected_log(
     figure_points: int | None = None,
     table: AbstractContextManager[Callable[..., None] | None] | None = None,
     kind: WrenchKind = FULL,
+    labels: Labels | None = None,
+    tolerance_s: float = DEFAULT_TOLERANCE_S,
 ) -> LogObservation:
     """The events of one prepared log (module docstring; ``merge_s`` and ``min_duration_s``
     of :class:`~dynid.observer.events.EventDetector`), ``wants`` the residual's std and
     the standstill margin, ``table`` the sink's writer of its residual table (or none);
     ``figure_points``: keep every k-th sample (at most that many) for a figure; ``kind``:
-    the wrench or the force alone at ``frame``."""
+    the wrench or the force alone at ``frame``; the events scored against ``labels``
+    (:func:`contact_labels`), else against the true torques stored beside the log (in
+    contact above :data:`~dynid.observer.scoring.TRUTH_LEVEL`), with ``tolerance_s``
+    (:func:`scored`)."""
     log, n = prep.log, model.n
     starts = tuple(a for a, _ in prep.spans)
     det = EventDetector(thresholds, merge_s=merge_s, min_duration_s=min_duration_s, restarts=starts)
@@ -140,7 +203,32 @@ def detected_log(
         figure=None if strided is None else strided.series(),
         peak_ratio=det.largest_ratio,
         friction=None if seen is model.friction else seen,
+        score=scored(log.t, events, labels, ext, tolerance_s),
     )
+
+
+def scored(
+    t: NDArray,
+    events: Sequence[ContactEvent],
+    labels: Labels | None,
+    ext: NDArray | None,
+    tolerance_s: float = DEFAULT_TOLERANCE_S,
+) -> ContactScore | None:
+    """The ``events`` of a log at times ``t`` (N,) [s] scored against its ``labels``, else
+    against the true external torques ``ext`` (N, n) [N m] (in contact where some joint
+    exceeds :data:`~dynid.observer.scoring.TRUTH_LEVEL`; the missed contacts' peaks
+    known); None with neither (:mod:`dynid.observer.scoring`)."""
+    if labels is not None:
+        intervals, source, peaks = label_intervals(t, labels.flags), labels.source, None
+    elif ext is not None:
+        intervals = label_intervals(t, truth_flags(ext))
+        source = f"tau_ext > {TRUTH_LEVEL:g} N m"
+        peaks = interval_peaks(t, ext, intervals)
+    else:
+        return None
+    ev = np.array([(e.start, e.end) for e in events], dtype=np.float64).reshape(-1, 2)
+    span = (float(t[0]), float(t[-1])) if t.shape[0] else (0.0, 0.0)
+    return score_events(ev, intervals, span, tolerance_s=tolerance_s, peaks=peaks, source=source)
 
 
 def observed_wrench(

@@ -1,0 +1,213 @@
+"""Scoring detected events against labelled contacts (dynid.observer.scoring): intervals
+of a 0/1 series, matching, counts; and ``dynid observe`` on simulated contacts and on a
+log with a label column, whose counts equal the contacts simulated."""
+
+from __future__ import annotations
+
+import json
+
+import numpy as np
+import pytest
+
+from dynid.cli.__main__ import main
+from dynid.exceptions import ShapeError
+from dynid.observer.scoring import (
+    ContactScore,
+    combined,
+    interval_peaks,
+    label_intervals,
+    match_events,
+    score_events,
+    truth_flags,
+)
+
+
+def test_intervals_of_a_series_are_its_runs_with_edges_and_nan():
+    """Runs at the first and last sample, a one-sample run, NaN as no contact: the first
+    and last sample time of each run."""
+    t = np.arange(10) * 0.5
+    flags = [1, 1, 0, 0, 1, np.nan, 3, 0, 0, 1]
+    np.testing.assert_array_equal(
+        label_intervals(t, flags), [[0.0, 0.5], [2.0, 2.0], [3.0, 3.0], [4.5, 4.5]]
+    )
+    assert label_intervals(t, np.zeros(10)).shape == (0, 2)
+    np.testing.assert_array_equal(label_intervals(t, np.ones(10)), [[0.0, 4.5]])
+    with pytest.raises(ShapeError, match="both be"):
+        label_intervals(t, np.ones(9))
+
+
+def test_truth_flags_and_peaks_of_true_torques():
+    """Some joint over the level is contact; the peak is the largest |tau_ext| over the
+    interval's samples and joints."""
+    rng = np.random.default_rng(5)
+    t = np.arange(8) * 0.1
+    ext = np.zeros((8, 2))
+    ext[2:5, 1] = [-0.5, -2.0, 0.3]
+    ext[6, 0] = 0.05 + 0.01 * rng.random()
+    flags = truth_flags(ext, 0.1)
+    np.testing.assert_array_equal(flags, [0, 0, 1, 1, 1, 0, 0, 0])
+    iv = label_intervals(t, flags)
+    np.testing.assert_allclose(interval_peaks(t, ext, iv), [2.0])
+
+
+def test_matching_a_miss_a_false_alarm_two_events_in_one_contact_one_over_two():
+    """Contacts [1, 2], [5, 6], [8, 8.5], [8.6, 9]; events (1.05, 1.3) and (1.5, 2.05) in the
+    first (one detection, delay 0.05), one at 3 (a false alarm), none near the second
+    (missed), one over the last two (both detected, one delay), one starting 0.08 s
+    after a contact's end (within the tolerance of 0.1 s)."""
+    labels = np.array([[1.0, 2.0], [5.0, 6.0], [8.0, 8.5], [8.6, 9.0], [10.0, 10.2]])
+    events = np.array([[1.05, 1.3], [1.5, 2.05], [3.0, 3.2], [8.02, 8.9], [10.28, 10.4]])
+    first, false = match_events(events, labels, 0.1)
+    np.testing.assert_array_equal(first, [0, -1, 3, 3, 4])
+    np.testing.assert_array_equal(false, [False, False, True, False, False])
+    s = score_events(events, labels, (0.0, 12.0), tolerance_s=0.1, peaks=[3, 0.7, 2, 2, 5])
+    assert (s.labelled, s.detected, s.false_alarms) == (5, 4, 1)
+    assert [(m.start, m.end, m.peak) for m in s.missed] == [(5.0, 6.0, 0.7)]
+    np.testing.assert_allclose(s.delays, [0.05, 0.02, 0.28])
+    # contact-free: 12 s less [1, 2.1], [5, 6.1], [8, 9.1] (two windows joined), [10, 10.3]
+    assert s.contact_free_s == pytest.approx(12.0 - 1.1 - 1.1 - 1.1 - 0.3)
+    assert s.false_alarms_per_min == pytest.approx(60.0 / s.contact_free_s)
+    assert s.delay_median == pytest.approx(0.05) and s.delay_max == pytest.approx(0.28)
+    tight = score_events(events, labels, (0.0, 12.0), tolerance_s=0.05)
+    assert (tight.detected, tight.false_alarms) == (3, 2)  # the late event: a false alarm
+
+
+def test_no_labels_every_event_false_and_totals_pool_logs():
+    """Without contacts every event is a false alarm over the whole span; the total adds
+    counts and times and pools delays."""
+    a = score_events([[1.0, 1.1]], np.zeros((0, 2)), (0.0, 30.0), source="x")
+    assert (a.labelled, a.detected, a.false_alarms, a.contact_free_s) == (0, 0, 1, 30.0)
+    assert a.delay_median is None and a.false_alarms_per_min == pytest.approx(2.0)
+    b = ContactScore("x", 0.1, 2, 1, (), 0, 10.0, (0.04,))
+    total = combined([a, b])
+    assert (total.labelled, total.detected, total.false_alarms) == (2, 1, 1)
+    assert total.contact_free_s == 40.0 and total.delays == (0.04,)
+    with pytest.raises(ValueError, match="no score"):
+        combined([])
+    with pytest.raises(ShapeError, match="peaks"):
+        score_events([], [[0.0, 1.0]], (0.0, 2.0), peaks=[1.0, 2.0])
+
+
+@pytest.fixture(scope="module")
+def pushes(tmp_path_factory):
+    """Thresholds from a free 3 s Panda log, and a 4 s log with three pushes at 0.8-1.1,
+    1.9-2.3 and 3.0-3.2 s (tau_ext written beside it)."""
+    d = tmp_path_factory.mktemp("scoring")
+    sim = ["simulate", "--robot", "panda", "--trajectory", "fourier", "-q"]
+    assert main([*sim, "--duration", "3", "--seed", "2", "--out", str(d / "free.csv")]) == 0
+    hit = [
+        "--contact", "link6:0,0,-15:0.8,1.1", "--contact", "flange:10,0,0:1.9,2.3",
+        "--contact", "link4:0,0,-20:3,3.2",
+    ]  # fmt: skip
+    assert main([*sim, "--duration", "4", "--seed", "3", *hit, "--out", str(d / "hit.csv")]) == 0
+    p = ["observe", "--params", "panda", "--no-figures", "-q"]
+    assert main([*p, "--data", str(d / "free.csv"), "--calibrate", "--out", str(d / "cal")]) == 0
+    return d
+
+
+def _with_column(src, dst, name, values):
+    """``src`` (a dynid CSV log) with one more column ``name`` holding ``values``."""
+    lines = src.read_text().splitlines()
+    head, rows = lines[:3], lines[3:]
+    head[2] += f",{name}"
+    dst.write_text("\n".join(head + [f"{r},{v:g}" for r, v in zip(rows, values, strict=True)]))
+
+
+def test_observe_scores_a_simulated_log_against_its_true_torques(pushes, capsys):
+    """dynid observe on the log of three simulated pushes: 3 labelled (tau_ext > 0.1 N m),
+    3 detected, none missed, no false alarm, each within 25 ms (K_O = 50/s: a 20 ms time
+    constant) of the push; the summary, events.json and the report say so."""
+    d = pushes
+    p = ["observe", "--params", "panda", "--no-figures"]
+    th = ["--thresholds", str(d / "cal" / "thresholds.json")]
+    assert main([*p, *th, "--data", str(d / "hit.csv"), "--out", str(d / "sim")]) == 0
+    out = capsys.readouterr().out
+    assert "3 labelled, 3 detected, 0 missed; 0 false alarm(s)" in out
+    score = json.loads((d / "sim" / "events.json").read_text())["score"]
+    assert (score["labelled"], score["detected"], score["missed"]) == (3, 3, 0)
+    assert score["false_alarms"] == 0 and score["source"] == "tau_ext > 0.1 N m"
+    assert 0.0 <= score["delay_median_ms"] <= score["delay_max_ms"] <= 25.0
+    (log,) = score["logs"]
+    starts = [a for a, _ in log["contacts"]]
+    np.testing.assert_allclose(starts, [0.8, 1.9, 3.0], atol=2e-3)
+    report = (d / "sim" / "report.html").read_text()
+    assert "3 labelled, 3 detected, 0 missed; 0 false alarm(s)" in report
+    assert log["contact_free_s"] == pytest.approx(
+        4.0 - sum(b + 0.1 - a for a, b in log["contacts"])
+    )
+
+
+@pytest.mark.parametrize("mapped", [False, True])
+def test_observe_scores_against_a_label_column_by_default_name_or_mapped(pushes, capsys, mapped):
+    """A 0/1 column labelling the first push and a contact that never happened
+    (3.5-3.7 s), the second and third unlabelled: 2 labelled, 1 detected, the made-up
+    one missed (its times, no peak), 2 false alarms; read as ``collision`` or through
+    ``--columns label=touch``; the figure hatches the labels."""
+    from dynid.io.torque_log import load_torque_log
+
+    d = pushes
+    t = load_torque_log(d / "hit.csv").t
+    flags = ((t >= 0.8) & (t <= 1.1)) | ((t >= 3.5) & (t <= 3.7))
+    name = "touch" if mapped else "collision"
+    _with_column(d / "hit.csv", d / f"{name}.csv", name, flags.astype(float))
+    args = ["--columns", f"label={name}"] if mapped else []
+    th = ["--thresholds", str(d / "cal" / "thresholds.json")]
+    out_dir = d / f"lab_{name}"
+    cmd = ["observe", "--params", "panda", *th, *args, "--data", str(d / f"{name}.csv")]
+    assert main([*cmd, "--out", str(out_dir)]) == 0
+    out = capsys.readouterr().out
+    assert "2 labelled, 1 detected, 1 missed; 2 false alarm(s)" in out
+    assert "missed in" in out and "3.500 s .. 3.700 s" in out
+    score = json.loads((out_dir / "events.json").read_text())["score"]
+    assert score["source"] == f"column {name!r}"
+    assert score["missed_contacts"] == [{"start": 3.5, "end": 3.7, "peak": None}]
+    assert (out_dir / "residuals.png").stat().st_size > 0
+
+
+def test_a_log_without_labels_is_not_scored(pushes, capsys):
+    """A free simulated log (no tau_ext, no label column): no score printed nor written."""
+    d = pushes
+    p = ["observe", "--params", "panda", "--no-figures"]
+    th = ["--thresholds", str(d / "cal" / "thresholds.json")]
+    assert main([*p, *th, "--data", str(d / "free.csv"), "--out", str(d / "free")]) == 0
+    assert "scored against" not in capsys.readouterr().out
+    assert "score" not in json.loads((d / "free" / "events.json").read_text())
+
+
+def test_a_mapped_label_the_log_lacks_and_a_label_unit_are_refused(pushes, capsys):
+    """--columns label=NAME without that column names it; --units label=... is refused."""
+    d = pushes
+    p = ["observe", "--params", "panda", "--no-figures", "--thresholds"]
+    p += [str(d / "cal" / "thresholds.json"), "--data", str(d / "hit.csv")]
+    assert main([*p, "--columns", "label=bump", "--out", str(d / "x")]) != 0
+    assert "no column 'bump' for 'label'" in capsys.readouterr().err
+    assert main([*p, "--units", "label=s", "--out", str(d / "y")]) != 0
+    assert "a label column has no unit" in capsys.readouterr().err
+
+
+def test_labels_follow_the_log_past_rows_dropped_and_a_column_not_numbers(pushes, capsys):
+    """Rows dropped for NaN (--drop-invalid): the labels matched by time give the same
+    score; a ``label`` column of text is warned about and the true torques score
+    instead."""
+    from dynid.io.torque_log import load_torque_log
+
+    d = pushes
+    t = load_torque_log(d / "hit.csv").t
+    flags = ((t >= 0.8) & (t <= 1.1)) | ((t >= 3.5) & (t <= 3.7))
+    _with_column(d / "hit.csv", d / "holes.csv", "contact", flags.astype(float))
+    lines = (d / "holes.csv").read_text().splitlines()
+    for k in (500, 2700):  # rows at 0.497 and 2.697 s, outside the pushes: NaN tau1
+        cells = lines[k].split(",")
+        cells[15] = "nan"
+        lines[k] = ",".join(cells)
+    (d / "holes.csv").write_text("\n".join(lines))
+    p = ["observe", "--params", "panda", "--no-figures", "--drop-invalid", "--thresholds"]
+    p += [str(d / "cal" / "thresholds.json")]
+    assert main([*p, "--data", str(d / "holes.csv"), "--out", str(d / "holes")]) == 0
+    assert "2 labelled, 1 detected, 1 missed; 2 false alarm(s)" in capsys.readouterr().out
+    _with_column(d / "hit.csv", d / "text.csv", "label", np.zeros(t.size))
+    (d / "text.csv").write_text((d / "text.csv").read_text().replace(",0\n", ",no\n"))
+    assert main([*p, "--data", str(d / "text.csv"), "--out", str(d / "text")]) == 0
+    captured = capsys.readouterr()
+    assert "column 'label' read as no contact labels" in captured.err
+    assert "(tau_ext > 0.1 N m;" in captured.out and "3 labelled, 3 detected" in captured.out
