@@ -141,7 +141,7 @@ def test_an_identified_model_says_nothing_of_the_scale():
 
 def test_cli_payload_prints_and_records_the_scale(tmp_path, capsys):
     """dynid payload --robot panda on static data scaled by 0.834 with --unloaded: the
-    warning, the printed factor and m / a, payload.json's torque_scale."""
+    warning, the printed factor and m / a, payload.json's torque_scale, the report's line."""
     save_static_csv(tmp_path / "with.csv", _scaled(_static(LOADED, 60, 1e-3, 1), SCALE))
     save_static_csv(tmp_path / "without.csv", _scaled(_static(ARM, 60, 1e-3, 2), SCALE))
     args = ["payload", "--robot", "panda", "--data", str(tmp_path / "with.csv")]
@@ -154,3 +154,5 @@ def test_cli_payload_prints_and_records_the_scale(tmp_path, capsys):
     t = doc["torque_scale"]
     assert abs(t["value"] - SCALE) < 3 * t["std"] and t["data"] == "unloaded"
     assert abs(t["mass"] - MASS) < 0.01 * MASS and doc["load_mass"] is None
+    page = (tmp_path / "out" / "report.html").read_text()
+    assert "x the arm description&#x27;s" in page or "x the arm description's" in page

@@ -50,7 +50,7 @@ from pathlib import Path
 from typing import Any
 
 from ..feasibility.payload import PayloadEstimate
-from ..feasibility.payload_scale import TorqueScale
+from ..feasibility.payload_scale import SCALE_OFF, SCALE_SIGMAS, TorqueScale
 from ..identification.model import IdentifiedModel
 from ..io.model_json import save_model_json
 from ..io.payload_json import save_payload_json
@@ -223,13 +223,20 @@ def print_payload(console: Console, result: PayloadFileResult, label: str) -> No
 
 
 def scale_line(t: TorqueScale) -> str:
-    """``torques 1.0002 x the arm description's (std 0.00021, on the loaded data)``, with
-    the load's mass at that scale when it is off (:attr:`PayloadEstimate.torque_scale`)."""
+    """``torques 1.0002 x the arm description's (std 0.00021, on the loaded data); at the
+    description's scale the load is m / a = 0.8292 kg (std 0.0013); no doubt (a within 5 %
+    or 3 std of 1)``
+    (:attr:`PayloadEstimate.torque_scale`)."""
     where = "the data without the load" if t.data == "unloaded" else "the loaded data"
-    line = f"torques  {t.value:.4g} x the arm description's (std {t.std:.2g}, on {where})"
-    if t.off:
-        line += f": the load at the description's scale m / a = {t.mass:.4g} kg"
-    return line
+    return (
+        f"torques  {t.value:.4f} x the arm description's (std {t.std:.2g}, on {where}); "
+        f"at the description's scale the load is m / a = {t.mass:.4g} kg (std {t.std_mass:.2g})"
+        + (
+            ""
+            if t.off
+            else f"; no doubt (a within {100 * SCALE_OFF:g} % or {SCALE_SIGMAS:g} std of 1)"
+        )
+    )
 
 
 def residual_line(est: PayloadEstimate) -> str:
