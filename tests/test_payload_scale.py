@@ -19,9 +19,11 @@ import dynid
 from dynid.cli.__main__ import main
 from dynid.exceptions import DataError
 from dynid.feasibility.payload import identify_payload
+from dynid.feasibility.payload_scale import TorqueScale, scale_doubts
 from dynid.identification.structure import Structure
 from dynid.io.payload_json import payload_to_dict
 from dynid.io.static_data import save_static_csv
+from dynid.model.drive import Drive
 from dynid.simulation.measurement import simulate_measurement
 from dynid.simulation.trajectories import random_fourier, uniform_times
 
@@ -156,3 +158,16 @@ def test_cli_payload_prints_and_records_the_scale(tmp_path, capsys):
     assert abs(t["mass"] - MASS) < 0.01 * MASS and doc["load_mass"] is None
     page = (tmp_path / "out" / "report.html").read_text()
     assert "x the arm description&#x27;s" in page or "x the arm description's" in page
+
+
+def test_the_hint_names_the_drive_files_torque_constant_for_currents():
+    """Through a drive of currents the doubt's hint is the torque constant times 1 / a; at
+    4.9 % or within 3 std of 1 there is no doubt."""
+    drive = dataclasses.replace(Drive.identity(7), effort="current", torque_constant=np.ones(7))
+    off = TorqueScale(0.834, 0.001, 0.83, 0.01, "loaded")
+    (line,) = scale_doubts(off, 0.69, drive)
+    assert "multiply the drive file's torque_constant by 1.199" in line
+    assert "m / a = 0.83 kg" in line and "not 0.69 kg" in line
+    assert "--units tau=1.199" in scale_doubts(off, 0.69)[0]
+    assert not scale_doubts(TorqueScale(0.951, 0.001, 0.83, 0.01, "loaded"), 0.5)
+    assert not scale_doubts(TorqueScale(0.9, 0.04, 0.83, 0.01, "loaded"), 0.5)

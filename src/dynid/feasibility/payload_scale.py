@@ -149,7 +149,7 @@ def torque_scale(
         grad = np.array([-x / a**2, 1.0 / a])
         mass, std_mass = x / a, float(np.sqrt(max(grad @ cov[:2, :2] @ grad, 0.0)))
     else:
-        m, sm = load  # type: ignore[misc]
+        m, sm = load or (np.nan, np.nan)  # given with p = 0 (checked above)
         mass = m / a
         std_mass = float(np.hypot(sm / a, m * np.sqrt(cov[0, 0]) / a**2))
     std = float(np.sqrt(max(cov[0, 0], 0.0)))
