@@ -16,8 +16,11 @@ repeats the loaded motion (the recordings --model was identified from give the m
 itself, which a note says). The estimate is physically consistent (pseudo-inertia LMI).
 --columns/--units read files of other tools.
 
-A mass less than 3 standard deviations above zero, or a CoM farther from --frame than
-the arm is long, is warned about and no setLoad values are written. An inertia whose
+A mass less than 3 standard deviations above zero, a CoM farther from --frame than the
+arm is long, or (--robot, --params) measured torques more than 5 % and 3 standard
+deviations off the arm description's (a torque constant or gear ratio off: the factor is
+fitted beside the load, or on the --unloaded data, and the load's mass divided by it is
+said) is warned about and no setLoad values are written. An inertia whose
 moments lie less than 3 standard deviations above zero, or whose products have a
 standard deviation above a third of their largest possible magnitude, or that the
 consistency constraint set on its bound, is not determined: warned about (naming the
@@ -27,14 +30,14 @@ estimate's spread over 10 held-out time blocks where that is larger (errors of t
 model that vary along the motion).
 
 Writes DIR/payload.json (mass, com [m] in --frame, inertia about the CoM, their std, the
-preprocessing used, and libfranka's setLoad values load_mass, F_x_Cload, load_inertia)
-and the arm carrying the load, for the other commands: with --robot or --params
-DIR/robot_with_payload.toml (what `dynid export` writes of the arm, as TOML: its links,
-the load added to the link of --frame, its friction and drive); with --model
-DIR/model_with_payload.json (an identification.json: its base parameters with the load's,
-its friction, rotor inertias and offsets; base parameters are combinations of the links'
-parameters, which no robot description holds, so no TOML is written). The standard
-deviations in it are the arm's.
+torques' scale against the description, the preprocessing used, and libfranka's setLoad
+values load_mass, F_x_Cload, load_inertia) and the arm carrying the load, for the other
+commands: with --robot or --params DIR/robot_with_payload.toml (what `dynid export`
+writes of the arm, as TOML: its links, the load added to the link of --frame, its
+friction and drive); with --model DIR/model_with_payload.json (an identification.json:
+its base parameters with the load's, its friction, rotor inertias and offsets; base
+parameters are combinations of the links' parameters, which no robot description holds,
+so no TOML is written). The standard deviations in it are the arm's.
 
 example:
   dynid payload --robot panda --data static_with_gripper.csv --out payload
@@ -47,6 +50,7 @@ from pathlib import Path
 from typing import Any
 
 from ..feasibility.payload import PayloadEstimate
+from ..feasibility.payload_scale import SCALE_OFF, SCALE_SIGMAS, TorqueScale
 from ..identification.model import IdentifiedModel
 from ..io.model_json import save_model_json
 from ..io.payload_json import save_payload_json
@@ -194,6 +198,8 @@ def print_payload(console: Console, result: PayloadFileResult, label: str) -> No
             flag = "  not determined" if f"I{name}" in est.undetermined else ""
             console.print(f"  I{name}      {v:+.4e} kg m^2  (std {s:.2g}){flag}")
     console.print(f"  {residual_line(est)}")
+    if est.torque_scale is not None:
+        console.print(f"  {scale_line(est.torque_scale)}")
     if result.recordings:
         console.print(result.describe())
     prep = est.preprocessing
@@ -214,6 +220,23 @@ def print_payload(console: Console, result: PayloadFileResult, label: str) -> No
             f"inertia not determined ({', '.join(est.undetermined)}): setLoad's mass and CoM "
             "written, its inertia not (see the warnings)"
         )
+
+
+def scale_line(t: TorqueScale) -> str:
+    """``torques 1.0002 x the arm description's (std 0.00021, on the loaded data); at the
+    description's scale the load is m / a = 0.8292 kg (std 0.0013); no doubt (a within 5 %
+    or 3 std of 1)``
+    (:attr:`PayloadEstimate.torque_scale`)."""
+    where = "the data without the load" if t.data == "unloaded" else "the loaded data"
+    return (
+        f"torques  {t.value:.4f} x the arm description's (std {t.std:.2g}, on {where}); "
+        f"at the description's scale the load is m / a = {t.mass:.4g} kg (std {t.std_mass:.2g})"
+        + (
+            ""
+            if t.off
+            else f"; no doubt (a within {100 * SCALE_OFF:g} % or {SCALE_SIGMAS:g} std of 1)"
+        )
+    )
 
 
 def residual_line(est: PayloadEstimate) -> str:

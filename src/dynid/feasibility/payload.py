@@ -55,8 +55,12 @@ Doubts (:attr:`PayloadEstimate.doubts`, each also a :class:`~dynid.exceptions.Dy
 a mass less than :data:`MIN_MASS_SIGMAS` standard deviations above zero (no load the data
 can tell from none: unloaded data, or a load too light for them), or a CoM farther from
 the frame than the arm is long (no load the arm carries reaches past its own base; such
-a CoM is the first moment ``m c`` divided by a mass near zero). A doubtful estimate is
-not a load to hand to a controller. An inertia whose elements the data do not determine
+a CoM is the first moment ``m c`` divided by a mass near zero), or torques of another
+scale than the arm description's (:mod:`dynid.feasibility.payload_scale`: a robot or
+feasible parameters, whose links do not come from these sensors; the factor and the load's
+mass divided by it in :attr:`PayloadEstimate.torque_scale`, and in the error when the
+least-squares mass is not positive). A doubtful estimate is not a load to hand to a
+controller. An inertia whose elements the data do not determine
 (:attr:`PayloadEstimate.undetermined`, :mod:`dynid.feasibility.payload_doubts`) is doubted
 on its own (:attr:`PayloadEstimate.inertia_doubts`): the mass and CoM are handed on, the
 inertia is not. The fit's residual is compared with the torque noise left after the
@@ -106,6 +110,7 @@ from .payload_rows import (
     static_load_rows,
     still_joints,
 )
+from .payload_scale import TorqueScale, scale_doubts, torque_scale
 
 __all__ = [
     "PayloadEstimate",
@@ -113,6 +118,14 @@ __all__ = [
     "link_params_from_frame",
     "model_with_payload",
     "robot_with_payload",
+]
+
+
+#: The rows of :func:`~dynid.feasibility.payload_scale.torque_scale`: the targets (the
+#: measured rows minus the description's), the description's rows, the other columns
+#: (the load's ``p`` first), the columns fitted and ``p`` (0: the data without the load).
+_ScaleRows = tuple[
+    NDArray[np.float64], NDArray[np.float64], NDArray[np.float64], NDArray[np.bool_] | None, int
 ]
 
 
@@ -171,6 +184,11 @@ class PayloadEstimate:
         after the low-pass (each piece's white noise per joint through the filter's noise
         gain): the :attr:`residual_rms` of a perfect model. None for static data, or when
         a recording's noise could not be read.
+    torque_scale : TorqueScale or None
+        The factor between the measured torques and the arm description's, with the load's
+        mass at the description's scale (:mod:`dynid.feasibility.payload_scale`); None for
+        an identified model (its scale was fitted to the same sensors) or a description
+        without inertial parameters.
     preprocessing : mapping
         Torque logs: ``cutoff_hz`` [Hz], ``cutoff_source`` (``"given"``, ``"model"``: the
         identification's, ``"motion"``: read from the recordings), ``decimate``,
@@ -211,6 +229,7 @@ class PayloadEstimate:
     undetermined: tuple[str, ...] = ()
     inertia_doubts: tuple[str, ...] = ()
     noise_rms: float | None = None
+    torque_scale: TorqueScale | None = None
 
     @property
     def plausible(self) -> bool:
@@ -306,7 +325,9 @@ def identify_payload(
     RankDeficientError
         The data do not excite the load's parameters (named: a load that never rotates).
     DataError
-        The least-squares mass is not positive (no load, or a wrong model of the arm); a
+        The least-squares mass is not positive (no load, or a wrong model of the arm, or
+        torques of another scale than the arm description's: then named with the load's
+        mass divided by that factor); a
         drive other than the model's; a recording without a piece long enough to filter.
     SolverError
         The constrained problem failed.
@@ -334,26 +355,72 @@ def identify_payload(
     cols = slice(10 * (k - 1), 10 * k)
     kept: NDArray[np.bool_] | None = None
     record: dict[str, Any] = {}
+    described = _description(arm, d, friction)
     if isinstance(data, StaticDataset):
-        if base is None:
-            the_arm, differenced = arm_model(arm, drive=d, friction=friction), False
-        else:
-            the_arm, note = unloaded_arm(kin, base[0], rtol=rtol, drive=d)  # type: ignore[arg-type]
-            differenced = _difference_said(inner, the_arm, note, notes)
-        W, yv, route = static_load_rows(the_arm, data, cols, A, gravity_only, notes)
+        empty = None if base is None else cast(StaticDataset, base[0])
+        W, yv, route, differenced, scale = _static_route(
+            arm, data, empty, d, friction, rtol, cols, A, gravity_only, notes, described
+        )
     else:
         opt = dict(structure=structure, drive=d, friction=friction, cutoff_hz=cutoff_hz)
         opt |= dict(decimate=decimate, max_gap_s=max_gap_s, rtol=rtol)
         logs = cast(list[TorqueLog], list(items))
         without = None if base is None else cast(list[TorqueLog], list(base))
-        W, yv, route, kept, record, differenced = _log_route(
-            arm, logs, names, without, unloaded_names, cols, A, notes, opt
+        W, yv, route, kept, record, differenced, scale = _log_route(
+            arm, logs, names, without, unloaded_names, cols, A, notes, opt, described
         )
-    p = 4 if (static and gravity_only) else 10
+    fit = (W, yv, kept, 4 if (static and gravity_only) else 10, static, rtol, margin)
     route += ", difference" if differenced else ""
-    return _estimate(
-        W, yv, kept, p, static, rtol, margin, kin, frame, route, notes, record, differenced
-    )
+    scale_rows = None if described is None else scale
+    return _estimate(*fit, kin, frame, route, notes, record, differenced, scale_rows, d)
+
+
+def _static_route(
+    arm: Robot | IdentifiedModel | ArmModel,
+    data: StaticDataset,
+    base: StaticDataset | None,
+    drive: Drive | None,
+    friction: ArmFriction,
+    rtol: float | None,
+    cols: slice,
+    A: NDArray[np.float64],
+    gravity_only: bool,
+    notes: list[str],
+    described: ArmModel | None,
+) -> tuple[NDArray[np.float64], NDArray[np.float64], str, bool, _ScaleRows]:
+    """The rows of static data with the arm given or identified from ``base``
+    (:func:`~dynid.feasibility.payload_rows.static_load_rows`), whether the difference
+    method changed the arm, and the rows of the torques' scale against the arm's
+    ``described`` model (on ``base`` when given)."""
+    inner = arm.model if isinstance(arm, ArmModel) else arm
+    if base is None:
+        the_arm, differenced = arm_model(arm, drive=drive, friction=friction), False
+    else:
+        kin = inner.robot if isinstance(inner, IdentifiedModel) else inner
+        the_arm, note = unloaded_arm(kin, base, rtol=rtol, drive=drive)
+        differenced = _difference_said(inner, the_arm, note, notes)
+    W, yv, route, own = static_load_rows(the_arm, data, cols, A, gravity_only, notes)
+    scale: _ScaleRows = (yv, own, W, None, W.shape[1])
+    if base is not None and described is not None:  # on the data without the load
+        _, y0, _, own0 = static_load_rows(described, base, cols, A, gravity_only, [])
+        scale = (y0, own0, np.zeros((y0.size, 0)), None, 0)
+    return W, yv, route, differenced, scale
+
+
+def _description(
+    arm: Robot | IdentifiedModel | ArmModel, drive: Drive | None, friction: ArmFriction
+) -> ArmModel | None:
+    """The arm's description as a whole model (:func:`~dynid.feasibility.payload_arm.arm_model`)
+    when its links do not come from the data's sensors: a robot with inertial parameters
+    and known rotor inertias; None for an identified model (its scale was fitted to the
+    same sensors)."""
+    inner = arm.model if isinstance(arm, ArmModel) else arm
+    if not isinstance(inner, Robot) or not np.any(inner.phi):
+        return None
+    try:
+        return arm_model(arm, drive=drive, friction=friction)
+    except ModelError:  # rotor inertias to identify: the description's torques unknown
+        return None
 
 
 def _estimate(
@@ -370,19 +437,25 @@ def _estimate(
     notes: list[str],
     record: dict[str, Any],
     difference: bool,
+    scale_rows: _ScaleRows | None,
+    drive: Drive | None,
 ) -> PayloadEstimate:
     """The load's estimate from its rows: least squares, consistency, doubts (warned);
-    ``difference``: the arm was identified from unloaded data (its hint differs)."""
+    ``difference``: the arm was identified from unloaded data (its hint differs);
+    ``scale_rows``: the rows of the torques' scale against the arm's description (None:
+    no description, or one identified from these sensors), ``drive`` for its hint."""
     n, k = kin.n, kin.frame(frame).link
     fit = fit_load(W, yv, kept, rtol, p, static)
     est = np.asarray(fit.beta)
     cov = np.asarray(fit.covariance)[:p, :p]
     prep = record.get("preprocessing") or {}
     cols = np.ones(W.shape[1], bool) if kept is None else kept
+    per_period = None
     if prep.get("cutoff_hz"):  # filtered rows: their noise is serially correlated
         rate = prep["sample_rate_hz"] / prep["decimate"]
+        per_period = int(np.ceil(rate / prep["cutoff_hz"]))
         resid = yv - W[:, cols] @ est[cols]
-        factor, lags = serial_correlation_factor(resid, n, int(np.ceil(rate / prep["cutoff_hz"])))
+        factor, lags = serial_correlation_factor(resid, n, per_period)
         cov = cov * factor
         notes.append(
             f"standard deviations widened x{np.sqrt(factor):.3g} for the serial correlation "
@@ -390,9 +463,30 @@ def _estimate(
         )
     if not static:  # static configurations are exchangeable: their blocks spread alike
         cov = _held_out_spread(cov, W[:, cols], yv, n, notes)
-    phi, active, marg = load_parameters(est[:p], float(np.sqrt(cov[0, 0])), W, margin, notes)
+    m_ls, sm_ls = float(est[0]), float(np.sqrt(cov[0, 0]))
+    scale = None
+    if scale_rows is not None:
+        y_s, arm_s, W_s, kept_s, p_s = scale_rows
+        scale = torque_scale(
+            y_s,
+            arm_s,
+            W_s,
+            kept_s,
+            n,
+            p=p_s,
+            lags=per_period,
+            held_out=not static,
+            load=(m_ls, sm_ls),
+        )
+    try:
+        phi, active, marg = load_parameters(est[:p], sm_ls, W, margin, notes)
+    except DataError as exc:  # a mass not positive: the torques' scale may say why
+        said = scale_doubts(scale, m_ls, drive)
+        if not said:
+            raise
+        raise DataError(f"{exc}; {said[0]}") from None
     m, c, I, sm, sc, si = summary(phi, cov, p == 10)
-    doubts = doubts_about(kin, frame, m, sm, c)
+    doubts = doubts_about(kin, frame, m, sm, c) + scale_doubts(scale, m, drive)
     by_std = undetermined_inertia(I, si) if p == 10 and not doubts else ()
     at_bound = active and p == 10 and not doubts  # the bound, not the data, set it
     undetermined = tuple(f"I{name}" for name in INERTIA_ORDER) if at_bound else by_std
@@ -433,6 +527,7 @@ def _estimate(
         doubts=doubts,
         undetermined=undetermined,
         inertia_doubts=about_inertia,
+        torque_scale=scale,
         **record,
     )
 
@@ -481,12 +576,22 @@ def _log_route(
     A: NDArray[np.float64],
     notes: list[str],
     opt: dict[str, Any],
-) -> tuple[NDArray[np.float64], NDArray[np.float64], str, NDArray[np.bool_], dict[str, Any], bool]:
+    described: ArmModel | None,
+) -> tuple[
+    NDArray[np.float64],
+    NDArray[np.float64],
+    str,
+    NDArray[np.bool_],
+    dict[str, Any],
+    bool,
+    _ScaleRows,
+]:
     """The rows of recordings (:func:`~dynid.feasibility.payload_rows.log_rows`) with the
     arm given or identified from ``base``; the preprocessing, recordings and pieces left
     out, for the record (:class:`PayloadEstimate`'s fields); whether the arm identified
-    from ``base`` differs from the one given (the difference method changed it). ``opt``:
-    the options of :func:`identify_payload`."""
+    from ``base`` differs from the one given (the difference method changed it); the rows
+    of the torques' scale against the arm's ``described`` model (on ``base`` when given:
+    :func:`_base_scale`). ``opt``: the options of :func:`identify_payload`."""
     inner = arm.model if isinstance(arm, ArmModel) else arm
     kin = inner.robot if isinstance(inner, IdentifiedModel) else inner
     d = opt["drive"]
@@ -515,9 +620,44 @@ def _log_route(
             rtol=opt["rtol"],
         )
         differenced = _difference_said(inner, the_arm, note, notes)
-    W, yv, route, kept = log_rows(the_arm, rec, still_joints(logs, d), cols, A, notes)
-    record = {"preprocessing": prep, "recordings": rec.summary(), "skipped": rec.skipped}
-    return W, yv, route, kept, record | {"noise_rms": filtered_noise_rms(rec)}, differenced
+    W, yv, route, kept, modelled = log_rows(the_arm, rec, still_joints(logs, d), cols, A, notes)
+    scale: _ScaleRows = (yv, modelled, W, kept, 10)
+    if base is not None and described is not None:
+        scale = _base_scale(described, base, base_names, rec.cutoff_hz, used, cols, A, opt)
+    record: dict[str, Any] = {"preprocessing": prep, "recordings": rec.summary()}
+    record |= {"skipped": rec.skipped, "noise_rms": filtered_noise_rms(rec)}
+    return W, yv, route, kept, record, differenced, scale
+
+
+def _base_scale(
+    described: ArmModel,
+    base: Sequence[TorqueLog],
+    base_names: Sequence[str] | None,
+    cutoff_hz: float | None,
+    decimate: int,
+    cols: slice,
+    A: NDArray[np.float64],
+    opt: dict[str, Any],
+) -> _ScaleRows:
+    """The rows of the torques' scale on the recordings without the load: the description's
+    torques (its whole model, ``described``) and the classical friction per joint, the
+    recordings prepared as the loaded ones (their preparation's warnings said once
+    already, by :func:`~dynid.feasibility.payload_arm.unloaded_arm`)."""
+    kin = described.robot
+    d, gap = opt["drive"], opt["max_gap_s"]
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", DynidWarning)
+        rec = prepare_recordings(
+            kin,
+            list(base),
+            base_names,
+            cutoff_hz=cutoff_hz,
+            max_gap_s=gap,
+            decimate=decimate,
+            drive=d,
+        )
+        W, y, _, kept, own = log_rows(described, rec, still_joints(base, d), cols, A, [])
+    return y, own, W[:, 10:], kept[10:], 0
 
 
 def _difference_said(

@@ -4,7 +4,9 @@
   cannot tell the load from none (unloaded data, or a load too light for them); its CoM
   is then the first moment ``m c`` divided by a mass near zero, and its inertia noise;
 * a CoM farther from the frame than the arm is long (:func:`arm_length`): no load the arm
-  carries reaches past its own base.
+  carries reaches past its own base;
+* measured torques of another scale than the arm description's
+  (:func:`~dynid.feasibility.payload_scale.scale_doubts`): the load carries the factor.
 
 Such an estimate is not handed to a controller (``payload.json`` leaves libfranka's
 ``setLoad`` values out).

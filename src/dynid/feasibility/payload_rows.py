@@ -61,8 +61,9 @@ def static_load_rows(
     A: NDArray[np.float64],
     gravity_only: bool,
     notes: list[str],
-) -> tuple[NDArray[np.float64], NDArray[np.float64], str]:
-    """Regressor rows (in the load's frame parameters) and targets of static data.
+) -> tuple[NDArray[np.float64], NDArray[np.float64], str, NDArray[np.float64]]:
+    """Regressor rows (in the load's frame parameters), targets (measured minus the arm's)
+    and the arm's modelled rows of static data.
 
     Only the load link's 10 columns of the static regressor are computed, a block of
     configurations at a time (a 50-joint arm's full regressor is 5.3 MB a configuration);
@@ -78,14 +79,15 @@ def static_load_rows(
             for a in range(0, q.shape[0], step)
         ]
     )
-    y = static_vector(data.M, data.g) - static_vector(arm.mass_matrix(q), arm.gravity_torques(q))
+    own = static_vector(arm.mass_matrix(q), arm.gravity_torques(q))
+    y = static_vector(data.M, data.g) - own
     route = "static M and g"
     if gravity_only:
         rows = n * (n + 1) // 2
-        Y, y = Y[:, rows:, :4], y[:, rows:]
+        Y, y, own = Y[:, rows:, :4], y[:, rows:], own[:, rows:]
         route = "static g"
         notes.append("g only: mass and CoM identified, the inertia is not")
-    return Y.reshape(-1, Y.shape[-1]), y.reshape(-1), route
+    return Y.reshape(-1, Y.shape[-1]), y.reshape(-1), route, own.reshape(-1)
 
 
 def log_preparation(
@@ -170,11 +172,12 @@ def log_rows(
     cols: slice,
     A: NDArray[np.float64],
     notes: list[str],
-) -> tuple[NDArray[np.float64], NDArray[np.float64], str, NDArray[np.bool_]]:
+) -> tuple[NDArray[np.float64], NDArray[np.float64], str, NDArray[np.bool_], NDArray[np.float64]]:
     """Regressor rows (the load's parameters, then classical friction per joint), targets
-    (measured torques minus the arm's) of prepared recordings, and the columns fitted
+    (measured torques minus the arm's) of prepared recordings, the columns fitted
     (the viscous and Coulomb friction of ``still`` joints are not: their velocity is
-    noise, taken as zero). The rows are held whole (``N n`` rows of ``10 + 3 n``
+    noise, taken as zero), and the arm's torques subtracted [N m] (its friction included
+    when subtracted). The rows are held whole (``N n`` rows of ``10 + 3 n``
     columns), not the ``10 n`` columns of every link.
 
     The arm's own friction is kept in its torques when the rows explain the targets with
@@ -186,7 +189,7 @@ def log_rows(
     n = robot.n
     classical = LinearFriction(Drive.identity(n))
     own = None if arm.friction is None else _ArmFriction(arm.friction, still)
-    Ws, ys, fs = [], [], []
+    Ws, ys, fs, taus = [], [], [], []
     for piece in data.pieces:
         log = piece.log
         assert log.ddq is not None  # prepared logs are differentiated
@@ -194,7 +197,8 @@ def log_rows(
         Y = _load_columns(robot, q, dq, ddq, cols, A)
         Y = np.concatenate([Y, stepped_columns(classical, log, **piece.filtering)], axis=-1)
         Ws.append(Y.reshape(-1, Y.shape[-1]))
-        ys.append((np.asarray(log.tau) - arm.torques(q, dq, ddq, with_friction=False)).ravel())
+        taus.append(np.asarray(log.tau).ravel())
+        ys.append(taus[-1] - arm.torques(q, dq, ddq, with_friction=False).ravel())
         if own is not None:
             fs.append(stepped_columns(own, log, **piece.filtering).ravel())
     kept = np.ones(Ws[0].shape[-1], dtype=bool)
@@ -219,7 +223,7 @@ def log_rows(
         )
     k = len(data.names)
     route = "torque log" if k == 1 else f"{k} torque logs"
-    return W, y, route, kept
+    return W, y, route, kept, np.concatenate(taus) - y
 
 
 def filtered_noise_rms(data: Recordings) -> float | None:

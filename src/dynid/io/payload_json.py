@@ -12,6 +12,8 @@
      "condition_number": ..., "residual_rms": ..., "noise_rms": ... | null,
      "n_rows": ..., "notes": [...], "plausible": true, "doubts": [...],
      "inertia_determined": true, "undetermined_inertia": ["Izz", ...],
+     "torque_scale": {"value": ..., "std": ..., "mass": ..., "std_mass": ...,
+                      "data": "loaded"} | null,
      "preprocessing": {"cutoff_hz": ..., "cutoff_source": "model", "decimate": ...,
                        "max_gap_s": null} | null,
      "recordings": [{"file": ..., "pieces": ..., "samples": ..., "duration_s": ...}],
@@ -25,10 +27,18 @@ the flange's link and its mass and CoM are not in doubt; null otherwise (and
 ``load_inertia`` null when the inertia was not identified or the data do not determine
 it). ``doubts`` says why an estimate is not plausible
 (:mod:`dynid.feasibility.payload_doubts`: a mass not significantly above zero, a CoM
-farther than the arm is long: such a load is not handed to a controller; inertia elements
+farther than the arm is long, torques of another scale than the arm description's
+(``torque_scale``): such a load is not handed to a controller; inertia elements
 not determined, ``undetermined_inertia``: its inertia is not). ``residual_rms`` [N m for
 torque logs] is the fit's, ``noise_rms`` [N m] what the torque noise alone leaves after
 the low-pass (null for static data).
+``torque_scale`` is the factor ``value`` [1] (with its ``std``) between the measured
+torques and the arm description's (:mod:`dynid.feasibility.payload_scale`), fitted on the
+``loaded`` data beside the load or on the data without it (``unloaded``), and the load's
+``mass`` [kg] (``std_mass``) if the description is right (the torques divided by the
+factor); null with an identified model (its scale was fitted to the same sensors) or a
+description without inertial parameters. A factor more than 5 % and 3 standard deviations
+from 1 is a doubt.
 ``preprocessing`` is how torque logs were prepared (cut-off [Hz] and where it came from:
 ``given``, ``model`` (the identification's) or ``motion``; decimation; longest gap
 bridged [s], null for the default rule); null for static data. Floats use Python's
@@ -107,6 +117,7 @@ def payload_to_dict(
             "doubts": list(est.doubts + est.inertia_doubts),
             "inertia_determined": est.inertia_determined,
             "undetermined_inertia": list(est.undetermined),
+            "torque_scale": _scale(est),
             "preprocessing": dict(est.preprocessing) or None,
             "recordings": [dict(r) for r in est.recordings],
             "units": {
@@ -115,6 +126,7 @@ def payload_to_dict(
                 "inertia": "kg m^2",
                 "residual_rms": "N m (torque logs); the rows' SI units (static data)",
                 "noise_rms": "N m",
+                "torque_scale": "value, std: 1; mass, std_mass: kg",
             },
             "conventions": {
                 "com": f"centre of mass in frame {est.frame!r}",
@@ -128,6 +140,20 @@ def payload_to_dict(
         }
     )
     return d
+
+
+def _scale(est: PayloadEstimate) -> dict[str, Any] | None:
+    """``torque_scale`` of the document (module docstring), or None."""
+    t = est.torque_scale
+    if t is None:
+        return None
+    return {
+        "value": _num(t.value),
+        "std": _num(t.std),
+        "mass": _num(t.mass),
+        "std_mass": _num(t.std_mass),
+        "data": t.data,
+    }
 
 
 def save_payload_json(

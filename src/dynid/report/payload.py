@@ -12,7 +12,8 @@ the data do not determine (``undetermined_inertia`` of ``payload.json``). The le
   physical-consistency constraint active (the least-squares estimate was not a body);
 * good otherwise.
 
-The residual is given in N m beside that noise (``noise_rms``) for torque logs.
+The residual is given in N m beside that noise (``noise_rms``) for torque logs, and the
+measured torques' scale against the arm description's (``torque_scale``) when known.
 """
 
 from __future__ import annotations
@@ -57,6 +58,9 @@ def payload_answer(run: RunFiles) -> Answer | None:
         f"From {esc(doc.get('route', ''))}: rank {cell(doc.get('rank'))}, condition number "
         f"{cell(doc.get('condition_number'))}",
     ]
+    scale = _scale_fact(doc)
+    if scale:
+        facts.append(scale)
     if doc.get("inertia_identified") is False:
         facts.append("Inertia not identified from these data (mass and CoM only)")
     head = _headline(doc, std, rel, undetermined)
@@ -92,6 +96,18 @@ def _residual_fact(doc: dict[str, Any]) -> str:
     static_m = str(doc.get("route", "")).startswith("static M")
     unit = " (rows of M [kg m^2] and g [N m])" if static_m else " N m"
     return f"Residual RMS {cell(r)}{esc(unit)}"
+
+
+def _scale_fact(doc: dict[str, Any]) -> str | None:
+    """The measured torques against the arm description's (``torque_scale``), or None."""
+    t = doc.get("torque_scale")
+    if not isinstance(t, dict) or not is_number(t.get("value")):
+        return None
+    where = "the data without the load" if t.get("data") == "unloaded" else "the loaded data"
+    return (
+        f"Measured torques {number(t['value'], 4)} x the arm description's (std "
+        f"{cell(t.get('std'))}, on {where})"
+    )
 
 
 def _headline(

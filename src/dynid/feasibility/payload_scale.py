@@ -1,0 +1,183 @@
+"""The scale of the measured torques against an arm description's: a factor the load carries.
+
+A torque constant or gear ratio off by a factor ``a`` (a servo's current-to-torque
+constant), or a sensor of another scale, makes every measured torque ``a`` times the true
+one, the load's included: the load's mass comes out ``a`` times too large, and the fit
+does not show it (its columns absorb the factor). An arm description whose links do not
+come from these torques (a robot file, a ``feasible.json``) tells it: the measured
+quantities are ``a`` times its modelled ones ``y_arm`` (rigid body, rotors, and the
+friction subtracted) plus the load's and the friction's,
+
+.. math:: y = a \\, y_{arm} + Y A \\phi' \\; (+ F f), \\qquad \\phi' = a \\phi,
+
+fitted with the column ``y_arm`` beside the load's (:func:`torque_scale`): the fit of the
+target ``y - y_arm`` of the load's estimate with one column more, its coefficient
+``a - 1``. The load's estimate is not changed (the factor is only a doubt): with the
+difference method (data without the load), ``a`` is fitted on those data alone,
+``y_0 = a y_{0,arm} (+ F f)``, where no load's column shares it. An identified model's
+scale was fitted to the same sensors: it tells nothing, and no factor is estimated.
+
+Standard deviations as the load's (:mod:`dynid.feasibility.payload`): HC1, widened for
+filtered rows' serial correlation (Newey-West) and to the spread over held-out time blocks
+where that is larger. :func:`scale_doubts` says when the factor differs from 1 by more
+than :data:`SCALE_OFF` and :data:`SCALE_SIGMAS` of its standard deviations.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+from numpy.typing import NDArray
+
+from ..exceptions import RankDeficientError
+from ..identification.least_squares import fit_least_squares
+from ..model.drive import Drive
+from .payload_fit import block_jackknife_covariance, serial_correlation_factor
+
+__all__ = ["SCALE_OFF", "SCALE_SIGMAS", "TorqueScale", "scale_doubts", "torque_scale"]
+
+#: Relative distance from 1 of a factor that makes a doubt.
+SCALE_OFF = 0.05
+#: Standard deviations by which the factor must differ from 1 to make a doubt.
+SCALE_SIGMAS = 3.0
+
+
+@dataclass(frozen=True, slots=True)
+class TorqueScale:
+    """The factor between the measured torques and the arm description's.
+
+    Attributes
+    ----------
+    value : float
+        ``a`` [1]: measured = ``a`` x modelled.
+    std : float
+        Its standard deviation [1].
+    mass : float
+        The load's mass [kg] if the description is right: the torques divided by ``a``
+        (the fit's load mass with the factor, or the difference method's, over ``a``).
+    std_mass : float
+        Its standard deviation [kg] (first order).
+    data : str
+        ``"loaded"`` (fitted beside the load's columns) or ``"unloaded"`` (on the data
+        without the load).
+    """
+
+    value: float
+    std: float
+    mass: float
+    std_mass: float
+    data: str
+
+    @property
+    def off(self) -> bool:
+        """``a`` differs from 1 by more than :data:`SCALE_OFF` and :data:`SCALE_SIGMAS`
+        standard deviations."""
+        d = abs(self.value - 1.0)
+        return d > SCALE_OFF and d > SCALE_SIGMAS * self.std
+
+
+def torque_scale(
+    y: NDArray[np.float64],
+    y_arm: NDArray[np.float64],
+    W: NDArray[np.float64],
+    kept: NDArray[np.bool_] | None,
+    n: int,
+    *,
+    p: int,
+    lags: int | None,
+    held_out: bool,
+    load: tuple[float, float] | None = None,
+) -> TorqueScale | None:
+    """The factor ``a`` of ``y + y_arm = a y_arm + W x`` (module docstring).
+
+    Parameters
+    ----------
+    y : ndarray, shape (m,)
+        The measured rows minus the description's ``y_arm`` [SI of the rows].
+    y_arm : ndarray, shape (m,)
+        The description's modelled rows.
+    W : ndarray, shape (m, c)
+        The other columns: the load's ``p`` first (``p = 0``: data without the load),
+        then the friction's.
+    kept : ndarray of bool, shape (c,), optional
+        The columns of ``W`` fitted.
+    n : int
+        Rows per sample.
+    p : int
+        The load's columns in ``W``; its mass is the first.
+    lags : int, optional
+        Filtered rows: the Newey-West lags (the samples per cut-off period); None: none.
+    held_out : bool
+        Widen to the spread over held-out time blocks (torque logs).
+    load : (float, float), optional
+        ``p = 0``: the load's mass [kg] and its standard deviation, divided by ``a``.
+
+    Returns
+    -------
+    TorqueScale or None
+        None when the description models no torques (no inertial parameters) or the
+        columns do not determine ``a`` (rank deficient).
+    """
+    if not np.any(y_arm) or (p == 0 and load is None):
+        return None
+    A = np.concatenate([y_arm[:, None], W], axis=1)
+    used = np.ones(A.shape[1], dtype=bool)
+    if kept is not None:
+        used[1:] = kept
+    try:
+        fit = fit_least_squares(A, y, kept=used, rtol=1e-10, std="robust")
+    except RankDeficientError:
+        return None
+    beta = np.asarray(fit.beta)
+    cov = np.asarray(fit.covariance)
+    if lags:
+        factor, _ = serial_correlation_factor(y - A[:, used] @ beta[used], n, lags)
+        cov = cov * factor
+    if held_out:
+        jack = block_jackknife_covariance(A[:, used], y, n)
+        if jack is not None:
+            full = np.zeros_like(cov)
+            full[np.ix_(used, used)] = jack
+            widen = np.sqrt(
+                np.maximum(1.0, np.diag(full) / np.where(np.diag(cov) > 0, np.diag(cov), np.inf))
+            )
+            cov = cov * np.outer(widen, widen)
+    a = 1.0 + float(beta[0])
+    if p:
+        x = float(beta[1])
+        grad = np.array([-x / a**2, 1.0 / a])
+        mass, std_mass = x / a, float(np.sqrt(max(grad @ cov[:2, :2] @ grad, 0.0)))
+    else:
+        m, sm = load or (np.nan, np.nan)  # given with p = 0 (checked above)
+        mass = m / a
+        std_mass = float(np.hypot(sm / a, m * np.sqrt(cov[0, 0]) / a**2))
+    std = float(np.sqrt(max(cov[0, 0], 0.0)))
+    return TorqueScale(a, std, mass, std_mass, "loaded" if p else "unloaded")
+
+
+def scale_doubts(
+    scale: TorqueScale | None, mass: float, drive: Drive | None = None
+) -> tuple[str, ...]:
+    """The doubt about a load of ``mass`` [kg] whose torques are ``scale.value`` times the
+    description's (:attr:`TorqueScale.off`), with the remedy as the user gives it (a drive
+    of currents: its ``torque_constant``; else ``--units tau=``); empty when none."""
+    if scale is None or not scale.off:
+        return ()
+    a = scale.value
+    where = "the data without the load" if scale.data == "unloaded" else "the loaded data"
+    if drive is not None and drive.effort == "current":
+        remedy = f"multiply the drive file's torque_constant by {1 / a:.4g}"
+    elif drive is not None and not drive.is_identity:
+        remedy = (
+            f"check the drive file's gear_ratio, or read the torques with --units tau={1 / a:.4g}"
+        )
+    else:
+        remedy = f"read the torques with --units tau={1 / a:.4g}"
+    return (
+        f"the measured torques are {a:.4g} x the arm model's (std {scale.std:.2g}, on "
+        f"{where}): a torque constant or gear ratio off by that factor, or the arm's "
+        f"masses are; if the arm's description is right, the load is m / a = "
+        f"{scale.mass:.4g} kg (std {scale.std_mass:.2g}), not {mass:.4g} kg; hint: {remedy}, "
+        "or fix the arm's masses",
+    )

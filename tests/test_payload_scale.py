@@ -1,0 +1,173 @@
+"""The measured torques' scale against the arm description's, in payload identification.
+
+References: the published Panda (Gaz et al. 2019) carrying a known load (``Robot.with_tool``),
+its simulated static data and torque logs with every measured torque (and ``M``) scaled by
+a known factor, 0.834 (a servo's current-to-torque constant off), or 1: the factor and the
+load's mass divided by it are compared with that truth.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import json
+
+import numpy as np
+import pytest
+from test_payload import COM, MASS, _inertia, _static
+
+import dynid
+from dynid.cli.__main__ import main
+from dynid.exceptions import DataError
+from dynid.feasibility.payload import identify_payload
+from dynid.feasibility.payload_scale import TorqueScale, scale_doubts
+from dynid.identification.structure import Structure
+from dynid.io.payload_json import payload_to_dict
+from dynid.io.static_data import save_static_csv
+from dynid.model.drive import Drive
+from dynid.simulation.measurement import simulate_measurement
+from dynid.simulation.trajectories import random_fourier, uniform_times
+
+from conftest import said_warnings
+
+SCALE = 0.834
+ARM = dynid.panda()
+LOADED = ARM.with_tool(np.eye(4), MASS, COM, _inertia(), name="load")
+
+
+def _scaled(data, a):
+    """Static data with ``M`` and ``g`` times ``a``."""
+    return dataclasses.replace(data, M=data.M * a, g=data.g * a)
+
+
+def _log(robot, seed, a):
+    """6 s at 200 Hz of ``robot`` with its own friction and sensor noise, torques times ``a``."""
+    traj = random_fourier(ARM, np.random.default_rng(seed), q0=dynid.PANDA_NEUTRAL_Q)(
+        uniform_times(6.0, 200.0)
+    )
+    log = simulate_measurement(robot, traj, rng=np.random.default_rng(seed + 1))
+    return dataclasses.replace(log, tau=log.tau * a)
+
+
+def _said_scale(doubts):
+    """The doubts that speak of the torques' scale."""
+    return [d for d in doubts if "x the arm model's" in d]
+
+
+def _check(scale, mass, tol):
+    """The factor within 3 of its std of SCALE, and the load's mass at that scale within
+    3 of its std of the truth, its std under ``tol`` of it."""
+    assert abs(scale.value - SCALE) < 3 * scale.std and scale.std < 0.002
+    assert abs(scale.mass - MASS) < max(3 * scale.std_mass, 1e-3) and scale.std_mass < tol * MASS
+    assert abs(mass - SCALE * MASS) < 0.02 * MASS  # the difference method's load carries it
+
+
+def test_static_difference_method_doubts_torques_scaled_by_0834():
+    """Regression (torques 0.834 x the true ones gave a load 17 % light without a word):
+    static M, g with and without the load, both scaled: the factor 0.834 is found within
+    its std, a doubt names it and m / a, and setLoad's values are not written."""
+    data = _scaled(_static(LOADED, 100, 1e-3, 1), SCALE)
+    unloaded = _scaled(_static(ARM, 100, 1e-3, 2), SCALE)
+    est, said = said_warnings(identify_payload, ARM, data, unloaded=unloaded)
+    _check(est.torque_scale, est.mass, 0.002)
+    assert est.torque_scale.data == "unloaded" and _said_scale(est.doubts)
+    assert any(f"m / a = {est.torque_scale.mass:.4g} kg" in w for w in said)
+    assert "--units tau=1.199" in _said_scale(est.doubts)[0]
+    d = payload_to_dict(est, ARM)
+    assert d["load_mass"] is None and not d["plausible"]
+    assert d["torque_scale"]["value"] == pytest.approx(est.torque_scale.value)
+
+
+def test_static_data_scaled_by_0834_name_the_factor_when_the_mass_is_not_positive():
+    """Static M, g with the load only, scaled by 0.834: the arm's torques left over make the
+    load's mass negative; the error names the factor (fitted beside the load) and m / a
+    within 1 % of the true mass."""
+    data = _scaled(_static(LOADED, 100, 1e-3, 1), SCALE)
+    with pytest.raises(DataError, match=r"not positive.*the measured torques are 0\.83") as exc:
+        identify_payload(ARM, data)
+    m = float(str(exc.value).split("m / a = ")[1].split(" kg")[0])
+    assert abs(m - MASS) < 0.01 * MASS and "on the loaded data" in str(exc.value)
+
+
+def test_static_data_scaled_by_092_keep_a_positive_mass_and_are_doubted():
+    """Static g only, scaled by 0.92: the load comes out far too light, the factor 0.92 is
+    found beside it within 3 of its std and m / a is the true mass to 1 %."""
+    a = 0.92
+    est, said = said_warnings(
+        identify_payload, ARM, _scaled(_static(LOADED, 100, 1e-3, 3), a), gravity_only=True
+    )
+    t = est.torque_scale
+    assert est.mass < 0.7 * MASS and abs(t.value - a) < 3 * t.std
+    assert abs(t.mass - MASS) < 0.01 * MASS and t.data == "loaded"
+    assert _said_scale(est.doubts) and any("x the arm model's" in w for w in said)
+
+
+def test_torque_logs_scaled_by_0834_are_doubted_on_the_unloaded_log():
+    """Torque logs with and without the load, torques 0.834 x the true ones (difference
+    method, structure given): the factor within its std, the doubt, m / a the true mass;
+    without --unloaded the error names the factor."""
+    loaded, unloaded = _log(LOADED, 1, SCALE), _log(ARM, 5, SCALE)
+    est, _ = said_warnings(
+        identify_payload,
+        ARM,
+        loaded,
+        unloaded=unloaded,
+        structure=Structure.parse("viscous,coulomb,offset"),
+    )
+    _check(est.torque_scale, est.mass, 0.02)
+    assert _said_scale(est.doubts)
+    with pytest.raises(DataError, match=r"the measured torques are 0\.83\d* x the arm model's"):
+        identify_payload(ARM, loaded)
+
+
+def test_exact_scale_with_noise_gives_no_doubt():
+    """Torques at their true scale with noise (static M, g and a torque log): the factor is
+    1 within 3 of its std and no doubt is given."""
+    static = identify_payload(ARM, _static(LOADED, 100, 1e-3, 4))
+    log, said = said_warnings(identify_payload, ARM, _log(LOADED, 7, 1.0))
+    for est in (static, log):
+        t = est.torque_scale
+        assert abs(t.value - 1.0) < 3 * t.std and not _said_scale(est.doubts)
+        assert abs(t.mass - MASS) < max(3 * t.std_mass, 0.01 * MASS)
+    assert not any("x the arm model's" in w for w in said)
+
+
+def test_an_identified_model_says_nothing_of_the_scale():
+    """An arm identified from the same sensors (torques 0.834 x the true ones): its scale
+    is theirs, no factor is estimated and no doubt given (the load is 0.834 x its mass)."""
+    model = dynid.identify_static(ARM, _scaled(_static(ARM, 150, 0.0, 6), SCALE))
+    est = identify_payload(model, _scaled(_static(LOADED, 100, 1e-3, 1), SCALE))
+    assert est.torque_scale is None and not _said_scale(est.doubts)
+    assert abs(est.mass - SCALE * MASS) < 0.01 * MASS
+    assert payload_to_dict(est, ARM)["torque_scale"] is None
+
+
+def test_cli_payload_prints_and_records_the_scale(tmp_path, capsys):
+    """dynid payload --robot panda on static data scaled by 0.834 with --unloaded: the
+    warning, the printed factor and m / a, payload.json's torque_scale, the report's line."""
+    save_static_csv(tmp_path / "with.csv", _scaled(_static(LOADED, 60, 1e-3, 1), SCALE))
+    save_static_csv(tmp_path / "without.csv", _scaled(_static(ARM, 60, 1e-3, 2), SCALE))
+    args = ["payload", "--robot", "panda", "--data", str(tmp_path / "with.csv")]
+    args += ["--unloaded", str(tmp_path / "without.csv"), "--out", str(tmp_path / "out")]
+    assert main(args) == 0
+    said = capsys.readouterr()
+    assert "warning: the measured torques are 0.834 x the arm model's" in said.err
+    assert "x the arm description's" in said.out and "m / a = " in said.out
+    doc = json.loads((tmp_path / "out" / "payload.json").read_text())
+    t = doc["torque_scale"]
+    assert abs(t["value"] - SCALE) < 3 * t["std"] and t["data"] == "unloaded"
+    assert abs(t["mass"] - MASS) < 0.01 * MASS and doc["load_mass"] is None
+    page = (tmp_path / "out" / "report.html").read_text()
+    assert "x the arm description&#x27;s" in page or "x the arm description's" in page
+
+
+def test_the_hint_names_the_drive_files_torque_constant_for_currents():
+    """Through a drive of currents the doubt's hint is the torque constant times 1 / a; at
+    4.9 % or within 3 std of 1 there is no doubt."""
+    drive = dataclasses.replace(Drive.identity(7), effort="current", torque_constant=np.ones(7))
+    off = TorqueScale(0.834, 0.001, 0.83, 0.01, "loaded")
+    (line,) = scale_doubts(off, 0.69, drive)
+    assert "multiply the drive file's torque_constant by 1.199" in line
+    assert "m / a = 0.83 kg" in line and "not 0.69 kg" in line
+    assert "--units tau=1.199" in scale_doubts(off, 0.69)[0]
+    assert not scale_doubts(TorqueScale(0.951, 0.001, 0.83, 0.01, "loaded"), 0.5)
+    assert not scale_doubts(TorqueScale(0.9, 0.04, 0.83, 0.01, "loaded"), 0.5)
