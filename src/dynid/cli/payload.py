@@ -199,7 +199,7 @@ def print_payload(console: Console, result: PayloadFileResult, label: str) -> No
             console.print(f"  I{name}      {v:+.4e} kg m^2  (std {s:.2g}){flag}")
     console.print(f"  {residual_line(est)}")
     if est.torque_scale is not None:
-        console.print(f"  {scale_line(est.torque_scale)}")
+        console.print(f"  {scale_line(est.torque_scale, est.mass)}")
     if result.recordings:
         console.print(result.describe())
     prep = est.preprocessing
@@ -222,10 +222,11 @@ def print_payload(console: Console, result: PayloadFileResult, label: str) -> No
         )
 
 
-def scale_line(t: TorqueScale) -> str:
+def scale_line(t: TorqueScale, mass: float) -> str:
     """``torques 1.0002 x the arm description's (std 0.00021, on the loaded data); at the
-    description's scale the load is m / a = 0.8292 kg (std 0.0013); no doubt (a within 5 %
-    or 3 std of 1)``
+    description's scale the load is m / a = 0.8292 kg (std 0.0013); no doubt (a within 3
+    std of 1, or within 5 % and the load's mass too)`` (``mass``: the load's estimate [kg],
+    :meth:`TorqueScale.off`)
     (:attr:`PayloadEstimate.torque_scale`)."""
     where = "the data without the load" if t.data == "unloaded" else "the loaded data"
     return (
@@ -233,8 +234,9 @@ def scale_line(t: TorqueScale) -> str:
         f"at the description's scale the load is m / a = {t.mass:.4g} kg (std {t.std_mass:.2g})"
         + (
             ""
-            if t.off
-            else f"; no doubt (a within {100 * SCALE_OFF:g} % or {SCALE_SIGMAS:g} std of 1)"
+            if t.off(mass)
+            else f"; no doubt (a within {SCALE_SIGMAS:g} std of 1, or within "
+            f"{100 * SCALE_OFF:g} % and the load's mass too)"
         )
     )
 

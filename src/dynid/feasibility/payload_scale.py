@@ -20,7 +20,9 @@ scale was fitted to the same sensors: it tells nothing, and no factor is estimat
 Standard deviations as the load's (:mod:`dynid.feasibility.payload`): HC1, widened for
 filtered rows' serial correlation (Newey-West) and to the spread over held-out time blocks
 where that is larger. :func:`scale_doubts` says when the factor differs from 1 by more
-than :data:`SCALE_OFF` and :data:`SCALE_SIGMAS` of its standard deviations.
+than :data:`SCALE_SIGMAS` of its standard deviations and either by more than
+:data:`SCALE_OFF` or by enough to move the load's mass by more than that share
+(:meth:`TorqueScale.off`).
 """
 
 from __future__ import annotations
@@ -69,12 +71,19 @@ class TorqueScale:
     std_mass: float
     data: str
 
-    @property
-    def off(self) -> bool:
-        """``a`` differs from 1 by more than :data:`SCALE_OFF` and :data:`SCALE_SIGMAS`
-        standard deviations."""
+    def off(self, mass: float) -> bool:
+        """``a`` differs from 1 by more than :data:`SCALE_SIGMAS` standard deviations, and
+        by more than :data:`SCALE_OFF` or enough to move the load's estimated ``mass`` [kg]
+        from :attr:`mass` by more than :data:`SCALE_OFF` of it and :data:`SCALE_SIGMAS` of
+        its standard deviations (without data free of the load, a factor of 0.95 moved a
+        0.83 kg load to 0.50 kg: the arm's torques, not the load's, carry the factor)."""
         d = abs(self.value - 1.0)
-        return d > SCALE_OFF and d > SCALE_SIGMAS * self.std
+        if not d > SCALE_SIGMAS * self.std:
+            return False
+        shift = abs(mass - self.mass)
+        return d > SCALE_OFF or (
+            shift > SCALE_OFF * abs(self.mass) and shift > SCALE_SIGMAS * self.std_mass
+        )
 
 
 def torque_scale(
@@ -160,9 +169,9 @@ def scale_doubts(
     scale: TorqueScale | None, mass: float, drive: Drive | None = None
 ) -> tuple[str, ...]:
     """The doubt about a load of ``mass`` [kg] whose torques are ``scale.value`` times the
-    description's (:attr:`TorqueScale.off`), with the remedy as the user gives it (a drive
+    description's (:meth:`TorqueScale.off`), with the remedy as the user gives it (a drive
     of currents: its ``torque_constant``; else ``--units tau=``); empty when none."""
-    if scale is None or not scale.off:
+    if scale is None or not scale.off(mass):
         return ()
     a = scale.value
     where = "the data without the load" if scale.data == "unloaded" else "the loaded data"
