@@ -188,5 +188,11 @@ def scale_doubts(
         f"{where}): a torque constant or gear ratio off by that factor, or the arm's "
         f"masses are; if the arm's description is right, the load is m / a = "
         f"{scale.mass:.4g} kg (std {scale.std_mass:.2g}), not {mass:.4g} kg; hint: {remedy}, "
-        "or fix the arm's masses",
+        "or fix the arm's masses"
+        + (
+            ", or record the same motions without the load and give them with --unloaded "
+            "(the arm is then identified from them)"
+            if scale.data == "loaded"
+            else ""
+        ),
     )
