@@ -19,6 +19,7 @@ from dynid.exceptions import DynidWarning
 from dynid.friction.model import ClassicalFriction
 from dynid.identification.residual_dependence import (
     dependence_hint,
+    held_terms,
     outside_model_note,
     residual_dependence,
 )
@@ -26,6 +27,7 @@ from dynid.identification.sanity import opposite_sign
 from dynid.identification.selection import identify_recordings
 from dynid.identification.structure import Structure
 from dynid.io.torque_log import save_torque_log
+from dynid.model.stiffness import JointStiffness
 from dynid.simulation.measurement import SensorNoise
 from dynid.workflows.identify import IdentifyOptions, identify_files
 from dynid.workflows.validate import ValidateOptions, validate_files
@@ -181,3 +183,32 @@ def test_a_stiff_spring_is_not_called_a_flipped_torque_sign(panda):
     tau[:, 1] *= -1.0
     said = opposite_sign(panda, replace(plain, tau=tau))
     assert said is not None and "tau2=-1" in said and "joint2" in said, said
+
+
+def test_the_remedy_names_only_what_the_model_lacks(panda):
+    """Regression (a model fitted with --terms viscous,coulomb,spring was told "try adding
+    spring to --terms", and validate and identify were told of --friction-model, an option
+    of dynid friction alone): a residual that follows the position asks for the spring
+    where the model has none, for the offset that places a spring's rest position where it
+    has the spring without one, and for neither where it has both; the terms are read off
+    an identified model and a robot."""
+    rng = np.random.default_rng(3)
+    q = rng.uniform(-1.0, 1.0, (4000, 1))
+    dq = rng.normal(0.0, 0.5, (4000, 1))
+    e = 0.8 * q + rng.normal(0.0, 0.1, (4000, 1))
+    said = {
+        terms: dependence_hint([q], [dq], [e], np.array([0.1]), ["j"], terms)
+        for terms in ((), ("spring",), ("spring", "offset"))
+    }
+    assert "spring to --terms of dynid identify" in said[()]
+    assert "add offset to --terms" in said[("spring",)] and "adding spring" not in said[("spring",)]
+    assert (
+        "linear spring" in said[("spring", "offset")]
+        and "--terms" not in said[("spring", "offset")]
+    )
+    v = dependence_hint(
+        [q], [q * 0 + dq], [0.8 * np.tanh(dq / 0.1) + e - 0.8 * q], np.array([0.1]), ["j"]
+    )
+    assert "dynid friction compares the laws" in v and "--friction-model" not in v
+    assert held_terms(panda) == frozenset()
+    assert held_terms(panda.with_spring(JointStiffness(np.ones(7), np.zeros(7)))) == {"spring"}

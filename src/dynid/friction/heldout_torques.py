@@ -48,6 +48,7 @@ from ..identification.model import IdentifiedModel
 from ..identification.pieces import split_at_gaps, unwrapped, wrappable
 from ..identification.residual_dependence import (
     Dependence,
+    held_terms,
     residual_dependence,
     with_dependence_hint,
 )
@@ -93,6 +94,10 @@ class HeldOutTorques:
         The variance [N^2 m^2] the held-out states' noise puts into the prediction at every
         k-th sample (:func:`~dynid.identification.floor_verdict.prediction_input_noise`);
         None: not known (the floor is the sensors' noise alone).
+    terms : frozenset of str
+        The names of the terms the model holds beside the rigid bodies
+        (:func:`~dynid.identification.residual_dependence.held_terms`): the remedies of the
+        verdict name only what it lacks.
     """
 
     validation: Validation
@@ -104,6 +109,7 @@ class HeldOutTorques:
     caveat: str | None = None
     spikes: int = 0
     inputs: tuple[tuple[int, NDArray[np.float64]], ...] | None = None
+    terms: frozenset[str] = frozenset()
 
     def _judged(self) -> tuple[Verdict, NoiseFloor]:
         """:func:`~dynid.identification.floor_verdict.judged_prediction` of the held-out
@@ -148,7 +154,13 @@ class HeldOutTorques:
         verdict, fl = self._judged()
         v = self.validation
         verdict = with_dependence_hint(
-            verdict, [v.log.q], [v.log.dq], [v.log.tau - v.tau_hat], fl.total_rms, self.joint_names
+            verdict,
+            [v.log.q],
+            [v.log.dq],
+            [v.log.tau - v.tau_hat],
+            fl.total_rms,
+            self.joint_names,
+            self.terms,
         )
         verdict = with_derived_cutoff_hint(verdict, self.logs, self.cutoff_hz)
         verdict = with_hint(verdict, self.low_speed, ", ")
@@ -360,7 +372,9 @@ def _held_out(
     )
     names = tuple(model.robot.joint_names)
     given = None if model.info.log.cutoff_source == "motion" else model.info.log.cutoff_hz
-    return HeldOutTorques(v, noise, block, names, read, given, caveat, spikes, inputs)
+    return HeldOutTorques(
+        v, noise, block, names, read, given, caveat, spikes, inputs, held_terms(model)
+    )
 
 
 def _input_noise(

@@ -19,18 +19,24 @@ the velocity little.
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+from collections.abc import Collection, Sequence
 from dataclasses import dataclass
+from typing import TYPE_CHECKING
 
 import numpy as np
 from numpy.typing import NDArray
 
+from ..model.robot import Robot
 from .verdict import SYSTEMATIC_RATIO, Verdict, with_hint
+
+if TYPE_CHECKING:
+    from .model import IdentifiedModel
 
 __all__ = [
     "BINS",
     "Dependence",
     "dependence_hint",
+    "held_terms",
     "outside_model_note",
     "residual_dependence",
     "with_dependence_hint",
@@ -136,19 +142,31 @@ def residual_dependence(
     return tuple(out)
 
 
-def _sentence(d: Dependence, name: str) -> str:
-    """One joint's diagnosis in words."""
+def _sentence(d: Dependence, name: str, terms: Collection[str] = ()) -> str:
+    """One joint's diagnosis in words; ``terms`` the model's term names (:func:`held_terms`),
+    so that the remedy names what the model lacks, not what it holds."""
     head = f"{name}: "
     if d.position >= d.velocity and d.position >= FOLLOWS * d.systematic:
+        if "spring" not in terms:
+            why = (
+                "a spring, a cable or a counterbalance outside the rigid-body model; try adding "
+                "spring to --terms of dynid identify, with offset: the spring's rest position"
+            )
+        elif "offset" not in terms:
+            why = (
+                "the model's spring acts about the middle of the joint's limits: add offset to "
+                "--terms of dynid identify so that its rest position is identified"
+            )
+        else:
+            why = "beyond the model's linear spring: a spring that is not linear, a cable"
         return (
-            f"{head}{d.position:.2g} of {d.rms:.2g} N m RMS residual follows its position (a "
-            "spring, a cable or a counterbalance outside the rigid-body model; try adding "
-            "spring to --terms)"
+            f"{head}{d.position:.2g} of {d.rms:.2g} N m RMS residual follows its position ({why})"
         )
     if d.velocity >= FOLLOWS * d.systematic:
         return (
             f"{head}{d.velocity:.2g} of {d.rms:.2g} N m RMS residual follows its velocity "
-            "(friction the law misses; try another --friction-model)"
+            "(friction the law misses; dynid friction compares the laws on held-out data, "
+            "and --terms of dynid identify takes the one it chooses)"
         )
     if abs(d.mean) >= FOLLOWS * d.systematic:
         return f"{head}{abs(d.mean):.2g} of {d.rms:.2g} N m RMS residual is a constant (an offset)"
@@ -158,12 +176,25 @@ def _sentence(d: Dependence, name: str) -> str:
     )
 
 
+def held_terms(model: IdentifiedModel | Robot) -> frozenset[str]:
+    """The names of the terms ``model`` holds beside the rigid bodies, as ``--terms`` names
+    them: an identified model's terms (``spring``, ``armature``) and its friction's parts
+    (``viscous``, ``coulomb``, ``offset``, ...); a robot's ``spring`` when it has one."""
+    if isinstance(model, Robot):
+        return frozenset({"spring"} if model.spring is not None else ())
+    out = set(model.terms)
+    for t in model.terms.values():
+        out.update(getattr(t.term, "parts", ()) or ())
+    return frozenset(out)
+
+
 def dependence_hint(
     q: Sequence[NDArray[np.float64]],
     dq: Sequence[NDArray[np.float64]],
     error: Sequence[NDArray[np.float64]],
     noise_rms: NDArray[np.float64],
     joint_names: Sequence[str],
+    terms: Collection[str] = (),
 ) -> str | None:
     """:func:`residual_dependence` in words, one clause per joint above its noise joined by
     ``"; "`` (``"right_s1: 0.41 of 0.59 N m RMS residual follows its position (...)"``),
@@ -173,7 +204,7 @@ def dependence_hint(
     if not found:
         return None
     worst = sorted(found, key=lambda d: d.rms / d.noise, reverse=True)
-    said = "; ".join(_sentence(d, joint_names[d.joint]) for d in worst[:NAMED])
+    said = "; ".join(_sentence(d, joint_names[d.joint], terms) for d in worst[:NAMED])
     more = len(worst) - NAMED
     return said + (f" ({more} more joint(s) above their noise)" if more > 0 else "")
 
@@ -185,15 +216,19 @@ def with_dependence_hint(
     error: Sequence[NDArray[np.float64]],
     noise_rms: NDArray[np.float64],
     joint_names: Sequence[str],
+    terms: Collection[str] = (),
 ) -> Verdict:
     """``verdict`` with :func:`dependence_hint` appended when it is above the noise floor
-    (not ``"good"``) and a joint is above its noise; else ``verdict`` itself."""
+    (not ``"good"``) and a joint is above its noise; else ``verdict`` itself. ``terms``: the
+    model's (:func:`held_terms`)."""
     if verdict.level == "good":
         return verdict
-    return with_hint(verdict, dependence_hint(q, dq, error, noise_rms, joint_names))
+    return with_hint(verdict, dependence_hint(q, dq, error, noise_rms, joint_names, terms))
 
 
-def outside_model_note(found: Sequence[Dependence], joint_names: Sequence[str]) -> str | None:
+def outside_model_note(
+    found: Sequence[Dependence], joint_names: Sequence[str], terms: Collection[str] = ()
+) -> str | None:
     """Why a physically consistent fit predicts held-out torques worse than least squares
     when least squares itself leaves a systematic residual (``found``:
     :func:`residual_dependence` of its held-out prediction): an effect outside the
@@ -213,5 +248,5 @@ def outside_model_note(found: Sequence[Dependence], joint_names: Sequence[str]) 
         f"least squares itself leaves a systematic residual on {which}: an effect outside "
         "the rigid-body model there pulls the links' parameters, and the consistent fit "
         "cannot absorb it; model it before the constraints are blamed: "
-        + "; ".join(_sentence(d, joint_names[d.joint]) for d in found)
+        + "; ".join(_sentence(d, joint_names[d.joint], terms) for d in found)
     )

@@ -497,7 +497,7 @@ def _with_outside_model_note(
     held-out judgement rejected it; else ``result`` itself."""
     if held is None or result.heldout is None or result.heldout.accepted:
         return result
-    said = outside_model_note(held.systematic, names)
+    said = outside_model_note(held.systematic, names, held.terms)
     return result if said is None else dataclasses.replace(result, notes=(said, *result.notes))
 
 

@@ -63,7 +63,7 @@ from ..identification.low_speed import with_low_speed_hint
 from ..identification.metrics import TorqueErrors
 from ..identification.model import IdentifiedModel
 from ..identification.motion_range import motion_range_hint, with_motion_range_hint
-from ..identification.residual_dependence import with_dependence_hint
+from ..identification.residual_dependence import held_terms, with_dependence_hint
 from ..identification.sanity import SPIKES_BEFORE_JUDGING
 from ..identification.verdict import LEVELS, Verdict, with_replaced_spikes
 from ..io.feasible import load_feasible_drive, load_feasible_linear_friction
@@ -309,7 +309,9 @@ def validate_files(
     dq = [v.log.dq for v in val.parts]
     # a motion beyond the identification's is the likelier cause of what the residual follows
     beyond = motion_range_hint(speeds, dq, names) is not None
-    verdict = _with_hints(verdict, val, rec.logs, noise, names, dependence=not beyond)
+    verdict = _with_hints(
+        verdict, val, rec.logs, noise, names, dependence=not beyond, terms=held_terms(model)
+    )
     verdict = with_motion_range_hint(verdict, speeds, dq, names)
     files = ", ".join(f"{n} {c}" for n, c in zip(rec.names, spikes, strict=True) if c)
     verdict = with_replaced_spikes(verdict, sum(spikes), f" before judging ({files})")
@@ -337,17 +339,18 @@ def _with_hints(
     names: Sequence[str],
     *,
     dependence: bool = True,
+    terms: frozenset[str] = frozenset(),
 ) -> Verdict:
     """``verdict`` with what the residual of each joint above its noise follows
     (:func:`~dynid.identification.residual_dependence.with_dependence_hint`; not with
     ``dependence`` False: a recording that moves beyond the identification's data, where
-    any residual follows the motion), the hint of a cut-off too high for derived states,
-    and that of an error at low speed."""
+    any residual follows the motion; ``terms`` the model's, which its remedies leave out),
+    the hint of a cut-off too high for derived states, and that of an error at low speed."""
     error = [v.log.tau - v.tau_hat for v in val.parts]
     dq = [v.log.dq for v in val.parts]
     q = [v.log.q for v in val.parts]
     if dependence:
-        verdict = with_dependence_hint(verdict, q, dq, error, noise.total, names)
+        verdict = with_dependence_hint(verdict, q, dq, error, noise.total, names, terms)
     verdict = with_derived_cutoff_hint(verdict, logs, val.pieces.cutoff_hz)
     high = derived_cutoff_hint(logs, val.pieces.cutoff_hz)
     if verdict.level == "good" and high is not None and noise.inputs is not None:
