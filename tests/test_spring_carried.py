@@ -189,3 +189,24 @@ def test_springs_of_the_wrong_shape_or_sign_are_refused(arm, tmp_path):
     path.write_text(path.read_text() + "\n[spring]\nk = [1.0, -2.0]\nq0 = [0.0, 0.0]\n")
     with pytest.raises(DataError, match=r"key 'spring.k\[1\]': expected a number >= 0"):
         load_robot(path)
+
+
+def test_the_mjcf_spring_reference_holds_the_joints_offset(arm, tmp_path):
+    """Regression (a spring identified about the middle of the limits with the offset that
+    places its rest position, fo2 = +12 N m, was written as springref = 0 with the offset
+    dropped: 12 N m off at every position in MuJoCo, 60 % held-out error): MuJoCo's
+    ``qfrc_spring + fo`` equals ``-(k (q - q0) + fo)`` to 1e-10 on the joint with a spring,
+    whose offset the warning no longer names; the joint without one keeps its offset named."""
+    mujoco = pytest.importorskip("mujoco")
+    k, q0, fo = np.array([30.0, 0.0]), np.array([0.3, 0.3]), np.array([12.0, 0.5])
+    robot = arm.with_spring(JointStiffness(k, q0))
+    fr = ClassicalFriction(np.array([0.3, 0.2]), np.array([0.4, 0.3]), fo)
+    _, said = said_warnings(save_robot, tmp_path / "r.xml", robot, friction=fr)
+    offsets = [s for s in said if "offsets fo" in s]
+    assert offsets and "+0.5 N m at joint 2" in offsets[0], said
+    m = mujoco.MjModel.from_xml_path(str(tmp_path / "r.xml"))
+    d = mujoco.MjData(m)
+    for q in np.random.default_rng(9).uniform(LOWER, UPPER, (5, 2)):
+        d.qpos[:] = q
+        mujoco.mj_forward(m, d)
+        assert abs(-d.qfrc_spring[0] - (k[0] * (q[0] - q0[0]) + fo[0])) < 1e-10

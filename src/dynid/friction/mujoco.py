@@ -345,14 +345,18 @@ def _refit_note(
 
 
 def unheld_friction(
-    friction: FrictionModel | FrictionSum, dq_max: ArrayLike | None = None
+    friction: FrictionModel | FrictionSum,
+    dq_max: ArrayLike | None = None,
+    offset_held: NDArray[np.bool_] | None = None,
 ) -> tuple[str, ...]:
     """What per-joint viscous and sharp Coulomb friction (MJCF ``damping`` and
     ``frictionloss``, URDF ``<dynamics damping friction>``) cannot hold of a friction
     model beyond the law's own losses (:func:`joint_coulomb_viscous`'s ``notes``), one
     line each: the smooth law's ``tanh(dq / v_s)`` rounding, a standstill band, the
     offsets ``fo`` [N m], and that the friction acts at the motors (written reflected to
-    the joints). Empty when the coefficients hold the model exactly.
+    the joints). Empty when the coefficients hold the model exactly. ``offset_held`` (n,):
+    the joints whose offset the file holds otherwise (a joint spring's reference, MJCF's
+    ``springref``), left out of the offsets' line.
     """
     notes: list[str] = []
     for p in friction_parts(friction):
@@ -376,6 +380,8 @@ def unheld_friction(
                 )
         vmax = np.full(p.n, 2.0) if dq_max is None else np.asarray(dq_max, dtype=np.float64)
         offset = np.asarray(p.law.mjcf(p.as_array(), law_velocity_range(p, vmax)).offset)
+        if offset_held is not None and not p.at_motors:
+            offset = np.where(offset_held, 0.0, offset)
         if p.kind != "sigmoid" and np.any(offset != 0):  # the sigmoid's: its law's note
             j = int(np.argmax(np.abs(offset)))
             notes.append(f"the offsets fo{where} (up to {offset[j]:+.3g} N m at {what} {j + 1})")

@@ -38,7 +38,10 @@ keeping the robot's link and joint names:
 * a joint spring (:attr:`~dynid.model.robot.Robot.spring`, the motors' torque
   ``k (q - q0)`` against it) as MuJoCo's passive spring, joint ``stiffness = k``
   [N m/rad] and ``springref = q0`` [rad]: MuJoCo's ``qfrc_spring = -k (q - q0)`` is the
-  spring's own torque, the opposite of dynid's.
+  spring's own torque, the opposite of dynid's. The friction offset ``fo`` of a joint
+  with a spring is its rest position's (the spring term acts about the middle of the
+  limits, and the offset takes up the difference): written as ``springref = q0 - fo / k``
+  (:func:`spring_held_offsets`), not dropped.
 
 Numbers use Python's shortest round-trip representation.
 """
@@ -69,7 +72,7 @@ from ...model.robot import Robot
 from ..atomic import write_text
 from .export_options import ExportOptions, kept_elsewhere, with_caveat
 
-__all__ = ["export_mjcf", "mjcf_from_robot", "save_mjcf"]
+__all__ = ["export_mjcf", "mjcf_from_robot", "save_mjcf", "spring_held_offsets"]
 
 
 def _f(x: float) -> str:
@@ -87,16 +90,36 @@ def _pose(T: np.ndarray) -> str:
     return f'pos="{_v(T[:3, 3])}" quat="{_v(np.array([w, x, y, z]))}"'
 
 
+def spring_held_offsets(
+    robot: Robot, offset: NDArray[np.float64], at_motors: bool
+) -> NDArray[np.bool_]:
+    """The joints (n,) whose friction offset ``offset`` [N m] the robot's spring holds as
+    its reference: ``k (q - q0) + fo = k (q - (q0 - fo / k))``. A spring term acts about a
+    fixed ``q0`` (the middle of the limits) and the offset takes up its true rest position,
+    so an MJCF written with ``springref = q0`` and no offset was off by ``fo`` at every
+    position. Only where ``k > 0``, the offset acts at the joint, and the reference moves
+    by no more than the joint's range (else the offset is not the spring's)."""
+    spring = robot.spring
+    if spring is None or at_motors:
+        return np.zeros(robot.n, dtype=bool)
+    span = np.where(np.isfinite(robot.q_max - robot.q_min), robot.q_max - robot.q_min, 2 * np.pi)
+    out: NDArray[np.bool_] = (spring.k > 0) & (offset != 0) & (np.abs(offset) <= spring.k * span)
+    return out
+
+
 def _law_terms(
-    friction: FrictionModel | FrictionSum, dq_max: NDArray[np.float64], kept: str
+    friction: FrictionModel | FrictionSum, robot: Robot, kept: str
 ) -> tuple[CoulombViscous, tuple[str, ...]]:
     """A friction model as MuJoCo holds it, and what it drops (one line each, ending with
-    ``kept``: the files that hold it, :func:`~dynid.io.robot.export_options.kept_elsewhere`)."""
+    ``kept``: the files that hold it, :func:`~dynid.io.robot.export_options.kept_elsewhere`).
+    The offsets the robot's spring holds (:func:`spring_held_offsets`) are not dropped."""
+    dq_max = robot.dq_max
     vmax = np.where(np.isfinite(dq_max), dq_max, 2.0)
     jt = joint_coulomb_viscous(friction, vmax)
     z = np.zeros(friction.n)
     offset = z if jt.offset is None else jt.offset
-    lost = jt.notes + unheld_friction(friction, vmax)
+    held = spring_held_offsets(robot, offset, friction.at_motors)
+    lost = jt.notes + unheld_friction(friction, vmax, held)
     if not lost:
         return CoulombViscous(jt.frictionloss, jt.damping, offset, z, z), ()
     note = (
@@ -139,8 +162,14 @@ def _joint_terms(
         return coulomb_viscous_from_sigmoid(sigmoid, robot.dq_max), armature, notes
     if model is None:
         return None, armature, notes
-    approx, more = _law_terms(model, robot.dq_max, kept)
+    approx, more = _law_terms(model, robot, kept)
     return approx, armature, notes + more
+
+
+def _at_motors(robot: Robot, friction: bool | FrictionModel | FrictionSum) -> bool:
+    """Whether the friction written acts at the motors of a drive."""
+    model = robot_friction(robot) if friction is True else friction or None
+    return bool(model is not None and model.at_motors)
 
 
 def _comment(
@@ -168,10 +197,20 @@ def _comment(
 
 
 def _bodies(
-    robot: Robot, approx: CoulombViscous | None, armature: NDArray[np.float64] | None
+    robot: Robot,
+    approx: CoulombViscous | None,
+    armature: NDArray[np.float64] | None,
+    at_motors: bool = False,
 ) -> list[str]:
-    """The nested ``<body>`` lines of the links (the base's sites first), closed."""
+    """The nested ``<body>`` lines of the links (the base's sites first), closed; a joint
+    spring's reference holds the friction offset of its joint (:func:`spring_held_offsets`;
+    ``at_motors``: the friction acts at the motors, and its offsets are not the joints')."""
     n = robot.n
+    held = (
+        np.zeros(n, dtype=bool)
+        if approx is None
+        else spring_held_offsets(robot, approx.offset, at_motors)
+    )
     I6 = inertia6_from_matrix(robot.inertia)[:, [0, 3, 5, 1, 2, 4]]  # xx yy zz xy xz yz
     mass, com = robot.mass, robot.com
     sites: dict[int, list[str]] = {}
@@ -202,6 +241,8 @@ def _bodies(
             attrs += f' armature="{_f(armature[i])}"'
         if robot.spring is not None:  # MuJoCo's own torque -k (q - q0): dynid's tau_s held
             k, q0 = robot.spring.k[i], robot.spring.q0[i]
+            if approx is not None and held[i]:  # the offset, as the spring's reference
+                q0 = q0 - approx.offset[i] / k
             attrs += f' stiffness="{_f(k)}" springref="{_f(q0)}"'
         lines += [
             f"{ind[:-2]}<body name={quoteattr(robot.link_names[i + 1])} "
@@ -285,7 +326,7 @@ def mjcf_from_robot(
         '  <compiler angle="radian" autolimits="true" boundmass="1e-10" boundinertia="1e-14"/>',
         f'  <option gravity="{_v(robot.gravity)}"/>',
         "  <worldbody>",
-        *_bodies(robot, approx, armature),
+        *_bodies(robot, approx, armature, _at_motors(robot, friction)),
         "  </worldbody>",
         "  <actuator>",
         *_actuators(robot),
