@@ -84,7 +84,7 @@ def test_static_data_scaled_by_0834_name_the_factor_when_the_mass_is_not_positiv
     data = _scaled(_static(LOADED, 100, 1e-3, 1), SCALE)
     with pytest.raises(DataError, match=r"not positive.*the measured torques are 0\.83") as exc:
         identify_payload(ARM, data)
-    m = float(str(exc.value).split("m / a = ")[1].split(" kg")[0])
+    m = float(str(exc.value).split("the load is ")[1].split(" kg")[0])
     assert abs(m - MASS) < 0.01 * MASS and "on the loaded data" in str(exc.value)
 
 
@@ -170,7 +170,8 @@ def test_the_hint_names_the_drive_files_torque_constant_for_currents():
     off = TorqueScale(0.834, 0.001, 0.83, 0.01, "loaded")
     (line,) = scale_doubts(off, 0.69, drive)
     assert "multiply the drive file's torque_constant by 1.199" in line
-    assert "m / a = 0.83 kg" in line and "not 0.69 kg" in line
+    assert "the load is 0.83 kg (fitted beside the factor" in line and "not 0.69 kg" in line
+    assert "m / a = 0.83 kg" in scale_doubts(dataclasses.replace(off, data="unloaded"), 0.69)[0]
     assert "--units tau=1.199" in scale_doubts(off, 0.69)[0]
     assert not scale_doubts(TorqueScale(0.951, 0.001, 0.83, 0.01, "loaded"), 0.83 * 0.951)
     assert scale_doubts(TorqueScale(0.951, 0.001, 0.83, 0.01, "loaded"), 0.5)

@@ -50,7 +50,7 @@ from pathlib import Path
 from typing import Any
 
 from ..feasibility.payload import PayloadEstimate
-from ..feasibility.payload_scale import SCALE_OFF, SCALE_SIGMAS, TorqueScale
+from ..feasibility.payload_scale import SCALE_OFF, SCALE_SIGMAS, TorqueScale, scale_mass
 from ..identification.model import IdentifiedModel
 from ..io.model_json import save_model_json
 from ..io.payload_json import save_payload_json
@@ -224,14 +224,14 @@ def print_payload(console: Console, result: PayloadFileResult, label: str) -> No
 
 def scale_line(t: TorqueScale, mass: float) -> str:
     """``torques 1.0002 x the arm description's (std 0.00021, on the loaded data); at the
-    description's scale the load is m / a = 0.8292 kg (std 0.0013); no doubt (a within 3
-    std of 1, or within 5 % and the load's mass too)`` (``mass``: the load's estimate [kg],
-    :meth:`TorqueScale.off`)
-    (:attr:`PayloadEstimate.torque_scale`)."""
+    description's scale the load is 0.8292 kg (fitted beside the factor, over it; std
+    0.0013); no doubt (a within 3 std of 1, or within 5 % and the load's mass too)``
+    (:attr:`PayloadEstimate.torque_scale`, :func:`~dynid.feasibility.payload_scale.
+    scale_mass`; ``mass``: the load's estimate [kg], :meth:`TorqueScale.off`)."""
     where = "the data without the load" if t.data == "unloaded" else "the loaded data"
     return (
         f"torques  {t.value:.4f} x the arm description's (std {t.std:.2g}, on {where}); "
-        f"at the description's scale the load is m / a = {t.mass:.4g} kg (std {t.std_mass:.2g})"
+        f"at the description's scale the load is {scale_mass(t)}"
         + (
             ""
             if t.off(mass)

@@ -37,7 +37,14 @@ from ..identification.least_squares import fit_least_squares
 from ..model.drive import Drive
 from .payload_fit import block_jackknife_covariance, serial_correlation_factor
 
-__all__ = ["SCALE_OFF", "SCALE_SIGMAS", "TorqueScale", "scale_doubts", "torque_scale"]
+__all__ = [
+    "SCALE_OFF",
+    "SCALE_SIGMAS",
+    "TorqueScale",
+    "scale_doubts",
+    "scale_mass",
+    "torque_scale",
+]
 
 #: Relative distance from 1 of a factor that makes a doubt.
 SCALE_OFF = 0.05
@@ -165,6 +172,16 @@ def torque_scale(
     return TorqueScale(a, std, mass, std_mass, "loaded" if p else "unloaded")
 
 
+def scale_mass(scale: TorqueScale) -> str:
+    """The load's mass at the description's scale in words: ``m / a = 0.8313 kg (std
+    0.00086)`` on data without the load (the difference method's mass over the factor),
+    ``0.829 kg (fitted beside the factor, over it; std 0.0014)`` on the loaded data, where
+    it is not the printed mass over ``a`` (the arm's torques carry the factor too)."""
+    if scale.data == "unloaded":
+        return f"m / a = {scale.mass:.4g} kg (std {scale.std_mass:.2g})"
+    return f"{scale.mass:.4g} kg (fitted beside the factor, over it; std {scale.std_mass:.2g})"
+
+
 def scale_doubts(
     scale: TorqueScale | None, mass: float, drive: Drive | None = None
 ) -> tuple[str, ...]:
@@ -186,8 +203,8 @@ def scale_doubts(
     return (
         f"the measured torques are {a:.4g} x the arm model's (std {scale.std:.2g}, on "
         f"{where}): a torque constant or gear ratio off by that factor, or the arm's "
-        f"masses are; if the arm's description is right, the load is m / a = "
-        f"{scale.mass:.4g} kg (std {scale.std_mass:.2g}), not {mass:.4g} kg; hint: {remedy}, "
+        f"masses are; if the arm's description is right, the load is {scale_mass(scale)}, "
+        f"not {mass:.4g} kg; hint: {remedy}, "
         "or fix the arm's masses"
         + (
             ", or record the same motions without the load and give them with --unloaded "
