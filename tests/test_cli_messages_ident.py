@@ -48,6 +48,21 @@ def test_a_missing_input_file_is_named_with_its_option(tmp_path, capsys, argv):
     assert not (tmp_path / "o").exists()
 
 
+def test_files_joined_by_a_comma_are_told_to_be_separated_by_spaces(tmp_path, capsys):
+    """Regression (``--data a.csv,b.csv`` said only that the joined name does not exist):
+    when every comma-separated part exists, the hint gives the option with them apart."""
+    sim = ["simulate", "--robot", "panda", "--duration", "1", "--rate", "200", "-q"]
+    for name in ("a.csv", "b.csv"):
+        assert main([*sim, "--out", str(tmp_path / name)]) == 0
+    capsys.readouterr()
+    joined = f"{tmp_path / 'a.csv'},{tmp_path / 'b.csv'}"
+    line = _error(["identify", "--robot", "panda", "--data", joined, "--out", "o"], capsys)
+    assert line.endswith(
+        f"does not exist; hint: separate the files with spaces, --data {tmp_path / 'a.csv'} "
+        f"{tmp_path / 'b.csv'}"
+    )
+
+
 def test_export_of_base_parameters_says_what_makes_link_parameters(tmp_path, capsys):
     path = tmp_path / "identification.json"
     save_json(path, {"coefficients": []}, schema="dynid-identified-model/1")

@@ -68,7 +68,13 @@ def missing_input(args: argparse.Namespace, filename: str | Path) -> str | None:
         value = getattr(args, name, None)
         for p in value if isinstance(value, list | tuple) else [value]:
             if isinstance(p, str | Path) and Path(p) == Path(filename) and not Path(p).exists():
-                return f"{Path(p).name}: {flag(name)}: {p} does not exist"
+                said = f"{Path(p).name}: {flag(name)}: {p} does not exist"
+                parts = str(p).split(",")
+                if len(parts) > 1 and all(Path(x).exists() for x in parts if x):
+                    said += f"; hint: separate the files with spaces, {flag(name)} " + " ".join(
+                        x for x in parts if x
+                    )
+                return said
     return None
 
 
