@@ -160,7 +160,9 @@ def test_observe_scores_against_a_label_column_by_default_name_or_mapped(pushes,
     assert "missed in" in out and "3.500 s .. 3.700 s" in out
     score = json.loads((out_dir / "events.json").read_text())["score"]
     assert score["source"] == f"column {name!r}"
-    assert score["missed_contacts"] == [{"start": 3.5, "end": 3.7, "peak": None}]
+    # the invented contact: no push in the true torques, which a column map leaves unread
+    peak = None if mapped else 0.0
+    assert score["missed_contacts"] == [{"start": 3.5, "end": 3.7, "peak": peak}]
     assert (out_dir / "residuals.png").stat().st_size > 0
 
 
@@ -211,3 +213,21 @@ def test_labels_follow_the_log_past_rows_dropped_and_a_column_not_numbers(pushes
     captured = capsys.readouterr()
     assert "column 'label' read as no contact labels" in captured.err
     assert "(tau_ext > 0.1 N m;" in captured.out and "3 labelled, 3 detected" in captured.out
+
+
+def test_missed_labelled_contacts_carry_the_true_torques_peak_where_it_is_known():
+    """Regression (a label column beside simulate --contact's true torques gave missed
+    contacts a peak of null; a log with labelled contacts and no event failed on an empty
+    argmin): with both, the contacts are the labels' and a missed one's peak is the largest
+    true |tau_ext| over it; with the labels alone it is not known."""
+    from dynid.workflows.observe_detect import Labels, scored
+
+    t = np.arange(0.0, 4.0, 0.01)
+    flags = ((t >= 1.0) & (t < 1.5)).astype(float)
+    ext = np.zeros((t.size, 2))
+    ext[(t >= 1.0) & (t < 1.5), 1] = 0.7
+    with_truth = scored(t, [], Labels("column 'collision'", flags), ext)
+    alone = scored(t, [], Labels("column 'collision'", flags), None)
+    assert with_truth is not None and alone is not None
+    assert [m.peak for m in with_truth.missed] == [0.7]
+    assert [m.peak for m in alone.missed] == [None]

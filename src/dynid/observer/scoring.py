@@ -147,6 +147,8 @@ def match_events(
     ev = _as_intervals(events, "events")
     lab = _as_intervals(labels, "labels")
     over = (ev[None, :, 0] <= lab[:, None, 1] + tolerance_s) & (ev[None, :, 1] >= lab[:, None, 0])
+    if ev.shape[0] == 0:  # no event: every contact missed
+        return np.full(lab.shape[0], -1, dtype=np.intp), np.zeros(0, dtype=bool)
     starts = np.where(over, ev[None, :, 0], np.inf)
     first = np.where(over.any(axis=1), np.argmin(starts, axis=1), -1).astype(np.intp)
     false: NDArray[np.bool_] = np.logical_not(over.any(axis=0))

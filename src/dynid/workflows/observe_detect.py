@@ -216,10 +216,12 @@ def scored(
 ) -> ContactScore | None:
     """The ``events`` of a log at times ``t`` (N,) [s] scored against its ``labels``, else
     against the true external torques ``ext`` (N, n) [N m] (in contact where some joint
-    exceeds :data:`~dynid.observer.scoring.TRUTH_LEVEL`; the missed contacts' peaks
-    known); None with neither (:mod:`dynid.observer.scoring`)."""
+    exceeds :data:`~dynid.observer.scoring.TRUTH_LEVEL`); the missed contacts' peaks known
+    wherever the true torques are, the labels' contacts too; None with neither
+    (:mod:`dynid.observer.scoring`)."""
     if labels is not None:
-        intervals, source, peaks = label_intervals(t, labels.flags), labels.source, None
+        intervals, source = label_intervals(t, labels.flags), labels.source
+        peaks = None if ext is None else interval_peaks(t, ext, intervals)
     elif ext is not None:
         intervals = label_intervals(t, truth_flags(ext))
         source = f"tau_ext > {TRUTH_LEVEL:g} N m"
