@@ -210,3 +210,21 @@ def test_the_mjcf_spring_reference_holds_the_joints_offset(arm, tmp_path):
         d.qpos[:] = q
         mujoco.mj_forward(m, d)
         assert abs(-d.qfrc_spring[0] - (k[0] * (q[0] - q0[0]) + fo[0])) < 1e-10
+
+
+def test_simulate_says_the_springs_it_puts_in_the_torques(tmp_path, capsys):
+    """Regression (simulate from a robot with a [spring] table never said so): the
+    command names each joint's spring among its notes."""
+    import dynid
+    from dynid.cli.__main__ import main
+
+    k = np.zeros(7)
+    k[1] = 30.0
+    robot = dynid.panda().with_spring(JointStiffness(k, np.full(7, -0.4)))
+    save_robot(tmp_path / "p.toml", robot, friction=False)
+    argv = ["simulate", "--robot", str(tmp_path / "p.toml"), "--duration", "0.5"]
+    assert main([*argv, "--rate", "100", "--out", str(tmp_path / "x.csv")]) == 0
+    said = capsys.readouterr()
+    assert "joint springs in the torques, k (q - q0): joint2 30 N m/rad about -0.4 rad" in (
+        said.out + said.err
+    )

@@ -172,17 +172,19 @@ def test_a_consistent_fit_rejected_over_a_spring_says_least_squares_is_off_first
 
 def test_a_stiff_spring_is_not_called_a_flipped_torque_sign(panda):
     """Regression: a 60 N m/rad spring on joint 2 that the rigid-body model lacks made its
-    torques correlate -0.51 with the model's while every other joint agreed, and identify
-    refused the log as of the opposite sign on joint 2 (its hint, --units tau2=-1, would
-    have corrupted the data). The negated model explains that joint at 0.29 of its scale,
-    a flipped sign at about 1: the same joint's torques truly negated are still refused."""
-    log = _logs(panda, True, k=60.0)[0]
-    assert opposite_sign(panda, log) is None
-    plain = _logs(panda, False)[0]
-    tau = plain.tau.copy()
-    tau[:, 1] *= -1.0
-    said = opposite_sign(panda, replace(plain, tau=tau))
-    assert said is not None and "tau2=-1" in said and "joint2" in said, said
+    torques correlate -0.51 (factor -0.29) and -0.96 (factor -1.17, as a flipped sign's)
+    with the model's while every other joint agreed, and identify refused the logs as of
+    the opposite sign on joint 2 (its hint, --units tau2=-1, would have corrupted them).
+    None of the four recordings is refused: the negated model does not explain the joint
+    at its scale, or its friction still dissipates as the torques read. The same joint's
+    torques truly negated are refused in every recording."""
+    for log in _logs(panda, True, k=60.0):
+        assert opposite_sign(panda, log) is None
+    for plain in _logs(panda, False):
+        tau = plain.tau.copy()
+        tau[:, 1] *= -1.0
+        said = opposite_sign(panda, replace(plain, tau=tau))
+        assert said is not None and "tau2=-1" in said and "joint2" in said, said
 
 
 def test_the_remedy_names_only_what_the_model_lacks(panda):

@@ -18,7 +18,10 @@ with them before fitting (:func:`log_findings`). None of them changes the data.
   explain other joints at their scale, a joint is called opposite only if the negated
   ones explain it at about its own (least-squares factor within :data:`CONFIRMED_SLOPE`):
   a 60 N m/rad spring the rigid bodies lack turned a Panda shoulder's correlation to
-  -0.51 at a factor of -0.29, and that is no sign to flip.
+  -0.51 at a factor of -0.29, and that is no sign to flip; nor where the joint's friction
+  dissipates as its torques read (:func:`_dissipating`: on another recording the same
+  spring gave -0.96 at -1.17, as a flipped sign would). A robot's joint spring
+  (:attr:`~dynid.model.robot.Robot.spring`) is part of its torques at rest and in motion.
 * **Scale**: the least-squares factor ``a`` in ``tau ~ a g(q)`` over the gravity-loaded
   joints; ``a`` near 1e3 or 1e-3 is a unit off by a power of ten (mN m against N m:
   :func:`torque_unit_finding`, refused by the commands unless ``--units`` names the
@@ -421,7 +424,7 @@ def _gravity_spread(
     by at least 5 % of the most varied joint's and span at least
     :data:`GRAVITY_RANGE_SHARE` of the largest gravity torque (on a short stretch gravity
     barely changes, and the torques' variations are the motion's, of either sign)."""
-    g = gravity_torques(robot, q)
+    g = _static_torques(robot, q)
     loaded = _loaded(g)
     if not np.any(loaded):
         return None
@@ -435,7 +438,15 @@ def gravity_loaded(robot: Robot, q: ArrayLike) -> NDArray[np.bool_]:
     qq = _checks.as_array("q", q)
     if qq.ndim != 2 or qq.shape[0] < 2 or not np.any(robot.phi):
         return np.zeros(robot.n, dtype=bool)
-    return _loaded(gravity_torques(robot, qq[:: max(1, qq.shape[0] // _MAX_SAMPLES)]))
+    return _loaded(_static_torques(robot, qq[:: max(1, qq.shape[0] // _MAX_SAMPLES)]))
+
+
+def _static_torques(robot: Robot, q: NDArray[np.float64]) -> NDArray[np.float64]:
+    """The torques [N m] (N, n) that hold the robot at rest at ``q`` (N, n): gravity's, and
+    its joint springs' where it has them (a gravity-compensation spring opposes gravity:
+    without it, a shoulder's torques read as of the opposite sign)."""
+    g = gravity_torques(robot, q)
+    return g if robot.spring is None else g + robot.spring.torques(q)
 
 
 def opposite_sign(robot: Robot, log: TorqueLog) -> str | None:
@@ -467,8 +478,11 @@ def opposite_sign(robot: Robot, log: TorqueLog) -> str | None:
         off_scale = right.any() & ((-slope < lo) | (-slope > hi))
     # where the model explains other joints at their scale, a joint whose negated model
     # torques would not explain its own at about theirs holds something the rigid bodies
-    # lack (a spring, a counterbalance), not a flipped sign
+    # lack (a spring, a counterbalance), not a flipped sign; nor does one whose friction
+    # dissipates as its torques read (a counterbalance that outweighs gravity)
     strong = (loaded & (corr < OPPOSITE_CORRELATION) & ~off_scale) | flipped
+    if right.any() and strong.any() and whole is not None:
+        strong &= ~_dissipating(log, at, whole[0], whole[1], strong)
     if not strong.any():
         return None
     if right.any() or not bool(np.all(every[loaded] < 0)):
@@ -494,6 +508,55 @@ def opposite_sign(robot: Robot, log: TorqueLog) -> str | None:
         "links'), is not told by this check; hint: --units tau=-1 if every joint's is "
         f"opposite, --units {','.join(f'tau{k + 1}=-1' for k in seen)} if these only"
     )
+
+
+#: Position bins of a joint's friction hysteresis (:func:`_dissipating`), and the fewest
+#: samples of each direction of motion a bin must hold.
+HYSTERESIS_BINS = 12
+HYSTERESIS_MIN_SAMPLES = 5
+#: Standard errors by which the hysteresis must be positive.
+HYSTERESIS_SIGMAS = 3.0
+
+
+def _dissipating(
+    log: TorqueLog,
+    at: NDArray[np.intp],
+    model: NDArray[np.float64],
+    ok: NDArray[np.bool_],
+    asked: NDArray[np.bool_],
+) -> NDArray[np.bool_]:
+    """The joints among ``asked`` (n,) whose friction dissipates as their torques read: at
+    like positions the torque less the model's rigid-body torques ``model`` (at the samples
+    ``at`` where ``ok``) is larger moving forward than backward, the mean difference over
+    :data:`HYSTERESIS_BINS` bins of the joint's position at least
+    :data:`HYSTERESIS_SIGMAS` standard errors above zero. Whatever depends on the position
+    alone (gravity, a spring, a counterbalance) cancels in the difference, and so does
+    the inertia of a motion that passes a position both ways; a flipped sign turns the
+    friction, which then pushes: a 60 N m/rad spring on a Panda shoulder made its torques
+    correlate -0.96 with gravity's at a factor of -1.17, as a flipped sign would, while
+    its friction still dissipated."""
+    out = np.zeros(log.n, dtype=bool)
+    dq = log.dq[at][ok]
+    band = noise_band(velocity_noise_std(log.dq, log.t))
+    e = log.tau[at][ok] - model[ok]
+    for j in np.flatnonzero(asked):
+        fwd, bwd = dq[:, j] > max(band[j], MIN_MOTION), dq[:, j] < -max(band[j], MIN_MOTION)
+        q = log.q[at][ok][:, j]
+        moving = fwd | bwd
+        if np.count_nonzero(moving) < 2 * HYSTERESIS_BINS * HYSTERESIS_MIN_SAMPLES:
+            continue
+        edges = np.quantile(q[moving], np.linspace(0.0, 1.0, HYSTERESIS_BINS + 1))
+        which = np.clip(np.searchsorted(edges, q, side="right") - 1, 0, HYSTERESIS_BINS - 1)
+        diffs = []
+        for b in range(HYSTERESIS_BINS):
+            f, r = fwd & (which == b), bwd & (which == b)
+            if min(np.count_nonzero(f), np.count_nonzero(r)) >= HYSTERESIS_MIN_SAMPLES:
+                diffs.append(float(np.mean(e[f, j]) - np.mean(e[r, j])))
+        if len(diffs) >= 3:
+            d = np.asarray(diffs)
+            se = float(np.std(d, ddof=1)) / np.sqrt(d.size)
+            out[j] = bool(np.mean(d) > HYSTERESIS_SIGMAS * se and np.mean(d) > 0)
+    return out
 
 
 def _explained(
@@ -551,6 +614,8 @@ def _motion_torques(
         return None
     model = np.zeros_like(ddq)
     model[ok] = rnea(robot, log.q[at][ok], dq[at][ok], ddq[ok])
+    if robot.spring is not None:
+        model[ok] += robot.spring.torques(log.q[at][ok])
     return model, ok
 
 

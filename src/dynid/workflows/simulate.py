@@ -222,6 +222,16 @@ def simulate_log(robot: Robot, options: SimulateOptions | None = None) -> Simula
         )
         if opt.friction == "robot" and (said := own_at_motors_note(robot, opt.drive)):
             notes.append(said)
+    if robot.spring is not None and np.any(robot.spring.k):
+        on = np.flatnonzero(robot.spring.k)
+        notes.append(
+            "joint springs in the torques, k (q - q0): "
+            + ", ".join(
+                f"{robot.joint_names[j]} {robot.spring.k[j]:.4g} N m/rad about "
+                f"{robot.spring.q0[j]:+.4g} rad"
+                for j in on
+            )
+        )
     effects = None
     if opt.unmodelled:
         from ..simulation.unmodelled import UnmodelledEffects

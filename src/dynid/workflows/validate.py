@@ -267,7 +267,7 @@ def validate_files(
         drive=placed,
         q_start=opt.q_start,
         max_gap_s=opt.max_gap_s,
-        reference=model.equivalent_robot if isinstance(model, IdentifiedModel) else None,
+        reference=_reference(model),
         signs=True,  # the joints of the opposite sign named before the verdict
     )
     rec, spikes = despiked_recordings(rec, robot.joint_names, SPIKES_BEFORE_JUDGING)
@@ -418,6 +418,15 @@ def _judged(
         opposite=opposite_sign([v.log.tau for v in parts], [v.tau_hat for v in parts]),
     )
     return verdict, _Noise(fl.sensor_rms, fl.input_rms, fl.total_rms), fl.percent
+
+
+def _reference(model: IdentifiedModel | Robot) -> Robot | None:
+    """The robot a recording's torque sign is checked against: an identified model's
+    equivalent links with its joint spring (a stiff one outweighs gravity on its joint),
+    None for a robot (itself)."""
+    if not isinstance(model, IdentifiedModel):
+        return None
+    return model.equivalent_robot.with_spring(model.spring)
 
 
 def _friction(
