@@ -45,9 +45,11 @@ the published Panda's links lie between 2e-4 and 2e-3 of their trace.
 ``sum_i ||S0_i^{-1} J_i S0_i^{-T} - 1||_F^2`` (the prior's own metric).
 
 **Solver**: cvxpy with Clarabel, in whitened variables ``X_i = S0_i^{-1} J_i S0_i^{-T}``
-(``J0_i = S0_i S0_i^T``); when the interior-point method stalls it is retried with
-``max_iter=500`` and static regularisation ``1e-7``, then with SCS (``eps=1e-7``, 20 000
-iterations); a failure raises
+(``J0_i = S0_i S0_i^T``), the prior's weight inside the log-det's exponential cones (their
+duals about 1 at any weight) and the duality gap to a hundredth of ``Delta chi^2``; when
+the interior-point method stalls it is retried with ``max_iter=500`` and static
+regularisation ``1e-7``, then with SCS (``eps=1e-7``, 20 000 iterations), and the result's
+notes say at how many solves; a failure raises
 :class:`~dynid.exceptions.SolverError` with the solver's status. An equality that no
 consistent set meets is reported (``feasible = False``, status ``"infeasible"``) with the
 closest consistent set (least relative coefficient error) and how far it is.

@@ -26,8 +26,12 @@ from .data_term import DataTerm
 from .options import SDPOptions
 from .solvers import SCS_SIGINT, clarabel, scs
 
-__all__ = ["SCS_SIGINT", "ConvexProblem", "Values", "data_scale"]
+__all__ = ["SCS_SIGINT", "ConvexProblem", "Values", "data_scale", "fallback_note"]
 
+
+#: The weighted fit's duality gap, in the data term's own unit: ``Delta chi^2``, the increase
+#: of the residual sum of squares over the noise variance (:func:`gap_tolerance`).
+GAP_CHI2 = 1e-2
 
 #: Boxes and the band are shrunk by this fraction inside the solver, so that its tolerance
 #: (about 1e-8) cannot put the solution outside them (:func:`_inset`).
@@ -135,6 +139,7 @@ class ConvexProblem:
         eps = self.margin = options.margin
         self.scale = 1.0 if equality or closest else float(max(term.dof, 1))
         self.equality = equality
+        self.weighted = not (equality or closest)
         cons: list[Any] = []
         for i in range(n):
             C = self.S0[i].T @ self.S0[i]
@@ -150,10 +155,17 @@ class ConvexProblem:
             M = sum(p[0] for p in phis)
             db = _inset(band[0], band[1], float(prior.mass.sum()))
             cons += [M >= band[0] + db, M <= band[1] - db]
-        if options.objective == "logdet":  # (- 4 log kappa dropped: a constant)
-            div = sum(-cp.log_det(X) + kappa * cp.trace(X) - 4.0 for X in self.X)
+        # the divergence times its coefficient c (the weight; 1 for an exact fit, 1e-6 for
+        # the closest one): c enters the log-det's cones, not only their cost
+        c = 1e-6 if closest else (1.0 if equality else self.w)
+        if options.objective == "logdet":  # (constants dropped: -4 log kappa, 4 c log c, 4 c)
+            wdiv = 0.0
+            for X in self.X:
+                term_i, cons_i = weighted_neg_log_det(X, c)
+                wdiv = wdiv + term_i + c * kappa * cp.trace(X)
+                cons += cons_i
         else:
-            div = sum(cp.sum_squares(kappa * X - np.eye(4)) for X in self.X)
+            wdiv = c * sum(cp.sum_squares(kappa * X - np.eye(4)) for X in self.X)
         k = term.n_friction
         self.f = cp.Variable(k, name="f") if k else None
         p_links = 10 * n
@@ -182,20 +194,21 @@ class ConvexProblem:
         if equality:
             s = np.maximum(np.abs(term.x_hat), 1e-6 * max(float(np.abs(term.x_hat).max()), 1e-12))
             cons.append(cp.multiply(1.0 / s, x - term.x_hat) == 0)
-            obj = div
+            obj = wdiv
         elif closest:
             s = np.maximum(np.abs(term.x_hat), 1e-3 * max(float(np.abs(term.x_hat).max()), 1e-12))
-            obj = 1e-6 * div + 0.5 * cp.sum_squares(cp.multiply(1.0 / s, x - term.x_hat))
+            obj = wdiv + 0.5 * cp.sum_squares(cp.multiply(1.0 / s, x - term.x_hat))
         else:
             # divided by dof (the data term's size at a good fit): same minimiser, better scaled
             # (and, above weight 1, both terms divided by the weight: same minimiser again,
             # and a weight of 1e200 does not make the solver's numbers overflow)
             ks = 1.0 / math.sqrt(self.scale)
-            obj = self.w * div + self.v * 0.5 * cp.sum_squares(
+            obj = wdiv + self.v * 0.5 * cp.sum_squares(
                 (ks * term.A) @ x - (ks * term.A) @ term.x_hat
             )
         self.problem = cp.Problem(cp.Minimize(obj), cons)
         self.term = term
+        self.solves = self.retried = self.by_scs = 0  # (:meth:`solve`)
 
     def solve(self, w: float) -> str:
         """Solve at weight ``w``; the status (retries as in the module docstring).
@@ -205,18 +218,29 @@ class ConvexProblem:
         misreport a badly scaled feasible problem). SCS runs only when neither Clarabel
         attempt gave a solution: after an ``optimal_inaccurate`` one it too ended
         inaccurate, at 12-20 s a solve, eight times in one weight search, and the first
-        inaccurate answer was kept all the same.
+        inaccurate answer was kept all the same. Counted in :attr:`solves`, :attr:`retried`
+        (the first attempt gave no optimal answer) and :attr:`by_scs` (:func:`fallback_note`).
         """
+        self.solves += 1
+        seen: list[str] = []
+        try:
+            return self._attempts(w, seen)
+        finally:
+            self.retried += len(seen) > 1
+            self.by_scs += any(x.startswith("SCS") for x in seen)
+
+    def _attempts(self, w: float, seen: list[str]) -> str:
+        """The attempts of :meth:`solve`, each named with its outcome in ``seen``."""
         import cvxpy as cp
 
         report(f"solving at prior weight {float(w):.3g}")  # (seconds each, dozens a search)
         self.w.value, self.v.value = objective_weights(float(w) / self.scale)
+        gap = {"tol_gap_abs": gap_tolerance(self.v.value, self.scale, self.weighted)}
         attempts: list[tuple[str, dict[str, Any]]] = [
-            ("CLARABEL", {}),
-            ("CLARABEL", {"max_iter": 500, "static_regularization_constant": 1e-7}),
+            ("CLARABEL", gap),
+            ("CLARABEL", {**gap, "max_iter": 500, "static_regularization_constant": 1e-7}),
             ("SCS", {"eps": 1e-7, "max_iters": 20_000}),
         ]
-        seen: list[str] = []
         inaccurate = None
         for solver, kw in attempts:
             if solver == "SCS" and inaccurate is not None:
@@ -278,10 +302,64 @@ def objective_weights(w: float) -> tuple[float, float]:
     return 1.0, max(1.0 / w, _DATA_FLOOR)
 
 
+def fallback_note(problems: Sequence[ConvexProblem]) -> str | None:
+    """What the user should know when Clarabel's first attempt failed at some solves of
+    ``problems`` (None when it never did): how many, and how many SCS answered."""
+    n = sum(p.solves for p in problems)
+    retried = sum(p.retried for p in problems)
+    by_scs = sum(p.by_scs for p in problems)
+    if not retried:
+        return None
+    tail = f", {by_scs} of them by SCS (slower, less accurate)" if by_scs else ""
+    return f"the convex solver (Clarabel) needed a second attempt at {retried} of {n} solves{tail}"
+
+
+def gap_tolerance(v: float, scale: float, weighted: bool) -> float:
+    """Clarabel's absolute duality gap: :data:`GAP_CHI2` in units of the objective, whose data
+    term is ``v Delta chi^2 / (2 scale)``, and never below Clarabel's own 1e-8 (only that
+    for the exact and the closest fits, whose objective is no ``Delta chi^2``).
+
+    A thousandth of one noise variance over the whole log, far below what the noise can tell
+    apart (``chi^2`` itself scatters by ``sqrt(2 dof)``). At 1e-8 a fit on a short log
+    stalled a little above it (Clarabel's "AlmostSolved", every residual met but the gap,
+    about 5e-7 of the objective) in about one solve in ten of a held-out weight search,
+    each then solved a second time.
+    """
+    if not weighted:
+        return 1e-8
+    return max(1e-8, float(v) * GAP_CHI2 / (2.0 * float(scale)))
+
+
 def is_solver_panic(exc: BaseException) -> bool:
     """Whether ``exc`` is a compiled solver's panic (Clarabel's ``pyo3_runtime.PanicException``,
     a :class:`BaseException` that is no :class:`Exception`): a failed solve, not a stop."""
     return type(exc).__name__ == "PanicException"
+
+
+#: (16, 10): the lower triangle of a 4x4 matrix (row-major) from its 10 entries.
+_LOWER = np.zeros((16, 10))
+_LOWER[np.ravel_multi_index(np.tril_indices(4), (4, 4)), np.arange(10)] = 1.0
+
+
+def weighted_neg_log_det(X: Any, c: Any) -> tuple[Any, list[Any]]:
+    """``c (-log det X)`` up to the constant ``4 c log c``, and its constraints: ``X``'s
+    factor ``[[X, Z], [Z^T, diag Z]] >= 0`` (``Z`` lower triangular) and the exponential
+    cones ``(t_k, c, Z_kk)``, i.e. ``t_k <= c log(Z_kk / c)``; the term is ``-sum t``.
+
+    ``c`` sits in the cones rather than in the cost: their dual variables are then about 1
+    whatever the weight. With cvxpy's ``log_det`` (cones ``(t, 1, z)``, cost ``-c t``) they
+    were ``c``, down to 1e-8 at the small weights of a held-out search, and Clarabel's
+    line search stalled (InsufficientProgress) or ended short of its tolerance.
+    """
+    import cvxpy as cp
+
+    z = cp.Variable(10)
+    Z = cp.reshape(_LOWER @ z, (4, 4), order="C")
+    d = cp.diag(Z)
+    K = cp.bmat([[X, Z], [Z.T, cp.diag(d)]])
+    t = cp.Variable(4)
+    cons = [0.5 * (K + K.T) >> 0, cp.constraints.ExpCone(t, c * np.ones(4), d)]
+    return -cp.sum(t), cons
 
 
 def data_scale(term: DataTerm, prior: Prior) -> float:

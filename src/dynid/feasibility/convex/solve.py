@@ -17,7 +17,7 @@ from ..heldout import HeldOutJudgement
 from ..prior import Prior, default_prior, prior_from_robot
 from .data_term import DataTerm
 from .options import SDPOptions
-from .problem import ConvexProblem, check_band, mass_bounds, polish, solution_x
+from .problem import ConvexProblem, check_band, fallback_note, mass_bounds, polish, solution_x
 from .result import ConsistentResult, build_result
 from .weight import auto_weight, auto_weight_note, fold_terms, judged, solved, with_training
 
@@ -160,15 +160,25 @@ def _solve_weighted(
         values = prob.values()
         judgement = with_training(judgement, term.holdout, solution_x(term, *values))
         notes.append(f"prior weight {w:.3g}: {judgement.choice}")
+        _note_fallbacks(notes, [prob, *folds])
         return finish(*values, w, "weighted", status, judgement)
     if opts.prior_weight is not None:
         status = prob.solve(opts.prior_weight)
         if status.startswith("infeasible"):
             raise InfeasibleError("the bounds and constraints admit no consistent parameters")
+        _note_fallbacks(notes, [prob])
         return finish(*prob.values(), opts.prior_weight, "weighted", status)
     w, limit, status, (phi, f, ia), search[:] = auto_weight(prob, term, opts)
     notes.append(auto_weight_note(w, limit, search, opts))
+    _note_fallbacks(notes, [prob])
     return finish(phi, f, ia, w, "weighted", status)
+
+
+def _note_fallbacks(notes: list[str], problems: Sequence[ConvexProblem]) -> None:
+    """Say once when the solver's first attempt failed (:func:`fallback_note`)."""
+    note = fallback_note(problems)
+    if note is not None:
+        notes.append(note)
 
 
 def _checked_bounds(

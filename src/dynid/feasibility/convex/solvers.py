@@ -17,6 +17,7 @@
 from __future__ import annotations
 
 import contextlib
+import functools
 import signal
 import threading
 from collections.abc import Iterator
@@ -55,8 +56,14 @@ def stop_signals_recorded() -> Iterator[list[int]]:
             signal.raise_signal(s)
 
 
+@functools.cache
 def clarabel() -> Any:
-    """cvxpy's Clarabel interface whose solve a stop signal ends (module docstring)."""
+    """cvxpy's Clarabel interface whose solve a stop signal ends (module docstring).
+
+    One instance per process: cvxpy keeps a problem's compiled form (its parameters
+    substituted at each solve) only while the solver is the same object; a new one each
+    solve compiled the problem again, about ten times Clarabel's own time.
+    """
     from cvxpy.reductions.solvers.conic_solvers.clarabel_conif import CLARABEL
 
     class InterruptibleClarabel(CLARABEL):
@@ -96,8 +103,10 @@ def clarabel() -> Any:
     return InterruptibleClarabel()
 
 
+@functools.cache
 def scs() -> Any:
-    """cvxpy's SCS interface that lets a Ctrl-C through (module docstring)."""
+    """cvxpy's SCS interface that lets a Ctrl-C through (module docstring); one instance
+    per process, as :func:`clarabel`."""
     from cvxpy.reductions.solvers.conic_solvers.scs_conif import SCS
 
     class InterruptibleSCS(SCS):
