@@ -18,9 +18,10 @@ with them before fitting (:func:`log_findings`). None of them changes the data.
   explain other joints at their scale, a joint is called opposite only if the negated
   ones explain it at about its own (least-squares factor within :data:`CONFIRMED_SLOPE`):
   a 60 N m/rad spring the rigid bodies lack turned a Panda shoulder's correlation to
-  -0.51 at a factor of -0.29, and that is no sign to flip; nor where the joint's friction
-  dissipates as its torques read (:func:`_dissipating`: on another recording the same
-  spring gave -0.96 at -1.17, as a flipped sign would). A robot's joint spring
+  -0.51 at a factor of -0.29, and that is no sign to flip; nor where the torques as read
+  are the model's plus a function of the joint's own position and friction, far better
+  than the negated ones (:func:`_reads_right`: on another recording the same spring gave
+  -0.96 at -1.17, as a flipped sign would). A robot's joint spring
   (:attr:`~dynid.model.robot.Robot.spring`) is part of its torques at rest and in motion.
 * **Scale**: the least-squares factor ``a`` in ``tau ~ a g(q)`` over the gravity-loaded
   joints; ``a`` near 1e3 or 1e-3 is a unit off by a power of ten (mN m against N m:
@@ -478,11 +479,11 @@ def opposite_sign(robot: Robot, log: TorqueLog) -> str | None:
         off_scale = right.any() & ((-slope < lo) | (-slope > hi))
     # where the model explains other joints at their scale, a joint whose negated model
     # torques would not explain its own at about theirs holds something the rigid bodies
-    # lack (a spring, a counterbalance), not a flipped sign; nor does one whose friction
-    # dissipates as its torques read (a counterbalance that outweighs gravity)
+    # lack (a spring, a counterbalance), not a flipped sign; nor does one whose torques as
+    # read are the model's plus a function of its own position and friction
     strong = (loaded & (corr < OPPOSITE_CORRELATION) & ~off_scale) | flipped
     if right.any() and strong.any() and whole is not None:
-        strong &= ~_dissipating(log, at, whole[0], whole[1], strong)
+        strong &= ~_reads_right(log, at, whole[0], whole[1], strong)
     if not strong.any():
         return None
     if right.any() or not bool(np.all(every[loaded] < 0)):
@@ -510,52 +511,55 @@ def opposite_sign(robot: Robot, log: TorqueLog) -> str | None:
     )
 
 
-#: Position bins of a joint's friction hysteresis (:func:`_dissipating`), and the fewest
-#: samples of each direction of motion a bin must hold.
-HYSTERESIS_BINS = 12
-HYSTERESIS_MIN_SAMPLES = 5
-#: Standard errors by which the hysteresis must be positive.
-HYSTERESIS_SIGMAS = 3.0
+#: Position bins of the function of a joint's own position in :func:`_reads_right`.
+SIGN_POSITION_BINS = 12
+#: :func:`_reads_right` keeps a joint's sign when the torques as read leave at most this
+#: share of the residual sum of squares the negated torques leave.
+SIGN_RESIDUAL_SHARE = 0.5
 
 
-def _dissipating(
+def _reads_right(
     log: TorqueLog,
     at: NDArray[np.intp],
     model: NDArray[np.float64],
     ok: NDArray[np.bool_],
     asked: NDArray[np.bool_],
 ) -> NDArray[np.bool_]:
-    """The joints among ``asked`` (n,) whose friction dissipates as their torques read: at
-    like positions the torque less the model's rigid-body torques ``model`` (at the samples
-    ``at`` where ``ok``) is larger moving forward than backward, the mean difference over
-    :data:`HYSTERESIS_BINS` bins of the joint's position at least
-    :data:`HYSTERESIS_SIGMAS` standard errors above zero. Whatever depends on the position
-    alone (gravity, a spring, a counterbalance) cancels in the difference, and so does
-    the inertia of a motion that passes a position both ways; a flipped sign turns the
-    friction, which then pushes: a 60 N m/rad spring on a Panda shoulder made its torques
-    correlate -0.96 with gravity's at a factor of -1.17, as a flipped sign would, while
-    its friction still dissipated."""
+    """The joints among ``asked`` (n,) whose torques as read, not negated, are the model's
+    rigid-body torques ``model`` (at the samples ``at`` where ``ok``) plus a function of
+    the joint's own position (a spring, a counterbalance: linear in it plus a constant per
+    :data:`SIGN_POSITION_BINS` bins of it) and friction (``fc sign(dq) + fv dq``): the
+    least-squares residual of ``tau - model`` on those columns is at most
+    :data:`SIGN_RESIDUAL_SHARE` of that of ``-tau - model``. Under a flipped sign the
+    negated torques are the ones so explained, and the torques as read leave twice the
+    rigid-body torques of every joint's motion. A 60 N m/rad spring on a Panda shoulder
+    made its torques correlate -0.96 with gravity's at a factor of -1.17, as a flipped
+    sign would; read as they are, they were its model's torques plus such a function."""
     out = np.zeros(log.n, dtype=bool)
     dq = log.dq[at][ok]
+    q = log.q[at][ok]
+    tau = log.tau[at][ok]
     band = noise_band(velocity_noise_std(log.dq, log.t))
-    e = log.tau[at][ok] - model[ok]
     for j in np.flatnonzero(asked):
-        fwd, bwd = dq[:, j] > max(band[j], MIN_MOTION), dq[:, j] < -max(band[j], MIN_MOTION)
-        q = log.q[at][ok][:, j]
-        moving = fwd | bwd
-        if np.count_nonzero(moving) < 2 * HYSTERESIS_BINS * HYSTERESIS_MIN_SAMPLES:
+        edges = np.quantile(q[:, j], np.linspace(0.0, 1.0, SIGN_POSITION_BINS + 1))
+        which = np.clip(np.searchsorted(edges, q[:, j], side="right") - 1, 0, None)
+        which = np.minimum(which, SIGN_POSITION_BINS - 1)
+        moving = np.abs(dq[:, j]) > max(band[j], MIN_MOTION)
+        X = np.column_stack(
+            [
+                which[:, None] == np.arange(SIGN_POSITION_BINS),
+                q[:, j],
+                np.sign(dq[:, j]) * moving,
+                dq[:, j],
+            ]
+        ).astype(np.float64)
+        if X.shape[0] <= 2 * X.shape[1]:
             continue
-        edges = np.quantile(q[moving], np.linspace(0.0, 1.0, HYSTERESIS_BINS + 1))
-        which = np.clip(np.searchsorted(edges, q, side="right") - 1, 0, HYSTERESIS_BINS - 1)
-        diffs = []
-        for b in range(HYSTERESIS_BINS):
-            f, r = fwd & (which == b), bwd & (which == b)
-            if min(np.count_nonzero(f), np.count_nonzero(r)) >= HYSTERESIS_MIN_SAMPLES:
-                diffs.append(float(np.mean(e[f, j]) - np.mean(e[r, j])))
-        if len(diffs) >= 3:
-            d = np.asarray(diffs)
-            se = float(np.std(d, ddof=1)) / np.sqrt(d.size)
-            out[j] = bool(np.mean(d) > HYSTERESIS_SIGMAS * se and np.mean(d) > 0)
+        left = []
+        for y in (tau[:, j] - model[ok][:, j], -tau[:, j] - model[ok][:, j]):
+            coef = np.linalg.lstsq(X, y, rcond=None)[0]
+            left.append(float(np.sum((y - X @ coef) ** 2)))
+        out[j] = left[0] <= SIGN_RESIDUAL_SHARE * left[1]
     return out
 
 
