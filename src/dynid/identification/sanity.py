@@ -463,13 +463,15 @@ def opposite_sign(robot: Robot, log: TorqueLog) -> str | None:
     step = max(1, log.n_samples // _MAX_SAMPLES)
     at = np.arange(0, log.n_samples, step)
     centred = _gravity_spread(robot, log.q[at], log.tau[at])
-    if centred is None:
-        return None
-    gc, tc, loaded = centred
-    corr = _correlations(gc, tc)
+    if centred is None:  # gravity barely varies: its means and the motion's torques tell
+        loaded, corr = np.zeros(robot.n, dtype=bool), np.zeros(robot.n)
+    else:
+        gc, tc, loaded = centred
+        corr = _correlations(gc, tc)
     right = flipped = np.zeros(robot.n, dtype=bool)
     every = corr
     off_scale = np.zeros(robot.n, dtype=bool)
+    closer: dict[int, tuple[float, float]] = {}
     if (whole := _motion_torques(robot, log, at)) is not None:  # each can be fooled alone
         model, ok = whole
         every, slope = _explained(model[ok], log.tau[at][ok])
@@ -477,17 +479,19 @@ def opposite_sign(robot: Robot, log: TorqueLog) -> str | None:
         right, flipped = _confirmed(every, slope), _confirmed(-every, -slope) & ~loaded
         lo, hi = CONFIRMED_SLOPE
         off_scale = right.any() & ((-slope < lo) | (-slope > hi))
+        closer = _closer_negated(model[ok], log.tau[at][ok])
+        flipped = flipped | np.isin(np.arange(robot.n), list(closer))
     # where the model explains other joints at their scale, a joint whose negated model
     # torques would not explain its own at about theirs holds something the rigid bodies
     # lack (a spring, a counterbalance), not a flipped sign; nor does one whose torques as
     # read are the model's plus a function of its own position and friction
     strong = (loaded & (corr < OPPOSITE_CORRELATION) & ~off_scale) | flipped
-    if right.any() and strong.any() and whole is not None:
+    if strong.any() and whole is not None:
         strong &= ~_reads_right(log, at, whole[0], whole[1], strong)
     if not strong.any():
         return None
-    if right.any() or not bool(np.all(every[loaded] < 0)):
-        return _opposite(corr, strong, loaded | right, robot.joint_names)
+    if right.any() or not loaded.any() or not bool(np.all(every[loaded] < 0)):
+        return _opposite(corr, strong, loaded | right, robot.joint_names, closer)
     names = robot.joint_names
     j = int(np.flatnonzero(strong)[np.argmin(corr[strong])])
     said = (
@@ -561,6 +565,30 @@ def _reads_right(
             left.append(float(np.sum((y - X @ coef) ** 2)))
         out[j] = left[0] <= SIGN_RESIDUAL_SHARE * left[1]
     return out
+
+
+#: A joint's measured torques are the negated model's (:func:`_closer_negated`) when
+#: their RMS distance from those is below this share of that from the model's own...
+NEGATED_DISTANCE_SHARE = 0.5
+#: ... and the model's torques there have at least this share of the measured torques'
+#: RMS (a joint the model barely loads tells nothing).
+NEGATED_MODEL_SHARE = 0.3
+
+
+def _closer_negated(
+    model: NDArray[np.float64], tau: NDArray[np.float64]
+) -> dict[int, tuple[float, float]]:
+    """The joints whose measured torques ``tau`` (N, n) [N m] lie far closer to the negated
+    model's torques ``model`` (N, n) than to the model's own, means included
+    (:data:`NEGATED_DISTANCE_SHARE`, :data:`NEGATED_MODEL_SHARE`), with the RMS distances
+    [N m] from the negated and from the model's torques. The correlations look at the
+    variations alone: a UR5 elbow logged with the opposite sign held +15 N m where the
+    model's gravity held -15 N m, while its variations correlated -0.01 to -0.43 with
+    the model's, and the log was fitted without a word."""
+    rms = lambda x: np.sqrt(np.mean(x**2, axis=0))  # noqa: E731
+    near, far, size = rms(tau + model), rms(tau - model), rms(tau)
+    hit = (near < NEGATED_DISTANCE_SHARE * far) & (rms(model) >= NEGATED_MODEL_SHARE * size)
+    return {int(j): (float(near[j]), float(far[j])) for j in np.flatnonzero(hit)}
 
 
 def _explained(
@@ -651,18 +679,37 @@ def _opposite(
     strong: NDArray[np.bool_],
     judged: NDArray[np.bool_],
     names: tuple[str, ...],
+    closer: dict[int, tuple[float, float]] | None = None,
 ) -> str | None:
     """The finding of the joints ``strong`` (n,) anti-correlated with the model's torques
-    (``corr``, n) while others the checks judge (``judged``) are not: named, with the
-    ``--units`` entries that flip their columns alone (``tau2=-1``), and the joints
-    neither check judges."""
+    (``corr``, n), or closer to its negated torques (``closer``: the RMS distances from
+    the negated and from the model's, :func:`_closer_negated`), while others the checks
+    judge (``judged``) are not: named, with the ``--units`` entries that flip their
+    columns alone (``tau2=-1``), and the joints neither check judges."""
     rest = np.flatnonzero(judged & ~strong)
     free = np.flatnonzero(~judged & ~strong)
     bad = np.flatnonzero(strong)
     which = ", ".join(names[k] for k in bad)
+    near = {k: v for k, v in (closer or {}).items() if strong[k]}
+    anti = bool(np.all(corr[bad] < OPPOSITE_CORRELATION))
+    evidence = (
+        f"correlation {', '.join(f'{corr[k]:+.2f}' for k in bad)}"
+        if not near
+        else "; ".join(
+            f"{names[k]}: correlation {corr[k]:+.2f}"
+            + (
+                f", {near[k][0]:.3g} N m RMS from the negated model's torques against "
+                f"{near[k][1]:.3g} from the model's, means included"
+                if k in near
+                else ""
+            )
+            for k in bad
+        )
+    )
     return (
-        f"the measured torques of {which} are anti-correlated with the model's torques "
-        f"(gravity and motion; correlation {', '.join(f'{corr[k]:+.2f}' for k in bad)})"
+        f"the measured torques of {which} are "
+        + ("anti-correlated with" if anti else "of the opposite sign to")
+        + f" the model's torques (gravity and motion; {evidence})"
         + (
             f" while those of {', '.join(f'{names[k]} ({corr[k]:+.2f})' for k in rest)} are "
             "not, on some joints only"
