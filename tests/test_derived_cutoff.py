@@ -84,3 +84,23 @@ def test_the_hint_needs_derived_velocities_and_a_cut_off_well_above_the_motions(
     assert derived_cutoff_hint([meas], 3.0 * motion) is None
     good = Verdict("good", "at the noise floor", "error 0.5 %", 1.1)
     assert with_derived_cutoff_hint(good, [pos], 3.0 * motion) is good
+
+
+def test_positions_logged_in_milliseconds_are_told_so_not_a_cutoff_error():
+    """Regression (a positions-only log with its time in ms, 500 Hz read as 0.5 Hz, failed
+    with "cutoff_hz must lie in (0, fs/2) = (0, 0.25) Hz; got 5 Hz", before any check could
+    say milliseconds): the error gives the rate and the hint --units t=ms; a log sampled in
+    seconds too slowly for the cut-off gives the rate alone."""
+    from dynid.exceptions import DataError
+
+    t = np.arange(200) * 2.0  # ms
+    q = np.sin(2 * np.pi * t[:, None] / 1000.0) * np.ones((1, 2))
+    log = TorqueLog(t, q, np.zeros_like(q), np.zeros_like(q))
+    with pytest.raises(DataError, match=r"sampled at 0\.5 Hz.*steps of 2 look like milli.*t=ms"):
+        with_derived_velocities(log, 5.0)
+    slow = TorqueLog(t / 200.0, q, np.zeros_like(q), np.zeros_like(q))  # 100 Hz, in seconds
+    with pytest.raises(DataError, match=r"sampled at 100 Hz: velocities cannot be derived at 60"):
+        with_derived_velocities(slow, 60.0)
+    with pytest.raises(DataError) as caught:
+        with_derived_velocities(slow, 60.0)
+    assert "t=ms" not in str(caught.value)

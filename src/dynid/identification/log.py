@@ -328,7 +328,26 @@ class TorqueLog:
 def with_derived_velocities(log: TorqueLog, cutoff_hz: float = DEFAULT_CUTOFF_HZ) -> TorqueLog:
     """The log with ``dq`` from the zero-phase filtered derivative of ``q``
     (:func:`dynid.signals.filtered_derivative`, low-pass at ``cutoff_hz`` [Hz]); for logs that
-    record positions only (whatever ``log.dq`` holds is replaced). ``ddq`` is kept."""
+    record positions only (whatever ``log.dq`` holds is replaced). ``ddq`` is kept.
+
+    Raises
+    ------
+    DataError
+        A log sampled at less than twice ``cutoff_hz``: its rate, and where its time steps
+        look like milliseconds (0.5 to 100 units), the hint ``--units t=ms``.
+    """
+    if log.t.shape[0] > 1:
+        dt = float(np.median(np.diff(log.t)))
+        if dt > 0 and cutoff_hz >= 0.5 / dt:
+            ms = (
+                f"; its time steps of {dt:g} look like milliseconds; hint: --units t=ms"
+                if 0.5 <= dt <= 100
+                else ""
+            )
+            raise DataError(
+                f"positions only, sampled at {1 / dt:.3g} Hz: velocities cannot be derived at "
+                f"{cutoff_hz:g} Hz (above half the rate){ms}"
+            )
     dq = signals.filtered_derivative(log.t, log.q, cutoff_hz)
     return TorqueLog(log.t, log.q, dq, log.tau, log.ddq, log.cleaning, dq_derived=True)
 
