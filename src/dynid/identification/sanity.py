@@ -723,9 +723,14 @@ def _opposite(
             if free.size
             else ""
         )
-        + f"; hint: --units {','.join(f'tau{k + 1}=-1' for k in bad)} reads "
-        + ("it" if bad.size == 1 else "them")
-        + " flipped (beside the torques' unit, if one is given)"
+        + (
+            f"; hint: --units tau=-1 if every joint's is opposite, --units "
+            f"{','.join(f'tau{k + 1}=-1' for k in bad)} if these only"
+            if rest.size == 0 and bad.size > 1
+            else f"; hint: --units {','.join(f'tau{k + 1}=-1' for k in bad)} reads "
+            + ("it" if bad.size == 1 else "them")
+            + " flipped (beside the torques' unit, if one is given)"
+        )
     )
 
 
