@@ -81,3 +81,24 @@ def test_a_single_missing_torque_column_is_named_without_a_map(tmp_path):
     with pytest.raises(DataError, match=r"missing column\(s\) \['tau7'\]") as err:
         load_torque_log(path)
     assert "present but unused: note" in str(err.value) and "--columns '" not in str(err.value)
+
+
+def test_a_time_column_of_another_name_is_mapped_with_its_unit(tmp_path):
+    """Regression (a header time_ms, pos_1.., vel_1.., effort_1.. gave no --columns hint:
+    the hint needed a column named t): the hint maps the time column too, with --units
+    t=ms from its name, and that map reads the values written."""
+    rng = np.random.default_rng(4)
+    t = np.arange(50) * 10.0  # ms
+    q, dq, tau = (rng.uniform(-1, 1, (50, N)) for _ in range(3))
+    header = ["time_ms", *_cols("pos_"), *_cols("vel_"), *_cols("effort_")]
+    path = tmp_path / "log.csv"
+    np.savetxt(path, np.column_stack([t, q, dq, tau]), delimiter=",", header=",".join(header),
+               comments="", fmt="%.17g")  # fmt: skip
+    with pytest.raises(DataError) as err:
+        load_torque_log(path)
+    said = str(err.value)
+    spec = "t=time_ms,q=pos_{i},dq=vel_{i},tau=effort_{i}"
+    assert f"hint: --columns '{spec}' --units t=ms reads them" in said, said
+    log = load_mapped_torque_log(path, parse_column_map(spec, "t=ms")).log
+    np.testing.assert_allclose(log.t, t / 1000.0)
+    np.testing.assert_array_equal(log.tau, tau)

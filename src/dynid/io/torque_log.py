@@ -39,7 +39,7 @@ from __future__ import annotations
 import logging
 import re
 import zipfile
-from collections.abc import Callable, Iterable
+from collections.abc import Callable, Iterable, Sequence
 from pathlib import Path
 
 import numpy as np
@@ -414,6 +414,17 @@ def _annotated_hint(names: list[str]) -> str:
     return f"; hint: names with units are read by --columns '{spec}' (and --units if not SI)"
 
 
+def _time_column(names: Sequence[str]) -> str | None:
+    """The one column of a header whose name reads as time (``time``, ``timestamp``,
+    ``time_ms``, ``stamp_s``), or None (none, or several)."""
+    found = [
+        c
+        for c in names
+        if re.fullmatch(r"(t|time|timestamp|stamp|sec|secs|seconds)([_ ]?(s|ms|us|ns))?", c.lower())
+    ]
+    return found[0] if len(found) == 1 else None
+
+
 def _columns(path: Path, names: list[str], line: int) -> tuple[int, bool]:
     """Check the header; return the joint count n and whether ddq columns are present."""
     at = f"line {line}"
@@ -426,10 +437,19 @@ def _columns(path: Path, names: list[str], line: int) -> tuple[int, bool]:
     n = len(qs)
     if "t" not in names or n == 0:
         hint = _annotated_hint(names) or import_hint(names, path.name)
-        if not hint and "t" in names and (k := position_count(names)):
+        time = "t" if "t" in names else _time_column(names)
+        if not hint and time is not None and (k := position_count(names)):
             signals = [s for s in ("q", "tau") if f"{s}1" not in names]
             optional = ["dq"] if "dq1" not in names else []
-            hint = column_hint(names, k, signals, {"t"}, optional).split("; hint: ", 1)[-1]
+            hint = column_hint(names, k, signals, {time}, optional).split("; hint: ", 1)[-1]
+            if time != "t" and "--columns '" in hint:  # the time column mapped too
+                unit = re.search(r"(ms|us|ns)$", time.lower())
+                hint = hint.replace("--columns '", f"--columns 't={time},", 1)
+                hint = hint.replace(
+                    "' reads them",
+                    "'" + (f" --units t={unit[1]}" if unit else "") + " reads them",
+                    1,
+                )
             hint = f"; hint: {hint}"
         raise DataError(
             f"header must name columns t, q1..qn, dq1..dqn, tau1..taun; "
