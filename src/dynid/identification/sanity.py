@@ -703,7 +703,7 @@ def _opposite(
                 if k in near
                 else ""
             )
-            for k in bad
+            for k in map(int, bad)
         )
     )
     return (
