@@ -203,8 +203,10 @@ def register(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParser:
         type=positive_type,
         default=None,
         metavar="SECONDS",
-        help="longest step the observer integrates over [s]; the log is cut at longer "
-        "ones and the observer starts again (default: 2.5 median steps, at least 0.02 s)",
+        help="longest step the observer integrates over [s], rows dropped by "
+        "--drop-invalid included (bridged as identify bridges them); the log is cut at "
+        "longer ones and the observer starts again (default: 2.5 median steps, at least "
+        "0.02 s)",
     )
     p.add_argument("--no-figures", action="store_true", help="skip the PNG figures")
     p.add_argument("--out", type=output_path, required=True, help="output directory")

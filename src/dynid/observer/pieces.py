@@ -1,10 +1,14 @@
 """A log as the observer may read it: pieces between its gaps, and positions that jump.
 
 The residual integrates the measured torques from the momentum at its first sample: across
-a gap (a stop of the recording longer than the longest step, or rows dropped for NaN or
-inf) the momentum and the torques of the missing time are unknown, so the observer starts
-again after it (:func:`pieces`; the residual is 0 at each piece's first sample and no event
-spans a cut, :func:`~dynid.observer.detection.detect`'s ``restarts``). Inside a piece, a
+a gap (a stop of the recording longer than the gap rule ``identify`` cuts at, 2.5 median
+steps by default) the momentum and the torques of the missing time are unknown, so the
+observer starts again after it (:func:`pieces`; the residual is 0 at each piece's first
+sample and no event spans a cut, :func:`~dynid.observer.detection.detect`'s ``restarts``).
+A shorter step (a sample or two lost, a row dropped for NaN or inf) is bridged as
+``identify`` bridges it: the observer's update takes any step ``T``
+(:mod:`~dynid.observer.residual`), exact for an external torque constant over it, so it
+carries on across the step with its actual length. Inside a piece, a
 position that moves more than its recorded velocity allows over one step (an encoder
 glitch, a re-homing) changes ``M(q)`` and ``g(q)`` at once: :func:`position_jumps` finds it
 for a warning.
@@ -12,7 +16,6 @@ for a warning.
 
 from __future__ import annotations
 
-from collections.abc import Sequence
 from dataclasses import dataclass
 
 import numpy as np
@@ -29,15 +32,14 @@ JUMP_FACTOR = 20.0
 JUMP_FLOOR = 1e-3
 
 
-def pieces(t: ArrayLike, max_gap_s: float, cut_after: Sequence[float] = ()) -> NDArray[np.int64]:
-    """First sample of every piece (K,) of the times ``t`` (N,) [s]: 0, every sample after a
-    step longer than ``max_gap_s`` [s], and every sample after a time of ``cut_after`` [s]
-    (rows dropped there)."""
+def pieces(t: ArrayLike, max_gap_s: float) -> NDArray[np.int64]:
+    """First sample of every piece (K,) of the times ``t`` (N,) [s]: 0 and every sample
+    after a step longer than ``max_gap_s`` [s] (the rule of
+    :func:`~dynid.identification.pieces.split_at_gaps`); rows dropped where the step stays
+    within it are bridged."""
     ta = _checks.as_array("t", t)
     starts = np.flatnonzero(np.diff(ta) > max_gap_s) + 1
-    after = np.searchsorted(ta, np.asarray(cut_after, dtype=np.float64), side="right")
-    cuts = np.union1d(np.concatenate([[0], starts]), after[after < ta.shape[0]])
-    return cuts.astype(np.int64)
+    return np.concatenate([[0], starts]).astype(np.int64)
 
 
 @dataclass(frozen=True, slots=True)

@@ -13,11 +13,14 @@ the command applies, so that the Python API behaves as the command does.
   warning), through the column map the model's data were read with when none is given, and
   brought to the joint side through the model's drive. A log is cut at its gaps (steps
   longer than ``max_gap``, default :func:`~dynid.identification.log.default_max_gap`, as
-  ``identify`` cuts) and after rows dropped for NaN or inf (``drop_invalid``; refused
-  otherwise, the row named): the observer starts again on each piece and no event spans a
-  cut (one warning names the file and the times); a position that jumps more than its
-  velocity explains over a regular time step (samples lost without a gap in the stamps, an
-  encoder glitch) cuts the log there too, with a warning (:mod:`dynid.observer.pieces`).
+  ``identify`` cuts): the observer starts again on each piece and no event spans a cut
+  (one warning names the file and the times). Rows dropped for NaN or inf
+  (``drop_invalid``; refused otherwise, the row named) are bridged as ``identify``
+  bridges them: the observer carries on across the step they leave when it is within
+  that rule (its update takes any step), and a longer one is a gap. A position that
+  jumps more than its velocity explains over a regular time step (samples lost without a
+  gap in the stamps, an encoder glitch) cuts the log there too, with a warning
+  (:mod:`dynid.observer.pieces`).
   Several logs are checked together: one in other units than the others is refused, one
   far outside the joint limits warned about (:mod:`dynid.workflows.recordings`).
 * One-sample torque spikes (a sensor or logging fault, by the rule ``identify`` replaces
@@ -185,9 +188,11 @@ class ObserveOptions:
         ``--columns``/``--units``; default: those the model's data were read with.
     drop_invalid : bool
         Drop rows with NaN/inf or a repeated timestamp instead of failing (the observer
-        starts again after rows dropped for NaN/inf).
+        carries on across the step they leave, or starts again after it when it is longer
+        than ``max_gap``).
     max_gap : float, optional
-        Longest step [s] the observer integrates over; the log is cut at longer ones.
+        Longest step [s] the observer integrates over (rows dropped with
+        ``drop_invalid`` included); the log is cut at longer ones.
     base, tip : str, optional
         The chain of a ``params`` URDF with several leaves (its root and only leaf by
         default).

@@ -1,9 +1,10 @@
 """A log as ``dynid observe`` runs the momentum observer on it (:mod:`dynid.workflows.observe`).
 
 :func:`prepared_log` brings it to the joints through the model's drive, unwraps joints
-recorded in ``[-pi, pi]``, cuts it at its gaps and after rows dropped for NaN or inf, and
-again where positions jump more than the velocities explain (each with a warning naming the
-file), and keeps the spans the observer runs on. :func:`observed_blocks` then runs one
+recorded in ``[-pi, pi]``, cuts it at its gaps (steps longer than the rule ``identify``
+cuts at: rows dropped for NaN or inf leaving a shorter step are bridged), and again where
+positions jump more than the velocities explain (each with a warning naming the file),
+and keeps the spans the observer runs on. :func:`observed_blocks` then runs one
 observer per piece a block of :data:`OBSERVE_BLOCK` samples at a time, with the residual's
 std from the model's covariance and the standstill margin of the same samples: a long log
 is observed with one block's temporaries (a calibration keeps only running statistics;
@@ -286,18 +287,24 @@ def _observed_spans(path: Path, log: TorqueLog, starts: list[int]) -> list[tuple
 
 def _pieces(path: Path, log: TorqueLog, max_gap: float | None) -> list[int]:
     """First sample of each piece the observer runs on (module docstring), with a
-    warning of the cuts (file and times)."""
+    warning of the cuts (file and times). Rows dropped for NaN or inf are bridged where
+    the step they leave is within the gap rule, as ``identify`` bridges them (one NaN row
+    inside a push split its event in two; on a log of positions only each restart also
+    left 0.2 s unobserved); a longer step is a gap like any other."""
     c = log.cleaning
     dt = np.diff(log.t)
     limit = max_gap
     if limit is None:
         limit = default_max_gap(float(np.median(dt)) if dt.size else 1.0)
-    starts = [int(k) for k in pieces(log.t, limit, c.invalid_after)]
+    starts = [int(k) for k in pieces(log.t, limit)]
     if len(starts) > 1:
         at = ", ".join(f"{log.t[k]:.6g}" for k in starts[1:6])
         more = f" and {len(starts) - 6} more" if len(starts) > 6 else ""
+        after = np.searchsorted(log.t, np.asarray(c.invalid_after, dtype=np.float64), side="right")
         why = f"gaps longer than {limit:.3g} s" + (
-            f" or after {c.n_nan_rows} row(s) dropped for NaN/inf" if c.invalid_after else ""
+            " (some where rows were dropped for NaN/inf)"
+            if np.intersect1d(after, starts[1:]).size
+            else ""
         )
         warnings.warn(
             f"{path.name}: cut at {why}: the observer starts again at t = {at}{more} s "
