@@ -140,8 +140,8 @@ def test_a_solver_panic_is_a_failed_solve(noisy_panda_model, monkeypatch, tmp_pa
 
     def panicking(make):
         def made():
-            solver = make()
-            solver.solve_via_data = panic
+            solver = make()  # the one instance the process shares: patched until teardown
+            monkeypatch.setattr(solver, "solve_via_data", panic)
             return solver
 
         return made
