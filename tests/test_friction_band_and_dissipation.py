@@ -90,6 +90,14 @@ def test_a_law_that_pushes_the_arm_is_set_aside_though_it_predicts_best():
     assert not law_violations(sel.fit.friction, np.array([2.0, 2.0]))
 
 
+def test_a_law_pushing_at_every_speed_within_the_limit_names_the_torque_sign():
+    """Up to 1 rad/s, 2 v - 3 < 0 on joint 1: pushing at every speed, as a flipped tau1."""
+    sel = select_friction(_pushing_residual(5), dq_max=np.array([1.0, 1.0]))
+    (v,) = next(s for s in sel.scores if s.name == "asymmetric").unphysical
+    assert v.everywhere
+    assert "check the sign of tau1" in sel.table()
+
+
 def test_when_every_law_pushes_the_choice_says_so():
     """Only the asymmetric law compared: kept, with a warning naming joint 1's fc_neg1."""
     res = _pushing_residual(4)

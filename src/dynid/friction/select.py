@@ -217,9 +217,16 @@ class FrictionSelection:
         )
         for s in self.scores:
             if s.unphysical:
+                flipped = [f"tau{v.joint + 1}" for v in s.unphysical if v.everywhere]
                 rows.append(
                     f"set aside (x): {s.name}, not dissipative within the velocity limits "
                     f"(the offset aside): {'; '.join(map(str, s.unphysical))}"
+                    + (
+                        f" (pushing at every speed, as a torque of the opposite sign does: "
+                        f"check the sign of {', '.join(flipped)})"
+                        if flipped
+                        else ""
+                    )
                 )
         return "\n".join(rows)
 
