@@ -6,7 +6,10 @@ robot's own link parameters with --robot) is fitted per joint by a friction law:
 no extra friction) on 4 of 5 contiguous blocks of the log in turn (with several
 recordings: on all but one recording in turn), predicts the block left out, keeps the
 simplest law within one standard error of the lowest held-out error, each joint in units
-of its own torque noise, as identify chooses its structure (the model's own friction is a
+of its own torque noise, as identify chooses its structure, among the laws whose
+friction is dissipative within the robot's velocity limits, the offset aside (a law that
+pushes the arm somewhere is marked x and set aside, as identify skips such a structure;
+when every law does, the choice says so in a warning) (the model's own friction is a
 candidate too, judged on the same blocks: as it is, or its own law, band and coefficients
 refitted on the other blocks when --model was identified from these recordings, the law
 it was trained with; a robot's own friction is never refitted; kept, it is kept as it is,
@@ -18,7 +21,8 @@ takes several recordings (or a folder of them): each recording, and each piece o
 cut at a gap longer than --max-gap, is filtered on its own, and the laws are fitted on
 the residual of all pieces together, at every sample as measured (the torques validate
 judges; a log of jittered stamps at its own samples, not on a grid between them).
-Coulomb friction is off where |dq| is inside the velocity noise band. The states are
+Coulomb friction is off where |dq| is inside the velocity noise band of the filtered
+velocities, the band identify gives its Coulomb terms on the same recordings. The states are
 low-pass filtered with zero phase (--cutoff) and the accelerations differentiated from
 the filtered velocities. With a drive (--drive, the model's own, or a --robot TOML's
 [drive] table) the log is read through it, a robot's links get the drive's known rotor

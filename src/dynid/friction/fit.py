@@ -47,7 +47,8 @@ from ..exceptions import ConvergenceError, DataError, DynidWarning, ShapeError, 
 from ..identification.log import TorqueLog, joint_side_log
 from ..identification.model import IdentifiedModel
 from ..identification.prepare import MEASURED, Preprocessing, prepare_log
-from ..identification.sanity import moving_joints, noise_band, velocity_noise_std
+from ..identification.recordings import standstill_band
+from ..identification.sanity import NOISE_BAND_STD, moving_joints, noise_band, velocity_noise_std
 from ..model.drive import Drive
 from ..model.robot import Robot
 from .laws import FrictionLaw, law_named
@@ -158,8 +159,10 @@ class FrictionResidual:
     residual : ndarray, shape (N, n)
         ``log.tau - tau_model`` [N m].
     dq_noise_std : ndarray, shape (n,), optional
-        White-noise std of the measured (unfiltered) velocities [rad/s]
-        (:func:`velocity_noise_std` of the log before preparation); None when unknown.
+        White-noise std of the prepared (low-passed) velocities [rad/s], read from the log
+        before preparation as identification reads it: its standstill band
+        (:func:`~dynid.identification.recordings.standstill_band`) over
+        :data:`~dynid.identification.sanity.NOISE_BAND_STD`; None when unknown.
     recording : ndarray of int, shape (N,), optional
         The recording of each sample when the residual holds several
         (:func:`~dynid.friction.recordings.pieces_residual`); None: one recording.
@@ -259,7 +262,7 @@ def friction_residual(
     p = prepare_log(log, prep)
     assert p.ddq is not None  # prepare_log always fills ddq
     tau_m = torques_through(model, d, p.q, p.dq, p.ddq)
-    noise = _checks.frozen(velocity_noise_std(log.dq, log.t))
+    noise = _checks.frozen(standstill_band([log], prep.cutoff_hz) / NOISE_BAND_STD)
     return FrictionResidual(log=p, tau_model=tau_m, residual=p.tau - tau_m, dq_noise_std=noise)
 
 

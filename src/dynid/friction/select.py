@@ -30,6 +30,15 @@ to:
    differences under :data:`~dynid.identification.candidates.RELATIVE_TIE` of the lowest
    counting as ties), fitted on the whole log. A Stribeck bump that predicts 0.005 points
    better than the classical law is not worth its two coefficients.
+5. A law whose fit on the whole log is not dissipative within the robot's velocity
+   limits, its offset aside (``f(v) v < 0`` somewhere: friction that pushes the arm,
+   :func:`~dynid.friction.dissipative.law_violations`, the check identification's
+   structure selection applies to its candidates), is set aside: judged and shown, not
+   chosen (an asymmetric law with ``fc+ = 7.86``, ``fc- = -13.8`` on a UR5 elbow, an
+   offset and a Coulomb level of -2.97 N m, was kept without a word). When every
+   candidate is, the choice is made among them with a warning naming where each pushes.
+   The model's own friction is not judged here (identification judged it; a robot's is
+   its description's).
 
 The candidates are the laws of the registry (``none``: no extra friction, the rigid model
 alone) and, when the model comes with friction of its own (an identification's classical
@@ -52,18 +61,20 @@ from __future__ import annotations
 
 import warnings
 from collections.abc import Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
-from numpy.typing import NDArray
+from numpy.typing import ArrayLike, NDArray
 
 from ..exceptions import DataError, DynidWarning, OptionError
 from ..identification.candidates import RELATIVE_TIE, paired_fold_se
+from ..identification.dissipation import Violation
 from ..identification.holdout import DEFAULT_FOLDS, block_labels
 from ..identification.input_noise import quantized_noise_std
 from ..identification.structure import ERROR_FLOOR_PERCENT
 from ..identification.verdict import NOISE_FLOOR_SHARE
 from ..model.drive import Drive
+from .dissipative import law_violations
 from .fit import FrictionFit, FrictionResidual, fit_friction_through, fit_law_through
 from .laws import LAWS
 from .laws.base import _LinearFit, bounded_lstsq
@@ -114,6 +125,10 @@ class CandidateScore:
         :attr:`scaled_error_percent` per fold.
     n_params : int
         Coefficients per joint (the model's own: those it holds, nonzero on some joint).
+    unphysical : tuple of Violation
+        Where the law fitted on the whole log is not dissipative within the velocity
+        limits, its offset aside (:func:`~dynid.friction.dissipative.law_violations`):
+        such a candidate is set aside (module docstring); empty for the model's own.
     """
 
     name: str
@@ -123,6 +138,7 @@ class CandidateScore:
     scaled_error_percent: float = float("nan")
     fold_scaled_percent: tuple[float, ...] = ()
     n_params: int = 0
+    unphysical: tuple[Violation, ...] = ()
 
 
 @dataclass(frozen=True, slots=True, eq=False)
@@ -155,12 +171,15 @@ class FrictionSelection:
         """JSON-ready: ``method``, ``folds``, ``rule``, ``chosen`` and one row per candidate
         (``model``, ``parameters``, ``n_params``, ``train_error_percent``,
         ``heldout_error_percent``, ``heldout_scaled_percent``,
-        ``heldout_scaled_per_fold_percent``)."""
+        ``heldout_scaled_per_fold_percent``, ``not_dissipative``: one line per joint where
+        its friction pushes the arm, empty when it does not) and ``set_aside``: the
+        candidates not chosen for that."""
         return {
             "method": self.method,
             "folds": self.folds,
             "rule": self.rule,
             "chosen": self.chosen,
+            "set_aside": [s.name for s in self.scores if s.unphysical],
             "candidates": [
                 {
                     "model": s.name,
@@ -170,13 +189,15 @@ class FrictionSelection:
                     "heldout_error_percent": s.heldout_error_percent,
                     "heldout_scaled_percent": s.scaled_error_percent,
                     "heldout_scaled_per_fold_percent": list(s.fold_scaled_percent),
+                    "not_dissipative": [str(v) for v in s.unphysical],
                 }
                 for s in self.scores
             ],
         }
 
     def table(self) -> str:
-        """The candidates as a text table, the kept one marked with ``*``, and the rule."""
+        """The candidates as a text table, the kept one marked with ``*``, those set aside
+        (not dissipative) with ``x`` and a line each saying where, and the rule."""
         w = max([12, *(len(s.name) for s in self.scores)])
         p = max([10, *(len(", ".join(s.params)) for s in self.scores)])
         rows = [
@@ -184,7 +205,7 @@ class FrictionSelection:
             f"{'held-out [%]':>13} {'by noise [%]':>13}"
         ]
         for s in self.scores:
-            mark = "*" if s.name == self.chosen else " "
+            mark = "*" if s.name == self.chosen else ("x" if s.unphysical else " ")
             rows.append(
                 f"{mark} {s.name:<{w}} {', '.join(s.params) or '-':<{p}} "
                 f"{s.train_error_percent:>10.3f} {s.heldout_error_percent:>13.3f} "
@@ -194,6 +215,19 @@ class FrictionSelection:
             f"kept (*): {self.rule} (by noise); {self.method}, the rigid-body model as "
             "given (not refitted per fold)"
         )
+        for s in self.scores:
+            if s.unphysical:
+                flipped = [f"tau{v.joint + 1}" for v in s.unphysical if v.everywhere]
+                rows.append(
+                    f"set aside (x): {s.name}, not dissipative within the velocity limits "
+                    f"(the offset aside): {'; '.join(map(str, s.unphysical))}"
+                    + (
+                        f" (pushing at every speed, as a torque of the opposite sign does: "
+                        f"check the sign of {', '.join(flipped)})"
+                        if flipped
+                        else ""
+                    )
+                )
         return "\n".join(rows)
 
 
@@ -225,6 +259,7 @@ def select_friction(
     own: FrictionModel | FrictionSum | None = None,
     own_fitted_here: bool = False,
     folds: int = FOLDS,
+    dq_max: ArrayLike | None = None,
 ) -> FrictionSelection:
     """Fit the candidate laws and keep the simplest that predicts held-out data as well as
     the best (module docstring, step 4).
@@ -248,6 +283,10 @@ def select_friction(
     folds : int
         Number of contiguous blocks (>= 2); not used when ``res`` holds several
         recordings (one is left out at a time).
+    dq_max : array_like, shape (n,), optional
+        Joint velocity limits [rad/s]: a law whose fit on the whole log is not
+        dissipative within them (:func:`~dynid.friction.dissipative.law_violations`) is
+        set aside (module docstring); None: no check.
 
     Returns
     -------
@@ -263,7 +302,8 @@ def select_friction(
     Warns
     -----
     DynidWarning
-        Joints that never move (their friction is zero).
+        Joints that never move (their friction is zero); every candidate set aside (the
+        choice made among them, their joints and coefficients named).
     """
     compared = [name for name, law in LAWS.items() if law.compared]
     if own_fitted_here and isinstance(own, FrictionModel) and own.kind in LAWS:
@@ -293,11 +333,31 @@ def select_friction(
             fits[name] = fit_friction_through(res, drive, name)
         train = fits[name].friction.torques(res.dq)
         held = _heldout_torques(res, drive, name, labels)
-        scores.append(judge.score(name, LAWS[name].params, len(LAWS[name].params), train, held))
+        bad = () if dq_max is None else law_violations(fits[name].friction, dq_max)
+        score = judge.score(name, LAWS[name].params, len(LAWS[name].params), train, held)
+        scores.append(replace(score, unphysical=bad))
     if own_score is not None and last:
         scores.append(own_score)
-    kept = simplest_within(scores, prefer=OWN if own is not None else None)
+    kept = simplest_within(_dissipative(scores), prefer=OWN if own is not None else None)
     return FrictionSelection(fits[kept.name], kept.name, tuple(scores), folds, method)
+
+
+def _dissipative(scores: Sequence[CandidateScore]) -> list[CandidateScore]:
+    """The candidates whose friction dissipates (all of them, with a warning naming
+    where each pushes the arm, when none does), as identification's structure selection
+    skips a candidate whose friction is not dissipative."""
+    kept = [s for s in scores if not s.unphysical]
+    if kept:
+        return kept
+    where = "; ".join(f"{s.name}: {', '.join(map(str, s.unphysical))}" for s in scores)
+    warnings.warn(
+        f"every friction law compared is not dissipative within the velocity limits (the "
+        f"offset aside), so the one kept pushes the arm somewhere: {where}; hint: check the "
+        "torque sign of those joints (--units tauJ=-1) and the model's terms",
+        DynidWarning,
+        stacklevel=3,
+    )
+    return list(scores)
 
 
 def simplest_within(scores: Sequence[CandidateScore], prefer: str | None = None) -> CandidateScore:

@@ -20,12 +20,12 @@ transmission, the identity at the joints); joints without a limit are not checke
 from __future__ import annotations
 
 import warnings
-from collections.abc import Sequence
+from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
-from numpy.typing import NDArray
+from numpy.typing import ArrayLike, NDArray
 
 from ..exceptions import DynidWarning
 from ..regressors.terms import PART_LABELS, LinearFriction, ModelTerm
@@ -42,7 +42,9 @@ __all__ = [
     "friction_columns",
     "friction_violations",
     "negative_viscous",
+    "power_violations",
     "reversed_sign_finding",
+    "speed_limits",
     "warn_unphysical",
 ]
 
@@ -198,16 +200,9 @@ def friction_violations(
         return ()
     drive = terms[0][0].drive
     n = drive.n
-    K = np.abs(np.asarray(drive.friction_transmission, dtype=np.float64))
-    limit = np.broadcast_to(np.asarray(dq_max, dtype=np.float64), (n,))
-    vmax = np.array([float(np.sum(K[m, K[m] != 0] * limit[K[m] != 0])) for m in range(n)])
-    where = "motor" if drive.friction_at == "motor" else "joint"
-    grid = np.linspace(-1.0, 1.0, GRID)
-    v = grid[:, None] * np.where(np.isfinite(vmax), vmax, 0.0)[None, :]
-    f = np.zeros_like(v)
+    parts: list[tuple[LinearFriction, int, str, float]] = []  # (term, joint, part, value)
     coefficients: list[dict[str, float]] = [{} for _ in range(n)]
     for k, (term, values) in enumerate(terms):
-        cols = term.part_columns(v)  # (s, n, k): the parts in order
         every = [(j, p) for j in range(n) for p in term.parts]
         mask = term.mask or (True,) * len(every)
         held = [jp for jp, h in zip(every, mask, strict=True) if h]
@@ -218,23 +213,78 @@ def friction_violations(
         for (j, p), x in zip(held, x_all, strict=True):
             if p == "offset" or x == 0.0:
                 continue
-            f[:, j] += x * cols[:, j, term.parts.index(p)]
+            parts.append((term, j, p, float(x)))
             lab = f"{PART_LABELS[p]}{j + 1}"
             coefficients[j][lab] = coefficients[j].get(lab, 0.0) + float(x)
-    power = f * v
+
+    def torques(v: NDArray[np.float64]) -> NDArray[np.float64]:
+        f = np.zeros_like(v)
+        cols = {id(t): t.part_columns(v) for t in {id(t): t for t, *_ in parts}.values()}
+        for term, j, p, x in parts:
+            f[:, j] += x * cols[id(term)][:, j, term.parts.index(p)]
+        return f
+
+    where = "motor" if drive.friction_at == "motor" else "joint"
+    vmax = speed_limits(drive.friction_transmission, dq_max)
+    return power_violations(torques, vmax, coefficients, where)
+
+
+def speed_limits(transmission: ArrayLike, dq_max: ArrayLike) -> NDArray[np.float64]:
+    """The velocity limit [rad/s] (n,) of each motor (joint) where friction acts:
+    ``sum_j |K_mj| dq_max_j`` over the joints it moves (``K`` the friction transmission
+    (n, n), the identity at the joints; ``dq_max`` (n,) the joint limits, ``inf``: none)."""
+    K = np.abs(np.asarray(transmission, dtype=np.float64))
+    n = K.shape[0]
+    limit = np.broadcast_to(np.asarray(dq_max, dtype=np.float64), (n,))
+    return np.array([float(np.sum(K[m, K[m] != 0] * limit[K[m] != 0])) for m in range(n)])
+
+
+def power_violations(
+    torques: Callable[[NDArray[np.float64]], NDArray[np.float64]],
+    vmax: NDArray[np.float64],
+    coefficients: Sequence[Mapping[str, float]],
+    place: str = "joint",
+) -> tuple[Violation, ...]:
+    """Where friction ``f`` is not dissipative: ``f(v) v < 0`` at some ``|v| <= v_max``,
+    on :data:`GRID` velocities per motor (joint) evenly over ``[-v_max, v_max]``; the one
+    check of identified friction (:func:`friction_violations`) and of the laws
+    ``dynid friction`` fits (:func:`~dynid.friction.dissipative.law_violations`).
+
+    Parameters
+    ----------
+    torques : callable
+        ``torques(v (s, n)) -> (s, n)``: the friction torques [N m] at the motor (joint)
+        velocities ``v`` [rad/s], offsets (velocity-independent torques) left out.
+    vmax : ndarray, shape (n,)
+        Velocity limits [rad/s] (:func:`speed_limits`; not finite: not checked).
+    coefficients : sequence of mapping
+        Per motor (joint), its coefficients by label (``{"fc3": -2.97}``): a violation
+        names those below zero, else all of them.
+    place : str
+        ``"joint"`` or ``"motor"``: where the friction acts.
+
+    Returns
+    -------
+    tuple of Violation
+        One per motor (joint) where the friction puts energy in.
+    """
+    vmax = np.asarray(vmax, dtype=np.float64)
+    grid = np.linspace(-1.0, 1.0, GRID)
+    v = grid[:, None] * np.where(np.isfinite(vmax), vmax, 0.0)[None, :]
+    power = np.asarray(torques(v), dtype=np.float64) * v
     scale = np.max(np.abs(power), axis=0)
     out = []
-    for j in range(n):
+    for j in range(vmax.shape[0]):
         if not np.isfinite(vmax[j]) or scale[j] == 0.0:
             continue
         bad = power[:, j] < -1e-9 * scale[j]
         if not bad.any():
             continue
         at = float(np.max(np.abs(v[bad, j])))
-        neg = {k: x for k, x in coefficients[j].items() if x < 0} or coefficients[j]
+        neg = {k: x for k, x in coefficients[j].items() if x < 0} or dict(coefficients[j])
         everywhere = bool(np.all(bad[grid != 0.0]))
         out.append(
-            Violation(j, where, tuple(neg), tuple(neg.values()), at, float(vmax[j]), everywhere)
+            Violation(j, place, tuple(neg), tuple(neg.values()), at, float(vmax[j]), everywhere)
         )
     return tuple(out)
 

@@ -42,7 +42,7 @@ from dataclasses import dataclass
 from typing import Any, Literal
 
 import numpy as np
-from numpy.typing import NDArray
+from numpy.typing import ArrayLike, NDArray
 
 from ..exceptions import DataError, DynidWarning, ShapeError
 from ..model.drive import Drive
@@ -98,6 +98,7 @@ __all__ = [
     "recording_pieces",
     "skipped_piece",
     "split_at_gaps",
+    "standstill_band",
     "unwrapped",
     "wrappable",
 ]
@@ -510,10 +511,8 @@ def prepare_recordings(
     if cutoff_hz == "auto" and cutoff is not None:  # read from the motion: recorded so
         f_q = cutoff / CUTOFF_MULTIPLE
         prepared = [dataclasses.replace(p, motion_frequency_hz=f_q) for p in prepared]
-    gain = lowpass_noise_gain(float(np.median([p.sample_rate for _, p in pieces])), cutoff)
-    # velocities derived from positions: at this cut-off and low-passed again when filtering,
-    # else as read (at the readers' default cut-off)
-    derived = (DEFAULT_CUTOFF_HZ if cutoff is None else cutoff, cutoff is not None, gain)
+    derived = _derived([p for _, p in pieces], cutoff)
+    gain = derived[2]
     return Recordings(
         pieces=tuple(prepared),
         recording=tuple(recording),
@@ -642,7 +641,17 @@ def _band(
     larger of the two where both kinds of piece are given."""
     sides = [joint_side_log(p, drive) for p in pieces]
     K = None if drive is None else np.asarray(drive.friction_transmission)
-    measured = [x for x, p in zip(sides, pieces, strict=True) if not p.dq_derived]
+    return _sides_band(sides, K, derived)
+
+
+def _sides_band(
+    sides: Sequence[TorqueLog],
+    K: NDArray[np.float64] | None,
+    derived: tuple[float, bool, float],
+) -> NDArray[np.float64]:
+    """:func:`_band` of pieces already at the joints, at the velocities ``dq K^T`` (``K``
+    None: the joints')."""
+    measured = [x for x in sides if not x.dq_derived]
     n = sides[0].dq.shape[1] if K is None else K.shape[0]
     out = np.zeros(n)
     if measured:
@@ -653,10 +662,47 @@ def _band(
             t = np.concatenate([x.t for x in measured])
             out = np.asarray(noise_band(velocity_noise_std(dq, t)), dtype=np.float64)
     cutoff, lowpassed, gain = derived
-    of_q = [
-        (x.t, x.q if K is None else x.q @ K.T)
-        for x, p in zip(sides, pieces, strict=True)
-        if p.dq_derived
-    ]
+    of_q = [(x.t, x.q if K is None else x.q @ K.T) for x in sides if x.dq_derived]
     band = derived_velocity_band(of_q, cutoff, lowpassed=lowpassed) if of_q else None
     return out if band is None else np.maximum(out, band / gain)
+
+
+def _derived(pieces: Sequence[TorqueLog], cutoff: float | None) -> tuple[float, bool, float]:
+    """The cut-off of velocities derived from the positions, whether the preparation
+    low-passes them again, and the low-pass noise gain at the pieces' median rate."""
+    gain = lowpass_noise_gain(float(np.median([p.sample_rate for p in pieces])), cutoff)
+    # velocities derived from positions: at this cut-off and low-passed again when filtering,
+    # else as read (at the readers' default cut-off)
+    return (DEFAULT_CUTOFF_HZ if cutoff is None else cutoff, cutoff is not None, gain)
+
+
+def standstill_band(
+    sides: Sequence[TorqueLog], cutoff_hz: float | None, transmission: ArrayLike | None = None
+) -> NDArray[np.float64]:
+    """The standstill band [rad/s] (n,) of velocities prepared at ``cutoff_hz``: the band
+    identification gives its Coulomb terms,
+    ``band_gain * band`` (:class:`Recordings`), read from the raw pieces ``sides``.
+
+    Parameters
+    ----------
+    sides : sequence of TorqueLog
+        The pieces at the joints, before filtering (measured velocities, or velocities
+        derived from the positions, ``dq_derived``), each with N >= 1.
+    cutoff_hz : float or None
+        The low-pass cut-off of the preparation [Hz] (None: not filtered).
+    transmission : array_like, shape (n, n), optional
+        ``K``: the band of the velocities ``dq K^T`` (a drive's motors); default the
+        joints'.
+
+    Returns
+    -------
+    ndarray, shape (n,)
+        ``lowpass_noise_gain`` at the pieces' median rate times the raw velocities' noise
+        band (:func:`~dynid.identification.sanity.noise_band`; for derived velocities the
+        band of :mod:`~dynid.identification.derived_band`, divided by that gain): the
+        noise band of the prepared velocities (a UR5 at 500 Hz, 0.002 rad/s of velocity
+        noise, 5 Hz: 0.0004 rad/s, against 0.01 rad/s for the raw velocities).
+    """
+    derived = _derived(sides, cutoff_hz)
+    K = None if transmission is None else np.asarray(transmission, dtype=np.float64)
+    return np.asarray(derived[2] * _sides_band(sides, K, derived), dtype=np.float64)

@@ -698,8 +698,8 @@ def _opposite(
         else "; ".join(
             f"{names[k]}: correlation {corr[k]:+.2f}"
             + (
-                f", {near[k][0]:.3g} N m RMS from the negated model's torques against "
-                f"{near[k][1]:.3g} from the model's, means included"
+                f", {near[int(k)][0]:.3g} N m RMS from the negated model's torques against "
+                f"{near[int(k)][1]:.3g} from the model's, means included"
                 if k in near
                 else ""
             )

@@ -30,6 +30,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from ..exceptions import DynidWarning
+from ..friction.dissipative import law_violations
 from ..friction.fit import FrictionFit, FrictionResidual, fit_friction_through
 from ..friction.laws import LAWS
 from ..friction.model import FrictionSum
@@ -212,11 +213,14 @@ def fit_friction_files(
             )
             # where it acts (a robot's where the drive puts it); a sum judged too
             own = own_friction(model, pieces.drive)
-            sel = select_friction(res, pieces.drive, own=own, own_fitted_here=here)
+            sel = select_friction(
+                res, pieces.drive, own=own, own_fitted_here=here, dq_max=robot.dq_max
+            )
             return FrictionFileResult(sel.fit, res, sel, cut, pieces, torque_noise_std(res))
         chosen = fit_friction_through(res, pieces.drive, law)
         if law == "quadratic":
             _quadratic_at_bound(chosen)
+        _say_not_dissipative(chosen, robot.dq_max)
         return FrictionFileResult(chosen, res, None, cut, pieces, torque_noise_std(res))
 
     result: FrictionFileResult = in_file(rec.paths[0], fit) if len(rec.paths) == 1 else fit()
@@ -246,6 +250,20 @@ def _quadratic_at_bound(fit: FrictionFit) -> None:
             f"{', '.join(map(str, held))}: the friction of these data grows slower than "
             "linearly with speed (it saturates), which fq >= 0 cannot follow; there the law "
             "is the classical one (a saturating law follows it: sigmoid, smooth, stribeck)",
+            DynidWarning,
+            stacklevel=3,
+        )
+
+
+def _say_not_dissipative(fit: FrictionFit, dq_max: NDArray[np.float64]) -> None:
+    """A warning, one line per joint (motor), where the law asked for by name is not
+    dissipative within the velocity limits, its offset aside (the selection sets such a
+    law aside: :func:`~dynid.friction.dissipative.law_violations`)."""
+    for v in law_violations(fit.friction, dq_max):
+        warnings.warn(
+            f"{fit.kind} friction not dissipative within the velocity limits (the offset "
+            f"aside): {v}; the friction pushes the arm there (--friction-model auto sets "
+            "such a law aside)",
             DynidWarning,
             stacklevel=3,
         )
