@@ -99,3 +99,38 @@ def test_block_jackknife_against_refits_without_each_block():
     assert got is not None
     np.testing.assert_allclose(got, expected, rtol=1e-9, atol=1e-14)
     assert block_jackknife_covariance(W[: 2 * n * K - n], y[: 2 * n * K - n], n, K) is None
+
+
+def test_torques_the_arm_model_leaves_withhold_the_inertia_and_are_no_torque_scale(loaded_log):
+    """Regression (a spring the arm's model lacks, on joints 2 and 4: the torque-scale
+    column took it as a factor of 0.969 and the doubt said to read the torques with --units
+    tau=1.032, which would not fix it; on a Panda with effects outside its model a load's
+    Izz read ten times its truth at 5.5 x the noise and setLoad got it): the fit leaves over
+    3 x the torque noise, so the inertia is not written and the doubt says why; the
+    torques' scale is no doubt; the mass and CoM are still handed on."""
+    import dataclasses
+
+    tau = loaded_log.tau.copy()
+    tau[:, 1] += 0.5 * (loaded_log.q[:, 1] - 0.2)
+    tau[:, 3] += 0.25 * (loaded_log.q[:, 3] + 2.0)
+    est = _estimate(ARM, dataclasses.replace(loaded_log, tau=tau))
+    assert est.residual_rms > 3 * est.noise_rms
+    assert not [d for d in est.doubts if "x the arm model's" in d], est.doubts
+    assert est.undetermined == ("Ixx", "Ixy", "Ixz", "Iyy", "Iyz", "Izz")
+    (said,) = est.inertia_doubts
+    assert "is not determined" in said and "x the torque noise" in said and "--unloaded" in said
+    d = payload_to_dict(est, ARM)
+    assert d["load_inertia"] is None and d["load_mass"] is not None
+
+
+def test_an_inertia_fitted_above_three_times_the_noise_is_doubted_whatever_its_std():
+    """inertia_doubts with no element undetermined by its standard deviation: a fit that
+    leaves 5.5 x the torque noise is doubted as a whole (the cause and --unloaded said), one
+    at 2 x is not."""
+    from dynid.feasibility.payload_doubts import inertia_doubts
+
+    I, std = INERTIA, np.full(6, 1e-5)
+    (said,) = inertia_doubts((), I, std, 0.275, 0.05, unexplained=True)
+    assert "does not explain the torques to their noise" in said and "5.5 x the torque" in said
+    assert "--unloaded" in said and "setLoad's inertia is not written" in said
+    assert inertia_doubts((), I, std, 0.1, 0.05) == ()

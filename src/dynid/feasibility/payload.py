@@ -89,6 +89,7 @@ from ..identification.log import TorqueLog
 from ..identification.model import IdentifiedModel
 from ..identification.recordings import prepare_recordings
 from ..identification.structure import Structure
+from ..identification.verdict import FLOOR_FAIR
 from ..model.drive import Drive
 from ..model.inertia import INERTIA_ORDER
 from ..model.robot import Robot
@@ -486,11 +487,15 @@ def _estimate(
             raise
         raise DataError(f"{exc}; {said[0]}") from None
     m, c, I, sm, sc, si = summary(phi, cov, p == 10)
-    doubts = doubts_about(kin, frame, m, sm, c) + scale_doubts(scale, m, drive)
+    noise = record.get("noise_rms")
+    doubts = doubts_about(kin, frame, m, sm, c) + scale_doubts(scale, m, drive, noise)
     by_std = undetermined_inertia(I, si) if p == 10 and not doubts else ()
     at_bound = active and p == 10 and not doubts  # the bound, not the data, set it
-    undetermined = tuple(f"I{name}" for name in INERTIA_ORDER) if at_bound else by_std
-    noise = record.get("noise_rms")
+    unexplained = bool(
+        p == 10 and not doubts and noise and fit.residual_rms > FLOOR_FAIR * noise
+    )  # torques the arm's model leaves: the inertia takes them first
+    every = tuple(f"I{name}" for name in INERTIA_ORDER)
+    undetermined = every if at_bound or unexplained else by_std
     about_inertia = inertia_doubts(
         by_std,
         I,
@@ -500,6 +505,7 @@ def _estimate(
         at_bound=at_bound,
         margin=margin,
         difference=difference,
+        unexplained=unexplained,
     )
     for line in doubts + about_inertia:
         warnings.warn(line, DynidWarning, stacklevel=3)

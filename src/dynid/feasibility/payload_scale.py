@@ -34,6 +34,7 @@ from numpy.typing import NDArray
 
 from ..exceptions import RankDeficientError
 from ..identification.least_squares import fit_least_squares
+from ..identification.verdict import FLOOR_FAIR
 from ..model.drive import Drive
 from .payload_fit import block_jackknife_covariance, serial_correlation_factor
 
@@ -70,6 +71,10 @@ class TorqueScale:
     data : str
         ``"loaded"`` (fitted beside the load's columns) or ``"unloaded"`` (on the data
         without the load).
+    residual_rms : float
+        The RMS residual of the fit with the factor [units of the rows: N m for torque
+        logs]: a factor that leaves torques far above their noise is the arm's model
+        error absorbed, not a scale (:func:`scale_doubts`).
     """
 
     value: float
@@ -77,6 +82,7 @@ class TorqueScale:
     mass: float
     std_mass: float
     data: str
+    residual_rms: float = float("nan")
 
     def off(self, mass: float) -> bool:
         """``a`` differs from 1 by more than :data:`SCALE_SIGMAS` standard deviations, and
@@ -169,7 +175,9 @@ def torque_scale(
         mass = m / a
         std_mass = float(np.hypot(sm / a, m * np.sqrt(cov[0, 0]) / a**2))
     std = float(np.sqrt(max(cov[0, 0], 0.0)))
-    return TorqueScale(a, std, mass, std_mass, "loaded" if p else "unloaded")
+    return TorqueScale(
+        a, std, mass, std_mass, "loaded" if p else "unloaded", float(fit.residual_rms)
+    )
 
 
 def scale_mass(scale: TorqueScale) -> str:
@@ -183,12 +191,22 @@ def scale_mass(scale: TorqueScale) -> str:
 
 
 def scale_doubts(
-    scale: TorqueScale | None, mass: float, drive: Drive | None = None
+    scale: TorqueScale | None,
+    mass: float,
+    drive: Drive | None = None,
+    noise_rms: float | None = None,
 ) -> tuple[str, ...]:
     """The doubt about a load of ``mass`` [kg] whose torques are ``scale.value`` times the
     description's (:meth:`TorqueScale.off`), with the remedy as the user gives it (a drive
-    of currents: its ``torque_constant``; else ``--units tau=``); empty when none."""
+    of currents: its ``torque_constant``; else ``--units tau=``); empty when none, and when
+    the fit with the factor leaves more than :data:`~dynid.identification.verdict.
+    FLOOR_FAIR` times the torque noise ``noise_rms`` [N m] (torque logs): the factor then
+    absorbs torques the arm's model does not explain (an unmodelled spring on a Panda
+    shoulder read as 0.969 with the load's mass moved by 16 %, at 6.9 x the noise), which
+    no unit would fix; the residual's own doubts speak of it."""
     if scale is None or not scale.off(mass):
+        return ()
+    if noise_rms and scale.residual_rms > FLOOR_FAIR * noise_rms:
         return ()
     a = scale.value
     where = "the data without the load" if scale.data == "unloaded" else "the loaded data"
