@@ -104,3 +104,19 @@ def test_positions_logged_in_milliseconds_are_told_so_not_a_cutoff_error():
     with pytest.raises(DataError) as caught:
         with_derived_velocities(slow, 60.0)
     assert "t=ms" not in str(caught.value)
+
+
+def test_a_positions_only_file_too_slow_for_its_cutoff_is_named(tmp_path):
+    """The error of a positions-only log read through a column map names its file (with
+    several recordings it did not say which)."""
+    from dynid.exceptions import DataError
+    from dynid.io.columns import load_mapped_torque_log, parse_column_map
+
+    t = np.arange(100) * 2.0  # ms, read as s
+    q = np.sin(t[:, None] / 300.0) * np.ones((1, 2))
+    body = np.column_stack([t, q, np.zeros_like(q)])
+    np.savetxt(tmp_path / "slow.csv", body, delimiter=",", comments="",
+               header="time_ms,pos_1,pos_2,effort_1,effort_2", fmt="%.17g")  # fmt: skip
+    cmap = parse_column_map("t=time_ms,q=pos_{i},tau=effort_{i}", None)
+    with pytest.raises(DataError, match=r"^slow\.csv: positions only, sampled at 0\.5 Hz"):
+        load_mapped_torque_log(tmp_path / "slow.csv", cmap)

@@ -588,7 +588,11 @@ def load_mapped_torque_log(
     except DataError as exc:
         raise DataError(str(exc), file=path.name) from exc
     notes = (velocity_note(columns.velocity_cutoff_hz),)
-    return MappedLog(with_derived_velocities(raw, columns.velocity_cutoff_hz), notes, said)
+    try:
+        log = with_derived_velocities(raw, columns.velocity_cutoff_hz)
+    except DataError as exc:  # a rate too low for the cut-off: the file named
+        raise DataError(str(exc), file=path.name) from exc
+    return MappedLog(log, notes, said)
 
 
 def conversion_notes(columns: ColumnMap, quantities: Sequence[str]) -> tuple[str, ...]:
