@@ -100,6 +100,7 @@ from .payload_fit import (
     HELD_OUT_BLOCKS,
     block_jackknife_covariance,
     fit_load,
+    held_out_widening,
     load_parameters,
     serial_correlation_factor,
     summary,
@@ -553,15 +554,13 @@ def _held_out_spread(
     10 %: an error of the arm's model that varies along the motion, which the residual's
     covariance does not see."""
     jack = block_jackknife_covariance(W, yv, n)
-    p = cov.shape[0]
     if jack is None:
         notes.append(
             "the standard deviations were not checked on held-out time blocks (a block alone "
             "excites some direction of the load, or the log is too short)"
         )
         return cov
-    var = np.diag(cov)
-    widen = np.sqrt(np.maximum(1.0, np.diag(jack)[:p] / np.where(var > 0, var, np.inf)))
+    widened, widen = held_out_widening(cov, jack)
     if widen.max() > 1.1:
         notes.append(
             f"standard deviations widened up to x{widen.max():.3g} to the spread of the "
@@ -569,7 +568,7 @@ def _held_out_spread(
             "fit's errors vary along the motion (the arm's model), more than the residual's "
             "covariance says"
         )
-    return cov * np.outer(widen, widen)
+    return widened
 
 
 def _log_route(

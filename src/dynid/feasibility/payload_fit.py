@@ -30,6 +30,7 @@ __all__ = [
     "HELD_OUT_BLOCKS",
     "block_jackknife_covariance",
     "fit_load",
+    "held_out_widening",
     "load_parameters",
     "serial_correlation_factor",
     "summary",
@@ -286,3 +287,15 @@ def block_jackknife_covariance(
     b = np.asarray(est)
     d = b - b.mean(axis=0)
     return (blocks - 1) / blocks * (d.T @ d)
+
+
+def held_out_widening(
+    cov: NDArray[np.float64], jack: NDArray[np.float64]
+) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+    """``cov`` (k, k) with each variance raised to the block jackknife's ``jack`` (the
+    first k of its diagonal, :func:`block_jackknife_covariance`) where that is larger, the
+    correlations kept; and the factor (k,) each standard deviation was widened by (>= 1)."""
+    var = np.diag(cov)
+    k = var.shape[0]
+    widen = np.sqrt(np.maximum(1.0, np.diag(jack)[:k] / np.where(var > 0, var, np.inf)))
+    return cov * np.outer(widen, widen), widen

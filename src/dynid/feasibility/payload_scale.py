@@ -36,7 +36,11 @@ from ..exceptions import RankDeficientError
 from ..identification.least_squares import fit_least_squares
 from ..identification.verdict import FLOOR_FAIR
 from ..model.drive import Drive
-from .payload_fit import block_jackknife_covariance, serial_correlation_factor
+from .payload_fit import (
+    block_jackknife_covariance,
+    held_out_widening,
+    serial_correlation_factor,
+)
 
 __all__ = [
     "SCALE_OFF",
@@ -161,10 +165,7 @@ def torque_scale(
         if jack is not None:
             full = np.zeros_like(cov)
             full[np.ix_(used, used)] = jack
-            widen = np.sqrt(
-                np.maximum(1.0, np.diag(full) / np.where(np.diag(cov) > 0, np.diag(cov), np.inf))
-            )
-            cov = cov * np.outer(widen, widen)
+            cov = held_out_widening(cov, full)[0]
     a = 1.0 + float(beta[0])
     if p:
         x = float(beta[1])
