@@ -109,10 +109,11 @@ def spring_held_offsets(
 
 def _law_terms(
     friction: FrictionModel | FrictionSum, robot: Robot, kept: str
-) -> tuple[CoulombViscous, tuple[str, ...]]:
-    """A friction model as MuJoCo holds it, and what it drops (one line each, ending with
-    ``kept``: the files that hold it, :func:`~dynid.io.robot.export_options.kept_elsewhere`).
-    The offsets the robot's spring holds (:func:`spring_held_offsets`) are not dropped."""
+) -> tuple[CoulombViscous, tuple[str, ...], NDArray[np.bool_]]:
+    """A friction model as MuJoCo holds it, what it drops (one line each, ending with
+    ``kept``: the files that hold it, :func:`~dynid.io.robot.export_options.kept_elsewhere`),
+    and the joints whose offset the robot's spring holds (:func:`spring_held_offsets`),
+    which are not dropped."""
     dq_max = robot.dq_max
     vmax = np.where(np.isfinite(dq_max), dq_max, 2.0)
     jt = joint_coulomb_viscous(friction, vmax)
@@ -121,24 +122,25 @@ def _law_terms(
     held = spring_held_offsets(robot, offset, friction.at_motors)
     lost = jt.notes + unheld_friction(friction, vmax, held)
     if not lost:
-        return CoulombViscous(jt.frictionloss, jt.damping, offset, z, z), ()
+        return CoulombViscous(jt.frictionloss, jt.damping, offset, z, z), (), held
     note = (
         f"the joints' frictionloss and damping (Coulomb and viscous friction at the joints) "
         f"hold the {friction.kind} friction without {', '.join(lost)}"
         + (f": {kept}" if kept else "")
     )
-    return CoulombViscous(jt.frictionloss, jt.damping, offset, z, z), (note,)
+    return CoulombViscous(jt.frictionloss, jt.damping, offset, z, z), (note,), held
 
 
 def _joint_terms(
     robot: Robot, friction: bool | FrictionModel | FrictionSum, drive: Drive | None, kept: str
-) -> tuple[CoulombViscous | None, NDArray[np.float64] | None, tuple[str, ...]]:
+) -> tuple[CoulombViscous | None, NDArray[np.float64] | None, tuple[str, ...], NDArray[np.bool_]]:
     """The friction written to the joints, the rotor ``armature`` and what MJCF cannot hold.
 
-    Returns ``(approximation, armature, notes)``: the Coulomb and viscous terms per joint
-    (None: frictionless), the armature (n,) [kg m^2] (None: no drive with rotor inertias)
-    and one note per thing dropped (:func:`dynid.friction.mujoco.drive_joint_terms`,
-    :func:`_law_terms`). ``friction=True`` is the robot's own friction: its sigmoid
+    Returns ``(approximation, armature, notes, held)``: the Coulomb and viscous terms per
+    joint (None: frictionless), the armature (n,) [kg m^2] (None: no drive with rotor
+    inertias), one note per thing dropped (:func:`dynid.friction.mujoco.drive_joint_terms`,
+    :func:`_law_terms`) and the joints (n,) whose friction offset the spring's reference
+    holds (:func:`spring_held_offsets`). ``friction=True`` is the robot's own friction: its sigmoid
     (``Robot.friction``) by the fit of its odd part up to ``dq_max``, another law as that
     law maps itself.
     """
@@ -158,18 +160,13 @@ def _joint_terms(
         notes = jt.notes
         armature = jt.armature if d.rotor_inertia is not None else None
     sigmoid = sigmoid_parameters(model) if friction is True else None
-    if sigmoid is not None:  # the description's sigmoid
-        return coulomb_viscous_from_sigmoid(sigmoid, robot.dq_max), armature, notes
+    if model is not None and sigmoid is not None:  # the description's sigmoid
+        fit = coulomb_viscous_from_sigmoid(sigmoid, robot.dq_max)
+        return fit, armature, notes, spring_held_offsets(robot, fit.offset, model.at_motors)
     if model is None:
-        return None, armature, notes
-    approx, more = _law_terms(model, robot, kept)
-    return approx, armature, notes + more
-
-
-def _at_motors(robot: Robot, friction: bool | FrictionModel | FrictionSum) -> bool:
-    """Whether the friction written acts at the motors of a drive."""
-    model = robot_friction(robot) if friction is True else friction or None
-    return bool(model is not None and model.at_motors)
+        return None, armature, notes, np.zeros(n, dtype=bool)
+    approx, more, held = _law_terms(model, robot, kept)
+    return approx, armature, notes + more, held
 
 
 def _comment(
@@ -200,17 +197,12 @@ def _bodies(
     robot: Robot,
     approx: CoulombViscous | None,
     armature: NDArray[np.float64] | None,
-    at_motors: bool = False,
+    held: NDArray[np.bool_],
 ) -> list[str]:
     """The nested ``<body>`` lines of the links (the base's sites first), closed; a joint
-    spring's reference holds the friction offset of its joint (:func:`spring_held_offsets`;
-    ``at_motors``: the friction acts at the motors, and its offsets are not the joints')."""
+    spring's reference holds the friction offset of the joints ``held`` (n,)
+    (:func:`spring_held_offsets`)."""
     n = robot.n
-    held = (
-        np.zeros(n, dtype=bool)
-        if approx is None
-        else spring_held_offsets(robot, approx.offset, at_motors)
-    )
     I6 = inertia6_from_matrix(robot.inertia)[:, [0, 3, 5, 1, 2, 4]]  # xx yy zz xy xz yz
     mass, com = robot.mass, robot.com
     sites: dict[int, list[str]] = {}
@@ -315,7 +307,7 @@ def mjcf_from_robot(
     ModelError
         A link other than the base is named ``world`` (MuJoCo's world body).
     """
-    approx, armature, notes = _joint_terms(robot, friction, drive, kept)
+    approx, armature, notes, held = _joint_terms(robot, friction, drive, kept)
     if notes:  # one line: what MJCF cannot hold
         warnings.warn(f"MJCF export: {'; '.join(notes)}", DynidWarning, stacklevel=2)
     text = comment or _comment(robot, friction, approx, armature, notes)
@@ -326,7 +318,7 @@ def mjcf_from_robot(
         '  <compiler angle="radian" autolimits="true" boundmass="1e-10" boundinertia="1e-14"/>',
         f'  <option gravity="{_v(robot.gravity)}"/>',
         "  <worldbody>",
-        *_bodies(robot, approx, armature, _at_motors(robot, friction)),
+        *_bodies(robot, approx, armature, held),
         "  </worldbody>",
         "  <actuator>",
         *_actuators(robot),
