@@ -16,14 +16,26 @@ from dynid.observer.events import EventDetector
 from dynid.observer.residual import ObserverOptions
 
 
-def _reference(t, r, contact, collision, merge_s, restarts, min_duration_s=0.0):
+def _reference(t, r, contact, collision, merge_s, restarts, min_duration_s=0.0, dropped=None):
     """Events sample by sample: (start, end, joints, peak, level). Runs of samples over
     the threshold one after the other in one piece; a run shorter than
     ``min_duration_s`` at the contact level with no other run within ``merge_s / 2``
     before or after it in its piece left out; the other runs joined when closer than
     ``merge_s`` in one piece; events shorter than ``min_duration_s`` at the contact
-    level left out; joints, peaks and level over every sample of an event."""
+    level left out; joints, peaks and level over every sample of an event. The runs and
+    events left out are appended to ``dropped`` as (start, end, joints, peak, rule,
+    ratio), ``ratio`` the largest ``|r| / contact`` per joint over their samples."""
     r = np.where(np.isfinite(r), r, 0.0)
+
+    def named(a, last, rule):
+        b = last + 1
+        over = (np.abs(r[a:b]) > contact[a:b]).any(0)
+        k = np.argmax(np.abs(r[a:b]), axis=0)  # the first of the largest magnitudes
+        peak = tuple(float(r[a + k[j], j]) for j in range(r.shape[1]))
+        with np.errstate(divide="ignore", invalid="ignore"):
+            ratio = np.nan_to_num(np.abs(r[a:b]) / contact[a:b], nan=0.0).max(0)
+        joints = tuple(int(j) + 1 for j in np.flatnonzero(over))
+        return (float(t[a]), float(t[last]), joints, peak, rule, tuple(ratio))
 
     def piece(k):
         return sum(s <= k for s in restarts)
@@ -46,6 +58,8 @@ def _reference(t, r, contact, collision, merge_s, restarts, min_duration_s=0.0):
                    for x in others)  # fmt: skip
         if t[b] - t[a] >= min_duration_s or collides(a, b) or near:
             kept.append((a, b))
+        elif dropped is not None:
+            dropped.append(named(a, b, "isolated"))
     events = []
     for a, b in kept:
         if events and piece(a) == piece(events[-1][1]) and t[a] - t[events[-1][1]] <= merge_s:
@@ -55,6 +69,8 @@ def _reference(t, r, contact, collision, merge_s, restarts, min_duration_s=0.0):
     out = []
     for a, last in events:
         if t[last] - t[a] < min_duration_s and not collides(a, last):
+            if dropped is not None:
+                dropped.append(named(a, last, "short"))
             continue
         b = last + 1
         joints = tuple(int(j) + 1 for j in np.flatnonzero((np.abs(r[a:b]) > contact[a:b]).any(0)))
@@ -74,16 +90,26 @@ def _as_tuples(events):
     return [(e.start, e.end, e.joints, e.peak, e.level) for e in events]
 
 
+def _same_dropped(got, want):
+    """Dropped crossings equal: times, joints, peaks and rule exactly, ratios to 1e-12."""
+    assert [(d.start, d.end, d.joints, d.peak, d.rule) for d in got] == [w[:5] for w in want]
+    for d, w in zip(got, want, strict=True):
+        np.testing.assert_allclose(d.ratio, w[5], rtol=1e-12)
+
+
 @pytest.mark.parametrize("merge", [0.05, 0.0])
 def test_events_fed_in_blocks_are_those_of_the_definition(merge):
     """A noisy residual with bursts (some closer than merge_s, one across a restart, NaN
     samples, the uncertainty's std and a standstill margin, a one-sample crossing 40 ms
-    before a burst, a contact-level burst that the noise dips below the threshold):
+    before a burst, a contact-level burst that the noise dips below the threshold, two
+    one-sample crossings 3 ms apart):
     blocks of every size from 1 sample to the whole log give the reference's events, as
     the whole log in one block (detect) does. The lone crossing does not start the
     burst's event (joined first, it began the event 40 ms early); the dipping burst is
     one contact event (its crossings are close together). With ``merge_s = 0`` a run of
-    samples over the threshold one after the other is one event (each sample was one)."""
+    samples over the threshold one after the other is one event (each sample was one).
+    The crossings the minimum duration drops are the reference's, isolated or short, in
+    any blocks."""
     rng = np.random.default_rng(4)
     N, n = 1000, 3
     t = np.cumsum(rng.uniform(0.8e-3, 1.2e-3, N))
@@ -93,9 +119,10 @@ def test_events_fed_in_blocks_are_those_of_the_definition(merge):
     r[850:870, 2] += 0.35  # a contact-level burst
     r[450:470] = np.nan  # the observer did not run
     r[360, 2] = 0.4  # one sample over the contact level only (std 0 there, no margin)
+    r[[990, 993], 1] = 0.4  # two crossings 3 samples apart: together still short
     std = np.abs(0.02 * rng.standard_normal((N, n)))
     std[450:470] = np.nan
-    std[360] = 0.0
+    std[[360, 990, 993]] = 0.0
     margin = np.where(np.arange(N)[:, None] % 200 < 20, 0.1, 0.0) * np.ones(n)
     th = Thresholds(
         contact=np.full(n, 0.2), collision=np.full(n, 0.6), margin=1.5, quantile=1.0,
@@ -105,7 +132,10 @@ def test_events_fed_in_blocks_are_those_of_the_definition(merge):
     restarts = [0, 610]
     c = 3.0 * np.nan_to_num(std) + 0.15 + margin
     k = 3.0 * (3.0 * np.nan_to_num(std) + 0.15) + margin
-    want = _reference(t, r, c, k, merge, restarts, 0.01)
+    gone: list = []
+    want = _reference(t, r, c, k, merge, restarts, 0.01, gone)
+    assert {d[4] for d in gone} == ({"isolated", "short"} if merge else {"isolated"})
+    assert all(d[1] - d[0] < 0.01 and max(d[5]) > 1.0 for d in gone)
     levels = {e[4] for e in want}
     assert len(want) >= 5 and levels == ({"contact", "collision"} if merge else {"collision"})
     assert all(e[1] - e[0] >= 0.01 or e[4] == "collision" for e in want)
@@ -136,6 +166,8 @@ def test_events_fed_in_blocks_are_those_of_the_definition(merge):
             got += det.feed(t[k], r[k], std=std[k], standstill=margin[k])
         assert _as_tuples(got + det.finish()) == want, block
         np.testing.assert_allclose(det.largest_ratio, ratio, rtol=1e-12)
+        _same_dropped(det.dropped, gone)
+        assert det.dropped_count == len(gone)
 
 
 def test_one_push_near_a_flickering_threshold_is_one_event_starting_at_its_first_crossing():

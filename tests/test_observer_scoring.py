@@ -231,3 +231,47 @@ def test_missed_labelled_contacts_carry_the_true_torques_peak_where_it_is_known(
     assert with_truth is not None and alone is not None
     assert [m.peak for m in with_truth.missed] == [0.7]
     assert [m.peak for m in alone.missed] == [None]
+
+
+def test_a_push_shorter_than_the_minimum_duration_is_named_as_a_dropped_crossing(pushes, capsys):
+    """Regression (max |r|/contact 1.93 on a joint and no event, with nothing saying why):
+    a simulated 12 ms push of 25 N with --min-duration 0.05 is no event and the one
+    labelled contact of the true torques is missed, while the summary, events.json and
+    the report name the crossing the minimum duration dropped (not a contact) at the
+    push, on the joint of the largest true torque, with its sign, under it (the lag), over
+    its threshold and shorter than 0.05 s; with the default 0.01 s it is an event and
+    nothing is dropped."""
+    from dynid.io.columns import load_joint_columns
+
+    d = pushes
+    sim = ["simulate", "--robot", "panda", "--trajectory", "fourier", "-q", "--duration", "3"]
+    push = ["--contact", "link6:0,0,-25:1.0,1.012"]
+    assert main([*sim, "--seed", "3", *push, "--out", str(d / "short.csv")]) == 0
+    ext = load_joint_columns(d / "short.csv", "tau_ext", 7)
+    assert ext is not None
+    j = int(np.argmax(np.abs(ext).max(axis=0)))  # the joint the push loads most
+    p = ["observe", "--params", "panda", "--no-figures", "--data", str(d / "short.csv")]
+    p += ["--thresholds", str(d / "cal" / "thresholds.json")]
+    assert main([*p, "--min-duration", "0.05", "--out", str(d / "short")]) == 0
+    out = capsys.readouterr().out
+    doc = json.loads((d / "short" / "events.json").read_text())
+    assert doc["events"] == [] and doc["score"]["missed"] == 1
+    (miss,) = doc["score"]["missed_contacts"]
+    drop = doc["dropped"]
+    assert (drop["count"], drop["min_duration_s"]) == (1, 0.05)
+    (c,) = drop["crossings"]
+    assert miss["start"] <= c["start"] <= miss["end"] + 0.02 and c["duration_s"] < 0.05
+    assert j + 1 in c["joints"] and c["ratio"][j] > 1.0
+    true_peak = ext[np.argmax(np.abs(ext[:, j])), j]
+    assert np.sign(c["peak"][j]) == np.sign(true_peak) and abs(c["peak"][j]) < abs(true_peak)
+    top = c["joint"]
+    assert c["ratio"][top - 1] == max(c["ratio"])
+    assert "1 crossing(s) over the contact threshold dropped as shorter than --min-duration" in out
+    assert f"= {c['ratio'][top - 1]:.3g} x contact" in out and "< 50 ms" in out
+    report = (d / "short" / "report.html").read_text()
+    assert "No event, but 1 crossing(s)" in report and "not contacts" in report
+    assert "every residual stayed below" not in report
+    assert main([*p, "--out", str(d / "short_default")]) == 0
+    doc = json.loads((d / "short_default" / "events.json").read_text())
+    assert len(doc["events"]) == 1 and doc["dropped"]["count"] == 0
+    assert doc["score"]["detected"] == 1 and "dropped as shorter" not in capsys.readouterr().out

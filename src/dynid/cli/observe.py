@@ -60,7 +60,10 @@ standstill margin follows the velocity noise), and an event shorter than --min-d
 (0.01 s) that stays at the contact level is dropped (the velocity noise crosses for a
 few samples). A crossing shorter than --min-duration with no other within half of
 --merge is dropped before runs are joined: it neither starts nor extends an event.
---merge 0 --min-duration 0: every run over the threshold.
+--merge 0 --min-duration 0: every run over the threshold. The crossings dropped are
+not contacts but are said: the summary counts them and names those furthest over the
+threshold (time, joint, peak, |r|/contact, duration against --min-duration, the rule),
+and events.json holds them under dropped.
 A torque sample off both neighbours by more than 20 times the noise while the joint moves
 (a one-sample spike, a sensor or logging fault, as identify finds them) is replaced by the
 line between its neighbours before the observer runs, calibrating or detecting, with a
@@ -185,7 +188,8 @@ def register(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParser:
         metavar="SECONDS",
         help="drop contact-level events shorter than this, and crossings shorter than it "
         f"with no other within --merge / 2 (default {DEFAULT_MIN_DURATION_S:g} s; 0 with "
-        "--merge 0: every run over the threshold)",
+        "--merge 0: every run over the threshold); those dropped are counted and named "
+        "(events.json's dropped), not called contacts",
     )
     p.add_argument(
         "--label-tolerance",

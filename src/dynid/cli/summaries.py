@@ -23,7 +23,7 @@ from ..identification.structure import MIN_WIDTH, joint_side_joints
 from ..io.observer_files import log_labels
 from ..observer.detection import undetected_at_rest
 from ..observer.gain_noise import GainNoise
-from ..observer.results import LogObservation, ObserveResult, flagged_words
+from ..observer.results import LogObservation, ObserveResult, dropped_words, flagged_words
 from ..observer.scoring import score_words
 from ..observer.wrench import estimate_words
 from ..pipeline.collision import CollisionStageResult
@@ -767,9 +767,10 @@ def format_observation(result: ObserveResult, names: list[str], *, calibrating: 
         rows.append(f"calibrated on {th.samples} samples of {len(result.logs)} log(s)")
         return "\n".join(rows)
     if "max |r|/contact" in cols:
+        least = "" if result.min_duration_s is None else f" for {result.min_duration_s:g} s"
         rows.append(
             "max |r|/contact: the largest residual over the contact threshold at the same "
-            "sample (as it stood then); an event needs 1 or more"
+            f"sample (as it stood then); an event needs 1 or more{least} (--min-duration)"
         )
     labels = log_labels([x.path for x in result.logs])
     if len(result.logs) > 1:  # the pooled column holds the contacts of every log
@@ -785,6 +786,7 @@ def format_observation(result: ObserveResult, names: list[str], *, calibrating: 
             f"  {log}: {e.level:<9} {e.start:9.3f} s .. {e.end:9.3f} s  joints "
             f"{','.join(map(str, e.joints))}  peak {e.peak[top - 1]:+.2f} N m (joint {top})"
         )
+    rows += _dropped_lines(result, labels, names)
     rows += _score_lines(result, labels)
     if result.frame is not None:  # what the residual tables' fx..mz hold
         words = estimate_words(result.model.robot, result.frame, result.wrench)
@@ -809,6 +811,37 @@ def format_collision_stage(res: CollisionStageResult) -> str:
         "(first-order lag) RMS [N m]: " + " ".join(f"{x:.3f}" for x in res.residual_error_rms)
     )
     return "\n".join(rows)
+
+
+#: Dropped crossings printed at most (those furthest over the threshold); events.json
+#: holds more.
+DROPPED_SHOWN = 10
+
+
+def _dropped_lines(result: ObserveResult, labels: list[str], names: list[str]) -> list[str]:
+    """The crossings over the contact threshold that the minimum duration dropped: how
+    many, and those furthest over it (time, joint, peak, ratio, duration against the
+    minimum, rule); nothing when there were none."""
+    total = result.dropped_count()
+    if not total:
+        return []
+    least = "" if result.min_duration_s is None else f" {result.min_duration_s:g} s"
+    rows = [
+        f"{total} crossing(s) over the contact threshold dropped as shorter than "
+        f"--min-duration{least} (not contacts; events.json's dropped):"
+    ]
+    found = [(lab, d) for x, lab in zip(result.logs, labels, strict=True) for d in x.dropped]
+    shown = sorted(found, key=lambda ld: -ld[1].ratio[ld[1].joint - 1])[:DROPPED_SHOWN]
+    for lab, d in sorted(shown, key=lambda ld: (labels.index(ld[0]), ld[1].start)):
+        j = d.joint
+        words = dropped_words(
+            d.start, d.end, names[j - 1], d.peak[j - 1], d.ratio[j - 1], d.rule,
+            result.min_duration_s,
+        )  # fmt: skip
+        rows.append(f"  {lab}: {words}")
+    if total > len(shown):
+        rows.append(f"  and {total - len(shown)} more, less far over the threshold")
+    return rows
 
 
 def _score_lines(result: ObserveResult, labels: list[str]) -> list[str]:

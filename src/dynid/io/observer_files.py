@@ -19,7 +19,14 @@
 of the event's log, one log or several), with the model's ``joints`` (names), the data
 files, their sample counts, durations and the time their events cover (``duration_s``,
 ``flagged_s`` [s] per log), the model's files and their SHA-256 (``model_files``,
-``model_sha256``) and the units.
+``model_sha256``) and the units. ``dropped`` (detecting with the event rules recorded)
+holds the crossings over the contact threshold that the minimum duration dropped, which
+are not events: ``min_duration_s`` and ``merge_s`` [s], ``count`` (all of them) and
+``crossings`` (those furthest over the threshold, at most
+:data:`~dynid.observer.events.MAX_DROPPED` per log), each ``{"start", "end",
+"duration_s"}`` [s], ``joints`` and ``joint_names`` (over the threshold), ``joint`` (the
+one furthest over it, 1-based), ``peak`` [N m] and ``ratio`` (``|r| / contact``) per
+joint, ``rule`` (``isolated`` or ``short``) and ``log``.
 
 ``residuals.csv``: a dynid CSV table (comment lines, ``# rows: N``, a header) with ``t``
 [s], ``r1 .. rn`` [N m] and, with a frame, ``fx, fy, fz`` [N], ``mx, my, mz`` [N m] and
@@ -52,6 +59,7 @@ from .atomic import open_atomic
 from .schema import Field, Format, Record, load_document, save_document
 
 __all__ = [
+    "DROPPED",
     "EVENTS",
     "EVENTS_SCHEMA",
     "SCORE",
@@ -169,8 +177,34 @@ SCORE = Record(
         ),
     }
 )
-#: ``events.json``: the events and the score declared; the logs' and the model's
-#: metadata (``data``, ``samples``, ``duration_s``, ``model``, ...) kept unchecked.
+#: ``events.json``'s ``dropped``: crossings the minimum duration dropped (not events).
+DROPPED = Record(
+    {
+        "min_duration_s": _S,
+        "merge_s": _S,
+        "count": _COUNT,
+        "crossings": Field(
+            "objects",
+            required=True,
+            record=Record(
+                {
+                    "start": Field("number", required=True, unit="s"),
+                    "end": Field("number", required=True, unit="s"),
+                    "duration_s": _S,
+                    "joints": Field("numbers", required=True, shape=(None,)),
+                    "joint_names": Field("strings"),
+                    "joint": Field("integer", required=True, low=1),
+                    "peak": Field("numbers", required=True, shape=(None,), unit=_NM),
+                    "ratio": Field("numbers", required=True, shape=(None,), low=0.0),
+                    "rule": Field("string", required=True, choices=("isolated", "short")),
+                    "log": Field("string"),
+                }
+            ),
+        ),
+    }
+)
+#: ``events.json``: the events, the crossings dropped and the score declared; the logs'
+#: and the model's metadata (``data``, ``samples``, ``duration_s``, ``model``, ...) kept unchecked.
 EVENTS = Format(
     EVENTS_SCHEMA,
     Record(
@@ -195,6 +229,7 @@ EVENTS = Format(
             "duration_s": Field("numbers", shape=(None,), low=0.0, unit="s"),
             "flagged_s": Field("numbers", shape=(None,), low=0.0, unit="s"),
             "score": Field("object", record=SCORE),
+            "dropped": Field("object", record=DROPPED),
             "units": Field("any"),
         },
         open=True,
@@ -310,9 +345,14 @@ def save_events(
         ],
         **(meta or {}),
         "units": {"start": "s", "end": "s", "peak": "N m", "joints": "1-based"}
-        | {k: "s" for k in ("duration_s", "flagged_s") if k in (meta or {})},
+        | {k: "s" for k in ("duration_s", "flagged_s") if k in (meta or {})}
+        | ({"dropped": _DROPPED_UNITS} if "dropped" in (meta or {}) else {}),
     }
     return save_document(path, EVENTS, doc)
+
+
+#: The units of ``events.json``'s ``dropped``.
+_DROPPED_UNITS = "start, end, duration_s, min_duration_s, merge_s: s; peak: N m; ratio: 1"
 
 
 def save_residuals_csv(
@@ -508,6 +548,7 @@ def save_observation(
         **_fingerprint(result.fingerprint),
         **({} if result.frame is None else {"wrench": _estimate_info(result)}),
         **({} if (total := result.score()) is None else {"score": _score_info(result, total)}),
+        **({} if result.min_duration_s is None else {"dropped": _dropped_info(result, joints)}),
         **meta,
     }
     paths.insert(
@@ -515,6 +556,34 @@ def save_observation(
         save_events(out / "events.json", events, meta=info, logs=logs_of, joints=joints),
     )
     return paths
+
+
+def _dropped_info(result: ObserveResult, joints: Sequence[str]) -> dict[str, Any]:
+    """``events.json``'s ``dropped`` (:data:`DROPPED`): the crossings every log's minimum
+    duration dropped, named by their log and joints."""
+    labels = log_labels([x.path for x in result.logs])
+    crossings = [
+        {
+            "start": d.start,
+            "end": d.end,
+            "duration_s": d.duration,
+            "joints": list(d.joints),
+            "joint_names": [joints[j - 1] for j in d.joints],
+            "joint": d.joint,
+            "peak": list(d.peak),
+            "ratio": list(d.ratio),
+            "rule": d.rule,
+            "log": label,
+        }
+        for x, label in zip(result.logs, labels, strict=True)
+        for d in x.dropped
+    ]
+    return {
+        "min_duration_s": result.min_duration_s,
+        "merge_s": result.merge_s,
+        "count": result.dropped_count(),
+        "crossings": crossings,
+    }
 
 
 def _score_record(sc: ContactScore) -> dict[str, Any]:

@@ -30,6 +30,13 @@ open (its start, last sample over the threshold, peaks, joints and level) and th
 residual since its last sample over the threshold are carried to the next block, so a
 long log is read with one block's temporaries and gives the events of the whole log
 exactly. :func:`detect` is the detector fed the whole log as one block.
+
+A crossing the minimum duration drops is not a contact, but it is not silence either: the
+detector counts every one (:attr:`EventDetector.dropped_count`) and keeps the
+:data:`MAX_DROPPED` that went furthest over the threshold as :class:`DroppedCrossing`
+records (:attr:`EventDetector.dropped`: start, end, joints, peaks, the largest ``|r|``
+over the threshold and the rule that dropped it, ``isolated`` or ``short``), so that a
+joint whose residual passed its threshold with no event says why.
 """
 
 from __future__ import annotations
@@ -48,7 +55,9 @@ __all__ = [
     "DEFAULT_MERGE_S",
     "DEFAULT_MIN_DURATION_S",
     "ISOLATION_FRACTION",
+    "MAX_DROPPED",
     "ContactEvent",
+    "DroppedCrossing",
     "EventDetector",
     "detect",
 ]
@@ -62,6 +71,8 @@ DEFAULT_MIN_DURATION_S = 0.01
 #: ``merge_s`` before or after it is an isolated crossing, dropped before runs are joined
 #: (module docstring).
 ISOLATION_FRACTION = 0.5
+#: Dropped crossings kept as records (those furthest over the threshold); all are counted.
+MAX_DROPPED = 100
 
 
 @dataclass(frozen=True, slots=True)
@@ -86,32 +97,81 @@ class ContactEvent:
     level: Literal["contact", "collision"]
 
 
+@dataclass(frozen=True, slots=True)
+class DroppedCrossing:
+    """A run over the contact threshold that the minimum duration dropped: not a contact
+    (module docstring).
+
+    Attributes
+    ----------
+    start, end : float
+        First and last sample over the threshold [s].
+    joints : tuple of int
+        Joints over their threshold, 1-based.
+    peak : tuple of float
+        Every joint's residual at its largest magnitude in the crossing [N m] (signed).
+    ratio : tuple of float
+        Every joint's largest ``|r| / contact threshold`` in it (the threshold as it stood
+        at each sample); over 1 on its ``joints``.
+    rule : {"isolated", "short"}
+        ``isolated``: a run shorter than the minimum duration with no other within the
+        isolation window; ``short``: runs joined into an event still shorter than it.
+    """
+
+    start: float
+    end: float
+    joints: tuple[int, ...]
+    peak: tuple[float, ...]
+    ratio: tuple[float, ...]
+    rule: Literal["isolated", "short"]
+
+    @property
+    def duration(self) -> float:
+        """``end - start`` [s], the span the minimum duration is compared with."""
+        return self.end - self.start
+
+    @property
+    def joint(self) -> int:
+        """The joint (1-based) furthest over its threshold."""
+        return max(self.joints, key=lambda j: self.ratio[j - 1])
+
+
 @dataclass(slots=True)
 class _Stretch:
     """What a stretch of samples contributes to an event: per joint the largest ``|r|``
-    (n,) and ``r`` at its first occurrence, the joints over the contact threshold, and
-    whether some joint passed its collision threshold."""
+    (n,) and ``r`` at its first occurrence, the largest ``|r| / contact threshold``, the
+    joints over the contact threshold, and whether some joint passed its collision
+    threshold."""
 
     top: NDArray[np.float64]
     value: NDArray[np.float64]
     joints: NDArray[np.bool_]
     collision: bool
+    ratio: NDArray[np.float64]
 
     @staticmethod
     def empty(n: int) -> _Stretch:
-        return _Stretch(np.full(n, -np.inf), np.zeros(n), np.zeros(n, dtype=bool), False)
+        return _Stretch(
+            np.full(n, -np.inf), np.zeros(n), np.zeros(n, dtype=bool), False, np.zeros(n)
+        )
 
     @staticmethod
-    def of(r: NDArray[np.float64], over: NDArray[np.bool_], beyond: NDArray[np.bool_]) -> _Stretch:
+    def of(
+        r: NDArray[np.float64],
+        over: NDArray[np.bool_],
+        beyond: NDArray[np.bool_],
+        ratio: NDArray[np.float64],
+    ) -> _Stretch:
         """Of the samples ``r`` (m, n), over the contact (``over``) and the collision
-        (``beyond``) thresholds (m, n)."""
+        (``beyond``) thresholds (m, n), ``|r|`` over the contact threshold ``ratio`` (m, n;
+        0 where not observed)."""
         n = r.shape[1]
         if r.shape[0] == 0:
             return _Stretch.empty(n)
         k = np.argmax(np.abs(r), axis=0)
         value = r[k, np.arange(n)]
         joints: NDArray[np.bool_] = np.asarray(over.any(axis=0))
-        return _Stretch(np.abs(value), value, joints, bool(beyond.any()))
+        return _Stretch(np.abs(value), value, joints, bool(beyond.any()), ratio.max(axis=0))
 
     def then(self, later: _Stretch) -> _Stretch:
         """This stretch followed by ``later``: a peak of ``later`` replaces one of this
@@ -122,6 +182,18 @@ class _Stretch:
             np.where(take, later.value, self.value),
             self.joints | later.joints,
             self.collision or later.collision,
+            np.fmax(self.ratio, later.ratio),
+        )
+
+    def dropped(self, start: float, end: float, rule: str) -> DroppedCrossing:
+        """The stretch as a crossing from ``start`` to ``end`` [s] dropped by ``rule``."""
+        return DroppedCrossing(
+            start,
+            end,
+            tuple(int(j) + 1 for j in np.flatnonzero(self.joints)),
+            tuple(float(x) for x in self.value),
+            tuple(float(x) for x in self.ratio),
+            "isolated" if rule == "isolated" else "short",
         )
 
 
@@ -214,6 +286,33 @@ class EventDetector:
         self._open: _Open | None = None
         self._run: _Run | None = None  # a run that reached the end of the last block
         self._ratio = np.full(thresholds.n, np.nan)
+        self._dropped: list[DroppedCrossing] = []
+        self._dropped_count = 0
+
+    @property
+    def dropped(self) -> tuple[DroppedCrossing, ...]:
+        """The crossings over the contact threshold dropped so far by the minimum
+        duration (module docstring), in time order: the :data:`MAX_DROPPED` furthest over
+        the threshold when there were more (:attr:`dropped_count` counts them all)."""
+        return tuple(sorted(self._kept_dropped(), key=lambda d: d.start))
+
+    @property
+    def dropped_count(self) -> int:
+        """Every crossing dropped so far by the minimum duration."""
+        return self._dropped_count
+
+    def _kept_dropped(self) -> list[DroppedCrossing]:
+        """The :data:`MAX_DROPPED` records furthest over the threshold."""
+        if len(self._dropped) > MAX_DROPPED:
+            self._dropped.sort(key=lambda d: -max(d.ratio))
+            del self._dropped[MAX_DROPPED:]
+        return self._dropped
+
+    def _drop(self, crossing: DroppedCrossing) -> None:
+        self._dropped_count += 1
+        self._dropped.append(crossing)
+        if len(self._dropped) > 2 * MAX_DROPPED:  # bounded memory on a noisy log
+            self._kept_dropped()
 
     @property
     def largest_ratio(self) -> NDArray[np.float64]:
@@ -261,16 +360,18 @@ class EventDetector:
             std = np.where(seen[:, None], np.asarray(std, dtype=np.float64), 0.0)
         ra = np.where(seen[:, None], ra, 0.0)
         contact, collision = threshold_series(self.thresholds, m, std, standstill)
+        with np.errstate(divide="ignore", invalid="ignore"):
+            ratio = np.abs(ra) / contact
+        ratio = np.where((ratio >= 0) & seen[:, None], ratio, np.nan)  # NaN: not observed
         if seen.any():
-            with np.errstate(divide="ignore", invalid="ignore"):
-                ratio = np.abs(ra[seen]) / contact[seen]
-            self._ratio = np.fmax(self._ratio, np.nanmax(np.where(ratio >= 0, ratio, np.nan), 0))
+            self._ratio = np.fmax(self._ratio, np.nanmax(ratio[seen], 0))
+        ratio = np.nan_to_num(ratio, nan=0.0, posinf=np.finfo(float).max)
         first, self._next = self._next, self._next + m
         over = np.abs(ra) > contact
         beyond = np.abs(ra) > collision
 
         def stretch(a: int, b: int) -> _Stretch:
-            return _Stretch.of(ra[a:b], over[a:b], beyond[a:b])
+            return _Stretch.of(ra[a:b], over[a:b], beyond[a:b], ratio[a:b])
 
         hit = np.flatnonzero(over.any(axis=1))
         piece = np.searchsorted(self._restarts, first + hit, side="right")
@@ -329,6 +430,7 @@ class EventDetector:
         short) and the run opens the next."""
         short = run.last - run.start < self.min_duration_s and not run.held.collision
         if short and not (run.near or near):
+            self._drop(run.held.dropped(run.start, run.last, "isolated"))
             self._between(run.held)
             self._between(run.tail)
             return []
@@ -344,6 +446,7 @@ class EventDetector:
         """The event closed, or none when it is shorter than ``min_duration_s`` and
         stayed at the contact level."""
         if event.last - event.start < self.min_duration_s and not event.held.collision:
+            self._drop(event.held.dropped(event.start, event.last, "short"))
             return []
         return [event.closed()]
 

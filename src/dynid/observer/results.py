@@ -15,6 +15,7 @@ from numpy.typing import NDArray
 from ..exceptions import DataError
 from ..friction.model import FrictionModel, FrictionSum
 from .detection import ContactEvent, Thresholds
+from .events import DroppedCrossing
 from .friction import banding_note
 from .gain_noise import GainNoise
 from .model import ObserverModel
@@ -27,6 +28,7 @@ __all__ = [
     "FigureSeries",
     "LogObservation",
     "ObserveResult",
+    "dropped_words",
     "flagged_words",
     "robot_friction_note",
 ]
@@ -105,6 +107,13 @@ class LogObservation:
         The events against the log's labelled contacts (a label column, or the true
         external torques of a simulated log: :mod:`~dynid.observer.scoring`); None: no
         label.
+    dropped : tuple of DroppedCrossing
+        Crossings over the contact threshold the minimum duration dropped (not contacts;
+        :attr:`~dynid.observer.events.EventDetector.dropped`: those furthest over the
+        threshold when there were more than
+        :data:`~dynid.observer.events.MAX_DROPPED`), when detecting.
+    dropped_count : int
+        Every such crossing.
     """
 
     path: Path
@@ -123,6 +132,8 @@ class LogObservation:
     peak_ratio: NDArray[np.float64] | None = None
     friction: FrictionModel | FrictionSum | None = None
     score: ContactScore | None = None
+    dropped: tuple[DroppedCrossing, ...] = ()
+    dropped_count: int = 0
 
     @property
     def series(self) -> NDArray[np.float64]:
@@ -187,7 +198,9 @@ class ObserveResult:
     ``<dynamics>``; None: a friction given or identified); ``frame``, where the wrench was
     estimated (None: nowhere), and ``wrench``, what was estimated there (the whole wrench
     or the force of a point contact); ``gain_noise``, of a calibration: how much of its
-    residual is the velocities' noise times the gain (None: not calibrated)."""
+    residual is the velocities' noise times the gain (None: not calibrated);
+    ``min_duration_s`` and ``merge_s`` [s], the event rules a detection applied (None:
+    calibrated)."""
 
     model: ObserverModel
     thresholds: Thresholds
@@ -197,6 +210,13 @@ class ObserveResult:
     frame: str | None = None
     wrench: WrenchKind = FULL
     gain_noise: GainNoise | None = None
+    min_duration_s: float | None = None
+    merge_s: float | None = None
+
+    def dropped_count(self) -> int:
+        """The crossings over the contact threshold every log's minimum duration dropped
+        (not contacts)."""
+        return sum(x.dropped_count for x in self.logs)
 
     def score(self) -> ContactScore | None:
         """The events of every log with labelled contacts against them, in total
@@ -270,3 +290,31 @@ def flagged_words(flagged: float, logged: float) -> str:
     of the logs' duration."""
     share = 100.0 * flagged / logged if logged > 0 else 0.0
     return f"{flagged:.3g} s flagged ({share:.3g} % of {logged:.3g} s logged)"
+
+
+#: What each rule of :class:`~dynid.observer.events.DroppedCrossing` means, in words.
+DROP_RULES = {
+    "isolated": "isolated: no other crossing within --merge / 2",
+    "short": "short: with the crossings --merge joined to it",
+}
+
+
+def dropped_words(
+    start: float,
+    end: float,
+    joint: str,
+    peak: float,
+    ratio: float,
+    rule: str,
+    min_duration_s: float | None,
+) -> str:
+    """``"0.803 s .. 0.806 s, joint2 peak +3.1 N m = 1.93 x contact, 3 ms < 10 ms
+    (isolated: ...)"``: a crossing the minimum duration dropped, at ``start``, ``end``
+    [s], on ``joint`` (its name, the one furthest over its threshold) with its ``peak``
+    residual [N m] and its largest ``|r| / contact threshold`` ``ratio``, its duration
+    against ``min_duration_s`` [s] and its ``rule``."""
+    least = "" if min_duration_s is None else f" < {1e3 * min_duration_s:.3g} ms"
+    return (
+        f"{start:.3f} s .. {end:.3f} s, {joint} peak {peak:+.3g} N m = {ratio:.3g} x contact, "
+        f"{1e3 * (end - start):.3g} ms{least} ({DROP_RULES.get(rule, rule)})"
+    )

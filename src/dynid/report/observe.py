@@ -89,6 +89,47 @@ def _scored(doc: Any) -> str | None:
     return esc(said + ".")
 
 
+#: Dropped crossings a report names at most (events.json holds more).
+DROPPED_SHOWN = 5
+
+
+def _dropped(doc: Any) -> tuple[int, str | None]:
+    """The crossings over the contact threshold that the minimum duration dropped
+    (``events.json``'s ``dropped``): their count and one escaped sentence naming those
+    furthest over the threshold (time, joint, peak, ratio, duration against the minimum);
+    ``(0, None)`` where the file has none."""
+    drop = doc.get("dropped") if isinstance(doc, dict) else None
+    if not isinstance(drop, dict) or not is_number(count := drop.get("count")) or not count:
+        return 0, None
+    from ..observer.results import dropped_words
+
+    least = drop.get("min_duration_s")
+    least = float(least) if is_number(least) else None
+    named = []
+    for c in drop.get("crossings") or ():
+        try:
+            j = int(c["joint"]) - 1
+            names = c.get("joint_names") or []
+            joint = dict(zip(c["joints"], names, strict=False)).get(j + 1, f"joint {j + 1}")
+            ratio = float(c["ratio"][j])
+            words = dropped_words(
+                float(c["start"]), float(c["end"]), str(joint), float(c["peak"][j]), ratio,
+                str(c["rule"]), least,
+            )  # fmt: skip
+        except (KeyError, IndexError, TypeError, ValueError):
+            continue
+        named.append((ratio, f"{c.get('log', '?')}: {words}"))
+    named = sorted(named, key=lambda x: -x[0])[:DROPPED_SHOWN]
+    said = (
+        f"{int(count)} crossing(s) over the contact threshold dropped as shorter than the "
+        f"minimum duration{'' if least is None else f' ({least:g} s, --min-duration)'}; "
+        "not contacts"
+    )
+    if named:
+        said += ": " + "; ".join(w for _, w in named)
+    return int(count), esc(said + ".")
+
+
 def _numbers(v: Any) -> bool:
     return isinstance(v, list) and bool(v) and all(is_number(x) for x in v)
 
@@ -107,6 +148,7 @@ def answer(run: RunFiles) -> Answer | None:
     facts = []
     label = None
     calibrated = _calibration(run.docs.get(found["thresholds.json"] or ""))
+    dropped, said = _dropped(run.docs.get(found["events.json"] or ""))
     if events is None and calibrated is not None:  # a calibration judges no events
         head, level, label = calibrated, "info", "thresholds calibrated"
     elif events is None:
@@ -114,8 +156,16 @@ def answer(run: RunFiles) -> Answer | None:
     elif events:
         head = f"{len(events)} event{'s' if len(events) != 1 else ''} detected"
         head, level = head + _flagged(run.docs.get(found["events.json"] or "")) + ".", "info"
+    elif dropped:
+        head = (
+            f"No event, but {dropped} crossing(s) of a threshold too short to count "
+            "(below the minimum duration)."
+        )
+        level = "info"
     else:
         head, level = "No event: every residual stayed below its threshold.", "good"
+    if said is not None:
+        facts.append(said)
     if (scored := _scored(run.docs.get(found["events.json"] or ""))) is not None:
         facts.append(scored)
     if found["thresholds.json"] is not None:

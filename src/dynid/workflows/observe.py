@@ -529,7 +529,10 @@ def observe_files(opts: ObserveOptions, sink: ResidualSink | None = None) -> Obs
                 tolerance_s=opts.label_tolerance_s,
             )  # fmt: skip
         )
-    return ObserveResult(model, given, tuple(logs), fingerprint, own, opts.frame, kind)
+    return ObserveResult(
+        model, given, tuple(logs), fingerprint, own, opts.frame, kind,
+        min_duration_s=opts.min_duration_s, merge_s=opts.merge_s,
+    )  # fmt: skip
 
 
 def model_fingerprint(opts: ObserveOptions) -> ModelFingerprint:

@@ -204,6 +204,8 @@ def detected_log(
         peak_ratio=det.largest_ratio,
         friction=None if seen is model.friction else seen,
         score=scored(log.t, events, labels, ext, tolerance_s),
+        dropped=det.dropped,
+        dropped_count=det.dropped_count,
     )
 
 
