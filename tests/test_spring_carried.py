@@ -1,10 +1,12 @@
 """The identified joint spring carried downstream of identification: the consistent fit,
-``feasible.json``, validation, the observer, simulation and the robot exports.
+``feasible.json``, validation, the observer (its residual and its uncertainty),
+simulation and the robot exports.
 
 References: simulated recordings of the planar 2R arm (``tests/conftest.py``) whose torques
 hold a known spring ``k (q - q0)`` about the middle of the joints' limits, classical friction
 and sensor noise (the stiffnesses judged against the truth, the torques on a recording the
-fit did not see against its noise); MuJoCo's passive spring force for the MJCF export.
+fit did not see against its noise); MuJoCo's passive spring force for the MJCF export;
+the observer's own residual at other stiffnesses for the spring's uncertainty.
 """
 
 from __future__ import annotations
@@ -22,10 +24,11 @@ from dynid.identification.structure import Structure
 from dynid.io.export import save_robot
 from dynid.io.feasible import load_feasible_spring
 from dynid.io.feasible_bundle import save_feasible_bundle
+from dynid.io.model_json import save_model_json
 from dynid.io.robot_file import load_robot
 from dynid.io.torque_log import save_torque_log
 from dynid.model.stiffness import JointStiffness
-from dynid.observer.model import from_robot
+from dynid.observer.model import from_identified, from_robot
 from dynid.simulation.measurement import SensorNoise, sample_times, simulate_measurement
 from dynid.simulation.trajectories import random_fourier
 from dynid.workflows.validate import ValidateOptions, validate_files
@@ -66,6 +69,8 @@ def fitted(arm, tmp_path_factory):
         )
         save_feasible_bundle(out, res)
     save_torque_log(out / "held.csv", logs[2])
+    save_torque_log(out / "train.csv", logs[0])
+    save_model_json(out / "identification.json", res.identified)
     return res, out
 
 
@@ -154,6 +159,80 @@ def test_toml_and_feasible_round_trips_give_the_spring_torques(fitted, tmp_path)
     again = load_robot(tmp_path / "again.toml").spring
     assert again is not None
     np.testing.assert_array_equal(again.k, res.spring.k)
+
+
+def test_the_observer_with_the_fitted_spring_raises_no_alarm_on_free_motion(fitted, tmp_path):
+    """``observe`` calibrated on a training recording of the spring arm, detecting on the
+    held-out one (free motion, no contact): with the fitted spring (``feasible.json``, and
+    ``identification.json`` with its uncertainty) no event and every residual under its
+    threshold; the same thresholds with the spring left out of ``feasible.json`` take the
+    spring's torque for contacts."""
+    import json
+
+    from dynid.io.observer_files import save_thresholds
+    from dynid.workflows.observe import ObserveOptions, observe_files
+
+    _, out = fitted
+    doc = json.loads((out / "feasible.json").read_text())
+    del doc["spring"]
+    (tmp_path / "nospring.json").write_text(json.dumps(doc))
+    train, held = (out / "train.csv",), (out / "held.csv",)
+    runs = {
+        "identified": ({"model": out / "identification.json"}, None),
+        "feasible": ({"params": out / "feasible.json"}, {"params": tmp_path / "nospring.json"}),
+    }
+    found = {}
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", DynidWarning)  # another model than calibrated
+        for name, (src, without) in runs.items():
+            cal = observe_files(ObserveOptions(data=train, calibrate=True, **src))
+            assert cal.thresholds.uses_uncertainty == (name == "identified")
+            th = save_thresholds(tmp_path / f"{name}.json", cal.thresholds, joints=("a", "b"))
+            for key, spec in ((name, src), (f"{name} without", without)):
+                if spec is not None:
+                    x = observe_files(ObserveOptions(data=held, thresholds=th, **spec)).logs[0]
+                    found[key] = (len(x.events), float(np.nanmax(x.peak_ratio)))
+    assert found["identified"][0] == 0 and found["feasible"][0] == 0, found
+    assert found["identified"][1] < 1.0 and found["feasible"][1] < 1.0, found
+    assert found["feasible without"][0] >= 1 and found["feasible without"][1] > 3.0, found
+
+
+def test_the_residual_uncertainty_holds_the_springs(fitted):
+    """The observer model of the identified spring carries the stiffnesses' variances
+    (``std**2``); with the covariance a direction ``e e^T`` in the stiffnesses alone the
+    propagated std is ``|r(k + e) - r(k)|``, the observer run on the model with the
+    stiffnesses moved (the residual is linear in them): the spring's uncertainty goes
+    through the observer's filter exactly."""
+    import dataclasses
+
+    from dynid.observer.detection import residual_std
+    from dynid.observer.residual import ObserverOptions, observe
+
+    res, _ = fitted
+    ident = res.identified
+    model = from_identified(ident, friction=None)
+    spring = ident.terms["spring"]
+    assert model.position_covariance is not None
+    np.testing.assert_allclose(np.diag(model.position_covariance), spring.std**2, rtol=1e-15)
+    rng = np.random.default_rng(21)
+    t = np.arange(0.0, 1.5, 1e-3)
+    w, phase = np.array([2.0, 3.0]), rng.uniform(0.0, 1.0, 2)
+    q = (LOWER + UPPER) / 2 + 1.5 * np.sin(np.outer(t, w) + phase)
+    dq = 1.5 * w * np.cos(np.outer(t, w) + phase)
+    tau = rng.normal(size=q.shape)
+    e = np.array([0.3, -0.2])  # N m/rad
+    opts = ObserverOptions(gain=30.0)
+    ((term, values),) = model.position_terms
+    moved = dataclasses.replace(model, position_terms=((term, values + e),))
+    r0 = observe(model, t, q, dq, tau, opts).r
+    r1 = observe(moved, t, q, dq, tau, opts).r
+    cov = np.zeros_like(np.asarray(model.covariance))
+    one = dataclasses.replace(model, covariance=cov, position_covariance=np.outer(e, e))
+    s = residual_std(one, t, q, dq, opts)
+    assert np.abs(r1 - r0).max() > 0.1
+    np.testing.assert_allclose(s, np.abs(r1 - r0), rtol=0, atol=1e-9)
+    without = dataclasses.replace(one, position_covariance=None)
+    np.testing.assert_allclose(residual_std(without, t, q, dq, opts), 0.0, atol=1e-12)
 
 
 def test_only_the_urdf_export_says_it_leaves_the_spring_out(arm, tmp_path):

@@ -15,7 +15,11 @@ events.
   (:func:`residual_std`; ``Y_p`` and ``Y_beta`` of
   :func:`~dynid.observer.terms.base_momentum_regressor`, the rule's mean of ``Y_beta``
   with the trapezoid rule). The noise floor ``nu_j = margin * Q_q((|r_j| - k sigma_j)^+)``
-  is what the uncertainty leaves unexplained on the calibration data.
+  is what the uncertainty leaves unexplained on the calibration data. The terms of the
+  positions (a joint spring ``k (q - q0)``, whose torque the residual takes off the
+  measured one as it takes ``g``) add their columns to ``Y_beta`` and their
+  coefficients' variances to ``Sigma`` (uncorrelated with the base parameters: an
+  identification file keeps no covariance between them).
 
 **The standstill margin** (``standstill``): inside a friction law's standstill band its
 Coulomb term is off, while the true friction of a slow reversal lies anywhere in
@@ -136,13 +140,18 @@ def residual_std_blocks(
     K = options.gains(n)
     gam = -np.expm1(-K * T) if options.discretisation == "exact" else K * T
     trap = options.rule == "trapezoid"
-    w, V = np.linalg.eigh(np.asarray(model.covariance))
+    w, V = np.linalg.eigh(_covariance(model))
     L = V * np.sqrt(np.clip(w, 0.0, None))  # Sigma = L L^T
     r = L.shape[0]
     zi = np.zeros((n, 1, r))
     prev_p = prev_b = None
     for a in range(0, N, BLOCK):
         Yp, Yb = base_momentum_regressor(model, qa[a : a + BLOCK], dqa[a : a + BLOCK])
+        Ys = model.position_columns(qa[a : a + BLOCK])
+        if Ys is not None and model.position_covariance is not None:
+            # a spring's torque enters the integral as g does; it holds no momentum
+            Yp = np.concatenate([Yp, np.zeros_like(Ys)], axis=-1)
+            Yb = np.concatenate([Yb, Ys], axis=-1)
         dp = np.empty_like(Yp)
         dp[1:] = np.diff(Yp, axis=0) / T
         dp[0] = 0.0 if prev_p is None else (Yp[0] - prev_p) / T
@@ -162,6 +171,20 @@ def residual_std_blocks(
             zi[j] = zf
         prev_p, prev_b = Yp[-1], Yb[-1]
         yield a, np.sqrt(np.sum((Z @ L) ** 2, axis=-1))
+
+
+def _covariance(model: ObserverModel) -> NDArray[np.float64]:
+    """The covariance of the parameters the residual's uncertainty is taken over: the
+    base parameters', then the position terms' (a joint spring's stiffnesses), taken as
+    uncorrelated with them (a file keeps no covariance between the two)."""
+    import scipy.linalg
+
+    base = np.asarray(model.covariance, dtype=np.float64)
+    held = model.position_covariance
+    if held is None or not model.position_terms:
+        return base
+    out: NDArray[np.float64] = scipy.linalg.block_diag(base, np.asarray(held))
+    return out
 
 
 def standstill_series(

@@ -24,7 +24,7 @@ from .. import _checks
 from ..exceptions import ShapeError
 from ..friction.model import FrictionModel, FrictionSum
 from ..friction.validation import own_friction
-from ..identification.model import IdentifiedModel
+from ..identification.model import IdentifiedModel, IdentifiedTerm
 from ..model.drive import Drive
 from ..model.robot import Robot
 from ..regressors.base import BaseParameters
@@ -65,6 +65,13 @@ class ObserverModel:
         The identified model's terms that are neither friction nor in the base (a joint
         spring), each with its coefficients: torques of the position that the measured
         torque spends beside the links' (:meth:`position_torques`), no momentum.
+    position_covariance : ndarray, shape (s, s), or None
+        The covariance of those coefficients, stacked in order (``s`` of them, in their
+        units): the squares of an identified model's standard deviations on the
+        diagonal, 0 for a coefficient not kept (a file keeps no covariance between
+        them and the base parameters: taken as uncorrelated). The residual's uncertainty
+        adds it to the base parameters' (:mod:`dynid.observer.detection`); None: no
+        position term, or a robot's own (no uncertainty).
     """
 
     robot: Robot
@@ -77,6 +84,7 @@ class ObserverModel:
     source: str = "robot"
     base_terms: tuple[ModelTerm, ...] = ()
     position_terms: tuple[tuple[ModelTerm, NDArray[np.float64]], ...] = ()
+    position_covariance: NDArray[np.float64] | None = None
 
     def __post_init__(self) -> None:
         n = self.robot.n
@@ -88,6 +96,10 @@ class ObserverModel:
             object.__setattr__(self, "beta", _checks.frozen(np.asarray(self.beta, float)))
         if self.covariance is not None:
             object.__setattr__(self, "covariance", _checks.frozen(np.asarray(self.covariance)))
+        if self.position_covariance is not None:
+            s = sum(len(term.labels) for term, _ in self.position_terms)
+            P = _checks.as_exact("position_covariance", self.position_covariance, (s, s))
+            object.__setattr__(self, "position_covariance", _checks.frozen(P))
 
     @property
     def n(self) -> int:
@@ -99,6 +111,7 @@ class ObserverModel:
         return ObserverModel(
             self.robot, self.rotor_mass, friction, self.base, self.beta, self.covariance,
             self.drive, self.source, self.base_terms, self.position_terms,
+            self.position_covariance,
         )  # fmt: skip
 
     def position_torques(self, q: NDArray[np.float64]) -> NDArray[np.float64] | None:
@@ -111,6 +124,15 @@ class ObserverModel:
             (term.torque_columns(q, z, z) @ values for term, values in self.position_terms),
             np.zeros_like(q),
         )
+
+    def position_columns(self, q: NDArray[np.float64]) -> NDArray[np.float64] | None:
+        """The torque columns (N, n, s) of :attr:`position_terms` at the positions ``q``
+        (N, n) [rad], stacked in order (``position_torques = columns @ values``), or None
+        without such terms."""
+        if not self.position_terms:
+            return None
+        z = np.zeros_like(q)
+        return np.concatenate([term.torque_columns(q, z, z) for term, _ in self.position_terms], -1)
 
     def mass_matrix(self, q: ArrayLike) -> NDArray[np.float64]:
         """``M(q)`` [kg m^2] with the rotor part: (..., n) -> (..., n, n)."""
@@ -129,7 +151,8 @@ def from_identified(
     model : IdentifiedModel
         Base parameters (through ``equivalent_robot``), the rotor inertias (the drive's
         known ones, and the terms in the base, each its own mass through its momentum
-        columns: :func:`term_mass`), the identified friction and the covariance of ``fit``.
+        columns: :func:`term_mass`), the identified friction, the covariance of ``fit``
+        and the terms of the positions (a joint spring) with their standard deviations.
     friction : FrictionModel, None or "model"
         ``"model"`` (default): the friction identified with the model (each friction term
         where it acts: :func:`~dynid.friction.validation.own_friction`), none if it has none.
@@ -147,6 +170,9 @@ def from_identified(
         Mr = Mr + term_mass(t.term, t.values, n)
     fr = own_friction(model) if isinstance(friction, str) else friction
     fit = model.fit
+    held = [
+        t for t in model.terms.values() if not t.term.in_base and t.term.friction(t.values) is None
+    ]
     return ObserverModel(
         robot=model.equivalent_robot,
         rotor_mass=Mr,
@@ -157,12 +183,16 @@ def from_identified(
         drive=model.drive,
         source="identified",
         base_terms=tuple(t.term for t in in_base),
-        position_terms=tuple(
-            (t.term, np.asarray(t.values, dtype=np.float64))
-            for t in model.terms.values()
-            if not t.term.in_base and t.term.friction(t.values) is None
-        ),
+        position_terms=tuple((t.term, np.asarray(t.values, dtype=np.float64)) for t in held),
+        position_covariance=None if not held else np.diag(_variances(held)),
     )
+
+
+def _variances(terms: list[IdentifiedTerm]) -> NDArray[np.float64]:
+    """The squared standard deviations of the terms' coefficients, stacked (0 where one is
+    not kept or has none)."""
+    std = np.concatenate([np.where(t.kept, t.std, 0.0) for t in terms])
+    return np.square(np.nan_to_num(std, nan=0.0, posinf=0.0))
 
 
 def term_mass(term: ModelTerm, values: ArrayLike, n: int) -> NDArray[np.float64]:
