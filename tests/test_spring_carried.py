@@ -46,14 +46,13 @@ def arm():
     return planar_2r().replace(q_min=LOWER, q_max=UPPER)
 
 
-@pytest.fixture(scope="module")
-def fitted(arm, tmp_path_factory):
-    """``identify --consistent --terms viscous,coulomb,spring`` on two recordings of the
-    arm with a spring, judged on a third; its files and the held-out recording."""
+def _spring_logs(arm):
+    """Three noisy recordings of the arm with the spring and classical friction (seeds 11,
+    12, 13)."""
     q0 = (LOWER + UPPER) / 2
     fr = ClassicalFriction(np.array([0.3, 0.2]), np.array([0.4, 0.3]), np.zeros(2))
     noise = SensorNoise(tau_std=NOISE, q_std=1e-5, dq_std=1e-3)
-    logs = recordings(
+    return recordings(
         arm,
         (11, 12, 13),
         friction=fr,
@@ -61,6 +60,13 @@ def fitted(arm, tmp_path_factory):
         noise=noise,
         added=lambda log: K * (log.q - q0),
     )
+
+
+@pytest.fixture(scope="module")
+def fitted(arm, tmp_path_factory):
+    """``identify --consistent --terms viscous,coulomb,spring`` on two recordings of the
+    arm with a spring, judged on a third; its files and the held-out recording."""
+    logs = _spring_logs(arm)
     out = tmp_path_factory.mktemp("spring")
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", DynidWarning)
@@ -233,6 +239,28 @@ def test_the_residual_uncertainty_holds_the_springs(fitted):
     np.testing.assert_allclose(s, np.abs(r1 - r0), rtol=0, atol=1e-9)
     without = dataclasses.replace(one, position_covariance=None)
     np.testing.assert_allclose(residual_std(without, t, q, dq, opts), 0.0, atol=1e-12)
+
+
+def test_a_priors_spring_is_said_to_be_unused_and_changes_nothing(arm, fitted):
+    """A prior robot with a [spring] (k = 100 N m/rad, 25 and 50 times the truth): the
+    consistent fit is the one with the description's prior, to the bit (stiffnesses and
+    links from the data; a prior holds the links' inertials only), and a note says the
+    prior's spring is not used, where it was ignored without a word."""
+    res, _ = fitted
+    logs = _spring_logs(arm)
+    prior = arm.with_spring(JointStiffness(np.array([100.0, 100.0]), (LOWER + UPPER) / 2))
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", DynidWarning)
+        got = identify_consistent(
+            arm, logs[:2], structure=Structure.parse("viscous,coulomb,spring"),
+            validate_on=logs[2], prior=prior,
+        )  # fmt: skip
+    assert got.spring is not None and res.spring is not None
+    np.testing.assert_array_equal(got.spring.k, res.spring.k)
+    np.testing.assert_array_equal(got.robot.phi, res.robot.phi)
+    said = [x for x in got.notes if "joint spring" in x]
+    assert len(said) == 1 and "k = 100, 100 N m/rad) is not used" in said[0], got.notes
+    assert not [x for x in res.notes if "joint spring" in x]
 
 
 def test_only_the_urdf_export_says_it_leaves_the_spring_out(arm, tmp_path):

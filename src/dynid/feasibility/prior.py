@@ -184,7 +184,8 @@ def prior_from_robot(
     Parameters
     ----------
     robot : Robot
-        A robot with link inertials (``robot.phi``).
+        A robot with link inertials (``robot.phi``); its joint spring, when it has one,
+        is not part of a prior (a note says so).
     source : str, optional
         Name in reports (default ``robot.name``).
     margin : float
@@ -233,6 +234,12 @@ def prior_from_robot(
             notes.append(
                 f"prior {name}: total mass {M:.3f} kg lies outside the band {lo:g}..{hi:g} kg"
             )
+    if robot.spring is not None:  # a prior is of the links: the fit never reads it
+        k = ", ".join(f"{x:.3g}" for x in robot.spring.k)
+        notes.append(
+            f"prior {name}: its joint spring (k = {k} N m/rad) is not used; a prior holds the "
+            "links' inertials only, and the stiffnesses come from the data (spring in --terms)"
+        )
     return Prior(phi=phi, source=name, repaired=tuple(sorted(set(repaired))), notes=tuple(notes))
 
 
