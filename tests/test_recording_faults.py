@@ -371,3 +371,31 @@ def test_a_flipped_joint_whose_gravity_barely_varies_is_found_by_its_mean(seed):
     assert said is not None and "the measured torques of elbow_joint are" in said, said
     assert "from the negated model's torques" in said and "--units tau3=-1" in said
     assert opposite_sign(*_ur5_log(seed, [])) is None
+
+
+def test_one_recording_of_another_convention_is_flipped_alone(panda, log, tmp_path):
+    """Two recordings, the second logged with joint 4's torque of the opposite sign: the
+    fit refuses it naming that file; ``--units b.csv:tau4=-1`` reads that file alone
+    flipped, and the fit is the one of both recordings logged alike (bit for bit); an
+    entry naming a file not given is refused in one line."""
+    from dynid.workflows.identify import IdentifyOptions, identify_files
+
+    half = len(log.t) // 2
+    a = TorqueLog(log.t[:half], log.q[:half], log.dq[:half], log.tau[:half])
+    b = TorqueLog(log.t[half:], log.q[half:], log.dq[half:], log.tau[half:])
+    flipped = b.tau.copy()
+    flipped[:, 3] *= -1
+    save_torque_log(tmp_path / "a.csv", a)
+    save_torque_log(tmp_path / "alike" / "b.csv", b)
+    save_torque_log(tmp_path / "b.csv", TorqueLog(b.t, b.q, b.dq, flipped))
+    both = [tmp_path / "a.csv", tmp_path / "b.csv"]
+    with pytest.raises(DataError, match="b.csv") as exc:
+        identify_files(panda, both)
+    assert "tau4=-1" in str(exc.value)
+    own = identify_files(panda, both, IdentifyOptions(columns=(None, "b.csv:tau4=-1")))
+    alike = identify_files(panda, [tmp_path / "a.csv", tmp_path / "alike" / "b.csv"])
+    np.testing.assert_array_equal(own.model.fit.beta, alike.model.fit.beta)
+    with pytest.raises(DataError, match="c.csv is none of the files given"):
+        identify_files(panda, both, IdentifyOptions(columns=(None, "c.csv:tau4=-1")))
+    with pytest.raises(DataError, match="a file's own entry flips single joints"):
+        identify_files(panda, both, IdentifyOptions(columns=(None, "b.csv:tau=mNm")))

@@ -204,6 +204,25 @@ def test_std_is_honoured_on_every_route_and_with_the_consistent_fit(files, tmp_p
     assert doc["std_estimator"] == "classical"
 
 
+def test_retrieve_from_a_model_file_starts_from_the_description_it_was_identified_with(
+    files, tmp_path
+):
+    """identification.json keeps the description's link inertials: retrieve without a
+    prior gives what --prior with that description gives, and a file without them (an
+    older file) falls back to the generic prior, saying so."""
+    path = files / "id" / "identification.json"
+    doc = json.loads(path.read_text())
+    np.testing.assert_array_equal(np.array(doc["robot"]["phi"]), dynid.panda().phi)
+    own = retrieve_files(path).result
+    named = retrieve_files(path, RetrieveOptions(prior="panda")).result
+    np.testing.assert_allclose(own.phi, named.phi, rtol=1e-9, atol=1e-12)
+    assert "description (panda)" in own.notes[0]
+    del doc["robot"]["phi"]
+    (tmp_path / "old.json").write_text(json.dumps(doc))
+    old = retrieve_files(tmp_path / "old.json").result
+    assert "has no link inertials" in old.notes[0]
+
+
 def test_the_output_bundle_of_a_consistent_fit_is_the_same_for_identify_and_retrieve(
     files, tmp_path
 ):

@@ -3,7 +3,8 @@
 --method sdp (default): convex retrieval. Every link's 4x4 pseudo-inertia J is kept
 positive definite (lambda_min(J) >= --margin * tr(J), default 1e-4: the parameters can come
 from a real mass density), masses and CoMs stay in their boxes and the total mass in its
-band, and the parameters are pulled towards a prior (--prior panda|FILE; default a solid
+band, and the parameters are pulled towards a prior (--prior panda|FILE; default the
+link inertials of the robot's description, kept in identification.json, else a solid
 cylinder per link from the kinematics) by the log-det divergence (--objective). Exact
 coefficients are met exactly; noisy ones are weighed by their covariance, and the prior's
 weight is by default the largest that keeps the identification's residual RMS within 1 % of

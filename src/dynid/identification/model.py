@@ -133,7 +133,8 @@ class IdentifiedModel:
     ----------
     robot : Robot
         Kinematics (and gravity) the coefficients belong to; its inertial parameters
-        are not used.
+        (the description's) are not the model's: a consistent fit from the model starts
+        from them when given no prior.
     base : BaseParameters
         Labels, expressions and the map from standard parameters.
     fit : LeastSquaresFit

@@ -16,7 +16,9 @@ A :class:`ColumnMap` names, per quantity, the column template of a file and its 
   says it once (:meth:`ColumnMap.unit_note`), not each file;
 * sign flips of single joints: ``tau2=-1`` (also ``q3``, ``dq3``, ``ddq3``; joints from 1)
   flips that joint's column as it is read, after its quantity's unit (a controller whose
-  convention differs on some joints; ``tau=-1`` flips every joint).
+  convention differs on some joints; ``tau=-1`` flips every joint); prefixed by a file's
+  name, ``rec2.csv:tau4=-1``, it flips that joint in that file only (a recording logged
+  with another convention among several).
 
 Written on the command line as ``--columns 'q=position_{i0},tau=effort_{i0}'`` and
 ``--units 'q=deg,tau=mNm'``, or as a TOML file with tables ``[columns]`` and ``[units]``.
@@ -135,6 +137,9 @@ class ColumnMap:
     flips : mapping of str to tuple of int
         Quantity -> the joints (from 0) whose columns are read with the opposite sign
         (``--units tau2=-1,tau3=-1``: ``{"tau": (1, 2)}``).
+    file_flips : mapping of str to mapping of str to tuple of int
+        A file's name -> its own flips, added to ``flips`` when that file is read
+        (``--units rec2.csv:tau4=-1``: ``{"rec2.csv": {"tau": (3,)}}``, :meth:`for_file`).
     """
 
     columns: Mapping[str, str] = field(default_factory=dict)
@@ -142,14 +147,20 @@ class ColumnMap:
     velocity_cutoff_hz: float = DEFAULT_CUTOFF_HZ
     names: Mapping[str, str] = field(default_factory=dict)
     flips: Mapping[str, tuple[int, ...]] = field(default_factory=dict)
+    file_flips: Mapping[str, Mapping[str, tuple[int, ...]]] = field(default_factory=dict)
 
     def __post_init__(self) -> None:
         for key in list(self.columns) + list(self.factors):
             if key not in _DEFAULT:
                 raise DataError(f"unknown quantity {key!r}; expected one of {list(_DEFAULT)}")
-        for key in self.flips:
+        for key in [*self.flips, *(k for f in self.file_flips.values() for k in f)]:
             if key not in _FLIPPABLE:
                 raise DataError(f"a joint's sign flips one of {list(_FLIPPABLE)}; got {key!r}")
+        object.__setattr__(
+            self,
+            "file_flips",
+            MappingProxyType({k: MappingProxyType(dict(v)) for k, v in self.file_flips.items()}),
+        )
         object.__setattr__(self, "flips", MappingProxyType(dict(self.flips)))
         object.__setattr__(self, "columns", MappingProxyType(dict(self.columns)))
         object.__setattr__(self, "factors", MappingProxyType(dict(self.factors)))
@@ -162,8 +173,18 @@ class ColumnMap:
         """Map from templates and unit names (``{"q": "deg", "tau": "mNm"}``) and single
         joints' sign flips (``{"tau2": -1}``)."""
         flips: dict[str, set[int]] = {}
+        files: dict[str, dict[str, set[int]]] = {}
         for key, u in units.items():
-            if (joint := _joint_key(key)) is not None:
+            if ":" in key:
+                name, _, own = key.rpartition(":")
+                if (joint := _joint_key(own)) is None or not name.strip():
+                    raise DataError(
+                        f"{key}={u}: a file's own entry flips single joints "
+                        f"(FILE:tau4=-1); units other than a sign are every file's"
+                    )
+                if _sign_flip(own, u):
+                    files.setdefault(name.strip(), {}).setdefault(joint[0], set()).add(joint[1])
+            elif (joint := _joint_key(key)) is not None:
                 if _sign_flip(key, u):
                     flips.setdefault(joint[0], set()).add(joint[1])
             elif key not in _DEFAULT:
@@ -173,11 +194,33 @@ class ColumnMap:
                     f"label={u}: a label column has no unit (nonzero is in contact); give "
                     "its name with --columns label=NAME"
                 )
-        given = {k: u for k, u in units.items() if _joint_key(k) is None}
+        given = {k: u for k, u in units.items() if _joint_key(k) is None and ":" not in k}
         factors = {k: _to_factor(k, u) for k, u in given.items()}
         names = {k: str(u) for k, u in given.items()}
         signs = {k: tuple(sorted(v)) for k, v in flips.items()}
-        return cls(dict(columns), factors, names=names, flips=signs, **kw)
+        per_file = {f: {k: tuple(sorted(v)) for k, v in d.items()} for f, d in files.items()}
+        return cls(dict(columns), factors, names=names, flips=signs, file_flips=per_file, **kw)
+
+    def for_file(self, name: str) -> ColumnMap:
+        """The map the file ``name`` is read with: the flips of every file and its own
+        (:attr:`file_flips`), without the other files' own."""
+        if not self.file_flips:
+            return self
+        own = self.file_flips.get(name, {})
+        flips = {
+            k: tuple(sorted({*self.flips.get(k, ()), *own.get(k, ())})) for k in {*self.flips, *own}
+        }
+        return ColumnMap(
+            self.columns,
+            self.factors,
+            self.velocity_cutoff_hz,
+            names=self.names,
+            flips=flips,
+        )
+
+    def unknown_files(self, names: Sequence[str]) -> tuple[str, ...]:
+        """The files named by a file's own entry that are not among ``names``."""
+        return tuple(f for f in self.file_flips if f not in set(names))
 
     @property
     def tau_is_current(self) -> bool:
@@ -543,6 +586,7 @@ def load_mapped_torque_log(
     ----------
     path : str or Path
     columns : ColumnMap
+        Read as :meth:`ColumnMap.for_file` of the file's name gives.
     n : int, optional
         Expected joint count (default: the number of position columns).
     gap_factor : float
@@ -561,6 +605,7 @@ def load_mapped_torque_log(
         templates, a malformed file, a joint count other than ``n``, time running backwards.
     """
     path = Path(path)
+    columns = columns.for_file(path.name)
     table = _read_table(path, columns, ("t", "q", "dq", "tau", "ddq"))
     t = table.columns.get(columns.template("t"))
     if t is None:

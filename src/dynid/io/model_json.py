@@ -164,7 +164,7 @@ def model_to_dict(model: IdentifiedModel, *, seed: int | None = None) -> dict[st
     frictions = model.frictions
     out["friction"] = frictions[0].params.tolist() if len(frictions) == 1 else None
     out["drive"] = None if model.drive is None else model.drive.as_dict()
-    out["robot"] = robot_to_dict(model.robot)
+    out["robot"] = robot_to_dict(model.robot, inertials=True)
     out["metadata"] = info_to_dict(info, model.drive) | friction_metadata(model)
     law = LAWS[frictions[0].law if len(frictions) == 1 else "classical"]
     out["units"] = {

@@ -7,11 +7,15 @@ gravity vector they were identified with. Fields (see :class:`dynid.Robot`): ``n
 ``q_max`` [rad or m], ``dq_max`` [rad/s], ``ddq_max`` [rad/s^2], ``tau_max`` [N m]; ``null``
 where there is no limit), ``gravity`` (3,) [m/s^2] in the base frame, and ``frames``
 (name -> ``{"link": index, "T_link_frame": 4x4}``, and ``"joint"``: the fixed joint that
-attaches it in the source URDF, when it has one).
+attaches it in the source URDF, when it has one), and, written beside identified
+coefficients, ``phi`` (n, 10): the description's standard parameters per link (m [kg],
+mc [kg m], J [kg m^2] about the link origin), the prior a later consistent fit starts from,
+never the identified values.
 
-Inertial parameters and friction are not written: a robot read back has zero standard
-parameters and no friction model. Floats are written with Python's shortest round-trip
-representation, so the kinematics read back are bit-identical.
+Friction is not written, nor the inertial parameters unless asked: a robot read back
+without ``phi`` has zero standard parameters, and none has a friction model. Floats are
+written with Python's shortest round-trip representation, so the kinematics read back are
+bit-identical.
 """
 
 from __future__ import annotations
@@ -49,6 +53,7 @@ ROBOT_RECORD = Record(
             ),
         ),
         "gravity": Field("numbers", required=True, shape=(3,), unit="m/s^2"),
+        "phi": Field("numbers", shape=(_N, 10)),
         "frames": Field(
             "named",
             required=True,
@@ -65,8 +70,12 @@ ROBOT_RECORD = Record(
 )
 
 
-def robot_to_dict(robot: Robot) -> dict[str, Any]:
-    """The kinematic fields of a robot as a JSON-ready dictionary (no inertial parameters)."""
+def robot_to_dict(robot: Robot, *, inertials: bool = False) -> dict[str, Any]:
+    """The kinematic fields of a robot as a JSON-ready dictionary; with ``inertials`` also
+    its standard parameters ``phi`` (n, 10) when it has any (the description's, kept as the
+    default prior of a consistent fit from the file)."""
+    phi = np.asarray(robot.phi, dtype=float)
+    kept = {"phi": phi.tolist()} if inertials and np.any(phi) else {}
     return {
         "schema": ROBOT_SCHEMA,
         "name": robot.name,
@@ -77,6 +86,7 @@ def robot_to_dict(robot: Robot) -> dict[str, Any]:
         "prismatic": [bool(p) for p in robot.prismatic],
         "limits": {k: finite_or_none(getattr(robot, k)) for k in _LIMITS},
         "gravity": robot.gravity.tolist(),
+        **kept,
         "frames": {
             name: {
                 "link": int(f.link),
@@ -92,6 +102,7 @@ def robot_to_dict(robot: Robot) -> dict[str, Any]:
             "ddq_max": "rad/s^2",
             "tau_max": "N m",
             "gravity": "m/s^2, base frame",
+            **({"phi": "per link m kg, mc kg m, J kg m^2 about the link origin"} if kept else {}),
         },
     }
 
@@ -99,7 +110,8 @@ def robot_to_dict(robot: Robot) -> dict[str, Any]:
 def robot_from_dict(
     d: Mapping[str, Any], *, source: str = "robot description", at: str = ""
 ) -> Robot:
-    """A robot (zero inertial parameters, no friction) from :func:`robot_to_dict` output.
+    """A robot (no friction; zero inertial parameters unless ``phi`` is given) from
+    :func:`robot_to_dict` output.
 
     ``source`` and ``at``: the file and the key path of ``d`` in it, for messages.
 
@@ -125,7 +137,7 @@ def robot_from_dict(
             T_parent_joint=np.array(d["T_parent_joint"], dtype=float).reshape(n, 4, 4),
             axes=np.array(d["axes"], dtype=float).reshape(n, 3),
             prismatic=np.array(d["prismatic"], dtype=bool).reshape(n),
-            phi=np.zeros((n, 10)),
+            phi=np.array(d["phi"], dtype=float).reshape(n, 10) if "phi" in d else np.zeros((n, 10)),
             gravity=np.array(d["gravity"], dtype=float),
             frames={
                 str(name): Frame(

@@ -46,6 +46,7 @@ from ..progress import NOTE
 __all__ = [
     "ColumnSpec",
     "DataKind",
+    "check_file_entries",
     "column_map",
     "data_files",
     "data_kind",
@@ -126,6 +127,7 @@ def column_map(
                 {**cmap.factors, **extra.factors},
                 names={**cmap.names, **extra.names},
                 flips={**cmap.flips, **extra.flips},
+                file_flips={**cmap.file_flips, **extra.file_flips},
                 **kw,
             )
     else:
@@ -201,6 +203,24 @@ def data_kind(path: str | Path, columns: ColumnMap | None = None) -> DataKind:
             raise DataError("a single array, not an NPZ archive", file=path.name) from None
         return "torque_log" if "t" in keys or "tau" in keys else "static"
     raise DataError("a data file must be .csv or .npz", file=path.name)
+
+
+def check_file_entries(cmap: ColumnMap | None, paths: Sequence[str | Path]) -> None:
+    """Refuse a file's own ``--units`` entry (``rec2.csv:tau4=-1``) that names none of
+    ``paths`` (a typo would otherwise leave the file unflipped).
+
+    Raises
+    ------
+    DataError
+        Naming the entry's file and the files given.
+    """
+    names = [Path(p).name for p in paths]
+    if cmap is not None and (bad := cmap.unknown_files(names)):
+        raise DataError(
+            f"--units {bad[0]}:...: {bad[0]} is none of the files given "
+            f"({', '.join(names[:4])}{', ...' if len(names) > 4 else ''}); a file's own entry "
+            "names it as --data does, without its folder"
+        )
 
 
 def read_torque_log(

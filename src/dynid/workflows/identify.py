@@ -52,6 +52,7 @@ from ..model.drive import Drive
 from ..model.robot import Robot
 from .data_files import (
     ColumnSpec,
+    check_file_entries,
     column_map,
     data_files,
     data_kind,
@@ -383,6 +384,7 @@ def _identify(
     held-out prediction."""
     path = paths[0]
     cmap = _columns(opt.columns, opt.cutoff_hz, opt.drive)
+    check_file_entries(cmap, [*paths, *([] if opt.validate_on is None else [opt.validate_on])])
     kind = data_kind(path, cmap)
     heldout = _heldout(paths, kind, opt.folds, opt.validate_on, robot, cmap, opt.drop_invalid)
     if kind == "torque_log":
@@ -518,6 +520,7 @@ def _identify_consistent(
     """
     path = paths[0]
     cmap = _columns(opt.columns, opt.cutoff_hz, opt.drive)
+    check_file_entries(cmap, [*paths, *([] if opt.validate_on is None else [opt.validate_on])])
     kind = data_kind(path, cmap)
     heldout = _heldout(paths, kind, opt.folds, opt.validate_on, robot, cmap, opt.drop_invalid)
     common: dict[str, Any] = dict(prior=prior, total_mass=opt.total_mass, options=opt.sdp())

@@ -65,6 +65,7 @@ from ..progress import NOTE
 from ..signals import sample_rate
 from .data_files import (
     ColumnSpec,
+    check_file_entries,
     column_map,
     data_files,
     in_file,
@@ -199,6 +200,8 @@ def read_recordings(
     paths = data_files(data)
     names, units = recorded_columns(recorded, *(columns or (None, None)))
     cmap = column_map(names, units, cutoff_hz=cutoff_hz, drive=drive)
+    if columns is not None:  # the user's (a model's recorded map names its own files)
+        check_file_entries(cmap, paths)
 
     def read(p: Path) -> TorqueLog:
         return read_torque_log(
