@@ -22,6 +22,7 @@ from dynid.feasibility.payload import identify_payload
 from dynid.feasibility.payload_arm import arm_model
 from dynid.feasibility.payload_doubts import arm_length, undetermined_inertia
 from dynid.feasibility.payload_fit import serial_correlation_factor
+from dynid.identification.log import TorqueLog
 from dynid.identification.selection import identify_recordings
 from dynid.identification.structure import Structure
 from dynid.io.model_json import save_model_json
@@ -293,9 +294,10 @@ def test_a_load_fitted_far_above_the_noise_is_not_a_load_to_trust_printed_and_re
     makes the command print the mass and CoM in doubt with the ratio, write no setLoad
     values, and the report call it not a load to trust, naming the ratio."""
     arm, log = _slow_or_fast(1.0, 22)
-    tau = log.tau.copy()
-    tau[:, 1] += 5.0 * (log.q[:, 1] - 0.2)
-    save_torque_log(tmp_path / "spring.csv", dataclasses.replace(log, tau=tau))
+    half = slice(0, log.t.size // 2)  # 5 s
+    tau = log.tau[half] + 5.0 * (log.q[half, 1:2] - 0.2) * [0, 1, 0, 0, 0, 0, 0]
+    q, dq = log.q[half], log.dq[half]
+    save_torque_log(tmp_path / "spring.csv", TorqueLog(t=log.t[half], q=q, dq=dq, tau=tau))
     argv = ["payload", "--robot", "panda", "--data", str(tmp_path / "spring.csv")]
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", DynidWarning)
