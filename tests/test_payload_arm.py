@@ -22,6 +22,7 @@ from dynid.feasibility.payload import identify_payload
 from dynid.feasibility.payload_arm import arm_model
 from dynid.feasibility.payload_doubts import arm_length, undetermined_inertia
 from dynid.feasibility.payload_fit import serial_correlation_factor
+from dynid.identification.log import TorqueLog
 from dynid.identification.selection import identify_recordings
 from dynid.identification.structure import Structure
 from dynid.io.model_json import save_model_json
@@ -283,6 +284,36 @@ def test_payload_report_covers_mass_com_and_inertia_and_weighs_the_residual(tmp_
     assert "its inertia is not determined (Ixx, Ixy" in text
     assert "Reservations: the data do not determine the inertia&#x27;s Ixx" in text
     assert re.search(r"Residual RMS \S+ N m, \S+ x the torque noise after the low-pass", text)
+
+
+def test_a_load_fitted_far_above_the_noise_is_not_a_load_to_trust_printed_and_reported(
+    tmp_path, capsys
+):
+    """Regression (a fit that left tens of times the torque noise handed its mass and CoM
+    to setLoad as a usable load): a spring the arm's model lacks on joint 2 (5 N m/rad)
+    makes the command print the mass and CoM in doubt with the ratio, write no setLoad
+    values, and the report call it not a load to trust, naming the ratio."""
+    arm, log = _slow_or_fast(1.0, 22)
+    half = slice(0, log.t.size // 2)  # 5 s
+    tau = log.tau[half] + 5.0 * (log.q[half, 1:2] - 0.2) * [0, 1, 0, 0, 0, 0, 0]
+    q, dq = log.q[half], log.dq[half]
+    save_torque_log(tmp_path / "spring.csv", TorqueLog(t=log.t[half], q=q, dq=dq, tau=tau))
+    argv = ["payload", "--robot", "panda", "--data", str(tmp_path / "spring.csv")]
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", DynidWarning)
+        assert main([*argv, "--out", str(tmp_path / "p")]) == 0
+    printed = capsys.readouterr().out
+    assert re.search(r"mass +\S+ kg +\(std \S+\) +in doubt", printed)
+    assert "over 3 x, torques the arm's model leaves" in printed
+    assert "not a load to trust: no setLoad values written" in printed
+    doc = json.loads((tmp_path / "p" / "payload.json").read_text())
+    ratio = doc["residual_rms"] / doc["noise_rms"]
+    assert ratio > 10 and doc["load_mass"] is None and doc["F_x_Cload"] is None
+    html = (tmp_path / "p" / "report.html").read_text(encoding="utf-8")
+    box = re.search(r'<section class="verdict.*?</section>', html, re.S)
+    assert box is not None
+    text = " ".join(re.sub(r"<[^>]+>", " ", box.group(0)).split())
+    assert "not a load to trust" in text and f"{ratio:.3g} x the torque noise" in text
 
 
 @pytest.mark.parametrize(

@@ -105,8 +105,10 @@ def test_static_data_scaled_by_092_keep_a_positive_mass_and_are_doubted(a):
 
 def test_torque_logs_scaled_by_0834_are_doubted_on_the_unloaded_log():
     """Torque logs with and without the load, torques 0.834 x the true ones (difference
-    method, structure given): the factor within its std, the doubt, m / a the true mass;
-    without --unloaded the error names the factor."""
+    method, structure given): the factor within its std, the doubt, m / a the true mass
+    (its std raised to the misfit's bound: the loaded fit leaves 4.9 x the noise, the
+    arm's sigmoid friction fitted as Coulomb on other motions); without --unloaded the
+    error names the factor."""
     loaded, unloaded = _log(LOADED, 1, SCALE), _log(ARM, 5, SCALE)
     est, _ = said_warnings(
         identify_payload,
@@ -115,7 +117,7 @@ def test_torque_logs_scaled_by_0834_are_doubted_on_the_unloaded_log():
         unloaded=unloaded,
         structure=Structure.parse("viscous,coulomb,offset"),
     )
-    _check(est.torque_scale, est.mass, 0.02)
+    _check(est.torque_scale, est.mass, 0.2)
     assert _said_scale(est.doubts)
     with pytest.raises(DataError, match=r"the measured torques are 0\.83\d* x the arm model's"):
         identify_payload(ARM, loaded)

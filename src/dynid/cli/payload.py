@@ -20,11 +20,15 @@ A mass less than 3 standard deviations above zero, a CoM farther from --frame th
 arm is long, or (--robot, --params) measured torques more than 5 % and 3 standard
 deviations off the arm description's (a torque constant or gear ratio off: the factor is
 fitted beside the load, or on the --unloaded data, and the load's mass divided by it is
-said) is warned about and no setLoad values are written. An inertia whose
+said), or a fit of torque logs that leaves more than 3 x the torque noise after the
+low-pass (torques the arm's model does not explain, a spring, friction or a tilt, which
+go into the mass and CoM too; their standard deviations then raised to the largest
+change a torque as large as the misfit makes) is warned about and no setLoad values are
+written. An inertia whose
 moments lie less than 3 standard deviations above zero, or whose products have a
 standard deviation above a third of their largest possible magnitude, or that the
 consistency constraint set on its bound, is not determined: warned about (naming the
-elements, the fit's residual against the torque noise and what to record), and setLoad's
+elements and what to record), and setLoad's
 load_inertia is not written. Standard deviations from torque logs are widened to the
 estimate's spread over 10 held-out time blocks where that is larger (errors of the arm's
 model that vary along the motion).
@@ -52,6 +56,7 @@ from typing import Any
 from ..feasibility.payload import PayloadEstimate
 from ..feasibility.payload_scale import SCALE_OFF, SCALE_SIGMAS, TorqueScale, scale_mass
 from ..identification.model import IdentifiedModel
+from ..identification.verdict import FLOOR_FAIR
 from ..io.model_json import save_model_json
 from ..io.payload_json import save_payload_json
 from ..model.inertia import INERTIA_ORDER, inertia6_from_matrix
@@ -187,10 +192,11 @@ def print_payload(console: Console, result: PayloadFileResult, label: str) -> No
     the notes and whether setLoad values were written."""
     est = result.estimate
     console.print(f"payload on frame {est.frame!r} ({est.route}; arm: {label})")
-    console.print(f"  mass     {est.mass:.6g} kg  (std {est.std_mass:.2g})")
+    doubt = "  in doubt" if est.doubts else ""
+    console.print(f"  mass     {est.mass:.6g} kg  (std {est.std_mass:.2g}){doubt}")
     com = ", ".join(f"{x:+.5f}" for x in est.com)
     std = ", ".join(f"{x:.2g}" for x in est.std_com)
-    console.print(f"  com      [{com}] m  (std [{std}])")
+    console.print(f"  com      [{com}] m  (std [{std}]){doubt}")
     if est.inertia_identified:
         for name, v, s in zip(
             INERTIA_ORDER, inertia6_from_matrix(est.inertia), est.std_inertia, strict=True
@@ -243,12 +249,20 @@ def scale_line(t: TorqueScale, mass: float) -> str:
 
 def residual_line(est: PayloadEstimate) -> str:
     """``residual RMS 0.0067 N m, 1.5 x the torque noise (0.0044 N m after the low-pass)``
-    for torque logs; the static rows' residual without a unit of its own."""
+    for torque logs (over :data:`~dynid.identification.verdict.FLOOR_FAIR` x, what it
+    means: :func:`~dynid.feasibility.payload_doubts.misfit_doubts`); the static rows'
+    residual without a unit of its own."""
     if not est.noise_rms:  # static data, or no noise read from the logs
         mixed = est.route.startswith("static M")
         unit = " (rows of M [kg m^2] and g [N m])" if mixed else " N m"
         return f"residual RMS {est.residual_rms:.2g}{unit}"
+    ratio = est.residual_rms / est.noise_rms
     return (
-        f"residual RMS {est.residual_rms:.2g} N m, {est.residual_rms / est.noise_rms:.3g} x "
-        f"the torque noise ({est.noise_rms:.2g} N m after the low-pass)"
+        f"residual RMS {est.residual_rms:.2g} N m, {ratio:.3g} x the torque noise "
+        f"({est.noise_rms:.2g} N m after the low-pass)"
+        + (
+            f": over {FLOOR_FAIR:g} x, torques the arm's model leaves, which the load took"
+            if ratio > FLOOR_FAIR
+            else ""
+        )
     )

@@ -64,7 +64,13 @@ controller. An inertia whose elements the data do not determine
 (:attr:`PayloadEstimate.undetermined`, :mod:`dynid.feasibility.payload_doubts`) is doubted
 on its own (:attr:`PayloadEstimate.inertia_doubts`): the mass and CoM are handed on, the
 inertia is not. The fit's residual is compared with the torque noise left after the
-low-pass (:attr:`PayloadEstimate.noise_rms`).
+low-pass (:attr:`PayloadEstimate.noise_rms`): above
+:data:`~dynid.identification.verdict.FLOOR_FAIR` times it, the torques the arm's model
+leaves go into the mass and CoM too (an unmodelled spring at 74 x the noise read a 1.5 kg
+load as 1.04 kg), so the whole load is a doubt
+(:func:`~dynid.feasibility.payload_doubts.misfit_doubts`), its inertia not determined, and
+the standard deviations are raised to the largest change an unmodelled torque as large
+as the misfit can make (:func:`~dynid.feasibility.payload_fit.misfit_covariance`).
 """
 
 from __future__ import annotations
@@ -95,13 +101,14 @@ from ..model.inertia import INERTIA_ORDER
 from ..model.robot import Robot
 from .lmi import phi_from_pseudo_inertia, pseudo_inertia
 from .payload_arm import ArmFriction, ArmModel, arm_model, model_structure, unloaded_arm
-from .payload_doubts import doubts_about, inertia_doubts, undetermined_inertia
+from .payload_doubts import doubts_about, inertia_doubts, misfit_doubts, undetermined_inertia
 from .payload_fit import (
     HELD_OUT_BLOCKS,
     block_jackknife_covariance,
     fit_load,
     held_out_widening,
     load_parameters,
+    misfit_covariance,
     serial_correlation_factor,
     summary,
 )
@@ -174,7 +181,9 @@ class PayloadEstimate:
         the arm's own model's.
     notes : tuple of str
     doubts : tuple of str
-        Why the estimate is not a load to trust (module docstring); empty when none.
+        Why the estimate is not a load to trust (module docstring), a fit that leaves
+        more than :data:`~dynid.identification.verdict.FLOOR_FAIR` times
+        :attr:`noise_rms` among them; empty when none.
     undetermined : tuple of str
         The inertia's elements the data do not determine (``"Ixx"`` .. ``"Izz"``,
         :func:`~dynid.feasibility.payload_doubts.undetermined_inertia`); empty when every
@@ -329,7 +338,7 @@ def identify_payload(
     DataError
         The least-squares mass is not positive (no load, or a wrong model of the arm, or
         torques of another scale than the arm description's: then named with the load's
-        mass divided by that factor); a
+        mass over the factor; a fit over 3 x the torque noise: named with the ratio); a
         drive other than the model's; a recording without a piece long enough to filter.
     SolverError
         The constrained problem failed.
@@ -449,22 +458,17 @@ def _estimate(
     n, k = kin.n, kin.frame(frame).link
     fit = fit_load(W, yv, kept, rtol, p, static)
     est = np.asarray(fit.beta)
-    cov = np.asarray(fit.covariance)[:p, :p]
-    prep = record.get("preprocessing") or {}
     cols = np.ones(W.shape[1], bool) if kept is None else kept
-    per_period = None
-    if prep.get("cutoff_hz"):  # filtered rows: their noise is serially correlated
-        rate = prep["sample_rate_hz"] / prep["decimate"]
-        per_period = int(np.ceil(rate / prep["cutoff_hz"]))
-        resid = yv - W[:, cols] @ est[cols]
-        factor, lags = serial_correlation_factor(resid, n, per_period)
-        cov = cov * factor
-        notes.append(
-            f"standard deviations widened x{np.sqrt(factor):.3g} for the serial correlation "
-            f"of the filtered samples (Newey-West, {lags} lags)"
-        )
+    noise = record.get("noise_rms")
+    misfit = misfit_doubts(fit.residual_rms, noise, difference=difference)
+    resid = yv - W[:, cols] @ est[cols]
+    prep = record.get("preprocessing") or {}
+    cov, per_period = _serial_widening(np.asarray(fit.covariance)[:p, :p], resid, n, prep, notes)
     if not static:  # static configurations are exchangeable: their blocks spread alike
         cov = _held_out_spread(cov, W[:, cols], yv, n, notes)
+    sm_noise = float(np.sqrt(cov[0, 0]))  # whether there is a load: the misfit says its own
+    if misfit and noise:  # torques the arm's model leaves: the residual does not see them
+        cov = _misfit_spread(cov, W[:, cols], resid, noise, notes)
     m_ls, sm_ls = float(est[0]), float(np.sqrt(cov[0, 0]))
     scale = None
     if scale_rows is not None:
@@ -482,32 +486,20 @@ def _estimate(
         )
     try:
         phi, active, marg = load_parameters(est[:p], sm_ls, W, margin, notes)
-    except DataError as exc:  # a mass not positive: the torques' scale may say why
-        said = scale_doubts(scale, m_ls, drive)
+    except DataError as exc:  # a mass not positive: the torques' scale or misfit may say why
+        said = scale_doubts(scale, m_ls, drive, noise) or misfit
         if not said:
             raise
         raise DataError(f"{exc}; {said[0]}") from None
     m, c, I, sm, sc, si = summary(phi, cov, p == 10)
-    noise = record.get("noise_rms")
-    doubts = doubts_about(kin, frame, m, sm, c) + scale_doubts(scale, m, drive, noise)
+    doubts = doubts_about(kin, frame, m, sm_noise, c) + scale_doubts(scale, m, drive, noise)
+    doubts += misfit
     by_std = undetermined_inertia(I, si) if p == 10 and not doubts else ()
     at_bound = active and p == 10 and not doubts  # the bound, not the data, set it
-    unexplained = bool(
-        p == 10 and not doubts and noise and fit.residual_rms > FLOOR_FAIR * noise
-    )  # torques the arm's model leaves: the inertia takes them first
     every = tuple(f"I{name}" for name in INERTIA_ORDER)
-    undetermined = every if at_bound or unexplained else by_std
-    about_inertia = inertia_doubts(
-        by_std,
-        I,
-        si,
-        fit.residual_rms,
-        noise,
-        at_bound=at_bound,
-        margin=margin,
-        difference=difference,
-        unexplained=unexplained,
-    )
+    # torques the arm's model leaves: the inertia takes them first
+    undetermined = every if at_bound or (misfit and p == 10) else by_std
+    about_inertia = inertia_doubts(by_std, I, si, at_bound=at_bound, margin=margin)
     for line in doubts + about_inertia:
         warnings.warn(line, DynidWarning, stacklevel=3)
     return PayloadEstimate(
@@ -537,6 +529,53 @@ def _estimate(
         torque_scale=scale,
         **record,
     )
+
+
+def _serial_widening(
+    cov: NDArray[np.float64],
+    resid: NDArray[np.float64],
+    n: int,
+    prep: Mapping[str, Any],
+    notes: list[str],
+) -> tuple[NDArray[np.float64], int | None]:
+    """``cov`` widened for the serial correlation of the residual ``resid`` (``n`` rows a
+    sample; :func:`~dynid.feasibility.payload_fit.serial_correlation_factor`) over a
+    cut-off period of filtered rows (``prep``: the record's preprocessing), and the
+    samples per cut-off period (None: unfiltered rows, ``cov`` as it is)."""
+    if not prep.get("cutoff_hz"):
+        return cov, None
+    rate = prep["sample_rate_hz"] / prep["decimate"]
+    per_period = int(np.ceil(rate / prep["cutoff_hz"]))
+    factor, lags = serial_correlation_factor(resid, n, per_period)
+    notes.append(
+        f"standard deviations widened x{np.sqrt(factor):.3g} for the serial correlation "
+        f"of the filtered samples (Newey-West, {lags} lags)"
+    )
+    return cov * factor, per_period
+
+
+def _misfit_spread(
+    cov: NDArray[np.float64],
+    W: NDArray[np.float64],
+    resid: NDArray[np.float64],
+    noise_rms: float,
+    notes: list[str],
+) -> NDArray[np.float64]:
+    """``cov`` (the load's ``p`` parameters) with each variance raised, where that is
+    larger (:func:`~dynid.feasibility.payload_fit.held_out_widening`, the correlations
+    kept), to the squared largest change an unmodelled torque as large as the fit's
+    misfit over the noise ``noise_rms`` [N m] can make
+    (:func:`~dynid.feasibility.payload_fit.misfit_covariance`; ``W`` the fitted columns,
+    ``resid`` the residual), with a note."""
+    bound = misfit_covariance(W, resid, noise_rms, cov.shape[0])
+    widened, widen = held_out_widening(cov, bound)
+    notes.append(
+        f"standard deviations widened up to x{widen.max():.3g} (the mass's x{widen[0]:.3g}) "
+        "to the largest change an unmodelled torque as large as the fit's misfit makes "
+        f"(the fit leaves more than {FLOOR_FAIR:g} x the torque noise): a rough bound, not "
+        "a noise's standard deviation"
+    )
+    return widened
 
 
 def _held_out_spread(

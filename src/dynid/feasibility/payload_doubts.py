@@ -15,12 +15,18 @@ The inertia is judged element by element (:func:`undetermined_inertia`): a momen
 than :data:`MIN_INERTIA_SIGMAS` standard deviations above zero, or a product of inertia
 whose standard deviation exceeds a :data:`MIN_INERTIA_SIGMAS`-th of the largest magnitude
 a rigid body allows it (half the third moment: ``|Ixy| <= Izz / 2``), is not determined
-by the data (a load that barely rotates, or torques the arm's model leaves, which the
-inertia absorbs). An inertia the pseudo-inertia LMI moved onto the consistency bound is
-not determined as a whole: the least squares gave no body's inertia, and the bound, not
-the data, sets the result (the torques the arm's model leaves, as a rule).
-:func:`inertia_doubts` says which, with the fit's residual against the torque noise and
-what to record; the mass and CoM are still handed on, the inertia is not.
+by the data (a load that barely rotates). An inertia the pseudo-inertia LMI moved onto
+the consistency bound is not determined as a whole: the least squares gave no body's
+inertia, and the bound, not the data, sets the result. :func:`inertia_doubts` says which
+and what to record; the mass and CoM are still handed on, the inertia is not.
+
+A fit of torque logs that leaves more than :data:`~dynid.identification.verdict.FLOOR_FAIR`
+times the torque noise after the low-pass (:func:`misfit_doubts`, the rule the residual's
+verdict and the torques' scale apply) is the arm's model missing torques, which go into
+the mass and CoM as well as the inertia, by more than the residual's covariance says: the
+whole load is in doubt, no setLoad values are written, and its standard deviations are
+raised to the largest change an unmodelled torque as large as the misfit can make
+(:func:`~dynid.feasibility.payload_fit.misfit_covariance`).
 """
 
 from __future__ import annotations
@@ -39,6 +45,8 @@ __all__ = [
     "arm_length",
     "doubts_about",
     "inertia_doubts",
+    "misfit_doubts",
+    "misfit_ratio",
     "undetermined_inertia",
 ]
 
@@ -107,29 +115,67 @@ def undetermined_inertia(inertia: NDArray[np.float64], std: NDArray[np.float64])
     return tuple(out)
 
 
+def misfit_ratio(residual_rms: float, noise_rms: float | None) -> float | None:
+    """The fit's residual [N m] over the torque noise after the low-pass ``noise_rms``
+    [N m]; None when the noise is not known (static data)."""
+    return residual_rms / noise_rms if noise_rms else None
+
+
+def misfit_doubts(
+    residual_rms: float, noise_rms: float | None, *, difference: bool = False
+) -> tuple[str, ...]:
+    """The doubt about a load whose fit leaves more than
+    :data:`~dynid.identification.verdict.FLOOR_FAIR` times the torque noise ``noise_rms``
+    [N m] (:func:`misfit_ratio`; ``residual_rms`` [N m]): torques the arm's model does not
+    explain go into the load's mass, CoM and inertia, by more than a noise-based standard
+    deviation says (an unmodelled spring on a Panda's joints 2 and 4 at 74 x the noise
+    read a 1.5 kg load as 1.04 kg, 3.7 of its std off; the standard deviations are
+    raised for it, :func:`~dynid.feasibility.payload_fit.misfit_covariance`), and no setLoad
+    values are written; the likely causes and what to record (``difference``: the arm
+    was identified from unloaded data already). Empty at or below the threshold."""
+    ratio = misfit_ratio(residual_rms, noise_rms)
+    if ratio is None or not ratio > FLOOR_FAIR:
+        return ()
+    hint = (
+        "identify the arm without the load with the terms these torques need (its friction "
+        "law, a joint spring, the base's tilt: dynid identify on a log without the load, "
+        "then --model), or record the same motion without the load and give it as "
+        "--unloaded (the difference method cancels the arm's model errors)"
+    )
+    if difference:
+        hint = (
+            "the arm identified from the --unloaded data does not explain the loaded data: "
+            "record the loaded motion repeated without the load (the arm's errors cancel "
+            "only where the motions match), and give as --model an arm identified with the "
+            "terms these torques need (friction law, joint spring), whose terms the "
+            "--unloaded data are then fitted with"
+        )
+    return (
+        f"the fit leaves {ratio:.3g} x the torque noise ({residual_rms:.2g} N m RMS, more "
+        f"than {FLOOR_FAIR:g} x): torques the arm's model does not explain (unmodelled "
+        "friction, a joint spring, a tilted base, the links' or the drive's parameters, or "
+        "the states' noise at a high cut-off) go into the load's mass, CoM and inertia, by "
+        "more than a noise-based standard deviation says (the standard deviations are "
+        "raised to the largest change a torque as large as the misfit makes, a rough "
+        f"bound); no setLoad values are written; hint: {hint}",
+    )
+
+
 def inertia_doubts(
     names: tuple[str, ...],
     inertia: NDArray[np.float64],
     std: NDArray[np.float64],
-    residual_rms: float,
-    noise_rms: float | None,
     *,
     at_bound: bool = False,
     margin: float = 0.0,
-    difference: bool = False,
-    unexplained: bool = False,
 ) -> tuple[str, ...]:
     """The doubt about an inertia whose elements ``names`` are not determined
     (:func:`undetermined_inertia`), each with its value and standard deviation [kg m^2],
-    or that the LMI of ``margin`` put on its bound (``at_bound``): the likely cause, the
-    fit's residual [N m] against the torque noise after the low-pass ``noise_rms`` [N m]
-    when known, and what to record (``difference``: the arm was identified from unloaded
-    data already); or, ``unexplained``, whose fit leaves more than
-    :data:`~dynid.identification.verdict.FLOOR_FAIR` times the torque noise (the torques
-    the arm's model leaves go into the inertia first: on a Panda with effects outside its
-    model, a 1.2 kg load's Izz read 0.0207 kg m^2 for 0.002 at 5.5 x the noise, its
-    standard deviations small); empty for none of these."""
-    if not names and not at_bound and not unexplained:
+    or that the LMI of ``margin`` put on its bound (``at_bound``), with the likely cause
+    and what to record; empty for neither. A fit that leaves more than
+    :data:`~dynid.identification.verdict.FLOOR_FAIR` times the torque noise is doubted as
+    a whole load (:func:`misfit_doubts`), its inertia with it."""
+    if not names and not at_bound:
         return ()
     v = inertia6_from_matrix(np.asarray(inertia, dtype=np.float64))
     order = [f"I{n}" for n in INERTIA_ORDER]
@@ -140,33 +186,13 @@ def inertia_doubts(
             f"{which} kg m^2 (a moment needs {MIN_INERTIA_SIGMAS:g} std above zero, a product "
             f"a std under 1/{MIN_INERTIA_SIGMAS:g} of half the third moment)"
         )
-    if unexplained and not names and not at_bound:
-        what.append("the fit does not explain the torques to their noise")
     if at_bound:
         what.append(
             f"the consistency constraint (pseudo-inertia margin {margin:g}) set it on its "
             "bound, not the data (the least squares gave no body's inertia)"
         )
-    ratio = residual_rms / noise_rms if noise_rms else None
-    if ratio is not None and ratio > FLOOR_FAIR:
-        cause = (
-            f"the fit leaves {ratio:.3g} x the torque noise ({residual_rms:.2g} N m RMS): "
-            "torques the arm's model does not explain (its links, friction, drive or "
-            "armature, or the states' noise at a high cut-off) go into the inertia"
-        )
-        hint = (
-            "record the same motion without the load and give it as --unloaded (the "
-            "difference method cancels the arm's model errors), validate the arm's model "
-            "on a log without the load, or keep the cut-off the motion needs"
-        )
-        if difference:
-            hint = (
-                "longer recordings of one motion with and without the load (the arm fitted "
-                "to the unloaded one carries its noise), turning the flange about every axis"
-            )
-    else:
-        cause = "the load turns too little or too slowly about some axis for the data to weigh it"
-        hint = "a recording that turns the flange faster, about every axis"
+    cause = "the load turns too little or too slowly about some axis for the data to weigh it"
+    hint = "a recording that turns the flange faster, about every axis"
     return (
         f"the load's inertia is not determined: {'; '.join(what)}; {cause}; setLoad's "
         f"inertia is not written; hint: {hint}",

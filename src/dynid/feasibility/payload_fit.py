@@ -9,6 +9,8 @@
 * :func:`summary`: mass, CoM, inertia about the CoM and their standard deviations;
 * :func:`serial_correlation_factor`: how much the variances of a fit to low-pass filtered
   samples exceed those of independent rows;
+* :func:`misfit_covariance`: the largest change of the estimate an unmodelled torque as
+  large as the fit's misfit can make, which the residual's covariance does not see;
 * :func:`block_jackknife_covariance`: the spread of the estimate over held-out time
   blocks, which an error of the arm's model that varies along the motion widens (the
   residual's covariance does not see the part of that error the load's columns absorb).
@@ -32,6 +34,7 @@ __all__ = [
     "fit_load",
     "held_out_widening",
     "load_parameters",
+    "misfit_covariance",
     "serial_correlation_factor",
     "summary",
 ]
@@ -238,6 +241,49 @@ def serial_correlation_factor(
         rho = float(np.sum(R[lag:] * R[:-lag])) / var
         f += 2.0 * (1.0 - lag / (L + 1)) * rho
     return max(f, 1.0), L
+
+
+def misfit_covariance(
+    W: NDArray[np.float64], residual: NDArray[np.float64], noise_rms: float, p: int
+) -> NDArray[np.float64]:
+    """The squared largest change of each of the first ``p`` coefficients of the least
+    squares ``W b = y`` that an unmodelled torque as large as the fit's misfit can make.
+
+    A torque ``e`` the model lacks moves the estimate by ``G W^T e`` with
+    ``G = (W^T W)^{-1}``; by Cauchy-Schwarz ``|db_i| <= sqrt(G_ii) ||e||``, with equality
+    for ``e`` along the estimator's row. ``||e||^2`` is taken as the residual's sum of
+    squares less the noise's, ``||r||^2 - m noise_rms^2`` (``m`` rows): the misfit the
+    residual shows. The part of ``e`` the columns absorb does not show in the residual,
+    so this is no strict bound; on a simulated Panda with unmodelled springs, tilts or
+    friction at 7 to 79 x the noise, the mass's error stayed under 0.9 of it (a spring's
+    0.46 kg error on a 1.5 kg load against 0.71 kg), where the residual's covariance,
+    which treats the misfit as noise, gave 0.125 kg.
+
+    Parameters
+    ----------
+    W : ndarray, shape (m, k)
+        The fitted columns only.
+    residual : ndarray, shape (m,)
+        The fit's residual [SI of the rows].
+    noise_rms : float
+        The RMS the noise alone leaves in a row [SI of the rows].
+    p : int
+        The coefficients returned.
+
+    Returns
+    -------
+    ndarray, shape (p, p)
+        ``G[:p, :p] (||r||^2 - m noise_rms^2)``, zero when the residual is at the noise.
+    """
+    import scipy.linalg  # as the rest of the module: scipy on first use
+
+    norms = np.linalg.norm(W, axis=0)
+    s = np.where(norms > 0, norms, 1.0)
+    R = scipy.linalg.qr(W / s, mode="r")[0][: W.shape[1]]
+    rows = scipy.linalg.solve_triangular(R, np.eye(W.shape[1]))[:p]  # of R^-1
+    G = (rows @ rows.T) / np.outer(s[:p], s[:p])  # (W^T W)^-1 = R^-1 R^-T, columns unscaled
+    misfit = max(float(residual @ residual) - residual.size * noise_rms**2, 0.0)
+    return G * misfit
 
 
 def block_jackknife_covariance(

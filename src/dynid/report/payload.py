@@ -5,11 +5,13 @@ The headline covers all three: the mass with its relative standard deviation, th
 with its largest standard deviation, the inertia with its largest one, or the elements
 the data do not determine (``undetermined_inertia`` of ``payload.json``). The level:
 
-* not a load to trust (poor): a doubt about the mass or the CoM (no setLoad values);
+* not a load to trust (poor): a doubt about the mass or the CoM (no setLoad values), a
+  residual above :data:`~dynid.identification.verdict.FLOOR_FAIR` times the torque noise
+  left after the low-pass among them (effects outside the arm's model, which the mass and
+  CoM take too: :func:`~dynid.feasibility.payload_doubts.misfit_doubts`);
 * usable, with reservations (fair), each reason listed: inertia elements not determined,
-  a mass known to 5 % or worse, a residual above :data:`~dynid.identification.verdict.FLOOR_FAIR`
-  times the torque noise left after the low-pass (effects outside the arm's model), the
-  physical-consistency constraint active (the least-squares estimate was not a body);
+  a mass known to 5 % or worse, the physical-consistency constraint active (the
+  least-squares estimate was not a body);
 * good otherwise.
 
 The residual is given in N m beside that noise (``noise_rms``) for torque logs, and the
@@ -42,8 +44,11 @@ def payload_answer(run: RunFiles) -> Answer | None:
     frame = esc(doc.get("frame", ""))
     undetermined = [str(x) for x in doc.get("undetermined_inertia") or []]
     doubts = [str(x) for x in doc.get("doubts") or []]
-    # the inertia is judged only when the mass and CoM are not in doubt (its one line last)
-    load_doubts = [] if undetermined else doubts
+    # the inertia is judged only when the mass and CoM are not in doubt (its one line
+    # last), and is not determined when the fit leaves the torques above the noise
+    ratio = _noise_ratio(doc)
+    misfit = ratio is not None and ratio > FLOOR_FAIR
+    load_doubts = doubts if misfit or not undetermined else []
     facts = [
         f"Mass <b>{number(m)} kg</b>"
         + (f" &plusmn; {number(sm, 2)} kg (1 std)" if is_number(sm) else "")
@@ -146,7 +151,7 @@ def _reservations(doc: dict[str, Any], rel: float | None, undetermined: list[str
             "the mass is known to " + (f"{100 * rel:.2g} %" if rel is not None else "no std")
         )
     ratio = _noise_ratio(doc)
-    if ratio is not None and ratio > FLOOR_FAIR:
+    if ratio is not None and ratio > FLOOR_FAIR:  # a file written without its doubt
         out.append(
             f"the fit leaves {number(ratio, 3)} x the torque noise: the arm's model misses "
             "torques the load's parameters may absorb"
