@@ -73,6 +73,7 @@ from ..model.robot import Robot
 from ..observer.friction import banded_if_narrow, banding_note, noise_bands
 from ..progress import NOTE
 from .data_files import ColumnSpec, in_file
+from .options import NO_FILTER, Cutoff, library_cutoff, velocity_cutoff
 from .recordings import despiked_recordings, read_recordings
 
 __all__ = ["ValidateOptions", "ValidateResult", "validate_files"]
@@ -93,9 +94,10 @@ class ValidateOptions:
         Column names and units of another tool's files; default: the model's recorded ones.
     drop_invalid : bool
         Drop rows with NaN/inf or a repeated timestamp (counted) instead of failing.
-    cutoff_hz : float, optional
-        Low-pass cut-off of the states [Hz]; default: the identification's recorded one,
-        else the one read from the recordings' motion.
+    cutoff_hz : float or "none", optional
+        Low-pass cut-off of the states [Hz]; default: the identification's recorded one
+        (no filter if it was identified without), else the one read from the recordings'
+        motion; ``"none"`` (:data:`~dynid.workflows.options.NO_FILTER`): no low-pass.
     max_gap_s : float, optional
         Longest gap bridged by interpolation [s]; a longer one cuts a recording into
         pieces.
@@ -116,7 +118,7 @@ class ValidateOptions:
     friction: Literal["own", "none"] | str | Path | FrictionModel = "own"
     columns: ColumnSpec | None = None
     drop_invalid: bool = False
-    cutoff_hz: float | None = None
+    cutoff_hz: Cutoff = None
     max_gap_s: float | None = None
     drive: Drive | None = None
     q_start: tuple[float, ...] | None = None
@@ -127,6 +129,8 @@ class ValidateOptions:
             ("max_gap_s", "the longest gap bridged [s]"),
         ):
             v = getattr(self, name)
+            if name == "cutoff_hz" and v == NO_FILTER:
+                continue
             if v is not None and not (isinstance(v, int | float) and np.isfinite(v) and v > 0):
                 raise OptionError(f"{name} ({what}) must be a positive number; got {v!r}")
         fr = self.friction
@@ -262,7 +266,7 @@ def validate_files(
         recorded=model.info.column_map if isinstance(model, IdentifiedModel) else None,
         columns=opt.columns,
         drop_invalid=opt.drop_invalid,
-        cutoff_hz=opt.cutoff_hz,
+        cutoff_hz=velocity_cutoff(opt.cutoff_hz),
         owner=f"the model ({label or robot.name})",
         drive=placed,
         q_start=opt.q_start,
@@ -279,7 +283,7 @@ def validate_files(
             rec.logs,
             rec.names,
             friction=fr,
-            cutoff_hz=RECORDED if opt.cutoff_hz is None else opt.cutoff_hz,
+            cutoff_hz=library_cutoff(opt.cutoff_hz, RECORDED),
             max_gap_s=opt.max_gap_s,
             drive=drive,
         )
