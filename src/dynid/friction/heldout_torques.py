@@ -188,8 +188,9 @@ class HeldOutTorques:
         the latter null when not known), the floor, the torque spikes replaced before
         judging, each joint's error over its noise as the verdict weighs it
         (``joint_ratios``: the numbers its reason and the report name), the verdict (with
-        its ``ratio`` to the floor, each sample weighed against its own noise) and, above the floor, the low-speed note (``low_speed``, the
-        report's own line; schema ``heldout.json``)."""
+        its ``ratio`` to the floor, each sample weighed against its own noise) and, above
+        the floor, the low-speed note (``low_speed``, the report's own line; schema
+        ``heldout.json``)."""
         e, v, fl = self.validation.errors, self.verdict, self.floor
         return {
             "block": self.block,

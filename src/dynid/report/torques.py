@@ -126,6 +126,11 @@ def validate_answer(run: RunFiles) -> Answer | None:
         if level == "unusable"
         else f"The model predicts the log's torques to {percent(best)}."
     )
+    if isinstance(doc.get("sign_map"), str):  # the likelier cause, said before the error
+        head = (
+            "The model's recorded sign map looks wrong for this file (--units overrides it; "
+            f"below); as read: {head[0].lower()}{head[1:]}"
+        )
     figs, shown = _figures(
         run,
         (

@@ -38,6 +38,7 @@ from __future__ import annotations
 
 import dataclasses
 import logging
+import warnings
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from pathlib import Path
@@ -46,7 +47,7 @@ from typing import Any, Literal
 import numpy as np
 from numpy.typing import NDArray
 
-from ..exceptions import DataError, OptionError
+from ..exceptions import DataError, DynidWarning, OptionError
 from ..friction.fit import same_drive, torques_through
 from ..friction.model import FrictionModel, FrictionSum, own_at_motors_note, placed_friction
 from ..friction.recordings import RecordingsValidation, validate_recordings
@@ -74,7 +75,13 @@ from ..observer.friction import banded_if_narrow, banding_note, noise_bands
 from ..progress import NOTE
 from .data_files import ColumnSpec, in_file
 from .options import NO_FILTER, Cutoff, library_cutoff, velocity_cutoff
-from .recordings import despiked_recordings, read_recordings
+from .recordings import (
+    Recorded,
+    despiked_recordings,
+    read_recordings,
+    recorded_sign_map_findings,
+    warn_signs,
+)
 
 __all__ = ["ValidateOptions", "ValidateResult", "validate_files"]
 
@@ -172,6 +179,13 @@ class ValidateResult:
     spikes : tuple of int
         Torque samples of each recording replaced as one-sample spikes before judging
         (empty: not known).
+    sensor_noise_rms, input_noise_rms : ndarray, shape (n,), optional
+        The parts of ``noise_rms`` [N m].
+    sign_map : str, optional
+        Where the model's recorded sign map (``--units tau3=-1``) looks wrong for a
+        recording, the finding (naming the file, the joints and the ``--units`` that
+        overrides it; :func:`~dynid.workflows.recordings.recorded_sign_map_findings`),
+        also the start of ``verdict``'s reason; None otherwise.
     """
 
     validation: RecordingsValidation
@@ -186,14 +200,15 @@ class ValidateResult:
     spikes: tuple[int, ...] = ()
     sensor_noise_rms: NDArray[np.float64] | None = None
     input_noise_rms: NDArray[np.float64] | None = None
+    sign_map: str | None = None
 
     def metadata(self) -> dict[str, Any]:
         """The keys ``validation.json`` records beside the errors: ``model``,
         ``friction_source``, ``data`` (the files, comma-separated), ``files``,
         ``cutoff_hz``, ``noise_rms``, ``noise_floor_percent``, ``sensor_noise_rms`` and
         ``input_noise_rms`` (its parts, when known), ``torque_spikes_replaced`` (per file,
-        when known), ``verdict`` (``level``, ``label``, ``reason``) and ``joint_names``
-        (when known)."""
+        when known), ``sign_map`` (the recorded sign map's finding, when there is one),
+        ``verdict`` (``level``, ``label``, ``reason``) and ``joint_names`` (when known)."""
         v = self.verdict
         spikes = dict(zip(self.files, self.spikes, strict=True)) if self.spikes else None
         parts = {
@@ -214,6 +229,7 @@ class ValidateResult:
             "noise_floor_percent": self.noise_floor_percent,
             **parts,
             **({"torque_spikes_replaced": spikes} if spikes is not None else {}),
+            **({"sign_map": self.sign_map} if self.sign_map is not None else {}),
             "verdict": {"level": v.level, "label": v.label, "reason": v.reason},
         } | ({"joint_names": list(self.joint_names)} if self.joint_names else {})
 
@@ -272,8 +288,8 @@ def validate_files(
         q_start=opt.q_start,
         max_gap_s=opt.max_gap_s,
         reference=_reference(model),
-        signs=True,  # the joints of the opposite sign named before the verdict
     )
+    sign_map = _said_signs(rec, model, opt)  # before the verdict, naming the joints
     rec, spikes = despiked_recordings(rec, robot.joint_names, SPIKES_BEFORE_JUDGING)
     friction, source = _friction(model, opt.friction, feasible, placed)
 
@@ -319,6 +335,10 @@ def validate_files(
     verdict = with_motion_range_hint(verdict, speeds, dq, names)
     files = ", ".join(f"{n} {c}" for n, c in zip(rec.names, spikes, strict=True) if c)
     verdict = with_replaced_spikes(verdict, sum(spikes), f" before judging ({files})")
+    if sign_map is not None:  # the likelier cause, said first
+        verdict = Verdict(
+            verdict.level, verdict.label, f"{sign_map}; {verdict.reason}", verdict.ratio
+        )
     return ValidateResult(
         validation=val,
         model=label or f"robot {robot.name}",
@@ -332,6 +352,7 @@ def validate_files(
         spikes=spikes,
         sensor_noise_rms=noise.sensor,
         input_noise_rms=noise.inputs,
+        sign_map=sign_map,
     )
 
 
@@ -422,6 +443,23 @@ def _judged(
         opposite=opposite_sign([v.log.tau for v in parts], [v.tau_hat for v in parts]),
     )
     return verdict, _Noise(fl.sensor_rms, fl.input_rms, fl.total_rms), fl.percent
+
+
+def _said_signs(rec: Recorded, model: IdentifiedModel | Robot, opt: ValidateOptions) -> str | None:
+    """Warn of the recordings whose torques look of the opposite sign: first those for
+    which the model's recorded sign map looks wrong
+    (:func:`~dynid.workflows.recordings.recorded_sign_map_findings`), then the others
+    (:func:`~dynid.workflows.recordings.warn_signs`); the former's findings, joined, or
+    None."""
+    robot = model.robot if isinstance(model, IdentifiedModel) else model
+    ref = _reference(model) or robot
+    recorded = model.info.column_map if isinstance(model, IdentifiedModel) else None
+    units = None if opt.columns is None else opt.columns[1]
+    found = recorded_sign_map_findings(rec, ref, recorded, units)
+    for text in found.values():
+        warnings.warn(text, DynidWarning, stacklevel=3)
+    warn_signs(rec, ref, skip=tuple(found))
+    return "; ".join(found.values()) or None
 
 
 def _reference(model: IdentifiedModel | Robot) -> Robot | None:
