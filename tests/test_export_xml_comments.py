@@ -17,10 +17,18 @@ from dynid.io.robot.export_options import xml_comment
 from dynid.io.robot.mjcf import save_mjcf
 from dynid.io.robot.urdf import save_urdf
 from dynid.model.drive import Drive
+from dynid.model.robot import Robot
 
-from test_export_mjcf import _ur5_from_urdf
+from conftest import robot_data_urdf
 
 CAVEAT = "not accepted: run --consistent -- or give --allow-rejected---to write it"
+
+
+def _ur5_from_urdf() -> Robot:
+    """UR5 of example-robot-data (skipped when not installed)."""
+    return Robot.from_urdf(
+        robot_data_urdf("ur_description/urdf/ur5_robot.urdf"), "base_link", "tool0"
+    )
 
 
 def _comments(text: str) -> list[str]:
