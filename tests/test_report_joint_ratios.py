@@ -52,3 +52,40 @@ def test_identify_headline_and_verdict_give_each_joint_one_ratio(tmp_path):
     names = held["joint_names"]
     for name, r in reason.items():
         assert float(r) == float(f"{held['joint_ratios'][names.index(name)]:.3g}")
+
+
+def test_validate_report_gives_the_worst_joint_the_verdicts_ratio(tmp_path):
+    """validate on the same kind of log: validation.json's joint_ratios are the numbers
+    of the verdict's reason, and the report's worst joint line gives the largest."""
+    robot = load_robot(str(SO101_URDF), snap_angles=True)
+    fr = ClassicalFriction(np.full(5, 0.02), np.full(5, 0.05), np.zeros(5))
+    noise = SensorNoise(tau_std=0.005, dq_std=0.01)
+    logs = recordings(robot, (3, 4), friction=fr, duration=4.0, noise=noise, added=_spring)
+    paths = [save_torque_log(tmp_path / f"{k}.npz", g) for k, g in enumerate(logs)]
+    args = ["--robot", str(SO101_URDF), "--snap-angles", "--no-figures", "-q"]
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", DynidWarning)
+        main(["identify", *args, "--data", str(paths[0]), "--out", str(tmp_path / "id")])
+        model = str(tmp_path / "id" / "identification.json")
+        main(
+            [
+                "validate",
+                "--model",
+                model,
+                "--data",
+                str(paths[1]),
+                "--out",
+                str(tmp_path / "v"),
+                "--no-figures",
+                "-q",
+            ]
+        )
+    doc = json.loads((tmp_path / "v" / "validation.json").read_text())
+    reason = dict(re.findall(r"(\w+) at ([\d.]+) x \(", doc["verdict"]["reason"]))
+    assert reason, doc["verdict"]["reason"]
+    names, r = doc["joint_names"], doc["joint_ratios"]
+    for name, said in reason.items():
+        assert float(said) == float(f"{r[names.index(name)]:.3g}")
+    page = html.unescape(re.sub(r"<[^>]+>", "", (tmp_path / "v" / "report.html").read_text()))
+    worst = max(range(len(r)), key=lambda j: r[j])
+    assert f"{names[worst]}: relative error" in page and f"{r[worst]:.3g} x its noise" in page

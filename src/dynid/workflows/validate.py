@@ -181,6 +181,9 @@ class ValidateResult:
         (empty: not known).
     sensor_noise_rms, input_noise_rms : ndarray, shape (n,), optional
         The parts of ``noise_rms`` [N m].
+    joint_ratios : ndarray, shape (n,), optional
+        Each joint's error over its noise as the verdict weighed it (each sample against
+        its own noise), the numbers its reason gives; None: not known.
     sign_map : str, optional
         Where the model's recorded sign map (``--units tau3=-1``) looks wrong for a
         recording, the finding (naming the file, the joints and the ``--units`` that
@@ -200,13 +203,15 @@ class ValidateResult:
     spikes: tuple[int, ...] = ()
     sensor_noise_rms: NDArray[np.float64] | None = None
     input_noise_rms: NDArray[np.float64] | None = None
+    joint_ratios: NDArray[np.float64] | None = None
     sign_map: str | None = None
 
     def metadata(self) -> dict[str, Any]:
         """The keys ``validation.json`` records beside the errors: ``model``,
         ``friction_source``, ``data`` (the files, comma-separated), ``files``,
         ``cutoff_hz``, ``noise_rms``, ``noise_floor_percent``, ``sensor_noise_rms`` and
-        ``input_noise_rms`` (its parts, when known), ``torque_spikes_replaced`` (per file,
+        ``input_noise_rms`` (its parts, when known), ``joint_ratios`` (each joint's error
+        over its noise as the verdict weighed it, when known), ``torque_spikes_replaced`` (per file,
         when known), ``sign_map`` (the recorded sign map's finding, when there is one),
         ``verdict`` (``level``, ``label``, ``reason``) and ``joint_names`` (when known)."""
         v = self.verdict
@@ -216,6 +221,7 @@ class ValidateResult:
             for k, a in (
                 ("sensor_noise_rms", self.sensor_noise_rms),
                 ("input_noise_rms", self.input_noise_rms),
+                ("joint_ratios", self.joint_ratios),
             )
             if a is not None
         }
@@ -352,6 +358,7 @@ def validate_files(
         spikes=spikes,
         sensor_noise_rms=noise.sensor,
         input_noise_rms=noise.inputs,
+        joint_ratios=noise.ratios,
         sign_map=sign_map,
     )
 
@@ -391,11 +398,12 @@ def _with_hints(
 class _Noise:
     """The noise per joint [N m] (n,) of the pieces judged: the torque sensors', that of
     the states the model is evaluated at (None: not known) and both (root sum of
-    squares)."""
+    squares), and each joint's error over it as the verdict weighed it (None: not known)."""
 
     sensor: NDArray[np.float64]
     inputs: NDArray[np.float64] | None
     total: NDArray[np.float64]
+    ratios: NDArray[np.float64] | None = None
 
 
 def _input_noise(
@@ -442,7 +450,7 @@ def _judged(
         None if inputs is None else [inputs[k] for k in chosen],
         opposite=opposite_sign([v.log.tau for v in parts], [v.tau_hat for v in parts]),
     )
-    return verdict, _Noise(fl.sensor_rms, fl.input_rms, fl.total_rms), fl.percent
+    return verdict, _Noise(fl.sensor_rms, fl.input_rms, fl.total_rms, fl.joint_ratios), fl.percent
 
 
 def _said_signs(rec: Recorded, model: IdentifiedModel | Robot, opt: ValidateOptions) -> str | None:
