@@ -24,6 +24,7 @@ from ..kinematics.inverse import default_q0
 from ..model.builtin import BUILTIN_ROBOTS
 from ..model.robot import Robot
 from ..plots.save import save_figure as write_figure
+from ..workflows.options import NO_FILTER
 from ..workflows.prior import load_prior as workflow_prior
 from .console import Console
 
@@ -162,6 +163,26 @@ count_type = number(int, min=1)
 positive_type = number(float, min=0, min_open=True)
 #: Non-negative finite floats (noise levels, margins).
 nonnegative_type = number(float, min=0)
+
+
+def cutoff_type(text: str) -> float | str:
+    """The ``--cutoff`` argument: a positive frequency [Hz], or ``none`` (no low-pass:
+    :data:`~dynid.workflows.options.NO_FILTER`)."""
+    if text.strip().lower() in ("none", "off"):
+        return NO_FILTER
+    try:
+        return positive_type(text)
+    except argparse.ArgumentTypeError:
+        raise argparse.ArgumentTypeError(
+            f"must be a finite frequency > 0 [Hz], or none (no low-pass); got {text!r}"
+        ) from None
+
+
+cutoff_type.__name__ = "cutoff"
+#: The end of every ``--cutoff`` help: how to turn the filter off.
+CUTOFF_NONE_HELP = (
+    "; 'none': no low-pass, every sample as recorded (exact or already filtered data)"
+)
 
 
 def add_subcommand(

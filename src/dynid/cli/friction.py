@@ -54,6 +54,7 @@ from ..model.robot import Robot
 from ..workflows.friction import FrictionOptions, fit_friction_files
 from .applies import urdf_chain
 from .common import (
+    CUTOFF_NONE_HELP,
     add_column_options,
     add_drive_option,
     add_log_options,
@@ -61,11 +62,11 @@ from .common import (
     add_recordings_option,
     add_snap_angles_option,
     add_subcommand,
+    cutoff_type,
     load_drive_arg,
     load_robot,
     options_from,
     output_path,
-    positive_type,
     shown,
 )
 from .console import Console
@@ -109,10 +110,11 @@ def register(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParser:
     )
     p.add_argument(
         "--cutoff",
-        type=positive_type,
+        type=cutoff_type,
         default=None,
+        metavar="HZ",
         help="low-pass cutoff of the states [Hz] (default: the one --model was identified "
-        "with, else the one identification reads from the log's motion)",
+        "with, else the one identification reads from the log's motion)" + CUTOFF_NONE_HELP,
     )
     add_log_options(p)
     p.add_argument("--no-figures", action="store_true", help="skip the PNG figures")

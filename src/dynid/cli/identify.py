@@ -101,6 +101,7 @@ from ..io.model_json import save_model_json
 from ..workflows.identify import IdentifyOptions, identify_files
 from .applies import urdf_chain
 from .common import (
+    CUTOFF_NONE_HELP,
     add_column_options,
     add_consistency_options,
     add_drive_option,
@@ -108,6 +109,7 @@ from .common import (
     add_q_start_option,
     add_robot_options,
     add_subcommand,
+    cutoff_type,
     load_drive_arg,
     load_robot,
     number,
@@ -225,12 +227,12 @@ def register(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParser:
     )
     p.add_argument(
         "--cutoff",
-        type=positive_type,
+        type=cutoff_type,
         default=None,
         metavar="HZ",
         help="torque logs: zero-phase low-pass cutoff [Hz] (default: 10 x the motion's highest "
         "significant frequency, read from the log; decimation keeps at least 10 %% of the "
-        "samples)",
+        "samples)" + CUTOFF_NONE_HELP,
     )
     p.add_argument(
         "--folds",

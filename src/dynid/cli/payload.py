@@ -64,15 +64,16 @@ from ..workflows.export import ExportRobotOptions, save_export
 from ..workflows.payload import PayloadFileResult, identify_payload_files
 from .applies import is_urdf, urdf_chain
 from .common import (
+    CUTOFF_NONE_HELP,
     add_column_options,
     add_drive_option,
     add_log_options,
     add_q_start_option,
     add_snap_angles_option,
     add_subcommand,
+    cutoff_type,
     load_drive_arg,
     output_path,
-    positive_type,
 )
 from .console import Console
 from .sources import load_model_source, params_as_robot
@@ -127,11 +128,12 @@ def register(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParser:
     p.add_argument("--gravity-only", action="store_true", help="static data: use g alone")
     p.add_argument(
         "--cutoff",
-        type=positive_type,
+        type=cutoff_type,
         default=None,
+        metavar="HZ",
         help="torque logs: low-pass [Hz] (default: the one --model was identified with, and "
         "its decimation, else the one identification reads from the logs' motion; static "
-        "data are not filtered)",
+        "data are not filtered)" + CUTOFF_NONE_HELP,
     )
     add_drive_option(p)
     add_q_start_option(p)

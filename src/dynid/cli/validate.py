@@ -68,6 +68,7 @@ from ..io.validation_json import save_validation_json
 from ..workflows.validate import ValidateOptions, ValidateResult, validate_files
 from .applies import urdf_chain
 from .common import (
+    CUTOFF_NONE_HELP,
     add_column_options,
     add_drive_option,
     add_log_options,
@@ -75,9 +76,9 @@ from .common import (
     add_recordings_option,
     add_snap_angles_option,
     add_subcommand,
+    cutoff_type,
     load_drive_arg,
     output_path,
-    positive_type,
     shown,
 )
 from .console import Console
@@ -120,10 +121,11 @@ def register(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParser:
     p.add_argument("--out", type=output_path, required=True, help="output directory")
     p.add_argument(
         "--cutoff",
-        type=positive_type,
+        type=cutoff_type,
         default=None,
+        metavar="HZ",
         help="low-pass cutoff of the states [Hz] (default: the one --model was identified "
-        "with, else the one identification reads from the log's motion)",
+        "with, else the one identification reads from the log's motion)" + CUTOFF_NONE_HELP,
     )
     add_drive_option(p)
     add_q_start_option(p)

@@ -186,9 +186,11 @@ class HeldOutTorques:
         """JSON-ready: the errors per joint, the noise (``noise_rms``: the sensors' and the
         states', root sum of squares; ``sensor_noise_rms``, ``input_noise_rms``: its parts,
         the latter null when not known), the floor, the torque spikes replaced before
-        judging, the verdict (with its ``ratio`` to the floor, each sample weighed against
-        its own noise) and, above the floor, the low-speed note (``low_speed``, the
-        report's own line; schema ``heldout.json``)."""
+        judging, each joint's error over its noise as the verdict weighs it
+        (``joint_ratios``: the numbers its reason and the report name), the verdict (with
+        its ``ratio`` to the floor, each sample weighed against its own noise) and, above
+        the floor, the low-speed note (``low_speed``, the report's own line; schema
+        ``heldout.json``)."""
         e, v, fl = self.validation.errors, self.verdict, self.floor
         return {
             "block": self.block,
@@ -201,6 +203,7 @@ class HeldOutTorques:
             "relative_error_percent": float(e.relative_error_percent),
             "relative_error_percent_per_joint": e.relative_error_percent_per_joint.tolist(),
             "noise_floor_percent": fl.percent,
+            "joint_ratios": None if fl.joint_ratios is None else fl.joint_ratios.tolist(),
             "torque_spikes_replaced": self.spikes,
             "verdict": {"level": v.level, "label": v.label, "reason": v.reason, "ratio": v.ratio},
             "low_speed": None if v.level == "good" else self.low_speed,

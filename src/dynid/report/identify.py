@@ -184,7 +184,7 @@ def _above_noise(held: dict) -> str:
         return ""
     if not len(rms) == len(noise) == len(names) or not all(map(is_number, rms + noise)):
         return ""
-    r = joint_ratios(rms, noise)
+    r = _held_ratios(held, rms, noise)
     s, i = held.get("sensor_noise_rms"), held.get("input_noise_rms")
     rough = None
     if isinstance(s, list) and isinstance(i, list) and len(s) == len(i) == len(r):
@@ -198,6 +198,17 @@ def _above_noise(held: dict) -> str:
         if levels[j] != "good"
     ]
     return ", ".join(said) + (" (a systematic residual)" if said else "")
+
+
+def _held_ratios(held: dict, rms: list, noise: list) -> np.ndarray:
+    """Each joint's held-out error over its noise as the verdict weighed it (heldout.json
+    ``joint_ratios``: each sample against its own noise, the numbers of the verdict's
+    reason), or, in a file without them, the RMS error over ``noise_rms``
+    (:func:`~dynid.identification.verdict.joint_ratios`)."""
+    got = held.get("joint_ratios")
+    if isinstance(got, list) and len(got) == len(rms) and all(map(is_number, got)):
+        return np.asarray(got, dtype=np.float64)
+    return joint_ratios(rms, noise)
 
 
 def _parameters_per_row(doc: dict) -> float | None:
@@ -378,7 +389,7 @@ def _heldout_verdict(held: dict, err: float | None = None, floor: float | None =
         return [float("nan") if v is None else float(v) for v in x] if ok else None
 
     rms, noise, per = numbers(rms), numbers(noise), numbers(per)
-    ratios = joint_ratios(rms, noise) if rms and noise and len(rms) == len(noise) else None
+    ratios = _held_ratios(held, rms, noise) if rms and noise and len(rms) == len(noise) else None
     if per is not None and ratios is not None and len(per) != len(ratios):
         per = None
     n = len(per) if per is not None else (len(ratios) if ratios is not None else 0)
@@ -624,9 +635,12 @@ def _torques_section(run: RunFiles, held: dict | None) -> str:
         states = held.get("input_noise_rms")  # the held-out states' noise through the model
         rel = held.get("relative_error_percent_per_joint") or [None] * len(names)
         rows = []
+        weighed = held.get("joint_ratios")  # the verdict's, each sample against its noise
+        weighed = weighed if isinstance(weighed, list) and len(weighed) == len(names) else None
         for j, name in enumerate(names):
             e, s = held["rms"][j], noise[j] if j < len(noise) else None
             ratio = e / s if is_number(e) and is_number(s) and s > 0 else None
+            ratio = weighed[j] if weighed is not None and is_number(weighed[j]) else ratio
             row = [esc(name), cell(e), cell(sensor[j] if j < len(sensor) else None)]
             row += [cell(states[j] if j < len(states) else None)] if states else []
             rows.append([*row, cell(ratio), cell(rel[j])])

@@ -102,10 +102,10 @@ def validate_answer(run: RunFiles) -> Answer | None:
         joint = joint_levels([per[j]], [known], _rough(doc, j))[0]
         if LEVELS.index(joint) > LEVELS.index(level) and level != "unusable":
             level = joint
-        noise = f", {ratio[j]:.3g} x its sensor noise" if ratio[j] < float("inf") else ""
+        noise = f", {ratio[j]:.3g} x its noise" if ratio[j] < float("inf") else ""
         ranked = (
-            "Worst joint against its own noise (the largest RMS error over sensor noise; "
-            "another joint's relative error can be larger)"
+            "Worst joint against its own noise (the largest error over its noise, as the "
+            "verdict weighs it; another joint's relative error can be larger)"
             if ratio[j] < float("inf")
             else "Worst joint by relative error"
         )
@@ -126,6 +126,11 @@ def validate_answer(run: RunFiles) -> Answer | None:
         if level == "unusable"
         else f"The model predicts the log's torques to {percent(best)}."
     )
+    if isinstance(doc.get("sign_map"), str):  # the likelier cause, said before the error
+        head = (
+            "The model's recorded sign map looks wrong for this file (--units overrides it; "
+            f"below); as read: {head[0].lower()}{head[1:]}"
+        )
     figs, shown = _figures(
         run,
         (
@@ -138,8 +143,12 @@ def validate_answer(run: RunFiles) -> Answer | None:
 
 
 def _noise_ratios(doc: dict, n: int) -> list[float]:
-    """Per joint, the RMS error over the sensor noise (validation.json ``rms`` and
-    ``noise_rms``); inf where either is missing."""
+    """Per joint, the error over the noise as the verdict weighed it (validation.json
+    ``joint_ratios``: the numbers of its reason), else the RMS error over the noise
+    (``rms`` and ``noise_rms``); inf where neither is known."""
+    weighed = doc.get("joint_ratios")
+    if isinstance(weighed, list) and len(weighed) == n and all(map(is_number, weighed)):
+        return [float(r) for r in weighed]
     rms, noise = doc.get("rms"), doc.get("noise_rms")
     if not (isinstance(rms, list) and isinstance(noise, list) and len(rms) == len(noise) == n):
         return [float("inf")] * n

@@ -42,7 +42,14 @@ from ..identification.sanity import SPIKES_BEFORE_FIT
 from ..model.drive import Drive
 from ..model.robot import Robot
 from .data_files import ColumnSpec, in_file
-from .options import check_choice, check_number
+from .options import (
+    Cutoff,
+    check_choice,
+    check_cutoff,
+    check_number,
+    library_cutoff,
+    velocity_cutoff,
+)
 from .recordings import despiked_recordings, read_recordings
 
 __all__ = ["FrictionFileResult", "FrictionOptions", "fit_friction_files"]
@@ -65,10 +72,12 @@ class FrictionOptions:
         Drop rows with NaN/inf or a repeated timestamp (counted) instead of failing.
     drive : Drive, optional
         The drive the log was recorded through, for a model without one.
-    cutoff_hz : float, optional
+    cutoff_hz : float or "none", optional
         Zero-phase low-pass cut-off of the states [Hz] (and of velocities derived from
-        positions); default: the identification's recorded one, else the one read from the
-        log's motion (:func:`~dynid.friction.validation.recorded_cutoff`).
+        positions); default: the identification's recorded one (no filter if it was
+        identified without), else the one read from the log's motion
+        (:func:`~dynid.friction.validation.recorded_cutoff`); ``"none"``
+        (:data:`~dynid.workflows.options.NO_FILTER`): no low-pass.
     max_gap_s : float, optional
         Longest gap bridged by interpolation [s]; a longer one cuts a log into pieces.
     q_start : tuple of float, optional
@@ -87,13 +96,13 @@ class FrictionOptions:
     columns: ColumnSpec | None = None
     drop_invalid: bool = False
     drive: Drive | None = None
-    cutoff_hz: float | None = None
+    cutoff_hz: Cutoff = None
     max_gap_s: float | None = None
     q_start: tuple[float, ...] | None = None
 
     def __post_init__(self) -> None:
         check_choice(self, "law", ("auto", *LAWS), optional=False)
-        check_number(self, "cutoff_hz")
+        check_cutoff(self)
         check_number(self, "max_gap_s")
 
 
@@ -182,7 +191,7 @@ def fit_friction_files(
         recorded=model.info.column_map if isinstance(model, IdentifiedModel) else None,
         columns=columns,
         drop_invalid=drop_invalid,
-        cutoff_hz=cutoff_hz,
+        cutoff_hz=velocity_cutoff(cutoff_hz),
         owner="the model",
         drive=(model.drive if isinstance(model, IdentifiedModel) else None) or drive,
         q_start=opt.q_start,
@@ -196,7 +205,7 @@ def fit_friction_files(
             model,
             rec.logs,
             rec.names,
-            cutoff_hz=RECORDED if cutoff_hz is None else cutoff_hz,
+            cutoff_hz=library_cutoff(cutoff_hz, RECORDED),
             max_gap_s=max_gap_s,
             drive=drive,
             decimate=1,  # every sample, at its own time: the torques validate judges

@@ -60,7 +60,18 @@ from .data_files import (
     read_static_file,
     read_torque_log,
 )
-from .options import check_band, check_choice, check_count, check_number, only_with, refused_with
+from .options import (
+    Cutoff,
+    check_band,
+    check_choice,
+    check_count,
+    check_cutoff,
+    check_number,
+    library_cutoff,
+    only_with,
+    refused_with,
+    velocity_cutoff,
+)
 from .prior import load_prior
 from .recordings import (
     Recorded,
@@ -75,8 +86,9 @@ from .recordings import (
 __all__ = ["ColumnSpec", "IdentifyOptions", "IdentifyResult", "data_files", "identify_files"]
 
 
-def _columns(spec: ColumnSpec | None, cutoff_hz: float | None, drive: Drive | None) -> Any:
-    return None if spec is None else column_map(*spec, cutoff_hz=cutoff_hz, drive=drive)
+def _columns(spec: ColumnSpec | None, cutoff_hz: Cutoff, drive: Drive | None) -> Any:
+    cut = velocity_cutoff(cutoff_hz)
+    return None if spec is None else column_map(*spec, cutoff_hz=cut, drive=drive)
 
 
 def _heldout(
@@ -191,9 +203,11 @@ class IdentifyOptions:
         Least squares: ordinary, weighted by the noise level, or Huber-reweighted.
     drive : Drive, optional
         The drive train the data were recorded through.
-    cutoff_hz : float, optional
+    cutoff_hz : float or "none", optional
         Torque logs: zero-phase low-pass cut-off [Hz] (default: read from the log); also
         the cut-off of velocities derived from positions through ``columns``.
+        ``"none"`` (:data:`~dynid.workflows.options.NO_FILTER`): no low-pass, every
+        sample kept (no decimation); recorded, so that validate and friction reuse it.
     max_gap_s : float, optional
         Torque logs: longest gap bridged by interpolation [s]; a longer one cuts the log.
     q_start : tuple of float, optional
@@ -236,7 +250,7 @@ class IdentifyOptions:
     std: StdMethod | None = None
     estimator: EstimatorName = "ols"
     drive: Drive | None = None
-    cutoff_hz: float | None = None
+    cutoff_hz: Cutoff = None
     max_gap_s: float | None = None
     q_start: tuple[float, ...] | None = None
     folds: int | None = None
@@ -251,8 +265,9 @@ class IdentifyOptions:
     total_mass: tuple[float, float] | None = None
 
     def __post_init__(self) -> None:
-        for name in ("max_std_percent", "cutoff_hz", "max_gap_s"):
+        for name in ("max_std_percent", "max_gap_s"):
             check_number(self, name)
+        check_cutoff(self)
         check_number(self, "rtol", high=1.0, high_open=True)
         check_number(self, "prior_weight", low_open=False)
         check_number(self, "margin", low_open=False, high=0.25, high_open=True)
@@ -400,7 +415,7 @@ def _identify(
             drive=opt.drive,
             estimator=opt.estimator,
             std=opt.std or "hac",
-            cutoff_hz="auto" if opt.cutoff_hz is None else opt.cutoff_hz,
+            cutoff_hz=library_cutoff(opt.cutoff_hz, "auto"),
             **heldout,
         )
         model = in_file(path, fit) if len(paths) == 1 else fit()
@@ -538,7 +553,7 @@ def _identify_consistent(
                 drive=opt.drive,
                 estimator=opt.estimator,
                 std=opt.std,
-                cutoff_hz="auto" if opt.cutoff_hz is None else opt.cutoff_hz,
+                cutoff_hz=library_cutoff(opt.cutoff_hz, "auto"),
                 max_gap_s=opt.max_gap_s,
                 **heldout,
                 **common,

@@ -6,18 +6,55 @@ from __future__ import annotations
 
 import math
 from collections.abc import Iterable
-from typing import Any
+from typing import Any, Literal
 
 from ..exceptions import OptionError
 
 __all__ = [
+    "NO_FILTER",
+    "Cutoff",
     "check_band",
     "check_choice",
+    "check_cutoff",
     "check_count",
     "check_number",
+    "library_cutoff",
+    "velocity_cutoff",
     "only_with",
     "refused_with",
 ]
+
+#: ``cutoff_hz`` of the options that turns the low-pass off (``--cutoff none``): the
+#: states and torques are used as recorded, the accelerations differentiated from them.
+NO_FILTER: Literal["none"] = "none"
+#: A cut-off option: a frequency [Hz], :data:`NO_FILTER`, or None (the command's default).
+Cutoff = float | Literal["none"] | None
+
+
+def check_cutoff(options: Any, field: str = "cutoff_hz") -> None:
+    """``options.field`` is None, :data:`NO_FILTER` or a positive finite frequency [Hz].
+
+    Raises
+    ------
+    OptionError
+        Anything else; ``field`` set.
+    """
+    if getattr(options, field) != NO_FILTER:
+        check_number(options, field)
+
+
+def library_cutoff(value: Cutoff, default: Any) -> Any:
+    """The ``cutoff_hz`` a library call takes for the option ``value``: None (no filter)
+    for :data:`NO_FILTER`, ``default`` (``"auto"``, ``"recorded"``) for None, else the
+    frequency [Hz]."""
+    return None if value == NO_FILTER else default if value is None else value
+
+
+def velocity_cutoff(value: Cutoff) -> float | None:
+    """The cut-off [Hz] of velocities derived from positions through a column map for the
+    option ``value``: the frequency given, else None (the library's default; velocities
+    derived from positions are always filtered, also under :data:`NO_FILTER`)."""
+    return None if value is None or value == NO_FILTER else float(value)
 
 
 def check_number(

@@ -40,6 +40,7 @@ from ..model.robot import Robot
 from .data_files import ColumnSpec, column_map, data_kind, in_file, read_static_file
 from .export import ExportRobotOptions, RobotExport, export_robot
 from .identify import data_files
+from .options import Cutoff, library_cutoff, velocity_cutoff
 from .recordings import despiked_recordings, read_recordings
 
 __all__ = ["PayloadFileResult", "identify_payload_files"]
@@ -121,7 +122,7 @@ def identify_payload_files(
     gravity_only: bool = False,
     columns: ColumnSpec | None = None,
     drop_invalid: bool = False,
-    cutoff_hz: float | None = None,
+    cutoff_hz: Cutoff = None,
     max_gap_s: float | None = None,
     drive: Drive | None = None,
     feasible: str | Path | None = None,
@@ -145,9 +146,11 @@ def identify_payload_files(
         model's recorded ones).
     drop_invalid : bool
         Drop invalid rows (counted) instead of failing.
-    cutoff_hz : float, optional
+    cutoff_hz : float or "none", optional
         Torque logs: zero-phase low-pass cut-off [Hz]; default: the identification's
-        recorded one (with its decimation), else the one read from the recordings' motion.
+        recorded one (with its decimation; none if it was identified without), else the
+        one read from the recordings' motion; ``"none"``
+        (:data:`~dynid.workflows.options.NO_FILTER`): no low-pass.
         Refused with static data, which are not filtered.
     max_gap_s : float, optional
         Torque logs: longest gap bridged [s]; a longer one cuts a log into pieces.
@@ -183,7 +186,8 @@ def identify_payload_files(
         drive = drive or load_feasible_drive(feasible)
         friction = load_feasible_linear_friction(feasible) or "own"
     recorded = arm.info.log if isinstance(arm, IdentifiedModel) else None
-    known = cutoff_hz if cutoff_hz is not None or recorded is None else recorded.cutoff_hz
+    given = velocity_cutoff(cutoff_hz)
+    known = given if cutoff_hz is not None or recorded is None else recorded.cutoff_hz
     read_drive = arm.drive if isinstance(arm, IdentifiedModel) and drive is None else drive
     cmap = column_map(*(columns or (None, None)), cutoff_hz=known, drive=read_drive)
     kind = data_kind(paths[0], cmap)
@@ -219,7 +223,7 @@ def identify_payload_files(
         names=rec.names,
         unloaded=None if without_rec is None else without_rec.logs,
         unloaded_names=None if without_rec is None else without_rec.names,
-        cutoff_hz="recorded" if cutoff_hz is None else cutoff_hz,
+        cutoff_hz=library_cutoff(cutoff_hz, "recorded"),
         max_gap_s=max_gap_s,
         **common,
     )

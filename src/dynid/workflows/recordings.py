@@ -36,6 +36,7 @@ Pieces too short to filter are the preparation's (:mod:`dynid.friction.recording
 
 from __future__ import annotations
 
+import dataclasses
 import logging
 import warnings
 from collections.abc import Sequence
@@ -52,13 +53,14 @@ from ..identification.sanity import (
     despiked,
     moving_joints,
     opposite_sign,
+    sign_confirmed,
     spike_finding,
     time_unit_finding,
     too_few_samples,
     torque_unit_finding,
 )
 from ..identification.unit_mix import degrees_among_radians, joints_in_degrees
-from ..io.columns import ColumnMap
+from ..io.columns import ColumnMap, parse_column_map
 from ..model.drive import Drive
 from ..model.robot import Robot
 from ..progress import NOTE
@@ -81,6 +83,7 @@ __all__ = [
     "check_limits",
     "check_signs",
     "warn_signs",
+    "recorded_sign_map_findings",
     "check_torque_unit",
     "check_units",
     "despiked_recordings",
@@ -380,15 +383,79 @@ def check_degrees(rec: Recorded, robot: Robot) -> None:
         raise DataError(found[1], file=rec.names[found[0]])
 
 
-def warn_signs(rec: Recorded, robot: Robot) -> None:
+def warn_signs(rec: Recorded, robot: Robot, skip: Sequence[str] = ()) -> None:
     """Warn of each recording whose (joint-side) torques have the opposite sign to the
     robot's (:func:`~dynid.identification.sanity.opposite_sign`, the finding
     :func:`check_signs` refuses with), naming the file: ``validate`` judges such a log
     "unusable" and writes its files, and said only "of another sign?" without the joints
-    or the ``--units`` entries that read them."""
+    or the ``--units`` entries that read them. The recordings ``skip`` (by name) are left
+    out (their sign said otherwise: :func:`recorded_sign_map_findings`)."""
     for name, log in zip(rec.names, rec.joint_side, strict=True):
+        if name in skip:
+            continue
         if too_few_samples(log) is None and (opposite := opposite_sign(robot, log)):
             warnings.warn(f"{name}: {opposite}", DynidWarning, stacklevel=3)
+
+
+def recorded_sign_map_findings(
+    rec: Recorded, robot: Robot, recorded: Any, units: str | None
+) -> dict[str, str]:
+    """Per recording (by name), the finding that the sign flips of the model's recorded
+    ``--units`` (``tau3=-1``, applied because no ``units`` were given) look wrong for it:
+    a flipped joint whose torques the robot's rigid-body torques confirm as the file holds
+    them and not as read (:func:`~dynid.identification.sanity.sign_confirmed`). Said
+    first, naming the joints and the ``--units`` that reads the file without the flips;
+    the verdict judges the torques as read. Empty without such a recording.
+
+    Parameters
+    ----------
+    rec : Recorded
+        The recordings as read (with the recorded map).
+    robot : Robot
+        The robot whose torques confirm a sign (an identified model's equivalent links).
+    recorded : mapping, optional
+        The model's ``info.column_map`` (``columns``, ``units``).
+    units : str, optional
+        ``--units`` as given: when given, the recorded map is not used and not judged.
+    """
+    said = None if recorded is None or units is not None else recorded.get("units")
+    if not isinstance(said, str) or not said.strip():
+        return {}
+    try:
+        flips = parse_column_map(None, said).flips.get("tau", ())
+    except DataError:  # not a plain --units text: nothing to judge
+        return {}
+    out: dict[str, str] = {}
+    for name, log in zip(rec.names, rec.logs, strict=True):
+        if not flips or too_few_samples(log) is not None:
+            continue
+        sign = np.ones(log.tau.shape[1])
+        sign[[k for k in flips if k < sign.size]] = -1.0
+        held = dataclasses.replace(log, tau=log.tau * sign)  # as the file holds them
+        as_read = sign_confirmed(robot, [_joint_side(log, rec.drive)])
+        as_held = sign_confirmed(robot, [_joint_side(held, rec.drive)])
+        wrong = [k for k in flips if k < robot.n and as_held[k] and not as_read[k]]
+        if wrong:
+            out[name] = _sign_map_finding(name, said, wrong, robot.joint_names)
+    return out
+
+
+def _sign_map_finding(name: str, units: str, wrong: list[int], names: Sequence[str]) -> str:
+    """The words of :func:`recorded_sign_map_findings` for the recording ``name``."""
+    entries = [f"tau{k + 1}=-1" for k in wrong]
+    kept = [
+        e.strip()
+        for e in units.split(",")
+        if e.strip() and e.replace(" ", "").split("=")[0] not in {x[:-3] for x in entries}
+    ]
+    joints = ", ".join(f"{names[k]} (tau{k + 1})" for k in wrong)
+    return (
+        f"{name}: the model's recorded sign map (--units {units}) looks wrong for this "
+        f"file: the torques of {joints} match the model's as the file holds them and are "
+        f"opposite once flipped, and are judged flipped; hint: --units "
+        f"{','.join(kept) or 'tau=Nm'} reads the file without {', '.join(entries)} (a "
+        "--units given replaces the recorded map)"
+    )
 
 
 def check_signs(rec: Recorded, robot: Robot) -> None:

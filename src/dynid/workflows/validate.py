@@ -38,6 +38,7 @@ from __future__ import annotations
 
 import dataclasses
 import logging
+import warnings
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from pathlib import Path
@@ -46,7 +47,7 @@ from typing import Any, Literal
 import numpy as np
 from numpy.typing import NDArray
 
-from ..exceptions import DataError, OptionError
+from ..exceptions import DataError, DynidWarning, OptionError
 from ..friction.fit import same_drive, torques_through
 from ..friction.model import FrictionModel, FrictionSum, own_at_motors_note, placed_friction
 from ..friction.recordings import RecordingsValidation, validate_recordings
@@ -73,7 +74,14 @@ from ..model.robot import Robot
 from ..observer.friction import banded_if_narrow, banding_note, noise_bands
 from ..progress import NOTE
 from .data_files import ColumnSpec, in_file
-from .recordings import despiked_recordings, read_recordings
+from .options import NO_FILTER, Cutoff, library_cutoff, velocity_cutoff
+from .recordings import (
+    Recorded,
+    despiked_recordings,
+    read_recordings,
+    recorded_sign_map_findings,
+    warn_signs,
+)
 
 __all__ = ["ValidateOptions", "ValidateResult", "validate_files"]
 
@@ -93,9 +101,10 @@ class ValidateOptions:
         Column names and units of another tool's files; default: the model's recorded ones.
     drop_invalid : bool
         Drop rows with NaN/inf or a repeated timestamp (counted) instead of failing.
-    cutoff_hz : float, optional
-        Low-pass cut-off of the states [Hz]; default: the identification's recorded one,
-        else the one read from the recordings' motion.
+    cutoff_hz : float or "none", optional
+        Low-pass cut-off of the states [Hz]; default: the identification's recorded one
+        (no filter if it was identified without), else the one read from the recordings'
+        motion; ``"none"`` (:data:`~dynid.workflows.options.NO_FILTER`): no low-pass.
     max_gap_s : float, optional
         Longest gap bridged by interpolation [s]; a longer one cuts a recording into
         pieces.
@@ -116,7 +125,7 @@ class ValidateOptions:
     friction: Literal["own", "none"] | str | Path | FrictionModel = "own"
     columns: ColumnSpec | None = None
     drop_invalid: bool = False
-    cutoff_hz: float | None = None
+    cutoff_hz: Cutoff = None
     max_gap_s: float | None = None
     drive: Drive | None = None
     q_start: tuple[float, ...] | None = None
@@ -127,6 +136,8 @@ class ValidateOptions:
             ("max_gap_s", "the longest gap bridged [s]"),
         ):
             v = getattr(self, name)
+            if name == "cutoff_hz" and v == NO_FILTER:
+                continue
             if v is not None and not (isinstance(v, int | float) and np.isfinite(v) and v > 0):
                 raise OptionError(f"{name} ({what}) must be a positive number; got {v!r}")
         fr = self.friction
@@ -168,6 +179,16 @@ class ValidateResult:
     spikes : tuple of int
         Torque samples of each recording replaced as one-sample spikes before judging
         (empty: not known).
+    sensor_noise_rms, input_noise_rms : ndarray, shape (n,), optional
+        The parts of ``noise_rms`` [N m].
+    joint_ratios : ndarray, shape (n,), optional
+        Each joint's error over its noise as the verdict weighed it (each sample against
+        its own noise), the numbers its reason gives; None: not known.
+    sign_map : str, optional
+        Where the model's recorded sign map (``--units tau3=-1``) looks wrong for a
+        recording, the finding (naming the file, the joints and the ``--units`` that
+        overrides it; :func:`~dynid.workflows.recordings.recorded_sign_map_findings`),
+        also the start of ``verdict``'s reason; None otherwise.
     """
 
     validation: RecordingsValidation
@@ -182,14 +203,17 @@ class ValidateResult:
     spikes: tuple[int, ...] = ()
     sensor_noise_rms: NDArray[np.float64] | None = None
     input_noise_rms: NDArray[np.float64] | None = None
+    joint_ratios: NDArray[np.float64] | None = None
+    sign_map: str | None = None
 
     def metadata(self) -> dict[str, Any]:
         """The keys ``validation.json`` records beside the errors: ``model``,
         ``friction_source``, ``data`` (the files, comma-separated), ``files``,
         ``cutoff_hz``, ``noise_rms``, ``noise_floor_percent``, ``sensor_noise_rms`` and
-        ``input_noise_rms`` (its parts, when known), ``torque_spikes_replaced`` (per file,
-        when known), ``verdict`` (``level``, ``label``, ``reason``) and ``joint_names``
-        (when known)."""
+        ``input_noise_rms`` (its parts, when known), ``joint_ratios`` (each joint's error
+        over its noise as the verdict weighed it, when known), ``torque_spikes_replaced`` (per file,
+        when known), ``sign_map`` (the recorded sign map's finding, when there is one),
+        ``verdict`` (``level``, ``label``, ``reason``) and ``joint_names`` (when known)."""
         v = self.verdict
         spikes = dict(zip(self.files, self.spikes, strict=True)) if self.spikes else None
         parts = {
@@ -197,6 +221,7 @@ class ValidateResult:
             for k, a in (
                 ("sensor_noise_rms", self.sensor_noise_rms),
                 ("input_noise_rms", self.input_noise_rms),
+                ("joint_ratios", self.joint_ratios),
             )
             if a is not None
         }
@@ -210,6 +235,7 @@ class ValidateResult:
             "noise_floor_percent": self.noise_floor_percent,
             **parts,
             **({"torque_spikes_replaced": spikes} if spikes is not None else {}),
+            **({"sign_map": self.sign_map} if self.sign_map is not None else {}),
             "verdict": {"level": v.level, "label": v.label, "reason": v.reason},
         } | ({"joint_names": list(self.joint_names)} if self.joint_names else {})
 
@@ -262,14 +288,14 @@ def validate_files(
         recorded=model.info.column_map if isinstance(model, IdentifiedModel) else None,
         columns=opt.columns,
         drop_invalid=opt.drop_invalid,
-        cutoff_hz=opt.cutoff_hz,
+        cutoff_hz=velocity_cutoff(opt.cutoff_hz),
         owner=f"the model ({label or robot.name})",
         drive=placed,
         q_start=opt.q_start,
         max_gap_s=opt.max_gap_s,
         reference=_reference(model),
-        signs=True,  # the joints of the opposite sign named before the verdict
     )
+    sign_map = _said_signs(rec, model, opt)  # before the verdict, naming the joints
     rec, spikes = despiked_recordings(rec, robot.joint_names, SPIKES_BEFORE_JUDGING)
     friction, source = _friction(model, opt.friction, feasible, placed)
 
@@ -279,7 +305,7 @@ def validate_files(
             rec.logs,
             rec.names,
             friction=fr,
-            cutoff_hz=RECORDED if opt.cutoff_hz is None else opt.cutoff_hz,
+            cutoff_hz=library_cutoff(opt.cutoff_hz, RECORDED),
             max_gap_s=opt.max_gap_s,
             drive=drive,
         )
@@ -315,6 +341,10 @@ def validate_files(
     verdict = with_motion_range_hint(verdict, speeds, dq, names)
     files = ", ".join(f"{n} {c}" for n, c in zip(rec.names, spikes, strict=True) if c)
     verdict = with_replaced_spikes(verdict, sum(spikes), f" before judging ({files})")
+    if sign_map is not None:  # the likelier cause, said first
+        verdict = Verdict(
+            verdict.level, verdict.label, f"{sign_map}; {verdict.reason}", verdict.ratio
+        )
     return ValidateResult(
         validation=val,
         model=label or f"robot {robot.name}",
@@ -328,6 +358,8 @@ def validate_files(
         spikes=spikes,
         sensor_noise_rms=noise.sensor,
         input_noise_rms=noise.inputs,
+        joint_ratios=noise.ratios,
+        sign_map=sign_map,
     )
 
 
@@ -366,11 +398,12 @@ def _with_hints(
 class _Noise:
     """The noise per joint [N m] (n,) of the pieces judged: the torque sensors', that of
     the states the model is evaluated at (None: not known) and both (root sum of
-    squares)."""
+    squares), and each joint's error over it as the verdict weighed it (None: not known)."""
 
     sensor: NDArray[np.float64]
     inputs: NDArray[np.float64] | None
     total: NDArray[np.float64]
+    ratios: NDArray[np.float64] | None = None
 
 
 def _input_noise(
@@ -417,7 +450,24 @@ def _judged(
         None if inputs is None else [inputs[k] for k in chosen],
         opposite=opposite_sign([v.log.tau for v in parts], [v.tau_hat for v in parts]),
     )
-    return verdict, _Noise(fl.sensor_rms, fl.input_rms, fl.total_rms), fl.percent
+    return verdict, _Noise(fl.sensor_rms, fl.input_rms, fl.total_rms, fl.joint_ratios), fl.percent
+
+
+def _said_signs(rec: Recorded, model: IdentifiedModel | Robot, opt: ValidateOptions) -> str | None:
+    """Warn of the recordings whose torques look of the opposite sign: first those for
+    which the model's recorded sign map looks wrong
+    (:func:`~dynid.workflows.recordings.recorded_sign_map_findings`), then the others
+    (:func:`~dynid.workflows.recordings.warn_signs`); the former's findings, joined, or
+    None."""
+    robot = model.robot if isinstance(model, IdentifiedModel) else model
+    ref = _reference(model) or robot
+    recorded = model.info.column_map if isinstance(model, IdentifiedModel) else None
+    units = None if opt.columns is None else opt.columns[1]
+    found = recorded_sign_map_findings(rec, ref, recorded, units)
+    for text in found.values():
+        warnings.warn(text, DynidWarning, stacklevel=3)
+    warn_signs(rec, ref, skip=tuple(found))
+    return "; ".join(found.values()) or None
 
 
 def _reference(model: IdentifiedModel | Robot) -> Robot | None:

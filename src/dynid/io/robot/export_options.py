@@ -10,6 +10,7 @@ A format is one module of :mod:`dynid.io.robot` with a writer
 
 from __future__ import annotations
 
+import re
 from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -18,7 +19,7 @@ from ...friction.model import Friction, FrictionSum
 from ...model.drive import Drive
 from ...model.robot import Robot
 
-__all__ = ["ExportOptions", "RobotFormat", "kept_elsewhere", "with_caveat"]
+__all__ = ["ExportOptions", "RobotFormat", "kept_elsewhere", "with_caveat", "xml_comment"]
 
 
 @dataclass(frozen=True, slots=True)
@@ -171,8 +172,21 @@ def with_caveat(text: str, caveat: str | None, *, xml: bool) -> str:
     flat = " ".join(caveat.split())
     if not xml:
         return f"# {flat}\n{text}"
-    line = f"<!-- {flat.replace('--', '- -')} -->\n"
+    line = xml_comment(flat) + "\n"
     if text.startswith("<?xml"):
         head, _, rest = text.partition("\n")
         return f"{head}\n{line}{rest}"
     return line + text
+
+
+#: A command-line flag in a comment's text (``--out``, ``--prior-weight``).
+_FLAG = re.compile(r"(?<![\w-])--([A-Za-z][\w-]*)")
+
+
+def xml_comment(text: str) -> str:
+    """``<!-- text -->`` on one line, valid XML: a comment holds no ``--`` and does not
+    end in ``-``. A command-line flag reads as the option it is (``--out r.xml`` as
+    ``option out r.xml``), any other run of hyphens as one dash between spaces."""
+    flat = _FLAG.sub(r"option \1", " ".join(text.split()))
+    flat = re.sub(r"\s*-{2,}\s*", " - ", flat)
+    return f"<!-- {flat} -->"

@@ -70,7 +70,7 @@ from ...model.drive import Drive
 from ...model.inertia import inertia6_from_matrix
 from ...model.robot import Robot
 from ..atomic import write_text
-from .export_options import ExportOptions, kept_elsewhere, with_caveat
+from .export_options import ExportOptions, kept_elsewhere, with_caveat, xml_comment
 
 __all__ = ["export_mjcf", "mjcf_from_robot", "save_mjcf", "spring_held_offsets"]
 
@@ -313,7 +313,7 @@ def mjcf_from_robot(
     text = comment or _comment(robot, friction, approx, armature, notes)
     lines = [
         '<?xml version="1.0"?>',
-        f"<!-- {text.replace('--', '- -')} -->",
+        xml_comment(text),
         f"<mujoco model={quoteattr(robot.name)}>",
         '  <compiler angle="radian" autolimits="true" boundmass="1e-10" boundinertia="1e-14"/>',
         f'  <option gravity="{_v(robot.gravity)}"/>',

@@ -58,7 +58,7 @@ from ...model.inertia import inertia6_from_matrix
 from ...model.robot import Frame, Robot
 from ..atomic import write_text
 from ..input_files import file_text
-from .export_options import ExportOptions, kept_elsewhere, with_caveat
+from .export_options import ExportOptions, kept_elsewhere, with_caveat, xml_comment
 from .urdf_parse import load_urdf, robot_from_urdf_string
 from .urdf_patch import patch_urdf_dynamics, patch_urdf_inertials
 
@@ -165,7 +165,7 @@ def urdf_from_robot(
     )
     lines = [
         '<?xml version="1.0"?>',
-        f"<!-- {text.replace('--', '- -')} -->",
+        xml_comment(text),
         f"<robot name={quoteattr(robot.name)}>",
     ]
     lines.append(f"  <link name={quoteattr(robot.link_names[0])}/>")
