@@ -65,8 +65,9 @@ def test_a_residual_of_tilt_columns_gives_its_angles():
 
 
 def _identified(robot, truth, tmp_path, name, spring=0.0):
-    """identify_files with default options on three noisy recordings of ``truth`` (with a
-    spring of ``spring`` N m/rad on joint 2), for the level description ``robot``."""
+    """identify_files with default options on three noisy recordings of ``truth`` with
+    friction, offsets and rotor inertias (and a spring of ``spring`` N m/rad on joint 2),
+    for the level description ``robot``."""
 
     def added(log):
         out = np.zeros_like(log.q)
@@ -76,12 +77,13 @@ def _identified(robot, truth, tmp_path, name, spring=0.0):
     fr = ClassicalFriction(
         np.array([0.3, 0.3, 0.2, 0.2, 0.05, 0.05, 0.03]),
         np.array([0.5, 0.5, 0.4, 0.4, 0.2, 0.2, 0.1]),
-        np.zeros(7),
+        np.array([0.2, -0.3, 0.1, 0.4, -0.1, 0.05, 0.02]),
     )
     logs = recordings(
         truth,
         (61, 62, 63),
         friction=fr,
+        armature=np.array([0.3, 0.3, 0.2, 0.2, 0.1, 0.1, 0.05]),
         duration=5.0,
         noise=SensorNoise(tau_std=0.05, q_std=1e-5, dq_std=1e-3),
         added=added if spring else None,
@@ -100,9 +102,10 @@ def _identified(robot, truth, tmp_path, name, spring=0.0):
 @pytest.mark.slow
 def test_a_tilted_base_is_named_with_its_angle_not_called_a_spring(panda, tmp_path):
     """Regression: a Panda whose base is tilted 0.3 deg about x, identified with the level
-    description, was told to add a spring on joint 1. The verdict now names the tilt with
-    its angle (0.3 deg within 10 %) and no spring; a level arm with a 1.5 N m/rad spring on
-    joint 2 still gets the spring and no tilt, and a level arm without one no tilt."""
+    description, was told to add a spring on joint 1 (and the structure chosen left out
+    an offset the arm has). The verdict now names the tilt with its angle (0.3 deg within
+    10 %) and no spring; a level arm with a 1.5 N m/rad spring on joint 2 still gets the
+    spring and no tilt, and a level arm without one no tilt."""
     truth = panda.with_gravity(_rotation(0, np.radians(0.3)) @ panda.gravity)
     held = _identified(panda, truth, tmp_path, "tilted")
     assert held.tilt is not None and held.tilt.named
