@@ -7,13 +7,14 @@ in the gravity vector, so the derivative with respect to the tilt is the gravity
 of the description's links under the gravity ``e_x x g0`` (:func:`tilt_columns`, two
 columns: about x and about y; [N m/rad]). The fit absorbs the part of those columns its
 own regressor spans (a tilt moves the base parameters); what remains in the residual is
-the part orthogonal to it. :func:`gravity_tilt` regresses the residual, each joint
-weighed by its noise, on the tilt columns with the model's own columns projected out (the
-Frisch-Waugh-Lovell theorem: the angles the joint fit of both would give): the estimated
-angles, their standard deviations, and the share of the residual's part above the noise
-they explain. The tilt is named (:attr:`GravityTilt.named`) when it explains at least
-:data:`EXPLAINS` of that part, both angles' estimate standing :data:`SIGNIFICANT` standard
-deviations clear, and the residual's per-joint diagnosis
+the part orthogonal to it. :func:`gravity_tilt` fits the measured torques, each joint
+weighed by its noise, with the tilt columns and the model's own columns together (by the
+Frisch-Waugh-Lovell theorem: on the tilt columns with the model's projected out): the
+estimated angles, their standard deviations, and the share of the residual the model's
+columns leave alone, above the noise, that the tilt explains. The tilt is named
+(:attr:`GravityTilt.named`) when it explains at least :data:`EXPLAINS` of that part, the
+angles standing :data:`SIGNIFICANT` standard deviations clear, and the residual's
+per-joint diagnosis
 (:mod:`~dynid.identification.residual_dependence`) then reads what the tilt leaves.
 
 A Panda whose base is tilted 0.3 deg about x, identified with the level description: the
