@@ -27,6 +27,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from ..model.robot import Robot
+from .gravity_tilt import GravityTilt
 from .verdict import SYSTEMATIC_RATIO, Verdict, with_hint
 
 if TYPE_CHECKING:
@@ -195,11 +196,24 @@ def dependence_hint(
     noise_rms: NDArray[np.float64],
     joint_names: Sequence[str],
     terms: Collection[str] = (),
+    tilt: GravityTilt | None = None,
 ) -> str | None:
     """:func:`residual_dependence` in words, one clause per joint above its noise joined by
     ``"; "`` (``"right_s1: 0.41 of 0.59 N m RMS residual follows its position (...)"``),
     the :data:`NAMED` farthest above their noise first, or None when no joint is above
-    its noise."""
+    its noise.
+
+    ``tilt``: the tilt of the gravity vector the residual points to
+    (:func:`~dynid.identification.gravity_tilt.gravity_tilt` of the pieces concatenated);
+    when it explains the residual (:attr:`~dynid.identification.gravity_tilt.GravityTilt.
+    named`) it is said first and the joints are diagnosed on what it leaves (a residual
+    the tilt explains is no spring's)."""
+    if tilt is not None and tilt.named:
+        rows = tilt.rows
+        q = [np.concatenate([np.asarray(x, dtype=np.float64) for x in q])[rows]]
+        dq = [np.concatenate([np.asarray(x, dtype=np.float64) for x in dq])[rows]]
+        rest = dependence_hint(q, dq, [tilt.rest], noise_rms, joint_names, terms)
+        return tilt.sentence() + ("" if rest is None else f"; what it leaves: {rest}")
     found = residual_dependence(q, dq, error, noise_rms)
     if not found:
         return None
@@ -217,13 +231,16 @@ def with_dependence_hint(
     noise_rms: NDArray[np.float64],
     joint_names: Sequence[str],
     terms: Collection[str] = (),
+    tilt: GravityTilt | None = None,
 ) -> Verdict:
     """``verdict`` with :func:`dependence_hint` appended when it is above the noise floor
     (not ``"good"``) and a joint is above its noise; else ``verdict`` itself. ``terms``: the
-    model's (:func:`held_terms`)."""
+    model's (:func:`held_terms`); ``tilt``: the tilt of the gravity vector the residual
+    points to, said first when it explains it."""
     if verdict.level == "good":
         return verdict
-    return with_hint(verdict, dependence_hint(q, dq, error, noise_rms, joint_names, terms))
+    said = dependence_hint(q, dq, error, noise_rms, joint_names, terms, tilt)
+    return with_hint(verdict, said)
 
 
 def outside_model_note(

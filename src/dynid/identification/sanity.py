@@ -21,7 +21,11 @@ with them before fitting (:func:`log_findings`). None of them changes the data.
   -0.51 at a factor of -0.29, and that is no sign to flip; nor where the torques as read
   are the model's plus a function of the joint's own position and friction, far better
   than the negated ones (:func:`_reads_right`: on another recording the same spring gave
-  -0.96 at -1.17, as a flipped sign would). A robot's joint spring
+  -0.96 at -1.17, as a flipped sign would; the samples whose velocity is within its noise
+  left out, where a Coulomb friction of 80 N m steps). Where friction outweighs a loaded
+  joint's rigid bodies the correlations cannot see a flip: a joint whose negated torques
+  are so explained while its friction as read pushes is called opposite
+  (:func:`_pushing_as_read`). A robot's joint spring
   (:attr:`~dynid.model.robot.Robot.spring`) is part of its torques at rest and in motion.
 * **Scale**: the least-squares factor ``a`` in ``tau ~ a g(q)`` over the gravity-loaded
   joints; ``a`` near 1e3 or 1e-3 is a unit off by a power of ten (mN m against N m:
@@ -472,6 +476,7 @@ def opposite_sign(robot: Robot, log: TorqueLog) -> str | None:
     every = corr
     off_scale = np.zeros(robot.n, dtype=bool)
     closer: dict[int, tuple[float, float]] = {}
+    pushing: dict[int, float] = {}
     if (whole := _motion_torques(robot, log, at)) is not None:  # each can be fooled alone
         model, ok = whole
         every, slope = _explained(model[ok], log.tau[at][ok])
@@ -480,7 +485,8 @@ def opposite_sign(robot: Robot, log: TorqueLog) -> str | None:
         lo, hi = CONFIRMED_SLOPE
         off_scale = right.any() & ((-slope < lo) | (-slope > hi))
         closer = _closer_negated(model[ok], log.tau[at][ok])
-        flipped = flipped | np.isin(np.arange(robot.n), list(closer))
+        pushing = _pushing_as_read(log, at, model, ok, loaded & ~right)
+        flipped = flipped | np.isin(np.arange(robot.n), [*closer, *pushing])
     # where the model explains other joints at their scale, a joint whose negated model
     # torques would not explain its own at about theirs holds something the rigid bodies
     # lack (a spring, a counterbalance), not a flipped sign; nor does one whose torques as
@@ -491,7 +497,7 @@ def opposite_sign(robot: Robot, log: TorqueLog) -> str | None:
     if not strong.any():
         return None
     if right.any() or not loaded.any() or not bool(np.all(every[loaded] < 0)):
-        return _opposite(corr, strong, loaded | right, robot.joint_names, closer)
+        return _opposite(corr, strong, loaded | right, robot.joint_names, closer, pushing)
     names = robot.joint_names
     j = int(np.flatnonzero(strong)[np.argmin(corr[strong])])
     said = (
@@ -522,6 +528,54 @@ SIGN_POSITION_BINS = 12
 SIGN_RESIDUAL_SHARE = 0.5
 
 
+def _sign_fits(
+    log: TorqueLog,
+    at: NDArray[np.intp],
+    model: NDArray[np.float64],
+    ok: NDArray[np.bool_],
+    asked: NDArray[np.bool_],
+) -> dict[int, tuple[float, float, float]]:
+    """Per joint among ``asked`` (n,): the least-squares residual sums of squares
+    [N^2 m^2] of the torques as read and negated, less the model's rigid-body torques
+    ``model`` (at the samples ``at`` where ``ok``), on a function of the joint's own
+    position (a spring, a counterbalance: linear in it plus a constant per
+    :data:`SIGN_POSITION_BINS` bins of it) and friction (``fc sign(dq) + fv dq``), and the
+    Coulomb coefficient ``fc`` [N m] of the torques as read. The samples whose velocity is
+    within its noise band are left out: friction there is anywhere between ``-fc`` and
+    ``fc``, and a Coulomb friction of 80 N m left its full step at the reversals in the
+    residual, which then outweighed the rest (a right-signed UR5 shoulder called flipped).
+    A joint with too few samples left is not given."""
+    out: dict[int, tuple[float, float, float]] = {}
+    dq = log.dq[at][ok]
+    q = log.q[at][ok]
+    tau = log.tau[at][ok]
+    band = noise_band(velocity_noise_std(log.dq, log.t))
+    for j in np.flatnonzero(asked):
+        moving = np.abs(dq[:, j]) > max(band[j], MIN_MOTION)
+        qj = q[moving, j]
+        edges = np.quantile(qj, np.linspace(0.0, 1.0, SIGN_POSITION_BINS + 1)) if qj.size else ()
+        which = np.clip(np.searchsorted(edges, qj, side="right") - 1, 0, None)
+        which = np.minimum(which, SIGN_POSITION_BINS - 1)
+        X = np.column_stack(
+            [
+                which[:, None] == np.arange(SIGN_POSITION_BINS),
+                qj,
+                np.sign(dq[moving, j]),
+                dq[moving, j],
+            ]
+        ).astype(np.float64)
+        if X.shape[0] <= 2 * X.shape[1]:
+            continue
+        left, fc = [], 0.0
+        for k, y in enumerate((tau[moving, j], -tau[moving, j])):
+            y = y - model[ok][moving, j]
+            coef = np.linalg.lstsq(X, y, rcond=None)[0]
+            left.append(float(np.sum((y - X @ coef) ** 2)))
+            fc = float(coef[-2]) if k == 0 else fc
+        out[int(j)] = (left[0], left[1], fc)
+    return out
+
+
 def _reads_right(
     log: TorqueLog,
     at: NDArray[np.intp],
@@ -531,40 +585,40 @@ def _reads_right(
 ) -> NDArray[np.bool_]:
     """The joints among ``asked`` (n,) whose torques as read, not negated, are the model's
     rigid-body torques ``model`` (at the samples ``at`` where ``ok``) plus a function of
-    the joint's own position (a spring, a counterbalance: linear in it plus a constant per
-    :data:`SIGN_POSITION_BINS` bins of it) and friction (``fc sign(dq) + fv dq``): the
-    least-squares residual of ``tau - model`` on those columns is at most
-    :data:`SIGN_RESIDUAL_SHARE` of that of ``-tau - model``. Under a flipped sign the
-    negated torques are the ones so explained, and the torques as read leave twice the
-    rigid-body torques of every joint's motion. A 60 N m/rad spring on a Panda shoulder
-    made its torques correlate -0.96 with gravity's at a factor of -1.17, as a flipped
-    sign would; read as they are, they were its model's torques plus such a function."""
+    the joint's own position and friction (:func:`_sign_fits`): the least-squares
+    residual of ``tau - model`` on those columns is at most :data:`SIGN_RESIDUAL_SHARE`
+    of that of ``-tau - model``. Under a flipped sign the negated torques are the ones so
+    explained, and the torques as read leave twice the rigid-body torques of every
+    joint's motion. A 60 N m/rad spring on a Panda shoulder made its torques correlate
+    -0.96 with gravity's at a factor of -1.17, as a flipped sign would; read as they are,
+    they were its model's torques plus such a function."""
     out = np.zeros(log.n, dtype=bool)
-    dq = log.dq[at][ok]
-    q = log.q[at][ok]
-    tau = log.tau[at][ok]
-    band = noise_band(velocity_noise_std(log.dq, log.t))
-    for j in np.flatnonzero(asked):
-        edges = np.quantile(q[:, j], np.linspace(0.0, 1.0, SIGN_POSITION_BINS + 1))
-        which = np.clip(np.searchsorted(edges, q[:, j], side="right") - 1, 0, None)
-        which = np.minimum(which, SIGN_POSITION_BINS - 1)
-        moving = np.abs(dq[:, j]) > max(band[j], MIN_MOTION)
-        X = np.column_stack(
-            [
-                which[:, None] == np.arange(SIGN_POSITION_BINS),
-                q[:, j],
-                np.sign(dq[:, j]) * moving,
-                dq[:, j],
-            ]
-        ).astype(np.float64)
-        if X.shape[0] <= 2 * X.shape[1]:
-            continue
-        left = []
-        for y in (tau[:, j] - model[ok][:, j], -tau[:, j] - model[ok][:, j]):
-            coef = np.linalg.lstsq(X, y, rcond=None)[0]
-            left.append(float(np.sum((y - X @ coef) ** 2)))
-        out[j] = left[0] <= SIGN_RESIDUAL_SHARE * left[1]
+    for j, (read, negated, _) in _sign_fits(log, at, model, ok, asked).items():
+        out[j] = read <= SIGN_RESIDUAL_SHARE * negated
     return out
+
+
+def _pushing_as_read(
+    log: TorqueLog,
+    at: NDArray[np.intp],
+    model: NDArray[np.float64],
+    ok: NDArray[np.bool_],
+    asked: NDArray[np.bool_],
+) -> dict[int, float]:
+    """The joints among ``asked`` whose negated torques, not those as read, are the
+    model's plus a function of their own position and friction (:func:`_sign_fits`, the
+    reverse of :func:`_reads_right`) while the friction as read pushes (a negative Coulomb
+    coefficient), with that coefficient [N m]: a flipped sign where friction outweighs
+    the rigid bodies, which the correlations cannot see (a UR5 shoulder with 80 N m of
+    Coulomb friction, flipped, correlated +0.52 with its model's torques). Asked of the
+    joints gravity loads: the sign of one it does not is judged by the identification's
+    dissipation check, which offers the structure without its friction as the way on."""
+    fits = _sign_fits(log, at, model, ok, asked)
+    return {
+        j: fc
+        for j, (read, negated, fc) in fits.items()
+        if negated <= SIGN_RESIDUAL_SHARE * read and fc < 0.0
+    }
 
 
 #: A joint's measured torques are the negated model's (:func:`_closer_negated`) when
@@ -680,27 +734,36 @@ def _opposite(
     judged: NDArray[np.bool_],
     names: tuple[str, ...],
     closer: dict[int, tuple[float, float]] | None = None,
+    pushing: dict[int, float] | None = None,
 ) -> str | None:
     """The finding of the joints ``strong`` (n,) anti-correlated with the model's torques
     (``corr``, n), or closer to its negated torques (``closer``: the RMS distances from
-    the negated and from the model's, :func:`_closer_negated`), while others the checks
-    judge (``judged``) are not: named, with the ``--units`` entries that flip their
-    columns alone (``tau2=-1``), and the joints neither check judges."""
+    the negated and from the model's, :func:`_closer_negated`; ``pushing``: the Coulomb
+    coefficient [N m] of friction that pushes as read, :func:`_pushing_as_read`), while
+    others the checks judge (``judged``) are not: named, with the ``--units`` entries
+    that flip their columns alone (``tau2=-1``), and the joints neither check judges."""
     rest = np.flatnonzero(judged & ~strong)
     free = np.flatnonzero(~judged & ~strong)
     bad = np.flatnonzero(strong)
     which = ", ".join(names[k] for k in bad)
     near = {k: v for k, v in (closer or {}).items() if strong[k]}
+    push = {k: v for k, v in (pushing or {}).items() if strong[k]}
     anti = bool(np.all(corr[bad] < OPPOSITE_CORRELATION))
     evidence = (
         f"correlation {', '.join(f'{corr[k]:+.2f}' for k in bad)}"
-        if not near
+        if not near and not push
         else "; ".join(
             f"{names[k]}: correlation {corr[k]:+.2f}"
             + (
                 f", {near[int(k)][0]:.3g} N m RMS from the negated model's torques against "
                 f"{near[int(k)][1]:.3g} from the model's, means included"
                 if k in near
+                else ""
+            )
+            + (
+                f", friction that pushes as read (Coulomb {push[int(k)]:.3g} N m), the "
+                "negated torques the model's plus friction"
+                if k in push and k not in near
                 else ""
             )
             for k in map(int, bad)
