@@ -487,6 +487,9 @@ def prepare_recordings(
         if mine:  # sign, units, frozen joints: on the whole recording, said once
             whole = joined([joint_side_log(p, drive) for p in mine])
             if (opposite := opposite_sign(robot, whole)) is not None:
+                others = [joint_side_log(x, drive) for i, x in enumerate(logs) if i != r]
+                if any(opposite_sign(robot, x) is None for x in others):  # this one's alone
+                    opposite = opposite_sign(robot, whole, file=name) or opposite
                 raise DataError(opposite, file=name)  # a fit would negate the masses
             for finding in check_torque_log(robot, whole, drive):
                 found.setdefault(finding, []).append(name)

@@ -64,7 +64,7 @@ from __future__ import annotations
 
 import dataclasses
 import math
-from collections.abc import Sequence
+from collections.abc import Iterable, Sequence
 from dataclasses import dataclass
 
 import numpy as np
@@ -454,11 +454,19 @@ def _static_torques(robot: Robot, q: NDArray[np.float64]) -> NDArray[np.float64]
     return g if robot.spring is None else g + robot.spring.torques(q)
 
 
-def opposite_sign(robot: Robot, log: TorqueLog) -> str | None:
+def _flips(joints: Iterable[int], file: str | None = None) -> str:
+    """The ``--units`` entries that flip the torques of ``joints`` (from 0): ``tau2=-1``,
+    or a file's own, ``rec2.csv:tau2=-1``."""
+    at = "" if file is None else f"{file}:"
+    return ",".join(f"{at}tau{k + 1}=-1" for k in joints)
+
+
+def opposite_sign(robot: Robot, log: TorqueLog, *, file: str | None = None) -> str | None:
     """The finding that a joint-side log's torques have the opposite sign to ``robot``'s
     (anti-correlated with its gravity torques and with its whole rigid-body torques along
     the logged motion, module docstring), or None; None too for a robot without inertial
-    parameters to compare with.
+    parameters to compare with. ``file``: the hint flips that recording's columns alone
+    (``rec2.csv:tau2=-1``: one recording among several whose others read right).
 
     ``identify`` refuses such a log: a fit of the negated torques returns negated
     masses, and friction that pushes the arm."""
@@ -497,7 +505,7 @@ def opposite_sign(robot: Robot, log: TorqueLog) -> str | None:
     if not strong.any():
         return None
     if right.any() or not loaded.any() or not bool(np.all(every[loaded] < 0)):
-        return _opposite(corr, strong, loaded | right, robot.joint_names, closer, pushing)
+        return _opposite(corr, strong, loaded | right, robot.joint_names, closer, pushing, file)
     names = robot.joint_names
     j = int(np.flatnonzero(strong)[np.argmin(corr[strong])])
     said = (
@@ -506,9 +514,10 @@ def opposite_sign(robot: Robot, log: TorqueLog) -> str | None:
     )
     unjudged = np.flatnonzero(~(loaded | strong))
     if unjudged.size == 0:
+        every_joint = "tau=-1" if file is None else _flips(range(robot.n), file)
         return (
             f"{said}: the torque sign is probably opposite to the model's; hint: --units "
-            "tau=-1 reads them flipped"
+            f"{every_joint} reads them flipped"
         )
     seen = np.flatnonzero(loaded | strong)
     return (
@@ -516,8 +525,9 @@ def opposite_sign(robot: Robot, log: TorqueLog) -> str | None:
         "): the torque sign is probably opposite to the model's there; the sign of "
         f"{', '.join(names[k] for k in unjudged)}, whose torques the model's do not explain "
         "(gravity barely loads them, and friction or a drive's rotor inertia outweighs their "
-        "links'), is not told by this check; hint: --units tau=-1 if every joint's is "
-        f"opposite, --units {','.join(f'tau{k + 1}=-1' for k in seen)} if these only"
+        "links'), is not told by this check; hint: --units "
+        f"{'tau=-1' if file is None else _flips(range(robot.n), file)} if every joint's is "
+        f"opposite, --units {_flips(seen, file)} if these only"
     )
 
 
@@ -735,13 +745,15 @@ def _opposite(
     names: tuple[str, ...],
     closer: dict[int, tuple[float, float]] | None = None,
     pushing: dict[int, float] | None = None,
+    file: str | None = None,
 ) -> str | None:
     """The finding of the joints ``strong`` (n,) anti-correlated with the model's torques
     (``corr``, n), or closer to its negated torques (``closer``: the RMS distances from
     the negated and from the model's, :func:`_closer_negated`; ``pushing``: the Coulomb
     coefficient [N m] of friction that pushes as read, :func:`_pushing_as_read`), while
     others the checks judge (``judged``) are not: named, with the ``--units`` entries
-    that flip their columns alone (``tau2=-1``), and the joints neither check judges."""
+    that flip their columns alone (``tau2=-1``; of ``file`` alone: ``rec2.csv:tau2=-1``),
+    and the joints neither check judges."""
     rest = np.flatnonzero(judged & ~strong)
     free = np.flatnonzero(~judged & ~strong)
     bad = np.flatnonzero(strong)
@@ -787,10 +799,11 @@ def _opposite(
             else ""
         )
         + (
-            f"; hint: --units tau=-1 if every joint's is opposite, --units "
-            f"{','.join(f'tau{k + 1}=-1' for k in bad)} if these only"
+            f"; hint: --units "
+            f"{'tau=-1' if file is None else _flips(range(len(names)), file)} if every "
+            f"joint's is opposite, --units {_flips(bad, file)} if these only"
             if rest.size == 0 and bad.size > 1
-            else f"; hint: --units {','.join(f'tau{k + 1}=-1' for k in bad)} reads "
+            else f"; hint: --units {_flips(bad, file)} reads "
             + ("it" if bad.size == 1 else "them")
             + " flipped (beside the torques' unit, if one is given)"
         )

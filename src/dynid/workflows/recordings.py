@@ -468,13 +468,20 @@ def check_signs(rec: Recorded, robot: Robot) -> None:
     ------
     DataError
         Naming the recording, the joints and the remedy (``--units tau=-1``, or the
-        columns to flip).
+        columns to flip; of that recording alone, ``rec2.csv:tau2=-1``, when the others
+        read right).
     """
+    found = []
     for name, log in zip(rec.names, rec.joint_side, strict=True):
         if (few := too_few_samples(log)) is not None:  # before the correlations
             raise DataError(few, file=name)
-        if (opposite := opposite_sign(robot, log)) is not None:
-            raise DataError(opposite, file=name)
+        found.append(opposite_sign(robot, log))
+    for k, opposite in enumerate(found):
+        if opposite is None:
+            continue
+        if None in found:  # the others read right: this file's columns alone
+            opposite = opposite_sign(robot, rec.joint_side[k], file=rec.names[k])
+        raise DataError(str(opposite), file=rec.names[k])
 
 
 def check_torque_unit(rec: Recorded, robot: Robot, cmap: ColumnMap | None) -> None:
