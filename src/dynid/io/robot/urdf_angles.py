@@ -111,8 +111,8 @@ def rounding_message(
         f"hold coefficients near {size:.2g} (the sine of the rounding; the exact angles give "
         f"none) and the structural regressor's unscaled condition number is {c_written:.3g} "
         f"as written, {c_snapped:.3g} with the angles snapped"
-        f"{'' if harmful else ' (harmless here)'}; --snap-angles (snap_angles=True) snaps "
-        "them to the multiples of pi/2"
+        f"{'' if harmful else ' (harmless here)'}; hint: --snap-angles (snap_angles=True) "
+        "snaps them to the multiples of pi/2"
     ), harmful
 
 
