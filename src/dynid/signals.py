@@ -46,6 +46,7 @@ __all__ = [
     "derivative_noise_gain",
     "edge_seconds",
     "filtered_derivative",
+    "grid_steps",
     "is_uniform",
     "lowpass",
     "lowpass_noise_gain",
@@ -195,6 +196,82 @@ def _grid_indices(s: NDArray[np.float64], h: float, scan: bool = True) -> NDArra
             out: NDArray[np.float64] = np.round((s - offset) / h)
             return out
         L = min(2 * L, s.size)
+
+
+def grid_steps(t: ArrayLike) -> tuple[NDArray[np.int64], float, float]:
+    """The nominal periods each step of stamps ``t`` (N,) [s] spans, the period [s] and the
+    jitter of the stamps about their grid (standard deviation [s]).
+
+    A step spanning 2 periods or more holds dropped samples; one spanning 1 is a sample
+    after the last, however jittered. Steps are counted against the stamps' grid, not
+    their own length: at 100 Hz with stamps jittered by 2 ms (std), 3.8 % of the steps are
+    longer than 1.5 periods with no sample dropped. The period is :func:`sample_rate`'s.
+    When every step lies within 0.4 of a period of a whole number, each is rounded.
+    Otherwise, on each run between steps over :data:`_RUN_GAP` periods (those rounded),
+    the stamps' lag behind a grid without drops (in periods) is a staircase rising by one
+    at each dropped sample, blurred by the jitter: its mean over :data:`_SMOOTH` stamps,
+    rounded, counts the drops (a jitter of 0.25 periods errs by 0.06 there), and each rise
+    is put on the step near it longest beyond the periods it holds, one holding drops
+    already favoured by half a period (a gap is more likely than two side by side). With
+    a jitter beyond :data:`_GRID_JITTER` periods each step is rounded to whole periods
+    (at least 1). The jitter is that of the stamps
+    about the grid fitted to each run (its own offset); 0 for fewer than 3 stamps.
+
+    Returns
+    -------
+    steps : ndarray of int64, shape (N - 1,)
+        Periods each step spans (1: no sample dropped).
+    period : float
+        The period [s] (``1 / sample_rate(t)``).
+    jitter : float
+        Standard deviation of the stamps about their grid [s].
+    """
+    t = _time(t)
+    dt = np.diff(t)
+    h = 1.0 / sample_rate(t)
+    m = dt / h
+    steps = np.maximum(np.round(m), 1).astype(np.int64)
+    if t.size < 3:
+        return steps, h, 0.0
+    counted = bool(np.all(np.abs(m - np.round(m)) <= 0.4))
+    jitter = 1.4826 * float(np.median(np.abs(dt - h))) / np.sqrt(2.0)
+    if not counted and jitter <= _GRID_JITTER * h:
+        cuts = np.concatenate([[0], np.flatnonzero(m > _RUN_GAP) + 1, [t.size]])
+        for a, b in zip(cuts[:-1], cuts[1:], strict=True):
+            if b - a >= 3:
+                steps[a : b - 1] = _run_steps(t[a:b], h)
+    place = np.concatenate([[0], np.cumsum(steps)]) * h
+    r = t - place
+    cuts = np.concatenate([[0], np.flatnonzero(steps > _RUN_GAP) + 1, [t.size]])
+    for a, b in zip(cuts[:-1], cuts[1:], strict=True):
+        r[a:b] -= r[a:b].mean()
+    return steps, h, float(np.std(r))
+
+
+#: Stamps over which :func:`grid_steps` averages the stamps' lag behind the grid.
+_SMOOTH = 16
+
+
+def _run_steps(s: NDArray[np.float64], h: float) -> NDArray[np.int64]:
+    """Periods each step of a run of stamps ``s`` (L >= 3,) [s] spans at the period ``h``
+    [s] (:func:`grid_steps`)."""
+    L = s.size
+    lag = (s - s[0]) / h - np.arange(L)  # periods: one more after each dropped sample
+    lag -= float(np.angle(np.exp(2j * np.pi * lag).mean())) / (2 * np.pi)
+    w = min(_SMOOTH, L)
+    cs = np.concatenate([[0.0], np.cumsum(lag)])
+    lo = np.clip(np.arange(L) - w // 2, 0, L - w)
+    drops = np.maximum.accumulate(np.round((cs[lo + w] - cs[lo]) / w))
+    steps = 1 + np.diff(drops).astype(np.int64)
+    m = np.diff(s) / h
+    for i in np.flatnonzero(steps > 1):  # the mean rises over w stamps: the long step,
+        a, b = max(0, int(i) - w), min(L - 1, int(i) + w + 1)  # one holding drops first
+        room = m[a:b] - steps[a:b] + 0.5 * (steps[a:b] > 1)
+        j = a + int(np.argmax(room))
+        if j != i:
+            steps[j] += steps[i] - 1
+            steps[i] = 1
+    return steps
 
 
 def is_uniform(t: ArrayLike, *, rtol: float = 1e-6) -> bool:

@@ -264,8 +264,9 @@ def add_snap_angles_option(p: argparse.ArgumentParser, robot: str = "--robot") -
         "--snap-angles",
         action="store_true",
         help=f"a URDF {robot}: read joint angles within 1e-3 rad of a multiple of pi/2 as "
-        'that multiple (rpy="1.5708" as pi/2); without it such rounded angles are reported '
-        "with the condition numbers they cause",
+        'that multiple (rpy="1.5708" as pi/2); without it such rounded angles are read as '
+        "written and named in a note with the leftovers and condition numbers they cause "
+        "(angles snapped are named too)",
     )
 
 

@@ -54,8 +54,10 @@ Rank and conditioning. The base parameters come from the robot's kinematics: the
 (the rank) is read from the first clear gap (a factor >= 1e3, below 1e-3 of the largest)
 in the singular values of the column-scaled regressor, and the gap is printed. A URDF
 whose angles are rounded (rpy="1.5708 0 0") has near-dependencies near 1e-4 that are
-treated as dependencies; reading it names the rounded joints with the unscaled condition
-numbers, and --snap-angles reads such angles as the multiples of pi/2. --rtol overrides
+treated as dependencies; reading it names the rounded joints in a note (without -v), with
+the unscaled condition numbers and the leftovers of the size of the rounding that the
+base-parameter expressions then hold (-7.3e-06*mc3y for rpy="3.1416"), and --snap-angles
+reads such angles as the multiples of pi/2 (no leftovers). --rtol overrides
 this with a fixed relative threshold: singular values (and column norms) at or below RTOL
 times the largest count as dependencies; set it above the near-dependencies (1e-4 for
 4-digit angles) to drop them, below (1e-10) to keep them, at the price of an

@@ -18,6 +18,7 @@ from ..friction.model import friction_parts
 from ..friction.validation import NewtonEulerValidation
 from ..identification.dissipation import SIGNIFICANCE, negative_viscous
 from ..identification.info import IdentificationInfo, LogInfo
+from ..identification.log import jitter_text
 from ..identification.model import IdentifiedModel
 from ..identification.structure import MIN_WIDTH, joint_side_joints
 from ..io.observer_files import log_labels
@@ -344,7 +345,17 @@ def samples_text(log: LogInfo, decimations: Sequence[int] = ()) -> str:
         f"of {log.n_samples_log} recorded"
     )
     if log.resampled:
-        text += f", resampled onto a uniform grid, {log.n_gaps} gap(s) bridged"
+        jitter = jitter_text(log.stamp_jitter_s, 1.0 / log.sample_rate_hz)
+        if jitter is not None:  # steps long by jitter alone are no gaps
+            text += f", {jitter}"
+        text += ", resampled onto a uniform grid"
+        if log.n_gaps:
+            dropped = log.n_dropped and not log.n_cuts  # the drops of the gaps bridged
+            text += f", {log.n_gaps} gap(s) bridged" + (
+                f" ({log.n_dropped} sample(s) dropped)" if dropped else ""
+            )
+        elif jitter is not None and not log.n_dropped and not log.n_cuts:
+            text += ", no sample dropped"
     if log.n_cuts:
         text += f", cut into pieces at {log.n_cuts} longer gap(s)"
     return text + ")"

@@ -37,6 +37,11 @@ NOISE_FREE_RELATIVE_ERROR_PERCENT = 1e-6
 #: relative noise (in %).
 NOISE_FACTOR = 10.0
 
+#: A joint transform differing by at most this [rad, as rotation entries] is named as a
+#: URDF angle rounded near a multiple of pi/2 read as written once and snapped once (the
+#: band of :data:`dynid.io.robot.urdf_angles.ROUNDED_BAND`).
+_ROUNDING = 1e-3
+
 
 def kinematics_record(robot: Robot) -> dict[str, Any]:
     """The kinematics to record with a data set: ``T_parent_joint``, ``axes``, ``gravity``."""
@@ -79,9 +84,17 @@ def recorded_robot_mismatch(
             )
         diff = float(np.max(np.abs(theirs - mine))) if theirs.size else 0.0
         if not diff <= atol:
+            snap = key == "T_parent_joint" and diff <= _ROUNDING
             return (
                 f"the recorded kinematics differ from those of robot {robot.name!r}: largest "
                 f"difference {diff:.3g} in {key}"
+                + (
+                    " (the size of a URDF angle rounded near a multiple of pi/2: read as "
+                    "written for one and snapped for the other? give --snap-angles to both "
+                    "commands or to neither)"
+                    if snap
+                    else ""
+                )
             )
     return None
 

@@ -77,6 +77,11 @@ class LogInfo:
         The longest gap bridged, as given [s]; None: the default rule
         (:func:`~dynid.identification.log.default_max_gap`). ``validate`` and ``friction``
         cut their recordings with it unless told otherwise.
+    n_dropped : int
+        Samples missing from the stamps' grid over the recordings (jitter drops none).
+    stamp_jitter_s : float
+        Standard deviation of the timestamps about their grid [s] (the largest of the
+        recordings'; 0 for uniform stamps).
     speed_max : tuple of float or None
         Each joint's largest speed [rad/s or m/s] over the samples used (as prepared, at
         the joints): the motion the model was identified on, which ``validate`` compares
@@ -100,6 +105,8 @@ class LogInfo:
     n_cuts: int = 0
     max_gap_s: float | None = None
     speed_max: tuple[float, ...] | None = None
+    n_dropped: int = 0
+    stamp_jitter_s: float = 0.0
 
     @property
     def preprocessing(self) -> Preprocessing:

@@ -203,6 +203,8 @@ class PreparedLog(TorqueRoute):
                 n_nan_rows=self.cleaning.n_nan_rows,
                 n_duplicates=self.cleaning.n_duplicates,
                 n_gaps=len(self.cleaning.gaps),
+                n_dropped=self.cleaning.n_dropped,
+                stamp_jitter_s=self.cleaning.stamp_jitter_s,
                 cutoff_source="given" if self.motion_frequency_hz is None else "motion",
                 motion_frequency_hz=self.motion_frequency_hz,
                 resampled=self.resampled,

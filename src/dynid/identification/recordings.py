@@ -384,6 +384,8 @@ class Recordings(TorqueRoute):
                 float(x) for x in np.max([np.max(np.abs(p.log.dq), axis=0) for p in ps], axis=0)
             ),
             max_gap_s=self.max_gap_s,
+            n_dropped=sum(c.n_dropped for c in found.values()),
+            stamp_jitter_s=max(c.stamp_jitter_s for c in found.values()),
         )
         notes = tuple(self.skipped)
         if self.unwrapped:

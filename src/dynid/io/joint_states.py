@@ -40,7 +40,7 @@ from numpy.typing import NDArray
 
 from .. import _checks
 from ..exceptions import DataError
-from ..identification.log import TorqueLog, with_derived_velocities
+from ..identification.log import TorqueLog, timing_notes, with_derived_velocities
 
 __all__ = [
     "JointStateImport",
@@ -451,8 +451,7 @@ def assemble(
     ):
         if count:
             notes.append(f"{count} {what}")
-    if log.cleaning.gaps:
-        notes.append(f"{len(log.cleaning.gaps)} gap(s) in time (longer than {gap_factor:g} steps)")
+    notes += timing_notes(log.cleaning)
     return JointStateImport(
         log=log,
         topic=topic,

@@ -29,6 +29,7 @@ def load_robot(
     what: str = "robot",
     snap_angles: bool = False,
     parameters: bool = True,
+    note_angles: bool = True,
 ) -> Robot:
     """A built-in robot by name, or a robot file by its suffix: the one dispatch of robots.
 
@@ -41,7 +42,9 @@ def load_robot(
     MuJoCo's compiler when the ``mujoco`` package is installed:
     :func:`dynid.io.robot.mjcf_read.load_mjcf`). ``what`` names the option in errors;
     ``parameters`` False: the caller uses the kinematics alone, and a built-in robot's note
-    on its link parameters is not given (:func:`~dynid.model.builtin.builtin_robot`).
+    on its link parameters is not given (:func:`~dynid.model.builtin.builtin_robot`);
+    ``note_angles`` False: a URDF's rounded angles are not named in a note (a file read for
+    its inertials alone).
 
     Raises
     ------
@@ -70,7 +73,9 @@ def load_robot(
     if suffix == ".urdf":
         from .robot.urdf import load_urdf
 
-        return load_urdf(path, base_link=base, tip_link=tip, snap_angles=snap_angles)
+        return load_urdf(
+            path, base_link=base, tip_link=tip, snap_angles=snap_angles, note_angles=note_angles
+        )
     if suffix == ".toml":
         from .robot.toml import load_toml
 

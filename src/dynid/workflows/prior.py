@@ -93,6 +93,7 @@ def load_prior(
                     base=base or robot.link_names[0],
                     tip=tip or robot.link_names[-1],
                     snap_angles=True,
+                    note_angles=False,
                 )
             else:
                 prior = load_robot(path)

@@ -10,10 +10,13 @@ condition number does not show it; the unscaled one does.
 :class:`AngleRounding` collects, while a URDF is read, every ``rpy`` component within
 :data:`ROUNDED_BAND` rad of a multiple of pi/2 but not equal to it to :data:`EXACT` rad,
 and snaps such components (all those within the band) to the multiple when asked.
-:func:`rounding_message` is the one-line report: the joints, how far off, and the unscaled
+:func:`rounding_message` is the one-line report of angles read as written: the joints, how
+far off, the leftovers they put in the base-parameter expressions (a coefficient of about
+the offset, ``-7.3e-06*mc3y``, that the exact angles do not give) and the unscaled
 condition numbers of the structural regressor with the angles as written and snapped; the
 reader warns with it when the rounding multiplies the condition number by more than
-:data:`HARMFUL_FACTOR`, and logs it (``-v``) otherwise.
+:data:`HARMFUL_FACTOR`, and gives it as a note (shown without ``-v``) otherwise.
+:func:`snapped_message` is the note of angles snapped.
 """
 
 from __future__ import annotations
@@ -33,6 +36,7 @@ __all__ = [
     "ROUNDED_BAND",
     "AngleRounding",
     "rounding_message",
+    "snapped_message",
     "structural_condition",
 ]
 
@@ -95,19 +99,29 @@ HARMFUL_FACTOR = 10.0
 def rounding_message(
     source: str, found: dict[str, float], as_written: Robot, snapped: Robot
 ) -> tuple[str, bool]:
-    """One line naming the joints whose angles are rounded, with the condition numbers, and
-    whether the rounding matters (the condition number as written over
-    :data:`HARMFUL_FACTOR` times the snapped one)."""
-    names = ", ".join(f"{j} ({off:.2g} rad off)" for j, off in found.items())
+    """One line naming the joints whose angles are rounded and read as written, with the
+    condition numbers, the leftovers the rounding puts in the base-parameter expressions
+    and the option that snaps them; and whether the rounding matters (the condition number
+    as written over :data:`HARMFUL_FACTOR` times the snapped one)."""
     c_written, c_snapped = structural_condition(as_written), structural_condition(snapped)
     harmful = not c_written <= HARMFUL_FACTOR * c_snapped
-    msg = (
-        f"{source}: joint origin angles rounded near multiples of pi/2 on {names}: the "
-        f"structural regressor's unscaled condition number is {c_written:.3g} as written, "
-        f"{c_snapped:.3g} with the angles snapped"
-    )
-    if harmful:
-        return msg + (
-            "; hint: --snap-angles (snap_angles=True) snaps them to the multiples of pi/2"
-        ), True
-    return msg + " (harmless here)", False
+    size = max(found.values())
+    return (
+        f"{_named(source, found)}, read as written: the base-parameter expressions may "
+        f"hold coefficients near {size:.2g} (the sine of the rounding; the exact angles give "
+        f"none) and the structural regressor's unscaled condition number is {c_written:.3g} "
+        f"as written, {c_snapped:.3g} with the angles snapped"
+        f"{'' if harmful else ' (harmless here)'}; hint: --snap-angles (snap_angles=True) "
+        "snaps them to the multiples of pi/2"
+    ), harmful
+
+
+def snapped_message(source: str, found: dict[str, float]) -> str:
+    """One line naming the joints whose rounded angles were snapped to multiples of pi/2."""
+    return f"{_named(source, found)}, snapped to the multiples (--snap-angles)"
+
+
+def _named(source: str, found: dict[str, float]) -> str:
+    """The opening both messages share: the file and the joints with their offsets."""
+    names = ", ".join(f"{j} ({off:.2g} rad off)" for j, off in found.items())
+    return f"{source}: joint origin angles rounded near multiples of pi/2 on {names}"

@@ -70,7 +70,7 @@ from ...model.inertia import inertial_problems, phi_from_inertial
 from ...model.robot import MAX_LINK_MASS, MAX_LINK_OFFSET, Frame, Robot
 from ...progress import NOTE
 from ..input_files import file_bytes
-from .urdf_angles import AngleRounding, rounding_message
+from .urdf_angles import AngleRounding, rounding_message, snapped_message
 from .urdf_branches import OffChain, off_chain
 from .urdf_tree import (
     _chain,
@@ -210,6 +210,7 @@ def robot_from_urdf_string(
     *,
     source: str = "URDF text",
     snap_angles: bool = False,
+    note_angles: bool = True,
 ) -> Robot:
     """Serial chain between ``base_link`` and ``tip_link`` of a URDF document.
 
@@ -227,6 +228,10 @@ def robot_from_urdf_string(
     snap_angles : bool
         Snap the joint-origin ``rpy`` angles within 1e-3 rad of a multiple of pi/2 to it
         (``rpy="1.5708"`` read as pi/2; :mod:`dynid.io.robot.urdf_angles`).
+    note_angles : bool
+        Name the rounded angles in a note (level :data:`~dynid.progress.NOTE`): read as
+        written, with the leftovers and condition numbers, or snapped. False for a file
+        read for its inertials alone (a prior), whose angles are the robot's to report.
 
     Returns
     -------
@@ -260,9 +265,9 @@ def robot_from_urdf_string(
         angles are rounded near multiples of pi/2 (``rpy="1.5708"``) in a way that
         matters and ``snap_angles`` is False: the joints and the unscaled condition
         numbers of the structural regressor as written and snapped are named (a harmless
-        rounding is logged).
+        rounding is a note, as are angles snapped).
     """
-    return _robot_from_text(text, base_link, tip_link, source, snap_angles)
+    return _robot_from_text(text, base_link, tip_link, source, snap_angles, note_angles)
 
 
 def _chain_ends(
@@ -422,6 +427,7 @@ def _robot_from_text(
     tip_link: str | None,
     source: str,
     snap_angles: bool = False,
+    note_angles: bool = True,
 ) -> Robot:
     """Body of the two public readers (called directly by both, so warnings point at the caller)."""
     angles = AngleRounding(snap=snap_angles)
@@ -435,15 +441,17 @@ def _robot_from_text(
         _log.log(NOTE, "%s", hanging)
     if (merged := found.merged_line) is not None:
         _log.info("%s", merged)
-    if angles.found and not snap_angles:
+    if angles.found and snap_angles and note_angles:
+        _log.log(NOTE, "%s", snapped_message(source, angles.found))
+    elif angles.found and not snap_angles:
         with warnings.catch_warnings():  # the inertials' warnings were given once
             warnings.simplefilter("ignore", DynidWarning)
             snapped = _read_chain(text, base_link, tip_link, source, AngleRounding(snap=True))[0]
         msg, harmful = rounding_message(source, angles.found, robot, snapped)
         if harmful:
             warnings.warn(msg, DynidWarning, stacklevel=3)
-        else:
-            _log.info("%s", msg)
+        elif note_angles:
+            _log.log(NOTE, "%s", msg)
     fr = robot.friction
     if isinstance(fr, Friction):
         held = [
@@ -525,6 +533,7 @@ def load_urdf(
     tip_link: str | None = None,
     *,
     snap_angles: bool = False,
+    note_angles: bool = True,
 ) -> Robot:
     """Serial chain between ``base_link`` and ``tip_link`` of a URDF file.
 
@@ -539,6 +548,8 @@ def load_urdf(
         below ``base_link``.
     snap_angles : bool
         Snap joint-origin angles rounded near multiples of pi/2 (:func:`robot_from_urdf_string`).
+    note_angles : bool
+        Name rounded angles in a note (:func:`robot_from_urdf_string`).
 
     Returns
     -------
@@ -572,4 +583,6 @@ def load_urdf(
         raise ModelError(f"URDF file not found: {str(p)!r}") from exc
     except OSError as exc:
         raise ModelError(f"cannot read URDF file {str(p)!r}: {exc.strerror or exc}") from exc
-    return _robot_from_text(data, base_link, tip_link, f"URDF file {str(p)!r}", snap_angles)
+    return _robot_from_text(
+        data, base_link, tip_link, f"URDF file {str(p)!r}", snap_angles, note_angles
+    )

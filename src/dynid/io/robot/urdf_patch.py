@@ -195,7 +195,7 @@ def patch_urdf_inertials(
         raise ModelError(f"merged must be one of {MERGED_POLICIES}; got {merged!r}")
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", DynidWarning)  # the template's own inertials
-        chain = robot_from_urdf_string(template, base, tip, source=source)
+        chain = robot_from_urdf_string(template, base, tip, source=source, note_angles=False)
     _check_same_chain(robot, chain, source)
     root = ET.fromstring(template)
     elems = {el.get("name"): el for el in root if el.tag.rsplit("}", 1)[-1] == "link"}
@@ -257,7 +257,7 @@ def patch_urdf_inertials(
         out = out[:a] + s + out[b:]
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", DynidWarning)
-        back = robot_from_urdf_string(out, base, tip, source=source)
+        back = robot_from_urdf_string(out, base, tip, source=source, note_angles=False)
     scale = max(float(np.max(np.abs(expected))), 1e-300)
     if not np.allclose(back.phi, expected, rtol=1e-9, atol=1e-12 * scale):
         raise ModelError("the patched inertials do not read back as the robot's", file=source)
