@@ -28,6 +28,7 @@ def logs(tmp_path_factory):
                 str(d / "ident.csv"),
                 "--out",
                 str(d / "id"),
+                "--no-figures",  # (identify's figures are not read)
                 "-q",
             ]
         )

@@ -121,7 +121,7 @@ def test_summary_counts_validate_reuses_the_cutoff_and_resampling_is_said(tmp_pa
     path = save_torque_log(tmp_path / "log.csv", log.select(np.flatnonzero(keep)))
     out = tmp_path / "id"
     terms = ["--terms", "viscous,coulomb,offset"]  # 14 friction, 7 offset columns
-    assert main(["identify", "--data", str(path), *terms, "--out", str(out)]) == 0
+    assert main(["identify", "--data", str(path), *terms, "--no-figures", "--out", str(out)]) == 0
     text = capsys.readouterr().out
     meta = json.loads((out / "identification.json").read_text())["metadata"]
     r = len(json.loads((out / "identification.json").read_text())["coefficients"])
