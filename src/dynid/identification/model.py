@@ -133,8 +133,7 @@ class IdentifiedModel:
     ----------
     robot : Robot
         Kinematics (and gravity) the coefficients belong to; its inertial parameters
-        (the description's) are not the model's: a consistent fit from the model starts
-        from them when given no prior.
+        are not used.
     base : BaseParameters
         Labels, expressions and the map from standard parameters.
     fit : LeastSquaresFit
@@ -160,6 +159,11 @@ class IdentifiedModel:
         Classical route: the normal equations of the contiguous time blocks (or of the
         ``--validate-on`` log) over the columns of ``joint_fit`` (or ``fit``), for held-out
         judgement (:mod:`dynid.identification.holdout`); not saved to files.
+    description_phi : ndarray, shape (n, 10), optional
+        The link inertials of the description identified with (m [kg], mc [kg m], J
+        [kg m^2] about the link origin), kept apart from ``robot`` by a model read from a
+        file (whose robot holds the kinematics only): the prior a consistent fit from the
+        model starts from (:attr:`description`). None: ``robot``'s own.
     """
 
     robot: Robot
@@ -170,6 +174,7 @@ class IdentifiedModel:
     joint_fit: LeastSquaresFit | None = None
     drive: Drive | None = None
     holdout: HeldOut | None = None
+    description_phi: NDArray[np.float64] | None = None
     equivalent_robot: Robot = field(init=False)
     rotor_inertia: NDArray[np.float64] | None = field(init=False)
     _other: tuple[IdentifiedTerm, ...] = field(init=False, repr=False)
@@ -225,6 +230,14 @@ class IdentifiedModel:
             out[t.name] = IdentifiedTerm(t, phi[start : start + k], std, kept)
             start += k
         return out
+
+    @property
+    def description(self) -> Robot:
+        """``robot`` with the description's link inertials (:attr:`description_phi`, or
+        its own): the default prior of a consistent fit from the model."""
+        if self.description_phi is None:
+            return self.robot
+        return self.robot.with_params(self.description_phi)
 
     @property
     def appended(self) -> tuple[IdentifiedTerm, ...]:

@@ -164,7 +164,7 @@ def model_to_dict(model: IdentifiedModel, *, seed: int | None = None) -> dict[st
     frictions = model.frictions
     out["friction"] = frictions[0].params.tolist() if len(frictions) == 1 else None
     out["drive"] = None if model.drive is None else model.drive.as_dict()
-    out["robot"] = robot_to_dict(model.robot, inertials=True)
+    out["robot"] = robot_to_dict(model.description, inertials=True)
     out["metadata"] = info_to_dict(info, model.drive) | friction_metadata(model)
     law = LAWS[frictions[0].law if len(frictions) == 1 else "classical"]
     out["units"] = {
@@ -466,7 +466,17 @@ def model_from_dict(d: Mapping[str, Any], *, source: str = "identified model") -
         scaled_condition_number=_float(d.get("scaled_condition_number")),
     )
     info = info_from_dict(metadata, source=source)
-    return IdentifiedModel(robot=robot, base=base, fit=fit, terms=terms, info=info, drive=drive)
+    kept = d["robot"].get("phi")  # the description's inertials: the default prior
+    description = None if kept is None else np.array(kept, dtype=float).reshape(robot.n, 10)
+    return IdentifiedModel(
+        robot=robot,
+        base=base,
+        fit=fit,
+        terms=terms,
+        info=info,
+        drive=drive,
+        description_phi=description,
+    )
 
 
 def save_model_json(path: str | Path, model: IdentifiedModel, *, seed: int | None = None) -> Path:

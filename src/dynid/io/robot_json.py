@@ -10,10 +10,11 @@ where there is no limit), ``gravity`` (3,) [m/s^2] in the base frame, and ``fram
 attaches it in the source URDF, when it has one), and, written beside identified
 coefficients, ``phi`` (n, 10): the description's standard parameters per link (m [kg],
 mc [kg m], J [kg m^2] about the link origin), the prior a later consistent fit starts from,
-never the identified values.
+never the identified values (:attr:`~dynid.identification.model.IdentifiedModel.
+description_phi`: a robot read back has zero standard parameters).
 
-Friction is not written, nor the inertial parameters unless asked: a robot read back
-without ``phi`` has zero standard parameters, and none has a friction model. Floats are
+Friction is not written, nor the inertial parameters unless asked; a robot read back has
+no friction model. Floats are
 written with Python's shortest round-trip representation, so the kinematics read back are
 bit-identical.
 """
@@ -110,7 +111,7 @@ def robot_to_dict(robot: Robot, *, inertials: bool = False) -> dict[str, Any]:
 def robot_from_dict(
     d: Mapping[str, Any], *, source: str = "robot description", at: str = ""
 ) -> Robot:
-    """A robot (no friction; zero inertial parameters unless ``phi`` is given) from
+    """A robot (zero inertial parameters, ``phi`` left to the caller; no friction) from
     :func:`robot_to_dict` output.
 
     ``source`` and ``at``: the file and the key path of ``d`` in it, for messages.
@@ -137,7 +138,7 @@ def robot_from_dict(
             T_parent_joint=np.array(d["T_parent_joint"], dtype=float).reshape(n, 4, 4),
             axes=np.array(d["axes"], dtype=float).reshape(n, 3),
             prismatic=np.array(d["prismatic"], dtype=bool).reshape(n),
-            phi=np.array(d["phi"], dtype=float).reshape(n, 10) if "phi" in d else np.zeros((n, 10)),
+            phi=np.zeros((n, 10)),
             gravity=np.array(d["gravity"], dtype=float),
             frames={
                 str(name): Frame(

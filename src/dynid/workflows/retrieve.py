@@ -299,6 +299,8 @@ def retrieve_files(
     method_options = opt.method_options()
     if kind == "model":
         model = load_model_with_friction(source, opt.friction)
+        if opt.prior is None:  # the description's inertials, as in the fit's own run
+            model = replace(model, robot=model.description, description_phi=None)
         robot = model.robot
     elif robot is None:
         raise DynidError("retrieving from static data needs the robot that recorded them")

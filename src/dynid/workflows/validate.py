@@ -327,11 +327,7 @@ def validate_files(
         if min(rank) < rank[r] and rank[r] >= LEVELS.index(verdict.level):
             v = each[r]
             verdict = Verdict(v.level, v.label, f"{rec.names[r]}: {v.reason}", v.ratio)
-    speeds = (
-        model.info.log.speed_max
-        if isinstance(model, IdentifiedModel) and model.info.log is not None
-        else None
-    )
+    speeds = _identified_speeds(model)
     dq = [v.log.dq for v in val.parts]
     # a motion beyond the identification's is the likelier cause of what the residual follows
     beyond = motion_range_hint(speeds, dq, names) is not None
@@ -361,6 +357,14 @@ def validate_files(
         joint_ratios=noise.ratios,
         sign_map=sign_map,
     )
+
+
+def _identified_speeds(model: IdentifiedModel | Robot) -> Any:
+    """Each joint's largest speed [rad/s] over the identification's samples, or None (a
+    robot, a model of static data)."""
+    if isinstance(model, IdentifiedModel) and model.info.log is not None:
+        return model.info.log.speed_max
+    return None
 
 
 def _with_hints(
