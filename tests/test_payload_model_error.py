@@ -16,6 +16,7 @@ import numpy as np
 import pytest
 
 import dynid
+from dynid.cli.payload import scale_line
 from dynid.feasibility.payload import identify_payload
 from dynid.feasibility.payload_fit import block_jackknife_covariance
 from dynid.identification.log import TorqueLog
@@ -150,11 +151,31 @@ def test_a_mass_biased_by_an_unmodelled_spring_is_withheld_and_its_interval_cove
     assert any("as large as the fit's misfit" in note for note in est.notes)
     d = payload_to_dict(est, ARM)
     assert d["load_mass"] is None and d["F_x_Cload"] is None and not d["plausible"]
+    # the factor fitted beside the load takes the spring's torques: not judged, not a load
+    assert d["torque_scale"]["judged"] is False and clean.torque_scale is not None
+    assert payload_to_dict(clean, ARM)["torque_scale"]["judged"] is True
+    assert "not judged" in scale_line(est.torque_scale, est.mass, est.noise_rms)
+    assert "not judged" not in scale_line(clean.torque_scale, clean.mass, clean.noise_rms)
+
+
+def test_a_mass_near_zero_at_a_misfit_is_the_misfits_not_an_empty_load():
+    """doubts_about: a mass within 3 std of zero is said to be data that cannot tell a load
+    from none; with a misfit (the whole load's doubt, said first) it is not said apart, and
+    a CoM beyond the arm's length still is."""
+    from dynid.feasibility.payload_doubts import doubts_about
+
+    far = np.array([5.0, 0.0, 0.0])
+    (said,) = doubts_about(ARM, "flange", 0.43, 0.15, np.zeros(3))
+    assert "not significantly above zero" in said
+    assert doubts_about(ARM, "flange", 0.43, 0.15, np.zeros(3), misfit=True) == ()
+    (said,) = doubts_about(ARM, "flange", 0.43, 0.15, far, misfit=True)
+    assert "farther than the arm is long" in said
 
 
 def test_a_fit_above_three_times_the_noise_is_doubted_as_a_whole_load():
     """misfit_doubts: a fit that leaves 5.5 x the torque noise is doubted (the ratio, the
-    causes and --unloaded said; with the difference method, the motion repeated), one at
+    causes and --unloaded said; with the difference method, the arm's missing terms and
+    the motions recorded alike), one at
     2 x is not, nor one without a known noise (static data)."""
     from dynid.feasibility.payload_doubts import misfit_doubts
 
@@ -162,7 +183,7 @@ def test_a_fit_above_three_times_the_noise_is_doubted_as_a_whole_load():
     assert "5.5 x the torque noise" in said and "joint spring" in said
     assert "--unloaded" in said and "no setLoad values are written" in said
     (said,) = misfit_doubts(0.275, 0.05, difference=True)
-    assert "repeated without the load" in said
+    assert "give it as --model" in said and "record them alike" in said
     assert misfit_doubts(0.1, 0.05) == () and misfit_doubts(0.275, None) == ()
 
 

@@ -54,7 +54,13 @@ from pathlib import Path
 from typing import Any
 
 from ..feasibility.payload import PayloadEstimate
-from ..feasibility.payload_scale import SCALE_OFF, SCALE_SIGMAS, TorqueScale, scale_mass
+from ..feasibility.payload_scale import (
+    SCALE_OFF,
+    SCALE_SIGMAS,
+    TorqueScale,
+    scale_mass,
+    unjudged_ratio,
+)
 from ..identification.model import IdentifiedModel
 from ..identification.verdict import FLOOR_FAIR
 from ..io.model_json import save_model_json
@@ -207,7 +213,7 @@ def print_payload(console: Console, result: PayloadFileResult, label: str) -> No
             console.print(f"  I{name}      {v:+.4e} kg m^2  (std {s:.2g}){flag}")
     console.print(f"  {residual_line(est)}")
     if est.torque_scale is not None:
-        console.print(f"  {scale_line(est.torque_scale, est.mass)}")
+        console.print(f"  {scale_line(est.torque_scale, est.mass, est.noise_rms)}")
     if result.recordings:
         console.print(result.describe())
     prep = est.preprocessing
@@ -230,13 +236,21 @@ def print_payload(console: Console, result: PayloadFileResult, label: str) -> No
         )
 
 
-def scale_line(t: TorqueScale, mass: float) -> str:
+def scale_line(t: TorqueScale, mass: float, noise_rms: float | None = None) -> str:
     """``torques 1.0002 x the arm description's (std 0.00021, on the loaded data); at the
     description's scale the load is 0.8292 kg (fitted beside the factor, over it; std
     0.0013); no doubt (a within 3 std of 1, or within 5 % and the load's mass too)``
     (:attr:`PayloadEstimate.torque_scale`, :func:`~dynid.feasibility.payload_scale.
-    scale_mass`; ``mass``: the load's estimate [kg], :meth:`TorqueScale.off`)."""
+    scale_mass`; ``mass``: the load's estimate [kg], :meth:`TorqueScale.off`); with a fit
+    that leaves more than 3 x the torque noise ``noise_rms`` [N m], the factor not judged
+    (:func:`~dynid.feasibility.payload_scale.unjudged_ratio`)."""
     where = "the data without the load" if t.data == "unloaded" else "the loaded data"
+    if (ratio := unjudged_ratio(t, noise_rms)) is not None:
+        return (
+            f"torques  {t.value:.4f} x the arm description's (std {t.std:.2g}, on {where}): "
+            f"not judged, the fit with the factor leaves {ratio:.3g} x the torque noise (the "
+            "factor takes torques the arm's model lacks; see the warnings)"
+        )
     return (
         f"torques  {t.value:.4f} x the arm description's (std {t.std:.2g}, on {where}); "
         f"at the description's scale the load is {scale_mass(t)}"

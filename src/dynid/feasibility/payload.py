@@ -492,8 +492,8 @@ def _estimate(
             raise
         raise DataError(f"{exc}; {said[0]}") from None
     m, c, I, sm, sc, si = summary(phi, cov, p == 10)
-    doubts = doubts_about(kin, frame, m, sm_noise, c) + scale_doubts(scale, m, drive, noise)
-    doubts += misfit
+    doubts = misfit + doubts_about(kin, frame, m, sm_noise, c, misfit=bool(misfit))
+    doubts += scale_doubts(scale, m, drive, noise)
     by_std = undetermined_inertia(I, si) if p == 10 and not doubts else ()
     at_bound = active and p == 10 and not doubts  # the bound, not the data, set it
     every = tuple(f"I{name}" for name in INERTIA_ORDER)

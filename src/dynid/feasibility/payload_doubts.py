@@ -70,11 +70,20 @@ def arm_length(robot: Robot) -> float:
 
 
 def doubts_about(
-    robot: Robot, frame: str, m: float, sm: float, c: NDArray[np.float64]
+    robot: Robot,
+    frame: str,
+    m: float,
+    sm: float,
+    c: NDArray[np.float64],
+    *,
+    misfit: bool = False,
 ) -> tuple[str, ...]:
-    """Why the estimate is not a load to trust (module docstring); empty when none."""
+    """Why the estimate is not a load to trust (module docstring); empty when none.
+    ``misfit``: the fit leaves more than :data:`~dynid.identification.verdict.FLOOR_FAIR`
+    times the noise (:func:`misfit_doubts`, the whole load's doubt): a mass near zero is
+    then that misfit's, not data that cannot tell a load from none, and is not said apart."""
     out = []
-    if not m > MIN_MASS_SIGMAS * sm:
+    if not misfit and not m > MIN_MASS_SIGMAS * sm:
         out.append(
             f"the load's mass {m:.3g} kg is not significantly above zero (std {sm:.2g} kg, "
             f"{m / sm if sm > 0 else float('inf'):.1f} std; at least {MIN_MASS_SIGMAS:g} "
@@ -145,10 +154,11 @@ def misfit_doubts(
     if difference:
         hint = (
             "the arm identified from the --unloaded data does not explain the loaded data: "
-            "record the loaded motion repeated without the load (the arm's errors cancel "
-            "only where the motions match), and give as --model an arm identified with the "
-            "terms these torques need (friction law, joint spring), whose terms the "
-            "--unloaded data are then fitted with"
+            "it lacks terms these torques need (a joint spring, another friction law): "
+            "identify the arm on the unloaded data (dynid identify names what its residual "
+            "follows) and give it as --model, whose terms the --unloaded data are then "
+            "fitted with; where the loaded and unloaded motions differ, record them alike "
+            "(the arm's errors cancel only where the motions match)"
         )
     return (
         f"the fit leaves {ratio:.3g} x the torque noise ({residual_rms:.2g} N m RMS, more "

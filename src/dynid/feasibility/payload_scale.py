@@ -49,6 +49,7 @@ __all__ = [
     "scale_doubts",
     "scale_mass",
     "torque_scale",
+    "unjudged_ratio",
 ]
 
 #: Relative distance from 1 of a factor that makes a doubt.
@@ -191,6 +192,16 @@ def scale_mass(scale: TorqueScale) -> str:
     return f"{scale.mass:.4g} kg (fitted beside the factor, over it; std {scale.std_mass:.2g})"
 
 
+def unjudged_ratio(scale: TorqueScale, noise_rms: float | None) -> float | None:
+    """The residual of the fit with the factor over the torque noise ``noise_rms`` [N m]
+    when above :data:`~dynid.identification.verdict.FLOOR_FAIR`: the factor then takes
+    torques the arm's model does not explain, and is not judged (no doubt, no load at the
+    description's scale to trust); None at or below it, or with no noise known."""
+    if noise_rms and scale.residual_rms > FLOOR_FAIR * noise_rms:
+        return scale.residual_rms / noise_rms
+    return None
+
+
 def scale_doubts(
     scale: TorqueScale | None,
     mass: float,
@@ -205,9 +216,7 @@ def scale_doubts(
     absorbs torques the arm's model does not explain (an unmodelled spring on a Panda
     shoulder read as 0.969 with the load's mass moved by 16 %, at 6.9 x the noise), which
     no unit would fix; the residual's own doubts speak of it."""
-    if scale is None or not scale.off(mass):
-        return ()
-    if noise_rms and scale.residual_rms > FLOOR_FAIR * noise_rms:
+    if scale is None or not scale.off(mass) or unjudged_ratio(scale, noise_rms) is not None:
         return ()
     a = scale.value
     where = "the data without the load" if scale.data == "unloaded" else "the loaded data"

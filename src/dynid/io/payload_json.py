@@ -39,7 +39,9 @@ torques and the arm description's (:mod:`dynid.feasibility.payload_scale`), fitt
 ``mass`` [kg] (``std_mass``) if the description is right (the torques divided by the
 factor); null with an identified model (its scale was fitted to the same sensors) or a
 description without inertial parameters. A factor more than 5 % and 3 standard deviations
-from 1 is a doubt.
+from 1 is a doubt; ``judged`` is false when the fit with the factor leaves more than 3 x
+``noise_rms`` (the factor then takes torques the arm's model lacks: neither a doubt nor a
+load to trust).
 ``preprocessing`` is how torque logs were prepared (cut-off [Hz] and where it came from:
 ``given``, ``model`` (the identification's) or ``motion``; decimation; longest gap
 bridged [s], null for the default rule); null for static data. Floats use Python's
@@ -55,6 +57,7 @@ import numpy as np
 
 from .. import __version__, spatial
 from ..feasibility.payload import PayloadEstimate
+from ..feasibility.payload_scale import unjudged_ratio
 from ..model.inertia import INERTIA_ORDER, inertia6_from_matrix
 from ..model.robot import Robot
 from .json_files import save_json
@@ -154,6 +157,7 @@ def _scale(est: PayloadEstimate) -> dict[str, Any] | None:
         "mass": _num(t.mass),
         "std_mass": _num(t.std_mass),
         "data": t.data,
+        "judged": unjudged_ratio(t, est.noise_rms) is None,
     }
 
 

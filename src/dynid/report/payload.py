@@ -109,9 +109,16 @@ def _scale_fact(doc: dict[str, Any]) -> str | None:
     if not isinstance(t, dict) or not is_number(t.get("value")):
         return None
     where = "the data without the load" if t.get("data") == "unloaded" else "the loaded data"
+    unjudged = (
+        f"; not judged: the fit with the factor leaves more than {FLOOR_FAIR:g} x the torque "
+        "noise, the "
+        "factor takes torques the arm's model lacks"
+        if t.get("judged") is False
+        else ""
+    )
     return (
         f"Measured torques {number(t['value'], 4)} x the arm description's (std "
-        f"{cell(t.get('std'))}, on {where})"
+        f"{cell(t.get('std'))}, on {where}){esc(unjudged)}"
     )
 
 
