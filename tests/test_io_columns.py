@@ -269,8 +269,10 @@ def test_a_log_in_other_units_is_scaled_in_place_as_it_is_read(tmp_path, monkeyp
     for k in ("q", "dq", "tau"):
         np.testing.assert_allclose(getattr(got, k), getattr(log, k), rtol=1e-14, atol=1e-15)
     N, n = 60_000, 3
-    arrays, one = 8 * N * (1 + 3 * n), 8 * N * n
-    assert peak < arrays + one + (2 << 20), (peak, arrays)  # the arrays, a copy, a chunk
+    arrays, one, stamps = 8 * N * (1 + 3 * n), 8 * N * n, 8 * N
+    # the arrays, a copy, a chunk, and a few vectors of the stamps' length (their steps
+    # counted against the grid, signals.grid_steps): none of the joints' arrays copied twice
+    assert peak < arrays + one + 4 * stamps + (2 << 20), (peak, arrays)
 
 
 def test_validate_reads_a_log_in_other_units_than_the_models(tmp_path, caplog):
@@ -410,3 +412,22 @@ def test_recorded_column_map_warning_names_flags_not_python_none(caplog):
     assert "None" not in caplog.text
     assert "(--units q=deg)" in caplog.text
     assert "with --units tau=Nm; the model's data were read with --units q=deg" in caplog.text
+
+
+def test_a_files_own_flip_reads_that_file_alone_and_is_said_with_its_name(tmp_path):
+    """``--units b.csv:tau2=-1`` negates joint 2's torques of ``b.csv`` (as written) and
+    of no other file, said as the entry given; with ``tau3=-1`` for every file too."""
+    from dynid.io.torque_log import save_torque_log
+
+    logs = {"a.csv": _log(7), "b.csv": _log(8)}
+    for name, log in logs.items():
+        save_torque_log(tmp_path / name, log)
+    cmap = parse_column_map(None, "b.csv:tau2=-1,tau3=-1")
+    a = load_mapped_torque_log(tmp_path / "a.csv", cmap)
+    b = load_mapped_torque_log(tmp_path / "b.csv", cmap)
+    np.testing.assert_array_equal(a.log.tau, logs["a.csv"].tau * [1.0, 1.0, -1.0])
+    np.testing.assert_array_equal(b.log.tau, logs["b.csv"].tau * [1.0, -1.0, -1.0])
+    assert a.conversions == ("tau3 sign flipped (--units tau3=-1)",)
+    assert b.conversions == ("tau2, tau3 sign flipped (--units b.csv:tau2=-1,tau3=-1)",)
+    assert cmap.unknown_files(["a.csv", "b.csv"]) == ()
+    assert cmap.unknown_files(["a.csv"]) == ("b.csv",)

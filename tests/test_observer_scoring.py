@@ -270,8 +270,19 @@ def test_a_push_shorter_than_the_minimum_duration_is_named_as_a_dropped_crossing
     assert f"= {c['ratio'][top - 1]:.3g} x contact" in out and "< 50 ms" in out
     report = (d / "short" / "report.html").read_text()
     assert "No event, but 1 crossing(s)" in report and "not contacts" in report
+    assert '<span class="level">no event</span>' in report
     assert "every residual stayed below" not in report
     assert main([*p, "--out", str(d / "short_default")]) == 0
     doc = json.loads((d / "short_default" / "events.json").read_text())
     assert len(doc["events"]) == 1 and doc["dropped"]["count"] == 0
     assert doc["score"]["detected"] == 1 and "dropped as shorter" not in capsys.readouterr().out
+
+
+def test_a_one_sample_crossing_is_said_to_last_one_sample():
+    """dropped_words: a crossing of one sample (start == end) reads "one sample", not a
+    span from a time to itself of 0 ms."""
+    from dynid.observer.results import dropped_words
+
+    said = dropped_words(2.01, 2.01, "joint4", -0.7, 1.26, "isolated", 0.05)
+    assert said.startswith("2.010 s, joint4") and "one sample < 50 ms" in said
+    assert " 0 ms" not in said and ".." not in said

@@ -203,7 +203,8 @@ class ColumnMap:
 
     def for_file(self, name: str) -> ColumnMap:
         """The map the file ``name`` is read with: the flips of every file and its own
-        (:attr:`file_flips`), without the other files' own."""
+        (:attr:`file_flips`, kept as its only entry for the notes), without the other
+        files' own."""
         if not self.file_flips:
             return self
         own = self.file_flips.get(name, {})
@@ -216,6 +217,7 @@ class ColumnMap:
             self.velocity_cutoff_hz,
             names=self.names,
             flips=flips,
+            file_flips={name: own} if own else {},
         )
 
     def unknown_files(self, names: Sequence[str]) -> tuple[str, ...]:
@@ -652,8 +654,12 @@ def conversion_notes(columns: ColumnMap, quantities: Sequence[str]) -> tuple[str
             scaled = "" if f == -1.0 else f" and scaled by {-f:.17g} to SI"
             out.append(f"{k} sign flipped{scaled} (--units {k}={f:.17g})")
         if joints := columns.flips.get(k, ()):
+            own = {f: set(d.get(k, ())) for f, d in columns.file_flips.items()}
             which = ", ".join(f"{k}{j + 1}" for j in joints)
-            flags = ",".join(f"{k}{j + 1}=-1" for j in joints)
+            flags = ",".join(  # a file's own entry as given (ColumnMap.for_file)
+                "".join(f"{f}:" for f, js in own.items() if j in js) + f"{k}{j + 1}=-1"
+                for j in joints
+            )
             out.append(f"{which} sign flipped (--units {flags})")
     return tuple(out)
 

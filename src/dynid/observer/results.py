@@ -295,7 +295,7 @@ def flagged_words(flagged: float, logged: float) -> str:
 #: What each rule of :class:`~dynid.observer.events.DroppedCrossing` means, in words.
 DROP_RULES = {
     "isolated": "isolated: no other crossing within --merge / 2",
-    "short": "short: with the crossings --merge joined to it",
+    "short": "short: still under the minimum with the crossings within --merge joined",
 }
 
 
@@ -312,9 +312,11 @@ def dropped_words(
     (isolated: ...)"``: a crossing the minimum duration dropped, at ``start``, ``end``
     [s], on ``joint`` (its name, the one furthest over its threshold) with its ``peak``
     residual [N m] and its largest ``|r| / contact threshold`` ``ratio``, its duration
-    against ``min_duration_s`` [s] and its ``rule``."""
+    against ``min_duration_s`` [s] (one sample: ``start == end``) and its ``rule``."""
     least = "" if min_duration_s is None else f" < {1e3 * min_duration_s:.3g} ms"
+    when = f"{start:.3f} s" if end <= start else f"{start:.3f} s .. {end:.3f} s"
+    lasted = "one sample" if end <= start else f"{1e3 * (end - start):.3g} ms"
     return (
-        f"{start:.3f} s .. {end:.3f} s, {joint} peak {peak:+.3g} N m = {ratio:.3g} x contact, "
-        f"{1e3 * (end - start):.3g} ms{least} ({DROP_RULES.get(rule, rule)})"
+        f"{when}, {joint} peak {peak:+.3g} N m = {ratio:.3g} x contact, "
+        f"{lasted}{least} ({DROP_RULES.get(rule, rule)})"
     )

@@ -118,15 +118,16 @@ def _dropped(doc: Any) -> tuple[int, str | None]:
             )  # fmt: skip
         except (KeyError, IndexError, TypeError, ValueError):
             continue
-        named.append((ratio, f"{c.get('log', '?')}: {words}"))
-    named = sorted(named, key=lambda x: -x[0])[:DROPPED_SHOWN]
+        named.append((ratio, str(c.get("log", "?")), float(c["start"]), words))
+    shown = sorted(named, key=lambda x: -x[0])[:DROPPED_SHOWN]  # the furthest over, by time
+    shown.sort(key=lambda x: (x[1], x[2]))
     said = (
         f"{int(count)} crossing(s) over the contact threshold dropped as shorter than the "
         f"minimum duration{'' if least is None else f' ({least:g} s, --min-duration)'}; "
         "not contacts"
     )
-    if named:
-        said += ": " + "; ".join(w for _, w in named)
+    if shown:
+        said += ": " + "; ".join(f"{log}: {words}" for _, log, _, words in shown)
     return int(count), esc(said + ".")
 
 
@@ -161,7 +162,7 @@ def answer(run: RunFiles) -> Answer | None:
             f"No event, but {dropped} crossing(s) of a threshold too short to count "
             "(below the minimum duration)."
         )
-        level = "info"
+        level, label = "info", "no event"
     else:
         head, level = "No event: every residual stayed below its threshold.", "good"
     if said is not None:
