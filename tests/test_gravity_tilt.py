@@ -50,7 +50,8 @@ def test_the_tilt_columns_are_the_gravity_torques_derivative(panda):
 
 def test_a_residual_of_tilt_columns_gives_its_angles():
     """A residual made of the tilt columns times known angles plus white noise: the angles
-    come back within 3 standard deviations and the tilt is named; noise alone names none."""
+    come back within 3 standard deviations and the tilt is named, with the gravity vector
+    the data read as (the description's turned by them); noise alone names none."""
     robot = dynid.panda()
     rng = np.random.default_rng(11)
     q, _, _ = random_states(robot, 3000, seed=12)
@@ -60,6 +61,13 @@ def test_a_residual_of_tilt_columns_gives_its_angles():
     found = gravity_tilt(robot, q, e, sigma)
     assert found is not None and found.named
     assert np.all(np.abs(found.angle - angle) < 3 * found.std), (found.angle, found.std)
+    # the gravity vector the data read as: the description's turned by those angles
+    g0, g = robot.gravity, found.gravity
+    turned = g0 + np.cross([angle[0], angle[1], 0.0], g0)  # to first order in the angles
+    assert abs(np.linalg.norm(g) - np.linalg.norm(g0)) < 1e-12
+    tol = 3 * np.linalg.norm(found.std) * np.linalg.norm(g0) + 1e-4 * np.linalg.norm(g0 - turned)
+    np.testing.assert_allclose(g, turned, atol=tol)
+    assert f"gravity = [{g[0]:.4g}, {g[1]:.4g}, {g[2]:.4g}] m/s^2" in found.sentence()
     quiet = gravity_tilt(robot, q, rng.normal(0.0, 0.05, (3000, 7)), sigma)
     assert quiet is None or not quiet.named
 

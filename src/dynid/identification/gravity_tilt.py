@@ -32,6 +32,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from ..dynamics.terms import gravity_torques
 from ..model.robot import Robot
+from ..spatial import matrix_from_angle_axis
 
 __all__ = ["EXPLAINS", "SIGNIFICANT", "GravityTilt", "gravity_tilt", "tilt_columns"]
 
@@ -63,6 +64,10 @@ class GravityTilt:
         there.
     rows : ndarray of int, shape (M,)
         The residual's samples the tilt was estimated on (at most 4000, evenly spread).
+    gravity : ndarray, shape (3,)
+        The gravity vector [m/s^2] (base frame) the data read as: the description's rotated
+        by ``angle`` (the rotation vector ``(ax, ay, 0)``), what a description's
+        ``gravity`` would hold for them.
     """
 
     angle: NDArray[np.float64]
@@ -70,6 +75,7 @@ class GravityTilt:
     explained: float
     rest: NDArray[np.float64]
     rows: NDArray[np.intp]
+    gravity: NDArray[np.float64]
 
     @property
     def named(self) -> bool:
@@ -86,7 +92,8 @@ class GravityTilt:
             f"and {ay:.2g} deg about y (it explains {100 * min(self.explained, 1.0):.0f} % of "
             "the residual above the noise): check the robot's gravity vector / base "
             "orientation (the description's gravity or the base's mounting), not the "
-            "model's terms"
+            "model's terms; the data read as gravity = "
+            f"[{', '.join(f'{x:.4g}' for x in self.gravity)}] m/s^2 in the base frame"
         )
 
 
@@ -180,4 +187,5 @@ def gravity_tilt(
         explained=explained,
         rest=r - G @ theta,
         rows=rows,
+        gravity=matrix_from_angle_axis([theta[0], theta[1], 0.0]) @ np.asarray(robot.gravity),
     )
