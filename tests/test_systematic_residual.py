@@ -214,3 +214,24 @@ def test_the_remedy_names_only_what_the_model_lacks(panda):
     assert "dynid friction compares the laws" in v and "--friction-model" not in v
     assert held_terms(panda) == frozenset()
     assert held_terms(panda.with_spring(JointStiffness(np.ones(7), np.zeros(7)))) == {"spring"}
+
+
+def test_the_joints_diagnosed_are_those_the_verdicts_ratios_put_above_their_noise():
+    """Given the verdict's per-joint ratios (each sample weighed by its own noise), the
+    joints diagnosed are those above 1.25 by them, in their order, not by the plain RMS
+    over the mean noise: a joint at 1.4 x plainly but 1.1 x as judged is not named, one at
+    1.2 x plainly but 1.5 x as judged is (a residual of its position: a spring)."""
+    rng = np.random.default_rng(5)
+    N = 4000
+    q = rng.uniform(-1.0, 1.0, (N, 3))
+    dq = rng.normal(0.0, 1.0, (N, 3))
+    noise = np.array([0.1, 0.1, 0.1])
+    e = rng.normal(0.0, 0.1, (N, 3))
+    e[:, 0] += 0.1 * np.sqrt(1.4**2 - 1) * np.sign(q[:, 0])  # 1.4 x plainly
+    e[:, 1] += 0.1 * np.sqrt(1.2**2 - 1) * np.sign(q[:, 1])  # 1.2 x plainly
+    plain = residual_dependence([q], [dq], [e], noise)
+    assert [d.joint for d in plain] == [0]
+    judged = residual_dependence([q], [dq], [e], noise, np.array([1.1, 1.5, 1.0]))
+    assert [(d.joint, d.ratio) for d in judged] == [(1, 1.5)]
+    said = dependence_hint([q], [dq], [e], noise, ("a", "b", "c"), ratios=np.array([1.1, 1.5, 1]))
+    assert said is not None and said.startswith("b: ") and "follows its position" in said

@@ -170,6 +170,7 @@ class HeldOutTorques:
             self.joint_names,
             self.terms,
             self.tilt,
+            fl.joint_ratios,
         )
         verdict = with_derived_cutoff_hint(verdict, self.logs, self.cutoff_hz)
         verdict = with_hint(verdict, self.low_speed, ", ")

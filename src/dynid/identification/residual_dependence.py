@@ -71,6 +71,9 @@ class Dependence:
         (about the overall mean, the noise they keep taken out).
     mean : float
         The residual's mean [N m] (a constant: an offset).
+    ratio : float
+        The joint's error over its noise as the verdict judges it (each sample weighed by
+        its own noise), or ``rms / noise``: what orders the joints.
     """
 
     joint: int
@@ -79,6 +82,11 @@ class Dependence:
     position: float
     velocity: float
     mean: float
+    ratio: float = float("nan")
+
+    def __post_init__(self) -> None:
+        if not np.isfinite(self.ratio):
+            object.__setattr__(self, "ratio", self.rms / self.noise if self.noise > 0 else np.inf)
 
     @property
     def systematic(self) -> float:
@@ -101,6 +109,7 @@ def residual_dependence(
     dq: Sequence[NDArray[np.float64]],
     error: Sequence[NDArray[np.float64]],
     noise_rms: NDArray[np.float64],
+    ratios: NDArray[np.float64] | None = None,
 ) -> tuple[Dependence, ...]:
     """Each joint above :data:`~dynid.identification.verdict.SYSTEMATIC_RATIO` x its noise,
     its residual's dependence on its own position and velocity (module docstring).
@@ -113,6 +122,11 @@ def residual_dependence(
         Measured less predicted torques at the same samples [N m].
     noise_rms : ndarray, shape (n,)
         Each joint's noise [N m] (the sensors' and the states' through the model).
+    ratios : ndarray, shape (n,), optional
+        Each joint's error over its noise as the verdict judges it (the samples weighed by
+        their own noise: :attr:`~dynid.identification.input_noise.NoiseFloor.joint_ratios`),
+        which then says which joints are above their noise, so that the joints named are
+        the verdict's; default ``rms / noise_rms``.
 
     Returns
     -------
@@ -127,8 +141,9 @@ def residual_dependence(
     if E.shape[0] < BINS * MIN_PER_BIN or not np.all(np.isfinite(s)):
         return ()
     rms = np.sqrt(np.mean(E**2, axis=0))
+    judged = rms / s if ratios is None else np.asarray(ratios, dtype=np.float64)
     out = []
-    for j in np.flatnonzero(rms > SYSTEMATIC_RATIO * s):
+    for j in np.flatnonzero((judged > SYSTEMATIC_RATIO) & (rms > s)):  # a part to diagnose
         var = float(s[j]) ** 2
         out.append(
             Dependence(
@@ -138,6 +153,7 @@ def residual_dependence(
                 position=_binned(Q[:, j], E[:, j], var),
                 velocity=_binned(V[:, j], E[:, j], var),
                 mean=float(np.mean(E[:, j])),
+                ratio=float(judged[j]),
             )
         )
     return tuple(out)
@@ -197,6 +213,7 @@ def dependence_hint(
     joint_names: Sequence[str],
     terms: Collection[str] = (),
     tilt: GravityTilt | None = None,
+    ratios: NDArray[np.float64] | None = None,
 ) -> str | None:
     """:func:`residual_dependence` in words, one clause per joint above its noise joined by
     ``"; "`` (``"right_s1: 0.41 of 0.59 N m RMS residual follows its position (...)"``),
@@ -207,17 +224,18 @@ def dependence_hint(
     (:func:`~dynid.identification.gravity_tilt.gravity_tilt` of the pieces concatenated);
     when it explains the residual (:attr:`~dynid.identification.gravity_tilt.GravityTilt.
     named`) it is said first and the joints are diagnosed on what it leaves (a residual
-    the tilt explains is no spring's)."""
+    the tilt explains is no spring's). ``ratios``: the verdict's per joint
+    (:func:`residual_dependence`)."""
     if tilt is not None and tilt.named:
         rows = tilt.rows
         q = [np.concatenate([np.asarray(x, dtype=np.float64) for x in q])[rows]]
         dq = [np.concatenate([np.asarray(x, dtype=np.float64) for x in dq])[rows]]
         rest = dependence_hint(q, dq, [tilt.rest], noise_rms, joint_names, terms)
         return tilt.sentence() + ("" if rest is None else f"; what it leaves: {rest}")
-    found = residual_dependence(q, dq, error, noise_rms)
+    found = residual_dependence(q, dq, error, noise_rms, ratios)
     if not found:
         return None
-    worst = sorted(found, key=lambda d: d.rms / d.noise, reverse=True)
+    worst = sorted(found, key=lambda d: d.ratio, reverse=True)
     said = "; ".join(_sentence(d, joint_names[d.joint], terms) for d in worst[:NAMED])
     more = len(worst) - NAMED
     return said + (f" ({more} more joint(s) above their noise)" if more > 0 else "")
@@ -232,14 +250,16 @@ def with_dependence_hint(
     joint_names: Sequence[str],
     terms: Collection[str] = (),
     tilt: GravityTilt | None = None,
+    ratios: NDArray[np.float64] | None = None,
 ) -> Verdict:
     """``verdict`` with :func:`dependence_hint` appended when it is above the noise floor
     (not ``"good"``) and a joint is above its noise; else ``verdict`` itself. ``terms``: the
     model's (:func:`held_terms`); ``tilt``: the tilt of the gravity vector the residual
-    points to, said first when it explains it."""
+    points to, said first when it explains it; ``ratios``: the verdict's per joint, which
+    say which joints are above their noise."""
     if verdict.level == "good":
         return verdict
-    said = dependence_hint(q, dq, error, noise_rms, joint_names, terms, tilt)
+    said = dependence_hint(q, dq, error, noise_rms, joint_names, terms, tilt, ratios)
     return with_hint(verdict, said)
 
 
@@ -254,12 +274,11 @@ def outside_model_note(
     ``found`` is empty."""
     if not found:
         return None
-    found = sorted(found, key=lambda d: d.rms / d.noise, reverse=True)
+    found = sorted(found, key=lambda d: d.ratio, reverse=True)
     more = len(found) - NAMED
     found = found[:NAMED]
     which = ", ".join(
-        f"{joint_names[d.joint]} ({d.rms / d.noise:.3g} x its noise, {d.rms:.3g} N m RMS)"
-        for d in found
+        f"{joint_names[d.joint]} ({d.ratio:.3g} x its noise, {d.rms:.3g} N m RMS)" for d in found
     ) + (f" and {more} more joint(s)" if more > 0 else "")
     return (
         f"least squares itself leaves a systematic residual on {which}: an effect outside "

@@ -386,7 +386,9 @@ def _with_hints(
     dq = [v.log.dq for v in val.parts]
     q = [v.log.q for v in val.parts]
     if dependence:
-        verdict = with_dependence_hint(verdict, q, dq, error, noise.total, names, terms)
+        verdict = with_dependence_hint(
+            verdict, q, dq, error, noise.total, names, terms, ratios=noise.ratios
+        )
     verdict = with_derived_cutoff_hint(verdict, logs, val.pieces.cutoff_hz)
     high = derived_cutoff_hint(logs, val.pieces.cutoff_hz)
     if verdict.level == "good" and high is not None and noise.inputs is not None:
