@@ -183,7 +183,8 @@ class HeldOutTorques:
         (:func:`~dynid.identification.residual_dependence.residual_dependence`)."""
         v = self.validation
         fl = self._judged()[1]
-        return residual_dependence([v.log.q], [v.log.dq], [v.log.tau - v.tau_hat], fl.total_rms)
+        error = [v.log.tau - v.tau_hat]
+        return residual_dependence([v.log.q], [v.log.dq], error, fl.total_rms, fl.joint_ratios)
 
     @property
     def low_speed(self) -> str | None:
