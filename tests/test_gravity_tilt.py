@@ -123,6 +123,9 @@ def test_a_tilted_base_is_named_with_its_angle_not_called_a_spring(panda, tmp_pa
     m = re.search(r"tilted by about ([-0-9.e]+) deg about x", said)
     assert m is not None and abs(float(m[1]) - 0.3) < 0.03, said
     assert "check the robot's gravity vector / base orientation" in said, said
+    doc = held.as_dict()["gravity_tilt"]  # heldout.json's record of it
+    assert doc["named"] and abs(doc["angle_deg"][0] - 0.3) < 0.03, doc
+    np.testing.assert_allclose(doc["gravity"], truth.gravity, atol=0.1 * 0.0514)
     assert "spring" not in said, said
 
     held = _identified(panda, panda, tmp_path, "spring", spring=1.5)

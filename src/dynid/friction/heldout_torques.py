@@ -200,8 +200,9 @@ class HeldOutTorques:
         judging, each joint's error over its noise as the verdict weighs it
         (``joint_ratios``: the numbers its reason and the report name), the verdict (with
         its ``ratio`` to the floor, each sample weighed against its own noise) and, above
-        the floor, the low-speed note (``low_speed``, the report's own line; schema
-        ``heldout.json``)."""
+        the floor, the low-speed note (``low_speed``, the report's own line) and the tilt
+        of the gravity vector the residual points to (``gravity_tilt``, null when not
+        judged; schema ``heldout.json``)."""
         e, v, fl = self.validation.errors, self.verdict, self.floor
         return {
             "block": self.block,
@@ -218,6 +219,7 @@ class HeldOutTorques:
             "torque_spikes_replaced": self.spikes,
             "verdict": {"level": v.level, "label": v.label, "reason": v.reason, "ratio": v.ratio},
             "low_speed": None if v.level == "good" else self.low_speed,
+            "gravity_tilt": None if self.tilt is None else self.tilt.as_dict(),
             "units": {
                 "rms": "N m",
                 "noise_rms": "N m",

@@ -26,6 +26,7 @@ from __future__ import annotations
 
 from collections.abc import Callable
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -83,6 +84,18 @@ class GravityTilt:
         above the noise, the angle :data:`SIGNIFICANT` standard deviations clear."""
         z = float(np.linalg.norm(self.angle / np.maximum(self.std, 1e-300)))
         return self.explained >= EXPLAINS and z >= SIGNIFICANT
+
+    def as_dict(self) -> dict[str, Any]:
+        """JSON-ready: ``angle_deg`` and ``std_deg`` about base x and y [deg],
+        ``explained`` (share of the residual above the noise), ``named`` and the
+        ``gravity`` vector the data read as [m/s^2, base frame]."""
+        return {
+            "angle_deg": np.degrees(self.angle).tolist(),
+            "std_deg": np.degrees(self.std).tolist(),
+            "explained": float(self.explained),
+            "named": bool(self.named),
+            "gravity": self.gravity.tolist(),
+        }
 
     def sentence(self) -> str:
         """The finding in words, with the angles [deg] and what to check."""
