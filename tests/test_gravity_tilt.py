@@ -136,3 +136,25 @@ def test_a_tilted_base_is_named_with_its_angle_not_called_a_spring(panda, tmp_pa
     held = _identified(panda, panda, tmp_path, "level")
     assert held.tilt is None or not held.tilt.named
     assert "tilted" not in held.verdict.reason, held.verdict
+
+
+def test_validate_names_the_tilt_of_a_recording_against_a_robots_own_parameters(tmp_path):
+    """validate of a recording of a Panda tilted 0.3 deg about y against the level Panda's
+    own parameters (its published friction in both): the verdict names the tilt, its angle
+    within 10 %, and no spring; the level recording names none."""
+    from dynid.workflows.validate import ValidateOptions, validate_files
+
+    panda = dynid.panda()
+    tilted = panda.with_gravity(_rotation(1, np.radians(0.3)) @ panda.gravity)
+    noise = SensorNoise(tau_std=0.05, q_std=1e-5, dq_std=1e-3)
+    said = {}
+    for name, truth in (("tilted", tilted), ("level", panda)):
+        (log,) = recordings(truth, (71,), friction=panda.friction, duration=4.0, noise=noise)
+        save_torque_log(tmp_path / f"{name}.csv", log)
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore", DynidWarning)
+            res = validate_files(panda, tmp_path / f"{name}.csv", ValidateOptions())
+        said[name] = res.verdict.reason
+    m = re.search(r"0?\.?[0-9.e-]+ deg about x and ([-0-9.e]+) deg about y", said["tilted"])
+    assert m is not None and abs(float(m[1]) - 0.3) < 0.03, said["tilted"]
+    assert "spring" not in said["tilted"] and "tilted" not in said["level"], said

@@ -57,11 +57,12 @@ from ..identification.residual_dependence import (
 )
 from ..identification.sanity import despiked
 from ..identification.verdict import Verdict, with_caveat, with_hint, with_replaced_spikes
+from ..model.robot import Robot
 from .fit import model_drive, torques_through
 from .pooled import joined_validation
 from .validation import Validation, own_friction, validate_torques
 
-__all__ = ["HeldOutTorques", "heldout_torques"]
+__all__ = ["HeldOutTorques", "heldout_torques", "residual_tilt"]
 
 
 @dataclass(frozen=True, slots=True, eq=False)
@@ -391,30 +392,38 @@ def _held_out(
     held = HeldOutTorques(
         v, noise, block, names, read, given, caveat, spikes, inputs, held_terms(model)
     )
-    return dataclasses.replace(held, tilt=_tilt(model, v, held.floor.total_rms))
+    return dataclasses.replace(held, tilt=residual_tilt(model, [v], held.floor.total_rms))
 
 
-def _tilt(model: IdentifiedModel, v: Validation, noise: NDArray[np.float64]) -> GravityTilt | None:
-    """The tilt of the gravity vector the held-out residual of ``v`` points to, the model's
-    own columns projected out (:func:`~dynid.identification.gravity_tilt.gravity_tilt`)
-    and with them each joint's viscous, Coulomb, offset and rotor-inertia columns (terms
-    the structure chosen may have left out: a tilt the fit partly took as offsets made it
-    drop the offset of joint 3, which then pulled the tilt to 0.17 deg for 0.3);
-    None for a model whose drive converts the log (motor side, currents, offsets) or
-    without accelerations."""
-    log = v.log
-    if (model.drive is not None and not model.drive.is_identity) or log.ddq is None:
+def residual_tilt(
+    model: IdentifiedModel | Robot, parts: Sequence[Validation], noise: NDArray[np.float64]
+) -> GravityTilt | None:
+    """The tilt of the gravity vector the residual of the predictions ``parts`` points to
+    (:func:`~dynid.identification.gravity_tilt.gravity_tilt`; ``noise`` (n,) [N m] each
+    joint's): of an identified model, its own columns projected out and with them each
+    joint's viscous, Coulomb, offset and rotor-inertia columns (terms the structure chosen
+    may have left out: a tilt the fit partly took as offsets made it drop the offset of
+    joint 3, which then pulled the tilt to 0.17 deg for 0.3); of a robot's own
+    parameters, on the residual as it is. None for a model whose drive converts the log
+    (motor side, currents, offsets) or without accelerations."""
+    if not parts or any(p.log.ddq is None for p in parts):
+        return None
+    q, dq, tau = (np.concatenate([getattr(p.log, k) for p in parts]) for k in ("q", "dq", "tau"))
+    ddq = np.concatenate([np.asarray(p.log.ddq) for p in parts])
+    error = tau - np.concatenate([p.tau_hat for p in parts])
+    if isinstance(model, Robot):
+        return gravity_tilt(model, q, error, noise)
+    if model.drive is not None and not model.drive.is_identity:
         return None
     terms = tuple(t.term for t in model.terms.values())
-    ddq = log.ddq
+    n = q.shape[1]
 
     def columns(rows: NDArray[np.intp]) -> NDArray[np.float64]:
-        q, dq, a = log.q[rows], log.dq[rows], ddq[rows]
-        Y, _ = term_regressor(model.robot, model.base, terms, q, dq, a)
-        rotor = a[:, :, None] * np.eye(log.n)  # each joint's ddq: a rotor inertia
-        return np.concatenate([Y, friction_regressor(dq), rotor], axis=-1)
+        Y, _ = term_regressor(model.robot, model.base, terms, q[rows], dq[rows], ddq[rows])
+        rotor = ddq[rows][:, :, None] * np.eye(n)  # each joint's ddq: a rotor inertia
+        return np.concatenate([Y, friction_regressor(dq[rows]), rotor], axis=-1)
 
-    return gravity_tilt(model.robot, log.q, log.tau - v.tau_hat, noise, log.tau, columns)
+    return gravity_tilt(model.robot, q, error, noise, tau, columns)
 
 
 def _input_noise(

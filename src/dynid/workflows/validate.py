@@ -49,6 +49,7 @@ from numpy.typing import NDArray
 
 from ..exceptions import DataError, DynidWarning, OptionError
 from ..friction.fit import same_drive, torques_through
+from ..friction.heldout_torques import residual_tilt
 from ..friction.model import FrictionModel, FrictionSum, own_at_motors_note, placed_friction
 from ..friction.recordings import RecordingsValidation, validate_recordings
 from ..friction.validation import RECORDED, own_friction
@@ -332,7 +333,7 @@ def validate_files(
     # a motion beyond the identification's is the likelier cause of what the residual follows
     beyond = motion_range_hint(speeds, dq, names) is not None
     verdict = _with_hints(
-        verdict, val, rec.logs, noise, names, dependence=not beyond, terms=held_terms(model)
+        model, verdict, val, rec.logs, noise, names, dependence=not beyond, terms=held_terms(model)
     )
     verdict = with_motion_range_hint(verdict, speeds, dq, names)
     files = ", ".join(f"{n} {c}" for n, c in zip(rec.names, spikes, strict=True) if c)
@@ -368,6 +369,7 @@ def _identified_speeds(model: IdentifiedModel | Robot) -> Any:
 
 
 def _with_hints(
+    model: IdentifiedModel | Robot,
     verdict: Verdict,
     val: RecordingsValidation,
     logs: Sequence[TorqueLog],
@@ -380,14 +382,17 @@ def _with_hints(
     """``verdict`` with what the residual of each joint above its noise follows
     (:func:`~dynid.identification.residual_dependence.with_dependence_hint`; not with
     ``dependence`` False: a recording that moves beyond the identification's data, where
-    any residual follows the motion; ``terms`` the model's, which its remedies leave out),
-    the hint of a cut-off too high for derived states, and that of an error at low speed."""
+    any residual follows the motion; ``terms`` the model's, which its remedies leave out;
+    first the tilt of the gravity vector the residual points to, when it explains it:
+    :func:`~dynid.friction.heldout_torques.residual_tilt` of ``model``), the hint of a
+    cut-off too high for derived states, and that of an error at low speed."""
     error = [v.log.tau - v.tau_hat for v in val.parts]
     dq = [v.log.dq for v in val.parts]
     q = [v.log.q for v in val.parts]
     if dependence:
+        tilt = residual_tilt(model, val.parts, noise.total) if verdict.level != "good" else None
         verdict = with_dependence_hint(
-            verdict, q, dq, error, noise.total, names, terms, ratios=noise.ratios
+            verdict, q, dq, error, noise.total, names, terms, tilt, noise.ratios
         )
     verdict = with_derived_cutoff_hint(verdict, logs, val.pieces.cutoff_hz)
     high = derived_cutoff_hint(logs, val.pieces.cutoff_hz)
