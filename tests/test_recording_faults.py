@@ -399,3 +399,26 @@ def test_one_recording_of_another_convention_is_flipped_alone(panda, log, tmp_pa
         identify_files(panda, both, IdentifyOptions(columns=(None, "c.csv:tau4=-1")))
     with pytest.raises(DataError, match="a file's own entry flips single joints"):
         identify_files(panda, both, IdentifyOptions(columns=(None, "b.csv:tau=mNm")))
+
+
+def test_a_log_whose_comment_lines_say_currents_is_not_read_as_torques(panda, log, tmp_path):
+    """A CSV whose units line gives its tau columns in A (dynid's own ``tau [A]``, or
+    another tool's ``tau [A] (motor current)``), read without a drive of effort =
+    "current", is refused naming the unit and the remedy (before, its currents were fitted
+    as torques with no word); ``--units tau=Nm`` reads the columns as torques."""
+    from dynid.io.torque_log import declared_tau_unit
+    from dynid.workflows.identify import IdentifyOptions, identify_files
+
+    path = save_torque_log(tmp_path / "amps.csv", log)
+    text = path.read_text()
+    assert "tau [N m]" in text and declared_tau_unit(path) == "N m"
+    path.write_text(text.replace("tau [N m]", "tau [A]", 1))
+    assert declared_tau_unit(path) == "A"
+    with pytest.raises(DataError, match=r"tau columns in A \(motor currents\)") as exc:
+        identify_files(panda, [path])
+    assert 'effort = "current"' in str(exc.value) and "--units tau=Nm" in str(exc.value)
+    res = identify_files(panda, [path], IdentifyOptions(columns=(None, "tau=Nm")))
+    assert res.model.fit.beta.size > 0
+    other = tmp_path / "other.csv"
+    other.write_text("# controller export; units: t [s], q [rad], tau [A] (motor current)\n")
+    assert declared_tau_unit(other) == "A"

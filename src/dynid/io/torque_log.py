@@ -62,6 +62,7 @@ from .static_data import check_row_count
 
 __all__ = [
     "LABEL_COLUMNS",
+    "declared_tau_unit",
     "load_torque_log",
     "save_torque_log",
     "save_torque_log_pieces",
@@ -69,6 +70,31 @@ __all__ = [
 ]
 
 _log = logging.getLogger(__name__)
+
+
+#: A ``tau`` column's unit declared in a comment line: ``tau [A]``, ``tau (mA)``.
+_TAU_UNIT = re.compile(r"\btau\s*[\[(]\s*([^\])]+?)\s*[\])]")
+
+
+def declared_tau_unit(path: str | Path, lines: int = 20) -> str | None:
+    """The unit the comment lines (``#``) at the top of a CSV log give its ``tau``
+    columns (``"A"`` in dynid's own ``units: ... tau [A]``, or another tool's ``tau [A]
+    (motor current)``), or None: none said, not a CSV, or unreadable. Only the first
+    ``lines`` lines are read."""
+    path = Path(path)
+    if path.suffix.lower() != ".csv":
+        return None
+    try:
+        with open(path, encoding="utf-8", errors="replace") as f:
+            head = [f.readline() for _ in range(lines)]
+    except OSError:
+        return None
+    for line in head:
+        if not line.lstrip().startswith("#"):
+            break
+        if (m := _TAU_UNIT.search(line)) is not None:
+            return m.group(1).strip()
+    return None
 
 
 def _units(tau_unit: str) -> str:
