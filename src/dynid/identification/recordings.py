@@ -82,6 +82,7 @@ from .sanity import (
     despiked,
     noise_band,
     opposite_sign,
+    reversed_joint,
     spike_finding,
     velocity_noise_std,
 )
@@ -488,6 +489,8 @@ def prepare_recordings(
         cuts.append(max(0, len(mine) - 1))
         if mine:  # sign, units, frozen joints: on the whole recording, said once
             whole = joined([joint_side_log(p, drive) for p in mine])
+            if (mirrored := reversed_joint(robot, whole)) is not None:
+                raise DataError(mirrored, file=name)  # a fit would bend to mirrored motion
             if (opposite := opposite_sign(robot, whole)) is not None:
                 others = [joint_side_log(x, drive) for i, x in enumerate(logs) if i != r]
                 if any(opposite_sign(robot, x) is None for x in others):  # this one's alone
