@@ -675,10 +675,12 @@ def reversed_joint(robot: Robot, log: TorqueLog) -> str | None:
     motor friction, which the description lacks): with the joint reversed that residual
     is within :data:`NEGATED_DISTANCE_SHARE` of its RMS as read, where that is at least
     :data:`REVERSED_MODEL_SHARE` of the torques' RMS (a model that explains the log is not
-    questioned), and better than the joint's torque alone negated (then None: that is
-    :func:`opposite_sign`'s finding; where friction outweighs gravity on a joint, an
-    encoder reversed and a torque negated look alike, and the reversal must explain it
-    better). Judged before :func:`opposite_sign`, which read an encoder reversed as a
+    questioned), and below :data:`NEGATED_MODEL_SHARE` of it, and better than the joint's
+    torque alone negated or every torque negated (then None: that is
+    :func:`opposite_sign`'s finding, which a log of every torque negated, joint 2
+    reversed, explained to 0.41 of its residual as read; where friction outweighs gravity
+    on a joint, an encoder reversed and a torque negated look alike, and the reversal must
+    explain it better). Judged before :func:`opposite_sign`, which read an encoder reversed as a
     torque of the opposite sign and asked for ``tau3=-1``. Before, a
     geared arm's motor 3 logged reversed was fitted to 34 % error with a spring suggested
     on joint 3."""
@@ -712,7 +714,10 @@ def reversed_joint(robot: Robot, log: TorqueLog) -> str | None:
     if best is None or not best[0] < NEGATED_DISTANCE_SHARE**2 * read:
         return None
     left, j, motion, torque = best
-    if not motion:  # a torque alone of the opposite sign explains it best: opposite_sign's
+    if not motion or not left < NEGATED_MODEL_SHARE**2 * total:
+        return None  # a torque alone negated explains it best, or none explains it
+    negated = _left_over(-log.tau[at][ok] - model[ok], log.dq[at][ok], ddq[at][ok])
+    if negated <= left:  # every torque of the opposite sign: opposite_sign's
         return None
     name = robot.joint_names[j]
     cols = f"q{j + 1}=-1" + (f",tau{j + 1}=-1" if torque else "")
