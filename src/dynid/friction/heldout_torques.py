@@ -392,13 +392,14 @@ def _held_out(
     held = HeldOutTorques(
         v, noise, block, names, read, given, caveat, spikes, inputs, held_terms(model)
     )
-    return dataclasses.replace(held, tilt=residual_tilt(model, [v], held.floor.total_rms))
+    return dataclasses.replace(held, tilt=residual_tilt(model, v, held.floor.total_rms))
 
 
 def residual_tilt(
-    model: IdentifiedModel | Robot, parts: Sequence[Validation], noise: NDArray[np.float64]
+    model: IdentifiedModel | Robot, v: Validation, noise: NDArray[np.float64]
 ) -> GravityTilt | None:
-    """The tilt of the gravity vector the residual of the predictions ``parts`` points to
+    """The tilt of the gravity vector the residual of the prediction ``v`` points to (of
+    several pieces: :func:`~dynid.friction.pooled.joined_validation`)
     (:func:`~dynid.identification.gravity_tilt.gravity_tilt`; ``noise`` (n,) [N m] each
     joint's): of an identified model, its own columns projected out and with them each
     joint's viscous, Coulomb, offset and rotor-inertia columns (terms the structure chosen
@@ -406,11 +407,11 @@ def residual_tilt(
     joint 3, which then pulled the tilt to 0.17 deg for 0.3); of a robot's own
     parameters, on the residual as it is. None for a model whose drive converts the log
     (motor side, currents, offsets) or without accelerations."""
-    if not parts or any(p.log.ddq is None for p in parts):
+    log = v.log
+    if log.ddq is None:
         return None
-    q, dq, tau = (np.concatenate([getattr(p.log, k) for p in parts]) for k in ("q", "dq", "tau"))
-    ddq = np.concatenate([np.asarray(p.log.ddq) for p in parts])
-    error = tau - np.concatenate([p.tau_hat for p in parts])
+    q, dq, ddq, tau = log.q, log.dq, log.ddq, log.tau
+    error = tau - v.tau_hat
     if isinstance(model, Robot):
         return gravity_tilt(model, q, error, noise)
     if model.drive is not None and not model.drive.is_identity:

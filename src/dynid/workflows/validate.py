@@ -51,6 +51,7 @@ from ..exceptions import DataError, DynidWarning, OptionError
 from ..friction.fit import same_drive, torques_through
 from ..friction.heldout_torques import residual_tilt
 from ..friction.model import FrictionModel, FrictionSum, own_at_motors_note, placed_friction
+from ..friction.pooled import joined_validation
 from ..friction.recordings import RecordingsValidation, validate_recordings
 from ..friction.validation import RECORDED, own_friction
 from ..identification.derived_cutoff import derived_cutoff_hint, with_derived_cutoff_hint
@@ -390,7 +391,8 @@ def _with_hints(
     dq = [v.log.dq for v in val.parts]
     q = [v.log.q for v in val.parts]
     if dependence:
-        tilt = residual_tilt(model, val.parts, noise.total) if verdict.level != "good" else None
+        whole = joined_validation(val.parts) if verdict.level != "good" else None
+        tilt = None if whole is None else residual_tilt(model, whole, noise.total)
         verdict = with_dependence_hint(
             verdict, q, dq, error, noise.total, names, terms, tilt, noise.ratios
         )
