@@ -81,7 +81,7 @@ from .sanity import (
     check_torque_log,
     despiked,
     noise_band,
-    opposite_sign,
+    opposite_sign_among,
     reversed_joint,
     spike_finding,
     velocity_noise_std,
@@ -491,10 +491,8 @@ def prepare_recordings(
             whole = joined([joint_side_log(p, drive) for p in mine])
             if (mirrored := reversed_joint(robot, whole)) is not None:
                 raise DataError(mirrored, file=name)  # a fit would bend to mirrored motion
-            if (opposite := opposite_sign(robot, whole)) is not None:
-                others = [joint_side_log(x, drive) for i, x in enumerate(logs) if i != r]
-                if any(opposite_sign(robot, x) is None for x in others):  # this one's alone
-                    opposite = opposite_sign(robot, whole, file=name) or opposite
+            others = (joint_side_log(x, drive) for i, x in enumerate(logs) if i != r)
+            if (opposite := opposite_sign_among(robot, whole, name, others)) is not None:
                 raise DataError(opposite, file=name)  # a fit would negate the masses
             for finding in check_torque_log(robot, whole, drive):
                 found.setdefault(finding, []).append(name)

@@ -92,6 +92,7 @@ __all__ = [
     "gravity_loaded",
     "joint_rate_factor",
     "opposite_sign",
+    "opposite_sign_among",
     "reversed_joint",
     "REVERSED_MODEL_SHARE",
     "moving_joints",
@@ -531,6 +532,20 @@ def opposite_sign(robot: Robot, log: TorqueLog, *, file: str | None = None) -> s
         f"{'tau=-1' if file is None else _flips(range(robot.n), file)} if every joint's is "
         f"opposite, --units {_flips(seen, file)} if these only"
     )
+
+
+def opposite_sign_among(
+    robot: Robot, log: TorqueLog, name: str, others: Iterable[TorqueLog]
+) -> str | None:
+    """:func:`opposite_sign` of the recording ``log`` named ``name``, its hint the
+    recording's own entries (``rec2.csv:tau2=-1``) when one of the ``others`` (read
+    lazily, only when ``log`` is found of the opposite sign) reads right: then ``--units
+    tau2=-1`` would flip them too."""
+    if (found := opposite_sign(robot, log)) is None:
+        return None
+    if any(opposite_sign(robot, x) is None for x in others):
+        return opposite_sign(robot, log, file=name) or found
+    return found
 
 
 #: Position bins of the function of a joint's own position in :func:`_reads_right`.

@@ -53,6 +53,7 @@ from ..identification.sanity import (
     despiked,
     moving_joints,
     opposite_sign,
+    opposite_sign_among,
     sign_confirmed,
     spike_finding,
     time_unit_finding,
@@ -472,17 +473,14 @@ def check_signs(rec: Recorded, robot: Robot) -> None:
         columns to flip; of that recording alone, ``rec2.csv:tau2=-1``, when the others
         read right).
     """
-    found = []
-    for name, log in zip(rec.names, rec.joint_side, strict=True):
+    sides = rec.joint_side
+    for name, log in zip(rec.names, sides, strict=True):
         if (few := too_few_samples(log)) is not None:  # before the correlations
             raise DataError(few, file=name)
-        found.append(opposite_sign(robot, log))
-    for k, opposite in enumerate(found):
-        if opposite is None:
-            continue
-        if None in found:  # the others read right: this file's columns alone
-            opposite = opposite_sign(robot, rec.joint_side[k], file=rec.names[k])
-        raise DataError(str(opposite), file=rec.names[k])
+    for k, (name, log) in enumerate(zip(rec.names, sides, strict=True)):
+        others = (x for i, x in enumerate(sides) if i != k)
+        if (opposite := opposite_sign_among(robot, log, name, others)) is not None:
+            raise DataError(opposite, file=name)
 
 
 def check_torque_unit(rec: Recorded, robot: Robot, cmap: ColumnMap | None) -> None:
