@@ -46,6 +46,7 @@ __all__ = [
     "doubts_about",
     "inertia_doubts",
     "misfit_doubts",
+    "misfit_above",
     "misfit_ratio",
     "undetermined_inertia",
 ]
@@ -130,6 +131,14 @@ def misfit_ratio(residual_rms: float, noise_rms: float | None) -> float | None:
     return residual_rms / noise_rms if noise_rms else None
 
 
+def misfit_above(residual_rms: float, noise_rms: float | None) -> float | None:
+    """:func:`misfit_ratio` when above :data:`~dynid.identification.verdict.FLOOR_FAIR`
+    (a fit that leaves torques its model does not explain), else None: the one rule the
+    load's doubt and the torques' scale apply."""
+    ratio = misfit_ratio(residual_rms, noise_rms)
+    return ratio if ratio is not None and ratio > FLOOR_FAIR else None
+
+
 def misfit_doubts(
     residual_rms: float, noise_rms: float | None, *, difference: bool = False
 ) -> tuple[str, ...]:
@@ -142,8 +151,7 @@ def misfit_doubts(
     raised for it, :func:`~dynid.feasibility.payload_fit.misfit_covariance`), and no setLoad
     values are written; the likely causes and what to record (``difference``: the arm
     was identified from unloaded data already). Empty at or below the threshold."""
-    ratio = misfit_ratio(residual_rms, noise_rms)
-    if ratio is None or not ratio > FLOOR_FAIR:
+    if (ratio := misfit_above(residual_rms, noise_rms)) is None:
         return ()
     hint = (
         "identify the arm without the load with the terms these torques need (its friction "

@@ -34,8 +34,8 @@ from numpy.typing import NDArray
 
 from ..exceptions import RankDeficientError
 from ..identification.least_squares import fit_least_squares
-from ..identification.verdict import FLOOR_FAIR
 from ..model.drive import Drive
+from .payload_doubts import misfit_above
 from .payload_fit import (
     block_jackknife_covariance,
     held_out_widening,
@@ -197,9 +197,7 @@ def unjudged_ratio(scale: TorqueScale, noise_rms: float | None) -> float | None:
     when above :data:`~dynid.identification.verdict.FLOOR_FAIR`: the factor then takes
     torques the arm's model does not explain, and is not judged (no doubt, no load at the
     description's scale to trust); None at or below it, or with no noise known."""
-    if noise_rms and scale.residual_rms > FLOOR_FAIR * noise_rms:
-        return scale.residual_rms / noise_rms
-    return None
+    return misfit_above(scale.residual_rms, noise_rms)
 
 
 def scale_doubts(
