@@ -77,3 +77,40 @@ def test_an_armature_left_out_by_hand(logs):
     assert Structure.parse("armature, " + ", ".join(f"-Ia{j}" for j in range(1, 8))).collapsed(
         7
     ) == Structure(friction=())
+
+
+def test_a_regrouped_armature_names_the_base_parameter_that_holds_it(logs):
+    """Joints 1 and 2's armatures regroup with ``J1zz`` and ``J2zz`` (the classical
+    ``ZZ1R``, ``ZZ2R``: a rotor turning with the joint adds to the link's inertia about its
+    axis), the others are their own: the summary, identification.json and the report name
+    that base parameter instead of showing 0, and its identified value holds Ia1 (exact
+    data: the truth's combination with Ia1 = 0.30, not without it)."""
+    from dynid.cli.summaries import term_lines
+    from dynid.report.model_terms import terms_sections
+
+    panda, recs = logs
+    model = identify_recordings(
+        panda, recs, cutoff_hz=None, structure=Structure.parse("armature, viscous, -ia3, -ia5")
+    )
+    held = model.regrouped_in("rotor_inertia")
+    labels = model.terms["rotor_inertia"].labels
+    holder = held[labels.index("Ia1")]
+    assert holder and "+" not in holder and model.base.holding("J1zz") == (holder,)
+    assert model.base.holding("J2zz") == (held[labels.index("Ia2")],)
+    assert not any(held[labels.index(lab)] for lab in ("Ia4", "Ia6", "Ia7"))
+    k = model.base.labels.index(holder)
+    phi = np.concatenate([panda.phi.reshape(-1), np.zeros(model.base.n_std - 70)])
+    ia1 = model.base.std_labels.index("Ia1")
+    without = model.base.beta_from_phi(phi)[k]
+    phi[ia1] = ARMATURE[0]
+    np.testing.assert_allclose(model.fit.beta[k], model.base.beta_from_phi(phi)[k], atol=1e-6)
+    assert abs(model.fit.beta[k] - without) > 0.29
+    lines = "\n".join(term_lines(model))
+    legend = next(x for x in lines.splitlines() if "regrouped with link inertias" in x)
+    assert f"  1      in {holder}" in lines and holder in legend
+    doc = model_to_dict(model)
+    term = next(t for t in doc["terms"] if t["name"] == "rotor_inertia")
+    assert term["regrouped_in"][labels.index("Ia1")] == holder
+    html = "".join(terms_sections(doc))
+    assert f"in {holder} (regrouped)" in html
+    assert model_from_dict(doc).regrouped_in("rotor_inertia") == held

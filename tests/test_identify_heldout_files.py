@@ -68,7 +68,16 @@ def test_heldout_json_when_the_held_out_recording_has_a_gap(folder, tmp_path, ca
     base = ["identify", "--robot", "panda", "--terms", "viscous"]
     argv = [*base, "--data", str(folder / "r1.csv"), str(gap), "--out", str(tmp_path / "a")]
     assert main(argv) == 0
-    assert "skipped the held-out" not in capsys.readouterr().err
+    out, err = capsys.readouterr()
+    assert "skipped the held-out" not in err
+    # rows 300:550 of 250 Hz stamps from 0 s: the last stamp before the gap 299 / 250 s,
+    # the gap 251 steps long; each said where it is
+    rec = json.loads((tmp_path / "a" / "identification.json").read_text())
+    gaps = rec["metadata"]["recordings"][1]["gaps"]
+    assert "gaps" not in rec["metadata"]["recordings"][0]
+    assert len(gaps) == 1 and gaps[0] == pytest.approx([299 / 250, 251 / 250], abs=1e-9)
+    assert "gap.csv: 2 piece(s)" in out and "cut at the gap(s) after 1.196 s (1 s long)" in out
+    assert "2 (gap after 1.196 s, 1 s long)" in (tmp_path / "a" / "report.html").read_text()
     doc = _heldout(tmp_path / "a")
     assert "each of the 2 recordings" in doc["block"] and "(3 pieces between gaps)" in doc["block"]
     assert (tmp_path / "a" / "heldout_torques.png").is_file()

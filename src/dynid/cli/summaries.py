@@ -121,10 +121,10 @@ def format_identification(model: IdentifiedModel, *, width: int = 60) -> str:
 def term_lines(model: IdentifiedModel) -> list[str]:
     """The terms identified with the links (friction, armature), one table each: a row per
     joint (motor, where the term acts at the motors), a column per coefficient, each
-    value with its standard deviation in %; ``in beta`` where the coefficient is regrouped
-    into a base parameter (a rotor with a link's inertia), ``-`` where left out,
-    ``combined`` where it holds a coefficient left out as structurally combined with it
-    (named below the table with what it holds)."""
+    value with its standard deviation in %; ``in beta1`` where the coefficient is
+    regrouped into a base parameter (a rotor with a link's inertia: ``beta1 = J1zz + ... +
+    Ia1``), ``-`` where left out, ``combined`` where it holds a coefficient left out as
+    structurally combined with it (named below the table with what it holds)."""
     out: list[str] = []
     for name, t in model.terms.items():
         if not t.labels:
@@ -132,11 +132,12 @@ def term_lines(model: IdentifiedModel) -> list[str]:
         stems = list(dict.fromkeys(lab.rstrip("0123456789") for lab in t.labels))
         cells: dict[tuple[str, int], str] = {}
         units: dict[str, str] = {}
+        holders = model.regrouped_in(name)
         for k, lab in enumerate(t.labels):
             stem = lab.rstrip("0123456789")
             units[stem] = t.term.units[k] if k < len(t.term.units) else ""
             cells[(stem, int(lab[len(stem) :]))] = _coefficient(
-                float(t.values[k]), float(t.std[k]), bool(t.kept[k]), bool(t.regrouped[k])
+                float(t.values[k]), float(t.std[k]), bool(t.kept[k]), holders[k]
             ) + (f" {COMBINED}" if lab in model.info.combined and t.kept[k] else "")
         drive = getattr(t.term, "drive", None)
         row = "motor" if drive is not None and drive.friction_at == "motor" else "joint"
@@ -166,6 +167,12 @@ def term_lines(model: IdentifiedModel) -> list[str]:
                 f"  {MOTORS}: a motor turns joint(s) {', '.join(map(str, alone))} alone: "
                 "their friction at the joint acts on the motor's columns and is identified "
                 "in the motor's (its fc holds fc_motor + fc_joint / gear ratio)"
+            )
+        held = sorted({h for h in holders if h}, key=lambda h: (len(h), h))
+        if held:
+            out.append(
+                f"  in {'/'.join(held)}: regrouped with link inertias into that base "
+                "parameter (listed above); the data give the sum, not this coefficient alone"
             )
         out += _scales_lines(scales, model)
         out += _negative_viscous_line(t)
@@ -267,26 +274,42 @@ def _scales_lines(scales: dict[str, tuple[float, ...]], model: IdentifiedModel) 
     return out
 
 
-def _coefficient(value: float, std: float, kept: bool, regrouped: bool) -> str:
-    """One coefficient of a term's table (:func:`term_lines`)."""
+def _coefficient(value: float, std: float, kept: bool, holder: str) -> str:
+    """One coefficient of a term's table (:func:`term_lines`); ``holder``: the base
+    parameters a regrouped coefficient is in (``beta1``), or ``""``."""
     if not kept:
-        return "in beta" if regrouped else "-"
+        return f"in {holder}" if holder else "-"
     if not np.isfinite(std) or not value:
         return f"{value:+.4g}"
     return f"{value:+.4g} ({abs(100.0 * std / value):.2g} %)"
 
 
 def recordings_lines(recordings: Any) -> list[str]:
-    """One line per recording when there are several or one was cut into pieces."""
+    """One line per recording when there are several or one was cut into pieces, with
+    where each was cut (the time stamp before each gap and its length)."""
     recs = list(recordings or ())
     if len(recs) < 2 and all(r.get("pieces", 1) == 1 for r in recs):
         return []
     each = len(_decimations(recs)) > 1  # recordings at other rates: each its own
     return [
         f"recording {r['file']}: {r['pieces']} piece(s), {r['samples']} samples used "
-        f"({r['duration_s']:.4g} s" + (f", 1 in {r['decimate']}" if each else "") + f"){_lost(r)}"
+        f"({r['duration_s']:.4g} s"
+        + (f", 1 in {r['decimate']}" if each else "")
+        + ")"
+        + _gaps(r)
+        + _lost(r)
         for r in recs
     ]
+
+
+def _gaps(rec: Any) -> str:
+    """``, cut at gaps after 5.2 s (0.4 s long)`` (empty for a record without gaps)."""
+    gaps = rec.get("gaps") or []
+    if not gaps:
+        return ""
+    said = [f"{t:.4g} s ({length:.3g} s long)" for t, length in gaps[:4]]
+    more = f" and {len(gaps) - 4} more" if len(gaps) > 4 else ""
+    return f", cut at the gap(s) after {', '.join(said)}{more}"
 
 
 def _decimations(recordings: Any) -> tuple[int, ...]:

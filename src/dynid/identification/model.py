@@ -231,6 +231,25 @@ class IdentifiedModel:
             start += k
         return out
 
+    def regrouped_in(self, name: str) -> tuple[str, ...]:
+        """Per coefficient of the term ``name``: the base parameters that hold it where it
+        is regrouped with link inertias (``"beta1"`` for ``Ia1`` in ``beta1 = J1zz + ... +
+        Ia1``; several joined by ``+``), ``""`` where it is not (its own base parameter,
+        left out, or a term outside the base)."""
+        t = self.terms[name]
+        if not t.term.in_base:
+            return ("",) * len(t.labels)
+        start = 10 * self.robot.n
+        for other in self.terms.values():
+            if other.term.name == name:
+                break
+            if other.term.in_base:
+                start += len(other.labels)
+        return tuple(
+            "+".join(self.base.holding(self.base.std_labels[start + i])) if regrouped else ""
+            for i, regrouped in enumerate(t.regrouped)
+        )
+
     @property
     def description(self) -> Robot:
         """``robot`` with the description's link inertials (:attr:`description_phi`, or

@@ -38,6 +38,7 @@ __all__ = [
     "Q_START_TOLERANCE",
     "WRAP_SPAN",
     "check_below_nyquist",
+    "gaps_between",
     "joined",
     "nearest_turns",
     "recording_pieces",
@@ -102,6 +103,14 @@ def split_at_gaps(
     return [
         log.select(np.arange(a, b)) for a, b in zip(cuts[:-1], cuts[1:], strict=True) if b - a > 1
     ]
+
+
+def gaps_between(pieces: Sequence[TorqueLog]) -> tuple[tuple[float, float], ...]:
+    """The gaps between consecutive ``pieces`` of one recording (:func:`split_at_gaps`):
+    per gap the last time stamp before it and its length, both [s]."""
+    return tuple(
+        (float(a.t[-1]), float(b.t[0] - a.t[-1])) for a, b in zip(pieces, pieces[1:], strict=False)
+    )
 
 
 def wrappable(robot: Robot, drive: Drive | None = None) -> NDArray[np.bool_]:

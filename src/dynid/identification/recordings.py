@@ -60,6 +60,7 @@ from .log_rows import log_blocks, still_columns
 from .pieces import (
     WRAP_SPAN,
     check_below_nyquist,
+    gaps_between,
     joined,
     recording_pieces,
     skipped_piece,
@@ -194,6 +195,9 @@ class Recordings(TorqueRoute):
         :func:`~dynid.identification.log.default_max_gap` of each recording's step).
     cuts : tuple of int
         Per recording, the gaps longer than ``max_gap_s`` it was cut at.
+    gaps : tuple of tuple of (float, float)
+        Per recording, each gap it was cut at: the last time stamp before it [s, the
+        recording's own time] and its length [s] (empty: not recorded).
     n_recorded : int
         Samples of every recording as read (pieces left out included); 0: the pieces'.
     band_gain : float
@@ -215,6 +219,7 @@ class Recordings(TorqueRoute):
     bands: Mapping[str, NDArray[np.float64]] = dataclasses.field(default_factory=dict)
     max_gap_s: float | None = None
     cuts: tuple[int, ...] = ()
+    gaps: tuple[tuple[tuple[float, float], ...], ...] = ()
     n_recorded: int = 0
     band_gain: float = 1.0
     counts: tuple[SampleCounts, ...] = ()
@@ -342,7 +347,8 @@ class Recordings(TorqueRoute):
     def summary(self) -> tuple[dict[str, Any], ...]:
         """Per recording: ``file``, ``pieces``, ``samples`` used and ``duration_s`` used,
         ``decimate`` (every k-th sample kept: at its own rate, 10 times the cut-off or
-        more), and where the others went (:meth:`SampleCounts.as_dict`) when counted."""
+        more), the ``gaps`` it was cut at (``[t_before, length]`` [s] each, when any), and
+        where the others went (:meth:`SampleCounts.as_dict`) when counted."""
         out = []
         for r, name in enumerate(self.names):
             mine = [p for p, k in zip(self.pieces, self.recording, strict=True) if k == r]
@@ -353,6 +359,8 @@ class Recordings(TorqueRoute):
                 "duration_s": float(sum(p.log.duration for p in mine)),
                 "decimate": max(p.decimate for p in mine),
             }
+            if r < len(self.gaps) and self.gaps[r]:
+                rec["gaps"] = [[t, length] for t, length in self.gaps[r]]
             if self.counts:
                 rec.update(self.counts[r].as_dict())
             out.append(rec)
@@ -469,6 +477,7 @@ def prepare_recordings(
     pieces: list[tuple[int, TorqueLog]] = []
     turned: set[int] = set()
     cuts: list[int] = []
+    gaps: list[tuple[tuple[float, float], ...]] = []
     found: dict[str, list[str]] = {}  # each finding and the recordings it holds for
     wrapped: dict[str, list[str]] = {}  # each set of wrapped joints and its recordings
     for r, (name, log) in enumerate(zip(names, logs, strict=True)):
@@ -487,6 +496,7 @@ def prepare_recordings(
             motors = drive is not None and drive.side == "motor"
             wrapped.setdefault(wrapped_finding(joints, motors), []).append(name)
         cuts.append(max(0, len(mine) - 1))
+        gaps.append(gaps_between(mine))
         if mine:  # sign, units, frozen joints: on the whole recording, said once
             whole = joined([joint_side_log(p, drive) for p in mine])
             if (mirrored := reversed_joint(robot, whole)) is not None:
@@ -530,6 +540,7 @@ def prepare_recordings(
         band_gain=gain,
         max_gap_s=None if max_gap_s is None else float(max_gap_s),
         cuts=tuple(cuts),
+        gaps=tuple(gaps),
         n_recorded=sum(log.n_samples for log in logs),
         counts=tuple(
             SampleCounts(

@@ -46,14 +46,18 @@ TERM_RECORD = Record(
         "values": Field("numbers", required=True),
         "std": Field("numbers", required=True, null_items=True),
         "kept": Field("bools", required=True),
+        "regrouped_in": Field("strings"),
     }
 )
 
 
 def terms_to_list(model: IdentifiedModel) -> list[dict[str, Any]]:
-    """The ``terms`` of ``model``, JSON-ready, in order."""
-    return [
-        {
+    """The ``terms`` of ``model``, JSON-ready, in order; a term in the base with
+    coefficients regrouped with link inertias also names, per coefficient, the base
+    parameters that hold it (``regrouped_in``: ``"beta1"``, ``""`` where none)."""
+    out = []
+    for name, t in model.terms.items():
+        rec = {
             "name": t.term.name,
             "kind": t.term.kind,
             "definition": dict(t.term.definition()),
@@ -62,8 +66,11 @@ def terms_to_list(model: IdentifiedModel) -> list[dict[str, Any]]:
             "std": [finite_or_none(x) for x in t.std],
             "kept": [bool(x) for x in t.kept],
         }
-        for t in model.terms.values()
-    ]
+        held = model.regrouped_in(name)
+        if any(held):
+            rec["regrouped_in"] = list(held)
+        out.append(rec)
+    return out
 
 
 def friction_metadata(model: IdentifiedModel) -> dict[str, Any]:

@@ -135,6 +135,18 @@ class BaseParameters:
             raise ShapeError(f"phi must have shape (..., {self.n_std}); got {p.shape}")
         return p[..., self.independent] + p[..., self.dependent] @ self.K_d.T
 
+    def holding(self, label: str) -> tuple[str, ...]:
+        """The base parameters whose combination holds the standard parameter ``label``
+        (``("beta1",)`` for ``Ia1`` when ``beta1 = J1zz + ... + Ia1``); empty for a
+        standard parameter no base parameter holds (unidentifiable)."""
+        k = self.std_labels.index(label)
+        own = np.flatnonzero(np.asarray(self.independent) == k)
+        if own.size:
+            return (self.labels[int(own[0])],)
+        d = np.flatnonzero(np.asarray(self.dependent) == k)
+        col = np.asarray(self.K_d)[:, int(d[0])]
+        return tuple(self.labels[i] for i in np.flatnonzero(col))
+
     def meaning(self, combinations: Sequence[str], *, width: int = 60) -> str:
         """`` (where beta3 = J3zz + ..., ...)`` for the base labels that ``combinations``
         name (each expression cut at ``width`` characters), or ``""``."""

@@ -4,8 +4,10 @@ Every term the model holds beside the base parameters gets its table: friction a
 motors, friction at the joints (a coupled drive's ``at:both`` model holds both), the
 armature or rotor inertia and a joint spring. Each row is a motor (the term acts at the
 motors) or a joint; each column one kind of coefficient (``fv``, ``fc``, ``Ia``, ...) with
-its unit, the value ``± std`` in each cell. Files without ``terms`` (written before it) show
-the top-level ``friction`` matrix: ``fv, fc, fo`` per joint.
+its unit, the value ``± std`` in each cell (``in beta1`` where the coefficient is
+regrouped with link inertias into that base parameter: no value of its own). Files
+without ``terms`` (written before it) show the top-level ``friction`` matrix: ``fv, fc,
+fo`` per joint.
 """
 
 from __future__ import annotations
@@ -53,6 +55,7 @@ def _term_table(
     combined = combined or {}
     labels, values = term.get("labels") or [], term.get("values") or []
     std = term.get("std") or []
+    held = term.get("regrouped_in") or []
     at_motors = term.get("kind") == "rotor_inertia" or (
         (term.get("definition") or {}).get("at") == "motor"
     )
@@ -65,7 +68,9 @@ def _term_table(
             codes.append(code)
         s = std[k] if k < len(std) else None
         v = values[k] if k < len(values) else None
+        holder = str(held[k]) if k < len(held) and held[k] else ""
         text = cell(v) + (f" &plusmn; {number(s, 2)}" if is_number(s) else "")
+        text = f"in {esc(holder)} (regrouped)" if holder else text
         text += " (combined)" if str(lab) in combined else ""
         rows.setdefault(index, {})[code] = text
     body = []
@@ -87,6 +92,12 @@ def _term_table(
         if mine
         else ""
     )
+    regrouped = sorted({str(h) for h in held if h}, key=lambda h: (len(h), h))
+    if regrouped:
+        note += (
+            f"<p>regrouped: in {esc(', '.join(regrouped))}, with link inertias (see the base "
+            "parameters); the data give the sum, not this coefficient alone</p>"
+        )
     return table(headers, body) + note
 
 

@@ -38,7 +38,7 @@ from typing import Any
 
 from ..io.atomic import write_text
 from .answers import answer_for
-from .html import cell, esc, figure, href, size, table
+from .html import cell, esc, figure, href, number, size, table
 from .json_tables import json_section, key_numbers
 from .run import REPORT_NAME, ReportTable, RunFiles, RunSummary
 
@@ -125,8 +125,16 @@ def _recordings(docs: Mapping[str, Any]) -> dict[str, dict[str, Any]]:
         ):
             for r in recs if isinstance(recs, list) else ():
                 if isinstance(r, dict) and isinstance(r.get("file"), str):
-                    out.setdefault(r["file"], r)
+                    out[r["file"]] = {**r, **out.get(r["file"], {})}  # the first file's first
     return out
+
+
+def _pieces(rec: Mapping[str, Any]) -> str:
+    """A recording's pieces, with where it was cut: ``2 (gap after 1.2 s, 1 s long)``."""
+    gaps = [g for g in rec.get("gaps") or () if isinstance(g, list) and len(g) == 2]
+    said = "; ".join(f"gap after {number(t, 4)} s, {number(n, 3)} s long" for t, n in gaps[:4])
+    more = f"; {len(gaps) - 4} more" if len(gaps) > 4 else ""
+    return esc(rec.get("pieces", "")) + (f" ({said}{more})" if said else "")
 
 
 def _rows(path: Path) -> str:
@@ -180,7 +188,7 @@ def _inputs_html(
         rec = recs.get(p.name)
         counts = [] if not read else ["", "", ""]
         if rec is not None:
-            counts = [_rows(p), esc(rec.get("pieces", "")), esc(rec.get("samples", ""))]
+            counts = [_rows(p), _pieces(rec), esc(rec.get("samples", ""))]
         rows.append(
             [
                 f"<code>{esc(flag)}</code>",
