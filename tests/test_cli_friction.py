@@ -127,6 +127,10 @@ def test_friction_then_validate_write_json_and_figures(workdir, capsys):
     assert _png(fr / "friction.png")
     out = capsys.readouterr().out
     assert "RMS after" in out and "held-out [%]" in out and "* sigmoid" in out
+    # fitted on every k-th measured sample, k the identification's decimation, and said so
+    k = json.loads((workdir / "identification.json").read_text())["metadata"]["decimate"]
+    assert doc["metadata"]["decimate"] == k > 1
+    assert f"the torques as measured at every {k}th sample (the identification's" in out
     sel = doc["selection"]
     assert sel["chosen"] == "sigmoid" and sel["folds"] == 5
     held = {c["model"]: c["heldout_error_percent"] for c in sel["candidates"]}

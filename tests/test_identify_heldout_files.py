@@ -9,10 +9,12 @@ another arm (a UR10 identified with the UR5 model).
 from __future__ import annotations
 
 import json
+import warnings
 
 import pytest
 
 from dynid.cli.__main__ import main
+from dynid.exceptions import DynidWarning
 
 from conftest import robot_data_urdf
 
@@ -85,6 +87,18 @@ def test_heldout_json_when_the_held_out_recording_has_a_gap(folder, tmp_path, ca
     argv = [*base, "--data", str(folder / "r1.csv"), str(gap), "--no-figures"]
     assert main([*argv, "-q", "--out", str(tmp_path / "b")]) == 0
     assert _heldout(tmp_path / "b") == doc
+    # validate on a recording the model was fitted to is said to be a training error;
+    # one it did not see (r2.csv: the fit saw gap.csv) is not
+    model = str(tmp_path / "b" / "identification.json")
+    val = ["validate", "--model", model, "--no-figures", "--out", str(tmp_path / "v")]
+    capsys.readouterr()
+    for data, said in ((folder / "r1.csv", True), (folder / "r2.csv", False)):
+        with warnings.catch_warnings():
+            warnings.simplefilter("always", DynidWarning)  # this test ignores the others
+            assert main([*val, "--data", str(data)]) == 0
+        err = capsys.readouterr().err
+        assert ("r1.csv: the model was identified from" in err) is said
+        assert ("training errors, not a held-out judgement" in err) is said
 
 
 @pytest.mark.filterwarnings("ignore::dynid.exceptions.DynidWarning")

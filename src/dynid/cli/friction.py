@@ -19,8 +19,9 @@ The rigid-body model is not refitted per block: on the recordings --model was id
 from, the errors are training errors of the links (validate judges new data). --data
 takes several recordings (or a folder of them): each recording, and each piece of one
 cut at a gap longer than --max-gap, is filtered on its own, and the laws are fitted on
-the residual of all pieces together, at every sample as measured (the torques validate
-judges; a log of jittered stamps at its own samples, not on a grid between them).
+the residual of all pieces together, at the torques as measured (not low-passed: the
+torques validate judges; a log of jittered stamps at its own samples, not on a grid
+between them), every k-th sample of a model identified with a decimation of k.
 Coulomb friction is off where |dq| is inside the velocity noise band of the filtered
 velocities, the band identify gives its Coulomb terms on the same recordings. The states are
 low-pass filtered with zero phase (--cutoff) and the accelerations differentiated from
@@ -153,7 +154,7 @@ def run(args: argparse.Namespace, console: Console) -> int:
         )
     if sel is not None:
         console.print(sel.table())
-    console.print(format_friction_rms(names, fit, result.noise_std))
+    console.print(format_friction_rms(names, fit, result.noise_std, result.decimate))
     if result.pieces is not None:
         console.print(result.pieces.describe())
     console.wrote(args.out / "friction.json")

@@ -678,19 +678,33 @@ def format_rms_table(names: list[str], columns: dict[str, np.ndarray]) -> str:
     return "\n".join(rows)
 
 
-def format_friction_rms(names: list[str], fit: FrictionFit, noise: np.ndarray | None) -> str:
+def format_friction_rms(
+    names: list[str], fit: FrictionFit, noise: np.ndarray | None, decimate: int = 1
+) -> str:
     """``dynid friction``'s table: per joint the residual RMS before and after the friction
     [N m] and the torques' sensor noise, and what they are: on the recordings the friction
-    was fitted to, every sample as measured (the torques validate judges)."""
+    was fitted to, the torques as measured at every sample (every ``decimate``-th, the
+    identification's decimation)."""
     cols = {"RMS before [N m]": fit.rms_before, "RMS after [N m]": fit.rms_after}
     if noise is not None:
         cols["sensor noise [N m]"] = noise
+    at = (
+        "every sample"
+        if decimate <= 1
+        else f"every {_ordinal(decimate)} sample (the identification's decimation)"
+    )
     return (
         format_rms_table(names, cols)
         + "\nRMS on the recordings the friction was fitted to (training data of the friction, "
-        "and of the rigid-body model when identified from them), every sample as measured; "
-        "validate judges new recordings"
+        f"and of the rigid-body model when identified from them), the torques as measured at "
+        f"{at}; validate judges new recordings"
     )
+
+
+def _ordinal(k: int) -> str:
+    """``2nd``, ``3rd``, ``9th``, ``11th``, ``21st``."""
+    tail = "th" if 10 <= k % 100 <= 20 else {1: "st", 2: "nd", 3: "rd"}.get(k % 10, "th")
+    return f"{k}{tail}"
 
 
 def _rms_text(x: float) -> str:

@@ -13,8 +13,9 @@ kept in ``extra``.
 
 from __future__ import annotations
 
-from collections.abc import Mapping
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
+from pathlib import Path
 from typing import Any, Literal
 
 from .least_squares import StdMethod
@@ -200,3 +201,9 @@ class IdentificationInfo:
     selection: Mapping[str, Any] | None = None
     recordings: tuple[Mapping[str, Any], ...] = ()
     combined: Mapping[str, str] = field(default_factory=dict)
+
+    def fitted_on(self, names: Sequence[str]) -> tuple[str, ...]:
+        """Those of ``names`` (recordings' file names or paths) that name a recording the
+        model was identified from (by file name: the record holds no path)."""
+        fitted = {Path(str(r.get("file", ""))).name for r in self.recordings}
+        return tuple(n for n in names if Path(str(n)).name in fitted)

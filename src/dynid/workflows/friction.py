@@ -126,6 +126,9 @@ class FrictionFileResult:
         Per joint, the white-noise std [N m] of the measured torques
         (:func:`~dynid.friction.select.torque_noise_std`): what ``rms_after`` reaches for
         a correct model; None when not known.
+    decimate : int
+        Every ``decimate``-th measured sample of each piece was fitted (the model's
+        identification's decimation; 1: every sample).
     """
 
     fit: FrictionFit
@@ -134,6 +137,7 @@ class FrictionFileResult:
     cutoff_hz: float | None = None
     pieces: Pieces | None = None
     noise_std: NDArray[np.float64] | None = None
+    decimate: int = 1
 
     def metadata(self, model: str) -> dict[str, Any]:
         """The keys ``friction.json`` records beside the fit: the recordings, ``model``
@@ -147,6 +151,7 @@ class FrictionFileResult:
             "model": model,
             "cutoff_hz": self.cutoff_hz,
             "n_samples": self.fit.n_samples,
+            "decimate": self.decimate,
             "converged": [bool(x) for x in self.fit.converged],
             "noise_rms": None if self.noise_std is None else [float(x) for x in self.noise_std],
         }
@@ -211,26 +216,26 @@ def fit_friction_files(
             decimate=1,  # every sample, at its own time: the torques validate judges
             measured_samples=True,
         )
-        pieces = thinned(pieces, _recorded_decimation(model))  # samples, not averages
+        every = _recorded_decimation(model)
+        pieces = thinned(pieces, every)  # samples, not averages
         res = pieces_residual(model, pieces)
         cut = pieces.cutoff_hz
         if law == "auto":
             # the model identified from one of these recordings: its friction is judged by
             # its law refitted on the held-out folds' training data
-            here = isinstance(model, IdentifiedModel) and bool(
-                set(rec.names) & {str(r.get("file")) for r in model.info.recordings}
-            )
+            here = isinstance(model, IdentifiedModel) and bool(model.info.fitted_on(rec.names))
             # where it acts (a robot's where the drive puts it); a sum judged too
             own = own_friction(model, pieces.drive)
             sel = select_friction(
                 res, pieces.drive, own=own, own_fitted_here=here, dq_max=robot.dq_max
             )
-            return FrictionFileResult(sel.fit, res, sel, cut, pieces, torque_noise_std(res))
+            noise = torque_noise_std(res)
+            return FrictionFileResult(sel.fit, res, sel, cut, pieces, noise, every)
         chosen = fit_friction_through(res, pieces.drive, law)
         if law == "quadratic":
             _quadratic_at_bound(chosen)
         _say_not_dissipative(chosen, robot.dq_max)
-        return FrictionFileResult(chosen, res, None, cut, pieces, torque_noise_std(res))
+        return FrictionFileResult(chosen, res, None, cut, pieces, torque_noise_std(res), every)
 
     result: FrictionFileResult = in_file(rec.paths[0], fit) if len(rec.paths) == 1 else fit()
     return result

@@ -298,6 +298,7 @@ def validate_files(
         reference=_reference(model),
     )
     sign_map = _said_signs(rec, model, opt)  # before the verdict, naming the joints
+    _say_training_data(model, rec.names)
     rec, spikes = despiked_recordings(rec, robot.joint_names, SPIKES_BEFORE_JUDGING)
     friction, source = _friction(model, opt.friction, feasible, placed)
 
@@ -481,6 +482,22 @@ def _said_signs(rec: Recorded, model: IdentifiedModel | Robot, opt: ValidateOpti
         warnings.warn(text, DynidWarning, stacklevel=3)
     warn_signs(rec, ref, skip=tuple(found))
     return "; ".join(found.values()) or None
+
+
+def _say_training_data(model: IdentifiedModel | Robot, names: Sequence[str]) -> None:
+    """Warn when recordings of the names the model was identified from are validated on:
+    their errors are training errors, not a judgement on data the fit did not see."""
+    if not isinstance(model, IdentifiedModel):
+        return
+    if same := model.info.fitted_on(names):
+        warnings.warn(
+            f"{', '.join(same)}: the model was identified from recording(s) of "
+            f"{'this name' if len(same) == 1 else 'these names'}: the errors below are "
+            "training errors, not a held-out judgement; hint: validate on a recording the "
+            "fit did not see (identify's held-out verdict judges its own recordings)",
+            DynidWarning,
+            stacklevel=3,
+        )
 
 
 def _reference(model: IdentifiedModel | Robot) -> Robot | None:
