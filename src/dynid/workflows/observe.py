@@ -91,6 +91,7 @@ from ..observer.results import LogObservation, ObserveResult
 from ..observer.scoring import DEFAULT_TOLERANCE_S
 from ..observer.sign import TorqueSign, opposite_finding, unexplained_finding
 from ..observer.thresholds import ModelFingerprint
+from ..observer.unmodelled import FrictionTally
 from ..observer.wrench import wrench_kind, wrench_rank
 from ..progress import NOTE
 from .data_files import (
@@ -499,6 +500,7 @@ def observe_files(opts: ObserveOptions, sink: ResidualSink | None = None) -> Obs
         return dataclasses.replace(cal, thresholds=th, fingerprint=fingerprint, friction_source=own)
     paths = tuple(map(Path, read.paths))
     logs = []
+    unmodelled = None if model.friction is not None else FrictionTally(model.n, options.gain)
     kind = wrench_kind(opts.wrench)
     if opts.frame is not None:  # an unknown frame, a frame on the base: before any log
         wrench_rank(model.robot, opts.frame, kind)
@@ -527,11 +529,13 @@ def observe_files(opts: ObserveOptions, sink: ResidualSink | None = None) -> Obs
                 kind=kind,
                 labels=labels,
                 tolerance_s=opts.label_tolerance_s,
+                unmodelled=unmodelled,
             )  # fmt: skip
         )
     return ObserveResult(
         model, given, tuple(logs), fingerprint, own, opts.frame, kind,
         min_duration_s=opts.min_duration_s, merge_s=opts.merge_s,
+        unmodelled=None if unmodelled is None else unmodelled.result(),
     )  # fmt: skip
 
 
@@ -632,6 +636,7 @@ def _calibrated(
     logs: list[LogObservation] = []
     names = model.robot.joint_names
     tally = GainNoiseTally(model, np.asarray(options.gain, dtype=np.float64))
+    unmodelled = None if model.friction is not None else FrictionTally(model.n, options.gain)
 
     def blocks() -> Iterator[ObservedBlock]:
         for path, log, side in zip(read.paths, read.logs, read.joint_side, strict=True):
@@ -641,6 +646,8 @@ def _calibrated(
             sign = TorqueSign(model.n)
             q, dq = prep.log.q, prep.dq
             seen = model.friction
+            if unmodelled is not None:
+                unmodelled.new_log()
             for blk in observed_blocks(prep, model, options, wants_std, wants_margin):
                 if blk.friction is not None and blk.friction is not model.friction:
                     seen = blk.friction  # banded for the velocity noise (a note says so)
@@ -651,6 +658,8 @@ def _calibrated(
                 rows = slice(blk.a, blk.a + blk.r.shape[0])
                 sign.add(prep.log.tau[rows], blk.r)
                 tally.add(q[rows], dq[rows], blk.r)
+                if unmodelled is not None:  # the friction the model misses, at speed
+                    unmodelled.add(prep.log.t[rows], dq[rows], blk.r)
                 yield blk
             if (opposite := opposite_finding(sign, names)) is not None:
                 raise DataError(opposite, file=Path(path).name)
@@ -687,7 +696,13 @@ def _calibrated(
         collision_factor=opts.collision_factor,
         k_sigma=opts.k_sigma,
     )
-    return ObserveResult(model, th, tuple(logs), gain_noise=tally.result())
+    return ObserveResult(
+        model,
+        th,
+        tuple(logs),
+        gain_noise=tally.result(),
+        unmodelled=None if unmodelled is None else unmodelled.result(),
+    )
 
 
 def _std(x: ObservedBlock) -> NDArray[np.float64]:
