@@ -14,6 +14,7 @@ from numpy.typing import NDArray
 
 from ..exceptions import DataError
 from ..friction.model import FrictionModel, FrictionSum
+from .calibration_check import CalibrationCheck
 from .detection import ContactEvent, Thresholds
 from .events import DroppedCrossing
 from .friction import banding_note
@@ -203,7 +204,9 @@ class ObserveResult:
     ``min_duration_s`` and ``merge_s`` [s], the event rules a detection applied (None:
     calibrated); ``unmodelled``, of a model that holds no friction: the friction its
     residual shows at speed (:mod:`~dynid.observer.unmodelled`; None: a model with
-    friction, or no sample at speed)."""
+    friction, or no sample at speed); ``check``, of a calibration: its false alarms on its
+    own logs and the smallest external torques it detects
+    (:mod:`~dynid.observer.calibration_check`)."""
 
     model: ObserverModel
     thresholds: Thresholds
@@ -216,6 +219,7 @@ class ObserveResult:
     min_duration_s: float | None = None
     merge_s: float | None = None
     unmodelled: UnmodelledFriction | None = None
+    check: CalibrationCheck | None = None
 
     def dropped_count(self) -> int:
         """The crossings over the contact threshold every log's minimum duration dropped
