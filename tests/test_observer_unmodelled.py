@@ -89,3 +89,19 @@ def test_a_log_at_rest_says_it_cannot_measure():
     """No sample at speed: the note says the logs cannot tell, and how to add friction."""
     note = no_friction_note(None, ["a", "b"])
     assert "never move a joint fast enough" in note and note.endswith("--friction")
+
+
+def test_a_joint_moved_one_way_is_fitted_without_an_offset():
+    """A joint that only turns one way: its Coulomb term and an offset are one column, so
+    the fit leaves the offset out and reads the whole friction, ``fc + fv dq``, in a
+    synthetic residual ``-(0.4 + 0.2 dq)`` plus white noise (its RMS within 1 %)."""
+    rng = np.random.default_rng(8)
+    t = np.arange(0.0, 4.0, 1e-3)
+    dq = (0.5 + 0.3 * np.sin(2.0 * t))[:, None]
+    r = -(0.4 + 0.2 * dq) + 0.02 * rng.standard_normal(dq.shape)
+    tally = FrictionTally(1, np.array(50.0))
+    tally.add(t, dq, r)
+    found = tally.result()
+    truth = np.sqrt(np.mean((0.4 + 0.2 * dq[t > 0.1]) ** 2))
+    assert found is not None and found.seen[0]
+    np.testing.assert_allclose(found.size[0], truth, rtol=0.01)

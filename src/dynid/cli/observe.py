@@ -32,7 +32,11 @@ Two steps:
   whose torques have the opposite sign to the model's on some joint (the residual there
   twice the torque) is refused, naming the file and the joints.
   thresholds.json records the model's files and a SHA-256 of their content: detecting
-  with another model warns.
+  with another model warns. Whether the observer is good enough is printed below the
+  table, kept in thresholds.json's calibration and put first in the report: the false
+  alarms the thresholds raise on the calibration logs (the events --thresholds would
+  find there, and per minute) and the smallest external torque detected per joint while
+  it moves (the largest contact threshold along the motion; at rest: its column).
   --thresholds thresholds.json on any logs writes OUT/events.json (dynid-events/1: start
   and end [s], joints (1-based) and joint_names, peak [N m] per joint and level, contact
   or collision, and the log of every event), OUT/residuals.csv (t, r1..rn and, with

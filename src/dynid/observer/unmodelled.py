@@ -8,7 +8,8 @@ an external torque that is not one. At speed it is fitted per joint by
 
 .. math:: r_j = -(f_{c,j} \\operatorname{sign}\\dot q_j + f_{v,j} \\dot q_j) + o_j
 
-(least squares over running normal equations, a block of samples at a time), on the
+(least squares over running normal equations, a block of samples at a time; without the
+offset ``o_j`` for a joint that moved one way only, :data:`ONE_WAY`), on the
 samples where ``|dq_j|`` exceeds :data:`SPEED` and five velocity-noise stds and its sign
 has held for :data:`SETTLE` time constants ``1 / K_O`` (the lag has passed the step of
 the Coulomb term at a reversal). The size reported per joint is the RMS of the fitted
@@ -48,6 +49,9 @@ SETTLE = 5.0
 #: Chi-square (2 degrees of freedom) above which the fitted friction is seen: 13.8, a
 #: chance of 1e-3 for a model whose friction is right.
 CHI2_SEEN = 13.82
+#: Share of a joint's samples at speed in one direction above which its Coulomb term and an
+#: offset cannot be told apart: the fit then has no offset (the size an upper bound).
+ONE_WAY = 0.95
 #: Samples per joint at speed below which nothing is said of it.
 MIN_SAMPLES = 50
 
@@ -173,8 +177,10 @@ class FrictionTally:
             if N < MIN_SAMPLES:
                 continue
             G, b = self._AtA[j], self._Atr[j]
+            if abs(G[0, 2]) > ONE_WAY * N:  # moved one way only: no offset told apart
+                G, b = G[:2, :2], b[:2]
             x = np.linalg.lstsq(G, b, rcond=None)[0]
-            s2 = max(float(self._rr[j] - x @ b), 0.0) / max(N - 3, 1)
+            s2 = max(float(self._rr[j] - x @ b), 0.0) / max(N - G.shape[0], 1)
             inflation = max(1.0, 2.0 / (self.gain[j] * dt)) if dt > 0 else 1.0
             cov = s2 * inflation * np.linalg.pinv(G)
             Gf, xf, cf = G[:2, :2] / N, x[:2], cov[:2, :2]
