@@ -9,8 +9,11 @@ feasible.json with its drive and friction, a URDF, or a TOML robot with its [dri
 table); --drive gives the drive of a robot without one (as validate takes it; another
 drive than the model's or the feasible.json's is refused); --friction replaces the
 friction (a friction.json of `dynid friction`, with its standstill band). A model that
-holds no friction (identified from static data) leaves the joints' friction in the
-residual, where it reads as an external torque: a note says so; so does a note name
+holds no friction (identified from static data, a URDF without <dynamics friction>)
+leaves the arm's friction in the residual, where it reads as an external torque: a note
+says how much the logs' residual at speed holds per joint (RMS [N m] of a Coulomb and
+viscous fit while the joint moves; none above its noise: nothing to do) and the
+`dynid friction` command that identifies it for --friction; a note also names
 the friction a URDF brings of its own (<dynamics damping friction>) when no --friction
 is given, and a sharp Coulomb law without a standstill band (or with one well inside the
 velocity noise), which is observed with the noise band as its band.
@@ -29,7 +32,11 @@ Two steps:
   whose torques have the opposite sign to the model's on some joint (the residual there
   twice the torque) is refused, naming the file and the joints.
   thresholds.json records the model's files and a SHA-256 of their content: detecting
-  with another model warns.
+  with another model warns. Whether the observer is good enough is printed below the
+  table, kept in thresholds.json's calibration and put first in the report: the false
+  alarms the thresholds raise on the calibration logs (the events --thresholds would
+  find there, and per minute) and the smallest external torque detected per joint while
+  it moves (the largest contact threshold along the motion; at rest: its column).
   --thresholds thresholds.json on any logs writes OUT/events.json (dynid-events/1: start
   and end [s], joints (1-based) and joint_names, peak [N m] per joint and level, contact
   or collision, and the log of every event), OUT/residuals.csv (t, r1..rn and, with
@@ -245,8 +252,8 @@ def run(args: argparse.Namespace, console: Console) -> int:
     names = list(result.model.robot.joint_names)
     console.print(format_observation(result, names, calibrating=args.calibrate))
     for note in result.notes:
-        hint = "; --friction FILE (a friction.json of `dynid friction`) takes it out"
-        console.note(note + (hint if note == NO_FRICTION else ""))
+        asks = note.startswith(NO_FRICTION) and note.endswith("--friction")
+        console.note(note + (_friction_recipe(args) if asks else ""))
     meta = {"model": str(args.model or args.params), "source": result.model.source}
     saved = save_observation(
         args.out, result, joints=names, calibrating=args.calibrate, meta=meta, residuals=False
@@ -256,3 +263,13 @@ def run(args: argparse.Namespace, console: Console) -> int:
     if not args.no_figures:
         save_observer_figures(args.out, result, names=names)
     return 0
+
+
+def _friction_recipe(args: argparse.Namespace) -> str:
+    """The command line that identifies this model's friction, after a note on a model
+    without friction that asks for it."""
+    if args.model is None and str(args.params).endswith(".json"):
+        return ""  # a feasible.json: its friction comes from identify, with the links
+    source = f"--model {args.model}" if args.model is not None else f"--robot {args.params}"
+    data = " ".join(str(d) for d in args.data)
+    return f" (dynid friction {source} --data {data} --out fr; then --friction fr/friction.json)"

@@ -22,6 +22,7 @@ from ..identification.log import jitter_text
 from ..identification.model import IdentifiedModel
 from ..identification.structure import MIN_WIDTH, joint_side_joints
 from ..io.observer_files import log_labels
+from ..observer.calibration_check import CalibrationCheck
 from ..observer.detection import undetected_at_rest
 from ..observer.gain_noise import GainNoise
 from ..observer.results import LogObservation, ObserveResult, dropped_words, flagged_words
@@ -750,6 +751,26 @@ def _gain_noise_line(noise: GainNoise | None, names: Sequence[str]) -> list[str]
     ]
 
 
+def _check_lines(check: CalibrationCheck | None) -> list[str]:
+    """Whether the calibrated observer is good enough: its false alarms on its own logs
+    and the smallest external torque it detects per joint while moving."""
+    if check is None:
+        return []
+    out = []
+    if check.false_alarms is not None:
+        rate = check.false_alarms_per_min
+        out.append(
+            f"{check.false_alarms} false alarm(s) on the calibration logs"
+            + ("" if rate is None else f" ({rate:.3g} per minute)")
+        )
+    out.append(
+        "smallest external torque detected while a joint moves: "
+        + ", ".join(f"{v:.3g}" for v in check.detectable)
+        + " N m (the largest contact threshold along the motion)"
+    )
+    return out
+
+
 def _margin_peak(x: LogObservation) -> NDArray[np.float64] | None:
     """A log's largest standstill margin per joint [N m] (its own, or of its series)."""
     if x.standstill_peak is not None:
@@ -813,6 +834,7 @@ def format_observation(result: ObserveResult, names: list[str], *, calibrating: 
     if calibrating:
         rows += _gain_noise_line(result.gain_noise, names)
         rows.append(f"calibrated on {th.samples} samples of {len(result.logs)} log(s)")
+        rows += _check_lines(result.check)
         return "\n".join(rows)
     if "max |r|/contact" in cols:
         least = "" if result.min_duration_s is None else f" for {result.min_duration_s:g} s"

@@ -10,7 +10,13 @@
      "observer": {"gain": [...], "discretisation": "exact", "rule": "trapezoid"},
      "calibration": {"samples": N, "data": [file names], "model": ...,
                      "model_files": [...], "model_sha256": "...",  # what the model was
-                     "at_rest": [...]},   # N m per joint, with the standstill margin
+                     "at_rest": [...],    # N m per joint, with the standstill margin
+                     "duration_s": T,     # s, the calibration logs' total duration
+                     "false_alarms": k,   # events on them (null: not counted)
+                     "detectable": [...], # N m per joint, the smallest torque detected
+                                          # while the joint moves
+                     "peak": [...],       # N m per joint, the largest |r| read
+                     "sigma_max": [...]}, # N m per joint, the largest sigma (uncertainty)
      "units": {...}}
 
 ``events.json`` (schema ``dynid-events/1``): ``events``, a list of ``{"start", "end"}``
@@ -513,6 +519,15 @@ def save_observation(
         rest = undetected_at_rest(result.model, result.thresholds)
         if result.thresholds.standstill and np.any(rest > result.thresholds.contact):
             cal["at_rest"] = rest.tolist()  # the thresholds of a joint standing still
+        if (check := result.check) is not None:  # is the observer good enough
+            cal |= {
+                "duration_s": check.duration_s,
+                "false_alarms": check.false_alarms,
+                "detectable": check.detectable.tolist(),
+                "peak": check.peak.tolist(),
+            }
+            if check.sigma_max is not None:
+                cal["sigma_max"] = check.sigma_max.tolist()
         return [
             save_thresholds(
                 out / "thresholds.json", result.thresholds, joints=joints, calibration=cal

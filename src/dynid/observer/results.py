@@ -14,6 +14,7 @@ from numpy.typing import NDArray
 
 from ..exceptions import DataError
 from ..friction.model import FrictionModel, FrictionSum
+from .calibration_check import CalibrationCheck
 from .detection import ContactEvent, Thresholds
 from .events import DroppedCrossing
 from .friction import banding_note
@@ -21,6 +22,7 @@ from .gain_noise import GainNoise
 from .model import ObserverModel
 from .scoring import ContactScore, combined
 from .thresholds import ModelFingerprint
+from .unmodelled import UnmodelledFriction, no_friction_note
 from .wrench import FULL, WrenchEstimate, WrenchKind, underdetermined_note
 
 __all__ = [
@@ -200,7 +202,11 @@ class ObserveResult:
     or the force of a point contact); ``gain_noise``, of a calibration: how much of its
     residual is the velocities' noise times the gain (None: not calibrated);
     ``min_duration_s`` and ``merge_s`` [s], the event rules a detection applied (None:
-    calibrated)."""
+    calibrated); ``unmodelled``, of a model that holds no friction: the friction its
+    residual shows at speed (:mod:`~dynid.observer.unmodelled`; None: a model with
+    friction, or no sample at speed); ``check``, of a calibration: its false alarms on its
+    own logs and the smallest external torques it detects
+    (:mod:`~dynid.observer.calibration_check`)."""
 
     model: ObserverModel
     thresholds: Thresholds
@@ -212,6 +218,8 @@ class ObserveResult:
     gain_noise: GainNoise | None = None
     min_duration_s: float | None = None
     merge_s: float | None = None
+    unmodelled: UnmodelledFriction | None = None
+    check: CalibrationCheck | None = None
 
     def dropped_count(self) -> int:
         """The crossings over the contact threshold every log's minimum duration dropped
@@ -237,7 +245,9 @@ class ObserveResult:
     def notes(self) -> tuple[str, ...]:
         """What the run's reader should know, one line each: a model without friction
         (static data identify none) leaves the joints' friction in the residual, and in
-        thresholds calibrated on it, where it reads as an external torque; the friction
+        thresholds calibrated on it, where it reads as an external torque: how much the
+        logs show at speed per joint, or that they show none
+        (:func:`~dynid.observer.unmodelled.no_friction_note`); the friction
         a robot file holds of its own, used when none is given (a URDF's ``<dynamics>``:
         often a vendor's rough values); a friction
         whose Coulomb step is narrower than the logs' velocity noise is observed with the
@@ -245,7 +255,9 @@ class ObserveResult:
         fewer than six joints move is the least-norm one
         (:func:`~dynid.observer.wrench.underdetermined_note`), a force alone at a frame
         that fewer than three joints move too."""
-        out: tuple[str, ...] = (NO_FRICTION,) if self.model.friction is None else ()
+        out: tuple[str, ...] = ()
+        if self.model.friction is None:
+            out = (no_friction_note(self.unmodelled, self.model.robot.joint_names),)
         if self.model.friction is not None:
             own = None
             if self.friction_source is not None:
@@ -261,11 +273,8 @@ class ObserveResult:
         return out
 
 
-#: The note of a model that holds no friction (:attr:`ObserveResult.notes`).
-NO_FRICTION = (
-    "the model holds no friction: the joints' friction stays in the residual as an "
-    "external torque (and in thresholds calibrated on it)"
-)
+#: How the note of a model that holds no friction begins (:attr:`ObserveResult.notes`).
+NO_FRICTION = "the model holds no friction"
 
 
 def robot_friction_note(source: str, friction: FrictionModel | FrictionSum) -> str:

@@ -13,7 +13,7 @@ from __future__ import annotations
 
 from typing import Any
 
-from .html import esc, figure, href, is_number, section, verdict
+from .html import esc, figure, href, is_number, number, section, table, verdict
 from .json_tables import json_section
 from .run import Answer, RunFiles
 
@@ -28,28 +28,63 @@ def _events(doc: Any) -> list | None:
     return None
 
 
-def _calibration(doc: Any) -> str | None:
-    """What a calibration did, in one sentence (``thresholds.json``'s ``calibration``: the
-    samples and logs, and the thresholds' range over the joints, moving and, where the
-    file records them, standing still), or None when the file records none."""
+def _calibration(doc: Any) -> tuple[str, list[str]] | None:
+    """Whether a calibrated observer is good enough, from ``thresholds.json``'s
+    ``calibration``: the escaped headline (the logs, the false alarms the thresholds raise
+    on them and their rate per minute, the smallest detectable torque's range) and the
+    per-joint table (smallest torque detected while moving and at rest, the largest
+    ``|r|`` read, the thresholds), or None when the file records no calibration."""
     cal = doc.get("calibration") if isinstance(doc, dict) else None
     if not isinstance(cal, dict):
         return None
     logs = [str(d) for d in cal.get("data") or ()]
-    said = f"Thresholds calibrated on {cal.get('samples', 'the')} samples of {len(logs)} log"
-    said += ("s" if len(logs) != 1 else "") + (f" ({', '.join(logs)})" if logs else "")
-    ranges = [
-        f"{key} {_span(v)} N m" for key in ("contact", "collision") if _numbers(v := doc.get(key))
-    ]
+    said = "Thresholds calibrated on "
+    duration = cal.get("duration_s")
+    if is_number(duration):
+        said += f"{duration:.3g} s ({cal.get('samples', '?')} samples)"
+    else:
+        said += f"{cal.get('samples', 'the')} samples"
+    said += f" of {len(logs)} collision-free log" + ("s" if len(logs) != 1 else "")
+    said += f" ({', '.join(logs)})" if logs else ""
+    alarms = cal.get("false_alarms")
+    if is_number(alarms):
+        said += f": {int(alarms)} false alarm{'s' if alarms != 1 else ''} on them"
+        if is_number(duration) and duration > 0:
+            said += f" ({60.0 * alarms / duration:.3g} per minute)"
+    moving = cal.get("detectable") if _numbers(cal.get("detectable")) else doc.get("contact")
+    if _numbers(moving):
+        said += f"; an external torque above {_span(moving)} N m is detected while a joint moves"
     rest = cal.get("at_rest")
-    said += ": " + ", ".join(ranges) + " over the joints" if ranges else ""
-    if ranges and _numbers(rest):  # the standstill margin raises a still joint's threshold
-        said += (
-            " while they move; on a joint standing still (inside its friction's standstill "
-            f"band) a contact goes undetected below {_span(rest)} N m (its Coulomb level "
-            "plus the contact threshold)"
-        )
-    return said + "."
+    if _numbers(rest):
+        said += f", above {_span(rest)} N m on a joint at rest"
+    return esc(said + "."), [_joint_table(doc, cal)] if _numbers(moving) else []
+
+
+def _joint_table(doc: dict, cal: dict) -> str:
+    """Per joint: the smallest external torque detected while moving (the largest contact
+    threshold there) and at rest, the collision level while moving (``collision_factor``
+    times the first) and the largest ``|r|`` the calibration read [N m]."""
+    moving = cal.get("detectable") if _numbers(cal.get("detectable")) else doc.get("contact")
+    rule = doc.get("rule")
+    factor = rule.get("collision_factor") if isinstance(rule, dict) else None
+    collision = None
+    if is_number(factor) and isinstance(moving, list) and _numbers(moving):
+        collision = [factor * x for x in moving]
+    given = [
+        ("smallest torque detected, moving [N m]", moving),
+        ("at rest [N m]", cal.get("at_rest")),
+        ("collision level, moving [N m]", collision),
+        ("largest |r| read [N m]", cal.get("peak")),
+    ]
+    columns = [(h, v) for h, v in given if isinstance(v, list) and _numbers(v)]
+    n = len(columns[0][1])
+    names = doc.get("joints")
+    if not (isinstance(names, list) and len(names) == n):
+        names = [f"joint{j + 1}" for j in range(n)]
+    rows = [
+        [esc(names[j])] + [number(v[j]) if j < len(v) else "" for _, v in columns] for j in range(n)
+    ]
+    return table(["joint", *(h for h, _ in columns)], rows, cls="calibration")
 
 
 def _flagged(doc: Any) -> str:
@@ -151,26 +186,30 @@ def answer(run: RunFiles) -> Answer | None:
     calibrated = _calibration(run.docs.get(found["thresholds.json"] or ""))
     dropped, said = _dropped(run.docs.get(found["events.json"] or ""))
     if events is None and calibrated is not None:  # a calibration judges no events
-        head, level, label = calibrated, "info", "thresholds calibrated"
+        head, facts = calibrated[0], list(calibrated[1])
+        level, label = "info", "thresholds calibrated"
     elif events is None:
-        head, level = "The run wrote residuals; no events file to judge.", "fair"
+        head, level = esc("The run wrote residuals; no events file to judge."), "fair"
     elif events:
         head = f"{len(events)} event{'s' if len(events) != 1 else ''} detected"
-        head, level = head + _flagged(run.docs.get(found["events.json"] or "")) + ".", "info"
+        head += _flagged(run.docs.get(found["events.json"] or "")) + "."
+        head, level = esc(head), "info"
     elif dropped:
-        head = (
+        head = esc(
             f"No event, but {dropped} crossing(s) of a threshold too short to count "
             "(below the minimum duration)."
         )
         level, label = "info", "no event"
     else:
-        head, level = "No event: every residual stayed below its threshold.", "good"
+        head, level = esc("No event: every residual stayed below its threshold."), "good"
     if said is not None:
         facts.append(said)
     if (scored := _scored(run.docs.get(found["events.json"] or ""))) is not None:
         facts.append(scored)
+    if events is None and calibrated is not None and found["residuals.png"] is not None:
+        facts.append("The residual over the calibration with its thresholds: the figure below")
     if found["thresholds.json"] is not None:
-        facts.append("Thresholds: see the table below (from thresholds.json)")
+        facts.append("Thresholds: every entry in the table below (from thresholds.json)")
     if found["residuals.csv"] is not None:
         rel = found["residuals.csv"]
         facts.append(f'Residuals over time: <a href="{href(rel)}">{esc(rel)}</a>')
@@ -181,14 +220,15 @@ def answer(run: RunFiles) -> Answer | None:
             sections.append(section("events", title, json_section(name, run.docs[name])))
     if found["residuals.png"] is not None:
         rel = found["residuals.png"]
-        fig = figure(rel, run.files[rel], "Residuals and thresholds")
+        title = "Residuals and thresholds" + (" over the calibration" if events is None else "")
+        fig = figure(rel, run.files[rel], title)
         sections.append(section("residuals", "Residuals", fig))
     name = found["thresholds.json"]
     if name is not None and name in run.docs:
         sections.append(section("thresholds", "Thresholds", json_section(name, run.docs[name])))
     shown = frozenset(r for r in (found["residuals.png"],) if r is not None)
     return Answer(
-        verdict(level, esc(head), facts or ["Residuals, thresholds and events below"], label),
+        verdict(level, head, facts or ["Residuals, thresholds and events below"], label),
         tuple(sections),
         shown,
     )

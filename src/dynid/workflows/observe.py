@@ -82,6 +82,7 @@ from ..io.observer_files import load_thresholds
 from ..io.robot_file import load_robot
 from ..model.drive import Drive
 from ..model.robot import Robot
+from ..observer.calibration_check import CalibrationCheck, calibration_false_alarms, detectable
 from ..observer.detection import Thresholds, calibrate
 from ..observer.events import DEFAULT_MERGE_S, DEFAULT_MIN_DURATION_S
 from ..observer.gain_noise import GainNoiseTally
@@ -91,6 +92,7 @@ from ..observer.results import LogObservation, ObserveResult
 from ..observer.scoring import DEFAULT_TOLERANCE_S
 from ..observer.sign import TorqueSign, opposite_finding, unexplained_finding
 from ..observer.thresholds import ModelFingerprint
+from ..observer.unmodelled import FrictionTally
 from ..observer.wrench import wrench_kind, wrench_rank
 from ..progress import NOTE
 from .data_files import (
@@ -499,6 +501,11 @@ def observe_files(opts: ObserveOptions, sink: ResidualSink | None = None) -> Obs
         return dataclasses.replace(cal, thresholds=th, fingerprint=fingerprint, friction_source=own)
     paths = tuple(map(Path, read.paths))
     logs = []
+    unmodelled = (
+        None
+        if model.friction is not None
+        else FrictionTally(model.n, np.asarray(options.gain, dtype=np.float64))
+    )
     kind = wrench_kind(opts.wrench)
     if opts.frame is not None:  # an unknown frame, a frame on the base: before any log
         wrench_rank(model.robot, opts.frame, kind)
@@ -527,11 +534,13 @@ def observe_files(opts: ObserveOptions, sink: ResidualSink | None = None) -> Obs
                 kind=kind,
                 labels=labels,
                 tolerance_s=opts.label_tolerance_s,
+                unmodelled=unmodelled,
             )  # fmt: skip
         )
     return ObserveResult(
         model, given, tuple(logs), fingerprint, own, opts.frame, kind,
         min_duration_s=opts.min_duration_s, merge_s=opts.merge_s,
+        unmodelled=None if unmodelled is None else unmodelled.result(),
     )  # fmt: skip
 
 
@@ -632,6 +641,13 @@ def _calibrated(
     logs: list[LogObservation] = []
     names = model.robot.joint_names
     tally = GainNoiseTally(model, np.asarray(options.gain, dtype=np.float64))
+    unmodelled = (
+        None
+        if model.friction is not None
+        else FrictionTally(model.n, np.asarray(options.gain, dtype=np.float64))
+    )
+    sigma_max = np.zeros(model.n) if wants_std else None
+    r_max = np.zeros(model.n)  # the largest |r| of every log
 
     def blocks() -> Iterator[ObservedBlock]:
         for path, log, side in zip(read.paths, read.logs, read.joint_side, strict=True):
@@ -641,6 +657,8 @@ def _calibrated(
             sign = TorqueSign(model.n)
             q, dq = prep.log.q, prep.dq
             seen = model.friction
+            if unmodelled is not None:
+                unmodelled.new_log()
             for blk in observed_blocks(prep, model, options, wants_std, wants_margin):
                 if blk.friction is not None and blk.friction is not model.friction:
                     seen = blk.friction  # banded for the velocity noise (a note says so)
@@ -651,6 +669,12 @@ def _calibrated(
                 rows = slice(blk.a, blk.a + blk.r.shape[0])
                 sign.add(prep.log.tau[rows], blk.r)
                 tally.add(q[rows], dq[rows], blk.r)
+                if np.isfinite(blk.r).any():
+                    np.fmax(r_max, np.nanmax(np.abs(blk.r), axis=0), out=r_max)
+                if sigma_max is not None and blk.std is not None and np.isfinite(blk.std).any():
+                    np.fmax(sigma_max, np.nanmax(blk.std, axis=0), out=sigma_max)
+                if unmodelled is not None:  # the friction the model misses, at speed
+                    unmodelled.add(prep.log.t[rows], dq[rows], blk.r)
                 yield blk
             if (opposite := opposite_finding(sign, names)) is not None:
                 raise DataError(opposite, file=Path(path).name)
@@ -687,7 +711,33 @@ def _calibrated(
         collision_factor=opts.collision_factor,
         k_sigma=opts.k_sigma,
     )
-    return ObserveResult(model, th, tuple(logs), gain_noise=tally.result())
+    return ObserveResult(
+        model,
+        th,
+        tuple(logs),
+        gain_noise=tally.result(),
+        unmodelled=None if unmodelled is None else unmodelled.result(),
+        check=_checked(th, logs, sigma_max, r_max),
+    )
+
+
+def _checked(
+    th: Thresholds,
+    logs: list[LogObservation],
+    sigma_max: NDArray[np.float64] | None,
+    peak: NDArray[np.float64],
+) -> CalibrationCheck:
+    """The calibration's false alarms on its own logs (counted on their series when kept;
+    none by construction with the largest ``|r|``) and its smallest detectable torques
+    (:mod:`~dynid.observer.calibration_check`); ``peak`` the largest ``|r|`` [N m]."""
+    kept = all(x.r is not None for x in logs)
+    count = None
+    if kept:
+        count = calibration_false_alarms(th, ((x.t, x.series, x.std, x.standstill) for x in logs))
+    elif th.quantile >= 1.0:
+        count = 0  # every sample's |r| lies under margin (>= 1) times the largest
+    duration = float(sum(x.duration() for x in logs))
+    return CalibrationCheck(duration, count, sigma_max, detectable(th, sigma_max), peak)
 
 
 def _std(x: ObservedBlock) -> NDArray[np.float64]:

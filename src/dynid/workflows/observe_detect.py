@@ -44,6 +44,7 @@ from ..observer.scoring import (
 )
 from ..observer.sign import TorqueSign, opposite_finding
 from ..observer.thresholds import Thresholds, threshold_series
+from ..observer.unmodelled import FrictionTally
 from ..observer.wrench import FULL, WrenchEstimate, WrenchKind, external_wrench, wrench_rank
 from .data_files import in_file
 from .observe_logs import ObservedBlock, PreparedLog, Series, observed_rows
@@ -145,6 +146,7 @@ def detected_log(
     kind: WrenchKind = FULL,
     labels: Labels | None = None,
     tolerance_s: float = DEFAULT_TOLERANCE_S,
+    unmodelled: FrictionTally | None = None,
 ) -> LogObservation:
     """The events of one prepared log (module docstring; ``merge_s`` and ``min_duration_s``
     of :class:`~dynid.observer.events.EventDetector`), ``wants`` the residual's std and
@@ -153,7 +155,8 @@ def detected_log(
     the wrench or the force alone at ``frame``; the events scored against ``labels``
     (:func:`contact_labels`), else against the true torques stored beside the log (in
     contact above :data:`~dynid.observer.scoring.TRUTH_LEVEL`), with ``tolerance_s``
-    (:func:`scored`)."""
+    (:func:`scored`); ``unmodelled`` (a model without friction) is fed the samples under
+    the contact threshold."""
     log, n = prep.log, model.n
     starts = tuple(a for a, _ in prep.spans)
     det = EventDetector(thresholds, merge_s=merge_s, min_duration_s=min_duration_s, restarts=starts)
@@ -165,6 +168,8 @@ def detected_log(
     events: list[ContactEvent] = []
     wrenches: list[WrenchEstimate] = []
     seen = model.friction
+    if unmodelled is not None:
+        unmodelled.new_log()
     with about_file(prep.path.name), table or nullcontext(None) as put:
         for blk in observed_rows(prep, model, options, *wants):
             a, b = blk.a, blk.a + blk.r.shape[0]
@@ -178,6 +183,9 @@ def detected_log(
                 wrenches.append(w)
             stats.add(blk.r, blk.margin, None if ext is None else ext[a:b])
             sign.add(log.tau[a:b], blk.r)
+            if unmodelled is not None:  # the friction the model misses, contacts left out
+                contact, _ = threshold_series(thresholds, b - a, blk.std, blk.margin)
+                unmodelled.add(log.t[a:b], prep.dq[a:b], blk.r, ~(np.abs(blk.r) > contact))
             if keep is not None:
                 keep.put(blk)
             if strided is not None:

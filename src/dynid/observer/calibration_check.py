@@ -1,0 +1,90 @@
+"""Is a calibrated observer good enough: its false alarms on the calibration logs and the
+smallest external torque it detects.
+
+A calibration answers two questions beside its thresholds. *False alarms*: the events the
+detector (:func:`~dynid.observer.events.detect`, the default event rules) raises on the
+collision-free logs the thresholds came from, per minute of them; with ``--quantile`` 1
+none by construction (every sample's ``|r|`` lies under ``margin`` times the largest), with
+a lower quantile the samples above it may raise some. *Smallest detectable torque*: a
+constant external torque ``A`` on joint ``j`` moves its residual to ``A`` after the
+observer's lag and crosses the contact threshold once ``A`` exceeds it, so the smallest
+torque detected wherever the joint moves along the calibration motion is the largest
+contact threshold there, ``nu_j + k max_t sigma_j(t)`` (``nu`` the noise floor, ``sigma``
+the model's uncertainty propagated along the motion: :mod:`~dynid.observer.detection`), or
+the fixed threshold without the uncertainty; the standstill margin aside (a joint at rest:
+:func:`~dynid.observer.detection.undetected_at_rest`).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Iterable
+from dataclasses import dataclass
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+
+from .events import detect
+from .thresholds import Thresholds
+
+__all__ = ["CalibrationCheck", "calibration_false_alarms", "detectable"]
+
+
+@dataclass(frozen=True, slots=True, eq=False)
+class CalibrationCheck:
+    """What a calibration says of the observer (module docstring).
+
+    Attributes
+    ----------
+    duration_s : float
+        The calibration logs' total duration [s].
+    false_alarms : int or None
+        Events on the calibration logs against their thresholds (None: not counted, the
+        residual not kept with a quantile below 1).
+    sigma_max : ndarray, shape (n,), or None
+        The largest ``sigma_j(t)`` over the calibration samples [N m] (None: thresholds
+        without the uncertainty).
+    detectable : ndarray, shape (n,)
+        The smallest external torque detected wherever the joint moves [N m].
+    peak : ndarray, shape (n,)
+        The largest ``|r|`` of the calibration logs [N m].
+    """
+
+    duration_s: float
+    false_alarms: int | None
+    sigma_max: NDArray[np.float64] | None
+    detectable: NDArray[np.float64]
+    peak: NDArray[np.float64]
+
+    @property
+    def false_alarms_per_min(self) -> float | None:
+        """False alarms per minute of the calibration logs (None: not counted, or no
+        time logged)."""
+        if self.false_alarms is None or not self.duration_s > 0:
+            return None
+        return 60.0 * self.false_alarms / self.duration_s
+
+
+def detectable(thresholds: Thresholds, sigma_max: ArrayLike | None) -> NDArray[np.float64]:
+    """The smallest external torque [N m] (n,) detected wherever a joint moves: ``nu +
+    k sigma_max`` for thresholds with the uncertainty (``sigma_max`` (n,) [N m], the
+    largest ``sigma`` over the calibration), else the fixed contact threshold."""
+    if thresholds.uses_uncertainty and sigma_max is not None:
+        assert thresholds.noise is not None and thresholds.k_sigma is not None
+        s = np.asarray(sigma_max, dtype=np.float64)
+        return np.asarray(thresholds.noise + thresholds.k_sigma * s, dtype=np.float64)
+    return np.array(thresholds.contact, dtype=np.float64)
+
+
+def calibration_false_alarms(
+    thresholds: Thresholds,
+    logs: Iterable[tuple[NDArray[np.float64], NDArray[np.float64], NDArray | None, NDArray | None]],
+) -> int:
+    """Events the default rules raise on the calibration logs, each ``(t, r, std,
+    standstill)``: times [s] (N,), residual, its std and standstill margin [N m] (N, n;
+    None where the thresholds do not use them)."""
+    count = 0
+    for t, r, std, still in logs:
+        std = std if thresholds.uses_uncertainty else None
+        still = still if thresholds.standstill else None
+        count += len(detect(t, r, thresholds, std=std, standstill=still))
+    return count

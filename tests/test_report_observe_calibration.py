@@ -1,0 +1,83 @@
+"""The first screen of a calibration's report: is the observer good enough.
+
+It listed only the thresholds table. It now opens with the false alarms on the
+calibration logs (count and rate per minute), the smallest external torque detected per
+joint, the residual's figure with the thresholds, then the table. References: the
+numbers recomputed from thresholds.json and from events.json of a detection run with
+those thresholds on the same log, and the log's own duration.
+"""
+
+from __future__ import annotations
+
+import json
+import re
+
+import numpy as np
+import pytest
+
+import dynid
+from dynid.cli.__main__ import main
+from dynid.io.torque_log import save_torque_log
+from dynid.report.html import number
+from dynid.simulation.measurement import SensorNoise, sample_times, simulate_measurement
+from dynid.simulation.trajectories import random_fourier
+
+
+@pytest.fixture(scope="module")
+def free(tmp_path_factory):
+    """A collision-free 3 s, 500 Hz noisy log of the Panda with its own friction."""
+    panda = dynid.panda()
+    rng = np.random.default_rng(44)
+    traj = random_fourier(panda, rng)(sample_times(3.0, 500.0))
+    log = simulate_measurement(panda, traj, rng=rng, noise=SensorNoise())
+    return save_torque_log(tmp_path_factory.mktemp("cal") / "free.csv", log), log
+
+
+@pytest.mark.parametrize("rule", [[], ["--margin", "1", "--quantile", "0.6"]])
+def test_the_calibration_report_opens_with_false_alarms_detectable_torques_and_figure(
+    free, tmp_path, rule
+):
+    """The answer box holds the false alarms (equal to the events a detection with the
+    thresholds finds on the same log) and their rate per minute of the log, the smallest
+    detectable torque of every joint (the contact threshold of thresholds.json), and the
+    figure comes before the thresholds table."""
+    path, log = free
+    cal, det = tmp_path / "cal", tmp_path / "det"
+    base = ["observe", "--params", "panda", "--data", str(path)]
+    assert main([*base, "--calibrate", *rule, "--out", str(cal)]) == 0
+    th = json.loads((cal / "thresholds.json").read_text())
+    assert main([*base, "--thresholds", str(cal / "thresholds.json"), "--no-figures",
+                 "--out", str(det)]) == 0  # fmt: skip
+    events = json.loads((det / "events.json").read_text())["events"]
+    page = (cal / "report.html").read_text()
+    answer = page[page.index('id="verdict"') : page.index("</section>", page.index('id="verdict"'))]
+    k, duration = len(events), float(log.t[-1] - log.t[0])
+    assert th["calibration"]["false_alarms"] == k and th["calibration"]["duration_s"] == duration
+    word = "false alarm" if k == 1 else "false alarms"
+    assert f"{k} {word} on them ({60.0 * k / duration:.3g} per minute)" in answer
+    assert (k > 0) == bool(rule)  # the lower quantile leaves samples over the threshold
+    cells = re.findall(r"<tr><td>(joint\d)</td><td>([^<]*)</td>", answer)
+    assert [c[0] for c in cells] == [f"joint{j}" for j in range(1, 8)]
+    assert [c[1] for c in cells] == [number(x) for x in th["contact"]]  # no uncertainty
+    assert f"above {min(th['contact']):.3g}-{max(th['contact']):.3g} N m" in answer
+    figure, thresholds = page.index('id="residuals"'), page.index('id="thresholds"')
+    assert figure < thresholds and "<img" in page[figure:thresholds]
+
+
+def test_the_smallest_detectable_torque_grows_with_the_largest_uncertainty():
+    """With the model's uncertainty the contact threshold while moving is ``nu + k
+    sigma(t)``: its largest value, ``nu + k max sigma``, is the smallest torque detected
+    wherever the joint moves; without it, the fixed threshold."""
+    from dynid.observer.calibration_check import CalibrationCheck, detectable
+    from dynid.observer.residual import ObserverOptions
+    from dynid.observer.thresholds import Thresholds
+
+    nu, s = np.array([0.5, 0.2]), np.array([0.1, 0.02])
+    fixed = Thresholds(np.array([0.9, 0.3]), np.array([1.8, 0.6]), 1.5, 1.0, 2.0,
+                       ObserverOptions(), 100)  # fmt: skip
+    grown = Thresholds(np.array([0.9, 0.3]), np.array([1.8, 0.6]), 1.5, 1.0, 2.0,
+                       ObserverOptions(), 100, k_sigma=3.0, noise=nu)  # fmt: skip
+    np.testing.assert_allclose(detectable(grown, s), [0.8, 0.26], rtol=1e-12)
+    np.testing.assert_allclose(detectable(fixed, s), [0.9, 0.3], rtol=1e-12)
+    check = CalibrationCheck(30.0, 2, s, detectable(grown, s), np.array([0.3, 0.1]))
+    assert check.false_alarms_per_min == pytest.approx(4.0, rel=1e-12)
