@@ -383,11 +383,10 @@ def identify_payload(
     if base is not None and isinstance(unloaded, StaticDataset) != static:
         raise ShapeError("unloaded must be the same kind of data as data (static or log)")
     notes: list[str] = []
-    A = link_params_from_frame(f.T_link_frame)
-    cols = slice(10 * (k - 1), 10 * k)
+    A, cols = link_params_from_frame(f.T_link_frame), slice(10 * (k - 1), 10 * k)
     kept: NDArray[np.bool_] | None = None
     record: dict[str, Any] = {}
-    against: _Unloaded | None = None
+    against: _Unloaded | None = None  # the arm's residual without the load (logs)
     described = _description(arm, d, friction)
     if isinstance(data, StaticDataset):
         empty = None if base is None else cast(StaticDataset, base[0])
@@ -404,8 +403,8 @@ def identify_payload(
         )
     fit = (W, yv, kept, 4 if (static and gravity_only) else 10, static, rtol, margin)
     route += ", difference" if differenced else ""
-    scale_rows = None if described is None else scale
-    return _estimate(*fit, kin, frame, route, notes, record, differenced, scale_rows, d, against)
+    scaled = None if described is None else scale
+    return _estimate(*fit, kin, frame, route, notes, record, differenced, scaled, d, against)
 
 
 def _static_route(
