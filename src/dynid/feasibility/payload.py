@@ -70,7 +70,11 @@ leaves go into the mass and CoM too (an unmodelled spring at 74 x the noise read
 load as 1.04 kg), so the whole load is a doubt
 (:func:`~dynid.feasibility.payload_doubts.misfit_doubts`), its inertia not determined, and
 the standard deviations are raised to the largest change an unmodelled torque as large
-as the misfit can make (:func:`~dynid.feasibility.payload_fit.misfit_covariance`).
+as the misfit can make (:func:`~dynid.feasibility.payload_fit.misfit_covariance`). With
+recordings of the same motion without the load, the residual judged is the loaded fit's
+less the unloaded arm's at matched states, against the noise of both
+(:mod:`dynid.feasibility.payload_difference`, :attr:`PayloadEstimate.judged`): an arm's
+misfit common to both cancels, a load that moved does not.
 """
 
 from __future__ import annotations

@@ -26,7 +26,10 @@ verdict and the torques' scale apply) is the arm's model missing torques, which 
 the mass and CoM as well as the inertia, by more than the residual's covariance says: the
 whole load is in doubt, no setLoad values are written, and its standard deviations are
 raised to the largest change an unmodelled torque as large as the misfit can make
-(:func:`~dynid.feasibility.payload_fit.misfit_covariance`).
+(:func:`~dynid.feasibility.payload_fit.misfit_covariance`). With recordings of the same
+motion without the load, the residual judged is the loaded fit's less the unloaded arm's
+at matched states (:mod:`~dynid.feasibility.payload_difference`): an arm's misfit common
+to both does not doubt the load, what the load leaves unexplained does.
 """
 
 from __future__ import annotations
