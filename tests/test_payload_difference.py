@@ -12,6 +12,7 @@ from __future__ import annotations
 
 import dataclasses
 import json
+import re
 import warnings
 
 import numpy as np
@@ -22,7 +23,9 @@ from dynid.cli.__main__ import main
 from dynid.feasibility.payload import identify_payload
 from dynid.feasibility.payload_difference import MATCH_DISTANCE, matched_residual
 from dynid.identification.log import TorqueLog
+from dynid.identification.selection import identify_recordings
 from dynid.identification.structure import Structure
+from dynid.io.model_json import save_model_json
 from dynid.io.payload_json import payload_to_dict
 from dynid.io.torque_log import save_torque_log
 from dynid.simulation.trajectories import random_fourier, uniform_times
@@ -120,23 +123,36 @@ def test_a_load_that_moved_between_the_recordings_is_still_withheld(logs):
 
 
 def test_cli_prints_the_residual_judged_and_its_ratio(logs, tmp_path, capsys):
-    """dynid payload --unloaded prints which residual was judged and its ratio, and
-    payload.json records it with the setLoad values of a load within its std."""
+    """dynid payload --model (the arm's links, identified on the unloaded log) --unloaded:
+    the fit at over 3 x the torque noise, the printout names the difference judged and its
+    ratio, payload.json records it with setLoad's mass within its std, and the report
+    calls the load no misfit's (not 'not a load to trust')."""
     loaded, _, unloaded = logs
-    save_torque_log(tmp_path / "loaded.csv", loaded)
-    save_torque_log(tmp_path / "unloaded.csv", unloaded)
-    argv = ["payload", "--robot", "panda", "--data", str(tmp_path / "loaded.csv")]
-    argv += ["--unloaded", str(tmp_path / "unloaded.csv"), "--out", str(tmp_path / "p")]
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", dynid.DynidWarning)
-        assert main(argv) == 0
+        model = identify_recordings(ARM, [unloaded], structure=LINKS)
+    save_model_json(tmp_path / "arm.json", model)
+    save_torque_log(tmp_path / "loaded.csv", loaded)
+    save_torque_log(tmp_path / "unloaded.csv", unloaded)
+    argv = ["payload", "--model", str(tmp_path / "arm.json"), "--data"]
+    argv += [str(tmp_path / "loaded.csv"), "--unloaded", str(tmp_path / "unloaded.csv")]
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", dynid.DynidWarning)
+        assert main([*argv, "--out", str(tmp_path / "p")]) == 0
     out = capsys.readouterr().out
     (line,) = [x for x in out.splitlines() if x.strip().startswith("judged")]
     doc = json.loads((tmp_path / "p" / "payload.json").read_text())
     ratio = doc["judged_residual"]["ratio"]
+    assert doc["residual_rms"] > 3 * doc["noise_rms"]
     assert "difference from the unloaded arm's residual" in line and f"{ratio:.3g} x" in line
     assert ratio < 3 and doc["load_mass"] is not None
     assert abs(doc["load_mass"] - MASS) < doc["std"]["mass"]
+    html = (tmp_path / "p" / "report.html").read_text(encoding="utf-8")
+    box = re.search(r'<section class="verdict.*?</section>', html, re.S)
+    assert box is not None
+    text = " ".join(re.sub(r"<[^>]+>", " ", box.group(0)).split())
+    assert "not a load to trust" not in text
+    assert "judged on the difference from the unloaded arm" in text
 
 
 def test_matching_interpolates_along_the_unloaded_trajectory():
