@@ -199,9 +199,9 @@ class PayloadEstimate:
         the arm's own model's.
     notes : tuple of str
     doubts : tuple of str
-        Why the estimate is not a load to trust (module docstring), a fit that leaves
-        more than :data:`~dynid.identification.verdict.FLOOR_FAIR` times
-        :attr:`noise_rms` among them; empty when none.
+        Why the estimate is not a load to trust (module docstring), a residual judged
+        (:attr:`judged`) more than :data:`~dynid.identification.verdict.FLOOR_FAIR` times
+        its noise among them; empty when none.
     undetermined : tuple of str
         The inertia's elements the data do not determine (``"Ixx"`` .. ``"Izz"``,
         :func:`~dynid.feasibility.payload_doubts.undetermined_inertia`); empty when every

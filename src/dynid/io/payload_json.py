@@ -30,8 +30,9 @@ the flange's link and its mass and CoM are not in doubt; null otherwise (and
 it). ``doubts`` says why an estimate is not plausible
 (:mod:`dynid.feasibility.payload_doubts`: a mass not significantly above zero, a CoM
 farther than the arm is long, torques of another scale than the arm description's
-(``torque_scale``), a fit of torque logs that leaves more than 3 x ``noise_rms``: such a
-load is not handed to a controller; inertia elements
+(``torque_scale``), a fit of torque logs that leaves more than 3 x ``noise_rms`` (with
+``--unloaded`` logs of the same motion: ``judged_residual``'s ratio): such a load is not
+handed to a controller; inertia elements
 not determined, ``undetermined_inertia``: its inertia is not). ``residual_rms`` [N m for
 torque logs] is the fit's, ``noise_rms`` [N m] what the torque noise alone leaves after
 the low-pass (null for static data). ``judged_residual`` is the residual the load's doubt
