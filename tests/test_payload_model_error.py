@@ -177,14 +177,15 @@ def test_a_fit_above_three_times_the_noise_is_doubted_as_a_whole_load():
     causes and --unloaded said; with the difference method, the arm's missing terms and
     the motions recorded alike), one at
     2 x is not, nor one without a known noise (static data)."""
+    from dynid.feasibility.payload_difference import JudgedResidual as J
     from dynid.feasibility.payload_doubts import misfit_doubts
 
-    (said,) = misfit_doubts(0.275, 0.05)
+    (said,) = misfit_doubts(J("fit", 0.275, 0.05))
     assert "5.5 x the torque noise" in said and "joint spring" in said
     assert "--unloaded" in said and "no setLoad values are written" in said
-    (said,) = misfit_doubts(0.275, 0.05, difference=True)
+    (said,) = misfit_doubts(J("fit", 0.275, 0.05), difference=True)
     assert "give it as --model" in said and "record them alike" in said
-    assert misfit_doubts(0.1, 0.05) == () and misfit_doubts(0.275, None) == ()
+    assert misfit_doubts(J("fit", 0.1, 0.05)) == () and misfit_doubts(J("fit", 0.275, None)) == ()
 
 
 def test_misfit_covariance_is_the_cauchy_schwarz_bound_and_is_attained():

@@ -24,7 +24,10 @@ said), or a fit of torque logs that leaves more than 3 x the torque noise after 
 low-pass (torques the arm's model does not explain, a spring, friction or a tilt, which
 go into the mass and CoM too; their standard deviations then raised to the largest
 change a torque as large as the misfit makes) is warned about and no setLoad values are
-written. An inertia whose
+written. With --unloaded logs of the same motion the residual judged is the difference
+of the loaded fit's and the unloaded arm's at matched states, against the noise of both:
+an arm's misfit common to both recordings cancels, a load that moved or another load
+does not (the residual judged and its ratio are printed). An inertia whose
 moments lie less than 3 standard deviations above zero, or whose products have a
 standard deviation above a third of their largest possible magnitude, or that the
 consistency constraint set on its bound, is not determined: warned about (naming the
@@ -212,6 +215,8 @@ def print_payload(console: Console, result: PayloadFileResult, label: str) -> No
             flag = "  not determined" if f"I{name}" in est.undetermined else ""
             console.print(f"  I{name}      {v:+.4e} kg m^2  (std {s:.2g}){flag}")
     console.print(f"  {residual_line(est)}")
+    if (judged := judged_line(est)) is not None:
+        console.print(f"  {judged}")
     if est.torque_scale is not None:
         console.print(f"  {scale_line(est.torque_scale, est.mass, est.noise_rms)}")
     if result.recordings:
@@ -273,12 +278,43 @@ def residual_line(est: PayloadEstimate) -> str:
         unit = " (rows of M [kg m^2] and g [N m])" if mixed else " N m"
         return f"residual RMS {est.residual_rms:.2g}{unit}"
     ratio = est.residual_rms / est.noise_rms
+    fit = est.judged is None or est.judged.kind == "fit"
     return (
         f"residual RMS {est.residual_rms:.2g} N m, {ratio:.3g} x the torque noise "
         f"({est.noise_rms:.2g} N m after the low-pass)"
         + (
             f": over {FLOOR_FAIR:g} x, torques the arm's model leaves, which the load took"
-            if ratio > FLOOR_FAIR
+            if ratio > FLOOR_FAIR and fit
             else ""
+        )
+    )
+
+
+def judged_line(est: PayloadEstimate) -> str | None:
+    """``judged   the difference from the unloaded arm's residual at matched states (100 %
+    of the samples): 0.012 N m, 1.16 x the noise of both recordings (0.01 N m); within 3 x:
+    the arm's misfit is common to both, not the load's``: the residual the load's doubt
+    was judged on and its ratio (:attr:`PayloadEstimate.judged`,
+    :mod:`~dynid.feasibility.payload_difference`); None when not judged (static data, or
+    the torque noise not known)."""
+    j = est.judged
+    if j is None or (ratio := j.ratio) is None:
+        return None
+    over = ratio > FLOOR_FAIR
+    if j.kind == "fit":
+        what = "the fit's residual"
+        if j.matched or est.route.endswith("difference"):
+            what += f" (the motions do not match: {100 * j.matched:.0f} % of the samples)"
+        return f"judged   {what}: {ratio:.3g} x the torque noise; " + (
+            f"over {FLOOR_FAIR:g} x: the load in doubt" if over else f"within {FLOOR_FAIR:g} x"
+        )
+    return (
+        "judged   the difference from the unloaded arm's residual at matched states "
+        f"({100 * j.matched:.0f} % of the samples): {j.residual_rms:.2g} N m, {ratio:.3g} x "
+        f"the noise of both recordings ({j.noise_rms:.2g} N m); "
+        + (
+            f"over {FLOOR_FAIR:g} x: the load does not explain what changed between them"
+            if over
+            else f"within {FLOOR_FAIR:g} x: the arm's misfit is common to both, not the load's"
         )
     )

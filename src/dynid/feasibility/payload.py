@@ -70,7 +70,11 @@ leaves go into the mass and CoM too (an unmodelled spring at 74 x the noise read
 load as 1.04 kg), so the whole load is a doubt
 (:func:`~dynid.feasibility.payload_doubts.misfit_doubts`), its inertia not determined, and
 the standard deviations are raised to the largest change an unmodelled torque as large
-as the misfit can make (:func:`~dynid.feasibility.payload_fit.misfit_covariance`).
+as the misfit can make (:func:`~dynid.feasibility.payload_fit.misfit_covariance`). With
+recordings of the same motion without the load, the residual judged is the loaded fit's
+less the unloaded arm's at matched states, against the noise of both
+(:mod:`dynid.feasibility.payload_difference`, :attr:`PayloadEstimate.judged`): an arm's
+misfit common to both cancels, a load that moved does not.
 """
 
 from __future__ import annotations
@@ -93,7 +97,7 @@ from ..friction.fit import model_drive
 from ..identification.data import StaticDataset
 from ..identification.log import TorqueLog
 from ..identification.model import IdentifiedModel
-from ..identification.recordings import prepare_recordings
+from ..identification.recordings import Recordings, prepare_recordings
 from ..identification.structure import Structure
 from ..identification.verdict import FLOOR_FAIR
 from ..model.drive import Drive
@@ -101,6 +105,7 @@ from ..model.inertia import INERTIA_ORDER
 from ..model.robot import Robot
 from .lmi import phi_from_pseudo_inertia, pseudo_inertia
 from .payload_arm import ArmFriction, ArmModel, arm_model, model_structure, unloaded_arm
+from .payload_difference import JudgedResidual, arm_residual, judged_residual, piece_states
 from .payload_doubts import doubts_about, inertia_doubts, misfit_doubts, undetermined_inertia
 from .payload_fit import (
     HELD_OUT_BLOCKS,
@@ -135,6 +140,19 @@ __all__ = [
 #: (the load's ``p`` first), the columns fitted and ``p`` (0: the data without the load).
 _ScaleRows = tuple[
     NDArray[np.float64], NDArray[np.float64], NDArray[np.float64], NDArray[np.bool_] | None, int
+]
+
+
+#: The arm's residual on the recordings without the load, for the difference
+#: (:func:`~dynid.feasibility.payload_difference.judged_residual`): the loaded samples'
+#: states, the unloaded samples' states, their pieces, the arm's residual on them [N m]
+#: and what the torque noise leaves in it [N m].
+_Unloaded = tuple[
+    NDArray[np.float64],
+    NDArray[np.float64],
+    NDArray[np.int64],
+    NDArray[np.float64],
+    float | None,
 ]
 
 
@@ -181,9 +199,9 @@ class PayloadEstimate:
         the arm's own model's.
     notes : tuple of str
     doubts : tuple of str
-        Why the estimate is not a load to trust (module docstring), a fit that leaves
-        more than :data:`~dynid.identification.verdict.FLOOR_FAIR` times
-        :attr:`noise_rms` among them; empty when none.
+        Why the estimate is not a load to trust (module docstring), a residual judged
+        (:attr:`judged`) more than :data:`~dynid.identification.verdict.FLOOR_FAIR` times
+        its noise among them; empty when none.
     undetermined : tuple of str
         The inertia's elements the data do not determine (``"Ixx"`` .. ``"Izz"``,
         :func:`~dynid.feasibility.payload_doubts.undetermined_inertia`); empty when every
@@ -195,6 +213,12 @@ class PayloadEstimate:
         after the low-pass (each piece's white noise per joint through the filter's noise
         gain): the :attr:`residual_rms` of a perfect model. None for static data, or when
         a recording's noise could not be read.
+    judged : JudgedResidual or None
+        The residual the load's doubt was judged on, with its ratio to the noise
+        (:mod:`dynid.feasibility.payload_difference`): the fit's, or with recordings
+        without the load of the same motion the loaded fit's residual less the unloaded
+        arm's at matched states (an arm's misfit common to both cancels); None for
+        static data.
     torque_scale : TorqueScale or None
         The factor between the measured torques and the arm description's, with the load's
         mass at the description's scale (:mod:`dynid.feasibility.payload_scale`); None for
@@ -241,6 +265,7 @@ class PayloadEstimate:
     inertia_doubts: tuple[str, ...] = ()
     noise_rms: float | None = None
     torque_scale: TorqueScale | None = None
+    judged: JudgedResidual | None = None
 
     @property
     def plausible(self) -> bool:
@@ -362,10 +387,10 @@ def identify_payload(
     if base is not None and isinstance(unloaded, StaticDataset) != static:
         raise ShapeError("unloaded must be the same kind of data as data (static or log)")
     notes: list[str] = []
-    A = link_params_from_frame(f.T_link_frame)
-    cols = slice(10 * (k - 1), 10 * k)
+    A, cols = link_params_from_frame(f.T_link_frame), slice(10 * (k - 1), 10 * k)
     kept: NDArray[np.bool_] | None = None
     record: dict[str, Any] = {}
+    against: _Unloaded | None = None  # the arm's residual without the load (logs)
     described = _description(arm, d, friction)
     if isinstance(data, StaticDataset):
         empty = None if base is None else cast(StaticDataset, base[0])
@@ -377,13 +402,13 @@ def identify_payload(
         opt |= dict(decimate=decimate, max_gap_s=max_gap_s, rtol=rtol)
         logs = cast(list[TorqueLog], list(items))
         without = None if base is None else cast(list[TorqueLog], list(base))
-        W, yv, route, kept, record, differenced, scale = _log_route(
+        W, yv, route, kept, record, differenced, scale, against = _log_route(
             arm, logs, names, without, unloaded_names, cols, A, notes, opt, described
         )
     fit = (W, yv, kept, 4 if (static and gravity_only) else 10, static, rtol, margin)
     route += ", difference" if differenced else ""
-    scale_rows = None if described is None else scale
-    return _estimate(*fit, kin, frame, route, notes, record, differenced, scale_rows, d)
+    scaled = None if described is None else scale
+    return _estimate(*fit, kin, frame, route, notes, record, differenced, scaled, d, against)
 
 
 def _static_route(
@@ -450,25 +475,29 @@ def _estimate(
     difference: bool,
     scale_rows: _ScaleRows | None,
     drive: Drive | None,
+    against: _Unloaded | None = None,
 ) -> PayloadEstimate:
     """The load's estimate from its rows: least squares, consistency, doubts (warned);
     ``difference``: the arm was identified from unloaded data (its hint differs);
     ``scale_rows``: the rows of the torques' scale against the arm's description (None:
-    no description, or one identified from these sensors), ``drive`` for its hint."""
+    no description, or one identified from these sensors), ``drive`` for its hint;
+    ``against``: the arm's residual on recordings without the load, the misfit then
+    judged on the difference at matched states (:func:`_judged`)."""
     n, k = kin.n, kin.frame(frame).link
     fit = fit_load(W, yv, kept, rtol, p, static)
     est = np.asarray(fit.beta)
     cols = np.ones(W.shape[1], bool) if kept is None else kept
     noise = record.get("noise_rms")
-    misfit = misfit_doubts(fit.residual_rms, noise, difference=difference)
     resid = yv - W[:, cols] @ est[cols]
+    judged, judged_rows = _judged(fit.residual_rms, resid, noise, n, static, against, notes)
+    misfit = () if judged is None else misfit_doubts(judged, difference=difference)
     prep = record.get("preprocessing") or {}
     cov, per_period = _serial_widening(np.asarray(fit.covariance)[:p, :p], resid, n, prep, notes)
     if not static:  # static configurations are exchangeable: their blocks spread alike
         cov = _held_out_spread(cov, W[:, cols], yv, n, notes)
     sm_noise = float(np.sqrt(cov[0, 0]))  # whether there is a load: the misfit says its own
-    if misfit and noise:  # torques the arm's model leaves: the residual does not see them
-        cov = _misfit_spread(cov, W[:, cols], resid, noise, notes)
+    if misfit and judged is not None and judged.noise_rms:  # the residual does not see them
+        cov = _misfit_spread(cov, W[:, cols], judged_rows, judged.noise_rms, notes)
     m_ls, sm_ls = float(est[0]), float(np.sqrt(cov[0, 0]))
     scale = None
     if scale_rows is not None:
@@ -527,8 +556,39 @@ def _estimate(
         undetermined=undetermined,
         inertia_doubts=about_inertia,
         torque_scale=scale,
+        judged=judged,
         **record,
     )
+
+
+def _judged(
+    residual_rms: float,
+    resid: NDArray[np.float64],
+    noise: float | None,
+    n: int,
+    static: bool,
+    against: _Unloaded | None,
+    notes: list[str],
+) -> tuple[JudgedResidual | None, NDArray[np.float64]]:
+    """The residual the load's doubt is judged on and its rows
+    (:func:`~dynid.feasibility.payload_difference.judged_residual`): the fit's
+    (``residual_rms`` [N m], ``resid`` its rows, ``noise`` [N m] the torque noise after the
+    low-pass), or the difference from the unloaded arm's residual ``against`` at matched
+    states, with a note; None for static data."""
+    if static:
+        return None, resid
+    if against is None:
+        return JudgedResidual("fit", residual_rms, noise), resid
+    x1, x0, labels0, r0, noise0 = against
+    judged, rows = judged_residual(resid.reshape(-1, n), noise, x1, x0, labels0, r0, noise0)
+    if judged.kind == "fit":
+        notes.append(
+            f"the loaded and unloaded motions do not match ({100 * judged.matched:.0f} % of "
+            "the loaded samples within reach of the unloaded trajectory): the fit's residual "
+            "is judged, the arm's model errors do not cancel"
+        )
+        return JudgedResidual("fit", residual_rms, noise, judged.matched), resid
+    return judged, rows
 
 
 def _serial_widening(
@@ -566,8 +626,8 @@ def _misfit_spread(
     kept), to the squared largest change an unmodelled torque as large as the fit's
     misfit over the noise ``noise_rms`` [N m] can make
     (:func:`~dynid.feasibility.payload_fit.misfit_covariance`; ``W`` the fitted columns,
-    ``resid`` the residual), with a note."""
-    bound = misfit_covariance(W, resid, noise_rms, cov.shape[0])
+    ``resid`` the judged residual's rows, spread over ``W``'s), with a note."""
+    bound = misfit_covariance(W, resid, noise_rms, cov.shape[0], rows=W.shape[0])
     widened, widen = held_out_widening(cov, bound)
     notes.append(
         f"standard deviations widened up to x{widen.max():.3g} (the mass's x{widen[0]:.3g}) "
@@ -629,13 +689,15 @@ def _log_route(
     dict[str, Any],
     bool,
     _ScaleRows,
+    _Unloaded | None,
 ]:
     """The rows of recordings (:func:`~dynid.feasibility.payload_rows.log_rows`) with the
     arm given or identified from ``base``; the preprocessing, recordings and pieces left
     out, for the record (:class:`PayloadEstimate`'s fields); whether the arm identified
     from ``base`` differs from the one given (the difference method changed it); the rows
     of the torques' scale against the arm's ``described`` model (on ``base`` when given:
-    :func:`_base_scale`). ``opt``: the options of :func:`identify_payload`."""
+    :func:`_base_scale`); the arm's residual on ``base`` (:func:`_arm_on_base`, None
+    without it). ``opt``: the options of :func:`identify_payload`."""
     inner = arm.model if isinstance(arm, ArmModel) else arm
     kin = inner.robot if isinstance(inner, IdentifiedModel) else inner
     d = opt["drive"]
@@ -664,43 +726,79 @@ def _log_route(
             rtol=opt["rtol"],
         )
         differenced = _difference_said(inner, the_arm, note, notes)
-    W, yv, route, kept, modelled = log_rows(the_arm, rec, still_joints(logs, d), cols, A, notes)
+    still = still_joints(logs, d)
+    W, yv, route, kept, modelled = log_rows(the_arm, rec, still, cols, A, notes)
     scale: _ScaleRows = (yv, modelled, W, kept, 10)
-    if base is not None and described is not None:
-        scale = _base_scale(described, base, base_names, rec.cutoff_hz, used, cols, A, opt)
+    against = None
+    if base is not None:
+        rec0 = _prepared_base(kin, base, base_names, rec.cutoff_hz, used, opt)
+        against = _arm_on_base(the_arm, rec0, rec, still, cols, A)
+        if described is not None:
+            scale = _base_scale(described, rec0, base, cols, A, d)
     record: dict[str, Any] = {"preprocessing": prep, "recordings": rec.summary()}
     record |= {"skipped": rec.skipped, "noise_rms": filtered_noise_rms(rec)}
-    return W, yv, route, kept, record, differenced, scale
+    return W, yv, route, kept, record, differenced, scale, against
 
 
-def _base_scale(
-    described: ArmModel,
+def _prepared_base(
+    kin: Robot,
     base: Sequence[TorqueLog],
     base_names: Sequence[str] | None,
     cutoff_hz: float | None,
     decimate: int,
-    cols: slice,
-    A: NDArray[np.float64],
     opt: dict[str, Any],
-) -> _ScaleRows:
-    """The rows of the torques' scale on the recordings without the load: the description's
-    torques (its whole model, ``described``) and the classical friction per joint, the
-    recordings prepared as the loaded ones (their preparation's warnings said once
-    already, by :func:`~dynid.feasibility.payload_arm.unloaded_arm`)."""
-    kin = described.robot
-    d, gap = opt["drive"], opt["max_gap_s"]
+) -> Recordings:
+    """The recordings without the load prepared as the loaded ones (their preparation's
+    warnings said once already, by :func:`~dynid.feasibility.payload_arm.unloaded_arm`)."""
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", DynidWarning)
-        rec = prepare_recordings(
+        return prepare_recordings(
             kin,
             list(base),
             base_names,
             cutoff_hz=cutoff_hz,
-            max_gap_s=gap,
+            max_gap_s=opt["max_gap_s"],
             decimate=decimate,
-            drive=d,
+            drive=opt["drive"],
         )
-        W, y, _, kept, own = log_rows(described, rec, still_joints(base, d), cols, A, [])
+
+
+def _arm_on_base(
+    arm: ArmModel,
+    rec0: Recordings,
+    rec: Recordings,
+    still: NDArray[np.bool_],
+    cols: slice,
+    A: NDArray[np.float64],
+) -> _Unloaded:
+    """The arm's residual on the prepared recordings without the load ``rec0``
+    (:func:`~dynid.feasibility.payload_difference.arm_residual`: the classical friction
+    fitted as beside the load), the states of the loaded ``rec`` and unloaded samples
+    (``still`` joints zeroed in both), the unloaded samples' pieces and the noise the
+    torques leave in that residual."""
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", DynidWarning)
+        W0, y0, _, kept0, _ = log_rows(arm, rec0, still, cols, A, [])
+    x1, _ = piece_states(rec.pieces, still)
+    x0, labels0 = piece_states(rec0.pieces, still)
+    r0 = arm_residual(W0, y0, kept0, arm.robot.n)
+    return x1, x0, labels0, r0, filtered_noise_rms(rec0)
+
+
+def _base_scale(
+    described: ArmModel,
+    rec0: Recordings,
+    base: Sequence[TorqueLog],
+    cols: slice,
+    A: NDArray[np.float64],
+    drive: Drive | None,
+) -> _ScaleRows:
+    """The rows of the torques' scale on the recordings without the load ``rec0``
+    (:func:`_prepared_base`; ``base`` as read): the description's torques (its whole
+    model, ``described``) and the classical friction per joint."""
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", DynidWarning)
+        W, y, _, kept, own = log_rows(described, rec0, still_joints(base, drive), cols, A, [])
     return y, own, W[:, 10:], kept[10:], 0
 
 

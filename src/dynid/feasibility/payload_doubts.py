@@ -26,7 +26,10 @@ verdict and the torques' scale apply) is the arm's model missing torques, which 
 the mass and CoM as well as the inertia, by more than the residual's covariance says: the
 whole load is in doubt, no setLoad values are written, and its standard deviations are
 raised to the largest change an unmodelled torque as large as the misfit can make
-(:func:`~dynid.feasibility.payload_fit.misfit_covariance`).
+(:func:`~dynid.feasibility.payload_fit.misfit_covariance`). With recordings of the same
+motion without the load, the residual judged is the loaded fit's less the unloaded arm's
+at matched states (:mod:`~dynid.feasibility.payload_difference`): an arm's misfit common
+to both does not doubt the load, what the load leaves unexplained does.
 """
 
 from __future__ import annotations
@@ -38,6 +41,7 @@ from ..identification.verdict import FLOOR_FAIR
 from ..kinematics.forward import link_poses
 from ..model.inertia import INERTIA_ORDER, inertia6_from_matrix
 from ..model.robot import Robot
+from .payload_difference import JudgedResidual
 
 __all__ = [
     "MIN_INERTIA_SIGMAS",
@@ -139,20 +143,32 @@ def misfit_above(residual_rms: float, noise_rms: float | None) -> float | None:
     return ratio if ratio is not None and ratio > FLOOR_FAIR else None
 
 
-def misfit_doubts(
-    residual_rms: float, noise_rms: float | None, *, difference: bool = False
-) -> tuple[str, ...]:
-    """The doubt about a load whose fit leaves more than
-    :data:`~dynid.identification.verdict.FLOOR_FAIR` times the torque noise ``noise_rms``
-    [N m] (:func:`misfit_ratio`; ``residual_rms`` [N m]): torques the arm's model does not
-    explain go into the load's mass, CoM and inertia, by more than a noise-based standard
-    deviation says (an unmodelled spring on a Panda's joints 2 and 4 at 74 x the noise
-    read a 1.5 kg load as 1.04 kg, 3.7 of its std off; the standard deviations are
-    raised for it, :func:`~dynid.feasibility.payload_fit.misfit_covariance`), and no setLoad
-    values are written; the likely causes and what to record (``difference``: the arm
-    was identified from unloaded data already). Empty at or below the threshold."""
-    if (ratio := misfit_above(residual_rms, noise_rms)) is None:
+def misfit_doubts(judged: JudgedResidual, *, difference: bool = False) -> tuple[str, ...]:
+    """The doubt about a load whose ``judged`` residual
+    (:mod:`~dynid.feasibility.payload_difference`: the fit's, or with recordings of the
+    same motion without the load, its difference from the unloaded arm's at matched
+    states) is more than :data:`~dynid.identification.verdict.FLOOR_FAIR` times the
+    torque noise it holds (:func:`misfit_above`): torques the load's and the arm's models
+    do not explain go into the load's mass, CoM and inertia, by more than a noise-based
+    standard deviation says (an unmodelled spring on a Panda's joints 2 and 4 at 74 x the
+    noise read a 1.5 kg load as 1.04 kg, 3.7 of its std off; the standard deviations are
+    raised for it, :func:`~dynid.feasibility.payload_fit.misfit_covariance`), and no
+    setLoad values are written; the likely causes and what to record (``difference``:
+    the arm was identified from unloaded data already). Empty at or below the threshold,
+    or when the noise is not known (static data)."""
+    if (ratio := misfit_above(judged.residual_rms, judged.noise_rms)) is None:
         return ()
+    if judged.kind == "difference":
+        return (
+            f"{judged.what} leaves {ratio:.3g} x the noise of both recordings "
+            f"({judged.residual_rms:.2g} N m RMS, more than {FLOOR_FAIR:g} x): the load does "
+            "not explain what changed between the recordings (the load moved or slipped, "
+            "another load, a load that is no rigid body, or the motions differ where they "
+            "matched), and those torques go into its mass, CoM and inertia (the standard "
+            "deviations are raised to the largest change a torque as large as that misfit "
+            "makes, a rough bound); no setLoad values are written; hint: fix the load "
+            "rigidly and record the same trajectory with and without it",
+        )
     hint = (
         "identify the arm without the load with the terms these torques need (its friction "
         "law, a joint spring, the base's tilt: dynid identify on a log without the load, "
@@ -169,8 +185,8 @@ def misfit_doubts(
             "(the arm's errors cancel only where the motions match)"
         )
     return (
-        f"the fit leaves {ratio:.3g} x the torque noise ({residual_rms:.2g} N m RMS, more "
-        f"than {FLOOR_FAIR:g} x): torques the arm's model does not explain (unmodelled "
+        f"the fit leaves {ratio:.3g} x the torque noise ({judged.residual_rms:.2g} N m RMS, "
+        f"more than {FLOOR_FAIR:g} x): torques the arm's model does not explain (unmodelled "
         "friction, a joint spring, a tilted base, the links' or the drive's parameters, or "
         "the states' noise at a high cut-off) go into the load's mass, CoM and inertia, by "
         "more than a noise-based standard deviation says (the standard deviations are "

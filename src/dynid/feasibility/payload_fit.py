@@ -244,7 +244,12 @@ def serial_correlation_factor(
 
 
 def misfit_covariance(
-    W: NDArray[np.float64], residual: NDArray[np.float64], noise_rms: float, p: int
+    W: NDArray[np.float64],
+    residual: NDArray[np.float64],
+    noise_rms: float,
+    p: int,
+    *,
+    rows: int | None = None,
 ) -> NDArray[np.float64]:
     """The squared largest change of each of the first ``p`` coefficients of the least
     squares ``W b = y`` that an unmodelled torque as large as the fit's misfit can make.
@@ -269,6 +274,10 @@ def misfit_covariance(
         The RMS the noise alone leaves in a row [SI of the rows].
     p : int
         The coefficients returned.
+    rows : int, optional
+        The rows the misfit spreads over, when ``residual`` is another one's (a judged
+        residual on some of them): ``||e||^2 = rows (mean(r^2) - noise_rms^2)``;
+        default ``m``.
 
     Returns
     -------
@@ -277,12 +286,14 @@ def misfit_covariance(
     """
     import scipy.linalg  # as the rest of the module: scipy on first use
 
+    m = residual.size if rows is None else rows
     norms = np.linalg.norm(W, axis=0)
     s = np.where(norms > 0, norms, 1.0)
     R = scipy.linalg.qr(W / s, mode="r")[0][: W.shape[1]]
-    rows = scipy.linalg.solve_triangular(R, np.eye(W.shape[1]))[:p]  # of R^-1
-    G = (rows @ rows.T) / np.outer(s[:p], s[:p])  # (W^T W)^-1 = R^-1 R^-T, columns unscaled
+    Rinv = scipy.linalg.solve_triangular(R, np.eye(W.shape[1]))[:p]  # rows of R^-1
+    G = (Rinv @ Rinv.T) / np.outer(s[:p], s[:p])  # (W^T W)^-1 = R^-1 R^-T, columns unscaled
     misfit = max(float(residual @ residual) - residual.size * noise_rms**2, 0.0)
+    misfit *= m / residual.size
     return G * misfit
 
 

@@ -10,6 +10,8 @@
      "with_tool": "robot_with_payload.toml", "inertia_identified": true,
      "constraint_active": false, "pseudo_inertia_margin": ..., "rank": 10,
      "condition_number": ..., "residual_rms": ..., "noise_rms": ... | null,
+     "judged_residual": {"kind": "difference", "residual_rms": ..., "noise_rms": ...,
+                         "ratio": ..., "matched": ...} | null,
      "n_rows": ..., "notes": [...], "plausible": true, "doubts": [...],
      "inertia_determined": true, "undetermined_inertia": ["Izz", ...],
      "torque_scale": {"value": ..., "std": ..., "mass": ..., "std_mass": ...,
@@ -28,11 +30,17 @@ the flange's link and its mass and CoM are not in doubt; null otherwise (and
 it). ``doubts`` says why an estimate is not plausible
 (:mod:`dynid.feasibility.payload_doubts`: a mass not significantly above zero, a CoM
 farther than the arm is long, torques of another scale than the arm description's
-(``torque_scale``), a fit of torque logs that leaves more than 3 x ``noise_rms``: such a
-load is not handed to a controller; inertia elements
+(``torque_scale``), a fit of torque logs that leaves more than 3 x ``noise_rms`` (with
+``--unloaded`` logs of the same motion: ``judged_residual``'s ratio): such a load is not
+handed to a controller; inertia elements
 not determined, ``undetermined_inertia``: its inertia is not). ``residual_rms`` [N m for
 torque logs] is the fit's, ``noise_rms`` [N m] what the torque noise alone leaves after
-the low-pass (null for static data).
+the low-pass (null for static data). ``judged_residual`` is the residual the load's doubt
+was judged on (:mod:`dynid.feasibility.payload_difference`): ``kind`` ``fit`` (the fit's
+residual against ``noise_rms``) or ``difference`` (with ``--unloaded`` logs of the same
+motion: the loaded fit's residual less the unloaded arm's at matched states, against the
+noise of both), its RMS and noise [N m], their ``ratio`` (a doubt above 3) and the part of
+the loaded samples ``matched`` to the unloaded trajectory [1]; null for static data.
 ``torque_scale`` is the factor ``value`` [1] (with its ``std``) between the measured
 torques and the arm description's (:mod:`dynid.feasibility.payload_scale`), fitted on the
 ``loaded`` data beside the load or on the data without it (``unloaded``), and the load's
@@ -115,6 +123,7 @@ def payload_to_dict(
             "condition_number": _num(est.condition_number),
             "residual_rms": _num(est.residual_rms),
             "noise_rms": None if est.noise_rms is None else _num(est.noise_rms),
+            "judged_residual": _judged(est),
             "n_rows": int(est.n_rows),
             "notes": list(est.notes),
             "plausible": est.plausible,
@@ -130,6 +139,7 @@ def payload_to_dict(
                 "inertia": "kg m^2",
                 "residual_rms": "N m (torque logs); the rows' SI units (static data)",
                 "noise_rms": "N m",
+                "judged_residual": "residual_rms, noise_rms: N m; ratio, matched: 1",
                 "torque_scale": "value, std: 1; mass, std_mass: kg",
             },
             "conventions": {
@@ -144,6 +154,20 @@ def payload_to_dict(
         }
     )
     return d
+
+
+def _judged(est: PayloadEstimate) -> dict[str, Any] | None:
+    """``judged_residual`` of the document (module docstring), or None."""
+    j = est.judged
+    if j is None:
+        return None
+    return {
+        "kind": j.kind,
+        "residual_rms": _num(j.residual_rms),
+        "noise_rms": None if j.noise_rms is None else _num(j.noise_rms),
+        "ratio": None if j.ratio is None else _num(j.ratio),
+        "matched": _num(j.matched),
+    }
 
 
 def _scale(est: PayloadEstimate) -> dict[str, Any] | None:

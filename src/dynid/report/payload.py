@@ -8,7 +8,10 @@ the data do not determine (``undetermined_inertia`` of ``payload.json``). The le
 * not a load to trust (poor): a doubt about the mass or the CoM (no setLoad values), a
   residual above :data:`~dynid.identification.verdict.FLOOR_FAIR` times the torque noise
   left after the low-pass among them (effects outside the arm's model, which the mass and
-  CoM take too: :func:`~dynid.feasibility.payload_doubts.misfit_doubts`);
+  CoM take too: :func:`~dynid.feasibility.payload_doubts.misfit_doubts`), or with
+  ``--unloaded`` logs of the same motion the residual judged (``judged_residual``: the
+  loaded fit's less the unloaded arm's at matched states) above that times the noise of
+  both;
 * usable, with reservations (fair), each reason listed: inertia elements not determined,
   a mass known to 5 % or worse, the physical-consistency constraint active (the
   least-squares estimate was not a body);
@@ -46,7 +49,7 @@ def payload_answer(run: RunFiles) -> Answer | None:
     doubts = [str(x) for x in doc.get("doubts") or []]
     # the inertia is judged only when the mass and CoM are not in doubt (its one line
     # last), and is not determined when the fit leaves the torques above the noise
-    ratio = _noise_ratio(doc)
+    ratio = _judged_ratio(doc)
     misfit = ratio is not None and ratio > FLOOR_FAIR
     load_doubts = doubts if misfit or not undetermined else []
     facts = [
@@ -86,6 +89,19 @@ def _noise_ratio(doc: dict[str, Any]) -> float | None:
     return r / n if is_number(r) and is_number(n) and n > 0 else None
 
 
+def _judged(doc: dict[str, Any]) -> dict[str, Any] | None:
+    """``judged_residual`` when it is the difference from the unloaded arm's, else None."""
+    j = doc.get("judged_residual")
+    ok = isinstance(j, dict) and j.get("kind") == "difference" and is_number(j.get("ratio"))
+    return j if ok else None
+
+
+def _judged_ratio(doc: dict[str, Any]) -> float | None:
+    """The ratio the load's doubt was judged on: the difference's, else the fit's."""
+    j = _judged(doc)
+    return float(j["ratio"]) if j is not None else _noise_ratio(doc)
+
+
 def _residual_fact(doc: dict[str, Any]) -> str:
     """The residual RMS in N m beside the torque noise (torque logs), or in the rows' units."""
     r = doc.get("residual_rms")
@@ -94,10 +110,22 @@ def _residual_fact(doc: dict[str, Any]) -> str:
         said = "at the noise floor" if ratio <= FLOOR_GOOD else "close to it"
         if ratio > FLOOR_FAIR:
             said = "effects outside the arm's model remain"
-        return (
+        fact = (
             f"Residual RMS {number(doc['residual_rms'], 2)} N m, {number(ratio, 3)} x the "
             f"torque noise after the low-pass ({number(doc['noise_rms'], 2)} N m): {said}"
         )
+        if (j := _judged(doc)) is not None:
+            common = j["ratio"] <= FLOOR_FAIR
+            fact += (
+                f"; judged on the difference from the unloaded arm's residual at matched "
+                f"states: {number(j['ratio'], 3)} x the noise of both recordings ("
+                + (
+                    "the arm's misfit is common to both, not the load's)"
+                    if common
+                    else "the load does not explain what changed between them)"
+                )
+            )
+        return fact
     static_m = str(doc.get("route", "")).startswith("static M")
     unit = " (rows of M [kg m^2] and g [N m])" if static_m else " N m"
     return f"Residual RMS {cell(r)}{esc(unit)}"
@@ -158,7 +186,12 @@ def _reservations(doc: dict[str, Any], rel: float | None, undetermined: list[str
             "the mass is known to " + (f"{100 * rel:.2g} %" if rel is not None else "no std")
         )
     ratio = _noise_ratio(doc)
-    if ratio is not None and ratio > FLOOR_FAIR:  # a file written without its doubt
+    if ratio is not None and ratio > FLOOR_FAIR and _judged(doc) is not None:
+        out.append(
+            f"the fit leaves {number(ratio, 3)} x the torque noise: the arm's model misses "
+            "torques in both recordings, which cancel in their difference"
+        )
+    elif ratio is not None and ratio > FLOOR_FAIR:  # a file written without its doubt
         out.append(
             f"the fit leaves {number(ratio, 3)} x the torque noise: the arm's model misses "
             "torques the load's parameters may absorb"
