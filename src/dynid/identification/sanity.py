@@ -48,6 +48,10 @@ with them before fitting (:func:`log_findings`). None of them changes the data.
 * **Milliseconds**: logged velocities ``1e3`` times the derivative of the positions (or a
   median time step of at least 0.5 s with integer steps when no velocities were logged):
   ``--units t=ms``.
+* **Reversed columns**: a motor or encoder mounted the other way, its position and
+  velocity (with its effort or without) of the opposite sign; several at once, named in
+  the log's own columns (a motor-side log's motors) with one ``--units`` hint, judged
+  through the drive before the sign (:func:`reversed_joint`).
 * **Frozen joints**: a joint whose velocity never leaves its noise band (fewer than 1 % of
   the samples beyond 5 times the robust noise level, :func:`velocity_noise_std`, and
   :data:`MIN_MOTION`); its friction cannot be identified (:func:`moving_joints`).
@@ -733,8 +737,7 @@ def _recorded(log: TorqueLog, drive: Drive | None) -> _Recorded | None:
     if found is None:
         return None
     ddq, ok = found
-    d = None if drive is None or drive.is_identity else drive
-    return _Recorded(log.q[at][ok], log.dq[at][ok], ddq[ok], log.tau[at][ok], d)
+    return _Recorded(log.q[at][ok], log.dq[at][ok], ddq[ok], log.tau[at][ok], drive)
 
 
 def reversed_joint(robot: Robot, log: TorqueLog, drive: Drive | None = None) -> str | None:
