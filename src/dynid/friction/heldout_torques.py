@@ -45,7 +45,7 @@ from ..identification.input_noise import (
     state_noise,
 )
 from ..identification.log import TorqueLog, joint_side_log
-from ..identification.log_rows import friction_regressor, term_regressor
+from ..identification.log_rows import term_regressor
 from ..identification.low_speed import low_speed_hint
 from ..identification.model import IdentifiedModel
 from ..identification.pieces import split_at_gaps, unwrapped, wrappable
@@ -57,7 +57,9 @@ from ..identification.residual_dependence import (
 )
 from ..identification.sanity import despiked
 from ..identification.verdict import Verdict, with_caveat, with_hint, with_replaced_spikes
+from ..model.drive import Drive
 from ..model.robot import Robot
+from ..regressors.terms import LinearFriction
 from .fit import model_drive, torques_through
 from .pooled import joined_validation
 from .validation import Validation, own_friction, validate_torques
@@ -402,11 +404,13 @@ def residual_tilt(
     several pieces: :func:`~dynid.friction.pooled.joined_validation`)
     (:func:`~dynid.identification.gravity_tilt.gravity_tilt`; ``noise`` (n,) [N m] each
     joint's): of an identified model, its own columns projected out and with them each
-    joint's viscous, Coulomb, offset and rotor-inertia columns (terms the structure chosen
-    may have left out: a tilt the fit partly took as offsets made it drop the offset of
-    joint 3, which then pulled the tilt to 0.17 deg for 0.3); of a robot's own
-    parameters, on the residual as it is. None for a model whose drive converts the log
-    (motor side, currents, offsets) or without accelerations."""
+    motor's viscous, Coulomb, offset and rotor-inertia columns mapped to the joints
+    through the model's drive as the fit maps them (``K_f^T`` of the friction at ``K_f
+    dq``, ``K^T`` of the rotor at ``K ddq``; each joint's own without a drive: terms the
+    structure chosen may have left out: a tilt the fit partly took as offsets made it drop
+    the offset of joint 3, which then pulled the tilt to 0.17 deg for 0.3); of a robot's
+    own parameters, on the residual as it is. ``v`` is at the joints (a motor-side log or
+    currents read through the drive). None without accelerations."""
     log = v.log
     if log.ddq is None:
         return None
@@ -414,15 +418,15 @@ def residual_tilt(
     error = tau - v.tau_hat
     if isinstance(model, Robot):
         return gravity_tilt(model, q, error, noise)
-    if model.drive is not None and not model.drive.is_identity:
-        return None
     terms = tuple(t.term for t in model.terms.values())
-    n = q.shape[1]
+    drive = Drive.identity(q.shape[1]) if model.drive is None else model.drive
+    own = LinearFriction(drive)
 
     def columns(rows: NDArray[np.intp]) -> NDArray[np.float64]:
         Y, _ = term_regressor(model.robot, model.base, terms, q[rows], dq[rows], ddq[rows])
-        rotor = ddq[rows][:, :, None] * np.eye(n)  # each joint's ddq: a rotor inertia
-        return np.concatenate([Y, friction_regressor(dq[rows]), rotor], axis=-1)
+        friction = own.torque_columns(q[rows], dq[rows], ddq[rows])
+        rotor = drive.rotor_columns(ddq[rows])  # each motor's rotor inertia
+        return np.concatenate([Y, friction, rotor], axis=-1)
 
     return gravity_tilt(model.robot, q, error, noise, tau, columns)
 

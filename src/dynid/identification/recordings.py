@@ -498,9 +498,10 @@ def prepare_recordings(
         cuts.append(max(0, len(mine) - 1))
         gaps.append(gaps_between(mine))
         if mine:  # sign, units, frozen joints: on the whole recording, said once
-            whole = joined([joint_side_log(p, drive) for p in mine])
-            if (mirrored := reversed_joint(robot, whole)) is not None:
+            # reversed columns: the log's own (a motor-side log's motors), through the drive
+            if (mirrored := reversed_joint(robot, joined(mine), drive)) is not None:
                 raise DataError(mirrored, file=name)  # a fit would bend to mirrored motion
+            whole = joined([joint_side_log(p, drive) for p in mine])
             others = (joint_side_log(x, drive) for i, x in enumerate(logs) if i != r)
             if (opposite := opposite_sign_among(robot, whole, name, others)) is not None:
                 raise DataError(opposite, file=name)  # a fit would negate the masses

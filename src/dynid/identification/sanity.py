@@ -48,6 +48,10 @@ with them before fitting (:func:`log_findings`). None of them changes the data.
 * **Milliseconds**: logged velocities ``1e3`` times the derivative of the positions (or a
   median time step of at least 0.5 s with integer steps when no velocities were logged):
   ``--units t=ms``.
+* **Reversed columns**: a motor or encoder mounted the other way, its position and
+  velocity (with its effort or without) of the opposite sign; several at once, named in
+  the log's own columns (a motor-side log's motors) with one ``--units`` hint, judged
+  through the drive before the sign (:func:`reversed_joint`).
 * **Frozen joints**: a joint whose velocity never leaves its noise band (fewer than 1 % of
   the samples beyond 5 times the robust noise level, :func:`velocity_noise_std`, and
   :data:`MIN_MOTION`); its friction cannot be identified (:func:`moving_joints`).
@@ -64,7 +68,7 @@ from __future__ import annotations
 
 import dataclasses
 import math
-from collections.abc import Iterable, Sequence
+from collections.abc import Iterable, Iterator, Sequence
 from dataclasses import dataclass
 
 import numpy as np
@@ -95,6 +99,7 @@ __all__ = [
     "opposite_sign_among",
     "reversed_joint",
     "REVERSED_MODEL_SHARE",
+    "REVERSED_STEP_SHARE",
     "moving_joints",
     "noise_band",
     "OPPOSITE_CORRELATION",
@@ -672,90 +677,262 @@ def _closer_negated(
     return {int(j): (float(near[j]), float(far[j])) for j in np.flatnonzero(hit)}
 
 
-#: :func:`reversed_joint` questions a log whose residual, each joint's own friction and
-#: armature taken out, is at least this share of the torques' RMS (a geared arm's motor 3
-#: logged reversed left 0.30 and 0.37 on two recordings, 0.015 and 0.016 once reversed).
+#: :func:`reversed_joint` questions a log whose residual, each motor's own friction and
+#: rotor taken out, is at least this share of the RMS of what they leave of the torques
+#: (the links' share; clean simulated Panda logs left 0.04, and 0.05 geared with rotors
+#: that outweigh the links; a geared Panda's motor 3 logged reversed 0.37, 0.053 once
+#: reversed).
 REVERSED_MODEL_SHARE = 0.1
+#: :func:`reversed_joint` changes one more column's signs while that leaves at most this
+#: share of the sum of squares left before (a Panda's joints 2 and 5 reversed: joint 2
+#: alone left 0.004 of it as read, joint 5 alone 0.99, both 1.3e-4; a geared Panda's
+#: motors 3 and 6: motor 1 alone left 0.15 against motor 3's 0.18, joints 1 and 3 being
+#: parallel near q2 = 0, and the move from motor 1 to motor 3 then 0.011 for 0.072).
+REVERSED_STEP_SHARE = 0.75
 
 
-def reversed_joint(robot: Robot, log: TorqueLog) -> str | None:
-    """The finding that one joint of a joint-side log was recorded reversed, its position
-    (and velocity) of the opposite sign, with or without its torque (a motor mounted or
-    wired the other way: its encoder and current both negated; or the encoder alone), or
-    None; None too for a robot without inertial parameters.
+@dataclass(frozen=True, slots=True)
+class _Recorded:
+    """A log's samples as recorded, for :func:`reversed_joint`: positions, velocities,
+    accelerations (one derivation, :func:`_motion_accelerations`) and efforts (N, n) in
+    the log's own columns, and the drive that reads them (None: joint-side torques)."""
 
-    Judged on the robot's whole rigid-body torques (:func:`_motion_torques`) over every
-    joint, each joint's residual freed of its own viscous, Coulomb, offset and armature
-    torques (least squares on ``dq``, ``sign(dq)``, 1, ``ddq``: a geared arm's rotors and
-    motor friction, which the description lacks): with the joint reversed that residual
-    is within :data:`NEGATED_DISTANCE_SHARE` of its RMS as read, where that is at least
-    :data:`REVERSED_MODEL_SHARE` of the torques' RMS (a model that explains the log is not
-    questioned), and below :data:`NEGATED_MODEL_SHARE` of it, and better than the joint's
-    torque alone negated or every torque negated (then None: that is
+    q: NDArray[np.float64]
+    dq: NDArray[np.float64]
+    ddq: NDArray[np.float64]
+    tau: NDArray[np.float64]
+    drive: Drive | None
+
+    @property
+    def joint_torques(self) -> NDArray[np.float64]:
+        """The efforts as joint torques [N m] (N, n)."""
+        return self.tau if self.drive is None else self.drive.joint_torques(self.tau)
+
+    def carried(self) -> float:
+        """The sum of squares [N^2 m^2] of what each motor's friction and rotor leave of the
+        joint torques (:func:`_left_over`): the links' share, which a reversal disturbs (a
+        geared arm's rotors outweigh it)."""
+        states = (self.q, self.dq, self.ddq)
+        _, dq, ddq = states if self.drive is None else self.drive.joint_states(*states)
+        return _left_over(self.joint_torques, dq, ddq, self.drive)
+
+    def left(self, robot: Robot, motion: NDArray[np.float64], torque: NDArray[np.float64]) -> float:
+        """What the model and each motor's friction and rotor leave [N^2 m^2] (sum of
+        squares over the joints) with the columns' signs ``motion`` and ``torque`` (n,)."""
+        q, dq, ddq, tau = self.q * motion, self.dq * motion, self.ddq * motion, self.tau * torque
+        if self.drive is not None:
+            q, dq, ddq = self.drive.joint_states(q, dq, ddq)
+            tau = self.drive.joint_torques(tau)
+        model = rnea(robot, q, dq, ddq)
+        if robot.spring is not None:
+            model = model + robot.spring.torques(q)
+        return _left_over(tau - model, dq, ddq, self.drive)
+
+
+def _recorded(log: TorqueLog, drive: Drive | None) -> _Recorded | None:
+    """:class:`_Recorded` of ``log`` at every k-th of its samples whose accelerations are
+    known (:func:`_motion_accelerations`), or None when too few are."""
+    at = np.arange(0, log.n_samples, max(1, log.n_samples // _MAX_SAMPLES))
+    found = _motion_accelerations(log, at)
+    if found is None:
+        return None
+    ddq, ok = found
+    return _Recorded(log.q[at][ok], log.dq[at][ok], ddq[ok], log.tau[at][ok], drive)
+
+
+def reversed_joint(robot: Robot, log: TorqueLog, drive: Drive | None = None) -> str | None:
+    """The finding that columns of a log were recorded reversed, each position (and
+    velocity) of the opposite sign, with or without its effort (a motor mounted or wired
+    the other way: its encoder and current both negated; or the encoder alone), or None;
+    None too for a robot without inertial parameters.
+
+    ``log`` is as recorded, read through ``drive`` (motor-side positions and efforts,
+    currents): a reversed column is the log's own, a motor's of a motor-side log (a
+    coupled wrist's motor turns two joints), named so with the ``--units`` entries in the
+    log's columns (``q6=-1,tau6=-1``).
+
+    Judged on the robot's whole rigid-body torques over every joint, at the accelerations
+    :func:`_motion_accelerations` derives (one derivation for the torques and the rotor
+    columns, of the sign check's whole torques too), each joint's residual freed of its
+    own viscous, Coulomb, offset and armature torques (least squares on ``dq``,
+    ``sign(dq)``, 1, ``ddq``; through a drive, each motor's, where its friction acts, and
+    its rotor's ``K^T (K ddq)``: a geared arm's rotors and motor friction, which the
+    description lacks), against the torques those columns leave (the links' share: a
+    geared arm's rotors outweigh it). The columns' signs change one step at a time
+    (:func:`_changes`: a column's position and effort, position or effort reversed, or
+    back, or a reversal moved to another column), the step that leaves least first, while
+    it leaves at most :data:`REVERSED_STEP_SHARE` of what was left; the reversed columns
+    are named when what they leave is within :data:`NEGATED_DISTANCE_SHARE` of the RMS as
+    read, where that is at least :data:`REVERSED_MODEL_SHARE` of the links' share (a model
+    that explains the log is not questioned), and below :data:`NEGATED_MODEL_SHARE` of it,
+    a position among them, and better than every torque negated (then None: that is
     :func:`opposite_sign`'s finding, which a log of every torque negated, joint 2
     reversed, explained to 0.41 of its residual as read; where friction outweighs gravity
     on a joint, an encoder reversed and a torque negated look alike, and the reversal must
-    explain it better). Judged before :func:`opposite_sign`, which read an encoder reversed as a
-    torque of the opposite sign and asked for ``tau3=-1``. Before, a
+    explain it better). Efforts alone negated are named beside a reversal, and left to
+    :func:`opposite_sign` without one. Judged before :func:`opposite_sign`, which read an
+    encoder reversed as a torque of the opposite sign and asked for ``tau3=-1``. Before, a
     geared arm's motor 3 logged reversed was fitted to 34 % error with a spring suggested
-    on joint 3."""
+    on joint 3; a coupled wrist's motor, which turns two joints, could not be named.
+
+    Parameters
+    ----------
+    robot : Robot
+    log : TorqueLog
+        As recorded (its columns the drive's side and effort).
+    drive : Drive, optional
+        What reads ``log`` (:func:`~dynid.identification.log.joint_side_log`).
+
+    Returns
+    -------
+    str or None
+        The finding, one line with the ``--units`` entries.
+    """
     if not np.any(robot.phi):
         return None
-    at = np.arange(0, log.n_samples, max(1, log.n_samples // _MAX_SAMPLES))
-    whole = _motion_torques(robot, log, at)
-    if whole is None:
+    rec = _recorded(log, drive)
+    if rec is None:
         return None
-    ddq = log.ddq if log.ddq is not None else np.gradient(log.dq, log.t, axis=0)
-    model, ok = whole
-    total = float(np.sum(log.tau[at][ok] ** 2))
-    read = _left_over(log.tau[at][ok] - model[ok], log.dq[at][ok], ddq[at][ok])
+    one = np.ones(log.n)
+    total = rec.carried()
+    read = rec.left(robot, one, one)
     if read < REVERSED_MODEL_SHARE**2 * total:
         return None
-    best: tuple[float, int, bool, bool] | None = None
-    for j in range(log.n):
-        sign = np.ones(log.n)
-        sign[j] = -1.0
-        for motion, torque in ((True, True), (True, False), (False, True)):
-            tau = log.tau * sign if torque else log.tau
-            m_sign = sign if motion else np.ones(log.n)
-            flipped = TorqueLog(log.t, log.q * m_sign, log.dq * m_sign, tau, log.ddq)
-            other = _motion_torques(robot, flipped, at)
-            if other is None or not np.all(other[1][ok]):
-                continue
-            m = other[0][ok]
-            left = _left_over(tau[at][ok] - m, flipped.dq[at][ok], (ddq * m_sign)[at][ok])
-            if best is None or left < best[0]:
-                best = (left, j, motion, torque)
-    if best is None or not best[0] < NEGATED_DISTANCE_SHARE**2 * read:
+    motion, torque, left = one.copy(), one.copy(), read
+    while True:  # the change of one column (or a move to another) that leaves least
+        best = min(
+            ((rec.left(robot, m, t), m, t) for m, t in _changes(motion, torque)),
+            key=lambda x: x[0],
+        )
+        if not best[0] <= REVERSED_STEP_SHARE * left:
+            break
+        left, motion, torque = best
+    if not left < NEGATED_DISTANCE_SHARE**2 * read or not left < NEGATED_MODEL_SHARE**2 * total:
+        return None  # none explains it
+    if np.all(motion > 0):
+        return None  # torques alone negated explain it best: opposite_sign's
+    if rec.left(robot, one, -one) <= left:  # every torque of the opposite sign
         return None
-    left, j, motion, torque = best
-    if not motion or not left < NEGATED_MODEL_SHARE**2 * total:
-        return None  # a torque alone negated explains it best, or none explains it
-    negated = _left_over(-log.tau[at][ok] - model[ok], log.dq[at][ok], ddq[at][ok])
-    if negated <= left:  # every torque of the opposite sign: opposite_sign's
-        return None
-    name = robot.joint_names[j]
-    cols = f"q{j + 1}=-1" + (f",tau{j + 1}=-1" if torque else "")
+    return _reversed_line(robot, rec.drive, motion < 0, torque < 0, (left, read, total))
+
+
+def _changes(
+    motion: NDArray[np.float64], torque: NDArray[np.float64]
+) -> Iterator[tuple[NDArray[np.float64], NDArray[np.float64]]]:
+    """Every sign of the columns (``motion``, ``torque``: +-1, n) one step from these: a
+    column set to another of its signs (position and effort reversed, position alone,
+    effort alone, neither), or a reversed column's signs moved to one not reversed (a
+    Panda's joints 1 and 3, parallel when joint 2 is near zero, look alike)."""
+    states = ((-1.0, -1.0), (-1.0, 1.0), (1.0, -1.0), (1.0, 1.0))
+    for j in range(motion.size):
+        for m, t in states:
+            if (m, t) != (motion[j], torque[j]):
+                ms, ts = motion.copy(), torque.copy()
+                ms[j], ts[j] = m, t
+                yield ms, ts
+    flipped = (motion < 0) | (torque < 0)
+    for i in np.flatnonzero(flipped):
+        for k in np.flatnonzero(~flipped):
+            pair = np.array([i, k])
+            ms, ts = motion.copy(), torque.copy()
+            ms[pair], ts[pair] = ms[pair[::-1]], ts[pair[::-1]]
+            yield ms, ts
+
+
+def _reversed_line(
+    robot: Robot,
+    drive: Drive | None,
+    motion: NDArray[np.bool_],
+    torque: NDArray[np.bool_],
+    sums: tuple[float, float, float],
+) -> str:
+    """:func:`reversed_joint`'s finding: the columns reversed (``motion``, n) and the
+    efforts negated (``torque``, n) named in the log's own columns (a motor-side log's
+    motors), what is left reversed and as read (``sums``: those and the torques' sums of
+    squares), the ``--units`` entries."""
+    left, read, total = sums
+    motors = drive is not None and drive.side == "motor"
+    names = [f"motor {k + 1}" if motors else robot.joint_names[k] for k in range(robot.n)]
+    rev = np.flatnonzero(motion)
+    alone = np.flatnonzero(torque & ~motion)
+    one = rev.size == 1
+    what = [
+        ("its " if one else f"{names[k]}'s ") + ("position and torque" if torque[k] else "position")
+        for k in rev
+    ] + [f"{names[k]}'s torque" for k in alone]
+    cols = ",".join(
+        [f"q{k + 1}=-1" + (f",tau{k + 1}=-1" if torque[k] else "") for k in rev]
+        + [f"tau{k + 1}=-1" for k in alone]
+    )
+    rates = ", ".join(f"dq{k + 1}=-1, ddq{k + 1}=-1" for k in rev)
+    gears = drive is not None and not drive.is_coupled and bool(np.all(torque[rev]))
     return (
-        f"{name} looks recorded reversed: its position"
-        + (" and torque" if torque else "")
-        + " of the opposite sign to the model's convention (with it reversed, what the "
-        f"model and each joint's friction and armature leave is {np.sqrt(left / total):.2g} "
-        f"of the torques' RMS, {np.sqrt(read / total):.2g} as read): a motor or encoder "
-        f"mounted the other way; hint: --units {cols} reads it so (and dq{j + 1}=-1, "
-        f"ddq{j + 1}=-1 for the log's velocity and acceleration columns, if it has them; "
-        "of a motor-side log, the motor's columns)"
+        f"{', '.join(names[k] for k in rev)} {'looks' if one else 'look'} recorded reversed: "
+        f"{', '.join(what)} of the opposite sign to the model's convention (with "
+        f"{'it' if one else 'them'} reversed, what the model and each "
+        + ("motor's friction and rotor" if drive is not None else "joint's friction and armature")
+        + f" leave is {np.sqrt(left / total):.2g} of the RMS of the torques the links carry "
+        f"(what that friction leaves of them), {np.sqrt(read / total):.2g} as read): a "
+        "motor or encoder mounted the other way; "
+        f"hint: --units {cols} reads {'it' if one else 'them'} so (and {rates} for the log's "
+        "velocity and acceleration columns, if it has them"
+        + ("; the motors' columns of this motor-side log" if motors else "")
+        + ")"
+        + (
+            "; or a negative gear_ratio in the drive file, a motor turning the other way"
+            if gears
+            else ""
+        )
     )
 
 
-def _left_over(r: NDArray[np.float64], dq: NDArray[np.float64], ddq: NDArray[np.float64]) -> float:
+def _left_over(
+    r: NDArray[np.float64],
+    dq: NDArray[np.float64],
+    ddq: NDArray[np.float64],
+    drive: Drive | None = None,
+) -> float:
     """The sum of squares [N^2 m^2] of the residuals ``r`` (N, n) left by each joint's own
-    viscous, Coulomb, offset and armature columns (``dq``, ``sign(dq)``, 1, ``ddq``)."""
+    viscous, Coulomb, offset and armature columns (``dq``, ``sign(dq)``, 1, ``ddq``); with
+    a ``drive``, each motor's where its friction acts (``K_f^T`` of those of ``K_f dq``)
+    and its rotor's (``K^T`` of ``K ddq``), the joints a motor couples fitted together."""
+    n = r.shape[1]
+    Kf = np.eye(n) if drive is None else drive.friction_transmission
+    K = np.eye(n) if drive is None else drive.transmission
+    v, a = dq @ Kf.T, ddq @ K.T
     out = 0.0
-    for j in range(r.shape[1]):
-        X = np.column_stack([dq[:, j], np.sign(dq[:, j]), np.ones(len(r)), ddq[:, j]])
-        coef = np.linalg.lstsq(X, r[:, j], rcond=None)[0]
-        out += float(np.sum((r[:, j] - X @ coef) ** 2))
+    for joints, motors in _motor_groups((K != 0) | (Kf != 0)):
+        cols = []
+        for k in motors:  # motor k's columns at the group's joints: (N, m) each
+            for f in (v[:, k], np.sign(v[:, k]), np.ones(len(r))):
+                cols.append(f[:, None] * Kf[k, joints])
+            cols.append(a[:, k, None] * K[k, joints])
+        X = np.stack(cols, axis=-1).reshape(len(r) * len(joints), len(cols))
+        y = r[:, joints].reshape(-1)
+        coef = np.linalg.lstsq(X, y, rcond=None)[0]
+        out += float(np.sum((y - X @ coef) ** 2))
+    return out
+
+
+def _motor_groups(acts: NDArray[np.bool_]) -> list[tuple[list[int], list[int]]]:
+    """The joints and motors ``acts`` (motors x joints: motor k acts on joint j) links,
+    group by group: a joint alone with its motor, a coupled wrist's joints together."""
+    group = list(range(acts.shape[1]))
+
+    def root(j: int) -> int:
+        while group[j] != j:
+            j = group[j]
+        return j
+
+    for row in acts:
+        on = np.flatnonzero(row)
+        for j in on[1:]:
+            group[root(int(j))] = root(int(on[0]))
+    roots = sorted({root(j) for j in range(acts.shape[1])})
+    out = []
+    for g in roots:
+        joints = [j for j in range(acts.shape[1]) if root(j) == g]
+        out.append((joints, [int(k) for k in np.flatnonzero(acts[:, joints].any(axis=1))]))
     return out
 
 
@@ -783,15 +960,17 @@ def _centred(x: NDArray[np.float64]) -> NDArray[np.float64]:
     return out
 
 
-def _motion_torques(
-    robot: Robot, log: TorqueLog, at: NDArray[np.intp]
+def _motion_accelerations(
+    log: TorqueLog, at: NDArray[np.intp]
 ) -> tuple[NDArray[np.float64], NDArray[np.bool_]] | None:
-    """The robot's rigid-body torques ``M ddq + c + g`` (no friction) at the samples
-    ``at`` of ``log``, and where they are known: with its logged accelerations, else the
-    central difference of its velocities over +-:data:`MOTION_HALF_SPAN_S` (at least one
-    and a half sample steps), known where that span stays inside the log and crosses no
-    gap (a step over three median steps). None when fewer than
-    :data:`MOTION_MIN_SAMPLES` samples are known."""
+    """The accelerations (at.size, n) at the samples ``at`` of ``log`` that the checks
+    against the whole rigid-body torques use, and where they are known: its logged
+    accelerations, else the central difference of its velocities over
+    +-:data:`MOTION_HALF_SPAN_S` (at least one and a half sample steps), known where that
+    span stays inside the log and crosses no gap (a step over three median steps) and the
+    states are finite. Linear in the velocities: of a log read through a drive, the
+    drive's map of the recorded ones. None when fewer than :data:`MOTION_MIN_SAMPLES`
+    samples are known."""
     t, dq = log.t, log.dq
     ts = t[at]
     if log.ddq is not None:
@@ -812,6 +991,20 @@ def _motion_torques(
     ok &= np.all(np.isfinite(ddq) & np.isfinite(log.q[at]) & np.isfinite(dq[at]), axis=1)
     if np.count_nonzero(ok) < MOTION_MIN_SAMPLES:
         return None
+    return ddq, ok
+
+
+def _motion_torques(
+    robot: Robot, log: TorqueLog, at: NDArray[np.intp]
+) -> tuple[NDArray[np.float64], NDArray[np.bool_]] | None:
+    """The robot's rigid-body torques ``M ddq + c + g`` (no friction, its spring
+    included) at the samples ``at`` of ``log``, at the accelerations
+    :func:`_motion_accelerations` gives, and where they are known (None: too few)."""
+    found = _motion_accelerations(log, at)
+    if found is None:
+        return None
+    ddq, ok = found
+    dq = log.dq
     model = np.zeros_like(ddq)
     model[ok] = rnea(robot, log.q[at][ok], dq[at][ok], ddq[ok])
     if robot.spring is not None:
