@@ -6,12 +6,14 @@ no hint); a log with a real offset on a joint is still called an offset."""
 from __future__ import annotations
 
 import dataclasses
+import json
 import warnings
 
 import numpy as np
 import pytest
 
 import dynid
+from dynid.cli.__main__ import main
 from dynid.exceptions import DynidWarning
 from dynid.io.torque_log import save_torque_log
 from dynid.simulation.measurement import SensorNoise
@@ -100,3 +102,19 @@ def test_one_flipped_recording_among_others_gets_its_own_units_entry(panda_logs)
     assert again.opposite_sign == ()
     assert again.verdict.level == "good"
     assert np.max(again.validation.errors.rms) < 1.5 * NOISE
+
+
+def test_report_headline_and_json_name_the_flipped_file(panda_logs, tmp_path):
+    """dynid validate on flip.csv: validation.json's opposite_sign holds the finding and
+    the report's headline says the file's torques read with the opposite sign."""
+    _, d = panda_logs
+    out = tmp_path / "v"
+    args = ["validate", "--robot", "panda", "--no-friction", "--data", str(d / "flip.csv")]
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", DynidWarning)
+        assert main([*args, "--out", str(out), "--no-figures"]) == 1  # unusable
+    doc = json.loads((out / "validation.json").read_text())
+    assert "--units tau4=-1 " in doc["opposite_sign"]["flip.csv"]
+    page = (out / "report.html").read_text()
+    head = page[page.index('class="headline"') :].split("</p>")[0]
+    assert "The torques of flip.csv read with the opposite sign" in head

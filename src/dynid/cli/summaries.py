@@ -399,9 +399,9 @@ def heldout_line(ho: dict[str, Any], effort: str = "torque", *, verdict_below: b
     states', each sample against its own noise) the line gives no ratio of its own and
     points to the verdict, the judged figure: beside it, the pooled error over the
     torques' noise alone was a second ratio for the same fit, of another error (every
-    fold's) over another floor (the torques' noise alone). Without, how many times the noise of the measured torques
-    (``effort="current"``: of the motor currents the torques were read from) the
-    held-out error is."""
+    fold's) over another floor (the torques' noise alone). Without, how many times the
+    noise of the measured torques (``effort="current"``: of the motor currents the
+    torques were read from) the held-out error is."""
     measured = "motor currents'" if effort == "current" else "measured torques'"
     how = {
         "file": "on the --validate-on log",

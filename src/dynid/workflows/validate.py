@@ -355,11 +355,7 @@ def validate_files(
     verdict = with_motion_range_hint(verdict, speeds, dq, names)
     files = ", ".join(f"{n} {c}" for n, c in zip(rec.names, spikes, strict=True) if c)
     verdict = with_replaced_spikes(verdict, sum(spikes), f" before judging ({files})")
-    for said in (_opposite_said(opposite), sign_map):  # the likelier causes, said first
-        if said is not None:
-            verdict = Verdict(
-                verdict.level, verdict.label, f"{said}; {verdict.reason}", verdict.ratio
-            )
+    verdict = _signs_first(verdict, opposite, sign_map)
     return ValidateResult(
         validation=val,
         model=label or f"robot {robot.name}",
@@ -503,10 +499,14 @@ def _said_signs(
     return "; ".join(found.values()) or None, opposite
 
 
-def _opposite_said(opposite: dict[str, str]) -> str | None:
-    """The findings of torques of the opposite sign (:func:`_said_signs`), each after its
-    recording's name, joined; None without one."""
-    return "; ".join(f"{name}: {said}" for name, said in opposite.items()) or None
+def _signs_first(verdict: Verdict, opposite: dict[str, str], sign_map: str | None) -> Verdict:
+    """``verdict`` with the sign findings (:func:`_said_signs`), the likelier causes, at
+    the start of its reason: the recorded sign map's, then each recording's torques of
+    the opposite sign after its name."""
+    for said in ("; ".join(f"{k}: {v}" for k, v in opposite.items()) or None, sign_map):
+        if said is not None:
+            verdict = dataclasses.replace(verdict, reason=f"{said}; {verdict.reason}")
+    return verdict
 
 
 def _reference(model: IdentifiedModel | Robot) -> Robot | None:
