@@ -3,16 +3,20 @@ perfect model leaves on them (the raw torque noise through the low-pass)."""
 
 from __future__ import annotations
 
+import json
+import re
 import warnings
 
 import numpy as np
 import pytest
 
+from dynid.cli.__main__ import main
 from dynid.cli.summaries import heldout_line
 from dynid.exceptions import DynidWarning
 from dynid.friction.model import ClassicalFriction
 from dynid.identification.selection import identify_recordings
 from dynid.identification.structure import Structure
+from dynid.io.torque_log import save_torque_log
 from dynid.simulation.measurement import SensorNoise
 
 from conftest import recordings
@@ -43,9 +47,9 @@ def test_the_floor_is_named_after_what_was_measured():
     sensors: the line said "the torque sensors' noise floor" for it."""
     ho = dict(training_error_percent=1.0, heldout_error_percent=1.5, noise_floor_percent=0.5)
     ho.update(scheme="recordings", folds=3)
-    assert "3 x the measured torques' noise alone (0.5 %;" in heldout_line(ho)
+    assert "3 x the measured torques' noise alone (0.5 %)" in heldout_line(ho)
     line = heldout_line(ho, "current")
-    assert "3 x the motor currents' noise alone (0.5 %;" in line and "sensor" not in line
+    assert "3 x the motor currents' noise alone (0.5 %)" in line and "sensor" not in line
 
 
 def _judged_on_a_separate_log(panda, train_seeds, other_seed, other_std):
@@ -84,3 +88,25 @@ def test_with_a_separate_log_the_training_error_is_read_on_the_measured_torques(
     report took for a fit that follows the noise)."""
     ho = _judged_on_a_separate_log(panda, (61, 62), 63, 0.05)
     assert ho["training_error_percent"] == pytest.approx(ho["heldout_error_percent"], rel=0.15)
+
+
+def test_the_summary_gives_one_ratio_to_the_floor_the_verdicts(panda, tmp_path, capsys):
+    """identify on a log of the true structure with 0.05 N m of noise: the summary prints
+    one ratio to a noise floor, the held-out verdict's, equal to heldout.json's, and near
+    1 (the simulated noise); the pooled line points to it (it had printed a second ratio,
+    over the torques' noise alone, beside it)."""
+    fr = ClassicalFriction(np.linspace(0.3, 0.1, 7), np.zeros(7), np.zeros(7))
+    noise = SensorNoise(tau_std=0.05, q_std=0.0, dq_std=0.0)
+    (log,) = recordings(panda, (71,), friction=fr, duration=8.0, noise=noise)
+    save_torque_log(tmp_path / "log.csv", log)
+    out = tmp_path / "id"
+    args = ["identify", "--data", str(tmp_path / "log.csv"), "--terms", "viscous"]
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", DynidWarning)
+        assert main([*args, "--out", str(out), "--no-figures"]) == 0
+    text = capsys.readouterr().out
+    ratios = re.findall(r"([0-9.]+) x the (?:noise floor|[a-z' ]*noise alone)", text)
+    doc = json.loads((out / "heldout.json").read_text())
+    assert ratios == [f"{doc['verdict']['ratio']:.3g}"]
+    assert "judged against the noise floor in the held-out verdict below" in text
+    assert 0.9 < doc["verdict"]["ratio"] < 1.3

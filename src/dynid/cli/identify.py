@@ -266,8 +266,8 @@ def run(args: argparse.Namespace, console: Console) -> int:
     )
     result = identify_files(robot, args.data, options)
     files = [save_model_json(args.out / "identification.json", result.model)]
-    text = [format_identification(result.model)]
     held = result.heldout
+    text = [format_identification(result.model, verdict_below=held is not None)]
     if held is not None:  # every sample of the figures' data, not the decimated rows
         doc = held.as_dict()
         files.append(save_json(args.out / "heldout.json", doc, schema="dynid-heldout-torques/1"))

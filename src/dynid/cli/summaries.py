@@ -56,8 +56,12 @@ def _fitted_rows(info: IdentificationInfo) -> str:
     return "rows"
 
 
-def format_identification(model: IdentifiedModel, *, width: int = 60) -> str:
-    """A readable summary: metrics, then one line per coefficient (expressions shortened)."""
+def format_identification(
+    model: IdentifiedModel, *, width: int = 60, verdict_below: bool = False
+) -> str:
+    """A readable summary: metrics, then one line per coefficient (expressions shortened).
+    ``verdict_below``: a held-out verdict is printed after it, the one ratio to the noise
+    floor the summary gives (:func:`heldout_line`)."""
     fit, info = model.fit, model.info
     if info.static is not None:
         data = f"{info.static.n_configurations} configurations"
@@ -85,7 +89,7 @@ def format_identification(model: IdentifiedModel, *, width: int = 60) -> str:
     ho = info.heldout
     if ho:
         effort = "torque" if model.drive is None else model.drive.effort
-        head.append(heldout_line(dict(ho), effort))
+        head.append(heldout_line(dict(ho), effort, verdict_below=verdict_below))
     if model.base.gap is not None:
         hi, lo = model.base.gap
         head.append(
@@ -410,12 +414,18 @@ def columns_text(model: IdentifiedModel) -> str:
     return f"columns: {cols}, rank {model.fit.rank} of {r + k}"
 
 
-def heldout_line(ho: dict[str, Any], effort: str = "torque") -> str:
-    """The training and held-out errors of least squares (``info.heldout``), and how many
-    times the noise of the measured torques (``effort="current"``: of the motor currents
-    the torques were read from) the held-out error is: the sensors' alone, beside the
-    held-out verdict, whose floor adds the noise the prepared states put into the
-    prediction (it read "2.59 x the noise floor" beside "at the noise floor, 1.01 x")."""
+def heldout_line(ho: dict[str, Any], effort: str = "torque", *, verdict_below: bool = False) -> str:
+    """The training and held-out errors of least squares (``info.heldout``: every fold
+    predicted by the fit of the others, pooled; the structure's choice reads them).
+
+    With ``verdict_below`` (the held-out verdict printed after it, ``heldout.json``'s:
+    one block, or the separate log, against the floor of the torques' noise and the
+    states', each sample against its own noise) the line gives no ratio of its own and
+    points to the verdict, the judged figure: beside it, the pooled error over the
+    torques' noise alone was a second ratio for the same fit, of another error (every
+    fold's) over another floor (the torques' noise alone). Without, how many times the
+    noise of the measured torques (``effort="current"``: of the motor currents the
+    torques were read from) the held-out error is."""
     measured = "motor currents'" if effort == "current" else "measured torques'"
     how = {
         "file": "on the --validate-on log",
@@ -423,10 +433,12 @@ def heldout_line(ho: dict[str, Any], effort: str = "torque") -> str:
     }.get(str(ho.get("scheme")), f"over {ho.get('folds')} contiguous time blocks")
     floor = ho.get("noise_floor_percent")
     said = (
-        ""
+        "; judged against the noise floor in the held-out verdict below"
+        if verdict_below
+        else ""
         if floor is None
         else f"; {ho['heldout_error_percent'] / floor:.3g} x the {measured} noise alone "
-        f"({floor:.3g} %; the verdict's floor below adds the prepared states' noise)"
+        f"({floor:.3g} %)"
         if floor > 0
         else ""
     )

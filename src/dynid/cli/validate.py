@@ -36,7 +36,11 @@ The verdict weighs the relative error against the sensor-noise floor read from t
 measured torques (the smallest error a model can reach on them): "at the noise floor"
 (at most 1.5 x the floor), "usable" (at most 3 x, or below 15 %), "poor" (below 50 %: the
 model misses effects the data show), "unusable" (50 % or more, or torques anti-correlated
-with the model's: a log of another robot, in other units or of the other sign). With
+with the model's: a log of another robot, in other units or of the other sign). A
+recording whose torques read with the opposite sign on some joints or on all (the check
+identify and observe refuse it by) is named at the start of the verdict with those joints
+and the --units entries that read them (of that file alone, --units rec2.csv:tau4=-1, when
+the other recordings read right), and in validation.json's "opposite_sign". With
 several recordings, a recording worse than the whole is named. When most of the error
 above the noise sits at low speed (standstill, reversals, the edges of a move: where the
 velocities' noise and low-pass blur a friction step) the verdict says so, with the error

@@ -300,7 +300,8 @@ def identify(
         warnings.warn(msg, DynidWarning, stacklevel=2)
     info = _record(data, columns, fit, stack, est.name, std, max_std_percent, rtol)
     if held is not None:
-        errors = cross_validate(held.restricted(np.flatnonzero(fit.kept)))
+        kept = np.flatnonzero(fit.kept)
+        errors = cross_validate(held.restricted(kept), fit=np.asarray(fit.beta)[kept])
         info = dataclasses.replace(info, heldout=errors.as_dict())
     return _model(robot, columns, fit, info, held)
 

@@ -24,7 +24,7 @@ from .core import Judge, ModelColumns, RegressorStack, StreamedRows, selected_co
 from .estimators import Estimator, row_weights
 from .holdout import HeldOut, Normals, block_normals
 from .recordings import Recordings
-from .streaming import BlockSource, normals_by_label, normals_by_label_scaled
+from .streaming import BlockSource, normals_by_label_scaled
 from .verdict import NOISE_FLOOR_SHARE
 
 __all__ = ["NOISE_FLOOR_SHARE", "heldout_judge", "inverse_noise"]
@@ -61,7 +61,7 @@ def heldout_judge(
         if isinstance(stack, StreamedRows) and stack.normals is not None and validation is None:
             assert labels is not None  # the fit gathered the folds' normals by these labels
             source = rows if measured_ok else selected_columns(stack.source, cols)
-            plain, white = normals_by_label_scaled(source, labels, None, inv_noise)
+            plain, white = normals_by_label_scaled(source, labels, None, inv_noise, b)
             judged = plain if measured_ok else None
             held = replace(HeldOut.k_fold(stack.normals, judged), scheme=scheme, whitened=white)
             return held.expanded(cols)
@@ -70,18 +70,18 @@ def heldout_judge(
             e = np.concatenate([y - W @ b for W, y, _ in source()])
             rw = estimator.row_weights(e, np.tile(np.arange(data.n), e.size // data.n), b.size)
             m = e.size
-            normals = lambda lab: normals_by_label(source, lab, rw)  # noqa: E731
+            normals = lambda lab: normals_by_label_scaled(source, lab, rw, None, b)[0]  # noqa: E731
             fitted = source
         else:
             W = stack.W if cols.all() else stack.W[:, cols]
             rw = row_weights(estimator, W, stack.y, stack.groups, b)
             Ww, yw, m = W * rw[:, None], stack.y * rw, stack.y.size
-            normals = lambda lab: block_normals(Ww, yw, lab)  # noqa: E731
+            normals = lambda lab: block_normals(Ww, yw, lab, b)  # noqa: E731
             fitted = lambda: iter([(W, stack.y, stack.groups)])  # noqa: E731
         if validation is not None:
             test, test_white = _normals(robot, validation, columns, cols)
             one = np.zeros(m, np.intp)  # the training error on the torques as measured too
-            whole = normals_by_label_scaled(rows, one)[0][0] if measured_ok else None
+            whole = normals_by_label_scaled(rows, one, origin=b)[0][0] if measured_ok else None
             held = HeldOut.separate(normals(one)[0], test, whole)
             held = held if test_white is None else replace(held, whitened=(test_white,))
         elif labels is None:
@@ -93,7 +93,7 @@ def heldout_judge(
             # measured rows judged unweighted too, the error of the torques as measured
             # (weighted, an irls fit read 40 % above the same model's plain error)
             plain, white = normals_by_label_scaled(
-                rows if measured_ok else fitted, labels, None if measured_ok else rw, inv_noise
+                rows if measured_ok else fitted, labels, None if measured_ok else rw, inv_noise, b
             )
             judged = plain if measured_ok else None
             held = replace(HeldOut.k_fold(normals(labels), judged), scheme=scheme, whitened=white)

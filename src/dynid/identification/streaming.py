@@ -405,10 +405,13 @@ def normals_by_label_scaled(
     labels: NDArray[np.intp],
     weights: NDArray[np.float64] | None = None,
     group_scale: NDArray[np.float64] | None = None,
+    origin: NDArray[np.float64] | None = None,
 ) -> tuple[tuple[Normals, ...], tuple[Normals, ...]]:
     """:func:`normals_by_label` of the rows times ``weights``, and in the same pass those
     of the rows times ``group_scale[group]`` (each row's noise group: a joint) alone (empty
-    without ``group_scale``).
+    without ``group_scale``). ``origin`` (p,): the fit's coefficients, whose residual on
+    the rows each set's normal equations keep (:attr:`~.holdout.Normals.origin`), so that
+    an error far below the torques' norm is resolved.
 
     Raises
     ------
@@ -420,6 +423,7 @@ def normals_by_label_scaled(
     G: list[NDArray[np.float64]] = []
     b: list[NDArray[np.float64]] = []
     c = np.zeros((sets, k))
+    e0 = np.zeros((sets, k))
     o = 0
     for W, y, g in _blocks(source):
         if not G:
@@ -445,12 +449,18 @@ def normals_by_label_scaled(
                 G[s_][j] += Wj.T @ Wj
                 b[s_][j] += Wj.T @ yj
                 c[s_, j] += float(yj @ yj)
+                if origin is not None:
+                    r = yj - Wj @ origin
+                    e0[s_, j] += float(r @ r)
         o += y.size
     if o != labels.size or not G:
         raise ShapeError(f"labels hold {labels.size} rows; the blocks {o}")
     cnt = np.bincount(labels, minlength=k)
     out = [
-        tuple(Normals(G[s_][j], b[s_][j], float(c[s_, j]), int(cnt[j])) for j in range(k))
+        tuple(
+            Normals(G[s_][j], b[s_][j], float(c[s_, j]), int(cnt[j]), origin, float(e0[s_, j]))
+            for j in range(k)
+        )
         for s_ in range(sets)
     ]
     return out[0], (out[1] if sets == 2 else ())

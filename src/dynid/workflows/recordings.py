@@ -52,7 +52,6 @@ from ..identification.pieces import with_start_turns
 from ..identification.sanity import (
     despiked,
     moving_joints,
-    opposite_sign,
     opposite_sign_among,
     sign_confirmed,
     spike_finding,
@@ -84,6 +83,7 @@ __all__ = [
     "check_derived_velocities",
     "check_limits",
     "check_signs",
+    "sign_findings",
     "warn_signs",
     "recorded_sign_map_findings",
     "check_torque_unit",
@@ -385,18 +385,36 @@ def check_degrees(rec: Recorded, robot: Robot) -> None:
         raise DataError(found[1], file=rec.names[found[0]])
 
 
-def warn_signs(rec: Recorded, robot: Robot, skip: Sequence[str] = ()) -> None:
+def sign_findings(rec: Recorded, robot: Robot, skip: Sequence[str] = ()) -> dict[str, str]:
+    """Per recording (by name), the finding that its (joint-side) torques have the
+    opposite sign to the robot's on every joint gravity loads or on some
+    (:func:`~dynid.identification.sanity.opposite_sign_among`: the joints named and the
+    ``--units`` entries that read them, the recording's own, ``rec2.csv:tau4=-1``, when
+    another reads right); the one rule :func:`check_signs` refuses by and
+    :func:`warn_signs` warns by. Recordings too short to judge and those named in
+    ``skip`` are left out; empty when every recording reads right."""
+    sides = rec.joint_side
+    out: dict[str, str] = {}
+    for k, (name, log) in enumerate(zip(rec.names, sides, strict=True)):
+        if name in skip or too_few_samples(log) is not None:
+            continue
+        others = (x for i, x in enumerate(sides) if i != k)
+        if (opposite := opposite_sign_among(robot, log, name, others)) is not None:
+            out[name] = opposite
+    return out
+
+
+def warn_signs(rec: Recorded, robot: Robot, skip: Sequence[str] = ()) -> dict[str, str]:
     """Warn of each recording whose (joint-side) torques have the opposite sign to the
-    robot's (:func:`~dynid.identification.sanity.opposite_sign`, the finding
-    :func:`check_signs` refuses with), naming the file: ``validate`` judges such a log
+    robot's (:func:`sign_findings`, the finding :func:`check_signs` refuses with), naming
+    the file, and return the findings by recording: ``validate`` judges such a log
     "unusable" and writes its files, and said only "of another sign?" without the joints
     or the ``--units`` entries that read them. The recordings ``skip`` (by name) are left
     out (their sign said otherwise: :func:`recorded_sign_map_findings`)."""
-    for name, log in zip(rec.names, rec.joint_side, strict=True):
-        if name in skip:
-            continue
-        if too_few_samples(log) is None and (opposite := opposite_sign(robot, log)):
-            warnings.warn(f"{name}: {opposite}", DynidWarning, stacklevel=3)
+    found = sign_findings(rec, robot, skip)
+    for name, opposite in found.items():
+        warnings.warn(f"{name}: {opposite}", DynidWarning, stacklevel=3)
+    return found
 
 
 def recorded_sign_map_findings(
@@ -473,14 +491,11 @@ def check_signs(rec: Recorded, robot: Robot) -> None:
         columns to flip; of that recording alone, ``rec2.csv:tau2=-1``, when the others
         read right).
     """
-    sides = rec.joint_side
-    for name, log in zip(rec.names, sides, strict=True):
+    for name, log in zip(rec.names, rec.joint_side, strict=True):
         if (few := too_few_samples(log)) is not None:  # before the correlations
             raise DataError(few, file=name)
-    for k, (name, log) in enumerate(zip(rec.names, sides, strict=True)):
-        others = (x for i, x in enumerate(sides) if i != k)
-        if (opposite := opposite_sign_among(robot, log, name, others)) is not None:
-            raise DataError(opposite, file=name)
+    for name, opposite in sign_findings(rec, robot).items():
+        raise DataError(opposite, file=name)
 
 
 def check_torque_unit(rec: Recorded, robot: Robot, cmap: ColumnMap | None) -> None:

@@ -191,6 +191,14 @@ class ValidateResult:
         recording, the finding (naming the file, the joints and the ``--units`` that
         overrides it; :func:`~dynid.workflows.recordings.recorded_sign_map_findings`),
         also the start of ``verdict``'s reason; None otherwise.
+    opposite_sign : tuple of (str, str)
+        Per recording whose torques read with the opposite sign to the model's on some
+        joints or on all, its name and the finding (naming the joints and the
+        ``--units`` entries that read them, the recording's own, ``rec2.csv:tau4=-1``,
+        when another reads right: :func:`~dynid.workflows.recordings.sign_findings`, the
+        rule ``identify`` and ``observe`` refuse by), said at the start of ``verdict``'s
+        reason (after ``sign_map``) in place of a diagnosis of the residual; empty
+        otherwise.
     """
 
     validation: RecordingsValidation
@@ -207,6 +215,7 @@ class ValidateResult:
     input_noise_rms: NDArray[np.float64] | None = None
     joint_ratios: NDArray[np.float64] | None = None
     sign_map: str | None = None
+    opposite_sign: tuple[tuple[str, str], ...] = ()
 
     def metadata(self) -> dict[str, Any]:
         """The keys ``validation.json`` records beside the errors: ``model``,
@@ -215,6 +224,9 @@ class ValidateResult:
         ``input_noise_rms`` (its parts, when known), ``joint_ratios`` (each joint's error
         over its noise as the verdict weighed it, when known), ``torque_spikes_replaced`` (per file,
         when known), ``sign_map`` (the recorded sign map's finding, when there is one),
+        ``opposite_sign`` (by file, the finding that its torques read with the opposite
+        sign on some joints or on all, with the ``--units`` that reads them; when there is
+        one),
         ``verdict`` (``level``, ``label``, ``reason``) and ``joint_names`` (when known)."""
         v = self.verdict
         spikes = dict(zip(self.files, self.spikes, strict=True)) if self.spikes else None
@@ -238,6 +250,7 @@ class ValidateResult:
             **parts,
             **({"torque_spikes_replaced": spikes} if spikes is not None else {}),
             **({"sign_map": self.sign_map} if self.sign_map is not None else {}),
+            **({"opposite_sign": dict(self.opposite_sign)} if self.opposite_sign else {}),
             "verdict": {"level": v.level, "label": v.label, "reason": v.reason},
         } | ({"joint_names": list(self.joint_names)} if self.joint_names else {})
 
@@ -297,8 +310,12 @@ def validate_files(
         max_gap_s=opt.max_gap_s,
         reference=_reference(model),
     )
+<<<<<<< HEAD
     sign_map = _said_signs(rec, model, opt)  # before the verdict, naming the joints
     _say_training_data(model, rec.names)
+=======
+    sign_map, opposite = _said_signs(rec, model, opt)  # before the verdict, naming the joints
+>>>>>>> validate
     rec, spikes = despiked_recordings(rec, robot.joint_names, SPIKES_BEFORE_JUDGING)
     friction, source = _friction(model, opt.friction, feasible, placed)
 
@@ -334,16 +351,16 @@ def validate_files(
     dq = [v.log.dq for v in val.parts]
     # a motion beyond the identification's is the likelier cause of what the residual follows
     beyond = motion_range_hint(speeds, dq, names) is not None
+    # a torque of the opposite sign leaves twice the torque, which no term of the model
+    # explains: what the residual follows is not diagnosed (it read as an offset)
+    dependence = not beyond and not opposite
     verdict = _with_hints(
-        model, verdict, val, rec.logs, noise, names, dependence=not beyond, terms=held_terms(model)
+        model, verdict, val, rec.logs, noise, names, dependence=dependence, terms=held_terms(model)
     )
     verdict = with_motion_range_hint(verdict, speeds, dq, names)
     files = ", ".join(f"{n} {c}" for n, c in zip(rec.names, spikes, strict=True) if c)
     verdict = with_replaced_spikes(verdict, sum(spikes), f" before judging ({files})")
-    if sign_map is not None:  # the likelier cause, said first
-        verdict = Verdict(
-            verdict.level, verdict.label, f"{sign_map}; {verdict.reason}", verdict.ratio
-        )
+    verdict = _signs_first(verdict, opposite, sign_map)
     return ValidateResult(
         validation=val,
         model=label or f"robot {robot.name}",
@@ -359,6 +376,7 @@ def validate_files(
         input_noise_rms=noise.inputs,
         joint_ratios=noise.ratios,
         sign_map=sign_map,
+        opposite_sign=tuple(opposite.items()),
     )
 
 
@@ -467,12 +485,14 @@ def _judged(
     return verdict, _Noise(fl.sensor_rms, fl.input_rms, fl.total_rms, fl.joint_ratios), fl.percent
 
 
-def _said_signs(rec: Recorded, model: IdentifiedModel | Robot, opt: ValidateOptions) -> str | None:
+def _said_signs(
+    rec: Recorded, model: IdentifiedModel | Robot, opt: ValidateOptions
+) -> tuple[str | None, dict[str, str]]:
     """Warn of the recordings whose torques look of the opposite sign: first those for
     which the model's recorded sign map looks wrong
     (:func:`~dynid.workflows.recordings.recorded_sign_map_findings`), then the others
-    (:func:`~dynid.workflows.recordings.warn_signs`); the former's findings, joined, or
-    None."""
+    (:func:`~dynid.workflows.recordings.warn_signs`, the rule ``identify`` and ``observe``
+    refuse by); the former's findings, joined, or None, and the latter's by recording."""
     robot = model.robot if isinstance(model, IdentifiedModel) else model
     ref = _reference(model) or robot
     recorded = model.info.column_map if isinstance(model, IdentifiedModel) else None
@@ -480,8 +500,18 @@ def _said_signs(rec: Recorded, model: IdentifiedModel | Robot, opt: ValidateOpti
     found = recorded_sign_map_findings(rec, ref, recorded, units)
     for text in found.values():
         warnings.warn(text, DynidWarning, stacklevel=3)
-    warn_signs(rec, ref, skip=tuple(found))
-    return "; ".join(found.values()) or None
+    opposite = warn_signs(rec, ref, skip=tuple(found))
+    return "; ".join(found.values()) or None, opposite
+
+
+def _signs_first(verdict: Verdict, opposite: dict[str, str], sign_map: str | None) -> Verdict:
+    """``verdict`` with the sign findings (:func:`_said_signs`), the likelier causes, at
+    the start of its reason: the recorded sign map's, then each recording's torques of
+    the opposite sign after its name."""
+    for said in ("; ".join(f"{k}: {v}" for k, v in opposite.items()) or None, sign_map):
+        if said is not None:
+            verdict = dataclasses.replace(verdict, reason=f"{said}; {verdict.reason}")
+    return verdict
 
 
 def _say_training_data(model: IdentifiedModel | Robot, names: Sequence[str]) -> None:
