@@ -310,12 +310,8 @@ def validate_files(
         max_gap_s=opt.max_gap_s,
         reference=_reference(model),
     )
-<<<<<<< HEAD
-    sign_map = _said_signs(rec, model, opt)  # before the verdict, naming the joints
-    _say_training_data(model, rec.names)
-=======
     sign_map, opposite = _said_signs(rec, model, opt)  # before the verdict, naming the joints
->>>>>>> validate
+    _say_training_data(model, rec.names)
     rec, spikes = despiked_recordings(rec, robot.joint_names, SPIKES_BEFORE_JUDGING)
     friction, source = _friction(model, opt.friction, feasible, placed)
 
