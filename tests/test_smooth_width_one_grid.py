@@ -25,6 +25,7 @@ from dynid.identification.structure import (
     smooth_width,
     smooth_width_grid,
 )
+from dynid.simulation.measurement import SensorNoise
 
 from conftest import recordings
 
@@ -68,3 +69,18 @@ def test_friction_and_identify_choose_the_same_width(smooth_log):
     auto = select_friction(res, candidates=["classical", "smooth"])
     assert auto.chosen == "smooth"
     np.testing.assert_allclose(auto.fit.friction.band, TRUE_FACTOR * MIN_WIDTH, rtol=1e-12)
+
+
+def test_the_same_width_on_a_noisy_log():
+    """With sensor noise (standstill band about 1.3 mrad/s) and a true width of 0.15 rad/s
+    (about 110 bands), identify's selection and the friction command both choose 100
+    bands."""
+    panda = dynid.panda()
+    P = np.tile([0.1, 0.4, 0.0], (7, 1))
+    truth = LAWS["smooth"].model(P, np.full(7, 0.15))
+    log = recordings(panda, (3,), friction=truth, duration=4.0, noise=SensorNoise())[0]
+    data = prepare_recordings(panda, [log], cutoff_hz=20.0)
+    cands = [Structure(False, ("viscous", "smooth", "offset"), width=w) for w in SMOOTH_WIDTHS]
+    sel = select_structure(panda, data, candidates=cands, per_joint=False)
+    res = friction_residual(panda, log, Preprocessing(cutoff_hz=20.0, filter_tau=False))
+    assert sel is not None and sel.chosen.width == choose_smooth_width(res) == 100.0
