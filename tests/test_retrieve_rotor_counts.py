@@ -4,11 +4,13 @@ retrieved parameters the data do not determine are marked as taken from the prio
 
 from __future__ import annotations
 
+import re
 import warnings
 
 import numpy as np
 import pytest
 
+from dynid.cli.__main__ import main
 from dynid.cli.summaries import format_consistent
 from dynid.exceptions import DynidWarning
 from dynid.feasibility.determined import DATA, determined_by_data
@@ -46,7 +48,7 @@ def retrieved(tmp_path_factory):
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", DynidWarning)
         result = retrieve_files(path, RetrieveOptions(prior=prior)).result
-    return panda, logs, model, result
+    return panda, logs, model, result, path
 
 
 def _independent_sources(panda, logs) -> tuple[int, int, np.ndarray]:
@@ -80,7 +82,7 @@ def test_counts_and_prior_rotors_match_an_independent_rank_test(retrieved):
     """The counts are the link regressor's rank and what the rotors' columns add, and
     the rotors marked as taken from the prior are exactly those whose column lies in the
     span of the others (SVD rank of the stacked regressor; the Panda's motors 1 and 2)."""
-    panda, logs, model, result = retrieved
+    panda, logs, model, result, _ = retrieved
     links, rotors, in_span = _independent_sources(panda, logs)
     det = result.determined
     assert det is not None
@@ -102,7 +104,7 @@ def test_determined_parameters_match_the_truth(retrieved):
     """The rotor inertias and link parameters the data determine are the truth's to
     1e-6 (relative) although the prior is 20 % off; the links' determined parameters
     include the standard parameters the base gives alone (``J7zz``)."""
-    panda, logs, model, result = retrieved
+    panda, logs, model, result, _ = retrieved
     det = determined_by_data(model)
     src = dict(zip(det.labels, det.source, strict=True))
     ia = np.asarray(result.rotor_inertia)
@@ -114,3 +116,22 @@ def test_determined_parameters_match_the_truth(retrieved):
     got = [k for k, lab in enumerate(det.labels[:70]) if src[lab] == DATA]
     assert "J7zz" in [det.labels[k] for k in got]
     np.testing.assert_allclose(phi[got], truth[got], atol=1e-6 * scale)
+
+
+def test_the_report_page_says_the_counts_and_the_rotors_from_the_prior(retrieved, tmp_path):
+    """``dynid retrieve``'s report.html: the counts, a rotor table whose motors 1 and 2
+    say "the prior", and a mass column (link 1's mass: not excited)."""
+    *_, path = retrieved
+    out = tmp_path / "ret"
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", DynidWarning)
+        assert (
+            main(["retrieve", "--model", str(path), "--out", str(out), "-q", "--no-figures"]) == 0
+        )
+    page = (out / "report.html").read_text()
+    text = re.sub(r"<[^>]+>", "", page)
+    assert "Coefficients: 43 link base parameters + 5 rotor inertias (armatures)" in text
+    rotors = page[page.index("Rotor inertias (armatures)") :]
+    rows = rotors.split("<tr>")[2:9]
+    assert ["the prior" in r for r in rows] == [True, True] + [False] * 5
+    assert "mass from" in page and "the data do not excite it" in page
