@@ -8,13 +8,16 @@ recordings: on all but one recording in turn), predicts the block left out, keep
 simplest law within one standard error of the lowest held-out error, each joint in units
 of its own torque noise, as identify chooses its structure, among the laws whose
 friction is dissipative within the robot's velocity limits, the offset aside (a law that
-pushes the arm somewhere is marked x and set aside, as identify skips such a structure;
+pushes the arm somewhere by more than 2 standard deviations of its fitted torque, a linear
+law's uncertainty, is marked x and set aside, as identify skips such a structure;
 when every law does, the choice says so in a warning) (the model's own friction is a
 candidate too, judged on the same blocks: as it is, or its own law, band and coefficients
 refitted on the other blocks when --model was identified from these recordings, the law
 it was trained with; a robot's own friction is never refitted; kept, it is kept as it is,
 friction at the motors and at the joints both) and prints the table; a law's name fits
-that law. smooth_stribeck is compared only when the model's own friction is that law.
+that law. The smooth law's width tanh(dq / w) is chosen on the same held-out blocks among
+the widths identify searches (0.3 to 300 standstill bands), by name and in the
+comparison. smooth_stribeck is compared only when the model's own friction is that law.
 The rigid-body model is not refitted per block: on the recordings --model was identified
 from, the errors are training errors of the links (validate judges new data). --data
 takes several recordings (or a folder of them): each recording, and each piece of one

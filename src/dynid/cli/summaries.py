@@ -11,8 +11,10 @@ from numpy.typing import NDArray
 
 from ..feasibility.constraints import principal_moments
 from ..feasibility.convex import ConsistentResult
+from ..feasibility.determined import PRIOR, SUM
 from ..feasibility.heldout import HeldOutJudgement
 from ..feasibility.penalty import RetrievalProgress, RetrievalResult
+from ..feasibility.result import FeasibleResult
 from ..friction.fit import FrictionFit
 from ..friction.model import friction_parts
 from ..friction.validation import NewtonEulerValidation
@@ -523,6 +525,7 @@ def format_retrieval(result: RetrievalResult) -> str:
         f"{_stage_costs(r.stage_costs)}; {r.run_time:.1f} s on {r.workers} worker(s), "
         f"seed {r.seed}",
     ]
+    lines += _determined_lines(r)
     if not r.feasible:
         lines.append(str(r.report))
     return "\n".join(lines)
@@ -629,50 +632,51 @@ def format_consistent(result: ConsistentResult) -> str:
             + "; q0 [rad]: "
             + " ".join(f"{x:.4g}" for x in r.spring.q0)
         )
-    prior_masses, prior_rotors = _decided_by_prior(r)
-    if r.rotor_inertia is not None:
-        lines.append(
-            "rotor inertia at the motors [kg m^2] (>= 0): "
-            + " ".join(
-                f"{x:.4g}" + ("*" if prior_rotors[m] else "") for m, x in enumerate(r.rotor_inertia)
-            )
-        )
-        if prior_rotors.any():
-            motors = ", ".join(str(m + 1) for m in np.flatnonzero(prior_rotors))
-            lines.append(
-                f"  * rotor(s) {motors}: the data give each only in a sum with link inertias "
-                "(in beta): the prior and the constraints decide its share"
-            )
-    if prior_masses:
-        lines.append(
-            "note: masses the data do not give (unidentifiable: "
-            + ", ".join(prior_masses)
-            + "): the prior, the bounds and the total-mass band decide them"
-        )
+    lines += _determined_lines(r)
     lines += [f"note: {s}" for s in r.notes]
     if not r.feasible:
         lines.append(str(r.report))
     return "\n".join(lines)
 
 
-def _decided_by_prior(r: ConsistentResult) -> tuple[list[str], NDArray[np.bool_]]:
-    """What the data of a one-step consistent fit do not give and the prior decides: the
-    unidentifiable link masses (their labels) and the rotors (n,) regrouped with link
-    inertias."""
-    n = 0 if r.rotor_inertia is None else len(r.rotor_inertia)
-    rotors = np.zeros(n, dtype=bool)
-    model = r.identified
-    if model is None:
-        return [], rotors
-    status = dict(zip(model.base.std_labels, identifiability(model.base), strict=True))
-    masses = [
-        f"m{i}" for i in range(1, model.robot.n + 1) if status.get(f"m{i}") == "unidentifiable"
-    ]
-    for t in model.terms.values():
-        shares = t.term.inertia(t.regrouped.astype(np.float64))
-        if shares is not None and shares.shape == rotors.shape:
-            rotors |= shares > 0
-    return masses, rotors
+def _determined_lines(r: FeasibleResult) -> list[str]:
+    """What the identified coefficients hold (``N link base parameters + K rotor inertias
+    (armatures)``), the rotor inertias retrieved with those the data do not give alone
+    marked ``*`` (taken from the prior), and the link masses the data do not excite."""
+    det = r.determined
+    out = [] if det is None else [f"coefficients: {det.counts()}"]
+    src = None if det is None else det.rotor_source
+    if r.rotor_inertia is not None:
+        ia = np.asarray(r.rotor_inertia)
+        marked = [s in (SUM, PRIOR) for s in src] if src and len(src) == ia.size else []
+        out.append(
+            "rotor inertia at the motors [kg m^2] (>= 0): "
+            + " ".join(f"{x:.4g}" + ("*" if marked and marked[m] else "") for m, x in enumerate(ia))
+        )
+        if any(marked):
+            summed = [str(m + 1) for m, s in enumerate(src or ()) if s == SUM]
+            unexcited = [str(m + 1) for m, s in enumerate(src or ()) if s == PRIOR]
+            if summed:
+                out.append(
+                    f"  * rotor(s) {', '.join(summed)}: from the prior: the data give each only "
+                    "in a sum with link inertias (in beta): the prior and the constraints "
+                    "decide its share"
+                )
+            if unexcited:
+                out.append(
+                    f"  * rotor(s) {', '.join(unexcited)}: from the prior: the data do not "
+                    "excite them"
+                )
+    masses = (
+        [] if det is None else [f"m{i + 1}" for i, s in enumerate(det.mass_source) if s == PRIOR]
+    )
+    if masses:
+        out.append(
+            "note: masses the data do not give (unidentifiable: "
+            + ", ".join(masses)
+            + "): the prior, the bounds and the total-mass band decide them"
+        )
+    return out
 
 
 def format_rms_table(names: list[str], columns: dict[str, np.ndarray]) -> str:

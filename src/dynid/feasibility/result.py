@@ -32,6 +32,7 @@ from ..model.robot import Robot
 from ..model.stiffness import JointStiffness
 from .bounds import Bounds
 from .constraints import FeasibilityReport
+from .determined import Determined
 from .heldout import HeldOutJudgement
 from .lmi import pseudo_inertia_margin
 
@@ -87,6 +88,11 @@ class FeasibleResult:
     heldout : HeldOutJudgement or None
         Training and held-out errors against least squares and the acceptance, when the
         data held held-out folds.
+    determined : Determined or None
+        Of an identified model's coefficients: how many are link base parameters and how
+        many rotor inertias, and which retrieved parameters (masses, rotor inertias) the
+        data determine and which the prior decides (:mod:`dynid.feasibility.determined`);
+        None from static data.
     method : str
         Class attribute: ``"sdp"`` or ``"penalty"``.
     nullable_fields : frozenset of str
@@ -112,6 +118,7 @@ class FeasibleResult:
     drive: Drive | None = None
     spring: JointStiffness | None = None
     heldout: HeldOutJudgement | None = None
+    determined: Determined | None = None
 
     method: ClassVar[str] = ""
     nullable_fields: ClassVar[frozenset[str]] = frozenset()

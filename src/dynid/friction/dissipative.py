@@ -14,6 +14,13 @@ level ``(fc+ + fc-) / 2`` judged (``fc+ = 7.86``, ``fc- = -13.8`` on a UR5 elbow
 and a Coulomb level of -2.97 N m that pushes the arm). A law at the motors of a drive is
 checked per motor up to ``sum_j |K_mj| dq_max_j``
 (:func:`~dynid.identification.dissipation.speed_limits`).
+
+With the fitted parameters' covariance ``C`` (a law linear in them:
+:attr:`~dynid.friction.fit.FrictionFit.covariance`), a velocity counts only where the
+law pushes beyond its uncertainty: ``f_odd(v) sign(v) < -ALLOWANCE_STD sigma(v)``, with
+``sigma(v)^2 = a(v)^T C a(v)`` the variance of ``f_odd(v) = a(v)^T p`` (a Coulomb level of
+-0.002 N m fitted with a standard deviation of 0.003 N m on a joint without Coulomb
+friction is no violation; one of -0.5 N m is).
 """
 
 from __future__ import annotations
@@ -22,16 +29,24 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from ..identification.dissipation import Violation, power_violations, speed_limits
+from .laws.base import _LinearFit
 from .model import FrictionModel, FrictionSum, friction_parts
 
-__all__ = ["law_violations"]
+__all__ = ["ALLOWANCE_STD", "law_violations"]
+
+#: Standard deviations of the law's odd torque by which it may push the arm before it is
+#: flagged (the fit's uncertainty; about 2: a 5 % chance for a truly dissipative law).
+ALLOWANCE_STD = 2.0
 
 
 def law_violations(
-    friction: FrictionModel | FrictionSum, dq_max: ArrayLike
+    friction: FrictionModel | FrictionSum,
+    dq_max: ArrayLike,
+    covariance: ArrayLike | None = None,
 ) -> tuple[Violation, ...]:
-    """Where ``friction`` is not dissipative within the velocity limits, its offset aside
-    (module docstring).
+    """Where ``friction`` is not dissipative within the velocity limits, its offset aside,
+    beyond :data:`ALLOWANCE_STD` standard deviations when its covariance is given (module
+    docstring).
 
     Parameters
     ----------
@@ -40,6 +55,9 @@ def law_violations(
         each judged where they act.
     dq_max : array_like, shape (n,)
         Joint velocity limits [rad/s] (``inf``: a joint not checked).
+    covariance : array_like, shape (n, k, k), optional
+        The covariance of each joint's (motor's) ``k`` parameters of a law linear in them
+        (:attr:`~dynid.friction.fit.FrictionFit.covariance`); None: no allowance.
 
     Returns
     -------
@@ -54,9 +72,21 @@ def law_violations(
         K = part.transmission if part.at_motors else np.eye(part.n)
         vmax = speed_limits(K, dq_max)
 
-        def odd(v: NDArray[np.float64], part: FrictionModel = part) -> NDArray[np.float64]:
+        C = _linear_covariance(part, covariance) if len(friction_parts(friction)) == 1 else None
+
+        def odd(
+            v: NDArray[np.float64],
+            part: FrictionModel = part,
+            C: NDArray[np.float64] | None = C,
+        ) -> NDArray[np.float64]:
             law, p, b = part.law, part.params, part.band
-            return np.asarray(0.5 * (law.torques(v, p, b) - law.torques(-v, p, b)))
+            f = np.asarray(0.5 * (law.torques(v, p, b) - law.torques(-v, p, b)))
+            if C is None:
+                return f
+            assert isinstance(law.fit, _LinearFit)  # (_linear_covariance checked it)
+            a = 0.5 * (law.fit.columns(v, b) - law.fit.columns(-v, b))  # (s, n, k)
+            sigma = np.sqrt(np.maximum(np.einsum("snk,nkl,snl->sn", a, C, a), 0.0))
+            return f + ALLOWANCE_STD * sigma * np.sign(v)  # moved towards dissipating
 
         coefficients = [
             {f"{name}{j + 1}": float(P[j, i]) for i, name in enumerate(part.names)}
@@ -64,3 +94,15 @@ def law_violations(
         ]
         out += power_violations(odd, vmax, coefficients, place)
     return tuple(out)
+
+
+def _linear_covariance(
+    part: FrictionModel, covariance: ArrayLike | None
+) -> NDArray[np.float64] | None:
+    """``covariance`` as (n, k, k) for ``part``'s law, linear in its ``k`` parameters;
+    None without one or for a law that is not linear (no allowance)."""
+    if covariance is None or not isinstance(part.law.fit, _LinearFit):
+        return None
+    C = np.asarray(covariance, dtype=np.float64)
+    k = len(part.law.params)
+    return C if C.shape == (part.n, k, k) and np.all(np.isfinite(C)) else None

@@ -49,9 +49,11 @@ from ..identification.model import IdentifiedModel
 from ..identification.prepare import MEASURED, Preprocessing, prepare_log
 from ..identification.recordings import standstill_band
 from ..identification.sanity import NOISE_BAND_STD, moving_joints, noise_band, velocity_noise_std
+from ..identification.structure import smooth_width
 from ..model.drive import Drive
 from ..model.robot import Robot
 from .laws import FrictionLaw, law_named
+from .laws.base import _LinearFit
 from .model import FrictionModel, FrictionSum
 
 __all__ = [
@@ -309,6 +311,12 @@ class FrictionFit:
     identified : ndarray of bool, shape (n,)
         Joints whose friction was fitted; the others never left their velocity noise
         band and have zero friction (:func:`moving_joints`).
+    covariance : ndarray, shape (n, k, k), or None
+        Of a law linear in its ``k`` parameters: each joint's (motor's) covariance of its
+        parameters [their units squared], ``s^2 (A^T A)^+`` of its columns ``A`` and
+        residual variance ``s^2`` (the samples taken as independent: a lower bound on a
+        filtered log); zero for a joint not fitted. None for another law or a model's own
+        friction.
     """
 
     friction: FrictionModel | FrictionSum
@@ -318,6 +326,7 @@ class FrictionFit:
     iterations: NDArray[np.int_]
     n_samples: int
     identified: NDArray[np.bool_]
+    covariance: NDArray[np.float64] | None = None
 
     @property
     def kind(self) -> str:
@@ -332,6 +341,7 @@ def fit_law(
     *,
     dq_noise_std: ArrayLike | None = None,
     warn: bool = True,
+    width: float | None = None,
 ) -> FrictionFit:
     """Fit a law of the registry (:mod:`dynid.friction.laws`) to a residual, joint by joint.
 
@@ -352,6 +362,11 @@ def fit_law(
         :data:`~dynid.identification.sanity.MIN_MOTION` tells still joints).
     warn : bool
         Warn about joints that do not move (False: silently zero, as in cross-validation).
+    width : float, optional
+        The smooth Coulomb's width in standstill bands: the law's band becomes
+        :func:`~dynid.identification.structure.smooth_width` of it (a factor of
+        :func:`~dynid.identification.structure.smooth_width_grid`, the grid ``identify``
+        searches); None: the standstill band itself.
 
     Returns
     -------
@@ -377,6 +392,7 @@ def fit_law(
     n = dq.shape[1]
     noise = np.zeros(n) if dq_noise_std is None else np.broadcast_to(dq_noise_std, (n,))
     band = noise_band(noise)
+    lb = band if width is None else np.asarray(smooth_width(band.tolist(), width), dtype=np.float64)
     if warn:
         moving = _identifiable(dq, noise)
     else:
@@ -387,11 +403,34 @@ def fit_law(
     ok = np.ones(n, bool)
     it = np.zeros(n, int)
     for j in np.flatnonzero(moving):
-        jf = lw.fit(dq[:, j], residual[:, j], float(band[j]))
+        jf = lw.fit(dq[:, j], residual[:, j], float(lb[j]))
         P[j], ok[j], it[j] = jf.params, jf.converged, jf.iterations
     if not np.all(np.isfinite(P)):
         raise ConvergenceError(f"{lw.name} friction fit gave non-finite parameters: {P.tolist()}")
-    return _result(lw.model(P, band), dq, residual, ok, it, moving)
+    fit = _result(lw.model(P, lb), dq, residual, ok, it, moving)
+    if not isinstance(lw.fit, _LinearFit):
+        return fit
+    return replace(fit, covariance=_linear_covariance(lw.fit, dq, residual, lb, P, moving))
+
+
+def _linear_covariance(
+    lf: _LinearFit,
+    dq: NDArray[np.float64],
+    residual: NDArray[np.float64],
+    band: NDArray[np.float64],
+    P: NDArray[np.float64],
+    moving: NDArray[np.bool_],
+) -> NDArray[np.float64]:
+    """(n, k, k): each moving joint's ``s^2 (A^T A)^+`` (:class:`FrictionFit`), zero for
+    the others."""
+    n, k = P.shape
+    out = np.zeros((n, k, k))
+    for j in np.flatnonzero(moving):
+        A = lf.columns(dq[:, j : j + 1], band[j : j + 1])[:, 0, :]
+        e = residual[:, j] - A @ P[j]
+        s2 = float(e @ e) / max(A.shape[0] - k, 1)
+        out[j] = s2 * np.linalg.pinv(A.T @ A)
+    return out
 
 
 def fit_sigmoid(
@@ -529,7 +568,12 @@ def fit_friction(
 
 
 def fit_friction_through(
-    res: FrictionResidual, drive: Drive | None, kind: str = "sigmoid", *, warn: bool = True
+    res: FrictionResidual,
+    drive: Drive | None,
+    kind: str = "sigmoid",
+    *,
+    warn: bool = True,
+    width: float | None = None,
 ) -> FrictionFit:
     """Fit a friction law where the drive says it acts: :func:`fit_law_through` on the
     residual of :func:`friction_residual`.
@@ -540,7 +584,7 @@ def fit_friction_through(
     drive : Drive or None
     kind : str
         A law of the registry (:mod:`dynid.friction.laws`).
-    warn : bool
+    warn, width
         As in :func:`fit_law`.
 
     Returns
@@ -555,7 +599,7 @@ def fit_friction_through(
         No joint moves beyond its velocity noise band.
     """
     return fit_law_through(
-        kind, res.dq, res.residual, drive, dq_noise_std=res.dq_noise_std, warn=warn
+        kind, res.dq, res.residual, drive, dq_noise_std=res.dq_noise_std, warn=warn, width=width
     )
 
 
@@ -567,6 +611,7 @@ def fit_law_through(
     *,
     dq_noise_std: ArrayLike | None = None,
     warn: bool = True,
+    width: float | None = None,
 ) -> FrictionFit:
     """Fit a friction law where the drive says it acts (the motors of a gear train).
 
@@ -588,7 +633,7 @@ def fit_law_through(
     drive : Drive or None
     dq_noise_std : array_like, shape (n,), optional
         White-noise std of the measured joint velocities [rad/s].
-    warn : bool
+    warn, width
         As in :func:`fit_law`.
 
     Returns
@@ -603,13 +648,13 @@ def fit_law_through(
         As :func:`fit_law`.
     """
     if drive is None or drive.friction_at == "joint":
-        return fit_law(law, dq, residual, dq_noise_std=dq_noise_std, warn=warn)
+        return fit_law(law, dq, residual, dq_noise_std=dq_noise_std, warn=warn, width=width)
     dq, residual = _pair(dq, residual)
     K = drive.transmission
     v = drive.motor_velocities(dq)
     r = np.asarray(np.linalg.solve(K.T, residual.T).T, dtype=np.float64)
     noise = None if dq_noise_std is None else np.sqrt((K**2) @ np.asarray(dq_noise_std) ** 2)
-    fit = fit_law(law, v, r, dq_noise_std=noise, warn=warn)
+    fit = fit_law(law, v, r, dq_noise_std=noise, warn=warn, width=width)
     assert isinstance(fit.friction, FrictionModel)  # fit_law fits one law
     fr = fit.friction.at(drive)  # the law per motor
     after = residual - fr.torques(dq)

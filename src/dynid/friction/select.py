@@ -30,15 +30,16 @@ to:
    differences under :data:`~dynid.identification.candidates.RELATIVE_TIE` of the lowest
    counting as ties), fitted on the whole log. A Stribeck bump that predicts 0.005 points
    better than the classical law is not worth its two coefficients.
-5. A law whose fit on the whole log is not dissipative within the robot's velocity
-   limits, its offset aside (``f(v) v < 0`` somewhere: friction that pushes the arm,
-   :func:`~dynid.friction.dissipative.law_violations`, the check identification's
-   structure selection applies to its candidates), is set aside: judged and shown, not
-   chosen (an asymmetric law with ``fc+ = 7.86``, ``fc- = -13.8`` on a UR5 elbow, an
-   offset and a Coulomb level of -2.97 N m, was kept without a word). When every
-   candidate is, the choice is made among them with a warning naming where each pushes.
-   The model's own friction is not judged here (identification judged it; a robot's is
-   its description's).
+5. A law whose fit on the whole log is not dissipative within the robot's velocity limits,
+   its offset aside (``f(v) v < 0`` somewhere beyond
+   :data:`~dynid.friction.dissipative.ALLOWANCE_STD` standard deviations of the fit:
+   friction that pushes the arm, :func:`~dynid.friction.dissipative.law_violations`, the
+   check identification's structure selection applies to its candidates), is set aside:
+   judged and shown, not chosen (an asymmetric law with ``fc+ = 7.86``, ``fc- = -13.8`` on
+   a UR5 elbow, an offset and a Coulomb level of -2.97 N m, was kept without a word). When
+   every candidate is, the choice is made among them with a warning naming where each
+   pushes. The model's own friction is not judged here (identification judged it; a robot's
+   is its description's).
 
 The candidates are the laws of the registry (``none``: no extra friction, the rigid model
 alone) and, when the model comes with friction of its own (an identification's classical
@@ -71,7 +72,7 @@ from ..identification.candidates import RELATIVE_TIE, paired_fold_se
 from ..identification.dissipation import Violation
 from ..identification.holdout import DEFAULT_FOLDS, block_labels
 from ..identification.input_noise import quantized_noise_std
-from ..identification.structure import ERROR_FLOOR_PERCENT
+from ..identification.structure import ERROR_FLOOR_PERCENT, smooth_width_grid
 from ..identification.verdict import NOISE_FLOOR_SHARE
 from ..model.drive import Drive
 from .dissipative import law_violations
@@ -86,6 +87,8 @@ __all__ = [
     "RULE",
     "CandidateScore",
     "FrictionSelection",
+    "WIDTH_LAWS",
+    "choose_smooth_width",
     "held_names",
     "select_friction",
     "simplest_within",
@@ -94,6 +97,10 @@ __all__ = [
 
 #: Number of contiguous blocks of the cross-validation (the identification's default).
 FOLDS = DEFAULT_FOLDS
+#: Laws whose band is a width chosen on held-out data among
+#: :func:`~dynid.identification.structure.smooth_width_grid`, the grid ``identify``
+#: searches for the same law (the smooth Coulomb ``tanh(dq / w)``).
+WIDTH_LAWS = ("smooth",)
 #: Name of the candidate "the model's own friction, as it is".
 OWN = "own"
 #: How the kept candidate is chosen (module docstring, step 4).
@@ -232,7 +239,11 @@ class FrictionSelection:
 
 
 def _heldout_torques(
-    res: FrictionResidual, drive: Drive | None, name: str, labels: NDArray[np.intp]
+    res: FrictionResidual,
+    drive: Drive | None,
+    name: str,
+    labels: NDArray[np.intp],
+    width: float | None = None,
 ) -> NDArray[np.float64]:
     """Each block's friction torques (N, n) predicted by ``name`` fitted on the others; a
     block whose training blocks move no joint gets zero."""
@@ -243,7 +254,13 @@ def _heldout_torques(
         noise = res.dq_noise_std
         try:
             fit = fit_law_through(
-                name, res.dq[keep], res.residual[keep], drive, dq_noise_std=noise, warn=False
+                name,
+                res.dq[keep],
+                res.residual[keep],
+                drive,
+                dq_noise_std=noise,
+                warn=False,
+                width=width,
             )
         except DataError:
             continue
@@ -327,19 +344,72 @@ def select_friction(
         if not last:  # new data to the model: its prediction is held out as it is
             scores.append(own_score)
     for name in names:
+        width = _best_width(res, drive, labels, judge) if name in WIDTH_LAWS else None
         with warnings.catch_warnings():
             if name != names[-1]:  # one warning about still joints is enough
                 warnings.simplefilter("ignore", DynidWarning)
-            fits[name] = fit_friction_through(res, drive, name)
+            fits[name] = fit_friction_through(res, drive, name, width=width)
         train = fits[name].friction.torques(res.dq)
-        held = _heldout_torques(res, drive, name, labels)
-        bad = () if dq_max is None else law_violations(fits[name].friction, dq_max)
+        held = _heldout_torques(res, drive, name, labels, width)
+        bad = (
+            ()
+            if dq_max is None
+            else law_violations(fits[name].friction, dq_max, fits[name].covariance)
+        )
         score = judge.score(name, LAWS[name].params, len(LAWS[name].params), train, held)
         scores.append(replace(score, unphysical=bad))
     if own_score is not None and last:
         scores.append(own_score)
     kept = simplest_within(_dissipative(scores), prefer=OWN if own is not None else None)
     return FrictionSelection(fits[kept.name], kept.name, tuple(scores), folds, method)
+
+
+def choose_smooth_width(
+    res: FrictionResidual, drive: Drive | None = None, *, folds: int = FOLDS
+) -> float:
+    """The smooth Coulomb's width [standstill bands] that predicts held-out data best.
+
+    Each factor of :func:`~dynid.identification.structure.smooth_width_grid` (the grid
+    ``identify`` searches for the same law) is fitted on the training blocks and judged on
+    the held-out ones as :func:`select_friction` judges laws (each joint in units of its
+    torque noise); of as many coefficients, the lowest error is kept (the narrower on a
+    tie), as ``identify`` keeps among its widths.
+
+    Parameters
+    ----------
+    res : FrictionResidual
+    drive : Drive, optional
+        Where the friction acts (:func:`~dynid.friction.fit.fit_law_through`).
+    folds : int
+        Contiguous blocks (>= 2; a residual of several recordings leaves one out at a time).
+
+    Returns
+    -------
+    float
+        The factor, for :func:`~dynid.friction.fit.fit_law`'s ``width``.
+
+    Raises
+    ------
+    OptionError
+        ``folds < 2`` or fewer than 10 samples per block.
+    """
+    labels, _, _ = _folds(res, folds)
+    return _best_width(res, drive, labels, _Judge(res, labels))
+
+
+def _best_width(
+    res: FrictionResidual, drive: Drive | None, labels: NDArray[np.intp], judge: _Judge
+) -> float:
+    """:func:`choose_smooth_width` on the blocks ``labels``."""
+    n = res.dq.shape[1]
+    best: tuple[float, float] | None = None
+    for factor, _ in smooth_width_grid([0.0] * n):
+        held = _heldout_torques(res, drive, WIDTH_LAWS[0], labels, factor)
+        score = judge.score(WIDTH_LAWS[0], (), 0, held, held).scaled_error_percent
+        if best is None or score < best[1]:
+            best = (factor, score)
+    assert best is not None  # (the grid is not empty)
+    return best[0]
 
 
 def _dissipative(scores: Sequence[CandidateScore]) -> list[CandidateScore]:

@@ -56,6 +56,7 @@ __all__ = [
     "largest_terms",
     "smooth_stribeck_candidates",
     "smooth_width",
+    "smooth_width_grid",
     "structure_terms",
     "width_key",
     "width_text",
@@ -512,7 +513,7 @@ def candidate_structures(
             out += [
                 Structure(a, ("viscous", "smooth") + o, width=w, at=at)
                 for o in ((), ("offset",))
-                for w in SMOOTH_WIDTHS
+                for w, _ in smooth_width_grid(())
             ]
             out.append(Structure(a, ("viscous", "quadratic", "coulomb", "offset"), at=at))
             out += [
@@ -534,6 +535,15 @@ def smooth_stribeck_candidates(
     armature and placement, at each Stribeck velocity of ``vsts`` [rad/s]."""
     parts = ("viscous", "smooth", "stribeck", "offset")
     return tuple(Structure(smooth.armature, parts, smooth.width, v, at=smooth.at) for v in vsts)
+
+
+def smooth_width_grid(band: Sequence[float]) -> tuple[tuple[float, tuple[float, ...]], ...]:
+    """The smooth Coulomb's candidate widths, the one grid of ``identify``'s structure
+    search (:func:`candidate_structures`) and of ``dynid friction``'s smooth law
+    (:func:`~dynid.friction.select.choose_smooth_width`): per factor of
+    :data:`SMOOTH_WIDTHS` [standstill bands], narrowest first, the widths [rad/s] per
+    joint of ``band`` (n,) [rad/s] (:func:`smooth_width`)."""
+    return tuple((f, smooth_width(band, f)) for f in SMOOTH_WIDTHS)
 
 
 def smooth_width(band: Sequence[float], factor: float | Sequence[float]) -> tuple[float, ...]:

@@ -65,10 +65,14 @@ def report_to_dict(result: FeasibleResult) -> dict[str, Any]:
         margin, unit, satisfied), ``pseudo_inertia_margin`` (``lambda_min(J)/tr(J)`` per
         link [1]), ``friction`` (the friction identified with the links: ``model``, its law,
         and the law's parameters, ``fv, fc, fo`` of the classical law; or None), ``heldout``
-        (the held-out judgement, or None), ``run_time_s`` [s], ``seed``, ``notes``,
-        ``total_mass`` [kg], ``bounds`` (a bounds file's content) and ``units``;
-        then the method's own (:meth:`~dynid.feasibility.result.FeasibleResult.report_fields`),
-        their numbers that may have no value written None."""
+        (the held-out judgement, or None), ``determined`` (of an identified model's
+        coefficients: ``link_base_parameters``, ``rotor_inertias``, each standard
+        parameter's ``source``, ``"data"``, ``"sum"`` or ``"prior"``, and per motor
+        ``rotor_inertia`` [kg m^2] with its ``rotor_source``; or None), ``run_time_s`` [s],
+        ``seed``, ``notes``, ``total_mass`` [kg], ``bounds`` (a bounds file's content) and
+        ``units``; then the method's own
+        (:meth:`~dynid.feasibility.result.FeasibleResult.report_fields`), their numbers that
+        may have no value written None."""
     rep = result.report
     fr = result.friction
     d: dict[str, Any] = {
@@ -85,6 +89,7 @@ def report_to_dict(result: FeasibleResult) -> dict[str, Any]:
         "pseudo_inertia_margin": finite_or_none(result.pseudo_inertia_margin),
         "friction": None if fr is None else _friction_record(fr),
         "heldout": None if result.heldout is None else result.heldout.as_dict(),
+        "determined": _determined_record(result),
         "run_time_s": float(result.run_time),
         "seed": result.seed,
         "notes": list(result.notes),
@@ -107,6 +112,16 @@ def save_report_json(path: str | Path, result: FeasibleResult, **extra: Any) -> 
         A NaN or infinite number where the report admits none (named).
     """
     return save_json(path, report_to_dict(result) | extra)
+
+
+def _determined_record(result: FeasibleResult) -> dict[str, Any] | None:
+    """:meth:`~dynid.feasibility.determined.Determined.as_dict` with the rotor inertias
+    retrieved [kg m^2] (None without a determination)."""
+    det = result.determined
+    if det is None:
+        return None
+    ia = result.rotor_inertia
+    return det.as_dict() | {"rotor_inertia": None if ia is None else [float(x) for x in ia]}
 
 
 def _friction_record(fr: Friction | FrictionSum) -> dict[str, Any]:

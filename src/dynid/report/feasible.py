@@ -4,10 +4,12 @@ the prior.
 
 The verdict: consistent or not, the residual on the coefficients, the smallest margin of
 the constraints, the total mass against its band, the bounds the result sits on, the links
-found implausible (either of the last two: not good, usable with reservations). Below it:
-per link the mass with its bounds, the prior's mass and the difference, the centre of mass
-with its box, the pseudo-inertia margin; the constraints that are not satisfied; the
-figures (``retrieval.png``, ``comparison.png``).
+found implausible (either of the last two: not good, usable with reservations), what the
+coefficients hold (link base parameters and rotor inertias). Below it: per link the mass
+with its bounds, the prior's mass and the difference, the centre of mass with its box, the
+pseudo-inertia margin and whether the data or the prior give the mass; per motor the rotor
+inertia and whether the data or the prior give it; the constraints that are not satisfied;
+the figures (``retrieval.png``, ``comparison.png``).
 """
 
 from __future__ import annotations
@@ -66,6 +68,7 @@ def answer(run: RunFiles) -> Answer | None:
         + (f" (band {cell(band)} kg)" if isinstance(band, list) else "")
     )
     facts += _structure_fact(run, feas)
+    facts += _coefficients_fact(rep.get("determined"))
     for note in rep.get("on_bound") or []:
         facts.append("On a bound: " + esc(note))
     held = rep.get("heldout")
@@ -95,6 +98,7 @@ def answer(run: RunFiles) -> Answer | None:
     fig_html = "".join(figure(r, run.files[r], c) for r, c in figs if r is not None)
     sections = (
         _links_table(feas, rep),
+        _rotors_table(rep.get("determined")),
         _violations(rep),
         f'<div class="figures">{fig_html}</div>' if fig_html else "",
     )
@@ -120,6 +124,54 @@ def _structure_fact(run: RunFiles, feas: dict) -> list[str]:
     return [f"Structure of the consistent fit: <b>{esc(used)}</b>; {said}"]
 
 
+#: What a parameter's source (``report.json``'s ``determined``) says on the page.
+_SOURCE = {
+    "data": "the data",
+    "sum": "the prior (the data give it only in a sum with link inertias)",
+    "prior": "the prior (the data do not excite it)",
+}
+
+#: The same for a link's mass.
+_MASS_SOURCE = _SOURCE | {
+    "sum": "the data in sums with other link parameters, split by the prior",
+}
+
+
+def _coefficients_fact(det: Any) -> list[str]:
+    """``Coefficients: 43 link base parameters + 5 rotor inertias (armatures)``, the rotors
+    the prior gives named."""
+    if not isinstance(det, dict) or not is_number(det.get("link_base_parameters")):
+        return []
+    text = f"Coefficients: <b>{cell(det['link_base_parameters'])}</b> link base parameters"
+    src = det.get("rotor_source")
+    if isinstance(src, list):
+        text += f" + <b>{cell(det.get('rotor_inertias'))}</b> rotor inertias (armatures)"
+        prior = [str(m + 1) for m, s in enumerate(src) if s in ("sum", "prior")]
+        if prior:
+            text += f"; rotor inertia(s) of motor(s) {', '.join(prior)} taken from the prior"
+    return [text]
+
+
+def _rotors_table(det: Any) -> str:
+    """Per motor the rotor inertia retrieved and where its value comes from."""
+    if not isinstance(det, dict) or not isinstance(det.get("rotor_source"), list):
+        return ""
+    ia = det.get("rotor_inertia")
+    rows = [
+        [
+            cell(m + 1),
+            cell(_at(ia, m)),
+            esc(_SOURCE.get(s, "not in the model") if s else "not in the model"),
+        ]
+        for m, s in enumerate(det["rotor_source"])
+    ]
+    return section(
+        "rotors",
+        "Rotor inertias (armatures)",
+        table(["motor", "rotor inertia [kg m^2]", "value from"], rows),
+    )
+
+
 def _where(feas: dict) -> str:
     drive = feas.get("drive")
     at = drive.get("friction_at") if isinstance(drive, dict) else None
@@ -134,6 +186,8 @@ def _links_table(feas: dict, rep: dict) -> str:
     }
     prior = (rep.get("prior") or {}).get("mass") if isinstance(rep.get("prior"), dict) else None
     margin = rep.get("pseudo_inertia_margin")
+    det = rep.get("determined")
+    source = det.get("source") if isinstance(det, dict) else None
     rows = []
     for k, link in enumerate(feas["links"]):
         b = bounds.get(link.get("name"), {})
@@ -164,6 +218,11 @@ def _links_table(feas: dict, rep: dict) -> str:
                 cell(diag),
                 cell(_at(margin, k)),
             ]
+            + (
+                [esc(_MASS_SOURCE.get(source.get(f"m{k + 1}", ""), "?"))]
+                if isinstance(source, dict)
+                else []
+            )
         )
     headers = [
         "link",
@@ -175,7 +234,7 @@ def _links_table(feas: dict, rep: dict) -> str:
         "CoM box x; y; z [m]",
         "inertia xx, yy, zz about the CoM [kg m^2]",
         "pseudo-inertia margin",
-    ]
+    ] + (["mass from"] if isinstance(source, dict) else [])
     return section("links", "Physical parameters per link", table(headers, rows))
 
 

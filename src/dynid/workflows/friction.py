@@ -15,7 +15,9 @@ as the command does.
   simplest within one standard error of the best, the model's own friction a candidate
   judged on the same blocks and kept as it is (a sum at the motors and joints too)
   (:func:`~dynid.friction.select.select_friction`);
-  a law's name fits that law (:func:`~dynid.friction.fit.fit_friction_through`).
+  a law's name fits that law (:func:`~dynid.friction.fit.fit_friction_through`; the
+  smooth law at the width :func:`~dynid.friction.select.choose_smooth_width` chooses on
+  held-out blocks among the widths ``identify`` searches).
 """
 
 from __future__ import annotations
@@ -30,12 +32,18 @@ import numpy as np
 from numpy.typing import NDArray
 
 from ..exceptions import DynidWarning
-from ..friction.dissipative import law_violations
+from ..friction.dissipative import ALLOWANCE_STD, law_violations
 from ..friction.fit import FrictionFit, FrictionResidual, fit_friction_through
 from ..friction.laws import LAWS
 from ..friction.model import FrictionSum
 from ..friction.recordings import Pieces, pieces_residual, prepare_pieces, thinned
-from ..friction.select import FrictionSelection, select_friction, torque_noise_std
+from ..friction.select import (
+    WIDTH_LAWS,
+    FrictionSelection,
+    choose_smooth_width,
+    select_friction,
+    torque_noise_std,
+)
 from ..friction.validation import RECORDED, own_friction
 from ..identification.model import IdentifiedModel
 from ..identification.sanity import SPIKES_BEFORE_FIT
@@ -231,7 +239,8 @@ def fit_friction_files(
             )
             noise = torque_noise_std(res)
             return FrictionFileResult(sel.fit, res, sel, cut, pieces, noise, every)
-        chosen = fit_friction_through(res, pieces.drive, law)
+        width = choose_smooth_width(res, pieces.drive) if law in WIDTH_LAWS else None
+        chosen = fit_friction_through(res, pieces.drive, law, width=width)
         if law == "quadratic":
             _quadratic_at_bound(chosen)
         _say_not_dissipative(chosen, robot.dq_max)
@@ -273,10 +282,17 @@ def _say_not_dissipative(fit: FrictionFit, dq_max: NDArray[np.float64]) -> None:
     """A warning, one line per joint (motor), where the law asked for by name is not
     dissipative within the velocity limits, its offset aside (the selection sets such a
     law aside: :func:`~dynid.friction.dissipative.law_violations`)."""
-    for v in law_violations(fit.friction, dq_max):
+    allowance = fit.covariance is not None
+    for v in law_violations(fit.friction, dq_max, fit.covariance):
         warnings.warn(
             f"{fit.kind} friction not dissipative within the velocity limits (the offset "
-            f"aside): {v}; the friction pushes the arm there (--friction-model auto sets "
+            "aside"
+            + (
+                f", by more than {ALLOWANCE_STD:g} standard deviations of the fit"
+                if allowance
+                else ""
+            )
+            + f"): {v}; the friction pushes the arm there (--friction-model auto sets "
             "such a law aside)",
             DynidWarning,
             stacklevel=3,

@@ -19,6 +19,7 @@ from .._parallel import available_cores
 from ..exceptions import DynidError, OptionError
 from ..feasibility.bounds import Bounds, default_bounds
 from ..feasibility.convex import DEFAULT_SDP_MARGIN, SDPOptions
+from ..feasibility.determined import determined_by_data
 from ..feasibility.methods import METHODS
 from ..feasibility.methods import method as consistent_method
 from ..feasibility.penalty import RetrievalOptions, RetrievalProgress
@@ -329,7 +330,7 @@ def retrieve_files(
         "progress": progress,
     }
     if kind == "model":
-        return Retrieval(
-            with_model_friction(m.from_coefficients(model, **common), model), tuple(notes)
-        )
+        result = with_model_friction(m.from_coefficients(model, **common), model)
+        result = replace(result, determined=determined_by_data(model))
+        return Retrieval(result, tuple(notes))
     return Retrieval(m.from_data(robot, data, **common), tuple(notes))

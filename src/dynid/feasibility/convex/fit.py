@@ -48,6 +48,7 @@ from ...model.drive import Drive
 from ...model.robot import Robot
 from ...progress import stage
 from ..bounds import Bounds
+from ..determined import determined_by_data
 from ..prior import Prior
 from .data_term import DataTerm, coefficient_term
 from .options import SDPOptions
@@ -281,6 +282,7 @@ def consistent_from_identified(
     res = replace(
         res,
         identified=model,
+        determined=determined_by_data(model),
         rotor_inertia=_rotor_inertia(model, res.rotor_inertia),
         notes=res.notes + combined_notes(model.info.combined),
     )

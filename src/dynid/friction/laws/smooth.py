@@ -4,8 +4,9 @@
 
 ``v_s`` [rad/s] is not fitted: it is the law's band (:mod:`dynid.friction.laws.base`),
 the Coulomb torque reaching 76 % of ``fc`` at ``dq = v_s`` (without a band, ``v_s = 0``:
-the plain sign). ``dynid friction`` takes the joint's velocity noise band; ``identify``
-chooses it on held-out data among multiples of that band, the narrowest (0.3 bands,
+the plain sign). ``dynid friction`` and ``identify`` both choose it on held-out data
+among the same multiples of the joint's standstill band
+(:func:`~dynid.identification.structure.smooth_width_grid`), the narrowest (0.3 bands,
 about the noise's standard deviation) the expected sign of a sharp Coulomb law given
 the noise. Linear in ``fv`` [N m s/rad] ``>= 0``,
 ``fc`` [N m] ``>= 0`` and ``fo`` [N m]. MuJoCo holds ``fv`` as ``damping`` and ``fc`` as
