@@ -118,3 +118,35 @@ def test_report_headline_and_json_name_the_flipped_file(panda_logs, tmp_path):
     page = (out / "report.html").read_text()
     head = page[page.index('class="headline"') :].split("</p>")[0]
     assert "The torques of flip.csv read with the opposite sign" in head
+
+
+def test_a_model_identified_with_a_files_own_flip_validates_other_files(panda_logs):
+    """A model identified with ``--units flip.csv:tau4=-1`` (flip.csv's own entry) reads a
+    new file as recorded, the entry holding for flip.csv alone: validate on a.csv runs,
+    at the noise level with no sign finding (it was refused: "flip.csv is none of the
+    files given"), and on flip.csv the recorded entry reads it right."""
+    from dynid.workflows.identify import IdentifyOptions, identify_files
+
+    robot, d = panda_logs
+    opts = IdentifyOptions(columns=(None, "flip.csv:tau4=-1"), terms="links")
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", DynidWarning)
+        model = identify_files(robot, [d / "a.csv", d / "flip.csv"], opts).model
+    for name in ("a.csv", "flip.csv"):
+        result, said = _validate(model, d / name)
+        assert not any("opposite" in s for s in said), said
+        np.testing.assert_allclose(result.validation.errors.rms, NOISE, rtol=0.25)
+
+
+def test_torques_declared_in_n_m_through_a_current_drive_are_refused(panda_logs):
+    """``--units tau=Nm`` with a drive whose effort is current was accepted and the
+    column read as amperes all the same; it is refused in one line naming the drive's
+    effort and what to give instead."""
+    from dynid.exceptions import OptionError
+    from dynid.model.drive import Drive
+    from dynid.workflows.data_files import column_map
+
+    drive = Drive(np.eye(7), np.zeros(7), effort="current", torque_constant=np.ones(7))
+    with pytest.raises(OptionError, match="declares torques, but the drive's effort is 'current'"):
+        column_map(None, "tau=Nm", drive=drive)
+    assert column_map(None, "tau=mA", drive=drive).factor("tau") == pytest.approx(1e-3)

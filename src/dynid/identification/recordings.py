@@ -82,6 +82,7 @@ from .sanity import (
     check_torque_log,
     despiked,
     noise_band,
+    opposite_friction_among,
     opposite_sign_among,
     reversed_joint,
     spike_finding,
@@ -508,6 +509,10 @@ def prepare_recordings(
             for finding in check_torque_log(robot, whole, drive):
                 found.setdefault(finding, []).append(name)
         pieces += [(r, p) for p in mine]
+    have = [r for r in range(len(logs)) if any(k == r for k, _ in pieces)]
+    wholes = [joined([p for k, p in pieces if k == r]) for r in have]
+    if among := opposite_friction_among(robot, wholes, [names[r] for r in have], drive):
+        raise DataError(among)  # a fit would average the joint's friction to nothing
     for finding, which in wrapped.items():
         warnings.warn(f"{', '.join(which)}: {finding}", DynidWarning, stacklevel=2)
     for finding, which in found.items():  # one warning a finding, its recordings named

@@ -96,6 +96,7 @@ __all__ = [
     "gravity_loaded",
     "joint_rate_factor",
     "opposite_sign",
+    "opposite_friction_among",
     "opposite_sign_among",
     "reversed_joint",
     "REVERSED_MODEL_SHARE",
@@ -895,12 +896,39 @@ def _left_over(
     """The sum of squares [N^2 m^2] of the residuals ``r`` (N, n) left by each joint's own
     viscous, Coulomb, offset and armature columns (``dq``, ``sign(dq)``, 1, ``ddq``); with
     a ``drive``, each motor's where its friction acts (``K_f^T`` of those of ``K_f dq``)
-    and its rotor's (``K^T`` of ``K ddq``), the joints a motor couples fitted together."""
+    and its rotor's (``K^T`` of ``K ddq``), the joints a motor couples fitted together
+    (:func:`_own_terms`)."""
+    return sum(g.left for g in _own_terms(r, dq, ddq, drive))
+
+
+@dataclass(frozen=True)
+class _OwnTerms:
+    """One group's least-squares fit in :func:`_own_terms`: its motors (joints), per motor
+    the coefficients ``fv, fc, fo, Ia`` (4,) and their covariance (4, 4) (white-noise
+    formula), the residual sum of squares ``left`` [N^2 m^2], and per motor the mean of
+    ``|v|`` and of ``v^2`` at its velocities ``v``."""
+
+    motors: list[int]
+    coef: NDArray[np.float64]
+    cov: NDArray[np.float64]
+    left: float
+    speed: NDArray[np.float64]
+
+
+def _own_terms(
+    r: NDArray[np.float64],
+    dq: NDArray[np.float64],
+    ddq: NDArray[np.float64],
+    drive: Drive | None = None,
+) -> list[_OwnTerms]:
+    """Each joint's (motor's) own viscous, Coulomb, offset and armature coefficients fitted
+    to the residuals ``r`` (N, n), group by group (:func:`_motor_groups`: a coupled wrist's
+    joints together), as :func:`_left_over` describes."""
     n = r.shape[1]
     Kf = np.eye(n) if drive is None else drive.friction_transmission
     K = np.eye(n) if drive is None else drive.transmission
     v, a = dq @ Kf.T, ddq @ K.T
-    out = 0.0
+    out = []
     for joints, motors in _motor_groups((K != 0) | (Kf != 0)):
         cols = []
         for k in motors:  # motor k's columns at the group's joints: (N, m) each
@@ -910,8 +938,128 @@ def _left_over(
         X = np.stack(cols, axis=-1).reshape(len(r) * len(joints), len(cols))
         y = r[:, joints].reshape(-1)
         coef = np.linalg.lstsq(X, y, rcond=None)[0]
-        out += float(np.sum((y - X @ coef) ** 2))
+        left = float(np.sum((y - X @ coef) ** 2))
+        dof = max(X.shape[0] - X.shape[1], 1)
+        cov = (left / dof) * np.linalg.pinv(X.T @ X)
+        m = len(motors)
+        blocks = np.array([cov[4 * i : 4 * i + 4, 4 * i : 4 * i + 4] for i in range(m)])
+        speed = np.array([[np.mean(np.abs(v[:, k])), np.mean(v[:, k] ** 2)] for k in motors])
+        coefs = np.asarray(coef, dtype=np.float64).reshape(m, 4)
+        out.append(_OwnTerms(motors, coefs, blocks, left, speed))
     return out
+
+
+#: A motor's (joint's) friction and rotor read of the opposite sign in one recording to
+#: another's (:func:`opposite_friction_among`) when each is at least this many standard
+#: deviations from zero (white-noise formula: samples a few ms apart are correlated, so a
+#: wide margin).
+OWN_TERMS_SIGNIFICANCE = 8.0
+#: ... and the one's size at least this share of the other's (a sign, not a drift).
+OWN_TERMS_SIZE_SHARE = 0.3
+
+
+def _own_signs(
+    robot: Robot, log: TorqueLog, drive: Drive | None
+) -> dict[int, tuple[float, float, float, float]] | None:
+    """Per motor (joint) of a log as recorded: the power its fitted friction dissipates
+    (``fc mean|v| + fv mean(v^2)``) and the rotor inertia fitted (``Ia``), each with its
+    standard deviation, fitted to what the robot's links leave of its torques
+    (:func:`_own_terms`): both positive for torques of the right sign. None: too few
+    samples with known accelerations."""
+    rec = _recorded(log, drive)
+    if rec is None:
+        return None
+    q, dq, ddq = (rec.q, rec.dq, rec.ddq)
+    if rec.drive is not None:
+        q, dq, ddq = rec.drive.joint_states(q, dq, ddq)
+    model = rnea(robot, q, dq, ddq)
+    if robot.spring is not None:
+        model = model + robot.spring.torques(q)
+    out = {}
+    for g in _own_terms(rec.joint_torques - model, dq, ddq, rec.drive):
+        for i, k in enumerate(g.motors):
+            grad = np.array([g.speed[i, 1], g.speed[i, 0], 0.0, 0.0])  # d power / d coef
+            power, power_std = float(grad @ g.coef[i]), math.sqrt(grad @ g.cov[i] @ grad)
+            out[k] = (power, power_std, float(g.coef[i, 3]), math.sqrt(g.cov[i][3, 3]))
+    return out
+
+
+def _comparable(flipped: tuple, right: tuple, share: float) -> bool:
+    """Whether a motor's terms read of the opposite sign (``flipped``: its
+    :func:`_own_signs` values and the signs of its power and inertia) are of about the
+    size of another recording's of the right sign (at least ``share`` of them), judged on
+    the power where both tell it, else on the inertia."""
+    (p, _, ia, _), sp, si = flipped
+    (q, _, ib, _), sq, sj = right
+    if sp and sq:
+        return abs(p) >= share * abs(q)
+    return bool(si and sj) and abs(ia) >= share * abs(ib)
+
+
+def opposite_friction_among(
+    robot: Robot, logs: Sequence[TorqueLog], names: Sequence[str], drive: Drive | None = None
+) -> str | None:
+    """The finding that one recording's torques of a motor (joint) have the opposite sign
+    to another recording's, read from the motor's own friction and rotor (:func:`_own_signs`):
+    the friction dissipates and the inertia is positive in one, both the other way in
+    the other, each beyond :data:`OWN_TERMS_SIGNIFICANCE` standard deviations and of a
+    comparable size (:data:`OWN_TERMS_SIZE_SHARE`); or None.
+
+    The check the whole rigid-body torques make (:func:`opposite_sign`) does not tell the
+    sign of a joint whose torques the links barely make (a geared wrist: its rotor and
+    friction outweigh them), and a fit of several recordings, one of them of the opposite
+    sign there, averages that joint's friction to nothing (a current-logged UR5's motor
+    4 flipped in one of two recordings: fitted to 9.4 %, its Coulomb friction left out,
+    springs suggested). ``logs`` are as recorded (read through ``drive``); the hint is the
+    file's own ``--units`` entry in the log's columns."""
+    if len(logs) < 2 or not np.any(robot.phi):
+        return None
+    signs = [_own_signs(robot, log, drive) for log in logs]
+    z, share = OWN_TERMS_SIGNIFICANCE, OWN_TERMS_SIZE_SHARE
+
+    def sign(x: float, sd: float) -> int:
+        return 0 if not abs(x) > z * sd else (1 if x > 0 else -1)
+
+    found: dict[int, list[int]] = {}  # recording: its motors of the opposite sign
+    for k in range(logs[0].n):
+        each = [
+            None
+            if s is None or k not in s
+            else (s[k], sign(s[k][0], s[k][1]), sign(s[k][2], s[k][3]))
+            for s in signs
+        ]
+        right = [e for e in each if e is not None and min(e[1:]) >= 0 and max(e[1:]) > 0]
+        for r, e in enumerate(each):
+            if e is None or not (max(e[1:]) <= 0 and min(e[1:]) < 0) or not right:
+                continue
+            if any(_comparable(e, o, share) for o in right):
+                found.setdefault(r, []).append(k)
+    if not found:
+        return None
+    r = min(found)
+    motors = found[r]
+    who = "motor" if drive is not None and drive.side == "motor" else "joint"
+    named = ", ".join(f"motor {k + 1}" if who == "motor" else robot.joint_names[k] for k in motors)
+    others = [names[i] for i in range(len(names)) if i != r and i not in found]
+    mine = signs[r]
+    assert mine is not None  # found holds recordings with their terms
+    power = any(mine[k][0] < -z * mine[k][1] for k in motors)
+    inertia = any(mine[k][2] < -z * mine[k][3] for k in motors)
+    what = " and ".join(
+        w
+        for w, said in (
+            ("the friction fitted there puts energy into the arm", power),
+            ("the rotor inertia fitted there is negative", inertia),
+        )
+        if said
+    )
+    return (
+        f"{names[r]}: the torques of {named} read of the opposite sign to those of "
+        f"{', '.join(others) or 'the other recordings'}: {what}, where in the others they "
+        "are of the right sign (a file logged with another sign convention; the check "
+        "against the model's torques does not tell a joint the links barely load); hint: "
+        f"--units {_flips(motors, names[r])} reads it flipped"
+    )
 
 
 def _motor_groups(acts: NDArray[np.bool_]) -> list[tuple[list[int], list[int]]]:

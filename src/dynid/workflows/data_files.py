@@ -30,6 +30,7 @@ from ..exceptions import in_file as about_file
 from ..identification.data import StaticDataset
 from ..identification.log import TorqueLog
 from ..io.columns import (
+    TORQUE_UNITS,
     ColumnMap,
     load_column_map,
     load_mapped_static_data,
@@ -113,7 +114,8 @@ def column_map(
     DataError
         A malformed map or unit (named).
     OptionError
-        ``tau`` in a current's unit without a drive of effort = "current".
+        ``tau`` in a current's unit without a drive of effort = "current", or in a
+        torque's unit with one.
     """
     if columns is None and units is None:
         return None
@@ -140,13 +142,22 @@ def column_map(
 
 def check_current_unit(cmap: ColumnMap | None, drive: Drive | None) -> None:
     """Refuse ``tau`` declared a current (``--units tau=mA``) unless ``drive`` makes
-    currents torques (effort = "current", with its torque constants).
+    currents torques (effort = "current", with its torque constants), and ``tau`` declared
+    a torque (``--units tau=Nm``) with such a drive (its columns would be read as currents
+    all the same).
 
     Raises
     ------
     OptionError
         Naming ``--units`` and the drive's effort.
     """
+    if cmap is not None and cmap.tau_is_torque and drive is not None and drive.effort == "current":
+        raise OptionError(
+            f"--units tau={cmap.names['tau']} declares torques, but the drive's effort is "
+            "'current': its tau columns are read as motor currents and turned into torques "
+            "by its torque_constant; hint: leave tau's unit out (amperes), --units tau=mA "
+            'for milliamperes, or a drive file with effort = "torque" for a log of torques'
+        )
     if cmap is None or not cmap.tau_is_current:
         return
     if drive is None or drive.effort != "current":
@@ -353,8 +364,9 @@ def recorded_columns(
     if used == rec and used != given:
         _log.warning(
             "reading the data as the model's data were read (%s); a file of other names or "
-            "units is read with its own --columns/--units (e.g. --units tau=Nm for SI torques)",
+            "units is read with its own --columns/--units (%s)",
             _read_with(*used),
+            _another_file(str(rec[1] or "")),
         )
     elif used != rec:
         _log.warning(
@@ -363,6 +375,21 @@ def recorded_columns(
             _read_with(*rec),
         )
     return used[0], used[1]
+
+
+def _another_file(units: str) -> str:
+    """How to read a file unlike the recorded ``units``: SI torques where those declare
+    torques in another unit; a file's own entries (``rec2.csv:tau4=-1``) hold for a file
+    of that name only."""
+    entries = [u.strip() for u in units.split(",") if u.strip()]
+    own = [u for u in entries if ":" in u.split("=")[0]]
+    scaled = any(
+        u.split("=")[0].strip() == "tau" and u.split("=")[-1] in TORQUE_UNITS for u in entries
+    )
+    said = ["e.g. --units tau=Nm for SI torques"] if scaled else []
+    if own:
+        said.append("a file's own entry, such as " + own[0] + ", holds for a file of that name")
+    return "; ".join(said) or "given, they replace the recorded ones"
 
 
 def _read_with(columns: str | None, units: str | None) -> str:

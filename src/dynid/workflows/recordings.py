@@ -205,8 +205,9 @@ def read_recordings(
     paths = data_files(data)
     names, units = recorded_columns(recorded, *(columns or (None, None)))
     cmap = column_map(names, units, cutoff_hz=cutoff_hz, drive=drive)
-    if columns is not None:  # the user's (a model's recorded map names its own files)
-        check_file_entries(cmap, paths)
+    mine, toml = columns or (None, None), str((columns or (None,))[0] or "").lower()
+    if mine[1] is not None or toml.endswith(".toml"):  # the user's units, not the model's
+        check_file_entries(cmap, paths)  # recorded map (it names its own files)
 
     def read(p: Path) -> TorqueLog:
         return read_torque_log(
