@@ -41,6 +41,7 @@ from .lmi import pseudo_inertia, pseudo_inertia_margin, repair_pseudo_inertia
 
 __all__ = [
     "DEFAULT_PRIOR_MARGIN",
+    "GENERIC_SOURCE",
     "Prior",
     "default_prior",
     "generic_prior",
@@ -55,6 +56,8 @@ DEFAULT_PRIOR_MARGIN = 2e-4
 GENERIC_RADIUS_FRACTION = 0.2
 GENERIC_RADIUS_MIN = 0.04
 #: Generic masses (before scaling to a band): a drive plus a structure [kg, kg/m].
+#: The name of the generic prior (:func:`generic_prior`), in reports and as a robot's.
+GENERIC_SOURCE = "generic (a solid cylinder per link)"
 GENERIC_LINK_MASS_BASE = 1.0
 GENERIC_LINK_MASS_PER_M = 10.0
 #: Shortest generic cylinder [m] (links whose frames coincide with the next joint's).
@@ -71,7 +74,7 @@ class Prior:
         Standard parameters (m, m c, J about the link origin), every link strictly
         consistent with the margin.
     source : str
-        Where it came from (``"panda"``, a file name, ``"generic"``).
+        Where it came from (``"panda"``, a file name, :data:`GENERIC_SOURCE`).
     repaired : tuple of int
         Links (1-based) whose parameters were repaired.
     notes : tuple of str
@@ -92,6 +95,12 @@ class Prior:
     def pseudo_inertia(self) -> NDArray[np.float64]:
         """``J0`` of every link, (n, 4, 4)."""
         return pseudo_inertia(self.phi)
+
+    @property
+    def generic(self) -> bool:
+        """Whether this is the generic prior (a guess from the kinematics, however given:
+        ``--prior generic`` or the default for a description without inertials)."""
+        return self.source == GENERIC_SOURCE
 
     @property
     def mass(self) -> NDArray[np.float64]:
@@ -169,7 +178,7 @@ def generic_prior(robot: Robot, total_mass: tuple[float, float] | None = None) -
             m = m * (target / total)
             notes[0] += f", scaled to {target:g} kg in all"
     phi = np.stack([_cylinder(float(m[i]), *_segment(robot, i)) for i in range(robot.n)])
-    return Prior(phi=phi, source="generic", notes=tuple(notes))
+    return Prior(phi=phi, source=GENERIC_SOURCE, notes=tuple(notes))
 
 
 def prior_from_robot(

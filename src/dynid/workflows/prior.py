@@ -68,11 +68,9 @@ def load_prior(
         return None
     spec = str(spec)
     if spec == GENERIC:  # the cylinders the default takes only without inertials
-        from ..feasibility.prior import generic_prior
+        from ..feasibility.prior import GENERIC_SOURCE, generic_prior
 
-        return robot.with_params(generic_prior(robot).phi).replace(
-            name="generic (a solid cylinder per link)"
-        )
+        return robot.with_params(generic_prior(robot).phi).replace(name=GENERIC_SOURCE)
     if spec in BUILTIN_ROBOTS:
         prior = builtin_robot(spec)
     else:

@@ -66,7 +66,7 @@ def mass_bounds(
     lo = np.array(bounds.mass_min, dtype=float)
     hi = np.array(bounds.mass_max, dtype=float)
     notes: list[str] = []
-    if factor is None or prior.source == "generic":  # a guess does not bound the masses
+    if factor is None or prior.generic:  # a guess does not bound the masses
         return lo, hi, notes
     m0 = prior.mass
     plo, phi_ = m0 / factor, m0 * factor
