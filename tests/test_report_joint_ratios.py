@@ -52,6 +52,9 @@ def test_identify_headline_and_verdict_give_each_joint_one_ratio(tmp_path):
     names = held["joint_names"]
     for name, r in reason.items():
         assert float(r) == float(f"{held['joint_ratios'][names.index(name)]:.3g}")
+    # the table's ratio column says it is the weighed one, not RMS over a noise column
+    assert "error / noise (each sample against its own)" in page
+    assert "not the quotient of the pooled percentages" in held["verdict"]["reason"]
 
 
 def test_validate_report_gives_the_worst_joint_the_verdicts_ratio(tmp_path):

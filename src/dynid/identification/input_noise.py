@@ -355,7 +355,8 @@ def noise_floor(
         words = (
             f", of which the torques' noise {100 * np.sqrt(var.sum() / norm2):.3g} % and that "
             f"of the states through the model {100 * np.sqrt(put.sum() / norm2):.3g} %; "
-            "each sample against its own noise"
+            "the ratio weighs each sample against its own noise, which varies along the "
+            "motion, so it is not the quotient of the pooled percentages"
         )
     return NoiseFloor(
         sensor_rms=np.sqrt(var / max(N, 1)),

@@ -649,7 +649,7 @@ def _torques_section(run: RunFiles, held: dict | None) -> str:
             "held-out RMS error [N m]",
             "sensor noise RMS [N m]",
             *(["states' noise through the model RMS [N m]"] if states else []),
-            "error / noise",
+            "error / noise" + (" (each sample against its own)" if weighed else ""),
             "held-out relative error [%]",
         ]
         parts.append(f"<p>{esc(held.get('block', ''))}</p>" + table(headers, rows))
