@@ -484,8 +484,11 @@ def _rank_fact(doc: dict) -> tuple[str, list[str]]:
     columns = len(coefs) + len(friction)
     rank, base = doc.get("rank"), _get(doc, "base", "rank")
     parts = f"{base} base parameters (the structural rank of the kinematics)"
-    if friction:
-        parts += f" + {len(friction)} friction"
+    offsets = [x for x in friction if str(x).rstrip("0123456789").removeprefix("j") == "fo"]
+    if len(friction) > len(offsets):
+        parts += f" + {len(friction) - len(offsets)} friction"
+    if offsets:
+        parts += f" + {len(offsets)} offset"
     if not is_number(rank):
         return f"Model columns: {parts}", []
     full = rank >= columns
