@@ -259,7 +259,7 @@ def test_the_page_shows_the_held_out_verdict_the_command_printed(tmp_path, capsy
     out = tmp_path / "run"
     argv = ["identify", "--data", str(train), "--validate-on", str(held), "--no-figures"]
     assert main([*argv, "--terms", "viscous,coulomb", "--out", str(out)]) == 0
-    line = next(x for x in capsys.readouterr().out.splitlines() if "held-out verdict" in x)
+    line = next(x for x in capsys.readouterr().out.splitlines() if x.startswith("held-out verdict"))
     doc = json.loads((out / "heldout.json").read_text())
     v = doc["verdict"]
     assert f": {v['label']}: " in line and f"{v['ratio']:.3g} x the noise floor" in line

@@ -37,7 +37,7 @@ from __future__ import annotations
 import contextlib
 import dataclasses
 import warnings
-from collections.abc import Iterator, Mapping, Sequence
+from collections.abc import Iterable, Iterator, Mapping, Sequence
 from dataclasses import dataclass
 from typing import Any, Literal
 
@@ -470,6 +470,8 @@ def prepare_recordings(
     """
     if not logs:
         raise DataError("no recording given")
+    if isinstance(cutoff_hz, int | float):  # the option first: no data check can help it
+        check_below_nyquist(list(logs), float(cutoff_hz))
     names = tuple(names) if names is not None else tuple(f"log{k + 1}" for k in range(len(logs)))
     if len(names) != len(logs):
         raise ShapeError(f"{len(names)} names for {len(logs)} recordings")
@@ -499,14 +501,8 @@ def prepare_recordings(
         cuts.append(max(0, len(mine) - 1))
         gaps.append(gaps_between(mine))
         if mine:  # sign, units, frozen joints: on the whole recording, said once
-            # reversed columns: the log's own (a motor-side log's motors), through the drive
-            if (mirrored := reversed_joint(robot, joined(mine), drive)) is not None:
-                raise DataError(mirrored, file=name)  # a fit would bend to mirrored motion
-            whole = joined([joint_side_log(p, drive) for p in mine])
-            others = (joint_side_log(x, drive) for i, x in enumerate(logs) if i != r)
-            if (opposite := opposite_sign_among(robot, whole, name, others)) is not None:
-                raise DataError(opposite, file=name)  # a fit would negate the masses
-            for finding in check_torque_log(robot, whole, drive):
+            others = (x for i, x in enumerate(logs) if i != r)
+            for finding in _checked(robot, name, mine, others, drive):
                 found.setdefault(finding, []).append(name)
         pieces += [(r, p) for p in mine]
     have = [r for r in range(len(logs)) if any(k == r for k, _ in pieces)]
@@ -557,6 +553,33 @@ def prepare_recordings(
             for r, log in enumerate(logs)
         ),
     )
+
+
+def _checked(
+    robot: Robot,
+    name: str,
+    mine: Sequence[TorqueLog],
+    others: Iterable[TorqueLog],
+    drive: Drive | None,
+) -> tuple[str, ...]:
+    """The checks of one recording's pieces ``mine`` (as read) taken whole: refused when a
+    column reads reversed (:func:`~.sanity.reversed_joint`, the log's own columns, a
+    motor-side log's motors) or the torques of the opposite sign
+    (:func:`~.sanity.opposite_sign_among`, against the ``others`` as read); the findings
+    of :func:`~.sanity.check_torque_log` to warn of otherwise.
+
+    Raises
+    ------
+    DataError
+        Naming ``name``: a fit would bend to mirrored motion, or negate the masses.
+    """
+    if (mirrored := reversed_joint(robot, joined(list(mine)), drive)) is not None:
+        raise DataError(mirrored, file=name)
+    whole = joined([joint_side_log(p, drive) for p in mine])
+    sides = (joint_side_log(x, drive) for x in others)
+    if (opposite := opposite_sign_among(robot, whole, name, sides)) is not None:
+        raise DataError(opposite, file=name)
+    return tuple(check_torque_log(robot, whole, drive))
 
 
 def _cutoff_and_edge(
