@@ -27,7 +27,7 @@ from __future__ import annotations
 
 import dataclasses
 import warnings
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from typing import Any
 
@@ -55,6 +55,7 @@ from ..identification.residual_dependence import (
     residual_dependence,
     with_dependence_hint,
 )
+from ..identification.residual_spring import ResidualSpring, residual_spring, spring_columns
 from ..identification.sanity import despiked
 from ..identification.verdict import Verdict, with_caveat, with_hint, with_replaced_spikes
 from ..model.robot import Robot
@@ -62,7 +63,7 @@ from .fit import model_drive, torques_through
 from .pooled import joined_validation
 from .validation import Validation, own_friction, validate_torques
 
-__all__ = ["HeldOutTorques", "heldout_torques", "residual_tilt"]
+__all__ = ["HeldOutTorques", "heldout_torques", "residual_springs", "residual_tilt"]
 
 
 @dataclass(frozen=True, slots=True, eq=False)
@@ -106,6 +107,9 @@ class HeldOutTorques:
         The tilt of the gravity vector the held-out residual points to
         (:func:`~dynid.identification.gravity_tilt.gravity_tilt`, the model's columns
         projected out); the verdict names it first when it explains the residual.
+    springs : ResidualSpring or None
+        The stiffness per joint the held-out residual points to
+        (:func:`residual_springs`); the verdict gives a named joint's.
     """
 
     validation: Validation
@@ -119,6 +123,7 @@ class HeldOutTorques:
     inputs: tuple[tuple[int, NDArray[np.float64]], ...] | None = None
     terms: frozenset[str] = frozenset()
     tilt: GravityTilt | None = None
+    springs: ResidualSpring | None = None
 
     def _judged(self) -> tuple[Verdict, NoiseFloor]:
         """:func:`~dynid.identification.floor_verdict.judged_prediction` of the held-out
@@ -172,6 +177,7 @@ class HeldOutTorques:
             self.terms,
             self.tilt,
             fl.joint_ratios,
+            self.springs,
         )
         verdict = with_derived_cutoff_hint(verdict, self.logs, self.cutoff_hz)
         verdict = with_hint(verdict, self.low_speed, ", ")
@@ -203,6 +209,7 @@ class HeldOutTorques:
         its ``ratio`` to the floor, each sample weighed against its own noise) and, above
         the floor, the low-speed note (``low_speed``, the report's own line) and the tilt
         of the gravity vector the residual points to (``gravity_tilt``, null when not
+        judged), and the stiffness per joint it points to (``springs``, null when not
         judged; schema ``heldout.json``)."""
         e, v, fl = self.validation.errors, self.verdict, self.floor
         return {
@@ -221,6 +228,7 @@ class HeldOutTorques:
             "verdict": {"level": v.level, "label": v.label, "reason": v.reason, "ratio": v.ratio},
             "low_speed": None if v.level == "good" else self.low_speed,
             "gravity_tilt": None if self.tilt is None else self.tilt.as_dict(),
+            "springs": None if self.springs is None else self.springs.as_dict(),
             "units": {
                 "rms": "N m",
                 "noise_rms": "N m",
@@ -334,7 +342,11 @@ def _predicted(
     v, said = _pieces_validation(fitted, pieces)
     read = (held if model.holdout.scheme == "file" else log,)  # the motion of a whole log
     caveat = (model.info.heldout or {}).get("caveat") if model.holdout.scheme == "blocks" else None
-    return _held_out(model, v, block + said, read, caveat, spikes, _input_noise(fitted, v, pieces))
+    whole = None  # a time block too short to fit the springs with the model's columns
+    if model.holdout.scheme == "blocks":
+        whole = _pieces_validation(model, _pieces(model, _despiked_from(log)[0], turns))[0]
+    inputs = _input_noise(fitted, v, pieces)
+    return _held_out(model, v, block + said, read, caveat, spikes, inputs, whole)
 
 
 def _each_recording(
@@ -377,9 +389,13 @@ def _held_out(
     caveat: str | None,
     spikes: int,
     inputs: tuple[tuple[int, NDArray[np.float64]], ...] | None,
+    whole: Validation | None = None,
 ) -> HeldOutTorques:
     """The held-out prediction ``v`` judged against the sensors' noise: the
-    identification's record, at least the held-out torques' rounding."""
+    identification's record, at least the held-out torques' rounding; the springs fitted
+    on ``whole`` (the model on the whole log of a held-out time block, whose few samples
+    leave a stiffness fitted with the model's columns loose: 776 N m/rad for 20 on a
+    Panda's last 1.4 s) or on ``v``."""
     assert model.info.log is not None
     recorded = _recorded_noise(model)
     noise = (
@@ -392,7 +408,12 @@ def _held_out(
     held = HeldOutTorques(
         v, noise, block, names, read, given, caveat, spikes, inputs, held_terms(model)
     )
-    return dataclasses.replace(held, tilt=residual_tilt(model, v, held.floor.total_rms))
+    total = held.floor.total_rms
+    tilt, springs = (
+        residual_tilt(model, v, total),
+        residual_springs(model, v if whole is None else whole, total),
+    )
+    return dataclasses.replace(held, tilt=tilt, springs=springs)
 
 
 def residual_tilt(
@@ -402,21 +423,56 @@ def residual_tilt(
     several pieces: :func:`~dynid.friction.pooled.joined_validation`)
     (:func:`~dynid.identification.gravity_tilt.gravity_tilt`; ``noise`` (n,) [N m] each
     joint's): of an identified model, its own columns projected out and with them each
-    joint's viscous, Coulomb, offset and rotor-inertia columns (terms the structure chosen
-    may have left out: a tilt the fit partly took as offsets made it drop the offset of
-    joint 3, which then pulled the tilt to 0.17 deg for 0.3); of a robot's own
-    parameters, on the residual as it is. None for a model whose drive converts the log
-    (motor side, currents, offsets) or without accelerations."""
+    joint's viscous, Coulomb, offset, rotor-inertia and spring columns (terms the structure
+    chosen may have left out: a tilt the fit partly took as offsets made it drop the offset
+    of joint 3, which then pulled the tilt to 0.17 deg for 0.3; a 20 N m/rad spring on a
+    Panda shoulder read as a tilt of 0.89 and 1.8 deg without the springs' columns); of a
+    robot's own parameters, on the residual as it is. None for a model whose drive
+    converts the log (motor side, currents, offsets) or without accelerations."""
     log = v.log
     if log.ddq is None:
         return None
-    q, dq, ddq, tau = log.q, log.dq, log.ddq, log.tau
-    error = tau - v.tau_hat
+    error = log.tau - v.tau_hat
     if isinstance(model, Robot):
-        return gravity_tilt(model, q, error, noise)
-    if model.drive is not None and not model.drive.is_identity:
+        return gravity_tilt(model, log.q, error, noise)
+    columns = _beside_columns(model, log)
+    if columns is None:
+        return None
+
+    def with_springs(rows: NDArray[np.intp]) -> NDArray[np.float64]:
+        return np.concatenate([columns(rows), spring_columns(log.q[rows])], axis=-1)
+
+    return gravity_tilt(model.robot, log.q, error, noise, log.tau, with_springs)
+
+
+def residual_springs(
+    model: IdentifiedModel | Robot, v: Validation, noise: NDArray[np.float64]
+) -> ResidualSpring | None:
+    """The stiffness per joint the residual of the prediction ``v`` points to
+    (:func:`~dynid.identification.residual_spring.residual_spring`; ``noise`` (n,) [N m]
+    each joint's): the measured torques fitted with the identified model's own columns,
+    each joint's viscous, Coulomb, offset and rotor-inertia columns and a spring per joint.
+    None for a robot's own parameters, a model that holds a spring already, a drive that
+    converts the log, or a log without accelerations."""
+    log = v.log
+    if isinstance(model, Robot) or log.ddq is None or model.spring is not None:
+        return None
+    columns = _beside_columns(model, log)
+    if columns is None:
+        return None
+    return residual_spring(log.q, log.tau, log.tau - v.tau_hat, noise, columns)
+
+
+def _beside_columns(
+    model: IdentifiedModel, log: TorqueLog
+) -> Callable[[NDArray[np.intp]], NDArray[np.float64]] | None:
+    """The regressor (M, n, p) of ``model``'s own columns at the rows ``rows`` (M,) of the
+    prepared ``log``, with each joint's viscous, Coulomb, offset and rotor-inertia columns;
+    None for a drive that converts the log or a log without accelerations."""
+    if log.ddq is None or (model.drive is not None and not model.drive.is_identity):
         return None
     terms = tuple(t.term for t in model.terms.values())
+    q, dq, ddq = log.q, log.dq, log.ddq
     n = q.shape[1]
 
     def columns(rows: NDArray[np.intp]) -> NDArray[np.float64]:
@@ -424,7 +480,7 @@ def residual_tilt(
         rotor = ddq[rows][:, :, None] * np.eye(n)  # each joint's ddq: a rotor inertia
         return np.concatenate([Y, friction_regressor(dq[rows]), rotor], axis=-1)
 
-    return gravity_tilt(model.robot, q, error, noise, tau, columns)
+    return columns
 
 
 def _input_noise(
