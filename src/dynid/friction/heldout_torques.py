@@ -37,7 +37,7 @@ from numpy.typing import NDArray
 from ..exceptions import DynidError, DynidWarning
 from ..identification.derived_cutoff import with_derived_cutoff_hint
 from ..identification.floor_verdict import judged_prediction, prediction_input_noise
-from ..identification.gravity_tilt import GravityTilt, gravity_tilt
+from ..identification.gravity_tilt import GravityTilt, gravity_tilt, tilt_columns
 from ..identification.input_noise import (
     NoiseFloor,
     quantized_noise_std,
@@ -55,7 +55,7 @@ from ..identification.residual_dependence import (
     residual_dependence,
     with_dependence_hint,
 )
-from ..identification.residual_spring import ResidualSpring, residual_spring, spring_columns
+from ..identification.residual_spring import ResidualSpring, residual_spring
 from ..identification.sanity import despiked
 from ..identification.verdict import Verdict, with_caveat, with_hint, with_replaced_spikes
 from ..model.robot import Robot
@@ -409,26 +409,30 @@ def _held_out(
         v, noise, block, names, read, given, caveat, spikes, inputs, held_terms(model)
     )
     total = held.floor.total_rms
-    tilt, springs = (
-        residual_tilt(model, v, total),
-        residual_springs(model, v if whole is None else whole, total),
-    )
+    fit_on = v if whole is None else whole  # the springs of a time block: on the whole log
+    springs = residual_springs(model, fit_on, total, v)
+    tilt = residual_tilt(model, v, total, springs)
     return dataclasses.replace(held, tilt=tilt, springs=springs)
 
 
 def residual_tilt(
-    model: IdentifiedModel | Robot, v: Validation, noise: NDArray[np.float64]
+    model: IdentifiedModel | Robot,
+    v: Validation,
+    noise: NDArray[np.float64],
+    springs: ResidualSpring | None = None,
 ) -> GravityTilt | None:
     """The tilt of the gravity vector the residual of the prediction ``v`` points to (of
     several pieces: :func:`~dynid.friction.pooled.joined_validation`)
     (:func:`~dynid.identification.gravity_tilt.gravity_tilt`; ``noise`` (n,) [N m] each
     joint's): of an identified model, its own columns projected out and with them each
-    joint's viscous, Coulomb, offset, rotor-inertia and spring columns (terms the structure
-    chosen may have left out: a tilt the fit partly took as offsets made it drop the offset
-    of joint 3, which then pulled the tilt to 0.17 deg for 0.3; a 20 N m/rad spring on a
-    Panda shoulder read as a tilt of 0.89 and 1.8 deg without the springs' columns); of a
-    robot's own parameters, on the residual as it is. None for a model whose drive
-    converts the log (motor side, currents, offsets) or without accelerations."""
+    joint's viscous, Coulomb, offset and rotor-inertia columns (terms the structure chosen
+    may have left out: a tilt the fit partly took as offsets made it drop the offset of
+    joint 3, which then pulled the tilt to 0.17 deg for 0.3), the torques of the springs
+    ``springs`` names (:func:`residual_springs`, fitted beside a tilt, on the whole log of
+    a time block) taken out first (a 20 N m/rad spring on a Panda shoulder had read as a
+    tilt of 0.89 and 1.8 deg); of a robot's own parameters, on the residual as it is.
+    None for a model whose drive converts the log (motor side, currents, offsets) or
+    without accelerations."""
     log = v.log
     if log.ddq is None:
         return None
@@ -438,29 +442,42 @@ def residual_tilt(
     columns = _beside_columns(model, log)
     if columns is None:
         return None
-
-    def with_springs(rows: NDArray[np.intp]) -> NDArray[np.float64]:
-        return np.concatenate([columns(rows), spring_columns(log.q[rows])], axis=-1)
-
-    return gravity_tilt(model.robot, log.q, error, noise, log.tau, with_springs)
+    tau = log.tau
+    if springs is not None and springs.named:  # fitted beside a tilt: no tilt's part
+        named = list(springs.named)
+        spring = np.zeros_like(tau)
+        spring[:, named] = log.q[:, named] * springs.stiffness[named]
+        tau, error = tau - spring, error - spring
+    return gravity_tilt(model.robot, log.q, error, noise, tau, columns)
 
 
 def residual_springs(
-    model: IdentifiedModel | Robot, v: Validation, noise: NDArray[np.float64]
+    model: IdentifiedModel | Robot,
+    v: Validation,
+    noise: NDArray[np.float64],
+    judged: Validation | None = None,
 ) -> ResidualSpring | None:
     """The stiffness per joint the residual of the prediction ``v`` points to
     (:func:`~dynid.identification.residual_spring.residual_spring`; ``noise`` (n,) [N m]
     each joint's): the measured torques fitted with the identified model's own columns,
-    each joint's viscous, Coulomb, offset and rotor-inertia columns and a spring per joint.
-    None for a robot's own parameters, a model that holds a spring already, a drive that
-    converts the log, or a log without accelerations."""
+    each joint's viscous, Coulomb, offset and rotor-inertia columns, a tilt of the gravity
+    vector's (:func:`~dynid.identification.gravity_tilt.tilt_columns`: a tilted base is no
+    spring) and a spring per joint; the residual a spring must explain that of ``judged``
+    (a held-out time block of ``v``'s log; default ``v``). None for a robot's own
+    parameters, a model that holds a spring already, a drive that converts the log, or a
+    log without accelerations."""
     log = v.log
     if isinstance(model, Robot) or log.ddq is None or model.spring is not None:
         return None
-    columns = _beside_columns(model, log)
-    if columns is None:
+    beside = _beside_columns(model, log)
+    if beside is None:
         return None
-    return residual_spring(log.q, log.tau, log.tau - v.tau_hat, noise, columns)
+
+    def columns(rows: NDArray[np.intp]) -> NDArray[np.float64]:
+        return np.concatenate([beside(rows), tilt_columns(model.robot, log.q[rows])], axis=-1)
+
+    seen = v if judged is None else judged
+    return residual_spring(log.q, log.tau, seen.log.tau - seen.tau_hat, noise, columns)
 
 
 def _beside_columns(

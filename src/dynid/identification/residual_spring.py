@@ -7,14 +7,15 @@ shoulder swept over 2.5 rad). :func:`residual_spring` fits the measured torques,
 joint weighed by its noise, with the model's own columns and one column ``q_j`` per joint
 on the joint itself (:func:`spring_columns`) together: the coefficients of the latter are
 the stiffnesses [N m/rad] the data hold beyond the model, its offsets taking the rest
-position. A joint's spring is named (:attr:`ResidualSpring.named`) when its stiffness
-stands :data:`SIGNIFICANT` standard deviations clear and its torque over the samples
+position, and a tilt of the gravity vector beside them where the caller adds its columns
+(a tilted base is no spring). A joint's spring is named (:attr:`ResidualSpring.named`)
+when the joint's held-out residual is above its noise, the stiffness stands
+:data:`SIGNIFICANT` standard deviations clear and the spring's torque over the samples
 (``|k_j|`` times the RMS of ``q_j`` about its mean) is at least :data:`FOLLOWS` of the
-joint's held-out residual above its noise: a stiffness too small to make the residual is
-not its cause.
+residual above the noise: a stiffness too small to make the residual is not its cause.
 
-A simulated Panda with a 20 N m/rad spring on joint 2: 19.97 N m/rad from one 8 s
-recording, 20.18 and 20.00 from two and three (each predicted by the fit of the others);
+A simulated Panda with a 20 N m/rad spring on joint 2: 19.92 N m/rad from one 8 s
+recording, 20.19 and 19.99 from two and three (each predicted by the fit of the others);
 a 20 s recording's residual alone had been read as a gravity vector tilted by 0.89 and
 1.8 deg.
 """
@@ -27,6 +28,8 @@ from typing import Any
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
+
+from .verdict import SYSTEMATIC_RATIO
 
 __all__ = ["FOLLOWS", "SIGNIFICANT", "ResidualSpring", "residual_spring", "spring_columns"]
 
@@ -57,21 +60,25 @@ class ResidualSpring:
     systematic : ndarray, shape (n,)
         Each joint's residual above its noise (RMS) [N m]: of the prediction judged, the
         ``error`` of :func:`residual_spring`.
+    noise : ndarray, shape (n,)
+        Each joint's noise [N m].
     """
 
     stiffness: NDArray[np.float64]
     std: NDArray[np.float64]
     torque: NDArray[np.float64]
     systematic: NDArray[np.float64]
+    noise: NDArray[np.float64]
 
     @property
     def named(self) -> tuple[int, ...]:
-        """The joints whose spring explains their residual: the stiffness
-        :data:`SIGNIFICANT` standard deviations clear, its torque at least :data:`FOLLOWS`
-        of the residual above the noise."""
+        """The joints whose spring explains their residual: the residual above the noise
+        (its RMS over :data:`~dynid.identification.verdict.SYSTEMATIC_RATIO` x the
+        noise), the stiffness :data:`SIGNIFICANT` standard deviations clear, its torque at
+        least :data:`FOLLOWS` of the residual above the noise."""
         z = np.abs(self.stiffness) / np.maximum(self.std, 1e-300)
         ok = (z >= SIGNIFICANT) & (self.torque >= FOLLOWS * self.systematic)
-        ok &= self.systematic > 0
+        ok &= self.systematic**2 + self.noise**2 > (SYSTEMATIC_RATIO * self.noise) ** 2
         return tuple(int(j) for j in np.flatnonzero(ok))
 
     def as_dict(self) -> dict[str, Any]:
@@ -126,8 +133,10 @@ def residual_spring(
         Positions [rad] of the residual's samples.
     tau : array_like, shape (N, n)
         The measured torques [N m] at the samples.
-    error : array_like, shape (N, n)
-        Measured less predicted torques [N m] (the held-out residual judged).
+    error : array_like, shape (M, n)
+        Measured less predicted torques [N m] of the prediction judged (the held-out
+        residual), at its own samples (a time block of the log fitted: ``M <= N``): what a
+        spring must explain.
     noise_rms : array_like, shape (n,)
         Each joint's noise [N m].
     columns : callable
@@ -141,11 +150,12 @@ def residual_spring(
     """
     E = np.asarray(error, dtype=np.float64)
     s = np.asarray(noise_rms, dtype=np.float64)
-    if E.ndim != 2 or not np.all(np.isfinite(s) & (s > 0)):
+    Q = np.asarray(q, dtype=np.float64)
+    if E.ndim != 2 or Q.ndim != 2 or not np.all(np.isfinite(s) & (s > 0)):
         return None
-    N, n = E.shape
+    N, n = Q.shape
     rows = np.unique(np.linspace(0, N - 1, min(N, _SAMPLES)).astype(np.intp))
-    Q = np.asarray(q, dtype=np.float64)[rows]
+    Q = Q[rows]
     W = np.concatenate([np.asarray(columns(rows), dtype=np.float64), spring_columns(Q)], axis=-1)
     A = (W / s[:, None]).reshape(rows.size * n, -1)
     if A.shape[0] <= A.shape[1]:
@@ -164,4 +174,5 @@ def residual_spring(
         std=np.sqrt(np.maximum(np.diag(cov), 0.0)),
         torque=np.abs(k) * spread,
         systematic=above,
+        noise=s,
     )

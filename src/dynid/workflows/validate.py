@@ -394,8 +394,8 @@ def _with_hints(
     q = [v.log.q for v in val.parts]
     if dependence:
         whole = joined_validation(val.parts) if verdict.level != "good" else None
-        tilt = None if whole is None else residual_tilt(model, whole, noise.total)
         springs = None if whole is None else residual_springs(model, whole, noise.total)
+        tilt = None if whole is None else residual_tilt(model, whole, noise.total, springs)
         verdict = with_dependence_hint(
             verdict, q, dq, error, noise.total, names, terms, tilt, noise.ratios, springs
         )
