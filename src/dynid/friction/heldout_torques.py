@@ -344,7 +344,10 @@ def _predicted(
     caveat = (model.info.heldout or {}).get("caveat") if model.holdout.scheme == "blocks" else None
     whole = None  # a time block too short to fit the springs with the model's columns
     if model.holdout.scheme == "blocks":
-        whole = _pieces_validation(model, _pieces(model, _despiked_from(log)[0], turns))[0]
+
+        def whole() -> Validation:
+            return _pieces_validation(model, _pieces(model, _despiked_from(log)[0], turns))[0]
+
     inputs = _input_noise(fitted, v, pieces)
     return _held_out(model, v, block + said, read, caveat, spikes, inputs, whole)
 
@@ -389,13 +392,13 @@ def _held_out(
     caveat: str | None,
     spikes: int,
     inputs: tuple[tuple[int, NDArray[np.float64]], ...] | None,
-    whole: Validation | None = None,
+    whole: Callable[[], Validation] | None = None,
 ) -> HeldOutTorques:
     """The held-out prediction ``v`` judged against the sensors' noise: the
-    identification's record, at least the held-out torques' rounding; the springs fitted
-    on ``whole`` (the model on the whole log of a held-out time block, whose few samples
-    leave a stiffness fitted with the model's columns loose: 776 N m/rad for 20 on a
-    Panda's last 1.4 s) or on ``v``."""
+    identification's record, at least the held-out torques' rounding; above the noise
+    floor, the springs fitted on ``whole()`` (the model on the whole log of a held-out
+    time block, whose few samples leave a stiffness fitted with the model's columns
+    loose: 776 N m/rad for 20 on a Panda's last 1.4 s) or on ``v``."""
     assert model.info.log is not None
     recorded = _recorded_noise(model)
     noise = (
@@ -408,9 +411,11 @@ def _held_out(
     held = HeldOutTorques(
         v, noise, block, names, read, given, caveat, spikes, inputs, held_terms(model)
     )
-    total = held.floor.total_rms
-    fit_on = v if whole is None else whole  # the springs of a time block: on the whole log
-    springs = residual_springs(model, fit_on, total, v)
+    verdict, floor = held._judged()
+    total = floor.total_rms
+    springs = None  # said only above the floor: a good verdict takes no hint
+    if verdict.level != "good":
+        springs = residual_springs(model, v if whole is None else whole(), total, v)
     tilt = residual_tilt(model, v, total, springs)
     return dataclasses.replace(held, tilt=tilt, springs=springs)
 
