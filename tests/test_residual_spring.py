@@ -67,9 +67,9 @@ def _heldout(panda, paths):
 def test_the_springs_joint_is_named_with_its_stiffness(panda, files, count):
     """Regression: a 20 N m/rad spring on joint 2 was named without its stiffness, and
     one recording's residual was read as a tilted gravity vector (0.89 and 1.8 deg); from
-    one recording (its last time block) and from two or three (each predicted by the fit
-    of the others) the verdict names joint 2 alone as a spring, its stiffness within
-    20 % of the truth, and no tilt."""
+    one recording (its last time block judged, the springs fitted on the whole log) and
+    from two or three (each predicted by the fit of the others) the verdict names joint 2
+    alone as a spring, its stiffness within 20 % of the truth, and no tilt."""
     held = _heldout(panda, files[True][:count])
     assert held.springs is not None and held.springs.named == (1,), held.springs
     assert abs(held.springs.stiffness[1] - K) < 0.2 * K, held.springs.stiffness
