@@ -113,7 +113,7 @@ def test_a_tilted_base_is_named_with_its_angle_not_called_a_spring(panda, tmp_pa
     description, was told to add a spring on joint 1 (and the structure chosen left out
     an offset the arm has). The verdict now names the tilt with its angle (0.3 deg within
     10 %) and no spring; a level arm with a 1.5 N m/rad spring on joint 2 still gets the
-    spring and no tilt, and a level arm without one no tilt."""
+    spring (its stiffness within 20 %) and no tilt, and a level arm without one no tilt."""
     truth = panda.with_gravity(_rotation(0, np.radians(0.3)) @ panda.gravity)
     held = _identified(panda, truth, tmp_path, "tilted")
     assert held.tilt is not None and held.tilt.named
@@ -127,11 +127,14 @@ def test_a_tilted_base_is_named_with_its_angle_not_called_a_spring(panda, tmp_pa
     assert doc["named"] and abs(doc["angle_deg"][0] - 0.3) < 0.03, doc
     np.testing.assert_allclose(doc["gravity"], truth.gravity, atol=0.1 * 0.0514)
     assert "spring" not in said, said
+    assert held.springs is None or held.springs.named == (), held.springs
 
     held = _identified(panda, panda, tmp_path, "spring", spring=1.5)
     said = held.verdict.reason
     assert "spring to --terms" in said and "tilted" not in said, said
     assert held.tilt is None or not held.tilt.named
+    assert held.springs is not None and held.springs.named == (1,), held.springs
+    assert abs(held.springs.stiffness[1] - 1.5) < 0.2 * 1.5, held.springs.stiffness
 
     held = _identified(panda, panda, tmp_path, "level")
     assert held.tilt is None or not held.tilt.named

@@ -117,4 +117,4 @@ def test_cli_import_names_jitter_and_only_real_gaps(tmp_path, capsys):
             assert "(no sample dropped)" in out and "gap" not in out
         else:
             assert "(4 sample(s) dropped)" in out
-            assert "1 gap(s) in time of dropped samples (4 dropped" in out
+            assert "1 gap(s) in time of dropped samples at t = " in out

@@ -207,14 +207,17 @@ def grid_steps(t: ArrayLike) -> tuple[NDArray[np.int64], float, float]:
     their own length: at 100 Hz with stamps jittered by 2 ms (std), 3.8 % of the steps are
     longer than 1.5 periods with no sample dropped. The period is :func:`sample_rate`'s.
     When every step lies within 0.4 of a period of a whole number, each is rounded.
-    Otherwise, on each run between steps over :data:`_RUN_GAP` periods (those rounded),
-    the stamps' lag behind a grid without drops (in periods) is a staircase rising by one
-    at each dropped sample, blurred by the jitter: its mean over :data:`_SMOOTH` stamps,
-    rounded, counts the drops (a jitter of 0.25 periods errs by 0.06 there), and each rise
-    is put on the step near it longest beyond the periods it holds, one holding drops
-    already favoured by half a period (a gap is more likely than two side by side). With
-    a jitter beyond :data:`_GRID_JITTER` periods each step is rounded to whole periods
-    (at least 1). The jitter is that of the stamps
+    Otherwise, on each run between steps over :data:`_RUN_GAP` periods (those rounded):
+    with a jitter (read from the steps' distance to whole periods, which the dropped
+    samples' steps do not widen) up to :data:`_ROUND_JITTER` periods, each stamp is given
+    its place on the run's grid (:func:`_grid_indices`); beyond, the stamps' lag behind a
+    grid without drops (in periods) is a staircase rising by one at each dropped sample,
+    blurred by the jitter: its mean over :data:`_SMOOTH` stamps, rounded, counts the drops
+    (a jitter of 0.25 periods errs by 0.06 there), and each rise is put, a drop at a time,
+    on the step near it longest beyond the periods it holds, one holding drops already
+    favoured by half a period (a gap is more likely than two side by side; two gaps within
+    :data:`_SMOOTH` stamps stay two). With a jitter beyond :data:`_GRID_JITTER` periods
+    each step is rounded to whole periods (at least 1). The jitter is that of the stamps
     about the grid fitted to each run (its own offset); 0 for fewer than 3 stamps.
 
     Returns
@@ -233,12 +236,18 @@ def grid_steps(t: ArrayLike) -> tuple[NDArray[np.int64], float, float]:
     steps = np.maximum(np.round(m), 1).astype(np.int64)
     if t.size < 3:
         return steps, h, 0.0
-    counted = bool(np.all(np.abs(m - np.round(m)) <= 0.4))
+    frac = m - np.round(m)
+    counted = bool(np.all(np.abs(frac) <= 0.4))
     jitter = 1.4826 * float(np.median(np.abs(dt - h))) / np.sqrt(2.0)
     if not counted and jitter <= _GRID_JITTER * h:
+        # the steps' distance to whole periods: the jitter without the dropped samples' steps
+        rounded = 1.4826 * float(np.median(np.abs(frac))) / np.sqrt(2.0) <= _ROUND_JITTER
         cuts = np.concatenate([[0], np.flatnonzero(m > _RUN_GAP) + 1, [t.size]])
         for a, b in zip(cuts[:-1], cuts[1:], strict=True):
-            if b - a >= 3:
+            if b - a >= 3 and rounded:
+                n = _grid_indices(t[a:b] - t[a], h, scan=False)
+                steps[a : b - 1] = np.maximum(np.diff(n), 1).astype(np.int64)
+            elif b - a >= 3:
                 steps[a : b - 1] = _run_steps(t[a:b], h)
     place = np.concatenate([[0], np.cumsum(steps)]) * h
     r = t - place
@@ -250,6 +259,11 @@ def grid_steps(t: ArrayLike) -> tuple[NDArray[np.int64], float, float]:
 
 #: Stamps over which :func:`grid_steps` averages the stamps' lag behind the grid.
 _SMOOTH = 16
+#: Stamp jitter (std, in periods, read from the steps' distance to whole periods) up to
+#: which :func:`grid_steps` rounds each stamp to its run's grid (an index one off at a
+#: stamp in 1e3 at 0.15 periods) rather than counting drops on the smoothed lag, which
+#: merges gaps within :data:`_SMOOTH` stamps of each other into one.
+_ROUND_JITTER = 0.15
 
 
 def _run_steps(s: NDArray[np.float64], h: float) -> NDArray[np.int64]:
@@ -266,11 +280,10 @@ def _run_steps(s: NDArray[np.float64], h: float) -> NDArray[np.int64]:
     m = np.diff(s) / h
     for i in np.flatnonzero(steps > 1):  # the mean rises over w stamps: the long step,
         a, b = max(0, int(i) - w), min(L - 1, int(i) + w + 1)  # one holding drops first
-        room = m[a:b] - steps[a:b] + 0.5 * (steps[a:b] > 1)
-        j = a + int(np.argmax(room))
-        if j != i:
-            steps[j] += steps[i] - 1
-            steps[i] = 1
+        rise, steps[i] = steps[i] - 1, 1
+        for _ in range(rise):  # a drop at a time: two gaps near each other stay two
+            room = m[a:b] - steps[a:b] + 0.5 * (steps[a:b] > 1)
+            steps[a + int(np.argmax(room))] += 1
     return steps
 
 

@@ -27,7 +27,7 @@ from __future__ import annotations
 
 import dataclasses
 import warnings
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from typing import Any
 
@@ -37,7 +37,7 @@ from numpy.typing import NDArray
 from ..exceptions import DynidError, DynidWarning
 from ..identification.derived_cutoff import with_derived_cutoff_hint
 from ..identification.floor_verdict import judged_prediction, prediction_input_noise
-from ..identification.gravity_tilt import GravityTilt, gravity_tilt
+from ..identification.gravity_tilt import GravityTilt, gravity_tilt, tilt_columns
 from ..identification.input_noise import (
     NoiseFloor,
     quantized_noise_std,
@@ -55,6 +55,7 @@ from ..identification.residual_dependence import (
     residual_dependence,
     with_dependence_hint,
 )
+from ..identification.residual_spring import ResidualSpring, residual_spring
 from ..identification.sanity import despiked
 from ..identification.verdict import Verdict, with_caveat, with_hint, with_replaced_spikes
 from ..model.drive import Drive
@@ -64,7 +65,7 @@ from .fit import model_drive, torques_through
 from .pooled import joined_validation
 from .validation import Validation, own_friction, validate_torques
 
-__all__ = ["HeldOutTorques", "heldout_torques", "residual_tilt"]
+__all__ = ["HeldOutTorques", "heldout_torques", "residual_springs", "residual_tilt"]
 
 
 @dataclass(frozen=True, slots=True, eq=False)
@@ -108,6 +109,9 @@ class HeldOutTorques:
         The tilt of the gravity vector the held-out residual points to
         (:func:`~dynid.identification.gravity_tilt.gravity_tilt`, the model's columns
         projected out); the verdict names it first when it explains the residual.
+    springs : ResidualSpring or None
+        The stiffness per joint the held-out residual points to
+        (:func:`residual_springs`); the verdict gives a named joint's.
     """
 
     validation: Validation
@@ -121,6 +125,7 @@ class HeldOutTorques:
     inputs: tuple[tuple[int, NDArray[np.float64]], ...] | None = None
     terms: frozenset[str] = frozenset()
     tilt: GravityTilt | None = None
+    springs: ResidualSpring | None = None
 
     def _judged(self) -> tuple[Verdict, NoiseFloor]:
         """:func:`~dynid.identification.floor_verdict.judged_prediction` of the held-out
@@ -174,6 +179,7 @@ class HeldOutTorques:
             self.terms,
             self.tilt,
             fl.joint_ratios,
+            self.springs,
         )
         verdict = with_derived_cutoff_hint(verdict, self.logs, self.cutoff_hz)
         verdict = with_hint(verdict, self.low_speed, ", ")
@@ -205,6 +211,7 @@ class HeldOutTorques:
         its ``ratio`` to the floor, each sample weighed against its own noise) and, above
         the floor, the low-speed note (``low_speed``, the report's own line) and the tilt
         of the gravity vector the residual points to (``gravity_tilt``, null when not
+        judged), and the stiffness per joint it points to (``springs``, null when not
         judged; schema ``heldout.json``)."""
         e, v, fl = self.validation.errors, self.verdict, self.floor
         return {
@@ -223,6 +230,7 @@ class HeldOutTorques:
             "verdict": {"level": v.level, "label": v.label, "reason": v.reason, "ratio": v.ratio},
             "low_speed": None if v.level == "good" else self.low_speed,
             "gravity_tilt": None if self.tilt is None else self.tilt.as_dict(),
+            "springs": None if self.springs is None else self.springs.as_dict(),
             "units": {
                 "rms": "N m",
                 "noise_rms": "N m",
@@ -336,7 +344,14 @@ def _predicted(
     v, said = _pieces_validation(fitted, pieces)
     read = (held if model.holdout.scheme == "file" else log,)  # the motion of a whole log
     caveat = (model.info.heldout or {}).get("caveat") if model.holdout.scheme == "blocks" else None
-    return _held_out(model, v, block + said, read, caveat, spikes, _input_noise(fitted, v, pieces))
+    whole = None  # a time block too short to fit the springs with the model's columns
+    if model.holdout.scheme == "blocks":
+
+        def whole() -> Validation:
+            return _pieces_validation(model, _pieces(model, _despiked_from(log)[0], turns))[0]
+
+    inputs = _input_noise(fitted, v, pieces)
+    return _held_out(model, v, block + said, read, caveat, spikes, inputs, whole)
 
 
 def _each_recording(
@@ -379,9 +394,13 @@ def _held_out(
     caveat: str | None,
     spikes: int,
     inputs: tuple[tuple[int, NDArray[np.float64]], ...] | None,
+    whole: Callable[[], Validation] | None = None,
 ) -> HeldOutTorques:
     """The held-out prediction ``v`` judged against the sensors' noise: the
-    identification's record, at least the held-out torques' rounding."""
+    identification's record, at least the held-out torques' rounding; above the noise
+    floor, the springs fitted on ``whole()`` (the model on the whole log of a held-out
+    time block, whose few samples leave a stiffness fitted with the model's columns
+    loose: 776 N m/rad for 20 on a Panda's last 1.4 s) or on ``v``."""
     assert model.info.log is not None
     recorded = _recorded_noise(model)
     noise = (
@@ -394,31 +413,92 @@ def _held_out(
     held = HeldOutTorques(
         v, noise, block, names, read, given, caveat, spikes, inputs, held_terms(model)
     )
-    return dataclasses.replace(held, tilt=residual_tilt(model, v, held.floor.total_rms))
+    verdict, floor = held._judged()
+    total = floor.total_rms
+    springs = None  # said only above the floor: a good verdict takes no hint
+    if verdict.level != "good":
+        springs = residual_springs(model, v if whole is None else whole(), total, v)
+    tilt = residual_tilt(model, v, total, springs)
+    return dataclasses.replace(held, tilt=tilt, springs=springs)
 
 
 def residual_tilt(
-    model: IdentifiedModel | Robot, v: Validation, noise: NDArray[np.float64]
+    model: IdentifiedModel | Robot,
+    v: Validation,
+    noise: NDArray[np.float64],
+    springs: ResidualSpring | None = None,
 ) -> GravityTilt | None:
     """The tilt of the gravity vector the residual of the prediction ``v`` points to (of
     several pieces: :func:`~dynid.friction.pooled.joined_validation`)
     (:func:`~dynid.identification.gravity_tilt.gravity_tilt`; ``noise`` (n,) [N m] each
     joint's): of an identified model, its own columns projected out and with them each
     motor's viscous, Coulomb, offset and rotor-inertia columns mapped to the joints
-    through the model's drive as the fit maps them (``K_f^T`` of the friction at ``K_f
-    dq``, ``K^T`` of the rotor at ``K ddq``; each joint's own without a drive: terms the
+    through the model's drive as the fit maps them (:func:`_beside_columns`: terms the
     structure chosen may have left out: a tilt the fit partly took as offsets made it drop
-    the offset of joint 3, which then pulled the tilt to 0.17 deg for 0.3); of a robot's
-    own parameters, on the residual as it is. ``v`` is at the joints (a motor-side log or
-    currents read through the drive). None without accelerations."""
+    the offset of joint 3, which then pulled the tilt to 0.17 deg for 0.3), the torques of
+    the springs ``springs`` names (:func:`residual_springs`, fitted beside a tilt, on the
+    whole log of a time block) taken out first (a 20 N m/rad spring on a Panda shoulder had
+    read as a tilt of 0.89 and 1.8 deg); of a robot's own parameters, on the residual as it
+    is. ``v`` is at the joints (a motor-side log or currents read through the drive). None
+    without accelerations."""
     log = v.log
     if log.ddq is None:
         return None
-    q, dq, ddq, tau = log.q, log.dq, log.ddq, log.tau
-    error = tau - v.tau_hat
+    error = log.tau - v.tau_hat
     if isinstance(model, Robot):
-        return gravity_tilt(model, q, error, noise)
+        return gravity_tilt(model, log.q, error, noise)
+    columns = _beside_columns(model, log)
+    if columns is None:
+        return None
+    tau = log.tau
+    if springs is not None and springs.named:  # fitted beside a tilt: no tilt's part
+        named = list(springs.named)
+        spring = np.zeros_like(tau)
+        spring[:, named] = log.q[:, named] * springs.stiffness[named]
+        tau, error = tau - spring, error - spring
+    return gravity_tilt(model.robot, log.q, error, noise, tau, columns)
+
+
+def residual_springs(
+    model: IdentifiedModel | Robot,
+    v: Validation,
+    noise: NDArray[np.float64],
+    judged: Validation | None = None,
+) -> ResidualSpring | None:
+    """The stiffness per joint the residual of the prediction ``v`` points to
+    (:func:`~dynid.identification.residual_spring.residual_spring`; ``noise`` (n,) [N m]
+    each joint's): the measured torques fitted with the identified model's own columns,
+    each joint's viscous, Coulomb, offset and rotor-inertia columns, a tilt of the gravity
+    vector's (:func:`~dynid.identification.gravity_tilt.tilt_columns`: a tilted base is no
+    spring) and a spring per joint; the residual a spring must explain that of ``judged``
+    (a held-out time block of ``v``'s log; default ``v``). None for a robot's own
+    parameters, a model that holds a spring already, or a log without accelerations."""
+    log = v.log
+    if isinstance(model, Robot) or log.ddq is None or model.spring is not None:
+        return None
+    beside = _beside_columns(model, log)
+    if beside is None:
+        return None
+
+    def columns(rows: NDArray[np.intp]) -> NDArray[np.float64]:
+        return np.concatenate([beside(rows), tilt_columns(model.robot, log.q[rows])], axis=-1)
+
+    seen = v if judged is None else judged
+    return residual_spring(log.q, log.tau, seen.log.tau - seen.tau_hat, noise, columns)
+
+
+def _beside_columns(
+    model: IdentifiedModel, log: TorqueLog
+) -> Callable[[NDArray[np.intp]], NDArray[np.float64]] | None:
+    """The regressor (M, n, p) of ``model``'s own columns at the rows ``rows`` (M,) of the
+    prepared joint-side ``log``, with each motor's viscous, Coulomb, offset and
+    rotor-inertia columns mapped to the joints through the model's drive as the fit maps
+    them (``K_f^T`` of the friction at ``K_f dq``, ``K^T`` of the rotor at ``K ddq``; each
+    joint's own without a drive); None for a log without accelerations."""
+    if log.ddq is None:
+        return None
     terms = tuple(t.term for t in model.terms.values())
+    q, dq, ddq = log.q, log.dq, log.ddq
     drive = Drive.identity(q.shape[1]) if model.drive is None else model.drive
     own = LinearFriction(drive)
 
@@ -428,7 +508,7 @@ def residual_tilt(
         rotor = drive.rotor_columns(ddq[rows])  # each motor's rotor inertia
         return np.concatenate([Y, friction, rotor], axis=-1)
 
-    return gravity_tilt(model.robot, q, error, noise, tau, columns)
+    return columns
 
 
 def _input_noise(

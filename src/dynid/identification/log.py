@@ -79,6 +79,8 @@ _SIGNALS = ("q", "dq", "tau", "ddq")
 MIN_MAX_GAP_S = 0.02
 
 
+#: Gaps whose start times [s] :func:`timing_notes` lists, the first ones.
+GAPS_SAID = 5
 #: Stamps are said to be jittered when their jitter about their grid exceeds this fraction
 #: of a period (a uniform log written with 15 digits stays below it).
 JITTER_SAID = 1e-3
@@ -94,7 +96,8 @@ def jitter_text(jitter_s: float, period_s: float) -> str | None:
 
 def timing_notes(c: LogCleaning) -> list[str]:
     """What a reader says of a log's timestamps: their jitter (its size, and the samples
-    dropped or none) and the gaps that drop samples (count, samples, longest [ms])."""
+    dropped or none) and the gaps that drop samples (count, the first :data:`GAPS_SAID`
+    start times [s], samples, longest [ms])."""
     notes = []
     jitter = jitter_text(c.stamp_jitter_s, c.period_s)
     if jitter is not None:  # steps long by jitter alone are no gaps
@@ -104,9 +107,11 @@ def timing_notes(c: LogCleaning) -> list[str]:
             "uniform grid"
         )
     if c.gaps:
+        at = ", ".join(f"{a:.4g}" for a, _ in c.gaps[:GAPS_SAID])
+        more = ", ..." if len(c.gaps) > GAPS_SAID else ""
         notes.append(
-            f"{len(c.gaps)} gap(s) in time of dropped samples ({c.n_dropped} dropped; "
-            f"longest {max(b - a for a, b in c.gaps) * 1e3:.3g} ms)"
+            f"{len(c.gaps)} gap(s) in time of dropped samples at t = {at}{more} s "
+            f"({c.n_dropped} dropped; longest {max(b - a for a, b in c.gaps) * 1e3:.3g} ms)"
         )
     return notes
 

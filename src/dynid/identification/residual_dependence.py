@@ -28,6 +28,7 @@ from numpy.typing import NDArray
 
 from ..model.robot import Robot
 from .gravity_tilt import GravityTilt
+from .residual_spring import ResidualSpring
 from .verdict import SYSTEMATIC_RATIO, Verdict, with_hint
 
 if TYPE_CHECKING:
@@ -159,25 +160,52 @@ def residual_dependence(
     return tuple(out)
 
 
-def _sentence(d: Dependence, name: str, terms: Collection[str] = ()) -> str:
-    """One joint's diagnosis in words; ``terms`` the model's term names (:func:`held_terms`),
-    so that the remedy names what the model lacks, not what it holds."""
-    head = f"{name}: "
-    if d.position >= d.velocity and d.position >= FOLLOWS * d.systematic:
-        if "spring" not in terms:
-            why = (
-                "a spring, a cable or a counterbalance outside the rigid-body model; try adding "
-                "spring to --terms of dynid identify, with offset: the spring's rest position"
-            )
-        elif "offset" not in terms:
-            why = (
-                "the model's spring acts about the middle of the joint's limits: add offset to "
-                "--terms of dynid identify so that its rest position is identified"
-            )
-        else:
-            why = "beyond the model's linear spring: a spring that is not linear, a cable"
+def _remedy(terms: Collection[str]) -> str:
+    """What to add to the model for a residual that follows a joint's position, given the
+    model's ``terms``: the spring, the offset that places its rest position, or neither."""
+    if "spring" not in terms:
         return (
-            f"{head}{d.position:.2g} of {d.rms:.2g} N m RMS residual follows its position ({why})"
+            "try adding spring to --terms of dynid identify, with offset: the spring's rest "
+            "position"
+        )
+    if "offset" not in terms:
+        return (
+            "the model's spring acts about the middle of the joint's limits: add offset to "
+            "--terms of dynid identify so that its rest position is identified"
+        )
+    return "beyond the model's linear spring: a spring that is not linear, a cable"
+
+
+def _sentence(
+    d: Dependence,
+    name: str,
+    terms: Collection[str] = (),
+    springs: ResidualSpring | None = None,
+) -> str:
+    """One joint's diagnosis in words; ``terms`` the model's term names (:func:`held_terms`),
+    so that the remedy names what the model lacks, not what it holds; ``springs`` the
+    stiffness per joint fitted with the model (its named joints' said with their
+    stiffness, a position dependence no spring explains said so)."""
+    head = f"{name}: "
+    named = springs is not None and d.joint in springs.named
+    follows = f"{head}{d.position:.2g} of {d.rms:.2g} N m RMS residual follows its position"
+    if named:
+        assert springs is not None
+        return (
+            f"{follows}: {springs.sentence(d.joint)} outside the rigid-body model, fitted "
+            f"with the model's columns to these torques ({_remedy(terms)})"
+        )
+    if d.position >= d.velocity and d.position >= FOLLOWS * d.systematic:
+        if springs is None or "spring" in terms:
+            if "spring" not in terms:
+                why = "a spring, a cable or a counterbalance outside the rigid-body model; "
+                return f"{follows} ({why}{_remedy(terms)})"
+            return f"{follows} ({_remedy(terms)})"
+        k = float(springs.stiffness[d.joint])
+        return (
+            f"{follows}, but a linear spring fitted there with the model's columns explains "
+            f"little of it ({k:.2g} N m/rad): the links' parameters pulled by an effect on "
+            "another joint, or a dependence that is not a spring's"
         )
     if d.velocity >= FOLLOWS * d.systematic:
         return (
@@ -214,6 +242,7 @@ def dependence_hint(
     terms: Collection[str] = (),
     tilt: GravityTilt | None = None,
     ratios: NDArray[np.float64] | None = None,
+    springs: ResidualSpring | None = None,
 ) -> str | None:
     """:func:`residual_dependence` in words, one clause per joint above its noise joined by
     ``"; "`` (``"right_s1: 0.41 of 0.59 N m RMS residual follows its position (...)"``),
@@ -225,7 +254,10 @@ def dependence_hint(
     when it explains the residual (:attr:`~dynid.identification.gravity_tilt.GravityTilt.
     named`) it is said first and the joints are diagnosed on what it leaves (a residual
     the tilt explains is no spring's). ``ratios``: the verdict's per joint
-    (:func:`residual_dependence`)."""
+    (:func:`residual_dependence`). ``springs``: the stiffness per joint fitted with the
+    model (:func:`~dynid.identification.residual_spring.residual_spring`), which names a
+    spring's joint with its stiffness and says where a position dependence is no
+    spring's."""
     if tilt is not None and tilt.named:
         rows = tilt.rows
         q = [np.concatenate([np.asarray(x, dtype=np.float64) for x in q])[rows]]
@@ -236,7 +268,7 @@ def dependence_hint(
     if not found:
         return None
     worst = sorted(found, key=lambda d: d.ratio, reverse=True)
-    said = "; ".join(_sentence(d, joint_names[d.joint], terms) for d in worst[:NAMED])
+    said = "; ".join(_sentence(d, joint_names[d.joint], terms, springs) for d in worst[:NAMED])
     more = len(worst) - NAMED
     return said + (f" ({more} more joint(s) above their noise)" if more > 0 else "")
 
@@ -251,15 +283,17 @@ def with_dependence_hint(
     terms: Collection[str] = (),
     tilt: GravityTilt | None = None,
     ratios: NDArray[np.float64] | None = None,
+    springs: ResidualSpring | None = None,
 ) -> Verdict:
     """``verdict`` with :func:`dependence_hint` appended when it is above the noise floor
     (not ``"good"``) and a joint is above its noise; else ``verdict`` itself. ``terms``: the
     model's (:func:`held_terms`); ``tilt``: the tilt of the gravity vector the residual
     points to, said first when it explains it; ``ratios``: the verdict's per joint, which
-    say which joints are above their noise."""
+    say which joints are above their noise; ``springs``: the stiffness per joint fitted
+    with the model, said for a spring's joint."""
     if verdict.level == "good":
         return verdict
-    said = dependence_hint(q, dq, error, noise_rms, joint_names, terms, tilt, ratios)
+    said = dependence_hint(q, dq, error, noise_rms, joint_names, terms, tilt, ratios, springs)
     return with_hint(verdict, said)
 
 

@@ -49,7 +49,7 @@ from numpy.typing import NDArray
 
 from ..exceptions import DataError, DynidWarning, OptionError
 from ..friction.fit import same_drive, torques_through
-from ..friction.heldout_torques import residual_tilt
+from ..friction.heldout_torques import residual_springs, residual_tilt
 from ..friction.model import FrictionModel, FrictionSum, own_at_motors_note, placed_friction
 from ..friction.pooled import joined_validation
 from ..friction.recordings import RecordingsValidation, validate_recordings
@@ -400,16 +400,19 @@ def _with_hints(
     ``dependence`` False: a recording that moves beyond the identification's data, where
     any residual follows the motion; ``terms`` the model's, which its remedies leave out;
     first the tilt of the gravity vector the residual points to, when it explains it:
-    :func:`~dynid.friction.heldout_torques.residual_tilt` of ``model``), the hint of a
+    :func:`~dynid.friction.heldout_torques.residual_tilt` of ``model``; a spring's joint
+    with its stiffness, :func:`~dynid.friction.heldout_torques.residual_springs`), the
+    hint of a
     cut-off too high for derived states, and that of an error at low speed."""
     error = [v.log.tau - v.tau_hat for v in val.parts]
     dq = [v.log.dq for v in val.parts]
     q = [v.log.q for v in val.parts]
     if dependence:
         whole = joined_validation(val.parts) if verdict.level != "good" else None
-        tilt = None if whole is None else residual_tilt(model, whole, noise.total)
+        springs = None if whole is None else residual_springs(model, whole, noise.total)
+        tilt = None if whole is None else residual_tilt(model, whole, noise.total, springs)
         verdict = with_dependence_hint(
-            verdict, q, dq, error, noise.total, names, terms, tilt, noise.ratios
+            verdict, q, dq, error, noise.total, names, terms, tilt, noise.ratios, springs
         )
     verdict = with_derived_cutoff_hint(verdict, logs, val.pieces.cutoff_hz)
     high = derived_cutoff_hint(logs, val.pieces.cutoff_hz)
