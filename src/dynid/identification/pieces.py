@@ -38,6 +38,7 @@ __all__ = [
     "Q_START_TOLERANCE",
     "WRAP_SPAN",
     "check_below_nyquist",
+    "check_samples_and_time",
     "gaps_between",
     "joined",
     "nearest_turns",
@@ -175,6 +176,23 @@ def unwrapped(log: TorqueLog, revolute: NDArray[np.bool_]) -> tuple[TorqueLog, t
     return out, joints
 
 
+def check_samples_and_time(name: str, log: TorqueLog) -> None:
+    """Refuse a recording of too few samples
+    (:func:`~dynid.identification.sanity.too_few_samples`, before any statistic of it) or
+    whose time column looks like ms, us or ns
+    (:func:`~dynid.identification.sanity.time_unit_finding`).
+
+    Raises
+    ------
+    DataError
+        Naming the file ``name`` (and for the time column, the factor).
+    """
+    if (few := too_few_samples(log)) is not None:
+        raise DataError(few, file=name)
+    if (unit := time_unit_finding(name, log)) is not None:  # it names the file
+        raise DataError(unit.removeprefix(f"{name}: "), file=name)
+
+
 def recording_pieces(
     name: str,
     log: TorqueLog,
@@ -214,10 +232,7 @@ def recording_pieces(
     OptionError
         ``max_gap_s`` below the sample step.
     """
-    if (few := too_few_samples(log)) is not None:  # before any statistic of it
-        raise DataError(few, file=name)
-    if (unit := time_unit_finding(name, log)) is not None:  # it names the file
-        raise DataError(unit.removeprefix(f"{name}: "), file=name)
+    check_samples_and_time(name, log)
     pieces: list[TorqueLog] = []
     turned: set[int] = set()
     for piece in split_at_gaps(log, max_gap_s, name):

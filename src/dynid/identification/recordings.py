@@ -60,6 +60,7 @@ from .log_rows import log_blocks, still_columns
 from .pieces import (
     WRAP_SPAN,
     check_below_nyquist,
+    check_samples_and_time,
     gaps_between,
     joined,
     recording_pieces,
@@ -470,11 +471,10 @@ def prepare_recordings(
     """
     if not logs:
         raise DataError("no recording given")
-    if isinstance(cutoff_hz, int | float):  # the option first: no data check can help it
-        check_below_nyquist(list(logs), float(cutoff_hz))
     names = tuple(names) if names is not None else tuple(f"log{k + 1}" for k in range(len(logs)))
     if len(names) != len(logs):
         raise ShapeError(f"{len(names)} names for {len(logs)} recordings")
+    _check_cutoff(names, logs, cutoff_hz)
     # a motor-side log: its motors turn (a joint-side one: joints whose limits span a turn)
     turns = wrappable(robot, drive)
     pieces: list[tuple[int, TorqueLog]] = []
@@ -553,6 +553,19 @@ def prepare_recordings(
             for r, log in enumerate(logs)
         ),
     )
+
+
+def _check_cutoff(
+    names: Sequence[str], logs: Sequence[TorqueLog], cutoff_hz: float | str | None
+) -> None:
+    """A cut-off given [Hz] refused at or above every recording's Nyquist rate
+    (:func:`~.pieces.check_below_nyquist`) before the data's own checks (a log read
+    reversed is no reason for it), once each time column reads in seconds and holds
+    enough samples (:func:`~.pieces.check_samples_and_time`)."""
+    if isinstance(cutoff_hz, int | float):
+        for name, log in zip(names, logs, strict=True):
+            check_samples_and_time(name, log)
+        check_below_nyquist(list(logs), float(cutoff_hz))
 
 
 def _checked(
