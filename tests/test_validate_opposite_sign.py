@@ -7,6 +7,7 @@ from __future__ import annotations
 
 import dataclasses
 import json
+import logging
 import warnings
 
 import numpy as np
@@ -120,7 +121,7 @@ def test_report_headline_and_json_name_the_flipped_file(panda_logs, tmp_path):
     assert "The torques of flip.csv read with the opposite sign" in head
 
 
-def test_a_model_identified_with_a_files_own_flip_validates_other_files(panda_logs):
+def test_a_model_identified_with_a_files_own_flip_validates_other_files(panda_logs, caplog):
     """A model identified with ``--units flip.csv:tau4=-1`` (flip.csv's own entry) reads a
     new file as recorded, the entry holding for flip.csv alone: validate on a.csv runs,
     at the noise level with no sign finding (it was refused: "flip.csv is none of the
@@ -133,9 +134,14 @@ def test_a_model_identified_with_a_files_own_flip_validates_other_files(panda_lo
         warnings.simplefilter("ignore", DynidWarning)
         model = identify_files(robot, [d / "a.csv", d / "flip.csv"], opts).model
     for name in ("a.csv", "flip.csv"):
-        result, said = _validate(model, d / name)
+        caplog.clear()
+        with caplog.at_level(logging.WARNING):
+            result, said = _validate(model, d / name)
         assert not any("opposite" in s for s in said), said
         np.testing.assert_allclose(result.validation.errors.rms, NOISE, rtol=0.25)
+        # the recorded entry is said where it applies, not on another file
+        told = any("as the model's data were read" in r.getMessage() for r in caplog.records)
+        assert told is (name == "flip.csv")
 
 
 def test_torques_declared_in_n_m_through_a_current_drive_are_refused(panda_logs):

@@ -350,18 +350,23 @@ def read_static_file(
 
 
 def recorded_columns(
-    recorded: Mapping[str, Any] | None, columns: str | None, units: str | None
+    recorded: Mapping[str, Any] | None,
+    columns: str | None,
+    units: str | None,
+    files: Sequence[str | Path] | None = None,
 ) -> tuple[str | None, str | None]:
     """The ``--columns`` and ``--units`` to read a log with for a model identified with
     the column map ``recorded`` (its ``info.column_map``): each as given, else as recorded
     (another file may be written in other units or with other names); logged where the
-    recorded one is used or one given differs from it."""
+    recorded one is used or one given differs from it, not where the recorded map is a
+    file's own entries (``rec3.csv:tau6=-1``) naming none of the ``files`` read (nothing
+    of it applies to them)."""
     if recorded is None:
         return columns, units
     rec = (recorded.get("columns"), recorded.get("units"))
     given = (columns, units)
     used = tuple(g if g is not None else r for g, r in zip(given, rec, strict=True))
-    if used == rec and used != given:
+    if used == rec and used != given and _applies(rec, files):
         _log.warning(
             "reading the data as the model's data were read (%s); a file of other names or "
             "units is read with its own --columns/--units (%s)",
@@ -375,6 +380,17 @@ def recorded_columns(
             _read_with(*rec),
         )
     return used[0], used[1]
+
+
+def _applies(rec: tuple[Any, Any], files: Sequence[str | Path] | None) -> bool:
+    """Whether the recorded ``(columns, units)`` say anything of the ``files`` read (None:
+    not known, so it may): no when they are only a file's own entries naming none."""
+    if files is None or rec[0] is not None:
+        return True
+    entries = [u.strip() for u in str(rec[1] or "").split(",") if u.strip()]
+    own = [u.split("=")[0].rsplit(":", 1)[0] for u in entries if ":" in u.split("=")[0]]
+    names = {Path(f).name for f in files}
+    return len(own) < len(entries) or any(f in names for f in own)
 
 
 def _another_file(units: str) -> str:

@@ -487,9 +487,10 @@ def observe_files(opts: ObserveOptions, sink: ResidualSink | None = None) -> Obs
         else given.uses_uncertainty and model.covariance is not None
     )
     wants_margin = opts.standstill if given is None else given.standstill
-    columns = recorded_columns(recorded, *opts.columns)  # (names, units), said once
+    files = data_files(opts.data)
+    columns = recorded_columns(recorded, *opts.columns, files)  # (names, units), said once
     cmap = column_map(*columns, drive=model.drive)
-    read = _read_logs(data_files(opts.data), model, cmap, opts)
+    read = _read_logs(files, model, cmap, opts)
     read, _ = despiked_recordings(
         read, model.robot.joint_names, SPIKES_BEFORE_OBSERVER, min_rate_hz=SPIKE_RATE_HZ
     )

@@ -203,7 +203,7 @@ def read_recordings(
         degrees among recordings in radians or in mN m read as N m (each names the file).
     """
     paths = data_files(data)
-    names, units = recorded_columns(recorded, *(columns or (None, None)))
+    names, units = recorded_columns(recorded, *(columns or (None, None)), paths)
     cmap = column_map(names, units, cutoff_hz=cutoff_hz, drive=drive)
     mine, toml = columns or (None, None), str((columns or (None,))[0] or "").lower()
     if mine[1] is not None or toml.endswith(".toml"):  # the user's units, not the model's
