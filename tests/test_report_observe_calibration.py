@@ -35,7 +35,7 @@ def free(tmp_path_factory):
 
 @pytest.mark.parametrize("rule", [[], ["--margin", "1", "--quantile", "0.6"]])
 def test_the_calibration_report_opens_with_false_alarms_detectable_torques_and_figure(
-    free, tmp_path, rule
+    free, tmp_path, rule, capsys
 ):
     """The answer box holds the false alarms (equal to the events a detection with the
     thresholds finds on the same log) and their rate per minute of the log, the smallest
@@ -44,8 +44,16 @@ def test_the_calibration_report_opens_with_false_alarms_detectable_torques_and_f
     path, log = free
     cal, det = tmp_path / "cal", tmp_path / "det"
     base = ["observe", "--params", "panda", "--data", str(path)]
+    capsys.readouterr()
     assert main([*base, "--calibrate", *rule, "--out", str(cal)]) == 0
     th = json.loads((cal / "thresholds.json").read_text())
+    # the printout's residual column is the one past the standstill margin (contact /
+    # margin), labelled so: the report's "largest |r| read" is the raw peak, margin in
+    head = next(x for x in capsys.readouterr().out.splitlines() if "past margin [N m]" in x)
+    assert head.split()[0] == "joint"
+    assert th["rule"]["standstill_margin"]  # the default: the margin is left out
+    over = th["rule"]["margin"]
+    assert any(p > c / over for p, c in zip(th["calibration"]["peak"], th["contact"], strict=True))
     assert main([*base, "--thresholds", str(cal / "thresholds.json"), "--no-figures",
                  "--out", str(det)]) == 0  # fmt: skip
     events = json.loads((det / "events.json").read_text())["events"]

@@ -799,6 +799,7 @@ def format_observation(result: ObserveResult, names: list[str], *, calibrating: 
     th = result.thresholds
     if calibrating:  # the residual the rule read: after the standstill margin
         read = "|r| read" if th.quantile == 1.0 else f"|r| q{th.quantile:g}"
+        read += " past margin" if th.standstill else ""  # not the report's raw largest |r|
         cols = {f"{read} [N m]": th.contact / th.margin}
     else:
         peaks = [x.largest() for x in result.logs]
