@@ -154,7 +154,8 @@ def test_a_mass_biased_by_an_unmodelled_spring_is_withheld_and_its_interval_cove
     # the factor fitted beside the load takes the spring's torques: not judged, not a load
     assert d["torque_scale"]["judged"] is False and clean.torque_scale is not None
     assert payload_to_dict(clean, ARM)["torque_scale"]["judged"] is True
-    assert "not judged" in scale_line(est.torque_scale, est.mass, est.noise_rms)
+    said = scale_line(est.torque_scale, est.mass, est.noise_rms)
+    assert "not judged" in said and "lacks torques of these data (a spring" in said, said
     assert "not judged" not in scale_line(clean.torque_scale, clean.mass, clean.noise_rms)
 
 

@@ -253,8 +253,10 @@ def scale_line(t: TorqueScale, mass: float, noise_rms: float | None = None) -> s
     if (ratio := unjudged_ratio(t, noise_rms)) is not None:
         return (
             f"torques  {t.value:.4f} x the arm description's (std {t.std:.2g}, on {where}): "
-            f"not judged, the fit with the factor leaves {ratio:.3g} x the torque noise (the "
-            "factor takes torques the arm's model lacks; see the warnings)"
+            f"not judged, the fit with the factor leaves {ratio:.3g} x the torque noise: the "
+            "arm's description lacks torques of these data (a spring, friction, inertials "
+            "off), which the factor takes in, so it says nothing of the sensors' scale; "
+            "hint: judge it with an arm identified from these recordings (--model)"
         )
     return (
         f"torques  {t.value:.4f} x the arm description's (std {t.std:.2g}, on {where}); "
