@@ -6,9 +6,11 @@ References: simulated Panda recordings with sensor noise, classical friction and
 
 from __future__ import annotations
 
+import re
+
 import numpy as np
 import pytest
-from test_systematic_residual import K, _fitted, _logs
+from test_systematic_residual import Q0, K, _fitted, _logs
 
 from dynid.identification.structure import Structure
 from dynid.io.model_json import load_model_json, save_model_json
@@ -60,3 +62,24 @@ def test_the_structure_names_spring_as_a_term():
     assert Structure.parse(",".join(s.terms)) == s
     with pytest.raises(ValueError, match="terms are armature, spring, viscous"):
         Structure.parse("springs")
+
+
+def test_the_summary_gives_the_springs_rest_position_with_its_offset(panda, spring_logs):
+    """The spring term is ``k (q - q0)`` about the joint's mid-range, the offset ``fo``
+    beside it: the summary gives where the two leave no torque, ``q0 - fo/k``, for the
+    determined spring alone: the truth's rest position 0.3 rad on joint 2, within 0.01 rad
+    (the offset's and stiffness's standard deviations put 3 std of the ratio at 0.0064)."""
+    from dynid.cli.summaries import term_lines
+
+    *train, _ = spring_logs
+    model = _fitted(panda, train, "viscous,coulomb,offset,spring")
+    line = next(x for x in term_lines(model) if x.startswith("  rest position"))
+    said = dict(
+        (int(j), float(r)) for j, r in re.findall(r"joint (\d+) at ([+-][\d.e+-]+) rad", line)
+    )
+    assert list(said) == [2], line
+    fr = model.terms["friction"]
+    i = fr.labels.index("fo2")
+    k, sk = model.spring.k[1], model.terms["spring"].std[1]
+    spread = 3 * np.hypot(fr.std[i] / k, fr.values[i] * sk / k**2)
+    assert abs(said[2] - Q0) < 0.01 and spread < 0.01, (line, spread)

@@ -22,7 +22,7 @@ from ..identification.dissipation import SIGNIFICANCE, negative_viscous
 from ..identification.info import IdentificationInfo, LogInfo
 from ..identification.log import jitter_text
 from ..identification.model import IdentifiedModel
-from ..identification.structure import MIN_WIDTH, joint_side_joints
+from ..identification.structure import JOINT_PREFIX, MIN_WIDTH, joint_side_joints
 from ..io.observer_files import log_labels
 from ..observer.calibration_check import CalibrationCheck
 from ..observer.detection import undetected_at_rest
@@ -182,6 +182,7 @@ def term_lines(model: IdentifiedModel) -> list[str]:
                 "parameter (listed above); the data give the sum, not this coefficient alone"
             )
         out += _scales_lines(scales, model)
+        out += _rest_line(t, model)
         out += _negative_viscous_line(t)
         mine = [lab for lab in t.labels if lab in model.info.combined]
         if mine:
@@ -191,6 +192,38 @@ def term_lines(model: IdentifiedModel) -> list[str]:
                 + "; ".join(f"{lab} holds {model.info.combined[lab]}" for lab in mine)
             )
     return out
+
+
+def _rest_line(t: Any, model: IdentifiedModel) -> list[str]:
+    """For a spring term: where each determined spring (kept, std under 20 % of k) and the
+    joint's torque offset, when the model holds one at the joint (``fo``; ``jfo`` with a
+    drive), leave no torque: ``q0 - fo / k`` [rad], ``q0`` the spring's own rest position
+    (the joint's mid-range)."""
+    stiff = t.stiffness
+    if stiff is None:
+        return []
+    at_joints = "fo" if model.drive is None else f"{JOINT_PREFIX}fo"  # a motor's acts on all
+    offsets = {
+        lab.removeprefix(JOINT_PREFIX): float(v)
+        for other in model.appended
+        for lab, v, kept in zip(other.labels, other.values, other.kept, strict=True)
+        if kept and lab.rstrip("0123456789") == at_joints
+    }
+    said = []
+    for k, lab in enumerate(t.labels):
+        j = int(lab[len(lab.rstrip("0123456789")) :]) - 1
+        if not (t.kept[k] and np.isfinite(t.std[k]) and abs(t.std[k]) < 0.2 * abs(t.values[k])):
+            continue
+        fo = offsets.get(f"fo{j + 1}", 0.0)
+        rest = float(stiff.q0[j]) - fo / float(stiff.k[j])
+        with_fo = f" - fo{j + 1}/k" if f"fo{j + 1}" in offsets else ""
+        said.append(f"joint {j + 1} at {rest:+.4g} rad (q0 {float(stiff.q0[j]):+.4g}{with_fo})")
+    if not said:
+        return []
+    return [
+        "  rest position (the spring's torque, with the joint's offset, is zero there): "
+        + "; ".join(said)
+    ]
 
 
 def _negative_viscous_line(t: Any) -> list[str]:
