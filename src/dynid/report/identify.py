@@ -606,7 +606,10 @@ def answer(run: RunFiles) -> Answer | None:
             first, more, headline = _consistent_facts(doc, consistent)
             above = _above_noise(held) if isinstance(held, dict) else ""
             headline += f"; least squares leaves {esc(above)}" if above else ""
-            facts = first + [f"Least squares: {f[0].lower()}{f[1:]}" for f in facts]
+            own = "Held-out error of least squares"  # says whose already
+            facts = first + [
+                f if f.startswith(own) else f"Least squares: {f[0].lower()}{f[1:]}" for f in facts
+            ]
             problems = more + problems
         facts += spring_facts(held)  # where the verdict names a spring: its stiffness
     rank, p = _rank_fact(doc)
