@@ -44,6 +44,7 @@ from ..identification.verdict import (
 from .html import bar, cell, esc, figure, is_number, number, percent, section, table, verdict
 from .model_terms import terms_sections
 from .run import Answer, RunFiles
+from .springs import spring_facts, springs_section
 
 __all__ = ["answer", "coefficient_unit"]
 
@@ -127,7 +128,7 @@ def _heldout_facts(
     if judged is not None:
         fact, more, headline = _floor_fact(
             judged, test, floor, "torques it was judged on", contradicted,
-            within_motion=isinstance(caveat, str),
+            within_motion=isinstance(caveat, str), samples=pooled_label(ho),
         )  # fmt: skip
         facts += [fact] if floor_fact else []
         problems += more
@@ -163,8 +164,11 @@ def _own_facts(
         within_motion=within_motion,
         what="noise floor",
         above=_above_noise(held),
+        samples=VERDICT_SAMPLES,
     )
-    facts = [f"On {esc(str(held.get('block', 'held-out data')))}: {fact[0].lower()}{fact[1:]}"]
+    block = esc(str(held.get("block", "held-out data")))
+    said = f"{fact[0].lower()}{fact[1:]}"
+    facts = [f"Held-out verdict on {block} (every sample, torques as measured): {said}"]
     spikes = held.get("torque_spikes_replaced")
     if is_number(spikes) and spikes > 0:
         facts.append(f"{int(spikes)} one-sample torque spike(s) replaced, as the fit replaced them")
@@ -252,14 +256,27 @@ def _overfit_fact(
     else:
         why = "the fit over-fits"
     fact = (
-        f"Held-out error <b>{percent(test)}</b> {esc(scheme)} (the torques as measured), "
-        f"training error {percent(train)} on the same (ratio {ratio:.2f}: {why})"
+        f"Held-out error of least squares <b>{percent(test)}</b> {esc(scheme)} "
+        f"({esc(pooled_label(ho))}), training error {percent(train)} on the same (ratio "
+        f"{ratio:.2f}: {why})"
     )
     if few or at_floor:
         return fact, []
     if ratio > OVERFIT_FAIR:
         return fact, ["poor"]
     return fact, ["fair"] if ratio > OVERFIT_GOOD else []
+
+
+#: What the held-out verdict's error is computed on (heldout.json's, the command's verdict).
+VERDICT_SAMPLES = "every sample of the held-out block, torques as measured"
+
+
+def pooled_label(ho: Any) -> str:
+    """What least squares' held-out error of the record (``metadata.heldout``) is computed
+    on: the fit's own rows, filtered and decimated, pooled over the folds where there are
+    several (a figure apart from the verdict's, :data:`VERDICT_SAMPLES`)."""
+    folds = isinstance(ho, dict) and ho.get("scheme") in ("blocks", "recordings")
+    return "filtered, decimated samples" + (", pooled over the folds" if folds else "")
 
 
 def _floor_fact(
@@ -272,12 +289,15 @@ def _floor_fact(
     within_motion: bool = False,
     what: str = "sensor-noise floor",
     above: str = "",
+    samples: str = "",
 ) -> tuple[str, list[str], str]:
     """(fact, problems, headline) of an error against a noise floor, ``what`` it is (the
     joints the verdict names, or why it was reached; unusable where the data contradict the
     robot; ``within_motion``: judged on blocks of the motion the model was fitted to, which
     test too little, :func:`~dynid.identification.least_squares.within_motion_caveat`);
-    ``above``: the joints above their own noise in words, said in the headline."""
+    ``above``: the joints above their own noise in words, said in the headline;
+    ``samples``: what the error is computed on, said beside it in the headline with the
+    verdict's label (a verdict the command printed)."""
     r = v.ratio if v.ratio is not None else math.inf
     joints = "joint(s) " + v.reason.split("; joint(s) ", 1)[1] if "; joint(s) " in v.reason else ""
     said = (
@@ -290,9 +310,12 @@ def _floor_fact(
         f"{esc(torques)} (<b>{r:.3g} x the floor</b>): {said}"
     )
     level = "at" if r <= FLOOR_GOOD and not above else f"{r:.3g} times"  # as in the fact
+    said_level = f" (held-out verdict: {esc(v.label)})" if samples and v.level != "good" else ""
     headline = (
-        f"The model predicts held-out torques to {percent(err)}, {level} the "
-        f"{what} of {percent(floor)}" + (f"; {esc(above)}" if above else "")
+        f"The model predicts held-out torques to {percent(err)}"
+        + (f" ({esc(samples)})" if samples else "")
+        + f", {level} the {what} of {percent(floor)}{said_level}"
+        + (f"; {esc(above)}" if above else "")
     )
     if contradicted:
         headline = (
@@ -429,13 +452,13 @@ def _consistent_facts(doc: dict, ho: dict) -> tuple[list[str], list[str], str]:
         "recordings": f"leaving out each of {ho.get('folds')} recordings in turn",
     }.get(str(ho.get("scheme")), "on the separate log")
     facts = [
-        f"Held-out error of the consistent fit <b>{percent(test)}</b> {esc(scheme)} (the "
-        f"torques as measured), training error {percent(train)}; least squares, for "
+        f"Held-out error of the consistent fit <b>{percent(test)}</b> {esc(scheme)} "
+        f"({esc(pooled_label(ho))}), training error {percent(train)}; least squares, for "
         f"comparison: held-out {percent(ls_test)}, training {percent(ls_train)}"
     ]
     headline = (
         f"The consistent fit predicts held-out torques to {percent(test)} (least squares: "
-        f"{percent(ls_test)})"
+        f"{percent(ls_test)}; both on {pooled_label(ho)})"
     )
     floor = _get(doc, "metadata", "heldout", "noise_floor_percent")
     v = judge_prediction(test, floor if is_number(floor) and floor > 0 else None)
@@ -583,8 +606,12 @@ def answer(run: RunFiles) -> Answer | None:
             first, more, headline = _consistent_facts(doc, consistent)
             above = _above_noise(held) if isinstance(held, dict) else ""
             headline += f"; least squares leaves {esc(above)}" if above else ""
-            facts = first + [f"Least squares: {f[0].lower()}{f[1:]}" for f in facts]
+            own = "Held-out error of least squares"  # says whose already
+            facts = first + [
+                f if f.startswith(own) else f"Least squares: {f[0].lower()}{f[1:]}" for f in facts
+            ]
             problems = more + problems
+        facts += spring_facts(held)  # where the verdict names a spring: its stiffness
     rank, p = _rank_fact(doc)
     facts.append(rank)
     problems += p
@@ -600,7 +627,7 @@ def answer(run: RunFiles) -> Answer | None:
         headline = "The identification's record holds no error to judge it by"
         level = "fair"
     shown = frozenset(f for f, _ in FIGURES if f in run.files)
-    sections = [_torques_section(run, held), _structure_section(doc)]
+    sections = [_torques_section(run, held), springs_section(held), _structure_section(doc)]
     sections += [_coefficients_section(doc), *terms_sections(doc)]
     return Answer(
         verdict(level, esc(headline) + ".", facts, label),
@@ -655,7 +682,8 @@ def _torques_section(run: RunFiles, held: dict | None) -> str:
             "error / noise" + (" (each sample against its own)" if weighed else ""),
             "held-out relative error [%]",
         ]
-        parts.append(f"<p>{esc(held.get('block', ''))}</p>" + table(headers, rows))
+        said = f"{held.get('block', 'Held-out data')}: {VERDICT_SAMPLES} (the verdict's numbers)"
+        parts.append(f"<p>{esc(said[0].upper() + said[1:])}.</p>" + table(headers, rows))
     if not parts:
         return ""
     return section("torques", "Torques on held-out data", *parts)

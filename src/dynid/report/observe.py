@@ -7,12 +7,18 @@ answer says what it calibrated.
 The files' layouts belong to the command that writes them; this page reads them
 generically: the events are the records of ``events.json`` (a list, or the list under
 ``events``), the thresholds the file's tables.
+
+The run's notes (:attr:`~dynid.observer.results.ObserveResult.notes`, in the run summary)
+are facts of the answer: a model without friction whose residual shows the arm's friction
+(its size per joint, and the ``dynid friction`` command that identifies it) lowers a
+clean result to usable, the thresholds and the residual holding that friction.
 """
 
 from __future__ import annotations
 
 from typing import Any
 
+from ..observer.results import NO_FRICTION
 from .html import esc, figure, href, is_number, number, section, table, verdict
 from .json_tables import json_section
 from .run import Answer, RunFiles
@@ -166,6 +172,25 @@ def _dropped(doc: Any) -> tuple[int, str | None]:
     return int(count), esc(said + ".")
 
 
+#: Words of the note of a model without friction whose residual shows the arm's.
+FRICTION_FOUND = "friction is in the logs"
+#: Words of a note on a figure left out (the page's banner says it).
+_FIGURE_SKIPPED = "skipped the figure "
+
+
+def _notes(run: RunFiles) -> list[str]:
+    """The run's notes as facts (HTML), the friction a model without friction leaves in
+    the residual first, its opening words bold; a figure's note left to the banner."""
+    notes = [n for n in run.summary.notes if _FIGURE_SKIPPED not in n]
+    notes.sort(key=lambda n: not n.startswith(NO_FRICTION))
+    out = []
+    for n in notes:
+        head, rest = (n.split(": ", 1) + [""])[:2] if ": " in n else (n, "")
+        said = esc(head[0].upper() + head[1:])
+        out.append(f"<b>Note: {said}</b>" + (f": {esc(rest)}" if rest else ""))
+    return out
+
+
 def _numbers(v: Any) -> bool:
     return isinstance(v, list) and bool(v) and all(is_number(x) for x in v)
 
@@ -208,6 +233,10 @@ def answer(run: RunFiles) -> Answer | None:
         facts.append(scored)
     if events is None and calibrated is not None and found["residuals.png"] is not None:
         facts.append("The residual over the calibration with its thresholds: the figure below")
+    notes = _notes(run)
+    facts[0:0] = notes  # before the tables: what the numbers below hold
+    if level == "good" and any(FRICTION_FOUND in n for n in notes):  # thresholds hold it
+        level = "fair"
     if found["thresholds.json"] is not None:
         facts.append("Thresholds: every entry in the table below (from thresholds.json)")
     if found["residuals.csv"] is not None:

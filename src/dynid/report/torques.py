@@ -30,6 +30,7 @@ from ..identification.verdict import (
 )
 from .html import cell, esc, figure, is_number, percent, section, table, verdict
 from .run import Answer, RunFiles
+from .springs import spring_facts, springs_section
 
 __all__ = ["friction_answer", "validate_answer"]
 
@@ -94,6 +95,7 @@ def validate_answer(run: RunFiles) -> Answer | None:
         f"{UNUSABLE_PERCENT:g} %, unusable from {UNUSABLE_PERCENT:g} % or with torques of "
         "the opposite sign",
     ]
+    facts[1:1] = spring_facts(doc)  # where the verdict names a spring: its stiffness
     per = (with_ if isinstance(with_, dict) else without).get("relative_error_percent_per_joint")
     if isinstance(per, list) and per and all(is_number(p) for p in per):
         ratio = _noise_ratios(doc, len(per))
@@ -145,7 +147,8 @@ def validate_answer(run: RunFiles) -> Answer | None:
         ),
     )
     shown_label = label if level == judged_level else None  # a worse joint: the level's own
-    return Answer(verdict(level, head, facts, shown_label), (_joint_errors(doc), figs), shown)
+    sections = (_joint_errors(doc), springs_section(doc), figs)
+    return Answer(verdict(level, head, facts, shown_label), sections, shown)
 
 
 def _noise_ratios(doc: dict, n: int) -> list[float]:

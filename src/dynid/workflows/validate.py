@@ -67,6 +67,7 @@ from ..identification.metrics import TorqueErrors
 from ..identification.model import IdentifiedModel
 from ..identification.motion_range import motion_range_hint, with_motion_range_hint
 from ..identification.residual_dependence import held_terms, with_dependence_hint
+from ..identification.residual_spring import ResidualSpring
 from ..identification.sanity import SPIKES_BEFORE_JUDGING
 from ..identification.verdict import LEVELS, Verdict, with_replaced_spikes
 from ..io.feasible import load_feasible_drive, load_feasible_linear_friction
@@ -199,6 +200,11 @@ class ValidateResult:
         rule ``identify`` and ``observe`` refuse by), said at the start of ``verdict``'s
         reason (after ``sign_map``) in place of a diagnosis of the residual; empty
         otherwise.
+    springs : ResidualSpring, optional
+        The stiffness per joint [N m/rad] the residual points to, fitted with the model's
+        columns to the recordings joined (:func:`~dynid.friction.heldout_torques.
+        residual_springs`; its named joints the verdict's reason names with their
+        stiffness); None: not judged (a good verdict, or no diagnosis of the residual).
     """
 
     validation: RecordingsValidation
@@ -216,6 +222,7 @@ class ValidateResult:
     joint_ratios: NDArray[np.float64] | None = None
     sign_map: str | None = None
     opposite_sign: tuple[tuple[str, str], ...] = ()
+    springs: ResidualSpring | None = None
 
     def metadata(self) -> dict[str, Any]:
         """The keys ``validation.json`` records beside the errors: ``model``,
@@ -227,7 +234,9 @@ class ValidateResult:
         ``opposite_sign`` (by file, the finding that its torques read with the opposite
         sign on some joints or on all, with the ``--units`` that reads them; when there is
         one),
-        ``verdict`` (``level``, ``label``, ``reason``) and ``joint_names`` (when known)."""
+        ``verdict`` (``level``, ``label``, ``reason``), ``joint_names`` (when known) and
+        ``springs`` (the stiffness per joint the residual points to, when judged:
+        :meth:`~dynid.identification.residual_spring.ResidualSpring.as_dict`)."""
         v = self.verdict
         spikes = dict(zip(self.files, self.spikes, strict=True)) if self.spikes else None
         parts = {
@@ -252,6 +261,7 @@ class ValidateResult:
             **({"sign_map": self.sign_map} if self.sign_map is not None else {}),
             **({"opposite_sign": dict(self.opposite_sign)} if self.opposite_sign else {}),
             "verdict": {"level": v.level, "label": v.label, "reason": v.reason},
+            **({"springs": self.springs.as_dict()} if self.springs is not None else {}),
         } | ({"joint_names": list(self.joint_names)} if self.joint_names else {})
 
 
@@ -350,7 +360,7 @@ def validate_files(
     # a torque of the opposite sign leaves twice the torque, which no term of the model
     # explains: what the residual follows is not diagnosed (it read as an offset)
     dependence = not beyond and not opposite
-    verdict = _with_hints(
+    verdict, springs = _with_hints(
         model, verdict, val, rec.logs, noise, names, dependence=dependence, terms=held_terms(model)
     )
     verdict = with_motion_range_hint(verdict, speeds, dq, names)
@@ -373,6 +383,7 @@ def validate_files(
         joint_ratios=noise.ratios,
         sign_map=sign_map,
         opposite_sign=tuple(opposite.items()),
+        springs=springs,
     )
 
 
@@ -394,7 +405,7 @@ def _with_hints(
     *,
     dependence: bool = True,
     terms: frozenset[str] = frozenset(),
-) -> Verdict:
+) -> tuple[Verdict, ResidualSpring | None]:
     """``verdict`` with what the residual of each joint above its noise follows
     (:func:`~dynid.identification.residual_dependence.with_dependence_hint`; not with
     ``dependence`` False: a recording that moves beyond the identification's data, where
@@ -403,10 +414,12 @@ def _with_hints(
     :func:`~dynid.friction.heldout_torques.residual_tilt` of ``model``; a spring's joint
     with its stiffness, :func:`~dynid.friction.heldout_torques.residual_springs`), the
     hint of a
-    cut-off too high for derived states, and that of an error at low speed."""
+    cut-off too high for derived states, and that of an error at low speed; and the
+    springs fitted (None: not judged)."""
     error = [v.log.tau - v.tau_hat for v in val.parts]
     dq = [v.log.dq for v in val.parts]
     q = [v.log.q for v in val.parts]
+    springs = None
     if dependence:
         whole = joined_validation(val.parts) if verdict.level != "good" else None
         springs = None if whole is None else residual_springs(model, whole, noise.total)
@@ -422,7 +435,7 @@ def _with_hints(
             verdict, reason=f"{verdict.reason}; a floor raised because {high}"
         )
     # the low-speed hint's "above the noise": the sensors' (its module docstring)
-    return with_low_speed_hint(verdict, dq, error, noise.sensor, names)
+    return with_low_speed_hint(verdict, dq, error, noise.sensor, names), springs
 
 
 @dataclass(frozen=True, slots=True)

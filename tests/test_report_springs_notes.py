@@ -1,0 +1,175 @@
+"""What the identify, validate and observe pages showed only in the console.
+
+A spring the held-out verdict named (heldout.json's ``springs``) was in the verdict's long
+reason alone; the identify headline quoted least squares' pooled held-out error beside the
+verdict's (two held-out errors, unlabelled); observe's note on the friction a model
+without friction leaves in the residual was at the foot of the page. References: a
+simulated Panda with a 20 N m/rad spring on joint 2 (the truth's stiffness), heldout.json's
+and validation.json's own numbers, and a simulated Panda with known classical friction
+observed without friction (the true friction's RMS at speed).
+"""
+
+from __future__ import annotations
+
+import html
+import json
+import re
+import warnings
+
+import numpy as np
+import pytest
+
+from dynid.cli.__main__ import main
+from dynid.exceptions import DynidWarning
+from dynid.friction.model import ClassicalFriction
+from dynid.io.robot.toml import save_toml
+from dynid.io.torque_log import save_torque_log
+from dynid.observer.unmodelled import SPEED
+from dynid.report.html import number, percent
+from dynid.report.page import render_html_report
+from dynid.report.run import RunSummary
+from dynid.simulation.measurement import SensorNoise, sample_times, simulate_measurement
+from dynid.simulation.trajectories import random_fourier
+
+from conftest import recordings
+
+K, Q0 = 20.0, 0.3  # the spring on joint 2: N m/rad, rad
+VISCOUS = np.array([0.3, 0.3, 0.2, 0.2, 0.05, 0.05, 0.03])  # N m s/rad
+COULOMB = np.array([0.5, 0.5, 0.4, 0.4, 0.2, 0.2, 0.1])  # N m
+
+
+def _text(fragment: str) -> str:
+    """The text of an HTML fragment as a person reads it, whitespace collapsed."""
+    return " ".join(html.unescape(re.sub(r"<[^>]+>", "", fragment)).split())
+
+
+def _box(page: str) -> str:
+    """The text of the page's answer box (headline and facts)."""
+    start = page.index('id="verdict"')
+    return _text(page[start : page.index("</section>", start)])
+
+
+@pytest.fixture(scope="module")
+def spring_runs(panda, tmp_path_factory):
+    """identify on an 8 s noisy recording with the spring (fixed terms), and validate of
+    the model on the same recording: the two output folders."""
+    out = tmp_path_factory.mktemp("springs")
+
+    def torque(log):
+        added = np.zeros_like(log.q)
+        added[:, 1] = K * (log.q[:, 1] - Q0)
+        return added
+
+    (log,) = recordings(
+        panda,
+        (71,),
+        friction=ClassicalFriction(VISCOUS, COULOMB, np.zeros(7)),
+        duration=8.0,
+        noise=SensorNoise(tau_std=0.05, q_std=1e-5, dq_std=1e-3),
+        added=torque,
+    )
+    path = str(save_torque_log(out / "spring.csv", log))
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", DynidWarning)
+        args = ["identify", "--robot", "panda", "--data", path, "--terms", "viscous,coulomb,offset"]
+        assert main([*args, "--no-figures", "-q", "--out", str(out / "id")]) == 0
+        model = str(out / "id" / "identification.json")
+        args = ["validate", "--model", model, "--data", path, "--no-figures", "-q"]
+        assert main([*args, "--out", str(out / "val")]) == 0
+    return out / "id", out / "val"
+
+
+@pytest.mark.parametrize("page", ["id", "val"])
+def test_the_named_spring_is_shown_with_the_stiffness_its_file_holds(spring_runs, page):
+    """The answer box of identify (heldout.json) and validate (validation.json) names the
+    spring's joint with the stiffness and std the file holds (within 20 % of the truth's
+    20 N m/rad) and the verdict's hint; the table lists every joint's stiffness."""
+    folder = spring_runs[0] if page == "id" else spring_runs[1]
+    doc = json.loads((folder / ("heldout.json" if page == "id" else "validation.json")).read_text())
+    springs = doc["springs"]
+    assert springs["named"] == [1]
+    k, s = springs["stiffness"][1], springs["std"][1]
+    assert abs(k - K) < 0.2 * K
+    report = (folder / "report.html").read_text()
+    box = _box(report)
+    said = f"A spring on joint2 outside the model: stiffness {number(k, 3)} N m/rad (std "
+    assert said + f"{number(s, 2)} N m/rad)" in box, box
+    assert "What to do: try adding spring to --terms of dynid identify" in box
+    assert "spring to --terms" in doc["verdict"]["reason"]  # the verdict's own hint
+    table = report[report.index('id="springs"') :].split("</table>")[0]
+    rows = re.findall(r"<td>(joint\d)</td><td>(.*?)</td>", table)
+    assert [(name, _text(k)) for name, k in rows] == [
+        (f"joint{j + 1}", number(x)) for j, x in enumerate(springs["stiffness"])
+    ], rows
+
+
+def test_the_identify_headline_gives_the_verdicts_numbers_and_labels_each_error(spring_runs):
+    """The headline's error, floor, ratio and level are heldout.json's verdict; the pooled
+    least-squares held-out error is said as such, the verdict's as every sample."""
+    folder = spring_runs[0]
+    held = json.loads((folder / "heldout.json").read_text())
+    ident = json.loads((folder / "identification.json").read_text())
+    page = (folder / "report.html").read_text()
+    headline = _text(re.search(r'<p class="headline">(.*?)</p>', page, re.S)[1])
+    v = held["verdict"]
+    err, floor = percent(held["relative_error_percent"]), percent(held["noise_floor_percent"])
+    assert v["level"] != "good"  # the spring leaves a residual: a level to say
+    assert (
+        f"The model predicts held-out torques to {_text(err)} (every sample of the held-out "
+        f"block, torques as measured), {v['ratio']:.3g} times the noise floor of "
+        f"{_text(floor)} (held-out verdict: {v['label']})"
+    ) in headline, headline
+    pooled = ident["metadata"]["heldout"]["heldout_error_percent"]
+    assert _text(percent(pooled)) not in headline
+    box = _box(page)
+    assert (
+        f"Held-out error of least squares {_text(percent(pooled))} over 5 contiguous time "
+        "blocks (filtered, decimated samples, pooled over the folds)"
+    ) in box, box
+    assert "Held-out verdict on the last of 5 time blocks" in box
+    assert "(every sample, torques as measured): error " + _text(err) in box
+
+
+FV = np.linspace(0.5, 0.2, 7)  # N m s/rad
+FC = np.linspace(0.8, 0.3, 7)  # N m
+
+
+def test_the_observe_page_holds_the_friction_note_with_its_sizes(panda, tmp_path, capsys):
+    """A model without friction observed on a log with friction: the answer box holds the
+    note the command printed, each joint's size in it within 30 % of the true friction's
+    RMS at speed, and the dynid friction command."""
+    rng = np.random.default_rng(12)
+    traj = random_fourier(panda, rng)(sample_times(3.0, 500.0))
+    truth = ClassicalFriction(FV, FC, np.zeros(7))
+    log = simulate_measurement(panda, traj, rng=rng, noise=SensorNoise(), friction=truth)
+    path = save_torque_log(tmp_path / "free.csv", log)
+    save_toml(tmp_path / "bare.toml", panda.with_friction(None))
+    args = ["observe", "--params", str(tmp_path / "bare.toml"), "--data", str(path)]
+    assert main([*args, "--calibrate", "--no-figures", "--out", str(tmp_path / "obs")]) == 0
+    (note,) = [x for x in capsys.readouterr().err.splitlines() if "no friction" in x]
+    sizes = dict(re.findall(r"(joint\d) ([\d.]+)", note.split("holds ", 2)[2].split(" N m")[0]))
+    assert sorted(sizes) == [f"joint{j}" for j in range(1, 8)], note
+    box = _box((tmp_path / "obs" / "report.html").read_text())
+    said = ", ".join(f"{name} {size}" for name, size in sizes.items())
+    assert f"the residual at speed holds {said} N m (RMS while the joint moves)" in box, box
+    assert "`dynid friction` on a collision-free log" in box
+    moving = np.abs(traj.dq) > 2 * SPEED
+    tau_f = FC * np.sign(traj.dq) + FV * traj.dq
+    for j in range(7):
+        rms = np.sqrt(np.mean(tau_f[moving[:, j], j] ** 2))
+        assert abs(float(sizes[f"joint{j + 1}"]) - rms) < 0.3 * rms, (j, sizes, rms)
+
+
+def test_a_clean_detection_whose_residual_holds_friction_reads_usable(tmp_path):
+    """No event, but the note says the residual holds the arm's friction (the thresholds
+    with it): the box reads usable, not good; without the note, good."""
+    (tmp_path / "events.json").write_text(json.dumps({"events": []}))
+    files = {p.name: p for p in tmp_path.iterdir()}
+    note = (
+        "the model holds no friction, but the arm's friction is in the logs: the residual "
+        "at speed holds joint1 0.23 N m (RMS while the joint moves)"
+    )
+    for notes, level in (((note,), "fair"), ((), "good")):
+        page = render_html_report(RunSummary("observe", notes=notes), files)
+        assert f'<section class="verdict {level}" id="verdict">' in page
+        assert ("holds joint1 0.23 N m" in _box(page)) == bool(notes)
