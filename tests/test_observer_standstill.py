@@ -157,7 +157,7 @@ def test_the_calibration_summary_prints_the_residual_the_rule_read_and_the_level
         ObserveResult(model, th, (log,)), [f"j{k}" for k in range(1, 8)], calibrating=True
     )
     head, *rows = text.splitlines()[:8]
-    assert head.split()[1:4] == ["|r|", "read", "[N"] and "at rest [N m]" in head
+    assert head.split()[1:5] == ["|r|", "read", "past", "margin"] and "at rest [N m]" in head
     read = np.max(np.clip(np.abs(r) - w, 0.0, None), axis=0)
     raw = np.max(np.abs(r), axis=0)
     assert np.any(raw - read > 1e-3)  # the margin left samples out: the two differ

@@ -18,7 +18,6 @@ from __future__ import annotations
 
 from typing import Any
 
-from ..observer.results import NO_FRICTION
 from .html import esc, figure, href, is_number, number, section, table, verdict
 from .json_tables import json_section
 from .run import Answer, RunFiles
@@ -181,6 +180,8 @@ _FIGURE_SKIPPED = "skipped the figure "
 def _notes(run: RunFiles) -> list[str]:
     """The run's notes as facts (HTML), the friction a model without friction leaves in
     the residual first, its opening words bold; a figure's note left to the banner."""
+    from ..observer.results import NO_FRICTION  # here: a page of any run loads this module
+
     notes = [n for n in run.summary.notes if _FIGURE_SKIPPED not in n]
     notes.sort(key=lambda n: not n.startswith(NO_FRICTION))
     out = []
