@@ -67,7 +67,7 @@ from ..identification.metrics import TorqueErrors
 from ..identification.model import IdentifiedModel
 from ..identification.motion_range import motion_range_hint, with_motion_range_hint
 from ..identification.residual_dependence import held_terms, with_dependence_hint
-from ..identification.sanity import SPIKES_BEFORE_JUDGING
+from ..identification.sanity import SPIKES_BEFORE_JUDGING, SignFinding
 from ..identification.verdict import LEVELS, Verdict, with_replaced_spikes
 from ..io.feasible import load_feasible_drive, load_feasible_linear_friction
 from ..io.friction_json import load_friction_json
@@ -199,6 +199,12 @@ class ValidateResult:
         rule ``identify`` and ``observe`` refuse by), said at the start of ``verdict``'s
         reason (after ``sign_map``) in place of a diagnosis of the residual; empty
         otherwise.
+    reversed_columns : tuple of (str, str)
+        Per recording with columns recorded reversed (a motor or encoder mounted the
+        other way: its position, velocity and effort negated), its name and the finding
+        (the joints or motors and the ``--units`` entries, ``q6=-1,tau6=-1``, in the log's
+        own columns), said at the start of ``verdict``'s reason as ``opposite_sign`` is;
+        empty otherwise.
     """
 
     validation: RecordingsValidation
@@ -216,6 +222,7 @@ class ValidateResult:
     joint_ratios: NDArray[np.float64] | None = None
     sign_map: str | None = None
     opposite_sign: tuple[tuple[str, str], ...] = ()
+    reversed_columns: tuple[tuple[str, str], ...] = ()
 
     def metadata(self) -> dict[str, Any]:
         """The keys ``validation.json`` records beside the errors: ``model``,
@@ -226,7 +233,8 @@ class ValidateResult:
         when known), ``sign_map`` (the recorded sign map's finding, when there is one),
         ``opposite_sign`` (by file, the finding that its torques read with the opposite
         sign on some joints or on all, with the ``--units`` that reads them; when there is
-        one),
+        one), ``reversed_columns`` (by file, the finding that columns were recorded
+        reversed, with the ``--units`` that reads them; when there is one),
         ``verdict`` (``level``, ``label``, ``reason``) and ``joint_names`` (when known)."""
         v = self.verdict
         spikes = dict(zip(self.files, self.spikes, strict=True)) if self.spikes else None
@@ -251,6 +259,7 @@ class ValidateResult:
             **({"torque_spikes_replaced": spikes} if spikes is not None else {}),
             **({"sign_map": self.sign_map} if self.sign_map is not None else {}),
             **({"opposite_sign": dict(self.opposite_sign)} if self.opposite_sign else {}),
+            **({"reversed_columns": dict(self.reversed_columns)} if self.reversed_columns else {}),
             "verdict": {"level": v.level, "label": v.label, "reason": v.reason},
         } | ({"joint_names": list(self.joint_names)} if self.joint_names else {})
 
@@ -372,7 +381,8 @@ def validate_files(
         input_noise_rms=noise.inputs,
         joint_ratios=noise.ratios,
         sign_map=sign_map,
-        opposite_sign=tuple(opposite.items()),
+        opposite_sign=tuple((f.name, f.text) for f in opposite if f.kind == "opposite"),
+        reversed_columns=tuple((f.name, f.text) for f in opposite if f.kind == "reversed"),
     )
 
 
@@ -486,12 +496,14 @@ def _judged(
 
 def _said_signs(
     rec: Recorded, model: IdentifiedModel | Robot, opt: ValidateOptions
-) -> tuple[str | None, dict[str, str]]:
+) -> tuple[str | None, tuple[SignFinding, ...]]:
     """Warn of the recordings whose torques look of the opposite sign: first those for
     which the model's recorded sign map looks wrong
     (:func:`~dynid.workflows.recordings.recorded_sign_map_findings`), then the others
     (:func:`~dynid.workflows.recordings.warn_signs`, the rule ``identify`` and ``observe``
-    refuse by); the former's findings, joined, or None, and the latter's by recording."""
+    refuse by: columns recorded reversed, torques of the opposite sign, a motor of the
+    opposite sign to the other recordings' or to the model's own friction and rotor,
+    :func:`_own_terms`); the former's findings, joined, or None, and the latter's."""
     robot = model.robot if isinstance(model, IdentifiedModel) else model
     ref = _reference(model) or robot
     recorded = model.info.column_map if isinstance(model, IdentifiedModel) else None
@@ -499,15 +511,36 @@ def _said_signs(
     found = recorded_sign_map_findings(rec, ref, recorded, units)
     for text in found.values():
         warnings.warn(text, DynidWarning, stacklevel=3)
-    opposite = warn_signs(rec, ref, skip=tuple(found))
+    opposite = warn_signs(rec, ref, skip=tuple(found), reference=_own_terms(model, rec.drive))
     return "; ".join(found.values()) or None, opposite
 
 
-def _signs_first(verdict: Verdict, opposite: dict[str, str], sign_map: str | None) -> Verdict:
+def _own_terms(model: IdentifiedModel | Robot, drive: Drive | None) -> NDArray[np.float64] | None:
+    """An identified model's own ``fv, fc, Ia`` (n, 3) per motor (joint) where ``drive``
+    puts the friction, the reference a recording's own friction and rotor are compared
+    with (:func:`~dynid.identification.sanity.opposite_friction_among`): its one friction
+    term's viscous and Coulomb coefficients, its rotor inertias (zeros without them);
+    None for a robot, a model of several friction terms, or friction placed elsewhere."""
+    if not isinstance(model, IdentifiedModel) or len(model.frictions) != 1:
+        return None
+    fr = model.frictions[0]
+    at_joints = drive is None or np.allclose(drive.friction_transmission, np.eye(drive.n))
+    coulomb = {"classical": 1, "smooth": 1, "stribeck": 1, "quadratic": 2}.get(fr.law)
+    n = model.robot.n
+    if coulomb is None or (fr.drive is None) != at_joints or fr.params.shape[0] != n:
+        return None
+    ia = model.rotor_inertia
+    ia = np.zeros(n) if ia is None or np.shape(ia) != (n,) else np.asarray(ia)
+    return np.column_stack([fr.params[:, 0], fr.params[:, coulomb], ia])
+
+
+def _signs_first(
+    verdict: Verdict, opposite: Sequence[SignFinding], sign_map: str | None
+) -> Verdict:
     """``verdict`` with the sign findings (:func:`_said_signs`), the likelier causes, at
-    the start of its reason: the recorded sign map's, then each recording's torques of
-    the opposite sign after its name."""
-    for said in ("; ".join(f"{k}: {v}" for k, v in opposite.items()) or None, sign_map):
+    the start of its reason: the recorded sign map's, then each recording's columns
+    recorded reversed or torques of the opposite sign after its name."""
+    for said in ("; ".join(f"{f.name}: {f.text}" for f in opposite) or None, sign_map):
         if said is not None:
             verdict = dataclasses.replace(verdict, reason=f"{said}; {verdict.reason}")
     return verdict
