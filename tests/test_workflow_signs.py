@@ -149,3 +149,24 @@ def test_one_flipped_recording_alone_is_named_against_the_identified_models_fric
     )
     assert "--units tau5=-1" in reason, reason
     assert "opposite_sign" not in clean.metadata(), clean.verdict.reason
+
+
+def test_the_command_writes_reversed_columns_and_says_it_first_in_the_report(geared, tmp_path):
+    """dynid validate --drive on rev.csv: validation.json's reversed_columns holds the
+    finding with --units q6=-1,tau6=-1 and the report's headline names the file."""
+    import json
+
+    from dynid.cli.__main__ import main
+    from dynid.io.drive_file import drive_toml
+
+    d, drive = geared
+    (tmp_path / "drive.toml").write_text(drive_toml(drive).removeprefix("[drive]\n"))
+    out = tmp_path / "v"
+    args = ["validate", "--robot", "panda", "--drive", str(tmp_path / "drive.toml")]
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", DynidWarning)
+        main([*args, "--no-friction", "--data", str(d / "rev.csv"), "--out", str(out)])
+    doc = json.loads((out / "validation.json").read_text())
+    assert "--units q6=-1,tau6=-1 " in doc["reversed_columns"]["rev.csv"]
+    page = (out / "report.html").read_text()
+    assert "rev.csv: columns look recorded reversed" in page

@@ -51,7 +51,10 @@ with them before fitting (:func:`log_findings`). None of them changes the data.
 * **Reversed columns**: a motor or encoder mounted the other way, its position and
   velocity (with its effort or without) of the opposite sign; several at once, named in
   the log's own columns (a motor-side log's motors) with one ``--units`` hint, judged
-  through the drive before the sign (:func:`reversed_joint`).
+  through the drive before the sign (:func:`reversed_joint`). Of several recordings, one
+  motor (joint) the links barely load of the opposite sign to the others' is told by its
+  own friction and rotor (:func:`opposite_friction_among`). :func:`recording_sign_findings`
+  runs these sign checks in the one order ``identify``, ``validate`` and ``observe`` share.
 * **Frozen joints**: a joint whose velocity never leaves its noise band (fewer than 1 % of
   the samples beyond 5 times the robust noise level, :func:`velocity_noise_std`, and
   :data:`MIN_MOTION`); its friction cannot be identified (:func:`moving_joints`).
