@@ -1126,6 +1126,7 @@ def recording_sign_findings(
     sides: Sequence[TorqueLog] | None = None,
     reference: ArrayLike | None = None,
     first: bool = False,
+    among: bool = True,
 ) -> tuple[SignFinding, ...]:
     """The sign checks of several recordings, in the one order ``identify`` refuses by and
     ``validate`` and ``observe`` judge by: per recording, columns recorded reversed
@@ -1152,6 +1153,9 @@ def recording_sign_findings(
         As :func:`opposite_friction_among`.
     first : bool
         Stop at the first finding (a check that refuses).
+    among : bool
+        Compare the recordings' own friction and rotors (False: logs that may hold
+        contacts, whose external torques the motors' own terms would take for a sign).
 
     Returns
     -------
@@ -1170,15 +1174,17 @@ def recording_sign_findings(
                 out.append(SignFinding(name, "opposite", opposite))
         if first and out:
             return tuple(out)
+    if not among:
+        return tuple(out)
     said = {f.name for f in out}
     rest = [r for r, name in enumerate(names) if name not in said]
     kept = [names[r] for r in rest]
-    among = opposite_friction_among(
+    found = opposite_friction_among(
         robot, [logs[r] for r in rest], kept, drive, reference=reference
     )
-    if among is not None:
-        name = next(n for n in kept if among.startswith(f"{n}: "))
-        out.append(SignFinding(name, "opposite", among.removeprefix(f"{name}: ")))
+    if found is not None:
+        name = next(n for n in kept if found.startswith(f"{n}: "))
+        out.append(SignFinding(name, "opposite", found.removeprefix(f"{name}: ")))
     return tuple(out)
 
 

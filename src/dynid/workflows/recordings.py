@@ -405,9 +405,13 @@ def sign_findings(
 
 
 def _sign_findings(
-    rec: Recorded, robot: Robot, skip: Sequence[str] = (), reference: Any = None
+    rec: Recorded,
+    robot: Robot,
+    skip: Sequence[str] = (),
+    reference: Any = None,
+    among: bool = True,
 ) -> tuple[SignFinding, ...]:
-    """:func:`sign_findings` as found."""
+    """:func:`sign_findings` as found (``among``: the recordings' own friction compared)."""
     keep = [
         k
         for k, (name, log) in enumerate(zip(rec.names, rec.joint_side, strict=True))
@@ -423,6 +427,7 @@ def _sign_findings(
         drive,
         sides=[rec.joint_side[k] for k in keep],
         reference=reference,
+        among=among,
     )
 
 
@@ -503,11 +508,13 @@ def _sign_map_finding(name: str, units: str, wrong: list[int], names: Sequence[s
     )
 
 
-def check_signs(rec: Recorded, robot: Robot) -> None:
+def check_signs(rec: Recorded, robot: Robot, *, among: bool = True) -> None:
     """Refuse a recording :func:`sign_findings` finds (columns recorded reversed, or
     torques of the opposite sign to the robot's or, on a motor the links barely load, to
     the other recordings'), as ``identify`` does: thresholds calibrated on it, or
-    residuals of it, would be of the wrong sign.
+    residuals of it, would be of the wrong sign. ``among`` False: the recordings' own
+    friction and rotors are not compared (logs that may hold contacts: their external
+    torques go into a motor's own terms, which one log of a push read as a flipped joint 3).
 
     Raises
     ------
@@ -519,8 +526,8 @@ def check_signs(rec: Recorded, robot: Robot) -> None:
     for name, log in zip(rec.names, rec.joint_side, strict=True):
         if (few := too_few_samples(log)) is not None:  # before the correlations
             raise DataError(few, file=name)
-    for name, opposite in sign_findings(rec, robot).items():
-        raise DataError(opposite, file=name)
+    for f in _sign_findings(rec, robot, among=among):
+        raise DataError(f.text, file=f.name)
 
 
 def check_torque_unit(rec: Recorded, robot: Robot, cmap: ColumnMap | None) -> None:

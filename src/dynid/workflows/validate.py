@@ -503,7 +503,7 @@ def _said_signs(
     (:func:`~dynid.workflows.recordings.warn_signs`, the rule ``identify`` and ``observe``
     refuse by: columns recorded reversed, torques of the opposite sign, a motor of the
     opposite sign to the other recordings' or to the model's own friction and rotor,
-    :func:`_own_terms`); the former's findings, joined, or None, and the latter's."""
+    :func:`_model_friction`); the former's findings, joined, or None, and the latter's."""
     robot = model.robot if isinstance(model, IdentifiedModel) else model
     ref = _reference(model) or robot
     recorded = model.info.column_map if isinstance(model, IdentifiedModel) else None
@@ -511,11 +511,13 @@ def _said_signs(
     found = recorded_sign_map_findings(rec, ref, recorded, units)
     for text in found.values():
         warnings.warn(text, DynidWarning, stacklevel=3)
-    opposite = warn_signs(rec, ref, skip=tuple(found), reference=_own_terms(model, rec.drive))
+    opposite = warn_signs(rec, ref, skip=tuple(found), reference=_model_friction(model, rec.drive))
     return "; ".join(found.values()) or None, opposite
 
 
-def _own_terms(model: IdentifiedModel | Robot, drive: Drive | None) -> NDArray[np.float64] | None:
+def _model_friction(
+    model: IdentifiedModel | Robot, drive: Drive | None
+) -> NDArray[np.float64] | None:
     """An identified model's own ``fv, fc, Ia`` (n, 3) per motor (joint) where ``drive``
     puts the friction, the reference a recording's own friction and rotor are compared
     with (:func:`~dynid.identification.sanity.opposite_friction_among`): its one friction
