@@ -436,7 +436,8 @@ def warn_signs(
 ) -> tuple[SignFinding, ...]:
     """Warn of each recording :func:`sign_findings` finds (columns recorded reversed, or
     torques of the opposite sign; the findings :func:`check_signs` refuses with), naming
-    the file, and return the findings by recording: ``validate`` judges such a log
+    the file, and return them, each with its kind (``"reversed"`` columns, ``"opposite"``
+    torques): ``validate`` judges such a log
     "unusable" and writes its files, and said only "of another sign?" without the joints
     or the ``--units`` entries that read them. The recordings ``skip`` (by name) are left
     out (their sign said otherwise: :func:`recorded_sign_map_findings`); ``reference``
