@@ -66,6 +66,7 @@ from ..identification.low_speed import with_low_speed_hint
 from ..identification.metrics import TorqueErrors
 from ..identification.model import IdentifiedModel
 from ..identification.motion_range import motion_range_hint, with_motion_range_hint
+from ..identification.pieces import check_below_nyquist
 from ..identification.residual_dependence import held_terms, with_dependence_hint
 from ..identification.sanity import SPIKES_BEFORE_JUDGING, SignFinding
 from ..identification.verdict import LEVELS, Verdict, with_replaced_spikes
@@ -503,7 +504,13 @@ def _said_signs(
     (:func:`~dynid.workflows.recordings.warn_signs`, the rule ``identify`` and ``observe``
     refuse by: columns recorded reversed, torques of the opposite sign, a motor of the
     opposite sign to the other recordings' or to the model's own friction and rotor,
-    :func:`_model_friction`); the former's findings, joined, or None, and the latter's."""
+    :func:`_model_friction`); the former's findings, joined, or None, and the latter's.
+    A cut-off given at or above half the sample rate is refused first
+    (:func:`~dynid.identification.pieces.check_below_nyquist`): the option is at fault,
+    not the data (a short log read a joint reversed before it was refused)."""
+    given = library_cutoff(opt.cutoff_hz, RECORDED)
+    if isinstance(given, int | float):
+        check_below_nyquist(list(rec.logs), float(given))
     robot = model.robot if isinstance(model, IdentifiedModel) else model
     ref = _reference(model) or robot
     recorded = model.info.column_map if isinstance(model, IdentifiedModel) else None
