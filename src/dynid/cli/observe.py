@@ -30,7 +30,11 @@ Two steps:
   standstill margin; --no-standstill-margin turns it off). --gain,
   --discretisation and --rule choose the observer, which the thresholds keep. A log
   whose torques have the opposite sign to the model's on some joint (the residual there
-  twice the torque) is refused, naming the file and the joints.
+  twice the torque) is refused, naming the file and the joints; so, by the rule identify
+  refuses by, is a log with columns recorded reversed (a motor mounted the other way,
+  --units q6=-1,tau6=-1) and, among several --calibrate logs (collision-free), one whose
+  motor the links barely load reads with the opposite sign to the others' (--units
+  b.csv:tau5=-1).
   thresholds.json records the model's files and a SHA-256 of their content: detecting
   with another model warns. Whether the observer is good enough is printed below the
   table, kept in thresholds.json's calibration and put first in the report: the false

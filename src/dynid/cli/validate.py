@@ -40,7 +40,11 @@ with the model's: a log of another robot, in other units or of the other sign). 
 recording whose torques read with the opposite sign on some joints or on all (the check
 identify and observe refuse it by) is named at the start of the verdict with those joints
 and the --units entries that read them (of that file alone, --units rec2.csv:tau4=-1, when
-the other recordings read right), and in validation.json's "opposite_sign". With
+the other recordings read right), and in validation.json's "opposite_sign"; so is, by the
+same rule, a recording with columns recorded reversed (a motor mounted the other way:
+--units q6=-1,tau6=-1, in "reversed_columns"), and one whose motor the links barely load
+reads with the opposite sign to the other recordings' or to the model's own friction
+(--units b.csv:tau5=-1). With
 several recordings, a recording worse than the whole is named. When most of the error
 above the noise sits at low speed (standstill, reversals, the edges of a move: where the
 velocities' noise and low-pass blur a friction step) the verdict says so, with the error

@@ -37,7 +37,7 @@ from __future__ import annotations
 import contextlib
 import dataclasses
 import warnings
-from collections.abc import Iterable, Iterator, Mapping, Sequence
+from collections.abc import Iterator, Mapping, Sequence
 from dataclasses import dataclass
 from typing import Any, Literal
 
@@ -83,9 +83,7 @@ from .sanity import (
     check_torque_log,
     despiked,
     noise_band,
-    opposite_friction_among,
-    opposite_sign_among,
-    reversed_joint,
+    recording_sign_findings,
     spike_finding,
     velocity_noise_std,
 )
@@ -464,8 +462,9 @@ def prepare_recordings(
     ------
     DataError
         No recording, or no piece long enough to filter (the files are named); a
-        recording whose torques have the opposite sign to the robot's
-        (:func:`~dynid.identification.sanity.opposite_sign`, named).
+        recording with columns recorded reversed or torques of the opposite sign to the
+        robot's or to the other recordings' (the first finding of
+        :func:`~dynid.identification.sanity.recording_sign_findings`, named).
     ShapeError
         A recording with another number of joints than the robot (named).
     """
@@ -500,15 +499,16 @@ def prepare_recordings(
             wrapped.setdefault(wrapped_finding(joints, motors), []).append(name)
         cuts.append(max(0, len(mine) - 1))
         gaps.append(gaps_between(mine))
-        if mine:  # sign, units, frozen joints: on the whole recording, said once
-            others = (x for i, x in enumerate(logs) if i != r)
-            for finding in _checked(robot, name, mine, others, drive):
-                found.setdefault(finding, []).append(name)
         pieces += [(r, p) for p in mine]
     have = [r for r in range(len(logs)) if any(k == r for k, _ in pieces)]
     wholes = [joined([p for k, p in pieces if k == r]) for r in have]
-    if among := opposite_friction_among(robot, wholes, [names[r] for r in have], drive):
-        raise DataError(among)  # a fit would average the joint's friction to nothing
+    # signs: a fit would bend to mirrored motion, negate the masses, or average a joint's
+    # friction to nothing
+    for bad in recording_sign_findings(robot, wholes, [names[r] for r in have], drive, first=True):
+        raise DataError(bad.text, file=bad.name)
+    for r, whole in zip(have, wholes, strict=True):  # units, frozen joints: said once
+        for finding in check_torque_log(robot, joint_side_log(whole, drive), drive):
+            found.setdefault(finding, []).append(names[r])
     for finding, which in wrapped.items():
         warnings.warn(f"{', '.join(which)}: {finding}", DynidWarning, stacklevel=2)
     for finding, which in found.items():  # one warning a finding, its recordings named
@@ -566,33 +566,6 @@ def _check_cutoff(
         for name, log in zip(names, logs, strict=True):
             check_samples_and_time(name, log)
         check_below_nyquist(list(logs), float(cutoff_hz))
-
-
-def _checked(
-    robot: Robot,
-    name: str,
-    mine: Sequence[TorqueLog],
-    others: Iterable[TorqueLog],
-    drive: Drive | None,
-) -> tuple[str, ...]:
-    """The checks of one recording's pieces ``mine`` (as read) taken whole: refused when a
-    column reads reversed (:func:`~.sanity.reversed_joint`, the log's own columns, a
-    motor-side log's motors) or the torques of the opposite sign
-    (:func:`~.sanity.opposite_sign_among`, against the ``others`` as read); the findings
-    of :func:`~.sanity.check_torque_log` to warn of otherwise.
-
-    Raises
-    ------
-    DataError
-        Naming ``name``: a fit would bend to mirrored motion, or negate the masses.
-    """
-    if (mirrored := reversed_joint(robot, joined(list(mine)), drive)) is not None:
-        raise DataError(mirrored, file=name)
-    whole = joined([joint_side_log(p, drive) for p in mine])
-    sides = (joint_side_log(x, drive) for x in others)
-    if (opposite := opposite_sign_among(robot, whole, name, sides)) is not None:
-        raise DataError(opposite, file=name)
-    return tuple(check_torque_log(robot, whole, drive))
 
 
 def _cutoff_and_edge(

@@ -51,7 +51,10 @@ with them before fitting (:func:`log_findings`). None of them changes the data.
 * **Reversed columns**: a motor or encoder mounted the other way, its position and
   velocity (with its effort or without) of the opposite sign; several at once, named in
   the log's own columns (a motor-side log's motors) with one ``--units`` hint, judged
-  through the drive before the sign (:func:`reversed_joint`).
+  through the drive before the sign (:func:`reversed_joint`). Of several recordings, one
+  motor (joint) the links barely load of the opposite sign to the others' is told by its
+  own friction and rotor (:func:`opposite_friction_among`). :func:`recording_sign_findings`
+  runs these sign checks in the one order ``identify``, ``validate`` and ``observe`` share.
 * **Frozen joints**: a joint whose velocity never leaves its noise band (fewer than 1 % of
   the samples beyond 5 times the robust noise level, :func:`velocity_noise_std`, and
   :data:`MIN_MOTION`); its friction cannot be identified (:func:`moving_joints`).
@@ -80,7 +83,7 @@ from ..dynamics.terms import gravity_torques
 from ..exceptions import ShapeError
 from ..model.drive import Drive
 from ..model.robot import Robot
-from .log import TorqueLog
+from .log import TorqueLog, joint_side_log
 
 __all__ = [
     "CONFIRMED_CORRELATION",
@@ -99,6 +102,8 @@ __all__ = [
     "opposite_friction_among",
     "opposite_sign_among",
     "reversed_joint",
+    "recording_sign_findings",
+    "SignFinding",
     "REVERSED_MODEL_SHARE",
     "REVERSED_STEP_SHARE",
     "moving_joints",
@@ -960,12 +965,12 @@ OWN_TERMS_SIZE_SHARE = 0.3
 
 def _own_signs(
     robot: Robot, log: TorqueLog, drive: Drive | None
-) -> dict[int, tuple[float, float, float, float]] | None:
+) -> dict[int, tuple[float, float, float, float, float, float]] | None:
     """Per motor (joint) of a log as recorded: the power its fitted friction dissipates
     (``fc mean|v| + fv mean(v^2)``) and the rotor inertia fitted (``Ia``), each with its
     standard deviation, fitted to what the robot's links leave of its torques
-    (:func:`_own_terms`): both positive for torques of the right sign. None: too few
-    samples with known accelerations."""
+    (:func:`_own_terms`): both positive for torques of the right sign; then ``mean|v|``
+    and ``mean(v^2)`` at the motor. None: too few samples with known accelerations."""
     rec = _recorded(log, drive)
     if rec is None:
         return None
@@ -980,7 +985,8 @@ def _own_signs(
         for i, k in enumerate(g.motors):
             grad = np.array([g.speed[i, 1], g.speed[i, 0], 0.0, 0.0])  # d power / d coef
             power, power_std = float(grad @ g.coef[i]), math.sqrt(grad @ g.cov[i] @ grad)
-            out[k] = (power, power_std, float(g.coef[i, 3]), math.sqrt(g.cov[i][3, 3]))
+            ia, ia_std = float(g.coef[i, 3]), math.sqrt(g.cov[i][3, 3])
+            out[k] = (power, power_std, ia, ia_std, float(g.speed[i, 0]), float(g.speed[i, 1]))
     return out
 
 
@@ -989,15 +995,20 @@ def _comparable(flipped: tuple, right: tuple, share: float) -> bool:
     :func:`_own_signs` values and the signs of its power and inertia) are of about the
     size of another recording's of the right sign (at least ``share`` of them), judged on
     the power where both tell it, else on the inertia."""
-    (p, _, ia, _), sp, si = flipped
-    (q, _, ib, _), sq, sj = right
+    (p, _, ia, *_), sp, si = flipped
+    (q, _, ib, *_), sq, sj = right
     if sp and sq:
         return abs(p) >= share * abs(q)
     return bool(si and sj) and abs(ia) >= share * abs(ib)
 
 
 def opposite_friction_among(
-    robot: Robot, logs: Sequence[TorqueLog], names: Sequence[str], drive: Drive | None = None
+    robot: Robot,
+    logs: Sequence[TorqueLog],
+    names: Sequence[str],
+    drive: Drive | None = None,
+    *,
+    reference: ArrayLike | None = None,
 ) -> str | None:
     """The finding that one recording's torques of a motor (joint) have the opposite sign
     to another recording's, read from the motor's own friction and rotor (:func:`_own_signs`):
@@ -1011,14 +1022,29 @@ def opposite_friction_among(
     sign there, averages that joint's friction to nothing (a current-logged UR5's motor
     4 flipped in one of two recordings: fitted to 9.4 %, its Coulomb friction left out,
     springs suggested). ``logs`` are as recorded (read through ``drive``); the hint is the
-    file's own ``--units`` entry in the log's columns."""
-    if len(logs) < 2 or not np.any(robot.phi):
+    file's own ``--units`` entry in the log's columns.
+
+    ``reference`` (n, 3), a model's own ``fv, fc, Ia`` per motor (joint), where the drive's
+    friction acts [N m s/rad, N m, kg m^2]: each recording is compared with it too, its
+    power at the recording's own speeds (``fc mean|v| + fv mean(v^2)``), so that one
+    recording alone is judged (a model identified on logs of the right sign dissipates
+    where a flipped motor's fitted friction puts energy into the arm)."""
+    if len(logs) < (1 if reference is not None else 2) or not np.any(robot.phi):
         return None
     signs = [_own_signs(robot, log, drive) for log in logs]
+    model = None if reference is None else np.asarray(reference, dtype=np.float64)
     z, share = OWN_TERMS_SIGNIFICANCE, OWN_TERMS_SIZE_SHARE
 
     def sign(x: float, sd: float) -> int:
         return 0 if not abs(x) > z * sd else (1 if x > 0 else -1)
+
+    def of_model(k: int, s: tuple[float, ...]) -> tuple | None:
+        """Motor k of the model at the speeds ``s`` of a recording's terms."""
+        if model is None or k >= model.shape[0]:
+            return None
+        fv, fc, ia = (float(x) for x in model[k])
+        power = fc * s[4] + fv * s[5]
+        return ((power, 0.0, ia, 0.0), sign(power, 0.0), sign(ia, 0.0))
 
     found: dict[int, list[int]] = {}  # recording: its motors of the opposite sign
     for k in range(logs[0].n):
@@ -1030,9 +1056,13 @@ def opposite_friction_among(
         ]
         right = [e for e in each if e is not None and min(e[1:]) >= 0 and max(e[1:]) > 0]
         for r, e in enumerate(each):
-            if e is None or not (max(e[1:]) <= 0 and min(e[1:]) < 0) or not right:
+            if e is None or not (max(e[1:]) <= 0 and min(e[1:]) < 0):
                 continue
-            if any(_comparable(e, o, share) for o in right):
+            mine = signs[r]
+            assert mine is not None  # e is not None
+            own = of_model(k, mine[k])
+            ok = [o for o in (*right, own) if o is not None and min(o[1:]) >= 0 < max(o[1:])]
+            if any(_comparable(e, o, share) for o in ok):
                 found.setdefault(r, []).append(k)
     if not found:
         return None
@@ -1053,13 +1083,109 @@ def opposite_friction_among(
         )
         if said
     )
-    return (
-        f"{names[r]}: the torques of {named} read of the opposite sign to those of "
-        f"{', '.join(others) or 'the other recordings'}: {what}, where in the others they "
-        "are of the right sign (a file logged with another sign convention; the check "
-        "against the model's torques does not tell a joint the links barely load); hint: "
-        f"--units {_flips(motors, names[r])} reads it flipped"
+    against, where = (
+        (f"those of {', '.join(others) or 'the other recordings'}", "in the others they are")
+        if others or model is None
+        else ("the model's", "the model's identified friction and rotor are")
     )
+    return (
+        f"{names[r]}: the torques of {named} read of the opposite sign to {against}: "
+        f"{what}, where {where} of the right sign (a file logged with another sign "
+        "convention; the check "
+        "against the model's torques does not tell a joint the links barely load); hint: "
+        f"--units {_flips(motors, names[r] if len(names) > 1 else None)} reads it flipped"
+    )
+
+
+@dataclass(frozen=True, slots=True)
+class SignFinding:
+    """One recording's sign finding (:func:`recording_sign_findings`).
+
+    Attributes
+    ----------
+    name : str
+        The recording's name (its file).
+    kind : {"reversed", "opposite"}
+        Columns recorded reversed (position and effort, :func:`reversed_joint`), or torques
+        of the opposite sign (:func:`opposite_sign_among`, :func:`opposite_friction_among`).
+    text : str
+        The finding, without the name: the joints (motors) and the ``--units`` entries.
+    """
+
+    name: str
+    kind: str
+    text: str
+
+
+def recording_sign_findings(
+    robot: Robot,
+    logs: Sequence[TorqueLog],
+    names: Sequence[str],
+    drive: Drive | None = None,
+    *,
+    sides: Sequence[TorqueLog] | None = None,
+    reference: ArrayLike | None = None,
+    first: bool = False,
+    among: bool = True,
+) -> tuple[SignFinding, ...]:
+    """The sign checks of several recordings, in the one order ``identify`` refuses by and
+    ``validate`` and ``observe`` judge by: per recording, columns recorded reversed
+    (:func:`reversed_joint`, on the log as recorded through ``drive``), else torques of
+    the opposite sign to the robot's (:func:`opposite_sign_among`, on its joint side,
+    against the others'); then, among the recordings not found so, one whose motor
+    (joint) the links barely load reads of the opposite sign to the others', told by its
+    own friction and rotor (:func:`opposite_friction_among`; against ``reference`` too,
+    a model's ``fv, fc, Ia`` (n, 3), so that one recording alone is judged).
+
+    Parameters
+    ----------
+    robot : Robot
+    logs : sequence of TorqueLog
+        The recordings as recorded (the drive's side and effort), each with enough samples
+        (:func:`too_few_samples`).
+    names : sequence of str
+        One name per recording.
+    drive : Drive, optional
+        What reads ``logs`` (:func:`~dynid.identification.log.joint_side_log`).
+    sides : sequence of TorqueLog, optional
+        The recordings at the joints, when already mapped (default: mapped here).
+    reference : array_like, shape (n, 3), optional
+        As :func:`opposite_friction_among`.
+    first : bool
+        Stop at the first finding (a check that refuses).
+    among : bool
+        Compare the recordings' own friction and rotors (False: logs that may hold
+        contacts, whose external torques the motors' own terms would take for a sign).
+
+    Returns
+    -------
+    tuple of SignFinding
+        In the recordings' order, then the finding among them; empty when all read right.
+    """
+    if sides is None:
+        sides = [joint_side_log(log, drive) for log in logs]
+    out: list[SignFinding] = []
+    for r, (name, log) in enumerate(zip(names, logs, strict=True)):
+        if (mirrored := reversed_joint(robot, log, drive)) is not None:
+            out.append(SignFinding(name, "reversed", mirrored))
+        else:
+            others = (x for i, x in enumerate(sides) if i != r)
+            if (opposite := opposite_sign_among(robot, sides[r], name, others)) is not None:
+                out.append(SignFinding(name, "opposite", opposite))
+        if first and out:
+            return tuple(out)
+    if not among:
+        return tuple(out)
+    said = {f.name for f in out}
+    rest = [r for r, name in enumerate(names) if name not in said]
+    kept = [names[r] for r in rest]
+    found = opposite_friction_among(
+        robot, [logs[r] for r in rest], kept, drive, reference=reference
+    )
+    if found is not None:
+        name = next(n for n in kept if found.startswith(f"{n}: "))
+        out.append(SignFinding(name, "opposite", found.removeprefix(f"{name}: ")))
+    return tuple(out)
 
 
 def _motor_groups(acts: NDArray[np.bool_]) -> list[tuple[list[int], list[int]]]:

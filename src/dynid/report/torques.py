@@ -128,6 +128,12 @@ def validate_answer(run: RunFiles) -> Answer | None:
         if level == "unusable"
         else f"The model predicts the log's torques to {percent(best)}."
     )
+    if isinstance(doc.get("reversed_columns"), dict) and doc["reversed_columns"]:  # likelier
+        files = ", ".join(esc(str(k)) for k in doc["reversed_columns"])
+        head = (
+            f"{files}: columns look recorded reversed (--units flips them; below); as read: "
+            f"{head[0].lower()}{head[1:]}"
+        )
     if isinstance(doc.get("opposite_sign"), dict) and doc["opposite_sign"]:  # the likelier cause
         files = ", ".join(esc(str(k)) for k in doc["opposite_sign"])
         head = (

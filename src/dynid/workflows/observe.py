@@ -615,7 +615,7 @@ def _read_logs(
     check_limits(read, model.robot)
     check_units(read)
     check_derived_velocities(read, cmap)
-    check_signs(read, model.robot)
+    check_signs(read, model.robot, among=opts.calibrate)  # detection logs hold contacts
     check_torque_unit(read, model.robot, cmap)
     return read
 

@@ -50,9 +50,10 @@ from ..exceptions import DataError, DynidWarning, OptionError
 from ..identification.log import DEFAULT_CUTOFF_HZ, TorqueLog, joint_side_log, velocity_note
 from ..identification.pieces import with_start_turns
 from ..identification.sanity import (
+    SignFinding,
     despiked,
     moving_joints,
-    opposite_sign_among,
+    recording_sign_findings,
     sign_confirmed,
     spike_finding,
     time_unit_finding,
@@ -386,35 +387,64 @@ def check_degrees(rec: Recorded, robot: Robot) -> None:
         raise DataError(found[1], file=rec.names[found[0]])
 
 
-def sign_findings(rec: Recorded, robot: Robot, skip: Sequence[str] = ()) -> dict[str, str]:
-    """Per recording (by name), the finding that its (joint-side) torques have the
-    opposite sign to the robot's on every joint gravity loads or on some
-    (:func:`~dynid.identification.sanity.opposite_sign_among`: the joints named and the
-    ``--units`` entries that read them, the recording's own, ``rec2.csv:tau4=-1``, when
-    another reads right); the one rule :func:`check_signs` refuses by and
-    :func:`warn_signs` warns by. Recordings too short to judge and those named in
-    ``skip`` are left out; empty when every recording reads right."""
-    sides = rec.joint_side
-    out: dict[str, str] = {}
-    for k, (name, log) in enumerate(zip(rec.names, sides, strict=True)):
-        if name in skip or too_few_samples(log) is not None:
-            continue
-        others = (x for i, x in enumerate(sides) if i != k)
-        if (opposite := opposite_sign_among(robot, log, name, others)) is not None:
-            out[name] = opposite
-    return out
+def sign_findings(
+    rec: Recorded, robot: Robot, skip: Sequence[str] = (), reference: Any = None
+) -> dict[str, str]:
+    """Per recording (by name), its sign finding, by the one rule ``identify`` refuses by
+    (:func:`~dynid.identification.sanity.recording_sign_findings`): columns recorded
+    reversed (a motor mounted the other way: its position and effort negated), its
+    (joint-side) torques of the opposite sign to the robot's on every joint gravity loads
+    or on some, or a motor (joint) the links barely load of the opposite sign to the other
+    recordings' (and to ``reference``, a model's own ``fv, fc, Ia`` (n, 3), when given),
+    told by its own friction and rotor; each naming the joints (motors) and the
+    ``--units`` entries that read them (the recording's own, ``rec2.csv:tau4=-1``, when
+    another reads right). The one rule :func:`check_signs` refuses by and
+    :func:`warn_signs` warns by. Recordings too short to judge and those named in ``skip``
+    are left out; empty when every recording reads right."""
+    return {f.name: f.text for f in _sign_findings(rec, robot, skip, reference)}
 
 
-def warn_signs(rec: Recorded, robot: Robot, skip: Sequence[str] = ()) -> dict[str, str]:
-    """Warn of each recording whose (joint-side) torques have the opposite sign to the
-    robot's (:func:`sign_findings`, the finding :func:`check_signs` refuses with), naming
-    the file, and return the findings by recording: ``validate`` judges such a log
+def _sign_findings(
+    rec: Recorded,
+    robot: Robot,
+    skip: Sequence[str] = (),
+    reference: Any = None,
+    among: bool = True,
+) -> tuple[SignFinding, ...]:
+    """:func:`sign_findings` as found (``among``: the recordings' own friction compared)."""
+    keep = [
+        k
+        for k, (name, log) in enumerate(zip(rec.names, rec.joint_side, strict=True))
+        if name not in skip and too_few_samples(log) is None
+    ]
+    if not keep:
+        return ()
+    drive = rec.drive if rec.drive is not None and rec.drive.n == robot.n else None
+    return recording_sign_findings(
+        robot,
+        [rec.logs[k] for k in keep],
+        [rec.names[k] for k in keep],
+        drive,
+        sides=[rec.joint_side[k] for k in keep],
+        reference=reference,
+        among=among,
+    )
+
+
+def warn_signs(
+    rec: Recorded, robot: Robot, skip: Sequence[str] = (), reference: Any = None
+) -> tuple[SignFinding, ...]:
+    """Warn of each recording :func:`sign_findings` finds (columns recorded reversed, or
+    torques of the opposite sign; the findings :func:`check_signs` refuses with), naming
+    the file, and return them, each with its kind (``"reversed"`` columns, ``"opposite"``
+    torques): ``validate`` judges such a log
     "unusable" and writes its files, and said only "of another sign?" without the joints
     or the ``--units`` entries that read them. The recordings ``skip`` (by name) are left
-    out (their sign said otherwise: :func:`recorded_sign_map_findings`)."""
-    found = sign_findings(rec, robot, skip)
-    for name, opposite in found.items():
-        warnings.warn(f"{name}: {opposite}", DynidWarning, stacklevel=3)
+    out (their sign said otherwise: :func:`recorded_sign_map_findings`); ``reference``
+    as :func:`sign_findings`."""
+    found = _sign_findings(rec, robot, skip, reference)
+    for f in found:
+        warnings.warn(f"{f.name}: {f.text}", DynidWarning, stacklevel=3)
     return found
 
 
@@ -479,24 +509,26 @@ def _sign_map_finding(name: str, units: str, wrong: list[int], names: Sequence[s
     )
 
 
-def check_signs(rec: Recorded, robot: Robot) -> None:
-    """Refuse a recording whose (joint-side) torques have the opposite sign to the
-    robot's, on every joint gravity loads or on some
-    (:func:`~dynid.identification.sanity.opposite_sign`), as ``identify`` does: thresholds
-    calibrated on it, or residuals of it, would be of the wrong sign.
+def check_signs(rec: Recorded, robot: Robot, *, among: bool = True) -> None:
+    """Refuse a recording :func:`sign_findings` finds (columns recorded reversed, or
+    torques of the opposite sign to the robot's or, on a motor the links barely load, to
+    the other recordings'), as ``identify`` does: thresholds calibrated on it, or
+    residuals of it, would be of the wrong sign. ``among`` False: the recordings' own
+    friction and rotors are not compared (logs that may hold contacts: their external
+    torques go into a motor's own terms, which one log of a push read as a flipped joint 3).
 
     Raises
     ------
     DataError
         Naming the recording, the joints and the remedy (``--units tau=-1``, or the
-        columns to flip; of that recording alone, ``rec2.csv:tau2=-1``, when the others
-        read right).
+        columns to flip, ``q6=-1,tau6=-1`` for a column recorded reversed; of that
+        recording alone, ``rec2.csv:tau2=-1``, when the others read right).
     """
     for name, log in zip(rec.names, rec.joint_side, strict=True):
         if (few := too_few_samples(log)) is not None:  # before the correlations
             raise DataError(few, file=name)
-    for name, opposite in sign_findings(rec, robot).items():
-        raise DataError(opposite, file=name)
+    for f in _sign_findings(rec, robot, among=among):
+        raise DataError(f.text, file=f.name)
 
 
 def check_torque_unit(rec: Recorded, robot: Robot, cmap: ColumnMap | None) -> None:

@@ -66,9 +66,10 @@ from ..identification.low_speed import with_low_speed_hint
 from ..identification.metrics import TorqueErrors
 from ..identification.model import IdentifiedModel
 from ..identification.motion_range import motion_range_hint, with_motion_range_hint
+from ..identification.pieces import check_below_nyquist
 from ..identification.residual_dependence import held_terms, with_dependence_hint
 from ..identification.residual_spring import ResidualSpring
-from ..identification.sanity import SPIKES_BEFORE_JUDGING
+from ..identification.sanity import SPIKES_BEFORE_JUDGING, SignFinding
 from ..identification.verdict import LEVELS, Verdict, with_replaced_spikes
 from ..io.feasible import load_feasible_drive, load_feasible_linear_friction
 from ..io.friction_json import load_friction_json
@@ -205,6 +206,12 @@ class ValidateResult:
         columns to the recordings joined (:func:`~dynid.friction.heldout_torques.
         residual_springs`; its named joints the verdict's reason names with their
         stiffness); None: not judged (a good verdict, or no diagnosis of the residual).
+    reversed_columns : tuple of (str, str)
+        Per recording with columns recorded reversed (a motor or encoder mounted the
+        other way: its position, velocity and effort negated), its name and the finding
+        (the joints or motors and the ``--units`` entries, ``q6=-1,tau6=-1``, in the log's
+        own columns), said at the start of ``verdict``'s reason as ``opposite_sign`` is;
+        empty otherwise.
     """
 
     validation: RecordingsValidation
@@ -223,6 +230,7 @@ class ValidateResult:
     sign_map: str | None = None
     opposite_sign: tuple[tuple[str, str], ...] = ()
     springs: ResidualSpring | None = None
+    reversed_columns: tuple[tuple[str, str], ...] = ()
 
     def metadata(self) -> dict[str, Any]:
         """The keys ``validation.json`` records beside the errors: ``model``,
@@ -233,7 +241,8 @@ class ValidateResult:
         when known), ``sign_map`` (the recorded sign map's finding, when there is one),
         ``opposite_sign`` (by file, the finding that its torques read with the opposite
         sign on some joints or on all, with the ``--units`` that reads them; when there is
-        one),
+        one), ``reversed_columns`` (by file, the finding that columns were recorded
+        reversed, with the ``--units`` that reads them; when there is one),
         ``verdict`` (``level``, ``label``, ``reason``), ``joint_names`` (when known) and
         ``springs`` (the stiffness per joint the residual points to, when judged:
         :meth:`~dynid.identification.residual_spring.ResidualSpring.as_dict`)."""
@@ -260,6 +269,7 @@ class ValidateResult:
             **({"torque_spikes_replaced": spikes} if spikes is not None else {}),
             **({"sign_map": self.sign_map} if self.sign_map is not None else {}),
             **({"opposite_sign": dict(self.opposite_sign)} if self.opposite_sign else {}),
+            **({"reversed_columns": dict(self.reversed_columns)} if self.reversed_columns else {}),
             "verdict": {"level": v.level, "label": v.label, "reason": v.reason},
             **({"springs": self.springs.as_dict()} if self.springs is not None else {}),
         } | ({"joint_names": list(self.joint_names)} if self.joint_names else {})
@@ -382,7 +392,8 @@ def validate_files(
         input_noise_rms=noise.inputs,
         joint_ratios=noise.ratios,
         sign_map=sign_map,
-        opposite_sign=tuple(opposite.items()),
+        opposite_sign=tuple((f.name, f.text) for f in opposite if f.kind == "opposite"),
+        reversed_columns=tuple((f.name, f.text) for f in opposite if f.kind == "reversed"),
         springs=springs,
     )
 
@@ -499,12 +510,20 @@ def _judged(
 
 def _said_signs(
     rec: Recorded, model: IdentifiedModel | Robot, opt: ValidateOptions
-) -> tuple[str | None, dict[str, str]]:
+) -> tuple[str | None, tuple[SignFinding, ...]]:
     """Warn of the recordings whose torques look of the opposite sign: first those for
     which the model's recorded sign map looks wrong
     (:func:`~dynid.workflows.recordings.recorded_sign_map_findings`), then the others
     (:func:`~dynid.workflows.recordings.warn_signs`, the rule ``identify`` and ``observe``
-    refuse by); the former's findings, joined, or None, and the latter's by recording."""
+    refuse by: columns recorded reversed, torques of the opposite sign, a motor of the
+    opposite sign to the other recordings' or to the model's own friction and rotor,
+    :func:`_model_friction`); the former's findings, joined, or None, and the latter's.
+    A cut-off given at or above half the sample rate is refused first
+    (:func:`~dynid.identification.pieces.check_below_nyquist`): the option is at fault,
+    not the data (a short log read a joint reversed before it was refused)."""
+    given = library_cutoff(opt.cutoff_hz, RECORDED)
+    if isinstance(given, int | float):
+        check_below_nyquist(list(rec.logs), float(given))
     robot = model.robot if isinstance(model, IdentifiedModel) else model
     ref = _reference(model) or robot
     recorded = model.info.column_map if isinstance(model, IdentifiedModel) else None
@@ -512,15 +531,38 @@ def _said_signs(
     found = recorded_sign_map_findings(rec, ref, recorded, units)
     for text in found.values():
         warnings.warn(text, DynidWarning, stacklevel=3)
-    opposite = warn_signs(rec, ref, skip=tuple(found))
+    opposite = warn_signs(rec, ref, skip=tuple(found), reference=_model_friction(model, rec.drive))
     return "; ".join(found.values()) or None, opposite
 
 
-def _signs_first(verdict: Verdict, opposite: dict[str, str], sign_map: str | None) -> Verdict:
+def _model_friction(
+    model: IdentifiedModel | Robot, drive: Drive | None
+) -> NDArray[np.float64] | None:
+    """An identified model's own ``fv, fc, Ia`` (n, 3) per motor (joint) where ``drive``
+    puts the friction, the reference a recording's own friction and rotor are compared
+    with (:func:`~dynid.identification.sanity.opposite_friction_among`): its one friction
+    term's viscous and Coulomb coefficients, its rotor inertias (zeros without them);
+    None for a robot, a model of several friction terms, or friction placed elsewhere."""
+    if not isinstance(model, IdentifiedModel) or len(model.frictions) != 1:
+        return None
+    fr = model.frictions[0]
+    at_joints = drive is None or np.allclose(drive.friction_transmission, np.eye(drive.n))
+    coulomb = {"classical": 1, "smooth": 1, "stribeck": 1, "quadratic": 2}.get(fr.law)
+    n = model.robot.n
+    if coulomb is None or (fr.drive is None) != at_joints or fr.params.shape[0] != n:
+        return None
+    ia = model.rotor_inertia
+    ia = np.zeros(n) if ia is None or np.shape(ia) != (n,) else np.asarray(ia)
+    return np.column_stack([fr.params[:, 0], fr.params[:, coulomb], ia])
+
+
+def _signs_first(
+    verdict: Verdict, opposite: Sequence[SignFinding], sign_map: str | None
+) -> Verdict:
     """``verdict`` with the sign findings (:func:`_said_signs`), the likelier causes, at
-    the start of its reason: the recorded sign map's, then each recording's torques of
-    the opposite sign after its name."""
-    for said in ("; ".join(f"{k}: {v}" for k, v in opposite.items()) or None, sign_map):
+    the start of its reason: the recorded sign map's, then each recording's columns
+    recorded reversed or torques of the opposite sign after its name."""
+    for said in ("; ".join(f"{f.name}: {f.text}" for f in opposite) or None, sign_map):
         if said is not None:
             verdict = dataclasses.replace(verdict, reason=f"{said}; {verdict.reason}")
     return verdict
