@@ -352,17 +352,7 @@ def validate_files(
     names = robot.joint_names
     inputs = _input_noise(model, val.friction, val)
     verdict, noise, floor = _judged(val, np.ones(len(val.parts), bool), errors, names, inputs)
-    labels = np.asarray(val.pieces.recording)
-    if len(rec.names) > 1:  # recordings judged apart: the worst named, when they differ
-        each = [
-            _judged(val, labels == r, val.recordings[r].errors, names, inputs)[0]
-            for r in range(len(rec.names))
-        ]
-        rank = [LEVELS.index(v.level) for v in each]
-        r = int(np.argmax(rank))
-        if min(rank) < rank[r] and rank[r] >= LEVELS.index(verdict.level):
-            v = each[r]
-            verdict = Verdict(v.level, v.label, f"{rec.names[r]}: {v.reason}", v.ratio)
+    verdict = _worst_recording(val, verdict, rec.names, names, inputs)
     speeds = _identified_speeds(model)
     dq = [v.log.dq for v in val.parts]
     # a motion beyond the identification's is the likelier cause of what the residual follows
@@ -506,6 +496,31 @@ def _judged(
         opposite=opposite_sign([v.log.tau for v in parts], [v.tau_hat for v in parts]),
     )
     return verdict, _Noise(fl.sensor_rms, fl.input_rms, fl.total_rms, fl.joint_ratios), fl.percent
+
+
+def _worst_recording(
+    val: RecordingsValidation,
+    verdict: Verdict,
+    files: Sequence[str],
+    names: Sequence[str],
+    inputs: list[tuple[int, NDArray[np.float64]]] | None,
+) -> Verdict:
+    """The pooled ``verdict``, or with several recordings (``files``) judged apart the
+    worst one's, named, where they differ and it is at least as bad as the pooled one
+    (``names``: the joints')."""
+    if len(files) < 2:
+        return verdict
+    labels = np.asarray(val.pieces.recording)
+    each = [
+        _judged(val, labels == r, val.recordings[r].errors, names, inputs)[0]
+        for r in range(len(files))
+    ]
+    rank = [LEVELS.index(v.level) for v in each]
+    r = int(np.argmax(rank))
+    if min(rank) < rank[r] and rank[r] >= LEVELS.index(verdict.level):
+        v = each[r]
+        return Verdict(v.level, v.label, f"{files[r]}: {v.reason}", v.ratio)
+    return verdict
 
 
 def _said_signs(
