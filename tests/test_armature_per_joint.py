@@ -105,6 +105,12 @@ def test_a_regrouped_armature_names_the_base_parameter_that_holds_it(logs):
     phi[ia1] = ARMATURE[0]
     np.testing.assert_allclose(model.fit.beta[k], model.base.beta_from_phi(phi)[k], atol=1e-6)
     assert abs(model.fit.beta[k] - without) > 0.29
+    from dynid.cli.summaries import columns_text
+
+    # Ia4, Ia6, Ia7 are base parameters of their own: counted among the base, said so
+    assert f"{model.base.rank} base parameters (3 of them rotor inertias of their own)" in (
+        columns_text(model)
+    )
     lines = "\n".join(term_lines(model))
     legend = next(x for x in lines.splitlines() if "regrouped with link inertias" in x)
     assert f"  1      in {holder}" in lines and holder in legend

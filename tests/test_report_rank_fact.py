@@ -22,3 +22,18 @@ def test_offsets_are_counted_apart_from_friction():
     assert text.count("+ 2 friction + 2 offset") == 1, text
     doc["metadata"]["friction_labels"] = ["fv1", "fc1"]
     assert "+ 2 friction" in _rank_fact(doc)[0] and "offset" not in _rank_fact(doc)[0]
+
+
+def test_rotor_inertias_of_their_own_are_counted_among_the_base_parameters():
+    """A base whose independent columns hold two rotor inertias (``Ia3``, ``Ia4``: not
+    regrouped with a link's) says so beside the count; a regrouped one (dependent) is not
+    counted."""
+    labels = ["m1", "J1zz", "Ia1", "Ia3", "Ia4"]
+    doc = {
+        "coefficients": [{"name": f"beta{k}"} for k in (1, 2, 3, 4)],
+        "rank": 4,
+        "base": {"rank": 4, "std_labels": labels, "independent": [0, 1, 3, 4]},
+        "metadata": {},
+    }
+    text = _rank_fact(doc)[0]
+    assert "4 base parameters (the structural rank of the kinematics; 2 of them rotor" in text

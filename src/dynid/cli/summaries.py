@@ -22,7 +22,7 @@ from ..identification.dissipation import SIGNIFICANCE, negative_viscous
 from ..identification.info import IdentificationInfo, LogInfo
 from ..identification.log import jitter_text
 from ..identification.model import IdentifiedModel
-from ..identification.structure import JOINT_PREFIX, MIN_WIDTH, joint_side_joints
+from ..identification.structure import JOINT_PREFIX, MIN_WIDTH, joint_side_joints, own_rotors
 from ..io.observer_files import log_labels
 from ..observer.calibration_check import CalibrationCheck
 from ..observer.detection import undetected_at_rest
@@ -440,12 +440,14 @@ def columns_text(model: IdentifiedModel) -> str:
                 _KIND_WORDS[t.term.kind]
                 if t.term.kind in _KIND_WORDS
                 else "offset"
-                if label.startswith("fo")  # the offset term's coefficients, fo1 .. fon
+                if label.removeprefix(JOINT_PREFIX).startswith("fo")  # fo1 .. fon, jfo1 ..
                 else "friction"
             )
             counts[what] = counts.get(what, 0) + 1
     said = " and ".join(f"{c} {what}" for what, c in counts.items()) or str(k)
-    cols = f"{r} base parameters" + (f" and {said} columns" if k else "")
+    rotors = len(own_rotors(model.base, model.robot.n))
+    of_them = f" ({rotors} of them rotor inertias of their own)" if rotors else ""
+    cols = f"{r} base parameters{of_them}" + (f" and {said} columns" if k else "")
     return f"columns: {cols}, rank {model.fit.rank} of {r + k}"
 
 

@@ -506,7 +506,14 @@ def _rank_fact(doc: dict) -> tuple[str, list[str]]:
     friction = _get(doc, "metadata", "friction_labels") or []
     columns = len(coefs) + len(friction)
     rank, base = doc.get("rank"), _get(doc, "base", "rank")
-    parts = f"{base} base parameters (the structural rank of the kinematics)"
+    labels, own = _get(doc, "base", "std_labels"), _get(doc, "base", "independent")
+    rotors = (
+        sum(1 for k in own if 0 <= k < len(labels) and str(labels[k]).startswith("Ia"))
+        if isinstance(labels, list) and isinstance(own, list)
+        else 0
+    )
+    of_them = f"; {rotors} of them rotor inertias (armatures) of their own" if rotors else ""
+    parts = f"{base} base parameters (the structural rank of the kinematics{of_them})"
     offsets = [x for x in friction if str(x).rstrip("0123456789").removeprefix("j") == "fo"]
     if len(friction) > len(offsets):
         parts += f" + {len(friction) - len(offsets)} friction"
