@@ -208,6 +208,41 @@ def recordings(
     return logs
 
 
+#: A geared Panda with a coupled wrist (motor 7 turns with joint 6: ``qm7 = 50 q7 + 20
+#: q6``), logged as motor currents: gear ratios, rotor inertias [kg m^2] and torque
+#: constants [N m/A] at the motors, the motors' friction (viscous, Coulomb, offset).
+GEARED_GEARS = np.array([100.0, 100.0, 100.0, 100.0, 80.0, 80.0, 50.0])
+GEARED_ROTORS = np.array([3e-4, 3e-4, 2.5e-4, 2.5e-4, 1e-4, 1e-4, 1e-4])
+GEARED_NOISE = SensorNoise(tau_std=0.05, q_std=1e-5, dq_std=1e-3)
+
+
+def geared_drive() -> Drive:
+    """The geared Panda's true drive (:data:`GEARED_GEARS`, its rotor inertias known)."""
+    return Drive.from_gears(
+        GEARED_GEARS,
+        [(7, 6, 20.0)],
+        side="motor",
+        effort="current",
+        torque_constant=np.full(7, 0.1),
+        rotor_inertia=GEARED_ROTORS,
+    )
+
+
+def geared_recordings(
+    robot: dynid.Robot, seeds: Sequence[int], *, duration: float = 3.0, offset: float = 0.0
+) -> tuple[list[TorqueLog], Drive]:
+    """Noisy motor-side current logs of ``robot`` through :func:`geared_drive`, with motor
+    friction (viscous 2e-3, Coulomb 4e-3, ``offset`` [N m] at each motor) and rotor
+    inertias the description lacks, one per seed; and the drive file's drive they are
+    read through (its rotor inertias to identify)."""
+    from dynid.friction.model import ClassicalFriction
+
+    truth = geared_drive()
+    fr = ClassicalFriction(np.full(7, 2e-3), np.full(7, 4e-3), np.full(7, offset))
+    logs = recordings(robot, seeds, friction=fr, drive=truth, duration=duration, noise=GEARED_NOISE)
+    return logs, dataclasses.replace(truth, rotor_inertia=None)
+
+
 def point_to_point(robot: dynid.Robot, seed: int, fs: float = 500.0) -> Trajectory:
     """Eight moves between random configurations (quintic profiles of 1.2 s), each
     followed by a rest of 1 s: the joints stand still more than a third of the time."""

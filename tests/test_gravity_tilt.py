@@ -23,7 +23,7 @@ from dynid.io.torque_log import save_torque_log
 from dynid.simulation.measurement import SensorNoise
 from dynid.workflows.identify import IdentifyOptions, identify_files
 
-from conftest import random_states, recordings
+from conftest import geared_recordings, random_states, recordings
 
 
 def _rotation(axis: int, a: float) -> np.ndarray:
@@ -170,30 +170,13 @@ def test_a_tilted_geared_arm_with_a_coupled_wrist_is_told_its_tilt(panda):
     springs, the tilt check being run for joint-side torques only. It now reads the tilt
     (0.3 deg within 10 %, the motors' friction and rotors mapped through the drive's
     transmission as the fit maps them); the level arm is not called tilted."""
-    import dataclasses
-
     from dynid.friction.heldout_torques import heldout_torques
     from dynid.identification.classical import identify_from_log
-    from dynid.model.drive import Drive
 
-    gears = np.array([100.0, 100.0, 100.0, 100.0, 80.0, 80.0, 50.0])
-    truth_drive = Drive.from_gears(
-        gears,
-        [(7, 6, 20.0)],
-        side="motor",
-        effort="current",
-        torque_constant=np.full(7, 0.1),
-        rotor_inertia=np.array([3e-4, 3e-4, 2.5e-4, 2.5e-4, 1e-4, 1e-4, 1e-4]),
-    )
-    drive = dataclasses.replace(truth_drive, rotor_inertia=None)  # the drive file's: identify
-    fr = ClassicalFriction(np.full(7, 2e-3), np.full(7, 4e-3), np.full(7, 1e-3))  # at the motors
-    noise = SensorNoise(tau_std=0.05, q_std=1e-5, dq_std=1e-3)
     tilted = panda.with_gravity(_rotation(0, np.radians(0.3)) @ panda.gravity)
     found = {}
     for name, truth in (("tilted", tilted), ("level", panda)):
-        train, held = recordings(
-            truth, (1, 2), friction=fr, drive=truth_drive, duration=5.0, noise=noise
-        )
+        (train, held), drive = geared_recordings(truth, (1, 2), duration=5.0, offset=1e-3)
         with warnings.catch_warnings():
             warnings.simplefilter("ignore", DynidWarning)
             model = identify_from_log(panda, train, drive=drive, validate_on=held)

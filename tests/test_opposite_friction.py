@@ -20,14 +20,8 @@ from dynid.exceptions import DataError
 from dynid.friction.model import ClassicalFriction
 from dynid.identification.recordings import prepare_recordings
 from dynid.identification.sanity import opposite_friction_among
-from dynid.model.drive import Drive
-from dynid.simulation.measurement import SensorNoise
 
-from conftest import recordings
-
-NOISE = SensorNoise(tau_std=0.05, q_std=1e-5, dq_std=1e-3)
-GEARS = np.array([100.0, 100.0, 100.0, 100.0, 80.0, 80.0, 50.0])
-ROTORS = np.array([3e-4, 3e-4, 2.5e-4, 2.5e-4, 1e-4, 1e-4, 1e-4])  # [kg m^2] at the motors
+from conftest import GEARED_NOISE, geared_recordings, recordings
 
 
 def _negated(log, column: int):
@@ -41,17 +35,7 @@ def _negated(log, column: int):
 def geared():
     """Two 3 s motor-side current logs of the geared Panda with its coupled wrist (motor
     friction and rotor inertias the description lacks), and the drive they are read by."""
-    truth = Drive.from_gears(
-        GEARS,
-        [(7, 6, 20.0)],
-        side="motor",
-        effort="current",
-        torque_constant=np.full(7, 0.1),
-        rotor_inertia=ROTORS,
-    )
-    fr = ClassicalFriction(np.full(7, 2e-3), np.full(7, 4e-3), np.zeros(7))
-    logs = recordings(dynid.panda(), (71, 72), friction=fr, drive=truth, duration=3.0, noise=NOISE)
-    return logs, dataclasses.replace(truth, rotor_inertia=None)
+    return geared_recordings(dynid.panda(), (71, 72))
 
 
 def test_a_motor_of_the_opposite_sign_in_one_recording_is_named_with_its_files_entry(geared):
@@ -76,7 +60,7 @@ def test_three_clean_joint_side_recordings_name_nothing_and_a_wrist_flip_is_name
     panda = dynid.panda()
     fr = ClassicalFriction(np.full(7, 0.3), np.full(7, 0.4), np.zeros(7))
     logs = recordings(
-        panda, (81, 82, 83), friction=fr, armature=np.full(7, 0.2), duration=3.0, noise=NOISE
+        panda, (81, 82, 83), friction=fr, armature=np.full(7, 0.2), duration=3.0, noise=GEARED_NOISE
     )
     names = ["a.csv", "b.csv", "c.csv"]
     assert opposite_friction_among(panda, logs, names) is None

@@ -8,8 +8,6 @@ through a drive file's transmission and torque constants.
 
 from __future__ import annotations
 
-import dataclasses
-
 import numpy as np
 import pytest
 
@@ -22,15 +20,8 @@ from dynid.identification.sanity import opposite_sign, reversed_joint
 from dynid.io.columns import load_mapped_torque_log, parse_column_map
 from dynid.io.torque_log import save_torque_log
 from dynid.model.drive import Drive
-from dynid.simulation.measurement import SensorNoise
 
-from conftest import recordings
-
-NOISE = SensorNoise(tau_std=0.05, q_std=1e-5, dq_std=1e-3)
-GEARS = np.array([100.0, 100.0, 100.0, 100.0, 80.0, 80.0, 50.0])
-COUPLING = [(7, 6, 20.0)]  # motor 7 turns with joint 6: qm7 = 50 q7 + 20 q6
-ROTORS = np.array([3e-4, 3e-4, 2.5e-4, 2.5e-4, 1e-4, 1e-4, 1e-4])  # [kg m^2] at the motors
-KT = np.full(7, 0.1)  # [N m/A] at the motors
+from conftest import GEARED_NOISE, geared_recordings, recordings
 
 
 def _negated(log: TorqueLog, motion: list[int], torque: list[int]) -> TorqueLog:
@@ -42,15 +33,10 @@ def _negated(log: TorqueLog, motion: list[int], torque: list[int]) -> TorqueLog:
 
 
 def _geared(seed: int) -> tuple[TorqueLog, Drive]:
-    """A 3 s motor-side log of motor currents of the geared Panda with its coupled wrist
-    (rotor inertias and motor friction the description lacks, noise), and the drive file's
-    drive it is read through (rotor inertias to identify)."""
-    truth = Drive.from_gears(
-        GEARS, COUPLING, side="motor", effort="current", torque_constant=KT, rotor_inertia=ROTORS
-    )
-    fr = ClassicalFriction(np.full(7, 2e-3), np.full(7, 4e-3), np.zeros(7))
-    (log,) = recordings(dynid.panda(), (seed,), friction=fr, drive=truth, duration=3.0, noise=NOISE)
-    return log, dataclasses.replace(truth, rotor_inertia=None)
+    """A 3 s motor-side current log of the geared Panda with its coupled wrist, and the
+    drive file's drive it is read through (:func:`conftest.geared_recordings`)."""
+    (log,), drive = geared_recordings(dynid.panda(), (seed,))
+    return log, drive
 
 
 def test_two_joints_recorded_reversed_are_named_with_one_hint(panda, tmp_path):
@@ -58,7 +44,7 @@ def test_two_joints_recorded_reversed_are_named_with_one_hint(panda, tmp_path):
     both are named, one --units hint lists both, and the log read back through that hint
     is the log as recorded the right way (not questioned); the clean log names nothing."""
     fr = ClassicalFriction(np.full(7, 0.3), np.full(7, 0.4), np.zeros(7))
-    kw = dict(friction=fr, armature=np.full(7, 0.2), duration=3.0, noise=NOISE)
+    kw = dict(friction=fr, armature=np.full(7, 0.2), duration=3.0, noise=GEARED_NOISE)
     (right,) = recordings(panda, (91,), **kw)
     assert reversed_joint(panda, right) is None
     rev = _negated(right, [1, 4], [1, 4])

@@ -19,19 +19,12 @@ import pytest
 
 import dynid
 from dynid.exceptions import DataError, DynidWarning
-from dynid.friction.model import ClassicalFriction
 from dynid.identification.log import TorqueLog
 from dynid.io.torque_log import save_torque_log
-from dynid.model.drive import Drive
-from dynid.simulation.measurement import SensorNoise
 from dynid.workflows.observe import ObserveOptions, observe_files
 from dynid.workflows.validate import ValidateOptions, validate_files
 
-from conftest import recordings
-
-NOISE = SensorNoise(tau_std=0.05, q_std=1e-5, dq_std=1e-3)
-GEARS = np.array([100.0, 100.0, 100.0, 100.0, 80.0, 80.0, 50.0])
-ROTORS = np.array([3e-4, 3e-4, 2.5e-4, 2.5e-4, 1e-4, 1e-4, 1e-4])  # [kg m^2] at the motors
+from conftest import geared_recordings
 
 
 def _negated(log: TorqueLog, motion: list[int], torque: list[int]) -> TorqueLog:
@@ -48,16 +41,7 @@ def geared(tmp_path_factory):
     recorded (clean/a.csv, clean/b.csv), b with motor 5's current negated beside a
     (flip/b.csv, flip/a.csv), a with motor 6 recorded reversed (rev.csv); and the drive
     file's drive (rotor inertias to identify) they are read through."""
-    truth = Drive.from_gears(
-        GEARS,
-        [(7, 6, 20.0)],
-        side="motor",
-        effort="current",
-        torque_constant=np.full(7, 0.1),
-        rotor_inertia=ROTORS,
-    )
-    fr = ClassicalFriction(np.full(7, 2e-3), np.full(7, 4e-3), np.zeros(7))
-    a, b = recordings(dynid.panda(), (71, 72), friction=fr, drive=truth, duration=3.0, noise=NOISE)
+    (a, b), drive = geared_recordings(dynid.panda(), (71, 72))
     d = tmp_path_factory.mktemp("signs")
     for sub in ("clean", "flip"):
         (d / sub).mkdir()
@@ -65,7 +49,7 @@ def geared(tmp_path_factory):
     save_torque_log(d / "clean" / "b.csv", b)
     save_torque_log(d / "flip" / "b.csv", _negated(b, [], [4]))
     save_torque_log(d / "rev.csv", _negated(a, [5], [5]))
-    return d, dataclasses.replace(truth, rotor_inertia=None)
+    return d, drive
 
 
 def _validate(files, drive):
