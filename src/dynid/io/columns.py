@@ -60,7 +60,6 @@ from .torque_log import LABEL_COLUMNS
 
 __all__ = [
     "CURRENT_UNITS",
-    "TORQUE_UNITS",
     "LABEL_COLUMNS",
     "ColumnMap",
     "MappedLog",
@@ -89,8 +88,6 @@ _ANGLE = {"rad": 1.0, "deg": math.pi / 180, "m": 1.0, "mm": 1e-3}
 _TORQUE = {"Nm": 1.0, "N m": 1.0, "N": 1.0, "mNm": 1e-3, "mN m": 1e-3}
 #: Motor currents for ``tau`` [A]: a drive of effort = "current" makes them torques.
 CURRENT_UNITS = {"A": 1.0, "mA": 1e-3}
-#: The torque units ``tau`` may be declared in, each with its factor to N m.
-TORQUE_UNITS = dict(_TORQUE)
 _UNITS: dict[str, dict[str, float]] = {
     "t": _TIME,
     "q": _ANGLE,
@@ -235,7 +232,7 @@ class ColumnMap:
     @property
     def tau_is_torque(self) -> bool:
         """Whether ``tau`` was declared in a torque's unit (``Nm``, ``mNm``)."""
-        return str(self.names.get("tau", "")).strip() in TORQUE_UNITS
+        return str(self.names.get("tau", "")).strip() in _TORQUE
 
     def unit_note(self) -> str | None:
         """One line saying the units declared and their factors (``tau in mA: x 0.001 to

@@ -30,7 +30,6 @@ from ..exceptions import in_file as about_file
 from ..identification.data import StaticDataset
 from ..identification.log import TorqueLog
 from ..io.columns import (
-    TORQUE_UNITS,
     ColumnMap,
     load_column_map,
     load_mapped_static_data,
@@ -387,24 +386,24 @@ def _applies(rec: tuple[Any, Any], files: Sequence[str | Path] | None) -> bool:
     not known, so it may): no when they are only a file's own entries naming none."""
     if files is None or rec[0] is not None:
         return True
-    entries = [u.strip() for u in str(rec[1] or "").split(",") if u.strip()]
-    own = [u.split("=")[0].rsplit(":", 1)[0] for u in entries if ":" in u.split("=")[0]]
-    names = {Path(f).name for f in files}
-    return len(own) < len(entries) or any(f in names for f in own)
+    cmap = parse_column_map(None, rec[1])
+    if cmap.factors or cmap.flips:  # entries for every file
+        return True
+    names = [Path(f).name for f in files]
+    return len(cmap.unknown_files(names)) < len(cmap.file_flips)
 
 
 def _another_file(units: str) -> str:
     """How to read a file unlike the recorded ``units``: SI torques where those declare
     torques in another unit; a file's own entries (``rec2.csv:tau4=-1``) hold for a file
     of that name only."""
-    entries = [u.strip() for u in units.split(",") if u.strip()]
-    own = [u for u in entries if ":" in u.split("=")[0]]
-    scaled = any(
-        u.split("=")[0].strip() == "tau" and u.split("=")[-1] in TORQUE_UNITS for u in entries
-    )
-    said = ["e.g. --units tau=Nm for SI torques"] if scaled else []
-    if own:
-        said.append("a file's own entry, such as " + own[0] + ", holds for a file of that name")
+    cmap = parse_column_map(None, units or None)
+    said = ["e.g. --units tau=Nm for SI torques"] if cmap.tau_is_torque else []
+    if cmap.file_flips:
+        said.append(
+            f"a file's own entries ({', '.join(f'{f}:...' for f in cmap.file_flips)}) hold "
+            "for a file of that name"
+        )
     return "; ".join(said) or "given, they replace the recorded ones"
 
 
