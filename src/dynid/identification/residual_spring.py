@@ -29,6 +29,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from ..regressors.spring import JointSpring
 from .verdict import SYSTEMATIC_RATIO
 
 __all__ = ["FOLLOWS", "SIGNIFICANT", "ResidualSpring", "residual_spring", "spring_columns"]
@@ -100,7 +101,8 @@ class ResidualSpring:
 
 
 def spring_columns(q: ArrayLike) -> NDArray[np.float64]:
-    """The regressor of a linear spring on each joint: ``q_j`` on joint ``j``.
+    """The regressor of a linear spring on each joint: ``q_j`` on joint ``j`` (the spring
+    term's own columns, :class:`~dynid.regressors.spring.JointSpring`, about ``q = 0``).
 
     Parameters
     ----------
@@ -114,7 +116,8 @@ def spring_columns(q: ArrayLike) -> NDArray[np.float64]:
         position, is an offset's).
     """
     q = np.asarray(q, dtype=np.float64)
-    return q[..., :, None] * np.eye(q.shape[-1])
+    term = JointSpring(tuple(np.zeros(q.shape[-1])))  # the spring term, about q = 0
+    return term.torque_columns(q, np.zeros_like(q), np.zeros_like(q))
 
 
 def residual_spring(
