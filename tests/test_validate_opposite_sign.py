@@ -156,3 +156,31 @@ def test_torques_declared_in_n_m_through_a_current_drive_are_refused(panda_logs)
     with pytest.raises(OptionError, match="declares torques, but the drive's effort is 'current'"):
         column_map(None, "tau=Nm", drive=drive)
     assert column_map(None, "tau=mA", drive=drive).factor("tau") == pytest.approx(1e-3)
+
+
+def test_observe_says_a_models_recorded_flip_looks_wrong_for_a_file_read_right(
+    panda_logs, tmp_path
+):
+    """A model identified with ``--units tau4=-1`` (all of its files flipped) observes a log
+    recorded the right way: refused naming the recorded map as wrong for this file, with
+    the --units that reads it without the flip (it asked for ``--units tau4=-1``, the flip
+    already applied), as validate says it."""
+    from dynid.exceptions import DataError
+    from dynid.io.model_json import save_model_json
+    from dynid.workflows.identify import IdentifyOptions, identify_files
+    from dynid.workflows.observe import ObserveOptions, observe_files
+
+    robot, d = panda_logs
+    opts = IdentifyOptions(columns=(None, "tau4=-1"), terms="links")
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", DynidWarning)
+        model = identify_files(robot, d / "flip.csv", opts).model
+    path = save_model_json(tmp_path / "identification.json", model)
+    observe = ObserveOptions(data=(d / "a.csv",), model=path, calibrate=True)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", DynidWarning)
+        with pytest.raises(DataError) as caught:
+            observe_files(observe)
+    said = str(caught.value)
+    assert "the model's recorded sign map (--units tau4=-1) looks wrong" in said, said
+    assert "reads the file without tau4=-1" in said, said

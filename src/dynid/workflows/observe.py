@@ -490,7 +490,7 @@ def observe_files(opts: ObserveOptions, sink: ResidualSink | None = None) -> Obs
     files = data_files(opts.data)
     columns = recorded_columns(recorded, *opts.columns, files)  # (names, units), said once
     cmap = column_map(*columns, drive=model.drive)
-    read = _read_logs(files, model, cmap, opts)
+    read = _read_logs(files, model, cmap, opts, recorded)
     read, _ = despiked_recordings(
         read, model.robot.joint_names, SPIKES_BEFORE_OBSERVER, min_rate_hz=SPIKE_RATE_HZ
     )
@@ -592,12 +592,13 @@ def _read_logs(
     model: ObserverModel,
     cmap: ColumnMap | None,
     opts: ObserveOptions,
+    recorded: Mapping[str, str | None] | None = None,
 ) -> Recorded:
     """The logs ``paths`` read strictly for the model through ``cmap``; a log in other
     units than the others, with joints in degrees, with torques of the opposite sign to the
-    model's or in mN m read as N m refused,
-    and one far outside the joint limits warned about, each naming the file
-    (:mod:`dynid.workflows.recordings`)."""
+    model's or in mN m read as N m refused (the model's ``recorded`` column map, when it
+    looks wrong for a file, named first), and one far outside the joint limits warned
+    about, each naming the file (:mod:`dynid.workflows.recordings`)."""
     logs = [
         read_torque_log(
             p,
@@ -615,7 +616,8 @@ def _read_logs(
     check_limits(read, model.robot)
     check_units(read)
     check_derived_velocities(read, cmap)
-    check_signs(read, model.robot, among=opts.calibrate)  # detection logs hold contacts
+    # detection logs hold contacts; a model's recorded sign map judged first
+    check_signs(read, model.robot, among=opts.calibrate, recorded=recorded, units=opts.columns[1])
     check_torque_unit(read, model.robot, cmap)
     return read
 

@@ -509,13 +509,24 @@ def _sign_map_finding(name: str, units: str, wrong: list[int], names: Sequence[s
     )
 
 
-def check_signs(rec: Recorded, robot: Robot, *, among: bool = True) -> None:
+def check_signs(
+    rec: Recorded,
+    robot: Robot,
+    *,
+    among: bool = True,
+    recorded: Any = None,
+    units: str | None = None,
+) -> None:
     """Refuse a recording :func:`sign_findings` finds (columns recorded reversed, or
     torques of the opposite sign to the robot's or, on a motor the links barely load, to
     the other recordings'), as ``identify`` does: thresholds calibrated on it, or
     residuals of it, would be of the wrong sign. ``among`` False: the recordings' own
     friction and rotors are not compared (logs that may hold contacts: their external
     torques go into a motor's own terms, which one log of a push read as a flipped joint 3).
+    A recording for which the model's recorded sign map (``recorded``, applied without
+    ``units`` given) looks wrong is refused with that finding instead
+    (:func:`recorded_sign_map_findings`: its hint reads the file without the flips; the
+    generic one would ask for the flip already applied).
 
     Raises
     ------
@@ -528,7 +539,8 @@ def check_signs(rec: Recorded, robot: Robot, *, among: bool = True) -> None:
         if (few := too_few_samples(log)) is not None:  # before the correlations
             raise DataError(few, file=name)
     for f in _sign_findings(rec, robot, among=among):
-        raise DataError(f.text, file=f.name)
+        wrong = recorded_sign_map_findings(rec, robot, recorded, units).get(f.name)
+        raise DataError(wrong or f.text, file=f.name)
 
 
 def check_torque_unit(rec: Recorded, robot: Robot, cmap: ColumnMap | None) -> None:
