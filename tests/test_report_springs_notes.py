@@ -173,3 +173,43 @@ def test_a_clean_detection_whose_residual_holds_friction_reads_usable(tmp_path):
         page = render_html_report(RunSummary("observe", notes=notes), files)
         assert f'<section class="verdict {level}" id="verdict">' in page
         assert ("holds joint1 0.23 N m" in _box(page)) == bool(notes)
+
+
+def test_the_identify_badge_tells_the_held_out_verdicts_story_on_a_spring_log(spring_runs):
+    """Regression: a spring outside the model makes the fit extrapolate badly to the time
+    blocks left out (least squares' held-out error over 1.5 x its training error), and the
+    over-fit check set the badge to "poor" beside a headline saying "usable". The badge is
+    the held-out verdict's level, and the check is said as a check of extrapolation that
+    does not set it."""
+    folder = spring_runs[0]
+    held = json.loads((folder / "heldout.json").read_text())
+    ho = json.loads((folder / "identification.json").read_text())["metadata"]["heldout"]
+    assert ho["heldout_error_percent"] > 1.5 * ho["training_error_percent"]  # the case
+    page = (folder / "report.html").read_text()
+    level = re.search(r'<section class="verdict (\w+)" id="verdict">', page)[1]
+    assert level == held["verdict"]["level"], (level, held["verdict"])
+    box = _box(page)
+    assert "the fit over-fits" not in box and "poor: improve the model" not in box, box
+    assert "a check of extrapolation: the time blocks left out are predicted worse" in box
+    assert "it does not set the verdict" in box
+
+
+def test_spikes_replaced_before_the_held_out_verdict_are_said_once(tmp_path):
+    """Regression: the verdict's reason says it was judged with 3 torque spikes replaced
+    and the page said it again as a fact of its own; a reason without it keeps the fact."""
+    reason = (
+        "error 2 % (2 x the noise floor of 1 %); judged with 3 one-sample torque spike(s) "
+        "replaced by the line between their neighbours, as the fit replaced them"
+    )
+    verdict = {"level": "fair", "label": "usable", "reason": reason, "ratio": 2.0}
+    held = {"schema": "dynid-heldout/1", "relative_error_percent": 2.0,
+            "noise_floor_percent": 1.0, "sensor_noise_rms": [0.01], "verdict": verdict,
+            "torque_spikes_replaced": 3, "block": "the last block"}  # fmt: skip
+    ident = {"schema": "dynid-identification/1", "route": "classical", "rank": 1}
+    (tmp_path / "identification.json").write_text(json.dumps(ident))
+    h = tmp_path / "heldout.json"
+    files = {p: tmp_path / p for p in ("identification.json", "heldout.json")}
+    for said, count in ((reason, 1), ("error 2 % (2 x the noise floor of 1 %)", 1)):
+        h.write_text(json.dumps(held | {"verdict": verdict | {"reason": said}}))
+        box = _box(render_html_report(RunSummary(command="identify"), files))
+        assert box.count("3 one-sample torque spike(s) replaced") == count, box

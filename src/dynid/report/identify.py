@@ -116,8 +116,11 @@ def _heldout_facts(
     else:
         at_floor = False
     headline = ""
+    bf = held.get("noise_floor_percent") if held is not None else None
+    floored = judged is not None or (block and is_number(bf) and bf > 0)
     if is_number(train) and is_number(test):
-        fact, more = _overfit_fact(ho, train, test, at_floor, _parameters_per_row(doc))
+        per_row = _parameters_per_row(doc)
+        fact, more = _overfit_fact(ho, train, test, at_floor, per_row, judged=floored)
         facts.append(fact)
         problems += more
         headline = f"The model predicts held-out torques to {percent(test)}"
@@ -170,12 +173,17 @@ def _own_facts(
     said = f"{fact[0].lower()}{fact[1:]}"
     facts = [f"Held-out verdict on {block} (every sample, torques as measured): {said}"]
     spikes = held.get("torque_spikes_replaced")
-    if is_number(spikes) and spikes > 0:
+    if is_number(spikes) and spikes > 0 and SPIKES_SAID not in own.reason:  # said once
         facts.append(f"{int(spikes)} one-sample torque spike(s) replaced, as the fit replaced them")
     low = held.get("low_speed")
     if isinstance(low, str) and low:  # where the rest of the error sits
         facts.append(esc(low[0].upper() + low[1:]))
     return facts, problems, headline
+
+
+#: Words of a verdict's reason that say it was judged with torque spikes replaced
+#: (:func:`~dynid.identification.verdict.with_replaced_spikes`): the page says it once.
+SPIKES_SAID = "torque spike(s) replaced"
 
 
 def _above_noise(held: dict) -> str:
@@ -231,18 +239,32 @@ FEW_PARAMETERS_PER_ROW = 0.01
 
 
 def _overfit_fact(
-    ho: dict, train: float, test: float, at_floor: bool, per_row: float | None = None
+    ho: dict,
+    train: float,
+    test: float,
+    at_floor: bool,
+    per_row: float | None = None,
+    *,
+    judged: bool = False,
 ) -> tuple[str, list[str]]:
     """The training against the held-out error (over-fitting), and its problem. With few
     coefficients per row (``per_row`` below :data:`FEW_PARAMETERS_PER_ROW`) a gap between
     recordings left out in turn is not over-fitting: the recordings hold effects outside
-    the model that differ between them (the held-out error against the floor judges it)."""
+    the model that differ between them (the held-out error against the floor judges it).
+    ``judged``: a held-out verdict against a noise floor is on the page (the headline's);
+    the ratio is then a check of extrapolation to the data left out, which an effect
+    outside the model that changes over time (a spring, a drift) fails as over-fitting
+    does: it is said as that check and leaves the level to the verdict, which has already
+    weighed the held-out error, over-fitting or not (one story on the page)."""
     scheme = {
         "blocks": f"over {ho.get('folds')} contiguous time blocks",
         "recordings": f"leaving out each of {ho.get('folds')} recordings in turn",
     }.get(str(ho.get("scheme")), "on the separate log")
     ratio = test / train if train > 0 else 1.0
     few = per_row is not None and per_row < FEW_PARAMETERS_PER_ROW
+    left_out = {"blocks": "time blocks", "recordings": "recordings"}.get(
+        str(ho.get("scheme")), "data"
+    )
     if ratio <= OVERFIT_GOOD:
         why = "no sign of over-fitting"
     elif few:
@@ -253,14 +275,22 @@ def _overfit_fact(
         )
     elif at_floor:  # the fit follows some noise, and predicts as well as noise allows
         why = "the fit follows some of the noise, yet predicts to the noise floor below"
+    elif judged:  # the verdict judges the model; this checks extrapolation
+        why = (
+            f"a check of extrapolation: the {left_out} left out are predicted worse than "
+            "those fitted, by over-fitting or by an effect outside the model that changes "
+            f"over the {left_out} (the joints named above); it does not set the verdict: "
+            "the held-out verdict in the headline weighs the held-out error against the "
+            "noise floor"
+        )
     else:
         why = "the fit over-fits"
     fact = (
         f"Held-out error of least squares <b>{percent(test)}</b> {esc(scheme)} "
         f"({esc(pooled_label(ho))}), training error {percent(train)} on the same (ratio "
-        f"{ratio:.2f}: {why})"
+        f"{ratio:.2f}: {esc(why)})"
     )
-    if few or at_floor:
+    if few or at_floor or judged:
         return fact, []
     if ratio > OVERFIT_FAIR:
         return fact, ["poor"]
