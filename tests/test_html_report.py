@@ -756,7 +756,7 @@ def test_a_calibration_says_it_calibrated_thresholds_not_that_it_has_no_events(t
     level, text = _verdict_of(page)
     assert "events file" not in text and level == "info", text
     assert text.strip().startswith("thresholds calibrated Thresholds calibrated on 1200"), text
-    assert "free.csv" in text and "above 0.25-0.5 N m is detected while a joint moves" in text
+    assert "free.csv" in text and "above 0.25 to 0.5 N m is detected while a joint moves" in text
 
 
 def test_calibration_thresholds_table_names_its_rows_by_joint(tmp_path):

@@ -194,9 +194,9 @@ def test_the_calibration_report_gives_the_thresholds_at_rest_beside_the_moving_o
     page = render_html_report(RunSummary(command="observe"), {path.name: path})
     box = re.search(r'<section class="verdict \w+" id="verdict">(.*?)</section>', page, re.S)
     text = re.sub(r"<[^>]+>", "", box[1])
-    moving = f"above {th.contact.min():.3g}-{th.contact.max():.3g} N m is detected while a joint"
+    moving = f"above {th.contact.min():.3g} to {th.contact.max():.3g} N m is detected while a joint"
     assert moving in text, text
-    assert f"above {rest.min():.3g}-{rest.max():.3g} N m on a joint at rest" in text, text
+    assert f"above {rest.min():.3g} to {rest.max():.3g} N m on a joint at rest" in text, text
 
 
 def test_the_margin_of_a_coupled_drive_is_taken_at_the_motors():

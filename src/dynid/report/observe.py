@@ -197,7 +197,8 @@ def _numbers(v: Any) -> bool:
 
 
 def _span(v: Any) -> str:
-    return f"{min(v):.3g}-{max(v):.3g}"
+    """``"0.0716 to 1"``: the smallest and largest of ``v`` (a hyphen reads as a minus)."""
+    return f"{min(v):.3g} to {max(v):.3g}"
 
 
 def answer(run: RunFiles) -> Answer | None:
