@@ -67,9 +67,33 @@ def test_the_calibration_report_opens_with_false_alarms_detectable_torques_and_f
     cells = re.findall(r"<tr><td>(joint\d)</td><td>([^<]*)</td>", answer)
     assert [c[0] for c in cells] == [f"joint{j}" for j in range(1, 8)]
     assert [c[1] for c in cells] == [number(x) for x in th["contact"]]  # no uncertainty
-    assert f"above {min(th['contact']):.3g}-{max(th['contact']):.3g} N m" in answer
+    assert f"above {min(th['contact']):.3g} to {max(th['contact']):.3g} N m" in answer
     figure, thresholds = page.index('id="residuals"'), page.index('id="thresholds"')
     assert figure < thresholds and "<img" in page[figure:thresholds]
+
+
+def test_false_alarms_are_counted_without_figures_below_quantile_one(free, tmp_path, capsys):
+    """Regression: --quantile 0.6 with --no-figures wrote false_alarms null (the residual
+    was not kept to count them on). The count is now the events a detection with the
+    thresholds finds on the same log, figures or not, in thresholds.json, the report and
+    the printed summary."""
+    path, log = free
+    base = ["observe", "--params", "panda", "--data", str(path)]
+    cal, det = tmp_path / "cal", tmp_path / "det"
+    args = [*base, "--calibrate", "--margin", "1", "--quantile", "0.6", "--no-figures"]
+    capsys.readouterr()
+    assert main([*args, "--out", str(cal)]) == 0
+    printed = capsys.readouterr().out
+    th = json.loads((cal / "thresholds.json").read_text())
+    args = [*base, "--thresholds", str(cal / "thresholds.json"), "--no-figures"]
+    assert main([*args, "--out", str(det)]) == 0
+    k = len(json.loads((det / "events.json").read_text())["events"])
+    assert k > 0  # the lower quantile leaves samples over the threshold
+    assert th["calibration"]["false_alarms"] == k
+    rate = 60.0 * k / float(log.t[-1] - log.t[0])
+    assert f"{k} false alarm(s) on the calibration logs ({rate:.3g} per minute)" in printed
+    said = f"{k} false alarm{'s' if k != 1 else ''} on them ({rate:.3g} per minute)"
+    assert said in (cal / "report.html").read_text()
 
 
 def test_the_smallest_detectable_torque_grows_with_the_largest_uncertainty():

@@ -38,8 +38,8 @@ class CalibrationCheck:
     duration_s : float
         The calibration logs' total duration [s].
     false_alarms : int or None
-        Events on the calibration logs against their thresholds (None: not counted, the
-        residual not kept with a quantile below 1).
+        Events on the calibration logs against their thresholds (None: not counted;
+        ``dynid observe`` counts them whether or not it keeps the residual).
     sigma_max : ndarray, shape (n,), or None
         The largest ``sigma_j(t)`` over the calibration samples [N m] (None: thresholds
         without the uncertainty).

@@ -103,7 +103,13 @@ from .data_files import (
     read_torque_log,
     recorded_columns,
 )
-from .observe_detect import ResidualSink, contact_labels, detected_log, true_torques
+from .observe_detect import (
+    ResidualSink,
+    contact_labels,
+    counted_events,
+    detected_log,
+    true_torques,
+)
 from .observe_logs import ObservedBlock, PreparedLog, Series, observed_blocks, prepared_log
 from .recordings import (
     Recorded,
@@ -208,8 +214,10 @@ class ObserveOptions:
         When calibrating: keep every log's residual (and its std and margin) in the
         result, for figures. False: only the calibration's running statistics, a block of
         samples at a time (bounded memory on a long log); the result's logs then hold no
-        series. Detecting: False keeps no series (the events, the residual tables of the
-        ``sink`` and the summaries a block at a time); True keeps them too.
+        series, and with a ``quantile`` below 1 the observer runs over the logs a second
+        time, a block at a time, to count the thresholds' false alarms on them.
+        Detecting: False keeps no series (the events, the residual tables of the ``sink``
+        and the summaries a block at a time); True keeps them too.
     figure_points : int, optional
         Detecting: keep every k-th sample of the residual, its thresholds and the true
         torques, at most this many, for a figure (``LogObservation.figure``).
@@ -651,10 +659,14 @@ def _calibrated(
     )
     sigma_max = np.zeros(model.n) if wants_std else None
     r_max = np.zeros(model.n)  # the largest |r| of every log
+    # a quantile below 1 without the series: its false alarms counted on a second pass
+    again: list[PreparedLog] | None = [] if opts.quantile < 1 and not opts.keep_series else None
 
     def blocks() -> Iterator[ObservedBlock]:
         for path, log, side in zip(read.paths, read.logs, read.joint_side, strict=True):
             prep = prepared_log(Path(path), log, model, opts.max_gap, side)
+            if again is not None:
+                again.append(prep)
             keep = Series.new(prep, model.n, wants_std, wants_margin) if opts.keep_series else None
             peak = np.zeros(model.n)
             sign = TorqueSign(model.n)
@@ -714,13 +726,17 @@ def _calibrated(
         collision_factor=opts.collision_factor,
         k_sigma=opts.k_sigma,
     )
+    counted = None
+    if again is not None:  # the observer again, a block at a time: no series kept
+        wants = (wants_std, wants_margin)
+        counted = sum(counted_events(p, model, th, options, wants) for p in again)
     return ObserveResult(
         model,
         th,
         tuple(logs),
         gain_noise=tally.result(),
         unmodelled=None if unmodelled is None else unmodelled.result(),
-        check=_checked(th, logs, sigma_max, r_max),
+        check=_checked(th, logs, sigma_max, r_max, counted),
     )
 
 
@@ -729,12 +745,14 @@ def _checked(
     logs: list[LogObservation],
     sigma_max: NDArray[np.float64] | None,
     peak: NDArray[np.float64],
+    counted: int | None = None,
 ) -> CalibrationCheck:
     """The calibration's false alarms on its own logs (counted on their series when kept;
-    none by construction with the largest ``|r|``) and its smallest detectable torques
+    ``counted`` on a second pass of the observer when not; none by construction with the
+    largest ``|r|``) and its smallest detectable torques
     (:mod:`~dynid.observer.calibration_check`); ``peak`` the largest ``|r|`` [N m]."""
     kept = all(x.r is not None for x in logs)
-    count = None
+    count = counted
     if kept:
         count = calibration_false_alarms(th, ((x.t, x.series, x.std, x.standstill) for x in logs))
     elif th.quantile >= 1.0:

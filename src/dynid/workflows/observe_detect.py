@@ -53,6 +53,7 @@ __all__ = [
     "Labels",
     "ResidualSink",
     "contact_labels",
+    "counted_events",
     "detected_log",
     "observed_wrench",
     "scored",
@@ -215,6 +216,29 @@ def detected_log(
         dropped=det.dropped,
         dropped_count=det.dropped_count,
     )
+
+
+def counted_events(
+    prep: PreparedLog,
+    model: ObserverModel,
+    thresholds: Thresholds,
+    options: ObserverOptions,
+    wants: tuple[bool, bool],
+) -> int:
+    """The events the default rules raise on one prepared log against ``thresholds``, the
+    observer run again a block at a time (``wants`` its std and standstill margin): the
+    count :func:`~dynid.observer.calibration_check.calibration_false_alarms` makes on a
+    kept series, without keeping one (a calibration with a quantile below 1 and no
+    figures)."""
+    det = EventDetector(thresholds)
+    count = 0
+    with about_file(prep.path.name):
+        for blk in observed_rows(prep, model, options, *wants):
+            a, b = blk.a, blk.a + blk.r.shape[0]
+            std = blk.std if thresholds.uses_uncertainty else None
+            still = blk.margin if thresholds.standstill else None
+            count += len(det.feed(prep.log.t[a:b], blk.r, std=std, standstill=still))
+        return count + len(det.finish())
 
 
 def scored(
